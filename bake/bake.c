@@ -1,0 +1,415 @@
+#include "bake.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#include <pmmintrin.h>
+#endif
+
+#include "sampling.h"
+#include "vdsh.h"
+#include "vdsh_sh.h"
+
+#define VB_PI 3.14159265358979323846
+#define BLOCK 16 /* receivers per work item */
+
+double vb_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- ray-offset normals ------------------------------------------------ */
+
+typedef struct pos_key {
+    float p[3];
+    uint32_t index;
+} pos_key;
+
+static int cmp_pos(const void *a, const void *b)
+{
+    const pos_key *x = a, *y = b;
+    int c = memcmp(x->p, y->p, sizeof x->p);
+    if (c)
+        return c;
+    return (x->index > y->index) - (x->index < y->index);
+}
+
+vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err)
+{
+    uint32_t n = m->vertex_count;
+    pos_key *key = malloc((size_t)n * sizeof *key + 1);
+    if (!key)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    for (uint32_t i = 0; i < n; i++) {
+        for (int c = 0; c < 3; c++) /* + 0.0f folds -0 into +0 */
+            key[i].p[c] = m->positions[3 * (size_t)i + c] + 0.0f;
+        key[i].index = i;
+    }
+    /* Sorting by the position's bytes groups bit-identical positions; ties
+     * are ordered by index, so each group's sum runs in a fixed order. */
+    qsort(key, n, sizeof *key, cmp_pos);
+
+    for (uint32_t a = 0; a < n;) {
+        uint32_t b = a + 1;
+        while (b < n && memcmp(key[a].p, key[b].p, sizeof key[a].p) == 0)
+            b++;
+        double s[3] = {0, 0, 0};
+        for (uint32_t k = a; k < b; k++)
+            for (int c = 0; c < 3; c++)
+                s[c] += m->normals[3 * (size_t)key[k].index + c];
+        double len = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+        for (uint32_t k = a; k < b; k++)
+            for (int c = 0; c < 3; c++)
+                out[3 * (size_t)key[k].index + c] =
+                    len > 1e-12 ? (float)(s[c] / len) : 0.0f;
+        a = b;
+    }
+    free(key);
+    return VB_OK;
+}
+
+vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, float *out,
+                         vb_error *err)
+{
+    uint32_t n = m->vertex_count;
+    float *navg = malloc((size_t)n * 3 * sizeof *navg);
+    double *inset = calloc((size_t)n * 4, sizeof *inset); /* x, y, z, weight */
+    if (!navg || !inset) {
+        free(navg);
+        free(inset);
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for ray origins");
+    }
+    vb_result r = vb_offset_normals(m, navg, err);
+    if (r != VB_OK) {
+        free(navg);
+        free(inset);
+        return r;
+    }
+    /* Inset: the mean direction from a vertex to the centroids of its own
+     * triangles, weighted by their distance. Interior vertices' pulls
+     * cancel (length ~0); a vertex on a boundary or crease gets a vector
+     * of length up to 1 pointing into its own surface. */
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *ix = m->indices + 3 * (size_t)t;
+        double c[3] = {0, 0, 0};
+        for (int k = 0; k < 3; k++)
+            for (int i = 0; i < 3; i++)
+                c[i] += m->positions[3 * (size_t)ix[k] + i] / 3.0;
+        for (int k = 0; k < 3; k++) {
+            const float *p = m->positions + 3 * (size_t)ix[k];
+            double d[3] = {c[0] - p[0], c[1] - p[1], c[2] - p[2]};
+            double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            double *a = inset + 4 * (size_t)ix[k];
+            for (int i = 0; i < 3; i++)
+                a[i] += d[i];
+            a[3] += len;
+        }
+    }
+    for (uint32_t v = 0; v < n; v++) {
+        const float *nv = navg + 3 * (size_t)v;
+        const double *a = inset + 4 * (size_t)v;
+        float u[3] = {0, 0, 0};
+        if (a[3] > 0.0) {
+            double dot = (a[0] * nv[0] + a[1] * nv[1] + a[2] * nv[2]);
+            for (int i = 0; i < 3; i++)
+                u[i] = (float)((a[i] - dot * nv[i]) / a[3]);
+        }
+        float p[3], o[3];
+        vb_scene_to_local(s, m->positions + 3 * (size_t)v, p);
+        vb_offset_origin(p, nv, o);
+        vb_offset_origin(o, u, out + 3 * (size_t)v);
+    }
+    free(navg);
+    free(inset);
+    return VB_OK;
+}
+
+/* ---- the trace-and-project loop ----------------------------------------- */
+
+typedef struct job {
+    const vb_bake_desc *d;
+    const vb_dirgrid *grid;
+    const float *origins;  /* per receiver, traced frame */
+    float *coeffs;
+    int ncoef;
+    int order;
+    float max_local;       /* max distance in the traced frame */
+    float inv_scale;
+    float degenerate_dist; /* scene units */
+    int horizon;           /* paper: skip w.n < 0 */
+    _Atomic uint32_t next;
+    _Atomic uint32_t done;
+    _Atomic uint64_t traced, missed;
+    _Atomic uint32_t degenerate, undefined;
+    _Atomic int running;
+    pthread_mutex_t lock;
+    pthread_cond_t cond;
+} job;
+
+static void bake_vertex(job *J, uint32_t v, uint64_t *traced, uint64_t *missed,
+                        uint32_t *degenerate)
+{
+    const vb_bake_desc *d = J->d;
+    const vb_scene *S = d->scene;
+    const float *n = d->receivers->normals + 3 * (size_t)v;
+    const float *org = J->origins + 3 * (size_t)v;
+
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+
+    float acc[VDSH_MAX_COEFFS][VB_PACKET];
+    memset(acc, 0, sizeof acc);
+    uint32_t near_zero = 0, upper = 0;
+
+    for (uint32_t pk = 0; pk < J->grid->packet_count; pk++) {
+        if (J->horizon && vb_dirgrid_packet_below(J->grid, pk, n))
+            continue;
+        struct RTCRayHit16 rh __attribute__((aligned(64)));
+        int valid[VB_PACKET] __attribute__((aligned(64)));
+        vb_dirgrid_packet(J->grid, pk, d->seed, v, n, rh.ray.dir_x, rh.ray.dir_y,
+                          rh.ray.dir_z, valid);
+        int any = 0;
+        for (int k = 0; k < VB_PACKET; k++) {
+            if (J->horizon && valid[k]) {
+                float c = rh.ray.dir_x[k] * n[0] + rh.ray.dir_y[k] * n[1] +
+                          rh.ray.dir_z[k] * n[2];
+                if (c < 0.0f)
+                    valid[k] = 0;
+            }
+            any |= valid[k];
+            rh.ray.org_x[k] = org[0];
+            rh.ray.org_y[k] = org[1];
+            rh.ray.org_z[k] = org[2];
+            rh.ray.tnear[k] = 0.0f;
+            rh.ray.tfar[k] = J->max_local;
+            rh.ray.time[k] = 0.0f;
+            rh.ray.mask[k] = 0xffffffffu;
+            rh.ray.id[k] = (unsigned)k;
+            rh.ray.flags[k] = 0;
+            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        }
+        if (!any)
+            continue;
+        rtcIntersect16(valid, S->scene, &ctx, &rh);
+        for (int k = 0; k < VB_PACKET; k++)
+            *traced += valid[k] != 0;
+        if (d->trace_only)
+            continue;
+
+        float dist[VB_PACKET];
+        for (int k = 0; k < VB_PACKET; k++) {
+            if (!valid[k]) {
+                dist[k] = 0.0f;
+                continue;
+            }
+            int hit = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+            float t = hit ? rh.ray.tfar[k] * J->inv_scale : d->max_distance;
+            dist[k] = t;
+            *missed += !hit;
+            float c = rh.ray.dir_x[k] * n[0] + rh.ray.dir_y[k] * n[1] +
+                      rh.ray.dir_z[k] * n[2];
+            if (c > 0.0f) {
+                upper++;
+                near_zero += t < J->degenerate_dist;
+            }
+        }
+        vdsh_sh_project_soa(J->order, VB_PACKET, rh.ray.dir_x, rh.ray.dir_y,
+                            rh.ray.dir_z, dist, &acc[0][0], VB_PACKET);
+    }
+    if (d->trace_only)
+        return;
+
+    double w = (J->grid->hemisphere ? 2.0 : 4.0) * VB_PI / J->grid->count;
+    float *c = J->coeffs + (size_t)v * J->ncoef;
+    for (int i = 0; i < J->ncoef; i++) {
+        double s = 0.0;
+        for (int k = 0; k < VB_PACKET; k++)
+            s += acc[i][k];
+        c[i] = (float)(s * w);
+    }
+    if (upper > 0 && near_zero >= 0.9 * upper)
+        (*degenerate)++;
+}
+
+static void *worker(void *arg)
+{
+    job *J = arg;
+#if defined(__SSE__)
+    /* Embree's recommendation; set in every worker alike so results do not
+     * depend on which thread baked a vertex. */
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+#endif
+    uint32_t total = J->d->receivers->vertex_count;
+    uint64_t traced = 0, missed = 0;
+    uint32_t degenerate = 0;
+    for (;;) {
+        uint32_t a = atomic_fetch_add(&J->next, BLOCK);
+        if (a >= total)
+            break;
+        uint32_t b = a + BLOCK < total ? a + BLOCK : total;
+        uint64_t before = traced;
+        for (uint32_t v = a; v < b; v++)
+            bake_vertex(J, v, &traced, &missed, &degenerate);
+        atomic_fetch_add(&J->traced, traced - before);
+        atomic_fetch_add(&J->done, b - a);
+    }
+    atomic_fetch_add(&J->missed, missed);
+    atomic_fetch_add(&J->degenerate, degenerate);
+    pthread_mutex_lock(&J->lock);
+    atomic_fetch_sub(&J->running, 1);
+    pthread_cond_signal(&J->cond);
+    pthread_mutex_unlock(&J->lock);
+    return NULL;
+}
+
+void vb_bake_output_free(vb_bake_output *out)
+{
+    if (!out)
+        return;
+    free(out->coeffs);
+    memset(out, 0, sizeof *out);
+}
+
+vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
+                      vb_error *err)
+{
+    vb_bake_desc d = *desc;
+    if (!d.receivers || !d.scene || d.receivers->vertex_count == 0)
+        return vb_fail(err, VB_ERR_ARGUMENT, "nothing to bake: no receivers or no scene");
+    if (d.rays == 0)
+        d.rays = 2500;
+    if (d.max_order == 0)
+        d.max_order = VDSH_MAX_ORDER;
+    if (d.max_order < 1 || d.max_order > VDSH_MAX_ORDER)
+        return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..%d, not %d",
+                       VDSH_MAX_ORDER, d.max_order);
+    if (d.method != VDSH_METHOD_PAPER && d.method != VDSH_METHOD_FULL)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", d.method);
+    if (d.max_distance == 0.0f)
+        d.max_distance = d.scene->diagonal;
+    if (!(d.max_distance > 0.0f) || !isfinite(d.max_distance))
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "max distance must be finite and > 0 (scene diagonal %g)",
+                       (double)d.scene->diagonal);
+    if (d.threads == 0) {
+        long nc = sysconf(_SC_NPROCESSORS_ONLN);
+        d.threads = nc > 0 ? (unsigned)nc : 1;
+    }
+    if (d.threads > 256)
+        d.threads = 256;
+
+    const vb_mesh *R = d.receivers;
+    vb_dirgrid grid = {0};
+    vb_result r = vb_dirgrid_create(d.rays, 0, &grid, err);
+    if (r != VB_OK)
+        return r;
+    int ncoef = d.max_order * d.max_order;
+    float *origins = malloc((size_t)R->vertex_count * 3 * sizeof *origins);
+    float *coeffs = d.trace_only ? NULL
+                                 : malloc((size_t)R->vertex_count * ncoef * sizeof *coeffs);
+    pthread_t *th = calloc(d.threads, sizeof *th);
+    job *J = calloc(1, sizeof *J);
+    if (!origins || (!coeffs && !d.trace_only) || !th || !J) {
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
+                    R->vertex_count);
+        goto done;
+    }
+    r = vb_ray_origins(R, d.scene, origins, err);
+    if (r != VB_OK)
+        goto done;
+
+    J->d = &d;
+    J->grid = &grid;
+    J->origins = origins;
+    J->coeffs = coeffs;
+    J->ncoef = ncoef;
+    J->order = d.max_order;
+    J->max_local = d.max_distance * d.scene->scale;
+    J->inv_scale = 1.0f / d.scene->scale;
+    J->degenerate_dist = 1e-3f * d.scene->diagonal;
+    J->horizon = d.method == VDSH_METHOD_PAPER;
+    pthread_mutex_init(&J->lock, NULL);
+    pthread_cond_init(&J->cond, NULL);
+
+    uint32_t undefined = 0;
+    for (uint32_t v = 0; v < R->vertex_count; v++) {
+        const float *n = R->normals + 3 * (size_t)v;
+        undefined += n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f;
+    }
+
+    double t0 = vb_now();
+    unsigned started = 0;
+    atomic_store(&J->running, (int)d.threads);
+    for (; started < d.threads; started++)
+        if (pthread_create(&th[started], NULL, worker, J) != 0)
+            break;
+    if (started < d.threads)
+        atomic_fetch_sub(&J->running, (int)(d.threads - started));
+    if (started == 0) {
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
+        goto done_sync;
+    }
+
+    pthread_mutex_lock(&J->lock);
+    while (atomic_load(&J->running) > 0) {
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        ts.tv_nsec += 200000000L;
+        if (ts.tv_nsec >= 1000000000L) {
+            ts.tv_sec++;
+            ts.tv_nsec -= 1000000000L;
+        }
+        pthread_cond_timedwait(&J->cond, &J->lock, &ts);
+        if (d.progress && atomic_load(&J->running) > 0) {
+            pthread_mutex_unlock(&J->lock);
+            d.progress(d.progress_user, atomic_load(&J->done), R->vertex_count,
+                       atomic_load(&J->traced));
+            pthread_mutex_lock(&J->lock);
+        }
+    }
+    pthread_mutex_unlock(&J->lock);
+    for (unsigned i = 0; i < started; i++)
+        pthread_join(th[i], NULL);
+    if (d.progress)
+        d.progress(d.progress_user, R->vertex_count, R->vertex_count,
+                   atomic_load(&J->traced));
+
+    vb_bake_output o = {0};
+    o.max_order = d.max_order;
+    o.vertex_count = R->vertex_count;
+    o.coeffs = coeffs;
+    coeffs = NULL;
+    o.rays = grid.count;
+    o.hemisphere = grid.hemisphere;
+    o.max_distance = d.max_distance;
+    o.threads = started;
+    o.rays_traced = atomic_load(&J->traced);
+    o.rays_missed = atomic_load(&J->missed);
+    o.degenerate_receivers = atomic_load(&J->degenerate);
+    o.undefined_normals = undefined;
+    o.seconds = vb_now() - t0;
+    *out = o;
+    r = VB_OK;
+
+done_sync:
+    pthread_cond_destroy(&J->cond);
+    pthread_mutex_destroy(&J->lock);
+done:
+    free(J);
+    free(th);
+    free(coeffs);
+    free(origins);
+    vb_dirgrid_destroy(&grid);
+    return r;
+}

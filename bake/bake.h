@@ -1,0 +1,100 @@
+/*
+ * bake.h - the bake core: for every receiver vertex, trace a jittered
+ * stratified set of rays against the occluder scene and project the hit
+ * distances onto real SH (formats/vdsh_sh.h).
+ *
+ * Method `paper` (DESIGN.md section 1): directions over the whole sphere;
+ * those below the receiver's horizon (w.n < 0) count as distance 0 with
+ * the same 4 pi / N weight. They are not traced at all, since their result
+ * is thrown away: about half the rays, for identical coefficients.
+ * Method `full`: every direction of the sphere traced and projected.
+ *
+ * Ray origins (vb_ray_origins): the receiver position in the scene's
+ * normalised frame (scene.h), offset twice with vb_offset_origin: along
+ * the normal averaged over every receiver vertex at the same position, then
+ * along the inset vector into the vertex's own triangles. The first keeps
+ * the unwelded corners of a closed room from leaking rays between their
+ * faces' planes; the second lifts vertices on a boundary off any other
+ * surface whose plane they lie in (a floor's edge on the wall it meets, a
+ * pillar's foot on the floor): without it, half of such a vertex's rays
+ * start on the wall's plane and escape the room. Rays that hit nothing
+ * within max_distance get max_distance.
+ *
+ * Determinism: a receiver's coefficients depend only on (seed, vertex
+ * index, its position/normal, the scene): every per-vertex sum runs in a
+ * fixed order, so the output is bit-identical for any thread count.
+ *
+ * Threads: `threads` workers take blocks of receivers from a shared
+ * counter; the calling thread only reports progress.
+ *
+ * Errors: vb_result. Ownership: vb_bake_output_free frees what
+ * vb_bake_run put into *out (and accepts a zeroed output).
+ */
+#ifndef VB_BAKE_H
+#define VB_BAKE_H
+
+#include <stdint.h>
+
+#include "mesh.h"
+#include "scene.h"
+#include "vb.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct vb_bake_desc {
+    const vb_mesh *receivers;  /* positions and normals (borrowed) */
+    const vb_scene *scene;     /* the occluders (borrowed) */
+    uint32_t rays;             /* directions per receiver; 0: 2500 */
+    uint64_t seed;             /* 0 is a valid seed */
+    float max_distance;        /* clamp; 0: the occluders' bbox diagonal */
+    uint32_t method;           /* vdsh_method; 0 = paper */
+    int max_order;             /* coefficients kept: max_order^2; 0: 5 */
+    unsigned threads;          /* 0: every online core */
+    int trace_only;            /* benchmark: trace the same rays, nothing else */
+    /* Called from the calling thread a few times a second, and once at the
+     * end, with receivers done and rays traced so far. May be NULL. */
+    void (*progress)(void *user, uint32_t done, uint32_t total,
+                     uint64_t rays_traced);
+    void *progress_user;
+} vb_bake_desc;
+
+typedef struct vb_bake_output {
+    int max_order;
+    uint32_t vertex_count;
+    float *coeffs;             /* vertex_count * max_order^2, vertex-major;
+                                  NULL with trace_only */
+    uint32_t rays;             /* directions per receiver actually used */
+    int hemisphere;            /* sampling domain: 0 sphere, 1 hemisphere */
+    float max_distance;        /* the clamp used, scene units */
+    unsigned threads;          /* workers used */
+    uint64_t rays_traced;
+    uint64_t rays_missed;
+    uint32_t degenerate_receivers;
+    uint32_t undefined_normals;
+    double seconds;            /* wall time of the trace-and-project loop */
+} vb_bake_output;
+
+vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
+                      vb_error *err);
+void vb_bake_output_free(vb_bake_output *out);
+
+/* The ray-offset normals: for every receiver vertex, the normalised sum of
+ * the normals of all receiver vertices at bit-identical positions (its own
+ * included). out has 3 * vertex_count floats. */
+vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err);
+
+/* Ray origins in the scene's traced frame for every receiver (3 floats
+ * each), by the rule above. */
+vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, float *out,
+                         vb_error *err);
+
+/* Monotonic wall clock in seconds. */
+double vb_now(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VB_BAKE_H */

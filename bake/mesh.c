@@ -1,0 +1,608 @@
+/*
+ * mesh.c - loading (dispatch, file bytes, validation and cleaning), welding,
+ * normals, appending, bounds and OBJ output for vb_mesh. The OpenMesh side
+ * (reading, refinement) is in mesh_openmesh.cpp, behind mesh.h.
+ */
+#include "mesh.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* ---------------------------------------------------------------------- */
+/* Small helpers                                                          */
+/* ---------------------------------------------------------------------- */
+
+void vb_mesh_free(vb_mesh *m)
+{
+    if (!m)
+        return;
+    free(m->positions);
+    free(m->normals);
+    free(m->indices);
+    memset(m, 0, sizeof *m);
+}
+
+void vb_mesh_bounds(const vb_mesh *m, float min[3], float max[3])
+{
+    for (int k = 0; k < 3; k++)
+        min[k] = max[k] = 0.0f;
+    if (!m || m->vertex_count == 0 || !m->positions)
+        return;
+    for (int k = 0; k < 3; k++)
+        min[k] = max[k] = m->positions[k];
+    for (uint32_t i = 1; i < m->vertex_count; i++) {
+        const float *p = m->positions + 3 * (size_t)i;
+        for (int k = 0; k < 3; k++) {
+            if (p[k] < min[k])
+                min[k] = p[k];
+            if (p[k] > max[k])
+                max[k] = p[k];
+        }
+    }
+}
+
+/* n * size bytes, or NULL when that overflows or malloc fails; never a
+ * zero-byte request (so NULL always means failure). */
+static void *alloc_array(size_t n, size_t size)
+{
+    if (size != 0 && n > SIZE_MAX / size)
+        return NULL;
+    size_t bytes = n * size;
+    return malloc(bytes ? bytes : 1);
+}
+
+/* ---------------------------------------------------------------------- */
+/* Normals                                                                */
+/* ---------------------------------------------------------------------- */
+
+/* Angle-weighted vertex normals (Thürmer and Wüthrich): each triangle adds
+ * its unit normal times its angle at the corner. Unlike area weighting this
+ * does not depend on how a flat region happens to be triangulated, and it
+ * only ever sees the vertex's own triangles, so unwelded hard edges stay
+ * hard. Arithmetic in double: coordinates of 1e5 with millimetre edges
+ * would lose the cross product in float. */
+void vb_mesh_compute_normals(vb_mesh *m)
+{
+    if (!m || !m->positions)
+        return;
+    if (!m->normals) {
+        m->normals = alloc_array(3 * (size_t)m->vertex_count, sizeof(float));
+        if (!m->normals)
+            return;
+    }
+    memset(m->normals, 0, 3 * (size_t)m->vertex_count * sizeof(float));
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *tri = m->indices + 3 * (size_t)t;
+        if (tri[0] >= m->vertex_count || tri[1] >= m->vertex_count || tri[2] >= m->vertex_count)
+            continue;
+        double p[3][3];
+        for (int c = 0; c < 3; c++)
+            for (int k = 0; k < 3; k++)
+                p[c][k] = m->positions[3 * (size_t)tri[c] + (size_t)k];
+        double e1[3], e2[3];
+        for (int k = 0; k < 3; k++) {
+            e1[k] = p[1][k] - p[0][k];
+            e2[k] = p[2][k] - p[0][k];
+        }
+        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
+        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(len > 0.0) || !isfinite(len))
+            continue;
+        for (int k = 0; k < 3; k++)
+            n[k] /= len;
+        for (int c = 0; c < 3; c++) {
+            const double *a = p[c], *b = p[(c + 1) % 3], *d = p[(c + 2) % 3];
+            double u[3], v[3];
+            for (int k = 0; k < 3; k++) {
+                u[k] = b[k] - a[k];
+                v[k] = d[k] - a[k];
+            }
+            double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2],
+                   cz = u[0] * v[1] - u[1] * v[0];
+            double angle = atan2(sqrt(cx * cx + cy * cy + cz * cz), u[0] * v[0] + u[1] * v[1] + u[2] * v[2]);
+            float *out = m->normals + 3 * (size_t)tri[c];
+            for (int k = 0; k < 3; k++)
+                out[k] += (float)(n[k] * angle);
+        }
+    }
+    for (uint32_t i = 0; i < m->vertex_count; i++) {
+        float *out = m->normals + 3 * (size_t)i;
+        double len = sqrt((double)out[0] * out[0] + (double)out[1] * out[1] + (double)out[2] * out[2]);
+        for (int k = 0; k < 3; k++)
+            out[k] = len > 1e-30 ? (float)(out[k] / len) : 0.0f;
+    }
+}
+
+/* ---------------------------------------------------------------------- */
+/* Compaction: drop triangles with a repeated index, then unused vertices  */
+/* ---------------------------------------------------------------------- */
+
+/* Renumbers vertices in their original order. `normals` may be NULL.
+ * Writes *out only on success (its normals then are a copy or zeros). */
+static vb_result compact(uint32_t vertex_count, const float *positions, const float *normals,
+                         uint32_t triangle_count, const uint32_t *indices, vb_mesh *out,
+                         uint32_t *dropped_triangles)
+{
+    vb_mesh res = {0};
+    uint32_t *remap = alloc_array(vertex_count, sizeof(uint32_t));
+    res.indices = alloc_array(3 * (size_t)triangle_count, sizeof(uint32_t));
+    if (!remap || !res.indices) {
+        free(remap);
+        vb_mesh_free(&res);
+        return VB_ERR_OUT_OF_MEMORY;
+    }
+    const uint32_t unused = UINT32_MAX;
+    for (uint32_t i = 0; i < vertex_count; i++)
+        remap[i] = unused;
+    uint32_t kept = 0;
+    for (uint32_t t = 0; t < triangle_count; t++) {
+        const uint32_t *tri = indices + 3 * (size_t)t;
+        if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+            continue;
+        for (int k = 0; k < 3; k++) {
+            remap[tri[k]] = 0;
+            res.indices[3 * (size_t)kept + (size_t)k] = tri[k];
+        }
+        kept++;
+    }
+    uint32_t used = 0;
+    for (uint32_t i = 0; i < vertex_count; i++)
+        if (remap[i] != unused)
+            remap[i] = used++;
+    res.vertex_count = used;
+    res.triangle_count = kept;
+    res.positions = alloc_array(3 * (size_t)used, sizeof(float));
+    res.normals = alloc_array(3 * (size_t)used, sizeof(float));
+    if (!res.positions || !res.normals) {
+        free(remap);
+        vb_mesh_free(&res);
+        return VB_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t i = 0; i < vertex_count; i++) {
+        if (remap[i] == unused)
+            continue;
+        memcpy(res.positions + 3 * (size_t)remap[i], positions + 3 * (size_t)i, 3 * sizeof(float));
+        if (normals)
+            memcpy(res.normals + 3 * (size_t)remap[i], normals + 3 * (size_t)i, 3 * sizeof(float));
+        else
+            memset(res.normals + 3 * (size_t)remap[i], 0, 3 * sizeof(float));
+    }
+    for (size_t j = 0; j < 3 * (size_t)kept; j++)
+        res.indices[j] = remap[res.indices[j]];
+    free(remap);
+    if (dropped_triangles)
+        *dropped_triangles = triangle_count - kept;
+    *out = res;
+    return VB_OK;
+}
+
+/* ---------------------------------------------------------------------- */
+/* Welding                                                                */
+/* ---------------------------------------------------------------------- */
+
+static uint32_t position_key(const float *p, uint32_t bits[3])
+{
+    uint32_t h = 2166136261u;
+    for (int k = 0; k < 3; k++) {
+        float f = p[k] == 0.0f ? 0.0f : p[k];   /* -0 and +0 weld */
+        memcpy(&bits[k], &f, sizeof f);
+        h = (h ^ bits[k]) * 16777619u;
+        h ^= h >> 15;
+    }
+    return h;
+}
+
+vb_result vb_mesh_weld(vb_mesh *m, vb_error *err)
+{
+    if (!m || (m->vertex_count && !m->positions) || (m->triangle_count && !m->indices))
+        return vb_fail(err, VB_ERR_ARGUMENT, "weld: invalid mesh");
+    for (size_t j = 0; j < 3 * (size_t)m->triangle_count; j++)
+        if (m->indices[j] >= m->vertex_count)
+            return vb_fail(err, VB_ERR_INVALID, "weld: triangle %zu: index %u out of range (%u vertices)",
+                           j / 3, m->indices[j], m->vertex_count);
+
+    /* Open addressing keyed by position bits; the first vertex with a
+     * position represents it, so the result does not depend on hashing. */
+    size_t cap = 16;
+    while (cap < 2 * (size_t)m->vertex_count)
+        cap *= 2;
+    uint32_t *slot = alloc_array(cap, sizeof(uint32_t));
+    uint32_t *first = alloc_array(m->vertex_count, sizeof(uint32_t));
+    uint32_t *idx = alloc_array(3 * (size_t)m->triangle_count, sizeof(uint32_t));
+    if (!slot || !first || !idx) {
+        free(slot);
+        free(first);
+        free(idx);
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "weld: out of memory");
+    }
+    for (size_t s = 0; s < cap; s++)
+        slot[s] = UINT32_MAX;
+    for (uint32_t i = 0; i < m->vertex_count; i++) {
+        uint32_t bits[3];
+        size_t s = position_key(m->positions + 3 * (size_t)i, bits) & (cap - 1);
+        for (;;) {
+            if (slot[s] == UINT32_MAX) {
+                slot[s] = i;
+                first[i] = i;
+                break;
+            }
+            uint32_t other[3];
+            position_key(m->positions + 3 * (size_t)slot[s], other);
+            if (memcmp(bits, other, sizeof bits) == 0) {
+                first[i] = slot[s];
+                break;
+            }
+            s = (s + 1) & (cap - 1);
+        }
+    }
+    free(slot);
+    for (size_t j = 0; j < 3 * (size_t)m->triangle_count; j++)
+        idx[j] = first[m->indices[j]];
+    free(first);
+
+    vb_mesh res;
+    vb_result r = compact(m->vertex_count, m->positions, NULL, m->triangle_count, idx, &res, NULL);
+    free(idx);
+    if (r != VB_OK)
+        return vb_fail(err, r, "weld: out of memory");
+    vb_mesh_compute_normals(&res);
+    vb_mesh_free(m);
+    *m = res;
+    return VB_OK;
+}
+
+/* ---------------------------------------------------------------------- */
+/* Append                                                                 */
+/* ---------------------------------------------------------------------- */
+
+vb_result vb_mesh_append(vb_mesh *dst, const vb_mesh *src, vb_error *err)
+{
+    if (!dst || !src || (src->vertex_count && !src->positions) || (src->triangle_count && !src->indices) ||
+        (dst->vertex_count && !dst->positions) || (dst->triangle_count && !dst->indices))
+        return vb_fail(err, VB_ERR_ARGUMENT, "append: invalid mesh");
+    if (src->vertex_count > UINT32_MAX - dst->vertex_count ||
+        src->triangle_count > UINT32_MAX / 3 - dst->triangle_count ||
+        dst->triangle_count > UINT32_MAX / 3)
+        return vb_fail(err, VB_ERR_ARGUMENT, "append: too many vertices or triangles (%u + %u, %u + %u)",
+                       dst->vertex_count, src->vertex_count, dst->triangle_count, src->triangle_count);
+    uint32_t nv = dst->vertex_count + src->vertex_count;
+    uint32_t nt = dst->triangle_count + src->triangle_count;
+    vb_mesh res = {0};
+    res.positions = alloc_array(3 * (size_t)nv, sizeof(float));
+    res.normals = alloc_array(3 * (size_t)nv, sizeof(float));
+    res.indices = alloc_array(3 * (size_t)nt, sizeof(uint32_t));
+    if (!res.positions || !res.normals || !res.indices) {
+        vb_mesh_free(&res);
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "append: out of memory");
+    }
+    res.vertex_count = nv;
+    res.triangle_count = nt;
+    size_t dv = 3 * (size_t)dst->vertex_count, sv = 3 * (size_t)src->vertex_count;
+    if (dv)
+        memcpy(res.positions, dst->positions, dv * sizeof(float));
+    if (sv)
+        memcpy(res.positions + dv, src->positions, sv * sizeof(float));
+    if (dv && dst->normals)
+        memcpy(res.normals, dst->normals, dv * sizeof(float));
+    else
+        memset(res.normals, 0, dv * sizeof(float));
+    if (sv && src->normals)
+        memcpy(res.normals + dv, src->normals, sv * sizeof(float));
+    else
+        memset(res.normals + dv, 0, sv * sizeof(float));
+    size_t di = 3 * (size_t)dst->triangle_count;
+    if (di)
+        memcpy(res.indices, dst->indices, di * sizeof(uint32_t));
+    for (size_t j = 0; j < 3 * (size_t)src->triangle_count; j++)
+        res.indices[di + j] = src->indices[j] + dst->vertex_count;
+    vb_mesh_free(dst);
+    *dst = res;
+    return VB_OK;
+}
+
+/* ---------------------------------------------------------------------- */
+/* OBJ output                                                             */
+/* ---------------------------------------------------------------------- */
+
+vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path, vb_error *err)
+{
+    if (!m || !path || !path[0] || (m->vertex_count && !m->positions) || (m->triangle_count && !m->indices))
+        return vb_fail(err, VB_ERR_ARGUMENT, "write_obj: invalid argument");
+    for (size_t j = 0; j < 3 * (size_t)m->triangle_count; j++)
+        if (m->indices[j] >= m->vertex_count)
+            return vb_fail(err, VB_ERR_INVALID, "%s: triangle %zu: index %u out of range (%u vertices)",
+                           path, j / 3, m->indices[j], m->vertex_count);
+
+    /* The temporary sits next to the target, so rename() replaces the
+     * target atomically (same file system); O_EXCL with pid and counter
+     * keeps concurrent writers apart, and 0666 lets the umask decide the
+     * final permissions as for any other output. */
+    static atomic_uint counter;
+    size_t len = strlen(path);
+    char *tmp = malloc(len + 64);
+    if (!tmp)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    int fd = -1;
+    for (int attempt = 0; attempt < 100 && fd < 0; attempt++) {
+        snprintf(tmp, len + 64, "%s.tmp.%ld.%u", path, (long)getpid(), atomic_fetch_add(&counter, 1u));
+        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
+        if (fd < 0 && errno != EEXIST)
+            break;
+    }
+    if (fd < 0) {
+        int e = errno;
+        free(tmp);
+        return vb_fail(err, VB_ERR_IO, "%s: cannot create a temporary file next to it: %s", path, strerror(e));
+    }
+    FILE *f = fdopen(fd, "w");
+    if (!f) {
+        int e = errno;
+        close(fd);
+        unlink(tmp);
+        free(tmp);
+        return vb_fail(err, VB_ERR_IO, "%s: %s", path, strerror(e));
+    }
+    setvbuf(f, NULL, _IOFBF, 1 << 16);
+
+    /* %.9g: 9 significant digits read back as the same float. */
+    fprintf(f, "# vdsh mesh: %u vertices, %u triangles\n", m->vertex_count, m->triangle_count);
+    for (uint32_t i = 0; i < m->vertex_count; i++) {
+        const float *p = m->positions + 3 * (size_t)i;
+        fprintf(f, "v %.9g %.9g %.9g\n", (double)p[0], (double)p[1], (double)p[2]);
+    }
+    if (m->normals)
+        for (uint32_t i = 0; i < m->vertex_count; i++) {
+            const float *n = m->normals + 3 * (size_t)i;
+            fprintf(f, "vn %.9g %.9g %.9g\n", (double)n[0], (double)n[1], (double)n[2]);
+        }
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *tri = m->indices + 3 * (size_t)t;
+        if (m->normals)
+            fprintf(f, "f %u//%u %u//%u %u//%u\n", tri[0] + 1, tri[0] + 1, tri[1] + 1, tri[1] + 1,
+                    tri[2] + 1, tri[2] + 1);
+        else
+            fprintf(f, "f %u %u %u\n", tri[0] + 1, tri[1] + 1, tri[2] + 1);
+    }
+
+    int failed = ferror(f) || fflush(f) != 0 || fsync(fileno(f)) != 0;
+    int e = errno;
+    if (fclose(f) != 0 && !failed) {
+        failed = 1;
+        e = errno;
+    }
+    if (!failed && rename(tmp, path) != 0) {
+        failed = 1;
+        e = errno;
+    }
+    if (failed) {
+        unlink(tmp);
+        free(tmp);
+        return vb_fail(err, VB_ERR_IO, "%s: cannot write: %s", path, strerror(e));
+    }
+    free(tmp);
+    return VB_OK;
+}
+
+/* ---------------------------------------------------------------------- */
+/* Loading                                                                */
+/* ---------------------------------------------------------------------- */
+
+static vb_result read_file(const char *path, uint8_t **bytes, size_t *size, vb_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return vb_fail(err, VB_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fileno(f), &st) != 0) {
+        int e = errno;
+        fclose(f);
+        return vb_fail(err, VB_ERR_IO, "%s: cannot stat: %s", path, strerror(e));
+    }
+    if (!S_ISREG(st.st_mode)) {
+        fclose(f);
+        return vb_fail(err, VB_ERR_IO, "%s: not a regular file", path);
+    }
+    if ((uint64_t)st.st_size > (uint64_t)SIZE_MAX - 1) {
+        fclose(f);
+        return vb_fail(err, VB_ERR_IO, "%s: file too large", path);
+    }
+    size_t n = (size_t)st.st_size;
+    uint8_t *buf = malloc(n ? n : 1);
+    if (!buf) {
+        fclose(f);
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory for %zu bytes", path, n);
+    }
+    size_t got = n ? fread(buf, 1, n, f) : 0;
+    int bad = ferror(f);
+    fclose(f);
+    if (bad || got != n) {
+        free(buf);
+        return vb_fail(err, VB_ERR_IO, "%s: read error (%zu of %zu bytes)", path, got, n);
+    }
+    *bytes = buf;
+    *size = n;
+    return VB_OK;
+}
+
+/* Raw file mesh -> clean vb_mesh (see mesh.h for what clean means). */
+static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mesh_raw *raw,
+                           vb_mesh *out, vb_error *err)
+{
+    /* Vertex numbers in messages as the format counts them. */
+    unsigned base = format == VB_MESH_OBJ ? 1 : 0;
+    for (uint32_t i = 0; i < raw->vertex_count; i++) {
+        const float *p = raw->positions + 3 * (size_t)i;
+        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
+            return vb_fail(err, VB_ERR_INVALID, "%s: vertex %llu has a non-finite coordinate (%g, %g, %g)",
+                           path, (unsigned long long)i + base, (double)p[0], (double)p[1], (double)p[2]);
+    }
+    uint32_t *idx = alloc_array(3 * (size_t)raw->triangle_count, sizeof(uint32_t));
+    if (!idx)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    for (size_t j = 0; j < 3 * (size_t)raw->triangle_count; j++) {
+        int64_t v = raw->indices[j];
+        if (v < 0 || v >= (int64_t)raw->vertex_count) {
+            free(idx);
+            return vb_fail(err, VB_ERR_INVALID, "%s: face %llu: vertex index %lld out of range (%u vertices)",
+                           path, (unsigned long long)raw->faces[j / 3] + base, (long long)v + base,
+                           raw->vertex_count);
+        }
+        idx[j] = (uint32_t)v;
+    }
+
+    vb_mesh m;
+    uint32_t degenerate = 0;
+    vb_result r = compact(raw->vertex_count, raw->positions, NULL, raw->triangle_count, idx, &m, &degenerate);
+    if (r != VB_OK) {
+        free(idx);
+        return vb_fail(err, r, "%s: out of memory", path);
+    }
+    if (m.triangle_count == 0) {
+        free(idx);
+        vb_mesh_free(&m);
+        if (degenerate)
+            return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh (all %u triangles repeat a vertex)", path, degenerate);
+        return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh (no faces)", path);
+    }
+
+    /* File normals only when every vertex kept has one: a mix of given and
+     * computed normals would be inconsistent across the mesh. */
+    int use_file = raw->normals != NULL && raw->has_normal != NULL;
+    if (use_file) {
+        uint32_t next = 0;
+        uint8_t *seen = calloc(raw->vertex_count ? raw->vertex_count : 1, 1);
+        if (!seen) {
+            free(idx);
+            vb_mesh_free(&m);
+            return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+        }
+        for (uint32_t t = 0; t < raw->triangle_count; t++) {
+            const uint32_t *tri = idx + 3 * (size_t)t;
+            if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+                continue;
+            for (int k = 0; k < 3; k++)
+                seen[tri[k]] = 1;
+        }
+        /* compact() numbers kept vertices in their original order */
+        for (uint32_t i = 0; i < raw->vertex_count && use_file; i++) {
+            if (!seen[i])
+                continue;
+            if (!raw->has_normal[i])
+                use_file = 0;
+            else
+                memcpy(m.normals + 3 * (size_t)next++, raw->normals + 3 * (size_t)i, 3 * sizeof(float));
+        }
+        free(seen);
+    }
+    free(idx);
+    if (!use_file)
+        vb_mesh_compute_normals(&m);
+    *out = m;
+    return VB_OK;
+}
+
+/* The built-in scene's source description: its positions and indices as
+ * little-endian 32-bit words, the same bytes on every machine. */
+static vb_result builtin_info(const vb_mesh *m, vb_source_info *info, vb_error *err)
+{
+    size_t words = 3 * (size_t)m->vertex_count + 3 * (size_t)m->triangle_count;
+    uint8_t *buf = alloc_array(words, 4);
+    if (!buf)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "builtin: out of memory");
+    size_t w = 0;
+    for (size_t j = 0; j < 3 * (size_t)m->vertex_count; j++, w++) {
+        uint32_t u;
+        memcpy(&u, &m->positions[j], 4);
+        for (int b = 0; b < 4; b++)
+            buf[4 * w + (size_t)b] = (uint8_t)(u >> (8 * b));
+    }
+    for (size_t j = 0; j < 3 * (size_t)m->triangle_count; j++, w++)
+        for (int b = 0; b < 4; b++)
+            buf[4 * w + (size_t)b] = (uint8_t)(m->indices[j] >> (8 * b));
+    info->size = (uint64_t)words * 4;
+    vb_sha256(buf, words * 4, info->sha256);
+    free(buf);
+    return VB_OK;
+}
+
+static int has_extension(const char *path, const char *ext)
+{
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(path, '.');
+    if (!dot || (slash && dot < slash))
+        return 0;
+    return strcasecmp(dot + 1, ext) == 0;
+}
+
+vb_result vb_mesh_load(const char *path, const vb_load_desc *desc, vb_mesh *out,
+                       vb_source_info *info, vb_error *err)
+{
+    if (!path || !out)
+        return vb_fail(err, VB_ERR_ARGUMENT, "load: NULL path or output");
+    int weld = desc ? desc->weld : 0;
+    vb_mesh m = {0};
+    vb_source_info si;
+    memset(&si, 0, sizeof si);
+    vb_result r;
+
+    if (strncmp(path, "builtin:", 8) == 0) {
+        if (strcmp(path + 8, "room") != 0)
+            return vb_fail(err, VB_ERR_ARGUMENT, "%s: unknown built-in scene (known: builtin:room)", path);
+        r = vb_builtin_room(&m, err);
+        if (r != VB_OK)
+            return r;
+        r = builtin_info(&m, &si, err);
+    } else {
+        vb_mesh_format format;
+        if (has_extension(path, "obj"))
+            format = VB_MESH_OBJ;
+        else if (has_extension(path, "ply"))
+            format = VB_MESH_PLY;
+        else if (has_extension(path, "off"))
+            format = VB_MESH_OFF;
+        else if (has_extension(path, "stl"))
+            format = VB_MESH_STL;
+        else
+            return vb_fail(err, VB_ERR_FORMAT, "%s: unsupported file type (expected .obj, .ply, .off or .stl)", path);
+
+        uint8_t *bytes = NULL;
+        size_t size = 0;
+        r = read_file(path, &bytes, &size, err);
+        if (r != VB_OK)
+            return r;
+        if (size == 0) {
+            free(bytes);
+            return vb_fail(err, VB_ERR_FORMAT, "%s: empty file", path);
+        }
+        si.size = size;
+        vb_sha256(bytes, size, si.sha256);
+
+        vb_mesh_raw raw;
+        memset(&raw, 0, sizeof raw);
+        r = vb_mesh_read_openmesh(path, format, bytes, size, &raw, err);
+        free(bytes);
+        if (r != VB_OK)
+            return r;
+        r = clean_raw(path, format, &raw, &m, err);
+        vb_mesh_raw_free(&raw);
+    }
+    if (r == VB_OK && weld)
+        r = vb_mesh_weld(&m, err);
+    if (r != VB_OK) {
+        vb_mesh_free(&m);
+        return r;
+    }
+    *out = m;
+    if (info)
+        *info = si;
+    return VB_OK;
+}

@@ -1,0 +1,190 @@
+/*
+ * mesh.h - triangle meshes for the baker: loading OBJ/PLY/OFF/STL (through
+ * OpenMesh, behind this C header), the built-in procedural scenes, welding,
+ * normals, receiver refinement and OBJ output.
+ *
+ * Does not: trace rays or know about SH. Only mesh_openmesh.cpp includes
+ * OpenMesh, and it lets no C++ exception escape.
+ *
+ * Usage (tests/test_mesh.c is a compiled example):
+ *
+ *     vb_mesh m = {0};
+ *     vb_source_info info;
+ *     vb_load_desc desc = {0};                (zero = documented defaults)
+ *     if (vb_mesh_load("scene.obj", &desc, &m, &info, &err) != VB_OK) ...
+ *     vb_mesh fine = {0};
+ *     vb_mesh_refine(&m, 0.2f, &fine, &err);  (receivers: no edge > 0.2)
+ *     vb_mesh_free(&fine); vb_mesh_free(&m);
+ *
+ * Scene names: a path ending in .obj/.ply/.off/.stl (case-insensitive), or
+ * "builtin:room" - the procedural paper-style room (19 x 6 x 19 m, y up,
+ * boxes, pillars and a sphere; coarse triangles; refine with
+ * vb_mesh_refine to make it dense: max edge 0.2 gives the paper-sized
+ * ~57k receivers).
+ *
+ * Loaded meshes are clean: triangles only (polygons fan-triangulated),
+ * every index < vertex_count, no unreferenced vertices, every coordinate
+ * finite, normals unit length or (0,0,0) where undefined (a vertex whose
+ * faces all have zero area). Vertex normals come from the file when it has
+ * them for every vertex, else are computed (angle-weighted face normals
+ * over the vertex's own faces, so unwelded hard edges stay hard).
+ * Triangles with a repeated index are dropped (they have no area and no
+ * effect on rays); zero-area triangles with distinct indices are kept.
+ *
+ * Files are read once (the same bytes are hashed for vb_source_info and
+ * checked by a strict pre-pass), then parsed by OpenMesh's readers into a
+ * plain array collector (no half-edge structure, so non-manifold and
+ * duplicate faces are kept as they are: nothing in the file is lost). The
+ * pre-pass rejects what OpenMesh would silently skip or misread: numbers
+ * that do not parse or are NaN/Inf, faces with fewer than 3 vertices,
+ * out-of-range indices, truncated files, counts that do not fit the file,
+ * PLY list properties OpenMesh cannot skip. Counts are cross-checked after
+ * OpenMesh has read the file. OBJ: negative (relative) indices and TABs are
+ * fine; materials and texture coordinates are ignored. STL: OpenMesh's
+ * reader itself merges vertices with identical positions and drops
+ * triangles that then repeat a vertex, with or without `weld`.
+ *
+ * Errors: vb_result; messages name the file and the problem ("x.obj: line
+ * 12: face index 40 out of range (30 vertices)", "x.ply: empty mesh").
+ * Element numbers follow the format's own convention: 1-based for OBJ
+ * (with the line), 0-based for PLY and OFF.
+ *
+ * Ownership: a vb_mesh owns its arrays; vb_mesh_free() frees them and
+ * zeroes the struct; it accepts a zeroed or half-built mesh. Functions that
+ * produce a mesh write *out only on success. Input meshes may have
+ * normals == NULL (treated as undefined normals).
+ *
+ * Threading: no shared state in this module; calls that use OpenMesh
+ * (vb_mesh_load of a file, vb_mesh_refine) are serialised by one internal
+ * mutex, because OpenMesh's readers and its log streams (omerr, omlog,
+ * which are captured while OpenMesh runs, never printed) are process-wide.
+ */
+#ifndef VB_MESH_H
+#define VB_MESH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "vb.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct vb_mesh {
+    uint32_t vertex_count;
+    uint32_t triangle_count;
+    float *positions;      /* 3 * vertex_count */
+    float *normals;        /* 3 * vertex_count; unit, or 0,0,0 = undefined */
+    uint32_t *indices;     /* 3 * triangle_count */
+} vb_mesh;
+
+typedef struct vb_load_desc {
+    int weld;              /* 1: merge vertices with bit-identical positions
+                              (-0 and +0 count as equal; normals then
+                              recomputed); 0 (default): keep the file's
+                              vertices */
+} vb_load_desc;
+
+/* What a loaded source was, for the .vdsh SRCS chunk. */
+typedef struct vb_source_info {
+    uint64_t size;         /* bytes of the file (or of the built-in arrays) */
+    uint8_t sha256[32];
+} vb_source_info;
+
+/* Load one file or built-in scene. `info` may be NULL. */
+vb_result vb_mesh_load(const char *path, const vb_load_desc *desc,
+                       vb_mesh *out, vb_source_info *info, vb_error *err);
+
+/* The built-in room, coarse (before refinement). */
+vb_result vb_builtin_room(vb_mesh *out, vb_error *err);
+
+/* Append src to dst (indices offset); dst may be zeroed (empty). */
+vb_result vb_mesh_append(vb_mesh *dst, const vb_mesh *src, vb_error *err);
+
+/* Merge vertices with bit-identical positions (-0 == +0), keeping the
+ * first of each in order; drop triangles that then repeat a vertex and
+ * vertices no longer used; recompute normals. On failure (out of memory)
+ * m is unchanged. */
+vb_result vb_mesh_weld(vb_mesh *m, vb_error *err);
+
+/* Recompute angle-weighted vertex normals from the triangles. */
+void vb_mesh_compute_normals(vb_mesh *m);
+
+/* Receiver refinement: split edges longer than max_edge (OpenMesh) until
+ * none is; conforming (both triangles of an edge are split), deterministic,
+ * no edge split that is already short enough. Original vertices keep their
+ * indices; new vertices follow, with normals interpolated from the split
+ * edge's ends and renormalised ((0,0,0) if they cancel). max_edge <= 0
+ * copies the mesh.
+ *
+ * Longest edge first: the edge split next is the longest one left (ties:
+ * lowest OpenMesh edge index), its length re-checked when it is taken, and
+ * it is cut at its midpoint; each split halves the edge and joins the
+ * midpoint to the opposite corner of each triangle on it. A mesh whose
+ * edges are already <= max_edge comes back unchanged.
+ *
+ * Non-manifold input: a triangle OpenMesh's half-edge structure refuses
+ * (third face on an edge, opposite orientation, complex vertex) is added
+ * with its own copies of its three vertices (as OpenMesh's ImporterT does);
+ * the copies are mapped back to the original indices afterwards and
+ * midpoints of the same original edge are merged, so the output stays
+ * conforming and no triangle is lost. Triangles that repeat a vertex index
+ * have no area and are dropped.
+ *
+ * Errors: VB_ERR_ARGUMENT for a NaN max_edge or when the result would need
+ * more than 2^24 vertices; VB_ERR_INVALID for an index out of range or a
+ * non-finite position. */
+vb_result vb_mesh_refine(const vb_mesh *in, float max_edge, vb_mesh *out,
+                         vb_error *err);
+
+/* Write as OBJ (v, vn, f with v//vn; no vn when normals == NULL), with
+ * enough digits (%.9g) that reading it back gives the same floats.
+ * Atomically: a temporary file in the same directory, renamed over `path`
+ * when complete; on failure no partial file is left and `path` keeps its
+ * old content. */
+vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path,
+                            vb_error *err);
+
+/* Axis-aligned bounds of all vertices; min = max = (0,0,0) when empty. */
+void vb_mesh_bounds(const vb_mesh *m, float min[3], float max[3]);
+
+void vb_mesh_free(vb_mesh *m);
+
+/* SHA-256 of a byte buffer (used for source hashes). */
+void vb_sha256(const void *data, size_t size, uint8_t out[32]);
+
+/* ---- Internal: between mesh.c and mesh_openmesh.cpp only. ------------ */
+
+typedef enum vb_mesh_format {
+    VB_MESH_OBJ,
+    VB_MESH_PLY,
+    VB_MESH_OFF,
+    VB_MESH_STL
+} vb_mesh_format;
+
+/* A file as OpenMesh read it, before validation and cleaning: polygons
+ * fan-triangulated, indices exactly as read (possibly out of range), file
+ * normals averaged per vertex. All arrays are malloc'ed. */
+typedef struct vb_mesh_raw {
+    uint32_t vertex_count;
+    uint32_t triangle_count;
+    float *positions;      /* 3 * vertex_count */
+    float *normals;        /* 3 * vertex_count or NULL (file has none) */
+    uint8_t *has_normal;   /* vertex_count or NULL: file gave a normal */
+    int64_t *indices;      /* 3 * triangle_count */
+    uint32_t *faces;       /* triangle_count: 0-based polygon in the file */
+} vb_mesh_raw;
+
+/* Check `bytes` (the whole file) and read `path` with OpenMesh. */
+vb_result vb_mesh_read_openmesh(const char *path, vb_mesh_format format,
+                                const uint8_t *bytes, size_t size,
+                                vb_mesh_raw *out, vb_error *err);
+
+void vb_mesh_raw_free(vb_mesh_raw *raw);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VB_MESH_H */

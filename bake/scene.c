@@ -1,0 +1,128 @@
+#include "scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void on_embree_error(void *user, enum RTCError code, const char *str)
+{
+    vb_scene *s = user;
+    snprintf(s->embree_error, sizeof s->embree_error, "Embree error %d: %s",
+             (int)code, str ? str : "(no message)");
+}
+
+void vb_scene_destroy(vb_scene *s)
+{
+    if (!s)
+        return;
+    if (s->scene)
+        rtcReleaseScene(s->scene);
+    if (s->device)
+        rtcReleaseDevice(s->device);
+    free(s);
+}
+
+vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc,
+                          vb_scene **out, vb_error *err)
+{
+    vb_scene_desc d = desc ? *desc : (vb_scene_desc){0};
+    if (!occ || occ->triangle_count == 0)
+        return vb_fail(err, VB_ERR_INVALID, "no occluder triangles");
+
+    vb_scene *s = calloc(1, sizeof *s);
+    if (!s)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    s->vertex_count = occ->vertex_count;
+    s->triangle_count = occ->triangle_count;
+    vb_mesh_bounds(occ, s->bounds_min, s->bounds_max);
+    double diag2 = 0.0, extent = 0.0;
+    for (int i = 0; i < 3; i++) {
+        double e = (double)s->bounds_max[i] - s->bounds_min[i];
+        diag2 += e * e;
+        extent = fmax(extent, e);
+        s->centre[i] = (float)(0.5 * ((double)s->bounds_min[i] + s->bounds_max[i]));
+    }
+    s->diagonal = (float)sqrt(diag2);
+    /* Largest power of two with extent * scale <= 2: local coordinates in
+     * [-1, 1]. A zero extent (all points equal) keeps scale 1. */
+    s->scale = 1.0f;
+    if (extent > 0.0) {
+        int e2;
+        frexp(extent, &e2); /* extent = m * 2^e2, m in [0.5, 1) */
+        s->scale = ldexpf(1.0f, 1 - e2);
+    }
+
+    char config[64];
+    snprintf(config, sizeof config, "threads=%u,verbose=0", d.threads);
+    s->device = rtcNewDevice(config);
+    if (!s->device) {
+        enum RTCError code = rtcGetDeviceError(NULL);
+        vb_scene_destroy(s);
+        return vb_fail(err, VB_ERR_EMBREE, "cannot create Embree device (error %d)",
+                       (int)code);
+    }
+    rtcSetDeviceErrorFunction(s->device, on_embree_error, s);
+
+    s->scene = rtcNewScene(s->device);
+    RTCGeometry geom = s->scene ? rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE) : NULL;
+    float *v = geom ? rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+                                              RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                              occ->vertex_count)
+                    : NULL;
+    unsigned *ix = v ? rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0,
+                                               RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+                                               occ->triangle_count)
+                     : NULL;
+    if (!ix) {
+        if (geom)
+            rtcReleaseGeometry(geom);
+        vb_result r = vb_fail(err, VB_ERR_EMBREE, "cannot create the Embree scene: %s",
+                              s->embree_error[0] ? s->embree_error : "unknown error");
+        vb_scene_destroy(s);
+        return r;
+    }
+    for (uint32_t i = 0; i < occ->vertex_count; i++)
+        vb_scene_to_local(s, occ->positions + 3 * i, v + 3 * i);
+    memcpy(ix, occ->indices, (size_t)occ->triangle_count * 3 * sizeof *ix);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(s->scene, geom);
+    rtcReleaseGeometry(geom);
+    rtcSetSceneFlags(s->scene, d.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
+    rtcSetSceneBuildQuality(s->scene, RTC_BUILD_QUALITY_HIGH);
+    rtcCommitScene(s->scene);
+    if (s->embree_error[0]) {
+        vb_result r = vb_fail(err, VB_ERR_EMBREE, "building the BVH failed: %s",
+                              s->embree_error);
+        vb_scene_destroy(s);
+        return r;
+    }
+    *out = s;
+    return VB_OK;
+}
+
+static inline float as_float(int32_t i)
+{
+    float f;
+    memcpy(&f, &i, sizeof f);
+    return f;
+}
+
+static inline int32_t as_int(float f)
+{
+    int32_t i;
+    memcpy(&i, &f, sizeof i);
+    return i;
+}
+
+void vb_offset_origin(const float p[3], const float n[3], float out[3])
+{
+    const float origin = 1.0f / 32.0f;
+    const float float_scale = 1.0f / 65536.0f;
+    const float int_scale = 256.0f;
+    for (int i = 0; i < 3; i++) {
+        int32_t of = (int32_t)(int_scale * n[i]);
+        float pi = as_float(as_int(p[i]) + (p[i] < 0.0f ? -of : of));
+        out[i] = fabsf(p[i]) < origin ? p[i] + float_scale * n[i] : pi;
+    }
+}

@@ -1,0 +1,70 @@
+/*
+ * scene.h - the occluder scene in Embree 3, in a normalised frame.
+ *
+ * Rays are traced in a frame where the occluders' bounding box is centred
+ * on the origin and scaled by a power of two to about unit size:
+ *     local = (p - centre) * scale,   distance = local distance / scale.
+ * The power of two makes the scaling exact, and the centring keeps the
+ * float coordinates small, so a scene translated to 1e5 or shrunk to 1e-4
+ * is traced with the same relative precision as one at unit size, and the
+ * ray-origin offset (Waechter & Binder, Ray Tracing Gems ch. 6, whose
+ * constants assume unit-sized scenes) means the same thing in every scene.
+ *
+ * Does not: load meshes (mesh.h) or sample directions (sampling.h).
+ *
+ * Errors: vb_result; Embree's own error text is copied into the message.
+ * Ownership: vb_scene_destroy frees a created scene and accepts NULL.
+ * Threading: a created scene may be traced from any number of threads.
+ */
+#ifndef VB_SCENE_H
+#define VB_SCENE_H
+
+#include <embree3/rtcore.h>
+#include <stdint.h>
+
+#include "mesh.h"
+#include "vb.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct vb_scene_desc {
+    int robust;              /* 1: RTC_SCENE_FLAG_ROBUST (default 0) */
+    unsigned threads;        /* Embree build threads; 0 = all cores */
+} vb_scene_desc;
+
+typedef struct vb_scene {
+    RTCDevice device;
+    RTCScene scene;
+    float centre[3];         /* subtracted before scaling */
+    float scale;             /* power of two */
+    float bounds_min[3], bounds_max[3];  /* occluders, scene units */
+    float diagonal;          /* of the bounds, scene units */
+    uint32_t vertex_count, triangle_count;
+    char embree_error[256];  /* last Embree error reported on this device */
+} vb_scene;
+
+vb_result vb_scene_create(const vb_mesh *occluders, const vb_scene_desc *desc,
+                          vb_scene **out, vb_error *err);
+void vb_scene_destroy(vb_scene *s);
+
+/* Scene units to the traced frame (a point, not a direction). */
+static inline void vb_scene_to_local(const vb_scene *s, const float p[3],
+                                     float out[3])
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = (p[i] - s->centre[i]) * s->scale;
+}
+
+/* A ray origin just off the surface at local point p along unit normal n
+ * (Waechter & Binder): a few hundred ulps for coordinates above 1/32,
+ * a fixed 2^-16 below, so the offset grows with the coordinates' float
+ * spacing instead of being a fixed world distance. n = 0 leaves p. */
+void vb_offset_origin(const float p[3], const float n[3], float out[3]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VB_SCENE_H */

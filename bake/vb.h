@@ -1,0 +1,46 @@
+/*
+ * vb.h - result codes and error messages shared by the whole bake module
+ * (prefix vb_): mesh loading, the Embree scene, the bake core, cubemaps,
+ * the evaluator.
+ *
+ * Errors: fallible functions return a vb_result (VB_OK = 0) and, when `err`
+ * is not NULL, write a message naming the file (or the input) and the
+ * problem into err->msg. Outputs are untouched on failure. There is no
+ * global error state.
+ */
+#ifndef VB_H
+#define VB_H
+
+#include <stdarg.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum vb_result {
+    VB_OK = 0,
+    VB_ERR_IO,             /* cannot open, read, write or rename a file */
+    VB_ERR_OUT_OF_MEMORY,
+    VB_ERR_FORMAT,         /* a file's content cannot be parsed / unsupported */
+    VB_ERR_INVALID,        /* parsed but unusable: NaN/Inf, bad index, empty */
+    VB_ERR_EMBREE,         /* Embree device or scene failure */
+    VB_ERR_ARGUMENT        /* bad option value or inconsistent request */
+} vb_result;
+
+const char *vb_result_str(vb_result r);
+
+typedef struct vb_error {
+    char msg[512];
+} vb_error;
+
+/* Format a message into err (if not NULL) and return r. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 3, 4)))
+#endif
+vb_result vb_fail(vb_error *err, vb_result r, const char *fmt, ...);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VB_H */

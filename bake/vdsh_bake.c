@@ -1,0 +1,606 @@
+/*
+ * vdsh-bake - bake visibility-distance SH for a static scene.
+ *
+ * The story of a bake: load every mesh given (they form one scene of
+ * occluders), refine a copy into the receivers, build the BVH, trace and
+ * project, then write the basis cubemaps and, last, the .vdsh file - each
+ * atomically, so an interrupted bake never leaves a partial file behind.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <libgen.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "bake.h"
+#include "cubemap.h"
+#include "mesh.h"
+#include "scene.h"
+#include "vdsh.h"
+
+#define EXIT_USAGE 2
+
+typedef struct options {
+    const char *output;
+    const char *cubemap_dir;
+    const char *report;
+    const char *export_obj;
+    uint32_t rays;
+    int orders[VDSH_MAX_ORDER];
+    int order_count;
+    uint32_t method;
+    uint32_t encoding;
+    float max_distance;
+    float max_edge;
+    int weld;
+    uint64_t seed;
+    unsigned threads;
+    int cube_size;
+    int robust;
+    int record_timings;
+    int trace_only;
+    int quiet;
+} options;
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+"Usage: vdsh-bake [options] MESH... -o OUT.vdsh\n"
+"Bake visibility-distance spherical harmonics for a static scene.\n"
+"\n"
+"MESH is an OBJ, PLY, OFF or STL file, or builtin:room (a procedural\n"
+"19 x 6 x 19 m room). Several meshes form one scene: they occlude each other.\n"
+"Receivers are the mesh vertices (refined with --max-edge); rays are traced\n"
+"against the original triangles.\n"
+"\n"
+"Output:\n"
+"  -o, --output FILE       the .vdsh file to write (atomically)\n"
+"      --cubemap-dir DIR   where the SH basis cubemaps go (default: beside OUT)\n"
+"      --cube-size N       cubemap face size in texels (default 64; 0: none)\n"
+"      --encoding E        coefficient encoding: f16 (default) or f32\n"
+"      --report FILE       write timings and throughput as JSON\n"
+"      --record-timings    also store timings in the .vdsh (the file is then\n"
+"                          no longer byte-identical between runs)\n"
+"      --export-obj FILE   write the receiver mesh as OBJ and exit (no bake)\n"
+"      --trace-only        benchmark: build the BVH and trace the same rays,\n"
+"                          nothing else; no file is written (with --report,\n"
+"                          the bare loop's time is the build + trace time)\n"
+"\n"
+"Bake:\n"
+"      --rays N            directions per receiver, stratified and jittered\n"
+"                          (default 2500 = 50 x 50)\n"
+"      --orders LIST       SH orders to store, order n = n bands = n*n\n"
+"                          coefficients (default 2,3,5; each 1..5)\n"
+"      --method M          paper (default): the paper's fit, directions below\n"
+"                          the horizon count as distance 0; full: the whole\n"
+"                          sphere, no horizon\n"
+"      --max-distance D    clamp distance; misses get it (default: the\n"
+"                          scene's bounding-box diagonal)\n"
+"      --max-edge L        refine receivers until no edge is longer than L\n"
+"                          (default 0: the mesh vertices as they are)\n"
+"      --weld              merge vertices with identical positions\n"
+"      --seed N            seed of every random sequence (default 1)\n"
+"      --robust            Embree's robust traversal (slower)\n"
+"      --threads N         worker threads (default: all cores)\n"
+"\n"
+"  -q, --quiet             no progress or summary on stderr\n"
+"  -h, --help              this text\n"
+"  -V, --version           version\n"
+"\n"
+"Exit status: 0 success, 1 error, 2 usage error.\n"
+"Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n");
+}
+
+static int bad_usage(const char *fmt, const char *arg)
+{
+    fprintf(stderr, "vdsh-bake: ");
+    fprintf(stderr, fmt, arg);
+    fprintf(stderr, "\nTry 'vdsh-bake --help'.\n");
+    return EXIT_USAGE;
+}
+
+static int parse_u64(const char *s, uint64_t max, uint64_t *out)
+{
+    char *end;
+    errno = 0;
+    if (!*s || *s == '-')
+        return 0;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (errno || *end || v > max)
+        return 0;
+    *out = v;
+    return 1;
+}
+
+static int parse_float(const char *s, float *out)
+{
+    char *end;
+    errno = 0;
+    float v = strtof(s, &end);
+    if (errno || end == s || *end || !isfinite(v) || v < 0.0f)
+        return 0;
+    *out = v;
+    return 1;
+}
+
+static int parse_orders(const char *s, options *o)
+{
+    o->order_count = 0;
+    int seen[VDSH_MAX_ORDER + 1] = {0};
+    const char *p = s;
+    while (*p) {
+        if (*p < '1' || *p > '0' + VDSH_MAX_ORDER)
+            return 0;
+        int n = *p++ - '0';
+        if (seen[n] || (*p && *p != ','))
+            return 0;
+        seen[n] = 1;
+        if (*p == ',' && !*++p)
+            return 0;
+    }
+    for (int n = 1; n <= VDSH_MAX_ORDER; n++)
+        if (seen[n])
+            o->orders[o->order_count++] = n;
+    return o->order_count > 0;
+}
+
+/* ---- progress on a terminal -------------------------------------------- */
+
+typedef struct progress {
+    int enabled;
+    double t0;
+} progress;
+
+static void on_progress(void *user, uint32_t done, uint32_t total,
+                        uint64_t traced)
+{
+    progress *p = user;
+    if (!p->enabled)
+        return;
+    double t = vb_now() - p->t0;
+    double frac = total ? (double)done / total : 1.0;
+    double eta = frac > 0.0 ? t * (1.0 - frac) / frac : 0.0;
+    fprintf(stderr, "\r  %5.1f%%  %u/%u receivers  %.1f Mrays/s  ETA %.1f s   ",
+            100.0 * frac, done, total, t > 0 ? traced / t * 1e-6 : 0.0, eta);
+    if (done == total)
+        fputc('\n', stderr);
+    fflush(stderr);
+}
+
+/* ---- output -------------------------------------------------------------- */
+
+static int write_report(const char *path, const options *o, const vdsh_file *f,
+                        const vb_bake_output *b, const vdsh_timings *t,
+                        double write_seconds, size_t coef_bytes,
+                        long long file_size)
+{
+    char tmp[PATH_MAX];
+    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
+        return -1;
+    FILE *fp = fopen(tmp, "w");
+    if (!fp)
+        return -1;
+    fprintf(fp, "{\n  \"output\": \"%s\",\n  \"sources\": [", o->output);
+    for (uint32_t i = 0; i < f->source_count; i++)
+        fprintf(fp, "%s\"%s\"", i ? ", " : "", f->sources[i].name);
+    fprintf(fp, "],\n");
+    fprintf(fp, "  \"receivers\": %u,\n  \"receiver_triangles\": %u,\n",
+            f->header.vertex_count, f->header.triangle_count);
+    fprintf(fp, "  \"occluder_triangles\": %u,\n", f->header.occluder_triangle_count);
+    fprintf(fp, "  \"rays_per_receiver\": %u,\n  \"method\": \"%s\",\n", b->rays,
+            vdsh_method_name(o->method));
+    fprintf(fp, "  \"orders\": [");
+    for (int i = 0; i < o->order_count; i++)
+        fprintf(fp, "%s%d", i ? ", " : "", o->orders[i]);
+    fprintf(fp, "],\n  \"encoding\": \"%s\",\n", vdsh_encoding_name(o->encoding));
+    fprintf(fp, "  \"max_distance\": %.9g,\n  \"max_edge\": %.9g,\n  \"seed\": %llu,\n",
+            (double)b->max_distance, (double)o->max_edge, (unsigned long long)o->seed);
+    fprintf(fp, "  \"threads\": %u,\n  \"robust\": %s,\n", b->threads,
+            o->robust ? "true" : "false");
+    fprintf(fp, "  \"rays_traced\": %llu,\n  \"rays_missed\": %llu,\n",
+            (unsigned long long)b->rays_traced, (unsigned long long)b->rays_missed);
+    fprintf(fp, "  \"degenerate_receivers\": %u,\n  \"undefined_normals\": %u,\n",
+            b->degenerate_receivers, b->undefined_normals);
+    fprintf(fp, "  \"seconds\": {\"load\": %.6f, \"refine\": %.6f, \"build\": %.6f, "
+                "\"trace\": %.6f, \"write\": %.6f, \"total\": %.6f},\n",
+            t->load, t->refine, t->build, t->trace, write_seconds,
+            t->total + write_seconds);
+    fprintf(fp, "  \"mrays_per_second_trace\": %.4f,\n",
+            t->trace > 0 ? b->rays_traced / t->trace * 1e-6 : 0.0);
+    fprintf(fp, "  \"mrays_per_second_total\": %.4f,\n",
+            t->total + write_seconds > 0
+                ? b->rays_traced / (t->total + write_seconds) * 1e-6 : 0.0);
+    fprintf(fp, "  \"coefficient_bytes_per_vertex\": %zu,\n", coef_bytes);
+    fprintf(fp, "  \"file_bytes\": %lld\n}\n", file_size);
+    int bad = ferror(fp);
+    if (fclose(fp) != 0 || bad || rename(tmp, path) != 0) {
+        unlink(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+/* The bare loop's record: what the benchmark compares the bake against. */
+static int write_bare_report(const char *path, const vb_bake_output *b,
+                             const vdsh_timings *t)
+{
+    char tmp[PATH_MAX];
+    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
+        return -1;
+    FILE *fp = fopen(tmp, "w");
+    if (!fp)
+        return -1;
+    fprintf(fp, "{\n  \"trace_only\": true,\n  \"receivers\": %u,\n"
+                "  \"rays_per_receiver\": %u,\n  \"threads\": %u,\n"
+                "  \"rays_traced\": %llu,\n"
+                "  \"seconds\": {\"load\": %.6f, \"refine\": %.6f, \"build\": %.6f, "
+                "\"trace\": %.6f, \"bare\": %.6f}\n}\n",
+            b->vertex_count, b->rays, b->threads, (unsigned long long)b->rays_traced,
+            t->load, t->refine, t->build, t->trace, t->build + t->trace);
+    int bad = ferror(fp);
+    if (fclose(fp) != 0 || bad || rename(tmp, path) != 0) {
+        unlink(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+/* File stem and directory of OUT: "dir/room.vdsh" -> "dir", "room". */
+static void split_output(const char *out, char *dir, char *stem, size_t cap)
+{
+    char a[PATH_MAX], b[PATH_MAX];
+    snprintf(a, sizeof a, "%s", out);
+    snprintf(b, sizeof b, "%s", out);
+    snprintf(dir, cap, "%s", dirname(a));
+    snprintf(stem, cap, "%s", basename(b));
+    size_t n = strlen(stem);
+    if (n > 5 && strcmp(stem + n - 5, ".vdsh") == 0)
+        stem[n - 5] = '\0';
+}
+
+/* ---- main ---------------------------------------------------------------- */
+
+int main(int argc, char **argv)
+{
+    options o = {0};
+    o.rays = 2500;
+    o.orders[0] = 2, o.orders[1] = 3, o.orders[2] = 5, o.order_count = 3;
+    o.method = VDSH_METHOD_PAPER;
+    o.encoding = VDSH_ENCODING_F16;
+    o.seed = 1;
+    o.cube_size = 64;
+
+    enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
+           O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST,
+           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY };
+    static const struct option longopts[] = {
+        {"output", required_argument, 0, 'o'},
+        {"rays", required_argument, 0, O_RAYS},
+        {"orders", required_argument, 0, O_ORDERS},
+        {"method", required_argument, 0, O_METHOD},
+        {"encoding", required_argument, 0, O_ENCODING},
+        {"max-distance", required_argument, 0, O_MAXDIST},
+        {"max-edge", required_argument, 0, O_MAXEDGE},
+        {"weld", no_argument, 0, O_WELD},
+        {"seed", required_argument, 0, O_SEED},
+        {"threads", required_argument, 0, O_THREADS},
+        {"cube-size", required_argument, 0, O_CUBESIZE},
+        {"cubemap-dir", required_argument, 0, O_CUBEDIR},
+        {"robust", no_argument, 0, O_ROBUST},
+        {"report", required_argument, 0, O_REPORT},
+        {"record-timings", no_argument, 0, O_TIMINGS},
+        {"export-obj", required_argument, 0, O_EXPORT},
+        {"trace-only", no_argument, 0, O_TRACE_ONLY},
+        {"quiet", no_argument, 0, 'q'},
+        {"help", no_argument, 0, 'h'},
+        {"version", no_argument, 0, 'V'},
+        {0, 0, 0, 0}};
+    int c;
+    uint64_t u;
+    while ((c = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'o': o.output = optarg; break;
+        case O_RAYS:
+            if (!parse_u64(optarg, 1u << 20, &u) || u == 0)
+                return bad_usage("--rays takes a whole number 1..1048576, not '%s'", optarg);
+            o.rays = (uint32_t)u;
+            break;
+        case O_ORDERS:
+            if (!parse_orders(optarg, &o))
+                return bad_usage("--orders takes distinct orders 1..5 such as 2,3,5, not '%s'", optarg);
+            break;
+        case O_METHOD:
+            if (strcmp(optarg, "paper") == 0) o.method = VDSH_METHOD_PAPER;
+            else if (strcmp(optarg, "full") == 0) o.method = VDSH_METHOD_FULL;
+            else return bad_usage("--method takes paper or full, not '%s'", optarg);
+            break;
+        case O_ENCODING:
+            if (strcmp(optarg, "f16") == 0) o.encoding = VDSH_ENCODING_F16;
+            else if (strcmp(optarg, "f32") == 0) o.encoding = VDSH_ENCODING_F32;
+            else return bad_usage("--encoding takes f16 or f32, not '%s'", optarg);
+            break;
+        case O_MAXDIST:
+            if (!parse_float(optarg, &o.max_distance) || o.max_distance == 0.0f)
+                return bad_usage("--max-distance takes a positive number, not '%s'", optarg);
+            break;
+        case O_MAXEDGE:
+            if (!parse_float(optarg, &o.max_edge))
+                return bad_usage("--max-edge takes a number >= 0, not '%s'", optarg);
+            break;
+        case O_WELD: o.weld = 1; break;
+        case O_SEED:
+            if (!parse_u64(optarg, UINT64_MAX, &o.seed))
+                return bad_usage("--seed takes a whole number, not '%s'", optarg);
+            break;
+        case O_THREADS:
+            if (!parse_u64(optarg, 256, &u) || u == 0)
+                return bad_usage("--threads takes a whole number 1..256, not '%s'", optarg);
+            o.threads = (unsigned)u;
+            break;
+        case O_CUBESIZE:
+            if (!parse_u64(optarg, 4096, &u))
+                return bad_usage("--cube-size takes a whole number 0..4096, not '%s'", optarg);
+            o.cube_size = (int)u;
+            break;
+        case O_CUBEDIR: o.cubemap_dir = optarg; break;
+        case O_ROBUST: o.robust = 1; break;
+        case O_REPORT: o.report = optarg; break;
+        case O_TIMINGS: o.record_timings = 1; break;
+        case O_EXPORT: o.export_obj = optarg; break;
+        case O_TRACE_ONLY: o.trace_only = 1; break;
+        case 'q': o.quiet = 1; break;
+        case 'h': usage(stdout); return 0;
+        case 'V':
+            printf("vdsh-bake %s (.vdsh format %u, Embree %s)\n", VDSH_VERSION_STRING,
+                   VDSH_FORMAT_VERSION, RTC_VERSION_STRING);
+            return 0;
+        default:
+            fprintf(stderr, "Try 'vdsh-bake --help'.\n");
+            return EXIT_USAGE;
+        }
+    }
+    int nmesh = argc - optind;
+    if (nmesh < 1)
+        return bad_usage("%s", "no mesh given");
+    if (nmesh > VDSH_MAX_SOURCES)
+        return bad_usage("%s", "too many meshes (at most 64)");
+    if (!o.output && !o.export_obj && !o.trace_only)
+        return bad_usage("%s", "no output: give -o OUT.vdsh (or --export-obj FILE)");
+    FILE *log = o.quiet ? NULL : stderr;
+
+    /* 1. Load every mesh into one occluder scene. */
+    int status = 1;
+    vb_error err;
+    vb_mesh occ = {0}, rec = {0};
+    vb_scene *scene = NULL;
+    vb_bake_output bo = {0};
+    vdsh_source *sources = calloc((size_t)nmesh, sizeof *sources);
+    vdsh_stream streams[VDSH_MAX_ORDER];
+    void *stream_data[VDSH_MAX_ORDER] = {0};
+    vdsh_timings tm = {0};
+    if (!sources) {
+        fprintf(stderr, "vdsh-bake: out of memory\n");
+        return 1;
+    }
+    double t_start = vb_now();
+    vb_load_desc ld = {.weld = o.weld};
+    for (int i = 0; i < nmesh; i++) {
+        const char *path = argv[optind + i];
+        vb_mesh m = {0};
+        vb_source_info info;
+        double t = vb_now();
+        if (vb_mesh_load(path, &ld, &m, &info, &err) != VB_OK ||
+            vb_mesh_append(&occ, &m, &err) != VB_OK) {
+            fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+            vb_mesh_free(&m);
+            goto out;
+        }
+        sources[i].name = (char *)path;
+        sources[i].size = info.size;
+        memcpy(sources[i].sha256, info.sha256, 32);
+        if (log)
+            fprintf(log, "vdsh-bake: %s: %u vertices, %u triangles (%.2f s)\n", path,
+                    m.vertex_count, m.triangle_count, vb_now() - t);
+        vb_mesh_free(&m);
+    }
+    tm.load = vb_now() - t_start;
+
+    /* 2. Receivers: the scene's vertices, refined if asked. */
+    double t = vb_now();
+    if (vb_mesh_refine(&occ, o.max_edge, &rec, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-bake: refining receivers: %s\n", err.msg);
+        goto out;
+    }
+    tm.refine = vb_now() - t;
+    if (log && o.max_edge > 0.0f)
+        fprintf(log, "vdsh-bake: receivers refined to max edge %g: %u vertices, "
+                     "%u triangles (%.2f s)\n",
+                (double)o.max_edge, rec.vertex_count, rec.triangle_count, tm.refine);
+    if (o.export_obj) {
+        if (vb_mesh_write_obj(&rec, o.export_obj, &err) != VB_OK) {
+            fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+            goto out;
+        }
+        if (log)
+            fprintf(log, "vdsh-bake: wrote %s\n", o.export_obj);
+        if (!o.output && !o.trace_only) {
+            status = 0;
+            goto out;
+        }
+    }
+
+    /* 3. The occluders' BVH. */
+    t = vb_now();
+    vb_scene_desc sd = {.robust = o.robust, .threads = o.threads};
+    if (vb_scene_create(&occ, &sd, &scene, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+        goto out;
+    }
+    tm.build = vb_now() - t;
+    if (o.max_distance == 0.0f)
+        o.max_distance = scene->diagonal;
+
+    /* 4. Trace and project. */
+    int max_order = o.orders[o.order_count - 1];
+    progress pr = {.enabled = log && isatty(STDERR_FILENO), .t0 = vb_now()};
+    vb_bake_desc bd = {
+        .receivers = &rec, .scene = scene, .rays = o.rays, .seed = o.seed,
+        .max_distance = o.max_distance, .method = o.method,
+        .max_order = max_order, .threads = o.threads, .trace_only = o.trace_only,
+        .progress = on_progress, .progress_user = &pr};
+    if (log)
+        fprintf(log, "vdsh-bake: tracing %u rays x %u receivers against %u triangles "
+                     "(method %s, max distance %g)\n",
+                o.rays, rec.vertex_count, occ.triangle_count,
+                vdsh_method_name(o.method), (double)o.max_distance);
+    if (vb_bake_run(&bd, &bo, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+        goto out;
+    }
+    tm.trace = bo.seconds;
+    tm.threads = bo.threads;
+    tm.total = vb_now() - t_start;
+    if (log)
+        fprintf(log, "vdsh-bake: traced %.1f M rays in %.2f s (%.1f Mrays/s on %u "
+                     "threads), %.2f%% missed, %u degenerate receivers\n",
+                bo.rays_traced * 1e-6, bo.seconds,
+                bo.seconds > 0 ? bo.rays_traced / bo.seconds * 1e-6 : 0.0, bo.threads,
+                bo.rays_traced ? 100.0 * bo.rays_missed / bo.rays_traced : 0.0,
+                bo.degenerate_receivers);
+    if (o.trace_only) {
+        if (o.report && write_bare_report(o.report, &bo, &tm) != 0) {
+            fprintf(stderr, "vdsh-bake: %s: cannot write the report: %s\n", o.report,
+                    strerror(errno));
+            goto out;
+        }
+        status = 0;
+        goto out;
+    }
+
+    /* 5. Streams: one per order, the first order^2 coefficients. */
+    t = vb_now();
+    size_t coef_bytes = 0;
+    int nc_max = max_order * max_order;
+    for (int s = 0; s < o.order_count; s++) {
+        int n = o.orders[s], nc = n * n;
+        size_t count = (size_t)rec.vertex_count * nc;
+        float *f = malloc(count * sizeof *f);
+        if (!f) {
+            fprintf(stderr, "vdsh-bake: out of memory\n");
+            goto out;
+        }
+        for (uint32_t v = 0; v < rec.vertex_count; v++)
+            memcpy(f + (size_t)v * nc, bo.coeffs + (size_t)v * nc_max, nc * sizeof *f);
+        streams[s] = (vdsh_stream){.order = (uint32_t)n, .encoding = o.encoding,
+                                   .method = o.method, .quantity = VDSH_QUANTITY_DISTANCE,
+                                   .scale = 1.0f};
+        if (o.encoding == VDSH_ENCODING_F16) {
+            /* Stored values are coefficients / clamp distance: a few units
+             * at most whatever the scene's size, so f16 neither overflows
+             * nor sinks into subnormals. */
+            uint16_t *h = malloc(count * sizeof *h);
+            streams[s].scale = o.max_distance;
+            if (!h || vdsh_encode_f16(f, count, o.max_distance, h) != VDSH_OK) {
+                fprintf(stderr, "vdsh-bake: %s\n",
+                        h ? "coefficients do not fit f16" : "out of memory");
+                free(h);
+                free(f);
+                goto out;
+            }
+            free(f);
+            stream_data[s] = h;
+        } else {
+            stream_data[s] = f;
+        }
+        streams[s].data = stream_data[s];
+        coef_bytes += vdsh_stream_bytes_per_vertex(&streams[s]);
+    }
+
+    /* 6. Basis cubemaps (order 4 and up evaluates bands 3-4 from them). */
+    char dir[PATH_MAX], stem[PATH_MAX];
+    split_output(o.output, dir, stem, sizeof dir);
+    int cube_size = max_order >= 4 ? o.cube_size : 0;
+    if (cube_size > 0) {
+        const char *cdir = o.cubemap_dir ? o.cubemap_dir : dir;
+        if (vb_cubemap_write_basis(cdir, stem, cube_size, &err) != VB_OK) {
+            fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+            goto out;
+        }
+    }
+
+    /* 7. The .vdsh file, last. */
+    vdsh_file f = {0};
+    f.header.vertex_count = rec.vertex_count;
+    f.header.triangle_count = rec.triangle_count;
+    f.header.rays = bo.rays;
+    f.header.sampling = bo.hemisphere ? VDSH_SAMPLING_HEMISPHERE : VDSH_SAMPLING_SPHERE;
+    f.header.seed = o.seed;
+    f.header.max_distance = o.max_distance;
+    f.header.max_edge = o.max_edge;
+    f.header.offset_rule = VDSH_OFFSET_WB_AVG;
+    f.header.load_flags = o.weld ? VDSH_LOAD_WELD : 0;
+    f.header.cube_size = (uint32_t)cube_size;
+    f.header.occluder_vertex_count = occ.vertex_count;
+    f.header.occluder_triangle_count = occ.triangle_count;
+    f.header.trace_flags = o.robust ? VDSH_TRACE_ROBUST : 0;
+    memcpy(f.header.bounds_min, scene->bounds_min, sizeof f.header.bounds_min);
+    memcpy(f.header.bounds_max, scene->bounds_max, sizeof f.header.bounds_max);
+    f.source_count = (uint32_t)nmesh;
+    f.sources = sources;
+    f.positions = rec.positions;
+    f.normals = rec.normals;
+    f.indices = rec.indices;
+    f.stream_count = (uint32_t)o.order_count;
+    f.streams = streams;
+    f.has_stats = 1;
+    f.stats = (vdsh_stats){.rays_traced = bo.rays_traced, .rays_missed = bo.rays_missed,
+                           .degenerate_receivers = bo.degenerate_receivers,
+                           .undefined_normals = bo.undefined_normals};
+    f.has_timings = o.record_timings;
+    f.timings = tm;
+    vdsh_error verr;
+    if (vdsh_write(o.output, &f, &verr) != VDSH_OK) {
+        fprintf(stderr, "vdsh-bake: %s\n", verr.msg);
+        goto out;
+    }
+    double write_seconds = vb_now() - t;
+    long long file_size = -1;
+    FILE *fp = fopen(o.output, "rb");
+    if (fp && fseek(fp, 0, SEEK_END) == 0)
+        file_size = ftell(fp);
+    if (fp)
+        fclose(fp);
+    if (log) {
+        fprintf(log, "vdsh-bake: wrote %s (%.2f MB, %zu bytes of coefficients per "
+                     "vertex for orders",
+                o.output, file_size / 1e6, coef_bytes);
+        for (int s = 0; s < o.order_count; s++)
+            fprintf(log, "%s%d", s ? "," : " ", o.orders[s]);
+        fprintf(log, ", %s)", vdsh_encoding_name(o.encoding));
+        if (cube_size > 0)
+            fprintf(log, " and 4 basis cubemaps %dx%d in %s", cube_size, cube_size,
+                    o.cubemap_dir ? o.cubemap_dir : dir);
+        fprintf(log, "\nvdsh-bake: done in %.2f s\n", tm.total + write_seconds);
+    }
+    if (o.report && write_report(o.report, &o, &f, &bo, &tm, write_seconds, coef_bytes,
+                                 file_size) != 0) {
+        fprintf(stderr, "vdsh-bake: %s: cannot write the report: %s\n", o.report,
+                strerror(errno));
+        goto out;
+    }
+    status = 0;
+
+out:
+    for (int s = 0; s < VDSH_MAX_ORDER; s++)
+        free(stream_data[s]);
+    vb_bake_output_free(&bo);
+    vb_scene_destroy(scene);
+    vb_mesh_free(&rec);
+    vb_mesh_free(&occ);
+    free(sources);
+    return status;
+}

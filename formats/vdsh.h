@@ -1,0 +1,274 @@
+/*
+ * vdsh.h - read and write .vdsh files (baked visibility-distance SH).
+ *
+ * Purpose: the one piece of code that knows the byte layout of a .vdsh file
+ * (specified in formats/VDSH.md). Plain C11, POSIX libc (for the atomic
+ * write: open, fsync, rename) and libm; nothing else.
+ *
+ * Does not: trace rays, fit SH, or touch GL. SH evaluation is vdsh_sh.h;
+ * cubemap face conventions are vdsh_cube.h.
+ *
+ * Usage (tests/test_format.c is a compiled example):
+ *
+ *     vdsh_file *f = NULL;
+ *     vdsh_error err;
+ *     vdsh_result r = vdsh_read("room.vdsh", &f, &err);
+ *     if (r != VDSH_OK) { fprintf(stderr, "%s\n", err.msg); return 1; }
+ *     const vdsh_stream *s = vdsh_find_stream(f, 5, VDSH_QUANTITY_DISTANCE);
+ *     float c[25];
+ *     vdsh_stream_decode(s, 0, c);            (vertex 0's 25 coefficients)
+ *     vdsh_free(f);
+ *
+ * Errors: every fallible function returns a vdsh_result (VDSH_OK = 0) and,
+ * when `err` is not NULL, writes a message into err->msg that names the file
+ * (or "memory") and what is wrong, e.g.
+ * "room.vdsh: chunk 3 'COEF' at offset 1234: CRC mismatch". On failure the
+ * outputs are left untouched. There is no global error state.
+ *
+ * Ownership: vdsh_read*() returns a vdsh_file owned by the caller and freed
+ * with vdsh_free() (which accepts NULL). Every pointer inside it points into
+ * memory it owns: the whole file is loaded into one 16-byte-aligned buffer
+ * and positions, normals, indices and stream data point into it (so they
+ * are 16-byte aligned). vdsh_write*() only borrows its argument.
+ *
+ * Writing: vdsh_write() creates `path.tmp.<pid>.<n>` beside `path` with
+ * O_EXCL and mode 0666 (less the umask), writes, fsyncs and renames it over
+ * `path`; a failure removes it and leaves `path` as it was.
+ *
+ * Tools: vdsh_scan_chunks() lists the chunks of a file image with their
+ * stored and computed CRCs, also for a damaged file (vdsh-info --verify).
+ *
+ * Threading: no shared state; any number of threads may read and write
+ * different files at once.
+ *
+ * Byte order: the file is little-endian; this implementation supports
+ * little-endian hosts only (checked at compile time).
+ */
+#ifndef VDSH_H
+#define VDSH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define VDSH_FORMAT_VERSION 1u
+#define VDSH_MAX_ORDER 5
+#define VDSH_MAX_COEFFS (VDSH_MAX_ORDER * VDSH_MAX_ORDER)
+#define VDSH_MAX_STREAMS 16
+#define VDSH_MAX_SOURCES 64
+#define VDSH_MAX_NAME 4096
+#define VDSH_MAX_VERTICES (1u << 28)
+#define VDSH_MAX_TRIANGLES (1u << 28)
+
+typedef enum vdsh_result {
+    VDSH_OK = 0,
+    VDSH_ERR_IO,            /* could not open, read, write or rename (errno in msg) */
+    VDSH_ERR_OUT_OF_MEMORY,
+    VDSH_ERR_NOT_VDSH,      /* wrong magic: not a .vdsh file */
+    VDSH_ERR_VERSION,       /* a version this reader does not support */
+    VDSH_ERR_TRUNCATED,     /* shorter than its header or a chunk says */
+    VDSH_ERR_CRC,           /* header or chunk CRC mismatch */
+    VDSH_ERR_CHUNK,         /* chunk structure: unknown critical id, missing,
+                               repeated or misplaced chunk, bad size, padding */
+    VDSH_ERR_INVALID,       /* a value out of range: count, enum, index, NaN */
+    VDSH_ERR_ARGUMENT       /* the caller passed an inconsistent vdsh_file */
+} vdsh_result;
+
+/* A static string such as "CRC mismatch"; never NULL. */
+const char *vdsh_result_str(vdsh_result r);
+
+typedef struct vdsh_error {
+    char msg[512];
+} vdsh_error;
+
+typedef enum vdsh_sampling {
+    VDSH_SAMPLING_SPHERE = 0,
+    VDSH_SAMPLING_HEMISPHERE = 1
+} vdsh_sampling;
+
+typedef enum vdsh_offset_rule {
+    VDSH_OFFSET_NONE = 0,
+    VDSH_OFFSET_WB_AVG = 1
+} vdsh_offset_rule;
+
+enum { VDSH_LOAD_WELD = 1u };
+enum { VDSH_TRACE_ROBUST = 1u };
+
+typedef enum vdsh_encoding {
+    VDSH_ENCODING_F32 = 0,
+    VDSH_ENCODING_F16 = 1
+} vdsh_encoding;
+
+typedef enum vdsh_method {
+    VDSH_METHOD_PAPER = 0,
+    VDSH_METHOD_FULL = 1
+} vdsh_method;
+
+typedef enum vdsh_quantity {
+    VDSH_QUANTITY_DISTANCE = 0,
+    VDSH_QUANTITY_DISTANCE2 = 1,
+    VDSH_QUANTITY_LOG_DISTANCE = 2
+} vdsh_quantity;
+
+typedef enum vdsh_window {
+    VDSH_WINDOW_NONE = 0,
+    VDSH_WINDOW_HANN = 1,
+    VDSH_WINDOW_LANCZOS = 2
+} vdsh_window;
+
+/* Names used on command lines and in reports ("paper", "f16", ...);
+ * "?" for values this version does not know. */
+const char *vdsh_method_name(uint32_t method);
+const char *vdsh_encoding_name(uint32_t encoding);
+const char *vdsh_quantity_name(uint32_t quantity);
+const char *vdsh_window_name(uint32_t window);
+const char *vdsh_sampling_name(uint32_t sampling);
+const char *vdsh_offset_rule_name(uint32_t rule);
+
+/* HEAD chunk: see VDSH.md for the meaning and range of every field. */
+typedef struct vdsh_header {
+    uint32_t vertex_count;
+    uint32_t triangle_count;
+    uint32_t rays;
+    uint32_t sampling;
+    uint64_t seed;
+    float max_distance;
+    float max_edge;
+    uint32_t offset_rule;
+    uint32_t load_flags;
+    uint32_t cube_size;
+    uint32_t occluder_vertex_count;
+    uint32_t occluder_triangle_count;
+    uint32_t trace_flags;
+    float bounds_min[3];
+    float bounds_max[3];
+} vdsh_header;
+
+typedef struct vdsh_source {
+    char *name;            /* NUL-terminated copy of the stored name */
+    uint64_t size;
+    uint8_t sha256[32];
+} vdsh_source;
+
+typedef struct vdsh_stream {
+    uint32_t order;        /* bands n; n*n coefficients per vertex */
+    uint32_t encoding;     /* vdsh_encoding */
+    uint32_t method;       /* vdsh_method */
+    uint32_t quantity;     /* vdsh_quantity */
+    uint32_t window;       /* vdsh_window */
+    float window_param;
+    float method_param;
+    float scale;           /* coefficient = stored value * scale */
+    const void *data;      /* vertex_count * order^2 values of `encoding` */
+} vdsh_stream;
+
+typedef struct vdsh_stats {
+    uint64_t rays_traced;
+    uint64_t rays_missed;
+    uint32_t degenerate_receivers;
+    uint32_t undefined_normals;
+} vdsh_stats;
+
+typedef struct vdsh_timings {
+    double load, refine, build, trace, total;
+    uint32_t threads;
+} vdsh_timings;
+
+typedef struct vdsh_file {
+    vdsh_header header;
+    uint32_t source_count;
+    vdsh_source *sources;
+    const float *positions;    /* 3 * vertex_count */
+    const float *normals;      /* 3 * vertex_count */
+    const uint32_t *indices;   /* 3 * triangle_count */
+    uint32_t stream_count;
+    vdsh_stream *streams;
+    int has_stats;             /* `stat` chunk present */
+    vdsh_stats stats;
+    int has_timings;           /* `time` chunk present */
+    vdsh_timings timings;
+    void *storage_;            /* owned memory; do not touch */
+} vdsh_file;
+
+/* Read and validate a whole file (every rule in VDSH.md, all CRCs).
+ * On success *out owns everything; on failure *out is untouched. */
+vdsh_result vdsh_read(const char *path, vdsh_file **out, vdsh_error *err);
+
+/* The same from memory (the bytes are copied; `name` is used in messages
+ * and may be NULL). This is what the fuzz target calls. */
+vdsh_result vdsh_read_memory(const void *data, size_t size, const char *name,
+                             vdsh_file **out, vdsh_error *err);
+
+void vdsh_free(vdsh_file *f);
+
+/* Write `f` atomically: to a temporary file in the same directory, flushed,
+ * then renamed over `path`; on any failure the temporary file is removed
+ * and `path` is left as it was. `f` is validated first with the same rules
+ * as the reader (VDSH_ERR_ARGUMENT names the offending field). Pointers in
+ * `f` are borrowed; storage_ is ignored. */
+vdsh_result vdsh_write(const char *path, const vdsh_file *f, vdsh_error *err);
+
+/* Serialise to memory. On success *out_data is a malloc'd buffer the
+ * caller frees with free(). */
+vdsh_result vdsh_write_memory(const vdsh_file *f, void **out_data,
+                              size_t *out_size, vdsh_error *err);
+
+/* The stream for (order, quantity), or NULL. */
+const vdsh_stream *vdsh_find_stream(const vdsh_file *f, uint32_t order,
+                                    uint32_t quantity);
+
+/* Decode vertex v's order^2 coefficients of `s` to floats (scale applied).
+ * v must be < vertex_count of the file the stream belongs to. */
+void vdsh_stream_decode(const vdsh_stream *s, uint32_t v, float *out);
+
+/* Bytes of coefficient data per vertex of a stream: order^2 * 4 or * 2. */
+size_t vdsh_stream_bytes_per_vertex(const vdsh_stream *s);
+
+/* IEEE binary16 conversion, round to nearest even; overflow gives +-Inf
+ * (the caller checks), NaN stays NaN. */
+uint16_t vdsh_f16_from_f32(float f);
+float vdsh_f32_from_f16(uint16_t h);
+
+/* Encode n floats to f16 as value / scale. Returns VDSH_ERR_INVALID if an
+ * input is not finite or a result overflows f16; dst is then unspecified. */
+vdsh_result vdsh_encode_f16(const float *src, size_t n, float scale,
+                            uint16_t *dst);
+
+/* CRC-32 (zlib/PNG), continuing from `crc` (start with 0). */
+uint32_t vdsh_crc32(uint32_t crc, const void *data, size_t size);
+
+/* One chunk as it lies in a file image, for tools that list and check
+ * chunks (vdsh-info --verify). */
+typedef struct vdsh_chunk_info {
+    char id[5];            /* the 4 id bytes + NUL; non-letters read as '?' */
+    int complete;          /* payload and padding lie inside the data; if 0,
+                              crc_computed is 0 and this is the last entry */
+    uint64_t offset;       /* of the 16-byte chunk header */
+    uint64_t size;         /* payload bytes the header states (no padding) */
+    uint32_t crc_stored;
+    uint32_t crc_computed; /* over id, size, payload and padding */
+} vdsh_chunk_info;
+
+/* List the chunks of a file image without judging it: walk chunk headers
+ * back to back from offset 32 to the end of the data, ignoring the file
+ * header's chunk_count and CRC so that a damaged file still lists, and
+ * compute every chunk's CRC. The walk stops at the end of the data, where
+ * fewer than 16 bytes remain, or after a chunk that is not complete.
+ * Writes the first `max` entries to `out` (NULL is fine when max is 0) and
+ * the number found to *count, which may exceed max.
+ * Returns VDSH_ERR_NOT_VDSH or VDSH_ERR_TRUNCATED (outputs untouched) when
+ * the data does not start with the magic and a 32-byte header, else
+ * VDSH_OK: CRC mismatches and incomplete chunks are in the entries for the
+ * caller to report. Whether the file is valid is vdsh_read_memory's call. */
+vdsh_result vdsh_scan_chunks(const void *data, size_t size, const char *name,
+                             vdsh_chunk_info *out, uint32_t max,
+                             uint32_t *count, vdsh_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VDSH_H */

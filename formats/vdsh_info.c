@@ -1,0 +1,616 @@
+/*
+ * vdsh-info - print what a .vdsh file holds, or verify it chunk by chunk.
+ *
+ *     vdsh-info room.vdsh               summary for people
+ *     vdsh-info --json room.vdsh        the same as JSON, one object per file
+ *     vdsh-info --verify *.vdsh         every chunk's CRC, then full validation
+ *
+ * Exit status: 0 when every file was read (and verified), 1 when any file
+ * failed (the message on stderr names the file), 2 for a usage error.
+ *
+ * Everything about the byte layout comes from vdsh.h; this file only reads
+ * the decoded structs (and, for --verify, vdsh_scan_chunks' list).
+ */
+#include "vdsh.h"
+
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#ifndef VDSH_VERSION_STRING
+#define VDSH_VERSION_STRING "unknown"
+#endif
+
+static const char *prog = "vdsh-info";
+
+static void usage(FILE *to)
+{
+    fprintf(to,
+            "usage: %s [--json] [--verify] FILE.vdsh...\n"
+            "\n"
+            "Print what a .vdsh file holds: counts, bounds, every bake "
+            "parameter,\n"
+            "sources, coefficient streams, statistics and timings.\n"
+            "\n"
+            "  -j, --json     print the same as JSON on stdout, one object "
+            "per file\n"
+            "      --verify   list every chunk with its stored and computed "
+            "CRC, then\n"
+            "                 validate the whole file; fail if anything is "
+            "wrong\n"
+            "  -h, --help     print this help and exit\n"
+            "  -V, --version  print the version and exit\n"
+            "\n"
+            "Exit status: 0 every file is fine, 1 a file could not be read "
+            "or\n"
+            "failed verification, 2 usage error.\n",
+            prog);
+}
+
+/* ------------------------------------------------------------------ */
+/* JSON output                                                         */
+/* ------------------------------------------------------------------ */
+
+/* Strings from the file are valid UTF-8 (the reader checks), but a path on
+ * the command line may not be: invalid bytes become U+FFFD so the output
+ * always parses. */
+static void json_str(const char *s)
+{
+    const unsigned char *p = (const unsigned char *)s;
+    putchar('"');
+    while (*p) {
+        unsigned c = *p;
+        if (c == '"' || c == '\\') {
+            printf("\\%c", c);
+            p++;
+        } else if (c < 0x20) {
+            printf("\\u%04x", c);
+            p++;
+        } else if (c < 0x80) {
+            putchar((int)c);
+            p++;
+        } else {
+            size_t len = (c & 0xe0) == 0xc0   ? 2
+                         : (c & 0xf0) == 0xe0 ? 3
+                         : (c & 0xf8) == 0xf0 ? 4
+                                              : 0;
+            size_t k = 1;
+            while (len && k < len && (p[k] & 0xc0) == 0x80)
+                k++;
+            if (len && k == len) {
+                fwrite(p, 1, len, stdout);
+                p += len;
+            } else {
+                fputs("\\ufffd", stdout);
+                p++;
+            }
+        }
+    }
+    putchar('"');
+}
+
+static void json_num(double v)
+{
+    if (isfinite(v))
+        printf("%.9g", v);
+    else
+        fputs("null", stdout);
+}
+
+static void json_num17(double v)
+{
+    if (isfinite(v))
+        printf("%.17g", v);
+    else
+        fputs("null", stdout);
+}
+
+static void json_vec3(const float v[3])
+{
+    putchar('[');
+    for (int k = 0; k < 3; k++) {
+        if (k)
+            fputs(", ", stdout);
+        json_num(v[k]);
+    }
+    putchar(']');
+}
+
+/* ------------------------------------------------------------------ */
+/* Derived numbers                                                     */
+/* ------------------------------------------------------------------ */
+
+typedef struct coef0_stats {
+    double min, max, mean;
+} coef0_stats;
+
+static coef0_stats stream_coef0(const vdsh_file *f, const vdsh_stream *s)
+{
+    float c[VDSH_MAX_COEFFS];
+    coef0_stats st = {INFINITY, -INFINITY, 0.0};
+    double sum = 0.0;
+    for (uint32_t v = 0; v < f->header.vertex_count; v++) {
+        vdsh_stream_decode(s, v, c);
+        st.min = c[0] < st.min ? c[0] : st.min;
+        st.max = c[0] > st.max ? c[0] : st.max;
+        sum += c[0];
+    }
+    st.mean = sum / f->header.vertex_count;
+    return st;
+}
+
+static void receiver_bounds(const vdsh_file *f, float lo[3], float hi[3])
+{
+    for (int k = 0; k < 3; k++) {
+        lo[k] = INFINITY;
+        hi[k] = -INFINITY;
+    }
+    for (uint32_t v = 0; v < f->header.vertex_count; v++)
+        for (int k = 0; k < 3; k++) {
+            float x = f->positions[3 * v + k];
+            lo[k] = x < lo[k] ? x : lo[k];
+            hi[k] = x > hi[k] ? x : hi[k];
+        }
+}
+
+static double diagonal(const float lo[3], const float hi[3])
+{
+    double d = 0.0;
+    for (int k = 0; k < 3; k++)
+        d += ((double)hi[k] - lo[k]) * ((double)hi[k] - lo[k]);
+    return sqrt(d);
+}
+
+static void sha_hex(const uint8_t sha[32], char out[65])
+{
+    for (int i = 0; i < 32; i++)
+        snprintf(out + 2 * i, 3, "%02x", sha[i]);
+}
+
+static const char *or_unknown(const char *name)
+{
+    return strcmp(name, "?") == 0 ? "unknown" : name;
+}
+
+static uint64_t file_size_of(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 ? (uint64_t)st.st_size : 0;
+}
+
+/* ------------------------------------------------------------------ */
+/* Summary                                                             */
+/* ------------------------------------------------------------------ */
+
+static void print_summary(const char *path, const vdsh_file *f,
+                          uint64_t size)
+{
+    const vdsh_header *h = &f->header;
+    float lo[3], hi[3];
+    receiver_bounds(f, lo, hi);
+
+    printf("%s\n", path);
+    printf("  receivers    %u vertices, %u triangles\n", h->vertex_count,
+           h->triangle_count);
+    printf("               bounds (%g, %g, %g) .. (%g, %g, %g), diagonal "
+           "%g\n", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2],
+           diagonal(lo, hi));
+    printf("  occluders    %u vertices, %u triangles\n",
+           h->occluder_vertex_count, h->occluder_triangle_count);
+    printf("               bounds (%g, %g, %g) .. (%g, %g, %g), diagonal "
+           "%g\n", h->bounds_min[0], h->bounds_min[1], h->bounds_min[2],
+           h->bounds_max[0], h->bounds_max[1], h->bounds_max[2],
+           diagonal(h->bounds_min, h->bounds_max));
+    printf("  bake         rays %u per receiver, sampling %s, seed %llu\n",
+           h->rays, or_unknown(vdsh_sampling_name(h->sampling)),
+           (unsigned long long)h->seed);
+    printf("               max_distance %g, max_edge %g%s\n",
+           h->max_distance, h->max_edge,
+           h->max_edge == 0.0f ? " (not refined)" : "");
+    printf("               offset_rule %s, welded %s, robust trace %s\n",
+           or_unknown(vdsh_offset_rule_name(h->offset_rule)),
+           (h->load_flags & VDSH_LOAD_WELD) ? "yes" : "no",
+           (h->trace_flags & VDSH_TRACE_ROBUST) ? "yes" : "no");
+    if (h->cube_size)
+        printf("               basis cubemaps %u x %u per face\n",
+               h->cube_size, h->cube_size);
+    else
+        printf("               basis cubemaps none\n");
+
+    printf("  sources      %u\n", f->source_count);
+    for (uint32_t i = 0; i < f->source_count; i++) {
+        char hex[65];
+        sha_hex(f->sources[i].sha256, hex);
+        printf("    [%u] %s\n        %llu bytes, sha256 %s\n", i,
+               f->sources[i].name, (unsigned long long)f->sources[i].size,
+               hex);
+    }
+
+    printf("  streams      %u\n", f->stream_count);
+    for (uint32_t i = 0; i < f->stream_count; i++) {
+        const vdsh_stream *s = &f->streams[i];
+        coef0_stats st = stream_coef0(f, s);
+        printf("    [%u] order %u (%u coefficients), %s, method %s",
+               i, s->order, s->order * s->order,
+               vdsh_encoding_name(s->encoding),
+               or_unknown(vdsh_method_name(s->method)));
+        if (strcmp(vdsh_method_name(s->method), "?") == 0)
+            printf(" (%u)", s->method);
+        printf(", quantity %s\n", vdsh_quantity_name(s->quantity));
+        printf("        window %s", vdsh_window_name(s->window));
+        if (s->window != VDSH_WINDOW_NONE)
+            printf(" (param %g)", s->window_param);
+        printf(", method_param %g, scale %g\n", s->method_param, s->scale);
+        printf("        %zu bytes per vertex\n",
+               vdsh_stream_bytes_per_vertex(s));
+        printf("        coefficient 0: min %g, max %g, mean %g\n", st.min,
+               st.max, st.mean);
+    }
+
+    if (f->has_stats) {
+        const vdsh_stats *t = &f->stats;
+        printf("  stats        rays traced %llu, missed %llu",
+               (unsigned long long)t->rays_traced,
+               (unsigned long long)t->rays_missed);
+        if (t->rays_traced)
+            printf(" (%.2f%%)", 100.0 * (double)t->rays_missed /
+                                    (double)t->rays_traced);
+        printf("\n               degenerate receivers %u, undefined normals "
+               "%u\n", t->degenerate_receivers, t->undefined_normals);
+    }
+    if (f->has_timings) {
+        const vdsh_timings *t = &f->timings;
+        printf("  timings      load %.3f s, refine %.3f s, build %.3f s, "
+               "trace %.3f s\n               total %.3f s, %u threads\n",
+               t->load, t->refine, t->build, t->trace, t->total, t->threads);
+    }
+    printf("  size         %llu bytes, %.2f bytes per vertex\n",
+           (unsigned long long)size, (double)size / h->vertex_count);
+}
+
+static void print_json(const char *path, const vdsh_file *f, uint64_t size)
+{
+    const vdsh_header *h = &f->header;
+    float lo[3], hi[3];
+    receiver_bounds(f, lo, hi);
+
+    fputs("{\n  \"file\": ", stdout);
+    json_str(path);
+    printf(",\n  \"valid\": true,\n  \"file_size\": %llu,\n",
+           (unsigned long long)size);
+    fputs("  \"bytes_per_vertex\": ", stdout);
+    json_num((double)size / h->vertex_count);
+    printf(",\n  \"format_version\": %u,\n", VDSH_FORMAT_VERSION);
+    printf("  \"vertex_count\": %u,\n  \"triangle_count\": %u,\n",
+           h->vertex_count, h->triangle_count);
+    fputs("  \"receiver_bounds\": {\"min\": ", stdout);
+    json_vec3(lo);
+    fputs(", \"max\": ", stdout);
+    json_vec3(hi);
+    fputs("},\n", stdout);
+
+    printf("  \"bake\": {\n    \"rays\": %u,\n    \"sampling\": ", h->rays);
+    json_str(vdsh_sampling_name(h->sampling));
+    printf(",\n    \"seed\": %llu,\n    \"max_distance\": ",
+           (unsigned long long)h->seed);
+    json_num(h->max_distance);
+    fputs(",\n    \"max_edge\": ", stdout);
+    json_num(h->max_edge);
+    fputs(",\n    \"offset_rule\": ", stdout);
+    json_str(vdsh_offset_rule_name(h->offset_rule));
+    printf(",\n    \"load_flags\": %u,\n    \"welded\": %s,\n",
+           h->load_flags, (h->load_flags & VDSH_LOAD_WELD) ? "true" : "false");
+    printf("    \"trace_flags\": %u,\n    \"robust\": %s,\n", h->trace_flags,
+           (h->trace_flags & VDSH_TRACE_ROBUST) ? "true" : "false");
+    printf("    \"cube_size\": %u,\n", h->cube_size);
+    printf("    \"occluder_vertex_count\": %u,\n"
+           "    \"occluder_triangle_count\": %u,\n",
+           h->occluder_vertex_count, h->occluder_triangle_count);
+    fputs("    \"occluder_bounds\": {\"min\": ", stdout);
+    json_vec3(h->bounds_min);
+    fputs(", \"max\": ", stdout);
+    json_vec3(h->bounds_max);
+    fputs("}\n  },\n", stdout);
+
+    fputs("  \"sources\": [", stdout);
+    for (uint32_t i = 0; i < f->source_count; i++) {
+        char hex[65];
+        sha_hex(f->sources[i].sha256, hex);
+        fputs(i ? ",\n    {\"name\": " : "\n    {\"name\": ", stdout);
+        json_str(f->sources[i].name);
+        printf(", \"size\": %llu, \"sha256\": \"%s\"}",
+               (unsigned long long)f->sources[i].size, hex);
+    }
+    fputs(f->source_count ? "\n  ],\n" : "],\n", stdout);
+
+    fputs("  \"streams\": [", stdout);
+    for (uint32_t i = 0; i < f->stream_count; i++) {
+        const vdsh_stream *s = &f->streams[i];
+        coef0_stats st = stream_coef0(f, s);
+        fputs(i ? ",\n    {" : "\n    {", stdout);
+        printf("\"order\": %u, \"coefficients\": %u, \"encoding\": ",
+               s->order, s->order * s->order);
+        json_str(vdsh_encoding_name(s->encoding));
+        fputs(",\n     \"method\": ", stdout);
+        json_str(or_unknown(vdsh_method_name(s->method)));
+        printf(", \"method_id\": %u, \"method_param\": ", s->method);
+        json_num(s->method_param);
+        fputs(",\n     \"quantity\": ", stdout);
+        json_str(vdsh_quantity_name(s->quantity));
+        fputs(", \"window\": ", stdout);
+        json_str(vdsh_window_name(s->window));
+        fputs(", \"window_param\": ", stdout);
+        json_num(s->window_param);
+        fputs(", \"scale\": ", stdout);
+        json_num(s->scale);
+        printf(",\n     \"bytes_per_vertex\": %zu,\n",
+               vdsh_stream_bytes_per_vertex(s));
+        fputs("     \"coefficient0\": {\"min\": ", stdout);
+        json_num(st.min);
+        fputs(", \"max\": ", stdout);
+        json_num(st.max);
+        fputs(", \"mean\": ", stdout);
+        json_num(st.mean);
+        fputs("}}", stdout);
+    }
+    fputs("\n  ],\n", stdout);
+
+    fputs("  \"stats\": ", stdout);
+    if (f->has_stats)
+        printf("{\"rays_traced\": %llu, \"rays_missed\": %llu, "
+               "\"degenerate_receivers\": %u, \"undefined_normals\": %u},\n",
+               (unsigned long long)f->stats.rays_traced,
+               (unsigned long long)f->stats.rays_missed,
+               f->stats.degenerate_receivers, f->stats.undefined_normals);
+    else
+        fputs("null,\n", stdout);
+
+    fputs("  \"timings\": ", stdout);
+    if (f->has_timings) {
+        const vdsh_timings *t = &f->timings;
+        const double v[5] = {t->load, t->refine, t->build, t->trace,
+                             t->total};
+        static const char *const n[5] = {"load", "refine", "build", "trace",
+                                         "total"};
+        putchar('{');
+        for (int k = 0; k < 5; k++) {
+            printf("\"%s\": ", n[k]);
+            json_num17(v[k]);
+            fputs(", ", stdout);
+        }
+        printf("\"threads\": %u}\n", t->threads);
+    } else {
+        fputs("null\n", stdout);
+    }
+    fputs("}\n", stdout);
+}
+
+static void print_json_error(const char *path, vdsh_result r, const char *msg)
+{
+    fputs("{\n  \"file\": ", stdout);
+    json_str(path);
+    fputs(",\n  \"valid\": false,\n  \"result\": ", stdout);
+    json_str(vdsh_result_str(r));
+    fputs(",\n  \"error\": ", stdout);
+    json_str(msg);
+    fputs("\n}\n", stdout);
+}
+
+/* ------------------------------------------------------------------ */
+/* Verify                                                              */
+/* ------------------------------------------------------------------ */
+
+/* The whole file, for the chunk walk and the validation of the same bytes.
+ * Plain stdio, no knowledge of the layout. */
+static int slurp(const char *path, uint8_t **out, size_t *out_size,
+                 char *msg, size_t msg_size)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp) {
+        snprintf(msg, msg_size, "%s: cannot open: %s", path,
+                 strerror(errno));
+        return 0;
+    }
+    size_t cap = 1 << 16, size = 0;
+    uint8_t *buf = malloc(cap);
+    while (buf) {
+        size += fread(buf + size, 1, cap - size, fp);
+        if (size < cap)
+            break;
+        uint8_t *grown = cap <= SIZE_MAX / 2 ? realloc(buf, cap * 2) : NULL;
+        if (!grown) {
+            free(buf);
+            buf = NULL;
+            break;
+        }
+        buf = grown;
+        cap *= 2;
+    }
+    int failed = !buf || ferror(fp);
+    int e = errno;
+    fclose(fp);
+    if (failed) {
+        snprintf(msg, msg_size, "%s: %s", path,
+                 buf ? strerror(e) : "out of memory");
+        free(buf);
+        return 0;
+    }
+    *out = buf;
+    *out_size = size;
+    return 1;
+}
+
+static int verify(const char *path, int json)
+{
+    uint8_t *data = NULL;
+    size_t size = 0;
+    char msg[600];
+    vdsh_error err;
+    if (!slurp(path, &data, &size, msg, sizeof msg)) {
+        fprintf(stderr, "%s: %s\n", prog, msg);
+        if (json)
+            print_json_error(path, VDSH_ERR_IO, msg);
+        return 0;
+    }
+
+    uint32_t count = 0;
+    vdsh_chunk_info *chunks = NULL;
+    vdsh_result r = vdsh_scan_chunks(data, size, path, NULL, 0, &count, &err);
+    if (r == VDSH_OK && count) {
+        chunks = calloc(count, sizeof *chunks);
+        r = chunks ? vdsh_scan_chunks(data, size, path, chunks, count, &count,
+                                      &err)
+                   : VDSH_ERR_OUT_OF_MEMORY;
+        if (!chunks)
+            snprintf(err.msg, sizeof err.msg, "%s: out of memory", path);
+    }
+    int bad_chunks = 0;
+    for (uint32_t i = 0; r == VDSH_OK && i < count; i++)
+        bad_chunks += !chunks[i].complete ||
+                      chunks[i].crc_stored != chunks[i].crc_computed;
+
+    /* The walk lists what is there; the reader judges every rule. */
+    vdsh_file *f = NULL;
+    vdsh_result valid = r;
+    if (r == VDSH_OK)
+        valid = vdsh_read_memory(data, size, path, &f, &err);
+    vdsh_free(f);
+
+    if (json) {
+        fputs("{\n  \"file\": ", stdout);
+        json_str(path);
+        printf(",\n  \"file_size\": %zu,\n  \"chunks\": [", size);
+        for (uint32_t i = 0; r == VDSH_OK && i < count; i++) {
+            const vdsh_chunk_info *c = &chunks[i];
+            printf("%s\n    {\"index\": %u, \"id\": ", i ? "," : "", i);
+            json_str(c->id);
+            printf(", \"offset\": %llu, \"size\": %llu, \"complete\": %s, "
+                   "\"crc_stored\": \"0x%08x\", \"crc_computed\": "
+                   "\"0x%08x\", \"crc_ok\": %s}",
+                   (unsigned long long)c->offset, (unsigned long long)c->size,
+                   c->complete ? "true" : "false", c->crc_stored,
+                   c->crc_computed,
+                   c->complete && c->crc_stored == c->crc_computed
+                       ? "true"
+                       : "false");
+        }
+        printf("%s],\n  \"valid\": %s,\n  \"result\": ", count ? "\n  " : "",
+               valid == VDSH_OK ? "true" : "false");
+        json_str(vdsh_result_str(valid));
+        fputs(",\n  \"error\": ", stdout);
+        if (valid == VDSH_OK)
+            fputs("null", stdout);
+        else
+            json_str(err.msg);
+        fputs("\n}\n", stdout);
+    } else {
+        printf("%s: %zu bytes\n", path, size);
+        if (r == VDSH_OK)
+            printf("  chunk  id        offset          size  crc\n");
+        for (uint32_t i = 0; r == VDSH_OK && i < count; i++) {
+            const vdsh_chunk_info *c = &chunks[i];
+            printf("  %5u  %-4s  %12llu  %12llu  0x%08x ", i, c->id,
+                   (unsigned long long)c->offset, (unsigned long long)c->size,
+                   c->crc_stored);
+            if (!c->complete)
+                printf("incomplete: runs past the end of the file\n");
+            else if (c->crc_stored == c->crc_computed)
+                printf("ok\n");
+            else
+                printf("MISMATCH (computed 0x%08x)\n", c->crc_computed);
+        }
+        if (valid == VDSH_OK)
+            printf("  valid: every rule of format version %u holds\n",
+                   VDSH_FORMAT_VERSION);
+        else
+            printf("  INVALID (%s): %s\n", vdsh_result_str(valid), err.msg);
+    }
+    if (valid != VDSH_OK)
+        fprintf(stderr, "%s: %s\n", prog, err.msg);
+    else if (bad_chunks) /* cannot happen for a file the reader accepts */
+        fprintf(stderr, "%s: %s: %d chunks fail their CRC\n", prog, path,
+                bad_chunks);
+    free(chunks);
+    free(data);
+    return valid == VDSH_OK && bad_chunks == 0;
+}
+
+/* ------------------------------------------------------------------ */
+
+static int info(const char *path, int json, int first)
+{
+    vdsh_file *f = NULL;
+    vdsh_error err;
+    vdsh_result r = vdsh_read(path, &f, &err);
+    if (r != VDSH_OK) {
+        fprintf(stderr, "%s: %s\n", prog, err.msg);
+        if (json)
+            print_json_error(path, r, err.msg);
+        return 0;
+    }
+    uint64_t size = file_size_of(path);
+    if (json) {
+        print_json(path, f, size);
+    } else {
+        if (!first)
+            putchar('\n');
+        print_summary(path, f, size);
+    }
+    vdsh_free(f);
+    return 1;
+}
+
+int main(int argc, char **argv)
+{
+    static const struct option options[] = {
+        {"json", no_argument, NULL, 'j'},
+        {"verify", no_argument, NULL, 'c'},
+        {"help", no_argument, NULL, 'h'},
+        {"version", no_argument, NULL, 'V'},
+        {NULL, 0, NULL, 0},
+    };
+    int json = 0, check = 0, opt;
+    while ((opt = getopt_long(argc, argv, "jhV", options, NULL)) != -1) {
+        switch (opt) {
+        case 'j':
+            json = 1;
+            break;
+        case 'c':
+            check = 1;
+            break;
+        case 'h':
+            usage(stdout);
+            return 0;
+        case 'V':
+            printf("vdsh-info %s (.vdsh format version %u)\n",
+                   VDSH_VERSION_STRING, VDSH_FORMAT_VERSION);
+            return 0;
+        default:
+            usage(stderr);
+            return 2;
+        }
+    }
+    if (optind >= argc) {
+        fprintf(stderr, "%s: no input file\n", prog);
+        usage(stderr);
+        return 2;
+    }
+
+    int ok = 1;
+    for (int i = optind; i < argc; i++) {
+        if (check && !json && i > optind)
+            putchar('\n');
+        ok &= check ? verify(argv[i], json)
+                    : info(argv[i], json, i == optind);
+    }
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        fprintf(stderr, "%s: cannot write output: %s\n", prog,
+                strerror(errno));
+        return 1;
+    }
+    return ok ? 0 : 1;
+}

@@ -1,0 +1,139 @@
+#include "vdsh_sh.h"
+
+#include <assert.h>
+
+/* Constants: K_l^m normalisation, sqrt(2) folded in for m != 0. */
+#define C00 0.28209479177387814f
+#define C1 0.4886025119029199f
+#define C2A 1.0925484305920792f
+#define C20 0.31539156525252005f
+#define C22 0.5462742152960396f
+#define C33 0.5900435899266435f
+#define C32 2.890611442640554f
+#define C31 0.4570457994644658f
+#define C30 0.3731763325901154f
+#define C32B 1.445305721320277f
+#define C44 2.5033429417967046f
+#define C43 1.7701307697799304f
+#define C42 0.9461746957575601f
+#define C41 0.6690465435572892f
+#define C40 0.10578554691520431f
+#define C42B 0.47308734787878004f
+#define C44B 0.6258357354491761f
+
+/* The one kernel. With acc = 0, o[i * s] = Y_i; with acc = 1,
+ * o[i * s] += w * Y_i (the callers pass constants, so each use compiles to
+ * straight-line code). */
+#define EMIT(i, value)                                   \
+    do {                                                 \
+        if (acc)                                         \
+            o[(i) * s] += w * (value);                   \
+        else                                             \
+            o[(i) * s] = (value);                        \
+    } while (0)
+
+static inline __attribute__((always_inline)) void sh_kernel(int order, float x, float y, float z, float *o,
+                             size_t s, int acc, float w)
+{
+    EMIT(0, C00);
+    if (order < 2)
+        return;
+    EMIT(1, -C1 * y);
+    EMIT(2, C1 * z);
+    EMIT(3, -C1 * x);
+    if (order < 3)
+        return;
+    float x2 = x * x, y2 = y * y, z2 = z * z;
+    EMIT(4, C2A * x * y);
+    EMIT(5, -C2A * y * z);
+    EMIT(6, C20 * (3.0f * z2 - 1.0f));
+    EMIT(7, -C2A * x * z);
+    EMIT(8, C22 * (x2 - y2));
+    if (order < 4)
+        return;
+    EMIT(9, -C33 * y * (3.0f * x2 - y2));
+    EMIT(10, C32 * x * y * z);
+    EMIT(11, -C31 * y * (5.0f * z2 - 1.0f));
+    EMIT(12, C30 * z * (5.0f * z2 - 3.0f));
+    EMIT(13, -C31 * x * (5.0f * z2 - 1.0f));
+    EMIT(14, C32B * z * (x2 - y2));
+    EMIT(15, -C33 * x * (x2 - 3.0f * y2));
+    if (order < 5)
+        return;
+    EMIT(16, C44 * x * y * (x2 - y2));
+    EMIT(17, -C43 * y * z * (3.0f * x2 - y2));
+    EMIT(18, C42 * x * y * (7.0f * z2 - 1.0f));
+    EMIT(19, -C41 * y * z * (7.0f * z2 - 3.0f));
+    EMIT(20, C40 * (35.0f * z2 * z2 - 30.0f * z2 + 3.0f));
+    EMIT(21, -C41 * x * z * (7.0f * z2 - 3.0f));
+    EMIT(22, C42B * (x2 - y2) * (7.0f * z2 - 1.0f));
+    EMIT(23, -C43 * x * z * (x2 - 3.0f * y2));
+    EMIT(24, C44B * (x2 * x2 - 6.0f * x2 * y2 + y2 * y2));
+}
+
+void vdsh_sh_eval(int order, const float d[3], float *out)
+{
+    assert(order >= 1 && order <= 5);
+    sh_kernel(order, d[0], d[1], d[2], out, 1, 0, 0.0f);
+}
+
+/* The batch loops. `order` is a constant in every call below, so each
+ * compiles to a straight-line, vectorised loop over k. */
+static inline __attribute__((always_inline)) void soa_loop(
+    int order, size_t n, const float *restrict x, const float *restrict y,
+    const float *restrict z, const float *restrict w, float *restrict o,
+    size_t stride, int acc)
+{
+    for (size_t k = 0; k < n; k++)
+        sh_kernel(order, x[k], y[k], z[k], o + k, stride, acc, acc ? w[k] : 0.0f);
+}
+
+static inline __attribute__((always_inline)) void soa_dispatch(
+    int order, size_t n, const float *x, const float *y, const float *z,
+    const float *w, float *o, size_t stride, int acc)
+{
+    /* Packets of 16 with rows of 16 (the bake's layout) get their own
+     * loops: with constant sizes the compiler can see that the 25 output
+     * rows never overlap, and vectorises. */
+    if (n == 16 && stride == 16) {
+        switch (order) {
+        case 1: soa_loop(1, 16, x, y, z, w, o, 16, acc); return;
+        case 2: soa_loop(2, 16, x, y, z, w, o, 16, acc); return;
+        case 3: soa_loop(3, 16, x, y, z, w, o, 16, acc); return;
+        case 4: soa_loop(4, 16, x, y, z, w, o, 16, acc); return;
+        default: soa_loop(5, 16, x, y, z, w, o, 16, acc); return;
+        }
+    }
+    switch (order) {
+    case 1: soa_loop(1, n, x, y, z, w, o, stride, acc); break;
+    case 2: soa_loop(2, n, x, y, z, w, o, stride, acc); break;
+    case 3: soa_loop(3, n, x, y, z, w, o, stride, acc); break;
+    case 4: soa_loop(4, n, x, y, z, w, o, stride, acc); break;
+    default: soa_loop(5, n, x, y, z, w, o, stride, acc); break;
+    }
+}
+
+void vdsh_sh_eval_soa(int order, size_t n, const float *x, const float *y,
+                      const float *z, float *out, size_t out_stride)
+{
+    assert(order >= 1 && order <= 5);
+    soa_dispatch(order, n, x, y, z, NULL, out, out_stride, 0);
+}
+
+void vdsh_sh_project_soa(int order, size_t n, const float *x, const float *y,
+                         const float *z, const float *w, float *acc,
+                         size_t acc_stride)
+{
+    assert(order >= 1 && order <= 5);
+    soa_dispatch(order, n, x, y, z, w, acc, acc_stride, 1);
+}
+
+float vdsh_sh_reconstruct(int order, const float *c, const float d[3])
+{
+    float y[25];
+    vdsh_sh_eval(order, d, y);
+    float sum = 0.0f;
+    for (int i = 0; i < order * order; i++)
+        sum += c[i] * y[i];
+    return sum;
+}

@@ -1,0 +1,67 @@
+/*
+ * vdsh_sh.h - the one C evaluation of the real SH basis used everywhere.
+ *
+ * Purpose: evaluate the real, orthonormal spherical-harmonic basis up to
+ * band 4 (order 5, 25 functions) in the D3DX/DirectXMath convention that
+ * the paper used (Condon-Shortley phase, index i = l(l+1)+m):
+ *
+ *   band 0   0.282095
+ *   band 1   0.488603 * (-y, z, -x)
+ *   band 2   1.092548 xy, -1.092548 yz, 0.315392 (3z^2-1), -1.092548 xz,
+ *            0.546274 (x^2-y^2)
+ *   band 3   -0.590044 y(3x^2-y^2), 2.890611 xyz, -0.457046 y(5z^2-1),
+ *            0.373176 z(5z^2-3), -0.457046 x(5z^2-1), 1.445306 z(x^2-y^2),
+ *            -0.590044 x(x^2-3y^2)
+ *   band 4   2.503343 xy(x^2-y^2), -1.770131 yz(3x^2-y^2),
+ *            0.946175 xy(7z^2-1), -0.669047 yz(7z^2-3),
+ *            0.105786 (35z^4-30z^2+3), -0.669047 xz(7z^2-3),
+ *            0.473087 (x^2-y^2)(7z^2-1), -1.770131 xz(x^2-3y^2),
+ *            0.625836 (x^4-6x^2y^2+y^4)
+ *
+ * The bake, the evaluator, the tests and (by a rendering test) the GLSL in
+ * runtime/ all agree with this file.
+ *
+ * Does not: normalise directions (callers pass unit vectors), rotate or
+ * window coefficients.
+ *
+ * Errors: none; orders outside 1..5 are programmer errors (asserted).
+ * Threading: pure functions.
+ */
+#ifndef VDSH_SH_H
+#define VDSH_SH_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Number of coefficients of an order (bands): order * order. */
+static inline int vdsh_sh_count(int order) { return order * order; }
+
+/* out[0 .. order^2-1] = Y_i(d) for a unit direction d. */
+void vdsh_sh_eval(int order, const float d[3], float *out);
+
+/* Batch form for n directions given as separate x, y, z arrays:
+ * out[i * out_stride + k] = Y_i(direction k). Same arithmetic as
+ * vdsh_sh_eval (one kernel), laid out so the compiler vectorises over k.
+ * `out` must not overlap the inputs. */
+void vdsh_sh_eval_soa(int order, size_t n, const float *x, const float *y,
+                      const float *z, float *out, size_t out_stride);
+
+/* Projection step for n directions with weights w (the bake's distances):
+ * acc[i * acc_stride + k] += w[k] * Y_i(direction k). The same kernel;
+ * the caller sums acc over k (in a fixed order) and scales. `acc` must not
+ * overlap the inputs. */
+void vdsh_sh_project_soa(int order, size_t n, const float *x, const float *y,
+                         const float *z, const float *w, float *acc,
+                         size_t acc_stride);
+
+/* Reconstruct sum_i c[i] * Y_i(d). */
+float vdsh_sh_reconstruct(int order, const float *c, const float d[3]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VDSH_SH_H */

@@ -1,0 +1,114 @@
+# Tests of formats/: the .vdsh library (test_format), the fuzz target's
+# replay, and the vdsh-info tool run on files a fixture writes.
+# Included by tests/CMakeLists.txt; every test name starts with "format".
+
+add_executable(test_format ${CMAKE_CURRENT_LIST_DIR}/test_format.c)
+target_link_libraries(test_format PRIVATE vdsh_format)
+add_test(NAME format_unit COMMAND test_format)
+
+add_executable(test_format_tool ${CMAKE_CURRENT_LIST_DIR}/test_format_tool.c)
+target_link_libraries(test_format_tool PRIVATE vdsh_format)
+
+add_executable(test_format_fuzz ${CMAKE_CURRENT_LIST_DIR}/test_format_fuzz.c)
+target_link_libraries(test_format_fuzz PRIVATE vdsh_format)
+
+# Fixture files for the tool tests, written by the library itself.
+set(_fx ${CMAKE_CURRENT_BINARY_DIR}/format_fixtures)
+add_test(NAME format_fixtures_make COMMAND test_format_tool make ${_fx})
+add_test(NAME format_fixtures_clean COMMAND test_format_tool clean ${_fx})
+set_tests_properties(format_fixtures_make PROPERTIES
+                     FIXTURES_SETUP vdsh_format_files)
+set_tests_properties(format_fixtures_clean PROPERTIES
+                     FIXTURES_CLEANUP vdsh_format_files)
+
+set(_expect $<TARGET_FILE:test_format_tool> expect)
+set(_info $<TARGET_FILE:vdsh-info>)
+set(_format_tool_tests)
+
+# Usage: name, then the arguments of `test_format_tool expect`. A function,
+# not a macro, so escapes in the arguments are not parsed twice; and no '['
+# in them: an unbalanced bracket stops CMake splitting ${ARGN}.
+function(_format_tool_test name)
+  add_test(NAME ${name} COMMAND ${_expect} ${ARGN})
+  set_tests_properties(${name} PROPERTIES FIXTURES_REQUIRED vdsh_format_files)
+endfunction()
+
+_format_tool_test(format_info_summary 0
+  --out "order 5 (25 coefficients), f16, method paper, quantity distance"
+  --out "order 3 (9 coefficients), f32, method full, quantity log-distance"
+  --out "40 vertices, 60 triangles"
+  --out "sha256 a0a1a2a3a4a5a6a7a8a9aaabacadaeafb0b1b2b3b4b5b6b7b8b9babbbcbdbebf"
+  --out "window hann (param 2.5)"
+  --out "50 bytes per vertex"
+  --out "coefficient 0: min 7.5, max 11.4"
+  --out "rays traced 100000, missed 2500 (2.50%)"
+  --out "total 11.000 s, 2 threads"
+  -- ${_info} ${_fx}/good.vdsh)
+_format_tool_test(format_info_verify 0
+  --out "HEAD" --out "COEF" --out "time" --out " ok"
+  --out "valid: every rule"
+  -- ${_info} --verify ${_fx}/good.vdsh)
+_format_tool_test(format_info_json 0
+  --out "\"streams\": " --out "\"sha256\": \"000102"
+  --out "\\\"quoted\\\"\\\\caf"
+  -- ${_info} --json ${_fx}/good.vdsh)
+_format_tool_test(format_info_corrupt 1
+  --out "MISMATCH" --err "corrupt.vdsh: chunk 6 'COEF' at offset"
+  --err "CRC mismatch"
+  -- ${_info} --verify ${_fx}/corrupt.vdsh)
+_format_tool_test(format_info_corrupt_summary 1
+  --err "corrupt.vdsh: chunk 6 'COEF'"
+  -- ${_info} ${_fx}/corrupt.vdsh)
+_format_tool_test(format_info_truncated 1
+  --out "incomplete" --err "truncated.vdsh: truncated"
+  -- ${_info} --verify ${_fx}/truncated.vdsh)
+_format_tool_test(format_info_not_vdsh 1
+  --err "text.vdsh: not a .vdsh file"
+  -- ${_info} ${_fx}/text.vdsh)
+_format_tool_test(format_info_missing 1
+  --err "no-such-file.vdsh: cannot open"
+  -- ${_info} ${_fx}/no-such-file.vdsh)
+# One bad file among good ones: all are printed, the exit code says 1.
+_format_tool_test(format_info_several 1
+  --out "good.vdsh\n" --err "corrupt.vdsh"
+  -- ${_info} ${_fx}/good.vdsh ${_fx}/corrupt.vdsh ${_fx}/good.vdsh)
+_format_tool_test(format_info_bad_option 2
+  --err "usage:" -- ${_info} --no-such-option ${_fx}/good.vdsh)
+_format_tool_test(format_info_no_file 2
+  --err "no input file" -- ${_info})
+_format_tool_test(format_info_help 0
+  --out "usage:" --out "--verify" -- ${_info} --help)
+_format_tool_test(format_info_version 0
+  --out "vdsh-info ${PROJECT_VERSION}" -- ${_info} --version)
+
+add_test(NAME format_fuzz_replay
+         COMMAND test_format_fuzz ${_fx}/good.vdsh ${_fx}/corrupt.vdsh
+                 ${_fx}/truncated.vdsh ${_fx}/text.vdsh)
+set(_format_tool_tests format_fuzz_replay)
+
+# The JSON must parse, and say what the file holds.
+find_package(Python3 COMPONENTS Interpreter QUIET)
+if(Python3_Interpreter_FOUND)
+  add_test(NAME format_info_json_parses
+           COMMAND ${Python3_EXECUTABLE} -c
+"import json, subprocess, sys
+def run(*a):
+    p = subprocess.run([sys.argv[1], *a], capture_output=True, text=True)
+    return p.returncode, json.loads(p.stdout)
+rc, d = run('--json', sys.argv[2])
+assert rc == 0 and d['valid'] and d['vertex_count'] == 40, d
+assert [s['order'] for s in d['streams']] == [5, 3], d['streams']
+assert d['streams'][0]['coefficients'] == 25
+assert d['sources'][1]['name'] == 'scenes/\"quoted\"\\\\caf\\u00e9.obj', d['sources']
+assert len(d['sources'][0]['sha256']) == 64
+assert d['timings']['threads'] == 2 and d['stats']['rays_missed'] == 2500
+rc, d = run('--json', '--verify', sys.argv[3])
+assert rc == 1 and not d['valid'] and d['result'] == 'CRC mismatch', d
+assert sum(not c['crc_ok'] for c in d['chunks']) == 1, d['chunks']
+print('ok')"
+           ${_info} ${_fx}/good.vdsh ${_fx}/corrupt.vdsh)
+  list(APPEND _format_tool_tests format_info_json_parses)
+endif()
+
+set_tests_properties(${_format_tool_tests} PROPERTIES
+                     FIXTURES_REQUIRED vdsh_format_files)

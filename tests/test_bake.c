@@ -1,0 +1,408 @@
+/*
+ * Bake core against analytic truth: the centre of a closed sphere, points
+ * on the floor of a closed box; the direction grid; thread determinism.
+ * Scenes are generated here, so the test needs no files.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake.h"
+#include "sampling.h"
+#include "scene.h"
+#include "test_util.h"
+#include "vdsh.h"
+#include "vdsh_sh.h"
+
+/* ---- scene builders ----------------------------------------------------- */
+
+static void mesh_alloc(vb_mesh *m, uint32_t nv, uint32_t nt)
+{
+    m->vertex_count = nv;
+    m->triangle_count = nt;
+    m->positions = calloc(3 * (size_t)nv, sizeof(float));
+    m->normals = calloc(3 * (size_t)nv, sizeof(float));
+    m->indices = calloc(3 * (size_t)nt, sizeof(uint32_t));
+}
+
+/* UV sphere of radius r around c, fine enough that the chord error is
+ * below 1e-3 r. */
+static void make_sphere(vb_mesh *m, float r, const float c[3])
+{
+    enum { NT = 96, NP = 192 };
+    mesh_alloc(m, (NT + 1) * NP, 2 * NT * NP);
+    for (int i = 0; i <= NT; i++)
+        for (int j = 0; j < NP; j++) {
+            double th = M_PI * i / NT, ph = 2 * M_PI * j / NP;
+            float *p = m->positions + 3 * (i * NP + j);
+            float d[3] = {(float)(sin(th) * cos(ph)), (float)(sin(th) * sin(ph)),
+                          (float)cos(th)};
+            for (int k = 0; k < 3; k++) {
+                p[k] = c[k] + r * d[k];
+                m->normals[3 * (i * NP + j) + k] = -d[k];
+            }
+        }
+    uint32_t t = 0;
+    for (int i = 0; i < NT; i++)
+        for (int j = 0; j < NP; j++) {
+            uint32_t a = i * NP + j, b = i * NP + (j + 1) % NP;
+            uint32_t cc = a + NP, dd = b + NP;
+            uint32_t q[6] = {a, b, cc, b, dd, cc};
+            memcpy(m->indices + 3 * t, q, sizeof q);
+            t += 2;
+        }
+}
+
+/* Closed box [-a,a] x [0,h] x [-b,b], 12 triangles (orientation does not
+ * matter to the rays). */
+static void make_box(vb_mesh *m, float a, float h, float b)
+{
+    mesh_alloc(m, 8, 12);
+    for (int i = 0; i < 8; i++) {
+        m->positions[3 * i + 0] = (i & 1) ? a : -a;
+        m->positions[3 * i + 1] = (i & 2) ? h : 0.0f;
+        m->positions[3 * i + 2] = (i & 4) ? b : -b;
+        m->normals[3 * i + 1] = 1.0f;
+    }
+    static const uint32_t q[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                                     {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+    for (int f = 0; f < 6; f++) {
+        uint32_t t[6] = {q[f][0], q[f][1], q[f][2], q[f][0], q[f][2], q[f][3]};
+        memcpy(m->indices + 6 * f, t, sizeof t);
+    }
+}
+
+/* Receivers: given points and normals, no triangles. */
+static void make_points(vb_mesh *m, int n, const float *p, const float *nrm)
+{
+    mesh_alloc(m, (uint32_t)n, 0);
+    memcpy(m->positions, p, 3 * n * sizeof(float));
+    memcpy(m->normals, nrm, 3 * n * sizeof(float));
+}
+
+static void free_mesh(vb_mesh *m)
+{
+    free(m->positions);
+    free(m->normals);
+    free(m->indices);
+    memset(m, 0, sizeof *m);
+}
+
+static int bake(const vb_mesh *occ, const vb_mesh *rec, uint32_t method,
+                uint32_t rays, unsigned threads, vb_bake_output *out)
+{
+    vb_error err;
+    vb_scene *s = NULL;
+    if (vb_scene_create(occ, NULL, &s, &err) != VB_OK) {
+        fprintf(stderr, "scene: %s\n", err.msg);
+        return 0;
+    }
+    vb_bake_desc d = {.receivers = rec, .scene = s, .rays = rays, .seed = 5,
+                      .method = method, .threads = threads};
+    vb_result r = vb_bake_run(&d, out, &err);
+    if (r != VB_OK)
+        fprintf(stderr, "bake: %s\n", err.msg);
+    vb_scene_destroy(s);
+    return r == VB_OK;
+}
+
+/* ---- tests -------------------------------------------------------------- */
+
+/* The centre of a closed sphere sees D = R everywhere: `full` reconstructs
+ * it at every order; `paper` gives the projection of R * step(w.n), whose
+ * zonal coefficients are known in closed form. */
+static void test_sphere_centre(void)
+{
+    const float R = 3.0f, c[3] = {0.5f, -1.0f, 2.0f};
+    vb_mesh occ = {0}, rec = {0};
+    make_sphere(&occ, R, c);
+    float n[3] = {0, 0, 1};
+    make_points(&rec, 1, c, n);
+
+    vb_bake_output full = {0}, paper = {0};
+    CHECK(bake(&occ, &rec, VDSH_METHOD_FULL, 2500, 2, &full), "full bake");
+    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 2500, 2, &paper), "paper bake");
+    if (!full.coeffs || !paper.coeffs)
+        goto out;
+    CHECK(full.rays_missed == 0, "%llu rays escaped a closed sphere",
+          (unsigned long long)full.rays_missed);
+    CHECK(full.rays_traced == 2500, "full traced %llu rays", (unsigned long long)full.rays_traced);
+    CHECK(paper.rays_traced > 1200 && paper.rays_traced < 1300,
+          "paper should trace only the upper half: %llu", (unsigned long long)paper.rays_traced);
+
+    /* Equal-weight sampling integrates a constant exactly: c_0 = R sqrt(4 pi),
+     * less the tessellation's chord sag (at most 1.4e-4 R for this sphere).
+     * The higher coefficients carry the jittered sampling's noise, which
+     * grows with the band (measured: RMS 0.3% of R at order 3, 0.9% at
+     * order 5 over many seeds), so the bound loosens with the order. */
+    CHECK(fabs(full.coeffs[0] - R * sqrt(4 * M_PI)) < 2e-4 * R * sqrt(4 * M_PI), "c0 = %g, want %g",
+          full.coeffs[0], R * sqrt(4 * M_PI));
+    uint64_t s = 1;
+    const double bound[6] = {0, 0, 0.002, 0.006, 0.012, 0.018};
+    for (int order = 2; order <= 5; order++) {
+        double se = 0.0;
+        for (int k = 0; k < 2000; k++) {
+            float d[3];
+            test_rand_dir(&s, d);
+            double e = vdsh_sh_reconstruct(order, full.coeffs, d) - R;
+            se += e * e;
+        }
+        double rms = sqrt(se / 2000) / R;
+        CHECK(rms < bound[order], "order %d: RMS |D - R| / R = %g", order, rms);
+    }
+
+    /* Zonal coefficients of R * step(z): c_l0 = R * 2 pi * int_0^1 Y_l0(z) dz
+     * (Simpson's rule in double), all m != 0 coefficients zero. */
+    for (int l = 0; l <= 4; l++) {
+        double sum = 0.0;
+        const int N = 2000;
+        for (int i = 0; i <= N; i++) {
+            double z = (double)i / N, r = sqrt(fmax(0.0, 1 - z * z));
+            float d[3] = {(float)r, 0.0f, (float)z}, y[25];
+            vdsh_sh_eval(5, d, y);
+            double w = (i == 0 || i == N) ? 1 : (i % 2 ? 4 : 2);
+            sum += w * y[l * (l + 1)];
+        }
+        double want = R * 2 * M_PI * sum / (3.0 * N);
+        for (int m = -l; m <= l; m++) {
+            double got = paper.coeffs[l * (l + 1) + m];
+            double exp = m == 0 ? want : 0.0;
+            CHECK(fabs(got - exp) < 0.02 * R, "paper c_%d,%d = %g, analytic %g", l, m, got, exp);
+        }
+    }
+out:
+    vb_bake_output_free(&full);
+    vb_bake_output_free(&paper);
+    free_mesh(&occ);
+    free_mesh(&rec);
+}
+
+/* Distance from p (inside the box) along unit d to the box's walls. */
+static double box_exit(const float p[3], const float d[3], const float lo[3],
+                       const float hi[3])
+{
+    double t = INFINITY;
+    for (int i = 0; i < 3; i++) {
+        if (d[i] > 0)
+            t = fmin(t, (hi[i] - p[i]) / d[i]);
+        else if (d[i] < 0)
+            t = fmin(t, (lo[i] - p[i]) / d[i]);
+    }
+    return t;
+}
+
+/* Points on the floor of a closed box: the reconstruction converges to the
+ * analytic distance as the order grows (RMS over the upper hemisphere,
+ * relative to the true distance), within bounds that tighten with order. */
+static void test_box_floor(void)
+{
+    const float a = 4.0f, h = 3.0f, b = 2.5f;
+    const float lo[3] = {-a, 0, -b}, hi[3] = {a, h, b};
+    vb_mesh occ = {0}, rec = {0};
+    make_box(&occ, a, h, b);
+    enum { NP = 5 };
+    float p[3 * NP] = {0, 0, 0, 1.5f, 0, 0.5f, -2.0f, 0, -1.0f, 3.0f, 0, 1.5f, -0.5f, 0, 1.8f};
+    float n[3 * NP];
+    for (int i = 0; i < NP; i++)
+        n[3 * i] = 0, n[3 * i + 1] = 1, n[3 * i + 2] = 0;
+    make_points(&rec, NP, p, n);
+    vb_bake_output out = {0};
+    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 10000, 2, &out), "box bake");
+    if (!out.coeffs)
+        goto done;
+    CHECK(out.rays_missed == 0, "%llu rays escaped a closed box",
+          (unsigned long long)out.rays_missed);
+
+    const int orders[3] = {2, 3, 5};
+    const double bound[3] = {0.40, 0.33, 0.25};
+    double rms[3];
+    for (int oi = 0; oi < 3; oi++) {
+        double se = 0.0;
+        int cnt = 0;
+        uint64_t s = 99;
+        for (int v = 0; v < NP; v++)
+            for (int k = 0; k < 400; k++) {
+                float d[3];
+                test_rand_dir(&s, d);
+                if (d[1] < 0.05f)
+                    d[1] = -d[1];
+                if (d[1] < 0.05f)
+                    continue;
+                double truth = box_exit(p + 3 * v, d, lo, hi);
+                double got = vdsh_sh_reconstruct(orders[oi], out.coeffs + 25 * v, d);
+                se += (got - truth) * (got - truth) / (truth * truth);
+                cnt++;
+            }
+        rms[oi] = sqrt(se / cnt);
+        CHECK(rms[oi] < bound[oi], "order %d: relative RMS %g above %g", orders[oi],
+              rms[oi], bound[oi]);
+    }
+    printf("box floor relative RMS: order 2 %.4f, order 3 %.4f, order 5 %.4f\n", rms[0],
+           rms[1], rms[2]);
+    CHECK(rms[2] < rms[1] && rms[1] < rms[0], "error must fall with order: %g %g %g",
+          rms[0], rms[1], rms[2]);
+done:
+    vb_bake_output_free(&out);
+    free_mesh(&occ);
+    free_mesh(&rec);
+}
+
+/* The grid: unit directions, one per cell, packets of neighbouring cells,
+ * per-vertex jitter, hemisphere directions above the horizon. */
+static void test_grid(void)
+{
+    vb_dirgrid g = {0};
+    vb_error err;
+    CHECK(vb_dirgrid_create(2500, 0, &g, &err) == VB_OK, "grid");
+    CHECK(g.nu == 50 && g.nv == 50 && g.count == 2500 && g.packet_count == 157,
+          "grid %ux%u, %u packets", g.nu, g.nv, g.packet_count);
+    char *seen = calloc(g.count, 1);
+    int blocks_ok = 0, full_blocks = 0;
+    for (uint32_t pk = 0; pk < g.packet_count; pk++) {
+        float x[16], y[16], z[16];
+        int valid[16];
+        float n[3] = {0, 0, 1};
+        vb_dirgrid_packet(&g, pk, 1, 7, n, x, y, z, valid);
+        uint32_t rmin = UINT32_MAX, rmax = 0, cmin = UINT32_MAX, cmax = 0;
+        for (int k = 0; k < 16; k++) {
+            uint32_t cell = g.cells[pk * 16 + k];
+            if (cell == UINT32_MAX) {
+                CHECK(!valid[k], "empty lane marked valid");
+                continue;
+            }
+            CHECK(valid[k] == -1, "lane not valid");
+            CHECK(!seen[cell], "cell %u twice", cell);
+            seen[cell] = 1;
+            float len = sqrtf(x[k] * x[k] + y[k] * y[k] + z[k] * z[k]);
+            CHECK(fabsf(len - 1) < 1e-5f, "direction length %g", len);
+            uint32_t row = cell / g.nv, col = cell % g.nv;
+            /* The direction lies inside its cell. */
+            double w = (1.0 - z[k]) / 2.0 * g.nu;
+            double phi = atan2(y[k], x[k]);
+            if (phi < 0)
+                phi += 2 * M_PI;
+            double cc = phi / (2 * M_PI) * g.nv;
+            CHECK(w >= row - 1e-3 && w <= row + 1 + 1e-3, "row %u: %g", row, w);
+            CHECK(cc >= col - 1e-3 && cc <= col + 1 + 1e-3, "col %u: %g", col, cc);
+            rmin = row < rmin ? row : rmin, rmax = row > rmax ? row : rmax;
+            cmin = col < cmin ? col : cmin, cmax = col > cmax ? col : cmax;
+        }
+        blocks_ok += rmax - rmin <= 7 && cmax - cmin <= 7;
+        full_blocks += rmax - rmin == 3 && cmax - cmin == 3;
+    }
+    for (uint32_t i = 0; i < g.count; i++)
+        CHECK(seen[i], "cell %u never sampled", i);
+
+    /* Horizon culling is conservative: no direction of a culled packet,
+     * for any receiver's jitter, is above the horizon; and it culls about
+     * half the packets, or it would be pointless. */
+    uint64_t rs = 17;
+    uint32_t culled = 0, considered = 0;
+    for (int trial = 0; trial < 200; trial++) {
+        float nn[3];
+        test_rand_dir(&rs, nn);
+        for (uint32_t pk = 0; pk < g.packet_count; pk++) {
+            considered++;
+            if (!vb_dirgrid_packet_below(&g, pk, nn))
+                continue;
+            culled++;
+            for (uint32_t vtx = 0; vtx < 20; vtx++) {
+                float x[16], y[16], z[16];
+                int valid[16];
+                vb_dirgrid_packet(&g, pk, 3, vtx * 7919u + (uint32_t)trial, nn, x, y, z, valid);
+                for (int k = 0; k < 16; k++)
+                    if (valid[k])
+                        CHECK(x[k] * nn[0] + y[k] * nn[1] + z[k] * nn[2] < 0.0f,
+                              "culled packet %u has a direction above the horizon", pk);
+            }
+        }
+    }
+    CHECK(culled > considered / 3, "culled only %u of %u packets", culled, considered);
+    printf("horizon culling skips %.1f%% of packets\n", 100.0 * culled / considered);
+    /* Morton order: 144 packets are exact 4x4 blocks, the rest compact. */
+    CHECK(blocks_ok == (int)g.packet_count, "only %d of %u packets are compact", blocks_ok, g.packet_count);
+    CHECK(full_blocks >= 144, "only %d packets are 4x4 blocks", full_blocks);
+
+    /* Jitter differs between vertices, repeats for the same vertex. */
+    float a[16], b[16], c[16], d2[16], e[16], f[16];
+    int va[16];
+    float n[3] = {0, 0, 1};
+    vb_dirgrid_packet(&g, 3, 1, 7, n, a, b, c, va);
+    vb_dirgrid_packet(&g, 3, 1, 8, n, d2, e, f, va);
+    CHECK(memcmp(a, d2, sizeof a) != 0, "two vertices got the same jitter");
+    vb_dirgrid_packet(&g, 3, 1, 7, n, d2, e, f, va);
+    CHECK(memcmp(a, d2, sizeof a) == 0 && memcmp(c, f, sizeof c) == 0, "jitter not repeatable");
+    free(seen);
+    vb_dirgrid_destroy(&g);
+
+    CHECK(vb_dirgrid_create(1000, 1, &g, &err) == VB_OK, "hemisphere grid");
+    CHECK(g.count == 31 * 32, "1000 rays give %u", g.count);
+    float nn[3] = {0.6f, -0.48f, 0.64f};
+    for (uint32_t pk = 0; pk < g.packet_count; pk++) {
+        float x[16], y[16], z[16];
+        int valid[16];
+        vb_dirgrid_packet(&g, pk, 2, 0, nn, x, y, z, valid);
+        for (int k = 0; k < 16; k++)
+            if (valid[k])
+                CHECK(x[k] * nn[0] + y[k] * nn[1] + z[k] * nn[2] >= -1e-6f,
+                      "hemisphere direction below the horizon");
+    }
+    vb_dirgrid_destroy(&g);
+    CHECK(vb_dirgrid_create(0, 0, &g, &err) == VB_ERR_ARGUMENT, "0 rays accepted");
+}
+
+/* 1 and 2 threads give bit-identical coefficients. */
+static void test_threads(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    make_box(&occ, 2, 2, 2);
+    enum { NP = 200 };
+    float p[3 * NP], n[3 * NP];
+    uint64_t s = 5;
+    for (int i = 0; i < NP; i++) {
+        p[3 * i] = (float)(3.6 * test_rand(&s) - 1.8);
+        p[3 * i + 1] = (float)(2 * test_rand(&s));
+        p[3 * i + 2] = (float)(3.6 * test_rand(&s) - 1.8);
+        test_rand_dir(&s, n + 3 * i);
+    }
+    make_points(&rec, NP, p, n);
+    vb_bake_output one = {0}, two = {0};
+    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 400, 1, &one), "1 thread");
+    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 400, 2, &two), "2 threads");
+    if (one.coeffs && two.coeffs)
+        CHECK(memcmp(one.coeffs, two.coeffs, NP * 25 * sizeof(float)) == 0,
+              "1 and 2 threads differ");
+    CHECK(one.rays_traced == two.rays_traced, "ray counts differ");
+    vb_bake_output_free(&one);
+    vb_bake_output_free(&two);
+    free_mesh(&occ);
+    free_mesh(&rec);
+}
+
+/* Offset normals average over bit-identical positions only. */
+static void test_offset_normals(void)
+{
+    vb_mesh m = {0};
+    float p[9] = {1, 2, 3, 1, 2, 3, 1, 2, 3.0001f};
+    float n[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    make_points(&m, 3, p, n);
+    float out[9];
+    vb_error err;
+    CHECK(vb_offset_normals(&m, out, &err) == VB_OK, "offset normals");
+    float r = 1.0f / sqrtf(2.0f);
+    CHECK(fabsf(out[0] - r) < 1e-6f && fabsf(out[1] - r) < 1e-6f && out[2] == 0,
+          "averaged normal (%g %g %g)", out[0], out[1], out[2]);
+    CHECK(memcmp(out, out + 3, 3 * sizeof(float)) == 0, "shared position, different normals");
+    CHECK(out[6] == 0 && out[7] == 0 && out[8] == 1, "distinct position changed");
+    free_mesh(&m);
+}
+
+int main(void)
+{
+    test_grid();
+    test_offset_normals();
+    test_sphere_centre();
+    test_box_floor();
+    test_threads();
+    return test_report("test_bake");
+}
