@@ -1104,7 +1104,11 @@ public:
     }
 
     /* A vertex may be given several normals (an OBJ position used with
-     * different "vn" in different faces): their unit average is used. */
+     * different "vn" in different faces): their unit average is used. One
+     * normal (or the same one each time) is kept as it is when it is
+     * already unit length, so that writing and reading back a mesh
+     * reproduces its normals bit for bit. has_normal: 0 none, 1 one value
+     * in normal_sums as given, 2 a sum of unit vectors. */
     void set_normal(VertexHandle vh, const Vec3f &n) override
     {
         if (!valid(vh) || !std::isfinite(n[0]) || !std::isfinite(n[1]) || !std::isfinite(n[2]))
@@ -1114,12 +1118,34 @@ public:
             normal_sums.resize(3 * nv, 0.0f);
             has_normal.resize(nv, 0);
         }
-        double len = std::sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
         size_t i = (size_t)vh.idx();
-        has_normal[i] = 1;
-        if (len > 0.0)
-            for (int k = 0; k < 3; k++)
-                normal_sums[3 * i + (size_t)k] += (float)(n[k] / len);
+        float *sum = &normal_sums[3 * i];
+        if (has_normal[i] == 0) {
+            has_normal[i] = 1;
+            sum[0] = n[0], sum[1] = n[1], sum[2] = n[2];
+            return;
+        }
+        if (has_normal[i] == 1) {
+            if (sum[0] == n[0] && sum[1] == n[1] && sum[2] == n[2])
+                return;
+            unit(sum);
+            has_normal[i] = 2;
+        }
+        float u[3] = {n[0], n[1], n[2]};
+        unit(u);
+        for (int k = 0; k < 3; k++)
+            sum[k] += u[k];
+    }
+
+    /* n scaled to unit length, (0,0,0) if it has none; a vector already
+     * unit to float precision is left alone. */
+    static void unit(float *n)
+    {
+        double len = std::sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        if (std::fabs(len - 1.0) <= 4.0 * FLT_EPSILON)
+            return;
+        for (int k = 0; k < 3; k++)
+            n[k] = len > 0.0 && std::isfinite(len) ? (float)(n[k] / len) : 0.0f;
     }
     void set_normal(VertexHandle vh, const Vec3d &n) override
     {
@@ -1261,12 +1287,10 @@ vb_result read_openmesh(const char *path, vb_mesh_format format, const uint8_t *
         if (!col.has_normal.empty()) {
             col.normal_sums.resize(3 * nv, 0.0f);
             col.has_normal.resize(nv, 0);
-            for (size_t i = 0; i < nv; i++) {
-                float *n = &col.normal_sums[3 * i];
-                double len = std::sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-                for (int k = 0; k < 3; k++)
-                    n[k] = len > 0.0 ? (float)(n[k] / len) : 0.0f;
-            }
+            for (size_t i = 0; i < nv; i++)
+                collector::unit(&col.normal_sums[3 * i]);
+            for (uint8_t &h : col.has_normal)
+                h = h != 0;
             raw.normals = malloc_copy(col.normal_sums);
             raw.has_normal = malloc_copy(col.has_normal);
         }
@@ -1456,9 +1480,12 @@ vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
         om_mesh::VertexHandle a = m.from_vertex_handle(h), b = m.to_vertex_handle(h);
         const om_mesh::Point pa = m.point(a), pb = m.point(b);
         om_mesh::Point mid((pa[0] + pb[0]) * 0.5f, (pa[1] + pb[1]) * 0.5f, (pa[2] + pb[2]) * 0.5f);
-        /* Far from the origin with a tiny max_edge, the float midpoint can
-         * land on an end: the edge would never get shorter. */
-        if (!(dist2(pa, mid) < l2 && dist2(mid, pb) < l2))
+        /* Far from the origin with a tiny max_edge, float midpoints stop
+         * halving edges (one lands on an end, the other keeps the whole
+         * length) and refinement would never end. Each half must be clearly
+         * shorter (at most 90% of the edge; exactly 50% when the spacing of
+         * floats is small against the edge). */
+        if (!(dist2(pa, mid) <= 0.81 * l2 && dist2(mid, pb) <= 0.81 * l2))
             return vb_fail(err, VB_ERR_ARGUMENT,
                            "refine: max_edge %g is below float precision at (%g, %g, %g)",
                            (double)max_edge, (double)pa[0], (double)pa[1], (double)pa[2]);
@@ -1478,20 +1505,20 @@ vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
                        (size_t)m.n_faces(), (unsigned long long)(kept + faces_added));
 
     /* Output numbering: originals keep theirs, copies map back, and new
-     * vertices follow in creation order. With copies, an original edge that
-     * a copied triangle shares has been split once per copy: those
-     * midpoints sit at the same place (same float arithmetic on the same
-     * ends) and must become one vertex, or the shared edge would not be
-     * conforming. So, when there are copies, a new vertex is known by its
-     * parents' output numbers and made only once. Without copies every
-     * OpenMesh edge is a distinct pair of vertices and no lookup is needed. */
+     * vertices follow in creation order. An original edge that a copied
+     * triangle shares has been split once per copy: those midpoints sit at
+     * the same place (same float arithmetic on the same ends) and must
+     * become one vertex, or the shared edge would not be conforming. (The
+     * same happens inside coincident triangles, where OpenMesh makes two
+     * edges between the same two vertices.) So a new vertex is known by its
+     * parents' output numbers and made only once. */
     const size_t total = m.n_vertices();
     std::vector<uint32_t> out_of(total);
     for (uint32_t i = 0; i < n; i++)
         out_of[i] = i;
     for (size_t i = 0; i < copy_of.size(); i++)
         out_of[n + i] = copy_of[i];
-    pair_table merged(copy_of.empty() ? 0 : total - (size_t)first_new);
+    pair_table merged(total - (size_t)first_new);
     std::vector<float> pos(3 * (size_t)n), nrm(3 * (size_t)n, 0.0f);
     pos.reserve(3 * (total - (size_t)first_new + n));
     nrm.reserve(pos.capacity());
@@ -1502,13 +1529,11 @@ vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
     for (size_t v = (size_t)first_new; v < total; v++) {
         size_t k = v - (size_t)first_new;
         uint32_t pa = out_of[parents[2 * k]], pb = out_of[parents[2 * k + 1]];
-        if (!copy_of.empty()) {
-            uint64_t key = (uint64_t)std::min(pa, pb) << 32 | std::max(pa, pb);
-            uint32_t id = merged.find_or_insert(key, next);
-            if (id != next) {
-                out_of[v] = id;
-                continue;
-            }
+        uint64_t key = (uint64_t)std::min(pa, pb) << 32 | std::max(pa, pb);
+        uint32_t id = merged.find_or_insert(key, next);
+        if (id != next) {
+            out_of[v] = id;
+            continue;
         }
         out_of[v] = next++;
         const om_mesh::Point &p = m.point(om_mesh::VertexHandle((int)v));

@@ -1,3 +1,7 @@
 add_executable(test_bake test_bake.c)
 target_link_libraries(test_bake PRIVATE vb_core)
 add_test(NAME bake_core COMMAND test_bake)
+
+add_test(NAME bake_cli
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_bake_cli.sh
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info>)

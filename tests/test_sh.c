@@ -5,7 +5,9 @@
 #include <string.h>
 
 #include "test_util.h"
+#include "vdsh.h"
 #include "vdsh_sh.h"
+#include "vdsh_shadow.h"
 
 /* Gauss-Legendre nodes/weights on [-1, 1] by Newton iteration. */
 static void gauss_legendre(int n, double *x, double *w)
@@ -166,8 +168,82 @@ static void test_soa_and_prefix(void)
     }
 }
 
+/* The shadow evaluation: the ramp, both comparisons, the defined edge
+ * cases, and a stream whose reconstruction is known (a constant). */
+static void test_shadow(void)
+{
+    CHECK(vdsh_ramp(1.0f / 3.0f) == 0.0f && vdsh_ramp(1.0f) == 1.0f, "ramp ends");
+    CHECK(fabsf(vdsh_ramp(2.0f / 3.0f) - 0.5f) < 1e-6f, "ramp middle");
+    CHECK(vdsh_ramp(-5.0f) == 0.0f && vdsh_ramp(7.0f) == 1.0f, "ramp saturates");
+    CHECK(vdsh_ramp(NAN) == 0.0f, "ramp(NaN)");
+    CHECK(vdsh_shadow_compare(1.0f, 0.0f, VDSH_COMPARE_SMOOTH) == 1.0f, "light at receiver");
+    CHECK(vdsh_shadow_compare(1.0f, 0.0f, VDSH_COMPARE_BINARY) == 1.0f, "light at receiver");
+    CHECK(vdsh_shadow_compare(INFINITY, 5.0f, VDSH_COMPARE_SMOOTH) == 1.0f, "infinite distance");
+    CHECK(vdsh_shadow_compare(NAN, 5.0f, VDSH_COMPARE_SMOOTH) == 0.0f, "NaN distance");
+    CHECK(vdsh_shadow_compare(1.0f, NAN, VDSH_COMPARE_SMOOTH) == 0.0f, "NaN light distance");
+    CHECK(vdsh_shadow_compare(2.0f, 2.0f, VDSH_COMPARE_BINARY) == 1.0f &&
+          vdsh_shadow_compare(1.99f, 2.0f, VDSH_COMPARE_BINARY) == 0.0f, "binary step");
+
+    /* D = 4 everywhere: c0 = 4 sqrt(4 pi). */
+    float c[25] = {0};
+    c[0] = (float)(4.0 * sqrt(4.0 * M_PI));
+    float p[3] = {1, 2, 3}, near[3] = {1, 2, 5}, far[3] = {1, 2, 23}, mid[3] = {1, 2, 9};
+    CHECK(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, c, p, near, VDSH_COMPARE_SMOOTH) == 1.0f,
+          "light at 2 < D = 4 must be lit");
+    CHECK(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, c, p, far, VDSH_COMPARE_SMOOTH) == 0.0f,
+          "light at 20 > 3 D must be dark");
+    CHECK(fabsf(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, c, p, mid, VDSH_COMPARE_SMOOTH) - 0.5f) < 1e-5f,
+          "light at 6 = 1.5 D gives ramp(2/3) = 0.5");
+    CHECK(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, c, p, p, VDSH_COMPARE_SMOOTH) == 1.0f,
+          "light exactly at the receiver");
+    float neg[25] = {0};
+    neg[0] = -1.0f;
+    CHECK(vdsh_stream_distance(3, VDSH_QUANTITY_DISTANCE, neg, near) == 0.0f, "negative rings to 0");
+    float lg[25] = {0};
+    lg[0] = (float)(log(4.0) * sqrt(4.0 * M_PI));
+    float d[3] = {0, 0, 1};
+    CHECK(fabsf(vdsh_stream_distance(2, VDSH_QUANTITY_LOG_DISTANCE, lg, d) - 4.0f) < 1e-4f,
+          "log-distance reconstructs exp of the sum");
+    float sq[25] = {0};
+    sq[0] = (float)(16.0 * sqrt(4.0 * M_PI));
+    CHECK(fabsf(vdsh_stream_distance(2, VDSH_QUANTITY_DISTANCE2, sq, d) - 4.0f) < 1e-4f,
+          "distance2 reconstructs the square root");
+}
+
+/* The fused projection is the same kernel as evaluation. */
+static void test_project(void)
+{
+    enum { N = 16 };
+    float x[N], y[N], z[N], w[N], Y[25 * N], acc[25 * N];
+    uint64_t s = 21;
+    for (int k = 0; k < N; k++) {
+        float d[3];
+        test_rand_dir(&s, d);
+        x[k] = d[0], y[k] = d[1], z[k] = d[2], w[k] = (float)(3 * test_rand(&s));
+    }
+    for (int order = 1; order <= 5; order++) {
+        vdsh_sh_eval_soa(order, N, x, y, z, Y, N);
+        for (int i = 0; i < 25 * N; i++)
+            acc[i] = 0.5f;
+        vdsh_sh_project_soa(order, N, x, y, z, w, acc, N);
+        for (int i = 0; i < order * order; i++)
+            for (int k = 0; k < N; k++)
+                CHECK(acc[i * N + k] == 0.5f + w[k] * Y[i * N + k],
+                      "order %d: project differs at %d,%d", order, i, k);
+        /* A run that is not the 16 x 16 fast path agrees too. */
+        float acc2[25 * 7] = {0}, Y2[25 * 7];
+        vdsh_sh_eval_soa(order, 7, x, y, z, Y2, 7);
+        vdsh_sh_project_soa(order, 7, x, y, z, w, acc2, 7);
+        for (int i = 0; i < order * order; i++)
+            for (int k = 0; k < 7; k++)
+                CHECK(acc2[i * 7 + k] == w[k] * Y2[i * 7 + k], "general path");
+    }
+}
+
 int main(void)
 {
+    test_shadow();
+    test_project();
     test_orthonormal();
     test_design_values();
     test_recurrence();

@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# vdsh-bake end to end: determinism across thread counts and runs, the
+# files it writes, exit codes, and no output left behind on failure.
+# Usage: test_bake_cli.sh VDSH_BAKE VDSH_INFO
+set -u
+bake=$1
+info=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail=0
+check() { # check DESCRIPTION COMMAND...
+  local what=$1; shift
+  if ! "$@"; then echo "FAIL: $what" >&2; fail=1; fi
+}
+expect_exit() { # expect_exit CODE DESCRIPTION COMMAND...
+  local want=$1 what=$2; shift 2
+  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"
+  local got=$?
+  if [[ $got -ne $want ]]; then
+    echo "FAIL: $what: exit $got, want $want; stderr:" >&2; cat "$tmp/err.txt" >&2; fail=1
+  fi
+}
+
+quick=(builtin:room --max-edge 1.5 --rays 256 -q)
+
+# Determinism: 1 thread, 2 threads and a repeat give byte-identical files.
+expect_exit 0 "bake, 1 thread" "$bake" "${quick[@]}" --threads 1 -o "$tmp/a.vdsh"
+expect_exit 0 "bake, 2 threads" "$bake" "${quick[@]}" --threads 2 -o "$tmp/b.vdsh"
+expect_exit 0 "bake, repeat" "$bake" "${quick[@]}" --threads 2 -o "$tmp/c.vdsh"
+check "1 and 2 threads give identical files" cmp -s "$tmp/a.vdsh" "$tmp/b.vdsh"
+check "repeated bakes give identical files" cmp -s "$tmp/b.vdsh" "$tmp/c.vdsh"
+for k in 09-12 13-16 17-20 21-24; do
+  check "cubemap sh$k written beside the output" test -s "$tmp/a.sh$k.exr"
+  check "cubemaps identical between bakes" cmp -s "$tmp/a.sh$k.exr" "$tmp/b.sh$k.exr"
+done
+
+# The file verifies and says what it is.
+expect_exit 0 "vdsh-info --verify accepts the bake" "$info" --verify "$tmp/a.vdsh"
+"$info" "$tmp/a.vdsh" >"$tmp/info.txt" 2>&1
+check "info names the source" grep -q "builtin:room" "$tmp/info.txt"
+check "info lists order 5" grep -q "order 5 (25 coefficients)" "$tmp/info.txt"
+
+# Options land in the file; timings only when asked.
+expect_exit 0 "bake f32 orders 2,3 full" "$bake" "${quick[@]}" --orders 3,2 --encoding f32 \
+  --method full --seed 9 -o "$tmp/d.vdsh" --report "$tmp/d.json"
+"$info" --json "$tmp/d.vdsh" >"$tmp/d.info.json"
+check "f32 recorded" grep -q '"f32"' "$tmp/d.info.json"
+check "method full recorded" grep -q '"full"' "$tmp/d.info.json"
+check "no order 5 stream" bash -c "! grep -q '\"order\": 5' '$tmp/d.info.json'"
+check "no cubemaps without order 4+" test ! -e "$tmp/d.sh09-12.exr"
+check "report written" grep -q '"rays_traced"' "$tmp/d.json"
+expect_exit 0 "bake with timings" "$bake" "${quick[@]}" --record-timings -o "$tmp/e.vdsh"
+"$info" --json "$tmp/e.vdsh" >"$tmp/e.info.json"
+check "timings stored when asked" grep -qi '"timings"' "$tmp/e.info.json"
+check "--cubemap-dir" bash -c "mkdir -p '$tmp/cubes' && '$bake' ${quick[*]} --cubemap-dir '$tmp/cubes' -o '$tmp/f.vdsh' && test -s '$tmp/cubes/f.sh21-24.exr' && test ! -e '$tmp/f.sh21-24.exr'"
+
+# Export the built-in scene as OBJ and bake it back: same occluders.
+expect_exit 0 "export OBJ" "$bake" builtin:room -q --export-obj "$tmp/room.obj"
+check "OBJ has faces" grep -q "^f " "$tmp/room.obj"
+
+# Usage errors exit 2 and write nothing.
+expect_exit 2 "no mesh" "$bake" -o "$tmp/x.vdsh"
+expect_exit 2 "no output" "$bake" builtin:room
+expect_exit 2 "bad order" "$bake" builtin:room --orders 2,6 -o "$tmp/x.vdsh"
+expect_exit 2 "bad rays" "$bake" builtin:room --rays 0 -o "$tmp/x.vdsh"
+expect_exit 2 "bad method" "$bake" builtin:room --method magic -o "$tmp/x.vdsh"
+expect_exit 2 "unknown option" "$bake" builtin:room --frobnicate -o "$tmp/x.vdsh"
+check "no output after usage errors" test ! -e "$tmp/x.vdsh"
+expect_exit 0 "--help" "$bake" --help
+check "--help shows usage" grep -q "Usage: vdsh-bake" "$tmp/out.txt"
+expect_exit 0 "--version" "$bake" --version
+
+# Data errors exit 1, name the file, and leave no output (nor temp files).
+: >"$tmp/empty.obj"
+printf 'v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n' >"$tmp/nan.obj"
+for bad in "$tmp/missing.obj" "$tmp/empty.obj" "$tmp/nan.obj" "$tmp/file.xyz"; do
+  expect_exit 1 "bad input $(basename "$bad")" "$bake" "$bad" -q -o "$tmp/y.vdsh"
+  check "message names $(basename "$bad")" grep -q "$(basename "$bad")" "$tmp/err.txt"
+done
+check "no output after data errors" test ! -e "$tmp/y.vdsh"
+expect_exit 1 "unwritable output" "$bake" "${quick[@]}" -o "$tmp/no/such/dir/z.vdsh"
+check "no temporary files left" bash -c "! ls '$tmp' | grep -q tmp"
+
+# A failed bake never touches an existing output.
+cp "$tmp/a.vdsh" "$tmp/keep.vdsh"
+expect_exit 1 "bad input over an existing file" "$bake" "$tmp/empty.obj" -q -o "$tmp/keep.vdsh"
+check "existing output untouched" cmp -s "$tmp/a.vdsh" "$tmp/keep.vdsh"
+
+exit $fail
