@@ -4,23 +4,24 @@
  * three boxes (one stacked on another, one turned about y), three
  * floor-to-ceiling pillars and a sphere.
  *
- * Built like a game level: every flat face has its own vertices (hard
- * edges, nothing welded across faces or objects); the sphere is one smooth
- * surface (welded within itself, as a round prop would be). Faces are
- * coarse; the receiver density comes from vb_mesh_refine: at a maximum
- * edge of 0.2 m this room gives 57,853 receivers (the paper's had 54,500).
+ * Built like a game level: every face has its own vertices (hard edges,
+ * nothing welded across faces or objects; the sphere is faceted, each of
+ * its triangles on its own). Faces are coarse; the receiver density comes
+ * from vb_mesh_refine: at a maximum edge of 0.2 m this room gives 58,805
+ * receivers (the paper's had 54,500).
  * Faces nobody can see are left out: box bottoms resting on the floor or
  * on another box, pillar ends in the floor and ceiling. Their vertices
  * would lie inside other surfaces and bake to zero distance.
  *
- * Why the faces are lattices rather than two-triangle quads: the shell is
- * 95% of the receivers, and how many vertices longest-edge bisection
- * produces depends on the shape and size of the starting triangles. A quad
- * cut along its diagonal refines into right isosceles triangles, 50 or
- * (one level off) 90 vertices per m^2 at 0.2 m; near-equilateral triangles
+ * Why the faces are lattices rather than two-triangle quads: the shell
+ * holds over 90% of the receivers, and how many vertices longest-edge
+ * bisection produces depends on the shape and size of the starting
+ * triangles. A quad cut along its diagonal refines into right isosceles
+ * triangles: 50 or (one level off) 90 vertices per m^2 at 0.2 m, which
+ * would give the bare shell 100,000 receivers. Near-equilateral triangles
  * whose edges sit just under 0.2 * 2^k m refine to about 46. The lattice
  * sizes below are chosen that way (floor and ceiling edges 3.17/3.14 m,
- * walls 0.79/0.78 m, pillar sides 1.2/0.63 m), which keeps the room at the
+ * walls 0.79/0.78 m, pillar sides 1.2/0.72 m), which keeps the room at the
  * paper's receiver count with this layout.
  *
  * Coordinates: metres, y up, floor at y = 0, ceiling at y = 6, walls at
@@ -46,12 +47,14 @@
 #define PILLAR_COLS 5    /* along the pillar's height */
 #define PILLAR_ROWS 1
 
-/* Icosahedron subdivided twice: 162 vertices, 320 triangles. */
+/* Icosahedron subdivided twice: 320 triangles. */
 #define SPHERE_LEVELS 2
 
+/* Room for the whole room (it has 2,316 vertices and 2,428 triangles;
+ * test_mesh checks the counts). */
 enum {
-    MAX_VERTICES = 8192,
-    MAX_TRIANGLES = 8192,
+    MAX_VERTICES = 4096,
+    MAX_TRIANGLES = 4096,
     MAX_LATTICE = 64,
     SPHERE_MAX_VERTICES = 162,
     SPHERE_MAX_TRIANGLES = 320
@@ -209,7 +212,7 @@ static void add_box(room_builder *b, float cx, float cz, float y0, float sx, flo
 /* A unit icosphere: the icosahedron, each triangle split into four with
  * midpoints pushed onto the sphere, SPHERE_LEVELS times. Midpoints are
  * shared between the two triangles of an edge (found by a linear search:
- * a few hundred edges), so the surface is closed and welded. */
+ * a few hundred edges), so the facets meet exactly. */
 static void icosphere(float pos[][3], uint32_t *nv, uint32_t tri[][3], uint32_t *nt)
 {
     const float t = 1.6180339887f;
@@ -267,7 +270,8 @@ static void icosphere(float pos[][3], uint32_t *nv, uint32_t tri[][3], uint32_t 
     }
 }
 
-/* The sphere of radius r with its lowest vertex on y = y0. */
+/* The sphere of radius r with its lowest vertex on y = y0, every facet
+ * with its own three vertices. */
 static void add_sphere(room_builder *b, float cx, float y0, float cz, float r)
 {
     static float pos[SPHERE_MAX_VERTICES][3];
@@ -278,13 +282,15 @@ static void add_sphere(room_builder *b, float cx, float y0, float cz, float r)
     for (uint32_t i = 0; i < nv; i++)
         if (pos[i][1] < lowest)
             lowest = pos[i][1];
-    uint32_t first = b->m->vertex_count;
-    for (uint32_t i = 0; i < nv; i++) {
-        float p[3] = {cx + r * pos[i][0], y0 + r * (pos[i][1] - lowest), cz + r * pos[i][2]};
-        add_vertex(b, p);
+    for (uint32_t f = 0; f < nt; f++) {
+        uint32_t c[3];
+        for (int k = 0; k < 3; k++) {
+            const float *q = pos[tri[f][k]];
+            float p[3] = {cx + r * q[0], y0 + r * (q[1] - lowest), cz + r * q[2]};
+            c[k] = add_vertex(b, p);
+        }
+        add_triangle(b, c[0], c[1], c[2]);
     }
-    for (uint32_t f = 0; f < nt; f++)
-        add_triangle(b, first + tri[f][0], first + tri[f][1], first + tri[f][2]);
 }
 
 vb_result vb_builtin_room(vb_mesh *out, vb_error *err)
@@ -305,8 +311,9 @@ vb_result vb_builtin_room(vb_mesh *out, vb_error *err)
     add_shell(&b);
 
     /* Crates: a 1.58 m one with a 0.79 m one stacked on it, off centre,
-     * and a 1.12 m one turned 30 degrees about y. (Square faces just
-     * under 0.2 * 2^(k/2) * sqrt(2) refine economically as quads.) */
+     * and a 1.12 m one turned 30 degrees about y. (Square faces whose
+     * diagonal sits just under 0.2 * sqrt(2)^k m refine economically as
+     * two-triangle quads: 2.23, 1.12 and 1.58 m here.) */
     add_box(&b, -4.0f, -3.0f, 0.0f, 1.58f, 1.58f, 1.58f, 0.0f, FACE_BOTTOM);
     add_box(&b, -4.2f, -3.15f, 1.58f, 0.79f, 0.79f, 0.79f, 0.0f, FACE_BOTTOM);
     add_box(&b, 4.0f, 3.5f, 0.0f, 1.12f, 1.12f, 1.12f, 30.0f * deg, FACE_BOTTOM);
@@ -317,8 +324,9 @@ vb_result vb_builtin_room(vb_mesh *out, vb_error *err)
         add_box(&b, at[i][0], at[i][1], 0.0f, 0.4f, ROOM_HEIGHT, 0.4f, 0.0f,
                 FACE_BOTTOM | FACE_TOP | AS_PILLAR);
 
-    /* A sphere of radius 0.8 m resting on the floor. */
-    add_sphere(&b, -1.0f, 0.0f, 2.0f, 0.8f);
+    /* A sphere of radius 0.6 m resting on the floor (its facets are about
+     * 0.2 m already). */
+    add_sphere(&b, -1.0f, 0.0f, 2.0f, 0.6f);
 
     vb_mesh_compute_normals(&m);
     *out = m;

@@ -504,8 +504,32 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
         free(seen);
     }
     free(idx);
-    if (!use_file)
+    if (!use_file) {
         vb_mesh_compute_normals(&m);
+    } else {
+        /* A zero file normal says nothing: such vertices get the computed
+         * normal (itself zero only where all their triangles are). */
+        size_t zeros = 0;
+        for (uint32_t i = 0; i < m.vertex_count; i++) {
+            const float *n = m.normals + 3 * (size_t)i;
+            zeros += n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f;
+        }
+        if (zeros) {
+            float *given = alloc_array(3 * (size_t)m.vertex_count, sizeof(float));
+            if (!given) {
+                vb_mesh_free(&m);
+                return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+            }
+            memcpy(given, m.normals, 3 * (size_t)m.vertex_count * sizeof(float));
+            vb_mesh_compute_normals(&m);
+            for (uint32_t i = 0; i < m.vertex_count; i++) {
+                const float *n = given + 3 * (size_t)i;
+                if (n[0] != 0.0f || n[1] != 0.0f || n[2] != 0.0f)
+                    memcpy(m.normals + 3 * (size_t)i, n, 3 * sizeof(float));
+            }
+            free(given);
+        }
+    }
     *out = m;
     return VB_OK;
 }

@@ -18,36 +18,38 @@
  *
  * Scene names: a path ending in .obj/.ply/.off/.stl (case-insensitive), or
  * "builtin:room" - the procedural paper-style room (19 x 6 x 19 m, y up,
- * boxes, pillars and a sphere; coarse triangles; refine with
- * vb_mesh_refine to make it dense: max edge 0.2 gives the paper-sized
- * ~57k receivers).
+ * boxes, pillars and a sphere; 2,316 vertices and 2,428 coarse triangles;
+ * refine with vb_mesh_refine to make it dense: max edge 0.2 gives 58,805
+ * receivers, the paper's scene had 54,500).
  *
  * Loaded meshes are clean: triangles only (polygons fan-triangulated),
  * every index < vertex_count, no unreferenced vertices, every coordinate
  * finite, normals unit length or (0,0,0) where undefined (a vertex whose
  * faces all have zero area). Vertex normals come from the file when it has
- * them for every vertex, else are computed (angle-weighted face normals
- * over the vertex's own faces, so unwelded hard edges stay hard).
+ * them for every vertex (a zero one is replaced by the computed normal),
+ * else are computed (angle-weighted face normals over the vertex's own
+ * faces, so unwelded hard edges stay hard).
  * Triangles with a repeated index are dropped (they have no area and no
  * effect on rays); zero-area triangles with distinct indices are kept.
  *
- * Files are read once (the same bytes are hashed for vb_source_info and
- * checked by a strict pre-pass), then parsed by OpenMesh's readers into a
- * plain array collector (no half-edge structure, so non-manifold and
- * duplicate faces are kept as they are: nothing in the file is lost). The
- * pre-pass rejects what OpenMesh would silently skip or misread: numbers
- * that do not parse or are NaN/Inf, faces with fewer than 3 vertices,
- * out-of-range indices, truncated files, counts that do not fit the file,
- * PLY list properties OpenMesh cannot skip. Counts are cross-checked after
- * OpenMesh has read the file. OBJ: negative (relative) indices and TABs are
- * fine; materials and texture coordinates are ignored. STL: OpenMesh's
- * reader itself merges vertices with identical positions and drops
- * triangles that then repeat a vertex, with or without `weld`.
+ * Files are read into memory once; those bytes are hashed for
+ * vb_source_info, checked by a strict pre-pass and parsed by OpenMesh's
+ * readers (OFF: OpenMesh reads the path itself) into a plain array
+ * collector (no half-edge structure, so non-manifold and duplicate faces
+ * are kept as they are: nothing in the file is lost). The pre-pass rejects
+ * what OpenMesh would silently skip or misread: numbers that do not parse
+ * or are NaN/Inf, faces with fewer than 3 vertices, out-of-range indices,
+ * truncated files, counts that do not fit the file, PLY list properties
+ * OpenMesh cannot skip. Counts are cross-checked after OpenMesh has read
+ * the file. OBJ: negative (relative) indices and TABs are fine; materials
+ * and texture coordinates are ignored. STL: OpenMesh's reader itself
+ * merges vertices with identical positions and drops triangles that then
+ * repeat a vertex, with or without `weld`.
  *
  * Errors: vb_result; messages name the file and the problem ("x.obj: line
  * 12: face index 40 out of range (30 vertices)", "x.ply: empty mesh").
  * Element numbers follow the format's own convention: 1-based for OBJ
- * (with the line), 0-based for PLY and OFF.
+ * (with the line), 0-based for PLY, OFF and STL triangles.
  *
  * Ownership: a vb_mesh owns its arrays; vb_mesh_free() frees them and
  * zeroes the struct; it accepts a zeroed or half-built mesh. Functions that
@@ -56,8 +58,10 @@
  *
  * Threading: no shared state in this module; calls that use OpenMesh
  * (vb_mesh_load of a file, vb_mesh_refine) are serialised by one internal
- * mutex, because OpenMesh's readers and its log streams (omerr, omlog,
- * which are captured while OpenMesh runs, never printed) are process-wide.
+ * mutex, because OpenMesh's readers and its log streams are process-wide.
+ * While such a call runs, std::cerr/clog/cout are redirected into a buffer
+ * (OpenMesh's warnings are captured for error messages, never printed);
+ * C stdio is not affected.
  */
 #ifndef VB_MESH_H
 #define VB_MESH_H
@@ -108,7 +112,9 @@ vb_result vb_mesh_append(vb_mesh *dst, const vb_mesh *src, vb_error *err);
  * m is unchanged. */
 vb_result vb_mesh_weld(vb_mesh *m, vb_error *err);
 
-/* Recompute angle-weighted vertex normals from the triangles. */
+/* Recompute angle-weighted vertex normals from the triangles ((0,0,0)
+ * for a vertex whose triangles all have zero area); allocates m->normals
+ * when it is NULL (and leaves it NULL if that fails). */
 void vb_mesh_compute_normals(vb_mesh *m);
 
 /* Receiver refinement: split edges longer than max_edge (OpenMesh) until
@@ -127,14 +133,21 @@ void vb_mesh_compute_normals(vb_mesh *m);
  * Non-manifold input: a triangle OpenMesh's half-edge structure refuses
  * (third face on an edge, opposite orientation, complex vertex) is added
  * with its own copies of its three vertices (as OpenMesh's ImporterT does);
- * the copies are mapped back to the original indices afterwards and
- * midpoints of the same original edge are merged, so the output stays
- * conforming and no triangle is lost. Triangles that repeat a vertex index
- * have no area and are dropped.
+ * the copies are mapped back to the original indices afterwards and new
+ * vertices with the same two parents (a shared edge split once per copy)
+ * are merged, so the output stays conforming and no triangle is lost.
+ * Triangles that repeat a vertex index have no area and are dropped
+ * (except by the max_edge <= 0 copy).
  *
- * Errors: VB_ERR_ARGUMENT for a NaN max_edge or when the result would need
- * more than 2^24 vertices; VB_ERR_INVALID for an index out of range or a
- * non-finite position. */
+ * Cost: about 0.6 us per output vertex (builtin:room at 0.2: 58,805
+ * vertices in ~35 ms; Sponza at 0.2: 1.08 M in ~1.1 s).
+ *
+ * Errors: VB_ERR_ARGUMENT for a NaN max_edge, when the input or the result
+ * would have more than 2^24 vertices (checked from the surface area before
+ * any work)
+ * or when max_edge is below the float spacing of the coordinates (far from
+ * the origin); VB_ERR_INVALID for an index out of range or a non-finite
+ * position. */
 vb_result vb_mesh_refine(const vb_mesh *in, float max_edge, vb_mesh *out,
                          vb_error *err);
 
@@ -165,7 +178,8 @@ typedef enum vb_mesh_format {
 
 /* A file as OpenMesh read it, before validation and cleaning: polygons
  * fan-triangulated, indices exactly as read (possibly out of range), file
- * normals averaged per vertex. All arrays are malloc'ed. */
+ * normals per vertex (one given normal as is, several: their unit
+ * average). All arrays are malloc'ed; vb_mesh_raw_free() frees them. */
 typedef struct vb_mesh_raw {
     uint32_t vertex_count;
     uint32_t triangle_count;

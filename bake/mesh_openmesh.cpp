@@ -333,11 +333,13 @@ const uint64_t max_count = 0x7fffffffu;
 /* Mirrors OpenMesh's OBJ reader: lines split at '\n' only, first token is
  * the keyword, '#' lines are comments; "v" needs three numbers (a vertex
  * whose numbers do not parse is skipped by OpenMesh, shifting every later
- * index), "vn" three, "vt" two (OpenMesh fails the read otherwise); "f"
- * takes the part before the first '/' of each corner, resolves negative
- * indices against the "v" lines so far, and drops repeated corners before
- * adding the face (fewer than three left: no face). Inline '#' ends a
- * line, as it does for OpenMesh's number parsing in practice. */
+ * index), so does "vn" (the same for normal indices); "f" takes the part
+ * before the first '/' of each corner, resolves negative indices against
+ * the "v" lines so far, and drops repeated corners before adding the face
+ * (fewer than three left: no face, which is fine: it had no area). An
+ * inline '#' ends a line. Stricter than OpenMesh where it would guess: a
+ * number must be the whole token, a face needs three corners. "vt",
+ * "mtllib" and "usemtl" lines are only noted, to be commented out. */
 vb_result scan_obj(const char *path, const uint8_t *bytes, size_t size,
                    expectation *ex, vb_error *err)
 {
@@ -396,7 +398,7 @@ vb_result scan_obj(const char *path, const uint8_t *bytes, size_t size,
                     return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: face corner '%.*s' has no valid vertex index",
                                    path, c.line, t.show_len(), t.b);
                 if (v < 0) {
-                    if ((unsigned long long)(-v) > nv)
+                    if (v < -(long long)nv)
                         return vb_fail(err, VB_ERR_INVALID,
                                        "%s: line %lu: face index %lld out of range (%llu vertices so far)",
                                        path, c.line, v, (unsigned long long)nv);
@@ -1388,6 +1390,9 @@ vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
     const double limit2 = (double)max_edge * (double)max_edge;
 
     /* Input checks: the mesh may come from anywhere, not only a loader. */
+    if (n > refine_max_vertices)
+        return vb_fail(err, VB_ERR_ARGUMENT, "refine: the mesh has %u vertices; refinement handles at most %llu", n,
+                       (unsigned long long)refine_max_vertices);
     for (uint64_t i = 0; i < 3 * (uint64_t)n; i++)
         if (!std::isfinite(in->positions[i]))
             return vb_fail(err, VB_ERR_INVALID, "refine: vertex %llu has a non-finite coordinate",
@@ -1454,10 +1459,13 @@ vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
     }
     const uint64_t first_new = (uint64_t)n + copy_of.size();
 
-    /* Longest edge first. An entry is stale when its edge has been split
-     * since it was queued (its length changed): the split queued the edge
-     * again with its new length. OpenMesh's LongestEdgeT skips that check
-     * and cuts edges that are already short enough. */
+    /* Longest edge first. Each entry's length is checked again when it is
+     * taken: an entry whose edge has changed since it was queued (the
+     * change queued it again) or that is short enough is skipped, never
+     * split. OpenMesh's LongestEdgeT splits whatever it pops on the queued
+     * length alone. (Here, as there, every edge is queued once per length,
+     * so in practice entries do not go stale: on the meshes measured both
+     * split the same edges. The check makes it a guarantee.) */
     std::priority_queue<edge_entry, std::vector<edge_entry>, edge_order> queue;
     for (om_mesh::EdgeHandle e : m.edges()) {
         double l2 = edge_len2(m, e);
