@@ -206,22 +206,19 @@ static void bake_vertex(job *J, uint32_t v, uint64_t *traced, uint64_t *missed,
         if (d->trace_only)
             continue;
 
+        /* Branch-free over the lanes, so it vectorises. Lanes not traced
+         * (empty, or below the horizon) count as distance 0. */
         float dist[VB_PACKET];
         for (int k = 0; k < VB_PACKET; k++) {
-            if (!valid[k]) {
-                dist[k] = 0.0f;
-                continue;
-            }
+            int live = valid[k] != 0;
             int hit = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
             float t = hit ? rh.ray.tfar[k] * J->inv_scale : d->max_distance;
-            dist[k] = t;
-            *missed += !hit;
-            float c = rh.ray.dir_x[k] * n[0] + rh.ray.dir_y[k] * n[1] +
-                      rh.ray.dir_z[k] * n[2];
-            if (c > 0.0f) {
-                upper++;
-                near_zero += t < J->degenerate_dist;
-            }
+            float c = rh.ray.dir_x[k] * n[0] + rh.ray.dir_y[k] * n[1] + rh.ray.dir_z[k] * n[2];
+            int up = live & (c > 0.0f);
+            dist[k] = live ? t : 0.0f;
+            *missed += (uint64_t)(live & !hit);
+            upper += (uint32_t)up;
+            near_zero += (uint32_t)(up & (t < J->degenerate_dist));
         }
         vdsh_sh_project_soa(J->order, VB_PACKET, rh.ray.dir_x, rh.ray.dir_y,
                             rh.ray.dir_z, dist, &acc[0][0], VB_PACKET);
@@ -273,6 +270,48 @@ static void *worker(void *arg)
     return NULL;
 }
 
+vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
+                         vdsh_stream *out, void **storage, vb_error *err)
+{
+    if (!b->coeffs || order < 1 || order > b->max_order)
+        return vb_fail(err, VB_ERR_ARGUMENT, "order %d is not in the bake (orders 1..%d)",
+                       order, b->max_order);
+    int nc = order * order, nc_max = b->max_order * b->max_order;
+    size_t count = (size_t)b->vertex_count * nc;
+    float *f = malloc(count * sizeof *f);
+    if (!f)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the order %d stream", order);
+    for (uint32_t v = 0; v < b->vertex_count; v++)
+        memcpy(f + (size_t)v * nc, b->coeffs + (size_t)v * nc_max, nc * sizeof *f);
+    vdsh_stream s = {.order = (uint32_t)order, .encoding = encoding, .method = b->method,
+                     .quantity = VDSH_QUANTITY_DISTANCE, .scale = 1.0f, .data = f};
+    if (encoding == VDSH_ENCODING_F16) {
+        /* Stored values are coefficient / (the stream's largest
+         * |coefficient|): within [-1, 1] whatever the scene's size or clamp
+         * distance, so f16 neither overflows nor sinks into subnormals and
+         * keeps its full relative precision. */
+        float amax = 0.0f;
+        for (size_t i = 0; i < count; i++)
+            amax = fmaxf(amax, fabsf(f[i]));
+        s.scale = amax > 0.0f ? amax : 1.0f;
+        uint16_t *h = malloc(count * sizeof *h);
+        vdsh_result r = h ? vdsh_encode_f16(f, count, s.scale, h) : VDSH_ERR_OUT_OF_MEMORY;
+        free(f);
+        if (r != VDSH_OK) {
+            free(h);
+            return vb_fail(err, r == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_INVALID,
+                           "order %d coefficients do not fit f16", order);
+        }
+        s.data = h;
+    } else if (encoding != VDSH_ENCODING_F32) {
+        free(f);
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown encoding %u", encoding);
+    }
+    *storage = (void *)s.data;
+    *out = s;
+    return VB_OK;
+}
+
 void vb_bake_output_free(vb_bake_output *out)
 {
     if (!out)
@@ -310,6 +349,15 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         d.threads = 256;
 
     const vb_mesh *R = d.receivers;
+    for (size_t i = 0; i < 3 * (size_t)R->vertex_count; i++)
+        if (!isfinite(R->positions[i]) || !isfinite(R->normals[i]))
+            return vb_fail(err, VB_ERR_INVALID,
+                           "receiver %zu has a non-finite position or normal", i / 3);
+    for (size_t i = 0; i < 3 * (size_t)R->triangle_count; i++)
+        if (R->indices[i] >= R->vertex_count)
+            return vb_fail(err, VB_ERR_INVALID,
+                           "receiver triangle %zu: index %u out of range (%u vertices)", i / 3,
+                           R->indices[i], R->vertex_count);
     vb_dirgrid grid = {0};
     vb_result r = vb_dirgrid_create(d.rays, 0, &grid, err);
     if (r != VB_OK)
@@ -387,6 +435,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
 
     vb_bake_output o = {0};
     o.max_order = d.max_order;
+    o.method = d.method;
     o.vertex_count = R->vertex_count;
     o.coeffs = coeffs;
     coeffs = NULL;

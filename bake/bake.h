@@ -38,6 +38,7 @@
 #include "mesh.h"
 #include "scene.h"
 #include "vb.h"
+#include "vdsh.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -62,6 +63,7 @@ typedef struct vb_bake_desc {
 
 typedef struct vb_bake_output {
     int max_order;
+    uint32_t method;           /* vdsh_method used */
     uint32_t vertex_count;
     float *coeffs;             /* vertex_count * max_order^2, vertex-major;
                                   NULL with trace_only */
@@ -79,6 +81,13 @@ typedef struct vb_bake_output {
 vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
                       vb_error *err);
 void vb_bake_output_free(vb_bake_output *out);
+
+/* The .vdsh stream of one order (1 .. max_order) of a bake: its first
+ * order^2 coefficients per vertex, as f32, or as f16 scaled by the
+ * stream's largest |coefficient| (stored values in [-1, 1]). *storage
+ * receives the data the stream points at; the caller frees it. */
+vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
+                         vdsh_stream *out, void **storage, vb_error *err);
 
 /* The ray-offset normals: for every receiver vertex, the normalised sum of
  * the normals of all receiver vertices at bit-identical positions (its own

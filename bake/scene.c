@@ -30,6 +30,16 @@ vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc,
     if (!occ || occ->triangle_count == 0)
         return vb_fail(err, VB_ERR_INVALID, "no occluder triangles");
 
+    for (size_t i = 0; i < 3 * (size_t)occ->vertex_count; i++)
+        if (!isfinite(occ->positions[i]))
+            return vb_fail(err, VB_ERR_INVALID, "occluder vertex %zu has a non-finite coordinate",
+                           i / 3);
+    for (size_t i = 0; i < 3 * (size_t)occ->triangle_count; i++)
+        if (occ->indices[i] >= occ->vertex_count)
+            return vb_fail(err, VB_ERR_INVALID,
+                           "occluder triangle %zu: index %u out of range (%u vertices)", i / 3,
+                           occ->indices[i], occ->vertex_count);
+
     vb_scene *s = calloc(1, sizeof *s);
     if (!s)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");

@@ -471,6 +471,11 @@ int main(int argc, char **argv)
                 bo.seconds > 0 ? bo.rays_traced / bo.seconds * 1e-6 : 0.0, bo.threads,
                 bo.rays_traced ? 100.0 * bo.rays_missed / bo.rays_traced : 0.0,
                 bo.degenerate_receivers);
+    if (log && bo.degenerate_receivers > 0)
+        fprintf(log, "vdsh-bake: warning: %u receivers (%.2f%%) see distance ~0 in almost "
+                     "every direction above their horizon: receivers inside or flush "
+                     "against other geometry, or inverted normals\n",
+                bo.degenerate_receivers, 100.0 * bo.degenerate_receivers / rec.vertex_count);
     if (o.trace_only) {
         if (o.report && write_bare_report(o.report, &bo, &tm) != 0) {
             fprintf(stderr, "vdsh-bake: %s: cannot write the report: %s\n", o.report,
@@ -481,42 +486,15 @@ int main(int argc, char **argv)
         goto out;
     }
 
-    /* 5. Streams: one per order, the first order^2 coefficients. */
+    /* 5. Streams: one per order. */
     t = vb_now();
     size_t coef_bytes = 0;
-    int nc_max = max_order * max_order;
     for (int s = 0; s < o.order_count; s++) {
-        int n = o.orders[s], nc = n * n;
-        size_t count = (size_t)rec.vertex_count * nc;
-        float *f = malloc(count * sizeof *f);
-        if (!f) {
-            fprintf(stderr, "vdsh-bake: out of memory\n");
+        if (vb_bake_stream(&bo, o.orders[s], o.encoding, &streams[s], &stream_data[s],
+                           &err) != VB_OK) {
+            fprintf(stderr, "vdsh-bake: %s\n", err.msg);
             goto out;
         }
-        for (uint32_t v = 0; v < rec.vertex_count; v++)
-            memcpy(f + (size_t)v * nc, bo.coeffs + (size_t)v * nc_max, nc * sizeof *f);
-        streams[s] = (vdsh_stream){.order = (uint32_t)n, .encoding = o.encoding,
-                                   .method = o.method, .quantity = VDSH_QUANTITY_DISTANCE,
-                                   .scale = 1.0f};
-        if (o.encoding == VDSH_ENCODING_F16) {
-            /* Stored values are coefficients / clamp distance: a few units
-             * at most whatever the scene's size, so f16 neither overflows
-             * nor sinks into subnormals. */
-            uint16_t *h = malloc(count * sizeof *h);
-            streams[s].scale = o.max_distance;
-            if (!h || vdsh_encode_f16(f, count, o.max_distance, h) != VDSH_OK) {
-                fprintf(stderr, "vdsh-bake: %s\n",
-                        h ? "coefficients do not fit f16" : "out of memory");
-                free(h);
-                free(f);
-                goto out;
-            }
-            free(f);
-            stream_data[s] = h;
-        } else {
-            stream_data[s] = f;
-        }
-        streams[s].data = stream_data[s];
         coef_bytes += vdsh_stream_bytes_per_vertex(&streams[s]);
     }
 

@@ -2,6 +2,17 @@
 
 #include <assert.h>
 
+/* An AVX2 clone of the batch loops, chosen at run time where the CPU has
+ * it (Debian builds for baseline x86-64, i.e. SSE2). No FMA: every lane
+ * does the same IEEE operations in the same order either way, so results
+ * are bit-identical whichever clone runs. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
+#define VDSH_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define VDSH_CLONES
+#endif
+
 /* Constants: K_l^m normalisation, sqrt(2) folded in for m != 0. */
 #define C00 0.28209479177387814f
 #define C1 0.4886025119029199f
@@ -120,7 +131,7 @@ void vdsh_sh_eval_soa(int order, size_t n, const float *x, const float *y,
     soa_dispatch(order, n, x, y, z, NULL, out, out_stride, 0);
 }
 
-void vdsh_sh_project_soa(int order, size_t n, const float *x, const float *y,
+VDSH_CLONES void vdsh_sh_project_soa(int order, size_t n, const float *x, const float *y,
                          const float *z, const float *w, float *acc,
                          size_t acc_stride)
 {

@@ -5,3 +5,7 @@ add_test(NAME bake_core COMMAND test_bake)
 add_test(NAME bake_cli
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_bake_cli.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info>)
+
+add_executable(test_hard test_hard.c)
+target_link_libraries(test_hard PRIVATE vb_core)
+add_test(NAME bake_hard_cases COMMAND test_hard)

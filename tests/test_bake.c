@@ -10,27 +10,19 @@
 #include "bake.h"
 #include "sampling.h"
 #include "scene.h"
+#include "test_scenes.h"
 #include "test_util.h"
 #include "vdsh.h"
 #include "vdsh_sh.h"
 
 /* ---- scene builders ----------------------------------------------------- */
 
-static void mesh_alloc(vb_mesh *m, uint32_t nv, uint32_t nt)
-{
-    m->vertex_count = nv;
-    m->triangle_count = nt;
-    m->positions = calloc(3 * (size_t)nv, sizeof(float));
-    m->normals = calloc(3 * (size_t)nv, sizeof(float));
-    m->indices = calloc(3 * (size_t)nt, sizeof(uint32_t));
-}
-
 /* UV sphere of radius r around c, fine enough that the chord error is
  * below 1e-3 r. */
 static void make_sphere(vb_mesh *m, float r, const float c[3])
 {
     enum { NT = 96, NP = 192 };
-    mesh_alloc(m, (NT + 1) * NP, 2 * NT * NP);
+    test_mesh_alloc(m, (NT + 1) * NP, 2 * NT * NP);
     for (int i = 0; i <= NT; i++)
         for (int j = 0; j < NP; j++) {
             double th = M_PI * i / NT, ph = 2 * M_PI * j / NP;
@@ -51,41 +43,6 @@ static void make_sphere(vb_mesh *m, float r, const float c[3])
             memcpy(m->indices + 3 * t, q, sizeof q);
             t += 2;
         }
-}
-
-/* Closed box [-a,a] x [0,h] x [-b,b], 12 triangles (orientation does not
- * matter to the rays). */
-static void make_box(vb_mesh *m, float a, float h, float b)
-{
-    mesh_alloc(m, 8, 12);
-    for (int i = 0; i < 8; i++) {
-        m->positions[3 * i + 0] = (i & 1) ? a : -a;
-        m->positions[3 * i + 1] = (i & 2) ? h : 0.0f;
-        m->positions[3 * i + 2] = (i & 4) ? b : -b;
-        m->normals[3 * i + 1] = 1.0f;
-    }
-    static const uint32_t q[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
-                                     {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
-    for (int f = 0; f < 6; f++) {
-        uint32_t t[6] = {q[f][0], q[f][1], q[f][2], q[f][0], q[f][2], q[f][3]};
-        memcpy(m->indices + 6 * f, t, sizeof t);
-    }
-}
-
-/* Receivers: given points and normals, no triangles. */
-static void make_points(vb_mesh *m, int n, const float *p, const float *nrm)
-{
-    mesh_alloc(m, (uint32_t)n, 0);
-    memcpy(m->positions, p, 3 * n * sizeof(float));
-    memcpy(m->normals, nrm, 3 * n * sizeof(float));
-}
-
-static void free_mesh(vb_mesh *m)
-{
-    free(m->positions);
-    free(m->normals);
-    free(m->indices);
-    memset(m, 0, sizeof *m);
 }
 
 static int bake(const vb_mesh *occ, const vb_mesh *rec, uint32_t method,
@@ -117,7 +74,7 @@ static void test_sphere_centre(void)
     vb_mesh occ = {0}, rec = {0};
     make_sphere(&occ, R, c);
     float n[3] = {0, 0, 1};
-    make_points(&rec, 1, c, n);
+    test_make_points(&rec, 1, c, n);
 
     vb_bake_output full = {0}, paper = {0};
     CHECK(bake(&occ, &rec, VDSH_METHOD_FULL, 2500, 2, &full), "full bake");
@@ -173,8 +130,8 @@ static void test_sphere_centre(void)
 out:
     vb_bake_output_free(&full);
     vb_bake_output_free(&paper);
-    free_mesh(&occ);
-    free_mesh(&rec);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
 }
 
 /* Distance from p (inside the box) along unit d to the box's walls. */
@@ -199,13 +156,13 @@ static void test_box_floor(void)
     const float a = 4.0f, h = 3.0f, b = 2.5f;
     const float lo[3] = {-a, 0, -b}, hi[3] = {a, h, b};
     vb_mesh occ = {0}, rec = {0};
-    make_box(&occ, a, h, b);
+    test_make_box(&occ, a, h, b);
     enum { NP = 5 };
     float p[3 * NP] = {0, 0, 0, 1.5f, 0, 0.5f, -2.0f, 0, -1.0f, 3.0f, 0, 1.5f, -0.5f, 0, 1.8f};
     float n[3 * NP];
     for (int i = 0; i < NP; i++)
         n[3 * i] = 0, n[3 * i + 1] = 1, n[3 * i + 2] = 0;
-    make_points(&rec, NP, p, n);
+    test_make_points(&rec, NP, p, n);
     vb_bake_output out = {0};
     CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 10000, 2, &out), "box bake");
     if (!out.coeffs)
@@ -243,8 +200,8 @@ static void test_box_floor(void)
           rms[0], rms[1], rms[2]);
 done:
     vb_bake_output_free(&out);
-    free_mesh(&occ);
-    free_mesh(&rec);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
 }
 
 /* The grid: unit directions, one per cell, packets of neighbouring cells,
@@ -355,7 +312,7 @@ static void test_grid(void)
 static void test_threads(void)
 {
     vb_mesh occ = {0}, rec = {0};
-    make_box(&occ, 2, 2, 2);
+    test_make_box(&occ, 2, 2, 2);
     enum { NP = 200 };
     float p[3 * NP], n[3 * NP];
     uint64_t s = 5;
@@ -365,7 +322,7 @@ static void test_threads(void)
         p[3 * i + 2] = (float)(3.6 * test_rand(&s) - 1.8);
         test_rand_dir(&s, n + 3 * i);
     }
-    make_points(&rec, NP, p, n);
+    test_make_points(&rec, NP, p, n);
     vb_bake_output one = {0}, two = {0};
     CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 400, 1, &one), "1 thread");
     CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 400, 2, &two), "2 threads");
@@ -375,8 +332,8 @@ static void test_threads(void)
     CHECK(one.rays_traced == two.rays_traced, "ray counts differ");
     vb_bake_output_free(&one);
     vb_bake_output_free(&two);
-    free_mesh(&occ);
-    free_mesh(&rec);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
 }
 
 /* Offset normals average over bit-identical positions only. */
@@ -385,7 +342,7 @@ static void test_offset_normals(void)
     vb_mesh m = {0};
     float p[9] = {1, 2, 3, 1, 2, 3, 1, 2, 3.0001f};
     float n[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-    make_points(&m, 3, p, n);
+    test_make_points(&m, 3, p, n);
     float out[9];
     vb_error err;
     CHECK(vb_offset_normals(&m, out, &err) == VB_OK, "offset normals");
@@ -394,7 +351,7 @@ static void test_offset_normals(void)
           "averaged normal (%g %g %g)", out[0], out[1], out[2]);
     CHECK(memcmp(out, out + 3, 3 * sizeof(float)) == 0, "shared position, different normals");
     CHECK(out[6] == 0 && out[7] == 0 && out[8] == 1, "distinct position changed");
-    free_mesh(&m);
+    test_mesh_free(&m);
 }
 
 int main(void)

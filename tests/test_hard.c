@@ -1,0 +1,415 @@
+/*
+ * Hard cases for the bake (DESIGN.md section 5): each either gets the right
+ * answer or a clean rejection. Scenes are built in code.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake.h"
+#include "scene.h"
+#include "test_scenes.h"
+#include "test_util.h"
+#include "vdsh.h"
+#include "vdsh_sh.h"
+
+static int bake_with(const vb_mesh *occ, const vb_mesh *rec, uint32_t method, uint32_t rays,
+                     int robust, vb_bake_output *out)
+{
+    vb_error err;
+    vb_scene *s = NULL;
+    vb_scene_desc sd = {.robust = robust};
+    if (vb_scene_create(occ, &sd, &s, &err) != VB_OK) {
+        fprintf(stderr, "scene: %s\n", err.msg);
+        return 0;
+    }
+    vb_bake_desc d = {.receivers = rec, .scene = s, .rays = rays, .seed = 3, .method = method};
+    vb_result r = vb_bake_run(&d, out, &err);
+    if (r != VB_OK)
+        fprintf(stderr, "bake: %s\n", err.msg);
+    vb_scene_destroy(s);
+    return r == VB_OK;
+}
+
+static int bake(const vb_mesh *occ, const vb_mesh *rec, uint32_t method, uint32_t rays,
+                vb_bake_output *out)
+{
+    return bake_with(occ, rec, method, rays, 0, out);
+}
+
+static int all_finite(const vb_bake_output *b)
+{
+    size_t n = (size_t)b->vertex_count * b->max_order * b->max_order;
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(b->coeffs[i]))
+            return 0;
+    return 1;
+}
+
+/* The room of unwelded quads refined to receivers every 0.5 m. */
+static void refined_room(vb_mesh *occ, vb_mesh *rec, float a, float h, float b)
+{
+    vb_error err;
+    test_make_room(occ, a, h, b);
+    CHECK(vb_mesh_refine(occ, 0.5f, rec, &err) == VB_OK, "refine: %s", err.msg);
+}
+
+/* Concave corners and creases: a closed room of unwelded quads leaks no
+ * ray from our origins with Embree's robust traversal; the fast traversal
+ * may let a grazing ray slip through a crease edge (measured: 1 in 50,000
+ * here), so it gets a bound instead. A receiver in a floor corner sees ~0
+ * toward the two walls it touches (three quarters of its upper hemisphere)
+ * and the room beyond. */
+static void test_corners(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    refined_room(&occ, &rec, 4.0f, 3.0f, 2.5f);
+    vb_bake_output out = {0}, fast = {0};
+    CHECK(bake_with(&occ, &rec, VDSH_METHOD_PAPER, 1024, 1, &out), "bake");
+    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 1024, &fast), "fast bake");
+    if (!out.coeffs || !fast.coeffs)
+        goto done;
+    CHECK(out.rays_missed == 0, "%llu rays escaped a closed room of unwelded quads",
+          (unsigned long long)out.rays_missed);
+    CHECK(fast.rays_missed * 10000 < fast.rays_traced, "fast traversal: %llu of %llu escaped",
+          (unsigned long long)fast.rays_missed, (unsigned long long)fast.rays_traced);
+    CHECK(all_finite(&out), "non-finite coefficient");
+    int corners = 0;
+    for (uint32_t v = 0; v < rec.vertex_count; v++) {
+        const float *p = rec.positions + 3 * v, *n = rec.normals + 3 * v;
+        if (!(p[1] == 0 && n[1] == 1 && fabsf(p[0]) == 4 && fabsf(p[2]) == 2.5f))
+            continue;
+        corners++;
+        /* Directions above the floor: blocked if they head into either wall. */
+        double blocked = 0, open = 0;
+        int nb = 0, no = 0;
+        uint64_t s = v + 1;
+        for (int k = 0; k < 2000; k++) {
+            float d[3];
+            test_rand_dir(&s, d);
+            if (d[1] < 0.1f)
+                continue;
+            float D = vdsh_sh_reconstruct(5, out.coeffs + 25 * (size_t)v, d);
+            CHECK(isfinite(D), "non-finite reconstruction");
+            D = D > 0 ? D : 0;
+            if (d[0] * p[0] > 0 || d[2] * p[2] > 0)
+                blocked += D, nb++;
+            else
+                open += D, no++;
+        }
+        blocked /= nb, open /= no;
+        CHECK(blocked < 0.3 * open, "corner (%g, %g): mean D toward the walls %g vs %g open",
+              p[0], p[2], blocked, open);
+    }
+    CHECK(corners == 4, "found %d floor corners", corners);
+done:
+    vb_bake_output_free(&out);
+    vb_bake_output_free(&fast);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+}
+
+/* Zero-area triangles (collinear corners, repeated corners) hit nothing:
+ * adding them changes nothing but float rounding (they change the BVH, and
+ * a ray through a quad's diagonal gets its t from whichever of the two
+ * triangles is visited first; robust traversal, so that no grazing ray
+ * flips between hit and miss); needles and slivers occlude without NaN. */
+static void test_degenerate_triangles(void)
+{
+    vb_mesh occ = {0}, rec = {0}, junk = {0};
+    refined_room(&occ, &rec, 4.0f, 3.0f, 2.5f);
+    /* The same room plus 40 zero-area triangles inside it. */
+    test_make_room(&junk, 4.0f, 3.0f, 2.5f);
+    uint64_t s = 5;
+    uint32_t nv0 = junk.vertex_count, nt0 = junk.triangle_count;
+    junk.positions = realloc(junk.positions, 3 * (size_t)(nv0 + 120) * sizeof(float));
+    junk.normals = realloc(junk.normals, 3 * (size_t)(nv0 + 120) * sizeof(float));
+    junk.indices = realloc(junk.indices, 3 * (size_t)(nt0 + 40) * sizeof(uint32_t));
+    for (int t = 0; t < 40; t++) {
+        float a[3] = {(float)(6 * test_rand(&s) - 3), (float)(2.5 * test_rand(&s) + 0.2),
+                      (float)(4 * test_rand(&s) - 2)};
+        float dir[3];
+        test_rand_dir(&s, dir);
+        for (int k = 0; k < 3; k++) {
+            float f = t % 2 ? (float)k * 0.4f : (k == 2 ? 0.0f : 0.5f * k); /* collinear / repeated */
+            for (int c = 0; c < 3; c++) {
+                junk.positions[3 * (nv0 + 3 * t + k) + c] = a[c] + f * dir[c];
+                junk.normals[3 * (nv0 + 3 * t + k) + c] = 0;
+            }
+            junk.indices[3 * (nt0 + t) + k] = nv0 + 3 * t + k;
+        }
+    }
+    junk.vertex_count = nv0 + 120;
+    junk.triangle_count = nt0 + 40;
+    vb_bake_output a = {0}, b = {0};
+    CHECK(bake_with(&occ, &rec, VDSH_METHOD_PAPER, 400, 1, &a), "clean bake");
+    CHECK(bake_with(&junk, &rec, VDSH_METHOD_PAPER, 400, 1, &b), "bake with zero-area triangles");
+    if (a.coeffs && b.coeffs) {
+        double worst = 0;
+        for (size_t i = 0; i < (size_t)rec.vertex_count * 25; i++)
+            worst = fmax(worst, fabs(a.coeffs[i] - b.coeffs[i]));
+        CHECK(worst < 1e-5 * a.max_distance, "zero-area triangles changed a coefficient by %g",
+              worst);
+        CHECK(a.rays_missed == b.rays_missed, "zero-area triangles changed the misses");
+    }
+    vb_bake_output_free(&a);
+    vb_bake_output_free(&b);
+
+    /* Needles (1e-6 wide, 2 m long) and slivers: finite, and they occlude. */
+    vb_mesh nee = {0};
+    test_make_room(&nee, 4.0f, 3.0f, 2.5f);
+    const float n0[4][3] = {{-1, 0.5f, 0}, {1, 0.5f, 0}, {1, 0.500001f, 0}, {-1, 0.500001f, 0}};
+    const float up[3] = {0, 1, 0};
+    test_add_quad(&nee, n0, up);
+    const float sl[4][3] = {{0, 1, -1}, {0, 1, 1}, {1e-5f, 2, 1}, {1e-5f, 2, -1}};
+    test_add_quad(&nee, sl, up);
+    CHECK(bake(&nee, &rec, VDSH_METHOD_FULL, 400, &a), "bake with needles and slivers");
+    if (a.coeffs)
+        CHECK(all_finite(&a), "needles or slivers made a non-finite coefficient");
+    vb_bake_output_free(&a);
+    test_mesh_free(&nee);
+    test_mesh_free(&junk);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+}
+
+/* A receiver whose normal is undefined (0,0,0: only zero-area faces) has
+ * no horizon: `paper` then uses every direction, exactly like `full`. */
+static void test_undefined_normal(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    test_make_box(&occ, 2, 2, 2);
+    float p[6] = {0.5f, 1, 0.25f, -1, 0.3f, 1}, n[6] = {0};
+    test_make_points(&rec, 2, p, n);
+    vb_bake_output a = {0}, b = {0};
+    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 625, &a), "paper");
+    CHECK(bake(&occ, &rec, VDSH_METHOD_FULL, 625, &b), "full");
+    if (a.coeffs && b.coeffs) {
+        CHECK(all_finite(&a), "non-finite coefficients");
+        CHECK(memcmp(a.coeffs, b.coeffs, 2 * 25 * sizeof(float)) == 0,
+              "undefined normal: paper differs from full");
+        CHECK(a.undefined_normals == 2, "undefined normals counted: %u", a.undefined_normals);
+    }
+    vb_bake_output_free(&a);
+    vb_bake_output_free(&b);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+}
+
+static void transform(vb_mesh *m, float scale, const float offset[3])
+{
+    for (size_t i = 0; i < 3 * (size_t)m->vertex_count; i++)
+        m->positions[i] = m->positions[i] * scale + offset[i % 3];
+}
+
+/* Far from the origin and tiny: tracing happens in a normalised frame
+ * (power-of-two scale, centred), so a room moved to 1e5 or scaled by a
+ * power of two gives bit-identical coefficients (times the scale). One
+ * scaled by 1e-4 or 1e4 differs by float rounding of its input, which can
+ * flip a ray that grazes a crease between two surfaces: the same relative
+ * errors, not the same bits, so the check is on the mean and the share of
+ * receivers that moved. Robust traversal keeps traversal out of it. */
+static void test_scale_and_offset(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    refined_room(&occ, &rec, 4.0f, 3.0f, 2.5f);
+    vb_bake_output ref = {0};
+    CHECK(bake_with(&occ, &rec, VDSH_METHOD_PAPER, 400, 1, &ref), "reference bake");
+    size_t n = (size_t)rec.vertex_count * 25;
+
+    struct { float scale, off; int exact; const char *what; } cases[] = {
+        {1.0f, 1e5f, 1, "moved to 1e5"},
+        {1.0f, -3e5f, 1, "moved to -3e5"},
+        {1.0f / 16384, 0.0f, 1, "scaled by 2^-14"},
+        {1e-4f, 0.0f, 0, "scaled by 1e-4"},
+        {1e4f, 0.0f, 0, "scaled by 1e4"}};
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0] && ref.coeffs; c++) {
+        vb_mesh o2 = {0}, r2 = {0};
+        refined_room(&o2, &r2, 4.0f, 3.0f, 2.5f);
+        float off[3] = {cases[c].off, 0.0f, cases[c].off};
+        transform(&o2, cases[c].scale, off);
+        transform(&r2, cases[c].scale, off);
+        vb_bake_output b = {0};
+        CHECK(bake_with(&o2, &r2, VDSH_METHOD_PAPER, 400, 1, &b), "%s", cases[c].what);
+        if (b.coeffs) {
+            CHECK(b.rays_missed == ref.rays_missed, "%s: %llu rays escaped (%llu before)",
+                  cases[c].what, (unsigned long long)b.rays_missed,
+                  (unsigned long long)ref.rays_missed);
+            double worst = 0, sum = 0;
+            uint32_t moved = 0;
+            for (uint32_t v = 0; v < rec.vertex_count; v++) {
+                double vw = 0;
+                for (int i = 0; i < 25; i++) {
+                    size_t k = 25 * (size_t)v + i;
+                    double e = fabs(b.coeffs[k] / cases[c].scale - ref.coeffs[k]);
+                    vw = fmax(vw, e), sum += e;
+                }
+                worst = fmax(worst, vw);
+                moved += vw > 1e-4 * ref.max_distance;
+            }
+            if (cases[c].exact) {
+                CHECK(worst == 0.0, "%s: coefficients differ by %g", cases[c].what, worst);
+            } else {
+                CHECK(sum / n < 1e-5 * ref.max_distance, "%s: mean difference %g",
+                      cases[c].what, sum / n);
+                CHECK(moved * 100 <= rec.vertex_count, "%s: %u of %u receivers moved",
+                      cases[c].what, moved, rec.vertex_count);
+            }
+        }
+        vb_bake_output_free(&b);
+        test_mesh_free(&o2);
+        test_mesh_free(&r2);
+    }
+    vb_bake_output_free(&ref);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+}
+
+/* f16 streams keep their relative precision at any scale (stored values
+ * are coefficients / the largest |coefficient|). */
+static void test_f16_range(void)
+{
+    const float scales[3] = {1e-6f, 1.0f, 1e6f};
+    for (int k = 0; k < 3; k++) {
+        vb_mesh occ = {0}, rec = {0};
+        refined_room(&occ, &rec, 4.0f, 3.0f, 2.5f);
+        float zero[3] = {0, 0, 0};
+        transform(&occ, scales[k], zero);
+        transform(&rec, scales[k], zero);
+        vb_bake_output b = {0};
+        CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 256, &b), "bake at scale %g", scales[k]);
+        vdsh_stream s;
+        void *mem = NULL;
+        vb_error err;
+        if (b.coeffs &&
+            vb_bake_stream(&b, 5, VDSH_ENCODING_F16, &s, &mem, &err) == VB_OK) {
+            double worst = 0, amax = 0;
+            for (uint32_t v = 0; v < rec.vertex_count; v++) {
+                float c[25];
+                vdsh_stream_decode(&s, v, c);
+                for (int i = 0; i < 25; i++) {
+                    CHECK(isfinite(c[i]), "scale %g: non-finite f16 coefficient", scales[k]);
+                    worst = fmax(worst, fabs(c[i] - b.coeffs[25 * (size_t)v + i]));
+                    amax = fmax(amax, fabs(b.coeffs[25 * (size_t)v + i]));
+                }
+            }
+            /* Half precision: 2^-11 relative to the value, so at most
+             * 2^-11 of the largest coefficient. */
+            CHECK(worst <= amax / 2048.0 * 1.0001, "scale %g: f16 error %g of %g", scales[k],
+                  worst, amax);
+        } else {
+            CHECK(0, "f16 stream at scale %g", scales[k]);
+        }
+        free(mem);
+        vb_bake_output_free(&b);
+        test_mesh_free(&occ);
+        test_mesh_free(&rec);
+    }
+}
+
+/* Receivers in the plane of another, unjoined surface. A floor whose edge
+ * lies on a wall's plane: its edge vertices' rays toward the wall must hit
+ * it at ~0, not slip through the plane and escape. A pillar standing on
+ * the floor: its foot's downward rays must hit the floor. The scene is
+ * open, so rays away from the wall do escape: an edge vertex sees the
+ * clamp distance over about half of its hemisphere, not all of it. */
+static void test_coplanar_receivers(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    const float fl[4][3] = {{-4, 0, -2}, {-4, 0, 2}, {4, 0, 2}, {4, 0, -2}};
+    const float wall[4][3] = {{-4, -1, -3}, {-4, 3, -3}, {-4, 3, 3}, {-4, -1, 3}};
+    const float pil[4][3] = {{1, 0, -0.5f}, {1, 0, 0.5f}, {1, 2, 0.5f}, {1, 2, -0.5f}};
+    const float up[3] = {0, 1, 0}, px[3] = {1, 0, 0};
+    test_add_quad(&occ, fl, up);
+    test_add_quad(&occ, wall, px);
+    test_add_quad(&occ, pil, px);
+    vb_error err;
+    CHECK(vb_mesh_refine(&occ, 1.0f, &rec, &err) == VB_OK, "refine");
+    vb_bake_output b = {0};
+    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 1024, &b), "bake");
+    if (!b.coeffs)
+        goto done;
+    double all_escape = b.max_distance * sqrt(M_PI); /* c0 when every ray misses */
+    int floor_edge = 0, pillar_foot = 0;
+    for (uint32_t v = 0; v < rec.vertex_count; v++) {
+        const float *p = rec.positions + 3 * v, *n = rec.normals + 3 * v;
+        int on_wall = n[1] == 1 && p[0] == -4;
+        int foot = n[0] == 1 && p[0] == 1 && p[1] == 0;
+        if (!on_wall && !foot)
+            continue;
+        floor_edge += on_wall, pillar_foot += foot;
+        double c0 = b.coeffs[25 * (size_t)v];
+        CHECK(c0 < 0.6 * all_escape, "%s vertex (%g %g %g): c0 = %g, every ray escaping gives %g",
+              on_wall ? "floor-edge" : "pillar-foot", p[0], p[1], p[2], c0, all_escape);
+    }
+    CHECK(floor_edge >= 5 && pillar_foot >= 2, "found %d floor-edge and %d pillar-foot vertices",
+          floor_edge, pillar_foot);
+done:
+    vb_bake_output_free(&b);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+}
+
+/* An open mesh: every ray from a lone floor escapes and gets the clamp
+ * distance, so c0 is the projection of max * step(w.n). */
+static void test_open_mesh(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    const float fl[4][3] = {{-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}};
+    const float up[3] = {0, 1, 0};
+    test_add_quad(&occ, fl, up);
+    vb_error err;
+    CHECK(vb_mesh_refine(&occ, 0.5f, &rec, &err) == VB_OK, "refine");
+    vb_bake_output b = {0};
+    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 2500, &b), "bake");
+    if (b.coeffs) {
+        CHECK(b.rays_missed == b.rays_traced, "%llu of %llu rays hit an open floor",
+              (unsigned long long)(b.rays_traced - b.rays_missed),
+              (unsigned long long)b.rays_traced);
+        double want = b.max_distance * sqrt(M_PI);
+        for (uint32_t v = 0; v < rec.vertex_count; v++)
+            CHECK(fabs(b.coeffs[25 * (size_t)v] - want) < 0.03 * want, "c0 %g, want %g",
+                  b.coeffs[25 * (size_t)v], want);
+    }
+    vb_bake_output_free(&b);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+}
+
+/* Non-finite or out-of-range input through the API is rejected with a
+ * result code, not an assert or a crash. */
+static void test_bad_api_input(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    test_make_box(&occ, 1, 1, 1);
+    vb_error err;
+    vb_scene *s = NULL;
+    occ.positions[4] = NAN;
+    CHECK(vb_scene_create(&occ, NULL, &s, &err) == VB_ERR_INVALID && !s, "NaN occluder accepted");
+    occ.positions[4] = 1.0f;
+    occ.indices[5] = 99;
+    CHECK(vb_scene_create(&occ, NULL, &s, &err) == VB_ERR_INVALID && !s, "bad index accepted");
+    occ.indices[5] = 1;
+    CHECK(vb_scene_create(&occ, NULL, &s, &err) == VB_OK, "scene");
+    float p[3] = {0, 0.5f, 0}, n[3] = {0, INFINITY, 0};
+    test_make_points(&rec, 1, p, n);
+    vb_bake_desc d = {.receivers = &rec, .scene = s, .rays = 64};
+    vb_bake_output out = {0};
+    CHECK(vb_bake_run(&d, &out, &err) == VB_ERR_INVALID && !out.coeffs, "Inf normal accepted");
+    vb_scene_destroy(s);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+}
+
+int main(void)
+{
+    test_corners();
+    test_degenerate_triangles();
+    test_undefined_normal();
+    test_scale_and_offset();
+    test_f16_range();
+    test_coplanar_receivers();
+    test_open_mesh();
+    test_bad_api_input();
+    return test_report("test_hard");
+}
