@@ -89,14 +89,19 @@ static double angle(const double a[3], const double b[3])
  * largest diagonal, plus 1e-4 rad for rounding. */
 static void packet_cone(const vb_dirgrid *g, const uint32_t *cells, float cone[4])
 {
-    enum { S = 8 };
-    double axis[3] = {0, 0, 0}, d[3], e[3];
+    enum { S = 8, P = (S + 1) * (S + 1) };
+    /* Corner directions of every sub-cell of every live cell. */
+    double pts[VB_PACKET][P][3];
+    int live[VB_PACKET];
+    double axis[3] = {0, 0, 0};
     for (int k = 0; k < VB_PACKET; k++) {
-        if (cells[k] == UINT32_MAX)
+        live[k] = cells[k] != UINT32_MAX;
+        if (!live[k])
             continue;
         uint32_t row = cells[k] / g->nv, col = cells[k] % g->nv;
         for (int i = 0; i <= S; i++)
             for (int j = 0; j <= S; j++) {
+                double *d = pts[k][i * (S + 1) + j];
                 sphere_dir(g, row + (double)i / S, col + (double)j / S, d);
                 for (int c = 0; c < 3; c++)
                     axis[c] += d[c];
@@ -111,20 +116,17 @@ static void packet_cone(const vb_dirgrid *g, const uint32_t *cells, float cone[4
         axis[c] /= len;
     double worst = 0.0, diag = 0.0;
     for (int k = 0; k < VB_PACKET; k++) {
-        if (cells[k] == UINT32_MAX)
+        if (!live[k])
             continue;
-        uint32_t row = cells[k] / g->nv, col = cells[k] % g->nv;
         for (int i = 0; i <= S; i++)
             for (int j = 0; j <= S; j++) {
-                sphere_dir(g, row + (double)i / S, col + (double)j / S, d);
+                const double *d = pts[k][i * (S + 1) + j];
                 worst = fmax(worst, angle(axis, d));
                 if (i < S && j < S) {
-                    sphere_dir(g, row + (double)(i + 1) / S, col + (double)(j + 1) / S, e);
-                    diag = fmax(diag, angle(d, e));
-                    double f[3];
-                    sphere_dir(g, row + (double)(i + 1) / S, col + (double)j / S, e);
-                    sphere_dir(g, row + (double)i / S, col + (double)(j + 1) / S, f);
-                    diag = fmax(diag, angle(e, f));
+                    const double *r = pts[k][i * (S + 1) + j + 1];
+                    const double *u = pts[k][(i + 1) * (S + 1) + j];
+                    const double *ru = pts[k][(i + 1) * (S + 1) + j + 1];
+                    diag = fmax(diag, fmax(angle(d, ru), angle(r, u)));
                 }
             }
     }

@@ -173,15 +173,32 @@ static void on_progress(void *user, uint32_t done, uint32_t total,
 
 /* ---- output -------------------------------------------------------------- */
 
+/* Reports are small: open a temporary file beside `path`; report_close
+ * renames it over `path` only if everything was written. */
+static FILE *report_open(const char *path, char tmp[PATH_MAX])
+{
+    if (snprintf(tmp, PATH_MAX, "%s.tmp", path) >= PATH_MAX)
+        return NULL;
+    return fopen(tmp, "w");
+}
+
+static int report_close(FILE *fp, const char *tmp, const char *path)
+{
+    int bad = ferror(fp);
+    if (fclose(fp) != 0 || bad || rename(tmp, path) != 0) {
+        unlink(tmp);
+        return -1;
+    }
+    return 0;
+}
+
 static int write_report(const char *path, const options *o, const vdsh_file *f,
                         const vb_bake_output *b, const vdsh_timings *t,
                         double write_seconds, size_t coef_bytes,
                         long long file_size)
 {
     char tmp[PATH_MAX];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
-        return -1;
-    FILE *fp = fopen(tmp, "w");
+    FILE *fp = report_open(path, tmp);
     if (!fp)
         return -1;
     fprintf(fp, "{\n  \"output\": \"%s\",\n  \"sources\": [", o->output);
@@ -216,12 +233,7 @@ static int write_report(const char *path, const options *o, const vdsh_file *f,
                 ? b->rays_traced / (t->total + write_seconds) * 1e-6 : 0.0);
     fprintf(fp, "  \"coefficient_bytes_per_vertex\": %zu,\n", coef_bytes);
     fprintf(fp, "  \"file_bytes\": %lld\n}\n", file_size);
-    int bad = ferror(fp);
-    if (fclose(fp) != 0 || bad || rename(tmp, path) != 0) {
-        unlink(tmp);
-        return -1;
-    }
-    return 0;
+    return report_close(fp, tmp, path);
 }
 
 /* The bare loop's record: what the benchmark compares the bake against. */
@@ -229,9 +241,7 @@ static int write_bare_report(const char *path, const vb_bake_output *b,
                              const vdsh_timings *t)
 {
     char tmp[PATH_MAX];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
-        return -1;
-    FILE *fp = fopen(tmp, "w");
+    FILE *fp = report_open(path, tmp);
     if (!fp)
         return -1;
     fprintf(fp, "{\n  \"trace_only\": true,\n  \"receivers\": %u,\n"
@@ -241,12 +251,7 @@ static int write_bare_report(const char *path, const vb_bake_output *b,
                 "\"trace\": %.6f, \"bare\": %.6f}\n}\n",
             b->vertex_count, b->rays, b->threads, (unsigned long long)b->rays_traced,
             t->load, t->refine, t->build, t->trace, t->build + t->trace);
-    int bad = ferror(fp);
-    if (fclose(fp) != 0 || bad || rename(tmp, path) != 0) {
-        unlink(tmp);
-        return -1;
-    }
-    return 0;
+    return report_close(fp, tmp, path);
 }
 
 /* File stem and directory of OUT: "dir/room.vdsh" -> "dir", "room". */
