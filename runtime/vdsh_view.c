@@ -1,0 +1,1251 @@
+/*
+ * vdsh-view - look at a baked VDSH scene: interactively in a window, or
+ * headless (--render one image, --grid the paper's comparison row,
+ * --bench frame times of every shadow mode).
+ *
+ * The app layer: the only code that knows both the runtime (vr.h) and the
+ * context (vr_context.h), plus GLFW input and PNG files.
+ *
+ * Exit status: 0 success, 1 error (a file, GL), 2 usage error.
+ */
+#include "vr.h"
+#include "vr_context.h"
+
+#ifdef VR_HAVE_GLFW
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#endif
+#include <stb/stb_image_write.h>
+
+#include <errno.h>
+#include <malloc.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#ifndef VDSH_VERSION_STRING
+#define VDSH_VERSION_STRING "0"
+#endif
+
+enum { MAX_LIGHTS = 64, MAX_FILES = 8, EXIT_USAGE = 2 };
+
+typedef struct options {
+    const char *render_path, *grid_path;
+    int bench;
+    const char *files[MAX_FILES];
+    int file_count;
+    int have_camera;
+    float camera[6];
+    float fov;
+    vr_light lights[MAX_LIGHTS];
+    int light_count;
+    int default_lights;        /* --lights N; 0: 1 (3 for --bench's second set) */
+    int have_att;
+    float att[3];
+    int have_ambient;
+    float ambient;
+    vr_mode mode;
+    uint32_t compare;
+    int pcf;
+    int shadow_size;
+    int have_size;
+    int width, height;
+    const char *cubemap_dir;
+    int no_cubemaps;
+    uint32_t egl;
+    int frames;
+    int no_mallopt;
+    int quiet;
+    const char *screenshot;
+    int no_overlay;
+    const char *keys;
+} options;
+
+static const char usage_text[] =
+    "Usage: vdsh-view [options] SCENE.vdsh              (a window)\n"
+    "       vdsh-view --render OUT.png [options] SCENE.vdsh\n"
+    "       vdsh-view --grid OUT.png [options] SCENE.vdsh\n"
+    "       vdsh-view --bench [options] SCENE.vdsh...\n"
+    "Look at a scene baked by vdsh-bake, lit by point lights with precomputed\n"
+    "visibility-distance shadows (VDSH) or cube shadow maps.\n"
+    "\n"
+    "Output:\n"
+    "      --render FILE     render one image headless (no display needed)\n"
+    "      --grid FILE       render the comparison row: no shadows | cube shadow\n"
+    "                        map | VDSH order 5 | 3 | 2, labelled, into one image\n"
+    "      --bench           time every shadow mode with 1 and 3 lights on each\n"
+    "                        SCENE, all in this process; JSON on stdout\n"
+    "\n"
+    "View (defaults come from the scene's bounds, y up):\n"
+    "      --camera EX,EY,EZ,TX,TY,TZ   eye and target point\n"
+    "      --fov DEG         vertical field of view (default 60)\n"
+    "      --light X,Y,Z[,R,G,B]  a point light (repeatable)\n"
+    "      --lights N        use N default lights, 1..4 (default 1)\n"
+    "      --attenuation A0,A1,A2  for every light: 1/(A0 + A1 d + A2 d^2)\n"
+    "                        (default 1, 0, 1/(0.3 * diagonal)^2)\n"
+    "      --ambient V       ambient light (default 0.03)\n"
+    "      --mode M          none, cube, vdsh2, vdsh3, vdsh5 (order 5, basis\n"
+    "                        cubemaps; the default) or vdsh5poly (order 5,\n"
+    "                        polynomials); order n = n bands = n*n coefficients\n"
+    "      --compare C       smooth (the paper's ramp, default) or binary\n"
+    "      --pcf             cube shadow maps with PCF (default: 1 tap)\n"
+    "      --shadow-size N   cube shadow map face size (default 512)\n"
+    "      --size WxH        image or window size (default 1024x768; with\n"
+    "                        --grid the size of each panel, default 512x384)\n"
+    "\n"
+    "Files:\n"
+    "      --cubemap-dir DIR where the basis cubemaps are (default: beside\n"
+    "                        the .vdsh)\n"
+    "      --no-cubemaps     do not load them (mode vdsh5 is then unavailable)\n"
+    "\n"
+    "Other:\n"
+    "      --egl P           headless EGL platform: device or surfaceless\n"
+    "                        (default: device, else surfaceless)\n"
+    "      --frames N        window: quit after N frames; --bench: timed\n"
+    "                        rounds per mode (default 7)\n"
+    "      --screenshot FILE window: save what the window shows after the\n"
+    "                        last frame (with --frames) as PNG\n"
+    "      --no-overlay      window: start without the text overlay\n"
+    "      --keys KEYS       window: press these keys, one per frame from the\n"
+    "                        first (letters, digits, space; '>' is Tab, '<'\n"
+    "                        Backspace): scripted demos and tests\n"
+    "      --no-mallopt      keep glibc's default malloc trimming (by default\n"
+    "                        the viewer raises M_TRIM_THRESHOLD and\n"
+    "                        M_MMAP_THRESHOLD: see docs/BENCHMARKS.md)\n"
+    "  -q, --quiet           no summary on stderr\n"
+    "  -h, --help            this text (the window's keys: press h in it)\n"
+    "  -V, --version         version\n"
+    "\n"
+    "Exit status: 0 success, 1 error, 2 usage error.\n"
+    "Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n"
+    "         vdsh-view room.vdsh --grid room-grid.png\n";
+
+static const char keys_text[] =
+    "vdsh-view keys:\n"
+    "  mouse left drag   orbit around the target     right drag   look around\n"
+    "  wheel             closer / farther            W A S D Q E  fly (shift: faster)\n"
+    "  1 2 3 4 5 6       mode: none, cube shadow map, VDSH order 2, 3, 5 (cubemaps),\n"
+    "                    5 (polynomials)                M  next mode\n"
+    "  C                 comparison smooth / binary   P  cube map PCF on / off\n"
+    "  Tab               select the next light        N  new light at the target\n"
+    "  arrows, PgUp/PgDn move the selected light      Backspace  remove it\n"
+    "  Space             animate the lights           F  fire a short-lived light\n"
+    "  R                 reset the view               X  save a screenshot (PNG)\n"
+    "  O                 overlay on / off             H  this list\n"
+    "  Esc               quit\n";
+
+static int usage_error(const char *fmt, const char *arg)
+{
+    fprintf(stderr, "vdsh-view: ");
+    fprintf(stderr, fmt, arg);
+    fprintf(stderr, "\nTry 'vdsh-view --help'.\n");
+    return EXIT_USAGE;
+}
+
+/* Parse exactly n..max comma-separated finite floats. Returns the count,
+ * or -1. */
+static int parse_floats(const char *s, float *out, int min, int max)
+{
+    int n = 0;
+    const char *p = s;
+    while (n < max) {
+        char *end;
+        errno = 0;
+        float v = strtof(p, &end);
+        if (end == p || errno || !isfinite(v))
+            return -1;
+        out[n++] = v;
+        if (*end == '\0')
+            return n >= min ? n : -1;
+        if (*end != ',')
+            return -1;
+        p = end + 1;
+    }
+    return -1;
+}
+
+static int parse_int(const char *s, int lo, int hi, int *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (end == s || *end || errno || v < lo || v > hi)
+        return -1;
+    *out = (int)v;
+    return 0;
+}
+
+/* Returns 0, or an exit status (help/version: -1 meaning exit 0). */
+static int parse_args(int argc, char **argv, options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->mode = VR_MODE_VDSH5;
+    o->egl = VR_EGL_AUTO;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+#define NEED_VALUE()                                                   \
+    do {                                                               \
+        if (!v)                                                        \
+            return usage_error("%s needs a value", a);                 \
+        i++;                                                           \
+    } while (0)
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            fputs(usage_text, stdout);
+            return -1;
+        } else if (!strcmp(a, "-V") || !strcmp(a, "--version")) {
+            printf("vdsh-view %s\n", VDSH_VERSION_STRING);
+            return -1;
+        } else if (!strcmp(a, "--render")) {
+            NEED_VALUE();
+            o->render_path = v;
+        } else if (!strcmp(a, "--grid")) {
+            NEED_VALUE();
+            o->grid_path = v;
+        } else if (!strcmp(a, "--bench")) {
+            o->bench = 1;
+        } else if (!strcmp(a, "--camera")) {
+            NEED_VALUE();
+            if (parse_floats(v, o->camera, 6, 6) != 6)
+                return usage_error("--camera: expected EX,EY,EZ,TX,TY,TZ, got '%s'", v);
+            o->have_camera = 1;
+        } else if (!strcmp(a, "--fov")) {
+            NEED_VALUE();
+            if (parse_floats(v, &o->fov, 1, 1) != 1 || !(o->fov > 1.0f && o->fov < 179.0f))
+                return usage_error("--fov: expected degrees in (1, 179), got '%s'", v);
+        } else if (!strcmp(a, "--light")) {
+            NEED_VALUE();
+            float f[6];
+            int n = parse_floats(v, f, 3, 6);
+            if (n != 3 && n != 6)
+                return usage_error("--light: expected X,Y,Z or X,Y,Z,R,G,B, got '%s'", v);
+            if (o->light_count == MAX_LIGHTS)
+                return usage_error("--light: at most 64 lights (%s)", v);
+            vr_light *l = &o->lights[o->light_count++];
+            memset(l, 0, sizeof *l);
+            memcpy(l->position, f, sizeof l->position);
+            if (n == 6) {
+                memcpy(l->color, f + 3, sizeof l->color);
+                /* all-zero means white in vr_light: keep a black light black */
+                if (!f[3] && !f[4] && !f[5])
+                    l->color[0] = 1e-30f;
+            }
+        } else if (!strcmp(a, "--lights")) {
+            NEED_VALUE();
+            if (parse_int(v, 1, 4, &o->default_lights))
+                return usage_error("--lights: expected 1..4, got '%s'", v);
+        } else if (!strcmp(a, "--attenuation")) {
+            NEED_VALUE();
+            if (parse_floats(v, o->att, 3, 3) != 3 || o->att[0] < 0 || o->att[1] < 0 ||
+                o->att[2] < 0 || !(o->att[0] + o->att[1] + o->att[2] > 0))
+                return usage_error("--attenuation: expected A0,A1,A2 >= 0, not all 0, got '%s'",
+                                   v);
+            o->have_att = 1;
+        } else if (!strcmp(a, "--ambient")) {
+            NEED_VALUE();
+            if (parse_floats(v, &o->ambient, 1, 1) != 1 || o->ambient < 0)
+                return usage_error("--ambient: expected a value >= 0, got '%s'", v);
+            o->have_ambient = 1;
+        } else if (!strcmp(a, "--mode")) {
+            NEED_VALUE();
+            if (vr_mode_from_name(v, &o->mode))
+                return usage_error("--mode: expected none, cube, vdsh2, vdsh3, vdsh5 or "
+                                   "vdsh5poly, got '%s'", v);
+        } else if (!strcmp(a, "--compare")) {
+            NEED_VALUE();
+            if (!strcmp(v, "smooth"))
+                o->compare = VDSH_COMPARE_SMOOTH;
+            else if (!strcmp(v, "binary"))
+                o->compare = VDSH_COMPARE_BINARY;
+            else
+                return usage_error("--compare: expected smooth or binary, got '%s'", v);
+        } else if (!strcmp(a, "--pcf")) {
+            o->pcf = 1;
+        } else if (!strcmp(a, "--shadow-size")) {
+            NEED_VALUE();
+            if (parse_int(v, 1, 8192, &o->shadow_size))
+                return usage_error("--shadow-size: expected 1..8192, got '%s'", v);
+        } else if (!strcmp(a, "--size")) {
+            NEED_VALUE();
+            char *x;
+            long w = strtol(v, &x, 10), h = 0;
+            if (x != v && (*x == 'x' || *x == 'X')) {
+                char *end;
+                h = strtol(x + 1, &end, 10);
+                if (*end || end == x + 1)
+                    h = 0;
+            }
+            if (w < 1 || w > 16384 || h < 1 || h > 16384)
+                return usage_error("--size: expected WxH (1..16384), got '%s'", v);
+            o->width = (int)w;
+            o->height = (int)h;
+            o->have_size = 1;
+        } else if (!strcmp(a, "--cubemap-dir")) {
+            NEED_VALUE();
+            o->cubemap_dir = v;
+        } else if (!strcmp(a, "--no-cubemaps")) {
+            o->no_cubemaps = 1;
+        } else if (!strcmp(a, "--egl")) {
+            NEED_VALUE();
+            if (!strcmp(v, "device"))
+                o->egl = VR_EGL_DEVICE;
+            else if (!strcmp(v, "surfaceless"))
+                o->egl = VR_EGL_SURFACELESS;
+            else
+                return usage_error("--egl: expected device or surfaceless, got '%s'", v);
+        } else if (!strcmp(a, "--frames")) {
+            NEED_VALUE();
+            if (parse_int(v, 1, 1000000, &o->frames))
+                return usage_error("--frames: expected a positive count, got '%s'", v);
+        } else if (!strcmp(a, "--screenshot")) {
+            NEED_VALUE();
+            o->screenshot = v;
+        } else if (!strcmp(a, "--no-overlay")) {
+            o->no_overlay = 1;
+        } else if (!strcmp(a, "--keys")) {
+            NEED_VALUE();
+            for (const char *k = v; *k; k++)
+                if (!strchr("abcdefghijklmnopqrstuvwxyz0123456789 <>", *k))
+                    return usage_error("--keys: letters, digits, space, '<' and '>' only, "
+                                       "got '%s'", v);
+            o->keys = v;
+        } else if (!strcmp(a, "--no-mallopt")) {
+            o->no_mallopt = 1;
+        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
+            o->quiet = 1;
+        } else if (a[0] == '-' && a[1]) {
+            return usage_error("unknown option '%s'", a);
+        } else {
+            if (o->file_count == MAX_FILES)
+                return usage_error("too many scene files (%s)", a);
+            o->files[o->file_count++] = a;
+        }
+#undef NEED_VALUE
+    }
+    if (o->file_count == 0)
+        return usage_error("%s", "no scene file given");
+    if ((o->render_path != NULL) + (o->grid_path != NULL) + o->bench > 1)
+        return usage_error("%s", "choose one of --render, --grid and --bench");
+    if (o->file_count > 1 && !o->bench)
+        return usage_error("one scene file at a time (several only with --bench), got '%s'",
+                           o->files[1]);
+    return 0;
+}
+
+/* ------------------------------------------------------------------ */
+/* Scene defaults                                                       */
+
+static float scene_diagonal(const vr_scene *s)
+{
+    vr_scene_info info;
+    vr_scene_get_info(s, &info);
+    float d2 = 0.0f;
+    for (int k = 0; k < 3; k++)
+        d2 += (info.bounds_max[k] - info.bounds_min[k]) * (info.bounds_max[k] - info.bounds_min[k]);
+    return sqrtf(d2) > 0.0f ? sqrtf(d2) : 1.0f;
+}
+
+/* n default lights of the scene: positions from vr_scene_default_lights,
+ * warm/cool colours, and a fall-off that halves the light at about 0.3 of
+ * the scene's diagonal. */
+static int default_lights(const vr_scene *s, const options *o, int n, vr_light *out)
+{
+    static const float colors[4][3] = {
+        {1.0f, 0.92f, 0.8f}, {0.55f, 0.7f, 1.0f}, {1.0f, 0.62f, 0.4f}, {0.7f, 1.0f, 0.7f}};
+    n = vr_scene_default_lights(s, out, n);
+    float r = 0.3f * scene_diagonal(s);
+    /* dimmer when there are several, so that their sum stays in range */
+    float intensity = 1.6f / (1.0f + 0.6f * (float)(n - 1));
+    for (int i = 0; i < n; i++) {
+        for (int k = 0; k < 3; k++)
+            out[i].color[k] = intensity * colors[i][k];
+        if (o->have_att)
+            memcpy(out[i].attenuation, o->att, sizeof o->att);
+        else {
+            out[i].attenuation[0] = 1.0f;
+            out[i].attenuation[2] = 1.0f / (r * r);
+        }
+    }
+    return n;
+}
+
+/* The lights of options (with --attenuation applied), else n defaults. */
+static int scene_lights(const vr_scene *s, const options *o, int n, vr_light *out)
+{
+    if (o->light_count == 0)
+        return default_lights(s, o, n, out);
+    float r = 0.3f * scene_diagonal(s);
+    for (int i = 0; i < o->light_count; i++) {
+        out[i] = o->lights[i];
+        if (o->have_att)
+            memcpy(out[i].attenuation, o->att, sizeof o->att);
+        else {
+            out[i].attenuation[0] = 1.0f;
+            out[i].attenuation[2] = 1.0f / (r * r);
+        }
+        if (!out[i].color[0] && !out[i].color[1] && !out[i].color[2])
+            out[i].color[0] = out[i].color[1] = out[i].color[2] = 1.6f;
+    }
+    return o->light_count;
+}
+
+static void scene_camera(const vr_scene *s, const options *o, vr_camera *c)
+{
+    vr_scene_default_camera(s, c);
+    if (o->have_camera) {
+        memcpy(c->eye, o->camera, 3 * sizeof(float));
+        memcpy(c->target, o->camera + 3, 3 * sizeof(float));
+    }
+    if (o->fov > 0.0f)
+        c->fov_y = o->fov;
+}
+
+static vr_draw_desc base_desc(const options *o, const vr_light *lights, int n)
+{
+    vr_draw_desc d;
+    memset(&d, 0, sizeof d);
+    d.mode = o->mode;
+    d.compare = o->compare;
+    d.pcf = o->pcf;
+    d.lights = lights;
+    d.light_count = n;
+    float amb = o->have_ambient ? o->ambient : 0.03f;
+    d.ambient[0] = d.ambient[1] = d.ambient[2] = amb;
+    return d;
+}
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
+}
+
+static int write_png(const char *path, int w, int h, const unsigned char *rgba)
+{
+    /* Opaque PNGs: the framebuffer's alpha is whatever blending left. */
+    size_t n = (size_t)w * (size_t)h;
+    unsigned char *copy = malloc(n * 4);
+    if (!copy) {
+        fprintf(stderr, "vdsh-view: %s: out of memory\n", path);
+        return 1;
+    }
+    for (size_t i = 0; i < n; i++) {
+        memcpy(copy + 4 * i, rgba + 4 * i, 3);
+        copy[4 * i + 3] = 255;
+    }
+    errno = 0;
+    int ok = stbi_write_png(path, w, h, 4, copy, w * 4);
+    free(copy);
+    if (!ok) {
+        fprintf(stderr, "vdsh-view: %s: cannot write PNG%s%s\n", path, errno ? ": " : "",
+                errno ? strerror(errno) : "");
+        return 1;
+    }
+    return 0;
+}
+
+/* Everything a run needs: a context, the scene, a renderer. */
+typedef struct session {
+    vr_context *ctx;
+    vr_scene *scene;
+    vr_renderer *r;
+} session;
+
+static void session_close(session *s)
+{
+    vr_renderer_destroy(s->r);
+    vr_scene_destroy(s->scene);
+    vr_context_destroy(s->ctx);
+    memset(s, 0, sizeof *s);
+}
+
+static int open_scene(const options *o, const char *path, vr_scene **out)
+{
+    vr_error err;
+    vr_scene_desc sd = {.path = path, .cubemap_dir = o->cubemap_dir,
+                        .skip_cubemaps = o->no_cubemaps};
+    vr_result r = vr_scene_create(&sd, out, &err);
+    if (r != VR_OK) {
+        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+        if (r == VR_ERR_MISSING && !o->no_cubemaps)
+            fprintf(stderr, "vdsh-view: (--no-cubemaps loads the scene without them; "
+                    "mode vdsh5poly needs none)\n");
+        return 1;
+    }
+    return 0;
+}
+
+static int session_open(const options *o, uint32_t kind, int w, int h, session *s)
+{
+    vr_error err;
+    memset(s, 0, sizeof *s);
+    vr_context_desc cd = {.kind = kind, .egl_platform = o->egl, .width = w, .height = h};
+    if (vr_context_create(&cd, &s->ctx, &err) != VR_OK) {
+        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+        return 1;
+    }
+    if (open_scene(o, o->files[0], &s->scene)) {
+        session_close(s);
+        return 1;
+    }
+    vr_renderer_desc rd = {.width = w, .height = h, .shadow_map_size = o->shadow_size};
+    if (vr_renderer_create(&rd, &s->r, &err) != VR_OK) {
+        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+        session_close(s);
+        return 1;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------ */
+/* --render and --grid                                                  */
+
+static int run_render(const options *o)
+{
+    int w = o->have_size ? o->width : 1024, h = o->have_size ? o->height : 768;
+    session s;
+    if (session_open(o, VR_CONTEXT_HEADLESS, w, h, &s))
+        return 1;
+    vr_light lights[MAX_LIGHTS];
+    int n = scene_lights(s.scene, o, o->default_lights ? o->default_lights : 1, lights);
+    vr_draw_desc d = base_desc(o, lights, n);
+    scene_camera(s.scene, o, &d.camera);
+    vr_error err;
+    int rc = 1;
+    unsigned char *px = malloc((size_t)w * (size_t)h * 4);
+    double t0 = now_ms();
+    if (!px)
+        fprintf(stderr, "vdsh-view: out of memory\n");
+    else if (vr_draw(s.r, s.scene, &d, &err) != VR_OK ||
+             vr_read_pixels(s.r, px, (size_t)w * (size_t)h * 4, &err) != VR_OK)
+        fprintf(stderr, "vdsh-view: %s: %s\n", o->files[0], err.msg);
+    else {
+        double ms = now_ms() - t0;
+        rc = write_png(o->render_path, w, h, px);
+        if (!rc && !o->quiet)
+            fprintf(stderr, "vdsh-view: wrote %s (%dx%d, mode %s, %d light%s, %.0f ms, %s; %s)\n",
+                    o->render_path, w, h, vr_mode_name(o->mode), n, n == 1 ? "" : "s", ms,
+                    vr_gl_renderer(), vr_context_description(s.ctx));
+    }
+    free(px);
+    session_close(&s);
+    return rc;
+}
+
+static int run_grid(const options *o)
+{
+    int w = o->have_size ? o->width : 512, h = o->have_size ? o->height : 384;
+    session s;
+    if (session_open(o, VR_CONTEXT_HEADLESS, w, h, &s))
+        return 1;
+    vr_light lights[MAX_LIGHTS];
+    int n = scene_lights(s.scene, o, o->default_lights ? o->default_lights : 1, lights);
+    /* The paper's row. Order 5 the paper's way when the cubemaps are
+     * there, else with the polynomials (the same image to f16 precision). */
+    vr_mode modes[5] = {VR_MODE_NONE, VR_MODE_CUBE, VR_MODE_VDSH5, VR_MODE_VDSH3, VR_MODE_VDSH2};
+    if (!vr_scene_supports(s.scene, VR_MODE_VDSH5))
+        modes[2] = VR_MODE_VDSH5_POLY;
+    size_t panel = (size_t)w * (size_t)h * 4;
+    unsigned char *px = malloc(panel), *img = calloc(5, panel);
+    int rc = 0;
+    if (!px || !img) {
+        fprintf(stderr, "vdsh-view: out of memory\n");
+        rc = 1;
+    }
+    for (int m = 0; m < 5 && !rc; m++) {
+        vr_error err;
+        vr_draw_desc d = base_desc(o, lights, n);
+        d.mode = modes[m];
+        scene_camera(s.scene, o, &d.camera);
+        char label[160];
+        int shadow = o->shadow_size ? o->shadow_size : 512;
+        if (modes[m] == VR_MODE_CUBE)
+            snprintf(label, sizeof label, "cube shadow map (%d^2 x 6, %s)", shadow,
+                     o->pcf ? "PCF" : "1 tap");
+        else if (modes[m] >= VR_MODE_VDSH2)
+            snprintf(label, sizeof label, "%s%s", vr_mode_label(modes[m]),
+                     o->compare == VDSH_COMPARE_BINARY ? ", binary" : "");
+        else
+            snprintf(label, sizeof label, "%s", vr_mode_label(modes[m]));
+        vr_result r = VR_OK;
+        if (!vr_scene_supports(s.scene, modes[m])) {
+            /* A file baked without this order: say so in the panel. */
+            vr_draw_desc none = d;
+            none.light_count = 0;
+            none.mode = VR_MODE_NONE;
+            snprintf(label + strlen(label), sizeof label - strlen(label), ": not in this file");
+            r = vr_draw(s.r, s.scene, &none, &err);
+        } else
+            r = vr_draw(s.r, s.scene, &d, &err);
+        if (r == VR_OK)
+            r = vr_draw_text(s.r, 4, 4, w >= 400 ? 2.0f : 1.0f, NULL, label, &err);
+        if (r == VR_OK)
+            r = vr_read_pixels(s.r, px, panel, &err);
+        if (r != VR_OK) {
+            fprintf(stderr, "vdsh-view: %s: %s: %s\n", o->files[0], vr_mode_name(modes[m]),
+                    err.msg);
+            rc = 1;
+            break;
+        }
+        for (int y = 0; y < h; y++)
+            memcpy(img + ((size_t)y * 5 * (size_t)w + (size_t)m * (size_t)w) * 4,
+                   px + (size_t)y * (size_t)w * 4, (size_t)w * 4);
+    }
+    if (!rc) {
+        /* A thin dark line between panels. */
+        for (int m = 1; m < 5; m++)
+            for (int y = 0; y < h; y++)
+                memset(img + ((size_t)y * 5 * (size_t)w + (size_t)m * (size_t)w) * 4, 40, 4);
+        rc = write_png(o->grid_path, 5 * w, h, img);
+        if (!rc && !o->quiet)
+            fprintf(stderr, "vdsh-view: wrote %s (%dx%d: none | cube | %s | vdsh3 | vdsh2, "
+                    "%d light%s, %s)\n", o->grid_path, 5 * w, h, vr_mode_name(modes[2]), n,
+                    n == 1 ? "" : "s", vr_gl_renderer());
+    }
+    free(px);
+    free(img);
+    session_close(&s);
+    return rc;
+}
+
+/* ------------------------------------------------------------------ */
+/* --bench                                                              */
+
+typedef struct bench_mode {
+    vr_mode mode;
+    int pcf;
+    const char *name;
+} bench_mode;
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static void print_series(const char *key, const double *v, int n, int last)
+{
+    printf("\"%s\": [", key);
+    for (int i = 0; i < n; i++)
+        printf("%s%.4f", i ? ", " : "", v[i]);
+    printf("]%s", last ? "" : ", ");
+}
+
+/* A JSON string: quotes, backslashes and control characters escaped. */
+static void print_json_string(const char *s)
+{
+    putchar('"');
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if (*p == '"' || *p == '\\')
+            printf("\\%c", *p);
+        else if (*p < 0x20)
+            printf("\\u%04x", *p);
+        else
+            putchar(*p);
+    }
+    putchar('"');
+}
+
+static int bench_scene(const options *o, const char *path, vr_renderer *r, int first_scene)
+{
+    vr_scene *scene = NULL;
+    if (open_scene(o, path, &scene))
+        return 1;
+    vr_scene_info info;
+    vr_scene_get_info(scene, &info);
+    static const bench_mode all[] = {
+        {VR_MODE_NONE, 0, "none"},   {VR_MODE_CUBE, 0, "cube"},
+        {VR_MODE_CUBE, 1, "cube_pcf"}, {VR_MODE_VDSH2, 0, "vdsh2"},
+        {VR_MODE_VDSH3, 0, "vdsh3"}, {VR_MODE_VDSH5, 0, "vdsh5"},
+        {VR_MODE_VDSH5_POLY, 0, "vdsh5poly"}};
+    enum { NMODES = sizeof all / sizeof all[0], MAX_ROUNDS = 64 };
+    bench_mode modes[NMODES];
+    int nm = 0;
+    for (int i = 0; i < NMODES; i++)
+        if (vr_scene_supports(scene, all[i].mode))
+            modes[nm++] = all[i];
+    int rounds = o->frames ? (o->frames < MAX_ROUNDS ? o->frames : MAX_ROUNDS) : 7;
+    static const int light_sets[2] = {1, 3};
+
+    printf("%s{\"file\": ", first_scene ? "" : ", ");
+    print_json_string(path);
+    printf(", \"vertices\": %u, \"triangles\": %u, \"results\": [", info.vertex_count,
+           info.triangle_count);
+    int rc = 0;
+    for (int ls = 0; ls < 2 && !rc; ls++) {
+        vr_light lights[4];
+        int n = default_lights(scene, o, light_sets[ls], lights);
+        static double cpu[NMODES][MAX_ROUNDS], gpu[NMODES][MAX_ROUNDS];
+        static double shadow[NMODES][MAX_ROUNDS], lighting[NMODES][MAX_ROUNDS];
+        /* Warm-up: compile every program and allocate every shadow map
+         * before anything is timed. Then rounds that each time every mode
+         * once, starting at a different mode each round, so that slow
+         * drifts of a shared machine spread over all modes alike. */
+        for (int round = -2; round < rounds && !rc; round++) {
+            for (int k = 0; k < nm && !rc; k++) {
+                int m = (k + (round > 0 ? round : 0)) % nm;
+                vr_draw_desc d = base_desc(o, lights, n);
+                d.mode = modes[m].mode;
+                d.pcf = modes[m].pcf;
+                scene_camera(scene, o, &d.camera);
+                vr_error err;
+                if (vr_draw(r, scene, &d, &err) != VR_OK) {
+                    fprintf(stderr, "vdsh-view: %s: %s: %s\n", path, modes[m].name, err.msg);
+                    rc = 1;
+                    break;
+                }
+                vr_renderer_finish(r);
+                vr_timings t;
+                vr_renderer_timings(r, &t);
+                if (round >= 0) {
+                    cpu[m][round] = t.cpu_ms;
+                    gpu[m][round] = t.gpu_ms;
+                    shadow[m][round] = t.shadow_total_ms;
+                    lighting[m][round] = t.lighting_total_ms;
+                }
+            }
+        }
+        for (int m = 0; m < nm && !rc; m++) {
+            double sorted[MAX_ROUNDS];
+            memcpy(sorted, cpu[m], (size_t)rounds * sizeof(double));
+            qsort(sorted, (size_t)rounds, sizeof(double), cmp_double);
+            printf("%s{\"lights\": %d, \"mode\": \"%s\", \"median_cpu_ms\": %.4f, ",
+                   ls == 0 && m == 0 ? "" : ", ", n, modes[m].name, sorted[rounds / 2]);
+            print_series("cpu_ms", cpu[m], rounds, 0);
+            print_series("gpu_ms", gpu[m], rounds, 0);
+            print_series("shadow_ms", shadow[m], rounds, 0);
+            print_series("lighting_ms", lighting[m], rounds, 1);
+            printf("}");
+            if (!o->quiet)
+                fprintf(stderr, "vdsh-view: %s, %d light%s, %-9s median %.1f ms\n", path, n,
+                        n == 1 ? "" : "s", modes[m].name, sorted[rounds / 2]);
+        }
+        fflush(stdout);
+    }
+    printf("]}");
+    vr_scene_destroy(scene);
+    return rc;
+}
+
+static int run_bench(const options *o)
+{
+    int w = o->have_size ? o->width : 1024, h = o->have_size ? o->height : 768;
+    vr_context *ctx = NULL;
+    vr_renderer *r = NULL;
+    vr_error err;
+    vr_context_desc cd = {.kind = VR_CONTEXT_HEADLESS, .egl_platform = o->egl};
+    if (vr_context_create(&cd, &ctx, &err) != VR_OK) {
+        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+        return 1;
+    }
+    vr_renderer_desc rd = {.width = w, .height = h, .shadow_map_size = o->shadow_size};
+    if (vr_renderer_create(&rd, &r, &err) != VR_OK) {
+        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+        vr_context_destroy(ctx);
+        return 1;
+    }
+    printf("{\"version\": ");
+    print_json_string(VDSH_VERSION_STRING);
+    printf(", \"renderer\": ");
+    print_json_string(vr_gl_renderer());
+    printf(", \"context\": ");
+    print_json_string(vr_context_description(ctx));
+    printf(", \"width\": %d, \"height\": %d, \"shadow_size\": %d, \"mallopt\": %s, "
+           "\"rounds\": %d, \"scenes\": [",
+           w, h, o->shadow_size ? o->shadow_size : 512, o->no_mallopt ? "false" : "true",
+           o->frames ? o->frames : 7);
+    int rc = 0;
+    for (int i = 0; i < o->file_count && !rc; i++)
+        rc = bench_scene(o, o->files[i], r, i == 0);
+    printf("]}\n");
+    vr_renderer_destroy(r);
+    vr_context_destroy(ctx);
+    return rc;
+}
+
+/* ------------------------------------------------------------------ */
+/* The window                                                           */
+
+#ifdef VR_HAVE_GLFW
+typedef struct app {
+    const options *o;
+    session s;
+    vr_light base[MAX_LIGHTS];   /* user lights before animation */
+    int n;
+    int selected;
+    float target[3], yaw, pitch, dist, diag;
+    vr_camera home;
+    int animate;
+    double anim_t;
+    int fired;                   /* a short-lived light is alive */
+    float fired_pos[3], fired_vel[3];
+    double fired_age;
+    vr_mode mode;
+    uint32_t compare;
+    int pcf, overlay;
+    double mx, my;
+    int drag;                    /* 1 left (orbit), 2 right (look) */
+    int shots;
+    char status[256];
+} app;
+
+static const double FIRE_LIFE = 2.0;
+
+static void forward(const app *a, float f[3])
+{
+    f[0] = cosf(a->pitch) * cosf(a->yaw);
+    f[1] = sinf(a->pitch);
+    f[2] = cosf(a->pitch) * sinf(a->yaw);
+}
+
+static void set_view(app *a, const vr_camera *c)
+{
+    float f[3] = {c->target[0] - c->eye[0], c->target[1] - c->eye[1], c->target[2] - c->eye[2]};
+    a->dist = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    if (!(a->dist > 0.0f))
+        a->dist = 1.0f;
+    memcpy(a->target, c->target, sizeof a->target);
+    a->yaw = atan2f(f[2], f[0]);
+    a->pitch = asinf(f[1] / a->dist);
+}
+
+static void eye_of(const app *a, float eye[3])
+{
+    float f[3];
+    forward(a, f);
+    for (int k = 0; k < 3; k++)
+        eye[k] = a->target[k] - a->dist * f[k];
+}
+
+static void print_status(app *a, const char *what)
+{
+    snprintf(a->status, sizeof a->status, "%s", what);
+    if (!a->o->quiet)
+        printf("%s\n", what);
+}
+
+static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
+{
+    (void)scancode;
+    (void)mods;
+    app *a = glfwGetWindowUserPointer(w);
+    if (action != GLFW_PRESS)
+        return;
+    char msg[200];
+    static const vr_mode by_digit[6] = {VR_MODE_NONE, VR_MODE_CUBE, VR_MODE_VDSH2,
+                                        VR_MODE_VDSH3, VR_MODE_VDSH5, VR_MODE_VDSH5_POLY};
+    if (key >= GLFW_KEY_1 && key <= GLFW_KEY_6) {
+        vr_mode m = by_digit[key - GLFW_KEY_1];
+        if (!vr_scene_supports(a->s.scene, m)) {
+            snprintf(msg, sizeof msg, "mode %s: not available in this file", vr_mode_name(m));
+            print_status(a, msg);
+            return;
+        }
+        a->mode = m;
+        snprintf(msg, sizeof msg, "mode: %s", vr_mode_label(m));
+        print_status(a, msg);
+        return;
+    }
+    switch (key) {
+    case GLFW_KEY_ESCAPE:
+        glfwSetWindowShouldClose(w, GLFW_TRUE);
+        break;
+    case GLFW_KEY_M:
+        for (int i = 1; i <= 6; i++) {
+            vr_mode m = by_digit[(a->mode - VR_MODE_NONE + i) % 6];
+            if (vr_scene_supports(a->s.scene, m)) {
+                a->mode = m;
+                break;
+            }
+        }
+        snprintf(msg, sizeof msg, "mode: %s", vr_mode_label(a->mode));
+        print_status(a, msg);
+        break;
+    case GLFW_KEY_C:
+        a->compare = a->compare == VDSH_COMPARE_SMOOTH ? VDSH_COMPARE_BINARY : VDSH_COMPARE_SMOOTH;
+        print_status(a, a->compare == VDSH_COMPARE_SMOOTH ? "comparison: smooth (paper ramp)"
+                                                          : "comparison: binary");
+        break;
+    case GLFW_KEY_P:
+        a->pcf = !a->pcf;
+        print_status(a, a->pcf ? "cube shadow map: PCF" : "cube shadow map: 1 tap");
+        break;
+    case GLFW_KEY_TAB:
+        if (a->n == 0) {
+            print_status(a, "no lights (N adds one)");
+            break;
+        }
+        a->selected = (a->selected + 1) % a->n;
+        snprintf(msg, sizeof msg, "light %d of %d selected", a->selected + 1, a->n);
+        print_status(a, msg);
+        break;
+    case GLFW_KEY_N:
+        if (a->n < MAX_LIGHTS - 1) {
+            vr_light *l = &a->base[a->n];
+            *l = a->base[a->n > 0 ? a->n - 1 : 0];
+            memcpy(l->position, a->target, sizeof l->position);
+            l->position[1] += 0.05f * a->diag;
+            if (a->n == 0) {
+                l->color[0] = l->color[1] = l->color[2] = 1.6f;
+                l->attenuation[0] = 1.0f;
+                l->attenuation[2] = 1.0f / (0.09f * a->diag * a->diag);
+            }
+            a->selected = a->n++;
+            snprintf(msg, sizeof msg, "light %d added at the target", a->n);
+            print_status(a, msg);
+        }
+        break;
+    case GLFW_KEY_BACKSPACE:
+    case GLFW_KEY_DELETE:
+        if (a->n > 0) {
+            memmove(&a->base[a->selected], &a->base[a->selected + 1],
+                    (size_t)(a->n - a->selected - 1) * sizeof a->base[0]);
+            a->n--;
+            if (a->selected >= a->n)
+                a->selected = a->n > 0 ? a->n - 1 : 0;
+            print_status(a, "light removed");
+        }
+        break;
+    case GLFW_KEY_SPACE:
+        a->animate = !a->animate;
+        print_status(a, a->animate ? "lights animated" : "lights still");
+        break;
+    case GLFW_KEY_F: {
+        float f[3];
+        forward(a, f);
+        eye_of(a, a->fired_pos);
+        for (int k = 0; k < 3; k++)
+            a->fired_vel[k] = 0.35f * a->diag * f[k];
+        a->fired = 1;
+        a->fired_age = 0.0;
+        print_status(a, "fired a light");
+        break;
+    }
+    case GLFW_KEY_R:
+        set_view(a, &a->home);
+        print_status(a, "view reset");
+        break;
+    case GLFW_KEY_O:
+        a->overlay = !a->overlay;
+        break;
+    case GLFW_KEY_H:
+        fputs(keys_text, stdout);
+        a->overlay = 2;
+        break;
+    case GLFW_KEY_X: {
+        int fw, fh;
+        vr_renderer_size(a->s.r, &fw, &fh);
+        unsigned char *px = malloc((size_t)fw * (size_t)fh * 4);
+        vr_error err;
+        char path[64];
+        snprintf(path, sizeof path, "vdsh-view-%03d.png", a->shots++);
+        if (px && vr_read_pixels(a->s.r, px, (size_t)fw * (size_t)fh * 4, &err) == VR_OK &&
+            write_png(path, fw, fh, px) == 0) {
+            snprintf(msg, sizeof msg, "saved %s", path);
+            print_status(a, msg);
+        }
+        free(px);
+        break;
+    }
+    default:
+        break;
+    }
+}
+
+static void on_mouse_button(GLFWwindow *w, int button, int action, int mods)
+{
+    (void)mods;
+    app *a = glfwGetWindowUserPointer(w);
+    if (action == GLFW_PRESS) {
+        a->drag = button == GLFW_MOUSE_BUTTON_LEFT ? 1 : button == GLFW_MOUSE_BUTTON_RIGHT ? 2 : 0;
+        glfwGetCursorPos(w, &a->mx, &a->my);
+    } else {
+        a->drag = 0;
+    }
+}
+
+static void on_cursor(GLFWwindow *w, double x, double y)
+{
+    app *a = glfwGetWindowUserPointer(w);
+    if (!a->drag)
+        return;
+    float dx = (float)(x - a->mx), dy = (float)(y - a->my);
+    a->mx = x;
+    a->my = y;
+    float eye[3];
+    eye_of(a, eye);
+    a->yaw += 0.005f * dx;
+    a->pitch -= 0.005f * dy;
+    if (a->pitch > 1.5f)
+        a->pitch = 1.5f;
+    if (a->pitch < -1.5f)
+        a->pitch = -1.5f;
+    if (a->drag == 2) {
+        /* look around: the eye stays, the target moves */
+        float f[3];
+        forward(a, f);
+        for (int k = 0; k < 3; k++)
+            a->target[k] = eye[k] + a->dist * f[k];
+    }
+}
+
+static void on_scroll(GLFWwindow *w, double xoff, double yoff)
+{
+    (void)xoff;
+    app *a = glfwGetWindowUserPointer(w);
+    a->dist *= powf(0.9f, (float)yoff);
+    if (a->dist < 0.01f * a->diag)
+        a->dist = 0.01f * a->diag;
+}
+
+/* Held keys: fly the camera, move the selected light. */
+static void update(app *a, GLFWwindow *w, float dt)
+{
+    float f[3], right[3], speed = 0.25f * a->diag * dt;
+    forward(a, f);
+    float hl = sqrtf(f[0] * f[0] + f[2] * f[2]);
+    float fh[3] = {hl > 0 ? f[0] / hl : 1.0f, 0.0f, hl > 0 ? f[2] / hl : 0.0f};
+    right[0] = -fh[2];
+    right[1] = 0.0f;
+    right[2] = fh[0];
+    if (glfwGetKey(w, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS)
+        speed *= 4.0f;
+    float move[3] = {0, 0, 0};
+    for (int k = 0; k < 3; k++) {
+        if (glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS)
+            move[k] += f[k];
+        if (glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS)
+            move[k] -= f[k];
+        if (glfwGetKey(w, GLFW_KEY_D) == GLFW_PRESS)
+            move[k] += right[k];
+        if (glfwGetKey(w, GLFW_KEY_A) == GLFW_PRESS)
+            move[k] -= right[k];
+    }
+    if (glfwGetKey(w, GLFW_KEY_E) == GLFW_PRESS)
+        move[1] += 1.0f;
+    if (glfwGetKey(w, GLFW_KEY_Q) == GLFW_PRESS)
+        move[1] -= 1.0f;
+    for (int k = 0; k < 3; k++)
+        a->target[k] += speed * move[k];
+
+    if (a->n > 0) {
+        float lm[3] = {0, 0, 0}, ls = 0.15f * a->diag * dt;
+        for (int k = 0; k < 3; k++) {
+            if (glfwGetKey(w, GLFW_KEY_UP) == GLFW_PRESS)
+                lm[k] += fh[k];
+            if (glfwGetKey(w, GLFW_KEY_DOWN) == GLFW_PRESS)
+                lm[k] -= fh[k];
+            if (glfwGetKey(w, GLFW_KEY_RIGHT) == GLFW_PRESS)
+                lm[k] += right[k];
+            if (glfwGetKey(w, GLFW_KEY_LEFT) == GLFW_PRESS)
+                lm[k] -= right[k];
+        }
+        if (glfwGetKey(w, GLFW_KEY_PAGE_UP) == GLFW_PRESS)
+            lm[1] += 1.0f;
+        if (glfwGetKey(w, GLFW_KEY_PAGE_DOWN) == GLFW_PRESS)
+            lm[1] -= 1.0f;
+        for (int k = 0; k < 3; k++)
+            a->base[a->selected].position[k] += ls * lm[k];
+    }
+    if (a->animate)
+        a->anim_t += dt;
+    if (a->fired) {
+        a->fired_age += dt;
+        for (int k = 0; k < 3; k++)
+            a->fired_pos[k] += dt * a->fired_vel[k];
+        if (a->fired_age > FIRE_LIFE)
+            a->fired = 0;
+    }
+}
+
+/* The lights of this frame: the user's (circling when animated) and the
+ * fired one, fading out. */
+static int frame_lights(const app *a, vr_light *out)
+{
+    int n = 0;
+    for (int i = 0; i < a->n; i++) {
+        out[n] = a->base[i];
+        if (a->animate) {
+            float ph = (float)a->anim_t * 0.8f + 2.1f * (float)i, r = 0.08f * a->diag;
+            out[n].position[0] += r * cosf(ph);
+            out[n].position[2] += r * sinf(ph);
+        }
+        n++;
+    }
+    if (a->fired && n < MAX_LIGHTS) {
+        vr_light *l = &out[n++];
+        memset(l, 0, sizeof *l);
+        memcpy(l->position, a->fired_pos, sizeof l->position);
+        float fade = 1.0f - (float)(a->fired_age / FIRE_LIFE);
+        l->color[0] = 2.0f * fade + 1e-6f;
+        l->color[1] = 1.1f * fade;
+        l->color[2] = 0.4f * fade;
+        l->attenuation[0] = 1.0f;
+        l->attenuation[2] = 1.0f / (0.01f * a->diag * a->diag);
+    }
+    return n;
+}
+
+static int run_window(const options *o)
+{
+    int w = o->have_size ? o->width : 1024, h = o->have_size ? o->height : 768;
+    app a;
+    memset(&a, 0, sizeof a);
+    a.o = o;
+    if (session_open(o, VR_CONTEXT_WINDOW, w, h, &a.s)) {
+        fprintf(stderr, "vdsh-view: (use --render or --grid without a display)\n");
+        return 1;
+    }
+    GLFWwindow *win = vr_context_window(a.s.ctx);
+    glfwSetWindowUserPointer(win, &a);
+    glfwSetKeyCallback(win, on_key);
+    glfwSetMouseButtonCallback(win, on_mouse_button);
+    glfwSetCursorPosCallback(win, on_cursor);
+    glfwSetScrollCallback(win, on_scroll);
+
+    a.diag = scene_diagonal(a.s.scene);
+    a.n = scene_lights(a.s.scene, o, o->default_lights ? o->default_lights : 1, a.base);
+    scene_camera(a.s.scene, o, &a.home);
+    set_view(&a, &a.home);
+    a.mode = o->mode;
+    if (!vr_scene_supports(a.s.scene, a.mode))
+        a.mode = VR_MODE_VDSH5_POLY;
+    a.compare = o->compare;
+    a.pcf = o->pcf;
+    a.overlay = !o->no_overlay;
+    if (!o->quiet) {
+        printf("vdsh-view: %s on %s (%s)\n", o->files[0], vr_gl_renderer(),
+               vr_context_description(a.s.ctx));
+        fputs(keys_text, stdout);
+    }
+
+    int rc = 0;
+    long frames = 0, keys_len = o->keys ? (long)strlen(o->keys) : 0;
+    double last = now_ms(), fps_t0 = last, frame_ms = 0.0;
+    int fps_frames = 0;
+    while (!glfwWindowShouldClose(win)) {
+        glfwPollEvents();
+        if (frames < keys_len) {
+            char k = o->keys[frames];
+            int key = k == ' ' ? GLFW_KEY_SPACE : k == '>' ? GLFW_KEY_TAB
+                    : k == '<' ? GLFW_KEY_BACKSPACE
+                    : k >= '0' && k <= '9' ? GLFW_KEY_0 + (k - '0') : GLFW_KEY_A + (k - 'a');
+            on_key(win, key, 0, GLFW_PRESS, 0);
+        }
+        double t = now_ms();
+        float dt = (float)((t - last) * 1e-3);
+        last = t;
+        update(&a, win, dt);
+
+        int fw = 0, fh = 0;
+        glfwGetFramebufferSize(win, &fw, &fh);
+        vr_error err;
+        if (fw > 0 && fh > 0 && vr_renderer_resize(a.s.r, fw, fh, &err) != VR_OK) {
+            fprintf(stderr, "vdsh-view: %s\n", err.msg);
+            rc = 1;
+            break;
+        }
+        vr_light lights[MAX_LIGHTS];
+        int n = frame_lights(&a, lights);
+        vr_draw_desc d = base_desc(o, lights, n);
+        d.mode = a.mode;
+        d.compare = a.compare;
+        d.pcf = a.pcf;
+        memcpy(d.camera.target, a.target, sizeof a.target);
+        eye_of(&a, d.camera.eye);
+        d.camera.fov_y = a.home.fov_y;
+        if (vr_draw(a.s.r, a.s.scene, &d, &err) != VR_OK) {
+            fprintf(stderr, "vdsh-view: %s\n", err.msg);
+            rc = 1;
+            break;
+        }
+        if (a.overlay) {
+            vr_timings tm;
+            vr_renderer_timings(a.s.r, &tm);
+            char text[1024];
+            int len = snprintf(text, sizeof text,
+                               "%s, %s\n%d light%s (selected %d)%s\n"
+                               "frame %.1f ms (%.1f fps)\n"
+                               "GPU: shadow maps %.1f ms, lighting %.1f ms\n%s",
+                               vr_mode_label(a.mode),
+                               a.mode == VR_MODE_CUBE ? (a.pcf ? "PCF" : "1 tap")
+                               : a.compare == VDSH_COMPARE_SMOOTH ? "smooth" : "binary",
+                               n, n == 1 ? "" : "s", a.n ? a.selected + 1 : 0,
+                               a.animate ? ", animated" : "", frame_ms,
+                               frame_ms > 0 ? 1e3 / frame_ms : 0.0, tm.shadow_total_ms,
+                               tm.lighting_total_ms, a.status[0] ? a.status : "h: keys");
+            (void)len;
+            vr_draw_text(a.s.r, 8, 8, fw >= 700 ? 2.0f : 1.0f, NULL, text, &err);
+            /* the key list in the small font, along the bottom (13 lines
+             * of stb_easy_font's 12-pixel line height) */
+            if (a.overlay == 2)
+                vr_draw_text(a.s.r, 8, fh - 13 * 12 - 16, 1.0f, NULL, keys_text, &err);
+        }
+        vr_renderer_blit(a.s.r, 0, fw, fh);
+        if (o->screenshot && o->frames && frames + 1 >= o->frames) {
+            /* what the window shows, read back from it */
+            size_t size = (size_t)fw * (size_t)fh * 4;
+            unsigned char *px = malloc(size);
+            if (!px || vr_read_window(fw, fh, px, size, &err) != VR_OK) {
+                fprintf(stderr, "vdsh-view: %s: %s\n", o->screenshot,
+                        px ? err.msg : "out of memory");
+                rc = 1;
+            } else if (write_png(o->screenshot, fw, fh, px)) {
+                rc = 1;
+            }
+            free(px);
+        }
+        vr_context_swap(a.s.ctx);
+        frames++;
+        fps_frames++;
+        if (t - fps_t0 > 500.0) {
+            frame_ms = (t - fps_t0) / fps_frames;
+            fps_t0 = t;
+            fps_frames = 0;
+        }
+        if (o->frames && frames >= o->frames)
+            break;
+    }
+    if (!o->quiet)
+        fprintf(stderr, "vdsh-view: %ld frames in a window (%s, %s)\n", frames,
+                vr_context_description(a.s.ctx), vr_gl_renderer());
+    session_close(&a.s);
+    return rc;
+}
+#else
+static int run_window(const options *o)
+{
+    (void)o;
+    fprintf(stderr, "vdsh-view: built without GLFW: no window (use --render or --grid)\n");
+    return 1;
+}
+#endif
+
+int main(int argc, char **argv)
+{
+    options o;
+    int rc = parse_args(argc, argv, &o);
+    if (rc)
+        return rc < 0 ? 0 : rc;
+    /* llvmpipe allocates and frees large blocks every frame; glibc's
+     * defaults (a 128 KiB trim threshold, mmap for large blocks) can hand
+     * that memory back to the kernel each time and fault it in again on
+     * the next frame. Keeping it costs some resident memory. Measured in
+     * docs/BENCHMARKS.md (scripts/bench_runtime): on the 2-core llvmpipe
+     * machine it halves the page faults and the kernel time, but the frame
+     * time does not measurably change; --no-mallopt turns it off. */
+    if (!o.no_mallopt) {
+        mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
+        mallopt(M_TRIM_THRESHOLD, 512 * 1024 * 1024);
+    }
+    if (o.bench)
+        return run_bench(&o);
+    if (o.render_path)
+        return run_render(&o);
+    if (o.grid_path)
+        return run_grid(&o);
+    return run_window(&o);
+}

@@ -1,0 +1,338 @@
+/*
+ * vr.h - the VDSH GL runtime (prefix vr_): load a baked .vdsh scene, upload
+ * it, and draw it lit by point lights with precomputed visibility-distance
+ * shadows (orders 2, 3, 5) or with the cube-shadow-map baseline, into an
+ * offscreen framebuffer that the caller reads back or blits.
+ *
+ * Does not: create a GL context or window (vr_context.h does, and only the
+ * viewer uses both), bake anything, or write image files. Every function
+ * here assumes the calling thread has a current GL 3.3 core (or later)
+ * context, the same one for the whole life of an object.
+ *
+ * Usage (tests/test_runtime_glsl.c and runtime/vdsh_view.c are compiled
+ * examples):
+ *
+ *     vr_error err;
+ *     vr_scene *scene = NULL;
+ *     vr_renderer *r = NULL;
+ *     if (vr_scene_create(&(vr_scene_desc){.path = "room.vdsh"}, &scene, &err) ||
+ *         vr_renderer_create(&(vr_renderer_desc){.width = 1024, .height = 768},
+ *                            &r, &err)) {
+ *         fprintf(stderr, "%s\n", err.msg);
+ *         ...
+ *     }
+ *     vr_light light = {.position = {0, 3, 0}};
+ *     vr_draw_desc d = {.mode = VR_MODE_VDSH3, .lights = &light, .light_count = 1};
+ *     if (vr_draw(r, scene, &d, &err) != VR_OK) ...
+ *     vr_read_pixels(r, rgba, rgba_size, &err);   (top row first)
+ *     vr_renderer_destroy(r);
+ *     vr_scene_destroy(scene);
+ *
+ * Descriptors: every *_desc struct (and vr_light, vr_camera) is read with
+ * "zero means the documented default", so `{0}` plus the fields you care
+ * about is always valid. Defaults are filled in one place per struct.
+ *
+ * Shadow modes (DESIGN.md section 1):
+ *   VR_MODE_NONE        Lambert lighting only.
+ *   VR_MODE_CUBE        baseline: one omnidirectional depth cube map per
+ *                       light (shadow_map_size^2 per face), re-rendered on
+ *                       every vr_draw; 1 nearest tap, or with pcf 4 taps of
+ *                       bilinear (2x2) depth comparison.
+ *   VR_MODE_VDSH2/3     order 2 / 3 (4 / 9 coefficients), the shadow term
+ *                       evaluated per vertex and interpolated.
+ *   VR_MODE_VDSH5       order 5 the paper's way: the first 9 coefficients in
+ *                       the vertex stage, the last 16 interpolated and dotted
+ *                       with the four basis cubemaps in the fragment stage.
+ *   VR_MODE_VDSH5_POLY  order 5 with the last 16 basis functions evaluated as
+ *                       polynomials in the fragment stage (no cubemaps).
+ * The comparison (vdsh_compare from formats/vdsh_shadow.h: smooth ramp or
+ * binary) and the stored quantity (distance, distance^2, log-distance) mean
+ * exactly what formats/vdsh_shadow.h says; tests/test_runtime_glsl.c checks
+ * the shaders against it.
+ *
+ * Lights: any number. Up to max_lights_per_pass lights are summed in one
+ * pass (a loop in the shaders); more lights take more passes, added with
+ * additive blending. Each light's Lambert term is multiplied by its shadow.
+ *
+ * Errors: fallible functions return a vr_result (VR_OK = 0) and, when err
+ * is not NULL, write a message that names the file (or the object) and the
+ * problem, e.g. "room.sh13-16.exr: cannot open: No such file or directory
+ * (basis cubemap needed for order 5)". Outputs are untouched on failure.
+ * GL errors and shader compile/link logs end up in the message too.
+ * Nothing is printed; there is no global error state.
+ *
+ * Ownership: vr_scene_create/vr_renderer_create return objects owned by
+ * the caller and freed by vr_scene_destroy/vr_renderer_destroy, which
+ * accept NULL. A scene owns its GL buffers and textures; a renderer owns
+ * its framebuffer, programs, shadow maps and queries. Descriptors and the
+ * arrays they point to are only borrowed for the duration of the call. A
+ * scene may be drawn by several renderers of the same context.
+ *
+ * Threading: GL objects belong to the context; use each object from the
+ * thread where its context is current. No shared state between objects.
+ */
+#ifndef VR_H
+#define VR_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "vdsh.h"
+#include "vdsh_shadow.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum vr_result {
+    VR_OK = 0,
+    VR_ERR_IO,             /* a file cannot be opened or read */
+    VR_ERR_FORMAT,         /* a .vdsh or cubemap file is corrupt or unsupported */
+    VR_ERR_MISSING,        /* a needed stream, cubemap or extension is absent */
+    VR_ERR_GL,             /* GL error, incomplete framebuffer, no context */
+    VR_ERR_SHADER,         /* a shader failed to compile or link (log in msg) */
+    VR_ERR_OUT_OF_MEMORY,
+    VR_ERR_ARGUMENT        /* a bad descriptor field or argument */
+} vr_result;
+
+/* A static string such as "missing stream or file"; never NULL. */
+const char *vr_result_str(vr_result r);
+
+typedef struct vr_error {
+    char msg[1024];
+} vr_error;
+
+/* ------------------------------------------------------------------ */
+/* Scene: the .vdsh geometry and coefficient streams on the GPU          */
+
+typedef struct vr_scene vr_scene;
+
+typedef struct vr_scene_desc {
+    /* The .vdsh file to load. Either path or file must be set. */
+    const char *path;
+    /* An already-read file to upload instead (borrowed for the call; path,
+     * if also set, is then only used in messages and to find cubemaps). */
+    const vdsh_file *file;
+    /* Stream quantity to draw (vdsh_quantity); 0: distance. Streams of
+     * other quantities are not uploaded. */
+    uint32_t quantity;
+    /* Where the basis cubemaps <stem>.sh09-12.exr ... are; NULL: the
+     * directory of path (or the working directory without a path). */
+    const char *cubemap_dir;
+    /* Their stem; NULL: path's file name without ".vdsh". A file from
+     * memory with neither path nor cubemap_stem loads no cubemaps. */
+    const char *cubemap_stem;
+    /* 0 (default): when the file has an order-5 stream and a cube_size,
+     * the four cubemaps are required and a missing or corrupt one fails
+     * the create. 1: do not load them (VR_MODE_VDSH5 then fails with
+     * VR_ERR_MISSING; VR_MODE_VDSH5_POLY needs no cubemaps). */
+    int skip_cubemaps;
+} vr_scene_desc;
+
+/* Load (when desc->path is set and desc->file is not), validate, upload
+ * positions, normals, indices, every stream of the chosen quantity (f16
+ * streams as GL_HALF_FLOAT attributes, f32 as GL_FLOAT, no conversion) and
+ * the basis cubemaps (converted to GL face orientation with
+ * vdsh_cube_gl_to_exr). On failure *out is untouched and nothing stays
+ * allocated. Errors: VR_ERR_IO / VR_ERR_FORMAT from the .vdsh reader or
+ * the cubemap reader, VR_ERR_MISSING for a missing cubemap, VR_ERR_GL. */
+vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out,
+                          vr_error *err);
+
+/* NULL is fine. */
+void vr_scene_destroy(vr_scene *s);
+
+typedef struct vr_scene_info {
+    uint32_t vertex_count;
+    uint32_t triangle_count;
+    float bounds_min[3];          /* of the receiver vertices */
+    float bounds_max[3];
+    int has_order[6];             /* has_order[n]: a stream of order n */
+    uint32_t encoding[6];         /* its vdsh_encoding */
+    float scale[6];               /* its stream scale */
+    int has_cubemaps;             /* basis cubemaps uploaded */
+    int cube_size;                /* their face size, or 0 */
+    uint32_t quantity;            /* the quantity drawn */
+    size_t gpu_bytes;             /* buffers and textures uploaded */
+} vr_scene_info;
+
+void vr_scene_get_info(const vr_scene *s, vr_scene_info *out);
+
+/* ------------------------------------------------------------------ */
+/* Renderer: framebuffer, programs, shadow maps, timers                  */
+
+typedef struct vr_renderer vr_renderer;
+
+enum { VR_MAX_LIGHTS_PER_PASS = 8 };
+
+typedef enum vr_color_format {
+    VR_COLOR_RGBA8 = 0,      /* default: an image to look at */
+    VR_COLOR_RGBA32F = 1     /* exact values for tests and debug outputs */
+} vr_color_format;
+
+typedef struct vr_renderer_desc {
+    int width, height;          /* 0: 1024 x 768 */
+    uint32_t color_format;      /* vr_color_format; 0: RGBA8 */
+    int shadow_map_size;        /* cube shadow map face size; 0: 512 */
+    int max_lights_per_pass;    /* 1..VR_MAX_LIGHTS_PER_PASS; 0: 8 */
+} vr_renderer_desc;
+
+/* Create the offscreen framebuffer (colour texture + 32-bit float depth)
+ * and the timer queries. Programs are compiled when first needed. */
+vr_result vr_renderer_create(const vr_renderer_desc *desc, vr_renderer **out,
+                             vr_error *err);
+
+/* NULL and half-built renderers are fine. */
+void vr_renderer_destroy(vr_renderer *r);
+
+/* Resize the framebuffer (contents undefined afterwards). On failure the
+ * old size stays. */
+vr_result vr_renderer_resize(vr_renderer *r, int width, int height,
+                             vr_error *err);
+
+void vr_renderer_size(const vr_renderer *r, int *width, int *height);
+
+/* The GL name of the framebuffer vr_draw renders into. */
+unsigned vr_renderer_framebuffer(const vr_renderer *r);
+
+/* "llvmpipe (LLVM 15.0.6, 256 bits)" etc.: GL_RENDERER of the current
+ * context; never NULL. */
+const char *vr_gl_renderer(void);
+
+/* ------------------------------------------------------------------ */
+/* Drawing                                                               */
+
+typedef enum vr_mode {
+    VR_MODE_DEFAULT = 0,     /* VR_MODE_VDSH5_POLY */
+    VR_MODE_NONE,
+    VR_MODE_CUBE,
+    VR_MODE_VDSH2,
+    VR_MODE_VDSH3,
+    VR_MODE_VDSH5,
+    VR_MODE_VDSH5_POLY,
+    VR_MODE_COUNT_
+} vr_mode;
+
+/* "none", "cube", "vdsh2", "vdsh3", "vdsh5", "vdsh5poly" (the viewer's
+ * --mode names); "?" for others. vr_mode_from_name returns 0 on success
+ * and leaves *out untouched on an unknown name. */
+const char *vr_mode_name(vr_mode m);
+int vr_mode_from_name(const char *name, vr_mode *out);
+/* A label for pictures: "VDSH order 5 (25 coeff., cubemaps)" etc. */
+const char *vr_mode_label(vr_mode m);
+/* 1 when the scene has what the mode needs (stream, cubemaps). */
+int vr_scene_supports(const vr_scene *s, vr_mode m);
+
+typedef struct vr_light {
+    float position[3];
+    float color[3];          /* linear RGB; all zero: white (1, 1, 1) */
+    float attenuation[3];    /* 1 / (a0 + a1 d + a2 d^2); all zero: (1, 0, 0) */
+} vr_light;
+
+typedef struct vr_camera {
+    float eye[3];
+    float target[3];         /* eye == target (e.g. both zero): the scene's
+                                default view (vr_scene_default_camera) */
+    float up[3];             /* zero: (0, 1, 0) */
+    float fov_y;             /* degrees; 0: 60 */
+    float znear, zfar;       /* 0: from the scene bounds */
+    float ortho_height;      /* > 0: orthographic, this many units tall */
+} vr_camera;
+
+typedef enum vr_output {
+    VR_OUTPUT_COLOR = 0,     /* albedo * (ambient + sum lambert * shadow) */
+    VR_OUTPUT_SHADOW = 1,    /* light 0: (s, d_V, d_L, 1); d_V is -1 in
+                                modes none and cube */
+    VR_OUTPUT_POSITION = 2   /* (world x, y, z, 1) */
+} vr_output;
+
+typedef struct vr_draw_desc {
+    uint32_t mode;           /* vr_mode; 0: VR_MODE_VDSH5_POLY */
+    uint32_t compare;        /* vdsh_compare; 0: smooth (the paper's ramp) */
+    int pcf;                 /* VR_MODE_CUBE: 0 one nearest tap, 1 PCF */
+    const vr_light *lights;  /* light_count entries, borrowed */
+    int light_count;         /* 0: no lights (ambient only) */
+    vr_camera camera;
+    float ambient[3];        /* added before the albedo multiply; zero: none */
+    float albedo[3];         /* all zero: 0.8 grey */
+    float clear_color[4];    /* zero: black, alpha 0 */
+    uint32_t output;         /* vr_output; 0: colour */
+    int points;              /* 1: draw the vertices as 1-pixel points, not
+                                triangles (a test aid: each pixel then holds
+                                one vertex's unclipped, uninterpolated value) */
+} vr_draw_desc;
+
+/* Draw one frame into the renderer's framebuffer: for each group of up to
+ * max_lights_per_pass lights, render their cube shadow maps (VR_MODE_CUBE)
+ * and one lighting pass. Errors: VR_ERR_MISSING when the scene lacks the
+ * mode's stream or cubemaps, VR_ERR_ARGUMENT for bad fields, VR_ERR_SHADER
+ * / VR_ERR_GL. On failure the framebuffer contents are undefined. */
+vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *d,
+                  vr_error *err);
+
+/* The default camera for a scene: from inside its bounds near one end,
+ * along the longest horizontal axis, a little above the floor, so that
+ * closed rooms and open objects both show. */
+void vr_scene_default_camera(const vr_scene *s, vr_camera *out);
+
+/* Up to max default light positions spread through the scene's bounds
+ * (light 0 roughly in the middle, a little above the floor); returns how
+ * many were written. Colours and attenuations are left to the caller. */
+int vr_scene_default_lights(const vr_scene *s, vr_light *out, int max);
+
+/* Draw text (ASCII, stb_easy_font's 7-pixel font scaled by `scale`) on top
+ * of the framebuffer at pixel (x, y) from the top-left, on a dark box.
+ * color NULL: white. Lines break at '\n'. */
+vr_result vr_draw_text(vr_renderer *r, int x, int y, float scale,
+                       const float color[4], const char *text, vr_error *err);
+
+/* Read the framebuffer, top row first: RGBA8 gives width*height*4 bytes,
+ * RGBA32F width*height*4 floats. size is the byte size of dst; too small
+ * gives VR_ERR_ARGUMENT and dst untouched. */
+vr_result vr_read_pixels(vr_renderer *r, void *dst, size_t size,
+                         vr_error *err);
+
+/* Copy the framebuffer to framebuffer `dst` (0: the window), scaled to
+ * dst_width x dst_height. */
+void vr_renderer_blit(vr_renderer *r, unsigned dst, int dst_width,
+                      int dst_height);
+
+/* Read width x height RGBA8 pixels of the window's back buffer
+ * (framebuffer 0), top row first: what the next swap will show. */
+vr_result vr_read_window(int width, int height, void *dst, size_t size,
+                         vr_error *err);
+
+/* ------------------------------------------------------------------ */
+/* Timings                                                               */
+
+enum { VR_TIMING_MAX_GROUPS = 8 };
+
+typedef struct vr_timings {
+    uint64_t frame;          /* 1 for the first vr_draw; 0: none available */
+    int groups;              /* light groups (passes) drawn */
+    /* GPU time (GL_TIME_ELAPSED), milliseconds. Per group g: the cube
+     * shadow maps of its lights and its lighting pass (groups beyond the
+     * last slot add into the last). */
+    double shadow_ms[VR_TIMING_MAX_GROUPS];
+    double lighting_ms[VR_TIMING_MAX_GROUPS];
+    double shadow_total_ms, lighting_total_ms;
+    double gpu_ms;           /* sum of the above */
+    /* CPU wall time from the start of vr_draw to the end of
+     * vr_renderer_finish (glFinish); 0 if the frame was not finished. */
+    double cpu_ms;
+} vr_timings;
+
+/* glFinish, then collect every pending timer result. Afterwards
+ * vr_renderer_timings returns this frame's complete timings. */
+void vr_renderer_finish(vr_renderer *r);
+
+/* The most recent frame whose timer results are available (queries are
+ * kept in a ring of a few frames, so without vr_renderer_finish this lags
+ * a frame or two behind and never stalls). out->frame is 0 when none. */
+void vr_renderer_timings(vr_renderer *r, vr_timings *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VR_H */

@@ -1,0 +1,500 @@
+/*
+ * vr_glsl.c - the shaders. One source per stage, specialised with
+ * #defines for each program key (mode, comparison, quantity, output, PCF,
+ * lights in the pass), so every variant is straight-line code and nothing
+ * branches on a uniform per pixel.
+ *
+ * The VDSH part is written as three layers, so that a new stored quantity
+ * or a new comparison touches one function each:
+ *   sh_sum4 / sh_sum9 / sh_basis16   the SH basis, formats/vdsh_sh.c
+ *   vdsh_distance(sum)               an SH sum -> a distance, per quantity
+ *                                    (formats/vdsh_shadow.c
+ *                                    vdsh_stream_distance)
+ *   vdsh_compare(d_vis, d_light)     a distance pair -> visibility, per
+ *                                    comparison (vdsh_shadow_compare)
+ * and each path only decides where the sum is computed:
+ *   order 2, 3   vertex stage, the visibility is interpolated;
+ *   order 5      the paper's split: bands 0-2 in the vertex stage toward
+ *                the vertex's light direction, interpolated; bands 3-4
+ *                (16 coefficients, interpolated) dotted in the fragment
+ *                stage with the basis cubemaps, or with the polynomials.
+ * tests/test_runtime_glsl.c renders these against the C functions.
+ *
+ * Lights: the per-light code is a macro, LIGHT(I), expanded once per light
+ * of the pass with a literal index, because GLSL 3.30 only lets sampler
+ * arrays (the shadow cube maps) be indexed by constant expressions.
+ */
+#include "vr_internal.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Shared by both stages: the SH basis (D3DX convention, the constants of
+ * formats/vdsh_sh.c to float precision) and the two VDSH functions. */
+static const char common_glsl[] =
+    "const float C00 = 0.28209479177387814;\n"
+    "const float C1 = 0.4886025119029199;\n"
+    "const float C2A = 1.0925484305920792;\n"
+    "const float C20 = 0.31539156525252005;\n"
+    "const float C22 = 0.5462742152960396;\n"
+    "const float C33 = 0.5900435899266435;\n"
+    "const float C32 = 2.890611442640554;\n"
+    "const float C31 = 0.4570457994644658;\n"
+    "const float C30 = 0.3731763325901154;\n"
+    "const float C32B = 1.445305721320277;\n"
+    "const float C44 = 2.5033429417967046;\n"
+    "const float C43 = 1.7701307697799304;\n"
+    "const float C42 = 0.9461746957575601;\n"
+    "const float C41 = 0.6690465435572892;\n"
+    "const float C40 = 0.10578554691520431;\n"
+    "const float C42B = 0.47308734787878004;\n"
+    "const float C44B = 0.6258357354491761;\n"
+    "\n"
+    "/* sum of c_i Y_i(d), coefficients 0..3 (bands 0-1), unit d */\n"
+    "float sh_sum4(vec4 c0, vec3 d)\n"
+    "{\n"
+    "    return dot(c0, vec4(C00, -C1 * d.y, C1 * d.z, -C1 * d.x));\n"
+    "}\n"
+    "\n"
+    "/* coefficients 0..8 (bands 0-2) */\n"
+    "float sh_sum9(vec4 c0, vec4 c1, float c8, vec3 d)\n"
+    "{\n"
+    "    float x = d.x, y = d.y, z = d.z;\n"
+    "    vec4 b = vec4(C2A * x * y, -C2A * y * z, C20 * (3.0 * z * z - 1.0),\n"
+    "                  -C2A * x * z);\n"
+    "    return sh_sum4(c0, d) + dot(c1, b) + c8 * (C22 * (x * x - y * y));\n"
+    "}\n"
+    "\n"
+    "/* basis functions 9..24 (bands 3-4), four per vec4 like the cubemaps */\n"
+    "void sh_basis16(vec3 d, out vec4 b9, out vec4 b13, out vec4 b17, out vec4 b21)\n"
+    "{\n"
+    "    float x = d.x, y = d.y, z = d.z;\n"
+    "    float x2 = x * x, y2 = y * y, z2 = z * z;\n"
+    "    b9 = vec4(-C33 * y * (3.0 * x2 - y2), C32 * x * y * z,\n"
+    "              -C31 * y * (5.0 * z2 - 1.0), C30 * z * (5.0 * z2 - 3.0));\n"
+    "    b13 = vec4(-C31 * x * (5.0 * z2 - 1.0), C32B * z * (x2 - y2),\n"
+    "               -C33 * x * (x2 - 3.0 * y2), C44 * x * y * (x2 - y2));\n"
+    "    b17 = vec4(-C43 * y * z * (3.0 * x2 - y2), C42 * x * y * (7.0 * z2 - 1.0),\n"
+    "               -C41 * y * z * (7.0 * z2 - 3.0),\n"
+    "               C40 * (35.0 * z2 * z2 - 30.0 * z2 + 3.0));\n"
+    "    b21 = vec4(-C41 * x * z * (7.0 * z2 - 3.0), C42B * (x2 - y2) * (7.0 * z2 - 1.0),\n"
+    "               -C43 * x * z * (x2 - 3.0 * y2),\n"
+    "               C44B * (x2 * x2 - 6.0 * x2 * y2 + y2 * y2));\n"
+    "}\n"
+    "\n"
+    "/* The distance a stream's SH sum stands for (vdsh_stream_distance):\n"
+    " * never negative, ringing below zero counts as 0. */\n"
+    "float vdsh_distance(float sum)\n"
+    "{\n"
+    "#if QUANTITY == 1\n"
+    "    return sum > 0.0 ? sqrt(sum) : 0.0;\n"
+    "#elif QUANTITY == 2\n"
+    "    return exp(sum);\n"
+    "#else\n"
+    "    return sum > 0.0 ? sum : 0.0;\n"
+    "#endif\n"
+    "}\n"
+    "\n"
+    "/* Visibility of a light at distance dl when the stored distance toward\n"
+    " * it is dv (vdsh_shadow_compare). A light at the receiver is visible. */\n"
+    "float vdsh_compare(float dv, float dl)\n"
+    "{\n"
+    "    if (!(dl > 0.0))\n"
+    "        return 1.0;\n"
+    "#if COMPARE == 1\n"
+    "    return dv >= dl ? 1.0 : 0.0;\n"
+    "#else\n"
+    "    if (isinf(dv) && dv > 0.0)\n"
+    "        return 1.0;\n"
+    "    /* ramp(x) = saturate((x - 1/3) * 1.5), written as in vdsh_ramp */\n"
+    "    return clamp(1.5 * (dv / dl) - 0.5, 0.0, 1.0);\n"
+    "#endif\n"
+    "}\n";
+
+static const char vertex_glsl[] =
+    "layout(location = 0) in vec3 a_position;\n"
+    "layout(location = 1) in vec3 a_normal;\n"
+    "#if ORDER >= 2\n"
+    "layout(location = 2) in vec4 a_c0;   /* coefficients 0..3 */\n"
+    "#endif\n"
+    "#if ORDER >= 3\n"
+    "layout(location = 3) in vec4 a_c1;   /* 4..7 */\n"
+    "layout(location = 4) in float a_c8;  /* 8 */\n"
+    "#endif\n"
+    "#if ORDER >= 5\n"
+    "layout(location = 5) in vec4 a_c9;   /* 9..12, the first basis cubemap */\n"
+    "layout(location = 6) in vec4 a_c13;\n"
+    "layout(location = 7) in vec4 a_c17;\n"
+    "layout(location = 8) in vec4 a_c21;\n"
+    "#endif\n"
+    "uniform mat4 u_view_proj;\n"
+    "uniform float u_scale;   /* coefficient = stored value * u_scale */\n"
+    "#if NUM_LIGHTS > 0\n"
+    "uniform vec3 u_light_pos[NUM_LIGHTS];\n"
+    "#endif\n"
+    "/* Later passes (more lights) test depth with GL_LEQUAL against the\n"
+    " * first pass's depth: every program must compute the same position. */\n"
+    "invariant gl_Position;\n"
+    "out vec3 v_position;\n"
+    "out vec3 v_normal;\n"
+    "#if VDSH_VERTEX && NUM_LIGHTS > 0\n"
+    "out float v_vis[NUM_LIGHTS];\n"
+    "#endif\n"
+    "#if VDSH_VERTEX && OUTPUT == 1\n"
+    "out float v_dv;\n"
+    "out float v_dl;\n"
+    "#endif\n"
+    "#if VDSH_SPLIT\n"
+    "#if NUM_LIGHTS > 0\n"
+    "out float v_sum9[NUM_LIGHTS];\n"
+    "#endif\n"
+    "out vec4 v_c9, v_c13, v_c17, v_c21;\n"
+    "#endif\n"
+    "\n"
+    "#if VDSH_VERTEX\n"
+    "/* The stream's SH sum toward unit direction d. */\n"
+    "float vdsh_sh_sum(vec3 d)\n"
+    "{\n"
+    "#if ORDER == 2\n"
+    "    return u_scale * sh_sum4(a_c0, d);\n"
+    "#else\n"
+    "    return u_scale * sh_sum9(a_c0, a_c1, a_c8, d);\n"
+    "#endif\n"
+    "}\n"
+    "#endif\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    v_position = a_position;\n"
+    "    v_normal = a_normal;\n"
+    "    gl_Position = u_view_proj * vec4(a_position, 1.0);\n"
+    "#if VDSH_VERTEX && OUTPUT == 1\n"
+    "    v_dv = -1.0;\n"
+    "    v_dl = 0.0;\n"
+    "#endif\n"
+    "#if (VDSH_VERTEX || VDSH_SPLIT) && NUM_LIGHTS > 0\n"
+    "    for (int i = 0; i < NUM_LIGHTS; i++) {\n"
+    "        vec3 lv = u_light_pos[i] - a_position;\n"
+    "        float dl = length(lv);\n"
+    "#if VDSH_VERTEX\n"
+    "        float dv = dl > 0.0 ? vdsh_distance(vdsh_sh_sum(lv / dl)) : 0.0;\n"
+    "        v_vis[i] = vdsh_compare(dv, dl);\n"
+    "#if OUTPUT == 1\n"
+    "        if (i == 0) {\n"
+    "            v_dv = dv;\n"
+    "            v_dl = dl;\n"
+    "        }\n"
+    "#endif\n"
+    "#else\n"
+    "        /* A light at the vertex has no direction: store 0, not NaN,\n"
+    "         * which would spread over every triangle around the vertex;\n"
+    "         * the fragment stage gives such a light visibility 1. */\n"
+    "        v_sum9[i] = dl > 0.0 ? u_scale * sh_sum9(a_c0, a_c1, a_c8, lv / dl) : 0.0;\n"
+    "#endif\n"
+    "    }\n"
+    "#endif\n"
+    "#if VDSH_SPLIT\n"
+    "    v_c9 = u_scale * a_c9;\n"
+    "    v_c13 = u_scale * a_c13;\n"
+    "    v_c17 = u_scale * a_c17;\n"
+    "    v_c21 = u_scale * a_c21;\n"
+    "#endif\n"
+    "}\n";
+
+static const char fragment_glsl[] =
+    "in vec3 v_position;\n"
+    "in vec3 v_normal;\n"
+    "#if VDSH_VERTEX && NUM_LIGHTS > 0\n"
+    "in float v_vis[NUM_LIGHTS];\n"
+    "#endif\n"
+    "#if VDSH_VERTEX && OUTPUT == 1\n"
+    "in float v_dv;\n"
+    "in float v_dl;\n"
+    "#endif\n"
+    "#if VDSH_SPLIT\n"
+    "#if NUM_LIGHTS > 0\n"
+    "in float v_sum9[NUM_LIGHTS];\n"
+    "#endif\n"
+    "in vec4 v_c9, v_c13, v_c17, v_c21;\n"
+    "#endif\n"
+    "#if NUM_LIGHTS > 0\n"
+    "uniform vec3 u_light_pos[NUM_LIGHTS];\n"
+    "uniform vec3 u_light_color[NUM_LIGHTS];\n"
+    "uniform vec3 u_light_att[NUM_LIGHTS];\n"
+    "#endif\n"
+    "uniform vec3 u_ambient;\n"
+    "uniform vec3 u_albedo;\n"
+    "#if SHADOW_CUBE && NUM_LIGHTS > 0\n"
+    "uniform samplerCubeShadow u_shadow[NUM_LIGHTS];\n"
+    "uniform vec2 u_shadow_nf[NUM_LIGHTS];   /* near, far of the face projections */\n"
+    "uniform float u_shadow_texel;           /* 2 / face size */\n"
+    "#endif\n"
+    "#if VDSH_SPLIT && CUBEMAP_BASIS\n"
+    "uniform samplerCube u_basis[4];\n"
+    "#endif\n"
+    "out vec4 o_color;\n"
+    "\n"
+    "#if VDSH_SPLIT\n"
+    "/* The SH sum of bands 3-4 toward unit direction d. */\n"
+    "float vdsh_sh_sum16(vec3 d)\n"
+    "{\n"
+    "#if CUBEMAP_BASIS\n"
+    "    return dot(v_c9, texture(u_basis[0], d)) + dot(v_c13, texture(u_basis[1], d)) +\n"
+    "           dot(v_c17, texture(u_basis[2], d)) + dot(v_c21, texture(u_basis[3], d));\n"
+    "#else\n"
+    "    vec4 b9, b13, b17, b21;\n"
+    "    sh_basis16(d, b9, b13, b17, b21);\n"
+    "    return dot(v_c9, b9) + dot(v_c13, b13) + dot(v_c17, b17) + dot(v_c21, b21);\n"
+    "#endif\n"
+    "}\n"
+    "\n"
+    "/* sum9: bands 0-2 from the vertex stage; lv: receiver to light. */\n"
+    "float split_visibility(float sum9, vec3 lv, float dl, out float dv)\n"
+    "{\n"
+    "    dv = 0.0;\n"
+    "    if (!(dl > 0.0))\n"
+    "        return vdsh_compare(0.0, dl);\n"
+    "    dv = vdsh_distance(sum9 + vdsh_sh_sum16(lv / dl));\n"
+    "    return vdsh_compare(dv, dl);\n"
+    "}\n"
+    "#endif\n"
+    "\n"
+    "#if SHADOW_CUBE && NUM_LIGHTS > 0\n"
+    "/* Baseline: depth cube map of the light, compared at the receiver's\n"
+    " * depth in the face it falls in (major axis). The receiver is first\n"
+    " * pushed off its surface along the normal by 1.5 shadow texels at its\n"
+    " * distance (normal-offset bias: removes acne at grazing angles without\n"
+    " * the detached shadows of a large depth bias). */\n"
+    "float cube_visibility(samplerCubeShadow map, vec2 nf, vec3 lv, float dl, vec3 n)\n"
+    "{\n"
+    "    if (!(dl > 0.0))\n"
+    "        return 1.0;   /* at the receiver, as vdsh_compare */\n"
+    "    vec3 v = -lv;\n"
+    "    float ma = max(max(abs(v.x), abs(v.y)), abs(v.z));\n"
+    "    v += n * (1.5 * u_shadow_texel * ma);\n"
+    "    ma = max(max(abs(v.x), abs(v.y)), abs(v.z));\n"
+    "    float z = (nf.y + nf.x) / (nf.y - nf.x) - 2.0 * nf.y * nf.x / ((nf.y - nf.x) * ma);\n"
+    "    float ref = 0.5 * z + 0.5;\n"
+    "#if PCF\n"
+    "    /* four bilinear (2x2) taps a texel apart around v */\n"
+    "    vec3 a = abs(v.y) < 0.9 * length(v) ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);\n"
+    "    vec3 t1 = normalize(cross(v, a)) * (0.5 * u_shadow_texel * ma);\n"
+    "    vec3 t2 = normalize(cross(v, t1)) * (0.5 * u_shadow_texel * ma);\n"
+    "    return 0.25 * (texture(map, vec4(v + t1 + t2, ref)) + texture(map, vec4(v + t1 - t2, ref)) +\n"
+    "                   texture(map, vec4(v - t1 + t2, ref)) + texture(map, vec4(v - t1 - t2, ref)));\n"
+    "#else\n"
+    "    return texture(map, vec4(v, ref));\n"
+    "#endif\n"
+    "}\n"
+    "#endif\n"
+    "\n"
+    "#if NUM_LIGHTS > 0\n"
+    "/* Lambert with distance attenuation, before the shadow. */\n"
+    "vec3 light_term(int i, vec3 lv, float dl, vec3 n)\n"
+    "{\n"
+    "    float ndl = dl > 0.0 ? max(dot(n, lv) / dl, 0.0) : 1.0;\n"
+    "    float att = 1.0 / dot(u_light_att[i], vec3(1.0, dl, dl * dl));\n"
+    "    return u_light_color[i] * (ndl * att);\n"
+    "}\n"
+    "#endif\n"
+    "\n"
+    "/* Per mode: the visibility of light I; may set dv (debug output). */\n"
+    "#if VDSH_VERTEX\n"
+    "#define VISIBILITY(I) v_vis[I]\n"
+    "#elif VDSH_SPLIT\n"
+    "#define VISIBILITY(I) split_visibility(v_sum9[I], lv, dl, dv)\n"
+    "#elif SHADOW_CUBE\n"
+    "#define VISIBILITY(I) cube_visibility(u_shadow[I], u_shadow_nf[I], lv, dl, n)\n"
+    "#else\n"
+    "#define VISIBILITY(I) 1.0\n"
+    "#endif\n"
+    "#define LIGHT(I) { vec3 lv = u_light_pos[I] - v_position; float dl = length(lv); float dv = -1.0; float s = VISIBILITY(I); acc += s * light_term(I, lv, dl, n); if (I == 0) { s0 = s; dv0 = dv; dl0 = dl; } }\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    vec3 n = normalize(v_normal);\n"
+    "    vec3 acc = vec3(0.0);\n"
+    "    float s0 = 1.0, dv0 = -1.0, dl0 = 0.0;\n"
+    "    FOR_EACH_LIGHT\n"
+    "#if VDSH_VERTEX && OUTPUT == 1\n"
+    "    /* the values the vertex stage compared */\n"
+    "    dv0 = v_dv;\n"
+    "    dl0 = v_dl;\n"
+    "#endif\n"
+    "#if OUTPUT == 1\n"
+    "    o_color = vec4(s0, dv0, dl0, 1.0);\n"
+    "#elif OUTPUT == 2\n"
+    "    o_color = vec4(v_position, 1.0);\n"
+    "#else\n"
+    "    o_color = vec4(u_albedo * (u_ambient + acc), 1.0);\n"
+    "#endif\n"
+    "}\n";
+
+static const char depth_vs[] =
+    "#version 330 core\n"
+    "layout(location = 0) in vec3 a_position;\n"
+    "uniform mat4 u_view_proj;\n"
+    "void main()\n"
+    "{\n"
+    "    gl_Position = u_view_proj * vec4(a_position, 1.0);\n"
+    "}\n";
+
+static const char depth_fs[] =
+    "#version 330 core\n"
+    "void main()\n"
+    "{\n"
+    "}\n";
+
+/* ------------------------------------------------------------------ */
+
+static void key_name(const vr_program_key *k, char *buf, size_t size)
+{
+    snprintf(buf, size, "program %s, %s, %s, output %u, pcf %u, %u lights",
+             vr_mode_name((vr_mode)k->mode),
+             k->compare == VDSH_COMPARE_BINARY ? "binary" : "smooth",
+             vdsh_quantity_name(k->quantity), k->output, k->pcf, k->lights);
+}
+
+/* The #defines that specialise the sources for one key. */
+static void key_defines(const vr_program_key *k, char *buf, size_t size)
+{
+    int order = 0, vertex = 0, split = 0, cubemap = 0, cube = 0;
+    switch ((vr_mode)k->mode) {
+    case VR_MODE_VDSH2: order = 2; vertex = 1; break;
+    case VR_MODE_VDSH3: order = 3; vertex = 1; break;
+    case VR_MODE_VDSH5: order = 5; split = 1; cubemap = 1; break;
+    case VR_MODE_VDSH5_POLY: order = 5; split = 1; break;
+    case VR_MODE_CUBE: cube = 1; break;
+    default: break;
+    }
+    int n = snprintf(buf, size,
+                     "#version 330 core\n"
+                     "#define ORDER %d\n#define VDSH_VERTEX %d\n#define VDSH_SPLIT %d\n"
+                     "#define CUBEMAP_BASIS %d\n#define SHADOW_CUBE %d\n"
+                     "#define QUANTITY %u\n#define COMPARE %u\n#define OUTPUT %u\n"
+                     "#define PCF %u\n#define NUM_LIGHTS %u\n#define FOR_EACH_LIGHT",
+                     order, vertex, split, cubemap, cube, k->quantity, k->compare,
+                     k->output, k->pcf, k->lights);
+    for (unsigned i = 0; i < k->lights && n > 0 && (size_t)n < size; i++)
+        n += snprintf(buf + n, size - (size_t)n, " LIGHT(%u)", i);
+    if (n > 0 && (size_t)n < size)
+        snprintf(buf + n, size - (size_t)n, "\n");
+}
+
+static vr_result compile(const char *name, GLenum stage, const char *src,
+                         GLuint *out, vr_error *err)
+{
+    GLuint sh = glCreateShader(stage);
+    if (!sh)
+        return vr_fail(err, VR_ERR_GL, "%s: glCreateShader failed", name);
+    glShaderSource(sh, 1, &src, NULL);
+    glCompileShader(sh);
+    GLint ok = 0;
+    glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[768] = "";
+        glGetShaderInfoLog(sh, sizeof log, NULL, log);
+        glDeleteShader(sh);
+        return vr_fail(err, VR_ERR_SHADER, "%s: %s shader: %s", name,
+                       stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
+    }
+    *out = sh;
+    return VR_OK;
+}
+
+vr_result vr_link(const char *name, const char *vs, const char *fs,
+                  GLuint *out, vr_error *err)
+{
+    GLuint v = 0, f = 0;
+    vr_result r = compile(name, GL_VERTEX_SHADER, vs, &v, err);
+    if (r == VR_OK)
+        r = compile(name, GL_FRAGMENT_SHADER, fs, &f, err);
+    if (r != VR_OK) {
+        if (v)
+            glDeleteShader(v);
+        return r;
+    }
+    GLuint p = glCreateProgram();
+    glAttachShader(p, v);
+    glAttachShader(p, f);
+    glLinkProgram(p);
+    /* The program keeps what it needs; the shaders can go now. */
+    glDeleteShader(v);
+    glDeleteShader(f);
+    GLint ok = 0;
+    glGetProgramiv(p, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[768] = "";
+        glGetProgramInfoLog(p, sizeof log, NULL, log);
+        glDeleteProgram(p);
+        return vr_fail(err, VR_ERR_SHADER, "%s: link: %s", name, log);
+    }
+    *out = p;
+    return VR_OK;
+}
+
+vr_result vr_program_build(const vr_program_key *key, vr_program *out,
+                           vr_error *err)
+{
+    char name[160], defines[1024];
+    key_name(key, name, sizeof name);
+    key_defines(key, defines, sizeof defines);
+
+    size_t vs_size = strlen(defines) + sizeof common_glsl + sizeof vertex_glsl;
+    size_t fs_size = strlen(defines) + sizeof common_glsl + sizeof fragment_glsl;
+    char *vs = malloc(vs_size), *fs = malloc(fs_size);
+    if (!vs || !fs) {
+        free(vs);
+        free(fs);
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+    }
+    snprintf(vs, vs_size, "%s%s%s", defines, common_glsl, vertex_glsl);
+    snprintf(fs, fs_size, "%s%s%s", defines, common_glsl, fragment_glsl);
+    GLuint prog = 0;
+    vr_result r = vr_link(name, vs, fs, &prog, err);
+    free(vs);
+    free(fs);
+    if (r != VR_OK)
+        return r;
+
+    vr_program p = {.key = *key, .prog = prog};
+    p.u_view_proj = glGetUniformLocation(prog, "u_view_proj");
+    p.u_scale = glGetUniformLocation(prog, "u_scale");
+    p.u_light_pos = glGetUniformLocation(prog, "u_light_pos");
+    p.u_light_color = glGetUniformLocation(prog, "u_light_color");
+    p.u_light_att = glGetUniformLocation(prog, "u_light_att");
+    p.u_ambient = glGetUniformLocation(prog, "u_ambient");
+    p.u_albedo = glGetUniformLocation(prog, "u_albedo");
+    p.u_shadow_nf = glGetUniformLocation(prog, "u_shadow_nf");
+    p.u_shadow_texel = glGetUniformLocation(prog, "u_shadow_texel");
+
+    /* Samplers never change unit: set them once. */
+    glUseProgram(prog);
+    GLint basis = glGetUniformLocation(prog, "u_basis");
+    if (basis >= 0) {
+        const GLint units[4] = {VR_UNIT_BASIS, VR_UNIT_BASIS + 1, VR_UNIT_BASIS + 2,
+                                VR_UNIT_BASIS + 3};
+        glUniform1iv(basis, 4, units);
+    }
+    GLint shadow = glGetUniformLocation(prog, "u_shadow");
+    if (shadow >= 0) {
+        GLint units[VR_MAX_LIGHTS_PER_PASS];
+        for (int i = 0; i < VR_MAX_LIGHTS_PER_PASS; i++)
+            units[i] = VR_UNIT_SHADOW + i;
+        glUniform1iv(shadow, key->lights, units);
+    }
+    glUseProgram(0);
+    r = vr_check_gl(err, name);
+    if (r != VR_OK) {
+        glDeleteProgram(prog);
+        return r;
+    }
+    *out = p;
+    return VR_OK;
+}
+
+vr_result vr_program_build_depth(GLuint *out, vr_error *err)
+{
+    return vr_link("cube shadow map depth program", depth_vs, depth_fs, out, err);
+}

@@ -1,0 +1,110 @@
+/*
+ * vr_internal.h - what the files of the runtime library share and nobody
+ * else sees: the scene and renderer structs, the GLSL program builder, the
+ * error helper and a little matrix arithmetic.
+ */
+#ifndef VR_INTERNAL_H
+#define VR_INTERNAL_H
+
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/glcorearb.h>
+
+#include "vr.h"
+
+/* Format a message into err (if not NULL) and return r. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 3, 4)))
+#endif
+vr_result vr_fail(vr_error *err, vr_result r, const char *fmt, ...);
+
+/* VR_OK when glGetError reports nothing; else VR_ERR_GL naming `what`.
+ * Drains every pending error so that the next check starts clean. */
+vr_result vr_check_gl(vr_error *err, const char *what);
+
+/* Attribute locations, the same in every program. Coefficient attribute
+ * k covers coefficients first[k] .. first[k] + size[k] - 1 of the stream
+ * (vr_coef_attribs): grouped so that bands 0-2 (0..8) and the four
+ * cubemap groups (9..12, ..., 21..24) each map to whole attributes. */
+enum {
+    VR_ATTR_POSITION = 0,
+    VR_ATTR_NORMAL = 1,
+    VR_ATTR_COEF0 = 2,
+    VR_COEF_ATTRIBS = 7
+};
+extern const int vr_coef_first[VR_COEF_ATTRIBS];
+extern const int vr_coef_size[VR_COEF_ATTRIBS];
+/* How many coefficient attributes an order uses (2: 1, 3: 3, 5: 7). */
+int vr_coef_attrib_count(int order);
+
+/* Texture units: the four basis cubemaps, then one shadow cube map per
+ * light of a pass. */
+enum { VR_UNIT_BASIS = 0, VR_UNIT_SHADOW = 4 };
+
+struct vr_scene {
+    uint32_t vertex_count, triangle_count;
+    float bounds_min[3], bounds_max[3];
+    uint32_t quantity;
+    GLuint vbo_position, vbo_normal, ibo;
+    /* Per order 1..5: the stream's buffer and a VAO with positions,
+     * normals and its coefficients; vao[0] has positions and normals only. */
+    GLuint vbo_stream[6];
+    GLuint vao[6];
+    uint32_t encoding[6];
+    float scale[6];
+    GLuint basis[4];            /* cube textures, functions 9+4k..12+4k */
+    int cube_size;
+    size_t gpu_bytes;
+};
+
+/* Which program: everything that changes the shader source. */
+typedef struct vr_program_key {
+    uint8_t mode;       /* vr_mode, resolved (never DEFAULT) */
+    uint8_t compare;    /* vdsh_compare */
+    uint8_t quantity;   /* vdsh_quantity */
+    uint8_t output;     /* vr_output */
+    uint8_t pcf;        /* 0 or 1 */
+    uint8_t lights;     /* lights in this pass, 0..VR_MAX_LIGHTS_PER_PASS */
+} vr_program_key;
+
+typedef struct vr_program {
+    vr_program_key key;
+    GLuint prog;
+    GLint u_view_proj, u_scale, u_light_pos, u_light_color, u_light_att;
+    GLint u_ambient, u_albedo, u_shadow_nf, u_shadow_texel;
+} vr_program;
+
+/* Compile and link the lighting program for `key`. On failure returns
+ * VR_ERR_SHADER with the info log (and the key) in err; *out untouched. */
+vr_result vr_program_build(const vr_program_key *key, vr_program *out,
+                           vr_error *err);
+
+/* The depth-only program that renders cube shadow map faces
+ * (uniform u_view_proj). */
+vr_result vr_program_build_depth(GLuint *out, vr_error *err);
+
+/* Compile and link vertex + fragment source; `name` for messages. */
+vr_result vr_link(const char *name, const char *vs, const char *fs,
+                  GLuint *out, vr_error *err);
+
+/* Column-major 4x4 matrices. */
+void vr_mat4_mul(float out[16], const float a[16], const float b[16]);
+void vr_mat4_look_at(float out[16], const float eye[3], const float target[3],
+                     const float up[3]);
+void vr_mat4_perspective(float out[16], float fov_y_rad, float aspect,
+                         float znear, float zfar);
+void vr_mat4_ortho(float out[16], float half_w, float half_h, float znear,
+                   float zfar);
+
+/* Text (vr_text.c): lazily created GL objects owned by the renderer. */
+typedef struct vr_text_state {
+    GLuint prog, vao, vbo;
+    GLint u_viewport, u_color;
+    size_t vbo_size;
+} vr_text_state;
+void vr_text_destroy(vr_text_state *t);
+/* Draw text into framebuffer fbo of size w x h (vr_draw_text). */
+vr_result vr_text_draw_impl(vr_text_state *t, GLuint fbo, int w, int h, int x, int y,
+                            float scale, const float color[4], const char *text,
+                            vr_error *err);
+
+#endif /* VR_INTERNAL_H */

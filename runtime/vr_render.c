@@ -1,0 +1,765 @@
+/*
+ * vr_render.c - the renderer: offscreen framebuffer, program cache, cube
+ * shadow maps, the light passes and the timer queries.
+ *
+ * A frame (vr_draw):
+ *   1. clear the framebuffer;
+ *   2. for each group of up to max_lights_per_pass lights:
+ *        VR_MODE_CUBE: render a depth cube map per light of the group
+ *          (6 faces, the whole scene each, every frame: the baseline's
+ *          real cost), timed as the group's shadow pass;
+ *        draw the scene once with the group's program, timed as its
+ *          lighting pass; the first group writes depth, later groups add
+ *          with GL_ONE/GL_ONE blending where depth is equal.
+ * The debug outputs (shadow terms, positions) draw the first group only.
+ */
+#include "vr_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+enum { FRAMES_IN_FLIGHT = 4, MAX_PROGRAMS = 96 };
+
+/* Timer queries of one frame. */
+typedef struct frame_slot {
+    uint64_t frame;          /* 0: slot unused */
+    int pending;             /* queries issued, results not collected */
+    int count, cap;
+    GLuint *queries;
+    uint8_t *kind;           /* 0 shadow, 1 lighting */
+    uint8_t *group;
+    int groups;
+    double cpu_start;        /* seconds, CLOCK_MONOTONIC */
+} frame_slot;
+
+struct vr_renderer {
+    int width, height;
+    uint32_t color_format;
+    int shadow_size;
+    int per_pass;
+    GLuint fbo, color, depth;
+    /* Cube shadow maps: one depth cube per light slot of a pass. */
+    GLuint shadow_fbo, depth_prog;
+    GLint depth_u_view_proj;
+    GLuint shadow_tex[VR_MAX_LIGHTS_PER_PASS];
+    GLuint sampler_nearest, sampler_linear;
+    vr_program programs[MAX_PROGRAMS];
+    int program_count;
+    int timers;              /* GL_TIME_ELAPSED available */
+    frame_slot slots[FRAMES_IN_FLIGHT];
+    uint64_t frame;
+    vr_timings last;
+    vr_text_state text;
+};
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ------------------------------------------------------------------ */
+/* Framebuffer                                                          */
+
+static void delete_targets(vr_renderer *r)
+{
+    glDeleteFramebuffers(1, &r->fbo);
+    glDeleteTextures(1, &r->color);
+    glDeleteRenderbuffers(1, &r->depth);
+    r->fbo = r->color = r->depth = 0;
+}
+
+static const char *fbo_status_name(GLenum s)
+{
+    switch (s) {
+    case GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT: return "incomplete attachment";
+    case GL_FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT: return "missing attachment";
+    case GL_FRAMEBUFFER_UNSUPPORTED: return "unsupported format combination";
+    default: return "incomplete";
+    }
+}
+
+static vr_result make_targets(vr_renderer *r, int w, int h, vr_error *err)
+{
+    GLuint fbo = 0, color = 0, depth = 0;
+    glGenTextures(1, &color);
+    glBindTexture(GL_TEXTURE_2D, color);
+    if (r->color_format == VR_COLOR_RGBA32F)
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, NULL);
+    else
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenRenderbuffers(1, &depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
+    glBindRenderbuffer(GL_RENDERBUFFER, 0);
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+    GLenum st = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    vr_result res = vr_check_gl(err, "framebuffer");
+    if (res == VR_OK && st != GL_FRAMEBUFFER_COMPLETE)
+        res = vr_fail(err, VR_ERR_GL, "framebuffer %dx%d: %s (0x%04x)", w, h,
+                      fbo_status_name(st), (unsigned)st);
+    if (res != VR_OK) {
+        glDeleteFramebuffers(1, &fbo);
+        glDeleteTextures(1, &color);
+        glDeleteRenderbuffers(1, &depth);
+        return res;
+    }
+    delete_targets(r);
+    r->fbo = fbo;
+    r->color = color;
+    r->depth = depth;
+    r->width = w;
+    r->height = h;
+    return VR_OK;
+}
+
+static vr_result check_size(int w, int h, vr_error *err)
+{
+    GLint max = 0;
+    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max);
+    if (w < 1 || h < 1 || w > max || h > max)
+        return vr_fail(err, VR_ERR_ARGUMENT, "framebuffer size %dx%d not in 1..%d", w, h,
+                       (int)max);
+    return VR_OK;
+}
+
+vr_result vr_renderer_create(const vr_renderer_desc *desc, vr_renderer **out,
+                             vr_error *err)
+{
+    vr_renderer_desc d = desc ? *desc : (vr_renderer_desc){0};
+    /* Defaults, in one place. */
+    if (!d.width && !d.height) {
+        d.width = 1024;
+        d.height = 768;
+    }
+    if (!d.shadow_map_size)
+        d.shadow_map_size = 512;
+    if (!d.max_lights_per_pass)
+        d.max_lights_per_pass = VR_MAX_LIGHTS_PER_PASS;
+    if (!out)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_renderer_create: NULL output");
+    if (!glGetString(GL_VERSION))
+        return vr_fail(err, VR_ERR_GL, "vr_renderer_create: no current GL context");
+    if (d.color_format > VR_COLOR_RGBA32F)
+        return vr_fail(err, VR_ERR_ARGUMENT, "unknown colour format %u", d.color_format);
+    if (d.max_lights_per_pass < 1 || d.max_lights_per_pass > VR_MAX_LIGHTS_PER_PASS)
+        return vr_fail(err, VR_ERR_ARGUMENT, "max_lights_per_pass %d not in 1..%d",
+                       d.max_lights_per_pass, VR_MAX_LIGHTS_PER_PASS);
+    GLint max_cube = 0;
+    glGetIntegerv(GL_MAX_CUBE_MAP_TEXTURE_SIZE, &max_cube);
+    if (d.shadow_map_size < 1 || d.shadow_map_size > max_cube)
+        return vr_fail(err, VR_ERR_ARGUMENT, "shadow map size %d not in 1..%d",
+                       d.shadow_map_size, (int)max_cube);
+    vr_result res = check_size(d.width, d.height, err);
+    if (res != VR_OK)
+        return res;
+
+    vr_renderer *r = calloc(1, sizeof *r);
+    if (!r)
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "renderer: out of memory");
+    r->color_format = d.color_format;
+    r->shadow_size = d.shadow_map_size;
+    r->per_pass = d.max_lights_per_pass;
+    res = make_targets(r, d.width, d.height, err);
+    if (res == VR_OK)
+        res = vr_program_build_depth(&r->depth_prog, err);
+    if (res == VR_OK) {
+        r->depth_u_view_proj = glGetUniformLocation(r->depth_prog, "u_view_proj");
+        glGenFramebuffers(1, &r->shadow_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, r->shadow_fbo);
+        glDrawBuffer(GL_NONE);
+        glReadBuffer(GL_NONE);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        /* Depth comparison in the sampler: one tap is one compare
+         * (nearest); PCF taps are 2x2 bilinear compares (linear). */
+        glGenSamplers(1, &r->sampler_nearest);
+        glGenSamplers(1, &r->sampler_linear);
+        const GLuint smp[2] = {r->sampler_nearest, r->sampler_linear};
+        for (int i = 0; i < 2; i++) {
+            GLint filter = i ? GL_LINEAR : GL_NEAREST;
+            glSamplerParameteri(smp[i], GL_TEXTURE_MIN_FILTER, filter);
+            glSamplerParameteri(smp[i], GL_TEXTURE_MAG_FILTER, filter);
+            glSamplerParameteri(smp[i], GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+            glSamplerParameteri(smp[i], GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+            glSamplerParameteri(smp[i], GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+            glSamplerParameteri(smp[i], GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+            glSamplerParameteri(smp[i], GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+        }
+        GLint bits = 0;
+        glGetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &bits);
+        r->timers = bits > 0;
+        res = vr_check_gl(err, "renderer");
+    }
+    if (res != VR_OK) {
+        vr_renderer_destroy(r);
+        return res;
+    }
+    *out = r;
+    return VR_OK;
+}
+
+void vr_renderer_destroy(vr_renderer *r)
+{
+    if (!r)
+        return;
+    delete_targets(r);
+    glDeleteFramebuffers(1, &r->shadow_fbo);
+    glDeleteTextures(VR_MAX_LIGHTS_PER_PASS, r->shadow_tex);
+    glDeleteSamplers(1, &r->sampler_nearest);
+    glDeleteSamplers(1, &r->sampler_linear);
+    if (r->depth_prog)
+        glDeleteProgram(r->depth_prog);
+    for (int i = 0; i < r->program_count; i++)
+        glDeleteProgram(r->programs[i].prog);
+    for (int i = 0; i < FRAMES_IN_FLIGHT; i++) {
+        frame_slot *s = &r->slots[i];
+        if (s->cap)
+            glDeleteQueries(s->cap, s->queries);
+        free(s->queries);
+        free(s->kind);
+        free(s->group);
+    }
+    vr_text_destroy(&r->text);
+    free(r);
+}
+
+vr_result vr_renderer_resize(vr_renderer *r, int width, int height, vr_error *err)
+{
+    if (width == r->width && height == r->height)
+        return VR_OK;
+    vr_result res = check_size(width, height, err);
+    return res != VR_OK ? res : make_targets(r, width, height, err);
+}
+
+void vr_renderer_size(const vr_renderer *r, int *width, int *height)
+{
+    *width = r->width;
+    *height = r->height;
+}
+
+unsigned vr_renderer_framebuffer(const vr_renderer *r)
+{
+    return r->fbo;
+}
+
+/* ------------------------------------------------------------------ */
+/* Timer queries                                                        */
+
+/* Move a finished frame's results into r->last. With wait = 0 only when
+ * they are available (never stalls); returns 1 when collected. */
+static int collect(vr_renderer *r, frame_slot *s, int wait)
+{
+    if (!s->pending)
+        return 0;
+    if (s->count > 0 && !wait) {
+        GLint ready = 0;
+        glGetQueryObjectiv(s->queries[s->count - 1], GL_QUERY_RESULT_AVAILABLE, &ready);
+        if (!ready)
+            return 0;
+    }
+    vr_timings t;
+    memset(&t, 0, sizeof t);
+    t.frame = s->frame;
+    t.groups = s->groups;
+    for (int i = 0; i < s->count; i++) {
+        GLuint64 ns = 0;
+        glGetQueryObjectui64v(s->queries[i], GL_QUERY_RESULT, &ns);
+        double ms = 1e-6 * (double)ns;
+        int g = s->group[i];
+        if (s->kind[i] == 0) {
+            t.shadow_ms[g] += ms;
+            t.shadow_total_ms += ms;
+        } else {
+            t.lighting_ms[g] += ms;
+            t.lighting_total_ms += ms;
+        }
+    }
+    t.gpu_ms = t.shadow_total_ms + t.lighting_total_ms;
+    s->pending = 0;
+    if (t.frame >= r->last.frame)
+        r->last = t;
+    return 1;
+}
+
+/* Begin timing `kind` of group g in the current frame's slot. Returns 0
+ * when nothing was begun (no timers or out of memory). */
+static int timer_begin(vr_renderer *r, frame_slot *s, int kind, int g)
+{
+    if (!r->timers)
+        return 0;
+    if (s->count == s->cap) {
+        int cap = s->cap ? 2 * s->cap : 8;
+        GLuint *q = realloc(s->queries, (size_t)cap * sizeof *q);
+        if (q)
+            s->queries = q;
+        uint8_t *k = q ? realloc(s->kind, (size_t)cap) : NULL;
+        if (k)
+            s->kind = k;
+        uint8_t *gr = k ? realloc(s->group, (size_t)cap) : NULL;
+        if (!gr)
+            return 0;
+        s->group = gr;
+        glGenQueries(cap - s->cap, s->queries + s->cap);
+        s->cap = cap;
+    }
+    s->kind[s->count] = (uint8_t)kind;
+    s->group[s->count] = (uint8_t)(g < VR_TIMING_MAX_GROUPS ? g : VR_TIMING_MAX_GROUPS - 1);
+    glBeginQuery(GL_TIME_ELAPSED, s->queries[s->count++]);
+    return 1;
+}
+
+static void timer_end(int begun)
+{
+    if (begun)
+        glEndQuery(GL_TIME_ELAPSED);
+}
+
+void vr_renderer_finish(vr_renderer *r)
+{
+    glFinish();
+    double end = now_seconds();
+    frame_slot *cur = NULL;
+    for (int i = 0; i < FRAMES_IN_FLIGHT; i++) {
+        frame_slot *s = &r->slots[i];
+        if (s->frame == r->frame && r->frame)
+            cur = s;
+        collect(r, s, 1);
+    }
+    if (cur && r->last.frame == cur->frame)
+        r->last.cpu_ms = 1e3 * (end - cur->cpu_start);
+}
+
+void vr_renderer_timings(vr_renderer *r, vr_timings *out)
+{
+    for (int i = 0; i < FRAMES_IN_FLIGHT; i++)
+        collect(r, &r->slots[i], 0);
+    *out = r->last;
+}
+
+/* ------------------------------------------------------------------ */
+/* Programs                                                             */
+
+static vr_result get_program(vr_renderer *r, const vr_program_key *k, const vr_program **out,
+                             vr_error *err)
+{
+    for (int i = 0; i < r->program_count; i++)
+        if (memcmp(&r->programs[i].key, k, sizeof *k) == 0) {
+            *out = &r->programs[i];
+            return VR_OK;
+        }
+    /* A full cache drops everything: it only fills when cycling through
+     * every combination, and rebuilding is cheap next to that. */
+    if (r->program_count == MAX_PROGRAMS) {
+        for (int i = 0; i < r->program_count; i++)
+            glDeleteProgram(r->programs[i].prog);
+        r->program_count = 0;
+    }
+    vr_result res = vr_program_build(k, &r->programs[r->program_count], err);
+    if (res != VR_OK)
+        return res;
+    *out = &r->programs[r->program_count++];
+    return VR_OK;
+}
+
+/* ------------------------------------------------------------------ */
+/* Cube shadow maps                                                     */
+
+static vr_result ensure_shadow_tex(vr_renderer *r, int slot, vr_error *err)
+{
+    if (r->shadow_tex[slot])
+        return VR_OK;
+    GLuint t = 0;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_CUBE_MAP, t);
+    for (int f = 0; f < 6; f++)
+        glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, 0, GL_DEPTH_COMPONENT32F,
+                     r->shadow_size, r->shadow_size, 0, GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
+    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAX_LEVEL, 0);
+    glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    vr_result res = vr_check_gl(err, "shadow cube map");
+    if (res == VR_OK) {
+        glBindFramebuffer(GL_FRAMEBUFFER, r->shadow_fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_CUBE_MAP_POSITIVE_X,
+                               t, 0);
+        GLenum st = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+        if (st != GL_FRAMEBUFFER_COMPLETE)
+            res = vr_fail(err, VR_ERR_GL, "shadow framebuffer: %s (0x%04x)", fbo_status_name(st),
+                          (unsigned)st);
+    }
+    if (res != VR_OK) {
+        glDeleteTextures(1, &t);
+        return res;
+    }
+    r->shadow_tex[slot] = t;
+    return VR_OK;
+}
+
+/* Near and far planes of a light's face projections: far reaches the
+ * farthest corner of the scene; near is a fixed fraction of it (32-bit
+ * float depth keeps about far/near * 2^-24 relative precision at far). */
+static void shadow_planes(const vr_scene *s, const float l[3], float nf[2])
+{
+    float far2 = 0.0f;
+    for (int c = 0; c < 8; c++) {
+        float d2 = 0.0f;
+        for (int k = 0; k < 3; k++) {
+            float x = ((c >> k) & 1) ? s->bounds_max[k] : s->bounds_min[k];
+            d2 += (x - l[k]) * (x - l[k]);
+        }
+        far2 = fmaxf(far2, d2);
+    }
+    float far = 1.01f * sqrtf(far2) + 1e-6f;
+    nf[0] = far * 1e-3f;
+    nf[1] = far;
+}
+
+/* GL cube-map face f seen from `eye`: the look-at directions and up
+ * vectors that make a 90-degree render land in GL's face orientation
+ * (OpenGL 4.6 table 8.19; the face images have t = -y on the side faces). */
+static void face_view_proj(int f, const float eye[3], const float nf[2], float out[16])
+{
+    static const float dir[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
+                                    {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    static const float up[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1},
+                                   {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+    float target[3] = {eye[0] + dir[f][0], eye[1] + dir[f][1], eye[2] + dir[f][2]};
+    float view[16], proj[16];
+    vr_mat4_look_at(view, eye, target, up[f]);
+    vr_mat4_perspective(proj, 1.5707963267948966f, 1.0f, nf[0], nf[1]);
+    vr_mat4_mul(out, proj, view);
+}
+
+static vr_result render_shadow_maps(vr_renderer *r, const vr_scene *s, const vr_light *lights,
+                                    int n, float nf[][2], vr_error *err)
+{
+    for (int i = 0; i < n; i++) {
+        vr_result res = ensure_shadow_tex(r, i, err);
+        if (res != VR_OK)
+            return res;
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, r->shadow_fbo);
+    glViewport(0, 0, r->shadow_size, r->shadow_size);
+    glUseProgram(r->depth_prog);
+    glBindVertexArray(s->vao[0]);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    /* Slope-scaled offset for surfaces at grazing angles to the light;
+     * the normal offset in the shader does the rest. */
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(1.5f, 2.0f);
+    for (int i = 0; i < n; i++) {
+        shadow_planes(s, lights[i].position, nf[i]);
+        for (int f = 0; f < 6; f++) {
+            float vp[16];
+            face_view_proj(f, lights[i].position, nf[i], vp);
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT,
+                                   GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, r->shadow_tex[i], 0);
+            glClear(GL_DEPTH_BUFFER_BIT);
+            glUniformMatrix4fv(r->depth_u_view_proj, 1, GL_FALSE, vp);
+            glDrawElements(GL_TRIANGLES, (GLsizei)(3 * s->triangle_count), GL_UNSIGNED_INT, NULL);
+        }
+    }
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    return VR_OK;
+}
+
+/* ------------------------------------------------------------------ */
+/* Drawing                                                              */
+
+static int mode_order(vr_mode m)
+{
+    switch (m) {
+    case VR_MODE_VDSH2: return 2;
+    case VR_MODE_VDSH3: return 3;
+    case VR_MODE_VDSH5:
+    case VR_MODE_VDSH5_POLY: return 5;
+    default: return 0;
+    }
+}
+
+static int finite3(const float v[3])
+{
+    return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
+}
+
+/* The camera with its defaults filled in, as one view-projection matrix. */
+static void camera_matrix(const vr_renderer *r, const vr_scene *s, const vr_camera *in,
+                          float vp[16])
+{
+    vr_camera c = *in;
+    if (c.eye[0] == c.target[0] && c.eye[1] == c.target[1] && c.eye[2] == c.target[2]) {
+        vr_camera def;
+        vr_scene_default_camera(s, &def);
+        memcpy(c.eye, def.eye, sizeof c.eye);
+        memcpy(c.target, def.target, sizeof c.target);
+        if (!c.up[0] && !c.up[1] && !c.up[2])
+            memcpy(c.up, def.up, sizeof c.up);
+    }
+    if (!c.up[0] && !c.up[1] && !c.up[2])
+        c.up[1] = 1.0f;
+    if (!(c.fov_y > 0.0f))
+        c.fov_y = 60.0f;
+    float far2 = 0.0f;
+    for (int k = 0; k < 8; k++) {
+        float d2 = 0.0f;
+        for (int a = 0; a < 3; a++) {
+            float x = ((k >> a) & 1) ? s->bounds_max[a] : s->bounds_min[a];
+            d2 += (x - c.eye[a]) * (x - c.eye[a]);
+        }
+        far2 = fmaxf(far2, d2);
+    }
+    float far = 1.05f * sqrtf(far2) + 1e-6f;
+    float aspect = (float)r->width / (float)r->height;
+    float view[16], proj[16];
+    vr_mat4_look_at(view, c.eye, c.target, c.up);
+    if (c.ortho_height > 0.0f) {
+        float zn = c.znear != 0.0f ? c.znear : -far, zf = c.zfar != 0.0f ? c.zfar : far;
+        vr_mat4_ortho(proj, 0.5f * c.ortho_height * aspect, 0.5f * c.ortho_height, zn, zf);
+    } else {
+        float zf = c.zfar > 0.0f ? c.zfar : far;
+        float zn = c.znear > 0.0f ? c.znear : zf / 4000.0f;
+        vr_mat4_perspective(proj, c.fov_y * 3.14159265358979f / 180.0f, aspect, zn, zf);
+    }
+    vr_mat4_mul(vp, proj, view);
+}
+
+vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, vr_error *err)
+{
+    if (!r || !s || !desc)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: NULL renderer, scene or descriptor");
+    vr_draw_desc d = *desc;
+    /* Defaults, in one place. */
+    if (d.mode == VR_MODE_DEFAULT)
+        d.mode = VR_MODE_VDSH5_POLY;
+    if (!d.albedo[0] && !d.albedo[1] && !d.albedo[2])
+        d.albedo[0] = d.albedo[1] = d.albedo[2] = 0.8f;
+
+    if (d.mode >= VR_MODE_COUNT_)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown mode %u", d.mode);
+    if (d.compare > VDSH_COMPARE_BINARY)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown comparison %u", d.compare);
+    if (d.output > VR_OUTPUT_POSITION)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown output %u", d.output);
+    if (d.light_count < 0 || (d.light_count > 0 && !d.lights))
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: %d lights but no array", d.light_count);
+    for (int i = 0; i < d.light_count; i++)
+        if (!finite3(d.lights[i].position) || !finite3(d.lights[i].color) ||
+            !finite3(d.lights[i].attenuation))
+            return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: light %d is not finite", i);
+    vr_mode mode = (vr_mode)d.mode;
+    if (!vr_scene_supports(s, mode)) {
+        if (mode == VR_MODE_VDSH5 && s->vbo_stream[5])
+            return vr_fail(err, VR_ERR_MISSING,
+                           "mode %s needs the basis cubemaps, which were not loaded "
+                           "(vdsh5poly needs none)", vr_mode_name(mode));
+        return vr_fail(err, VR_ERR_MISSING, "mode %s: the scene has no order-%d %s stream",
+                       vr_mode_name(mode), mode_order(mode), vdsh_quantity_name(s->quantity));
+    }
+    int order = mode_order(mode);
+
+    /* Timing slot of this frame. */
+    uint64_t frame = ++r->frame;
+    frame_slot *slot = &r->slots[frame % FRAMES_IN_FLIGHT];
+    for (int i = 0; i < FRAMES_IN_FLIGHT; i++)
+        collect(r, &r->slots[i], 0);
+    collect(r, slot, 1);
+    slot->frame = frame;
+    slot->count = 0;
+    slot->pending = 1;
+    slot->cpu_start = now_seconds();
+
+    float vp[16];
+    camera_matrix(r, s, &d.camera, vp);
+
+    int per = r->per_pass;
+    int groups = d.light_count > 0 ? (d.light_count + per - 1) / per : 1;
+    if (d.output != VR_OUTPUT_COLOR)
+        groups = 1;
+    slot->groups = groups;
+
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
+    glViewport(0, 0, r->width, r->height);
+    glDepthMask(GL_TRUE);
+    glClearColor(d.clear_color[0], d.clear_color[1], d.clear_color[2], d.clear_color[3]);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+
+    vr_result res = VR_OK;
+    for (int g = 0; g < groups && res == VR_OK; g++) {
+        const vr_light *group = d.lights ? d.lights + g * per : NULL;
+        int n = d.light_count - g * per;
+        if (n > per)
+            n = per;
+        if (n < 0)
+            n = 0;
+
+        float nf[VR_MAX_LIGHTS_PER_PASS][2];
+        if (mode == VR_MODE_CUBE && n > 0) {
+            int t = timer_begin(r, slot, 0, g);
+            res = render_shadow_maps(r, s, group, n, nf, err);
+            timer_end(t);
+            if (res != VR_OK)
+                break;
+        }
+
+        vr_program_key key = {(uint8_t)mode, (uint8_t)d.compare, (uint8_t)s->quantity,
+                              (uint8_t)d.output, (uint8_t)(d.pcf ? 1 : 0), (uint8_t)n};
+        if (mode != VR_MODE_CUBE)
+            key.pcf = 0;
+        const vr_program *p = NULL;
+        res = get_program(r, &key, &p, err);
+        if (res != VR_OK)
+            break;
+
+        int t = timer_begin(r, slot, 1, g);
+        glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
+        glViewport(0, 0, r->width, r->height);
+        glEnable(GL_DEPTH_TEST);
+        if (g == 0) {
+            glDepthFunc(GL_LESS);
+            glDepthMask(GL_TRUE);
+            glDisable(GL_BLEND);
+        } else {
+            glDepthFunc(GL_LEQUAL);
+            glDepthMask(GL_FALSE);
+            glEnable(GL_BLEND);
+            glBlendFunc(GL_ONE, GL_ONE);
+        }
+        glUseProgram(p->prog);
+        glUniformMatrix4fv(p->u_view_proj, 1, GL_FALSE, vp);
+        glUniform1f(p->u_scale, order ? s->scale[order] : 1.0f);
+        const float zero[3] = {0, 0, 0};
+        glUniform3fv(p->u_ambient, 1, g == 0 ? d.ambient : zero);
+        glUniform3fv(p->u_albedo, 1, d.albedo);
+        if (n > 0) {
+            float pos[VR_MAX_LIGHTS_PER_PASS][3], col[VR_MAX_LIGHTS_PER_PASS][3];
+            float att[VR_MAX_LIGHTS_PER_PASS][3];
+            for (int i = 0; i < n; i++) {
+                const vr_light *L = &group[i];
+                memcpy(pos[i], L->position, sizeof pos[i]);
+                int black = !L->color[0] && !L->color[1] && !L->color[2];
+                for (int k = 0; k < 3; k++)
+                    col[i][k] = black ? 1.0f : L->color[k];
+                int none = !L->attenuation[0] && !L->attenuation[1] && !L->attenuation[2];
+                for (int k = 0; k < 3; k++)
+                    att[i][k] = none ? (k == 0 ? 1.0f : 0.0f) : L->attenuation[k];
+            }
+            glUniform3fv(p->u_light_pos, n, &pos[0][0]);
+            glUniform3fv(p->u_light_color, n, &col[0][0]);
+            glUniform3fv(p->u_light_att, n, &att[0][0]);
+        }
+        if (mode == VR_MODE_CUBE && n > 0) {
+            glUniform2fv(p->u_shadow_nf, n, &nf[0][0]);
+            glUniform1f(p->u_shadow_texel, 2.0f / (float)r->shadow_size);
+            for (int i = 0; i < n; i++) {
+                glActiveTexture(GL_TEXTURE0 + VR_UNIT_SHADOW + (GLenum)i);
+                glBindTexture(GL_TEXTURE_CUBE_MAP, r->shadow_tex[i]);
+                glBindSampler(VR_UNIT_SHADOW + (GLuint)i,
+                              key.pcf ? r->sampler_linear : r->sampler_nearest);
+            }
+        }
+        if (mode == VR_MODE_VDSH5) {
+            for (int k = 0; k < 4; k++) {
+                glActiveTexture(GL_TEXTURE0 + VR_UNIT_BASIS + (GLenum)k);
+                glBindTexture(GL_TEXTURE_CUBE_MAP, s->basis[k]);
+            }
+        }
+        glActiveTexture(GL_TEXTURE0);
+        glBindVertexArray(s->vao[order]);
+        if (d.points)
+            glDrawArrays(GL_POINTS, 0, (GLsizei)s->vertex_count);
+        else
+            glDrawElements(GL_TRIANGLES, (GLsizei)(3 * s->triangle_count), GL_UNSIGNED_INT, NULL);
+        timer_end(t);
+    }
+
+    /* Leave the state as the next user expects it. */
+    for (int i = 0; i < per; i++)
+        glBindSampler(VR_UNIT_SHADOW + (GLuint)i, 0);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_BLEND);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (res == VR_OK)
+        res = vr_check_gl(err, "vr_draw");
+    return res;
+}
+
+/* ------------------------------------------------------------------ */
+/* Results                                                              */
+
+/* Read a w x h area of framebuffer fbo, top row first. */
+static vr_result read_framebuffer(GLuint fbo, GLenum buffer, int w, int h, int floats, void *dst,
+                                  size_t size, vr_error *err)
+{
+    size_t px = floats ? 16 : 4;
+    size_t row = (size_t)w * px, need = row * (size_t)h;
+    if (!dst || w < 1 || h < 1 || size < need)
+        return vr_fail(err, VR_ERR_ARGUMENT, "read pixels: buffer of %zu bytes, need %zu",
+                       size, need);
+    unsigned char *tmp = malloc(row);
+    if (!tmp)
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "read pixels: out of memory");
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    glReadBuffer(buffer);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, w, h, GL_RGBA, floats ? GL_FLOAT : GL_UNSIGNED_BYTE, dst);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    /* GL's first row is the bottom one; images start at the top. */
+    unsigned char *p = dst;
+    for (int y = 0; y < h / 2; y++) {
+        unsigned char *a = p + (size_t)y * row, *b = p + (size_t)(h - 1 - y) * row;
+        memcpy(tmp, a, row);
+        memcpy(a, b, row);
+        memcpy(b, tmp, row);
+    }
+    free(tmp);
+    return vr_check_gl(err, "read pixels");
+}
+
+vr_result vr_read_pixels(vr_renderer *r, void *dst, size_t size, vr_error *err)
+{
+    return read_framebuffer(r->fbo, GL_COLOR_ATTACHMENT0, r->width, r->height,
+                            r->color_format == VR_COLOR_RGBA32F, dst, size, err);
+}
+
+vr_result vr_read_window(int width, int height, void *dst, size_t size, vr_error *err)
+{
+    return read_framebuffer(0, GL_BACK, width, height, 0, dst, size, err);
+}
+
+void vr_renderer_blit(vr_renderer *r, unsigned dst, int dst_width, int dst_height)
+{
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, r->fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, dst);
+    int same = dst_width == r->width && dst_height == r->height;
+    glBlitFramebuffer(0, 0, r->width, r->height, 0, 0, dst_width, dst_height,
+                      GL_COLOR_BUFFER_BIT, same ? GL_NEAREST : GL_LINEAR);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+vr_result vr_draw_text(vr_renderer *r, int x, int y, float scale, const float color[4],
+                       const char *text, vr_error *err)
+{
+    if (!r || !text)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw_text: NULL argument");
+    return vr_text_draw_impl(&r->text, r->fbo, r->width, r->height, x, y, scale, color, text,
+                             err);
+}

@@ -1,0 +1,361 @@
+/*
+ * vr_scene.c - load a .vdsh (formats/) and its basis cubemaps
+ * (bake/cubemap.h), upload them, and derive a default view.
+ *
+ * Coefficients go to the GPU exactly as stored: f16 streams as
+ * GL_HALF_FLOAT attributes, with the stream's scale applied in the shader,
+ * so nothing is converted on the CPU and an f16 scene takes half the
+ * memory. Each order's stream gets its own VAO; attribute k of a VAO
+ * points at coefficients vr_coef_first[k].. of each vertex (vr_internal.h).
+ */
+#include "vr_internal.h"
+
+#include "cubemap.h"
+#include "vdsh_cube.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+/* Where the basis cubemaps of `path` live: its directory and its file name
+ * without ".vdsh". */
+static void split_path(const char *path, char *dir, size_t dir_size,
+                       char *stem, size_t stem_size)
+{
+    const char *slash = path ? strrchr(path, '/') : NULL;
+    const char *base = slash ? slash + 1 : (path ? path : "");
+    if (slash)
+        snprintf(dir, dir_size, "%.*s", (int)(slash - path + 1), path);
+    else
+        snprintf(dir, dir_size, "%s", "");
+    size_t n = strlen(base);
+    if (n > 5 && strcmp(base + n - 5, ".vdsh") == 0)
+        n -= 5;
+    snprintf(stem, stem_size, "%.*s", (int)n, base);
+}
+
+static vr_result map_vdsh_result(vdsh_result r)
+{
+    switch (r) {
+    case VDSH_ERR_IO: return VR_ERR_IO;
+    case VDSH_ERR_OUT_OF_MEMORY: return VR_ERR_OUT_OF_MEMORY;
+    case VDSH_ERR_ARGUMENT: return VR_ERR_ARGUMENT;
+    default: return VR_ERR_FORMAT;
+    }
+}
+
+/* Read the four basis cubemaps. A file that does not exist is
+ * VR_ERR_MISSING (the usual mistake: the .vdsh was copied without them);
+ * one that exists but does not read is the reader's error. */
+static vr_result read_basis(const char *name, const char *dir, const char *stem,
+                            int size, vb_cubemap *maps[VB_CUBEMAP_BASIS_FILES],
+                            vr_error *err)
+{
+    for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++) {
+        char p[4096];
+        vb_error ve;
+        if (vb_cubemap_basis_path(dir, stem, k, p, sizeof p, &ve) != VB_OK)
+            return vr_fail(err, VR_ERR_ARGUMENT, "%s: %s", name, ve.msg);
+        struct stat st;
+        if (stat(p, &st) != 0)
+            return vr_fail(err, errno == ENOENT ? VR_ERR_MISSING : VR_ERR_IO,
+                           "%s: %s (basis cubemap %d of 4, needed for order 5 of %s; "
+                           "bake writes it beside the .vdsh, or load without cubemaps)",
+                           p, strerror(errno), k + 1, name);
+    }
+    vb_error ve;
+    vb_result r = vb_cubemap_read_basis(dir, stem, size, maps, &ve);
+    if (r != VB_OK)
+        return vr_fail(err, r == VB_ERR_IO ? VR_ERR_IO
+                            : r == VB_ERR_OUT_OF_MEMORY ? VR_ERR_OUT_OF_MEMORY
+                                                        : VR_ERR_FORMAT,
+                       "%s (basis cubemap for order 5 of %s)", ve.msg, name);
+    return VR_OK;
+}
+
+/* One basis cubemap to a GL cube texture. The EXR faces are mirrored
+ * relative to GL's (vdsh_cube.h): every GL texel is fetched from the EXR
+ * texel vdsh_cube_gl_to_exr names, so a lookup in direction d returns
+ * the basis functions at d. Half floats hold the EXR's values exactly. */
+static vr_result upload_basis(const vb_cubemap *m, GLuint tex, vr_error *err)
+{
+    int n = m->size;
+    float *face = malloc((size_t)n * (size_t)n * 4 * sizeof(float));
+    if (!face)
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "basis cubemap: out of memory");
+    glBindTexture(GL_TEXTURE_CUBE_MAP, tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    for (int f = 0; f < 6; f++) {
+        for (int j = 0; j < n; j++)
+            for (int i = 0; i < n; i++) {
+                int ei, ej;
+                vdsh_cube_gl_to_exr(f, i, j, n, &ei, &ej);
+                const float *src = m->rgba + (((size_t)f * (size_t)n + (size_t)ej) * (size_t)n +
+                                              (size_t)ei) * 4;
+                memcpy(face + ((size_t)j * (size_t)n + (size_t)i) * 4, src, 4 * sizeof(float));
+            }
+        glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, 0, GL_RGBA16F, n, n, 0,
+                     GL_RGBA, GL_FLOAT, face);
+    }
+    free(face);
+    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAX_LEVEL, 0);
+    glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
+    return VR_OK;
+}
+
+static void set_base_attribs(const vr_scene *s)
+{
+    glBindBuffer(GL_ARRAY_BUFFER, s->vbo_position);
+    glVertexAttribPointer(VR_ATTR_POSITION, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), NULL);
+    glEnableVertexAttribArray(VR_ATTR_POSITION);
+    glBindBuffer(GL_ARRAY_BUFFER, s->vbo_normal);
+    glVertexAttribPointer(VR_ATTR_NORMAL, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), NULL);
+    glEnableVertexAttribArray(VR_ATTR_NORMAL);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, s->ibo);
+}
+
+static vr_result upload_stream(vr_scene *s, const vdsh_stream *st, size_t vertices)
+{
+    int order = (int)st->order;
+    size_t bpv = vdsh_stream_bytes_per_vertex(st);
+    size_t elem = st->encoding == VDSH_ENCODING_F16 ? 2 : 4;
+    glGenBuffers(1, &s->vbo_stream[order]);
+    glBindBuffer(GL_ARRAY_BUFFER, s->vbo_stream[order]);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(bpv * vertices), st->data, GL_STATIC_DRAW);
+    s->gpu_bytes += bpv * vertices;
+
+    glGenVertexArrays(1, &s->vao[order]);
+    glBindVertexArray(s->vao[order]);
+    set_base_attribs(s);
+    glBindBuffer(GL_ARRAY_BUFFER, s->vbo_stream[order]);
+    GLenum type = st->encoding == VDSH_ENCODING_F16 ? GL_HALF_FLOAT : GL_FLOAT;
+    int n = vr_coef_attrib_count(order);
+    for (int k = 0; k < n; k++) {
+        int size = vr_coef_size[k];
+        /* Order 1 has one coefficient: only the first component. */
+        if (vr_coef_first[k] + size > order * order)
+            size = order * order - vr_coef_first[k];
+        if (size <= 0)
+            break;
+        glVertexAttribPointer(VR_ATTR_COEF0 + (GLuint)k, size, type, GL_FALSE, (GLsizei)bpv,
+                              (const void *)(uintptr_t)((size_t)vr_coef_first[k] * elem));
+        glEnableVertexAttribArray(VR_ATTR_COEF0 + (GLuint)k);
+    }
+    glBindVertexArray(0);
+    s->encoding[order] = st->encoding;
+    s->scale[order] = st->scale;
+    return VR_OK;
+}
+
+vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *err)
+{
+    if (!desc || !out || (!desc->path && !desc->file))
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_scene_create: no path or file given");
+    const char *name = desc->path ? desc->path : "(memory)";
+    if (desc->quantity > VDSH_QUANTITY_LOG_DISTANCE)
+        return vr_fail(err, VR_ERR_ARGUMENT, "%s: unknown quantity %u", name, desc->quantity);
+    if (!glGetString(GL_VERSION))
+        return vr_fail(err, VR_ERR_GL, "%s: no current GL context", name);
+
+    /* 1. The file: read and validated by formats/ (every CRC and range). */
+    vdsh_file *owned = NULL;
+    const vdsh_file *f = desc->file;
+    if (!f) {
+        vdsh_error ve;
+        vdsh_result vr = vdsh_read(desc->path, &owned, &ve);
+        if (vr != VDSH_OK)
+            return vr_fail(err, map_vdsh_result(vr), "%s", ve.msg);
+        f = owned;
+    }
+    const vdsh_header *h = &f->header;
+    vr_result r = VR_OK;
+    vr_scene *s = NULL;
+    vb_cubemap *maps[VB_CUBEMAP_BASIS_FILES] = {0};
+    int have_maps = 0;
+    if (h->vertex_count == 0 || h->triangle_count == 0) {
+        r = vr_fail(err, VR_ERR_FORMAT, "%s: no triangles to draw", name);
+        goto done;
+    }
+
+    /* 2. The basis cubemaps, when order 5 could use them. */
+    const vdsh_stream *s5 = vdsh_find_stream(f, 5, desc->quantity);
+    /* From memory with neither a path nor a stem there is nothing to look
+     * for: as skip_cubemaps. */
+    int findable = desc->path || desc->cubemap_stem;
+    if (s5 && h->cube_size > 0 && !desc->skip_cubemaps && findable) {
+        char dir[4096], stem[1024];
+        split_path(desc->path, dir, sizeof dir, stem, sizeof stem);
+        r = read_basis(name, desc->cubemap_dir ? desc->cubemap_dir : dir,
+                       desc->cubemap_stem ? desc->cubemap_stem : stem, (int)h->cube_size, maps,
+                       err);
+        if (r != VR_OK)
+            goto done;
+        have_maps = 1;
+    }
+
+    /* 3. Upload. */
+    s = calloc(1, sizeof *s);
+    if (!s) {
+        r = vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+        goto done;
+    }
+    s->vertex_count = h->vertex_count;
+    s->triangle_count = h->triangle_count;
+    s->quantity = desc->quantity;
+    for (int k = 0; k < 3; k++) {
+        s->bounds_min[k] = INFINITY;
+        s->bounds_max[k] = -INFINITY;
+    }
+    for (uint32_t v = 0; v < h->vertex_count; v++)
+        for (int k = 0; k < 3; k++) {
+            float x = f->positions[3 * (size_t)v + (size_t)k];
+            s->bounds_min[k] = fminf(s->bounds_min[k], x);
+            s->bounds_max[k] = fmaxf(s->bounds_max[k], x);
+        }
+
+    size_t nv = h->vertex_count;
+    glGenBuffers(1, &s->vbo_position);
+    glBindBuffer(GL_ARRAY_BUFFER, s->vbo_position);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 12), f->positions, GL_STATIC_DRAW);
+    glGenBuffers(1, &s->vbo_normal);
+    glBindBuffer(GL_ARRAY_BUFFER, s->vbo_normal);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 12), f->normals, GL_STATIC_DRAW);
+    glGenVertexArrays(1, &s->vao[0]);
+    glBindVertexArray(s->vao[0]);
+    glGenBuffers(1, &s->ibo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, s->ibo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)((size_t)h->triangle_count * 12), f->indices,
+                 GL_STATIC_DRAW);
+    set_base_attribs(s);
+    glBindVertexArray(0);
+    s->gpu_bytes = nv * 24 + (size_t)h->triangle_count * 12;
+
+    for (uint32_t i = 0; i < f->stream_count; i++) {
+        const vdsh_stream *st = &f->streams[i];
+        if (st->quantity != desc->quantity || st->order < 1 || st->order > 5 ||
+            s->vbo_stream[st->order])
+            continue;
+        upload_stream(s, st, nv);
+    }
+    if (have_maps) {
+        glGenTextures(4, s->basis);
+        for (int k = 0; k < 4 && r == VR_OK; k++)
+            r = upload_basis(maps[k], s->basis[k], err);
+        s->cube_size = maps[0]->size;
+        s->gpu_bytes += 4 * 6 * (size_t)s->cube_size * (size_t)s->cube_size * 8;
+        if (r != VR_OK)
+            goto done;
+    }
+    r = vr_check_gl(err, name);
+
+done:
+    for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
+        vb_cubemap_free(maps[k]);
+    vdsh_free(owned);
+    if (r != VR_OK) {
+        vr_scene_destroy(s);
+        return r;
+    }
+    *out = s;
+    return VR_OK;
+}
+
+void vr_scene_destroy(vr_scene *s)
+{
+    if (!s)
+        return;
+    /* glDelete* ignore the name 0, so a half-built scene is fine. */
+    glDeleteVertexArrays(6, s->vao);
+    glDeleteBuffers(6, s->vbo_stream);
+    glDeleteBuffers(1, &s->vbo_position);
+    glDeleteBuffers(1, &s->vbo_normal);
+    glDeleteBuffers(1, &s->ibo);
+    glDeleteTextures(4, s->basis);
+    free(s);
+}
+
+void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
+{
+    vr_scene_info i;
+    memset(&i, 0, sizeof i);
+    i.vertex_count = s->vertex_count;
+    i.triangle_count = s->triangle_count;
+    memcpy(i.bounds_min, s->bounds_min, sizeof i.bounds_min);
+    memcpy(i.bounds_max, s->bounds_max, sizeof i.bounds_max);
+    for (int o = 1; o <= 5; o++) {
+        i.has_order[o] = s->vbo_stream[o] != 0;
+        i.encoding[o] = s->encoding[o];
+        i.scale[o] = s->scale[o];
+    }
+    i.has_cubemaps = s->basis[0] != 0;
+    i.cube_size = s->cube_size;
+    i.quantity = s->quantity;
+    i.gpu_bytes = s->gpu_bytes;
+    *out = i;
+}
+
+int vr_scene_supports(const vr_scene *s, vr_mode m)
+{
+    switch (m) {
+    case VR_MODE_NONE:
+    case VR_MODE_CUBE: return 1;
+    case VR_MODE_VDSH2: return s->vbo_stream[2] != 0;
+    case VR_MODE_VDSH3: return s->vbo_stream[3] != 0;
+    case VR_MODE_VDSH5: return s->vbo_stream[5] != 0 && s->basis[0] != 0;
+    case VR_MODE_DEFAULT:
+    case VR_MODE_VDSH5_POLY: return s->vbo_stream[5] != 0;
+    default: return 0;
+    }
+}
+
+/* The scenes are y-up (the built-in room, OBJ convention). The eye stands
+ * inside the bounds, a third of the way from the middle to one end of the
+ * longest horizontal axis, at about a quarter of the height, looking
+ * along that axis at the far half of the floor: inside a closed room or
+ * a courtyard that shows floor, walls and props with room around them;
+ * for an open object it is still a view from within its extent. */
+void vr_scene_default_camera(const vr_scene *s, vr_camera *out)
+{
+    const float *lo = s->bounds_min, *hi = s->bounds_max;
+    float c[3], e[3];
+    for (int k = 0; k < 3; k++) {
+        c[k] = 0.5f * (lo[k] + hi[k]);
+        e[k] = hi[k] - lo[k];
+    }
+    int ax = e[0] >= e[2] ? 0 : 2, other = 2 - ax;
+    vr_camera cam;
+    memset(&cam, 0, sizeof cam);
+    cam.eye[ax] = c[ax] + 0.36f * e[ax];
+    cam.eye[other] = c[other] + 0.05f * e[other];
+    cam.eye[1] = lo[1] + 0.28f * e[1];
+    cam.target[ax] = c[ax] - 0.2f * e[ax];
+    cam.target[other] = c[other];
+    cam.target[1] = lo[1] + 0.13f * e[1];
+    cam.up[1] = 1.0f;
+    cam.fov_y = 60.0f;
+    *out = cam;
+}
+
+int vr_scene_default_lights(const vr_scene *s, vr_light *out, int max)
+{
+    /* In bounds fractions (x, y, z): light 0 a little off centre at 40% of
+     * the height, the others toward the corners, so that props between
+     * them cast shadows in different directions. */
+    static const float at[4][3] = {
+        {0.42f, 0.4f, 0.45f}, {0.2f, 0.6f, 0.78f}, {0.78f, 0.3f, 0.22f}, {0.65f, 0.75f, 0.7f}};
+    int n = 0;
+    for (; n < max && n < 4; n++) {
+        memset(&out[n], 0, sizeof out[n]);
+        for (int k = 0; k < 3; k++)
+            out[n].position[k] = s->bounds_min[k] + at[n][k] * (s->bounds_max[k] - s->bounds_min[k]);
+    }
+    return n;
+}

@@ -1,0 +1,293 @@
+/*
+ * test_runtime_errors.c - bad input ends in a clear error, never a crash:
+ * missing, empty, truncated and corrupted .vdsh files, missing and corrupt
+ * basis cubemaps, streams a mode needs but the file lacks, and bad
+ * arguments. Every failure must name the file (or the argument), leave
+ * the output untouched, and leave nothing allocated (the sanitizer build
+ * checks that).
+ */
+#include "test_runtime_util.h"
+
+#include <unistd.h>
+
+static vr_scene *const SENTINEL = (vr_scene *)(uintptr_t)0x5e7;
+
+static int slurp(const char *path, unsigned char **data, size_t *size)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return -1;
+    fseek(fp, 0, SEEK_END);
+    long n = ftell(fp);
+    fseek(fp, 0, SEEK_SET);
+    *data = malloc((size_t)n + 1);
+    *size = (size_t)n;
+    int ok = *data && fread(*data, 1, (size_t)n, fp) == (size_t)n;
+    fclose(fp);
+    return ok ? 0 : -1;
+}
+
+static int spit(const char *path, const void *data, size_t size)
+{
+    FILE *fp = fopen(path, "wb");
+    if (!fp)
+        return -1;
+    int ok = fwrite(data, 1, size, fp) == size;
+    return fclose(fp) == 0 && ok ? 0 : -1;
+}
+
+/* Create a scene from `path` and expect `want` with `needle` in the
+ * message (the file it names) and *out untouched. */
+static void expect_fail(const char *what, const vr_scene_desc *sd, vr_result want,
+                        const char *needle)
+{
+    vr_scene *s = SENTINEL;
+    vr_error err = {{0}};
+    vr_result r = vr_scene_create(sd, &s, &err);
+    CHECK(r == want, "%s: got %s (%s), want %s", what, vr_result_str(r), err.msg,
+          vr_result_str(want));
+    CHECK(s == SENTINEL, "%s: output changed on failure", what);
+    CHECK(!needle || strstr(err.msg, needle), "%s: message '%s' does not name '%s'", what,
+          err.msg, needle);
+    if (r == VR_OK && s != SENTINEL)
+        vr_scene_destroy(s);
+    printf("%-28s -> %s: %s\n", what, vr_result_str(r), err.msg);
+}
+
+/* A small valid scene on disk: a quad with orders 3 and 5. */
+static void small_file(rt_file *f, int with5)
+{
+    rt_file_init(f, 4, 2);
+    const float p[4][3] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+    for (int i = 0; i < 4; i++) {
+        memcpy(f->pos + 3 * i, p[i], sizeof p[i]);
+        f->nrm[3 * i + 2] = 1.0f;
+    }
+    const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(f->idx, idx, sizeof idx);
+    rt_file_bounds(f);
+    float *c3 = calloc(4 * 9, sizeof(float));
+    for (int i = 0; i < 4; i++)
+        c3[9 * i] = 5.0f;
+    rt_file_add_stream(f, 3, VDSH_ENCODING_F16, 0, c3, 0.01f);
+    if (with5) {
+        float *c5 = calloc(4 * 25, sizeof(float));
+        for (int i = 0; i < 4; i++)
+            c5[25 * i] = 5.0f;
+        rt_file_add_stream(f, 5, VDSH_ENCODING_F32, 0, c5, 1.0f);
+    }
+}
+
+static void test_files(const char *dir)
+{
+    char path[512], bad[700], exr[600];
+    rt_file f;
+    small_file(&f, 1);
+    CHECK(rt_file_write(&f, dir, "good", path, sizeof path) == 0, "write");
+    rt_file_free(&f);
+    vr_scene_desc sd = {.path = path};
+    vr_scene *s = NULL;
+    vr_error err;
+    CHECK(vr_scene_create(&sd, &s, &err) == VR_OK, "the good file: %s", err.msg);
+    vr_scene_destroy(s);
+
+    /* The file itself. */
+    snprintf(bad, sizeof bad, "%s/does-not-exist.vdsh", dir);
+    sd.path = bad;
+    expect_fail("missing file", &sd, VR_ERR_IO, "does-not-exist.vdsh");
+
+    unsigned char *data = NULL;
+    size_t size = 0;
+    CHECK(slurp(path, &data, &size) == 0, "read %s", path);
+    snprintf(bad, sizeof bad, "%s/bad.vdsh", dir);
+    sd.path = bad;
+    spit(bad, data, 0);
+    expect_fail("empty file", &sd, VR_ERR_FORMAT, "bad.vdsh");
+    spit(bad, data, size / 2);
+    expect_fail("truncated file", &sd, VR_ERR_FORMAT, "bad.vdsh");
+    spit(bad, "\x89PNG\r\n\x1a\n0000000000000000000000000000000000", 40);
+    expect_fail("not a .vdsh file", &sd, VR_ERR_FORMAT, "bad.vdsh");
+    data[size / 2] ^= 0x40;
+    spit(bad, data, size);
+    expect_fail("one bit flipped", &sd, VR_ERR_FORMAT, "bad.vdsh");
+    data[size / 2] ^= 0x40;
+
+    /* Corruption anywhere: an error (or, for bytes nothing checks, a
+     * scene), never a crash. */
+    uint64_t rng = 77;
+    int failed = 0, loaded = 0;
+    for (int i = 0; i < 300; i++) {
+        unsigned char *copy = malloc(size);
+        memcpy(copy, data, size);
+        int flips = 1 + (int)(test_rand(&rng) * 4);
+        for (int k = 0; k < flips; k++)
+            copy[(size_t)(test_rand(&rng) * (double)size)] ^= (unsigned char)(1 + test_rand(&rng) * 255);
+        size_t n = test_rand(&rng) < 0.2 ? (size_t)(test_rand(&rng) * (double)size) : size;
+        spit(bad, copy, n);
+        free(copy);
+        vr_scene *t = SENTINEL;
+        vr_result r = vr_scene_create(&sd, &t, &err);
+        if (r == VR_OK) {
+            loaded++;
+            vr_scene_destroy(t);
+        } else {
+            failed++;
+            CHECK(t == SENTINEL && strstr(err.msg, "bad.vdsh"), "corruption %d: %s", i, err.msg);
+        }
+    }
+    printf("random corruption: %d rejected, %d loaded\n", failed, loaded);
+    free(data);
+
+    /* The basis cubemaps. */
+    sd.path = path;
+    vb_error be;
+    vb_cubemap_basis_path(dir, "good", 2, exr, sizeof exr, &be);
+    snprintf(bad, sizeof bad, "%s.away", exr);
+    CHECK(rename(exr, bad) == 0, "rename %s", exr);
+    expect_fail("missing cubemap", &sd, VR_ERR_MISSING, "good.sh17-20.exr");
+    /* without cubemaps: order 5 only through the polynomials */
+    sd.skip_cubemaps = 1;
+    s = NULL;
+    CHECK(vr_scene_create(&sd, &s, &err) == VR_OK, "skip_cubemaps: %s", err.msg);
+    sd.skip_cubemaps = 0;
+    if (s) {
+        vr_renderer *r = NULL;
+        vr_renderer_desc rd = {.width = 8, .height = 8};
+        CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
+        vr_light light = {.position = {0, 0, 1}};
+        vr_draw_desc d = {.mode = VR_MODE_VDSH5, .lights = &light, .light_count = 1};
+        vr_result res = vr_draw(r, s, &d, &err);
+        CHECK(res == VR_ERR_MISSING && strstr(err.msg, "cubemap"), "vdsh5 without cubemaps: %s",
+              err.msg);
+        d.mode = VR_MODE_VDSH5_POLY;
+        CHECK(vr_draw(r, s, &d, &err) == VR_OK, "vdsh5poly: %s", err.msg);
+        CHECK(!vr_scene_supports(s, VR_MODE_VDSH5) && vr_scene_supports(s, VR_MODE_VDSH5_POLY),
+              "supports");
+        vr_renderer_destroy(r);
+        vr_scene_destroy(s);
+    }
+    spit(exr, "not an exr file at all", 22);
+    expect_fail("corrupt cubemap", &sd, VR_ERR_FORMAT, "good.sh17-20.exr");
+    CHECK(rename(bad, exr) == 0, "rename back");
+    /* a cubemap of the wrong size */
+    char other[64];
+    snprintf(other, sizeof other, "%s/small", dir);
+    mkdir(other, 0777);
+    CHECK(vb_cubemap_write_basis(other, "good", 8, &be) == VB_OK, "%s", be.msg);
+    sd.cubemap_dir = other;
+    expect_fail("cubemap of the wrong size", &sd, VR_ERR_FORMAT, "good.sh09-12.exr");
+    sd.cubemap_dir = NULL;
+}
+
+static void test_streams_and_arguments(const char *dir)
+{
+    char path[512];
+    rt_file f;
+    small_file(&f, 0);
+    CHECK(rt_file_write(&f, dir, "only3", path, sizeof path) == 0, "write");
+    vr_scene *s = NULL;
+    vr_renderer *r = NULL;
+    vr_error err;
+    vr_scene_desc sd = {.path = path};
+    CHECK(vr_scene_create(&sd, &s, &err) == VR_OK, "%s", err.msg);
+    vr_renderer_desc rd = {.width = 16, .height = 16};
+    CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
+    if (!s || !r)
+        return;
+    vr_light light = {.position = {0, 0, 1}};
+    vr_draw_desc d = {.lights = &light, .light_count = 1};
+    static const vr_mode missing[3] = {VR_MODE_VDSH2, VR_MODE_VDSH5, VR_MODE_VDSH5_POLY};
+    for (int i = 0; i < 3; i++) {
+        d.mode = missing[i];
+        vr_result res = vr_draw(r, s, &d, &err);
+        CHECK(res == VR_ERR_MISSING && strstr(err.msg, "stream"), "%s: %s",
+              vr_mode_name(missing[i]), err.msg);
+    }
+    d.mode = VR_MODE_DEFAULT; /* order 5 polynomials: not in this file */
+    CHECK(vr_draw(r, s, &d, &err) == VR_ERR_MISSING, "default mode");
+    d.mode = VR_MODE_VDSH3;
+    CHECK(vr_draw(r, s, &d, &err) == VR_OK, "vdsh3: %s", err.msg);
+
+    /* Arguments. */
+    d.mode = 99;
+    CHECK(vr_draw(r, s, &d, &err) == VR_ERR_ARGUMENT, "mode 99");
+    d.mode = VR_MODE_VDSH3;
+    d.compare = 7;
+    CHECK(vr_draw(r, s, &d, &err) == VR_ERR_ARGUMENT, "compare 7");
+    d.compare = 0;
+    d.output = 5;
+    CHECK(vr_draw(r, s, &d, &err) == VR_ERR_ARGUMENT, "output 5");
+    d.output = 0;
+    light.position[1] = NAN;
+    CHECK(vr_draw(r, s, &d, &err) == VR_ERR_ARGUMENT && strstr(err.msg, "light 0"), "NaN light");
+    light.position[1] = 0.0f;
+    d.lights = NULL;
+    CHECK(vr_draw(r, s, &d, &err) == VR_ERR_ARGUMENT, "lights NULL");
+    d.lights = &light;
+    CHECK(vr_draw(NULL, s, &d, &err) == VR_ERR_ARGUMENT, "NULL renderer");
+    CHECK(vr_draw(r, NULL, &d, &err) == VR_ERR_ARGUMENT, "NULL scene");
+    CHECK(vr_draw(r, s, NULL, &err) == VR_ERR_ARGUMENT, "NULL desc");
+    /* a light count of zero is fine: ambient only */
+    d.light_count = 0;
+    CHECK(vr_draw(r, s, &d, &err) == VR_OK, "no lights: %s", err.msg);
+
+    unsigned char small[16];
+    memset(small, 0xab, sizeof small);
+    CHECK(vr_read_pixels(r, small, sizeof small, &err) == VR_ERR_ARGUMENT, "small buffer");
+    CHECK(small[0] == 0xab, "buffer changed on failure");
+    CHECK(vr_renderer_resize(r, 0, 10, &err) == VR_ERR_ARGUMENT, "resize 0");
+    int w, h;
+    vr_renderer_size(r, &w, &h);
+    CHECK(w == 16 && h == 16, "size changed on failure: %dx%d", w, h);
+    CHECK(vr_renderer_resize(r, 40, 30, &err) == VR_OK, "resize: %s", err.msg);
+    vr_renderer_size(r, &w, &h);
+    CHECK(w == 40 && h == 30, "resize: %dx%d", w, h);
+
+    vr_renderer *r2 = (vr_renderer *)(uintptr_t)0x5e7;
+    vr_renderer_desc bad = {.width = -4, .height = 4};
+    CHECK(vr_renderer_create(&bad, &r2, &err) == VR_ERR_ARGUMENT, "width -4");
+    bad = (vr_renderer_desc){.max_lights_per_pass = 9};
+    CHECK(vr_renderer_create(&bad, &r2, &err) == VR_ERR_ARGUMENT, "9 lights per pass");
+    bad = (vr_renderer_desc){.shadow_map_size = -1};
+    CHECK(vr_renderer_create(&bad, &r2, &err) == VR_ERR_ARGUMENT, "shadow size");
+    CHECK(r2 == (vr_renderer *)(uintptr_t)0x5e7, "output changed on failure");
+    CHECK(vr_draw_text(r, 2, 2, 1.0f, NULL, "text ok", &err) == VR_OK, "text: %s", err.msg);
+
+    vr_scene_desc none = {0};
+    vr_scene *s2 = SENTINEL;
+    CHECK(vr_scene_create(&none, &s2, &err) == VR_ERR_ARGUMENT && s2 == SENTINEL, "no path");
+    vr_scene_desc q = {.path = path, .quantity = 3};
+    CHECK(vr_scene_create(&q, &s2, &err) == VR_ERR_ARGUMENT && s2 == SENTINEL, "quantity 3");
+    /* a quantity the file does not have: loads, but no VDSH mode draws */
+    q.quantity = VDSH_QUANTITY_LOG_DISTANCE;
+    s2 = NULL;
+    CHECK(vr_scene_create(&q, &s2, &err) == VR_OK, "%s", err.msg);
+    d.light_count = 1;
+    d.mode = VR_MODE_VDSH3;
+    CHECK(s2 && vr_draw(r, s2, &d, &err) == VR_ERR_MISSING && strstr(err.msg, "log-distance"),
+          "log-distance: %s", err.msg);
+    vr_scene_destroy(s2);
+
+    vr_scene_destroy(NULL);
+    vr_renderer_destroy(NULL);
+    vr_context_destroy(NULL);
+    CHECK(strcmp(vr_result_str(VR_ERR_MISSING), "missing stream or file") == 0, "result str");
+    CHECK(strcmp(vr_result_str((vr_result)99), "unknown result") == 0, "result str 99");
+    vr_mode m = VR_MODE_NONE;
+    CHECK(vr_mode_from_name("vdsh5poly", &m) == 0 && m == VR_MODE_VDSH5_POLY, "mode name");
+    CHECK(vr_mode_from_name("bogus", &m) != 0 && m == VR_MODE_VDSH5_POLY, "bad mode name");
+    vr_renderer_destroy(r);
+    vr_scene_destroy(s);
+    rt_file_free(&f);
+}
+
+int main(int argc, char **argv)
+{
+    const char *dir = argc > 1 ? argv[1] : "runtime_errors";
+    mkdir(dir, 0777);
+    vr_context *ctx = rt_context_or_skip("test_runtime_errors");
+    test_files(dir);
+    test_streams_and_arguments(dir);
+    vr_context_destroy(ctx);
+    return test_report("test_runtime_errors");
+}
