@@ -5,9 +5,9 @@
  * floor-to-ceiling pillars and a sphere.
  *
  * Built like a game level: every face has its own vertices (hard edges,
- * nothing welded across faces or objects; the sphere is faceted, each of
- * its triangles on its own). Faces are coarse; the receiver density comes
- * from vb_mesh_refine: at a maximum edge of 0.2 m this room gives 58,805
+ * nothing welded across faces or objects); only the sphere is smooth, its
+ * triangles sharing vertices. Faces are coarse; the receiver density comes
+ * from vb_mesh_refine: at a maximum edge of 0.2 m this room gives 58,007
  * receivers (the paper's had 54,500).
  * Faces nobody can see are left out: box bottoms resting on the floor or
  * on another box, pillar ends in the floor and ceiling. Their vertices
@@ -232,9 +232,9 @@ static void icosphere(float pos[][3], uint32_t *nv, uint32_t tri[][3], uint32_t 
     memcpy(tri, faces, sizeof faces);
     *nt = 20;
     for (int level = 0; level < SPHERE_LEVELS; level++) {
-        static uint32_t edge_a[SPHERE_MAX_TRIANGLES * 3 / 2], edge_b[SPHERE_MAX_TRIANGLES * 3 / 2];
-        static uint32_t edge_mid[SPHERE_MAX_TRIANGLES * 3 / 2];
-        static uint32_t next[SPHERE_MAX_TRIANGLES][3];
+        uint32_t edge_a[SPHERE_MAX_TRIANGLES * 3 / 2], edge_b[SPHERE_MAX_TRIANGLES * 3 / 2];
+        uint32_t edge_mid[SPHERE_MAX_TRIANGLES * 3 / 2];
+        uint32_t next[SPHERE_MAX_TRIANGLES][3];
         uint32_t ne = 0, nn = 0;
         for (uint32_t f = 0; f < *nt; f++) {
             uint32_t mid[3];
@@ -270,27 +270,27 @@ static void icosphere(float pos[][3], uint32_t *nv, uint32_t tri[][3], uint32_t 
     }
 }
 
-/* The sphere of radius r with its lowest vertex on y = y0, every facet
- * with its own three vertices. */
+/* The sphere of radius r with its lowest vertex on y = y0: smooth, its
+ * triangles sharing vertices, so the computed normals are radial. */
 static void add_sphere(room_builder *b, float cx, float y0, float cz, float r)
 {
-    static float pos[SPHERE_MAX_VERTICES][3];
-    static uint32_t tri[SPHERE_MAX_TRIANGLES][3];
+    float pos[SPHERE_MAX_VERTICES][3];
+    uint32_t tri[SPHERE_MAX_TRIANGLES][3];
     uint32_t nv = 0, nt = 0;
     icosphere(pos, &nv, tri, &nt);
     float lowest = 0.0f;
     for (uint32_t i = 0; i < nv; i++)
         if (pos[i][1] < lowest)
             lowest = pos[i][1];
-    for (uint32_t f = 0; f < nt; f++) {
-        uint32_t c[3];
-        for (int k = 0; k < 3; k++) {
-            const float *q = pos[tri[f][k]];
-            float p[3] = {cx + r * q[0], y0 + r * (q[1] - lowest), cz + r * q[2]};
-            c[k] = add_vertex(b, p);
-        }
-        add_triangle(b, c[0], c[1], c[2]);
+    uint32_t first = 0;
+    for (uint32_t i = 0; i < nv; i++) {
+        float p[3] = {cx + r * pos[i][0], y0 + r * (pos[i][1] - lowest), cz + r * pos[i][2]};
+        uint32_t v = add_vertex(b, p);
+        if (i == 0)
+            first = v;
     }
+    for (uint32_t f = 0; f < nt; f++)
+        add_triangle(b, first + tri[f][0], first + tri[f][1], first + tri[f][2]);
 }
 
 vb_result vb_builtin_room(vb_mesh *out, vb_error *err)

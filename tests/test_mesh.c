@@ -758,7 +758,7 @@ static void test_room(void)
     CHECK(same_mesh(&room, &again), "room: not deterministic");
     check_clean(&room, "room");
     printf("builtin:room coarse: %u vertices, %u triangles\n", room.vertex_count, room.triangle_count);
-    CHECK(room.vertex_count == 2316 && room.triangle_count == 2428, "room: %u vertices, %u triangles",
+    CHECK(room.vertex_count == 1518 && room.triangle_count == 2428, "room: %u vertices, %u triangles",
           room.vertex_count, room.triangle_count);
 
     float lo[3], hi[3];
