@@ -104,7 +104,9 @@ typedef enum vdsh_encoding {
 
 typedef enum vdsh_method {
     VDSH_METHOD_PAPER = 0,
-    VDSH_METHOD_FULL = 1
+    VDSH_METHOD_FULL = 1,
+    VDSH_METHOD_MIRROR = 2,
+    VDSH_METHOD_LSQ = 3
 } vdsh_method;
 
 typedef enum vdsh_quantity {

@@ -9,3 +9,7 @@ add_test(NAME bake_cli
 add_executable(test_hard test_hard.c)
 target_link_libraries(test_hard PRIVATE vb_core)
 add_test(NAME bake_hard_cases COMMAND test_hard)
+
+add_executable(test_fit test_fit.c)
+target_link_libraries(test_fit PRIVATE vb_core)
+add_test(NAME bake_fit COMMAND test_fit)

@@ -1,0 +1,244 @@
+#include "fit.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "sampling.h"
+#include "vdsh.h"
+#include "vdsh_sh.h"
+
+#define PI 3.14159265358979323846
+
+static int band_of(int i)
+{
+    int l = 0;
+    while ((l + 1) * (l + 1) <= i)
+        l++;
+    return l;
+}
+
+static void eval_d(int order, const double d[3], double *y)
+{
+    float f[3] = {(float)d[0], (float)d[1], (float)d[2]}, yy[VB_FIT_MAX];
+    vdsh_sh_eval(order, f, yy);
+    for (int i = 0; i < order * order; i++)
+        y[i] = yy[i];
+}
+
+/* Gauss-Jordan inverse with partial pivoting of an n x n matrix (n <= 25).
+ * Returns 0 if singular. */
+static int invert(int n, const double *a, double *inv)
+{
+    double m[VB_FIT_MAX][2 * VB_FIT_MAX];
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < 2 * n; j++)
+            m[i][j] = j < n ? a[i * n + j] : (j - n == i);
+    for (int c = 0; c < n; c++) {
+        int p = c;
+        for (int r = c + 1; r < n; r++)
+            if (fabs(m[r][c]) > fabs(m[p][c]))
+                p = r;
+        if (fabs(m[p][c]) < 1e-14)
+            return 0;
+        if (p != c)
+            for (int j = 0; j < 2 * n; j++) {
+                double t = m[c][j];
+                m[c][j] = m[p][j];
+                m[p][j] = t;
+            }
+        double s = 1.0 / m[c][c];
+        for (int j = 0; j < 2 * n; j++)
+            m[c][j] *= s;
+        for (int r = 0; r < n; r++)
+            if (r != c && m[r][c] != 0.0) {
+                double f = m[r][c];
+                for (int j = 0; j < 2 * n; j++)
+                    m[r][j] -= f * m[c][j];
+            }
+    }
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+            inv[i * n + j] = m[i][n + j];
+    return 1;
+}
+
+/* Gauss-Legendre nodes and weights on [0, 1]. */
+static void gauss01(int n, double *x, double *w)
+{
+    for (int i = 0; i < n; i++) {
+        double z = cos(PI * (i + 0.75) / (n + 0.5)), pp = 1.0;
+        for (int it = 0; it < 100; it++) {
+            double p1 = 1.0, p2 = 0.0;
+            for (int j = 1; j <= n; j++) {
+                double p3 = p2;
+                p2 = p1;
+                p1 = ((2.0 * j - 1.0) * z * p2 - (j - 1.0) * p3) / j;
+            }
+            pp = n * (z * p1 - p2) / (z * z - 1.0);
+            double z1 = z;
+            z = z1 - p1 / pp;
+            if (fabs(z - z1) < 1e-15)
+                break;
+        }
+        x[i] = 0.5 * (z + 1.0);
+        w[i] = 1.0 / ((1.0 - z * z) * pp * pp); /* 2/(...) halved for [0,1] */
+    }
+}
+
+vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
+                        vb_error *err)
+{
+    if (order < 1 || order > 5)
+        return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..5, not %d", order);
+    if (!(lambda >= 0.0f) || !isfinite(lambda))
+        return vb_fail(err, VB_ERR_ARGUMENT, "regularisation must be a number >= 0");
+    vb_fit f;
+    memset(&f, 0, sizeof f);
+    f.order = order;
+    f.method = method;
+    f.lambda = lambda;
+    int n = order * order;
+
+    switch (method) {
+    case VDSH_METHOD_PAPER:
+    case VDSH_METHOD_FULL:
+        for (int i = 0; i < n; i++)
+            f.M[i * n + i] = 1.0;
+        break;
+    case VDSH_METHOD_MIRROR:
+        /* Y_lm(x, y, -z) = (-1)^(l+m) Y_lm(x, y, z): the mirrored lower
+         * half doubles the even terms and cancels the odd ones. */
+        for (int i = 0; i < n; i++) {
+            int l = band_of(i), m = i - l * (l + 1);
+            f.M[i * n + i] = ((l + m) % 2 == 0) ? 2.0 : 0.0;
+        }
+        break;
+    case VDSH_METHOD_LSQ: {
+        /* G_ij = integral over z > 0 of Y_i Y_j: Gauss-Legendre in z
+         * (exact to degree 31) times 64 azimuths (exact for cos/sin of
+         * order < 64); the products here have degree <= 8. */
+        enum { NZ = 16, NP = 64 };
+        double zx[NZ], zw[NZ], G[VB_FIT_MAX * VB_FIT_MAX] = {0};
+        gauss01(NZ, zx, zw);
+        for (int a = 0; a < NZ; a++)
+            for (int b = 0; b < NP; b++) {
+                double r = sqrt(1.0 - zx[a] * zx[a]), phi = 2.0 * PI * (b + 0.5) / NP;
+                double d[3] = {r * cos(phi), r * sin(phi), zx[a]}, y[VB_FIT_MAX];
+                eval_d(order, d, y);
+                double w = zw[a] * 2.0 * PI / NP;
+                for (int i = 0; i < n; i++)
+                    for (int j = 0; j < n; j++)
+                        G[i * n + j] += w * y[i] * y[j];
+            }
+        for (int i = 0; i < n; i++) {
+            double l = band_of(i);
+            G[i * n + i] += (double)lambda * (l * (l + 1)) * (l * (l + 1));
+        }
+        if (!invert(n, G, f.M))
+            return vb_fail(err, VB_ERR_ARGUMENT,
+                           "least squares at order %d is singular: use a regularisation > 0",
+                           order);
+        break;
+    }
+    default:
+        return vb_fail(err, VB_ERR_ARGUMENT, "method %u has no hemisphere fit", method);
+    }
+
+    /* Rotation samples: a Fibonacci sphere, over-determined for every
+     * band, so each band's basis block is close to a multiple of an
+     * orthogonal matrix (condition ~1) and float evaluation error is not
+     * amplified. pinv_l = B_l^T (B_l B_l^T)^-1. */
+    const int K = VB_FIT_ROT_DIRS;
+    for (int j = 0; j < K; j++) {
+        double z = 1.0 - (2.0 * j + 1.0) / K, r = sqrt(1.0 - z * z);
+        double phi = j * PI * (3.0 - sqrt(5.0));
+        f.rot_dirs[j][0] = r * cos(phi), f.rot_dirs[j][1] = r * sin(phi), f.rot_dirs[j][2] = z;
+    }
+    double Y[VB_FIT_ROT_DIRS][VB_FIT_MAX];
+    for (int j = 0; j < K; j++)
+        eval_d(order, f.rot_dirs[j], Y[j]);
+    for (int l = 0; l < order; l++) {
+        int k = 2 * l + 1, o = l * l;
+        double BBt[9 * 9], inv[9 * 9];
+        for (int a = 0; a < k; a++)
+            for (int b = 0; b < k; b++) {
+                double s = 0.0;
+                for (int j = 0; j < K; j++)
+                    s += Y[j][o + a] * Y[j][o + b];
+                BBt[a * k + b] = s;
+            }
+        if (!invert(k, BBt, inv))
+            return vb_fail(err, VB_ERR_ARGUMENT, "rotation samples degenerate at band %d", l);
+        for (int j = 0; j < K; j++)
+            for (int b = 0; b < k; b++) {
+                double s = 0.0;
+                for (int a = 0; a < k; a++)
+                    s += Y[j][o + a] * inv[a * k + b];
+                f.rot_pinv[l][j * k + b] = s;
+            }
+    }
+    *out = f;
+    return VB_OK;
+}
+
+void vb_sh_rotation(const vb_fit *f, const double R[9], double *out)
+{
+    int n = f->order * f->order;
+    memset(out, 0, (size_t)n * n * sizeof *out);
+    /* Band by band: Y_l(R^T s_j) = S_l^T Y_l(s_j) at the sample directions
+     * s_j, i.e. [Y_l(R^T s_j)]_j = S_l^T B_l, so S_l^T = [Y_l(R^T s_j)]_j
+     * pinv_l (exact: the basis of a band is closed under rotation). */
+    double yr[VB_FIT_ROT_DIRS][VB_FIT_MAX];
+    for (int j = 0; j < VB_FIT_ROT_DIRS; j++) {
+        const double *s = f->rot_dirs[j];
+        double d[3] = {R[0] * s[0] + R[3] * s[1] + R[6] * s[2],
+                       R[1] * s[0] + R[4] * s[1] + R[7] * s[2],
+                       R[2] * s[0] + R[5] * s[1] + R[8] * s[2]};
+        eval_d(f->order, d, yr[j]);
+    }
+    for (int l = 0; l < f->order; l++) {
+        int k = 2 * l + 1, o = l * l;
+        const double *pinv = f->rot_pinv[l];
+        for (int a = 0; a < k; a++)     /* row of S_l^T */
+            for (int b = 0; b < k; b++) { /* column of S_l^T */
+                double s = 0.0;
+                for (int j = 0; j < VB_FIT_ROT_DIRS; j++)
+                    s += yr[j][o + a] * pinv[j * k + b];
+                out[(o + b) * n + (o + a)] = s; /* transpose into S */
+            }
+    }
+}
+
+void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c)
+{
+    int nc = f->order * f->order;
+    int no_normal = n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f;
+    if (f->method == VDSH_METHOD_PAPER || f->method == VDSH_METHOD_FULL || no_normal) {
+        for (int i = 0; i < nc; i++)
+            c[i] = (float)b[i];
+        return;
+    }
+    float t[3], bt[3];
+    vb_frame(n, t, bt);
+    const double R[9] = {t[0], bt[0], n[0], t[1], bt[1], n[1], t[2], bt[2], n[2]};
+    double S[VB_FIT_MAX * VB_FIT_MAX], u[VB_FIT_MAX], v[VB_FIT_MAX];
+    vb_sh_rotation(f, R, S);
+    for (int i = 0; i < nc; i++) { /* u = S^T b */
+        double s = 0.0;
+        for (int j = 0; j < nc; j++)
+            s += S[j * nc + i] * b[j];
+        u[i] = s;
+    }
+    for (int i = 0; i < nc; i++) { /* v = M u */
+        double s = 0.0;
+        for (int j = 0; j < nc; j++)
+            s += f->M[i * nc + j] * u[j];
+        v[i] = s;
+    }
+    for (int i = 0; i < nc; i++) { /* c = S v */
+        double s = 0.0;
+        for (int j = 0; j < nc; j++)
+            s += S[i * nc + j] * v[j];
+        c[i] = (float)s;
+    }
+}

@@ -1,0 +1,71 @@
+/*
+ * fit.h - from a receiver's projected distances to the coefficients a
+ * method stores. Pure C on small arrays: no Embree, no meshes.
+ *
+ * Every method that looks only at the upper hemisphere is one linear map of
+ * the same per-receiver projection b = sum_k w f(d_k) Y(omega_k) (f the
+ * quantity: d, d^2 or log d), written in a local frame whose pole is the
+ * receiver's normal:
+ *
+ *     c_world = S M S^T b_world
+ *
+ * S is the SH rotation taking the pole to the normal (vb_sh_rotation). M
+ * depends only on the method:
+ *   paper      M = I                    zero below the horizon
+ *   mirror     M = I + P                P reflects through the tangent plane,
+ *                                       Y_lm(x, y, -z) = (-1)^(l+m) Y_lm
+ *   lsq        M = (G + lambda L)^-1    least squares over the hemisphere:
+ *                                       G is the hemisphere's Gram matrix of
+ *                                       the basis, L = diag((l(l+1))^2)
+ * G is invariant under rotations about the pole, so the local frame's
+ * azimuth does not matter and M is one matrix for every receiver.
+ *
+ * Threading: a created vb_fit is read-only. Errors: vb_result.
+ */
+#ifndef VB_FIT_H
+#define VB_FIT_H
+
+#include <stdint.h>
+
+#include "vb.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define VB_FIT_MAX 25
+#define VB_FIT_ROT_DIRS 36
+
+typedef struct vb_fit {
+    int order;                        /* coefficients kept: order^2 */
+    uint32_t method;                  /* vdsh_method */
+    float lambda;                     /* lsq regularisation */
+    double M[VB_FIT_MAX * VB_FIT_MAX];  /* local-frame map, order^2 square */
+    /* Rotations: sample directions and, per band l, the pseudo-inverse of
+     * the (2l+1) x VB_FIT_ROT_DIRS basis block at them. */
+    double rot_dirs[VB_FIT_ROT_DIRS][3];
+    double rot_pinv[5][VB_FIT_ROT_DIRS * 9];
+} vb_fit;
+
+/* Prepare the map for (order, method, lambda). The hemisphere Gram matrix
+ * is computed by Gauss-Legendre x uniform-azimuth quadrature (exact for
+ * these polynomials). */
+vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
+                        vb_error *err);
+
+/* c = S M S^T b for a receiver with unit normal n (b and c: order^2
+ * values, world frame; b in double for the sums it comes from). A zero
+ * normal has no hemisphere: c = b (the projection as it is). */
+void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c);
+
+/* SH rotation for bands 0..order-1: out (order^2 x order^2, row-major,
+ * block-diagonal) such that if f(w) = sum c_i Y_i(R^T w) then
+ * f(w) = sum (out c)_i Y_i(w). R is row-major 3x3, columns the images of
+ * the local x, y, z axes. */
+void vb_sh_rotation(const vb_fit *f, const double R[9], double *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VB_FIT_H */

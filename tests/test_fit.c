@@ -1,0 +1,199 @@
+/* The fit core: SH rotations, the hemisphere Gram matrix, and each
+ * method's map on functions it must reproduce exactly. */
+#include <math.h>
+#include <string.h>
+
+#include "fit.h"
+#include "sampling.h"
+#include "test_util.h"
+#include "vdsh.h"
+#include "vdsh_sh.h"
+
+/* A random rotation from a random unit quaternion. */
+static void rand_rotation(uint64_t *s, double R[9])
+{
+    double q[4], len = 0;
+    for (int i = 0; i < 4; i++)
+        q[i] = 2 * test_rand(s) - 1, len += q[i] * q[i];
+    len = sqrt(len);
+    double w = q[0] / len, x = q[1] / len, y = q[2] / len, z = q[3] / len;
+    double m[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                   2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                   2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)};
+    memcpy(R, m, sizeof m);
+}
+
+static double recon(int order, const double *c, const float d[3])
+{
+    float y[25];
+    vdsh_sh_eval(order, d, y);
+    double s = 0;
+    for (int i = 0; i < order * order; i++)
+        s += c[i] * y[i];
+    return s;
+}
+
+static void test_rotation(void)
+{
+    vb_fit f;
+    vb_error err;
+    CHECK(vb_fit_create(5, VDSH_METHOD_PAPER, 0, &f, &err) == VB_OK, "fit");
+    uint64_t s = 3;
+    double worst = 0, orth = 0;
+    for (int t = 0; t < 50; t++) {
+        double R[9], S[625], c[25], cw[25] = {0};
+        rand_rotation(&s, R);
+        vb_sh_rotation(&f, R, S);
+        for (int i = 0; i < 25; i++)
+            c[i] = 2 * test_rand(&s) - 1;
+        for (int i = 0; i < 25; i++)
+            for (int j = 0; j < 25; j++)
+                cw[i] += S[i * 25 + j] * c[j];
+        for (int k = 0; k < 40; k++) {
+            float w[3], l[3];
+            test_rand_dir(&s, w);
+            for (int i = 0; i < 3; i++) /* R^T w */
+                l[i] = (float)(R[0 + i] * w[0] + R[3 + i] * w[1] + R[6 + i] * w[2]);
+            worst = fmax(worst, fabs(recon(5, cw, w) - recon(5, c, l)));
+        }
+        for (int i = 0; i < 25; i++)
+            for (int j = 0; j < 25; j++) {
+                double d = 0;
+                for (int k = 0; k < 25; k++)
+                    d += S[k * 25 + i] * S[k * 25 + j];
+                orth = fmax(orth, fabs(d - (i == j)));
+            }
+    }
+    CHECK(worst < 1e-4, "rotated function differs by %g", worst);
+    CHECK(orth < 1e-5, "rotation not orthogonal: %g", orth);
+}
+
+/* Least squares over the hemisphere recovers any function of the basis
+ * from its upper half. The hemisphere's Gram matrix is ill-conditioned
+ * (condition 14, 250, 5900, 150000 at orders 2..5), so without
+ * regularisation only orders 2-4 can be checked against float data; order
+ * 5 gets a small lambda and a function of bands 0-1, which the penalty
+ * (lambda (l(l+1))^2) barely touches. */
+static void test_lsq_recovers(void)
+{
+    vb_error err;
+    for (int order = 2; order <= 5; order++) {
+        vb_fit f;
+        float lambda = order == 5 ? 1e-4f : 0.0f;
+        CHECK(vb_fit_create(order, VDSH_METHOD_LSQ, lambda, &f, &err) == VB_OK, "lsq %d: %s",
+              order, err.msg);
+        int n = order * order;
+        uint64_t s = 10 + order;
+        double c[25] = {0};
+        for (int i = 0; i < (order == 5 ? 4 : n); i++)
+            c[i] = 2 * test_rand(&s) - 1;
+        float nrm[3];
+        test_rand_dir(&s, nrm);
+        /* b = integral over the hemisphere around nrm of f Y: dense
+         * quadrature (midpoint rule in cos theta and phi, 400 x 400). */
+        double b[25] = {0};
+        float t[3], bt[3];
+        vb_frame(nrm, t, bt);
+        const int NZ = 400, NP = 400;
+        for (int a = 0; a < NZ; a++)
+            for (int p = 0; p < NP; p++) {
+                double z = (a + 0.5) / NZ, r = sqrt(1 - z * z), ph = 2 * M_PI * (p + 0.5) / NP;
+                double lx = r * cos(ph), ly = r * sin(ph);
+                float d[3];
+                for (int k = 0; k < 3; k++)
+                    d[k] = (float)(lx * t[k] + ly * bt[k] + z * nrm[k]);
+                float y[25];
+                vdsh_sh_eval(order, d, y);
+                double fv = recon(order, c, d), w = 2 * M_PI / ((double)NZ * NP);
+                for (int i = 0; i < n; i++)
+                    b[i] += w * fv * y[i];
+            }
+        float out[25];
+        vb_fit_apply(&f, nrm, b, out);
+        /* Compare where the fit looked: the upper hemisphere. */
+        double worst = 0, cd[25];
+        for (int i = 0; i < n; i++)
+            cd[i] = out[i];
+        uint64_t s2 = 99;
+        for (int k = 0; k < 500; k++) {
+            float d[3];
+            test_rand_dir(&s2, d);
+            float up = d[0] * nrm[0] + d[1] * nrm[1] + d[2] * nrm[2];
+            if (up < 0)
+                for (int i = 0; i < 3; i++)
+                    d[i] -= 2 * up * nrm[i];
+            worst = fmax(worst, fabs(recon(order, cd, d) - recon(order, c, d)));
+        }
+        CHECK(worst < (order == 5 ? 5e-3 : 2e-3),
+              "order %d: least squares reproduces the function on the hemisphere to %g", order,
+              worst);
+    }
+}
+
+static void test_mirror_and_paper(void)
+{
+    vb_error err;
+    vb_fit f, p;
+    CHECK(vb_fit_create(5, VDSH_METHOD_MIRROR, 0, &f, &err) == VB_OK, "mirror");
+    CHECK(vb_fit_create(5, VDSH_METHOD_PAPER, 0, &p, &err) == VB_OK, "paper");
+    uint64_t s = 77;
+    float nrm[3];
+    test_rand_dir(&s, nrm);
+    float t[3], bt[3];
+    vb_frame(nrm, t, bt);
+    /* f(w) = g(w.t, w.b, |w.n|): symmetric. */
+    double b[25] = {0};
+    const int NZ = 300, NP = 300;
+    for (int a = 0; a < NZ; a++)
+        for (int q = 0; q < NP; q++) {
+            double z = (a + 0.5) / NZ, r = sqrt(1 - z * z), ph = 2 * M_PI * (q + 0.5) / NP;
+            double lx = r * cos(ph), ly = r * sin(ph);
+            float d[3];
+            for (int k = 0; k < 3; k++)
+                d[k] = (float)(lx * t[k] + ly * bt[k] + z * nrm[k]);
+            float y[25];
+            vdsh_sh_eval(5, d, y);
+            double fv = 1.0 + 0.5 * lx * ly + 0.3 * z * z + 0.2 * lx, w = 2 * M_PI / ((double)NZ * NP);
+            for (int i = 0; i < 25; i++)
+                b[i] += w * fv * y[i];
+        }
+    float c[25], cp[25];
+    vb_fit_apply(&f, nrm, b, c);
+    vb_fit_apply(&p, nrm, b, cp);
+    double worst = 0;
+    uint64_t s2 = 5;
+    for (int k = 0; k < 300; k++) {
+        float d[3];
+        test_rand_dir(&s2, d);
+        double lx = d[0] * t[0] + d[1] * t[1] + d[2] * t[2];
+        double ly = d[0] * bt[0] + d[1] * bt[1] + d[2] * bt[2];
+        double lz = d[0] * nrm[0] + d[1] * nrm[1] + d[2] * nrm[2];
+        double want = 1.0 + 0.5 * lx * ly + 0.3 * lz * lz + 0.2 * lx;
+        worst = fmax(worst, fabs(vdsh_sh_reconstruct(5, c, d) - want));
+    }
+    CHECK(worst < 1e-3, "mirror reproduces a symmetric function to %g", worst);
+    for (int i = 0; i < 25; i++)
+        CHECK(cp[i] == (float)b[i], "paper changes the projection");
+    float zero[3] = {0, 0, 0};
+    vb_fit_apply(&f, zero, b, c);
+    for (int i = 0; i < 25; i++)
+        CHECK(c[i] == (float)b[i], "no normal: the projection as it is");
+}
+
+static void test_errors(void)
+{
+    vb_fit f;
+    vb_error err;
+    CHECK(vb_fit_create(6, VDSH_METHOD_LSQ, 0, &f, &err) == VB_ERR_ARGUMENT, "order 6");
+    CHECK(vb_fit_create(3, VDSH_METHOD_LSQ, -1, &f, &err) == VB_ERR_ARGUMENT, "lambda < 0");
+    CHECK(vb_fit_create(3, 99, 0, &f, &err) == VB_ERR_ARGUMENT, "unknown method");
+}
+
+int main(void)
+{
+    test_rotation();
+    test_lsq_recovers();
+    test_mirror_and_paper();
+    test_errors();
+    return test_report("test_fit");
+}
