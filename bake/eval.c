@@ -1,0 +1,1047 @@
+/*
+ * eval.c - the evaluator core (eval.h): receivers, held-out samples, the
+ * ground-truth ray cast and the scores.
+ *
+ * The story of a run: pick the receivers (a hashed sample of vertices,
+ * area-weighted interior points) and give each its truth origin; workers
+ * take blocks of receivers, trace each one's held-out directions in 16-wide
+ * packets and score every stream against the truth into per-receiver sums
+ * (and per-worker integer histograms); the calling thread then reduces the
+ * sums in receiver order, so no result depends on which worker did what.
+ */
+#include "eval.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#if defined(__SSE__)
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+#endif
+
+#include "bake.h"
+#include "sampling.h"
+#include "vdsh_sh.h"
+#include "vdsh_shadow.h"
+
+#define BLOCK 32 /* receivers per work item */
+
+/* Every purpose gets its own random stream from the one seed, so that
+ * adding directions does not move the lights, and so that no stream can
+ * coincide with the bake's jitter even when the seeds are equal. */
+enum {
+    PURPOSE_DIRECTIONS = 0x44495253u, /* "DIRS" */
+    PURPOSE_LIGHTS = 0x4c474854u,     /* "LGHT" */
+    PURPOSE_VERTICES = 0x56525453u,   /* "VRTS" */
+    PURPOSE_INTERIOR = 0x494e5452u    /* "INTR" */
+};
+
+static uint64_t purpose_seed(uint64_t seed, uint32_t purpose)
+{
+    /* splitmix64 finaliser over (seed, purpose) */
+    uint64_t z = seed ^ ((uint64_t)purpose * 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+/* ---- distance-error histogram ------------------------------------------
+ * Bin 0: exactly 0; bin 1: (0, 1e-6); then 100 bins per decade up to 1e4;
+ * the last bin: 1e4 and above (and NaN). Percentiles are read at a bin's
+ * geometric centre: 2.3% resolution, plenty for p50/p90/p99, and integer
+ * counts merge across workers in any order to the same totals. */
+#define HIST_LOG_MIN (-6)
+#define HIST_PER_DECADE 100
+#define HIST_DECADES 10
+#define HIST_BINS (2 + HIST_PER_DECADE * HIST_DECADES + 1)
+
+static inline int hist_bin(float e)
+{
+    if (e == 0.0f)
+        return 0;
+    if (e < 1e-6f)
+        return 1;
+    if (!(e < 1e4f))
+        return HIST_BINS - 1;
+    int b = (int)floorf((log10f(e) - HIST_LOG_MIN) * HIST_PER_DECADE);
+    b = b < 0 ? 0 : b > HIST_PER_DECADE * HIST_DECADES - 1
+                        ? HIST_PER_DECADE * HIST_DECADES - 1 : b;
+    return 2 + b;
+}
+
+static double hist_value(int b)
+{
+    if (b == 0)
+        return 0.0;
+    if (b == 1)
+        return 1e-6;
+    if (b == HIST_BINS - 1)
+        return 1e4;
+    return pow(10.0, HIST_LOG_MIN + (b - 2 + 0.5) / HIST_PER_DECADE);
+}
+
+static double hist_quantile(const uint64_t *h, double q)
+{
+    uint64_t total = 0;
+    for (int b = 0; b < HIST_BINS; b++)
+        total += h[b];
+    if (total == 0)
+        return NAN;
+    /* The smallest value with at least q of the samples at or below it. */
+    double want = q * (double)total;
+    uint64_t run = 0;
+    for (int b = 0; b < HIST_BINS; b++) {
+        run += h[b];
+        if ((double)run >= want && h[b] > 0)
+            return hist_value(b);
+    }
+    return hist_value(HIST_BINS - 1);
+}
+
+/* The held-out directions of one receiver, one packet at a time: the
+ * hemisphere grid around its normal with the evaluator's own jitter. The
+ * run and vb_eval_directions (which the tests compare with the bake's
+ * directions) both call this. */
+static inline void heldout_packet(const vb_dirgrid *g, uint32_t packet, uint64_t dir_seed,
+                                  uint32_t id, const float n[3], float *dx, float *dy,
+                                  float *dz, int *valid)
+{
+    vb_dirgrid_packet(g, packet, dir_seed, id, n, dx, dy, dz, valid);
+}
+
+/* ---- receivers ---------------------------------------------------------- */
+
+typedef struct receiver {
+    uint32_t kind;
+    uint32_t index;        /* vertex, or interior point number */
+    uint32_t id;           /* the random streams' receiver number */
+    uint32_t triangle;
+    float bary[3];
+    float position[3];     /* scene units */
+    float normal[3];       /* unit */
+    float origin[3];       /* truth ray origin, traced frame */
+} receiver;
+
+/* One receiver's sums for one stream, in a fixed order. */
+typedef struct racc {
+    double sq;             /* squared relative distance errors */
+    double abs;            /* relative distance errors */
+    double mae, mae_bin;   /* |s_hat - s_ideal| */
+    uint32_t n;            /* samples */
+    uint32_t vis, fals, fals_bin;     /* d_T >= d_L; s_hat < .5; D < d_L */
+    uint32_t occ, leak;               /* s_ideal < .5; s_hat > .5 */
+    uint32_t occ_bin, leak_bin;       /* d_T < d_L; D >= d_L */
+    uint32_t ringing;                 /* D == 0: the sum rang to <= 0 */
+} racc;
+
+typedef struct rtruth {
+    uint32_t n, near_zero, escaped;
+} rtruth;
+
+typedef struct job {
+    const vb_eval_desc *d;
+    const vdsh_file *f;
+    const vb_scene *scene;
+    const vb_dirgrid *grid;
+    const receiver *rec;
+    uint32_t rec_count;
+    uint32_t streams;
+    racc *acc;             /* rec_count * streams */
+    rtruth *truth;         /* rec_count */
+    uint64_t *hist;        /* per worker: KINDS * streams * HIST_BINS */
+    uint64_t dir_seed, light_seed;
+    float max_local, inv_scale, max_distance, floor_dist, near_zero_dist;
+    _Atomic uint32_t next;
+    _Atomic uint32_t done;
+    _Atomic int running;
+    _Atomic int worker_id;
+    pthread_mutex_t lock;
+    pthread_cond_t cond;
+} job;
+
+/* The stream's coefficients at a receiver: decoded at a vertex,
+ * interpolated inside a triangle. */
+static void receiver_coeffs(const vdsh_file *f, const vdsh_stream *s,
+                            const receiver *r, float *c)
+{
+    if (r->kind == VB_EVAL_VERTICES)
+        vdsh_stream_decode(s, r->index, c);
+    else
+        vb_eval_interpolate(f, s, r->triangle, r->bary, NULL, NULL, c);
+}
+
+static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
+{
+    const receiver *r = J->rec + ri;
+    const vdsh_file *f = J->f;
+    const uint32_t S = J->streams;
+    float coef[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS];
+    for (uint32_t s = 0; s < S; s++)
+        receiver_coeffs(f, &f->streams[s], r, coef[s]);
+    racc *acc = J->acc + (size_t)ri * S;
+    rtruth *tr = J->truth + ri;
+    uint64_t *h = hist + (size_t)r->kind * S * HIST_BINS;
+
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+
+    for (uint32_t pk = 0; pk < J->grid->packet_count; pk++) {
+        struct RTCRayHit16 rh __attribute__((aligned(64)));
+        int valid[VB_PACKET] __attribute__((aligned(64)));
+        heldout_packet(J->grid, pk, J->dir_seed, r->id, r->normal, rh.ray.dir_x,
+                       rh.ray.dir_y, rh.ray.dir_z, valid);
+        for (int k = 0; k < VB_PACKET; k++) {
+            rh.ray.org_x[k] = r->origin[0];
+            rh.ray.org_y[k] = r->origin[1];
+            rh.ray.org_z[k] = r->origin[2];
+            rh.ray.tnear[k] = 0.0f;
+            rh.ray.tfar[k] = J->max_local;
+            rh.ray.time[k] = 0.0f;
+            rh.ray.mask[k] = 0xffffffffu;
+            rh.ray.id[k] = (unsigned)k;
+            rh.ray.flags[k] = 0;
+            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect16(valid, J->scene->scene, &ctx, &rh);
+
+        for (int k = 0; k < VB_PACKET; k++) {
+            if (!valid[k])
+                continue;
+            const uint32_t sample = pk * VB_PACKET + (uint32_t)k;
+            const float w[3] = {rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]};
+            const int hit = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+            /* Clamped like the bake: a miss is max_distance. */
+            const float dt = hit ? rh.ray.tfar[k] * J->inv_scale : J->max_distance;
+            tr->n++;
+            tr->escaped += !hit;
+            tr->near_zero += dt < J->near_zero_dist;
+
+            /* The light: u in (0.05, 1] (1 - u1 is in (0, 1]). */
+            float u1, u2;
+            vb_hash2(J->light_seed, r->id, sample, &u1, &u2);
+            const float dl = (0.05f + 0.95f * (1.0f - u1)) * 2.0f * dt;
+            const float s_ideal = vdsh_shadow_compare(dt, dl, VDSH_COMPARE_SMOOTH);
+            const float b_ideal = vdsh_shadow_compare(dt, dl, VDSH_COMPARE_BINARY);
+            const int vis = dt >= dl, occ = s_ideal < 0.5f, occ_bin = b_ideal < 0.5f;
+            const float floor_ = dt > J->floor_dist ? dt : J->floor_dist;
+
+            for (uint32_t s = 0; s < S; s++) {
+                const vdsh_stream *st = &f->streams[s];
+                const float D = J->d->oracle
+                                    ? dt
+                                    : vdsh_stream_distance(st->order, st->quantity,
+                                                           coef[s], w);
+                const float e = fabsf(D - dt) / floor_;
+                const float s_hat = vdsh_shadow_compare(D, dl, VDSH_COMPARE_SMOOTH);
+                const float b_hat = vdsh_shadow_compare(D, dl, VDSH_COMPARE_BINARY);
+                racc *a = acc + s;
+                a->n++;
+                a->sq += (double)e * e;
+                a->abs += e;
+                a->mae += fabsf(s_hat - s_ideal);
+                a->mae_bin += fabsf(b_hat - b_ideal);
+                a->vis += vis;
+                a->fals += vis && s_hat < 0.5f;
+                a->fals_bin += vis && b_hat < 0.5f;
+                a->occ += occ;
+                a->leak += occ && s_hat > 0.5f;
+                a->occ_bin += occ_bin;
+                a->leak_bin += occ_bin && b_hat > 0.5f;
+                a->ringing += D == 0.0f && dt > 0.0f;
+                h[(size_t)s * HIST_BINS + hist_bin(e)]++;
+            }
+        }
+    }
+}
+
+static void *worker(void *arg)
+{
+    job *J = arg;
+#if defined(__SSE__)
+    /* As in the bake: Embree's recommendation, set in every worker alike so
+     * results do not depend on which thread did a receiver. */
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+#endif
+    int me = atomic_fetch_add(&J->worker_id, 1);
+    uint64_t *hist = J->hist + (size_t)me * VB_EVAL_KINDS * J->streams * HIST_BINS;
+    for (;;) {
+        uint32_t a = atomic_fetch_add(&J->next, BLOCK);
+        if (a >= J->rec_count)
+            break;
+        uint32_t b = a + BLOCK < J->rec_count ? a + BLOCK : J->rec_count;
+        for (uint32_t i = a; i < b; i++)
+            eval_receiver(J, i, hist);
+        atomic_fetch_add(&J->done, b - a);
+    }
+    pthread_mutex_lock(&J->lock);
+    atomic_fetch_sub(&J->running, 1);
+    pthread_cond_signal(&J->cond);
+    pthread_mutex_unlock(&J->lock);
+    return NULL;
+}
+
+/* ---- public pieces ------------------------------------------------------- */
+
+void vb_eval_interpolate(const vdsh_file *f, const vdsh_stream *s, uint32_t tri,
+                         const float bary[3], float position[3],
+                         float normal[3], float *coeffs)
+{
+    const uint32_t *ix = f->indices + 3 * (size_t)tri;
+    if (position || normal) {
+        float p[3] = {0, 0, 0}, n[3] = {0, 0, 0};
+        for (int i = 0; i < 3; i++) {
+            const float *a = f->positions + 3 * (size_t)ix[0];
+            const float *b = f->positions + 3 * (size_t)ix[1];
+            const float *c = f->positions + 3 * (size_t)ix[2];
+            const float *na = f->normals + 3 * (size_t)ix[0];
+            const float *nb = f->normals + 3 * (size_t)ix[1];
+            const float *nc = f->normals + 3 * (size_t)ix[2];
+            p[i] = bary[0] * a[i] + bary[1] * b[i] + bary[2] * c[i];
+            n[i] = bary[0] * na[i] + bary[1] * nb[i] + bary[2] * nc[i];
+        }
+        float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int i = 0; i < 3; i++) {
+            if (position)
+                position[i] = p[i];
+            if (normal)
+                normal[i] = len > 1e-6f ? n[i] / len : 0.0f;
+        }
+    }
+    if (coeffs && s) {
+        float ca[VDSH_MAX_COEFFS], cb[VDSH_MAX_COEFFS], cc[VDSH_MAX_COEFFS];
+        vdsh_stream_decode(s, ix[0], ca);
+        vdsh_stream_decode(s, ix[1], cb);
+        vdsh_stream_decode(s, ix[2], cc);
+        int nc = (int)(s->order * s->order);
+        for (int i = 0; i < nc; i++)
+            coeffs[i] = bary[0] * ca[i] + bary[1] * cb[i] + bary[2] * cc[i];
+    }
+}
+
+double *vb_eval_area_cdf(const vdsh_file *f, double *total)
+{
+    uint32_t T = f->header.triangle_count;
+    double *cdf = malloc(((size_t)T + 1) * sizeof *cdf);
+    if (!cdf)
+        return NULL;
+    double sum = 0.0;
+    for (uint32_t t = 0; t < T; t++) {
+        const uint32_t *ix = f->indices + 3 * (size_t)t;
+        const float *a = f->positions + 3 * (size_t)ix[0];
+        const float *b = f->positions + 3 * (size_t)ix[1];
+        const float *c = f->positions + 3 * (size_t)ix[2];
+        double e1[3], e2[3];
+        for (int i = 0; i < 3; i++)
+            e1[i] = (double)b[i] - a[i], e2[i] = (double)c[i] - a[i];
+        double x = e1[1] * e2[2] - e1[2] * e2[1];
+        double y = e1[2] * e2[0] - e1[0] * e2[2];
+        double z = e1[0] * e2[1] - e1[1] * e2[0];
+        sum += 0.5 * sqrt(x * x + y * y + z * z);
+        cdf[t] = sum;
+    }
+    for (uint32_t t = 0; t < T; t++)
+        cdf[t] = sum > 0.0 ? cdf[t] / sum : 0.0;
+    if (total)
+        *total = sum;
+    return cdf;
+}
+
+int vb_eval_interior_point(const double *cdf, uint32_t triangle_count,
+                           uint64_t seed, uint32_t j, uint32_t *tri,
+                           float bary[3])
+{
+    if (triangle_count == 0 || !(cdf[triangle_count - 1] > 0.0))
+        return 0;
+    uint64_t s = purpose_seed(seed, PURPOSE_INTERIOR);
+    float u1, u2, u3, u4;
+    vb_hash2(s, j, 0, &u1, &u2);
+    vb_hash2(s, j, 1, &u3, &u4);
+    /* 48 bits for the triangle choice: millions of triangles. */
+    double u = u1 + u3 * (1.0 / 16777216.0);
+    /* First triangle whose cumulative area exceeds u: zero-area triangles
+     * (cdf equal to the previous one) can never be chosen. */
+    uint32_t lo = 0, hi = triangle_count - 1;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (cdf[mid] > u)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    /* Uniform in the triangle (Osada et al.); the half-step keeps r1, r2 in
+     * (0, 1), so the point is strictly inside, never on an edge. */
+    double r1 = u2 + 0.5 / 16777216.0, r2 = u4 + 0.5 / 16777216.0;
+    double sr = sqrt(r1);
+    *tri = lo;
+    bary[0] = (float)(1.0 - sr);
+    bary[1] = (float)(sr * (1.0 - r2));
+    bary[2] = (float)(sr * r2);
+    return 1;
+}
+
+uint32_t vb_eval_directions(uint64_t seed, uint32_t directions, uint32_t id,
+                            const float n[3], float *d, uint32_t max)
+{
+    if (seed == 0)
+        seed = VB_EVAL_DEFAULT_SEED;
+    if (directions == 0)
+        directions = VB_EVAL_DEFAULT_DIRECTIONS;
+    vb_dirgrid g = {0};
+    if (vb_dirgrid_create(directions, 1, &g, NULL) != VB_OK)
+        return 0;
+    uint64_t ds = purpose_seed(seed, PURPOSE_DIRECTIONS);
+    uint32_t got = 0;
+    for (uint32_t pk = 0; pk < g.packet_count; pk++) {
+        float x[16], y[16], z[16];
+        int valid[16];
+        heldout_packet(&g, pk, ds, id, n, x, y, z, valid);
+        for (int k = 0; k < 16; k++) {
+            if (!valid[k])
+                continue;
+            if (got < max) {
+                d[3 * got] = x[k], d[3 * got + 1] = y[k], d[3 * got + 2] = z[k];
+            }
+            got++;
+        }
+    }
+    vb_dirgrid_destroy(&g);
+    return got;
+}
+
+void vb_eval_result_free(vb_eval_result *r)
+{
+    if (!r)
+        return;
+    for (int k = 0; k < VB_EVAL_KINDS; k++)
+        free(r->metrics[k]);
+    free(r->per_vertex);
+    memset(r, 0, sizeof *r);
+}
+
+/* ---- reduction ----------------------------------------------------------- */
+
+static int is_zero_normal(const float n[3])
+{
+    return n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f;
+}
+
+static void describe(const receiver *r, const rtruth *t, const racc *a,
+                     vb_eval_receiver *out)
+{
+    memset(out, 0, sizeof *out);
+    out->index = r->index;
+    out->triangle = r->kind == VB_EVAL_VERTICES ? UINT32_MAX : r->triangle;
+    memcpy(out->bary, r->bary, sizeof out->bary);
+    memcpy(out->position, r->position, sizeof out->position);
+    memcpy(out->normal, r->normal, sizeof out->normal);
+    out->near_zero = t->n ? (double)t->near_zero / t->n : NAN;
+    out->escaped = t->n ? (double)t->escaped / t->n : NAN;
+    if (a) {
+        out->shadow_mae = a->n ? a->mae / a->n : NAN;
+        out->distance_rms = a->n ? sqrt(a->sq / a->n) : NAN;
+        out->false_shadow = a->vis ? (double)a->fals / a->vis : NAN;
+    } else {
+        out->shadow_mae = out->distance_rms = out->false_shadow = NAN;
+    }
+}
+
+/* Ratio sum(a) / sum(b) over receivers and its standard error, linearised
+ * with receivers as clusters: var = n / (n - 1) * sum (a_i - r b_i)^2 / B^2. */
+typedef struct ratio {
+    double a, b, res;
+} ratio;
+
+static void ratio_add(ratio *q, double a, double b) { q->a += a, q->b += b; }
+static double ratio_value(const ratio *q) { return q->b > 0 ? q->a / q->b : NAN; }
+static void ratio_res(ratio *q, double a, double b)
+{
+    double r = q->b > 0 ? q->a / q->b : 0.0, e = a - r * b;
+    q->res += e * e;
+}
+static double ratio_se(const ratio *q, uint32_t n)
+{
+    if (!(q->b > 0) || n < 2)
+        return NAN;
+    return sqrt((double)n / (n - 1) * q->res) / q->b;
+}
+
+typedef struct sort_item {
+    double key;
+    uint32_t index;
+} sort_item;
+
+/* Worst first; ties by receiver order, so the list is reproducible. */
+static int cmp_worst(const void *x, const void *y)
+{
+    const sort_item *a = x, *b = y;
+    if (a->key != b->key)
+        return a->key < b->key ? 1 : -1;
+    return (a->index > b->index) - (a->index < b->index);
+}
+
+static int cmp_double(const void *x, const void *y)
+{
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+/* Linear interpolation between order statistics of sorted v[0..n-1]. */
+static double quantile_sorted(const double *v, size_t n, double q)
+{
+    if (n == 0)
+        return NAN;
+    double pos = q * (double)(n - 1);
+    size_t i = (size_t)pos;
+    if (i + 1 >= n)
+        return v[n - 1];
+    return v[i] + (pos - (double)i) * (v[i + 1] - v[i]);
+}
+
+static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind,
+                        unsigned workers, uint32_t worst_n, vb_eval_metrics *m,
+                        vb_error *err)
+{
+    const uint32_t S = J->streams;
+    double *mae = malloc(((size_t)count + 1) * sizeof *mae);
+    sort_item *items = malloc(((size_t)count + 1) * sizeof *items);
+    if (!mae || !items) {
+        free(mae);
+        free(items);
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the scores");
+    }
+    for (uint32_t s = 0; s < S; s++) {
+        vb_eval_metrics *o = m + s;
+        memset(o, 0, sizeof *o);
+        ratio sq = {0}, ab = {0}, mae_r = {0}, mb = {0}, fa = {0}, le = {0}, fb = {0}, lb = {0};
+        uint32_t n_used = 0, nm = 0;
+        uint64_t ringing = 0;
+        for (int pass = 0; pass < 2; pass++) {
+            for (uint32_t i = first; i < first + count; i++) {
+                const racc *a = J->acc + (size_t)i * S + s;
+                if (a->n == 0)
+                    continue;
+                if (pass == 0) {
+                    n_used++;
+                    ratio_add(&sq, a->sq, a->n);
+                    ratio_add(&ab, a->abs, a->n);
+                    ratio_add(&mae_r, a->mae, a->n);
+                    ratio_add(&mb, a->mae_bin, a->n);
+                    ratio_add(&fa, a->fals, a->vis);
+                    ratio_add(&le, a->leak, a->occ);
+                    ratio_add(&fb, a->fals_bin, a->vis);
+                    ratio_add(&lb, a->leak_bin, a->occ_bin);
+                    o->visible += a->vis;
+                    o->occluded += a->occ;
+                    o->occluded_binary += a->occ_bin;
+                    ringing += a->ringing;
+                    mae[nm] = a->mae / a->n;
+                    items[nm].key = mae[nm];
+                    items[nm].index = i;
+                    nm++;
+                } else {
+                    ratio_res(&sq, a->sq, a->n);
+                    ratio_res(&mae_r, a->mae, a->n);
+                    ratio_res(&mb, a->mae_bin, a->n);
+                    ratio_res(&fa, a->fals, a->vis);
+                    ratio_res(&le, a->leak, a->occ);
+                    ratio_res(&fb, a->fals_bin, a->vis);
+                    ratio_res(&lb, a->leak_bin, a->occ_bin);
+                }
+            }
+        }
+        o->samples = (uint64_t)sq.b;
+        o->ringing = o->samples ? (double)ringing / o->samples : NAN;
+        double ms = ratio_value(&sq);
+        o->distance_rms = sqrt(ms);
+        /* Delta method: se(sqrt(x)) = se(x) / (2 sqrt(x)). */
+        o->distance_rms_se = ms > 0 ? ratio_se(&sq, n_used) / (2.0 * o->distance_rms)
+                                    : (n_used > 1 ? 0.0 : NAN);
+        o->distance_mean = ratio_value(&ab);
+        o->shadow_mae = ratio_value(&mae_r), o->shadow_mae_se = ratio_se(&mae_r, n_used);
+        o->binary_mae = ratio_value(&mb), o->binary_mae_se = ratio_se(&mb, n_used);
+        o->false_shadow = ratio_value(&fa), o->false_shadow_se = ratio_se(&fa, n_used);
+        o->light_leak = ratio_value(&le), o->light_leak_se = ratio_se(&le, n_used);
+        o->binary_false_shadow = ratio_value(&fb);
+        o->binary_false_shadow_se = ratio_se(&fb, n_used);
+        o->binary_light_leak = ratio_value(&lb);
+        o->binary_light_leak_se = ratio_se(&lb, n_used);
+
+        uint64_t h[HIST_BINS] = {0};
+        for (unsigned w = 0; w < workers; w++) {
+            const uint64_t *src = J->hist + (((size_t)w * VB_EVAL_KINDS + kind) * S + s) * HIST_BINS;
+            for (int b = 0; b < HIST_BINS; b++)
+                h[b] += src[b];
+        }
+        o->distance_p50 = hist_quantile(h, 0.50);
+        o->distance_p90 = hist_quantile(h, 0.90);
+        o->distance_p99 = hist_quantile(h, 0.99);
+
+        qsort(mae, nm, sizeof *mae, cmp_double);
+        o->receiver_mae_p50 = quantile_sorted(mae, nm, 0.50);
+        o->receiver_mae_p90 = quantile_sorted(mae, nm, 0.90);
+        o->receiver_mae_p99 = quantile_sorted(mae, nm, 0.99);
+        qsort(items, nm, sizeof *items, cmp_worst);
+        o->worst_count = nm < worst_n ? nm : worst_n;
+        for (uint32_t w = 0; w < o->worst_count; w++) {
+            uint32_t i = items[w].index;
+            describe(J->rec + i, J->truth + i, J->acc + (size_t)i * S + s, &o->worst[w]);
+        }
+    }
+    free(mae);
+    free(items);
+    return VB_OK;
+}
+
+static vb_result list_escaping(const job *J, uint32_t first, uint32_t count,
+                               uint32_t max, vb_eval_truth *t, vb_error *err)
+{
+    sort_item *items = malloc(((size_t)count + 1) * sizeof *items);
+    if (!items)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the scores");
+    uint32_t n = 0;
+    for (uint32_t i = first; i < first + count; i++) {
+        const rtruth *x = J->truth + i;
+        if (x->escaped > 0) {
+            items[n].key = (double)x->escaped / x->n;
+            items[n++].index = i;
+        }
+    }
+    qsort(items, n, sizeof *items, cmp_worst);
+    t->escaping_listed = n < max ? n : max;
+    for (uint32_t w = 0; w < t->escaping_listed; w++) {
+        uint32_t i = items[w].index;
+        describe(J->rec + i, J->truth + i, NULL, &t->escaping_list[w]);
+    }
+    free(items);
+    return VB_OK;
+}
+
+/* ---- the run ------------------------------------------------------------- */
+
+static int cmp_sort_item_key(const void *x, const void *y)
+{
+    const sort_item *a = x, *b = y;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
+    return (a->index > b->index) - (a->index < b->index);
+}
+
+static int cmp_u32(const void *x, const void *y)
+{
+    uint32_t a = *(const uint32_t *)x, b = *(const uint32_t *)y;
+    return (a > b) - (a < b);
+}
+
+/* The vertices to evaluate, in index order: all, or the `want` whose hash
+ * is smallest (a uniform sample without replacement that does not depend
+ * on anything but the seed and the vertex count). */
+static vb_result pick_vertices(uint32_t V, uint32_t want, uint64_t seed,
+                               uint32_t **out, uint32_t *count, vb_error *err)
+{
+    uint32_t n = (want == 0 || want >= V) ? V : want;
+    uint32_t *v = malloc(((size_t)n + 1) * sizeof *v);
+    if (!v)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers", n);
+    if (n == V) {
+        for (uint32_t i = 0; i < V; i++)
+            v[i] = i;
+    } else {
+        sort_item *it = malloc((size_t)V * sizeof *it);
+        if (!it) {
+            free(v);
+            return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u vertices", V);
+        }
+        uint64_t s = purpose_seed(seed, PURPOSE_VERTICES);
+        for (uint32_t i = 0; i < V; i++) {
+            float a, b;
+            vb_hash2(s, i, 0, &a, &b);
+            it[i].key = a + b * (1.0 / 16777216.0);
+            it[i].index = i;
+        }
+        qsort(it, V, sizeof *it, cmp_sort_item_key);
+        for (uint32_t i = 0; i < n; i++)
+            v[i] = it[i].index;
+        free(it);
+        qsort(v, n, sizeof *v, cmp_u32); /* back to index order */
+    }
+    *out = v;
+    *count = n;
+    return VB_OK;
+}
+
+vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
+                      vb_error *err)
+{
+    vb_eval_desc d = *desc;
+    const vdsh_file *f = d.file;
+    if (!f || !d.scene)
+        return vb_fail(err, VB_ERR_ARGUMENT, "nothing to evaluate: no file or no scene");
+    if (f->stream_count == 0 && !d.oracle)
+        return vb_fail(err, VB_ERR_ARGUMENT, "the file has no coefficient streams");
+    if (f->stream_count > VDSH_MAX_STREAMS)
+        return vb_fail(err, VB_ERR_ARGUMENT, "too many streams (%u)", f->stream_count);
+    for (uint32_t s = 0; s < f->stream_count; s++)
+        if (f->streams[s].order < 1 || f->streams[s].order > VDSH_MAX_ORDER)
+            return vb_fail(err, VB_ERR_ARGUMENT, "stream %u: order %u out of range", s,
+                           f->streams[s].order);
+    if (d.seed == 0)
+        d.seed = VB_EVAL_DEFAULT_SEED;
+    if (d.directions == 0)
+        d.directions = VB_EVAL_DEFAULT_DIRECTIONS;
+    if (d.worst == 0)
+        d.worst = VB_EVAL_DEFAULT_WORST;
+    if (d.worst > VB_EVAL_MAX_WORST)
+        d.worst = VB_EVAL_MAX_WORST;
+    if (d.interior > VB_EVAL_MAX_RECEIVERS)
+        return vb_fail(err, VB_ERR_ARGUMENT, "at most %u interior points, not %u",
+                       VB_EVAL_MAX_RECEIVERS, d.interior);
+    if (d.interior > 0 && f->header.triangle_count == 0)
+        d.interior = 0; /* a point cloud has no inside: vertices only */
+    if (d.threads == 0) {
+        long nc = sysconf(_SC_NPROCESSORS_ONLN);
+        d.threads = nc > 0 ? (unsigned)nc : 1;
+    }
+    if (d.threads > 256)
+        d.threads = 256;
+    const double t0 = vb_now();
+    const uint32_t V = f->header.vertex_count, S = f->stream_count;
+    float diag = 0.0f;
+    {
+        double d2 = 0.0;
+        for (int i = 0; i < 3; i++) {
+            double e = (double)f->header.bounds_max[i] - f->header.bounds_min[i];
+            d2 += e * e;
+        }
+        diag = (float)sqrt(d2);
+    }
+    if (!(diag > 0.0f))
+        diag = d.scene->diagonal;
+
+    vb_result r = VB_OK;
+    vb_dirgrid grid = {0};
+    uint32_t *vsel = NULL, nv = 0;
+    float *vorigin = NULL;
+    double *cdf = NULL;
+    receiver *rec = NULL;
+    job *J = NULL;
+    pthread_t *th = NULL;
+    vb_eval_result o = {0};
+    unsigned started = 0;
+    int sync = 0;
+
+    r = vb_dirgrid_create(d.directions, 1, &grid, err);
+    if (r != VB_OK)
+        goto done;
+    r = pick_vertices(V, d.points, d.seed, &vsel, &nv, err);
+    if (r != VB_OK)
+        goto done;
+
+    /* 1. Receivers and their truth origins. */
+    vorigin = malloc((size_t)V * 3 * sizeof *vorigin);
+    rec = calloc((size_t)nv + d.interior + 1, sizeof *rec);
+    if (!vorigin || !rec) {
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
+                    nv + d.interior);
+        goto done;
+    }
+    {
+        vb_mesh m = {.vertex_count = V, .triangle_count = f->header.triangle_count,
+                     .positions = (float *)f->positions, .normals = (float *)f->normals,
+                     .indices = (uint32_t *)f->indices};
+        r = vb_ray_origins(&m, d.scene, vorigin, err);
+        if (r != VB_OK)
+            goto done;
+    }
+    uint32_t count[VB_EVAL_KINDS] = {0, 0}, skipped[VB_EVAL_KINDS] = {0, 0};
+    uint32_t nr = 0;
+    for (uint32_t i = 0; i < nv; i++) {
+        uint32_t v = vsel[i];
+        const float *n = f->normals + 3 * (size_t)v;
+        if (is_zero_normal(n)) {
+            skipped[VB_EVAL_VERTICES]++;
+            continue;
+        }
+        receiver *x = rec + nr++;
+        x->kind = VB_EVAL_VERTICES;
+        x->index = v;
+        x->id = v;
+        x->triangle = UINT32_MAX;
+        x->bary[0] = 1.0f;
+        memcpy(x->position, f->positions + 3 * (size_t)v, sizeof x->position);
+        memcpy(x->normal, n, sizeof x->normal);
+        memcpy(x->origin, vorigin + 3 * (size_t)v, sizeof x->origin);
+    }
+    count[VB_EVAL_VERTICES] = nr;
+    if (d.interior > 0) {
+        double area = 0.0;
+        cdf = vb_eval_area_cdf(f, &area);
+        if (!cdf) {
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the triangle areas");
+            goto done;
+        }
+        for (uint32_t j = 0; j < d.interior && area > 0.0; j++) {
+            receiver x = {.kind = VB_EVAL_INTERIOR, .index = j, .id = VB_EVAL_INTERIOR_ID(j)};
+            vb_eval_interior_point(cdf, f->header.triangle_count, d.seed, j, &x.triangle,
+                                   x.bary);
+            vb_eval_interpolate(f, NULL, x.triangle, x.bary, x.position, x.normal, NULL);
+            if (is_zero_normal(x.normal)) {
+                skipped[VB_EVAL_INTERIOR]++;
+                continue;
+            }
+            float p[3];
+            vb_scene_to_local(d.scene, x.position, p);
+            vb_offset_origin(p, x.normal, x.origin);
+            rec[nr++] = x;
+        }
+        count[VB_EVAL_INTERIOR] = nr - count[VB_EVAL_VERTICES];
+    }
+    free(vorigin);
+    vorigin = NULL;
+
+    /* 2. Trace and score. */
+    J = calloc(1, sizeof *J);
+    th = calloc(d.threads, sizeof *th);
+    if (!J || !th) {
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+        goto done;
+    }
+    J->d = &d;
+    J->f = f;
+    J->scene = d.scene;
+    J->grid = &grid;
+    J->rec = rec;
+    J->rec_count = nr;
+    J->streams = S;
+    J->acc = calloc((size_t)nr * (S ? S : 1) + 1, sizeof *J->acc);
+    J->truth = calloc((size_t)nr + 1, sizeof *J->truth);
+    J->hist = calloc((size_t)d.threads * VB_EVAL_KINDS * (S ? S : 1) * HIST_BINS,
+                     sizeof *J->hist);
+    if (!J->acc || !J->truth || !J->hist) {
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers", nr);
+        goto done;
+    }
+    J->dir_seed = purpose_seed(d.seed, PURPOSE_DIRECTIONS);
+    J->light_seed = purpose_seed(d.seed, PURPOSE_LIGHTS);
+    J->max_distance = f->header.max_distance;
+    J->max_local = f->header.max_distance * d.scene->scale;
+    J->inv_scale = 1.0f / d.scene->scale;
+    J->floor_dist = 0.01f * diag;
+    J->near_zero_dist = VB_EVAL_NEAR_ZERO * diag;
+    pthread_mutex_init(&J->lock, NULL);
+    pthread_cond_init(&J->cond, NULL);
+    sync = 1;
+
+    atomic_store(&J->running, (int)d.threads);
+    for (; started < d.threads; started++)
+        if (pthread_create(&th[started], NULL, worker, J) != 0)
+            break;
+    if (started < d.threads)
+        atomic_fetch_sub(&J->running, (int)(d.threads - started));
+    if (started == 0) {
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
+        goto done;
+    }
+    pthread_mutex_lock(&J->lock);
+    while (atomic_load(&J->running) > 0) {
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        ts.tv_nsec += 200000000L;
+        if (ts.tv_nsec >= 1000000000L) {
+            ts.tv_sec++;
+            ts.tv_nsec -= 1000000000L;
+        }
+        pthread_cond_timedwait(&J->cond, &J->lock, &ts);
+        if (d.progress && atomic_load(&J->running) > 0) {
+            pthread_mutex_unlock(&J->lock);
+            d.progress(d.progress_user, atomic_load(&J->done), nr);
+            pthread_mutex_lock(&J->lock);
+        }
+    }
+    pthread_mutex_unlock(&J->lock);
+    for (unsigned i = 0; i < started; i++)
+        pthread_join(th[i], NULL);
+    if (d.progress)
+        d.progress(d.progress_user, nr, nr);
+
+    /* 3. Reduce in receiver order. */
+    o.stream_count = S;
+    for (int k = 0; k < VB_EVAL_KINDS; k++) {
+        o.metrics[k] = calloc(S ? S : 1, sizeof *o.metrics[k]);
+        if (!o.metrics[k]) {
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+            goto done;
+        }
+    }
+    for (int k = 0; k < VB_EVAL_KINDS; k++) {
+        uint32_t first = k == VB_EVAL_VERTICES ? 0 : count[VB_EVAL_VERTICES];
+        vb_eval_truth *t = &o.truth[k];
+        t->receivers = count[k];
+        t->skipped = skipped[k];
+        for (uint32_t i = first; i < first + count[k]; i++) {
+            const rtruth *x = J->truth + i;
+            t->rays += x->n;
+            t->escaped += x->escaped;
+            t->near_zero += x->near_zero;
+            if (x->n > 0 && x->near_zero >= VB_EVAL_DEGENERATE * x->n) {
+                if (t->degenerate_listed < d.worst)
+                    describe(rec + i, x, NULL, &t->degenerate_list[t->degenerate_listed++]);
+                t->degenerate++;
+            }
+        }
+        r = list_escaping(J, first, count[k], d.worst, t, err);
+        if (r != VB_OK)
+            goto done;
+        r = reduce(J, first, count[k], k, started, d.worst, o.metrics[k], err);
+        if (r != VB_OK)
+            goto done;
+    }
+    if (d.per_vertex) {
+        o.per_vertex_fields = VB_EVAL_PV_TRUTH_FIELDS + VB_EVAL_PV_STREAM_FIELDS * S;
+        o.per_vertex = malloc(((size_t)V * o.per_vertex_fields + 1) * sizeof *o.per_vertex);
+        if (!o.per_vertex) {
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the per-vertex errors");
+            goto done;
+        }
+        for (size_t i = 0; i < (size_t)V * o.per_vertex_fields; i++)
+            o.per_vertex[i] = NAN;
+        for (uint32_t i = 0; i < count[VB_EVAL_VERTICES]; i++) {
+            const rtruth *x = J->truth + i;
+            float *pv = o.per_vertex + (size_t)rec[i].index * o.per_vertex_fields;
+            if (x->n == 0)
+                continue;
+            pv[VB_EVAL_PV_NEAR_ZERO] = (float)x->near_zero / (float)x->n;
+            pv[VB_EVAL_PV_ESCAPED] = (float)x->escaped / (float)x->n;
+            for (uint32_t s = 0; s < S; s++) {
+                const racc *a = J->acc + (size_t)i * S + s;
+                float *q = pv + VB_EVAL_PV_TRUTH_FIELDS + VB_EVAL_PV_STREAM_FIELDS * s;
+                q[VB_EVAL_PV_DISTANCE_RMS] = (float)sqrt(a->sq / a->n);
+                q[VB_EVAL_PV_SHADOW_MAE] = (float)(a->mae / a->n);
+                q[VB_EVAL_PV_FALSE_SHADOW] = a->vis ? (float)a->fals / (float)a->vis : NAN;
+                q[VB_EVAL_PV_LIGHT_LEAK] = a->occ ? (float)a->leak / (float)a->occ : NAN;
+                q[VB_EVAL_PV_BINARY_MAE] = (float)(a->mae_bin / a->n);
+            }
+        }
+    }
+    o.seed = d.seed;
+    o.directions = grid.count;
+    o.diagonal = diag;
+    o.max_distance = f->header.max_distance;
+    o.oracle = d.oracle;
+    o.threads = started;
+    o.seconds = vb_now() - t0;
+    *out = o;
+    memset(&o, 0, sizeof o);
+    r = VB_OK;
+
+done:
+    if (J) {
+        if (sync) {
+            pthread_cond_destroy(&J->cond);
+            pthread_mutex_destroy(&J->lock);
+        }
+        free(J->acc);
+        free(J->truth);
+        free(J->hist);
+    }
+    vb_eval_result_free(&o);
+    free(J);
+    free(th);
+    free(rec);
+    free(cdf);
+    free(vorigin);
+    free(vsel);
+    vb_dirgrid_destroy(&grid);
+    return r;
+}
+
+/* ---- scene reconstruction ------------------------------------------------ */
+
+static void hex(const uint8_t *h, int n, char *out)
+{
+    static const char digits[] = "0123456789abcdef";
+    for (int i = 0; i < n; i++) {
+        out[2 * i] = digits[h[i] >> 4];
+        out[2 * i + 1] = digits[h[i] & 15];
+    }
+    out[2 * n] = '\0';
+}
+
+vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths,
+                               uint32_t count, const vb_eval_scene_desc *desc,
+                               vb_scene **out, vb_error *err)
+{
+    vb_eval_scene_desc d = desc ? *desc : (vb_eval_scene_desc){0};
+    if (count != f->source_count)
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "%u mesh(es) given but the bake used %u source(s)", count,
+                       f->source_count);
+    if (count == 0)
+        return vb_fail(err, VB_ERR_INVALID,
+                       "the file records no source meshes: give the bake's meshes");
+    vb_load_desc ld = {.weld = (f->header.load_flags & VDSH_LOAD_WELD) != 0};
+    vb_mesh occ = {0};
+    vb_result r = VB_OK;
+    for (uint32_t i = 0; i < count; i++) {
+        vb_mesh m = {0};
+        vb_source_info info;
+        r = vb_mesh_load(paths[i], &ld, &m, &info, err);
+        if (r != VB_OK)
+            goto fail;
+        const vdsh_source *src = &f->sources[i];
+        if (info.size != src->size || memcmp(info.sha256, src->sha256, 32) != 0) {
+            char now[65], then[65], msg[768];
+            hex(info.sha256, 32, now);
+            hex(src->sha256, 32, then);
+            snprintf(msg, sizeof msg,
+                     "source %u of %u, '%s' (recorded as '%s'), is not the mesh the bake "
+                     "used: %llu bytes, SHA-256 %.16s..., but the bake recorded %llu "
+                     "bytes, SHA-256 %.16s...",
+                     i + 1, count, paths[i], src->name, (unsigned long long)info.size, now,
+                     (unsigned long long)src->size, then);
+            if (!d.allow_mismatch) {
+                vb_mesh_free(&m);
+                r = vb_fail(err, VB_ERR_INVALID, "%s", msg);
+                goto fail;
+            }
+            if (d.warn)
+                d.warn(d.warn_user, msg);
+        }
+        r = vb_mesh_append(&occ, &m, err);
+        vb_mesh_free(&m);
+        if (r != VB_OK)
+            goto fail;
+    }
+    if (!d.allow_mismatch &&
+        (occ.vertex_count != f->header.occluder_vertex_count ||
+         occ.triangle_count != f->header.occluder_triangle_count)) {
+        r = vb_fail(err, VB_ERR_INVALID,
+                    "the sources load as %u vertices and %u triangles, but the bake traced "
+                    "%u and %u (the mesh loader changed since the bake?)",
+                    occ.vertex_count, occ.triangle_count,
+                    f->header.occluder_vertex_count, f->header.occluder_triangle_count);
+        goto fail;
+    }
+    float lo[3], hi[3];
+    vb_mesh_bounds(&occ, lo, hi);
+    if (!d.allow_mismatch && (memcmp(lo, f->header.bounds_min, sizeof lo) != 0 ||
+                              memcmp(hi, f->header.bounds_max, sizeof hi) != 0)) {
+        r = vb_fail(err, VB_ERR_INVALID,
+                    "the sources' bounds (%g %g %g .. %g %g %g) differ from the bake's",
+                    (double)lo[0], (double)lo[1], (double)lo[2], (double)hi[0],
+                    (double)hi[1], (double)hi[2]);
+        goto fail;
+    }
+    vb_scene_desc sd = {.robust = !d.fast, .threads = d.threads};
+    r = vb_scene_create(&occ, &sd, out, err);
+fail:
+    vb_mesh_free(&occ);
+    return r;
+}

@@ -1,0 +1,8 @@
+# The evaluator (included from bake/CMakeLists.txt): its core (eval.c, the
+# ground truth and the scores, prefix vb_eval_) and the vdsh-eval tool.
+add_library(vb_eval STATIC eval.c)
+target_link_libraries(vb_eval PUBLIC vb_core)
+
+add_executable(vdsh-eval vdsh_eval.c)
+target_link_libraries(vdsh-eval PRIVATE vb_eval)
+install(TARGETS vdsh-eval RUNTIME DESTINATION bin)

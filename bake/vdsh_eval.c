@@ -1,0 +1,926 @@
+/*
+ * vdsh-eval - how far a baked .vdsh is from the truth (DESIGN.md section 3).
+ *
+ * The story of an evaluation: read the file; rebuild the occluder scene the
+ * bake traced (its recorded sources, or meshes given on the command line,
+ * each checked against the recorded SHA-256); run the evaluator (eval.h:
+ * an independent Embree ray cast from held-out directions, lights and
+ * points); print a table, and write the JSON and per-vertex files if asked.
+ * Every report carries the bake's parameters and time beside the errors.
+ *
+ * --per-vertex FILE, for a heat map in a viewer (little-endian):
+ *
+ *   offset  type      field
+ *   0       u8[8]     magic "VDSHPVE1"
+ *   8       u32       version = 1
+ *   12      u32       vertex_count V (the .vdsh file's)
+ *   16      u32       stream_count K (the streams scored, in file order)
+ *   20      u32       fields per record F = 2 + 5K
+ *   24      u32       data_offset = 64 + 16K
+ *   28      u8[36]    zero
+ *   64      K x u32[4] per stream: order, quantity, method, encoding
+ *   data_offset       V records of F f32, vertex-major:
+ *           [0] fraction of the vertex's truth at ~0 distance (< 1e-3 diag)
+ *           [1] fraction of its truth rays that hit nothing
+ *           [2 + 5k + 0] distance RMS (relative) of stream k
+ *           [2 + 5k + 1] smooth shadow MAE
+ *           [2 + 5k + 2] false-shadow rate (NaN: no truly visible light)
+ *           [2 + 5k + 3] light-leak rate (NaN: no truly occluded light)
+ *           [2 + 5k + 4] binary shadow MAE
+ *   Every field of a vertex that was not evaluated (--points sample,
+ *   undefined normal) is NaN. Interior points are not in this file; the
+ *   JSON lists the worst of them.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <libgen.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "bake.h"
+#include "eval.h"
+#include "scene.h"
+#include "vdsh.h"
+
+#define EXIT_USAGE 2
+#define PV_MAGIC "VDSHPVE1"
+#define PV_VERSION 1u
+#define PV_HEADER 64u
+#define PV_STREAM 16u
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+"Usage: vdsh-eval [options] FILE.vdsh [MESH...]\n"
+"Measure a bake's error against an independent Embree ray cast.\n"
+"\n"
+"The occluder scene is rebuilt from the sources recorded in FILE (looked\n"
+"up as recorded, then beside FILE), or from the MESHes given, one per\n"
+"recorded source and in the same order; each must have the SHA-256 the\n"
+"bake recorded. Receivers are vertices and random points inside triangles\n"
+"(coefficients interpolated as the GPU does); each gets its own held-out\n"
+"upper-hemisphere directions (never the bake's) and one point light per\n"
+"direction at d_L = u * 2 * d_T, u uniform in (0.05, 1].\n"
+"\n"
+"Sampling:\n"
+"      --points N          vertices evaluated: a deterministic sample of N\n"
+"                          (default: all)\n"
+"      --interior N        random points inside triangles (default 65536;\n"
+"                          0: none)\n"
+"      --directions N      held-out directions (and lights) per receiver\n"
+"                          (default 64 = 8 x 8 grid over the hemisphere)\n"
+"      --seed N            the evaluator's seed (default %u; 0 is the\n"
+"                          default); any seed, even the bake's, gives other\n"
+"                          directions than the bake's\n"
+"      --orders LIST       only these orders, e.g. 3,5 (default: every stream)\n"
+"      --oracle            score the ray-cast truth instead of the streams:\n"
+"                          every error must come out exactly 0\n"
+"      --fast-truth        Embree's default traversal for the truth (default:\n"
+"                          robust, so truth rays do not leak through edges)\n"
+"      --allow-mismatch    use sources whose SHA-256 differs (with a warning)\n"
+"\n"
+"Output:\n"
+"      --json FILE         everything as JSON (bake parameters and timings too)\n"
+"      --per-vertex FILE   per-vertex errors for a heat map (layout below)\n"
+"      --bake-report FILE  take the bake time from vdsh-bake --report JSON\n"
+"                          (default: the file's time chunk, if recorded)\n"
+"      --worst N           worst receivers listed (default 10, at most 64)\n"
+"      --threads N         worker threads (default: all cores)\n"
+"  -q, --quiet             no progress on stderr\n"
+"  -h, --help              this text\n"
+"  -V, --version           version\n"
+"\n"
+"Errors (per stream, for vertices and interior points separately):\n"
+"  distance  |D - d_T| / max(d_T, 0.01 diag): RMS, p50, p90, p99\n"
+"  shadow    smooth ramp(d / d_L): MAE |s_hat - s_ideal|, false-shadow rate\n"
+"            P(s_hat < .5 | d_T >= d_L), light-leak rate P(s_hat > .5 |\n"
+"            s_ideal < .5); and the same with the binary comparison\n"
+"  +- is a 95%% interval (1.96 standard errors, receivers as clusters).\n"
+"\n"
+"--per-vertex layout (little-endian): a 64-byte header: magic \"%s\",\n"
+"u32 version (1), u32 vertex_count V, u32 stream_count K, u32 fields F\n"
+"(= 2 + 5K), u32 data_offset (= 64 + 16K), zero to 64; then K stream\n"
+"descriptors of 4 u32: order, quantity, method, encoding; then V records\n"
+"of F f32 at data_offset, vertex-major: [0] fraction of the truth at ~0\n"
+"distance, [1] fraction of truth rays that escaped, then per stream k at\n"
+"2 + 5k: distance RMS, smooth shadow MAE, false-shadow rate, light-leak\n"
+"rate, binary shadow MAE. NaN: vertex not evaluated (or, for the two\n"
+"rates, no light of that kind).\n"
+"\n"
+"Exit status: 0 success, 1 error, 2 usage error.\n"
+"Example: vdsh-bake builtin:room --max-edge 0.5 -o room.vdsh --record-timings\n"
+"         vdsh-eval room.vdsh --json room.eval.json\n",
+            VB_EVAL_DEFAULT_SEED, PV_MAGIC);
+}
+
+static int bad_usage(const char *fmt, const char *arg)
+{
+    fprintf(stderr, "vdsh-eval: ");
+    fprintf(stderr, fmt, arg);
+    fprintf(stderr, "\nTry 'vdsh-eval --help'.\n");
+    return EXIT_USAGE;
+}
+
+static int parse_u64(const char *s, uint64_t max, uint64_t *out)
+{
+    char *end;
+    errno = 0;
+    if (!*s || *s == '-')
+        return 0;
+    unsigned long long v = strtoull(s, &end, 0);
+    if (errno || *end || v > max)
+        return 0;
+    *out = v;
+    return 1;
+}
+
+static int parse_orders(const char *s, int *want)
+{
+    int any = 0;
+    for (const char *p = s; *p;) {
+        if (*p < '1' || *p > '0' + VDSH_MAX_ORDER)
+            return 0;
+        want[*p++ - '0'] = 1;
+        any = 1;
+        if (*p == ',') {
+            if (!*++p)
+                return 0;
+        } else if (*p) {
+            return 0;
+        }
+    }
+    return any;
+}
+
+/* ---- progress on a terminal -------------------------------------------- */
+
+typedef struct progress {
+    int enabled;
+    double t0;
+} progress;
+
+static void on_progress(void *user, uint32_t done, uint32_t total)
+{
+    progress *p = user;
+    if (!p->enabled)
+        return;
+    double t = vb_now() - p->t0;
+    double frac = total ? (double)done / total : 1.0;
+    double eta = frac > 0.0 ? t * (1.0 - frac) / frac : 0.0;
+    fprintf(stderr, "\r  %5.1f%%  %u/%u receivers  ETA %.1f s   ", 100.0 * frac, done,
+            total, eta);
+    if (done == total)
+        fputs("\r                                                        \r", stderr);
+    fflush(stderr);
+}
+
+typedef struct warnings {
+    const char *path;
+    int count;
+} warnings;
+
+static void on_warn(void *user, const char *msg)
+{
+    warnings *w = user;
+    w->count++;
+    fprintf(stderr, "vdsh-eval: %s: warning: %s\n", w->path, msg);
+}
+
+/* ---- sources -------------------------------------------------------------- */
+
+static int exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/* Where a recorded source is now: as recorded (relative to the working
+ * directory), else beside the .vdsh file. NULL if neither exists. */
+static char *resolve_source(const char *name, const char *vdsh_path)
+{
+    if (strncmp(name, "builtin:", 8) == 0 || exists(name))
+        return strdup(name);
+    if (name[0] == '/')
+        return NULL;
+    char tmp[PATH_MAX];
+    snprintf(tmp, sizeof tmp, "%s", vdsh_path);
+    const char *dir = dirname(tmp);
+    size_t n = strlen(dir) + strlen(name) + 2;
+    char *p = malloc(n);
+    if (!p)
+        return NULL;
+    snprintf(p, n, "%s/%s", dir, name);
+    if (exists(p))
+        return p;
+    free(p);
+    return NULL;
+}
+
+/* ---- bake time ------------------------------------------------------------- */
+
+typedef struct bake_time {
+    double total, trace;
+    unsigned threads;
+    const char *source;    /* "time chunk", "bake report" or NULL */
+} bake_time;
+
+/* vdsh-bake --report: "seconds": {..., "trace": T, ..., "total": T} and
+ * "threads": N. A tiny reader for the one flat object the baker writes. */
+static int read_bake_report(const char *path, bake_time *bt, char *msg, size_t cap)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp) {
+        snprintf(msg, cap, "%s: cannot open: %s", path, strerror(errno));
+        return 0;
+    }
+    char buf[65536];
+    size_t n = fread(buf, 1, sizeof buf - 1, fp);
+    fclose(fp);
+    buf[n] = '\0';
+    const char *sec = strstr(buf, "\"seconds\"");
+    const char *tot = sec ? strstr(sec, "\"total\"") : NULL;
+    const char *tr = sec ? strstr(sec, "\"trace\"") : NULL;
+    const char *th = strstr(buf, "\"threads\"");
+    if (!tot || !strchr(tot, ':')) {
+        snprintf(msg, cap, "%s: no \"seconds\": {\"total\": ...} (not a vdsh-bake --report?)",
+                 path);
+        return 0;
+    }
+    bt->total = strtod(strchr(tot, ':') + 1, NULL);
+    bt->trace = tr && strchr(tr, ':') ? strtod(strchr(tr, ':') + 1, NULL) : NAN;
+    bt->threads = th && strchr(th, ':') ? (unsigned)strtoul(strchr(th, ':') + 1, NULL, 10) : 0;
+    bt->source = "bake report";
+    return 1;
+}
+
+/* ---- JSON ------------------------------------------------------------------- */
+
+static void json_str(FILE *fp, const char *s)
+{
+    fputc('"', fp);
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if (*p == '"' || *p == '\\')
+            fprintf(fp, "\\%c", *p);
+        else if (*p < 0x20)
+            fprintf(fp, "\\u%04x", *p);
+        else
+            fputc(*p, fp);
+    }
+    fputc('"', fp);
+}
+
+static void json_num(FILE *fp, double v)
+{
+    if (isfinite(v))
+        fprintf(fp, "%.9g", v);
+    else
+        fputs("null", fp);
+}
+
+static void json_vec(FILE *fp, const float *v)
+{
+    fputc('[', fp);
+    for (int i = 0; i < 3; i++) {
+        if (i)
+            fputs(", ", fp);
+        json_num(fp, v[i]);
+    }
+    fputc(']', fp);
+}
+
+static void json_receiver(FILE *fp, const vb_eval_receiver *r, int kind)
+{
+    fprintf(fp, "{\"index\": %u, ", r->index);
+    if (kind == VB_EVAL_INTERIOR) {
+        fprintf(fp, "\"triangle\": %u, \"bary\": ", r->triangle);
+        json_vec(fp, r->bary);
+        fputs(", ", fp);
+    }
+    fputs("\"position\": ", fp);
+    json_vec(fp, r->position);
+    fputs(", \"normal\": ", fp);
+    json_vec(fp, r->normal);
+    fputs(", \"shadow_mae\": ", fp);
+    json_num(fp, r->shadow_mae);
+    fputs(", \"distance_rms\": ", fp);
+    json_num(fp, r->distance_rms);
+    fputs(", \"false_shadow\": ", fp);
+    json_num(fp, r->false_shadow);
+    fputs(", \"near_zero\": ", fp);
+    json_num(fp, r->near_zero);
+    fputs(", \"escaped\": ", fp);
+    json_num(fp, r->escaped);
+    fputc('}', fp);
+}
+
+#define JV(name, value)                                                        \
+    do {                                                                       \
+        fprintf(fp, "%s\"%s\": ", first ? "" : ", ", name);                    \
+        json_num(fp, value);                                                   \
+        first = 0;                                                             \
+    } while (0)
+
+static void json_metrics(FILE *fp, const vb_eval_metrics *m, int kind)
+{
+    int first = 1;
+    fputc('{', fp);
+    fprintf(fp, "\"samples\": %llu", (unsigned long long)m->samples);
+    first = 0;
+    JV("distance_rms", m->distance_rms);
+    JV("distance_rms_se", m->distance_rms_se);
+    JV("distance_mean", m->distance_mean);
+    JV("distance_p50", m->distance_p50);
+    JV("distance_p90", m->distance_p90);
+    JV("distance_p99", m->distance_p99);
+    JV("shadow_mae", m->shadow_mae);
+    JV("shadow_mae_se", m->shadow_mae_se);
+    JV("false_shadow", m->false_shadow);
+    JV("false_shadow_se", m->false_shadow_se);
+    JV("light_leak", m->light_leak);
+    JV("light_leak_se", m->light_leak_se);
+    JV("binary_mae", m->binary_mae);
+    JV("binary_mae_se", m->binary_mae_se);
+    JV("binary_false_shadow", m->binary_false_shadow);
+    JV("binary_false_shadow_se", m->binary_false_shadow_se);
+    JV("binary_light_leak", m->binary_light_leak);
+    JV("binary_light_leak_se", m->binary_light_leak_se);
+    JV("ringing", m->ringing);
+    JV("receiver_mae_p50", m->receiver_mae_p50);
+    JV("receiver_mae_p90", m->receiver_mae_p90);
+    JV("receiver_mae_p99", m->receiver_mae_p99);
+    fprintf(fp, ", \"visible\": %llu, \"occluded\": %llu, \"occluded_binary\": %llu",
+            (unsigned long long)m->visible, (unsigned long long)m->occluded,
+            (unsigned long long)m->occluded_binary);
+    fputs(",\n          \"worst\": [", fp);
+    for (uint32_t i = 0; i < m->worst_count; i++) {
+        fputs(i ? ",\n            " : "\n            ", fp);
+        json_receiver(fp, &m->worst[i], kind);
+    }
+    fputs("]}", fp);
+}
+
+static void json_truth(FILE *fp, const vb_eval_truth *t, int kind)
+{
+    fprintf(fp, "{\"receivers\": %u, \"skipped_undefined_normal\": %u, \"rays\": %llu, "
+                "\"escaped\": %llu, \"escape_rate\": ",
+            t->receivers, t->skipped, (unsigned long long)t->rays,
+            (unsigned long long)t->escaped);
+    json_num(fp, t->rays ? (double)t->escaped / t->rays : NAN);
+    fprintf(fp, ", \"near_zero\": %llu, \"near_zero_rate\": ", (unsigned long long)t->near_zero);
+    json_num(fp, t->rays ? (double)t->near_zero / t->rays : NAN);
+    fprintf(fp, ", \"degenerate\": %u, \"degenerate_rate\": ", t->degenerate);
+    json_num(fp, t->receivers ? (double)t->degenerate / t->receivers : NAN);
+    fputs(",\n        \"degenerate_list\": [", fp);
+    for (uint32_t i = 0; i < t->degenerate_listed; i++) {
+        fputs(i ? ",\n          " : "\n          ", fp);
+        json_receiver(fp, &t->degenerate_list[i], kind);
+    }
+    fputs("],\n        \"escaping_list\": [", fp);
+    for (uint32_t i = 0; i < t->escaping_listed; i++) {
+        fputs(i ? ",\n          " : "\n          ", fp);
+        json_receiver(fp, &t->escaping_list[i], kind);
+    }
+    fputs("]}", fp);
+}
+
+typedef struct context {
+    const char *path;
+    const vdsh_file *f;
+    char **source_paths;
+    long long file_bytes;
+    bake_time bt;
+    const vb_eval_result *r;
+    const vb_eval_desc *d;
+    int fast_truth;
+    int mismatched;        /* sources used despite a different SHA-256 */
+} context;
+
+static const char *kind_name(int k) { return k == VB_EVAL_VERTICES ? "vertices" : "interior"; }
+
+static int write_json(const char *out, const context *c)
+{
+    char tmp[PATH_MAX];
+    if (snprintf(tmp, sizeof tmp, "%s.tmp.%ld", out, (long)getpid()) >= (int)sizeof tmp)
+        return -1;
+    FILE *fp = fopen(tmp, "w");
+    if (!fp)
+        return -1;
+    const vdsh_file *f = c->f;
+    const vdsh_header *h = &f->header;
+    const vb_eval_result *r = c->r;
+    fputs("{\n  \"tool\": \"vdsh-eval\",\n  \"version\": \"" VDSH_VERSION_STRING "\",\n", fp);
+    fputs("  \"file\": ", fp);
+    json_str(fp, c->path);
+    fprintf(fp, ",\n  \"file_bytes\": %lld,\n", c->file_bytes);
+    fputs("  \"scene\": {\n    \"sources\": [", fp);
+    for (uint32_t i = 0; i < f->source_count; i++) {
+        char hx[65];
+        for (int k = 0; k < 32; k++)
+            snprintf(hx + 2 * k, 3, "%02x", f->sources[i].sha256[k]);
+        fputs(i ? ",\n      {\"name\": " : "\n      {\"name\": ", fp);
+        json_str(fp, f->sources[i].name);
+        fputs(", \"loaded_from\": ", fp);
+        json_str(fp, c->source_paths[i]);
+        fprintf(fp, ", \"size\": %llu, \"sha256\": \"%s\"}",
+                (unsigned long long)f->sources[i].size, hx);
+    }
+    fprintf(fp, "],\n    \"receiver_vertices\": %u, \"receiver_triangles\": %u,\n"
+                "    \"occluder_vertices\": %u, \"occluder_triangles\": %u,\n",
+            h->vertex_count, h->triangle_count, h->occluder_vertex_count,
+            h->occluder_triangle_count);
+    fputs("    \"bounds_min\": ", fp);
+    json_vec(fp, h->bounds_min);
+    fputs(", \"bounds_max\": ", fp);
+    json_vec(fp, h->bounds_max);
+    fputs(", \"diagonal\": ", fp);
+    json_num(fp, r->diagonal);
+    fputs("\n  },\n", fp);
+
+    fprintf(fp, "  \"bake\": {\n    \"rays\": %u, \"sampling\": \"%s\", \"seed\": %llu, "
+                "\"max_distance\": ",
+            h->rays, vdsh_sampling_name(h->sampling), (unsigned long long)h->seed);
+    json_num(fp, h->max_distance);
+    fputs(", \"max_edge\": ", fp);
+    json_num(fp, h->max_edge);
+    fprintf(fp, ",\n    \"offset_rule\": \"%s\", \"welded\": %s, \"robust\": %s, "
+                "\"cube_size\": %u,\n",
+            vdsh_offset_rule_name(h->offset_rule),
+            (h->load_flags & VDSH_LOAD_WELD) ? "true" : "false",
+            (h->trace_flags & VDSH_TRACE_ROBUST) ? "true" : "false", h->cube_size);
+    if (f->has_stats)
+        fprintf(fp, "    \"stats\": {\"rays_traced\": %llu, \"rays_missed\": %llu, "
+                    "\"degenerate_receivers\": %u, \"undefined_normals\": %u},\n",
+                (unsigned long long)f->stats.rays_traced,
+                (unsigned long long)f->stats.rays_missed, f->stats.degenerate_receivers,
+                f->stats.undefined_normals);
+    else
+        fputs("    \"stats\": null,\n", fp);
+    if (f->has_timings) {
+        const vdsh_timings *t = &f->timings;
+        fprintf(fp, "    \"timings\": {\"load\": %.6f, \"refine\": %.6f, \"build\": %.6f, "
+                    "\"trace\": %.6f, \"total\": %.6f, \"threads\": %u},\n",
+                t->load, t->refine, t->build, t->trace, t->total, t->threads);
+    } else {
+        fputs("    \"timings\": null,\n", fp);
+    }
+    fputs("    \"seconds\": ", fp);
+    json_num(fp, c->bt.source ? c->bt.total : NAN);
+    fputs(", \"seconds_from\": ", fp);
+    if (c->bt.source)
+        json_str(fp, c->bt.source);
+    else
+        fputs("null", fp);
+    fputs("\n  },\n", fp);
+
+    fprintf(fp, "  \"eval\": {\"seed\": %llu, \"points_requested\": %u, \"interior_requested\": %u, "
+                "\"directions\": %u, \"oracle\": %s, \"truth_traversal\": \"%s\",\n"
+                "    \"sources_mismatched\": %d, \"error_floor\": ",
+            (unsigned long long)r->seed, c->d->points, c->d->interior, r->directions,
+            r->oracle ? "true" : "false", c->fast_truth ? "default" : "robust", c->mismatched);
+    json_num(fp, 0.01 * r->diagonal);
+    fprintf(fp, ", \"threads\": %u, \"seconds\": %.6f},\n", r->threads, r->seconds);
+
+    fputs("  \"truth\": {", fp);
+    for (int k = 0; k < VB_EVAL_KINDS; k++) {
+        fprintf(fp, "%s\n    \"%s\": ", k ? "," : "", kind_name(k));
+        json_truth(fp, &r->truth[k], k);
+    }
+    fputs("\n  },\n  \"streams\": [", fp);
+    for (uint32_t s = 0; s < r->stream_count; s++) {
+        const vdsh_stream *st = &f->streams[s];
+        fprintf(fp, "%s\n    {\"order\": %u, \"coefficients\": %u, \"method\": \"%s\", "
+                    "\"encoding\": \"%s\", \"quantity\": \"%s\", \"window\": \"%s\", "
+                    "\"bytes_per_vertex\": %zu,",
+                s ? "," : "", st->order, st->order * st->order, vdsh_method_name(st->method),
+                vdsh_encoding_name(st->encoding), vdsh_quantity_name(st->quantity),
+                vdsh_window_name(st->window), vdsh_stream_bytes_per_vertex(st));
+        for (int k = 0; k < VB_EVAL_KINDS; k++) {
+            fprintf(fp, "%s\n      \"%s\": ", k ? "," : "", kind_name(k));
+            json_metrics(fp, &r->metrics[k][s], k);
+        }
+        fputs("}", fp);
+    }
+    fputs("\n  ]\n}\n", fp);
+    int bad = ferror(fp);
+    if (fclose(fp) != 0 || bad || rename(tmp, out) != 0) {
+        unlink(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+/* ---- per-vertex file (layout in usage()) --------------------------------- */
+
+static void put_u32(unsigned char *p, uint32_t v)
+{
+    p[0] = (unsigned char)v, p[1] = (unsigned char)(v >> 8);
+    p[2] = (unsigned char)(v >> 16), p[3] = (unsigned char)(v >> 24);
+}
+
+static int write_per_vertex(const char *out, const vdsh_file *f, const vb_eval_result *r)
+{
+    char tmp[PATH_MAX];
+    if (snprintf(tmp, sizeof tmp, "%s.tmp.%ld", out, (long)getpid()) >= (int)sizeof tmp)
+        return -1;
+    FILE *fp = fopen(tmp, "wb");
+    if (!fp)
+        return -1;
+    unsigned char head[PV_HEADER] = {0};
+    memcpy(head, PV_MAGIC, 8);
+    put_u32(head + 8, PV_VERSION);
+    put_u32(head + 12, f->header.vertex_count);
+    put_u32(head + 16, r->stream_count);
+    put_u32(head + 20, r->per_vertex_fields);
+    put_u32(head + 24, PV_HEADER + PV_STREAM * r->stream_count);
+    fwrite(head, 1, sizeof head, fp);
+    for (uint32_t s = 0; s < r->stream_count; s++) {
+        unsigned char d[PV_STREAM];
+        put_u32(d, f->streams[s].order);
+        put_u32(d + 4, f->streams[s].quantity);
+        put_u32(d + 8, f->streams[s].method);
+        put_u32(d + 12, f->streams[s].encoding);
+        fwrite(d, 1, sizeof d, fp);
+    }
+    /* f32 little-endian: the host's own layout (vdsh.h supports only
+     * little-endian hosts). */
+    fwrite(r->per_vertex, sizeof(float),
+           (size_t)f->header.vertex_count * r->per_vertex_fields, fp);
+    int bad = ferror(fp);
+    if (fclose(fp) != 0 || bad || rename(tmp, out) != 0) {
+        unlink(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+/* ---- the table ---------------------------------------------------------------- */
+
+static void print_table(FILE *o, const context *c)
+{
+    const vdsh_file *f = c->f;
+    const vdsh_header *h = &f->header;
+    const vb_eval_result *r = c->r;
+    fprintf(o, "vdsh-eval %s: %s\n", VDSH_VERSION_STRING, c->path);
+    fprintf(o, "  scene     ");
+    for (uint32_t i = 0; i < f->source_count; i++)
+        fprintf(o, "%s%s", i ? ", " : "", f->sources[i].name);
+    if (c->mismatched)
+        fprintf(o, " (%d source(s) DIFFER from the bake's: --allow-mismatch)\n", c->mismatched);
+    else
+        fprintf(o, " (SHA-256 verified)\n");
+    fprintf(o, "            %u receiver vertices, %u triangles; %u occluder triangles; "
+               "diagonal %.4g\n",
+            h->vertex_count, h->triangle_count, h->occluder_triangle_count,
+            (double)r->diagonal);
+    fprintf(o, "  bake      %u rays/receiver (%s), seed %llu, max distance %.4g, max edge %g",
+            h->rays, vdsh_sampling_name(h->sampling), (unsigned long long)h->seed,
+            (double)h->max_distance, (double)h->max_edge);
+    if (c->bt.source)
+        fprintf(o, "; %.2f s (%s)\n", c->bt.total, c->bt.source);
+    else
+        fprintf(o, "; time not recorded (bake with --record-timings or pass --bake-report)\n");
+    if (f->has_stats)
+        fprintf(o, "            bake's own rays: %.4f%% missed, %u degenerate receivers, "
+                   "%u undefined normals\n",
+                f->stats.rays_traced ? 100.0 * f->stats.rays_missed / f->stats.rays_traced
+                                     : 0.0,
+                f->stats.degenerate_receivers, f->stats.undefined_normals);
+    fprintf(o, "  eval      seed %llu, %u held-out directions/receiver (one light each), "
+               "%s truth traversal%s; %.2f s on %u threads\n",
+            (unsigned long long)r->seed, r->directions, c->fast_truth ? "default" : "robust",
+            r->oracle ? ", ORACLE (truth scored against itself)" : "", r->seconds, r->threads);
+    for (int k = 0; k < VB_EVAL_KINDS; k++) {
+        const vb_eval_truth *t = &r->truth[k];
+        fprintf(o, "  truth     %-8s %u receivers", kind_name(k), t->receivers);
+        if (t->skipped)
+            fprintf(o, " (+%u skipped: undefined normal)", t->skipped);
+        fprintf(o, ", %llu rays, %.4f%% escaped, %.3f%% at ~0 distance, %u degenerate",
+                (unsigned long long)t->rays, t->rays ? 100.0 * t->escaped / t->rays : 0.0,
+                t->rays ? 100.0 * t->near_zero / t->rays : 0.0, t->degenerate);
+        if (t->degenerate && t->receivers)
+            fprintf(o, " (%.2f%%)", 100.0 * t->degenerate / t->receivers);
+        fputc('\n', o);
+    }
+    fprintf(o, "\n  order = n bands, n^2 coefficients; B/v = bytes of coefficients per vertex; "
+               "+- = 95%% interval\n");
+    fprintf(o, "  distance = |D - d_T| / max(d_T, 0.01 diag); false = P(s_hat < .5 | d_T >= d_L), "
+               "leak = P(s_hat > .5 | s_ideal < .5)\n\n");
+    fprintf(o, "  %-8s %5s %3s %3s %-6s | %-14s %6s %6s %6s | %-15s %-13s %-13s | %-6s %6s %6s\n",
+            "", "order", "B/v", "enc", "method", "distance RMS", "p50", "p90", "p99",
+            "smooth: MAE", "false", "leak", "binary", "false", "leak");
+    for (int k = 0; k < VB_EVAL_KINDS; k++) {
+        if (r->truth[k].receivers == 0)
+            continue;
+        for (uint32_t s = 0; s < r->stream_count; s++) {
+            const vdsh_stream *st = &f->streams[s];
+            const vb_eval_metrics *m = &r->metrics[k][s];
+            char rms[32], mae[32], fa[32], le[32];
+            snprintf(rms, sizeof rms, "%.3f+-%.3f", m->distance_rms, 1.96 * m->distance_rms_se);
+            snprintf(mae, sizeof mae, "%.4f+-%.4f", m->shadow_mae, 1.96 * m->shadow_mae_se);
+            snprintf(fa, sizeof fa, "%.2f+-%.2f%%", 100.0 * m->false_shadow,
+                     196.0 * m->false_shadow_se);
+            snprintf(le, sizeof le, "%.2f+-%.2f%%", 100.0 * m->light_leak,
+                     196.0 * m->light_leak_se);
+            fprintf(o, "  %-8s %5u %3zu %3s %-6s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s %-13s "
+                       "| %6.4f %5.2f%% %5.2f%%\n",
+                    kind_name(k), st->order, vdsh_stream_bytes_per_vertex(st),
+                    vdsh_encoding_name(st->encoding), vdsh_method_name(st->method), rms,
+                    m->distance_p50, m->distance_p90, m->distance_p99, mae, fa, le,
+                    m->binary_mae, 100.0 * m->binary_false_shadow,
+                    100.0 * m->binary_light_leak);
+        }
+    }
+    for (int k = 0; k < VB_EVAL_KINDS; k++) {
+        if (r->truth[k].receivers == 0 || r->oracle)
+            continue;
+        fprintf(o, "  %-8s SH sum rang <= 0 (read as distance 0) on", kind_name(k));
+        for (uint32_t s = 0; s < r->stream_count; s++)
+            fprintf(o, "%s order %u %.3f%%", s ? "," : "", f->streams[s].order,
+                    100.0 * r->metrics[k][s].ringing);
+        fprintf(o, " of samples\n");
+    }
+    /* Where to look: the worst receivers of the highest order, both kinds. */
+    uint32_t best = 0;
+    for (uint32_t s = 1; s < r->stream_count; s++)
+        if (f->streams[s].order > f->streams[best].order)
+            best = s;
+    for (int k = 0; k < VB_EVAL_KINDS && r->stream_count; k++) {
+        const vb_eval_metrics *m = &r->metrics[k][best];
+        if (m->worst_count == 0)
+            continue;
+        fprintf(o, "\n  worst %s, order %u (shadow MAE; per-receiver p50 %.4f, p90 %.4f, "
+                   "p99 %.4f):\n",
+                kind_name(k), f->streams[best].order, m->receiver_mae_p50,
+                m->receiver_mae_p90, m->receiver_mae_p99);
+        uint32_t n = m->worst_count < 5 ? m->worst_count : 5;
+        for (uint32_t i = 0; i < n; i++) {
+            const vb_eval_receiver *w = &m->worst[i];
+            if (k == VB_EVAL_VERTICES)
+                fprintf(o, "    vertex %-9u", w->index);
+            else
+                fprintf(o, "    point %-6u tri %-8u", w->index, w->triangle);
+            fprintf(o, " at (%.4g, %.4g, %.4g) n (%.2f, %.2f, %.2f): shadow MAE %.3f, "
+                       "distance RMS %.3f, %.0f%% truth at ~0\n",
+                    (double)w->position[0], (double)w->position[1], (double)w->position[2],
+                    (double)w->normal[0], (double)w->normal[1], (double)w->normal[2],
+                    w->shadow_mae, w->distance_rms, 100.0 * w->near_zero);
+        }
+    }
+    for (int k = 0; k < VB_EVAL_KINDS; k++) {
+        const vb_eval_truth *t = &r->truth[k];
+        if (t->escaping_listed == 0 || t->escaping_list[0].escaped < 0.5)
+            continue;
+        fprintf(o, "\n  %s whose truth mostly escapes (a leak if the scene is closed):\n",
+                kind_name(k));
+        for (uint32_t i = 0; i < t->escaping_listed && i < 5; i++) {
+            const vb_eval_receiver *w = &t->escaping_list[i];
+            if (w->escaped < 0.5)
+                break;
+            fprintf(o, "    %s %u at (%.4g, %.4g, %.4g) n (%.2f, %.2f, %.2f): %.0f%% escaped\n",
+                    k == VB_EVAL_VERTICES ? "vertex" : "point", w->index,
+                    (double)w->position[0], (double)w->position[1], (double)w->position[2],
+                    (double)w->normal[0], (double)w->normal[1], (double)w->normal[2],
+                    100.0 * w->escaped);
+        }
+    }
+    for (int k = 0; k < VB_EVAL_KINDS; k++) {
+        const vb_eval_truth *t = &r->truth[k];
+        if (t->degenerate_listed == 0)
+            continue;
+        fprintf(o, "\n  degenerate %s (truth almost all at ~0 distance: a bake defect), "
+                   "first %u:\n", kind_name(k), t->degenerate_listed < 5 ? t->degenerate_listed : 5);
+        for (uint32_t i = 0; i < t->degenerate_listed && i < 5; i++) {
+            const vb_eval_receiver *w = &t->degenerate_list[i];
+            fprintf(o, "    %s %u at (%.4g, %.4g, %.4g) n (%.2f, %.2f, %.2f)\n",
+                    k == VB_EVAL_VERTICES ? "vertex" : "point", w->index,
+                    (double)w->position[0], (double)w->position[1], (double)w->position[2],
+                    (double)w->normal[0], (double)w->normal[1], (double)w->normal[2]);
+        }
+    }
+}
+
+/* ---- main -------------------------------------------------------------------- */
+
+int main(int argc, char **argv)
+{
+    vb_eval_desc d = {0};
+    d.interior = 65536;
+    const char *json = NULL, *per_vertex = NULL, *bake_report = NULL;
+    int want_order[VDSH_MAX_ORDER + 1] = {0}, filter = 0;
+    int quiet = 0, fast_truth = 0, allow_mismatch = 0;
+
+    enum { O_POINTS = 256, O_INTERIOR, O_DIRECTIONS, O_SEED, O_ORDERS, O_ORACLE,
+           O_FAST, O_ALLOW, O_JSON, O_PV, O_BAKE_REPORT, O_WORST, O_THREADS };
+    static const struct option longopts[] = {
+        {"points", required_argument, 0, O_POINTS},
+        {"interior", required_argument, 0, O_INTERIOR},
+        {"directions", required_argument, 0, O_DIRECTIONS},
+        {"seed", required_argument, 0, O_SEED},
+        {"orders", required_argument, 0, O_ORDERS},
+        {"oracle", no_argument, 0, O_ORACLE},
+        {"fast-truth", no_argument, 0, O_FAST},
+        {"allow-mismatch", no_argument, 0, O_ALLOW},
+        {"json", required_argument, 0, O_JSON},
+        {"per-vertex", required_argument, 0, O_PV},
+        {"bake-report", required_argument, 0, O_BAKE_REPORT},
+        {"worst", required_argument, 0, O_WORST},
+        {"threads", required_argument, 0, O_THREADS},
+        {"quiet", no_argument, 0, 'q'},
+        {"help", no_argument, 0, 'h'},
+        {"version", no_argument, 0, 'V'},
+        {0, 0, 0, 0}};
+    int c;
+    uint64_t u;
+    while ((c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
+        switch (c) {
+        case O_POINTS:
+            if (!parse_u64(optarg, VB_EVAL_MAX_RECEIVERS, &u) || u == 0)
+                return bad_usage("--points takes a whole number 1..268435456, not '%s'", optarg);
+            d.points = (uint32_t)u;
+            break;
+        case O_INTERIOR:
+            if (!parse_u64(optarg, VB_EVAL_MAX_RECEIVERS, &u))
+                return bad_usage("--interior takes a whole number 0..268435456, not '%s'", optarg);
+            d.interior = (uint32_t)u;
+            break;
+        case O_DIRECTIONS:
+            if (!parse_u64(optarg, 65536, &u) || u == 0)
+                return bad_usage("--directions takes a whole number 1..65536, not '%s'", optarg);
+            d.directions = (uint32_t)u;
+            break;
+        case O_SEED:
+            if (!parse_u64(optarg, UINT64_MAX, &d.seed))
+                return bad_usage("--seed takes a whole number, not '%s'", optarg);
+            break;
+        case O_ORDERS:
+            if (!parse_orders(optarg, want_order))
+                return bad_usage("--orders takes orders 1..5 such as 3,5, not '%s'", optarg);
+            filter = 1;
+            break;
+        case O_ORACLE: d.oracle = 1; break;
+        case O_FAST: fast_truth = 1; break;
+        case O_ALLOW: allow_mismatch = 1; break;
+        case O_JSON: json = optarg; break;
+        case O_PV: per_vertex = optarg; break;
+        case O_BAKE_REPORT: bake_report = optarg; break;
+        case O_WORST:
+            if (!parse_u64(optarg, VB_EVAL_MAX_WORST, &u) || u == 0)
+                return bad_usage("--worst takes a whole number 1..64, not '%s'", optarg);
+            d.worst = (uint32_t)u;
+            break;
+        case O_THREADS:
+            if (!parse_u64(optarg, 256, &u) || u == 0)
+                return bad_usage("--threads takes a whole number 1..256, not '%s'", optarg);
+            d.threads = (unsigned)u;
+            break;
+        case 'q': quiet = 1; break;
+        case 'h': usage(stdout); return 0;
+        case 'V':
+            printf("vdsh-eval %s (.vdsh format %u, Embree %s)\n", VDSH_VERSION_STRING,
+                   VDSH_FORMAT_VERSION, RTC_VERSION_STRING);
+            return 0;
+        default:
+            fprintf(stderr, "Try 'vdsh-eval --help'.\n");
+            return EXIT_USAGE;
+        }
+    }
+    if (optind >= argc)
+        return bad_usage("%s", "no .vdsh file given");
+    const char *path = argv[optind];
+    char **meshes = argv + optind + 1;
+    uint32_t nmesh = (uint32_t)(argc - optind - 1);
+
+    int status = 1;
+    vdsh_file *f = NULL;
+    vb_scene *scene = NULL;
+    vb_eval_result res = {0};
+    char **spath = NULL;
+    vdsh_stream *kept = NULL;
+    vdsh_error verr;
+    vb_error err;
+
+    /* 1. The file. */
+    if (vdsh_read(path, &f, &verr) != VDSH_OK) {
+        fprintf(stderr, "vdsh-eval: %s\n", verr.msg);
+        return 1;
+    }
+    if (nmesh && nmesh != f->source_count) {
+        fprintf(stderr, "vdsh-eval: %s: %u mesh(es) given but the bake used %u source(s):",
+                path, nmesh, f->source_count);
+        for (uint32_t i = 0; i < f->source_count; i++)
+            fprintf(stderr, " '%s'", f->sources[i].name);
+        fputc('\n', stderr);
+        vdsh_free(f);
+        return EXIT_USAGE;
+    }
+    vdsh_file view = *f; /* the streams to score; the file itself stays as read */
+    if (filter) {
+        kept = calloc(f->stream_count + 1, sizeof *kept);
+        if (!kept) {
+            fprintf(stderr, "vdsh-eval: out of memory\n");
+            goto out;
+        }
+        uint32_t n = 0;
+        for (uint32_t s = 0; s < f->stream_count; s++)
+            if (f->streams[s].order <= VDSH_MAX_ORDER && want_order[f->streams[s].order])
+                kept[n++] = f->streams[s];
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
+            int found = 0;
+            for (uint32_t s = 0; s < n; s++)
+                found |= want_order[o] && kept[s].order == (uint32_t)o;
+            if (want_order[o] && !found) {
+                fprintf(stderr, "vdsh-eval: %s: no stream of order %d\n", path, o);
+                goto out;
+            }
+        }
+        view.streams = kept;
+        view.stream_count = n;
+    }
+
+    /* 2. The bake time. */
+    bake_time bt = {0};
+    if (bake_report) {
+        char msg[PATH_MAX + 128];
+        if (!read_bake_report(bake_report, &bt, msg, sizeof msg)) {
+            fprintf(stderr, "vdsh-eval: %s\n", msg);
+            goto out;
+        }
+    } else if (f->has_timings) {
+        bt.total = f->timings.total;
+        bt.trace = f->timings.trace;
+        bt.threads = f->timings.threads;
+        bt.source = "time chunk";
+    }
+
+    /* 3. The occluders, as the bake traced them. */
+    spath = calloc(f->source_count + 1, sizeof *spath);
+    if (!spath) {
+        fprintf(stderr, "vdsh-eval: out of memory\n");
+        goto out;
+    }
+    for (uint32_t i = 0; i < f->source_count; i++) {
+        spath[i] = nmesh ? strdup(meshes[i]) : resolve_source(f->sources[i].name, path);
+        if (!spath[i]) {
+            fprintf(stderr, "vdsh-eval: %s: cannot find source %u of %u, '%s' (looked as "
+                            "recorded and beside the file); give the bake's meshes after "
+                            "the file name\n",
+                    path, i + 1, f->source_count, f->sources[i].name);
+            goto out;
+        }
+    }
+    warnings warned = {.path = path};
+    vb_eval_scene_desc sd = {.fast = fast_truth, .allow_mismatch = allow_mismatch,
+                             .threads = d.threads, .warn = on_warn, .warn_user = &warned};
+    if (vb_eval_scene_create(f, (const char *const *)spath, f->source_count, &sd, &scene,
+                             &err) != VB_OK) {
+        fprintf(stderr, "vdsh-eval: %s: %s\n", path, err.msg);
+        goto out;
+    }
+
+    /* 4. Evaluate. */
+    progress pr = {.enabled = !quiet && isatty(STDERR_FILENO), .t0 = vb_now()};
+    d.file = &view;
+    d.scene = scene;
+    d.per_vertex = per_vertex != NULL;
+    d.progress = on_progress;
+    d.progress_user = &pr;
+    if (vb_eval_run(&d, &res, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-eval: %s: %s\n", path, err.msg);
+        goto out;
+    }
+
+    /* 5. Report. */
+    context ctx = {.path = path, .f = &view, .source_paths = spath, .file_bytes = -1,
+                   .bt = bt, .r = &res, .d = &d, .fast_truth = fast_truth,
+                   .mismatched = warned.count};
+    struct stat st;
+    if (stat(path, &st) == 0)
+        ctx.file_bytes = (long long)st.st_size;
+    print_table(stdout, &ctx);
+    fflush(stdout);
+    if (json && write_json(json, &ctx) != 0) {
+        fprintf(stderr, "vdsh-eval: %s: cannot write: %s\n", json, strerror(errno));
+        goto out;
+    }
+    if (per_vertex && write_per_vertex(per_vertex, &view, &res) != 0) {
+        fprintf(stderr, "vdsh-eval: %s: cannot write: %s\n", per_vertex, strerror(errno));
+        goto out;
+    }
+    status = 0;
+
+out:
+    if (spath)
+        for (uint32_t i = 0; i < f->source_count; i++)
+            free(spath[i]);
+    free(spath);
+    free(kept);
+    vb_eval_result_free(&res);
+    vb_scene_destroy(scene);
+    vdsh_free(f);
+    return status;
+}

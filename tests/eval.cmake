@@ -1,0 +1,51 @@
+# The evaluator (bake/eval.h, vdsh-eval): reconstruction against ray-cast
+# ground truth on generated scenes and builtin:room (no files needed).
+#   eval_<part>  test_eval.c, one part each (see its header)
+#   eval_cli     vdsh-bake + vdsh-eval end to end: exit codes, messages,
+#                the JSON and the per-vertex file
+#   eval_json    the JSON parses and holds what the sweep reads
+if(TARGET vb_eval)
+  add_executable(test_eval ${CMAKE_CURRENT_LIST_DIR}/test_eval.c)
+  target_link_libraries(test_eval PRIVATE vb_eval)
+  foreach(part heldout interpolate sources sphere room oracle)
+    add_test(NAME eval_${part} COMMAND test_eval ${part})
+  endforeach()
+
+  add_executable(test_eval_cli ${CMAKE_CURRENT_LIST_DIR}/test_eval_cli.c)
+  target_link_libraries(test_eval_cli PRIVATE vdsh_format)
+  add_test(NAME eval_cli
+           COMMAND test_eval_cli $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval>
+                   ${CMAKE_CURRENT_BINARY_DIR}/eval_cli)
+
+  find_package(Python3 COMPONENTS Interpreter QUIET)
+  if(Python3_Interpreter_FOUND)
+    add_test(NAME eval_json
+             COMMAND ${Python3_EXECUTABLE} -c
+"import json, subprocess, sys, os, tempfile
+bake, ev = sys.argv[1], sys.argv[2]
+d = tempfile.mkdtemp()
+f = os.path.join(d, 'room.vdsh')
+subprocess.run([bake, 'builtin:room', '--max-edge', '1', '--rays', '64', '--orders', '2,5',
+                '--encoding', 'f32', '-q', '--record-timings', '--cube-size', '0', '-o', f], check=True)
+subprocess.run([ev, f, '-q', '--interior', '500', '--points', '700', '--json', f + '.json'],
+               check=True, stdout=subprocess.DEVNULL)
+j = json.load(open(f + '.json'))
+assert j['scene']['sources'][0]['name'] == 'builtin:room', j['scene']
+assert j['bake']['rays'] == 64 and j['bake']['seconds'] > 0, j['bake']
+assert j['bake']['seconds_from'] == 'time chunk'
+assert [s['order'] for s in j['streams']] == [2, 5]
+s = j['streams'][1]
+assert s['bytes_per_vertex'] == 100 and s['encoding'] == 'f32' and s['method'] == 'paper'
+for k in ('vertices', 'interior'):
+    m = s[k]
+    for key in ('distance_rms', 'distance_rms_se', 'distance_p50', 'distance_p90', 'distance_p99',
+                'shadow_mae', 'shadow_mae_se', 'false_shadow', 'light_leak', 'binary_mae',
+                'binary_false_shadow', 'binary_light_leak', 'worst'):
+        assert key in m, key
+    assert 0 < m['shadow_mae'] < 1 and len(m['worst']) == 10
+assert j['truth']['vertices']['receivers'] == 700 and j['truth']['interior']['receivers'] == 500
+assert j['eval']['directions'] == 64
+print('ok')"
+             $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval>)
+  endif()
+endif()

@@ -1,0 +1,230 @@
+/*
+ * test_eval_cli.c - vdsh-eval end to end: bake a small closed box written
+ * here as OBJ, evaluate it, and check exit codes, messages, the JSON and
+ * the per-vertex file; then change the mesh and check that the evaluator
+ * names the source that no longer matches.
+ *
+ *   test_eval_cli VDSH_BAKE VDSH_EVAL WORK_DIR
+ */
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "test_util.h"
+
+static const char *work;
+static char out_path[4096], err_path[4096];
+
+/* Run argv (NULL-terminated) with stdout and stderr to files; exit code. */
+static int run(char *const argv[])
+{
+    pid_t pid = fork();
+    if (pid < 0)
+        return -1;
+    if (pid == 0) {
+        int o = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        int e = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (o < 0 || e < 0)
+            _exit(127);
+        dup2(o, 1);
+        dup2(e, 2);
+        execv(argv[0], argv);
+        _exit(127);
+    }
+    int st;
+    if (waitpid(pid, &st, 0) < 0)
+        return -1;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static char *slurp(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *b = malloc((size_t)n + 1);
+    size_t got = fread(b, 1, (size_t)n, f);
+    fclose(f);
+    b[got] = '\0';
+    if (size)
+        *size = got;
+    return b;
+}
+
+static int contains(const char *path, const char *needle)
+{
+    char *b = slurp(path, NULL);
+    int ok = b && strstr(b, needle) != NULL;
+    free(b);
+    return ok;
+}
+
+static char *path_in(const char *name)
+{
+    static char buf[8][4096];
+    static int next;
+    char *p = buf[next++ % 8];
+    snprintf(p, 4096, "%s/%s", work, name);
+    return p;
+}
+
+/* A closed box [0,2] x [0,1] x [0,2], faces wound to face inwards. */
+static void write_box(const char *path, const char *extra)
+{
+    FILE *f = fopen(path, "w");
+    for (int i = 0; i < 8; i++)
+        fprintf(f, "v %d %d %d\n", (i & 1) ? 2 : 0, (i & 2) ? 1 : 0, (i & 4) ? 2 : 0);
+    static const int q[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                                {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+    for (int k = 0; k < 6; k++) {
+        /* Orient each quad so its normal points to the centre (1, .5, 1). */
+        float p[4][3];
+        for (int j = 0; j < 4; j++)
+            for (int c = 0; c < 3; c++)
+                p[j][c] = (float)((q[k][j] >> c) & 1) * (c == 1 ? 1.0f : 2.0f);
+        float e1[3], e2[3], n[3], mid[3] = {0, 0, 0};
+        for (int c = 0; c < 3; c++) {
+            e1[c] = p[1][c] - p[0][c], e2[c] = p[2][c] - p[0][c];
+            for (int j = 0; j < 4; j++)
+                mid[c] += p[j][c] / 4;
+        }
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        float to_c[3] = {1 - mid[0], 0.5f - mid[1], 1 - mid[2]};
+        int in = n[0] * to_c[0] + n[1] * to_c[1] + n[2] * to_c[2] > 0;
+        if (in)
+            fprintf(f, "f %d %d %d %d\n", q[k][0] + 1, q[k][1] + 1, q[k][2] + 1, q[k][3] + 1);
+        else
+            fprintf(f, "f %d %d %d %d\n", q[k][3] + 1, q[k][2] + 1, q[k][1] + 1, q[k][0] + 1);
+    }
+    if (extra)
+        fputs(extra, f);
+    fclose(f);
+}
+
+static uint32_t u32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 4) {
+        fprintf(stderr, "usage: test_eval_cli VDSH_BAKE VDSH_EVAL WORK_DIR\n");
+        return 2;
+    }
+    char *bake = argv[1], *ev = argv[2];
+    work = argv[3];
+    mkdir(work, 0755);
+    snprintf(out_path, sizeof out_path, "%s/stdout.txt", work);
+    snprintf(err_path, sizeof err_path, "%s/stderr.txt", work);
+
+    /* Usage. */
+    CHECK(run((char *[]){ev, "--help", NULL}) == 0, "--help");
+    CHECK(contains(out_path, "--per-vertex") && contains(out_path, "VDSHPVE1"),
+          "--help documents the per-vertex layout");
+    CHECK(run((char *[]){ev, "--version", NULL}) == 0 && contains(out_path, "vdsh-eval "),
+          "--version");
+    CHECK(run((char *[]){ev, NULL}) == 2 && contains(err_path, "no .vdsh file"), "no file");
+    CHECK(run((char *[]){ev, "--no-such-option", "x.vdsh", NULL}) == 2, "bad option");
+    CHECK(run((char *[]){ev, "--points", "0", "x.vdsh", NULL}) == 2, "--points 0");
+    CHECK(run((char *[]){ev, "--orders", "2,7", "x.vdsh", NULL}) == 2, "--orders 2,7");
+    char *missing = path_in("no-such.vdsh");
+    CHECK(run((char *[]){ev, missing, NULL}) == 1 && contains(err_path, "no-such.vdsh"),
+          "a missing file is named");
+
+    /* Bake a box. */
+    char *obj = path_in("box.obj"), *vdsh = path_in("box.vdsh"), *rep = path_in("box.bake.json");
+    write_box(obj, NULL);
+    int rc = run((char *[]){bake, obj, "--max-edge", "0.5", "--rays", "256", "--orders", "2,3,5",
+                            "--record-timings", "--cube-size", "0", "-q", "--report", rep,
+                            "-o", vdsh, NULL});
+    CHECK(rc == 0, "bake: exit %d", rc);
+    if (rc != 0) {
+        char *e = slurp(err_path, NULL);
+        fprintf(stderr, "%s\n", e ? e : "");
+        free(e);
+        return test_report("test_eval_cli");
+    }
+
+    /* Evaluate: table, JSON, per-vertex file. */
+    char *json = path_in("box.eval.json"), *pv = path_in("box.pv");
+    rc = run((char *[]){ev, vdsh, "--json", json, "--per-vertex", pv, "--interior", "1000",
+                        "--threads", "2", NULL});
+    CHECK(rc == 0, "eval: exit %d", rc);
+    CHECK(contains(out_path, "SHA-256 verified") && contains(out_path, "interior") &&
+              contains(out_path, "(time chunk)") && contains(out_path, "paper"),
+          "table");
+    CHECK(contains(out_path, " 0.0000% escaped"), "the truth escapes a closed box");
+    CHECK(contains(json, "\"streams\": [") && contains(json, "\"bytes_per_vertex\": 50"),
+          "JSON");
+    size_t size = 0;
+    unsigned char *b = (unsigned char *)slurp(pv, &size);
+    CHECK(b && size >= 64, "per-vertex file");
+    if (b && size >= 64) {
+        uint32_t V = u32(b + 12), K = u32(b + 16), F = u32(b + 20), off = u32(b + 24);
+        CHECK(memcmp(b, "VDSHPVE1", 8) == 0 && u32(b + 8) == 1, "magic, version");
+        CHECK(K == 3 && F == 2 + 5 * K && off == 64 + 16 * K, "K %u F %u offset %u", K, F, off);
+        CHECK(u32(b + 64) == 2 && u32(b + 64 + 16) == 3 && u32(b + 64 + 32) == 5, "orders");
+        CHECK(size == off + (size_t)V * F * 4, "size %zu for %u vertices", size, V);
+        if (size == off + (size_t)V * F * 4) {
+            int finite = 1;
+            for (uint32_t v = 0; v < V; v++) {
+                float x[32];
+                memcpy(x, b + off + (size_t)v * F * 4, F * 4);
+                for (uint32_t i = 0; i < F; i++)
+                    if (i != 2 + 2 && i != 2 + 3 && i != 7 + 2 && i != 7 + 3 &&
+                        i != 12 + 2 && i != 12 + 3)
+                        finite &= isfinite(x[i]) && x[i] >= 0;
+            }
+            CHECK(finite, "every vertex evaluated (no --points), values >= 0");
+        }
+    }
+    free(b);
+
+    /* The oracle scores exactly zero. */
+    rc = run((char *[]){ev, vdsh, "--oracle", "--interior", "200", "--json", json, NULL});
+    CHECK(rc == 0 && contains(json, "\"shadow_mae\": 0,") && !contains(json, "\"shadow_mae\": 0."),
+          "oracle");
+    /* Bake time from the bake's report. */
+    rc = run((char *[]){ev, vdsh, "--bake-report", rep, "--interior", "0", "--orders", "5",
+                        NULL});
+    CHECK(rc == 0 && contains(out_path, "(bake report)") && !contains(out_path, "order 2 "),
+          "--bake-report, --orders");
+
+    /* The mesh changes: named; --allow-mismatch goes on with a warning; the
+     * original content under another name is accepted. */
+    char *moved = path_in("moved.obj");
+    rename(obj, moved);
+    rc = run((char *[]){ev, vdsh, NULL});
+    CHECK(rc == 1 && contains(err_path, "cannot find source 1 of 1") &&
+              contains(err_path, "box.obj"),
+          "a missing source is named (exit %d)", rc);
+    rc = run((char *[]){ev, vdsh, moved, "--interior", "100", NULL});
+    CHECK(rc == 0, "the source under another name: exit %d", rc);
+    write_box(obj, "# changed\n");
+    rc = run((char *[]){ev, vdsh, NULL});
+    CHECK(rc == 1 && contains(err_path, "source 1 of 1") && contains(err_path, "box.obj") &&
+              contains(err_path, "SHA-256"),
+          "a changed source is named (exit %d)", rc);
+    rc = run((char *[]){ev, vdsh, "--allow-mismatch", "--interior", "100", NULL});
+    CHECK(rc == 0 && contains(err_path, "warning"), "--allow-mismatch (exit %d)", rc);
+    rc = run((char *[]){ev, vdsh, moved, moved, NULL});
+    CHECK(rc == 2 && contains(err_path, "2 mesh(es) given"), "two meshes for one source");
+
+    /* A file that is not a .vdsh. */
+    rc = run((char *[]){ev, obj, NULL});
+    CHECK(rc == 1 && contains(err_path, "box.obj"), "not a .vdsh: exit %d", rc);
+    return test_report("test_eval_cli");
+}
