@@ -12,6 +12,7 @@
 #include <pmmintrin.h>
 #endif
 
+#include "fit.h"
 #include "sampling.h"
 #include "vdsh.h"
 #include "vdsh_sh.h"
@@ -138,9 +139,11 @@ typedef struct job {
     const vb_bake_desc *d;
     const vb_dirgrid *grid;
     const float *origins;  /* per receiver, traced frame */
-    float *coeffs;
-    int ncoef;
-    int order;
+    float *coeffs[VDSH_MAX_ORDER + 1];
+    vb_fit fits[VDSH_MAX_ORDER + 1];
+    int order;             /* the projection's order (the highest asked) */
+    int log_quantity;      /* project ln(max(d, floor)) */
+    float log_floor;
     float max_local;       /* max distance in the traced frame */
     float inv_scale;
     float degenerate_dist; /* scene units */
@@ -154,6 +157,24 @@ typedef struct job {
     pthread_cond_t cond;
 } job;
 
+/* ln(x) for finite x > 0, to about 1e-7 relative, in plain float
+ * arithmetic: it vectorises (libm's logf does not), and gives the same bits
+ * on every machine. x = m 2^e with m in [sqrt(1/2), sqrt(2)); ln m from
+ * the series of 2 atanh(s), s = (m - 1)/(m + 1), |s| <= 0.172. */
+static inline float fast_log(float x)
+{
+    union { float f; uint32_t u; } v = {x};
+    int32_t e = (int32_t)((v.u >> 23) & 0xffu) - 127;
+    v.u = (v.u & 0x007fffffu) | 0x3f800000u; /* m in [1, 2) */
+    float m = v.f;
+    int big = m > 1.41421356f;
+    m = big ? 0.5f * m : m;
+    e += big;
+    float s = (m - 1.0f) / (m + 1.0f), s2 = s * s;
+    float p = s * (2.0f + s2 * (2.0f / 3 + s2 * (2.0f / 5 + s2 * (2.0f / 7 + s2 * (2.0f / 9)))));
+    return p + (float)e * 0.69314718f;
+}
+
 static void bake_vertex(job *J, uint32_t v, uint64_t *traced, uint64_t *missed,
                         uint32_t *degenerate)
 {
@@ -161,6 +182,9 @@ static void bake_vertex(job *J, uint32_t v, uint64_t *traced, uint64_t *missed,
     const vb_scene *S = d->scene;
     const float *n = d->receivers->normals + 3 * (size_t)v;
     const float *org = J->origins + 3 * (size_t)v;
+    static const float pole[3] = {0.0f, 0.0f, 1.0f};
+    if (J->grid->hemisphere && n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f)
+        n = pole; /* no surface: a hemisphere about +z, fitted as such */
 
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -215,7 +239,8 @@ static void bake_vertex(job *J, uint32_t v, uint64_t *traced, uint64_t *missed,
             float t = hit ? rh.ray.tfar[k] * J->inv_scale : d->max_distance;
             float c = rh.ray.dir_x[k] * n[0] + rh.ray.dir_y[k] * n[1] + rh.ray.dir_z[k] * n[2];
             int up = live & (c > 0.0f);
-            dist[k] = live ? t : 0.0f;
+            float value = J->log_quantity ? fast_log(t > J->log_floor ? t : J->log_floor) : t;
+            dist[k] = live ? value : 0.0f;
             *missed += (uint64_t)(live & !hit);
             upper += (uint32_t)up;
             near_zero += (uint32_t)(up & (t < J->degenerate_dist));
@@ -226,14 +251,20 @@ static void bake_vertex(job *J, uint32_t v, uint64_t *traced, uint64_t *missed,
     if (d->trace_only)
         return;
 
+    /* b = the projection (in double: it sums over thousands of rays); each
+     * order's coefficients are its fit's map of b (fit.h). */
     double w = (J->grid->hemisphere ? 2.0 : 4.0) * VB_PI / J->grid->count;
-    float *c = J->coeffs + (size_t)v * J->ncoef;
-    for (int i = 0; i < J->ncoef; i++) {
+    double b[VDSH_MAX_COEFFS];
+    int nb = J->order * J->order;
+    for (int i = 0; i < nb; i++) {
         double s = 0.0;
         for (int k = 0; k < VB_PACKET; k++)
             s += acc[i][k];
-        c[i] = (float)(s * w);
+        b[i] = s * w;
     }
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+        if (J->coeffs[o])
+            vb_fit_apply(&J->fits[o], n, b, J->coeffs[o] + (size_t)v * o * o);
     if (upper > 0 && near_zero >= 0.9 * upper)
         (*degenerate)++;
 }
@@ -273,18 +304,17 @@ static void *worker(void *arg)
 vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
                          vdsh_stream *out, void **storage, vb_error *err)
 {
-    if (!b->coeffs || order < 1 || order > b->max_order)
-        return vb_fail(err, VB_ERR_ARGUMENT, "order %d is not in the bake (orders 1..%d)",
-                       order, b->max_order);
-    int nc = order * order, nc_max = b->max_order * b->max_order;
+    if (order < 1 || order > VDSH_MAX_ORDER || !b->coeffs[order])
+        return vb_fail(err, VB_ERR_ARGUMENT, "order %d is not in the bake", order);
+    int nc = order * order;
     size_t count = (size_t)b->vertex_count * nc;
     float *f = malloc(count * sizeof *f);
     if (!f)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the order %d stream", order);
-    for (uint32_t v = 0; v < b->vertex_count; v++)
-        memcpy(f + (size_t)v * nc, b->coeffs + (size_t)v * nc_max, nc * sizeof *f);
+    memcpy(f, b->coeffs[order], count * sizeof *f);
     vdsh_stream s = {.order = (uint32_t)order, .encoding = encoding, .method = b->method,
-                     .quantity = VDSH_QUANTITY_DISTANCE, .scale = 1.0f, .data = f};
+                     .quantity = b->quantity, .method_param = b->lambda, .scale = 1.0f,
+                     .data = f};
     if (encoding == VDSH_ENCODING_F16) {
         /* Stored values are coefficient / (the stream's largest
          * |coefficient|): within [-1, 1] whatever the scene's size or clamp
@@ -316,7 +346,8 @@ void vb_bake_output_free(vb_bake_output *out)
 {
     if (!out)
         return;
-    free(out->coeffs);
+    for (int o = 0; o <= VDSH_MAX_ORDER; o++)
+        free(out->coeffs[o]);
     memset(out, 0, sizeof *out);
 }
 
@@ -328,19 +359,45 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         return vb_fail(err, VB_ERR_ARGUMENT, "nothing to bake: no receivers or no scene");
     if (d.rays == 0)
         d.rays = 2500;
+    if (d.order_mask & ~(uint32_t)(((1u << VDSH_MAX_ORDER) - 1) << 1))
+        return vb_fail(err, VB_ERR_ARGUMENT, "orders must be 1..%d", VDSH_MAX_ORDER);
+    if (d.max_order == 0)
+        for (int o = VDSH_MAX_ORDER; o >= 1 && !d.max_order; o--)
+            if (d.order_mask & (1u << o))
+                d.max_order = o;
     if (d.max_order == 0)
         d.max_order = VDSH_MAX_ORDER;
     if (d.max_order < 1 || d.max_order > VDSH_MAX_ORDER)
         return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..%d, not %d",
                        VDSH_MAX_ORDER, d.max_order);
-    if (d.method != VDSH_METHOD_PAPER && d.method != VDSH_METHOD_FULL)
+    if (d.order_mask == 0)
+        d.order_mask = 1u << d.max_order;
+    if (d.order_mask >> (d.max_order + 1))
+        return vb_fail(err, VB_ERR_ARGUMENT, "an order above max_order %d was asked for",
+                       d.max_order);
+    if (d.method > VDSH_METHOD_LSQ)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", d.method);
+    if (d.quantity != VDSH_QUANTITY_DISTANCE && d.quantity != VDSH_QUANTITY_LOG_DISTANCE)
+        return vb_fail(err, VB_ERR_ARGUMENT, "the bake stores distance or log-distance, not %s",
+                       vdsh_quantity_name(d.quantity));
+    if (d.quantity == VDSH_QUANTITY_LOG_DISTANCE && d.method == VDSH_METHOD_PAPER)
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "method paper fills the lower hemisphere with 0, which has no "
+                       "meaning for log-distance: use mirror, lsq or full");
+    if (d.lambda == 0.0f)
+        d.lambda = 1e-4f;
+    if (!(d.lambda > 0.0f) || !isfinite(d.lambda))
+        return vb_fail(err, VB_ERR_ARGUMENT, "the regularisation must be a positive number");
     if (d.max_distance == 0.0f)
         d.max_distance = d.scene->diagonal;
     if (!(d.max_distance > 0.0f) || !isfinite(d.max_distance))
         return vb_fail(err, VB_ERR_ARGUMENT,
                        "max distance must be finite and > 0 (scene diagonal %g)",
                        (double)d.scene->diagonal);
+    if (d.log_floor == 0.0f)
+        d.log_floor = 0.01f * d.max_distance;
+    if (!(d.log_floor > 0.0f) || !isfinite(d.log_floor))
+        return vb_fail(err, VB_ERR_ARGUMENT, "the log-distance floor must be a positive number");
     if (d.threads == 0) {
         long nc = sysconf(_SC_NPROCESSORS_ONLN);
         d.threads = nc > 0 ? (unsigned)nc : 1;
@@ -358,21 +415,31 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             return vb_fail(err, VB_ERR_INVALID,
                            "receiver triangle %zu: index %u out of range (%u vertices)", i / 3,
                            R->indices[i], R->vertex_count);
+    /* The sampling domain: the whole sphere for paper (the horizon culls
+     * half of it) and full; the hemisphere above each receiver, with half
+     * the directions (the same traced budget), for the hemisphere fits. */
+    int hemisphere = d.method == VDSH_METHOD_MIRROR || d.method == VDSH_METHOD_LSQ;
     vb_dirgrid grid = {0};
-    vb_result r = vb_dirgrid_create(d.rays, 0, &grid, err);
+    vb_result r = vb_dirgrid_create(hemisphere ? (d.rays + 1) / 2 : d.rays, hemisphere,
+                                    &grid, err);
     if (r != VB_OK)
         return r;
-    int ncoef = d.max_order * d.max_order;
     float *origins = malloc((size_t)R->vertex_count * 3 * sizeof *origins);
-    float *coeffs = d.trace_only ? NULL
-                                 : malloc((size_t)R->vertex_count * ncoef * sizeof *coeffs);
+    float *coeffs[VDSH_MAX_ORDER + 1] = {0};
+    int missing = 0;
+    for (int o = 1; o <= VDSH_MAX_ORDER && !d.trace_only; o++)
+        if (d.order_mask & (1u << o))
+            missing |= !(coeffs[o] = malloc((size_t)R->vertex_count * o * o * sizeof(float)));
     pthread_t *th = calloc(d.threads, sizeof *th);
     job *J = calloc(1, sizeof *J);
-    if (!origins || (!coeffs && !d.trace_only) || !th || !J) {
+    if (!origins || missing || !th || !J) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
                     R->vertex_count);
         goto done;
     }
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+        if (coeffs[o] && (r = vb_fit_create(o, d.method, d.lambda, &J->fits[o], err)) != VB_OK)
+            goto done;
     r = vb_ray_origins(R, d.scene, origins, err);
     if (r != VB_OK)
         goto done;
@@ -380,9 +447,10 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     J->d = &d;
     J->grid = &grid;
     J->origins = origins;
-    J->coeffs = coeffs;
-    J->ncoef = ncoef;
+    memcpy(J->coeffs, coeffs, sizeof coeffs);
     J->order = d.max_order;
+    J->log_quantity = d.quantity == VDSH_QUANTITY_LOG_DISTANCE;
+    J->log_floor = d.log_floor;
     J->max_local = d.max_distance * d.scene->scale;
     J->inv_scale = 1.0f / d.scene->scale;
     J->degenerate_dist = 1e-3f * d.scene->diagonal;
@@ -436,9 +504,12 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     vb_bake_output o = {0};
     o.max_order = d.max_order;
     o.method = d.method;
+    o.quantity = d.quantity;
+    o.lambda = d.method == VDSH_METHOD_LSQ ? d.lambda : 0.0f;
+    o.log_floor = J->log_quantity ? d.log_floor : 0.0f;
     o.vertex_count = R->vertex_count;
-    o.coeffs = coeffs;
-    coeffs = NULL;
+    memcpy(o.coeffs, coeffs, sizeof coeffs);
+    memset(coeffs, 0, sizeof coeffs);
     o.rays = grid.count;
     o.hemisphere = grid.hemisphere;
     o.max_distance = d.max_distance;
@@ -457,7 +528,8 @@ done_sync:
 done:
     free(J);
     free(th);
-    free(coeffs);
+    for (int k = 0; k <= VDSH_MAX_ORDER; k++)
+        free(coeffs[k]);
     free(origins);
     vb_dirgrid_destroy(&grid);
     return r;

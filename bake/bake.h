@@ -3,11 +3,23 @@
  * stratified set of rays against the occluder scene and project the hit
  * distances onto real SH (formats/vdsh_sh.h).
  *
- * Method `paper` (DESIGN.md section 1): directions over the whole sphere;
- * those below the receiver's horizon (w.n < 0) count as distance 0 with
- * the same 4 pi / N weight. They are not traced at all, since their result
- * is thrown away: about half the rays, for identical coefficients.
- * Method `full`: every direction of the sphere traced and projected.
+ * Methods (the fit is fit.h's):
+ *   paper   the paper's demo (DESIGN.md section 1): directions over the
+ *           whole sphere; those below the receiver's horizon (w.n < 0)
+ *           count as distance 0 with the same 4 pi / N weight. They are not
+ *           traced at all, since their result is thrown away: about half the
+ *           rays, for identical coefficients.
+ *   full    every direction of the sphere traced and projected.
+ *   mirror  the upper hemisphere only, the lower filled with its mirror
+ *           image before projecting.
+ *   lsq     regularised least squares to the upper hemisphere only.
+ * `rays` is always the density over the whole sphere: the hemisphere
+ * methods trace rays / 2 directions, stratified over the hemisphere around
+ * each receiver's normal, the same budget `paper` traces.
+ *
+ * Quantity: the stored function is D itself, or ln(max(D, log_floor)) for
+ * VDSH_QUANTITY_LOG_DISTANCE (hemisphere methods and full only: the
+ * paper's zero fill has no meaning in the log domain).
  *
  * Ray origins (vb_ray_origins): the receiver position in the scene's
  * normalised frame (scene.h), offset twice with vb_offset_origin: along
@@ -51,7 +63,11 @@ typedef struct vb_bake_desc {
     uint64_t seed;             /* 0 is a valid seed */
     float max_distance;        /* clamp; 0: the occluders' bbox diagonal */
     uint32_t method;           /* vdsh_method; 0 = paper */
-    int max_order;             /* coefficients kept: max_order^2; 0: 5 */
+    uint32_t quantity;         /* vdsh_quantity: distance (0) or log-distance */
+    float lambda;              /* lsq regularisation; 0: 1e-4 */
+    float log_floor;           /* log-distance floor; 0: 1% of max_distance */
+    uint32_t order_mask;       /* bit n: produce order n; 0: max_order only */
+    int max_order;             /* 0: the highest order in order_mask, or 5 */
     unsigned threads;          /* 0: every online core */
     int trace_only;            /* benchmark: trace the same rays, nothing else */
     /* Called from the calling thread a few times a second, and once at the
@@ -64,9 +80,13 @@ typedef struct vb_bake_desc {
 typedef struct vb_bake_output {
     int max_order;
     uint32_t method;           /* vdsh_method used */
+    uint32_t quantity;         /* vdsh_quantity stored */
+    float lambda;              /* lsq regularisation used (0 otherwise) */
+    float log_floor;           /* log-distance floor used (0 otherwise) */
     uint32_t vertex_count;
-    float *coeffs;             /* vertex_count * max_order^2, vertex-major;
-                                  NULL with trace_only */
+    /* Per order n (1..5): vertex_count * n^2 coefficients, vertex-major, or
+     * NULL where the order was not asked for (and with trace_only). */
+    float *coeffs[VDSH_MAX_ORDER + 1];
     uint32_t rays;             /* directions per receiver actually used */
     int hemisphere;            /* sampling domain: 0 sphere, 1 hemisphere */
     float max_distance;        /* the clamp used, scene units */

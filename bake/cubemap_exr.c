@@ -678,7 +678,9 @@ vb_result vb_cubemap_read(const char *path, vb_cubemap **out, vb_error *err)
         return vb_fail(err, VB_ERR_ARGUMENT, "vb_cubemap_read: %s is NULL",
                        !out ? "out" : "path");
     exr_io io = {.fd = -1};
-    io.fd = open(path, O_RDONLY | O_CLOEXEC);
+    /* O_NONBLOCK: opening a FIFO must not wait for a writer (it is refused
+     * below); regular files ignore the flag. */
+    io.fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (io.fd < 0)
         return vb_fail(err, VB_ERR_IO, "%s: cannot open: %s", path,
                        strerror(errno));

@@ -398,9 +398,16 @@ vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path, vb_error *err)
 
 static vb_result read_file(const char *path, uint8_t **bytes, size_t *size, vb_error *err)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return vb_fail(err, VB_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    /* O_NONBLOCK: opening a FIFO must not wait for a writer (it is refused
+     * below, as anything but a regular file); regular files ignore it. */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    FILE *f = fd >= 0 ? fdopen(fd, "rb") : NULL;
+    if (!f) {
+        int e = errno;
+        if (fd >= 0)
+            close(fd);
+        return vb_fail(err, VB_ERR_IO, "%s: cannot open: %s", path, strerror(e));
+    }
     struct stat st;
     if (fstat(fileno(f), &st) != 0) {
         int e = errno;
@@ -567,12 +574,60 @@ static int has_extension(const char *path, const char *ext)
     return strcasecmp(dot + 1, ext) == 0;
 }
 
+static vb_result format_of(const char *name, vb_mesh_format *format, vb_error *err)
+{
+    if (has_extension(name, "obj"))
+        *format = VB_MESH_OBJ;
+    else if (has_extension(name, "ply"))
+        *format = VB_MESH_PLY;
+    else if (has_extension(name, "off"))
+        *format = VB_MESH_OFF;
+    else if (has_extension(name, "stl"))
+        *format = VB_MESH_STL;
+    else
+        return vb_fail(err, VB_ERR_FORMAT, "%s: unsupported file type (expected .obj, .ply, .off or .stl)", name);
+    return VB_OK;
+}
+
+/* A file's bytes -> clean mesh and source info; `file` as for
+ * vb_mesh_read_openmesh. */
+static vb_result load_bytes(const char *name, const char *file, vb_mesh_format format, const uint8_t *bytes,
+                            size_t size, vb_mesh *m, vb_source_info *si, vb_error *err)
+{
+    if (size == 0)
+        return vb_fail(err, VB_ERR_FORMAT, "%s: empty file", name);
+    si->size = size;
+    vb_sha256(bytes, size, si->sha256);
+    vb_mesh_raw raw;
+    memset(&raw, 0, sizeof raw);
+    vb_result r = vb_mesh_read_openmesh(name, file, format, bytes, size, &raw, err);
+    if (r == VB_OK)
+        r = clean_raw(name, format, &raw, m, err);
+    vb_mesh_raw_free(&raw);
+    return r;
+}
+
+/* The common tail of both loaders: weld if asked, then hand over. */
+static vb_result finish_load(vb_result r, vb_mesh *m, const vb_source_info *si, int weld, vb_mesh *out,
+                             vb_source_info *info, vb_error *err)
+{
+    if (r == VB_OK && weld)
+        r = vb_mesh_weld(m, err);
+    if (r != VB_OK) {
+        vb_mesh_free(m);
+        return r;
+    }
+    *out = *m;
+    if (info)
+        *info = *si;
+    return VB_OK;
+}
+
 vb_result vb_mesh_load(const char *path, const vb_load_desc *desc, vb_mesh *out,
                        vb_source_info *info, vb_error *err)
 {
     if (!path || !out)
         return vb_fail(err, VB_ERR_ARGUMENT, "load: NULL path or output");
-    int weld = desc ? desc->weld : 0;
     vb_mesh m = {0};
     vb_source_info si;
     memset(&si, 0, sizeof si);
@@ -586,47 +641,33 @@ vb_result vb_mesh_load(const char *path, const vb_load_desc *desc, vb_mesh *out,
             return r;
         r = builtin_info(&m, &si, err);
     } else {
-        vb_mesh_format format;
-        if (has_extension(path, "obj"))
-            format = VB_MESH_OBJ;
-        else if (has_extension(path, "ply"))
-            format = VB_MESH_PLY;
-        else if (has_extension(path, "off"))
-            format = VB_MESH_OFF;
-        else if (has_extension(path, "stl"))
-            format = VB_MESH_STL;
-        else
-            return vb_fail(err, VB_ERR_FORMAT, "%s: unsupported file type (expected .obj, .ply, .off or .stl)", path);
-
+        vb_mesh_format format = VB_MESH_OBJ;
+        r = format_of(path, &format, err);
+        if (r != VB_OK)
+            return r;
         uint8_t *bytes = NULL;
         size_t size = 0;
         r = read_file(path, &bytes, &size, err);
         if (r != VB_OK)
             return r;
-        if (size == 0) {
-            free(bytes);
-            return vb_fail(err, VB_ERR_FORMAT, "%s: empty file", path);
-        }
-        si.size = size;
-        vb_sha256(bytes, size, si.sha256);
-
-        vb_mesh_raw raw;
-        memset(&raw, 0, sizeof raw);
-        r = vb_mesh_read_openmesh(path, format, bytes, size, &raw, err);
+        r = load_bytes(path, path, format, bytes, size, &m, &si, err);
         free(bytes);
-        if (r != VB_OK)
-            return r;
-        r = clean_raw(path, format, &raw, &m, err);
-        vb_mesh_raw_free(&raw);
     }
-    if (r == VB_OK && weld)
-        r = vb_mesh_weld(&m, err);
-    if (r != VB_OK) {
-        vb_mesh_free(&m);
+    return finish_load(r, &m, &si, desc ? desc->weld : 0, out, info, err);
+}
+
+vb_result vb_mesh_load_memory(const void *data, size_t size, const char *name, const vb_load_desc *desc,
+                              vb_mesh *out, vb_source_info *info, vb_error *err)
+{
+    if (!name || !out || (!data && size))
+        return vb_fail(err, VB_ERR_ARGUMENT, "load_memory: NULL name, data or output");
+    vb_mesh_format format = VB_MESH_OBJ;
+    vb_result r = format_of(name, &format, err);
+    if (r != VB_OK)
         return r;
-    }
-    *out = m;
-    if (info)
-        *info = si;
-    return VB_OK;
+    vb_mesh m = {0};
+    vb_source_info si;
+    memset(&si, 0, sizeof si);
+    r = load_bytes(name, NULL, format, (const uint8_t *)data, size, &m, &si, err);
+    return finish_load(r, &m, &si, desc ? desc->weld : 0, out, info, err);
 }

@@ -19,7 +19,7 @@
  * Scene names: a path ending in .obj/.ply/.off/.stl (case-insensitive), or
  * "builtin:room" - the procedural paper-style room (19 x 6 x 19 m, y up,
  * boxes, pillars and a sphere; 2,316 vertices and 2,428 coarse triangles;
- * refine with vb_mesh_refine to make it dense: max edge 0.2 gives 58,805
+ * refine with vb_mesh_refine to make it dense: max edge 0.2 gives 58,007
  * receivers, the paper's scene had 54,500).
  *
  * Loaded meshes are clean: triangles only (polygons fan-triangulated),
@@ -32,9 +32,10 @@
  * Triangles with a repeated index are dropped (they have no area and no
  * effect on rays); zero-area triangles with distinct indices are kept.
  *
- * Files are read into memory once; those bytes are hashed for
- * vb_source_info, checked by a strict pre-pass and parsed by OpenMesh's
- * readers (OFF: OpenMesh reads the path itself) into a plain array
+ * Files are read into memory once (vb_mesh_load_memory starts from such
+ * bytes); those bytes are hashed for vb_source_info, checked by a strict
+ * pre-pass and parsed by OpenMesh's readers (OFF: OpenMesh reads a file
+ * itself; see vb_mesh_load_memory) into a plain array
  * collector (no half-edge structure, so non-manifold and duplicate faces
  * are kept as they are: nothing in the file is lost). The pre-pass rejects
  * what OpenMesh would silently skip or misread: numbers that do not parse
@@ -44,7 +45,10 @@
  * the file. OBJ: negative (relative) indices and TABs are fine; materials
  * and texture coordinates are ignored. STL: OpenMesh's reader itself
  * merges vertices with identical positions and drops triangles that then
- * repeat a vertex, with or without `weld`.
+ * repeat a vertex, with or without `weld`; an ascii STL must end with
+ * "endsolid" (else it may have been cut between two facets), and a solid
+ * whose name contains "outer" is refused (OpenMesh reads that line as the
+ * start of a facet).
  *
  * Errors: vb_result; messages name the file and the problem ("x.obj: line
  * 12: face index 40 out of range (30 vertices)", "x.ply: empty mesh").
@@ -57,7 +61,7 @@
  * normals == NULL (treated as undefined normals).
  *
  * Threading: no shared state in this module; calls that use OpenMesh
- * (vb_mesh_load of a file, vb_mesh_refine) are serialised by one internal
+ * (loading a file or bytes, vb_mesh_refine) are serialised by one internal
  * mutex, because OpenMesh's readers and its log streams are process-wide.
  * While such a call runs, std::cerr/clog/cout are redirected into a buffer
  * (OpenMesh's warnings are captured for error messages, never printed);
@@ -100,6 +104,20 @@ typedef struct vb_source_info {
 vb_result vb_mesh_load(const char *path, const vb_load_desc *desc,
                        vb_mesh *out, vb_source_info *info, vb_error *err);
 
+/* Load a mesh file's bytes from memory (the fuzz targets' entry): exactly
+ * as vb_mesh_load would load a file holding them. `name` only names the
+ * bytes: it appears in messages and its extension (.obj/.ply/.off/.stl,
+ * case-insensitive) picks the format; nothing is opened by that name and
+ * "builtin:" names are refused. `data` is borrowed (may be NULL when size
+ * is 0); `info` may be NULL. OFF only: OpenMesh's OFF reader takes its
+ * options (binary, normals) from the header only when it opens a file
+ * itself, so the bytes are written to a temporary file (mkstemps in
+ * $TMPDIR, else /tmp), read from there and removed; VB_ERR_IO if that
+ * file cannot be written. */
+vb_result vb_mesh_load_memory(const void *data, size_t size, const char *name,
+                              const vb_load_desc *desc, vb_mesh *out,
+                              vb_source_info *info, vb_error *err);
+
 /* The built-in room, coarse (before refinement). */
 vb_result vb_builtin_room(vb_mesh *out, vb_error *err);
 
@@ -139,7 +157,7 @@ void vb_mesh_compute_normals(vb_mesh *m);
  * Triangles that repeat a vertex index have no area and are dropped
  * (except by the max_edge <= 0 copy).
  *
- * Cost: about 0.6 us per output vertex (builtin:room at 0.2: 58,805
+ * Cost: about 0.6 us per output vertex (builtin:room at 0.2: 58,007
  * vertices in ~35 ms; Sponza at 0.2: 1.08 M in ~1.1 s).
  *
  * Errors: VB_ERR_ARGUMENT for a NaN max_edge, when the input or the result
@@ -190,8 +208,11 @@ typedef struct vb_mesh_raw {
     uint32_t *faces;       /* triangle_count: 0-based polygon in the file */
 } vb_mesh_raw;
 
-/* Check `bytes` (the whole file) and read `path` with OpenMesh. */
-vb_result vb_mesh_read_openmesh(const char *path, vb_mesh_format format,
+/* Check `bytes` (the whole file) and read them with OpenMesh; `name` is
+ * for messages. OFF: OpenMesh reads `file` (the file the bytes came from),
+ * or a temporary copy of the bytes when `file` is NULL. */
+vb_result vb_mesh_read_openmesh(const char *name, const char *file,
+                                vb_mesh_format format,
                                 const uint8_t *bytes, size_t size,
                                 vb_mesh_raw *out, vb_error *err);
 

@@ -34,8 +34,9 @@
  *     end_header shifts every value it reads). STL: fed from memory. OFF:
  *     read from the path, because OpenMesh's OFF reader takes its options
  *     (binary, normals, colours) from the header only when it opens the
- *     file itself; the counts cross-check below catches a file that changed
- *     in between.
+ *     file itself (its stream reader keeps the options of whatever file it
+ *     saw last); the counts cross-check below catches a file that changed
+ *     in between. Bytes loaded from memory go through a temporary copy.
  *
  *  3. The counts OpenMesh delivered are compared with the pre-pass's; any
  *     difference is an error rather than a silently partial mesh.
@@ -56,7 +57,9 @@
  * include the first inclusion of the standard library headers for GCC to
  * apply it there. */
 #pragma GCC diagnostic push
+#ifndef __clang__ /* clang has no such warning, and warns about the name */
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/IO/importer/BaseImporter.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
@@ -68,6 +71,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cerrno>
 #include <cstring>
 #include <iostream>
 #include <mutex>
@@ -77,6 +81,9 @@
 #include <string>
 #include <system_error>
 #include <vector>
+
+#include <strings.h>
+#include <unistd.h>
 
 namespace {
 
@@ -464,7 +471,10 @@ bool stl_same(const float *a, const float *b)
 /* OpenMesh decides binary vs ascii by size alone: binary when the file is
  * exactly 84 + 50 * (count at byte 80) bytes long. Ascii: every line that
  * contains "outer" starts a facet whose next three lines are read as
- * "<word> x y z". Both drop a triangle whose corners share a position. */
+ * "<word> x y z" (so a solid named "outer..." is refused here). Both drop
+ * a triangle whose corners share a position. Stricter than OpenMesh: an
+ * ascii file must have an "endsolid" line after its last facet, or it may
+ * have been cut between two facets. */
 vb_result scan_stl(const char *path, const uint8_t *bytes, size_t size,
                    expectation *ex, vb_error *err)
 {
@@ -494,14 +504,26 @@ vb_result scan_stl(const char *path, const uint8_t *bytes, size_t size,
 
     cursor c(bytes, size);
     uint64_t facets = 0;
+    bool ended = false; /* an "endsolid" after the last facet */
     while (!c.at_end()) {
         const char *nl = (const char *)memchr(c.p, '\n', (size_t)(c.end - c.p));
         const char *le = nl ? nl : c.end;
         std::string line(c.p, le);
         unsigned long line_no = c.line;
         c.skip_line();
-        if (line.find("outer") == std::string::npos && line.find("OUTER") == std::string::npos)
+        size_t first = line.find_first_not_of(" \t\r\v\f");
+        const char *word = first == std::string::npos ? "" : line.c_str() + first;
+        bool name_line = strncasecmp(word, "solid", 5) == 0 || strncasecmp(word, "endsolid", 8) == 0;
+        if (line.find("outer") == std::string::npos && line.find("OUTER") == std::string::npos) {
+            if (strncasecmp(word, "endsolid", 8) == 0)
+                ended = true;
             continue;
+        }
+        if (name_line)
+            return vb_fail(err, VB_ERR_FORMAT,
+                           "%s: line %lu: the solid's name contains 'outer', which OpenMesh's STL reader "
+                           "takes for the start of a facet (rename the solid)", path, line_no);
+        ended = false;
         float v[9];
         for (int i = 0; i < 3; i++) {
             if (c.at_end())
@@ -539,6 +561,17 @@ vb_result scan_stl(const char *path, const uint8_t *bytes, size_t size,
                            "(%zu bytes, but 84 + 50 x %llu triangles = %llu)",
                            path, size, (unsigned long long)declared,
                            (unsigned long long)(84 + 50 * declared));
+    }
+    /* Without its closing line a text STL may have lost any number of
+     * facets: OpenMesh would read what is left without a word. */
+    if (!ended) {
+        if (facets == 0)
+            return vb_fail(err, VB_ERR_FORMAT,
+                           "%s: neither ascii STL (no facets and no 'endsolid': truncated?) nor binary STL "
+                           "(%zu bytes, but 84 + 50 x %llu triangles = %llu)",
+                           path, size, (unsigned long long)declared, (unsigned long long)(84 + 50 * declared));
+        return vb_fail(err, VB_ERR_FORMAT, "%s: ascii STL ends without 'endsolid' after its last facet (truncated?)",
+                       path);
     }
     return VB_OK;
 }
@@ -1217,7 +1250,53 @@ T *malloc_copy(const std::vector<T> &v)
     return p;
 }
 
-vb_result read_openmesh(const char *path, vb_mesh_format format, const uint8_t *bytes,
+/* OFF from memory: a private copy of the bytes in a file named *.off
+ * (OpenMesh picks its reader by the extension), removed when this goes. */
+class temp_off_file {
+public:
+    temp_off_file() = default;
+    ~temp_off_file()
+    {
+        if (!path_.empty())
+            unlink(path_.c_str());
+    }
+    temp_off_file(const temp_off_file &) = delete;
+    temp_off_file &operator=(const temp_off_file &) = delete;
+
+    vb_result create(const char *name, const uint8_t *bytes, size_t size, vb_error *err)
+    {
+        const char *dir = getenv("TMPDIR");
+        std::string templ = std::string(dir && dir[0] ? dir : "/tmp") + "/vdsh-mesh-XXXXXX.off";
+        int fd = mkstemps(&templ[0], 4);
+        if (fd < 0)
+            return vb_fail(err, VB_ERR_IO, "%s: cannot create a temporary file for OpenMesh's OFF reader (%s): %s",
+                           name, templ.c_str(), strerror(errno));
+        path_ = templ;
+        size_t done = 0;
+        while (done < size) {
+            ssize_t n = write(fd, bytes + done, size - done);
+            if (n < 0 && errno == EINTR)
+                continue;
+            if (n <= 0) {
+                int e = n < 0 ? errno : EIO;
+                close(fd);
+                return vb_fail(err, VB_ERR_IO, "%s: cannot write a temporary file for OpenMesh's OFF reader (%s): %s",
+                               name, path_.c_str(), strerror(e));
+            }
+            done += (size_t)n;
+        }
+        if (close(fd) != 0)
+            return vb_fail(err, VB_ERR_IO, "%s: cannot write a temporary file for OpenMesh's OFF reader (%s): %s",
+                           name, path_.c_str(), strerror(errno));
+        return VB_OK;
+    }
+    const std::string &path() const { return path_; }
+
+private:
+    std::string path_;
+};
+
+vb_result read_openmesh(const char *path, const char *file, vb_mesh_format format, const uint8_t *bytes,
                         size_t size, vb_mesh_raw *out, vb_error *err)
 {
     expectation ex;
@@ -1232,6 +1311,14 @@ vb_result read_openmesh(const char *path, vb_mesh_format format, const uint8_t *
     if (r != VB_OK)
         return r;
 
+    temp_off_file off_copy;
+    if (format == VB_MESH_OFF && !file) {
+        r = off_copy.create(path, bytes, size, err);
+        if (r != VB_OK)
+            return r;
+        file = off_copy.path().c_str();
+    }
+
     collector col;
     bool ok = false;
     std::string said;
@@ -1240,7 +1327,7 @@ vb_result read_openmesh(const char *path, vb_mesh_format format, const uint8_t *
         OpenMesh::IO::Options opt = OpenMesh::IO::Options::VertexNormal;
         OpenMesh::IO::_IOManager_ &io = OpenMesh::IO::IOManager();
         if (format == VB_MESH_OFF) {
-            ok = io.read(std::string(path), col, opt);
+            ok = io.read(std::string(file), col, opt);
         } else {
             std::string text;
             if (format == VB_MESH_PLY) {
@@ -1447,7 +1534,10 @@ vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
         if (!fh.is_valid()) {
             om_mesh::VertexHandle c[3];
             for (int k = 0; k < 3; k++) {
-                c[k] = m.add_vertex(m.point(om_mesh::VertexHandle((int)tri[k])));
+                /* A copy, not m.point()'s reference: add_vertex may
+                 * reallocate the array that reference points into. */
+                const om_mesh::Point p = m.point(om_mesh::VertexHandle((int)tri[k]));
+                c[k] = m.add_vertex(p);
                 copy_of.push_back(tri[k]);
             }
             fh = m.add_face(c[0], c[1], c[2]);
@@ -1613,14 +1703,14 @@ vb_result copy_mesh(const vb_mesh *in, vb_mesh *out, vb_error *err)
 /* C entry points: no exception passes these                              */
 /* ====================================================================== */
 
-extern "C" vb_result vb_mesh_read_openmesh(const char *path, vb_mesh_format format,
+extern "C" vb_result vb_mesh_read_openmesh(const char *path, const char *file, vb_mesh_format format,
                                            const uint8_t *bytes, size_t size,
                                            vb_mesh_raw *out, vb_error *err)
 {
     if (!path || !bytes || !out)
         return vb_fail(err, VB_ERR_ARGUMENT, "vb_mesh_read_openmesh: NULL argument");
     try {
-        return read_openmesh(path, format, bytes, size, out, err);
+        return read_openmesh(path, file, format, bytes, size, out, err);
     } catch (const std::bad_alloc &) {
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory while reading", path);
     } catch (const std::exception &e) {

@@ -11,6 +11,9 @@
 #include <libgen.h>
 #include <limits.h>
 #include <math.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -171,6 +174,62 @@ static void on_progress(void *user, uint32_t done, uint32_t total,
     fflush(stderr);
 }
 
+/* ---- interrupts ---------------------------------------------------------- */
+
+/* SIGINT, SIGTERM and SIGHUP end a bake at once, except while it writes
+ * its outputs: then the signal waits until the last file is in place, so
+ * an interrupted bake never leaves a temporary file behind (SIGKILL
+ * cannot wait: each output is still replaced atomically, but its
+ * temporary file stays, named "<output>.tmp...").
+ *
+ * No asynchronous handler: the signals are blocked before any thread
+ * exists (every thread inherits that) and one thread takes them with
+ * sigwait(); it needs output_lock, which main holds while writing, before
+ * it lets the signal end the process (also when the bake has just
+ * succeeded: the exit status says it was interrupted, whatever the race).
+ * Signals ignored at start (nohup, background jobs) stay ignored. */
+static pthread_mutex_t output_lock = PTHREAD_MUTEX_INITIALIZER;
+static sigset_t interrupt_signals;
+static atomic_int interrupted;
+
+static void *interrupt_thread(void *unused)
+{
+    (void)unused;
+    int sig;
+    if (sigwait(&interrupt_signals, &sig) != 0)
+        return NULL;
+    atomic_store(&interrupted, sig);
+    pthread_mutex_lock(&output_lock);
+    sigset_t one;
+    sigemptyset(&one);
+    sigaddset(&one, sig);
+    signal(sig, SIG_DFL);
+    pthread_sigmask(SIG_UNBLOCK, &one, NULL);
+    raise(sig); /* the default action: the process ends with this signal */
+    _exit(128 + sig);
+}
+
+static void defer_interrupts_while_writing(void)
+{
+    static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+    int count = 0;
+    sigemptyset(&interrupt_signals);
+    for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
+        struct sigaction sa;
+        if (sigaction(sigs[i], NULL, &sa) == 0 && sa.sa_handler != SIG_IGN) {
+            sigaddset(&interrupt_signals, sigs[i]);
+            count++;
+        }
+    }
+    pthread_t t;
+    if (count == 0 || pthread_sigmask(SIG_BLOCK, &interrupt_signals, NULL) != 0)
+        return;
+    if (pthread_create(&t, NULL, interrupt_thread, NULL) != 0)
+        pthread_sigmask(SIG_UNBLOCK, &interrupt_signals, NULL); /* plain signals then */
+    else
+        pthread_detach(t);
+}
+
 /* ---- output -------------------------------------------------------------- */
 
 /* Reports are small: open a temporary file beside `path`; report_close
@@ -271,6 +330,7 @@ static void split_output(const char *out, char *dir, char *stem, size_t cap)
 
 int main(int argc, char **argv)
 {
+    defer_interrupts_while_writing(); /* first: before any thread starts */
     options o = {0};
     o.rays = 2500;
     o.orders[0] = 2, o.orders[1] = 3, o.orders[2] = 5, o.order_count = 3;
@@ -379,6 +439,7 @@ int main(int argc, char **argv)
 
     /* 1. Load every mesh into one occluder scene. */
     int status = 1;
+    int writing = 0; /* output_lock held: outputs are being written */
     vb_error err;
     vb_mesh occ = {0}, rec = {0};
     vb_scene *scene = NULL;
@@ -426,7 +487,10 @@ int main(int argc, char **argv)
                      "%u triangles (%.2f s)\n",
                 (double)o.max_edge, rec.vertex_count, rec.triangle_count, tm.refine);
     if (o.export_obj) {
-        if (vb_mesh_write_obj(&rec, o.export_obj, &err) != VB_OK) {
+        pthread_mutex_lock(&output_lock);
+        vb_result written = vb_mesh_write_obj(&rec, o.export_obj, &err);
+        pthread_mutex_unlock(&output_lock);
+        if (written != VB_OK) {
             fprintf(stderr, "vdsh-bake: %s\n", err.msg);
             goto out;
         }
@@ -451,11 +515,15 @@ int main(int argc, char **argv)
 
     /* 4. Trace and project. */
     int max_order = o.orders[o.order_count - 1];
+    uint32_t order_mask = 0;
+    for (int s = 0; s < o.order_count; s++)
+        order_mask |= 1u << o.orders[s];
     progress pr = {.enabled = log && isatty(STDERR_FILENO), .t0 = vb_now()};
     vb_bake_desc bd = {
         .receivers = &rec, .scene = scene, .rays = o.rays, .seed = o.seed,
         .max_distance = o.max_distance, .method = o.method,
-        .max_order = max_order, .threads = o.threads, .trace_only = o.trace_only,
+        .max_order = max_order, .order_mask = order_mask, .threads = o.threads,
+        .trace_only = o.trace_only,
         .progress = on_progress, .progress_user = &pr};
     if (log)
         fprintf(log, "vdsh-bake: tracing %u rays x %u receivers against %u triangles "
@@ -482,6 +550,8 @@ int main(int argc, char **argv)
                      "against other geometry, or inverted normals\n",
                 bo.degenerate_receivers, 100.0 * bo.degenerate_receivers / rec.vertex_count);
     if (o.trace_only) {
+        pthread_mutex_lock(&output_lock);
+        writing = 1;
         if (o.report && write_bare_report(o.report, &bo, &tm) != 0) {
             fprintf(stderr, "vdsh-bake: %s: cannot write the report: %s\n", o.report,
                     strerror(errno));
@@ -504,6 +574,8 @@ int main(int argc, char **argv)
     }
 
     /* 6. Basis cubemaps (order 4 and up evaluates bands 3-4 from them). */
+    pthread_mutex_lock(&output_lock);
+    writing = 1;
     char dir[PATH_MAX], stem[PATH_MAX];
     split_output(o.output, dir, stem, sizeof dir);
     int cube_size = max_order >= 4 ? o.cube_size : 0;
@@ -578,6 +650,11 @@ int main(int argc, char **argv)
     status = 0;
 
 out:
+    if (writing) {
+        pthread_mutex_unlock(&output_lock);
+        while (atomic_load(&interrupted))
+            pause(); /* the interrupt thread ends the process */
+    }
     for (int s = 0; s < VDSH_MAX_ORDER; s++)
         free(stream_data[s]);
     vb_bake_output_free(&bo);

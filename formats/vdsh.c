@@ -1601,10 +1601,16 @@ vdsh_result vdsh_read(const char *path, vdsh_file **out, vdsh_error *err)
     if (!path || !out)
         return fail(err, VDSH_ERR_ARGUMENT, path ? path : "(null)",
                     "vdsh_read: NULL %s", path ? "out" : "path");
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return fail(err, VDSH_ERR_IO, path, "cannot open: %s",
-                    strerror(errno));
+    /* O_NONBLOCK: opening a FIFO must not wait for a writer (it is refused
+     * below, as anything but a regular file); regular files ignore it. */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    FILE *fp = fd >= 0 ? fdopen(fd, "rb") : NULL;
+    if (!fp) {
+        int e = errno;
+        if (fd >= 0)
+            close(fd);
+        return fail(err, VDSH_ERR_IO, path, "cannot open: %s", strerror(e));
+    }
     struct stat st;
     if (fstat(fileno(fp), &st) != 0) {
         int e = errno;

@@ -14,12 +14,14 @@
 #include "vdsh.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #ifndef VDSH_VERSION_STRING
 #define VDSH_VERSION_STRING "unknown"
@@ -409,10 +411,24 @@ static void print_json_error(const char *path, vdsh_result r, const char *msg)
 static int slurp(const char *path, uint8_t **out, size_t *out_size,
                  char *msg, size_t msg_size)
 {
-    FILE *fp = fopen(path, "rb");
-    if (!fp) {
+    /* Only regular files: /dev/zero would be read until memory runs out,
+     * and opening a FIFO would wait for a writer (hence O_NONBLOCK, which
+     * regular files ignore). */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) {
         snprintf(msg, msg_size, "%s: cannot open: %s", path,
                  strerror(errno));
+        return 0;
+    }
+    struct stat st;
+    int bad = fstat(fd, &st) != 0 ? errno : !S_ISREG(st.st_mode) ? -1 : 0;
+    FILE *fp = bad ? NULL : fdopen(fd, "rb");
+    if (!fp) {
+        if (!bad)
+            bad = errno;
+        snprintf(msg, msg_size, "%s: %s", path,
+                 bad < 0 ? "not a regular file" : strerror(bad));
+        close(fd);
         return 0;
     }
     size_t cap = 1 << 16, size = 0;

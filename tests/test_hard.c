@@ -41,7 +41,7 @@ static int all_finite(const vb_bake_output *b)
 {
     size_t n = (size_t)b->vertex_count * b->max_order * b->max_order;
     for (size_t i = 0; i < n; i++)
-        if (!isfinite(b->coeffs[i]))
+        if (!isfinite(b->coeffs[b->max_order][i]))
             return 0;
     return 1;
 }
@@ -67,7 +67,7 @@ static void test_corners(void)
     vb_bake_output out = {0}, fast = {0};
     CHECK(bake_with(&occ, &rec, VDSH_METHOD_PAPER, 1024, 1, &out), "bake");
     CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 1024, &fast), "fast bake");
-    if (!out.coeffs || !fast.coeffs)
+    if (!out.coeffs[5] || !fast.coeffs[5])
         goto done;
     CHECK(out.rays_missed == 0, "%llu rays escaped a closed room of unwelded quads",
           (unsigned long long)out.rays_missed);
@@ -89,7 +89,7 @@ static void test_corners(void)
             test_rand_dir(&s, d);
             if (d[1] < 0.1f)
                 continue;
-            float D = vdsh_sh_reconstruct(5, out.coeffs + 25 * (size_t)v, d);
+            float D = vdsh_sh_reconstruct(5, out.coeffs[5] + 25 * (size_t)v, d);
             CHECK(isfinite(D), "non-finite reconstruction");
             D = D > 0 ? D : 0;
             if (d[0] * p[0] > 0 || d[2] * p[2] > 0)
@@ -144,10 +144,10 @@ static void test_degenerate_triangles(void)
     vb_bake_output a = {0}, b = {0};
     CHECK(bake_with(&occ, &rec, VDSH_METHOD_PAPER, 400, 1, &a), "clean bake");
     CHECK(bake_with(&junk, &rec, VDSH_METHOD_PAPER, 400, 1, &b), "bake with zero-area triangles");
-    if (a.coeffs && b.coeffs) {
+    if (a.coeffs[5] && b.coeffs[5]) {
         double worst = 0;
         for (size_t i = 0; i < (size_t)rec.vertex_count * 25; i++)
-            worst = fmax(worst, fabs(a.coeffs[i] - b.coeffs[i]));
+            worst = fmax(worst, fabs(a.coeffs[5][i] - b.coeffs[5][i]));
         CHECK(worst < 1e-5 * a.max_distance, "zero-area triangles changed a coefficient by %g",
               worst);
         CHECK(a.rays_missed == b.rays_missed, "zero-area triangles changed the misses");
@@ -164,7 +164,7 @@ static void test_degenerate_triangles(void)
     const float sl[4][3] = {{0, 1, -1}, {0, 1, 1}, {1e-5f, 2, 1}, {1e-5f, 2, -1}};
     test_add_quad(&nee, sl, up);
     CHECK(bake(&nee, &rec, VDSH_METHOD_FULL, 400, &a), "bake with needles and slivers");
-    if (a.coeffs)
+    if (a.coeffs[5])
         CHECK(all_finite(&a), "needles or slivers made a non-finite coefficient");
     vb_bake_output_free(&a);
     test_mesh_free(&nee);
@@ -184,9 +184,9 @@ static void test_undefined_normal(void)
     vb_bake_output a = {0}, b = {0};
     CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 625, &a), "paper");
     CHECK(bake(&occ, &rec, VDSH_METHOD_FULL, 625, &b), "full");
-    if (a.coeffs && b.coeffs) {
+    if (a.coeffs[5] && b.coeffs[5]) {
         CHECK(all_finite(&a), "non-finite coefficients");
-        CHECK(memcmp(a.coeffs, b.coeffs, 2 * 25 * sizeof(float)) == 0,
+        CHECK(memcmp(a.coeffs[5], b.coeffs[5], 2 * 25 * sizeof(float)) == 0,
               "undefined normal: paper differs from full");
         CHECK(a.undefined_normals == 2, "undefined normals counted: %u", a.undefined_normals);
     }
@@ -223,7 +223,7 @@ static void test_scale_and_offset(void)
         {1.0f / 16384, 0.0f, 1, "scaled by 2^-14"},
         {1e-4f, 0.0f, 0, "scaled by 1e-4"},
         {1e4f, 0.0f, 0, "scaled by 1e4"}};
-    for (size_t c = 0; c < sizeof cases / sizeof cases[0] && ref.coeffs; c++) {
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0] && ref.coeffs[5]; c++) {
         vb_mesh o2 = {0}, r2 = {0};
         refined_room(&o2, &r2, 4.0f, 3.0f, 2.5f);
         float off[3] = {cases[c].off, 0.0f, cases[c].off};
@@ -231,7 +231,7 @@ static void test_scale_and_offset(void)
         transform(&r2, cases[c].scale, off);
         vb_bake_output b = {0};
         CHECK(bake_with(&o2, &r2, VDSH_METHOD_PAPER, 400, 1, &b), "%s", cases[c].what);
-        if (b.coeffs) {
+        if (b.coeffs[5]) {
             CHECK(b.rays_missed == ref.rays_missed, "%s: %llu rays escaped (%llu before)",
                   cases[c].what, (unsigned long long)b.rays_missed,
                   (unsigned long long)ref.rays_missed);
@@ -241,7 +241,7 @@ static void test_scale_and_offset(void)
                 double vw = 0;
                 for (int i = 0; i < 25; i++) {
                     size_t k = 25 * (size_t)v + i;
-                    double e = fabs(b.coeffs[k] / cases[c].scale - ref.coeffs[k]);
+                    double e = fabs(b.coeffs[5][k] / cases[c].scale - ref.coeffs[5][k]);
                     vw = fmax(vw, e), sum += e;
                 }
                 worst = fmax(worst, vw);
@@ -281,7 +281,7 @@ static void test_f16_range(void)
         vdsh_stream s;
         void *mem = NULL;
         vb_error err;
-        if (b.coeffs &&
+        if (b.coeffs[5] &&
             vb_bake_stream(&b, 5, VDSH_ENCODING_F16, &s, &mem, &err) == VB_OK) {
             double worst = 0, amax = 0;
             for (uint32_t v = 0; v < rec.vertex_count; v++) {
@@ -289,8 +289,8 @@ static void test_f16_range(void)
                 vdsh_stream_decode(&s, v, c);
                 for (int i = 0; i < 25; i++) {
                     CHECK(isfinite(c[i]), "scale %g: non-finite f16 coefficient", scales[k]);
-                    worst = fmax(worst, fabs(c[i] - b.coeffs[25 * (size_t)v + i]));
-                    amax = fmax(amax, fabs(b.coeffs[25 * (size_t)v + i]));
+                    worst = fmax(worst, fabs(c[i] - b.coeffs[5][25 * (size_t)v + i]));
+                    amax = fmax(amax, fabs(b.coeffs[5][25 * (size_t)v + i]));
                 }
             }
             /* Half precision: 2^-11 relative to the value, so at most
@@ -327,7 +327,7 @@ static void test_coplanar_receivers(void)
     CHECK(vb_mesh_refine(&occ, 1.0f, &rec, &err) == VB_OK, "refine");
     vb_bake_output b = {0};
     CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 1024, &b), "bake");
-    if (!b.coeffs)
+    if (!b.coeffs[5])
         goto done;
     double all_escape = b.max_distance * sqrt(M_PI); /* c0 when every ray misses */
     int floor_edge = 0, pillar_foot = 0;
@@ -338,7 +338,7 @@ static void test_coplanar_receivers(void)
         if (!on_wall && !foot)
             continue;
         floor_edge += on_wall, pillar_foot += foot;
-        double c0 = b.coeffs[25 * (size_t)v];
+        double c0 = b.coeffs[5][25 * (size_t)v];
         CHECK(c0 < 0.6 * all_escape, "%s vertex (%g %g %g): c0 = %g, every ray escaping gives %g",
               on_wall ? "floor-edge" : "pillar-foot", p[0], p[1], p[2], c0, all_escape);
     }
@@ -362,14 +362,14 @@ static void test_open_mesh(void)
     CHECK(vb_mesh_refine(&occ, 0.5f, &rec, &err) == VB_OK, "refine");
     vb_bake_output b = {0};
     CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 2500, &b), "bake");
-    if (b.coeffs) {
+    if (b.coeffs[5]) {
         CHECK(b.rays_missed == b.rays_traced, "%llu of %llu rays hit an open floor",
               (unsigned long long)(b.rays_traced - b.rays_missed),
               (unsigned long long)b.rays_traced);
         double want = b.max_distance * sqrt(M_PI);
         for (uint32_t v = 0; v < rec.vertex_count; v++)
-            CHECK(fabs(b.coeffs[25 * (size_t)v] - want) < 0.03 * want, "c0 %g, want %g",
-                  b.coeffs[25 * (size_t)v], want);
+            CHECK(fabs(b.coeffs[5][25 * (size_t)v] - want) < 0.03 * want, "c0 %g, want %g",
+                  b.coeffs[5][25 * (size_t)v], want);
     }
     vb_bake_output_free(&b);
     test_mesh_free(&occ);
@@ -395,7 +395,7 @@ static void test_bad_api_input(void)
     test_make_points(&rec, 1, p, n);
     vb_bake_desc d = {.receivers = &rec, .scene = s, .rays = 64};
     vb_bake_output out = {0};
-    CHECK(vb_bake_run(&d, &out, &err) == VB_ERR_INVALID && !out.coeffs, "Inf normal accepted");
+    CHECK(vb_bake_run(&d, &out, &err) == VB_ERR_INVALID && !out.coeffs[5], "Inf normal accepted");
     vb_scene_destroy(s);
     test_mesh_free(&occ);
     test_mesh_free(&rec);
