@@ -314,7 +314,7 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
     memcpy(f, b->coeffs[order], count * sizeof *f);
     vdsh_stream s = {.order = (uint32_t)order, .encoding = encoding, .method = b->method,
                      .quantity = b->quantity, .method_param = b->lambda, .scale = 1.0f,
-                     .data = f};
+                     .quantity_param = b->log_floor, .data = f};
     if (encoding == VDSH_ENCODING_F16) {
         /* Stored values are coefficient / (the stream's largest
          * |coefficient|): within [-1, 1] whatever the scene's size or clamp

@@ -183,6 +183,22 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
     float coef[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS];
     for (uint32_t s = 0; s < S; s++)
         receiver_coeffs(f, &f->streams[s], r, coef[s]);
+    /* Interior points: their triangle's corners, for the per-vertex
+     * interpolation modes. */
+    const int corners = r->kind == VB_EVAL_INTERIOR;
+    float vc[VDSH_MAX_STREAMS][3][VDSH_MAX_COEFFS];
+    const float *pv[3] = {NULL, NULL, NULL};
+    uint32_t interp[VDSH_MAX_STREAMS];
+    for (uint32_t s = 0; s < S && corners; s++) {
+        const uint32_t *t = f->indices + 3 * (size_t)r->triangle;
+        for (int k = 0; k < 3; k++) {
+            vdsh_stream_decode(&f->streams[s], t[k], vc[s][k]);
+            pv[k] = f->positions + 3 * (size_t)t[k];
+        }
+        interp[s] = J->d->interp == VB_EVAL_INTERP_RUNTIME
+                        ? vdsh_runtime_interp(f->streams[s].order, f->streams[s].quantity)
+                        : J->d->interp - 1;
+    }
     racc *acc = J->acc + (size_t)ri * S;
     rtruth *tr = J->truth + ri;
     uint64_t *h = hist + (size_t)r->kind * S * HIST_BINS;
@@ -232,15 +248,25 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
             const int vis = dt >= dl, occ = s_ideal < 0.5f, occ_bin = b_ideal < 0.5f;
             const float floor_ = dt > J->floor_dist ? dt : J->floor_dist;
 
+            /* The light, for the per-vertex modes: along w from the point. */
+            const float lp[3] = {r->position[0] + w[0] * dl, r->position[1] + w[1] * dl,
+                                 r->position[2] + w[2] * dl};
             for (uint32_t s = 0; s < S; s++) {
                 const vdsh_stream *st = &f->streams[s];
-                const float D = J->d->oracle
-                                    ? dt
-                                    : vdsh_stream_distance(st->order, st->quantity,
-                                                           coef[s], w);
+                float D, s_hat, b_hat;
+                if (J->d->oracle || !corners) {
+                    D = J->d->oracle ? dt
+                                     : vdsh_stream_distance(st->order, st->quantity, coef[s], w);
+                    s_hat = vdsh_shadow_compare(D, dl, VDSH_COMPARE_SMOOTH);
+                    b_hat = vdsh_shadow_compare(D, dl, VDSH_COMPARE_BINARY);
+                } else {
+                    const float *cv[3] = {vc[s][0], vc[s][1], vc[s][2]};
+                    s_hat = vdsh_shadow_interior(st->order, st->quantity, interp[s], cv, pv,
+                                                 r->bary, lp, VDSH_COMPARE_SMOOTH, &D);
+                    b_hat = vdsh_shadow_interior(st->order, st->quantity, interp[s], cv, pv,
+                                                 r->bary, lp, VDSH_COMPARE_BINARY, NULL);
+                }
                 const float e = fabsf(D - dt) / floor_;
-                const float s_hat = vdsh_shadow_compare(D, dl, VDSH_COMPARE_SMOOTH);
-                const float b_hat = vdsh_shadow_compare(D, dl, VDSH_COMPARE_BINARY);
                 racc *a = acc + s;
                 a->n++;
                 a->sq += (double)e * e;

@@ -100,6 +100,8 @@ enum { VB_EVAL_VERTICES = 0, VB_EVAL_INTERIOR = 1, VB_EVAL_KINDS = 2 };
 #define VB_EVAL_NEAR_ZERO 1e-3f    /* of the diagonal */
 #define VB_EVAL_DEGENERATE 0.9     /* of a receiver's directions */
 
+enum { VB_EVAL_INTERP_RUNTIME = 0 };
+
 typedef struct vb_eval_desc {
     const vdsh_file *file;     /* receivers and streams (borrowed) */
     const vb_scene *scene;     /* occluders as the bake traced them (borrowed) */
@@ -118,6 +120,11 @@ typedef struct vb_eval_desc {
                                   of the streams: every error must be exactly
                                   0 (tests the scoring and the sampling) */
     int per_vertex;            /* 1: fill result.per_vertex */
+    /* How interior points get a stream's value from their triangle's
+     * vertices (vdsh_shadow.h): VB_EVAL_INTERP_RUNTIME (0, the default) is
+     * the path runtime/ draws that stream with (vdsh_runtime_interp), what a
+     * viewer sees; or 1 + a vdsh_interp for the same mode on every stream. */
+    uint32_t interp;
     unsigned threads;          /* 0: every online core */
     /* Called from the calling thread a few times a second with receivers
      * done and total. May be NULL. */

@@ -787,7 +787,10 @@ struct ply_element {
  * "face" and have x, y, z; the only list OpenMesh can step over correctly
  * is the face's vertex_indices (or vertex_index), any other list is read as
  * one value and shifts everything after it, so such files are refused;
- * list counts must be uint8/uchar/uint16/int. Every value of the elements
+ * list counts must be uint8/uchar/uint16/int; only one "face" element
+ * (the ascii reader takes the count of the last one for the first) and
+ * nothing before vertex_indices in it (dropped from the property list
+ * but not from the data). Every value of the elements
  * read is checked (ascii: a number of the property's kind; both: sizes,
  * face indices in range, finite x, y, z), so a file OpenMesh would read
  * as garbage never reaches it. */
@@ -899,6 +902,10 @@ vb_result scan_ply(const char *path, const uint8_t *bytes, size_t size,
     }
     if (vertex_elem < 0)
         return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh (no vertex element)", path);
+    /* OpenMesh's ascii reader reads the first face element as many times
+     * as the last "element face" line says. */
+    if (std::count_if(elems.begin(), elems.end(), [](const ply_element &e) { return e.name == "face"; }) > 1)
+        return vb_fail(err, VB_ERR_FORMAT, "%s: a second face element is not supported", path);
     int xyz[3] = {-1, -1, -1};
     int indices_prop = -1;
     for (size_t i = 0; i < last; i++) {
@@ -927,6 +934,12 @@ vb_result scan_ply(const char *path, const uint8_t *bytes, size_t size,
     }
     if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0)
         return vb_fail(err, VB_ERR_FORMAT, "%s: the vertex element lacks x, y or z", path);
+    /* OpenMesh drops the face properties declared before vertex_indices
+     * from its list but not from the data, and misreads every face. */
+    if (indices_prop > 0)
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: face property '%s' before vertex_indices is not supported (OpenMesh would misread the "
+                       "faces)", path, elems[(size_t)face_elem].props[0].name.c_str());
     uint64_t nv = elems[(size_t)vertex_elem].count;
 
     /* OpenMesh finds binary data at a fixed distance after the last header

@@ -36,6 +36,9 @@ typedef struct options {
     int orders[VDSH_MAX_ORDER];
     int order_count;
     uint32_t method;
+    uint32_t quantity;
+    float lambda;
+    float log_floor;
     uint32_t encoding;
     float max_distance;
     float max_edge;
@@ -80,7 +83,15 @@ static void usage(FILE *f)
 "                          coefficients (default 2,3,5; each 1..5)\n"
 "      --method M          paper (default): the paper's fit, directions below\n"
 "                          the horizon count as distance 0; full: the whole\n"
-"                          sphere, no horizon\n"
+"                          sphere, no horizon; mirror: the upper hemisphere,\n"
+"                          mirrored below; lsq: least squares to the upper\n"
+"                          hemisphere. mirror and lsq trace only the upper\n"
+"                          half of the --rays directions\n"
+"      --log               store ln(distance) (reconstructed as exp of the SH\n"
+"                          sum); not with paper\n"
+"      --lambda X          lsq regularisation weight (default 1e-4)\n"
+"      --log-floor D       with --log, distances below D count as D\n"
+"                          (default: 1%% of the max distance)\n"
 "      --max-distance D    clamp distance; misses get it (default: the\n"
 "                          scene's bounding-box diagonal)\n"
 "      --max-edge L        refine receivers until no edge is longer than L\n"
@@ -341,7 +352,7 @@ int main(int argc, char **argv)
 
     enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST,
-           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY };
+           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_FLOOR };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
@@ -360,6 +371,9 @@ int main(int argc, char **argv)
         {"record-timings", no_argument, 0, O_TIMINGS},
         {"export-obj", required_argument, 0, O_EXPORT},
         {"trace-only", no_argument, 0, O_TRACE_ONLY},
+        {"log", no_argument, 0, O_LOG},
+        {"lambda", required_argument, 0, O_LAMBDA},
+        {"log-floor", required_argument, 0, O_LOG_FLOOR},
         {"quiet", no_argument, 0, 'q'},
         {"help", no_argument, 0, 'h'},
         {"version", no_argument, 0, 'V'},
@@ -381,7 +395,9 @@ int main(int argc, char **argv)
         case O_METHOD:
             if (strcmp(optarg, "paper") == 0) o.method = VDSH_METHOD_PAPER;
             else if (strcmp(optarg, "full") == 0) o.method = VDSH_METHOD_FULL;
-            else return bad_usage("--method takes paper or full, not '%s'", optarg);
+            else if (strcmp(optarg, "mirror") == 0) o.method = VDSH_METHOD_MIRROR;
+            else if (strcmp(optarg, "lsq") == 0) o.method = VDSH_METHOD_LSQ;
+            else return bad_usage("--method takes paper, full, mirror or lsq, not '%s'", optarg);
             break;
         case O_ENCODING:
             if (strcmp(optarg, "f16") == 0) o.encoding = VDSH_ENCODING_F16;
@@ -417,6 +433,15 @@ int main(int argc, char **argv)
         case O_TIMINGS: o.record_timings = 1; break;
         case O_EXPORT: o.export_obj = optarg; break;
         case O_TRACE_ONLY: o.trace_only = 1; break;
+        case O_LOG: o.quantity = VDSH_QUANTITY_LOG_DISTANCE; break;
+        case O_LAMBDA:
+            if (!parse_float(optarg, &o.lambda) || o.lambda == 0.0f)
+                return bad_usage("--lambda takes a positive number, not '%s'", optarg);
+            break;
+        case O_LOG_FLOOR:
+            if (!parse_float(optarg, &o.log_floor) || o.log_floor == 0.0f)
+                return bad_usage("--log-floor takes a positive number, not '%s'", optarg);
+            break;
         case 'q': o.quiet = 1; break;
         case 'h': usage(stdout); return 0;
         case 'V':
@@ -433,6 +458,9 @@ int main(int argc, char **argv)
         return bad_usage("%s", "no mesh given");
     if (nmesh > VDSH_MAX_SOURCES)
         return bad_usage("%s", "too many meshes (at most 64)");
+    if (o.quantity == VDSH_QUANTITY_LOG_DISTANCE && o.method == VDSH_METHOD_PAPER)
+        return bad_usage("%s", "--log needs --method mirror, lsq or full: the paper's zero fill "
+                               "below the horizon has no meaning for ln(distance)");
     if (!o.output && !o.export_obj && !o.trace_only)
         return bad_usage("%s", "no output: give -o OUT.vdsh (or --export-obj FILE)");
     FILE *log = o.quiet ? NULL : stderr;
@@ -522,6 +550,7 @@ int main(int argc, char **argv)
     vb_bake_desc bd = {
         .receivers = &rec, .scene = scene, .rays = o.rays, .seed = o.seed,
         .max_distance = o.max_distance, .method = o.method,
+        .quantity = o.quantity, .lambda = o.lambda, .log_floor = o.log_floor,
         .max_order = max_order, .order_mask = order_mask, .threads = o.threads,
         .trace_only = o.trace_only,
         .progress = on_progress, .progress_user = &pr};

@@ -44,6 +44,7 @@
 
 #include "bake.h"
 #include "eval.h"
+#include "vdsh_shadow.h"
 #include "scene.h"
 #include "vdsh.h"
 
@@ -80,6 +81,10 @@ static void usage(FILE *f)
 "      --orders LIST       only these orders, e.g. 3,5 (default: every stream)\n"
 "      --oracle            score the ray-cast truth instead of the streams:\n"
 "                          every error must come out exactly 0\n"
+"      --interp M          how interior points get a stream's value from the\n"
+"                          triangle's vertices: runtime (default: the path\n"
+"                          vdsh-view draws the stream with), coefficients,\n"
+"                          distance, visibility or split (vdsh_shadow.h)\n"
 "      --fast-truth        Embree's default traversal for the truth (default:\n"
 "                          robust, so truth rays do not leak through edges)\n"
 "      --allow-mismatch    use sources whose SHA-256 differs (with a warning)\n"
@@ -714,7 +719,7 @@ int main(int argc, char **argv)
     int want_order[VDSH_MAX_ORDER + 1] = {0}, filter = 0;
     int quiet = 0, fast_truth = 0, allow_mismatch = 0;
 
-    enum { O_POINTS = 256, O_INTERIOR, O_DIRECTIONS, O_SEED, O_ORDERS, O_ORACLE,
+    enum { O_POINTS = 256, O_INTERIOR, O_DIRECTIONS, O_SEED, O_ORDERS, O_ORACLE, O_INTERP,
            O_FAST, O_ALLOW, O_JSON, O_PV, O_BAKE_REPORT, O_WORST, O_THREADS };
     static const struct option longopts[] = {
         {"points", required_argument, 0, O_POINTS},
@@ -723,6 +728,7 @@ int main(int argc, char **argv)
         {"seed", required_argument, 0, O_SEED},
         {"orders", required_argument, 0, O_ORDERS},
         {"oracle", no_argument, 0, O_ORACLE},
+        {"interp", required_argument, 0, O_INTERP},
         {"fast-truth", no_argument, 0, O_FAST},
         {"allow-mismatch", no_argument, 0, O_ALLOW},
         {"json", required_argument, 0, O_JSON},
@@ -763,6 +769,18 @@ int main(int argc, char **argv)
             filter = 1;
             break;
         case O_ORACLE: d.oracle = 1; break;
+        case O_INTERP: {
+            d.interp = UINT32_MAX;
+            if (strcmp(optarg, "runtime") == 0)
+                d.interp = VB_EVAL_INTERP_RUNTIME;
+            for (uint32_t m = 0; m < 4; m++)
+                if (strcmp(optarg, vdsh_interp_name(m)) == 0)
+                    d.interp = m + 1;
+            if (d.interp == UINT32_MAX)
+                return bad_usage("--interp takes runtime, coefficients, distance, "
+                                   "visibility or split, not '%s'", optarg);
+            break;
+        }
         case O_FAST: fast_truth = 1; break;
         case O_ALLOW: allow_mismatch = 1; break;
         case O_JSON: json = optarg; break;

@@ -209,8 +209,8 @@ static const char *name_of(uint32_t v, const char *const *names, uint32_t n)
 
 const char *vdsh_method_name(uint32_t method)
 {
-    static const char *const n[] = {"paper", "full"};
-    return name_of(method, n, 2);
+    static const char *const n[] = {"paper", "full", "mirror", "lsq"};
+    return name_of(method, n, 4);
 }
 
 const char *vdsh_encoding_name(uint32_t encoding)
@@ -966,6 +966,12 @@ static int check_stream(const vdsh_stream *s, uint32_t i, why *w)
     if (!isfinite(s->scale) || !(s->scale > 0.0f))
         return bad(w, "%s: scale %g must be finite and > 0", l,
                    (double)s->scale);
+    if (s->quantity == VDSH_QUANTITY_LOG_DISTANCE
+            ? !(s->quantity_param > 0.0f) || !isfinite(s->quantity_param)
+            : s->quantity_param != 0.0f)
+        return bad(w, "%s: quantity_param %g must be %s", l, (double)s->quantity_param,
+                   s->quantity == VDSH_QUANTITY_LOG_DISTANCE
+                       ? "the log floor, finite and > 0" : "0 for this quantity");
     return 1;
 }
 
@@ -1341,11 +1347,12 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
     s->window_param = get_f32(p + 20);
     s->method_param = get_f32(p + 24);
     s->scale = get_f32(p + 28);
+    s->quantity_param = get_f32(p + 32);
     s->data = NULL;
     stream_label(s, i, l, sizeof l);
-    if (!all_zero(p + 32, 16))
+    if (!all_zero(p + 36, 12))
         return fail(r->err, VDSH_ERR_INVALID, r->name,
-                    "%s: reserved bytes 32..47 not zero", l);
+                    "%s: reserved bytes 36..47 not zero", l);
     if (!check_stream(s, i, &w))
         return invalid(r, &w);
     uint64_t need = (uint64_t)L->header.vertex_count * s->order * s->order *
@@ -1888,6 +1895,7 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
         put_f32(p + 20, s->window_param);
         put_f32(p + 24, s->method_param);
         put_f32(p + 28, s->scale);
+        put_f32(p + 32, s->quantity_param);
         add_chunk(P, "COEF", p, STREAM_HEADER_SIZE, s->data,
                   v * vdsh_stream_bytes_per_vertex(s));
     }

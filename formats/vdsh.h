@@ -164,6 +164,8 @@ typedef struct vdsh_stream {
     float window_param;
     float method_param;
     float scale;           /* coefficient = stored value * scale */
+    float quantity_param;  /* log-distance: the floor (distances below it
+                              were clamped to it before the log); else 0 */
     const void *data;      /* vertex_count * order^2 values of `encoding` */
 } vdsh_stream;
 

@@ -242,7 +242,10 @@ static void print_summary(const char *path, const vdsh_file *f,
                or_unknown(vdsh_method_name(s->method)));
         if (strcmp(vdsh_method_name(s->method), "?") == 0)
             printf(" (%u)", s->method);
-        printf(", quantity %s\n", vdsh_quantity_name(s->quantity));
+        printf(", quantity %s", vdsh_quantity_name(s->quantity));
+        if (s->quantity == VDSH_QUANTITY_LOG_DISTANCE)
+            printf(" (floor %g)", s->quantity_param);
+        putchar('\n');
         printf("        window %s", vdsh_window_name(s->window));
         if (s->window != VDSH_WINDOW_NONE)
             printf(" (param %g)", s->window_param);
@@ -343,6 +346,8 @@ static void print_json(const char *path, const vdsh_file *f, uint64_t size)
         json_num(s->method_param);
         fputs(",\n     \"quantity\": ", stdout);
         json_str(vdsh_quantity_name(s->quantity));
+        fputs(", \"quantity_param\": ", stdout);
+        json_num(s->quantity_param);
         fputs(", \"window\": ", stdout);
         json_str(vdsh_window_name(s->window));
         fputs(", \"window_param\": ", stdout);

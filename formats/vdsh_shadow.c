@@ -49,3 +49,99 @@ float vdsh_shadow(uint32_t order, uint32_t quantity, const float *c,
         v[i] /= dl;
     return vdsh_shadow_compare(vdsh_stream_distance(order, quantity, c, v), dl, compare);
 }
+
+const char *vdsh_interp_name(uint32_t interp)
+{
+    static const char *const n[] = {"coefficients", "distance", "visibility", "split"};
+    return interp < 4 ? n[interp] : "?";
+}
+
+uint32_t vdsh_runtime_interp(uint32_t order, uint32_t quantity)
+{
+    if (quantity == VDSH_QUANTITY_LOG_DISTANCE)
+        return VDSH_INTERP_DISTANCE;
+    return order <= 3 ? VDSH_INTERP_VISIBILITY : VDSH_INTERP_SPLIT;
+}
+
+/* The quantity's distance from an SH sum (as vdsh_stream_distance). */
+static float from_sum(uint32_t quantity, float sum)
+{
+    switch (quantity) {
+    case VDSH_QUANTITY_DISTANCE2:
+        return sum > 0.0f ? sqrtf(sum) : 0.0f;
+    case VDSH_QUANTITY_LOG_DISTANCE:
+        return expf(sum);
+    default:
+        return sum > 0.0f ? sum : 0.0f;
+    }
+}
+
+/* Unit direction and distance from a to b; 0 distance for a == b. */
+static float toward(const float a[3], const float b[3], float d[3])
+{
+    float v[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    float len = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int i = 0; i < 3; i++)
+        d[i] = len > 0.0f ? v[i] / len : 0.0f;
+    return len;
+}
+
+float vdsh_shadow_interior(uint32_t order, uint32_t quantity, uint32_t interp,
+                           const float *const c[3], const float *const pv[3],
+                           const float b[3], const float l[3], uint32_t compare,
+                           float *d_vis)
+{
+    const int n = (int)(order * order);
+    float p[3], w[3];
+    for (int i = 0; i < 3; i++)
+        p[i] = b[0] * pv[0][i] + b[1] * pv[1][i] + b[2] * pv[2][i];
+    const float dl = toward(p, l, w);
+
+    if (interp == VDSH_INTERP_COEFFICIENTS || interp > VDSH_INTERP_SPLIT ||
+        (interp == VDSH_INTERP_SPLIT && order < 4)) {
+        float ci[VDSH_MAX_COEFFS];
+        for (int i = 0; i < n; i++)
+            ci[i] = b[0] * c[0][i] + b[1] * c[1][i] + b[2] * c[2][i];
+        float d = dl > 0.0f ? vdsh_stream_distance(order, quantity, ci, w) : 0.0f;
+        if (d_vis)
+            *d_vis = d;
+        return vdsh_shadow_compare(d, dl, compare);
+    }
+    if (interp == VDSH_INTERP_SPLIT) {
+        /* Bands 0-2 toward the light from each vertex, interpolated;
+         * bands 3-4 at p from interpolated coefficients. */
+        float sum9 = 0.0f, y[VDSH_MAX_COEFFS], ci[VDSH_MAX_COEFFS];
+        for (int k = 0; k < 3; k++) {
+            float dk[3];
+            if (!(toward(pv[k], l, dk) > 0.0f))
+                continue; /* the runtime stores 0 for a light at the vertex */
+            vdsh_sh_eval(3, dk, y);
+            float s = 0.0f;
+            for (int i = 0; i < 9; i++)
+                s += c[k][i] * y[i];
+            sum9 += b[k] * s;
+        }
+        vdsh_sh_eval((int)order, w, y);
+        float sum16 = 0.0f;
+        for (int i = 9; i < n; i++) {
+            ci[i] = b[0] * c[0][i] + b[1] * c[1][i] + b[2] * c[2][i];
+            sum16 += ci[i] * y[i];
+        }
+        float d = dl > 0.0f ? from_sum(quantity, sum9 + sum16) : 0.0f;
+        if (d_vis)
+            *d_vis = d;
+        return vdsh_shadow_compare(d, dl, compare);
+    }
+    /* DISTANCE and VISIBILITY: each vertex toward the light. */
+    float d = 0.0f, s = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        float dk[3];
+        float dlk = toward(pv[k], l, dk);
+        float dvk = dlk > 0.0f ? vdsh_stream_distance(order, quantity, c[k], dk) : 0.0f;
+        d += b[k] * dvk;
+        s += b[k] * vdsh_shadow_compare(dvk, dlk, compare);
+    }
+    if (d_vis)
+        *d_vis = d;
+    return interp == VDSH_INTERP_DISTANCE ? vdsh_shadow_compare(d, dl, compare) : s;
+}

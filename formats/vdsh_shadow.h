@@ -47,6 +47,47 @@ float vdsh_shadow_compare(float d_vis, float d_light, uint32_t compare);
 float vdsh_shadow(uint32_t order, uint32_t quantity, const float *c,
                   const float p[3], const float l[3], uint32_t compare);
 
+/* How a renderer carries the stream from a triangle's vertices to a point
+ * p = sum b_k p_k inside it (the GPU interpolates linearly):
+ *   COEFFICIENTS  the coefficients are interpolated; the distance is
+ *                 reconstructed at p toward the light
+ *   DISTANCE      each vertex reconstructs its distance toward the light
+ *                 from where it is; the distances are interpolated and
+ *                 compared at p with p's own light distance
+ *   VISIBILITY    each vertex compares too; visibility is interpolated
+ *                 (the paper's orders 2 and 3, all in the vertex stage)
+ *   SPLIT         bands 0-2 are summed per vertex toward the light and the
+ *                 sums interpolated; bands 3-4 at p from interpolated
+ *                 coefficients (the paper's order 5: 9 coefficients in the
+ *                 vertex stage, 16 in the fragment stage)
+ * For a linear quantity and a distant light they all agree; they differ
+ * where a triangle is large next to its distance to the light, and for
+ * log-distance, where interpolating coefficients is a geometric mean of the
+ * vertices' distances (dominated by the smallest). */
+typedef enum vdsh_interp {
+    VDSH_INTERP_COEFFICIENTS = 0,
+    VDSH_INTERP_DISTANCE = 1,
+    VDSH_INTERP_VISIBILITY = 2,
+    VDSH_INTERP_SPLIT = 3
+} vdsh_interp;
+
+/* "coefficients", "distance", "visibility", "split"; "?" otherwise. */
+const char *vdsh_interp_name(uint32_t interp);
+
+/* The path runtime/ draws a stream with: log-distance per vertex and
+ * interpolated as DISTANCE (its exp cannot be split across stages);
+ * otherwise the paper's: VISIBILITY for orders 1-3, SPLIT for 4-5. */
+uint32_t vdsh_runtime_interp(uint32_t order, uint32_t quantity);
+
+/* Visibility at p = sum b_k pv[k] for a light at l, carried by `interp`;
+ * c[k] holds vertex k's order^2 coefficients. If d_vis is not NULL it
+ * receives the distance compared (for VISIBILITY: the interpolated vertex
+ * distances, for scoring). Defined for every input as vdsh_shadow is. */
+float vdsh_shadow_interior(uint32_t order, uint32_t quantity, uint32_t interp,
+                           const float *const c[3], const float *const pv[3],
+                           const float b[3], const float l[3], uint32_t compare,
+                           float *d_vis);
+
 #ifdef __cplusplus
 }
 #endif

@@ -226,6 +226,8 @@ static void add_stream(sample *s, uint32_t order, uint32_t enc, uint32_t q,
     st->window_param = wp;
     st->method_param = mp;
     st->scale = scale;
+    /* The log floor is the one quantity parameter (0 for the others). */
+    st->quantity_param = q == VDSH_QUANTITY_LOG_DISTANCE ? 0.0625f * (float)(i + 1) : 0.0f;
     if (enc == VDSH_ENCODING_F16) {
         uint16_t *d = malloc(n * 2 + 2);
         for (size_t k = 0; k < n; k++)
@@ -791,7 +793,9 @@ static void test_names(void)
 {
     CHECK(!strcmp(vdsh_method_name(0), "paper"));
     CHECK(!strcmp(vdsh_method_name(1), "full"));
-    CHECK(!strcmp(vdsh_method_name(2), "?"));
+    CHECK(!strcmp(vdsh_method_name(2), "mirror"));
+    CHECK(!strcmp(vdsh_method_name(3), "lsq"));
+    CHECK(!strcmp(vdsh_method_name(4), "?"));
     CHECK(!strcmp(vdsh_encoding_name(0), "f32"));
     CHECK(!strcmp(vdsh_encoding_name(1), "f16"));
     CHECK(!strcmp(vdsh_encoding_name(2), "?"));
@@ -1233,7 +1237,9 @@ static void test_rules(void)
     PATCH32(coef0 + 4, 2, 1, VDSH_ERR_INVALID, "encoding 2");
     PATCH32(coef0 + 4, 1, 1, VDSH_ERR_CHUNK, "need 32");
     PATCH32(coef0 + 12, 3, 1, VDSH_ERR_INVALID, "quantity 3");
-    PATCH32(coef0 + 12, 2, 1, VDSH_OK, NULL); /* (2, log-distance) */
+    /* A log-distance stream needs its floor; a distance stream has none. */
+    PATCH32(coef0 + 12, 2, 1, VDSH_ERR_INVALID, "quantity_param 0 must be the log floor");
+    PATCHF(coef0 + 32, 0.5f, VDSH_ERR_INVALID, "quantity_param 0.5 must be 0");
     PATCH32(coef0 + 16, 3, 1, VDSH_ERR_INVALID, "window 3");
     PATCHF(coef0 + 20, 1.0f, VDSH_ERR_INVALID, "without a window");
     PATCHF(coef1 + 20, NAN, VDSH_ERR_INVALID, "window_param");
@@ -1610,6 +1616,7 @@ static void test_writer_checks(void)
     REJECT("scale", s_.streams[0].scale = 0);
     REJECT("scale", s_.streams[0].scale = -2);
     REJECT("scale", s_.streams[0].scale = INFINITY);
+    REJECT("quantity_param 0.5 must be 0", s_.streams[0].quantity_param = 0.5f);
     REJECT("data is NULL", s_.streams[1].data = NULL);
     REJECT("streams 0 and 1 are both order 2 distance",
            s_.streams[1] = s_.streams[0]);

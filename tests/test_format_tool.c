@@ -90,12 +90,13 @@ static int write_fixtures(const char *dir)
     }
     f.source_count = 2;
     f.sources = src;
-    st[0] = (vdsh_stream){5, VDSH_ENCODING_F16, VDSH_METHOD_PAPER,
-                          VDSH_QUANTITY_DISTANCE, VDSH_WINDOW_HANN, 2.5f,
-                          0.0f, 15.0f, c5};
-    st[1] = (vdsh_stream){3, VDSH_ENCODING_F32, VDSH_METHOD_FULL,
-                          VDSH_QUANTITY_LOG_DISTANCE, VDSH_WINDOW_NONE, 0.0f,
-                          0.0f, 1.0f, c3};
+    st[0] = (vdsh_stream){.order = 5, .encoding = VDSH_ENCODING_F16,
+                          .method = VDSH_METHOD_PAPER, .quantity = VDSH_QUANTITY_DISTANCE,
+                          .window = VDSH_WINDOW_HANN, .window_param = 2.5f,
+                          .scale = 15.0f, .data = c5};
+    st[1] = (vdsh_stream){.order = 3, .encoding = VDSH_ENCODING_F32,
+                          .method = VDSH_METHOD_FULL, .quantity = VDSH_QUANTITY_LOG_DISTANCE,
+                          .scale = 1.0f, .quantity_param = 0.25f, .data = c3};
     f.stream_count = 2;
     f.streams = st;
     f.has_stats = 1;

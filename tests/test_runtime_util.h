@@ -104,6 +104,8 @@ static inline void rt_file_add_stream(rt_file *r, uint32_t order, uint32_t enc, 
     s->encoding = enc;
     s->quantity = quantity;
     s->scale = scale;
+    /* The floor is only a record of the bake; the test streams are synthetic. */
+    s->quantity_param = quantity == VDSH_QUANTITY_LOG_DISTANCE ? 0.01f : 0.0f;
     if (enc == VDSH_ENCODING_F16) {
         uint16_t *d = malloc(n * 2 + 2);
         for (size_t k = 0; k < n; k++) {

@@ -210,6 +210,72 @@ static void test_shadow(void)
           "distance2 reconstructs the square root");
 }
 
+/* Interior points: every mode agrees at a vertex; coefficients and
+ * distance agree for a constant linear function; for log-distance the
+ * coefficients give the geometric mean of the vertices' distances and the
+ * distance mode the arithmetic mean; a light at a vertex is defined. */
+static void test_interior(void)
+{
+    float ca[25] = {0}, cb[25] = {0}, cc[25] = {0};
+    uint64_t s = 5;
+    for (int i = 0; i < 25; i++) {
+        ca[i] = (float)(test_rand(&s) - 0.5), cb[i] = (float)(test_rand(&s) - 0.5);
+        cc[i] = (float)(test_rand(&s) - 0.5);
+    }
+    ca[0] = cb[0] = cc[0] = 12.0f; /* keep the distances positive */
+    const float pa[3] = {0, 0, 0}, pb[3] = {2, 0, 0}, pc[3] = {0, 0, 2}, l[3] = {0.7f, 3, 0.4f};
+    const float *c[3] = {ca, cb, cc}, *pv[3] = {pa, pb, pc};
+    for (uint32_t q = 0; q < 3; q += 2)
+        for (uint32_t m = 0; m < 4; m++)
+            for (int k = 0; k < 3; k++) {
+                float b[3] = {0, 0, 0};
+                b[k] = 1.0f;
+                float want = vdsh_shadow(5, q, c[k], pv[k], l, VDSH_COMPARE_SMOOTH);
+                float got = vdsh_shadow_interior(5, q, m, c, pv, b, l, VDSH_COMPARE_SMOOTH, NULL);
+                CHECK(fabsf(got - want) < 1e-5f, "%s, quantity %u, vertex %d: %g vs %g",
+                      vdsh_interp_name(m), q, k, got, want);
+            }
+
+    float k1[25] = {0}, k2[25] = {0};
+    k1[0] = k2[0] = (float)(3.0 * sqrt(4.0 * M_PI)); /* D = 3 everywhere */
+    const float *kc[3] = {k1, k2, k1}, b[3] = {0.2f, 0.5f, 0.3f};
+    float dc, dd, ds;
+    vdsh_shadow_interior(3, VDSH_QUANTITY_DISTANCE, VDSH_INTERP_COEFFICIENTS, kc, pv, b, l,
+                         VDSH_COMPARE_SMOOTH, &dc);
+    vdsh_shadow_interior(3, VDSH_QUANTITY_DISTANCE, VDSH_INTERP_DISTANCE, kc, pv, b, l,
+                         VDSH_COMPARE_SMOOTH, &dd);
+    vdsh_shadow_interior(5, VDSH_QUANTITY_DISTANCE, VDSH_INTERP_SPLIT, kc, pv, b, l,
+                         VDSH_COMPARE_SMOOTH, &ds);
+    CHECK(fabsf(dc - 3) < 1e-5f && fabsf(dd - 3) < 1e-5f && fabsf(ds - 3) < 1e-5f,
+          "constant D = 3: %g %g %g", dc, dd, ds);
+
+    float g1[25] = {0}, g2[25] = {0};
+    g1[0] = (float)(log(1.0) * sqrt(4.0 * M_PI)), g2[0] = (float)(log(100.0) * sqrt(4.0 * M_PI));
+    const float *gc[3] = {g1, g2, g2}, half[3] = {0.5f, 0.5f, 0.0f};
+    vdsh_shadow_interior(2, VDSH_QUANTITY_LOG_DISTANCE, VDSH_INTERP_COEFFICIENTS, gc, pv, half,
+                         l, VDSH_COMPARE_SMOOTH, &dc);
+    vdsh_shadow_interior(2, VDSH_QUANTITY_LOG_DISTANCE, VDSH_INTERP_DISTANCE, gc, pv, half, l,
+                         VDSH_COMPARE_SMOOTH, &dd);
+    CHECK(fabsf(dc - 10.0f) < 1e-3f, "log coefficients: geometric mean 10, got %g", dc);
+    CHECK(fabsf(dd - 50.5f) < 1e-3f, "log distances: arithmetic mean 50.5, got %g", dd);
+
+    for (uint32_t m = 0; m < 4; m++) {
+        float at_a[3] = {1, 0, 0};
+        float v = vdsh_shadow_interior(5, VDSH_QUANTITY_DISTANCE, m, c, pv, at_a, pa,
+                                       VDSH_COMPARE_SMOOTH, &dd);
+        CHECK(v == 1.0f && isfinite(dd), "%s: light at the vertex gives %g", vdsh_interp_name(m), v);
+        float mid[3] = {0.25f, 0.25f, 0.5f};
+        v = vdsh_shadow_interior(5, VDSH_QUANTITY_DISTANCE, m, c, pv, mid, pa,
+                                 VDSH_COMPARE_SMOOTH, &dd);
+        CHECK(v >= 0 && v <= 1 && isfinite(dd), "%s: light at a corner, inside: %g",
+              vdsh_interp_name(m), v);
+    }
+    CHECK(vdsh_runtime_interp(2, VDSH_QUANTITY_DISTANCE) == VDSH_INTERP_VISIBILITY &&
+          vdsh_runtime_interp(5, VDSH_QUANTITY_DISTANCE) == VDSH_INTERP_SPLIT &&
+          vdsh_runtime_interp(5, VDSH_QUANTITY_LOG_DISTANCE) == VDSH_INTERP_DISTANCE,
+          "runtime paths");
+}
+
 /* The fused projection is the same kernel as evaluation. */
 static void test_project(void)
 {
@@ -243,6 +309,7 @@ static void test_project(void)
 int main(void)
 {
     test_shadow();
+    test_interior();
     test_project();
     test_orthonormal();
     test_design_values();
