@@ -1,18 +1,13 @@
 #include "bake.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
-#if defined(__SSE__)
-#include <xmmintrin.h>
-#include <pmmintrin.h>
-#endif
 
 #include "fit.h"
+#include "parallel.h"
 #include "sampling.h"
 #include "vdsh.h"
 #include "vdsh_sh.h"
@@ -77,8 +72,8 @@ vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err)
     return VB_OK;
 }
 
-vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, float *out,
-                         vb_error *err)
+vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads,
+                         float *out, vb_error *err)
 {
     uint32_t n = m->vertex_count;
     float *navg = malloc((size_t)n * 3 * sizeof *navg);
@@ -148,13 +143,8 @@ typedef struct job {
     float inv_scale;
     float degenerate_dist; /* scene units */
     int horizon;           /* paper: skip w.n < 0 */
-    _Atomic uint32_t next;
-    _Atomic uint32_t done;
     _Atomic uint64_t traced, missed;
-    _Atomic uint32_t degenerate, undefined;
-    _Atomic int running;
-    pthread_mutex_t lock;
-    pthread_cond_t cond;
+    _Atomic uint32_t degenerate;
 } job;
 
 /* ln(x) for finite x > 0, to about 1e-7 relative, in plain float
@@ -269,36 +259,23 @@ static void bake_vertex(job *J, uint32_t v, uint64_t *traced, uint64_t *missed,
         (*degenerate)++;
 }
 
-static void *worker(void *arg)
+static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
 {
-    job *J = arg;
-#if defined(__SSE__)
-    /* Embree's recommendation; set in every worker alike so results do not
-     * depend on which thread baked a vertex. */
-    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-#endif
-    uint32_t total = J->d->receivers->vertex_count;
+    job *J = ctx;
+    (void)worker;
     uint64_t traced = 0, missed = 0;
     uint32_t degenerate = 0;
-    for (;;) {
-        uint32_t a = atomic_fetch_add(&J->next, BLOCK);
-        if (a >= total)
-            break;
-        uint32_t b = a + BLOCK < total ? a + BLOCK : total;
-        uint64_t before = traced;
-        for (uint32_t v = a; v < b; v++)
-            bake_vertex(J, v, &traced, &missed, &degenerate);
-        atomic_fetch_add(&J->traced, traced - before);
-        atomic_fetch_add(&J->done, b - a);
-    }
+    for (uint32_t v = begin; v < end; v++)
+        bake_vertex(J, v, &traced, &missed, &degenerate);
+    atomic_fetch_add(&J->traced, traced);
     atomic_fetch_add(&J->missed, missed);
     atomic_fetch_add(&J->degenerate, degenerate);
-    pthread_mutex_lock(&J->lock);
-    atomic_fetch_sub(&J->running, 1);
-    pthread_cond_signal(&J->cond);
-    pthread_mutex_unlock(&J->lock);
-    return NULL;
+}
+
+static void bake_progress(void *user, uint32_t done, uint32_t total)
+{
+    job *J = user;
+    J->d->progress(J->d->progress_user, done, total, atomic_load(&J->traced));
 }
 
 vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
@@ -398,12 +375,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         d.log_floor = 0.01f * d.max_distance;
     if (!(d.log_floor > 0.0f) || !isfinite(d.log_floor))
         return vb_fail(err, VB_ERR_ARGUMENT, "the log-distance floor must be a positive number");
-    if (d.threads == 0) {
-        long nc = sysconf(_SC_NPROCESSORS_ONLN);
-        d.threads = nc > 0 ? (unsigned)nc : 1;
-    }
-    if (d.threads > 256)
-        d.threads = 256;
+    d.threads = vb_parallel_threads(d.threads);
 
     const vb_mesh *R = d.receivers;
     for (size_t i = 0; i < 3 * (size_t)R->vertex_count; i++)
@@ -430,9 +402,8 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     for (int o = 1; o <= VDSH_MAX_ORDER && !d.trace_only; o++)
         if (d.order_mask & (1u << o))
             missing |= !(coeffs[o] = malloc((size_t)R->vertex_count * o * o * sizeof(float)));
-    pthread_t *th = calloc(d.threads, sizeof *th);
     job *J = calloc(1, sizeof *J);
-    if (!origins || missing || !th || !J) {
+    if (!origins || missing || !J) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
                     R->vertex_count);
         goto done;
@@ -440,7 +411,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     for (int o = 1; o <= VDSH_MAX_ORDER; o++)
         if (coeffs[o] && (r = vb_fit_create(o, d.method, d.lambda, &J->fits[o], err)) != VB_OK)
             goto done;
-    r = vb_ray_origins(R, d.scene, origins, err);
+    r = vb_ray_origins(R, d.scene, d.threads, origins, err);
     if (r != VB_OK)
         goto done;
 
@@ -455,9 +426,6 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     J->inv_scale = 1.0f / d.scene->scale;
     J->degenerate_dist = 1e-3f * d.scene->diagonal;
     J->horizon = d.method == VDSH_METHOD_PAPER;
-    pthread_mutex_init(&J->lock, NULL);
-    pthread_cond_init(&J->cond, NULL);
-
     uint32_t undefined = 0;
     for (uint32_t v = 0; v < R->vertex_count; v++) {
         const float *n = R->normals + 3 * (size_t)v;
@@ -465,41 +433,12 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     }
 
     double t0 = vb_now();
-    unsigned started = 0;
-    atomic_store(&J->running, (int)d.threads);
-    for (; started < d.threads; started++)
-        if (pthread_create(&th[started], NULL, worker, J) != 0)
-            break;
-    if (started < d.threads)
-        atomic_fetch_sub(&J->running, (int)(d.threads - started));
+    unsigned started = vb_parallel_for(d.threads, R->vertex_count, BLOCK, bake_block, J,
+                                       d.progress ? bake_progress : NULL, J);
     if (started == 0) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
-        goto done_sync;
+        goto done;
     }
-
-    pthread_mutex_lock(&J->lock);
-    while (atomic_load(&J->running) > 0) {
-        struct timespec ts;
-        clock_gettime(CLOCK_REALTIME, &ts);
-        ts.tv_nsec += 200000000L;
-        if (ts.tv_nsec >= 1000000000L) {
-            ts.tv_sec++;
-            ts.tv_nsec -= 1000000000L;
-        }
-        pthread_cond_timedwait(&J->cond, &J->lock, &ts);
-        if (d.progress && atomic_load(&J->running) > 0) {
-            pthread_mutex_unlock(&J->lock);
-            d.progress(d.progress_user, atomic_load(&J->done), R->vertex_count,
-                       atomic_load(&J->traced));
-            pthread_mutex_lock(&J->lock);
-        }
-    }
-    pthread_mutex_unlock(&J->lock);
-    for (unsigned i = 0; i < started; i++)
-        pthread_join(th[i], NULL);
-    if (d.progress)
-        d.progress(d.progress_user, R->vertex_count, R->vertex_count,
-                   atomic_load(&J->traced));
 
     vb_bake_output o = {0};
     o.max_order = d.max_order;
@@ -522,12 +461,8 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     *out = o;
     r = VB_OK;
 
-done_sync:
-    pthread_cond_destroy(&J->cond);
-    pthread_mutex_destroy(&J->lock);
 done:
     free(J);
-    free(th);
     for (int k = 0; k <= VDSH_MAX_ORDER; k++)
         free(coeffs[k]);
     free(origins);

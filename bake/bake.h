@@ -116,8 +116,8 @@ vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err);
 
 /* Ray origins in the scene's traced frame for every receiver (3 floats
  * each), by the rule above. */
-vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, float *out,
-                         vb_error *err);
+vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads,
+                         float *out, vb_error *err);
 
 /* Monotonic wall clock in seconds. */
 double vb_now(void);

@@ -10,19 +10,13 @@
  * sums in receiver order, so no result depends on which worker did what.
  */
 #include "eval.h"
+#include "parallel.h"
 
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
-#if defined(__SSE__)
-#include <pmmintrin.h>
-#include <xmmintrin.h>
-#endif
 
 #include "bake.h"
 #include "sampling.h"
@@ -156,12 +150,6 @@ typedef struct job {
     uint64_t *hist;        /* per worker: KINDS * streams * HIST_BINS */
     uint64_t dir_seed, light_seed;
     float max_local, inv_scale, max_distance, floor_dist, near_zero_dist;
-    _Atomic uint32_t next;
-    _Atomic uint32_t done;
-    _Atomic int running;
-    _Atomic int worker_id;
-    pthread_mutex_t lock;
-    pthread_cond_t cond;
 } job;
 
 /* The stream's coefficients at a receiver: decoded at a vertex,
@@ -287,31 +275,18 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
     }
 }
 
-static void *worker(void *arg)
+static void eval_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
 {
-    job *J = arg;
-#if defined(__SSE__)
-    /* As in the bake: Embree's recommendation, set in every worker alike so
-     * results do not depend on which thread did a receiver. */
-    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-#endif
-    int me = atomic_fetch_add(&J->worker_id, 1);
-    uint64_t *hist = J->hist + (size_t)me * VB_EVAL_KINDS * J->streams * HIST_BINS;
-    for (;;) {
-        uint32_t a = atomic_fetch_add(&J->next, BLOCK);
-        if (a >= J->rec_count)
-            break;
-        uint32_t b = a + BLOCK < J->rec_count ? a + BLOCK : J->rec_count;
-        for (uint32_t i = a; i < b; i++)
-            eval_receiver(J, i, hist);
-        atomic_fetch_add(&J->done, b - a);
-    }
-    pthread_mutex_lock(&J->lock);
-    atomic_fetch_sub(&J->running, 1);
-    pthread_cond_signal(&J->cond);
-    pthread_mutex_unlock(&J->lock);
-    return NULL;
+    job *J = ctx;
+    uint64_t *hist = J->hist + (size_t)worker * VB_EVAL_KINDS * J->streams * HIST_BINS;
+    for (uint32_t i = begin; i < end; i++)
+        eval_receiver(J, i, hist);
+}
+
+static void eval_progress(void *user, uint32_t done, uint32_t total)
+{
+    const job *J = user;
+    J->d->progress(J->d->progress_user, done, total);
 }
 
 /* ---- public pieces ------------------------------------------------------- */
@@ -731,12 +706,7 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
                        VB_EVAL_MAX_RECEIVERS, d.interior);
     if (d.interior > 0 && f->header.triangle_count == 0)
         d.interior = 0; /* a point cloud has no inside: vertices only */
-    if (d.threads == 0) {
-        long nc = sysconf(_SC_NPROCESSORS_ONLN);
-        d.threads = nc > 0 ? (unsigned)nc : 1;
-    }
-    if (d.threads > 256)
-        d.threads = 256;
+    d.threads = vb_parallel_threads(d.threads);
     const double t0 = vb_now();
     const uint32_t V = f->header.vertex_count, S = f->stream_count;
     float diag = 0.0f;
@@ -758,10 +728,8 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
     double *cdf = NULL;
     receiver *rec = NULL;
     job *J = NULL;
-    pthread_t *th = NULL;
     vb_eval_result o = {0};
     unsigned started = 0;
-    int sync = 0;
 
     r = vb_dirgrid_create(d.directions, 1, &grid, err);
     if (r != VB_OK)
@@ -782,7 +750,7 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
         vb_mesh m = {.vertex_count = V, .triangle_count = f->header.triangle_count,
                      .positions = (float *)f->positions, .normals = (float *)f->normals,
                      .indices = (uint32_t *)f->indices};
-        r = vb_ray_origins(&m, d.scene, vorigin, err);
+        r = vb_ray_origins(&m, d.scene, d.threads, vorigin, err);
         if (r != VB_OK)
             goto done;
     }
@@ -834,8 +802,7 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
 
     /* 2. Trace and score. */
     J = calloc(1, sizeof *J);
-    th = calloc(d.threads, sizeof *th);
-    if (!J || !th) {
+    if (!J) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
@@ -861,41 +828,12 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
     J->inv_scale = 1.0f / d.scene->scale;
     J->floor_dist = 0.01f * diag;
     J->near_zero_dist = VB_EVAL_NEAR_ZERO * diag;
-    pthread_mutex_init(&J->lock, NULL);
-    pthread_cond_init(&J->cond, NULL);
-    sync = 1;
-
-    atomic_store(&J->running, (int)d.threads);
-    for (; started < d.threads; started++)
-        if (pthread_create(&th[started], NULL, worker, J) != 0)
-            break;
-    if (started < d.threads)
-        atomic_fetch_sub(&J->running, (int)(d.threads - started));
+    started = vb_parallel_for(d.threads, nr, BLOCK, eval_block, J,
+                              d.progress ? eval_progress : NULL, J);
     if (started == 0) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
         goto done;
     }
-    pthread_mutex_lock(&J->lock);
-    while (atomic_load(&J->running) > 0) {
-        struct timespec ts;
-        clock_gettime(CLOCK_REALTIME, &ts);
-        ts.tv_nsec += 200000000L;
-        if (ts.tv_nsec >= 1000000000L) {
-            ts.tv_sec++;
-            ts.tv_nsec -= 1000000000L;
-        }
-        pthread_cond_timedwait(&J->cond, &J->lock, &ts);
-        if (d.progress && atomic_load(&J->running) > 0) {
-            pthread_mutex_unlock(&J->lock);
-            d.progress(d.progress_user, atomic_load(&J->done), nr);
-            pthread_mutex_lock(&J->lock);
-        }
-    }
-    pthread_mutex_unlock(&J->lock);
-    for (unsigned i = 0; i < started; i++)
-        pthread_join(th[i], NULL);
-    if (d.progress)
-        d.progress(d.progress_user, nr, nr);
 
     /* 3. Reduce in receiver order. */
     o.stream_count = S;
@@ -969,17 +907,12 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
 
 done:
     if (J) {
-        if (sync) {
-            pthread_cond_destroy(&J->cond);
-            pthread_mutex_destroy(&J->lock);
-        }
         free(J->acc);
         free(J->truth);
         free(J->hist);
     }
     vb_eval_result_free(&o);
     free(J);
-    free(th);
     free(rec);
     free(cdf);
     free(vorigin);
