@@ -750,7 +750,7 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
         vb_mesh m = {.vertex_count = V, .triangle_count = f->header.triangle_count,
                      .positions = (float *)f->positions, .normals = (float *)f->normals,
                      .indices = (uint32_t *)f->indices};
-        r = vb_ray_origins(&m, d.scene, d.threads, vorigin, err);
+        r = vb_ray_origins(&m, d.scene, d.threads, vorigin, NULL, err);
         if (r != VB_OK)
             goto done;
     }

@@ -49,6 +49,8 @@ typedef struct options {
     int robust;
     int record_timings;
     int trace_only;
+    int keep_normals;
+    uint32_t flipped;
     int quiet;
 } options;
 
@@ -97,6 +99,9 @@ static void usage(FILE *f)
 "      --max-edge L        refine receivers until no edge is longer than L\n"
 "                          (default 0: the mesh vertices as they are)\n"
 "      --weld              merge vertices with identical positions\n"
+"      --keep-normals      keep normals that point into geometry (default:\n"
+"                          a receiver blocked at ~0 on its own side and open\n"
+"                          on the other gets its normal flipped)\n"
 "      --seed N            seed of every random sequence (default 1)\n"
 "      --robust            Embree's robust traversal (slower)\n"
 "      --threads N         worker threads (default: all cores)\n"
@@ -292,6 +297,8 @@ static int write_report(const char *path, const options *o, const vdsh_file *f,
             (unsigned long long)b->rays_traced, (unsigned long long)b->rays_missed);
     fprintf(fp, "  \"degenerate_receivers\": %u,\n  \"undefined_normals\": %u,\n",
             b->degenerate_receivers, b->undefined_normals);
+    fprintf(fp, "  \"moved_origins\": %u,\n  \"flipped_normals\": %u,\n", b->moved_origins,
+            o->flipped);
     fprintf(fp, "  \"seconds\": {\"load\": %.6f, \"refine\": %.6f, \"build\": %.6f, "
                 "\"trace\": %.6f, \"write\": %.6f, \"total\": %.6f},\n",
             t->load, t->refine, t->build, t->trace, write_seconds,
@@ -352,7 +359,7 @@ int main(int argc, char **argv)
 
     enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST,
-           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_FLOOR };
+           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_FLOOR, O_KEEP_NORMALS };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
@@ -374,6 +381,7 @@ int main(int argc, char **argv)
         {"log", no_argument, 0, O_LOG},
         {"lambda", required_argument, 0, O_LAMBDA},
         {"log-floor", required_argument, 0, O_LOG_FLOOR},
+        {"keep-normals", no_argument, 0, O_KEEP_NORMALS},
         {"quiet", no_argument, 0, 'q'},
         {"help", no_argument, 0, 'h'},
         {"version", no_argument, 0, 'V'},
@@ -438,6 +446,7 @@ int main(int argc, char **argv)
             if (!parse_float(optarg, &o.lambda) || o.lambda == 0.0f)
                 return bad_usage("--lambda takes a positive number, not '%s'", optarg);
             break;
+        case O_KEEP_NORMALS: o.keep_normals = 1; break;
         case O_LOG_FLOOR:
             if (!parse_float(optarg, &o.log_floor) || o.log_floor == 0.0f)
                 return bad_usage("--log-floor takes a positive number, not '%s'", optarg);
@@ -540,6 +549,15 @@ int main(int argc, char **argv)
     tm.build = vb_now() - t;
     if (o.max_distance == 0.0f)
         o.max_distance = scene->diagonal;
+    if (!o.keep_normals) {
+        if (vb_orient_receivers(&rec, scene, o.threads, &o.flipped, &err) != VB_OK) {
+            fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+            goto out;
+        }
+        if (log && o.flipped)
+            fprintf(log, "vdsh-bake: %u receiver normals pointed into geometry and were "
+                         "flipped (--keep-normals keeps them)\n", o.flipped);
+    }
 
     /* 4. Trace and project. */
     int max_order = o.orders[o.order_count - 1];
@@ -568,11 +586,12 @@ int main(int argc, char **argv)
     tm.total = vb_now() - t_start;
     if (log)
         fprintf(log, "vdsh-bake: traced %.1f M rays in %.2f s (%.1f Mrays/s on %u "
-                     "threads), %.2f%% missed, %u degenerate receivers\n",
+                     "threads), %.2f%% missed, %u ray origins moved off other geometry, "
+                     "%u degenerate receivers\n",
                 bo.rays_traced * 1e-6, bo.seconds,
                 bo.seconds > 0 ? bo.rays_traced / bo.seconds * 1e-6 : 0.0, bo.threads,
                 bo.rays_traced ? 100.0 * bo.rays_missed / bo.rays_traced : 0.0,
-                bo.degenerate_receivers);
+                bo.moved_origins, bo.degenerate_receivers);
     if (log && bo.degenerate_receivers > 0)
         fprintf(log, "vdsh-bake: warning: %u receivers (%.2f%%) see distance ~0 in almost "
                      "every direction above their horizon: receivers inside or flush "
@@ -643,7 +662,9 @@ int main(int argc, char **argv)
     f.has_stats = 1;
     f.stats = (vdsh_stats){.rays_traced = bo.rays_traced, .rays_missed = bo.rays_missed,
                            .degenerate_receivers = bo.degenerate_receivers,
-                           .undefined_normals = bo.undefined_normals};
+                           .undefined_normals = bo.undefined_normals,
+                           .moved_origins = bo.moved_origins,
+                           .flipped_normals = o.flipped};
     f.has_timings = o.record_timings;
     f.timings = tm;
     vdsh_error verr;

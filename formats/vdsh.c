@@ -1016,6 +1016,22 @@ static int check_stream_data(const vdsh_stream *s, uint32_t i, uint32_t v,
     return 1;
 }
 
+/* The statistics must describe a bake of vertex_count receivers. */
+static int check_stats(const vdsh_stats *t, uint32_t vertex_count, why *w)
+{
+    if (t->rays_missed > t->rays_traced)
+        return bad(w, "stat: %llu rays missed of %llu traced",
+                   (unsigned long long)t->rays_missed, (unsigned long long)t->rays_traced);
+    const uint32_t v[4] = {t->degenerate_receivers, t->undefined_normals, t->moved_origins,
+                           t->flipped_normals};
+    static const char *const n[4] = {"degenerate_receivers", "undefined_normals",
+                                     "moved_origins", "flipped_normals"};
+    for (int k = 0; k < 4; k++)
+        if (v[k] > vertex_count)
+            return bad(w, "stat: %s %u exceeds the %u receivers", n[k], v[k], vertex_count);
+    return 1;
+}
+
 static int check_timings(const vdsh_timings *t, why *w)
 {
     const double v[5] = {t->load, t->refine, t->build, t->trace, t->total};
@@ -1382,17 +1398,19 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
 static vdsh_result read_stat(const reader *r, const chunk_ref *c, layout *L)
 {
     const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
+    why w;
     if (c->size != STAT_SIZE)
         return fail(r->err, VDSH_ERR_CHUNK, r->name,
                     "stat: payload is %llu bytes, must be %d",
                     (unsigned long long)c->size, STAT_SIZE);
-    if (!all_zero(p + 24, 8))
-        return fail(r->err, VDSH_ERR_INVALID, r->name,
-                    "stat: reserved bytes 24..31 not zero");
     L->stats.rays_traced = get_u64(p + 0);
     L->stats.rays_missed = get_u64(p + 8);
     L->stats.degenerate_receivers = get_u32(p + 16);
     L->stats.undefined_normals = get_u32(p + 20);
+    L->stats.moved_origins = get_u32(p + 24);
+    L->stats.flipped_normals = get_u32(p + 28);
+    if (!check_stats(&L->stats, L->header.vertex_count, &w))
+        return invalid(r, &w);
     L->has_stats = 1;
     return VDSH_OK;
 }
@@ -1806,6 +1824,8 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
         if (!check_stream_data(s, i, h->vertex_count, &w))
             return argument(err, name, &w);
     }
+    if (f->has_stats && !check_stats(&f->stats, h->vertex_count, &w))
+        return argument(err, name, &w);
     if (f->has_timings && !check_timings(&f->timings, &w))
         return argument(err, name, &w);
     return VDSH_OK;
@@ -1906,6 +1926,8 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
         put_u64(p + 8, f->stats.rays_missed);
         put_u32(p + 16, f->stats.degenerate_receivers);
         put_u32(p + 20, f->stats.undefined_normals);
+        put_u32(p + 24, f->stats.moved_origins);
+        put_u32(p + 28, f->stats.flipped_normals);
         add_chunk(P, "stat", p, STAT_SIZE, NULL, 0);
     }
     if (f->has_timings) {

@@ -174,6 +174,8 @@ typedef struct vdsh_stats {
     uint64_t rays_missed;
     uint32_t degenerate_receivers;
     uint32_t undefined_normals;
+    uint32_t moved_origins;    /* receivers whose ray origin was repaired */
+    uint32_t flipped_normals;  /* receivers whose normal was turned to free space */
 } vdsh_stats;
 
 typedef struct vdsh_timings {

@@ -264,8 +264,9 @@ static void print_summary(const char *path, const vdsh_file *f,
         if (t->rays_traced)
             printf(" (%.2f%%)", 100.0 * (double)t->rays_missed /
                                     (double)t->rays_traced);
-        printf("\n               degenerate receivers %u, undefined normals "
-               "%u\n", t->degenerate_receivers, t->undefined_normals);
+        printf("\n               degenerate receivers %u, undefined normals %u, "
+               "origins moved %u, normals flipped %u\n", t->degenerate_receivers,
+               t->undefined_normals, t->moved_origins, t->flipped_normals);
     }
     if (f->has_timings) {
         const vdsh_timings *t = &f->timings;
@@ -369,10 +370,12 @@ static void print_json(const char *path, const vdsh_file *f, uint64_t size)
     fputs("  \"stats\": ", stdout);
     if (f->has_stats)
         printf("{\"rays_traced\": %llu, \"rays_missed\": %llu, "
-               "\"degenerate_receivers\": %u, \"undefined_normals\": %u},\n",
+               "\"degenerate_receivers\": %u, \"undefined_normals\": %u, "
+               "\"moved_origins\": %u, \"flipped_normals\": %u},\n",
                (unsigned long long)f->stats.rays_traced,
                (unsigned long long)f->stats.rays_missed,
-               f->stats.degenerate_receivers, f->stats.undefined_normals);
+               f->stats.degenerate_receivers, f->stats.undefined_normals,
+               f->stats.moved_origins, f->stats.flipped_normals);
     else
         fputs("null,\n", stdout);
 

@@ -336,21 +336,27 @@ static void test_threads(void)
     test_mesh_free(&rec);
 }
 
-/* Offset normals average over bit-identical positions only. */
+/* Offset normals average over bit-identical positions only, and only
+ * normals facing the same side. */
 static void test_offset_normals(void)
 {
     vb_mesh m = {0};
-    float p[9] = {1, 2, 3, 1, 2, 3, 1, 2, 3.0001f};
-    float n[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-    test_make_points(&m, 3, p, n);
-    float out[9];
+    float p[12] = {1, 2, 3, 1, 2, 3, 1, 2, 3.0001f, 1, 2, 3};
+    float n[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, -1, 0};
+    test_make_points(&m, 4, p, n);
+    float out[12];
     vb_error err;
     CHECK(vb_offset_normals(&m, out, &err) == VB_OK, "offset normals");
+    /* Vertices 0, 1, 3 share a position; each sums the normals not facing
+     * away from its own: 0 takes (1,0,0) + (0,1,0) + (0,-1,0); 1 takes
+     * (1,0,0) + (0,1,0); 3 takes (1,0,0) + (0,-1,0). Vertex 2 is alone. */
     float r = 1.0f / sqrtf(2.0f);
-    CHECK(fabsf(out[0] - r) < 1e-6f && fabsf(out[1] - r) < 1e-6f && out[2] == 0,
-          "averaged normal (%g %g %g)", out[0], out[1], out[2]);
-    CHECK(memcmp(out, out + 3, 3 * sizeof(float)) == 0, "shared position, different normals");
+    CHECK(out[0] == 1 && out[1] == 0 && out[2] == 0, "vertex 0: (%g %g %g)", out[0], out[1], out[2]);
+    CHECK(fabsf(out[3] - r) < 1e-6f && fabsf(out[4] - r) < 1e-6f && out[5] == 0,
+          "vertex 1: (%g %g %g)", out[3], out[4], out[5]);
     CHECK(out[6] == 0 && out[7] == 0 && out[8] == 1, "distinct position changed");
+    CHECK(fabsf(out[9] - r) < 1e-6f && fabsf(out[10] + r) < 1e-6f && out[11] == 0,
+          "vertex 3: (%g %g %g)", out[9], out[10], out[11]);
     test_mesh_free(&m);
 }
 

@@ -352,8 +352,11 @@ static void sample_init(sample *s, int kind, uint32_t v)
         s->f.has_stats = 1;
         s->f.stats.rays_traced = 136250000000ull;
         s->f.stats.rays_missed = 12345;
-        s->f.stats.degenerate_receivers = 7;
+        /* Counts of receivers: at most the smallest sample's 4. */
+        s->f.stats.degenerate_receivers = 3;
         s->f.stats.undefined_normals = 2;
+        s->f.stats.moved_origins = 1;
+        s->f.stats.flipped_normals = 4;
         s->f.has_timings = 1;
         s->f.timings.load = 0.125;
         s->f.timings.refine = 1.0 / 3.0;
@@ -440,6 +443,8 @@ static void check_same_file(const vdsh_file *got, const vdsh_file *want)
         CHECK(got->stats.degenerate_receivers ==
               want->stats.degenerate_receivers);
         CHECK(got->stats.undefined_normals == want->stats.undefined_normals);
+        CHECK(got->stats.moved_origins == want->stats.moved_origins);
+        CHECK(got->stats.flipped_normals == want->stats.flipped_normals);
     }
     CHECK(!!got->has_timings == !!want->has_timings);
     if (want->has_timings) {
@@ -1282,7 +1287,8 @@ static void test_rules(void)
                    "name padding", __LINE__);
 
     /* Ancillary chunks we know. */
-    PATCH32(stat + 28, 1, 1, VDSH_ERR_INVALID, "stat: reserved");
+    PATCH32(stat + 28, 0xffffffffu, 1, VDSH_ERR_INVALID, "stat: flipped_normals 4294967295 exceeds");
+    PATCH32(stat + 12, 0x7fffffffu, 1, VDSH_ERR_INVALID, "rays missed of");
     PATCH32(tim + 4, 0x7ff80000u, 1, VDSH_ERR_INVALID, "time: load"); /* NaN */
     PATCH32(tim + 20, 0x7ff00000u, 1, VDSH_ERR_INVALID, "time: build");
     PATCH32(tim + 60, 1, 1, VDSH_ERR_INVALID, "time: reserved");

@@ -376,6 +376,110 @@ static void test_open_mesh(void)
     test_mesh_free(&rec);
 }
 
+/* A closed solid box [x0,x1] x [y0,y1] x [z0,z1]: six unwelded quads with
+ * outward normals (or inward with `inverted`). */
+static void add_box(vb_mesh *m, float x0, float x1, float y0, float y1, float z0, float z1,
+                    int inverted)
+{
+    const float c[8][3] = {{x0, y0, z0}, {x1, y0, z0}, {x0, y1, z0}, {x1, y1, z0},
+                           {x0, y0, z1}, {x1, y0, z1}, {x0, y1, z1}, {x1, y1, z1}};
+    static const int q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    static const float nrm[6][3] = {{0, 0, -1}, {0, 0, 1}, {0, -1, 0},
+                                    {0, 1, 0}, {-1, 0, 0}, {1, 0, 0}};
+    for (int f = 0; f < 6; f++) {
+        const float quad[4][3] = {{c[q[f][0]][0], c[q[f][0]][1], c[q[f][0]][2]},
+                                  {c[q[f][1]][0], c[q[f][1]][1], c[q[f][1]][2]},
+                                  {c[q[f][2]][0], c[q[f][2]][1], c[q[f][2]][2]},
+                                  {c[q[f][3]][0], c[q[f][3]][1], c[q[f][3]][2]}};
+        const float s = inverted ? -1.0f : 1.0f;
+        const float n[3] = {s * nrm[f][0], s * nrm[f][1], s * nrm[f][2]};
+        test_add_quad(m, quad, n);
+    }
+}
+
+/* Inverted normals: a closed solid whose normals point into it gets them
+ * turned back out; the room's own (right) normals, and a floor covered
+ * by a crate resting on it, are left alone. */
+static void test_inverted_normals(void)
+{
+    vb_mesh m = {0}, rec = {0};
+    test_make_room(&m, 4.0f, 3.0f, 2.5f);
+    uint32_t room_vertices = m.vertex_count;
+    add_box(&m, -1, 1, 1, 2, -0.5f, 0.5f, 1);  /* floating, normals inverted */
+    add_box(&m, 2, 3, 0, 1, -1, 0, 0);        /* a crate on the floor, right */
+    vb_error err;
+    CHECK(vb_mesh_refine(&m, 0.5f, &rec, &err) == VB_OK, "refine");
+    vb_scene *s = NULL;
+    CHECK(vb_scene_create(&m, NULL, &s, &err) == VB_OK, "scene");
+    float *before = malloc(3 * (size_t)rec.vertex_count * sizeof(float));
+    memcpy(before, rec.normals, 3 * (size_t)rec.vertex_count * sizeof(float));
+    uint32_t flipped = 0;
+    CHECK(vb_orient_receivers(&rec, s, 2, &flipped, &err) == VB_OK, "orient: %s", err.msg);
+    uint32_t box = 0, wrong = 0;
+    for (uint32_t v = 0; v < rec.vertex_count; v++) {
+        const float *p = rec.positions + 3 * (size_t)v, *n = rec.normals + 3 * (size_t)v;
+        int in_box = p[0] >= -1 && p[0] <= 1 && p[1] >= 1 && p[1] <= 2 && p[2] >= -0.5f &&
+                     p[2] <= 0.5f;
+        /* A box vertex's normal must now point out: away from its centre. */
+        if (in_box && v >= room_vertices) {
+            box++;
+            float out = n[0] * p[0] + n[1] * (p[1] - 1.5f) + n[2] * p[2];
+            wrong += !(out > 0);
+        } else {
+            wrong += memcmp(n, before + 3 * (size_t)v, 3 * sizeof(float)) != 0;
+        }
+    }
+    CHECK(box > 0 && wrong == 0, "%u of %u box or other receivers wrong after orienting (%u flipped)",
+          wrong, rec.vertex_count, flipped);
+    CHECK(flipped == box, "flipped %u, the inverted box has %u receivers", flipped, box);
+    free(before);
+    vb_scene_destroy(s);
+    test_mesh_free(&m);
+    test_mesh_free(&rec);
+}
+
+/* Contact and embedding. A box pressed on the floor with its bottom face
+ * present: those receivers face down into the floor, and an origin offset
+ * along their normal would leave the room (every ray escaping); they are
+ * degenerate by nature (true distances ~0), and only they may be. A wall
+ * panel whose edge is buried 0.2 m inside a solid pillar: those vertices
+ * see only the pillar's inside. The repair moves them onto their own
+ * surface in free space: no ray escapes the closed room, and no buried
+ * vertex stays degenerate. */
+static void test_contact_and_embedded(void)
+{
+    vb_mesh m = {0}, rec = {0};
+    test_make_room(&m, 4.0f, 3.0f, 2.5f);
+    add_box(&m, -2, -1, 0, 1, -1, 0, 0);             /* bottom face on the floor */
+    add_box(&m, 1.5f, 2.5f, 0, 3, 0.5f, 1.5f, 0);    /* a pillar */
+    const float panel[4][3] = {{0.3f, 0.5f, 1}, {0.3f, 2.5f, 1}, {1.7f, 2.5f, 1}, {1.7f, 0.5f, 1}};
+    const float pn[3] = {0, 0, -1};
+    test_add_quad(&m, panel, pn);                    /* its edge x = 1.7 inside the pillar */
+    vb_error err;
+    CHECK(vb_mesh_refine(&m, 0.5f, &rec, &err) == VB_OK, "refine");
+    vb_bake_output b = {0};
+    CHECK(bake_with(&m, &rec, VDSH_METHOD_PAPER, 1024, 1, &b), "bake");
+    if (b.coeffs[5]) {
+        CHECK(b.rays_missed == 0, "%llu rays escaped the closed room",
+              (unsigned long long)b.rays_missed);
+        CHECK(b.moved_origins > 0, "no origin was moved");
+        /* Faces pressed flat: box and pillar bottoms on the floor, the
+         * pillar's top against the ceiling (y = 3). */
+        uint32_t pressed = 0;
+        for (uint32_t v = 0; v < rec.vertex_count; v++) {
+            float ny = rec.normals[3 * (size_t)v + 1], y = rec.positions[3 * (size_t)v + 1];
+            pressed += (ny == -1.0f && y == 0.0f) || (ny == 1.0f && y == 3.0f);
+        }
+        CHECK(b.degenerate_receivers <= pressed,
+              "%u degenerate receivers, %u pressed against the floor or ceiling",
+              b.degenerate_receivers, pressed);
+    }
+    vb_bake_output_free(&b);
+    test_mesh_free(&m);
+    test_mesh_free(&rec);
+}
+
 /* Non-finite or out-of-range input through the API is rejected with a
  * result code, not an assert or a crash. */
 static void test_bad_api_input(void)
@@ -410,6 +514,8 @@ int main(void)
     test_f16_range();
     test_coplanar_receivers();
     test_open_mesh();
+    test_inverted_normals();
+    test_contact_and_embedded();
     test_bad_api_input();
     return test_report("test_hard");
 }
