@@ -608,7 +608,8 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
     memcpy(f, b->coeffs[order], count * sizeof *f);
     vdsh_stream s = {.order = (uint32_t)order, .encoding = encoding, .method = b->method,
                      .quantity = b->quantity, .method_param = b->lambda, .scale = 1.0f,
-                     .quantity_param = b->log_floor, .data = f};
+                     .quantity_param = b->log_floor, .window = b->window,
+                     .window_param = b->window ? (float)order : 0.0f, .data = f};
     if (encoding == VDSH_ENCODING_F16) {
         /* Stored values are coefficient / (the stream's largest
          * |coefficient|): within [-1, 1] whatever the scene's size or clamp
@@ -671,6 +672,8 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
                        d.max_order);
     if (d.method > VDSH_METHOD_LSQ)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", d.method);
+    if (d.window > VDSH_WINDOW_LANCZOS)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown window %u", d.window);
     if (d.quantity != VDSH_QUANTITY_DISTANCE && d.quantity != VDSH_QUANTITY_LOG_DISTANCE)
         return vb_fail(err, VB_ERR_ARGUMENT, "the bake stores distance or log-distance, not %s",
                        vdsh_quantity_name(d.quantity));
@@ -725,9 +728,13 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
                     R->vertex_count);
         goto done;
     }
-    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-        if (coeffs[o] && (r = vb_fit_create(o, d.method, d.lambda, &J->fits[o], err)) != VB_OK)
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
+        if (!coeffs[o])
+            continue;
+        if ((r = vb_fit_create(o, d.method, d.lambda, &J->fits[o], err)) != VB_OK)
             goto done;
+        vb_fit_window(&J->fits[o], d.window);
+    }
     uint32_t moved = 0;
     r = vb_ray_origins(R, d.scene, d.threads, origins, &moved, err);
     if (r != VB_OK)
@@ -764,6 +771,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     o.quantity = d.quantity;
     o.lambda = d.method == VDSH_METHOD_LSQ ? d.lambda : 0.0f;
     o.log_floor = J->log_quantity ? d.log_floor : 0.0f;
+    o.window = d.window;
     o.vertex_count = R->vertex_count;
     memcpy(o.coeffs, coeffs, sizeof coeffs);
     memset(coeffs, 0, sizeof coeffs);

@@ -67,6 +67,7 @@ typedef struct vb_bake_desc {
     uint32_t quantity;         /* vdsh_quantity: distance (0) or log-distance */
     float lambda;              /* lsq regularisation; 0: 1e-4 */
     float log_floor;           /* log-distance floor; 0: 1% of max_distance */
+    uint32_t window;           /* vdsh_window on each order's bands; 0: none */
     uint32_t order_mask;       /* bit n: produce order n; 0: max_order only */
     int max_order;             /* 0: the highest order in order_mask, or 5 */
     unsigned threads;          /* 0: every online core */
@@ -84,6 +85,7 @@ typedef struct vb_bake_output {
     uint32_t quantity;         /* vdsh_quantity stored */
     float lambda;              /* lsq regularisation used (0 otherwise) */
     float log_floor;           /* log-distance floor used (0 otherwise) */
+    uint32_t window;           /* vdsh_window applied */
     uint32_t vertex_count;
     /* Per order n (1..5): vertex_count * n^2 coefficients, vertex-major, or
      * NULL where the order was not asked for (and with trace_only). */

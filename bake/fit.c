@@ -85,6 +85,19 @@ static void gauss01(int n, double *x, double *w)
     }
 }
 
+double vb_window_weight(uint32_t window, int l, int order)
+{
+    double x = (double)l / order;
+    switch (window) {
+    case VDSH_WINDOW_HANN:
+        return 0.5 * (1.0 + cos(PI * x));
+    case VDSH_WINDOW_LANCZOS:
+        return l == 0 ? 1.0 : sin(PI * x) / (PI * x);
+    default:
+        return 1.0;
+    }
+}
+
 vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
                         vb_error *err)
 {
@@ -98,6 +111,8 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
     f.method = method;
     f.lambda = lambda;
     int n = order * order;
+    for (int i = 0; i < n; i++)
+        f.window[i] = 1.0;
 
     switch (method) {
     case VDSH_METHOD_PAPER:
@@ -181,6 +196,14 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
     return VB_OK;
 }
 
+void vb_fit_window(vb_fit *f, uint32_t window)
+{
+    /* A window scales whole bands, and rotations keep bands apart, so it
+     * commutes with S: it applies to the final coefficients. */
+    for (int i = 0; i < f->order * f->order; i++)
+        f->window[i] = vb_window_weight(window, band_of(i), f->order);
+}
+
 void vb_sh_rotation(const vb_fit *f, const double R[9], double *out)
 {
     int n = f->order * f->order;
@@ -215,7 +238,7 @@ void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c)
     int no_normal = n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f;
     if (f->method == VDSH_METHOD_PAPER || f->method == VDSH_METHOD_FULL || no_normal) {
         for (int i = 0; i < nc; i++)
-            c[i] = (float)b[i];
+            c[i] = (float)(f->window[i] * b[i]);
         return;
     }
     float t[3], bt[3];
@@ -235,10 +258,10 @@ void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c)
             s += f->M[i * nc + j] * u[j];
         v[i] = s;
     }
-    for (int i = 0; i < nc; i++) { /* c = S v */
+    for (int i = 0; i < nc; i++) { /* c = window * S v */
         double s = 0.0;
         for (int j = 0; j < nc; j++)
             s += S[i * nc + j] * v[j];
-        c[i] = (float)s;
+        c[i] = (float)(f->window[i] * s);
     }
 }

@@ -40,6 +40,7 @@ typedef struct vb_fit {
     int order;                        /* coefficients kept: order^2 */
     uint32_t method;                  /* vdsh_method */
     float lambda;                     /* lsq regularisation */
+    double window[VB_FIT_MAX];        /* per coefficient: its band's weight */
     double M[VB_FIT_MAX * VB_FIT_MAX];  /* local-frame map, order^2 square */
     /* Rotations: sample directions and, per band l, the pseudo-inverse of
      * the (2l+1) x VB_FIT_ROT_DIRS basis block at them. */
@@ -52,6 +53,14 @@ typedef struct vb_fit {
  * these polynomials). */
 vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
                         vb_error *err);
+
+/* The per-band window applied to a fit's coefficients: Hann
+ * (1 + cos(pi l / order)) / 2, Lanczos sinc(l / order), 1 for none; band
+ * l of `order` bands (vdsh_window values). */
+double vb_window_weight(uint32_t window, int l, int order);
+
+/* Scale the map's rows by the window (c_lm *= w_l). */
+void vb_fit_window(vb_fit *f, uint32_t window);
 
 /* c = S M S^T b for a receiver with unit normal n (b and c: order^2
  * values, world frame; b in double for the sums it comes from). A zero

@@ -39,6 +39,7 @@ typedef struct options {
     uint32_t quantity;
     float lambda;
     float log_floor;
+    uint32_t window;
     uint32_t encoding;
     float max_distance;
     float max_edge;
@@ -92,6 +93,8 @@ static void usage(FILE *f)
 "      --log               store ln(distance) (reconstructed as exp of the SH\n"
 "                          sum); not with paper\n"
 "      --lambda X          lsq regularisation weight (default 1e-4)\n"
+"      --window W          per-band window on the coefficients: none (default),\n"
+"                          hann or lanczos (width: the order)\n"
 "      --log-floor D       with --log, distances below D count as D\n"
 "                          (default: 1%% of the max distance)\n"
 "      --max-distance D    clamp distance; misses get it (default: the\n"
@@ -359,7 +362,7 @@ int main(int argc, char **argv)
 
     enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST,
-           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_FLOOR, O_KEEP_NORMALS };
+           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
@@ -382,6 +385,7 @@ int main(int argc, char **argv)
         {"lambda", required_argument, 0, O_LAMBDA},
         {"log-floor", required_argument, 0, O_LOG_FLOOR},
         {"keep-normals", no_argument, 0, O_KEEP_NORMALS},
+        {"window", required_argument, 0, O_WINDOW},
         {"quiet", no_argument, 0, 'q'},
         {"help", no_argument, 0, 'h'},
         {"version", no_argument, 0, 'V'},
@@ -447,6 +451,12 @@ int main(int argc, char **argv)
                 return bad_usage("--lambda takes a positive number, not '%s'", optarg);
             break;
         case O_KEEP_NORMALS: o.keep_normals = 1; break;
+        case O_WINDOW:
+            if (strcmp(optarg, "none") == 0) o.window = VDSH_WINDOW_NONE;
+            else if (strcmp(optarg, "hann") == 0) o.window = VDSH_WINDOW_HANN;
+            else if (strcmp(optarg, "lanczos") == 0) o.window = VDSH_WINDOW_LANCZOS;
+            else return bad_usage("--window takes none, hann or lanczos, not '%s'", optarg);
+            break;
         case O_LOG_FLOOR:
             if (!parse_float(optarg, &o.log_floor) || o.log_floor == 0.0f)
                 return bad_usage("--log-floor takes a positive number, not '%s'", optarg);
@@ -569,6 +579,7 @@ int main(int argc, char **argv)
         .receivers = &rec, .scene = scene, .rays = o.rays, .seed = o.seed,
         .max_distance = o.max_distance, .method = o.method,
         .quantity = o.quantity, .lambda = o.lambda, .log_floor = o.log_floor,
+        .window = o.window,
         .max_order = max_order, .order_mask = order_mask, .threads = o.threads,
         .trace_only = o.trace_only,
         .progress = on_progress, .progress_user = &pr};

@@ -180,6 +180,39 @@ static void test_mirror_and_paper(void)
         CHECK(c[i] == (float)b[i], "no normal: the projection as it is");
 }
 
+/* A window scales each band of the final coefficients, whatever the
+ * method, and is 1 for band 0. */
+static void test_window(void)
+{
+    vb_error err;
+    uint64_t s = 123;
+    double b[25];
+    for (int i = 0; i < 25; i++)
+        b[i] = 2 * test_rand(&s) - 1;
+    float nrm[3];
+    test_rand_dir(&s, nrm);
+    for (uint32_t method = VDSH_METHOD_PAPER; method <= VDSH_METHOD_LSQ; method++)
+        for (uint32_t win = VDSH_WINDOW_HANN; win <= VDSH_WINDOW_LANCZOS; win++) {
+            vb_fit plain, windowed;
+            CHECK(vb_fit_create(5, method, 1e-3f, &plain, &err) == VB_OK, "fit");
+            CHECK(vb_fit_create(5, method, 1e-3f, &windowed, &err) == VB_OK, "fit");
+            vb_fit_window(&windowed, win);
+            float a[25], c[25];
+            vb_fit_apply(&plain, nrm, b, a);
+            vb_fit_apply(&windowed, nrm, b, c);
+            for (int i = 0; i < 25; i++) {
+                int l = i < 1 ? 0 : i < 4 ? 1 : i < 9 ? 2 : i < 16 ? 3 : 4;
+                double w = vb_window_weight(win, l, 5);
+                CHECK(fabs(c[i] - w * a[i]) < 1e-5 * (1 + fabs(a[i])),
+                      "method %u window %u coefficient %d: %g vs %g x %g", method, win, i, c[i],
+                      w, a[i]);
+            }
+        }
+    CHECK(vb_window_weight(VDSH_WINDOW_HANN, 0, 3) == 1 && vb_window_weight(VDSH_WINDOW_LANCZOS, 0, 3) == 1,
+          "band 0 untouched");
+    CHECK(fabs(vb_window_weight(VDSH_WINDOW_HANN, 2, 4) - 0.5) < 1e-12, "Hann at half width");
+}
+
 static void test_errors(void)
 {
     vb_fit f;
@@ -194,6 +227,7 @@ int main(void)
     test_rotation();
     test_lsq_recovers();
     test_mirror_and_paper();
+    test_window();
     test_errors();
     return test_report("test_fit");
 }
