@@ -66,7 +66,7 @@ typedef struct options {
 static const char usage_text[] =
     "Usage: vdsh-view [options] SCENE.vdsh              (a window)\n"
     "       vdsh-view --render OUT.png [options] SCENE.vdsh\n"
-    "       vdsh-view --grid OUT.png [options] SCENE.vdsh\n"
+    "       vdsh-view --grid OUT.png [options] SCENE.vdsh...\n"
     "       vdsh-view --bench [options] SCENE.vdsh...\n"
     "Look at a scene baked by vdsh-bake, lit by point lights with precomputed\n"
     "visibility-distance shadows (VDSH) or cube shadow maps.\n"
@@ -74,9 +74,12 @@ static const char usage_text[] =
     "Output:\n"
     "      --render FILE     render one image headless (no display needed)\n"
     "      --grid FILE       render the comparison row: no shadows | cube shadow\n"
-    "                        map | VDSH order 5 | 3 | 2, labelled, into one image\n"
+    "                        map | VDSH order 5 | 3 | 2, labelled, into one image;\n"
+    "                        several SCENEs (e.g. the same scene baked two ways)\n"
+    "                        give one row each\n"
     "      --bench           time every shadow mode with 1 and 3 lights on each\n"
-    "                        SCENE, all in this process; JSON on stdout\n"
+    "                        SCENE, all in this process, each round timing\n"
+    "                        every mode of every SCENE once; JSON on stdout\n"
     "\n"
     "View (defaults come from the scene's bounds, y up):\n"
     "      --camera EX,EY,EZ,TX,TY,TZ   eye and target point\n"
@@ -88,7 +91,10 @@ static const char usage_text[] =
     "      --ambient V       ambient light (default 0.03)\n"
     "      --mode M          none, cube, vdsh2, vdsh3, vdsh5 (order 5, basis\n"
     "                        cubemaps; the default) or vdsh5poly (order 5,\n"
-    "                        polynomials); order n = n bands = n*n coefficients\n"
+    "                        polynomials); order n = n bands = n*n coefficients.\n"
+    "                        Scenes baked with --log are drawn per vertex in\n"
+    "                        every VDSH mode (distances interpolated, no\n"
+    "                        cubemaps; vdsh5 and vdsh5poly are then the same)\n"
     "      --compare C       smooth (the paper's ramp, default) or binary\n"
     "      --pcf             cube shadow maps with PCF (default: 1 tap)\n"
     "      --shadow-size N   cube shadow map face size (default 512)\n"
@@ -98,7 +104,8 @@ static const char usage_text[] =
     "Files:\n"
     "      --cubemap-dir DIR where the basis cubemaps are (default: beside\n"
     "                        the .vdsh)\n"
-    "      --no-cubemaps     do not load them (mode vdsh5 is then unavailable)\n"
+    "      --no-cubemaps     do not load them (mode vdsh5 is then unavailable,\n"
+    "                        except for --log scenes, which never need them)\n"
     "\n"
     "Other:\n"
     "      --egl P           headless EGL platform: device or surfaceless\n"
@@ -328,9 +335,9 @@ static int parse_args(int argc, char **argv, options *o)
         return usage_error("%s", "no scene file given");
     if ((o->render_path != NULL) + (o->grid_path != NULL) + o->bench > 1)
         return usage_error("%s", "choose one of --render, --grid and --bench");
-    if (o->file_count > 1 && !o->bench)
-        return usage_error("one scene file at a time (several only with --bench), got '%s'",
-                           o->files[1]);
+    if (o->file_count > 1 && !o->bench && !o->grid_path)
+        return usage_error("one scene file at a time (several only with --grid and --bench), "
+                           "got '%s'", o->files[1]);
     return 0;
 }
 
@@ -526,8 +533,9 @@ static int run_render(const options *o)
         double ms = now_ms() - t0;
         rc = write_png(o->render_path, w, h, px);
         if (!rc && !o->quiet)
-            fprintf(stderr, "vdsh-view: wrote %s (%dx%d, mode %s, %d light%s, %.0f ms, %s; %s)\n",
-                    o->render_path, w, h, vr_mode_name(o->mode), n, n == 1 ? "" : "s", ms,
+            fprintf(stderr, "vdsh-view: wrote %s (%dx%d, mode %s: %s, %d light%s, %.0f ms, %s; "
+                    "%s)\n", o->render_path, w, h, vr_mode_name(o->mode),
+                    vr_scene_mode_label(s.scene, o->mode), n, n == 1 ? "" : "s", ms,
                     vr_gl_renderer(), vr_context_description(s.ctx));
     }
     free(px);
@@ -535,79 +543,132 @@ static int run_render(const options *o)
     return rc;
 }
 
-static int run_grid(const options *o)
+/* What a scene's file holds, for a row label: "room.vdsh: paper bake,
+ * distance" (the method of its highest order drawn). */
+static void bake_label(const char *path, const vr_scene *s, char *out, size_t size)
 {
-    int w = o->have_size ? o->width : 512, h = o->have_size ? o->height : 384;
-    session s;
-    if (session_open(o, VR_CONTEXT_HEADLESS, w, h, &s))
+    vr_scene_info info;
+    vr_scene_get_info(s, &info);
+    const char *slash = strrchr(path, '/');
+    uint32_t method = 0;
+    for (int k = 1; k <= 5; k++)
+        if (info.has_order[k])
+            method = info.method[k];
+    snprintf(out, size, "%s: %s bake, %s", slash ? slash + 1 : path, vdsh_method_name(method),
+             vdsh_quantity_name(info.quantity));
+}
+
+/* One row of the grid: the five panels of one scene into row (5 w wide). */
+static int grid_row(const options *o, const char *path, vr_renderer *r, int w, int h,
+                    unsigned char *px, unsigned char *row)
+{
+    vr_scene *scene = NULL;
+    if (open_scene(o, path, &scene))
         return 1;
     vr_light lights[MAX_LIGHTS];
-    int n = scene_lights(s.scene, o, o->default_lights ? o->default_lights : 1, lights);
+    int n = scene_lights(scene, o, o->default_lights ? o->default_lights : 1, lights);
     /* The paper's row. Order 5 the paper's way when the cubemaps are
-     * there, else with the polynomials (the same image to f16 precision). */
+     * there, else with the polynomials (the same image to f16 precision);
+     * a log-distance scene draws both per vertex. */
     vr_mode modes[5] = {VR_MODE_NONE, VR_MODE_CUBE, VR_MODE_VDSH5, VR_MODE_VDSH3, VR_MODE_VDSH2};
-    if (!vr_scene_supports(s.scene, VR_MODE_VDSH5))
+    if (!vr_scene_supports(scene, VR_MODE_VDSH5))
         modes[2] = VR_MODE_VDSH5_POLY;
     size_t panel = (size_t)w * (size_t)h * 4;
-    unsigned char *px = malloc(panel), *img = calloc(5, panel);
     int rc = 0;
-    if (!px || !img) {
-        fprintf(stderr, "vdsh-view: out of memory\n");
-        rc = 1;
-    }
     for (int m = 0; m < 5 && !rc; m++) {
         vr_error err;
         vr_draw_desc d = base_desc(o, lights, n);
         d.mode = modes[m];
-        scene_camera(s.scene, o, &d.camera);
-        char label[160];
+        scene_camera(scene, o, &d.camera);
+        char label[320];
         int shadow = o->shadow_size ? o->shadow_size : 512;
         if (modes[m] == VR_MODE_CUBE)
             snprintf(label, sizeof label, "cube shadow map (%d^2 x 6, %s)", shadow,
                      o->pcf ? "PCF" : "1 tap");
         else if (modes[m] >= VR_MODE_VDSH2)
-            snprintf(label, sizeof label, "%s%s", vr_mode_label(modes[m]),
+            snprintf(label, sizeof label, "%s%s", vr_scene_mode_label(scene, modes[m]),
                      o->compare == VDSH_COMPARE_BINARY ? ", binary" : "");
-        else
-            snprintf(label, sizeof label, "%s", vr_mode_label(modes[m]));
-        vr_result r = VR_OK;
-        if (!vr_scene_supports(s.scene, modes[m])) {
+        else {
+            char bake[256];
+            bake_label(path, scene, bake, sizeof bake);
+            snprintf(label, sizeof label, "%s\n%s", vr_mode_label(modes[m]), bake);
+        }
+        vr_result res = VR_OK;
+        if (!vr_scene_supports(scene, modes[m])) {
             /* A file baked without this order: say so in the panel. */
             vr_draw_desc none = d;
             none.light_count = 0;
             none.mode = VR_MODE_NONE;
             snprintf(label + strlen(label), sizeof label - strlen(label), ": not in this file");
-            r = vr_draw(s.r, s.scene, &none, &err);
+            res = vr_draw(r, scene, &none, &err);
         } else
-            r = vr_draw(s.r, s.scene, &d, &err);
-        if (r == VR_OK)
-            r = vr_draw_text(s.r, 4, 4, w >= 400 ? 2.0f : 1.0f, NULL, label, &err);
-        if (r == VR_OK)
-            r = vr_read_pixels(s.r, px, panel, &err);
-        if (r != VR_OK) {
-            fprintf(stderr, "vdsh-view: %s: %s: %s\n", o->files[0], vr_mode_name(modes[m]),
-                    err.msg);
+            res = vr_draw(r, scene, &d, &err);
+        if (res == VR_OK)
+            res = vr_draw_text(r, 4, 4, w >= 400 ? 2.0f : 1.0f, NULL, label, &err);
+        if (res == VR_OK)
+            res = vr_read_pixels(r, px, panel, &err);
+        if (res != VR_OK) {
+            fprintf(stderr, "vdsh-view: %s: %s: %s\n", path, vr_mode_name(modes[m]), err.msg);
             rc = 1;
             break;
         }
         for (int y = 0; y < h; y++)
-            memcpy(img + ((size_t)y * 5 * (size_t)w + (size_t)m * (size_t)w) * 4,
+            memcpy(row + ((size_t)y * 5 * (size_t)w + (size_t)m * (size_t)w) * 4,
                    px + (size_t)y * (size_t)w * 4, (size_t)w * 4);
     }
+    if (!rc && !o->quiet)
+        fprintf(stderr, "vdsh-view: %s: none | cube | %s | vdsh3 | vdsh2 (%s), %d light%s\n",
+                path, vr_mode_name(modes[2]), vr_scene_mode_label(scene, modes[2]), n,
+                n == 1 ? "" : "s");
+    vr_scene_destroy(scene);
+    return rc;
+}
+
+static int run_grid(const options *o)
+{
+    int w = o->have_size ? o->width : 512, h = o->have_size ? o->height : 384;
+    int rows = o->file_count;
+    vr_context *ctx = NULL;
+    vr_renderer *r = NULL;
+    vr_error err;
+    vr_context_desc cd = {.kind = VR_CONTEXT_HEADLESS, .egl_platform = o->egl, .width = w,
+                          .height = h};
+    if (vr_context_create(&cd, &ctx, &err) != VR_OK) {
+        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+        return 1;
+    }
+    vr_renderer_desc rd = {.width = w, .height = h, .shadow_map_size = o->shadow_size};
+    if (vr_renderer_create(&rd, &r, &err) != VR_OK) {
+        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+        vr_context_destroy(ctx);
+        return 1;
+    }
+    size_t panel = (size_t)w * (size_t)h * 4;
+    unsigned char *px = malloc(panel), *img = calloc(5 * (size_t)rows, panel);
+    int rc = 0;
+    if (!px || !img) {
+        fprintf(stderr, "vdsh-view: out of memory\n");
+        rc = 1;
+    }
+    for (int i = 0; i < rows && !rc; i++)
+        rc = grid_row(o, o->files[i], r, w, h, px, img + (size_t)i * 5 * panel);
     if (!rc) {
-        /* A thin dark line between panels. */
-        for (int m = 1; m < 5; m++)
-            for (int y = 0; y < h; y++)
-                memset(img + ((size_t)y * 5 * (size_t)w + (size_t)m * (size_t)w) * 4, 40, 4);
-        rc = write_png(o->grid_path, 5 * w, h, img);
+        /* A thin dark line between panels and between rows. */
+        size_t stride = 5 * (size_t)w * 4;
+        for (int y = 0; y < rows * h; y++)
+            for (int m = 1; m < 5; m++)
+                memset(img + (size_t)y * stride + (size_t)m * (size_t)w * 4, 40, 4);
+        for (int i = 1; i < rows; i++)
+            memset(img + (size_t)i * (size_t)h * stride, 40, stride);
+        rc = write_png(o->grid_path, 5 * w, rows * h, img);
         if (!rc && !o->quiet)
-            fprintf(stderr, "vdsh-view: wrote %s (%dx%d: none | cube | %s | vdsh3 | vdsh2, "
-                    "%d light%s, %s)\n", o->grid_path, 5 * w, h, vr_mode_name(modes[2]), n,
-                    n == 1 ? "" : "s", vr_gl_renderer());
+            fprintf(stderr, "vdsh-view: wrote %s (%dx%d, %d row%s, %s)\n", o->grid_path, 5 * w,
+                    rows * h, rows, rows == 1 ? "" : "s", vr_gl_renderer());
     }
     free(px);
     free(img);
-    session_close(&s);
+    vr_renderer_destroy(r);
+    vr_context_destroy(ctx);
     return rc;
 }
 
@@ -649,85 +710,125 @@ static void print_json_string(const char *s)
     putchar('"');
 }
 
-static int bench_scene(const options *o, const char *path, vr_renderer *r, int first_scene)
+enum { BENCH_MODES = 7, BENCH_ROUNDS = 64 };
+
+/* One scene of a benchmark: what it times and the results. */
+typedef struct bench_scene {
+    const char *path;
+    vr_scene *scene;
+    bench_mode modes[BENCH_MODES];
+    int nm;
+    vr_light lights[2][4];
+    int nl[2];
+    /* [light set][mode][round] */
+    double cpu[2][BENCH_MODES][BENCH_ROUNDS], gpu[2][BENCH_MODES][BENCH_ROUNDS];
+    double shadow[2][BENCH_MODES][BENCH_ROUNDS], lighting[2][BENCH_MODES][BENCH_ROUNDS];
+} bench_scene;
+
+/* Load a scene and choose the modes it is timed in. */
+static int bench_open(const options *o, const char *path, bench_scene *b)
 {
-    vr_scene *scene = NULL;
-    if (open_scene(o, path, &scene))
-        return 1;
-    vr_scene_info info;
-    vr_scene_get_info(scene, &info);
-    static const bench_mode all[] = {
+    static const bench_mode all[BENCH_MODES] = {
         {VR_MODE_NONE, 0, "none"},   {VR_MODE_CUBE, 0, "cube"},
         {VR_MODE_CUBE, 1, "cube_pcf"}, {VR_MODE_VDSH2, 0, "vdsh2"},
         {VR_MODE_VDSH3, 0, "vdsh3"}, {VR_MODE_VDSH5, 0, "vdsh5"},
         {VR_MODE_VDSH5_POLY, 0, "vdsh5poly"}};
-    enum { NMODES = sizeof all / sizeof all[0], MAX_ROUNDS = 64 };
-    bench_mode modes[NMODES];
-    int nm = 0;
-    for (int i = 0; i < NMODES; i++)
-        if (vr_scene_supports(scene, all[i].mode))
-            modes[nm++] = all[i];
-    int rounds = o->frames ? (o->frames < MAX_ROUNDS ? o->frames : MAX_ROUNDS) : 7;
     static const int light_sets[2] = {1, 3};
+    b->path = path;
+    if (open_scene(o, path, &b->scene))
+        return 1;
+    for (int i = 0; i < BENCH_MODES; i++) {
+        /* On a log-distance scene both order-5 modes draw the same
+         * per-vertex program: time it once, as vdsh5. */
+        int same = all[i].mode == VR_MODE_VDSH5_POLY &&
+                   vr_scene_supports(b->scene, VR_MODE_VDSH5) &&
+                   vr_scene_interp(b->scene, VR_MODE_VDSH5) == VDSH_INTERP_DISTANCE;
+        if (vr_scene_supports(b->scene, all[i].mode) && !same)
+            b->modes[b->nm++] = all[i];
+    }
+    for (int ls = 0; ls < 2; ls++)
+        b->nl[ls] = default_lights(b->scene, o, light_sets[ls], b->lights[ls]);
+    return 0;
+}
 
-    printf("%s{\"file\": ", first_scene ? "" : ", ");
-    print_json_string(path);
-    printf(", \"vertices\": %u, \"triangles\": %u, \"results\": [", info.vertex_count,
-           info.triangle_count);
-    int rc = 0;
-    for (int ls = 0; ls < 2 && !rc; ls++) {
-        vr_light lights[4];
-        int n = default_lights(scene, o, light_sets[ls], lights);
-        static double cpu[NMODES][MAX_ROUNDS], gpu[NMODES][MAX_ROUNDS];
-        static double shadow[NMODES][MAX_ROUNDS], lighting[NMODES][MAX_ROUNDS];
-        /* Warm-up: compile every program and allocate every shadow map
-         * before anything is timed. Then rounds that each time every mode
-         * once, starting at a different mode each round, so that slow
-         * drifts of a shared machine spread over all modes alike. */
-        for (int round = -2; round < rounds && !rc; round++) {
-            for (int k = 0; k < nm && !rc; k++) {
-                int m = (k + (round > 0 ? round : 0)) % nm;
-                vr_draw_desc d = base_desc(o, lights, n);
-                d.mode = modes[m].mode;
-                d.pcf = modes[m].pcf;
-                scene_camera(scene, o, &d.camera);
+/* Time every mode of every scene, with 1 light and then 3. Warm-up
+ * first: compile every program and allocate every shadow map before
+ * anything is timed. Then rounds that each time every (scene, mode) once,
+ * starting at a different one each round, so that slow drifts of a shared
+ * machine spread over all scenes and modes alike: a ratio between any two
+ * of them compares frames of the same minutes. */
+static int bench_time(const options *o, bench_scene *b, int nb, vr_renderer *r, int rounds)
+{
+    int total = 0;
+    for (int i = 0; i < nb; i++)
+        total += b[i].nm;
+    for (int ls = 0; ls < 2; ls++)
+        for (int round = -2; round < rounds; round++)
+            for (int k = 0; k < total; k++) {
+                int j = (k + (round > 0 ? round : 0)) % total, i = 0;
+                while (j >= b[i].nm)
+                    j -= b[i++].nm;
+                bench_scene *bs = &b[i];
+                vr_draw_desc d = base_desc(o, bs->lights[ls], bs->nl[ls]);
+                d.mode = bs->modes[j].mode;
+                d.pcf = bs->modes[j].pcf;
+                scene_camera(bs->scene, o, &d.camera);
                 vr_error err;
-                if (vr_draw(r, scene, &d, &err) != VR_OK) {
-                    fprintf(stderr, "vdsh-view: %s: %s: %s\n", path, modes[m].name, err.msg);
-                    rc = 1;
-                    break;
+                if (vr_draw(r, bs->scene, &d, &err) != VR_OK) {
+                    fprintf(stderr, "vdsh-view: %s: %s: %s\n", bs->path, bs->modes[j].name,
+                            err.msg);
+                    return 1;
                 }
                 vr_renderer_finish(r);
                 vr_timings t;
                 vr_renderer_timings(r, &t);
                 if (round >= 0) {
-                    cpu[m][round] = t.cpu_ms;
-                    gpu[m][round] = t.gpu_ms;
-                    shadow[m][round] = t.shadow_total_ms;
-                    lighting[m][round] = t.lighting_total_ms;
+                    bs->cpu[ls][j][round] = t.cpu_ms;
+                    bs->gpu[ls][j][round] = t.gpu_ms;
+                    bs->shadow[ls][j][round] = t.shadow_total_ms;
+                    bs->lighting[ls][j][round] = t.lighting_total_ms;
                 }
             }
-        }
-        for (int m = 0; m < nm && !rc; m++) {
-            double sorted[MAX_ROUNDS];
-            memcpy(sorted, cpu[m], (size_t)rounds * sizeof(double));
+    return 0;
+}
+
+/* One scene's JSON object (and a summary on stderr). */
+static void bench_print(const options *o, const bench_scene *b, int rounds, int first)
+{
+    vr_scene_info info;
+    vr_scene_get_info(b->scene, &info);
+    uint32_t method = 0;
+    for (int k = 1; k <= 5; k++)
+        if (info.has_order[k])
+            method = info.method[k];
+    printf("%s{\"file\": ", first ? "" : ", ");
+    print_json_string(b->path);
+    printf(", \"vertices\": %u, \"triangles\": %u, \"quantity\": \"%s\", \"method\": \"%s\", "
+           "\"results\": [", info.vertex_count, info.triangle_count,
+           vdsh_quantity_name(info.quantity), vdsh_method_name(method));
+    for (int ls = 0; ls < 2; ls++)
+        for (int m = 0; m < b->nm; m++) {
+            double sorted[BENCH_ROUNDS];
+            memcpy(sorted, b->cpu[ls][m], (size_t)rounds * sizeof(double));
             qsort(sorted, (size_t)rounds, sizeof(double), cmp_double);
-            printf("%s{\"lights\": %d, \"mode\": \"%s\", \"median_cpu_ms\": %.4f, ",
-                   ls == 0 && m == 0 ? "" : ", ", n, modes[m].name, sorted[rounds / 2]);
-            print_series("cpu_ms", cpu[m], rounds, 0);
-            print_series("gpu_ms", gpu[m], rounds, 0);
-            print_series("shadow_ms", shadow[m], rounds, 0);
-            print_series("lighting_ms", lighting[m], rounds, 1);
+            int interp = vr_scene_interp(b->scene, b->modes[m].mode);
+            printf("%s{\"lights\": %d, \"mode\": \"%s\", \"path\": \"%s\", "
+                   "\"median_cpu_ms\": %.4f, ", ls == 0 && m == 0 ? "" : ", ", b->nl[ls],
+                   b->modes[m].name,
+                   interp >= 0 ? vdsh_interp_name((uint32_t)interp) : b->modes[m].name,
+                   sorted[rounds / 2]);
+            print_series("cpu_ms", b->cpu[ls][m], rounds, 0);
+            print_series("gpu_ms", b->gpu[ls][m], rounds, 0);
+            print_series("shadow_ms", b->shadow[ls][m], rounds, 0);
+            print_series("lighting_ms", b->lighting[ls][m], rounds, 1);
             printf("}");
             if (!o->quiet)
-                fprintf(stderr, "vdsh-view: %s, %d light%s, %-9s median %.1f ms\n", path, n,
-                        n == 1 ? "" : "s", modes[m].name, sorted[rounds / 2]);
+                fprintf(stderr, "vdsh-view: %s, %d light%s, %-9s median %.1f ms\n", b->path,
+                        b->nl[ls], b->nl[ls] == 1 ? "" : "s", b->modes[m].name,
+                        sorted[rounds / 2]);
         }
-        fflush(stdout);
-    }
     printf("]}");
-    vr_scene_destroy(scene);
-    return rc;
+    fflush(stdout);
 }
 
 static int run_bench(const options *o)
@@ -756,11 +857,22 @@ static int run_bench(const options *o)
     printf(", \"width\": %d, \"height\": %d, \"shadow_size\": %d, \"mallopt\": %s, "
            "\"rounds\": %d, \"scenes\": [",
            w, h, o->shadow_size ? o->shadow_size : 512, o->no_mallopt ? "false" : "true",
-           o->frames ? o->frames : 7);
-    int rc = 0;
+           o->frames ? (o->frames < BENCH_ROUNDS ? o->frames : BENCH_ROUNDS) : 7);
+    int rounds = o->frames ? (o->frames < BENCH_ROUNDS ? o->frames : BENCH_ROUNDS) : 7;
+    bench_scene *b = calloc((size_t)o->file_count, sizeof *b);
+    int rc = b ? 0 : 1;
+    if (!b)
+        fprintf(stderr, "vdsh-view: out of memory\n");
     for (int i = 0; i < o->file_count && !rc; i++)
-        rc = bench_scene(o, o->files[i], r, i == 0);
+        rc = bench_open(o, o->files[i], &b[i]);
+    if (!rc)
+        rc = bench_time(o, b, o->file_count, r, rounds);
+    for (int i = 0; i < o->file_count && !rc; i++)
+        bench_print(o, &b[i], rounds, i == 0);
     printf("]}\n");
+    for (int i = 0; b && i < o->file_count; i++)
+        vr_scene_destroy(b[i].scene);
+    free(b);
     vr_renderer_destroy(r);
     vr_context_destroy(ctx);
     return rc;
@@ -845,7 +957,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
             return;
         }
         a->mode = m;
-        snprintf(msg, sizeof msg, "mode: %s", vr_mode_label(m));
+        snprintf(msg, sizeof msg, "mode: %s", vr_scene_mode_label(a->s.scene, m));
         print_status(a, msg);
         return;
     }
@@ -861,7 +973,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
                 break;
             }
         }
-        snprintf(msg, sizeof msg, "mode: %s", vr_mode_label(a->mode));
+        snprintf(msg, sizeof msg, "mode: %s", vr_scene_mode_label(a->s.scene, a->mode));
         print_status(a, msg);
         break;
     case GLFW_KEY_C:
@@ -1170,7 +1282,7 @@ static int run_window(const options *o)
                                "%s, %s\n%d light%s (selected %d)%s\n"
                                "frame %.1f ms (%.1f fps)\n"
                                "GPU: shadow maps %.1f ms, lighting %.1f ms\n%s",
-                               vr_mode_label(a.mode),
+                               vr_scene_mode_label(a.s.scene, a.mode),
                                a.mode == VR_MODE_CUBE ? (a.pcf ? "PCF" : "1 tap")
                                : a.compare == VDSH_COMPARE_SMOOTH ? "smooth" : "binary",
                                n, n == 1 ? "" : "s", a.n ? a.selected + 1 : 0,

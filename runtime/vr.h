@@ -32,7 +32,8 @@
  * "zero means the documented default", so `{0}` plus the fields you care
  * about is always valid. Defaults are filled in one place per struct.
  *
- * Shadow modes (DESIGN.md section 1):
+ * Shadow modes (DESIGN.md section 1), for streams of a linear quantity
+ * (distance, distance^2):
  *   VR_MODE_NONE        Lambert lighting only.
  *   VR_MODE_CUBE        baseline: one omnidirectional depth cube map per
  *                       light (shadow_map_size^2 per face), re-rendered on
@@ -45,10 +46,18 @@
  *                       with the four basis cubemaps in the fragment stage.
  *   VR_MODE_VDSH5_POLY  order 5 with the last 16 basis functions evaluated as
  *                       polynomials in the fragment stage (no cubemaps).
+ * Log-distance streams (vdsh-bake --log) are drawn differently by every
+ * VDSH mode: each vertex sums all its coefficients toward the light and
+ * takes exp (its distance toward the light), the distances are
+ * interpolated, and each fragment compares the result with its own light
+ * distance; VR_MODE_VDSH5 and VR_MODE_VDSH5_POLY are then the same and need
+ * no cubemaps. Which path a mode takes is vdsh_runtime_interp(order,
+ * quantity) (vr_scene_interp), and what each path computes inside a
+ * triangle is vdsh_shadow_interior: the definitions vdsh-eval scores with.
  * The comparison (vdsh_compare from formats/vdsh_shadow.h: smooth ramp or
- * binary) and the stored quantity (distance, distance^2, log-distance) mean
- * exactly what formats/vdsh_shadow.h says; tests/test_runtime_glsl.c checks
- * the shaders against it.
+ * binary) and the stored quantity mean exactly what formats/vdsh_shadow.h
+ * says; tests/test_runtime_glsl.c checks the shaders against it, per
+ * vertex and per fragment.
  *
  * Lights: any number. Up to max_lights_per_pass lights are summed in one
  * pass (a loop in the shaders); more lights take more passes, added with
@@ -113,8 +122,11 @@ typedef struct vr_scene_desc {
     /* An already-read file to upload instead (borrowed for the call; path,
      * if also set, is then only used in messages and to find cubemaps). */
     const vdsh_file *file;
-    /* Stream quantity to draw (vdsh_quantity); 0: distance. Streams of
-     * other quantities are not uploaded. */
+    /* Stream quantity to draw (vdsh_quantity); 0: distance. A file with
+     * no stream of this quantity draws the quantity of its first stream
+     * instead (a file baked with --log has only log-distance streams);
+     * vr_scene_get_info says which. Streams of other quantities are not
+     * uploaded. */
     uint32_t quantity;
     /* Where the basis cubemaps <stem>.sh09-12.exr ... are; NULL: the
      * directory of path (or the working directory without a path). */
@@ -122,10 +134,12 @@ typedef struct vr_scene_desc {
     /* Their stem; NULL: path's file name without ".vdsh". A file from
      * memory with neither path nor cubemap_stem loads no cubemaps. */
     const char *cubemap_stem;
-    /* 0 (default): when the file has an order-5 stream and a cube_size,
-     * the four cubemaps are required and a missing or corrupt one fails
-     * the create. 1: do not load them (VR_MODE_VDSH5 then fails with
-     * VR_ERR_MISSING; VR_MODE_VDSH5_POLY needs no cubemaps). */
+    /* 0 (default): when the drawn order-5 stream is of a linear quantity
+     * and the file has a cube_size, the four cubemaps are required and a
+     * missing or corrupt one fails the create. 1: do not load them
+     * (VR_MODE_VDSH5 then fails with VR_ERR_MISSING; VR_MODE_VDSH5_POLY
+     * needs no cubemaps). Log-distance streams never load them: their
+     * path has no use for them. */
     int skip_cubemaps;
 } vr_scene_desc;
 
@@ -149,6 +163,7 @@ typedef struct vr_scene_info {
     float bounds_max[3];
     int has_order[6];             /* has_order[n]: a stream of order n */
     uint32_t encoding[6];         /* its vdsh_encoding */
+    uint32_t method[6];           /* its vdsh_method (how it was baked) */
     float scale[6];               /* its stream scale */
     int has_cubemaps;             /* basis cubemaps uploaded */
     int cube_size;                /* their face size, or 0 */
@@ -222,6 +237,12 @@ int vr_mode_from_name(const char *name, vr_mode *out);
 const char *vr_mode_label(vr_mode m);
 /* 1 when the scene has what the mode needs (stream, cubemaps). */
 int vr_scene_supports(const vr_scene *s, vr_mode m);
+/* The path (vdsh_interp) a VDSH mode draws this scene's stream with:
+ * vdsh_runtime_interp(order, quantity drawn); -1 for modes none and cube. */
+int vr_scene_interp(const vr_scene *s, vr_mode m);
+/* vr_mode_label, saying what is drawn for this scene: for log-distance
+ * streams "VDSH order 5 (25 coeff., log, per-vertex)" etc. */
+const char *vr_scene_mode_label(const vr_scene *s, vr_mode m);
 
 typedef struct vr_light {
     float position[3];
@@ -241,8 +262,11 @@ typedef struct vr_camera {
 
 typedef enum vr_output {
     VR_OUTPUT_COLOR = 0,     /* albedo * (ambient + sum lambert * shadow) */
-    VR_OUTPUT_SHADOW = 1,    /* light 0: (s, d_V, d_L, 1); d_V is -1 in
-                                modes none and cube */
+    VR_OUTPUT_SHADOW = 1,    /* light 0: (s, d_V, d_L, 1): the distances
+                                compared (on the visibility path, the
+                                vertices' values interpolated, as
+                                vdsh_shadow_interior's d_vis); d_V is -1
+                                in modes none and cube */
     VR_OUTPUT_POSITION = 2   /* (world x, y, z, 1) */
 } vr_output;
 

@@ -12,13 +12,26 @@
  *                                    vdsh_stream_distance)
  *   vdsh_compare(d_vis, d_light)     a distance pair -> visibility, per
  *                                    comparison (vdsh_shadow_compare)
- * and each path only decides where the sum is computed:
- *   order 2, 3   vertex stage, the visibility is interpolated;
- *   order 5      the paper's split: bands 0-2 in the vertex stage toward
- *                the vertex's light direction, interpolated; bands 3-4
- *                (16 coefficients, interpolated) dotted in the fragment
- *                stage with the basis cubemaps, or with the polynomials.
- * tests/test_runtime_glsl.c renders these against the C functions.
+ * and each path (vdsh_interp, chosen by vdsh_runtime_interp from the order
+ * and the stored quantity) only decides where sums are computed and what
+ * is interpolated:
+ *   VDSH_VISIBILITY  linear quantities, orders 2, 3: the whole sum, the
+ *                    distance and the comparison per vertex; the
+ *                    visibility is interpolated;
+ *   VDSH_SPLIT       linear quantities, order 5 (the paper's): bands 0-2
+ *                    per vertex toward the vertex's light direction,
+ *                    interpolated; bands 3-4 (16 coefficients,
+ *                    interpolated) dotted in the fragment stage with the
+ *                    basis cubemaps or with the polynomials;
+ *   VDSH_DISTANCE    log-distance, every order: the whole sum (all
+ *                    order^2 coefficients) and its distance per vertex,
+ *                    one interpolated distance per light, compared in the
+ *                    fragment stage with the fragment's own light distance
+ *                    (exp cannot be split across the stages, and
+ *                    interpolating log coefficients would be a geometric
+ *                    mean of the vertices' distances).
+ * tests/test_runtime_glsl.c renders these against vdsh_shadow (per
+ * vertex) and vdsh_shadow_interior (per fragment).
  *
  * Lights: the per-light code is a macro, LIGHT(I), expanded once per light
  * of the pass with a literal index, because GLSL 3.30 only lets sampler
@@ -138,12 +151,15 @@ static const char vertex_glsl[] =
     "invariant gl_Position;\n"
     "out vec3 v_position;\n"
     "out vec3 v_normal;\n"
-    "#if VDSH_VERTEX && NUM_LIGHTS > 0\n"
+    "#if VDSH_VISIBILITY && NUM_LIGHTS > 0\n"
     "out float v_vis[NUM_LIGHTS];\n"
     "#endif\n"
-    "#if VDSH_VERTEX && OUTPUT == 1\n"
+    "#if VDSH_VISIBILITY && OUTPUT == 1\n"
     "out float v_dv;\n"
     "out float v_dl;\n"
+    "#endif\n"
+    "#if VDSH_DISTANCE && NUM_LIGHTS > 0\n"
+    "out float v_dist[NUM_LIGHTS];\n"
     "#endif\n"
     "#if VDSH_SPLIT\n"
     "#if NUM_LIGHTS > 0\n"
@@ -152,14 +168,19 @@ static const char vertex_glsl[] =
     "out vec4 v_c9, v_c13, v_c17, v_c21;\n"
     "#endif\n"
     "\n"
-    "#if VDSH_VERTEX\n"
-    "/* The stream's SH sum toward unit direction d. */\n"
+    "#if VDSH_VISIBILITY || VDSH_DISTANCE\n"
+    "/* The stream's whole SH sum toward unit direction d. */\n"
     "float vdsh_sh_sum(vec3 d)\n"
     "{\n"
     "#if ORDER == 2\n"
     "    return u_scale * sh_sum4(a_c0, d);\n"
-    "#else\n"
+    "#elif ORDER == 3\n"
     "    return u_scale * sh_sum9(a_c0, a_c1, a_c8, d);\n"
+    "#else\n"
+    "    vec4 b9, b13, b17, b21;\n"
+    "    sh_basis16(d, b9, b13, b17, b21);\n"
+    "    return u_scale * (sh_sum9(a_c0, a_c1, a_c8, d) + dot(a_c9, b9) + dot(a_c13, b13) +\n"
+    "                      dot(a_c17, b17) + dot(a_c21, b21));\n"
     "#endif\n"
     "}\n"
     "#endif\n"
@@ -169,16 +190,20 @@ static const char vertex_glsl[] =
     "    v_position = a_position;\n"
     "    v_normal = a_normal;\n"
     "    gl_Position = u_view_proj * vec4(a_position, 1.0);\n"
-    "#if VDSH_VERTEX && OUTPUT == 1\n"
+    "#if VDSH_VISIBILITY && OUTPUT == 1\n"
     "    v_dv = -1.0;\n"
     "    v_dl = 0.0;\n"
     "#endif\n"
-    "#if (VDSH_VERTEX || VDSH_SPLIT) && NUM_LIGHTS > 0\n"
+    "#if (VDSH_VISIBILITY || VDSH_DISTANCE || VDSH_SPLIT) && NUM_LIGHTS > 0\n"
     "    for (int i = 0; i < NUM_LIGHTS; i++) {\n"
     "        vec3 lv = u_light_pos[i] - a_position;\n"
     "        float dl = length(lv);\n"
-    "#if VDSH_VERTEX\n"
+    "#if VDSH_VISIBILITY || VDSH_DISTANCE\n"
+    "        /* A light at the vertex has no direction: distance 0, not NaN,\n"
+    "         * which would spread over every triangle around the vertex. */\n"
     "        float dv = dl > 0.0 ? vdsh_distance(vdsh_sh_sum(lv / dl)) : 0.0;\n"
+    "#endif\n"
+    "#if VDSH_VISIBILITY\n"
     "        v_vis[i] = vdsh_compare(dv, dl);\n"
     "#if OUTPUT == 1\n"
     "        if (i == 0) {\n"
@@ -186,10 +211,11 @@ static const char vertex_glsl[] =
     "            v_dl = dl;\n"
     "        }\n"
     "#endif\n"
+    "#elif VDSH_DISTANCE\n"
+    "        v_dist[i] = dv;\n"
     "#else\n"
-    "        /* A light at the vertex has no direction: store 0, not NaN,\n"
-    "         * which would spread over every triangle around the vertex;\n"
-    "         * the fragment stage gives such a light visibility 1. */\n"
+    "        /* As above, 0 for a light at the vertex; the fragment stage\n"
+    "         * gives such a light visibility 1. */\n"
     "        v_sum9[i] = dl > 0.0 ? u_scale * sh_sum9(a_c0, a_c1, a_c8, lv / dl) : 0.0;\n"
     "#endif\n"
     "    }\n"
@@ -205,12 +231,15 @@ static const char vertex_glsl[] =
 static const char fragment_glsl[] =
     "in vec3 v_position;\n"
     "in vec3 v_normal;\n"
-    "#if VDSH_VERTEX && NUM_LIGHTS > 0\n"
+    "#if VDSH_VISIBILITY && NUM_LIGHTS > 0\n"
     "in float v_vis[NUM_LIGHTS];\n"
     "#endif\n"
-    "#if VDSH_VERTEX && OUTPUT == 1\n"
+    "#if VDSH_VISIBILITY && OUTPUT == 1\n"
     "in float v_dv;\n"
     "in float v_dl;\n"
+    "#endif\n"
+    "#if VDSH_DISTANCE && NUM_LIGHTS > 0\n"
+    "in float v_dist[NUM_LIGHTS];\n"
     "#endif\n"
     "#if VDSH_SPLIT\n"
     "#if NUM_LIGHTS > 0\n"
@@ -260,6 +289,16 @@ static const char fragment_glsl[] =
     "}\n"
     "#endif\n"
     "\n"
+    "#if VDSH_DISTANCE\n"
+    "/* dist: the vertices' distances toward the light, interpolated;\n"
+    " * compared with this fragment's own light distance dl. */\n"
+    "float distance_visibility(float dist, float dl, out float dv)\n"
+    "{\n"
+    "    dv = dist;\n"
+    "    return vdsh_compare(dist, dl);\n"
+    "}\n"
+    "#endif\n"
+    "\n"
     "#if SHADOW_CUBE && NUM_LIGHTS > 0\n"
     "/* Baseline: depth cube map of the light, compared at the receiver's\n"
     " * depth in the face it falls in (major axis). The receiver is first\n"
@@ -300,8 +339,10 @@ static const char fragment_glsl[] =
     "#endif\n"
     "\n"
     "/* Per mode: the visibility of light I; may set dv (debug output). */\n"
-    "#if VDSH_VERTEX\n"
+    "#if VDSH_VISIBILITY\n"
     "#define VISIBILITY(I) v_vis[I]\n"
+    "#elif VDSH_DISTANCE\n"
+    "#define VISIBILITY(I) distance_visibility(v_dist[I], dl, dv)\n"
     "#elif VDSH_SPLIT\n"
     "#define VISIBILITY(I) split_visibility(v_sum9[I], lv, dl, dv)\n"
     "#elif SHADOW_CUBE\n"
@@ -317,7 +358,7 @@ static const char fragment_glsl[] =
     "    vec3 acc = vec3(0.0);\n"
     "    float s0 = 1.0, dv0 = -1.0, dl0 = 0.0;\n"
     "    FOR_EACH_LIGHT\n"
-    "#if VDSH_VERTEX && OUTPUT == 1\n"
+    "#if VDSH_VISIBILITY && OUTPUT == 1\n"
     "    /* the values the vertex stage compared */\n"
     "    dv0 = v_dv;\n"
     "    dl0 = v_dl;\n"
@@ -350,31 +391,39 @@ static const char depth_fs[] =
 
 static void key_name(const vr_program_key *k, char *buf, size_t size)
 {
-    snprintf(buf, size, "program %s, %s, %s, output %u, pcf %u, %u lights",
-             vr_mode_name((vr_mode)k->mode),
+    int interp = vr_mode_interp((vr_mode)k->mode, k->quantity);
+    snprintf(buf, size, "program %s%s%s, %s, %s, output %u, pcf %u, %u lights",
+             vr_mode_name((vr_mode)k->mode), interp >= 0 ? " path " : "",
+             interp >= 0 ? vdsh_interp_name((uint32_t)interp) : "",
              k->compare == VDSH_COMPARE_BINARY ? "binary" : "smooth",
              vdsh_quantity_name(k->quantity), k->output, k->pcf, k->lights);
 }
 
-/* The #defines that specialise the sources for one key. */
+/* The #defines that specialise the sources for one key. The VDSH path
+ * comes from formats/vdsh_shadow.h, the same function vdsh-eval scores
+ * with, so the shaders draw what the evaluator measures. */
 static void key_defines(const vr_program_key *k, char *buf, size_t size)
 {
-    int order = 0, vertex = 0, split = 0, cubemap = 0, cube = 0;
-    switch ((vr_mode)k->mode) {
-    case VR_MODE_VDSH2: order = 2; vertex = 1; break;
-    case VR_MODE_VDSH3: order = 3; vertex = 1; break;
-    case VR_MODE_VDSH5: order = 5; split = 1; cubemap = 1; break;
-    case VR_MODE_VDSH5_POLY: order = 5; split = 1; break;
-    case VR_MODE_CUBE: cube = 1; break;
+    int order = vr_mode_order((vr_mode)k->mode), cube = k->mode == VR_MODE_CUBE;
+    int visibility = 0, split = 0, distance = 0, cubemap = 0;
+    /* (vr_program_build has checked that the path is one of these.) */
+    switch (vr_mode_interp((vr_mode)k->mode, k->quantity)) {
+    case VDSH_INTERP_VISIBILITY: visibility = 1; break;
+    case VDSH_INTERP_DISTANCE: distance = 1; break;
+    case VDSH_INTERP_SPLIT:
+        split = 1;
+        cubemap = k->mode == VR_MODE_VDSH5;
+        break;
     default: break;
     }
     int n = snprintf(buf, size,
                      "#version 330 core\n"
-                     "#define ORDER %d\n#define VDSH_VERTEX %d\n#define VDSH_SPLIT %d\n"
+                     "#define ORDER %d\n#define VDSH_VISIBILITY %d\n#define VDSH_SPLIT %d\n"
+                     "#define VDSH_DISTANCE %d\n"
                      "#define CUBEMAP_BASIS %d\n#define SHADOW_CUBE %d\n"
                      "#define QUANTITY %u\n#define COMPARE %u\n#define OUTPUT %u\n"
                      "#define PCF %u\n#define NUM_LIGHTS %u\n#define FOR_EACH_LIGHT",
-                     order, vertex, split, cubemap, cube, k->quantity, k->compare,
+                     order, visibility, split, distance, cubemap, cube, k->quantity, k->compare,
                      k->output, k->pcf, k->lights);
     for (unsigned i = 0; i < k->lights && n > 0 && (size_t)n < size; i++)
         n += snprintf(buf + n, size - (size_t)n, " LIGHT(%u)", i);
@@ -439,6 +488,13 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
 {
     char name[160], defines[1024];
     key_name(key, name, sizeof name);
+    /* The shaders implement the paths vdsh_runtime_interp chooses; should
+     * it ever choose another, say so rather than draw something else. */
+    int interp = vr_mode_interp((vr_mode)key->mode, key->quantity);
+    int order = vr_mode_order((vr_mode)key->mode);
+    if (interp >= 0 && interp != VDSH_INTERP_VISIBILITY && interp != VDSH_INTERP_DISTANCE &&
+        !(interp == VDSH_INTERP_SPLIT && order == 5))
+        return vr_fail(err, VR_ERR_SHADER, "%s: the runtime has no shaders for this path", name);
     key_defines(key, defines, sizeof defines);
 
     size_t vs_size = strlen(defines) + sizeof common_glsl + sizeof vertex_glsl;

@@ -21,6 +21,13 @@ vr_result vr_fail(vr_error *err, vr_result r, const char *fmt, ...);
  * Drains every pending error so that the next check starts clean. */
 vr_result vr_check_gl(vr_error *err, const char *what);
 
+/* The SH order a mode draws (2, 3, 5), 0 for modes none and cube. */
+int vr_mode_order(vr_mode m);
+
+/* The path (vdsh_interp) mode m draws a stream of `quantity` with:
+ * vdsh_runtime_interp of its order; -1 for modes none and cube. */
+int vr_mode_interp(vr_mode m, uint32_t quantity);
+
 /* Attribute locations, the same in every program. Coefficient attribute
  * k covers coefficients first[k] .. first[k] + size[k] - 1 of the stream
  * (vr_coef_attribs): grouped so that bands 0-2 (0..8) and the four
@@ -50,6 +57,7 @@ struct vr_scene {
     GLuint vbo_stream[6];
     GLuint vao[6];
     uint32_t encoding[6];
+    uint32_t method[6];
     float scale[6];
     GLuint basis[4];            /* cube textures, functions 9+4k..12+4k */
     int cube_size;

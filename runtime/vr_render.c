@@ -478,17 +478,6 @@ static vr_result render_shadow_maps(vr_renderer *r, const vr_scene *s, const vr_
 /* ------------------------------------------------------------------ */
 /* Drawing                                                              */
 
-static int mode_order(vr_mode m)
-{
-    switch (m) {
-    case VR_MODE_VDSH2: return 2;
-    case VR_MODE_VDSH3: return 3;
-    case VR_MODE_VDSH5:
-    case VR_MODE_VDSH5_POLY: return 5;
-    default: return 0;
-    }
-}
-
 static int finite3(const float v[3])
 {
     return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
@@ -565,9 +554,9 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                            "mode %s needs the basis cubemaps, which were not loaded "
                            "(vdsh5poly needs none)", vr_mode_name(mode));
         return vr_fail(err, VR_ERR_MISSING, "mode %s: the scene has no order-%d %s stream",
-                       vr_mode_name(mode), mode_order(mode), vdsh_quantity_name(s->quantity));
+                       vr_mode_name(mode), vr_mode_order(mode), vdsh_quantity_name(s->quantity));
     }
-    int order = mode_order(mode);
+    int order = vr_mode_order(mode);
 
     /* Timing slot of this frame. */
     uint64_t frame = ++r->frame;
@@ -673,7 +662,7 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                               key.pcf ? r->sampler_linear : r->sampler_nearest);
             }
         }
-        if (mode == VR_MODE_VDSH5) {
+        if (mode == VR_MODE_VDSH5 && vr_mode_interp(mode, s->quantity) == VDSH_INTERP_SPLIT) {
             for (int k = 0; k < 4; k++) {
                 glActiveTexture(GL_TEXTURE0 + VR_UNIT_BASIS + (GLenum)k);
                 glBindTexture(GL_TEXTURE_CUBE_MAP, s->basis[k]);

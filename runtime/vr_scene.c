@@ -37,6 +37,16 @@ static void split_path(const char *path, char *dir, size_t dir_size,
     snprintf(stem, stem_size, "%.*s", (int)n, base);
 }
 
+/* 1 when f has a stream of `quantity` that the runtime could upload. */
+static int has_quantity(const vdsh_file *f, uint32_t quantity)
+{
+    for (uint32_t i = 0; i < f->stream_count; i++)
+        if (f->streams[i].quantity == quantity && f->streams[i].order >= 1 &&
+            f->streams[i].order <= 5)
+            return 1;
+    return 0;
+}
+
 static vr_result map_vdsh_result(vdsh_result r)
 {
     switch (r) {
@@ -151,6 +161,7 @@ static vr_result upload_stream(vr_scene *s, const vdsh_stream *st, size_t vertic
     }
     glBindVertexArray(0);
     s->encoding[order] = st->encoding;
+    s->method[order] = st->method;
     s->scale[order] = st->scale;
     return VR_OK;
 }
@@ -185,12 +196,24 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
         goto done;
     }
 
-    /* 2. The basis cubemaps, when order 5 could use them. */
-    const vdsh_stream *s5 = vdsh_find_stream(f, 5, desc->quantity);
+    /* 2. The quantity to draw: the one asked for, else the file's own
+     * (a file baked with --log has only log-distance streams). */
+    uint32_t quantity = desc->quantity;
+    if (!has_quantity(f, quantity))
+        for (uint32_t i = 0; i < f->stream_count; i++)
+            if (f->streams[i].order >= 1 && f->streams[i].order <= 5) {
+                quantity = f->streams[i].quantity;
+                break;
+            }
+
+    /* 3. The basis cubemaps, when order 5 is drawn with them: the paper's
+     * split path. A log-distance stream is summed whole per vertex. */
+    const vdsh_stream *s5 = vdsh_find_stream(f, 5, quantity);
+    int split5 = vdsh_runtime_interp(5, quantity) == VDSH_INTERP_SPLIT;
     /* From memory with neither a path nor a stem there is nothing to look
      * for: as skip_cubemaps. */
     int findable = desc->path || desc->cubemap_stem;
-    if (s5 && h->cube_size > 0 && !desc->skip_cubemaps && findable) {
+    if (s5 && split5 && h->cube_size > 0 && !desc->skip_cubemaps && findable) {
         char dir[4096], stem[1024];
         split_path(desc->path, dir, sizeof dir, stem, sizeof stem);
         r = read_basis(name, desc->cubemap_dir ? desc->cubemap_dir : dir,
@@ -201,7 +224,7 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
         have_maps = 1;
     }
 
-    /* 3. Upload. */
+    /* 4. Upload. */
     s = calloc(1, sizeof *s);
     if (!s) {
         r = vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
@@ -209,7 +232,7 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     }
     s->vertex_count = h->vertex_count;
     s->triangle_count = h->triangle_count;
-    s->quantity = desc->quantity;
+    s->quantity = quantity;
     for (int k = 0; k < 3; k++) {
         s->bounds_min[k] = INFINITY;
         s->bounds_max[k] = -INFINITY;
@@ -240,7 +263,7 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
 
     for (uint32_t i = 0; i < f->stream_count; i++) {
         const vdsh_stream *st = &f->streams[i];
-        if (st->quantity != desc->quantity || st->order < 1 || st->order > 5 ||
+        if (st->quantity != quantity || st->order < 1 || st->order > 5 ||
             s->vbo_stream[st->order])
             continue;
         upload_stream(s, st, nv);
@@ -293,6 +316,7 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     for (int o = 1; o <= 5; o++) {
         i.has_order[o] = s->vbo_stream[o] != 0;
         i.encoding[o] = s->encoding[o];
+        i.method[o] = s->method[o];
         i.scale[o] = s->scale[o];
     }
     i.has_cubemaps = s->basis[0] != 0;
@@ -309,10 +333,31 @@ int vr_scene_supports(const vr_scene *s, vr_mode m)
     case VR_MODE_CUBE: return 1;
     case VR_MODE_VDSH2: return s->vbo_stream[2] != 0;
     case VR_MODE_VDSH3: return s->vbo_stream[3] != 0;
-    case VR_MODE_VDSH5: return s->vbo_stream[5] != 0 && s->basis[0] != 0;
+    case VR_MODE_VDSH5:
+        /* the cubemaps only on the paper's split path */
+        return s->vbo_stream[5] != 0 &&
+               (s->basis[0] != 0 || vr_mode_interp(m, s->quantity) != VDSH_INTERP_SPLIT);
     case VR_MODE_DEFAULT:
     case VR_MODE_VDSH5_POLY: return s->vbo_stream[5] != 0;
     default: return 0;
+    }
+}
+
+int vr_scene_interp(const vr_scene *s, vr_mode m)
+{
+    return vr_mode_interp(m == VR_MODE_DEFAULT ? VR_MODE_VDSH5_POLY : m, s->quantity);
+}
+
+const char *vr_scene_mode_label(const vr_scene *s, vr_mode m)
+{
+    if (vr_scene_interp(s, m) != VDSH_INTERP_DISTANCE ||
+        s->quantity != VDSH_QUANTITY_LOG_DISTANCE)
+        return vr_mode_label(m);
+    /* Orders 2, 3 and both order-5 modes: the same per-vertex path. */
+    switch (vr_mode_order(m)) {
+    case 2: return "VDSH order 2 (4 coeff., log, per-vertex)";
+    case 3: return "VDSH order 3 (9 coeff., log, per-vertex)";
+    default: return "VDSH order 5 (25 coeff., log, per-vertex)";
     }
 }
 

@@ -102,6 +102,23 @@ int vr_mode_from_name(const char *name, vr_mode *out)
     return -1;
 }
 
+int vr_mode_order(vr_mode m)
+{
+    switch (m) {
+    case VR_MODE_VDSH2: return 2;
+    case VR_MODE_VDSH3: return 3;
+    case VR_MODE_VDSH5:
+    case VR_MODE_VDSH5_POLY: return 5;
+    default: return 0;
+    }
+}
+
+int vr_mode_interp(vr_mode m, uint32_t quantity)
+{
+    int order = vr_mode_order(m);
+    return order ? (int)vdsh_runtime_interp((uint32_t)order, quantity) : -1;
+}
+
 /* ------------------------------------------------------------------ */
 
 const int vr_coef_first[VR_COEF_ATTRIBS] = {0, 4, 8, 9, 13, 17, 21};

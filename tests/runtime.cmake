@@ -30,12 +30,61 @@ add_test(NAME runtime_fixture_room
                  -o ${_rt_dir}/room/room.vdsh)
 set_tests_properties(runtime_fixture_room PROPERTIES FIXTURES_SETUP runtime_room)
 file(MAKE_DIRECTORY ${_rt_dir}/room)
+# The same room baked with --method lsq --log, without cubemaps (0.3 s).
+add_test(NAME runtime_fixture_room_log
+         COMMAND vdsh-bake builtin:room --max-edge 0.5 --rays 400 --method lsq --log
+                 --cube-size 0 -q -o ${_rt_dir}/room_log/room_log.vdsh)
+set_tests_properties(runtime_fixture_room_log PROPERTIES FIXTURES_SETUP runtime_room)
+file(MAKE_DIRECTORY ${_rt_dir}/room_log)
 
 # Rendering sanity: closed sphere, light behind a wall, modes, passes.
 _runtime_test(test_runtime_render)
 add_test(NAME runtime_render
          COMMAND test_runtime_render ${_rt_dir}/room/room.vdsh ${_rt_dir}/render)
 _runtime_props(runtime_render FIXTURES_REQUIRED runtime_room)
+
+# Log-distance streams on large triangles: a 20 x 20 floor of two
+# triangles and a box hovering over one corner, baked with --method lsq
+# --log and no cubemaps (0.1 s); drawn on the distance path.
+add_test(NAME runtime_fixture_floor COMMAND sh -c [=[
+set -e
+mkdir -p "$2"
+cat > "$2/floor.obj" <<EOF
+# a 20 x 20 floor of two triangles, a box hovering over its corner (-10, 0, -10)
+v -10 0 -10
+v 10 0 -10
+v 10 0 10
+v -10 0 10
+f 1 4 3
+f 1 3 2
+v -10.5 0.15 -10.5
+v -9 0.15 -10.5
+v -9 0.15 -9
+v -10.5 0.15 -9
+v -10.5 0.6 -10.5
+v -9 0.6 -10.5
+v -9 0.6 -9
+v -10.5 0.6 -9
+f 5 6 7
+f 5 7 8
+f 9 12 11
+f 9 11 10
+f 5 9 10
+f 5 10 6
+f 6 10 11
+f 6 11 7
+f 7 11 12
+f 7 12 8
+f 8 12 9
+f 8 9 5
+EOF
+"$1" "$2/floor.obj" --method lsq --log --cube-size 0 -q -o "$2/floor.vdsh"
+]=] sh $<TARGET_FILE:vdsh-bake> ${_rt_dir}/floor)
+set_tests_properties(runtime_fixture_floor PROPERTIES FIXTURES_SETUP runtime_floor)
+
+_runtime_test(test_runtime_log)
+add_test(NAME runtime_log COMMAND test_runtime_log ${_rt_dir}/floor/floor.vdsh)
+_runtime_props(runtime_log FIXTURES_REQUIRED runtime_floor)
 
 # Bad input: missing, corrupted and truncated files, missing cubemaps.
 _runtime_test(test_runtime_errors)
@@ -50,6 +99,7 @@ target_link_libraries(test_runtime_png PRIVATE ${VDSH_STB_LIB} m)
 set(_view $<TARGET_FILE:vdsh-view>)
 set(_png $<TARGET_FILE:test_runtime_png>)
 set(_room ${_rt_dir}/room/room.vdsh)
+set(_room_log ${_rt_dir}/room_log/room_log.vdsh)
 
 add_test(NAME runtime_view_help COMMAND sh -c [=[
 set -e
@@ -97,8 +147,10 @@ cp "$room" "$d/alone.vdsh"
 expect1 alone.sh09-12.exr --render "$d/x.png" "$d/alone.vdsh"
 expect1 "x/y/z.png" --render "$d/x/y/z.png" "$room"
 "$v" -q --render "$d/ok.png" --size 64x48 --no-cubemaps --mode vdsh5poly "$d/alone.vdsh" || { echo "--no-cubemaps failed"; fail=1; }
+# a log-distance bake needs no cubemaps in any mode
+"$v" -q --render "$d/log.png" --size 64x48 --mode vdsh5 "$4" || { echo "log-distance vdsh5 failed"; fail=1; }
 exit $fail
-]=] sh ${_view} ${_room} ${_rt_dir}/view_errors)
+]=] sh ${_view} ${_room} ${_rt_dir}/view_errors ${_room_log})
 
 # Headless images: one render per mode and the comparison row.
 add_test(NAME runtime_view_render COMMAND sh -c [=[
@@ -117,19 +169,34 @@ done
 "$png" info "$d/binary.png" 120 90
 "$v" --grid "$d/grid.png" --size 128x96 "$room"
 "$png" info "$d/grid.png" 640 96
-]=] sh ${_view} ${_png} ${_room} ${_rt_dir}/view_render)
+# log-distance: every mode, and a grid of two rows that says what it draws
+for m in vdsh2 vdsh3 vdsh5 vdsh5poly; do
+  "$v" -q --render "$d/log-$m.png" --size 160x120 --mode $m "$5"
+  "$png" info "$d/log-$m.png" 160 120
+done
+"$v" --grid "$d/grid2.png" --size 128x96 "$room" "$5" 2> "$d/grid2.log"
+cat "$d/grid2.log"
+"$png" info "$d/grid2.png" 640 192
+grep -q "VDSH order 5 (25 coeff., cubemaps)" "$d/grid2.log"
+grep -q "VDSH order 5 (25 coeff., log, per-vertex)" "$d/grid2.log"
+grep -q "2 rows" "$d/grid2.log"
+]=] sh ${_view} ${_png} ${_room} ${_rt_dir}/view_render ${_room_log})
 
 # The benchmark mode: every mode, 1 and 3 lights, two scenes, one process.
 add_test(NAME runtime_view_bench COMMAND sh -c [=[
 set -e
-out=$("$1" --bench --frames 1 --size 96x72 --shadow-size 64 -q "$2" "$2")
+out=$("$1" --bench --frames 1 --size 96x72 --shadow-size 64 -q "$2" "$2" "$3")
 echo "$out" | head -c 400; echo
 for m in none cube cube_pcf vdsh2 vdsh3 vdsh5 vdsh5poly; do
   echo "$out" | grep -q "\"mode\": \"$m\""
 done
 echo "$out" | grep -q '"lights": 3'
 echo "$out" | grep -q '"renderer": '
-]=] sh ${_view} ${_room})
+# the log-distance scene: its VDSH modes on the distance path
+echo "$out" | grep -q '"quantity": "log-distance", "method": "lsq"'
+echo "$out" | grep -q '"mode": "vdsh5", "path": "distance"'
+echo "$out" | grep -q '"mode": "vdsh5", "path": "split"'
+]=] sh ${_view} ${_room} ${_room_log})
 
 # The window: under a display server (Xvfb), the image the window shows
 # is the headless one.

@@ -177,6 +177,69 @@ static void test_files(const char *dir)
     sd.cubemap_dir = other;
     expect_fail("cubemap of the wrong size", &sd, VR_ERR_FORMAT, "good.sh09-12.exr");
     sd.cubemap_dir = NULL;
+
+    /* A log-distance file (vdsh-bake --log): drawn per vertex in every
+     * VDSH mode, so its cubemaps are never needed: none on disk, or
+     * corrupt ones beside it, and the default descriptor still loads it
+     * and draws order 5 both ways. */
+    rt_file lf;
+    rt_file_init(&lf, 4, 2);
+    const float p[4][3] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+    for (int i = 0; i < 4; i++) {
+        memcpy(lf.pos + 3 * i, p[i], sizeof p[i]);
+        lf.nrm[3 * i + 2] = 1.0f;
+    }
+    const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(lf.idx, idx, sizeof idx);
+    rt_file_bounds(&lf);
+    static const int orders[3] = {2, 3, 5};
+    for (int o = 0; o < 3; o++) {
+        float *c = calloc(4 * 25, sizeof(float));
+        for (int i = 0; i < 4; i++)
+            c[orders[o] * orders[o] * i] = 3.0f;
+        rt_file_add_stream(&lf, (uint32_t)orders[o], VDSH_ENCODING_F16,
+                           VDSH_QUANTITY_LOG_DISTANCE, c, 0.01f);
+    }
+    char logpath[600];
+    snprintf(logpath, sizeof logpath, "%s/log.vdsh", dir);
+    vdsh_error ve;
+    CHECK(vdsh_write(logpath, &lf.f, &ve) == VDSH_OK, "%s", ve.msg);
+    rt_file_free(&lf);
+    for (int pass = 0; pass < 2; pass++) {
+        if (pass == 1) /* corrupt cubemaps beside it */
+            for (int k = 0; k < 4; k++) {
+                vb_cubemap_basis_path(dir, "log", k, exr, sizeof exr, &be);
+                spit(exr, "not an exr file at all", 22);
+            }
+        vr_scene_desc ld = {.path = logpath};
+        s = NULL;
+        CHECK(vr_scene_create(&ld, &s, &err) == VR_OK, "log-distance, pass %d: %s", pass, err.msg);
+        if (!s)
+            continue;
+        vr_scene_info info;
+        vr_scene_get_info(s, &info);
+        CHECK(info.quantity == VDSH_QUANTITY_LOG_DISTANCE && !info.has_cubemaps &&
+              info.has_order[2] && info.has_order[3] && info.has_order[5], "log-distance info");
+        vr_renderer *r = NULL;
+        vr_renderer_desc rd = {.width = 8, .height = 8};
+        CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
+        vr_light light = {.position = {0, 0, 1}};
+        for (int m = VR_MODE_VDSH2; m <= VR_MODE_VDSH5_POLY && r; m++) {
+            vr_draw_desc d = {.mode = (uint32_t)m, .lights = &light, .light_count = 1};
+            CHECK(vr_scene_supports(s, (vr_mode)m) &&
+                  vr_scene_interp(s, (vr_mode)m) == VDSH_INTERP_DISTANCE,
+                  "log-distance %s: supported, distance path", vr_mode_name((vr_mode)m));
+            CHECK(vr_draw(r, s, &d, &err) == VR_OK, "log-distance %s: %s",
+                  vr_mode_name((vr_mode)m), err.msg);
+            CHECK(strstr(vr_scene_mode_label(s, (vr_mode)m), "log, per-vertex") != NULL,
+                  "label %s", vr_scene_mode_label(s, (vr_mode)m));
+        }
+        CHECK(strcmp(vr_scene_mode_label(s, VR_MODE_VDSH5),
+                     "VDSH order 5 (25 coeff., log, per-vertex)") == 0, "label");
+        CHECK(vr_scene_interp(s, VR_MODE_CUBE) == -1, "cube has no path");
+        vr_renderer_destroy(r);
+        vr_scene_destroy(s);
+    }
 }
 
 static void test_streams_and_arguments(const char *dir)
@@ -258,15 +321,23 @@ static void test_streams_and_arguments(const char *dir)
     CHECK(vr_scene_create(&none, &s2, &err) == VR_ERR_ARGUMENT && s2 == SENTINEL, "no path");
     vr_scene_desc q = {.path = path, .quantity = 3};
     CHECK(vr_scene_create(&q, &s2, &err) == VR_ERR_ARGUMENT && s2 == SENTINEL, "quantity 3");
-    /* a quantity the file does not have: loads, but no VDSH mode draws */
+    /* a quantity the file does not have: its own quantity is drawn */
     q.quantity = VDSH_QUANTITY_LOG_DISTANCE;
     s2 = NULL;
     CHECK(vr_scene_create(&q, &s2, &err) == VR_OK, "%s", err.msg);
-    d.light_count = 1;
-    d.mode = VR_MODE_VDSH3;
-    CHECK(s2 && vr_draw(r, s2, &d, &err) == VR_ERR_MISSING && strstr(err.msg, "log-distance"),
-          "log-distance: %s", err.msg);
-    vr_scene_destroy(s2);
+    vr_scene_info info;
+    if (s2) {
+        vr_scene_get_info(s2, &info);
+        CHECK(info.quantity == VDSH_QUANTITY_DISTANCE && info.has_order[3], "fallback: %s",
+              vdsh_quantity_name(info.quantity));
+        d.light_count = 1;
+        d.mode = VR_MODE_VDSH3;
+        CHECK(vr_draw(r, s2, &d, &err) == VR_OK, "fallback vdsh3: %s", err.msg);
+        d.mode = VR_MODE_VDSH5;
+        CHECK(vr_draw(r, s2, &d, &err) == VR_ERR_MISSING && strstr(err.msg, "order-5 distance"),
+              "no order 5: %s", err.msg);
+        vr_scene_destroy(s2);
+    }
 
     vr_scene_destroy(NULL);
     vr_renderer_destroy(NULL);
