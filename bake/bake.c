@@ -11,6 +11,7 @@
 #include "sampling.h"
 #include "vdsh.h"
 #include "vdsh_sh.h"
+#include "vdsh_shadow.h"
 
 #define VB_PI 3.14159265358979323846
 #define BLOCK 16 /* receivers per work item */
@@ -452,17 +453,30 @@ typedef struct job {
     const vb_dirgrid *grid;
     const float *origins;  /* per receiver, traced frame */
     float *coeffs[VDSH_MAX_ORDER + 1];
+    uint32_t quantity[VDSH_MAX_ORDER + 1]; /* per order: what coeffs hold */
     vb_fit fits[VDSH_MAX_ORDER + 1];
     int order;             /* the projection's order (the highest asked) */
-    int log_quantity;      /* project ln(max(d, floor)) */
     float log_floor;
     float max_local;       /* max distance in the traced frame */
     float inv_scale;
     float degenerate_dist; /* scene units */
     int horizon;           /* paper: skip w.n < 0 */
+    /* The quantity choice (VB_QUANTITY_AUTO): sampled receivers, and per
+     * sample, order and quantity (0 distance, 1 log) its estimated error. */
+    uint32_t choose_count;
+    double *choose_error;  /* choose_count * (VDSH_MAX_ORDER + 1) * 2 */
     _Atomic uint64_t traced, missed;
     _Atomic uint32_t degenerate;
 } job;
+
+/* Where one receiver's results go: per quantity (0 distance, 1 log) and
+ * order, its coefficients or NULL; and, when `n` is not NULL, the traced
+ * directions above its horizon with their distances (scene units). */
+typedef struct vertex_sink {
+    float *coeffs[2][VDSH_MAX_ORDER + 1];
+    float *x, *y, *z, *t;
+    uint32_t *n;
+} vertex_sink;
 
 /* ln(x) for finite x > 0, to about 1e-7 relative, in plain float
  * arithmetic: it vectorises (libm's logf does not), and gives the same bits
@@ -482,8 +496,8 @@ static inline float fast_log(float x)
     return p + (float)e * 0.69314718f;
 }
 
-static void bake_vertex(job *J, uint32_t v, uint64_t *traced, uint64_t *missed,
-                        uint32_t *degenerate)
+static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced,
+                        uint64_t *missed, uint32_t *degenerate)
 {
     const vb_bake_desc *d = J->d;
     const vb_scene *S = d->scene;
@@ -497,7 +511,11 @@ static void bake_vertex(job *J, uint32_t v, uint64_t *traced, uint64_t *missed,
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
 
-    float acc[VDSH_MAX_COEFFS][VB_PACKET];
+    int want[2] = {0, 0};
+    for (int q = 0; q < 2; q++)
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            want[q] |= out->coeffs[q][o] != NULL;
+    float acc[2][VDSH_MAX_COEFFS][VB_PACKET];
     memset(acc, 0, sizeof acc);
     uint32_t near_zero = 0, upper = 0;
 
@@ -539,21 +557,36 @@ static void bake_vertex(job *J, uint32_t v, uint64_t *traced, uint64_t *missed,
 
         /* Branch-free over the lanes, so it vectorises. Lanes not traced
          * (empty, or below the horizon) count as distance 0. */
-        float dist[VB_PACKET];
+        float dist[VB_PACKET], logd[VB_PACKET];
+        int up_lane[VB_PACKET];
         for (int k = 0; k < VB_PACKET; k++) {
             int live = valid[k] != 0;
             int hit = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
             float t = hit ? rh.ray.tfar[k] * J->inv_scale : d->max_distance;
             float c = rh.ray.dir_x[k] * n[0] + rh.ray.dir_y[k] * n[1] + rh.ray.dir_z[k] * n[2];
             int up = live & (c > 0.0f);
-            float value = J->log_quantity ? fast_log(t > J->log_floor ? t : J->log_floor) : t;
-            dist[k] = live ? value : 0.0f;
+            dist[k] = live ? t : 0.0f;
+            logd[k] = live ? fast_log(t > J->log_floor ? t : J->log_floor) : 0.0f;
+            up_lane[k] = up;
             *missed += (uint64_t)(live & !hit);
             upper += (uint32_t)up;
             near_zero += (uint32_t)(up & (t < J->degenerate_dist));
         }
-        vdsh_sh_project_soa(J->order, VB_PACKET, rh.ray.dir_x, rh.ray.dir_y,
-                            rh.ray.dir_z, dist, &acc[0][0], VB_PACKET);
+        if (want[0])
+            vdsh_sh_project_soa(J->order, VB_PACKET, rh.ray.dir_x, rh.ray.dir_y,
+                                rh.ray.dir_z, dist, &acc[0][0][0], VB_PACKET);
+        if (want[1])
+            vdsh_sh_project_soa(J->order, VB_PACKET, rh.ray.dir_x, rh.ray.dir_y,
+                                rh.ray.dir_z, logd, &acc[1][0][0], VB_PACKET);
+        if (out->n)
+            for (int k = 0; k < VB_PACKET; k++)
+                if (up_lane[k]) {
+                    uint32_t i = (*out->n)++;
+                    out->x[i] = rh.ray.dir_x[k];
+                    out->y[i] = rh.ray.dir_y[k];
+                    out->z[i] = rh.ray.dir_z[k];
+                    out->t[i] = dist[k];
+                }
     }
     if (d->trace_only)
         return;
@@ -561,17 +594,21 @@ static void bake_vertex(job *J, uint32_t v, uint64_t *traced, uint64_t *missed,
     /* b = the projection (in double: it sums over thousands of rays); each
      * order's coefficients are its fit's map of b (fit.h). */
     double w = (J->grid->hemisphere ? 2.0 : 4.0) * VB_PI / J->grid->count;
-    double b[VDSH_MAX_COEFFS];
     int nb = J->order * J->order;
-    for (int i = 0; i < nb; i++) {
-        double s = 0.0;
-        for (int k = 0; k < VB_PACKET; k++)
-            s += acc[i][k];
-        b[i] = s * w;
+    for (int q = 0; q < 2; q++) {
+        if (!want[q])
+            continue;
+        double b[VDSH_MAX_COEFFS];
+        for (int i = 0; i < nb; i++) {
+            double s = 0.0;
+            for (int k = 0; k < VB_PACKET; k++)
+                s += acc[q][i][k];
+            b[i] = s * w;
+        }
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            if (out->coeffs[q][o])
+                vb_fit_apply(&J->fits[o], n, b, out->coeffs[q][o]);
     }
-    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-        if (J->coeffs[o])
-            vb_fit_apply(&J->fits[o], n, b, J->coeffs[o] + (size_t)v * o * o);
     if (upper > 0 && near_zero >= 0.9 * upper)
         (*degenerate)++;
 }
@@ -582,11 +619,103 @@ static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
     (void)worker;
     uint64_t traced = 0, missed = 0;
     uint32_t degenerate = 0;
-    for (uint32_t v = begin; v < end; v++)
-        bake_vertex(J, v, &traced, &missed, &degenerate);
+    for (uint32_t v = begin; v < end; v++) {
+        vertex_sink out = {0};
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            if (J->coeffs[o])
+                out.coeffs[J->quantity[o] == VDSH_QUANTITY_LOG_DISTANCE][o] =
+                    J->coeffs[o] + (size_t)v * o * o;
+        bake_vertex(J, v, &out, &traced, &missed, &degenerate);
+    }
     atomic_fetch_add(&J->traced, traced);
     atomic_fetch_add(&J->missed, missed);
     atomic_fetch_add(&J->degenerate, degenerate);
+}
+
+/* ---- choosing the quantity (VB_QUANTITY_AUTO) --------------------------- */
+
+/* The shadow error vdsh-eval expects (DESIGN.md section 3) in a direction
+ * whose true distance is t when the stream reconstructs r t: lights at
+ * d_L = 2 u t, u uniform in (0.05, 1], scored |ramp(r / 2u) - ramp(1 / 2u)|.
+ * A function of r alone, constant from r = 2 on (the ramp is 1 for every
+ * u), tabulated on [0, 2] and interpolated linearly. */
+#define ERR_TABLE 512
+static double err_table[ERR_TABLE + 1];
+
+static void err_table_init(void)
+{
+    enum { U = 512 };
+    for (int i = 0; i <= ERR_TABLE; i++) {
+        double r = 2.0 * i / ERR_TABLE, s = 0.0;
+        for (int k = 0; k < U; k++) {
+            double u = 0.05 + 0.95 * (k + 0.5) / U;
+            s += fabs((double)vdsh_ramp((float)(r / (2.0 * u))) -
+                      (double)vdsh_ramp((float)(1.0 / (2.0 * u))));
+        }
+        err_table[i] = s / U;
+    }
+}
+
+static double expected_error(double r)
+{
+    double x = r * (ERR_TABLE / 2.0);
+    if (!(x < ERR_TABLE))
+        return err_table[ERR_TABLE];
+    if (x < 0.0)
+        x = 0.0;
+    int i = (int)x;
+    return err_table[i] + (x - i) * (err_table[i + 1] - err_table[i]);
+}
+
+#define CHOOSE_RECEIVERS 1024
+
+/* Sampled receiver i: trace it, fit both quantities at every asked order,
+ * and score each fit on the traced directions above the horizon. */
+static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
+{
+    job *J = ctx;
+    (void)worker;
+    uint32_t nrec = J->d->receivers->vertex_count, cap = J->grid->count;
+    float *buf = malloc((size_t)cap * 4 * sizeof *buf);
+    uint64_t traced = 0, missed = 0;
+    uint32_t degenerate = 0;
+    for (uint32_t i = begin; i < end && buf; i++) {
+        uint32_t v = (uint32_t)((uint64_t)i * nrec / J->choose_count), count = 0;
+        float c[2][VDSH_MAX_ORDER + 1][VDSH_MAX_COEFFS];
+        vertex_sink out = {.x = buf, .y = buf + cap, .z = buf + 2 * cap, .t = buf + 3 * cap,
+                           .n = &count};
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            if (J->coeffs[o])
+                out.coeffs[0][o] = c[0][o], out.coeffs[1][o] = c[1][o];
+        bake_vertex(J, v, &out, &traced, &missed, &degenerate);
+        double e[VDSH_MAX_ORDER + 1][2] = {{0}};
+        float tmin = 1e-4f * J->d->max_distance;
+        for (uint32_t k = 0; k < count; k++) {
+            float dir[3] = {out.x[k], out.y[k], out.z[k]}, y[VDSH_MAX_COEFFS];
+            vdsh_sh_eval(J->order, dir, y);
+            double t = out.t[k] > tmin ? out.t[k] : tmin;
+            for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
+                if (!J->coeffs[o])
+                    continue;
+                for (int q = 0; q < 2; q++) {
+                    double s = 0.0;
+                    for (int j = 0; j < o * o; j++)
+                        s += (double)c[q][o][j] * y[j];
+                    double dv = q ? exp(s) : (s > 0.0 ? s : 0.0);
+                    e[o][q] += expected_error(dv / t);
+                }
+            }
+        }
+        double *dst = J->choose_error + (size_t)i * (VDSH_MAX_ORDER + 1) * 2;
+        for (int o = 0; o <= VDSH_MAX_ORDER; o++)
+            for (int q = 0; q < 2; q++)
+                dst[2 * o + q] = count ? e[o][q] / count : 0.0;
+    }
+    if (!buf) /* out of memory: no vote from these receivers */
+        for (uint32_t i = begin; i < end; i++)
+            memset(J->choose_error + (size_t)i * (VDSH_MAX_ORDER + 1) * 2, 0,
+                   (VDSH_MAX_ORDER + 1) * 2 * sizeof(double));
+    free(buf);
 }
 
 static void bake_progress(void *user, uint32_t done, uint32_t total)
@@ -607,8 +736,9 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the order %d stream", order);
     memcpy(f, b->coeffs[order], count * sizeof *f);
     vdsh_stream s = {.order = (uint32_t)order, .encoding = encoding, .method = b->method,
-                     .quantity = b->quantity, .method_param = b->lambda, .scale = 1.0f,
-                     .quantity_param = b->log_floor, .window = b->window,
+                     .quantity = b->quantity[order], .method_param = b->lambda, .scale = 1.0f,
+                     .quantity_param = b->quantity[order] == VDSH_QUANTITY_LOG_DISTANCE
+                                           ? b->log_floor : 0.0f, .window = b->window,
                      .window_param = b->window ? (float)order : 0.0f, .data = f};
     if (encoding == VDSH_ENCODING_F16) {
         /* Stored values are coefficient / (the stream's largest
@@ -674,7 +804,10 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", d.method);
     if (d.window > VDSH_WINDOW_LANCZOS)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown window %u", d.window);
-    if (d.quantity != VDSH_QUANTITY_DISTANCE && d.quantity != VDSH_QUANTITY_LOG_DISTANCE)
+    if (d.quantity == VB_QUANTITY_AUTO && d.method == VDSH_METHOD_PAPER)
+        d.quantity = VDSH_QUANTITY_DISTANCE; /* the only one paper has */
+    if (d.quantity != VDSH_QUANTITY_DISTANCE && d.quantity != VDSH_QUANTITY_LOG_DISTANCE &&
+        d.quantity != VB_QUANTITY_AUTO)
         return vb_fail(err, VB_ERR_ARGUMENT, "the bake stores distance or log-distance, not %s",
                        vdsh_quantity_name(d.quantity));
     if (d.quantity == VDSH_QUANTITY_LOG_DISTANCE && d.method == VDSH_METHOD_PAPER)
@@ -745,7 +878,6 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     J->origins = origins;
     memcpy(J->coeffs, coeffs, sizeof coeffs);
     J->order = d.max_order;
-    J->log_quantity = d.quantity == VDSH_QUANTITY_LOG_DISTANCE;
     J->log_floor = d.log_floor;
     J->max_local = d.max_distance * d.scene->scale;
     J->inv_scale = 1.0f / d.scene->scale;
@@ -758,6 +890,45 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     }
 
     double t0 = vb_now();
+    double auto_error[VDSH_MAX_ORDER + 1][2] = {{0}};
+    uint32_t auto_receivers = 0;
+    if (d.quantity == VB_QUANTITY_AUTO && !d.trace_only) {
+        /* Per order, the quantity whose fits reconstruct the traced
+         * distances of a sample of receivers with the lower expected
+         * shadow error; sums in sample order, so the choice does not
+         * depend on the thread count. */
+        err_table_init();
+        auto_receivers = J->choose_count =
+            R->vertex_count < CHOOSE_RECEIVERS ? R->vertex_count : CHOOSE_RECEIVERS;
+        J->choose_error = calloc((size_t)J->choose_count * (VDSH_MAX_ORDER + 1) * 2,
+                                 sizeof(double));
+        if (!J->choose_error) {
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+            goto done;
+        }
+        if (vb_parallel_for(d.threads, J->choose_count, 4, choose_block, J, NULL, NULL) == 0) {
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
+            goto done;
+        }
+        for (uint32_t i = 0; i < J->choose_count; i++)
+            for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+                for (int q = 0; q < 2; q++)
+                    auto_error[o][q] +=
+                        J->choose_error[((size_t)i * (VDSH_MAX_ORDER + 1) + o) * 2 + q];
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
+            auto_error[o][0] /= J->choose_count;
+            auto_error[o][1] /= J->choose_count;
+            J->quantity[o] = auto_error[o][1] < auto_error[o][0] ? VDSH_QUANTITY_LOG_DISTANCE
+                                                                 : VDSH_QUANTITY_DISTANCE;
+        }
+        /* The sample's rays are traced again below, with the rest. */
+        atomic_store(&J->traced, 0);
+        atomic_store(&J->missed, 0);
+        atomic_store(&J->degenerate, 0);
+    } else {
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            J->quantity[o] = d.quantity == VB_QUANTITY_AUTO ? VDSH_QUANTITY_DISTANCE : d.quantity;
+    }
     unsigned started = vb_parallel_for(d.threads, R->vertex_count, BLOCK, bake_block, J,
                                        d.progress ? bake_progress : NULL, J);
     if (started == 0) {
@@ -768,9 +939,15 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     vb_bake_output o = {0};
     o.max_order = d.max_order;
     o.method = d.method;
-    o.quantity = d.quantity;
+    int any_log = 0;
+    for (int k = 0; k <= VDSH_MAX_ORDER; k++) {
+        o.quantity[k] = J->quantity[k];
+        any_log |= coeffs[k] && J->quantity[k] == VDSH_QUANTITY_LOG_DISTANCE;
+    }
+    o.auto_receivers = auto_receivers;
+    memcpy(o.auto_error, auto_error, sizeof auto_error);
     o.lambda = d.method == VDSH_METHOD_LSQ ? d.lambda : 0.0f;
-    o.log_floor = J->log_quantity ? d.log_floor : 0.0f;
+    o.log_floor = any_log ? d.log_floor : 0.0f;
     o.window = d.window;
     o.vertex_count = R->vertex_count;
     memcpy(o.coeffs, coeffs, sizeof coeffs);
@@ -789,6 +966,8 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     r = VB_OK;
 
 done:
+    if (J)
+        free(J->choose_error);
     free(J);
     for (int k = 0; k <= VDSH_MAX_ORDER; k++)
         free(coeffs[k]);

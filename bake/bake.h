@@ -19,7 +19,16 @@
  *
  * Quantity: the stored function is D itself, or ln(max(D, log_floor)) for
  * VDSH_QUANTITY_LOG_DISTANCE (hemisphere methods and full only: the
- * paper's zero fill has no meaning in the log domain).
+ * paper's zero fill has no meaning in the log domain). VB_QUANTITY_AUTO
+ * chooses per order: a first pass traces an evenly spaced sample of
+ * CHOOSE_RECEIVERS (1024) receivers, fits both quantities, and scores each
+ * fit on the traced directions above the horizon with the shadow error
+ * vdsh-eval expects there (DESIGN.md section 3: a light at 2 u d_T, u
+ * uniform in (0.05, 1], smooth ramp: a function of the ratio of the
+ * reconstructed to the true distance only); the lower mean wins. Log wins
+ * in closed rooms and levels, where what matters is relative error close
+ * to walls; distance on open objects, where most rays escape to the clamp
+ * distance. With paper, auto means distance.
  *
  * Ray origins (vb_ray_origins): the receiver position in the scene's
  * normalised frame (scene.h), offset twice with vb_offset_origin: along
@@ -57,6 +66,8 @@
 extern "C" {
 #endif
 
+#define VB_QUANTITY_AUTO 0xffu /* vb_bake_desc.quantity: chosen per order */
+
 typedef struct vb_bake_desc {
     const vb_mesh *receivers;  /* positions and normals (borrowed) */
     const vb_scene *scene;     /* the occluders (borrowed) */
@@ -64,7 +75,8 @@ typedef struct vb_bake_desc {
     uint64_t seed;             /* 0 is a valid seed */
     float max_distance;        /* clamp; 0: the occluders' bbox diagonal */
     uint32_t method;           /* vdsh_method; 0 = paper */
-    uint32_t quantity;         /* vdsh_quantity: distance (0) or log-distance */
+    uint32_t quantity;         /* vdsh_quantity: distance (0) or log-distance,
+                                * or VB_QUANTITY_AUTO */
     float lambda;              /* lsq regularisation; 0: 1e-4 */
     float log_floor;           /* log-distance floor; 0: 1% of max_distance */
     uint32_t window;           /* vdsh_window on each order's bands; 0: none */
@@ -82,7 +94,10 @@ typedef struct vb_bake_desc {
 typedef struct vb_bake_output {
     int max_order;
     uint32_t method;           /* vdsh_method used */
-    uint32_t quantity;         /* vdsh_quantity stored */
+    uint32_t quantity[VDSH_MAX_ORDER + 1]; /* per order: vdsh_quantity stored */
+    uint32_t auto_receivers;   /* VB_QUANTITY_AUTO: receivers sampled (else 0) */
+    double auto_error[VDSH_MAX_ORDER + 1][2]; /* their expected shadow error
+                                * per order, distance [0] and log [1] */
     float lambda;              /* lsq regularisation used (0 otherwise) */
     float log_floor;           /* log-distance floor used (0 otherwise) */
     uint32_t window;           /* vdsh_window applied */

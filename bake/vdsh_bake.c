@@ -84,14 +84,18 @@ static void usage(FILE *f)
 "                          (default 2500 = 50 x 50)\n"
 "      --orders LIST       SH orders to store, order n = n bands = n*n\n"
 "                          coefficients (default 2,3,5; each 1..5)\n"
-"      --method M          paper (default): the paper's fit, directions below\n"
-"                          the horizon count as distance 0; full: the whole\n"
-"                          sphere, no horizon; mirror: the upper hemisphere,\n"
-"                          mirrored below; lsq: least squares to the upper\n"
-"                          hemisphere. mirror and lsq trace only the upper\n"
-"                          half of the --rays directions\n"
-"      --log               store ln(distance) (reconstructed as exp of the SH\n"
-"                          sum); not with paper\n"
+"      --method M          lsq (default): regularised least squares to the\n"
+"                          upper hemisphere; mirror: the upper hemisphere,\n"
+"                          mirrored below; paper: the paper's fit, directions\n"
+"                          below the horizon count as distance 0; full: the\n"
+"                          whole sphere, no horizon. All but full trace only\n"
+"                          the upper half of the --rays directions\n"
+"      --quantity Q        what the SH store: auto (default): per order, the\n"
+"                          one with the lower expected shadow error on 1024\n"
+"                          sampled receivers; distance; log: ln(distance),\n"
+"                          reconstructed as exp of the SH sum (not with\n"
+"                          paper, where auto means distance)\n"
+"      --log               the same as --quantity log\n"
 "      --lambda X          lsq regularisation weight (default 1e-4)\n"
 "      --window W          per-band window on the coefficients: none (default),\n"
 "                          hann or lanczos (width: the order)\n"
@@ -355,14 +359,15 @@ int main(int argc, char **argv)
     options o = {0};
     o.rays = 2500;
     o.orders[0] = 2, o.orders[1] = 3, o.orders[2] = 5, o.order_count = 3;
-    o.method = VDSH_METHOD_PAPER;
+    o.method = VDSH_METHOD_LSQ;
+    o.quantity = VB_QUANTITY_AUTO;
     o.encoding = VDSH_ENCODING_F16;
     o.seed = 1;
     o.cube_size = 64;
 
     enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST,
-           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW };
+           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
@@ -382,6 +387,7 @@ int main(int argc, char **argv)
         {"export-obj", required_argument, 0, O_EXPORT},
         {"trace-only", no_argument, 0, O_TRACE_ONLY},
         {"log", no_argument, 0, O_LOG},
+        {"quantity", required_argument, 0, O_QUANTITY},
         {"lambda", required_argument, 0, O_LAMBDA},
         {"log-floor", required_argument, 0, O_LOG_FLOOR},
         {"keep-normals", no_argument, 0, O_KEEP_NORMALS},
@@ -446,6 +452,12 @@ int main(int argc, char **argv)
         case O_EXPORT: o.export_obj = optarg; break;
         case O_TRACE_ONLY: o.trace_only = 1; break;
         case O_LOG: o.quantity = VDSH_QUANTITY_LOG_DISTANCE; break;
+        case O_QUANTITY:
+            if (strcmp(optarg, "auto") == 0) o.quantity = VB_QUANTITY_AUTO;
+            else if (strcmp(optarg, "distance") == 0) o.quantity = VDSH_QUANTITY_DISTANCE;
+            else if (strcmp(optarg, "log") == 0) o.quantity = VDSH_QUANTITY_LOG_DISTANCE;
+            else return bad_usage("--quantity takes auto, distance or log, not '%s'", optarg);
+            break;
         case O_LAMBDA:
             if (!parse_float(optarg, &o.lambda) || o.lambda == 0.0f)
                 return bad_usage("--lambda takes a positive number, not '%s'", optarg);
@@ -478,7 +490,7 @@ int main(int argc, char **argv)
     if (nmesh > VDSH_MAX_SOURCES)
         return bad_usage("%s", "too many meshes (at most 64)");
     if (o.quantity == VDSH_QUANTITY_LOG_DISTANCE && o.method == VDSH_METHOD_PAPER)
-        return bad_usage("%s", "--log needs --method mirror, lsq or full: the paper's zero fill "
+        return bad_usage("%s", "log-distance needs --method mirror, lsq or full: the paper's zero fill "
                                "below the horizon has no meaning for ln(distance)");
     if (!o.output && !o.export_obj && !o.trace_only)
         return bad_usage("%s", "no output: give -o OUT.vdsh (or --export-obj FILE)");
@@ -603,6 +615,17 @@ int main(int argc, char **argv)
                 bo.seconds > 0 ? bo.rays_traced / bo.seconds * 1e-6 : 0.0, bo.threads,
                 bo.rays_traced ? 100.0 * bo.rays_missed / bo.rays_traced : 0.0,
                 bo.moved_origins, bo.degenerate_receivers);
+    if (log && bo.auto_receivers > 0) {
+        fprintf(log, "vdsh-bake: quantity chosen on %u sampled receivers (expected shadow "
+                     "error, distance / log):", bo.auto_receivers);
+        for (int s = 0; s < o.order_count; s++) {
+            int k = o.orders[s];
+            fprintf(log, "%s order %d %s (%.4f / %.4f)", s ? "," : "", k,
+                    bo.quantity[k] == VDSH_QUANTITY_LOG_DISTANCE ? "log" : "distance",
+                    bo.auto_error[k][0], bo.auto_error[k][1]);
+        }
+        fputc('\n', log);
+    }
     if (log && bo.degenerate_receivers > 0)
         fprintf(log, "vdsh-bake: warning: %u receivers (%.2f%%) see distance ~0 in almost "
                      "every direction above their horizon: receivers inside or flush "

@@ -13,3 +13,12 @@ add_test(NAME bake_hard_cases COMMAND test_hard)
 add_executable(test_fit test_fit.c)
 target_link_libraries(test_fit PRIVATE vb_core)
 add_test(NAME bake_fit COMMAND test_fit)
+
+# --quantity auto: deterministic, and it picks the better quantity per order.
+find_package(Python3 COMPONENTS Interpreter QUIET)
+if(Python3_Interpreter_FOUND)
+  add_test(NAME bake_quantity_auto
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_bake_auto.py
+                   $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval> $<TARGET_FILE:vdsh-info>
+                   ${CMAKE_CURRENT_BINARY_DIR}/bake_auto)
+endif()

@@ -25,7 +25,7 @@ if(TARGET vb_eval)
 bake, ev = sys.argv[1], sys.argv[2]
 d = tempfile.mkdtemp()
 f = os.path.join(d, 'room.vdsh')
-subprocess.run([bake, 'builtin:room', '--max-edge', '1', '--rays', '64', '--orders', '2,5',
+subprocess.run([bake, 'builtin:room', '--max-edge', '1', '--rays', '64', '--method', 'paper', '--orders', '2,5',
                 '--encoding', 'f32', '-q', '--record-timings', '--cube-size', '0', '-o', f], check=True)
 subprocess.run([ev, f, '-q', '--interior', '500', '--points', '700', '--json', f + '.json'],
                check=True, stdout=subprocess.DEVNULL)

@@ -26,7 +26,7 @@ _runtime_props(runtime_glsl)
 
 # A small bake of the built-in room for the tests below (0.2 s).
 add_test(NAME runtime_fixture_room
-         COMMAND vdsh-bake builtin:room --max-edge 0.5 --rays 400 -q
+         COMMAND vdsh-bake builtin:room --max-edge 0.5 --rays 400 --method paper -q
                  -o ${_rt_dir}/room/room.vdsh)
 set_tests_properties(runtime_fixture_room PROPERTIES FIXTURES_SETUP runtime_room)
 file(MAKE_DIRECTORY ${_rt_dir}/room)

@@ -147,7 +147,7 @@ int main(int argc, char **argv)
     /* Bake a box. */
     char *obj = path_in("box.obj"), *vdsh = path_in("box.vdsh"), *rep = path_in("box.bake.json");
     write_box(obj, NULL);
-    int rc = run((char *[]){bake, obj, "--max-edge", "0.5", "--rays", "256", "--orders", "2,3,5",
+    int rc = run((char *[]){bake, obj, "--max-edge", "0.5", "--rays", "256", "--method", "paper", "--orders", "2,3,5",
                             "--record-timings", "--cube-size", "0", "-q", "--report", rep,
                             "-o", vdsh, NULL});
     CHECK(rc == 0, "bake: exit %d", rc);
