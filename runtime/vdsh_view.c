@@ -624,25 +624,37 @@ static int grid_row(const options *o, const char *path, vr_renderer *r, int w, i
     return rc;
 }
 
+
+/* A headless context (of w x h when `sized`, else the platform's default
+ * surface) and a w x h renderer on it; 0, or 1 after printing why. */
+static int open_headless(const options *o, int w, int h, int sized, vr_context **ctx,
+                         vr_renderer **r)
+{
+    vr_error err;
+    vr_context_desc cd = {.kind = VR_CONTEXT_HEADLESS, .egl_platform = o->egl,
+                          .width = sized ? w : 0, .height = sized ? h : 0};
+    if (vr_context_create(&cd, ctx, &err) != VR_OK) {
+        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+        return 1;
+    }
+    vr_renderer_desc rd = {.width = w, .height = h, .shadow_map_size = o->shadow_size};
+    if (vr_renderer_create(&rd, r, &err) != VR_OK) {
+        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+        vr_context_destroy(*ctx);
+        *ctx = NULL;
+        return 1;
+    }
+    return 0;
+}
+
 static int run_grid(const options *o)
 {
     int w = o->have_size ? o->width : 512, h = o->have_size ? o->height : 384;
     int rows = o->file_count;
     vr_context *ctx = NULL;
     vr_renderer *r = NULL;
-    vr_error err;
-    vr_context_desc cd = {.kind = VR_CONTEXT_HEADLESS, .egl_platform = o->egl, .width = w,
-                          .height = h};
-    if (vr_context_create(&cd, &ctx, &err) != VR_OK) {
-        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+    if (open_headless(o, w, h, 1, &ctx, &r) != 0)
         return 1;
-    }
-    vr_renderer_desc rd = {.width = w, .height = h, .shadow_map_size = o->shadow_size};
-    if (vr_renderer_create(&rd, &r, &err) != VR_OK) {
-        fprintf(stderr, "vdsh-view: %s\n", err.msg);
-        vr_context_destroy(ctx);
-        return 1;
-    }
     size_t panel = (size_t)w * (size_t)h * 4;
     unsigned char *px = malloc(panel), *img = calloc(5 * (size_t)rows, panel);
     int rc = 0;
@@ -836,18 +848,8 @@ static int run_bench(const options *o)
     int w = o->have_size ? o->width : 1024, h = o->have_size ? o->height : 768;
     vr_context *ctx = NULL;
     vr_renderer *r = NULL;
-    vr_error err;
-    vr_context_desc cd = {.kind = VR_CONTEXT_HEADLESS, .egl_platform = o->egl};
-    if (vr_context_create(&cd, &ctx, &err) != VR_OK) {
-        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+    if (open_headless(o, w, h, 0, &ctx, &r) != 0)
         return 1;
-    }
-    vr_renderer_desc rd = {.width = w, .height = h, .shadow_map_size = o->shadow_size};
-    if (vr_renderer_create(&rd, &r, &err) != VR_OK) {
-        fprintf(stderr, "vdsh-view: %s\n", err.msg);
-        vr_context_destroy(ctx);
-        return 1;
-    }
     printf("{\"version\": ");
     print_json_string(VDSH_VERSION_STRING);
     printf(", \"renderer\": ");
