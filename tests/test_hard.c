@@ -7,11 +7,13 @@
 #include <string.h>
 
 #include "bake.h"
+#include "sampling.h"
 #include "scene.h"
 #include "test_scenes.h"
 #include "test_util.h"
 #include "vdsh.h"
 #include "vdsh_sh.h"
+#include "vdsh_shadow.h"
 
 static int bake_with(const vb_mesh *occ, const vb_mesh *rec, uint32_t method, uint32_t rays,
                      int robust, vb_bake_output *out)
@@ -480,6 +482,59 @@ static void test_contact_and_embedded(void)
     test_mesh_free(&rec);
 }
 
+/* The default fit (lsq, quantity chosen per order) on the hardest scene
+ * above: receivers in corners, pressed against the floor, buried in a
+ * pillar, where true distances are ~0 and ln 0 would be -Inf. Every
+ * coefficient is finite, and every reconstructed distance in 64 directions
+ * above each receiver is finite and >= 0 (the log floor bounds it below). */
+static void test_default_fit(void)
+{
+    vb_mesh m = {0}, rec = {0};
+    test_make_room(&m, 4.0f, 3.0f, 2.5f);
+    add_box(&m, -2, -1, 0, 1, -1, 0, 0);
+    add_box(&m, 1.5f, 2.5f, 0, 3, 0.5f, 1.5f, 0);
+    vb_error err;
+    CHECK(vb_mesh_refine(&m, 0.5f, &rec, &err) == VB_OK, "refine");
+    vb_scene *s = NULL;
+    CHECK(vb_scene_create(&m, NULL, &s, &err) == VB_OK, "scene");
+    vb_bake_desc d = {.receivers = &rec, .scene = s, .rays = 512, .seed = 3,
+                      .method = VDSH_METHOD_LSQ, .quantity = VB_QUANTITY_AUTO,
+                      .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
+    vb_bake_output b = {0};
+    CHECK(s && vb_bake_run(&d, &b, &err) == VB_OK, "bake: %s", err.msg);
+    CHECK(b.auto_receivers == (rec.vertex_count < 1024 ? rec.vertex_count : 1024),
+          "%u receivers sampled for the choice", b.auto_receivers);
+    long bad = 0, checked = 0;
+    for (int o = 2; o <= 5 && b.coeffs[5]; o++) {
+        if (!b.coeffs[o])
+            continue;
+        CHECK(b.quantity[o] == VDSH_QUANTITY_DISTANCE || b.quantity[o] == VDSH_QUANTITY_LOG_DISTANCE,
+              "order %d: quantity %u", o, b.quantity[o]);
+        for (uint32_t v = 0; v < rec.vertex_count; v++) {
+            const float *c = b.coeffs[o] + (size_t)v * o * o, *n = rec.normals + 3 * (size_t)v;
+            for (int i = 0; i < o * o; i++)
+                bad += !isfinite(c[i]);
+            float t[3], bt[3];
+            vb_frame(n, t, bt);
+            for (int k = 0; k < 64; k++) {
+                float ct = 0.05f + 0.9f * (k % 8) / 7.0f, st = sqrtf(1.0f - ct * ct);
+                float ph = 0.785398f * (float)(k / 8), w[3];
+                for (int j = 0; j < 3; j++)
+                    w[j] = st * cosf(ph) * t[j] + st * sinf(ph) * bt[j] + ct * n[j];
+                float dv = vdsh_stream_distance((uint32_t)o, b.quantity[o], c, w);
+                bad += !(isfinite(dv) && dv >= 0.0f);
+                checked++;
+            }
+        }
+    }
+    CHECK(bad == 0 && checked > 0, "%ld of %ld coefficients or distances not finite and >= 0",
+          bad, checked);
+    vb_bake_output_free(&b);
+    vb_scene_destroy(s);
+    test_mesh_free(&m);
+    test_mesh_free(&rec);
+}
+
 /* Non-finite or out-of-range input through the API is rejected with a
  * result code, not an assert or a crash. */
 static void test_bad_api_input(void)
@@ -516,6 +571,7 @@ int main(void)
     test_open_mesh();
     test_inverted_normals();
     test_contact_and_embedded();
+    test_default_fit();
     test_bad_api_input();
     return test_report("test_hard");
 }
