@@ -489,7 +489,7 @@ static inline float fast_log(float x)
     v.u = (v.u & 0x007fffffu) | 0x3f800000u; /* m in [1, 2) */
     float m = v.f;
     int big = m > 1.41421356f;
-    m = big ? 0.5f * m : m;
+    m *= 1.0f - 0.5f * (float)big; /* not ?: - it blocks vectorising */
     e += big;
     float s = (m - 1.0f) / (m + 1.0f), s2 = s * s;
     float p = s * (2.0f + s2 * (2.0f / 3 + s2 * (2.0f / 5 + s2 * (2.0f / 7 + s2 * (2.0f / 9)))));
@@ -515,6 +515,10 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
     for (int q = 0; q < 2; q++)
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             want[q] |= out->coeffs[q][o] != NULL;
+    /* Loop invariants in locals: the lane loops below vectorise. */
+    const float inv_scale = J->inv_scale, max_distance = d->max_distance;
+    const float degenerate_dist = J->degenerate_dist, log_floor = J->log_floor;
+    const float nx = n[0], ny = n[1], nz = n[2];
     float acc[2][VDSH_MAX_COEFFS][VB_PACKET];
     memset(acc, 0, sizeof acc);
     uint32_t near_zero = 0, upper = 0;
@@ -557,27 +561,46 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
 
         /* Branch-free over the lanes, so it vectorises. Lanes not traced
          * (empty, or below the horizon) count as distance 0. */
-        float dist[VB_PACKET], logd[VB_PACKET];
+        float dist[VB_PACKET];
         int up_lane[VB_PACKET];
+        int miss = 0, upper_pk = 0, near_pk = 0;
+        uint32_t gid[VB_PACKET];
+        float tfar[VB_PACKET], dx[VB_PACKET], dy[VB_PACKET], dz[VB_PACKET];
+        memcpy(gid, rh.hit.geomID, sizeof gid); /* locals: the loop vectorises */
+        memcpy(tfar, rh.ray.tfar, sizeof tfar);
+        memcpy(dx, rh.ray.dir_x, sizeof dx);
+        memcpy(dy, rh.ray.dir_y, sizeof dy);
+        memcpy(dz, rh.ray.dir_z, sizeof dz);
         for (int k = 0; k < VB_PACKET; k++) {
-            int live = valid[k] != 0;
-            int hit = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
-            float t = hit ? rh.ray.tfar[k] * J->inv_scale : d->max_distance;
-            float c = rh.ray.dir_x[k] * n[0] + rh.ray.dir_y[k] * n[1] + rh.ray.dir_z[k] * n[2];
+            /* Selects as arithmetic (exact for these finite values), in
+             * int: GCC if-converts and vectorises this loop only so. */
+            int live = valid[k] & 1; /* valid: 0 or -1 */
+            int hit = gid[k] != RTC_INVALID_GEOMETRY_ID;
+            float fh = (float)hit, fl = (float)live;
+            float t = tfar[k] * inv_scale * fh + max_distance * (1.0f - fh);
+            float c = dx[k] * nx + dy[k] * ny + dz[k] * nz;
             int up = live & (c > 0.0f);
-            dist[k] = live ? t : 0.0f;
-            logd[k] = live ? fast_log(t > J->log_floor ? t : J->log_floor) : 0.0f;
+            dist[k] = t * fl;
             up_lane[k] = up;
-            *missed += (uint64_t)(live & !hit);
-            upper += (uint32_t)up;
-            near_zero += (uint32_t)(up & (t < J->degenerate_dist));
+            miss += live & (hit ^ 1);
+            upper_pk += up;
+            near_pk += up & (t < degenerate_dist);
         }
+        upper += (uint32_t)upper_pk;
+        near_zero += (uint32_t)near_pk;
+        *missed += (uint64_t)miss;
         if (want[0])
             vdsh_sh_project_soa(J->order, VB_PACKET, rh.ray.dir_x, rh.ray.dir_y,
                                 rh.ray.dir_z, dist, &acc[0][0][0], VB_PACKET);
-        if (want[1])
+        if (want[1]) {
+            float logd[VB_PACKET];
+            for (int k = 0; k < VB_PACKET; k++) {
+                float l = fast_log(dist[k] > log_floor ? dist[k] : log_floor);
+                logd[k] = l * (float)(valid[k] & 1);
+            }
             vdsh_sh_project_soa(J->order, VB_PACKET, rh.ray.dir_x, rh.ray.dir_y,
                                 rh.ray.dir_z, logd, &acc[1][0][0], VB_PACKET);
+        }
         if (out->n)
             for (int k = 0; k < VB_PACKET; k++)
                 if (up_lane[k]) {
@@ -595,6 +618,12 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
      * order's coefficients are its fit's map of b (fit.h). */
     double w = (J->grid->hemisphere ? 2.0 : 4.0) * VB_PI / J->grid->count;
     int nb = J->order * J->order;
+    /* One rotation for every order: the highest order's leading bands. */
+    double rotation[VDSH_MAX_COEFFS * VDSH_MAX_COEFFS];
+    const vb_fit *top = &J->fits[J->order];
+    int rot = vb_fit_rotates(top, n);
+    if (rot)
+        vb_fit_rotation(top, n, rotation);
     for (int q = 0; q < 2; q++) {
         if (!want[q])
             continue;
@@ -607,7 +636,8 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
         }
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (out->coeffs[q][o])
-                vb_fit_apply(&J->fits[o], n, b, out->coeffs[q][o]);
+                vb_fit_apply_rotated(&J->fits[o], rot ? rotation : NULL, J->order, b,
+                                     out->coeffs[q][o]);
     }
     if (upper > 0 && near_zero >= 0.9 * upper)
         (*degenerate)++;
@@ -862,7 +892,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         goto done;
     }
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
-        if (!coeffs[o])
+        if (!coeffs[o] && o != d.max_order) /* the top one rotates for all */
             continue;
         if ((r = vb_fit_create(o, d.method, d.lambda, &J->fits[o], err)) != VB_OK)
             goto done;

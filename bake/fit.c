@@ -222,35 +222,52 @@ void vb_sh_rotation(const vb_fit *f, const double R[9], double *out)
     for (int l = 0; l < f->order; l++) {
         int k = 2 * l + 1, o = l * l;
         const double *pinv = f->rot_pinv[l];
-        for (int a = 0; a < k; a++)     /* row of S_l^T */
-            for (int b = 0; b < k; b++) { /* column of S_l^T */
-                double s = 0.0;
-                for (int j = 0; j < VB_FIT_ROT_DIRS; j++)
-                    s += yr[j][o + a] * pinv[j * k + b];
-                out[(o + b) * n + (o + a)] = s; /* transpose into S */
+        for (int a = 0; a < k; a++) { /* row a of S_l^T, all columns at once */
+            double s[9] = {0};        /* each sums over j in order: it vectorises over b */
+            for (int j = 0; j < VB_FIT_ROT_DIRS; j++) {
+                double y = yr[j][o + a];
+                for (int b = 0; b < k; b++)
+                    s[b] += y * pinv[j * k + b];
             }
+            for (int b = 0; b < k; b++)
+                out[(o + b) * n + (o + a)] = s[b]; /* transpose into S */
+        }
     }
 }
 
-void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c)
+int vb_fit_rotates(const vb_fit *f, const float n[3])
 {
-    int nc = f->order * f->order;
-    int no_normal = n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f;
-    if (f->method == VDSH_METHOD_PAPER || f->method == VDSH_METHOD_FULL || no_normal) {
+    return (f->method == VDSH_METHOD_MIRROR || f->method == VDSH_METHOD_LSQ) &&
+           !(n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f);
+}
+
+void vb_fit_rotation(const vb_fit *f, const float n[3], double *S)
+{
+    float t[3], bt[3];
+    vb_frame(n, t, bt);
+    const double R[9] = {t[0], bt[0], n[0], t[1], bt[1], n[1], t[2], bt[2], n[2]};
+    vb_sh_rotation(f, R, S);
+}
+
+void vb_fit_apply_rotated(const vb_fit *f, const double *S, int s_order, const double *b,
+                          float *c)
+{
+    int nc = f->order * f->order, ns = s_order * s_order;
+    if (!S) {
         for (int i = 0; i < nc; i++)
             c[i] = (float)(f->window[i] * b[i]);
         return;
     }
-    float t[3], bt[3];
-    vb_frame(n, t, bt);
-    const double R[9] = {t[0], bt[0], n[0], t[1], bt[1], n[1], t[2], bt[2], n[2]};
-    double S[VB_FIT_MAX * VB_FIT_MAX], u[VB_FIT_MAX], v[VB_FIT_MAX];
-    vb_sh_rotation(f, R, S);
-    for (int i = 0; i < nc; i++) { /* u = S^T b */
-        double s = 0.0;
-        for (int j = 0; j < nc; j++)
-            s += S[j * nc + i] * b[j];
-        u[i] = s;
+    /* S is block-diagonal by band: each product runs over its band only. */
+    double u[VB_FIT_MAX], v[VB_FIT_MAX];
+    for (int l = 0; l < f->order; l++) { /* u = S^T b */
+        int o = l * l, k = 2 * l + 1;
+        for (int i = o; i < o + k; i++) {
+            double s = 0.0;
+            for (int j = o; j < o + k; j++)
+                s += S[j * ns + i] * b[j];
+            u[i] = s;
+        }
     }
     for (int i = 0; i < nc; i++) { /* v = M u */
         double s = 0.0;
@@ -258,10 +275,22 @@ void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c)
             s += f->M[i * nc + j] * u[j];
         v[i] = s;
     }
-    for (int i = 0; i < nc; i++) { /* c = window * S v */
-        double s = 0.0;
-        for (int j = 0; j < nc; j++)
-            s += S[i * nc + j] * v[j];
-        c[i] = (float)(f->window[i] * s);
+    for (int l = 0; l < f->order; l++) { /* c = window * S v */
+        int o = l * l, k = 2 * l + 1;
+        for (int i = o; i < o + k; i++) {
+            double s = 0.0;
+            for (int j = o; j < o + k; j++)
+                s += S[i * ns + j] * v[j];
+            c[i] = (float)(f->window[i] * s);
+        }
     }
+}
+
+void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c)
+{
+    double S[VB_FIT_MAX * VB_FIT_MAX];
+    int rot = vb_fit_rotates(f, n);
+    if (rot)
+        vb_fit_rotation(f, n, S);
+    vb_fit_apply_rotated(f, rot ? S : NULL, f->order, b, c);
 }

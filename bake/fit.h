@@ -67,6 +67,17 @@ void vb_fit_window(vb_fit *f, uint32_t window);
  * normal has no hemisphere: c = b (the projection as it is). */
 void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c);
 
+/* vb_fit_apply in two steps, so that fits of several orders for one
+ * receiver share one rotation: whether f rotates at all for normal n
+ * (mirror and lsq with a non-zero normal), the rotation S (f->order^2
+ * square, vb_sh_rotation of the frame about n), and the map with an S
+ * made for any order s_order >= f->order (its leading bands are the same;
+ * NULL: no rotation, c = window * b). Same bits as vb_fit_apply. */
+int vb_fit_rotates(const vb_fit *f, const float n[3]);
+void vb_fit_rotation(const vb_fit *f, const float n[3], double *S);
+void vb_fit_apply_rotated(const vb_fit *f, const double *S, int s_order, const double *b,
+                          float *c);
+
 /* SH rotation for bands 0..order-1: out (order^2 x order^2, row-major,
  * block-diagonal) such that if f(w) = sum c_i Y_i(R^T w) then
  * f(w) = sum (out c)_i Y_i(w). R is row-major 3x3, columns the images of

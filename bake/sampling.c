@@ -206,6 +206,12 @@ void vb_dirgrid_destroy(vb_dirgrid *g)
     memset(g, 0, sizeof *g);
 }
 
+/* An AVX2 clone where the CPU has it (as formats/vdsh_sh.c does): no FMA
+ * (-std=c11 does not contract), so the same bits either way. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
 void vb_dirgrid_packet(const vb_dirgrid *g, uint32_t packet, uint64_t seed,
                        uint32_t vertex, const float n[3], float dx[16],
                        float dy[16], float dz[16], int valid[16])
