@@ -44,26 +44,9 @@ static int run(char *const argv[])
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
-static char *slurp(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)n + 1);
-    size_t got = fread(b, 1, (size_t)n, f);
-    fclose(f);
-    b[got] = '\0';
-    if (size)
-        *size = got;
-    return b;
-}
-
 static int contains(const char *path, const char *needle)
 {
-    char *b = slurp(path, NULL);
+    char *b = (char *)test_read_file(path, NULL);
     int ok = b && strstr(b, needle) != NULL;
     free(b);
     return ok;
@@ -152,7 +135,7 @@ int main(int argc, char **argv)
                             "-o", vdsh, NULL});
     CHECK(rc == 0, "bake: exit %d", rc);
     if (rc != 0) {
-        char *e = slurp(err_path, NULL);
+        char *e = (char *)test_read_file(err_path, NULL);
         fprintf(stderr, "%s\n", e ? e : "");
         free(e);
         return test_report("test_eval_cli");
@@ -170,7 +153,7 @@ int main(int argc, char **argv)
     CHECK(contains(json, "\"streams\": [") && contains(json, "\"bytes_per_vertex\": 50"),
           "JSON");
     size_t size = 0;
-    unsigned char *b = (unsigned char *)slurp(pv, &size);
+    unsigned char *b = test_read_file(pv, &size);
     CHECK(b && size >= 64, "per-vertex file");
     if (b && size >= 64) {
         uint32_t V = u32(b + 12), K = u32(b + 16), F = u32(b + 20), off = u32(b + 24);

@@ -65,25 +65,6 @@ static int run(char *const argv[], const char *err_path)
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-static uint8_t *read_all(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    struct stat st;
-    uint8_t *buf = NULL;
-    if (fstat(fileno(f), &st) == 0 && (buf = malloc((size_t)st.st_size + 1)) != NULL &&
-        fread(buf, 1, (size_t)st.st_size, f) != (size_t)st.st_size) {
-        free(buf);
-        buf = NULL;
-    }
-    if (buf)
-        buf[st.st_size] = 0; /* text files can be searched with strstr */
-    fclose(f);
-    *size = buf ? (size_t)st.st_size : 0;
-    return buf;
-}
-
 static int write_all(const char *path, const uint8_t *data, size_t size)
 {
     FILE *f = fopen(path, "wb");
@@ -133,7 +114,7 @@ static void expect_info_rejects(const char *info, const char *dir, const uint8_t
     char *argv[] = {(char *)info, "--verify", path, NULL};
     int rc = run(argv, err_path);
     size_t n;
-    uint8_t *msg = read_all(err_path, &n);
+    uint8_t *msg = test_read_file(err_path, &n);
     c->tried++;
     c->rejected += rc == 1;
     CHECK(rc == 1, "vdsh-info --verify on %s: exit %d, want 1", what, rc);
@@ -245,7 +226,7 @@ int main(int argc, char **argv)
     const char *paths[3] = {a, b, room};
     for (int k = 0; k < 3; k++) {
         size_t size;
-        uint8_t *data = read_all(paths[k], &size);
+        uint8_t *data = test_read_file(paths[k], &size);
         CHECK(data && size > 64, "cannot read %s", paths[k]);
         if (!data)
             continue;

@@ -26,24 +26,6 @@ static int is_mesh_name(const char *name)
                    !strcasecmp(dot, ".stl"));
 }
 
-static uint8_t *read_all(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    struct stat st;
-    uint8_t *buf = NULL;
-    if (f && fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) &&
-        (buf = malloc((size_t)st.st_size + 1)) != NULL) {
-        *size = fread(buf, 1, (size_t)st.st_size, f);
-        if (*size != (size_t)st.st_size) {
-            free(buf);
-            buf = NULL;
-        }
-    }
-    if (f)
-        fclose(f);
-    return buf;
-}
-
 static int same_mesh(const vb_mesh *a, const vb_mesh *b)
 {
     size_t nv = 3 * (size_t)a->vertex_count, nt = 3 * (size_t)a->triangle_count;
@@ -58,7 +40,7 @@ static unsigned files, accepted;
 static void compare(const char *path)
 {
     size_t size = 0;
-    uint8_t *bytes = read_all(path, &size);
+    uint8_t *bytes = test_read_file(path, &size);
     CHECK(bytes != NULL, "cannot read %s", path);
     if (!bytes)
         return;

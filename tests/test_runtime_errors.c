@@ -12,21 +12,6 @@
 
 static vr_scene *const SENTINEL = (vr_scene *)(uintptr_t)0x5e7;
 
-static int slurp(const char *path, unsigned char **data, size_t *size)
-{
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return -1;
-    fseek(fp, 0, SEEK_END);
-    long n = ftell(fp);
-    fseek(fp, 0, SEEK_SET);
-    *data = malloc((size_t)n + 1);
-    *size = (size_t)n;
-    int ok = *data && fread(*data, 1, (size_t)n, fp) == (size_t)n;
-    fclose(fp);
-    return ok ? 0 : -1;
-}
-
 static int spit(const char *path, const void *data, size_t size)
 {
     FILE *fp = fopen(path, "wb");
@@ -98,7 +83,7 @@ static void test_files(const char *dir)
 
     unsigned char *data = NULL;
     size_t size = 0;
-    CHECK(slurp(path, &data, &size) == 0, "read %s", path);
+    CHECK((data = test_read_file(path, &size)) != NULL, "read %s", path);
     snprintf(bad, sizeof bad, "%s/bad.vdsh", dir);
     sd.path = bad;
     spit(bad, data, 0);

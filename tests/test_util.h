@@ -8,6 +8,8 @@
 
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <sys/stat.h>
 
 static int test_failures;
 
@@ -51,6 +53,31 @@ static inline int test_report(const char *name)
     }
     printf("%s: all checks passed\n", name);
     return 0;
+}
+
+/* The whole of a regular file, followed by a NUL (so that text can be
+ * searched with strstr), its size in *size (may be NULL); NULL if it
+ * cannot be read. The caller frees. */
+static inline unsigned char *test_read_file(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    struct stat st;
+    unsigned char *buf = NULL;
+    if (f && fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) &&
+        (buf = malloc((size_t)st.st_size + 1)) != NULL) {
+        size_t got = fread(buf, 1, (size_t)st.st_size, f);
+        if (got != (size_t)st.st_size) {
+            free(buf);
+            buf = NULL;
+        } else {
+            buf[got] = 0;
+            if (size)
+                *size = got;
+        }
+    }
+    if (f)
+        fclose(f);
+    return buf;
 }
 
 #endif
