@@ -615,8 +615,8 @@ static void print_table(FILE *o, const context *c)
                "+- = 95%% interval\n");
     fprintf(o, "  distance = |D - d_T| / max(d_T, 0.01 diag); false = P(s_hat < .5 | d_T >= d_L), "
                "leak = P(s_hat > .5 | s_ideal < .5)\n\n");
-    fprintf(o, "  %-8s %5s %3s %3s %-6s | %-14s %6s %6s %6s | %-15s %-13s %-13s | %-6s %6s %6s\n",
-            "", "order", "B/v", "enc", "method", "distance RMS", "p50", "p90", "p99",
+    fprintf(o, "  %-8s %5s %3s %3s %-9s | %-14s %6s %6s %6s | %-15s %-13s %-13s | %-6s %6s %6s\n",
+            "", "order", "B/v", "enc", "fit", "distance RMS", "p50", "p90", "p99",
             "smooth: MAE", "false", "leak", "binary", "false", "leak");
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         if (r->truth[k].receivers == 0)
@@ -624,17 +624,20 @@ static void print_table(FILE *o, const context *c)
         for (uint32_t s = 0; s < r->stream_count; s++) {
             const vdsh_stream *st = &f->streams[s];
             const vb_eval_metrics *m = &r->metrics[k][s];
-            char rms[32], mae[32], fa[32], le[32];
+            char rms[32], mae[32], fa[32], le[32], fit[32];
+            snprintf(fit, sizeof fit, "%s%s", vdsh_method_name(st->method),
+                     st->quantity == VDSH_QUANTITY_LOG_DISTANCE ? "+log"
+                     : st->quantity == VDSH_QUANTITY_DISTANCE2  ? "+d2" : "");
             snprintf(rms, sizeof rms, "%.3f+-%.3f", m->distance_rms, 1.96 * m->distance_rms_se);
             snprintf(mae, sizeof mae, "%.4f+-%.4f", m->shadow_mae, 1.96 * m->shadow_mae_se);
             snprintf(fa, sizeof fa, "%.2f+-%.2f%%", 100.0 * m->false_shadow,
                      196.0 * m->false_shadow_se);
             snprintf(le, sizeof le, "%.2f+-%.2f%%", 100.0 * m->light_leak,
                      196.0 * m->light_leak_se);
-            fprintf(o, "  %-8s %5u %3zu %3s %-6s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s %-13s "
+            fprintf(o, "  %-8s %5u %3zu %3s %-9s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s %-13s "
                        "| %6.4f %5.2f%% %5.2f%%\n",
                     kind_name(k), st->order, vdsh_stream_bytes_per_vertex(st),
-                    vdsh_encoding_name(st->encoding), vdsh_method_name(st->method), rms,
+                    vdsh_encoding_name(st->encoding), fit, rms,
                     m->distance_p50, m->distance_p90, m->distance_p99, mae, fa, le,
                     m->binary_mae, 100.0 * m->binary_false_shadow,
                     100.0 * m->binary_light_leak);
