@@ -465,6 +465,8 @@ typedef struct job {
      * sample, order and quantity (0 distance, 1 log) its estimated error. */
     uint32_t choose_count;
     double *choose_error;  /* choose_count * (VDSH_MAX_ORDER + 1) * 2 */
+    float *choose_coeffs;  /* per sample, quantity and order: its fit */
+    uint8_t *done;         /* receivers the choice baked already (or NULL) */
     _Atomic uint64_t traced, missed;
     _Atomic uint32_t degenerate;
 } job;
@@ -650,6 +652,8 @@ static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
     uint64_t traced = 0, missed = 0;
     uint32_t degenerate = 0;
     for (uint32_t v = begin; v < end; v++) {
+        if (J->done && J->done[v])
+            continue;
         vertex_sink out = {0};
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (J->coeffs[o])
@@ -698,6 +702,13 @@ static double expected_error(double r)
 }
 
 #define CHOOSE_RECEIVERS 1024
+#define CHOOSE_STRIDE (1 + 4 + 9 + 16 + 25) /* coefficients of orders 1..5 */
+
+/* Where order o starts among one sample's coefficients of one quantity. */
+static size_t choose_offset(int o)
+{
+    return (size_t)(o - 1) * o * (2 * o - 1) / 6;
+}
 
 /* Sampled receiver i: trace it, fit both quantities at every asked order,
  * and score each fit on the traced directions above the horizon. */
@@ -718,6 +729,12 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
             if (J->coeffs[o])
                 out.coeffs[0][o] = c[0][o], out.coeffs[1][o] = c[1][o];
         bake_vertex(J, v, &out, &traced, &missed, &degenerate);
+        float *keep = J->choose_coeffs + (size_t)i * 2 * CHOOSE_STRIDE;
+        for (int q = 0; q < 2; q++)
+            for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+                if (J->coeffs[o])
+                    memcpy(keep + q * CHOOSE_STRIDE + choose_offset(o), c[q][o],
+                           (size_t)o * o * sizeof(float));
         double e[VDSH_MAX_ORDER + 1][2] = {{0}};
         float tmin = 1e-4f * J->d->max_distance;
         for (uint32_t k = 0; k < count; k++) {
@@ -745,6 +762,12 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
         for (uint32_t i = begin; i < end; i++)
             memset(J->choose_error + (size_t)i * (VDSH_MAX_ORDER + 1) * 2, 0,
                    (VDSH_MAX_ORDER + 1) * 2 * sizeof(double));
+    else /* their coefficients are kept: the main pass skips them */
+        for (uint32_t i = begin; i < end; i++)
+            J->done[(uint64_t)i * nrec / J->choose_count] = 1;
+    atomic_fetch_add(&J->traced, traced);
+    atomic_fetch_add(&J->missed, missed);
+    atomic_fetch_add(&J->degenerate, degenerate);
     free(buf);
 }
 
@@ -932,7 +955,9 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             R->vertex_count < CHOOSE_RECEIVERS ? R->vertex_count : CHOOSE_RECEIVERS;
         J->choose_error = calloc((size_t)J->choose_count * (VDSH_MAX_ORDER + 1) * 2,
                                  sizeof(double));
-        if (!J->choose_error) {
+        J->choose_coeffs = malloc((size_t)J->choose_count * 2 * CHOOSE_STRIDE * sizeof(float));
+        J->done = calloc(R->vertex_count, 1);
+        if (!J->choose_error || !J->choose_coeffs || !J->done) {
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
             goto done;
         }
@@ -951,10 +976,17 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             J->quantity[o] = auto_error[o][1] < auto_error[o][0] ? VDSH_QUANTITY_LOG_DISTANCE
                                                                  : VDSH_QUANTITY_DISTANCE;
         }
-        /* The sample's rays are traced again below, with the rest. */
-        atomic_store(&J->traced, 0);
-        atomic_store(&J->missed, 0);
-        atomic_store(&J->degenerate, 0);
+        /* The sampled receivers are baked: keep the chosen fits. */
+        for (uint32_t i = 0; i < J->choose_count; i++) {
+            uint32_t v = (uint32_t)((uint64_t)i * R->vertex_count / J->choose_count);
+            const float *keep = J->choose_coeffs + (size_t)i * 2 * CHOOSE_STRIDE;
+            for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+                if (coeffs[o] && J->done[v])
+                    memcpy(coeffs[o] + (size_t)v * o * o,
+                           keep + (J->quantity[o] == VDSH_QUANTITY_LOG_DISTANCE) * CHOOSE_STRIDE +
+                               choose_offset(o),
+                           (size_t)o * o * sizeof(float));
+        }
     } else {
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             J->quantity[o] = d.quantity == VB_QUANTITY_AUTO ? VDSH_QUANTITY_DISTANCE : d.quantity;
@@ -996,8 +1028,11 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     r = VB_OK;
 
 done:
-    if (J)
+    if (J) {
         free(J->choose_error);
+        free(J->choose_coeffs);
+        free(J->done);
+    }
     free(J);
     for (int k = 0; k <= VDSH_MAX_ORDER; k++)
         free(coeffs[k]);

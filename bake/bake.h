@@ -25,7 +25,8 @@
  * fit on the traced directions above the horizon with the shadow error
  * vdsh-eval expects there (DESIGN.md section 3: a light at 2 u d_T, u
  * uniform in (0.05, 1], smooth ramp: a function of the ratio of the
- * reconstructed to the true distance only); the lower mean wins. Log wins
+ * reconstructed to the true distance only); the lower mean wins, and the
+ * sampled receivers keep their fit of it (nothing is traced twice). Log wins
  * in closed rooms and levels, where what matters is relative error close
  * to walls; distance on open objects, where most rays escape to the clamp
  * distance. With paper, auto means distance.
