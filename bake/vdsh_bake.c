@@ -99,7 +99,7 @@ static void usage(FILE *f)
 "      --lambda X          lsq regularisation weight (default 1e-4)\n"
 "      --window W          per-band window on the coefficients: none (default),\n"
 "                          hann or lanczos (width: the order)\n"
-"      --log-floor D       with --log, distances below D count as D\n"
+"      --log-floor D       log-distance: distances below D count as D\n"
 "                          (default: 1%% of the max distance)\n"
 "      --max-distance D    clamp distance; misses get it (default: the\n"
 "                          scene's bounding-box diagonal)\n"
