@@ -581,7 +581,8 @@ vb_result scan_stl(const char *path, const uint8_t *bytes, size_t size,
 /* ---------------------------------------------------------------------- */
 
 /* Mirrors OpenMesh's OFF reader: header line [ST][C][N]OFF [BINARY]
- * ("4OFF"/"nOFF" unsupported); counts nV nF nE as tokens; each vertex is
+ * ("4OFF"/"nOFF" unsupported; BINARY exactly one character after OFF);
+ * counts nV nF nE as tokens; each vertex is
  * 3 numbers (+3 for a normal with N), then the rest of its line; each face
  * is a count and that many indices as tokens, then (only with C) the rest
  * of its line. Binary: little-endian uint32 counts, float32 coordinates,
@@ -611,8 +612,11 @@ vb_result scan_off(const char *path, const uint8_t *bytes, size_t size,
         return vb_fail(err, VB_ERR_FORMAT, "%s: 4OFF/nOFF (vertex dimension other than 3) is not supported", path);
     if (le - p < 3 || memcmp(p, "OFF", 3) != 0)
         return vb_fail(err, VB_ERR_FORMAT, "%s: not an OFF file (first line must be [ST][C][N]OFF)", path);
+    /* OpenMesh skips exactly one character after "OFF", whatever it is,
+     * then looks for BINARY: "OFFxBINARY" is binary to it and "OFF  BINARY"
+     * is not. Decide as it does, or the checks below check the wrong file. */
     p += 3;
-    while (p < le && is_blank(*p))
+    if (p < le)
         p++;
     if (le - p >= 6 && memcmp(p, "BINARY", 6) == 0)
         binary = true;

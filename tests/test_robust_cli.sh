@@ -152,6 +152,10 @@ printf 'OFF BINARY\n' >"$in/truncated-binary.off"
 printf '\x03\x00\x00\x00\x01\x00\x00\x00\x00\x00\x00\x00' >>"$in/truncated-binary.off"
 printf "$zero$zero$zero$one$zero$zero" >>"$in/truncated-binary.off"
 bad_mesh "$in/truncated-binary.off" "more than the file"
+# OpenMesh takes BINARY exactly one character after OFF ("OFFxBINARY" is
+# binary): the checks must read the same file it reads (fuzzer finding)
+f binary-after-x.off 'OFFxBINARY\n1 0 7 3\n4 4 6 2\n'
+bad_mesh "$in/binary-after-x.off" "header declares 540024881 vertices"
 f nan.off 'OFF\n3 1 0\n0 0 0\n1 NaN 0\n0 1 0\n3 0 1 2\n'
 bad_mesh "$in/nan.off" "'NaN' is not finite"
 f index-range.off 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n'
