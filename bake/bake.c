@@ -362,6 +362,42 @@ typedef struct orient_job {
     uint8_t *flip;
 } orient_job;
 
+/* Whether at least PROBE_UP_LIMIT of the 16 full-length upper probes from o
+ * around unit normal n hit faces turned away from the ray (back = 1) or
+ * toward it (back = 0); rays that escape count as neither. One ray at a
+ * time, stopping as soon as the answer is known: almost every receiver
+ * has its answer (no) after 3 probes, and the probes point too far apart
+ * for a 16-wide packet to share any work. */
+static int mostly_facing(const prober *J, const float o[3], const float n[3], int back)
+{
+    float t[3], b[3];
+    vb_frame(n, t, b);
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    int yes = 0, no = 0;
+    for (int k = 0; k < PROBES && yes < PROBE_UP_LIMIT && no <= PROBES - PROBE_UP_LIMIT; k++) {
+        const float *l = J->local_dir[k];
+        struct RTCRayHit rh;
+        rh.ray.dir_x = l[0] * t[0] + l[1] * b[0] + l[2] * n[0];
+        rh.ray.dir_y = l[0] * t[1] + l[1] * b[1] + l[2] * n[1];
+        rh.ray.dir_z = l[0] * t[2] + l[1] * b[2] + l[2] * n[2];
+        rh.ray.org_x = o[0], rh.ray.org_y = o[1], rh.ray.org_z = o[2];
+        rh.ray.tnear = 0.0f, rh.ray.tfar = 1e30f, rh.ray.time = 0.0f;
+        rh.ray.mask = 0xffffffffu, rh.ray.id = (unsigned)k, rh.ray.flags = 0;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(J->s->scene, &ctx, &rh);
+        int hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        float facing = rh.hit.Ng_x * rh.ray.dir_x + rh.hit.Ng_y * rh.ray.dir_y +
+                       rh.hit.Ng_z * rh.ray.dir_z;
+        if (hit && (facing > 0.0f) == (back != 0))
+            yes++;
+        else
+            no++;
+    }
+    return yes >= PROBE_UP_LIMIT;
+}
+
 static void orient_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
 {
     orient_job *J = ctx;
@@ -377,14 +413,11 @@ static void orient_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
          * resting on it has a solid above it and the void outside the room
          * below, and its normal is right. */
         float o[3], m[3] = {-n[0], -n[1], -n[2]};
-        int hits, own_back, other_back, unused;
         standard_origin(J->P.s, J->m, J->F, v, 1.0f, o);
-        probe_len(&J->P, o, n, 1e30f, 0, &hits, &own_back, &unused);
-        if (own_back < PROBE_UP_LIMIT)
+        if (!mostly_facing(&J->P, o, n, 1))
             continue;
         standard_origin(J->P.s, J->m, J->F, v, -1.0f, o);
-        probe_len(&J->P, o, m, 1e30f, 0, &hits, &other_back, &unused);
-        J->flip[v] = hits - other_back >= PROBE_UP_LIMIT; /* front faces */
+        J->flip[v] = (uint8_t)mostly_facing(&J->P, o, m, 0);
     }
 }
 
