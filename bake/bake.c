@@ -653,26 +653,25 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
      * order's coefficients are its fit's map of b (fit.h). */
     double w = (J->grid->hemisphere ? 2.0 : 4.0) * VB_PI / J->grid->count;
     int nb = J->order * J->order;
-    /* One rotation for every order: the highest order's leading bands. */
-    double rotation[VDSH_MAX_COEFFS * VDSH_MAX_COEFFS];
+    /* The rotation's first half once for every order: the highest
+     * order's leading bands are the lower orders' (fit.h). */
     const vb_fit *top = &J->fits[J->order];
-    int rot = vb_fit_rotates(top, n);
-    if (rot)
-        vb_fit_rotation(top, n, rotation);
+    vb_fit_angles angles;
+    vb_fit_frame(top, n, &angles);
     for (int q = 0; q < 2; q++) {
         if (!want[q])
             continue;
-        double b[VDSH_MAX_COEFFS];
+        double b[VDSH_MAX_COEFFS], u[VDSH_MAX_COEFFS];
         for (int i = 0; i < nb; i++) {
             double s = 0.0;
             for (int k = 0; k < VB_PACKET; k++)
                 s += acc[q][i][k];
             b[i] = s * w;
         }
+        vb_fit_unrotate(top, &angles, b, u);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (out->coeffs[q][o])
-                vb_fit_apply_rotated(&J->fits[o], rot ? rotation : NULL, J->order, b,
-                                     out->coeffs[q][o]);
+                vb_fit_finish(&J->fits[o], &angles, u, out->coeffs[q][o]);
     }
     if (upper > 0 && near_zero >= 0.9 * upper)
         (*degenerate)++;

@@ -3,7 +3,6 @@
 #include <math.h>
 #include <string.h>
 
-#include "sampling.h"
 #include "vdsh.h"
 #include "vdsh_sh.h"
 
@@ -192,6 +191,34 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
                 f.rot_pinv[l][j * k + b] = s;
             }
     }
+
+    /* X: the rotation by 90 degrees about x (y to z, z to -y), whose
+     * conjugate X^T Rz(beta) X is the rotation by beta about y. Most of
+     * its entries are 0, the others at least 0.125 in magnitude. Built
+     * from float SH values it is off by ~1e-7 (as the per-receiver
+     * rotations built the same way were); the zeros are made exact. */
+    static const double Q[9] = {1, 0, 0, 0, 0, -1, 0, 1, 0};
+    double XS[VB_FIT_MAX * VB_FIT_MAX];
+    vb_sh_rotation(&f, Q, XS);
+    for (int l = 0; l < order; l++) {
+        int k = 2 * l + 1, o = l * l;
+        for (int a = 0; a < k; a++)
+            for (int b = 0; b < k; b++) {
+                double x = XS[(o + a) * n + o + b];
+                f.X[l][a * k + b] = fabs(x) < 1e-6 ? 0.0 : x;
+            }
+    }
+    for (int i = 0; i < n; i++) /* N = X M X^T, X block-diagonal by band */
+        for (int j = 0; j < n; j++) {
+            int li = band_of(i), lj = band_of(j), ki = 2 * li + 1, kj = 2 * lj + 1;
+            int oi = li * li, oj = lj * lj;
+            double sum = 0.0;
+            for (int a = 0; a < ki; a++)
+                for (int b = 0; b < kj; b++)
+                    sum += f.X[li][(i - oi) * ki + a] * f.M[(oi + a) * n + oj + b] *
+                           f.X[lj][(j - oj) * kj + b];
+            f.N[i * n + j] = sum;
+        }
     *out = f;
     return VB_OK;
 }
@@ -235,62 +262,95 @@ void vb_sh_rotation(const vb_fit *f, const double R[9], double *out)
     }
 }
 
-int vb_fit_rotates(const vb_fit *f, const float n[3])
+void vb_fit_frame(const vb_fit *f, const float n[3], vb_fit_angles *a)
 {
-    return (f->method == VDSH_METHOD_MIRROR || f->method == VDSH_METHOD_LSQ) &&
-           !(n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f);
+    memset(a, 0, sizeof *a);
+    double x = n[0], y = n[1], z = n[2], r = sqrt(x * x + y * y), len = sqrt(r * r + z * z);
+    a->rotates = (f->method == VDSH_METHOD_MIRROR || f->method == VDSH_METHOD_LSQ) && len > 0.0;
+    if (!a->rotates)
+        return;
+    /* n = (sin beta cos alpha, sin beta sin alpha, cos beta); on the
+     * poles alpha is free: 0. Multiples by the angle-sum formulas. */
+    double ca = r > 0.0 ? x / r : 1.0, sa = r > 0.0 ? y / r : 0.0;
+    double cb = z / len, sb = r / len;
+    a->ca[0] = a->cb[0] = 1.0;
+    for (int m = 1; m < 5; m++) {
+        a->ca[m] = a->ca[m - 1] * ca - a->sa[m - 1] * sa;
+        a->sa[m] = a->sa[m - 1] * ca + a->ca[m - 1] * sa;
+        a->cb[m] = a->cb[m - 1] * cb - a->sb[m - 1] * sb;
+        a->sb[m] = a->sb[m - 1] * cb + a->cb[m - 1] * sb;
+    }
 }
 
-void vb_fit_rotation(const vb_fit *f, const float n[3], double *S)
+/* v = Rz(sign * gamma) v over bands 0..order-1, given cos and sin of
+ * m gamma: coefficient l(l+1)+m goes with cos m phi, l(l+1)-m with
+ * sin m phi (the same factor on both, phase included), and f(phi - gamma)
+ * turns each pair by m gamma. */
+static void rotate_z(int order, const double *cm, const double *sm, double sign, double *v)
 {
-    float t[3], bt[3];
-    vb_frame(n, t, bt);
-    const double R[9] = {t[0], bt[0], n[0], t[1], bt[1], n[1], t[2], bt[2], n[2]};
-    vb_sh_rotation(f, R, S);
+    for (int l = 1; l < order; l++) {
+        int c = l * (l + 1);
+        for (int m = 1; m <= l; m++) {
+            double p = v[c + m], q = v[c - m], s = sign * sm[m];
+            v[c + m] = p * cm[m] - q * s;
+            v[c - m] = p * s + q * cm[m];
+        }
+    }
 }
 
-void vb_fit_apply_rotated(const vb_fit *f, const double *S, int s_order, const double *b,
-                          float *c)
+/* v = X v, or X^T v, over bands 0..order-1. */
+static void rotate_x(const vb_fit *f, int order, int transpose, double *v)
 {
-    int nc = f->order * f->order, ns = s_order * s_order;
-    if (!S) {
-        for (int i = 0; i < nc; i++)
-            c[i] = (float)(f->window[i] * b[i]);
+    for (int l = 1; l < order; l++) {
+        int k = 2 * l + 1, o = l * l;
+        double in[9], *out = v + o;
+        memcpy(in, out, (size_t)k * sizeof *in);
+        for (int i = 0; i < k; i++) {
+            double s = 0.0;
+            for (int j = 0; j < k; j++)
+                s += (transpose ? f->X[l][j * k + i] : f->X[l][i * k + j]) * in[j];
+            out[i] = s;
+        }
+    }
+}
+
+void vb_fit_unrotate(const vb_fit *f, const vb_fit_angles *a, const double *b, double *u)
+{
+    memcpy(u, b, (size_t)f->order * f->order * sizeof *u);
+    if (!a->rotates)
+        return;
+    rotate_z(f->order, a->ca, a->sa, -1.0, u);
+    rotate_x(f, f->order, 0, u);
+    rotate_z(f->order, a->cb, a->sb, -1.0, u);
+}
+
+void vb_fit_finish(const vb_fit *f, const vb_fit_angles *a, const double *u, float *c)
+{
+    int n = f->order * f->order;
+    if (!a->rotates) {
+        for (int i = 0; i < n; i++)
+            c[i] = (float)(f->window[i] * u[i]);
         return;
     }
-    /* S is block-diagonal by band: each product runs over its band only. */
-    double u[VB_FIT_MAX], v[VB_FIT_MAX];
-    for (int l = 0; l < f->order; l++) { /* u = S^T b */
-        int o = l * l, k = 2 * l + 1;
-        for (int i = o; i < o + k; i++) {
-            double s = 0.0;
-            for (int j = o; j < o + k; j++)
-                s += S[j * ns + i] * b[j];
-            u[i] = s;
-        }
-    }
-    for (int i = 0; i < nc; i++) { /* v = M u */
+    double v[VB_FIT_MAX];
+    for (int i = 0; i < n; i++) {
         double s = 0.0;
-        for (int j = 0; j < nc; j++)
-            s += f->M[i * nc + j] * u[j];
+        for (int j = 0; j < n; j++)
+            s += f->N[i * n + j] * u[j];
         v[i] = s;
     }
-    for (int l = 0; l < f->order; l++) { /* c = window * S v */
-        int o = l * l, k = 2 * l + 1;
-        for (int i = o; i < o + k; i++) {
-            double s = 0.0;
-            for (int j = o; j < o + k; j++)
-                s += S[i * ns + j] * v[j];
-            c[i] = (float)(f->window[i] * s);
-        }
-    }
+    rotate_z(f->order, a->cb, a->sb, 1.0, v);
+    rotate_x(f, f->order, 1, v);
+    rotate_z(f->order, a->ca, a->sa, 1.0, v);
+    for (int i = 0; i < n; i++)
+        c[i] = (float)(f->window[i] * v[i]);
 }
 
 void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c)
 {
-    double S[VB_FIT_MAX * VB_FIT_MAX];
-    int rot = vb_fit_rotates(f, n);
-    if (rot)
-        vb_fit_rotation(f, n, S);
-    vb_fit_apply_rotated(f, rot ? S : NULL, f->order, b, c);
+    vb_fit_angles a;
+    double u[VB_FIT_MAX];
+    vb_fit_frame(f, n, &a);
+    vb_fit_unrotate(f, &a, b, u);
+    vb_fit_finish(f, &a, u, c);
 }

@@ -20,6 +20,15 @@
  * G is invariant under rotations about the pole, so the local frame's
  * azimuth does not matter and M is one matrix for every receiver.
  *
+ * That also makes S cheap: any rotation taking the pole to n will do, so
+ * S = Rz(alpha) Ry(beta) (n's azimuth and polar angle), and the rotation
+ * about y is X^T Rz(beta) X with X the fixed SH rotation by 90 degrees
+ * about x. Rotations about z turn each (cos m phi, sin m phi) pair of
+ * coefficients by m times the angle, so per receiver only the two small
+ * X products per band remain:
+ *
+ *     c = Rz(alpha) X^T Rz(beta) N Rz(-beta) X Rz(-alpha) b,   N = X M X^T
+ *
  * Threading: a created vb_fit is read-only. Errors: vb_result.
  */
 #ifndef VB_FIT_H
@@ -42,6 +51,8 @@ typedef struct vb_fit {
     float lambda;                     /* lsq regularisation */
     double window[VB_FIT_MAX];        /* per coefficient: its band's weight */
     double M[VB_FIT_MAX * VB_FIT_MAX];  /* local-frame map, order^2 square */
+    double N[VB_FIT_MAX * VB_FIT_MAX];  /* X M X^T, order^2 square */
+    double X[5][9 * 9];               /* per band l: the (2l+1)^2 block of X */
     /* Rotations: sample directions and, per band l, the pseudo-inverse of
      * the (2l+1) x VB_FIT_ROT_DIRS basis block at them. */
     double rot_dirs[VB_FIT_ROT_DIRS][3];
@@ -68,15 +79,22 @@ void vb_fit_window(vb_fit *f, uint32_t window);
 void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c);
 
 /* vb_fit_apply in two steps, so that fits of several orders for one
- * receiver share one rotation: whether f rotates at all for normal n
- * (mirror and lsq with a non-zero normal), the rotation S (f->order^2
- * square, vb_sh_rotation of the frame about n), and the map with an S
- * made for any order s_order >= f->order (its leading bands are the same;
- * NULL: no rotation, c = window * b). Same bits as vb_fit_apply. */
-int vb_fit_rotates(const vb_fit *f, const float n[3]);
-void vb_fit_rotation(const vb_fit *f, const float n[3], double *S);
-void vb_fit_apply_rotated(const vb_fit *f, const double *S, int s_order, const double *b,
-                          float *c);
+ * receiver share the first (the leading bands of the highest order's u
+ * are the lower orders' u). vb_fit_frame: the angles of unit normal n,
+ * and whether f rotates at all (mirror and lsq with a non-zero normal).
+ * vb_fit_unrotate: u = Rz(-beta) X Rz(-alpha) b over f's bands (u = b
+ * if f does not rotate). vb_fit_finish: c = window * (the rest of the
+ * product above), from the first order^2 values of a u made by a fit of
+ * the same method and any order >= f->order. */
+typedef struct vb_fit_angles {
+    int rotates;
+    double ca[5], sa[5];  /* cos, sin of m alpha, m = 0..4 */
+    double cb[5], sb[5];  /* cos, sin of m beta */
+} vb_fit_angles;
+
+void vb_fit_frame(const vb_fit *f, const float n[3], vb_fit_angles *a);
+void vb_fit_unrotate(const vb_fit *f, const vb_fit_angles *a, const double *b, double *u);
+void vb_fit_finish(const vb_fit *f, const vb_fit_angles *a, const double *u, float *c);
 
 /* SH rotation for bands 0..order-1: out (order^2 x order^2, row-major,
  * block-diagonal) such that if f(w) = sum c_i Y_i(R^T w) then

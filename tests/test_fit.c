@@ -68,6 +68,62 @@ static void test_rotation(void)
     CHECK(orth < 1e-5, "rotation not orthogonal: %g", orth);
 }
 
+/* The factored fit (fit.h: S = Rz(alpha) X^T Rz(beta) X, the first half
+ * shared between orders) equals S M S^T b with S the SH rotation of any
+ * frame about the normal, here vb_frame's: M commutes with rotations
+ * about the pole. Also on the poles, where the azimuth is free. */
+static void test_factored_fit(void)
+{
+    vb_error err;
+    uint64_t s = 42;
+    double worst = 0;
+    for (uint32_t method = VDSH_METHOD_MIRROR; method <= VDSH_METHOD_LSQ; method++)
+        for (int order = 1; order <= 5; order++) {
+            vb_fit f, top;
+            CHECK(vb_fit_create(order, method, 1e-3f, &f, &err) == VB_OK, "fit");
+            CHECK(vb_fit_create(5, method, 1e-3f, &top, &err) == VB_OK, "fit");
+            int n = order * order;
+            for (int t = 0; t < 20; t++) {
+                float nrm[3];
+                test_rand_dir(&s, nrm);
+                if (t < 2) /* the poles */
+                    nrm[0] = nrm[1] = 0.0f, nrm[2] = t ? -1.0f : 1.0f;
+                double b[25], u[25], S[625], v[25], w[25];
+                for (int i = 0; i < 25; i++)
+                    b[i] = 2 * test_rand(&s) - 1;
+                float t3[3], b3[3], c[25], ct[25];
+                vb_frame(nrm, t3, b3);
+                const double R[9] = {t3[0], b3[0], nrm[0], t3[1], b3[1], nrm[1],
+                                     t3[2], b3[2], nrm[2]};
+                vb_sh_rotation(&f, R, S);
+                for (int i = 0; i < n; i++) { /* v = S^T b */
+                    v[i] = 0;
+                    for (int j = 0; j < n; j++)
+                        v[i] += S[j * n + i] * b[j];
+                }
+                for (int i = 0; i < n; i++) { /* w = M v */
+                    w[i] = 0;
+                    for (int j = 0; j < n; j++)
+                        w[i] += f.M[i * n + j] * v[j];
+                }
+                vb_fit_apply(&f, nrm, b, c);
+                vb_fit_angles a;
+                vb_fit_frame(&top, nrm, &a); /* u from the order 5 fit */
+                vb_fit_unrotate(&top, &a, b, u);
+                vb_fit_finish(&f, &a, u, ct);
+                for (int i = 0; i < n; i++) {
+                    double want = 0; /* S w */
+                    for (int j = 0; j < n; j++)
+                        want += S[i * n + j] * w[j];
+                    worst = fmax(worst, fabs(c[i] - want) / (1 + fabs(want)));
+                    CHECK(c[i] == ct[i], "order %d from the order 5 rotation: %g vs %g", order,
+                          ct[i], c[i]);
+                }
+            }
+        }
+    CHECK(worst < 1e-5, "factored fit differs from S M S^T b by %g", worst);
+}
+
 /* Least squares over the hemisphere recovers any function of the basis
  * from its upper half. The hemisphere's Gram matrix is ill-conditioned
  * (condition 14, 250, 5900, 150000 at orders 2..5), so without
@@ -225,6 +281,7 @@ static void test_errors(void)
 int main(void)
 {
     test_rotation();
+    test_factored_fit();
     test_lsq_recovers();
     test_mirror_and_paper();
     test_window();
