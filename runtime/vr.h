@@ -147,9 +147,12 @@ typedef struct vr_scene_desc {
  * positions, normals, indices, every stream of the chosen quantity (f16
  * streams as GL_HALF_FLOAT attributes, f32 as GL_FLOAT, no conversion) and
  * the basis cubemaps (converted to GL face orientation with
- * vdsh_cube_gl_to_exr). On failure *out is untouched and nothing stays
- * allocated. Errors: VR_ERR_IO / VR_ERR_FORMAT from the .vdsh reader or
- * the cubemap reader, VR_ERR_MISSING for a missing cubemap, VR_ERR_GL. */
+ * vdsh_cube_gl_to_exr). Triangles and vertices are uploaded in an order
+ * chosen for the vertex cache (the same triangles, reordered; vertices
+ * renumbered), not the file's. On failure *out is untouched and nothing
+ * stays allocated. Errors: VR_ERR_IO / VR_ERR_FORMAT from the .vdsh reader
+ * or the cubemap reader (and VR_ERR_FORMAT for an index out of range in a
+ * desc->file), VR_ERR_MISSING for a missing cubemap, VR_ERR_GL. */
 vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out,
                           vr_error *err);
 

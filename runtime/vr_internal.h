@@ -28,6 +28,17 @@ int vr_mode_order(vr_mode m);
  * vdsh_runtime_interp of its order; -1 for modes none and cube. */
 int vr_mode_interp(vr_mode m, uint32_t quantity);
 
+/* The GPU order of a scene's nt triangles over nv vertices (vr_order.c):
+ * triangles reordered for the post-transform vertex cache, vertices
+ * renumbered in the order they are first used. Writes out (3 nt indices,
+ * in the new numbering) and remap (nv entries: remap[old] = new, a
+ * permutation; vertices no triangle uses go last). VR_ERR_FORMAT when an
+ * index is not below nv, VR_ERR_OUT_OF_MEMORY; `name` for messages;
+ * outputs are undefined on failure. */
+vr_result vr_order_triangles(const uint32_t *indices, uint32_t nt, uint32_t nv,
+                             uint32_t *out, uint32_t *remap, const char *name,
+                             vr_error *err);
+
 /* Attribute locations, the same in every program. Coefficient attribute
  * k covers coefficients first[k] .. first[k] + size[k] - 1 of the stream
  * (vr_coef_attribs): grouped so that bands 0-2 (0..8) and the four

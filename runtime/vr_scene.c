@@ -7,6 +7,8 @@
  * so nothing is converted on the CPU and an f16 scene takes half the
  * memory. Each order's stream gets its own VAO; attribute k of a VAO
  * points at coefficients vr_coef_first[k].. of each vertex (vr_internal.h).
+ * Triangles and vertices go up in the order of vr_order_triangles
+ * (vr_order.c), not the file's.
  */
 #include "vr_internal.h"
 
@@ -132,14 +134,32 @@ static void set_base_attribs(const vr_scene *s)
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, s->ibo);
 }
 
-static vr_result upload_stream(vr_scene *s, const vdsh_stream *st, size_t vertices)
+/* A vertex buffer of n elements of `size` bytes in the GPU order: element
+ * i of src goes to remap[i]. Returns 0, or 1 when out of memory. */
+static int upload_permuted(GLuint buffer, const void *src, size_t n, size_t size,
+                           const uint32_t *remap)
+{
+    unsigned char *dst = malloc(n * size);
+    if (!dst)
+        return 1;
+    for (size_t i = 0; i < n; i++)
+        memcpy(dst + (size_t)remap[i] * size, (const unsigned char *)src + i * size, size);
+    glBindBuffer(GL_ARRAY_BUFFER, buffer);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(n * size), dst, GL_STATIC_DRAW);
+    free(dst);
+    return 0;
+}
+
+static vr_result upload_stream(vr_scene *s, const vdsh_stream *st, size_t vertices,
+                               const uint32_t *remap, const char *name, vr_error *err)
 {
     int order = (int)st->order;
     size_t bpv = vdsh_stream_bytes_per_vertex(st);
     size_t elem = st->encoding == VDSH_ENCODING_F16 ? 2 : 4;
     glGenBuffers(1, &s->vbo_stream[order]);
-    glBindBuffer(GL_ARRAY_BUFFER, s->vbo_stream[order]);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(bpv * vertices), st->data, GL_STATIC_DRAW);
+    if (upload_permuted(s->vbo_stream[order], st->data, vertices, bpv, remap))
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory uploading order %d", name,
+                       order);
     s->gpu_bytes += bpv * vertices;
 
     glGenVertexArrays(1, &s->vao[order]);
@@ -191,6 +211,7 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     vr_scene *s = NULL;
     vb_cubemap *maps[VB_CUBEMAP_BASIS_FILES] = {0};
     int have_maps = 0;
+    uint32_t *gpu_indices = NULL, *remap = NULL;
     if (h->vertex_count == 0 || h->triangle_count == 0) {
         r = vr_fail(err, VR_ERR_FORMAT, "%s: no triangles to draw", name);
         goto done;
@@ -244,30 +265,45 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
             s->bounds_max[k] = fmaxf(s->bounds_max[k], x);
         }
 
-    size_t nv = h->vertex_count;
+    /* Everything per vertex goes up in the order of vr_order_triangles
+     * (the same vertices and triangles, arranged for the vertex cache). */
+    size_t nv = h->vertex_count, ni = 3 * (size_t)h->triangle_count;
+    gpu_indices = malloc(ni * sizeof *gpu_indices);
+    remap = malloc(nv * sizeof *remap);
+    if (!gpu_indices || !remap) {
+        r = vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+        goto done;
+    }
+    r = vr_order_triangles(f->indices, h->triangle_count, h->vertex_count, gpu_indices, remap,
+                           name, err);
+    if (r != VR_OK)
+        goto done;
     glGenBuffers(1, &s->vbo_position);
-    glBindBuffer(GL_ARRAY_BUFFER, s->vbo_position);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 12), f->positions, GL_STATIC_DRAW);
     glGenBuffers(1, &s->vbo_normal);
-    glBindBuffer(GL_ARRAY_BUFFER, s->vbo_normal);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 12), f->normals, GL_STATIC_DRAW);
+    if (upload_permuted(s->vbo_position, f->positions, nv, 12, remap) ||
+        upload_permuted(s->vbo_normal, f->normals, nv, 12, remap)) {
+        r = vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+        goto done;
+    }
     glGenVertexArrays(1, &s->vao[0]);
     glBindVertexArray(s->vao[0]);
     glGenBuffers(1, &s->ibo);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, s->ibo);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)((size_t)h->triangle_count * 12), f->indices,
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(ni * sizeof *gpu_indices), gpu_indices,
                  GL_STATIC_DRAW);
     set_base_attribs(s);
     glBindVertexArray(0);
     s->gpu_bytes = nv * 24 + (size_t)h->triangle_count * 12;
 
-    for (uint32_t i = 0; i < f->stream_count; i++) {
+    for (uint32_t i = 0; i < f->stream_count && r == VR_OK; i++) {
         const vdsh_stream *st = &f->streams[i];
         if (st->quantity != quantity || st->order < 1 || st->order > 5 ||
             s->vbo_stream[st->order])
             continue;
-        upload_stream(s, st, nv);
+        r = upload_stream(s, st, nv, remap, name, err);
     }
+    if (r != VR_OK)
+        goto done;
     if (have_maps) {
         glGenTextures(4, s->basis);
         for (int k = 0; k < 4 && r == VR_OK; k++)
@@ -280,6 +316,8 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     r = vr_check_gl(err, name);
 
 done:
+    free(gpu_indices);
+    free(remap);
     for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
         vb_cubemap_free(maps[k]);
     vdsh_free(owned);

@@ -19,6 +19,10 @@ function(_runtime_props name)
   set_tests_properties(${name} PROPERTIES SKIP_RETURN_CODE 77 ${ARGN})
 endfunction()
 
+# The upload order of a scene (vertex cache), no GL needed.
+_runtime_test(test_runtime_order)
+add_test(NAME runtime_order COMMAND test_runtime_order)
+
 # GLSL against the C SH and shadow evaluation (and cubemap orientation).
 _runtime_test(test_runtime_glsl)
 add_test(NAME runtime_glsl COMMAND test_runtime_glsl ${_rt_dir}/glsl)
