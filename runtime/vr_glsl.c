@@ -36,6 +36,20 @@
  * Lights: the per-light code is a macro, LIGHT(I), expanded once per light
  * of the pass with a literal index, because GLSL 3.30 only lets sampler
  * arrays (the shadow cube maps) be indexed by constant expressions.
+ *
+ * Per-draw constants of the fragment stage (light positions, colours,
+ * attenuations, the ambient term, the cube maps' planes) reach it as flat
+ * varyings that the vertex stage copies from the uniforms (FLAT_LIGHTS),
+ * not as uniforms: Mesa's llvmpipe (22.x) reads every uniform component
+ * in a fragment shader with a bounds-checked gather, about 20
+ * instructions per component for every 8 fragments, again in every 4x4
+ * block, where a flat input is one broadcast per block. The 15 components
+ * of one light's Lambert term cost a quarter of the lighting pass of the
+ * room on llvmpipe (docs/BENCHMARKS.md). The values are the uniforms' own,
+ * bit for bit. When the varyings would not fit in
+ * GL_MAX_VARYING_COMPONENTS (8 lights need up to 105 of the 128 that
+ * llvmpipe and GPUs offer; GL 3.3 only promises 60) the fragment stage
+ * reads the uniforms.
  */
 #include "vr_internal.h"
 
@@ -146,6 +160,24 @@ static const char vertex_glsl[] =
     "#if NUM_LIGHTS > 0\n"
     "uniform vec3 u_light_pos[NUM_LIGHTS];\n"
     "#endif\n"
+    "#if FLAT_LIGHTS\n"
+    "/* handed on to the fragment stage (see the top of vr_glsl.c) */\n"
+    "uniform vec3 u_ambient;\n"
+    "flat out vec3 f_ambient;\n"
+    "#if NUM_LIGHTS > 0\n"
+    "uniform vec3 u_light_color[NUM_LIGHTS];\n"
+    "uniform vec3 u_light_att[NUM_LIGHTS];\n"
+    "flat out vec3 f_light_pos[NUM_LIGHTS];\n"
+    "flat out vec3 f_light_color[NUM_LIGHTS];\n"
+    "flat out vec3 f_light_att[NUM_LIGHTS];\n"
+    "#endif\n"
+    "#if SHADOW_CUBE && NUM_LIGHTS > 0\n"
+    "uniform vec2 u_shadow_nf[NUM_LIGHTS];\n"
+    "uniform float u_shadow_texel;\n"
+    "flat out vec2 f_shadow_nf[NUM_LIGHTS];\n"
+    "flat out float f_shadow_texel;\n"
+    "#endif\n"
+    "#endif\n"
     "/* Later passes (more lights) test depth with GL_LEQUAL against the\n"
     " * first pass's depth: every program must compute the same position. */\n"
     "invariant gl_Position;\n"
@@ -190,6 +222,22 @@ static const char vertex_glsl[] =
     "    v_position = a_position;\n"
     "    v_normal = a_normal;\n"
     "    gl_Position = u_view_proj * vec4(a_position, 1.0);\n"
+    "#if FLAT_LIGHTS\n"
+    "    f_ambient = u_ambient;\n"
+    "#if NUM_LIGHTS > 0\n"
+    "    for (int i = 0; i < NUM_LIGHTS; i++) {\n"
+    "        f_light_pos[i] = u_light_pos[i];\n"
+    "        f_light_color[i] = u_light_color[i];\n"
+    "        f_light_att[i] = u_light_att[i];\n"
+    "#if SHADOW_CUBE\n"
+    "        f_shadow_nf[i] = u_shadow_nf[i];\n"
+    "#endif\n"
+    "    }\n"
+    "#endif\n"
+    "#if SHADOW_CUBE && NUM_LIGHTS > 0\n"
+    "    f_shadow_texel = u_shadow_texel;\n"
+    "#endif\n"
+    "#endif\n"
     "#if VDSH_VISIBILITY && OUTPUT == 1\n"
     "    v_dv = -1.0;\n"
     "    v_dl = 0.0;\n"
@@ -247,17 +295,46 @@ static const char fragment_glsl[] =
     "#endif\n"
     "in vec4 v_c9, v_c13, v_c17, v_c21;\n"
     "#endif\n"
+    "/* Per-draw constants: light colours and the ambient term are already\n"
+    " * multiplied by the albedo; shadow planes are (near, far) of the\n"
+    " * cube map's face projections, the texel size 2 / face size. */\n"
+    "#if FLAT_LIGHTS\n"
+    "flat in vec3 f_ambient;\n"
+    "#if NUM_LIGHTS > 0\n"
+    "flat in vec3 f_light_pos[NUM_LIGHTS];\n"
+    "flat in vec3 f_light_color[NUM_LIGHTS];\n"
+    "flat in vec3 f_light_att[NUM_LIGHTS];\n"
+    "#endif\n"
+    "#if SHADOW_CUBE && NUM_LIGHTS > 0\n"
+    "flat in vec2 f_shadow_nf[NUM_LIGHTS];\n"
+    "flat in float f_shadow_texel;\n"
+    "#endif\n"
+    "#define AMBIENT f_ambient\n"
+    "#define LIGHT_POS(I) f_light_pos[I]\n"
+    "#define LIGHT_COLOR(I) f_light_color[I]\n"
+    "#define LIGHT_ATT(I) f_light_att[I]\n"
+    "#define SHADOW_NF(I) f_shadow_nf[I]\n"
+    "#define SHADOW_TEXEL f_shadow_texel\n"
+    "#else\n"
+    "uniform vec3 u_ambient;\n"
     "#if NUM_LIGHTS > 0\n"
     "uniform vec3 u_light_pos[NUM_LIGHTS];\n"
     "uniform vec3 u_light_color[NUM_LIGHTS];\n"
     "uniform vec3 u_light_att[NUM_LIGHTS];\n"
     "#endif\n"
-    "uniform vec3 u_ambient;\n"
-    "uniform vec3 u_albedo;\n"
+    "#if SHADOW_CUBE && NUM_LIGHTS > 0\n"
+    "uniform vec2 u_shadow_nf[NUM_LIGHTS];\n"
+    "uniform float u_shadow_texel;\n"
+    "#endif\n"
+    "#define AMBIENT u_ambient\n"
+    "#define LIGHT_POS(I) u_light_pos[I]\n"
+    "#define LIGHT_COLOR(I) u_light_color[I]\n"
+    "#define LIGHT_ATT(I) u_light_att[I]\n"
+    "#define SHADOW_NF(I) u_shadow_nf[I]\n"
+    "#define SHADOW_TEXEL u_shadow_texel\n"
+    "#endif\n"
     "#if SHADOW_CUBE && NUM_LIGHTS > 0\n"
     "uniform samplerCubeShadow u_shadow[NUM_LIGHTS];\n"
-    "uniform vec2 u_shadow_nf[NUM_LIGHTS];   /* near, far of the face projections */\n"
-    "uniform float u_shadow_texel;           /* 2 / face size */\n"
     "#endif\n"
     "#if VDSH_SPLIT && CUBEMAP_BASIS\n"
     "uniform samplerCube u_basis[4];\n"
@@ -311,15 +388,15 @@ static const char fragment_glsl[] =
     "        return 1.0;   /* at the receiver, as vdsh_compare */\n"
     "    vec3 v = -lv;\n"
     "    float ma = max(max(abs(v.x), abs(v.y)), abs(v.z));\n"
-    "    v += n * (1.5 * u_shadow_texel * ma);\n"
+    "    v += n * (1.5 * SHADOW_TEXEL * ma);\n"
     "    ma = max(max(abs(v.x), abs(v.y)), abs(v.z));\n"
     "    float z = (nf.y + nf.x) / (nf.y - nf.x) - 2.0 * nf.y * nf.x / ((nf.y - nf.x) * ma);\n"
     "    float ref = 0.5 * z + 0.5;\n"
     "#if PCF\n"
     "    /* four bilinear (2x2) taps a texel apart around v */\n"
     "    vec3 a = abs(v.y) < 0.9 * length(v) ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);\n"
-    "    vec3 t1 = normalize(cross(v, a)) * (0.5 * u_shadow_texel * ma);\n"
-    "    vec3 t2 = normalize(cross(v, t1)) * (0.5 * u_shadow_texel * ma);\n"
+    "    vec3 t1 = normalize(cross(v, a)) * (0.5 * SHADOW_TEXEL * ma);\n"
+    "    vec3 t2 = normalize(cross(v, t1)) * (0.5 * SHADOW_TEXEL * ma);\n"
     "    return 0.25 * (texture(map, vec4(v + t1 + t2, ref)) + texture(map, vec4(v + t1 - t2, ref)) +\n"
     "                   texture(map, vec4(v - t1 + t2, ref)) + texture(map, vec4(v - t1 - t2, ref)));\n"
     "#else\n"
@@ -330,11 +407,11 @@ static const char fragment_glsl[] =
     "\n"
     "#if NUM_LIGHTS > 0\n"
     "/* Lambert with distance attenuation, before the shadow. */\n"
-    "vec3 light_term(int i, vec3 lv, float dl, vec3 n)\n"
+    "vec3 light_term(vec3 color, vec3 att3, vec3 lv, float dl, vec3 n)\n"
     "{\n"
     "    float ndl = dl > 0.0 ? max(dot(n, lv) / dl, 0.0) : 1.0;\n"
-    "    float att = 1.0 / dot(u_light_att[i], vec3(1.0, dl, dl * dl));\n"
-    "    return u_light_color[i] * (ndl * att);\n"
+    "    float att = 1.0 / dot(att3, vec3(1.0, dl, dl * dl));\n"
+    "    return color * (ndl * att);\n"
     "}\n"
     "#endif\n"
     "\n"
@@ -346,11 +423,11 @@ static const char fragment_glsl[] =
     "#elif VDSH_SPLIT\n"
     "#define VISIBILITY(I) split_visibility(v_sum9[I], lv, dl, dv)\n"
     "#elif SHADOW_CUBE\n"
-    "#define VISIBILITY(I) cube_visibility(u_shadow[I], u_shadow_nf[I], lv, dl, n)\n"
+    "#define VISIBILITY(I) cube_visibility(u_shadow[I], SHADOW_NF(I), lv, dl, n)\n"
     "#else\n"
     "#define VISIBILITY(I) 1.0\n"
     "#endif\n"
-    "#define LIGHT(I) { vec3 lv = u_light_pos[I] - v_position; float dl = length(lv); float dv = -1.0; float s = VISIBILITY(I); acc += s * light_term(I, lv, dl, n); if (I == 0) { s0 = s; dv0 = dv; dl0 = dl; } }\n"
+    "#define LIGHT(I) { vec3 lv = LIGHT_POS(I) - v_position; float dl = length(lv); float dv = -1.0; float s = VISIBILITY(I); acc += s * light_term(LIGHT_COLOR(I), LIGHT_ATT(I), lv, dl, n); if (I == 0) { s0 = s; dv0 = dv; dl0 = dl; } }\n"
     "\n"
     "void main()\n"
     "{\n"
@@ -368,7 +445,7 @@ static const char fragment_glsl[] =
     "#elif OUTPUT == 2\n"
     "    o_color = vec4(v_position, 1.0);\n"
     "#else\n"
-    "    o_color = vec4(u_albedo * (u_ambient + acc), 1.0);\n"
+    "    o_color = vec4(AMBIENT + acc, 1.0);\n"
     "#endif\n"
     "}\n";
 
@@ -399,10 +476,27 @@ static void key_name(const vr_program_key *k, char *buf, size_t size)
              vdsh_quantity_name(k->quantity), k->output, k->pcf, k->lights);
 }
 
+/* The varying components a program passes from the vertex to the
+ * fragment stage, with or without the flat per-draw constants. */
+static int varying_components(const vr_program_key *k, int flat)
+{
+    int interp = vr_mode_interp((vr_mode)k->mode, k->quantity), n = k->lights;
+    int c = 6;   /* position, normal */
+    if (interp >= 0)
+        c += n;  /* a visibility, distance or band 0-2 sum per light */
+    if (interp == VDSH_INTERP_SPLIT)
+        c += 16;
+    if (interp == VDSH_INTERP_VISIBILITY && k->output == VR_OUTPUT_SHADOW)
+        c += 2;
+    if (flat)
+        c += 3 + 9 * n + (k->mode == VR_MODE_CUBE && n > 0 ? 2 * n + 1 : 0);
+    return c;
+}
+
 /* The #defines that specialise the sources for one key. The VDSH path
  * comes from formats/vdsh_shadow.h, the same function vdsh-eval scores
  * with, so the shaders draw what the evaluator measures. */
-static void key_defines(const vr_program_key *k, char *buf, size_t size)
+static void key_defines(const vr_program_key *k, int flat, char *buf, size_t size)
 {
     int order = vr_mode_order((vr_mode)k->mode), cube = k->mode == VR_MODE_CUBE;
     int visibility = 0, split = 0, distance = 0, cubemap = 0;
@@ -422,9 +516,10 @@ static void key_defines(const vr_program_key *k, char *buf, size_t size)
                      "#define VDSH_DISTANCE %d\n"
                      "#define CUBEMAP_BASIS %d\n#define SHADOW_CUBE %d\n"
                      "#define QUANTITY %u\n#define COMPARE %u\n#define OUTPUT %u\n"
-                     "#define PCF %u\n#define NUM_LIGHTS %u\n#define FOR_EACH_LIGHT",
+                     "#define PCF %u\n#define NUM_LIGHTS %u\n#define FLAT_LIGHTS %d\n"
+                     "#define FOR_EACH_LIGHT",
                      order, visibility, split, distance, cubemap, cube, k->quantity, k->compare,
-                     k->output, k->pcf, k->lights);
+                     k->output, k->pcf, k->lights, flat);
     for (unsigned i = 0; i < k->lights && n > 0 && (size_t)n < size; i++)
         n += snprintf(buf + n, size - (size_t)n, " LIGHT(%u)", i);
     if (n > 0 && (size_t)n < size)
@@ -495,7 +590,9 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     if (interp >= 0 && interp != VDSH_INTERP_VISIBILITY && interp != VDSH_INTERP_DISTANCE &&
         !(interp == VDSH_INTERP_SPLIT && order == 5))
         return vr_fail(err, VR_ERR_SHADER, "%s: the runtime has no shaders for this path", name);
-    key_defines(key, defines, sizeof defines);
+    GLint max_varying = 0;
+    glGetIntegerv(GL_MAX_VARYING_COMPONENTS, &max_varying);
+    key_defines(key, varying_components(key, 1) <= max_varying, defines, sizeof defines);
 
     size_t vs_size = strlen(defines) + sizeof common_glsl + sizeof vertex_glsl;
     size_t fs_size = strlen(defines) + sizeof common_glsl + sizeof fragment_glsl;
@@ -521,7 +618,6 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     p.u_light_color = glGetUniformLocation(prog, "u_light_color");
     p.u_light_att = glGetUniformLocation(prog, "u_light_att");
     p.u_ambient = glGetUniformLocation(prog, "u_ambient");
-    p.u_albedo = glGetUniformLocation(prog, "u_albedo");
     p.u_shadow_nf = glGetUniformLocation(prog, "u_shadow_nf");
     p.u_shadow_texel = glGetUniformLocation(prog, "u_shadow_texel");
 

@@ -89,7 +89,7 @@ typedef struct vr_program {
     vr_program_key key;
     GLuint prog;
     GLint u_view_proj, u_scale, u_light_pos, u_light_color, u_light_att;
-    GLint u_ambient, u_albedo, u_shadow_nf, u_shadow_texel;
+    GLint u_ambient, u_shadow_nf, u_shadow_texel;
 } vr_program;
 
 /* Compile and link the lighting program for `key`. On failure returns

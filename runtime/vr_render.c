@@ -632,9 +632,12 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
         glUseProgram(p->prog);
         glUniformMatrix4fv(p->u_view_proj, 1, GL_FALSE, vp);
         glUniform1f(p->u_scale, order ? s->scale[order] : 1.0f);
-        const float zero[3] = {0, 0, 0};
-        glUniform3fv(p->u_ambient, 1, g == 0 ? d.ambient : zero);
-        glUniform3fv(p->u_albedo, 1, d.albedo);
+        /* The albedo multiplies the ambient term and the light colours
+         * here, once, rather than every fragment. */
+        float ambient[3];
+        for (int k = 0; k < 3; k++)
+            ambient[k] = g == 0 ? d.albedo[k] * d.ambient[k] : 0.0f;
+        glUniform3fv(p->u_ambient, 1, ambient);
         if (n > 0) {
             float pos[VR_MAX_LIGHTS_PER_PASS][3], col[VR_MAX_LIGHTS_PER_PASS][3];
             float att[VR_MAX_LIGHTS_PER_PASS][3];
@@ -643,7 +646,7 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                 memcpy(pos[i], L->position, sizeof pos[i]);
                 int black = !L->color[0] && !L->color[1] && !L->color[2];
                 for (int k = 0; k < 3; k++)
-                    col[i][k] = black ? 1.0f : L->color[k];
+                    col[i][k] = d.albedo[k] * (black ? 1.0f : L->color[k]);
                 int none = !L->attenuation[0] && !L->attenuation[1] && !L->attenuation[2];
                 for (int k = 0; k < 3; k++)
                     att[i][k] = none ? (k == 0 ? 1.0f : 0.0f) : L->attenuation[k];
