@@ -531,6 +531,12 @@ static inline float fast_log(float x)
     return p + (float)e * 0.69314718f;
 }
 
+/* An AVX2 clone where the CPU has it, for the lane loops (the log's
+ * division above all): no FMA, so the same bits either way. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
 static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced,
                         uint64_t *missed, uint32_t *degenerate)
 {
@@ -742,6 +748,47 @@ static size_t choose_offset(int o)
     return (size_t)(o - 1) * o * (2 * o - 1) / 6;
 }
 
+/* Add to e[o][q] the expected error of each asked order's fit of each
+ * quantity, c[q][o], in each of the `count` traced directions of `out`.
+ * A pass per fit over all directions, so that the sums vectorise: each
+ * is still accumulated in the same order as one direction at a time
+ * would, so the scores keep their bits. Scratch: `basis` holds
+ * 25 * grid count floats, `t` and `s` grid count doubles each. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+static void score_fits(const job *J, uint32_t count, const vertex_sink *out,
+                       float c[2][VDSH_MAX_ORDER + 1][VDSH_MAX_COEFFS], float *basis,
+                       double *t, double *s, double e[VDSH_MAX_ORDER + 1][2])
+{
+    const uint32_t cap = J->grid->count;
+    const float tmin = 1e-4f * J->d->max_distance;
+    vdsh_sh_eval_soa(J->order, count, out->x, out->y, out->z, basis, cap);
+    for (uint32_t k = 0; k < count; k++)
+        t[k] = out->t[k] > tmin ? out->t[k] : tmin;
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
+        if (!J->coeffs[o])
+            continue;
+        for (int q = 0; q < 2; q++) {
+            for (uint32_t k = 0; k < count; k++)
+                s[k] = 0.0;
+            for (int j = 0; j < o * o; j++) {
+                const double cj = c[q][o][j];
+                const float *yj = basis + (size_t)j * cap;
+                for (uint32_t k = 0; k < count; k++)
+                    s[k] += cj * yj[k];
+            }
+            double sum = 0.0;
+            for (uint32_t k = 0; k < count; k++) {
+                double dv = q ? exp(s[k]) : (s[k] > 0.0 ? s[k] : 0.0);
+                sum += expected_error(dv / t[k]);
+            }
+            e[o][q] += sum;
+        }
+    }
+}
+
 /* Sampled receiver i: trace it, fit both quantities at every asked order,
  * and score each fit on the traced directions above the horizon. */
 static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
@@ -749,9 +796,15 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
     job *J = ctx;
     (void)worker;
     uint32_t nrec = J->d->receivers->vertex_count, cap = J->grid->count;
-    float *buf = malloc((size_t)cap * 4 * sizeof *buf);
+    /* Per traced direction: x, y, z, distance, then the basis. */
+    float *buf = malloc((size_t)cap * (4 + VDSH_MAX_COEFFS) * sizeof *buf);
+    double *sums = malloc((size_t)cap * 2 * sizeof *sums);
     uint64_t traced = 0, missed = 0;
     uint32_t degenerate = 0;
+    if (!sums) {
+        free(buf);
+        buf = NULL;
+    }
     for (uint32_t i = begin; i < end && buf; i++) {
         uint32_t v = (uint32_t)((uint64_t)i * nrec / J->choose_count), count = 0;
         float c[2][VDSH_MAX_ORDER + 1][VDSH_MAX_COEFFS];
@@ -768,23 +821,7 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
                     memcpy(keep + q * CHOOSE_STRIDE + choose_offset(o), c[q][o],
                            (size_t)o * o * sizeof(float));
         double e[VDSH_MAX_ORDER + 1][2] = {{0}};
-        float tmin = 1e-4f * J->d->max_distance;
-        for (uint32_t k = 0; k < count; k++) {
-            float dir[3] = {out.x[k], out.y[k], out.z[k]}, y[VDSH_MAX_COEFFS];
-            vdsh_sh_eval(J->order, dir, y);
-            double t = out.t[k] > tmin ? out.t[k] : tmin;
-            for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
-                if (!J->coeffs[o])
-                    continue;
-                for (int q = 0; q < 2; q++) {
-                    double s = 0.0;
-                    for (int j = 0; j < o * o; j++)
-                        s += (double)c[q][o][j] * y[j];
-                    double dv = q ? exp(s) : (s > 0.0 ? s : 0.0);
-                    e[o][q] += expected_error(dv / t);
-                }
-            }
-        }
+        score_fits(J, count, &out, c, buf + 4 * (size_t)cap, sums, sums + cap, e);
         double *dst = J->choose_error + (size_t)i * (VDSH_MAX_ORDER + 1) * 2;
         for (int o = 0; o <= VDSH_MAX_ORDER; o++)
             for (int q = 0; q < 2; q++)
@@ -801,6 +838,7 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
     atomic_fetch_add(&J->missed, missed);
     atomic_fetch_add(&J->degenerate, degenerate);
     free(buf);
+    free(sums);
 }
 
 static void bake_progress(void *user, uint32_t done, uint32_t total)
