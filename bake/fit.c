@@ -205,10 +205,10 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
         for (int a = 0; a < k; a++)
             for (int b = 0; b < k; b++) {
                 double x = XS[(o + a) * n + o + b];
-                f.X[l][a * k + b] = fabs(x) < 1e-6 ? 0.0 : x;
+                f.X[l][a * k + b] = f.XT[l][b * k + a] = fabs(x) < 1e-6 ? 0.0 : x;
             }
     }
-    for (int i = 0; i < n; i++) /* N = X M X^T, X block-diagonal by band */
+    for (int i = 0; i < n; i++) /* X M X^T, X block-diagonal by band */
         for (int j = 0; j < n; j++) {
             int li = band_of(i), lj = band_of(j), ki = 2 * li + 1, kj = 2 * lj + 1;
             int oi = li * li, oj = lj * lj;
@@ -217,7 +217,7 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
                 for (int b = 0; b < kj; b++)
                     sum += f.X[li][(i - oi) * ki + a] * f.M[(oi + a) * n + oj + b] *
                            f.X[lj][(j - oj) * kj + b];
-            f.N[i * n + j] = sum;
+            f.NT[j * n + i] = sum;
         }
     *out = f;
     return VB_OK;
@@ -298,23 +298,32 @@ static void rotate_z(int order, const double *cm, const double *sm, double sign,
     }
 }
 
-/* v = X v, or X^T v, over bands 0..order-1. */
-static void rotate_x(const vb_fit *f, int order, int transpose, double *v)
+/* v = X v, or X^T v, over bands 0..order-1. The products here and in
+ * vb_fit_finish run down columns (a column-major copy where needed), so
+ * they vectorise over the rows while each row sums in column order. */
+static inline void rotate_x(const vb_fit *f, int order, int transpose, double *v)
 {
     for (int l = 1; l < order; l++) {
         int k = 2 * l + 1, o = l * l;
+        const double *cols = transpose ? f->X[l] : f->XT[l];
         double in[9], *out = v + o;
         memcpy(in, out, (size_t)k * sizeof *in);
-        for (int i = 0; i < k; i++) {
-            double s = 0.0;
-            for (int j = 0; j < k; j++)
-                s += (transpose ? f->X[l][j * k + i] : f->X[l][i * k + j]) * in[j];
-            out[i] = s;
-        }
+        for (int i = 0; i < k; i++)
+            out[i] = 0.0;
+        for (int j = 0; j < k; j++)
+            for (int i = 0; i < k; i++)
+                out[i] += cols[j * k + i] * in[j];
     }
 }
 
-void vb_fit_unrotate(const vb_fit *f, const vb_fit_angles *a, const double *b, double *u)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
+#define VB_CLONES __attribute__((target_clones("avx2", "default"))) /* no FMA: same bits */
+#else
+#define VB_CLONES
+#endif
+
+VB_CLONES void vb_fit_unrotate(const vb_fit *f, const vb_fit_angles *a, const double *b, double *u)
 {
     memcpy(u, b, (size_t)f->order * f->order * sizeof *u);
     if (!a->rotates)
@@ -324,7 +333,7 @@ void vb_fit_unrotate(const vb_fit *f, const vb_fit_angles *a, const double *b, d
     rotate_z(f->order, a->cb, a->sb, -1.0, u);
 }
 
-void vb_fit_finish(const vb_fit *f, const vb_fit_angles *a, const double *u, float *c)
+VB_CLONES void vb_fit_finish(const vb_fit *f, const vb_fit_angles *a, const double *u, float *c)
 {
     int n = f->order * f->order;
     if (!a->rotates) {
@@ -333,12 +342,11 @@ void vb_fit_finish(const vb_fit *f, const vb_fit_angles *a, const double *u, flo
         return;
     }
     double v[VB_FIT_MAX];
-    for (int i = 0; i < n; i++) {
-        double s = 0.0;
-        for (int j = 0; j < n; j++)
-            s += f->N[i * n + j] * u[j];
-        v[i] = s;
-    }
+    for (int i = 0; i < n; i++)
+        v[i] = 0.0;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++)
+            v[i] += f->NT[j * n + i] * u[j];
     rotate_z(f->order, a->cb, a->sb, 1.0, v);
     rotate_x(f, f->order, 1, v);
     rotate_z(f->order, a->ca, a->sa, 1.0, v);

@@ -51,8 +51,10 @@ typedef struct vb_fit {
     float lambda;                     /* lsq regularisation */
     double window[VB_FIT_MAX];        /* per coefficient: its band's weight */
     double M[VB_FIT_MAX * VB_FIT_MAX];  /* local-frame map, order^2 square */
-    double N[VB_FIT_MAX * VB_FIT_MAX];  /* X M X^T, order^2 square */
+    double NT[VB_FIT_MAX * VB_FIT_MAX]; /* N = X M X^T, order^2 square,
+                                       * column-major */
     double X[5][9 * 9];               /* per band l: the (2l+1)^2 block of X */
+    double XT[5][9 * 9];              /* and its transpose */
     /* Rotations: sample directions and, per band l, the pseudo-inverse of
      * the (2l+1) x VB_FIT_ROT_DIRS basis block at them. */
     double rot_dirs[VB_FIT_ROT_DIRS][3];
