@@ -15,6 +15,7 @@
 
 #define VB_PI 3.14159265358979323846
 #define BLOCK 16 /* receivers per work item */
+#define GROUP 8  /* packets traced before their lanes are processed */
 
 double vb_now(void)
 {
@@ -564,93 +565,105 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
     memset(acc, 0, sizeof acc);
     uint32_t near_zero = 0, upper = 0;
 
-    for (uint32_t pk = 0; pk < J->grid->packet_count; pk++) {
-        if (J->horizon && vb_dirgrid_packet_below(J->grid, pk, n))
-            continue;
-        struct RTCRayHit16 rh __attribute__((aligned(64)));
-        int valid[VB_PACKET] __attribute__((aligned(64)));
-        vb_dirgrid_packet(J->grid, pk, d->seed, v, n, rh.ray.dir_x, rh.ray.dir_y,
-                          rh.ray.dir_z, valid);
-        int any = 0;
-        for (int k = 0; k < VB_PACKET; k++) {
-            if (J->horizon && valid[k]) {
-                float c = rh.ray.dir_x[k] * n[0] + rh.ray.dir_y[k] * n[1] +
-                          rh.ray.dir_z[k] * n[2];
-                if (c < 0.0f)
-                    valid[k] = 0;
+    /* Packets are traced GROUP at a time, then their lanes are processed
+     * together: the log's division and series are a long dependency
+     * chain, which independent packets side by side keep the core busy
+     * through. Every sum still runs in packet order. */
+    for (uint32_t pk = 0; pk < J->grid->packet_count;) {
+        struct RTCRayHit16 rh[GROUP] __attribute__((aligned(64)));
+        int valid[GROUP][VB_PACKET] __attribute__((aligned(64)));
+        int np = 0;
+        for (; pk < J->grid->packet_count && np < GROUP; pk++) {
+            if (J->horizon && vb_dirgrid_packet_below(J->grid, pk, n))
+                continue;
+            struct RTCRayHit16 *r = &rh[np];
+            int *ok = valid[np];
+            vb_dirgrid_packet(J->grid, pk, d->seed, v, n, r->ray.dir_x, r->ray.dir_y,
+                              r->ray.dir_z, ok);
+            int any = 0;
+            for (int k = 0; k < VB_PACKET; k++) {
+                if (J->horizon && ok[k]) {
+                    float c = r->ray.dir_x[k] * n[0] + r->ray.dir_y[k] * n[1] +
+                              r->ray.dir_z[k] * n[2];
+                    if (c < 0.0f)
+                        ok[k] = 0;
+                }
+                any |= ok[k];
+                r->ray.org_x[k] = org[0];
+                r->ray.org_y[k] = org[1];
+                r->ray.org_z[k] = org[2];
+                r->ray.tnear[k] = 0.0f;
+                r->ray.tfar[k] = J->max_local;
+                r->ray.time[k] = 0.0f;
+                r->ray.mask[k] = 0xffffffffu;
+                r->ray.id[k] = (unsigned)k;
+                r->ray.flags[k] = 0;
+                r->hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+                r->hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
             }
-            any |= valid[k];
-            rh.ray.org_x[k] = org[0];
-            rh.ray.org_y[k] = org[1];
-            rh.ray.org_z[k] = org[2];
-            rh.ray.tnear[k] = 0.0f;
-            rh.ray.tfar[k] = J->max_local;
-            rh.ray.time[k] = 0.0f;
-            rh.ray.mask[k] = 0xffffffffu;
-            rh.ray.id[k] = (unsigned)k;
-            rh.ray.flags[k] = 0;
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+            if (!any)
+                continue;
+            rtcIntersect16(ok, S->scene, &ctx, r);
+            for (int k = 0; k < VB_PACKET; k++)
+                *traced += ok[k] != 0;
+            np++;
         }
-        if (!any)
-            continue;
-        rtcIntersect16(valid, S->scene, &ctx, &rh);
-        for (int k = 0; k < VB_PACKET; k++)
-            *traced += valid[k] != 0;
         if (d->trace_only)
             continue;
 
         /* Branch-free over the lanes, so it vectorises. Lanes not traced
          * (empty, or below the horizon) count as distance 0. */
-        float dist[VB_PACKET];
-        int up_lane[VB_PACKET];
-        int miss = 0, upper_pk = 0, near_pk = 0;
-        uint32_t gid[VB_PACKET];
-        float tfar[VB_PACKET], dx[VB_PACKET], dy[VB_PACKET], dz[VB_PACKET];
-        memcpy(gid, rh.hit.geomID, sizeof gid); /* locals: the loop vectorises */
-        memcpy(tfar, rh.ray.tfar, sizeof tfar);
-        memcpy(dx, rh.ray.dir_x, sizeof dx);
-        memcpy(dy, rh.ray.dir_y, sizeof dy);
-        memcpy(dz, rh.ray.dir_z, sizeof dz);
-        for (int k = 0; k < VB_PACKET; k++) {
-            /* Selects as arithmetic (exact for these finite values), in
-             * int: GCC if-converts and vectorises this loop only so. */
-            int live = valid[k] & 1; /* valid: 0 or -1 */
-            int hit = gid[k] != RTC_INVALID_GEOMETRY_ID;
-            float fh = (float)hit, fl = (float)live;
-            float t = tfar[k] * inv_scale * fh + max_distance * (1.0f - fh);
-            float c = dx[k] * nx + dy[k] * ny + dz[k] * nz;
-            int up = live & (c > 0.0f);
-            dist[k] = t * fl;
-            up_lane[k] = up;
-            miss += live & (hit ^ 1);
-            upper_pk += up;
-            near_pk += up & (t < degenerate_dist);
-        }
-        upper += (uint32_t)upper_pk;
-        near_zero += (uint32_t)near_pk;
-        *missed += (uint64_t)miss;
-        if (want[0])
-            vdsh_sh_project_soa(J->order, VB_PACKET, rh.ray.dir_x, rh.ray.dir_y,
-                                rh.ray.dir_z, dist, &acc[0][0][0], VB_PACKET);
-        if (want[1]) {
-            float logd[VB_PACKET];
+        float dist[GROUP][VB_PACKET], logd[GROUP][VB_PACKET];
+        int up_lane[GROUP][VB_PACKET];
+        for (int p = 0; p < np; p++) {
+            int miss = 0, upper_pk = 0, near_pk = 0;
+            const int *ok = valid[p];
+            const uint32_t *gid = rh[p].hit.geomID;
+            const float *tfar = rh[p].ray.tfar, *dx = rh[p].ray.dir_x, *dy = rh[p].ray.dir_y,
+                        *dz = rh[p].ray.dir_z;
             for (int k = 0; k < VB_PACKET; k++) {
-                float l = fast_log(dist[k] > log_floor ? dist[k] : log_floor);
-                logd[k] = l * (float)(valid[k] & 1);
+                /* Selects as arithmetic (exact for these finite values), in
+                 * int: GCC if-converts and vectorises this loop only so. */
+                int live = ok[k] & 1; /* valid: 0 or -1 */
+                int hit = gid[k] != RTC_INVALID_GEOMETRY_ID;
+                float fh = (float)hit, fl = (float)live;
+                float t = tfar[k] * inv_scale * fh + max_distance * (1.0f - fh);
+                float c = dx[k] * nx + dy[k] * ny + dz[k] * nz;
+                int up = live & (c > 0.0f);
+                dist[p][k] = t * fl;
+                up_lane[p][k] = up;
+                miss += live & (hit ^ 1);
+                upper_pk += up;
+                near_pk += up & (t < degenerate_dist);
             }
-            vdsh_sh_project_soa(J->order, VB_PACKET, rh.ray.dir_x, rh.ray.dir_y,
-                                rh.ray.dir_z, logd, &acc[1][0][0], VB_PACKET);
+            upper += (uint32_t)upper_pk;
+            near_zero += (uint32_t)near_pk;
+            *missed += (uint64_t)miss;
         }
-        if (out->n)
-            for (int k = 0; k < VB_PACKET; k++)
-                if (up_lane[k]) {
-                    uint32_t i = (*out->n)++;
-                    out->x[i] = rh.ray.dir_x[k];
-                    out->y[i] = rh.ray.dir_y[k];
-                    out->z[i] = rh.ray.dir_z[k];
-                    out->t[i] = dist[k];
+        if (want[1])
+            for (int p = 0; p < np; p++)
+                for (int k = 0; k < VB_PACKET; k++) {
+                    float l = fast_log(dist[p][k] > log_floor ? dist[p][k] : log_floor);
+                    logd[p][k] = l * (float)(valid[p][k] & 1);
                 }
+        for (int p = 0; p < np; p++) {
+            const float *dx = rh[p].ray.dir_x, *dy = rh[p].ray.dir_y, *dz = rh[p].ray.dir_z;
+            if (want[0])
+                vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, dist[p], &acc[0][0][0],
+                                    VB_PACKET);
+            if (want[1])
+                vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, logd[p], &acc[1][0][0],
+                                    VB_PACKET);
+            if (out->n)
+                for (int k = 0; k < VB_PACKET; k++)
+                    if (up_lane[p][k]) {
+                        uint32_t i = (*out->n)++;
+                        out->x[i] = dx[k];
+                        out->y[i] = dy[k];
+                        out->z[i] = dz[k];
+                        out->t[i] = dist[p][k];
+                    }
+        }
     }
     if (d->trace_only)
         return;
