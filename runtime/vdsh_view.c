@@ -79,7 +79,8 @@ static const char usage_text[] =
     "                        give one row each\n"
     "      --bench           time every shadow mode with 1 and 3 lights on each\n"
     "                        SCENE, all in this process, each round timing\n"
-    "                        every mode of every SCENE once; JSON on stdout\n"
+    "                        every mode of every SCENE once (wall time and\n"
+    "                        process CPU time per frame); JSON on stdout\n"
     "\n"
     "View (defaults come from the scene's bounds, y up):\n"
     "      --camera EX,EY,EZ,TX,TY,TZ   eye and target point\n"
@@ -724,6 +725,15 @@ static void print_json_string(const char *s)
 
 enum { BENCH_MODES = 7, BENCH_ROUNDS = 64 };
 
+/* CPU time of the whole process (every thread: llvmpipe's rasterizer
+ * threads render in this process), milliseconds. */
+static double process_cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
+}
+
 /* One scene of a benchmark: what it times and the results. */
 typedef struct bench_scene {
     const char *path;
@@ -735,6 +745,7 @@ typedef struct bench_scene {
     /* [light set][mode][round] */
     double cpu[2][BENCH_MODES][BENCH_ROUNDS], gpu[2][BENCH_MODES][BENCH_ROUNDS];
     double shadow[2][BENCH_MODES][BENCH_ROUNDS], lighting[2][BENCH_MODES][BENCH_ROUNDS];
+    double proc[2][BENCH_MODES][BENCH_ROUNDS];
 } bench_scene;
 
 /* Load a scene and choose the modes it is timed in. */
@@ -786,15 +797,18 @@ static int bench_time(const options *o, bench_scene *b, int nb, vr_renderer *r, 
                 d.pcf = bs->modes[j].pcf;
                 scene_camera(bs->scene, o, &d.camera);
                 vr_error err;
+                double proc0 = process_cpu_ms();
                 if (vr_draw(r, bs->scene, &d, &err) != VR_OK) {
                     fprintf(stderr, "vdsh-view: %s: %s: %s\n", bs->path, bs->modes[j].name,
                             err.msg);
                     return 1;
                 }
                 vr_renderer_finish(r);
+                double proc1 = process_cpu_ms();
                 vr_timings t;
                 vr_renderer_timings(r, &t);
                 if (round >= 0) {
+                    bs->proc[ls][j][round] = proc1 - proc0;
                     bs->cpu[ls][j][round] = t.cpu_ms;
                     bs->gpu[ls][j][round] = t.gpu_ms;
                     bs->shadow[ls][j][round] = t.shadow_total_ms;
@@ -830,6 +844,7 @@ static void bench_print(const options *o, const bench_scene *b, int rounds, int 
                    interp >= 0 ? vdsh_interp_name((uint32_t)interp) : b->modes[m].name,
                    sorted[rounds / 2]);
             print_series("cpu_ms", b->cpu[ls][m], rounds, 0);
+            print_series("process_cpu_ms", b->proc[ls][m], rounds, 0);
             print_series("gpu_ms", b->gpu[ls][m], rounds, 0);
             print_series("shadow_ms", b->shadow[ls][m], rounds, 0);
             print_series("lighting_ms", b->lighting[ls][m], rounds, 1);

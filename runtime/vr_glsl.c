@@ -43,10 +43,10 @@
  * not as uniforms: Mesa's llvmpipe (22.x) reads every uniform component
  * in a fragment shader with a bounds-checked gather, about 20
  * instructions per component for every 8 fragments, again in every 4x4
- * block, where a flat input is one broadcast per block. The 15 components
- * of one light's Lambert term cost a quarter of the lighting pass of the
- * room on llvmpipe (docs/BENCHMARKS.md). The values are the uniforms' own,
- * bit for bit. When the varyings would not fit in
+ * block, where a flat input is one broadcast per block. Read as uniforms,
+ * the 15 components of one light's Lambert term cost about a third of the
+ * room's lighting pass on llvmpipe (docs/BENCHMARKS.md). The values are
+ * the uniforms' own, bit for bit. When the varyings would not fit in
  * GL_MAX_VARYING_COMPONENTS (8 lights need up to 105 of the 128 that
  * llvmpipe and GPUs offer; GL 3.3 only promises 60) the fragment stage
  * reads the uniforms.

@@ -196,6 +196,7 @@ for m in none cube cube_pcf vdsh2 vdsh3 vdsh5 vdsh5poly; do
 done
 echo "$out" | grep -q '"lights": 3'
 echo "$out" | grep -q '"renderer": '
+echo "$out" | grep -q '"process_cpu_ms": \['
 # the log-distance scene: its VDSH modes on the distance path
 echo "$out" | grep -q '"quantity": "log-distance", "method": "lsq"'
 echo "$out" | grep -q '"mode": "vdsh5", "path": "distance"'
