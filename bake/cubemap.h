@@ -111,6 +111,22 @@ vb_result vb_cubemap_basis_path(const char *dir, const char *stem, int k,
 vb_result vb_cubemap_write_basis(const char *dir, const char *stem, int n,
                                  vb_error *err);
 
+/* vb_cubemap_write_basis in two steps, so that the encoding (mostly
+ * deflate) can run while the caller does other work: the four files of
+ * face size n encoded into memory (nothing is written), then written to
+ * dir, staged and renamed as vb_cubemap_write_basis does.
+ * vb_cubemap_basis_free frees an encoded or zeroed set. */
+typedef struct vb_cubemap_basis {
+    int size;                                      /* n */
+    unsigned char *bytes[VB_CUBEMAP_BASIS_FILES];  /* the files; owned */
+    size_t length[VB_CUBEMAP_BASIS_FILES];
+} vb_cubemap_basis;
+
+vb_result vb_cubemap_basis_encode(int n, vb_cubemap_basis *out, vb_error *err);
+vb_result vb_cubemap_basis_write(const vb_cubemap_basis *b, const char *dir,
+                                 const char *stem, vb_error *err);
+void vb_cubemap_basis_free(vb_cubemap_basis *b);
+
 /* Read the four basis files. expected_size > 0 requires that face size
  * (the cube_size of the .vdsh header); 0 accepts any size as long as all
  * four agree. On success out[k] holds SH functions 9+4k .. 12+4k; on

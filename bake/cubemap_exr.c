@@ -41,9 +41,11 @@
 /* I/O callbacks and error capture                                      */
 
 typedef struct exr_io {
-    int fd;
+    int fd;             /* -1: writes go to mem */
     int os_errno;       /* errno of the first failed read or write, or 0 */
     char msg[256];      /* first message OpenEXR reported since reset */
+    uint8_t *mem;       /* a file written to memory: size bytes, cap allocated */
+    size_t size, cap;
 } exr_io;
 
 static void io_reset_msg(exr_io *io)
@@ -124,6 +126,28 @@ static int64_t io_write(exr_const_context_t ctxt, void *ud, const void *buffer,
             error_cb(ctxt, EXR_ERR_WRITE_IO, "write out of range");
         return -1;
     }
+    if (io->fd < 0) { /* OpenEXR writes at offsets, the offset table last */
+        uint64_t end = offset + size;
+        if (end > io->cap) {
+            size_t cap = io->cap ? io->cap : 65536;
+            while (cap < end && cap <= SIZE_MAX / 2)
+                cap *= 2;
+            uint8_t *mem = cap >= end ? realloc(io->mem, cap) : NULL;
+            if (!mem) {
+                if (error_cb)
+                    error_cb(ctxt, EXR_ERR_OUT_OF_MEMORY, "out of memory");
+                return -1;
+            }
+            io->mem = mem;
+            io->cap = cap;
+        }
+        if (offset > io->size)
+            memset(io->mem + io->size, 0, (size_t)(offset - io->size));
+        memcpy(io->mem + offset, p, (size_t)size);
+        if (end > io->size)
+            io->size = (size_t)end;
+        return (int64_t)size;
+    }
     while (done < size) {
         uint64_t want = size - done;
         if (want > (1u << 30))
@@ -178,12 +202,11 @@ static size_t cube_floats(int n)
 /* ------------------------------------------------------------------ */
 /* Writing                                                              */
 
-/* Encode the image into the open file descriptor fd. `path` is only for
- * messages. */
-static vb_result encode_exr(const char *path, int fd, int n, const float *rgba,
+/* Encode the image through *io_out: into its open file descriptor, or
+ * into memory when that is -1. `path` is only for messages. */
+static vb_result encode_exr(const char *path, exr_io *io, int n, const float *rgba,
                             vb_error *err)
 {
-    exr_io io = {.fd = fd};
     exr_context_t ctxt = NULL;
     exr_encode_pipeline_t enc;
     int enc_live = 0, part = 0;
@@ -194,15 +217,15 @@ static vb_result encode_exr(const char *path, int fd, int n, const float *rgba,
     memset(&enc, 0, sizeof enc);
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = on_exr_error;
-    init.user_data = &io;
+    init.user_data = io;
     init.write_fn = io_write;
 
 #define EXR_TRY(call, what)                                                   \
     do {                                                                      \
-        io_reset_msg(&io);                                                    \
+        io_reset_msg(io);                                                    \
         rv = (call);                                                          \
         if (rv != EXR_ERR_SUCCESS) {                                          \
-            r = exr_fail(err, &io, rv, VB_ERR_IO, path, (what));              \
+            r = exr_fail(err, io, rv, VB_ERR_IO, path, (what));              \
             goto done;                                                        \
         }                                                                     \
     } while (0)
@@ -304,9 +327,10 @@ static void staged_discard(staged *s)
 }
 
 /* Write the image to a new temporary file beside `path` and flush it to
- * disk. On failure nothing is left behind. */
-static vb_result stage(const char *path, int n, const float *rgba, staged *out,
-                       vb_error *err)
+ * disk: encoded from rgba, or, if `encoded` is not NULL, the file already
+ * encoded in memory. On failure nothing is left behind. */
+static vb_result stage(const char *path, int n, const float *rgba, const exr_io *encoded,
+                       staged *out, vb_error *err)
 {
     /* Unique among threads (counter) and processes (pid); O_EXCL makes
      * sure we never write into somebody else's file. */
@@ -334,7 +358,13 @@ static vb_result stage(const char *path, int n, const float *rgba, staged *out,
                        "(all names taken)", path);
     }
 
-    vb_result r = encode_exr(path, fd, n, rgba, err);
+    exr_io io = {.fd = fd};
+    vb_result r = VB_OK;
+    if (!encoded)
+        r = encode_exr(path, &io, n, rgba, err);
+    else if (io_write(NULL, &io, encoded->mem, encoded->size, 0, NULL) < 0)
+        r = vb_fail(err, VB_ERR_IO, "%s: cannot write %s: %s", path, tmp,
+                    strerror(io.os_errno));
     if (r == VB_OK && fsync(fd) != 0)
         r = vb_fail(err, VB_ERR_IO, "%s: cannot flush %s: %s", path, tmp,
                     strerror(errno));
@@ -419,7 +449,7 @@ vb_result vb_cubemap_write(const char *path, int n, const float *rgba,
     }
 
     staged s = {0};
-    r = stage(path, n, rgba, &s, err);
+    r = stage(path, n, rgba, NULL, &s, err);
     if (r == VB_OK)
         r = commit(path, &s, err);
     if (r == VB_OK)
@@ -749,25 +779,45 @@ static vb_result basis_path_alloc(const char *dir, const char *stem, int k,
     return VB_OK;
 }
 
-vb_result vb_cubemap_write_basis(const char *dir, const char *stem, int n,
-                                 vb_error *err)
+vb_result vb_cubemap_basis_encode(int n, vb_cubemap_basis *out, vb_error *err)
+{
+    vb_cubemap_basis b = {.size = n};
+    float *rgba = NULL;
+    vb_result r = check_size("vb_cubemap_basis_encode", n, err);
+    if (r == VB_OK && !(rgba = malloc(cube_floats(n) * sizeof(float))))
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for a %d x %d cube map", n,
+                    6 * n);
+    for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++) {
+        char name[32];
+        snprintf(name, sizeof name, "basis cubemap sh%02d-%02d", 9 + 4 * k, 12 + 4 * k);
+        exr_io io = {.fd = -1};
+        vdsh_cube_fill_basis(n, 9 + 4 * k, rgba);
+        r = encode_exr(name, &io, n, rgba, err);
+        b.bytes[k] = io.mem;
+        b.length[k] = io.size;
+    }
+    free(rgba);
+    if (r != VB_OK)
+        vb_cubemap_basis_free(&b);
+    else
+        *out = b;
+    return r;
+}
+
+vb_result vb_cubemap_basis_write(const vb_cubemap_basis *b, const char *dir,
+                                 const char *stem, vb_error *err)
 {
     char *paths[VB_CUBEMAP_BASIS_FILES] = {0};
     staged st[VB_CUBEMAP_BASIS_FILES] = {{0}};
-    float *rgba = NULL;
-    vb_result r = check_size(stem ? stem : "vb_cubemap_write_basis", n, err);
-
+    vb_result r = VB_OK;
     for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++)
         r = basis_path_alloc(dir, stem, k, &paths[k], err);
-    if (r == VB_OK && !(rgba = malloc(cube_floats(n) * sizeof(float))))
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY,
-                    "%s: out of memory for a %d x %d cube map", paths[0], n, 6 * n);
 
     /* Stage all four, then rename: a failure while writing leaves every
      * destination as it was, never a mix of two bakes. */
     for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++) {
-        vdsh_cube_fill_basis(n, 9 + 4 * k, rgba);
-        r = stage(paths[k], n, rgba, &st[k], err);
+        exr_io encoded = {.fd = -1, .mem = b->bytes[k], .size = b->length[k]};
+        r = stage(paths[k], b->size, NULL, &encoded, &st[k], err);
     }
     for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++) {
         r = commit(paths[k], &st[k], err);
@@ -784,7 +834,33 @@ vb_result vb_cubemap_write_basis(const char *dir, const char *stem, int n,
         staged_discard(&st[k]);
         free(paths[k]);
     }
-    free(rgba);
+    return r;
+}
+
+void vb_cubemap_basis_free(vb_cubemap_basis *b)
+{
+    if (!b)
+        return;
+    for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
+        free(b->bytes[k]);
+    memset(b, 0, sizeof *b);
+}
+
+vb_result vb_cubemap_write_basis(const char *dir, const char *stem, int n,
+                                 vb_error *err)
+{
+    /* The arguments first, so that a bad one costs no encoding. */
+    char *path = NULL;
+    vb_result r = check_size(stem ? stem : "vb_cubemap_write_basis", n, err);
+    if (r == VB_OK)
+        r = basis_path_alloc(dir, stem, 0, &path, err);
+    free(path);
+    vb_cubemap_basis b = {0};
+    if (r == VB_OK)
+        r = vb_cubemap_basis_encode(n, &b, err);
+    if (r == VB_OK)
+        r = vb_cubemap_basis_write(&b, dir, stem, err);
+    vb_cubemap_basis_free(&b);
     return r;
 }
 

@@ -5,6 +5,8 @@
  * occluders), refine a copy into the receivers, build the BVH, trace and
  * project, then write the basis cubemaps and, last, the .vdsh file - each
  * atomically, so an interrupted bake never leaves a partial file behind.
+ * The cubemaps depend on the cube size only: a helper thread encodes them
+ * in memory meanwhile.
  */
 #include <errno.h>
 #include <getopt.h>
@@ -254,6 +256,23 @@ static void defer_interrupts_while_writing(void)
 }
 
 /* ---- output -------------------------------------------------------------- */
+
+/* The basis cubemaps depend on the cube size only: a helper thread encodes
+ * them (deflate, most of it) while the meshes load and the bake runs, and
+ * they are written, as before, after the bake. */
+typedef struct basis_job {
+    int size;
+    vb_cubemap_basis basis;
+    vb_result result;
+    vb_error err;
+} basis_job;
+
+static void *encode_basis(void *arg)
+{
+    basis_job *b = arg;
+    b->result = vb_cubemap_basis_encode(b->size, &b->basis, &b->err);
+    return NULL;
+}
 
 /* Reports are small: open a temporary file beside `path`; report_close
  * renames it over `path` only if everything was written. */
@@ -513,6 +532,12 @@ int main(int argc, char **argv)
     }
     double t_start = vb_now();
     vb_load_desc ld = {.weld = o.weld};
+    int max_order = o.orders[o.order_count - 1];
+    int cube_size = max_order >= 4 ? o.cube_size : 0;
+    basis_job basis = {.size = cube_size};
+    pthread_t basis_thread;
+    int basis_running = cube_size > 0 && o.output && !o.trace_only &&
+                        pthread_create(&basis_thread, NULL, encode_basis, &basis) == 0;
     for (int i = 0; i < nmesh; i++) {
         const char *path = argv[optind + i];
         vb_mesh m = {0};
@@ -582,7 +607,6 @@ int main(int argc, char **argv)
     }
 
     /* 4. Trace and project. */
-    int max_order = o.orders[o.order_count - 1];
     uint32_t order_mask = 0;
     for (int s = 0; s < o.order_count; s++)
         order_mask |= 1u << o.orders[s];
@@ -660,10 +684,18 @@ int main(int argc, char **argv)
     writing = 1;
     char dir[PATH_MAX], stem[PATH_MAX];
     split_output(o.output, dir, stem, sizeof dir);
-    int cube_size = max_order >= 4 ? o.cube_size : 0;
     if (cube_size > 0) {
         const char *cdir = o.cubemap_dir ? o.cubemap_dir : dir;
-        if (vb_cubemap_write_basis(cdir, stem, cube_size, &err) != VB_OK) {
+        if (basis_running)
+            pthread_join(basis_thread, NULL);
+        else /* no helper thread could start */
+            basis.result = vb_cubemap_basis_encode(cube_size, &basis.basis, &basis.err);
+        basis_running = 0;
+        if (basis.result != VB_OK) {
+            fprintf(stderr, "vdsh-bake: %s\n", basis.err.msg);
+            goto out;
+        }
+        if (vb_cubemap_basis_write(&basis.basis, cdir, stem, &err) != VB_OK) {
             fprintf(stderr, "vdsh-bake: %s\n", err.msg);
             goto out;
         }
@@ -734,6 +766,9 @@ int main(int argc, char **argv)
     status = 0;
 
 out:
+    if (basis_running)
+        pthread_join(basis_thread, NULL);
+    vb_cubemap_basis_free(&basis.basis);
     if (writing) {
         pthread_mutex_unlock(&output_lock);
         while (atomic_load(&interrupted))
