@@ -1,7 +1,8 @@
 /*
  * vr_glsl.c - the shaders. One source per stage, specialised with
  * #defines for each program key (mode, comparison, quantity, output, PCF,
- * lights in the pass), so every variant is straight-line code and nothing
+ * lights in the pass; and whether the per-draw constants travel as flat
+ * varyings, below), so every variant is straight-line code and nothing
  * branches on a uniform per pixel.
  *
  * The VDSH part is written as three layers, so that a new stored quantity
@@ -48,8 +49,8 @@
  * room's lighting pass on llvmpipe (docs/BENCHMARKS.md). The values are
  * the uniforms' own, bit for bit. When the varyings would not fit in
  * GL_MAX_VARYING_COMPONENTS (8 lights need up to 105 of the 128 that
- * llvmpipe and GPUs offer; GL 3.3 only promises 60) the fragment stage
- * reads the uniforms.
+ * llvmpipe and GPUs offer; GL 3.3 only promises 60), or a driver does not
+ * link them, the fragment stage reads the uniforms.
  */
 #include "vr_internal.h"
 
@@ -592,20 +593,28 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
         return vr_fail(err, VR_ERR_SHADER, "%s: the runtime has no shaders for this path", name);
     GLint max_varying = 0;
     glGetIntegerv(GL_MAX_VARYING_COMPONENTS, &max_varying);
-    key_defines(key, varying_components(key, 1) <= max_varying, defines, sizeof defines);
+    int flat = varying_components(key, 1) <= max_varying;
 
-    size_t vs_size = strlen(defines) + sizeof common_glsl + sizeof vertex_glsl;
-    size_t fs_size = strlen(defines) + sizeof common_glsl + sizeof fragment_glsl;
+    size_t vs_size = sizeof defines + sizeof common_glsl + sizeof vertex_glsl;
+    size_t fs_size = sizeof defines + sizeof common_glsl + sizeof fragment_glsl;
     char *vs = malloc(vs_size), *fs = malloc(fs_size);
     if (!vs || !fs) {
         free(vs);
         free(fs);
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
     }
-    snprintf(vs, vs_size, "%s%s%s", defines, common_glsl, vertex_glsl);
-    snprintf(fs, fs_size, "%s%s%s", defines, common_glsl, fragment_glsl);
+    /* A driver that packs varyings less tightly than the component count
+     * assumes may still refuse the flat constants: then read uniforms. */
     GLuint prog = 0;
-    vr_result r = vr_link(name, vs, fs, &prog, err);
+    vr_result r;
+    for (;; flat = 0) {
+        key_defines(key, flat, defines, sizeof defines);
+        snprintf(vs, vs_size, "%s%s%s", defines, common_glsl, vertex_glsl);
+        snprintf(fs, fs_size, "%s%s%s", defines, common_glsl, fragment_glsl);
+        r = vr_link(name, vs, fs, &prog, err);
+        if (r != VR_ERR_SHADER || !flat)
+            break;
+    }
     free(vs);
     free(fs);
     if (r != VR_OK)
