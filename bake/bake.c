@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "fit.h"
+#include "fit_shadow.h"
 #include "parallel.h"
 #include "sampling.h"
 #include "vdsh.h"
@@ -495,6 +496,11 @@ typedef struct job {
     float inv_scale;
     float degenerate_dist; /* scene units */
     int horizon;           /* paper: skip w.n < 0 */
+    /* Method shadow: the lsq fit of ln d refined on every
+     * shadow_stride-th traced direction (vb_shadow_fit_apply). */
+    uint32_t shadow_stride; /* 0: no refinement */
+    vb_shadow_fit shadow;
+    struct shadow_scratch *scratch; /* one per worker */
     /* The quantity choice (VB_QUANTITY_AUTO): sampled receivers, and per
      * sample, order and quantity (0 distance, 1 log) its estimated error. */
     uint32_t choose_count;
@@ -505,6 +511,14 @@ typedef struct job {
     _Atomic uint32_t degenerate;
 } job;
 
+/* A worker's room for the shadow fit's directions: their basis values up
+ * to order 9 (vb_shadow_fit_apply), 32-byte aligned rows. */
+typedef struct shadow_scratch {
+    float y[81 * VB_SHADOW_MAX_DIRS];
+    float x[VB_SHADOW_MAX_DIRS], yy[VB_SHADOW_MAX_DIRS], z[VB_SHADOW_MAX_DIRS];
+    float lnd[VB_SHADOW_MAX_DIRS];
+} shadow_scratch;
+
 /* Where one receiver's results go: per quantity (0 distance, 1 log) and
  * order, its coefficients or NULL; and, when `n` is not NULL, the traced
  * directions above its horizon with their distances (scene units). */
@@ -512,6 +526,7 @@ typedef struct vertex_sink {
     float *coeffs[2][VDSH_MAX_ORDER + 1];
     float *x, *y, *z, *t;
     uint32_t *n;
+    shadow_scratch *scratch; /* method shadow: the fit's directions */
 } vertex_sink;
 
 /* ln(x) for finite x > 0, to about 1e-7 relative, in plain float
@@ -563,6 +578,11 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
     const float nx = n[0], ny = n[1], nz = n[2];
     float acc[2][VDSH_MAX_COEFFS][VB_PACKET];
     memset(acc, 0, sizeof acc);
+    /* Method shadow: every shadow_stride-th direction in packet order (a
+     * 4 x 4 block's 2 x 2 corners for a stride of 4: still stratified),
+     * for the refinement at the end. */
+    shadow_scratch *sub = out->scratch;
+    uint32_t sub_n = 0;
     uint32_t near_zero = 0, upper = 0;
 
     /* Packets are traced GROUP at a time, then their lanes are processed
@@ -572,6 +592,7 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
     for (uint32_t pk = 0; pk < J->grid->packet_count;) {
         struct RTCRayHit16 rh[GROUP] __attribute__((aligned(64)));
         int valid[GROUP][VB_PACKET] __attribute__((aligned(64)));
+        uint32_t pkid[GROUP]; /* which packet each traced one is */
         int np = 0;
         for (; pk < J->grid->packet_count && np < GROUP; pk++) {
             if (J->horizon && vb_dirgrid_packet_below(J->grid, pk, n))
@@ -606,7 +627,7 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
             rtcIntersect16(ok, S->scene, &ctx, r);
             for (int k = 0; k < VB_PACKET; k++)
                 *traced += ok[k] != 0;
-            np++;
+            pkid[np++] = pk;
         }
         if (d->trace_only)
             continue;
@@ -654,6 +675,15 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
             if (want[1])
                 vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, logd[p], &acc[1][0][0],
                                     VB_PACKET);
+            if (sub && want[1])
+                for (int k = 0; k < VB_PACKET; k++)
+                    if (up_lane[p][k] && (pkid[p] * VB_PACKET + k) % J->shadow_stride == 0 &&
+                        sub_n < VB_SHADOW_MAX_DIRS) {
+                        sub->x[sub_n] = dx[k];
+                        sub->yy[sub_n] = dy[k];
+                        sub->z[sub_n] = dz[k];
+                        sub->lnd[sub_n++] = logd[p][k];
+                    }
             if (out->n)
                 for (int k = 0; k < VB_PACKET; k++)
                     if (up_lane[p][k]) {
@@ -692,6 +722,17 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
             if (out->coeffs[q][o])
                 vb_fit_finish(&J->fits[o], &angles, u, out->coeffs[q][o]);
     }
+    if (sub && want[1]) {
+        /* Padded to whole vectors with a harmless direction (ignored). */
+        uint32_t stride = (sub_n + 7) & ~7u;
+        for (uint32_t k = sub_n; k < stride; k++)
+            sub->x[k] = 0.0f, sub->yy[k] = 0.0f, sub->z[k] = 1.0f, sub->lnd[k] = 0.0f;
+        vdsh_sh_eval_soa(2 * J->order - 1, stride, sub->x, sub->yy, sub->z, sub->y, stride);
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            if (out->coeffs[1][o])
+                vb_shadow_fit_apply(&J->shadow, o, sub_n, sub->y, stride, sub->lnd,
+                                    out->coeffs[1][o]);
+    }
     if (upper > 0 && near_zero >= 0.9 * upper)
         (*degenerate)++;
 }
@@ -699,13 +740,12 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
 static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
 {
     job *J = ctx;
-    (void)worker;
     uint64_t traced = 0, missed = 0;
     uint32_t degenerate = 0;
     for (uint32_t v = begin; v < end; v++) {
         if (J->done && J->done[v])
             continue;
-        vertex_sink out = {0};
+        vertex_sink out = {.scratch = J->scratch ? J->scratch + worker : NULL};
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (J->coeffs[o])
                 out.coeffs[J->quantity[o] == VDSH_QUANTITY_LOG_DISTANCE][o] =
@@ -984,10 +1024,16 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     if (d.order_mask >> (d.max_order + 1))
         return vb_fail(err, VB_ERR_ARGUMENT, "an order above max_order %d was asked for",
                        d.max_order);
-    if (d.method > VDSH_METHOD_LSQ)
+    if (d.method > VDSH_METHOD_SHADOW)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", d.method);
     if (d.window > VDSH_WINDOW_LANCZOS)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown window %u", d.window);
+    if (d.method == VDSH_METHOD_SHADOW) {
+        if (d.quantity == VDSH_QUANTITY_DISTANCE)
+            return vb_fail(err, VB_ERR_ARGUMENT,
+                           "method shadow fits the log distance: use --quantity log or auto");
+        d.quantity = VDSH_QUANTITY_LOG_DISTANCE; /* the only one shadow has */
+    }
     if (d.quantity == VB_QUANTITY_AUTO && d.method == VDSH_METHOD_PAPER)
         d.quantity = VDSH_QUANTITY_DISTANCE; /* the only one paper has */
     if (d.quantity != VDSH_QUANTITY_DISTANCE && d.quantity != VDSH_QUANTITY_LOG_DISTANCE &&
@@ -1027,7 +1073,8 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     /* The sampling domain: the whole sphere for paper (the horizon culls
      * half of it) and full; the hemisphere above each receiver, with half
      * the directions (the same traced budget), for the hemisphere fits. */
-    int hemisphere = d.method == VDSH_METHOD_MIRROR || d.method == VDSH_METHOD_LSQ;
+    int hemisphere = d.method == VDSH_METHOD_MIRROR || d.method == VDSH_METHOD_LSQ ||
+                     d.method == VDSH_METHOD_SHADOW;
     vb_dirgrid grid = {0};
     vb_result r = vb_dirgrid_create(hemisphere ? (d.rays + 1) / 2 : d.rays, hemisphere,
                                     &grid, err);
@@ -1048,7 +1095,9 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!coeffs[o] && o != d.max_order) /* the top one rotates for all */
             continue;
-        if ((r = vb_fit_create(o, d.method, d.lambda, &J->fits[o], err)) != VB_OK)
+        /* shadow starts from the lsq fit */
+        uint32_t fm = d.method == VDSH_METHOD_SHADOW ? VDSH_METHOD_LSQ : d.method;
+        if ((r = vb_fit_create(o, fm, d.lambda, &J->fits[o], err)) != VB_OK)
             goto done;
         vb_fit_window(&J->fits[o], d.window);
     }
@@ -1067,6 +1116,20 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     J->inv_scale = 1.0f / d.scene->scale;
     J->degenerate_dist = 1e-3f * d.scene->diagonal;
     J->horizon = d.method == VDSH_METHOD_PAPER;
+    if (d.method == VDSH_METHOD_SHADOW) {
+        /* About 300 directions: as good as all of 1225 in the tests of
+         * fit_shadow.h, and a quarter of the work. */
+        J->shadow_stride = 1;
+        while (grid.count / (2 * J->shadow_stride) >= 300)
+            J->shadow_stride *= 2;
+        if ((r = vb_shadow_fit_init(&J->shadow, d.lambda, err)) != VB_OK)
+            goto done;
+        if (!d.trace_only &&
+            !(J->scratch = aligned_alloc(32, d.threads * sizeof *J->scratch))) {
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the shadow fit");
+            goto done;
+        }
+    }
     uint32_t undefined = 0;
     for (uint32_t v = 0; v < R->vertex_count; v++) {
         const float *n = R->normals + 3 * (size_t)v;
@@ -1139,7 +1202,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     }
     o.auto_receivers = auto_receivers;
     memcpy(o.auto_error, auto_error, sizeof auto_error);
-    o.lambda = d.method == VDSH_METHOD_LSQ ? d.lambda : 0.0f;
+    o.lambda = d.method == VDSH_METHOD_LSQ || d.method == VDSH_METHOD_SHADOW ? d.lambda : 0.0f;
     o.log_floor = any_log ? d.log_floor : 0.0f;
     o.window = d.window;
     o.vertex_count = R->vertex_count;
@@ -1160,6 +1223,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
 
 done:
     if (J) {
+        free(J->scratch);
         free(J->choose_error);
         free(J->choose_coeffs);
         free(J->done);

@@ -434,7 +434,9 @@ int main(int argc, char **argv)
             else if (strcmp(optarg, "full") == 0) o.method = VDSH_METHOD_FULL;
             else if (strcmp(optarg, "mirror") == 0) o.method = VDSH_METHOD_MIRROR;
             else if (strcmp(optarg, "lsq") == 0) o.method = VDSH_METHOD_LSQ;
-            else return bad_usage("--method takes paper, full, mirror or lsq, not '%s'", optarg);
+            else if (strcmp(optarg, "shadow") == 0) o.method = VDSH_METHOD_SHADOW;
+            else return bad_usage("--method takes shadow, lsq, mirror, paper or full, not '%s'",
+                                  optarg);
             break;
         case O_ENCODING:
             if (strcmp(optarg, "f16") == 0) o.encoding = VDSH_ENCODING_F16;

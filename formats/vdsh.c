@@ -209,8 +209,8 @@ static const char *name_of(uint32_t v, const char *const *names, uint32_t n)
 
 const char *vdsh_method_name(uint32_t method)
 {
-    static const char *const n[] = {"paper", "full", "mirror", "lsq"};
-    return name_of(method, n, 4);
+    static const char *const n[] = {"paper", "full", "mirror", "lsq", "shadow"};
+    return name_of(method, n, 5);
 }
 
 const char *vdsh_encoding_name(uint32_t encoding)

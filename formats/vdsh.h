@@ -106,7 +106,8 @@ typedef enum vdsh_method {
     VDSH_METHOD_PAPER = 0,
     VDSH_METHOD_FULL = 1,
     VDSH_METHOD_MIRROR = 2,
-    VDSH_METHOD_LSQ = 3
+    VDSH_METHOD_LSQ = 3,
+    VDSH_METHOD_SHADOW = 4
 } vdsh_method;
 
 typedef enum vdsh_quantity {

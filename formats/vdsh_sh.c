@@ -1,6 +1,8 @@
 #include "vdsh_sh.h"
 
 #include <assert.h>
+#include <math.h>
+#include <string.h>
 
 /* An AVX2 clone of the batch loops, chosen at run time where the CPU has
  * it (Debian builds for baseline x86-64, i.e. SSE2). No FMA: every lane
@@ -124,11 +126,75 @@ static inline __attribute__((always_inline)) void soa_dispatch(
     }
 }
 
-void vdsh_sh_eval_soa(int order, size_t n, const float *x, const float *y,
-                      const float *z, float *out, size_t out_stride)
+/* Bands 5 .. order-1 (order <= VDSH_SH_EVAL_MAX_ORDER) by the standard
+ * recurrence, in the same convention as bands 0-4 (Condon-Shortley phase,
+ * sin for m < 0): Y_l^m = K_l^m P_l^|m|(z) (sqrt 2 Re or Im (x + iy)^|m|),
+ * P_l^m here without its (1 - z^2)^(m/2) factor, which (x + iy)^m carries.
+ * Directions in chunks, each step a loop over the chunk, so it vectorises
+ * over directions like the kernel above. */
+static inline __attribute__((always_inline)) void eval_high_bands(
+    int order, size_t n, const float *x, const float *y, const float *z, float *out,
+    size_t stride)
 {
-    assert(order >= 1 && order <= 5);
-    soa_dispatch(order, n, x, y, z, NULL, out, out_stride, 0);
+    enum { CHUNK = 64 };
+    for (size_t k0 = 0; k0 < n; k0 += CHUNK) {
+        size_t cn = n - k0 < CHUNK ? n - k0 : CHUNK;
+        const float *xs = x + k0, *ys = y + k0, *zs = z + k0;
+        float c[CHUNK], sn[CHUNK], pmm[CHUNK], p0[CHUNK], p1[CHUNK], pl[CHUNK];
+        for (size_t k = 0; k < cn; k++)
+            c[k] = 1.0f, sn[k] = 0.0f, pmm[k] = 1.0f;
+        for (int m = 0; m < order; m++) {
+            if (m > 0) /* (x + iy)^m, and P_m^m = -(2m - 1) P_{m-1}^{m-1} */
+                for (size_t k = 0; k < cn; k++) {
+                    float cc = xs[k] * c[k] - ys[k] * sn[k];
+                    sn[k] = xs[k] * sn[k] + ys[k] * c[k];
+                    c[k] = cc;
+                    pmm[k] *= -(float)(2 * m - 1);
+                }
+            for (int l = m; l < order; l++) {
+                /* P_l^m from P_{l-1}^m (p1) and P_{l-2}^m (p0). */
+                if (l == m)
+                    for (size_t k = 0; k < cn; k++)
+                        pl[k] = pmm[k];
+                else if (l == m + 1)
+                    for (size_t k = 0; k < cn; k++)
+                        pl[k] = zs[k] * (float)(2 * m + 1) * pmm[k];
+                else {
+                    float a = (float)(2 * l - 1) / (float)(l - m);
+                    float b = (float)(l + m - 1) / (float)(l - m);
+                    for (size_t k = 0; k < cn; k++)
+                        pl[k] = a * zs[k] * p1[k] - b * p0[k];
+                }
+                memcpy(p0, p1, cn * sizeof *p0);
+                memcpy(p1, pl, cn * sizeof *p1);
+                if (l < 5)
+                    continue; /* the closed forms above */
+                double kk = (2.0 * l + 1.0) / (4.0 * 3.14159265358979323846);
+                for (int f = l - m + 1; f <= l + m; f++)
+                    kk /= f;
+                float K = (float)sqrt(kk), K2 = (float)sqrt(2.0 * kk);
+                float *pos = out + (size_t)(l * (l + 1) + m) * stride + k0;
+                float *neg = out + (size_t)(l * (l + 1) - m) * stride + k0;
+                if (m == 0)
+                    for (size_t k = 0; k < cn; k++)
+                        pos[k] = K * pl[k];
+                else
+                    for (size_t k = 0; k < cn; k++) {
+                        pos[k] = K2 * pl[k] * c[k];
+                        neg[k] = K2 * pl[k] * sn[k];
+                    }
+            }
+        }
+    }
+}
+
+VDSH_CLONES void vdsh_sh_eval_soa(int order, size_t n, const float *x, const float *y,
+                                  const float *z, float *out, size_t out_stride)
+{
+    assert(order >= 1 && order <= VDSH_SH_EVAL_MAX_ORDER);
+    soa_dispatch(order < 5 ? order : 5, n, x, y, z, NULL, out, out_stride, 0);
+    if (order > 5)
+        eval_high_bands(order, n, x, y, z, out, out_stride);
 }
 
 VDSH_CLONES void vdsh_sh_project_soa(int order, size_t n, const float *x, const float *y,

@@ -4,10 +4,12 @@
 #include <string.h>
 
 #include "fit.h"
+#include "fit_shadow.h"
 #include "sampling.h"
 #include "test_util.h"
 #include "vdsh.h"
 #include "vdsh_sh.h"
+#include "vdsh_shadow.h"
 
 /* A random rotation from a random unit quaternion. */
 static void rand_rotation(uint64_t *s, double R[9])
@@ -278,6 +280,180 @@ static void test_errors(void)
     CHECK(vb_fit_create(3, 99, 0, &f, &err) == VB_ERR_ARGUMENT, "unknown method");
 }
 
+
+/* e(r), the expected shadow error of a direction reconstructed at r times
+ * its true distance: 0 when exact, flat from 2 on (every light lit either
+ * way), rising toward its r = 0 value, and the same as the brute-force mean
+ * over lights the evaluator draws. */
+static void test_shadow_error(void)
+{
+    static vb_shadow_fit f;
+    vb_error err;
+    CHECK(vb_shadow_fit_init(&f, 1e-4f, &err) == VB_OK, "init");
+    CHECK(vb_shadow_error(&f, 1.0) < 1e-6, "e(1) = %g", vb_shadow_error(&f, 1.0));
+    CHECK(fabs(vb_shadow_error(&f, 2.0) - vb_shadow_error(&f, 7.0)) < 1e-12, "flat from 2");
+    double prev = 1.0;
+    for (double r = 0.0; r <= 1.0; r += 0.05) {
+        double e = vb_shadow_error(&f, r);
+        CHECK(e <= prev + 1e-12, "e not decreasing on [0, 1] at %g", r);
+        prev = e;
+    }
+    prev = 0.0;
+    for (double r = 1.0; r <= 2.0; r += 0.05) {
+        double e = vb_shadow_error(&f, r);
+        CHECK(e >= prev - 1e-12, "e not increasing on [1, 2] at %g", r);
+        prev = e;
+    }
+    /* Brute force: lights at u uniform in (0.05, 1], d_L = 2u d. */
+    uint64_t seed = 7;
+    for (double r = 0.1; r < 2.5; r += 0.3) {
+        double s = 0.0;
+        enum { N = 200000 };
+        for (int k = 0; k < N; k++) {
+            double u = 0.05 + 0.95 * (1.0 - test_rand(&seed));
+            s += fabs(vdsh_ramp((float)(r / (2 * u))) - vdsh_ramp((float)(1 / (2 * u))));
+        }
+        CHECK(fabs(s / N - vb_shadow_error(&f, r)) < 3e-3, "e(%g) = %g, lights say %g", r,
+              vb_shadow_error(&f, r), s / N);
+    }
+}
+
+/* Gauss-Jordan inverse of an n x n matrix (no pivoting: for the
+ * positive definite matrices here). Returns 0 on a zero pivot. */
+static int test_invert(int n, const double *a, double *inv)
+{
+    double m[25][50];
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < 2 * n; j++)
+            m[i][j] = j < n ? a[i * n + j] : (j - n == i);
+    for (int c = 0; c < n; c++) {
+        if (m[c][c] == 0.0)
+            return 0;
+        double p = 1.0 / m[c][c];
+        for (int j = 0; j < 2 * n; j++)
+            m[c][j] *= p;
+        for (int r = 0; r < n; r++)
+            if (r != c) {
+                double q = m[r][c];
+                for (int j = 0; j < 2 * n; j++)
+                    m[r][j] -= q * m[c][j];
+            }
+    }
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+            inv[i * n + j] = m[i][n + j];
+    return 1;
+}
+
+/* Directions over the upper hemisphere of +z and their basis values in
+ * vdsh_sh_eval_soa's layout. */
+enum { SHADOW_N = 304 }; /* a multiple of 8: vb_shadow_fit_apply's stride */
+static void shadow_dirs(uint64_t *seed, float *x, float *y, float *z, float *Y)
+{
+    for (int k = 0; k < SHADOW_N; k++) {
+        float d[3];
+        test_rand_dir(seed, d);
+        x[k] = d[0], y[k] = d[1], z[k] = fabsf(d[2]);
+    }
+    vdsh_sh_eval_soa(9, SHADOW_N, x, y, z, Y, SHADOW_N);
+}
+
+static double shadow_score(const vb_shadow_fit *f, int order, const float *Y, const float *lnd,
+                           const float *c)
+{
+    double s = 0.0;
+    for (int k = 0; k < SHADOW_N; k++) {
+        double v = 0.0;
+        for (int i = 0; i < order * order; i++)
+            v += (double)c[i] * Y[i * SHADOW_N + k];
+        s += vb_shadow_error(f, exp(v - lnd[k]));
+    }
+    return s / SHADOW_N;
+}
+
+/* The shadow fit: a log distance the basis holds exactly is a fixed
+ * point (found again from a poor start); with a thin occluder the fit
+ * cannot follow, it scores better than the least squares it starts from;
+ * too few directions leave the coefficients alone. */
+static void test_shadow_fit(void)
+{
+    static vb_shadow_fit f;
+    vb_error err;
+    CHECK(vb_shadow_fit_init(&f, 1e-4f, &err) == VB_OK, "init");
+    uint64_t seed = 11;
+    float x[SHADOW_N], y[SHADOW_N], z[SHADOW_N];
+    static float Y[81 * SHADOW_N] __attribute__((aligned(32)));
+    static float lnd[SHADOW_N] __attribute__((aligned(32)));
+    shadow_dirs(&seed, x, y, z, Y);
+    for (int order = 2; order <= 5; order++) {
+        int nc = order * order;
+        float truth[25] = {0}, c[25] = {0};
+        for (int i = 0; i < nc; i++)
+            truth[i] = (float)(0.3 * (test_rand(&seed) - 0.5));
+        truth[0] = 3.0f;
+        for (int k = 0; k < SHADOW_N; k++) {
+            double v = 0.0;
+            for (int i = 0; i < nc; i++)
+                v += (double)truth[i] * Y[i * SHADOW_N + k];
+            lnd[k] = (float)v;
+        }
+        c[0] = 2.5f; /* a poor start */
+        vb_shadow_fit_apply(&f, order, SHADOW_N, Y, SHADOW_N, lnd, c);
+        /* The function, not the coefficients: some combinations of
+         * order-5 functions are nearly 0 on a hemisphere, and the
+         * regularisation rightly leaves them alone. */
+        double worst = 0.0;
+        for (int k = 0; k < SHADOW_N; k++) {
+            double v = 0.0;
+            for (int i = 0; i < nc; i++)
+                v += (double)c[i] * Y[i * SHADOW_N + k];
+            worst = fmax(worst, fabs(v - lnd[k]));
+        }
+        CHECK(worst < 1e-2, "order %d: exact log distance found to %g", order, worst);
+        CHECK(shadow_score(&f, order, Y, lnd, c) < 1e-3, "order %d: exact fit scores %g", order,
+              shadow_score(&f, order, Y, lnd, c));
+    }
+
+    /* A room-like function, ln 5 everywhere, with a thin occluder at 0.2
+     * in a small cone: least squares smears it over the hemisphere; the
+     * fit gives it up and keeps the rest right. */
+    for (int order = 2; order <= 5; order++) {
+        int nc = order * order;
+        for (int k = 0; k < SHADOW_N; k++)
+            lnd[k] = (x[k] > 0.85f) ? logf(0.2f) : logf(5.0f);
+        double b[25] = {0};
+        for (int i = 0; i < nc; i++) { /* least squares on the samples */
+            for (int k = 0; k < SHADOW_N; k++)
+                b[i] += (double)Y[i * SHADOW_N + k] * lnd[k];
+        }
+        double G[25 * 25] = {0}, Ginv[25 * 25];
+        for (int i = 0; i < nc; i++)
+            for (int j = 0; j < nc; j++)
+                for (int k = 0; k < SHADOW_N; k++)
+                    G[i * nc + j] += (double)Y[i * SHADOW_N + k] * Y[j * SHADOW_N + k];
+        for (int i = 0; i < nc; i++)
+            G[i * nc + i] += 1e-6;
+        CHECK(test_invert(nc, G, Ginv), "order %d: Gram matrix", order);
+        float c[25], c0[25];
+        for (int i = 0; i < nc; i++) {
+            double v = 0.0;
+            for (int j = 0; j < nc; j++)
+                v += Ginv[i * nc + j] * b[j];
+            c[i] = c0[i] = (float)v;
+        }
+        vb_shadow_fit_apply(&f, order, SHADOW_N, Y, SHADOW_N, lnd, c);
+        double e0 = shadow_score(&f, order, Y, lnd, c0), e1 = shadow_score(&f, order, Y, lnd, c);
+        CHECK(e1 < 0.8 * e0, "order %d: shadow fit %g, least squares %g", order, e1, e0);
+        for (int i = 0; i < nc; i++)
+            CHECK(isfinite(c[i]), "order %d: coefficient %d not finite", order, i);
+        /* too few directions: untouched */
+        memcpy(c, c0, sizeof c);
+        vb_shadow_fit_apply(&f, order, (uint32_t)nc, Y, SHADOW_N, lnd, c);
+        CHECK(memcmp(c, c0, (size_t)nc * sizeof *c) == 0, "order %d: %d directions changed c",
+              order, nc);
+    }
+}
+
 int main(void)
 {
     test_rotation();
@@ -286,5 +462,7 @@ int main(void)
     test_mirror_and_paper();
     test_window();
     test_errors();
+    test_shadow_error();
+    test_shadow_fit();
     return test_report("test_fit");
 }
