@@ -86,19 +86,24 @@ static void usage(FILE *f)
 "                          (default 2500 = 50 x 50)\n"
 "      --orders LIST       SH orders to store, order n = n bands = n*n\n"
 "                          coefficients (default 2,3,5; each 1..5)\n"
-"      --method M          lsq (default): regularised least squares to the\n"
-"                          upper hemisphere; mirror: the upper hemisphere,\n"
-"                          mirrored below; paper: the paper's fit, directions\n"
-"                          below the horizon count as distance 0; full: the\n"
-"                          whole sphere, no horizon. All but full trace only\n"
-"                          the upper half of the --rays directions\n"
-"      --quantity Q        what the SH store: auto (default): per order, the\n"
-"                          one with the lower expected shadow error on 1024\n"
-"                          sampled receivers; distance; log: ln(distance),\n"
-"                          reconstructed as exp of the SH sum (not with\n"
-"                          paper, where auto means distance)\n"
+"      --method M          shadow (default): the log distance fitted to the\n"
+"                          upper hemisphere for the lowest expected shadow\n"
+"                          error (robust reweighted least squares from lsq's\n"
+"                          fit, on about 300 of the traced directions);\n"
+"                          lsq: regularised least squares to the upper\n"
+"                          hemisphere; mirror: the upper hemisphere, mirrored\n"
+"                          below; paper: the paper's fit, directions below the\n"
+"                          horizon count as distance 0; full: the whole\n"
+"                          sphere, no horizon. All but full trace only the\n"
+"                          upper half of the --rays directions\n"
+"      --quantity Q        what the SH store: auto (default): log for shadow,\n"
+"                          distance for paper, and for the others per order\n"
+"                          the one with the lower expected shadow error on\n"
+"                          1024 sampled receivers; distance; log:\n"
+"                          ln(distance), reconstructed as exp of the SH sum\n"
+"                          (not with paper; the only one with shadow)\n"
 "      --log               the same as --quantity log\n"
-"      --lambda X          lsq regularisation weight (default 1e-4)\n"
+"      --lambda X          lsq and shadow regularisation weight (default 1e-4)\n"
 "      --window W          per-band window on the coefficients: none (default),\n"
 "                          hann or lanczos (width: the order)\n"
 "      --log-floor D       log-distance: distances below D count as D\n"
@@ -378,7 +383,7 @@ int main(int argc, char **argv)
     options o = {0};
     o.rays = 2500;
     o.orders[0] = 2, o.orders[1] = 3, o.orders[2] = 5, o.order_count = 3;
-    o.method = VDSH_METHOD_LSQ;
+    o.method = VDSH_METHOD_SHADOW;
     o.quantity = VB_QUANTITY_AUTO;
     o.encoding = VDSH_ENCODING_F16;
     o.seed = 1;
@@ -510,6 +515,9 @@ int main(int argc, char **argv)
         return bad_usage("%s", "no mesh given");
     if (nmesh > VDSH_MAX_SOURCES)
         return bad_usage("%s", "too many meshes (at most 64)");
+    if (o.quantity == VDSH_QUANTITY_DISTANCE && o.method == VDSH_METHOD_SHADOW)
+        return bad_usage("%s", "--method shadow fits the log distance: use --quantity log or "
+                               "auto, or --method lsq for the distance");
     if (o.quantity == VDSH_QUANTITY_LOG_DISTANCE && o.method == VDSH_METHOD_PAPER)
         return bad_usage("%s", "log-distance needs --method mirror, lsq or full: the paper's zero fill "
                                "below the horizon has no meaning for ln(distance)");

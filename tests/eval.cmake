@@ -7,7 +7,7 @@
 if(TARGET vb_eval)
   add_executable(test_eval ${CMAKE_CURRENT_LIST_DIR}/test_eval.c)
   target_link_libraries(test_eval PRIVATE vb_eval)
-  foreach(part heldout interpolate sources sphere room oracle)
+  foreach(part heldout interpolate sources sphere room methods oracle)
     add_test(NAME eval_${part} COMMAND test_eval ${part})
   endforeach()
 

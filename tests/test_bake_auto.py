@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""--quantity auto (vdsh-bake's default) against both quantities forced.
+"""--quantity auto (the default for --method lsq) against both quantities forced.
 
 Two scenes at the two ends of the choice: the built-in room (closed: every
 ray hits a wall, relative error near walls is what matters) and a box on a
@@ -70,7 +70,7 @@ def run(cmd):
 
 def do_bake(name, args, tag, extra):
     out = os.path.join(tmp, "%s-%s.vdsh" % (name, tag))
-    run([bake] + args + ["--rays", "400", "--cube-size", "0", "-q", "-o", out] + extra)
+    run([bake] + args + ["--method", "lsq", "--rays", "400", "--cube-size", "0", "-q", "-o", out] + extra)
     return out
 
 

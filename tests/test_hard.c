@@ -482,12 +482,13 @@ static void test_contact_and_embedded(void)
     test_mesh_free(&rec);
 }
 
-/* The default fit (lsq, quantity chosen per order) on the hardest scene
- * above: receivers in corners, pressed against the floor, buried in a
- * pillar, where true distances are ~0 and ln 0 would be -Inf. Every
- * coefficient is finite, and every reconstructed distance in 64 directions
- * above each receiver is finite and >= 0 (the log floor bounds it below). */
-static void test_default_fit(void)
+/* The default fit (shadow: the log distance, reweighted) and lsq with the
+ * quantity chosen per order, on the hardest scene above: receivers in
+ * corners, pressed against the floor, buried in a pillar, where true
+ * distances are ~0 and ln 0 would be -Inf. Every coefficient is finite,
+ * and every reconstructed distance in 64 directions above each receiver is
+ * finite and >= 0. */
+static void test_default_fit(uint32_t method)
 {
     vb_mesh m = {0}, rec = {0};
     test_make_room(&m, 4.0f, 3.0f, 2.5f);
@@ -498,18 +499,22 @@ static void test_default_fit(void)
     vb_scene *s = NULL;
     CHECK(vb_scene_create(&m, NULL, &s, &err) == VB_OK, "scene");
     vb_bake_desc d = {.receivers = &rec, .scene = s, .rays = 512, .seed = 3,
-                      .method = VDSH_METHOD_LSQ, .quantity = VB_QUANTITY_AUTO,
+                      .method = method, .quantity = VB_QUANTITY_AUTO,
                       .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
     vb_bake_output b = {0};
-    CHECK(s && vb_bake_run(&d, &b, &err) == VB_OK, "bake: %s", err.msg);
-    CHECK(b.auto_receivers == (rec.vertex_count < 1024 ? rec.vertex_count : 1024),
-          "%u receivers sampled for the choice", b.auto_receivers);
+    CHECK(s && vb_bake_run(&d, &b, &err) == VB_OK, "%s bake: %s", vdsh_method_name(method),
+          err.msg);
+    uint32_t sampled = method == VDSH_METHOD_LSQ ? (rec.vertex_count < 1024 ? rec.vertex_count
+                                                                             : 1024) : 0;
+    CHECK(b.auto_receivers == sampled, "%s: %u receivers sampled for the choice",
+          vdsh_method_name(method), b.auto_receivers);
     long bad = 0, checked = 0;
     for (int o = 2; o <= 5 && b.coeffs[5]; o++) {
         if (!b.coeffs[o])
             continue;
-        CHECK(b.quantity[o] == VDSH_QUANTITY_DISTANCE || b.quantity[o] == VDSH_QUANTITY_LOG_DISTANCE,
-              "order %d: quantity %u", o, b.quantity[o]);
+        CHECK(b.quantity[o] == VDSH_QUANTITY_LOG_DISTANCE ||
+                  (method == VDSH_METHOD_LSQ && b.quantity[o] == VDSH_QUANTITY_DISTANCE),
+              "%s order %d: quantity %u", vdsh_method_name(method), o, b.quantity[o]);
         for (uint32_t v = 0; v < rec.vertex_count; v++) {
             const float *c = b.coeffs[o] + (size_t)v * o * o, *n = rec.normals + 3 * (size_t)v;
             for (int i = 0; i < o * o; i++)
@@ -527,8 +532,8 @@ static void test_default_fit(void)
             }
         }
     }
-    CHECK(bad == 0 && checked > 0, "%ld of %ld coefficients or distances not finite and >= 0",
-          bad, checked);
+    CHECK(bad == 0 && checked > 0, "%s: %ld of %ld coefficients or distances not finite and >= 0",
+          vdsh_method_name(method), bad, checked);
     vb_bake_output_free(&b);
     vb_scene_destroy(s);
     test_mesh_free(&m);
@@ -571,7 +576,8 @@ int main(void)
     test_open_mesh();
     test_inverted_normals();
     test_contact_and_embedded();
-    test_default_fit();
+    test_default_fit(VDSH_METHOD_SHADOW);
+    test_default_fit(VDSH_METHOD_LSQ);
     test_bad_api_input();
     return test_report("test_hard");
 }
