@@ -607,13 +607,16 @@ static vb_result decode_exr(const char *path, exr_io *io, vb_cubemap **out,
     int found[4] = {0, 0, 0, 0};
     for (int c = 0; chl && c < chl->num_channels; c++) {
         const exr_attr_chlist_entry_t *e = &chl->entries[c];
+        /* Any channel, used or not: OpenEXRCore 3.1's B44 decoder reads
+         * past its buffer on subsampled channels (a fuzzer find,
+         * tests/corpus/regressions/cubemap), and no basis map has one. */
+        if (e->x_sampling != 1 || e->y_sampling != 1)
+            BAD("%s: channel %s is subsampled", path, e->name.str);
         int comp = channel_component(e->name.str);
         if (comp < 0)
             continue;
         if (e->pixel_type != EXR_PIXEL_HALF && e->pixel_type != EXR_PIXEL_FLOAT)
             BAD("%s: channel %s is not half or float", path, e->name.str);
-        if (e->x_sampling != 1 || e->y_sampling != 1)
-            BAD("%s: channel %s is subsampled", path, e->name.str);
         found[comp] = 1;
     }
     for (int c = 0; c < 4; c++)

@@ -976,6 +976,11 @@ vb_result scan_ply(const char *path, const uint8_t *bytes, size_t size,
     }
     for (size_t i = 0; i < last; i++) {
         const ply_element &e = elems[i];
+        /* Items without properties hold no data: a count of billions of
+         * them would only spin this walk (a fuzzer find). */
+        if (e.props.empty() && e.count > 0)
+            return vb_fail(err, VB_ERR_FORMAT, "%s: element '%s' has %llu items but no properties",
+                           path, e.name.c_str(), (unsigned long long)e.count);
         for (uint64_t n = 0; n < e.count; n++) {
             for (size_t k = 0; k < e.props.size(); k++) {
                 const ply_property &p = e.props[k];
