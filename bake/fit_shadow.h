@@ -27,7 +27,8 @@
  *
  * Determinism: every sum runs in a fixed order; same inputs, same bits.
  * Threading: a vb_shadow_fit is read-only once made; share it.
- * Errors: none (inputs are finite by contract; a singular step keeps the
+ * Errors: vb_shadow_fit_init can run out of memory; the fit itself has
+ * none (inputs are finite by contract; a singular step keeps the
  * previous coefficients).
  */
 #ifndef VB_FIT_SHADOW_H
@@ -42,9 +43,10 @@ extern "C" {
 #endif
 
 #define VB_SHADOW_TABLE 1024   /* tabulated points of e(r) and eps'(x) */
-#define VB_SHADOW_STEPS 12     /* IRLS steps: 3 per weight width */
+#define VB_SHADOW_STEPS 8      /* IRLS steps: 2 per weight width */
 #define VB_SHADOW_MAX_DIRS 640 /* directions a fit may use (a subset of the traced ones) */
 
+#define VB_SHADOW_TAIL 0.02f   /* loss slope past e's flat ends (see irls_weight8) */
 #define VB_SHADOW_TERMS 4096 /* non-zero triple products (about 2,900) */
 
 typedef struct vb_shadow_fit {

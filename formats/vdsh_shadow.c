@@ -21,7 +21,7 @@ float vdsh_stream_distance(uint32_t order, uint32_t quantity, const float *c,
     case VDSH_QUANTITY_DISTANCE2:
         return sum > 0.0f ? sqrtf(sum) : 0.0f;
     case VDSH_QUANTITY_LOG_DISTANCE:
-        return expf(sum);
+        return expf(sum < VDSH_LOG_SUM_MAX ? sum : VDSH_LOG_SUM_MAX);
     default:
         return sum > 0.0f ? sum : 0.0f;
     }
@@ -70,7 +70,7 @@ static float from_sum(uint32_t quantity, float sum)
     case VDSH_QUANTITY_DISTANCE2:
         return sum > 0.0f ? sqrtf(sum) : 0.0f;
     case VDSH_QUANTITY_LOG_DISTANCE:
-        return expf(sum);
+        return expf(sum < VDSH_LOG_SUM_MAX ? sum : VDSH_LOG_SUM_MAX);
     default:
         return sum > 0.0f ? sum : 0.0f;
     }

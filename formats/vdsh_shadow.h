@@ -33,6 +33,12 @@ typedef enum vdsh_compare {
 /* saturate((x - 1/3) * 1.5); NaN gives 0. */
 float vdsh_ramp(float x);
 
+/* A log-distance sum above this reads as exp(VDSH_LOG_SUM_MAX), about
+ * 5.5e34: finite, so that the runtime's interpolation of per-vertex
+ * distances never meets 0 * inf. (No fit comes near it; a damaged or
+ * hand-made stream might.) */
+#define VDSH_LOG_SUM_MAX 80.0f
+
 /* The distance a stream reconstructs toward unit direction d, >= 0:
  * quantity distance: the SH sum; distance2: sqrt of the sum; log-distance:
  * exp of the sum. Negative sums (ringing) give 0. */

@@ -118,7 +118,7 @@ static const char common_glsl[] =
     "#if QUANTITY == 1\n"
     "    return sum > 0.0 ? sqrt(sum) : 0.0;\n"
     "#elif QUANTITY == 2\n"
-    "    return exp(sum);\n"
+    "    return exp(min(sum, 80.0)); /* VDSH_LOG_SUM_MAX: stays finite */\n"
     "#else\n"
     "    return sum > 0.0 ? sum : 0.0;\n"
     "#endif\n"

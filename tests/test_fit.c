@@ -446,12 +446,74 @@ static void test_shadow_fit(void)
         CHECK(e1 < 0.8 * e0, "order %d: shadow fit %g, least squares %g", order, e1, e0);
         for (int i = 0; i < nc; i++)
             CHECK(isfinite(c[i]), "order %d: coefficient %d not finite", order, i);
+        /* From a poor start (the mean only) the steps must not run away:
+         * every direction stays within a factor e^3 of the distances the
+         * fit saw (earlier steps that reused a stale normal matrix
+         * oscillated and diverged). */
+        float cp[25] = {0};
+        cp[0] = logf(5.0f) / 0.2820948f;
+        vb_shadow_fit_apply(&f, order, SHADOW_N, Y, SHADOW_N, lnd, cp);
+        double top = -1e30;
+        for (int k = 0; k < SHADOW_N; k++) {
+            double v = 0.0;
+            for (int i = 0; i < nc; i++)
+                v += (double)cp[i] * Y[i * SHADOW_N + k];
+            top = fmax(top, v);
+        }
+        CHECK(top < log(5.0) + 3.0, "order %d: from a poor start ln D reaches %g", order, top);
         /* too few directions: untouched */
         memcpy(c, c0, sizeof c);
         vb_shadow_fit_apply(&f, order, (uint32_t)nc, Y, SHADOW_N, lnd, c);
         CHECK(memcmp(c, c0, (size_t)nc * sizeof *c) == 0, "order %d: %d directions changed c",
               order, nc);
     }
+}
+
+/* A receiver of the room where the fit once ran away (tests/data): from
+ * its lsq start, the order-2 fit stays within e^3 of the distances it saw
+ * (it went to ln D ~ 17, distances of 10^7, when steps reused a stale
+ * normal matrix). */
+static void test_shadow_fit_regression(void)
+{
+    const char *path = VDSH_TEST_DATA "/shadow-fit-room-vertex-26.txt";
+    FILE *fp = fopen(path, "r");
+    CHECK(fp != NULL, "%s: cannot open", path);
+    if (!fp)
+        return;
+    enum { MAXN = 320 };
+    static float Y[9 * MAXN] __attribute__((aligned(32))), lnd[MAXN] __attribute__((aligned(32)));
+    float c[4], row[10];
+    char line[512];
+    uint32_t n = 0, stride = MAXN;
+    int have_c = 0;
+    while (fgets(line, sizeof line, fp) && n < MAXN) {
+        if (line[0] == '#')
+            continue;
+        if (!have_c) {
+            have_c = sscanf(line, "%f %f %f %f", &c[0], &c[1], &c[2], &c[3]) == 4;
+        } else if (sscanf(line, "%f %f %f %f %f %f %f %f %f %f", &row[0], &row[1], &row[2],
+                          &row[3], &row[4], &row[5], &row[6], &row[7], &row[8], &row[9]) == 10) {
+            lnd[n] = row[0];
+            for (int i = 0; i < 9; i++)
+                Y[i * stride + n] = row[1 + i];
+            n++;
+        }
+    }
+    fclose(fp);
+    CHECK(have_c && n == 307, "%s: %u directions", path, n);
+    static vb_shadow_fit f;
+    vb_error err;
+    CHECK(vb_shadow_fit_init(&f, 1e-4f, &err) == VB_OK, "init");
+    vb_shadow_fit_apply(&f, 2, n, Y, stride, lnd, c);
+    double top = -1e30, seen = -1e30;
+    for (uint32_t k = 0; k < n; k++) {
+        double v = 0.0;
+        for (int i = 0; i < 4; i++)
+            v += (double)c[i] * Y[i * stride + k];
+        top = fmax(top, v);
+        seen = fmax(seen, lnd[k]);
+    }
+    CHECK(top < seen + 3.0, "ln D reaches %g; the largest seen is %g", top, seen);
 }
 
 int main(void)
@@ -464,5 +526,6 @@ int main(void)
     test_errors();
     test_shadow_error();
     test_shadow_fit();
+    test_shadow_fit_regression();
     return test_report("test_fit");
 }

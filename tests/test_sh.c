@@ -225,6 +225,15 @@ static void test_soa_and_prefix(void)
  * cases, and a stream whose reconstruction is known (a constant). */
 static void test_shadow(void)
 {
+    /* A log-distance sum beyond any fit stays finite (VDSH_LOG_SUM_MAX),
+     * so interpolating it with a zero weight is 0, not NaN. */
+    {
+        float big[25] = {1000.0f}, up[3] = {0.0f, 0.0f, 1.0f};
+        float dv = vdsh_stream_distance(5, VDSH_QUANTITY_LOG_DISTANCE, big, up);
+        CHECK(isfinite(dv) && dv > 1e30f, "huge log sum reads as %g", dv);
+        CHECK(0.0f * dv == 0.0f, "0 * its distance is not 0");
+    }
+
     CHECK(vdsh_ramp(1.0f / 3.0f) == 0.0f && vdsh_ramp(1.0f) == 1.0f, "ramp ends");
     CHECK(fabsf(vdsh_ramp(2.0f / 3.0f) - 0.5f) < 1e-6f, "ramp middle");
     CHECK(vdsh_ramp(-5.0f) == 0.0f && vdsh_ramp(7.0f) == 1.0f, "ramp saturates");
