@@ -1816,7 +1816,6 @@ static void test_speed(void)
            "from memory; CRC alone %.2f ms (%.2f GB/s); write %.1f ms\n",
            (double)st.st_size / 1e6, best * 1e3, best_mem * 1e3, t_crc * 1e3,
            (double)n / t_crc / 1e9, t_write * 1e3);
-    CHECK(best < 1.0); /* generous: shared machines, sanitizers */
     free(bytes);
     sample_free(&s);
 }
