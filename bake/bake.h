@@ -78,7 +78,8 @@ typedef struct vb_bake_desc {
     uint32_t method;           /* vdsh_method; 0 = paper */
     uint32_t quantity;         /* vdsh_quantity: distance (0) or log-distance,
                                 * or VB_QUANTITY_AUTO */
-    float lambda;              /* lsq regularisation; 0: 1e-4 */
+    float lambda;              /* lsq and shadow regularisation, every order;
+                                * 0: vb_default_lambda per order */
     float log_floor;           /* log-distance floor; 0: 1% of max_distance */
     uint32_t window;           /* vdsh_window on each order's bands; 0: none */
     uint32_t order_mask;       /* bit n: produce order n; 0: max_order only */
@@ -99,7 +100,8 @@ typedef struct vb_bake_output {
     uint32_t auto_receivers;   /* VB_QUANTITY_AUTO: receivers sampled (else 0) */
     double auto_error[VDSH_MAX_ORDER + 1][2]; /* their expected shadow error
                                 * per order, distance [0] and log [1] */
-    float lambda;              /* lsq regularisation used (0 otherwise) */
+    float lambda[VDSH_MAX_ORDER + 1]; /* per order: lsq or shadow
+                                * regularisation used (0 for other methods) */
     float log_floor;           /* log-distance floor used (0 otherwise) */
     uint32_t window;           /* vdsh_window applied */
     uint32_t vertex_count;
@@ -117,6 +119,13 @@ typedef struct vb_bake_output {
     uint32_t moved_origins;    /* receivers whose origin the repair moved */
     double seconds;            /* wall time of the trace-and-project loop */
 } vb_bake_output;
+
+/* The regularisation weight a method uses at an order unless told
+ * otherwise (vb_bake_desc.lambda), chosen on the validation split
+ * (scripts/select_method, docs/ACCURACY.md): lsq 1e-4 at every order;
+ * shadow 1e-2, 1e-2, 3e-3, 2e-3, 1e-3 at orders 1 to 5 (order 4
+ * interpolated, not measured). 0 for methods without one. */
+float vb_default_lambda(uint32_t method, int order);
 
 vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
                       vb_error *err);

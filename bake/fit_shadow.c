@@ -124,10 +124,9 @@ static void gauss_legendre(int n, double *x, double *w)
     }
 }
 
-vb_result vb_shadow_fit_init(vb_shadow_fit *f, float lambda, vb_error *err)
+vb_result vb_shadow_fit_init(vb_shadow_fit *f, vb_error *err)
 {
     memset(f, 0, sizeof *f);
-    f->lambda = lambda;
     for (int i = 0; i <= VB_SHADOW_TABLE; i++)
         f->e[i] = expected_error(2.0 * i / VB_SHADOW_TABLE);
 
@@ -256,8 +255,8 @@ static inline void dots(const v8 *a, const float *rows, uint32_t stride, int cou
     !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("avx2", "default")))
 #endif
-void vb_shadow_fit_apply(const vb_shadow_fit *f, int order, uint32_t n, const float *y,
-                         uint32_t stride, const float *lnd, float *c)
+void vb_shadow_fit_apply(const vb_shadow_fit *f, int order, float lambda, uint32_t n,
+                         const float *y, uint32_t stride, const float *lnd, float *c)
 {
     /* Each weight width in turn, narrowing: early wide steps keep the fit
      * from locking onto the L1 kink. */
@@ -274,7 +273,7 @@ void vb_shadow_fit_apply(const vb_shadow_fit *f, int order, uint32_t n, const fl
         int l = 0;
         while ((l + 1) * (l + 1) <= i)
             l++;
-        lam[i] = (double)f->lambda * (double)(l * (l + 1)) * (l * (l + 1));
+        lam[i] = (double)lambda * (double)(l * (l + 1)) * (l * (l + 1));
         cd[i] = c[i];
     }
     const double scale = 2.0 * 3.14159265358979323846 / n; /* the hemisphere's 2 pi / n */

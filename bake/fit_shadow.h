@@ -50,7 +50,6 @@ extern "C" {
 #define VB_SHADOW_TERMS 4096 /* non-zero triple products (about 2,900) */
 
 typedef struct vb_shadow_fit {
-    float lambda;                        /* regularisation, as lsq */
     double e[VB_SHADOW_TABLE + 1];       /* e(r), r in [0, 2] */
     /* The normal matrix from moments: for the pair (i, j), j <= i < 25,
      * p = i (i + 1) / 2 + j, G_ij = sum over its terms of value * m_L. */
@@ -60,7 +59,7 @@ typedef struct vb_shadow_fit {
 } vb_shadow_fit;
 
 /* Fill the tables (a few milliseconds). VB_ERR_OUT_OF_MEMORY. */
-vb_result vb_shadow_fit_init(vb_shadow_fit *f, float lambda, vb_error *err);
+vb_result vb_shadow_fit_init(vb_shadow_fit *f, vb_error *err);
 
 /* e(r): the expected shadow error of a direction reconstructed at r times
  * its true distance (r >= 0; flat from 2 on). */
@@ -73,9 +72,10 @@ double vb_shadow_error(const vb_shadow_fit *f, double r);
  * of the true distance, floored as the stream's log floor. stride is a
  * multiple of 8 and at least n; y and lnd are 32-byte aligned and finite
  * up to stride (the entries from n on are ignored). With n < order^2 + 1
- * there is nothing to fit and c is left as it is. */
-void vb_shadow_fit_apply(const vb_shadow_fit *f, int order, uint32_t n, const float *y,
-                         uint32_t stride, const float *lnd, float *c);
+ * there is nothing to fit and c is left as it is. lambda weighs the
+ * regularisation lambda sum (l(l+1))^2 c^2 (vb_default_lambda). */
+void vb_shadow_fit_apply(const vb_shadow_fit *f, int order, float lambda, uint32_t n,
+                         const float *y, uint32_t stride, const float *lnd, float *c);
 
 #ifdef __cplusplus
 }

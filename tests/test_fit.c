@@ -289,7 +289,7 @@ static void test_shadow_error(void)
 {
     static vb_shadow_fit f;
     vb_error err;
-    CHECK(vb_shadow_fit_init(&f, 1e-4f, &err) == VB_OK, "init");
+    CHECK(vb_shadow_fit_init(&f, &err) == VB_OK, "init");
     CHECK(vb_shadow_error(&f, 1.0) < 1e-6, "e(1) = %g", vb_shadow_error(&f, 1.0));
     CHECK(fabs(vb_shadow_error(&f, 2.0) - vb_shadow_error(&f, 7.0)) < 1e-12, "flat from 2");
     double prev = 1.0;
@@ -379,7 +379,7 @@ static void test_shadow_fit(void)
 {
     static vb_shadow_fit f;
     vb_error err;
-    CHECK(vb_shadow_fit_init(&f, 1e-4f, &err) == VB_OK, "init");
+    CHECK(vb_shadow_fit_init(&f, &err) == VB_OK, "init");
     uint64_t seed = 11;
     float x[SHADOW_N], y[SHADOW_N], z[SHADOW_N];
     static float Y[81 * SHADOW_N] __attribute__((aligned(32)));
@@ -398,7 +398,7 @@ static void test_shadow_fit(void)
             lnd[k] = (float)v;
         }
         c[0] = 2.5f; /* a poor start */
-        vb_shadow_fit_apply(&f, order, SHADOW_N, Y, SHADOW_N, lnd, c);
+        vb_shadow_fit_apply(&f, order, 1e-4f, SHADOW_N, Y, SHADOW_N, lnd, c);
         /* The function, not the coefficients: some combinations of
          * order-5 functions are nearly 0 on a hemisphere, and the
          * regularisation rightly leaves them alone. */
@@ -441,7 +441,7 @@ static void test_shadow_fit(void)
                 v += Ginv[i * nc + j] * b[j];
             c[i] = c0[i] = (float)v;
         }
-        vb_shadow_fit_apply(&f, order, SHADOW_N, Y, SHADOW_N, lnd, c);
+        vb_shadow_fit_apply(&f, order, 1e-4f, SHADOW_N, Y, SHADOW_N, lnd, c);
         double e0 = shadow_score(&f, order, Y, lnd, c0), e1 = shadow_score(&f, order, Y, lnd, c);
         CHECK(e1 < 0.8 * e0, "order %d: shadow fit %g, least squares %g", order, e1, e0);
         for (int i = 0; i < nc; i++)
@@ -452,7 +452,7 @@ static void test_shadow_fit(void)
          * oscillated and diverged). */
         float cp[25] = {0};
         cp[0] = logf(5.0f) / 0.2820948f;
-        vb_shadow_fit_apply(&f, order, SHADOW_N, Y, SHADOW_N, lnd, cp);
+        vb_shadow_fit_apply(&f, order, 1e-4f, SHADOW_N, Y, SHADOW_N, lnd, cp);
         double top = -1e30;
         for (int k = 0; k < SHADOW_N; k++) {
             double v = 0.0;
@@ -463,7 +463,7 @@ static void test_shadow_fit(void)
         CHECK(top < log(5.0) + 3.0, "order %d: from a poor start ln D reaches %g", order, top);
         /* too few directions: untouched */
         memcpy(c, c0, sizeof c);
-        vb_shadow_fit_apply(&f, order, (uint32_t)nc, Y, SHADOW_N, lnd, c);
+        vb_shadow_fit_apply(&f, order, 1e-4f, (uint32_t)nc, Y, SHADOW_N, lnd, c);
         CHECK(memcmp(c, c0, (size_t)nc * sizeof *c) == 0, "order %d: %d directions changed c",
               order, nc);
     }
@@ -503,8 +503,8 @@ static void test_shadow_fit_regression(void)
     CHECK(have_c && n == 307, "%s: %u directions", path, n);
     static vb_shadow_fit f;
     vb_error err;
-    CHECK(vb_shadow_fit_init(&f, 1e-4f, &err) == VB_OK, "init");
-    vb_shadow_fit_apply(&f, 2, n, Y, stride, lnd, c);
+    CHECK(vb_shadow_fit_init(&f, &err) == VB_OK, "init");
+    vb_shadow_fit_apply(&f, 2, 1e-4f, n, Y, stride, lnd, c);
     double top = -1e30, seen = -1e30;
     for (uint32_t k = 0; k < n; k++) {
         double v = 0.0;
