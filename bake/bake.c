@@ -500,7 +500,7 @@ typedef struct job {
     /* Method shadow: the lsq fit of ln d refined on every
      * shadow_stride-th traced direction (vb_shadow_fit_apply). */
     uint32_t shadow_stride; /* 0: no refinement */
-    vb_shadow_fit shadow;
+    vb_shadow_fit shadow;  /* its tables; e(r) also scores the quantity choice */
     struct shadow_scratch *scratch; /* one per worker */
     /* The quantity choice (VB_QUANTITY_AUTO): sampled receivers, and per
      * sample, order and quantity (0 distance, 1 log) its estimated error. */
@@ -760,39 +760,6 @@ static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
 
 /* ---- choosing the quantity (VB_QUANTITY_AUTO) --------------------------- */
 
-/* The shadow error vdsh-eval expects (DESIGN.md section 3) in a direction
- * whose true distance is t when the stream reconstructs r t: lights at
- * d_L = 2 u t, u uniform in (0.05, 1], scored |ramp(r / 2u) - ramp(1 / 2u)|.
- * A function of r alone, constant from r = 2 on (the ramp is 1 for every
- * u), tabulated on [0, 2] and interpolated linearly. */
-#define ERR_TABLE 512
-static double err_table[ERR_TABLE + 1];
-
-static void err_table_init(void)
-{
-    enum { U = 512 };
-    for (int i = 0; i <= ERR_TABLE; i++) {
-        double r = 2.0 * i / ERR_TABLE, s = 0.0;
-        for (int k = 0; k < U; k++) {
-            double u = 0.05 + 0.95 * (k + 0.5) / U;
-            s += fabs((double)vdsh_ramp((float)(r / (2.0 * u))) -
-                      (double)vdsh_ramp((float)(1.0 / (2.0 * u))));
-        }
-        err_table[i] = s / U;
-    }
-}
-
-static double expected_error(double r)
-{
-    double x = r * (ERR_TABLE / 2.0);
-    if (!(x < ERR_TABLE))
-        return err_table[ERR_TABLE];
-    if (x < 0.0)
-        x = 0.0;
-    int i = (int)x;
-    return err_table[i] + (x - i) * (err_table[i + 1] - err_table[i]);
-}
-
 #define CHOOSE_RECEIVERS 1024
 #define CHOOSE_STRIDE (1 + 4 + 9 + 16 + 25) /* coefficients of orders 1..5 */
 
@@ -836,7 +803,7 @@ static void score_fits(const job *J, uint32_t count, const vertex_sink *out,
             double sum = 0.0;
             for (uint32_t k = 0; k < count; k++) {
                 double dv = q ? exp(s[k]) : (s[k] > 0.0 ? s[k] : 0.0);
-                sum += expected_error(dv / t[k]);
+                sum += vb_shadow_error(&J->shadow, dv / t[k]); /* what vdsh-eval would score */
             }
             e[o][q] += sum;
         }
@@ -1128,14 +1095,17 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     J->inv_scale = 1.0f / d.scene->scale;
     J->degenerate_dist = 1e-3f * d.scene->diagonal;
     J->horizon = d.method == VDSH_METHOD_PAPER;
+    /* The expected shadow error e(r): the shadow fit's loss, and the
+     * quantity choice's score. */
+    if ((d.method == VDSH_METHOD_SHADOW || d.quantity == VB_QUANTITY_AUTO) &&
+        (r = vb_shadow_fit_init(&J->shadow, err)) != VB_OK)
+        goto done;
     if (d.method == VDSH_METHOD_SHADOW) {
         /* About 300 directions: as good as all of 1225 in the tests of
          * fit_shadow.h, and a quarter of the work. */
         J->shadow_stride = 1;
         while (grid.count / (2 * J->shadow_stride) >= 300)
             J->shadow_stride *= 2;
-        if ((r = vb_shadow_fit_init(&J->shadow, err)) != VB_OK)
-            goto done;
         if (!d.trace_only &&
             !(J->scratch = aligned_alloc(32, d.threads * sizeof *J->scratch))) {
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the shadow fit");
@@ -1156,7 +1126,6 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
          * distances of a sample of receivers with the lower expected
          * shadow error; sums in sample order, so the choice does not
          * depend on the thread count. */
-        err_table_init();
         auto_receivers = J->choose_count =
             R->vertex_count < CHOOSE_RECEIVERS ? R->vertex_count : CHOOSE_RECEIVERS;
         J->choose_error = calloc((size_t)J->choose_count * (VDSH_MAX_ORDER + 1) * 2,
