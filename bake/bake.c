@@ -970,14 +970,8 @@ void vb_bake_output_free(vb_bake_output *out)
 
 float vb_default_lambda(uint32_t method, int order)
 {
-    /* shadow: the validation split's best per order (3, 5 measured; 4
-     * between them; order 1 has no band the penalty weighs). */
-    static const float shadow[VDSH_MAX_ORDER + 1] = {0, 1e-2f, 1e-2f, 3e-3f, 2e-3f, 1e-3f};
-    if (method == VDSH_METHOD_LSQ)
-        return 1e-4f;
-    if (method == VDSH_METHOD_SHADOW && order >= 1 && order <= VDSH_MAX_ORDER)
-        return shadow[order];
-    return 0.0f;
+    (void)order; /* one value serves every order (docs/ACCURACY.md) */
+    return method == VDSH_METHOD_LSQ || method == VDSH_METHOD_SHADOW ? 1e-4f : 0.0f;
 }
 
 vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,

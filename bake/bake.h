@@ -121,10 +121,9 @@ typedef struct vb_bake_output {
 } vb_bake_output;
 
 /* The regularisation weight a method uses at an order unless told
- * otherwise (vb_bake_desc.lambda), chosen on the validation split
- * (scripts/select_method, docs/ACCURACY.md): lsq 1e-4 at every order;
- * shadow 1e-2, 1e-2, 3e-3, 2e-3, 1e-3 at orders 1 to 5 (order 4
- * interpolated, not measured). 0 for methods without one. */
+ * otherwise (vb_bake_desc.lambda): 1e-4 for lsq and shadow at every order,
+ * chosen on the validation split and by looking at the renders
+ * (docs/ACCURACY.md); 0 for methods without one. */
 float vb_default_lambda(uint32_t method, int order);
 
 vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,

@@ -71,34 +71,33 @@ static inline v8 exp2_8(v8 t)
  * lights' u integral of e(r) becomes one over v in [0.5, 10] of
  * |ramp(r v) - ramp(v)| / (1.9 v^2), and its r-derivative the log of the
  * v-interval where ramp(r v) is on its slope (1/3r, 1/r), cut to [0.5, 10]:
- *     eps'(x) = r de/dr = 0.7895 r h(x),  r = e^x,
+ *     e'(x) = r de/dr = 0.7895 r h(x),  r = e^x,
  *     h = ln 2 - x           on [0, ln 2)       (r in [1, 2))
  *       = x - ln 2           on [ln 2/3, 0)
- *       = -ln 3              on [ln 0.1, ln 2/3)
- *       = -(ln 30 + x)       on [-ln 30, ln 0.1)
- *       = 0                  elsewhere (every light lit, or every one dark,
- *                            either way).
+ *       = 0                  from ln 2 on (every light lit either way).
+ * Below r = 2/3 the loss goes on as a straight line in x, with the slope
+ * e'(ln 2/3) = -0.7895 (2/3) ln 3 (fit_shadow.h: e saturates there, and a
+ * fit free to give up the directions it underestimates gave up different
+ * ones at neighbouring receivers: blotches of false shadow on walls).
+ * Beyond r = 2 (lights further off than the evaluator's would still see
+ * the error) a small constant slope VB_SHADOW_TAIL keeps a given-up
+ * direction from drifting by orders of magnitude.
  * x is held at least `width` away from 0 (the L1 kink), and the weight at
  * least 1e-4 (no direction drops out entirely: the normal matrix stays
  * positive definite). */
 static inline v8 irls_weight8(v8 x, float width)
 {
-    const float ln2 = 0.69314718f, ln3 = 1.09861229f, ln30 = 3.40119738f;
+    const float ln2 = 0.69314718f, ln23 = -0.40546511f;
+    const float under = -0.78947368f * 0.66666667f * 1.09861229f; /* e'(ln 2/3) */
     v8 zero = splat(0.0f);
     v8i neg = x < zero;
     v8 ax = max8(select8(neg, -x, x), splat(width));
     v8 sx = select8(neg, -ax, ax);
-    v8 up = max8(ln2 - sx, zero);
-    v8 lo = min8(min8(ln2 - sx, splat(ln3)), max8(ln30 + sx, zero));
-    v8 h = select8(neg, -lo, up);
-    v8 e = exp2_8(max8(sx, splat(-4.0f)) * 1.44269504f);
-    /* Past the ends of the evaluator's lights (r > 2, r < 1/30) a light
-     * further off or nearer than those it draws would still see the error:
-     * a small constant slope there keeps the fit from trading a direction
-     * it gives up on for a distance off by orders of magnitude. */
-    v8 tail = select8(sx > ln2, splat(VB_SHADOW_TAIL), zero) -
-              select8(sx < -ln30, splat(VB_SHADOW_TAIL), zero);
-    return max8((0.78947368f * e * h + tail) / sx, splat(1e-4f));
+    v8 h = select8(neg, sx - ln2, max8(ln2 - sx, zero));
+    v8 e = exp2_8(max8(sx, splat(ln23)) * 1.44269504f);
+    v8 psi = select8(sx < ln23, splat(under), 0.78947368f * e * h) +
+             select8(sx > ln2, splat(VB_SHADOW_TAIL), zero);
+    return max8(psi / sx, splat(1e-4f));
 }
 
 /* Gauss-Legendre nodes and weights on [-1, 1]. */

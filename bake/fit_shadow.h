@@ -9,11 +9,16 @@
  * ratio r = D / d of the reconstructed to the true distance alone: 0 at
  * r = 1, about 0.55 |ln r| near it, flat from r = 2 on (every light is lit
  * either way) and rising to 0.76 as r -> 0. In the log domain,
- * x = c . Y(w) - ln d, the loss is eps(x) = e(exp x): an L1-like error
- * that stops growing where a fit of few coefficients cannot follow the
- * function anyway (a thin occluder, a crease seen at grazing angles).
- * Least squares of ln d gives those directions the largest say; this fit
- * gives them none, and spends the coefficients where the shadows are.
+ * x = c . Y(w) - ln d, the loss is eps(x) = e(exp x) down to r = 2/3 and
+ * from there a straight line in x with e's slope at 2/3: an L1-like
+ * error that stops growing where an overestimate no longer matters (every
+ * light lit either way) but keeps growing with an underestimate. Least
+ * squares of ln d gives the directions a fit of few coefficients cannot
+ * follow the largest say; this fit lets it overestimate them, and spends
+ * the coefficients where the shadows are. (With e itself below 2/3, which
+ * saturates, the fit also gave up directions it underestimated, and
+ * neighbouring receivers gave up different ones: blotches of false shadow
+ * on flat walls at orders 2 and 3, and a higher error on the test scenes.)
  *
  * Solve: iteratively reweighted least squares from the lsq fit, with
  * weights eps'(x) / x (x clamped away from 0 by a width that narrows over
@@ -46,7 +51,7 @@ extern "C" {
 #define VB_SHADOW_STEPS 8      /* IRLS steps: 2 per weight width */
 #define VB_SHADOW_MAX_DIRS 640 /* directions a fit may use (a subset of the traced ones) */
 
-#define VB_SHADOW_TAIL 0.02f   /* loss slope past e's flat ends (see irls_weight8) */
+#define VB_SHADOW_TAIL 0.02f   /* loss slope past e's flat end, r > 2 (see irls_weight8) */
 #define VB_SHADOW_TERMS 4096 /* non-zero triple products (about 2,900) */
 
 typedef struct vb_shadow_fit {
