@@ -61,8 +61,7 @@ static int invert(int n, const double *a, double *inv)
     return 1;
 }
 
-/* Gauss-Legendre nodes and weights on [0, 1]. */
-static void gauss01(int n, double *x, double *w)
+void vb_gauss_legendre(int n, double *x, double *w)
 {
     for (int i = 0; i < n; i++) {
         double z = cos(PI * (i + 0.75) / (n + 0.5)), pp = 1.0;
@@ -79,8 +78,18 @@ static void gauss01(int n, double *x, double *w)
             if (fabs(z - z1) < 1e-15)
                 break;
         }
-        x[i] = 0.5 * (z + 1.0);
-        w[i] = 1.0 / ((1.0 - z * z) * pp * pp); /* 2/(...) halved for [0,1] */
+        x[i] = z;
+        w[i] = 2.0 / ((1.0 - z * z) * pp * pp);
+    }
+}
+
+/* Gauss-Legendre nodes and weights on [0, 1] (halving is exact). */
+static void gauss01(int n, double *x, double *w)
+{
+    vb_gauss_legendre(n, x, w);
+    for (int i = 0; i < n; i++) {
+        x[i] = 0.5 * (x[i] + 1.0);
+        w[i] *= 0.5;
     }
 }
 

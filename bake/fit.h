@@ -61,6 +61,9 @@ typedef struct vb_fit {
     double rot_pinv[5][VB_FIT_ROT_DIRS * 9];
 } vb_fit;
 
+/* Gauss-Legendre nodes and weights on [-1, 1]. */
+void vb_gauss_legendre(int n, double *x, double *w);
+
 /* Prepare the map for (order, method, lambda). The hemisphere Gram matrix
  * is computed by Gauss-Legendre x uniform-azimuth quadrature (exact for
  * these polynomials). */

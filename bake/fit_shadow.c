@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fit.h"
 #include "vdsh_sh.h"
 #include "vdsh_shadow.h"
 
@@ -100,29 +101,6 @@ static inline v8 irls_weight8(v8 x, float width)
     return max8(psi / sx, splat(1e-4f));
 }
 
-/* Gauss-Legendre nodes and weights on [-1, 1]. */
-static void gauss_legendre(int n, double *x, double *w)
-{
-    for (int i = 0; i < n; i++) {
-        double z = cos(3.14159265358979323846 * (i + 0.75) / (n + 0.5)), pp = 1.0;
-        for (int it = 0; it < 100; it++) {
-            double p1 = 1.0, p2 = 0.0;
-            for (int j = 1; j <= n; j++) {
-                double p3 = p2;
-                p2 = p1;
-                p1 = ((2.0 * j - 1.0) * z * p2 - (j - 1.0) * p3) / j;
-            }
-            pp = n * (z * p1 - p2) / (z * z - 1.0);
-            double z1 = z;
-            z = z1 - p1 / pp;
-            if (fabs(z - z1) < 1e-15)
-                break;
-        }
-        x[i] = z;
-        w[i] = 2.0 / ((1.0 - z * z) * pp * pp);
-    }
-}
-
 vb_result vb_shadow_fit_init(vb_shadow_fit *f, vb_error *err)
 {
     memset(f, 0, sizeof *f);
@@ -141,7 +119,7 @@ vb_result vb_shadow_fit_init(vb_shadow_fit *f, vb_error *err)
     float *q = malloc(sizeof(float) * NL * NQ);
     if (!q)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the shadow fit");
-    gauss_legendre(NZ, gz, gw);
+    vb_gauss_legendre(NZ, gz, gw);
     for (int a = 0; a < NZ; a++)
         for (int b = 0; b < NP; b++) {
             double r = sqrt(1.0 - gz[a] * gz[a]);
