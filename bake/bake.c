@@ -490,7 +490,6 @@ typedef struct job {
     float *coeffs[VDSH_MAX_ORDER + 1];
     uint32_t quantity[VDSH_MAX_ORDER + 1]; /* per order: what coeffs hold */
     vb_fit fits[VDSH_MAX_ORDER + 1];
-    float lambda[VDSH_MAX_ORDER + 1]; /* per order: lsq and shadow regularisation */
     int order;             /* the projection's order (the highest asked) */
     float log_floor;
     float max_local;       /* max distance in the traced frame */
@@ -731,7 +730,7 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
         vdsh_sh_eval_soa(2 * J->order - 1, stride, sub->x, sub->yy, sub->z, sub->y, stride);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (out->coeffs[1][o])
-                vb_shadow_fit_apply(&J->shadow, o, J->lambda[o], sub_n, sub->y, stride,
+                vb_shadow_fit_apply(&J->shadow, o, J->d->lambda, sub_n, sub->y, stride,
                                     sub->lnd, out->coeffs[1][o]);
     }
     if (upper > 0 && near_zero >= 0.9 * upper)
@@ -914,7 +913,7 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
     int nc = order * order;
     size_t count = (size_t)b->vertex_count * nc;
     vdsh_stream s = {.order = (uint32_t)order, .encoding = encoding, .method = b->method,
-                     .quantity = b->quantity[order], .method_param = b->lambda[order], .scale = 1.0f,
+                     .quantity = b->quantity[order], .method_param = b->lambda, .scale = 1.0f,
                      .quantity_param = b->quantity[order] == VDSH_QUANTITY_LOG_DISTANCE
                                            ? b->log_floor : 0.0f, .window = b->window,
                      .window_param = b->window ? (float)order : 0.0f};
@@ -968,12 +967,6 @@ void vb_bake_output_free(vb_bake_output *out)
     memset(out, 0, sizeof *out);
 }
 
-float vb_default_lambda(uint32_t method, int order)
-{
-    (void)order; /* one value serves every order (docs/ACCURACY.md) */
-    return method == VDSH_METHOD_LSQ || method == VDSH_METHOD_SHADOW ? 1e-4f : 0.0f;
-}
-
 vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
                       vb_error *err)
 {
@@ -1018,7 +1011,9 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         return vb_fail(err, VB_ERR_ARGUMENT,
                        "method paper fills the lower hemisphere with 0, which has no "
                        "meaning for log-distance: use mirror, lsq or full");
-    if (d.lambda != 0.0f && !(d.lambda > 0.0f && isfinite(d.lambda)))
+    if (d.lambda == 0.0f)
+        d.lambda = 1e-4f; /* lsq and shadow: chosen on the validation split (docs/ACCURACY.md) */
+    if (!(d.lambda > 0.0f) || !isfinite(d.lambda))
         return vb_fail(err, VB_ERR_ARGUMENT, "the regularisation must be a positive number");
     if (d.max_distance == 0.0f)
         d.max_distance = d.scene->diagonal;
@@ -1069,8 +1064,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             continue;
         /* shadow starts from the lsq fit */
         uint32_t fm = d.method == VDSH_METHOD_SHADOW ? VDSH_METHOD_LSQ : d.method;
-        J->lambda[o] = d.lambda != 0.0f ? d.lambda : vb_default_lambda(d.method, o);
-        if ((r = vb_fit_create(o, fm, J->lambda[o], &J->fits[o], err)) != VB_OK)
+        if ((r = vb_fit_create(o, fm, d.lambda, &J->fits[o], err)) != VB_OK)
             goto done;
         vb_fit_window(&J->fits[o], d.window);
     }
@@ -1177,9 +1171,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     }
     o.auto_receivers = auto_receivers;
     memcpy(o.auto_error, auto_error, sizeof auto_error);
-    if (d.method == VDSH_METHOD_LSQ || d.method == VDSH_METHOD_SHADOW)
-        for (int k = 1; k <= VDSH_MAX_ORDER; k++)
-            o.lambda[k] = coeffs[k] ? J->lambda[k] : 0.0f;
+    o.lambda = d.method == VDSH_METHOD_LSQ || d.method == VDSH_METHOD_SHADOW ? d.lambda : 0.0f;
     o.log_floor = any_log ? d.log_floor : 0.0f;
     o.window = d.window;
     o.vertex_count = R->vertex_count;

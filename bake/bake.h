@@ -78,8 +78,7 @@ typedef struct vb_bake_desc {
     uint32_t method;           /* vdsh_method; 0 = paper */
     uint32_t quantity;         /* vdsh_quantity: distance (0) or log-distance,
                                 * or VB_QUANTITY_AUTO */
-    float lambda;              /* lsq and shadow regularisation, every order;
-                                * 0: vb_default_lambda per order */
+    float lambda;              /* lsq and shadow regularisation; 0: 1e-4 */
     float log_floor;           /* log-distance floor; 0: 1% of max_distance */
     uint32_t window;           /* vdsh_window on each order's bands; 0: none */
     uint32_t order_mask;       /* bit n: produce order n; 0: max_order only */
@@ -100,8 +99,7 @@ typedef struct vb_bake_output {
     uint32_t auto_receivers;   /* VB_QUANTITY_AUTO: receivers sampled (else 0) */
     double auto_error[VDSH_MAX_ORDER + 1][2]; /* their expected shadow error
                                 * per order, distance [0] and log [1] */
-    float lambda[VDSH_MAX_ORDER + 1]; /* per order: lsq or shadow
-                                * regularisation used (0 for other methods) */
+    float lambda;              /* lsq or shadow regularisation used (0 otherwise) */
     float log_floor;           /* log-distance floor used (0 otherwise) */
     uint32_t window;           /* vdsh_window applied */
     uint32_t vertex_count;
@@ -119,12 +117,6 @@ typedef struct vb_bake_output {
     uint32_t moved_origins;    /* receivers whose origin the repair moved */
     double seconds;            /* wall time of the trace-and-project loop */
 } vb_bake_output;
-
-/* The regularisation weight a method uses at an order unless told
- * otherwise (vb_bake_desc.lambda): 1e-4 for lsq and shadow at every order,
- * chosen on the validation split and by looking at the renders
- * (docs/ACCURACY.md); 0 for methods without one. */
-float vb_default_lambda(uint32_t method, int order);
 
 vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
                       vb_error *err);

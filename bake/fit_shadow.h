@@ -78,7 +78,7 @@ double vb_shadow_error(const vb_shadow_fit *f, double r);
  * multiple of 8 and at least n; y and lnd are 32-byte aligned and finite
  * up to stride (the entries from n on are ignored). With n < order^2 + 1
  * there is nothing to fit and c is left as it is. lambda weighs the
- * regularisation lambda sum (l(l+1))^2 c^2 (vb_default_lambda). */
+ * regularisation lambda sum (l(l+1))^2 c^2 (as lsq's). */
 void vb_shadow_fit_apply(const vb_shadow_fit *f, int order, float lambda, uint32_t n,
                          const float *y, uint32_t stride, const float *lnd, float *c);
 
