@@ -8,6 +8,7 @@
 
 #include "fit.h"
 #include "fit_shadow.h"
+#include "origins.h"
 #include "parallel.h"
 #include "sampling.h"
 #include "vdsh.h"
@@ -25,468 +26,13 @@ double vb_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* ---- ray-offset normals ------------------------------------------------ */
-
-typedef struct pos_key {
-    float p[3];
-    uint32_t index;
-} pos_key;
-
-static int cmp_pos(const void *a, const void *b)
-{
-    const pos_key *x = a, *y = b;
-    int c = memcmp(x->p, y->p, sizeof x->p);
-    if (c)
-        return c;
-    return (x->index > y->index) - (x->index < y->index);
-}
-
-vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err)
-{
-    uint32_t n = m->vertex_count;
-    pos_key *key = malloc((size_t)n * sizeof *key + 1);
-    if (!key)
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-    for (uint32_t i = 0; i < n; i++) {
-        for (int c = 0; c < 3; c++) /* + 0.0f folds -0 into +0 */
-            key[i].p[c] = m->positions[3 * (size_t)i + c] + 0.0f;
-        key[i].index = i;
-    }
-    /* Sorting by the position's bytes groups bit-identical positions; ties
-     * are ordered by index, so each group's sum runs in a fixed order. */
-    qsort(key, n, sizeof *key, cmp_pos);
-
-    for (uint32_t a = 0; a < n;) {
-        uint32_t b = a + 1;
-        while (b < n && memcmp(key[a].p, key[b].p, sizeof key[a].p) == 0)
-            b++;
-        /* Each vertex of the group sums the normals that face its own side
-         * (n_u . n_v >= 0, itself included): an unwelded room corner
-         * (floor and walls at right angles) gets one diagonal normal for
-         * all its vertices, while a floor vertex under the corner of a
-         * crate does not average in the crate's bottom, which faces the
-         * other way. Sums run in group (index) order. */
-        for (uint32_t k = a; k < b; k++) {
-            const float *nk = m->normals + 3 * (size_t)key[k].index;
-            double s[3] = {0, 0, 0};
-            for (uint32_t j = a; j < b; j++) {
-                const float *nj = m->normals + 3 * (size_t)key[j].index;
-                if (nj[0] * nk[0] + nj[1] * nk[1] + nj[2] * nk[2] < 0.0f)
-                    continue;
-                for (int c = 0; c < 3; c++)
-                    s[c] += nj[c];
-            }
-            double len = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-            for (int c = 0; c < 3; c++)
-                out[3 * (size_t)key[k].index + c] = len > 1e-12 ? (float)(s[c] / len) : 0.0f;
-        }
-        a = b;
-    }
-    free(key);
-    return VB_OK;
-}
-
-/* ---- ray origins: the standard rule, then the repair of receivers
- * that the standard origin leaves inside or behind other geometry ---- */
-
-/* The probes: 16 directions above a receiver's horizon and their mirror
- * images below, on a staggered 4 x 4 grid in its normal's frame. */
-#define PROBES 16
-#define PROBE_UP_LIMIT 14   /* ~90% of the upper probes at ~0: squeezed or embedded */
-#define PROBE_BACK_LIMIT 8  /* a quarter of all probes on a back face at ~0: behind a surface */
-
-typedef struct prober {
-    const vb_scene *s;
-    float near;                       /* ~0 distance, traced frame */
-    float local_dir[PROBES][3];
-} prober;
-
-static void prober_init(prober *P, const vb_scene *s)
-{
-    P->s = s;
-    P->near = 1e-3f * s->diagonal * s->scale;
-    for (int i = 0; i < 4; i++)
-        for (int j = 0; j < 4; j++) {
-            double z = 1.0 - (i + 0.5) / 4.0, rr = sqrt(1.0 - z * z);
-            double phi = 2.0 * VB_PI * (j + 0.5 + 0.25 * i) / 4.0;
-            float *l = P->local_dir[4 * i + j];
-            l[0] = (float)(rr * cos(phi)), l[1] = (float)(rr * sin(phi)), l[2] = (float)z;
-        }
-}
-
-/* What the origin rules need to know about each receiver: the normal
- * averaged over every receiver at its position, the inset vector into its
- * own triangles, and the triangles around it. */
-typedef struct frames {
-    float *navg;                /* 3 per vertex */
-    float *inset;               /* 3 per vertex */
-    uint32_t *adj_start, *adj;  /* vertex -> its triangles, in triangle order */
-} frames;
-
-static void frames_free(frames *f)
-{
-    free(f->navg);
-    free(f->inset);
-    free(f->adj_start);
-    free(f->adj);
-    memset(f, 0, sizeof *f);
-}
-
-static vb_result frames_create(const vb_mesh *m, frames *f, vb_error *err)
-{
-    uint32_t n = m->vertex_count;
-    memset(f, 0, sizeof *f);
-    f->navg = malloc((size_t)n * 3 * sizeof *f->navg + 1);
-    f->inset = calloc((size_t)n * 3 + 1, sizeof *f->inset);
-    f->adj_start = calloc((size_t)n + 1, sizeof *f->adj_start);
-    f->adj = malloc((size_t)m->triangle_count * 3 * sizeof *f->adj + 1);
-    double *acc = calloc((size_t)n * 4 + 1, sizeof *acc); /* x, y, z, weight */
-    uint32_t *fill = malloc((size_t)n * sizeof *fill + 1);
-    vb_result r = VB_OK;
-    if (!f->navg || !f->inset || !f->adj_start || !f->adj || !acc || !fill) {
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for ray origins");
-        goto done;
-    }
-    r = vb_offset_normals(m, f->navg, err);
-    if (r != VB_OK)
-        goto done;
-    /* Inset: the mean direction from a vertex to the centroids of its own
-     * triangles, weighted by their distance, in the tangent plane.
-     * Interior vertices' pulls cancel (length ~0); a vertex on a boundary
-     * or crease gets a vector of length up to 1 into its own surface. */
-    for (uint32_t t = 0; t < m->triangle_count; t++) {
-        const uint32_t *ix = m->indices + 3 * (size_t)t;
-        double c[3] = {0, 0, 0};
-        for (int k = 0; k < 3; k++)
-            for (int i = 0; i < 3; i++)
-                c[i] += m->positions[3 * (size_t)ix[k] + i] / 3.0;
-        for (int k = 0; k < 3; k++) {
-            const float *p = m->positions + 3 * (size_t)ix[k];
-            double d[3] = {c[0] - p[0], c[1] - p[1], c[2] - p[2]};
-            double *a = acc + 4 * (size_t)ix[k];
-            for (int i = 0; i < 3; i++)
-                a[i] += d[i];
-            a[3] += sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-            f->adj_start[ix[k] + 1]++;
-        }
-    }
-    for (uint32_t v = 0; v < n; v++) {
-        const float *nv = f->navg + 3 * (size_t)v;
-        const double *a = acc + 4 * (size_t)v;
-        if (a[3] > 0.0) {
-            double dot = a[0] * nv[0] + a[1] * nv[1] + a[2] * nv[2];
-            for (int i = 0; i < 3; i++)
-                f->inset[3 * (size_t)v + i] = (float)((a[i] - dot * nv[i]) / a[3]);
-        }
-        f->adj_start[v + 1] += f->adj_start[v];
-    }
-    memcpy(fill, f->adj_start, (size_t)n * sizeof *fill);
-    for (uint32_t t = 0; t < m->triangle_count; t++)
-        for (int k = 0; k < 3; k++)
-            f->adj[fill[m->indices[3 * (size_t)t + k]]++] = t;
-done:
-    free(acc);
-    free(fill);
-    if (r != VB_OK)
-        frames_free(f);
-    return r;
-}
-
-/* The standard origin of receiver v on side `sign` of its surface (+1:
- * the side its normal points to), in the traced frame: offset along the
- * averaged normal, then along the inset. */
-static void standard_origin(const vb_scene *s, const vb_mesh *m, const frames *f, uint32_t v,
-                            float sign, float out[3])
-{
-    const float *nv = f->navg + 3 * (size_t)v;
-    float p[3], o[3], ns[3] = {sign * nv[0], sign * nv[1], sign * nv[2]};
-    vb_scene_to_local(s, m->positions + 3 * (size_t)v, p);
-    vb_offset_origin(p, ns, o);
-    vb_offset_origin(o, f->inset + 3 * (size_t)v, out);
-}
-
-/* Probe from o (traced frame) around unit normal n with 16 rays above the
- * horizon and, if `both`, their mirror images below, each `length` long:
- * how many of the upper ones hit anything, how many hit a back face, and
- * how many of the lower ones hit a back face (0 without `both`). */
-static void probe_len(const prober *J, const float o[3], const float n[3], float length,
-                      int both, int *up_hit, int *up_back, int *low_back)
-{
-    float t[3], b[3];
-    vb_frame(n, t, b);
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    int hits = 0, backs[2] = {0, 0};
-    for (int side = 0; side < 1 + (both != 0); side++) {
-        struct RTCRayHit16 rh __attribute__((aligned(64)));
-        int valid[16] __attribute__((aligned(64)));
-        float sz = side ? -1.0f : 1.0f;
-        for (int k = 0; k < PROBES; k++) {
-            const float *l = J->local_dir[k];
-            rh.ray.dir_x[k] = l[0] * t[0] + l[1] * b[0] + sz * l[2] * n[0];
-            rh.ray.dir_y[k] = l[0] * t[1] + l[1] * b[1] + sz * l[2] * n[1];
-            rh.ray.dir_z[k] = l[0] * t[2] + l[1] * b[2] + sz * l[2] * n[2];
-            rh.ray.org_x[k] = o[0], rh.ray.org_y[k] = o[1], rh.ray.org_z[k] = o[2];
-            rh.ray.tnear[k] = 0.0f, rh.ray.tfar[k] = length, rh.ray.time[k] = 0.0f;
-            rh.ray.mask[k] = 0xffffffffu, rh.ray.id[k] = (unsigned)k, rh.ray.flags[k] = 0;
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-            valid[k] = -1;
-        }
-        rtcIntersect16(valid, J->s->scene, &ctx, &rh);
-        for (int k = 0; k < PROBES; k++) {
-            int hit = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
-            float facing = rh.hit.Ng_x[k] * rh.ray.dir_x[k] + rh.hit.Ng_y[k] * rh.ray.dir_y[k] +
-                           rh.hit.Ng_z[k] * rh.ray.dir_z[k];
-            hits += !side && hit;
-            backs[side] += hit && facing > 0.0f;
-        }
-    }
-    *up_hit = hits;
-    *up_back = backs[0];
-    *low_back = backs[1];
-}
-
-/* The short probe: upper hits at ~0; back faces at ~0 in all 32 probes. */
-static void probe(const prober *J, const float o[3], const float n[3], int *up_zero,
-                  int *back)
-{
-    int up_back, low_back;
-    probe_len(J, o, n, J->near, 1, up_zero, &up_back, &low_back);
-    *back = up_back + low_back;
-}
-
-/* How bad an origin that is not in free space is, worst first: looking
- * into the void (full-length upper probes that hit nothing: an origin
- * pushed through the floor it rests on sees only the outside of the room,
- * and would store the clamp distance where the truth is ~0); on the back
- * of a surface; squeezed (upper probes blocked at ~0). */
-typedef struct badness {
-    int back, escape, up;
-} badness;
-
-static badness assess(const prober *J, const float o[3], const float n[3])
-{
-    badness b;
-    int hits, up_back, low_back;
-    probe(J, o, n, &b.up, &b.back);
-    probe_len(J, o, n, 1e30f, 0, &hits, &up_back, &low_back);
-    b.escape = PROBES - hits;
-    return b;
-}
-
-static int worse(badness a, badness b)
-{
-    if (a.escape != b.escape)
-        return a.escape > b.escape;
-    if (a.back != b.back)
-        return a.back > b.back;
-    return a.up > b.up;
-}
-
-typedef struct origin_job {
-    const vb_mesh *m;
-    const frames *F;
-    float *out;
-    prober P;
-    _Atomic uint32_t moved;
-} origin_job;
-
-static int acceptable(int up, int back)
-{
-    return up < PROBE_UP_LIMIT && back < PROBE_BACK_LIMIT;
-}
-
-static void repair_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
-{
-    origin_job *J = ctx;
-    (void)worker;
-    const vb_mesh *m = J->m;
-    const frames *F = J->F;
-    /* Steps toward the centroids of its own triangles, nearest first; up
-     * to 95% of the way, since a fan mostly buried in other geometry may
-     * show only near its far edge. */
-    static const float steps[6] = {0.05f, 0.15f, 0.35f, 0.6f, 0.8f, 0.95f};
-    for (uint32_t v = begin; v < end; v++) {
-        const float *n = m->normals + 3 * (size_t)v;
-        if (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f)
-            continue;
-        float *o = J->out + 3 * (size_t)v;
-        int up, back;
-        probe(&J->P, o, n, &up, &back);
-        if (acceptable(up, back))
-            continue;
-        const float *p = m->positions + 3 * (size_t)v;
-        float best[3] = {o[0], o[1], o[2]}, cand[3];
-        badness bb = assess(&J->P, o, n), c;
-        int found = 0;
-        for (int st = 0; st < 6 && !found; st++)
-            for (uint32_t a = F->adj_start[v]; a < F->adj_start[v + 1] && !found; a++) {
-                const uint32_t *ix = m->indices + 3 * (size_t)F->adj[a];
-                float q[3], ql[3];
-                for (int i = 0; i < 3; i++) {
-                    double ctr = ((double)m->positions[3 * (size_t)ix[0] + i] +
-                                  m->positions[3 * (size_t)ix[1] + i] +
-                                  m->positions[3 * (size_t)ix[2] + i]) / 3.0;
-                    q[i] = (float)(p[i] + steps[st] * (ctr - p[i]));
-                }
-                vb_scene_to_local(J->P.s, q, ql);
-                vb_offset_origin(ql, F->navg + 3 * (size_t)v, cand);
-                c = assess(&J->P, cand, n);
-                found = acceptable(c.up, c.back); /* in free space: take it */
-                if (found || worse(bb, c)) {
-                    memcpy(best, cand, sizeof best);
-                    bb = c;
-                }
-            }
-        /* Pressed flat against a surface it faces (a box's bottom on the
-         * floor): no point of its own surface is free, and the true
-         * distances are ~0. The origin just behind its own surface gives
-         * exactly that, instead of one pushed through the other surface. */
-        if (!found) {
-            standard_origin(J->P.s, m, F, v, -1.0f, cand);
-            c = assess(&J->P, cand, n);
-            if (worse(bb, c))
-                memcpy(best, cand, sizeof best);
-        }
-        if (memcmp(best, o, sizeof best) != 0) {
-            memcpy(o, best, sizeof best);
-            atomic_fetch_add(&J->moved, 1);
-        }
-    }
-}
-
-typedef struct orient_job {
-    vb_mesh *m;
-    const frames *F;
-    prober P;
-    uint8_t *flip;
-} orient_job;
-
-/* Whether at least PROBE_UP_LIMIT of the 16 full-length upper probes from o
- * around unit normal n hit faces turned away from the ray (back = 1) or
- * toward it (back = 0); rays that escape count as neither. One ray at a
- * time, stopping as soon as the answer is known: almost every receiver
- * has its answer (no) after 3 probes, and the probes point too far apart
- * for a 16-wide packet to share any work. */
-static int mostly_facing(const prober *J, const float o[3], const float n[3], int back)
-{
-    float t[3], b[3];
-    vb_frame(n, t, b);
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    int yes = 0, no = 0;
-    for (int k = 0; k < PROBES && yes < PROBE_UP_LIMIT && no <= PROBES - PROBE_UP_LIMIT; k++) {
-        const float *l = J->local_dir[k];
-        struct RTCRayHit rh;
-        rh.ray.dir_x = l[0] * t[0] + l[1] * b[0] + l[2] * n[0];
-        rh.ray.dir_y = l[0] * t[1] + l[1] * b[1] + l[2] * n[1];
-        rh.ray.dir_z = l[0] * t[2] + l[1] * b[2] + l[2] * n[2];
-        rh.ray.org_x = o[0], rh.ray.org_y = o[1], rh.ray.org_z = o[2];
-        rh.ray.tnear = 0.0f, rh.ray.tfar = 1e30f, rh.ray.time = 0.0f;
-        rh.ray.mask = 0xffffffffu, rh.ray.id = (unsigned)k, rh.ray.flags = 0;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(J->s->scene, &ctx, &rh);
-        int hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-        float facing = rh.hit.Ng_x * rh.ray.dir_x + rh.hit.Ng_y * rh.ray.dir_y +
-                       rh.hit.Ng_z * rh.ray.dir_z;
-        if (hit && (facing > 0.0f) == (back != 0))
-            yes++;
-        else
-            no++;
-    }
-    return yes >= PROBE_UP_LIMIT;
-}
-
-static void orient_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
-{
-    orient_job *J = ctx;
-    (void)worker;
-    for (uint32_t v = begin; v < end; v++) {
-        const float *n = J->m->normals + 3 * (size_t)v;
-        if (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f)
-            continue;
-        /* Full-length probes from the standard origins on both sides:
-         * toward +n mostly the backs of faces (inside a solid); toward -n
-         * mostly the fronts of faces (a scene seen from the outside).
-         * Escaping rays do not count as seen: a floor covered by a crate
-         * resting on it has a solid above it and the void outside the room
-         * below, and its normal is right. */
-        float o[3], m[3] = {-n[0], -n[1], -n[2]};
-        standard_origin(J->P.s, J->m, J->F, v, 1.0f, o);
-        if (!mostly_facing(&J->P, o, n, 1))
-            continue;
-        standard_origin(J->P.s, J->m, J->F, v, -1.0f, o);
-        J->flip[v] = (uint8_t)mostly_facing(&J->P, o, m, 0);
-    }
-}
-
-vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
-                              uint32_t *flipped, vb_error *err)
-{
-    frames F;
-    vb_result r = frames_create(m, &F, err);
-    if (r != VB_OK)
-        return r;
-    orient_job J = {.m = m, .F = &F};
-    J.flip = calloc((size_t)m->vertex_count + 1, 1);
-    if (!J.flip) {
-        frames_free(&F);
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for receiver normals");
-    }
-    prober_init(&J.P, s);
-    if (vb_parallel_for(threads, m->vertex_count, 256, orient_block, &J, NULL, NULL) == 0)
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
-    uint32_t count = 0;
-    for (uint32_t v = 0; v < m->vertex_count && r == VB_OK; v++)
-        if (J.flip[v]) {
-            for (int i = 0; i < 3; i++)
-                m->normals[3 * (size_t)v + i] = -m->normals[3 * (size_t)v + i];
-            count++;
-        }
-    free(J.flip);
-    frames_free(&F);
-    if (r == VB_OK && flipped)
-        *flipped = count;
-    return r;
-}
-
-vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads,
-                         float *out, uint32_t *moved, vb_error *err)
-{
-    frames F;
-    vb_result r = frames_create(m, &F, err);
-    if (r != VB_OK)
-        return r;
-    /* 1. The standard rule. */
-    for (uint32_t v = 0; v < m->vertex_count; v++)
-        standard_origin(s, m, &F, v, 1.0f, out + 3 * (size_t)v);
-    /* 2. Repair: probe every receiver, move those left inside or behind
-     * other geometry. */
-    origin_job *J = calloc(1, sizeof *J);
-    if (!J) {
-        frames_free(&F);
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for ray origins");
-    }
-    J->m = m, J->F = &F, J->out = out;
-    prober_init(&J->P, s);
-    if (vb_parallel_for(threads, m->vertex_count, 256, repair_block, J, NULL, NULL) == 0)
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
-    else if (moved)
-        *moved = atomic_load(&J->moved);
-    free(J);
-    frames_free(&F);
-    return r;
-}
-
 /* ---- the trace-and-project loop ----------------------------------------- */
 
 typedef struct job {
     const vb_bake_desc *d;
     const vb_dirgrid *grid;
     const float *origins;  /* per receiver, traced frame */
+    const float *near;     /* per receiver: ~0 distance, scene units */
     float *coeffs[VDSH_MAX_ORDER + 1];
     uint32_t quantity[VDSH_MAX_ORDER + 1]; /* per order: what coeffs hold */
     vb_fit fits[VDSH_MAX_ORDER + 1];
@@ -494,7 +40,6 @@ typedef struct job {
     float log_floor;
     float max_local;       /* max distance in the traced frame */
     float inv_scale;
-    float degenerate_dist; /* scene units */
     int horizon;           /* paper: skip w.n < 0 */
     /* Method shadow: the lsq fit of ln d refined on every
      * shadow_stride-th traced direction (vb_shadow_fit_apply). */
@@ -574,7 +119,7 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
             want[q] |= out->coeffs[q][o] != NULL;
     /* Loop invariants in locals: the lane loops below vectorise. */
     const float inv_scale = J->inv_scale, max_distance = d->max_distance;
-    const float degenerate_dist = J->degenerate_dist, log_floor = J->log_floor;
+    const float degenerate_dist = J->near[v], log_floor = J->log_floor;
     const float nx = n[0], ny = n[1], nz = n[2];
     float acc[2][VDSH_MAX_COEFFS][VB_PACKET];
     memset(acc, 0, sizeof acc);
@@ -1048,13 +593,14 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     if (r != VB_OK)
         return r;
     float *origins = malloc((size_t)R->vertex_count * 3 * sizeof *origins);
+    float *near = malloc((size_t)R->vertex_count * sizeof *near + 1);
     float *coeffs[VDSH_MAX_ORDER + 1] = {0};
     int missing = 0;
     for (int o = 1; o <= VDSH_MAX_ORDER && !d.trace_only; o++)
         if (d.order_mask & (1u << o))
             missing |= !(coeffs[o] = malloc((size_t)R->vertex_count * o * o * sizeof(float)));
     job *J = calloc(1, sizeof *J);
-    if (!origins || missing || !J) {
+    if (!origins || !near || missing || !J) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
                     R->vertex_count);
         goto done;
@@ -1068,20 +614,20 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             goto done;
         vb_fit_window(&J->fits[o], d.window);
     }
-    uint32_t moved = 0;
-    r = vb_ray_origins(R, d.scene, d.threads, origins, &moved, err);
+    vb_origins_stats ost = {0};
+    r = vb_ray_origins(R, d.scene, d.threads, origins, near, &ost, err);
     if (r != VB_OK)
         goto done;
 
     J->d = &d;
     J->grid = &grid;
     J->origins = origins;
+    J->near = near;
     memcpy(J->coeffs, coeffs, sizeof coeffs);
     J->order = d.max_order;
     J->log_floor = d.log_floor;
     J->max_local = d.max_distance * d.scene->scale;
     J->inv_scale = 1.0f / d.scene->scale;
-    J->degenerate_dist = 1e-3f * d.scene->diagonal;
     J->horizon = d.method == VDSH_METHOD_PAPER;
     /* The expected shadow error e(r): the shadow fit's loss, and the
      * quantity choice's score. */
@@ -1185,7 +731,8 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     o.rays_missed = atomic_load(&J->missed);
     o.degenerate_receivers = atomic_load(&J->degenerate);
     o.undefined_normals = undefined;
-    o.moved_origins = moved;
+    o.moved_origins = ost.moved;
+    o.origins = ost;
     o.seconds = vb_now() - t0;
     *out = o;
     r = VB_OK;
@@ -1201,6 +748,7 @@ done:
     for (int k = 0; k <= VDSH_MAX_ORDER; k++)
         free(coeffs[k]);
     free(origins);
+    free(near);
     vb_dirgrid_destroy(&grid);
     return r;
 }

@@ -31,17 +31,10 @@
  * to walls; distance on open objects, where most rays escape to the clamp
  * distance. With paper, auto means distance.
  *
- * Ray origins (vb_ray_origins): the receiver position in the scene's
- * normalised frame (scene.h), offset twice with vb_offset_origin: along
- * the normal averaged over the receiver vertices at the same position that
- * face the same side (vb_offset_normals), then
- * along the inset vector into the vertex's own triangles. The first keeps
- * the unwelded corners of a closed room from leaking rays between their
- * faces' planes; the second lifts vertices on a boundary off any other
- * surface whose plane they lie in (a floor's edge on the wall it meets, a
- * pillar's foot on the floor): without it, half of such a vertex's rays
- * start on the wall's plane and escape the room. Rays that hit nothing
- * within max_distance get max_distance.
+ * Ray origins: origins.h (the rule, the repair of receivers left inside or
+ * behind other geometry, and each receiver's near distance, below which a
+ * traced distance counts as ~0 for the degenerate count). Rays that hit
+ * nothing within max_distance get max_distance.
  *
  * Determinism: a receiver's coefficients depend only on (seed, vertex
  * index, its position/normal, the scene): every per-vertex sum runs in a
@@ -59,6 +52,7 @@
 #include <stdint.h>
 
 #include "mesh.h"
+#include "origins.h"
 #include "scene.h"
 #include "vb.h"
 #include "vdsh.h"
@@ -115,7 +109,9 @@ typedef struct vb_bake_output {
     uint32_t degenerate_receivers;
     uint32_t undefined_normals;
     uint32_t moved_origins;    /* receivers whose origin the repair moved */
-    double seconds;            /* wall time of the trace-and-project loop */
+    vb_origins_stats origins;  /* the ray origins' repair: what it did and cost */
+    double seconds;            /* wall time of the trace-and-project loop
+                                * (the origins' time is origins.seconds) */
 } vb_bake_output;
 
 vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
@@ -129,40 +125,6 @@ void vb_bake_output_free(vb_bake_output *out);
  * the caller frees it. */
 vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
                          vdsh_stream *out, void **storage, vb_error *err);
-
-/* The ray-offset normals: for every receiver vertex, the normalised sum of
- * the normals of the receiver vertices at its bit-identical position that
- * face its own side (n_u . n_v >= 0; its own included). out has
- * 3 * vertex_count floats. */
-vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err);
-
-/* Ray origins in the scene's traced frame for every receiver (3 floats
- * each), by the rule above; then the repair. Every receiver is probed with
- * 16 short rays above its horizon and 16 below. One left inside or
- * squeezed against other geometry (~90% of the upper probes at ~0
- * distance), or pushed through a surface it touches (half the lower
- * probes on the back of a surface at ~0: the foot of a ball resting on a
- * floor, offset along its downward normal) has its origin moved along its
- * own triangles toward their centroids, 5% to 60% of the way, nearest
- * first, to the first point that passes both tests (else the least bad):
- * the nearest visible part of its own surface. `moved` (may be NULL)
- * receives how many moved. Deterministic; `threads` as vb_parallel_for. */
-vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads,
-                         float *out, uint32_t *moved, vb_error *err);
-
-/* Face receivers toward free space: a receiver whose normal points into a
- * solid - full-length probes toward +n mostly (14 of 16) hit the backs of
- * faces, while from just behind its surface toward -n as many hit the
- * fronts of faces (escaping rays do not count: a floor under a crate has
- * a solid above it and the void outside the room below) - has an inverted
- * normal (common in imported meshes). Its normal is
- * flipped in place, so the hemisphere the bake fits and the normal stored
- * for shading face where it can be seen from. Back faces are judged by
- * triangle winding, so a mesh turned inside out as a whole (winding and
- * normals both inverted) is left alone. `flipped` (may be NULL) receives
- * how many. Deterministic; `threads` as vb_parallel_for. */
-vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
-                              uint32_t *flipped, vb_error *err);
 
 /* Monotonic wall clock in seconds. */
 double vb_now(void);

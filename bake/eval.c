@@ -119,6 +119,7 @@ typedef struct receiver {
     float position[3];     /* scene units */
     float normal[3];       /* unit */
     float origin[3];       /* truth ray origin, traced frame */
+    float near;            /* ~0 distance (origins.h), scene units */
 } receiver;
 
 /* One receiver's sums for one stream, in a fixed order. */
@@ -149,7 +150,7 @@ typedef struct job {
     rtruth *truth;         /* rec_count */
     uint64_t *hist;        /* per worker: KINDS * streams * HIST_BINS */
     uint64_t dir_seed, light_seed;
-    float max_local, inv_scale, max_distance, floor_dist, near_zero_dist;
+    float max_local, inv_scale, max_distance, floor_dist;
 } job;
 
 /* The stream's coefficients at a receiver: decoded at a vertex,
@@ -225,7 +226,7 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
             const float dt = hit ? rh.ray.tfar[k] * J->inv_scale : J->max_distance;
             tr->n++;
             tr->escaped += !hit;
-            tr->near_zero += dt < J->near_zero_dist;
+            tr->near_zero += dt < r->near;
 
             /* The light: u in (0.05, 1] (1 - u1 is in (0, 1]). */
             float u1, u2;
@@ -724,7 +725,7 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
     vb_result r = VB_OK;
     vb_dirgrid grid = {0};
     uint32_t *vsel = NULL, nv = 0;
-    float *vorigin = NULL;
+    float *vorigin = NULL, *vnear = NULL;
     double *cdf = NULL;
     receiver *rec = NULL;
     job *J = NULL;
@@ -740,8 +741,9 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
 
     /* 1. Receivers and their truth origins. */
     vorigin = malloc((size_t)V * 3 * sizeof *vorigin);
+    vnear = malloc((size_t)V * sizeof *vnear + 1);
     rec = calloc((size_t)nv + d.interior + 1, sizeof *rec);
-    if (!vorigin || !rec) {
+    if (!vorigin || !vnear || !rec) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
                     nv + d.interior);
         goto done;
@@ -750,7 +752,7 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
         vb_mesh m = {.vertex_count = V, .triangle_count = f->header.triangle_count,
                      .positions = (float *)f->positions, .normals = (float *)f->normals,
                      .indices = (uint32_t *)f->indices};
-        r = vb_ray_origins(&m, d.scene, d.threads, vorigin, NULL, err);
+        r = vb_ray_origins(&m, d.scene, d.threads, vorigin, vnear, NULL, err);
         if (r != VB_OK)
             goto done;
     }
@@ -772,6 +774,7 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
         memcpy(x->position, f->positions + 3 * (size_t)v, sizeof x->position);
         memcpy(x->normal, n, sizeof x->normal);
         memcpy(x->origin, vorigin + 3 * (size_t)v, sizeof x->origin);
+        x->near = vnear[v];
     }
     count[VB_EVAL_VERTICES] = nr;
     if (d.interior > 0) {
@@ -793,12 +796,23 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
             float p[3];
             vb_scene_to_local(d.scene, x.position, p);
             vb_offset_origin(p, x.normal, x.origin);
+            double edges = 0.0;
+            for (int k = 0; k < 3; k++) {
+                const float *a = f->positions + 3 * (size_t)f->indices[3 * (size_t)x.triangle + k];
+                const float *b =
+                    f->positions + 3 * (size_t)f->indices[3 * (size_t)x.triangle + (k + 1) % 3];
+                edges += sqrt(((double)a[0] - b[0]) * (a[0] - b[0]) +
+                              ((double)a[1] - b[1]) * (a[1] - b[1]) +
+                              ((double)a[2] - b[2]) * (a[2] - b[2]));
+            }
+            x.near = vb_receiver_near(d.scene->diagonal, (float)(edges / 3.0));
             rec[nr++] = x;
         }
         count[VB_EVAL_INTERIOR] = nr - count[VB_EVAL_VERTICES];
     }
     free(vorigin);
-    vorigin = NULL;
+    free(vnear);
+    vorigin = NULL, vnear = NULL;
 
     /* 2. Trace and score. */
     J = calloc(1, sizeof *J);
@@ -827,7 +841,6 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
     J->max_local = f->header.max_distance * d.scene->scale;
     J->inv_scale = 1.0f / d.scene->scale;
     J->floor_dist = 0.01f * diag;
-    J->near_zero_dist = VB_EVAL_NEAR_ZERO * diag;
     started = vb_parallel_for(d.threads, nr, BLOCK, eval_block, J,
                               d.progress ? eval_progress : NULL, J);
     if (started == 0) {
@@ -916,6 +929,7 @@ done:
     free(rec);
     free(cdf);
     free(vorigin);
+    free(vnear);
     free(vsel);
     vb_dirgrid_destroy(&grid);
     return r;

@@ -96,8 +96,9 @@ extern "C" {
 /* The two kinds of receivers, reported separately. */
 enum { VB_EVAL_VERTICES = 0, VB_EVAL_INTERIOR = 1, VB_EVAL_KINDS = 2 };
 
-/* Near-zero truth and the degenerate-receiver rule (the bake's). */
-#define VB_EVAL_NEAR_ZERO 1e-3f    /* of the diagonal */
+/* Near-zero truth: below the receiver's near distance (origins.h); a
+ * receiver is degenerate when this share of its truth is near zero (the
+ * bake's rule). */
 #define VB_EVAL_DEGENERATE 0.9     /* of a receiver's directions */
 
 enum { VB_EVAL_INTERP_RUNTIME = 0 };

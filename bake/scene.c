@@ -63,8 +63,13 @@ vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc,
         s->scale = ldexpf(1.0f, 1 - e2);
     }
 
-    char config[64];
-    snprintf(config, sizeof config, "threads=%u,verbose=0", d.threads);
+    /* VDSH_EMBREE_CONFIG is appended to Embree's device configuration
+     * (rtcNewDevice), e.g. "isa=avx2": the tests run the hard cases under
+     * every kernel set the CPU supports. */
+    const char *extra = getenv("VDSH_EMBREE_CONFIG");
+    char config[256];
+    snprintf(config, sizeof config, "threads=%u,verbose=0%s%.200s", d.threads,
+             extra && extra[0] ? "," : "", extra ? extra : "");
     s->device = rtcNewDevice(config);
     if (!s->device) {
         enum RTCError code = rtcGetDeviceError(NULL);
@@ -98,7 +103,7 @@ vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc,
     rtcCommitGeometry(geom);
     rtcAttachGeometry(s->scene, geom);
     rtcReleaseGeometry(geom);
-    rtcSetSceneFlags(s->scene, d.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
+    rtcSetSceneFlags(s->scene, (d.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE) | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(s->scene, RTC_BUILD_QUALITY_HIGH);
     rtcCommitScene(s->scene);
     if (s->embree_error[0]) {

@@ -117,7 +117,10 @@ static void usage(FILE *f)
 "                          a receiver blocked at ~0 on its own side and open\n"
 "                          on the other gets its normal flipped)\n"
 "      --seed N            seed of every random sequence (default 1)\n"
-"      --robust            Embree's robust traversal (slower)\n"
+"      --no-robust         Embree's fast traversal instead of the robust one\n"
+"                          (default: robust; the fast one is 4-11%% quicker\n"
+"                          but lets grazing rays slip through creases, and\n"
+"                          which ones differs between CPUs' kernels)\n"
 "      --threads N         worker threads (default: all cores)\n"
 "\n"
 "  -q, --quiet             no progress or summary on stderr\n"
@@ -387,10 +390,11 @@ int main(int argc, char **argv)
     o.quantity = VB_QUANTITY_AUTO;
     o.encoding = VDSH_ENCODING_F16;
     o.seed = 1;
+    o.robust = 1;
     o.cube_size = 64;
 
     enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
-           O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST,
+           O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
            O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
@@ -406,6 +410,7 @@ int main(int argc, char **argv)
         {"cube-size", required_argument, 0, O_CUBESIZE},
         {"cubemap-dir", required_argument, 0, O_CUBEDIR},
         {"robust", no_argument, 0, O_ROBUST},
+        {"no-robust", no_argument, 0, O_NO_ROBUST},
         {"report", required_argument, 0, O_REPORT},
         {"record-timings", no_argument, 0, O_TIMINGS},
         {"export-obj", required_argument, 0, O_EXPORT},
@@ -473,6 +478,7 @@ int main(int argc, char **argv)
             break;
         case O_CUBEDIR: o.cubemap_dir = optarg; break;
         case O_ROBUST: o.robust = 1; break;
+        case O_NO_ROBUST: o.robust = 0; break;
         case O_REPORT: o.report = optarg; break;
         case O_TIMINGS: o.record_timings = 1; break;
         case O_EXPORT: o.export_obj = optarg; break;
@@ -649,6 +655,12 @@ int main(int argc, char **argv)
                 bo.seconds > 0 ? bo.rays_traced / bo.seconds * 1e-6 : 0.0, bo.threads,
                 bo.rays_traced ? 100.0 * bo.rays_missed / bo.rays_traced : 0.0,
                 bo.moved_origins, bo.degenerate_receivers);
+    if (log)
+        fprintf(log, "vdsh-bake: ray origins checked in %.2f s: %llu probe rays (%.1f%% of the "
+                     "traced rays), %u receivers repaired, %u moved\n",
+                bo.origins.seconds, (unsigned long long)bo.origins.probe_rays,
+                bo.rays_traced ? 100.0 * bo.origins.probe_rays / bo.rays_traced : 0.0,
+                bo.origins.flagged, bo.origins.moved);
     if (log && bo.auto_receivers > 0) {
         fprintf(log, "vdsh-bake: quantity chosen on %u sampled receivers (expected shadow "
                      "error, distance / log):", bo.auto_receivers);

@@ -57,13 +57,14 @@ int main(int argc, char **argv)
     float *org = NULL, *buf = NULL;
     FILE *f = NULL;
     int status = 1;
-    uint32_t flipped = 0, moved = 0;
+    uint32_t flipped = 0;
+    vb_origins_stats ost = {0};
     if (vb_mesh_load(argv[1], NULL, &occ, NULL, &err) != VB_OK ||
         vb_mesh_refine(&occ, max_edge, &rec, &err) != VB_OK ||
         vb_scene_create(&occ, NULL, &s, &err) != VB_OK ||
         vb_orient_receivers(&rec, s, 0, &flipped, &err) != VB_OK ||
         !(org = malloc((size_t)rec.vertex_count * 3 * sizeof *org)) ||
-        vb_ray_origins(&rec, s, 0, org, &moved, &err) != VB_OK ||
+        vb_ray_origins(&rec, s, 0, org, NULL, &ost, &err) != VB_OK ||
         vb_dirgrid_create((uint32_t)(rays + 1) / 2, 1, &g, &err) != VB_OK) {
         fprintf(stderr, "vdsh-raydump: %s\n", org ? err.msg : "out of memory");
         goto out;
@@ -116,7 +117,7 @@ int main(int argc, char **argv)
     f = NULL;
     fprintf(stderr, "vdsh-raydump: %ld of %u receivers, %u traced + %ld held-out directions "
                     "each (%u normals flipped, %u origins moved)\n",
-            K, rec.vertex_count, g.count, H, flipped, moved);
+            K, rec.vertex_count, g.count, H, flipped, ost.moved);
     status = 0;
 out:
     if (f)

@@ -23,3 +23,17 @@ if(Python3_Interpreter_FOUND)
                    $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval> $<TARGET_FILE:vdsh-info>
                    ${CMAKE_CURRENT_BINARY_DIR}/bake_auto)
 endif()
+
+# Two bakes of one scene compared stream by stream (the cross-ISA tests).
+add_executable(vdsh_compare vdsh_compare.c)
+target_link_libraries(vdsh_compare PRIVATE vdsh_format m)
+
+# Every Embree kernel set the CPU supports (tests/with_each_isa.sh): the
+# hard cases pass with each, and bakes agree across them.
+add_test(NAME bake_hard_cases_isa
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/with_each_isa.sh $<TARGET_FILE:vdsh-bake>
+                 $<TARGET_FILE:test_hard>)
+add_test(NAME bake_isa_agree
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_isa_agree.sh $<TARGET_FILE:vdsh-bake>
+                 $<TARGET_FILE:vdsh-info> $<TARGET_FILE:vdsh_compare>
+                 ${CMAKE_CURRENT_SOURCE_DIR}/with_each_isa.sh ${VDSH_SHARED_SCENES})

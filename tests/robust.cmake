@@ -102,6 +102,13 @@ add_test(NAME robust_determinism
          COMMAND bash ${_robust_dir}/test_robust_determinism.sh $<TARGET_FILE:vdsh-bake>
                  ${VDSH_SHARED_SCENES})
 set_tests_properties(robust_determinism PROPERTIES SKIP_RETURN_CODE 77)
+# The same with every Embree kernel set the CPU supports (with_each_isa.sh).
+if(EXISTS ${VDSH_SHARED_SCENES})
+  add_test(NAME robust_determinism_isa
+           COMMAND bash ${_robust_dir}/with_each_isa.sh $<TARGET_FILE:vdsh-bake>
+                   bash ${_robust_dir}/test_robust_determinism.sh $<TARGET_FILE:vdsh-bake>
+                   ${VDSH_SHARED_SCENES})
+endif()
 
 # vb_mesh_load_memory (what the mesh fuzzers call) is vb_mesh_load: the
 # seed corpora and Debian's assimp models, loaded both ways.

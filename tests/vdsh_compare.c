@@ -1,0 +1,86 @@
+/*
+ * vdsh_compare A.vdsh B.vdsh [TOL [SHARE]]: how far apart two bakes of the same
+ * scene are. The geometry (positions, normals, indices) and the stream
+ * list must match exactly; per stream it prints the vertices whose
+ * coefficients differ and the largest difference in units of the stream's
+ * largest |coefficient| (its f16 scale). Exit 0 when every difference is
+ * at most TOL (default 0: identical) and at most a SHARE of the vertices
+ * (default 1) differ by more than 1e-3 (beyond the f16 rounding of a
+ * stream whose scale moved); 1 otherwise; 2 on usage or read errors. Used by the cross-ISA tests (tests/bake.cmake).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vdsh.h"
+
+int main(int argc, char **argv)
+{
+    if (argc < 3 || argc > 5) {
+        fprintf(stderr, "usage: vdsh_compare A.vdsh B.vdsh [TOL [SHARE]]\n");
+        return 2;
+    }
+    double tol = argc >= 4 ? strtod(argv[3], NULL) : 0.0;
+    double share = argc >= 5 ? strtod(argv[4], NULL) : 1.0;
+    vdsh_file *a = NULL, *b = NULL;
+    vdsh_error err;
+    if (vdsh_read(argv[1], &a, &err) != VDSH_OK || vdsh_read(argv[2], &b, &err) != VDSH_OK) {
+        fprintf(stderr, "vdsh_compare: %s\n", err.msg);
+        vdsh_free(a);
+        return 2;
+    }
+    int status = 0;
+    uint32_t V = a->header.vertex_count, T = a->header.triangle_count;
+    if (V != b->header.vertex_count || T != b->header.triangle_count ||
+        memcmp(a->positions, b->positions, 3 * sizeof(float) * V) ||
+        memcmp(a->normals, b->normals, 3 * sizeof(float) * V) ||
+        memcmp(a->indices, b->indices, 3 * sizeof(uint32_t) * T) ||
+        a->stream_count != b->stream_count) {
+        printf("geometry or stream list differ\n");
+        status = 1;
+        goto out;
+    }
+    for (uint32_t s = 0; s < a->stream_count; s++) {
+        const vdsh_stream *x = a->streams + s, *y = b->streams + s;
+        if (x->order != y->order || x->quantity != y->quantity) {
+            printf("stream %u: order or quantity differ\n", s);
+            status = 1;
+            continue;
+        }
+        uint32_t nc = x->order * x->order, differ = 0, above = 0, worst = 0;
+        float cx[VDSH_MAX_COEFFS], cy[VDSH_MAX_COEFFS];
+        double maxc = 0.0, maxd = 0.0;
+        for (uint32_t v = 0; v < V; v++) {
+            vdsh_stream_decode(x, v, cx);
+            for (uint32_t i = 0; i < nc; i++)
+                maxc = fmax(maxc, fabs(cx[i]));
+        }
+        for (uint32_t v = 0; v < V; v++) {
+            vdsh_stream_decode(x, v, cx);
+            vdsh_stream_decode(y, v, cy);
+            double dv = 0.0;
+            for (uint32_t i = 0; i < nc; i++)
+                dv = fmax(dv, fabs((double)cx[i] - cy[i]));
+            differ += dv > 0.0;
+            above += dv > 1e-3 * maxc; /* beyond the f16 rounding of a rescaled stream */
+            if (dv > maxd)
+                maxd = dv, worst = v;
+        }
+        double rel = maxc > 0.0 ? maxd / maxc : maxd;
+        printf("order %u %s: %u of %u vertices differ (%u by more than 1e-3), largest "
+               "difference %.3g of the largest |coefficient|",
+               x->order, vdsh_quantity_name(x->quantity), differ, V, above, rel);
+        if (differ)
+            printf(" (vertex %u at %g %g %g)", worst, (double)a->positions[3 * (size_t)worst],
+                   (double)a->positions[3 * (size_t)worst + 1],
+                   (double)a->positions[3 * (size_t)worst + 2]);
+        printf("\n");
+        if (rel > tol || above > share * V)
+            status = 1;
+    }
+out:
+    vdsh_free(a);
+    vdsh_free(b);
+    return status;
+}
