@@ -245,15 +245,18 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
                 float D, s_hat, b_hat;
                 if (J->d->oracle || !corners) {
                     D = J->d->oracle ? dt
-                                     : vdsh_stream_distance(st->order, st->quantity, coef[s], w);
+                                     : vdsh_stream_distance(st->order, st->quantity,
+                                                            J->max_distance, coef[s], w);
                     s_hat = vdsh_shadow_compare(D, dl, VDSH_COMPARE_SMOOTH);
                     b_hat = vdsh_shadow_compare(D, dl, VDSH_COMPARE_BINARY);
                 } else {
                     const float *cv[3] = {vc[s][0], vc[s][1], vc[s][2]};
-                    s_hat = vdsh_shadow_interior(st->order, st->quantity, interp[s], cv, pv,
-                                                 r->bary, lp, VDSH_COMPARE_SMOOTH, &D);
-                    b_hat = vdsh_shadow_interior(st->order, st->quantity, interp[s], cv, pv,
-                                                 r->bary, lp, VDSH_COMPARE_BINARY, NULL);
+                    s_hat = vdsh_shadow_interior(st->order, st->quantity, J->max_distance,
+                                                 interp[s], cv, pv, r->bary, lp,
+                                                 VDSH_COMPARE_SMOOTH, &D);
+                    b_hat = vdsh_shadow_interior(st->order, st->quantity, J->max_distance,
+                                                 interp[s], cv, pv, r->bary, lp,
+                                                 VDSH_COMPARE_BINARY, NULL);
                 }
                 const float e = fabsf(D - dt) / floor_;
                 racc *a = acc + s;

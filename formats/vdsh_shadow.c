@@ -13,18 +13,29 @@ float vdsh_ramp(float x)
     return s > 0.0f ? (s < 1.0f ? s : 1.0f) : 0.0f; /* NaN fails both: 0 */
 }
 
-float vdsh_stream_distance(uint32_t order, uint32_t quantity, const float *c,
-                           const float d[3])
+/* The quantity's distance from an SH sum, clamped to [0, max_distance]
+ * (the top of vdsh_shadow.h). A NaN max_distance clamps nothing. */
+static float from_sum(uint32_t quantity, float max_distance, float sum)
 {
-    float sum = vdsh_sh_reconstruct((int)order, c, d);
+    float d;
     switch (quantity) {
     case VDSH_QUANTITY_DISTANCE2:
-        return sum > 0.0f ? sqrtf(sum) : 0.0f;
+        d = sum > 0.0f ? sqrtf(sum) : 0.0f;
+        break;
     case VDSH_QUANTITY_LOG_DISTANCE:
-        return expf(sum < VDSH_LOG_SUM_MAX ? sum : VDSH_LOG_SUM_MAX);
+        d = expf(sum < VDSH_LOG_SUM_MAX ? sum : VDSH_LOG_SUM_MAX);
+        break;
     default:
-        return sum > 0.0f ? sum : 0.0f;
+        d = sum > 0.0f ? sum : 0.0f;
+        break;
     }
+    return d > max_distance ? max_distance : d;
+}
+
+float vdsh_stream_distance(uint32_t order, uint32_t quantity, float max_distance,
+                           const float *c, const float d[3])
+{
+    return from_sum(quantity, max_distance, vdsh_sh_reconstruct((int)order, c, d));
 }
 
 float vdsh_shadow_compare(float d_vis, float d_light, uint32_t compare)
@@ -38,8 +49,8 @@ float vdsh_shadow_compare(float d_vis, float d_light, uint32_t compare)
     return vdsh_ramp(d_vis / d_light);
 }
 
-float vdsh_shadow(uint32_t order, uint32_t quantity, const float *c,
-                  const float p[3], const float l[3], uint32_t compare)
+float vdsh_shadow(uint32_t order, uint32_t quantity, float max_distance,
+                  const float *c, const float p[3], const float l[3], uint32_t compare)
 {
     float v[3] = {l[0] - p[0], l[1] - p[1], l[2] - p[2]};
     float dl = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
@@ -47,7 +58,8 @@ float vdsh_shadow(uint32_t order, uint32_t quantity, const float *c,
         return vdsh_shadow_compare(0.0f, dl, compare);
     for (int i = 0; i < 3; i++)
         v[i] /= dl;
-    return vdsh_shadow_compare(vdsh_stream_distance(order, quantity, c, v), dl, compare);
+    return vdsh_shadow_compare(vdsh_stream_distance(order, quantity, max_distance, c, v), dl,
+                               compare);
 }
 
 const char *vdsh_interp_name(uint32_t interp)
@@ -63,19 +75,6 @@ uint32_t vdsh_runtime_interp(uint32_t order, uint32_t quantity)
     return order <= 3 ? VDSH_INTERP_VISIBILITY : VDSH_INTERP_SPLIT;
 }
 
-/* The quantity's distance from an SH sum (as vdsh_stream_distance). */
-static float from_sum(uint32_t quantity, float sum)
-{
-    switch (quantity) {
-    case VDSH_QUANTITY_DISTANCE2:
-        return sum > 0.0f ? sqrtf(sum) : 0.0f;
-    case VDSH_QUANTITY_LOG_DISTANCE:
-        return expf(sum < VDSH_LOG_SUM_MAX ? sum : VDSH_LOG_SUM_MAX);
-    default:
-        return sum > 0.0f ? sum : 0.0f;
-    }
-}
-
 /* Unit direction and distance from a to b; 0 distance for a == b. */
 static float toward(const float a[3], const float b[3], float d[3])
 {
@@ -86,8 +85,8 @@ static float toward(const float a[3], const float b[3], float d[3])
     return len;
 }
 
-float vdsh_shadow_interior(uint32_t order, uint32_t quantity, uint32_t interp,
-                           const float *const c[3], const float *const pv[3],
+float vdsh_shadow_interior(uint32_t order, uint32_t quantity, float max_distance,
+                           uint32_t interp, const float *const c[3], const float *const pv[3],
                            const float b[3], const float l[3], uint32_t compare,
                            float *d_vis)
 {
@@ -102,7 +101,7 @@ float vdsh_shadow_interior(uint32_t order, uint32_t quantity, uint32_t interp,
         float ci[VDSH_MAX_COEFFS];
         for (int i = 0; i < n; i++)
             ci[i] = b[0] * c[0][i] + b[1] * c[1][i] + b[2] * c[2][i];
-        float d = dl > 0.0f ? vdsh_stream_distance(order, quantity, ci, w) : 0.0f;
+        float d = dl > 0.0f ? vdsh_stream_distance(order, quantity, max_distance, ci, w) : 0.0f;
         if (d_vis)
             *d_vis = d;
         return vdsh_shadow_compare(d, dl, compare);
@@ -127,7 +126,7 @@ float vdsh_shadow_interior(uint32_t order, uint32_t quantity, uint32_t interp,
             ci[i] = b[0] * c[0][i] + b[1] * c[1][i] + b[2] * c[2][i];
             sum16 += ci[i] * y[i];
         }
-        float d = dl > 0.0f ? from_sum(quantity, sum9 + sum16) : 0.0f;
+        float d = dl > 0.0f ? from_sum(quantity, max_distance, sum9 + sum16) : 0.0f;
         if (d_vis)
             *d_vis = d;
         return vdsh_shadow_compare(d, dl, compare);
@@ -137,7 +136,8 @@ float vdsh_shadow_interior(uint32_t order, uint32_t quantity, uint32_t interp,
     for (int k = 0; k < 3; k++) {
         float dk[3];
         float dlk = toward(pv[k], l, dk);
-        float dvk = dlk > 0.0f ? vdsh_stream_distance(order, quantity, c[k], dk) : 0.0f;
+        float dvk =
+            dlk > 0.0f ? vdsh_stream_distance(order, quantity, max_distance, c[k], dk) : 0.0f;
         d += b[k] * dvk;
         s += b[k] * vdsh_shadow_compare(dvk, dlk, compare);
     }

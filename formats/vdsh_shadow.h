@@ -6,9 +6,17 @@
  * definition of what a stored stream means.
  *
  *   v   = (L - p) / |L - p|,  d_L = |L - p|
- *   d_V = D_p(v)                           (vdsh_stream_distance)
+ *   d_V = clamp(D_p(v), 0, max_distance)   (vdsh_stream_distance)
  *   s   = ramp(d_V / d_L)                  smooth: ramp(x) = saturate((x - 1/3) * 1.5)
  *   s   = d_V >= d_L ? 1 : 0               binary
+ *
+ * max_distance is the bake's clamp distance (vdsh_header.max_distance):
+ * no stored distance exceeded it (a ray that missed got it), so no
+ * reconstruction may either. The fit only constrains the upper
+ * hemisphere; below a vertex's horizon, and near it for low orders, a
+ * log-distance sum can run away to millions of times the scene's size,
+ * and the runtime does evaluate there (smooth normals, terminators), where
+ * one huge vertex distance interpolated across a triangle leaks light.
  *
  * Defined everywhere: a reconstructed distance that rings negative counts
  * as 0; a light at the receiver (d_L = 0) is unshadowed (s = 1), as is
@@ -34,24 +42,27 @@ typedef enum vdsh_compare {
 float vdsh_ramp(float x);
 
 /* A log-distance sum above this reads as exp(VDSH_LOG_SUM_MAX), about
- * 5.5e34: finite, so that the runtime's interpolation of per-vertex
- * distances never meets 0 * inf. (No fit comes near it; a damaged or
- * hand-made stream might.) */
+ * 5.5e34, before the clamp to max_distance: finite even with no clamp
+ * (max_distance +Inf), so that the runtime's interpolation of per-vertex
+ * distances never meets 0 * inf. */
 #define VDSH_LOG_SUM_MAX 80.0f
 
-/* The distance a stream reconstructs toward unit direction d, >= 0:
- * quantity distance: the SH sum; distance2: sqrt of the sum; log-distance:
- * exp of the sum. Negative sums (ringing) give 0. */
-float vdsh_stream_distance(uint32_t order, uint32_t quantity, const float *c,
-                           const float d[3]);
+/* The distance a stream reconstructs toward unit direction d, in
+ * [0, max_distance]: quantity distance: the SH sum; distance2: sqrt of the
+ * sum; log-distance: exp of the sum. Negative sums (ringing) give 0, and
+ * anything above max_distance gives max_distance. max_distance is the
+ * file's vdsh_header.max_distance (> 0), here and in every function
+ * below; +INFINITY clamps nothing. */
+float vdsh_stream_distance(uint32_t order, uint32_t quantity, float max_distance,
+                           const float *c, const float d[3]);
 
 /* Visibility in [0, 1] of a light at distance d_light when the stored
  * distance toward it is d_vis (see the top of this file). */
 float vdsh_shadow_compare(float d_vis, float d_light, uint32_t compare);
 
 /* The whole evaluation for one receiver p and light position l. */
-float vdsh_shadow(uint32_t order, uint32_t quantity, const float *c,
-                  const float p[3], const float l[3], uint32_t compare);
+float vdsh_shadow(uint32_t order, uint32_t quantity, float max_distance,
+                  const float *c, const float p[3], const float l[3], uint32_t compare);
 
 /* How a renderer carries the stream from a triangle's vertices to a point
  * p = sum b_k p_k inside it (the GPU interpolates linearly):
@@ -86,11 +97,14 @@ const char *vdsh_interp_name(uint32_t interp);
 uint32_t vdsh_runtime_interp(uint32_t order, uint32_t quantity);
 
 /* Visibility at p = sum b_k pv[k] for a light at l, carried by `interp`;
- * c[k] holds vertex k's order^2 coefficients. If d_vis is not NULL it
- * receives the distance compared (for VISIBILITY: the interpolated vertex
- * distances, for scoring). Defined for every input as vdsh_shadow is. */
-float vdsh_shadow_interior(uint32_t order, uint32_t quantity, uint32_t interp,
-                           const float *const c[3], const float *const pv[3],
+ * c[k] holds vertex k's order^2 coefficients. Every distance is clamped
+ * where it is reconstructed (per vertex, or at p), before it is
+ * interpolated, so d_vis never exceeds max_distance. If d_vis is not NULL
+ * it receives the distance compared (for VISIBILITY: the interpolated
+ * vertex distances, for scoring). Defined for every input as vdsh_shadow
+ * is. */
+float vdsh_shadow_interior(uint32_t order, uint32_t quantity, float max_distance,
+                           uint32_t interp, const float *const c[3], const float *const pv[3],
                            const float b[3], const float l[3], uint32_t compare,
                            float *d_vis);
 

@@ -56,8 +56,9 @@
  * triangle is vdsh_shadow_interior: the definitions vdsh-eval scores with.
  * The comparison (vdsh_compare from formats/vdsh_shadow.h: smooth ramp or
  * binary) and the stored quantity mean exactly what formats/vdsh_shadow.h
- * says; tests/test_runtime_glsl.c checks the shaders against it, per
- * vertex and per fragment.
+ * says, every reconstructed distance clamped to the file's max_distance;
+ * tests/test_runtime_glsl.c checks the shaders against it, per vertex and
+ * per fragment.
  *
  * Lights: any number. Up to max_lights_per_pass lights are summed in one
  * pass (a loop in the shaders); more lights take more passes, added with
@@ -151,8 +152,9 @@ typedef struct vr_scene_desc {
  * chosen for the vertex cache (the same triangles, reordered; vertices
  * renumbered), not the file's. On failure *out is untouched and nothing
  * stays allocated. Errors: VR_ERR_IO / VR_ERR_FORMAT from the .vdsh reader
- * or the cubemap reader (and VR_ERR_FORMAT for an index out of range in a
- * desc->file), VR_ERR_MISSING for a missing cubemap, VR_ERR_GL. */
+ * or the cubemap reader (and VR_ERR_FORMAT for an index out of range or a
+ * max_distance that is not finite and > 0 in a desc->file),
+ * VR_ERR_MISSING for a missing cubemap, VR_ERR_GL. */
 vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out,
                           vr_error *err);
 
@@ -171,6 +173,8 @@ typedef struct vr_scene_info {
     int has_cubemaps;             /* basis cubemaps uploaded */
     int cube_size;                /* their face size, or 0 */
     uint32_t quantity;            /* the quantity drawn */
+    float max_distance;           /* the file's: no reconstructed distance
+                                     exceeds it (vdsh_shadow.h) */
     size_t gpu_bytes;             /* buffers and textures uploaded */
 } vr_scene_info;
 

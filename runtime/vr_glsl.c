@@ -8,7 +8,8 @@
  * The VDSH part is written as three layers, so that a new stored quantity
  * or a new comparison touches one function each:
  *   sh_sum4 / sh_sum9 / sh_basis16   the SH basis, formats/vdsh_sh.c
- *   vdsh_distance(sum)               an SH sum -> a distance, per quantity
+ *   vdsh_distance(sum, max)          an SH sum -> a distance, per quantity,
+ *                                    clamped to the bake's max distance
  *                                    (formats/vdsh_shadow.c
  *                                    vdsh_stream_distance)
  *   vdsh_compare(d_vis, d_light)     a distance pair -> visibility, per
@@ -39,18 +40,20 @@
  * arrays (the shadow cube maps) be indexed by constant expressions.
  *
  * Per-draw constants of the fragment stage (light positions, colours,
- * attenuations, the ambient term, the cube maps' planes) reach it as flat
- * varyings that the vertex stage copies from the uniforms (FLAT_LIGHTS),
- * not as uniforms: Mesa's llvmpipe (22.x) reads every uniform component
- * in a fragment shader with a bounds-checked gather, about 20
- * instructions per component for every 8 fragments, again in every 4x4
- * block, where a flat input is one broadcast per block. Read as uniforms,
- * the 15 components of one light's Lambert term cost about a third of the
- * room's lighting pass on llvmpipe (docs/BENCHMARKS.md). The values are
- * the uniforms' own, bit for bit. When the varyings would not fit in
- * GL_MAX_VARYING_COMPONENTS (8 lights need up to 105 of the 128 that
- * llvmpipe and GPUs offer; GL 3.3 only promises 60), or a driver does not
- * link them, the fragment stage reads the uniforms.
+ * attenuations, the ambient term, the cube maps' planes, and on the split
+ * path, the only one that reconstructs a distance there, the scene's max
+ * distance) reach it as flat varyings that the vertex stage copies from
+ * the uniforms (FLAT_LIGHTS), not as uniforms: Mesa's llvmpipe (22.x)
+ * reads every uniform component in a fragment shader with a bounds-checked
+ * gather, about 20 instructions per component for every 8 fragments,
+ * again in every 4x4 block, where a flat input is one broadcast per block.
+ * Read as uniforms, the 15 components of one light's Lambert term cost
+ * about a third of the room's lighting pass on llvmpipe
+ * (docs/BENCHMARKS.md). The values are the uniforms' own, bit for bit.
+ * When the varyings would not fit in GL_MAX_VARYING_COMPONENTS (8 lights
+ * need up to 106 of the 128 that llvmpipe and GPUs offer; GL 3.3 only
+ * promises 60), or a driver does not link them, the fragment stage reads
+ * the uniforms.
  */
 #include "vr_internal.h"
 
@@ -112,16 +115,19 @@ static const char common_glsl[] =
     "}\n"
     "\n"
     "/* The distance a stream's SH sum stands for (vdsh_stream_distance):\n"
-    " * never negative, ringing below zero counts as 0. */\n"
-    "float vdsh_distance(float sum)\n"
+    " * never negative, ringing below zero counts as 0; never above the\n"
+    " * bake's max distance md, which sums below a vertex's horizon can\n"
+    " * run far past. */\n"
+    "float vdsh_distance(float sum, float md)\n"
     "{\n"
     "#if QUANTITY == 1\n"
-    "    return sum > 0.0 ? sqrt(sum) : 0.0;\n"
+    "    float d = sum > 0.0 ? sqrt(sum) : 0.0;\n"
     "#elif QUANTITY == 2\n"
-    "    return exp(min(sum, 80.0)); /* VDSH_LOG_SUM_MAX: stays finite */\n"
+    "    float d = exp(min(sum, 80.0)); /* VDSH_LOG_SUM_MAX: stays finite */\n"
     "#else\n"
-    "    return sum > 0.0 ? sum : 0.0;\n"
+    "    float d = sum > 0.0 ? sum : 0.0;\n"
     "#endif\n"
+    "    return d > md ? md : d;\n"
     "}\n"
     "\n"
     "/* Visibility of a light at distance dl when the stored distance toward\n"
@@ -158,6 +164,7 @@ static const char vertex_glsl[] =
     "#endif\n"
     "uniform mat4 u_view_proj;\n"
     "uniform float u_scale;   /* coefficient = stored value * u_scale */\n"
+    "uniform float u_max_distance; /* the clamp of every reconstructed distance */\n"
     "#if NUM_LIGHTS > 0\n"
     "uniform vec3 u_light_pos[NUM_LIGHTS];\n"
     "#endif\n"
@@ -177,6 +184,9 @@ static const char vertex_glsl[] =
     "uniform float u_shadow_texel;\n"
     "flat out vec2 f_shadow_nf[NUM_LIGHTS];\n"
     "flat out float f_shadow_texel;\n"
+    "#endif\n"
+    "#if VDSH_SPLIT\n"
+    "flat out float f_max_distance;\n"
     "#endif\n"
     "#endif\n"
     "/* Later passes (more lights) test depth with GL_LEQUAL against the\n"
@@ -238,6 +248,9 @@ static const char vertex_glsl[] =
     "#if SHADOW_CUBE && NUM_LIGHTS > 0\n"
     "    f_shadow_texel = u_shadow_texel;\n"
     "#endif\n"
+    "#if VDSH_SPLIT\n"
+    "    f_max_distance = u_max_distance;\n"
+    "#endif\n"
     "#endif\n"
     "#if VDSH_VISIBILITY && OUTPUT == 1\n"
     "    v_dv = -1.0;\n"
@@ -250,7 +263,7 @@ static const char vertex_glsl[] =
     "#if VDSH_VISIBILITY || VDSH_DISTANCE\n"
     "        /* A light at the vertex has no direction: distance 0, not NaN,\n"
     "         * which would spread over every triangle around the vertex. */\n"
-    "        float dv = dl > 0.0 ? vdsh_distance(vdsh_sh_sum(lv / dl)) : 0.0;\n"
+    "        float dv = dl > 0.0 ? vdsh_distance(vdsh_sh_sum(lv / dl), u_max_distance) : 0.0;\n"
     "#endif\n"
     "#if VDSH_VISIBILITY\n"
     "        v_vis[i] = vdsh_compare(dv, dl);\n"
@@ -310,12 +323,16 @@ static const char fragment_glsl[] =
     "flat in vec2 f_shadow_nf[NUM_LIGHTS];\n"
     "flat in float f_shadow_texel;\n"
     "#endif\n"
+    "#if VDSH_SPLIT\n"
+    "flat in float f_max_distance;\n"
+    "#endif\n"
     "#define AMBIENT f_ambient\n"
     "#define LIGHT_POS(I) f_light_pos[I]\n"
     "#define LIGHT_COLOR(I) f_light_color[I]\n"
     "#define LIGHT_ATT(I) f_light_att[I]\n"
     "#define SHADOW_NF(I) f_shadow_nf[I]\n"
     "#define SHADOW_TEXEL f_shadow_texel\n"
+    "#define MAX_DISTANCE f_max_distance\n"
     "#else\n"
     "uniform vec3 u_ambient;\n"
     "#if NUM_LIGHTS > 0\n"
@@ -327,12 +344,16 @@ static const char fragment_glsl[] =
     "uniform vec2 u_shadow_nf[NUM_LIGHTS];\n"
     "uniform float u_shadow_texel;\n"
     "#endif\n"
+    "#if VDSH_SPLIT\n"
+    "uniform float u_max_distance;\n"
+    "#endif\n"
     "#define AMBIENT u_ambient\n"
     "#define LIGHT_POS(I) u_light_pos[I]\n"
     "#define LIGHT_COLOR(I) u_light_color[I]\n"
     "#define LIGHT_ATT(I) u_light_att[I]\n"
     "#define SHADOW_NF(I) u_shadow_nf[I]\n"
     "#define SHADOW_TEXEL u_shadow_texel\n"
+    "#define MAX_DISTANCE u_max_distance\n"
     "#endif\n"
     "#if SHADOW_CUBE && NUM_LIGHTS > 0\n"
     "uniform samplerCubeShadow u_shadow[NUM_LIGHTS];\n"
@@ -362,7 +383,7 @@ static const char fragment_glsl[] =
     "    dv = 0.0;\n"
     "    if (!(dl > 0.0))\n"
     "        return vdsh_compare(0.0, dl);\n"
-    "    dv = vdsh_distance(sum9 + vdsh_sh_sum16(lv / dl));\n"
+    "    dv = vdsh_distance(sum9 + vdsh_sh_sum16(lv / dl), MAX_DISTANCE);\n"
     "    return vdsh_compare(dv, dl);\n"
     "}\n"
     "#endif\n"
@@ -490,7 +511,8 @@ static int varying_components(const vr_program_key *k, int flat)
     if (interp == VDSH_INTERP_VISIBILITY && k->output == VR_OUTPUT_SHADOW)
         c += 2;
     if (flat)
-        c += 3 + 9 * n + (k->mode == VR_MODE_CUBE && n > 0 ? 2 * n + 1 : 0);
+        c += 3 + 9 * n + (k->mode == VR_MODE_CUBE && n > 0 ? 2 * n + 1 : 0) +
+             (interp == VDSH_INTERP_SPLIT);
     return c;
 }
 
@@ -623,6 +645,7 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     vr_program p = {.key = *key, .prog = prog};
     p.u_view_proj = glGetUniformLocation(prog, "u_view_proj");
     p.u_scale = glGetUniformLocation(prog, "u_scale");
+    p.u_max_distance = glGetUniformLocation(prog, "u_max_distance");
     p.u_light_pos = glGetUniformLocation(prog, "u_light_pos");
     p.u_light_color = glGetUniformLocation(prog, "u_light_color");
     p.u_light_att = glGetUniformLocation(prog, "u_light_att");

@@ -62,6 +62,7 @@ struct vr_scene {
     uint32_t vertex_count, triangle_count;
     float bounds_min[3], bounds_max[3];
     uint32_t quantity;
+    float max_distance;         /* the file's: clamps reconstructed distances */
     GLuint vbo_position, vbo_normal, ibo;
     /* Per order 1..5: the stream's buffer and a VAO with positions,
      * normals and its coefficients; vao[0] has positions and normals only. */
@@ -88,7 +89,7 @@ typedef struct vr_program_key {
 typedef struct vr_program {
     vr_program_key key;
     GLuint prog;
-    GLint u_view_proj, u_scale, u_light_pos, u_light_color, u_light_att;
+    GLint u_view_proj, u_scale, u_max_distance, u_light_pos, u_light_color, u_light_att;
     GLint u_ambient, u_shadow_nf, u_shadow_texel;
 } vr_program;
 

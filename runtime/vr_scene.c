@@ -216,6 +216,13 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
         r = vr_fail(err, VR_ERR_FORMAT, "%s: no triangles to draw", name);
         goto done;
     }
+    /* Checked by the reader for a file, not for one from memory: every
+     * reconstructed distance is clamped to it. */
+    if (!isfinite(h->max_distance) || !(h->max_distance > 0.0f)) {
+        r = vr_fail(err, VR_ERR_FORMAT, "%s: max_distance %g must be finite and > 0", name,
+                    (double)h->max_distance);
+        goto done;
+    }
 
     /* 2. The quantity to draw: the one asked for, else the file's own
      * (a file baked with --log has only log-distance streams). */
@@ -254,6 +261,7 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     s->vertex_count = h->vertex_count;
     s->triangle_count = h->triangle_count;
     s->quantity = quantity;
+    s->max_distance = h->max_distance;
     for (int k = 0; k < 3; k++) {
         s->bounds_min[k] = INFINITY;
         s->bounds_max[k] = -INFINITY;
@@ -360,6 +368,7 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     i.has_cubemaps = s->basis[0] != 0;
     i.cube_size = s->cube_size;
     i.quantity = s->quantity;
+    i.max_distance = s->max_distance;
     i.gpu_bytes = s->gpu_bytes;
     *out = i;
 }

@@ -165,6 +165,29 @@ for m in none cube vdsh2 vdsh3 vdsh5 vdsh5poly; do
   "$v" -q --render "$d/$m.png" --size 160x120 --mode $m "$room"
   "$png" info "$d/$m.png" 160 120
 done
+# Shadows where the room's geometry (bake/builtin.c) puts them. The light
+# at (-4, 3.5, 1) is in front of the 1.58 m crate (x in [-4.79, -3.21], z
+# in [-3.79, -2.21]); the floor point (-4, 0, -4.2), 0.41 m behind the
+# crate, sees it through the crate; (-4, 0, 1.5) sees it 3.5 m away
+# across empty room. Seen from (0, 5.5, -6.5), every shadow mode, on the
+# paper bake and on the log-distance bake (drawn per vertex), must darken
+# the first point and leave the second lit, against mode none; and none
+# against itself must fail the darkening check (the control).
+cam=0,5.5,-6.5,-4,0,-2; light=-4,3.5,1,0.8,0.8,0.8; dark=-4,0,-4.2; lit=-4,0,1.5
+for s in room log; do
+  f=$room; [ $s = log ] && f=$5
+  for m in none cube vdsh2 vdsh3 vdsh5 vdsh5poly; do
+    "$v" -q --render "$d/$s-$m.png" --size 160x120 --mode $m --camera $cam --fov 60 \
+         --light $light "$f"
+    [ $m = none ] || "$png" shadow "$d/$s-$m.png" "$d/$s-none.png" $cam 60 $dark $lit
+  done
+done
+if "$png" shadow "$d/room-none.png" "$d/room-none.png" $cam 60 $dark $lit 2> "$d/control.log"
+then
+  echo "control: mode none passes the shadow check"; exit 1
+fi
+cat "$d/control.log"
+grep -q "not darkened" "$d/control.log"
 "$v" -q --render "$d/opts.png" --size 120x90 --mode cube --pcf --shadow-size 128 \
      --camera 5,3,5,0,0.5,0 --light 0,2,0,1,0.5,0.2 --light -3,4,2 --ambient 0.1 \
      --attenuation 1,0.1,0 --fov 75 --egl surfaceless "$room"

@@ -615,8 +615,9 @@ static void test_small_parts(void)
  * quantity chosen per order, on the hardest scene above: receivers in
  * corners, pressed against the floor, buried in a pillar, where true
  * distances are ~0 and ln 0 would be -Inf. Every coefficient is finite,
- * and every reconstructed distance in 64 directions above each receiver is
- * finite and >= 0. */
+ * and every reconstructed distance in 64 directions above each receiver,
+ * and 64 below, where the fit is unconstrained and may run away, is finite,
+ * >= 0 and at most the bake's max distance. */
 static void test_default_fit(uint32_t method)
 {
     vb_mesh m = {0}, rec = {0};
@@ -637,7 +638,7 @@ static void test_default_fit(uint32_t method)
                                                                              : 1024) : 0;
     CHECK(b.auto_receivers == sampled, "%s: %u receivers sampled for the choice",
           vdsh_method_name(method), b.auto_receivers);
-    long bad = 0, checked = 0;
+    long bad = 0, checked = 0, runaway = 0;
     for (int o = 2; o <= 5 && b.coeffs[5]; o++) {
         if (!b.coeffs[o])
             continue;
@@ -650,19 +651,26 @@ static void test_default_fit(uint32_t method)
                 bad += !isfinite(c[i]);
             float t[3], bt[3];
             vb_frame(n, t, bt);
-            for (int k = 0; k < 64; k++) {
+            for (int k = 0; k < 128; k++) {
                 float ct = 0.05f + 0.9f * (k % 8) / 7.0f, st = sqrtf(1.0f - ct * ct);
-                float ph = 0.785398f * (float)(k / 8), w[3];
+                float ph = 0.785398f * (float)(k / 8 % 8), w[3];
+                if (k >= 64)
+                    ct = -ct;
                 for (int j = 0; j < 3; j++)
                     w[j] = st * cosf(ph) * t[j] + st * sinf(ph) * bt[j] + ct * n[j];
-                float dv = vdsh_stream_distance((uint32_t)o, b.quantity[o], c, w);
-                bad += !(isfinite(dv) && dv >= 0.0f);
+                float dv = vdsh_stream_distance((uint32_t)o, b.quantity[o], b.max_distance, c, w);
+                bad += !(isfinite(dv) && dv >= 0.0f && dv <= b.max_distance);
+                runaway += vdsh_stream_distance((uint32_t)o, b.quantity[o], INFINITY, c, w) >
+                           b.max_distance;
                 checked++;
             }
         }
     }
-    CHECK(bad == 0 && checked > 0, "%s: %ld of %ld coefficients or distances not finite and >= 0",
+    CHECK(bad == 0 && checked > 0,
+          "%s: %ld of %ld coefficients or distances not finite, >= 0 and <= max distance",
           vdsh_method_name(method), bad, checked);
+    printf("%s: %ld of %ld reconstructions would exceed the max distance %g unclamped\n",
+           vdsh_method_name(method), runaway, checked, (double)b.max_distance);
     vb_bake_output_free(&b);
     vb_scene_destroy(s);
     test_mesh_free(&m);
@@ -704,7 +712,8 @@ static void test_lit_walls(void)
                 fabsf(on_x ? p[2] : p[0]) > 8.75f)
                 continue;
             walls++;
-            float s = vdsh_shadow(o, out.quantity[o], out.coeffs[o] + (size_t)o * o * v, p, light,
+            float s = vdsh_shadow(o, out.quantity[o], out.max_distance,
+                                  out.coeffs[o] + (size_t)o * o * v, p, light,
                                   VDSH_COMPARE_SMOOTH);
             dark += s < 1.0f;
             worst = s < worst ? s : worst;

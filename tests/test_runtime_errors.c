@@ -69,6 +69,15 @@ static void test_files(const char *dir)
     rt_file f;
     small_file(&f, 1);
     CHECK(rt_file_write(&f, dir, "good", path, sizeof path) == 0, "write");
+    /* From memory the reader's checks do not run: a max distance (the
+     * clamp of every reconstructed distance) that is not finite and > 0
+     * is refused by the scene itself. */
+    const float bad_md[3] = {0.0f, -1.0f, INFINITY};
+    for (int i = 0; i < 4; i++) {
+        f.f.header.max_distance = i < 3 ? bad_md[i] : NAN;
+        vr_scene_desc md = {.file = &f.f, .skip_cubemaps = 1};
+        expect_fail("bad max distance in memory", &md, VR_ERR_FORMAT, "max_distance");
+    }
     rt_file_free(&f);
     vr_scene_desc sd = {.path = path};
     vr_scene *s = NULL;

@@ -22,6 +22,14 @@
  *   at        a light exactly at a receiver: visibility 1 there in every
  *             mode, quantity and encoding (vdsh_shadow_compare), and no
  *             NaN anywhere else.
+ *   horizon   a light just below one vertex's horizon, toward which that
+ *             vertex's log-distance stream runs away: every fragment
+ *             against vdsh_shadow_interior, so the vertex's distance is
+ *             clamped to the file's max distance as the definition says,
+ *             and the light does not leak across the triangle.
+ * The f32 files of "vertex" and "fragment" have a max distance (2) that
+ * clamps a good share of their distances, so every path is also checked
+ * where the clamp acts; the f16 files keep 100, which clamps almost none.
  */
 #include "test_runtime_util.h"
 
@@ -34,14 +42,24 @@ enum { CUBE_N = 64 };
 
 static const float LIGHT[3] = {0.3f, -0.2f, 0.1f};
 
-/* The monotone map from an SH sum to a distance, per quantity. */
-static float to_distance(uint32_t q, float sum)
+/* The monotone map from an SH sum to a distance, per quantity, clamped
+ * to max distance md. */
+static float to_distance(uint32_t q, float md, float sum)
 {
+    float d;
     if (q == VDSH_QUANTITY_DISTANCE2)
-        return sum > 0.0f ? sqrtf(sum) : 0.0f;
-    if (q == VDSH_QUANTITY_LOG_DISTANCE)
-        return expf(sum);
-    return sum > 0.0f ? sum : 0.0f;
+        d = sum > 0.0f ? sqrtf(sum) : 0.0f;
+    else if (q == VDSH_QUANTITY_LOG_DISTANCE)
+        d = expf(sum);
+    else
+        d = sum > 0.0f ? sum : 0.0f;
+    return d > md ? md : d;
+}
+
+/* The max distance of the files of encoding e (see the top). */
+static float file_max_distance(int e)
+{
+    return e ? 2.0f : 100.0f;
 }
 
 /* Random coefficients: c0 mostly positive (a mean distance), the rest
@@ -97,36 +115,38 @@ static float abs_terms(const float *c, const float d[3], int lo, int hi)
 }
 
 typedef struct tally {
-    long checked, zero, partial, one, ambiguous, bad;
+    long checked, zero, partial, one, ambiguous, bad, clamped;
 } tally;
 
 /* Check one receiver: GPU (s, dv, dl) against the C evaluation, with the
  * SH sum allowed to differ by tol_sum (float rounding; half-float basis
  * values on the cubemap path). */
-static void check_receiver(tally *t, const char *what, uint32_t q, uint32_t cmp, int order,
-                           const float *c, const float p[3], const float l[3],
+static void check_receiver(tally *t, const char *what, uint32_t q, float md, uint32_t cmp,
+                           int order, const float *c, const float p[3], const float l[3],
                            const float *gpu, float tol_sum)
 {
     float v[3] = {l[0] - p[0], l[1] - p[1], l[2] - p[2]};
     float dl = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
     float d[3] = {v[0] / dl, v[1] / dl, v[2] / dl};
     float sum = vdsh_sh_reconstruct(order, c, d);
-    float dv = vdsh_stream_distance((uint32_t)order, q, c, d);
-    float s = vdsh_shadow((uint32_t)order, q, c, p, l, cmp);
+    float dv = vdsh_stream_distance((uint32_t)order, q, md, c, d);
+    float s = vdsh_shadow((uint32_t)order, q, md, c, p, l, cmp);
     /* The interval of distances and visibilities the tolerance allows. */
-    float dv_lo = to_distance(q, sum - tol_sum), dv_hi = to_distance(q, sum + tol_sum);
+    float dv_lo = to_distance(q, md, sum - tol_sum), dv_hi = to_distance(q, md, sum + tol_sum);
     float dl_tol = 2e-6f * dl + 1e-7f;
     float s_lo = vdsh_shadow_compare(dv_lo, dl + dl_tol, cmp);
     float s_hi = vdsh_shadow_compare(dv_hi, dl - dl_tol, cmp);
     float eps_dv = 2e-6f * fabsf(dv) + 1e-6f;
     t->checked++;
+    t->clamped += to_distance(q, INFINITY, sum) > md;
     if (s == 0.0f)
         t->zero++;
     else if (s == 1.0f)
         t->one++;
     else
         t->partial++;
-    int ok = fabsf(gpu[2] - dl) <= dl_tol && gpu[1] >= dv_lo - eps_dv && gpu[1] <= dv_hi + eps_dv;
+    int ok = fabsf(gpu[2] - dl) <= dl_tol && gpu[1] >= dv_lo - eps_dv &&
+             gpu[1] <= dv_hi + eps_dv && gpu[1] <= md;
     if (cmp == VDSH_COMPARE_BINARY && s_lo != s_hi)
         t->ambiguous++; /* d_V within rounding of d_L: either answer is right */
     else
@@ -165,6 +185,7 @@ static void test_vertex(const char *dir)
     for (int e = 0; e < 2; e++) {
         rt_file *f = &files[e];
         rt_file_init(f, nv, 1);
+        f->f.header.max_distance = file_max_distance(e);
         /* Receiver (f, i, j) at distance t from the light, opposite the GL
          * texel centre direction of (f, i, j): seen from it, the light is
          * exactly in that direction. */
@@ -289,8 +310,8 @@ static void test_vertex(const char *dir)
                             float tol = 3e-6f * abs_terms(c, dd, 0, nc) + 1e-6f;
                             if (modes[m] == VR_MODE_VDSH5 && interp == VDSH_INTERP_SPLIT)
                                 tol += 6e-4f * abs_terms(c, dd, 9, 25);
-                            check_receiver(&total[m][cmp], what, q, cmp, mode_order[m], c, p,
-                                           LIGHT, px + 4 * k, tol);
+                            check_receiver(&total[m][cmp], what, q, file_max_distance(e), cmp,
+                                           mode_order[m], c, p, LIGHT, px + 4 * k, tol);
                         }
                         free(px);
                     }
@@ -299,14 +320,15 @@ static void test_vertex(const char *dir)
         for (int cmp = 0; cmp < 2; cmp++) {
             tally *t = &total[m][cmp];
             printf("vertex %-9s %-6s: %ld receivers checked (s = 0: %ld, 0 < s < 1: %ld, "
-                   "s = 1: %ld, binary ties skipped: %ld), %ld wrong\n",
+                   "s = 1: %ld, binary ties skipped: %ld, clamped: %ld), %ld wrong\n",
                    vr_mode_name(modes[m]), cmp ? "binary" : "smooth", t->checked, t->zero,
-                   t->partial, t->one, t->ambiguous, t->bad);
+                   t->partial, t->one, t->ambiguous, t->clamped, t->bad);
             CHECK(t->bad == 0, "%s %s: %ld receivers disagree", vr_mode_name(modes[m]),
                   cmp ? "binary" : "smooth", t->bad);
             CHECK(t->checked == 2L * 3 * 6 * CUBE_N * CUBE_N, "%ld checked", t->checked);
             /* the data must exercise every branch */
             CHECK(t->zero > t->checked / 50 && t->one > t->checked / 50, "coverage");
+            CHECK(t->clamped > t->checked / 50, "coverage of the clamp: %ld", t->clamped);
             if (cmp == 0)
                 CHECK(t->partial > t->checked / 50, "coverage of the ramp");
             CHECK(t->ambiguous < t->checked / 1000, "too many ties: %ld", t->ambiguous);
@@ -329,6 +351,7 @@ static void grid_file(rt_file *f, uint64_t *rng, uint32_t enc)
 {
     uint32_t n = GRID_Q + 1;
     rt_file_init(f, n * n, 2 * GRID_Q * GRID_Q);
+    f->f.header.max_distance = file_max_distance(enc == VDSH_ENCODING_F32);
     for (uint32_t j = 0; j < n; j++)
         for (uint32_t i = 0; i < n; i++) {
             uint32_t v = j * n + i;
@@ -378,16 +401,16 @@ static vr_draw_desc grid_view(const vr_light *light)
 
 /* The distances that SH sums within delta of the one behind distance d
  * give (d = 0 on a linear quantity: any sum <= 0). */
-static void distance_interval(uint32_t q, float d, float delta, float *lo, float *hi)
+static void distance_interval(uint32_t q, float md, float d, float delta, float *lo, float *hi)
 {
     if (!(d > 0.0f)) {
         *lo = 0.0f;
-        *hi = q == VDSH_QUANTITY_LOG_DISTANCE ? 0.0f : to_distance(q, delta);
+        *hi = q == VDSH_QUANTITY_LOG_DISTANCE ? 0.0f : to_distance(q, md, delta);
         return;
     }
     float sum = q == VDSH_QUANTITY_DISTANCE2 ? d * d : q == VDSH_QUANTITY_LOG_DISTANCE ? logf(d) : d;
-    *lo = to_distance(q, sum - delta);
-    *hi = to_distance(q, sum + delta);
+    *lo = to_distance(q, md, sum - delta);
+    *hi = to_distance(q, md, sum + delta);
 }
 
 /* The visibility path's interval without a model of it: [s_lo, s_hi] and
@@ -399,7 +422,7 @@ typedef struct bracket {
     float s_lo, s_hi, d_lo, d_hi;
 } bracket;
 
-static bracket interior_bracket(uint32_t order, uint32_t q, uint32_t interp,
+static bracket interior_bracket(uint32_t order, uint32_t q, float md, uint32_t interp,
                                 const float *const c[3], const float *const pv[3],
                                 const float b[3], const float l[3], uint32_t cmp, float delta)
 {
@@ -416,13 +439,13 @@ static bracket interior_bracket(uint32_t order, uint32_t q, uint32_t interp,
         ch[k] = hi[k];
     }
     bracket r;
-    r.s_lo = vdsh_shadow_interior(order, q, interp, cl, pv, b, l, cmp, &r.d_lo);
-    r.s_hi = vdsh_shadow_interior(order, q, interp, ch, pv, b, l, cmp, &r.d_hi);
+    r.s_lo = vdsh_shadow_interior(order, q, md, interp, cl, pv, b, l, cmp, &r.d_lo);
+    r.s_hi = vdsh_shadow_interior(order, q, md, interp, ch, pv, b, l, cmp, &r.d_hi);
     return r;
 }
 
 typedef struct frag_tally {
-    long checked, ramp, ties, bad, differ;
+    long checked, ramp, ties, bad, differ, clamped;
 } frag_tally;
 
 /* One fragment: GPU (s, d_V, d_L) in g against the definition on the
@@ -435,6 +458,7 @@ static void check_fragment(frag_tally *t, const char *what, const rt_file *f, in
 {
     int nc = order * order;
     uint32_t interp = vdsh_runtime_interp((uint32_t)order, q);
+    const float md = f->f.header.max_distance;
     const float *c[3], *pv[3];
     float mag = 0.0f, mag16 = 0.0f;
     for (int k = 0; k < 3; k++) {
@@ -462,43 +486,46 @@ static void check_fragment(frag_tally *t, const char *what, const rt_file *f, in
         delta += 5.0f * mag16 * 1e-6f / fmaxf(dl, 1e-6f);
     }
     float d_ref;
-    float s_ref = vdsh_shadow_interior((uint32_t)order, q, interp, c, pv, w, l, cmp, &d_ref);
+    float s_ref = vdsh_shadow_interior((uint32_t)order, q, md, interp, c, pv, w, l, cmp, &d_ref);
     /* The barycentrics come from a read-back position, not from the
      * rasteriser: allow their rounding times the vertices' values. */
     float span = 0.0f;
     for (int k = 0; k < 3; k++) {
         float e[3] = {k == 0, k == 1, k == 2}, dk;
-        vdsh_shadow_interior((uint32_t)order, q, interp, c, pv, e, l, cmp, &dk);
+        vdsh_shadow_interior((uint32_t)order, q, md, interp, c, pv, e, l, cmp, &dk);
         span += fabsf(dk);
     }
     float tol_b = 2e-5f * span + 1e-6f;
     float d_lo, d_hi, s_lo, s_hi;
     if (interp == VDSH_INTERP_VISIBILITY) {
         /* compared per vertex: the visibilities are interpolated */
-        bracket r = interior_bracket((uint32_t)order, q, interp, c, pv, w, l, cmp, delta);
+        bracket r = interior_bracket((uint32_t)order, q, md, interp, c, pv, w, l, cmp, delta);
         d_lo = r.d_lo - tol_b, d_hi = r.d_hi + tol_b;
         s_lo = r.s_lo - 1e-5f;
         s_hi = r.s_hi + 1e-5f;
     } else {
         /* one distance, compared here with this fragment's own d_L */
-        distance_interval(q, d_ref, delta, &d_lo, &d_hi);
+        distance_interval(q, md, d_ref, delta, &d_lo, &d_hi);
         d_lo -= tol_b, d_hi += tol_b;
         float dl_lo = fmaxf(0.0f, dl * (1.0f - 4e-6f) - 1e-7f), dl_hi = dl * (1.0f + 4e-6f) + 1e-7f;
         s_lo = vdsh_shadow_compare(d_lo, dl_hi, cmp) - 2e-5f;
         s_hi = vdsh_shadow_compare(d_hi, dl_lo, cmp) + 2e-5f;
     }
     t->checked++;
+    float d_wild;
+    vdsh_shadow_interior((uint32_t)order, q, INFINITY, interp, c, pv, w, l, cmp, &d_wild);
+    t->clamped += d_wild > d_ref;
     if (s_ref > 0.05f && s_ref < 0.95f)
         t->ramp++;
     if (s_hi - s_lo > 0.5f)
         t->ties++; /* binary, d_V within rounding of d_L: either answer */
     if (q == VDSH_QUANTITY_LOG_DISTANCE) {
-        float sc = vdsh_shadow_interior((uint32_t)order, q, VDSH_INTERP_COEFFICIENTS, c, pv, w, l,
-                                        cmp, NULL);
+        float sc = vdsh_shadow_interior((uint32_t)order, q, md, VDSH_INTERP_COEFFICIENTS, c, pv,
+                                        w, l, cmp, NULL);
         t->differ += fabsf(sc - s_ref) > 0.1f;
     }
     int ok = g[0] >= s_lo && g[0] <= s_hi && g[1] >= d_lo - 1e-6f * fabsf(d_lo) &&
-             g[1] <= d_hi + 1e-6f * fabsf(d_hi);
+             g[1] <= d_hi + 1e-6f * fabsf(d_hi) && g[1] <= md;
     if (interp != VDSH_INTERP_VISIBILITY)
         ok = ok && fabsf(g[2] - dl) <= 4e-6f * dl + 2e-7f;
     if (at_light && interp != VDSH_INTERP_VISIBILITY) {
@@ -614,17 +641,21 @@ static void test_fragment(void)
                             sum[a]->ties += t.ties;
                             sum[a]->bad += t.bad;
                             sum[a]->differ += t.differ;
+                            sum[a]->clamped += t.clamped;
                         }
                     }
     for (uint32_t i = 0; i < 4; i++) {
         frag_tally *t = &paths[i];
         if (!t->checked)
             continue;
-        printf("fragment, path %-10s: %ld pixels checked (%ld in the ramp, %ld binary ties), "
-               "%ld wrong\n", vdsh_interp_name(i), t->checked, t->ramp, t->ties, t->bad);
+        printf("fragment, path %-10s: %ld pixels checked (%ld in the ramp, %ld binary ties, "
+               "%ld clamped), %ld wrong\n", vdsh_interp_name(i), t->checked, t->ramp, t->ties,
+               t->clamped, t->bad);
         CHECK(t->bad == 0, "path %s: %ld fragments disagree", vdsh_interp_name(i), t->bad);
         CHECK(t->ramp > t->checked / 50, "path %s: ramp coverage %ld", vdsh_interp_name(i),
               t->ramp);
+        CHECK(t->clamped > t->checked / 50, "path %s: clamp coverage %ld", vdsh_interp_name(i),
+              t->clamped);
         /* the cubemaps' half-float, filtered basis widens the split
          * path's interval: more binary answers are left open there */
         CHECK(t->ties < t->checked / (i == VDSH_INTERP_SPLIT ? 20 : 200), "path %s: %ld ties",
@@ -675,8 +706,9 @@ static void test_light_at_receiver(void)
         for (uint32_t q = 0; q < 3; q++) {
             /* The C definition first. */
             const float *c5 = stream_coefs(&f, 5, q) + 25 * at;
-            CHECK(vdsh_shadow(5, q, c5, L, L, VDSH_COMPARE_SMOOTH) == 1.0f, "C");
-            CHECK(vdsh_shadow(5, q, c5, L, L, VDSH_COMPARE_BINARY) == 1.0f, "C");
+            float md = f.f.header.max_distance;
+            CHECK(vdsh_shadow(5, q, md, c5, L, L, VDSH_COMPARE_SMOOTH) == 1.0f, "C");
+            CHECK(vdsh_shadow(5, q, md, c5, L, L, VDSH_COMPARE_BINARY) == 1.0f, "C");
 
             vr_scene *s = NULL;
             vr_scene_desc sd = {.file = &f.f, .quantity = q, .cubemap_dir = g_dir,
@@ -734,6 +766,149 @@ static void test_light_at_receiver(void)
     vr_renderer_destroy(r);
 }
 
+/* ------------------------------------------------------------------ */
+
+/* One triangle a, b, c in z = 0 seen from +z, lit from in front. The
+ * light is 3 degrees below a's horizon (a's smooth normal is turned away
+ * from it, as at a terminator) and above b's and c's. b and c see an
+ * occluder 0.3 away in every direction: ln D = ln 0.3. a's stream runs
+ * away toward the light, as fits do where nothing constrains them:
+ * ln D(w) = ln 0.3 + 14 (u . w), u the direction from a to the light, so
+ * that D toward it is 3.6e5 while the file's max distance is 4.
+ * Unclamped, a's distance interpolated over the triangle lit all of it;
+ * clamped, the side near b-c stays dark. (tests/test_sh.c checks the
+ * same case in C.) */
+static void test_horizon(void)
+{
+    static const float A[3] = {-1, -1, 0}, B[3] = {1, -1, 0}, C[3] = {-1, 1, 0};
+    static const float L[3] = {0.5f, 0.5f, 1.5f};
+    const float md = 4.0f, beta = 14.0f, eps = 3.0f * 3.14159265f / 180.0f;
+    const float c00 = 0.28209479177387814f, c1 = 0.4886025119029199f;
+    float u[3], len = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        u[k] = L[k] - A[k];
+        len += u[k] * u[k];
+    }
+    for (int k = 0; k < 3; k++)
+        u[k] /= sqrtf(len);
+
+    rt_file f;
+    rt_file_init(&f, 3, 1);
+    f.f.header.max_distance = md;
+    memcpy(f.pos, A, sizeof A);
+    memcpy(f.pos + 3, B, sizeof B);
+    memcpy(f.pos + 6, C, sizeof C);
+    /* a's normal: w (+z made perpendicular to u) turned 3 degrees past u */
+    float w[3] = {-u[2] * u[0], -u[2] * u[1], 1.0f - u[2] * u[2]};
+    float wl = sqrtf(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    for (int k = 0; k < 3; k++)
+        f.nrm[k] = -sinf(eps) * u[k] + cosf(eps) * w[k] / wl;
+    f.nrm[5] = f.nrm[8] = 1.0f;
+    f.idx[0] = 0, f.idx[1] = 1, f.idx[2] = 2;
+    rt_file_bounds(&f);
+    static const int orders[3] = {2, 3, 5};
+    for (int o = 0; o < 3; o++) {
+        int nc = orders[o] * orders[o];
+        float *c = calloc(3 * (size_t)nc, sizeof(float));
+        for (int v = 0; v < 3; v++)
+            c[v * nc] = logf(0.3f) / c00;
+        c[1] = -beta * u[1] / c1; /* Y_1-1 = -C1 y, Y_10 = C1 z, Y_11 = -C1 x */
+        c[2] = beta * u[2] / c1;
+        c[3] = -beta * u[0] / c1;
+        rt_file_add_stream(&f, (uint32_t)orders[o], VDSH_ENCODING_F32,
+                           VDSH_QUANTITY_LOG_DISTANCE, c, 1.0f);
+    }
+    float cosn = 0.0f;
+    for (int k = 0; k < 3; k++)
+        cosn += f.nrm[k] * u[k];
+    const float *c2 = stream_coefs(&f, 2, VDSH_QUANTITY_LOG_DISTANCE);
+    CHECK(cosn < -0.05f && cosn > -0.06f &&
+              vdsh_stream_distance(2, VDSH_QUANTITY_LOG_DISTANCE, INFINITY, c2, u) > 1e5f,
+          "the case: the light at %g below a's horizon", cosn);
+
+    vr_scene *s = NULL;
+    vr_renderer *r = NULL;
+    vr_error err;
+    vr_scene_desc sd = {.file = &f.f};
+    CHECK(vr_scene_create(&sd, &s, &err) == VR_OK, "%s", err.msg);
+    vr_renderer_desc rd = {.width = GRID_PX, .height = GRID_PX,
+                           .color_format = VR_COLOR_RGBA32F};
+    CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
+    if (!s || !r) {
+        vr_scene_destroy(s);
+        vr_renderer_destroy(r);
+        rt_file_free(&f);
+        return;
+    }
+    vr_scene_info info;
+    vr_scene_get_info(s, &info);
+    CHECK(info.max_distance == md, "scene info: max distance %g", info.max_distance);
+    vr_light light = {.position = {L[0], L[1], L[2]}};
+    vr_draw_desc d = grid_view(&light);
+    d.mode = VR_MODE_NONE;
+    d.output = VR_OUTPUT_POSITION;
+    rt_draw_or_die(r, s, &d);
+    float *pos = rt_read(r, GRID_PX, GRID_PX);
+
+    static const vr_mode modes[4] = {VR_MODE_VDSH2, VR_MODE_VDSH3, VR_MODE_VDSH5,
+                                     VR_MODE_VDSH5_POLY};
+    static const int mode_order[4] = {2, 3, 5, 5};
+    const uint32_t q = VDSH_QUANTITY_LOG_DISTANCE, tri[3] = {0, 1, 2};
+    for (int m = 0; m < 4; m++)
+        for (uint32_t cmp = 0; cmp < 2; cmp++) {
+            vr_draw_desc ds = grid_view(&light);
+            ds.mode = modes[m];
+            ds.compare = cmp;
+            ds.output = VR_OUTPUT_SHADOW;
+            rt_draw_or_die(r, s, &ds);
+            float *px = rt_read(r, GRID_PX, GRID_PX);
+            const float *coefs = stream_coefs(&f, mode_order[m], q);
+            const float *cv[3], *pv[3] = {A, B, C};
+            for (int k = 0; k < 3; k++)
+                cv[k] = coefs + (size_t)k * (size_t)(mode_order[m] * mode_order[m]);
+            char what[96];
+            snprintf(what, sizeof what, "horizon %s %s", vr_mode_name(modes[m]),
+                     cmp ? "binary" : "smooth");
+            frag_tally t;
+            memset(&t, 0, sizeof t);
+            long dark = 0, leak_stopped = 0;
+            float worst = 0.0f;
+            for (int k = 0; k < GRID_PX * GRID_PX; k++) {
+                const float *p = pos + 4 * k, *g = px + 4 * k;
+                if (p[3] != 1.0f)
+                    continue;
+                /* barycentrics in the right triangle a, b, c */
+                float b[3] = {0.0f, 0.5f * (p[0] + 1.0f), 0.5f * (p[1] + 1.0f)};
+                b[0] = 1.0f - b[1] - b[2];
+                check_fragment(&t, what, &f, mode_order[m], q, modes[m], cmp, coefs, p, tri, b,
+                               L, g, 0);
+                worst = fmaxf(worst, g[1]);
+                float s_wild = vdsh_shadow_interior((uint32_t)mode_order[m], q, INFINITY,
+                                                    VDSH_INTERP_DISTANCE, cv, pv, b, L, cmp,
+                                                    NULL);
+                dark += g[0] < 0.5f;
+                leak_stopped += g[0] < 0.5f && s_wild > 0.5f;
+            }
+            free(px);
+            printf("horizon %-9s %s: %ld fragments checked, %ld wrong, %ld dark, %ld of them "
+                   "lit without the clamp; largest distance %g (max %g)\n",
+                   vr_mode_name(modes[m]), cmp ? "binary" : "smooth", t.checked, t.bad, dark,
+                   leak_stopped, worst, md);
+            CHECK(t.bad == 0, "%s: %ld fragments disagree with vdsh_shadow_interior", what, t.bad);
+            CHECK(t.checked > GRID_PX * GRID_PX / 4, "%s: only %ld fragments", what, t.checked);
+            CHECK(worst <= md, "%s: a distance of %g past the max distance", what, worst);
+            /* the side near b-c, where a's weight is small (about half
+             * the triangle), is dark, and was lit unclamped */
+            CHECK(leak_stopped > t.checked / 5 && leak_stopped == dark,
+                  "%s: %ld of %ld fragments dark, %ld of them lit unclamped", what, dark,
+                  t.checked, leak_stopped);
+        }
+    free(pos);
+    vr_renderer_destroy(r);
+    vr_scene_destroy(s);
+    rt_file_free(&f);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1)
@@ -743,6 +918,7 @@ int main(int argc, char **argv)
     test_vertex(g_dir);
     test_fragment();
     test_light_at_receiver();
+    test_horizon();
     vr_context_destroy(ctx);
     return test_report("test_runtime_glsl");
 }

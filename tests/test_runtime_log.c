@@ -181,10 +181,11 @@ int main(int argc, char **argv)
                     if (near < 4.0f)
                         continue; /* only fragments far from every vertex */
                     float dv;
-                    float s_dist = vdsh_shadow_interior((uint32_t)order, q, interp, cp, pv, b,
-                                                     lights[li], cmp, &dv);
-                    float sc = vdsh_shadow_interior((uint32_t)order, q, VDSH_INTERP_COEFFICIENTS,
-                                                    cp, pv, b, lights[li], cmp, NULL);
+                    float s_dist = vdsh_shadow_interior((uint32_t)order, q, h->max_distance,
+                                                        interp, cp, pv, b, lights[li], cmp, &dv);
+                    float sc = vdsh_shadow_interior((uint32_t)order, q, h->max_distance,
+                                                    VDSH_INTERP_COEFFICIENTS, cp, pv, b,
+                                                    lights[li], cmp, NULL);
                     /* the truth: the box toward the light, or nothing */
                     float w[3] = {lights[li][0] - p[0], lights[li][1] - p[1],
                                   lights[li][2] - p[2]};

@@ -229,7 +229,7 @@ static void test_shadow(void)
      * so interpolating it with a zero weight is 0, not NaN. */
     {
         float big[25] = {1000.0f}, up[3] = {0.0f, 0.0f, 1.0f};
-        float dv = vdsh_stream_distance(5, VDSH_QUANTITY_LOG_DISTANCE, big, up);
+        float dv = vdsh_stream_distance(5, VDSH_QUANTITY_LOG_DISTANCE, INFINITY, big, up);
         CHECK(isfinite(dv) && dv > 1e30f, "huge log sum reads as %g", dv);
         CHECK(0.0f * dv == 0.0f, "0 * its distance is not 0");
     }
@@ -250,25 +250,28 @@ static void test_shadow(void)
     float c[25] = {0};
     c[0] = (float)(4.0 * sqrt(4.0 * M_PI));
     float p[3] = {1, 2, 3}, near[3] = {1, 2, 5}, far[3] = {1, 2, 23}, mid[3] = {1, 2, 9};
-    CHECK(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, c, p, near, VDSH_COMPARE_SMOOTH) == 1.0f,
+    CHECK(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, INFINITY, c, p, near, VDSH_COMPARE_SMOOTH) == 1.0f,
           "light at 2 < D = 4 must be lit");
-    CHECK(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, c, p, far, VDSH_COMPARE_SMOOTH) == 0.0f,
+    CHECK(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, INFINITY, c, p, far, VDSH_COMPARE_SMOOTH) == 0.0f,
           "light at 20 > 3 D must be dark");
-    CHECK(fabsf(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, c, p, mid, VDSH_COMPARE_SMOOTH) - 0.5f) < 1e-5f,
+    CHECK(fabsf(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, INFINITY, c, p, mid,
+                            VDSH_COMPARE_SMOOTH) - 0.5f) < 1e-5f,
           "light at 6 = 1.5 D gives ramp(2/3) = 0.5");
-    CHECK(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, c, p, p, VDSH_COMPARE_SMOOTH) == 1.0f,
+    CHECK(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, INFINITY, c, p, p, VDSH_COMPARE_SMOOTH) == 1.0f,
           "light exactly at the receiver");
     float neg[25] = {0};
     neg[0] = -1.0f;
-    CHECK(vdsh_stream_distance(3, VDSH_QUANTITY_DISTANCE, neg, near) == 0.0f, "negative rings to 0");
+    CHECK(vdsh_stream_distance(3, VDSH_QUANTITY_DISTANCE, INFINITY, neg, near) == 0.0f,
+          "negative rings to 0");
     float lg[25] = {0};
     lg[0] = (float)(log(4.0) * sqrt(4.0 * M_PI));
     float d[3] = {0, 0, 1};
-    CHECK(fabsf(vdsh_stream_distance(2, VDSH_QUANTITY_LOG_DISTANCE, lg, d) - 4.0f) < 1e-4f,
+    CHECK(fabsf(vdsh_stream_distance(2, VDSH_QUANTITY_LOG_DISTANCE, INFINITY, lg, d) - 4.0f) <
+              1e-4f,
           "log-distance reconstructs exp of the sum");
     float sq[25] = {0};
     sq[0] = (float)(16.0 * sqrt(4.0 * M_PI));
-    CHECK(fabsf(vdsh_stream_distance(2, VDSH_QUANTITY_DISTANCE2, sq, d) - 4.0f) < 1e-4f,
+    CHECK(fabsf(vdsh_stream_distance(2, VDSH_QUANTITY_DISTANCE2, INFINITY, sq, d) - 4.0f) < 1e-4f,
           "distance2 reconstructs the square root");
 }
 
@@ -292,8 +295,9 @@ static void test_interior(void)
             for (int k = 0; k < 3; k++) {
                 float b[3] = {0, 0, 0};
                 b[k] = 1.0f;
-                float want = vdsh_shadow(5, q, c[k], pv[k], l, VDSH_COMPARE_SMOOTH);
-                float got = vdsh_shadow_interior(5, q, m, c, pv, b, l, VDSH_COMPARE_SMOOTH, NULL);
+                float want = vdsh_shadow(5, q, INFINITY, c[k], pv[k], l, VDSH_COMPARE_SMOOTH);
+                float got = vdsh_shadow_interior(5, q, INFINITY, m, c, pv, b, l,
+                                                 VDSH_COMPARE_SMOOTH, NULL);
                 CHECK(fabsf(got - want) < 1e-5f, "%s, quantity %u, vertex %d: %g vs %g",
                       vdsh_interp_name(m), q, k, got, want);
             }
@@ -302,11 +306,11 @@ static void test_interior(void)
     k1[0] = k2[0] = (float)(3.0 * sqrt(4.0 * M_PI)); /* D = 3 everywhere */
     const float *kc[3] = {k1, k2, k1}, b[3] = {0.2f, 0.5f, 0.3f};
     float dc, dd, ds;
-    vdsh_shadow_interior(3, VDSH_QUANTITY_DISTANCE, VDSH_INTERP_COEFFICIENTS, kc, pv, b, l,
-                         VDSH_COMPARE_SMOOTH, &dc);
-    vdsh_shadow_interior(3, VDSH_QUANTITY_DISTANCE, VDSH_INTERP_DISTANCE, kc, pv, b, l,
+    vdsh_shadow_interior(3, VDSH_QUANTITY_DISTANCE, INFINITY, VDSH_INTERP_COEFFICIENTS, kc, pv, b,
+                         l, VDSH_COMPARE_SMOOTH, &dc);
+    vdsh_shadow_interior(3, VDSH_QUANTITY_DISTANCE, INFINITY, VDSH_INTERP_DISTANCE, kc, pv, b, l,
                          VDSH_COMPARE_SMOOTH, &dd);
-    vdsh_shadow_interior(5, VDSH_QUANTITY_DISTANCE, VDSH_INTERP_SPLIT, kc, pv, b, l,
+    vdsh_shadow_interior(5, VDSH_QUANTITY_DISTANCE, INFINITY, VDSH_INTERP_SPLIT, kc, pv, b, l,
                          VDSH_COMPARE_SMOOTH, &ds);
     CHECK(fabsf(dc - 3) < 1e-5f && fabsf(dd - 3) < 1e-5f && fabsf(ds - 3) < 1e-5f,
           "constant D = 3: %g %g %g", dc, dd, ds);
@@ -314,20 +318,20 @@ static void test_interior(void)
     float g1[25] = {0}, g2[25] = {0};
     g1[0] = (float)(log(1.0) * sqrt(4.0 * M_PI)), g2[0] = (float)(log(100.0) * sqrt(4.0 * M_PI));
     const float *gc[3] = {g1, g2, g2}, half[3] = {0.5f, 0.5f, 0.0f};
-    vdsh_shadow_interior(2, VDSH_QUANTITY_LOG_DISTANCE, VDSH_INTERP_COEFFICIENTS, gc, pv, half,
-                         l, VDSH_COMPARE_SMOOTH, &dc);
-    vdsh_shadow_interior(2, VDSH_QUANTITY_LOG_DISTANCE, VDSH_INTERP_DISTANCE, gc, pv, half, l,
-                         VDSH_COMPARE_SMOOTH, &dd);
+    vdsh_shadow_interior(2, VDSH_QUANTITY_LOG_DISTANCE, INFINITY, VDSH_INTERP_COEFFICIENTS, gc, pv,
+                         half, l, VDSH_COMPARE_SMOOTH, &dc);
+    vdsh_shadow_interior(2, VDSH_QUANTITY_LOG_DISTANCE, INFINITY, VDSH_INTERP_DISTANCE, gc, pv,
+                         half, l, VDSH_COMPARE_SMOOTH, &dd);
     CHECK(fabsf(dc - 10.0f) < 1e-3f, "log coefficients: geometric mean 10, got %g", dc);
     CHECK(fabsf(dd - 50.5f) < 1e-3f, "log distances: arithmetic mean 50.5, got %g", dd);
 
     for (uint32_t m = 0; m < 4; m++) {
         float at_a[3] = {1, 0, 0};
-        float v = vdsh_shadow_interior(5, VDSH_QUANTITY_DISTANCE, m, c, pv, at_a, pa,
+        float v = vdsh_shadow_interior(5, VDSH_QUANTITY_DISTANCE, INFINITY, m, c, pv, at_a, pa,
                                        VDSH_COMPARE_SMOOTH, &dd);
         CHECK(v == 1.0f && isfinite(dd), "%s: light at the vertex gives %g", vdsh_interp_name(m), v);
         float mid[3] = {0.25f, 0.25f, 0.5f};
-        v = vdsh_shadow_interior(5, VDSH_QUANTITY_DISTANCE, m, c, pv, mid, pa,
+        v = vdsh_shadow_interior(5, VDSH_QUANTITY_DISTANCE, INFINITY, m, c, pv, mid, pa,
                                  VDSH_COMPARE_SMOOTH, &dd);
         CHECK(v >= 0 && v <= 1 && isfinite(dd), "%s: light at a corner, inside: %g",
               vdsh_interp_name(m), v);
@@ -368,10 +372,154 @@ static void test_project(void)
     }
 }
 
+/* ---- the clamp to the bake's max distance -------------------------------- */
+
+/* Vertex a of a triangle whose light is just below a's horizon (a smooth
+ * normal at a terminator: the neighbours see it above theirs), and whose
+ * log-distance stream, unconstrained there by the fit, runs away toward
+ * it: ln D(w) = ln 0.3 + beta (u . w), u the direction from a to the
+ * light. The other two vertices see an occluder 0.3 away in every
+ * direction. Order-2 coefficients (bands 0-1; higher bands 0). */
+enum { HZ_ORDER = 5 };
+#define HZ_MAX 4.0f
+static const float HZ_A[3] = {-1, -1, 0}, HZ_B[3] = {1, -1, 0}, HZ_C[3] = {-1, 1, 0};
+static const float HZ_LIGHT[3] = {0.5f, 0.5f, 1.5f};
+
+static void horizon_streams(float beta, float ca[25], float cb[25], float n_a[3])
+{
+    const float c00 = 0.28209479177387814f, c1 = 0.4886025119029199f;
+    float u[3], len = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        u[k] = HZ_LIGHT[k] - HZ_A[k];
+        len += u[k] * u[k];
+    }
+    for (int k = 0; k < 3; k++)
+        u[k] /= sqrtf(len);
+    /* n_a: turned from +z so that the light is 3 degrees below it */
+    float z[3] = {0, 0, 1}, w[3], wl = 0.0f, eps = 3.0f * (float)M_PI / 180.0f;
+    for (int k = 0; k < 3; k++) {
+        w[k] = z[k] - u[2] * u[k];
+        wl += w[k] * w[k];
+    }
+    for (int k = 0; k < 3; k++)
+        n_a[k] = -sinf(eps) * u[k] + cosf(eps) * w[k] / sqrtf(wl);
+    memset(ca, 0, 25 * sizeof(float));
+    memset(cb, 0, 25 * sizeof(float));
+    ca[0] = cb[0] = logf(0.3f) / c00;
+    /* Y_1-1 = -C1 y, Y_10 = C1 z, Y_11 = -C1 x */
+    ca[1] = -beta * u[1] / c1;
+    ca[2] = beta * u[2] / c1;
+    ca[3] = -beta * u[0] / c1;
+}
+
+static void test_clamp_horizon(void)
+{
+    float ca[25], cb[25], n_a[3];
+    horizon_streams(14.0f, ca, cb, n_a);
+    float to_light[3], dl = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        to_light[k] = HZ_LIGHT[k] - HZ_A[k];
+        dl += to_light[k] * to_light[k];
+    }
+    dl = sqrtf(dl);
+    float cosn = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        to_light[k] /= dl;
+        cosn += to_light[k] * n_a[k];
+    }
+    CHECK(cosn < -0.05f && cosn > -0.06f, "the light is not just below a's horizon: %g", cosn);
+    const uint32_t q = VDSH_QUANTITY_LOG_DISTANCE;
+    for (uint32_t order = 2; order <= HZ_ORDER; order++) {
+        /* the runaway, and the clamp */
+        float wild = vdsh_stream_distance(order, q, INFINITY, ca, to_light);
+        float d = vdsh_stream_distance(order, q, HZ_MAX, ca, to_light);
+        CHECK(wild > 1e5f && d == HZ_MAX, "order %u: toward the light %g, clamped %g", order,
+              wild, d);
+        /* Near the edge b-c, which sees the occluder: dark. Unclamped,
+         * a's distance interpolated over the triangle lit it. */
+        const float *c[3] = {ca, cb, cb}, *pv[3] = {HZ_A, HZ_B, HZ_C};
+        const float bary[3] = {0.05f, 0.475f, 0.475f};
+        for (uint32_t cmp = 0; cmp < 2; cmp++) {
+            float dv, dv_wild;
+            float s = vdsh_shadow_interior(order, q, HZ_MAX, VDSH_INTERP_DISTANCE, c, pv, bary,
+                                           HZ_LIGHT, cmp, &dv);
+            float s_wild = vdsh_shadow_interior(order, q, INFINITY, VDSH_INTERP_DISTANCE, c, pv,
+                                                bary, HZ_LIGHT, cmp, &dv_wild);
+            CHECK(s < 0.5f && dv <= 0.05f * HZ_MAX + 0.95f * 0.3f + 1e-5f,
+                  "order %u %s: a light leak near b-c: s %g, distance %g", order,
+                  cmp ? "binary" : "smooth", s, dv);
+            CHECK(s_wild == 1.0f, "order %u: the case does not tell the clamp apart (%g, %g)",
+                  order, s_wild, dv_wild);
+            /* on every path the distance compared stays within the clamp */
+            for (uint32_t m = 0; m < 4; m++) {
+                vdsh_shadow_interior(order, q, HZ_MAX, m, c, pv, bary, HZ_LIGHT, cmp, &dv);
+                CHECK(dv >= 0.0f && dv <= HZ_MAX, "order %u %s: distance %g", order,
+                      vdsh_interp_name(m), dv);
+            }
+        }
+        /* and vdsh_shadow at a itself: the light counts as visible (it
+         * is at dl < max distance) rather than whatever the sum said */
+        CHECK(vdsh_shadow(order, q, HZ_MAX, ca, HZ_A, HZ_LIGHT, VDSH_COMPARE_BINARY) == 1.0f,
+              "order %u: at a", order);
+    }
+}
+
+/* No reconstruction exceeds max_distance, for any quantity, order, path
+ * and direction (below the horizon too), wild coefficients included; it
+ * is exactly max_distance where the unclamped value is above it, and
+ * the unclamped value elsewhere. */
+static void test_clamp_never_exceeds(void)
+{
+    uint64_t s = 11;
+    long checked = 0, clamped = 0;
+    const float md = 7.5f;
+    for (int trial = 0; trial < 2000; trial++) {
+        uint32_t q = (uint32_t)(trial % 3), order = 1 + (uint32_t)(trial / 3 % 5);
+        float c[3][25];
+        double spread = trial % 7 == 0 ? 400.0 : 6.0; /* some far past any fit */
+        for (int k = 0; k < 3; k++)
+            for (int i = 0; i < 25; i++)
+                c[k][i] = (float)(spread * (test_rand(&s) - 0.3));
+        float d[3];
+        test_rand_dir(&s, d);
+        float dv = vdsh_stream_distance(order, q, md, c[0], d);
+        float wild = vdsh_stream_distance(order, q, INFINITY, c[0], d);
+        CHECK(dv >= 0.0f && dv <= md && dv == (wild > md ? md : wild),
+              "quantity %u order %u: %g (unclamped %g)", q, order, dv, wild);
+        clamped += wild > md;
+        const float *cp[3] = {c[0], c[1], c[2]};
+        const float pa[3] = {0, 0, 0}, pb[3] = {0.5f, 0, 0}, pc[3] = {0, 0.5f, 0};
+        const float *pv[3] = {pa, pb, pc};
+        float b[3] = {(float)test_rand(&s), (float)test_rand(&s), 0.0f}, l[3];
+        if (b[0] + b[1] > 1.0f)
+            b[0] = 1.0f - b[0], b[1] = 1.0f - b[1];
+        b[2] = 1.0f - b[0] - b[1];
+        test_rand_dir(&s, l);
+        for (int k = 0; k < 3; k++)
+            l[k] *= 4.0f * (float)test_rand(&s);
+        for (uint32_t m = 0; m < 4; m++) {
+            float dvis = -1.0f;
+            float vis = vdsh_shadow_interior(order, q, md, m, cp, pv, b, l, VDSH_COMPARE_SMOOTH,
+                                             &dvis);
+            CHECK(dvis >= 0.0f && dvis <= md * (1.0f + 1e-6f) && vis >= 0.0f && vis <= 1.0f,
+                  "%s quantity %u order %u: distance %g, visibility %g", vdsh_interp_name(m), q,
+                  order, dvis, vis);
+        }
+        checked++;
+    }
+    /* a log sum beyond VDSH_LOG_SUM_MAX: the clamp, not e^80 */
+    float big[25] = {1000.0f}, up[3] = {0.0f, 0.0f, 1.0f};
+    CHECK(vdsh_stream_distance(5, VDSH_QUANTITY_LOG_DISTANCE, md, big, up) == md, "huge log sum");
+    CHECK(checked == 2000 && clamped > checked / 10 && clamped < checked * 9 / 10,
+          "coverage: %ld of %ld clamped", clamped, checked);
+}
+
 int main(void)
 {
     test_shadow();
     test_interior();
+    test_clamp_horizon();
+    test_clamp_never_exceeds();
     test_project();
     test_orthonormal();
     test_design_values();
