@@ -22,6 +22,7 @@
 #include "sampling.h"
 #include "vdsh_sh.h"
 #include "vdsh_shadow.h"
+#include "vdsh_light.h"
 
 #define BLOCK 32 /* receivers per work item */
 
@@ -32,7 +33,8 @@ enum {
     PURPOSE_DIRECTIONS = 0x44495253u, /* "DIRS" */
     PURPOSE_LIGHTS = 0x4c474854u,     /* "LGHT" */
     PURPOSE_VERTICES = 0x56525453u,   /* "VRTS" */
-    PURPOSE_INTERIOR = 0x494e5452u    /* "INTR" */
+    PURPOSE_INTERIOR = 0x494e5452u,   /* "INTR" */
+    PURPOSE_SCENE_LIGHTS = 0x53434e4cu /* "SCNL" */
 };
 
 static uint64_t purpose_seed(uint64_t seed, uint32_t purpose)
@@ -134,6 +136,15 @@ typedef struct racc {
     uint32_t ringing;                 /* D == 0: the sum rang to <= 0 */
 } racc;
 
+/* One receiver's sums for one stream under the scene lights. */
+typedef struct sacc {
+    double mae, mae_bin;
+    uint32_t n;
+    uint32_t vis, fals, fals_bin;     /* d_T >= d_L; s_hat < .5; D < d_L */
+    uint32_t occ, hit, leak;          /* s_ideal < .5; s_hat < .5; s_hat > .5 */
+    uint32_t occ_bin, hit_bin;        /* d_T < d_L; D < d_L */
+} sacc;
+
 typedef struct rtruth {
     uint32_t n, near_zero, escaped;
 } rtruth;
@@ -147,6 +158,10 @@ typedef struct job {
     uint32_t rec_count;
     uint32_t streams;
     racc *acc;             /* rec_count * streams */
+    sacc *sacc;            /* rec_count * streams: scene lights */
+    uint32_t light_count;
+    const float (*lights)[3];       /* scene units */
+    const float (*lights_local)[3]; /* traced frame */
     rtruth *truth;         /* rec_count */
     uint64_t *hist;        /* per worker: KINDS * streams * HIST_BINS */
     uint64_t dir_seed, light_seed;
@@ -162,6 +177,103 @@ static void receiver_coeffs(const vdsh_file *f, const vdsh_stream *s,
         vdsh_stream_decode(s, r->index, c);
     else
         vb_eval_interpolate(f, s, r->triangle, r->bary, NULL, NULL, c);
+}
+
+/* The scene lights at one receiver: every light above its horizon, the
+ * truth traced from the receiver's origin toward it (16 at a time), the
+ * streams evaluated toward it on the path the runtime draws them. */
+static void eval_scene_lights(job *J, uint32_t ri, const float coef[][VDSH_MAX_COEFFS],
+                              const float vc[][3][VDSH_MAX_COEFFS], const float *const pv[3],
+                              const uint32_t *interp, int corners)
+{
+    const receiver *r = J->rec + ri;
+    const vdsh_file *f = J->f;
+    const uint32_t S = J->streams;
+    sacc *acc = J->sacc + (size_t)ri * S;
+    const float scale = J->scene->scale;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    for (uint32_t first = 0; first < J->light_count; first += VB_PACKET) {
+        struct RTCRay16 ray __attribute__((aligned(64)));
+        int valid[VB_PACKET] __attribute__((aligned(64)));
+        float dl[VB_PACKET], w[VB_PACKET][3];
+        for (int k = 0; k < VB_PACKET; k++) {
+            uint32_t l = first + (uint32_t)k;
+            valid[k] = 0;
+            ray.tnear[k] = 0.0f, ray.tfar[k] = 0.0f, ray.time[k] = 0.0f;
+            ray.mask[k] = 0xffffffffu, ray.id[k] = (unsigned)k, ray.flags[k] = 0;
+            ray.org_x[k] = r->origin[0], ray.org_y[k] = r->origin[1], ray.org_z[k] = r->origin[2];
+            ray.dir_x[k] = 0.0f, ray.dir_y[k] = 0.0f, ray.dir_z[k] = 1.0f;
+            dl[k] = 0.0f;
+            if (l >= J->light_count)
+                continue;
+            const float *L = J->lights[l], *Ll = J->lights_local[l];
+            float v[3] = {L[0] - r->position[0], L[1] - r->position[1], L[2] - r->position[2]};
+            float d = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            if (!(d > 0.0f) || v[0] * r->normal[0] + v[1] * r->normal[1] + v[2] * r->normal[2] <= 0.0f)
+                continue; /* at the receiver, or below its horizon: not lit */
+            for (int a = 0; a < 3; a++)
+                w[k][a] = v[a] / d;
+            /* The truth ray runs from the origin to the light itself. */
+            float o2l[3] = {Ll[0] - r->origin[0], Ll[1] - r->origin[1], Ll[2] - r->origin[2]};
+            float dlocal = sqrtf(o2l[0] * o2l[0] + o2l[1] * o2l[1] + o2l[2] * o2l[2]);
+            if (!(dlocal > 0.0f))
+                continue;
+            ray.dir_x[k] = o2l[0] / dlocal, ray.dir_y[k] = o2l[1] / dlocal;
+            ray.dir_z[k] = o2l[2] / dlocal;
+            ray.tfar[k] = dlocal;
+            dl[k] = d;
+            valid[k] = -1;
+        }
+        struct RTCRayHit16 rh __attribute__((aligned(64)));
+        rh.ray = ray;
+        for (int k = 0; k < VB_PACKET; k++) {
+            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect16(valid, J->scene->scene, &ctx, &rh);
+        for (int k = 0; k < VB_PACKET; k++) {
+            if (!valid[k])
+                continue;
+            /* Nothing before the light: visible (d_T is larger than d_L). */
+            const float dt = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID
+                                 ? rh.ray.tfar[k] / scale : INFINITY;
+            const float L0 = dl[k];
+            const float s_ideal = vdsh_shadow_compare(dt, L0, VDSH_COMPARE_SMOOTH);
+            const int vis = dt >= L0, occ = s_ideal < 0.5f, occ_bin = dt < L0;
+            const float *L = J->lights[first + (uint32_t)k];
+            for (uint32_t s = 0; s < S; s++) {
+                const vdsh_stream *st = &f->streams[s];
+                float D, s_hat;
+                if (J->d->oracle) {
+                    D = dt;
+                    s_hat = vdsh_shadow_compare(D, L0, VDSH_COMPARE_SMOOTH);
+                } else if (!corners) {
+                    D = vdsh_stream_distance(st->order, st->quantity, J->max_distance, coef[s],
+                                             w[k]);
+                    s_hat = vdsh_shadow_compare(D, L0, VDSH_COMPARE_SMOOTH);
+                } else {
+                    const float *cv[3] = {vc[s][0], vc[s][1], vc[s][2]};
+                    s_hat = vdsh_shadow_interior(st->order, st->quantity, J->max_distance,
+                                                 interp[s], cv, pv, r->bary, L,
+                                                 VDSH_COMPARE_SMOOTH, &D);
+                }
+                const int b_dark = D < L0;
+                sacc *a = acc + s;
+                a->n++;
+                a->mae += fabsf(s_hat - s_ideal);
+                a->mae_bin += fabsf((float)!b_dark - (float)vis);
+                a->vis += vis;
+                a->fals += vis && s_hat < 0.5f;
+                a->fals_bin += vis && b_dark;
+                a->occ += occ;
+                a->hit += occ && s_hat < 0.5f;
+                a->leak += occ && s_hat > 0.5f;
+                a->occ_bin += occ_bin;
+                a->hit_bin += occ_bin && b_dark;
+            }
+        }
+    }
 }
 
 static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
@@ -277,6 +389,9 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
             }
         }
     }
+    if (J->light_count)
+        eval_scene_lights(J, ri, (const float(*)[VDSH_MAX_COEFFS])coef,
+                          (const float(*)[3][VDSH_MAX_COEFFS])vc, pv, interp, corners);
 }
 
 static void eval_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
@@ -291,6 +406,58 @@ static void eval_progress(void *user, uint32_t done, uint32_t total)
 {
     const job *J = user;
     J->d->progress(J->d->progress_user, done, total);
+}
+
+/* ---- scene lights --------------------------------------------------------- */
+
+/* Whether p (scene units) is in free space (vdsh_light.h), with Embree. */
+static int free_space(const vb_scene *s, const float p[3])
+{
+    float dirs[VDSH_FREE_PROBES][3], t[VDSH_FREE_PROBES];
+    int back[VDSH_FREE_PROBES];
+    vdsh_free_probe_dirs(dirs);
+    float o[3];
+    vb_scene_to_local(s, p, o);
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    for (int i = 0; i < VDSH_FREE_PROBES; i++) {
+        struct RTCRayHit rh;
+        rh.ray.org_x = o[0], rh.ray.org_y = o[1], rh.ray.org_z = o[2];
+        rh.ray.dir_x = dirs[i][0], rh.ray.dir_y = dirs[i][1], rh.ray.dir_z = dirs[i][2];
+        rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.time = 0.0f;
+        rh.ray.mask = 0xffffffffu, rh.ray.id = 0, rh.ray.flags = 0;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(s->scene, &ctx, &rh);
+        int hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        t[i] = hit ? rh.ray.tfar / s->scale : INFINITY;
+        back[i] = hit && rh.hit.Ng_x * dirs[i][0] + rh.hit.Ng_y * dirs[i][1] +
+                                 rh.hit.Ng_z * dirs[i][2] > 0.0f;
+    }
+    return vdsh_free_space(t, back, vdsh_free_clearance(s->diagonal));
+}
+
+vb_result vb_eval_place_lights(const vb_scene *s, uint64_t seed, uint32_t count,
+                               float (*out)[3], uint32_t *tried, vb_error *err)
+{
+    /* Give up when a thousand candidates per light find no room: a scene
+     * without free space (a solid, or everything closer than clearance). */
+    uint32_t n = 0, k = 0;
+    const uint64_t limit = 1000ull * (count ? count : 1);
+    while (n < count && k < limit) {
+        float p[3];
+        vdsh_light_candidate(s->bounds_min, s->bounds_max, seed, k++, p);
+        if (free_space(s, p))
+            memcpy(out[n++], p, sizeof out[0]);
+    }
+    if (tried)
+        *tried = k;
+    if (n < count)
+        return vb_fail(err, VB_ERR_INVALID,
+                       "no free space for lights: %u of %u candidates in the scene's bounds "
+                       "were inside solids or nearer than %g to a surface",
+                       k, k, (double)vdsh_free_clearance(s->diagonal));
+    return VB_OK;
 }
 
 /* ---- public pieces ------------------------------------------------------- */
@@ -425,8 +592,11 @@ void vb_eval_result_free(vb_eval_result *r)
 {
     if (!r)
         return;
-    for (int k = 0; k < VB_EVAL_KINDS; k++)
+    for (int k = 0; k < VB_EVAL_KINDS; k++) {
         free(r->metrics[k]);
+        free(r->scene[k]);
+    }
+    free(r->lights);
     free(r->per_vertex);
     memset(r, 0, sizeof *r);
 }
@@ -605,6 +775,45 @@ static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind,
     return VB_OK;
 }
 
+/* The scene-light scores of one kind of receiver, summed in receiver
+ * order. */
+static void reduce_scene(const job *J, uint32_t first, uint32_t count,
+                         vb_eval_scene_metrics *m)
+{
+    const uint32_t S = J->streams;
+    for (uint32_t s = 0; s < S; s++) {
+        vb_eval_scene_metrics *o = m + s;
+        memset(o, 0, sizeof *o);
+        ratio mae = {0}, fa = {0}, rc = {0}, le = {0}, mb = {0}, fb = {0}, rb = {0};
+        uint32_t n_used = 0;
+        for (int pass = 0; pass < 2; pass++)
+            for (uint32_t i = first; i < first + count; i++) {
+                const sacc *a = J->sacc + (size_t)i * S + s;
+                if (a->n == 0)
+                    continue;
+                void (*f)(ratio *, double, double) = pass ? ratio_res : ratio_add;
+                n_used += !pass;
+                f(&mae, a->mae, a->n);
+                f(&fa, a->fals, a->vis);
+                f(&rc, a->hit, a->occ);
+                f(&le, a->leak, a->occ);
+                f(&mb, a->mae_bin, a->n);
+                f(&fb, a->fals_bin, a->vis);
+                f(&rb, a->hit_bin, a->occ_bin);
+                if (!pass)
+                    o->visible += a->vis, o->occluded += a->occ;
+            }
+        o->pairs = (uint64_t)mae.b;
+        o->shadow_mae = ratio_value(&mae), o->shadow_mae_se = ratio_se(&mae, n_used);
+        o->false_shadow = ratio_value(&fa), o->false_shadow_se = ratio_se(&fa, n_used);
+        o->recall = ratio_value(&rc), o->recall_se = ratio_se(&rc, n_used);
+        o->light_leak = ratio_value(&le), o->light_leak_se = ratio_se(&le, n_used);
+        o->binary_mae = ratio_value(&mb);
+        o->binary_false_shadow = ratio_value(&fb);
+        o->binary_recall = ratio_value(&rb);
+    }
+}
+
 static vb_result list_escaping(const job *J, uint32_t first, uint32_t count,
                                uint32_t max, vb_eval_truth *t, vb_error *err)
 {
@@ -729,6 +938,7 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
     vb_dirgrid grid = {0};
     uint32_t *vsel = NULL, nv = 0;
     float *vorigin = NULL, *vnear = NULL;
+    float (*lights_local)[3] = NULL;
     double *cdf = NULL;
     receiver *rec = NULL;
     job *J = NULL;
@@ -838,6 +1048,27 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers", nr);
         goto done;
     }
+    /* The scene lights: placed once, scored at every receiver. */
+    {
+        uint32_t nl = d.lights ? d.lights : 32;
+        o.lights = malloc(((size_t)nl + 1) * sizeof *o.lights);
+        lights_local = malloc(((size_t)nl + 1) * sizeof *lights_local);
+        J->sacc = calloc((size_t)nr * (S ? S : 1) + 1, sizeof *J->sacc);
+        if (!o.lights || !lights_local || !J->sacc) {
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the scene lights");
+            goto done;
+        }
+        r = vb_eval_place_lights(d.scene, purpose_seed(d.seed, PURPOSE_SCENE_LIGHTS), nl,
+                                 o.lights, &o.light_candidates, err);
+        if (r != VB_OK)
+            goto done;
+        o.light_count = nl;
+        for (uint32_t l = 0; l < nl; l++)
+            vb_scene_to_local(d.scene, o.lights[l], lights_local[l]);
+        J->light_count = nl;
+        J->lights = (const float(*)[3])o.lights;
+        J->lights_local = (const float(*)[3])lights_local;
+    }
     J->dir_seed = purpose_seed(d.seed, PURPOSE_DIRECTIONS);
     J->light_seed = purpose_seed(d.seed, PURPOSE_LIGHTS);
     J->max_distance = f->header.max_distance;
@@ -855,7 +1086,8 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
     o.stream_count = S;
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         o.metrics[k] = calloc(S ? S : 1, sizeof *o.metrics[k]);
-        if (!o.metrics[k]) {
+        o.scene[k] = calloc(S ? S : 1, sizeof *o.scene[k]);
+        if (!o.metrics[k] || !o.scene[k]) {
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
             goto done;
         }
@@ -882,6 +1114,7 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
         r = reduce(J, first, count[k], k, started, d.worst, o.metrics[k], err);
         if (r != VB_OK)
             goto done;
+        reduce_scene(J, first, count[k], o.scene[k]);
     }
     if (d.per_vertex) {
         o.per_vertex_fields = VB_EVAL_PV_TRUTH_FIELDS + VB_EVAL_PV_STREAM_FIELDS * S;
@@ -922,7 +1155,9 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
     r = VB_OK;
 
 done:
+    free(lights_local);
     if (J) {
+        free(J->sacc);
         free(J->acc);
         free(J->truth);
         free(J->hist);

@@ -115,6 +115,8 @@ typedef struct vb_eval_desc {
     uint32_t directions;       /* held-out directions per receiver, each with
                                   one light; 0: 64 (an 8 x 8 grid). Like the
                                   bake's --rays, rounded down to a grid */
+    uint32_t lights;           /* scene lights (VB_EVAL_SCENE_LIGHTS): how many
+                                  are placed in free space; 0: 32 */
     uint32_t worst;            /* worst receivers kept per (kind, stream);
                                   0: 10; at most VB_EVAL_MAX_WORST */
     int oracle;                /* 1: score the truth itself (D := d_T) instead
@@ -171,6 +173,26 @@ typedef struct vb_eval_metrics {
     vb_eval_receiver worst[VB_EVAL_MAX_WORST];  /* by shadow MAE, worst first */
 } vb_eval_metrics;
 
+/* Scene lights, the primary shadow metric (DESIGN.md section 3): point
+ * lights placed uniformly in the scene's free space (vdsh_light.h), as a
+ * user places them, each scored at every receiver it lights (above the
+ * receiver's horizon: (L - p).n > 0). The truth is the first hit of the
+ * ray from the receiver toward the light, d_T (none before the light: the
+ * light is visible). Rates are fractions. */
+typedef struct vb_eval_scene_metrics {
+    uint64_t pairs;            /* (receiver, light) pairs scored */
+    double shadow_mae, shadow_mae_se;       /* |s_hat - s_ideal|, smooth */
+    double false_shadow, false_shadow_se;   /* P(s_hat < .5 | d_T >= d_L) */
+    double recall, recall_se;               /* P(s_hat < .5 | s_ideal < .5):
+                                               the shadows drawn */
+    double light_leak, light_leak_se;       /* P(s_hat > .5 | s_ideal < .5) */
+    double binary_mae;
+    double binary_false_shadow;             /* P(D < d_L | d_T >= d_L) */
+    double binary_recall;                   /* P(D < d_L | d_T < d_L) */
+    uint64_t visible;          /* pairs with d_T >= d_L */
+    uint64_t occluded;         /* pairs with s_ideal < 0.5 */
+} vb_eval_scene_metrics;
+
 /* The truth's own record for one kind of receiver. */
 typedef struct vb_eval_truth {
     uint32_t receivers;        /* evaluated */
@@ -204,7 +226,14 @@ enum {
 
 typedef struct vb_eval_result {
     uint32_t stream_count;     /* = the file's; metrics[k][i] is stream i */
-    vb_eval_metrics *metrics[VB_EVAL_KINDS];  /* stream_count each */
+    vb_eval_metrics *metrics[VB_EVAL_KINDS];  /* stream_count each: lights
+                                  relative to each direction's truth
+                                  (d_L = 2u d_T), the secondary metric */
+    vb_eval_scene_metrics *scene[VB_EVAL_KINDS]; /* stream_count each: scene
+                                  lights, the primary metric */
+    uint32_t light_count;      /* scene lights placed */
+    float (*lights)[3];        /* their positions, scene units */
+    uint32_t light_candidates; /* candidates tried to place them */
     vb_eval_truth truth[VB_EVAL_KINDS];
     uint64_t seed;             /* as used */
     uint32_t directions;       /* per receiver, as used */
@@ -270,6 +299,13 @@ int vb_eval_interior_point(const double *cdf, uint32_t triangle_count,
 /* cdf[t] = area of triangles 0..t / total area (triangle_count doubles,
  * malloc'ed; NULL when out of memory). *total gets the total area. */
 double *vb_eval_area_cdf(const vdsh_file *f, double *total);
+
+/* `count` lights placed uniformly in the free space of scene s
+ * (vdsh_light.h): the candidates of the sequence `seed` that pass, in
+ * order. *tried (may be NULL) gets how many candidates were drawn. Fails
+ * (VB_ERR_INVALID) when 1000 candidates per light are not enough. */
+vb_result vb_eval_place_lights(const vb_scene *s, uint64_t seed, uint32_t count,
+                               float (*out)[3], uint32_t *tried, vb_error *err);
 
 /* The held-out directions of receiver `id` (a vertex index, or
  * VB_EVAL_INTERIOR_ID(j) for interior point j) with unit normal n: the

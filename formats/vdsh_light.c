@@ -1,0 +1,54 @@
+/* Free space for lights: vdsh_light.h says what and why. */
+#include "vdsh_light.h"
+
+#include <math.h>
+
+void vdsh_free_probe_dirs(float dirs[VDSH_FREE_PROBES][3])
+{
+    int n = 0;
+    for (int a = 0; a < 3; a++)
+        for (int s = -1; s <= 1; s += 2, n++) {
+            dirs[n][0] = dirs[n][1] = dirs[n][2] = 0.0f;
+            dirs[n][a] = (float)s;
+        }
+    const float d = 0.57735026918962576f; /* 1 / sqrt(3) */
+    for (int k = 0; k < 8; k++, n++) {
+        dirs[n][0] = (k & 1) ? d : -d;
+        dirs[n][1] = (k & 2) ? d : -d;
+        dirs[n][2] = (k & 4) ? d : -d;
+    }
+}
+
+float vdsh_free_clearance(float diagonal)
+{
+    return 0.01f * diagonal;
+}
+
+int vdsh_free_space(const float t[VDSH_FREE_PROBES], const int back[VDSH_FREE_PROBES],
+                    float clearance)
+{
+    int backs = 0;
+    for (int i = 0; i < VDSH_FREE_PROBES; i++) {
+        if (t[i] < clearance)
+            return 0;
+        backs += t[i] < INFINITY && back[i];
+    }
+    return 2 * backs < VDSH_FREE_PROBES;
+}
+
+/* SplitMix64 on (seed, k, axis): a counter-based stream. */
+static double unit(uint64_t seed, uint32_t k, uint32_t axis)
+{
+    uint64_t z = seed + 0x9e3779b97f4a7c15ull * ((uint64_t)k * 4u + axis + 1u);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * (1.0 / 9007199254740992.0); /* [0, 1) */
+}
+
+void vdsh_light_candidate(const float lo[3], const float hi[3], uint64_t seed, uint32_t k,
+                          float out[3])
+{
+    for (int a = 0; a < 3; a++)
+        out[a] = (float)((double)lo[a] + unit(seed, k, (uint32_t)a) * ((double)hi[a] - lo[a]));
+}
