@@ -50,6 +50,12 @@ void vb_mesh_bounds(const vb_mesh *m, float min[3], float max[3])
     }
 }
 
+/* "s" for a count other than 1. */
+static const char *plural(uint32_t n)
+{
+    return n == 1 ? "" : "s";
+}
+
 void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb_mesh_report *r)
 {
     if (!fp || !r)
@@ -58,34 +64,33 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
     tool = tool ? tool : "";
     path = path ? path : "(mesh)";
     if (r->dropped_triangles)
-        fprintf(fp, "%s%s%s: %u triangles dropped: they repeat a vertex index (no area)\n", tool, sep, path,
-                r->dropped_triangles);
+        fprintf(fp, "%s%s%s: %u triangle%s dropped (a repeated vertex index: no area)\n", tool, sep, path,
+                r->dropped_triangles, plural(r->dropped_triangles));
     if (r->removed_vertices)
-        fprintf(fp, "%s%s%s: %u vertices removed: no remaining triangle uses them\n", tool, sep, path,
-                r->removed_vertices);
+        fprintf(fp, "%s%s%s: %u vert%s removed (used by no remaining triangle)\n", tool, sep, path,
+                r->removed_vertices, r->removed_vertices == 1 ? "ex" : "ices");
     if (r->split_vertices)
-        fprintf(fp, "%s%s%s: %u vertices split at creases (their face corners give normals more than %g "
-                    "degrees apart): %u vertices added\n",
-                tool, sep, path, r->split_vertices, VB_MESH_NORMAL_AGREE_DEG, r->split_added);
+        fprintf(fp, "%s%s%s: %u vert%s split at creases (their face corners give normals more than %g "
+                    "degrees apart): %u vert%s added\n",
+                tool, sep, path, r->split_vertices, r->split_vertices == 1 ? "ex" : "ices", VB_MESH_NORMAL_AGREE_DEG,
+                r->split_added, r->split_added == 1 ? "ex" : "ices");
     if (r->missing_normals)
-        fprintf(fp, "%s%s%s: %u used vertices have no normal in the file: every normal computed from the "
-                    "faces instead\n",
-                tool, sep, path, r->missing_normals);
+        fprintf(fp, "%s%s%s: %u used vert%s no normal in the file: every normal computed from the faces "
+                    "instead\n",
+                tool, sep, path, r->missing_normals, r->missing_normals == 1 ? "ex has" : "ices have");
     if (r->zero_normals)
-        fprintf(fp, "%s%s%s: %u vertices have a zero normal in the file: %u repaired from their own "
-                    "triangles\n",
-                tool, sep, path, r->zero_normals, r->zero_repaired);
+        fprintf(fp, "%s%s%s: %u vert%s a zero normal in the file: %u repaired from their own triangles\n", tool,
+                sep, path, r->zero_normals, r->zero_normals == 1 ? "ex has" : "ices have", r->zero_repaired);
     if (r->cancelled_normals)
-        fprintf(fp, "%s%s%s: %u vertices' face normals cancel (two-sided triangles): each given the normal "
-                    "of its largest triangle\n",
-                tool, sep, path, r->cancelled_normals);
+        fprintf(fp, "%s%s%s: %u vert%s face normals cancel (two-sided triangles): each given the normal of "
+                    "its largest triangle\n",
+                tool, sep, path, r->cancelled_normals, r->cancelled_normals == 1 ? "ex's" : "ices'");
     if (r->welded)
-        fprintf(fp, "%s%s%s: %u vertices merged by welding (normals then computed from the faces)\n", tool, sep,
-                path, r->welded);
+        fprintf(fp, "%s%s%s: %u vert%s merged by welding (normals then computed from the faces)\n", tool, sep,
+                path, r->welded, r->welded == 1 ? "ex" : "ices");
     if (r->undefined_normals)
-        fprintf(fp, "%s%s%s: %u vertices left without a normal (0,0,0): their triangles have no area or "
-                    "their normals cancel\n",
-                tool, sep, path, r->undefined_normals);
+        fprintf(fp, "%s%s%s: %u vert%s left without a normal (0,0,0): their triangles have no area\n", tool, sep,
+                path, r->undefined_normals, r->undefined_normals == 1 ? "ex" : "ices");
 }
 
 /* n * size bytes, or NULL when that overflows or malloc fails; never a

@@ -137,8 +137,7 @@ typedef struct vb_mesh_report {
                                     their largest triangle's normal */
     uint32_t welded;             /* vertices merged by weld */
     uint32_t undefined_normals;  /* loaded vertices left (0,0,0) at the end:
-                                    their triangles have no area, or their
-                                    normals cancel */
+                                    their triangles have no area */
 } vb_mesh_report;
 
 /* What a loaded source was: size and hash for the .vdsh SRCS chunk, and
@@ -154,7 +153,7 @@ typedef struct vb_source_info {
 
 /* One line per non-zero finding of `r` on fp, each "TOOL: PATH: ..."
  * (no "TOOL: " when tool is NULL), e.g. "vdsh-bake: scan.ply: 11160
- * triangles dropped: they repeat a vertex index (no area)". Nothing when
+ * triangles dropped (a repeated vertex index: no area)". Nothing when
  * fp is NULL (a tool's quiet mode) or nothing was found. */
 void vb_mesh_report_print(FILE *fp, const char *tool, const char *path,
                           const vb_mesh_report *r);

@@ -53,8 +53,8 @@ PLY
 if ! "$bake" "$tmp/scan.ply" --export-obj "$tmp/scan.obj" 2>"$tmp/err"; then
   echo "FAIL: export of scan.ply failed:" >&2; cat "$tmp/err" >&2; fail=1
 fi
-has "$tmp/err" "vdsh-bake: $tmp/scan.ply: 2 triangles dropped: they repeat a vertex index"
-has "$tmp/err" "vdsh-bake: $tmp/scan.ply: 3 vertices removed: no remaining triangle uses them"
+has "$tmp/err" "vdsh-bake: $tmp/scan.ply: 2 triangles dropped (a repeated vertex index: no area)"
+has "$tmp/err" "vdsh-bake: $tmp/scan.ply: 3 vertices removed (used by no remaining triangle)"
 has "$tmp/err" "vdsh-bake: $tmp/scan.ply: 5 vertices have a zero normal in the file: 2 repaired from their own triangles"
 has "$tmp/err" "vdsh-bake: $tmp/scan.ply: 3 vertices left without a normal (0,0,0)"
 n=$(grep -c "scan.ply: " "$tmp/err")
