@@ -7,6 +7,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <float.h>
 #include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -49,6 +50,49 @@ void vb_mesh_bounds(const vb_mesh *m, float min[3], float max[3])
     }
 }
 
+/* "s" for a count other than 1. */
+static const char *plural(uint32_t n)
+{
+    return n == 1 ? "" : "s";
+}
+
+void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb_mesh_report *r)
+{
+    if (!fp || !r)
+        return;
+    const char *sep = tool ? ": " : "";
+    tool = tool ? tool : "";
+    path = path ? path : "(mesh)";
+    if (r->dropped_triangles)
+        fprintf(fp, "%s%s%s: %u triangle%s dropped (a repeated vertex index: no area)\n", tool, sep, path,
+                r->dropped_triangles, plural(r->dropped_triangles));
+    if (r->removed_vertices)
+        fprintf(fp, "%s%s%s: %u vert%s removed (used by no remaining triangle)\n", tool, sep, path,
+                r->removed_vertices, r->removed_vertices == 1 ? "ex" : "ices");
+    if (r->split_vertices)
+        fprintf(fp, "%s%s%s: %u vert%s split at creases (their face corners give normals more than %g "
+                    "degrees apart): %u vert%s added\n",
+                tool, sep, path, r->split_vertices, r->split_vertices == 1 ? "ex" : "ices", VB_MESH_NORMAL_AGREE_DEG,
+                r->split_added, r->split_added == 1 ? "ex" : "ices");
+    if (r->missing_normals)
+        fprintf(fp, "%s%s%s: %u used vert%s no normal in the file: every normal computed from the faces "
+                    "instead\n",
+                tool, sep, path, r->missing_normals, r->missing_normals == 1 ? "ex has" : "ices have");
+    if (r->zero_normals)
+        fprintf(fp, "%s%s%s: %u vert%s a zero normal in the file: %u repaired from their own triangles\n", tool,
+                sep, path, r->zero_normals, r->zero_normals == 1 ? "ex has" : "ices have", r->zero_repaired);
+    if (r->cancelled_normals)
+        fprintf(fp, "%s%s%s: %u vert%s face normals cancel (two-sided triangles): each given the normal of "
+                    "its largest triangle\n",
+                tool, sep, path, r->cancelled_normals, r->cancelled_normals == 1 ? "ex's" : "ices'");
+    if (r->welded)
+        fprintf(fp, "%s%s%s: %u vert%s merged by welding (normals then computed from the faces)\n", tool, sep,
+                path, r->welded, r->welded == 1 ? "ex" : "ices");
+    if (r->undefined_normals)
+        fprintf(fp, "%s%s%s: %u vert%s left without a normal (0,0,0): their triangles have no area\n", tool, sep,
+                path, r->undefined_normals, r->undefined_normals == 1 ? "ex" : "ices");
+}
+
 /* n * size bytes, or NULL when that overflows or malloc fails; never a
  * zero-byte request (so NULL always means failure). */
 static void *alloc_array(size_t n, size_t size)
@@ -68,8 +112,43 @@ static void *alloc_array(size_t n, size_t size)
  * does not depend on how a flat region happens to be triangulated, and it
  * only ever sees the vertex's own triangles, so unwelded hard edges stay
  * hard. Arithmetic in double: coordinates of 1e5 with millimetre edges
- * would lose the cross product in float. */
-void vb_mesh_compute_normals(vb_mesh *m)
+ * would lose the cross product in float.
+ *
+ * A sum shorter than CANCEL times the sum of its weights has cancelled:
+ * the vertex sits on a two-sided triangle (a triangle and its reverse, as
+ * crude decimations leave) or a zero-width fold, and what is left of the
+ * sum is rounding, pointing anywhere. Such a vertex takes the unit normal
+ * of its largest triangle instead (the first of equal ones); `cancelled`
+ * (may be NULL) marks them. */
+#define CANCEL 1e-5
+
+/* Triangle t's corners (double) and unit normal; 0 when its indices are
+ * out of range or it has no area, else twice its area. */
+static double triangle_normal(const vb_mesh *m, uint32_t t, double p[3][3], double n[3])
+{
+    const uint32_t *tri = m->indices + 3 * (size_t)t;
+    if (tri[0] >= m->vertex_count || tri[1] >= m->vertex_count || tri[2] >= m->vertex_count)
+        return 0.0;
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < 3; k++)
+            p[c][k] = m->positions[3 * (size_t)tri[c] + (size_t)k];
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = p[1][k] - p[0][k];
+        e2[k] = p[2][k] - p[0][k];
+    }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0.0) || !isfinite(len))
+        return 0.0;
+    for (int k = 0; k < 3; k++)
+        n[k] /= len;
+    return len;
+}
+
+static void compute_normals(vb_mesh *m, uint8_t *cancelled)
 {
     if (!m || !m->positions)
         return;
@@ -79,26 +158,18 @@ void vb_mesh_compute_normals(vb_mesh *m)
             return;
     }
     memset(m->normals, 0, 3 * (size_t)m->vertex_count * sizeof(float));
+    if (cancelled)
+        memset(cancelled, 0, m->vertex_count);
+    /* Each vertex's sum of weights (angles); without room for them,
+     * cancellation goes undetected. */
+    float *weight = calloc(m->vertex_count ? m->vertex_count : 1, sizeof(float));
+
+    /* 1. Sum each triangle's unit normal times its angle at the corner. */
     for (uint32_t t = 0; t < m->triangle_count; t++) {
+        double p[3][3], n[3];
+        if (triangle_normal(m, t, p, n) == 0.0)
+            continue;
         const uint32_t *tri = m->indices + 3 * (size_t)t;
-        if (tri[0] >= m->vertex_count || tri[1] >= m->vertex_count || tri[2] >= m->vertex_count)
-            continue;
-        double p[3][3];
-        for (int c = 0; c < 3; c++)
-            for (int k = 0; k < 3; k++)
-                p[c][k] = m->positions[3 * (size_t)tri[c] + (size_t)k];
-        double e1[3], e2[3];
-        for (int k = 0; k < 3; k++) {
-            e1[k] = p[1][k] - p[0][k];
-            e2[k] = p[2][k] - p[0][k];
-        }
-        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                       e1[0] * e2[1] - e1[1] * e2[0]};
-        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        if (!(len > 0.0) || !isfinite(len))
-            continue;
-        for (int k = 0; k < 3; k++)
-            n[k] /= len;
         for (int c = 0; c < 3; c++) {
             const double *a = p[c], *b = p[(c + 1) % 3], *d = p[(c + 2) % 3];
             double u[3], v[3];
@@ -112,14 +183,53 @@ void vb_mesh_compute_normals(vb_mesh *m)
             float *out = m->normals + 3 * (size_t)tri[c];
             for (int k = 0; k < 3; k++)
                 out[k] += (float)(n[k] * angle);
+            if (weight)
+                weight[tri[c]] += (float)angle;
         }
     }
+
+    /* 2. Normalise; a sum that cancelled becomes (0,0,0) for now and its
+     * weight -1. */
+    uint32_t any = 0;
     for (uint32_t i = 0; i < m->vertex_count; i++) {
         float *out = m->normals + 3 * (size_t)i;
         double len = sqrt((double)out[0] * out[0] + (double)out[1] * out[1] + (double)out[2] * out[2]);
+        if (weight && weight[i] > 0.0f && !(len > CANCEL * weight[i])) {
+            weight[i] = -1.0f;
+            any++;
+            len = 0.0;
+        }
         for (int k = 0; k < 3; k++)
             out[k] = len > 1e-30 ? (float)(out[k] / len) : 0.0f;
     }
+
+    /* 3. A cancelled vertex takes its largest triangle's normal. */
+    double *best = any ? calloc(m->vertex_count, sizeof(double)) : NULL;
+    for (uint32_t t = 0; best && t < m->triangle_count; t++) {
+        const uint32_t *tri = m->indices + 3 * (size_t)t;
+        if (tri[0] >= m->vertex_count || tri[1] >= m->vertex_count || tri[2] >= m->vertex_count ||
+            (weight[tri[0]] >= 0.0f && weight[tri[1]] >= 0.0f && weight[tri[2]] >= 0.0f))
+            continue;
+        double p[3][3], n[3];
+        double len = triangle_normal(m, t, p, n);
+        for (int c = 0; c < 3; c++) {
+            uint32_t v = tri[c];
+            if (weight[v] < 0.0f && len > best[v]) {
+                best[v] = len;
+                for (int k = 0; k < 3; k++)
+                    m->normals[3 * (size_t)v + (size_t)k] = (float)n[k];
+                if (cancelled)
+                    cancelled[v] = 1;
+            }
+        }
+    }
+    free(best);
+    free(weight);
+}
+
+void vb_mesh_compute_normals(vb_mesh *m)
+{
+    compute_normals(m, NULL);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -440,9 +550,195 @@ static vb_result read_file(const char *path, uint8_t **bytes, size_t *size, vb_e
     return VB_OK;
 }
 
+/* ---------------------------------------------------------------------- */
+/* Creases: a vertex whose face corners give disagreeing normals is split  */
+/* ---------------------------------------------------------------------- */
+
+/* n scaled to unit length in double, (0,0,0) when it has no length. */
+static void unit_double(const float *n, double u[3])
+{
+    double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+    for (int k = 0; k < 3; k++)
+        u[k] = len > 0.0 && isfinite(len) ? n[k] / len : 0.0;
+}
+
+/* As OpenMesh's side keeps a single given normal: as it is when it is
+ * unit to float precision, else scaled to unit length. */
+static void unit_float(const float *n, float out[3])
+{
+    double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+    if (fabs(len - 1.0) <= 4.0 * FLT_EPSILON) {
+        memcpy(out, n, 3 * sizeof(float));
+        return;
+    }
+    for (int k = 0; k < 3; k++)
+        out[k] = len > 0.0 && isfinite(len) ? (float)(n[k] / len) : 0.0f;
+}
+
+#define MAX_GROUPS 256
+
+/* The split mesh's vertices, when some vertex splits (mesh.h, "Normals
+ * per face corner"); all NULL / 0 when none does. */
+typedef struct split_vertices {
+    uint32_t vertex_count;
+    float *positions;
+    float *normals;
+    uint8_t *has_normal;
+    uint32_t split, added;
+} split_vertices;
+
+static void split_free(split_vertices *sv)
+{
+    free(sv->positions);
+    free(sv->normals);
+    free(sv->has_normal);
+    memset(sv, 0, sizeof *sv);
+}
+
+/* Groups the corners of every vertex by normal and, when any vertex has
+ * more than one group, fills *sv and renumbers idx (3 * triangle_count,
+ * already range-checked) to the split vertices. Triangles that repeat an
+ * index take no part (they are dropped next) and stay repeated. */
+static vb_result split_creases(const vb_mesh_raw *raw, uint32_t *idx, split_vertices *sv)
+{
+    memset(sv, 0, sizeof *sv);
+    if (!raw->corner_normals || !raw->corner_given || raw->vertex_count == 0)
+        return VB_OK;
+    const uint32_t nv = raw->vertex_count;
+    const size_t corners = 3 * (size_t)raw->triangle_count;
+    const double agree = cos(VB_MESH_NORMAL_AGREE_DEG * 3.14159265358979323846 / 180.0);
+
+    /* Every vertex's corners, in triangle order (counting sort). */
+    size_t *start = calloc((size_t)nv + 1, sizeof *start);
+    size_t *list = alloc_array(corners, sizeof *list);
+    uint16_t *group = alloc_array(corners, sizeof *group);
+    uint32_t *groups = alloc_array(nv, sizeof *groups);
+    double *rep = alloc_array(3 * MAX_GROUPS, sizeof *rep);
+    vb_result r = VB_ERR_OUT_OF_MEMORY;
+    if (!start || !list || !group || !groups || !rep)
+        goto done;
+    for (size_t c = 0; c < corners; c++) {
+        const uint32_t *tri = idx + c / 3 * 3;
+        group[c] = 0;
+        if (tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2])
+            start[idx[c] + 1]++;
+    }
+    for (uint32_t v = 0; v < nv; v++)
+        start[v + 1] += start[v];
+    {
+        size_t *fill = alloc_array(nv, sizeof *fill);
+        if (!fill)
+            goto done;
+        memcpy(fill, start, nv * sizeof *fill);
+        for (size_t c = 0; c < corners; c++) {
+            const uint32_t *tri = idx + c / 3 * 3;
+            if (tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2])
+                list[fill[idx[c]]++] = c;
+        }
+        free(fill);
+    }
+
+    /* Group each vertex's corners: the first group whose first normal
+     * agrees, else a new group (the closest once there are MAX_GROUPS).
+     * Corners without a normal, or with a zero one, join group 0. */
+    uint64_t total = 0;
+    for (uint32_t v = 0; v < nv; v++) {
+        uint32_t ng = 0;
+        for (size_t j = start[v]; j < start[v + 1]; j++) {
+            size_t c = list[j];
+            double u[3];
+            unit_double(raw->corner_normals + 3 * c, u);
+            if (!raw->corner_given[c] || (u[0] == 0.0 && u[1] == 0.0 && u[2] == 0.0))
+                continue;
+            uint32_t best = 0;
+            double best_dot = -2.0;
+            for (uint32_t g = 0; g < ng; g++) {
+                double d = u[0] * rep[3 * g] + u[1] * rep[3 * g + 1] + u[2] * rep[3 * g + 2];
+                if (d >= agree) {
+                    best = g;
+                    best_dot = 2.0;
+                    break;
+                }
+                if (d > best_dot) {
+                    best = g;
+                    best_dot = d;
+                }
+            }
+            if (best_dot < 2.0 && ng < MAX_GROUPS) {
+                best = ng++;
+                memcpy(rep + 3 * best, u, sizeof u);
+            }
+            group[c] = (uint16_t)best;
+        }
+        groups[v] = ng ? ng : 1;
+        total += groups[v];
+    }
+    r = VB_OK;
+    if (total == nv)
+        goto done; /* nothing to split */
+    if (total > 0x7fffffffu) {
+        r = VB_ERR_INVALID;
+        goto done;
+    }
+
+    /* The split vertices, each vertex's groups in a row. A vertex that is
+     * not split keeps OpenMesh's per-vertex normal; a group takes its first
+     * given normal. */
+    sv->vertex_count = (uint32_t)total;
+    sv->positions = alloc_array(3 * (size_t)total, sizeof(float));
+    sv->normals = calloc(3 * (size_t)total, sizeof(float));
+    sv->has_normal = calloc((size_t)total, 1);
+    uint32_t *base = alloc_array(nv, sizeof *base);
+    if (!sv->positions || !sv->normals || !sv->has_normal || !base) {
+        free(base);
+        split_free(sv);
+        r = VB_ERR_OUT_OF_MEMORY;
+        goto done;
+    }
+    uint32_t next = 0;
+    for (uint32_t v = 0; v < nv; v++) {
+        base[v] = next;
+        for (uint32_t g = 0; g < groups[v]; g++)
+            memcpy(sv->positions + 3 * (size_t)(next + g), raw->positions + 3 * (size_t)v, 3 * sizeof(float));
+        if (groups[v] == 1) {
+            if (raw->normals && raw->has_normal) {
+                memcpy(sv->normals + 3 * (size_t)next, raw->normals + 3 * (size_t)v, 3 * sizeof(float));
+                sv->has_normal[next] = raw->has_normal[v];
+            }
+        } else {
+            sv->split++;
+            sv->added += groups[v] - 1;
+            for (size_t j = start[v]; j < start[v + 1]; j++) {
+                size_t c = list[j];
+                uint32_t w = next + group[c];
+                if (raw->corner_given[c] && !sv->has_normal[w]) {
+                    sv->has_normal[w] = 1;
+                    unit_float(raw->corner_normals + 3 * c, sv->normals + 3 * (size_t)w);
+                } else if (raw->corner_given[c] && sv->normals[3 * (size_t)w] == 0.0f &&
+                           sv->normals[3 * (size_t)w + 1] == 0.0f && sv->normals[3 * (size_t)w + 2] == 0.0f) {
+                    /* group 0 may have met a zero normal before its first */
+                    unit_float(raw->corner_normals + 3 * c, sv->normals + 3 * (size_t)w);
+                }
+            }
+        }
+        next += groups[v];
+    }
+    for (size_t c = 0; c < corners; c++)
+        idx[c] = base[idx[c]] + group[c];
+    free(base);
+
+done:
+    free(start);
+    free(list);
+    free(group);
+    free(groups);
+    free(rep);
+    return r;
+}
+
 /* Raw file mesh -> clean vb_mesh (see mesh.h for what clean means). */
 static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mesh_raw *raw,
-                           vb_mesh *out, vb_error *err)
+                           vb_mesh *out, vb_mesh_report *rep, vb_error *err)
 {
     /* Vertex numbers in messages as the format counts them. */
     unsigned base = format == VB_MESH_OBJ ? 1 : 0;
@@ -466,29 +762,52 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
         idx[j] = (uint32_t)v;
     }
 
-    vb_mesh m;
-    uint32_t degenerate = 0;
-    vb_result r = compact(raw->vertex_count, raw->positions, NULL, raw->triangle_count, idx, &m, &degenerate);
+    /* Creases first: from here on the vertices are the split ones (the
+     * file's own when nothing splits). */
+    split_vertices sv;
+    vb_result r = split_creases(raw, idx, &sv);
     if (r != VB_OK) {
         free(idx);
+        return r == VB_ERR_OUT_OF_MEMORY ? vb_fail(err, r, "%s: out of memory", path)
+                                         : vb_fail(err, r, "%s: too many vertices after splitting at creases", path);
+    }
+    const int split = sv.positions != NULL;
+    const uint32_t vertex_count = split ? sv.vertex_count : raw->vertex_count;
+    const float *positions = split ? sv.positions : raw->positions;
+    const float *normals = split ? sv.normals : raw->normals;
+    const uint8_t *has_normal = split ? sv.has_normal : raw->has_normal;
+
+    vb_mesh m;
+    uint32_t degenerate = 0;
+    r = compact(vertex_count, positions, NULL, raw->triangle_count, idx, &m, &degenerate);
+    if (r != VB_OK) {
+        free(idx);
+        split_free(&sv);
         return vb_fail(err, r, "%s: out of memory", path);
     }
     if (m.triangle_count == 0) {
         free(idx);
+        split_free(&sv);
         vb_mesh_free(&m);
         if (degenerate)
             return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh (all %u triangles repeat a vertex)", path, degenerate);
         return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh (no faces)", path);
     }
+    vb_mesh_report rp;
+    memset(&rp, 0, sizeof rp);
+    rp.dropped_triangles = degenerate + raw->dropped_triangles;
+    rp.split_vertices = sv.split;
+    rp.split_added = sv.added;
+    rp.removed_vertices = vertex_count - m.vertex_count;
 
     /* File normals only when every vertex kept has one: a mix of given and
      * computed normals would be inconsistent across the mesh. */
-    int use_file = raw->normals != NULL && raw->has_normal != NULL;
+    int use_file = normals != NULL && has_normal != NULL;
     if (use_file) {
-        uint32_t next = 0;
-        uint8_t *seen = calloc(raw->vertex_count ? raw->vertex_count : 1, 1);
+        uint8_t *seen = calloc(vertex_count ? vertex_count : 1, 1);
         if (!seen) {
             free(idx);
+            split_free(&sv);
             vb_mesh_free(&m);
             return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
         }
@@ -499,23 +818,31 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
             for (int k = 0; k < 3; k++)
                 seen[tri[k]] = 1;
         }
+        for (uint32_t i = 0; i < vertex_count; i++)
+            rp.missing_normals += seen[i] && !has_normal[i];
+        use_file = rp.missing_normals == 0;
         /* compact() numbers kept vertices in their original order */
-        for (uint32_t i = 0; i < raw->vertex_count && use_file; i++) {
-            if (!seen[i])
-                continue;
-            if (!raw->has_normal[i])
-                use_file = 0;
-            else
-                memcpy(m.normals + 3 * (size_t)next++, raw->normals + 3 * (size_t)i, 3 * sizeof(float));
-        }
+        uint32_t next = 0;
+        for (uint32_t i = 0; i < vertex_count && use_file; i++)
+            if (seen[i])
+                memcpy(m.normals + 3 * (size_t)next++, normals + 3 * (size_t)i, 3 * sizeof(float));
         free(seen);
     }
     free(idx);
+    split_free(&sv);
+    uint8_t *cancelled = calloc(m.vertex_count, 1);
+    if (!cancelled) {
+        vb_mesh_free(&m);
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    }
     if (!use_file) {
-        vb_mesh_compute_normals(&m);
+        compute_normals(&m, cancelled);
+        for (uint32_t i = 0; i < m.vertex_count; i++)
+            rp.cancelled_normals += cancelled[i];
     } else {
         /* A zero file normal says nothing: such vertices get the computed
-         * normal (itself zero only where all their triangles are). */
+         * normal of their own triangles (itself zero only where those all
+         * have no area, or cancel). */
         size_t zeros = 0;
         for (uint32_t i = 0; i < m.vertex_count; i++) {
             const float *n = m.normals + 3 * (size_t)i;
@@ -524,20 +851,29 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
         if (zeros) {
             float *given = alloc_array(3 * (size_t)m.vertex_count, sizeof(float));
             if (!given) {
+                free(cancelled);
                 vb_mesh_free(&m);
                 return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
             }
             memcpy(given, m.normals, 3 * (size_t)m.vertex_count * sizeof(float));
-            vb_mesh_compute_normals(&m);
+            compute_normals(&m, cancelled);
             for (uint32_t i = 0; i < m.vertex_count; i++) {
                 const float *n = given + 3 * (size_t)i;
-                if (n[0] != 0.0f || n[1] != 0.0f || n[2] != 0.0f)
+                if (n[0] != 0.0f || n[1] != 0.0f || n[2] != 0.0f) {
                     memcpy(m.normals + 3 * (size_t)i, n, 3 * sizeof(float));
+                } else {
+                    const float *c = m.normals + 3 * (size_t)i;
+                    rp.zero_normals++;
+                    rp.zero_repaired += c[0] != 0.0f || c[1] != 0.0f || c[2] != 0.0f;
+                    rp.cancelled_normals += cancelled[i];
+                }
             }
             free(given);
         }
     }
+    free(cancelled);
     *out = m;
+    *rep = rp;
     return VB_OK;
 }
 
@@ -602,20 +938,28 @@ static vb_result load_bytes(const char *name, const char *file, vb_mesh_format f
     memset(&raw, 0, sizeof raw);
     vb_result r = vb_mesh_read_openmesh(name, file, format, bytes, size, &raw, err);
     if (r == VB_OK)
-        r = clean_raw(name, format, &raw, m, err);
+        r = clean_raw(name, format, &raw, m, &si->report, err);
     vb_mesh_raw_free(&raw);
     return r;
 }
 
-/* The common tail of both loaders: weld if asked, then hand over. */
-static vb_result finish_load(vb_result r, vb_mesh *m, const vb_source_info *si, int weld, vb_mesh *out,
+/* The common tail of both loaders: weld if asked, count what is left
+ * without a normal, then hand over. */
+static vb_result finish_load(vb_result r, vb_mesh *m, vb_source_info *si, int weld, vb_mesh *out,
                              vb_source_info *info, vb_error *err)
 {
-    if (r == VB_OK && weld)
+    uint32_t before = m->vertex_count;
+    if (r == VB_OK && weld) {
         r = vb_mesh_weld(m, err);
+        si->report.welded = before - m->vertex_count;
+    }
     if (r != VB_OK) {
         vb_mesh_free(m);
         return r;
+    }
+    for (uint32_t i = 0; i < m->vertex_count; i++) {
+        const float *n = m->normals + 3 * (size_t)i;
+        si->report.undefined_normals += n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f;
     }
     *out = *m;
     if (info)

@@ -12,6 +12,7 @@
  *     vb_source_info info;
  *     vb_load_desc desc = {0};                (zero = documented defaults)
  *     if (vb_mesh_load("scene.obj", &desc, &m, &info, &err) != VB_OK) ...
+ *     vb_mesh_report_print(stderr, "tool", "scene.obj", &info.report);
  *     vb_mesh fine = {0};
  *     vb_mesh_refine(&m, 0.2f, &fine, &err);  (receivers: no edge > 0.2)
  *     vb_mesh_free(&fine); vb_mesh_free(&m);
@@ -26,11 +27,30 @@
  * every index < vertex_count, no unreferenced vertices, every coordinate
  * finite, normals unit length or (0,0,0) where undefined (a vertex whose
  * faces all have zero area). Vertex normals come from the file when it has
- * them for every vertex (a zero one is replaced by the computed normal),
- * else are computed (angle-weighted face normals over the vertex's own
- * faces, so unwelded hard edges stay hard).
+ * them for every vertex (a zero one is replaced by the computed normal of
+ * the vertex's own triangles), else are computed (angle-weighted face
+ * normals over the vertex's own faces, so unwelded hard edges stay hard).
  * Triangles with a repeated index are dropped (they have no area and no
  * effect on rays); zero-area triangles with distinct indices are kept.
+ * What was dropped, removed, split or repaired comes back as counts in
+ * vb_source_info.report (vb_mesh_report); loading itself prints nothing.
+ *
+ * Normals per face corner (OBJ "f v//vn", "f v/vt/vn"; the other formats
+ * give normals per vertex, and STL's facet normals are not read): a file
+ * vertex whose corners give normals that disagree is split into one vertex
+ * per normal, as the exporter meant (a floor and a wall sharing a position
+ * at a crease keep a vertical and a horizontal normal; averaging them would
+ * tilt both). Two corner normals agree when the angle between them is at
+ * most VB_MESH_NORMAL_AGREE_DEG (0.1 degrees: any rounding of a printed
+ * normal, 4 decimals ~0.006 degrees, welds; any crease meant, >= 1 degree,
+ * splits). Each corner joins the first group of its vertex (in triangle
+ * order) whose first normal it agrees with; a group's normal is that first
+ * normal (unit length). A vertex whose corners all agree is not split and
+ * keeps its normal as before (one given normal as is, several: their unit
+ * average). Split vertices follow each other in the file's vertex order;
+ * corners that give no normal, or a zero one, join the vertex's first
+ * group. At most 256 groups per vertex; further disagreeing corners join
+ * the closest.
  *
  * Files are read into memory once (vb_mesh_load_memory starts from such
  * bytes); those bytes are hashed for vb_source_info, checked by a strict
@@ -72,6 +92,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "vb.h"
 
@@ -94,11 +115,48 @@ typedef struct vb_load_desc {
                               vertices */
 } vb_load_desc;
 
-/* What a loaded source was, for the .vdsh SRCS chunk. */
+/* What loading found in a file and did about it, as counts (all zero for
+ * the built-in scene and for a file with nothing to say). Counts of
+ * vertices are of the file's vertices unless said otherwise. */
+typedef struct vb_mesh_report {
+    uint32_t dropped_triangles;  /* repeated a vertex index (no area),
+                                    dropped; OBJ faces OpenMesh drops for
+                                    fewer than 3 distinct vertices count as
+                                    their corners - 2 */
+    uint32_t removed_vertices;   /* used by no remaining triangle */
+    uint32_t split_vertices;     /* split at creases (corner normals) */
+    uint32_t split_added;        /* vertices those splits added */
+    uint32_t missing_normals;    /* used vertices with no file normal while
+                                    others have one: all normals computed */
+    uint32_t zero_normals;       /* loaded vertices whose file normal is
+                                    zero (or whose given normals cancel) */
+    uint32_t zero_repaired;      /* of those, given their own triangles'
+                                    normal (the rest have no area) */
+    uint32_t cancelled_normals;  /* loaded vertices whose computed normal
+                                    cancelled (two-sided triangles): given
+                                    their largest triangle's normal */
+    uint32_t welded;             /* vertices merged by weld */
+    uint32_t undefined_normals;  /* loaded vertices left (0,0,0) at the end:
+                                    their triangles have no area */
+} vb_mesh_report;
+
+/* What a loaded source was: size and hash for the .vdsh SRCS chunk, and
+ * what loading found. */
 typedef struct vb_source_info {
     uint64_t size;         /* bytes of the file (or of the built-in arrays) */
     uint8_t sha256[32];
+    vb_mesh_report report;
 } vb_source_info;
+
+/* Corner normals within this angle (degrees) agree: see the top. */
+#define VB_MESH_NORMAL_AGREE_DEG 0.1
+
+/* One line per non-zero finding of `r` on fp, each "TOOL: PATH: ..."
+ * (no "TOOL: " when tool is NULL), e.g. "vdsh-bake: scan.ply: 11160
+ * triangles dropped (a repeated vertex index: no area)". Nothing when
+ * fp is NULL (a tool's quiet mode) or nothing was found. */
+void vb_mesh_report_print(FILE *fp, const char *tool, const char *path,
+                          const vb_mesh_report *r);
 
 /* Load one file or built-in scene. `info` may be NULL. */
 vb_result vb_mesh_load(const char *path, const vb_load_desc *desc,
@@ -131,8 +189,12 @@ vb_result vb_mesh_append(vb_mesh *dst, const vb_mesh *src, vb_error *err);
 vb_result vb_mesh_weld(vb_mesh *m, vb_error *err);
 
 /* Recompute angle-weighted vertex normals from the triangles ((0,0,0)
- * for a vertex whose triangles all have zero area); allocates m->normals
- * when it is NULL (and leaves it NULL if that fails). */
+ * for a vertex whose triangles all have zero area). Where the weighted sum
+ * cancels (shorter than 1e-5 times the sum of its weights: a two-sided
+ * triangle, a zero-width fold; what is left is rounding, pointing
+ * anywhere) the vertex takes the unit normal of its largest triangle (the
+ * first of equal ones). Allocates m->normals when it is NULL (and leaves
+ * it NULL if that fails). */
 void vb_mesh_compute_normals(vb_mesh *m);
 
 /* Receiver refinement: split edges longer than max_edge (OpenMesh) until
@@ -197,7 +259,8 @@ typedef enum vb_mesh_format {
 /* A file as OpenMesh read it, before validation and cleaning: polygons
  * fan-triangulated, indices exactly as read (possibly out of range), file
  * normals per vertex (one given normal as is, several: their unit
- * average). All arrays are malloc'ed; vb_mesh_raw_free() frees them. */
+ * average) and, for OBJ, per triangle corner (as given). All arrays are
+ * malloc'ed; vb_mesh_raw_free() frees them. */
 typedef struct vb_mesh_raw {
     uint32_t vertex_count;
     uint32_t triangle_count;
@@ -206,6 +269,9 @@ typedef struct vb_mesh_raw {
     uint8_t *has_normal;   /* vertex_count or NULL: file gave a normal */
     int64_t *indices;      /* 3 * triangle_count */
     uint32_t *faces;       /* triangle_count: 0-based polygon in the file */
+    float *corner_normals; /* 9 * triangle_count or NULL (none given) */
+    uint8_t *corner_given; /* 3 * triangle_count or NULL: corner has one */
+    uint32_t dropped_triangles; /* the reader dropped (see vb_mesh_report) */
 } vb_mesh_raw;
 
 /* Check `bytes` (the whole file) and read them with OpenMesh; `name` is

@@ -323,6 +323,7 @@ struct expectation {
     bool vertices_known = true;   /* STL: OpenMesh merges, count unknown */
     uint64_t faces = 0;           /* add_face calls with >= 3 vertices */
     uint64_t triangles = 0;       /* after fan triangulation */
+    uint64_t dropped = 0;         /* OBJ: triangles of faces OpenMesh drops */
     bool stl_binary = false;
     std::vector<size_t> comment_out;   /* OBJ: offsets of mtllib/usemtl/vt */
     std::string ply_header;            /* PLY: the header rewritten plainly */
@@ -424,6 +425,8 @@ vb_result scan_obj(const char *path, const uint8_t *bytes, size_t size,
             if (distinct >= 3) {
                 ex->faces++;
                 ex->triangles += distinct - 2;
+            } else {
+                ex->dropped += corners.size() - 2;
             }
         } else if (kw.is("mtllib") || kw.is("usemtl") || kw.is("vt")) {
             ex->comment_out.push_back((size_t)(kw.b - (const char *)bytes));
@@ -1125,6 +1128,20 @@ public:
     uint64_t polygons = 0;
     uint64_t short_faces = 0;
 
+    /* OBJ: normals per face corner. OpenMesh's OBJ reader calls
+     * set_normal(vertex, normal) for each corner of a face line that names
+     * a normal, in order, then add_face with the face's vertices (repeated
+     * ones removed); no other call tells where a face line begins. Those
+     * calls are kept in `pending` until add_face, which gives each corner
+     * the last normal set for its vertex. (A line OpenMesh drops, with
+     * fewer than three distinct vertices, leaves its calls pending for the
+     * next face; they matter only where that face names the same vertex
+     * without a normal.) */
+    bool per_corner = false;
+    std::vector<std::pair<int, Vec3f>> pending;
+    std::vector<float> corner_normals; /* 9 per triangle, once one is given */
+    std::vector<uint8_t> corner_given; /* 3 per triangle */
+
     VertexHandle add_vertex(const Vec3f &p) override
     {
         positions.push_back(p[0]);
@@ -1150,7 +1167,55 @@ public:
             indices.push_back(v[i + 1].idx());
             tri_face.push_back((uint32_t)polygons);
         }
+        if (per_corner)
+            add_corner_normals(v);
         return FaceHandle((int)polygons++);
+    }
+
+    /* The corners of the polygon just fanned: its vertices' pending
+     * normals, onto each of its triangles' corners. */
+    void add_corner_normals(const VHandles &v)
+    {
+        if (pending.empty() && corner_normals.empty())
+            return;
+        size_t tris = indices.size() / 3, fan = v.size() - 2;
+        if (corner_normals.empty()) {
+            corner_normals.assign(9 * (tris - fan), 0.0f);
+            corner_given.assign(3 * (tris - fan), 0);
+        }
+        std::vector<const Vec3f *> given(v.size(), nullptr);
+        if (pending.size() <= 16) {
+            for (size_t c = 0; c < v.size(); c++)
+                for (size_t p = pending.size(); p-- > 0;)
+                    if (pending[p].first == v[c].idx()) {
+                        given[c] = &pending[p].second;
+                        break;
+                    }
+        } else {
+            std::vector<std::pair<int, size_t>> last;   /* vertex, latest pending entry */
+            last.reserve(pending.size());
+            for (size_t p = 0; p < pending.size(); p++)
+                last.emplace_back(pending[p].first, p);
+            std::stable_sort(last.begin(), last.end(),
+                             [](const std::pair<int, size_t> &a, const std::pair<int, size_t> &b) {
+                                 return a.first < b.first;
+                             });
+            for (size_t c = 0; c < v.size(); c++) {
+                auto it = std::upper_bound(last.begin(), last.end(), std::make_pair(v[c].idx(), SIZE_MAX));
+                if (it != last.begin() && (it - 1)->first == v[c].idx())
+                    given[c] = &pending[(it - 1)->second].second;
+            }
+        }
+        for (size_t i = 1; i + 1 < v.size(); i++) {
+            const size_t corner[3] = {0, i, i + 1};
+            for (size_t k = 0; k < 3; k++) {
+                const Vec3f *n = given[corner[k]];
+                corner_given.push_back(n != nullptr);
+                for (int q = 0; q < 3; q++)
+                    corner_normals.push_back(n ? (*n)[q] : 0.0f);
+            }
+        }
+        pending.clear();
     }
 
     void set_point(VertexHandle vh, const Vec3f &p) override
@@ -1170,6 +1235,8 @@ public:
     {
         if (!valid(vh) || !std::isfinite(n[0]) || !std::isfinite(n[1]) || !std::isfinite(n[2]))
             return;
+        if (per_corner)
+            pending.emplace_back(vh.idx(), n);
         size_t nv = positions.size() / 3;
         if (normal_sums.size() < 3 * nv) {
             normal_sums.resize(3 * nv, 0.0f);
@@ -1342,6 +1409,7 @@ vb_result read_openmesh(const char *path, const char *file, vb_mesh_format forma
     }
 
     collector col;
+    col.per_corner = format == VB_MESH_OBJ;
     bool ok = false;
     std::string said;
     {
@@ -1385,6 +1453,9 @@ vb_result read_openmesh(const char *path, const char *file, vb_mesh_format forma
                        said.empty() ? "" : (said + ")").c_str());
     if (nv > max_count)
         return vb_fail(err, VB_ERR_FORMAT, "%s: too many vertices", path);
+    if (!col.corner_normals.empty() && col.corner_normals.size() != 9 * (col.indices.size() / 3))
+        return vb_fail(err, VB_ERR_FORMAT, "%s: internal error: %zu corner normals for %zu triangles", path,
+                       col.corner_normals.size() / 3, col.indices.size() / 3);
 
     /* Hand over malloc'ed arrays (mesh.c frees them with free()). */
     vb_mesh_raw raw;
@@ -1405,6 +1476,11 @@ vb_result read_openmesh(const char *path, const char *file, vb_mesh_format forma
             raw.normals = malloc_copy(col.normal_sums);
             raw.has_normal = malloc_copy(col.has_normal);
         }
+        if (!col.corner_normals.empty()) {
+            raw.corner_normals = malloc_copy(col.corner_normals);
+            raw.corner_given = malloc_copy(col.corner_given);
+        }
+        raw.dropped_triangles = (uint32_t)std::min<uint64_t>(ex.dropped, UINT32_MAX);
     } catch (...) {
         vb_mesh_raw_free(&raw);
         throw;
@@ -1749,6 +1825,8 @@ extern "C" void vb_mesh_raw_free(vb_mesh_raw *raw)
     free(raw->positions);
     free(raw->normals);
     free(raw->has_normal);
+    free(raw->corner_normals);
+    free(raw->corner_given);
     free(raw->indices);
     free(raw->faces);
     memset(raw, 0, sizeof *raw);

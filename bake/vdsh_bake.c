@@ -571,6 +571,7 @@ int main(int argc, char **argv)
         if (log)
             fprintf(log, "vdsh-bake: %s: %u vertices, %u triangles (%.2f s)\n", path,
                     m.vertex_count, m.triangle_count, vb_now() - t);
+        vb_mesh_report_print(log, "vdsh-bake", path, &info.report);
         vb_mesh_free(&m);
     }
     tm.load = vb_now() - t_start;

@@ -13,3 +13,8 @@ add_test(NAME mesh_unit COMMAND test_mesh unit ${CMAKE_CURRENT_BINARY_DIR})
 add_test(NAME mesh_scenes COMMAND test_mesh scenes ${VDSH_SHARED_SCENES})
 add_test(NAME mesh_assimp COMMAND test_mesh assimp ${VDSH_ASSIMP_MODELS})
 set_tests_properties(mesh_scenes mesh_assimp PROPERTIES SKIP_RETURN_CODE 77)
+
+# What loading found, on vdsh-bake's stderr (and -q, and vdsh-eval quiet).
+add_test(NAME mesh_report_cli
+         COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/test_mesh_cli.sh
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval>)

@@ -33,6 +33,17 @@ put(o, 'cube-vt-vn.obj', ''.join('v %g %g %g\n' % v for v in cube_v) +
             for j, q in enumerate(cube_q)))
 put(o, 'cube-v-vn.obj', ''.join('v %g %g %g\n' % v for v in cube_v) + 'vn 0 0 -1\nvn 0 0 1\n' +
     ''.join('f ' + ' '.join('%d//%d' % (i, 1 + j % 2) for i in q) + '\n' for j, q in enumerate(cube_q)))
+# creases: each face's corners name its own normal (vertices split); one
+# corner without a normal, one zero normal, a face OpenMesh drops (two
+# distinct vertices) with normals, and a 20-gon naming a normal per corner
+put(o, 'cube-creases.obj', ''.join('v %g %g %g\n' % v for v in cube_v) +
+    'vn -1 0 0\nvn 1 0 0\nvn 0 -1 0\nvn 0 1 0\nvn 0 0 -1\nvn 0 0 1\nvn 0 0 0\n' +
+    ''.join('f ' + ' '.join('%d//%d' % (i, n) for i in q) + '\n'
+            for q, n in zip(cube_q, (1, 2, 3, 4, 5, 6))).replace('f 1//1 3//1', 'f 1 3//7', 1) +
+    'f 1//2 1//3 2//4\n')
+put(o, 'polygon-corner-normals.obj', ''.join('v %.6f %.6f 0\n' % (math.cos(k * math.pi / 10), math.sin(k * math.pi / 10)) for k in range(20)) +
+    ''.join('vn %.4f 0 1\n' % (0.01 * k) for k in range(20)) +
+    'f ' + ' '.join('%d//%d' % (k + 1, k + 1) for k in range(20)) + '\n')
 put(o, 'tabs-crlf-comments.obj', 'mtllib cube.mtl\r\n# comment\r\no box\r\ng side\r\nusemtl red\r\nv\t0 0 0\r\nv\t1 0 0 # inline\r\nv\t0 1 0\r\nv 0 0 1 1.0\r\ns 1\r\nf 1 2 3\r\nf\t1 3 4 # c\r\nl 1 2\r\np 3\r\n')
 put(o, 'no-final-newline.obj', 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3')
 put(o, 'vertex-colors.obj', 'v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n')

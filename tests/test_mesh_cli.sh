@@ -1,0 +1,109 @@
+#!/usr/bin/env bash
+# What the mesh loader drops, repairs or splits is said on vdsh-bake's
+# stderr, one line per finding with its count and the file's name
+# (vb_mesh_report_print); -q says nothing; vdsh-eval, which only rebuilds
+# the occluders from the same files, repeats none of it.
+# Usage: test_mesh_cli.sh VDSH_BAKE VDSH_EVAL
+set -u
+bake=$1
+eval=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail=0
+has() { # has FILE TEXT: the file has a line containing TEXT
+  if ! grep -qF -- "$2" "$1"; then
+    echo "FAIL: stderr lacks '$2':" >&2; cat "$1" >&2; fail=1
+  fi
+}
+
+# Vertices 1 and 2: zero normals on used vertices (repaired from the
+# square's faces); 4 and 5 unused; 6 used only by a triangle repeating it;
+# 7-9: zero normals on a zero-area triangle (nothing to repair from). Two
+# triangles repeat an index.
+cat >"$tmp/scan.ply" <<'PLY'
+ply
+format ascii 1.0
+element vertex 10
+property float x
+property float y
+property float z
+property float nx
+property float ny
+property float nz
+element face 5
+property list uchar int vertex_indices
+end_header
+0 0 0 0 0 1
+1 0 0 0 0 0
+0 1 0 0 0 0
+1 1 0 0 0 1
+5 5 5 0 0 1
+6 6 6 0 0 0
+2 2 2 0 0 1
+3 0 0 0 0 0
+4 0 0 0 0 0
+5 0 0 0 0 0
+3 0 1 2
+3 1 3 2
+3 1 1 2
+3 6 6 6
+3 7 8 9
+PLY
+
+if ! "$bake" "$tmp/scan.ply" --export-obj "$tmp/scan.obj" 2>"$tmp/err"; then
+  echo "FAIL: export of scan.ply failed:" >&2; cat "$tmp/err" >&2; fail=1
+fi
+has "$tmp/err" "vdsh-bake: $tmp/scan.ply: 2 triangles dropped (a repeated vertex index: no area)"
+has "$tmp/err" "vdsh-bake: $tmp/scan.ply: 3 vertices removed (used by no remaining triangle)"
+has "$tmp/err" "vdsh-bake: $tmp/scan.ply: 5 vertices have a zero normal in the file: 2 repaired from their own triangles"
+has "$tmp/err" "vdsh-bake: $tmp/scan.ply: 3 vertices left without a normal (0,0,0)"
+n=$(grep -c "scan.ply: " "$tmp/err")
+if [[ $n -ne 5 ]]; then  # the load line and four findings
+  echo "FAIL: $n lines name scan.ply, want 5:" >&2; cat "$tmp/err" >&2; fail=1
+fi
+# the repaired normals are the square's, (0,0,1): vn lines 2 and 3
+if [[ "$(sed -n '/^vn/p' "$tmp/scan.obj" | sed -n '2,3p' | tr '\n' ' ')" != "vn 0 0 1 vn 0 0 1 " ]]; then
+  echo "FAIL: repaired normals:" >&2; grep '^vn' "$tmp/scan.obj" >&2; fail=1
+fi
+
+# -q: nothing at all
+if ! "$bake" "$tmp/scan.ply" --export-obj "$tmp/scan.obj" -q 2>"$tmp/err" || [[ -s $tmp/err ]]; then
+  echo "FAIL: -q still printed:" >&2; cat "$tmp/err" >&2; fail=1
+fi
+
+# A crease: a floor and a wall sharing two positions, each corner naming
+# its own normal: the two shared positions split, two vertices added.
+cat >"$tmp/crease.obj" <<'OBJ'
+v 0 0 0
+v 1 0 0
+v 1 0 1
+v 0 0 1
+v 0 1 0
+v 1 1 0
+vn 0 1 0
+vn 0 0 1
+f 4//1 3//1 2//1 1//1
+f 1//2 2//2 6//2 5//2
+OBJ
+"$bake" "$tmp/crease.obj" --export-obj "$tmp/crease.out.obj" 2>"$tmp/err"
+has "$tmp/err" "vdsh-bake: $tmp/crease.obj: 8 vertices, 4 triangles"
+has "$tmp/err" "vdsh-bake: $tmp/crease.obj: 2 vertices split at creases"
+has "$tmp/err" "2 vertices added"
+sort -u <(grep '^vn' "$tmp/crease.out.obj") >"$tmp/vn"
+if [[ "$(tr '\n' ' ' <"$tmp/vn")" != "vn 0 0 1 vn 0 1 0 " ]]; then
+  echo "FAIL: crease normals are not the file's:" >&2; cat "$tmp/vn" >&2; fail=1
+fi
+
+# vdsh-eval rebuilds the occluders from the same file and says nothing
+# about it (the bake did)
+if "$bake" "$tmp/scan.ply" --rays 16 --cube-size 8 -q -o "$tmp/scan.vdsh" 2>"$tmp/err"; then
+  "$eval" "$tmp/scan.vdsh" --interior 64 --directions 4 -q >"$tmp/out" 2>"$tmp/err"
+  if grep -q "scan.ply: " "$tmp/err"; then
+    echo "FAIL: vdsh-eval repeated the loader's findings:" >&2; cat "$tmp/err" >&2; fail=1
+  fi
+else
+  echo "FAIL: bake of scan.ply failed:" >&2; cat "$tmp/err" >&2; fail=1
+fi
+
+[[ $fail -eq 0 ]] && echo "mesh report cli: all checks passed"
+exit $fail
