@@ -42,6 +42,7 @@ typedef struct options {
     int file_count;
     int have_camera;
     float camera[6];
+    int fit;                   /* --fit: frame the bounds from outside */
     float fov;
     vr_light lights[MAX_LIGHTS];
     int light_count;
@@ -86,8 +87,10 @@ static const char usage_text[] =
     "                        every mode of every SCENE once (wall time and\n"
     "                        process CPU time per frame); JSON on stdout\n"
     "\n"
-    "View (defaults come from the scene's bounds, y up):\n"
+    "View (defaults come from the scene's bounds, y up: a room is seen from\n"
+    "inside, an object framed from outside, lit from outside):\n"
     "      --camera EX,EY,EZ,TX,TY,TZ   eye and target point\n"
+    "      --fit             frame the whole scene from outside, also a room\n"
     "      --fov DEG         vertical field of view (default 60)\n"
     "      --light X,Y,Z[,R,G,B]  a point light (repeatable)\n"
     "      --lights N        use N default lights, 1..4 (default 1)\n"
@@ -159,7 +162,7 @@ static int parse_args(int argc, char **argv, options *o)
     memset(o, 0, sizeof *o);
     o->mode = VR_MODE_VDSH5;
     o->egl = VR_EGL_AUTO;
-    enum { O_RENDER = 256, O_GRID, O_BENCH, O_CAMERA, O_FOV, O_LIGHT, O_LIGHTS,
+    enum { O_RENDER = 256, O_GRID, O_BENCH, O_CAMERA, O_FIT, O_FOV, O_LIGHT, O_LIGHTS,
            O_ATT, O_AMBIENT, O_MODE, O_COMPARE, O_PCF, O_SHADOW_SIZE, O_SIZE, O_CUBEDIR,
            O_NO_CUBEMAPS, O_EGL, O_FRAMES, O_SCREENSHOT, O_NO_OVERLAY, O_KEYS,
            O_NO_MALLOPT };
@@ -168,6 +171,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"grid", required_argument, 0, O_GRID},
         {"bench", no_argument, 0, O_BENCH},
         {"camera", required_argument, 0, O_CAMERA},
+        {"fit", no_argument, 0, O_FIT},
         {"fov", required_argument, 0, O_FOV},
         {"light", required_argument, 0, O_LIGHT},
         {"lights", required_argument, 0, O_LIGHTS},
@@ -209,6 +213,7 @@ static int parse_args(int argc, char **argv, options *o)
                 return usage_error("--camera: expected EX,EY,EZ,TX,TY,TZ, got '%s'", v);
             o->have_camera = 1;
             break;
+        case O_FIT: o->fit = 1; break;
         case O_FOV:
             if (!vt_parse_float(v, &o->fov) || !(o->fov > 1.0f && o->fov < 179.0f))
                 return usage_error("--fov: expected degrees in (1, 179), got '%s'", v);
@@ -311,6 +316,8 @@ static int parse_args(int argc, char **argv, options *o)
     if (o->file_count > 1 && !o->bench && !o->grid_path)
         return usage_error("one scene file at a time (several only with --grid and --bench), "
                            "got '%s'", o->files[1]);
+    if (o->fit && o->have_camera)
+        return usage_error("%s", "--fit and --camera both choose the view: give one");
     return 0;
 }
 
@@ -329,11 +336,14 @@ static float scene_diagonal(const vr_scene *s)
 
 /* n default lights of the scene: positions from vr_scene_default_lights,
  * warm/cool colours, and a fall-off that halves the light at about 0.3 of
- * the scene's diagonal. */
+ * the scene's diagonal in a room, and at the middle of an object (its
+ * lights stand outside it). */
 static int default_lights(const vr_scene *s, const options *o, int n, vr_light *out)
 {
     static const float colors[4][3] = {
         {1.0f, 0.92f, 0.8f}, {0.55f, 0.7f, 1.0f}, {1.0f, 0.62f, 0.4f}, {0.7f, 1.0f, 0.7f}};
+    vr_scene_info info;
+    vr_scene_get_info(s, &info);
     n = vr_scene_default_lights(s, out, n);
     float r = 0.3f * scene_diagonal(s);
     /* dimmer when there are several, so that their sum stays in range */
@@ -341,6 +351,14 @@ static int default_lights(const vr_scene *s, const options *o, int n, vr_light *
     for (int i = 0; i < n; i++) {
         for (int k = 0; k < 3; k++)
             out[i].color[k] = intensity * colors[i][k];
+        if (!info.interior) {
+            r = 0.0f;
+            for (int k = 0; k < 3; k++) {
+                float d = out[i].position[k] - 0.5f * (info.bounds_min[k] + info.bounds_max[k]);
+                r += d * d;
+            }
+            r = sqrtf(r) > 0.0f ? sqrtf(r) : 1.0f;
+        }
         if (o->have_att)
             memcpy(out[i].attenuation, o->att, sizeof o->att);
         else {
@@ -373,7 +391,10 @@ static int scene_lights(const vr_scene *s, const options *o, int n, vr_light *ou
 
 static void scene_camera(const vr_scene *s, const options *o, vr_camera *c)
 {
-    vr_scene_default_camera(s, c);
+    if (o->fit)
+        vr_scene_fit_camera(s, c);
+    else
+        vr_scene_default_camera(s, c);
     if (o->have_camera) {
         memcpy(c->eye, o->camera, 3 * sizeof(float));
         memcpy(c->target, o->camera + 3, 3 * sizeof(float));
