@@ -242,14 +242,15 @@ import json, os, shutil, subprocess, sys
 view, room, room_log, d = sys.argv[1:5]
 shutil.rmtree(d, ignore_errors=True)
 os.makedirs(d)
-odd = os.path.join(d, 'q"x\\r oom.vdsh')
+odd = os.path.join(os.fsencode(d), b'q"x\\r\t\xffoom.vdsh')
 shutil.copy(room_log, odd)
 out = subprocess.run([view, '--bench', '--frames', '1', '--size', '96x72', '--shadow-size', '64',
-                      '-q', room, room, odd], check=True, capture_output=True, text=True).stdout
+                      '-q', room, room, odd], check=True, capture_output=True).stdout
 print(out[:400])
-b = json.loads(out)
+b = json.loads(out.decode('utf-8'))
 assert b['renderer'] and b['rounds'] == 1 and b['width'] == 96, b
-assert [s['file'] for s in b['scenes']] == [room, room, odd], [s['file'] for s in b['scenes']]
+shown = os.path.join(d, 'q"x\\r\t\ufffdoom.vdsh')
+assert [s['file'] for s in b['scenes']] == [room, room, shown], [s['file'] for s in b['scenes']]
 modes = {r['mode'] for s in b['scenes'] for r in s['results']}
 assert modes == {'none', 'cube', 'cube_pcf', 'vdsh2', 'vdsh3', 'vdsh5', 'vdsh5poly'}, modes
 assert {r['lights'] for r in b['scenes'][0]['results']} == {1, 3}
