@@ -2,5 +2,5 @@
 add_library(vb_core STATIC sampling.c scene.c origins.c bake.c fit.c fit_shadow.c parallel.c)
 target_link_libraries(vb_core PUBLIC vb_mesh vdsh_format embree Threads::Threads m)
 add_executable(vdsh-bake vdsh_bake.c)
-target_link_libraries(vdsh-bake PRIVATE vb_core vb_cubemap)
+target_link_libraries(vdsh-bake PRIVATE vb_core vb_cubemap vt_tools)
 install(TARGETS vdsh-bake RUNTIME DESTINATION bin)

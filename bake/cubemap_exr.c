@@ -9,7 +9,8 @@
  *    the temporary "tmp.<pid><name>" (two threads writing the same
  *    destination collide), opens it without O_EXCL (it truncates a file
  *    that happens to have that name) and never fsyncs before renaming
- *    (after a crash the destination can be empty);
+ *    (after a crash the destination can be empty); ours is the project's
+ *    one atomic output (vdsh_output.h), written at offsets through its fd;
  *  - get our own user data into OpenEXR's error handler, which receives
  *    only the context: the handler stores the message in that user data
  *    and it ends up in vb_error instead of on stderr;
@@ -22,6 +23,7 @@
  */
 #include "cubemap.h"
 #include "vdsh_cube.h"
+#include "vdsh_output.h"
 
 #include <openexr.h>
 
@@ -29,7 +31,6 @@
 #include <fcntl.h>
 #include <inttypes.h>
 #include <math.h>
-#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -312,107 +313,43 @@ done:
     return r;
 }
 
-/* A fully written temporary file waiting to be renamed over its path. */
-typedef struct staged {
-    char *tmp;
-} staged;
-
-static void staged_discard(staged *s)
-{
-    if (s->tmp) {
-        unlink(s->tmp);
-        free(s->tmp);
-        s->tmp = NULL;
-    }
-}
-
 /* Write the image to a new temporary file beside `path` and flush it to
- * disk: encoded from rgba, or, if `encoded` is not NULL, the file already
- * encoded in memory. On failure nothing is left behind. */
+ * disk (vdsh_output.h): encoded from rgba, or, if `encoded` is not NULL,
+ * the file already encoded in memory. On failure nothing is left behind. */
 static vb_result stage(const char *path, int n, const float *rgba, const exr_io *encoded,
-                       staged *out, vb_error *err)
+                       vdsh_output *out, vb_error *err)
 {
-    /* Unique among threads (counter) and processes (pid); O_EXCL makes
-     * sure we never write into somebody else's file. */
-    static atomic_uint seq;
-    size_t size = strlen(path) + 48;
-    char *tmp = malloc(size);
-    if (!tmp)
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
-    int fd = -1;
-    for (int attempt = 0; attempt < 64 && fd < 0; attempt++) {
-        unsigned k = atomic_fetch_add(&seq, 1u);
-        snprintf(tmp, size, "%s.tmp-%ld-%u", path, (long)getpid(), k);
-        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd < 0 && errno != EEXIST) {
-            vb_result r = vb_fail(err, VB_ERR_IO,
-                                  "%s: cannot create temporary file %s: %s",
-                                  path, tmp, strerror(errno));
-            free(tmp);
-            return r;
-        }
-    }
-    if (fd < 0) {
-        free(tmp);
-        return vb_fail(err, VB_ERR_IO, "%s: cannot create a temporary file "
-                       "(all names taken)", path);
-    }
-
-    exr_io io = {.fd = fd};
+    vdsh_error ve;
+    vdsh_result vr = vdsh_output_open(path, out, &ve);
+    if (vr != VDSH_OK)
+        return vb_fail(err, vr == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY
+                            : vr == VDSH_ERR_ARGUMENT ? VB_ERR_ARGUMENT : VB_ERR_IO,
+                       "%s", ve.msg);
+    /* OpenEXR writes at offsets: straight to the descriptor, never
+     * through the (unused) stream. */
+    exr_io io = {.fd = out->fd};
+    const char *tmp = out->tmp ? out->tmp : path;
     vb_result r = VB_OK;
     if (!encoded)
         r = encode_exr(path, &io, n, rgba, err);
     else if (io_write(NULL, &io, encoded->mem, encoded->size, 0, NULL) < 0)
         r = vb_fail(err, VB_ERR_IO, "%s: cannot write %s: %s", path, tmp,
                     strerror(io.os_errno));
-    if (r == VB_OK && fsync(fd) != 0)
-        r = vb_fail(err, VB_ERR_IO, "%s: cannot flush %s: %s", path, tmp,
-                    strerror(errno));
-    if (close(fd) != 0 && r == VB_OK)
-        r = vb_fail(err, VB_ERR_IO, "%s: cannot close %s: %s", path, tmp,
-                    strerror(errno));
-    out->tmp = tmp;
-    if (r != VB_OK)
-        staged_discard(out);
-    return r;
+    if (r != VB_OK) {
+        vdsh_output_abort(out);
+        return r;
+    }
+    if (vdsh_output_finish(out, &ve) != VDSH_OK)
+        return vb_fail(err, VB_ERR_IO, "%s", ve.msg);
+    return VB_OK;
 }
 
-static vb_result commit(const char *path, staged *s, vb_error *err)
+static vb_result commit(vdsh_output *s, vb_error *err)
 {
-    vb_result r = VB_OK;
-    if (rename(s->tmp, path) != 0)
-        r = vb_fail(err, VB_ERR_IO, "%s: cannot rename %s into place: %s",
-                    path, s->tmp, strerror(errno));
-    else {
-        free(s->tmp);
-        s->tmp = NULL;
-    }
-    staged_discard(s);
-    return r;
-}
-
-/* Make the renames themselves durable; best effort (some file systems
- * refuse fsync on directories, and the data is already safe). */
-static void sync_parent_dir(const char *path)
-{
-    const char *slash = strrchr(path, '/');
-    char *dir = NULL;
-    if (!slash)
-        dir = strdup(".");
-    else if (slash == path)
-        dir = strdup("/");
-    else if ((dir = malloc((size_t)(slash - path) + 1)) != NULL) {
-        memcpy(dir, path, (size_t)(slash - path));
-        dir[slash - path] = '\0';
-    }
-    if (!dir)
-        return;
-    int fd = open(dir, O_RDONLY | O_CLOEXEC);
-    if (fd >= 0) {
-        (void)fsync(fd);
-        close(fd);
-    }
-    free(dir);
+    vdsh_error ve;
+    if (vdsh_output_commit(s, &ve) != VDSH_OK)
+        return vb_fail(err, VB_ERR_IO, "%s", ve.msg);
+    return VB_OK;
 }
 
 static vb_result check_size(const char *what, int n, vb_error *err)
@@ -448,12 +385,10 @@ vb_result vb_cubemap_write(const char *path, int n, const float *rgba,
         }
     }
 
-    staged s = {0};
+    vdsh_output s;
     r = stage(path, n, rgba, NULL, &s, err);
     if (r == VB_OK)
-        r = commit(path, &s, err);
-    if (r == VB_OK)
-        sync_parent_dir(path);
+        r = commit(&s, err);
     return r;
 }
 
@@ -811,7 +746,7 @@ vb_result vb_cubemap_basis_write(const vb_cubemap_basis *b, const char *dir,
                                  const char *stem, vb_error *err)
 {
     char *paths[VB_CUBEMAP_BASIS_FILES] = {0};
-    staged st[VB_CUBEMAP_BASIS_FILES] = {{0}};
+    vdsh_output st[VB_CUBEMAP_BASIS_FILES] = {{0}};
     vb_result r = VB_OK;
     for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++)
         r = basis_path_alloc(dir, stem, k, &paths[k], err);
@@ -823,18 +758,16 @@ vb_result vb_cubemap_basis_write(const vb_cubemap_basis *b, const char *dir,
         r = stage(paths[k], b->size, NULL, &encoded, &st[k], err);
     }
     for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++) {
-        r = commit(paths[k], &st[k], err);
+        r = commit(&st[k], err);
         if (r != VB_OK && k > 0 && err) {
             size_t len = strlen(err->msg);
             snprintf(err->msg + len, sizeof err->msg - len,
                      " (the first %d basis files were already replaced)", k);
         }
     }
-    if (r == VB_OK)
-        sync_parent_dir(paths[0]);
 
     for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++) {
-        staged_discard(&st[k]);
+        vdsh_output_abort(&st[k]);
         free(paths[k]);
     }
     return r;

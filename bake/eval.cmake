@@ -4,10 +4,10 @@ add_library(vb_eval STATIC eval.c)
 target_link_libraries(vb_eval PUBLIC vb_core)
 
 add_executable(vdsh-eval vdsh_eval.c)
-target_link_libraries(vdsh-eval PRIVATE vb_eval)
+target_link_libraries(vdsh-eval PRIVATE vb_eval vt_tools)
 install(TARGETS vdsh-eval RUNTIME DESTINATION bin)
 
 # For fit studies outside the baker (scripts/fit_floor): the bake's rays of
 # sampled receivers and held-out truth, as a flat file.
 add_executable(vdsh-raydump vdsh_raydump.c)
-target_link_libraries(vdsh-raydump PRIVATE vb_core)
+target_link_libraries(vdsh-raydump PRIVATE vb_core vt_tools)

@@ -4,12 +4,12 @@
  * (reading, refinement) is in mesh_openmesh.cpp, behind mesh.h.
  */
 #include "mesh.h"
+#include "vdsh_output.h"
 
 #include <errno.h>
 #include <fcntl.h>
 #include <float.h>
 #include <math.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -432,35 +432,15 @@ vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path, vb_error *err)
             return vb_fail(err, VB_ERR_INVALID, "%s: triangle %zu: index %u out of range (%u vertices)",
                            path, j / 3, m->indices[j], m->vertex_count);
 
-    /* The temporary sits next to the target, so rename() replaces the
-     * target atomically (same file system); O_EXCL with pid and counter
-     * keeps concurrent writers apart, and 0666 lets the umask decide the
-     * final permissions as for any other output. */
-    static atomic_uint counter;
-    size_t len = strlen(path);
-    char *tmp = malloc(len + 64);
-    if (!tmp)
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
-    int fd = -1;
-    for (int attempt = 0; attempt < 100 && fd < 0; attempt++) {
-        snprintf(tmp, len + 64, "%s.tmp.%ld.%u", path, (long)getpid(), atomic_fetch_add(&counter, 1u));
-        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
-        if (fd < 0 && errno != EEXIST)
-            break;
-    }
-    if (fd < 0) {
-        int e = errno;
-        free(tmp);
-        return vb_fail(err, VB_ERR_IO, "%s: cannot create a temporary file next to it: %s", path, strerror(e));
-    }
-    FILE *f = fdopen(fd, "w");
-    if (!f) {
-        int e = errno;
-        close(fd);
-        unlink(tmp);
-        free(tmp);
-        return vb_fail(err, VB_ERR_IO, "%s: %s", path, strerror(e));
-    }
+    /* The project's atomic output (vdsh_output.h): a temporary file
+     * beside the target, renamed over it once complete and on disk. */
+    vdsh_output out;
+    vdsh_error ve;
+    vdsh_result vr = vdsh_output_open(path, &out, &ve);
+    if (vr != VDSH_OK)
+        return vb_fail(err, vr == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_IO,
+                       "%s", ve.msg);
+    FILE *f = out.fp;
     setvbuf(f, NULL, _IOFBF, 1 << 16);
 
     /* %.9g: 9 significant digits read back as the same float. */
@@ -483,22 +463,8 @@ vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path, vb_error *err)
             fprintf(f, "f %u %u %u\n", tri[0] + 1, tri[1] + 1, tri[2] + 1);
     }
 
-    int failed = ferror(f) || fflush(f) != 0 || fsync(fileno(f)) != 0;
-    int e = errno;
-    if (fclose(f) != 0 && !failed) {
-        failed = 1;
-        e = errno;
-    }
-    if (!failed && rename(tmp, path) != 0) {
-        failed = 1;
-        e = errno;
-    }
-    if (failed) {
-        unlink(tmp);
-        free(tmp);
-        return vb_fail(err, VB_ERR_IO, "%s: cannot write: %s", path, strerror(e));
-    }
-    free(tmp);
+    if (vdsh_output_commit(&out, &ve) != VDSH_OK)
+        return vb_fail(err, VB_ERR_IO, "%s", ve.msg);
     return VB_OK;
 }
 

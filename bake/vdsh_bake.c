@@ -26,8 +26,9 @@
 #include "mesh.h"
 #include "scene.h"
 #include "vdsh.h"
-
-#define EXIT_USAGE 2
+#include "vdsh_output.h"
+#include "vt_cli.h"
+#include "vt_json.h"
 
 typedef struct options {
     const char *output;
@@ -133,31 +134,14 @@ static void usage(FILE *f)
 
 static int bad_usage(const char *fmt, const char *arg)
 {
-    fprintf(stderr, "vdsh-bake: ");
-    fprintf(stderr, fmt, arg);
-    fprintf(stderr, "\nTry 'vdsh-bake --help'.\n");
-    return EXIT_USAGE;
+    return vt_usage_error("vdsh-bake", fmt, arg);
 }
 
-static int parse_u64(const char *s, uint64_t max, uint64_t *out)
-{
-    char *end;
-    errno = 0;
-    if (!*s || *s == '-')
-        return 0;
-    unsigned long long v = strtoull(s, &end, 10);
-    if (errno || *end || v > max)
-        return 0;
-    *out = v;
-    return 1;
-}
-
+/* A number >= 0 (vt_cli.h: strictly decimal, finite). */
 static int parse_float(const char *s, float *out)
 {
-    char *end;
-    errno = 0;
-    float v = strtof(s, &end);
-    if (errno || end == s || *end || !isfinite(v) || v < 0.0f)
+    float v;
+    if (!vt_parse_float(s, &v) || v < 0.0f)
         return 0;
     *out = v;
     return 1;
@@ -165,23 +149,21 @@ static int parse_float(const char *s, float *out)
 
 static int parse_orders(const char *s, options *o)
 {
-    o->order_count = 0;
+    uint64_t v[VDSH_MAX_ORDER];
+    int n = vt_parse_u64_list(s, 1, VDSH_MAX_ORDER, v, 1, VDSH_MAX_ORDER);
     int seen[VDSH_MAX_ORDER + 1] = {0};
-    const char *p = s;
-    while (*p) {
-        if (*p < '1' || *p > '0' + VDSH_MAX_ORDER)
+    for (int i = 0; i < n; i++) {
+        if (seen[v[i]])
             return 0;
-        int n = *p++ - '0';
-        if (seen[n] || (*p && *p != ','))
-            return 0;
-        seen[n] = 1;
-        if (*p == ',' && !*++p)
-            return 0;
+        seen[v[i]] = 1;
     }
-    for (int n = 1; n <= VDSH_MAX_ORDER; n++)
-        if (seen[n])
-            o->orders[o->order_count++] = n;
-    return o->order_count > 0;
+    if (n == 0)
+        return 0;
+    o->order_count = 0;
+    for (int k = 1; k <= VDSH_MAX_ORDER; k++)
+        if (seen[k])
+            o->orders[o->order_count++] = k;
+    return 1;
 }
 
 /* ---- progress on a terminal -------------------------------------------- */
@@ -282,87 +264,81 @@ static void *encode_basis(void *arg)
     return NULL;
 }
 
-/* Reports are small: open a temporary file beside `path`; report_close
- * renames it over `path` only if everything was written. */
-static FILE *report_open(const char *path, char tmp[PATH_MAX])
+/* The report: vt_json writes it atomically (formats/vdsh_output.h).
+ * 0, or -1 with a message naming the file in msg. */
+static void report_seconds(vt_json *j, cJSON *root, const vdsh_timings *t)
 {
-    if (snprintf(tmp, PATH_MAX, "%s.tmp", path) >= PATH_MAX)
-        return NULL;
-    return fopen(tmp, "w");
-}
-
-static int report_close(FILE *fp, const char *tmp, const char *path)
-{
-    int bad = ferror(fp);
-    if (fclose(fp) != 0 || bad || rename(tmp, path) != 0) {
-        unlink(tmp);
-        return -1;
-    }
-    return 0;
+    cJSON *sec = vt_json_object(j, root, "seconds");
+    vt_json_f64(j, sec, "load", t->load);
+    vt_json_f64(j, sec, "refine", t->refine);
+    vt_json_f64(j, sec, "build", t->build);
+    vt_json_f64(j, sec, "trace", t->trace);
 }
 
 static int write_report(const char *path, const options *o, const vdsh_file *f,
                         const vb_bake_output *b, const vdsh_timings *t,
                         double write_seconds, size_t coef_bytes,
-                        long long file_size)
+                        long long file_size, char *msg, size_t cap)
 {
-    char tmp[PATH_MAX];
-    FILE *fp = report_open(path, tmp);
-    if (!fp)
-        return -1;
-    fprintf(fp, "{\n  \"output\": \"%s\",\n  \"sources\": [", o->output);
+    vt_json j = {0};
+    cJSON *root = vt_json_object(&j, NULL, NULL);
+    vt_json_string(&j, root, "output", o->output);
+    cJSON *src = vt_json_array(&j, root, "sources");
     for (uint32_t i = 0; i < f->source_count; i++)
-        fprintf(fp, "%s\"%s\"", i ? ", " : "", f->sources[i].name);
-    fprintf(fp, "],\n");
-    fprintf(fp, "  \"receivers\": %u,\n  \"receiver_triangles\": %u,\n",
-            f->header.vertex_count, f->header.triangle_count);
-    fprintf(fp, "  \"occluder_triangles\": %u,\n", f->header.occluder_triangle_count);
-    fprintf(fp, "  \"rays_per_receiver\": %u,\n  \"method\": \"%s\",\n", b->rays,
-            vdsh_method_name(o->method));
-    fprintf(fp, "  \"orders\": [");
+        vt_json_string(&j, src, NULL, f->sources[i].name);
+    vt_json_u64(&j, root, "receivers", f->header.vertex_count);
+    vt_json_u64(&j, root, "receiver_triangles", f->header.triangle_count);
+    vt_json_u64(&j, root, "occluder_triangles", f->header.occluder_triangle_count);
+    vt_json_u64(&j, root, "rays_per_receiver", b->rays);
+    vt_json_string(&j, root, "method", vdsh_method_name(o->method));
+    cJSON *orders = vt_json_array(&j, root, "orders");
     for (int i = 0; i < o->order_count; i++)
-        fprintf(fp, "%s%d", i ? ", " : "", o->orders[i]);
-    fprintf(fp, "],\n  \"encoding\": \"%s\",\n", vdsh_encoding_name(o->encoding));
-    fprintf(fp, "  \"max_distance\": %.9g,\n  \"max_edge\": %.9g,\n  \"seed\": %llu,\n",
-            (double)b->max_distance, (double)o->max_edge, (unsigned long long)o->seed);
-    fprintf(fp, "  \"threads\": %u,\n  \"robust\": %s,\n", b->threads,
-            o->robust ? "true" : "false");
-    fprintf(fp, "  \"rays_traced\": %llu,\n  \"rays_missed\": %llu,\n",
-            (unsigned long long)b->rays_traced, (unsigned long long)b->rays_missed);
-    fprintf(fp, "  \"degenerate_receivers\": %u,\n  \"undefined_normals\": %u,\n",
-            b->degenerate_receivers, b->undefined_normals);
-    fprintf(fp, "  \"moved_origins\": %u,\n  \"flipped_normals\": %u,\n", b->moved_origins,
-            o->flipped);
-    fprintf(fp, "  \"seconds\": {\"load\": %.6f, \"refine\": %.6f, \"build\": %.6f, "
-                "\"trace\": %.6f, \"write\": %.6f, \"total\": %.6f},\n",
-            t->load, t->refine, t->build, t->trace, write_seconds,
-            t->total + write_seconds);
-    fprintf(fp, "  \"mrays_per_second_trace\": %.4f,\n",
-            t->trace > 0 ? b->rays_traced / t->trace * 1e-6 : 0.0);
-    fprintf(fp, "  \"mrays_per_second_total\": %.4f,\n",
-            t->total + write_seconds > 0
-                ? b->rays_traced / (t->total + write_seconds) * 1e-6 : 0.0);
-    fprintf(fp, "  \"coefficient_bytes_per_vertex\": %zu,\n", coef_bytes);
-    fprintf(fp, "  \"file_bytes\": %lld\n}\n", file_size);
-    return report_close(fp, tmp, path);
+        vt_json_u64(&j, orders, NULL, (uint64_t)o->orders[i]);
+    vt_json_string(&j, root, "encoding", vdsh_encoding_name(o->encoding));
+    vt_json_f32(&j, root, "max_distance", b->max_distance);
+    vt_json_f32(&j, root, "max_edge", o->max_edge);
+    vt_json_u64(&j, root, "seed", o->seed);
+    vt_json_u64(&j, root, "threads", b->threads);
+    vt_json_bool(&j, root, "robust", o->robust);
+    vt_json_u64(&j, root, "rays_traced", b->rays_traced);
+    vt_json_u64(&j, root, "rays_missed", b->rays_missed);
+    vt_json_u64(&j, root, "degenerate_receivers", b->degenerate_receivers);
+    vt_json_u64(&j, root, "undefined_normals", b->undefined_normals);
+    vt_json_u64(&j, root, "moved_origins", b->moved_origins);
+    vt_json_u64(&j, root, "flipped_normals", o->flipped);
+    report_seconds(&j, root, t);
+    cJSON *sec = cJSON_GetObjectItemCaseSensitive(root, "seconds");
+    vt_json_f64(&j, sec, "write", write_seconds);
+    vt_json_f64(&j, sec, "total", t->total + write_seconds);
+    vt_json_f64(&j, root, "mrays_per_second_trace",
+                t->trace > 0 ? b->rays_traced / t->trace * 1e-6 : 0.0);
+    vt_json_f64(&j, root, "mrays_per_second_total",
+                t->total + write_seconds > 0
+                    ? b->rays_traced / (t->total + write_seconds) * 1e-6 : 0.0);
+    vt_json_u64(&j, root, "coefficient_bytes_per_vertex", coef_bytes);
+    vt_json_i64(&j, root, "file_bytes", file_size);
+    int r = vt_json_write_file(&j, path, msg, cap);
+    vt_json_free(&j);
+    return r;
 }
 
 /* The bare loop's record: what the benchmark compares the bake against. */
 static int write_bare_report(const char *path, const vb_bake_output *b,
-                             const vdsh_timings *t)
+                             const vdsh_timings *t, char *msg, size_t cap)
 {
-    char tmp[PATH_MAX];
-    FILE *fp = report_open(path, tmp);
-    if (!fp)
-        return -1;
-    fprintf(fp, "{\n  \"trace_only\": true,\n  \"receivers\": %u,\n"
-                "  \"rays_per_receiver\": %u,\n  \"threads\": %u,\n"
-                "  \"rays_traced\": %llu,\n"
-                "  \"seconds\": {\"load\": %.6f, \"refine\": %.6f, \"build\": %.6f, "
-                "\"trace\": %.6f, \"bare\": %.6f}\n}\n",
-            b->vertex_count, b->rays, b->threads, (unsigned long long)b->rays_traced,
-            t->load, t->refine, t->build, t->trace, t->build + t->trace);
-    return report_close(fp, tmp, path);
+    vt_json j = {0};
+    cJSON *root = vt_json_object(&j, NULL, NULL);
+    vt_json_bool(&j, root, "trace_only", 1);
+    vt_json_u64(&j, root, "receivers", b->vertex_count);
+    vt_json_u64(&j, root, "rays_per_receiver", b->rays);
+    vt_json_u64(&j, root, "threads", b->threads);
+    vt_json_u64(&j, root, "rays_traced", b->rays_traced);
+    report_seconds(&j, root, t);
+    vt_json_f64(&j, cJSON_GetObjectItemCaseSensitive(root, "seconds"), "bare",
+                t->build + t->trace);
+    int r = vt_json_write_file(&j, path, msg, cap);
+    vt_json_free(&j);
+    return r;
 }
 
 /* File stem and directory of OUT: "dir/room.vdsh" -> "dir", "room". */
@@ -431,7 +407,7 @@ int main(int argc, char **argv)
         switch (c) {
         case 'o': o.output = optarg; break;
         case O_RAYS:
-            if (!parse_u64(optarg, 1u << 20, &u) || u == 0)
+            if (!vt_parse_u64(optarg, 1, 1u << 20, &u))
                 return bad_usage("--rays takes a whole number 1..1048576, not '%s'", optarg);
             o.rays = (uint32_t)u;
             break;
@@ -463,16 +439,16 @@ int main(int argc, char **argv)
             break;
         case O_WELD: o.weld = 1; break;
         case O_SEED:
-            if (!parse_u64(optarg, UINT64_MAX, &o.seed))
+            if (!vt_parse_u64(optarg, 0, UINT64_MAX, &o.seed))
                 return bad_usage("--seed takes a whole number, not '%s'", optarg);
             break;
         case O_THREADS:
-            if (!parse_u64(optarg, 256, &u) || u == 0)
+            if (!vt_parse_u64(optarg, 1, 256, &u))
                 return bad_usage("--threads takes a whole number 1..256, not '%s'", optarg);
             o.threads = (unsigned)u;
             break;
         case O_CUBESIZE:
-            if (!parse_u64(optarg, 4096, &u))
+            if (!vt_parse_u64(optarg, 0, 4096, &u))
                 return bad_usage("--cube-size takes a whole number 0..4096, not '%s'", optarg);
             o.cube_size = (int)u;
             break;
@@ -513,7 +489,7 @@ int main(int argc, char **argv)
             return 0;
         default:
             fprintf(stderr, "Try 'vdsh-bake --help'.\n");
-            return EXIT_USAGE;
+            return VT_EXIT_USAGE;
         }
     }
     int nmesh = argc - optind;
@@ -681,9 +657,9 @@ int main(int argc, char **argv)
     if (o.trace_only) {
         pthread_mutex_lock(&output_lock);
         writing = 1;
-        if (o.report && write_bare_report(o.report, &bo, &tm) != 0) {
-            fprintf(stderr, "vdsh-bake: %s: cannot write the report: %s\n", o.report,
-                    strerror(errno));
+        char msg[PATH_MAX + 256];
+        if (o.report && write_bare_report(o.report, &bo, &tm, msg, sizeof msg) != 0) {
+            fprintf(stderr, "vdsh-bake: %s (the report)\n", msg);
             goto out;
         }
         status = 0;
@@ -780,10 +756,10 @@ int main(int argc, char **argv)
                     o.cubemap_dir ? o.cubemap_dir : dir);
         fprintf(log, "\nvdsh-bake: done in %.2f s\n", tm.total + write_seconds);
     }
+    char msg[PATH_MAX + 256];
     if (o.report && write_report(o.report, &o, &f, &bo, &tm, write_seconds, coef_bytes,
-                                 file_size) != 0) {
-        fprintf(stderr, "vdsh-bake: %s: cannot write the report: %s\n", o.report,
-                strerror(errno));
+                                 file_size, msg, sizeof msg) != 0) {
+        fprintf(stderr, "vdsh-bake: %s (the report)\n", msg);
         goto out;
     }
     status = 0;

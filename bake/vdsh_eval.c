@@ -47,8 +47,10 @@
 #include "vdsh_shadow.h"
 #include "scene.h"
 #include "vdsh.h"
+#include "vdsh_output.h"
+#include "vt_cli.h"
+#include "vt_json.h"
 
-#define EXIT_USAGE 2
 #define PV_MAGIC "VDSHPVE1"
 #define PV_VERSION 1u
 #define PV_HEADER 64u
@@ -125,41 +127,25 @@ static void usage(FILE *f)
 
 static int bad_usage(const char *fmt, const char *arg)
 {
-    fprintf(stderr, "vdsh-eval: ");
-    fprintf(stderr, fmt, arg);
-    fprintf(stderr, "\nTry 'vdsh-eval --help'.\n");
-    return EXIT_USAGE;
+    return vt_usage_error("vdsh-eval", fmt, arg);
 }
 
-static int parse_u64(const char *s, uint64_t max, uint64_t *out)
-{
-    char *end;
-    errno = 0;
-    if (!*s || *s == '-')
-        return 0;
-    unsigned long long v = strtoull(s, &end, 0);
-    if (errno || *end || v > max)
-        return 0;
-    *out = v;
-    return 1;
-}
-
+/* Distinct orders 1..5 (vt_cli.h's list syntax). */
 static int parse_orders(const char *s, int *want)
 {
-    int any = 0;
-    for (const char *p = s; *p;) {
-        if (*p < '1' || *p > '0' + VDSH_MAX_ORDER)
+    uint64_t v[VDSH_MAX_ORDER];
+    int n = vt_parse_u64_list(s, 1, VDSH_MAX_ORDER, v, 1, VDSH_MAX_ORDER);
+    int seen[VDSH_MAX_ORDER + 1] = {0};
+    for (int i = 0; i < n; i++) {
+        if (seen[v[i]])
             return 0;
-        want[*p++ - '0'] = 1;
-        any = 1;
-        if (*p == ',') {
-            if (!*++p)
-                return 0;
-        } else if (*p) {
-            return 0;
-        }
+        seen[v[i]] = 1;
     }
-    return any;
+    if (n == 0)
+        return 0;
+    for (int k = 1; k <= VDSH_MAX_ORDER; k++)
+        want[k] = seen[k];
+    return 1;
 }
 
 /* ---- progress on a terminal -------------------------------------------- */
@@ -235,162 +221,100 @@ typedef struct bake_time {
 } bake_time;
 
 /* vdsh-bake --report: "seconds": {..., "trace": T, ..., "total": T} and
- * "threads": N. A tiny reader for the one flat object the baker writes. */
+ * "threads": N, read with the JSON parser every tool shares (vt_json.h). */
 static int read_bake_report(const char *path, bake_time *bt, char *msg, size_t cap)
 {
-    FILE *fp = fopen(path, "rb");
-    if (!fp) {
-        snprintf(msg, cap, "%s: cannot open: %s", path, strerror(errno));
+    cJSON *root = vt_json_read_file(path, msg, cap);
+    if (!root)
         return 0;
-    }
-    char buf[65536];
-    size_t n = fread(buf, 1, sizeof buf - 1, fp);
-    fclose(fp);
-    buf[n] = '\0';
-    const char *sec = strstr(buf, "\"seconds\"");
-    const char *tot = sec ? strstr(sec, "\"total\"") : NULL;
-    const char *tr = sec ? strstr(sec, "\"trace\"") : NULL;
-    const char *th = strstr(buf, "\"threads\"");
-    if (!tot || !strchr(tot, ':')) {
+    const cJSON *sec = cJSON_GetObjectItemCaseSensitive(root, "seconds");
+    double total = vt_json_number(sec, "total");
+    if (!cJSON_IsObject(root) || !cJSON_IsObject(sec) || !(total >= 0.0)) {
         snprintf(msg, cap, "%s: no \"seconds\": {\"total\": ...} (not a vdsh-bake --report?)",
                  path);
+        cJSON_Delete(root);
         return 0;
     }
-    bt->total = strtod(strchr(tot, ':') + 1, NULL);
-    bt->trace = tr && strchr(tr, ':') ? strtod(strchr(tr, ':') + 1, NULL) : NAN;
-    bt->threads = th && strchr(th, ':') ? (unsigned)strtoul(strchr(th, ':') + 1, NULL, 10) : 0;
+    double threads = vt_json_number(root, "threads");
+    bt->total = total;
+    bt->trace = vt_json_number(sec, "trace");
+    bt->threads = threads >= 1.0 && threads <= 65536.0 ? (unsigned)threads : 0;
     bt->source = "bake report";
+    cJSON_Delete(root);
     return 1;
 }
 
-/* ---- JSON ------------------------------------------------------------------- */
+/* ---- JSON (vt_json.h: cJSON, exact numbers, NaN as null) ------------------ */
 
-static void json_str(FILE *fp, const char *s)
+static void json_vec(vt_json *j, cJSON *parent, const char *key, const float *v)
 {
-    fputc('"', fp);
-    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-        if (*p == '"' || *p == '\\')
-            fprintf(fp, "\\%c", *p);
-        else if (*p < 0x20)
-            fprintf(fp, "\\u%04x", *p);
-        else
-            fputc(*p, fp);
-    }
-    fputc('"', fp);
+    cJSON *a = vt_json_array(j, parent, key);
+    for (int i = 0; i < 3; i++)
+        vt_json_f32(j, a, NULL, v[i]);
 }
 
-static void json_num(FILE *fp, double v)
+static void json_receiver(vt_json *j, cJSON *list, const vb_eval_receiver *r, int kind)
 {
-    if (isfinite(v))
-        fprintf(fp, "%.9g", v);
-    else
-        fputs("null", fp);
-}
-
-static void json_vec(FILE *fp, const float *v)
-{
-    fputc('[', fp);
-    for (int i = 0; i < 3; i++) {
-        if (i)
-            fputs(", ", fp);
-        json_num(fp, v[i]);
-    }
-    fputc(']', fp);
-}
-
-static void json_receiver(FILE *fp, const vb_eval_receiver *r, int kind)
-{
-    fprintf(fp, "{\"index\": %u, ", r->index);
+    cJSON *o = vt_json_object(j, list, NULL);
+    vt_json_u64(j, o, "index", r->index);
     if (kind == VB_EVAL_INTERIOR) {
-        fprintf(fp, "\"triangle\": %u, \"bary\": ", r->triangle);
-        json_vec(fp, r->bary);
-        fputs(", ", fp);
+        vt_json_u64(j, o, "triangle", r->triangle);
+        json_vec(j, o, "bary", r->bary);
     }
-    fputs("\"position\": ", fp);
-    json_vec(fp, r->position);
-    fputs(", \"normal\": ", fp);
-    json_vec(fp, r->normal);
-    fputs(", \"shadow_mae\": ", fp);
-    json_num(fp, r->shadow_mae);
-    fputs(", \"distance_rms\": ", fp);
-    json_num(fp, r->distance_rms);
-    fputs(", \"false_shadow\": ", fp);
-    json_num(fp, r->false_shadow);
-    fputs(", \"near_zero\": ", fp);
-    json_num(fp, r->near_zero);
-    fputs(", \"escaped\": ", fp);
-    json_num(fp, r->escaped);
-    fputc('}', fp);
+    json_vec(j, o, "position", r->position);
+    json_vec(j, o, "normal", r->normal);
+    vt_json_f64(j, o, "shadow_mae", r->shadow_mae);
+    vt_json_f64(j, o, "distance_rms", r->distance_rms);
+    vt_json_f64(j, o, "false_shadow", r->false_shadow);
+    vt_json_f64(j, o, "near_zero", r->near_zero);
+    vt_json_f64(j, o, "escaped", r->escaped);
 }
 
-#define JV(name, value)                                                        \
-    do {                                                                       \
-        fprintf(fp, "%s\"%s\": ", first ? "" : ", ", name);                    \
-        json_num(fp, value);                                                   \
-        first = 0;                                                             \
-    } while (0)
-
-static void json_metrics(FILE *fp, const vb_eval_metrics *m, int kind)
+static void json_metrics(vt_json *j, cJSON *o, const vb_eval_metrics *m, int kind)
 {
-    int first = 1;
-    fputc('{', fp);
-    fprintf(fp, "\"samples\": %llu", (unsigned long long)m->samples);
-    first = 0;
-    JV("distance_rms", m->distance_rms);
-    JV("distance_rms_se", m->distance_rms_se);
-    JV("distance_mean", m->distance_mean);
-    JV("distance_p50", m->distance_p50);
-    JV("distance_p90", m->distance_p90);
-    JV("distance_p99", m->distance_p99);
-    JV("shadow_mae", m->shadow_mae);
-    JV("shadow_mae_se", m->shadow_mae_se);
-    JV("false_shadow", m->false_shadow);
-    JV("false_shadow_se", m->false_shadow_se);
-    JV("light_leak", m->light_leak);
-    JV("light_leak_se", m->light_leak_se);
-    JV("binary_mae", m->binary_mae);
-    JV("binary_mae_se", m->binary_mae_se);
-    JV("binary_false_shadow", m->binary_false_shadow);
-    JV("binary_false_shadow_se", m->binary_false_shadow_se);
-    JV("binary_light_leak", m->binary_light_leak);
-    JV("binary_light_leak_se", m->binary_light_leak_se);
-    JV("ringing", m->ringing);
-    JV("receiver_mae_p50", m->receiver_mae_p50);
-    JV("receiver_mae_p90", m->receiver_mae_p90);
-    JV("receiver_mae_p99", m->receiver_mae_p99);
-    fprintf(fp, ", \"visible\": %llu, \"occluded\": %llu, \"occluded_binary\": %llu",
-            (unsigned long long)m->visible, (unsigned long long)m->occluded,
-            (unsigned long long)m->occluded_binary);
-    fputs(",\n          \"worst\": [", fp);
-    for (uint32_t i = 0; i < m->worst_count; i++) {
-        fputs(i ? ",\n            " : "\n            ", fp);
-        json_receiver(fp, &m->worst[i], kind);
-    }
-    fputs("]}", fp);
+    vt_json_u64(j, o, "samples", m->samples);
+    const struct { const char *name; double v; } num[] = {
+        {"distance_rms", m->distance_rms}, {"distance_rms_se", m->distance_rms_se},
+        {"distance_mean", m->distance_mean}, {"distance_p50", m->distance_p50},
+        {"distance_p90", m->distance_p90}, {"distance_p99", m->distance_p99},
+        {"shadow_mae", m->shadow_mae}, {"shadow_mae_se", m->shadow_mae_se},
+        {"false_shadow", m->false_shadow}, {"false_shadow_se", m->false_shadow_se},
+        {"light_leak", m->light_leak}, {"light_leak_se", m->light_leak_se},
+        {"binary_mae", m->binary_mae}, {"binary_mae_se", m->binary_mae_se},
+        {"binary_false_shadow", m->binary_false_shadow},
+        {"binary_false_shadow_se", m->binary_false_shadow_se},
+        {"binary_light_leak", m->binary_light_leak},
+        {"binary_light_leak_se", m->binary_light_leak_se}, {"ringing", m->ringing},
+        {"receiver_mae_p50", m->receiver_mae_p50}, {"receiver_mae_p90", m->receiver_mae_p90},
+        {"receiver_mae_p99", m->receiver_mae_p99}};
+    for (size_t i = 0; i < sizeof num / sizeof num[0]; i++)
+        vt_json_f64(j, o, num[i].name, num[i].v);
+    vt_json_u64(j, o, "visible", m->visible);
+    vt_json_u64(j, o, "occluded", m->occluded);
+    vt_json_u64(j, o, "occluded_binary", m->occluded_binary);
+    cJSON *worst = vt_json_array(j, o, "worst");
+    for (uint32_t i = 0; i < m->worst_count; i++)
+        json_receiver(j, worst, &m->worst[i], kind);
 }
 
-static void json_truth(FILE *fp, const vb_eval_truth *t, int kind)
+static void json_truth(vt_json *j, cJSON *o, const vb_eval_truth *t, int kind)
 {
-    fprintf(fp, "{\"receivers\": %u, \"skipped_undefined_normal\": %u, \"rays\": %llu, "
-                "\"escaped\": %llu, \"escape_rate\": ",
-            t->receivers, t->skipped, (unsigned long long)t->rays,
-            (unsigned long long)t->escaped);
-    json_num(fp, t->rays ? (double)t->escaped / t->rays : NAN);
-    fprintf(fp, ", \"near_zero\": %llu, \"near_zero_rate\": ", (unsigned long long)t->near_zero);
-    json_num(fp, t->rays ? (double)t->near_zero / t->rays : NAN);
-    fprintf(fp, ", \"degenerate\": %u, \"degenerate_rate\": ", t->degenerate);
-    json_num(fp, t->receivers ? (double)t->degenerate / t->receivers : NAN);
-    fputs(",\n        \"degenerate_list\": [", fp);
-    for (uint32_t i = 0; i < t->degenerate_listed; i++) {
-        fputs(i ? ",\n          " : "\n          ", fp);
-        json_receiver(fp, &t->degenerate_list[i], kind);
-    }
-    fputs("],\n        \"escaping_list\": [", fp);
-    for (uint32_t i = 0; i < t->escaping_listed; i++) {
-        fputs(i ? ",\n          " : "\n          ", fp);
-        json_receiver(fp, &t->escaping_list[i], kind);
-    }
-    fputs("]}", fp);
+    vt_json_u64(j, o, "receivers", t->receivers);
+    vt_json_u64(j, o, "skipped_undefined_normal", t->skipped);
+    vt_json_u64(j, o, "rays", t->rays);
+    vt_json_u64(j, o, "escaped", t->escaped);
+    vt_json_f64(j, o, "escape_rate", t->rays ? (double)t->escaped / t->rays : NAN);
+    vt_json_u64(j, o, "near_zero", t->near_zero);
+    vt_json_f64(j, o, "near_zero_rate", t->rays ? (double)t->near_zero / t->rays : NAN);
+    vt_json_u64(j, o, "degenerate", t->degenerate);
+    vt_json_f64(j, o, "degenerate_rate",
+                t->receivers ? (double)t->degenerate / t->receivers : NAN);
+    cJSON *deg = vt_json_array(j, o, "degenerate_list");
+    for (uint32_t i = 0; i < t->degenerate_listed; i++)
+        json_receiver(j, deg, &t->degenerate_list[i], kind);
+    cJSON *esc = vt_json_array(j, o, "escaping_list");
+    for (uint32_t i = 0; i < t->escaping_listed; i++)
+        json_receiver(j, esc, &t->escaping_list[i], kind);
 }
 
 typedef struct context {
@@ -407,116 +331,104 @@ typedef struct context {
 
 static const char *kind_name(int k) { return k == VB_EVAL_VERTICES ? "vertices" : "interior"; }
 
-static int write_json(const char *out, const context *c)
+static int write_json(const char *out, const context *c, char *msg, size_t cap)
 {
-    char tmp[PATH_MAX];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp.%ld", out, (long)getpid()) >= (int)sizeof tmp)
-        return -1;
-    FILE *fp = fopen(tmp, "w");
-    if (!fp)
-        return -1;
     const vdsh_file *f = c->f;
     const vdsh_header *h = &f->header;
     const vb_eval_result *r = c->r;
-    fputs("{\n  \"tool\": \"vdsh-eval\",\n  \"version\": \"" VDSH_VERSION_STRING "\",\n", fp);
-    fputs("  \"file\": ", fp);
-    json_str(fp, c->path);
-    fprintf(fp, ",\n  \"file_bytes\": %lld,\n", c->file_bytes);
-    fputs("  \"scene\": {\n    \"sources\": [", fp);
+    vt_json j = {0};
+    cJSON *root = vt_json_object(&j, NULL, NULL);
+    vt_json_string(&j, root, "tool", "vdsh-eval");
+    vt_json_string(&j, root, "version", VDSH_VERSION_STRING);
+    vt_json_string(&j, root, "file", c->path);
+    vt_json_i64(&j, root, "file_bytes", c->file_bytes);
+
+    cJSON *scene = vt_json_object(&j, root, "scene");
+    cJSON *sources = vt_json_array(&j, scene, "sources");
     for (uint32_t i = 0; i < f->source_count; i++) {
         char hx[65];
         for (int k = 0; k < 32; k++)
             snprintf(hx + 2 * k, 3, "%02x", f->sources[i].sha256[k]);
-        fputs(i ? ",\n      {\"name\": " : "\n      {\"name\": ", fp);
-        json_str(fp, f->sources[i].name);
-        fputs(", \"loaded_from\": ", fp);
-        json_str(fp, c->source_paths[i]);
-        fprintf(fp, ", \"size\": %llu, \"sha256\": \"%s\"}",
-                (unsigned long long)f->sources[i].size, hx);
+        cJSON *o = vt_json_object(&j, sources, NULL);
+        vt_json_string(&j, o, "name", f->sources[i].name);
+        vt_json_string(&j, o, "loaded_from", c->source_paths[i]);
+        vt_json_u64(&j, o, "size", f->sources[i].size);
+        vt_json_string(&j, o, "sha256", hx);
     }
-    fprintf(fp, "],\n    \"receiver_vertices\": %u, \"receiver_triangles\": %u,\n"
-                "    \"occluder_vertices\": %u, \"occluder_triangles\": %u,\n",
-            h->vertex_count, h->triangle_count, h->occluder_vertex_count,
-            h->occluder_triangle_count);
-    fputs("    \"bounds_min\": ", fp);
-    json_vec(fp, h->bounds_min);
-    fputs(", \"bounds_max\": ", fp);
-    json_vec(fp, h->bounds_max);
-    fputs(", \"diagonal\": ", fp);
-    json_num(fp, r->diagonal);
-    fputs("\n  },\n", fp);
+    vt_json_u64(&j, scene, "receiver_vertices", h->vertex_count);
+    vt_json_u64(&j, scene, "receiver_triangles", h->triangle_count);
+    vt_json_u64(&j, scene, "occluder_vertices", h->occluder_vertex_count);
+    vt_json_u64(&j, scene, "occluder_triangles", h->occluder_triangle_count);
+    json_vec(&j, scene, "bounds_min", h->bounds_min);
+    json_vec(&j, scene, "bounds_max", h->bounds_max);
+    vt_json_f32(&j, scene, "diagonal", r->diagonal);
 
-    fprintf(fp, "  \"bake\": {\n    \"rays\": %u, \"sampling\": \"%s\", \"seed\": %llu, "
-                "\"max_distance\": ",
-            h->rays, vdsh_sampling_name(h->sampling), (unsigned long long)h->seed);
-    json_num(fp, h->max_distance);
-    fputs(", \"max_edge\": ", fp);
-    json_num(fp, h->max_edge);
-    fprintf(fp, ",\n    \"offset_rule\": \"%s\", \"welded\": %s, \"robust\": %s, "
-                "\"cube_size\": %u,\n",
-            vdsh_offset_rule_name(h->offset_rule),
-            (h->load_flags & VDSH_LOAD_WELD) ? "true" : "false",
-            (h->trace_flags & VDSH_TRACE_ROBUST) ? "true" : "false", h->cube_size);
-    if (f->has_stats)
-        fprintf(fp, "    \"stats\": {\"rays_traced\": %llu, \"rays_missed\": %llu, "
-                    "\"degenerate_receivers\": %u, \"undefined_normals\": %u},\n",
-                (unsigned long long)f->stats.rays_traced,
-                (unsigned long long)f->stats.rays_missed, f->stats.degenerate_receivers,
-                f->stats.undefined_normals);
-    else
-        fputs("    \"stats\": null,\n", fp);
+    cJSON *bake = vt_json_object(&j, root, "bake");
+    vt_json_u64(&j, bake, "rays", h->rays);
+    vt_json_string(&j, bake, "sampling", vdsh_sampling_name(h->sampling));
+    vt_json_u64(&j, bake, "seed", h->seed);
+    vt_json_f32(&j, bake, "max_distance", h->max_distance);
+    vt_json_f32(&j, bake, "max_edge", h->max_edge);
+    vt_json_string(&j, bake, "offset_rule", vdsh_offset_rule_name(h->offset_rule));
+    vt_json_bool(&j, bake, "welded", h->load_flags & VDSH_LOAD_WELD);
+    vt_json_bool(&j, bake, "robust", h->trace_flags & VDSH_TRACE_ROBUST);
+    vt_json_u64(&j, bake, "cube_size", h->cube_size);
+    if (f->has_stats) {
+        cJSON *st = vt_json_object(&j, bake, "stats");
+        vt_json_u64(&j, st, "rays_traced", f->stats.rays_traced);
+        vt_json_u64(&j, st, "rays_missed", f->stats.rays_missed);
+        vt_json_u64(&j, st, "degenerate_receivers", f->stats.degenerate_receivers);
+        vt_json_u64(&j, st, "undefined_normals", f->stats.undefined_normals);
+    } else {
+        vt_json_null(&j, bake, "stats");
+    }
     if (f->has_timings) {
         const vdsh_timings *t = &f->timings;
-        fprintf(fp, "    \"timings\": {\"load\": %.6f, \"refine\": %.6f, \"build\": %.6f, "
-                    "\"trace\": %.6f, \"total\": %.6f, \"threads\": %u},\n",
-                t->load, t->refine, t->build, t->trace, t->total, t->threads);
+        cJSON *tm = vt_json_object(&j, bake, "timings");
+        vt_json_f64(&j, tm, "load", t->load);
+        vt_json_f64(&j, tm, "refine", t->refine);
+        vt_json_f64(&j, tm, "build", t->build);
+        vt_json_f64(&j, tm, "trace", t->trace);
+        vt_json_f64(&j, tm, "total", t->total);
+        vt_json_u64(&j, tm, "threads", t->threads);
     } else {
-        fputs("    \"timings\": null,\n", fp);
+        vt_json_null(&j, bake, "timings");
     }
-    fputs("    \"seconds\": ", fp);
-    json_num(fp, c->bt.source ? c->bt.total : NAN);
-    fputs(", \"seconds_from\": ", fp);
-    if (c->bt.source)
-        json_str(fp, c->bt.source);
-    else
-        fputs("null", fp);
-    fputs("\n  },\n", fp);
+    vt_json_f64(&j, bake, "seconds", c->bt.source ? c->bt.total : NAN);
+    vt_json_string(&j, bake, "seconds_from", c->bt.source);
 
-    fprintf(fp, "  \"eval\": {\"seed\": %llu, \"points_requested\": %u, \"interior_requested\": %u, "
-                "\"directions\": %u, \"oracle\": %s, \"truth_traversal\": \"%s\",\n"
-                "    \"sources_mismatched\": %d, \"error_floor\": ",
-            (unsigned long long)r->seed, c->d->points, c->d->interior, r->directions,
-            r->oracle ? "true" : "false", c->fast_truth ? "default" : "robust", c->mismatched);
-    json_num(fp, 0.01 * r->diagonal);
-    fprintf(fp, ", \"threads\": %u, \"seconds\": %.6f},\n", r->threads, r->seconds);
+    cJSON *ev = vt_json_object(&j, root, "eval");
+    vt_json_u64(&j, ev, "seed", r->seed);
+    vt_json_u64(&j, ev, "points_requested", c->d->points);
+    vt_json_u64(&j, ev, "interior_requested", c->d->interior);
+    vt_json_u64(&j, ev, "directions", r->directions);
+    vt_json_bool(&j, ev, "oracle", r->oracle);
+    vt_json_string(&j, ev, "truth_traversal", c->fast_truth ? "default" : "robust");
+    vt_json_i64(&j, ev, "sources_mismatched", c->mismatched);
+    vt_json_f64(&j, ev, "error_floor", 0.01 * r->diagonal);
+    vt_json_u64(&j, ev, "threads", r->threads);
+    vt_json_f64(&j, ev, "seconds", r->seconds);
 
-    fputs("  \"truth\": {", fp);
-    for (int k = 0; k < VB_EVAL_KINDS; k++) {
-        fprintf(fp, "%s\n    \"%s\": ", k ? "," : "", kind_name(k));
-        json_truth(fp, &r->truth[k], k);
-    }
-    fputs("\n  },\n  \"streams\": [", fp);
+    cJSON *truth = vt_json_object(&j, root, "truth");
+    for (int k = 0; k < VB_EVAL_KINDS; k++)
+        json_truth(&j, vt_json_object(&j, truth, kind_name(k)), &r->truth[k], k);
+    cJSON *streams = vt_json_array(&j, root, "streams");
     for (uint32_t s = 0; s < r->stream_count; s++) {
         const vdsh_stream *st = &f->streams[s];
-        fprintf(fp, "%s\n    {\"order\": %u, \"coefficients\": %u, \"method\": \"%s\", "
-                    "\"encoding\": \"%s\", \"quantity\": \"%s\", \"window\": \"%s\", "
-                    "\"bytes_per_vertex\": %zu,",
-                s ? "," : "", st->order, st->order * st->order, vdsh_method_name(st->method),
-                vdsh_encoding_name(st->encoding), vdsh_quantity_name(st->quantity),
-                vdsh_window_name(st->window), vdsh_stream_bytes_per_vertex(st));
-        for (int k = 0; k < VB_EVAL_KINDS; k++) {
-            fprintf(fp, "%s\n      \"%s\": ", k ? "," : "", kind_name(k));
-            json_metrics(fp, &r->metrics[k][s], k);
-        }
-        fputs("}", fp);
+        cJSON *o = vt_json_object(&j, streams, NULL);
+        vt_json_u64(&j, o, "order", st->order);
+        vt_json_u64(&j, o, "coefficients", st->order * st->order);
+        vt_json_string(&j, o, "method", vdsh_method_name(st->method));
+        vt_json_string(&j, o, "encoding", vdsh_encoding_name(st->encoding));
+        vt_json_string(&j, o, "quantity", vdsh_quantity_name(st->quantity));
+        vt_json_string(&j, o, "window", vdsh_window_name(st->window));
+        vt_json_u64(&j, o, "bytes_per_vertex", vdsh_stream_bytes_per_vertex(st));
+        for (int k = 0; k < VB_EVAL_KINDS; k++)
+            json_metrics(&j, vt_json_object(&j, o, kind_name(k)), &r->metrics[k][s], k);
     }
-    fputs("\n  ]\n}\n", fp);
-    int bad = ferror(fp);
-    if (fclose(fp) != 0 || bad || rename(tmp, out) != 0) {
-        unlink(tmp);
-        return -1;
-    }
-    return 0;
+    int rc = vt_json_write_file(&j, out, msg, cap);
+    vt_json_free(&j);
+    return rc;
 }
 
 /* ---- per-vertex file (layout in usage()) --------------------------------- */
@@ -527,14 +439,15 @@ static void put_u32(unsigned char *p, uint32_t v)
     p[2] = (unsigned char)(v >> 16), p[3] = (unsigned char)(v >> 24);
 }
 
-static int write_per_vertex(const char *out, const vdsh_file *f, const vb_eval_result *r)
+static int write_per_vertex(const char *out, const vdsh_file *f, const vb_eval_result *r,
+                            char *msg, size_t cap)
 {
-    char tmp[PATH_MAX];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp.%ld", out, (long)getpid()) >= (int)sizeof tmp)
+    vdsh_output o;
+    vdsh_error err;
+    if (vdsh_output_open(out, &o, &err) != VDSH_OK) {
+        snprintf(msg, cap, "%s", err.msg);
         return -1;
-    FILE *fp = fopen(tmp, "wb");
-    if (!fp)
-        return -1;
+    }
     unsigned char head[PV_HEADER] = {0};
     memcpy(head, PV_MAGIC, 8);
     put_u32(head + 8, PV_VERSION);
@@ -542,22 +455,22 @@ static int write_per_vertex(const char *out, const vdsh_file *f, const vb_eval_r
     put_u32(head + 16, r->stream_count);
     put_u32(head + 20, r->per_vertex_fields);
     put_u32(head + 24, PV_HEADER + PV_STREAM * r->stream_count);
-    fwrite(head, 1, sizeof head, fp);
+    vdsh_output_put(&o, head, sizeof head);
     for (uint32_t s = 0; s < r->stream_count; s++) {
         unsigned char d[PV_STREAM];
         put_u32(d, f->streams[s].order);
         put_u32(d + 4, f->streams[s].quantity);
         put_u32(d + 8, f->streams[s].method);
         put_u32(d + 12, f->streams[s].encoding);
-        fwrite(d, 1, sizeof d, fp);
+        vdsh_output_put(&o, d, sizeof d);
     }
     /* f32 little-endian: the host's own layout (vdsh.h supports only
-     * little-endian hosts). */
-    fwrite(r->per_vertex, sizeof(float),
-           (size_t)f->header.vertex_count * r->per_vertex_fields, fp);
-    int bad = ferror(fp);
-    if (fclose(fp) != 0 || bad || rename(tmp, out) != 0) {
-        unlink(tmp);
+     * little-endian hosts). A failed write is remembered:
+     * vdsh_output_commit reports it and removes the file. */
+    vdsh_output_put(&o, r->per_vertex,
+                    sizeof(float) * (size_t)f->header.vertex_count * r->per_vertex_fields);
+    if (vdsh_output_commit(&o, &err) != VDSH_OK) {
+        snprintf(msg, cap, "%s", err.msg);
         return -1;
     }
     return 0;
@@ -646,7 +559,7 @@ static void print_table(FILE *o, const context *c)
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         if (r->truth[k].receivers == 0 || r->oracle)
             continue;
-        fprintf(o, "  %-8s SH sum rang <= 0 (read as distance 0) on", kind_name(k));
+        fprintf(o, "  %-8s SH sum range <= 0 (read as distance 0) on", kind_name(k));
         for (uint32_t s = 0; s < r->stream_count; s++)
             fprintf(o, "%s order %u %.3f%%", s ? "," : "", f->streams[s].order,
                     100.0 * r->metrics[k][s].ringing);
@@ -748,27 +661,27 @@ int main(int argc, char **argv)
     while ((c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
         switch (c) {
         case O_POINTS:
-            if (!parse_u64(optarg, VB_EVAL_MAX_RECEIVERS, &u) || u == 0)
+            if (!vt_parse_u64(optarg, 1, VB_EVAL_MAX_RECEIVERS, &u))
                 return bad_usage("--points takes a whole number 1..268435456, not '%s'", optarg);
             d.points = (uint32_t)u;
             break;
         case O_INTERIOR:
-            if (!parse_u64(optarg, VB_EVAL_MAX_RECEIVERS, &u))
+            if (!vt_parse_u64(optarg, 0, VB_EVAL_MAX_RECEIVERS, &u))
                 return bad_usage("--interior takes a whole number 0..268435456, not '%s'", optarg);
             d.interior = (uint32_t)u;
             break;
         case O_DIRECTIONS:
-            if (!parse_u64(optarg, 65536, &u) || u == 0)
+            if (!vt_parse_u64(optarg, 1, 65536, &u))
                 return bad_usage("--directions takes a whole number 1..65536, not '%s'", optarg);
             d.directions = (uint32_t)u;
             break;
         case O_SEED:
-            if (!parse_u64(optarg, UINT64_MAX, &d.seed))
+            if (!vt_parse_u64(optarg, 0, UINT64_MAX, &d.seed))
                 return bad_usage("--seed takes a whole number, not '%s'", optarg);
             break;
         case O_ORDERS:
             if (!parse_orders(optarg, want_order))
-                return bad_usage("--orders takes orders 1..5 such as 3,5, not '%s'", optarg);
+                return bad_usage("--orders takes distinct orders 1..5 such as 3,5, not '%s'", optarg);
             filter = 1;
             break;
         case O_ORACLE: d.oracle = 1; break;
@@ -790,12 +703,12 @@ int main(int argc, char **argv)
         case O_PV: per_vertex = optarg; break;
         case O_BAKE_REPORT: bake_report = optarg; break;
         case O_WORST:
-            if (!parse_u64(optarg, VB_EVAL_MAX_WORST, &u) || u == 0)
+            if (!vt_parse_u64(optarg, 1, VB_EVAL_MAX_WORST, &u))
                 return bad_usage("--worst takes a whole number 1..64, not '%s'", optarg);
             d.worst = (uint32_t)u;
             break;
         case O_THREADS:
-            if (!parse_u64(optarg, 256, &u) || u == 0)
+            if (!vt_parse_u64(optarg, 1, 256, &u))
                 return bad_usage("--threads takes a whole number 1..256, not '%s'", optarg);
             d.threads = (unsigned)u;
             break;
@@ -807,7 +720,7 @@ int main(int argc, char **argv)
             return 0;
         default:
             fprintf(stderr, "Try 'vdsh-eval --help'.\n");
-            return EXIT_USAGE;
+            return VT_EXIT_USAGE;
         }
     }
     if (optind >= argc)
@@ -837,7 +750,7 @@ int main(int argc, char **argv)
             fprintf(stderr, " '%s'", f->sources[i].name);
         fputc('\n', stderr);
         vdsh_free(f);
-        return EXIT_USAGE;
+        return VT_EXIT_USAGE;
     }
     vdsh_file view = *f; /* the streams to score; the file itself stays as read */
     if (filter) {
@@ -924,12 +837,13 @@ int main(int argc, char **argv)
         ctx.file_bytes = (long long)st.st_size;
     print_table(stdout, &ctx);
     fflush(stdout);
-    if (json && write_json(json, &ctx) != 0) {
-        fprintf(stderr, "vdsh-eval: %s: cannot write: %s\n", json, strerror(errno));
+    char msg[PATH_MAX + 256];
+    if (json && write_json(json, &ctx, msg, sizeof msg) != 0) {
+        fprintf(stderr, "vdsh-eval: %s\n", msg);
         goto out;
     }
-    if (per_vertex && write_per_vertex(per_vertex, &view, &res) != 0) {
-        fprintf(stderr, "vdsh-eval: %s: cannot write: %s\n", per_vertex, strerror(errno));
+    if (per_vertex && write_per_vertex(per_vertex, &view, &res, msg, sizeof msg) != 0) {
+        fprintf(stderr, "vdsh-eval: %s\n", msg);
         goto out;
     }
     status = 0;

@@ -13,6 +13,7 @@
  * Exit status: 0, 1 error, 2 usage.
  */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,6 +22,8 @@
 #include "mesh.h"
 #include "sampling.h"
 #include "scene.h"
+#include "vdsh_output.h"
+#include "vt_cli.h"
 
 static float trace(const vb_scene *s, const float o[3], const float d[3], float tmax)
 {
@@ -36,6 +39,20 @@ static float trace(const vb_scene *s, const float o[3], const float d[3], float 
     return rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? tmax : rh.ray.tfar;
 }
 
+#if defined(__GNUC__)
+__attribute__((format(printf, 1, 2)))
+#endif
+static int bad_number(const char *fmt, ...)
+{
+    va_list ap;
+    fputs("vdsh-raydump: ", stderr);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+    return VT_EXIT_USAGE;
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 7) {
@@ -43,18 +60,26 @@ int main(int argc, char **argv)
                         "  RAYS as vdsh-bake --rays (its hemisphere half is traced)\n");
         return 2;
     }
-    float max_edge = strtof(argv[2], NULL);
-    long K = strtol(argv[3], NULL, 10), rays = strtol(argv[4], NULL, 10),
-         H = strtol(argv[5], NULL, 10);
-    if (!(max_edge >= 0.0f) || K < 1 || rays < 2 || rays > 100000 || H < 0 || H > 100000) {
-        fprintf(stderr, "vdsh-raydump: bad numbers\n");
-        return 2;
-    }
+    /* Strict decimal numbers, as every vdsh program reads them (vt_cli.h). */
+    float max_edge;
+    uint64_t K, rays, H;
+    if (!vt_parse_float(argv[2], &max_edge) || !(max_edge >= 0.0f))
+        return bad_number("MAX_EDGE takes a number >= 0, not '%s'", argv[2]);
+    if (!vt_parse_u64(argv[3], 1, VDSH_MAX_VERTICES, &K))
+        return bad_number("RECEIVERS takes a whole number 1..%u, not '%s'",
+                              VDSH_MAX_VERTICES, argv[3]);
+    if (!vt_parse_u64(argv[4], 2, 100000, &rays))
+        return bad_number("RAYS takes a whole number 2..100000, not '%s'",
+                              argv[4]);
+    if (!vt_parse_u64(argv[5], 0, 100000, &H))
+        return bad_number("HELD_OUT takes a whole number 0..100000, not '%s'",
+                              argv[5]);
     vb_error err;
     vb_mesh occ = {0}, rec = {0};
     vb_scene *s = NULL;
     vb_dirgrid g = {0};
     float *org = NULL, *buf = NULL;
+    vdsh_output out = {.fd = -1};
     FILE *f = NULL;
     int status = 1;
     uint32_t flipped = 0;
@@ -69,17 +94,22 @@ int main(int argc, char **argv)
         fprintf(stderr, "vdsh-raydump: %s\n", org ? err.msg : "out of memory");
         goto out;
     }
-    if (!(buf = malloc(sizeof(float) * 4 * (g.count + (size_t)H))) ||
-        !(f = fopen(argv[6], "wb"))) {
-        fprintf(stderr, "vdsh-raydump: %s: cannot write\n", argv[6]);
+    vdsh_error verr;
+    if (!(buf = malloc(sizeof(float) * 4 * (g.count + (size_t)H)))) {
+        fprintf(stderr, "vdsh-raydump: out of memory\n");
         goto out;
     }
+    if (vdsh_output_open(argv[6], &out, &verr) != VDSH_OK) {
+        fprintf(stderr, "vdsh-raydump: %s\n", verr.msg);
+        goto out;
+    }
+    f = out.fp;
     float clamp = s->diagonal, tmax = clamp * s->scale, inv = 1.0f / s->scale;
     uint32_t hdr[4] = {(uint32_t)K, g.count, (uint32_t)H, rec.vertex_count};
     fwrite(hdr, 4, 4, f);
     fwrite(&clamp, 4, 1, f);
-    for (long i = 0; i < K; i++) {
-        uint32_t v = (uint32_t)((uint64_t)i * rec.vertex_count / (uint64_t)K);
+    for (uint64_t i = 0; i < K; i++) {
+        uint32_t v = (uint32_t)(i * rec.vertex_count / K);
         const float *n = rec.normals + 3 * (size_t)v, *o = org + 3 * (size_t)v;
         size_t c = 0;
         fwrite(rec.positions + 3 * (size_t)v, 4, 3, f);
@@ -98,7 +128,7 @@ int main(int argc, char **argv)
         }
         float t[3], b[3];
         vb_frame(n, t, b);
-        for (long h = 0; h < H; h++) { /* held out: uniform over the hemisphere */
+        for (uint64_t h = 0; h < H; h++) { /* held out: uniform over the hemisphere */
             float u1, u2, d[3];
             vb_hash2(0x686f6c64ull, v, (uint32_t)h, &u1, &u2);
             float r = sqrtf(fmaxf(0.0f, 1.0f - u1 * u1)), ph = 6.2831853f * u2;
@@ -109,19 +139,18 @@ int main(int argc, char **argv)
         }
         fwrite(buf, 4, 4 * c, f);
     }
-    if (fclose(f) != 0) {
-        f = NULL;
-        fprintf(stderr, "vdsh-raydump: %s: write failed\n", argv[6]);
+    f = NULL;
+    if (vdsh_output_commit(&out, &verr) != VDSH_OK) {
+        fprintf(stderr, "vdsh-raydump: %s\n", verr.msg);
         goto out;
     }
-    f = NULL;
-    fprintf(stderr, "vdsh-raydump: %ld of %u receivers, %u traced + %ld held-out directions "
+    fprintf(stderr, "vdsh-raydump: %llu of %u receivers, %u traced + %llu held-out directions "
                     "each (%u normals flipped, %u origins moved)\n",
-            K, rec.vertex_count, g.count, H, flipped, ost.moved);
+            (unsigned long long)K, rec.vertex_count, g.count, (unsigned long long)H, flipped,
+            ost.moved);
     status = 0;
 out:
-    if (f)
-        fclose(f);
+    vdsh_output_abort(&out);
     free(buf);
     free(org);
     vb_dirgrid_destroy(&g);

@@ -15,6 +15,7 @@
  * without copying them.
  */
 #include "vdsh.h"
+#include "vdsh_output.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -2050,32 +2051,6 @@ vdsh_result vdsh_write_memory(const vdsh_file *f, void **out_data,
     return VDSH_OK;
 }
 
-/* Make the rename itself durable; best effort (some file systems refuse
- * to fsync a directory, and the data is already safe). */
-static void sync_parent_dir(const char *path)
-{
-    const char *slash = strrchr(path, '/');
-    char *dir;
-    if (!slash) {
-        dir = strdup(".");
-    } else {
-        size_t n = slash == path ? 1 : (size_t)(slash - path);
-        dir = (char *)malloc(n + 1);
-        if (dir) {
-            memcpy(dir, path, n);
-            dir[n] = 0;
-        }
-    }
-    if (!dir)
-        return;
-    int fd = open(dir, O_RDONLY);
-    if (fd >= 0) {
-        (void)fsync(fd);
-        close(fd);
-    }
-    free(dir);
-}
-
 vdsh_result vdsh_write(const char *path, const vdsh_file *f, vdsh_error *err)
 {
     plan P;
@@ -2088,91 +2063,23 @@ vdsh_result vdsh_write(const char *path, const vdsh_file *f, vdsh_error *err)
         return res;
     }
 
-    /*
-     * The temporary file sits next to `path` (rename is only atomic within
-     * one file system) and is created with O_EXCL, which is what mkstemp
-     * does, but with mode 0666 so that the umask and default ACLs give the
-     * result the permissions any new file gets; mkstemp's 0600 would make
-     * every baked file private. The name is unique per process and attempt;
-     * O_EXCL settles races and refuses to follow a planted symlink.
-     */
-    size_t tmp_cap = strlen(path) + 64;
-    char *tmp = (char *)malloc(tmp_cap);
-    FILE *fp = NULL;
-    int fd = -1, e = 0;
-    if (!tmp) {
-        plan_free(&P);
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, path, "out of memory");
-    }
-    for (unsigned attempt = 0; attempt < 1000; attempt++) {
-        snprintf(tmp, tmp_cap, "%s.tmp.%ld.%u", path, (long)getpid(),
-                 attempt);
-        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd >= 0 || errno != EEXIST)
-            break;
-    }
-    if (fd < 0) {
-        e = errno;
-        res = fail(err, VDSH_ERR_IO, path, "cannot create temporary file "
-                   "%s: %s", tmp, strerror(e));
-        free(tmp);
+    /* A temporary file beside `path`, renamed over it once complete and
+     * on disk (vdsh_output.h). */
+    vdsh_output out;
+    res = vdsh_output_open(path, &out, err);
+    if (res != VDSH_OK) {
         plan_free(&P);
         return res;
     }
-
-    const char *step = "write";
-    fp = fdopen(fd, "wb");
-    if (!fp) {
-        e = errno;
-        close(fd);
-        step = "open stream on";
-        goto failed;
-    }
-    sink s = {NULL, fp, 0, 0};
+    sink s = {NULL, out.fp, 0, 0};
     plan_emit(&P, &s);
+    plan_free(&P);
     if (s.error) {
-        e = s.error;
-        goto failed;
-    }
-    if (fflush(fp) != 0) {
-        e = errno;
-        goto failed;
-    }
-    /* Data on disk before the rename makes it visible: a crash must leave
-     * either the old file or the whole new one. */
-    if (fsync(fileno(fp)) != 0) {
-        e = errno;
-        step = "sync";
-        goto failed;
-    }
-    int closed = fclose(fp);
-    fp = NULL;
-    if (closed != 0) {
-        e = errno;
-        step = "close";
-        goto failed;
-    }
-    if (rename(tmp, path) != 0) {
-        e = errno;
-        unlink(tmp);
-        res = fail(err, VDSH_ERR_IO, path, "cannot rename %s to it: %s", tmp,
-                   strerror(e));
-        free(tmp);
-        plan_free(&P);
+        res = fail(err, VDSH_ERR_IO, path, "cannot write%s%s: %s",
+                   out.tmp ? " temporary file " : "", out.tmp ? out.tmp : "",
+                   strerror(s.error));
+        vdsh_output_abort(&out);
         return res;
     }
-    sync_parent_dir(path);
-    free(tmp);
-    plan_free(&P);
-    return VDSH_OK;
-
-failed:
-    if (fp)
-        fclose(fp);
-    unlink(tmp);
-    res = fail(err, VDSH_ERR_IO, path, "cannot %s temporary file %s: %s",
-               step, tmp, strerror(e ? e : EIO));
-    free(tmp);
-    plan_free(&P);
-    return res;
+    return vdsh_output_commit(&out, err);
 }

@@ -31,9 +31,10 @@
  * and positions, normals, indices and stream data point into it (so they
  * are 16-byte aligned). vdsh_write*() only borrows its argument.
  *
- * Writing: vdsh_write() creates `path.tmp.<pid>.<n>` beside `path` with
- * O_EXCL and mode 0666 (less the umask), writes, fsyncs and renames it over
- * `path`; a failure removes it and leaves `path` as it was.
+ * Writing: vdsh_write() writes through vdsh_output.h: `path.tmp.<pid>.<n>`
+ * beside `path`, created with O_EXCL and mode 0666 (less the umask),
+ * written, fsynced and renamed over `path`; a failure removes it and leaves
+ * `path` as it was.
  *
  * Tools: vdsh_scan_chunks() lists the chunks of a file image with their
  * stored and computed CRCs, also for a damaged file (vdsh-info --verify).

@@ -12,6 +12,7 @@
  * the decoded structs (and, for --verify, vdsh_scan_chunks' list).
  */
 #include "vdsh.h"
+#include "vt_json.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -54,72 +55,34 @@ static void usage(FILE *to)
 }
 
 /* ------------------------------------------------------------------ */
-/* JSON output                                                         */
+/* JSON output: vt_json.h (cJSON; strings of any bytes parse, numbers   */
+/* read back exactly, NaN and Inf are null), one document per file      */
 /* ------------------------------------------------------------------ */
 
-/* Strings from the file are valid UTF-8 (the reader checks), but a path on
- * the command line may not be: invalid bytes become U+FFFD so the output
- * always parses. */
-static void json_str(const char *s)
+static void json_vec3(vt_json *j, cJSON *parent, const char *key, const float v[3])
 {
-    const unsigned char *p = (const unsigned char *)s;
-    putchar('"');
-    while (*p) {
-        unsigned c = *p;
-        if (c == '"' || c == '\\') {
-            printf("\\%c", c);
-            p++;
-        } else if (c < 0x20) {
-            printf("\\u%04x", c);
-            p++;
-        } else if (c < 0x80) {
-            putchar((int)c);
-            p++;
-        } else {
-            size_t len = (c & 0xe0) == 0xc0   ? 2
-                         : (c & 0xf0) == 0xe0 ? 3
-                         : (c & 0xf8) == 0xf0 ? 4
-                                              : 0;
-            size_t k = 1;
-            while (len && k < len && (p[k] & 0xc0) == 0x80)
-                k++;
-            if (len && k == len) {
-                fwrite(p, 1, len, stdout);
-                p += len;
-            } else {
-                fputs("\\ufffd", stdout);
-                p++;
-            }
-        }
-    }
-    putchar('"');
+    cJSON *a = vt_json_array(j, parent, key);
+    for (int k = 0; k < 3; k++)
+        vt_json_f32(j, a, NULL, v[k]);
 }
 
-static void json_num(double v)
+static void json_bounds(vt_json *j, cJSON *parent, const char *key, const float lo[3],
+                        const float hi[3])
 {
-    if (isfinite(v))
-        printf("%.9g", v);
-    else
-        fputs("null", stdout);
+    cJSON *b = vt_json_object(j, parent, key);
+    json_vec3(j, b, "min", lo);
+    json_vec3(j, b, "max", hi);
 }
 
-static void json_num17(double v)
+/* Print the document on stdout and free it; 0 if it could not be built. */
+static int json_emit(vt_json *j, const char *path)
 {
-    if (isfinite(v))
-        printf("%.17g", v);
-    else
-        fputs("null", stdout);
-}
-
-static void json_vec3(const float v[3])
-{
-    putchar('[');
-    for (int k = 0; k < 3; k++) {
-        if (k)
-            fputs(", ", stdout);
-        json_num(v[k]);
-    }
-    putchar(']');
+    char msg[600];
+    int ok = vt_json_write_stream(j, stdout, "stdout", msg, sizeof msg) == 0;
+    if (!ok)
+        fprintf(stderr, "%s: %s: %s\n", prog, path, msg);
+    vt_json_free(j);
+    return ok;
 }
 
 /* ------------------------------------------------------------------ */
@@ -278,136 +241,108 @@ static void print_summary(const char *path, const vdsh_file *f,
            (unsigned long long)size, (double)size / h->vertex_count);
 }
 
-static void print_json(const char *path, const vdsh_file *f, uint64_t size)
+static int print_json(const char *path, const vdsh_file *f, uint64_t size)
 {
     const vdsh_header *h = &f->header;
     float lo[3], hi[3];
     receiver_bounds(f, lo, hi);
 
-    fputs("{\n  \"file\": ", stdout);
-    json_str(path);
-    printf(",\n  \"valid\": true,\n  \"file_size\": %llu,\n",
-           (unsigned long long)size);
-    fputs("  \"bytes_per_vertex\": ", stdout);
-    json_num((double)size / h->vertex_count);
-    printf(",\n  \"format_version\": %u,\n", VDSH_FORMAT_VERSION);
-    printf("  \"vertex_count\": %u,\n  \"triangle_count\": %u,\n",
-           h->vertex_count, h->triangle_count);
-    fputs("  \"receiver_bounds\": {\"min\": ", stdout);
-    json_vec3(lo);
-    fputs(", \"max\": ", stdout);
-    json_vec3(hi);
-    fputs("},\n", stdout);
+    vt_json j = {0};
+    cJSON *root = vt_json_object(&j, NULL, NULL);
+    vt_json_string(&j, root, "file", path);
+    vt_json_bool(&j, root, "valid", 1);
+    vt_json_u64(&j, root, "file_size", size);
+    vt_json_f64(&j, root, "bytes_per_vertex", (double)size / h->vertex_count);
+    vt_json_u64(&j, root, "format_version", VDSH_FORMAT_VERSION);
+    vt_json_u64(&j, root, "vertex_count", h->vertex_count);
+    vt_json_u64(&j, root, "triangle_count", h->triangle_count);
+    json_bounds(&j, root, "receiver_bounds", lo, hi);
 
-    printf("  \"bake\": {\n    \"rays\": %u,\n    \"sampling\": ", h->rays);
-    json_str(vdsh_sampling_name(h->sampling));
-    printf(",\n    \"seed\": %llu,\n    \"max_distance\": ",
-           (unsigned long long)h->seed);
-    json_num(h->max_distance);
-    fputs(",\n    \"max_edge\": ", stdout);
-    json_num(h->max_edge);
-    fputs(",\n    \"offset_rule\": ", stdout);
-    json_str(vdsh_offset_rule_name(h->offset_rule));
-    printf(",\n    \"load_flags\": %u,\n    \"welded\": %s,\n",
-           h->load_flags, (h->load_flags & VDSH_LOAD_WELD) ? "true" : "false");
-    printf("    \"trace_flags\": %u,\n    \"robust\": %s,\n", h->trace_flags,
-           (h->trace_flags & VDSH_TRACE_ROBUST) ? "true" : "false");
-    printf("    \"cube_size\": %u,\n", h->cube_size);
-    printf("    \"occluder_vertex_count\": %u,\n"
-           "    \"occluder_triangle_count\": %u,\n",
-           h->occluder_vertex_count, h->occluder_triangle_count);
-    fputs("    \"occluder_bounds\": {\"min\": ", stdout);
-    json_vec3(h->bounds_min);
-    fputs(", \"max\": ", stdout);
-    json_vec3(h->bounds_max);
-    fputs("}\n  },\n", stdout);
+    cJSON *bake = vt_json_object(&j, root, "bake");
+    vt_json_u64(&j, bake, "rays", h->rays);
+    vt_json_string(&j, bake, "sampling", vdsh_sampling_name(h->sampling));
+    vt_json_u64(&j, bake, "seed", h->seed);
+    vt_json_f32(&j, bake, "max_distance", h->max_distance);
+    vt_json_f32(&j, bake, "max_edge", h->max_edge);
+    vt_json_string(&j, bake, "offset_rule", vdsh_offset_rule_name(h->offset_rule));
+    vt_json_u64(&j, bake, "load_flags", h->load_flags);
+    vt_json_bool(&j, bake, "welded", h->load_flags & VDSH_LOAD_WELD);
+    vt_json_u64(&j, bake, "trace_flags", h->trace_flags);
+    vt_json_bool(&j, bake, "robust", h->trace_flags & VDSH_TRACE_ROBUST);
+    vt_json_u64(&j, bake, "cube_size", h->cube_size);
+    vt_json_u64(&j, bake, "occluder_vertex_count", h->occluder_vertex_count);
+    vt_json_u64(&j, bake, "occluder_triangle_count", h->occluder_triangle_count);
+    json_bounds(&j, bake, "occluder_bounds", h->bounds_min, h->bounds_max);
 
-    fputs("  \"sources\": [", stdout);
+    cJSON *sources = vt_json_array(&j, root, "sources");
     for (uint32_t i = 0; i < f->source_count; i++) {
         char hex[65];
         sha_hex(f->sources[i].sha256, hex);
-        fputs(i ? ",\n    {\"name\": " : "\n    {\"name\": ", stdout);
-        json_str(f->sources[i].name);
-        printf(", \"size\": %llu, \"sha256\": \"%s\"}",
-               (unsigned long long)f->sources[i].size, hex);
+        cJSON *o = vt_json_object(&j, sources, NULL);
+        vt_json_string(&j, o, "name", f->sources[i].name);
+        vt_json_u64(&j, o, "size", f->sources[i].size);
+        vt_json_string(&j, o, "sha256", hex);
     }
-    fputs(f->source_count ? "\n  ],\n" : "],\n", stdout);
 
-    fputs("  \"streams\": [", stdout);
+    cJSON *streams = vt_json_array(&j, root, "streams");
     for (uint32_t i = 0; i < f->stream_count; i++) {
         const vdsh_stream *s = &f->streams[i];
         coef0_stats st = stream_coef0(f, s);
-        fputs(i ? ",\n    {" : "\n    {", stdout);
-        printf("\"order\": %u, \"coefficients\": %u, \"encoding\": ",
-               s->order, s->order * s->order);
-        json_str(vdsh_encoding_name(s->encoding));
-        fputs(",\n     \"method\": ", stdout);
-        json_str(or_unknown(vdsh_method_name(s->method)));
-        printf(", \"method_id\": %u, \"method_param\": ", s->method);
-        json_num(s->method_param);
-        fputs(",\n     \"quantity\": ", stdout);
-        json_str(vdsh_quantity_name(s->quantity));
-        fputs(", \"quantity_param\": ", stdout);
-        json_num(s->quantity_param);
-        fputs(", \"window\": ", stdout);
-        json_str(vdsh_window_name(s->window));
-        fputs(", \"window_param\": ", stdout);
-        json_num(s->window_param);
-        fputs(", \"scale\": ", stdout);
-        json_num(s->scale);
-        printf(",\n     \"bytes_per_vertex\": %zu,\n",
-               vdsh_stream_bytes_per_vertex(s));
-        fputs("     \"coefficient0\": {\"min\": ", stdout);
-        json_num(st.min);
-        fputs(", \"max\": ", stdout);
-        json_num(st.max);
-        fputs(", \"mean\": ", stdout);
-        json_num(st.mean);
-        fputs("}}", stdout);
+        cJSON *o = vt_json_object(&j, streams, NULL);
+        vt_json_u64(&j, o, "order", s->order);
+        vt_json_u64(&j, o, "coefficients", s->order * s->order);
+        vt_json_string(&j, o, "encoding", vdsh_encoding_name(s->encoding));
+        vt_json_string(&j, o, "method", or_unknown(vdsh_method_name(s->method)));
+        vt_json_u64(&j, o, "method_id", s->method);
+        vt_json_f32(&j, o, "method_param", s->method_param);
+        vt_json_string(&j, o, "quantity", vdsh_quantity_name(s->quantity));
+        vt_json_f32(&j, o, "quantity_param", s->quantity_param);
+        vt_json_string(&j, o, "window", vdsh_window_name(s->window));
+        vt_json_f32(&j, o, "window_param", s->window_param);
+        vt_json_f32(&j, o, "scale", s->scale);
+        vt_json_u64(&j, o, "bytes_per_vertex", vdsh_stream_bytes_per_vertex(s));
+        cJSON *c0 = vt_json_object(&j, o, "coefficient0");
+        vt_json_f32(&j, c0, "min", (float)st.min);
+        vt_json_f32(&j, c0, "max", (float)st.max);
+        vt_json_f64(&j, c0, "mean", st.mean);
     }
-    fputs("\n  ],\n", stdout);
 
-    fputs("  \"stats\": ", stdout);
-    if (f->has_stats)
-        printf("{\"rays_traced\": %llu, \"rays_missed\": %llu, "
-               "\"degenerate_receivers\": %u, \"undefined_normals\": %u, "
-               "\"moved_origins\": %u, \"flipped_normals\": %u},\n",
-               (unsigned long long)f->stats.rays_traced,
-               (unsigned long long)f->stats.rays_missed,
-               f->stats.degenerate_receivers, f->stats.undefined_normals,
-               f->stats.moved_origins, f->stats.flipped_normals);
-    else
-        fputs("null,\n", stdout);
+    if (f->has_stats) {
+        cJSON *st = vt_json_object(&j, root, "stats");
+        vt_json_u64(&j, st, "rays_traced", f->stats.rays_traced);
+        vt_json_u64(&j, st, "rays_missed", f->stats.rays_missed);
+        vt_json_u64(&j, st, "degenerate_receivers", f->stats.degenerate_receivers);
+        vt_json_u64(&j, st, "undefined_normals", f->stats.undefined_normals);
+        vt_json_u64(&j, st, "moved_origins", f->stats.moved_origins);
+        vt_json_u64(&j, st, "flipped_normals", f->stats.flipped_normals);
+    } else {
+        vt_json_null(&j, root, "stats");
+    }
 
-    fputs("  \"timings\": ", stdout);
     if (f->has_timings) {
         const vdsh_timings *t = &f->timings;
-        const double v[5] = {t->load, t->refine, t->build, t->trace,
-                             t->total};
-        static const char *const n[5] = {"load", "refine", "build", "trace",
-                                         "total"};
-        putchar('{');
-        for (int k = 0; k < 5; k++) {
-            printf("\"%s\": ", n[k]);
-            json_num17(v[k]);
-            fputs(", ", stdout);
-        }
-        printf("\"threads\": %u}\n", t->threads);
+        cJSON *tm = vt_json_object(&j, root, "timings");
+        vt_json_f64(&j, tm, "load", t->load);
+        vt_json_f64(&j, tm, "refine", t->refine);
+        vt_json_f64(&j, tm, "build", t->build);
+        vt_json_f64(&j, tm, "trace", t->trace);
+        vt_json_f64(&j, tm, "total", t->total);
+        vt_json_u64(&j, tm, "threads", t->threads);
     } else {
-        fputs("null\n", stdout);
+        vt_json_null(&j, root, "timings");
     }
-    fputs("}\n", stdout);
+    return json_emit(&j, path);
 }
 
-static void print_json_error(const char *path, vdsh_result r, const char *msg)
+static int print_json_error(const char *path, vdsh_result r, const char *msg)
 {
-    fputs("{\n  \"file\": ", stdout);
-    json_str(path);
-    fputs(",\n  \"valid\": false,\n  \"result\": ", stdout);
-    json_str(vdsh_result_str(r));
-    fputs(",\n  \"error\": ", stdout);
-    json_str(msg);
-    fputs("\n}\n", stdout);
+    vt_json j = {0};
+    cJSON *root = vt_json_object(&j, NULL, NULL);
+    vt_json_string(&j, root, "file", path);
+    vt_json_bool(&j, root, "valid", 0);
+    vt_json_string(&j, root, "result", vdsh_result_str(r));
+    vt_json_string(&j, root, "error", msg);
+    return json_emit(&j, path);
 }
 
 /* ------------------------------------------------------------------ */
@@ -505,32 +440,31 @@ static int verify(const char *path, int json)
     vdsh_free(f);
 
     if (json) {
-        fputs("{\n  \"file\": ", stdout);
-        json_str(path);
-        printf(",\n  \"file_size\": %zu,\n  \"chunks\": [", size);
+        vt_json j = {0};
+        cJSON *root = vt_json_object(&j, NULL, NULL);
+        vt_json_string(&j, root, "file", path);
+        vt_json_u64(&j, root, "file_size", size);
+        cJSON *list = vt_json_array(&j, root, "chunks");
         for (uint32_t i = 0; r == VDSH_OK && i < count; i++) {
             const vdsh_chunk_info *c = &chunks[i];
-            printf("%s\n    {\"index\": %u, \"id\": ", i ? "," : "", i);
-            json_str(c->id);
-            printf(", \"offset\": %llu, \"size\": %llu, \"complete\": %s, "
-                   "\"crc_stored\": \"0x%08x\", \"crc_computed\": "
-                   "\"0x%08x\", \"crc_ok\": %s}",
-                   (unsigned long long)c->offset, (unsigned long long)c->size,
-                   c->complete ? "true" : "false", c->crc_stored,
-                   c->crc_computed,
-                   c->complete && c->crc_stored == c->crc_computed
-                       ? "true"
-                       : "false");
+            char crc[2][16];
+            snprintf(crc[0], sizeof crc[0], "0x%08x", c->crc_stored);
+            snprintf(crc[1], sizeof crc[1], "0x%08x", c->crc_computed);
+            cJSON *o = vt_json_object(&j, list, NULL);
+            vt_json_u64(&j, o, "index", i);
+            vt_json_string(&j, o, "id", c->id);
+            vt_json_u64(&j, o, "offset", c->offset);
+            vt_json_u64(&j, o, "size", c->size);
+            vt_json_bool(&j, o, "complete", c->complete);
+            vt_json_string(&j, o, "crc_stored", crc[0]);
+            vt_json_string(&j, o, "crc_computed", crc[1]);
+            vt_json_bool(&j, o, "crc_ok", c->complete && c->crc_stored == c->crc_computed);
         }
-        printf("%s],\n  \"valid\": %s,\n  \"result\": ", count ? "\n  " : "",
-               valid == VDSH_OK ? "true" : "false");
-        json_str(vdsh_result_str(valid));
-        fputs(",\n  \"error\": ", stdout);
-        if (valid == VDSH_OK)
-            fputs("null", stdout);
-        else
-            json_str(err.msg);
-        fputs("\n}\n", stdout);
+        vt_json_bool(&j, root, "valid", valid == VDSH_OK);
+        vt_json_string(&j, root, "result", vdsh_result_str(valid));
+        vt_json_string(&j, root, "error", valid == VDSH_OK ? NULL : err.msg);
+        if (!json_emit(&j, path))
+            bad_chunks = -1; /* not printed: json_emit said why */
     } else {
         printf("%s: %zu bytes\n", path, size);
         if (r == VDSH_OK)
@@ -555,7 +489,7 @@ static int verify(const char *path, int json)
     }
     if (valid != VDSH_OK)
         fprintf(stderr, "%s: %s\n", prog, err.msg);
-    else if (bad_chunks) /* cannot happen for a file the reader accepts */
+    else if (bad_chunks > 0) /* cannot happen for a file the reader accepts */
         fprintf(stderr, "%s: %s: %d chunks fail their CRC\n", prog, path,
                 bad_chunks);
     free(chunks);
@@ -577,15 +511,16 @@ static int info(const char *path, int json, int first)
         return 0;
     }
     uint64_t size = file_size_of(path);
+    int ok = 1;
     if (json) {
-        print_json(path, f, size);
+        ok = print_json(path, f, size);
     } else {
         if (!first)
             putchar('\n');
         print_summary(path, f, size);
     }
     vdsh_free(f);
-    return 1;
+    return ok;
 }
 
 int main(int argc, char **argv)

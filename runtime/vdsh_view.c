@@ -8,8 +8,11 @@
  *
  * Exit status: 0 success, 1 error (a file, GL), 2 usage error.
  */
+#include "vdsh_output.h"
 #include "vr.h"
 #include "vr_context.h"
+#include "vt_cli.h"
+#include "vt_json.h"
 
 #ifdef VR_HAVE_GLFW
 #define GLFW_INCLUDE_NONE
@@ -18,6 +21,7 @@
 #include <stb/stb_image_write.h>
 
 #include <errno.h>
+#include <getopt.h>
 #include <malloc.h>
 #include <math.h>
 #include <stdio.h>
@@ -29,7 +33,7 @@
 #define VDSH_VERSION_STRING "0"
 #endif
 
-enum { MAX_LIGHTS = 64, MAX_FILES = 8, EXIT_USAGE = 2 };
+enum { MAX_LIGHTS = 64, MAX_FILES = 8 };
 
 typedef struct options {
     const char *render_path, *grid_path;
@@ -38,6 +42,7 @@ typedef struct options {
     int file_count;
     int have_camera;
     float camera[6];
+    int fit;                   /* --fit: frame the bounds from outside */
     float fov;
     vr_light lights[MAX_LIGHTS];
     int light_count;
@@ -82,8 +87,10 @@ static const char usage_text[] =
     "                        every mode of every SCENE once (wall time and\n"
     "                        process CPU time per frame); JSON on stdout\n"
     "\n"
-    "View (defaults come from the scene's bounds, y up):\n"
+    "View (defaults come from the scene's bounds, y up: a room is seen from\n"
+    "inside, an object framed from outside, lit from outside):\n"
     "      --camera EX,EY,EZ,TX,TY,TZ   eye and target point\n"
+    "      --fit             frame the whole scene from outside, also a room\n"
     "      --fov DEG         vertical field of view (default 60)\n"
     "      --light X,Y,Z[,R,G,B]  a point light (repeatable)\n"
     "      --lights N        use N default lights, 1..4 (default 1)\n"
@@ -146,43 +153,7 @@ static const char keys_text[] =
 
 static int usage_error(const char *fmt, const char *arg)
 {
-    fprintf(stderr, "vdsh-view: ");
-    fprintf(stderr, fmt, arg);
-    fprintf(stderr, "\nTry 'vdsh-view --help'.\n");
-    return EXIT_USAGE;
-}
-
-/* Parse exactly n..max comma-separated finite floats. Returns the count,
- * or -1. */
-static int parse_floats(const char *s, float *out, int min, int max)
-{
-    int n = 0;
-    const char *p = s;
-    while (n < max) {
-        char *end;
-        errno = 0;
-        float v = strtof(p, &end);
-        if (end == p || errno || !isfinite(v))
-            return -1;
-        out[n++] = v;
-        if (*end == '\0')
-            return n >= min ? n : -1;
-        if (*end != ',')
-            return -1;
-        p = end + 1;
-    }
-    return -1;
-}
-
-static int parse_int(const char *s, int lo, int hi, int *out)
-{
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (end == s || *end || errno || v < lo || v > hi)
-        return -1;
-    *out = (int)v;
-    return 0;
+    return vt_usage_error("vdsh-view", fmt, arg);
 }
 
 /* Returns 0, or an exit status (help/version: -1 meaning exit 0). */
@@ -191,42 +162,65 @@ static int parse_args(int argc, char **argv, options *o)
     memset(o, 0, sizeof *o);
     o->mode = VR_MODE_VDSH5;
     o->egl = VR_EGL_AUTO;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-#define NEED_VALUE()                                                   \
-    do {                                                               \
-        if (!v)                                                        \
-            return usage_error("%s needs a value", a);                 \
-        i++;                                                           \
-    } while (0)
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+    enum { O_RENDER = 256, O_GRID, O_BENCH, O_CAMERA, O_FIT, O_FOV, O_LIGHT, O_LIGHTS,
+           O_ATT, O_AMBIENT, O_MODE, O_COMPARE, O_PCF, O_SHADOW_SIZE, O_SIZE, O_CUBEDIR,
+           O_NO_CUBEMAPS, O_EGL, O_FRAMES, O_SCREENSHOT, O_NO_OVERLAY, O_KEYS,
+           O_NO_MALLOPT };
+    static const struct option longopts[] = {
+        {"render", required_argument, 0, O_RENDER},
+        {"grid", required_argument, 0, O_GRID},
+        {"bench", no_argument, 0, O_BENCH},
+        {"camera", required_argument, 0, O_CAMERA},
+        {"fit", no_argument, 0, O_FIT},
+        {"fov", required_argument, 0, O_FOV},
+        {"light", required_argument, 0, O_LIGHT},
+        {"lights", required_argument, 0, O_LIGHTS},
+        {"attenuation", required_argument, 0, O_ATT},
+        {"ambient", required_argument, 0, O_AMBIENT},
+        {"mode", required_argument, 0, O_MODE},
+        {"compare", required_argument, 0, O_COMPARE},
+        {"pcf", no_argument, 0, O_PCF},
+        {"shadow-size", required_argument, 0, O_SHADOW_SIZE},
+        {"size", required_argument, 0, O_SIZE},
+        {"cubemap-dir", required_argument, 0, O_CUBEDIR},
+        {"no-cubemaps", no_argument, 0, O_NO_CUBEMAPS},
+        {"egl", required_argument, 0, O_EGL},
+        {"frames", required_argument, 0, O_FRAMES},
+        {"screenshot", required_argument, 0, O_SCREENSHOT},
+        {"no-overlay", no_argument, 0, O_NO_OVERLAY},
+        {"keys", required_argument, 0, O_KEYS},
+        {"no-mallopt", no_argument, 0, O_NO_MALLOPT},
+        {"quiet", no_argument, 0, 'q'},
+        {"help", no_argument, 0, 'h'},
+        {"version", no_argument, 0, 'V'},
+        {0, 0, 0, 0}};
+    int c;
+    while ((c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
+        const char *v = optarg;
+        switch (c) {
+        case 'h':
             fputs(usage_text, stdout);
             return -1;
-        } else if (!strcmp(a, "-V") || !strcmp(a, "--version")) {
+        case 'V':
             printf("vdsh-view %s\n", VDSH_VERSION_STRING);
             return -1;
-        } else if (!strcmp(a, "--render")) {
-            NEED_VALUE();
-            o->render_path = v;
-        } else if (!strcmp(a, "--grid")) {
-            NEED_VALUE();
-            o->grid_path = v;
-        } else if (!strcmp(a, "--bench")) {
-            o->bench = 1;
-        } else if (!strcmp(a, "--camera")) {
-            NEED_VALUE();
-            if (parse_floats(v, o->camera, 6, 6) != 6)
+        case 'q': o->quiet = 1; break;
+        case O_RENDER: o->render_path = v; break;
+        case O_GRID: o->grid_path = v; break;
+        case O_BENCH: o->bench = 1; break;
+        case O_CAMERA:
+            if (vt_parse_floats(v, o->camera, 6, 6) != 6)
                 return usage_error("--camera: expected EX,EY,EZ,TX,TY,TZ, got '%s'", v);
             o->have_camera = 1;
-        } else if (!strcmp(a, "--fov")) {
-            NEED_VALUE();
-            if (parse_floats(v, &o->fov, 1, 1) != 1 || !(o->fov > 1.0f && o->fov < 179.0f))
+            break;
+        case O_FIT: o->fit = 1; break;
+        case O_FOV:
+            if (!vt_parse_float(v, &o->fov) || !(o->fov > 1.0f && o->fov < 179.0f))
                 return usage_error("--fov: expected degrees in (1, 179), got '%s'", v);
-        } else if (!strcmp(a, "--light")) {
-            NEED_VALUE();
+            break;
+        case O_LIGHT: {
             float f[6];
-            int n = parse_floats(v, f, 3, 6);
+            int n = vt_parse_floats(v, f, 3, 6);
             if (n != 3 && n != 6)
                 return usage_error("--light: expected X,Y,Z or X,Y,Z,R,G,B, got '%s'", v);
             if (o->light_count == MAX_LIGHTS)
@@ -240,97 +234,80 @@ static int parse_args(int argc, char **argv, options *o)
                 if (!f[3] && !f[4] && !f[5])
                     l->color[0] = 1e-30f;
             }
-        } else if (!strcmp(a, "--lights")) {
-            NEED_VALUE();
-            if (parse_int(v, 1, 4, &o->default_lights))
+            break;
+        }
+        case O_LIGHTS:
+            if (!vt_parse_int(v, 1, 4, &o->default_lights))
                 return usage_error("--lights: expected 1..4, got '%s'", v);
-        } else if (!strcmp(a, "--attenuation")) {
-            NEED_VALUE();
-            if (parse_floats(v, o->att, 3, 3) != 3 || o->att[0] < 0 || o->att[1] < 0 ||
+            break;
+        case O_ATT:
+            if (vt_parse_floats(v, o->att, 3, 3) != 3 || o->att[0] < 0 || o->att[1] < 0 ||
                 o->att[2] < 0 || !(o->att[0] + o->att[1] + o->att[2] > 0))
                 return usage_error("--attenuation: expected A0,A1,A2 >= 0, not all 0, got '%s'",
                                    v);
             o->have_att = 1;
-        } else if (!strcmp(a, "--ambient")) {
-            NEED_VALUE();
-            if (parse_floats(v, &o->ambient, 1, 1) != 1 || o->ambient < 0)
+            break;
+        case O_AMBIENT:
+            if (!vt_parse_float(v, &o->ambient) || o->ambient < 0)
                 return usage_error("--ambient: expected a value >= 0, got '%s'", v);
             o->have_ambient = 1;
-        } else if (!strcmp(a, "--mode")) {
-            NEED_VALUE();
+            break;
+        case O_MODE:
             if (vr_mode_from_name(v, &o->mode))
                 return usage_error("--mode: expected none, cube, vdsh2, vdsh3, vdsh5 or "
                                    "vdsh5poly, got '%s'", v);
-        } else if (!strcmp(a, "--compare")) {
-            NEED_VALUE();
+            break;
+        case O_COMPARE:
             if (!strcmp(v, "smooth"))
                 o->compare = VDSH_COMPARE_SMOOTH;
             else if (!strcmp(v, "binary"))
                 o->compare = VDSH_COMPARE_BINARY;
             else
                 return usage_error("--compare: expected smooth or binary, got '%s'", v);
-        } else if (!strcmp(a, "--pcf")) {
-            o->pcf = 1;
-        } else if (!strcmp(a, "--shadow-size")) {
-            NEED_VALUE();
-            if (parse_int(v, 1, 8192, &o->shadow_size))
+            break;
+        case O_PCF: o->pcf = 1; break;
+        case O_SHADOW_SIZE:
+            if (!vt_parse_int(v, 1, 8192, &o->shadow_size))
                 return usage_error("--shadow-size: expected 1..8192, got '%s'", v);
-        } else if (!strcmp(a, "--size")) {
-            NEED_VALUE();
-            char *x;
-            long w = strtol(v, &x, 10), h = 0;
-            if (x != v && (*x == 'x' || *x == 'X')) {
-                char *end;
-                h = strtol(x + 1, &end, 10);
-                if (*end || end == x + 1)
-                    h = 0;
-            }
-            if (w < 1 || w > 16384 || h < 1 || h > 16384)
+            break;
+        case O_SIZE:
+            if (!vt_parse_size(v, 1, 16384, &o->width, &o->height))
                 return usage_error("--size: expected WxH (1..16384), got '%s'", v);
-            o->width = (int)w;
-            o->height = (int)h;
             o->have_size = 1;
-        } else if (!strcmp(a, "--cubemap-dir")) {
-            NEED_VALUE();
-            o->cubemap_dir = v;
-        } else if (!strcmp(a, "--no-cubemaps")) {
-            o->no_cubemaps = 1;
-        } else if (!strcmp(a, "--egl")) {
-            NEED_VALUE();
+            break;
+        case O_CUBEDIR: o->cubemap_dir = v; break;
+        case O_NO_CUBEMAPS: o->no_cubemaps = 1; break;
+        case O_EGL:
             if (!strcmp(v, "device"))
                 o->egl = VR_EGL_DEVICE;
             else if (!strcmp(v, "surfaceless"))
                 o->egl = VR_EGL_SURFACELESS;
             else
                 return usage_error("--egl: expected device or surfaceless, got '%s'", v);
-        } else if (!strcmp(a, "--frames")) {
-            NEED_VALUE();
-            if (parse_int(v, 1, 1000000, &o->frames))
+            break;
+        case O_FRAMES:
+            if (!vt_parse_int(v, 1, 1000000, &o->frames))
                 return usage_error("--frames: expected a positive count, got '%s'", v);
-        } else if (!strcmp(a, "--screenshot")) {
-            NEED_VALUE();
-            o->screenshot = v;
-        } else if (!strcmp(a, "--no-overlay")) {
-            o->no_overlay = 1;
-        } else if (!strcmp(a, "--keys")) {
-            NEED_VALUE();
+            break;
+        case O_SCREENSHOT: o->screenshot = v; break;
+        case O_NO_OVERLAY: o->no_overlay = 1; break;
+        case O_KEYS:
             for (const char *k = v; *k; k++)
                 if (!strchr("abcdefghijklmnopqrstuvwxyz0123456789 <>", *k))
                     return usage_error("--keys: letters, digits, space, '<' and '>' only, "
                                        "got '%s'", v);
             o->keys = v;
-        } else if (!strcmp(a, "--no-mallopt")) {
-            o->no_mallopt = 1;
-        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
-            o->quiet = 1;
-        } else if (a[0] == '-' && a[1]) {
-            return usage_error("unknown option '%s'", a);
-        } else {
-            if (o->file_count == MAX_FILES)
-                return usage_error("too many scene files (%s)", a);
-            o->files[o->file_count++] = a;
+            break;
+        case O_NO_MALLOPT: o->no_mallopt = 1; break;
+        default: /* getopt_long said what is wrong */
+            fprintf(stderr, "Try 'vdsh-view --help'.\n");
+            return VT_EXIT_USAGE;
         }
-#undef NEED_VALUE
+    }
+    for (int i = optind; i < argc; i++) {
+        if (o->file_count == MAX_FILES)
+            return usage_error("too many scene files (%s)", argv[i]);
+        o->files[o->file_count++] = argv[i];
     }
     if (o->file_count == 0)
         return usage_error("%s", "no scene file given");
@@ -339,6 +316,8 @@ static int parse_args(int argc, char **argv, options *o)
     if (o->file_count > 1 && !o->bench && !o->grid_path)
         return usage_error("one scene file at a time (several only with --grid and --bench), "
                            "got '%s'", o->files[1]);
+    if (o->fit && o->have_camera)
+        return usage_error("%s", "--fit and --camera both choose the view: give one");
     return 0;
 }
 
@@ -357,11 +336,14 @@ static float scene_diagonal(const vr_scene *s)
 
 /* n default lights of the scene: positions from vr_scene_default_lights,
  * warm/cool colours, and a fall-off that halves the light at about 0.3 of
- * the scene's diagonal. */
+ * the scene's diagonal in a room, and at the middle of an object (its
+ * lights stand outside it). */
 static int default_lights(const vr_scene *s, const options *o, int n, vr_light *out)
 {
     static const float colors[4][3] = {
         {1.0f, 0.92f, 0.8f}, {0.55f, 0.7f, 1.0f}, {1.0f, 0.62f, 0.4f}, {0.7f, 1.0f, 0.7f}};
+    vr_scene_info info;
+    vr_scene_get_info(s, &info);
     n = vr_scene_default_lights(s, out, n);
     float r = 0.3f * scene_diagonal(s);
     /* dimmer when there are several, so that their sum stays in range */
@@ -369,6 +351,14 @@ static int default_lights(const vr_scene *s, const options *o, int n, vr_light *
     for (int i = 0; i < n; i++) {
         for (int k = 0; k < 3; k++)
             out[i].color[k] = intensity * colors[i][k];
+        if (!info.interior) {
+            r = 0.0f;
+            for (int k = 0; k < 3; k++) {
+                float d = out[i].position[k] - 0.5f * (info.bounds_min[k] + info.bounds_max[k]);
+                r += d * d;
+            }
+            r = sqrtf(r) > 0.0f ? sqrtf(r) : 1.0f;
+        }
         if (o->have_att)
             memcpy(out[i].attenuation, o->att, sizeof o->att);
         else {
@@ -401,7 +391,10 @@ static int scene_lights(const vr_scene *s, const options *o, int n, vr_light *ou
 
 static void scene_camera(const vr_scene *s, const options *o, vr_camera *c)
 {
-    vr_scene_default_camera(s, c);
+    if (o->fit)
+        vr_scene_fit_camera(s, c);
+    else
+        vr_scene_default_camera(s, c);
     if (o->have_camera) {
         memcpy(c->eye, o->camera, 3 * sizeof(float));
         memcpy(c->target, o->camera + 3, 3 * sizeof(float));
@@ -431,6 +424,13 @@ static double now_ms(void)
     return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
 }
 
+/* stb_image_write's output callback: into the atomic output (a failed
+ * write is remembered; the commit reports it). */
+static void png_put(void *user, void *data, int size)
+{
+    vdsh_output_put(user, data, (size_t)size);
+}
+
 static int write_png(const char *path, int w, int h, const unsigned char *rgba)
 {
     /* Opaque PNGs: the framebuffer's alpha is whatever blending left. */
@@ -444,15 +444,21 @@ static int write_png(const char *path, int w, int h, const unsigned char *rgba)
         memcpy(copy + 4 * i, rgba + 4 * i, 3);
         copy[4 * i + 3] = 255;
     }
-    errno = 0;
-    int ok = stbi_write_png(path, w, h, 4, copy, w * 4);
+    /* The file appears complete or not at all (formats/vdsh_output.h). */
+    vdsh_output out;
+    vdsh_error err;
+    int rc = 1;
+    if (vdsh_output_open(path, &out, &err) != VDSH_OK)
+        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+    else if (!stbi_write_png_to_func(png_put, &out, w, h, 4, copy, w * 4)) {
+        fprintf(stderr, "vdsh-view: %s: cannot encode the PNG\n", path);
+        vdsh_output_abort(&out);
+    } else if (vdsh_output_commit(&out, &err) != VDSH_OK)
+        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+    else
+        rc = 0;
     free(copy);
-    if (!ok) {
-        fprintf(stderr, "vdsh-view: %s: cannot write PNG%s%s\n", path, errno ? ": " : "",
-                errno ? strerror(errno) : "");
-        return 1;
-    }
-    return 0;
+    return rc;
 }
 
 /* Everything a run needs: a context, the scene, a renderer. */
@@ -700,27 +706,11 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static void print_series(const char *key, const double *v, int n, int last)
+static void json_series(vt_json *j, cJSON *o, const char *key, const double *v, int n)
 {
-    printf("\"%s\": [", key);
+    cJSON *a = vt_json_array(j, o, key);
     for (int i = 0; i < n; i++)
-        printf("%s%.4f", i ? ", " : "", v[i]);
-    printf("]%s", last ? "" : ", ");
-}
-
-/* A JSON string: quotes, backslashes and control characters escaped. */
-static void print_json_string(const char *s)
-{
-    putchar('"');
-    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-        if (*p == '"' || *p == '\\')
-            printf("\\%c", *p);
-        else if (*p < 0x20)
-            printf("\\u%04x", *p);
-        else
-            putchar(*p);
-    }
-    putchar('"');
+        vt_json_f64(j, a, NULL, v[i]);
 }
 
 enum { BENCH_MODES = 7, BENCH_ROUNDS = 64 };
@@ -819,7 +809,8 @@ static int bench_time(const options *o, bench_scene *b, int nb, vr_renderer *r, 
 }
 
 /* One scene's JSON object (and a summary on stderr). */
-static void bench_print(const options *o, const bench_scene *b, int rounds, int first)
+static void bench_print(const options *o, const bench_scene *b, int rounds, vt_json *j,
+                        cJSON *list)
 {
     vr_scene_info info;
     vr_scene_get_info(b->scene, &info);
@@ -827,37 +818,39 @@ static void bench_print(const options *o, const bench_scene *b, int rounds, int 
     for (int k = 1; k <= 5; k++)
         if (info.has_order[k])
             method = info.method[k];
-    printf("%s{\"file\": ", first ? "" : ", ");
-    print_json_string(b->path);
-    printf(", \"vertices\": %u, \"triangles\": %u, \"quantity\": \"%s\", \"method\": \"%s\", "
-           "\"results\": [", info.vertex_count, info.triangle_count,
-           vdsh_quantity_name(info.quantity), vdsh_method_name(method));
+    cJSON *so = vt_json_object(j, list, NULL);
+    vt_json_string(j, so, "file", b->path);
+    vt_json_u64(j, so, "vertices", info.vertex_count);
+    vt_json_u64(j, so, "triangles", info.triangle_count);
+    vt_json_string(j, so, "quantity", vdsh_quantity_name(info.quantity));
+    vt_json_string(j, so, "method", vdsh_method_name(method));
+    cJSON *results = vt_json_array(j, so, "results");
     for (int ls = 0; ls < 2; ls++)
         for (int m = 0; m < b->nm; m++) {
             double sorted[BENCH_ROUNDS];
             memcpy(sorted, b->cpu[ls][m], (size_t)rounds * sizeof(double));
             qsort(sorted, (size_t)rounds, sizeof(double), cmp_double);
             int interp = vr_scene_interp(b->scene, b->modes[m].mode);
-            printf("%s{\"lights\": %d, \"mode\": \"%s\", \"path\": \"%s\", "
-                   "\"median_cpu_ms\": %.4f, ", ls == 0 && m == 0 ? "" : ", ", b->nl[ls],
-                   b->modes[m].name,
-                   interp >= 0 ? vdsh_interp_name((uint32_t)interp) : b->modes[m].name,
-                   sorted[rounds / 2]);
-            print_series("cpu_ms", b->cpu[ls][m], rounds, 0);
-            print_series("process_cpu_ms", b->proc[ls][m], rounds, 0);
-            print_series("gpu_ms", b->gpu[ls][m], rounds, 0);
-            print_series("shadow_ms", b->shadow[ls][m], rounds, 0);
-            print_series("lighting_ms", b->lighting[ls][m], rounds, 1);
-            printf("}");
+            cJSON *r = vt_json_object(j, results, NULL);
+            vt_json_i64(j, r, "lights", b->nl[ls]);
+            vt_json_string(j, r, "mode", b->modes[m].name);
+            vt_json_string(j, r, "path", interp >= 0 ? vdsh_interp_name((uint32_t)interp)
+                                                     : b->modes[m].name);
+            vt_json_f64(j, r, "median_cpu_ms", sorted[rounds / 2]);
+            json_series(j, r, "cpu_ms", b->cpu[ls][m], rounds);
+            json_series(j, r, "process_cpu_ms", b->proc[ls][m], rounds);
+            json_series(j, r, "gpu_ms", b->gpu[ls][m], rounds);
+            json_series(j, r, "shadow_ms", b->shadow[ls][m], rounds);
+            json_series(j, r, "lighting_ms", b->lighting[ls][m], rounds);
             if (!o->quiet)
                 fprintf(stderr, "vdsh-view: %s, %d light%s, %-9s median %.1f ms\n", b->path,
                         b->nl[ls], b->nl[ls] == 1 ? "" : "s", b->modes[m].name,
                         sorted[rounds / 2]);
         }
-    printf("]}");
-    fflush(stdout);
 }
 
+/* The results as one JSON document on stdout (vt_json.h), printed once
+ * every scene has been timed. */
 static int run_bench(const options *o)
 {
     int w = o->have_size ? o->width : 1024, h = o->have_size ? o->height : 768;
@@ -865,17 +858,18 @@ static int run_bench(const options *o)
     vr_renderer *r = NULL;
     if (open_headless(o, w, h, 0, &ctx, &r) != 0)
         return 1;
-    printf("{\"version\": ");
-    print_json_string(VDSH_VERSION_STRING);
-    printf(", \"renderer\": ");
-    print_json_string(vr_gl_renderer());
-    printf(", \"context\": ");
-    print_json_string(vr_context_description(ctx));
-    printf(", \"width\": %d, \"height\": %d, \"shadow_size\": %d, \"mallopt\": %s, "
-           "\"rounds\": %d, \"scenes\": [",
-           w, h, o->shadow_size ? o->shadow_size : 512, o->no_mallopt ? "false" : "true",
-           o->frames ? (o->frames < BENCH_ROUNDS ? o->frames : BENCH_ROUNDS) : 7);
     int rounds = o->frames ? (o->frames < BENCH_ROUNDS ? o->frames : BENCH_ROUNDS) : 7;
+    vt_json j = {0};
+    cJSON *root = vt_json_object(&j, NULL, NULL);
+    vt_json_string(&j, root, "version", VDSH_VERSION_STRING);
+    vt_json_string(&j, root, "renderer", vr_gl_renderer());
+    vt_json_string(&j, root, "context", vr_context_description(ctx));
+    vt_json_i64(&j, root, "width", w);
+    vt_json_i64(&j, root, "height", h);
+    vt_json_i64(&j, root, "shadow_size", o->shadow_size ? o->shadow_size : 512);
+    vt_json_bool(&j, root, "mallopt", !o->no_mallopt);
+    vt_json_i64(&j, root, "rounds", rounds);
+    cJSON *list = vt_json_array(&j, root, "scenes");
     bench_scene *b = calloc((size_t)o->file_count, sizeof *b);
     int rc = b ? 0 : 1;
     if (!b)
@@ -885,8 +879,13 @@ static int run_bench(const options *o)
     if (!rc)
         rc = bench_time(o, b, o->file_count, r, rounds);
     for (int i = 0; i < o->file_count && !rc; i++)
-        bench_print(o, &b[i], rounds, i == 0);
-    printf("]}\n");
+        bench_print(o, &b[i], rounds, &j, list);
+    char msg[256];
+    if (!rc && vt_json_write_stream(&j, stdout, "stdout", msg, sizeof msg) != 0) {
+        fprintf(stderr, "vdsh-view: --bench: %s\n", msg);
+        rc = 1;
+    }
+    vt_json_free(&j);
     for (int i = 0; b && i < o->file_count; i++)
         vr_scene_destroy(b[i].scene);
     free(b);

@@ -176,6 +176,9 @@ typedef struct vr_scene_info {
     float max_distance;           /* the file's: no reconstructed distance
                                      exceeds it (vdsh_shadow.h) */
     size_t gpu_bytes;             /* buffers and textures uploaded */
+    int interior;                 /* 1: a room, seen from inside by default;
+                                     0: an object, framed from outside (see
+                                     vr_scene_default_camera) */
 } vr_scene_info;
 
 void vr_scene_get_info(const vr_scene *s, vr_scene_info *out);
@@ -301,14 +304,27 @@ typedef struct vr_draw_desc {
 vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *d,
                   vr_error *err);
 
-/* The default camera for a scene: from inside its bounds near one end,
- * along the longest horizontal axis, a little above the floor, so that
- * closed rooms and open objects both show. */
+/* The default camera for a scene (y up). An interior (a room, a
+ * courtyard: vr_scene_info.interior) is seen from inside its bounds near
+ * one end, along the longest horizontal axis, a little above the floor.
+ * Anything else (an object, a terrain) is framed from outside, as
+ * vr_scene_fit_camera. A scene is an interior when, from that inside eye,
+ * at least 60% of 128 directions meet the front of a surface (the side its
+ * vertex normals face), decided once at load (vr_view.c says why). */
 void vr_scene_default_camera(const vr_scene *s, vr_camera *out);
 
-/* Up to max default light positions spread through the scene's bounds
- * (light 0 roughly in the middle, a little above the floor); returns how
- * many were written. Colours and attenuations are left to the caller. */
+/* The whole scene in view from outside, whatever the scene: the eye up and
+ * to the side of the bounds' centre, looking at it, just far enough that
+ * every corner of the bounds is within a 60-degree field of view (fov_y
+ * 60) vertically and horizontally (an image at least as wide as it is
+ * tall shows all of it; a wider fov too). */
+void vr_scene_fit_camera(const vr_scene *s, vr_camera *out);
+
+/* Up to max (at most 4) default light positions; returns how many were
+ * written. An interior's are spread through its bounds (light 0 roughly in
+ * the middle, a little above the floor); an object's stand outside its
+ * bounding sphere, light 0 above it and to the side of the default eye.
+ * Colours and attenuations are left to the caller. */
 int vr_scene_default_lights(const vr_scene *s, vr_light *out, int max);
 
 /* Draw text (ASCII, stb_easy_font's 7-pixel font scaled by `scale`) on top

@@ -1,6 +1,6 @@
 /*
  * vr_scene.c - load a .vdsh (formats/) and its basis cubemaps
- * (bake/cubemap.h), upload them, and derive a default view.
+ * (bake/cubemap.h) and upload them; the default view is vr_view.c's.
  *
  * Coefficients go to the GPU exactly as stored: f16 streams as
  * GL_HALF_FLOAT attributes, with the stream's scale applied in the shader,
@@ -272,6 +272,9 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
             s->bounds_min[k] = fminf(s->bounds_min[k], x);
             s->bounds_max[k] = fmaxf(s->bounds_max[k], x);
         }
+    /* Room or object: decides the default view (vr_view.c). */
+    s->interior = vr_view_interior(f->positions, f->normals, f->indices, h->triangle_count,
+                                   s->bounds_min, s->bounds_max);
 
     /* Everything per vertex goes up in the order of vr_order_triangles
      * (the same vertices and triangles, arranged for the vertex cache). */
@@ -370,6 +373,7 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     i.quantity = s->quantity;
     i.max_distance = s->max_distance;
     i.gpu_bytes = s->gpu_bytes;
+    i.interior = s->interior;
     *out = i;
 }
 
@@ -406,48 +410,4 @@ const char *vr_scene_mode_label(const vr_scene *s, vr_mode m)
     case 3: return "VDSH order 3 (9 coeff., log, per-vertex)";
     default: return "VDSH order 5 (25 coeff., log, per-vertex)";
     }
-}
-
-/* The scenes are y-up (the built-in room, OBJ convention). The eye stands
- * inside the bounds, a third of the way from the middle to one end of the
- * longest horizontal axis, at about a quarter of the height, looking
- * along that axis at the far half of the floor: inside a closed room or
- * a courtyard that shows floor, walls and props with room around them;
- * for an open object it is still a view from within its extent. */
-void vr_scene_default_camera(const vr_scene *s, vr_camera *out)
-{
-    const float *lo = s->bounds_min, *hi = s->bounds_max;
-    float c[3], e[3];
-    for (int k = 0; k < 3; k++) {
-        c[k] = 0.5f * (lo[k] + hi[k]);
-        e[k] = hi[k] - lo[k];
-    }
-    int ax = e[0] >= e[2] ? 0 : 2, other = 2 - ax;
-    vr_camera cam;
-    memset(&cam, 0, sizeof cam);
-    cam.eye[ax] = c[ax] + 0.36f * e[ax];
-    cam.eye[other] = c[other] + 0.05f * e[other];
-    cam.eye[1] = lo[1] + 0.28f * e[1];
-    cam.target[ax] = c[ax] - 0.2f * e[ax];
-    cam.target[other] = c[other];
-    cam.target[1] = lo[1] + 0.13f * e[1];
-    cam.up[1] = 1.0f;
-    cam.fov_y = 60.0f;
-    *out = cam;
-}
-
-int vr_scene_default_lights(const vr_scene *s, vr_light *out, int max)
-{
-    /* In bounds fractions (x, y, z): light 0 a little off centre at 40% of
-     * the height, the others toward the corners, so that props between
-     * them cast shadows in different directions. */
-    static const float at[4][3] = {
-        {0.42f, 0.4f, 0.45f}, {0.2f, 0.6f, 0.78f}, {0.78f, 0.3f, 0.22f}, {0.65f, 0.75f, 0.7f}};
-    int n = 0;
-    for (; n < max && n < 4; n++) {
-        memset(&out[n], 0, sizeof out[n]);
-        for (int k = 0; k < 3; k++)
-            out[n].position[k] = s->bounds_min[k] + at[n][k] * (s->bounds_max[k] - s->bounds_min[k]);
-    }
-    return n;
 }

@@ -12,7 +12,7 @@ if(TARGET vb_eval)
   endforeach()
 
   add_executable(test_eval_cli ${CMAKE_CURRENT_LIST_DIR}/test_eval_cli.c)
-  target_link_libraries(test_eval_cli PRIVATE vdsh_format)
+  target_link_libraries(test_eval_cli PRIVATE vdsh_format vt_tools)
   add_test(NAME eval_cli
            COMMAND test_eval_cli $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval>
                    ${CMAKE_CURRENT_BINARY_DIR}/eval_cli)

@@ -6,6 +6,11 @@ add_executable(test_format ${CMAKE_CURRENT_LIST_DIR}/test_format.c)
 target_link_libraries(test_format PRIVATE vdsh_format)
 add_test(NAME format_unit COMMAND test_format)
 
+# formats/vdsh_output.h: atomic output files (every program's writer).
+add_executable(test_output ${CMAKE_CURRENT_LIST_DIR}/test_output.c)
+target_link_libraries(test_output PRIVATE vdsh_format Threads::Threads)
+add_test(NAME format_output COMMAND test_output ${CMAKE_CURRENT_BINARY_DIR}/format_output)
+
 add_executable(test_format_tool ${CMAKE_CURRENT_LIST_DIR}/test_format_tool.c)
 target_link_libraries(test_format_tool PRIVATE vdsh_format)
 
@@ -49,7 +54,7 @@ _format_tool_test(format_info_verify 0
   --out "valid: every rule"
   -- ${_info} --verify ${_fx}/good.vdsh)
 _format_tool_test(format_info_json 0
-  --out "\"streams\": " --out "\"sha256\": \"000102"
+  --out "\"streams\":" --out "\"sha256\":\t\"000102"
   --out "\\\"quoted\\\"\\\\caf"
   -- ${_info} --json ${_fx}/good.vdsh)
 _format_tool_test(format_info_corrupt 1

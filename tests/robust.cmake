@@ -89,6 +89,7 @@ add_test(NAME robust_corrupt
 
 # SIGKILL at many moments of a bake: old outputs or complete new ones.
 add_executable(test_robust_kill ${_robust_dir}/test_robust_kill.c)
+target_link_libraries(test_robust_kill PRIVATE vt_tools m)
 add_test(NAME robust_kill
          COMMAND test_robust_kill $<TARGET_FILE:vdsh-bake> ${CMAKE_CURRENT_BINARY_DIR}/robust_kill)
 

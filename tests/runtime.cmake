@@ -130,6 +130,7 @@ expect2 --camera 1,2,3 "$room"
 expect2 --render a.png --grid b.png "$room"
 expect2 --render a.png "$room" "$room"
 expect2 --frames 0 "$room"
+expect2 --fit --camera 1,2,3,4,5,6 "$room"
 exit $fail
 ]=] sh ${_view} ${_room})
 
@@ -209,22 +210,84 @@ grep -q "VDSH order 5 (25 coeff., log, per-vertex)" "$d/grid2.log"
 grep -q "2 rows" "$d/grid2.log"
 ]=] sh ${_view} ${_png} ${_room} ${_rt_dir}/view_render ${_room_log})
 
-# The benchmark mode: every mode, 1 and 3 lights, two scenes, one process.
-add_test(NAME runtime_view_bench COMMAND sh -c [=[
+# The default view: an object (a ball baked here) is framed from outside
+# and lit from outside - it covers part of the image, not none and not all
+# of it (the room's inside eye would stand inside the ball); the room is
+# still seen from inside (it fills the image); --fit frames any scene from
+# outside. And a PNG that cannot be written whole leaves the old file and
+# no temporary.
+add_test(NAME runtime_view_frame COMMAND sh -c [=[
 set -e
-out=$("$1" --bench --frames 1 --size 96x72 --shadow-size 64 -q "$2" "$2" "$3")
-echo "$out" | head -c 400; echo
-for m in none cube cube_pcf vdsh2 vdsh3 vdsh5 vdsh5poly; do
-  echo "$out" | grep -q "\"mode\": \"$m\""
-done
-echo "$out" | grep -q '"lights": 3'
-echo "$out" | grep -q '"renderer": '
-echo "$out" | grep -q '"process_cpu_ms": \['
+v=$1; bake=$2; png=$3; room=$4; d=$5
+rm -rf "$d"; mkdir -p "$d"
+# A UV sphere of radius 1 at (3, 1, -2), 12 stacks x 16 slices, wound
+# counter-clockwise seen from outside.
+awk 'BEGIN {
+  S = 12; L = 16; pi = 3.14159265358979
+  print "v 3 2 -2"
+  for (i = 1; i < S; i++) for (j = 0; j < L; j++) {
+    t = pi * i / S; p = 2 * pi * j / L
+    printf "v %.6f %.6f %.6f\n", 3 + sin(t) * cos(p), 1 + cos(t), -2 + sin(t) * sin(p)
+  }
+  print "v 3 0 -2"
+  for (j = 0; j < L; j++) { a = 2 + j; b = 2 + (j + 1) % L; print "f 1", b, a }
+  for (i = 0; i < S - 2; i++) for (j = 0; j < L; j++) {
+    a = 2 + i * L + j; b = 2 + i * L + (j + 1) % L; c = a + L; e = b + L
+    print "f", a, b, e; print "f", a, e, c
+  }
+  n = 2 + (S - 1) * L
+  for (j = 0; j < L; j++) { a = 2 + (S - 2) * L + j; b = 2 + (S - 2) * L + (j + 1) % L; print "f", n, a, b }
+}' > "$d/ball.obj"
+"$bake" "$d/ball.obj" --rays 64 --method lsq --cube-size 0 -q -o "$d/ball.vdsh"
+"$v" -q --render "$d/ball.png" --size 160x120 --mode vdsh3 "$d/ball.vdsh"
+"$png" coverage "$d/ball.png" 0.05 0.9
+"$v" -q --render "$d/room.png" --size 160x120 --mode vdsh3 "$room"
+"$png" coverage "$d/room.png" 0.97 1
+"$v" -q --render "$d/room-fit.png" --size 160x120 --mode vdsh3 --fit "$room"
+"$png" coverage "$d/room-fit.png" 0.05 0.9
+# a write that fails (a 1 KiB file size limit): the old file stays
+echo old > "$d/keep.png"
+if (ulimit -f 1; trap '' XFSZ; exec "$v" -q --render "$d/keep.png" --size 160x120 "$room") 2> "$d/err.txt"; then
+  echo "a PNG past the size limit was written"; exit 1
+fi
+cat "$d/err.txt"
+grep -q "keep.png" "$d/err.txt"
+test "$(cat "$d/keep.png")" = old
+if ls "$d" | grep -q '\.tmp'; then echo "temporary left: $(ls "$d")"; exit 1; fi
+]=] sh ${_view} $<TARGET_FILE:vdsh-bake> ${_png} ${_room} ${_rt_dir}/view_frame)
+
+# The benchmark mode: every mode, 1 and 3 lights, two scenes, one process;
+# its JSON parses (a scene path with quotes and backslashes too).
+find_package(Python3 COMPONENTS Interpreter QUIET)
+if(Python3_Interpreter_FOUND)
+  add_test(NAME runtime_view_bench COMMAND ${Python3_EXECUTABLE} -c [=[
+import json, os, shutil, subprocess, sys
+view, room, room_log, d = sys.argv[1:5]
+shutil.rmtree(d, ignore_errors=True)
+os.makedirs(d)
+odd = os.path.join(os.fsencode(d), b'q"x\\r\t\xffoom.vdsh')
+shutil.copy(room_log, odd)
+out = subprocess.run([view, '--bench', '--frames', '1', '--size', '96x72', '--shadow-size', '64',
+                      '-q', room, room, odd], check=True, capture_output=True).stdout
+print(out[:400])
+b = json.loads(out.decode('utf-8'))
+assert b['renderer'] and b['rounds'] == 1 and b['width'] == 96, b
+shown = os.path.join(d, 'q"x\\r\t\ufffdoom.vdsh')
+assert [s['file'] for s in b['scenes']] == [room, room, shown], [s['file'] for s in b['scenes']]
+modes = {r['mode'] for s in b['scenes'] for r in s['results']}
+assert modes == {'none', 'cube', 'cube_pcf', 'vdsh2', 'vdsh3', 'vdsh5', 'vdsh5poly'}, modes
+assert {r['lights'] for r in b['scenes'][0]['results']} == {1, 3}
+r0 = b['scenes'][0]['results'][0]
+assert len(r0['process_cpu_ms']) == 1 and len(r0['cpu_ms']) == 1
 # the log-distance scene: its VDSH modes on the distance path
-echo "$out" | grep -q '"quantity": "log-distance", "method": "lsq"'
-echo "$out" | grep -q '"mode": "vdsh5", "path": "distance"'
-echo "$out" | grep -q '"mode": "vdsh5", "path": "split"'
-]=] sh ${_view} ${_room} ${_room_log})
+log = b['scenes'][2]
+assert log['quantity'] == 'log-distance' and log['method'] == 'lsq', log
+paths = {(r['mode'], r['path']) for r in log['results']}
+assert ('vdsh5', 'distance') in paths, paths
+assert ('vdsh5', 'split') in {(r['mode'], r['path']) for r in b['scenes'][0]['results']}
+print('ok')
+]=] ${_view} ${_room} ${_room_log} ${_rt_dir}/view_bench)
+endif()
 
 # The window: under a display server (Xvfb), the image the window shows
 # is the headless one.
@@ -251,7 +314,9 @@ grep -q "saved vdsh-view-000.png" keys.log
 ]=] sh ${_view} ${_png} ${_room} ${_rt_dir}/view_window)
 
 foreach(t runtime_view_usage runtime_view_errors runtime_view_render runtime_view_bench
-          runtime_view_window)
-  _runtime_props(${t} FIXTURES_REQUIRED runtime_room)
+          runtime_view_frame runtime_view_window)
+  if(TEST ${t})
+    _runtime_props(${t} FIXTURES_REQUIRED runtime_room)
+  endif()
 endforeach()
 _runtime_props(runtime_view_help)

@@ -344,7 +344,7 @@ static int count_entries(const char *dir)
     return count;
 }
 
-/* No "*.tmp-*" leftovers in dir. */
+/* No "*.tmp.*" leftovers in dir (vdsh_output.h names them NAME.tmp.PID.N). */
 static int count_temp_files(const char *dir)
 {
     DIR *d = opendir(dir);
@@ -353,7 +353,7 @@ static int count_temp_files(const char *dir)
     int count = 0;
     struct dirent *e;
     while ((e = readdir(d)) != NULL)
-        if (strstr(e->d_name, ".tmp-"))
+        if (strstr(e->d_name, ".tmp."))
             count++;
     closedir(d);
     return count;

@@ -32,15 +32,17 @@
  * (the calibration run's; bakes are deterministic), or absent when it was
  * absent before; a new .vdsh implies four new cubemaps (they are renamed
  * first). Anything else in the folder must be a temporary file whose name
- * cannot be mistaken for an output ("<output>.tmp.<pid>.<n>" for the
- * .vdsh, "<output>.tmp-<pid>-<k>" for the cubemaps); they are counted and
+ * cannot be mistaken for an output ("<output>.tmp.<pid>.<n>", every
+ * output's, formats/vdsh_output.h); they are counted and
  * removed. Test time: about 20 T.
  */
 #include "test_util.h"
+#include "vt_json.h"
 
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <signal.h>
 #include <spawn.h>
 #include <stdlib.h>
@@ -187,7 +189,7 @@ static int clean_dir(const char *dir, int *temps, char *example, size_t cap)
             size_t n = strlen(output_names[k]);
             output |= strcmp(e->d_name, output_names[k]) == 0;
             temp |= strncmp(e->d_name, output_names[k], n) == 0 &&
-                    (strncmp(e->d_name + n, ".tmp.", 5) == 0 || strncmp(e->d_name + n, ".tmp-", 5) == 0);
+                    strncmp(e->d_name + n, ".tmp.", 5) == 0;
         }
         if (temp) {
             ++*temps;
@@ -365,18 +367,16 @@ int main(int argc, char **argv)
         CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 0, "calibration bake failed");
         /* Loading ends after process start-up and the load itself; the
          * report's clock starts after start-up. */
-        blob r;
-        load(work, "calibration.json", &r);
-        double load_s = 0, total_s = 0;
-        const char *p = r.present ? strstr((const char *)r.data, "\"load\": ") : NULL;
-        const char *q = r.present ? strstr((const char *)r.data, "\"total\": ") : NULL;
-        CHECK(p && q && r.data[r.size - 1] == '\n', "no timings in %s/calibration.json", work);
-        if (p && q) {
-            load_s = strtod(p + 8, NULL);
-            total_s = strtod(q + 9, NULL);
-        }
+        char msg[4400];
+        cJSON *r = vt_json_read_file(report, msg, sizeof msg);
+        const cJSON *sec = cJSON_GetObjectItemCaseSensitive(r, "seconds");
+        double load_s = vt_json_number(sec, "load"), total_s = vt_json_number(sec, "total");
+        CHECK(isfinite(load_s) && isfinite(total_s), "no timings in %s: %s", report,
+              r ? "no seconds.load, seconds.total" : msg);
+        if (!isfinite(load_s) || !isfinite(total_s))
+            load_s = total_s = 0;
+        cJSON_Delete(r);
         t_load = T - total_s + load_s;
-        free(r.data);
         for (int k = 0; k < OUTPUTS; k++) {
             blob b;
             load(run_dir, output_names[k], &b);

@@ -16,6 +16,10 @@
  *                                      half as bright as NONE, around LIT
  *                                      at least 0.8 times. With IMG = NONE
  *                                      the first check fails: the control.
+ *   test_runtime_png coverage FILE MIN MAX
+ *                                      the share of pixels that are not
+ *                                      black (the background: something
+ *                                      was drawn there) is in MIN..MAX
  */
 #include <stb/stb_image.h>
 
@@ -183,7 +187,22 @@ int main(int argc, char **argv)
         printf("%ld of %ld values differ by more than %d\n", off, n, maxdiff);
         return off * 1000 <= n ? 0 : 1;
     }
+    if (argc == 5 && !strcmp(argv[1], "coverage")) {
+        int w, h;
+        unsigned char *px = load(argv[2], &w, &h);
+        if (!px)
+            return 1;
+        long n = (long)w * h, drawn = 0;
+        for (long i = 0; i < n; i++)
+            drawn += px[4 * i] || px[4 * i + 1] || px[4 * i + 2];
+        stbi_image_free(px);
+        double share = (double)drawn / (double)n, lo = atof(argv[3]), hi = atof(argv[4]);
+        printf("%s: %.1f%% of the pixels drawn (want %.1f%%..%.1f%%)\n", argv[2], 100.0 * share,
+               100.0 * lo, 100.0 * hi);
+        return share >= lo && share <= hi ? 0 : 1;
+    }
     fprintf(stderr, "usage: test_runtime_png info FILE W H | same A B MAXDIFF |\n"
-                    "       shadow IMG NONE EX,EY,EZ,TX,TY,TZ FOV DX,DY,DZ LX,LY,LZ\n");
+                    "       shadow IMG NONE EX,EY,EZ,TX,TY,TZ FOV DX,DY,DZ LX,LY,LZ |\n"
+                    "       coverage FILE MIN MAX\n");
     return 2;
 }

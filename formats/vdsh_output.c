@@ -1,0 +1,251 @@
+/*
+ * vdsh_output.c - output files that appear only when complete (see
+ * vdsh_output.h for the contract).
+ */
+#include "vdsh_output.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdarg.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* Temporary names tried before giving up: names taken by other writers
+ * (or planted) are skipped, one attempt each. */
+enum { MAX_ATTEMPTS = 1000 };
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 3, 4)))
+#endif
+static vdsh_result fail(vdsh_error *err, vdsh_result r, const char *fmt, ...)
+{
+    if (err) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+        va_end(ap);
+    }
+    return r;
+}
+
+static void release(vdsh_output *o)
+{
+    if (o->fp)
+        fclose(o->fp);
+    else if (o->fd >= 0)
+        close(o->fd);
+    if (o->tmp)
+        unlink(o->tmp);
+    free(o->tmp);
+    free(o->path);
+    memset(o, 0, sizeof *o);
+    o->fd = -1;
+}
+
+/* An existing character device or FIFO: opened in place (a stream). 1 when
+ * it is one and opened, 0 when the target is a regular file or absent (the
+ * temporary-file path follows), -1 on an error (already reported). */
+static int open_stream(const char *path, vdsh_output *o, vdsh_error *err, vdsh_result *res)
+{
+    struct stat st;
+    if (stat(path, &st) != 0 || S_ISREG(st.st_mode))
+        return 0;
+    if (!S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode)) {
+        *res = fail(err, VDSH_ERR_IO, "%s: cannot write: %s", path,
+                    S_ISDIR(st.st_mode) ? "is a directory" : "not a regular file");
+        return -1;
+    }
+    int fd = open(path, O_WRONLY | O_NOCTTY | O_CLOEXEC);
+    if (fd < 0) {
+        *res = fail(err, VDSH_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+        return -1;
+    }
+    /* What was opened, not what stat saw a moment ago, decides. */
+    if (fstat(fd, &st) != 0 || (!S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode))) {
+        close(fd);
+        *res = fail(err, VDSH_ERR_IO, "%s: cannot write: not a regular file "
+                    "(it changed while being opened)", path);
+        return -1;
+    }
+    o->fd = fd;
+    return 1;
+}
+
+vdsh_result vdsh_output_open(const char *path, vdsh_output *out, vdsh_error *err)
+{
+    static atomic_uint counter;
+    vdsh_output o = {.fd = -1};
+    if (out)
+        *out = o;
+    if (!out || !path || !path[0])
+        return fail(err, VDSH_ERR_ARGUMENT, "%s: cannot write: no file name given",
+                    path ? path : "(null)");
+    vdsh_result res = VDSH_OK;
+    size_t len = strlen(path);
+    o.path = malloc(len + 1);
+    if (!o.path)
+        return fail(err, VDSH_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    memcpy(o.path, path, len + 1);
+
+    int stream = open_stream(path, &o, err, &res);
+    if (stream < 0) {
+        release(&o);
+        return res;
+    }
+    if (!stream) {
+        size_t cap = len + 64;
+        o.tmp = malloc(cap);
+        if (!o.tmp) {
+            release(&o);
+            return fail(err, VDSH_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+        }
+        int e = 0;
+        for (int attempt = 0; attempt < MAX_ATTEMPTS; attempt++) {
+            snprintf(o.tmp, cap, "%s.tmp.%ld.%u", path, (long)getpid(),
+                     atomic_fetch_add(&counter, 1u));
+            o.fd = open(o.tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOCTTY | O_CLOEXEC, 0666);
+            e = errno;
+            if (o.fd >= 0 || e != EEXIST)
+                break;
+        }
+        if (o.fd < 0) {
+            res = fail(err, VDSH_ERR_IO, "%s: cannot create a temporary file beside it "
+                       "(%s): %s", path, o.tmp, e == EEXIST ? "every name taken" : strerror(e));
+            free(o.tmp); /* not ours: never unlink it */
+            o.tmp = NULL;
+            release(&o);
+            return res;
+        }
+    }
+    o.fp = fdopen(o.fd, "wb");
+    if (!o.fp) {
+        int e = errno;
+        release(&o);
+        return fail(err, VDSH_ERR_IO, "%s: cannot write: %s", path, strerror(e));
+    }
+    *out = o;
+    return VDSH_OK;
+}
+
+size_t vdsh_output_put(vdsh_output *o, const void *data, size_t n)
+{
+    if (!o || !o->fp)
+        return 0;
+    errno = 0;
+    size_t k = fwrite(data, 1, n, o->fp);
+    if (k != n && !o->error)
+        o->error = errno ? errno : EIO;
+    return k;
+}
+
+vdsh_result vdsh_output_finish(vdsh_output *o, vdsh_error *err)
+{
+    if (!o || !o->path)
+        return fail(err, VDSH_ERR_ARGUMENT, "vdsh_output_finish: no open output");
+    if (o->finished)
+        return VDSH_OK;
+    /* errno of the first step that failed; a write error that stdio only
+     * remembers (ferror), from a write not made through vdsh_output_put,
+     * reports EIO. */
+    int e = o->error;
+    const char *step = "write";
+    if (o->fp && !e) {
+        errno = 0;
+        if (fflush(o->fp) != 0)
+            e = errno ? errno : EIO;
+        else if (ferror(o->fp))
+            e = EIO;
+    }
+    if (!e && o->tmp && fsync(o->fd) != 0) {
+        e = errno;
+        step = "sync";
+    }
+    int closed = o->fp ? fclose(o->fp) : close(o->fd);
+    if (closed != 0 && !e) {
+        e = errno;
+        step = "close";
+    }
+    o->fp = NULL;
+    o->fd = -1;
+    if (e) {
+        vdsh_result r;
+        if (o->tmp)
+            r = fail(err, VDSH_ERR_IO, "%s: cannot %s (temporary file %s): %s", o->path,
+                     step, o->tmp, strerror(e));
+        else
+            r = fail(err, VDSH_ERR_IO, "%s: cannot %s: %s", o->path, step, strerror(e));
+        release(o);
+        return r;
+    }
+    o->finished = 1;
+    return VDSH_OK;
+}
+
+/* Make the rename itself durable; best effort (some file systems refuse
+ * to fsync a directory, and the data is already safe). */
+static void sync_parent_dir(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    char *dir;
+    if (!slash) {
+        dir = strdup(".");
+    } else {
+        size_t n = slash == path ? 1 : (size_t)(slash - path);
+        dir = malloc(n + 1);
+        if (dir) {
+            memcpy(dir, path, n);
+            dir[n] = 0;
+        }
+    }
+    if (!dir)
+        return;
+    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) {
+        (void)fsync(fd);
+        close(fd);
+    }
+    free(dir);
+}
+
+vdsh_result vdsh_output_commit(vdsh_output *o, vdsh_error *err)
+{
+    vdsh_result r = vdsh_output_finish(o, err);
+    if (r != VDSH_OK)
+        return r;
+    if (o->tmp) {
+        if (rename(o->tmp, o->path) != 0) {
+            int e = errno;
+            r = fail(err, VDSH_ERR_IO, "%s: cannot rename %s to it: %s", o->path, o->tmp,
+                     strerror(e));
+            release(o);
+            return r;
+        }
+        sync_parent_dir(o->path);
+        free(o->tmp);
+        o->tmp = NULL;
+    }
+    release(o);
+    return VDSH_OK;
+}
+
+void vdsh_output_abort(vdsh_output *o)
+{
+    if (o && o->path)
+        release(o);
+    else if (o)
+        o->fd = -1;
+}
+
+vdsh_result vdsh_output_write(const char *path, const void *data, size_t size,
+                              vdsh_error *err)
+{
+    vdsh_output o;
+    vdsh_result r = vdsh_output_open(path, &o, err);
+    if (r != VDSH_OK)
+        return r;
+    vdsh_output_put(&o, data, size);
+    return vdsh_output_commit(&o, err);
+}

@@ -1,0 +1,255 @@
+/*
+ * test_tools.c - tools/: the number rules every program's options follow
+ * (vt_cli.h) and the JSON every program writes and reads (vt_json.h).
+ *
+ *   test_tools WORK_DIR
+ */
+#include "test_util.h"
+#include "vt_cli.h"
+#include "vt_json.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+#include <sys/stat.h>
+
+static const char *work;
+
+static void test_integers(void)
+{
+    uint64_t u = 7;
+    CHECK(vt_parse_u64("010", 0, 100, &u) && u == 10, "010 is ten (decimal), got %llu",
+          (unsigned long long)u);
+    CHECK(vt_parse_u64("0", 0, 5, &u) && u == 0, "0");
+    CHECK(vt_parse_u64("18446744073709551615", 0, UINT64_MAX, &u) && u == UINT64_MAX,
+          "2^64 - 1");
+    static const char *const bad[] = {"", "18446744073709551616", "99999999999999999999999",
+                                      "0x10", "1e3", "12abc", " 12", "12 ", "+1", "-1",
+                                      "1,2", "1.0", "\t1", "１"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        u = 7;
+        CHECK(!vt_parse_u64(bad[i], 0, UINT64_MAX, &u) && u == 7,
+              "'%s' refused, output untouched", bad[i]);
+    }
+    CHECK(!vt_parse_u64("0", 1, 10, &u) && !vt_parse_u64("11", 1, 10, &u) &&
+              vt_parse_u64("10", 1, 10, &u),
+          "range lo..hi, both included");
+    uint32_t v = 3;
+    CHECK(!vt_parse_u32("4294967296", 0, UINT32_MAX, &v) && v == 3 &&
+              vt_parse_u32("4294967295", 0, UINT32_MAX, &v) && v == UINT32_MAX,
+          "u32 range");
+    int i = 5;
+    CHECK(vt_parse_int("-12", -20, 20, &i) && i == -12, "negative int");
+    CHECK(vt_parse_int("007", 0, 20, &i) && i == 7, "007");
+    CHECK(!vt_parse_int("-", -5, 5, &i) && !vt_parse_int("--1", -5, 5, &i) &&
+              !vt_parse_int("99999999999999999999", INT32_MIN, INT32_MAX, &i) &&
+              !vt_parse_int("-9223372036854775809", INT32_MIN, INT32_MAX, &i) &&
+              !vt_parse_int("21", -20, 20, &i) && i == 7,
+          "bad ints refused");
+}
+
+static void test_reals(void)
+{
+    float f = 9.0f;
+    static const struct { const char *s; float v; } good[] = {
+        {"0", 0.0f}, {"1.5", 1.5f}, {"-2", -2.0f}, {"+3.25", 3.25f}, {".5", 0.5f},
+        {"5.", 5.0f}, {"1e-4", 1e-4f}, {"2.5E+3", 2500.0f}, {"010", 10.0f}, {"-0", -0.0f}};
+    for (size_t i = 0; i < sizeof good / sizeof good[0]; i++)
+        CHECK(vt_parse_float(good[i].s, &f) && f == good[i].v, "'%s' -> %g", good[i].s,
+              (double)f);
+    static const char *const bad[] = {"", ".", "-", "e5", "1e", "1e+", "0x1p3", "inf", "nan",
+                                      "1e39", "1e-50", "1.5x", " 1", "1 ", "1,5", "--1",
+                                      "1..2", "1e5.5"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        f = 9.0f;
+        CHECK(!vt_parse_float(bad[i], &f) && f == 9.0f, "'%s' refused", bad[i]);
+    }
+    float l[6];
+    CHECK(vt_parse_floats("1,-2.5,3e1", l, 3, 6) == 3 && l[0] == 1 && l[1] == -2.5f &&
+              l[2] == 30.0f,
+          "a list");
+    static const char *const bad_lists[] = {"1,2", "1,2,3,", ",1,2,3", "1,,2,3", "1,2,x",
+                                            "1,2,3,4,5,6,7", "1;2;3", "1, 2, 3"};
+    for (size_t i = 0; i < sizeof bad_lists / sizeof bad_lists[0]; i++)
+        CHECK(vt_parse_floats(bad_lists[i], l, 3, 6) == 0, "list '%s' refused", bad_lists[i]);
+    uint64_t o[5];
+    CHECK(vt_parse_u64_list("2,3,05", 1, 5, o, 1, 5) == 3 && o[2] == 5, "u64 list");
+    CHECK(vt_parse_u64_list("2,6", 1, 5, o, 1, 5) == 0 && vt_parse_u64_list("", 1, 5, o, 1, 5) == 0 &&
+              vt_parse_u64_list("2,", 1, 5, o, 1, 5) == 0 &&
+              vt_parse_u64_list("1,2,3,4,5,1", 1, 5, o, 1, 5) == 0,
+          "bad u64 lists refused");
+    int w = 0, h = 0;
+    CHECK(vt_parse_size("640x480", 1, 16384, &w, &h) && w == 640 && h == 480, "WxH");
+    CHECK(vt_parse_size("08X09", 1, 16384, &w, &h) && w == 8 && h == 9, "WXH, decimal");
+    static const char *const bad_sizes[] = {"640", "640x", "x480", "0x480", "640x0",
+                                            "640x480x2", "16385x2", "-640x480", "640 x480"};
+    for (size_t i = 0; i < sizeof bad_sizes / sizeof bad_sizes[0]; i++)
+        CHECK(!vt_parse_size(bad_sizes[i], 1, 16384, &w, &h), "size '%s' refused",
+              bad_sizes[i]);
+}
+
+/* Build a document, print it, parse it back with cJSON. */
+static cJSON *round_trip(vt_json *j)
+{
+    char *text = vt_json_print(j);
+    CHECK(text != NULL, "printed");
+    cJSON *back = text ? cJSON_Parse(text) : NULL;
+    CHECK(back != NULL, "parses: %s", text ? text : "");
+    free(text);
+    return back;
+}
+
+static void test_json_strings(void)
+{
+    static const char *const s[] = {"plain", "q\"uote", "back\\slash", "tab\tnew\nline",
+                                    "ctl\x01\x1f", "caf\xc3\xa9", "bad \xff byte",
+                                    "cut \xc3", "overlong \xc0\xaf", "surrogate \xed\xa0\x80",
+                                    "emoji \xf0\x9f\x99\x82"};
+    static const char *const want[] = {"plain", "q\"uote", "back\\slash", "tab\tnew\nline",
+                                       "ctl\x01\x1f", "caf\xc3\xa9",
+                                       "bad \xef\xbf\xbd byte", "cut \xef\xbf\xbd",
+                                       "overlong \xef\xbf\xbd\xef\xbf\xbd",
+                                       "surrogate \xef\xbf\xbd\xef\xbf\xbd\xef\xbf\xbd",
+                                       "emoji \xf0\x9f\x99\x82"};
+    vt_json j = {0};
+    cJSON *root = vt_json_object(&j, NULL, NULL);
+    cJSON *a = vt_json_array(&j, root, "s");
+    for (size_t i = 0; i < sizeof s / sizeof s[0]; i++)
+        vt_json_string(&j, a, NULL, s[i]);
+    vt_json_string(&j, root, "null", NULL);
+    vt_json_string(&j, root, "k\"ey", "v");
+    char *text = vt_json_print(&j);
+    CHECK(text && text[strlen(text) - 1] == '\n', "ends in a newline");
+    CHECK(text && !strchr(text, '\x01') && !strstr(text, "\xff"),
+          "no raw control character or invalid byte in the output");
+    free(text);
+    cJSON *back = round_trip(&j);
+    cJSON *ba = cJSON_GetObjectItemCaseSensitive(back, "s");
+    for (size_t i = 0; i < sizeof s / sizeof s[0]; i++) {
+        const cJSON *it = cJSON_GetArrayItem(ba, (int)i);
+        CHECK(cJSON_IsString(it) && strcmp(it->valuestring, want[i]) == 0, "string %zu", i);
+    }
+    CHECK(cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(back, "null")), "NULL is null");
+    CHECK(cJSON_IsString(cJSON_GetObjectItemCaseSensitive(back, "k\"ey")), "keys escaped");
+    cJSON_Delete(back);
+    vt_json_free(&j);
+}
+
+static void test_json_numbers(void)
+{
+    enum { N = 2000 };
+    static float f[N];
+    static double d[N];
+    uint64_t seed = 42;
+    for (int i = 0; i < N; i++) {
+        double r = test_rand(&seed);
+        int e = (int)(test_rand(&seed) * 80.0) - 40;
+        f[i] = (float)ldexp(r, e) * (i % 2 ? -1.0f : 1.0f);
+        d[i] = ldexp(test_rand(&seed), (int)(test_rand(&seed) * 200.0) - 100);
+    }
+    f[0] = 0.1f, f[1] = FLT_MAX, f[2] = FLT_MIN, f[3] = -0.0f, f[4] = 16777217.0f;
+    d[0] = 0.1 + 0.2, d[1] = DBL_MAX, d[2] = DBL_MIN, d[3] = 1.0 / 3.0, d[4] = 5e-324;
+    vt_json j = {0};
+    cJSON *root = vt_json_object(&j, NULL, NULL);
+    cJSON *fa = vt_json_array(&j, root, "f"), *da = vt_json_array(&j, root, "d");
+    for (int i = 0; i < N; i++) {
+        vt_json_f32(&j, fa, NULL, f[i]);
+        vt_json_f64(&j, da, NULL, d[i]);
+    }
+    vt_json_u64(&j, root, "u", UINT64_MAX);
+    vt_json_u64(&j, root, "u53", (1ull << 53) + 1);
+    vt_json_i64(&j, root, "i", INT64_MIN);
+    vt_json_f32(&j, root, "k1", NAN);
+    vt_json_f64(&j, root, "k2", -INFINITY);
+    vt_json_f32(&j, root, "tenth", 0.1f);
+    vt_json_bool(&j, root, "yes", 7);
+    char *text = vt_json_print(&j);
+    CHECK(text && strstr(text, "\"u\":\t18446744073709551615") &&
+              strstr(text, "\"u53\":\t9007199254740993") &&
+              strstr(text, "\"i\":\t-9223372036854775808"),
+          "whole numbers printed in full");
+    CHECK(text && strstr(text, "\"tenth\":\t0.1,"), "the shortest float: 0.1, not 0.100000001");
+    CHECK(text && strstr(text, "\"k1\":\tnull") && strstr(text, "\"k2\":\tnull") &&
+              !strstr(text, "nan") && !strstr(text, "inf"),
+          "NaN and Inf print as null, never as nan or inf");
+    free(text);
+    cJSON *back = round_trip(&j);
+    cJSON *bf = cJSON_GetObjectItemCaseSensitive(back, "f"),
+          *bd = cJSON_GetObjectItemCaseSensitive(back, "d");
+    int exact_f = cJSON_GetArraySize(bf) == N, exact_d = cJSON_GetArraySize(bd) == N;
+    for (int i = 0; i < N && exact_f && exact_d; i++) {
+        float g = (float)cJSON_GetArrayItem(bf, i)->valuedouble;
+        exact_f &= memcmp(&g, &f[i], sizeof g) == 0;
+        exact_d &= cJSON_GetArrayItem(bd, i)->valuedouble == d[i];
+        if (!exact_f || !exact_d)
+            fprintf(stderr, "item %d: %.9g -> %.9g, %.17g -> %.17g\n", i, (double)f[i],
+                    (double)g, d[i], cJSON_GetArrayItem(bd, i)->valuedouble);
+    }
+    CHECK(exact_f, "every float reads back as the same float");
+    CHECK(exact_d, "every double reads back as the same double");
+    CHECK(cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(back, "k1")) &&
+              cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(back, "k2")),
+          "NaN and Inf are null");
+    CHECK(cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(back, "yes")), "bool");
+    cJSON_Delete(back);
+    vt_json_free(&j);
+
+    /* Misuse marks the document failed: nothing half-built is printed. */
+    vt_json bad = {0};
+    cJSON *r = vt_json_object(&bad, NULL, NULL);
+    vt_json_u64(&bad, r, NULL, 1); /* an object member needs a key */
+    CHECK(bad.failed && vt_json_print(&bad) == NULL, "a failed document is not printed");
+    vt_json_free(&bad);
+}
+
+static void test_json_files(void)
+{
+    char path[4200], msg[4400];
+    snprintf(path, sizeof path, "%s/doc.json", work);
+    vt_json j = {0};
+    cJSON *root = vt_json_object(&j, NULL, NULL);
+    cJSON *sec = vt_json_object(&j, root, "seconds");
+    vt_json_f64(&j, sec, "total", 1.25);
+    CHECK(vt_json_write_file(&j, path, msg, sizeof msg) == 0, "%s", msg);
+    vt_json_free(&j);
+    cJSON *back = vt_json_read_file(path, msg, sizeof msg);
+    CHECK(back && vt_json_number(cJSON_GetObjectItemCaseSensitive(back, "seconds"), "total") ==
+                      1.25,
+          "read back: %s", back ? "" : msg);
+    CHECK(isnan(vt_json_number(back, "absent")) && isnan(vt_json_number(back, "seconds")),
+          "absent or not a number: NaN");
+    cJSON_Delete(back);
+
+    static const char *const bad[] = {"{\"a\": 1} trailing", "{\"a\": }", "", "{\"a\": NaN}"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        FILE *f = fopen(path, "wb");
+        fputs(bad[i], f);
+        fclose(f);
+        back = vt_json_read_file(path, msg, sizeof msg);
+        CHECK(!back && strstr(msg, path) && strstr(msg, "not JSON"), "'%s' refused: %s", bad[i],
+              msg);
+        cJSON_Delete(back);
+    }
+    snprintf(path, sizeof path, "%s/none.json", work);
+    back = vt_json_read_file(path, msg, sizeof msg);
+    CHECK(!back && strstr(msg, path) && strstr(msg, "cannot open"), "missing file: %s", msg);
+    back = vt_json_read_file(work, msg, sizeof msg);
+    CHECK(!back && strstr(msg, "not a regular file"), "a directory: %s", msg);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 2) {
+        fprintf(stderr, "usage: test_tools WORK_DIR\n");
+        return 2;
+    }
+    work = argv[1];
+    mkdir(work, 0755);
+    test_integers();
+    test_reals();
+    test_json_strings();
+    test_json_numbers();
+    test_json_files();
+    return test_report("test_tools");
+}

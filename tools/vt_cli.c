@@ -1,0 +1,203 @@
+/*
+ * vt_cli.c - strict decimal numbers for every vdsh program (vt_cli.h).
+ */
+#include "vt_cli.h"
+
+#include <errno.h>
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int is_digit(char c)
+{
+    return c >= '0' && c <= '9';
+}
+
+/* Digits of s[0..n) as a u64; 0 on overflow or no digit. */
+static int digits_u64(const char *s, size_t n, uint64_t *out)
+{
+    uint64_t v = 0;
+    if (n == 0)
+        return 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!is_digit(s[i]))
+            return 0;
+        unsigned d = (unsigned)(s[i] - '0');
+        if (v > (UINT64_MAX - d) / 10)
+            return 0;
+        v = v * 10 + d;
+    }
+    *out = v;
+    return 1;
+}
+
+int vt_parse_u64(const char *s, uint64_t lo, uint64_t hi, uint64_t *out)
+{
+    uint64_t v;
+    if (!s || !digits_u64(s, strlen(s), &v) || v < lo || v > hi)
+        return 0;
+    *out = v;
+    return 1;
+}
+
+int vt_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
+{
+    uint64_t v;
+    if (!vt_parse_u64(s, lo, hi, &v))
+        return 0;
+    *out = (uint32_t)v;
+    return 1;
+}
+
+int vt_parse_int(const char *s, int lo, int hi, int *out)
+{
+    if (!s)
+        return 0;
+    int neg = s[0] == '-';
+    uint64_t m;
+    if (!digits_u64(s + neg, strlen(s + neg), &m))
+        return 0;
+    /* |INT_MIN| fits in u64: compare magnitudes before converting. */
+    long long v;
+    if (neg) {
+        if (m > (uint64_t)INT64_MAX)
+            return 0;
+        v = -(long long)m;
+    } else {
+        if (m > (uint64_t)INT64_MAX)
+            return 0;
+        v = (long long)m;
+    }
+    if (v < lo || v > hi)
+        return 0;
+    *out = (int)v;
+    return 1;
+}
+
+/* Is s[0..n) a decimal real: [+-] (d+ [. d*] | . d+) [(e|E) [+-] d+]? */
+static int decimal_syntax(const char *s, size_t n)
+{
+    size_t i = 0, int_digits = 0, frac_digits = 0;
+    if (i < n && (s[i] == '+' || s[i] == '-'))
+        i++;
+    while (i < n && is_digit(s[i]))
+        i++, int_digits++;
+    if (i < n && s[i] == '.') {
+        i++;
+        while (i < n && is_digit(s[i]))
+            i++, frac_digits++;
+    }
+    if (int_digits + frac_digits == 0)
+        return 0;
+    if (i < n && (s[i] == 'e' || s[i] == 'E')) {
+        i++;
+        if (i < n && (s[i] == '+' || s[i] == '-'))
+            i++;
+        size_t exp_digits = 0;
+        while (i < n && is_digit(s[i]))
+            i++, exp_digits++;
+        if (exp_digits == 0)
+            return 0;
+    }
+    return i == n;
+}
+
+/* A finite float that is normal (or zero): what strtof gives without
+ * ERANGE, checked again for the subnormals some libcs return quietly. */
+static int fits_float(float v)
+{
+    float a = fabsf(v);
+    return isfinite(v) && (a == 0.0f || a >= FLT_MIN);
+}
+
+/* s[0..n), which must be followed by ',' or the end: the syntax of the
+ * n characters first, then strtof, which stops exactly at n (no ',' can
+ * continue a decimal number). */
+static int float_n(const char *s, size_t n, float *out)
+{
+    if (!decimal_syntax(s, n))
+        return 0;
+    char *end;
+    errno = 0;
+    float v = strtof(s, &end);
+    if (errno || end != s + n || !fits_float(v))
+        return 0;
+    *out = v;
+    return 1;
+}
+
+int vt_parse_float(const char *s, float *out)
+{
+    return s && float_n(s, strlen(s), out);
+}
+
+int vt_parse_floats(const char *s, float *out, int min, int max)
+{
+    if (!s)
+        return 0;
+    int n = 0;
+    const char *p = s;
+    for (;;) {
+        const char *comma = strchr(p, ',');
+        size_t len = comma ? (size_t)(comma - p) : strlen(p);
+        float v;
+        if (n == max || !float_n(p, len, &v))
+            return 0;
+        out[n++] = v;
+        if (!comma)
+            break;
+        p = comma + 1;
+    }
+    return n >= min ? n : 0;
+}
+
+int vt_parse_u64_list(const char *s, uint64_t lo, uint64_t hi, uint64_t *out, int min,
+                      int max)
+{
+    if (!s)
+        return 0;
+    int n = 0;
+    const char *p = s;
+    for (;;) {
+        const char *comma = strchr(p, ',');
+        size_t len = comma ? (size_t)(comma - p) : strlen(p);
+        uint64_t v;
+        if (n == max || !digits_u64(p, len, &v) || v < lo || v > hi)
+            return 0;
+        out[n++] = v;
+        if (!comma)
+            break;
+        p = comma + 1;
+    }
+    return n >= min ? n : 0;
+}
+
+int vt_parse_size(const char *s, int lo, int hi, int *w, int *h)
+{
+    if (!s)
+        return 0;
+    const char *x = strpbrk(s, "xX");
+    uint64_t a, b;
+    if (!x || !digits_u64(s, (size_t)(x - s), &a) || !digits_u64(x + 1, strlen(x + 1), &b))
+        return 0;
+    if (lo < 0 || a < (uint64_t)lo || a > (uint64_t)hi || b < (uint64_t)lo ||
+        b > (uint64_t)hi)
+        return 0;
+    *w = (int)a;
+    *h = (int)b;
+    return 1;
+}
+
+int vt_usage_error(const char *prog, const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, "%s: ", prog);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\nTry '%s --help'.\n", prog);
+    return VT_EXIT_USAGE;
+}
