@@ -306,8 +306,14 @@ static int write_report(const char *path, const options *o, const vdsh_file *f,
     vt_json_u64(&j, root, "undefined_normals", b->undefined_normals);
     vt_json_u64(&j, root, "moved_origins", b->moved_origins);
     vt_json_u64(&j, root, "flipped_normals", o->flipped);
+    cJSON *org = vt_json_object(&j, root, "origins");
+    vt_json_u64(&j, org, "probe_rays", b->origins.probe_rays);
+    vt_json_u64(&j, org, "repaired", b->origins.flagged);
+    vt_json_u64(&j, org, "moved", b->origins.moved);
+    vt_json_u64(&j, org, "coincident_faces", b->origins.ties);
     report_seconds(&j, root, t);
     cJSON *sec = cJSON_GetObjectItemCaseSensitive(root, "seconds");
+    vt_json_f64(&j, sec, "origins", b->origins.seconds);
     vt_json_f64(&j, sec, "write", write_seconds);
     vt_json_f64(&j, sec, "total", t->total + write_seconds);
     vt_json_f64(&j, root, "mrays_per_second_trace",

@@ -45,7 +45,7 @@ expect_exit 0 "bake f32 orders 2,3 full" "$bake" "${quick[@]}" --orders 3,2 --en
   --method full --seed 9 -o "$tmp/d.vdsh" --report "$tmp/d.json"
 "$info" --json "$tmp/d.vdsh" >"$tmp/d.info.json"
 json() { # json FILE PYTHON_EXPRESSION_OF_d: true when it holds
-  python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); sys.exit(0 if eval(sys.argv[2]) else 1)' "$@"
+  /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); sys.exit(0 if eval(sys.argv[2]) else 1)' "$@"
 }
 check "f32 recorded" json "$tmp/d.info.json" "{s['encoding'] for s in d['streams']} == {'f32'}"
 check "method full recorded" json "$tmp/d.info.json" "{s['method'] for s in d['streams']} == {'full'}"
@@ -53,6 +53,8 @@ check "orders 2, 3 and no order 5 stream" json "$tmp/d.info.json" "sorted(s['ord
 check "seed recorded" json "$tmp/d.info.json" "d['bake']['seed'] == 9"
 check "no cubemaps without order 4+" test ! -e "$tmp/d.sh09-12.exr"
 check "report written" json "$tmp/d.json" "d['rays_traced'] > 0 and d['orders'] == [2, 3] and d['seed'] == 9"
+check "report: the origins' repair is its own phase" json "$tmp/d.json" \
+  "d['origins']['probe_rays'] >= 32 * d['receivers'] and d['seconds']['origins'] >= 0 and d['robust'] is True"
 expect_exit 0 "bake with timings" "$bake" "${quick[@]}" --record-timings -o "$tmp/e.vdsh"
 "$info" --json "$tmp/e.vdsh" >"$tmp/e.info.json"
 check "timings stored when asked" json "$tmp/e.info.json" "d['timings']['total'] > 0"

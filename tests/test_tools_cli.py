@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """What every vdsh program shares, end to end (tools/, formats/vdsh_output.h):
 
   json      vdsh-bake --report, vdsh-eval --json, vdsh-info --json (and
