@@ -13,6 +13,7 @@
  *          with GL_ONE/GL_ONE blending where depth is equal.
  * The debug outputs (shadow terms, positions) draw the first group only.
  */
+#include "vdsh_camera.h"
 #include "vr_internal.h"
 
 #include <math.h>
@@ -511,15 +512,22 @@ static void camera_matrix(const vr_renderer *r, const vr_scene *s, const vr_came
     }
     float far = 1.05f * sqrtf(far2) + 1e-6f;
     float aspect = (float)r->width / (float)r->height;
+    /* The view and the perspective are formats/vdsh_camera.h's: the same
+     * camera a ray-traced frame of this view uses (vdsh-frames). */
+    vdsh_camera vc;
+    memcpy(vc.eye, c.eye, sizeof vc.eye);
+    memcpy(vc.target, c.target, sizeof vc.target);
+    memcpy(vc.up, c.up, sizeof vc.up);
+    vc.fov_y = c.fov_y;
     float view[16], proj[16];
-    vr_mat4_look_at(view, c.eye, c.target, c.up);
+    vdsh_camera_view(&vc, view);
     if (c.ortho_height > 0.0f) {
         float zn = c.znear != 0.0f ? c.znear : -far, zf = c.zfar != 0.0f ? c.zfar : far;
         vr_mat4_ortho(proj, 0.5f * c.ortho_height * aspect, 0.5f * c.ortho_height, zn, zf);
     } else {
         float zf = c.zfar > 0.0f ? c.zfar : far;
         float zn = c.znear > 0.0f ? c.znear : zf / 4000.0f;
-        vr_mat4_perspective(proj, c.fov_y * 3.14159265358979f / 180.0f, aspect, zn, zf);
+        vdsh_camera_projection(&vc, aspect, zn, zf, proj);
     }
     vr_mat4_mul(vp, proj, view);
 }

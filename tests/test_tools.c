@@ -1,12 +1,17 @@
 /*
  * test_tools.c - tools/: the number rules every program's options follow
- * (vt_cli.h) and the JSON every program writes and reads (vt_json.h).
+ * (vt_cli.h), the JSON every program writes and reads (vt_json.h), 16-bit
+ * PNG frames (vt_image.h), view sets (vt_views.h) and the camera they use
+ * (formats/vdsh_camera.h).
  *
  *   test_tools WORK_DIR
  */
 #include "test_util.h"
 #include "vt_cli.h"
 #include "vt_json.h"
+#include "vt_image.h"
+#include "vt_views.h"
+#include "vdsh_camera.h"
 
 #include <float.h>
 #include <math.h>
@@ -238,6 +243,93 @@ static void test_json_files(void)
     CHECK(!back && strstr(msg, "not a regular file"), "a directory: %s", msg);
 }
 
+/* The camera's pixel-centre ray and its GL projection agree: a point on
+ * the ray through pixel (x, y) projects onto that pixel's centre. */
+static void test_camera(void)
+{
+    uint64_t seed = 7;
+    for (int trial = 0; trial < 200; trial++) {
+        vdsh_camera c;
+        memset(&c, 0, sizeof c);
+        for (int i = 0; i < 3; i++) {
+            c.eye[i] = (float)(test_rand(&seed) * 20 - 10);
+            c.target[i] = (float)(test_rand(&seed) * 20 - 10);
+        }
+        c.fov_y = (float)(20 + 100 * test_rand(&seed));
+        int w = 64 + (int)(test_rand(&seed) * 900), h = 48 + (int)(test_rand(&seed) * 700);
+        int x = (int)(test_rand(&seed) * w), y = (int)(test_rand(&seed) * h);
+        float o[3], d[3], view[16], proj[16];
+        vdsh_camera_ray(&c, w, h, x, y, o, d);
+        vdsh_camera_view(&c, view);
+        vdsh_camera_projection(&c, (float)w / (float)h, 0.01f, 100.0f, proj);
+        float t = 3.0f, p[4] = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2], 1.0f}, e[4], q[4];
+        for (int r = 0; r < 4; r++) {
+            e[r] = 0.0f;
+            for (int k = 0; k < 4; k++)
+                e[r] += view[k * 4 + r] * p[k];
+        }
+        for (int r = 0; r < 4; r++) {
+            q[r] = 0.0f;
+            for (int k = 0; k < 4; k++)
+                q[r] += proj[k * 4 + r] * e[k];
+        }
+        float px = (q[0] / q[3] * 0.5f + 0.5f) * (float)w, py = (0.5f - q[1] / q[3] * 0.5f) * (float)h;
+        CHECK(fabsf(px - (x + 0.5f)) < 2e-3f && fabsf(py - (y + 0.5f)) < 2e-3f,
+              "camera %d: pixel (%d, %d) of %dx%d projects to (%g, %g)", trial, x, y, w, h, px, py);
+    }
+}
+
+static void test_frames(void)
+{
+    char path[4200], msg[4400];
+    snprintf(path, sizeof path, "%s/frame.png", work);
+    enum { W = 37, H = 23 };
+    float v[W * H], *back = NULL;
+    for (int i = 0; i < W * H; i++)
+        v[i] = (float)i / (W * H - 1);
+    v[5] = -1.0f, v[6] = 2.0f, v[7] = NAN;
+    CHECK(vt_png16_write(path, W, H, v, msg, sizeof msg) == 0, "%s", msg);
+    int w = 0, h = 0;
+    CHECK(vt_png16_read(path, &w, &h, &back, msg, sizeof msg) == 0 && w == W && h == H, "%s",
+          msg);
+    if (back) {
+        float worst = 0.0f;
+        v[5] = 0.0f, v[6] = 1.0f, v[7] = 0.0f; /* clamped; NaN reads 0 */
+        for (int i = 0; i < W * H; i++)
+            worst = fmaxf(worst, fabsf(back[i] - v[i]));
+        CHECK(worst <= 0.5f / 65535.0f + 1e-7f, "16-bit round trip: off by %g", worst);
+        free(back);
+    }
+    snprintf(path, sizeof path, "%s/views.json", work);
+    vt_view one = {.name = "a-1", .camera = {{1, 2, 3}, {0, 1, 0}, {0, 1, 0}, 50},
+                   .set_count = 2, .light_count = {1, 3},
+                   .lights = {{{1, 1, 1}}, {{2, 2, 2}, {3, 3, 3}, {4, 4.5f, 4}}}};
+    vt_views vs = {.width = 320, .height = 200, .count = 1, .views = &one}, in = {0};
+    CHECK(vt_views_write(path, &vs, msg, sizeof msg) == 0, "%s", msg);
+    CHECK(vt_views_read(path, &in, msg, sizeof msg) == 0 && in.count == 1 && in.width == 320 &&
+              !strcmp(in.views[0].name, "a-1") && in.views[0].light_count[1] == 3 &&
+              in.views[0].lights[1][2][1] == 4.5f && in.views[0].camera.fov_y == 50.0f,
+          "views round trip: %s", msg);
+    vt_views_free(&in);
+    static const char *const bad[] = {
+        "{\"width\": 10, \"height\": 10, \"views\": []}",
+        "{\"width\": 10, \"height\": 10, \"views\": [{\"name\": \"a b\", \"eye\": [0,0,0], "
+        "\"target\": [1,0,0], \"light_sets\": [[[0,1,0]]]}]}",
+        "{\"width\": 10, \"height\": 10, \"views\": [{\"name\": \"a\", \"eye\": [0,0,0], "
+        "\"target\": [0,0,0], \"light_sets\": [[[0,1,0]]]}]}",
+        "{\"width\": 10, \"height\": 10, \"views\": [{\"name\": \"a\", \"eye\": [0,0,0], "
+        "\"target\": [1,0,0], \"light_sets\": [[]]}]}",
+        "{\"width\": 0.5, \"height\": 10, \"views\": [{\"name\": \"a\", \"eye\": [0,0,0], "
+        "\"target\": [1,0,0], \"light_sets\": [[[0,1,0]]]}]}"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        FILE *f = fopen(path, "wb");
+        fputs(bad[i], f);
+        fclose(f);
+        CHECK(vt_views_read(path, &in, msg, sizeof msg) == -1 && strstr(msg, path),
+              "bad view set %zu accepted", i);
+    }
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -251,5 +343,7 @@ int main(int argc, char **argv)
     test_json_strings();
     test_json_numbers();
     test_json_files();
+    test_camera();
+    test_frames();
     return test_report("test_tools");
 }
