@@ -66,9 +66,12 @@ static void usage(FILE *f)
 "up as recorded, then beside FILE), or from the MESHes given, one per\n"
 "recorded source and in the same order; each must have the SHA-256 the\n"
 "bake recorded. Receivers are vertices and random points inside triangles\n"
-"(coefficients interpolated as the GPU does); each gets its own held-out\n"
-"upper-hemisphere directions (never the bake's) and one point light per\n"
-"direction at d_L = u * 2 * d_T, u uniform in (0.05, 1].\n"
+"(coefficients interpolated as the GPU does). The primary shadow metric:\n"
+"point lights placed uniformly in the scene's free space (formats/\n"
+"vdsh_light.h), each scored at every receiver it lights, as a viewer sees\n"
+"them. Secondary (earlier figures): each receiver's own held-out upper-\n"
+"hemisphere directions (never the bake's), one light per direction at\n"
+"d_L = u * 2 * d_T, u uniform in (0.05, 1]; also the distance error.\n"
 "\n"
 "Sampling:\n"
 "      --points N          vertices evaluated: a deterministic sample of N\n"
@@ -80,7 +83,13 @@ static void usage(FILE *f)
 "      --seed N            the evaluator's seed (default %u; 0 is the\n"
 "                          default); any seed, even the bake's, gives other\n"
 "                          directions than the bake's\n"
+"      --lights N          scene lights (default 32)\n"
 "      --orders LIST       only these orders, e.g. 3,5 (default: every stream)\n"
+"      --offsets LIST      the trade between recall and false shadows as a\n"
+"                          curve: each stream is also scored with each\n"
+"                          offset added to its ln D (distance streams: D\n"
+"                          times e^offset), e.g. -0.2,0.2,0.4 (at most 16\n"
+"                          streams in all: pick orders with --orders)\n"
 "      --oracle            score the ray-cast truth instead of the streams:\n"
 "                          every error must come out exactly 0\n"
 "      --interp M          how interior points get a stream's value from the\n"
@@ -103,6 +112,9 @@ static void usage(FILE *f)
 "  -V, --version           version\n"
 "\n"
 "Errors (per stream, for vertices and interior points separately):\n"
+"  scene     smooth shadow MAE, false-shadow rate P(s_hat < .5 | d_T >= d_L),\n"
+"            recall P(s_hat < .5 | s_ideal < .5) (the shadows a viewer sees\n"
+"            drawn); binary: P(D < d_L | d_T >= d_L), P(D < d_L | d_T < d_L)\n"
 "  distance  |D - d_T| / max(d_T, 0.01 diag): RMS, p50, p90, p99\n"
 "  shadow    smooth ramp(d / d_L): MAE |s_hat - s_ideal|, false-shadow rate\n"
 "            P(s_hat < .5 | d_T >= d_L), light-leak rate P(s_hat > .5 |\n"
@@ -297,6 +309,22 @@ static void json_metrics(vt_json *j, cJSON *o, const vb_eval_metrics *m, int kin
         json_receiver(j, worst, &m->worst[i], kind);
 }
 
+static void json_scene(vt_json *j, cJSON *o, const vb_eval_scene_metrics *m)
+{
+    vt_json_u64(j, o, "pairs", m->pairs);
+    vt_json_u64(j, o, "visible", m->visible);
+    vt_json_u64(j, o, "occluded", m->occluded);
+    const struct { const char *k; double v; } f[] = {
+        {"shadow_mae", m->shadow_mae}, {"shadow_mae_se", m->shadow_mae_se},
+        {"false_shadow", m->false_shadow}, {"false_shadow_se", m->false_shadow_se},
+        {"recall", m->recall}, {"recall_se", m->recall_se},
+        {"light_leak", m->light_leak}, {"light_leak_se", m->light_leak_se},
+        {"binary_mae", m->binary_mae}, {"binary_false_shadow", m->binary_false_shadow},
+        {"binary_recall", m->binary_recall}};
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; i++)
+        vt_json_f64(j, o, f[i].k, f[i].v);
+}
+
 static void json_truth(vt_json *j, cJSON *o, const vb_eval_truth *t, int kind)
 {
     vt_json_u64(j, o, "receivers", t->receivers);
@@ -327,6 +355,7 @@ typedef struct context {
     const vb_eval_desc *d;
     int fast_truth;
     int mismatched;        /* sources used despite a different SHA-256 */
+    const float *offset;   /* per scored stream: the log offset added (--offsets) */
 } context;
 
 static const char *kind_name(int k) { return k == VB_EVAL_VERTICES ? "vertices" : "interior"; }
@@ -408,6 +437,11 @@ static int write_json(const char *out, const context *c, char *msg, size_t cap)
     vt_json_f64(&j, ev, "error_floor", 0.01 * r->diagonal);
     vt_json_u64(&j, ev, "threads", r->threads);
     vt_json_f64(&j, ev, "seconds", r->seconds);
+    vt_json_u64(&j, ev, "scene_lights", r->light_count);
+    vt_json_u64(&j, ev, "scene_light_candidates", r->light_candidates);
+    cJSON *lp = vt_json_array(&j, ev, "scene_light_positions");
+    for (uint32_t l = 0; l < r->light_count; l++)
+        json_vec(&j, lp, NULL, r->lights[l]);
 
     cJSON *truth = vt_json_object(&j, root, "truth");
     for (int k = 0; k < VB_EVAL_KINDS; k++)
@@ -423,6 +457,10 @@ static int write_json(const char *out, const context *c, char *msg, size_t cap)
         vt_json_string(&j, o, "quantity", vdsh_quantity_name(st->quantity));
         vt_json_string(&j, o, "window", vdsh_window_name(st->window));
         vt_json_u64(&j, o, "bytes_per_vertex", vdsh_stream_bytes_per_vertex(st));
+        vt_json_f32(&j, o, "log_offset", c->offset[s]);
+        cJSON *sl = vt_json_object(&j, o, "scene_lights");
+        for (int k = 0; k < VB_EVAL_KINDS; k++)
+            json_scene(&j, vt_json_object(&j, sl, kind_name(k)), &r->scene[k][s]);
         for (int k = 0; k < VB_EVAL_KINDS; k++)
             json_metrics(&j, vt_json_object(&j, o, kind_name(k)), &r->metrics[k][s], k);
     }
@@ -526,10 +564,40 @@ static void print_table(FILE *o, const context *c)
     }
     fprintf(o, "\n  order = n bands, n^2 coefficients; B/v = bytes of coefficients per vertex; "
                "+- = 95%% interval\n");
+    fprintf(o, "\n  SCENE LIGHTS (the primary metric): %u point lights placed uniformly in the "
+               "scene's free space, each\n  scored at every receiver it lights; "
+               "false = P(s_hat < .5 | d_T >= d_L), recall = P(s_hat < .5 | s_ideal < .5)\n\n",
+            r->light_count);
+    fprintf(o, "  %-8s %5s %6s %3s %3s %-9s | %7s | %-15s %-13s %-12s | %-6s %6s %6s\n", "",
+            "order", "offset", "B/v", "enc", "fit", "pairs", "smooth: MAE", "false", "recall",
+            "binary", "false", "recall");
+    for (int k = 0; k < VB_EVAL_KINDS; k++) {
+        if (r->truth[k].receivers == 0)
+            continue;
+        for (uint32_t s = 0; s < r->stream_count; s++) {
+            const vdsh_stream *st = &f->streams[s];
+            const vb_eval_scene_metrics *m = &r->scene[k][s];
+            char mae[32], fa[32], rc[32], fit[32];
+            snprintf(fit, sizeof fit, "%s%s", vdsh_method_name(st->method),
+                     st->quantity == VDSH_QUANTITY_LOG_DISTANCE ? "+log"
+                     : st->quantity == VDSH_QUANTITY_DISTANCE2  ? "+d2" : "");
+            snprintf(mae, sizeof mae, "%.4f+-%.4f", m->shadow_mae, 1.96 * m->shadow_mae_se);
+            snprintf(fa, sizeof fa, "%.2f+-%.2f%%", 100.0 * m->false_shadow,
+                     196.0 * m->false_shadow_se);
+            snprintf(rc, sizeof rc, "%.1f+-%.1f%%", 100.0 * m->recall, 196.0 * m->recall_se);
+            fprintf(o, "  %-8s %5u %+6.2f %3zu %3s %-9s | %7.2gM | %-15s %-13s %-12s | %6.4f "
+                       "%5.2f%% %5.1f%%\n",
+                    kind_name(k), st->order, (double)c->offset[s], vdsh_stream_bytes_per_vertex(st),
+                    vdsh_encoding_name(st->encoding), fit, (double)m->pairs * 1e-6, mae, fa, rc,
+                    m->binary_mae, 100.0 * m->binary_false_shadow, 100.0 * m->binary_recall);
+        }
+    }
+    fprintf(o, "\n  RELATIVE LIGHTS (secondary, as in earlier figures): one light per held-out "
+               "direction at d_L = 2u d_T,\n  u uniform in (0.05, 1]\n");
     fprintf(o, "  distance = |D - d_T| / max(d_T, 0.01 diag); false = P(s_hat < .5 | d_T >= d_L), "
                "leak = P(s_hat > .5 | s_ideal < .5)\n\n");
-    fprintf(o, "  %-8s %5s %3s %3s %-9s | %-14s %6s %6s %6s | %-15s %-13s %-13s | %-6s %6s %6s\n",
-            "", "order", "B/v", "enc", "fit", "distance RMS", "p50", "p90", "p99",
+    fprintf(o, "  %-8s %5s %6s %3s %3s %-9s | %-14s %6s %6s %6s | %-15s %-13s %-13s | %-6s %6s %6s\n",
+            "", "order", "offset", "B/v", "enc", "fit", "distance RMS", "p50", "p90", "p99",
             "smooth: MAE", "false", "leak", "binary", "false", "leak");
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         if (r->truth[k].receivers == 0)
@@ -547,9 +615,9 @@ static void print_table(FILE *o, const context *c)
                      196.0 * m->false_shadow_se);
             snprintf(le, sizeof le, "%.2f+-%.2f%%", 100.0 * m->light_leak,
                      196.0 * m->light_leak_se);
-            fprintf(o, "  %-8s %5u %3zu %3s %-9s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s %-13s "
-                       "| %6.4f %5.2f%% %5.2f%%\n",
-                    kind_name(k), st->order, vdsh_stream_bytes_per_vertex(st),
+            fprintf(o, "  %-8s %5u %+6.2f %3zu %3s %-9s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s "
+                       "%-13s | %6.4f %5.2f%% %5.2f%%\n",
+                    kind_name(k), st->order, (double)c->offset[s], vdsh_stream_bytes_per_vertex(st),
                     vdsh_encoding_name(st->encoding), fit, rms,
                     m->distance_p50, m->distance_p90, m->distance_p99, mae, fa, le,
                     m->binary_mae, 100.0 * m->binary_false_shadow,
@@ -633,10 +701,12 @@ int main(int argc, char **argv)
     d.interior = 65536;
     const char *json = NULL, *per_vertex = NULL, *bake_report = NULL;
     int want_order[VDSH_MAX_ORDER + 1] = {0}, filter = 0;
-    int quiet = 0, fast_truth = 0, allow_mismatch = 0;
+    int quiet = 0, fast_truth = 0, allow_mismatch = 0, noffsets = 0;
+    float offsets[VDSH_MAX_STREAMS];
 
     enum { O_POINTS = 256, O_INTERIOR, O_DIRECTIONS, O_SEED, O_ORDERS, O_ORACLE, O_INTERP,
-           O_FAST, O_ALLOW, O_JSON, O_PV, O_BAKE_REPORT, O_WORST, O_THREADS };
+           O_FAST, O_ALLOW, O_JSON, O_PV, O_BAKE_REPORT, O_WORST, O_THREADS, O_LIGHTS,
+           O_OFFSETS };
     static const struct option longopts[] = {
         {"points", required_argument, 0, O_POINTS},
         {"interior", required_argument, 0, O_INTERIOR},
@@ -652,6 +722,8 @@ int main(int argc, char **argv)
         {"bake-report", required_argument, 0, O_BAKE_REPORT},
         {"worst", required_argument, 0, O_WORST},
         {"threads", required_argument, 0, O_THREADS},
+        {"lights", required_argument, 0, O_LIGHTS},
+        {"offsets", required_argument, 0, O_OFFSETS},
         {"quiet", no_argument, 0, 'q'},
         {"help", no_argument, 0, 'h'},
         {"version", no_argument, 0, 'V'},
@@ -707,6 +779,20 @@ int main(int argc, char **argv)
                 return bad_usage("--worst takes a whole number 1..64, not '%s'", optarg);
             d.worst = (uint32_t)u;
             break;
+        case O_LIGHTS:
+            if (!vt_parse_u64(optarg, 1, 4096, &u))
+                return bad_usage("--lights takes a whole number 1..4096, not '%s'", optarg);
+            d.lights = (uint32_t)u;
+            break;
+        case O_OFFSETS:
+            noffsets = vt_parse_floats(optarg, offsets, 1, VDSH_MAX_STREAMS - 1);
+            for (int i = 0; i < noffsets; i++)
+                if (fabsf(offsets[i]) > 5.0f)
+                    noffsets = 0;
+            if (!noffsets)
+                return bad_usage("--offsets takes 1..15 numbers in -5..5 such as -0.4,-0.2,0.2, "
+                                 "not '%s'", optarg);
+            break;
         case O_THREADS:
             if (!vt_parse_u64(optarg, 1, 256, &u))
                 return bad_usage("--threads takes a whole number 1..256, not '%s'", optarg);
@@ -735,6 +821,7 @@ int main(int argc, char **argv)
     vb_eval_result res = {0};
     char **spath = NULL;
     vdsh_stream *kept = NULL;
+    uint32_t owned_from = UINT32_MAX; /* streams of kept whose data we allocated */
     vdsh_error verr;
     vb_error err;
 
@@ -773,6 +860,63 @@ int main(int argc, char **argv)
             }
         }
         view.streams = kept;
+        view.stream_count = n;
+    }
+
+    /* The curve (--offsets): each stream again with every offset added to
+     * its log distance (a distance stream: times e^offset), decoded to f32
+     * in memory. */
+    float soffset[VDSH_MAX_STREAMS] = {0};
+    if (noffsets) {
+        uint32_t n0 = view.stream_count, total = n0 * (uint32_t)(1 + noffsets);
+        if (total > VDSH_MAX_STREAMS) {
+            fprintf(stderr, "vdsh-eval: %u streams with %d offsets each make %u, more than %d: "
+                            "fewer offsets, or pick orders with --orders\n",
+                    n0, noffsets, total, VDSH_MAX_STREAMS);
+            free(kept);
+            vdsh_free(f);
+            return VT_EXIT_USAGE;
+        }
+        vdsh_stream *all = calloc(total, sizeof *all);
+        if (!all) {
+            fprintf(stderr, "vdsh-eval: out of memory\n");
+            goto out;
+        }
+        uint32_t n = 0, V = f->header.vertex_count;
+        for (uint32_t s = 0; s < n0; s++) {
+            soffset[n] = 0.0f;
+            all[n++] = view.streams[s];
+            for (int k = 0; k < noffsets; k++) {
+                vdsh_stream x = view.streams[s];
+                uint32_t nc = x.order * x.order;
+                float *data = malloc((size_t)V * nc * sizeof *data + 1);
+                if (!data) {
+                    fprintf(stderr, "vdsh-eval: out of memory\n");
+                    for (uint32_t i = 0; i < n; i++)
+                        if (i % (uint32_t)(1 + noffsets) != 0)
+                            free((void *)all[i].data);
+                    free(all);
+                    goto out;
+                }
+                for (uint32_t v = 0; v < V; v++) {
+                    float *cv = data + (size_t)v * nc;
+                    vdsh_stream_decode(&view.streams[s], v, cv);
+                    if (x.quantity == VDSH_QUANTITY_LOG_DISTANCE)
+                        cv[0] += offsets[k] / 0.28209479177387814f; /* Y00 */
+                    else
+                        for (uint32_t i = 0; i < nc; i++)
+                            cv[i] *= x.quantity == VDSH_QUANTITY_DISTANCE2
+                                         ? expf(2.0f * offsets[k]) : expf(offsets[k]);
+                }
+                x.encoding = VDSH_ENCODING_F32, x.scale = 1.0f, x.data = data;
+                soffset[n] = offsets[k];
+                all[n++] = x;
+            }
+        }
+        free(kept);
+        kept = all;
+        owned_from = n0;
+        view.streams = all;
         view.stream_count = n;
     }
 
@@ -831,7 +975,7 @@ int main(int argc, char **argv)
     /* 5. Report. */
     context ctx = {.path = path, .f = &view, .source_paths = spath, .file_bytes = -1,
                    .bt = bt, .r = &res, .d = &d, .fast_truth = fast_truth,
-                   .mismatched = warned.count};
+                   .mismatched = warned.count, .offset = soffset};
     struct stat st;
     if (stat(path, &st) == 0)
         ctx.file_bytes = (long long)st.st_size;
@@ -853,6 +997,10 @@ out:
         for (uint32_t i = 0; i < f->source_count; i++)
             free(spath[i]);
     free(spath);
+    if (kept && owned_from != UINT32_MAX)
+        for (uint32_t s = 0; s < view.stream_count; s++)
+            if (s % (uint32_t)(1 + noffsets) != 0) /* an offset copy: its data is ours */
+                free((void *)kept[s].data);
     free(kept);
     vb_eval_result_free(&res);
     vb_scene_destroy(scene);

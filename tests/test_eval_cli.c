@@ -205,6 +205,56 @@ int main(int argc, char **argv)
         CHECK(rc == 0 && streams == 3 && zero, "oracle: every shadow MAE exactly 0");
         cJSON_Delete(j);
     }
+    /* The curve: every stream again with each offset added to ln D (the
+     * paper's distance streams: times e^offset). Shorter distances
+     * (offset -0.5) draw more shadows: recall and false shadows rise; the
+     * zero offset reproduces the stream itself. */
+    char *room = path_in("room.vdsh");
+    rc = run((char *[]){bake, "builtin:room", "--max-edge", "1", "--rays", "256", "--method",
+                        "paper", "--cube-size", "0", "-q", "-o", room, NULL});
+    CHECK(rc == 0, "bake the room: exit %d", rc);
+    rc = run((char *[]){ev, room, "--orders", "5", "--offsets", "-0.5,0,0.5", "--lights", "16",
+                        "--interior", "2000", "--points", "2000", "--json", json, NULL});
+    {
+        char msg[512];
+        cJSON *j = rc == 0 ? vt_json_read_file(json, msg, sizeof msg) : NULL;
+        double rec[4], fa[4], mae[4], off[4];
+        int n = 0;
+        const cJSON *st;
+        cJSON_ArrayForEach(st, cJSON_GetObjectItemCaseSensitive(j, "streams")) {
+            if (n < 4) {
+                const cJSON *sl = cJSON_GetObjectItemCaseSensitive(
+                    cJSON_GetObjectItemCaseSensitive(st, "scene_lights"), "interior");
+                rec[n] = vt_json_number(sl, "recall");
+                fa[n] = vt_json_number(sl, "false_shadow");
+                mae[n] = vt_json_number(sl, "shadow_mae");
+                off[n] = vt_json_number(st, "log_offset");
+            }
+            n++;
+        }
+        CHECK(rc == 0 && n == 4 && vt_json_number(cJSON_GetObjectItemCaseSensitive(j, "eval"),
+                                                  "scene_lights") == 16,
+              "--offsets: %d streams (rc %d)", n, rc);
+        if (n == 4) {
+            CHECK(off[0] == 0 && off[1] == -0.5 && off[2] == 0 && off[3] == 0.5, "offsets %g %g %g %g",
+                  off[0], off[1], off[2], off[3]);
+            CHECK(rec[1] >= rec[0] && rec[0] >= rec[3] && fa[1] >= fa[0] && fa[0] >= fa[3] &&
+                      rec[1] > rec[3] && fa[1] > fa[3],
+                  "recall %g %g %g and false shadows %g %g %g must fall with the offset", rec[1],
+                  rec[0], rec[3], fa[1], fa[0], fa[3]);
+            CHECK(fabs(mae[2] - mae[0]) < 1e-6 && rec[2] == rec[0],
+                  "offset 0 (f32 copy) scores as the stream: MAE %.9g %.9g, recall %g %g", mae[2],
+                  mae[0], rec[2], rec[0]);
+        }
+        cJSON_Delete(j);
+    }
+    CHECK(run((char *[]){ev, vdsh, "--offsets", "9", NULL}) == 2 && contains(err_path, "--offsets"),
+          "--offsets 9 refused");
+    CHECK(run((char *[]){ev, vdsh, "--offsets", "0.1,0.2,0.3,0.4,0.5", NULL}) == 2 &&
+              contains(err_path, "streams"),
+          "too many offset streams refused");
+    CHECK(run((char *[]){ev, vdsh, "--lights", "0", NULL}) == 2, "--lights 0 refused");
+
     /* Bake time from the bake's report. */
     rc = run((char *[]){ev, vdsh, "--bake-report", rep, "--interior", "0", "--orders", "5",
                         NULL});
