@@ -7,7 +7,6 @@
 #include <time.h>
 
 #include "fit.h"
-#include "fit_shadow.h"
 #include "origins.h"
 #include "parallel.h"
 #include "sampling.h"
@@ -41,11 +40,9 @@ typedef struct job {
     float max_local;       /* max distance in the traced frame */
     float inv_scale;
     int horizon;           /* paper: skip w.n < 0 */
-    /* Method shadow: the lsq fit of ln d refined on every
-     * shadow_stride-th traced direction (vb_shadow_fit_apply). */
-    uint32_t shadow_stride; /* 0: no refinement */
-    vb_shadow_fit shadow;  /* its tables; e(r) also scores the quantity choice */
-    struct shadow_scratch *scratch; /* one per worker */
+    /* Method shadow: per order, added to the fitted ln d (through c0). */
+    float log_offset[VDSH_MAX_ORDER + 1];
+    double *error_table;   /* e(r), the quantity choice's score (VB_ERROR_TABLE + 1) */
     /* The quantity choice (VB_QUANTITY_AUTO): sampled receivers, and per
      * sample, order and quantity (0 distance, 1 log) its estimated error. */
     uint32_t choose_count;
@@ -56,13 +53,6 @@ typedef struct job {
     _Atomic uint32_t degenerate;
 } job;
 
-/* A worker's room for the shadow fit's directions: their basis values up
- * to order 9 (vb_shadow_fit_apply), 32-byte aligned rows. */
-typedef struct shadow_scratch {
-    float y[81 * VB_SHADOW_MAX_DIRS];
-    float x[VB_SHADOW_MAX_DIRS], yy[VB_SHADOW_MAX_DIRS], z[VB_SHADOW_MAX_DIRS];
-    float lnd[VB_SHADOW_MAX_DIRS];
-} shadow_scratch;
 
 /* Where one receiver's results go: per quantity (0 distance, 1 log) and
  * order, its coefficients or NULL; and, when `n` is not NULL, the traced
@@ -71,7 +61,6 @@ typedef struct vertex_sink {
     float *coeffs[2][VDSH_MAX_ORDER + 1];
     float *x, *y, *z, *t;
     uint32_t *n;
-    shadow_scratch *scratch; /* method shadow: the fit's directions */
 } vertex_sink;
 
 /* ln(x) for finite x > 0, to about 1e-7 relative, in plain float
@@ -123,11 +112,6 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
     const float nx = n[0], ny = n[1], nz = n[2];
     float acc[2][VDSH_MAX_COEFFS][VB_PACKET];
     memset(acc, 0, sizeof acc);
-    /* Method shadow: every shadow_stride-th direction in packet order (a
-     * 4 x 4 block's 2 x 2 corners for a stride of 4: still stratified),
-     * for the refinement at the end. */
-    shadow_scratch *sub = out->scratch;
-    uint32_t sub_n = 0;
     uint32_t near_zero = 0, upper = 0;
 
     /* Packets are traced GROUP at a time, then their lanes are processed
@@ -137,7 +121,6 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
     for (uint32_t pk = 0; pk < J->grid->packet_count;) {
         struct RTCRayHit16 rh[GROUP] __attribute__((aligned(64)));
         int valid[GROUP][VB_PACKET] __attribute__((aligned(64)));
-        uint32_t pkid[GROUP]; /* which packet each traced one is */
         int np = 0;
         for (; pk < J->grid->packet_count && np < GROUP; pk++) {
             if (J->horizon && vb_dirgrid_packet_below(J->grid, pk, n))
@@ -172,7 +155,7 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
             rtcIntersect16(ok, S->scene, &ctx, r);
             for (int k = 0; k < VB_PACKET; k++)
                 *traced += ok[k] != 0;
-            pkid[np++] = pk;
+            np++;
         }
         if (d->trace_only)
             continue;
@@ -220,15 +203,6 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
             if (want[1])
                 vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, logd[p], &acc[1][0][0],
                                     VB_PACKET);
-            if (sub && want[1])
-                for (int k = 0; k < VB_PACKET; k++)
-                    if (up_lane[p][k] && (pkid[p] * VB_PACKET + k) % J->shadow_stride == 0 &&
-                        sub_n < VB_SHADOW_MAX_DIRS) {
-                        sub->x[sub_n] = dx[k];
-                        sub->yy[sub_n] = dy[k];
-                        sub->z[sub_n] = dz[k];
-                        sub->lnd[sub_n++] = logd[p][k];
-                    }
             if (out->n)
                 for (int k = 0; k < VB_PACKET; k++)
                     if (up_lane[p][k]) {
@@ -267,17 +241,10 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
             if (out->coeffs[q][o])
                 vb_fit_finish(&J->fits[o], &angles, u, out->coeffs[q][o]);
     }
-    if (sub && want[1]) {
-        /* Padded to whole vectors with a harmless direction (ignored). */
-        uint32_t stride = (sub_n + 7) & ~7u;
-        for (uint32_t k = sub_n; k < stride; k++)
-            sub->x[k] = 0.0f, sub->yy[k] = 0.0f, sub->z[k] = 1.0f, sub->lnd[k] = 0.0f;
-        vdsh_sh_eval_soa(2 * J->order - 1, stride, sub->x, sub->yy, sub->z, sub->y, stride);
-        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-            if (out->coeffs[1][o])
-                vb_shadow_fit_apply(&J->shadow, o, J->d->lambda, sub_n, sub->y, stride,
-                                    sub->lnd, out->coeffs[1][o]);
-    }
+    /* Method shadow: the log offset, through c0 (Y00 is a constant). */
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+        if (out->coeffs[1][o] && J->log_offset[o] != 0.0f)
+            out->coeffs[1][o][0] += J->log_offset[o] / 0.28209479177387814f;
     if (upper > 0 && near_zero >= 0.9 * upper)
         (*degenerate)++;
 }
@@ -290,7 +257,7 @@ static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
     for (uint32_t v = begin; v < end; v++) {
         if (J->done && J->done[v])
             continue;
-        vertex_sink out = {.scratch = J->scratch ? J->scratch + worker : NULL};
+        vertex_sink out = {0};
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (J->coeffs[o])
                 out.coeffs[J->quantity[o] == VDSH_QUANTITY_LOG_DISTANCE][o] =
@@ -300,6 +267,47 @@ static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
     atomic_fetch_add(&J->traced, traced);
     atomic_fetch_add(&J->missed, missed);
     atomic_fetch_add(&J->degenerate, degenerate);
+}
+
+/* ---- the quantity choice's score ----------------------------------------- */
+
+#define ERROR_TABLE 1024 /* e(r) tabulated on r in [0, 2] */
+
+/* e(r): the mean over lights at d_L = 2u d, u uniform in (0.05, 1], of
+ * |ramp(r / 2u) - ramp(1 / 2u)| - the expected shadow error of a direction
+ * reconstructed at r times its true distance under vdsh-eval's relative
+ * lights (flat from r = 2 on). By the mean over 512 u at the midpoints. */
+static double *error_table_create(void)
+{
+    double *e = malloc((ERROR_TABLE + 1) * sizeof *e);
+    for (int i = 0; e && i <= ERROR_TABLE; i++) {
+        double r = 2.0 * i / ERROR_TABLE, sum = 0.0;
+        for (int k = 0; k < 512; k++) {
+            double u = 0.05 + 0.95 * (k + 0.5) / 512;
+            sum += fabs((double)vdsh_ramp((float)(r / (2.0 * u))) -
+                        (double)vdsh_ramp((float)(1.0 / (2.0 * u))));
+        }
+        e[i] = sum / 512;
+    }
+    return e;
+}
+
+static double expected_error(const double *e, double r)
+{
+    double x = r * (ERROR_TABLE / 2.0);
+    if (!(x < ERROR_TABLE))
+        return e[ERROR_TABLE];
+    if (x < 0.0)
+        x = 0.0;
+    int i = (int)x;
+    return e[i] + (x - i) * (e[i + 1] - e[i]);
+}
+
+float vb_shadow_log_offset(int order)
+{
+    /* Chosen on the validation scenes by frames (docs/ACCURACY.md). */
+    static const float table[VDSH_MAX_ORDER + 1] = {0.0f, 0.8f, 0.8f, 0.6f, 0.5f, 0.45f};
+    return order >= 1 && order <= VDSH_MAX_ORDER ? table[order] : 0.0f;
 }
 
 /* ---- choosing the quantity (VB_QUANTITY_AUTO) --------------------------- */
@@ -347,7 +355,7 @@ static void score_fits(const job *J, uint32_t count, const vertex_sink *out,
             double sum = 0.0;
             for (uint32_t k = 0; k < count; k++) {
                 double dv = q ? exp(s[k]) : (s[k] > 0.0 ? s[k] : 0.0);
-                sum += vb_shadow_error(&J->shadow, dv / t[k]); /* what vdsh-eval would score */
+                sum += expected_error(J->error_table, dv / t[k]);
             }
             e[o][q] += sum;
         }
@@ -458,7 +466,10 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
     int nc = order * order;
     size_t count = (size_t)b->vertex_count * nc;
     vdsh_stream s = {.order = (uint32_t)order, .encoding = encoding, .method = b->method,
-                     .quantity = b->quantity[order], .method_param = b->lambda, .scale = 1.0f,
+                     .quantity = b->quantity[order],
+                     .method_param = b->method == VDSH_METHOD_SHADOW ? b->log_offset[order]
+                                                                     : b->lambda,
+                     .scale = 1.0f,
                      .quantity_param = b->quantity[order] == VDSH_QUANTITY_LOG_DISTANCE
                                            ? b->log_floor : 0.0f, .window = b->window,
                      .window_param = b->window ? (float)order : 0.0f};
@@ -629,22 +640,19 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     J->max_local = d.max_distance * d.scene->scale;
     J->inv_scale = 1.0f / d.scene->scale;
     J->horizon = d.method == VDSH_METHOD_PAPER;
-    /* The expected shadow error e(r): the shadow fit's loss, and the
-     * quantity choice's score. */
-    if ((d.method == VDSH_METHOD_SHADOW || d.quantity == VB_QUANTITY_AUTO) &&
-        (r = vb_shadow_fit_init(&J->shadow, err)) != VB_OK)
-        goto done;
-    if (d.method == VDSH_METHOD_SHADOW) {
-        /* About 300 directions: as good as all of 1225 in the tests of
-         * fit_shadow.h, and a quarter of the work. */
-        J->shadow_stride = 1;
-        while (grid.count / (2 * J->shadow_stride) >= 300)
-            J->shadow_stride *= 2;
-        if (!d.trace_only &&
-            !(J->scratch = aligned_alloc(32, d.threads * sizeof *J->scratch))) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the shadow fit");
+    /* Method shadow: the per-order log offsets. */
+    for (int o = 1; o <= VDSH_MAX_ORDER && d.method == VDSH_METHOD_SHADOW; o++) {
+        J->log_offset[o] = d.log_offsets ? d.log_offsets[o] : vb_shadow_log_offset(o);
+        if (!isfinite(J->log_offset[o]) || fabsf(J->log_offset[o]) > 5.0f) {
+            r = vb_fail(err, VB_ERR_ARGUMENT, "order %d: log offset %g is not in -5..5", o,
+                        (double)J->log_offset[o]);
             goto done;
         }
+    }
+    /* The quantity choice's score: the expected shadow error e(r). */
+    if (d.quantity == VB_QUANTITY_AUTO && !(J->error_table = error_table_create())) {
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+        goto done;
     }
     uint32_t undefined = 0;
     for (uint32_t v = 0; v < R->vertex_count; v++) {
@@ -718,6 +726,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     o.auto_receivers = auto_receivers;
     memcpy(o.auto_error, auto_error, sizeof auto_error);
     o.lambda = d.method == VDSH_METHOD_LSQ || d.method == VDSH_METHOD_SHADOW ? d.lambda : 0.0f;
+    memcpy(o.log_offset, J->log_offset, sizeof o.log_offset);
     o.log_floor = any_log ? d.log_floor : 0.0f;
     o.window = d.window;
     o.vertex_count = R->vertex_count;
@@ -739,7 +748,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
 
 done:
     if (J) {
-        free(J->scratch);
+        free(J->error_table);
         free(J->choose_error);
         free(J->choose_coeffs);
         free(J->done);

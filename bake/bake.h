@@ -13,6 +13,13 @@
  *   mirror  the upper hemisphere only, the lower filled with its mirror
  *           image before projecting.
  *   lsq     regularised least squares to the upper hemisphere only.
+ *   shadow  lsq of the log distance, plus a per-order log offset (the
+ *           stored distances are e^offset times the fit's): under lights
+ *           placed in a scene's free space, least squares of ln d
+ *           underestimates next to silhouettes and draws false shadows;
+ *           the offset buys most of them back for a few lost shadow
+ *           pixels (docs/ACCURACY.md: the curve, and the point chosen on
+ *           the validation scenes).
  * `rays` is always the density over the whole sphere: the hemisphere
  * methods trace rays / 2 directions, stratified over the hemisphere around
  * each receiver's normal, the same budget `paper` traces.
@@ -73,6 +80,8 @@ typedef struct vb_bake_desc {
     uint32_t quantity;         /* vdsh_quantity: distance (0) or log-distance,
                                 * or VB_QUANTITY_AUTO */
     float lambda;              /* lsq and shadow regularisation; 0: 1e-4 */
+    const float *log_offsets;  /* method shadow: per order (index 1..5), added
+                                * to the fitted ln d; NULL: vb_shadow_log_offset */
     float log_floor;           /* log-distance floor; 0: 1% of max_distance */
     uint32_t window;           /* vdsh_window on each order's bands; 0: none */
     uint32_t order_mask;       /* bit n: produce order n; 0: max_order only */
@@ -94,6 +103,7 @@ typedef struct vb_bake_output {
     double auto_error[VDSH_MAX_ORDER + 1][2]; /* their expected shadow error
                                 * per order, distance [0] and log [1] */
     float lambda;              /* lsq or shadow regularisation used (0 otherwise) */
+    float log_offset[VDSH_MAX_ORDER + 1]; /* method shadow: per order, as used */
     float log_floor;           /* log-distance floor used (0 otherwise) */
     uint32_t window;           /* vdsh_window applied */
     uint32_t vertex_count;
@@ -116,6 +126,11 @@ typedef struct vb_bake_output {
 
 vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
                       vb_error *err);
+
+/* Method shadow's default log offset for an order: how much longer than
+ * the least-squares fit of ln d the stored distances are (a factor
+ * e^offset), trading a few drawn shadows for far fewer false ones. */
+float vb_shadow_log_offset(int order);
 void vb_bake_output_free(vb_bake_output *out);
 
 /* The .vdsh stream of one order (1 .. max_order) of a bake: its first

@@ -41,6 +41,8 @@ typedef struct options {
     uint32_t method;
     uint32_t quantity;
     float lambda;
+    float log_offset;
+    int have_log_offset;
     float log_floor;
     uint32_t window;
     uint32_t encoding;
@@ -87,10 +89,10 @@ static void usage(FILE *f)
 "                          (default 2500 = 50 x 50)\n"
 "      --orders LIST       SH orders to store, order n = n bands = n*n\n"
 "                          coefficients (default 2,3,5; each 1..5)\n"
-"      --method M          shadow (default): the log distance fitted to the\n"
-"                          upper hemisphere for the lowest expected shadow\n"
-"                          error (robust reweighted least squares from lsq's\n"
-"                          fit, on about 300 of the traced directions);\n"
+"      --method M          shadow (default): lsq of the log distance, the\n"
+"                          stored distances then e^offset times the fit's\n"
+"                          (--log-offset; fewer false shadows where a light\n"
+"                          sits just past a silhouette);\n"
 "                          lsq: regularised least squares to the upper\n"
 "                          hemisphere; mirror: the upper hemisphere, mirrored\n"
 "                          below; paper: the paper's fit, directions below the\n"
@@ -104,7 +106,12 @@ static void usage(FILE *f)
 "                          ln(distance), reconstructed as exp of the SH sum\n"
 "                          (not with paper; the only one with shadow)\n"
 "      --log               the same as --quantity log\n"
-"      --lambda X          lsq and shadow regularisation weight (default 1e-4)\n"
+"      --lambda X          lsq regularisation weight (default 1e-4; shadow\n"
+"                          uses lsq's default)\n"
+"      --log-offset X      shadow: added to the fitted ln d at every order\n"
+"                          (default per order 2/3/5: %.2f/%.2f/%.2f, chosen\n"
+"                          on validation scenes); recorded as the stream's\n"
+"                          method parameter\n"
 "      --window W          per-band window on the coefficients: none (default),\n"
 "                          hann or lanczos (width: the order)\n"
 "      --log-floor D       log-distance: distances below D count as D\n"
@@ -129,7 +136,9 @@ static void usage(FILE *f)
 "  -V, --version           version\n"
 "\n"
 "Exit status: 0 success, 1 error, 2 usage error.\n"
-"Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n");
+"Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n",
+            (double)vb_shadow_log_offset(2), (double)vb_shadow_log_offset(3),
+            (double)vb_shadow_log_offset(5));
 }
 
 static int bad_usage(const char *fmt, const char *arg)
@@ -377,7 +386,7 @@ int main(int argc, char **argv)
 
     enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
-           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY };
+           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
@@ -400,6 +409,7 @@ int main(int argc, char **argv)
         {"log", no_argument, 0, O_LOG},
         {"quantity", required_argument, 0, O_QUANTITY},
         {"lambda", required_argument, 0, O_LAMBDA},
+        {"log-offset", required_argument, 0, O_LOG_OFFSET},
         {"log-floor", required_argument, 0, O_LOG_FLOOR},
         {"keep-normals", no_argument, 0, O_KEEP_NORMALS},
         {"window", required_argument, 0, O_WINDOW},
@@ -476,6 +486,11 @@ int main(int argc, char **argv)
             if (!parse_float(optarg, &o.lambda) || o.lambda == 0.0f)
                 return bad_usage("--lambda takes a positive number, not '%s'", optarg);
             break;
+        case O_LOG_OFFSET:
+            if (!vt_parse_float(optarg, &o.log_offset) || fabsf(o.log_offset) > 5.0f)
+                return bad_usage("--log-offset takes a number in -5..5, not '%s'", optarg);
+            o.have_log_offset = 1;
+            break;
         case O_KEEP_NORMALS: o.keep_normals = 1; break;
         case O_WINDOW:
             if (strcmp(optarg, "none") == 0) o.window = VDSH_WINDOW_NONE;
@@ -506,6 +521,11 @@ int main(int argc, char **argv)
     if (o.quantity == VDSH_QUANTITY_DISTANCE && o.method == VDSH_METHOD_SHADOW)
         return bad_usage("%s", "--method shadow fits the log distance: use --quantity log or "
                                "auto, or --method lsq for the distance");
+    if (o.have_log_offset && o.method != VDSH_METHOD_SHADOW)
+        return bad_usage("%s", "--log-offset is method shadow's");
+    if (o.lambda != 0.0f && o.method == VDSH_METHOD_SHADOW)
+        return bad_usage("%s", "--lambda is lsq's: method shadow uses lsq's default (its method "
+                               "parameter is the log offset)");
     if (o.quantity == VDSH_QUANTITY_LOG_DISTANCE && o.method == VDSH_METHOD_PAPER)
         return bad_usage("%s", "log-distance needs --method mirror, lsq or full: the paper's zero fill "
                                "below the horizon has no meaning for ln(distance)");
@@ -610,10 +630,14 @@ int main(int argc, char **argv)
     for (int s = 0; s < o.order_count; s++)
         order_mask |= 1u << o.orders[s];
     progress pr = {.enabled = log && isatty(STDERR_FILENO), .t0 = vb_now()};
+    float offsets[VDSH_MAX_ORDER + 1];
+    for (int k = 0; k <= VDSH_MAX_ORDER; k++)
+        offsets[k] = o.log_offset;
     vb_bake_desc bd = {
         .receivers = &rec, .scene = scene, .rays = o.rays, .seed = o.seed,
         .max_distance = o.max_distance, .method = o.method,
         .quantity = o.quantity, .lambda = o.lambda, .log_floor = o.log_floor,
+        .log_offsets = o.have_log_offset ? offsets : NULL,
         .window = o.window,
         .max_order = max_order, .order_mask = order_mask, .threads = o.threads,
         .trace_only = o.trace_only,

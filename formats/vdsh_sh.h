@@ -47,9 +47,8 @@ void vdsh_sh_eval(int order, const float d[3], float *out);
  * vdsh_sh_eval (one kernel), laid out so the compiler vectorises over k.
  * `out` must not overlap the inputs. Unlike the other functions it also
  * evaluates orders 6..VDSH_SH_EVAL_MAX_ORDER (bands 5 to 8, by the
- * associated-Legendre recurrence in the same convention): the products of
- * two functions of order 5 lie in the span of order 9, which the bake's
- * shadow fit uses to form its normal matrix from moments. */
+ * associated-Legendre recurrence in the same convention), for fits and
+ * tests beyond the stored orders. */
 #define VDSH_SH_EVAL_MAX_ORDER 9
 void vdsh_sh_eval_soa(int order, size_t n, const float *x, const float *y,
                       const float *z, float *out, size_t out_stride);

@@ -12,7 +12,6 @@ add_test(NAME bake_hard_cases COMMAND test_hard)
 
 add_executable(test_fit test_fit.c)
 target_link_libraries(test_fit PRIVATE vb_core)
-target_compile_definitions(test_fit PRIVATE VDSH_TEST_DATA="${CMAKE_CURRENT_SOURCE_DIR}/data")
 add_test(NAME bake_fit COMMAND test_fit)
 
 # --quantity auto: deterministic, and it picks the better quantity per order.

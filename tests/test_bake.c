@@ -336,6 +336,65 @@ static void test_threads(void)
     test_mesh_free(&rec);
 }
 
+/* Method shadow is lsq of the log distance with each order's log offset
+ * added through c0 (Y00 = 1 / (2 sqrt(pi)), a constant): every stored
+ * distance is e^offset times lsq's, exactly, in every direction; the
+ * default offsets are positive (longer distances, fewer false shadows)
+ * and an explicit one is used at every order. */
+static void test_shadow_offset(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    test_make_box(&occ, 2, 2, 2);
+    enum { NP = 64 };
+    float p[3 * NP], n[3 * NP];
+    uint64_t s = 9;
+    for (int i = 0; i < NP; i++) {
+        p[3 * i] = (float)(3.6 * test_rand(&s) - 1.8);
+        p[3 * i + 1] = (float)(2 * test_rand(&s));
+        p[3 * i + 2] = (float)(3.6 * test_rand(&s) - 1.8);
+        test_rand_dir(&s, n + 3 * i);
+    }
+    test_make_points(&rec, NP, p, n);
+    vb_error err;
+    vb_scene *sc = NULL;
+    CHECK(vb_scene_create(&occ, NULL, &sc, &err) == VB_OK, "scene");
+    const float mine[VDSH_MAX_ORDER + 1] = {0, -0.3f, -0.3f, -0.3f, -0.3f, -0.3f};
+    vb_bake_output b[3] = {{0}};
+    for (int i = 0; i < 3 && sc; i++) {
+        vb_bake_desc d = {.receivers = &rec, .scene = sc, .rays = 400, .seed = 5,
+                          .method = i ? VDSH_METHOD_SHADOW : VDSH_METHOD_LSQ,
+                          .quantity = VDSH_QUANTITY_LOG_DISTANCE, .log_offsets = i == 2 ? mine : NULL,
+                          .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
+        CHECK(vb_bake_run(&d, &b[i], &err) == VB_OK, "bake %d: %s", i, err.msg);
+    }
+    for (int o = 2; o <= 5 && b[2].coeffs[5]; o++) {
+        if (!b[0].coeffs[o])
+            continue;
+        CHECK(vb_shadow_log_offset(o) > 0.0f, "order %d: default offset %g", o,
+              (double)vb_shadow_log_offset(o));
+        CHECK(b[1].log_offset[o] == vb_shadow_log_offset(o) && b[2].log_offset[o] == -0.3f,
+              "order %d: offsets recorded %g %g", o, (double)b[1].log_offset[o],
+              (double)b[2].log_offset[o]);
+        int bad = 0;
+        for (uint32_t v = 0; v < NP; v++) {
+            const float *l = b[0].coeffs[o] + (size_t)v * o * o;
+            for (int q = 1; q < 3; q++) {
+                const float *c = b[q].coeffs[o] + (size_t)v * o * o;
+                float off = q == 1 ? vb_shadow_log_offset(o) : -0.3f;
+                bad += fabsf(c[0] - (l[0] + off / 0.28209479f)) > 1e-5f * (1 + fabsf(c[0]));
+                for (int i = 1; i < o * o; i++)
+                    bad += c[i] != l[i];
+            }
+        }
+        CHECK(bad == 0, "order %d: %d coefficients are not lsq's with the offset", o, bad);
+    }
+    for (int i = 0; i < 3; i++)
+        vb_bake_output_free(&b[i]);
+    vb_scene_destroy(sc);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+}
+
 /* Offset normals average over bit-identical positions only, and only
  * normals facing the same side. */
 static void test_offset_normals(void)
@@ -367,5 +426,6 @@ int main(void)
     test_sphere_centre();
     test_box_floor();
     test_threads();
+    test_shadow_offset();
     return test_report("test_bake");
 }

@@ -71,6 +71,9 @@ expect_exit 2 "no output" "$bake" builtin:room
 expect_exit 2 "bad order" "$bake" builtin:room --orders 2,6 -o "$tmp/x.vdsh"
 expect_exit 2 "bad rays" "$bake" builtin:room --rays 0 -o "$tmp/x.vdsh"
 expect_exit 2 "bad method" "$bake" builtin:room --method magic -o "$tmp/x.vdsh"
+expect_exit 2 "--log-offset with lsq" "$bake" builtin:room --method lsq --log-offset 0.2 -o "$tmp/x.vdsh"
+expect_exit 2 "--log-offset out of range" "$bake" builtin:room --log-offset 7 -o "$tmp/x.vdsh"
+expect_exit 2 "--lambda with shadow" "$bake" builtin:room --lambda 1e-3 -o "$tmp/x.vdsh"
 expect_exit 2 "unknown option" "$bake" builtin:room --frobnicate -o "$tmp/x.vdsh"
 check "no output after usage errors" test ! -e "$tmp/x.vdsh"
 expect_exit 0 "--help" "$bake" --help
@@ -92,5 +95,11 @@ check "no temporary files left" bash -c "! ls '$tmp' | grep -q tmp"
 cp "$tmp/a.vdsh" "$tmp/keep.vdsh"
 expect_exit 1 "bad input over an existing file" "$bake" "$tmp/empty.obj" -q -o "$tmp/keep.vdsh"
 check "existing output untouched" cmp -s "$tmp/a.vdsh" "$tmp/keep.vdsh"
+
+# The shadow method's log offset: recorded per stream as its method parameter.
+expect_exit 0 "bake --log-offset" "$bake" "${quick[@]}" --log-offset 0.25 -o "$tmp/off.vdsh"
+"$info" --json "$tmp/off.vdsh" >"$tmp/off.json"
+check "log offset recorded" json "$tmp/off.json" \
+  "all(s['method'] == 'shadow' and abs(s['method_param'] - 0.25) < 1e-7 for s in d['streams'])"
 
 exit $fail

@@ -611,7 +611,7 @@ static void test_small_parts(void)
     test_mesh_free(&m);
 }
 
-/* The default fit (shadow: the log distance, reweighted) and lsq with the
+/* The default fit (shadow: lsq of the log distance, offset) and lsq with the
  * quantity chosen per order, on the hardest scene above: receivers in
  * corners, pressed against the floor, buried in a pillar, where true
  * distances are ~0 and ln 0 would be -Inf. Every coefficient is finite,
