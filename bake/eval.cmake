@@ -9,5 +9,3 @@ install(TARGETS vdsh-eval RUNTIME DESTINATION bin)
 
 # For fit studies outside the baker (scripts/fit_floor): the bake's rays of
 # sampled receivers and held-out truth, as a flat file.
-add_executable(vdsh-raydump vdsh_raydump.c)
-target_link_libraries(vdsh-raydump PRIVATE vb_core vt_tools)
