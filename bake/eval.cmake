@@ -7,5 +7,3 @@ add_executable(vdsh-eval vdsh_eval.c)
 target_link_libraries(vdsh-eval PRIVATE vb_eval vt_tools)
 install(TARGETS vdsh-eval RUNTIME DESTINATION bin)
 
-# For fit studies outside the baker (scripts/fit_floor): the bake's rays of
-# sampled receivers and held-out truth, as a flat file.

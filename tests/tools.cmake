@@ -14,6 +14,6 @@ if(Python3_Interpreter_FOUND)
   add_test(NAME tools_cli
            COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_tools_cli.py
                    $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval> $<TARGET_FILE:vdsh-info>
-                   $<TARGET_FILE:vdsh-view> $<TARGET_FILE:vdsh-raydump>
+                   $<TARGET_FILE:vdsh-view>
                    ${CMAKE_CURRENT_BINARY_DIR}/tools_cli)
 endif()
