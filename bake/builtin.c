@@ -50,8 +50,8 @@
 /* Icosahedron subdivided twice: 320 triangles. */
 #define SPHERE_LEVELS 2
 
-/* Room for the whole room (it has 2,316 vertices and 2,428 triangles;
- * test_mesh checks the counts). */
+/* Room for the whole of builtin:room (it has 1,518 vertices and 2,428
+ * triangles; test_mesh checks the counts). The builder's arrays grow. */
 enum {
     MAX_VERTICES = 4096,
     MAX_TRIANGLES = 4096,
@@ -62,33 +62,101 @@ enum {
 
 typedef struct room_builder {
     vb_mesh *m;
+    uint32_t vertex_cap, triangle_cap;  /* of m's arrays; they grow as needed */
+    int failed;                         /* out of memory: stop adding */
+    /* The variants' turned objects: a vertex p is placed at
+     * (tx + c p.x + s p.z, p.y, tz - s p.x + c p.z). Off for builtin:room. */
+    int turned;
+    float c, s, tx, tz;
 } room_builder;
+
+static int grow(void **array, uint32_t *cap, size_t item)
+{
+    uint32_t want = *cap ? 2 * *cap : 1024;
+    void *p = want > *cap ? realloc(*array, (size_t)want * item) : NULL;
+    if (!p)
+        return 0;
+    *array = p;
+    *cap = want;
+    return 1;
+}
 
 static uint32_t add_vertex(room_builder *b, const float p[3])
 {
     vb_mesh *m = b->m;
-    memcpy(m->positions + 3 * (size_t)m->vertex_count, p, 3 * sizeof(float));
+    if (m->vertex_count == b->vertex_cap) {
+        void *a = m->positions;
+        uint32_t cap = b->vertex_cap;
+        if (b->failed || cap > UINT32_MAX / 2 || !grow(&a, &cap, 3 * sizeof(float))) {
+            b->failed = 1;
+            return 0;
+        }
+        m->positions = a;
+        b->vertex_cap = cap;
+    }
+    float *q = m->positions + 3 * (size_t)m->vertex_count;
+    memcpy(q, p, 3 * sizeof(float));
+    if (b->turned) {
+        q[0] = b->tx + b->c * p[0] + b->s * p[2];
+        q[2] = b->tz - b->s * p[0] + b->c * p[2];
+    }
     return m->vertex_count++;
 }
 
 static void add_triangle(room_builder *b, uint32_t i0, uint32_t i1, uint32_t i2)
 {
     vb_mesh *m = b->m;
+    if (m->triangle_count == b->triangle_cap) {
+        void *a = m->indices;
+        uint32_t cap = b->triangle_cap;
+        if (b->failed || cap > UINT32_MAX / 2 || !grow(&a, &cap, 3 * sizeof(uint32_t)))
+            b->failed = 1;
+        else {
+            m->indices = a;
+            b->triangle_cap = cap;
+        }
+    }
+    if (b->failed)
+        return;
     uint32_t *t = m->indices + 3 * (size_t)m->triangle_count++;
     t[0] = i0;
     t[1] = i1;
     t[2] = i2;
 }
 
-/* A W x H rectangle at `o` spanned by unit vectors u (along W) and v
- * (along H), facing u x v, tiled with an offset lattice of nc columns and
- * nr rows: lattice lines alternate between nc + 1 and nc + 2 points (the
+/* Where a lattice point (x along the panel's width, t along its height)
+ * lies: o + x u + t v for builtin:room's panels; for the variants'
+ * axis-aligned rectangles, each coordinate separately, with the borders
+ * (x = 0 or W, t = 0 or H) exactly the rectangle's given edges, so that
+ * faces meant to meet (a cabinet's side and the wall behind it, a shelf
+ * board and its upright) meet without a rounding gap. */
+typedef struct panel_frame {
+    const float *o, *u, *v;
+    int exact;
+    int an, au, av;          /* axes of the normal, the width, the height */
+    float plane, u0, u1, v0, v1;
+} panel_frame;
+
+static void panel_point(const panel_frame *f, float W, float H, float x, float t, float p[3])
+{
+    if (!f->exact) {
+        for (int k = 0; k < 3; k++)
+            p[k] = f->o[k] + x * f->u[k] + t * f->v[k];
+        return;
+    }
+    p[f->an] = f->plane;
+    p[f->au] = x == 0.0f ? f->u0 : x == W ? f->u1 : f->u0 < f->u1 ? f->u0 + x : f->u0 - x;
+    p[f->av] = t == 0.0f ? f->v0 : t == H ? f->v1 : f->v0 + t;
+}
+
+/* A W x H rectangle placed by f (at o, spanned by unit vectors u along W
+ * and v along H, facing u x v; or the exact axis-aligned form), tiled with
+ * an offset lattice of nc columns and nr rows: lattice lines alternate between nc + 1 and nc + 2 points (the
  * odd ones offset by half a column, plus the two border points), and each
  * strip between two lines is zipped into triangles. Inside the triangles
  * are isosceles, near-equilateral when H / nr ~ 0.87 W / nc; at the left
  * and right borders they are halves of those. */
-static void add_panel(room_builder *b, const float o[3], const float u[3], const float v[3],
-                      float W, float H, int nc, int nr)
+static void add_lattice(room_builder *b, const panel_frame *f, float W, float H, int nc, int nr)
 {
     float xs[2][MAX_LATTICE + 2];
     uint32_t start[2] = {0, 0};
@@ -111,8 +179,7 @@ static void add_panel(room_builder *b, const float o[3], const float u[3], const
         count[cur] = n;
         for (int i = 0; i < n; i++) {
             float p[3];
-            for (int k = 0; k < 3; k++)
-                p[k] = o[k] + xs[cur][i] * u[k] + t * v[k];
+            panel_point(f, W, H, xs[cur][i], t, p);
             add_vertex(b, p);
         }
         if (j == 0)
@@ -138,6 +205,13 @@ static void add_panel(room_builder *b, const float o[3], const float u[3], const
             }
         }
     }
+}
+
+static void add_panel(room_builder *b, const float o[3], const float u[3], const float v[3],
+                      float W, float H, int nc, int nr)
+{
+    panel_frame f = {.o = o, .u = u, .v = v};
+    add_lattice(b, &f, W, H, nc, nr);
 }
 
 /* A planar quad a, b, c, d (counter-clockwise seen from the front) with
@@ -305,7 +379,7 @@ vb_result vb_builtin_room(vb_mesh *out, vb_error *err)
         vb_mesh_free(&m);
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "builtin:room: out of memory");
     }
-    room_builder b = {&m};
+    room_builder b = {.m = &m, .vertex_cap = MAX_VERTICES, .triangle_cap = MAX_TRIANGLES};
     const float deg = 3.14159265358979f / 180.0f;
 
     add_shell(&b);
@@ -328,6 +402,11 @@ vb_result vb_builtin_room(vb_mesh *out, vb_error *err)
      * 0.2 m already). */
     add_sphere(&b, -1.0f, 0.0f, 2.0f, 0.6f);
 
+    /* the normals were allocated for MAX_VERTICES: the layout fits */
+    if (b.failed || m.vertex_count > MAX_VERTICES) {
+        vb_mesh_free(&m);
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "builtin:room: out of memory");
+    }
     vb_mesh_compute_normals(&m);
     *out = m;
     return VB_OK;

@@ -809,6 +809,12 @@ static void test_room(void)
     CHECK(vb_mesh_load("builtin:room", NULL, &byname, &i2, &err) == VB_OK, "load builtin:room: %s", err.msg);
     CHECK(i1.size == 4ull * 3 * (room.vertex_count + room.triangle_count) && memcmp(&i1, &i2, sizeof i1) == 0,
           "builtin:room source info");
+    /* Every bake of builtin:room records these bytes' hash, and vdsh-eval
+     * rebuilds the room and compares: they must never change. */
+    char h[65];
+    hex(i1.sha256, h);
+    CHECK(strcmp(h, "0771ccaf925e49ce5dbe5f9212cfb458fbb067416cc05ea2123ffc206da35106") == 0,
+          "builtin:room changed: SHA-256 %s", h);
     vb_mesh_free(&byname);
 
     /* the paper-sized receiver set */
