@@ -1508,7 +1508,9 @@ vb_result vb_builtin_room_variant(uint32_t n, vb_mesh *out, vb_error *err)
     furnish(&p);
 
     /* One of the rectangle's eight symmetries, exact (swaps and sign
-     * changes); a mirror image reverses every triangle's winding. */
+     * changes); a mirror image reverses every triangle's winding. Adding
+     * +0 turns any -0 into +0: one bit pattern for zero (the ray-origin
+     * offset works on the bits, and -0 is INT_MIN there). */
     int sym = rng_int(&p.rng, 0, 7);
     for (uint32_t i = 0; i < m.vertex_count && !b.failed; i++) {
         float *q = m.positions + 3 * (size_t)i;
@@ -1521,6 +1523,8 @@ vb_result vb_builtin_room_variant(uint32_t n, vb_mesh *out, vb_error *err)
             q[0] = -q[0];
         if (sym & 4)
             q[2] = -q[2];
+        for (int k = 0; k < 3; k++)
+            q[k] += 0.0f;
     }
     if (((sym ^ (sym >> 1) ^ (sym >> 2)) & 1) && !b.failed)
         for (uint32_t t = 0; t < m.triangle_count; t++) {

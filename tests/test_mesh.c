@@ -1045,12 +1045,15 @@ static void test_room_variants(void)
             continue;
         }
         /* every normal defined (unit: check_clean), every triangle with an
-         * area */
-        uint32_t zero_normals = 0, flat = 0;
+         * area, no -0 coordinate (vb_offset_origin adds to its bits) */
+        uint32_t zero_normals = 0, flat = 0, negative_zeros = 0;
         for (uint32_t v = 0; v < m.vertex_count; v++) {
-            const float *n = m.normals + 3 * (size_t)v;
+            const float *n = m.normals + 3 * (size_t)v, *q = m.positions + 3 * (size_t)v;
             zero_normals += n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f;
+            for (int k = 0; k < 3; k++)
+                negative_zeros += q[k] == 0.0f && signbit(q[k]);
         }
+        CHECK(negative_zeros == 0, "%s: %u coordinates are -0", name, negative_zeros);
         for (uint32_t t = 0; t < m.triangle_count; t++)
             flat += !(triangle_area(&m, t) > 1e-6);
         CHECK(zero_normals == 0 && flat == 0, "%s: %u undefined normals, %u triangles without area", name,
