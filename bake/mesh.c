@@ -944,9 +944,7 @@ vb_result vb_mesh_load(const char *path, const vb_load_desc *desc, vb_mesh *out,
     vb_result r;
 
     if (strncmp(path, "builtin:", 8) == 0) {
-        if (strcmp(path + 8, "room") != 0)
-            return vb_fail(err, VB_ERR_ARGUMENT, "%s: unknown built-in scene (known: builtin:room)", path);
-        r = vb_builtin_room(&m, err);
+        r = vb_builtin_load(path, &m, err);
         if (r != VB_OK)
             return r;
         r = builtin_info(&m, &si, err);

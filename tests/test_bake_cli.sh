@@ -65,6 +65,18 @@ check "--cubemap-dir" bash -c "mkdir -p '$tmp/cubes' && '$bake' ${quick[*]} --cu
 expect_exit 0 "export OBJ" "$bake" builtin:room -q --export-obj "$tmp/room.obj"
 check "OBJ has faces" grep -q "^f " "$tmp/room.obj"
 
+# A seeded variant of the room bakes and exports by name; unknown names
+# list the known ones.
+expect_exit 0 "bake builtin:room:7" "$bake" builtin:room:7 --max-edge 1.5 --rays 64 --cube-size 0 -q \
+  -o "$tmp/v7.vdsh"
+"$info" "$tmp/v7.vdsh" >"$tmp/v7.txt" 2>&1
+check "info names the variant" grep -q "builtin:room:7" "$tmp/v7.txt"
+expect_exit 0 "export builtin:room:7" "$bake" builtin:room:7 --max-edge 0.5 -q --export-obj "$tmp/v7.obj"
+check "variant OBJ has faces" grep -q "^f " "$tmp/v7.obj"
+expect_exit 1 "unknown built-in" "$bake" builtin:hall -q -o "$tmp/y.vdsh"
+check "unknown built-in lists the known ones" grep -q "known: builtin:room, builtin:room:N" "$tmp/err.txt"
+expect_exit 1 "variant 0" "$bake" builtin:room:0 -q -o "$tmp/y.vdsh"
+
 # Usage errors exit 2 and write nothing.
 expect_exit 2 "no mesh" "$bake" -o "$tmp/x.vdsh"
 expect_exit 2 "no output" "$bake" builtin:room

@@ -1,15 +1,20 @@
 /*
  * test_mesh.c - tests for bake/mesh.h: SHA-256, loading and its error
  * messages (fixtures written at run time), cleaning, normals, welding,
- * appending, the built-in room, refinement, OBJ output.
+ * appending, the built-in room and its seeded variants (closed and facing
+ * free space, checked with rays through Embree), refinement, OBJ output.
  *
  *   test_mesh unit   TMPDIR        no data needed (fixtures go to TMPDIR)
  *   test_mesh scenes SCENES_DIR    ../shared/scenes (exit 77 when absent)
  *   test_mesh assimp MODELS_DIR    /usr/share/assimp/models (77 when absent)
  *   test_mesh bench  SCENES_DIR    timings, not part of the suite
  */
+#include "bake.h"
 #include "mesh.h"
+#include "origins.h"
+#include "scene.h"
 #include "test_util.h"
+#include "vdsh.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -1128,6 +1133,12 @@ static void test_room(void)
     CHECK(vb_mesh_load("builtin:room", NULL, &byname, &i2, &err) == VB_OK, "load builtin:room: %s", err.msg);
     CHECK(i1.size == 4ull * 3 * (room.vertex_count + room.triangle_count) && memcmp(&i1, &i2, sizeof i1) == 0,
           "builtin:room source info");
+    /* Every bake of builtin:room records these bytes' hash, and vdsh-eval
+     * rebuilds the room and compares: they must never change. */
+    char h[65];
+    hex(i1.sha256, h);
+    CHECK(strcmp(h, "0771ccaf925e49ce5dbe5f9212cfb458fbb067416cc05ea2123ffc206da35106") == 0,
+          "builtin:room changed: SHA-256 %s", h);
     vb_mesh_free(&byname);
 
     /* the paper-sized receiver set */
@@ -1147,6 +1158,321 @@ static void test_room(void)
     vb_mesh_free(&fine);
     vb_mesh_free(&room);
     vb_mesh_free(&again);
+}
+
+/* ---- builtin:room:N ----------------------------------------------------- */
+
+/* What a ray from p (scene units) along unit d meets first: nothing, the
+ * front of a face or its back (Embree's Ng against d, as origins.c). */
+enum { RAY_ESCAPES, RAY_FRONT, RAY_BACK };
+
+static int first_face(const vb_scene *s, const float p[3], const float d[3])
+{
+    struct RTCRayHit rh;
+    float o[3];
+    vb_scene_to_local(s, p, o);
+    rh.ray.org_x = o[0], rh.ray.org_y = o[1], rh.ray.org_z = o[2];
+    rh.ray.dir_x = d[0], rh.ray.dir_y = d[1], rh.ray.dir_z = d[2];
+    rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.time = 0.0f;
+    rh.ray.mask = 0xffffffffu, rh.ray.id = 0, rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    rtcIntersect1(s->scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+        return RAY_ESCAPES;
+    return rh.hit.Ng_x * d[0] + rh.hit.Ng_y * d[1] + rh.hit.Ng_z * d[2] > 0.0f ? RAY_BACK : RAY_FRONT;
+}
+
+/* A random direction in the hemisphere around unit n. */
+static void hemisphere_dir(uint64_t *seed, const float n[3], float d[3])
+{
+    test_rand_dir(seed, d);
+    if (d[0] * n[0] + d[1] * n[1] + d[2] * n[2] < 0.0f)
+        d[0] = -d[0], d[1] = -d[1], d[2] = -d[2];
+}
+
+typedef struct room_rays {
+    uint32_t samples;      /* face samples (triangle centroids) */
+    uint32_t open_front;   /* ... with a ray from their front side escaping */
+    uint32_t open_back;    /* ... whose back side sees nothing but fronts of
+                              faces: free space behind (turned inside out) */
+    uint32_t pressed;      /* ... whose front side meets a back face (inside
+                              something: a floor under a crate) */
+    double pressed_area, area; /* their triangles' area; all the area */
+    uint32_t points;       /* random points in the bounds */
+    uint32_t leaks;        /* ... that see the front of a face and the void */
+    float first_bad[3];    /* centroid of the first open or inverted face */
+} room_rays;
+
+/* Closed and facing free space, by rays. Every triangle's centroid, 1 mm
+ * off its surface on each side, casts `rays` rays into the hemisphere on
+ * that side. In a closed room whose every face looks into free space, no
+ * ray from a front side escapes, and no back side is free space: inside a
+ * solid or outside the room some ray meets the back of a face or escapes.
+ * And a point anywhere in the bounds is in the room (no ray escapes),
+ * inside a solid, or outside the shell (seeing only its back): it never
+ * sees both the front of a face and the void. */
+static room_rays check_room_rays(const vb_mesh *m, int rays, uint32_t points, uint64_t seed)
+{
+    room_rays out = {0};
+    vb_scene *s = NULL;
+    vb_error err;
+    vb_scene_desc sd = {.robust = 1};
+    CHECK(vb_scene_create(m, &sd, &s, &err) == VB_OK, "scene: %s", err.msg);
+    if (!s)
+        return out;
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const float *p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = m->positions + 3 * (size_t)m->indices[3 * t + k];
+        double u[3], v[3];
+        for (int k = 0; k < 3; k++) {
+            u[k] = (double)p[1][k] - p[0][k];
+            v[k] = (double)p[2][k] - p[0][k];
+        }
+        double c[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+        double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+        if (!(len > 0.0))
+            continue;
+        out.samples++;
+        float centre[3];
+        for (int k = 0; k < 3; k++)
+            centre[k] = (p[0][k] + p[1][k] + p[2][k]) / 3.0f;
+        int escaped = 0, front_back = 0, back_front = 0;
+        for (int side = 0; side < 2; side++) {
+            float n[3], o[3], d[3];
+            for (int k = 0; k < 3; k++) {
+                n[k] = (float)((side ? -c[k] : c[k]) / len);
+                o[k] = centre[k] + 1e-3f * n[k];
+            }
+            for (int r = 0; r < rays; r++) {
+                hemisphere_dir(&seed, n, d);
+                int f = first_face(s, o, d);
+                escaped |= !side && f == RAY_ESCAPES;
+                front_back |= !side && f == RAY_BACK;
+                back_front += side && f == RAY_FRONT;
+            }
+            /* Behind a face pressed into a pocket closed mostly by other
+             * faces' fronts (the inside of a seat under the sofa's back,
+             * pressed against the wall) only grazing rays meet a back
+             * face: make sure with many more. */
+            for (int r = 0; side && back_front == rays && r < 1024; r++) {
+                hemisphere_dir(&seed, n, d);
+                if (first_face(s, o, d) != RAY_FRONT)
+                    back_front = 0;
+            }
+        }
+        if ((escaped || back_front == rays) && !out.open_front && !out.open_back)
+            memcpy(out.first_bad, centre, sizeof centre);
+        out.open_front += escaped != 0;
+        out.open_back += back_front == rays;
+        out.pressed += front_back != 0;
+        out.pressed_area += front_back ? 0.5 * len : 0.0;
+        out.area += 0.5 * len;
+    }
+    float lo[3], hi[3];
+    vb_mesh_bounds(m, lo, hi);
+    for (uint32_t i = 0; i < points; i++) {
+        float o[3];
+        for (int k = 0; k < 3; k++)
+            o[k] = lo[k] + (float)test_rand(&seed) * (hi[k] - lo[k]);
+        int front = 0, escapes = 0;
+        for (int r = 0; r < 16; r++) {
+            float d[3];
+            test_rand_dir(&seed, d);
+            int f = first_face(s, o, d);
+            front += f == RAY_FRONT;
+            escapes += f == RAY_ESCAPES;
+        }
+        out.points++;
+        out.leaks += front && escapes;
+    }
+    vb_scene_destroy(s);
+    return out;
+}
+
+static double triangle_area(const vb_mesh *m, uint32_t t)
+{
+    const float *p0 = m->positions + 3 * (size_t)m->indices[3 * t];
+    const float *p1 = m->positions + 3 * (size_t)m->indices[3 * t + 1];
+    const float *p2 = m->positions + 3 * (size_t)m->indices[3 * t + 2];
+    double u[3], v[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = (double)p1[k] - p0[k];
+        v[k] = (double)p2[k] - p0[k];
+    }
+    double c[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    return 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+}
+
+/* What the bake itself says of the receivers at 0.2 m (its 64-ray check,
+ * `vdsh-bake builtin:room:N --rays 64`): no normal it would flip, no ray
+ * missing the room, and degenerate receivers (~0 distance all round) only
+ * where faces are pressed together, as in builtin:room (1 of 58,007). */
+static void check_room_bake(const vb_mesh *coarse, const char *name, vb_mesh *fine)
+{
+    vb_error err;
+    vb_scene *s = NULL;
+    vb_scene_desc sd = {.robust = 1};
+    if (vb_scene_create(coarse, &sd, &s, &err) != VB_OK) {
+        CHECK(0, "%s: scene: %s", name, err.msg);
+        return;
+    }
+    uint32_t flipped = 0;
+    CHECK(vb_orient_receivers(fine, s, 0, &flipped, &err) == VB_OK, "%s: orient: %s", name, err.msg);
+    vb_bake_desc d = {.receivers = fine, .scene = s, .rays = 64, .seed = 1, .method = VDSH_METHOD_PAPER};
+    vb_bake_output o = {0};
+    CHECK(vb_bake_run(&d, &o, &err) == VB_OK, "%s: bake: %s", name, err.msg);
+    printf("%s at 0.2 m: %u receivers, %u normals flipped, %llu of %llu rays missed, %u degenerate\n", name,
+           fine->vertex_count, flipped, (unsigned long long)o.rays_missed, (unsigned long long)o.rays_traced,
+           o.degenerate_receivers);
+    CHECK(flipped == 0, "%s: the bake flips %u normals", name, flipped);
+    CHECK(o.rays_traced > 0 && o.rays_missed == 0, "%s: %llu rays escape the room", name,
+          (unsigned long long)o.rays_missed);
+    CHECK(o.degenerate_receivers <= fine->vertex_count / 5000, "%s: %u degenerate receivers", name,
+          o.degenerate_receivers);
+    vb_bake_output_free(&o);
+    vb_scene_destroy(s);
+}
+
+static void test_room_variants(void)
+{
+    vb_error err;
+    /* 1..8 are the validation set; the others are far apart in N */
+    static const uint32_t ns[] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 1000, 65536, 4294967295u};
+    enum { COUNT = sizeof ns / sizeof ns[0] };
+    vb_source_info info[COUNT];
+    for (int i = 0; i < COUNT; i++) {
+        char name[32];
+        snprintf(name, sizeof name, "builtin:room:%u", ns[i]);
+        vb_mesh m = {0}, again = {0}, direct = {0};
+        vb_source_info again_info;
+        memset(&info[i], 0, sizeof info[i]);
+        CHECK(vb_mesh_load(name, NULL, &m, &info[i], &err) == VB_OK, "%s: %s", name, err.msg);
+        CHECK(vb_mesh_load(name, NULL, &again, &again_info, &err) == VB_OK, "%s: %s", name, err.msg);
+        CHECK(same_mesh(&m, &again) && memcmp(&info[i], &again_info, sizeof again_info) == 0,
+              "%s: two loads differ", name);
+        CHECK(vb_builtin_room_variant(ns[i], &direct, &err) == VB_OK && same_mesh(&m, &direct),
+              "%s: differs from vb_builtin_room_variant", name);
+        CHECK(info[i].size == 4ull * 3 * (m.vertex_count + m.triangle_count), "%s: source size", name);
+        vb_mesh_free(&direct);
+        vb_mesh_free(&again);
+        if (!check_clean(&m, name)) {
+            vb_mesh_free(&m);
+            continue;
+        }
+        /* every normal defined (unit: check_clean), every triangle with an
+         * area, no -0 coordinate (vb_offset_origin adds to its bits) */
+        uint32_t zero_normals = 0, flat = 0, negative_zeros = 0;
+        for (uint32_t v = 0; v < m.vertex_count; v++) {
+            const float *n = m.normals + 3 * (size_t)v, *q = m.positions + 3 * (size_t)v;
+            zero_normals += n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f;
+            for (int k = 0; k < 3; k++)
+                negative_zeros += q[k] == 0.0f && signbit(q[k]);
+        }
+        CHECK(negative_zeros == 0, "%s: %u coordinates are -0", name, negative_zeros);
+        for (uint32_t t = 0; t < m.triangle_count; t++)
+            flat += !(triangle_area(&m, t) > 1e-6);
+        CHECK(zero_normals == 0 && flat == 0, "%s: %u undefined normals, %u triangles without area", name,
+              zero_normals, flat);
+        /* the documented size: floor at y = 0, 8-25 m across, 2.5-8 m high */
+        float lo[3], hi[3];
+        vb_mesh_bounds(&m, lo, hi);
+        float sx = hi[0] - lo[0], sy = hi[1] - lo[1], sz = hi[2] - lo[2];
+        CHECK(lo[1] == 0.0f && sx >= 8.0f && sx <= 25.0f && sz >= 8.0f && sz <= 25.0f && sy >= 2.5f && sy <= 8.0f,
+              "%s: bounds %g %g %g .. %g %g %g", name, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+
+        room_rays rr = check_room_rays(&m, i < 8 ? 32 : 12, 2000, 0x1234u + ns[i]);
+        printf("%s: %.2f x %.2f x %.2f m, %u vertices, %u triangles; %u of %u face samples pressed (%.1f%% of "
+               "the area)\n",
+               name, sx, sz, sy, m.vertex_count, m.triangle_count, rr.pressed, rr.samples,
+               100.0 * rr.pressed_area / rr.area);
+        CHECK(rr.samples == m.triangle_count, "%s: %u samples", name, rr.samples);
+        CHECK(rr.open_front == 0, "%s: %u faces see the void (a hole in the room), first at %g %g %g", name,
+              rr.open_front, rr.first_bad[0], rr.first_bad[1], rr.first_bad[2]);
+        CHECK(rr.open_back == 0, "%s: %u faces have free space behind them (inside out), first at %g %g %g",
+              name, rr.open_back, rr.first_bad[0], rr.first_bad[1], rr.first_bad[2]);
+        CHECK(rr.leaks == 0, "%s: %u of %u points see both a face's front and the void", name, rr.leaks,
+              rr.points);
+        /* pressed faces (the floor under a cabinet, a table top where a
+         * leg meets it) are a small part of the room */
+        CHECK(rr.pressed_area < 0.08 * rr.area, "%s: %.1f%% of the area inside something", name,
+              100.0 * rr.pressed_area / rr.area);
+
+        if (i < 8) {
+            /* the validation range at the paper's receiver spacing */
+            vb_mesh fine = {0};
+            CHECK(vb_mesh_refine(&m, 0.2f, &fine, &err) == VB_OK, "%s: refine: %s", name, err.msg);
+            CHECK(fine.vertex_count >= 20000 && fine.vertex_count <= 80000, "%s at 0.2 m: %u receivers", name,
+                  fine.vertex_count);
+            check_room_bake(&m, name, &fine);
+            vb_mesh_free(&fine);
+        }
+        vb_mesh_free(&m);
+    }
+    /* different N, different rooms */
+    for (int i = 0; i < COUNT; i++)
+        for (int j = 0; j < i; j++)
+            CHECK(memcmp(info[i].sha256, info[j].sha256, 32) != 0, "builtin:room:%u and :%u are the same", ns[i],
+                  ns[j]);
+
+    /* The ray check catches what it is there for: one triangle of an
+     * object turned inside out, and one missing from the floor. */
+    vb_mesh m = {0};
+    CHECK(vb_builtin_room_variant(3, &m, &err) == VB_OK, "variant 3: %s", err.msg);
+    float lo[3], hi[3];
+    vb_mesh_bounds(&m, lo, hi);
+    uint32_t object = UINT32_MAX, floor_tri = UINT32_MAX;
+    double best = 0.0;
+    for (uint32_t t = 0; t < m.triangle_count; t++) {
+        const float *p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = m.positions + 3 * (size_t)m.indices[3 * t + k];
+        if (p[0][1] == 0.0f && p[1][1] == 0.0f && p[2][1] == 0.0f && floor_tri == UINT32_MAX)
+            floor_tri = t;
+        /* the largest upright triangle below 1 m, off the outer walls */
+        int on_wall = 1;
+        for (int k = 0; k < 3 && on_wall; k++)
+            on_wall = p[k][0] == lo[0] || p[k][0] == hi[0] || p[k][2] == lo[2] || p[k][2] == hi[2];
+        float y = (p[0][1] + p[1][1] + p[2][1]) / 3.0f;
+        double a = triangle_area(&m, t);
+        if (!on_wall && y > 0.2f && y < 1.0f && p[0][1] != p[1][1] && a > best) {
+            best = a;
+            object = t;
+        }
+    }
+    CHECK(object != UINT32_MAX && floor_tri != UINT32_MAX, "variant 3: no object or floor triangle");
+    if (object != UINT32_MAX && floor_tri != UINT32_MAX) {
+        uint32_t *tri = m.indices + 3 * (size_t)object, k = tri[1];
+        tri[1] = tri[2];
+        tri[2] = k;
+        room_rays inverted = check_room_rays(&m, 32, 0, 7);
+        CHECK(inverted.open_back == 1 && inverted.open_front == 0, "an inverted triangle went unnoticed (%u, %u)",
+              inverted.open_back, inverted.open_front);
+        tri[2] = tri[1];
+        tri[1] = k;
+        memmove(m.indices + 3 * (size_t)floor_tri, m.indices + 3 * (size_t)floor_tri + 3,
+                3 * sizeof(uint32_t) * (m.triangle_count - floor_tri - 1));
+        m.triangle_count--;
+        room_rays holed = check_room_rays(&m, 32, 20000, 7);
+        CHECK(holed.open_front >= 1 && holed.leaks >= 1, "a hole in the floor went unnoticed (%u, %u)",
+              holed.open_front, holed.leaks);
+    }
+    vb_mesh_free(&m);
+
+    /* names */
+    expect_fail("builtin:room:0", VB_ERR_ARGUMENT, "builtin:room:N");
+    expect_fail("builtin:room:007", VB_ERR_ARGUMENT, "without leading zeros");
+    expect_fail("builtin:room:4294967296", VB_ERR_ARGUMENT, "4294967295");
+    expect_fail("builtin:room:", VB_ERR_ARGUMENT, "builtin:room:N");
+    expect_fail("builtin:room:-1", VB_ERR_ARGUMENT, "builtin:room:N");
+    expect_fail("builtin:room:1x", VB_ERR_ARGUMENT, "builtin:room:N");
+    expect_fail("builtin:room:99999999999999999999", VB_ERR_ARGUMENT, "builtin:room:N");
+    expect_fail("builtin:rooms", VB_ERR_ARGUMENT, "known: builtin:room, builtin:room:N");
+    expect_fail("builtin:", VB_ERR_ARGUMENT, "known: builtin:room, builtin:room:N");
+    CHECK(vb_builtin_room_variant(0, &m, &err) == VB_ERR_ARGUMENT, "variant 0 accepted");
 }
 
 /* ====================================================================== */
@@ -1467,6 +1793,7 @@ static int run_unit(const char *tmp_parent)
     test_corner_normals();
     test_load_report();
     test_room();
+    test_room_variants();
     test_refine();
     test_write_obj();
     if (!test_failures)
