@@ -116,20 +116,6 @@ vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc,
     return VB_OK;
 }
 
-static inline float as_float(int32_t i)
-{
-    float f;
-    memcpy(&f, &i, sizeof f);
-    return f;
-}
-
-static inline int32_t as_int(float f)
-{
-    int32_t i;
-    memcpy(&i, &f, sizeof i);
-    return i;
-}
-
 void vb_offset_origin(const float p[3], const float n[3], float out[3])
 {
     const float origin = 1.0f / 32.0f;
@@ -137,7 +123,13 @@ void vb_offset_origin(const float p[3], const float n[3], float out[3])
     const float int_scale = 256.0f;
     for (int i = 0; i < 3; i++) {
         int32_t of = (int32_t)(int_scale * n[i]);
-        float pi = as_float(as_int(p[i]) + (p[i] < 0.0f ? -of : of));
+        /* In unsigned arithmetic: -0 is INT_MIN as an int, and the signed
+         * sum would overflow (the result is unused there, but undefined). */
+        uint32_t bits;
+        memcpy(&bits, &p[i], sizeof bits);
+        bits += (uint32_t)(p[i] < 0.0f ? -of : of);
+        float pi;
+        memcpy(&pi, &bits, sizeof pi);
         out[i] = fabsf(p[i]) < origin ? p[i] + float_scale * n[i] : pi;
     }
 }
