@@ -16,7 +16,7 @@
  *            default view first, every eye and light in free space, every
  *            view's lights light and shadow a share of it, no surface
  *            nearer than 5% of the diagonal; the same file for the same
- *            seed, another for another seed
+ *            seed (on 1 thread and on 2), another for another seed
  *   errors   missing and invalid view sets, a frame of another size, a
  *            missing frame: exit 1 naming the file and no output; usage
  *            errors exit 2
@@ -429,12 +429,14 @@ static int part_box(void)
 
 /* ---- the built-in room: views and the oracle --------------------------------------------- */
 
-static int room_views(const char *vdsh, const char *views, const char *seed)
+static int room_views(const char *vdsh, const char *views, const char *seed,
+                      const char *threads)
 {
     if (!exists(vdsh) && bake_to((char *[]){"builtin:room", NULL}, vdsh, "1") != 0)
         return -1;
-    int rc = run((char *[]){(char *)frames, "views", (char *)vdsh, "-o", (char *)views, "--cameras", "3",
-                            "--size", "160x120", "--seed", (char *)seed, NULL});
+    int rc = run((char *[]){(char *)frames, "views", (char *)vdsh, "-o", (char *)views,
+                            "--cameras", "3", "--size", "160x120", "--seed", (char *)seed,
+                            "--threads", (char *)threads, NULL});
     if (rc != 0)
         show_stderr();
     return rc;
@@ -444,13 +446,14 @@ static int part_views(void)
 {
     char *vdsh = path_in("room.vdsh"), *v1 = path_in("a.views.json"),
          *v2 = path_in("b.views.json"), *v3 = path_in("c.views.json");
-    CHECK(room_views(vdsh, v1, "5") == 0, "views, seed 5");
-    CHECK(room_views(vdsh, v2, "5") == 0, "views, seed 5 again");
-    CHECK(room_views(vdsh, v3, "6") == 0, "views, seed 6");
+    CHECK(room_views(vdsh, v1, "5", "2") == 0, "views, seed 5");
+    CHECK(room_views(vdsh, v2, "5", "1") == 0, "views, seed 5 again, one thread");
+    CHECK(room_views(vdsh, v3, "6", "2") == 0, "views, seed 6");
     size_t n1 = 0, n2 = 0, n3 = 0;
     unsigned char *a = test_read_file(v1, &n1), *b = test_read_file(v2, &n2),
                   *c = test_read_file(v3, &n3);
-    CHECK(a && b && n1 == n2 && memcmp(a, b, n1) == 0, "the same seed gives the same file");
+    CHECK(a && b && n1 == n2 && memcmp(a, b, n1) == 0,
+          "the same seed gives the same file (on 1 thread and on 2)");
     CHECK(a && c && (n1 != n3 || memcmp(a, c, n1) != 0), "another seed gives another file");
     free(a);
     free(b);
@@ -537,7 +540,7 @@ static int part_oracle(void)
 {
     char *vdsh = path_in("room.vdsh"), *views = path_in("room.views.json"),
          *truth = path_in("truth"), *json = path_in("oracle.json");
-    if (room_views(vdsh, views, "1") != 0) {
+    if (room_views(vdsh, views, "1", "2") != 0) {
         CHECK(0, "views");
         return test_report("frames_oracle");
     }
