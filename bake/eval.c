@@ -12,10 +12,12 @@
 #include "eval.h"
 #include "parallel.h"
 
+#include <libgen.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #include "bake.h"
@@ -410,8 +412,7 @@ static void eval_progress(void *user, uint32_t done, uint32_t total)
 
 /* ---- scene lights --------------------------------------------------------- */
 
-/* Whether p (scene units) is in free space (vdsh_light.h), with Embree. */
-static int free_space(const vb_scene *s, const float p[3])
+int vb_eval_free_space(const vb_scene *s, const float p[3])
 {
     float dirs[VDSH_FREE_PROBES][3], t[VDSH_FREE_PROBES];
     int back[VDSH_FREE_PROBES];
@@ -447,7 +448,7 @@ vb_result vb_eval_place_lights(const vb_scene *s, uint64_t seed, uint32_t count,
     while (n < count && k < limit) {
         float p[3];
         vdsh_light_candidate(s->bounds_min, s->bounds_max, seed, k++, p);
-        if (free_space(s, p))
+        if (vb_eval_free_space(s, p))
             memcpy(out[n++], p, sizeof out[0]);
     }
     if (tried)
@@ -1183,6 +1184,33 @@ static void hex(const uint8_t *h, int n, char *out)
         out[2 * i + 1] = digits[h[i] & 15];
     }
     out[2 * n] = '\0';
+}
+
+static int regular_file(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+char *vb_eval_find_source(const char *name, const char *vdsh_path)
+{
+    if (strncmp(name, "builtin:", 8) == 0 || regular_file(name))
+        return strdup(name);
+    if (name[0] == '/')
+        return NULL;
+    char *tmp = strdup(vdsh_path);
+    if (!tmp)
+        return NULL;
+    const char *dir = dirname(tmp);
+    size_t n = strlen(dir) + strlen(name) + 2;
+    char *p = malloc(n);
+    if (p)
+        snprintf(p, n, "%s/%s", dir, name);
+    free(tmp);
+    if (p && regular_file(p))
+        return p;
+    free(p);
+    return NULL;
 }
 
 vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths,

@@ -277,6 +277,12 @@ vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths,
                                uint32_t count, const vb_eval_scene_desc *desc,
                                vb_scene **out, vb_error *err);
 
+/* Where source `name`, as a .vdsh records it, is now: "builtin:..." as it
+ * is; a path as recorded (relative to the working directory), else beside
+ * the .vdsh file at vdsh_path. A malloc'ed path (the caller frees), or NULL
+ * when neither exists or memory ran out. */
+char *vb_eval_find_source(const char *name, const char *vdsh_path);
+
 /* ---- the pieces, for tests and tools ---------------------------------- */
 
 /* What the GPU does between vertices: position, normal (normalised; 0 if it
@@ -306,6 +312,11 @@ double *vb_eval_area_cdf(const vdsh_file *f, double *total);
  * (VB_ERR_INVALID) when 1000 candidates per light are not enough. */
 vb_result vb_eval_place_lights(const vb_scene *s, uint64_t seed, uint32_t count,
                                float (*out)[3], uint32_t *tried, vb_error *err);
+
+/* Whether p (scene units) is in the free space of scene s: vdsh_light.h's
+ * rule, its probes cast with Embree. The test vb_eval_place_lights applies
+ * to every candidate (vdsh-frames applies it to eyes too). */
+int vb_eval_free_space(const vb_scene *s, const float p[3]);
 
 /* The held-out directions of receiver `id` (a vertex index, or
  * VB_EVAL_INTERIOR_ID(j) for interior point j) with unit normal n: the

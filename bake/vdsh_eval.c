@@ -33,7 +33,6 @@
  */
 #include <errno.h>
 #include <getopt.h>
-#include <libgen.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -192,36 +191,6 @@ static void on_warn(void *user, const char *msg)
     warnings *w = user;
     w->count++;
     fprintf(stderr, "vdsh-eval: %s: warning: %s\n", w->path, msg);
-}
-
-/* ---- sources -------------------------------------------------------------- */
-
-static int exists(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
-}
-
-/* Where a recorded source is now: as recorded (relative to the working
- * directory), else beside the .vdsh file. NULL if neither exists. */
-static char *resolve_source(const char *name, const char *vdsh_path)
-{
-    if (strncmp(name, "builtin:", 8) == 0 || exists(name))
-        return strdup(name);
-    if (name[0] == '/')
-        return NULL;
-    char tmp[PATH_MAX];
-    snprintf(tmp, sizeof tmp, "%s", vdsh_path);
-    const char *dir = dirname(tmp);
-    size_t n = strlen(dir) + strlen(name) + 2;
-    char *p = malloc(n);
-    if (!p)
-        return NULL;
-    snprintf(p, n, "%s/%s", dir, name);
-    if (exists(p))
-        return p;
-    free(p);
-    return NULL;
 }
 
 /* ---- bake time ------------------------------------------------------------- */
@@ -942,7 +911,7 @@ int main(int argc, char **argv)
         goto out;
     }
     for (uint32_t i = 0; i < f->source_count; i++) {
-        spath[i] = nmesh ? strdup(meshes[i]) : resolve_source(f->sources[i].name, path);
+        spath[i] = nmesh ? strdup(meshes[i]) : vb_eval_find_source(f->sources[i].name, path);
         if (!spath[i]) {
             fprintf(stderr, "vdsh-eval: %s: cannot find source %u of %u, '%s' (looked as "
                             "recorded and beside the file); give the bake's meshes after "

@@ -1,0 +1,931 @@
+/*
+ * vdsh-frames - what a viewer sees: ray-traced truth for frames, and the
+ * image error of any frames against it (DESIGN.md section 3, "Image
+ * error"). Three subcommands:
+ *
+ *   views  choose a view set for a scene (tools/vt_views.h): the viewer's
+ *          default camera, then cameras in the scene's free space looking
+ *          at surfaces that are lit and shadowed, each with a set of one
+ *          light and a set of three (frames.h says how they are chosen)
+ *   truth  trace every view, light set and light: hard, ideal, mask and
+ *          the file's streams computed in C on the runtime's path, as
+ *          16-bit frames NAME-sK-lJ-MODE.png, and shaded pictures
+ *   score  score frames (GL frames of vdsh-view, or the C frames) against
+ *          the truth: per frame, per light set, per scene
+ *
+ * The story of each is its cmd_ function: read, compute with the core
+ * (bake/frames.h), write atomically, print.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "bake.h"
+#include "eval.h"
+#include "frames.h"
+#include "parallel.h"
+#include "scene.h"
+#include "vdsh.h"
+#include "vdsh_shadow.h"
+#include "vt_cli.h"
+#include "vt_image.h"
+#include "vt_json.h"
+#include "vt_views.h"
+
+#define PROG "vdsh-frames"
+#define MAX_MODES 32
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+"Usage: vdsh-frames views SCENE.vdsh -o VIEWS.json [options]\n"
+"       vdsh-frames truth SCENE.vdsh --views VIEWS.json -o DIR [options]\n"
+"       vdsh-frames score SCENE.vdsh --views VIEWS.json --truth DIR --frames DIR2\n"
+"                         --modes LIST [--json OUT.json]\n"
+"What a viewer sees: ray-traced truth for frames, and image error against it.\n"
+"\n"
+"The scene is rebuilt as vdsh-eval does: the occluders from the sources\n"
+"recorded in SCENE.vdsh (looked up as recorded, then beside the file; each\n"
+"must have the SHA-256 the bake recorded), the receivers (what the GL\n"
+"draws) from the file's own positions and triangles.\n"
+"\n"
+"views: a view set (JSON, tools/vt_views.h) for the scene. View 'default'\n"
+"  is the camera vdsh-view opens the scene with; views v1..vN look from\n"
+"  eyes in the scene's free space (the rule for lights: formats/\n"
+"  vdsh_light.h) at a surface point they see, between 53 degrees below the\n"
+"  horizon and 12 above, and are kept when a 64-pixel-wide frame shows no\n"
+"  surface nearer than 5%% of the diagonal and each of its lights lights\n"
+"  at least 5%% of the frame's pixels and hard-shadows as many. Every view\n"
+"  gets light set 0 (one light) and set 1 (three), drawn from 128 lights\n"
+"  placed in free space (vdsh-eval's rule); the default view takes the\n"
+"  best it can get. Deterministic for a seed.\n"
+"  -o, --output FILE       the view set to write\n"
+"      --cameras N         views besides the default (default 6)\n"
+"      --seed N            seed of the eyes, directions and lights (default 1)\n"
+"      --size WxH          frame size recorded in the set (default 512x384)\n"
+"\n"
+"truth: for every view, light set K and light J, frames DIR/NAME-sK-lJ-MODE.png\n"
+"  (16-bit grey, value round(v * 65535)), MODE:\n"
+"    hard     1 light visible, 0 blocked: the first hit toward the light\n"
+"             from the surface point (offset toward the camera) against the\n"
+"             occluders, d_T, against the light's distance d_L\n"
+"    ideal    ramp(d_T / d_L), ramp(x) = saturate((x - 1/3) * 1.5): the\n"
+"             exact distance through the runtime's comparison (--compare)\n"
+"    mask     1 where the pixel counts: a triangle is hit and its\n"
+"             interpolated normal faces the light (N . L > 0)\n"
+"    c-vdshN  the file's stream of order N, computed in C exactly on the\n"
+"             runtime's path (formats/vdsh_shadow.h: vdsh_shadow_interior\n"
+"             with the triangle's vertices and barycentrics)\n"
+"  Pixels that meet nothing hold 1 (mask 0). Primary rays go through pixel\n"
+"  centres (formats/vdsh_camera.h, the camera the runtime projects with)\n"
+"  and meet the receiver mesh; normals are interpolated as the GPU does.\n"
+"  Also DIR/NAME-sK-shaded-hard.png and -shaded-ideal.png: 8-bit RGBA\n"
+"  pictures of the set with the runtime's colour output: albedo 0.8 x\n"
+"  (ambient 0.03 + sum of 1.6 / (1 + 0.6 (n - 1)) x max(N . l, 0) /\n"
+"  (1 + d^2 / r^2) x shadow), r = 0.3 x the scene's diagonal, n lights.\n"
+"  Prints the time of each pass; a frame's truth is the primary pass plus\n"
+"  one light's shadow pass.\n"
+"      --views FILE        the view set\n"
+"  -o, --output DIR        where the frames go (created if missing)\n"
+"      --compare C         smooth (default, the paper's ramp) or binary,\n"
+"                          for ideal and the c-vdshN frames\n"
+"\n"
+"score: reads the truth (hard, ideal, mask from --truth DIR) and the frames\n"
+"  of each mode in LIST (comma-separated: vdsh-view's modes cube, cube-pcf,\n"
+"  vdsh2, vdsh3, vdsh5, vdsh5poly, or c-vdshN, or hard and ideal\n"
+"  themselves) from --frames DIR2, with the same names, and scores each\n"
+"  frame over its mask pixels; a light set pools its lights' frames and\n"
+"  the scene pools everything:\n"
+"    RMSE, PSNR   against ideal and against hard (PSNR peak 1; inf: equal)\n"
+"    recall       of the pixels with hard = 0 and ideal < .5, the share\n"
+"                 drawn at s < .5\n"
+"    false        false-shadow area: of the pixels with hard = 1, the share\n"
+"                 drawn at s < .5\n"
+"    blotches     4-connected regions of false shadow larger than 0.05%%\n"
+"                 of the frame's pixels: their count and area (share of\n"
+"                 the frames' pixels)\n"
+"  A missing frame or one of another size is an error naming the file.\n"
+"      --views FILE        the view set the frames were made for\n"
+"      --truth DIR         vdsh-frames truth's output\n"
+"      --frames DIR2       the frames to score (may be DIR itself)\n"
+"      --modes LIST        the modes to score\n"
+"      --json FILE         everything (per frame too) as JSON\n"
+"\n"
+"Common options:\n"
+"      --threads N         worker threads (default: all cores); the output\n"
+"                          does not depend on it\n"
+"  -q, --quiet             print nothing but errors\n"
+"  -h, --help              this text\n"
+"  -V, --version           version\n"
+"\n"
+"Exit status: 0 success, 1 error, 2 usage error.\n"
+"Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n"
+"         vdsh-frames views room.vdsh -o room.views.json\n"
+"         vdsh-frames truth room.vdsh --views room.views.json -o frames\n"
+"         vdsh-frames score room.vdsh --views room.views.json --truth frames \\\n"
+"             --frames frames --modes c-vdsh2,c-vdsh3,c-vdsh5\n");
+}
+
+static int bad_usage(const char *fmt, const char *arg)
+{
+    return vt_usage_error(PROG, fmt, arg);
+}
+
+/* ---- what every subcommand shares -------------------------------------------------- */
+
+typedef struct common {
+    unsigned threads;
+    int quiet;
+} common;
+
+/* The scene: the file, its occluders and the receiver scene. */
+typedef struct loaded {
+    vdsh_file *f;
+    vb_scene *occ;
+    vb_frames_scene *fs;
+} loaded;
+
+static void loaded_free(loaded *l)
+{
+    vb_frames_scene_destroy(l->fs);
+    vb_scene_destroy(l->occ);
+    vdsh_free(l->f);
+    memset(l, 0, sizeof *l);
+}
+
+static int load_scene(const char *path, unsigned threads, int traced, loaded *out)
+{
+    loaded l = {0};
+    vdsh_error verr;
+    vb_error err;
+    if (vdsh_read(path, &l.f, &verr) != VDSH_OK) {
+        fprintf(stderr, PROG ": %s\n", verr.msg);
+        return -1;
+    }
+    if (!traced) {
+        *out = l;
+        return 0;
+    }
+    char **spath = calloc(l.f->source_count + 1, sizeof *spath);
+    int rc = -1;
+    if (!spath) {
+        fprintf(stderr, PROG ": out of memory\n");
+        goto done;
+    }
+    for (uint32_t i = 0; i < l.f->source_count; i++) {
+        spath[i] = vb_eval_find_source(l.f->sources[i].name, path);
+        if (!spath[i]) {
+            fprintf(stderr, PROG ": %s: cannot find source %u of %u, '%s' (looked as "
+                            "recorded and beside the file)\n",
+                    path, i + 1, l.f->source_count, l.f->sources[i].name);
+            goto done;
+        }
+    }
+    vb_eval_scene_desc sd = {.threads = threads};
+    if (vb_eval_scene_create(l.f, (const char *const *)spath, l.f->source_count, &sd, &l.occ,
+                             &err) != VB_OK ||
+        vb_frames_scene_create(l.f, l.occ, threads, &l.fs, &err) != VB_OK) {
+        fprintf(stderr, PROG ": %s: %s\n", path, err.msg);
+        goto done;
+    }
+    rc = 0;
+done:
+    if (spath)
+        for (uint32_t i = 0; i < l.f->source_count; i++)
+            free(spath[i]);
+    free(spath);
+    if (rc)
+        loaded_free(&l);
+    else
+        *out = l;
+    return rc;
+}
+
+static int read_views(const char *path, vt_views *v)
+{
+    char msg[PATH_MAX + 256];
+    if (vt_views_read(path, v, msg, sizeof msg) != 0) {
+        fprintf(stderr, PROG ": %s\n", msg);
+        return -1;
+    }
+    return 0;
+}
+
+/* Options every subcommand takes; returns 1 if handled, or an exit code
+ * + 2 for help, version and errors (so 0 means "not mine"). */
+enum { O_THREADS = 256, O_CAMERAS, O_SEED, O_SIZE, O_VIEWS, O_COMPARE, O_TRUTH, O_FRAMES,
+       O_MODES, O_JSON };
+
+static int common_option(int c, common *co, int *exit_code)
+{
+    uint64_t u;
+    switch (c) {
+    case O_THREADS:
+        if (!vt_parse_u64(optarg, 1, 256, &u)) {
+            *exit_code = bad_usage("--threads takes a whole number 1..256, not '%s'", optarg);
+            return 2;
+        }
+        co->threads = (unsigned)u;
+        return 1;
+    case 'q':
+        co->quiet = 1;
+        return 1;
+    case 'h':
+        usage(stdout);
+        *exit_code = 0;
+        return 2;
+    case 'V':
+        printf(PROG " %s (.vdsh format %u, Embree %s)\n", VDSH_VERSION_STRING,
+               VDSH_FORMAT_VERSION, RTC_VERSION_STRING);
+        *exit_code = 0;
+        return 2;
+    case '?':
+    default:
+        fprintf(stderr, "Try '" PROG " --help'.\n");
+        *exit_code = VT_EXIT_USAGE;
+        return 2;
+    }
+}
+
+#define COMMON_OPTIONS                                                                       \
+    {"threads", required_argument, 0, O_THREADS}, {"quiet", no_argument, 0, 'q'},           \
+        {"help", no_argument, 0, 'h'}, {"version", no_argument, 0, 'V'}
+
+/* The one positional argument, SCENE.vdsh. */
+static const char *scene_argument(int argc, char **argv, const char *cmd)
+{
+    if (optind >= argc) {
+        vt_usage_error(PROG, "%s: no .vdsh file given", cmd);
+        return NULL;
+    }
+    if (optind + 1 < argc) {
+        vt_usage_error(PROG, "%s: one .vdsh file, not also '%s'", cmd, argv[optind + 1]);
+        return NULL;
+    }
+    return argv[optind];
+}
+
+/* ---- views ------------------------------------------------------------------------------ */
+
+static int cmd_views(int argc, char **argv)
+{
+    common co = {0};
+    vb_frames_views_desc d = {.cameras = 6, .seed = 1, .width = 512, .height = 384};
+    const char *out = NULL;
+    static const struct option longopts[] = {
+        {"output", required_argument, 0, 'o'}, {"cameras", required_argument, 0, O_CAMERAS},
+        {"seed", required_argument, 0, O_SEED}, {"size", required_argument, 0, O_SIZE},
+        COMMON_OPTIONS, {0, 0, 0, 0}};
+    int c, code;
+    uint64_t u;
+    while ((c = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'o': out = optarg; break;
+        case O_CAMERAS:
+            if (!vt_parse_u64(optarg, 1, VT_VIEWS_MAX - 1, &u))
+                return bad_usage("--cameras takes a whole number 1..255, not '%s'", optarg);
+            d.cameras = (uint32_t)u;
+            break;
+        case O_SEED:
+            if (!vt_parse_u64(optarg, 1, UINT64_MAX, &d.seed))
+                return bad_usage("--seed takes a whole number >= 1, not '%s'", optarg);
+            break;
+        case O_SIZE:
+            if (!vt_parse_size(optarg, 16, 16384, &d.width, &d.height))
+                return bad_usage("--size takes WxH, each 16..16384, not '%s'", optarg);
+            break;
+        default:
+            if (common_option(c, &co, &code) == 2)
+                return code;
+        }
+    }
+    const char *path = scene_argument(argc, argv, "views");
+    if (!path)
+        return VT_EXIT_USAGE;
+    if (!out)
+        return bad_usage("%s", "views: no output given (-o VIEWS.json)");
+    d.threads = co.threads;
+
+    loaded L;
+    if (load_scene(path, co.threads, 1, &L))
+        return 1;
+    int status = 1;
+    vb_frames_view *fv = calloc(1 + (size_t)d.cameras, sizeof *fv);
+    vt_views set = {.width = d.width, .height = d.height, .count = 1 + (int)d.cameras};
+    set.views = calloc((size_t)set.count, sizeof *set.views);
+    vb_frames_views_stats st;
+    vb_error err;
+    double t0 = vb_now();
+    if (!fv || !set.views) {
+        fprintf(stderr, PROG ": out of memory\n");
+        goto done;
+    }
+    if (vb_frames_make_views(L.fs, &d, fv, &st, &err) != VB_OK) {
+        fprintf(stderr, PROG ": %s: %s\n", path, err.msg);
+        goto done;
+    }
+    for (int i = 0; i < set.count; i++) {
+        vt_view *v = set.views + i;
+        if (i == 0)
+            snprintf(v->name, sizeof v->name, "default");
+        else
+            snprintf(v->name, sizeof v->name, "v%d", i);
+        v->camera = fv[i].camera;
+        v->set_count = VB_FRAMES_SETS;
+        v->light_count[0] = 1;
+        v->light_count[1] = 3;
+        memcpy(v->lights[0][0], fv[i].lights[0], sizeof v->lights[0][0]);
+        for (int j = 0; j < 3; j++)
+            memcpy(v->lights[1][j], fv[i].lights[1 + j], sizeof v->lights[1][j]);
+    }
+    char msg[PATH_MAX + 256];
+    if (vt_views_write(out, &set, msg, sizeof msg) != 0) {
+        fprintf(stderr, PROG ": %s\n", msg);
+        goto done;
+    }
+    if (!co.quiet) {
+        printf(PROG " views: %s -> %s: %d views, %d x %d, seed %llu; %u candidate eyes "
+                    "(%u in free space), %.2f s\n",
+               path, out, set.count, d.width, d.height, (unsigned long long)d.seed,
+               st.eyes_tried, st.eyes_free, vb_now() - t0);
+        if (st.default_lights_ok < VB_FRAMES_VIEW_LIGHTS)
+            printf("  note: only %u of the default view's 4 lights light and shadow %.0f%% "
+                   "of it each; the best others fill in\n",
+                   st.default_lights_ok, 100.0 * VB_FRAMES_MIN_SHARE);
+        for (int i = 0; i < set.count; i++) {
+            const vdsh_camera *cam = &fv[i].camera;
+            printf("  %-8s eye (%.3g, %.3g, %.3g) target (%.3g, %.3g, %.3g); lit / shadowed "
+                   "per light:",
+                   set.views[i].name, (double)cam->eye[0], (double)cam->eye[1],
+                   (double)cam->eye[2], (double)cam->target[0], (double)cam->target[1],
+                   (double)cam->target[2]);
+            for (int j = 0; j < VB_FRAMES_VIEW_LIGHTS; j++)
+                printf(" %.0f/%.0f%%", 100.0 * fv[i].lit[j], 100.0 * fv[i].shadowed[j]);
+            printf("\n");
+        }
+    }
+    status = 0;
+done:
+    free(fv);
+    vt_views_free(&set);
+    loaded_free(&L);
+    return status;
+}
+
+/* ---- truth ----------------------------------------------------------------------------- */
+
+static int make_dir(const char *dir)
+{
+    struct stat st;
+    if (mkdir(dir, 0777) == 0)
+        return 0;
+    if (errno == EEXIST && stat(dir, &st) == 0 && S_ISDIR(st.st_mode))
+        return 0;
+    fprintf(stderr, PROG ": %s: cannot create the folder: %s\n", dir,
+            errno == EEXIST ? "a file of that name is there" : strerror(errno));
+    return -1;
+}
+
+/* The frames of one light, written on the workers: PNG encoding is most
+ * of the truth's time. Each item keeps its own message; the first failure
+ * in item order is reported, whatever the scheduling. */
+typedef struct frame_item {
+    char mode[32];
+    const float *values;
+    int failed;
+    char msg[PATH_MAX + 256];
+} frame_item;
+
+typedef struct frame_batch {
+    const char *dir, *view;
+    int set, light, w, h;
+    frame_item *items;
+} frame_batch;
+
+static void write_items(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
+{
+    (void)worker;
+    frame_batch *b = ctx;
+    for (uint32_t i = begin; i < end; i++) {
+        frame_item *it = b->items + i;
+        char path[PATH_MAX];
+        if (vt_frame_path(path, sizeof path, b->dir, b->view, b->set, b->light, it->mode)) {
+            snprintf(it->msg, sizeof it->msg, "%s: path too long", b->dir);
+            it->failed = 1;
+        } else if (vt_png16_write(path, b->w, b->h, it->values, it->msg, sizeof it->msg)) {
+            it->failed = 1;
+        }
+    }
+}
+
+static int write_frames(const frame_batch *b, uint32_t count, unsigned threads)
+{
+    if (!vb_parallel_for(threads, count, 1, write_items, (void *)b, NULL, NULL)) {
+        fprintf(stderr, PROG ": cannot start worker threads\n");
+        return -1;
+    }
+    for (uint32_t i = 0; i < count; i++)
+        if (b->items[i].failed) {
+            fprintf(stderr, PROG ": %s\n", b->items[i].msg);
+            return -1;
+        }
+    return 0;
+}
+
+static int cmd_truth(int argc, char **argv)
+{
+    common co = {0};
+    const char *views_path = NULL, *dir = NULL;
+    uint32_t compare = VDSH_COMPARE_SMOOTH;
+    static const struct option longopts[] = {
+        {"output", required_argument, 0, 'o'}, {"views", required_argument, 0, O_VIEWS},
+        {"compare", required_argument, 0, O_COMPARE}, COMMON_OPTIONS, {0, 0, 0, 0}};
+    int c, code;
+    while ((c = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'o': dir = optarg; break;
+        case O_VIEWS: views_path = optarg; break;
+        case O_COMPARE:
+            if (strcmp(optarg, "smooth") == 0)
+                compare = VDSH_COMPARE_SMOOTH;
+            else if (strcmp(optarg, "binary") == 0)
+                compare = VDSH_COMPARE_BINARY;
+            else
+                return bad_usage("--compare takes smooth or binary, not '%s'", optarg);
+            break;
+        default:
+            if (common_option(c, &co, &code) == 2)
+                return code;
+        }
+    }
+    const char *path = scene_argument(argc, argv, "truth");
+    if (!path)
+        return VT_EXIT_USAGE;
+    if (!views_path)
+        return bad_usage("%s", "truth: no view set given (--views VIEWS.json)");
+    if (!dir)
+        return bad_usage("%s", "truth: no output folder given (-o DIR)");
+
+    vt_views V = {0};
+    if (read_views(views_path, &V))
+        return 1;
+    loaded L;
+    if (load_scene(path, co.threads, 1, &L)) {
+        vt_views_free(&V);
+        return 1;
+    }
+    int status = 1;
+    const vdsh_file *f = L.f;
+    const int w = V.width, h = V.height;
+    const size_t n = (size_t)w * (size_t)h;
+    vb_frames_hits hits = {0};
+    vb_frames_light lights[VT_VIEWS_MAX_LIGHTS];
+    memset(lights, 0, sizeof lights);
+    float *streams = malloc(((size_t)f->stream_count + 1) * n * sizeof *streams);
+    frame_item *items = calloc(3 + (size_t)f->stream_count, sizeof *items);
+    uint8_t *rgba = malloc(4 * n);
+    vb_error err;
+    /* One c-vdshN per order: the first stream of each. */
+    int use[VDSH_MAX_STREAMS] = {0}, seen[VDSH_MAX_ORDER + 1] = {0};
+    for (uint32_t s = 0; s < f->stream_count; s++) {
+        uint32_t o = f->streams[s].order;
+        if (o <= VDSH_MAX_ORDER && !seen[o]) {
+            use[s] = 1;
+            seen[o] = 1;
+        } else if (!co.quiet) {
+            fprintf(stderr, PROG ": %s: stream %u repeats order %u: only the first is drawn\n",
+                    path, s, o);
+        }
+    }
+    if (!streams || !items || !rgba) {
+        fprintf(stderr, PROG ": out of memory for %d x %d frames\n", w, h);
+        goto done;
+    }
+    if (make_dir(dir))
+        goto done;
+
+    double t_primary = 0.0, t_shadow = 0.0, t_streams = 0.0, t_write = 0.0, t0 = vb_now();
+    int light_frames = 0, stream_frames = 0;
+    if (!co.quiet)
+        printf(PROG " truth: %s, %d views from %s, %d x %d, %s comparison -> %s\n", path,
+               V.count, views_path, w, h, compare == VDSH_COMPARE_BINARY ? "binary" : "smooth",
+               dir);
+    for (int vi = 0; vi < V.count; vi++) {
+        const vt_view *v = V.views + vi;
+        double t = vb_now();
+        if (vb_frames_trace_primary(L.fs, &v->camera, w, h, co.threads, &hits, &err) != VB_OK) {
+            fprintf(stderr, PROG ": %s: view '%s': %s\n", views_path, v->name, err.msg);
+            goto done;
+        }
+        double tp = vb_now() - t, ts = 0.0, tc = 0.0;
+        t_primary += tp;
+        int view_lights = 0;
+        for (int k = 0; k < v->set_count; k++) {
+            const float *vis_hard[VT_VIEWS_MAX_LIGHTS], *vis_ideal[VT_VIEWS_MAX_LIGHTS];
+            for (int j = 0; j < v->light_count[k]; j++) {
+                const float *L0 = v->lights[k][j];
+                t = vb_now();
+                if (vb_frames_trace_light(L.fs, &hits, L0, compare, co.threads, &lights[j],
+                                          &err) != VB_OK) {
+                    fprintf(stderr, PROG ": view '%s': %s\n", v->name, err.msg);
+                    goto done;
+                }
+                ts += vb_now() - t;
+                light_frames++;
+                view_lights++;
+                vis_hard[j] = lights[j].hard;
+                vis_ideal[j] = lights[j].ideal;
+                frame_batch fb = {.dir = dir, .view = v->name, .set = k, .light = j, .w = w,
+                                  .h = h, .items = items};
+                uint32_t count = 0;
+                const char *truth_modes[3] = {"hard", "ideal", "mask"};
+                const float *truth_values[3] = {lights[j].hard, lights[j].ideal,
+                                                lights[j].mask};
+                for (int m = 0; m < 3; m++, count++) {
+                    memset(&items[count], 0, sizeof items[count]);
+                    snprintf(items[count].mode, sizeof items[count].mode, "%s", truth_modes[m]);
+                    items[count].values = truth_values[m];
+                }
+                for (uint32_t s = 0; s < f->stream_count; s++) {
+                    if (!use[s])
+                        continue;
+                    float *out = streams + (size_t)s * n;
+                    t = vb_now();
+                    if (vb_frames_eval_stream(L.fs, &hits, s, L0, compare, co.threads, out,
+                                              &err) != VB_OK) {
+                        fprintf(stderr, PROG ": %s: %s\n", path, err.msg);
+                        goto done;
+                    }
+                    tc += vb_now() - t;
+                    stream_frames++;
+                    memset(&items[count], 0, sizeof items[count]);
+                    snprintf(items[count].mode, sizeof items[count].mode, "c-vdsh%u",
+                             f->streams[s].order);
+                    items[count++].values = out;
+                }
+                t = vb_now();
+                if (write_frames(&fb, count, co.threads))
+                    goto done;
+                t_write += vb_now() - t;
+            }
+            /* The pictures of the set. */
+            vb_frames_shading sh;
+            vb_frames_shading_default(L.fs, v->light_count[k], &sh);
+            for (int pass = 0; pass < 2; pass++) {
+                char p[PATH_MAX], msg[PATH_MAX + 256];
+                int len = snprintf(p, sizeof p, "%s/%s-s%d-shaded-%s.png", dir, v->name, k,
+                                   pass ? "ideal" : "hard");
+                if (len < 0 || (size_t)len >= sizeof p) {
+                    fprintf(stderr, PROG ": %s: path too long\n", dir);
+                    goto done;
+                }
+                vb_frames_shade(&hits, (const float(*)[3])v->lights[k], v->light_count[k],
+                                pass ? vis_ideal : vis_hard, &sh, rgba);
+                if (vt_png_rgba_write(p, w, h, rgba, msg, sizeof msg) != 0) {
+                    fprintf(stderr, PROG ": %s\n", msg);
+                    goto done;
+                }
+            }
+            for (int j = 0; j < v->light_count[k]; j++)
+                vb_frames_light_free(&lights[j]);
+        }
+        vb_frames_hits_free(&hits);
+        t_shadow += ts;
+        t_streams += tc;
+        if (!co.quiet)
+            printf("  %-10s primary %6.1f ms; %d lights: shadow %6.1f ms per light, C streams "
+                   "%6.1f ms per light\n",
+                   v->name, 1e3 * tp, view_lights, 1e3 * ts / (view_lights ? view_lights : 1),
+                   1e3 * tc / (view_lights ? view_lights : 1));
+    }
+    if (!co.quiet) {
+        double per_view = t_primary / V.count;
+        double per_light = light_frames ? t_shadow / light_frames : 0.0;
+        printf("  a frame's truth (%d x %d, primary + shadow ray per pixel): %.1f ms "
+               "(primary %.1f + shadow %.1f) on %u threads\n",
+               w, h, 1e3 * (per_view + per_light), 1e3 * per_view, 1e3 * per_light,
+               vb_parallel_threads(co.threads));
+        printf("  C streams: %.1f ms per stream per frame; %d + %d frames written (%.2f s) in "
+               "%.2f s in all\n",
+               stream_frames ? 1e3 * t_streams / stream_frames : 0.0, 3 * light_frames,
+               stream_frames, t_write, vb_now() - t0);
+    }
+    status = 0;
+done:
+    for (int j = 0; j < VT_VIEWS_MAX_LIGHTS; j++)
+        vb_frames_light_free(&lights[j]);
+    vb_frames_hits_free(&hits);
+    free(streams);
+    free(items);
+    free(rgba);
+    loaded_free(&L);
+    vt_views_free(&V);
+    return status;
+}
+
+/* ---- score ------------------------------------------------------------------------------- */
+
+static int good_mode(const char *s, size_t n)
+{
+    if (n == 0 || n > 48)
+        return 0;
+    for (size_t i = 0; i < n; i++)
+        if (!((s[i] >= 'a' && s[i] <= 'z') || (s[i] >= 'A' && s[i] <= 'Z') ||
+              (s[i] >= '0' && s[i] <= '9') || s[i] == '-' || s[i] == '_'))
+            return 0;
+    return 1;
+}
+
+/* name,name,... into modes; the count, or 0 if not such a list. */
+static int parse_modes(const char *s, char modes[MAX_MODES][64])
+{
+    int n = 0;
+    for (;;) {
+        const char *e = strchr(s, ',');
+        size_t len = e ? (size_t)(e - s) : strlen(s);
+        if (!good_mode(s, len) || n == MAX_MODES)
+            return 0;
+        memcpy(modes[n], s, len);
+        modes[n][len] = '\0';
+        for (int i = 0; i < n; i++)
+            if (strcmp(modes[i], modes[n]) == 0)
+                return 0;
+        n++;
+        if (!e)
+            return n;
+        s = e + 1;
+    }
+}
+
+/* A frame of the view set's size, or -1 with the file named. */
+static int read_frame(const char *dir, const vt_views *V, const char *views_path,
+                      const char *view, int set, int light, const char *mode, float **out,
+                      char *path, size_t cap)
+{
+    char msg[PATH_MAX + 256];
+    int w, h;
+    if (vt_frame_path(path, cap, dir, view, set, light, mode) != 0) {
+        fprintf(stderr, PROG ": %s: path too long\n", dir);
+        return -1;
+    }
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        fprintf(stderr, PROG ": %s: missing frame (view '%s', set %d, light %d, mode %s): %s\n",
+                path, view, set, light, mode, strerror(errno));
+        return -1;
+    }
+    if (vt_png16_read(path, &w, &h, out, msg, sizeof msg) != 0) {
+        fprintf(stderr, PROG ": %s\n", msg);
+        return -1;
+    }
+    if (w != V->width || h != V->height) {
+        fprintf(stderr, PROG ": %s: %d x %d pixels, but the view set %s is %d x %d\n", path, w,
+                h, views_path, V->width, V->height);
+        free(*out);
+        *out = NULL;
+        return -1;
+    }
+    return 0;
+}
+
+static void json_scores(vt_json *j, cJSON *o, const vb_frames_tally *t)
+{
+    vb_frames_scores s;
+    vb_frames_scores_get(t, &s);
+    vt_json_u64(j, o, "frames", t->frames);
+    vt_json_u64(j, o, "pixels", t->pixels);
+    vt_json_u64(j, o, "counted", t->counted);
+    vt_json_f64(j, o, "rmse_ideal", s.rmse_ideal);
+    vt_json_f64(j, o, "psnr_ideal", s.psnr_ideal);
+    vt_json_f64(j, o, "rmse_hard", s.rmse_hard);
+    vt_json_f64(j, o, "psnr_hard", s.psnr_hard);
+    vt_json_f64(j, o, "recall", s.recall);
+    vt_json_u64(j, o, "shadowed", t->shadowed);
+    vt_json_f64(j, o, "false_area", s.false_area);
+    vt_json_u64(j, o, "lit", t->lit);
+    vt_json_u64(j, o, "blotches", s.blotches);
+    vt_json_f64(j, o, "blotch_area", s.blotch_area);
+}
+
+static void print_row(const char *view, const char *set, int lights, const vb_frames_tally *t)
+{
+    vb_frames_scores s;
+    vb_frames_scores_get(t, &s);
+    printf("  %-10s %-3s %6d %9llu  %8.4f %6.2f  %8.4f %6.2f  %7.4f %7.4f  %4llu %7.3f%%\n",
+           view, set, lights, (unsigned long long)t->counted, s.rmse_ideal, s.psnr_ideal,
+           s.rmse_hard, s.psnr_hard, s.recall, s.false_area, (unsigned long long)s.blotches,
+           100.0 * s.blotch_area);
+}
+
+static int cmd_score(int argc, char **argv)
+{
+    common co = {0};
+    const char *views_path = NULL, *truth = NULL, *frames = NULL, *json = NULL;
+    char modes[MAX_MODES][64];
+    int mode_count = 0;
+    static const struct option longopts[] = {
+        {"views", required_argument, 0, O_VIEWS}, {"truth", required_argument, 0, O_TRUTH},
+        {"frames", required_argument, 0, O_FRAMES}, {"modes", required_argument, 0, O_MODES},
+        {"json", required_argument, 0, O_JSON}, COMMON_OPTIONS, {0, 0, 0, 0}};
+    int c, code;
+    while ((c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
+        switch (c) {
+        case O_VIEWS: views_path = optarg; break;
+        case O_TRUTH: truth = optarg; break;
+        case O_FRAMES: frames = optarg; break;
+        case O_JSON: json = optarg; break;
+        case O_MODES:
+            mode_count = parse_modes(optarg, modes);
+            if (!mode_count)
+                return bad_usage("--modes takes distinct names of letters, digits, '-' and "
+                                 "'_' separated by commas (at most 32), not '%s'", optarg);
+            break;
+        default:
+            if (common_option(c, &co, &code) == 2)
+                return code;
+        }
+    }
+    const char *path = scene_argument(argc, argv, "score");
+    if (!path)
+        return VT_EXIT_USAGE;
+    if (!views_path)
+        return bad_usage("%s", "score: no view set given (--views VIEWS.json)");
+    if (!truth)
+        return bad_usage("%s", "score: no truth folder given (--truth DIR)");
+    if (!frames)
+        return bad_usage("%s", "score: no folder of frames given (--frames DIR2)");
+    if (!mode_count)
+        return bad_usage("%s", "score: no modes given (--modes LIST)");
+
+    vt_views V = {0};
+    if (read_views(views_path, &V))
+        return 1;
+    loaded L = {0};
+    if (load_scene(path, co.threads, 0, &L)) {
+        vt_views_free(&V);
+        return 1;
+    }
+    int status = 1;
+    /* Tallies: per mode, per (view, set, light) frame; sets and the scene
+     * are sums of those, in order. */
+    size_t frame_count = 0;
+    for (int vi = 0; vi < V.count; vi++)
+        for (int k = 0; k < V.views[vi].set_count; k++)
+            frame_count += (size_t)V.views[vi].light_count[k];
+    vb_frames_tally *tally = calloc((size_t)mode_count * frame_count, sizeof *tally);
+    float *hard = NULL, *ideal = NULL, *mask = NULL, *s = NULL;
+    vt_json j = {0};
+    vb_error err;
+    char p[PATH_MAX];
+    if (!tally) {
+        fprintf(stderr, PROG ": out of memory\n");
+        goto done;
+    }
+    size_t fi = 0;
+    for (int vi = 0; vi < V.count; vi++) {
+        const vt_view *v = V.views + vi;
+        for (int k = 0; k < v->set_count; k++)
+            for (int l = 0; l < v->light_count[k]; l++, fi++) {
+                if (read_frame(truth, &V, views_path, v->name, k, l, "hard", &hard, p,
+                               sizeof p) ||
+                    read_frame(truth, &V, views_path, v->name, k, l, "ideal", &ideal, p,
+                               sizeof p) ||
+                    read_frame(truth, &V, views_path, v->name, k, l, "mask", &mask, p,
+                               sizeof p))
+                    goto done;
+                for (int m = 0; m < mode_count; m++) {
+                    if (read_frame(frames, &V, views_path, v->name, k, l, modes[m], &s, p,
+                                   sizeof p))
+                        goto done;
+                    if (vb_frames_score_frame(s, hard, ideal, mask, V.width, V.height,
+                                              &tally[(size_t)m * frame_count + fi],
+                                              &err) != VB_OK) {
+                        fprintf(stderr, PROG ": %s: %s\n", p, err.msg);
+                        goto done;
+                    }
+                    free(s);
+                    s = NULL;
+                }
+                free(hard);
+                free(ideal);
+                free(mask);
+                hard = ideal = mask = NULL;
+            }
+    }
+
+    /* Report: the table, then the JSON. */
+    cJSON *root = vt_json_object(&j, NULL, NULL);
+    vt_json_string(&j, root, "tool", PROG);
+    vt_json_string(&j, root, "command", "score");
+    vt_json_string(&j, root, "version", VDSH_VERSION_STRING);
+    vt_json_string(&j, root, "scene", path);
+    vt_json_string(&j, root, "views", views_path);
+    vt_json_string(&j, root, "truth", truth);
+    vt_json_string(&j, root, "frames", frames);
+    vt_json_u64(&j, root, "width", (uint64_t)V.width);
+    vt_json_u64(&j, root, "height", (uint64_t)V.height);
+    vt_json_f64(&j, root, "blotch_threshold", VB_FRAMES_BLOTCH);
+    cJSON *jm = vt_json_array(&j, root, "modes");
+    if (!co.quiet)
+        printf(PROG " score: %s, %d views from %s, %d x %d; truth %s, frames %s\n", path,
+               V.count, views_path, V.width, V.height, truth, frames);
+    for (int m = 0; m < mode_count; m++) {
+        const vb_frames_tally *T = tally + (size_t)m * frame_count;
+        vb_frames_tally scene = {0};
+        cJSON *mo = vt_json_object(&j, jm, NULL);
+        vt_json_string(&j, mo, "mode", modes[m]);
+        cJSON *sets = vt_json_array(&j, mo, "sets");
+        if (!co.quiet)
+            printf("\n  mode %s\n  %-10s %-3s %6s %9s  %8s %6s  %8s %6s  %7s %7s  %s\n",
+                   modes[m], "view", "set", "lights", "counted", "RMSE/id", "PSNR", "RMSE/hd",
+                   "PSNR", "recall", "false", "blotches");
+        fi = 0;
+        for (int vi = 0; vi < V.count; vi++) {
+            const vt_view *v = V.views + vi;
+            for (int k = 0; k < v->set_count; k++) {
+                vb_frames_tally set = {0};
+                cJSON *so = vt_json_object(&j, sets, NULL);
+                vt_json_string(&j, so, "view", v->name);
+                vt_json_i64(&j, so, "set", k);
+                cJSON *fr = vt_json_array(&j, so, "frames");
+                for (int l = 0; l < v->light_count[k]; l++, fi++) {
+                    vb_frames_tally_add(&set, &T[fi]);
+                    cJSON *o = vt_json_object(&j, fr, NULL);
+                    vt_json_i64(&j, o, "light", l);
+                    vt_frame_path(p, sizeof p, frames, v->name, k, l, modes[m]);
+                    vt_json_string(&j, o, "file", p);
+                    json_scores(&j, o, &T[fi]);
+                }
+                json_scores(&j, so, &set);
+                vb_frames_tally_add(&scene, &set);
+                if (!co.quiet) {
+                    char sk[16];
+                    snprintf(sk, sizeof sk, "%d", k);
+                    print_row(v->name, sk, v->light_count[k], &set);
+                }
+            }
+        }
+        json_scores(&j, vt_json_object(&j, mo, "scene"), &scene);
+        if (!co.quiet)
+            print_row("scene", "", (int)scene.frames, &scene);
+    }
+    if (!co.quiet)
+        printf("\n  (over mask pixels; recall: of hard = 0 and ideal < .5, drawn < .5; false: "
+               "of hard = 1, drawn < .5;\n   blotches: false-shadow regions above %.2f%% of a "
+               "frame, count and area; scene row: lights = frames)\n",
+               100.0 * VB_FRAMES_BLOTCH);
+    char msg[PATH_MAX + 256];
+    if (json && vt_json_write_file(&j, json, msg, sizeof msg) != 0) {
+        fprintf(stderr, PROG ": %s\n", msg);
+        goto done;
+    }
+    status = 0;
+done:
+    vt_json_free(&j);
+    free(tally);
+    free(hard);
+    free(ideal);
+    free(mask);
+    free(s);
+    loaded_free(&L);
+    vt_views_free(&V);
+    return status;
+}
+
+/* ---- main ---------------------------------------------------------------------------------- */
+
+int main(int argc, char **argv)
+{
+    if (argc < 2)
+        return bad_usage("%s", "no subcommand given (views, truth or score)");
+    const char *cmd = argv[1];
+    if (strcmp(cmd, "-h") == 0 || strcmp(cmd, "--help") == 0) {
+        usage(stdout);
+        return 0;
+    }
+    if (strcmp(cmd, "-V") == 0 || strcmp(cmd, "--version") == 0) {
+        printf(PROG " %s (.vdsh format %u, Embree %s)\n", VDSH_VERSION_STRING,
+               VDSH_FORMAT_VERSION, RTC_VERSION_STRING);
+        return 0;
+    }
+    /* Each subcommand parses its own options; getopt's messages name it. */
+    optind = 1;
+    if (strcmp(cmd, "views") == 0) {
+        argv[1] = PROG " views";
+        return cmd_views(argc - 1, argv + 1);
+    }
+    if (strcmp(cmd, "truth") == 0) {
+        argv[1] = PROG " truth";
+        return cmd_truth(argc - 1, argv + 1);
+    }
+    if (strcmp(cmd, "score") == 0) {
+        argv[1] = PROG " score";
+        return cmd_score(argc - 1, argv + 1);
+    }
+    return bad_usage("unknown subcommand '%s' (views, truth or score)", cmd);
+}
