@@ -313,6 +313,11 @@ grep -q "saved vdsh-view-000.png" keys.log
 "$png" info vdsh-view-000.png 160 120
 ]=] sh ${_view} ${_png} ${_room} ${_rt_dir}/view_window)
 
+# The default lights of the built-in room (baked above) in free space: none
+# in or on a pillar, crate or the sphere (test_scene_view, no GL).
+add_test(NAME runtime_default_lights COMMAND test_scene_view room ${_rt_dir}/room/room.vdsh)
+set_tests_properties(runtime_default_lights PROPERTIES FIXTURES_REQUIRED runtime_room)
+
 foreach(t runtime_view_usage runtime_view_errors runtime_view_render runtime_view_bench
           runtime_view_frame runtime_view_window)
   if(TEST ${t})
