@@ -12,7 +12,9 @@
 #include "vr.h"
 #include "vr_context.h"
 #include "vt_cli.h"
+#include "vt_image.h"
 #include "vt_json.h"
+#include "vt_views.h"
 
 #ifdef VR_HAVE_GLFW
 #define GLFW_INCLUDE_NONE
@@ -27,6 +29,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #ifndef VDSH_VERSION_STRING
@@ -52,6 +55,7 @@ typedef struct options {
     int have_ambient;
     float ambient;
     vr_mode mode;
+    int have_mode;
     uint32_t compare;
     int pcf;
     int shadow_size;
@@ -66,6 +70,11 @@ typedef struct options {
     const char *screenshot;
     int no_overlay;
     const char *keys;
+    const char *views_path;    /* --views: frames for a view set */
+    const char *frames_arg;    /* --frames: a count, or with --views the folder */
+    const char *frames_dir;
+    int frame_modes[16];       /* --modes: indices into frame_modes[] */
+    int frame_mode_count;
 } options;
 
 static const char usage_text[] =
@@ -73,6 +82,7 @@ static const char usage_text[] =
     "       vdsh-view --render OUT.png [options] SCENE.vdsh\n"
     "       vdsh-view --grid OUT.png [options] SCENE.vdsh...\n"
     "       vdsh-view --bench [options] SCENE.vdsh...\n"
+    "       vdsh-view --views VIEWS.json --frames DIR [options] SCENE.vdsh\n"
     "Look at a scene baked by vdsh-bake, lit by point lights with precomputed\n"
     "visibility-distance shadows (VDSH) or cube shadow maps.\n"
     "\n"
@@ -86,6 +96,19 @@ static const char usage_text[] =
     "                        SCENE, all in this process, each round timing\n"
     "                        every mode of every SCENE once (wall time and\n"
     "                        process CPU time per frame); JSON on stdout\n"
+    "      --views FILE      with --frames DIR: for every view, light set and\n"
+    "                        light of the view set FILE (vdsh-frames writes\n"
+    "                        one), the shadow of that one light alone as a\n"
+    "                        16-bit grey PNG, DIR/NAME-sK-lJ-MODE.png (the\n"
+    "                        shadow factor s: 0 shadowed .. 1 lit, no shading;\n"
+    "                        1 where no surface is), and per view and set the\n"
+    "                        shaded picture of all its lights together,\n"
+    "                        DIR/NAME-sK-shaded-MODE.png; K and J count from 0.\n"
+    "                        At the view set's size; time per frame on stderr\n"
+    "      --modes LIST      with --views: modes to render, comma-separated:\n"
+    "                        cube, cube-pcf (4 taps), vdsh2, vdsh3, vdsh5,\n"
+    "                        vdsh5poly, none (default: every one of the first\n"
+    "                        six that the scene has)\n"
     "\n"
     "View (defaults come from the scene's bounds, y up: a room is seen from\n"
     "inside, an object framed from outside, lit from outside):\n"
@@ -119,7 +142,8 @@ static const char usage_text[] =
     "      --egl P           headless EGL platform: device or surfaceless\n"
     "                        (default: device, else surfaceless)\n"
     "      --frames N        window: quit after N frames; --bench: timed\n"
-    "                        rounds per mode (default 7)\n"
+    "                        rounds per mode (default 7); with --views the\n"
+    "                        folder the frames go to (made if missing)\n"
     "      --screenshot FILE window: save what the window shows after the\n"
     "                        last frame (with --frames) as PNG\n"
     "      --no-overlay      window: start without the text overlay\n"
@@ -156,6 +180,46 @@ static int usage_error(const char *fmt, const char *arg)
     return vt_usage_error("vdsh-view", fmt, arg);
 }
 
+/* The modes frames are rendered in, by file name (--modes); the first
+ * FRAME_DEFAULT_MODES are the default, where the scene has them. */
+typedef struct frame_mode {
+    const char *name;
+    vr_mode mode;
+    int pcf;
+} frame_mode;
+
+static const frame_mode frame_modes[] = {
+    {"cube", VR_MODE_CUBE, 0},       {"cube-pcf", VR_MODE_CUBE, 1},
+    {"vdsh2", VR_MODE_VDSH2, 0},     {"vdsh3", VR_MODE_VDSH3, 0},
+    {"vdsh5", VR_MODE_VDSH5, 0},     {"vdsh5poly", VR_MODE_VDSH5_POLY, 0},
+    {"none", VR_MODE_NONE, 0}};
+enum { FRAME_MODES = 7, FRAME_DEFAULT_MODES = 6 };
+
+/* "cube,vdsh5" into o->frame_modes (each once, in the order given);
+ * 0, or -1 for an unknown or empty name. */
+static int parse_modes(const char *list, options *o)
+{
+    o->frame_mode_count = 0;
+    const char *p = list;
+    for (;;) {
+        size_t len = strcspn(p, ",");
+        int found = -1;
+        for (int i = 0; i < FRAME_MODES; i++)
+            if (strlen(frame_modes[i].name) == len && !strncmp(p, frame_modes[i].name, len))
+                found = i;
+        if (found < 0)
+            return -1;
+        int seen = 0;
+        for (int i = 0; i < o->frame_mode_count; i++)
+            seen |= o->frame_modes[i] == found;
+        if (!seen)
+            o->frame_modes[o->frame_mode_count++] = found;
+        if (!p[len])
+            return 0;
+        p += len + 1;
+    }
+}
+
 /* Returns 0, or an exit status (help/version: -1 meaning exit 0). */
 static int parse_args(int argc, char **argv, options *o)
 {
@@ -165,7 +229,7 @@ static int parse_args(int argc, char **argv, options *o)
     enum { O_RENDER = 256, O_GRID, O_BENCH, O_CAMERA, O_FIT, O_FOV, O_LIGHT, O_LIGHTS,
            O_ATT, O_AMBIENT, O_MODE, O_COMPARE, O_PCF, O_SHADOW_SIZE, O_SIZE, O_CUBEDIR,
            O_NO_CUBEMAPS, O_EGL, O_FRAMES, O_SCREENSHOT, O_NO_OVERLAY, O_KEYS,
-           O_NO_MALLOPT };
+           O_NO_MALLOPT, O_VIEWS, O_MODES };
     static const struct option longopts[] = {
         {"render", required_argument, 0, O_RENDER},
         {"grid", required_argument, 0, O_GRID},
@@ -190,6 +254,8 @@ static int parse_args(int argc, char **argv, options *o)
         {"no-overlay", no_argument, 0, O_NO_OVERLAY},
         {"keys", required_argument, 0, O_KEYS},
         {"no-mallopt", no_argument, 0, O_NO_MALLOPT},
+        {"views", required_argument, 0, O_VIEWS},
+        {"modes", required_argument, 0, O_MODES},
         {"quiet", no_argument, 0, 'q'},
         {"help", no_argument, 0, 'h'},
         {"version", no_argument, 0, 'V'},
@@ -256,6 +322,7 @@ static int parse_args(int argc, char **argv, options *o)
             if (vr_mode_from_name(v, &o->mode))
                 return usage_error("--mode: expected none, cube, vdsh2, vdsh3, vdsh5 or "
                                    "vdsh5poly, got '%s'", v);
+            o->have_mode = 1;
             break;
         case O_COMPARE:
             if (!strcmp(v, "smooth"))
@@ -285,9 +352,12 @@ static int parse_args(int argc, char **argv, options *o)
             else
                 return usage_error("--egl: expected device or surfaceless, got '%s'", v);
             break;
-        case O_FRAMES:
-            if (!vt_parse_int(v, 1, 1000000, &o->frames))
-                return usage_error("--frames: expected a positive count, got '%s'", v);
+        case O_FRAMES: o->frames_arg = v; break;
+        case O_VIEWS: o->views_path = v; break;
+        case O_MODES:
+            if (parse_modes(v, o))
+                return usage_error("--modes: expected a comma-separated list of cube, cube-pcf, "
+                                   "vdsh2, vdsh3, vdsh5, vdsh5poly and none, got '%s'", v);
             break;
         case O_SCREENSHOT: o->screenshot = v; break;
         case O_NO_OVERLAY: o->no_overlay = 1; break;
@@ -311,6 +381,26 @@ static int parse_args(int argc, char **argv, options *o)
     }
     if (o->file_count == 0)
         return usage_error("%s", "no scene file given");
+    /* --frames: a folder with --views, else a count. */
+    if (o->views_path) {
+        if (!o->frames_arg || !*o->frames_arg)
+            return usage_error("%s", "--views: give the folder for the frames with --frames DIR");
+        o->frames_dir = o->frames_arg;
+        if (o->render_path || o->grid_path || o->bench)
+            return usage_error("%s", "--views makes frames: not with --render, --grid or --bench");
+        if (o->have_camera || o->fit || o->fov > 0.0f || o->light_count || o->default_lights ||
+            o->have_size)
+            return usage_error("%s", "--views gives the cameras, lights and size: not with "
+                               "--camera, --fit, --fov, --light, --lights or --size");
+        if (o->have_mode || o->pcf)
+            return usage_error("%s", "--views renders the modes of --modes (cube-pcf: the cube "
+                               "map with PCF): not with --mode or --pcf");
+    } else {
+        if (o->frame_mode_count)
+            return usage_error("%s", "--modes: only with --views");
+        if (o->frames_arg && !vt_parse_int(o->frames_arg, 1, 1000000, &o->frames))
+            return usage_error("--frames: expected a positive count, got '%s'", o->frames_arg);
+    }
     if ((o->render_path != NULL) + (o->grid_path != NULL) + o->bench > 1)
         return usage_error("%s", "choose one of --render, --grid and --bench");
     if (o->file_count > 1 && !o->bench && !o->grid_path)
@@ -688,6 +778,242 @@ static int run_grid(const options *o)
     free(img);
     vr_renderer_destroy(r);
     vr_context_destroy(ctx);
+    return rc;
+}
+
+/* ------------------------------------------------------------------ */
+/* --views: frames of a view set, to be scored against ray-traced truth  */
+
+/* The folder for the frames: made when missing (not its parents). */
+static int frames_dir(const char *dir)
+{
+    struct stat st;
+    if (stat(dir, &st) == 0) {
+        if (S_ISDIR(st.st_mode))
+            return 0;
+        fprintf(stderr, "vdsh-view: %s: not a directory (--frames)\n", dir);
+        return 1;
+    }
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "vdsh-view: %s: cannot make the folder for the frames: %s\n", dir,
+                strerror(errno));
+        return 1;
+    }
+    return 0;
+}
+
+static void view_camera(const vt_view *v, vr_camera *c)
+{
+    memset(c, 0, sizeof *c);
+    memcpy(c->eye, v->camera.eye, sizeof c->eye);
+    memcpy(c->target, v->camera.target, sizeof c->target);
+    memcpy(c->up, v->camera.up, sizeof c->up);
+    c->fov_y = v->camera.fov_y;
+}
+
+/* One shadow-only frame: light alone, s of every pixel (1 where nothing
+ * was drawn: VR_OUTPUT_SHADOW writes alpha 1, the clear colour 0). */
+static vr_result shadow_frame(vr_renderer *r, const vr_scene *scene, const options *o,
+                              const frame_mode *m, const vr_camera *cam, const float pos[3],
+                              float *rgba, float *grey, size_t n, vr_error *err)
+{
+    vr_light light;
+    memset(&light, 0, sizeof light);
+    memcpy(light.position, pos, sizeof light.position);
+    vr_draw_desc d;
+    memset(&d, 0, sizeof d);
+    d.mode = m->mode;
+    d.pcf = m->pcf;
+    d.compare = o->compare;
+    d.lights = &light;
+    d.light_count = 1;
+    d.camera = *cam;
+    d.output = VR_OUTPUT_SHADOW;
+    vr_result res = vr_draw(r, scene, &d, err);
+    if (res == VR_OK)
+        res = vr_read_pixels(r, rgba, n * 4 * sizeof(float), err);
+    if (res == VR_OK)
+        for (size_t i = 0; i < n; i++)
+            grey[i] = rgba[4 * i + 3] > 0.0f ? rgba[4 * i] : 1.0f;
+    return res;
+}
+
+/* The shaded picture of a light set: the viewer's white lights (dimmer
+ * when there are several), fall-off and ambient; opaque. */
+static vr_result shaded_frame(vr_renderer *r, const vr_scene *scene, const options *o,
+                              const frame_mode *m, const vr_camera *cam, const vt_view *v,
+                              int set, unsigned char *px, size_t n, vr_error *err)
+{
+    vr_light lights[VT_VIEWS_MAX_LIGHTS];
+    int nl = v->light_count[set];
+    float fall = 0.3f * scene_diagonal(scene);
+    float intensity = 1.6f / (1.0f + 0.6f * (float)(nl - 1));
+    for (int i = 0; i < nl; i++) {
+        memset(&lights[i], 0, sizeof lights[i]);
+        memcpy(lights[i].position, v->lights[set][i], sizeof lights[i].position);
+        lights[i].color[0] = lights[i].color[1] = lights[i].color[2] = intensity;
+        if (o->have_att)
+            memcpy(lights[i].attenuation, o->att, sizeof o->att);
+        else {
+            lights[i].attenuation[0] = 1.0f;
+            lights[i].attenuation[2] = 1.0f / (fall * fall);
+        }
+    }
+    vr_draw_desc d = base_desc(o, lights, nl);
+    d.mode = m->mode;
+    d.pcf = m->pcf;
+    d.camera = *cam;
+    vr_result res = vr_draw(r, scene, &d, err);
+    if (res == VR_OK)
+        res = vr_read_pixels(r, px, n * 4, err);
+    if (res == VR_OK)
+        for (size_t i = 0; i < n; i++)
+            px[4 * i + 3] = 255;
+    return res;
+}
+
+static int run_frames(const options *o)
+{
+    char msg[1024];
+    vt_views vs;
+    memset(&vs, 0, sizeof vs);
+    if (vt_views_read(o->views_path, &vs, msg, sizeof msg) != 0) {
+        fprintf(stderr, "vdsh-view: %s\n", msg);
+        return 1;
+    }
+    if (frames_dir(o->frames_dir)) {
+        vt_views_free(&vs);
+        return 1;
+    }
+    int w = vs.width, h = vs.height;
+    size_t n = (size_t)w * (size_t)h;
+    session s;
+    vr_renderer *rf = NULL;
+    vr_error err;
+    if (session_open(o, VR_CONTEXT_HEADLESS, w, h, &s)) {
+        vt_views_free(&vs);
+        return 1;
+    }
+    int rc = 0;
+    vr_renderer_desc rd = {.width = w, .height = h, .color_format = VR_COLOR_RGBA32F,
+                           .shadow_map_size = o->shadow_size};
+    if (vr_renderer_create(&rd, &rf, &err) != VR_OK) {
+        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+        rc = 1;
+    }
+
+    /* The modes: those asked for (each must be in the scene), else every
+     * shadow mode the scene has. */
+    int modes[FRAME_MODES], nm = 0;
+    if (!rc && o->frame_mode_count) {
+        for (int i = 0; i < o->frame_mode_count && !rc; i++) {
+            const frame_mode *m = &frame_modes[o->frame_modes[i]];
+            if (!vr_scene_supports(s.scene, m->mode)) {
+                fprintf(stderr, "vdsh-view: %s: mode %s is not available in this file%s\n",
+                        o->files[0], m->name,
+                        m->mode == VR_MODE_VDSH5 ? " (order 5 with its basis cubemaps)" : "");
+                rc = 1;
+            }
+            modes[nm++] = o->frame_modes[i];
+        }
+    } else if (!rc) {
+        for (int i = 0; i < FRAME_DEFAULT_MODES; i++)
+            if (vr_scene_supports(s.scene, frame_modes[i].mode))
+                modes[nm++] = i;
+    }
+
+    float *rgba = malloc(n * 4 * sizeof(float)), *grey = malloc(n * sizeof(float));
+    unsigned char *px = malloc(n * 4);
+    if (!rc && (!rgba || !grey || !px)) {
+        fprintf(stderr, "vdsh-view: out of memory (%dx%d frames)\n", w, h);
+        rc = 1;
+    }
+    int total = 0, done = 0;
+    for (int v = 0; v < vs.count; v++)
+        for (int k = 0; k < vs.views[v].set_count; k++)
+            total += vs.views[v].light_count[k];
+    total *= nm;
+    if (!rc && !o->quiet)
+        fprintf(stderr, "vdsh-view: %s: %d view%s of %s, %d shadow frames of %dx%d in %d "
+                "mode%s, into %s (%s)\n", o->files[0], vs.count, vs.count == 1 ? "" : "s",
+                o->views_path, total, w, h, nm, nm == 1 ? "" : "s", o->frames_dir,
+                vr_gl_renderer());
+
+    /* Mode by mode (one program, its shadow maps re-rendered per frame);
+     * the time of a frame is its draw and read-back, without the PNG. */
+    for (int mi = 0; mi < nm && !rc; mi++) {
+        const frame_mode *m = &frame_modes[modes[mi]];
+        double mode_ms = 0.0, first_ms = 0.0, png_ms = 0.0;
+        int mode_frames = 0;
+        for (int v = 0; v < vs.count && !rc; v++) {
+            const vt_view *view = &vs.views[v];
+            vr_camera cam;
+            view_camera(view, &cam);
+            for (int k = 0; k < view->set_count && !rc; k++) {
+                char path[4096];
+                for (int j = 0; j < view->light_count[k] && !rc; j++) {
+                    if (vt_frame_path(path, sizeof path, o->frames_dir, view->name, k, j,
+                                      m->name)) {
+                        fprintf(stderr, "vdsh-view: %s: frame path too long\n", o->frames_dir);
+                        rc = 1;
+                        break;
+                    }
+                    double t0 = now_ms();
+                    if (shadow_frame(rf, s.scene, o, m, &cam, view->lights[k][j], rgba, grey, n,
+                                     &err) != VR_OK) {
+                        fprintf(stderr, "vdsh-view: %s: %s: %s\n", o->files[0], path, err.msg);
+                        rc = 1;
+                        break;
+                    }
+                    double ms = now_ms() - t0;
+                    if (mode_frames++ == 0)
+                        first_ms = ms;
+                    else
+                        mode_ms += ms;
+                    done++;
+                    double t1 = now_ms();
+                    if (vt_png16_write(path, w, h, grey, msg, sizeof msg) != 0) {
+                        fprintf(stderr, "vdsh-view: %s\n", msg);
+                        rc = 1;
+                        break;
+                    }
+                    double wms = now_ms() - t1;
+                    png_ms += wms;
+                    if (!o->quiet)
+                        fprintf(stderr, "vdsh-view: [%d/%d] %s  %.1f ms (PNG %.1f ms)\n", done,
+                                total, path, ms, wms);
+                }
+                if (rc)
+                    break;
+                if (vt_shaded_path(path, sizeof path, o->frames_dir, view->name, k, m->name)) {
+                    fprintf(stderr, "vdsh-view: %s: frame path too long\n", o->frames_dir);
+                    rc = 1;
+                } else if (shaded_frame(s.r, s.scene, o, m, &cam, view, k, px, n, &err) !=
+                           VR_OK) {
+                    fprintf(stderr, "vdsh-view: %s: %s: %s\n", o->files[0], path, err.msg);
+                    rc = 1;
+                } else if (vt_png_rgba_write(path, w, h, px, msg, sizeof msg) != 0) {
+                    fprintf(stderr, "vdsh-view: %s\n", msg);
+                    rc = 1;
+                }
+            }
+        }
+        /* The first frame of a mode compiles its program. */
+        if (!rc && !o->quiet && mode_frames > 1)
+            fprintf(stderr, "vdsh-view: mode %s: %d frames of %dx%d, %.1f ms per frame after "
+                    "the first (%.1f ms: compiling), draw and read-back; PNG %.1f ms per "
+                    "frame\n", m->name, mode_frames, w, h, mode_ms / (mode_frames - 1), first_ms,
+                    png_ms / mode_frames);
+        else if (!rc && !o->quiet && mode_frames == 1)
+            fprintf(stderr, "vdsh-view: mode %s: 1 frame of %dx%d, %.1f ms (with compiling)\n",
+                    m->name, w, h, first_ms);
+    }
+    free(rgba);
+    free(grey);
+    free(px);
+    vr_renderer_destroy(rf);
+    session_close(&s);
+    vt_views_free(&vs);
     return rc;
 }
 
@@ -1377,5 +1703,7 @@ int main(int argc, char **argv)
         return run_render(&o);
     if (o.grid_path)
         return run_grid(&o);
+    if (o.views_path)
+        return run_frames(&o);
     return run_window(&o);
 }

@@ -272,11 +272,19 @@ typedef struct vr_camera {
 
 typedef enum vr_output {
     VR_OUTPUT_COLOR = 0,     /* albedo * (ambient + sum lambert * shadow) */
-    VR_OUTPUT_SHADOW = 1,    /* light 0: (s, d_V, d_L, 1): the distances
+    VR_OUTPUT_SHADOW = 1,    /* light 0: (s, d_V, d_L, 1): s the shadow
+                                factor alone (0 shadowed .. 1 lit; no
+                                Lambert term, no attenuation, also where
+                                the surface faces away from the light:
+                                whatever the mode's test gives there, the
+                                cube map's depth test or the SH distance
+                                below the horizon), and the distances
                                 compared (on the visibility path, the
                                 vertices' values interpolated, as
                                 vdsh_shadow_interior's d_vis); d_V is -1
-                                in modes none and cube */
+                                in modes none and cube. Alpha 1 where a
+                                surface was drawn: the clear colour's
+                                alpha elsewhere */
     VR_OUTPUT_POSITION = 2   /* (world x, y, z, 1) */
 } vr_output;
 
@@ -310,7 +318,9 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *d,
  * Anything else (an object, a terrain) is framed from outside, as
  * vr_scene_fit_camera. A scene is an interior when, from that inside eye,
  * at least 60% of 128 directions meet the front of a surface (the side its
- * vertex normals face), decided once at load (vr_view.c says why). */
+ * vertex normals face), decided once at load. The decision, the cameras
+ * and the default lights are formats/vdsh_scene_view.h's: the bake side's
+ * tools compute the same view from the same .vdsh mesh. */
 void vr_scene_default_camera(const vr_scene *s, vr_camera *out);
 
 /* The whole scene in view from outside, whatever the scene: the eye up and
@@ -324,7 +334,10 @@ void vr_scene_fit_camera(const vr_scene *s, vr_camera *out);
  * written. An interior's are spread through its bounds (light 0 roughly in
  * the middle, a little above the floor); an object's stand outside its
  * bounding sphere, light 0 above it and to the side of the default eye.
- * Colours and attenuations are left to the caller. */
+ * Each is in free space (formats/vdsh_light.h: not inside a solid, not on
+ * a surface), moved at load to the nearest such position when its place
+ * is not (vdsh_view_compute says how). Colours and attenuations are left
+ * to the caller. */
 int vr_scene_default_lights(const vr_scene *s, vr_light *out, int max);
 
 /* Draw text (ASCII, stb_easy_font's 7-pixel font scaled by `scale`) on top

@@ -9,6 +9,7 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 
+#include "vdsh_scene_view.h"
 #include "vr.h"
 
 /* Format a message into err (if not NULL) and return r. */
@@ -38,21 +39,6 @@ int vr_mode_interp(vr_mode m, uint32_t quantity);
 vr_result vr_order_triangles(const uint32_t *indices, uint32_t nt, uint32_t nv,
                              uint32_t *out, uint32_t *remap, const char *name,
                              vr_error *err);
-
-/* The default view (vr_view.c). vr_view_interior: 1 when the room
- * camera's eye (vr_view_room_camera) stands in a scene closed around it -
- * 60% of 128 rays from it hit the front (the vertex normals' side) of a
- * surface - 0 for an object to be framed from outside. The cameras and
- * lights are computed from the bounds only. */
-int vr_view_interior(const float *positions, const float *normals, const uint32_t *indices,
-                     uint32_t triangle_count, const float lo[3], const float hi[3]);
-/* The share of those rays that meet the front of a surface, 0..1. */
-float vr_view_front_share(const float *positions, const float *normals,
-                          const uint32_t *indices, uint32_t triangle_count, const float lo[3],
-                          const float hi[3]);
-void vr_view_room_camera(const float lo[3], const float hi[3], vr_camera *out);
-void vr_view_fit_camera(const float lo[3], const float hi[3], vr_camera *out);
-int vr_view_lights(const float lo[3], const float hi[3], int interior, vr_light *out, int max);
 
 /* Attribute locations, the same in every program. Coefficient attribute
  * k covers coefficients first[k] .. first[k] + size[k] - 1 of the stream
@@ -89,7 +75,7 @@ struct vr_scene {
     GLuint basis[4];            /* cube textures, functions 9+4k..12+4k */
     int cube_size;
     size_t gpu_bytes;
-    int interior;               /* vr_view_interior at load */
+    vdsh_view view;             /* the default view, decided at load */
 };
 
 /* Which program: everything that changes the shader source. */

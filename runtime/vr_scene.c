@@ -262,19 +262,6 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     s->triangle_count = h->triangle_count;
     s->quantity = quantity;
     s->max_distance = h->max_distance;
-    for (int k = 0; k < 3; k++) {
-        s->bounds_min[k] = INFINITY;
-        s->bounds_max[k] = -INFINITY;
-    }
-    for (uint32_t v = 0; v < h->vertex_count; v++)
-        for (int k = 0; k < 3; k++) {
-            float x = f->positions[3 * (size_t)v + (size_t)k];
-            s->bounds_min[k] = fminf(s->bounds_min[k], x);
-            s->bounds_max[k] = fmaxf(s->bounds_max[k], x);
-        }
-    /* Room or object: decides the default view (vr_view.c). */
-    s->interior = vr_view_interior(f->positions, f->normals, f->indices, h->triangle_count,
-                                   s->bounds_min, s->bounds_max);
 
     /* Everything per vertex goes up in the order of vr_order_triangles
      * (the same vertices and triangles, arranged for the vertex cache). */
@@ -289,6 +276,20 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
                            name, err);
     if (r != VR_OK)
         goto done;
+    /* The default view (room or object, camera, lights in free space),
+     * from the mesh as the file has it (formats/vdsh_scene_view.h). */
+    {
+        vdsh_view_mesh vm = {f->positions, f->normals, f->indices, h->vertex_count,
+                             h->triangle_count};
+        vdsh_error ve;
+        vdsh_result vr = vdsh_view_compute(&vm, &s->view, &ve);
+        if (vr != VDSH_OK) {
+            r = vr_fail(err, map_vdsh_result(vr), "%s: %s", name, ve.msg);
+            goto done;
+        }
+        memcpy(s->bounds_min, s->view.bounds_min, sizeof s->bounds_min);
+        memcpy(s->bounds_max, s->view.bounds_max, sizeof s->bounds_max);
+    }
     glGenBuffers(1, &s->vbo_position);
     glGenBuffers(1, &s->vbo_normal);
     if (upload_permuted(s->vbo_position, f->positions, nv, 12, remap) ||
@@ -373,7 +374,7 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     i.quantity = s->quantity;
     i.max_distance = s->max_distance;
     i.gpu_bytes = s->gpu_bytes;
-    i.interior = s->interior;
+    i.interior = s->view.interior;
     *out = i;
 }
 

@@ -117,3 +117,10 @@ endif()
 
 set_tests_properties(${_format_tool_tests} PROPERTIES
                      FIXTURES_REQUIRED vdsh_format_files)
+
+# formats/vdsh_scene_view.h: the default view from a mesh (rays through
+# the grid against every triangle, free space, room and object, lights
+# moved out of solids).
+add_executable(test_scene_view ${CMAKE_CURRENT_LIST_DIR}/test_scene_view.c)
+target_link_libraries(test_scene_view PRIVATE vdsh_format m)
+add_test(NAME format_scene_view COMMAND test_scene_view unit)

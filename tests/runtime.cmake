@@ -313,8 +313,79 @@ grep -q "saved vdsh-view-000.png" keys.log
 "$png" info vdsh-view-000.png 160 120
 ]=] sh ${_view} ${_png} ${_room} ${_rt_dir}/view_window)
 
+# The default lights of the built-in room (baked above) in free space: none
+# in or on a pillar, crate or the sphere (test_scene_view, no GL).
+add_test(NAME runtime_default_lights COMMAND test_scene_view room ${_rt_dir}/room/room.vdsh)
+set_tests_properties(runtime_default_lights PROPERTIES FIXTURES_REQUIRED runtime_room)
+
+# Frames of a view set (vdsh-view --views --frames): names, sizes and
+# formats; the crate's shadow low and a lit floor point 1 in every shadow
+# mode, also at a grazing angle (the frames are the shadow factor, no
+# Lambert term); pixels with no surface 1; a surface facing away from the
+# light hidden by the cube map; a subset of modes on the log-distance bake;
+# errors. The runtime's default view is vdsh_view_compute's.
+add_executable(test_runtime_frames ${CMAKE_CURRENT_LIST_DIR}/test_runtime_frames.c)
+target_include_directories(test_runtime_frames PRIVATE ${CMAKE_CURRENT_LIST_DIR})
+target_link_libraries(test_runtime_frames PRIVATE vr vr_context vb_cubemap vdsh_format vt_tools m)
+
+add_test(NAME runtime_view_frames COMMAND sh -c [=[
+v=$1; t=$2; room=$3; log=$4; d=$5
+"$t" gl || exit $?
+set -e
+rm -rf "$d"; mkdir -p "$d"
+cat > "$d/views.json" <<EOF
+{"width": 160, "height": 120,
+ "views": [{"name": "crate", "eye": [0, 5.5, -6.5], "target": [-4, 0, -2], "up": [0, 1, 0],
+            "fov_y": 60, "light_sets": [[[-4, 3.5, 1]], [[-4, 3.5, 1], [3, 4, 0]]]},
+           {"name": "outside", "eye": [26, 16, 22], "target": [0, 3, 0], "fov_y": 40,
+            "light_sets": [[[0, 3, 0]]]}]}
+EOF
+all=cube,cube-pcf,vdsh2,vdsh3,vdsh5,vdsh5poly
+"$v" --views "$d/views.json" --frames "$d/room" "$room" 2> "$d/room.log"
+cat "$d/room.log"
+grep -q "\[24/24\] $d/room/outside-s0-l0-vdsh5poly.png" "$d/room.log"
+grep -q "mode cube-pcf: 4 frames of 160x120" "$d/room.log"
+"$t" names "$d/views.json" "$d/room" $all
+test -f "$d/room/crate-s1-l1-cube-pcf.png"
+test -f "$d/room/crate-s1-shaded-cube-pcf.png"
+# the light at (-4, 3.5, 1) is in front of the 1.58 m crate; the floor at
+# (-4, 0, -4) is just behind it, (-4, 0, 1.5) below the light and (0, 0, -3)
+# lit at 58 degrees from the normal (Lambert 0.53)
+"$t" values "$d/views.json" "$d/room" crate 0 0 -4,0,-4 -4,0,1.5 $all
+"$t" values "$d/views.json" "$d/room" crate 1 0 -4,0,-4 0,0,-3 $all
+"$t" empty "$d/views.json" "$d/room" "$room" outside $all
+# the crate's side toward the camera faces away from the light
+"$t" facing "$d/views.json" "$d/room" crate 0 0 -4,0.79,-3.79 $all
+# a log-distance bake (no cubemaps), some modes
+"$v" -q --views "$d/views.json" --frames "$d/log" --modes vdsh5,cube-pcf,vdsh3,vdsh5 "$log"
+"$t" names "$d/views.json" "$d/log" vdsh5,cube-pcf,vdsh3
+"$t" values "$d/views.json" "$d/log" crate 0 0 -4,0,-4 -4,0,1.5 vdsh5,cube-pcf,vdsh3
+# errors: exit 1 naming the file or the mode, exit 2 for usage
+expect() {
+  code=$1; needle=$2; shift 2
+  rc=0; "$v" "$@" > "$d/err.txt" 2>&1 || rc=$?
+  cat "$d/err.txt"
+  [ $rc -eq $code ] || { echo "exit $rc, not $code: $*"; exit 1; }
+  grep -q -- "$needle" "$d/err.txt" || { echo "message does not say $needle"; exit 1; }
+}
+cp "$room" "$d/alone.vdsh"
+expect 1 "mode vdsh5 is not available" --views "$d/views.json" --frames "$d/x" --no-cubemaps --modes vdsh5 "$d/alone.vdsh"
+echo '{"width": 16}' > "$d/bad.json"
+expect 1 "bad.json" --views "$d/bad.json" --frames "$d/x" "$room"
+expect 1 "nothere.json" --views "$d/nothere.json" --frames "$d/x" "$room"
+expect 1 "not a directory" --views "$d/views.json" --frames "$d/views.json" "$room"
+expect 2 "--frames DIR" --views "$d/views.json" "$room"
+expect 2 "--modes" --views "$d/views.json" --frames "$d/x" --modes vdsh4 "$room"
+expect 2 "--modes" --modes vdsh5 --render "$d/x.png" "$room"
+expect 2 "not with" --views "$d/views.json" --frames "$d/x" --size 64x48 "$room"
+expect 2 "not with" --views "$d/views.json" --frames "$d/x" --bench "$room"
+expect 2 "not with --mode or --pcf" --views "$d/views.json" --frames "$d/x" --pcf "$room"
+expect 2 "positive count" --frames "$d/x" "$room"
+"$t" lights "$room"
+]=] sh ${_view} $<TARGET_FILE:test_runtime_frames> ${_room} ${_room_log} ${_rt_dir}/view_frames)
+
 foreach(t runtime_view_usage runtime_view_errors runtime_view_render runtime_view_bench
-          runtime_view_frame runtime_view_window)
+          runtime_view_frame runtime_view_window runtime_view_frames)
   if(TEST ${t})
     _runtime_props(${t} FIXTURES_REQUIRED runtime_room)
   endif()

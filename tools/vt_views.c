@@ -166,3 +166,10 @@ int vt_frame_path(char *out, size_t cap, const char *dir, const char *view, int 
     int n = snprintf(out, cap, "%s/%s-s%d-l%d-%s.png", dir, view, set, light, mode);
     return n < 0 || (size_t)n >= cap ? -1 : 0;
 }
+
+int vt_shaded_path(char *out, size_t cap, const char *dir, const char *view, int set,
+                   const char *mode)
+{
+    int n = snprintf(out, cap, "%s/%s-s%d-shaded-%s.png", dir, view, set, mode);
+    return n < 0 || (size_t)n >= cap ? -1 : 0;
+}

@@ -16,10 +16,12 @@
  * time (shadow-only images) and a set's scores pooled.
  *
  * Frame files in a folder: NAME-sK-lJ-MODE.png, 16-bit grey (vt_image.h),
- * for view NAME, light set K, light J of the set, and MODE one of the
- * runtime's mode names ("cube", "vdsh5", ...) or the truth's ("hard",
- * "ideal", and "c-vdshN": the stream of order N computed in C on the
- * runtime's path).
+ * for view NAME, light set K, light J of the set (K and J count from 0),
+ * and MODE one of the runtime's mode names ("cube", "vdsh5", ...; "cube-pcf"
+ * for the cube map with PCF) or the truth's ("hard", "ideal", and
+ * "c-vdshN": the stream of order N computed in C on the runtime's path).
+ * Beside them NAME-sK-shaded-MODE.png, 8-bit RGBA: the set's lights
+ * together, shaded, for looking at.
  *
  * Errors: 0, or -1 with a message naming the file and the field in msg.
  * Ownership: vt_views_free frees what vt_views_read allocated (and
@@ -61,6 +63,11 @@ void vt_views_free(vt_views *v);
 /* DIR/NAME-sK-lJ-MODE.png into out (cap bytes); -1 if it does not fit. */
 int vt_frame_path(char *out, size_t cap, const char *dir, const char *view, int set, int light,
                   const char *mode);
+
+/* DIR/NAME-sK-shaded-MODE.png: the shaded picture of light set K (all its
+ * lights together, 8-bit RGBA) for looking at; -1 if it does not fit. */
+int vt_shaded_path(char *out, size_t cap, const char *dir, const char *view, int set,
+                   const char *mode);
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,659 @@
+/* A scene's default view: vdsh_scene_view.h says what and why. */
+#include "vdsh_scene_view.h"
+
+#include "vdsh_light.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static vdsh_result fail(vdsh_error *err, vdsh_result r, const char *fmt, ...)
+{
+    if (err) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+        va_end(ap);
+    }
+    return r;
+}
+
+/* ---- cameras and preferred lights, from the bounds ------------------- */
+
+void vdsh_view_bounds(const float *positions, uint32_t vertex_count, float lo[3], float hi[3])
+{
+    for (int k = 0; k < 3; k++) {
+        lo[k] = INFINITY;
+        hi[k] = -INFINITY;
+    }
+    for (uint32_t v = 0; v < vertex_count; v++)
+        for (int k = 0; k < 3; k++) {
+            float x = positions[3 * (size_t)v + (size_t)k];
+            lo[k] = fminf(lo[k], x);
+            hi[k] = fmaxf(hi[k], x);
+        }
+}
+
+/* The longest horizontal axis (x or z) and the other one. */
+static void axes(const float lo[3], const float hi[3], int *ax, int *other)
+{
+    *ax = hi[0] - lo[0] >= hi[2] - lo[2] ? 0 : 2;
+    *other = 2 - *ax;
+}
+
+void vdsh_view_room_camera(const float lo[3], const float hi[3], vdsh_camera *out)
+{
+    float c[3], e[3];
+    for (int k = 0; k < 3; k++) {
+        c[k] = 0.5f * (lo[k] + hi[k]);
+        e[k] = hi[k] - lo[k];
+    }
+    int ax, other;
+    axes(lo, hi, &ax, &other);
+    vdsh_camera cam;
+    memset(&cam, 0, sizeof cam);
+    cam.eye[ax] = c[ax] + 0.36f * e[ax];
+    cam.eye[other] = c[other] + 0.05f * e[other];
+    cam.eye[1] = lo[1] + 0.28f * e[1];
+    cam.target[ax] = c[ax] - 0.2f * e[ax];
+    cam.target[other] = c[other];
+    cam.target[1] = lo[1] + 0.13f * e[1];
+    cam.up[1] = 1.0f;
+    cam.fov_y = 60.0f;
+    *out = cam;
+}
+
+/* Centre and radius of the bounding sphere of the bounds, and the unit
+ * vectors of the frame the outside views are placed in: along the longest
+ * horizontal axis, up, along the other. */
+static float frame(const float lo[3], const float hi[3], float c[3], float u[3][3])
+{
+    float r2 = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        c[k] = 0.5f * (lo[k] + hi[k]);
+        r2 += 0.25f * (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    }
+    int ax, other;
+    axes(lo, hi, &ax, &other);
+    memset(u, 0, 9 * sizeof(float));
+    u[0][ax] = 1.0f;
+    u[1][1] = 1.0f;
+    u[2][other] = 1.0f;
+    float r = sqrtf(r2);
+    return r > 0.0f ? r : 1.0f;
+}
+
+/* c + s * (a u0 + b u1 + d u2) */
+static void place(const float c[3], const float u[3][3], float s, float a, float b, float d,
+                  float out[3])
+{
+    for (int k = 0; k < 3; k++)
+        out[k] = c[k] + s * (a * u[0][k] + b * u[1][k] + d * u[2][k]);
+}
+
+void vdsh_view_fit_camera(const float lo[3], const float hi[3], vdsh_camera *out)
+{
+    float c[3], u[3][3];
+    float r = frame(lo, hi, c, u);
+    vdsh_camera cam;
+    memset(&cam, 0, sizeof cam);
+    cam.fov_y = 60.0f;
+    cam.up[1] = 1.0f;
+    memcpy(cam.target, c, sizeof cam.target);
+    /* Seen from the side of the room's eye, from above: w points from the
+     * centre to the eye, s to the right of the image, v up in it. */
+    float w[3], s[3], v[3];
+    place((float[3]){0, 0, 0}, u, 1.0f, 0.8f, 0.45f, 0.4f, w);
+    float n = sqrtf(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    for (int k = 0; k < 3; k++)
+        w[k] /= n;
+    s[0] = w[2], s[1] = 0.0f, s[2] = -w[0]; /* up x w */
+    n = sqrtf(s[0] * s[0] + s[2] * s[2]);
+    s[0] /= n, s[2] /= n;
+    v[0] = w[1] * s[2] - w[2] * s[1];
+    v[1] = w[2] * s[0] - w[0] * s[2];
+    v[2] = w[0] * s[1] - w[1] * s[0];
+    /* The distance at which every corner of the bounds is inside the
+     * field of view, vertically and (for an image at least as wide as it
+     * is tall) horizontally, with a 5% margin: a corner at depth d along
+     * w and offset o across needs o / (D - d) <= tan(fov / 2). */
+    float t = tanf(0.5f * cam.fov_y * 3.14159265358979f / 180.0f), dist = 0.0f;
+    for (int corner = 0; corner < 8; corner++) {
+        float p[3], d = 0.0f, a = 0.0f, b = 0.0f;
+        for (int k = 0; k < 3; k++) {
+            p[k] = ((corner >> k) & 1 ? hi[k] : lo[k]) - c[k];
+            d += p[k] * w[k];
+            a += p[k] * s[k];
+            b += p[k] * v[k];
+        }
+        dist = fmaxf(dist, d + fmaxf(fabsf(a), fabsf(b)) / t);
+    }
+    dist = 1.05f * (dist > 0.0f ? dist : r);
+    for (int k = 0; k < 3; k++)
+        cam.eye[k] = c[k] + dist * w[k];
+    *out = cam;
+}
+
+int vdsh_view_preferred_lights(const float lo[3], const float hi[3], int interior,
+                               float (*out)[3], int max)
+{
+    /* A room: in bounds fractions (x, y, z), light 0 a little off centre
+     * at 40% of the height, the others toward the corners, so that props
+     * between them cast shadows in different directions. */
+    static const float at[VDSH_VIEW_MAX_LIGHTS][3] = {
+        {0.42f, 0.4f, 0.45f}, {0.2f, 0.6f, 0.78f}, {0.78f, 0.3f, 0.22f}, {0.65f, 0.75f, 0.7f}};
+    /* An object: outside its bounding sphere, in the outside camera's
+     * frame (toward the eye, up, across): light 0 above and to the side of
+     * the eye and a little to its left, so that the side in view is lit and
+     * the object shades and shadows itself visibly. */
+    static const float around[VDSH_VIEW_MAX_LIGHTS][3] = {
+        {1.5f, 1.5f, -0.4f}, {-1.3f, 1.2f, 1.4f}, {0.5f, 2.1f, 1.5f}, {1.6f, 0.5f, 1.2f}};
+    float c[3], u[3][3];
+    float r = frame(lo, hi, c, u);
+    int n = 0;
+    for (; n < max && n < VDSH_VIEW_MAX_LIGHTS; n++) {
+        if (interior)
+            for (int k = 0; k < 3; k++)
+                out[n][k] = lo[k] + at[n][k] * (hi[k] - lo[k]);
+        else
+            place(c, u, r, around[n][0], around[n][1], around[n][2], out[n]);
+    }
+    return n;
+}
+
+/* ---- rays against triangles ------------------------------------------ */
+
+/* Moller-Trumbore of the ray (o, d) against triangle a, b, c: 1 with the
+ * distance, barycentrics and determinant (< 0: the back of the face), or
+ * 0. The arithmetic is written once, so that the grid and the plain loop
+ * compute the same bits. */
+static inline int intersect(const float o[3], const float d[3], const float *a,
+                            const float *b, const float *c, float *dist, float *uu,
+                            float *vv, float *det_out)
+{
+    float e1[3], e2[3], s[3], q[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = b[k] - a[k];
+        e2[k] = c[k] - a[k];
+        s[k] = o[k] - a[k];
+    }
+    q[0] = s[1] * e1[2] - s[2] * e1[1];
+    q[1] = s[2] * e1[0] - s[0] * e1[2];
+    q[2] = s[0] * e1[1] - s[1] * e1[0];
+    float qe2 = q[0] * e2[0] + q[1] * e2[1] + q[2] * e2[2];
+    float p[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2],
+                  d[0] * e2[1] - d[1] * e2[0]};
+    float det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
+    if (det == 0.0f)
+        return 0;
+    float inv = 1.0f / det;
+    float u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) * inv;
+    if (!(u >= 0.0f && u <= 1.0f))
+        return 0;
+    float v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) * inv;
+    if (!(v >= 0.0f && u + v <= 1.0f))
+        return 0;
+    *dist = qe2 * inv;
+    *uu = u;
+    *vv = v;
+    *det_out = det;
+    return 1;
+}
+
+/* How far outside its own bounding box (per axis) a hit on a triangle with
+ * these bounds may lie: rounding, not more. A nearly degenerate triangle
+ * (a sliver at a sphere's pole) can pass the barycentric tests for rays
+ * nowhere near it, with a meaningless distance; such hits are refused.
+ * The grid files each triangle in every cell within this of its box, so
+ * that it and the plain loop accept the same hits. */
+static inline float hit_slack(float lo, float hi, float extent)
+{
+    return 1e-3f * extent + 2e-6f * fmaxf(fabsf(lo), fabsf(hi));
+}
+
+static inline float tri_extent(const float *a, const float *b, const float *c)
+{
+    float e = 0.0f;
+    for (int k = 0; k < 3; k++)
+        e = fmaxf(e, fmaxf(a[k], fmaxf(b[k], c[k])) - fminf(a[k], fminf(b[k], c[k])));
+    return e;
+}
+
+/* Test triangle tri; keep it in *best when nearer (ties: lower index). */
+static inline void test_triangle(const float *positions, const uint32_t *indices, uint32_t tri,
+                                 const float o[3], const float d[3], float tmin,
+                                 vdsh_view_hit *best)
+{
+    const uint32_t *ix = indices + 3 * (size_t)tri;
+    const float *a = positions + 3 * (size_t)ix[0], *b = positions + 3 * (size_t)ix[1],
+                *c = positions + 3 * (size_t)ix[2];
+    float dist, u, v, det;
+    if (!intersect(o, d, a, b, c, &dist, &u, &v, &det))
+        return;
+    if (!(dist >= tmin))
+        return;
+    if (!(dist < best->t || (dist == best->t && tri < best->triangle)))
+        return;
+    float ext = tri_extent(a, b, c);
+    for (int k = 0; k < 3; k++) {
+        float lo = fminf(a[k], fminf(b[k], c[k])), hi = fmaxf(a[k], fmaxf(b[k], c[k]));
+        float p = o[k] + dist * d[k], slack = hit_slack(lo, hi, ext);
+        if (!(p >= lo - slack && p <= hi + slack))
+            return;
+    }
+    best->t = dist;
+    best->u = u;
+    best->v = v;
+    best->triangle = tri;
+    best->back = det < 0.0f;
+}
+
+int vdsh_view_trace_all(const vdsh_view_mesh *m, const float org[3], const float dir[3],
+                        float tmin, vdsh_view_hit *hit)
+{
+    vdsh_view_hit best = {INFINITY, 0.0f, 0.0f, UINT32_MAX, 0};
+    for (uint32_t t = 0; t < m->triangle_count; t++)
+        test_triangle(m->positions, m->indices, t, org, dir, tmin, &best);
+    if (best.triangle == UINT32_MAX)
+        return 0;
+    *hit = best;
+    return 1;
+}
+
+/* The grid: n[0] x n[1] x n[2] cells of size cell over lo..; cell i holds
+ * the triangles tris[start[i] .. start[i + 1] - 1], every triangle whose
+ * bounding box (padded: tri_cells) overlaps it. */
+struct vdsh_view_tracer {
+    const float *positions;
+    const uint32_t *indices;
+    uint32_t triangle_count;
+    float lo[3], hi[3], cell[3], inv_cell[3];
+    int n[3];
+    uint32_t *start;
+    uint32_t *tris;
+};
+
+void vdsh_view_tracer_destroy(vdsh_view_tracer *t)
+{
+    if (!t)
+        return;
+    free(t->start);
+    free(t->tris);
+    free(t);
+}
+
+static int cell_of(const vdsh_view_tracer *g, int k, float x)
+{
+    float f = floorf((x - g->lo[k]) * g->inv_cell[k]);
+    if (!(f >= 0.0f))
+        return 0;
+    return f >= (float)(g->n[k] - 1) ? g->n[k] - 1 : (int)f;
+}
+
+/* The cell range of triangle tri: its box widened by the slack a hit may
+ * have (hit_slack) and a thousandth of a cell (the traversal's rounding). */
+static void tri_cells(const vdsh_view_tracer *g, uint32_t tri, int c0[3], int c1[3])
+{
+    const uint32_t *ix = g->indices + 3 * (size_t)tri;
+    const float *pa = g->positions + 3 * (size_t)ix[0], *pb = g->positions + 3 * (size_t)ix[1],
+                *pc = g->positions + 3 * (size_t)ix[2];
+    float ext = tri_extent(pa, pb, pc);
+    for (int k = 0; k < 3; k++) {
+        float lo = fminf(pa[k], fminf(pb[k], pc[k])), hi = fmaxf(pa[k], fmaxf(pb[k], pc[k]));
+        float pad = 2.0f * hit_slack(lo, hi, ext) + 1e-3f * g->cell[k];
+        c0[k] = cell_of(g, k, lo - pad);
+        c1[k] = cell_of(g, k, hi + pad);
+    }
+}
+
+/* References all triangles' cell ranges would need with cells of side h. */
+static uint64_t grid_refs(vdsh_view_tracer *g)
+{
+    uint64_t refs = 0;
+    for (uint32_t t = 0; t < g->triangle_count; t++) {
+        int c0[3], c1[3];
+        tri_cells(g, t, c0, c1);
+        refs += (uint64_t)(c1[0] - c0[0] + 1) * (uint64_t)(c1[1] - c0[1] + 1) *
+                (uint64_t)(c1[2] - c0[2] + 1);
+    }
+    return refs;
+}
+
+static void grid_size(vdsh_view_tracer *g, const float ext[3], float h)
+{
+    for (int k = 0; k < 3; k++) {
+        float n = ceilf(ext[k] / h);
+        g->n[k] = n < 1.0f ? 1 : n > 512.0f ? 512 : (int)n;
+        g->cell[k] = ext[k] / (float)g->n[k];
+        g->inv_cell[k] = 1.0f / g->cell[k];
+    }
+}
+
+vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **out,
+                                    vdsh_error *err)
+{
+    for (size_t i = 0; i < 3 * (size_t)m->triangle_count; i++)
+        if (m->indices[i] >= m->vertex_count)
+            return fail(err, VDSH_ERR_INVALID,
+                        "mesh: triangle %zu: vertex index %u not below the %u vertices", i / 3,
+                        m->indices[i], m->vertex_count);
+    vdsh_view_tracer *g = calloc(1, sizeof *g);
+    if (!g)
+        return fail(err, VDSH_ERR_OUT_OF_MEMORY, "mesh: out of memory (ray grid)");
+    g->positions = m->positions;
+    g->indices = m->indices;
+    g->triangle_count = m->triangle_count;
+
+    /* Bounds of the triangles' vertices, padded a little, no axis flat. */
+    for (int k = 0; k < 3; k++)
+        g->lo[k] = INFINITY, g->hi[k] = -INFINITY;
+    for (size_t i = 0; i < 3 * (size_t)m->triangle_count; i++)
+        for (int k = 0; k < 3; k++) {
+            float x = m->positions[3 * (size_t)m->indices[i] + (size_t)k];
+            g->lo[k] = fminf(g->lo[k], x);
+            g->hi[k] = fmaxf(g->hi[k], x);
+        }
+    float ext[3], diag = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        if (!(g->lo[k] <= g->hi[k]))
+            g->lo[k] = g->hi[k] = 0.0f;
+        ext[k] = g->hi[k] - g->lo[k];
+        diag += ext[k] * ext[k];
+    }
+    diag = sqrtf(diag) > 0.0f ? sqrtf(diag) : 1.0f;
+    for (int k = 0; k < 3; k++) {
+        float pad = 1e-4f * diag;
+        g->lo[k] -= pad;
+        g->hi[k] += pad;
+        ext[k] = fmaxf(g->hi[k] - g->lo[k], 1e-3f * diag);
+        g->hi[k] = g->lo[k] + ext[k];
+    }
+
+    /* About two cells per triangle; coarser when big triangles would
+     * need more than eight references each. */
+    double target = 2.0 * (double)(m->triangle_count ? m->triangle_count : 1);
+    float h = (float)cbrt((double)ext[0] * ext[1] * ext[2] / target);
+    for (;;) {
+        grid_size(g, ext, h);
+        uint64_t refs = grid_refs(g);
+        if (refs <= 8ull * m->triangle_count + 1024 || (g->n[0] == 1 && g->n[1] == 1 &&
+                                                        g->n[2] == 1)) {
+            size_t cells = (size_t)g->n[0] * (size_t)g->n[1] * (size_t)g->n[2];
+            g->start = calloc(cells + 1, sizeof *g->start);
+            g->tris = malloc((size_t)(refs ? refs : 1) * sizeof *g->tris);
+            if (!g->start || !g->tris) {
+                vdsh_view_tracer_destroy(g);
+                return fail(err, VDSH_ERR_OUT_OF_MEMORY, "mesh: out of memory (ray grid)");
+            }
+            break;
+        }
+        h *= 1.5f;
+    }
+
+    /* Count, prefix sums, fill (in triangle order: each cell's list is
+     * sorted, though nothing depends on it). */
+    size_t nx = (size_t)g->n[0], nxy = nx * (size_t)g->n[1];
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        int c0[3], c1[3];
+        tri_cells(g, t, c0, c1);
+        for (int z = c0[2]; z <= c1[2]; z++)
+            for (int y = c0[1]; y <= c1[1]; y++)
+                for (int x = c0[0]; x <= c1[0]; x++)
+                    g->start[(size_t)z * nxy + (size_t)y * nx + (size_t)x + 1]++;
+    }
+    size_t cells = nxy * (size_t)g->n[2];
+    for (size_t i = 0; i < cells; i++)
+        g->start[i + 1] += g->start[i];
+    uint32_t *fill = malloc(cells * sizeof *fill);
+    if (!fill) {
+        vdsh_view_tracer_destroy(g);
+        return fail(err, VDSH_ERR_OUT_OF_MEMORY, "mesh: out of memory (ray grid)");
+    }
+    memcpy(fill, g->start, cells * sizeof *fill);
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        int c0[3], c1[3];
+        tri_cells(g, t, c0, c1);
+        for (int z = c0[2]; z <= c1[2]; z++)
+            for (int y = c0[1]; y <= c1[1]; y++)
+                for (int x = c0[0]; x <= c1[0]; x++)
+                    g->tris[fill[(size_t)z * nxy + (size_t)y * nx + (size_t)x]++] = t;
+    }
+    free(fill);
+    *out = g;
+    return VDSH_OK;
+}
+
+int vdsh_view_trace(const vdsh_view_tracer *g, const float org[3], const float dir[3],
+                    float tmin, vdsh_view_hit *hit)
+{
+    /* The ray's stretch inside the grid's box (slabs). */
+    float t0 = tmin > 0.0f ? tmin : 0.0f, t1 = INFINITY;
+    for (int k = 0; k < 3; k++) {
+        if (dir[k] == 0.0f) {
+            if (org[k] < g->lo[k] || org[k] > g->hi[k])
+                return 0;
+            continue;
+        }
+        float a = (g->lo[k] - org[k]) / dir[k], b = (g->hi[k] - org[k]) / dir[k];
+        t0 = fmaxf(t0, fminf(a, b));
+        t1 = fminf(t1, fmaxf(a, b));
+    }
+    if (!(t0 <= t1))
+        return 0;
+
+    /* Cell by cell (Amanatides-Woo), each boundary computed afresh from
+     * the cell index so that no error accumulates. Stop once the nearest
+     * hit so far lies before the current cell's far side. */
+    int c[3], step[3];
+    for (int k = 0; k < 3; k++) {
+        c[k] = cell_of(g, k, org[k] + t0 * dir[k]);
+        step[k] = dir[k] > 0.0f ? 1 : dir[k] < 0.0f ? -1 : 0;
+    }
+    size_t nx = (size_t)g->n[0], nxy = nx * (size_t)g->n[1];
+    vdsh_view_hit best = {INFINITY, 0.0f, 0.0f, UINT32_MAX, 0};
+    for (;;) {
+        size_t cell = (size_t)c[2] * nxy + (size_t)c[1] * nx + (size_t)c[0];
+        for (uint32_t i = g->start[cell]; i < g->start[cell + 1]; i++)
+            test_triangle(g->positions, g->indices, g->tris[i], org, dir, tmin, &best);
+        float next[3];
+        int axis = 0;
+        for (int k = 0; k < 3; k++) {
+            next[k] = step[k] ? (g->lo[k] + (float)(c[k] + (step[k] > 0)) * g->cell[k] -
+                                 org[k]) / dir[k]
+                              : INFINITY;
+            if (next[k] < next[axis])
+                axis = k;
+        }
+        float exit = next[axis];
+        if (best.t <= exit || exit > t1)
+            break;
+        c[axis] += step[axis];
+        if (c[axis] < 0 || c[axis] >= g->n[axis])
+            break;
+    }
+    if (best.triangle == UINT32_MAX)
+        return 0;
+    *hit = best;
+    return 1;
+}
+
+/* ---- the interior test and free space -------------------------------- */
+
+float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
+                            const float lo[3], const float hi[3])
+{
+    vdsh_camera room;
+    vdsh_view_room_camera(lo, hi, &room);
+    float diag2 = 0.0f;
+    for (int k = 0; k < 3; k++)
+        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    /* Hits up to this close are the surface the eye stands on (a flat
+     * scene) or rounding; they do not count. */
+    float tmin = nextafterf(1e-5f * sqrtf(diag2), INFINITY);
+    int front = 0;
+    for (int i = 0; i < VDSH_VIEW_RAYS; i++) {
+        /* A Fibonacci sphere: nearly uniform directions, the same every
+         * time. */
+        float z = 1.0f - (2.0f * (float)i + 1.0f) / (float)VDSH_VIEW_RAYS;
+        float rho = sqrtf(fmaxf(0.0f, 1.0f - z * z)), ph = 2.39996323f * (float)i;
+        float d[3] = {rho * cosf(ph), z, rho * sinf(ph)};
+        vdsh_view_hit h;
+        if (!vdsh_view_trace(t, room.eye, d, tmin, &h))
+            continue;
+        /* The interpolated vertex normal at the hit. */
+        const uint32_t *tri = m->indices + 3 * (size_t)h.triangle;
+        const float *na = m->normals + 3 * (size_t)tri[0], *nb = m->normals + 3 * (size_t)tri[1],
+                    *nc = m->normals + 3 * (size_t)tri[2];
+        float n[3];
+        for (int k = 0; k < 3; k++)
+            n[k] = (1.0f - h.u - h.v) * na[k] + h.u * nb[k] + h.v * nc[k];
+        front += n[0] * d[0] + n[1] * d[1] + n[2] * d[2] < 0.0f;
+    }
+    return (float)front / (float)VDSH_VIEW_RAYS;
+}
+
+int vdsh_view_free_space(const vdsh_view_tracer *t, const float p[3], float diagonal)
+{
+    float dirs[VDSH_FREE_PROBES][3], dist[VDSH_FREE_PROBES];
+    int back[VDSH_FREE_PROBES];
+    vdsh_free_probe_dirs(dirs);
+    for (int i = 0; i < VDSH_FREE_PROBES; i++) {
+        vdsh_view_hit h;
+        int hit = vdsh_view_trace(t, p, dirs[i], 0.0f, &h);
+        dist[i] = hit ? h.t : INFINITY;
+        back[i] = hit && h.back;
+    }
+    return vdsh_free_space(dist, back, vdsh_free_clearance(diagonal));
+}
+
+/* ---- default lights in free space ------------------------------------ */
+
+/* The 26 directions toward a cube's faces, edges and corners, unit. */
+static int nudge_dirs(float out[26][3])
+{
+    int n = 0;
+    for (int ones = 1; ones <= 3; ones++)
+        for (int z = -1; z <= 1; z++)
+            for (int y = -1; y <= 1; y++)
+                for (int x = -1; x <= 1; x++) {
+                    if (abs(x) + abs(y) + abs(z) != ones)
+                        continue;
+                    float l = sqrtf((float)ones);
+                    out[n][0] = (float)x / l;
+                    out[n][1] = (float)y / l;
+                    out[n][2] = (float)z / l;
+                    n++;
+                }
+    return n;
+}
+
+static int inside(const float p[3], const float lo[3], const float hi[3])
+{
+    return p[0] > lo[0] && p[0] < hi[0] && p[1] > lo[1] && p[1] < hi[1] && p[2] > lo[2] &&
+           p[2] < hi[2];
+}
+
+typedef struct cand {
+    float d2;
+    uint32_t k;
+} cand;
+
+static int cmp_cand(const void *a, const void *b)
+{
+    const cand *x = a, *y = b;
+    if (x->d2 != y->d2)
+        return x->d2 < y->d2 ? -1 : 1;
+    return (x->k > y->k) - (x->k < y->k);
+}
+
+enum { FALLBACK_CANDIDATES = 4096 };
+
+/* A position in free space near p0, into out; 1, or 0 when none found. */
+static int find_free(const vdsh_view_tracer *t, const float p0[3], const float lo[3],
+                     const float hi[3], int interior, float diagonal, uint32_t *trials,
+                     float out[3])
+{
+    (*trials)++;
+    if (vdsh_view_free_space(t, p0, diagonal)) {
+        memcpy(out, p0, 3 * sizeof(float));
+        return 1;
+    }
+    float dirs[26][3];
+    int nd = nudge_dirs(dirs);
+    float h = 0.5f * vdsh_free_clearance(diagonal);
+    int rings = (int)ceilf(0.5f * diagonal / h);
+    for (int k = 1; k <= rings; k++)
+        for (int j = 0; j < nd; j++) {
+            float p[3];
+            for (int a = 0; a < 3; a++)
+                p[a] = p0[a] + (float)k * h * dirs[j][a];
+            if (interior && !inside(p, lo, hi))
+                continue;
+            (*trials)++;
+            if (vdsh_view_free_space(t, p, diagonal)) {
+                memcpy(out, p, sizeof p);
+                return 1;
+            }
+        }
+    /* Nothing near: the seeded candidates in the bounds, nearest first. */
+    cand *c = malloc(FALLBACK_CANDIDATES * sizeof *c);
+    if (!c)
+        return 0;
+    for (uint32_t k = 0; k < FALLBACK_CANDIDATES; k++) {
+        float p[3];
+        vdsh_light_candidate(lo, hi, 1, k, p);
+        c[k].d2 = 0.0f;
+        for (int a = 0; a < 3; a++)
+            c[k].d2 += (p[a] - p0[a]) * (p[a] - p0[a]);
+        c[k].k = k;
+    }
+    qsort(c, FALLBACK_CANDIDATES, sizeof *c, cmp_cand);
+    int found = 0;
+    for (int i = 0; i < FALLBACK_CANDIDATES && !found; i++) {
+        float p[3];
+        vdsh_light_candidate(lo, hi, 1, c[i].k, p);
+        (*trials)++;
+        if (vdsh_view_free_space(t, p, diagonal)) {
+            memcpy(out, p, sizeof p);
+            found = 1;
+        }
+    }
+    free(c);
+    return found;
+}
+
+vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_error *err)
+{
+    vdsh_view_tracer *t = NULL;
+    vdsh_result r = vdsh_view_tracer_create(m, &t, err);
+    if (r != VDSH_OK)
+        return r;
+    vdsh_view v;
+    memset(&v, 0, sizeof v);
+    vdsh_view_bounds(m->positions, m->vertex_count, v.bounds_min, v.bounds_max);
+    const float *lo = v.bounds_min, *hi = v.bounds_max;
+    v.front_share = vdsh_view_front_share(t, m, lo, hi);
+    v.interior = v.front_share >= VDSH_VIEW_INTERIOR_SHARE;
+    if (v.interior)
+        vdsh_view_room_camera(lo, hi, &v.camera);
+    else
+        vdsh_view_fit_camera(lo, hi, &v.camera);
+
+    float diag = 0.0f;
+    for (int k = 0; k < 3; k++)
+        diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    diag = sqrtf(diag) > 0.0f ? sqrtf(diag) : 1.0f;
+    v.light_count = vdsh_view_preferred_lights(lo, hi, v.interior, v.preferred,
+                                               VDSH_VIEW_MAX_LIGHTS);
+    for (int i = 0; i < v.light_count; i++) {
+        v.light_free[i] =
+            find_free(t, v.preferred[i], lo, hi, v.interior, diag, &v.light_trials, v.lights[i]);
+        if (!v.light_free[i])
+            memcpy(v.lights[i], v.preferred[i], sizeof v.lights[i]);
+    }
+    vdsh_view_tracer_destroy(t);
+    *out = v;
+    return VDSH_OK;
+}

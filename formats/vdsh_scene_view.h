@@ -1,0 +1,170 @@
+/*
+ * vdsh_scene_view.h - a scene's default view, decided from its mesh alone:
+ * is it a room to stand in or an object to look at, the camera for each,
+ * and default point lights, each in free space (vdsh_light.h). One
+ * definition, so that the GL viewer (runtime/, vr_scene_default_camera and
+ * vr_scene_default_lights) and the bake side's tools (vdsh-frames, from the
+ * .vdsh mesh) mean the same thing by "the default view".
+ *
+ * The scenes are y-up (the built-in room, OBJ convention). A room (or a
+ * courtyard) is seen from inside: the eye a third of the way from the
+ * middle to one end of the longest horizontal axis, at about a quarter of
+ * the height, looking along that axis at the far half of the floor
+ * (vdsh_view_room_camera). From there an object (a bunny, a teapot) would
+ * be seen from inside its own bounding box, often from inside the mesh
+ * itself. So the room's eye casts VDSH_VIEW_RAYS rays against the
+ * triangles (vdsh_view_front_share): the scene is an interior when at
+ * least VDSH_VIEW_INTERIOR_SHARE of them first meet the front of a
+ * surface, the side its vertex normals face. Anything else is framed from
+ * outside (vdsh_view_fit_camera).
+ *
+ * Default lights: preferred positions from the bounds alone
+ * (vdsh_view_preferred_lights: a room's spread through it, an object's
+ * outside its bounding sphere); each that is not in free space (inside a
+ * pillar, on a wall) is moved to the nearest position that is, searched
+ * deterministically (vdsh_view_compute says how).
+ *
+ * The rays are cast on the CPU against a uniform grid of the triangles
+ * (vdsh_view_tracer): first hits exactly as testing every triangle would
+ * find them (the same arithmetic; ties to the lower triangle index).
+ *
+ * Does not: read files, touch GL, or use threads.
+ *
+ * Usage (tests/test_scene_view.c is a compiled example):
+ *
+ *     vdsh_view v;
+ *     vdsh_view_mesh m = {f->positions, f->normals, f->indices,
+ *                         f->header.vertex_count, f->header.triangle_count};
+ *     if (vdsh_view_compute(&m, &v, &err) != VDSH_OK) ...
+ *     v.camera, v.lights[0 .. v.light_count - 1]
+ *
+ * Errors: vdsh_view_compute and vdsh_view_tracer_create return
+ * VDSH_ERR_OUT_OF_MEMORY or VDSH_ERR_INVALID (a triangle index not below
+ * vertex_count), message in err, outputs untouched. The rest cannot fail.
+ * Ownership: the mesh arrays are borrowed; a tracer borrows them for its
+ * whole life (keep them until vdsh_view_tracer_destroy, which accepts
+ * NULL). vdsh_view holds no pointers.
+ * Threading: no shared state; a tracer may be used by several threads at
+ * once (tracing only reads it).
+ */
+#ifndef VDSH_SCENE_VIEW_H
+#define VDSH_SCENE_VIEW_H
+
+#include <stdint.h>
+
+#include "vdsh.h"
+#include "vdsh_camera.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Rays from the room's eye, and the share of them that must meet the
+ * front of a surface for the scene to count as an interior. Measured
+ * (vdsh_view_front_share, default bakes): the built-in room 1.0, Lost
+ * Empire 1.0, Sponza 0.99, the Cornell boxes (one wall open) 0.64-0.70; a
+ * floor with a box on it 0.48 (the floor below, the sky above), fandisk
+ * 0.40, the rocker arm 0.36, the teapot 0.27 (an eye beside the object
+ * inside its bounds), the bunnies 0 (an eye inside the mesh sees the backs
+ * of its faces). */
+#define VDSH_VIEW_RAYS 128
+#define VDSH_VIEW_INTERIOR_SHARE 0.6f
+#define VDSH_VIEW_MAX_LIGHTS 4
+
+typedef struct vdsh_view_mesh {
+    const float *positions;      /* vertex_count x 3 */
+    const float *normals;        /* vertex_count x 3: the front side */
+    const uint32_t *indices;     /* triangle_count x 3 */
+    uint32_t vertex_count;
+    uint32_t triangle_count;
+} vdsh_view_mesh;
+
+typedef struct vdsh_view {
+    float bounds_min[3];         /* of all vertices (vdsh_view_bounds) */
+    float bounds_max[3];
+    float front_share;           /* vdsh_view_front_share, 0..1 */
+    int interior;                /* front_share >= VDSH_VIEW_INTERIOR_SHARE */
+    vdsh_camera camera;          /* the default camera: room or fit */
+    int light_count;             /* VDSH_VIEW_MAX_LIGHTS */
+    float lights[VDSH_VIEW_MAX_LIGHTS][3];     /* default light positions */
+    float preferred[VDSH_VIEW_MAX_LIGHTS][3];  /* before any move */
+    /* 1: lights[i] is in free space (moved there when preferred[i] was
+     * not); 0: no position searched was (a scene without free space), and
+     * lights[i] is preferred[i]. */
+    int light_free[VDSH_VIEW_MAX_LIGHTS];
+    uint32_t light_trials;       /* positions tested for free space */
+} vdsh_view;
+
+/* Everything above from the mesh: bounds, the interior test, the default
+ * camera, the default lights. A preferred light position in free space is
+ * kept. Otherwise the candidates p + k h d are tried, rings k = 1, 2, ...
+ * of step h = half the clearance (vdsh_free_clearance of the bounds'
+ * diagonal), up to half the diagonal, d each of the 26 directions toward
+ * a cube's faces, edges and corners in a fixed order; an interior's
+ * candidates must lie inside its bounds. The first in free space is the
+ * light. If none is, the first 4096 candidates of vdsh_light_candidate
+ * (seed 1) are tried, nearest first. Deterministic: the same mesh gives
+ * the same view on every machine. */
+vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_error *err);
+
+/* The bounding box of positions (vertex_count x 3), fminf / fmaxf per
+ * axis; with no vertices lo = +INFINITY, hi = -INFINITY. */
+void vdsh_view_bounds(const float *positions, uint32_t vertex_count, float lo[3], float hi[3]);
+
+/* The cameras (fov_y 60, up +y), from the bounds only. Fit: the eye up and
+ * to the side of the bounds' centre, looking at it, just far enough that
+ * every corner of the bounds is within the field of view vertically and
+ * (for an image at least as wide as it is tall) horizontally. */
+void vdsh_view_room_camera(const float lo[3], const float hi[3], vdsh_camera *out);
+void vdsh_view_fit_camera(const float lo[3], const float hi[3], vdsh_camera *out);
+
+/* Up to max (at most VDSH_VIEW_MAX_LIGHTS) preferred light positions from
+ * the bounds only; returns how many. Not checked for free space. */
+int vdsh_view_preferred_lights(const float lo[3], const float hi[3], int interior,
+                               float (*out)[3], int max);
+
+/* ---- rays against the mesh ------------------------------------------ */
+
+typedef struct vdsh_view_tracer vdsh_view_tracer;
+
+typedef struct vdsh_view_hit {
+    float t;                     /* distance along the unit direction */
+    float u, v;                  /* barycentrics of vertices 1 and 2 */
+    uint32_t triangle;
+    int back;                    /* the ray met the face from behind: its
+                                    winding normal (v1 - v0) x (v2 - v0)
+                                    points along the ray */
+} vdsh_view_hit;
+
+/* A uniform grid of the mesh's triangles (about two cells per triangle). */
+vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **out,
+                                    vdsh_error *err);
+void vdsh_view_tracer_destroy(vdsh_view_tracer *t);
+
+/* The nearest hit with t >= tmin along org + t dir (Moller-Trumbore,
+ * edges and vertices included): 1 and *hit, or 0 (nothing; *hit
+ * untouched). Equal t: the lower triangle index. */
+int vdsh_view_trace(const vdsh_view_tracer *t, const float org[3], const float dir[3],
+                    float tmin, vdsh_view_hit *hit);
+
+/* vdsh_view_trace for every triangle in index order, no grid: the
+ * reference the grid is tested against (and the cost it saves). */
+int vdsh_view_trace_all(const vdsh_view_mesh *m, const float org[3], const float dir[3],
+                        float tmin, vdsh_view_hit *hit);
+
+/* The share of VDSH_VIEW_RAYS directions (a Fibonacci sphere) from the
+ * room camera's eye whose first hit farther than 1e-5 of the diagonal is
+ * the front of a surface (the interpolated vertex normal against the
+ * ray), 0..1. */
+float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
+                            const float lo[3], const float hi[3]);
+
+/* vdsh_free_space (vdsh_light.h) at p, its probes cast against the mesh,
+ * clearance from `diagonal`; back faces by winding. */
+int vdsh_view_free_space(const vdsh_view_tracer *t, const float p[3], float diagonal);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VDSH_SCENE_VIEW_H */

@@ -1,0 +1,505 @@
+/*
+ * test_scene_view.c - formats/vdsh_scene_view.h, the default view from a
+ * mesh (no GL):
+ *
+ *   test_scene_view unit
+ *     rays     the grid's first hits are the plain loop's, bit for bit
+ *              (distance, barycentrics, triangle, side), on a room with a
+ *              pillar, a sphere and a soup of large random triangles
+ *     space    free space: the middle of a room is, and far above it (open
+ *              sky); inside a pillar and near a wall are not
+ *     room     a closed room is an interior seen by the room camera; a
+ *              preferred light inside a pillar moves into free space
+ *              nearby, the others stay where they were
+ *     object   a sphere is framed from outside, lit from outside it
+ *     none     a scene with no free space keeps the preferred lights and
+ *              says they are not free
+ *     errors   an index out of range: VDSH_ERR_INVALID, output untouched
+ *   test_scene_view room ROOM.vdsh
+ *     the built-in room baked (a CTest fixture): the room camera; every
+ *     default light in free space (probes cast by the plain loop), none
+ *     inside or on a pillar, crate or the sphere (bake/builtin.c places
+ *     them); the two preferred positions that lie on and in pillars moved
+ *     less than a metre, the other two kept
+ */
+#include "test_util.h"
+
+#include "vdsh.h"
+#include "vdsh_camera.h"
+#include "vdsh_light.h"
+#include "vdsh_scene_view.h"
+
+#include <math.h>
+#include <string.h>
+
+/* ---- meshes ------------------------------------------------------------ */
+
+enum { MAX_V = 8192, MAX_T = 8192 };
+
+typedef struct mesh {
+    float pos[MAX_V][3], nrm[MAX_V][3];
+    uint32_t idx[MAX_T][3];
+    uint32_t nv, nt;
+} mesh;
+
+static vdsh_view_mesh view_mesh(const mesh *m)
+{
+    vdsh_view_mesh v = {&m->pos[0][0], &m->nrm[0][0], &m->idx[0][0], m->nv, m->nt};
+    return v;
+}
+
+/* Quad a b c d, counter-clockwise seen from the side its normal n faces. */
+static void quad(mesh *m, const float a[3], const float b[3], const float c[3], const float d[3])
+{
+    const float *p[4] = {a, b, c, d};
+    float e1[3], e2[3], n[3];
+    for (int k = 0; k < 3; k++)
+        e1[k] = b[k] - a[k], e2[k] = c[k] - a[k];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    float l = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    uint32_t base = m->nv;
+    for (int i = 0; i < 4; i++) {
+        memcpy(m->pos[m->nv], p[i], sizeof m->pos[0]);
+        for (int k = 0; k < 3; k++)
+            m->nrm[m->nv][k] = n[k] / l;
+        m->nv++;
+    }
+    uint32_t t0[3] = {base, base + 1, base + 2}, t1[3] = {base, base + 2, base + 3};
+    memcpy(m->idx[m->nt++], t0, sizeof t0);
+    memcpy(m->idx[m->nt++], t1, sizeof t1);
+}
+
+/* An axis-aligned box lo..hi, faces outward (a solid) or inward (a room). */
+static void box(mesh *m, const float lo[3], const float hi[3], int inward)
+{
+    for (int a = 0; a < 3; a++)
+        for (int side = 0; side < 2; side++) {
+            int b = (a + 1) % 3, c = (a + 2) % 3;
+            float q[4][3];
+            /* corners around the face, counter-clockwise seen along +a */
+            static const int uv[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+            for (int i = 0; i < 4; i++) {
+                q[i][a] = side ? hi[a] : lo[a];
+                q[i][b] = uv[i][0] ? hi[b] : lo[b];
+                q[i][c] = uv[i][1] ? hi[c] : lo[c];
+            }
+            /* b x c = a: this order faces +a; flip for the -a face, and
+             * again for a room */
+            if ((side == 1) != (inward != 0))
+                quad(m, q[0], q[1], q[2], q[3]);
+            else
+                quad(m, q[0], q[3], q[2], q[1]);
+        }
+}
+
+/* A UV sphere, faces and normals outward. */
+static void sphere(mesh *m, const float c[3], float r, int stacks, int slices)
+{
+    uint32_t base = m->nv;
+    for (int i = 0; i <= stacks; i++)
+        for (int j = 0; j <= slices; j++) {
+            float t = 3.14159265f * (float)i / (float)stacks;
+            float p = 6.2831853f * (float)j / (float)slices;
+            float n[3] = {sinf(t) * cosf(p), cosf(t), sinf(t) * sinf(p)};
+            for (int k = 0; k < 3; k++) {
+                m->pos[m->nv][k] = c[k] + r * n[k];
+                m->nrm[m->nv][k] = n[k];
+            }
+            m->nv++;
+        }
+    for (int i = 0; i < stacks; i++)
+        for (int j = 0; j < slices; j++) {
+            uint32_t a = base + (uint32_t)(i * (slices + 1) + j), b = a + 1;
+            uint32_t d = a + (uint32_t)(slices + 1), e = d + 1;
+            uint32_t t0[3] = {a, b, e}, t1[3] = {a, e, d};
+            memcpy(m->idx[m->nt++], t0, sizeof t0);
+            memcpy(m->idx[m->nt++], t1, sizeof t1);
+        }
+}
+
+/* ---- free space by the plain loop -------------------------------------- */
+
+static float diagonal_of(const float lo[3], const float hi[3])
+{
+    float d = 0.0f;
+    for (int k = 0; k < 3; k++)
+        d += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    return sqrtf(d);
+}
+
+/* vdsh_light.h's rule, probes cast at every triangle (no grid). */
+static int free_all(const vdsh_view_mesh *m, const float p[3], float diagonal)
+{
+    float dirs[VDSH_FREE_PROBES][3], t[VDSH_FREE_PROBES];
+    int back[VDSH_FREE_PROBES];
+    vdsh_free_probe_dirs(dirs);
+    for (int i = 0; i < VDSH_FREE_PROBES; i++) {
+        vdsh_view_hit h;
+        int hit = vdsh_view_trace_all(m, p, dirs[i], 0.0f, &h);
+        t[i] = hit ? h.t : INFINITY;
+        back[i] = hit && h.back;
+    }
+    return vdsh_free_space(t, back, vdsh_free_clearance(diagonal));
+}
+
+static float dist3(const float a[3], const float b[3])
+{
+    float d = 0.0f;
+    for (int k = 0; k < 3; k++)
+        d += (a[k] - b[k]) * (a[k] - b[k]);
+    return sqrtf(d);
+}
+
+static int same_camera(const vdsh_camera *a, const vdsh_camera *b)
+{
+    return !memcmp(a->eye, b->eye, sizeof a->eye) && !memcmp(a->target, b->target, sizeof a->target) &&
+           !memcmp(a->up, b->up, sizeof a->up) && a->fov_y == b->fov_y;
+}
+
+/* ---- unit tests --------------------------------------------------------- */
+
+static mesh M;
+
+/* Grid against plain loop on n random rays from in and around the box. */
+static void rays_agree(const mesh *mm, const char *name, uint64_t seed, int n)
+{
+    vdsh_view_mesh m = view_mesh(mm);
+    vdsh_view_tracer *t = NULL;
+    vdsh_error err;
+    CHECK(vdsh_view_tracer_create(&m, &t, &err) == VDSH_OK, "%s: %s", name, err.msg);
+    if (!t)
+        return;
+    float lo[3], hi[3];
+    vdsh_view_bounds(m.positions, m.vertex_count, lo, hi);
+    int hits = 0, differ = 0, backs = 0;
+    for (int i = 0; i < n; i++) {
+        float o[3], d[3];
+        for (int k = 0; k < 3; k++) {
+            float e = hi[k] - lo[k];
+            o[k] = lo[k] - 0.2f * e + 1.4f * e * (float)test_rand(&seed);
+        }
+        test_rand_dir(&seed, d);
+        /* some rays along the axes and through vertices: ties and edges */
+        if (i % 7 == 0)
+            for (int k = 0; k < 3; k++)
+                d[k] = k == i % 3 ? (i & 8 ? 1.0f : -1.0f) : 0.0f;
+        if (i % 11 == 0) {
+            const float *v = m.positions + 3 * (size_t)(i % (int)m.vertex_count);
+            float l = dist3(v, o);
+            for (int k = 0; k < 3; k++)
+                d[k] = (v[k] - o[k]) / l;
+        }
+        float tmin = i % 3 == 0 ? 0.0f : (float)test_rand(&seed) * 0.1f;
+        vdsh_view_hit a, b;
+        memset(&a, 0, sizeof a);
+        memset(&b, 0, sizeof b);
+        int ha = vdsh_view_trace(t, o, d, tmin, &a), hb = vdsh_view_trace_all(&m, o, d, tmin, &b);
+        hits += hb;
+        backs += hb && b.back;
+        if (ha != hb || memcmp(&a, &b, sizeof a)) {
+            if (differ++ < 5)
+                fprintf(stderr, "%s: ray %d: grid %d (t %g, triangle %u), loop %d (t %g, "
+                        "triangle %u)\n", name, i, ha, (double)a.t, a.triangle, hb,
+                        (double)b.t, b.triangle);
+        }
+    }
+    printf("rays: %s (%u triangles): %d rays, %d hits (%d from behind), %d differ\n", name,
+           m.triangle_count, n, hits, backs, differ);
+    CHECK(differ == 0, "%s: %d of %d rays hit differently through the grid", name, differ, n);
+    CHECK(hits > n / 10 && hits < n, "%s: %d hits of %d rays: the test proves little", name,
+          hits, n);
+    vdsh_view_tracer_destroy(t);
+}
+
+/* The room of the unit tests: 20 x 6 x 20, a 0.4 m pillar, floor to
+ * ceiling, around where preferred light 2 falls. */
+static void unit_room(mesh *m, float pillar_lo[3], float pillar_hi[3])
+{
+    memset(m, 0, sizeof *m);
+    const float lo[3] = {-10, 0, -10}, hi[3] = {10, 6, 10};
+    box(m, lo, hi, 1);
+    float pref[VDSH_VIEW_MAX_LIGHTS][3];
+    vdsh_view_preferred_lights(lo, hi, 1, pref, VDSH_VIEW_MAX_LIGHTS);
+    for (int k = 0; k < 3; k++) {
+        pillar_lo[k] = k == 1 ? 0.0f : pref[2][k] - 0.15f;
+        pillar_hi[k] = k == 1 ? 6.0f : pref[2][k] + 0.25f;
+    }
+    box(m, pillar_lo, pillar_hi, 0);
+}
+
+static void test_rays(void)
+{
+    float plo[3], phi[3];
+    unit_room(&M, plo, phi);
+    rays_agree(&M, "room with a pillar", 1, 4000);
+
+    memset(&M, 0, sizeof M);
+    sphere(&M, (float[3]){3, 1, -2}, 1.0f, 24, 32);
+    rays_agree(&M, "sphere", 2, 4000);
+
+    /* large random triangles: many cells each */
+    memset(&M, 0, sizeof M);
+    uint64_t s = 3;
+    for (int i = 0; i < 600; i++) {
+        float c[3], span = (float)(i % 10 == 0 ? 8.0 : 1.0);
+        for (int k = 0; k < 3; k++)
+            c[k] = 10.0f * (float)test_rand(&s);
+        for (int v = 0; v < 3; v++) {
+            for (int k = 0; k < 3; k++) {
+                M.pos[M.nv][k] = c[k] + span * (float)(test_rand(&s) - 0.5);
+                M.nrm[M.nv][k] = k == 1 ? 1.0f : 0.0f;
+            }
+            M.idx[M.nt][v] = M.nv++;
+        }
+        M.nt++;
+    }
+    rays_agree(&M, "soup", 4, 4000);
+}
+
+static void test_space(void)
+{
+    float plo[3], phi[3];
+    unit_room(&M, plo, phi);
+    vdsh_view_mesh m = view_mesh(&M);
+    vdsh_view_tracer *t = NULL;
+    vdsh_error err;
+    CHECK(vdsh_view_tracer_create(&m, &t, &err) == VDSH_OK, "%s", err.msg);
+    if (!t)
+        return;
+    float diag = diagonal_of((float[3]){-10, 0, -10}, (float[3]){10, 6, 10});
+    float c = vdsh_free_clearance(diag);
+    struct {
+        float p[3];
+        int free;
+        const char *what;
+    } cases[] = {
+        {{0, 3, 0}, 1, "the middle of the room"},
+        {{-9, 1, 9}, 1, "a corner, a metre from the walls"},
+        {{0.5f * (plo[0] + phi[0]), 3, 0.5f * (plo[2] + phi[2])}, 0, "inside the pillar"},
+        {{0, 3, 10.0f - 0.5f * c}, 0, "half the clearance from a wall"},
+        {{0, 6.0f - 0.5f * c, 0}, 0, "half the clearance below the ceiling"},
+        /* open sky counts as free: most probes escape */
+        {{0, 30, 0}, 1, "far above the room"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        int g = vdsh_view_free_space(t, cases[i].p, diag), a = free_all(&m, cases[i].p, diag);
+        CHECK(g == cases[i].free, "%s: free space %d, expected %d", cases[i].what, g,
+              cases[i].free);
+        CHECK(g == a, "%s: the grid says %d, the plain loop %d", cases[i].what, g, a);
+    }
+    vdsh_view_tracer_destroy(t);
+}
+
+static void test_room(void)
+{
+    float plo[3], phi[3];
+    unit_room(&M, plo, phi);
+    vdsh_view_mesh m = view_mesh(&M);
+    vdsh_view v, v2;
+    vdsh_error err;
+    CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
+    CHECK(vdsh_view_compute(&m, &v2, &err) == VDSH_OK, "%s", err.msg);
+    CHECK(!memcmp(&v, &v2, sizeof v), "two computations of the same view differ");
+    CHECK(v.front_share == 1.0f && v.interior, "a closed room: front share %g, interior %d",
+          (double)v.front_share, v.interior);
+    vdsh_camera room;
+    vdsh_view_room_camera(v.bounds_min, v.bounds_max, &room);
+    CHECK(same_camera(&v.camera, &room), "a room is not seen by the room camera");
+    float diag = diagonal_of(v.bounds_min, v.bounds_max);
+    CHECK(v.light_count == VDSH_VIEW_MAX_LIGHTS, "%d lights", v.light_count);
+    for (int i = 0; i < v.light_count; i++) {
+        int was_free = free_all(&m, v.preferred[i], diag);
+        CHECK(v.light_free[i] && free_all(&m, v.lights[i], diag),
+              "light %d at (%g, %g, %g) is not in free space", i, v.lights[i][0],
+              v.lights[i][1], v.lights[i][2]);
+        if (i == 2) {
+            CHECK(!was_free, "light 2's preferred position is free: the pillar misses it");
+            float moved = dist3(v.lights[i], v.preferred[i]);
+            CHECK(moved > 0.0f && moved < 4.0f * vdsh_free_clearance(diag),
+                  "light 2 moved %g from the pillar (clearance %g)", (double)moved,
+                  (double)vdsh_free_clearance(diag));
+            int in_pillar = 1;
+            for (int k = 0; k < 3; k++)
+                in_pillar &= v.lights[i][k] >= plo[k] && v.lights[i][k] <= phi[k];
+            CHECK(!in_pillar, "light 2 is still in the pillar");
+            printf("room: light 2 moved %.3f from (%g, %g, %g) to (%g, %g, %g)\n",
+                   (double)moved, v.preferred[i][0], v.preferred[i][1], v.preferred[i][2],
+                   v.lights[i][0], v.lights[i][1], v.lights[i][2]);
+        } else {
+            CHECK(was_free, "light %d's preferred position is not free", i);
+            CHECK(!memcmp(v.lights[i], v.preferred[i], sizeof v.lights[i]),
+                  "light %d moved from a free position", i);
+        }
+    }
+}
+
+static void test_object(void)
+{
+    memset(&M, 0, sizeof M);
+    const float c[3] = {3, 1, -2};
+    sphere(&M, c, 1.0f, 16, 24);
+    vdsh_view_mesh m = view_mesh(&M);
+    vdsh_view v;
+    vdsh_error err;
+    CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
+    CHECK(!v.interior && v.front_share == 0.0f, "a sphere: interior %d, front share %g",
+          v.interior, (double)v.front_share);
+    vdsh_camera fit;
+    vdsh_view_fit_camera(v.bounds_min, v.bounds_max, &fit);
+    CHECK(same_camera(&v.camera, &fit), "an object is not framed by the fit camera");
+    float diag = diagonal_of(v.bounds_min, v.bounds_max);
+    for (int i = 0; i < v.light_count; i++) {
+        float r = dist3(v.lights[i], c);
+        CHECK(r > 1.0f + vdsh_free_clearance(diag), "light %d is %g from the centre", i,
+              (double)r);
+        CHECK(v.light_free[i] && free_all(&m, v.lights[i], diag), "light %d is not free", i);
+        CHECK(!memcmp(v.lights[i], v.preferred[i], sizeof v.lights[i]), "light %d moved", i);
+    }
+}
+
+static void test_none(void)
+{
+    /* A solid cube (faces outward by winding) whose normals say "room":
+     * the interior test sees fronts, every point inside sees backs. */
+    memset(&M, 0, sizeof M);
+    box(&M, (float[3]){-5, 0, -5}, (float[3]){5, 3, 5}, 0);
+    for (uint32_t i = 0; i < M.nv; i++)
+        for (int k = 0; k < 3; k++)
+            M.nrm[i][k] = -M.nrm[i][k];
+    vdsh_view_mesh m = view_mesh(&M);
+    vdsh_view v;
+    vdsh_error err;
+    CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
+    CHECK(v.interior, "the inverted cube should pass as a room");
+    for (int i = 0; i < v.light_count; i++) {
+        CHECK(!v.light_free[i], "light %d found free space inside a solid", i);
+        CHECK(!memcmp(v.lights[i], v.preferred[i], sizeof v.lights[i]),
+              "light %d without free space moved", i);
+    }
+    printf("none: %u positions tried\n", v.light_trials);
+}
+
+static void test_errors(void)
+{
+    memset(&M, 0, sizeof M);
+    box(&M, (float[3]){0, 0, 0}, (float[3]){1, 1, 1}, 0);
+    M.idx[3][1] = M.nv;
+    vdsh_view_mesh m = view_mesh(&M);
+    vdsh_view v;
+    memset(&v, 0x5a, sizeof v);
+    vdsh_view before = v;
+    vdsh_error err = {{0}};
+    CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_ERR_INVALID, "an index out of range passed");
+    CHECK(strstr(err.msg, "triangle 3") != NULL, "message: %s", err.msg);
+    CHECK(!memcmp(&v, &before, sizeof v), "the output was written on failure");
+}
+
+/* ---- the built-in room -------------------------------------------------- */
+
+/* bake/builtin.c: pillars 0.4 m square, floor to ceiling; the crates (the
+ * third turned 30 degrees about y); the sphere. */
+static int in_solid(const float p[3], float margin, char *what, size_t cap)
+{
+    const float pillars[3][2] = {{-5.5f, 5.5f}, {5.5f, 5.5f}, {5.5f, -5.5f}};
+    for (int i = 0; i < 3; i++)
+        if (fabsf(p[0] - pillars[i][0]) <= 0.2f + margin &&
+            fabsf(p[2] - pillars[i][1]) <= 0.2f + margin) {
+            snprintf(what, cap, "the pillar at (%g, %g)", pillars[i][0], pillars[i][1]);
+            return 1;
+        }
+    /* centre x, z, bottom, size, turn */
+    const float boxes[3][5] = {{-4.0f, -3.0f, 0.0f, 1.58f, 0.0f},
+                               {-4.2f, -3.15f, 1.58f, 0.79f, 0.0f},
+                               {4.0f, 3.5f, 0.0f, 1.12f, 30.0f}};
+    for (int i = 0; i < 3; i++) {
+        float a = boxes[i][4] * 3.14159265f / 180.0f, dx = p[0] - boxes[i][0],
+              dz = p[2] - boxes[i][1];
+        float u = cosf(a) * dx + sinf(a) * dz, w = -sinf(a) * dx + cosf(a) * dz;
+        float h = 0.5f * boxes[i][3] + margin;
+        if (fabsf(u) <= h && fabsf(w) <= h && p[1] >= boxes[i][2] - margin &&
+            p[1] <= boxes[i][2] + boxes[i][3] + margin) {
+            snprintf(what, cap, "crate %d", i);
+            return 1;
+        }
+    }
+    if (dist3(p, (float[3]){-1.0f, 0.6f, 2.0f}) <= 0.6f + margin) {
+        snprintf(what, cap, "the sphere");
+        return 1;
+    }
+    return 0;
+}
+
+static int test_builtin_room(const char *path)
+{
+    vdsh_file *f = NULL;
+    vdsh_error err;
+    if (vdsh_read(path, &f, &err) != VDSH_OK) {
+        fprintf(stderr, "%s\n", err.msg);
+        return 1;
+    }
+    vdsh_view_mesh m = {f->positions, f->normals, f->indices, f->header.vertex_count,
+                        f->header.triangle_count};
+    vdsh_view v;
+    CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
+    CHECK(v.interior, "%s: not an interior (front share %g)", path, (double)v.front_share);
+    /* the room camera as it was written before it moved to formats/: a
+     * third of the way along x, 28% up, looking at the far half */
+    const float *lo = v.bounds_min, *hi = v.bounds_max;
+    vdsh_camera c = {{0.5f * (lo[0] + hi[0]) + 0.36f * (hi[0] - lo[0]), lo[1] + 0.28f * (hi[1] - lo[1]),
+                      0.5f * (lo[2] + hi[2]) + 0.05f * (hi[2] - lo[2])},
+                     {0.5f * (lo[0] + hi[0]) - 0.2f * (hi[0] - lo[0]), lo[1] + 0.13f * (hi[1] - lo[1]),
+                      0.5f * (lo[2] + hi[2])},
+                     {0, 1, 0},
+                     60.0f};
+    CHECK(same_camera(&v.camera, &c), "%s: the default camera is not the room camera", path);
+    float diag = diagonal_of(lo, hi), clear = vdsh_free_clearance(diag);
+    for (int i = 0; i < v.light_count; i++) {
+        char what[64];
+        int pref_free = free_all(&m, v.preferred[i], diag);
+        float moved = dist3(v.lights[i], v.preferred[i]);
+        printf("light %d: preferred (%g, %g, %g)%s, now (%g, %g, %g), moved %.3f\n", i,
+               v.preferred[i][0], v.preferred[i][1], v.preferred[i][2],
+               pref_free ? " free" : " not free", v.lights[i][0], v.lights[i][1],
+               v.lights[i][2], (double)moved);
+        CHECK(v.light_free[i] && free_all(&m, v.lights[i], diag),
+              "light %d is not in free space", i);
+        CHECK(!in_solid(v.lights[i], 0.0f, what, sizeof what), "light %d is inside %s", i,
+              what);
+        /* the axis probes keep it clear of the faces it is in front of:
+         * no closer than the clearance to a pillar's or crate's sides */
+        CHECK(!in_solid(v.lights[i], 0.5f * clear, what, sizeof what),
+              "light %d is within half the clearance (%g) of %s", i, (double)(0.5f * clear),
+              what);
+        if (i == 1 || i == 2) {
+            CHECK(!pref_free, "light %d's preferred position is in free space: the test has "
+                  "lost its pillar", i);
+            CHECK(in_solid(v.preferred[i], 0.01f, what, sizeof what),
+                  "light %d's preferred position is not at a pillar", i);
+            CHECK(moved > 0.0f && moved < 1.0f, "light %d moved %g", i, (double)moved);
+        } else {
+            CHECK(pref_free && moved == 0.0f, "light %d: free %d, moved %g", i, pref_free,
+                  (double)moved);
+        }
+    }
+    vdsh_free(f);
+    return test_report("scene_view room");
+}
+
+int main(int argc, char **argv)
+{
+    if (argc == 3 && !strcmp(argv[1], "room"))
+        return test_builtin_room(argv[2]);
+    if (argc != 2 || strcmp(argv[1], "unit")) {
+        fprintf(stderr, "usage: test_scene_view unit | room ROOM.vdsh\n");
+        return 2;
+    }
+    test_rays();
+    test_space();
+    test_room();
+    test_object();
+    test_none();
+    test_errors();
+    return test_report("scene_view");
+}
