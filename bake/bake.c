@@ -113,6 +113,10 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
     float acc[2][VDSH_MAX_COEFFS][VB_PACKET];
     memset(acc, 0, sizeof acc);
     uint32_t near_zero = 0, upper = 0;
+    static float sig_k = -1.0f;
+    if (sig_k < 0.0f) { const char *e = getenv("VDSH_EXP_SIGMA"); sig_k = e ? (float)atof(e) : 0.0f; }
+    float rx[2600], ry[2600], rz[2600], rl[2600];
+    uint32_t rn = 0;
 
     /* Packets are traced GROUP at a time, then their lanes are processed
      * together: the log's division and series are a long dependency
@@ -203,6 +207,10 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
             if (want[1])
                 vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, logd[p], &acc[1][0][0],
                                     VB_PACKET);
+            if (sig_k > 0.0f && want[1])
+                for (int k = 0; k < VB_PACKET; k++)
+                    if (up_lane[p][k] && rn < 2600)
+                        rx[rn] = dx[k], ry[rn] = dy[k], rz[rn] = dz[k], rl[rn++] = logd[p][k];
             if (out->n)
                 for (int k = 0; k < VB_PACKET; k++)
                     if (up_lane[p][k]) {
@@ -242,9 +250,26 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
                 vb_fit_finish(&J->fits[o], &angles, u, out->coeffs[q][o]);
     }
     /* Method shadow: the log offset, through c0 (Y00 is a constant). */
-    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-        if (out->coeffs[1][o] && J->log_offset[o] != 0.0f)
-            out->coeffs[1][o][0] += J->log_offset[o] / 0.28209479177387814f;
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
+        if (!out->coeffs[1][o])
+            continue;
+        float extra = 0.0f;
+        if (sig_k > 0.0f && rn > 0) {
+            double ss = 0.0;
+            for (uint32_t k = 0; k < rn; k++) {
+                float y[25], wd[3] = {rx[k], ry[k], rz[k]};
+                vdsh_sh_eval(o, wd, y);
+                float sum = 0.0f;
+                for (int i = 0; i < o * o; i++) sum += out->coeffs[1][o][i] * y[i];
+                double r = rl[k] - sum;
+                if (getenv("VDSH_EXP_POS") && r < 0) r = 0;
+                ss += r * r;
+            }
+            extra = sig_k * (float)sqrt(ss / rn);
+        }
+        if (J->log_offset[o] + extra != 0.0f)
+            out->coeffs[1][o][0] += (J->log_offset[o] + extra) / 0.28209479177387814f;
+    }
     if (upper > 0 && near_zero >= 0.9 * upper)
         (*degenerate)++;
 }

@@ -6,6 +6,8 @@
  */
 #include "frames.h"
 
+#include "vdsh_scene_view.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -552,186 +554,21 @@ void vb_frames_scores_get(const vb_frames_tally *t, vb_frames_scores *out)
     *out = r;
 }
 
-/* ---- the viewer's default camera -----------------------------------------------------
- * TODO(issue 14, at merge): replace default_camera() and the copy below
- * with formats/'s shared default camera (the function moved there from
- * runtime/vr_view.c: vr_view_room_camera, vr_view_fit_camera and the
- * 128-ray interior test vr_view_front_share / vr_view_interior), so that
- * this and the viewer cannot drift apart. Until then this is a line-for-
- * line copy of that logic (runtime/vr_view.c says why it is so). */
+/* ---- the viewer's default camera -------------------------------------------------------
+ * The camera vdsh-view opens a scene with: formats/vdsh_scene_view.h's,
+ * from the file's mesh, the one definition the runtime uses too. */
 
-enum { VIEW_RAYS = 128 };
-#define VIEW_INTERIOR_SHARE 0.6f
-
-static void view_axes(const float lo[3], const float hi[3], int *ax, int *other)
-{
-    *ax = hi[0] - lo[0] >= hi[2] - lo[2] ? 0 : 2;
-    *other = 2 - *ax;
-}
-
-static void room_camera(const float lo[3], const float hi[3], vdsh_camera *out)
-{
-    float c[3], e[3];
-    for (int k = 0; k < 3; k++) {
-        c[k] = 0.5f * (lo[k] + hi[k]);
-        e[k] = hi[k] - lo[k];
-    }
-    int ax, other;
-    view_axes(lo, hi, &ax, &other);
-    vdsh_camera cam;
-    memset(&cam, 0, sizeof cam);
-    cam.eye[ax] = c[ax] + 0.36f * e[ax];
-    cam.eye[other] = c[other] + 0.05f * e[other];
-    cam.eye[1] = lo[1] + 0.28f * e[1];
-    cam.target[ax] = c[ax] - 0.2f * e[ax];
-    cam.target[other] = c[other];
-    cam.target[1] = lo[1] + 0.13f * e[1];
-    cam.up[1] = 1.0f;
-    cam.fov_y = 60.0f;
-    *out = cam;
-}
-
-static float view_frame(const float lo[3], const float hi[3], float c[3], float u[3][3])
-{
-    float r2 = 0.0f;
-    for (int k = 0; k < 3; k++) {
-        c[k] = 0.5f * (lo[k] + hi[k]);
-        r2 += 0.25f * (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    }
-    int ax, other;
-    view_axes(lo, hi, &ax, &other);
-    memset(u, 0, 9 * sizeof(float));
-    u[0][ax] = 1.0f;
-    u[1][1] = 1.0f;
-    u[2][other] = 1.0f;
-    float r = sqrtf(r2);
-    return r > 0.0f ? r : 1.0f;
-}
-
-static void fit_camera(const float lo[3], const float hi[3], vdsh_camera *out)
-{
-    float c[3], u[3][3];
-    float r = view_frame(lo, hi, c, u);
-    vdsh_camera cam;
-    memset(&cam, 0, sizeof cam);
-    cam.fov_y = 60.0f;
-    cam.up[1] = 1.0f;
-    memcpy(cam.target, c, sizeof cam.target);
-    float w[3], s[3], v[3];
-    for (int k = 0; k < 3; k++)
-        w[k] = 0.8f * u[0][k] + 0.45f * u[1][k] + 0.4f * u[2][k];
-    float n = sqrtf(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    for (int k = 0; k < 3; k++)
-        w[k] /= n;
-    s[0] = w[2], s[1] = 0.0f, s[2] = -w[0];
-    n = sqrtf(s[0] * s[0] + s[2] * s[2]);
-    s[0] /= n, s[2] /= n;
-    v[0] = w[1] * s[2] - w[2] * s[1];
-    v[1] = w[2] * s[0] - w[0] * s[2];
-    v[2] = w[0] * s[1] - w[1] * s[0];
-    float t = tanf(0.5f * cam.fov_y * 3.14159265358979f / 180.0f), dist = 0.0f;
-    for (int corner = 0; corner < 8; corner++) {
-        float p[3], d = 0.0f, a = 0.0f, b = 0.0f;
-        for (int k = 0; k < 3; k++) {
-            p[k] = ((corner >> k) & 1 ? hi[k] : lo[k]) - c[k];
-            d += p[k] * w[k];
-            a += p[k] * s[k];
-            b += p[k] * v[k];
-        }
-        dist = fmaxf(dist, d + fmaxf(fabsf(a), fabsf(b)) / t);
-    }
-    dist = 1.05f * (dist > 0.0f ? dist : r);
-    for (int k = 0; k < 3; k++)
-        cam.eye[k] = c[k] + dist * w[k];
-    *out = cam;
-}
-
-static float front_share(const float *positions, const float *normals,
-                         const uint32_t *indices, uint32_t triangle_count, const float lo[3],
-                         const float hi[3])
-{
-    vdsh_camera room;
-    room_camera(lo, hi, &room);
-    const float *o = room.eye;
-    float diag2 = 0.0f;
-    for (int k = 0; k < 3; k++)
-        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    float tmin = 1e-5f * sqrtf(diag2);
-    float dir[VIEW_RAYS][3], best[VIEW_RAYS];
-    uint32_t hit[VIEW_RAYS];
-    float hu[VIEW_RAYS], hv[VIEW_RAYS];
-    for (int i = 0; i < VIEW_RAYS; i++) {
-        float z = 1.0f - (2.0f * (float)i + 1.0f) / (float)VIEW_RAYS;
-        float rho = sqrtf(fmaxf(0.0f, 1.0f - z * z)), ph = 2.39996323f * (float)i;
-        dir[i][0] = rho * cosf(ph);
-        dir[i][1] = z;
-        dir[i][2] = rho * sinf(ph);
-        best[i] = INFINITY;
-        hit[i] = UINT32_MAX;
-    }
-    for (uint32_t t = 0; t < triangle_count; t++) {
-        const uint32_t *tri = indices + 3 * (size_t)t;
-        const float *a = positions + 3 * (size_t)tri[0], *b = positions + 3 * (size_t)tri[1],
-                    *c = positions + 3 * (size_t)tri[2];
-        float e1[3], e2[3], s[3], q[3];
-        for (int k = 0; k < 3; k++) {
-            e1[k] = b[k] - a[k];
-            e2[k] = c[k] - a[k];
-            s[k] = o[k] - a[k];
-        }
-        q[0] = s[1] * e1[2] - s[2] * e1[1];
-        q[1] = s[2] * e1[0] - s[0] * e1[2];
-        q[2] = s[0] * e1[1] - s[1] * e1[0];
-        float qe2 = q[0] * e2[0] + q[1] * e2[1] + q[2] * e2[2];
-        for (int i = 0; i < VIEW_RAYS; i++) {
-            const float *d = dir[i];
-            float p[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2],
-                          d[0] * e2[1] - d[1] * e2[0]};
-            float det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
-            if (det == 0.0f)
-                continue;
-            float inv = 1.0f / det;
-            float u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) * inv;
-            if (!(u >= 0.0f && u <= 1.0f))
-                continue;
-            float v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) * inv;
-            if (!(v >= 0.0f && u + v <= 1.0f))
-                continue;
-            float dist = qe2 * inv;
-            if (dist > tmin && dist < best[i]) {
-                best[i] = dist;
-                hit[i] = t;
-                hu[i] = u;
-                hv[i] = v;
-            }
-        }
-    }
-    int front = 0;
-    for (int i = 0; i < VIEW_RAYS; i++) {
-        if (hit[i] == UINT32_MAX)
-            continue;
-        const uint32_t *tri = indices + 3 * (size_t)hit[i];
-        const float *na = normals + 3 * (size_t)tri[0], *nb = normals + 3 * (size_t)tri[1],
-                    *nc = normals + 3 * (size_t)tri[2];
-        float n[3];
-        for (int k = 0; k < 3; k++)
-            n[k] = (1.0f - hu[i] - hv[i]) * na[k] + hu[i] * nb[k] + hv[i] * nc[k];
-        front += n[0] * dir[i][0] + n[1] * dir[i][1] + n[2] * dir[i][2] < 0.0f;
-    }
-    return (float)front / (float)VIEW_RAYS;
-}
-
-/* The camera vdsh-view opens a scene with (vr_scene_default_camera):
- * from inside a room, from outside an object. */
-static void default_camera(const vb_frames_scene *s, vdsh_camera *out)
+static vb_result default_camera(const vb_frames_scene *s, vdsh_camera *out, vb_error *err)
 {
     const vdsh_file *f = s->file;
-    int interior = front_share(f->positions, f->normals, f->indices, f->header.triangle_count,
-                               s->bounds_min, s->bounds_max) >= VIEW_INTERIOR_SHARE;
-    if (interior)
-        room_camera(s->bounds_min, s->bounds_max, out);
-    else
-        fit_camera(s->bounds_min, s->bounds_max, out);
+    vdsh_view_mesh m = {f->positions, f->normals, f->indices, f->header.vertex_count,
+                        f->header.triangle_count};
+    vdsh_view v;
+    vdsh_error ve;
+    if (vdsh_view_compute(&m, &v, &ve) != VDSH_OK)
+        return vb_fail(err, VB_ERR_INVALID, "the default view: %s", ve.msg);
+    *out = v.camera;
+    return VB_OK;
 }
 
 /* ---- views ------------------------------------------------------------------------ */
@@ -856,8 +693,9 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
     /* View 0: the viewer's own camera; its lights are the best there are. */
     {
         vb_frames_view *v = &views[0];
-        default_camera(s, &v->camera);
-        r = vb_frames_trace_primary(s, &v->camera, V.width, V.height, d.threads, &h, err);
+        r = default_camera(s, &v->camera, err);
+        if (r == VB_OK)
+            r = vb_frames_trace_primary(s, &v->camera, V.width, V.height, d.threads, &h, err);
         if (r != VB_OK)
             goto done;
         uint32_t found;

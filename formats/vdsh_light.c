@@ -27,13 +27,14 @@ float vdsh_free_clearance(float diagonal)
 int vdsh_free_space(const float t[VDSH_FREE_PROBES], const int back[VDSH_FREE_PROBES],
                     float clearance)
 {
-    int backs = 0;
+    int backs = 0, fronts = 0;
     for (int i = 0; i < VDSH_FREE_PROBES; i++) {
         if (t[i] < clearance)
             return 0;
         backs += t[i] < INFINITY && back[i];
+        fronts += t[i] < INFINITY && !back[i];
     }
-    return 2 * backs < VDSH_FREE_PROBES;
+    return backs == 0 || fronts > backs;
 }
 
 /* SplitMix64 on (seed, k, axis): a counter-based stream. */

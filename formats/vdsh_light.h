@@ -5,12 +5,14 @@
  * (runtime/, which casts them on the CPU against the drawn mesh).
  *
  * A point is in free space when, of VDSH_FREE_PROBES rays from it in fixed
- * directions (the 6 axes and the 8 cube diagonals), fewer than half first
- * meet the back of a face (a point inside a solid, or outside a closed
- * room, sees the backs of the faces around it), and none meets anything
- * nearer than the clearance (1% of the scene's diagonal: a light on a
- * surface lights nothing but that surface's neighbourhood). Rays that meet
- * nothing count as free: an open scene's sky is free space.
+ * directions (the 6 axes and the 8 cube diagonals), none first meets the
+ * back of a face, or more meet the front of one than the back (a point
+ * inside a solid, or outside a closed room - above it, or in the notch of
+ * an L-shaped room's bounds - sees the backs of the faces around it and
+ * the void), and none meets anything nearer than the clearance (1% of the
+ * scene's diagonal: a light on a surface lights nothing but that surface's
+ * neighbourhood). Rays that meet nothing count for neither: an open
+ * scene's sky, and the space around an object, are free.
  *
  * Lights "placed uniformly in free space" are the candidates of a seeded
  * sequence, uniform in the scene's bounding box, that pass the test, in
