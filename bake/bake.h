@@ -4,7 +4,7 @@
  * distances onto real SH (formats/vdsh_sh.h).
  *
  * Methods (the fit is fit.h's):
- *   paper   the paper's demo (DESIGN.md section 1): directions over the
+ *   paper   the paper's demo (docs/DESIGN.md §1): directions over the
  *           whole sphere; those below the receiver's horizon (w.n < 0)
  *           count as distance 0 with the same 4 pi / N weight. They are not
  *           traced at all, since their result is thrown away: about half the
@@ -30,7 +30,7 @@
  * chooses per order: a first pass traces an evenly spaced sample of
  * CHOOSE_RECEIVERS (1024) receivers, fits both quantities, and scores each
  * fit on the traced directions above the horizon with the shadow error
- * vdsh-eval expects there (DESIGN.md section 3: a light at 2 u d_T, u
+ * vdsh-eval expects there (docs/DESIGN.md §3: a light at 2 u d_T, u
  * uniform in (0.05, 1], smooth ramp: a function of the ratio of the
  * reconstructed to the true distance only); the lower mean wins, and the
  * sampled receivers keep their fit of it (nothing is traced twice). Log wins

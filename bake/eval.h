@@ -1,6 +1,6 @@
 /*
  * eval.h - the evaluator: how far a baked .vdsh is from the truth, measured
- * against an independent Embree ray cast (DESIGN.md section 3). The core of
+ * against an independent Embree ray cast (docs/DESIGN.md §3). The core of
  * the vdsh-eval tool, and what the accuracy tests call.
  *
  * Ground truth, in one paragraph: receivers are the file's vertices (all,
@@ -173,7 +173,7 @@ typedef struct vb_eval_metrics {
     vb_eval_receiver worst[VB_EVAL_MAX_WORST];  /* by shadow MAE, worst first */
 } vb_eval_metrics;
 
-/* Scene lights, the primary shadow metric (DESIGN.md section 3): point
+/* Scene lights, the primary shadow metric (docs/DESIGN.md §3): point
  * lights placed uniformly in the scene's free space (vdsh_light.h), as a
  * user places them, each scored at every receiver it lights (above the
  * receiver's horizon: (L - p).n > 0). The truth is the first hit of the

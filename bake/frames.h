@@ -2,7 +2,7 @@
  * frames.h - what a viewer sees, ray-traced: per-pixel truth for a camera
  * and point lights given exactly as the GL viewer takes them, the file's
  * streams evaluated in C on the runtime's path at the same pixels, and the
- * image scores of DESIGN.md section 3 ("Image error"). The core of the
+ * image scores of docs/DESIGN.md §3 ("Image error"). The core of the
  * vdsh-frames tool (prefix vb_frames_).
  *
  * The truth of one pixel, in one paragraph: the primary ray through the
@@ -18,7 +18,7 @@
  * d_L = |L - p|:
  *   hard    vdsh_shadow_compare(d_T, d_L, binary): 1 visible, 0 blocked
  *   ideal   vdsh_shadow_compare(d_T, d_L, compare): the ramp of the exact
- *           distance (DESIGN 3's s_ideal; with the binary compare, hard)
+ *           distance (docs/DESIGN.md §3\'s s_ideal; with the binary compare, hard)
  *   mask    1 where the pixel counts: the primary ray hits a triangle and
  *           the interpolated normal faces the light (N . (L - p) > 0)
  *   stream  vdsh_shadow_interior with the triangle's three vertices, the

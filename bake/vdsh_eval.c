@@ -1,5 +1,5 @@
 /*
- * vdsh-eval - how far a baked .vdsh is from the truth (DESIGN.md section 3).
+ * vdsh-eval - how far a baked .vdsh is from the truth (docs/DESIGN.md §3).
  *
  * The story of an evaluation: read the file; rebuild the occluder scene the
  * bake traced (its recorded sources, or meshes given on the command line,

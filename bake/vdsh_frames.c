@@ -1,6 +1,6 @@
 /*
  * vdsh-frames - what a viewer sees: ray-traced truth for frames, and the
- * image error of any frames against it (DESIGN.md section 3, "Image
+ * image error of any frames against it (docs/DESIGN.md §3, "Image
  * error"). Three subcommands:
  *
  *   views  choose a view set for a scene (tools/vt_views.h): the viewer's

@@ -32,7 +32,7 @@
  * "zero means the documented default", so `{0}` plus the fields you care
  * about is always valid. Defaults are filled in one place per struct.
  *
- * Shadow modes (DESIGN.md section 1), for streams of a linear quantity
+ * Shadow modes (docs/DESIGN.md §1), for streams of a linear quantity
  * (distance, distance^2):
  *   VR_MODE_NONE        Lambert lighting only.
  *   VR_MODE_CUBE        baseline: one omnidirectional depth cube map per

@@ -1,5 +1,5 @@
 /*
- * Hard cases for the bake (DESIGN.md section 5): each either gets the right
+ * Hard cases for the bake (docs/DESIGN.md §5): each either gets the right
  * answer or a clean rejection. Scenes are built in code.
  */
 #include <math.h>

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Determinism on real scenes (issue 5, DESIGN §2): the same inputs and
+# Determinism on real scenes (issue 5, docs/DESIGN.md §2): the same inputs and
 # options give byte-identical .vdsh files and cubemaps with 1 and 2 worker
 # threads and across repeated runs. Scenes from ../shared/scenes, at
 # reduced rays so the whole test takes seconds; each one goes through a

@@ -1,4 +1,4 @@
-/* SH basis: orthonormality, the DESIGN.md values, and bands 3-4 against an
+/* SH basis: orthonormality, the docs/DESIGN.md values, and bands 3-4 against an
  * independent construction from the associated Legendre recurrence. */
 #include <math.h>
 #include <stdlib.h>
@@ -58,7 +58,7 @@ static void test_orthonormal(void)
     CHECK(worst < 2e-6, "Gram matrix differs from identity by %g", worst);
 }
 
-/* DESIGN.md section 2, bands 0-2, at a few directions. */
+/* docs/DESIGN.md §2, bands 0-2, at a few directions. */
 static void test_design_values(void)
 {
     uint64_t s = 7;
@@ -73,7 +73,7 @@ static void test_design_values(void)
                           0.315392 * (3 * z * z - 1), -1.092548 * x * z,
                           0.546274 * (x * x - yy * yy)};
         for (int i = 0; i < 9; i++)
-            CHECK(fabs(y[i] - want[i]) < 2e-6, "Y_%d(%g,%g,%g) = %g, DESIGN gives %g",
+            CHECK(fabs(y[i] - want[i]) < 2e-6, "Y_%d(%g,%g,%g) = %g, docs/DESIGN.md gives %g",
                   i, x, yy, z, y[i], want[i]);
     }
 }
