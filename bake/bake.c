@@ -17,7 +17,6 @@
 #define VB_PI 3.14159265358979323846
 #define BLOCK 16 /* receivers per work item */
 #define GROUP 8  /* packets traced before their lanes are processed */
-#define SPREAD_DIRS 320 /* method shadow: directions the fit's spread is measured on */
 
 double vb_now(void)
 {
@@ -41,12 +40,8 @@ typedef struct job {
     float max_local;       /* max distance in the traced frame */
     float inv_scale;
     int horizon;           /* paper: skip w.n < 0 */
-    /* Method shadow: per order, added to the fitted ln d (through c0):
-     * log_offset + log_spread x the fit's RMS residual on its own rays,
-     * measured on every spread_stride-th direction (0: not shadow). */
+    /* Method shadow: per order, added to the fitted ln d (through c0). */
     float log_offset[VDSH_MAX_ORDER + 1];
-    float log_spread[VDSH_MAX_ORDER + 1];
-    uint32_t spread_stride;
     double *error_table;   /* e(r), the quantity choice's score (VB_ERROR_TABLE + 1) */
     /* The quantity choice (VB_QUANTITY_AUTO): sampled receivers, and per
      * sample, order and quantity (0 distance, 1 log) its estimated error. */
@@ -118,12 +113,6 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
     float acc[2][VDSH_MAX_COEFFS][VB_PACKET];
     memset(acc, 0, sizeof acc);
     uint32_t near_zero = 0, upper = 0;
-    /* Method shadow: every spread_stride-th traced direction above the
-     * horizon (in packet order: still stratified), to measure how far the
-     * fit strays from its own rays (the offset's spread term). */
-    float rx[SPREAD_DIRS], ry[SPREAD_DIRS], rz[SPREAD_DIRS], rl[SPREAD_DIRS];
-    uint32_t rn = 0, rseen = 0;
-    const uint32_t rstride = J->spread_stride;
 
     /* Packets are traced GROUP at a time, then their lanes are processed
      * together: the log's division and series are a long dependency
@@ -214,10 +203,6 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
             if (want[1])
                 vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, logd[p], &acc[1][0][0],
                                     VB_PACKET);
-            if (rstride && want[1])
-                for (int k = 0; k < VB_PACKET; k++)
-                    if (up_lane[p][k] && rseen++ % rstride == 0 && rn < SPREAD_DIRS)
-                        rx[rn] = dx[k], ry[rn] = dy[k], rz[rn] = dz[k], rl[rn++] = logd[p][k];
             if (out->n)
                 for (int k = 0; k < VB_PACKET; k++)
                     if (up_lane[p][k]) {
@@ -256,27 +241,10 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
             if (out->coeffs[q][o])
                 vb_fit_finish(&J->fits[o], &angles, u, out->coeffs[q][o]);
     }
-    /* Method shadow: the log offset, through c0 (Y00 is a constant): the
-     * order's base offset plus its spread factor times the RMS residual of
-     * this receiver's own fit on its sampled rays, in ln d. */
-    for (int o = 1; o <= VDSH_MAX_ORDER && rstride; o++) {
-        if (!out->coeffs[1][o])
-            continue;
-        const float *c = out->coeffs[1][o];
-        double ss = 0.0;
-        for (uint32_t k = 0; k < rn; k++) {
-            float y[VDSH_MAX_COEFFS], wd[3] = {rx[k], ry[k], rz[k]};
-            vdsh_sh_eval(o, wd, y);
-            float sum = 0.0f;
-            for (int i = 0; i < o * o; i++)
-                sum += c[i] * y[i];
-            double r = (double)rl[k] - sum;
-            ss += r * r;
-        }
-        float spread = rn ? (float)sqrt(ss / rn) : 0.0f;
-        float offset = J->log_offset[o] + J->log_spread[o] * spread;
-        out->coeffs[1][o][0] += offset / 0.28209479177387814f;
-    }
+    /* Method shadow: the log offset, through c0 (Y00 is a constant). */
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+        if (out->coeffs[1][o] && J->log_offset[o] != 0.0f)
+            out->coeffs[1][o][0] += J->log_offset[o] / 0.28209479177387814f;
     if (upper > 0 && near_zero >= 0.9 * upper)
         (*degenerate)++;
 }
@@ -338,13 +306,7 @@ static double expected_error(const double *e, double r)
 float vb_shadow_log_offset(int order)
 {
     /* Chosen on the validation scenes by frames (docs/ACCURACY.md). */
-    static const float table[VDSH_MAX_ORDER + 1] = {0.0f, -0.2f, -0.2f, -0.2f, -0.2f, -0.2f};
-    return order >= 1 && order <= VDSH_MAX_ORDER ? table[order] : 0.0f;
-}
-
-float vb_shadow_log_spread(int order)
-{
-    static const float table[VDSH_MAX_ORDER + 1] = {0.0f, 3.0f, 3.0f, 3.0f, 3.0f, 3.0f};
+    static const float table[VDSH_MAX_ORDER + 1] = {0.0f, 1.6f, 1.6f, 1.1f, 0.9f, 0.8f};
     return order >= 1 && order <= VDSH_MAX_ORDER ? table[order] : 0.0f;
 }
 
@@ -681,16 +643,12 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     /* Method shadow: the per-order log offsets. */
     for (int o = 1; o <= VDSH_MAX_ORDER && d.method == VDSH_METHOD_SHADOW; o++) {
         J->log_offset[o] = d.log_offsets ? d.log_offsets[o] : vb_shadow_log_offset(o);
-        J->log_spread[o] = vb_shadow_log_spread(o);
         if (!isfinite(J->log_offset[o]) || fabsf(J->log_offset[o]) > 5.0f) {
             r = vb_fail(err, VB_ERR_ARGUMENT, "order %d: log offset %g is not in -5..5", o,
                         (double)J->log_offset[o]);
             goto done;
         }
     }
-    if (d.method == VDSH_METHOD_SHADOW) /* about 300 of the traced directions */
-        for (J->spread_stride = 1; grid.count / J->spread_stride > 300;)
-            J->spread_stride++;
     /* The quantity choice's score: the expected shadow error e(r). */
     if (d.quantity == VB_QUANTITY_AUTO && !(J->error_table = error_table_create())) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");

@@ -103,8 +103,7 @@ typedef struct vb_bake_output {
     double auto_error[VDSH_MAX_ORDER + 1][2]; /* their expected shadow error
                                 * per order, distance [0] and log [1] */
     float lambda;              /* lsq or shadow regularisation used (0 otherwise) */
-    float log_offset[VDSH_MAX_ORDER + 1]; /* method shadow: per order, the base
-                                * offset used (vb_shadow_log_offset) */
+    float log_offset[VDSH_MAX_ORDER + 1]; /* method shadow: per order, as used */
     float log_floor;           /* log-distance floor used (0 otherwise) */
     uint32_t window;           /* vdsh_window applied */
     uint32_t vertex_count;
@@ -128,17 +127,12 @@ typedef struct vb_bake_output {
 vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
                       vb_error *err);
 
-/* Method shadow's log offset for an order: how much longer than the
- * least-squares fit of ln d a receiver's stored distances are, as a
- * factor e^offset, offset = base + spread x sigma, sigma the RMS residual
- * of the receiver's own fit of ln d on (about 300 of) its traced
- * directions: a receiver whose distances the order follows closely (a
- * wall in the open) keeps them, one near silhouettes and clutter, where
- * the band-limited fit undershoots and a light there would draw a false
- * shadow, is lengthened more. The base is the default of
- * vb_bake_desc.log_offsets; the spread factor is fixed per order. */
+/* Method shadow's default log offset for an order: how much longer than
+ * the least-squares fit of ln d the stored distances are (a factor
+ * e^offset), trading drawn shadows for fewer false ones: a band-limited
+ * fit undershoots next to silhouettes, where a light would draw a false
+ * shadow on a lit wall. Chosen on the validation scenes by frames. */
 float vb_shadow_log_offset(int order);
-float vb_shadow_log_spread(int order);
 void vb_bake_output_free(vb_bake_output *out);
 
 /* The .vdsh stream of one order (1 .. max_order) of a bake: its first
