@@ -56,14 +56,14 @@ typedef struct options {
     float ambient;
     vr_mode mode;
     int have_mode;
-    uint32_t compare;
+    vdsh_compare compare;
     int pcf;
     int shadow_size;
     int have_size;
     int width, height;
     const char *cubemap_dir;
     int no_cubemaps;
-    uint32_t egl;
+    vr_egl_platform egl;
     int frames;
     int no_mallopt;
     int quiet;
@@ -121,8 +121,10 @@ static const char usage_text[] =
     "                        (default 1, 0, 1/(0.3 * diagonal)^2)\n"
     "      --ambient V       ambient light (default 0.03)\n"
     "      --mode M          none, cube, vdsh2, vdsh3, vdsh5 (order 5, basis\n"
-    "                        cubemaps; the default) or vdsh5poly (order 5,\n"
-    "                        polynomials); order n = n bands = n*n coefficients.\n"
+    "                        cubemaps) or vdsh5poly (order 5, polynomials);\n"
+    "                        order n = n bands = n*n coefficients. Default:\n"
+    "                        the runtime's, vdsh5 where the scene has it, else\n"
+    "                        vdsh5poly, else the highest order it has.\n"
     "                        Scenes baked with --log are drawn per vertex in\n"
     "                        every VDSH mode (distances interpolated, no\n"
     "                        cubemaps; vdsh5 and vdsh5poly are then the same)\n"
@@ -224,7 +226,7 @@ static int parse_modes(const char *list, options *o)
 static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
-    o->mode = VR_MODE_VDSH5;
+    o->mode = VR_MODE_DEFAULT; /* the runtime's, vr_scene_default_mode */
     o->egl = VR_EGL_AUTO;
     enum { O_RENDER = 256, O_GRID, O_BENCH, O_CAMERA, O_FIT, O_FOV, O_LIGHT, O_LIGHTS,
            O_ATT, O_AMBIENT, O_MODE, O_COMPARE, O_PCF, O_SHADOW_SIZE, O_SIZE, O_CUBEDIR,
@@ -582,7 +584,7 @@ static int open_scene(const options *o, const char *path, vr_scene **out)
     return 0;
 }
 
-static int session_open(const options *o, uint32_t kind, int w, int h, session *s)
+static int session_open(const options *o, vr_context_kind kind, int w, int h, session *s)
 {
     vr_error err;
     memset(s, 0, sizeof *s);
@@ -631,7 +633,8 @@ static int run_render(const options *o)
         rc = write_png(o->render_path, w, h, px);
         if (!rc && !o->quiet)
             fprintf(stderr, "vdsh-view: wrote %s (%dx%d, mode %s: %s, %d light%s, %.0f ms, %s; "
-                    "%s)\n", o->render_path, w, h, vr_mode_name(o->mode),
+                    "%s)\n", o->render_path, w, h,
+                    vr_mode_name(o->mode ? o->mode : vr_scene_default_mode(s.scene)),
                     vr_scene_mode_label(s.scene, o->mode), n, n == 1 ? "" : "s", ms,
                     vr_gl_renderer(), vr_context_description(s.ctx));
     }
@@ -1238,7 +1241,7 @@ typedef struct app {
     float fired_pos[3], fired_vel[3];
     double fired_age;
     vr_mode mode;
-    uint32_t compare;
+    vdsh_compare compare;
     int pcf, overlay;
     double mx, my;
     int drag;                    /* 1 left (orbit), 2 right (look) */
@@ -1565,8 +1568,8 @@ static int run_window(const options *o)
     scene_camera(a.s.scene, o, &a.home);
     set_view(&a, &a.home);
     a.mode = o->mode;
-    if (!vr_scene_supports(a.s.scene, a.mode))
-        a.mode = VR_MODE_VDSH5_POLY;
+    if (a.mode == VR_MODE_DEFAULT || !vr_scene_supports(a.s.scene, a.mode))
+        a.mode = vr_scene_default_mode(a.s.scene);
     a.compare = o->compare;
     a.pcf = o->pcf;
     a.overlay = !o->no_overlay;

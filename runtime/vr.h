@@ -123,12 +123,11 @@ typedef struct vr_scene_desc {
     /* An already-read file to upload instead (borrowed for the call; path,
      * if also set, is then only used in messages and to find cubemaps). */
     const vdsh_file *file;
-    /* Stream quantity to draw (vdsh_quantity); 0: distance. A file with
-     * no stream of this quantity draws the quantity of its first stream
-     * instead (a file baked with --log has only log-distance streams);
-     * vr_scene_get_info says which. Streams of other quantities are not
-     * uploaded. */
-    uint32_t quantity;
+    /* Stream quantity to draw; 0: distance. A file with no stream of this
+     * quantity draws the quantity of its first stream instead (a file
+     * baked with --log has only log-distance streams); vr_scene_get_info
+     * says which. Streams of other quantities are not uploaded. */
+    vdsh_quantity quantity;
     /* Where the basis cubemaps <stem>.sh09-12.exr ... are; NULL: the
      * directory of path (or the working directory without a path). */
     const char *cubemap_dir;
@@ -167,12 +166,12 @@ typedef struct vr_scene_info {
     float bounds_min[3];          /* of the receiver vertices */
     float bounds_max[3];
     int has_order[6];             /* has_order[n]: a stream of order n */
-    uint32_t encoding[6];         /* its vdsh_encoding */
-    uint32_t method[6];           /* its vdsh_method (how it was baked) */
+    vdsh_encoding encoding[6];    /* its encoding */
+    vdsh_method method[6];        /* how it was baked */
     float scale[6];               /* its stream scale */
     int has_cubemaps;             /* basis cubemaps uploaded */
     int cube_size;                /* their face size, or 0 */
-    uint32_t quantity;            /* the quantity drawn */
+    vdsh_quantity quantity;       /* the quantity drawn */
     float max_distance;           /* the file's: no reconstructed distance
                                      exceeds it (vdsh_shadow.h) */
     size_t gpu_bytes;             /* buffers and textures uploaded */
@@ -197,7 +196,7 @@ typedef enum vr_color_format {
 
 typedef struct vr_renderer_desc {
     int width, height;          /* 0: 1024 x 768 */
-    uint32_t color_format;      /* vr_color_format; 0: RGBA8 */
+    vr_color_format color_format; /* 0: RGBA8 */
     int shadow_map_size;        /* cube shadow map face size; 0: 512 */
     int max_lights_per_pass;    /* 1..VR_MAX_LIGHTS_PER_PASS; 0: 8 */
 } vr_renderer_desc;
@@ -228,7 +227,7 @@ const char *vr_gl_renderer(void);
 /* Drawing                                                               */
 
 typedef enum vr_mode {
-    VR_MODE_DEFAULT = 0,     /* VR_MODE_VDSH5_POLY */
+    VR_MODE_DEFAULT = 0,     /* vr_scene_default_mode: every tool's default */
     VR_MODE_NONE,
     VR_MODE_CUBE,
     VR_MODE_VDSH2,
@@ -245,7 +244,15 @@ const char *vr_mode_name(vr_mode m);
 int vr_mode_from_name(const char *name, vr_mode *out);
 /* A label for pictures: "VDSH order 5 (25 coeff., cubemaps)" etc. */
 const char *vr_mode_label(vr_mode m);
-/* 1 when the scene has what the mode needs (stream, cubemaps). */
+/* The mode VR_MODE_DEFAULT draws for a scene, the one definition of the
+ * default that vdsh-view (no --mode) uses too: order 5 the paper's way
+ * (VR_MODE_VDSH5) where the scene supports it, else order 5 with the
+ * polynomials, else the highest of orders 3 and 2 the file has. A scene
+ * with none of these streams gets VR_MODE_VDSH5, which vr_draw refuses
+ * with VR_ERR_MISSING naming the stream. Never VR_MODE_DEFAULT. */
+vr_mode vr_scene_default_mode(const vr_scene *s);
+/* 1 when the scene has what the mode needs (stream, cubemaps). Here and
+ * below VR_MODE_DEFAULT stands for vr_scene_default_mode(s). */
 int vr_scene_supports(const vr_scene *s, vr_mode m);
 /* The path (vdsh_interp) a VDSH mode draws this scene's stream with:
  * vdsh_runtime_interp(order, quantity drawn); -1 for modes none and cube. */
@@ -289,8 +296,8 @@ typedef enum vr_output {
 } vr_output;
 
 typedef struct vr_draw_desc {
-    uint32_t mode;           /* vr_mode; 0: VR_MODE_VDSH5_POLY */
-    uint32_t compare;        /* vdsh_compare; 0: smooth (the paper's ramp) */
+    vr_mode mode;            /* 0: vr_scene_default_mode of the scene */
+    vdsh_compare compare;    /* 0: smooth (the paper's ramp) */
     int pcf;                 /* VR_MODE_CUBE: 0 one nearest tap, 1 PCF */
     const vr_light *lights;  /* light_count entries, borrowed */
     int light_count;         /* 0: no lights (ambient only) */
@@ -298,7 +305,7 @@ typedef struct vr_draw_desc {
     float ambient[3];        /* added before the albedo multiply; zero: none */
     float albedo[3];         /* all zero: 0.8 grey */
     float clear_color[4];    /* zero: black, alpha 0 */
-    uint32_t output;         /* vr_output; 0: colour */
+    vr_output output;        /* 0: colour */
     int points;              /* 1: draw the vertices as 1-pixel points, not
                                 triangles (a test aid: each pixel then holds
                                 one vertex's unclipped, uninterpolated value) */

@@ -191,8 +191,9 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     if (!desc || !out || (!desc->path && !desc->file))
         return vr_fail(err, VR_ERR_ARGUMENT, "vr_scene_create: no path or file given");
     const char *name = desc->path ? desc->path : "(memory)";
-    if (desc->quantity > VDSH_QUANTITY_LOG_DISTANCE)
-        return vr_fail(err, VR_ERR_ARGUMENT, "%s: unknown quantity %u", name, desc->quantity);
+    if ((unsigned)desc->quantity > VDSH_QUANTITY_LOG_DISTANCE)
+        return vr_fail(err, VR_ERR_ARGUMENT, "%s: unknown quantity %u", name,
+                       (unsigned)desc->quantity);
     if (!glGetString(GL_VERSION))
         return vr_fail(err, VR_ERR_GL, "%s: no current GL context", name);
 
@@ -226,7 +227,7 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
 
     /* 2. The quantity to draw: the one asked for, else the file's own
      * (a file baked with --log has only log-distance streams). */
-    uint32_t quantity = desc->quantity;
+    vdsh_quantity quantity = desc->quantity;
     if (!has_quantity(f, quantity))
         for (uint32_t i = 0; i < f->stream_count; i++)
             if (f->streams[i].order >= 1 && f->streams[i].order <= 5) {
@@ -378,6 +379,16 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     *out = i;
 }
 
+vr_mode vr_scene_default_mode(const vr_scene *s)
+{
+    static const vr_mode best_first[4] = {VR_MODE_VDSH5, VR_MODE_VDSH5_POLY, VR_MODE_VDSH3,
+                                          VR_MODE_VDSH2};
+    for (int i = 0; i < 4; i++)
+        if (vr_scene_supports(s, best_first[i]))
+            return best_first[i];
+    return VR_MODE_VDSH5;
+}
+
 int vr_scene_supports(const vr_scene *s, vr_mode m)
 {
     switch (m) {
@@ -389,7 +400,7 @@ int vr_scene_supports(const vr_scene *s, vr_mode m)
         /* the cubemaps only on the paper's split path */
         return s->vbo_stream[5] != 0 &&
                (s->basis[0] != 0 || vr_mode_interp(m, s->quantity) != VDSH_INTERP_SPLIT);
-    case VR_MODE_DEFAULT:
+    case VR_MODE_DEFAULT: return vr_scene_supports(s, vr_scene_default_mode(s));
     case VR_MODE_VDSH5_POLY: return s->vbo_stream[5] != 0;
     default: return 0;
     }
@@ -397,11 +408,13 @@ int vr_scene_supports(const vr_scene *s, vr_mode m)
 
 int vr_scene_interp(const vr_scene *s, vr_mode m)
 {
-    return vr_mode_interp(m == VR_MODE_DEFAULT ? VR_MODE_VDSH5_POLY : m, s->quantity);
+    return vr_mode_interp(m == VR_MODE_DEFAULT ? vr_scene_default_mode(s) : m, s->quantity);
 }
 
 const char *vr_scene_mode_label(const vr_scene *s, vr_mode m)
 {
+    if (m == VR_MODE_DEFAULT)
+        m = vr_scene_default_mode(s);
     if (vr_scene_interp(s, m) != VDSH_INTERP_DISTANCE ||
         s->quantity != VDSH_QUANTITY_LOG_DISTANCE)
         return vr_mode_label(m);

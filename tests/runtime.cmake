@@ -166,6 +166,12 @@ for m in none cube vdsh2 vdsh3 vdsh5 vdsh5poly; do
   "$v" -q --render "$d/$m.png" --size 160x120 --mode $m "$room"
   "$png" info "$d/$m.png" 160 120
 done
+# No --mode: the runtime's default (vr_scene_default_mode), byte for byte:
+# order 5 with cubemaps, and without them the polynomials.
+"$v" -q --render "$d/default.png" --size 160x120 "$room"
+cmp "$d/default.png" "$d/vdsh5.png"
+"$v" -q --render "$d/default-nocube.png" --size 160x120 --no-cubemaps "$room"
+cmp "$d/default-nocube.png" "$d/vdsh5poly.png"
 # Shadows where the room's geometry (bake/builtin.c) puts them. The light
 # at (-4, 3.5, 1) is in front of the 1.58 m crate (x in [-4.79, -3.21], z
 # in [-3.79, -2.21]); the floor point (-4, 0, -4.2), 0.41 m behind the

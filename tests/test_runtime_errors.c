@@ -260,8 +260,39 @@ static void test_streams_and_arguments(const char *dir)
         CHECK(res == VR_ERR_MISSING && strstr(err.msg, "stream"), "%s: %s",
               vr_mode_name(missing[i]), err.msg);
     }
-    d.mode = VR_MODE_DEFAULT; /* order 5 polynomials: not in this file */
-    CHECK(vr_draw(r, s, &d, &err) == VR_ERR_MISSING, "default mode");
+    /* The default is the best mode the file has: here order 3. */
+    CHECK(vr_scene_default_mode(s) == VR_MODE_VDSH3, "default mode %s",
+          vr_mode_name(vr_scene_default_mode(s)));
+    d.mode = VR_MODE_DEFAULT;
+    CHECK(vr_draw(r, s, &d, &err) == VR_OK, "default mode: %s", err.msg);
+    /* A file with no stream of orders 2, 3 or 5 (order 1 alone): the
+     * default asks for order 5 and the draw says that stream is missing. */
+    {
+        rt_file f1;
+        small_file(&f1, 0);
+        f1.f.stream_count = 0;
+        free(f1.coef[0]);
+        free(f1.data[0]);
+        f1.coef[0] = NULL;
+        f1.data[0] = NULL;
+        float *c1 = calloc(4, sizeof(float));
+        for (int i = 0; i < 4; i++)
+            c1[i] = 5.0f;
+        rt_file_add_stream(&f1, 1, VDSH_ENCODING_F32, 0, c1, 1.0f);
+        vr_scene *s1 = NULL;
+        vr_scene_desc d1 = {.file = &f1.f};
+        CHECK(vr_scene_create(&d1, &s1, &err) == VR_OK, "order 1 alone: %s", err.msg);
+        if (s1) {
+            CHECK(vr_scene_default_mode(s1) == VR_MODE_VDSH5 &&
+                      !vr_scene_supports(s1, VR_MODE_DEFAULT), "order 1 alone: default");
+            d.mode = VR_MODE_DEFAULT;
+            vr_result res = vr_draw(r, s1, &d, &err);
+            CHECK(res == VR_ERR_MISSING && strstr(err.msg, "order-5"),
+                  "order 1 alone, default mode: %s", err.msg);
+        }
+        vr_scene_destroy(s1);
+        rt_file_free(&f1);
+    }
     d.mode = VR_MODE_VDSH3;
     CHECK(vr_draw(r, s, &d, &err) == VR_OK, "vdsh3: %s", err.msg);
 
