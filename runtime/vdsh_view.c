@@ -61,7 +61,6 @@ typedef struct options {
     int shadow_size;
     int have_size;
     int width, height;
-    const char *cubemap_dir;
     int no_cubemaps;
     vr_egl_platform egl;
     int frames;
@@ -134,10 +133,10 @@ static const char usage_text[] =
     "      --size WxH        image or window size (default 1024x768; with\n"
     "                        --grid the size of each panel, default 512x384)\n"
     "\n"
-    "Files:\n"
-    "      --cubemap-dir DIR where the basis cubemaps are (default: beside\n"
-    "                        the .vdsh)\n"
-    "      --no-cubemaps     do not load them (mode vdsh5 is then unavailable,\n"
+    "Files: only SCENE.vdsh is read (the basis cubemaps of mode vdsh5 are\n"
+    "computed at load, the same as the .exr files vdsh-bake writes for other\n"
+    "engines).\n"
+    "      --no-cubemaps     do not make them (mode vdsh5 is then unavailable,\n"
     "                        except for --log scenes, which never need them)\n"
     "\n"
     "Other:\n"
@@ -229,7 +228,7 @@ static int parse_args(int argc, char **argv, options *o)
     o->mode = VR_MODE_DEFAULT; /* the runtime's, vr_scene_default_mode */
     o->egl = VR_EGL_AUTO;
     enum { O_RENDER = 256, O_GRID, O_BENCH, O_CAMERA, O_FIT, O_FOV, O_LIGHT, O_LIGHTS,
-           O_ATT, O_AMBIENT, O_MODE, O_COMPARE, O_PCF, O_SHADOW_SIZE, O_SIZE, O_CUBEDIR,
+           O_ATT, O_AMBIENT, O_MODE, O_COMPARE, O_PCF, O_SHADOW_SIZE, O_SIZE,
            O_NO_CUBEMAPS, O_EGL, O_FRAMES, O_SCREENSHOT, O_NO_OVERLAY, O_KEYS,
            O_NO_MALLOPT, O_VIEWS, O_MODES };
     static const struct option longopts[] = {
@@ -248,7 +247,6 @@ static int parse_args(int argc, char **argv, options *o)
         {"pcf", no_argument, 0, O_PCF},
         {"shadow-size", required_argument, 0, O_SHADOW_SIZE},
         {"size", required_argument, 0, O_SIZE},
-        {"cubemap-dir", required_argument, 0, O_CUBEDIR},
         {"no-cubemaps", no_argument, 0, O_NO_CUBEMAPS},
         {"egl", required_argument, 0, O_EGL},
         {"frames", required_argument, 0, O_FRAMES},
@@ -344,7 +342,6 @@ static int parse_args(int argc, char **argv, options *o)
                 return usage_error("--size: expected WxH (1..16384), got '%s'", v);
             o->have_size = 1;
             break;
-        case O_CUBEDIR: o->cubemap_dir = v; break;
         case O_NO_CUBEMAPS: o->no_cubemaps = 1; break;
         case O_EGL:
             if (!strcmp(v, "device"))
@@ -571,14 +568,9 @@ static void session_close(session *s)
 static int open_scene(const options *o, const char *path, vr_scene **out)
 {
     vr_error err;
-    vr_scene_desc sd = {.path = path, .cubemap_dir = o->cubemap_dir,
-                        .skip_cubemaps = o->no_cubemaps};
-    vr_result r = vr_scene_create(&sd, out, &err);
-    if (r != VR_OK) {
+    vr_scene_desc sd = {.path = path, .skip_cubemaps = o->no_cubemaps};
+    if (vr_scene_create(&sd, out, &err) != VR_OK) {
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
-        if (r == VR_ERR_MISSING && !o->no_cubemaps)
-            fprintf(stderr, "vdsh-view: (--no-cubemaps loads the scene without them; "
-                    "mode vdsh5poly needs none)\n");
         return 1;
     }
     return 0;

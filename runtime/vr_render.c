@@ -561,8 +561,9 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
     if (!vr_scene_supports(s, mode)) {
         if (mode == VR_MODE_VDSH5 && s->vbo_stream[5])
             return vr_fail(err, VR_ERR_MISSING,
-                           "mode %s needs the basis cubemaps, which were not loaded "
-                           "(vdsh5poly needs none)", vr_mode_name(mode));
+                           "mode %s needs the basis cubemaps, which this scene has not "
+                           "(its file's cube_size is 0, or they were skipped; vdsh5poly "
+                           "needs none)", vr_mode_name(mode));
         return vr_fail(err, VR_ERR_MISSING, "mode %s: the scene has no order-%d %s stream",
                        vr_mode_name(mode), vr_mode_order(mode), vdsh_quantity_name(s->quantity));
     }
