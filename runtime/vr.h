@@ -12,8 +12,8 @@
  * here assumes the calling thread has a current GL 3.3 core (or later)
  * context, the same one for the whole life of an object.
  *
- * Usage (tests/test_runtime_glsl.c and runtime/vdsh_view.c are compiled
- * examples):
+ * Usage (tests/test_runtime_glsl.c and runtime/vdsh_view_render.c are
+ * compiled examples):
  *
  *     vr_error err;
  *     vr_scene *scene = NULL;
