@@ -175,7 +175,8 @@ static void bench_print(const vv_options *o, const bench_scene *b, int rounds, v
  * every scene has been timed. */
 int vv_run_bench(const vv_options *o)
 {
-    int w = o->have_size ? o->width : 1024, h = o->have_size ? o->height : 768;
+    int w = o->have_size ? o->width : VR_DEFAULT_WIDTH;
+    int h = o->have_size ? o->height : VR_DEFAULT_HEIGHT;
     vr_context *ctx = NULL;
     vr_renderer *r = NULL;
     if (vv_open_headless(o, w, h, 0, &ctx, &r) != 0)
@@ -188,7 +189,7 @@ int vv_run_bench(const vv_options *o)
     vt_json_string(&j, root, "context", vr_context_description(ctx));
     vt_json_i64(&j, root, "width", w);
     vt_json_i64(&j, root, "height", h);
-    vt_json_i64(&j, root, "shadow_size", o->shadow_size ? o->shadow_size : 512);
+    vt_json_i64(&j, root, "shadow_size", o->shadow_size ? o->shadow_size : VR_DEFAULT_SHADOW_MAP_SIZE);
     vt_json_bool(&j, root, "mallopt", !o->no_mallopt);
     vt_json_i64(&j, root, "rounds", rounds);
     cJSON *list = vt_json_array(&j, root, "scenes");

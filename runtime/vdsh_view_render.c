@@ -10,7 +10,8 @@
 
 int vv_run_render(const vv_options *o)
 {
-    int w = o->have_size ? o->width : 1024, h = o->have_size ? o->height : 768;
+    int w = o->have_size ? o->width : VR_DEFAULT_WIDTH;
+    int h = o->have_size ? o->height : VR_DEFAULT_HEIGHT;
     vv_session s;
     if (vv_session_open(o, VR_CONTEXT_HEADLESS, w, h, &s))
         return 1;
@@ -80,7 +81,7 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
         d.mode = modes[m];
         vv_scene_camera(scene, o, &d.camera);
         char label[320];
-        int shadow = o->shadow_size ? o->shadow_size : 512;
+        int shadow = o->shadow_size ? o->shadow_size : VR_DEFAULT_SHADOW_MAP_SIZE;
         if (modes[m] == VR_MODE_CUBE)
             snprintf(label, sizeof label, "cube shadow map (%d^2 x 6, %s)", shadow,
                      o->pcf ? "PCF" : "1 tap");

@@ -352,7 +352,8 @@ static int frame_lights(const app *a, vr_light *out)
 
 int vv_run_window(const vv_options *o)
 {
-    int w = o->have_size ? o->width : 1024, h = o->have_size ? o->height : 768;
+    int w = o->have_size ? o->width : VR_DEFAULT_WIDTH;
+    int h = o->have_size ? o->height : VR_DEFAULT_HEIGHT;
     app a;
     memset(&a, 0, sizeof a);
     a.o = o;

@@ -189,15 +189,24 @@ typedef struct vr_renderer vr_renderer;
 
 enum { VR_MAX_LIGHTS_PER_PASS = 8 };
 
+/* The defaults of zero sizes, here and in vr_context_desc; the viewer's
+ * too (it names them, it does not repeat them). */
+enum {
+    VR_DEFAULT_WIDTH = 1024,
+    VR_DEFAULT_HEIGHT = 768,
+    VR_DEFAULT_SHADOW_MAP_SIZE = 512
+};
+
 typedef enum vr_color_format {
     VR_COLOR_RGBA8 = 0,      /* default: an image to look at */
     VR_COLOR_RGBA32F = 1     /* exact values for tests and debug outputs */
 } vr_color_format;
 
 typedef struct vr_renderer_desc {
-    int width, height;          /* 0: 1024 x 768 */
+    int width, height;          /* 0: VR_DEFAULT_WIDTH x _HEIGHT, 1024 x 768 */
     vr_color_format color_format; /* 0: RGBA8 */
-    int shadow_map_size;        /* cube shadow map face size; 0: 512 */
+    int shadow_map_size;        /* cube shadow map face size; 0:
+                                   VR_DEFAULT_SHADOW_MAP_SIZE, 512 */
     int max_lights_per_pass;    /* 1..VR_MAX_LIGHTS_PER_PASS; 0: 8 */
 } vr_renderer_desc;
 

@@ -267,8 +267,8 @@ vr_result vr_context_create(const vr_context_desc *desc, vr_context **out, vr_er
 {
     vr_context_desc d = desc ? *desc : (vr_context_desc){0};
     if (!d.width && !d.height) {
-        d.width = 1024;
-        d.height = 768;
+        d.width = VR_DEFAULT_WIDTH;
+        d.height = VR_DEFAULT_HEIGHT;
     }
     if (!d.title)
         d.title = "vdsh-view";

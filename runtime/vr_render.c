@@ -141,11 +141,11 @@ vr_result vr_renderer_create(const vr_renderer_desc *desc, vr_renderer **out,
     vr_renderer_desc d = desc ? *desc : (vr_renderer_desc){0};
     /* Defaults, in one place. */
     if (!d.width && !d.height) {
-        d.width = 1024;
-        d.height = 768;
+        d.width = VR_DEFAULT_WIDTH;
+        d.height = VR_DEFAULT_HEIGHT;
     }
     if (!d.shadow_map_size)
-        d.shadow_map_size = 512;
+        d.shadow_map_size = VR_DEFAULT_SHADOW_MAP_SIZE;
     if (!d.max_lights_per_pass)
         d.max_lights_per_pass = VR_MAX_LIGHTS_PER_PASS;
     if (!out)
