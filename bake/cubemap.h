@@ -1,7 +1,8 @@
 /*
  * cubemap.h - SH basis cubemaps as OpenEXR cube environment maps
- * (prefix vb_cubemap_). The bake writes them, the runtime and the tests
- * read them back.
+ * (prefix vb_cubemap_). The bake writes them for other engines; the tests
+ * read them back. The runtime reads none: it computes the same half
+ * floats (formats/vdsh_cube.h, vdsh_cube_basis_face_gl_f16).
  *
  * Purpose: write and read one cube map (n wide, 6n tall, faces +X, -X,
  * +Y, -Y, +Z, -Z from top to bottom, header attribute envmap = cube,

@@ -3,7 +3,7 @@
  *
  * Purpose: the one piece of code that knows the byte layout of a .vdsh file
  * (specified in formats/VDSH.md). Plain C11, POSIX libc (for the atomic
- * write: open, fsync, rename) and libm; nothing else.
+ * write: open, fsync, rename), libm and zlib (its CRC-32); nothing else.
  *
  * Does not: trace rays, fit SH, or touch GL. SH evaluation is vdsh_sh.h;
  * cubemap face conventions are vdsh_cube.h.

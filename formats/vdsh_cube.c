@@ -1,4 +1,5 @@
 #include "vdsh_cube.h"
+#include "vdsh.h"
 #include "vdsh_sh.h"
 
 #include <assert.h>
@@ -62,6 +63,20 @@ void vdsh_cube_gl_to_exr(int face, int i, int j, int n, int *ei, int *ej)
     }
 }
 
+/* The 25 basis functions at the centre of OpenEXR texel (i, j) of
+ * `face`: the one computation behind both fills below, so the runtime's
+ * textures and the bake's files hold the same values. */
+static void exr_texel_basis(int face, int i, int j, int n, float y[25])
+{
+    float d[3];
+    vdsh_cube_exr_dir(face, i, j, n, d);
+    float inv = 1.0f / sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    d[0] *= inv;
+    d[1] *= inv;
+    d[2] *= inv;
+    vdsh_sh_eval(5, d, y);
+}
+
 void vdsh_cube_fill_basis(int n, int first, float *rgba)
 {
     assert(n >= 1);
@@ -69,19 +84,31 @@ void vdsh_cube_fill_basis(int n, int first, float *rgba)
     for (int face = 0; face < 6; face++) {
         for (int j = 0; j < n; j++) {
             for (int i = 0; i < n; i++) {
-                float d[3], y[25];
-                vdsh_cube_exr_dir(face, i, j, n, d);
-                float inv = 1.0f / sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-                d[0] *= inv;
-                d[1] *= inv;
-                d[2] *= inv;
-                vdsh_sh_eval(5, d, y);
+                float y[25];
+                exr_texel_basis(face, i, j, n, y);
                 float *o = rgba + (((size_t)face * (size_t)n + (size_t)j) * (size_t)n + (size_t)i) * 4;
                 o[0] = y[first];
                 o[1] = y[first + 1];
                 o[2] = y[first + 2];
                 o[3] = y[first + 3];
             }
+        }
+    }
+}
+
+void vdsh_cube_basis_face_gl_f16(int n, int face, uint16_t *const out[4])
+{
+    assert(n >= 1);
+    for (int j = 0; j < n; j++) {
+        for (int i = 0; i < n; i++) {
+            int ei, ej;
+            float y[25];
+            vdsh_cube_gl_to_exr(face, i, j, n, &ei, &ej);
+            exr_texel_basis(face, ei, ej, n, y);
+            size_t t = ((size_t)j * (size_t)n + (size_t)i) * 4;
+            for (int k = 0; k < 4; k++)
+                for (int c = 0; c < 4; c++)
+                    out[k][t + (size_t)c] = vdsh_f16_from_f32(y[9 + 4 * k + c]);
         }
     }
 }

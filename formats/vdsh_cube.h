@@ -1,7 +1,8 @@
 /*
  * vdsh_cube.h - cube-map face conventions: the one place that knows how an
  * OpenEXR cube environment map's faces are oriented and how that differs
- * from GL's cube-map faces. libc only.
+ * from GL's cube-map faces; and the SH basis cubemaps' texels in both.
+ * libc only.
  *
  * Both conventions stack/number the faces +X, -X, +Y, -Y, +Z, -Z (0..5).
  * Within a face of n x n texels, texel (i, j) has its centre at
@@ -31,6 +32,11 @@
  * strictly within half a pixel of i (tests/test_cube_openexr.cpp checks
  * every texel against the OpenEXR library).
  *
+ * The basis cubemaps depend on the face size alone: the bake writes them
+ * as OpenEXR files for other engines (vdsh_cube_fill_basis), the runtime
+ * computes its GL textures itself (vdsh_cube_basis_face_gl_f16); both
+ * hold the same half floats.
+ *
  * Errors: none; arguments out of range are programmer errors (asserted).
  * Threading: pure functions.
  */
@@ -38,6 +44,7 @@
 #define VDSH_CUBE_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -61,6 +68,18 @@ void vdsh_cube_gl_to_exr(int face, int i, int j, int n, int *ei, int *ej);
  * texel-centre direction of vdsh_cube_exr_dir normalised in float
  * (d / sqrtf(d.d)). */
 void vdsh_cube_fill_basis(int n, int first, float *rgba);
+
+/* One face of all four basis cubemaps in GL orientation, as half floats
+ * (binary16 bits): out[k][(j * n + i) * 4 + c] = the half of basis
+ * function 9 + 4k + c at GL texel (i, j), that is vdsh_cube_fill_basis's
+ * value at the OpenEXR texel vdsh_cube_gl_to_exr names, rounded to
+ * nearest even (vdsh_f16_from_f32): texel for texel the bits of the
+ * OpenEXR files, which OpenEXR rounds the same way (tests/test_cube.c
+ * compares them). Each out[k] holds n * n * 4 values, ready for
+ * glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + face, 0, GL_RGBA16F, n, n,
+ * 0, GL_RGBA, GL_HALF_FLOAT, out[k]): the runtime makes its textures so,
+ * without the files. */
+void vdsh_cube_basis_face_gl_f16(int n, int face, uint16_t *const out[4]);
 
 #ifdef __cplusplus
 }

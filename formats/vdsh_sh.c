@@ -15,24 +15,25 @@
 #define VDSH_CLONES
 #endif
 
-/* Constants: K_l^m normalisation, sqrt(2) folded in for m != 0. */
-#define C00 0.28209479177387814f
-#define C1 0.4886025119029199f
-#define C2A 1.0925484305920792f
-#define C20 0.31539156525252005f
-#define C22 0.5462742152960396f
-#define C33 0.5900435899266435f
-#define C32 2.890611442640554f
-#define C31 0.4570457994644658f
-#define C30 0.3731763325901154f
-#define C32B 1.445305721320277f
-#define C44 2.5033429417967046f
-#define C43 1.7701307697799304f
-#define C42 0.9461746957575601f
-#define C41 0.6690465435572892f
-#define C40 0.10578554691520431f
-#define C42B 0.47308734787878004f
-#define C44B 0.6258357354491761f
+/* Constants: K_l^m normalisation, sqrt(2) folded in for m != 0
+ * (vdsh_sh.h: the same literals go into the runtime's GLSL). */
+#define C00 VDSH_SH_C00
+#define C1 VDSH_SH_C1
+#define C2A VDSH_SH_C2A
+#define C20 VDSH_SH_C20
+#define C22 VDSH_SH_C22
+#define C33 VDSH_SH_C33
+#define C32 VDSH_SH_C32
+#define C31 VDSH_SH_C31
+#define C30 VDSH_SH_C30
+#define C32B VDSH_SH_C32B
+#define C44 VDSH_SH_C44
+#define C43 VDSH_SH_C43
+#define C42 VDSH_SH_C42
+#define C41 VDSH_SH_C41
+#define C40 VDSH_SH_C40
+#define C42B VDSH_SH_C42B
+#define C44B VDSH_SH_C44B
 
 /* The one kernel. With acc = 0, o[i * s] = Y_i; with acc = 1,
  * o[i * s] += w * Y_i (the callers pass constants, so each use compiles to

@@ -36,6 +36,29 @@
 extern "C" {
 #endif
 
+/* The normalisation constants K_l^m of the basis above (sqrt(2) folded in
+ * for m != 0), named by band and |m| (C2A: band 2, the xy/yz/xz terms;
+ * B: the second use of a band's |m|), as float literals that both C and
+ * GLSL 3.30 read. vdsh_sh.c evaluates with them and runtime/vr_glsl.c
+ * writes them into its shaders: one definition of the basis. */
+#define VDSH_SH_C00 0.28209479177387814f
+#define VDSH_SH_C1 0.4886025119029199f
+#define VDSH_SH_C2A 1.0925484305920792f
+#define VDSH_SH_C20 0.31539156525252005f
+#define VDSH_SH_C22 0.5462742152960396f
+#define VDSH_SH_C33 0.5900435899266435f
+#define VDSH_SH_C32 2.890611442640554f
+#define VDSH_SH_C31 0.4570457994644658f
+#define VDSH_SH_C30 0.3731763325901154f
+#define VDSH_SH_C32B 1.445305721320277f
+#define VDSH_SH_C44 2.5033429417967046f
+#define VDSH_SH_C43 1.7701307697799304f
+#define VDSH_SH_C42 0.9461746957575601f
+#define VDSH_SH_C41 0.6690465435572892f
+#define VDSH_SH_C40 0.10578554691520431f
+#define VDSH_SH_C42B 0.47308734787878004f
+#define VDSH_SH_C44B 0.6258357354491761f
+
 /* Number of coefficients of an order (bands): order * order. */
 static inline int vdsh_sh_count(int order) { return order * order; }
 

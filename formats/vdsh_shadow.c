@@ -8,8 +8,8 @@
 float vdsh_ramp(float x)
 {
     /* (x - 1/3) * 1.5 written so that x = 1/3 and x = 1 give exactly 0
-     * and 1 in float (the shaders use the same form). */
-    float s = 1.5f * x - 0.5f;
+     * and 1 in float (the shaders use the same form and constants). */
+    float s = VDSH_RAMP_SLOPE * x - VDSH_RAMP_OFFSET;
     return s > 0.0f ? (s < 1.0f ? s : 1.0f) : 0.0f; /* NaN fails both: 0 */
 }
 

@@ -38,9 +38,18 @@ typedef enum vdsh_compare {
     VDSH_COMPARE_BINARY = 1  /* the paper's reference step */
 } vdsh_compare;
 
-/* saturate((x - 1/3) * 1.5); NaN gives 0. */
+/* saturate((x - 1/3) * 1.5), computed as saturate(VDSH_RAMP_SLOPE * x -
+ * VDSH_RAMP_OFFSET) so that x = 1/3 and x = 1 give exactly 0 and 1 in
+ * float; NaN gives 0. */
 float vdsh_ramp(float x);
 
+/* The constants of this file that the runtime's shaders also compute with,
+ * as float literals that both C and GLSL 3.30 read: runtime/vr_glsl.c
+ * writes these very macros into its source, so the ramp and the clamp of
+ * the GLSL cannot drift from the C definition (and tests/
+ * test_runtime_glsl.c checks the result by rendering). */
+#define VDSH_RAMP_SLOPE 1.5f
+#define VDSH_RAMP_OFFSET 0.5f
 /* A log-distance sum above this reads as exp(VDSH_LOG_SUM_MAX), about
  * 5.5e34, before the clamp to max_distance: finite even with no clamp
  * (max_distance +Inf), so that the runtime's interpolation of per-vertex

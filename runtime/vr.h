@@ -5,12 +5,15 @@
  * offscreen framebuffer that the caller reads back or blits.
  *
  * Does not: create a GL context or window (vr_context.h does, and only the
- * viewer uses both), bake anything, or write image files. Every function
+ * viewer uses both), bake anything, read anything but the .vdsh (the basis
+ * cubemaps are computed, formats/vdsh_cube.h; the bake's OpenEXR copies
+ * are for other engines), or write image files. Links formats/ and GL
+ * only: neither bake/ nor OpenEXR, Embree or OpenMesh. Every function
  * here assumes the calling thread has a current GL 3.3 core (or later)
  * context, the same one for the whole life of an object.
  *
- * Usage (tests/test_runtime_glsl.c and runtime/vdsh_view.c are compiled
- * examples):
+ * Usage (tests/test_runtime_glsl.c and runtime/vdsh_view_render.c are
+ * compiled examples):
  *
  *     vr_error err;
  *     vr_scene *scene = NULL;
@@ -43,7 +46,9 @@
  *                       evaluated per vertex and interpolated.
  *   VR_MODE_VDSH5       order 5 the paper's way: the first 9 coefficients in
  *                       the vertex stage, the last 16 interpolated and dotted
- *                       with the four basis cubemaps in the fragment stage.
+ *                       with the four basis cubemaps in the fragment stage
+ *                       (half-float cube textures of the file's cube_size,
+ *                       made at load, texel for texel the bake's files).
  *   VR_MODE_VDSH5_POLY  order 5 with the last 16 basis functions evaluated as
  *                       polynomials in the fragment stage (no cubemaps).
  * Log-distance streams (vdsh-bake --log) are drawn differently by every
@@ -66,8 +71,8 @@
  *
  * Errors: fallible functions return a vr_result (VR_OK = 0) and, when err
  * is not NULL, write a message that names the file (or the object) and the
- * problem, e.g. "room.sh13-16.exr: cannot open: No such file or directory
- * (basis cubemap needed for order 5)". Outputs are untouched on failure.
+ * problem, e.g. "room.vdsh: chunk 3 'COEF' at offset 1234: CRC mismatch".
+ * Outputs are untouched on failure.
  * GL errors and shader compile/link logs end up in the message too.
  * Nothing is printed; there is no global error state.
  *
@@ -97,8 +102,8 @@ extern "C" {
 typedef enum vr_result {
     VR_OK = 0,
     VR_ERR_IO,             /* a file cannot be opened or read */
-    VR_ERR_FORMAT,         /* a .vdsh or cubemap file is corrupt or unsupported */
-    VR_ERR_MISSING,        /* a needed stream, cubemap or extension is absent */
+    VR_ERR_FORMAT,         /* a .vdsh file is corrupt or unsupported */
+    VR_ERR_MISSING,        /* a needed stream or the cubemaps are absent */
     VR_ERR_GL,             /* GL error, incomplete framebuffer, no context */
     VR_ERR_SHADER,         /* a shader failed to compile or link (log in msg) */
     VR_ERR_OUT_OF_MEMORY,
@@ -121,40 +126,34 @@ typedef struct vr_scene_desc {
     /* The .vdsh file to load. Either path or file must be set. */
     const char *path;
     /* An already-read file to upload instead (borrowed for the call; path,
-     * if also set, is then only used in messages and to find cubemaps). */
+     * if also set, is then only used in messages). */
     const vdsh_file *file;
-    /* Stream quantity to draw (vdsh_quantity); 0: distance. A file with
-     * no stream of this quantity draws the quantity of its first stream
-     * instead (a file baked with --log has only log-distance streams);
-     * vr_scene_get_info says which. Streams of other quantities are not
-     * uploaded. */
-    uint32_t quantity;
-    /* Where the basis cubemaps <stem>.sh09-12.exr ... are; NULL: the
-     * directory of path (or the working directory without a path). */
-    const char *cubemap_dir;
-    /* Their stem; NULL: path's file name without ".vdsh". A file from
-     * memory with neither path nor cubemap_stem loads no cubemaps. */
-    const char *cubemap_stem;
+    /* Stream quantity to draw; 0: distance. A file with no stream of this
+     * quantity draws the quantity of its first stream instead (a file
+     * baked with --log has only log-distance streams); vr_scene_get_info
+     * says which. Streams of other quantities are not uploaded. */
+    vdsh_quantity quantity;
     /* 0 (default): when the drawn order-5 stream is of a linear quantity
-     * and the file has a cube_size, the four cubemaps are required and a
-     * missing or corrupt one fails the create. 1: do not load them
-     * (VR_MODE_VDSH5 then fails with VR_ERR_MISSING; VR_MODE_VDSH5_POLY
-     * needs no cubemaps). Log-distance streams never load them: their
-     * path has no use for them. */
+     * and the file has a cube_size (the bake's choice of face size; 0:
+     * none), the four basis cubemaps are made at that size. 1: do not
+     * make them (VR_MODE_VDSH5 then fails with VR_ERR_MISSING;
+     * VR_MODE_VDSH5_POLY needs no cubemaps). Log-distance streams never
+     * get them: their path has no use for them. No file but the .vdsh is
+     * read either way. */
     int skip_cubemaps;
 } vr_scene_desc;
 
 /* Load (when desc->path is set and desc->file is not), validate, upload
  * positions, normals, indices, every stream of the chosen quantity (f16
  * streams as GL_HALF_FLOAT attributes, f32 as GL_FLOAT, no conversion) and
- * the basis cubemaps (converted to GL face orientation with
- * vdsh_cube_gl_to_exr). Triangles and vertices are uploaded in an order
- * chosen for the vertex cache (the same triangles, reordered; vertices
- * renumbered), not the file's. On failure *out is untouched and nothing
- * stays allocated. Errors: VR_ERR_IO / VR_ERR_FORMAT from the .vdsh reader
- * or the cubemap reader (and VR_ERR_FORMAT for an index out of range or a
- * max_distance that is not finite and > 0 in a desc->file),
- * VR_ERR_MISSING for a missing cubemap, VR_ERR_GL. */
+ * make the basis cubemaps (vdsh_cube_basis_face_gl_f16). Triangles and
+ * vertices are uploaded in an order chosen for the vertex cache (the same
+ * triangles, reordered; vertices renumbered), not the file's. On failure
+ * *out is untouched and nothing stays allocated. Errors: VR_ERR_IO /
+ * VR_ERR_FORMAT from the .vdsh reader (and VR_ERR_FORMAT for an index out
+ * of range or a max_distance that is not finite and > 0 in a desc->file,
+ * or a cube_size above GL_MAX_CUBE_MAP_TEXTURE_SIZE),
+ * VR_ERR_OUT_OF_MEMORY, VR_ERR_GL. */
 vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out,
                           vr_error *err);
 
@@ -167,12 +166,12 @@ typedef struct vr_scene_info {
     float bounds_min[3];          /* of the receiver vertices */
     float bounds_max[3];
     int has_order[6];             /* has_order[n]: a stream of order n */
-    uint32_t encoding[6];         /* its vdsh_encoding */
-    uint32_t method[6];           /* its vdsh_method (how it was baked) */
+    vdsh_encoding encoding[6];    /* its encoding */
+    vdsh_method method[6];        /* how it was baked */
     float scale[6];               /* its stream scale */
-    int has_cubemaps;             /* basis cubemaps uploaded */
+    int has_cubemaps;             /* basis cubemaps made */
     int cube_size;                /* their face size, or 0 */
-    uint32_t quantity;            /* the quantity drawn */
+    vdsh_quantity quantity;       /* the quantity drawn */
     float max_distance;           /* the file's: no reconstructed distance
                                      exceeds it (vdsh_shadow.h) */
     size_t gpu_bytes;             /* buffers and textures uploaded */
@@ -190,15 +189,24 @@ typedef struct vr_renderer vr_renderer;
 
 enum { VR_MAX_LIGHTS_PER_PASS = 8 };
 
+/* The defaults of zero sizes, here and in vr_context_desc; the viewer's
+ * too (it names them, it does not repeat them). */
+enum {
+    VR_DEFAULT_WIDTH = 1024,
+    VR_DEFAULT_HEIGHT = 768,
+    VR_DEFAULT_SHADOW_MAP_SIZE = 512
+};
+
 typedef enum vr_color_format {
     VR_COLOR_RGBA8 = 0,      /* default: an image to look at */
     VR_COLOR_RGBA32F = 1     /* exact values for tests and debug outputs */
 } vr_color_format;
 
 typedef struct vr_renderer_desc {
-    int width, height;          /* 0: 1024 x 768 */
-    uint32_t color_format;      /* vr_color_format; 0: RGBA8 */
-    int shadow_map_size;        /* cube shadow map face size; 0: 512 */
+    int width, height;          /* 0: VR_DEFAULT_WIDTH x _HEIGHT, 1024 x 768 */
+    vr_color_format color_format; /* 0: RGBA8 */
+    int shadow_map_size;        /* cube shadow map face size; 0:
+                                   VR_DEFAULT_SHADOW_MAP_SIZE, 512 */
     int max_lights_per_pass;    /* 1..VR_MAX_LIGHTS_PER_PASS; 0: 8 */
 } vr_renderer_desc;
 
@@ -228,7 +236,7 @@ const char *vr_gl_renderer(void);
 /* Drawing                                                               */
 
 typedef enum vr_mode {
-    VR_MODE_DEFAULT = 0,     /* VR_MODE_VDSH5_POLY */
+    VR_MODE_DEFAULT = 0,     /* vr_scene_default_mode: every tool's default */
     VR_MODE_NONE,
     VR_MODE_CUBE,
     VR_MODE_VDSH2,
@@ -245,7 +253,15 @@ const char *vr_mode_name(vr_mode m);
 int vr_mode_from_name(const char *name, vr_mode *out);
 /* A label for pictures: "VDSH order 5 (25 coeff., cubemaps)" etc. */
 const char *vr_mode_label(vr_mode m);
-/* 1 when the scene has what the mode needs (stream, cubemaps). */
+/* The mode VR_MODE_DEFAULT draws for a scene, the one definition of the
+ * default that vdsh-view (no --mode) uses too: order 5 the paper's way
+ * (VR_MODE_VDSH5) where the scene supports it, else order 5 with the
+ * polynomials, else the highest of orders 3 and 2 the file has. A scene
+ * with none of these streams gets VR_MODE_VDSH5, which vr_draw refuses
+ * with VR_ERR_MISSING naming the stream. Never VR_MODE_DEFAULT. */
+vr_mode vr_scene_default_mode(const vr_scene *s);
+/* 1 when the scene has what the mode needs (stream, cubemaps). Here and
+ * below VR_MODE_DEFAULT stands for vr_scene_default_mode(s). */
 int vr_scene_supports(const vr_scene *s, vr_mode m);
 /* The path (vdsh_interp) a VDSH mode draws this scene's stream with:
  * vdsh_runtime_interp(order, quantity drawn); -1 for modes none and cube. */
@@ -289,8 +305,8 @@ typedef enum vr_output {
 } vr_output;
 
 typedef struct vr_draw_desc {
-    uint32_t mode;           /* vr_mode; 0: VR_MODE_VDSH5_POLY */
-    uint32_t compare;        /* vdsh_compare; 0: smooth (the paper's ramp) */
+    vr_mode mode;            /* 0: vr_scene_default_mode of the scene */
+    vdsh_compare compare;    /* 0: smooth (the paper's ramp) */
     int pcf;                 /* VR_MODE_CUBE: 0 one nearest tap, 1 PCF */
     const vr_light *lights;  /* light_count entries, borrowed */
     int light_count;         /* 0: no lights (ambient only) */
@@ -298,7 +314,7 @@ typedef struct vr_draw_desc {
     float ambient[3];        /* added before the albedo multiply; zero: none */
     float albedo[3];         /* all zero: 0.8 grey */
     float clear_color[4];    /* zero: black, alpha 0 */
-    uint32_t output;         /* vr_output; 0: colour */
+    vr_output output;        /* 0: colour */
     int points;              /* 1: draw the vertices as 1-pixel points, not
                                 triangles (a test aid: each pixel then holds
                                 one vertex's unclipped, uninterpolated value) */

@@ -209,7 +209,7 @@ static vr_result try_surfaceless(vr_context *c, vr_error *err)
     return VR_OK;
 }
 
-static vr_result create_headless(vr_context *c, uint32_t platform, vr_error *err)
+static vr_result create_headless(vr_context *c, vr_egl_platform platform, vr_error *err)
 {
     vr_error first;
     vr_result r = VR_ERR_MISSING;
@@ -267,12 +267,13 @@ vr_result vr_context_create(const vr_context_desc *desc, vr_context **out, vr_er
 {
     vr_context_desc d = desc ? *desc : (vr_context_desc){0};
     if (!d.width && !d.height) {
-        d.width = 1024;
-        d.height = 768;
+        d.width = VR_DEFAULT_WIDTH;
+        d.height = VR_DEFAULT_HEIGHT;
     }
     if (!d.title)
         d.title = "vdsh-view";
-    if (!out || d.kind > VR_CONTEXT_WINDOW || d.egl_platform > VR_EGL_SURFACELESS ||
+    if (!out || (unsigned)d.kind > VR_CONTEXT_WINDOW ||
+        (unsigned)d.egl_platform > VR_EGL_SURFACELESS ||
         d.width < 1 || d.height < 1)
         return vr_fail(err, VR_ERR_ARGUMENT, "vr_context_create: bad descriptor");
     vr_context *c = calloc(1, sizeof *c);

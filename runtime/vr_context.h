@@ -50,9 +50,9 @@ typedef enum vr_egl_platform {
 } vr_egl_platform;
 
 typedef struct vr_context_desc {
-    uint32_t kind;            /* vr_context_kind; 0: headless */
-    uint32_t egl_platform;    /* headless only; vr_egl_platform; 0: auto */
-    int width, height;        /* window size; 0: 1024 x 768 */
+    vr_context_kind kind;     /* 0: headless */
+    vr_egl_platform egl_platform; /* headless only; 0: auto */
+    int width, height;        /* window size; 0: VR_DEFAULT_WIDTH x _HEIGHT */
     const char *title;        /* window title; NULL: "vdsh-view" */
     int vsync;                /* window: 1 waits for vertical sync */
 } vr_context_desc;

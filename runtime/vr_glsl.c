@@ -32,7 +32,10 @@
  *                    (exp cannot be split across the stages, and
  *                    interpolating log coefficients would be a geometric
  *                    mean of the vertices' distances).
- * tests/test_runtime_glsl.c renders these against vdsh_shadow (per
+ * The numbers these functions share with the C definition (the SH
+ * constants, the ramp's slope and offset, the log-sum limit) are not
+ * copied here: the C headers' macros are written into the source as they
+ * stand. tests/test_runtime_glsl.c renders these against vdsh_shadow (per
  * vertex) and vdsh_shadow_interior (per fragment).
  *
  * Lights: the per-light code is a macro, LIGHT(I), expanded once per light
@@ -57,30 +60,39 @@
  */
 #include "vr_internal.h"
 
+#include "vdsh_sh.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+/* A macro's value as a string literal: the constants below are the C
+ * definitions' own macros (formats/vdsh_sh.h, formats/vdsh_shadow.h),
+ * float literals that GLSL 3.30 reads as C does. */
+#define VR_STR_(x) #x
+#define VR_STR(x) VR_STR_(x)
+#define VR_CONST(name, macro) "const float " name " = " VR_STR(macro) ";\n"
+
 /* Shared by both stages: the SH basis (D3DX convention, the constants of
- * formats/vdsh_sh.c to float precision) and the two VDSH functions. */
+ * formats/vdsh_sh.h) and the two VDSH functions. */
 static const char common_glsl[] =
-    "const float C00 = 0.28209479177387814;\n"
-    "const float C1 = 0.4886025119029199;\n"
-    "const float C2A = 1.0925484305920792;\n"
-    "const float C20 = 0.31539156525252005;\n"
-    "const float C22 = 0.5462742152960396;\n"
-    "const float C33 = 0.5900435899266435;\n"
-    "const float C32 = 2.890611442640554;\n"
-    "const float C31 = 0.4570457994644658;\n"
-    "const float C30 = 0.3731763325901154;\n"
-    "const float C32B = 1.445305721320277;\n"
-    "const float C44 = 2.5033429417967046;\n"
-    "const float C43 = 1.7701307697799304;\n"
-    "const float C42 = 0.9461746957575601;\n"
-    "const float C41 = 0.6690465435572892;\n"
-    "const float C40 = 0.10578554691520431;\n"
-    "const float C42B = 0.47308734787878004;\n"
-    "const float C44B = 0.6258357354491761;\n"
+    VR_CONST("C00", VDSH_SH_C00)
+    VR_CONST("C1", VDSH_SH_C1)
+    VR_CONST("C2A", VDSH_SH_C2A)
+    VR_CONST("C20", VDSH_SH_C20)
+    VR_CONST("C22", VDSH_SH_C22)
+    VR_CONST("C33", VDSH_SH_C33)
+    VR_CONST("C32", VDSH_SH_C32)
+    VR_CONST("C31", VDSH_SH_C31)
+    VR_CONST("C30", VDSH_SH_C30)
+    VR_CONST("C32B", VDSH_SH_C32B)
+    VR_CONST("C44", VDSH_SH_C44)
+    VR_CONST("C43", VDSH_SH_C43)
+    VR_CONST("C42", VDSH_SH_C42)
+    VR_CONST("C41", VDSH_SH_C41)
+    VR_CONST("C40", VDSH_SH_C40)
+    VR_CONST("C42B", VDSH_SH_C42B)
+    VR_CONST("C44B", VDSH_SH_C44B)
     "\n"
     "/* sum of c_i Y_i(d), coefficients 0..3 (bands 0-1), unit d */\n"
     "float sh_sum4(vec4 c0, vec3 d)\n"
@@ -123,7 +135,7 @@ static const char common_glsl[] =
     "#if QUANTITY == 1\n"
     "    float d = sum > 0.0 ? sqrt(sum) : 0.0;\n"
     "#elif QUANTITY == 2\n"
-    "    float d = exp(min(sum, 80.0)); /* VDSH_LOG_SUM_MAX: stays finite */\n"
+    "    float d = exp(min(sum, " VR_STR(VDSH_LOG_SUM_MAX) ")); /* stays finite */\n"
     "#else\n"
     "    float d = sum > 0.0 ? sum : 0.0;\n"
     "#endif\n"
@@ -142,7 +154,8 @@ static const char common_glsl[] =
     "    if (isinf(dv) && dv > 0.0)\n"
     "        return 1.0;\n"
     "    /* ramp(x) = saturate((x - 1/3) * 1.5), written as in vdsh_ramp */\n"
-    "    return clamp(1.5 * (dv / dl) - 0.5, 0.0, 1.0);\n"
+    "    return clamp(" VR_STR(VDSH_RAMP_SLOPE) " * (dv / dl) - " VR_STR(VDSH_RAMP_OFFSET)
+    ", 0.0, 1.0);\n"
     "#endif\n"
     "}\n";
 

@@ -62,15 +62,15 @@ enum { VR_UNIT_BASIS = 0, VR_UNIT_SHADOW = 4 };
 struct vr_scene {
     uint32_t vertex_count, triangle_count;
     float bounds_min[3], bounds_max[3];
-    uint32_t quantity;
+    vdsh_quantity quantity;
     float max_distance;         /* the file's: clamps reconstructed distances */
     GLuint vbo_position, vbo_normal, ibo;
     /* Per order 1..5: the stream's buffer and a VAO with positions,
      * normals and its coefficients; vao[0] has positions and normals only. */
     GLuint vbo_stream[6];
     GLuint vao[6];
-    uint32_t encoding[6];
-    uint32_t method[6];
+    vdsh_encoding encoding[6];
+    vdsh_method method[6];
     float scale[6];
     GLuint basis[4];            /* cube textures, functions 9+4k..12+4k */
     int cube_size;

@@ -38,7 +38,7 @@ typedef struct frame_slot {
 
 struct vr_renderer {
     int width, height;
-    uint32_t color_format;
+    vr_color_format color_format;
     int shadow_size;
     int per_pass;
     GLuint fbo, color, depth;
@@ -141,19 +141,20 @@ vr_result vr_renderer_create(const vr_renderer_desc *desc, vr_renderer **out,
     vr_renderer_desc d = desc ? *desc : (vr_renderer_desc){0};
     /* Defaults, in one place. */
     if (!d.width && !d.height) {
-        d.width = 1024;
-        d.height = 768;
+        d.width = VR_DEFAULT_WIDTH;
+        d.height = VR_DEFAULT_HEIGHT;
     }
     if (!d.shadow_map_size)
-        d.shadow_map_size = 512;
+        d.shadow_map_size = VR_DEFAULT_SHADOW_MAP_SIZE;
     if (!d.max_lights_per_pass)
         d.max_lights_per_pass = VR_MAX_LIGHTS_PER_PASS;
     if (!out)
         return vr_fail(err, VR_ERR_ARGUMENT, "vr_renderer_create: NULL output");
     if (!glGetString(GL_VERSION))
         return vr_fail(err, VR_ERR_GL, "vr_renderer_create: no current GL context");
-    if (d.color_format > VR_COLOR_RGBA32F)
-        return vr_fail(err, VR_ERR_ARGUMENT, "unknown colour format %u", d.color_format);
+    if ((unsigned)d.color_format > VR_COLOR_RGBA32F)
+        return vr_fail(err, VR_ERR_ARGUMENT, "unknown colour format %u",
+                       (unsigned)d.color_format);
     if (d.max_lights_per_pass < 1 || d.max_lights_per_pass > VR_MAX_LIGHTS_PER_PASS)
         return vr_fail(err, VR_ERR_ARGUMENT, "max_lights_per_pass %d not in 1..%d",
                        d.max_lights_per_pass, VR_MAX_LIGHTS_PER_PASS);
@@ -539,28 +540,30 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
     vr_draw_desc d = *desc;
     /* Defaults, in one place. */
     if (d.mode == VR_MODE_DEFAULT)
-        d.mode = VR_MODE_VDSH5_POLY;
+        d.mode = vr_scene_default_mode(s);
     if (!d.albedo[0] && !d.albedo[1] && !d.albedo[2])
         d.albedo[0] = d.albedo[1] = d.albedo[2] = 0.8f;
 
-    if (d.mode >= VR_MODE_COUNT_)
-        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown mode %u", d.mode);
-    if (d.compare > VDSH_COMPARE_BINARY)
-        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown comparison %u", d.compare);
-    if (d.output > VR_OUTPUT_POSITION)
-        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown output %u", d.output);
+    if ((unsigned)d.mode >= VR_MODE_COUNT_)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown mode %u", (unsigned)d.mode);
+    if ((unsigned)d.compare > VDSH_COMPARE_BINARY)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown comparison %u",
+                       (unsigned)d.compare);
+    if ((unsigned)d.output > VR_OUTPUT_POSITION)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown output %u", (unsigned)d.output);
     if (d.light_count < 0 || (d.light_count > 0 && !d.lights))
         return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: %d lights but no array", d.light_count);
     for (int i = 0; i < d.light_count; i++)
         if (!finite3(d.lights[i].position) || !finite3(d.lights[i].color) ||
             !finite3(d.lights[i].attenuation))
             return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: light %d is not finite", i);
-    vr_mode mode = (vr_mode)d.mode;
+    vr_mode mode = d.mode;
     if (!vr_scene_supports(s, mode)) {
         if (mode == VR_MODE_VDSH5 && s->vbo_stream[5])
             return vr_fail(err, VR_ERR_MISSING,
-                           "mode %s needs the basis cubemaps, which were not loaded "
-                           "(vdsh5poly needs none)", vr_mode_name(mode));
+                           "mode %s needs the basis cubemaps, which this scene has not "
+                           "(its file's cube_size is 0, or they were skipped; vdsh5poly "
+                           "needs none)", vr_mode_name(mode));
         return vr_fail(err, VR_ERR_MISSING, "mode %s: the scene has no order-%d %s stream",
                        vr_mode_name(mode), vr_mode_order(mode), vdsh_quantity_name(s->quantity));
     }

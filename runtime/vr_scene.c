@@ -1,6 +1,7 @@
 /*
- * vr_scene.c - load a .vdsh (formats/) and its basis cubemaps
- * (bake/cubemap.h) and upload them; the default view is vr_view.c's.
+ * vr_scene.c - load a .vdsh (formats/) and upload it with the basis
+ * cubemaps it needs, made here (formats/vdsh_cube.h: they depend on their
+ * face size alone); the default view is vr_view.c's.
  *
  * Coefficients go to the GPU exactly as stored: f16 streams as
  * GL_HALF_FLOAT attributes, with the stream's scale applied in the shader,
@@ -12,32 +13,12 @@
  */
 #include "vr_internal.h"
 
-#include "cubemap.h"
 #include "vdsh_cube.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-
-/* Where the basis cubemaps of `path` live: its directory and its file name
- * without ".vdsh". */
-static void split_path(const char *path, char *dir, size_t dir_size,
-                       char *stem, size_t stem_size)
-{
-    const char *slash = path ? strrchr(path, '/') : NULL;
-    const char *base = slash ? slash + 1 : (path ? path : "");
-    if (slash)
-        snprintf(dir, dir_size, "%.*s", (int)(slash - path + 1), path);
-    else
-        snprintf(dir, dir_size, "%s", "");
-    size_t n = strlen(base);
-    if (n > 5 && strcmp(base + n - 5, ".vdsh") == 0)
-        n -= 5;
-    snprintf(stem, stem_size, "%.*s", (int)n, base);
-}
 
 /* 1 when f has a stream of `quantity` that the runtime could upload. */
 static int has_quantity(const vdsh_file *f, uint32_t quantity)
@@ -59,66 +40,45 @@ static vr_result map_vdsh_result(vdsh_result r)
     }
 }
 
-/* Read the four basis cubemaps. A file that does not exist is
- * VR_ERR_MISSING (the usual mistake: the .vdsh was copied without them);
- * one that exists but does not read is the reader's error. */
-static vr_result read_basis(const char *name, const char *dir, const char *stem,
-                            int size, vb_cubemap *maps[VB_CUBEMAP_BASIS_FILES],
-                            vr_error *err)
+/* The four basis cubemaps of face size n (SH functions 9..24, four per
+ * texture): they depend on n alone, so they are made here rather than
+ * read. vdsh_cube_basis_face_gl_f16 gives, face by face and already in
+ * GL's orientation, the very half floats of the bake's OpenEXR files, so
+ * a lookup in direction d returns the basis functions at d. */
+static vr_result make_basis(GLuint tex[4], uint32_t n32, const char *name, vr_error *err)
 {
-    for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++) {
-        char p[4096];
-        vb_error ve;
-        if (vb_cubemap_basis_path(dir, stem, k, p, sizeof p, &ve) != VB_OK)
-            return vr_fail(err, VR_ERR_ARGUMENT, "%s: %s", name, ve.msg);
-        struct stat st;
-        if (stat(p, &st) != 0)
-            return vr_fail(err, errno == ENOENT ? VR_ERR_MISSING : VR_ERR_IO,
-                           "%s: %s (basis cubemap %d of 4, needed for order 5 of %s; "
-                           "bake writes it beside the .vdsh, or load without cubemaps)",
-                           p, strerror(errno), k + 1, name);
-    }
-    vb_error ve;
-    vb_result r = vb_cubemap_read_basis(dir, stem, size, maps, &ve);
-    if (r != VB_OK)
-        return vr_fail(err, r == VB_ERR_IO ? VR_ERR_IO
-                            : r == VB_ERR_OUT_OF_MEMORY ? VR_ERR_OUT_OF_MEMORY
-                                                        : VR_ERR_FORMAT,
-                       "%s (basis cubemap for order 5 of %s)", ve.msg, name);
-    return VR_OK;
-}
-
-/* One basis cubemap to a GL cube texture. The EXR faces are mirrored
- * relative to GL's (vdsh_cube.h): every GL texel is fetched from the EXR
- * texel vdsh_cube_gl_to_exr names, so a lookup in direction d returns
- * the basis functions at d. Half floats hold the EXR's values exactly. */
-static vr_result upload_basis(const vb_cubemap *m, GLuint tex, vr_error *err)
-{
-    int n = m->size;
-    float *face = malloc((size_t)n * (size_t)n * 4 * sizeof(float));
-    if (!face)
-        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "basis cubemap: out of memory");
-    glBindTexture(GL_TEXTURE_CUBE_MAP, tex);
+    GLint max = 0;
+    glGetIntegerv(GL_MAX_CUBE_MAP_TEXTURE_SIZE, &max);
+    if (n32 > (uint32_t)max)
+        return vr_fail(err, VR_ERR_FORMAT,
+                       "%s: cube_size %u is above this GL's largest cube map (%d)", name, n32,
+                       (int)max);
+    int n = (int)n32;
+    size_t face = (size_t)n * (size_t)n * 4;
+    uint16_t *buf = malloc(4 * face * sizeof *buf);
+    if (!buf)
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory for the basis cubemaps",
+                       name);
+    uint16_t *const out[4] = {buf, buf + face, buf + 2 * face, buf + 3 * face};
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     for (int f = 0; f < 6; f++) {
-        for (int j = 0; j < n; j++)
-            for (int i = 0; i < n; i++) {
-                int ei, ej;
-                vdsh_cube_gl_to_exr(f, i, j, n, &ei, &ej);
-                const float *src = m->rgba + (((size_t)f * (size_t)n + (size_t)ej) * (size_t)n +
-                                              (size_t)ei) * 4;
-                memcpy(face + ((size_t)j * (size_t)n + (size_t)i) * 4, src, 4 * sizeof(float));
-            }
-        glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, 0, GL_RGBA16F, n, n, 0,
-                     GL_RGBA, GL_FLOAT, face);
+        vdsh_cube_basis_face_gl_f16(n, f, out);
+        for (int k = 0; k < 4; k++) {
+            glBindTexture(GL_TEXTURE_CUBE_MAP, tex[k]);
+            glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, 0, GL_RGBA16F, n, n, 0,
+                         GL_RGBA, GL_HALF_FLOAT, out[k]);
+        }
     }
-    free(face);
-    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAX_LEVEL, 0);
+    free(buf);
+    for (int k = 0; k < 4; k++) {
+        glBindTexture(GL_TEXTURE_CUBE_MAP, tex[k]);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAX_LEVEL, 0);
+    }
     glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
     return VR_OK;
 }
@@ -191,8 +151,9 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     if (!desc || !out || (!desc->path && !desc->file))
         return vr_fail(err, VR_ERR_ARGUMENT, "vr_scene_create: no path or file given");
     const char *name = desc->path ? desc->path : "(memory)";
-    if (desc->quantity > VDSH_QUANTITY_LOG_DISTANCE)
-        return vr_fail(err, VR_ERR_ARGUMENT, "%s: unknown quantity %u", name, desc->quantity);
+    if ((unsigned)desc->quantity > VDSH_QUANTITY_LOG_DISTANCE)
+        return vr_fail(err, VR_ERR_ARGUMENT, "%s: unknown quantity %u", name,
+                       (unsigned)desc->quantity);
     if (!glGetString(GL_VERSION))
         return vr_fail(err, VR_ERR_GL, "%s: no current GL context", name);
 
@@ -209,8 +170,6 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     const vdsh_header *h = &f->header;
     vr_result r = VR_OK;
     vr_scene *s = NULL;
-    vb_cubemap *maps[VB_CUBEMAP_BASIS_FILES] = {0};
-    int have_maps = 0;
     uint32_t *gpu_indices = NULL, *remap = NULL;
     if (h->vertex_count == 0 || h->triangle_count == 0) {
         r = vr_fail(err, VR_ERR_FORMAT, "%s: no triangles to draw", name);
@@ -226,7 +185,7 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
 
     /* 2. The quantity to draw: the one asked for, else the file's own
      * (a file baked with --log has only log-distance streams). */
-    uint32_t quantity = desc->quantity;
+    vdsh_quantity quantity = desc->quantity;
     if (!has_quantity(f, quantity))
         for (uint32_t i = 0; i < f->stream_count; i++)
             if (f->streams[i].order >= 1 && f->streams[i].order <= 5) {
@@ -234,23 +193,12 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
                 break;
             }
 
-    /* 3. The basis cubemaps, when order 5 is drawn with them: the paper's
-     * split path. A log-distance stream is summed whole per vertex. */
-    const vdsh_stream *s5 = vdsh_find_stream(f, 5, quantity);
-    int split5 = vdsh_runtime_interp(5, quantity) == VDSH_INTERP_SPLIT;
-    /* From memory with neither a path nor a stem there is nothing to look
-     * for: as skip_cubemaps. */
-    int findable = desc->path || desc->cubemap_stem;
-    if (s5 && split5 && h->cube_size > 0 && !desc->skip_cubemaps && findable) {
-        char dir[4096], stem[1024];
-        split_path(desc->path, dir, sizeof dir, stem, sizeof stem);
-        r = read_basis(name, desc->cubemap_dir ? desc->cubemap_dir : dir,
-                       desc->cubemap_stem ? desc->cubemap_stem : stem, (int)h->cube_size, maps,
-                       err);
-        if (r != VR_OK)
-            goto done;
-        have_maps = 1;
-    }
+    /* 3. The basis cubemaps, when order 5 is drawn with them (the paper's
+     * split path; a log-distance stream is summed whole per vertex), at
+     * the face size the bake chose (0: none). */
+    int want_basis = vdsh_find_stream(f, 5, quantity) &&
+                     vdsh_runtime_interp(5, quantity) == VDSH_INTERP_SPLIT &&
+                     h->cube_size > 0 && !desc->skip_cubemaps;
 
     /* 4. Upload. */
     s = calloc(1, sizeof *s);
@@ -316,22 +264,19 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     }
     if (r != VR_OK)
         goto done;
-    if (have_maps) {
+    if (want_basis) {
         glGenTextures(4, s->basis);
-        for (int k = 0; k < 4 && r == VR_OK; k++)
-            r = upload_basis(maps[k], s->basis[k], err);
-        s->cube_size = maps[0]->size;
-        s->gpu_bytes += 4 * 6 * (size_t)s->cube_size * (size_t)s->cube_size * 8;
+        r = make_basis(s->basis, h->cube_size, name, err);
         if (r != VR_OK)
             goto done;
+        s->cube_size = (int)h->cube_size;
+        s->gpu_bytes += 4 * 6 * (size_t)s->cube_size * (size_t)s->cube_size * 8;
     }
     r = vr_check_gl(err, name);
 
 done:
     free(gpu_indices);
     free(remap);
-    for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
-        vb_cubemap_free(maps[k]);
     vdsh_free(owned);
     if (r != VR_OK) {
         vr_scene_destroy(s);
@@ -378,6 +323,16 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     *out = i;
 }
 
+vr_mode vr_scene_default_mode(const vr_scene *s)
+{
+    static const vr_mode best_first[4] = {VR_MODE_VDSH5, VR_MODE_VDSH5_POLY, VR_MODE_VDSH3,
+                                          VR_MODE_VDSH2};
+    for (int i = 0; i < 4; i++)
+        if (vr_scene_supports(s, best_first[i]))
+            return best_first[i];
+    return VR_MODE_VDSH5;
+}
+
 int vr_scene_supports(const vr_scene *s, vr_mode m)
 {
     switch (m) {
@@ -389,7 +344,7 @@ int vr_scene_supports(const vr_scene *s, vr_mode m)
         /* the cubemaps only on the paper's split path */
         return s->vbo_stream[5] != 0 &&
                (s->basis[0] != 0 || vr_mode_interp(m, s->quantity) != VDSH_INTERP_SPLIT);
-    case VR_MODE_DEFAULT:
+    case VR_MODE_DEFAULT: return vr_scene_supports(s, vr_scene_default_mode(s));
     case VR_MODE_VDSH5_POLY: return s->vbo_stream[5] != 0;
     default: return 0;
     }
@@ -397,11 +352,13 @@ int vr_scene_supports(const vr_scene *s, vr_mode m)
 
 int vr_scene_interp(const vr_scene *s, vr_mode m)
 {
-    return vr_mode_interp(m == VR_MODE_DEFAULT ? VR_MODE_VDSH5_POLY : m, s->quantity);
+    return vr_mode_interp(m == VR_MODE_DEFAULT ? vr_scene_default_mode(s) : m, s->quantity);
 }
 
 const char *vr_scene_mode_label(const vr_scene *s, vr_mode m)
 {
+    if (m == VR_MODE_DEFAULT)
+        m = vr_scene_default_mode(s);
     if (vr_scene_interp(s, m) != VDSH_INTERP_DISTANCE ||
         s->quantity != VDSH_QUANTITY_LOG_DISTANCE)
         return vr_mode_label(m);

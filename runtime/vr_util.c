@@ -72,7 +72,7 @@ static const char *const mode_names[VR_MODE_COUNT_] = {
     "default", "none", "cube", "vdsh2", "vdsh3", "vdsh5", "vdsh5poly"};
 
 static const char *const mode_labels[VR_MODE_COUNT_] = {
-    "VDSH order 5 (25 coeff., polynomials)",
+    "the scene's default (VDSH order 5, cubemaps where it has them)",
     "no shadows",
     "cube shadow map",
     "VDSH order 2 (4 coeff.)",

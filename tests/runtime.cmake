@@ -12,7 +12,7 @@ file(MAKE_DIRECTORY ${_rt_dir})
 function(_runtime_test name)
   add_executable(${name} ${CMAKE_CURRENT_LIST_DIR}/${name}.c)
   target_include_directories(${name} PRIVATE ${CMAKE_CURRENT_LIST_DIR})
-  target_link_libraries(${name} PRIVATE vr vr_context vb_cubemap vdsh_format m)
+  target_link_libraries(${name} PRIVATE vr vr_context vdsh_format m)
 endfunction()
 
 function(_runtime_props name)
@@ -22,6 +22,14 @@ endfunction()
 # The upload order of a scene (vertex cache), no GL needed.
 _runtime_test(test_runtime_order)
 add_test(NAME runtime_order COMMAND test_runtime_order)
+
+# The basis cubemaps the runtime makes against its old upload of the bake's
+# .exr files, texel for texel (the one runtime test that links the EXR
+# reader).
+_runtime_test(test_runtime_basis)
+target_link_libraries(test_runtime_basis PRIVATE vb_cubemap)
+add_test(NAME runtime_basis COMMAND test_runtime_basis ${_rt_dir}/basis)
+_runtime_props(runtime_basis)
 
 # GLSL against the C SH and shadow evaluation (and cubemap orientation).
 _runtime_test(test_runtime_glsl)
@@ -90,7 +98,8 @@ _runtime_test(test_runtime_log)
 add_test(NAME runtime_log COMMAND test_runtime_log ${_rt_dir}/floor/floor.vdsh)
 _runtime_props(runtime_log FIXTURES_REQUIRED runtime_floor)
 
-# Bad input: missing, corrupted and truncated files, missing cubemaps.
+# Bad input: missing, corrupted and truncated files, a cube_size no GL
+# holds; no file but the .vdsh needed.
 _runtime_test(test_runtime_errors)
 add_test(NAME runtime_errors COMMAND test_runtime_errors ${_rt_dir}/errors)
 _runtime_props(runtime_errors)
@@ -148,8 +157,12 @@ expect1() {
 expect1 nothere.vdsh --render "$d/x.png" "$d/nothere.vdsh"
 head -c 1000 "$room" > "$d/cut.vdsh"
 expect1 cut.vdsh --render "$d/x.png" "$d/cut.vdsh"
+# The .vdsh alone, without the .exr files the bake wrote beside it:
+# vdsh5 draws the same bytes (the runtime makes the basis cubemaps).
 cp "$room" "$d/alone.vdsh"
-expect1 alone.sh09-12.exr --render "$d/x.png" "$d/alone.vdsh"
+"$v" -q --render "$d/alone.png" --size 64x48 --mode vdsh5 "$d/alone.vdsh" || { echo "vdsh5 of the .vdsh alone failed"; fail=1; }
+"$v" -q --render "$d/beside.png" --size 64x48 --mode vdsh5 "$room" || fail=1
+cmp "$d/alone.png" "$d/beside.png" || { echo "the .vdsh alone renders differently"; fail=1; }
 expect1 "x/y/z.png" --render "$d/x/y/z.png" "$room"
 "$v" -q --render "$d/ok.png" --size 64x48 --no-cubemaps --mode vdsh5poly "$d/alone.vdsh" || { echo "--no-cubemaps failed"; fail=1; }
 # a log-distance bake needs no cubemaps in any mode
@@ -166,6 +179,12 @@ for m in none cube vdsh2 vdsh3 vdsh5 vdsh5poly; do
   "$v" -q --render "$d/$m.png" --size 160x120 --mode $m "$room"
   "$png" info "$d/$m.png" 160 120
 done
+# No --mode: the runtime's default (vr_scene_default_mode), byte for byte:
+# order 5 with cubemaps, and without them the polynomials.
+"$v" -q --render "$d/default.png" --size 160x120 "$room"
+cmp "$d/default.png" "$d/vdsh5.png"
+"$v" -q --render "$d/default-nocube.png" --size 160x120 --no-cubemaps "$room"
+cmp "$d/default-nocube.png" "$d/vdsh5poly.png"
 # Shadows where the room's geometry (bake/builtin.c) puts them. The light
 # at (-4, 3.5, 1) is in front of the 1.58 m crate (x in [-4.79, -3.21], z
 # in [-3.79, -2.21]); the floor point (-4, 0, -4.2), 0.41 m behind the
@@ -391,3 +410,12 @@ foreach(t runtime_view_usage runtime_view_errors runtime_view_render runtime_vie
   endif()
 endforeach()
 _runtime_props(runtime_view_help)
+
+# The runtime library and vdsh-view without bake/ (-DVDSH_BAKE=OFF, with
+# OpenEXR, Embree and OpenMesh made unfindable), and their target graph in
+# the full configure: no vb_* target, none of those libraries. A configure
+# and a build of formats/, tools/ and runtime/ (seconds).
+add_test(NAME runtime_standalone
+         COMMAND ${CMAKE_CURRENT_LIST_DIR}/test_runtime_standalone.sh ${CMAKE_COMMAND}
+                 ${PROJECT_SOURCE_DIR} ${_rt_dir}/standalone ${CMAKE_C_COMPILER}
+                 ${CMAKE_CXX_COMPILER})

@@ -3,7 +3,10 @@
  * cubemap files (bake/cubemap_exr.c).
  *
  *   test_cube conventions          pure math: GL table, EXR<->GL, basis
- *   test_cube files DIR            write/read round trips, header, bytes
+ *   test_cube files DIR            write/read round trips, header, bytes;
+ *                                  the runtime's GL half texels
+ *                                  (vdsh_cube_basis_face_gl_f16) against
+ *                                  the files, bit for bit
  *   test_cube errors DIR           bad files and failing writes
  *   test_cube write PATH N         write one basis file (for exrheader)
  *
@@ -528,6 +531,30 @@ static void test_basis_round_trip(const char *dir)
                     bad++;
             CHECK(bad == 0, "n %d file %d: %zu values differ from half rounding",
                   n, k, bad);
+            /* What the runtime uploads instead of reading the file: the
+             * file's half of every texel, bit for bit (signed zeros
+             * too), at the texel vdsh_cube_gl_to_exr names. */
+            size_t face_values = (size_t)n * (size_t)n * 4;
+            uint16_t *gl = malloc(4 * face_values * sizeof *gl);
+            uint16_t *const out[4] = {gl, gl + face_values, gl + 2 * face_values,
+                                      gl + 3 * face_values};
+            bad = 0;
+            for (int f = 0; f < 6; f++) {
+                vdsh_cube_basis_face_gl_f16(n, f, out);
+                for (int j = 0; j < n; j++)
+                    for (int i = 0; i < n; i++) {
+                        int ei, ej;
+                        vdsh_cube_gl_to_exr(f, i, j, n, &ei, &ej);
+                        const float *file = maps[k]->rgba +
+                            (((size_t)f * (size_t)n + (size_t)ej) * (size_t)n + (size_t)ei) * 4;
+                        for (int c = 0; c < 4; c++)
+                            bad += out[k][((size_t)j * (size_t)n + (size_t)i) * 4 + (size_t)c] !=
+                                   vdsh_f16_from_f32(file[c]);
+                    }
+            }
+            CHECK(bad == 0, "n %d file %d: %zu GL half texels differ from the file's", n, k,
+                  bad);
+            free(gl);
             char path[512];
             vb_cubemap_basis_path(dir, "room", k, path, sizeof path, NULL);
             check_header(path, n);

@@ -1,10 +1,11 @@
 /*
  * test_runtime_errors.c - bad input ends in a clear error, never a crash:
- * missing, empty, truncated and corrupted .vdsh files, missing and corrupt
- * basis cubemaps, streams a mode needs but the file lacks, and bad
- * arguments. Every failure must name the file (or the argument), leave
- * the output untouched, and leave nothing allocated (the sanitizer build
- * checks that).
+ * missing, empty, truncated and corrupted .vdsh files, a cube_size no GL
+ * holds, streams a mode needs but the file lacks, and bad arguments; and
+ * no file beside the .vdsh is needed (the basis cubemaps are made). Every
+ * failure must name the file (or the argument), leave the output
+ * untouched, and leave nothing allocated (the sanitizer build checks
+ * that).
  */
 #include "test_runtime_util.h"
 
@@ -132,13 +133,35 @@ static void test_files(const char *dir)
     printf("random corruption: %d rejected, %d loaded\n", failed, loaded);
     free(data);
 
-    /* The basis cubemaps. */
+    /* The basis cubemaps: made by the runtime, no file read. The .vdsh
+     * alone (rt_file_write writes nothing else) draws order 5 with them,
+     * and so it does with garbage under the names of the bake's files
+     * beside it. */
     sd.path = path;
-    vb_error be;
-    vb_cubemap_basis_path(dir, "good", 2, exr, sizeof exr, &be);
-    snprintf(bad, sizeof bad, "%s.away", exr);
-    CHECK(rename(exr, bad) == 0, "rename %s", exr);
-    expect_fail("missing cubemap", &sd, VR_ERR_MISSING, "good.sh17-20.exr");
+    for (int pass = 0; pass < 2; pass++) {
+        static const char *const names[4] = {"sh09-12", "sh13-16", "sh17-20", "sh21-24"};
+        for (int k = 0; pass == 1 && k < 4; k++) {
+            snprintf(exr, sizeof exr, "%s/good.%s.exr", dir, names[k]);
+            spit(exr, "not an exr file at all", 22);
+        }
+        s = NULL;
+        CHECK(vr_scene_create(&sd, &s, &err) == VR_OK, "the .vdsh alone, pass %d: %s", pass,
+              err.msg);
+        if (!s)
+            continue;
+        vr_scene_info info;
+        vr_scene_get_info(s, &info);
+        CHECK(info.has_cubemaps && info.cube_size == 64, "cubemaps %d of %d", info.has_cubemaps,
+              info.cube_size);
+        vr_renderer *r = NULL;
+        vr_renderer_desc rd = {.width = 8, .height = 8};
+        CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
+        vr_light light = {.position = {0, 0, 1}};
+        vr_draw_desc d = {.mode = VR_MODE_VDSH5, .lights = &light, .light_count = 1};
+        CHECK(r && vr_draw(r, s, &d, &err) == VR_OK, "vdsh5 of the .vdsh alone: %s", err.msg);
+        vr_renderer_destroy(r);
+        vr_scene_destroy(s);
+    }
     /* without cubemaps: order 5 only through the polynomials */
     sd.skip_cubemaps = 1;
     s = NULL;
@@ -157,20 +180,31 @@ static void test_files(const char *dir)
         CHECK(vr_draw(r, s, &d, &err) == VR_OK, "vdsh5poly: %s", err.msg);
         CHECK(!vr_scene_supports(s, VR_MODE_VDSH5) && vr_scene_supports(s, VR_MODE_VDSH5_POLY),
               "supports");
+        vr_scene_info info;
+        vr_scene_get_info(s, &info);
+        CHECK(!info.has_cubemaps && info.cube_size == 0, "skipped cubemaps reported");
         vr_renderer_destroy(r);
         vr_scene_destroy(s);
     }
-    spit(exr, "not an exr file at all", 22);
-    expect_fail("corrupt cubemap", &sd, VR_ERR_FORMAT, "good.sh17-20.exr");
-    CHECK(rename(bad, exr) == 0, "rename back");
-    /* a cubemap of the wrong size */
-    char other[64];
-    snprintf(other, sizeof other, "%s/small", dir);
-    mkdir(other, 0777);
-    CHECK(vb_cubemap_write_basis(other, "good", 8, &be) == VB_OK, "%s", be.msg);
-    sd.cubemap_dir = other;
-    expect_fail("cubemap of the wrong size", &sd, VR_ERR_FORMAT, "good.sh09-12.exr");
-    sd.cubemap_dir = NULL;
+    /* A cube_size no GL can hold is refused by name before anything is
+     * allocated for it; cube_size 0 means none (vdsh5 unavailable). */
+    {
+        rt_file big;
+        small_file(&big, 1);
+        big.f.header.cube_size = 1u << 30;
+        vr_scene_desc bd = {.file = &big.f};
+        expect_fail("cube_size 2^30", &bd, VR_ERR_FORMAT, "cube_size");
+        big.f.header.cube_size = 0;
+        s = NULL;
+        CHECK(vr_scene_create(&bd, &s, &err) == VR_OK, "cube_size 0: %s", err.msg);
+        if (s)
+            CHECK(!vr_scene_supports(s, VR_MODE_VDSH5) &&
+                      vr_scene_supports(s, VR_MODE_VDSH5_POLY) &&
+                      vr_scene_default_mode(s) == VR_MODE_VDSH5_POLY,
+                  "cube_size 0: vdsh5 without cubemaps");
+        vr_scene_destroy(s);
+        rt_file_free(&big);
+    }
 
     /* A log-distance file (vdsh-bake --log): drawn per vertex in every
      * VDSH mode, so its cubemaps are never needed: none on disk, or
@@ -200,9 +234,9 @@ static void test_files(const char *dir)
     CHECK(vdsh_write(logpath, &lf.f, &ve) == VDSH_OK, "%s", ve.msg);
     rt_file_free(&lf);
     for (int pass = 0; pass < 2; pass++) {
-        if (pass == 1) /* corrupt cubemaps beside it */
+        if (pass == 1) /* garbage under the cubemaps' names beside it */
             for (int k = 0; k < 4; k++) {
-                vb_cubemap_basis_path(dir, "log", k, exr, sizeof exr, &be);
+                snprintf(exr, sizeof exr, "%s/log.sh%02d-%02d.exr", dir, 9 + 4 * k, 12 + 4 * k);
                 spit(exr, "not an exr file at all", 22);
             }
         vr_scene_desc ld = {.path = logpath};
@@ -260,8 +294,39 @@ static void test_streams_and_arguments(const char *dir)
         CHECK(res == VR_ERR_MISSING && strstr(err.msg, "stream"), "%s: %s",
               vr_mode_name(missing[i]), err.msg);
     }
-    d.mode = VR_MODE_DEFAULT; /* order 5 polynomials: not in this file */
-    CHECK(vr_draw(r, s, &d, &err) == VR_ERR_MISSING, "default mode");
+    /* The default is the best mode the file has: here order 3. */
+    CHECK(vr_scene_default_mode(s) == VR_MODE_VDSH3, "default mode %s",
+          vr_mode_name(vr_scene_default_mode(s)));
+    d.mode = VR_MODE_DEFAULT;
+    CHECK(vr_draw(r, s, &d, &err) == VR_OK, "default mode: %s", err.msg);
+    /* A file with no stream of orders 2, 3 or 5 (order 1 alone): the
+     * default asks for order 5 and the draw says that stream is missing. */
+    {
+        rt_file f1;
+        small_file(&f1, 0);
+        f1.f.stream_count = 0;
+        free(f1.coef[0]);
+        free(f1.data[0]);
+        f1.coef[0] = NULL;
+        f1.data[0] = NULL;
+        float *c1 = calloc(4, sizeof(float));
+        for (int i = 0; i < 4; i++)
+            c1[i] = 5.0f;
+        rt_file_add_stream(&f1, 1, VDSH_ENCODING_F32, 0, c1, 1.0f);
+        vr_scene *s1 = NULL;
+        vr_scene_desc d1 = {.file = &f1.f};
+        CHECK(vr_scene_create(&d1, &s1, &err) == VR_OK, "order 1 alone: %s", err.msg);
+        if (s1) {
+            CHECK(vr_scene_default_mode(s1) == VR_MODE_VDSH5 &&
+                      !vr_scene_supports(s1, VR_MODE_DEFAULT), "order 1 alone: default");
+            d.mode = VR_MODE_DEFAULT;
+            vr_result res = vr_draw(r, s1, &d, &err);
+            CHECK(res == VR_ERR_MISSING && strstr(err.msg, "order-5"),
+                  "order 1 alone, default mode: %s", err.msg);
+        }
+        vr_scene_destroy(s1);
+        rt_file_free(&f1);
+    }
     d.mode = VR_MODE_VDSH3;
     CHECK(vr_draw(r, s, &d, &err) == VR_OK, "vdsh3: %s", err.msg);
 

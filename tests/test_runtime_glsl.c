@@ -554,11 +554,8 @@ static void test_fragment(void)
     for (int e = 0; e < 2; e++) {
         grid_file(&files[e], &rng, e ? VDSH_ENCODING_F32 : VDSH_ENCODING_F16);
         for (uint32_t q = 0; q < 3; q++) {
-            vr_scene_desc sd = {.file = &files[e].f, .quantity = q, .skip_cubemaps = 0,
-                                .path = NULL};
-            /* from memory; cubemaps from the star test's files */
-            sd.cubemap_dir = g_dir;
-            sd.cubemap_stem = "star16";
+            /* from memory, the basis cubemaps made at the file's cube_size */
+            vr_scene_desc sd = {.file = &files[e].f, .quantity = q};
             CHECK(vr_scene_create(&sd, &scenes[e][q], &err) == VR_OK, "%s", err.msg);
             if (!scenes[e][q])
                 return;
@@ -711,8 +708,7 @@ static void test_light_at_receiver(void)
             CHECK(vdsh_shadow(5, q, md, c5, L, L, VDSH_COMPARE_BINARY) == 1.0f, "C");
 
             vr_scene *s = NULL;
-            vr_scene_desc sd = {.file = &f.f, .quantity = q, .cubemap_dir = g_dir,
-                                .cubemap_stem = "star16"};
+            vr_scene_desc sd = {.file = &f.f, .quantity = q};
             CHECK(vr_scene_create(&sd, &s, &err) == VR_OK, "%s", err.msg);
             if (!s)
                 break;

@@ -13,6 +13,10 @@
  *             order 2 against 5, smooth against binary) and agree where
  *             they must (order 5 with cubemaps against polynomials).
  *   passes    ten lights drawn 8, 3 or 1 per pass give the same image.
+ *   default   a zero mode draws vr_scene_default_mode, pixel for pixel:
+ *             order 5 with cubemaps where the scene has them, else with
+ *             the polynomials, else order 3, else 2 (vdsh-view's default
+ *             is the same definition: runtime_view_render checks that).
  */
 #include "test_runtime_util.h"
 
@@ -429,6 +433,68 @@ static void test_passes(vr_scene *room)
     }
 }
 
+/* vr_draw of mode 0 and of mode `want` give the same pixels, and every
+ * query about mode 0 answers as about `want`. */
+static void expect_default(vr_renderer *r, vr_scene *s, vr_mode want, const char *what)
+{
+    vr_mode got = vr_scene_default_mode(s);
+    CHECK(got == want, "%s: default mode %s, want %s", what, vr_mode_name(got),
+          vr_mode_name(want));
+    CHECK(vr_scene_supports(s, VR_MODE_DEFAULT) == vr_scene_supports(s, want), "%s", what);
+    CHECK(vr_scene_interp(s, VR_MODE_DEFAULT) == vr_scene_interp(s, want), "%s", what);
+    CHECK(!strcmp(vr_scene_mode_label(s, VR_MODE_DEFAULT), vr_scene_mode_label(s, want)), "%s",
+          what);
+    vr_light light = {.position = {-2.4f, 0.8f, -2.0f}, .attenuation = {1.0f, 0.0f, 0.01f}};
+    float *zero = render_color(r, s, VR_MODE_DEFAULT, 0, 0, &light, 1);
+    float *named = render_color(r, s, want, 0, 0, &light, 1);
+    CHECK(!memcmp(zero, named, (size_t)W * H * 4 * sizeof(float)),
+          "%s: mode 0 does not draw %s", what, vr_mode_name(want));
+    printf("default: %s: mode 0 draws %s (%s)\n", what, vr_mode_name(want),
+           vr_scene_mode_label(s, VR_MODE_DEFAULT));
+    free(zero);
+    free(named);
+}
+
+static void test_default(vr_renderer *r, vr_scene *room, const char *path)
+{
+    expect_default(r, room, VR_MODE_VDSH5, "room with cubemaps");
+    vr_scene *s = NULL;
+    vr_error err;
+    vr_scene_desc sd = {.path = path, .skip_cubemaps = 1};
+    CHECK(vr_scene_create(&sd, &s, &err) == VR_OK, "%s", err.msg);
+    if (s)
+        expect_default(r, s, VR_MODE_VDSH5_POLY, "room without cubemaps");
+    vr_scene_destroy(s);
+
+    /* A floor quad with orders 2 and 3, then order 2 alone. */
+    for (int orders = 2; orders >= 1; orders--) {
+        rt_file f;
+        rt_file_init(&f, 4, 2);
+        const float p[4][3] = {{-9, 0, -9}, {9, 0, -9}, {9, 0, 9}, {-9, 0, 9}};
+        for (int i = 0; i < 4; i++) {
+            memcpy(f.pos + 3 * i, p[i], sizeof p[i]);
+            f.nrm[3 * i + 1] = 1.0f;
+        }
+        const uint32_t idx[6] = {0, 2, 1, 0, 3, 2};
+        memcpy(f.idx, idx, sizeof idx);
+        rt_file_bounds(&f);
+        for (int o = 2; o <= orders + 1; o++) {
+            float *c = calloc((size_t)4 * o * o, sizeof(float));
+            for (int i = 0; i < 4; i++)
+                c[o * o * i] = 3.0f;
+            rt_file_add_stream(&f, (uint32_t)o, VDSH_ENCODING_F32, 0, c, 1.0f);
+        }
+        vr_scene_desc md = {.file = &f.f};
+        s = NULL;
+        CHECK(vr_scene_create(&md, &s, &err) == VR_OK, "%s", err.msg);
+        if (s)
+            expect_default(r, s, orders == 2 ? VR_MODE_VDSH3 : VR_MODE_VDSH2,
+                           orders == 2 ? "orders 2 and 3" : "order 2 alone");
+        vr_scene_destroy(s);
+        rt_file_free(&f);
+    }
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 3) {
@@ -448,6 +514,7 @@ int main(int argc, char **argv)
         test_wall(r, room);
         test_differ(r, room);
         test_passes(room);
+        test_default(r, room, argv[1]);
     }
     vr_scene_destroy(room);
     vr_renderer_destroy(r);

@@ -1,15 +1,15 @@
 /*
  * test_runtime_util.h - what the runtime tests share: a headless context
  * or "skipped" (exit 77), synthetic .vdsh files built in memory (written
- * with vdsh_write when a test needs them on disk, with their basis
- * cubemaps), and reading back float targets.
+ * with vdsh_write when a test needs them on disk; the runtime needs no
+ * other file: it makes the basis cubemaps), and reading back float
+ * targets.
  */
 #ifndef TEST_RUNTIME_UTIL_H
 #define TEST_RUNTIME_UTIL_H
 
 #include "test_util.h"
 
-#include "cubemap.h"
 #include "vdsh.h"
 #include "vdsh_sh.h"
 #include "vdsh_shadow.h"
@@ -137,7 +137,7 @@ static inline void rt_file_free(rt_file *r)
     memset(r, 0, sizeof *r);
 }
 
-/* Write dir/stem.vdsh and its four basis cubemaps (face size 64). */
+/* Write dir/stem.vdsh (the .vdsh alone). */
 static inline int rt_file_write(const rt_file *r, const char *dir, const char *stem, char *path,
                          size_t path_size)
 {
@@ -146,11 +146,6 @@ static inline int rt_file_write(const rt_file *r, const char *dir, const char *s
     vdsh_error ve;
     if (vdsh_write(path, &r->f, &ve) != VDSH_OK) {
         fprintf(stderr, "vdsh_write: %s\n", ve.msg);
-        return -1;
-    }
-    vb_error be;
-    if (vb_cubemap_write_basis(dir, stem, (int)r->f.header.cube_size, &be) != VB_OK) {
-        fprintf(stderr, "vb_cubemap_write_basis: %s\n", be.msg);
         return -1;
     }
     return 0;

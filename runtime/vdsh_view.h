@@ -1,0 +1,122 @@
+/*
+ * vdsh_view.h - what the files of vdsh-view share (prefix vv_): its
+ * options, the frame modes of --views, the scene defaults it draws with
+ * (lights, camera, the base draw descriptor), the session (a context, the
+ * scene, a renderer) and PNG output. One mode of the program per file,
+ * over this small core:
+ *   vdsh_view.c          main and the command line
+ *   vdsh_view_core.c     the functions below
+ *   vdsh_view_render.c   --render and --grid: headless images
+ *   vdsh_view_frames.c   --views --frames: frames of a view set
+ *   vdsh_view_bench.c    --bench: frame times of every mode, JSON
+ *   vdsh_view_window.c   the window (GLFW): keys, mouse, overlay
+ * The app layer: the only code that knows both the runtime (vr.h) and the
+ * context (vr_context.h), plus GLFW input and PNG files.
+ *
+ * Errors: functions returning int give 0, or 1 after printing why on
+ * stderr ("vdsh-view: ..."); the vv_run_* functions return the exit
+ * status. Ownership: a session owns its context, scene and renderer
+ * (vv_session_close frees them, also half-opened). One thread.
+ */
+#ifndef VDSH_VIEW_H
+#define VDSH_VIEW_H
+
+#include "vr.h"
+#include "vr_context.h"
+
+enum { VV_MAX_LIGHTS = 64, VV_MAX_FILES = 8 };
+
+typedef struct vv_options {
+    const char *render_path, *grid_path;
+    int bench;
+    const char *files[VV_MAX_FILES];
+    int file_count;
+    int have_camera;
+    float camera[6];
+    int fit;                   /* --fit: frame the bounds from outside */
+    float fov;
+    vr_light lights[VV_MAX_LIGHTS];
+    int light_count;
+    int default_lights;        /* --lights N; 0: 1 (3 for --bench's second set) */
+    int have_att;
+    float att[3];
+    int have_ambient;
+    float ambient;
+    vr_mode mode;
+    int have_mode;
+    vdsh_compare compare;
+    int pcf;
+    int shadow_size;
+    int have_size;
+    int width, height;
+    int no_cubemaps;
+    vr_egl_platform egl;
+    int frames;
+    int no_mallopt;
+    int quiet;
+    const char *screenshot;
+    int no_overlay;
+    const char *keys;
+    const char *views_path;    /* --views: frames for a view set */
+    const char *frames_arg;    /* --frames: a count, or with --views the folder */
+    const char *frames_dir;
+    int frame_modes[16];       /* --modes: indices into vv_frame_modes[] */
+    int frame_mode_count;
+} vv_options;
+
+/* The modes frames are rendered in, by file name (--modes); the first
+ * VV_FRAME_DEFAULT_MODES are the default, where the scene has them. */
+typedef struct vv_frame_mode {
+    const char *name;
+    vr_mode mode;
+    int pcf;
+} vv_frame_mode;
+
+enum { VV_FRAME_MODES = 7, VV_FRAME_DEFAULT_MODES = 6 };
+extern const vv_frame_mode vv_frame_modes[VV_FRAME_MODES];
+
+/* The scene's bounds' diagonal (1 for an empty box). */
+float vv_scene_diagonal(const vr_scene *s);
+/* n default lights of the scene: positions from vr_scene_default_lights,
+ * the viewer's colours and fall-off (or --attenuation). */
+int vv_default_lights(const vr_scene *s, const vv_options *o, int n, vr_light *out);
+/* The lights of the options (with --attenuation applied), else n
+ * defaults. */
+int vv_scene_lights(const vr_scene *s, const vv_options *o, int n, vr_light *out);
+/* The scene's default (or --fit) camera, with --camera and --fov. */
+void vv_scene_camera(const vr_scene *s, const vv_options *o, vr_camera *c);
+/* A draw of these lights with the options' mode, comparison, PCF and
+ * ambient term; the camera is left zero. */
+vr_draw_desc vv_base_desc(const vv_options *o, const vr_light *lights, int n);
+/* CLOCK_MONOTONIC in milliseconds. */
+double vv_now_ms(void);
+/* An opaque RGBA8 PNG, written atomically (formats/vdsh_output.h). */
+int vv_write_png(const char *path, int w, int h, const unsigned char *rgba);
+
+/* Everything a run needs: a context, the scene, a renderer. */
+typedef struct vv_session {
+    vr_context *ctx;
+    vr_scene *scene;
+    vr_renderer *r;
+} vv_session;
+
+/* Load a scene file (with --no-cubemaps). */
+int vv_open_scene(const vv_options *o, const char *path, vr_scene **out);
+/* A context of `kind` (w x h for a window), the first scene file and a
+ * w x h renderer. */
+int vv_session_open(const vv_options *o, vr_context_kind kind, int w, int h, vv_session *s);
+/* NULL members are fine. */
+void vv_session_close(vv_session *s);
+/* A headless context (of w x h when `sized`, else the platform's default
+ * surface) and a w x h renderer on it; 0, or 1 after printing why. */
+int vv_open_headless(const vv_options *o, int w, int h, int sized, vr_context **ctx,
+                     vr_renderer **r);
+
+/* The modes: the exit status of the program. */
+int vv_run_render(const vv_options *o);
+int vv_run_grid(const vv_options *o);
+int vv_run_frames(const vv_options *o);
+int vv_run_bench(const vv_options *o);
+int vv_run_window(const vv_options *o);
+
+#endif /* VDSH_VIEW_H */

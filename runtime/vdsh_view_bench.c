@@ -1,0 +1,219 @@
+/*
+ * vdsh_view_bench.c - vdsh-view --bench: frame times of every shadow mode
+ * with 1 and 3 lights on each scene, in one process, as one JSON document
+ * on stdout (scripts/bench_runtime reads it).
+ */
+#include "vdsh_view.h"
+
+#include "vt_json.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#ifndef VDSH_VERSION_STRING
+#define VDSH_VERSION_STRING "0"
+#endif
+
+typedef struct bench_mode {
+    vr_mode mode;
+    int pcf;
+    const char *name;
+} bench_mode;
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static void json_series(vt_json *j, cJSON *o, const char *key, const double *v, int n)
+{
+    cJSON *a = vt_json_array(j, o, key);
+    for (int i = 0; i < n; i++)
+        vt_json_f64(j, a, NULL, v[i]);
+}
+
+enum { BENCH_MODES = 7, BENCH_ROUNDS = 64 };
+
+/* CPU time of the whole process (every thread: llvmpipe's rasterizer
+ * threads render in this process), milliseconds. */
+static double process_cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
+}
+
+/* One scene of a benchmark: what it times and the results. */
+typedef struct bench_scene {
+    const char *path;
+    vr_scene *scene;
+    bench_mode modes[BENCH_MODES];
+    int nm;
+    vr_light lights[2][4];
+    int nl[2];
+    /* [light set][mode][round] */
+    double cpu[2][BENCH_MODES][BENCH_ROUNDS], gpu[2][BENCH_MODES][BENCH_ROUNDS];
+    double shadow[2][BENCH_MODES][BENCH_ROUNDS], lighting[2][BENCH_MODES][BENCH_ROUNDS];
+    double proc[2][BENCH_MODES][BENCH_ROUNDS];
+} bench_scene;
+
+/* Load a scene and choose the modes it is timed in. */
+static int bench_open(const vv_options *o, const char *path, bench_scene *b)
+{
+    static const bench_mode all[BENCH_MODES] = {
+        {VR_MODE_NONE, 0, "none"},   {VR_MODE_CUBE, 0, "cube"},
+        {VR_MODE_CUBE, 1, "cube_pcf"}, {VR_MODE_VDSH2, 0, "vdsh2"},
+        {VR_MODE_VDSH3, 0, "vdsh3"}, {VR_MODE_VDSH5, 0, "vdsh5"},
+        {VR_MODE_VDSH5_POLY, 0, "vdsh5poly"}};
+    static const int light_sets[2] = {1, 3};
+    b->path = path;
+    if (vv_open_scene(o, path, &b->scene))
+        return 1;
+    for (int i = 0; i < BENCH_MODES; i++) {
+        /* On a log-distance scene both order-5 modes draw the same
+         * per-vertex program: time it once, as vdsh5. */
+        int same = all[i].mode == VR_MODE_VDSH5_POLY &&
+                   vr_scene_supports(b->scene, VR_MODE_VDSH5) &&
+                   vr_scene_interp(b->scene, VR_MODE_VDSH5) == VDSH_INTERP_DISTANCE;
+        if (vr_scene_supports(b->scene, all[i].mode) && !same)
+            b->modes[b->nm++] = all[i];
+    }
+    for (int ls = 0; ls < 2; ls++)
+        b->nl[ls] = vv_default_lights(b->scene, o, light_sets[ls], b->lights[ls]);
+    return 0;
+}
+
+/* Time every mode of every scene, with 1 light and then 3. Warm-up
+ * first: compile every program and allocate every shadow map before
+ * anything is timed. Then rounds that each time every (scene, mode) once,
+ * starting at a different one each round, so that slow drifts of a shared
+ * machine spread over all scenes and modes alike: a ratio between any two
+ * of them compares frames of the same minutes. */
+static int bench_time(const vv_options *o, bench_scene *b, int nb, vr_renderer *r, int rounds)
+{
+    int total = 0;
+    for (int i = 0; i < nb; i++)
+        total += b[i].nm;
+    for (int ls = 0; ls < 2; ls++)
+        for (int round = -2; round < rounds; round++)
+            for (int k = 0; k < total; k++) {
+                int j = (k + (round > 0 ? round : 0)) % total, i = 0;
+                while (j >= b[i].nm)
+                    j -= b[i++].nm;
+                bench_scene *bs = &b[i];
+                vr_draw_desc d = vv_base_desc(o, bs->lights[ls], bs->nl[ls]);
+                d.mode = bs->modes[j].mode;
+                d.pcf = bs->modes[j].pcf;
+                vv_scene_camera(bs->scene, o, &d.camera);
+                vr_error err;
+                double proc0 = process_cpu_ms();
+                if (vr_draw(r, bs->scene, &d, &err) != VR_OK) {
+                    fprintf(stderr, "vdsh-view: %s: %s: %s\n", bs->path, bs->modes[j].name,
+                            err.msg);
+                    return 1;
+                }
+                vr_renderer_finish(r);
+                double proc1 = process_cpu_ms();
+                vr_timings t;
+                vr_renderer_timings(r, &t);
+                if (round >= 0) {
+                    bs->proc[ls][j][round] = proc1 - proc0;
+                    bs->cpu[ls][j][round] = t.cpu_ms;
+                    bs->gpu[ls][j][round] = t.gpu_ms;
+                    bs->shadow[ls][j][round] = t.shadow_total_ms;
+                    bs->lighting[ls][j][round] = t.lighting_total_ms;
+                }
+            }
+    return 0;
+}
+
+/* One scene's JSON object (and a summary on stderr). */
+static void bench_print(const vv_options *o, const bench_scene *b, int rounds, vt_json *j,
+                        cJSON *list)
+{
+    vr_scene_info info;
+    vr_scene_get_info(b->scene, &info);
+    uint32_t method = 0;
+    for (int k = 1; k <= 5; k++)
+        if (info.has_order[k])
+            method = info.method[k];
+    cJSON *so = vt_json_object(j, list, NULL);
+    vt_json_string(j, so, "file", b->path);
+    vt_json_u64(j, so, "vertices", info.vertex_count);
+    vt_json_u64(j, so, "triangles", info.triangle_count);
+    vt_json_string(j, so, "quantity", vdsh_quantity_name(info.quantity));
+    vt_json_string(j, so, "method", vdsh_method_name(method));
+    cJSON *results = vt_json_array(j, so, "results");
+    for (int ls = 0; ls < 2; ls++)
+        for (int m = 0; m < b->nm; m++) {
+            double sorted[BENCH_ROUNDS];
+            memcpy(sorted, b->cpu[ls][m], (size_t)rounds * sizeof(double));
+            qsort(sorted, (size_t)rounds, sizeof(double), cmp_double);
+            int interp = vr_scene_interp(b->scene, b->modes[m].mode);
+            cJSON *r = vt_json_object(j, results, NULL);
+            vt_json_i64(j, r, "lights", b->nl[ls]);
+            vt_json_string(j, r, "mode", b->modes[m].name);
+            vt_json_string(j, r, "path", interp >= 0 ? vdsh_interp_name((uint32_t)interp)
+                                                     : b->modes[m].name);
+            vt_json_f64(j, r, "median_cpu_ms", sorted[rounds / 2]);
+            json_series(j, r, "cpu_ms", b->cpu[ls][m], rounds);
+            json_series(j, r, "process_cpu_ms", b->proc[ls][m], rounds);
+            json_series(j, r, "gpu_ms", b->gpu[ls][m], rounds);
+            json_series(j, r, "shadow_ms", b->shadow[ls][m], rounds);
+            json_series(j, r, "lighting_ms", b->lighting[ls][m], rounds);
+            if (!o->quiet)
+                fprintf(stderr, "vdsh-view: %s, %d light%s, %-9s median %.1f ms\n", b->path,
+                        b->nl[ls], b->nl[ls] == 1 ? "" : "s", b->modes[m].name,
+                        sorted[rounds / 2]);
+        }
+}
+
+/* The results as one JSON document on stdout (vt_json.h), printed once
+ * every scene has been timed. */
+int vv_run_bench(const vv_options *o)
+{
+    int w = o->have_size ? o->width : VR_DEFAULT_WIDTH;
+    int h = o->have_size ? o->height : VR_DEFAULT_HEIGHT;
+    vr_context *ctx = NULL;
+    vr_renderer *r = NULL;
+    if (vv_open_headless(o, w, h, 0, &ctx, &r) != 0)
+        return 1;
+    int rounds = o->frames ? (o->frames < BENCH_ROUNDS ? o->frames : BENCH_ROUNDS) : 7;
+    vt_json j = {0};
+    cJSON *root = vt_json_object(&j, NULL, NULL);
+    vt_json_string(&j, root, "version", VDSH_VERSION_STRING);
+    vt_json_string(&j, root, "renderer", vr_gl_renderer());
+    vt_json_string(&j, root, "context", vr_context_description(ctx));
+    vt_json_i64(&j, root, "width", w);
+    vt_json_i64(&j, root, "height", h);
+    vt_json_i64(&j, root, "shadow_size", o->shadow_size ? o->shadow_size : VR_DEFAULT_SHADOW_MAP_SIZE);
+    vt_json_bool(&j, root, "mallopt", !o->no_mallopt);
+    vt_json_i64(&j, root, "rounds", rounds);
+    cJSON *list = vt_json_array(&j, root, "scenes");
+    bench_scene *b = calloc((size_t)o->file_count, sizeof *b);
+    int rc = b ? 0 : 1;
+    if (!b)
+        fprintf(stderr, "vdsh-view: out of memory\n");
+    for (int i = 0; i < o->file_count && !rc; i++)
+        rc = bench_open(o, o->files[i], &b[i]);
+    if (!rc)
+        rc = bench_time(o, b, o->file_count, r, rounds);
+    for (int i = 0; i < o->file_count && !rc; i++)
+        bench_print(o, &b[i], rounds, &j, list);
+    char msg[256];
+    if (!rc && vt_json_write_stream(&j, stdout, "stdout", msg, sizeof msg) != 0) {
+        fprintf(stderr, "vdsh-view: --bench: %s\n", msg);
+        rc = 1;
+    }
+    vt_json_free(&j);
+    for (int i = 0; b && i < o->file_count; i++)
+        vr_scene_destroy(b[i].scene);
+    free(b);
+    vr_renderer_destroy(r);
+    vr_context_destroy(ctx);
+    return rc;
+}
+

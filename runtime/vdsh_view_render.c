@@ -1,0 +1,163 @@
+/*
+ * vdsh_view_render.c - vdsh-view --render (one image) and --grid (the
+ * paper's comparison row, one row per scene), headless.
+ */
+#include "vdsh_view.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+int vv_run_render(const vv_options *o)
+{
+    int w = o->have_size ? o->width : VR_DEFAULT_WIDTH;
+    int h = o->have_size ? o->height : VR_DEFAULT_HEIGHT;
+    vv_session s;
+    if (vv_session_open(o, VR_CONTEXT_HEADLESS, w, h, &s))
+        return 1;
+    vr_light lights[VV_MAX_LIGHTS];
+    int n = vv_scene_lights(s.scene, o, o->default_lights ? o->default_lights : 1, lights);
+    vr_draw_desc d = vv_base_desc(o, lights, n);
+    vv_scene_camera(s.scene, o, &d.camera);
+    vr_error err;
+    int rc = 1;
+    unsigned char *px = malloc((size_t)w * (size_t)h * 4);
+    double t0 = vv_now_ms();
+    if (!px)
+        fprintf(stderr, "vdsh-view: out of memory\n");
+    else if (vr_draw(s.r, s.scene, &d, &err) != VR_OK ||
+             vr_read_pixels(s.r, px, (size_t)w * (size_t)h * 4, &err) != VR_OK)
+        fprintf(stderr, "vdsh-view: %s: %s\n", o->files[0], err.msg);
+    else {
+        double ms = vv_now_ms() - t0;
+        rc = vv_write_png(o->render_path, w, h, px);
+        if (!rc && !o->quiet)
+            fprintf(stderr, "vdsh-view: wrote %s (%dx%d, mode %s: %s, %d light%s, %.0f ms, %s; "
+                    "%s)\n", o->render_path, w, h,
+                    vr_mode_name(o->mode ? o->mode : vr_scene_default_mode(s.scene)),
+                    vr_scene_mode_label(s.scene, o->mode), n, n == 1 ? "" : "s", ms,
+                    vr_gl_renderer(), vr_context_description(s.ctx));
+    }
+    free(px);
+    vv_session_close(&s);
+    return rc;
+}
+
+/* What a scene's file holds, for a row label: "room.vdsh: paper bake,
+ * distance" (the method of its highest order drawn). */
+static void bake_label(const char *path, const vr_scene *s, char *out, size_t size)
+{
+    vr_scene_info info;
+    vr_scene_get_info(s, &info);
+    const char *slash = strrchr(path, '/');
+    uint32_t method = 0;
+    for (int k = 1; k <= 5; k++)
+        if (info.has_order[k])
+            method = info.method[k];
+    snprintf(out, size, "%s: %s bake, %s", slash ? slash + 1 : path, vdsh_method_name(method),
+             vdsh_quantity_name(info.quantity));
+}
+
+/* One row of the grid: the five panels of one scene into row (5 w wide). */
+static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w, int h,
+                    unsigned char *px, unsigned char *row)
+{
+    vr_scene *scene = NULL;
+    if (vv_open_scene(o, path, &scene))
+        return 1;
+    vr_light lights[VV_MAX_LIGHTS];
+    int n = vv_scene_lights(scene, o, o->default_lights ? o->default_lights : 1, lights);
+    /* The paper's row. Order 5 the paper's way when the cubemaps are
+     * there, else with the polynomials (the same image to f16 precision);
+     * a log-distance scene draws both per vertex. */
+    vr_mode modes[5] = {VR_MODE_NONE, VR_MODE_CUBE, VR_MODE_VDSH5, VR_MODE_VDSH3, VR_MODE_VDSH2};
+    if (!vr_scene_supports(scene, VR_MODE_VDSH5))
+        modes[2] = VR_MODE_VDSH5_POLY;
+    size_t panel = (size_t)w * (size_t)h * 4;
+    int rc = 0;
+    for (int m = 0; m < 5 && !rc; m++) {
+        vr_error err;
+        vr_draw_desc d = vv_base_desc(o, lights, n);
+        d.mode = modes[m];
+        vv_scene_camera(scene, o, &d.camera);
+        char label[320];
+        int shadow = o->shadow_size ? o->shadow_size : VR_DEFAULT_SHADOW_MAP_SIZE;
+        if (modes[m] == VR_MODE_CUBE)
+            snprintf(label, sizeof label, "cube shadow map (%d^2 x 6, %s)", shadow,
+                     o->pcf ? "PCF" : "1 tap");
+        else if (modes[m] >= VR_MODE_VDSH2)
+            snprintf(label, sizeof label, "%s%s", vr_scene_mode_label(scene, modes[m]),
+                     o->compare == VDSH_COMPARE_BINARY ? ", binary" : "");
+        else {
+            char bake[256];
+            bake_label(path, scene, bake, sizeof bake);
+            snprintf(label, sizeof label, "%s\n%s", vr_mode_label(modes[m]), bake);
+        }
+        vr_result res = VR_OK;
+        if (!vr_scene_supports(scene, modes[m])) {
+            /* A file baked without this order: say so in the panel. */
+            vr_draw_desc none = d;
+            none.light_count = 0;
+            none.mode = VR_MODE_NONE;
+            snprintf(label + strlen(label), sizeof label - strlen(label), ": not in this file");
+            res = vr_draw(r, scene, &none, &err);
+        } else
+            res = vr_draw(r, scene, &d, &err);
+        if (res == VR_OK)
+            res = vr_draw_text(r, 4, 4, w >= 400 ? 2.0f : 1.0f, NULL, label, &err);
+        if (res == VR_OK)
+            res = vr_read_pixels(r, px, panel, &err);
+        if (res != VR_OK) {
+            fprintf(stderr, "vdsh-view: %s: %s: %s\n", path, vr_mode_name(modes[m]), err.msg);
+            rc = 1;
+            break;
+        }
+        for (int y = 0; y < h; y++)
+            memcpy(row + ((size_t)y * 5 * (size_t)w + (size_t)m * (size_t)w) * 4,
+                   px + (size_t)y * (size_t)w * 4, (size_t)w * 4);
+    }
+    if (!rc && !o->quiet)
+        fprintf(stderr, "vdsh-view: %s: none | cube | %s | vdsh3 | vdsh2 (%s), %d light%s\n",
+                path, vr_mode_name(modes[2]), vr_scene_mode_label(scene, modes[2]), n,
+                n == 1 ? "" : "s");
+    vr_scene_destroy(scene);
+    return rc;
+}
+
+int vv_run_grid(const vv_options *o)
+{
+    int w = o->have_size ? o->width : 512, h = o->have_size ? o->height : 384;
+    int rows = o->file_count;
+    vr_context *ctx = NULL;
+    vr_renderer *r = NULL;
+    if (vv_open_headless(o, w, h, 1, &ctx, &r) != 0)
+        return 1;
+    size_t panel = (size_t)w * (size_t)h * 4;
+    unsigned char *px = malloc(panel), *img = calloc(5 * (size_t)rows, panel);
+    int rc = 0;
+    if (!px || !img) {
+        fprintf(stderr, "vdsh-view: out of memory\n");
+        rc = 1;
+    }
+    for (int i = 0; i < rows && !rc; i++)
+        rc = grid_row(o, o->files[i], r, w, h, px, img + (size_t)i * 5 * panel);
+    if (!rc) {
+        /* A thin dark line between panels and between rows. */
+        size_t stride = 5 * (size_t)w * 4;
+        for (int y = 0; y < rows * h; y++)
+            for (int m = 1; m < 5; m++)
+                memset(img + (size_t)y * stride + (size_t)m * (size_t)w * 4, 40, 4);
+        for (int i = 1; i < rows; i++)
+            memset(img + (size_t)i * (size_t)h * stride, 40, stride);
+        rc = vv_write_png(o->grid_path, 5 * w, rows * h, img);
+        if (!rc && !o->quiet)
+            fprintf(stderr, "vdsh-view: wrote %s (%dx%d, %d row%s, %s)\n", o->grid_path, 5 * w,
+                    rows * h, rows, rows == 1 ? "" : "s", vr_gl_renderer());
+    }
+    free(px);
+    free(img);
+    vr_renderer_destroy(r);
+    vr_context_destroy(ctx);
+    return rc;
+}
+
