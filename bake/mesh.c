@@ -1,12 +1,15 @@
 /*
- * mesh.c - loading (dispatch, file bytes, validation and cleaning), welding,
- * normals, appending, bounds and OBJ output for vb_mesh. Reading a file's
- * bytes into arrays is mesh_parse.cpp's (mesh_parse.h); refinement, the
- * one part on OpenMesh, is mesh_refine.cpp's.
+ * mesh.c - loading (dispatch, file bytes, hashing, validation and
+ * cleaning), welding, normals, appending, bounds and OBJ output for
+ * vb_mesh. Reading a file's bytes into arrays is mesh_parse.cpp's
+ * (mesh_parse.h); refinement, the one part on OpenMesh, is
+ * mesh_refine.cpp's; SHA-256 is nettle's.
  */
 #include "mesh.h"
 #include "mesh_parse.h"
 #include "vdsh_output.h"
+
+#include <nettle/sha2.h>
 
 #include <errno.h>
 #include <fcntl.h>
@@ -50,6 +53,15 @@ void vb_mesh_bounds(const vb_mesh *m, float min[3], float max[3])
                 max[k] = p[k];
         }
     }
+}
+
+void vb_sha256(const void *data, size_t size, uint8_t out[32])
+{
+    struct sha256_ctx ctx;
+    sha256_init(&ctx);
+    if (size)
+        sha256_update(&ctx, size, (const uint8_t *)data);
+    sha256_digest(&ctx, SHA256_DIGEST_SIZE, out);
 }
 
 /* "s" for a count other than 1. */

@@ -262,7 +262,8 @@ void vb_mesh_bounds(const vb_mesh *m, float min[3], float max[3]);
 
 void vb_mesh_free(vb_mesh *m);
 
-/* SHA-256 of a byte buffer (used for source hashes). */
+/* SHA-256 of a byte buffer (used for source hashes): nettle's. `data`
+ * may be NULL when size is 0. */
 void vb_sha256(const void *data, size_t size, uint8_t out[32]);
 
 #ifdef __cplusplus
