@@ -539,12 +539,13 @@ void remove_repeated(std::vector<int64_t> &v)
  * dropped). Texture coordinates, materials and every other keyword are
  * ignored.
  *
- * Refused because OpenMesh's reader read them differently from these
- * checks (and the baker refused them before): a "v" line, or a face line
- * with three distinct vertices, whose first character after spaces and
- * TABs is a vertical tab or form feed (OpenMesh skipped such lines; "vn"
- * and other such lines are skipped here too), and a face line whose text
- * after '#' names further vertices (OpenMesh read on). */
+ * Where OpenMesh's reader read a line otherwise than these checks, the
+ * reading follows OpenMesh, and the file is refused when the counts then
+ * differ (as the baker refused it before): a line whose first character
+ * after spaces, TABs and CRs is a vertical tab or form feed is skipped (a
+ * "v" line skipped that way always makes them differ), and the text after
+ * '#' on a face line is read on as corners (a new vertex there makes them
+ * differ; a repeated one may give its vertex a normal). */
 vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder &out, expectation *ex,
                    vb_error *err)
 {
@@ -1321,13 +1322,15 @@ vb_result ply_binary_read(const char *path, const std::vector<ply_element> &elem
  * read is checked (ascii: a whole number of the property's kind; both:
  * sizes, face indices in range, finite x, y, z) before it is used.
  *
- * Refused because OpenMesh's reader read them differently from these
- * checks (the baker refused them before, or read garbage): binary x, y, z,
- * normals or texture coordinates of an integer type (read as 0, consuming
- * nothing), binary colours of type double (the same), binary properties
- * named after another type of another size ("property double float32"),
- * ascii colours that are not whole integers of int range unless their type
- * is float (read as integers, the rest shifting into the next value). */
+ * Refused because OpenMesh's reader read them otherwise than declared
+ * (the baker refused such files before, or read garbage from them): binary
+ * x, y, z, normals or texture coordinates of an integer type (read as 0,
+ * consuming nothing), binary colours of type double (the same) and binary
+ * properties named after another type of another size ("property double
+ * float32"), unless what OpenMesh read (ply_binary_read) is still what the
+ * file declares; ascii colours that are not whole numbers of int range
+ * unless their type is float (read as integers: the rest failed or shifted
+ * into the next value), unless nothing used follows (the last face). */
 vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder &out, expectation *ex,
                    vb_error *err)
 {
