@@ -1,10 +1,15 @@
 /*
- * mesh.c - loading (dispatch, file bytes, validation and cleaning), welding,
- * normals, appending, bounds and OBJ output for vb_mesh. The OpenMesh side
- * (reading, refinement) is in mesh_openmesh.cpp, behind mesh.h.
+ * mesh.c - loading (dispatch, file bytes, hashing, validation and
+ * cleaning), welding, normals, appending, bounds and OBJ output for
+ * vb_mesh. Reading a file's bytes into arrays is mesh_parse.cpp's
+ * (mesh_parse.h); refinement, the one part on OpenMesh, is
+ * mesh_refine.cpp's; SHA-256 is nettle's.
  */
 #include "mesh.h"
+#include "mesh_parse.h"
 #include "vdsh_output.h"
+
+#include <nettle/sha2.h>
 
 #include <errno.h>
 #include <fcntl.h>
@@ -48,6 +53,15 @@ void vb_mesh_bounds(const vb_mesh *m, float min[3], float max[3])
                 max[k] = p[k];
         }
     }
+}
+
+void vb_sha256(const void *data, size_t size, uint8_t out[32])
+{
+    struct sha256_ctx ctx;
+    sha256_init(&ctx);
+    if (size)
+        sha256_update(&ctx, size, (const uint8_t *)data);
+    sha256_digest(&ctx, SHA256_DIGEST_SIZE, out);
 }
 
 /* "s" for a count other than 1. */
@@ -528,7 +542,7 @@ static void unit_double(const float *n, double u[3])
         u[k] = len > 0.0 && isfinite(len) ? n[k] / len : 0.0;
 }
 
-/* As OpenMesh's side keeps a single given normal: as it is when it is
+/* As mesh_parse.cpp keeps a single given normal: as it is when it is
  * unit to float precision, else scaled to unit length. */
 static void unit_float(const float *n, float out[3])
 {
@@ -648,7 +662,7 @@ static vb_result split_creases(const vb_mesh_raw *raw, uint32_t *idx, split_vert
     }
 
     /* The split vertices, each vertex's groups in a row. A vertex that is
-     * not split keeps OpenMesh's per-vertex normal; a group takes its first
+     * not split keeps the reader's per-vertex normal; a group takes its first
      * given normal. */
     sv->vertex_count = (uint32_t)total;
     sv->positions = alloc_array(3 * (size_t)total, sizeof(float));
@@ -891,10 +905,9 @@ static vb_result format_of(const char *name, vb_mesh_format *format, vb_error *e
     return VB_OK;
 }
 
-/* A file's bytes -> clean mesh and source info; `file` as for
- * vb_mesh_read_openmesh. */
-static vb_result load_bytes(const char *name, const char *file, vb_mesh_format format, const uint8_t *bytes,
-                            size_t size, vb_mesh *m, vb_source_info *si, vb_error *err)
+/* A file's bytes -> clean mesh and source info. */
+static vb_result load_bytes(const char *name, vb_mesh_format format, const uint8_t *bytes, size_t size, vb_mesh *m,
+                            vb_source_info *si, vb_error *err)
 {
     if (size == 0)
         return vb_fail(err, VB_ERR_FORMAT, "%s: empty file", name);
@@ -902,7 +915,7 @@ static vb_result load_bytes(const char *name, const char *file, vb_mesh_format f
     vb_sha256(bytes, size, si->sha256);
     vb_mesh_raw raw;
     memset(&raw, 0, sizeof raw);
-    vb_result r = vb_mesh_read_openmesh(name, file, format, bytes, size, &raw, err);
+    vb_result r = vb_mesh_parse(name, format, bytes, size, &raw, err);
     if (r == VB_OK)
         r = clean_raw(name, format, &raw, m, &si->report, err);
     vb_mesh_raw_free(&raw);
@@ -958,7 +971,7 @@ vb_result vb_mesh_load(const char *path, const vb_load_desc *desc, vb_mesh *out,
         r = read_file(path, &bytes, &size, err);
         if (r != VB_OK)
             return r;
-        r = load_bytes(path, path, format, bytes, size, &m, &si, err);
+        r = load_bytes(path, format, bytes, size, &m, &si, err);
         free(bytes);
     }
     return finish_load(r, &m, &si, desc ? desc->weld : 0, out, info, err);
@@ -976,6 +989,6 @@ vb_result vb_mesh_load_memory(const void *data, size_t size, const char *name, c
     vb_mesh m = {0};
     vb_source_info si;
     memset(&si, 0, sizeof si);
-    r = load_bytes(name, NULL, format, (const uint8_t *)data, size, &m, &si, err);
+    r = load_bytes(name, format, (const uint8_t *)data, size, &m, &si, err);
     return finish_load(r, &m, &si, desc ? desc->weld : 0, out, info, err);
 }

@@ -1,10 +1,10 @@
 /*
- * mesh.h - triangle meshes for the baker: loading OBJ/PLY/OFF/STL (through
- * OpenMesh, behind this C header), the built-in procedural scenes, welding,
- * normals, receiver refinement and OBJ output.
+ * mesh.h - triangle meshes for the baker: loading OBJ/PLY/OFF/STL (strict
+ * readers, mesh_parse.h), the built-in procedural scenes, welding, normals,
+ * receiver refinement (OpenMesh, behind this C header) and OBJ output.
  *
- * Does not: trace rays or know about SH. Only mesh_openmesh.cpp includes
- * OpenMesh, and it lets no C++ exception escape.
+ * Does not: trace rays or know about SH. Only mesh_refine.cpp includes
+ * OpenMesh; it and the readers (C++) let no C++ exception escape.
  *
  * Usage (tests/test_mesh.c is a compiled example):
  *
@@ -61,22 +61,28 @@
  * the closest.
  *
  * Files are read into memory once (vb_mesh_load_memory starts from such
- * bytes); those bytes are hashed for vb_source_info, checked by a strict
- * pre-pass and parsed by OpenMesh's readers (OFF: OpenMesh reads a file
- * itself; see vb_mesh_load_memory) into a plain array
- * collector (no half-edge structure, so non-manifold and duplicate faces
- * are kept as they are: nothing in the file is lost). The pre-pass rejects
- * what OpenMesh would silently skip or misread: numbers that do not parse
- * or are NaN/Inf, faces with fewer than 3 vertices, out-of-range indices,
- * truncated files, counts that do not fit the file, PLY list properties
- * OpenMesh cannot skip. Counts are cross-checked after OpenMesh has read
- * the file. OBJ: negative (relative) indices and TABs are fine; materials
- * and texture coordinates are ignored. STL: OpenMesh's reader itself
- * merges vertices with identical positions and drops triangles that then
- * repeat a vertex, with or without `weld`; an ascii STL must end with
- * "endsolid" (else it may have been cut between two facets), and a solid
- * whose name contains "outer" is refused (OpenMesh reads that line as the
- * start of a facet).
+ * bytes); those bytes are hashed for vb_source_info and read in one strict
+ * pass straight into arrays (mesh_parse.h; no half-edge structure, so
+ * non-manifold and duplicate faces are kept as they are: nothing in the
+ * file is lost). The readers read what OpenMesh 9's readers read (the
+ * baker used those until issue 13: the same floats, vertex numbering and
+ * normals, so the same bakes) and refuse what those would have skipped or
+ * misread: numbers that do not parse or are NaN/Inf, faces with fewer than
+ * 3 vertices, out-of-range indices, truncated files, counts that do not
+ * fit the file, PLY list properties other than the faces' vertex_indices,
+ * binary PLY coordinates, normals or texture coordinates of an integer
+ * type and colours of type double, ascii PLY colours that are not whole
+ * numbers of int range (unless typed float), OBJ "v" and face lines that
+ * start with a vertical tab or form feed, OBJ face lines whose text after
+ * '#' names further corners. What was read is cross-checked with what the
+ * checks counted. OBJ: negative (relative) indices and TABs are fine;
+ * materials and texture coordinates are ignored. STL: vertices with
+ * identical positions are merged and triangles that then repeat a vertex
+ * dropped, with or without `weld` (a file whose coordinates within FLT_MIN
+ * of each other make that merge ambiguous is refused); an ascii STL must
+ * end with "endsolid" (else it may have been cut between two facets), and
+ * a solid whose name contains "outer" is refused (STL readers take that
+ * line for the start of a facet).
  *
  * Errors: vb_result; messages name the file and the problem ("x.obj: line
  * 12: face index 40 out of range (30 vertices)", "x.ply: empty mesh").
@@ -88,12 +94,11 @@
  * produce a mesh write *out only on success. Input meshes may have
  * normals == NULL (treated as undefined normals).
  *
- * Threading: no shared state in this module; calls that use OpenMesh
- * (loading a file or bytes, vb_mesh_refine) are serialised by one internal
- * mutex, because OpenMesh's readers and its log streams are process-wide.
- * While such a call runs, std::cerr/clog/cout are redirected into a buffer
- * (OpenMesh's warnings are captured for error messages, never printed);
- * C stdio is not affected.
+ * Threading: no shared state in this module; loading runs concurrently.
+ * vb_mesh_refine calls are serialised by one internal mutex, because
+ * OpenMesh's log streams are process-wide: while one runs,
+ * std::cerr/clog/cout are redirected (OpenMesh's warnings are discarded,
+ * never printed); C stdio is not affected.
  */
 #ifndef VB_MESH_H
 #define VB_MESH_H
@@ -128,9 +133,9 @@ typedef struct vb_load_desc {
  * vertices are of the file's vertices unless said otherwise. */
 typedef struct vb_mesh_report {
     uint32_t dropped_triangles;  /* repeated a vertex index (no area),
-                                    dropped; OBJ faces OpenMesh drops for
-                                    fewer than 3 distinct vertices count as
-                                    their corners - 2 */
+                                    dropped; OBJ faces with fewer than 3
+                                    distinct vertices count as their
+                                    corners - 2 */
     uint32_t removed_vertices;   /* used by no remaining triangle */
     uint32_t split_vertices;     /* split at creases (corner normals) */
     uint32_t split_added;        /* vertices those splits added */
@@ -175,11 +180,7 @@ vb_result vb_mesh_load(const char *path, const vb_load_desc *desc,
  * bytes: it appears in messages and its extension (.obj/.ply/.off/.stl,
  * case-insensitive) picks the format; nothing is opened by that name and
  * "builtin:" names are refused. `data` is borrowed (may be NULL when size
- * is 0); `info` may be NULL. OFF only: OpenMesh's OFF reader takes its
- * options (binary, normals) from the header only when it opens a file
- * itself, so the bytes are written to a temporary file (mkstemps in
- * $TMPDIR, else /tmp), read from there and removed; VB_ERR_IO if that
- * file cannot be written. */
+ * is 0); `info` may be NULL. Nothing is written anywhere. */
 vb_result vb_mesh_load_memory(const void *data, size_t size, const char *name,
                               const vb_load_desc *desc, vb_mesh *out,
                               vb_source_info *info, vb_error *err);
@@ -261,45 +262,9 @@ void vb_mesh_bounds(const vb_mesh *m, float min[3], float max[3]);
 
 void vb_mesh_free(vb_mesh *m);
 
-/* SHA-256 of a byte buffer (used for source hashes). */
+/* SHA-256 of a byte buffer (used for source hashes): nettle's. `data`
+ * may be NULL when size is 0. */
 void vb_sha256(const void *data, size_t size, uint8_t out[32]);
-
-/* ---- Internal: between mesh.c and mesh_openmesh.cpp only. ------------ */
-
-typedef enum vb_mesh_format {
-    VB_MESH_OBJ,
-    VB_MESH_PLY,
-    VB_MESH_OFF,
-    VB_MESH_STL
-} vb_mesh_format;
-
-/* A file as OpenMesh read it, before validation and cleaning: polygons
- * fan-triangulated, indices exactly as read (possibly out of range), file
- * normals per vertex (one given normal as is, several: their unit
- * average) and, for OBJ, per triangle corner (as given). All arrays are
- * malloc'ed; vb_mesh_raw_free() frees them. */
-typedef struct vb_mesh_raw {
-    uint32_t vertex_count;
-    uint32_t triangle_count;
-    float *positions;      /* 3 * vertex_count */
-    float *normals;        /* 3 * vertex_count or NULL (file has none) */
-    uint8_t *has_normal;   /* vertex_count or NULL: file gave a normal */
-    int64_t *indices;      /* 3 * triangle_count */
-    uint32_t *faces;       /* triangle_count: 0-based polygon in the file */
-    float *corner_normals; /* 9 * triangle_count or NULL (none given) */
-    uint8_t *corner_given; /* 3 * triangle_count or NULL: corner has one */
-    uint32_t dropped_triangles; /* the reader dropped (see vb_mesh_report) */
-} vb_mesh_raw;
-
-/* Check `bytes` (the whole file) and read them with OpenMesh; `name` is
- * for messages. OFF: OpenMesh reads `file` (the file the bytes came from),
- * or a temporary copy of the bytes when `file` is NULL. */
-vb_result vb_mesh_read_openmesh(const char *name, const char *file,
-                                vb_mesh_format format,
-                                const uint8_t *bytes, size_t size,
-                                vb_mesh_raw *out, vb_error *err);
-
-void vb_mesh_raw_free(vb_mesh_raw *raw);
 
 #ifdef __cplusplus
 }

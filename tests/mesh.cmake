@@ -1,6 +1,7 @@
 # Mesh input (bake/mesh.h): loading, validation, welding, normals, the
 # built-in room and its variants, refinement, OBJ output, SHA-256.
 #   mesh_unit    no data needed: fixtures are written to a temporary folder
+#   mesh_parse   the readers alone, on bytes in memory
 #   mesh_scenes  the real scenes in VDSH_SHARED_SCENES (skips when absent)
 #   mesh_assimp  Debian's assimp-testmodels in VDSH_ASSIMP_MODELS, including
 #                the malformed files (skips when absent)
@@ -14,6 +15,12 @@ add_test(NAME mesh_unit COMMAND test_mesh unit ${CMAKE_CURRENT_BINARY_DIR})
 add_test(NAME mesh_scenes COMMAND test_mesh scenes ${VDSH_SHARED_SCENES})
 add_test(NAME mesh_assimp COMMAND test_mesh assimp ${VDSH_ASSIMP_MODELS})
 set_tests_properties(mesh_scenes mesh_assimp PROPERTIES SKIP_RETURN_CODE 77)
+
+# The strict readers (bake/mesh_parse.h) on bytes: the values bakes depend
+# on, and the files OpenMesh's readers misread that are now refused.
+add_executable(test_mesh_parse ${CMAKE_CURRENT_LIST_DIR}/test_mesh_parse.c)
+target_link_libraries(test_mesh_parse PRIVATE vb_mesh m)
+add_test(NAME mesh_parse COMMAND test_mesh_parse)
 
 # What loading found, on vdsh-bake's stderr (and -q, and vdsh-eval quiet).
 add_test(NAME mesh_report_cli

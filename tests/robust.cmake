@@ -22,7 +22,8 @@
 # Fuzz targets (one LLVMFuzzerTestOneInput each):
 #   vdsh       formats/vdsh.c reader (tests/test_format_fuzz.c)
 #   mesh_obj, mesh_ply, mesh_off, mesh_stl
-#              vb_mesh_load_memory of one format (tests/test_fuzz_mesh.c)
+#              vb_mesh_parse and vb_mesh_load_memory of one format
+#              (tests/test_fuzz_mesh.c)
 #   cubemap    vb_cubemap_read of the basis EXR files (test_fuzz_cubemap.c)
 # With -DVDSH_FUZZ=ON (clang only, together with -DVDSH_SANITIZE=ON) each
 # is also built as a libFuzzer binary fuzz_<target>; scripts/fuzz TARGET

@@ -1,7 +1,8 @@
 /*
- * test_fuzz_mesh.c - fuzz target for mesh loading (bake/mesh.h) from
- * memory: the strict pre-pass, OpenMesh's reader behind it and the
- * cleaning, then welding and refinement of whatever was accepted.
+ * test_fuzz_mesh.c - fuzz target for mesh input: the strict readers
+ * (bake/mesh_parse.h, vb_mesh_parse) on their own, then loading from
+ * memory (bake/mesh.h: the same readers and the cleaning), then welding
+ * and refinement (OpenMesh) of whatever was accepted.
  *
  * One source, one binary per format: VDSH_FUZZ_EXT ("obj", "ply", "off",
  * "stl") names the bytes "fuzz.<ext>", which picks the format, so each
@@ -11,10 +12,13 @@
  * VDSH_FUZZ=ON (scripts/fuzz mesh_obj 600).
  *
  * Properties checked beyond "no crash, no leak, no sanitizer report":
- * a rejection names the input, and an accepted mesh is as clean as
- * mesh.h promises, also after welding and refinement.
+ * a rejection names the input; the readers' arrays are what mesh_parse.h
+ * says (consistent counts, finite positions, unit or zero normals where
+ * given) and loading accepts exactly what they accept; an accepted mesh is
+ * as clean as mesh.h promises, also after welding and refinement.
  */
 #include "mesh.h"
+#include "mesh_parse.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -56,14 +60,58 @@ static void check_clean(const vb_mesh *m)
     }
 }
 
+static vb_mesh_format format_of_name(void)
+{
+    static const char *const ext[4] = {"obj", "ply", "off", "stl"};
+    for (int i = 0; i < 4; i++)
+        if (!strcmp(VDSH_FUZZ_EXT, ext[i]))
+            return (vb_mesh_format)i;
+    abort();
+}
+
+/* mesh_parse.h's promise for the readers' arrays. */
+static void check_raw(const vb_mesh_raw *r)
+{
+    REQUIRE(r->positions && r->indices && r->faces, "arrays missing");
+    for (size_t i = 0; i < 3 * (size_t)r->vertex_count; i++)
+        REQUIRE(isfinite(r->positions[i]), "non-finite position");
+    REQUIRE((r->normals == NULL) == (r->has_normal == NULL), "normals without has_normal or the reverse");
+    for (uint32_t i = 0; r->normals && i < r->vertex_count; i++) {
+        const float *n = r->normals + 3 * (size_t)i;
+        double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        REQUIRE(r->has_normal[i] <= 1 && isfinite(len), "bad file normal");
+        REQUIRE(len == 0.0 || fabs(len - 1.0) < 1e-3, "file normal neither unit nor zero");
+        REQUIRE(r->has_normal[i] || len == 0.0, "a normal where none was given");
+    }
+    REQUIRE((r->corner_normals == NULL) == (r->corner_given == NULL), "corner normals without flags");
+    for (size_t c = 0; r->corner_normals && c < 3 * (size_t)r->triangle_count; c++)
+        for (int k = 0; k < 3; k++)
+            REQUIRE(isfinite(r->corner_normals[3 * c + (size_t)k]), "non-finite corner normal");
+    for (size_t t = 0; t < r->triangle_count; t++) {
+        REQUIRE(t == 0 || r->faces[t] >= r->faces[t - 1], "faces out of order");
+        for (int k = 0; k < 3; k++)
+            REQUIRE(r->indices[3 * t + (size_t)k] >= 0 && r->indices[3 * t + (size_t)k] < (int64_t)r->vertex_count,
+                    "raw index out of range");
+    }
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     vb_mesh m = {0}, fine = {0};
     vb_error err;
+    vb_mesh_raw raw;
+    memset(&raw, 0, sizeof raw);
+    int parsed = size > 0 && vb_mesh_parse(NAME, format_of_name(), data, size, &raw, &err) == VB_OK;
+    if (parsed)
+        check_raw(&raw);
+    else if (size > 0)
+        REQUIRE(strncmp(err.msg, NAME ":", strlen(NAME ":")) == 0, "reader's message does not name the input");
+    vb_mesh_raw_free(&raw);
     if (vb_mesh_load_memory(data, size, NAME, NULL, &m, NULL, &err) != VB_OK) {
         REQUIRE(strncmp(err.msg, NAME ":", strlen(NAME ":")) == 0, "message does not name the input");
         return 0;
     }
+    REQUIRE(parsed, "loading accepted what the reader refused");
     check_clean(&m);
     /* Refinement to a quarter of the diagonal: a bounded amount of work
      * whatever the scale, on a mesh that may be anything but clean in
