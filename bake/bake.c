@@ -32,21 +32,21 @@ typedef struct job {
     const vb_dirgrid *grid;
     const float *origins;  /* per receiver, traced frame */
     const float *near;     /* per receiver: ~0 distance, scene units */
-    float *coeffs[VDSH_MAX_ORDER + 1];
-    uint32_t quantity[VDSH_MAX_ORDER + 1]; /* per order: what coeffs hold */
-    vb_fit fits[VDSH_MAX_ORDER + 1];
+    float *coeffs[VDSH_ORDER_SLOTS];
+    uint32_t quantity[VDSH_ORDER_SLOTS]; /* per order: what coeffs hold */
+    vb_fit fits[VDSH_ORDER_SLOTS];
     int order;             /* the projection's order (the highest asked) */
     float log_floor;
     float max_local;       /* max distance in the traced frame */
     float inv_scale;
     int horizon;           /* paper: skip w.n < 0 */
     /* Method shadow: per order, added to the fitted ln d (through c0). */
-    float log_offset[VDSH_MAX_ORDER + 1];
+    float log_offset[VDSH_ORDER_SLOTS];
     double *error_table;   /* e(r), the quantity choice's score (VB_ERROR_TABLE + 1) */
     /* The quantity choice (VB_QUANTITY_AUTO): sampled receivers, and per
      * sample, order and quantity (0 distance, 1 log) its estimated error. */
     uint32_t choose_count;
-    double *choose_error;  /* choose_count * (VDSH_MAX_ORDER + 1) * 2 */
+    double *choose_error;  /* choose_count * (VDSH_ORDER_SLOTS) * 2 */
     float *choose_coeffs;  /* per sample, quantity and order: its fit */
     uint8_t *done;         /* receivers the choice baked already (or NULL) */
     _Atomic uint64_t traced, missed;
@@ -58,7 +58,7 @@ typedef struct job {
  * order, its coefficients or NULL; and, when `n` is not NULL, the traced
  * directions above its horizon with their distances (scene units). */
 typedef struct vertex_sink {
-    float *coeffs[2][VDSH_MAX_ORDER + 1];
+    float *coeffs[2][VDSH_ORDER_SLOTS];
     float *x, *y, *z, *t;
     uint32_t *n;
 } vertex_sink;
@@ -306,14 +306,16 @@ static double expected_error(const double *e, double r)
 float vb_shadow_log_offset(int order)
 {
     /* Chosen on the validation scenes by frames (docs/ACCURACY.md). */
-    static const float table[VDSH_MAX_ORDER + 1] = {0.0f, 1.6f, 1.6f, 1.1f, 0.9f, 0.8f};
+    static const float table[] = {0.0f, 1.6f, 1.6f, 1.1f, 0.9f, 0.8f};
+    _Static_assert(sizeof table / sizeof table[0] == VDSH_ORDER_SLOTS,
+                   "one log offset per order");
     return order >= 1 && order <= VDSH_MAX_ORDER ? table[order] : 0.0f;
 }
 
 /* ---- choosing the quantity (VB_QUANTITY_AUTO) --------------------------- */
 
 #define CHOOSE_RECEIVERS 1024
-#define CHOOSE_STRIDE (1 + 4 + 9 + 16 + 25) /* coefficients of orders 1..5 */
+#define CHOOSE_STRIDE VDSH_COEFFS_THROUGH(VDSH_MAX_ORDER) /* coefficients of orders 1..max */
 
 /* Where order o starts among one sample's coefficients of one quantity. */
 static size_t choose_offset(int o)
@@ -326,14 +328,14 @@ static size_t choose_offset(int o)
  * A pass per fit over all directions, so that the sums vectorise: each
  * is still accumulated in the same order as one direction at a time
  * would, so the scores keep their bits. Scratch: `basis` holds
- * 25 * grid count floats, `t` and `s` grid count doubles each. */
+ * VDSH_MAX_COEFFS * grid count floats, `t` and `s` grid count doubles each. */
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
     !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("avx2", "default")))
 #endif
 static void score_fits(const job *J, uint32_t count, const vertex_sink *out,
-                       float c[2][VDSH_MAX_ORDER + 1][VDSH_MAX_COEFFS], float *basis,
-                       double *t, double *s, double e[VDSH_MAX_ORDER + 1][2])
+                       float c[2][VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS], float *basis,
+                       double *t, double *s, double e[VDSH_ORDER_SLOTS][2])
 {
     const uint32_t cap = J->grid->count;
     const float tmin = 1e-4f * J->d->max_distance;
@@ -380,7 +382,7 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
     }
     for (uint32_t i = begin; i < end && buf; i++) {
         uint32_t v = (uint32_t)((uint64_t)i * nrec / J->choose_count), count = 0;
-        float c[2][VDSH_MAX_ORDER + 1][VDSH_MAX_COEFFS];
+        float c[2][VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS];
         vertex_sink out = {.x = buf, .y = buf + cap, .z = buf + 2 * cap, .t = buf + 3 * cap,
                            .n = &count};
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
@@ -393,17 +395,17 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
                 if (J->coeffs[o])
                     memcpy(keep + q * CHOOSE_STRIDE + choose_offset(o), c[q][o],
                            (size_t)o * o * sizeof(float));
-        double e[VDSH_MAX_ORDER + 1][2] = {{0}};
+        double e[VDSH_ORDER_SLOTS][2] = {{0}};
         score_fits(J, count, &out, c, buf + 4 * (size_t)cap, sums, sums + cap, e);
-        double *dst = J->choose_error + (size_t)i * (VDSH_MAX_ORDER + 1) * 2;
+        double *dst = J->choose_error + (size_t)i * (VDSH_ORDER_SLOTS) * 2;
         for (int o = 0; o <= VDSH_MAX_ORDER; o++)
             for (int q = 0; q < 2; q++)
                 dst[2 * o + q] = count ? e[o][q] / count : 0.0;
     }
     if (!buf) /* out of memory: no vote from these receivers */
         for (uint32_t i = begin; i < end; i++)
-            memset(J->choose_error + (size_t)i * (VDSH_MAX_ORDER + 1) * 2, 0,
-                   (VDSH_MAX_ORDER + 1) * 2 * sizeof(double));
+            memset(J->choose_error + (size_t)i * (VDSH_ORDER_SLOTS) * 2, 0,
+                   (VDSH_ORDER_SLOTS) * 2 * sizeof(double));
     else /* their coefficients are kept: the main pass skips them */
         for (uint32_t i = begin; i < end; i++)
             J->done[(uint64_t)i * nrec / J->choose_count] = 1;
@@ -605,7 +607,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         return r;
     float *origins = malloc((size_t)R->vertex_count * 3 * sizeof *origins);
     float *near = malloc((size_t)R->vertex_count * sizeof *near + 1);
-    float *coeffs[VDSH_MAX_ORDER + 1] = {0};
+    float *coeffs[VDSH_ORDER_SLOTS] = {0};
     int missing = 0;
     for (int o = 1; o <= VDSH_MAX_ORDER && !d.trace_only; o++)
         if (d.order_mask & (1u << o))
@@ -661,7 +663,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     }
 
     double t0 = vb_now();
-    double auto_error[VDSH_MAX_ORDER + 1][2] = {{0}};
+    double auto_error[VDSH_ORDER_SLOTS][2] = {{0}};
     uint32_t auto_receivers = 0;
     if (d.quantity == VB_QUANTITY_AUTO && !d.trace_only) {
         /* Per order, the quantity whose fits reconstruct the traced
@@ -670,7 +672,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
          * depend on the thread count. */
         auto_receivers = J->choose_count =
             R->vertex_count < CHOOSE_RECEIVERS ? R->vertex_count : CHOOSE_RECEIVERS;
-        J->choose_error = calloc((size_t)J->choose_count * (VDSH_MAX_ORDER + 1) * 2,
+        J->choose_error = calloc((size_t)J->choose_count * (VDSH_ORDER_SLOTS) * 2,
                                  sizeof(double));
         J->choose_coeffs = malloc((size_t)J->choose_count * 2 * CHOOSE_STRIDE * sizeof(float));
         J->done = calloc(R->vertex_count, 1);
@@ -686,7 +688,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             for (int o = 1; o <= VDSH_MAX_ORDER; o++)
                 for (int q = 0; q < 2; q++)
                     auto_error[o][q] +=
-                        J->choose_error[((size_t)i * (VDSH_MAX_ORDER + 1) + o) * 2 + q];
+                        J->choose_error[((size_t)i * (VDSH_ORDER_SLOTS) + o) * 2 + q];
         for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
             auto_error[o][0] /= J->choose_count;
             auto_error[o][1] /= J->choose_count;

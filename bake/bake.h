@@ -98,18 +98,18 @@ typedef struct vb_bake_desc {
 typedef struct vb_bake_output {
     int max_order;
     uint32_t method;           /* vdsh_method used */
-    uint32_t quantity[VDSH_MAX_ORDER + 1]; /* per order: vdsh_quantity stored */
+    uint32_t quantity[VDSH_ORDER_SLOTS]; /* per order: vdsh_quantity stored */
     uint32_t auto_receivers;   /* VB_QUANTITY_AUTO: receivers sampled (else 0) */
-    double auto_error[VDSH_MAX_ORDER + 1][2]; /* their expected shadow error
+    double auto_error[VDSH_ORDER_SLOTS][2]; /* their expected shadow error
                                 * per order, distance [0] and log [1] */
     float lambda;              /* lsq or shadow regularisation used (0 otherwise) */
-    float log_offset[VDSH_MAX_ORDER + 1]; /* method shadow: per order, as used */
+    float log_offset[VDSH_ORDER_SLOTS]; /* method shadow: per order, as used */
     float log_floor;           /* log-distance floor used (0 otherwise) */
     uint32_t window;           /* vdsh_window applied */
     uint32_t vertex_count;
-    /* Per order n (1..5): vertex_count * n^2 coefficients, vertex-major, or
+    /* Per order n (1..VDSH_MAX_ORDER): vertex_count * n^2 coefficients, vertex-major, or
      * NULL where the order was not asked for (and with trace_only). */
-    float *coeffs[VDSH_MAX_ORDER + 1];
+    float *coeffs[VDSH_ORDER_SLOTS];
     uint32_t rays;             /* directions per receiver actually used */
     int hemisphere;            /* sampling domain: 0 sphere, 1 hemisphere */
     float max_distance;        /* the clamp used, scene units */

@@ -24,7 +24,7 @@ static void eval_d(int order, const double d[3], double *y)
         y[i] = yy[i];
 }
 
-/* Gauss-Jordan inverse with partial pivoting of an n x n matrix (n <= 25).
+/* Gauss-Jordan inverse with partial pivoting of an n x n matrix (n <= VB_FIT_MAX).
  * Returns 0 if singular. */
 static int invert(int n, const double *a, double *inv)
 {
@@ -109,8 +109,9 @@ double vb_window_weight(uint32_t window, int l, int order)
 vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
                         vb_error *err)
 {
-    if (order < 1 || order > 5)
-        return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..5, not %d", order);
+    if (order < 1 || order > VDSH_MAX_ORDER)
+        return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..%d, not %d", VDSH_MAX_ORDER,
+                       order);
     if (!(lambda >= 0.0f) || !isfinite(lambda))
         return vb_fail(err, VB_ERR_ARGUMENT, "regularisation must be a number >= 0");
     vb_fit f;
@@ -182,7 +183,8 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
         eval_d(order, f.rot_dirs[j], Y[j]);
     for (int l = 0; l < order; l++) {
         int k = 2 * l + 1, o = l * l;
-        double BBt[9 * 9], inv[9 * 9];
+        double BBt[VDSH_MAX_BAND_WIDTH * VDSH_MAX_BAND_WIDTH];
+        double inv[VDSH_MAX_BAND_WIDTH * VDSH_MAX_BAND_WIDTH];
         for (int a = 0; a < k; a++)
             for (int b = 0; b < k; b++) {
                 double s = 0.0;
@@ -259,7 +261,7 @@ void vb_sh_rotation(const vb_fit *f, const double R[9], double *out)
         int k = 2 * l + 1, o = l * l;
         const double *pinv = f->rot_pinv[l];
         for (int a = 0; a < k; a++) { /* row a of S_l^T, all columns at once */
-            double s[9] = {0};        /* each sums over j in order: it vectorises over b */
+            double s[VDSH_MAX_BAND_WIDTH] = {0}; /* each sums over j in order: it vectorises over b */
             for (int j = 0; j < VB_FIT_ROT_DIRS; j++) {
                 double y = yr[j][o + a];
                 for (int b = 0; b < k; b++)
@@ -283,7 +285,7 @@ void vb_fit_frame(const vb_fit *f, const float n[3], vb_fit_angles *a)
     double ca = r > 0.0 ? x / r : 1.0, sa = r > 0.0 ? y / r : 0.0;
     double cb = z / len, sb = r / len;
     a->ca[0] = a->cb[0] = 1.0;
-    for (int m = 1; m < 5; m++) {
+    for (int m = 1; m < VDSH_MAX_ORDER; m++) {
         a->ca[m] = a->ca[m - 1] * ca - a->sa[m - 1] * sa;
         a->sa[m] = a->sa[m - 1] * ca + a->ca[m - 1] * sa;
         a->cb[m] = a->cb[m - 1] * cb - a->sb[m - 1] * sb;
@@ -315,7 +317,7 @@ static inline void rotate_x(const vb_fit *f, int order, int transpose, double *v
     for (int l = 1; l < order; l++) {
         int k = 2 * l + 1, o = l * l;
         const double *cols = transpose ? f->X[l] : f->XT[l];
-        double in[9], *out = v + o;
+        double in[VDSH_MAX_BAND_WIDTH], *out = v + o;
         memcpy(in, out, (size_t)k * sizeof *in);
         for (int i = 0; i < k; i++)
             out[i] = 0.0;

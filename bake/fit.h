@@ -37,12 +37,13 @@
 #include <stdint.h>
 
 #include "vb.h"
+#include "vdsh.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#define VB_FIT_MAX 25
+#define VB_FIT_MAX VDSH_MAX_COEFFS
 #define VB_FIT_ROT_DIRS 36
 
 typedef struct vb_fit {
@@ -53,12 +54,13 @@ typedef struct vb_fit {
     double M[VB_FIT_MAX * VB_FIT_MAX];  /* local-frame map, order^2 square */
     double NT[VB_FIT_MAX * VB_FIT_MAX]; /* N = X M X^T, order^2 square,
                                        * column-major */
-    double X[5][9 * 9];               /* per band l: the (2l+1)^2 block of X */
-    double XT[5][9 * 9];              /* and its transpose */
+    /* per band l: the (2l+1)^2 block of X, and its transpose */
+    double X[VDSH_MAX_ORDER][VDSH_MAX_BAND_WIDTH * VDSH_MAX_BAND_WIDTH];
+    double XT[VDSH_MAX_ORDER][VDSH_MAX_BAND_WIDTH * VDSH_MAX_BAND_WIDTH];
     /* Rotations: sample directions and, per band l, the pseudo-inverse of
      * the (2l+1) x VB_FIT_ROT_DIRS basis block at them. */
     double rot_dirs[VB_FIT_ROT_DIRS][3];
-    double rot_pinv[5][VB_FIT_ROT_DIRS * 9];
+    double rot_pinv[VDSH_MAX_ORDER][VB_FIT_ROT_DIRS * VDSH_MAX_BAND_WIDTH];
 } vb_fit;
 
 /* Gauss-Legendre nodes and weights on [-1, 1]. */
@@ -93,8 +95,9 @@ void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c);
  * the same method and any order >= f->order. */
 typedef struct vb_fit_angles {
     int rotates;
-    double ca[5], sa[5];  /* cos, sin of m alpha, m = 0..4 */
-    double cb[5], sb[5];  /* cos, sin of m beta */
+    /* cos, sin of m alpha and of m beta, m = 0..VDSH_MAX_ORDER - 1 */
+    double ca[VDSH_MAX_ORDER], sa[VDSH_MAX_ORDER];
+    double cb[VDSH_MAX_ORDER], sb[VDSH_MAX_ORDER];
 } vb_fit_angles;
 
 void vb_fit_frame(const vb_fit *f, const float n[3], vb_fit_angles *a);

@@ -162,7 +162,7 @@ static int parse_orders(const char *s, options *o)
 {
     uint64_t v[VDSH_MAX_ORDER];
     int n = vt_parse_u64_list(s, 1, VDSH_MAX_ORDER, v, 1, VDSH_MAX_ORDER);
-    int seen[VDSH_MAX_ORDER + 1] = {0};
+    int seen[VDSH_ORDER_SLOTS] = {0};
     for (int i = 0; i < n; i++) {
         if (seen[v[i]])
             return 0;
@@ -632,7 +632,7 @@ int main(int argc, char **argv)
     for (int s = 0; s < o.order_count; s++)
         order_mask |= 1u << o.orders[s];
     progress pr = {.enabled = log && isatty(STDERR_FILENO), .t0 = vb_now()};
-    float offsets[VDSH_MAX_ORDER + 1];
+    float offsets[VDSH_ORDER_SLOTS];
     for (int k = 0; k <= VDSH_MAX_ORDER; k++)
         offsets[k] = o.log_offset;
     vb_bake_desc bd = {

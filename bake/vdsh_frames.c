@@ -491,7 +491,7 @@ static int cmd_truth(int argc, char **argv)
     uint8_t *rgba = malloc(4 * n);
     vb_error err;
     /* One c-vdshN per order: the first stream of each. */
-    int use[VDSH_MAX_STREAMS] = {0}, seen[VDSH_MAX_ORDER + 1] = {0};
+    int use[VDSH_MAX_STREAMS] = {0}, seen[VDSH_ORDER_SLOTS] = {0};
     for (uint32_t s = 0; s < f->stream_count; s++) {
         uint32_t o = f->streams[s].order;
         if (o <= VDSH_MAX_ORDER && !seen[o]) {
