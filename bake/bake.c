@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "fit.h"
+#include "method.h"
 #include "origins.h"
 #include "parallel.h"
 #include "sampling.h"
@@ -273,7 +274,7 @@ static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
 
 #define ERROR_TABLE 1024 /* e(r) tabulated on r in [0, 2] */
 
-/* e(r): the mean over lights at d_L = 2u d, u uniform in (0.05, 1], of
+/* e(r): the mean over lights at d_L = 2u d (vdsh_light_u), of
  * |ramp(r / 2u) - ramp(1 / 2u)| - the expected shadow error of a direction
  * reconstructed at r times its true distance under vdsh-eval's relative
  * lights (flat from r = 2 on). By the mean over 512 u at the midpoints. */
@@ -283,7 +284,7 @@ static double *error_table_create(void)
     for (int i = 0; e && i <= ERROR_TABLE; i++) {
         double r = 2.0 * i / ERROR_TABLE, sum = 0.0;
         for (int k = 0; k < 512; k++) {
-            double u = 0.05 + 0.95 * (k + 0.5) / 512;
+            double u = vdsh_light_u((k + 0.5) / 512);
             sum += fabs((double)vdsh_ramp((float)(r / (2.0 * u))) -
                         (double)vdsh_ramp((float)(1.0 / (2.0 * u))));
         }
@@ -305,10 +306,7 @@ static double expected_error(const double *e, double r)
 
 float vb_shadow_log_offset(int order)
 {
-    /* Chosen on the validation scenes by frames (docs/ACCURACY.md). */
-    static const float table[] = {0.0f, 1.6f, 1.6f, 1.1f, 0.9f, 0.8f};
-    _Static_assert(sizeof table / sizeof table[0] == VDSH_ORDER_SLOTS,
-                   "one log offset per order");
+    const float *table = vb_method_get(VDSH_METHOD_SHADOW)->default_log_offset;
     return order >= 1 && order <= VDSH_MAX_ORDER ? table[order] : 0.0f;
 }
 
@@ -465,12 +463,15 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
         return vb_fail(err, VB_ERR_ARGUMENT, "order %d is not in the bake", order);
     if (encoding != VDSH_ENCODING_F16 && encoding != VDSH_ENCODING_F32)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown encoding %u", encoding);
+    const vb_method_info *mi = vb_method_get(b->method);
+    if (!mi)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", b->method);
     int nc = order * order;
     size_t count = (size_t)b->vertex_count * nc;
     vdsh_stream s = {.order = (uint32_t)order, .encoding = encoding, .method = b->method,
                      .quantity = b->quantity[order],
-                     .method_param = b->method == VDSH_METHOD_SHADOW ? b->log_offset[order]
-                                                                     : b->lambda,
+                     .method_param = mi->param == VB_PARAM_LOG_OFFSET ? b->log_offset[order]
+                                                                      : b->lambda,
                      .scale = 1.0f,
                      .quantity_param = b->quantity[order] == VDSH_QUANTITY_LOG_DISTANCE
                                            ? b->log_floor : 0.0f, .window = b->window,
@@ -549,28 +550,23 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     if (d.order_mask >> (d.max_order + 1))
         return vb_fail(err, VB_ERR_ARGUMENT, "an order above max_order %d was asked for",
                        d.max_order);
-    if (d.method > VDSH_METHOD_SHADOW)
+    const vb_method_info *mi = vb_method_get(d.method);
+    if (!mi)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", d.method);
     if (d.window > VDSH_WINDOW_LANCZOS)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown window %u", d.window);
-    if (d.method == VDSH_METHOD_SHADOW) {
-        if (d.quantity == VDSH_QUANTITY_DISTANCE)
-            return vb_fail(err, VB_ERR_ARGUMENT,
-                           "method shadow fits the log distance: use --quantity log or auto");
-        d.quantity = VDSH_QUANTITY_LOG_DISTANCE; /* the only one shadow has */
-    }
-    if (d.quantity == VB_QUANTITY_AUTO && d.method == VDSH_METHOD_PAPER)
-        d.quantity = VDSH_QUANTITY_DISTANCE; /* the only one paper has */
+    /* The quantity: what the method allows; auto is its only one, if it
+     * has one, or the per-order choice below. */
+    if (d.quantity == VB_QUANTITY_AUTO && (mi->quantities & (mi->quantities - 1)) == 0)
+        d.quantity = (uint32_t)__builtin_ctz(mi->quantities);
     if (d.quantity != VDSH_QUANTITY_DISTANCE && d.quantity != VDSH_QUANTITY_LOG_DISTANCE &&
         d.quantity != VB_QUANTITY_AUTO)
         return vb_fail(err, VB_ERR_ARGUMENT, "the bake stores distance or log-distance, not %s",
                        vdsh_quantity_name(d.quantity));
-    if (d.quantity == VDSH_QUANTITY_LOG_DISTANCE && d.method == VDSH_METHOD_PAPER)
-        return vb_fail(err, VB_ERR_ARGUMENT,
-                       "method paper fills the lower hemisphere with 0, which has no "
-                       "meaning for log-distance: use mirror, lsq or full");
+    if (d.quantity != VB_QUANTITY_AUTO && !(mi->quantities & VB_QUANTITY_BIT(d.quantity)))
+        return vb_fail(err, VB_ERR_ARGUMENT, "%s", mi->refused[d.quantity]);
     if (d.lambda == 0.0f)
-        d.lambda = 1e-4f; /* lsq and shadow: chosen on the validation split (docs/ACCURACY.md) */
+        d.lambda = VB_DEFAULT_LAMBDA;
     if (!(d.lambda > 0.0f) || !isfinite(d.lambda))
         return vb_fail(err, VB_ERR_ARGUMENT, "the regularisation must be a positive number");
     if (d.max_distance == 0.0f)
@@ -595,11 +591,10 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             return vb_fail(err, VB_ERR_INVALID,
                            "receiver triangle %zu: index %u out of range (%u vertices)", i / 3,
                            R->indices[i], R->vertex_count);
-    /* The sampling domain: the whole sphere for paper (the horizon culls
-     * half of it) and full; the hemisphere above each receiver, with half
-     * the directions (the same traced budget), for the hemisphere fits. */
-    int hemisphere = d.method == VDSH_METHOD_MIRROR || d.method == VDSH_METHOD_LSQ ||
-                     d.method == VDSH_METHOD_SHADOW;
+    /* The sampling domain (the method's row): the whole sphere (paper's
+     * horizon culls half of it), or the hemisphere above each receiver,
+     * with half the directions (the same traced budget). */
+    int hemisphere = mi->hemisphere;
     vb_dirgrid grid = {0};
     vb_result r = vb_dirgrid_create(hemisphere ? (d.rays + 1) / 2 : d.rays, hemisphere,
                                     &grid, err);
@@ -621,9 +616,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!coeffs[o] && o != d.max_order) /* the top one rotates for all */
             continue;
-        /* shadow starts from the lsq fit */
-        uint32_t fm = d.method == VDSH_METHOD_SHADOW ? VDSH_METHOD_LSQ : d.method;
-        if ((r = vb_fit_create(o, fm, d.lambda, &J->fits[o], err)) != VB_OK)
+        if ((r = vb_fit_create(o, d.method, d.lambda, &J->fits[o], err)) != VB_OK)
             goto done;
         vb_fit_window(&J->fits[o], d.window);
     }
@@ -641,10 +634,10 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     J->log_floor = d.log_floor;
     J->max_local = d.max_distance * d.scene->scale;
     J->inv_scale = 1.0f / d.scene->scale;
-    J->horizon = d.method == VDSH_METHOD_PAPER;
-    /* Method shadow: the per-order log offsets. */
-    for (int o = 1; o <= VDSH_MAX_ORDER && d.method == VDSH_METHOD_SHADOW; o++) {
-        J->log_offset[o] = d.log_offsets ? d.log_offsets[o] : vb_shadow_log_offset(o);
+    J->horizon = mi->horizon;
+    /* The per-order log offsets, for the methods that have them. */
+    for (int o = 1; o <= VDSH_MAX_ORDER && mi->param == VB_PARAM_LOG_OFFSET; o++) {
+        J->log_offset[o] = d.log_offsets ? d.log_offsets[o] : mi->default_log_offset[o];
         if (!isfinite(J->log_offset[o]) || fabsf(J->log_offset[o]) > 5.0f) {
             r = vb_fail(err, VB_ERR_ARGUMENT, "order %d: log offset %g is not in -5..5", o,
                         (double)J->log_offset[o]);
@@ -727,7 +720,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     }
     o.auto_receivers = auto_receivers;
     memcpy(o.auto_error, auto_error, sizeof auto_error);
-    o.lambda = d.method == VDSH_METHOD_LSQ || d.method == VDSH_METHOD_SHADOW ? d.lambda : 0.0f;
+    o.lambda = mi->regularised ? d.lambda : 0.0f;
     memcpy(o.log_offset, J->log_offset, sizeof o.log_offset);
     o.log_floor = any_log ? d.log_floor : 0.0f;
     o.window = d.window;

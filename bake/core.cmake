@@ -1,5 +1,5 @@
 # The bake core and the command-line tools (included from bake/CMakeLists.txt).
-add_library(vb_core STATIC sampling.c scene.c origins.c bake.c fit.c parallel.c)
+add_library(vb_core STATIC sampling.c scene.c origins.c bake.c fit.c method.c parallel.c)
 target_link_libraries(vb_core PUBLIC vb_mesh vdsh_format embree Threads::Threads m)
 add_executable(vdsh-bake vdsh_bake.c)
 target_link_libraries(vdsh-bake PRIVATE vb_core vb_cubemap vt_tools)

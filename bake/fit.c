@@ -112,24 +112,27 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
     if (order < 1 || order > VDSH_MAX_ORDER)
         return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..%d, not %d", VDSH_MAX_ORDER,
                        order);
+    const vb_method_info *info = vb_method_get(method);
+    if (!info)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", method);
     if (!(lambda >= 0.0f) || !isfinite(lambda))
         return vb_fail(err, VB_ERR_ARGUMENT, "regularisation must be a number >= 0");
     vb_fit f;
     memset(&f, 0, sizeof f);
     f.order = order;
     f.method = method;
+    f.base = info->fit;
     f.lambda = lambda;
     int n = order * order;
     for (int i = 0; i < n; i++)
         f.window[i] = 1.0;
 
-    switch (method) {
-    case VDSH_METHOD_PAPER:
-    case VDSH_METHOD_FULL:
+    switch (info->fit) {
+    case VB_FIT_IDENTITY:
         for (int i = 0; i < n; i++)
             f.M[i * n + i] = 1.0;
         break;
-    case VDSH_METHOD_MIRROR:
+    case VB_FIT_MIRROR:
         /* Y_lm(x, y, -z) = (-1)^(l+m) Y_lm(x, y, z): the mirrored lower
          * half doubles the even terms and cancels the odd ones. */
         for (int i = 0; i < n; i++) {
@@ -137,7 +140,7 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
             f.M[i * n + i] = ((l + m) % 2 == 0) ? 2.0 : 0.0;
         }
         break;
-    case VDSH_METHOD_LSQ: {
+    case VB_FIT_LSQ: {
         /* G_ij = integral over z > 0 of Y_i Y_j: Gauss-Legendre in z
          * (exact to degree 31) times 64 azimuths (exact for cos/sin of
          * order < 64); the products here have degree <= 8. */
@@ -164,8 +167,6 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
                            order);
         break;
     }
-    default:
-        return vb_fail(err, VB_ERR_ARGUMENT, "method %u has no hemisphere fit", method);
     }
 
     /* Rotation samples: a Fibonacci sphere, over-determined for every
@@ -277,7 +278,7 @@ void vb_fit_frame(const vb_fit *f, const float n[3], vb_fit_angles *a)
 {
     memset(a, 0, sizeof *a);
     double x = n[0], y = n[1], z = n[2], r = sqrt(x * x + y * y), len = sqrt(r * r + z * z);
-    a->rotates = (f->method == VDSH_METHOD_MIRROR || f->method == VDSH_METHOD_LSQ) && len > 0.0;
+    a->rotates = f->base != VB_FIT_IDENTITY && len > 0.0;
     if (!a->rotates)
         return;
     /* n = (sin beta cos alpha, sin beta sin alpha, cos beta); on the

@@ -10,8 +10,8 @@
  *     c_world = S M S^T b_world
  *
  * S is the SH rotation taking the pole to the normal (vb_sh_rotation). M
- * depends only on the method:
- *   paper      M = I                    zero below the horizon
+ * depends only on the method's base fit (method.h, vb_fit_base):
+ *   identity   M = I                    paper (zero below the horizon), full
  *   mirror     M = I + P                P reflects through the tangent plane,
  *                                       Y_lm(x, y, -z) = (-1)^(l+m) Y_lm
  *   lsq        M = (G + lambda L)^-1    least squares over the hemisphere:
@@ -36,6 +36,7 @@
 
 #include <stdint.h>
 
+#include "method.h"
 #include "vb.h"
 #include "vdsh.h"
 
@@ -49,6 +50,7 @@ extern "C" {
 typedef struct vb_fit {
     int order;                        /* coefficients kept: order^2 */
     uint32_t method;                  /* vdsh_method */
+    vb_fit_base base;                 /* its map (method.h's row) */
     float lambda;                     /* lsq regularisation */
     double window[VB_FIT_MAX];        /* per coefficient: its band's weight */
     double M[VB_FIT_MAX * VB_FIT_MAX];  /* local-frame map, order^2 square */
@@ -66,7 +68,8 @@ typedef struct vb_fit {
 /* Gauss-Legendre nodes and weights on [-1, 1]. */
 void vb_gauss_legendre(int n, double *x, double *w);
 
-/* Prepare the map for (order, method, lambda). The hemisphere Gram matrix
+/* Prepare the map for (order, method, lambda): the method's base fit
+ * (method.h); lambda matters for VB_FIT_LSQ only. The hemisphere Gram matrix
  * is computed by Gauss-Legendre x uniform-azimuth quadrature (exact for
  * these polynomials). */
 vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
@@ -88,7 +91,7 @@ void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c);
 /* vb_fit_apply in two steps, so that fits of several orders for one
  * receiver share the first (the leading bands of the highest order's u
  * are the lower orders' u). vb_fit_frame: the angles of unit normal n,
- * and whether f rotates at all (mirror and lsq with a non-zero normal).
+ * and whether f rotates at all (base fit mirror or lsq, and a non-zero normal).
  * vb_fit_unrotate: u = Rz(-beta) X Rz(-alpha) b over f's bands (u = b
  * if f does not rotate). vb_fit_finish: c = window * (the rest of the
  * product above), from the first order^2 values of a u made by a fit of

@@ -24,6 +24,7 @@
 #include "bake.h"
 #include "cubemap.h"
 #include "mesh.h"
+#include "method.h"
 #include "scene.h"
 #include "vdsh.h"
 #include "vdsh_output.h"
@@ -60,6 +61,48 @@ typedef struct options {
     int quiet;
 } options;
 
+/* --method's help, from the table: each row's name and help, indented,
+ * then which rows trace only the upper half of the directions. */
+static const char *methods_help(void)
+{
+    static char text[4096];
+    int count, at = 0;
+    const vb_method_info *m = vb_methods(&count);
+    for (int i = 0; i < count; i++) {
+        at += snprintf(text + at, sizeof text - (size_t)at, "%26s%s%s: ", "",
+                       vdsh_method_name(m[i].method),
+                       m[i].method == VB_METHOD_DEFAULT ? " (default)" : "");
+        for (const char *p = m[i].help; *p; p++) {
+            at += snprintf(text + at, sizeof text - (size_t)at, "%c", *p);
+            if (*p == '\n')
+                at += snprintf(text + at, sizeof text - (size_t)at, "%26s", "");
+        }
+        at += snprintf(text + at, sizeof text - (size_t)at, "\n");
+    }
+    at += snprintf(text + at, sizeof text - (size_t)at, "%26sAll but", "");
+    int sphere = 0;
+    for (int i = 0; i < count; i++)
+        if (!m[i].hemisphere && !m[i].horizon)
+            at += snprintf(text + at, sizeof text - (size_t)at, "%s%s", sphere++ ? ", " : " ",
+                           vdsh_method_name(m[i].method));
+    snprintf(text + at, sizeof text - (size_t)at,
+             " trace only the upper half\n%26sof the --rays directions\n", "");
+    return text;
+}
+
+/* "shadow, lsq, mirror, paper or full": the table's names. */
+static const char *method_names(void)
+{
+    static char text[512];
+    int count, at = 0;
+    const vb_method_info *m = vb_methods(&count);
+    for (int i = 0; i < count; i++)
+        at += snprintf(text + at, sizeof text - (size_t)at, "%s%s",
+                       i == 0 ? "" : i + 1 == count ? " or " : ", ",
+                       vdsh_method_name(m[i].method));
+    return text;
+}
+
 static void usage(FILE *f)
 {
     fprintf(f,
@@ -91,16 +134,8 @@ static void usage(FILE *f)
 "                          (default 2500 = 50 x 50)\n"
 "      --orders LIST       SH orders to store, order n = n bands = n*n\n"
 "                          coefficients (default 2,3,5; each 1..5)\n"
-"      --method M          shadow (default): lsq of the log distance, the\n"
-"                          stored distances then e^offset times the fit's\n"
-"                          (--log-offset; fewer false shadows where a light\n"
-"                          sits just past a silhouette);\n"
-"                          lsq: regularised least squares to the upper\n"
-"                          hemisphere; mirror: the upper hemisphere, mirrored\n"
-"                          below; paper: the paper's fit, directions below the\n"
-"                          horizon count as distance 0; full: the whole\n"
-"                          sphere, no horizon. All but full trace only the\n"
-"                          upper half of the --rays directions\n"
+"      --method M          the fit:\n"
+"%s"
 "      --quantity Q        what the SH store: auto (default): log for shadow,\n"
 "                          distance for paper, and for the others per order\n"
 "                          the one with the lower expected shadow error on\n"
@@ -108,7 +143,7 @@ static void usage(FILE *f)
 "                          ln(distance), reconstructed as exp of the SH sum\n"
 "                          (not with paper; the only one with shadow)\n"
 "      --log               the same as --quantity log\n"
-"      --lambda X          lsq regularisation weight (default 1e-4; shadow\n"
+"      --lambda X          lsq regularisation weight (default %g; shadow\n"
 "                          uses lsq's default)\n"
 "      --log-offset X      shadow: added to the fitted ln d at every order\n"
 "                          (default per order 2/3/5: %.2f/%.2f/%.2f, chosen\n"
@@ -139,8 +174,8 @@ static void usage(FILE *f)
 "\n"
 "Exit status: 0 success, 1 error, 2 usage error.\n"
 "Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n",
-            (double)vb_shadow_log_offset(2), (double)vb_shadow_log_offset(3),
-            (double)vb_shadow_log_offset(5));
+            methods_help(), (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
+            (double)vb_shadow_log_offset(3), (double)vb_shadow_log_offset(5));
 }
 
 static int bad_usage(const char *fmt, const char *arg)
@@ -433,15 +468,16 @@ int main(int argc, char **argv)
             if (!parse_orders(optarg, &o))
                 return bad_usage("--orders takes distinct orders 1..5 such as 2,3,5, not '%s'", optarg);
             break;
-        case O_METHOD:
-            if (strcmp(optarg, "paper") == 0) o.method = VDSH_METHOD_PAPER;
-            else if (strcmp(optarg, "full") == 0) o.method = VDSH_METHOD_FULL;
-            else if (strcmp(optarg, "mirror") == 0) o.method = VDSH_METHOD_MIRROR;
-            else if (strcmp(optarg, "lsq") == 0) o.method = VDSH_METHOD_LSQ;
-            else if (strcmp(optarg, "shadow") == 0) o.method = VDSH_METHOD_SHADOW;
-            else return bad_usage("--method takes shadow, lsq, mirror, paper or full, not '%s'",
-                                  optarg);
+        case O_METHOD: {
+            const vb_method_info *m = vb_method_by_name(optarg);
+            if (!m) {
+                char fmt[640];
+                snprintf(fmt, sizeof fmt, "--method takes %s, not '%%s'", method_names());
+                return bad_usage(fmt, optarg);
+            }
+            o.method = m->method;
             break;
+        }
         case O_ENCODING:
             if (strcmp(optarg, "f16") == 0) o.encoding = VDSH_ENCODING_F16;
             else if (strcmp(optarg, "f32") == 0) o.encoding = VDSH_ENCODING_F32;
@@ -520,17 +556,15 @@ int main(int argc, char **argv)
         return bad_usage("%s", "no mesh given");
     if (nmesh > VDSH_MAX_SOURCES)
         return bad_usage("%s", "too many meshes (at most 64)");
-    if (o.quantity == VDSH_QUANTITY_DISTANCE && o.method == VDSH_METHOD_SHADOW)
-        return bad_usage("%s", "--method shadow fits the log distance: use --quantity log or "
-                               "auto, or --method lsq for the distance");
-    if (o.have_log_offset && o.method != VDSH_METHOD_SHADOW)
+    /* What the method's row allows. */
+    const vb_method_info *mi = vb_method_get(o.method);
+    if (o.quantity != VB_QUANTITY_AUTO && !(mi->quantities & VB_QUANTITY_BIT(o.quantity)))
+        return bad_usage("%s", mi->refused[o.quantity]);
+    if (o.have_log_offset && mi->param != VB_PARAM_LOG_OFFSET)
         return bad_usage("%s", "--log-offset is method shadow's");
-    if (o.lambda != 0.0f && o.method == VDSH_METHOD_SHADOW)
-        return bad_usage("%s", "--lambda is lsq's: method shadow uses lsq's default (its method "
-                               "parameter is the log offset)");
-    if (o.quantity == VDSH_QUANTITY_LOG_DISTANCE && o.method == VDSH_METHOD_PAPER)
-        return bad_usage("%s", "log-distance needs --method mirror, lsq or full: the paper's zero fill "
-                               "below the horizon has no meaning for ln(distance)");
+    if (o.lambda != 0.0f && mi->lambda_fixed)
+        return bad_usage("--lambda is lsq's: method %s uses lsq's default (its method "
+                         "parameter is the log offset)", vdsh_method_name(o.method));
     if (!o.output && !o.export_obj && !o.trace_only)
         return bad_usage("%s", "no output: give -o OUT.vdsh (or --export-obj FILE)");
     FILE *log = o.quiet ? NULL : stderr;

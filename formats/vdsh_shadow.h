@@ -56,6 +56,22 @@ float vdsh_ramp(float x);
  * distances never meets 0 * inf. */
 #define VDSH_LOG_SUM_MAX 80.0f
 
+/* The relative light model, the evaluator's secondary metric and the
+ * bake's choice of quantity (bake.h, VB_QUANTITY_AUTO): one light per
+ * direction at d_L = 2 u d_T, d_T the true distance, u uniform in
+ * (VDSH_LIGHT_U_MIN, 1]. vdsh_light_u maps t in (0, 1] onto u, in double
+ * (the bake) and in float (the evaluator), each with the literals it has
+ * always used, so the results keep their bits. */
+#define VDSH_LIGHT_U_MIN 0.05
+static inline double vdsh_light_u(double t)
+{
+    return VDSH_LIGHT_U_MIN + (1.0 - VDSH_LIGHT_U_MIN) * t;
+}
+static inline float vdsh_light_u_f(float t)
+{
+    return (float)VDSH_LIGHT_U_MIN + (float)(1.0 - VDSH_LIGHT_U_MIN) * t;
+}
+
 /* The distance a stream reconstructs toward unit direction d, in
  * [0, max_distance]: quantity distance: the SH sum; distance2: sqrt of the
  * sum; log-distance: exp of the sum. Negative sums (ringing) give 0, and

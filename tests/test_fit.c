@@ -280,6 +280,37 @@ static void test_errors(void)
 }
 
 
+/* method.h's table: one row per known method, found by value and by name,
+ * each refused quantity explained, its parameters consistent. */
+static void test_method_table(void)
+{
+    int count;
+    const vb_method_info *m = vb_methods(&count);
+    CHECK(count >= 1 && m[0].method == VB_METHOD_DEFAULT, "the default method comes first");
+    for (uint32_t v = 0; v < 64; v++) {
+        const char *name = vdsh_method_name(v);
+        const vb_method_info *row = vb_method_get(v);
+        CHECK((strcmp(name, "?") != 0) == (row != NULL), "method %u: named iff it has a row", v);
+        if (!row)
+            continue;
+        CHECK(vb_method_by_name(name) == row, "method %s found by its name", name);
+        CHECK(row->quantities != 0, "method %s stores some quantity", name);
+        for (uint32_t q = VDSH_QUANTITY_DISTANCE; q <= VDSH_QUANTITY_LOG_DISTANCE; q += 2)
+            CHECK((row->quantities & VB_QUANTITY_BIT(q)) || row->refused[q],
+                  "method %s: refusing %s says why", name, vdsh_quantity_name(q));
+        CHECK((row->param == VB_PARAM_LOG_OFFSET) == (row->default_log_offset != NULL),
+              "method %s: a log offset has defaults", name);
+        CHECK(!(row->param == VB_PARAM_LAMBDA) || row->regularised,
+              "method %s: a recorded lambda is used", name);
+        CHECK(!row->horizon || !row->hemisphere, "method %s: horizon means sphere sampling", name);
+        vb_fit f;
+        vb_error err;
+        CHECK(vb_fit_create(3, v, 1e-3f, &f, &err) == VB_OK && f.base == row->fit,
+              "method %s: fit.c builds its row's map", name);
+    }
+    CHECK(vb_method_by_name("bogus") == NULL, "no such method");
+}
+
 int main(void)
 {
     test_rotation();
@@ -288,5 +319,6 @@ int main(void)
     test_mirror_and_paper();
     test_window();
     test_errors();
+    test_method_table();
     return test_report("test_fit");
 }
