@@ -1,10 +1,24 @@
+/*
+ * bake.c - the bake core (bake.h): per receiver, trace its directions and
+ * project the distances onto SH, then fit each order (fit.h).
+ *
+ * The story of vb_bake_run, the driver at the bottom:
+ *   1. Resolve the description's defaults and check it against the
+ *      method's row (method.h): sampling domain, quantity, parameters.
+ *   2. Orient the receivers and place their ray origins (origins.h: one
+ *      pass over their frames).
+ *   3. With VB_QUANTITY_AUTO, trace a sample of receivers first and choose
+ *      each order's quantity by the expected shadow error (choose_block).
+ *   4. Trace and project every other receiver on the workers (bake_block,
+ *      bake_vertex: packets of 16 rays, sums in a fixed order).
+ * Encoding the result as .vdsh streams is stream.c's (vb_bake_stream).
+ */
 #include "bake.h"
 
 #include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "fit.h"
 #include "method.h"
@@ -18,13 +32,6 @@
 #define VB_PI 3.14159265358979323846
 #define BLOCK 16 /* receivers per work item */
 #define GROUP 8  /* packets traced before their lanes are processed */
-
-double vb_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* ---- the trace-and-project loop ----------------------------------------- */
 
@@ -420,109 +427,13 @@ static void bake_progress(void *user, uint32_t done, uint32_t total)
     J->d->progress(J->d->progress_user, done, total, atomic_load(&J->traced));
 }
 
-/* The f16 stream in chunks on the bake's workers: first each chunk's
- * largest |coefficient|, then, with the stream's scale, its encoding. */
-#define F16_CHUNK 65536u
-
-typedef struct f16_job {
-    const float *src;
-    size_t count;
-    float scale;
-    float *amax;          /* per chunk */
-    uint16_t *dst;
-    vdsh_result *result;  /* per chunk */
-} f16_job;
-
-static void f16_amax_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
-{
-    f16_job *J = ctx;
-    (void)worker;
-    for (uint32_t c = begin; c < end; c++) {
-        size_t a = (size_t)c * F16_CHUNK, b = J->count - a < F16_CHUNK ? J->count : a + F16_CHUNK;
-        float m = 0.0f;
-        for (size_t i = a; i < b; i++)
-            m = fmaxf(m, fabsf(J->src[i]));
-        J->amax[c] = m;
-    }
-}
-
-static void f16_encode_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
-{
-    f16_job *J = ctx;
-    (void)worker;
-    for (uint32_t c = begin; c < end; c++) {
-        size_t a = (size_t)c * F16_CHUNK, b = J->count - a < F16_CHUNK ? J->count : a + F16_CHUNK;
-        J->result[c] = vdsh_encode_f16(J->src + a, b - a, J->scale, J->dst + a);
-    }
-}
-
-vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
-                         vdsh_stream *out, void **storage, vb_error *err)
-{
-    if (order < 1 || order > VDSH_MAX_ORDER || !b->coeffs[order])
-        return vb_fail(err, VB_ERR_ARGUMENT, "order %d is not in the bake", order);
-    if (encoding != VDSH_ENCODING_F16 && encoding != VDSH_ENCODING_F32)
-        return vb_fail(err, VB_ERR_ARGUMENT, "unknown encoding %u", encoding);
-    const vb_method_info *mi = vb_method_get(b->method);
-    if (!mi)
-        return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", b->method);
-    int nc = order * order;
-    size_t count = (size_t)b->vertex_count * nc;
-    vdsh_stream s = {.order = (uint32_t)order, .encoding = encoding, .method = b->method,
-                     .quantity = b->quantity[order],
-                     .method_param = mi->param == VB_PARAM_LOG_OFFSET ? b->log_offset[order]
-                                                                      : b->lambda,
-                     .scale = 1.0f,
-                     .quantity_param = b->quantity[order] == VDSH_QUANTITY_LOG_DISTANCE
-                                           ? b->log_floor : 0.0f, .window = b->window,
-                     .window_param = b->window ? (float)order : 0.0f};
-    if (encoding == VDSH_ENCODING_F32) {
-        float *f = malloc(count * sizeof *f);
-        if (!f)
-            return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the order %d stream",
-                           order);
-        memcpy(f, b->coeffs[order], count * sizeof *f);
-        s.data = f;
-    } else {
-        /* Stored values are coefficient / (the stream's largest
-         * |coefficient|): within [-1, 1] whatever the scene's size or clamp
-         * distance, so f16 neither overflows nor sinks into subnormals and
-         * keeps its full relative precision. */
-        uint32_t chunks = (uint32_t)((count + F16_CHUNK - 1) / F16_CHUNK);
-        f16_job J = {.src = b->coeffs[order], .count = count};
-        J.amax = malloc(((size_t)chunks + 1) * sizeof *J.amax);
-        J.result = malloc(((size_t)chunks + 1) * sizeof *J.result);
-        J.dst = malloc(count * sizeof *J.dst + 1);
-        int ran = J.amax && J.result && J.dst &&
-                  vb_parallel_for(b->threads, chunks, 1, f16_amax_block, &J, NULL, NULL) > 0;
-        float amax = 0.0f;
-        for (uint32_t c = 0; ran && c < chunks; c++)
-            amax = fmaxf(amax, J.amax[c]);
-        J.scale = s.scale = amax > 0.0f ? amax : 1.0f;
-        ran = ran && vb_parallel_for(b->threads, chunks, 1, f16_encode_block, &J, NULL, NULL) > 0;
-        vdsh_result r = ran ? VDSH_OK : VDSH_ERR_OUT_OF_MEMORY;
-        for (uint32_t c = 0; ran && c < chunks && r == VDSH_OK; c++)
-            r = J.result[c];
-        free(J.amax);
-        free(J.result);
-        if (r != VDSH_OK) {
-            free(J.dst);
-            return vb_fail(err, r == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_INVALID,
-                           "order %d coefficients do not fit f16", order);
-        }
-        s.data = J.dst;
-    }
-    *storage = (void *)s.data;
-    *out = s;
-    return VB_OK;
-}
-
 void vb_bake_output_free(vb_bake_output *out)
 {
     if (!out)
         return;
     for (int o = 0; o <= VDSH_MAX_ORDER; o++)
         free(out->coeffs[o]);
+    free(out->normals);
     memset(out, 0, sizeof *out);
 }
 
@@ -603,7 +514,12 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     float *origins = malloc((size_t)R->vertex_count * 3 * sizeof *origins);
     float *near = malloc((size_t)R->vertex_count * sizeof *near + 1);
     float *coeffs[VDSH_ORDER_SLOTS] = {0};
-    int missing = 0;
+    /* Oriented receivers: a copy of their normals, turned toward free
+     * space (origins.h); the bake then reads the copy. */
+    float *normals = d.keep_normals ? NULL
+                                    : malloc((size_t)R->vertex_count * 3 * sizeof *normals + 1);
+    vb_mesh oriented = *R;
+    int missing = !d.keep_normals && !normals;
     for (int o = 1; o <= VDSH_MAX_ORDER && !d.trace_only; o++)
         if (d.order_mask & (1u << o))
             missing |= !(coeffs[o] = malloc((size_t)R->vertex_count * o * o * sizeof(float)));
@@ -621,9 +537,14 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         vb_fit_window(&J->fits[o], d.window);
     }
     vb_origins_stats ost = {0};
-    r = vb_ray_origins(R, d.scene, d.threads, origins, near, &ost, err);
+    uint32_t flipped = 0;
+    r = vb_receivers_prepare(R, d.scene, d.threads, normals, &flipped, origins, near, &ost, err);
     if (r != VB_OK)
         goto done;
+    if (normals) {
+        oriented.normals = normals;
+        d.receivers = R = &oriented;
+    }
 
     J->d = &d;
     J->grid = &grid;
@@ -735,6 +656,9 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     o.rays_missed = atomic_load(&J->missed);
     o.degenerate_receivers = atomic_load(&J->degenerate);
     o.undefined_normals = undefined;
+    o.normals = normals;
+    normals = NULL;
+    o.flipped_normals = flipped;
     o.moved_origins = ost.moved;
     o.origins = ost;
     o.seconds = vb_now() - t0;
@@ -753,6 +677,7 @@ done:
         free(coeffs[k]);
     free(origins);
     free(near);
+    free(normals);
     vb_dirgrid_destroy(&grid);
     return r;
 }

@@ -38,10 +38,15 @@
  * to walls; distance on open objects, where most rays escape to the clamp
  * distance. With paper, auto means distance.
  *
- * Ray origins: origins.h (the rule, the repair of receivers left inside or
- * behind other geometry, and each receiver's near distance, below which a
- * traced distance counts as ~0 for the degenerate count). Rays that hit
- * nothing within max_distance get max_distance.
+ * Orientation and ray origins: origins.h (receivers whose normals point
+ * into geometry turned toward free space, unless keep_normals; the rule,
+ * the repair of receivers left inside or behind other geometry, and each
+ * receiver's near distance, below which a traced distance counts as ~0 for
+ * the degenerate count), in one pass over the receivers' frames. Rays that
+ * hit nothing within max_distance get max_distance.
+ *
+ * The whole bake around this (load, refine, fill and write the file):
+ * job.h. Encoding the coefficients as streams: vb_bake_stream (stream.c).
  *
  * Determinism: a receiver's coefficients depend only on (seed, vertex
  * index, its position/normal, the scene): every per-vertex sum runs in a
@@ -87,6 +92,10 @@ typedef struct vb_bake_desc {
     uint32_t order_mask;       /* bit n: produce order n; 0: max_order only */
     int max_order;             /* 0: the highest order in order_mask, or 5 */
     unsigned threads;          /* 0: every online core */
+    /* 0 (the tools' default): receivers whose normals point into geometry
+     * are turned toward free space first (vb_orient_receivers, on a copy:
+     * vb_bake_output.normals); 1: the normals as given. */
+    int keep_normals;
     int trace_only;            /* benchmark: trace the same rays, nothing else */
     /* Called from the calling thread a few times a second, and once at the
      * end, with receivers done and rays traced so far. May be NULL. */
@@ -118,6 +127,10 @@ typedef struct vb_bake_output {
     uint64_t rays_missed;
     uint32_t degenerate_receivers;
     uint32_t undefined_normals;
+    /* The receivers' normals as baked (3 per vertex), turned toward free
+     * space, or NULL with keep_normals (then the receivers' own). */
+    float *normals;
+    uint32_t flipped_normals;  /* receivers whose normal was turned */
     uint32_t moved_origins;    /* receivers whose origin the repair moved */
     vb_origins_stats origins;  /* the ray origins' repair: what it did and cost */
     double seconds;            /* wall time of the trace-and-project loop
@@ -143,8 +156,6 @@ void vb_bake_output_free(vb_bake_output *out);
 vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
                          vdsh_stream *out, void **storage, vb_error *err);
 
-/* Monotonic wall clock in seconds. */
-double vb_now(void);
 
 #ifdef __cplusplus
 }

@@ -1680,6 +1680,12 @@ vdsh_result vdsh_write_memory(const vdsh_file *f, void **out_data,
 
 vdsh_result vdsh_write(const char *path, const vdsh_file *f, vdsh_error *err)
 {
+    return vdsh_write_sized(path, f, NULL, err);
+}
+
+vdsh_result vdsh_write_sized(const char *path, const vdsh_file *f, uint64_t *size,
+                             vdsh_error *err)
+{
     plan P;
     if (!path)
         return fail(err, VDSH_ERR_ARGUMENT, "(null)",
@@ -1700,6 +1706,7 @@ vdsh_result vdsh_write(const char *path, const vdsh_file *f, vdsh_error *err)
     }
     sink s = {NULL, out.fp, 0, 0};
     plan_emit(&P, &s);
+    uint64_t total = P.file_size;
     plan_free(&P);
     if (s.error) {
         res = fail(err, VDSH_ERR_IO, path, "cannot write%s%s: %s",
@@ -1708,5 +1715,8 @@ vdsh_result vdsh_write(const char *path, const vdsh_file *f, vdsh_error *err)
         vdsh_output_abort(&out);
         return res;
     }
-    return vdsh_output_commit(&out, err);
+    res = vdsh_output_commit(&out, err);
+    if (res == VDSH_OK && size)
+        *size = total;
+    return res;
 }

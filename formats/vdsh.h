@@ -229,6 +229,11 @@ void vdsh_free(vdsh_file *f);
  * `f` are borrowed; storage_ is ignored. */
 vdsh_result vdsh_write(const char *path, const vdsh_file *f, vdsh_error *err);
 
+/* vdsh_write, and on success the file's size in bytes in *size (may be
+ * NULL; untouched on failure): a caller need not open the file again. */
+vdsh_result vdsh_write_sized(const char *path, const vdsh_file *f, uint64_t *size,
+                             vdsh_error *err);
+
 /* Serialise to memory. On success *out_data is a malloc'd buffer the
  * caller frees with free(). */
 vdsh_result vdsh_write_memory(const vdsh_file *f, void **out_data,

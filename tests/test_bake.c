@@ -54,7 +54,7 @@ static int bake(const vb_mesh *occ, const vb_mesh *rec, uint32_t method,
         fprintf(stderr, "scene: %s\n", err.msg);
         return 0;
     }
-    vb_bake_desc d = {.receivers = rec, .scene = s, .rays = rays, .seed = 5,
+    vb_bake_desc d = {.keep_normals = 1, .receivers = rec, .scene = s, .rays = rays, .seed = 5,
                       .method = method, .threads = threads};
     vb_result r = vb_bake_run(&d, out, &err);
     if (r != VB_OK)
@@ -361,7 +361,7 @@ static void test_shadow_offset(void)
     const float mine[VDSH_MAX_ORDER + 1] = {0, -0.3f, -0.3f, -0.3f, -0.3f, -0.3f};
     vb_bake_output b[3] = {{0}};
     for (int i = 0; i < 3 && sc; i++) {
-        vb_bake_desc d = {.receivers = &rec, .scene = sc, .rays = 400, .seed = 5,
+        vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = sc, .rays = 400, .seed = 5,
                           .method = i ? VDSH_METHOD_SHADOW : VDSH_METHOD_LSQ,
                           .quantity = VDSH_QUANTITY_LOG_DISTANCE, .log_offsets = i == 2 ? mine : NULL,
                           .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};

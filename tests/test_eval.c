@@ -143,7 +143,7 @@ static int bake(const vb_mesh *rec, const vb_scene *s, uint32_t method, uint32_t
                 uint64_t seed, vb_bake_output *out)
 {
     vb_error err;
-    vb_bake_desc d = {.receivers = rec, .scene = s, .rays = rays, .seed = seed,
+    vb_bake_desc d = {.keep_normals = 1, .receivers = rec, .scene = s, .rays = rays, .seed = seed,
                       .method = method, .threads = 2,
                       .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
     vb_result r = vb_bake_run(&d, out, &err);
@@ -428,7 +428,7 @@ static void test_methods(void)
     memset(mf, 0, sizeof mf);
     for (int i = 0; i < 3; i++) {
         vb_error err;
-        vb_bake_desc d = {.receivers = &rec, .scene = s, .rays = 1024, .seed = 5,
+        vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = s, .rays = 1024, .seed = 5,
                           .method = methods[i], .threads = 2,
                           .quantity = i ? VDSH_QUANTITY_LOG_DISTANCE : VDSH_QUANTITY_DISTANCE,
                           .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};

@@ -25,7 +25,7 @@ static int bake_with(const vb_mesh *occ, const vb_mesh *rec, uint32_t method, ui
         fprintf(stderr, "scene: %s\n", err.msg);
         return 0;
     }
-    vb_bake_desc d = {.receivers = rec, .scene = s, .rays = rays, .seed = 3, .method = method};
+    vb_bake_desc d = {.keep_normals = 1, .receivers = rec, .scene = s, .rays = rays, .seed = 3, .method = method};
     vb_result r = vb_bake_run(&d, out, &err);
     if (r != VB_OK)
         fprintf(stderr, "bake: %s\n", err.msg);
@@ -441,6 +441,47 @@ static void test_inverted_normals(void)
     test_mesh_free(&rec);
 }
 
+/* The bake orients its receivers itself unless told to keep their normals
+ * (vb_bake_desc.keep_normals): the same coefficients, normals and count as
+ * vb_orient_receivers followed by a bake that keeps them, with the
+ * receivers' frames built once instead of twice. */
+static void test_orient_in_bake(void)
+{
+    vb_mesh m = {0}, rec = {0}, mine = {0};
+    test_make_room(&m, 4.0f, 3.0f, 2.5f);
+    add_box(&m, -1, 1, 1, 2, -0.5f, 0.5f, 1); /* floating, normals inverted */
+    vb_error err;
+    CHECK(vb_mesh_refine(&m, 0.5f, &rec, &err) == VB_OK, "refine");
+    CHECK(vb_mesh_refine(&m, 0.5f, &mine, &err) == VB_OK, "refine");
+    vb_scene *s = NULL;
+    CHECK(vb_scene_create(&m, NULL, &s, &err) == VB_OK, "scene");
+    uint32_t flipped = 0;
+    CHECK(vb_orient_receivers(&mine, s, 2, &flipped, &err) == VB_OK, "orient: %s", err.msg);
+    CHECK(flipped > 0, "the inverted box has receivers to flip");
+    vb_bake_desc a = {.receivers = &rec, .scene = s, .rays = 256, .seed = 3, .threads = 2,
+                      .order_mask = 1u << 3, .method = VDSH_METHOD_LSQ};
+    vb_bake_desc b = a;
+    b.receivers = &mine;
+    b.keep_normals = 1;
+    vb_bake_output oa = {0}, ob = {0};
+    CHECK(vb_bake_run(&a, &oa, &err) == VB_OK, "bake, oriented inside: %s", err.msg);
+    CHECK(vb_bake_run(&b, &ob, &err) == VB_OK, "bake, oriented before: %s", err.msg);
+    size_t n = (size_t)rec.vertex_count;
+    CHECK(oa.flipped_normals == flipped && ob.flipped_normals == 0 && ob.normals == NULL,
+          "flipped %u inside, %u before", oa.flipped_normals, flipped);
+    CHECK(oa.normals && memcmp(oa.normals, mine.normals, 3 * n * sizeof(float)) == 0,
+          "the bake's oriented normals are vb_orient_receivers'");
+    CHECK(memcmp(oa.coeffs[3], ob.coeffs[3], 9 * n * sizeof(float)) == 0,
+          "the same coefficients either way");
+    CHECK(oa.moved_origins == ob.moved_origins, "the same origins repaired");
+    vb_bake_output_free(&oa);
+    vb_bake_output_free(&ob);
+    vb_scene_destroy(s);
+    test_mesh_free(&m);
+    test_mesh_free(&rec);
+    test_mesh_free(&mine);
+}
+
 /* Contact and embedding. A box pressed on the floor with its bottom face
  * present: those receivers face down into the floor, and an origin offset
  * along their normal would leave the room (every ray escaping); they are
@@ -596,7 +637,7 @@ static void test_small_parts(void)
     vb_error err;
     vb_scene *s = NULL;
     CHECK(vb_scene_create(&m, NULL, &s, &err) == VB_OK, "scene");
-    vb_bake_desc d = {.receivers = &m, .scene = s, .rays = 1024, .seed = 3,
+    vb_bake_desc d = {.keep_normals = 1, .receivers = &m, .scene = s, .rays = 1024, .seed = 3,
                       .method = VDSH_METHOD_LSQ, .quantity = VDSH_QUANTITY_LOG_DISTANCE};
     vb_bake_output b = {0};
     CHECK(vb_bake_run(&d, &b, &err) == VB_OK, "bake: %s", err.msg);
@@ -628,7 +669,7 @@ static void test_default_fit(uint32_t method)
     CHECK(vb_mesh_refine(&m, 0.5f, &rec, &err) == VB_OK, "refine");
     vb_scene *s = NULL;
     CHECK(vb_scene_create(&m, NULL, &s, &err) == VB_OK, "scene");
-    vb_bake_desc d = {.receivers = &rec, .scene = s, .rays = 512, .seed = 3,
+    vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = s, .rays = 512, .seed = 3,
                       .method = method, .quantity = VB_QUANTITY_AUTO,
                       .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
     vb_bake_output b = {0};
@@ -693,7 +734,7 @@ static void test_lit_walls(void)
     vb_scene *sc = NULL;
     CHECK(vb_scene_create(&occ, NULL, &sc, &err) == VB_OK, "scene: %s", err.msg);
     /* The default bake: what vdsh-bake does with no method or quantity. */
-    vb_bake_desc d = {.receivers = &rec, .scene = sc, .rays = 625, .seed = 3,
+    vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = sc, .rays = 625, .seed = 3,
                       .method = VDSH_METHOD_SHADOW, .quantity = VB_QUANTITY_AUTO,
                       .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
     vb_bake_output out = {0};
@@ -752,7 +793,7 @@ static void test_bad_api_input(void)
     CHECK(vb_scene_create(&occ, NULL, &s, &err) == VB_OK, "scene");
     float p[3] = {0, 0.5f, 0}, n[3] = {0, INFINITY, 0};
     test_make_points(&rec, 1, p, n);
-    vb_bake_desc d = {.receivers = &rec, .scene = s, .rays = 64};
+    vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = s, .rays = 64};
     vb_bake_output out = {0};
     CHECK(vb_bake_run(&d, &out, &err) == VB_ERR_INVALID && !out.coeffs[5], "Inf normal accepted");
     vb_scene_destroy(s);
@@ -770,6 +811,7 @@ int main(void)
     test_coplanar_receivers();
     test_open_mesh();
     test_inverted_normals();
+    test_orient_in_bake();
     test_contact_and_embedded();
     test_coincident_faces();
     test_small_parts();
