@@ -313,7 +313,7 @@ static double expected_error(const double *e, double r)
 
 float vb_shadow_log_offset(int order)
 {
-    const float *table = vb_method_get(VDSH_METHOD_SHADOW)->default_log_offset;
+    const float *table = vb_method_get(VB_METHOD_SHADOW)->default_log_offset;
     return order >= 1 && order <= VDSH_MAX_ORDER ? table[order] : 0.0f;
 }
 
@@ -463,19 +463,22 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
                        d.max_order);
     const vb_method_info *mi = vb_method_get(d.method);
     if (!mi)
-        return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", d.method);
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %d", (int)d.method);
     if (d.window > VDSH_WINDOW_LANCZOS)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown window %u", d.window);
     /* The quantity: what the method allows; auto is its only one, if it
      * has one, or the per-order choice below. */
-    if (d.quantity == VB_QUANTITY_AUTO && (mi->quantities & (mi->quantities - 1)) == 0)
-        d.quantity = (uint32_t)__builtin_ctz(mi->quantities);
-    if (d.quantity != VDSH_QUANTITY_DISTANCE && d.quantity != VDSH_QUANTITY_LOG_DISTANCE &&
-        d.quantity != VB_QUANTITY_AUTO)
-        return vb_fail(err, VB_ERR_ARGUMENT, "the bake stores distance or log-distance, not %s",
-                       vdsh_quantity_name(d.quantity));
-    if (d.quantity != VB_QUANTITY_AUTO && !(mi->quantities & VB_QUANTITY_BIT(d.quantity)))
-        return vb_fail(err, VB_ERR_ARGUMENT, "%s", mi->refused[d.quantity]);
+    if (d.quantity != VB_QUANTITY_AUTO && d.quantity != VB_QUANTITY_DISTANCE &&
+        d.quantity != VB_QUANTITY_LOG)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown quantity %d", (int)d.quantity);
+    int choose = d.quantity == VB_QUANTITY_AUTO; /* per order, below */
+    vdsh_quantity stored = vb_quantity_stored(d.quantity);
+    if (choose && (mi->quantities & (mi->quantities - 1)) == 0) {
+        choose = 0; /* the method's only one */
+        stored = (vdsh_quantity)__builtin_ctz(mi->quantities);
+    }
+    if (!choose && !(mi->quantities & VB_QUANTITY_BIT(stored)))
+        return vb_fail(err, VB_ERR_ARGUMENT, "%s", mi->refused[stored]);
     if (d.lambda == 0.0f)
         d.lambda = VB_DEFAULT_LAMBDA;
     if (!(d.lambda > 0.0f) || !isfinite(d.lambda))
@@ -532,7 +535,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!coeffs[o] && o != d.max_order) /* the top one rotates for all */
             continue;
-        if ((r = vb_fit_create(o, d.method, d.lambda, &J->fits[o], err)) != VB_OK)
+        if ((r = vb_fit_create(o, mi->fit, d.lambda, &J->fits[o], err)) != VB_OK)
             goto done;
         vb_fit_window(&J->fits[o], d.window);
     }
@@ -566,7 +569,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         }
     }
     /* The quantity choice's score: the expected shadow error e(r). */
-    if (d.quantity == VB_QUANTITY_AUTO && !(J->error_table = error_table_create())) {
+    if (choose && !(J->error_table = error_table_create())) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
@@ -579,7 +582,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     double t0 = vb_now();
     double auto_error[VDSH_ORDER_SLOTS][2] = {{0}};
     uint32_t auto_receivers = 0;
-    if (d.quantity == VB_QUANTITY_AUTO && !d.trace_only) {
+    if (choose && !d.trace_only) {
         /* Per order, the quantity whose fits reconstruct the traced
          * distances of a sample of receivers with the lower expected
          * shadow error; sums in sample order, so the choice does not
@@ -622,7 +625,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         }
     } else {
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-            J->quantity[o] = d.quantity == VB_QUANTITY_AUTO ? VDSH_QUANTITY_DISTANCE : d.quantity;
+            J->quantity[o] = choose ? VDSH_QUANTITY_DISTANCE : stored;
     }
     unsigned started = vb_parallel_for(d.threads, R->vertex_count, BLOCK, bake_block, J,
                                        d.progress ? bake_progress : NULL, J);
@@ -633,7 +636,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
 
     vb_bake_output o = {0};
     o.max_order = d.max_order;
-    o.method = d.method;
+    o.method = mi->stored;
     int any_log = 0;
     for (int k = 0; k <= VDSH_MAX_ORDER; k++) {
         o.quantity[k] = J->quantity[k];

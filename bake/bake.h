@@ -64,6 +64,7 @@
 #include <stdint.h>
 
 #include "mesh.h"
+#include "method.h"
 #include "origins.h"
 #include "scene.h"
 #include "vb.h"
@@ -73,22 +74,19 @@
 extern "C" {
 #endif
 
-#define VB_QUANTITY_AUTO 0xffu /* vb_bake_desc.quantity: chosen per order */
-
 typedef struct vb_bake_desc {
     const vb_mesh *receivers;  /* positions and normals (borrowed) */
     const vb_scene *scene;     /* the occluders (borrowed) */
     uint32_t rays;             /* directions per receiver; 0: 2500 */
     uint64_t seed;             /* 0 is a valid seed */
     float max_distance;        /* clamp; 0: the occluders' bbox diagonal */
-    uint32_t method;           /* vdsh_method; 0 = paper */
-    uint32_t quantity;         /* vdsh_quantity: distance (0) or log-distance,
-                                * or VB_QUANTITY_AUTO */
+    vb_method method;          /* method.h; 0: shadow (the default) */
+    vb_quantity quantity;      /* method.h; 0: auto (the default) */
     float lambda;              /* lsq and shadow regularisation; 0: 1e-4 */
     const float *log_offsets;  /* method shadow: per order (index 1..5), added
                                 * to the fitted ln d; NULL: vb_shadow_log_offset */
     float log_floor;           /* log-distance floor; 0: 1% of max_distance */
-    uint32_t window;           /* vdsh_window on each order's bands; 0: none */
+    vdsh_window window;        /* on each order's bands; 0: none */
     uint32_t order_mask;       /* bit n: produce order n; 0: max_order only */
     int max_order;             /* 0: the highest order in order_mask, or 5 */
     unsigned threads;          /* 0: every online core */
@@ -106,15 +104,15 @@ typedef struct vb_bake_desc {
 
 typedef struct vb_bake_output {
     int max_order;
-    uint32_t method;           /* vdsh_method used */
-    uint32_t quantity[VDSH_ORDER_SLOTS]; /* per order: vdsh_quantity stored */
+    vdsh_method method;        /* the method as stored */
+    vdsh_quantity quantity[VDSH_ORDER_SLOTS]; /* per order: the quantity stored */
     uint32_t auto_receivers;   /* VB_QUANTITY_AUTO: receivers sampled (else 0) */
     double auto_error[VDSH_ORDER_SLOTS][2]; /* their expected shadow error
                                 * per order, distance [0] and log [1] */
     float lambda;              /* lsq or shadow regularisation used (0 otherwise) */
     float log_offset[VDSH_ORDER_SLOTS]; /* method shadow: per order, as used */
     float log_floor;           /* log-distance floor used (0 otherwise) */
-    uint32_t window;           /* vdsh_window applied */
+    vdsh_window window;        /* applied */
     uint32_t vertex_count;
     /* Per order n (1..VDSH_MAX_ORDER): vertex_count * n^2 coefficients, vertex-major, or
      * NULL where the order was not asked for (and with trace_only). */
@@ -153,7 +151,7 @@ void vb_bake_output_free(vb_bake_output *out);
  * stream's largest |coefficient| (stored values in [-1, 1]), encoded on
  * b->threads workers. *storage receives the data the stream points at;
  * the caller frees it. */
-vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
+vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encoding,
                          vdsh_stream *out, void **storage, vb_error *err);
 
 

@@ -93,7 +93,7 @@ static void gauss01(int n, double *x, double *w)
     }
 }
 
-double vb_window_weight(uint32_t window, int l, int order)
+double vb_window_weight(vdsh_window window, int l, int order)
 {
     double x = (double)l / order;
     switch (window) {
@@ -106,28 +106,26 @@ double vb_window_weight(uint32_t window, int l, int order)
     }
 }
 
-vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
+vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out,
                         vb_error *err)
 {
     if (order < 1 || order > VDSH_MAX_ORDER)
         return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..%d, not %d", VDSH_MAX_ORDER,
                        order);
-    const vb_method_info *info = vb_method_get(method);
-    if (!info)
-        return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", method);
+    if (base != VB_FIT_IDENTITY && base != VB_FIT_MIRROR && base != VB_FIT_LSQ)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown base fit %d", (int)base);
     if (!(lambda >= 0.0f) || !isfinite(lambda))
         return vb_fail(err, VB_ERR_ARGUMENT, "regularisation must be a number >= 0");
     vb_fit f;
     memset(&f, 0, sizeof f);
     f.order = order;
-    f.method = method;
-    f.base = info->fit;
+    f.base = base;
     f.lambda = lambda;
     int n = order * order;
     for (int i = 0; i < n; i++)
         f.window[i] = 1.0;
 
-    switch (info->fit) {
+    switch (base) {
     case VB_FIT_IDENTITY:
         for (int i = 0; i < n; i++)
             f.M[i * n + i] = 1.0;
@@ -235,7 +233,7 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
     return VB_OK;
 }
 
-void vb_fit_window(vb_fit *f, uint32_t window)
+void vb_fit_window(vb_fit *f, vdsh_window window)
 {
     /* A window scales whole bands, and rotations keep bands apart, so it
      * commutes with S: it applies to the final coefficients. */

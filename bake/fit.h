@@ -49,8 +49,7 @@ extern "C" {
 
 typedef struct vb_fit {
     int order;                        /* coefficients kept: order^2 */
-    uint32_t method;                  /* vdsh_method */
-    vb_fit_base base;                 /* its map (method.h's row) */
+    vb_fit_base base;                 /* the map (a method's row, method.h) */
     float lambda;                     /* lsq regularisation */
     double window[VB_FIT_MAX];        /* per coefficient: its band's weight */
     double M[VB_FIT_MAX * VB_FIT_MAX];  /* local-frame map, order^2 square */
@@ -68,20 +67,20 @@ typedef struct vb_fit {
 /* Gauss-Legendre nodes and weights on [-1, 1]. */
 void vb_gauss_legendre(int n, double *x, double *w);
 
-/* Prepare the map for (order, method, lambda): the method's base fit
- * (method.h); lambda matters for VB_FIT_LSQ only. The hemisphere Gram matrix
- * is computed by Gauss-Legendre x uniform-azimuth quadrature (exact for
- * these polynomials). */
-vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
+/* Prepare the map for (order, base fit, lambda); lambda matters for
+ * VB_FIT_LSQ only. A method's base fit is its row's (method.h). The
+ * hemisphere Gram matrix is computed by Gauss-Legendre x uniform-azimuth
+ * quadrature (exact for these polynomials). */
+vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out,
                         vb_error *err);
 
 /* The per-band window applied to a fit's coefficients: Hann
  * (1 + cos(pi l / order)) / 2, Lanczos sinc(l / order), 1 for none; band
  * l of `order` bands (vdsh_window values). */
-double vb_window_weight(uint32_t window, int l, int order);
+double vb_window_weight(vdsh_window window, int l, int order);
 
 /* Scale the map's rows by the window (c_lm *= w_l). */
-void vb_fit_window(vb_fit *f, uint32_t window);
+void vb_fit_window(vb_fit *f, vdsh_window window);
 
 /* c = S M S^T b for a receiver with unit normal n (b and c: order^2
  * values, world frame; b in double for the sums it comes from). A zero

@@ -5,9 +5,10 @@
  * parameters apply and their defaults, and its help text).
  *
  * Adding a method: a value in formats/vdsh.h's vdsh_method (the file's
- * vocabulary: the stored value never changes once shipped) and its name in
- * formats/vdsh.c, one row in method.c, and, if no existing base fit does,
- * the map in fit.c (vb_fit_base). The CLI's parsing, help and
+ * vocabulary: a stored value never changes once shipped) and its name in
+ * formats/vdsh.c's table, a value in vb_method below and its row in
+ * method.c, and, if no existing base fit does, the map in fit.c
+ * (vb_fit_base). The CLI's parsing, help and
  * compatibility checks, bake.c's sampling and parameters and fit.c's map
  * all read the row.
  *
@@ -24,6 +25,30 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* The bake's methods. Zero is the tools' default, so that a zeroed
+ * vb_bake_desc bakes what vdsh-bake does; each row records the value the
+ * file stores (vdsh_method, whose numbers never change). The table is in
+ * this order, which is also the CLI's. */
+typedef enum vb_method {
+    VB_METHOD_SHADOW = 0, /* the default */
+    VB_METHOD_LSQ,
+    VB_METHOD_MIRROR,
+    VB_METHOD_PAPER,
+    VB_METHOD_FULL,
+    VB_METHOD_COUNT
+} vb_method;
+
+/* What the bake stores: zero chooses per order (or the method's only
+ * one). vb_quantity_stored gives the file's vdsh_quantity. */
+typedef enum vb_quantity {
+    VB_QUANTITY_AUTO = 0, /* the default */
+    VB_QUANTITY_DISTANCE,
+    VB_QUANTITY_LOG
+} vb_quantity;
+
+/* The file's value of a quantity other than auto. */
+vdsh_quantity vb_quantity_stored(vb_quantity q);
 
 /* The linear map from a receiver's projection to its coefficients
  * (fit.h). */
@@ -44,7 +69,8 @@ typedef enum vb_method_param {
 #define VB_QUANTITY_BIT(q) (1u << (q))
 
 typedef struct vb_method_info {
-    vdsh_method method;
+    vb_method method;
+    vdsh_method stored;        /* the value in the file's streams */
     /* Sampling: the upper hemisphere about each receiver's normal, with
      * half the directions; otherwise the whole sphere. */
     int hemisphere;
@@ -76,17 +102,17 @@ typedef struct vb_method_info {
  * validation split (docs/ACCURACY.md). */
 #define VB_DEFAULT_LAMBDA 1e-4f
 
-/* The rows in the CLI's order (the default first); count in *count. */
-const vb_method_info *vb_methods(int *count);
-
 /* The row of a method, or NULL for a value this version does not know. */
-const vb_method_info *vb_method_get(uint32_t method);
+const vb_method_info *vb_method_get(vb_method method);
+
+/* The row of the method a file's stream records (vdsh_method), or NULL. */
+const vb_method_info *vb_method_stored(uint32_t stored);
 
 /* The row named `name` (vdsh_method_name's names), or NULL. */
 const vb_method_info *vb_method_by_name(const char *name);
 
-/* The default method: the first row. */
-#define VB_METHOD_DEFAULT VDSH_METHOD_SHADOW
+/* Its name: the file's (vdsh_method_name). */
+const char *vb_method_name(vb_method method);
 
 #ifdef __cplusplus
 }

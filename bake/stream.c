@@ -47,14 +47,14 @@ static void f16_encode_block(void *ctx, uint32_t begin, uint32_t end, unsigned w
     }
 }
 
-vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
+vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encoding,
                          vdsh_stream *out, void **storage, vb_error *err)
 {
     if (order < 1 || order > VDSH_MAX_ORDER || !b->coeffs[order])
         return vb_fail(err, VB_ERR_ARGUMENT, "order %d is not in the bake", order);
     if (encoding != VDSH_ENCODING_F16 && encoding != VDSH_ENCODING_F32)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown encoding %u", encoding);
-    const vb_method_info *mi = vb_method_get(b->method);
+    const vb_method_info *mi = vb_method_stored(b->method);
     if (!mi)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", b->method);
     int nc = order * order;

@@ -39,14 +39,14 @@ typedef struct options {
     uint32_t rays;
     int orders[VDSH_MAX_ORDER];
     int order_count;
-    uint32_t method;
-    uint32_t quantity;
+    vb_method method;
+    vb_quantity quantity;
     float lambda;
     float log_offset;
     int have_log_offset;
     float log_floor;
-    uint32_t window;
-    uint32_t encoding;
+    vdsh_window window;
+    vdsh_encoding encoding;
     float max_distance;
     float max_edge;
     int weld;
@@ -65,12 +65,11 @@ typedef struct options {
 static const char *methods_help(void)
 {
     static char text[4096];
-    int count, at = 0;
-    const vb_method_info *m = vb_methods(&count);
+    int count = VB_METHOD_COUNT, at = 0;
+    const vb_method_info *m = vb_method_get(0);
     for (int i = 0; i < count; i++) {
         at += snprintf(text + at, sizeof text - (size_t)at, "%26s%s%s: ", "",
-                       vdsh_method_name(m[i].method),
-                       m[i].method == VB_METHOD_DEFAULT ? " (default)" : "");
+                       vb_method_name(m[i].method), i == 0 ? " (default)" : "");
         for (const char *p = m[i].help; *p; p++) {
             at += snprintf(text + at, sizeof text - (size_t)at, "%c", *p);
             if (*p == '\n')
@@ -83,7 +82,7 @@ static const char *methods_help(void)
     for (int i = 0; i < count; i++)
         if (!m[i].hemisphere && !m[i].horizon)
             at += snprintf(text + at, sizeof text - (size_t)at, "%s%s", sphere++ ? ", " : " ",
-                           vdsh_method_name(m[i].method));
+                           vb_method_name(m[i].method));
     snprintf(text + at, sizeof text - (size_t)at,
              " trace only the upper half\n%26sof the --rays directions\n", "");
     return text;
@@ -93,12 +92,11 @@ static const char *methods_help(void)
 static const char *method_names(void)
 {
     static char text[512];
-    int count, at = 0;
-    const vb_method_info *m = vb_methods(&count);
-    for (int i = 0; i < count; i++)
+    int at = 0;
+    for (int i = 0; i < VB_METHOD_COUNT; i++)
         at += snprintf(text + at, sizeof text - (size_t)at, "%s%s",
-                       i == 0 ? "" : i + 1 == count ? " or " : ", ",
-                       vdsh_method_name(m[i].method));
+                       i == 0 ? "" : i + 1 == VB_METHOD_COUNT ? " or " : ", ",
+                       vb_method_name((vb_method)i));
     return text;
 }
 
@@ -321,7 +319,7 @@ static int write_report(const char *path, const options *o, const vb_job *job,
     vt_json_u64(&j, root, "receiver_triangles", f->header.triangle_count);
     vt_json_u64(&j, root, "occluder_triangles", f->header.occluder_triangle_count);
     vt_json_u64(&j, root, "rays_per_receiver", b->rays);
-    vt_json_string(&j, root, "method", vdsh_method_name(o->method));
+    vt_json_string(&j, root, "method", vb_method_name(o->method));
     cJSON *orders = vt_json_array(&j, root, "orders");
     for (int i = 0; i < o->order_count; i++)
         vt_json_u64(&j, orders, NULL, (uint64_t)o->orders[i]);
@@ -397,8 +395,7 @@ int main(int argc, char **argv)
     options o = {0};
     o.rays = 2500;
     o.orders[0] = 2, o.orders[1] = 3, o.orders[2] = 5, o.order_count = 3;
-    o.method = VDSH_METHOD_SHADOW;
-    o.quantity = VB_QUANTITY_AUTO;
+    /* method and quantity: 0 is the default (shadow, auto) */
     o.encoding = VDSH_ENCODING_F16;
     o.seed = 1;
     o.robust = 1;
@@ -496,11 +493,11 @@ int main(int argc, char **argv)
         case O_TIMINGS: o.record_timings = 1; break;
         case O_EXPORT: o.export_obj = optarg; break;
         case O_TRACE_ONLY: o.trace_only = 1; break;
-        case O_LOG: o.quantity = VDSH_QUANTITY_LOG_DISTANCE; break;
+        case O_LOG: o.quantity = VB_QUANTITY_LOG; break;
         case O_QUANTITY:
             if (strcmp(optarg, "auto") == 0) o.quantity = VB_QUANTITY_AUTO;
-            else if (strcmp(optarg, "distance") == 0) o.quantity = VDSH_QUANTITY_DISTANCE;
-            else if (strcmp(optarg, "log") == 0) o.quantity = VDSH_QUANTITY_LOG_DISTANCE;
+            else if (strcmp(optarg, "distance") == 0) o.quantity = VB_QUANTITY_DISTANCE;
+            else if (strcmp(optarg, "log") == 0) o.quantity = VB_QUANTITY_LOG;
             else return bad_usage("--quantity takes auto, distance or log, not '%s'", optarg);
             break;
         case O_LAMBDA:
@@ -541,13 +538,14 @@ int main(int argc, char **argv)
         return bad_usage("%s", "too many meshes (at most 64)");
     /* What the method's row allows. */
     const vb_method_info *mi = vb_method_get(o.method);
-    if (o.quantity != VB_QUANTITY_AUTO && !(mi->quantities & VB_QUANTITY_BIT(o.quantity)))
-        return bad_usage("%s", mi->refused[o.quantity]);
+    vdsh_quantity stored = vb_quantity_stored(o.quantity);
+    if (o.quantity != VB_QUANTITY_AUTO && !(mi->quantities & VB_QUANTITY_BIT(stored)))
+        return bad_usage("%s", mi->refused[stored]);
     if (o.have_log_offset && mi->param != VB_PARAM_LOG_OFFSET)
         return bad_usage("%s", "--log-offset is method shadow's");
     if (o.lambda != 0.0f && mi->lambda_fixed)
         return bad_usage("--lambda is lsq's: method %s uses lsq's default (its method "
-                         "parameter is the log offset)", vdsh_method_name(o.method));
+                         "parameter is the log offset)", vb_method_name(o.method));
     if (!o.output && !o.export_obj && !o.trace_only)
         return bad_usage("%s", "no output: give -o OUT.vdsh (or --export-obj FILE)");
     FILE *log = o.quiet ? NULL : stderr;
@@ -616,7 +614,7 @@ int main(int argc, char **argv)
         fprintf(log, "vdsh-bake: tracing %u rays x %u receivers against %u triangles "
                      "(method %s)\n",
                 o.rays, rec->vertex_count, job.occluders.triangle_count,
-                vdsh_method_name(o.method));
+                vb_method_name(o.method));
     pr.t0 = vb_now();
     if (vb_job_bake(&job, &jd, &err) != VB_OK) {
         fprintf(stderr, "vdsh-bake: %s\n", err.msg);

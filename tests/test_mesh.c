@@ -1322,7 +1322,7 @@ static void check_room_bake(const vb_mesh *coarse, const char *name, vb_mesh *fi
     }
     uint32_t flipped = 0;
     CHECK(vb_orient_receivers(fine, s, 0, &flipped, &err) == VB_OK, "%s: orient: %s", name, err.msg);
-    vb_bake_desc d = {.keep_normals = 1, .receivers = fine, .scene = s, .rays = 64, .seed = 1, .method = VDSH_METHOD_PAPER};
+    vb_bake_desc d = {.keep_normals = 1, .receivers = fine, .scene = s, .rays = 64, .seed = 1, .method = VB_METHOD_PAPER};
     vb_bake_output o = {0};
     CHECK(vb_bake_run(&d, &o, &err) == VB_OK, "%s: bake: %s", name, err.msg);
     printf("%s at 0.2 m: %u receivers, %u normals flipped, %llu of %llu rays missed, %u degenerate\n", name,
