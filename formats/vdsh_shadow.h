@@ -33,10 +33,21 @@
 extern "C" {
 #endif
 
+/* How a reconstructed distance d_V is compared with the light's d_L. One
+ * row per value in vdsh_shadow.c's table (its name and its function);
+ * adding one: a value here, its row there, its GLSL in runtime/vr_glsl.c
+ * (tested against this file by tests/test_runtime_glsl.c). */
 typedef enum vdsh_compare {
-    VDSH_COMPARE_SMOOTH = 0, /* the paper's ramp */
-    VDSH_COMPARE_BINARY = 1  /* the paper's reference step */
+    VDSH_COMPARE_SMOOTH = 0, /* the paper's ramp (the default) */
+    VDSH_COMPARE_BINARY = 1, /* the paper's reference step */
+    VDSH_COMPARE_COUNT
 } vdsh_compare;
+
+/* "smooth", "binary"; "?" for an unknown value. */
+const char *vdsh_compare_name(uint32_t compare);
+
+/* The comparison named `name`, or VDSH_COMPARE_COUNT for none. */
+vdsh_compare vdsh_compare_by_name(const char *name);
 
 /* saturate((x - 1/3) * 1.5), computed as saturate(VDSH_RAMP_SLOPE * x -
  * VDSH_RAMP_OFFSET) so that x = 1/3 and x = 1 give exactly 0 and 1 in
