@@ -1,5 +1,5 @@
 /*
- * test_eval.c - the evaluator (bake/eval.h) against analytic truth and
+ * test_eval.c - the evaluator (bake/eval/eval.h) against analytic truth and
  * against itself. Scenes are generated here or are builtin:room, with small
  * ray counts, so the test needs no files and runs in seconds.
  *
@@ -530,7 +530,7 @@ static void test_oracle_and_threads(void)
         int inside = !(L[1] > cl && L[1] < 6.0f - cl && fabsf(L[0]) < 9.5f - cl &&
                        fabsf(L[2]) < 9.5f - cl);
         /* Not inside builtin:room's pillars (0.4 m square at (+-5.5,
-         * +-5.5), not at (-5.5, -5.5)) or its big crate (bake/builtin.c).
+         * +-5.5), not at (-5.5, -5.5)) or its big crate (bake/lib/builtin.c).
          * (The clearance is checked along the 14 probes only: near a
          * pillar's corner a light may sit a little closer.) */
         const float pillar[3][2] = {{-5.5f, 5.5f}, {5.5f, 5.5f}, {5.5f, -5.5f}};

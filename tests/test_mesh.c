@@ -1,5 +1,5 @@
 /*
- * test_mesh.c - tests for bake/mesh.h: SHA-256, loading and its error
+ * test_mesh.c - tests for bake/lib/mesh.h: SHA-256, loading and its error
  * messages (fixtures written at run time), cleaning, normals, welding,
  * appending, the built-in room and its seeded variants (closed and facing
  * free space, checked with rays through Embree), refinement, OBJ output.
