@@ -3,7 +3,8 @@
  * stratified set of rays against the occluder scene and project the hit
  * distances onto real SH (formats/vdsh_sh.h).
  *
- * Methods (the fit is fit.h's):
+ * Methods (their properties: one row each in method.h's table; the maps:
+ * fit.h):
  *   paper   the paper's demo (docs/DESIGN.md §1): directions over the
  *           whole sphere; those below the receiver's horizon (w.n < 0)
  *           count as distance 0 with the same 4 pi / N weight. They are not
