@@ -1,6 +1,11 @@
 # The bake core and the command-line tools (included from bake/CMakeLists.txt).
-add_library(vb_core STATIC sampling.c scene.c origins.c bake.c fit.c parallel.c)
+add_library(vb_core STATIC lib/sampling.c lib/scene.c lib/origins.c lib/bake.c lib/stream.c
+            lib/fit.c lib/method.c lib/parallel.c)
 target_link_libraries(vb_core PUBLIC vb_mesh vdsh_format embree Threads::Threads m)
-add_executable(vdsh-bake vdsh_bake.c)
-target_link_libraries(vdsh-bake PRIVATE vb_core vb_cubemap vt_tools)
+# A whole bake as one straight line (job.h): load, refine, bake, fill the
+# file, write it with its basis cubemaps.
+add_library(vb_job STATIC lib/job.c)
+target_link_libraries(vb_job PUBLIC vb_core vb_cubemap)
+add_executable(vdsh-bake tools/vdsh_bake.c)
+target_link_libraries(vdsh-bake PRIVATE vb_job vt_tools)
 install(TARGETS vdsh-bake RUNTIME DESTINATION bin)

@@ -204,45 +204,50 @@ const char *vdsh_result_str(vdsh_result r)
     return "unknown result";
 }
 
-static const char *name_of(uint32_t v, const char *const *names, uint32_t n)
+static const char *name_of(uint32_t v, const char *const *names, size_t n)
 {
     return v < n ? names[v] : "?";
 }
 
+/* The names of an enum's values, by value: the count is the table's. */
+#define NAME_OF(v, names) name_of((v), (names), sizeof(names) / sizeof((names)[0]))
+
 const char *vdsh_method_name(uint32_t method)
 {
-    static const char *const n[] = {"paper", "full", "mirror", "lsq", "shadow"};
-    return name_of(method, n, 5);
+    static const char *const n[] = {[VDSH_METHOD_PAPER] = "paper", [VDSH_METHOD_FULL] = "full",
+                                    [VDSH_METHOD_MIRROR] = "mirror", [VDSH_METHOD_LSQ] = "lsq",
+                                    [VDSH_METHOD_SHADOW] = "shadow"};
+    return NAME_OF(method, n);
 }
 
 const char *vdsh_encoding_name(uint32_t encoding)
 {
     static const char *const n[] = {"f32", "f16"};
-    return name_of(encoding, n, 2);
+    return NAME_OF(encoding, n);
 }
 
 const char *vdsh_quantity_name(uint32_t quantity)
 {
     static const char *const n[] = {"distance", "distance2", "log-distance"};
-    return name_of(quantity, n, 3);
+    return NAME_OF(quantity, n);
 }
 
 const char *vdsh_window_name(uint32_t window)
 {
     static const char *const n[] = {"none", "hann", "lanczos"};
-    return name_of(window, n, 3);
+    return NAME_OF(window, n);
 }
 
 const char *vdsh_sampling_name(uint32_t sampling)
 {
     static const char *const n[] = {"sphere", "hemisphere"};
-    return name_of(sampling, n, 2);
+    return NAME_OF(sampling, n);
 }
 
 const char *vdsh_offset_rule_name(uint32_t rule)
 {
     static const char *const n[] = {"none", "wb-avg"};
-    return name_of(rule, n, 2);
+    return NAME_OF(rule, n);
 }
 
 /* ------------------------------------------------------------------ */
@@ -1675,6 +1680,12 @@ vdsh_result vdsh_write_memory(const vdsh_file *f, void **out_data,
 
 vdsh_result vdsh_write(const char *path, const vdsh_file *f, vdsh_error *err)
 {
+    return vdsh_write_sized(path, f, NULL, err);
+}
+
+vdsh_result vdsh_write_sized(const char *path, const vdsh_file *f, uint64_t *size,
+                             vdsh_error *err)
+{
     plan P;
     if (!path)
         return fail(err, VDSH_ERR_ARGUMENT, "(null)",
@@ -1695,6 +1706,7 @@ vdsh_result vdsh_write(const char *path, const vdsh_file *f, vdsh_error *err)
     }
     sink s = {NULL, out.fp, 0, 0};
     plan_emit(&P, &s);
+    uint64_t total = P.file_size;
     plan_free(&P);
     if (s.error) {
         res = fail(err, VDSH_ERR_IO, path, "cannot write%s%s: %s",
@@ -1703,5 +1715,8 @@ vdsh_result vdsh_write(const char *path, const vdsh_file *f, vdsh_error *err)
         vdsh_output_abort(&out);
         return res;
     }
-    return vdsh_output_commit(&out, err);
+    res = vdsh_output_commit(&out, err);
+    if (res == VDSH_OK && size)
+        *size = total;
+    return res;
 }

@@ -56,8 +56,18 @@ extern "C" {
 #endif
 
 #define VDSH_FORMAT_VERSION 1u
+/* The largest SH order a stream stores: every size below, in the bake and
+ * in the runtime, is derived from it. */
 #define VDSH_MAX_ORDER 5
-#define VDSH_MAX_COEFFS (VDSH_MAX_ORDER * VDSH_MAX_ORDER)
+/* Coefficients of order n (bands 0..n-1). */
+#define VDSH_COEFFS(n) ((n) * (n))
+#define VDSH_MAX_COEFFS VDSH_COEFFS(VDSH_MAX_ORDER)
+/* Arrays indexed by order 1..VDSH_MAX_ORDER ([0] unused). */
+#define VDSH_ORDER_SLOTS (VDSH_MAX_ORDER + 1)
+/* Functions in the highest band, 2l + 1 for l = VDSH_MAX_ORDER - 1. */
+#define VDSH_MAX_BAND_WIDTH (2 * VDSH_MAX_ORDER - 1)
+/* Coefficients of orders 1..n together: 1 + 4 + ... + n^2. */
+#define VDSH_COEFFS_THROUGH(n) ((n) * ((n) + 1) * (2 * (n) + 1) / 6)
 #define VDSH_MAX_STREAMS 16
 #define VDSH_MAX_SOURCES 64
 #define VDSH_MAX_NAME 4096
@@ -218,6 +228,11 @@ void vdsh_free(vdsh_file *f);
  * as the reader (VDSH_ERR_ARGUMENT names the offending field). Pointers in
  * `f` are borrowed; storage_ is ignored. */
 vdsh_result vdsh_write(const char *path, const vdsh_file *f, vdsh_error *err);
+
+/* vdsh_write, and on success the file's size in bytes in *size (may be
+ * NULL; untouched on failure): a caller need not open the file again. */
+vdsh_result vdsh_write_sized(const char *path, const vdsh_file *f, uint64_t *size,
+                             vdsh_error *err);
 
 /* Serialise to memory. On success *out_data is a malloc'd buffer the
  * caller frees with free(). */

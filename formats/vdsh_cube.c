@@ -63,10 +63,10 @@ void vdsh_cube_gl_to_exr(int face, int i, int j, int n, int *ei, int *ej)
     }
 }
 
-/* The 25 basis functions at the centre of OpenEXR texel (i, j) of
+/* The VDSH_MAX_COEFFS basis functions at the centre of OpenEXR texel (i, j) of
  * `face`: the one computation behind both fills below, so the runtime's
  * textures and the bake's files hold the same values. */
-static void exr_texel_basis(int face, int i, int j, int n, float y[25])
+static void exr_texel_basis(int face, int i, int j, int n, float y[VDSH_MAX_COEFFS])
 {
     float d[3];
     vdsh_cube_exr_dir(face, i, j, n, d);
@@ -74,7 +74,7 @@ static void exr_texel_basis(int face, int i, int j, int n, float y[25])
     d[0] *= inv;
     d[1] *= inv;
     d[2] *= inv;
-    vdsh_sh_eval(5, d, y);
+    vdsh_sh_eval(VDSH_MAX_ORDER, d, y);
 }
 
 void vdsh_cube_fill_basis(int n, int first, float *rgba)
@@ -84,7 +84,7 @@ void vdsh_cube_fill_basis(int n, int first, float *rgba)
     for (int face = 0; face < 6; face++) {
         for (int j = 0; j < n; j++) {
             for (int i = 0; i < n; i++) {
-                float y[25];
+                float y[VDSH_MAX_COEFFS];
                 exr_texel_basis(face, i, j, n, y);
                 float *o = rgba + (((size_t)face * (size_t)n + (size_t)j) * (size_t)n + (size_t)i) * 4;
                 o[0] = y[first];
@@ -102,7 +102,7 @@ void vdsh_cube_basis_face_gl_f16(int n, int face, uint16_t *const out[4])
     for (int j = 0; j < n; j++) {
         for (int i = 0; i < n; i++) {
             int ei, ej;
-            float y[25];
+            float y[VDSH_MAX_COEFFS];
             vdsh_cube_gl_to_exr(face, i, j, n, &ei, &ej);
             exr_texel_basis(face, ei, ej, n, y);
             size_t t = ((size_t)j * (size_t)n + (size_t)i) * 4;

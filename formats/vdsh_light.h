@@ -1,6 +1,6 @@
 /*
  * vdsh_light.h - where point lights may go: the one definition of "a light
- * in the scene's free space", shared by the evaluator (bake/eval.c, which
+ * in the scene's free space", shared by the evaluator (bake/eval/eval.c, which
  * casts the probes with Embree) and the runtime's default lights
  * (runtime/, which casts them on the CPU against the drawn mesh).
  *

@@ -1,4 +1,5 @@
 #include "vdsh_sh.h"
+#include "vdsh.h"
 
 #include <assert.h>
 #include <math.h>
@@ -46,6 +47,11 @@
             o[(i) * s] = (value);                        \
     } while (0)
 
+/* The closed forms below are written out for bands 0..KERNEL_ORDER-1: the
+ * stored orders (VDSH_MAX_ORDER); eval_high_bands goes further. */
+#define KERNEL_ORDER 5
+_Static_assert(KERNEL_ORDER == VDSH_MAX_ORDER, "sh_kernel covers the stored orders exactly");
+
 static inline __attribute__((always_inline)) void sh_kernel(int order, float x, float y, float z, float *o,
                              size_t s, int acc, float w)
 {
@@ -72,7 +78,7 @@ static inline __attribute__((always_inline)) void sh_kernel(int order, float x, 
     EMIT(13, -C31 * x * (5.0f * z2 - 1.0f));
     EMIT(14, C32B * z * (x2 - y2));
     EMIT(15, -C33 * x * (x2 - 3.0f * y2));
-    if (order < 5)
+    if (order < KERNEL_ORDER)
         return;
     EMIT(16, C44 * x * y * (x2 - y2));
     EMIT(17, -C43 * y * z * (3.0f * x2 - y2));
@@ -87,7 +93,7 @@ static inline __attribute__((always_inline)) void sh_kernel(int order, float x, 
 
 void vdsh_sh_eval(int order, const float d[3], float *out)
 {
-    assert(order >= 1 && order <= 5);
+    assert(order >= 1 && order <= VDSH_MAX_ORDER);
     sh_kernel(order, d[0], d[1], d[2], out, 1, 0, 0.0f);
 }
 
@@ -107,7 +113,7 @@ static inline __attribute__((always_inline)) void soa_dispatch(
     const float *w, float *o, size_t stride, int acc)
 {
     /* Packets of 16 with rows of 16 (the bake's layout) get their own
-     * loops: with constant sizes the compiler can see that the 25 output
+     * loops: with constant sizes the compiler can see that the output
      * rows never overlap, and vectorises. */
     if (n == 16 && stride == 16) {
         switch (order) {
@@ -168,7 +174,7 @@ static inline __attribute__((always_inline)) void eval_high_bands(
                 }
                 memcpy(p0, p1, cn * sizeof *p0);
                 memcpy(p1, pl, cn * sizeof *p1);
-                if (l < 5)
+                if (l < KERNEL_ORDER)
                     continue; /* the closed forms above */
                 double kk = (2.0 * l + 1.0) / (4.0 * 3.14159265358979323846);
                 for (int f = l - m + 1; f <= l + m; f++)
@@ -193,8 +199,8 @@ VDSH_CLONES void vdsh_sh_eval_soa(int order, size_t n, const float *x, const flo
                                   const float *z, float *out, size_t out_stride)
 {
     assert(order >= 1 && order <= VDSH_SH_EVAL_MAX_ORDER);
-    soa_dispatch(order < 5 ? order : 5, n, x, y, z, NULL, out, out_stride, 0);
-    if (order > 5)
+    soa_dispatch(order < KERNEL_ORDER ? order : KERNEL_ORDER, n, x, y, z, NULL, out, out_stride, 0);
+    if (order > KERNEL_ORDER)
         eval_high_bands(order, n, x, y, z, out, out_stride);
 }
 
@@ -202,13 +208,13 @@ VDSH_CLONES void vdsh_sh_project_soa(int order, size_t n, const float *x, const 
                          const float *z, const float *w, float *acc,
                          size_t acc_stride)
 {
-    assert(order >= 1 && order <= 5);
+    assert(order >= 1 && order <= VDSH_MAX_ORDER);
     soa_dispatch(order, n, x, y, z, w, acc, acc_stride, 1);
 }
 
 float vdsh_sh_reconstruct(int order, const float *c, const float d[3])
 {
-    float y[25];
+    float y[VDSH_MAX_COEFFS];
     vdsh_sh_eval(order, d, y);
     float sum = 0.0f;
     for (int i = 0; i < order * order; i++)

@@ -1,6 +1,7 @@
 #include "vdsh_shadow.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "vdsh.h"
 #include "vdsh_sh.h"
@@ -38,15 +39,48 @@ float vdsh_stream_distance(uint32_t order, uint32_t quantity, float max_distance
     return from_sum(quantity, max_distance, vdsh_sh_reconstruct((int)order, c, d));
 }
 
+/* The comparisons, for d_light > 0 (vdsh_shadow_compare handles the
+ * rest): one row each, by vdsh_compare value. */
+static float compare_smooth(float d_vis, float d_light)
+{
+    if (isinf(d_vis) && d_vis > 0.0f)
+        return 1.0f;
+    return vdsh_ramp(d_vis / d_light);
+}
+
+static float compare_binary(float d_vis, float d_light)
+{
+    return d_vis >= d_light ? 1.0f : 0.0f;
+}
+
+static const struct {
+    const char *name;
+    float (*fn)(float d_vis, float d_light);
+} compares[VDSH_COMPARE_COUNT] = {
+    [VDSH_COMPARE_SMOOTH] = {"smooth", compare_smooth},
+    [VDSH_COMPARE_BINARY] = {"binary", compare_binary},
+};
+
+const char *vdsh_compare_name(uint32_t compare)
+{
+    return compare < VDSH_COMPARE_COUNT ? compares[compare].name : "?";
+}
+
+vdsh_compare vdsh_compare_by_name(const char *name)
+{
+    for (int i = 0; i < VDSH_COMPARE_COUNT; i++)
+        if (strcmp(compares[i].name, name) == 0)
+            return (vdsh_compare)i;
+    return VDSH_COMPARE_COUNT;
+}
+
 float vdsh_shadow_compare(float d_vis, float d_light, uint32_t compare)
 {
     if (!(d_light > 0.0f)) /* at the receiver (or NaN): unshadowed */
         return d_light == 0.0f ? 1.0f : 0.0f;
-    if (compare == VDSH_COMPARE_BINARY)
-        return d_vis >= d_light ? 1.0f : 0.0f;
-    if (isinf(d_vis) && d_vis > 0.0f)
-        return 1.0f;
-    return vdsh_ramp(d_vis / d_light);
+    /* An unknown value compares smoothly, as before the table. */
+    return compares[compare < VDSH_COMPARE_COUNT ? compare : VDSH_COMPARE_SMOOTH].fn(d_vis,
+                                                                                     d_light);
 }
 
 float vdsh_shadow(uint32_t order, uint32_t quantity, float max_distance,

@@ -33,10 +33,21 @@
 extern "C" {
 #endif
 
+/* How a reconstructed distance d_V is compared with the light's d_L. One
+ * row per value in vdsh_shadow.c's table (its name and its function);
+ * adding one: a value here, its row there, its GLSL in runtime/vr_glsl.c
+ * (tested against this file by tests/test_runtime_glsl.c). */
 typedef enum vdsh_compare {
-    VDSH_COMPARE_SMOOTH = 0, /* the paper's ramp */
-    VDSH_COMPARE_BINARY = 1  /* the paper's reference step */
+    VDSH_COMPARE_SMOOTH = 0, /* the paper's ramp (the default) */
+    VDSH_COMPARE_BINARY = 1, /* the paper's reference step */
+    VDSH_COMPARE_COUNT
 } vdsh_compare;
+
+/* "smooth", "binary"; "?" for an unknown value. */
+const char *vdsh_compare_name(uint32_t compare);
+
+/* The comparison named `name`, or VDSH_COMPARE_COUNT for none. */
+vdsh_compare vdsh_compare_by_name(const char *name);
 
 /* saturate((x - 1/3) * 1.5), computed as saturate(VDSH_RAMP_SLOPE * x -
  * VDSH_RAMP_OFFSET) so that x = 1/3 and x = 1 give exactly 0 and 1 in
@@ -55,6 +66,22 @@ float vdsh_ramp(float x);
  * (max_distance +Inf), so that the runtime's interpolation of per-vertex
  * distances never meets 0 * inf. */
 #define VDSH_LOG_SUM_MAX 80.0f
+
+/* The relative light model, the evaluator's secondary metric and the
+ * bake's choice of quantity (bake.h, VB_QUANTITY_AUTO): one light per
+ * direction at d_L = 2 u d_T, d_T the true distance, u uniform in
+ * (VDSH_LIGHT_U_MIN, 1]. vdsh_light_u maps t in (0, 1] onto u, in double
+ * (the bake) and in float (the evaluator), each with the literals it has
+ * always used, so the results keep their bits. */
+#define VDSH_LIGHT_U_MIN 0.05
+static inline double vdsh_light_u(double t)
+{
+    return VDSH_LIGHT_U_MIN + (1.0 - VDSH_LIGHT_U_MIN) * t;
+}
+static inline float vdsh_light_u_f(float t)
+{
+    return (float)VDSH_LIGHT_U_MIN + (float)(1.0 - VDSH_LIGHT_U_MIN) * t;
+}
 
 /* The distance a stream reconstructs toward unit direction d, in
  * [0, max_distance]: quantity distance: the SH sum; distance2: sqrt of the

@@ -137,7 +137,7 @@ static void bench_print(const vv_options *o, const bench_scene *b, int rounds, v
     vr_scene_info info;
     vr_scene_get_info(b->scene, &info);
     uint32_t method = 0;
-    for (int k = 1; k <= 5; k++)
+    for (int k = 1; k <= VDSH_MAX_ORDER; k++)
         if (info.has_order[k])
             method = info.method[k];
     cJSON *so = vt_json_object(j, list, NULL);

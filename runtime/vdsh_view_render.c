@@ -51,7 +51,7 @@ static void bake_label(const char *path, const vr_scene *s, char *out, size_t si
     vr_scene_get_info(s, &info);
     const char *slash = strrchr(path, '/');
     uint32_t method = 0;
-    for (int k = 1; k <= 5; k++)
+    for (int k = 1; k <= VDSH_MAX_ORDER; k++)
         if (info.has_order[k])
             method = info.method[k];
     snprintf(out, size, "%s: %s bake, %s", slash ? slash + 1 : path, vdsh_method_name(method),

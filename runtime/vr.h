@@ -165,10 +165,10 @@ typedef struct vr_scene_info {
     uint32_t triangle_count;
     float bounds_min[3];          /* of the receiver vertices */
     float bounds_max[3];
-    int has_order[6];             /* has_order[n]: a stream of order n */
-    vdsh_encoding encoding[6];    /* its encoding */
-    vdsh_method method[6];        /* how it was baked */
-    float scale[6];               /* its stream scale */
+    int has_order[VDSH_ORDER_SLOTS];          /* has_order[n]: a stream of order n */
+    vdsh_encoding encoding[VDSH_ORDER_SLOTS]; /* its encoding */
+    vdsh_method method[VDSH_ORDER_SLOTS];     /* how it was baked */
+    float scale[VDSH_ORDER_SLOTS];            /* its stream scale */
     int has_cubemaps;             /* basis cubemaps made */
     int cube_size;                /* their face size, or 0 */
     vdsh_quantity quantity;       /* the quantity drawn */

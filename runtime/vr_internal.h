@@ -65,13 +65,13 @@ struct vr_scene {
     vdsh_quantity quantity;
     float max_distance;         /* the file's: clamps reconstructed distances */
     GLuint vbo_position, vbo_normal, ibo;
-    /* Per order 1..5: the stream's buffer and a VAO with positions,
+    /* Per order 1..VDSH_MAX_ORDER: the stream's buffer and a VAO with positions,
      * normals and its coefficients; vao[0] has positions and normals only. */
-    GLuint vbo_stream[6];
-    GLuint vao[6];
-    vdsh_encoding encoding[6];
-    vdsh_method method[6];
-    float scale[6];
+    GLuint vbo_stream[VDSH_ORDER_SLOTS];
+    GLuint vao[VDSH_ORDER_SLOTS];
+    vdsh_encoding encoding[VDSH_ORDER_SLOTS];
+    vdsh_method method[VDSH_ORDER_SLOTS];
+    float scale[VDSH_ORDER_SLOTS];
     GLuint basis[4];            /* cube textures, functions 9+4k..12+4k */
     int cube_size;
     size_t gpu_bytes;

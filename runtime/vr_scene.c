@@ -25,7 +25,7 @@ static int has_quantity(const vdsh_file *f, uint32_t quantity)
 {
     for (uint32_t i = 0; i < f->stream_count; i++)
         if (f->streams[i].quantity == quantity && f->streams[i].order >= 1 &&
-            f->streams[i].order <= 5)
+            f->streams[i].order <= VDSH_MAX_ORDER)
             return 1;
     return 0;
 }
@@ -188,7 +188,7 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     vdsh_quantity quantity = desc->quantity;
     if (!has_quantity(f, quantity))
         for (uint32_t i = 0; i < f->stream_count; i++)
-            if (f->streams[i].order >= 1 && f->streams[i].order <= 5) {
+            if (f->streams[i].order >= 1 && f->streams[i].order <= VDSH_MAX_ORDER) {
                 quantity = f->streams[i].quantity;
                 break;
             }

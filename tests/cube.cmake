@@ -1,5 +1,5 @@
 # Cube-face conventions (formats/vdsh_cube.c) and SH basis cubemap files
-# (bake/cubemap_exr.c). Run with: ctest -R cube
+# (bake/lib/cubemap_exr.c). Run with: ctest -R cube
 find_package(OpenEXR REQUIRED)
 
 set(VDSH_CUBE_TEST_DIR ${CMAKE_CURRENT_BINARY_DIR}/cube_tmp)

@@ -1,4 +1,4 @@
-# The evaluator (bake/eval.h, vdsh-eval): reconstruction against ray-cast
+# The evaluator (bake/eval/eval.h, vdsh-eval): reconstruction against ray-cast
 # ground truth on generated scenes and builtin:room (no files needed).
 #   eval_<part>  test_eval.c, one part each (see its header)
 #   eval_cli     vdsh-bake + vdsh-eval end to end: exit codes, messages,

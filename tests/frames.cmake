@@ -1,4 +1,4 @@
-# vdsh-frames and its core (bake/frames.h): ray-traced truth for frames and
+# vdsh-frames and its core (bake/eval/frames.h): ray-traced truth for frames and
 # image scores. test_frames.c, one part each (see its header):
 #   frames_score   the scores on hand-made frames (no files)
 #   frames_oracle  the truth scored as a method is exact (built-in room)

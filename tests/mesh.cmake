@@ -1,4 +1,4 @@
-# Mesh input (bake/mesh.h): loading, validation, welding, normals, the
+# Mesh input (bake/lib/mesh.h): loading, validation, welding, normals, the
 # built-in room and its variants, refinement, OBJ output, SHA-256.
 #   mesh_unit    no data needed: fixtures are written to a temporary folder
 #   mesh_parse   the readers alone, on bytes in memory
@@ -16,7 +16,7 @@ add_test(NAME mesh_scenes COMMAND test_mesh scenes ${VDSH_SHARED_SCENES})
 add_test(NAME mesh_assimp COMMAND test_mesh assimp ${VDSH_ASSIMP_MODELS})
 set_tests_properties(mesh_scenes mesh_assimp PROPERTIES SKIP_RETURN_CODE 77)
 
-# The strict readers (bake/mesh_parse.h) on bytes: the values bakes depend
+# The strict readers (bake/lib/mesh_parse.h) on bytes: the values bakes depend
 # on, and the files OpenMesh's readers misread that are now refused.
 add_executable(test_mesh_parse ${CMAKE_CURRENT_LIST_DIR}/test_mesh_parse.c)
 target_link_libraries(test_mesh_parse PRIVATE vb_mesh m)

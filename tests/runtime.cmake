@@ -185,7 +185,7 @@ done
 cmp "$d/default.png" "$d/vdsh5.png"
 "$v" -q --render "$d/default-nocube.png" --size 160x120 --no-cubemaps "$room"
 cmp "$d/default-nocube.png" "$d/vdsh5poly.png"
-# Shadows where the room's geometry (bake/builtin.c) puts them. The light
+# Shadows where the room's geometry (bake/lib/builtin.c) puts them. The light
 # at (-4, 3.5, 1) is in front of the 1.58 m crate (x in [-4.79, -3.21], z
 # in [-3.79, -2.21]); the floor point (-4, 0, -4.2), 0.41 m behind the
 # crate, sees it through the crate; (-4, 0, 1.5) sees it 3.5 m away

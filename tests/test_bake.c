@@ -45,7 +45,7 @@ static void make_sphere(vb_mesh *m, float r, const float c[3])
         }
 }
 
-static int bake(const vb_mesh *occ, const vb_mesh *rec, uint32_t method,
+static int bake(const vb_mesh *occ, const vb_mesh *rec, vb_method method,
                 uint32_t rays, unsigned threads, vb_bake_output *out)
 {
     vb_error err;
@@ -54,7 +54,7 @@ static int bake(const vb_mesh *occ, const vb_mesh *rec, uint32_t method,
         fprintf(stderr, "scene: %s\n", err.msg);
         return 0;
     }
-    vb_bake_desc d = {.receivers = rec, .scene = s, .rays = rays, .seed = 5,
+    vb_bake_desc d = {.keep_normals = 1, .receivers = rec, .scene = s, .rays = rays, .seed = 5,
                       .method = method, .threads = threads};
     vb_result r = vb_bake_run(&d, out, &err);
     if (r != VB_OK)
@@ -77,8 +77,8 @@ static void test_sphere_centre(void)
     test_make_points(&rec, 1, c, n);
 
     vb_bake_output full = {0}, paper = {0};
-    CHECK(bake(&occ, &rec, VDSH_METHOD_FULL, 2500, 2, &full), "full bake");
-    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 2500, 2, &paper), "paper bake");
+    CHECK(bake(&occ, &rec, VB_METHOD_FULL, 2500, 2, &full), "full bake");
+    CHECK(bake(&occ, &rec, VB_METHOD_PAPER, 2500, 2, &paper), "paper bake");
     if (!full.coeffs[5] || !paper.coeffs[5])
         goto out;
     CHECK(full.rays_missed == 0, "%llu rays escaped a closed sphere",
@@ -164,7 +164,7 @@ static void test_box_floor(void)
         n[3 * i] = 0, n[3 * i + 1] = 1, n[3 * i + 2] = 0;
     test_make_points(&rec, NP, p, n);
     vb_bake_output out = {0};
-    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 10000, 2, &out), "box bake");
+    CHECK(bake(&occ, &rec, VB_METHOD_PAPER, 10000, 2, &out), "box bake");
     if (!out.coeffs[5])
         goto done;
     CHECK(out.rays_missed == 0, "%llu rays escaped a closed box",
@@ -324,8 +324,8 @@ static void test_threads(void)
     }
     test_make_points(&rec, NP, p, n);
     vb_bake_output one = {0}, two = {0};
-    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 400, 1, &one), "1 thread");
-    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 400, 2, &two), "2 threads");
+    CHECK(bake(&occ, &rec, VB_METHOD_PAPER, 400, 1, &one), "1 thread");
+    CHECK(bake(&occ, &rec, VB_METHOD_PAPER, 400, 2, &two), "2 threads");
     if (one.coeffs[5] && two.coeffs[5])
         CHECK(memcmp(one.coeffs[5], two.coeffs[5], NP * 25 * sizeof(float)) == 0,
               "1 and 2 threads differ");
@@ -361,9 +361,9 @@ static void test_shadow_offset(void)
     const float mine[VDSH_MAX_ORDER + 1] = {0, -0.3f, -0.3f, -0.3f, -0.3f, -0.3f};
     vb_bake_output b[3] = {{0}};
     for (int i = 0; i < 3 && sc; i++) {
-        vb_bake_desc d = {.receivers = &rec, .scene = sc, .rays = 400, .seed = 5,
-                          .method = i ? VDSH_METHOD_SHADOW : VDSH_METHOD_LSQ,
-                          .quantity = VDSH_QUANTITY_LOG_DISTANCE, .log_offsets = i == 2 ? mine : NULL,
+        vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = sc, .rays = 400, .seed = 5,
+                          .method = i ? VB_METHOD_SHADOW : VB_METHOD_LSQ,
+                          .quantity = VB_QUANTITY_LOG, .log_offsets = i == 2 ? mine : NULL,
                           .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
         CHECK(vb_bake_run(&d, &b[i], &err) == VB_OK, "bake %d: %s", i, err.msg);
     }

@@ -1,6 +1,6 @@
 /*
  * test_cube.c - cube-face conventions (formats/vdsh_cube.c) and the basis
- * cubemap files (bake/cubemap_exr.c).
+ * cubemap files (bake/lib/cubemap_exr.c).
  *
  *   test_cube conventions          pure math: GL table, EXR<->GL, basis
  *   test_cube files DIR            write/read round trips, header, bytes;

@@ -1,5 +1,5 @@
 // test_cube_openexr.cpp - our cube-face convention (formats/vdsh_cube.h)
-// and our files (bake/cubemap_exr.c) against OpenEXR's own C++ library:
+// and our files (bake/lib/cubemap_exr.c) against OpenEXR's own C++ library:
 // Imf::CubeMap::faceAndPixelPosition / pixelPosition / direction
 // (ImfEnvmap.cpp) and the C++ RGBA file reader and writer.
 //

@@ -1,5 +1,5 @@
 /*
- * test_eval.c - the evaluator (bake/eval.h) against analytic truth and
+ * test_eval.c - the evaluator (bake/eval/eval.h) against analytic truth and
  * against itself. Scenes are generated here or are builtin:room, with small
  * ray counts, so the test needs no files and runs in seconds.
  *
@@ -103,7 +103,7 @@ typedef struct memfile {
 } memfile;
 
 static void make_file(memfile *mf, const vb_mesh *rec, const vb_scene *s,
-                      const vb_bake_output *b, uint32_t method, uint32_t encoding,
+                      const vb_bake_output *b, vb_method method, uint32_t encoding,
                       const int *orders, int norders)
 {
     memset(mf, 0, sizeof *mf);
@@ -126,7 +126,7 @@ static void make_file(memfile *mf, const vb_mesh *rec, const vb_scene *s,
         CHECK(vb_bake_stream(b, orders[i], encoding, &mf->streams[i], &mf->data[i], &err) ==
                   VB_OK,
               "stream of order %d: %s", orders[i], err.msg);
-        mf->streams[i].method = method;
+        mf->streams[i].method = vb_method_get(method)->stored;
     }
     f->stream_count = (uint32_t)norders;
     f->streams = mf->streams;
@@ -139,11 +139,11 @@ static void free_file(memfile *mf)
     memset(mf, 0, sizeof *mf);
 }
 
-static int bake(const vb_mesh *rec, const vb_scene *s, uint32_t method, uint32_t rays,
+static int bake(const vb_mesh *rec, const vb_scene *s, vb_method method, uint32_t rays,
                 uint64_t seed, vb_bake_output *out)
 {
     vb_error err;
-    vb_bake_desc d = {.receivers = rec, .scene = s, .rays = rays, .seed = seed,
+    vb_bake_desc d = {.keep_normals = 1, .receivers = rec, .scene = s, .rays = rays, .seed = seed,
                       .method = method, .threads = 2,
                       .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
     vb_result r = vb_bake_run(&d, out, &err);
@@ -249,7 +249,9 @@ static void test_sphere(void)
     if (!scene_from(&occ, &s))
         goto out;
     const int orders[3] = {2, 3, 5};
-    for (uint32_t method = VDSH_METHOD_PAPER; method <= VDSH_METHOD_FULL; method++) {
+    static const vb_method sphere_methods[2] = {VB_METHOD_PAPER, VB_METHOD_FULL};
+    for (int k_m = 0; k_m < 2; k_m++) {
+        const vb_method method = sphere_methods[k_m];
         vb_bake_output b = {0};
         memfile mf;
         vb_eval_result r = {0};
@@ -271,7 +273,7 @@ static void test_sphere(void)
         for (int i = 0; i < 3; i++) {
             const vb_eval_metrics *mv = &r.metrics[VB_EVAL_VERTICES][i];
             const vb_eval_metrics *mi = &r.metrics[VB_EVAL_INTERIOR][i];
-            if (method == VDSH_METHOD_FULL) {
+            if (method == VB_METHOD_FULL) {
                 /* D = R everywhere: only the bake's sampling noise is left
                  * (it grows with the band: about 1% RMS at order 5). */
                 const double bound[3] = {0.01, 0.01, 0.02};
@@ -333,12 +335,12 @@ static void test_room(void)
      * own views of the light, which is not a property of the fit). */
     vb_eval_desc d = {.interior = 4096, .interp = 1 + VDSH_INTERP_COEFFICIENTS};
     for (int i = 0; i < 3; i++) {
-        CHECK(bake(&rec, s, VDSH_METHOD_PAPER, rays[i], 11, &b[i]), "bake %u", rays[i]);
+        CHECK(bake(&rec, s, VB_METHOD_PAPER, rays[i], 11, &b[i]), "bake %u", rays[i]);
         if (!b[i].coeffs[5]) {
             memset(&mf[i], 0, sizeof mf[i]);
             continue;
         }
-        make_file(&mf[i], &rec, s, &b[i], VDSH_METHOD_PAPER, VDSH_ENCODING_F32, orders, 3);
+        make_file(&mf[i], &rec, s, &b[i], VB_METHOD_PAPER, VDSH_ENCODING_F32, orders, 3);
         CHECK(evaluate(&mf[i].f, s, d, &r[i]), "evaluate %u rays", rays[i]);
     }
     if (!r[0].metrics[0] || !r[1].metrics[0] || !r[2].metrics[0])
@@ -420,7 +422,7 @@ static void test_methods(void)
         goto out;
     }
     const int orders[3] = {2, 3, 5};
-    const uint32_t methods[3] = {VDSH_METHOD_PAPER, VDSH_METHOD_LSQ, VDSH_METHOD_SHADOW};
+    const vb_method methods[3] = {VB_METHOD_PAPER, VB_METHOD_LSQ, VB_METHOD_SHADOW};
     vb_bake_output b[3] = {{0}};
     memfile mf[3];
     vb_eval_result r[3] = {{0}};
@@ -428,16 +430,16 @@ static void test_methods(void)
     memset(mf, 0, sizeof mf);
     for (int i = 0; i < 3; i++) {
         vb_error err;
-        vb_bake_desc d = {.receivers = &rec, .scene = s, .rays = 1024, .seed = 5,
+        vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = s, .rays = 1024, .seed = 5,
                           .method = methods[i], .threads = 2,
-                          .quantity = i ? VDSH_QUANTITY_LOG_DISTANCE : VDSH_QUANTITY_DISTANCE,
+                          .quantity = i ? VB_QUANTITY_LOG : VB_QUANTITY_DISTANCE,
                           .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
         CHECK(vb_bake_run(&d, &b[i], &err) == VB_OK, "bake %s: %s",
-              vdsh_method_name(methods[i]), err.msg);
+              vb_method_name(methods[i]), err.msg);
         if (!b[i].coeffs[5])
             goto done;
         make_file(&mf[i], &rec, s, &b[i], methods[i], VDSH_ENCODING_F16, orders, 3);
-        CHECK(evaluate(&mf[i].f, s, ed, &r[i]), "evaluate %s", vdsh_method_name(methods[i]));
+        CHECK(evaluate(&mf[i].f, s, ed, &r[i]), "evaluate %s", vb_method_name(methods[i]));
         if (!r[i].metrics[0])
             goto done;
     }
@@ -459,8 +461,8 @@ static void test_methods(void)
                     double tol = 3 * hypot(m[i]->shadow_mae_se, m[j]->shadow_mae_se);
                     CHECK(m[j]->shadow_mae < m[i]->shadow_mae - tol,
                           "%s order %d: %s %g not below %s %g by 3 se (%g)",
-                          k ? "interior" : "vertices", orders[o], vdsh_method_name(methods[j]),
-                          m[j]->shadow_mae, vdsh_method_name(methods[i]), m[i]->shadow_mae, tol);
+                          k ? "interior" : "vertices", orders[o], vb_method_name(methods[j]),
+                          m[j]->shadow_mae, vb_method_name(methods[i]), m[i]->shadow_mae, tol);
                 }
             CHECK(m[2]->false_shadow < m[1]->false_shadow && m[2]->false_shadow < m[0]->false_shadow,
                   "%s order %d: shadow's false shadows %g not below lsq's %g and paper's %g",
@@ -493,10 +495,10 @@ static void test_oracle_and_threads(void)
     vb_bake_output b = {0};
     memfile mf;
     vb_eval_result one = {0}, two = {0}, oracle = {0};
-    CHECK(bake(&rec, s, VDSH_METHOD_PAPER, 256, 1, &b), "bake");
+    CHECK(bake(&rec, s, VB_METHOD_PAPER, 256, 1, &b), "bake");
     if (!b.coeffs[5])
         goto out;
-    make_file(&mf, &rec, s, &b, VDSH_METHOD_PAPER, VDSH_ENCODING_F16, orders, 2);
+    make_file(&mf, &rec, s, &b, VB_METHOD_PAPER, VDSH_ENCODING_F16, orders, 2);
 
     vb_eval_desc d = {.interior = 3000, .points = 2000, .per_vertex = 1};
     d.oracle = 1;
@@ -528,7 +530,7 @@ static void test_oracle_and_threads(void)
         int inside = !(L[1] > cl && L[1] < 6.0f - cl && fabsf(L[0]) < 9.5f - cl &&
                        fabsf(L[2]) < 9.5f - cl);
         /* Not inside builtin:room's pillars (0.4 m square at (+-5.5,
-         * +-5.5), not at (-5.5, -5.5)) or its big crate (bake/builtin.c).
+         * +-5.5), not at (-5.5, -5.5)) or its big crate (bake/lib/builtin.c).
          * (The clearance is checked along the 14 probes only: near a
          * pillar's corner a light may sit a little closer.) */
         const float pillar[3][2] = {{-5.5f, 5.5f}, {5.5f, 5.5f}, {5.5f, -5.5f}};

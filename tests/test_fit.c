@@ -38,7 +38,7 @@ static void test_rotation(void)
 {
     vb_fit f;
     vb_error err;
-    CHECK(vb_fit_create(5, VDSH_METHOD_PAPER, 0, &f, &err) == VB_OK, "fit");
+    CHECK(vb_fit_create(5, VB_FIT_IDENTITY, 0, &f, &err) == VB_OK, "fit");
     uint64_t s = 3;
     double worst = 0, orth = 0;
     for (int t = 0; t < 50; t++) {
@@ -78,7 +78,7 @@ static void test_factored_fit(void)
     vb_error err;
     uint64_t s = 42;
     double worst = 0;
-    for (uint32_t method = VDSH_METHOD_MIRROR; method <= VDSH_METHOD_LSQ; method++)
+    for (vb_fit_base method = VB_FIT_MIRROR; method <= VB_FIT_LSQ; method++)
         for (int order = 1; order <= 5; order++) {
             vb_fit f, top;
             CHECK(vb_fit_create(order, method, 1e-3f, &f, &err) == VB_OK, "fit");
@@ -137,7 +137,7 @@ static void test_lsq_recovers(void)
     for (int order = 2; order <= 5; order++) {
         vb_fit f;
         float lambda = order == 5 ? 1e-4f : 0.0f;
-        CHECK(vb_fit_create(order, VDSH_METHOD_LSQ, lambda, &f, &err) == VB_OK, "lsq %d: %s",
+        CHECK(vb_fit_create(order, VB_FIT_LSQ, lambda, &f, &err) == VB_OK, "lsq %d: %s",
               order, err.msg);
         int n = order * order;
         uint64_t s = 10 + order;
@@ -191,8 +191,8 @@ static void test_mirror_and_paper(void)
 {
     vb_error err;
     vb_fit f, p;
-    CHECK(vb_fit_create(5, VDSH_METHOD_MIRROR, 0, &f, &err) == VB_OK, "mirror");
-    CHECK(vb_fit_create(5, VDSH_METHOD_PAPER, 0, &p, &err) == VB_OK, "paper");
+    CHECK(vb_fit_create(5, VB_FIT_MIRROR, 0, &f, &err) == VB_OK, "mirror");
+    CHECK(vb_fit_create(5, VB_FIT_IDENTITY, 0, &p, &err) == VB_OK, "paper");
     uint64_t s = 77;
     float nrm[3];
     test_rand_dir(&s, nrm);
@@ -248,7 +248,7 @@ static void test_window(void)
         b[i] = 2 * test_rand(&s) - 1;
     float nrm[3];
     test_rand_dir(&s, nrm);
-    for (uint32_t method = VDSH_METHOD_PAPER; method <= VDSH_METHOD_LSQ; method++)
+    for (vb_fit_base method = VB_FIT_IDENTITY; method <= VB_FIT_LSQ; method++)
         for (uint32_t win = VDSH_WINDOW_HANN; win <= VDSH_WINDOW_LANCZOS; win++) {
             vb_fit plain, windowed;
             CHECK(vb_fit_create(5, method, 1e-3f, &plain, &err) == VB_OK, "fit");
@@ -274,11 +274,50 @@ static void test_errors(void)
 {
     vb_fit f;
     vb_error err;
-    CHECK(vb_fit_create(6, VDSH_METHOD_LSQ, 0, &f, &err) == VB_ERR_ARGUMENT, "order 6");
-    CHECK(vb_fit_create(3, VDSH_METHOD_LSQ, -1, &f, &err) == VB_ERR_ARGUMENT, "lambda < 0");
-    CHECK(vb_fit_create(3, 99, 0, &f, &err) == VB_ERR_ARGUMENT, "unknown method");
+    CHECK(vb_fit_create(6, VB_FIT_LSQ, 0, &f, &err) == VB_ERR_ARGUMENT, "order 6");
+    CHECK(vb_fit_create(3, VB_FIT_LSQ, -1, &f, &err) == VB_ERR_ARGUMENT, "lambda < 0");
+    CHECK(vb_fit_create(3, (vb_fit_base)99, 0, &f, &err) == VB_ERR_ARGUMENT, "unknown base fit");
 }
 
+
+/* method.h's table: one row per known method, found by value and by name,
+ * each refused quantity explained, its parameters consistent. */
+static void test_method_table(void)
+{
+    CHECK(vb_method_name((vb_method)0) == vdsh_method_name(VDSH_METHOD_SHADOW),
+          "zero is the default method, shadow");
+    int rows = 0;
+    for (uint32_t v = 0; v < 64; v++) {
+        const char *name = vdsh_method_name(v);
+        const vb_method_info *row = vb_method_stored(v);
+        CHECK((strcmp(name, "?") != 0) == (row != NULL), "stored method %u: named iff it has a row",
+              v);
+        if (!row)
+            continue;
+        rows++;
+        CHECK(vb_method_get(row->method) == row, "method %s: its row by its id", name);
+        CHECK(vb_method_by_name(name) == row, "method %s found by its name", name);
+        CHECK(row->quantities != 0, "method %s stores some quantity", name);
+        for (uint32_t q = VDSH_QUANTITY_DISTANCE; q <= VDSH_QUANTITY_LOG_DISTANCE; q += 2)
+            CHECK((row->quantities & VB_QUANTITY_BIT(q)) || row->refused[q],
+                  "method %s: refusing %s says why", name, vdsh_quantity_name(q));
+        CHECK((row->param == VB_PARAM_LOG_OFFSET) == (row->default_log_offset != NULL),
+              "method %s: a log offset has defaults", name);
+        CHECK(!(row->param == VB_PARAM_LAMBDA) || row->regularised,
+              "method %s: a recorded lambda is used", name);
+        CHECK(!row->horizon || !row->hemisphere, "method %s: horizon means sphere sampling", name);
+        vb_fit f;
+        vb_error err;
+        CHECK(vb_fit_create(3, row->fit, 1e-3f, &f, &err) == VB_OK && f.base == row->fit,
+              "method %s: fit.c builds its row's map", name);
+    }
+    CHECK(rows == VB_METHOD_COUNT, "%d rows for %d methods", rows, VB_METHOD_COUNT);
+    CHECK(vb_method_get(VB_METHOD_COUNT) == NULL, "no row past the table");
+    CHECK(vb_method_by_name("bogus") == NULL, "no such method");
+    CHECK(vb_quantity_stored(VB_QUANTITY_LOG) == VDSH_QUANTITY_LOG_DISTANCE &&
+              vb_quantity_stored(VB_QUANTITY_DISTANCE) == VDSH_QUANTITY_DISTANCE,
+          "quantities as stored");
+}
 
 int main(void)
 {
@@ -288,5 +327,6 @@ int main(void)
     test_mirror_and_paper();
     test_window();
     test_errors();
+    test_method_table();
     return test_report("test_fit");
 }

@@ -1,5 +1,5 @@
 /*
- * test_frames.c - vdsh-frames and its core (bake/frames.h), one part per
+ * test_frames.c - vdsh-frames and its core (bake/eval/frames.h), one part per
  * ctest:
  *
  *   score    the scores on hand-made frames: RMSE, PSNR, recall, false

@@ -1,6 +1,6 @@
 /*
  * test_fuzz_cubemap.c - fuzz target for the basis cubemap reader
- * (vb_cubemap_read, bake/cubemap.h): OpenEXR's header and chunk parsing
+ * (vb_cubemap_read, bake/lib/cubemap.h): OpenEXR's header and chunk parsing
  * as we drive it, our checks on shape and channels, the decode into our
  * buffer, the finiteness check.
  *

@@ -1,7 +1,7 @@
 /*
  * test_fuzz_mesh.c - fuzz target for mesh input: the strict readers
- * (bake/mesh_parse.h, vb_mesh_parse) on their own, then loading from
- * memory (bake/mesh.h: the same readers and the cleaning), then welding
+ * (bake/lib/mesh_parse.h, vb_mesh_parse) on their own, then loading from
+ * memory (bake/lib/mesh.h: the same readers and the cleaning), then welding
  * and refinement (OpenMesh) of whatever was accepted.
  *
  * One source, one binary per format: VDSH_FUZZ_EXT ("obj", "ply", "off",

@@ -15,7 +15,7 @@
 #include "vdsh_sh.h"
 #include "vdsh_shadow.h"
 
-static int bake_with(const vb_mesh *occ, const vb_mesh *rec, uint32_t method, uint32_t rays,
+static int bake_with(const vb_mesh *occ, const vb_mesh *rec, vb_method method, uint32_t rays,
                      int robust, vb_bake_output *out)
 {
     vb_error err;
@@ -25,7 +25,7 @@ static int bake_with(const vb_mesh *occ, const vb_mesh *rec, uint32_t method, ui
         fprintf(stderr, "scene: %s\n", err.msg);
         return 0;
     }
-    vb_bake_desc d = {.receivers = rec, .scene = s, .rays = rays, .seed = 3, .method = method};
+    vb_bake_desc d = {.keep_normals = 1, .receivers = rec, .scene = s, .rays = rays, .seed = 3, .method = method};
     vb_result r = vb_bake_run(&d, out, &err);
     if (r != VB_OK)
         fprintf(stderr, "bake: %s\n", err.msg);
@@ -33,7 +33,7 @@ static int bake_with(const vb_mesh *occ, const vb_mesh *rec, uint32_t method, ui
     return r == VB_OK;
 }
 
-static int bake(const vb_mesh *occ, const vb_mesh *rec, uint32_t method, uint32_t rays,
+static int bake(const vb_mesh *occ, const vb_mesh *rec, vb_method method, uint32_t rays,
                 vb_bake_output *out)
 {
     return bake_with(occ, rec, method, rays, 0, out);
@@ -67,8 +67,8 @@ static void test_corners(void)
     vb_mesh occ = {0}, rec = {0};
     refined_room(&occ, &rec, 4.0f, 3.0f, 2.5f);
     vb_bake_output out = {0}, fast = {0};
-    CHECK(bake_with(&occ, &rec, VDSH_METHOD_PAPER, 1024, 1, &out), "bake");
-    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 1024, &fast), "fast bake");
+    CHECK(bake_with(&occ, &rec, VB_METHOD_PAPER, 1024, 1, &out), "bake");
+    CHECK(bake(&occ, &rec, VB_METHOD_PAPER, 1024, &fast), "fast bake");
     if (!out.coeffs[5] || !fast.coeffs[5])
         goto done;
     CHECK(out.rays_missed == 0, "%llu rays escaped a closed room of unwelded quads",
@@ -144,8 +144,8 @@ static void test_degenerate_triangles(void)
     junk.vertex_count = nv0 + 120;
     junk.triangle_count = nt0 + 40;
     vb_bake_output a = {0}, b = {0};
-    CHECK(bake_with(&occ, &rec, VDSH_METHOD_PAPER, 400, 1, &a), "clean bake");
-    CHECK(bake_with(&junk, &rec, VDSH_METHOD_PAPER, 400, 1, &b), "bake with zero-area triangles");
+    CHECK(bake_with(&occ, &rec, VB_METHOD_PAPER, 400, 1, &a), "clean bake");
+    CHECK(bake_with(&junk, &rec, VB_METHOD_PAPER, 400, 1, &b), "bake with zero-area triangles");
     if (a.coeffs[5] && b.coeffs[5]) {
         double worst = 0;
         for (size_t i = 0; i < (size_t)rec.vertex_count * 25; i++)
@@ -165,7 +165,7 @@ static void test_degenerate_triangles(void)
     test_add_quad(&nee, n0, up);
     const float sl[4][3] = {{0, 1, -1}, {0, 1, 1}, {1e-5f, 2, 1}, {1e-5f, 2, -1}};
     test_add_quad(&nee, sl, up);
-    CHECK(bake(&nee, &rec, VDSH_METHOD_FULL, 400, &a), "bake with needles and slivers");
+    CHECK(bake(&nee, &rec, VB_METHOD_FULL, 400, &a), "bake with needles and slivers");
     if (a.coeffs[5])
         CHECK(all_finite(&a), "needles or slivers made a non-finite coefficient");
     vb_bake_output_free(&a);
@@ -184,8 +184,8 @@ static void test_undefined_normal(void)
     float p[6] = {0.5f, 1, 0.25f, -1, 0.3f, 1}, n[6] = {0};
     test_make_points(&rec, 2, p, n);
     vb_bake_output a = {0}, b = {0};
-    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 625, &a), "paper");
-    CHECK(bake(&occ, &rec, VDSH_METHOD_FULL, 625, &b), "full");
+    CHECK(bake(&occ, &rec, VB_METHOD_PAPER, 625, &a), "paper");
+    CHECK(bake(&occ, &rec, VB_METHOD_FULL, 625, &b), "full");
     if (a.coeffs[5] && b.coeffs[5]) {
         CHECK(all_finite(&a), "non-finite coefficients");
         CHECK(memcmp(a.coeffs[5], b.coeffs[5], 2 * 25 * sizeof(float)) == 0,
@@ -216,7 +216,7 @@ static void test_scale_and_offset(void)
     vb_mesh occ = {0}, rec = {0};
     refined_room(&occ, &rec, 4.0f, 3.0f, 2.5f);
     vb_bake_output ref = {0};
-    CHECK(bake_with(&occ, &rec, VDSH_METHOD_PAPER, 400, 1, &ref), "reference bake");
+    CHECK(bake_with(&occ, &rec, VB_METHOD_PAPER, 400, 1, &ref), "reference bake");
     size_t n = (size_t)rec.vertex_count * 25;
 
     struct { float scale, off; int exact; const char *what; } cases[] = {
@@ -232,7 +232,7 @@ static void test_scale_and_offset(void)
         transform(&o2, cases[c].scale, off);
         transform(&r2, cases[c].scale, off);
         vb_bake_output b = {0};
-        CHECK(bake_with(&o2, &r2, VDSH_METHOD_PAPER, 400, 1, &b), "%s", cases[c].what);
+        CHECK(bake_with(&o2, &r2, VB_METHOD_PAPER, 400, 1, &b), "%s", cases[c].what);
         if (b.coeffs[5]) {
             CHECK(b.rays_missed == ref.rays_missed, "%s: %llu rays escaped (%llu before)",
                   cases[c].what, (unsigned long long)b.rays_missed,
@@ -279,7 +279,7 @@ static void test_f16_range(void)
         transform(&occ, scales[k], zero);
         transform(&rec, scales[k], zero);
         vb_bake_output b = {0};
-        CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 256, &b), "bake at scale %g", scales[k]);
+        CHECK(bake(&occ, &rec, VB_METHOD_PAPER, 256, &b), "bake at scale %g", scales[k]);
         vdsh_stream s;
         void *mem = NULL;
         vb_error err;
@@ -328,7 +328,7 @@ static void test_coplanar_receivers(void)
     vb_error err;
     CHECK(vb_mesh_refine(&occ, 1.0f, &rec, &err) == VB_OK, "refine");
     vb_bake_output b = {0};
-    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 1024, &b), "bake");
+    CHECK(bake(&occ, &rec, VB_METHOD_PAPER, 1024, &b), "bake");
     if (!b.coeffs[5])
         goto done;
     double all_escape = b.max_distance * sqrt(M_PI); /* c0 when every ray misses */
@@ -363,7 +363,7 @@ static void test_open_mesh(void)
     vb_error err;
     CHECK(vb_mesh_refine(&occ, 0.5f, &rec, &err) == VB_OK, "refine");
     vb_bake_output b = {0};
-    CHECK(bake(&occ, &rec, VDSH_METHOD_PAPER, 2500, &b), "bake");
+    CHECK(bake(&occ, &rec, VB_METHOD_PAPER, 2500, &b), "bake");
     if (b.coeffs[5]) {
         CHECK(b.rays_missed == b.rays_traced, "%llu of %llu rays hit an open floor",
               (unsigned long long)(b.rays_traced - b.rays_missed),
@@ -441,6 +441,57 @@ static void test_inverted_normals(void)
     test_mesh_free(&rec);
 }
 
+/* The bake orients its receivers itself unless told to keep their normals
+ * (vb_bake_desc.keep_normals): the same coefficients, normals and count as
+ * vb_orient_receivers followed by a bake that keeps them, with the
+ * receivers' frames built once instead of twice. */
+static void test_orient_in_bake(void)
+{
+    vb_mesh m = {0}, rec = {0}, mine = {0};
+    test_make_room(&m, 4.0f, 3.0f, 2.5f);
+    add_box(&m, -1, 1, 1, 2, -0.5f, 0.5f, 1); /* floating, normals inverted */
+    vb_error err;
+    CHECK(vb_mesh_refine(&m, 0.5f, &rec, &err) == VB_OK, "refine");
+    CHECK(vb_mesh_refine(&m, 0.5f, &mine, &err) == VB_OK, "refine");
+    vb_scene *s = NULL;
+    CHECK(vb_scene_create(&m, NULL, &s, &err) == VB_OK, "scene");
+    uint32_t flipped = 0;
+    CHECK(vb_orient_receivers(&mine, s, 2, &flipped, &err) == VB_OK, "orient: %s", err.msg);
+    CHECK(flipped > 0, "the inverted box has receivers to flip");
+    vb_bake_desc a = {.receivers = &rec, .scene = s, .rays = 256, .seed = 3, .threads = 2,
+                      .order_mask = 1u << 3, .method = VB_METHOD_LSQ};
+    vb_bake_desc b = a;
+    b.receivers = &mine;
+    b.keep_normals = 1;
+    vb_bake_output oa = {0}, ob = {0};
+    CHECK(vb_bake_run(&a, &oa, &err) == VB_OK, "bake, oriented inside: %s", err.msg);
+    CHECK(vb_bake_run(&b, &ob, &err) == VB_OK, "bake, oriented before: %s", err.msg);
+    size_t n = (size_t)rec.vertex_count;
+    CHECK(oa.flipped_normals == flipped && ob.flipped_normals == 0 && ob.normals == NULL,
+          "flipped %u inside, %u before", oa.flipped_normals, flipped);
+    CHECK(oa.normals && memcmp(oa.normals, mine.normals, 3 * n * sizeof(float)) == 0,
+          "the bake's oriented normals are vb_orient_receivers'");
+    CHECK(memcmp(oa.coeffs[3], ob.coeffs[3], 9 * n * sizeof(float)) == 0,
+          "the same coefficients either way");
+    CHECK(oa.moved_origins == ob.moved_origins, "the same origins repaired");
+    /* A zeroed description is vdsh-bake's defaults: method shadow, its
+     * log distance, oriented receivers, order 5. */
+    vb_bake_desc z = {.receivers = &rec, .scene = s, .rays = 64, .threads = 2};
+    vb_bake_output oz = {0};
+    CHECK(vb_bake_run(&z, &oz, &err) == VB_OK, "bake, zeroed description: %s", err.msg);
+    CHECK(oz.method == VDSH_METHOD_SHADOW && oz.quantity[5] == VDSH_QUANTITY_LOG_DISTANCE &&
+              oz.coeffs[5] && oz.flipped_normals == flipped && oz.normals,
+          "zeroed description: method %s, quantity %s, %u flipped",
+          vdsh_method_name(oz.method), vdsh_quantity_name(oz.quantity[5]), oz.flipped_normals);
+    vb_bake_output_free(&oz);
+    vb_bake_output_free(&oa);
+    vb_bake_output_free(&ob);
+    vb_scene_destroy(s);
+    test_mesh_free(&m);
+    test_mesh_free(&rec);
+    test_mesh_free(&mine);
+}
+
 /* Contact and embedding. A box pressed on the floor with its bottom face
  * present: those receivers face down into the floor, and an origin offset
  * along their normal would leave the room (every ray escaping); they are
@@ -461,7 +512,7 @@ static void test_contact_and_embedded(void)
     vb_error err;
     CHECK(vb_mesh_refine(&m, 0.5f, &rec, &err) == VB_OK, "refine");
     vb_bake_output b = {0};
-    CHECK(bake_with(&m, &rec, VDSH_METHOD_PAPER, 1024, 1, &b), "bake");
+    CHECK(bake_with(&m, &rec, VB_METHOD_PAPER, 1024, 1, &b), "bake");
     if (b.coeffs[5]) {
         CHECK(b.rays_missed == 0, "%llu rays escaped the closed room",
               (unsigned long long)b.rays_missed);
@@ -596,8 +647,8 @@ static void test_small_parts(void)
     vb_error err;
     vb_scene *s = NULL;
     CHECK(vb_scene_create(&m, NULL, &s, &err) == VB_OK, "scene");
-    vb_bake_desc d = {.receivers = &m, .scene = s, .rays = 1024, .seed = 3,
-                      .method = VDSH_METHOD_LSQ, .quantity = VDSH_QUANTITY_LOG_DISTANCE};
+    vb_bake_desc d = {.keep_normals = 1, .receivers = &m, .scene = s, .rays = 1024, .seed = 3,
+                      .method = VB_METHOD_LSQ, .quantity = VB_QUANTITY_LOG};
     vb_bake_output b = {0};
     CHECK(vb_bake_run(&d, &b, &err) == VB_OK, "bake: %s", err.msg);
     CHECK(b.degenerate_receivers <= 100 * 4 + 8, "%u degenerate receivers",
@@ -618,7 +669,7 @@ static void test_small_parts(void)
  * and every reconstructed distance in 64 directions above each receiver,
  * and 64 below, where the fit is unconstrained and may run away, is finite,
  * >= 0 and at most the bake's max distance. */
-static void test_default_fit(uint32_t method)
+static void test_default_fit(vb_method method)
 {
     vb_mesh m = {0}, rec = {0};
     test_make_room(&m, 4.0f, 3.0f, 2.5f);
@@ -628,23 +679,23 @@ static void test_default_fit(uint32_t method)
     CHECK(vb_mesh_refine(&m, 0.5f, &rec, &err) == VB_OK, "refine");
     vb_scene *s = NULL;
     CHECK(vb_scene_create(&m, NULL, &s, &err) == VB_OK, "scene");
-    vb_bake_desc d = {.receivers = &rec, .scene = s, .rays = 512, .seed = 3,
+    vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = s, .rays = 512, .seed = 3,
                       .method = method, .quantity = VB_QUANTITY_AUTO,
                       .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
     vb_bake_output b = {0};
-    CHECK(s && vb_bake_run(&d, &b, &err) == VB_OK, "%s bake: %s", vdsh_method_name(method),
+    CHECK(s && vb_bake_run(&d, &b, &err) == VB_OK, "%s bake: %s", vb_method_name(method),
           err.msg);
-    uint32_t sampled = method == VDSH_METHOD_LSQ ? (rec.vertex_count < 1024 ? rec.vertex_count
+    uint32_t sampled = method == VB_METHOD_LSQ ? (rec.vertex_count < 1024 ? rec.vertex_count
                                                                              : 1024) : 0;
     CHECK(b.auto_receivers == sampled, "%s: %u receivers sampled for the choice",
-          vdsh_method_name(method), b.auto_receivers);
+          vb_method_name(method), b.auto_receivers);
     long bad = 0, checked = 0, runaway = 0;
     for (int o = 2; o <= 5 && b.coeffs[5]; o++) {
         if (!b.coeffs[o])
             continue;
         CHECK(b.quantity[o] == VDSH_QUANTITY_LOG_DISTANCE ||
-                  (method == VDSH_METHOD_LSQ && b.quantity[o] == VDSH_QUANTITY_DISTANCE),
-              "%s order %d: quantity %u", vdsh_method_name(method), o, b.quantity[o]);
+                  (method == VB_METHOD_LSQ && b.quantity[o] == VDSH_QUANTITY_DISTANCE),
+              "%s order %d: quantity %u", vb_method_name(method), o, b.quantity[o]);
         for (uint32_t v = 0; v < rec.vertex_count; v++) {
             const float *c = b.coeffs[o] + (size_t)v * o * o, *n = rec.normals + 3 * (size_t)v;
             for (int i = 0; i < o * o; i++)
@@ -668,9 +719,9 @@ static void test_default_fit(uint32_t method)
     }
     CHECK(bad == 0 && checked > 0,
           "%s: %ld of %ld coefficients or distances not finite, >= 0 and <= max distance",
-          vdsh_method_name(method), bad, checked);
+          vb_method_name(method), bad, checked);
     printf("%s: %ld of %ld reconstructions would exceed the max distance %g unclamped\n",
-           vdsh_method_name(method), runaway, checked, (double)b.max_distance);
+           vb_method_name(method), runaway, checked, (double)b.max_distance);
     vb_bake_output_free(&b);
     vb_scene_destroy(s);
     test_mesh_free(&m);
@@ -693,8 +744,8 @@ static void test_lit_walls(void)
     vb_scene *sc = NULL;
     CHECK(vb_scene_create(&occ, NULL, &sc, &err) == VB_OK, "scene: %s", err.msg);
     /* The default bake: what vdsh-bake does with no method or quantity. */
-    vb_bake_desc d = {.receivers = &rec, .scene = sc, .rays = 625, .seed = 3,
-                      .method = VDSH_METHOD_SHADOW, .quantity = VB_QUANTITY_AUTO,
+    vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = sc, .rays = 625, .seed = 3,
+                      .method = VB_METHOD_SHADOW, .quantity = VB_QUANTITY_AUTO,
                       .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
     vb_bake_output out = {0};
     CHECK(sc && vb_bake_run(&d, &out, &err) == VB_OK, "bake: %s", err.msg);
@@ -752,7 +803,7 @@ static void test_bad_api_input(void)
     CHECK(vb_scene_create(&occ, NULL, &s, &err) == VB_OK, "scene");
     float p[3] = {0, 0.5f, 0}, n[3] = {0, INFINITY, 0};
     test_make_points(&rec, 1, p, n);
-    vb_bake_desc d = {.receivers = &rec, .scene = s, .rays = 64};
+    vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = s, .rays = 64};
     vb_bake_output out = {0};
     CHECK(vb_bake_run(&d, &out, &err) == VB_ERR_INVALID && !out.coeffs[5], "Inf normal accepted");
     vb_scene_destroy(s);
@@ -770,11 +821,12 @@ int main(void)
     test_coplanar_receivers();
     test_open_mesh();
     test_inverted_normals();
+    test_orient_in_bake();
     test_contact_and_embedded();
     test_coincident_faces();
     test_small_parts();
-    test_default_fit(VDSH_METHOD_SHADOW);
-    test_default_fit(VDSH_METHOD_LSQ);
+    test_default_fit(VB_METHOD_SHADOW);
+    test_default_fit(VB_METHOD_LSQ);
     test_lit_walls();
     test_bad_api_input();
     return test_report("test_hard");

@@ -1,5 +1,5 @@
 /*
- * test_mesh.c - tests for bake/mesh.h: SHA-256, loading and its error
+ * test_mesh.c - tests for bake/lib/mesh.h: SHA-256, loading and its error
  * messages (fixtures written at run time), cleaning, normals, welding,
  * appending, the built-in room and its seeded variants (closed and facing
  * free space, checked with rays through Embree), refinement, OBJ output.
@@ -1322,7 +1322,7 @@ static void check_room_bake(const vb_mesh *coarse, const char *name, vb_mesh *fi
     }
     uint32_t flipped = 0;
     CHECK(vb_orient_receivers(fine, s, 0, &flipped, &err) == VB_OK, "%s: orient: %s", name, err.msg);
-    vb_bake_desc d = {.receivers = fine, .scene = s, .rays = 64, .seed = 1, .method = VDSH_METHOD_PAPER};
+    vb_bake_desc d = {.keep_normals = 1, .receivers = fine, .scene = s, .rays = 64, .seed = 1, .method = VB_METHOD_PAPER};
     vb_bake_output o = {0};
     CHECK(vb_bake_run(&d, &o, &err) == VB_OK, "%s: bake: %s", name, err.msg);
     printf("%s at 0.2 m: %u receivers, %u normals flipped, %llu of %llu rays missed, %u degenerate\n", name,

@@ -1,5 +1,5 @@
 /*
- * test_mesh_parse.c - the strict readers (bake/mesh_parse.h) on bytes in
+ * test_mesh_parse.c - the strict readers (bake/lib/mesh_parse.h) on bytes in
  * memory: the values they produce where bakes depend on them (numbers as
  * std::istream reads them, OBJ corner normals, STL vertex merging, PLY
  * property layouts), and the files OpenMesh's readers misread that the

@@ -4,7 +4,7 @@
  * runtime used to upload from the bake's OpenEXR files:
  *
  *   for face sizes 1, 3, 16 and 64 (vdsh-bake's default), the four files
- *   are written by bake/cubemap_exr.c and read back (the EXR reader is a
+ *   are written by bake/lib/cubemap_exr.c and read back (the EXR reader is a
  *   test aid now, linked here only); each file's floats go into an RGBA16F
  *   cube texture the way the runtime did before (glTexImage2D from
  *   GL_FLOAT, every GL texel fetched from the EXR texel

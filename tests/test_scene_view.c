@@ -18,7 +18,7 @@
  *   test_scene_view room ROOM.vdsh
  *     the built-in room baked (a CTest fixture): the room camera; every
  *     default light in free space (probes cast by the plain loop), none
- *     inside or on a pillar, crate or the sphere (bake/builtin.c places
+ *     inside or on a pillar, crate or the sphere (bake/lib/builtin.c places
  *     them); the two preferred positions that lie on and in pillars moved
  *     less than a metre, the other two kept
  */
@@ -398,7 +398,7 @@ static void test_errors(void)
 
 /* ---- the built-in room -------------------------------------------------- */
 
-/* bake/builtin.c: pillars 0.4 m square, floor to ceiling; the crates (the
+/* bake/lib/builtin.c: pillars 0.4 m square, floor to ceiling; the crates (the
  * third turned 30 degrees about y); the sphere. */
 static int in_solid(const float p[3], float margin, char *what, size_t cap)
 {

@@ -514,9 +514,27 @@ static void test_clamp_never_exceeds(void)
           "coverage: %ld of %ld clamped", clamped, checked);
 }
 
+/* vdsh_shadow.c's table of comparisons: names round-trip, each row
+ * compares (a light just past the stored distance is blocked, one well
+ * before it lit), unknown names are refused. */
+static void test_compare_table(void)
+{
+    for (int i = 0; i < VDSH_COMPARE_COUNT; i++) {
+        const char *name = vdsh_compare_name((uint32_t)i);
+        CHECK(strcmp(name, "?") != 0 && vdsh_compare_by_name(name) == (vdsh_compare)i,
+              "comparison %d (%s) found by its name", i, name);
+        CHECK(vdsh_shadow_compare(1.0f, 4.0f, (uint32_t)i) == 0.0f &&
+                  vdsh_shadow_compare(4.0f, 1.0f, (uint32_t)i) == 1.0f,
+              "comparison %s: blocked and lit", name);
+    }
+    CHECK(vdsh_compare_by_name("bogus") == VDSH_COMPARE_COUNT, "no such comparison");
+    CHECK(strcmp(vdsh_compare_name(VDSH_COMPARE_COUNT), "?") == 0, "no name past the table");
+}
+
 int main(void)
 {
     test_shadow();
+    test_compare_table();
     test_interior();
     test_clamp_horizon();
     test_clamp_never_exceeds();

@@ -21,7 +21,7 @@
  * Does not: print the message for a bad value (each tool says what the
  * option takes, naming it) - vt_usage_error prints it the common way.
  *
- * Usage: bake/vdsh_bake.c, bake/vdsh_eval.c, tools/vdsh_info.c,
+ * Usage: bake/tools/vdsh_bake.c, bake/tools/vdsh_eval.c, tools/vdsh_info.c,
  * runtime/vdsh_view.c; tests/test_tools.c checks every rule.
  *
  * Errors: the parsers return 1 for a valid value (written to *out) and 0

@@ -29,7 +29,7 @@
  *     vt_json_f32(&j, v, NULL, 1.5f);            (array items: key NULL)
  *     if (vt_json_write_file(&j, "out.json", msg, sizeof msg)) ...error...
  *     vt_json_free(&j);
- * (bake/vdsh_eval.c; tests/test_tools.c checks strings, numbers and the
+ * (bake/tools/vdsh_eval.c; tests/test_tools.c checks strings, numbers and the
  * reader.)
  *
  * Errors: vt_json_write_file and vt_json_write_stream return 0 or -1 with a

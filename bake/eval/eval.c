@@ -342,10 +342,10 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
             tr->escaped += !hit;
             tr->near_zero += dt < r->near;
 
-            /* The light: u in (0.05, 1] (1 - u1 is in (0, 1]). */
+            /* The light: vdsh_light_u (vdsh_shadow.h); 1 - u1 is in (0, 1]. */
             float u1, u2;
             vb_hash2(J->light_seed, r->id, sample, &u1, &u2);
-            const float dl = (0.05f + 0.95f * (1.0f - u1)) * 2.0f * dt;
+            const float dl = vdsh_light_u_f(1.0f - u1) * 2.0f * dt;
             const float s_ideal = vdsh_shadow_compare(dt, dl, VDSH_COMPARE_SMOOTH);
             const float b_ideal = vdsh_shadow_compare(dt, dl, VDSH_COMPARE_BINARY);
             const int vis = dt >= dl, occ = s_ideal < 0.5f, occ_bin = b_ideal < 0.5f;

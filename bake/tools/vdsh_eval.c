@@ -146,7 +146,7 @@ static int parse_orders(const char *s, int *want)
 {
     uint64_t v[VDSH_MAX_ORDER];
     int n = vt_parse_u64_list(s, 1, VDSH_MAX_ORDER, v, 1, VDSH_MAX_ORDER);
-    int seen[VDSH_MAX_ORDER + 1] = {0};
+    int seen[VDSH_ORDER_SLOTS] = {0};
     for (int i = 0; i < n; i++) {
         if (seen[v[i]])
             return 0;
@@ -669,7 +669,7 @@ int main(int argc, char **argv)
     vb_eval_desc d = {0};
     d.interior = 65536;
     const char *json = NULL, *per_vertex = NULL, *bake_report = NULL;
-    int want_order[VDSH_MAX_ORDER + 1] = {0}, filter = 0;
+    int want_order[VDSH_ORDER_SLOTS] = {0}, filter = 0;
     int quiet = 0, fast_truth = 0, allow_mismatch = 0, noffsets = 0;
     float offsets[VDSH_MAX_STREAMS];
 

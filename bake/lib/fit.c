@@ -24,7 +24,7 @@ static void eval_d(int order, const double d[3], double *y)
         y[i] = yy[i];
 }
 
-/* Gauss-Jordan inverse with partial pivoting of an n x n matrix (n <= 25).
+/* Gauss-Jordan inverse with partial pivoting of an n x n matrix (n <= VB_FIT_MAX).
  * Returns 0 if singular. */
 static int invert(int n, const double *a, double *inv)
 {
@@ -93,7 +93,7 @@ static void gauss01(int n, double *x, double *w)
     }
 }
 
-double vb_window_weight(uint32_t window, int l, int order)
+double vb_window_weight(vdsh_window window, int l, int order)
 {
     double x = (double)l / order;
     switch (window) {
@@ -106,29 +106,31 @@ double vb_window_weight(uint32_t window, int l, int order)
     }
 }
 
-vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
+vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out,
                         vb_error *err)
 {
-    if (order < 1 || order > 5)
-        return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..5, not %d", order);
+    if (order < 1 || order > VDSH_MAX_ORDER)
+        return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..%d, not %d", VDSH_MAX_ORDER,
+                       order);
+    if (base != VB_FIT_IDENTITY && base != VB_FIT_MIRROR && base != VB_FIT_LSQ)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown base fit %d", (int)base);
     if (!(lambda >= 0.0f) || !isfinite(lambda))
         return vb_fail(err, VB_ERR_ARGUMENT, "regularisation must be a number >= 0");
     vb_fit f;
     memset(&f, 0, sizeof f);
     f.order = order;
-    f.method = method;
+    f.base = base;
     f.lambda = lambda;
     int n = order * order;
     for (int i = 0; i < n; i++)
         f.window[i] = 1.0;
 
-    switch (method) {
-    case VDSH_METHOD_PAPER:
-    case VDSH_METHOD_FULL:
+    switch (base) {
+    case VB_FIT_IDENTITY:
         for (int i = 0; i < n; i++)
             f.M[i * n + i] = 1.0;
         break;
-    case VDSH_METHOD_MIRROR:
+    case VB_FIT_MIRROR:
         /* Y_lm(x, y, -z) = (-1)^(l+m) Y_lm(x, y, z): the mirrored lower
          * half doubles the even terms and cancels the odd ones. */
         for (int i = 0; i < n; i++) {
@@ -136,7 +138,7 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
             f.M[i * n + i] = ((l + m) % 2 == 0) ? 2.0 : 0.0;
         }
         break;
-    case VDSH_METHOD_LSQ: {
+    case VB_FIT_LSQ: {
         /* G_ij = integral over z > 0 of Y_i Y_j: Gauss-Legendre in z
          * (exact to degree 31) times 64 azimuths (exact for cos/sin of
          * order < 64); the products here have degree <= 8. */
@@ -163,8 +165,6 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
                            order);
         break;
     }
-    default:
-        return vb_fail(err, VB_ERR_ARGUMENT, "method %u has no hemisphere fit", method);
     }
 
     /* Rotation samples: a Fibonacci sphere, over-determined for every
@@ -182,7 +182,8 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
         eval_d(order, f.rot_dirs[j], Y[j]);
     for (int l = 0; l < order; l++) {
         int k = 2 * l + 1, o = l * l;
-        double BBt[9 * 9], inv[9 * 9];
+        double BBt[VDSH_MAX_BAND_WIDTH * VDSH_MAX_BAND_WIDTH];
+        double inv[VDSH_MAX_BAND_WIDTH * VDSH_MAX_BAND_WIDTH];
         for (int a = 0; a < k; a++)
             for (int b = 0; b < k; b++) {
                 double s = 0.0;
@@ -232,7 +233,7 @@ vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
     return VB_OK;
 }
 
-void vb_fit_window(vb_fit *f, uint32_t window)
+void vb_fit_window(vb_fit *f, vdsh_window window)
 {
     /* A window scales whole bands, and rotations keep bands apart, so it
      * commutes with S: it applies to the final coefficients. */
@@ -259,7 +260,7 @@ void vb_sh_rotation(const vb_fit *f, const double R[9], double *out)
         int k = 2 * l + 1, o = l * l;
         const double *pinv = f->rot_pinv[l];
         for (int a = 0; a < k; a++) { /* row a of S_l^T, all columns at once */
-            double s[9] = {0};        /* each sums over j in order: it vectorises over b */
+            double s[VDSH_MAX_BAND_WIDTH] = {0}; /* each sums over j in order: it vectorises over b */
             for (int j = 0; j < VB_FIT_ROT_DIRS; j++) {
                 double y = yr[j][o + a];
                 for (int b = 0; b < k; b++)
@@ -275,7 +276,7 @@ void vb_fit_frame(const vb_fit *f, const float n[3], vb_fit_angles *a)
 {
     memset(a, 0, sizeof *a);
     double x = n[0], y = n[1], z = n[2], r = sqrt(x * x + y * y), len = sqrt(r * r + z * z);
-    a->rotates = (f->method == VDSH_METHOD_MIRROR || f->method == VDSH_METHOD_LSQ) && len > 0.0;
+    a->rotates = f->base != VB_FIT_IDENTITY && len > 0.0;
     if (!a->rotates)
         return;
     /* n = (sin beta cos alpha, sin beta sin alpha, cos beta); on the
@@ -283,7 +284,7 @@ void vb_fit_frame(const vb_fit *f, const float n[3], vb_fit_angles *a)
     double ca = r > 0.0 ? x / r : 1.0, sa = r > 0.0 ? y / r : 0.0;
     double cb = z / len, sb = r / len;
     a->ca[0] = a->cb[0] = 1.0;
-    for (int m = 1; m < 5; m++) {
+    for (int m = 1; m < VDSH_MAX_ORDER; m++) {
         a->ca[m] = a->ca[m - 1] * ca - a->sa[m - 1] * sa;
         a->sa[m] = a->sa[m - 1] * ca + a->ca[m - 1] * sa;
         a->cb[m] = a->cb[m - 1] * cb - a->sb[m - 1] * sb;
@@ -315,7 +316,7 @@ static inline void rotate_x(const vb_fit *f, int order, int transpose, double *v
     for (int l = 1; l < order; l++) {
         int k = 2 * l + 1, o = l * l;
         const double *cols = transpose ? f->X[l] : f->XT[l];
-        double in[9], *out = v + o;
+        double in[VDSH_MAX_BAND_WIDTH], *out = v + o;
         memcpy(in, out, (size_t)k * sizeof *in);
         for (int i = 0; i < k; i++)
             out[i] = 0.0;

@@ -451,11 +451,8 @@ static int cmd_truth(int argc, char **argv)
         case 'o': dir = optarg; break;
         case O_VIEWS: views_path = optarg; break;
         case O_COMPARE:
-            if (strcmp(optarg, "smooth") == 0)
-                compare = VDSH_COMPARE_SMOOTH;
-            else if (strcmp(optarg, "binary") == 0)
-                compare = VDSH_COMPARE_BINARY;
-            else
+            compare = vdsh_compare_by_name(optarg);
+            if (compare == VDSH_COMPARE_COUNT)
                 return bad_usage("--compare takes smooth or binary, not '%s'", optarg);
             break;
         default:
@@ -491,7 +488,7 @@ static int cmd_truth(int argc, char **argv)
     uint8_t *rgba = malloc(4 * n);
     vb_error err;
     /* One c-vdshN per order: the first stream of each. */
-    int use[VDSH_MAX_STREAMS] = {0}, seen[VDSH_MAX_ORDER + 1] = {0};
+    int use[VDSH_MAX_STREAMS] = {0}, seen[VDSH_ORDER_SLOTS] = {0};
     for (uint32_t s = 0; s < f->stream_count; s++) {
         uint32_t o = f->streams[s].order;
         if (o <= VDSH_MAX_ORDER && !seen[o]) {
@@ -513,7 +510,7 @@ static int cmd_truth(int argc, char **argv)
     int light_frames = 0, stream_frames = 0;
     if (!co.quiet)
         printf(PROG " truth: %s, %d views from %s, %d x %d, %s comparison -> %s\n", path,
-               V.count, views_path, w, h, compare == VDSH_COMPARE_BINARY ? "binary" : "smooth",
+               V.count, views_path, w, h, vdsh_compare_name(compare),
                dir);
     for (int vi = 0; vi < V.count; vi++) {
         const vt_view *v = V.views + vi;

@@ -22,8 +22,9 @@
 #include <unistd.h>
 
 #include "bake.h"
-#include "cubemap.h"
+#include "job.h"
 #include "mesh.h"
+#include "method.h"
 #include "scene.h"
 #include "vdsh.h"
 #include "vdsh_output.h"
@@ -38,14 +39,14 @@ typedef struct options {
     uint32_t rays;
     int orders[VDSH_MAX_ORDER];
     int order_count;
-    uint32_t method;
-    uint32_t quantity;
+    vb_method method;
+    vb_quantity quantity;
     float lambda;
     float log_offset;
     int have_log_offset;
     float log_floor;
-    uint32_t window;
-    uint32_t encoding;
+    vdsh_window window;
+    vdsh_encoding encoding;
     float max_distance;
     float max_edge;
     int weld;
@@ -56,9 +57,48 @@ typedef struct options {
     int record_timings;
     int trace_only;
     int keep_normals;
-    uint32_t flipped;
     int quiet;
 } options;
+
+/* --method's help, from the table: each row's name and help, indented,
+ * then which rows trace only the upper half of the directions. */
+static const char *methods_help(void)
+{
+    static char text[4096];
+    int count = VB_METHOD_COUNT, at = 0;
+    const vb_method_info *m = vb_method_get(0);
+    for (int i = 0; i < count; i++) {
+        at += snprintf(text + at, sizeof text - (size_t)at, "%26s%s%s: ", "",
+                       vb_method_name(m[i].method), i == 0 ? " (default)" : "");
+        for (const char *p = m[i].help; *p; p++) {
+            at += snprintf(text + at, sizeof text - (size_t)at, "%c", *p);
+            if (*p == '\n')
+                at += snprintf(text + at, sizeof text - (size_t)at, "%26s", "");
+        }
+        at += snprintf(text + at, sizeof text - (size_t)at, "\n");
+    }
+    at += snprintf(text + at, sizeof text - (size_t)at, "%26sAll but", "");
+    int sphere = 0;
+    for (int i = 0; i < count; i++)
+        if (!m[i].hemisphere && !m[i].horizon)
+            at += snprintf(text + at, sizeof text - (size_t)at, "%s%s", sphere++ ? ", " : " ",
+                           vb_method_name(m[i].method));
+    snprintf(text + at, sizeof text - (size_t)at,
+             " trace only the upper half\n%26sof the --rays directions\n", "");
+    return text;
+}
+
+/* "shadow, lsq, mirror, paper or full": the table's names. */
+static const char *method_names(void)
+{
+    static char text[512];
+    int at = 0;
+    for (int i = 0; i < VB_METHOD_COUNT; i++)
+        at += snprintf(text + at, sizeof text - (size_t)at, "%s%s",
+                       i == 0 ? "" : i + 1 == VB_METHOD_COUNT ? " or " : ", ",
+                       vb_method_name((vb_method)i));
+    return text;
+}
 
 static void usage(FILE *f)
 {
@@ -91,16 +131,8 @@ static void usage(FILE *f)
 "                          (default 2500 = 50 x 50)\n"
 "      --orders LIST       SH orders to store, order n = n bands = n*n\n"
 "                          coefficients (default 2,3,5; each 1..5)\n"
-"      --method M          shadow (default): lsq of the log distance, the\n"
-"                          stored distances then e^offset times the fit's\n"
-"                          (--log-offset; fewer false shadows where a light\n"
-"                          sits just past a silhouette);\n"
-"                          lsq: regularised least squares to the upper\n"
-"                          hemisphere; mirror: the upper hemisphere, mirrored\n"
-"                          below; paper: the paper's fit, directions below the\n"
-"                          horizon count as distance 0; full: the whole\n"
-"                          sphere, no horizon. All but full trace only the\n"
-"                          upper half of the --rays directions\n"
+"      --method M          the fit:\n"
+"%s"
 "      --quantity Q        what the SH store: auto (default): log for shadow,\n"
 "                          distance for paper, and for the others per order\n"
 "                          the one with the lower expected shadow error on\n"
@@ -108,7 +140,7 @@ static void usage(FILE *f)
 "                          ln(distance), reconstructed as exp of the SH sum\n"
 "                          (not with paper; the only one with shadow)\n"
 "      --log               the same as --quantity log\n"
-"      --lambda X          lsq regularisation weight (default 1e-4; shadow\n"
+"      --lambda X          lsq regularisation weight (default %g; shadow\n"
 "                          uses lsq's default)\n"
 "      --log-offset X      shadow: added to the fitted ln d at every order\n"
 "                          (default per order 2/3/5: %.2f/%.2f/%.2f, chosen\n"
@@ -139,8 +171,8 @@ static void usage(FILE *f)
 "\n"
 "Exit status: 0 success, 1 error, 2 usage error.\n"
 "Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n",
-            (double)vb_shadow_log_offset(2), (double)vb_shadow_log_offset(3),
-            (double)vb_shadow_log_offset(5));
+            methods_help(), (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
+            (double)vb_shadow_log_offset(3), (double)vb_shadow_log_offset(5));
 }
 
 static int bad_usage(const char *fmt, const char *arg)
@@ -162,7 +194,7 @@ static int parse_orders(const char *s, options *o)
 {
     uint64_t v[VDSH_MAX_ORDER];
     int n = vt_parse_u64_list(s, 1, VDSH_MAX_ORDER, v, 1, VDSH_MAX_ORDER);
-    int seen[VDSH_MAX_ORDER + 1] = {0};
+    int seen[VDSH_ORDER_SLOTS] = {0};
     for (int i = 0; i < n; i++) {
         if (seen[v[i]])
             return 0;
@@ -258,23 +290,6 @@ static void defer_interrupts_while_writing(void)
 
 /* ---- output -------------------------------------------------------------- */
 
-/* The basis cubemaps depend on the cube size only: a helper thread encodes
- * them (deflate, most of it) while the meshes load and the bake runs, and
- * they are written, as before, after the bake. */
-typedef struct basis_job {
-    int size;
-    vb_cubemap_basis basis;
-    vb_result result;
-    vb_error err;
-} basis_job;
-
-static void *encode_basis(void *arg)
-{
-    basis_job *b = arg;
-    b->result = vb_cubemap_basis_encode(b->size, &b->basis, &b->err);
-    return NULL;
-}
-
 /* The report: vt_json writes it atomically (formats/vdsh_output.h).
  * 0, or -1 with a message naming the file in msg. */
 static void report_seconds(vt_json *j, cJSON *root, const vdsh_timings *t)
@@ -286,11 +301,14 @@ static void report_seconds(vt_json *j, cJSON *root, const vdsh_timings *t)
     vt_json_f64(j, sec, "trace", t->trace);
 }
 
-static int write_report(const char *path, const options *o, const vdsh_file *f,
-                        const vb_bake_output *b, const vdsh_timings *t,
-                        double write_seconds, size_t coef_bytes,
-                        long long file_size, char *msg, size_t cap)
+static int write_report(const char *path, const options *o, const vb_job *job,
+                        double write_seconds, char *msg, size_t cap)
 {
+    const vdsh_file *f = &job->file;
+    const vb_bake_output *b = &job->bake;
+    const vdsh_timings *t = &job->timings;
+    size_t coef_bytes = job->coefficient_bytes;
+    long long file_size = (long long)job->file_bytes;
     vt_json j = {0};
     cJSON *root = vt_json_object(&j, NULL, NULL);
     vt_json_string(&j, root, "output", o->output);
@@ -301,7 +319,7 @@ static int write_report(const char *path, const options *o, const vdsh_file *f,
     vt_json_u64(&j, root, "receiver_triangles", f->header.triangle_count);
     vt_json_u64(&j, root, "occluder_triangles", f->header.occluder_triangle_count);
     vt_json_u64(&j, root, "rays_per_receiver", b->rays);
-    vt_json_string(&j, root, "method", vdsh_method_name(o->method));
+    vt_json_string(&j, root, "method", vb_method_name(o->method));
     cJSON *orders = vt_json_array(&j, root, "orders");
     for (int i = 0; i < o->order_count; i++)
         vt_json_u64(&j, orders, NULL, (uint64_t)o->orders[i]);
@@ -316,7 +334,7 @@ static int write_report(const char *path, const options *o, const vdsh_file *f,
     vt_json_u64(&j, root, "degenerate_receivers", b->degenerate_receivers);
     vt_json_u64(&j, root, "undefined_normals", b->undefined_normals);
     vt_json_u64(&j, root, "moved_origins", b->moved_origins);
-    vt_json_u64(&j, root, "flipped_normals", o->flipped);
+    vt_json_u64(&j, root, "flipped_normals", b->flipped_normals);
     cJSON *org = vt_json_object(&j, root, "origins");
     vt_json_u64(&j, org, "probe_rays", b->origins.probe_rays);
     vt_json_u64(&j, org, "repaired", b->origins.flagged);
@@ -358,17 +376,15 @@ static int write_bare_report(const char *path, const vb_bake_output *b,
     return r;
 }
 
-/* File stem and directory of OUT: "dir/room.vdsh" -> "dir", "room". */
-static void split_output(const char *out, char *dir, char *stem, size_t cap)
+/* One mesh loaded (vb_job_desc.on_mesh): what it holds, and what the
+ * reader repaired or refused. */
+static void on_mesh(void *user, const char *path, const vb_mesh *m, const vb_source_info *info,
+                    double seconds)
 {
-    char a[PATH_MAX], b[PATH_MAX];
-    snprintf(a, sizeof a, "%s", out);
-    snprintf(b, sizeof b, "%s", out);
-    snprintf(dir, cap, "%s", dirname(a));
-    snprintf(stem, cap, "%s", basename(b));
-    size_t n = strlen(stem);
-    if (n > 5 && strcmp(stem + n - 5, ".vdsh") == 0)
-        stem[n - 5] = '\0';
+    FILE *log = user;
+    fprintf(log, "vdsh-bake: %s: %u vertices, %u triangles (%.2f s)\n", path, m->vertex_count,
+            m->triangle_count, seconds);
+    vb_mesh_report_print(log, "vdsh-bake", path, &info->report);
 }
 
 /* ---- main ---------------------------------------------------------------- */
@@ -379,8 +395,7 @@ int main(int argc, char **argv)
     options o = {0};
     o.rays = 2500;
     o.orders[0] = 2, o.orders[1] = 3, o.orders[2] = 5, o.order_count = 3;
-    o.method = VDSH_METHOD_SHADOW;
-    o.quantity = VB_QUANTITY_AUTO;
+    /* method and quantity: 0 is the default (shadow, auto) */
     o.encoding = VDSH_ENCODING_F16;
     o.seed = 1;
     o.robust = 1;
@@ -433,15 +448,16 @@ int main(int argc, char **argv)
             if (!parse_orders(optarg, &o))
                 return bad_usage("--orders takes distinct orders 1..5 such as 2,3,5, not '%s'", optarg);
             break;
-        case O_METHOD:
-            if (strcmp(optarg, "paper") == 0) o.method = VDSH_METHOD_PAPER;
-            else if (strcmp(optarg, "full") == 0) o.method = VDSH_METHOD_FULL;
-            else if (strcmp(optarg, "mirror") == 0) o.method = VDSH_METHOD_MIRROR;
-            else if (strcmp(optarg, "lsq") == 0) o.method = VDSH_METHOD_LSQ;
-            else if (strcmp(optarg, "shadow") == 0) o.method = VDSH_METHOD_SHADOW;
-            else return bad_usage("--method takes shadow, lsq, mirror, paper or full, not '%s'",
-                                  optarg);
+        case O_METHOD: {
+            const vb_method_info *m = vb_method_by_name(optarg);
+            if (!m) {
+                char fmt[640];
+                snprintf(fmt, sizeof fmt, "--method takes %s, not '%%s'", method_names());
+                return bad_usage(fmt, optarg);
+            }
+            o.method = m->method;
             break;
+        }
         case O_ENCODING:
             if (strcmp(optarg, "f16") == 0) o.encoding = VDSH_ENCODING_F16;
             else if (strcmp(optarg, "f32") == 0) o.encoding = VDSH_ENCODING_F32;
@@ -477,11 +493,11 @@ int main(int argc, char **argv)
         case O_TIMINGS: o.record_timings = 1; break;
         case O_EXPORT: o.export_obj = optarg; break;
         case O_TRACE_ONLY: o.trace_only = 1; break;
-        case O_LOG: o.quantity = VDSH_QUANTITY_LOG_DISTANCE; break;
+        case O_LOG: o.quantity = VB_QUANTITY_LOG; break;
         case O_QUANTITY:
             if (strcmp(optarg, "auto") == 0) o.quantity = VB_QUANTITY_AUTO;
-            else if (strcmp(optarg, "distance") == 0) o.quantity = VDSH_QUANTITY_DISTANCE;
-            else if (strcmp(optarg, "log") == 0) o.quantity = VDSH_QUANTITY_LOG_DISTANCE;
+            else if (strcmp(optarg, "distance") == 0) o.quantity = VB_QUANTITY_DISTANCE;
+            else if (strcmp(optarg, "log") == 0) o.quantity = VB_QUANTITY_LOG;
             else return bad_usage("--quantity takes auto, distance or log, not '%s'", optarg);
             break;
         case O_LAMBDA:
@@ -520,80 +536,66 @@ int main(int argc, char **argv)
         return bad_usage("%s", "no mesh given");
     if (nmesh > VDSH_MAX_SOURCES)
         return bad_usage("%s", "too many meshes (at most 64)");
-    if (o.quantity == VDSH_QUANTITY_DISTANCE && o.method == VDSH_METHOD_SHADOW)
-        return bad_usage("%s", "--method shadow fits the log distance: use --quantity log or "
-                               "auto, or --method lsq for the distance");
-    if (o.have_log_offset && o.method != VDSH_METHOD_SHADOW)
+    /* What the method's row allows. */
+    const vb_method_info *mi = vb_method_get(o.method);
+    vdsh_quantity stored = vb_quantity_stored(o.quantity);
+    if (o.quantity != VB_QUANTITY_AUTO && !(mi->quantities & VB_QUANTITY_BIT(stored)))
+        return bad_usage("%s", mi->refused[stored]);
+    if (o.have_log_offset && mi->param != VB_PARAM_LOG_OFFSET)
         return bad_usage("%s", "--log-offset is method shadow's");
-    if (o.lambda != 0.0f && o.method == VDSH_METHOD_SHADOW)
-        return bad_usage("%s", "--lambda is lsq's: method shadow uses lsq's default (its method "
-                               "parameter is the log offset)");
-    if (o.quantity == VDSH_QUANTITY_LOG_DISTANCE && o.method == VDSH_METHOD_PAPER)
-        return bad_usage("%s", "log-distance needs --method mirror, lsq or full: the paper's zero fill "
-                               "below the horizon has no meaning for ln(distance)");
+    if (o.lambda != 0.0f && mi->lambda_fixed)
+        return bad_usage("--lambda is lsq's: method %s uses lsq's default (its method "
+                         "parameter is the log offset)", vb_method_name(o.method));
     if (!o.output && !o.export_obj && !o.trace_only)
         return bad_usage("%s", "no output: give -o OUT.vdsh (or --export-obj FILE)");
     FILE *log = o.quiet ? NULL : stderr;
 
-    /* 1. Load every mesh into one occluder scene. */
+    /* The bake, described once: vb_job (job.h) runs it as a straight line. */
+    uint32_t order_mask = 0;
+    for (int s = 0; s < o.order_count; s++)
+        order_mask |= 1u << o.orders[s];
+    progress pr = {.enabled = log && isatty(STDERR_FILENO)};
+    float offsets[VDSH_ORDER_SLOTS];
+    for (int k = 0; k <= VDSH_MAX_ORDER; k++)
+        offsets[k] = o.log_offset;
+    vb_job_desc jd = {
+        .paths = (const char *const *)argv + optind, .path_count = (uint32_t)nmesh,
+        .output = o.trace_only ? NULL : o.output, .cubemap_dir = o.cubemap_dir,
+        .weld = o.weld, .max_edge = o.max_edge, .fast_traversal = !o.robust,
+        .bake = {.rays = o.rays, .seed = o.seed, .max_distance = o.max_distance,
+                 .method = o.method, .quantity = o.quantity, .lambda = o.lambda,
+                 .log_floor = o.log_floor, .log_offsets = o.have_log_offset ? offsets : NULL,
+                 .window = o.window, .order_mask = order_mask, .threads = o.threads,
+                 .keep_normals = o.keep_normals, .trace_only = o.trace_only,
+                 .progress = on_progress, .progress_user = &pr},
+        .f32 = o.encoding == VDSH_ENCODING_F32,
+        .cube_size = o.cube_size > 0 ? o.cube_size : -1,
+        .record_timings = o.record_timings,
+        .on_mesh = log ? on_mesh : NULL, .user = log};
     int status = 1;
     int writing = 0; /* output_lock held: outputs are being written */
     vb_error err;
-    vb_mesh occ = {0}, rec = {0};
-    vb_scene *scene = NULL;
-    vb_bake_output bo = {0};
-    vdsh_source *sources = calloc((size_t)nmesh, sizeof *sources);
-    vdsh_stream streams[VDSH_MAX_ORDER];
-    void *stream_data[VDSH_MAX_ORDER] = {0};
-    vdsh_timings tm = {0};
-    if (!sources) {
-        fprintf(stderr, "vdsh-bake: out of memory\n");
-        return 1;
+    vb_job job = {0};
+
+    /* 1. Load every mesh into one occluder scene. */
+    if (vb_job_load(&job, &jd, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+        goto out;
     }
-    double t_start = vb_now();
-    vb_load_desc ld = {.weld = o.weld};
-    int max_order = o.orders[o.order_count - 1];
-    int cube_size = max_order >= 4 ? o.cube_size : 0;
-    basis_job basis = {.size = cube_size};
-    pthread_t basis_thread;
-    int basis_running = cube_size > 0 && o.output && !o.trace_only &&
-                        pthread_create(&basis_thread, NULL, encode_basis, &basis) == 0;
-    for (int i = 0; i < nmesh; i++) {
-        const char *path = argv[optind + i];
-        vb_mesh m = {0};
-        vb_source_info info;
-        double t = vb_now();
-        if (vb_mesh_load(path, &ld, &m, &info, &err) != VB_OK ||
-            vb_mesh_append(&occ, &m, &err) != VB_OK) {
-            fprintf(stderr, "vdsh-bake: %s\n", err.msg);
-            vb_mesh_free(&m);
-            goto out;
-        }
-        sources[i].name = (char *)path;
-        sources[i].size = info.size;
-        memcpy(sources[i].sha256, info.sha256, 32);
-        if (log)
-            fprintf(log, "vdsh-bake: %s: %u vertices, %u triangles (%.2f s)\n", path,
-                    m.vertex_count, m.triangle_count, vb_now() - t);
-        vb_mesh_report_print(log, "vdsh-bake", path, &info.report);
-        vb_mesh_free(&m);
-    }
-    tm.load = vb_now() - t_start;
 
     /* 2. Receivers: the scene's vertices, refined if asked. */
-    double t = vb_now();
-    if (vb_mesh_refine(&occ, o.max_edge, &rec, &err) != VB_OK) {
+    if (vb_job_refine(&job, &jd, &err) != VB_OK) {
         fprintf(stderr, "vdsh-bake: refining receivers: %s\n", err.msg);
         goto out;
     }
-    tm.refine = vb_now() - t;
+    const vb_mesh *rec = &job.receivers;
     if (log && o.max_edge > 0.0f)
         fprintf(log, "vdsh-bake: receivers refined to max edge %g: %u vertices, "
                      "%u triangles (%.2f s)\n",
-                (double)o.max_edge, rec.vertex_count, rec.triangle_count, tm.refine);
+                (double)o.max_edge, rec->vertex_count, rec->triangle_count, job.timings.refine);
     if (o.export_obj) {
         pthread_mutex_lock(&output_lock);
-        vb_result written = vb_mesh_write_obj(&rec, o.export_obj, &err);
+        vb_result written = vb_mesh_write_obj(rec, o.export_obj, &err);
         pthread_mutex_unlock(&output_lock);
         if (written != VB_OK) {
             fprintf(stderr, "vdsh-bake: %s\n", err.msg);
@@ -607,90 +609,56 @@ int main(int argc, char **argv)
         }
     }
 
-    /* 3. The occluders' BVH. */
-    t = vb_now();
-    vb_scene_desc sd = {.robust = o.robust, .threads = o.threads};
-    if (vb_scene_create(&occ, &sd, &scene, &err) != VB_OK) {
-        fprintf(stderr, "vdsh-bake: %s\n", err.msg);
-        goto out;
-    }
-    tm.build = vb_now() - t;
-    if (o.max_distance == 0.0f)
-        o.max_distance = scene->diagonal;
-    if (!o.keep_normals) {
-        if (vb_orient_receivers(&rec, scene, o.threads, &o.flipped, &err) != VB_OK) {
-            fprintf(stderr, "vdsh-bake: %s\n", err.msg);
-            goto out;
-        }
-        if (log && o.flipped)
-            fprintf(log, "vdsh-bake: %u receiver normals pointed into geometry and were "
-                         "flipped (--keep-normals keeps them)\n", o.flipped);
-    }
-
-    /* 4. Trace and project. */
-    uint32_t order_mask = 0;
-    for (int s = 0; s < o.order_count; s++)
-        order_mask |= 1u << o.orders[s];
-    progress pr = {.enabled = log && isatty(STDERR_FILENO), .t0 = vb_now()};
-    float offsets[VDSH_MAX_ORDER + 1];
-    for (int k = 0; k <= VDSH_MAX_ORDER; k++)
-        offsets[k] = o.log_offset;
-    vb_bake_desc bd = {
-        .receivers = &rec, .scene = scene, .rays = o.rays, .seed = o.seed,
-        .max_distance = o.max_distance, .method = o.method,
-        .quantity = o.quantity, .lambda = o.lambda, .log_floor = o.log_floor,
-        .log_offsets = o.have_log_offset ? offsets : NULL,
-        .window = o.window,
-        .max_order = max_order, .order_mask = order_mask, .threads = o.threads,
-        .trace_only = o.trace_only,
-        .progress = on_progress, .progress_user = &pr};
+    /* 3. The occluders' BVH, then orient, trace and project. */
     if (log)
         fprintf(log, "vdsh-bake: tracing %u rays x %u receivers against %u triangles "
-                     "(method %s, max distance %g)\n",
-                o.rays, rec.vertex_count, occ.triangle_count,
-                vdsh_method_name(o.method), (double)o.max_distance);
-    if (vb_bake_run(&bd, &bo, &err) != VB_OK) {
+                     "(method %s)\n",
+                o.rays, rec->vertex_count, job.occluders.triangle_count,
+                vb_method_name(o.method));
+    pr.t0 = vb_now();
+    if (vb_job_bake(&job, &jd, &err) != VB_OK) {
         fprintf(stderr, "vdsh-bake: %s\n", err.msg);
         goto out;
     }
-    tm.trace = bo.seconds;
-    tm.threads = bo.threads;
-    tm.total = vb_now() - t_start;
+    const vb_bake_output *bo = &job.bake;
+    if (log && bo->flipped_normals)
+        fprintf(log, "vdsh-bake: %u receiver normals pointed into geometry and were "
+                     "flipped (--keep-normals keeps them)\n", bo->flipped_normals);
     if (log)
         fprintf(log, "vdsh-bake: traced %.1f M rays in %.2f s (%.1f Mrays/s on %u "
                      "threads), %.2f%% missed, %u ray origins moved off other geometry, "
-                     "%u degenerate receivers\n",
-                bo.rays_traced * 1e-6, bo.seconds,
-                bo.seconds > 0 ? bo.rays_traced / bo.seconds * 1e-6 : 0.0, bo.threads,
-                bo.rays_traced ? 100.0 * bo.rays_missed / bo.rays_traced : 0.0,
-                bo.moved_origins, bo.degenerate_receivers);
+                     "%u degenerate receivers (max distance %g)\n",
+                bo->rays_traced * 1e-6, bo->seconds,
+                bo->seconds > 0 ? bo->rays_traced / bo->seconds * 1e-6 : 0.0, bo->threads,
+                bo->rays_traced ? 100.0 * bo->rays_missed / bo->rays_traced : 0.0,
+                bo->moved_origins, bo->degenerate_receivers, (double)bo->max_distance);
     if (log)
         fprintf(log, "vdsh-bake: ray origins checked in %.2f s: %llu probe rays (%.1f%% of the "
                      "traced rays), %u receivers repaired, %u moved\n",
-                bo.origins.seconds, (unsigned long long)bo.origins.probe_rays,
-                bo.rays_traced ? 100.0 * bo.origins.probe_rays / bo.rays_traced : 0.0,
-                bo.origins.flagged, bo.origins.moved);
-    if (log && bo.auto_receivers > 0) {
+                bo->origins.seconds, (unsigned long long)bo->origins.probe_rays,
+                bo->rays_traced ? 100.0 * bo->origins.probe_rays / bo->rays_traced : 0.0,
+                bo->origins.flagged, bo->origins.moved);
+    if (log && bo->auto_receivers > 0) {
         fprintf(log, "vdsh-bake: quantity chosen on %u sampled receivers (expected shadow "
-                     "error, distance / log):", bo.auto_receivers);
+                     "error, distance / log):", bo->auto_receivers);
         for (int s = 0; s < o.order_count; s++) {
             int k = o.orders[s];
             fprintf(log, "%s order %d %s (%.4f / %.4f)", s ? "," : "", k,
-                    bo.quantity[k] == VDSH_QUANTITY_LOG_DISTANCE ? "log" : "distance",
-                    bo.auto_error[k][0], bo.auto_error[k][1]);
+                    bo->quantity[k] == VDSH_QUANTITY_LOG_DISTANCE ? "log" : "distance",
+                    bo->auto_error[k][0], bo->auto_error[k][1]);
         }
         fputc('\n', log);
     }
-    if (log && bo.degenerate_receivers > 0)
+    if (log && bo->degenerate_receivers > 0)
         fprintf(log, "vdsh-bake: warning: %u receivers (%.2f%%) see distance ~0 in almost "
                      "every direction above their horizon: receivers inside or flush "
                      "against other geometry, or inverted normals\n",
-                bo.degenerate_receivers, 100.0 * bo.degenerate_receivers / rec.vertex_count);
+                bo->degenerate_receivers, 100.0 * bo->degenerate_receivers / rec->vertex_count);
+    char msg[PATH_MAX + 256];
     if (o.trace_only) {
         pthread_mutex_lock(&output_lock);
         writing = 1;
-        char msg[PATH_MAX + 256];
-        if (o.report && write_bare_report(o.report, &bo, &tm, msg, sizeof msg) != 0) {
+        if (o.report && write_bare_report(o.report, bo, &job.timings, msg, sizeof msg) != 0) {
             fprintf(stderr, "vdsh-bake: %s (the report)\n", msg);
             goto out;
         }
@@ -698,119 +666,46 @@ int main(int argc, char **argv)
         goto out;
     }
 
-    /* 5. Streams: one per order. */
-    t = vb_now();
-    size_t coef_bytes = 0;
-    for (int s = 0; s < o.order_count; s++) {
-        if (vb_bake_stream(&bo, o.orders[s], o.encoding, &streams[s], &stream_data[s],
-                           &err) != VB_OK) {
-            fprintf(stderr, "vdsh-bake: %s\n", err.msg);
-            goto out;
-        }
-        coef_bytes += vdsh_stream_bytes_per_vertex(&streams[s]);
+    /* 4. The file: streams, header and all, filled by the core. */
+    double t = vb_now();
+    if (vb_bake_fill_file(&job, &jd, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+        goto out;
     }
 
-    /* 6. Basis cubemaps (order 4 and up evaluates bands 3-4 from them). */
+    /* 5. Write: the basis cubemaps, then the .vdsh file, last. */
     pthread_mutex_lock(&output_lock);
     writing = 1;
-    char dir[PATH_MAX], stem[PATH_MAX];
-    split_output(o.output, dir, stem, sizeof dir);
-    if (cube_size > 0) {
-        const char *cdir = o.cubemap_dir ? o.cubemap_dir : dir;
-        if (basis_running)
-            pthread_join(basis_thread, NULL);
-        else /* no helper thread could start */
-            basis.result = vb_cubemap_basis_encode(cube_size, &basis.basis, &basis.err);
-        basis_running = 0;
-        if (basis.result != VB_OK) {
-            fprintf(stderr, "vdsh-bake: %s\n", basis.err.msg);
-            goto out;
-        }
-        if (vb_cubemap_basis_write(&basis.basis, cdir, stem, &err) != VB_OK) {
-            fprintf(stderr, "vdsh-bake: %s\n", err.msg);
-            goto out;
-        }
-    }
-
-    /* 7. The .vdsh file, last. */
-    vdsh_file f = {0};
-    f.header.vertex_count = rec.vertex_count;
-    f.header.triangle_count = rec.triangle_count;
-    f.header.rays = bo.rays;
-    f.header.sampling = bo.hemisphere ? VDSH_SAMPLING_HEMISPHERE : VDSH_SAMPLING_SPHERE;
-    f.header.seed = o.seed;
-    f.header.max_distance = o.max_distance;
-    f.header.max_edge = o.max_edge;
-    f.header.offset_rule = VDSH_OFFSET_WB_AVG;
-    f.header.load_flags = o.weld ? VDSH_LOAD_WELD : 0;
-    f.header.cube_size = (uint32_t)cube_size;
-    f.header.occluder_vertex_count = occ.vertex_count;
-    f.header.occluder_triangle_count = occ.triangle_count;
-    f.header.trace_flags = o.robust ? VDSH_TRACE_ROBUST : 0;
-    memcpy(f.header.bounds_min, scene->bounds_min, sizeof f.header.bounds_min);
-    memcpy(f.header.bounds_max, scene->bounds_max, sizeof f.header.bounds_max);
-    f.source_count = (uint32_t)nmesh;
-    f.sources = sources;
-    f.positions = rec.positions;
-    f.normals = rec.normals;
-    f.indices = rec.indices;
-    f.stream_count = (uint32_t)o.order_count;
-    f.streams = streams;
-    f.has_stats = 1;
-    f.stats = (vdsh_stats){.rays_traced = bo.rays_traced, .rays_missed = bo.rays_missed,
-                           .degenerate_receivers = bo.degenerate_receivers,
-                           .undefined_normals = bo.undefined_normals,
-                           .moved_origins = bo.moved_origins,
-                           .flipped_normals = o.flipped};
-    f.has_timings = o.record_timings;
-    f.timings = tm;
-    vdsh_error verr;
-    if (vdsh_write(o.output, &f, &verr) != VDSH_OK) {
-        fprintf(stderr, "vdsh-bake: %s\n", verr.msg);
+    if (vb_job_write(&job, &jd, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-bake: %s\n", err.msg);
         goto out;
     }
     double write_seconds = vb_now() - t;
-    long long file_size = -1;
-    FILE *fp = fopen(o.output, "rb");
-    if (fp && fseek(fp, 0, SEEK_END) == 0)
-        file_size = ftell(fp);
-    if (fp)
-        fclose(fp);
+    int cube_size = vb_job_cube_size(&jd);
     if (log) {
         fprintf(log, "vdsh-bake: wrote %s (%.2f MB, %zu bytes of coefficients per "
                      "vertex for orders",
-                o.output, file_size / 1e6, coef_bytes);
+                o.output, job.file_bytes / 1e6, job.coefficient_bytes);
         for (int s = 0; s < o.order_count; s++)
             fprintf(log, "%s%d", s ? "," : " ", o.orders[s]);
         fprintf(log, ", %s)", vdsh_encoding_name(o.encoding));
         if (cube_size > 0)
             fprintf(log, " and 4 basis cubemaps %dx%d in %s", cube_size, cube_size,
-                    o.cubemap_dir ? o.cubemap_dir : dir);
-        fprintf(log, "\nvdsh-bake: done in %.2f s\n", tm.total + write_seconds);
+                    o.cubemap_dir ? o.cubemap_dir : "the output's directory");
+        fprintf(log, "\nvdsh-bake: done in %.2f s\n", job.timings.total + write_seconds);
     }
-    char msg[PATH_MAX + 256];
-    if (o.report && write_report(o.report, &o, &f, &bo, &tm, write_seconds, coef_bytes,
-                                 file_size, msg, sizeof msg) != 0) {
+    if (o.report && write_report(o.report, &o, &job, write_seconds, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-bake: %s (the report)\n", msg);
         goto out;
     }
     status = 0;
 
 out:
-    if (basis_running)
-        pthread_join(basis_thread, NULL);
-    vb_cubemap_basis_free(&basis.basis);
     if (writing) {
         pthread_mutex_unlock(&output_lock);
         while (atomic_load(&interrupted))
             pause(); /* the interrupt thread ends the process */
     }
-    for (int s = 0; s < VDSH_MAX_ORDER; s++)
-        free(stream_data[s]);
-    vb_bake_output_free(&bo);
-    vb_scene_destroy(scene);
-    vb_mesh_free(&rec);
-    vb_mesh_free(&occ);
-    free(sources);
+    vb_job_free(&job);
     return status;
 }

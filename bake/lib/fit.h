@@ -10,8 +10,8 @@
  *     c_world = S M S^T b_world
  *
  * S is the SH rotation taking the pole to the normal (vb_sh_rotation). M
- * depends only on the method:
- *   paper      M = I                    zero below the horizon
+ * depends only on the method's base fit (method.h, vb_fit_base):
+ *   identity   M = I                    paper (zero below the horizon), full
  *   mirror     M = I + P                P reflects through the tangent plane,
  *                                       Y_lm(x, y, -z) = (-1)^(l+m) Y_lm
  *   lsq        M = (G + lambda L)^-1    least squares over the hemisphere:
@@ -36,47 +36,51 @@
 
 #include <stdint.h>
 
+#include "method.h"
 #include "vb.h"
+#include "vdsh.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#define VB_FIT_MAX 25
+#define VB_FIT_MAX VDSH_MAX_COEFFS
 #define VB_FIT_ROT_DIRS 36
 
 typedef struct vb_fit {
     int order;                        /* coefficients kept: order^2 */
-    uint32_t method;                  /* vdsh_method */
+    vb_fit_base base;                 /* the map (a method's row, method.h) */
     float lambda;                     /* lsq regularisation */
     double window[VB_FIT_MAX];        /* per coefficient: its band's weight */
     double M[VB_FIT_MAX * VB_FIT_MAX];  /* local-frame map, order^2 square */
     double NT[VB_FIT_MAX * VB_FIT_MAX]; /* N = X M X^T, order^2 square,
                                        * column-major */
-    double X[5][9 * 9];               /* per band l: the (2l+1)^2 block of X */
-    double XT[5][9 * 9];              /* and its transpose */
+    /* per band l: the (2l+1)^2 block of X, and its transpose */
+    double X[VDSH_MAX_ORDER][VDSH_MAX_BAND_WIDTH * VDSH_MAX_BAND_WIDTH];
+    double XT[VDSH_MAX_ORDER][VDSH_MAX_BAND_WIDTH * VDSH_MAX_BAND_WIDTH];
     /* Rotations: sample directions and, per band l, the pseudo-inverse of
      * the (2l+1) x VB_FIT_ROT_DIRS basis block at them. */
     double rot_dirs[VB_FIT_ROT_DIRS][3];
-    double rot_pinv[5][VB_FIT_ROT_DIRS * 9];
+    double rot_pinv[VDSH_MAX_ORDER][VB_FIT_ROT_DIRS * VDSH_MAX_BAND_WIDTH];
 } vb_fit;
 
 /* Gauss-Legendre nodes and weights on [-1, 1]. */
 void vb_gauss_legendre(int n, double *x, double *w);
 
-/* Prepare the map for (order, method, lambda). The hemisphere Gram matrix
- * is computed by Gauss-Legendre x uniform-azimuth quadrature (exact for
- * these polynomials). */
-vb_result vb_fit_create(int order, uint32_t method, float lambda, vb_fit *out,
+/* Prepare the map for (order, base fit, lambda); lambda matters for
+ * VB_FIT_LSQ only. A method's base fit is its row's (method.h). The
+ * hemisphere Gram matrix is computed by Gauss-Legendre x uniform-azimuth
+ * quadrature (exact for these polynomials). */
+vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out,
                         vb_error *err);
 
 /* The per-band window applied to a fit's coefficients: Hann
  * (1 + cos(pi l / order)) / 2, Lanczos sinc(l / order), 1 for none; band
  * l of `order` bands (vdsh_window values). */
-double vb_window_weight(uint32_t window, int l, int order);
+double vb_window_weight(vdsh_window window, int l, int order);
 
 /* Scale the map's rows by the window (c_lm *= w_l). */
-void vb_fit_window(vb_fit *f, uint32_t window);
+void vb_fit_window(vb_fit *f, vdsh_window window);
 
 /* c = S M S^T b for a receiver with unit normal n (b and c: order^2
  * values, world frame; b in double for the sums it comes from). A zero
@@ -86,15 +90,16 @@ void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c);
 /* vb_fit_apply in two steps, so that fits of several orders for one
  * receiver share the first (the leading bands of the highest order's u
  * are the lower orders' u). vb_fit_frame: the angles of unit normal n,
- * and whether f rotates at all (mirror and lsq with a non-zero normal).
+ * and whether f rotates at all (base fit mirror or lsq, and a non-zero normal).
  * vb_fit_unrotate: u = Rz(-beta) X Rz(-alpha) b over f's bands (u = b
  * if f does not rotate). vb_fit_finish: c = window * (the rest of the
  * product above), from the first order^2 values of a u made by a fit of
  * the same method and any order >= f->order. */
 typedef struct vb_fit_angles {
     int rotates;
-    double ca[5], sa[5];  /* cos, sin of m alpha, m = 0..4 */
-    double cb[5], sb[5];  /* cos, sin of m beta */
+    /* cos, sin of m alpha and of m beta, m = 0..VDSH_MAX_ORDER - 1 */
+    double ca[VDSH_MAX_ORDER], sa[VDSH_MAX_ORDER];
+    double cb[VDSH_MAX_ORDER], sb[VDSH_MAX_ORDER];
 } vb_fit_angles;
 
 void vb_fit_frame(const vb_fit *f, const float n[3], vb_fit_angles *a);

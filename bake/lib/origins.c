@@ -262,12 +262,15 @@ static int escapes(const prober *J, const float o[3], const float n[3], uint64_t
 
 /* What the origin rules need to know about each receiver: the normal
  * averaged over every receiver at its position, the inset vector into its
- * own triangles, the triangles around it and its near distance. */
+ * own triangles, the triangles around it and its near distance. Built once
+ * per bake: the orientation flips normals, and then only the parts that
+ * depend on them (navg, inset) are computed again (frames_normals). */
 typedef struct frames {
     float *navg;                /* 3 per vertex */
     float *inset;               /* 3 per vertex */
     float *near;                /* per vertex, scene units */
     uint32_t *adj_start, *adj;  /* vertex -> its triangles, in triangle order */
+    double *pull;               /* 4 per vertex: the centroids' pull x, y, z, weight */
 } frames;
 
 static void frames_free(frames *f)
@@ -277,7 +280,27 @@ static void frames_free(frames *f)
     free(f->near);
     free(f->adj_start);
     free(f->adj);
+    free(f->pull);
     memset(f, 0, sizeof *f);
+}
+
+/* The parts of f that depend on m's normals: the averaged normals, and the
+ * inset (the centroids' pull in the tangent plane of the averaged normal). */
+static vb_result frames_normals(const vb_mesh *m, frames *f, vb_error *err)
+{
+    vb_result r = vb_offset_normals(m, f->navg, err);
+    if (r != VB_OK)
+        return r;
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        const float *nv = f->navg + 3 * (size_t)v;
+        const double *a = f->pull + 4 * (size_t)v;
+        if (a[3] > 0.0) {
+            double dot = a[0] * nv[0] + a[1] * nv[1] + a[2] * nv[2];
+            for (int i = 0; i < 3; i++)
+                f->inset[3 * (size_t)v + i] = (float)((a[i] - dot * nv[i]) / a[3]);
+        }
+    }
+    return VB_OK;
 }
 
 static vb_result frames_create(const vb_mesh *m, const vb_scene *s, frames *f, vb_error *err)
@@ -289,15 +312,14 @@ static vb_result frames_create(const vb_mesh *m, const vb_scene *s, frames *f, v
     f->near = malloc((size_t)n * sizeof *f->near + 1);
     f->adj_start = calloc((size_t)n + 1, sizeof *f->adj_start);
     f->adj = malloc((size_t)m->triangle_count * 3 * sizeof *f->adj + 1);
-    double *acc = calloc((size_t)n * 4 + 1, sizeof *acc); /* x, y, z, weight */
+    double *acc = f->pull = calloc((size_t)n * 4 + 1, sizeof *acc); /* x, y, z, weight */
     uint32_t *fill = malloc((size_t)n * sizeof *fill + 1);
     vb_result r = VB_OK;
     if (!f->navg || !f->inset || !f->near || !f->adj_start || !f->adj || !acc || !fill) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for ray origins");
         goto done;
     }
-    if ((r = vb_offset_normals(m, f->navg, err)) != VB_OK ||
-        (r = vb_mean_edges(m, f->near, err)) != VB_OK)
+    if ((r = vb_mean_edges(m, f->near, err)) != VB_OK)
         goto done;
     for (uint32_t v = 0; v < n; v++)
         f->near[v] = vb_receiver_near(s->diagonal, f->near[v]);
@@ -321,22 +343,14 @@ static vb_result frames_create(const vb_mesh *m, const vb_scene *s, frames *f, v
             f->adj_start[ix[k] + 1]++;
         }
     }
-    for (uint32_t v = 0; v < n; v++) {
-        const float *nv = f->navg + 3 * (size_t)v;
-        const double *a = acc + 4 * (size_t)v;
-        if (a[3] > 0.0) {
-            double dot = a[0] * nv[0] + a[1] * nv[1] + a[2] * nv[2];
-            for (int i = 0; i < 3; i++)
-                f->inset[3 * (size_t)v + i] = (float)((a[i] - dot * nv[i]) / a[3]);
-        }
+    for (uint32_t v = 0; v < n; v++)
         f->adj_start[v + 1] += f->adj_start[v];
-    }
     memcpy(fill, f->adj_start, (size_t)n * sizeof *fill);
     for (uint32_t t = 0; t < m->triangle_count; t++)
         for (int k = 0; k < 3; k++)
             f->adj[fill[m->indices[3 * (size_t)t + k]]++] = t;
+    r = frames_normals(m, f, err);
 done:
-    free(acc);
     free(fill);
     if (r != VB_OK)
         frames_free(f);
@@ -523,24 +537,20 @@ static void repair_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
     atomic_fetch_add(&J->rays, rays);
 }
 
-vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads, float *out,
-                         float *near_out, vb_origins_stats *stats, vb_error *err)
+static vb_result place_origins(const vb_mesh *m, const vb_scene *s, const frames *Fp,
+                               unsigned threads, float *out, float *near_out,
+                               vb_origins_stats *stats, double t0, vb_error *err)
 {
-    double t0 = vb_now();
-    frames F;
-    vb_result r = frames_create(m, s, &F, err);
-    if (r != VB_OK)
-        return r;
+    const frames F = *Fp;
+    vb_result r = VB_OK;
     /* 1. The standard rule. */
     for (uint32_t v = 0; v < m->vertex_count; v++)
         standard_origin(s, m, &F, v, 1.0f, out + 3 * (size_t)v);
     /* 2. Repair: probe every receiver, move those left inside or behind
      * other geometry. */
     origin_job *J = calloc(1, sizeof *J);
-    if (!J) {
-        frames_free(&F);
+    if (!J)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for ray origins");
-    }
     J->m = m, J->F = &F, J->out = out;
     prober_init(&J->P, s);
     if (vb_parallel_for(threads, m->vertex_count, 256, repair_block, J, NULL, NULL) == 0)
@@ -555,6 +565,18 @@ vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads, 
         stats->seconds = vb_now() - t0;
     }
     free(J);
+    return r;
+}
+
+vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads, float *out,
+                         float *near_out, vb_origins_stats *stats, vb_error *err)
+{
+    double t0 = vb_now();
+    frames F;
+    vb_result r = frames_create(m, s, &F, err);
+    if (r != VB_OK)
+        return r;
+    r = place_origins(m, s, &F, threads, out, near_out, stats, t0, err);
     frames_free(&F);
     return r;
 }
@@ -562,7 +584,7 @@ vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads, 
 /* ---- orientation -------------------------------------------------------- */
 
 typedef struct orient_job {
-    vb_mesh *m;
+    const vb_mesh *m;
     const frames *F;
     prober P;
     uint8_t *flip;
@@ -648,19 +670,16 @@ static void orient_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
     }
 }
 
-vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
-                              uint32_t *flipped, vb_error *err)
+/* Orient m's receivers with frames F of m: flip, in `normals` (m's or a
+ * copy of them), those pointing into geometry. */
+static vb_result orient(const vb_mesh *m, const vb_scene *s, const frames *F, unsigned threads,
+                        float *normals, uint32_t *flipped, vb_error *err)
 {
-    frames F;
-    vb_result r = frames_create(m, s, &F, err);
-    if (r != VB_OK)
-        return r;
-    orient_job J = {.m = m, .F = &F};
+    vb_result r = VB_OK;
+    orient_job J = {.m = m, .F = F};
     J.flip = calloc((size_t)m->vertex_count + 1, 1);
-    if (!J.flip) {
-        frames_free(&F);
+    if (!J.flip)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for receiver normals");
-    }
     prober_init(&J.P, s);
     if (vb_parallel_for(threads, m->vertex_count, 256, orient_block, &J, NULL, NULL) == 0)
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
@@ -668,10 +687,52 @@ vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
     for (uint32_t v = 0; v < m->vertex_count && r == VB_OK; v++)
         if (J.flip[v]) {
             for (int i = 0; i < 3; i++)
-                m->normals[3 * (size_t)v + i] = -m->normals[3 * (size_t)v + i];
+                normals[3 * (size_t)v + i] = -normals[3 * (size_t)v + i];
             count++;
         }
     free(J.flip);
+    if (r == VB_OK)
+        *flipped = count;
+    return r;
+}
+
+vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
+                              uint32_t *flipped, vb_error *err)
+{
+    frames F;
+    vb_result r = frames_create(m, s, &F, err);
+    if (r != VB_OK)
+        return r;
+    uint32_t count = 0;
+    r = orient(m, s, &F, threads, m->normals, &count, err);
+    frames_free(&F);
+    if (r == VB_OK && flipped)
+        *flipped = count;
+    return r;
+}
+
+vb_result vb_receivers_prepare(const vb_mesh *m, const vb_scene *s, unsigned threads,
+                               float *normals, uint32_t *flipped, float *out,
+                               float *near_out, vb_origins_stats *stats, vb_error *err)
+{
+    double t0 = vb_now();
+    frames F;
+    vb_result r = frames_create(m, s, &F, err);
+    if (r != VB_OK)
+        return r;
+    vb_mesh oriented = *m;
+    uint32_t count = 0;
+    if (normals) {
+        memcpy(normals, m->normals, (size_t)m->vertex_count * 3 * sizeof *normals);
+        oriented.normals = normals;
+        r = orient(m, s, &F, threads, normals, &count, err);
+        /* The frames again where they depend on the normals. */
+        if (r == VB_OK && count > 0)
+            r = frames_normals(&oriented, &F, err);
+        t0 = vb_now(); /* the origins' time, as before: not the orientation's */
+    }
+    if (r == VB_OK)
+        r = place_origins(&oriented, s, &F, threads, out, near_out, stats, t0, err);
     frames_free(&F);
     if (r == VB_OK && flipped)
         *flipped = count;

@@ -1,12 +1,27 @@
+/*
+ * bake.c - the bake core (bake.h): per receiver, trace its directions and
+ * project the distances onto SH, then fit each order (fit.h).
+ *
+ * The story of vb_bake_run, the driver at the bottom:
+ *   1. Resolve the description's defaults and check it against the
+ *      method's row (method.h): sampling domain, quantity, parameters.
+ *   2. Orient the receivers and place their ray origins (origins.h: one
+ *      pass over their frames).
+ *   3. With VB_QUANTITY_AUTO, trace a sample of receivers first and choose
+ *      each order's quantity by the expected shadow error (choose_block).
+ *   4. Trace and project every other receiver on the workers (bake_block,
+ *      bake_vertex: packets of 16 rays, sums in a fixed order).
+ * Encoding the result as .vdsh streams is stream.c's (vb_bake_stream).
+ */
 #include "bake.h"
 
 #include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "fit.h"
+#include "method.h"
 #include "origins.h"
 #include "parallel.h"
 #include "sampling.h"
@@ -18,13 +33,6 @@
 #define BLOCK 16 /* receivers per work item */
 #define GROUP 8  /* packets traced before their lanes are processed */
 
-double vb_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* ---- the trace-and-project loop ----------------------------------------- */
 
 typedef struct job {
@@ -32,21 +40,21 @@ typedef struct job {
     const vb_dirgrid *grid;
     const float *origins;  /* per receiver, traced frame */
     const float *near;     /* per receiver: ~0 distance, scene units */
-    float *coeffs[VDSH_MAX_ORDER + 1];
-    uint32_t quantity[VDSH_MAX_ORDER + 1]; /* per order: what coeffs hold */
-    vb_fit fits[VDSH_MAX_ORDER + 1];
+    float *coeffs[VDSH_ORDER_SLOTS];
+    uint32_t quantity[VDSH_ORDER_SLOTS]; /* per order: what coeffs hold */
+    vb_fit fits[VDSH_ORDER_SLOTS];
     int order;             /* the projection's order (the highest asked) */
     float log_floor;
     float max_local;       /* max distance in the traced frame */
     float inv_scale;
     int horizon;           /* paper: skip w.n < 0 */
     /* Method shadow: per order, added to the fitted ln d (through c0). */
-    float log_offset[VDSH_MAX_ORDER + 1];
+    float log_offset[VDSH_ORDER_SLOTS];
     double *error_table;   /* e(r), the quantity choice's score (VB_ERROR_TABLE + 1) */
     /* The quantity choice (VB_QUANTITY_AUTO): sampled receivers, and per
      * sample, order and quantity (0 distance, 1 log) its estimated error. */
     uint32_t choose_count;
-    double *choose_error;  /* choose_count * (VDSH_MAX_ORDER + 1) * 2 */
+    double *choose_error;  /* choose_count * (VDSH_ORDER_SLOTS) * 2 */
     float *choose_coeffs;  /* per sample, quantity and order: its fit */
     uint8_t *done;         /* receivers the choice baked already (or NULL) */
     _Atomic uint64_t traced, missed;
@@ -58,7 +66,7 @@ typedef struct job {
  * order, its coefficients or NULL; and, when `n` is not NULL, the traced
  * directions above its horizon with their distances (scene units). */
 typedef struct vertex_sink {
-    float *coeffs[2][VDSH_MAX_ORDER + 1];
+    float *coeffs[2][VDSH_ORDER_SLOTS];
     float *x, *y, *z, *t;
     uint32_t *n;
 } vertex_sink;
@@ -273,7 +281,7 @@ static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
 
 #define ERROR_TABLE 1024 /* e(r) tabulated on r in [0, 2] */
 
-/* e(r): the mean over lights at d_L = 2u d, u uniform in (0.05, 1], of
+/* e(r): the mean over lights at d_L = 2u d (vdsh_light_u), of
  * |ramp(r / 2u) - ramp(1 / 2u)| - the expected shadow error of a direction
  * reconstructed at r times its true distance under vdsh-eval's relative
  * lights (flat from r = 2 on). By the mean over 512 u at the midpoints. */
@@ -283,7 +291,7 @@ static double *error_table_create(void)
     for (int i = 0; e && i <= ERROR_TABLE; i++) {
         double r = 2.0 * i / ERROR_TABLE, sum = 0.0;
         for (int k = 0; k < 512; k++) {
-            double u = 0.05 + 0.95 * (k + 0.5) / 512;
+            double u = vdsh_light_u((k + 0.5) / 512);
             sum += fabs((double)vdsh_ramp((float)(r / (2.0 * u))) -
                         (double)vdsh_ramp((float)(1.0 / (2.0 * u))));
         }
@@ -305,15 +313,14 @@ static double expected_error(const double *e, double r)
 
 float vb_shadow_log_offset(int order)
 {
-    /* Chosen on the validation scenes by frames (docs/ACCURACY.md). */
-    static const float table[VDSH_MAX_ORDER + 1] = {0.0f, 1.6f, 1.6f, 1.1f, 0.9f, 0.8f};
+    const float *table = vb_method_get(VB_METHOD_SHADOW)->default_log_offset;
     return order >= 1 && order <= VDSH_MAX_ORDER ? table[order] : 0.0f;
 }
 
 /* ---- choosing the quantity (VB_QUANTITY_AUTO) --------------------------- */
 
 #define CHOOSE_RECEIVERS 1024
-#define CHOOSE_STRIDE (1 + 4 + 9 + 16 + 25) /* coefficients of orders 1..5 */
+#define CHOOSE_STRIDE VDSH_COEFFS_THROUGH(VDSH_MAX_ORDER) /* coefficients of orders 1..max */
 
 /* Where order o starts among one sample's coefficients of one quantity. */
 static size_t choose_offset(int o)
@@ -326,14 +333,14 @@ static size_t choose_offset(int o)
  * A pass per fit over all directions, so that the sums vectorise: each
  * is still accumulated in the same order as one direction at a time
  * would, so the scores keep their bits. Scratch: `basis` holds
- * 25 * grid count floats, `t` and `s` grid count doubles each. */
+ * VDSH_MAX_COEFFS * grid count floats, `t` and `s` grid count doubles each. */
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
     !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("avx2", "default")))
 #endif
 static void score_fits(const job *J, uint32_t count, const vertex_sink *out,
-                       float c[2][VDSH_MAX_ORDER + 1][VDSH_MAX_COEFFS], float *basis,
-                       double *t, double *s, double e[VDSH_MAX_ORDER + 1][2])
+                       float c[2][VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS], float *basis,
+                       double *t, double *s, double e[VDSH_ORDER_SLOTS][2])
 {
     const uint32_t cap = J->grid->count;
     const float tmin = 1e-4f * J->d->max_distance;
@@ -380,7 +387,7 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
     }
     for (uint32_t i = begin; i < end && buf; i++) {
         uint32_t v = (uint32_t)((uint64_t)i * nrec / J->choose_count), count = 0;
-        float c[2][VDSH_MAX_ORDER + 1][VDSH_MAX_COEFFS];
+        float c[2][VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS];
         vertex_sink out = {.x = buf, .y = buf + cap, .z = buf + 2 * cap, .t = buf + 3 * cap,
                            .n = &count};
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
@@ -393,17 +400,17 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
                 if (J->coeffs[o])
                     memcpy(keep + q * CHOOSE_STRIDE + choose_offset(o), c[q][o],
                            (size_t)o * o * sizeof(float));
-        double e[VDSH_MAX_ORDER + 1][2] = {{0}};
+        double e[VDSH_ORDER_SLOTS][2] = {{0}};
         score_fits(J, count, &out, c, buf + 4 * (size_t)cap, sums, sums + cap, e);
-        double *dst = J->choose_error + (size_t)i * (VDSH_MAX_ORDER + 1) * 2;
+        double *dst = J->choose_error + (size_t)i * (VDSH_ORDER_SLOTS) * 2;
         for (int o = 0; o <= VDSH_MAX_ORDER; o++)
             for (int q = 0; q < 2; q++)
                 dst[2 * o + q] = count ? e[o][q] / count : 0.0;
     }
     if (!buf) /* out of memory: no vote from these receivers */
         for (uint32_t i = begin; i < end; i++)
-            memset(J->choose_error + (size_t)i * (VDSH_MAX_ORDER + 1) * 2, 0,
-                   (VDSH_MAX_ORDER + 1) * 2 * sizeof(double));
+            memset(J->choose_error + (size_t)i * (VDSH_ORDER_SLOTS) * 2, 0,
+                   (VDSH_ORDER_SLOTS) * 2 * sizeof(double));
     else /* their coefficients are kept: the main pass skips them */
         for (uint32_t i = begin; i < end; i++)
             J->done[(uint64_t)i * nrec / J->choose_count] = 1;
@@ -420,106 +427,13 @@ static void bake_progress(void *user, uint32_t done, uint32_t total)
     J->d->progress(J->d->progress_user, done, total, atomic_load(&J->traced));
 }
 
-/* The f16 stream in chunks on the bake's workers: first each chunk's
- * largest |coefficient|, then, with the stream's scale, its encoding. */
-#define F16_CHUNK 65536u
-
-typedef struct f16_job {
-    const float *src;
-    size_t count;
-    float scale;
-    float *amax;          /* per chunk */
-    uint16_t *dst;
-    vdsh_result *result;  /* per chunk */
-} f16_job;
-
-static void f16_amax_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
-{
-    f16_job *J = ctx;
-    (void)worker;
-    for (uint32_t c = begin; c < end; c++) {
-        size_t a = (size_t)c * F16_CHUNK, b = J->count - a < F16_CHUNK ? J->count : a + F16_CHUNK;
-        float m = 0.0f;
-        for (size_t i = a; i < b; i++)
-            m = fmaxf(m, fabsf(J->src[i]));
-        J->amax[c] = m;
-    }
-}
-
-static void f16_encode_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
-{
-    f16_job *J = ctx;
-    (void)worker;
-    for (uint32_t c = begin; c < end; c++) {
-        size_t a = (size_t)c * F16_CHUNK, b = J->count - a < F16_CHUNK ? J->count : a + F16_CHUNK;
-        J->result[c] = vdsh_encode_f16(J->src + a, b - a, J->scale, J->dst + a);
-    }
-}
-
-vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
-                         vdsh_stream *out, void **storage, vb_error *err)
-{
-    if (order < 1 || order > VDSH_MAX_ORDER || !b->coeffs[order])
-        return vb_fail(err, VB_ERR_ARGUMENT, "order %d is not in the bake", order);
-    if (encoding != VDSH_ENCODING_F16 && encoding != VDSH_ENCODING_F32)
-        return vb_fail(err, VB_ERR_ARGUMENT, "unknown encoding %u", encoding);
-    int nc = order * order;
-    size_t count = (size_t)b->vertex_count * nc;
-    vdsh_stream s = {.order = (uint32_t)order, .encoding = encoding, .method = b->method,
-                     .quantity = b->quantity[order],
-                     .method_param = b->method == VDSH_METHOD_SHADOW ? b->log_offset[order]
-                                                                     : b->lambda,
-                     .scale = 1.0f,
-                     .quantity_param = b->quantity[order] == VDSH_QUANTITY_LOG_DISTANCE
-                                           ? b->log_floor : 0.0f, .window = b->window,
-                     .window_param = b->window ? (float)order : 0.0f};
-    if (encoding == VDSH_ENCODING_F32) {
-        float *f = malloc(count * sizeof *f);
-        if (!f)
-            return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the order %d stream",
-                           order);
-        memcpy(f, b->coeffs[order], count * sizeof *f);
-        s.data = f;
-    } else {
-        /* Stored values are coefficient / (the stream's largest
-         * |coefficient|): within [-1, 1] whatever the scene's size or clamp
-         * distance, so f16 neither overflows nor sinks into subnormals and
-         * keeps its full relative precision. */
-        uint32_t chunks = (uint32_t)((count + F16_CHUNK - 1) / F16_CHUNK);
-        f16_job J = {.src = b->coeffs[order], .count = count};
-        J.amax = malloc(((size_t)chunks + 1) * sizeof *J.amax);
-        J.result = malloc(((size_t)chunks + 1) * sizeof *J.result);
-        J.dst = malloc(count * sizeof *J.dst + 1);
-        int ran = J.amax && J.result && J.dst &&
-                  vb_parallel_for(b->threads, chunks, 1, f16_amax_block, &J, NULL, NULL) > 0;
-        float amax = 0.0f;
-        for (uint32_t c = 0; ran && c < chunks; c++)
-            amax = fmaxf(amax, J.amax[c]);
-        J.scale = s.scale = amax > 0.0f ? amax : 1.0f;
-        ran = ran && vb_parallel_for(b->threads, chunks, 1, f16_encode_block, &J, NULL, NULL) > 0;
-        vdsh_result r = ran ? VDSH_OK : VDSH_ERR_OUT_OF_MEMORY;
-        for (uint32_t c = 0; ran && c < chunks && r == VDSH_OK; c++)
-            r = J.result[c];
-        free(J.amax);
-        free(J.result);
-        if (r != VDSH_OK) {
-            free(J.dst);
-            return vb_fail(err, r == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_INVALID,
-                           "order %d coefficients do not fit f16", order);
-        }
-        s.data = J.dst;
-    }
-    *storage = (void *)s.data;
-    *out = s;
-    return VB_OK;
-}
-
 void vb_bake_output_free(vb_bake_output *out)
 {
     if (!out)
         return;
     for (int o = 0; o <= VDSH_MAX_ORDER; o++)
         free(out->coeffs[o]);
+    free(out->normals);
     memset(out, 0, sizeof *out);
 }
 
@@ -547,28 +461,26 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     if (d.order_mask >> (d.max_order + 1))
         return vb_fail(err, VB_ERR_ARGUMENT, "an order above max_order %d was asked for",
                        d.max_order);
-    if (d.method > VDSH_METHOD_SHADOW)
-        return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", d.method);
+    const vb_method_info *mi = vb_method_get(d.method);
+    if (!mi)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %d", (int)d.method);
     if (d.window > VDSH_WINDOW_LANCZOS)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown window %u", d.window);
-    if (d.method == VDSH_METHOD_SHADOW) {
-        if (d.quantity == VDSH_QUANTITY_DISTANCE)
-            return vb_fail(err, VB_ERR_ARGUMENT,
-                           "method shadow fits the log distance: use --quantity log or auto");
-        d.quantity = VDSH_QUANTITY_LOG_DISTANCE; /* the only one shadow has */
+    /* The quantity: what the method allows; auto is its only one, if it
+     * has one, or the per-order choice below. */
+    if (d.quantity != VB_QUANTITY_AUTO && d.quantity != VB_QUANTITY_DISTANCE &&
+        d.quantity != VB_QUANTITY_LOG)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown quantity %d", (int)d.quantity);
+    int choose = d.quantity == VB_QUANTITY_AUTO; /* per order, below */
+    vdsh_quantity stored = vb_quantity_stored(d.quantity);
+    if (choose && (mi->quantities & (mi->quantities - 1)) == 0) {
+        choose = 0; /* the method's only one */
+        stored = (vdsh_quantity)__builtin_ctz(mi->quantities);
     }
-    if (d.quantity == VB_QUANTITY_AUTO && d.method == VDSH_METHOD_PAPER)
-        d.quantity = VDSH_QUANTITY_DISTANCE; /* the only one paper has */
-    if (d.quantity != VDSH_QUANTITY_DISTANCE && d.quantity != VDSH_QUANTITY_LOG_DISTANCE &&
-        d.quantity != VB_QUANTITY_AUTO)
-        return vb_fail(err, VB_ERR_ARGUMENT, "the bake stores distance or log-distance, not %s",
-                       vdsh_quantity_name(d.quantity));
-    if (d.quantity == VDSH_QUANTITY_LOG_DISTANCE && d.method == VDSH_METHOD_PAPER)
-        return vb_fail(err, VB_ERR_ARGUMENT,
-                       "method paper fills the lower hemisphere with 0, which has no "
-                       "meaning for log-distance: use mirror, lsq or full");
+    if (!choose && !(mi->quantities & VB_QUANTITY_BIT(stored)))
+        return vb_fail(err, VB_ERR_ARGUMENT, "%s", mi->refused[stored]);
     if (d.lambda == 0.0f)
-        d.lambda = 1e-4f; /* lsq and shadow: chosen on the validation split (docs/ACCURACY.md) */
+        d.lambda = VB_DEFAULT_LAMBDA;
     if (!(d.lambda > 0.0f) || !isfinite(d.lambda))
         return vb_fail(err, VB_ERR_ARGUMENT, "the regularisation must be a positive number");
     if (d.max_distance == 0.0f)
@@ -593,11 +505,10 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             return vb_fail(err, VB_ERR_INVALID,
                            "receiver triangle %zu: index %u out of range (%u vertices)", i / 3,
                            R->indices[i], R->vertex_count);
-    /* The sampling domain: the whole sphere for paper (the horizon culls
-     * half of it) and full; the hemisphere above each receiver, with half
-     * the directions (the same traced budget), for the hemisphere fits. */
-    int hemisphere = d.method == VDSH_METHOD_MIRROR || d.method == VDSH_METHOD_LSQ ||
-                     d.method == VDSH_METHOD_SHADOW;
+    /* The sampling domain (the method's row): the whole sphere (paper's
+     * horizon culls half of it), or the hemisphere above each receiver,
+     * with half the directions (the same traced budget). */
+    int hemisphere = mi->hemisphere;
     vb_dirgrid grid = {0};
     vb_result r = vb_dirgrid_create(hemisphere ? (d.rays + 1) / 2 : d.rays, hemisphere,
                                     &grid, err);
@@ -605,8 +516,13 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         return r;
     float *origins = malloc((size_t)R->vertex_count * 3 * sizeof *origins);
     float *near = malloc((size_t)R->vertex_count * sizeof *near + 1);
-    float *coeffs[VDSH_MAX_ORDER + 1] = {0};
-    int missing = 0;
+    float *coeffs[VDSH_ORDER_SLOTS] = {0};
+    /* Oriented receivers: a copy of their normals, turned toward free
+     * space (origins.h); the bake then reads the copy. */
+    float *normals = d.keep_normals ? NULL
+                                    : malloc((size_t)R->vertex_count * 3 * sizeof *normals + 1);
+    vb_mesh oriented = *R;
+    int missing = !d.keep_normals && !normals;
     for (int o = 1; o <= VDSH_MAX_ORDER && !d.trace_only; o++)
         if (d.order_mask & (1u << o))
             missing |= !(coeffs[o] = malloc((size_t)R->vertex_count * o * o * sizeof(float)));
@@ -619,16 +535,19 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!coeffs[o] && o != d.max_order) /* the top one rotates for all */
             continue;
-        /* shadow starts from the lsq fit */
-        uint32_t fm = d.method == VDSH_METHOD_SHADOW ? VDSH_METHOD_LSQ : d.method;
-        if ((r = vb_fit_create(o, fm, d.lambda, &J->fits[o], err)) != VB_OK)
+        if ((r = vb_fit_create(o, mi->fit, d.lambda, &J->fits[o], err)) != VB_OK)
             goto done;
         vb_fit_window(&J->fits[o], d.window);
     }
     vb_origins_stats ost = {0};
-    r = vb_ray_origins(R, d.scene, d.threads, origins, near, &ost, err);
+    uint32_t flipped = 0;
+    r = vb_receivers_prepare(R, d.scene, d.threads, normals, &flipped, origins, near, &ost, err);
     if (r != VB_OK)
         goto done;
+    if (normals) {
+        oriented.normals = normals;
+        d.receivers = R = &oriented;
+    }
 
     J->d = &d;
     J->grid = &grid;
@@ -639,10 +558,10 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     J->log_floor = d.log_floor;
     J->max_local = d.max_distance * d.scene->scale;
     J->inv_scale = 1.0f / d.scene->scale;
-    J->horizon = d.method == VDSH_METHOD_PAPER;
-    /* Method shadow: the per-order log offsets. */
-    for (int o = 1; o <= VDSH_MAX_ORDER && d.method == VDSH_METHOD_SHADOW; o++) {
-        J->log_offset[o] = d.log_offsets ? d.log_offsets[o] : vb_shadow_log_offset(o);
+    J->horizon = mi->horizon;
+    /* The per-order log offsets, for the methods that have them. */
+    for (int o = 1; o <= VDSH_MAX_ORDER && mi->param == VB_PARAM_LOG_OFFSET; o++) {
+        J->log_offset[o] = d.log_offsets ? d.log_offsets[o] : mi->default_log_offset[o];
         if (!isfinite(J->log_offset[o]) || fabsf(J->log_offset[o]) > 5.0f) {
             r = vb_fail(err, VB_ERR_ARGUMENT, "order %d: log offset %g is not in -5..5", o,
                         (double)J->log_offset[o]);
@@ -650,7 +569,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         }
     }
     /* The quantity choice's score: the expected shadow error e(r). */
-    if (d.quantity == VB_QUANTITY_AUTO && !(J->error_table = error_table_create())) {
+    if (choose && !(J->error_table = error_table_create())) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
@@ -661,16 +580,16 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     }
 
     double t0 = vb_now();
-    double auto_error[VDSH_MAX_ORDER + 1][2] = {{0}};
+    double auto_error[VDSH_ORDER_SLOTS][2] = {{0}};
     uint32_t auto_receivers = 0;
-    if (d.quantity == VB_QUANTITY_AUTO && !d.trace_only) {
+    if (choose && !d.trace_only) {
         /* Per order, the quantity whose fits reconstruct the traced
          * distances of a sample of receivers with the lower expected
          * shadow error; sums in sample order, so the choice does not
          * depend on the thread count. */
         auto_receivers = J->choose_count =
             R->vertex_count < CHOOSE_RECEIVERS ? R->vertex_count : CHOOSE_RECEIVERS;
-        J->choose_error = calloc((size_t)J->choose_count * (VDSH_MAX_ORDER + 1) * 2,
+        J->choose_error = calloc((size_t)J->choose_count * (VDSH_ORDER_SLOTS) * 2,
                                  sizeof(double));
         J->choose_coeffs = malloc((size_t)J->choose_count * 2 * CHOOSE_STRIDE * sizeof(float));
         J->done = calloc(R->vertex_count, 1);
@@ -686,7 +605,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             for (int o = 1; o <= VDSH_MAX_ORDER; o++)
                 for (int q = 0; q < 2; q++)
                     auto_error[o][q] +=
-                        J->choose_error[((size_t)i * (VDSH_MAX_ORDER + 1) + o) * 2 + q];
+                        J->choose_error[((size_t)i * (VDSH_ORDER_SLOTS) + o) * 2 + q];
         for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
             auto_error[o][0] /= J->choose_count;
             auto_error[o][1] /= J->choose_count;
@@ -706,7 +625,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         }
     } else {
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-            J->quantity[o] = d.quantity == VB_QUANTITY_AUTO ? VDSH_QUANTITY_DISTANCE : d.quantity;
+            J->quantity[o] = choose ? VDSH_QUANTITY_DISTANCE : stored;
     }
     unsigned started = vb_parallel_for(d.threads, R->vertex_count, BLOCK, bake_block, J,
                                        d.progress ? bake_progress : NULL, J);
@@ -717,7 +636,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
 
     vb_bake_output o = {0};
     o.max_order = d.max_order;
-    o.method = d.method;
+    o.method = mi->stored;
     int any_log = 0;
     for (int k = 0; k <= VDSH_MAX_ORDER; k++) {
         o.quantity[k] = J->quantity[k];
@@ -725,7 +644,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     }
     o.auto_receivers = auto_receivers;
     memcpy(o.auto_error, auto_error, sizeof auto_error);
-    o.lambda = d.method == VDSH_METHOD_LSQ || d.method == VDSH_METHOD_SHADOW ? d.lambda : 0.0f;
+    o.lambda = mi->regularised ? d.lambda : 0.0f;
     memcpy(o.log_offset, J->log_offset, sizeof o.log_offset);
     o.log_floor = any_log ? d.log_floor : 0.0f;
     o.window = d.window;
@@ -740,6 +659,9 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     o.rays_missed = atomic_load(&J->missed);
     o.degenerate_receivers = atomic_load(&J->degenerate);
     o.undefined_normals = undefined;
+    o.normals = normals;
+    normals = NULL;
+    o.flipped_normals = flipped;
     o.moved_origins = ost.moved;
     o.origins = ost;
     o.seconds = vb_now() - t0;
@@ -758,6 +680,7 @@ done:
         free(coeffs[k]);
     free(origins);
     free(near);
+    free(normals);
     vb_dirgrid_destroy(&grid);
     return r;
 }

@@ -39,6 +39,9 @@ __attribute__((format(printf, 3, 4)))
 #endif
 vb_result vb_fail(vb_error *err, vb_result r, const char *fmt, ...);
 
+/* Monotonic wall clock in seconds. */
+double vb_now(void);
+
 #ifdef __cplusplus
 }
 #endif

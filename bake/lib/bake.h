@@ -3,7 +3,8 @@
  * stratified set of rays against the occluder scene and project the hit
  * distances onto real SH (formats/vdsh_sh.h).
  *
- * Methods (the fit is fit.h's):
+ * Methods (their properties: one row each in method.h's table; the maps:
+ * fit.h):
  *   paper   the paper's demo (docs/DESIGN.md §1): directions over the
  *           whole sphere; those below the receiver's horizon (w.n < 0)
  *           count as distance 0 with the same 4 pi / N weight. They are not
@@ -38,10 +39,15 @@
  * to walls; distance on open objects, where most rays escape to the clamp
  * distance. With paper, auto means distance.
  *
- * Ray origins: origins.h (the rule, the repair of receivers left inside or
- * behind other geometry, and each receiver's near distance, below which a
- * traced distance counts as ~0 for the degenerate count). Rays that hit
- * nothing within max_distance get max_distance.
+ * Orientation and ray origins: origins.h (receivers whose normals point
+ * into geometry turned toward free space, unless keep_normals; the rule,
+ * the repair of receivers left inside or behind other geometry, and each
+ * receiver's near distance, below which a traced distance counts as ~0 for
+ * the degenerate count), in one pass over the receivers' frames. Rays that
+ * hit nothing within max_distance get max_distance.
+ *
+ * The whole bake around this (load, refine, fill and write the file):
+ * job.h. Encoding the coefficients as streams: vb_bake_stream (stream.c).
  *
  * Determinism: a receiver's coefficients depend only on (seed, vertex
  * index, its position/normal, the scene): every per-vertex sum runs in a
@@ -59,6 +65,7 @@
 #include <stdint.h>
 
 #include "mesh.h"
+#include "method.h"
 #include "origins.h"
 #include "scene.h"
 #include "vb.h"
@@ -68,25 +75,26 @@
 extern "C" {
 #endif
 
-#define VB_QUANTITY_AUTO 0xffu /* vb_bake_desc.quantity: chosen per order */
-
 typedef struct vb_bake_desc {
     const vb_mesh *receivers;  /* positions and normals (borrowed) */
     const vb_scene *scene;     /* the occluders (borrowed) */
     uint32_t rays;             /* directions per receiver; 0: 2500 */
     uint64_t seed;             /* 0 is a valid seed */
     float max_distance;        /* clamp; 0: the occluders' bbox diagonal */
-    uint32_t method;           /* vdsh_method; 0 = paper */
-    uint32_t quantity;         /* vdsh_quantity: distance (0) or log-distance,
-                                * or VB_QUANTITY_AUTO */
+    vb_method method;          /* method.h; 0: shadow (the default) */
+    vb_quantity quantity;      /* method.h; 0: auto (the default) */
     float lambda;              /* lsq and shadow regularisation; 0: 1e-4 */
     const float *log_offsets;  /* method shadow: per order (index 1..5), added
                                 * to the fitted ln d; NULL: vb_shadow_log_offset */
     float log_floor;           /* log-distance floor; 0: 1% of max_distance */
-    uint32_t window;           /* vdsh_window on each order's bands; 0: none */
+    vdsh_window window;        /* on each order's bands; 0: none */
     uint32_t order_mask;       /* bit n: produce order n; 0: max_order only */
     int max_order;             /* 0: the highest order in order_mask, or 5 */
     unsigned threads;          /* 0: every online core */
+    /* 0 (the tools' default): receivers whose normals point into geometry
+     * are turned toward free space first (vb_orient_receivers, on a copy:
+     * vb_bake_output.normals); 1: the normals as given. */
+    int keep_normals;
     int trace_only;            /* benchmark: trace the same rays, nothing else */
     /* Called from the calling thread a few times a second, and once at the
      * end, with receivers done and rays traced so far. May be NULL. */
@@ -97,19 +105,19 @@ typedef struct vb_bake_desc {
 
 typedef struct vb_bake_output {
     int max_order;
-    uint32_t method;           /* vdsh_method used */
-    uint32_t quantity[VDSH_MAX_ORDER + 1]; /* per order: vdsh_quantity stored */
+    vdsh_method method;        /* the method as stored */
+    vdsh_quantity quantity[VDSH_ORDER_SLOTS]; /* per order: the quantity stored */
     uint32_t auto_receivers;   /* VB_QUANTITY_AUTO: receivers sampled (else 0) */
-    double auto_error[VDSH_MAX_ORDER + 1][2]; /* their expected shadow error
+    double auto_error[VDSH_ORDER_SLOTS][2]; /* their expected shadow error
                                 * per order, distance [0] and log [1] */
     float lambda;              /* lsq or shadow regularisation used (0 otherwise) */
-    float log_offset[VDSH_MAX_ORDER + 1]; /* method shadow: per order, as used */
+    float log_offset[VDSH_ORDER_SLOTS]; /* method shadow: per order, as used */
     float log_floor;           /* log-distance floor used (0 otherwise) */
-    uint32_t window;           /* vdsh_window applied */
+    vdsh_window window;        /* applied */
     uint32_t vertex_count;
-    /* Per order n (1..5): vertex_count * n^2 coefficients, vertex-major, or
+    /* Per order n (1..VDSH_MAX_ORDER): vertex_count * n^2 coefficients, vertex-major, or
      * NULL where the order was not asked for (and with trace_only). */
-    float *coeffs[VDSH_MAX_ORDER + 1];
+    float *coeffs[VDSH_ORDER_SLOTS];
     uint32_t rays;             /* directions per receiver actually used */
     int hemisphere;            /* sampling domain: 0 sphere, 1 hemisphere */
     float max_distance;        /* the clamp used, scene units */
@@ -118,6 +126,10 @@ typedef struct vb_bake_output {
     uint64_t rays_missed;
     uint32_t degenerate_receivers;
     uint32_t undefined_normals;
+    /* The receivers' normals as baked (3 per vertex), turned toward free
+     * space, or NULL with keep_normals (then the receivers' own). */
+    float *normals;
+    uint32_t flipped_normals;  /* receivers whose normal was turned */
     uint32_t moved_origins;    /* receivers whose origin the repair moved */
     vb_origins_stats origins;  /* the ray origins' repair: what it did and cost */
     double seconds;            /* wall time of the trace-and-project loop
@@ -140,11 +152,9 @@ void vb_bake_output_free(vb_bake_output *out);
  * stream's largest |coefficient| (stored values in [-1, 1]), encoded on
  * b->threads workers. *storage receives the data the stream points at;
  * the caller frees it. */
-vb_result vb_bake_stream(const vb_bake_output *b, int order, uint32_t encoding,
+vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encoding,
                          vdsh_stream *out, void **storage, vb_error *err);
 
-/* Monotonic wall clock in seconds. */
-double vb_now(void);
 
 #ifdef __cplusplus
 }

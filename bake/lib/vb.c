@@ -1,6 +1,7 @@
 #include "vb.h"
 
 #include <stdio.h>
+#include <time.h>
 
 const char *vb_result_str(vb_result r)
 {
@@ -25,4 +26,11 @@ vb_result vb_fail(vb_error *err, vb_result r, const char *fmt, ...)
         va_end(ap);
     }
     return r;
+}
+
+double vb_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }

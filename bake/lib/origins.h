@@ -104,6 +104,15 @@ vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads, 
 vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
                               uint32_t *flipped, vb_error *err);
 
+/* The bake's receivers in one pass over their frames (built once):
+ * vb_orient_receivers (when `normals` is not NULL: m's normals are copied
+ * there and oriented in the copy; m is not changed) then vb_ray_origins
+ * with the oriented normals. `flipped` and `stats` may be NULL; stats'
+ * seconds count the origins only. The same results as the two calls. */
+vb_result vb_receivers_prepare(const vb_mesh *m, const vb_scene *s, unsigned threads,
+                               float *normals, uint32_t *flipped, float *out,
+                               float *near_out, vb_origins_stats *stats, vb_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,0 +1,209 @@
+/* job.c - a whole bake as one straight line (job.h). */
+#include "job.h"
+
+#include <libgen.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "origins.h"
+
+#define DEFAULT_CUBE_SIZE 64
+
+int vb_job_cube_size(const vb_job_desc *d)
+{
+    int max_order = 0;
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+        if (d->bake.order_mask & (1u << o))
+            max_order = o;
+    if (d->bake.max_order > max_order)
+        max_order = d->bake.max_order;
+    if (max_order == 0)
+        max_order = VDSH_MAX_ORDER; /* bake.h: no orders asked, the highest */
+    if (max_order < 4 || d->cube_size < 0)
+        return 0;
+    return d->cube_size > 0 ? d->cube_size : DEFAULT_CUBE_SIZE;
+}
+
+static void *encode_basis(void *arg)
+{
+    vb_job *j = arg;
+    j->basis_result = vb_cubemap_basis_encode(j->basis_size, &j->basis, &j->basis_err);
+    return NULL;
+}
+
+vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err)
+{
+    if (d->path_count < 1 || d->path_count > VDSH_MAX_SOURCES)
+        return vb_fail(err, VB_ERR_ARGUMENT, "%u meshes: 1..%d make a scene", d->path_count,
+                       VDSH_MAX_SOURCES);
+    j->t_start = vb_now();
+    j->sources = calloc(d->path_count, sizeof *j->sources);
+    if (!j->sources)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    /* The basis cubemaps meanwhile (deflate, most of it). */
+    int cube_size = vb_job_cube_size(d);
+    j->basis_size = cube_size;
+    j->basis_running = cube_size > 0 && d->output && !d->bake.trace_only &&
+                       pthread_create(&j->basis_thread, NULL, encode_basis, j) == 0;
+    vb_load_desc ld = {.weld = d->weld};
+    for (uint32_t i = 0; i < d->path_count; i++) {
+        const char *path = d->paths[i];
+        vb_mesh m = {0};
+        vb_source_info info;
+        double t = vb_now();
+        vb_result r = vb_mesh_load(path, &ld, &m, &info, err);
+        if (r == VB_OK)
+            r = vb_mesh_append(&j->occluders, &m, err);
+        if (r != VB_OK) {
+            vb_mesh_free(&m);
+            return r;
+        }
+        j->sources[i].name = (char *)path;
+        j->sources[i].size = info.size;
+        memcpy(j->sources[i].sha256, info.sha256, 32);
+        j->source_count = i + 1;
+        if (d->on_mesh)
+            d->on_mesh(d->user, path, &m, &info, vb_now() - t);
+        vb_mesh_free(&m);
+    }
+    j->timings.load = vb_now() - j->t_start;
+    return VB_OK;
+}
+
+vb_result vb_job_refine(vb_job *j, const vb_job_desc *d, vb_error *err)
+{
+    double t = vb_now();
+    vb_result r = vb_mesh_refine(&j->occluders, d->max_edge, &j->receivers, err);
+    j->timings.refine = vb_now() - t;
+    return r;
+}
+
+vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
+{
+    double t = vb_now();
+    vb_scene_desc sd = {.robust = !d->fast_traversal, .threads = d->bake.threads};
+    vb_result r = vb_scene_create(&j->occluders, &sd, &j->scene, err);
+    if (r != VB_OK)
+        return r;
+    j->timings.build = vb_now() - t;
+    vb_bake_desc bd = d->bake;
+    bd.receivers = &j->receivers;
+    bd.scene = j->scene;
+    if ((r = vb_bake_run(&bd, &j->bake, err)) != VB_OK)
+        return r;
+    j->timings.trace = j->bake.seconds;
+    j->timings.threads = j->bake.threads;
+    j->timings.total = vb_now() - j->t_start;
+    return VB_OK;
+}
+
+vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
+{
+    const vb_bake_output *b = &j->bake;
+    uint32_t count = 0;
+    j->coefficient_bytes = 0;
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
+        if (!b->coeffs[o])
+            continue;
+        vb_result r = vb_bake_stream(b, o, d->f32 ? VDSH_ENCODING_F32 : VDSH_ENCODING_F16,
+                                     &j->streams[count], &j->stream_data[count], err);
+        if (r != VB_OK)
+            return r;
+        j->coefficient_bytes += vdsh_stream_bytes_per_vertex(&j->streams[count]);
+        count++;
+    }
+    vdsh_file f = {0};
+    vdsh_header *h = &f.header;
+    h->vertex_count = j->receivers.vertex_count;
+    h->triangle_count = j->receivers.triangle_count;
+    h->rays = b->rays;
+    h->sampling = b->hemisphere ? VDSH_SAMPLING_HEMISPHERE : VDSH_SAMPLING_SPHERE;
+    h->seed = d->bake.seed;
+    h->max_distance = b->max_distance;
+    h->max_edge = d->max_edge;
+    h->offset_rule = VDSH_OFFSET_WB_AVG;
+    h->load_flags = d->weld ? VDSH_LOAD_WELD : 0;
+    h->cube_size = (uint32_t)vb_job_cube_size(d);
+    h->occluder_vertex_count = j->occluders.vertex_count;
+    h->occluder_triangle_count = j->occluders.triangle_count;
+    h->trace_flags = d->fast_traversal ? 0 : VDSH_TRACE_ROBUST;
+    memcpy(h->bounds_min, j->scene->bounds_min, sizeof h->bounds_min);
+    memcpy(h->bounds_max, j->scene->bounds_max, sizeof h->bounds_max);
+    f.source_count = j->source_count;
+    f.sources = j->sources;
+    f.positions = j->receivers.positions;
+    f.normals = b->normals ? b->normals : j->receivers.normals;
+    f.indices = j->receivers.indices;
+    f.stream_count = count;
+    f.streams = j->streams;
+    f.has_stats = 1;
+    f.stats = (vdsh_stats){.rays_traced = b->rays_traced, .rays_missed = b->rays_missed,
+                           .degenerate_receivers = b->degenerate_receivers,
+                           .undefined_normals = b->undefined_normals,
+                           .moved_origins = b->moved_origins,
+                           .flipped_normals = b->flipped_normals};
+    f.has_timings = d->record_timings;
+    f.timings = j->timings;
+    j->file = f;
+    return VB_OK;
+}
+
+/* File stem and directory of OUT: "dir/room.vdsh" -> "dir", "room". */
+static void split_output(const char *out, char *dir, char *stem, size_t cap)
+{
+    char a[PATH_MAX], b[PATH_MAX];
+    snprintf(a, sizeof a, "%s", out);
+    snprintf(b, sizeof b, "%s", out);
+    snprintf(dir, cap, "%s", dirname(a));
+    snprintf(stem, cap, "%s", basename(b));
+    size_t n = strlen(stem);
+    if (n > 5 && strcmp(stem + n - 5, ".vdsh") == 0)
+        stem[n - 5] = '\0';
+}
+
+vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vb_error *err)
+{
+    if (!d->output)
+        return vb_fail(err, VB_ERR_ARGUMENT, "no output file");
+    char dir[PATH_MAX], stem[PATH_MAX];
+    split_output(d->output, dir, stem, sizeof dir);
+    int cube_size = vb_job_cube_size(d);
+    if (cube_size > 0) {
+        if (j->basis_running)
+            pthread_join(j->basis_thread, NULL);
+        else /* no helper thread could start */
+            j->basis_result = vb_cubemap_basis_encode(cube_size, &j->basis, &j->basis_err);
+        j->basis_running = 0;
+        if (j->basis_result != VB_OK) {
+            *err = j->basis_err;
+            return j->basis_result;
+        }
+        vb_result r = vb_cubemap_basis_write(&j->basis, d->cubemap_dir ? d->cubemap_dir : dir,
+                                             stem, err);
+        if (r != VB_OK)
+            return r;
+    }
+    vdsh_error verr;
+    if (vdsh_write_sized(d->output, &j->file, &j->file_bytes, &verr) != VDSH_OK)
+        return vb_fail(err, VB_ERR_IO, "%s", verr.msg);
+    return VB_OK;
+}
+
+void vb_job_free(vb_job *j)
+{
+    if (!j)
+        return;
+    if (j->basis_running)
+        pthread_join(j->basis_thread, NULL);
+    vb_cubemap_basis_free(&j->basis);
+    for (int s = 0; s < VDSH_MAX_ORDER; s++)
+        free(j->stream_data[s]);
+    vb_bake_output_free(&j->bake);
+    vb_scene_destroy(j->scene);
+    vb_mesh_free(&j->receivers);
+    vb_mesh_free(&j->occluders);
+    free(j->sources);
+    memset(j, 0, sizeof *j);
+}

@@ -1,0 +1,114 @@
+/*
+ * job.h - a whole bake as one straight line: load every mesh into one
+ * occluder scene, refine a copy into the receivers, build the BVH and bake
+ * (bake.h: orientation, ray origins, trace and project), fill the .vdsh
+ * file, write the basis cubemaps and the file. vdsh-bake's main() is the
+ * command line around these calls; a program that bakes without it calls
+ * them in the same order:
+ *
+ *     vb_job j = {0};
+ *     vb_job_desc d = {.paths = paths, .path_count = n, .output = "room.vdsh"};
+ *     ok = vb_job_load(&j, &d, &err) == VB_OK && vb_job_refine(&j, &d, &err) == VB_OK &&
+ *          vb_job_bake(&j, &d, &err) == VB_OK && vb_bake_fill_file(&j, &d, &err) == VB_OK &&
+ *          vb_job_write(&j, &d, &err) == VB_OK;
+ *     vb_job_free(&j);
+ *
+ * A zero vb_job_desc (apart from paths and output) is vdsh-bake's defaults
+ * (bake.h's for the bake; f16 coefficients; 64 x 64 basis cubemaps).
+ * The basis cubemaps depend on their size only: vb_job_load starts a
+ * helper thread that encodes them in memory while the bake runs.
+ *
+ * Does not: parse command lines, print (except through on_mesh), or defer
+ * signals (the caller holds its own lock around vb_job_write).
+ * Errors: vb_result, with err naming the file. Ownership: the job owns
+ * everything in it; vb_job_free frees it at any stage (also a zeroed job).
+ * Threading: one job per thread; the bake runs on bake.threads workers.
+ */
+#ifndef VB_JOB_H
+#define VB_JOB_H
+
+#include <pthread.h>
+#include <stdint.h>
+
+#include "bake.h"
+#include "cubemap.h"
+#include "mesh.h"
+#include "scene.h"
+#include "vb.h"
+#include "vdsh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct vb_job_desc {
+    const char *const *paths;  /* meshes (mesh.h names), borrowed */
+    uint32_t path_count;       /* 1..VDSH_MAX_SOURCES */
+    const char *output;        /* the .vdsh file; NULL: none (vb_job_write refuses) */
+    const char *cubemap_dir;   /* NULL: beside output */
+    int weld;                  /* vb_load_desc.weld */
+    float max_edge;            /* receivers refined to it; 0: the vertices as they are */
+    int fast_traversal;        /* 0: Embree's robust traversal (default) */
+    /* The bake (receivers and scene are the job's). Its orders give the
+     * streams, in increasing order. */
+    vb_bake_desc bake;
+    int f32;                   /* 1: f32 coefficients; 0: f16 (default) */
+    int cube_size;             /* basis cubemap face; 0: 64; < 0: none */
+    int record_timings;        /* store the timings in the file */
+    /* Called after each mesh loads (may be NULL). */
+    void (*on_mesh)(void *user, const char *path, const vb_mesh *m,
+                    const vb_source_info *info, double seconds);
+    void *user;
+} vb_job_desc;
+
+typedef struct vb_job {
+    vb_mesh occluders, receivers;
+    vdsh_source *sources;      /* names borrowed from the desc's paths */
+    uint32_t source_count;
+    vb_scene *scene;
+    vb_bake_output bake;
+    vdsh_stream streams[VDSH_MAX_ORDER];
+    void *stream_data[VDSH_MAX_ORDER];
+    size_t coefficient_bytes;  /* per vertex, all streams */
+    vdsh_file file;            /* filled by vb_bake_fill_file (borrows the above) */
+    uint64_t file_bytes;       /* the written file's size (vb_job_write) */
+    vdsh_timings timings;
+    double t_start;
+    /* The basis cubemaps' helper thread. */
+    pthread_t basis_thread;
+    int basis_running;
+    int basis_size;
+    vb_cubemap_basis basis;
+    vb_result basis_result;
+    vb_error basis_err;
+} vb_job;
+
+/* The face size of the basis cubemaps the job writes: 0 when none (the
+ * orders need none: only orders 4 and up evaluate bands 3-4 from them). */
+int vb_job_cube_size(const vb_job_desc *d);
+
+/* Load every mesh into one occluder scene and record its source. */
+vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err);
+
+/* The receivers: the occluders' vertices, refined to max_edge. */
+vb_result vb_job_refine(vb_job *j, const vb_job_desc *d, vb_error *err);
+
+/* Build the BVH and bake (bake.h); timings recorded. */
+vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err);
+
+/* Encode one stream per order and fill j->file: the header, sources,
+ * receivers (with the bake's oriented normals), streams, statistics and,
+ * if asked, timings. */
+vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err);
+
+/* Write the basis cubemaps (if any), then the .vdsh file, each atomically;
+ * j->file_bytes receives the file's size. */
+vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vb_error *err);
+
+void vb_job_free(vb_job *j);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VB_JOB_H */

@@ -1,0 +1,109 @@
+/* stream.c - a bake's coefficients as .vdsh streams (vb_bake_stream in
+ * bake.h): f32 as they are, or f16 scaled by the stream's largest
+ * |coefficient|, encoded in chunks on the bake's workers. */
+#include "bake.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "method.h"
+#include "parallel.h"
+#include "vdsh.h"
+
+/* The f16 stream in chunks on the bake's workers: first each chunk's
+ * largest |coefficient|, then, with the stream's scale, its encoding. */
+#define F16_CHUNK 65536u
+
+typedef struct f16_job {
+    const float *src;
+    size_t count;
+    float scale;
+    float *amax;          /* per chunk */
+    uint16_t *dst;
+    vdsh_result *result;  /* per chunk */
+} f16_job;
+
+static void f16_amax_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
+{
+    f16_job *J = ctx;
+    (void)worker;
+    for (uint32_t c = begin; c < end; c++) {
+        size_t a = (size_t)c * F16_CHUNK, b = J->count - a < F16_CHUNK ? J->count : a + F16_CHUNK;
+        float m = 0.0f;
+        for (size_t i = a; i < b; i++)
+            m = fmaxf(m, fabsf(J->src[i]));
+        J->amax[c] = m;
+    }
+}
+
+static void f16_encode_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
+{
+    f16_job *J = ctx;
+    (void)worker;
+    for (uint32_t c = begin; c < end; c++) {
+        size_t a = (size_t)c * F16_CHUNK, b = J->count - a < F16_CHUNK ? J->count : a + F16_CHUNK;
+        J->result[c] = vdsh_encode_f16(J->src + a, b - a, J->scale, J->dst + a);
+    }
+}
+
+vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encoding,
+                         vdsh_stream *out, void **storage, vb_error *err)
+{
+    if (order < 1 || order > VDSH_MAX_ORDER || !b->coeffs[order])
+        return vb_fail(err, VB_ERR_ARGUMENT, "order %d is not in the bake", order);
+    if (encoding != VDSH_ENCODING_F16 && encoding != VDSH_ENCODING_F32)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown encoding %u", encoding);
+    const vb_method_info *mi = vb_method_stored(b->method);
+    if (!mi)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", b->method);
+    int nc = order * order;
+    size_t count = (size_t)b->vertex_count * nc;
+    vdsh_stream s = {.order = (uint32_t)order, .encoding = encoding, .method = b->method,
+                     .quantity = b->quantity[order],
+                     .method_param = mi->param == VB_PARAM_LOG_OFFSET ? b->log_offset[order]
+                                                                      : b->lambda,
+                     .scale = 1.0f,
+                     .quantity_param = b->quantity[order] == VDSH_QUANTITY_LOG_DISTANCE
+                                           ? b->log_floor : 0.0f, .window = b->window,
+                     .window_param = b->window ? (float)order : 0.0f};
+    if (encoding == VDSH_ENCODING_F32) {
+        float *f = malloc(count * sizeof *f);
+        if (!f)
+            return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the order %d stream",
+                           order);
+        memcpy(f, b->coeffs[order], count * sizeof *f);
+        s.data = f;
+    } else {
+        /* Stored values are coefficient / (the stream's largest
+         * |coefficient|): within [-1, 1] whatever the scene's size or clamp
+         * distance, so f16 neither overflows nor sinks into subnormals and
+         * keeps its full relative precision. */
+        uint32_t chunks = (uint32_t)((count + F16_CHUNK - 1) / F16_CHUNK);
+        f16_job J = {.src = b->coeffs[order], .count = count};
+        J.amax = malloc(((size_t)chunks + 1) * sizeof *J.amax);
+        J.result = malloc(((size_t)chunks + 1) * sizeof *J.result);
+        J.dst = malloc(count * sizeof *J.dst + 1);
+        int ran = J.amax && J.result && J.dst &&
+                  vb_parallel_for(b->threads, chunks, 1, f16_amax_block, &J, NULL, NULL) > 0;
+        float amax = 0.0f;
+        for (uint32_t c = 0; ran && c < chunks; c++)
+            amax = fmaxf(amax, J.amax[c]);
+        J.scale = s.scale = amax > 0.0f ? amax : 1.0f;
+        ran = ran && vb_parallel_for(b->threads, chunks, 1, f16_encode_block, &J, NULL, NULL) > 0;
+        vdsh_result r = ran ? VDSH_OK : VDSH_ERR_OUT_OF_MEMORY;
+        for (uint32_t c = 0; ran && c < chunks && r == VDSH_OK; c++)
+            r = J.result[c];
+        free(J.amax);
+        free(J.result);
+        if (r != VDSH_OK) {
+            free(J.dst);
+            return vb_fail(err, r == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_INVALID,
+                           "order %d coefficients do not fit f16", order);
+        }
+        s.data = J.dst;
+    }
+    *storage = (void *)s.data;
+    *out = s;
+    return VB_OK;
+}
