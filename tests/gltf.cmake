@@ -14,3 +14,18 @@ foreach(ext gltf glb)
   _robust_fuzz_target(mesh_${ext} SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_fuzz_mesh.c
                       LIBS vb_mesh m DEFS VDSH_FUZZ_EXT="${ext}")
 endforeach()
+
+# npm packages (gltf-validator) into the build dir, once: a fixture.
+#   gltf_export       bake -> vdsh-export -> the Khronos glTF Validator
+find_program(VDSH_NODE node)
+add_test(NAME gltf_npm_setup
+         COMMAND bash ${PROJECT_SOURCE_DIR}/scripts/npm_gltf_tools ${CMAKE_BINARY_DIR}/npm)
+set_tests_properties(gltf_npm_setup PROPERTIES FIXTURES_SETUP gltf_npm SKIP_RETURN_CODE 77)
+if(VDSH_NODE)
+  add_test(NAME gltf_export
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_gltf_export.py
+                   $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-export> ${VDSH_NODE}
+                   ${CMAKE_BINARY_DIR}/npm/node_modules ${CMAKE_CURRENT_BINARY_DIR}/gltf_export
+                   ${VDSH_ASSIMP_MODELS})
+  set_tests_properties(gltf_export PROPERTIES FIXTURES_REQUIRED gltf_npm)
+endif()
