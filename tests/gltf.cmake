@@ -29,3 +29,16 @@ if(VDSH_NODE)
                    ${VDSH_ASSIMP_MODELS})
   set_tests_properties(gltf_export PROPERTIES FIXTURES_REQUIRED gltf_npm)
 endif()
+
+#   gltf_web_viewer   runtime/web in headless chromium against vdsh-view's
+#                     shadow-only frame of the same view (skips with 77
+#                     without chromium or a GL context)
+find_program(VDSH_CHROMIUM chromium)
+if(NOT VDSH_CHROMIUM)
+  set(VDSH_CHROMIUM chromium)
+endif()
+add_test(NAME gltf_web_viewer
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_web_viewer.py
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-export> $<TARGET_FILE:vdsh-view>
+                 ${VDSH_CHROMIUM} ${PROJECT_SOURCE_DIR}/runtime/web ${CMAKE_CURRENT_BINARY_DIR}/gltf_web)
+set_tests_properties(gltf_web_viewer PROPERTIES SKIP_RETURN_CODE 77)
