@@ -40,5 +40,6 @@ endif()
 add_test(NAME gltf_web_viewer
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_web_viewer.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-export> $<TARGET_FILE:vdsh-view>
-                 ${VDSH_CHROMIUM} ${PROJECT_SOURCE_DIR}/runtime/web ${CMAKE_CURRENT_BINARY_DIR}/gltf_web)
+                 ${VDSH_CHROMIUM} ${PROJECT_SOURCE_DIR}/runtime/web ${CMAKE_CURRENT_BINARY_DIR}/gltf_web
+                 ${VDSH_ASSIMP_MODELS})
 set_tests_properties(gltf_web_viewer PROPERTIES SKIP_RETURN_CODE 77)
