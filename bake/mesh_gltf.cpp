@@ -34,7 +34,9 @@
 
 namespace {
 
-constexpr size_t max_vertices = (size_t)1 << 26;
+/* Elements of one accessor, and vertices of the whole mesh: 2^24, the
+ * refinement's limit (mesh.h). */
+constexpr size_t max_vertices = (size_t)1 << 24;
 
 struct reader {
     const char *name;
@@ -152,12 +154,17 @@ vb_result read_accessor(const reader &rd, int index, int want_type, bool integer
         return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: too many elements (%zu)", rd.name, what, index,
                        a.count);
     size_t elem = cs * (size_t)nc;
-    out.assign(a.count * (size_t)nc, 0.0);
     vb_result r = VB_OK;
+    /* Bytes first, memory after: a count the buffer cannot hold is refused
+     * before anything is allocated for it. */
+    const uint8_t *p = nullptr;
     if (a.bufferView >= 0 && a.count) {
-        const uint8_t *p = view_span(rd, a.bufferView, a.byteOffset, a.count, elem, elem, what, &r);
+        p = view_span(rd, a.bufferView, a.byteOffset, a.count, elem, elem, what, &r);
         if (!p)
             return r;
+    }
+    out.assign(a.count * (size_t)nc, 0.0);
+    if (p) {
         size_t stride = m.bufferViews[(size_t)a.bufferView].byteStride;
         if (!stride)
             stride = elem;

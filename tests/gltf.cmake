@@ -43,3 +43,21 @@ add_test(NAME gltf_web_viewer
                  ${VDSH_CHROMIUM} ${PROJECT_SOURCE_DIR}/runtime/web ${CMAKE_CURRENT_BINARY_DIR}/gltf_web
                  ${VDSH_ASSIMP_MODELS})
 set_tests_properties(gltf_web_viewer PROPERTIES SKIP_RETURN_CODE 77)
+
+#   gltf_robust_load  vb_mesh_load_memory is vb_mesh_load for glTF too: the
+#                     seeds and every assimp-testmodels glTF2 folder
+#                     (valid and broken files), loaded both ways (with the
+#                     other formats' seeds: the test wants >= 100 inputs)
+set(_gltf_load_inputs)
+foreach(c mesh_gltf mesh_glb mesh_obj mesh_ply mesh_off mesh_stl)
+  list(APPEND _gltf_load_inputs ${PROJECT_SOURCE_DIR}/tests/corpus/${c})
+endforeach()
+file(GLOB_RECURSE _gltf_models LIST_DIRECTORIES false
+     ${VDSH_ASSIMP_MODELS}/glTF2/*.gltf ${VDSH_ASSIMP_MODELS}/glTF2/*.glb)
+foreach(f ${_gltf_models})
+  get_filename_component(d ${f} DIRECTORY)
+  list(APPEND _gltf_load_inputs ${d})
+endforeach()
+list(REMOVE_DUPLICATES _gltf_load_inputs)
+add_test(NAME gltf_robust_load
+         COMMAND test_robust_load ${CMAKE_CURRENT_BINARY_DIR}/gltf_robust_load_tmp ${_gltf_load_inputs})
