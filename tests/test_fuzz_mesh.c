@@ -26,7 +26,7 @@
 #include <string.h>
 
 #ifndef VDSH_FUZZ_EXT
-#error "define VDSH_FUZZ_EXT (obj, ply, off or stl)"
+#error "define VDSH_FUZZ_EXT (obj, ply, off, stl, gltf or glb)"
 #endif
 #define NAME "fuzz." VDSH_FUZZ_EXT
 
@@ -62,8 +62,8 @@ static void check_clean(const vb_mesh *m)
 
 static vb_mesh_format format_of_name(void)
 {
-    static const char *const ext[4] = {"obj", "ply", "off", "stl"};
-    for (int i = 0; i < 4; i++)
+    static const char *const ext[6] = {"obj", "ply", "off", "stl", "gltf", "glb"};
+    for (int i = 0; i < 6; i++)
         if (!strcmp(VDSH_FUZZ_EXT, ext[i]))
             return (vb_mesh_format)i;
     abort();
@@ -101,7 +101,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     vb_error err;
     vb_mesh_raw raw;
     memset(&raw, 0, sizeof raw);
-    int parsed = size > 0 && vb_mesh_parse(NAME, format_of_name(), data, size, &raw, &err) == VB_OK;
+    vb_mesh_format format = format_of_name();
+    int parsed = size > 0 && (format == VB_MESH_GLTF || format == VB_MESH_GLB
+                                  ? vb_mesh_parse_gltf(NAME, format == VB_MESH_GLB, -1, data, size, &raw, &err)
+                                  : vb_mesh_parse(NAME, format, data, size, &raw, &err)) == VB_OK;
     if (parsed)
         check_raw(&raw);
     else if (size > 0)

@@ -24,7 +24,7 @@ static int is_mesh_name(const char *name)
 {
     const char *dot = strrchr(name, '.');
     return dot && (!strcasecmp(dot, ".obj") || !strcasecmp(dot, ".ply") || !strcasecmp(dot, ".off") ||
-                   !strcasecmp(dot, ".stl"));
+                   !strcasecmp(dot, ".stl") || !strcasecmp(dot, ".gltf") || !strcasecmp(dot, ".glb"));
 }
 
 static int same_mesh(const vb_mesh *a, const vb_mesh *b)

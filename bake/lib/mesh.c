@@ -102,6 +102,15 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
     if (r->welded)
         fprintf(fp, "%s%s%s: %u vert%s merged by welding (normals then computed from the faces)\n", tool, sep,
                 path, r->welded, r->welded == 1 ? "ex" : "ices");
+    if (r->gltf_skipped_modes)
+        fprintf(fp, "%s%s%s: %u glTF primitive%s of points or lines skipped (no surface)\n", tool, sep, path,
+                r->gltf_skipped_modes, plural(r->gltf_skipped_modes));
+    if (r->gltf_skipped_morph)
+        fprintf(fp, "%s%s%s: %u glTF primitive%s with morph targets skipped (not baked)\n", tool, sep, path,
+                r->gltf_skipped_morph, plural(r->gltf_skipped_morph));
+    if (r->gltf_skipped_skin)
+        fprintf(fp, "%s%s%s: %u glTF primitive%s of skinned nodes skipped (not baked)\n", tool, sep, path,
+                r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
     if (r->undefined_normals)
         fprintf(fp, "%s%s%s: %u vert%s left without a normal (0,0,0): their triangles have no area\n", tool, sep,
                 path, r->undefined_normals, r->undefined_normals == 1 ? "ex" : "ices");
@@ -776,6 +785,9 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
     vb_mesh_report rp;
     memset(&rp, 0, sizeof rp);
     rp.dropped_triangles = degenerate + raw->dropped_triangles;
+    rp.gltf_skipped_modes = raw->gltf_skipped_modes;
+    rp.gltf_skipped_morph = raw->gltf_skipped_morph;
+    rp.gltf_skipped_skin = raw->gltf_skipped_skin;
     rp.split_vertices = sv.split;
     rp.split_added = sv.added;
     rp.removed_vertices = vertex_count - m.vertex_count;
@@ -900,14 +912,19 @@ static vb_result format_of(const char *name, vb_mesh_format *format, vb_error *e
         *format = VB_MESH_OFF;
     else if (has_extension(name, "stl"))
         *format = VB_MESH_STL;
+    else if (has_extension(name, "gltf"))
+        *format = VB_MESH_GLTF;
+    else if (has_extension(name, "glb"))
+        *format = VB_MESH_GLB;
     else
-        return vb_fail(err, VB_ERR_FORMAT, "%s: unsupported file type (expected .obj, .ply, .off or .stl)", name);
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: unsupported file type (expected .obj, .ply, .off, .stl, .gltf or .glb)", name);
     return VB_OK;
 }
 
 /* A file's bytes -> clean mesh and source info. */
-static vb_result load_bytes(const char *name, vb_mesh_format format, const uint8_t *bytes, size_t size, vb_mesh *m,
-                            vb_source_info *si, vb_error *err)
+static vb_result load_bytes(const char *name, vb_mesh_format format, int gltf_scene, const uint8_t *bytes,
+                            size_t size, vb_mesh *m, vb_source_info *si, vb_error *err)
 {
     if (size == 0)
         return vb_fail(err, VB_ERR_FORMAT, "%s: empty file", name);
@@ -915,7 +932,9 @@ static vb_result load_bytes(const char *name, vb_mesh_format format, const uint8
     vb_sha256(bytes, size, si->sha256);
     vb_mesh_raw raw;
     memset(&raw, 0, sizeof raw);
-    vb_result r = vb_mesh_parse(name, format, bytes, size, &raw, err);
+    vb_result r = format == VB_MESH_GLTF || format == VB_MESH_GLB
+                      ? vb_mesh_parse_gltf(name, format == VB_MESH_GLB, gltf_scene - 1, bytes, size, &raw, err)
+                      : vb_mesh_parse(name, format, bytes, size, &raw, err);
     if (r == VB_OK)
         r = clean_raw(name, format, &raw, m, &si->report, err);
     vb_mesh_raw_free(&raw);
@@ -971,7 +990,7 @@ vb_result vb_mesh_load(const char *path, const vb_load_desc *desc, vb_mesh *out,
         r = read_file(path, &bytes, &size, err);
         if (r != VB_OK)
             return r;
-        r = load_bytes(path, format, bytes, size, &m, &si, err);
+        r = load_bytes(path, format, desc ? desc->gltf_scene : 0, bytes, size, &m, &si, err);
         free(bytes);
     }
     return finish_load(r, &m, &si, desc ? desc->weld : 0, out, info, err);
@@ -989,6 +1008,6 @@ vb_result vb_mesh_load_memory(const void *data, size_t size, const char *name, c
     vb_mesh m = {0};
     vb_source_info si;
     memset(&si, 0, sizeof si);
-    r = load_bytes(name, format, (const uint8_t *)data, size, &m, &si, err);
+    r = load_bytes(name, format, desc ? desc->gltf_scene : 0, (const uint8_t *)data, size, &m, &si, err);
     return finish_load(r, &m, &si, desc ? desc->weld : 0, out, info, err);
 }

@@ -17,7 +17,8 @@
  *     vb_mesh_refine(&m, 0.2f, &fine, &err);  (receivers: no edge > 0.2)
  *     vb_mesh_free(&fine); vb_mesh_free(&m);
  *
- * Scene names: a path ending in .obj/.ply/.off/.stl (case-insensitive), or
+ * Scene names: a path ending in .obj/.ply/.off/.stl/.gltf/.glb
+ * (case-insensitive; glTF: bake/lib/mesh_gltf.cpp says what is read), or
  * "builtin:room" - the procedural paper-style room (19 x 6 x 19 m, y up,
  * boxes, pillars and a sphere; 1,518 vertices and 2,428 coarse triangles;
  * refine with vb_mesh_refine to make it dense: max edge 0.2 gives 58,007
@@ -126,6 +127,8 @@ typedef struct vb_load_desc {
                               (-0 and +0 count as equal; normals then
                               recomputed); 0 (default): keep the file's
                               vertices */
+    int gltf_scene;        /* glTF: 0 (default) = the file's default scene
+                              (or its first); N + 1 = scene N */
 } vb_load_desc;
 
 /* What loading found in a file and did about it, as counts (all zero for
@@ -151,6 +154,12 @@ typedef struct vb_mesh_report {
     uint32_t welded;             /* vertices merged by weld */
     uint32_t undefined_normals;  /* loaded vertices left (0,0,0) at the end:
                                     their triangles have no area */
+    uint32_t gltf_skipped_modes; /* glTF: point and line primitives skipped */
+    uint32_t gltf_skipped_morph; /* glTF: primitives with morph targets
+                                    skipped (their base shape is not what
+                                    the file shows once animated) */
+    uint32_t gltf_skipped_skin;  /* glTF: primitives of skinned nodes
+                                    skipped */
 } vb_mesh_report;
 
 /* What a loaded source was: size and hash for the .vdsh SRCS chunk, and

@@ -51,7 +51,9 @@ typedef enum vb_mesh_format {
     VB_MESH_OBJ,
     VB_MESH_PLY,
     VB_MESH_OFF,
-    VB_MESH_STL
+    VB_MESH_STL,
+    VB_MESH_GLTF,          /* mesh_gltf.cpp (vb_mesh_parse_gltf) */
+    VB_MESH_GLB
 } vb_mesh_format;
 
 /* A file as read, before cleaning: polygons fan-triangulated (triangles
@@ -71,6 +73,9 @@ typedef struct vb_mesh_raw {
     uint8_t *corner_given; /* 3 * triangle_count or NULL: corner has one */
     uint32_t dropped_triangles; /* OBJ faces dropped for fewer than 3
                                    distinct vertices (see vb_mesh_report) */
+    uint32_t gltf_skipped_modes; /* glTF primitives skipped: points, lines */
+    uint32_t gltf_skipped_morph; /* glTF primitives skipped: morph targets */
+    uint32_t gltf_skipped_skin;  /* glTF primitives skipped: skinned node */
 } vb_mesh_raw;
 
 /* Read `size` bytes (the whole file) of `format`; `name` is for messages. */
@@ -78,6 +83,11 @@ vb_result vb_mesh_parse(const char *name, vb_mesh_format format, const uint8_t *
                         vb_mesh_raw *out, vb_error *err);
 
 void vb_mesh_raw_free(vb_mesh_raw *raw);
+
+/* glTF 2.0 (binary = 0: .gltf JSON, 1: .glb) from mesh_gltf.cpp: scene
+ * `scene`, or the default scene when < 0; see that file's top comment. */
+vb_result vb_mesh_parse_gltf(const char *name, int binary, int scene, const uint8_t *bytes, size_t size,
+                             vb_mesh_raw *out, vb_error *err);
 
 #ifdef __cplusplus
 }

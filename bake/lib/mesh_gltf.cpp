@@ -1,0 +1,492 @@
+/*
+ * mesh_gltf.cpp - glTF 2.0 input (.gltf with its buffers, .glb) for the
+ * baker, through tinygltf (Debian libtinygltf-dev): the JSON and the
+ * containers are tinygltf's; every accessor is read and bounds-checked
+ * here (tinygltf does not apply sparse accessors nor check strides).
+ *
+ * What is read: every mesh primitive reachable from the default scene (or
+ * scene `scene` when >= 0), each node's matrix or TRS applied (normals by
+ * the inverse transpose; a mirroring transform flips the winding), modes
+ * TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN, indexed or not, float or
+ * normalised integer POSITION/NORMAL, sparse accessors. What is skipped and
+ * counted (vb_mesh_raw.gltf_*, printed by vb_mesh_report_print): POINTS and
+ * LINE* primitives, primitives with morph targets, meshes of skinned
+ * nodes. Refused with the file and reason: unparsable JSON, buffers out of
+ * range, an accessor of the wrong type, node cycles, no scene, extensions
+ * the file requires (e.g. Draco compression), images are never decoded.
+ *
+ * External buffers (.gltf) resolve relative to `name`'s directory; a glTF
+ * loaded from memory under a name without a directory resolves them in
+ * the current directory.
+ *
+ * Errors: vb_result; no C++ exception leaves this file.
+ * Threading: no shared state; concurrent calls are fine.
+ */
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <tiny_gltf.h>
+
+#include "mesh_parse.h"
+
+namespace {
+
+/* Elements of one accessor, and vertices of the whole mesh: 2^24, the
+ * refinement's limit (mesh.h). */
+constexpr size_t max_vertices = (size_t)1 << 24;
+
+struct reader {
+    const char *name;
+    const tinygltf::Model &m;
+    vb_error *err;
+};
+
+/* Element size of a component type, 0 for an unknown one. */
+size_t component_size(int t)
+{
+    switch (t) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0;
+    }
+}
+
+double read_component(const uint8_t *p, int t, bool normalized)
+{
+    switch (t) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        int8_t v; memcpy(&v, p, 1);
+        return normalized ? std::fmax(v / 127.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        int16_t v; memcpy(&v, p, 2);
+        return normalized ? std::fmax(v / 32767.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t v; memcpy(&v, p, 2);
+        return normalized ? v / 65535.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+        uint32_t v; memcpy(&v, p, 4);
+        return v;
+    }
+    default: {
+        float v; memcpy(&v, p, 4);
+        return v;
+    }
+    }
+}
+
+/* Bytes [offset, offset + count * stride) of a buffer view, checked:
+ * returns a pointer to the first element or NULL after vb_fail. */
+const uint8_t *view_span(const reader &rd, int view, size_t offset, size_t count, size_t elem, size_t stride,
+                         const char *what, vb_result *r)
+{
+    const tinygltf::Model &m = rd.m;
+    if (view < 0 || (size_t)view >= m.bufferViews.size()) {
+        *r = vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: buffer view %d does not exist", rd.name, what, view);
+        return nullptr;
+    }
+    const tinygltf::BufferView &bv = m.bufferViews[(size_t)view];
+    if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size()) {
+        *r = vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: buffer view %d names buffer %d, which does not exist", rd.name,
+                     what, view, bv.buffer);
+        return nullptr;
+    }
+    const std::vector<unsigned char> &data = m.buffers[(size_t)bv.buffer].data;
+    if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset) {
+        *r = vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: buffer view %d (offset %zu, length %zu) overruns its buffer "
+                     "(%zu bytes)", rd.name, what, view, bv.byteOffset, bv.byteLength, data.size());
+        return nullptr;
+    }
+    if (bv.byteStride)
+        stride = bv.byteStride;
+    if (count && (stride < elem || stride > 252)) {
+        if (!(bv.byteStride == 0 && stride == elem)) {
+            *r = vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: byte stride %zu with %zu-byte elements", rd.name, what,
+                         stride, elem);
+            return nullptr;
+        }
+    }
+    /* offset + (count - 1) * stride + elem <= byteLength, without overflow */
+    if (count && (offset > bv.byteLength || (count - 1) > (bv.byteLength - offset) / stride ||
+                  (count - 1) * stride + elem > bv.byteLength - offset)) {
+        *r = vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: %zu elements at offset %zu overrun buffer view %d (%zu bytes)",
+                     rd.name, what, count, offset, view, bv.byteLength);
+        return nullptr;
+    }
+    return data.data() + bv.byteOffset + offset;
+}
+
+/* Accessor `index` as count x ncomp doubles (sparse applied). `types`
+ * lists the allowed TINYGLTF_TYPE_ (element shape). */
+vb_result read_accessor(const reader &rd, int index, int want_type, bool integer_only, const char *what,
+                        std::vector<double> &out, size_t *count_out)
+{
+    const tinygltf::Model &m = rd.m;
+    if (index < 0 || (size_t)index >= m.accessors.size())
+        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d does not exist", rd.name, what, index);
+    const tinygltf::Accessor &a = m.accessors[(size_t)index];
+    if (a.type != want_type)
+        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d has the wrong type (%d, expected %d)", rd.name,
+                       what, index, a.type, want_type);
+    size_t cs = component_size(a.componentType);
+    if (cs == 0)
+        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d has an unknown component type %d", rd.name,
+                       what, index, a.componentType);
+    if (integer_only && (a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || a.normalized ||
+                         a.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
+                         a.componentType == TINYGLTF_COMPONENT_TYPE_SHORT))
+        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: indices must be unsigned integers", rd.name,
+                       what, index);
+    int nc = tinygltf::GetNumComponentsInType((uint32_t)a.type);
+    if (nc <= 0)
+        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: bad type", rd.name, what, index);
+    if (a.count > max_vertices)
+        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: too many elements (%zu)", rd.name, what, index,
+                       a.count);
+    size_t elem = cs * (size_t)nc;
+    vb_result r = VB_OK;
+    /* Bytes first, memory after: a count the buffer cannot hold is refused
+     * before anything is allocated for it. */
+    const uint8_t *p = nullptr;
+    if (a.bufferView >= 0 && a.count) {
+        p = view_span(rd, a.bufferView, a.byteOffset, a.count, elem, elem, what, &r);
+        if (!p)
+            return r;
+    }
+    out.assign(a.count * (size_t)nc, 0.0);
+    if (p) {
+        size_t stride = m.bufferViews[(size_t)a.bufferView].byteStride;
+        if (!stride)
+            stride = elem;
+        for (size_t i = 0; i < a.count; i++)
+            for (int c = 0; c < nc; c++)
+                out[i * (size_t)nc + (size_t)c] =
+                    read_component(p + i * stride + (size_t)c * cs, a.componentType, a.normalized);
+    }
+    if (a.sparse.isSparse) {
+        if (a.sparse.count < 0 || (size_t)a.sparse.count > a.count)
+            return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: sparse count %d out of range", rd.name,
+                           what, index, a.sparse.count);
+        size_t sc = (size_t)a.sparse.count;
+        size_t ics = component_size(a.sparse.indices.componentType);
+        if (ics < 1 || a.sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+            a.sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
+            a.sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_SHORT ||
+            a.sparse.indices.byteOffset < 0 || a.sparse.values.byteOffset < 0)
+            return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: bad sparse indices", rd.name, what, index);
+        const uint8_t *pi = view_span(rd, a.sparse.indices.bufferView, (size_t)a.sparse.indices.byteOffset, sc, ics,
+                                      ics, what, &r);
+        if (!pi && sc)
+            return r;
+        const uint8_t *pv = view_span(rd, a.sparse.values.bufferView, (size_t)a.sparse.values.byteOffset, sc, elem,
+                                      elem, what, &r);
+        if (!pv && sc)
+            return r;
+        for (size_t k = 0; k < sc; k++) {
+            double di = read_component(pi + k * ics, a.sparse.indices.componentType, false);
+            if (di >= (double)a.count)
+                return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: sparse index %.0f out of range (%zu)",
+                               rd.name, what, index, di, a.count);
+            size_t i = (size_t)di;
+            for (int c = 0; c < nc; c++)
+                out[i * (size_t)nc + (size_t)c] =
+                    read_component(pv + k * elem + (size_t)c * cs, a.componentType, a.normalized);
+        }
+    }
+    *count_out = a.count;
+    return VB_OK;
+}
+
+typedef std::array<double, 16> mat4; /* column-major, as glTF */
+
+mat4 mul(const mat4 &a, const mat4 &b)
+{
+    mat4 c{};
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            double s = 0;
+            for (int k = 0; k < 4; k++)
+                s += a[(size_t)(k * 4 + i)] * b[(size_t)(j * 4 + k)];
+            c[(size_t)(j * 4 + i)] = s;
+        }
+    return c;
+}
+
+mat4 node_matrix(const tinygltf::Node &n)
+{
+    mat4 m{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    if (n.matrix.size() == 16) {
+        for (size_t i = 0; i < 16; i++)
+            m[i] = n.matrix[i];
+        return m;
+    }
+    mat4 t = m, r = m, s = m;
+    if (n.translation.size() == 3)
+        t[12] = n.translation[0], t[13] = n.translation[1], t[14] = n.translation[2];
+    if (n.rotation.size() == 4) {
+        double x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
+        r = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0,
+             2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0,
+             2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0,
+             0, 0, 0, 1};
+    }
+    if (n.scale.size() == 3)
+        s[0] = n.scale[0], s[5] = n.scale[1], s[10] = n.scale[2];
+    return mul(t, mul(r, s));
+}
+
+struct out_mesh {
+    std::vector<float> pos, nrm;
+    std::vector<uint8_t> has_n;
+    std::vector<int64_t> idx;
+    uint32_t skipped_modes = 0, skipped_morph = 0, skipped_skin = 0;
+};
+
+vb_result add_primitive(const reader &rd, const tinygltf::Primitive &p, const mat4 &w, out_mesh &o)
+{
+    auto it = p.attributes.find("POSITION");
+    if (it == p.attributes.end())
+        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: a triangle primitive has no POSITION", rd.name);
+    std::vector<double> pos, nrm, ind;
+    size_t nv = 0, nn = 0, ni = 0;
+    vb_result r = read_accessor(rd, it->second, TINYGLTF_TYPE_VEC3, false, "POSITION", pos, &nv);
+    if (r != VB_OK)
+        return r;
+    auto itn = p.attributes.find("NORMAL");
+    if (itn != p.attributes.end()) {
+        r = read_accessor(rd, itn->second, TINYGLTF_TYPE_VEC3, false, "NORMAL", nrm, &nn);
+        if (r != VB_OK)
+            return r;
+        if (nn != nv)
+            return vb_fail(rd.err, VB_ERR_FORMAT, "%s: NORMAL has %zu elements, POSITION %zu", rd.name, nn, nv);
+    }
+    if (p.indices >= 0) {
+        r = read_accessor(rd, p.indices, TINYGLTF_TYPE_SCALAR, true, "indices", ind, &ni);
+        if (r != VB_OK)
+            return r;
+    } else {
+        ni = nv;
+        ind.resize(nv);
+        for (size_t i = 0; i < nv; i++)
+            ind[i] = (double)i;
+    }
+    for (size_t i = 0; i < ni; i++)
+        if (ind[i] >= (double)nv)
+            return vb_fail(rd.err, VB_ERR_INVALID, "%s: index %.0f out of range (%zu vertices)", rd.name, ind[i], nv);
+    if (o.pos.size() / 3 + nv > max_vertices)
+        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: too many vertices", rd.name);
+    /* Normal matrix: inverse transpose of the upper 3x3 (cofactors). */
+    const double a = w[0], b = w[4], c = w[8], d = w[1], e = w[5], f = w[9], g = w[2], h = w[6], k = w[10];
+    const double det = a * (e * k - f * h) - b * (d * k - f * g) + c * (d * h - e * g);
+    const double cof[9] = {e * k - f * h, -(d * k - f * g), d * h - e * g, -(b * k - c * h), a * k - c * g,
+                           -(a * h - b * g), b * f - c * e, -(a * f - c * d), a * e - b * d};
+    const int64_t base = (int64_t)(o.pos.size() / 3);
+    for (size_t i = 0; i < nv; i++) {
+        const double *q = &pos[3 * i];
+        for (int r3 = 0; r3 < 3; r3++)
+            o.pos.push_back((float)(w[(size_t)r3] * q[0] + w[(size_t)(4 + r3)] * q[1] + w[(size_t)(8 + r3)] * q[2] +
+                                    w[(size_t)(12 + r3)]));
+        if (!nrm.empty()) {
+            const double *n = &nrm[3 * i];
+            double t[3];
+            for (int r3 = 0; r3 < 3; r3++)
+                t[r3] = cof[3 * r3] * n[0] + cof[3 * r3 + 1] * n[1] + cof[3 * r3 + 2] * n[2];
+            double l = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+            for (int r3 = 0; r3 < 3; r3++)
+                o.nrm.push_back(l > 0 && std::isfinite(l) ? (float)(t[r3] / l) : 0.0f);
+            o.has_n.push_back(1);
+        } else {
+            o.nrm.insert(o.nrm.end(), {0.0f, 0.0f, 0.0f});
+            o.has_n.push_back(0);
+        }
+    }
+    const bool flip = det < 0;
+    auto tri = [&](size_t i0, size_t i1, size_t i2) {
+        int64_t v0 = base + (int64_t)ind[i0], v1 = base + (int64_t)ind[i1], v2 = base + (int64_t)ind[i2];
+        if (flip)
+            std::swap(v1, v2);
+        o.idx.insert(o.idx.end(), {v0, v1, v2});
+    };
+    if (p.mode == TINYGLTF_MODE_TRIANGLES || p.mode == -1) {
+        for (size_t i = 0; i + 2 < ni; i += 3)
+            tri(i, i + 1, i + 2);
+    } else if (p.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        for (size_t i = 0; i + 2 < ni; i++)
+            if (i % 2 == 0)
+                tri(i, i + 1, i + 2);
+            else
+                tri(i + 1, i, i + 2);
+    } else { /* fan */
+        for (size_t i = 1; i + 1 < ni; i++)
+            tri(0, i, i + 1);
+    }
+    return VB_OK;
+}
+
+vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint8_t> &on_path, int depth,
+                out_mesh &o)
+{
+    const tinygltf::Model &m = rd.m;
+    if (node < 0 || (size_t)node >= m.nodes.size())
+        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: node %d does not exist", rd.name, node);
+    if (on_path[(size_t)node] || depth > 1000)
+        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: node %d is its own ancestor (a cycle in the node tree)", rd.name,
+                       node);
+    on_path[(size_t)node] = 1;
+    const tinygltf::Node &n = m.nodes[(size_t)node];
+    mat4 w = mul(parent, node_matrix(n));
+    for (double v : w)
+        if (!std::isfinite(v))
+            return vb_fail(rd.err, VB_ERR_INVALID, "%s: node %d: non-finite transform", rd.name, node);
+    if (n.mesh >= 0) {
+        if ((size_t)n.mesh >= m.meshes.size())
+            return vb_fail(rd.err, VB_ERR_FORMAT, "%s: node %d: mesh %d does not exist", rd.name, node, n.mesh);
+        for (const tinygltf::Primitive &p : m.meshes[(size_t)n.mesh].primitives) {
+            if (n.skin >= 0) {
+                o.skipped_skin++;
+                continue;
+            }
+            if (!p.targets.empty()) {
+                o.skipped_morph++;
+                continue;
+            }
+            if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES && p.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+                p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+                o.skipped_modes++;
+                continue;
+            }
+            vb_result r = add_primitive(rd, p, w, o);
+            if (r != VB_OK)
+                return r;
+        }
+    }
+    for (int c : n.children) {
+        vb_result r = visit(rd, c, w, on_path, depth + 1, o);
+        if (r != VB_OK)
+            return r;
+    }
+    on_path[(size_t)node] = 0;
+    return VB_OK;
+}
+
+bool no_images(tinygltf::Image *, const int, std::string *, std::string *, int, int, const unsigned char *, int,
+               void *)
+{
+    return true;
+}
+
+template <class T> T *copy_out(const std::vector<T> &v)
+{
+    T *p = (T *)malloc(v.empty() ? 1 : v.size() * sizeof(T));
+    if (!p)
+        throw std::bad_alloc();
+    if (!v.empty())
+        memcpy(p, v.data(), v.size() * sizeof(T));
+    return p;
+}
+
+vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, size_t size, vb_mesh_raw *out,
+                vb_error *err)
+{
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(no_images, nullptr);
+    tinygltf::Model model;
+    std::string e, w;
+    std::string path(name);
+    size_t slash = path.rfind('/');
+    std::string dir = slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+    if (size > 0xffffffffu)
+        return vb_fail(err, VB_ERR_FORMAT, "%s: file too large", name);
+    bool ok = binary ? loader.LoadBinaryFromMemory(&model, &e, &w, bytes, (unsigned)size, dir)
+                     : loader.LoadASCIIFromString(&model, &e, &w, (const char *)bytes, (unsigned)size, dir);
+    if (!ok) {
+        while (!e.empty() && (e.back() == '\n' || e.back() == ' '))
+            e.pop_back();
+        for (char &ch : e)
+            if (ch == '\n')
+                ch = ';';
+        return vb_fail(err, VB_ERR_FORMAT, "%s: not a readable glTF 2.0 file: %s", name,
+                       e.empty() ? "(no reason given)" : e.c_str());
+    }
+    for (const std::string &x : model.extensionsRequired)
+        return vb_fail(err, VB_ERR_FORMAT, "%s: requires the extension %s, which the baker does not read", name,
+                       x.c_str());
+    if (model.scenes.empty())
+        return vb_fail(err, VB_ERR_FORMAT, "%s: no scene", name);
+    int s = scene >= 0 ? scene : (model.defaultScene >= 0 ? model.defaultScene : 0);
+    if ((size_t)s >= model.scenes.size())
+        return vb_fail(err, VB_ERR_ARGUMENT, "%s: scene %d does not exist (%zu scenes)", name, s,
+                       model.scenes.size());
+    reader rd{name, model, err};
+    out_mesh o;
+    std::vector<uint8_t> on_path(model.nodes.size(), 0);
+    const mat4 id{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    for (int n : model.scenes[(size_t)s].nodes) {
+        vb_result r = visit(rd, n, id, on_path, 0, o);
+        if (r != VB_OK)
+            return r;
+    }
+    for (float v : o.pos)
+        if (!std::isfinite(v))
+            return vb_fail(err, VB_ERR_INVALID, "%s: a vertex has a non-finite coordinate", name);
+    if (o.idx.empty() && o.skipped_modes + o.skipped_morph + o.skipped_skin)
+        return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh: no triangles left after skipping %u point/line, %u "
+                       "morph-target and %u skinned primitives", name, o.skipped_modes, o.skipped_morph,
+                       o.skipped_skin);
+    vb_mesh_raw raw;
+    memset(&raw, 0, sizeof raw);
+    raw.vertex_count = (uint32_t)(o.pos.size() / 3);
+    raw.triangle_count = (uint32_t)(o.idx.size() / 3);
+    raw.gltf_skipped_modes = o.skipped_modes;
+    raw.gltf_skipped_morph = o.skipped_morph;
+    raw.gltf_skipped_skin = o.skipped_skin;
+    try {
+        raw.positions = copy_out(o.pos);
+        raw.indices = copy_out(o.idx);
+        std::vector<uint32_t> faces(raw.triangle_count);
+        for (uint32_t t = 0; t < raw.triangle_count; t++)
+            faces[t] = t;
+        raw.faces = copy_out(faces);
+        bool any = false;
+        for (uint8_t h : o.has_n)
+            any = any || h;
+        if (any) {
+            raw.normals = copy_out(o.nrm);
+            raw.has_normal = copy_out(o.has_n);
+        }
+    } catch (...) {
+        vb_mesh_raw_free(&raw);
+        throw;
+    }
+    *out = raw;
+    return VB_OK;
+}
+
+} // namespace
+
+extern "C" vb_result vb_mesh_parse_gltf(const char *name, int binary, int scene, const uint8_t *bytes, size_t size,
+                                        vb_mesh_raw *out, vb_error *err)
+{
+    if (!name || (!bytes && size) || !out)
+        return vb_fail(err, VB_ERR_ARGUMENT, "vb_mesh_parse_gltf: NULL argument");
+    static const uint8_t nothing = 0;
+    try {
+        return parse(name, binary, scene, bytes ? bytes : &nothing, size, out, err);
+    } catch (const std::bad_alloc &) {
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory while reading", name);
+    } catch (const std::exception &e) {
+        return vb_fail(err, VB_ERR_FORMAT, "%s: reading failed: %s", name, e.what());
+    } catch (...) {
+        return vb_fail(err, VB_ERR_FORMAT, "%s: reading failed with an unknown exception", name);
+    }
+}

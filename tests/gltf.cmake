@@ -1,0 +1,63 @@
+# glTF 2.0 input and export (issue 18).
+#
+#   gltf_input        hand-written fixtures (.gltf and .glb) and Debian's
+#                     assimp-testmodels glTF2 files through vdsh-bake
+#   robust_fuzz_mesh_gltf, robust_fuzz_mesh_glb
+#                     the glTF reader's fuzz targets on their seed corpora
+#                     (tests/corpus/mesh_gltf, mesh_glb: written by
+#                     tests/gltf_fixtures.py)
+add_test(NAME gltf_input
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_gltf_input.py
+                 $<TARGET_FILE:vdsh-bake> ${CMAKE_CURRENT_BINARY_DIR}/gltf_input ${VDSH_ASSIMP_MODELS})
+
+foreach(ext gltf glb)
+  _robust_fuzz_target(mesh_${ext} SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_fuzz_mesh.c
+                      LIBS vb_mesh m DEFS VDSH_FUZZ_EXT="${ext}")
+endforeach()
+
+# npm packages (gltf-validator) into the build dir, once: a fixture.
+#   gltf_export       bake -> vdsh-export -> the Khronos glTF Validator
+find_program(VDSH_NODE node)
+add_test(NAME gltf_npm_setup
+         COMMAND bash ${PROJECT_SOURCE_DIR}/scripts/npm_gltf_tools ${CMAKE_BINARY_DIR}/npm)
+set_tests_properties(gltf_npm_setup PROPERTIES FIXTURES_SETUP gltf_npm SKIP_RETURN_CODE 77)
+if(VDSH_NODE)
+  add_test(NAME gltf_export
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_gltf_export.py
+                   $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-export> ${VDSH_NODE}
+                   ${CMAKE_BINARY_DIR}/npm/node_modules ${CMAKE_CURRENT_BINARY_DIR}/gltf_export
+                   ${VDSH_ASSIMP_MODELS})
+  set_tests_properties(gltf_export PROPERTIES FIXTURES_REQUIRED gltf_npm)
+endif()
+
+#   gltf_web_viewer   runtime/web in headless chromium against vdsh-view's
+#                     shadow-only frame of the same view (skips with 77
+#                     without chromium or a GL context)
+find_program(VDSH_CHROMIUM chromium)
+if(NOT VDSH_CHROMIUM)
+  set(VDSH_CHROMIUM chromium)
+endif()
+add_test(NAME gltf_web_viewer
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_web_viewer.py
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-export> $<TARGET_FILE:vdsh-view>
+                 ${VDSH_CHROMIUM} ${PROJECT_SOURCE_DIR}/runtime/web ${CMAKE_CURRENT_BINARY_DIR}/gltf_web
+                 ${VDSH_ASSIMP_MODELS})
+set_tests_properties(gltf_web_viewer PROPERTIES SKIP_RETURN_CODE 77)
+
+#   gltf_robust_load  vb_mesh_load_memory is vb_mesh_load for glTF too: the
+#                     seeds and every assimp-testmodels glTF2 folder
+#                     (valid and broken files), loaded both ways (with the
+#                     other formats' seeds: the test wants >= 100 inputs)
+set(_gltf_load_inputs)
+foreach(c mesh_gltf mesh_glb mesh_obj mesh_ply mesh_off mesh_stl)
+  list(APPEND _gltf_load_inputs ${PROJECT_SOURCE_DIR}/tests/corpus/${c})
+endforeach()
+file(GLOB_RECURSE _gltf_models LIST_DIRECTORIES false
+     ${VDSH_ASSIMP_MODELS}/glTF2/*.gltf ${VDSH_ASSIMP_MODELS}/glTF2/*.glb)
+foreach(f ${_gltf_models})
+  get_filename_component(d ${f} DIRECTORY)
+  list(APPEND _gltf_load_inputs ${d})
+endforeach()
+list(REMOVE_DUPLICATES _gltf_load_inputs)
+add_test(NAME gltf_robust_load
+         COMMAND test_robust_load ${CMAKE_CURRENT_BINARY_DIR}/gltf_robust_load_tmp ${_gltf_load_inputs})

@@ -1,0 +1,120 @@
+"""test_gltf_export.py BAKE EXPORT NODE NODE_MODULES WORKDIR ASSIMP_MODELS -
+bake -> vdsh-export -> Khronos glTF Validator (npm gltf-validator).
+
+Bakes builtin:room (orders 2, 3, 5) and Debian assimp-testmodels'
+BoxTextured.glb (read by the glTF reader), exports each as int16 and as
+float glb, and requires: zero validator errors; the layout of
+formats/GLTF.md (attributes _VDSH<order>_<k>, ceil(order^2/4) VEC4 each,
+extras.vdsh with method, quantity, order, max distance and source
+hashes); the int16 coefficients times their scale equal the float ones
+within half a quantisation step; positions identical to the bake's mesh
+(vdsh-bake --export-obj). A missing input fails with exit 1, naming it,
+and leaves no output.
+"""
+import json
+import math
+import os
+import struct
+import subprocess
+import sys
+
+bake, export, node, modules, work, models = sys.argv[1:7]
+here = os.path.dirname(os.path.abspath(__file__))
+os.makedirs(work, exist_ok=True)
+fail = []
+
+
+def run(cmd):
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        fail.append("%s: rc %d: %s" % (" ".join(cmd), p.returncode, p.stderr.strip()))
+    return p
+
+
+def read_glb(path):
+    d = open(path, "rb").read()
+    magic, ver, total = struct.unpack_from("<III", d, 0)
+    assert magic == 0x46546C67 and ver == 2 and total == len(d), path
+    jl, jt = struct.unpack_from("<II", d, 12)
+    g = json.loads(d[20:20 + jl])
+    bl, bt = struct.unpack_from("<II", d, 20 + jl)
+    return g, d[28 + jl:28 + jl + bl]
+
+
+def accessor(g, binary, i):
+    a = g["accessors"][i]
+    v = g["bufferViews"][a["bufferView"]]
+    n = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[a["type"]]
+    fmt = {5126: "f", 5122: "h", 5123: "H", 5125: "I"}[a["componentType"]]
+    vals = struct.unpack_from("<%d%s" % (a["count"] * n, fmt), binary, v["byteOffset"])
+    return [vals[k * n:(k + 1) * n] for k in range(a["count"])]
+
+
+scenes = [("room", "builtin:room", ["--rays", "64", "--orders", "2,3,5"])]
+box = os.path.join(models, "glTF2", "BoxTextured-glTF-Binary", "BoxTextured.glb")
+if os.path.exists(box):
+    scenes.append(("box", box, ["--rays", "64", "--orders", "2,5", "--max-edge", "0.3"]))
+glbs = []
+for name, src, opts in scenes:
+    vd = os.path.join(work, name + ".vdsh")
+    run([bake, src, "-o", vd, "-q"] + opts)
+    run([bake, src, "--export-obj", os.path.join(work, name + ".obj"), "-q"] +
+        [o for o in opts if o == "--max-edge" or (opts.index(o) > 0 and opts[opts.index(o) - 1] == "--max-edge")])
+    q, fl = os.path.join(work, name + ".glb"), os.path.join(work, name + "_float.glb")
+    run([export, vd, "-o", q])
+    run([export, vd, "-o", fl, "--float"])
+    if fail:
+        break
+    glbs += [q, fl]
+    gq, bq = read_glb(q)
+    gf, bf = read_glb(fl)
+    prim_q, prim_f = gq["meshes"][0]["primitives"][0], gf["meshes"][0]["primitives"][0]
+    x = gq["meshes"][0]["extras"]["vdsh"]
+    for key in ("max_distance", "sources", "streams"):
+        if key not in x:
+            fail.append("%s: extras.vdsh lacks %s" % (q, key))
+    if not x["sources"] or len(x["sources"][0]["sha256"]) != 64:
+        fail.append("%s: no source hash" % q)
+    orders = [int(o) for o in opts[opts.index("--orders") + 1].split(",")]
+    if sorted(s["order"] for s in x["streams"]) != sorted(orders):
+        fail.append("%s: streams %s, baked %s" % (q, x["streams"], orders))
+    for s, sf in zip(x["streams"], gf["meshes"][0]["extras"]["vdsh"]["streams"]):
+        for key in ("method", "quantity"):
+            if not s.get(key):
+                fail.append("%s: stream without %s" % (q, key))
+        groups = (s["order"] ** 2 + 3) // 4
+        if s["attributes"] != groups:
+            fail.append("%s: order %d: %d attributes" % (q, s["order"], s["attributes"]))
+        worst = 0.0
+        for k in range(groups):
+            nm = "%s%d" % (s["attribute_prefix"], k)
+            if nm not in prim_q["attributes"] or nm not in prim_f["attributes"]:
+                fail.append("%s: attribute %s missing" % (q, nm))
+                continue
+            a = accessor(gq, bq, prim_q["attributes"][nm])
+            b = accessor(gf, bf, prim_f["attributes"][nm])
+            for va, vb in zip(a, b):
+                for ca, cb in zip(va, vb):
+                    worst = max(worst, abs(max(ca / 32767.0, -1.0) * s["scale"] - cb))
+        if worst > 0.5001 * s["scale"] / 32767 + 1e-7:
+            fail.append("%s: order %d: int16 and float differ by %g (scale %g)" % (q, s["order"], worst, s["scale"]))
+    pos = accessor(gf, bf, prim_f["attributes"]["POSITION"])
+    objv = [struct.unpack("<3f", struct.pack("<3f", *(float(t) for t in line.split()[1:4]))) for line in open(os.path.join(work, name + ".obj"))
+            if line.startswith("v ")]
+    if len(objv) != len(pos) or any(abs(a - b) > 0 for p, o in zip(pos, objv) for a, b in zip(p, o)):
+        fail.append("%s: positions differ from the bake's mesh (%d vs %d vertices)" % (q, len(pos), len(objv)))
+
+p = subprocess.run([node, os.path.join(here, "gltf_validate.js"), modules] + glbs, capture_output=True, text=True)
+print(p.stdout, end="")
+if p.returncode != 0 or not glbs:
+    fail.append("validator: rc %d %s" % (p.returncode, p.stderr.strip()))
+
+missing = os.path.join(work, "missing.vdsh")
+out = os.path.join(work, "never.glb")
+p = subprocess.run([export, missing, "-o", out], capture_output=True, text=True)
+if p.returncode != 1 or missing not in p.stderr or os.path.exists(out):
+    fail.append("missing input: rc %d, %s" % (p.returncode, p.stderr.strip()))
+
+for f in fail:
+    print("FAIL:", f)
+sys.exit(1 if fail else 0)

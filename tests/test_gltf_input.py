@@ -1,0 +1,110 @@
+"""test_gltf_input.py VDSH_BAKE WORKDIR ASSIMP_MODELS - glTF 2.0 input.
+
+The hand-written fixtures (gltf_fixtures.py: lists, strips, fans, sparse
+accessors, node matrices and TRS, a mirroring scale, points and lines
+skipped; refused files) loaded as .gltf and .glb through
+`vdsh-bake FILE --export-obj OUT`: the triangles written must be the
+expected ones (positions, winding); refused files fail with a message
+naming the file, never by a signal. Then Debian's assimp-testmodels glTF2
+files: the valid ones load with their triangle counts (primitive modes
+4-6, strips and fans, give the quad of mode 4), the malformed ones are
+refused with the file named.
+"""
+import os
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import gltf_fixtures  # noqa: E402
+
+bake, work, models = sys.argv[1], sys.argv[2], sys.argv[3]
+os.makedirs(work, exist_ok=True)
+failures = []
+
+
+def load(path):
+    out = os.path.join(work, "out.obj")
+    if os.path.exists(out):
+        os.remove(out)
+    p = subprocess.run([bake, path, "--export-obj", out], capture_output=True, text=True)
+    if p.returncode < 0 or p.returncode >= 128:
+        failures.append("%s: killed by a signal (%d)" % (path, p.returncode))
+        return None, p
+    if p.returncode != 0:
+        return None, p
+    vs, tris = [], []
+    for line in open(out):
+        f = line.split()
+        if f and f[0] == "v":
+            vs.append(tuple(float(x) for x in f[1:4]))
+        elif f and f[0] == "f":
+            tris.append(tuple(vs[int(c.split("/")[0]) - 1] for c in f[1:4]))
+    return tris, p
+
+
+def same(t, e):
+    for r in range(3):
+        rot = e[r:] + e[:r]
+        if all(abs(a - b) < 1e-5 for p, q in zip(t, rot) for a, b in zip(p, q)):
+            return True
+    return False
+
+
+def refused(path, p):
+    if p.returncode in (0,) or p.returncode >= 128 or p.returncode < 0:
+        failures.append("%s: expected a refusal, got rc %d" % (path, p.returncode))
+    elif path not in p.stderr:
+        failures.append("%s: the message does not name the file: %s" % (path, p.stderr.strip()))
+
+
+for name, g, binary, expected in gltf_fixtures.fixtures():
+    for ext, data in (("gltf", gltf_fixtures.as_gltf(g, binary)), ("glb", gltf_fixtures.as_glb(g, binary))):
+        path = os.path.join(work, "%s.%s" % (name, ext))
+        open(path, "wb").write(data)
+        tris, p = load(path)
+        if expected is None:
+            refused(path, p)
+            continue
+        if tris is None:
+            failures.append("%s: refused: %s" % (path, p.stderr.strip()))
+            continue
+        if len(tris) != len(expected) or not all(same(t, e) for t, e in zip(tris, expected)):
+            failures.append("%s: triangles %s, expected %s" % (path, tris, expected))
+        if name == "points_lines" and "2 glTF primitives of points or lines skipped" not in p.stderr:
+            failures.append("%s: skipped primitives not reported: %s" % (path, p.stderr.strip()))
+
+g2 = os.path.join(models, "glTF2")
+if os.path.isdir(g2):
+    gen = os.path.join(g2, "glTF-Asset-Generator", "Mesh_PrimitiveMode")
+    good = {os.path.join(gen, "Mesh_PrimitiveMode_%02d.gltf" % i): 2 for i in (4, 5, 6, 11, 12, 13, 14, 15)}
+    good[os.path.join(g2, "BoxTextured-glTF-Binary", "BoxTextured.glb")] = 12
+    good[os.path.join(g2, "BoxTextured-glTF-Embedded", "BoxTextured.gltf")] = 12
+    good[os.path.join(g2, "BoxTextured-glTF", "BoxTextured.gltf")] = 12
+    good[os.path.join(g2, "cameras", "Cameras.gltf")] = 2
+    quad = None
+    for path, n in sorted(good.items()):
+        tris, p = load(path)
+        if tris is None or len(tris) != n:
+            failures.append("%s: expected %d triangles, got %s (%s)" % (path, n, None if tris is None else len(tris),
+                                                                      p.stderr.strip()))
+        elif "Mesh_PrimitiveMode" in path:
+            area = sum(abs((t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]))
+                       for t in tris) / 2
+            quad = quad if quad is not None else area
+            if abs(area - quad) > 1e-5 or area <= 0:
+                failures.append("%s: area %g, mode 4's %g" % (path, area, quad))
+    bad = ["IndexOutOfRange/IndexOutOfRange.gltf", "IndexOutOfRange/AllIndicesOutOfRange.gltf",
+           "MissingBin/BoxTextured.gltf", "RecursiveNodes/RecursiveNodes.gltf", "TestNoRootNode/NoScene.gltf",
+           "BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb", "draco/2CylinderEngine.gltf",
+           "glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_00.gltf",
+           "glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf", "simple_skin/simple_skin.gltf"]
+    for rel in bad:
+        path = os.path.join(g2, rel)
+        tris, p = load(path)
+        refused(path, p)
+else:
+    print("no %s: assimp-testmodels part skipped" % g2)
+
+for f in failures:
+    print("FAIL:", f)
+sys.exit(1 if failures else 0)

@@ -1,0 +1,386 @@
+/*
+ * vdsh_export.c - vdsh-export: a .vdsh as glTF 2.0 binary (.glb), in the
+ * layout of formats/GLTF.md: the receiver mesh (POSITION, NORMAL,
+ * indices) and each coefficient stream as custom vertex attributes
+ * _VDSH<order>_<k> (VEC4, k = 0 .. ceil(order^2 / 4) - 1, the last padded
+ * with zeros), normalised int16 with the stream's scale in extras (or
+ * float with --float); the bake's method, quantity, order, max distance
+ * and source hashes in the mesh's extras.vdsh.
+ *
+ *     vdsh-export scene.vdsh -o scene.glb [--orders 2,3,5] [--float]
+ *
+ * Errors: a message naming the file and the problem on stderr, exit 1 (2
+ * for a usage error); the output is written atomically
+ * (formats/vdsh_output.h): a failed export leaves no partial file.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cjson/cJSON.h>
+
+#include "vdsh.h"
+#include "vdsh_output.h"
+
+typedef struct blob {
+    uint8_t *data;
+    size_t size, cap;
+} blob;
+
+static int blob_put(blob *b, const void *p, size_t n)
+{
+    if (b->size + n + 4 > b->cap) {
+        size_t cap = b->cap ? b->cap : 1 << 20;
+        while (cap < b->size + n + 4)
+            cap *= 2;
+        uint8_t *d = realloc(b->data, cap);
+        if (!d)
+            return -1;
+        b->data = d;
+        b->cap = cap;
+    }
+    memcpy(b->data + b->size, p, n);
+    b->size += n;
+    return 0;
+}
+
+static int blob_align4(blob *b)
+{
+    static const uint8_t zero[4] = {0};
+    return b->size % 4 ? blob_put(b, zero, 4 - b->size % 4) : 0;
+}
+
+/* Append a buffer view over `n` bytes at `p`; returns its index or -1. */
+static int add_view(blob *b, cJSON *views, const void *p, size_t n, int target)
+{
+    if (blob_align4(b) || n == 0)
+        return -1;
+    size_t off = b->size;
+    if (blob_put(b, p, n))
+        return -1;
+    cJSON *v = cJSON_CreateObject();
+    cJSON_AddNumberToObject(v, "buffer", 0);
+    cJSON_AddNumberToObject(v, "byteOffset", (double)off);
+    cJSON_AddNumberToObject(v, "byteLength", (double)n);
+    if (target)
+        cJSON_AddNumberToObject(v, "target", target);
+    cJSON_AddItemToArray(views, v);
+    return cJSON_GetArraySize(views) - 1;
+}
+
+static int add_accessor(cJSON *accs, int view, int ctype, int normalized, size_t count, const char *type)
+{
+    cJSON *a = cJSON_CreateObject();
+    cJSON_AddNumberToObject(a, "bufferView", view);
+    cJSON_AddNumberToObject(a, "componentType", ctype);
+    if (normalized)
+        cJSON_AddBoolToObject(a, "normalized", 1);
+    cJSON_AddNumberToObject(a, "count", (double)count);
+    cJSON_AddStringToObject(a, "type", type);
+    cJSON_AddItemToArray(accs, a);
+    return cJSON_GetArraySize(accs) - 1;
+}
+
+static void usage(FILE *fp)
+{
+    fprintf(fp, "usage: vdsh-export IN.vdsh -o OUT.glb [--orders LIST] [--float]\n"
+                "Write a .vdsh as glTF 2.0 binary (layout: formats/GLTF.md): the receiver mesh and\n"
+                "each SH stream as vertex attributes _VDSH<order>_<k> (VEC4).\n"
+                "  -o, --output FILE  the .glb to write (atomically)\n"
+                "      --orders LIST  orders to export (default: every stream of the file)\n"
+                "      --float        coefficients as float (default: normalised int16, scale in extras)\n");
+}
+
+int main(int argc, char **argv)
+{
+    const char *in = NULL, *out = NULL;
+    int want[16] = {0}, any_order = 0, use_float = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "-o") || !strcmp(argv[i], "--output")) {
+            if (++i >= argc) {
+                usage(stderr);
+                return 2;
+            }
+            out = argv[i];
+        } else if (!strcmp(argv[i], "--orders")) {
+            if (++i >= argc) {
+                usage(stderr);
+                return 2;
+            }
+            char *s = argv[i];
+            while (*s) {
+                char *end;
+                long o = strtol(s, &end, 10);
+                if (end == s || o < 1 || o > 15 || (*end && *end != ',') || *s == '0') {
+                    fprintf(stderr, "vdsh-export: --orders: bad list '%s' (orders 1..15, comma-separated)\n",
+                            argv[i]);
+                    return 2;
+                }
+                want[o] = any_order = 1;
+                s = *end ? end + 1 : end;
+            }
+        } else if (!strcmp(argv[i], "--float")) {
+            use_float = 1;
+        } else if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
+            usage(stdout);
+            return 0;
+        } else if (argv[i][0] == '-' || in) {
+            fprintf(stderr, "vdsh-export: unexpected argument '%s'\n", argv[i]);
+            usage(stderr);
+            return 2;
+        } else {
+            in = argv[i];
+        }
+    }
+    if (!in || !out) {
+        usage(stderr);
+        return 2;
+    }
+    vdsh_file *f = NULL;
+    vdsh_error verr;
+    if (vdsh_read(in, &f, &verr) != VDSH_OK) {
+        fprintf(stderr, "vdsh-export: %s\n", verr.msg);
+        return 1;
+    }
+    const uint32_t nv = f->header.vertex_count, nt = f->header.triangle_count;
+    int rc = 1;
+    blob b = {0};
+    cJSON *root = cJSON_CreateObject();
+    cJSON *asset = cJSON_AddObjectToObject(root, "asset");
+    cJSON_AddStringToObject(asset, "version", "2.0");
+    cJSON_AddStringToObject(asset, "generator", "vdsh-export (formats/GLTF.md)");
+    cJSON *views = cJSON_AddArrayToObject(root, "bufferViews");
+    cJSON *accs = cJSON_AddArrayToObject(root, "accessors");
+    cJSON *attrs = cJSON_CreateObject();
+    cJSON *vx = cJSON_CreateObject();
+    cJSON_AddNumberToObject(vx, "format", 1);
+    float *tmp = malloc((size_t)nv * 4 * sizeof(float) * 4 + 16);
+    float *coef = malloc(sizeof(float) * 256);
+    if (!tmp || !coef)
+        goto oom;
+
+    /* Indices: uint16 when they fit, else uint32. */
+    int ind_acc;
+    if (nv <= 65535) {
+        uint16_t *ix = (uint16_t *)tmp;
+        uint16_t *buf = malloc((size_t)nt * 6 + 2);
+        if (!buf)
+            goto oom;
+        (void)ix;
+        for (size_t j = 0; j < 3 * (size_t)nt; j++)
+            buf[j] = (uint16_t)f->indices[j];
+        int v = add_view(&b, views, buf, (size_t)nt * 6, 34963);
+        free(buf);
+        ind_acc = add_accessor(accs, v, 5123, 0, 3 * (size_t)nt, "SCALAR");
+    } else {
+        int v = add_view(&b, views, f->indices, (size_t)nt * 12, 34963);
+        ind_acc = add_accessor(accs, v, 5125, 0, 3 * (size_t)nt, "SCALAR");
+    }
+    /* Positions with their bounds. */
+    {
+        int v = add_view(&b, views, f->positions, (size_t)nv * 12, 34962);
+        int a = add_accessor(accs, v, 5126, 0, nv, "VEC3");
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i < nv; i++)
+            for (int k = 0; k < 3; k++) {
+                float p = f->positions[3 * i + (size_t)k];
+                lo[k] = p < lo[k] ? p : lo[k];
+                hi[k] = p > hi[k] ? p : hi[k];
+            }
+        cJSON *acc = cJSON_GetArrayItem(accs, a);
+        double dlo[3] = {lo[0], lo[1], lo[2]}, dhi[3] = {hi[0], hi[1], hi[2]};
+        cJSON_AddItemToObject(acc, "min", cJSON_CreateDoubleArray(dlo, 3));
+        cJSON_AddItemToObject(acc, "max", cJSON_CreateDoubleArray(dhi, 3));
+        cJSON_AddNumberToObject(attrs, "POSITION", a);
+    }
+    /* Normals: unit; an undefined (0,0,0) one is written as (0,0,1) and
+     * counted in extras (glTF requires unit normals). */
+    {
+        uint32_t undefined = 0;
+        for (size_t i = 0; i < nv; i++) {
+            const float *n = f->normals + 3 * i;
+            double l = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+            if (l < 1e-6) {
+                tmp[3 * i] = 0, tmp[3 * i + 1] = 0, tmp[3 * i + 2] = 1;
+                undefined++;
+            } else {
+                for (int k = 0; k < 3; k++)
+                    tmp[3 * i + (size_t)k] = (float)(n[k] / l);
+            }
+        }
+        int v = add_view(&b, views, tmp, (size_t)nv * 12, 34962);
+        cJSON_AddNumberToObject(attrs, "NORMAL", add_accessor(accs, v, 5126, 0, nv, "VEC3"));
+        cJSON_AddNumberToObject(vx, "undefined_normals", undefined);
+    }
+    cJSON_AddNumberToObject(vx, "vertex_count", nv);
+    cJSON_AddNumberToObject(vx, "triangle_count", nt);
+    cJSON_AddNumberToObject(vx, "max_distance", f->header.max_distance);
+    cJSON_AddNumberToObject(vx, "max_edge", f->header.max_edge);
+    cJSON_AddNumberToObject(vx, "rays", f->header.rays);
+    cJSON_AddNumberToObject(vx, "seed", (double)f->header.seed);
+    cJSON *srcs = cJSON_AddArrayToObject(vx, "sources");
+    for (uint32_t s = 0; s < f->source_count; s++) {
+        cJSON *o = cJSON_CreateObject();
+        char hex[65];
+        for (int k = 0; k < 32; k++)
+            snprintf(hex + 2 * k, 3, "%02x", f->sources[s].sha256[k]);
+        cJSON_AddStringToObject(o, "name", f->sources[s].name);
+        cJSON_AddNumberToObject(o, "size", (double)f->sources[s].size);
+        cJSON_AddStringToObject(o, "sha256", hex);
+        cJSON_AddItemToArray(srcs, o);
+    }
+    cJSON *streams = cJSON_AddArrayToObject(vx, "streams");
+    int exported = 0;
+    for (uint32_t si = 0; si < f->stream_count; si++) {
+        const vdsh_stream *s = &f->streams[si];
+        if (any_order && (s->order > 15 || !want[s->order]))
+            continue;
+        const uint32_t nc = s->order * s->order, groups = (nc + 3) / 4;
+        /* Two streams of one order (distance and log): the second gets a
+         * suffix so attribute names stay unique. */
+        int dup = 0;
+        for (uint32_t sj = 0; sj < si; sj++)
+            dup += f->streams[sj].order == s->order && (!any_order || want[s->order]);
+        char prefix[32];
+        if (dup)
+            snprintf(prefix, sizeof prefix, "_VDSH%u%c_", s->order, 'a' + dup);
+        else
+            snprintf(prefix, sizeof prefix, "_VDSH%u_", s->order);
+        double maxabs = 0;
+        for (uint32_t v = 0; v < nv; v++) {
+            vdsh_stream_decode(s, v, coef);
+            for (uint32_t c = 0; c < nc; c++)
+                maxabs = fabs(coef[c]) > maxabs ? fabs(coef[c]) : maxabs;
+        }
+        const double scale = maxabs > 0 ? maxabs : 1.0;
+        cJSON *so = cJSON_CreateObject();
+        cJSON_AddNumberToObject(so, "order", s->order);
+        cJSON_AddStringToObject(so, "attribute_prefix", prefix);
+        cJSON_AddNumberToObject(so, "attributes", groups);
+        cJSON_AddStringToObject(so, "method", vdsh_method_name(s->method));
+        cJSON_AddNumberToObject(so, "method_param", s->method_param);
+        cJSON_AddStringToObject(so, "quantity", vdsh_quantity_name(s->quantity));
+        cJSON_AddNumberToObject(so, "quantity_param", s->quantity_param);
+        cJSON_AddStringToObject(so, "window", vdsh_window_name(s->window));
+        cJSON_AddNumberToObject(so, "window_param", s->window_param);
+        cJSON_AddStringToObject(so, "source_encoding", vdsh_encoding_name(s->encoding));
+        cJSON_AddStringToObject(so, "component", use_float ? "float" : "int16_normalized");
+        cJSON_AddNumberToObject(so, "scale", use_float ? 1.0 : scale);
+        cJSON_AddItemToArray(streams, so);
+        for (uint32_t g = 0; g < groups; g++) {
+            size_t bytes;
+            if (use_float) {
+                for (uint32_t v = 0; v < nv; v++) {
+                    vdsh_stream_decode(s, v, coef);
+                    for (uint32_t k = 0; k < 4; k++)
+                        tmp[4 * (size_t)v + k] = 4 * g + k < nc ? coef[4 * g + k] : 0.0f;
+                }
+                bytes = (size_t)nv * 16;
+            } else {
+                int16_t *q = (int16_t *)tmp;
+                for (uint32_t v = 0; v < nv; v++) {
+                    vdsh_stream_decode(s, v, coef);
+                    for (uint32_t k = 0; k < 4; k++) {
+                        double c = 4 * g + k < nc ? coef[4 * g + k] / scale : 0.0;
+                        long r = lrint(c * 32767.0);
+                        q[4 * (size_t)v + k] = (int16_t)(r > 32767 ? 32767 : r < -32767 ? -32767 : r);
+                    }
+                }
+                bytes = (size_t)nv * 8;
+            }
+            int view = add_view(&b, views, tmp, bytes, 34962);
+            if (view < 0)
+                goto oom;
+            char name[48];
+            snprintf(name, sizeof name, "%s%u", prefix, g);
+            cJSON_AddNumberToObject(attrs, name,
+                                    add_accessor(accs, view, use_float ? 5126 : 5122, !use_float, nv, "VEC4"));
+        }
+        exported++;
+    }
+    if (any_order && !exported) {
+        fprintf(stderr, "vdsh-export: %s: no stream of the orders asked for\n", in);
+        goto done;
+    }
+    if (blob_align4(&b))
+        goto oom;
+    {
+        cJSON *buffers = cJSON_AddArrayToObject(root, "buffers");
+        cJSON *buf = cJSON_CreateObject();
+        cJSON_AddNumberToObject(buf, "byteLength", (double)b.size);
+        cJSON_AddItemToArray(buffers, buf);
+        cJSON *prim = cJSON_CreateObject();
+        cJSON_AddItemToObject(prim, "attributes", attrs);
+        attrs = NULL;
+        cJSON_AddNumberToObject(prim, "indices", ind_acc);
+        cJSON_AddNumberToObject(prim, "mode", 4);
+        cJSON *mesh = cJSON_CreateObject();
+        cJSON *prims = cJSON_AddArrayToObject(mesh, "primitives");
+        cJSON_AddItemToArray(prims, prim);
+        cJSON *extras = cJSON_AddObjectToObject(mesh, "extras");
+        cJSON_AddItemToObject(extras, "vdsh", vx);
+        vx = NULL;
+        cJSON *meshes = cJSON_AddArrayToObject(root, "meshes");
+        cJSON_AddItemToArray(meshes, mesh);
+        cJSON *node = cJSON_CreateObject();
+        cJSON_AddNumberToObject(node, "mesh", 0);
+        cJSON *nodes = cJSON_AddArrayToObject(root, "nodes");
+        cJSON_AddItemToArray(nodes, node);
+        cJSON *scene = cJSON_CreateObject();
+        cJSON *sn = cJSON_AddArrayToObject(scene, "nodes");
+        cJSON_AddItemToArray(sn, cJSON_CreateNumber(0));
+        cJSON *scenes = cJSON_AddArrayToObject(root, "scenes");
+        cJSON_AddItemToArray(scenes, scene);
+        cJSON_AddNumberToObject(root, "scene", 0);
+    }
+    {
+        char *json = cJSON_PrintUnformatted(root);
+        if (!json)
+            goto oom;
+        size_t jl = strlen(json), jpad = (4 - jl % 4) % 4;
+        uint64_t total = 12 + 8 + jl + jpad + 8 + b.size;
+        if (total > 0xffffffffu) {
+            fprintf(stderr, "vdsh-export: %s: the glb would be %llu bytes (over glTF's 4 GiB)\n", in,
+                    (unsigned long long)total);
+            free(json);
+            goto done;
+        }
+        vdsh_output o;
+        if (vdsh_output_open(out, &o, &verr) != VDSH_OK) {
+            fprintf(stderr, "vdsh-export: %s\n", verr.msg);
+            free(json);
+            goto done;
+        }
+        uint32_t h[3] = {0x46546C67u, 2, (uint32_t)total};
+        uint32_t jh[2] = {(uint32_t)(jl + jpad), 0x4E4F534Au};
+        uint32_t bh[2] = {(uint32_t)b.size, 0x004E4942u};
+        vdsh_output_put(&o, h, 12);
+        vdsh_output_put(&o, jh, 8);
+        vdsh_output_put(&o, json, jl);
+        vdsh_output_put(&o, "   ", jpad);
+        vdsh_output_put(&o, bh, 8);
+        vdsh_output_put(&o, b.data, b.size);
+        free(json);
+        if (vdsh_output_commit(&o, &verr) != VDSH_OK) {
+            fprintf(stderr, "vdsh-export: %s\n", verr.msg);
+            goto done;
+        }
+        fprintf(stderr, "vdsh-export: wrote %s (%llu bytes, %d stream%s)\n", out, (unsigned long long)total,
+                exported, exported == 1 ? "" : "s");
+        rc = 0;
+        goto done;
+    }
+oom:
+    fprintf(stderr, "vdsh-export: %s: out of memory\n", in);
+done:
+    cJSON_Delete(root);
+    cJSON_Delete(attrs);
+    cJSON_Delete(vx);
+    free(b.data);
+    free(tmp);
+    free(coef);
+    vdsh_free(f);
+    return rc;
+}
