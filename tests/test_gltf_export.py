@@ -104,10 +104,16 @@ for name, src, opts in scenes:
     if len(objv) != len(pos) or any(abs(a - b) > 0 for p, o in zip(pos, objv) for a, b in zip(p, o)):
         fail.append("%s: positions differ from the bake's mesh (%d vs %d vertices)" % (q, len(pos), len(objv)))
 
-p = subprocess.run([node, os.path.join(here, "gltf_validate.js"), modules] + glbs, capture_output=True, text=True)
-print(p.stdout, end="")
-if p.returncode != 0 or not glbs:
-    fail.append("validator: rc %d %s" % (p.returncode, p.stderr.strip()))
+# The validator comes from npm (gltf_npm_setup); where the registry cannot
+# be reached that fixture skips, and so does this test's validation: every
+# other check still runs and fails the test if it fails.
+validator = os.path.isfile(os.path.join(modules, "gltf-validator", "package.json"))
+if validator:
+    p = subprocess.run([node, os.path.join(here, "gltf_validate.js"), modules] + glbs,
+                       capture_output=True, text=True)
+    print(p.stdout, end="")
+    if p.returncode != 0 or not glbs:
+        fail.append("validator: rc %d %s" % (p.returncode, p.stderr.strip()))
 
 missing = os.path.join(work, "missing.vdsh")
 out = os.path.join(work, "never.glb")
@@ -117,4 +123,8 @@ if p.returncode != 1 or missing not in p.stderr or os.path.exists(out):
 
 for f in fail:
     print("FAIL:", f)
+if not fail and not validator:
+    print("gltf-validator not installed in %s (npm registry unreachable?): "
+          "layout checks passed, validation skipped" % modules)
+    sys.exit(77)
 sys.exit(1 if fail else 0)
