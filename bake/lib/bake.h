@@ -114,7 +114,7 @@ typedef struct vb_bake_desc {
     void *progress_user;
 } vb_bake_desc;
 
-#define VB_DEFAULT_RAY_TOLERANCE 0.002f
+#define VB_DEFAULT_RAY_TOLERANCE 0.06f /* validation room: docs/ACCURACY.md */
 
 typedef struct vb_bake_output {
     int max_order;

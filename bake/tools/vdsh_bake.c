@@ -136,7 +136,7 @@ static void usage(FILE *f)
 "                          grid under 2500, from 1/16 of it), each receiver\n"
 "                          stopping when a round changes its fit by less\n"
 "                          than --ray-tolerance in expected shadow error\n"
-"      --ray-tolerance T   with --rays auto (default 0.002; 0: every round)\n"
+"      --ray-tolerance T   with --rays auto (default 0.06; 0: every round)\n"
 "      --orders LIST       SH orders to store, order n = n bands = n*n\n"
 "                          coefficients (default 2,3,5; each 1..5)\n"
 "      --method M          the fit:\n"
