@@ -25,6 +25,13 @@
  * methods trace rays / 2 directions, stratified over the hemisphere around
  * each receiver's normal, the same budget `paper` traces.
  *
+ * Adaptive rays (adaptive_rays, `--rays auto`): `rays` is the cap; each
+ * receiver traces nested stratified rounds of a power-of-two grid and stops
+ * when a round no longer changes its fit (vb_bake_desc below; figures:
+ * docs/ACCURACY.md, "Adaptive rays and receivers"). Opt-in: the default
+ * path traces the fixed grid, byte-identical to bakes before it. With
+ * trace_only, every round is traced.
+ *
  * Quantity: the stored function is D itself, or ln(max(D, log_floor)) for
  * VDSH_QUANTITY_LOG_DISTANCE (hemisphere methods and full only: the
  * paper's zero fill has no meaning in the log domain). VB_QUANTITY_AUTO
