@@ -419,6 +419,135 @@ static void test_offset_normals(void)
     test_mesh_free(&m);
 }
 
+
+/* Adaptive rays' nested grid: a 1250-direction hemisphere gives 32 x 32
+ * cells in 5 rounds (64, 128, ..., 1024 cells); for a receiver, every
+ * prefix of rounds is a stratified sub-grid (one cell in each block of the
+ * Morton code's free high bits), each contains the last, and the full
+ * grid visits every cell once. */
+static void test_nested_grid(void)
+{
+    vb_dirgrid g = {0};
+    vb_error err;
+    CHECK(vb_dirgrid_create_nested(1250, 1, &g, &err) == VB_OK, "nested grid: %s", err.msg);
+    CHECK(g.nu == 32 && g.nv == 32 && g.count == 1024 && g.rounds == 5, "%ux%u, %u rounds",
+          g.nu, g.nv, g.rounds);
+    for (uint32_t r = 0; r < g.rounds && r < 5; r++)
+        CHECK(g.round_end[r] == (64u << r) / 16, "round %u ends at packet %u", r, g.round_end[r]);
+    const float n[3] = {0, 0, 1};
+    for (uint32_t vertex = 0; vertex < 3; vertex++) {
+        static unsigned char seen[1024];
+        memset(seen, 0, sizeof seen);
+        int bad = 0, twice = 0, pole = 0;
+        for (uint32_t r = 0; r < g.rounds && r < 5; r++) {
+            for (uint32_t pk = r ? g.round_end[r - 1] : 0; pk < g.round_end[r]; pk++) {
+                float x[16], y[16], z[16];
+                int valid[16];
+                vb_dirgrid_packet_nested(&g, pk, 9, vertex, n, x, y, z, valid);
+                for (int k = 0; k < 16; k++) {
+                    double phi = atan2(y[k], x[k]);
+                    if (phi < 0)
+                        phi += 2 * M_PI;
+                    uint32_t row = (uint32_t)((1.0 - z[k]) * 32), col = (uint32_t)(phi / (2 * M_PI) * 32);
+                    bad += valid[k] != -1 || row > 31 || col > 31;
+                    if (x[k] * x[k] + y[k] * y[k] < 1e-8f) { /* at the pole: no column */
+                        pole++;
+                        continue;
+                    }
+                    if (row < 32 && col < 32) {
+                        twice += seen[row * 32 + col] != 0;
+                        seen[row * 32 + col] = 1;
+                    }
+                }
+            }
+            /* The prefix so far: 2^p cells, the low (10 - p) Morton bits
+             * fixed: fr low row bits and fc low column bits. */
+            int p = 6 + (int)r, fixed = 10 - p, fr = fixed / 2, fc = fixed - fr;
+            static unsigned char block[1024];
+            memset(block, 0, sizeof block);
+            int cells = 0, strata_twice = 0;
+            for (uint32_t c = 0; c < 1024; c++)
+                if (seen[c]) {
+                    uint32_t b = ((c / 32) >> fr) * (32u >> fc) + ((c % 32) >> fc);
+                    strata_twice += block[b]++ != 0;
+                    cells++;
+                }
+            cells += pole;
+            CHECK(cells == (1 << p), "vertex %u round %u: %d cells, want %d", vertex, r, cells,
+                  1 << p);
+            CHECK(strata_twice == 0, "vertex %u round %u: %d strata sampled twice", vertex, r,
+                  strata_twice);
+        }
+        CHECK(bad == 0 && twice == 0, "vertex %u: %d bad lanes, %d cells twice", vertex, bad,
+              twice);
+    }
+    vb_dirgrid_destroy(&g);
+    CHECK(vb_dirgrid_create_nested(100, 1, &g, &err) == VB_ERR_ARGUMENT, "cap 100 accepted");
+}
+
+/* Adaptive rays on receivers in a box: the same coefficients and ray
+ * count on 1 and 3 threads; tolerance 0 traces every round (the whole
+ * 32 x 32 grid), infinity stops at the first check (2/16 of it), the
+ * default in between; every coefficient finite. */
+static void test_adaptive_rays(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    test_make_box(&occ, 2, 2, 2);
+    enum { NP = 300 };
+    float p[3 * NP], n[3 * NP];
+    uint64_t s = 11;
+    for (int i = 0; i < NP; i++) {
+        p[3 * i] = (float)(3.6 * test_rand(&s) - 1.8);
+        p[3 * i + 1] = (float)(2 * test_rand(&s));
+        p[3 * i + 2] = (float)(3.6 * test_rand(&s) - 1.8);
+        test_rand_dir(&s, n + 3 * i);
+    }
+    /* A few on the floor, facing up into the box, and one in a corner. */
+    for (int i = 0; i < 20; i++) {
+        p[3 * i + 1] = 0.0f;
+        n[3 * i] = 0, n[3 * i + 1] = 1, n[3 * i + 2] = 0;
+    }
+    p[0] = 1.999f, p[1] = 0.0f, p[2] = 1.999f;
+    test_make_points(&rec, NP, p, n);
+    vb_error err;
+    vb_scene *sc = NULL;
+    CHECK(vb_scene_create(&occ, NULL, &sc, &err) == VB_OK, "scene");
+    const float tol[4] = {0.0f, 0.0f, -1.0f, INFINITY}; /* default x2, 0, inf */
+    const unsigned threads[4] = {1, 3, 2, 2};
+    vb_bake_output b[4] = {{0}};
+    for (int i = 0; i < 4 && sc; i++) {
+        vb_bake_desc d = {.receivers = &rec, .scene = sc, .rays = 2500, .adaptive_rays = 1,
+                          .ray_tolerance = tol[i], .seed = 3, .threads = threads[i],
+                          .order_mask = (1u << 3) | (1u << 5)};
+        CHECK(vb_bake_run(&d, &b[i], &err) == VB_OK, "adaptive bake %d: %s", i, err.msg);
+    }
+    if (b[0].coeffs[5] && b[1].coeffs[5] && b[2].coeffs[5] && b[3].coeffs[5]) {
+        CHECK(memcmp(b[0].coeffs[5], b[1].coeffs[5], NP * 25 * sizeof(float)) == 0 &&
+                  memcmp(b[0].coeffs[3], b[1].coeffs[3], NP * 9 * sizeof(float)) == 0,
+              "1 and 3 threads differ");
+        CHECK(b[0].rays_traced == b[1].rays_traced, "ray counts differ: %llu, %llu",
+              (unsigned long long)b[0].rays_traced, (unsigned long long)b[1].rays_traced);
+        CHECK(b[0].rays == 1024 && b[0].ray_tolerance == VB_DEFAULT_RAY_TOLERANCE,
+              "cap %u, tolerance %g", b[0].rays, (double)b[0].ray_tolerance);
+        CHECK(b[2].rays_traced == (uint64_t)NP * 1024, "tolerance 0 traced %llu",
+              (unsigned long long)b[2].rays_traced);
+        CHECK(b[3].rays_traced == (uint64_t)NP * 128, "tolerance inf traced %llu",
+              (unsigned long long)b[3].rays_traced);
+        CHECK(b[0].rays_traced > b[3].rays_traced && b[0].rays_traced < b[2].rays_traced,
+              "default traced %llu, not between", (unsigned long long)b[0].rays_traced);
+        int finite = 1;
+        for (int i = 0; i < 4; i++)
+            for (int k = 0; k < NP * 25; k++)
+                finite &= isfinite(b[i].coeffs[5][k]) != 0;
+        CHECK(finite, "a coefficient is not finite");
+    }
+    for (int i = 0; i < 4; i++)
+        vb_bake_output_free(&b[i]);
+    vb_scene_destroy(sc);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+}
+
 int main(void)
 {
     test_grid();
@@ -427,5 +556,7 @@ int main(void)
     test_box_floor();
     test_threads();
     test_shadow_offset();
+    test_nested_grid();
+    test_adaptive_rays();
     return test_report("test_bake");
 }

@@ -114,4 +114,25 @@ expect_exit 0 "bake --log-offset" "$bake" "${quick[@]}" --log-offset 0.25 -o "$t
 check "log offset recorded" json "$tmp/off.json" \
   "all(s['method'] == 'shadow' and abs(s['method_param'] - 0.25) < 1e-7 for s in d['streams'])"
 
+# --rays auto: byte-identical across thread counts, the cap and tolerance in
+# the report, fewer rays than the cap; --ray-tolerance only with it.
+auto=(builtin:room --max-edge 1.5 --rays auto --cube-size 0 -q)
+expect_exit 0 "adaptive rays, 1 thread" "$bake" "${auto[@]}" --threads 1 -o "$tmp/ar1.vdsh" \
+  --report "$tmp/ar1.json"
+expect_exit 0 "adaptive rays, 2 threads" "$bake" "${auto[@]}" --threads 2 -o "$tmp/ar2.vdsh"
+check "adaptive rays: 1 and 2 threads give identical files" cmp -s "$tmp/ar1.vdsh" "$tmp/ar2.vdsh"
+check "adaptive rays reported" json "$tmp/ar1.json" \
+  "d['adaptive_rays'] is True and d['rays_per_receiver'] == 1024 and abs(d['ray_tolerance'] - 0.06) < 1e-6 and 128 <= d['mean_rays_traced'] < 1024"
+expect_exit 0 "adaptive rays, tolerance 0" "$bake" "${auto[@]}" --ray-tolerance 0 -o "$tmp/ar0.vdsh" \
+  --report "$tmp/ar0.json"
+check "tolerance 0 traces every round" json "$tmp/ar0.json" "d['mean_rays_traced'] == 1024"
+expect_exit 0 "adaptive rays, tolerance inf" "$bake" "${auto[@]}" --ray-tolerance inf \
+  -o "$tmp/ari.vdsh" --report "$tmp/ari.json"
+check "tolerance inf stops at the first check" json "$tmp/ari.json" "d['mean_rays_traced'] == 128"
+expect_exit 2 "--ray-tolerance without --rays auto" "$bake" builtin:room --ray-tolerance 0.1 \
+  -o "$tmp/x.vdsh"
+expect_exit 2 "negative --ray-tolerance" "$bake" builtin:room --rays auto --ray-tolerance -1 \
+  -o "$tmp/x.vdsh"
+check "no output after refused tolerances" test ! -e "$tmp/x.vdsh"
+
 exit $fail

@@ -57,6 +57,8 @@ typedef struct job {
     double *choose_error;  /* choose_count * (VDSH_ORDER_SLOTS) * 2 */
     float *choose_coeffs;  /* per sample, quantity and order: its fit */
     uint8_t *done;         /* receivers the choice baked already (or NULL) */
+    int adaptive;          /* adaptive rays: grid is nested */
+    float ray_tol;         /* their tolerance (0: every round) */
     _Atomic uint64_t traced, missed;
     _Atomic uint32_t degenerate;
 } job;
@@ -87,6 +89,29 @@ static inline float fast_log(float x)
     float s = (m - 1.0f) / (m + 1.0f), s2 = s * s;
     float p = s * (2.0f + s2 * (2.0f / 3 + s2 * (2.0f / 5 + s2 * (2.0f / 7 + s2 * (2.0f / 9)))));
     return p + (float)e * 0.69314718f;
+}
+
+static double expected_error(const double *e, double r);
+
+/* Adaptive rays: the highest order's fit of accumulated projection `acc`
+ * (a quantity's per-lane sums) over `cells` directions, into c. */
+static void adapt_fit(const job *J, const float n[3], float acc[VDSH_MAX_COEFFS][VB_PACKET],
+                      uint32_t cells, float c[VDSH_MAX_COEFFS])
+{
+    double w = (J->grid->hemisphere ? 2.0 : 4.0) * VB_PI / cells;
+    int nb = J->order * J->order;
+    double b[VDSH_MAX_COEFFS], u[VDSH_MAX_COEFFS];
+    for (int i = 0; i < nb; i++) {
+        double s = 0.0;
+        for (int k = 0; k < VB_PACKET; k++)
+            s += acc[i][k];
+        b[i] = s * w;
+    }
+    const vb_fit *top = &J->fits[J->order];
+    vb_fit_angles angles;
+    vb_fit_frame(top, n, &angles);
+    vb_fit_unrotate(top, &angles, b, u);
+    vb_fit_finish(top, &angles, u, c);
 }
 
 /* An AVX2 clone where the CPU has it, for the lane loops (the log's
@@ -126,17 +151,36 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
      * together: the log's division and series are a long dependency
      * chain, which independent packets side by side keep the core busy
      * through. Every sum still runs in packet order. */
-    for (uint32_t pk = 0; pk < J->grid->packet_count;) {
+    /* Adaptive rays: the nested grid's rounds, a fit after each from the
+     * second on, compared with the last (adapt_* below). */
+    const uint32_t rounds = J->adaptive ? J->grid->rounds : 1;
+    const int aq = want[1]; /* the quantity the stopping rule reads */
+    uint32_t cells_used = J->grid->count, adapt_from = 0, adapt_n = 0;
+    float adapt_prev[VDSH_MAX_COEFFS];
+    float *ax = NULL, *ay = NULL, *az = NULL; /* directions above the horizon */
+    float adapt_buf[3 * 4096];
+    if (J->adaptive) {
+        ax = adapt_buf;
+        ay = ax + J->grid->count;
+        az = ay + J->grid->count;
+    }
+    for (uint32_t round = 0, pk = 0; round < rounds; round++) {
+    const uint32_t pk_end = J->adaptive ? J->grid->round_end[round] : J->grid->packet_count;
+    for (; pk < pk_end;) {
         struct RTCRayHit16 rh[GROUP] __attribute__((aligned(64)));
         int valid[GROUP][VB_PACKET] __attribute__((aligned(64)));
         int np = 0;
-        for (; pk < J->grid->packet_count && np < GROUP; pk++) {
-            if (J->horizon && vb_dirgrid_packet_below(J->grid, pk, n))
+        for (; pk < pk_end && np < GROUP; pk++) {
+            if (J->horizon && !J->adaptive && vb_dirgrid_packet_below(J->grid, pk, n))
                 continue;
             struct RTCRayHit16 *r = &rh[np];
             int *ok = valid[np];
-            vb_dirgrid_packet(J->grid, pk, d->seed, v, n, r->ray.dir_x, r->ray.dir_y,
-                              r->ray.dir_z, ok);
+            if (J->adaptive)
+                vb_dirgrid_packet_nested(J->grid, pk, d->seed, v, n, r->ray.dir_x,
+                                         r->ray.dir_y, r->ray.dir_z, ok);
+            else
+                vb_dirgrid_packet(J->grid, pk, d->seed, v, n, r->ray.dir_x, r->ray.dir_y,
+                                  r->ray.dir_z, ok);
             int any = 0;
             for (int k = 0; k < VB_PACKET; k++) {
                 if (J->horizon && ok[k]) {
@@ -220,14 +264,58 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
                         out->z[i] = dz[k];
                         out->t[i] = dist[p][k];
                     }
+            if (J->adaptive)
+                for (int k = 0; k < VB_PACKET; k++)
+                    if (up_lane[p][k]) {
+                        ax[adapt_n] = dx[k];
+                        ay[adapt_n] = dy[k];
+                        az[adapt_n] = dz[k];
+                        adapt_n++;
+                    }
         }
+    }
+    if (!J->adaptive || d->trace_only)
+        continue;
+    /* The round's fit of the highest order, and, from the second round,
+     * the expected shadow error between it and the last round's on this
+     * round's directions: below the tolerance, the receiver stops. */
+    cells_used = pk * VB_PACKET;
+    if (round + 1 < rounds && (want[0] || want[1])) {
+        float cur[VDSH_MAX_COEFFS];
+        adapt_fit(J, n, acc[aq], cells_used, cur);
+        int stop = 0;
+        if (round > 0) {
+            double sum = 0.0;
+            for (uint32_t i = adapt_from; i < adapt_n; i++) {
+                float dir[3] = {ax[i], ay[i], az[i]}, y[VDSH_MAX_COEFFS];
+                vdsh_sh_eval(J->order, dir, y);
+                double s1 = 0.0, s0 = 0.0;
+                for (int j = 0; j < J->order * J->order; j++)
+                    s1 += (double)cur[j] * y[j], s0 += (double)adapt_prev[j] * y[j];
+                double ratio;
+                if (aq)
+                    ratio = exp(s1 - s0);
+                else {
+                    double tmin = 1e-4 * d->max_distance;
+                    ratio = (s1 > tmin ? s1 : tmin) / (s0 > tmin ? s0 : tmin);
+                }
+                sum += expected_error(J->error_table, ratio);
+            }
+            uint32_t m = adapt_n - adapt_from;
+            stop = m == 0 || sum / m < J->ray_tol;
+        }
+        memcpy(adapt_prev, cur, sizeof cur);
+        adapt_from = adapt_n;
+        if (stop)
+            break;
+    }
     }
     if (d->trace_only)
         return;
 
     /* b = the projection (in double: it sums over thousands of rays); each
      * order's coefficients are its fit's map of b (fit.h). */
-    double w = (J->grid->hemisphere ? 2.0 : 4.0) * VB_PI / J->grid->count;
+    double w = (J->grid->hemisphere ? 2.0 : 4.0) * VB_PI / cells_used;
     int nb = J->order * J->order;
     /* The rotation's first half once for every order: the highest
      * order's leading bands are the lower orders' (fit.h). */
@@ -510,8 +598,23 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
      * with half the directions (the same traced budget). */
     int hemisphere = mi->hemisphere;
     vb_dirgrid grid = {0};
-    vb_result r = vb_dirgrid_create(hemisphere ? (d.rays + 1) / 2 : d.rays, hemisphere,
-                                    &grid, err);
+    uint32_t domain_rays = hemisphere ? (d.rays + 1) / 2 : d.rays;
+    vb_result r;
+    if (d.adaptive_rays) {
+        if (d.ray_tolerance == 0.0f)
+            d.ray_tolerance = VB_DEFAULT_RAY_TOLERANCE;
+        if (d.ray_tolerance < 0.0f)
+            d.ray_tolerance = 0.0f;
+        if (isnan(d.ray_tolerance))
+            return vb_fail(err, VB_ERR_ARGUMENT, "the ray tolerance must be a number >= 0");
+        if (domain_rays > 4096)
+            return vb_fail(err, VB_ERR_ARGUMENT,
+                           "adaptive rays: the cap must be at most %u rays, not %u",
+                           hemisphere ? 8192u : 4096u, d.rays);
+        r = vb_dirgrid_create_nested(domain_rays, hemisphere, &grid, err);
+    } else {
+        r = vb_dirgrid_create(domain_rays, hemisphere, &grid, err);
+    }
     if (r != VB_OK)
         return r;
     float *origins = malloc((size_t)R->vertex_count * 3 * sizeof *origins);
@@ -559,6 +662,8 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     J->max_local = d.max_distance * d.scene->scale;
     J->inv_scale = 1.0f / d.scene->scale;
     J->horizon = mi->horizon;
+    J->adaptive = d.adaptive_rays != 0;
+    J->ray_tol = d.ray_tolerance;
     /* The per-order log offsets, for the methods that have them. */
     for (int o = 1; o <= VDSH_MAX_ORDER && mi->param == VB_PARAM_LOG_OFFSET; o++) {
         J->log_offset[o] = d.log_offsets ? d.log_offsets[o] : mi->default_log_offset[o];
@@ -569,7 +674,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         }
     }
     /* The quantity choice's score: the expected shadow error e(r). */
-    if (choose && !(J->error_table = error_table_create())) {
+    if ((choose || J->adaptive) && !(J->error_table = error_table_create())) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
@@ -652,6 +757,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     memcpy(o.coeffs, coeffs, sizeof coeffs);
     memset(coeffs, 0, sizeof coeffs);
     o.rays = grid.count;
+    o.ray_tolerance = J->adaptive ? d.ray_tolerance : 0.0f;
     o.hemisphere = grid.hemisphere;
     o.max_distance = d.max_distance;
     o.threads = started;

@@ -25,6 +25,13 @@
  * methods trace rays / 2 directions, stratified over the hemisphere around
  * each receiver's normal, the same budget `paper` traces.
  *
+ * Adaptive rays (adaptive_rays, `--rays auto`): `rays` is the cap; each
+ * receiver traces nested stratified rounds of a power-of-two grid and stops
+ * when a round no longer changes its fit (vb_bake_desc below; figures:
+ * docs/ACCURACY.md, "Adaptive rays and receivers"). Opt-in: the default
+ * path traces the fixed grid, byte-identical to bakes before it. With
+ * trace_only, every round is traced.
+ *
  * Quantity: the stored function is D itself, or ln(max(D, log_floor)) for
  * VDSH_QUANTITY_LOG_DISTANCE (hemisphere methods and full only: the
  * paper's zero fill has no meaning in the log domain). VB_QUANTITY_AUTO
@@ -78,7 +85,18 @@ extern "C" {
 typedef struct vb_bake_desc {
     const vb_mesh *receivers;  /* positions and normals (borrowed) */
     const vb_scene *scene;     /* the occluders (borrowed) */
-    uint32_t rays;             /* directions per receiver; 0: 2500 */
+    uint32_t rays;             /* directions per receiver; 0: 2500. With
+                                * adaptive_rays: the cap */
+    /* Adaptive rays (--rays auto): 1 traces nested stratified rounds
+     * (vb_dirgrid_create_nested: 1/16, 1/8, ... of the cap's power-of-two
+     * grid) and stops a receiver once a round changed its fit of the
+     * highest order by less than ray_tolerance in expected shadow error
+     * (the mean over the round's directions above the horizon of e(r), r
+     * the new fit's distance over the last one's: the quantity choice's
+     * score below). The decision reads the receiver's own rays only. */
+    int adaptive_rays;
+    float ray_tolerance;       /* 0: VB_DEFAULT_RAY_TOLERANCE; < 0: tolerance 0
+                                * (every round); inf: stop at the first check */
     uint64_t seed;             /* 0 is a valid seed */
     float max_distance;        /* clamp; 0: the occluders' bbox diagonal */
     vb_method method;          /* method.h; 0: shadow (the default) */
@@ -103,6 +121,8 @@ typedef struct vb_bake_desc {
     void *progress_user;
 } vb_bake_desc;
 
+#define VB_DEFAULT_RAY_TOLERANCE 0.06f /* validation room: docs/ACCURACY.md */
+
 typedef struct vb_bake_output {
     int max_order;
     vdsh_method method;        /* the method as stored */
@@ -118,7 +138,9 @@ typedef struct vb_bake_output {
     /* Per order n (1..VDSH_MAX_ORDER): vertex_count * n^2 coefficients, vertex-major, or
      * NULL where the order was not asked for (and with trace_only). */
     float *coeffs[VDSH_ORDER_SLOTS];
-    uint32_t rays;             /* directions per receiver actually used */
+    uint32_t rays;             /* directions per receiver actually used (the
+                                * cap with adaptive rays) */
+    float ray_tolerance;       /* adaptive rays: the tolerance used, else 0 */
     int hemisphere;            /* sampling domain: 0 sphere, 1 hemisphere */
     float max_distance;        /* the clamp used, scene units */
     unsigned threads;          /* workers used */

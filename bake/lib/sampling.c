@@ -275,3 +275,95 @@ void vb_dirgrid_packet(const vb_dirgrid *g, uint32_t packet, uint64_t seed,
         dz[k] = live ? dz[k] : 0.0f;
     }
 }
+
+/* ---- nested grids (adaptive rays) ---------------------------------------- */
+
+static uint32_t bit_reverse(uint32_t x, int bits)
+{
+    uint32_t r = 0;
+    for (int i = 0; i < bits; i++)
+        r |= ((x >> i) & 1u) << (bits - 1 - i);
+    return r;
+}
+
+vb_result vb_dirgrid_create_nested(uint32_t rays, int hemisphere, vb_dirgrid *out,
+                                   vb_error *err)
+{
+    if (rays < 128 || rays > VB_MAX_RAYS)
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "adaptive rays need a cap of 128..%u directions, not %u", VB_MAX_RAYS,
+                       rays);
+    int a = 0, b = 0; /* nu = 2^a rows, nv = 2^b columns, b = a or a + 1 */
+    while (((uint64_t)1 << (a + b + 1)) <= rays) {
+        if (b == a)
+            b++;
+        else
+            a++;
+    }
+    vb_dirgrid g = {0};
+    g.nu = 1u << a;
+    g.nv = 1u << b;
+    g.count = g.nu * g.nv;
+    g.packet_count = g.count / VB_PACKET;
+    g.hemisphere = hemisphere;
+    g.cells = malloc((size_t)g.count * sizeof *g.cells);
+    uint64_t *key = malloc((size_t)g.count * sizeof *key);
+    if (!g.cells || !key) {
+        free(key);
+        vb_dirgrid_destroy(&g);
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u ray directions", rays);
+    }
+    int bits = a + b;
+    /* Round sizes: 2^p cells for p from bits - 4 (at least 64) to bits. */
+    int first = bits - 4 < 6 ? 6 : bits - 4;
+    for (uint32_t u = 0; u < g.nu; u++)
+        for (uint32_t v = 0; v < g.nv; v++) {
+            uint32_t code = morton2(u, v);
+            uint32_t rank = bit_reverse(code, bits);
+            uint32_t round = 0;
+            while (rank >= (1u << (first + round)))
+                round++;
+            key[u * g.nv + v] = ((uint64_t)round << 56) | ((uint64_t)code << 24) |
+                                (u * g.nv + v);
+        }
+    qsort(key, g.count, sizeof *key, cmp_u64);
+    for (uint32_t k = 0; k < g.count; k++)
+        g.cells[k] = (uint32_t)(key[k] & 0xffffffu);
+    free(key);
+    g.rounds = (uint32_t)(bits - first + 1);
+    for (uint32_t r = 0; r < g.rounds; r++)
+        g.round_end[r] = (1u << (first + r)) / VB_PACKET;
+    *out = g;
+    return VB_OK;
+}
+
+void vb_dirgrid_packet_nested(const vb_dirgrid *g, uint32_t packet, uint64_t seed,
+                              uint32_t vertex, const float n[3], float dx[16],
+                              float dy[16], float dz[16], int valid[16])
+{
+    const uint32_t *cells = g->cells + (size_t)packet * VB_PACKET;
+    const uint32_t key = hash_key(seed, vertex);
+    const uint32_t shift = mix32(key ^ 0x5bd1e995u);
+    const uint32_t hr = shift & (g->nu - 1), hc = (shift >> 16) & (g->nv - 1);
+    const float zscale = g->hemisphere ? 1.0f : 2.0f;
+    float t[3], b[3];
+    if (g->hemisphere)
+        vb_frame(n, t, b);
+    for (int k = 0; k < VB_PACKET; k++) {
+        uint32_t row = (cells[k] / g->nv) ^ hr, col = (cells[k] % g->nv) ^ hc;
+        float ju, jv;
+        hash_uv(key, row * g->nv + col, &ju, &jv);
+        float z = 1.0f - zscale * ((float)row + ju) / (float)g->nu;
+        float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+        float phi = (float)(2.0 * VB_PI) * ((float)col + jv) / (float)g->nv;
+        float x = r * cosf(phi), y = r * sinf(phi);
+        if (g->hemisphere) {
+            dx[k] = x * t[0] + y * b[0] + z * n[0];
+            dy[k] = x * t[1] + y * b[1] + z * n[1];
+            dz[k] = x * t[2] + y * b[2] + z * n[2];
+        } else {
+            dx[k] = x, dy[k] = y, dz[k] = z;
+        }
+        valid[k] = -1;
+    }
+}

@@ -40,6 +40,7 @@ extern "C" {
 
 #define VB_PACKET 16
 #define VB_MAX_RAYS (1u << 20)
+#define VB_MAX_ROUNDS 24
 
 typedef struct vb_dirgrid {
     uint32_t nu, nv;         /* rows (cos theta) x columns (phi) */
@@ -53,11 +54,35 @@ typedef struct vb_dirgrid {
                                 domain only) */
     float *lane_row;         /* per lane (packet order): the cell's row */
     float *lane_cos, *lane_sin;  /* per lane: cos, sin of the cell's first phi */
+    /* Nested grids (vb_dirgrid_create_nested) only, else 0: the packets
+     * end of each round (round r is packets [round_end[r-1], round_end[r])). */
+    uint32_t rounds;
+    uint32_t round_end[VB_MAX_ROUNDS];
 } vb_dirgrid;
 
 vb_result vb_dirgrid_create(uint32_t rays, int hemisphere, vb_dirgrid *out,
                             vb_error *err);
 void vb_dirgrid_destroy(vb_dirgrid *g);
+
+/* A nested grid for adaptive rays: nu x nv = 2^a x 2^b cells (b = a or
+ * a + 1), the most that fit in `rays`, taken in rounds of 1/16, 1/8, ...,
+ * 1 of them (at least 64 cells in the first). The cells up to the end of
+ * any round are the cells whose Morton code (row, column) has its low bits
+ * equal to a per-receiver shift: a regular sub-grid, one cell in each
+ * block of 2^i x 2^j cells, so every prefix of rounds is a stratified sample
+ * with equal weights, and each round's set contains the last. Within a
+ * round the cells are in Morton order (packets are compact patches of the
+ * sub-grid); every round is a whole number of full packets. Packets:
+ * vb_dirgrid_packet_nested (not vb_dirgrid_packet, nor packet cones). */
+vb_result vb_dirgrid_create_nested(uint32_t rays, int hemisphere, vb_dirgrid *out,
+                                   vb_error *err);
+
+/* vb_dirgrid_packet for a nested grid: the grid's cells XORed with the
+ * receiver's shift (a hash of seed and vertex), so that the sub-grids
+ * differ from one receiver to the next. Every lane valid. */
+void vb_dirgrid_packet_nested(const vb_dirgrid *g, uint32_t packet, uint64_t seed,
+                              uint32_t vertex, const float n[3], float dx[16],
+                              float dy[16], float dz[16], int valid[16]);
 
 /* The 16 directions of `packet` for receiver `vertex`. For the hemisphere
  * domain, `n` is the receiver's unit normal (the local pole); for the

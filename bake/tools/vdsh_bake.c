@@ -37,6 +37,9 @@ typedef struct options {
     const char *report;
     const char *export_obj;
     uint32_t rays;
+    int adaptive_rays;         /* --rays auto */
+    float ray_tolerance;       /* --ray-tolerance; 0: the default */
+    int have_ray_tolerance;
     int orders[VDSH_MAX_ORDER];
     int order_count;
     vb_method method;
@@ -129,6 +132,11 @@ static void usage(FILE *f)
 "Bake:\n"
 "      --rays N            directions per receiver, stratified and jittered\n"
 "                          (default 2500 = 50 x 50)\n"
+"      --rays auto         adaptive: nested stratified rounds (a power-of-two\n"
+"                          grid under 2500, from 1/16 of it), each receiver\n"
+"                          stopping when a round changes its fit by less\n"
+"                          than --ray-tolerance in expected shadow error\n"
+"      --ray-tolerance T   with --rays auto (default 0.06; 0: every round)\n"
 "      --orders LIST       SH orders to store, order n = n bands = n*n\n"
 "                          coefficients (default 2,3,5; each 1..5)\n"
 "      --method M          the fit:\n"
@@ -319,6 +327,11 @@ static int write_report(const char *path, const options *o, const vb_job *job,
     vt_json_u64(&j, root, "receiver_triangles", f->header.triangle_count);
     vt_json_u64(&j, root, "occluder_triangles", f->header.occluder_triangle_count);
     vt_json_u64(&j, root, "rays_per_receiver", b->rays);
+    vt_json_bool(&j, root, "adaptive_rays", o->adaptive_rays);
+    if (o->adaptive_rays)
+        vt_json_f64(&j, root, "ray_tolerance", b->ray_tolerance);
+    vt_json_f64(&j, root, "mean_rays_traced",
+                b->vertex_count ? (double)b->rays_traced / b->vertex_count : 0.0);
     vt_json_string(&j, root, "method", vb_method_name(o->method));
     cJSON *orders = vt_json_array(&j, root, "orders");
     for (int i = 0; i < o->order_count; i++)
@@ -403,10 +416,11 @@ int main(int argc, char **argv)
 
     enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
-           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY };
+           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
+        {"ray-tolerance", required_argument, 0, O_RAY_TOL},
         {"orders", required_argument, 0, O_ORDERS},
         {"method", required_argument, 0, O_METHOD},
         {"encoding", required_argument, 0, O_ENCODING},
@@ -440,10 +454,27 @@ int main(int argc, char **argv)
         switch (c) {
         case 'o': o.output = optarg; break;
         case O_RAYS:
+            if (strcmp(optarg, "auto") == 0) {
+                o.adaptive_rays = 1;
+                o.rays = 2500;
+                break;
+            }
             if (!vt_parse_u64(optarg, 1, 1u << 20, &u))
-                return bad_usage("--rays takes a whole number 1..1048576, not '%s'", optarg);
+                return bad_usage("--rays takes auto or a whole number 1..1048576, not '%s'",
+                                 optarg);
+            o.adaptive_rays = 0;
             o.rays = (uint32_t)u;
             break;
+        case O_RAY_TOL: {
+            char *end = NULL;
+            double t = strtod(optarg, &end);
+            if (end == optarg || *end || !(t >= 0.0))
+                return bad_usage("--ray-tolerance takes a number >= 0 (or inf), not '%s'",
+                                 optarg);
+            o.ray_tolerance = t == 0.0 ? -1.0f : (float)t;
+            o.have_ray_tolerance = 1;
+            break;
+        }
         case O_ORDERS:
             if (!parse_orders(optarg, &o))
                 return bad_usage("--orders takes distinct orders 1..5 such as 2,3,5, not '%s'", optarg);
@@ -531,6 +562,8 @@ int main(int argc, char **argv)
             return VT_EXIT_USAGE;
         }
     }
+    if (o.have_ray_tolerance && !o.adaptive_rays)
+        return bad_usage("%s needs --rays auto", "--ray-tolerance");
     int nmesh = argc - optind;
     if (nmesh < 1)
         return bad_usage("%s", "no mesh given");
@@ -562,7 +595,9 @@ int main(int argc, char **argv)
         .paths = (const char *const *)argv + optind, .path_count = (uint32_t)nmesh,
         .output = o.trace_only ? NULL : o.output, .cubemap_dir = o.cubemap_dir,
         .weld = o.weld, .max_edge = o.max_edge, .fast_traversal = !o.robust,
-        .bake = {.rays = o.rays, .seed = o.seed, .max_distance = o.max_distance,
+        .bake = {.rays = o.rays, .adaptive_rays = o.adaptive_rays,
+                 .ray_tolerance = o.ray_tolerance, .seed = o.seed,
+                 .max_distance = o.max_distance,
                  .method = o.method, .quantity = o.quantity, .lambda = o.lambda,
                  .log_floor = o.log_floor, .log_offsets = o.have_log_offset ? offsets : NULL,
                  .window = o.window, .order_mask = order_mask, .threads = o.threads,
@@ -632,6 +667,11 @@ int main(int argc, char **argv)
                 bo->seconds > 0 ? bo->rays_traced / bo->seconds * 1e-6 : 0.0, bo->threads,
                 bo->rays_traced ? 100.0 * bo->rays_missed / bo->rays_traced : 0.0,
                 bo->moved_origins, bo->degenerate_receivers, (double)bo->max_distance);
+    if (log && o.adaptive_rays)
+        fprintf(log, "vdsh-bake: adaptive rays: %.1f traced per receiver on average "
+                     "(cap %u, tolerance %g)\n",
+                bo->vertex_count ? (double)bo->rays_traced / bo->vertex_count : 0.0, bo->rays,
+                (double)bo->ray_tolerance);
     if (log)
         fprintf(log, "vdsh-bake: ray origins checked in %.2f s: %llu probe rays (%.1f%% of the "
                      "traced rays), %u receivers repaired, %u moved\n",
