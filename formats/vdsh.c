@@ -588,6 +588,9 @@ static int check_stream(const vdsh_stream *s, uint32_t i, why *w)
     if (s->window == VDSH_WINDOW_NONE && s->window_param != 0.0f)
         return bad(w, "%s: window_param %g must be 0 without a window", l,
                    (double)s->window_param);
+    if (s->window != VDSH_WINDOW_NONE && !(s->window_param > 0.0f))
+        return bad(w, "%s: window_param %g must be > 0 with a window", l,
+                   (double)s->window_param);
     if (!isfinite(s->method_param))
         return bad(w, "%s: method_param %g not finite", l,
                    (double)s->method_param);

@@ -1623,6 +1623,10 @@ static void test_writer_checks(void)
     REJECT("quantity 3", s_.streams[0].quantity = 3);
     REJECT("window 3", s_.streams[0].window = 3);
     REJECT("without a window", s_.streams[0].window_param = 0.5f);
+    REJECT("with a window", (s_.streams[0].window = VDSH_WINDOW_HANN,
+                             s_.streams[0].window_param = 0.0f));
+    REJECT("with a window", (s_.streams[0].window = VDSH_WINDOW_LANCZOS,
+                             s_.streams[0].window_param = -3.0f));
     REJECT("window_param", s_.streams[1].window_param = NAN);
     REJECT("method_param", s_.streams[1].method_param = -INFINITY);
     REJECT("scale", s_.streams[0].scale = 0);
