@@ -187,6 +187,11 @@ static int bad(why *w, const char *fmt, ...)
     return 0;
 }
 
+const char *vdsh_library_version(void)
+{
+    return VDSH_VERSION_STRING;
+}
+
 const char *vdsh_result_str(vdsh_result r)
 {
     switch (r) {

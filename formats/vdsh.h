@@ -91,6 +91,11 @@ typedef enum vdsh_result {
 /* A static string such as "CRC mismatch"; never NULL. */
 const char *vdsh_result_str(vdsh_result r);
 
+/* The library's version, "MAJOR.MINOR.PATCH" (the CMake project's; the
+ * installed package's vdshConfigVersion.cmake and .pc files carry the
+ * same). The file format's version is VDSH_FORMAT_VERSION's. */
+const char *vdsh_library_version(void);
+
 typedef struct vdsh_error {
     char msg[512];
 } vdsh_error;

@@ -1,0 +1,37 @@
+# The installed package: `cmake --install BUILD [--prefix DIR]` puts the
+# formats and runtime libraries (static, or shared with
+# -DBUILD_SHARED_LIBS=ON), their public headers (include/vdsh/), the
+# programs, a CMake config package and pkg-config files in place:
+#   find_package(vdsh CONFIG REQUIRED)
+#   target_link_libraries(app PRIVATE vdsh::formats)   # .vdsh reader/writer
+#   target_link_libraries(app PRIVATE vdsh::runtime)   # GL runtime (vr.h)
+#   target_link_libraries(app PRIVATE vdsh::context)   # EGL/GLFW contexts
+#   pkg-config --cflags --libs vdsh-formats  (or vdsh-runtime)
+# tests/install.cmake builds and runs a consumer against an installed tree.
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+install(TARGETS vdsh_format vr vr_context EXPORT vdshTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+        PUBLIC_HEADER DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vdsh)
+install(EXPORT vdshTargets NAMESPACE vdsh:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vdsh)
+
+set(VDSH_HAVE_GLFW ${glfw3_FOUND})
+configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/vdshConfig.cmake.in
+                              ${CMAKE_CURRENT_BINARY_DIR}/vdshConfig.cmake
+                              INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vdsh)
+write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/vdshConfigVersion.cmake
+                                 VERSION ${PROJECT_VERSION} COMPATIBILITY SameMinorVersion)
+install(FILES ${CMAKE_CURRENT_BINARY_DIR}/vdshConfig.cmake
+              ${CMAKE_CURRENT_BINARY_DIR}/vdshConfigVersion.cmake
+        DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vdsh)
+
+# pkg-config: relocatable (prefix from the .pc file's own place, lib/pkgconfig);
+# static builds list their dependencies in Libs.private.
+file(RELATIVE_PATH VDSH_PC_TO_PREFIX /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
+foreach(pc vdsh-formats vdsh-runtime)
+  configure_file(${CMAKE_CURRENT_LIST_DIR}/${pc}.pc.in ${CMAKE_CURRENT_BINARY_DIR}/${pc}.pc @ONLY)
+  install(FILES ${CMAKE_CURRENT_BINARY_DIR}/${pc}.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+endforeach()

@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# The installed package (issue 19): formats/, tools/ and runtime/ configured
+# alone (-DVDSH_BAKE=OFF), built as shared libraries, installed into a
+# temporary prefix with `cmake --install`; then a program outside the tree
+# (tests/install_consumer) finds it with find_package(vdsh CONFIG), builds,
+# and runs (writes, reads back and checks a .vdsh; links the runtime); the
+# same program builds with `pkg-config --cflags --libs vdsh-runtime`; the
+# installed vdsh-info reads the consumer's file. Then the same with static
+# libraries.
+# Usage: test_install.sh CMAKE SOURCE_DIR WORK_DIR C_COMPILER
+set -u
+cmake=$1 src=$2 work=$3 cc=$4
+fail=0
+rm -rf "$work"
+mkdir -p "$work"
+for kind in shared static; do
+  shared=$([ $kind = shared ] && echo ON || echo OFF)
+  b=$work/$kind/build p=$work/$kind/prefix c=$work/$kind/consumer
+  if ! "$cmake" -S "$src" -B "$b" -DCMAKE_BUILD_TYPE=Release -DVDSH_BAKE=OFF \
+       -DBUILD_SHARED_LIBS=$shared -DCMAKE_C_COMPILER="$cc" > "$work/$kind.cfg.log" 2>&1; then
+    cat "$work/$kind.cfg.log"; echo "FAIL: $kind: configure"; exit 1
+  fi
+  if ! "$cmake" --build "$b" -j 2 --target vdsh_format vr vr_context vdsh-info > "$work/$kind.build.log" 2>&1; then
+    tail -30 "$work/$kind.build.log"; echo "FAIL: $kind: build"; exit 1
+  fi
+  # vdsh-view needs the whole runtime build; the install rule of every target
+  # wants it built, so build all (formats, tools, runtime: seconds).
+  "$cmake" --build "$b" -j 2 > "$work/$kind.build2.log" 2>&1 || { tail -30 "$work/$kind.build2.log"; echo "FAIL: $kind: build all"; exit 1; }
+  if ! "$cmake" --install "$b" --prefix "$p" > "$work/$kind.install.log" 2>&1; then
+    cat "$work/$kind.install.log"; echo "FAIL: $kind: install"; exit 1
+  fi
+  for f in include/vdsh/vdsh.h include/vdsh/vr.h lib/cmake/vdsh/vdshConfig.cmake \
+           lib/cmake/vdsh/vdshConfigVersion.cmake lib/pkgconfig/vdsh-formats.pc \
+           lib/pkgconfig/vdsh-runtime.pc bin/vdsh-info bin/vdsh-view; do
+    [ -e "$p/$f" ] || { echo "FAIL: $kind: $f not installed"; fail=1; }
+  done
+  if [ $kind = shared ]; then
+    ls "$p"/lib/libvdsh-formats.so.* > /dev/null 2>&1 || { echo "FAIL: no shared libvdsh-formats"; fail=1; }
+  else
+    [ -e "$p/lib/libvdsh-formats.a" ] || { echo "FAIL: no static libvdsh-formats"; fail=1; }
+  fi
+  if ! "$cmake" -S "$src/tests/install_consumer" -B "$c" -DCMAKE_PREFIX_PATH="$p" \
+       -DCMAKE_C_COMPILER="$cc" > "$work/$kind.consumer.log" 2>&1 ||
+     ! "$cmake" --build "$c" >> "$work/$kind.consumer.log" 2>&1; then
+    cat "$work/$kind.consumer.log"; echo "FAIL: $kind: consumer with find_package"; fail=1; continue
+  fi
+  out=$(LD_LIBRARY_PATH="$p/lib" "$c/consumer" "$work/$kind/c.vdsh") || { echo "$out"; echo "FAIL: $kind: consumer run"; fail=1; }
+  echo "$kind, find_package: $out"
+  echo "$out" | grep -q "read back ok" || { echo "FAIL: $kind: consumer output"; fail=1; }
+  echo "$out" | grep -q "^vdsh $(sed -n 's/^project(vdsh VERSION \([0-9.]*\).*/\1/p' "$src/CMakeLists.txt") " ||
+    { echo "FAIL: $kind: version"; fail=1; }
+  LD_LIBRARY_PATH="$p/lib" "$p/bin/vdsh-info" --verify "$work/$kind/c.vdsh" > /dev/null ||
+    { echo "FAIL: $kind: installed vdsh-info cannot read the consumer's file"; fail=1; }
+  if command -v pkg-config > /dev/null; then
+    flags=$(PKG_CONFIG_PATH="$p/lib/pkgconfig" pkg-config --cflags --libs \
+            $([ $kind = static ] && echo --static) vdsh-runtime) ||
+      { echo "FAIL: $kind: pkg-config"; fail=1; continue; }
+    if ! "$cc" -o "$work/$kind/pc-consumer" "$src/tests/install_consumer/consumer.c" $flags \
+         > "$work/$kind.pc.log" 2>&1; then
+      cat "$work/$kind.pc.log"; echo "FAIL: $kind: consumer with pkg-config ($flags)"; fail=1; continue
+    fi
+    LD_LIBRARY_PATH="$p/lib" "$work/$kind/pc-consumer" "$work/$kind/d.vdsh" | grep -q "read back ok" ||
+      { echo "FAIL: $kind: pkg-config consumer run"; fail=1; }
+    echo "$kind, pkg-config: builds and runs"
+  fi
+done
+[ $fail -eq 0 ] && echo "the package installs, and a consumer builds and runs against it (shared and static)"
+exit $fail
