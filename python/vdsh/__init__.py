@@ -1,0 +1,281 @@
+"""vdsh - read and validate .vdsh files, written from formats/VDSH.md alone.
+
+    import vdsh
+    f = vdsh.read("room.vdsh")          # raises vdsh.VdshError naming the problem
+    f.header["vertex_count"], f.positions (V x 3), f.normals, f.triangles (T x 3)
+    s = f.streams[0]                   # dict: order, encoding, method, quantity, ...
+    c = vdsh.coefficients(s)           # V x order^2 float32 (stored x scale)
+    d = vdsh.reconstruct(f, s, v, dirs)    # distances of vertex v toward unit dirs (N x 3)
+
+Every reading rule of the spec is checked; numpy only.
+"""
+import struct
+import zlib
+
+import numpy as np
+
+__all__ = ["VdshError", "VdshFile", "read", "coefficients", "sh_basis", "reconstruct"]
+__version__ = "0.1.0"
+
+MAGIC = b"VDSH\r\n\x1a\n"
+METHODS = ["paper", "full", "mirror", "lsq", "shadow"]
+ENCODINGS = ["f32", "f16"]
+QUANTITIES = ["distance", "distance2", "log-distance"]
+WINDOWS = ["none", "hann", "lanczos"]
+KNOWN = {b"HEAD", b"SRCS", b"POSN", b"NORM", b"TRIS", b"COEF", b"stat", b"time"}
+LOG_SUM_MAX = 80.0
+
+
+class VdshError(Exception):
+    """A file that breaks a rule of formats/VDSH.md; the message names it."""
+
+
+class VdshFile:
+    def __init__(self):
+        self.header, self.sources, self.streams = {}, [], []
+        self.stats = self.timings = None
+        self.positions = self.normals = self.triangles = None
+
+
+def _fail(path, msg):
+    raise VdshError("%s: %s" % (path, msg))
+
+
+def _finite(*v):
+    return all(np.isfinite(x) for x in v)
+
+
+def read(path):
+    with open(path, "rb") as fh:
+        data = fh.read()
+    return parse(data, path)
+
+
+def parse(data, path="memory"):
+    n = len(data)
+    if n < 32 or data[:8] != MAGIC:
+        _fail(path, "not a .vdsh file (magic)")
+    version, count, size, flags, crc = struct.unpack_from("<IIQII", data, 8)
+    if zlib.crc32(data[:28]) != crc:
+        _fail(path, "header CRC mismatch")
+    if version != 1:
+        _fail(path, "version %d unsupported" % version)
+    if size != n:
+        _fail(path, "file_size %d but the file has %d bytes" % (size, n))
+    if not 1 <= count <= 64 or flags != 0:
+        _fail(path, "chunk_count %d or flags %d out of range" % (count, flags))
+    f, off, seen = VdshFile(), 32, []
+    for k in range(count):
+        if off + 16 > n:
+            _fail(path, "chunk %d header runs past the end" % k)
+        cid, ccrc, csize = data[off:off + 4], *struct.unpack_from("<IQ", data, off + 4)
+        pad = (-csize) % 16
+        if csize > n - off - 16 or pad > n - off - 16 - csize:
+            _fail(path, "chunk %d runs past the end" % k)
+        body = data[off + 16:off + 16 + csize]
+        padding = data[off + 16 + csize:off + 16 + csize + pad]
+        c = zlib.crc32(data[off:off + 4])
+        c = zlib.crc32(data[off + 8:off + 16], c)
+        c = zlib.crc32(body + padding, c)
+        if c != ccrc:
+            _fail(path, "chunk %d %r: CRC mismatch" % (k, cid))
+        if any(padding):
+            _fail(path, "chunk %d: padding not zero" % k)
+        if k == 0 and cid != b"HEAD":
+            _fail(path, "HEAD is not the first chunk")
+        if cid not in KNOWN:
+            if 65 <= cid[0] <= 90:
+                _fail(path, "unknown critical chunk %r" % cid)
+        elif cid != b"COEF" and cid in seen:
+            _fail(path, "a second %r chunk" % cid)
+        seen.append(cid)
+        if cid in KNOWN:
+            _chunk(f, cid, body, path)
+        off += 16 + csize + pad
+    if off != n:
+        _fail(path, "the last chunk ends at %d, file_size is %d" % (off, n))
+    for req in (b"HEAD", b"SRCS", b"POSN", b"NORM", b"TRIS"):
+        if req not in seen:
+            _fail(path, "required chunk %r missing" % req)
+    if not f.streams:
+        _fail(path, "no COEF chunk")
+    if f.stats and f.stats["rays_missed"] > f.stats["rays_traced"]:
+        _fail(path, "stat: rays_missed > rays_traced")
+    return f
+
+
+def _chunk(f, cid, b, path):
+    h = f.header
+    if cid == b"HEAD":
+        if len(b) != 128:
+            _fail(path, "HEAD is %d bytes, must be 128" % len(b))
+        (V, T, rays, sampling, seed, maxd, maxe, rule, lflags, cube, ov, ot, tflags) = \
+            struct.unpack_from("<IIIIQffIIIIII", b, 0)
+        bmin = struct.unpack_from("<3f", b, 56)
+        bmax = struct.unpack_from("<3f", b, 68)
+        if not 1 <= V <= 1 << 28 or T > 1 << 28 or rays < 1 or sampling > 1:
+            _fail(path, "HEAD: a count or sampling out of range")
+        if not (_finite(maxd) and maxd > 0 and _finite(maxe) and maxe >= 0):
+            _fail(path, "HEAD: max_distance or max_edge out of range")
+        if rule > 1 or lflags & ~1 or tflags & ~1:
+            _fail(path, "HEAD: offset_rule or flags out of range")
+        if not _finite(*bmin, *bmax) or any(a > c for a, c in zip(bmin, bmax)):
+            _fail(path, "HEAD: bounds not finite or min > max")
+        if any(b[80:128]):
+            _fail(path, "HEAD: reserved bytes 80..127 not zero")
+        h.update(vertex_count=V, triangle_count=T, rays=rays,
+                 sampling=["sphere", "hemisphere"][sampling], seed=seed, max_distance=maxd,
+                 max_edge=maxe, offset_rule=rule, load_flags=lflags, cube_size=cube,
+                 occluder_vertex_count=ov, occluder_triangle_count=ot, trace_flags=tflags,
+                 bounds_min=bmin, bounds_max=bmax)
+        return
+    V, T = h["vertex_count"], h["triangle_count"]
+    if cid == b"SRCS":
+        if len(b) < 4:
+            _fail(path, "SRCS too short")
+        (cnt,), o = struct.unpack_from("<I", b, 0), 4
+        if cnt > 64:
+            _fail(path, "SRCS: count %d > 64" % cnt)
+        for _ in range(cnt):
+            if o + 44 > len(b):
+                _fail(path, "SRCS runs past its payload")
+            sha, sz, ln = b[o:o + 32], *struct.unpack_from("<QI", b, o + 32)
+            o += 44
+            if not 1 <= ln <= 4096 or o + ln + (-ln) % 4 > len(b):
+                _fail(path, "SRCS: name length %d" % ln)
+            raw = b[o:o + ln]
+            if 0 in raw or any(b[o + ln:o + ln + (-ln) % 4]):
+                _fail(path, "SRCS: NUL in a name or padding not zero")
+            try:
+                name = raw.decode("utf-8")
+            except UnicodeDecodeError:
+                _fail(path, "SRCS: a name is not UTF-8")
+            f.sources.append(dict(name=name, size=sz, sha256=sha.hex()))
+            o += ln + (-ln) % 4
+        if o != len(b):
+            _fail(path, "SRCS: payload does not end after the last name")
+    elif cid in (b"POSN", b"NORM"):
+        if len(b) != 12 * V:
+            _fail(path, "%s is %d bytes, must be %d" % (cid.decode(), len(b), 12 * V))
+        a = np.frombuffer(b, "<f4").reshape(V, 3)
+        if not np.isfinite(a).all():
+            _fail(path, "%s: a value is not finite" % cid.decode())
+        if cid == b"NORM":
+            ln = np.linalg.norm(a.astype(np.float64), axis=1)
+            zero = (a == 0).all(axis=1)
+            if ((np.abs(ln - 1) >= 1e-3) & ~zero).any():
+                _fail(path, "NORM: a normal is neither unit nor zero")
+            f.normals = a
+        else:
+            f.positions = a
+    elif cid == b"TRIS":
+        if len(b) != 12 * T:
+            _fail(path, "TRIS is %d bytes, must be %d" % (len(b), 12 * T))
+        t = np.frombuffer(b, "<u4").reshape(T, 3)
+        if T and t.max() >= V:
+            _fail(path, "TRIS: an index is out of range")
+        f.triangles = t
+    elif cid == b"COEF":
+        _coef(f, b, path)
+    elif cid == b"stat":
+        if len(b) != 32:
+            _fail(path, "stat is %d bytes, must be 32" % len(b))
+        v = struct.unpack("<QQIIII", b)
+        f.stats = dict(zip(["rays_traced", "rays_missed", "degenerate_receivers",
+                            "undefined_normals", "moved_origins", "flipped_normals"], v))
+    elif cid == b"time":
+        if len(b) != 64:
+            _fail(path, "time is %d bytes, must be 64" % len(b))
+        v = struct.unpack_from("<5d", b, 0)
+        if not all(np.isfinite(x) and x >= 0 for x in v):
+            _fail(path, "time: a value is not finite or negative")
+        if any(b[44:64]):
+            _fail(path, "time: reserved bytes 44..63 not zero")
+        f.timings = dict(zip(["load", "refine", "build", "trace", "total"], v),
+                         threads=struct.unpack_from("<I", b, 40)[0])
+
+
+def _coef(f, b, path):
+    V = f.header["vertex_count"]
+    if len(b) < 48:
+        _fail(path, "COEF shorter than its header")
+    order, enc, method, qty, win = struct.unpack_from("<5I", b, 0)
+    wp, mp, scale, qp = struct.unpack_from("<4f", b, 20)
+    if not 1 <= order <= 5 or enc > 1 or qty > 2 or win > 2:
+        _fail(path, "COEF: order, encoding, quantity or window out of range")
+    if not _finite(wp, mp) or (win == 0 and wp != 0) or (win != 0 and not wp > 0):
+        _fail(path, "COEF: window_param or method_param out of range")
+    if not (_finite(scale) and scale > 0):
+        _fail(path, "COEF: scale must be finite and > 0")
+    if (qty == 2 and not (_finite(qp) and qp > 0)) or (qty != 2 and qp != 0):
+        _fail(path, "COEF: quantity_param out of range")
+    if any(b[36:48]):
+        _fail(path, "COEF: reserved bytes 36..47 not zero")
+    n = V * order * order
+    width = 4 if enc == 0 else 2
+    if len(b) != 48 + n * width:
+        _fail(path, "COEF: payload is %d bytes, must be %d" % (len(b), 48 + n * width))
+    stored = np.frombuffer(b, "<f4" if enc == 0 else "<f2", n, 48).reshape(V, order * order)
+    if not np.isfinite(stored).all():
+        _fail(path, "COEF: a stored value is not finite")
+    big = float(np.abs(stored).max()) if n else 0.0
+    with np.errstate(over="ignore"):
+        if not np.isfinite(np.float32(big) * np.float32(scale)):
+            _fail(path, "COEF: a stored value times scale overflows f32")
+    if any(s["order"] == order and s["quantity"] == QUANTITIES[qty] for s in f.streams):
+        _fail(path, "COEF: a second stream of order %d, %s" % (order, QUANTITIES[qty]))
+    if len(f.streams) >= 15:
+        _fail(path, "more than 15 COEF chunks")
+    f.streams.append(dict(order=order, encoding=ENCODINGS[enc],
+                          method=METHODS[method] if method < len(METHODS) else method,
+                          method_id=method, quantity=QUANTITIES[qty], window=WINDOWS[win],
+                          window_param=wp, method_param=mp, scale=scale, quantity_param=qp,
+                          stored=stored))
+
+
+def coefficients(stream):
+    """V x n^2 float32: stored value x scale (the window is already applied)."""
+    return stream["stored"].astype(np.float32) * np.float32(stream["scale"])
+
+
+def sh_basis(order, dirs):
+    """N x order^2 real SH (VDSH.md, Conventions) at unit directions (N x 3)."""
+    d = np.asarray(dirs, np.float64).reshape(-1, 3)
+    x, y, z = d[:, 0], d[:, 1], d[:, 2]
+    out = np.zeros((len(d), order * order))
+    fact = [1.0]
+    for i in range(1, 2 * order + 2):
+        fact.append(fact[-1] * i)
+    xy = x + 1j * y
+    for m in range(order):
+        # P_m^m with the Condon-Shortley phase, times e^{i m phi} sin^m
+        dfact = np.prod(np.arange(2 * m - 1, 0, -2)) if m else 1.0
+        pmm = (-1) ** m * dfact * xy ** m
+        p_prev, p = None, pmm
+        for l in range(m, order):
+            if l == m + 1:
+                p_prev, p = p, z * (2 * m + 1) * pmm
+            elif l > m + 1:
+                p_prev, p = p, ((2 * l - 1) * z * p - (l + m - 1) * p_prev) / (l - m)
+            k = np.sqrt((2 * l + 1) / (4 * np.pi) * fact[l - m] / fact[l + m])
+            if m == 0:
+                out[:, l * (l + 1)] = k * p.real
+            else:
+                out[:, l * (l + 1) + m] = np.sqrt(2) * k * p.real
+                out[:, l * (l + 1) - m] = np.sqrt(2) * k * p.imag
+    return out
+
+
+def reconstruct(f, stream, vertex, dirs):
+    """Distances of one vertex toward unit directions (VDSH.md, Reconstruction rules)."""
+    c = coefficients(stream)[vertex].astype(np.float64)
+    s = sh_basis(stream["order"], dirs) @ c
+    dmax = f.header["max_distance"]
+    q = stream["quantity"]
+    if q == "distance":
+        d = np.maximum(s, 0)
+    elif q == "distance2":
+        d = np.sqrt(np.maximum(s, 0))
+    else:
+        d = np.exp(np.minimum(s, LOG_SUM_MAX))
+    return np.minimum(d, dmax)

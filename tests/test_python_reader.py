@@ -1,0 +1,168 @@
+"""test_python_reader.py BAKE INFO SRC_DIR WORK - the Python reader (python/)
+against the C reader (tools/vdsh-info, formats/vdsh.c).
+
+Installs python/ with pip (--no-build-isolation --no-index, into WORK: no
+network, Debian's pip and setuptools), imports it from there, and checks:
+- the SH basis against formats/VDSH.md's table of values;
+- on files baked here (default, paper f32, lsq with the quantity chosen per
+  order, a Hann window, with --record-timings) and on every file of
+  tests/corpus/vdsh: both readers accept or both refuse; where both accept,
+  the fields vdsh-info --json prints agree (counts, bake parameters,
+  streams, coefficient 0's min/max/mean, statistics);
+- a corruption sweep: a small good file with one byte changed (xor 0x55)
+  at 400 evenly spread offsets: both readers accept and refuse the same
+  files (a changed byte anywhere must be refused: CRCs);
+- reconstruction: for the default bake's order-5 log stream, distances
+  toward 64 directions at 50 vertices equal exp of the SH sum clamped to
+  max_distance, and lie in (0, max_distance].
+"""
+import glob
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+
+bake, info, src, work = sys.argv[1:5]
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+fail = []
+
+# Install the package as a user would, from a copy (pip builds in place).
+pkg = os.path.join(work, "python")
+shutil.copytree(os.path.join(src, "python"), pkg)
+target = os.path.join(work, "site")
+r = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-build-isolation",
+                    "--no-deps", "--no-index", "--target", target, pkg],
+                   capture_output=True, text=True)
+if r.returncode:
+    sys.exit("FAIL: pip install ./python: %s" % r.stderr)
+sys.path.insert(0, target)
+import vdsh  # noqa: E402
+
+assert vdsh.__file__.startswith(target), vdsh.__file__
+
+# The spec's table of values (VDSH.md, Conventions).
+table = {(0.48, 0.6, 0.64): [0.282095, -0.293162, 0.312706, -0.234529, 0.314654, -0.419539,
+                             0.072162, -0.335631, -0.070797, -0.117253, 0.532798, -0.287390,
+                             -0.227369, -0.229912, -0.119879, 0.240625, -0.093437, -0.225127,
+                             0.508809, 0.034118, -0.361361, 0.027295, -0.114482, 0.461999,
+                             -0.197126],
+         (1, 0, 0): [0.282095, 0, 0, -0.488603, 0, 0, -0.315392, 0, 0.546274, 0, 0, 0, 0,
+                     0.457046, 0, -0.590044, 0, 0, 0, 0, 0.317357, 0, -0.473087, 0, 0.625836]}
+for d, want in table.items():
+    got = vdsh.sh_basis(5, [d])[0]
+    if np.abs(got - want).max() > 2e-6:
+        fail.append("sh_basis%s: %s" % (d, np.round(got, 6)))
+
+
+def c_reader(path):
+    r = subprocess.run([info, "--json", path], capture_output=True, text=True)
+    if r.returncode != 0:
+        return None
+    d = json.loads(r.stdout)
+    return d if d.get("valid") else None
+
+
+def py_reader(path):
+    try:
+        return vdsh.read(path)
+    except vdsh.VdshError as e:
+        return str(e)
+
+
+def close(a, b, rel=1e-5):
+    return abs(a - b) <= rel * max(1.0, abs(a), abs(b))
+
+
+def compare(path):
+    c, p = c_reader(path), py_reader(path)
+    if (c is None) != isinstance(p, str):
+        fail.append("%s: C %s, Python %s" % (path, "refuses" if c is None else "accepts",
+                                             p if isinstance(p, str) else "accepts"))
+        return None
+    if c is None:
+        return None
+    h, b = p.header, c["bake"]
+    pairs = [("vertex_count", c["vertex_count"], h["vertex_count"]),
+             ("triangle_count", c["triangle_count"], h["triangle_count"]),
+             ("rays", b["rays"], h["rays"]), ("sampling", b["sampling"], h["sampling"]),
+             ("seed", b["seed"], h["seed"]), ("cube_size", b["cube_size"], h["cube_size"]),
+             ("streams", len(c["streams"]), len(p.streams)),
+             ("sources", len(c["sources"]), len(p.sources))]
+    for k, a, v in pairs:
+        if a != v:
+            fail.append("%s: %s: C %s, Python %s" % (path, k, a, v))
+    if not close(b["max_distance"], h["max_distance"]):
+        fail.append("%s: max_distance" % path)
+    for cs, ps in zip(c["streams"], p.streams):
+        for k in ("order", "encoding", "quantity", "window", "method_id"):
+            if cs[k] != ps[k]:
+                fail.append("%s: stream %s: C %s, Python %s" % (path, k, cs[k], ps[k]))
+        if not close(cs["scale"], ps["scale"]):
+            fail.append("%s: stream scale" % path)
+        c0 = vdsh.coefficients(ps)[:, 0]
+        for k, v in (("min", c0.min()), ("max", c0.max()), ("mean", c0.astype(np.float64).mean())):
+            if not close(cs["coefficient0"][k], float(v), 1e-5):
+                fail.append("%s: order %d coefficient0 %s: C %s, Python %s"
+                            % (path, ps["order"], k, cs["coefficient0"][k], v))
+    if c.get("stats") and p.stats and c["stats"] != {k: p.stats[k] for k in c["stats"]}:
+        fail.append("%s: stats differ" % path)
+    return p
+
+
+baked = {}
+for name, args in (("default", []), ("paper-f32", ["--method", "paper", "--encoding", "f32"]),
+                   ("lsq-auto", ["--method", "lsq", "--quantity", "auto"]),
+                   ("hann", ["--method", "lsq", "--window", "hann"]),
+                   ("timings", ["--record-timings", "--orders", "3"])):
+    out = os.path.join(work, name + ".vdsh")
+    r = subprocess.run([bake, "builtin:room", "--max-edge", "1.5", "--rays", "256", "-q",
+                        "--cube-size", "0", "-o", out] + args, capture_output=True, text=True)
+    if r.returncode:
+        fail.append("bake %s: %s" % (name, r.stderr.strip()))
+        continue
+    baked[name] = compare(out)
+
+corpus = sorted(glob.glob(os.path.join(src, "tests", "corpus", "vdsh", "*")))
+accepted = sum(compare(f) is not None for f in corpus)
+print("corpus: %d files, %d accepted by both" % (len(corpus), accepted))
+
+# Corruption sweep on the smallest baked file.
+good = os.path.join(work, "timings.vdsh")
+data = open(good, "rb").read()
+bad = os.path.join(work, "bad.vdsh")
+refused = 0
+for off in np.linspace(0, len(data) - 1, 400).astype(int):
+    d = bytearray(data)
+    d[off] ^= 0x55
+    open(bad, "wb").write(d)
+    c_ok = c_reader(bad) is not None
+    p_ok = not isinstance(py_reader(bad), str)
+    if c_ok != p_ok:
+        fail.append("corrupt byte %d: C %s, Python %s" % (off, c_ok, p_ok))
+    refused += not p_ok
+print("corruption sweep: 400 files, %d refused by both" % refused)
+if refused != 400:
+    fail.append("a changed byte was accepted (%d of 400 refused)" % refused)
+
+f = baked.get("default")
+if f:
+    s = next(s for s in f.streams if s["order"] == 5)
+    rng = np.random.default_rng(1)
+    dirs = rng.normal(size=(64, 3))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    for v in rng.choice(f.header["vertex_count"], 50, replace=False):
+        d = vdsh.reconstruct(f, s, v, dirs)
+        want = np.minimum(np.exp(np.minimum(vdsh.sh_basis(5, dirs) @ vdsh.coefficients(s)[v], 80)),
+                          f.header["max_distance"])
+        if not (np.allclose(d, want) and (d > 0).all() and (d <= f.header["max_distance"]).all()):
+            fail.append("reconstruct at vertex %d" % v)
+
+for m in fail:
+    print("FAIL:", m)
+print("python reader: %d files compared, %s" % (len(baked) + len(corpus) + 400,
+                                                  "agrees with the C reader" if not fail else "DISAGREES"))
+sys.exit(1 if fail else 0)
