@@ -36,3 +36,8 @@ add_test(NAME bake_isa_agree
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_isa_agree.sh $<TARGET_FILE:vdsh-bake>
                  $<TARGET_FILE:vdsh-info> $<TARGET_FILE:vdsh_compare>
                  ${CMAKE_CURRENT_SOURCE_DIR}/with_each_isa.sh ${VDSH_SHARED_SCENES})
+
+# Sharded bakes (vdsh-bake --shard I/N, vdsh-merge): byte for byte.
+add_test(NAME bake_shard
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard.sh
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge>)
