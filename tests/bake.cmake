@@ -46,3 +46,9 @@ add_test(NAME bake_shard_parallel
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard_parallel.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> ${PROJECT_SOURCE_DIR}/scripts)
 set_tests_properties(bake_shard_parallel PROPERTIES SKIP_RETURN_CODE 77)
+# The Slurm recipe (scripts/bake-slurm) on a real one-node Slurm it starts
+# as root (skipped, 77, otherwise).
+add_test(NAME bake_shard_slurm
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard_slurm.sh
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> ${PROJECT_SOURCE_DIR}/scripts)
+set_tests_properties(bake_shard_slurm PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 300)
