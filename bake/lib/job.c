@@ -122,6 +122,10 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
             return r;
         j->coefficient_bytes += vdsh_stream_bytes_per_vertex(&j->streams[count]);
         count++;
+        /* The stream holds its own copy: drop the bake's now, so that peak
+         * memory holds one order's two copies, not every order's. */
+        free(j->bake.coeffs[o]);
+        j->bake.coeffs[o] = NULL;
     }
     vdsh_file f = {0};
     vdsh_header *h = &f.header;

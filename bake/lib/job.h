@@ -101,7 +101,8 @@ vb_result vb_job_refine(vb_job *j, const vb_job_desc *d, vb_error *err);
 /* Build the BVH and bake (bake.h); timings recorded. */
 vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err);
 
-/* Encode one stream per order and fill j->file: the header, sources,
+/* Encode one stream per order (freeing the bake's coefficients of each
+ * order once its stream holds them) and fill j->file: the header, sources,
  * receivers (with the bake's oriented normals), streams, statistics and,
  * if asked, timings. */
 vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err);
