@@ -9,3 +9,7 @@ target_link_libraries(vb_job PUBLIC vb_core vb_cubemap)
 add_executable(vdsh-bake tools/vdsh_bake.c)
 target_link_libraries(vdsh-bake PRIVATE vb_job vt_tools)
 install(TARGETS vdsh-bake RUNTIME DESTINATION bin)
+# Join a sharded bake's parts (vdsh-bake --shard I/N) byte for byte.
+add_executable(vdsh-merge tools/vdsh_merge.c)
+target_link_libraries(vdsh-merge PRIVATE vb_job vt_tools)
+install(TARGETS vdsh-merge RUNTIME DESTINATION bin)

@@ -55,6 +55,7 @@ enum {
     STREAM_HEADER_SIZE = 48,
     STAT_SIZE = 32,
     TIME_SIZE = 64,
+    PART_SIZE = 32,
     SOURCE_FIXED_SIZE = 44, /* sha256, size, name_length */
     MAX_CHUNKS = 64
 };
@@ -668,6 +669,18 @@ static int check_stats(const vdsh_stats *t, uint32_t vertex_count, why *w)
     return 1;
 }
 
+static int check_part(const vdsh_part *t, uint32_t vertex_count, why *w)
+{
+    if (t->count < 1 || t->index >= t->count)
+        return bad(w, "part: shard %u of %u", t->index, t->count);
+    if (t->range_begin >= t->range_end || t->range_end > vertex_count)
+        return bad(w, "part: receivers %u..%u not within 0..%u", t->range_begin,
+                   t->range_end, vertex_count);
+    if (t->encoding > VDSH_ENCODING_F16)
+        return bad(w, "part: unknown encoding %u", t->encoding);
+    return 1;
+}
+
 static int check_timings(const vdsh_timings *t, why *w)
 {
     const double v[5] = {t->load, t->refine, t->build, t->trace, t->total};
@@ -754,6 +767,8 @@ typedef struct layout {
     vdsh_stats stats;
     int has_timings;
     vdsh_timings timings;
+    int has_part;
+    vdsh_part part;
 } layout;
 
 typedef struct reader {
@@ -1074,6 +1089,26 @@ static vdsh_result read_time(const reader *r, const chunk_ref *c, layout *L)
     return VDSH_OK;
 }
 
+static vdsh_result read_part(const reader *r, const chunk_ref *c, layout *L)
+{
+    const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
+    why w;
+    if (c->size != PART_SIZE)
+        return fail(r->err, VDSH_ERR_CHUNK, r->name, "part: payload is %llu bytes, must be %d",
+                    (unsigned long long)c->size, PART_SIZE);
+    if (!all_zero(p + 20, 12))
+        return fail(r->err, VDSH_ERR_INVALID, r->name, "part: reserved bytes 20..31 not zero");
+    L->part.index = get_u32(p + 0);
+    L->part.count = get_u32(p + 4);
+    L->part.range_begin = get_u32(p + 8);
+    L->part.range_end = get_u32(p + 12);
+    L->part.encoding = get_u32(p + 16);
+    if (!check_part(&L->part, L->header.vertex_count, &w))
+        return invalid(r, &w);
+    L->has_part = 1;
+    return VDSH_OK;
+}
+
 /* Pass 2: which chunks, in which numbers, with which contents. */
 static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
                                  uint32_t count, layout *L)
@@ -1141,6 +1176,12 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
                              "chunk %u at offset %llu: a second time chunk",
                              i, (unsigned long long)c->offset)
                       : read_time(r, c, L);
+        } else if (memcmp(c->id, "part", 4) == 0) {
+            res = L->has_part
+                      ? fail(r->err, VDSH_ERR_CHUNK, r->name,
+                             "chunk %u at offset %llu: a second part chunk",
+                             i, (unsigned long long)c->offset)
+                      : read_part(r, c, L);
         } else if (c->id[0] >= 'A' && c->id[0] <= 'Z') {
             res = fail(r->err, VDSH_ERR_CHUNK, r->name,
                        "chunk %u '%s' at offset %llu: unknown critical chunk "
@@ -1228,6 +1269,8 @@ static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name,
     f->stats = L.stats;
     f->has_timings = L.has_timings;
     f->timings = L.timings;
+    f->has_part = L.has_part;
+    f->part = L.part;
     *out = f;
     return VDSH_OK;
 }
@@ -1387,6 +1430,7 @@ typedef struct plan {
     uint8_t stream_header[VDSH_MAX_STREAMS][STREAM_HEADER_SIZE];
     uint8_t stat[STAT_SIZE];
     uint8_t time[TIME_SIZE];
+    uint8_t part[PART_SIZE];
     uint8_t *srcs; /* malloc'd SRCS payload */
     out_chunk chunks[MAX_CHUNKS];
     uint32_t count;
@@ -1463,6 +1507,8 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
     if (f->has_stats && !check_stats(&f->stats, h->vertex_count, &w))
         return argument(err, name, &w);
     if (f->has_timings && !check_timings(&f->timings, &w))
+        return argument(err, name, &w);
+    if (f->has_part && !check_part(&f->part, h->vertex_count, &w))
         return argument(err, name, &w);
     return VDSH_OK;
 }
@@ -1575,6 +1621,15 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
         put_f64(p + 32, f->timings.total);
         put_u32(p + 40, f->timings.threads);
         add_chunk(P, "time", p, TIME_SIZE, NULL, 0);
+    }
+    if (f->has_part) {
+        p = P->part;
+        put_u32(p + 0, f->part.index);
+        put_u32(p + 4, f->part.count);
+        put_u32(p + 8, f->part.range_begin);
+        put_u32(p + 12, f->part.range_end);
+        put_u32(p + 16, f->part.encoding);
+        add_chunk(P, "part", p, PART_SIZE, NULL, 0);
     }
 
     /* Sizes are bounded by the checks above (2^28 vertices, 16 streams of

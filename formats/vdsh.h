@@ -200,6 +200,15 @@ typedef struct vdsh_timings {
     uint32_t threads;
 } vdsh_timings;
 
+/* A part of a sharded bake (`part` chunk, VDSH.md "Parts"): shard `index`
+ * of `count`, which baked receivers [range_begin, range_end); the merged
+ * file's streams use `encoding`. */
+typedef struct vdsh_part {
+    uint32_t index, count;
+    uint32_t range_begin, range_end;
+    uint32_t encoding;         /* vdsh_encoding of the merged file */
+} vdsh_part;
+
 typedef struct vdsh_file {
     vdsh_header header;
     uint32_t source_count;
@@ -213,6 +222,8 @@ typedef struct vdsh_file {
     vdsh_stats stats;
     int has_timings;           /* `time` chunk present */
     vdsh_timings timings;
+    int has_part;              /* `part` chunk present: a shard's part */
+    vdsh_part part;
     void *storage_;            /* owned memory; do not touch */
 } vdsh_file;
 

@@ -36,3 +36,19 @@ add_test(NAME bake_isa_agree
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_isa_agree.sh $<TARGET_FILE:vdsh-bake>
                  $<TARGET_FILE:vdsh-info> $<TARGET_FILE:vdsh_compare>
                  ${CMAKE_CURRENT_SOURCE_DIR}/with_each_isa.sh ${VDSH_SHARED_SCENES})
+
+# Sharded bakes (vdsh-bake --shard I/N, vdsh-merge): byte for byte.
+add_test(NAME bake_shard
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard.sh
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge>)
+# The GNU parallel recipe (scripts/bake-parallel), with Debian's parallel.
+add_test(NAME bake_shard_parallel
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard_parallel.sh
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> ${PROJECT_SOURCE_DIR}/scripts)
+set_tests_properties(bake_shard_parallel PROPERTIES SKIP_RETURN_CODE 77)
+# The Slurm recipe (scripts/bake-slurm) on a real one-node Slurm it starts
+# as root (skipped, 77, otherwise).
+add_test(NAME bake_shard_slurm
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard_slurm.sh
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> ${PROJECT_SOURCE_DIR}/scripts)
+set_tests_properties(bake_shard_slurm PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 300)

@@ -548,6 +548,66 @@ static void test_adaptive_rays(void)
     test_mesh_free(&rec);
 }
 
+/* A receiver range (a shard) gets the whole bake's coefficients bit for
+ * bit, with the automatic quantity choice and orientation on, and the
+ * ranges' ray counts add up to the whole bake's. */
+static void test_ranges(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    test_make_box(&occ, 2, 2, 2);
+    enum { NP = 301 };
+    float p[3 * NP], n[3 * NP];
+    uint64_t s = 17;
+    for (int i = 0; i < NP; i++) {
+        p[3 * i] = (float)(1.8 * test_rand(&s) - 0.9);
+        p[3 * i + 1] = (float)(1.8 * test_rand(&s));
+        p[3 * i + 2] = (float)(1.8 * test_rand(&s) - 0.9);
+        test_rand_dir(&s, n + 3 * i);
+    }
+    test_make_points(&rec, NP, p, n);
+    vb_error err;
+    vb_scene *sc = NULL;
+    CHECK(vb_scene_create(&occ, NULL, &sc, &err) == VB_OK, "scene");
+    const uint32_t cut[5] = {0, 1, 150, 151, NP};
+    vb_bake_output whole = {0}, part[4] = {{0}};
+    uint32_t mask = (1u << 3) | (1u << 5);
+    for (int i = -1; i < 4 && sc; i++) {
+        vb_bake_desc d = {.receivers = &rec, .scene = sc, .rays = 200, .seed = 3,
+                          .order_mask = mask, .threads = 2};
+        if (i >= 0)
+            d.range_begin = cut[i], d.range_end = cut[i + 1];
+        CHECK(vb_bake_run(&d, i < 0 ? &whole : &part[i], &err) == VB_OK, "bake %d: %s", i,
+              err.msg);
+    }
+    uint64_t traced = 0, missed = 0;
+    for (int i = 0; i < 4 && whole.coeffs[5] && part[i].coeffs[5]; i++) {
+        traced += part[i].rays_traced;
+        missed += part[i].rays_missed;
+        for (int o = 3; o <= 5; o += 2) {
+            size_t a = (size_t)cut[i] * o * o, b = (size_t)cut[i + 1] * o * o;
+            CHECK(memcmp(part[i].coeffs[o] + a, whole.coeffs[o] + a, (b - a) * sizeof(float)) == 0,
+                  "range %u..%u order %d: coefficients differ", cut[i], cut[i + 1], o);
+            CHECK(part[i].quantity[o] == whole.quantity[o], "range %d order %d: quantity", i, o);
+        }
+        CHECK(memcmp(part[i].normals, whole.normals, 3 * NP * sizeof(float)) == 0,
+              "range %d: oriented normals differ", i);
+    }
+    CHECK(traced == whole.rays_traced && missed == whole.rays_missed,
+          "ranges traced %llu missed %llu, the whole bake %llu %llu", (unsigned long long)traced,
+          (unsigned long long)missed, (unsigned long long)whole.rays_traced,
+          (unsigned long long)whole.rays_missed);
+    vb_bake_desc bad = {.receivers = &rec, .scene = sc, .range_begin = 5, .range_end = NP + 1};
+    vb_bake_output none = {0};
+    CHECK(vb_bake_run(&bad, &none, &err) == VB_ERR_ARGUMENT, "a range past the end is refused");
+    vb_bake_output_free(&none);
+    vb_bake_output_free(&whole);
+    for (int i = 0; i < 4; i++)
+        vb_bake_output_free(&part[i]);
+    vb_scene_destroy(sc);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+}
+
 int main(void)
 {
     test_grid();
@@ -558,5 +618,6 @@ int main(void)
     test_shadow_offset();
     test_nested_grid();
     test_adaptive_rays();
+    test_ranges();
     return test_report("test_bake");
 }

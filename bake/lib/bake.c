@@ -59,6 +59,7 @@ typedef struct job {
     uint8_t *done;         /* receivers the choice baked already (or NULL) */
     int adaptive;          /* adaptive rays: grid is nested */
     float ray_tol;         /* their tolerance (0: every round) */
+    uint32_t lo, hi;       /* the range baked (vb_bake_desc.range_*) */
     _Atomic uint64_t traced, missed;
     _Atomic uint32_t degenerate;
 } job;
@@ -350,7 +351,7 @@ static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
     job *J = ctx;
     uint64_t traced = 0, missed = 0;
     uint32_t degenerate = 0;
-    for (uint32_t v = begin; v < end; v++) {
+    for (uint32_t v = begin < J->lo ? J->lo : begin; v < end && v < J->hi; v++) {
         if (J->done && J->done[v])
             continue;
         vertex_sink out = {0};
@@ -481,7 +482,11 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (J->coeffs[o])
                 out.coeffs[0][o] = c[0][o], out.coeffs[1][o] = c[1][o];
-        bake_vertex(J, v, &out, &traced, &missed, &degenerate);
+        uint64_t t = 0, m = 0;
+        uint32_t g = 0;
+        bake_vertex(J, v, &out, &t, &m, &g);
+        if (v >= J->lo && v < J->hi) /* a shard counts its own receivers */
+            traced += t, missed += m, degenerate += g;
         float *keep = J->choose_coeffs + (size_t)i * 2 * CHOOSE_STRIDE;
         for (int q = 0; q < 2; q++)
             for (int o = 1; o <= VDSH_MAX_ORDER; o++)
@@ -652,6 +657,16 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         d.receivers = R = &oriented;
     }
 
+    J->lo = d.range_begin;
+    J->hi = d.range_end ? d.range_end : R->vertex_count;
+    if (J->lo >= J->hi || J->hi > R->vertex_count) {
+        r = vb_fail(err, VB_ERR_ARGUMENT, "receiver range %u..%u is not within 0..%u",
+                    d.range_begin, d.range_end, R->vertex_count);
+        goto done;
+    }
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++) /* outside a shard's range */
+        if (coeffs[o] && (J->lo > 0 || J->hi < R->vertex_count))
+            memset(coeffs[o], 0, (size_t)R->vertex_count * o * o * sizeof(float));
     J->d = &d;
     J->grid = &grid;
     J->origins = origins;
@@ -722,7 +737,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             uint32_t v = (uint32_t)((uint64_t)i * R->vertex_count / J->choose_count);
             const float *keep = J->choose_coeffs + (size_t)i * 2 * CHOOSE_STRIDE;
             for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-                if (coeffs[o] && J->done[v])
+                if (coeffs[o] && J->done[v] && v >= J->lo && v < J->hi)
                     memcpy(coeffs[o] + (size_t)v * o * o,
                            keep + (J->quantity[o] == VDSH_QUANTITY_LOG_DISTANCE) * CHOOSE_STRIDE +
                                choose_offset(o),

@@ -114,6 +114,13 @@ typedef struct vb_bake_desc {
      * vb_bake_output.normals); 1: the normals as given. */
     int keep_normals;
     int trace_only;            /* benchmark: trace the same rays, nothing else */
+    /* A shard (vdsh-bake --shard): only receivers [range_begin, range_end)
+     * get coefficients (the others' are zero) and only they count in
+     * rays_traced, rays_missed and degenerate_receivers; everything decided
+     * over all receivers (orientation, origins, the quantity choice) is
+     * decided as in the whole bake, so a range's coefficients are the whole
+     * bake's bit for bit. 0, 0: every receiver. */
+    uint32_t range_begin, range_end;
     /* Called from the calling thread a few times a second, and once at the
      * end, with receivers done and rays traced so far. May be NULL. */
     void (*progress)(void *user, uint32_t done, uint32_t total,

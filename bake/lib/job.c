@@ -89,6 +89,14 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
         return r;
     j->timings.build = vb_now() - t;
     vb_bake_desc bd = d->bake;
+    if (d->shard_count) {
+        if (d->shard_index >= d->shard_count || d->shard_count > j->receivers.vertex_count)
+            return vb_fail(err, VB_ERR_ARGUMENT,
+                           "shard %u/%u: needs shard < count <= the %u receivers",
+                           d->shard_index, d->shard_count, j->receivers.vertex_count);
+        vb_shard_range(j->receivers.vertex_count, d->shard_index, d->shard_count,
+                       &bd.range_begin, &bd.range_end);
+    }
     bd.receivers = &j->receivers;
     bd.scene = j->scene;
     if ((r = vb_bake_run(&bd, &j->bake, err)) != VB_OK)
@@ -107,12 +115,17 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!b->coeffs[o])
             continue;
-        vb_result r = vb_bake_stream(b, o, d->f32 ? VDSH_ENCODING_F32 : VDSH_ENCODING_F16,
+        vb_result r = vb_bake_stream(b, o, d->f32 || d->shard_count ? VDSH_ENCODING_F32
+                                                                    : VDSH_ENCODING_F16,
                                      &j->streams[count], &j->stream_data[count], err);
         if (r != VB_OK)
             return r;
         j->coefficient_bytes += vdsh_stream_bytes_per_vertex(&j->streams[count]);
         count++;
+        /* The stream holds its own copy: drop the bake's now, so that peak
+         * memory holds one order's two copies, not every order's. */
+        free(j->bake.coeffs[o]);
+        j->bake.coeffs[o] = NULL;
     }
     vdsh_file f = {0};
     vdsh_header *h = &f.header;
@@ -146,6 +159,13 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
                            .flipped_normals = b->flipped_normals};
     f.has_timings = d->record_timings;
     f.timings = j->timings;
+    if (d->shard_count) {
+        f.has_part = 1;
+        f.part = (vdsh_part){.index = d->shard_index, .count = d->shard_count,
+                             .encoding = d->f32 ? VDSH_ENCODING_F32 : VDSH_ENCODING_F16};
+        vb_shard_range(h->vertex_count, d->shard_index, d->shard_count, &f.part.range_begin,
+                       &f.part.range_end);
+    }
     j->file = f;
     return VB_OK;
 }
@@ -169,7 +189,7 @@ vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vb_error *err)
         return vb_fail(err, VB_ERR_ARGUMENT, "no output file");
     char dir[PATH_MAX], stem[PATH_MAX];
     split_output(d->output, dir, stem, sizeof dir);
-    int cube_size = vb_job_cube_size(d);
+    int cube_size = d->shard_count ? 0 : vb_job_cube_size(d); /* parts: the merge's */
     if (cube_size > 0) {
         if (j->basis_running)
             pthread_join(j->basis_thread, NULL);
@@ -189,6 +209,12 @@ vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vb_error *err)
     if (vdsh_write_sized(d->output, &j->file, &j->file_bytes, &verr) != VDSH_OK)
         return vb_fail(err, VB_ERR_IO, "%s", verr.msg);
     return VB_OK;
+}
+
+void vb_shard_range(uint32_t v, uint32_t i, uint32_t n, uint32_t *begin, uint32_t *end)
+{
+    *begin = (uint32_t)((uint64_t)v * i / n);
+    *end = (uint32_t)((uint64_t)v * (i + 1) / n);
 }
 
 void vb_job_free(vb_job *j)

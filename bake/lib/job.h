@@ -55,6 +55,11 @@ typedef struct vb_job_desc {
     int f32;                   /* 1: f32 coefficients; 0: f16 (default) */
     int cube_size;             /* basis cubemap face; 0: 64; < 0: none */
     int record_timings;        /* store the timings in the file */
+    /* A shard (vdsh-bake --shard I/N): shard_count 0 is the whole bake;
+     * else receivers vb_shard_range(V, shard_index, shard_count) only, and
+     * the file is a part (VDSH.md "Parts": f32 streams, a `part` chunk, no
+     * basis cubemaps; vdsh-merge joins the parts). */
+    uint32_t shard_index, shard_count;
     /* Called after each mesh loads (may be NULL). */
     void (*on_mesh)(void *user, const char *path, const vb_mesh *m,
                     const vb_source_info *info, double seconds);
@@ -96,7 +101,8 @@ vb_result vb_job_refine(vb_job *j, const vb_job_desc *d, vb_error *err);
 /* Build the BVH and bake (bake.h); timings recorded. */
 vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err);
 
-/* Encode one stream per order and fill j->file: the header, sources,
+/* Encode one stream per order (freeing the bake's coefficients of each
+ * order once its stream holds them) and fill j->file: the header, sources,
  * receivers (with the bake's oriented normals), streams, statistics and,
  * if asked, timings. */
 vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err);
@@ -106,6 +112,10 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err);
 vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vb_error *err);
 
 void vb_job_free(vb_job *j);
+
+/* Shard i of n of v receivers: [v*i/n, v*(i+1)/n), contiguous, sizes
+ * differing by at most one (receivers cost alike). Needs n <= v. */
+void vb_shard_range(uint32_t v, uint32_t i, uint32_t n, uint32_t *begin, uint32_t *end);
 
 #ifdef __cplusplus
 }

@@ -9,6 +9,7 @@
  * in memory meanwhile.
  */
 #include <errno.h>
+#include <ctype.h>
 #include <getopt.h>
 #include <libgen.h>
 #include <limits.h>
@@ -121,6 +122,9 @@ static void usage(FILE *f)
 "      --cubemap-dir DIR   where the SH basis cubemaps go (default: beside OUT)\n"
 "      --cube-size N       cubemap face size in texels (default 64; 0: none)\n"
 "      --encoding E        coefficient encoding: f16 (default) or f32\n"
+"      --shard I/N         bake shard I (0-based) of N only and write a part\n"
+"                          file; vdsh-merge joins the N parts into the file\n"
+"                          the whole bake writes, byte for byte\n"
 "      --report FILE       write timings and throughput as JSON\n"
 "      --record-timings    also store timings in the .vdsh (the file is then\n"
 "                          no longer byte-identical between runs)\n"
@@ -416,7 +420,7 @@ int main(int argc, char **argv)
 
     enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
-           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL };
+           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL, O_SHARD };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
@@ -444,12 +448,14 @@ int main(int argc, char **argv)
         {"log-floor", required_argument, 0, O_LOG_FLOOR},
         {"keep-normals", no_argument, 0, O_KEEP_NORMALS},
         {"window", required_argument, 0, O_WINDOW},
+        {"shard", required_argument, 0, O_SHARD},
         {"quiet", no_argument, 0, 'q'},
         {"help", no_argument, 0, 'h'},
         {"version", no_argument, 0, 'V'},
         {0, 0, 0, 0}};
     int c;
     uint64_t u;
+    uint32_t shard_index = 0, shard_count = 0;
     while ((c = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
         switch (c) {
         case 'o': o.output = optarg; break;
@@ -551,6 +557,16 @@ int main(int argc, char **argv)
             if (!parse_float(optarg, &o.log_floor) || o.log_floor == 0.0f)
                 return bad_usage("--log-floor takes a positive number, not '%s'", optarg);
             break;
+        case O_SHARD: {
+            unsigned si, sn;
+            int used = 0;
+            if (sscanf(optarg, "%u/%u%n", &si, &sn, &used) != 2 || optarg[used] || sn < 1 ||
+                sn > 1u << 20 || si >= sn || !isdigit((unsigned char)optarg[0]))
+                return bad_usage("--shard takes I/N with 0 <= I < N <= 1048576, such as 3/8, "
+                                 "not '%s'", optarg);
+            shard_index = si, shard_count = sn;
+            break;
+        }
         case 'q': o.quiet = 1; break;
         case 'h': usage(stdout); return 0;
         case 'V':
@@ -606,6 +622,7 @@ int main(int argc, char **argv)
         .f32 = o.encoding == VDSH_ENCODING_F32,
         .cube_size = o.cube_size > 0 ? o.cube_size : -1,
         .record_timings = o.record_timings,
+        .shard_index = shard_index, .shard_count = shard_count,
         .on_mesh = log ? on_mesh : NULL, .user = log};
     int status = 1;
     int writing = 0; /* output_lock held: outputs are being written */

@@ -1,0 +1,289 @@
+/*
+ * vdsh-merge - join the parts of a sharded bake (vdsh-bake --shard I/N)
+ * into the file the whole bake writes, byte for byte (VDSH.md "Parts").
+ *
+ *     vdsh-merge part-0.vdsh part-1.vdsh ... -o scene.vdsh
+ *
+ * Every part is read and checked against the first: same inputs (SRCS:
+ * names, sizes, SHA-256), same options (HEAD and every stream header),
+ * same receivers (positions, oriented normals, triangles), same shard
+ * count and merged encoding; each shard exactly once, with the receiver
+ * range vb_shard_range gives it. A refusal names the part (and, for
+ * missing shards, their numbers). The coefficients are then copied range
+ * by range and encoded as vdsh-bake encodes them (f16: scaled by the
+ * stream's largest |coefficient|), the ray counts summed, and the file and
+ * its basis cubemaps written atomically.
+ *
+ * Memory: every part is read whole (the parts together are about the
+ * merged file in f32 plus the receiver mesh once per part).
+ * Exit status: 0 merged, 1 refused or failed (nothing written), 2 usage.
+ */
+#include <getopt.h>
+#include <libgen.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cubemap.h"
+#include "job.h"
+#include "vdsh.h"
+#include "vt_cli.h"
+
+static void usage(FILE *f)
+{
+    fputs("Usage: vdsh-merge PART.vdsh... -o OUT.vdsh\n"
+          "Join the parts written by 'vdsh-bake ... --shard I/N' (every I of one N,\n"
+          "in any order) into the file the whole bake writes, byte for byte, and\n"
+          "its SH basis cubemaps beside it.\n"
+          "\n"
+          "  -o, --output FILE   the merged .vdsh (written atomically)\n"
+          "  -q, --quiet         no progress on stderr\n"
+          "  -h, --help          this help\n"
+          "\n"
+          "Exit status: 0 merged, 1 refused or failed (nothing written), 2 usage error.\n",
+          f);
+}
+
+static int same_header(const vdsh_header *a, const vdsh_header *b)
+{
+    return a->vertex_count == b->vertex_count && a->triangle_count == b->triangle_count &&
+           a->rays == b->rays && a->sampling == b->sampling && a->seed == b->seed &&
+           memcmp(&a->max_distance, &b->max_distance, 4) == 0 &&
+           memcmp(&a->max_edge, &b->max_edge, 4) == 0 && a->offset_rule == b->offset_rule &&
+           a->load_flags == b->load_flags && a->cube_size == b->cube_size &&
+           a->occluder_vertex_count == b->occluder_vertex_count &&
+           a->occluder_triangle_count == b->occluder_triangle_count &&
+           a->trace_flags == b->trace_flags &&
+           memcmp(a->bounds_min, b->bounds_min, sizeof a->bounds_min) == 0 &&
+           memcmp(a->bounds_max, b->bounds_max, sizeof a->bounds_max) == 0;
+}
+
+static int same_sources(const vdsh_file *a, const vdsh_file *b)
+{
+    if (a->source_count != b->source_count)
+        return 0;
+    for (uint32_t i = 0; i < a->source_count; i++)
+        if (memcmp(a->sources[i].sha256, b->sources[i].sha256, 32) != 0 ||
+            a->sources[i].size != b->sources[i].size ||
+            strcmp(a->sources[i].name, b->sources[i].name) != 0)
+            return 0;
+    return 1;
+}
+
+static int same_stream(const vdsh_stream *a, const vdsh_stream *b)
+{
+    return a->order == b->order && a->encoding == b->encoding && a->method == b->method &&
+           a->quantity == b->quantity && a->window == b->window &&
+           memcmp(&a->window_param, &b->window_param, 4) == 0 &&
+           memcmp(&a->method_param, &b->method_param, 4) == 0 &&
+           memcmp(&a->scale, &b->scale, 4) == 0 &&
+           memcmp(&a->quantity_param, &b->quantity_param, 4) == 0;
+}
+
+/* Why part b does not belong with part a (the first), or NULL. */
+static const char *mismatch(const vdsh_file *a, const vdsh_file *b)
+{
+    if (!same_sources(a, b))
+        return "other inputs (SRCS: names, sizes or SHA-256 differ)";
+    if (!same_header(&a->header, &b->header))
+        return "other options or receivers (HEAD differs)";
+    if (a->stream_count != b->stream_count)
+        return "other orders (stream count differs)";
+    for (uint32_t s = 0; s < a->stream_count; s++)
+        if (!same_stream(&a->streams[s], &b->streams[s]))
+            return "other options (a COEF stream header differs)";
+    if (a->part.count != b->part.count)
+        return "another shard count";
+    if (a->part.encoding != b->part.encoding)
+        return "another --encoding";
+    uint64_t v = a->header.vertex_count, t = a->header.triangle_count;
+    if (memcmp(a->positions, b->positions, v * 12) != 0 ||
+        memcmp(a->normals, b->normals, v * 12) != 0 ||
+        memcmp(a->indices, b->indices, t * 12) != 0)
+        return "other receivers (POSN, NORM or TRIS differ)";
+    if (a->has_stats != b->has_stats ||
+        (a->has_stats && (a->stats.undefined_normals != b->stats.undefined_normals ||
+                          a->stats.moved_origins != b->stats.moved_origins ||
+                          a->stats.flipped_normals != b->stats.flipped_normals)))
+        return "other statistics of the whole receiver set (stat differs)";
+    return NULL;
+}
+
+int main(int argc, char **argv)
+{
+    static const struct option longopts[] = {{"output", required_argument, 0, 'o'},
+                                             {"quiet", no_argument, 0, 'q'},
+                                             {"help", no_argument, 0, 'h'},
+                                             {0, 0, 0, 0}};
+    const char *output = NULL;
+    int quiet = 0, c;
+    while ((c = getopt_long(argc, argv, "o:qh", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'o': output = optarg; break;
+        case 'q': quiet = 1; break;
+        case 'h': usage(stdout); return 0;
+        default: fprintf(stderr, "Try 'vdsh-merge --help'.\n"); return VT_EXIT_USAGE;
+        }
+    }
+    int n = argc - optind;
+    if (n < 1)
+        return vt_usage_error("vdsh-merge", "%s", "no part given");
+    if (!output)
+        return vt_usage_error("vdsh-merge", "%s", "no output: give -o OUT.vdsh");
+    char **paths = argv + optind;
+    vdsh_file **parts = calloc((size_t)n, sizeof *parts);
+    int status = 1;
+    float *merged[VDSH_MAX_STREAMS] = {0};
+    uint16_t *encoded[VDSH_MAX_STREAMS] = {0};
+    int *owner = NULL;
+    vb_cubemap_basis basis = {0};
+    if (!parts) {
+        fprintf(stderr, "vdsh-merge: out of memory\n");
+        return 1;
+    }
+    for (int i = 0; i < n; i++) {
+        vdsh_error verr;
+        if (vdsh_read(paths[i], &parts[i], &verr) != VDSH_OK) {
+            fprintf(stderr, "vdsh-merge: %s\n", verr.msg);
+            goto out;
+        }
+        if (!parts[i]->has_part) {
+            fprintf(stderr, "vdsh-merge: %s: not a part (no part chunk: a whole bake, not "
+                            "'vdsh-bake --shard I/N')\n", paths[i]);
+            goto out;
+        }
+        const char *why = i ? mismatch(parts[0], parts[i]) : NULL;
+        if (why) {
+            fprintf(stderr, "vdsh-merge: %s: does not belong with %s: %s\n", paths[i],
+                    paths[0], why);
+            goto out;
+        }
+        for (uint32_t s = 0; s < parts[i]->stream_count; s++)
+            if (parts[i]->streams[s].encoding != VDSH_ENCODING_F32) {
+                fprintf(stderr, "vdsh-merge: %s: stream %u is not f32 (parts hold f32)\n",
+                        paths[i], s);
+                goto out;
+            }
+    }
+    const vdsh_file *p0 = parts[0];
+    uint32_t count = p0->part.count, V = p0->header.vertex_count;
+    owner = malloc((size_t)count * sizeof *owner);
+    if (!owner) {
+        fprintf(stderr, "vdsh-merge: out of memory\n");
+        goto out;
+    }
+    for (uint32_t k = 0; k < count; k++)
+        owner[k] = -1;
+    for (int i = 0; i < n; i++) {
+        const vdsh_part *pt = &parts[i]->part;
+        uint32_t b, e;
+        vb_shard_range(V, pt->index, count, &b, &e);
+        if (pt->range_begin != b || pt->range_end != e) {
+            fprintf(stderr, "vdsh-merge: %s: receivers %u..%u, but shard %u of %u is %u..%u\n",
+                    paths[i], pt->range_begin, pt->range_end, pt->index, count, b, e);
+            goto out;
+        }
+        if (owner[pt->index] >= 0) {
+            fprintf(stderr, "vdsh-merge: %s: shard %u of %u again (also %s)\n", paths[i],
+                    pt->index, count, paths[owner[pt->index]]);
+            goto out;
+        }
+        owner[pt->index] = i;
+    }
+    if ((uint32_t)n != count) {
+        fprintf(stderr, "vdsh-merge: %u of %u shards missing:", count - (uint32_t)n, count);
+        for (uint32_t k = 0, shown = 0; k < count; k++)
+            if (owner[k] < 0 && shown++ < 32)
+                fprintf(stderr, " %u", k);
+        fprintf(stderr, "%s (rerun 'vdsh-bake ... --shard I/%u' for each)\n",
+                count - (uint32_t)n > 32 ? " ..." : "", count);
+        goto out;
+    }
+
+    /* The whole file: the first part's, with every shard's coefficients. */
+    vdsh_file f = *p0;
+    vdsh_stream streams[VDSH_MAX_STREAMS];
+    f.has_part = 0;
+    f.has_timings = 0;
+    f.storage_ = NULL;
+    f.streams = streams;
+    f.stats.rays_traced = f.stats.rays_missed = 0;
+    f.stats.degenerate_receivers = 0;
+    for (int i = 0; i < n; i++) {
+        f.stats.rays_traced += parts[i]->stats.rays_traced;
+        f.stats.rays_missed += parts[i]->stats.rays_missed;
+        f.stats.degenerate_receivers += parts[i]->stats.degenerate_receivers;
+    }
+    for (uint32_t s = 0; s < p0->stream_count; s++) {
+        streams[s] = p0->streams[s];
+        size_t nc = (size_t)streams[s].order * streams[s].order;
+        if (!(merged[s] = malloc((size_t)V * nc * sizeof(float) + 1))) {
+            fprintf(stderr, "vdsh-merge: out of memory for %u receivers\n", V);
+            goto out;
+        }
+        for (int i = 0; i < n; i++) {
+            const vdsh_part *pt = &parts[i]->part;
+            size_t a = pt->range_begin * nc, b = pt->range_end * nc;
+            memcpy(merged[s] + a, (const float *)parts[i]->streams[s].data + a,
+                   (b - a) * sizeof(float));
+        }
+        streams[s].data = merged[s];
+        if (p0->part.encoding == VDSH_ENCODING_F16) {
+            /* As vb_bake_stream: stored = coefficient / the largest |coefficient|. */
+            float amax = 0.0f;
+            for (size_t k = 0; k < (size_t)V * nc; k++)
+                amax = fmaxf(amax, fabsf(merged[s][k]));
+            streams[s].encoding = VDSH_ENCODING_F16;
+            streams[s].scale = amax > 0.0f ? amax : 1.0f;
+            if (!(encoded[s] = malloc((size_t)V * nc * sizeof(uint16_t) + 1)) ||
+                vdsh_encode_f16(merged[s], (size_t)V * nc, streams[s].scale, encoded[s]) !=
+                    VDSH_OK) {
+                fprintf(stderr, "vdsh-merge: order %u coefficients do not fit f16\n",
+                        streams[s].order);
+                goto out;
+            }
+            free(merged[s]);
+            merged[s] = NULL;
+            streams[s].data = encoded[s];
+        }
+    }
+
+    /* The basis cubemaps (the whole bake writes them beside its file). */
+    if (f.header.cube_size > 0) {
+        char a[PATH_MAX], b[PATH_MAX];
+        snprintf(a, sizeof a, "%s", output);
+        snprintf(b, sizeof b, "%s", output);
+        char *stem = basename(b);
+        size_t len = strlen(stem);
+        if (len > 5 && strcmp(stem + len - 5, ".vdsh") == 0)
+            stem[len - 5] = '\0';
+        vb_error err;
+        if (vb_cubemap_basis_encode((int)f.header.cube_size, &basis, &err) != VB_OK ||
+            vb_cubemap_basis_write(&basis, dirname(a), stem, &err) != VB_OK) {
+            fprintf(stderr, "vdsh-merge: %s\n", err.msg);
+            goto out;
+        }
+    }
+    vdsh_error verr;
+    uint64_t bytes = 0;
+    if (vdsh_write_sized(output, &f, &bytes, &verr) != VDSH_OK) {
+        fprintf(stderr, "vdsh-merge: %s\n", verr.msg);
+        goto out;
+    }
+    if (!quiet)
+        fprintf(stderr, "vdsh-merge: wrote %s (%u shards, %u receivers, %.2f MB)\n", output,
+                count, V, bytes / 1e6);
+    status = 0;
+
+out:
+    vb_cubemap_basis_free(&basis);
+    for (int s = 0; s < VDSH_MAX_STREAMS; s++)
+        free(merged[s]), free(encoded[s]);
+    free(owner);
+    for (int i = 0; i < n; i++)
+        vdsh_free(parts[i]);
+    free(parts);
+    return status;
+}

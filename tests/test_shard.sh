@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# Sharded bakes: vdsh-bake --shard I/N parts joined by vdsh-merge give the
+# whole bake's file (and basis cubemaps) byte for byte for 1, 2, 7 and 64
+# shards, f16 and f32; vdsh-merge refuses parts that do not belong together
+# (other inputs, other options, a whole file, missing, duplicate shards)
+# naming the part, and writes nothing then; a shard killed mid-bake leaves
+# no part, and rerunning it alone completes the set.
+# Usage: test_shard.sh VDSH_BAKE VDSH_MERGE
+set -u
+bake=$1
+merge=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail=0
+check() { # check DESCRIPTION COMMAND...
+  local what=$1; shift
+  if ! "$@"; then echo "FAIL: $what" >&2; fail=1; fi
+}
+expect_exit() { # expect_exit CODE DESCRIPTION COMMAND...
+  local want=$1 what=$2; shift 2
+  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"
+  local got=$?
+  if [[ $got -ne $want ]]; then
+    echo "FAIL: $what: exit $got, want $want; stderr:" >&2; cat "$tmp/err.txt" >&2; fail=1
+  fi
+}
+says() { # says DESCRIPTION TEXT: the last command's stderr holds TEXT
+  if ! grep -qF -- "$2" "$tmp/err.txt"; then
+    echo "FAIL: $1: stderr lacks '$2':" >&2; cat "$tmp/err.txt" >&2; fail=1
+  fi
+}
+
+tiny=(builtin:room --max-edge 1.5 --rays 32 --cube-size 8 -q)
+expect_exit 0 "whole bake" "$bake" "${tiny[@]}" -o "$tmp/whole.vdsh"
+expect_exit 0 "whole bake f32" "$bake" "${tiny[@]}" --encoding f32 -o "$tmp/whole32.vdsh"
+
+for n in 1 2 7 64; do
+  d=$tmp/n$n; mkdir -p "$d"
+  for ((i = 0; i < n; i++)); do
+    expect_exit 0 "shard $i/$n" "$bake" "${tiny[@]}" --threads 1 --shard "$i/$n" -o "$d/part-$i.vdsh"
+  done
+  # in reverse order: the merge sorts by shard
+  expect_exit 0 "merge $n" "$merge" -q $(ls -r "$d"/part-*.vdsh) -o "$d/scene.vdsh"
+  check "$n shards: merged file identical to the whole bake" cmp "$d/scene.vdsh" "$tmp/whole.vdsh"
+  for k in 09-12 13-16 17-20 21-24; do
+    check "$n shards: basis cubemap $k identical" cmp "$d/scene.sh$k.exr" "$tmp/whole.sh$k.exr"
+  done
+done
+d=$tmp/f32; mkdir -p "$d"
+for i in 0 1 2; do
+  expect_exit 0 "f32 shard $i/3" "$bake" "${tiny[@]}" --encoding f32 --shard "$i/3" -o "$d/p$i.vdsh"
+done
+expect_exit 0 "merge f32" "$merge" -q "$d"/p*.vdsh -o "$d/scene.vdsh"
+check "3 f32 shards: identical to the whole f32 bake" cmp "$d/scene.vdsh" "$tmp/whole32.vdsh"
+
+# Refusals, each naming the part; nothing written.
+p=$tmp/n7
+out=$tmp/refused.vdsh
+expect_exit 0 "foreign shard" "$bake" builtin:room:2 --max-edge 1.5 --rays 32 --cube-size 8 -q --shard 3/7 -o "$tmp/foreign-3.vdsh"
+expect_exit 1 "foreign part refused" "$merge" -q "$p"/part-{0,1,2,4,5,6}.vdsh "$tmp/foreign-3.vdsh" -o "$out"
+says "foreign part" "$tmp/foreign-3.vdsh: does not belong with $p/part-0.vdsh: other inputs"
+expect_exit 0 "other options" "$bake" "${tiny[@]}" --seed 9 --shard 3/7 -o "$tmp/seed-3.vdsh"
+expect_exit 1 "other options refused" "$merge" -q "$p"/part-{0,1,2,4,5,6}.vdsh "$tmp/seed-3.vdsh" -o "$out"
+says "other options" "$tmp/seed-3.vdsh: does not belong with $p/part-0.vdsh: other options"
+expect_exit 1 "missing shards refused" "$merge" -q "$p"/part-{0,2,3,5,6}.vdsh -o "$out"
+says "missing shards" "2 of 7 shards missing: 1 4"
+expect_exit 1 "duplicate shard refused" "$merge" -q "$p"/part-{0,1,2,3,4,5,6,3}.vdsh -o "$out"
+says "duplicate shard" "shard 3 of 7 again"
+expect_exit 1 "a whole file is not a part" "$merge" -q "$p"/part-0.vdsh "$tmp/whole.vdsh" -o "$out"
+says "whole file" "$tmp/whole.vdsh: not a part"
+expect_exit 1 "mixed shard counts refused" "$merge" -q "$tmp"/n2/part-0.vdsh "$p"/part-1.vdsh -o "$out"
+says "mixed counts" "$p/part-1.vdsh: does not belong with $tmp/n2/part-0.vdsh"
+check "no output after refusals" test ! -e "$out"
+expect_exit 2 "--shard 7/7 is a usage error" "$bake" "${tiny[@]}" --shard 7/7 -o "$out"
+expect_exit 2 "--shard x is a usage error" "$bake" "${tiny[@]}" --shard 1/x -o "$out"
+expect_exit 1 "more shards than receivers" "$bake" builtin:room --rays 8 -q --shard 0/1000000 -o "$out"
+check "no output after bad shards" test ! -e "$out"
+
+# A shard killed mid-bake leaves no part; rerunning it alone completes the set.
+k=$tmp/killed; mkdir -p "$k"
+cp "$p"/part-*.vdsh "$k"/ && rm "$k/part-5.vdsh"
+"$bake" builtin:room --max-edge 0.1 --rays 4096 -q --shard 5/7 -o "$k/part-5.vdsh" &
+pid=$!
+sleep 1
+kill -9 "$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
+check "a killed shard leaves no part" test ! -e "$k/part-5.vdsh"
+expect_exit 1 "merge names the killed shard" "$merge" -q "$k"/part-*.vdsh -o "$k/scene.vdsh"
+says "killed shard" "1 of 7 shards missing: 5"
+expect_exit 0 "rerun shard 5" "$bake" "${tiny[@]}" --shard 5/7 -o "$k/part-5.vdsh"
+expect_exit 0 "merge after rerun" "$merge" -q "$k"/part-*.vdsh -o "$k/scene.vdsh"
+check "rerun set identical to the whole bake" cmp "$k/scene.vdsh" "$tmp/whole.vdsh"
+
+exit $fail
