@@ -276,6 +276,12 @@ float vdsh_f32_from_f16(uint16_t h);
 vdsh_result vdsh_encode_f16(const float *src, size_t n, float scale,
                             uint16_t *dst);
 
+/* The scale every writer of an f16 stream uses (VDSH.md, COEF): the
+ * stream's largest |coefficient| `amax`, or 1 for an all-zero stream, so
+ * stored values lie in [-1, 1]. vdsh-bake and vdsh-merge must agree on it
+ * to the bit (merged files are byte-identical to whole bakes). */
+static inline float vdsh_f16_scale(float amax) { return amax > 0.0f ? amax : 1.0f; }
+
 /* CRC-32 (zlib/PNG), continuing from `crc` (start with 0). */
 uint32_t vdsh_crc32(uint32_t crc, const void *data, size_t size);
 

@@ -89,7 +89,7 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encod
         float amax = 0.0f;
         for (uint32_t c = 0; ran && c < chunks; c++)
             amax = fmaxf(amax, J.amax[c]);
-        J.scale = s.scale = amax > 0.0f ? amax : 1.0f;
+        J.scale = s.scale = vdsh_f16_scale(amax);
         ran = ran && vb_parallel_for(b->threads, chunks, 1, f16_encode_block, &J, NULL, NULL) > 0;
         vdsh_result r = ran ? VDSH_OK : VDSH_ERR_OUT_OF_MEMORY;
         for (uint32_t c = 0; ran && c < chunks && r == VDSH_OK; c++)

@@ -231,12 +231,12 @@ int main(int argc, char **argv)
         }
         streams[s].data = merged[s];
         if (p0->part.encoding == VDSH_ENCODING_F16) {
-            /* As vb_bake_stream: stored = coefficient / the largest |coefficient|. */
+            /* As vb_bake_stream: the same scale rule, vdsh_f16_scale. */
             float amax = 0.0f;
             for (size_t k = 0; k < (size_t)V * nc; k++)
                 amax = fmaxf(amax, fabsf(merged[s][k]));
             streams[s].encoding = VDSH_ENCODING_F16;
-            streams[s].scale = amax > 0.0f ? amax : 1.0f;
+            streams[s].scale = vdsh_f16_scale(amax);
             if (!(encoded[s] = malloc((size_t)V * nc * sizeof(uint16_t) + 1)) ||
                 vdsh_encode_f16(merged[s], (size_t)V * nc, streams[s].scale, encoded[s]) !=
                     VDSH_OK) {
