@@ -583,6 +583,15 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     }
     if (!choose && !(mi->quantities & VB_QUANTITY_BIT(stored)))
         return vb_fail(err, VB_ERR_ARGUMENT, "%s", mi->refused[stored]);
+    if (d.order_quantity) {
+        choose = 0;
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            if ((d.order_mask & (1u << o) || o == d.max_order) &&
+                (d.order_quantity[o] > VDSH_QUANTITY_LOG_DISTANCE ||
+                 !(mi->quantities & VB_QUANTITY_BIT(d.order_quantity[o]))))
+                return vb_fail(err, VB_ERR_ARGUMENT, "order %d: quantity %u is not the method's", o,
+                               (unsigned)d.order_quantity[o]);
+    }
     if (d.lambda == 0.0f)
         d.lambda = VB_DEFAULT_LAMBDA;
     if (!(d.lambda > 0.0f) || !isfinite(d.lambda))
@@ -772,7 +781,8 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         }
     } else {
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-            J->quantity[o] = choose ? VDSH_QUANTITY_DISTANCE : stored;
+            J->quantity[o] = d.order_quantity ? d.order_quantity[o]
+                             : choose ? VDSH_QUANTITY_DISTANCE : stored;
     }
     unsigned started = vb_parallel_for(d.threads, R->vertex_count, BLOCK, bake_block, J,
                                        d.progress ? bake_progress : NULL, J);

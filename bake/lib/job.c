@@ -99,8 +99,20 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
     }
     bd.receivers = &j->receivers;
     bd.scene = j->scene;
-    if ((r = vb_bake_run(&bd, &j->bake, err)) != VB_OK)
+    if (d->adaptive) {
+        if (d->shard_count)
+            return vb_fail(err, VB_ERR_ARGUMENT,
+                           "adaptive receivers cannot be sharded yet (the refinement bakes "
+                           "as it decides): bake them in one process");
+        vb_mesh fine = {0};
+        r = vb_bake_adaptive(&bd, &j->receivers, &d->adapt, &fine, &j->bake, &j->adaptive, err);
+        if (r != VB_OK)
+            return r;
+        vb_mesh_free(&j->receivers);
+        j->receivers = fine;
+    } else if ((r = vb_bake_run(&bd, &j->bake, err)) != VB_OK) {
         return r;
+    }
     j->timings.trace = j->bake.seconds;
     j->timings.threads = j->bake.threads;
     j->timings.total = vb_now() - j->t_start;
