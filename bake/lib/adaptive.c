@@ -196,7 +196,8 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
                                    err)) != VB_OK)
         goto done;
 
-    const uint32_t max_rounds = ad->max_rounds ? ad->max_rounds : VB_ADAPTIVE_ROUNDS;
+    const uint32_t max_rounds = st.max_rounds =
+        ad->max_rounds ? ad->max_rounds : VB_ADAPTIVE_ROUNDS;
     while (isfinite(ad->tolerance) && st.rounds < max_rounds) {
         const uint32_t V = M.vertex_count;
         if (ad->max_receivers && V >= ad->max_receivers) {

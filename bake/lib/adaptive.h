@@ -63,6 +63,7 @@ typedef struct vb_adaptive_stats {
     uint32_t rounds;           /* rounds that baked midpoints */
     uint32_t candidates;       /* midpoints baked (split or not) */
     uint32_t lights;           /* lights the error was scored with */
+    uint32_t max_rounds;       /* the round limit used */
     int budget_reached;        /* the receiver budget stopped it */
 } vb_adaptive_stats;
 
