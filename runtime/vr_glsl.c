@@ -177,6 +177,16 @@ static const char vertex_glsl[] =
     "#endif\n"
     "uniform mat4 u_view_proj;\n"
     "uniform float u_scale;   /* coefficient = stored value * u_scale */\n"
+    "/* and times a factor per coefficient, as the attributes are grouped:\n"
+    " * an s8 stream's steps (vdsh_s8_step), 1 for f16 and f32 (exact) */\n"
+    "uniform vec4 u_coef_step[7];\n"
+    "#define C0 (a_c0 * u_coef_step[0])\n"
+    "#define C1 (a_c1 * u_coef_step[1])\n"
+    "#define C8 (a_c8 * u_coef_step[2].x)\n"
+    "#define C9 (a_c9 * u_coef_step[3])\n"
+    "#define C13 (a_c13 * u_coef_step[4])\n"
+    "#define C17 (a_c17 * u_coef_step[5])\n"
+    "#define C21 (a_c21 * u_coef_step[6])\n"
     "uniform float u_max_distance; /* the clamp of every reconstructed distance */\n"
     "#if NUM_LIGHTS > 0\n"
     "uniform vec3 u_light_pos[NUM_LIGHTS];\n"
@@ -229,14 +239,14 @@ static const char vertex_glsl[] =
     "float vdsh_sh_sum(vec3 d)\n"
     "{\n"
     "#if ORDER == 2\n"
-    "    return u_scale * sh_sum4(a_c0, d);\n"
+    "    return u_scale * sh_sum4(C0, d);\n"
     "#elif ORDER == 3\n"
-    "    return u_scale * sh_sum9(a_c0, a_c1, a_c8, d);\n"
+    "    return u_scale * sh_sum9(C0, C1, C8, d);\n"
     "#else\n"
     "    vec4 b9, b13, b17, b21;\n"
     "    sh_basis16(d, b9, b13, b17, b21);\n"
-    "    return u_scale * (sh_sum9(a_c0, a_c1, a_c8, d) + dot(a_c9, b9) + dot(a_c13, b13) +\n"
-    "                      dot(a_c17, b17) + dot(a_c21, b21));\n"
+    "    return u_scale * (sh_sum9(C0, C1, C8, d) + dot(C9, b9) + dot(C13, b13) +\n"
+    "                      dot(C17, b17) + dot(C21, b21));\n"
     "#endif\n"
     "}\n"
     "#endif\n"
@@ -291,15 +301,15 @@ static const char vertex_glsl[] =
     "#else\n"
     "        /* As above, 0 for a light at the vertex; the fragment stage\n"
     "         * gives such a light visibility 1. */\n"
-    "        v_sum9[i] = dl > 0.0 ? u_scale * sh_sum9(a_c0, a_c1, a_c8, lv / dl) : 0.0;\n"
+    "        v_sum9[i] = dl > 0.0 ? u_scale * sh_sum9(C0, C1, C8, lv / dl) : 0.0;\n"
     "#endif\n"
     "    }\n"
     "#endif\n"
     "#if VDSH_SPLIT\n"
-    "    v_c9 = u_scale * a_c9;\n"
-    "    v_c13 = u_scale * a_c13;\n"
-    "    v_c17 = u_scale * a_c17;\n"
-    "    v_c21 = u_scale * a_c21;\n"
+    "    v_c9 = u_scale * C9;\n"
+    "    v_c13 = u_scale * C13;\n"
+    "    v_c17 = u_scale * C17;\n"
+    "    v_c21 = u_scale * C21;\n"
     "#endif\n"
     "}\n";
 
@@ -658,6 +668,7 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     vr_program p = {.key = *key, .prog = prog};
     p.u_view_proj = glGetUniformLocation(prog, "u_view_proj");
     p.u_scale = glGetUniformLocation(prog, "u_scale");
+    p.u_coef_step = glGetUniformLocation(prog, "u_coef_step");
     p.u_max_distance = glGetUniformLocation(prog, "u_max_distance");
     p.u_light_pos = glGetUniformLocation(prog, "u_light_pos");
     p.u_light_color = glGetUniformLocation(prog, "u_light_color");

@@ -643,6 +643,8 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
         glUseProgram(p->prog);
         glUniformMatrix4fv(p->u_view_proj, 1, GL_FALSE, vp);
         glUniform1f(p->u_scale, order ? s->scale[order] : 1.0f);
+        if (order)
+            glUniform4fv(p->u_coef_step, VR_COEF_ATTRIBS, s->coef_step[order]);
         glUniform1f(p->u_max_distance, s->max_distance);
         /* The albedo multiplies the ambient term and the light colours
          * here, once, rather than every fragment. */

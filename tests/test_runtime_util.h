@@ -92,7 +92,8 @@ static inline void rt_file_bounds(rt_file *r)
 /* Add a stream whose coefficients coef (vertex-major, order^2 each, taken
  * over) are stored in `enc`: f16 as coef / scale rounded (coef is then
  * replaced by what the file really holds, so references use the exact
- * stored values), f32 as coef / scale too (scale need not be 1). */
+ * stored values), f32 as coef / scale too (scale need not be 1), s8 by
+ * vdsh_encode_s8 (scale ignored: 1; coef replaced as for f16). */
 static inline void rt_file_add_stream(rt_file *r, uint32_t order, uint32_t enc, uint32_t quantity,
                                float *coef, float scale)
 {
@@ -113,6 +114,20 @@ static inline void rt_file_add_stream(rt_file *r, uint32_t order, uint32_t enc, 
             coef[k] = vdsh_f32_from_f16(d[k]) * scale;
         }
         r->data[i] = d;
+    } else if (enc == VDSH_ENCODING_S8) {
+        /* vdsh_encode_s8 picks the scales (scale must be 1) */
+        float *d = malloc(VDSH_MAX_COEFFS * sizeof(float) + n + 1);
+        int8_t *b = (int8_t *)(d + VDSH_MAX_COEFFS);
+        if (vdsh_encode_s8(coef, r->f.header.vertex_count, order * order, d, b) != VDSH_OK)
+            abort();
+        s->scale = 1.0f;
+        s->coef_scales = d;
+        for (size_t k = 0; k < n; k++)
+            coef[k] = (float)b[k] * vdsh_s8_step(d[k % (order * order)]);
+        r->data[i] = d;
+        s->data = b;
+        r->coef[i] = coef;
+        return;
     } else {
         float *d = malloc(n * 4 + 4);
         for (size_t k = 0; k < n; k++) {

@@ -121,7 +121,9 @@ static void usage(FILE *f)
 "  -o, --output FILE       the .vdsh file to write (atomically)\n"
 "      --cubemap-dir DIR   where the SH basis cubemaps go (default: beside OUT)\n"
 "      --cube-size N       cubemap face size in texels (default 64; 0: none)\n"
-"      --encoding E        coefficient encoding: f16 (default) or f32\n"
+"      --encoding E        coefficient encoding: f16 (default), f32, or s8 (signed\n"
+"                          8-bit with a scale per coefficient index: 25 bytes\n"
+"                          per vertex at order 5; docs/ACCURACY.md)\n"
 "      --shard I/N         bake shard I (0-based) of N only and write a part\n"
 "                          file; vdsh-merge joins the N parts into the file\n"
 "                          the whole bake writes, byte for byte\n"
@@ -498,7 +500,8 @@ int main(int argc, char **argv)
         case O_ENCODING:
             if (strcmp(optarg, "f16") == 0) o.encoding = VDSH_ENCODING_F16;
             else if (strcmp(optarg, "f32") == 0) o.encoding = VDSH_ENCODING_F32;
-            else return bad_usage("--encoding takes f16 or f32, not '%s'", optarg);
+            else if (strcmp(optarg, "s8") == 0) o.encoding = VDSH_ENCODING_S8;
+            else return bad_usage("--encoding takes f16, f32 or s8, not '%s'", optarg);
             break;
         case O_MAXDIST:
             if (!parse_float(optarg, &o.max_distance) || o.max_distance == 0.0f)
@@ -620,6 +623,7 @@ int main(int argc, char **argv)
                  .keep_normals = o.keep_normals, .trace_only = o.trace_only,
                  .progress = on_progress, .progress_user = &pr},
         .f32 = o.encoding == VDSH_ENCODING_F32,
+        .s8 = o.encoding == VDSH_ENCODING_S8,
         .cube_size = o.cube_size > 0 ? o.cube_size : -1,
         .record_timings = o.record_timings,
         .shard_index = shard_index, .shard_count = shard_count,
