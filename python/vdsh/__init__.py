@@ -4,7 +4,8 @@
     f = vdsh.read("room.vdsh")          # raises vdsh.VdshError naming the problem
     f.header["vertex_count"], f.positions (V x 3), f.normals, f.triangles (T x 3)
     s = f.streams[0]                   # dict: order, encoding, method, quantity, ...
-    c = vdsh.coefficients(s)           # V x order^2 float32 (stored x scale)
+    c = vdsh.coefficients(s)           # V x order^2 float32 (stored x scale;
+                                       # s8: stored x float32(scale_i / 127))
     d = vdsh.reconstruct(f, s, v, dirs)    # distances of vertex v toward unit dirs (N x 3)
 
 Every reading rule of the spec is checked; numpy only.
@@ -19,7 +20,7 @@ __version__ = "0.1.0"
 
 MAGIC = b"VDSH\r\n\x1a\n"
 METHODS = ["paper", "full", "mirror", "lsq", "shadow"]
-ENCODINGS = ["f32", "f16"]
+ENCODINGS = ["f32", "f16", "s8"]
 QUANTITIES = ["distance", "distance2", "log-distance"]
 WINDOWS = ["none", "hann", "lanczos"]
 KNOWN = {b"HEAD", b"SRCS", b"POSN", b"NORM", b"TRIS", b"COEF", b"stat", b"time"}
@@ -201,7 +202,7 @@ def _coef(f, b, path):
         _fail(path, "COEF shorter than its header")
     order, enc, method, qty, win = struct.unpack_from("<5I", b, 0)
     wp, mp, scale, qp = struct.unpack_from("<4f", b, 20)
-    if not 1 <= order <= 5 or enc > 1 or qty > 2 or win > 2:
+    if not 1 <= order <= 5 or enc > 2 or qty > 2 or win > 2:
         _fail(path, "COEF: order, encoding, quantity or window out of range")
     if not _finite(wp, mp) or (win == 0 and wp != 0) or (win != 0 and not wp > 0):
         _fail(path, "COEF: window_param or method_param out of range")
@@ -212,13 +213,31 @@ def _coef(f, b, path):
     if any(b[36:48]):
         _fail(path, "COEF: reserved bytes 36..47 not zero")
     n = V * order * order
-    width = 4 if enc == 0 else 2
-    if len(b) != 48 + n * width:
-        _fail(path, "COEF: payload is %d bytes, must be %d" % (len(b), 48 + n * width))
-    stored = np.frombuffer(b, "<f4" if enc == 0 else "<f2", n, 48).reshape(V, order * order)
-    if not np.isfinite(stored).all():
+    width = [4, 2, 1][enc]
+    # s8: order^2 f32 scales, zero-padded to 16 bytes, before the data
+    table = (order * order * 4 + 15) // 16 * 16 if enc == 2 else 0
+    if len(b) != 48 + table + n * width:
+        _fail(path, "COEF: payload is %d bytes, must be %d" % (len(b), 48 + table + n * width))
+    scales = None
+    if enc == 2:
+        if scale != 1:
+            _fail(path, "COEF: scale must be 1 for s8")
+        scales = np.frombuffer(b, "<f4", order * order, 48)
+        if not (np.isfinite(scales).all() and (scales >= 0).all()):
+            _fail(path, "COEF: an s8 scale is not finite and >= 0")
+        with np.errstate(over="ignore"):
+            if not np.isfinite(np.float32(127) * (scales / np.float32(127))).all():
+                _fail(path, "COEF: an s8 scale's 127 steps overflow f32")
+        if any(b[48 + order * order * 4:48 + table]):
+            _fail(path, "COEF: padding after the s8 scale table not zero")
+    dtype = ["<f4", "<f2", "i1"][enc]
+    stored = np.frombuffer(b, dtype, n, 48 + table).reshape(V, order * order)
+    if enc == 2:
+        if (stored == -128).any():
+            _fail(path, "COEF: an s8 stored value is -128 (range -127..127)")
+    elif not np.isfinite(stored).all():
         _fail(path, "COEF: a stored value is not finite")
-    big = float(np.abs(stored).max()) if n else 0.0
+    big = float(np.abs(stored.astype(np.float32)).max()) if n else 0.0
     with np.errstate(over="ignore"):
         if not np.isfinite(np.float32(big) * np.float32(scale)):
             _fail(path, "COEF: a stored value times scale overflows f32")
@@ -230,11 +249,15 @@ def _coef(f, b, path):
                           method=METHODS[method] if method < len(METHODS) else method,
                           method_id=method, quantity=QUANTITIES[qty], window=WINDOWS[win],
                           window_param=wp, method_param=mp, scale=scale, quantity_param=qp,
-                          stored=stored))
+                          stored=stored, coef_scales=scales))
 
 
 def coefficients(stream):
-    """V x n^2 float32: stored value x scale (the window is already applied)."""
+    """V x n^2 float32: stored value x scale (the window is already applied);
+    s8: stored value x step_i, step_i = float32(scale_i / 127) (as vdsh.c)."""
+    if stream["encoding"] == "s8":
+        step = (stream["coef_scales"] / np.float32(127)).astype(np.float32)
+        return stream["stored"].astype(np.float32) * step
     return stream["stored"].astype(np.float32) * np.float32(stream["scale"])
 
 
