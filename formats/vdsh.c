@@ -230,7 +230,7 @@ const char *vdsh_method_name(uint32_t method)
 
 const char *vdsh_encoding_name(uint32_t encoding)
 {
-    static const char *const n[] = {"f32", "f16", "s8"};
+    static const char *const n[] = {"f32", "f16", "s8", "s8s6"};
     return NAME_OF(encoding, n);
 }
 
@@ -348,10 +348,52 @@ vdsh_result vdsh_encode_f16(const float *src, size_t n, float scale,
     return VDSH_OK;
 }
 
+size_t vdsh_encoding_bytes(uint32_t e, uint32_t nc)
+{
+    switch (e) {
+    case VDSH_ENCODING_F32: return (size_t)nc * 4;
+    case VDSH_ENCODING_F16: return (size_t)nc * 2;
+    case VDSH_ENCODING_S8: return nc;
+    case VDSH_ENCODING_S8S6:
+        return nc <= VDSH_S8S6_BYTES
+                   ? nc
+                   : VDSH_S8S6_BYTES + 4 * (size_t)((nc - VDSH_S8S6_BYTES + VDSH_S8S6_PER_WORD - 1) /
+                                                    VDSH_S8S6_PER_WORD);
+    default: return 0;
+    }
+}
+
+/* s8s6: where coefficient i >= 4 of a vertex lies: its word's byte
+ * offset in the vertex and the field's shift. */
+static void s8s6_field(uint32_t i, size_t *byte, unsigned *shift)
+{
+    uint32_t k = i - VDSH_S8S6_BYTES;
+    *byte = VDSH_S8S6_BYTES + 4 * (size_t)(k / VDSH_S8S6_PER_WORD);
+    *shift = VDSH_S8S6_BITS * (k % VDSH_S8S6_PER_WORD);
+}
+
+/* Stored value of coefficient i of the vertex at p (quantised encoding e). */
+static int32_t quant_stored(uint32_t e, const uint8_t *p, uint32_t i)
+{
+    if (e == VDSH_ENCODING_S8 || i < VDSH_S8S6_BYTES)
+        return (int8_t)p[i];
+    size_t byte;
+    unsigned shift;
+    s8s6_field(i, &byte, &shift);
+    uint32_t f = (get_u32(p + byte) >> shift) & 63u;
+    return f >= 32u ? (int32_t)f - 64 : (int32_t)f;
+}
+
 vdsh_result vdsh_encode_s8(const float *src, size_t vertices, uint32_t nc, float *scales,
                            int8_t *dst)
 {
-    if (nc < 1 || nc > VDSH_MAX_COEFFS)
+    return vdsh_encode_quantised(VDSH_ENCODING_S8, src, vertices, nc, scales, dst);
+}
+
+vdsh_result vdsh_encode_quantised(uint32_t encoding, const float *src, size_t vertices,
+                                  uint32_t nc, float *scales, void *dst)
+{
+    if (nc < 1 || nc > VDSH_MAX_COEFFS || !vdsh_encoding_quantised(encoding))
         return VDSH_ERR_ARGUMENT;
     float amax[VDSH_MAX_COEFFS] = {0};
     for (size_t v = 0; v < vertices; v++)
@@ -361,18 +403,32 @@ vdsh_result vdsh_encode_s8(const float *src, size_t vertices, uint32_t nc, float
                 return VDSH_ERR_INVALID;
             amax[i] = a > amax[i] ? a : amax[i];
         }
-    for (uint32_t i = 0; i < nc; i++)
-        if (!isfinite(127.0f * vdsh_s8_step(amax[i])))
-            return VDSH_ERR_INVALID; /* near FLT_MAX: 127 steps would overflow */
-    /* stored = round(127 c / scale) in double: |c| <= scale, so the
+    for (uint32_t i = 0; i < nc; i++) {
+        int levels = vdsh_quant_levels(encoding, i);
+        if (!isfinite((float)levels * vdsh_quant_step(amax[i], levels)))
+            return VDSH_ERR_INVALID; /* near FLT_MAX: `levels` steps would overflow */
+    }
+    /* stored = round(levels c / scale) in double: |c| <= scale, so the
      * quotient is finite for every finite scale, subnormal ones too. */
+    size_t bpv = vdsh_encoding_bytes(encoding, nc);
+    uint8_t *out = (uint8_t *)dst;
+    if (vertices)
+        memset(out, 0, vertices * bpv);
     for (size_t v = 0; v < vertices; v++)
         for (uint32_t i = 0; i < nc; i++) {
-            double q = amax[i] > 0.0f ? round(127.0 * ((double)src[v * nc + i] /
-                                                       (double)amax[i]))
+            double l = (double)vdsh_quant_levels(encoding, i);
+            double q = amax[i] > 0.0f ? round(l * ((double)src[v * nc + i] / (double)amax[i]))
                                       : 0.0;
-            q = q > 127.0 ? 127.0 : q < -127.0 ? -127.0 : q;
-            dst[v * nc + i] = (int8_t)q;
+            q = q > l ? l : q < -l ? -l : q;
+            uint8_t *p = out + v * bpv;
+            if (encoding == VDSH_ENCODING_S8 || i < VDSH_S8S6_BYTES) {
+                p[i] = (uint8_t)(int8_t)q;
+            } else {
+                size_t byte;
+                unsigned shift;
+                s8s6_field(i, &byte, &shift);
+                put_u32(p + byte, get_u32(p + byte) | ((uint32_t)(int32_t)q & 63u) << shift);
+            }
         }
     memcpy(scales, amax, nc * sizeof *scales);
     return VDSH_OK;
@@ -386,7 +442,7 @@ vdsh_result vdsh_encode_s8(const float *src, size_t vertices, uint32_t nc, float
  * table (order^2 f32), zero-padded to a multiple of 16; else 0. */
 static size_t stream_table_bytes(uint32_t encoding, uint32_t order)
 {
-    if (encoding != VDSH_ENCODING_S8)
+    if (!vdsh_encoding_quantised(encoding))
         return 0;
     return ((size_t)order * order * 4 + 15) & ~(size_t)15;
 }
@@ -407,14 +463,7 @@ size_t vdsh_stream_bytes_per_vertex(const vdsh_stream *s)
 {
     if (!s || s->order < 1 || s->order > VDSH_MAX_ORDER)
         return 0;
-    size_t n = (size_t)s->order * s->order;
-    if (s->encoding == VDSH_ENCODING_F32)
-        return n * 4;
-    if (s->encoding == VDSH_ENCODING_F16)
-        return n * 2;
-    if (s->encoding == VDSH_ENCODING_S8)
-        return n;
-    return 0;
+    return vdsh_encoding_bytes(s->encoding, s->order * s->order);
 }
 
 void vdsh_stream_decode(const vdsh_stream *s, uint32_t v, float *out)
@@ -430,10 +479,11 @@ void vdsh_stream_decode(const vdsh_stream *s, uint32_t v, float *out)
         const float *d = (const float *)s->data + (size_t)v * n;
         for (uint32_t i = 0; i < n; i++)
             out[i] = d[i] * s->scale;
-    } else if (s->encoding == VDSH_ENCODING_S8 && s->coef_scales) {
-        const int8_t *d = (const int8_t *)s->data + (size_t)v * n;
+    } else if (vdsh_encoding_quantised(s->encoding) && s->coef_scales) {
+        const uint8_t *d = (const uint8_t *)s->data + (size_t)v * vdsh_encoding_bytes(s->encoding, n);
         for (uint32_t i = 0; i < n; i++)
-            out[i] = (float)d[i] * vdsh_s8_step(s->coef_scales[i]);
+            out[i] = (float)quant_stored(s->encoding, d, i) *
+                     vdsh_quant_step(s->coef_scales[i], vdsh_quant_levels(s->encoding, i));
     } else {
         for (uint32_t i = 0; i < n; i++)
             out[i] = 0.0f;
@@ -650,15 +700,47 @@ static int check_stream(const vdsh_stream *s, uint32_t i, why *w)
     if (!isfinite(s->scale) || !(s->scale > 0.0f))
         return bad(w, "%s: scale %g must be finite and > 0", l,
                    (double)s->scale);
-    if (s->encoding == VDSH_ENCODING_S8 && s->scale != 1.0f)
-        return bad(w, "%s: scale %g must be 1 for s8 (its scale table scales)", l,
-                   (double)s->scale);
+    if (vdsh_encoding_quantised(s->encoding) && s->scale != 1.0f)
+        return bad(w, "%s: scale %g must be 1 for %s (its scale table scales)", l,
+                   (double)s->scale, vdsh_encoding_name(s->encoding));
     if (s->quantity == VDSH_QUANTITY_LOG_DISTANCE
             ? !(s->quantity_param > 0.0f) || !isfinite(s->quantity_param)
             : s->quantity_param != 0.0f)
         return bad(w, "%s: quantity_param %g must be %s", l, (double)s->quantity_param,
                    s->quantity == VDSH_QUANTITY_LOG_DISTANCE
                        ? "the log floor, finite and > 0" : "0 for this quantity");
+    return 1;
+}
+
+/* A quantised stream's stored values lie within +-levels, and s8s6's bits
+ * that no coefficient uses (bits 30-31 of every word, the last word's
+ * unused fields) are zero, so every file has one spelling. */
+static int check_quant_data(const vdsh_stream *s, const char *l, uint32_t v, why *w)
+{
+    uint32_t nc = s->order * s->order;
+    size_t bpv = vdsh_encoding_bytes(s->encoding, nc);
+    uint32_t words = s->encoding == VDSH_ENCODING_S8S6 && nc > VDSH_S8S6_BYTES
+                         ? (uint32_t)((bpv - VDSH_S8S6_BYTES) / 4)
+                         : 0;
+    const uint8_t *d = (const uint8_t *)s->data;
+    for (size_t x = 0; x < v; x++) {
+        const uint8_t *p = d + x * bpv;
+        for (uint32_t i = 0; i < nc; i++) {
+            int levels = vdsh_quant_levels(s->encoding, i);
+            int32_t q = quant_stored(s->encoding, p, i);
+            if (q < -levels)
+                return bad(w, "%s: vertex %zu coefficient %u is %d (%s stores %d..%d there)", l,
+                           x, i, (int)q, vdsh_encoding_name(s->encoding), -levels, levels);
+        }
+        for (uint32_t k = 0; k < words; k++) {
+            uint32_t left = nc - VDSH_S8S6_BYTES - k * VDSH_S8S6_PER_WORD;
+            uint32_t fields = left < VDSH_S8S6_PER_WORD ? left : VDSH_S8S6_PER_WORD;
+            uint32_t used = (1u << (VDSH_S8S6_BITS * fields)) - 1u;
+            if (get_u32(p + VDSH_S8S6_BYTES + 4 * k) & ~used)
+                return bad(w, "%s: vertex %zu: unused bits of packed word %u not zero", l, x,
+                           k);
+        }
+    }
     return 1;
 }
 
@@ -672,25 +754,22 @@ static int check_stream_data(const vdsh_stream *s, uint32_t i, uint32_t v,
     size_t n = (size_t)v * nc;
     float maxabs;
     stream_label(s, i, l, sizeof l);
-    if (s->encoding == VDSH_ENCODING_S8) {
-        /* Scales finite and >= 0; stored values -127..127 (-128 would make
-         * the range lopsided, and GL's normalisation rules disagree on it),
-         * so |coefficient| <= its scale, finite. */
+    if (vdsh_encoding_quantised(s->encoding)) {
+        /* Scales finite and >= 0; stored values within +-levels (-128, or
+         * -32 in 6 bits, would make the range lopsided, and GL's
+         * normalisation rules disagree on -128), so |coefficient| <= about
+         * its scale, finite. */
         for (uint32_t k = 0; k < nc; k++) {
             float sc = s->coef_scales[k];
+            int levels = vdsh_quant_levels(s->encoding, k);
             if (!isfinite(sc) || !(sc >= 0.0f))
                 return bad(w, "%s: scale of coefficient %zu is %g, not finite and >= 0", l,
                            (size_t)k, (double)sc);
-            if (!isfinite(127.0f * vdsh_s8_step(sc)))
-                return bad(w, "%s: scale of coefficient %zu, %g: 127 steps overflow a float",
-                           l, (size_t)k, (double)sc);
+            if (!isfinite((float)levels * vdsh_quant_step(sc, levels)))
+                return bad(w, "%s: scale of coefficient %zu, %g: %d steps overflow a float",
+                           l, (size_t)k, (double)sc, levels);
         }
-        const int8_t *d = (const int8_t *)s->data;
-        for (size_t k = 0; k < n; k++)
-            if (d[k] == -128)
-                return bad(w, "%s: vertex %zu coefficient %zu is -128 (s8 stores "
-                           "-127..127)", l, k / nc, k % nc);
-        return 1;
+        return check_quant_data(s, l, v, w);
     }
     if (s->encoding == VDSH_ENCODING_F16) {
         const uint16_t *d = (const uint16_t *)s->data;
@@ -1578,9 +1657,10 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
         if (!s->data)
             return fail(err, VDSH_ERR_ARGUMENT, name,
                         "not written: COEF stream %u: data is NULL", i);
-        if (s->encoding == VDSH_ENCODING_S8 && !s->coef_scales)
+        if (vdsh_encoding_quantised(s->encoding) && !s->coef_scales)
             return fail(err, VDSH_ERR_ARGUMENT, name,
-                        "not written: COEF stream %u: s8 without coef_scales", i);
+                        "not written: COEF stream %u: %s without coef_scales", i,
+                        vdsh_encoding_name(s->encoding));
         for (uint32_t k = 0; k < i; k++)
             if (f->streams[k].order == s->order &&
                 f->streams[k].quantity == s->quantity)

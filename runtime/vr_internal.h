@@ -89,6 +89,7 @@ typedef struct vr_program_key {
     uint8_t output;     /* vr_output */
     uint8_t pcf;        /* 0 or 1 */
     uint8_t lights;     /* lights in this pass, 0..VR_MAX_LIGHTS_PER_PASS */
+    uint8_t packed;     /* 1: the stream is s8s6 (bands 2+ in packed words) */
 } vr_program_key;
 
 typedef struct vr_program {

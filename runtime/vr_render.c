@@ -618,9 +618,10 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
         }
 
         vr_program_key key = {(uint8_t)mode, (uint8_t)d.compare, (uint8_t)s->quantity,
-                              (uint8_t)d.output, (uint8_t)(d.pcf ? 1 : 0), (uint8_t)n};
+                              (uint8_t)d.output, (uint8_t)(d.pcf ? 1 : 0), (uint8_t)n, 0};
         if (mode != VR_MODE_CUBE)
             key.pcf = 0;
+        key.packed = order && s->encoding[order] == VDSH_ENCODING_S8S6;
         const vr_program *p = NULL;
         res = get_program(r, &key, &p, err);
         if (res != VR_OK)

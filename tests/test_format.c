@@ -242,11 +242,12 @@ static void add_stream(sample *s, uint32_t order, uint32_t enc, uint32_t q,
         if (n > 3)
             d[3] = 0xfbff;
         s->data[i] = d;
-    } else if (enc == VDSH_ENCODING_S8) {
+    } else if (vdsh_encoding_quantised(enc)) {
         /* The scale table, then the bytes (one block, as the baker's). */
         uint32_t nc = order * order;
-        float *t = malloc(VDSH_MAX_COEFFS * sizeof(float) + n + 1);
-        int8_t *b = (int8_t *)(t + VDSH_MAX_COEFFS);
+        size_t bpv = vdsh_encoding_bytes(enc, nc);
+        float *t = malloc(VDSH_MAX_COEFFS * sizeof(float) + v * bpv + 1);
+        uint8_t *b = (uint8_t *)(t + VDSH_MAX_COEFFS);
         for (uint32_t k = 0; k < nc; k++)
             t[k] = rndf(0.0f, 20.0f);
         t[0] = 0.0f;               /* an all-zero index */
@@ -254,11 +255,25 @@ static void add_stream(sample *s, uint32_t order, uint32_t enc, uint32_t q,
             t[1] = 3.4e38f;        /* huge: |stored| <= 127 keeps it finite */
         if (nc > 2)
             t[2] = float_of(1);    /* subnormal */
-        for (size_t k = 0; k < n; k++)
-            b[k] = (int8_t)((int)(rnd() % 255u) - 127);
-        b[0] = -127;
-        if (n > 1)
-            b[1] = 127;
+        if (enc == VDSH_ENCODING_S8) {
+            for (size_t k = 0; k < n; k++)
+                b[k] = (uint8_t)(int8_t)((int)(rnd() % 255u) - 127);
+            b[0] = (uint8_t)-127;
+            if (n > 1)
+                b[1] = 127;
+        } else {
+            /* random valid values through the encoder: fields -31..31,
+             * unused bits 0; the extremes from +-scale */
+            float *c = malloc(n * sizeof *c + 4);
+            for (size_t k = 0; k < n; k++)
+                c[k] = rndf(-1.0f, 1.0f);
+            c[0] = -1.0f;
+            c[n - 1] = 1.0f;
+            float sc[VDSH_MAX_COEFFS];
+            if (vdsh_encode_quantised(enc, c, v, nc, sc, b) != VDSH_OK)
+                abort();
+            free(c);
+        }
         st->scale = 1.0f;
         st->coef_scales = t;
         s->data[i] = t;
@@ -352,6 +367,10 @@ static void sample_init(sample *s, int kind, uint32_t v)
         add_stream(s, 4, VDSH_ENCODING_S8, VDSH_QUANTITY_DISTANCE,
                    VDSH_METHOD_LSQ, VDSH_WINDOW_NONE, 0, 0, 1);
         add_stream(s, 3, VDSH_ENCODING_S8, VDSH_QUANTITY_LOG_DISTANCE,
+                   VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1);
+        add_stream(s, 5, VDSH_ENCODING_S8S6, VDSH_QUANTITY_LOG_DISTANCE,
+                   VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1);
+        add_stream(s, 4, VDSH_ENCODING_S8S6, VDSH_QUANTITY_LOG_DISTANCE,
                    VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1);
         s->long_name = malloc(VDSH_MAX_NAME + 1);
         memset(s->long_name, 'n', VDSH_MAX_NAME);
@@ -460,8 +479,11 @@ static void check_same_file(const vdsh_file *got, const vdsh_file *want)
         CHECK(vdsh_stream_bytes_per_vertex(x) ==
               (size_t)y->order * y->order *
                   (y->encoding == VDSH_ENCODING_F16 ? 2
-                   : y->encoding == VDSH_ENCODING_S8 ? 1 : 4));
-        CHECK(!x->coef_scales == (y->encoding != VDSH_ENCODING_S8));
+                   : y->encoding == VDSH_ENCODING_S8 ? 1 : 4) ||
+              (y->encoding == VDSH_ENCODING_S8S6 &&
+               vdsh_stream_bytes_per_vertex(x) ==
+                   (size_t[]){0, 1, 4, 8, 16, 24}[y->order]));
+        CHECK(!x->coef_scales == !vdsh_encoding_quantised(y->encoding));
         if (x->coef_scales && y->coef_scales) {
             CHECK((uintptr_t)x->coef_scales % 16 == 0);
             CHECK(memcmp(x->coef_scales, y->coef_scales,
@@ -873,6 +895,49 @@ static void check_s8_roundtrip(const float *src, size_t v, uint32_t nc, const ch
     free(b);
 }
 
+/* vdsh_encode_quantised of encoding enc at order `order` (the first
+ * order^2 of every NC = 25 values of src), decoded by vdsh_stream_decode:
+ * within half a step of the input (plus what a subnormal step loses), the
+ * extremes +-scale exact to the step's rounding, zeros zero. */
+static void check_quant_roundtrip(uint32_t enc, const float *src25, size_t v, uint32_t order,
+                                  const char *what)
+{
+    uint32_t nc = order * order;
+    float *src = malloc(v * nc * sizeof *src + 4), out[VDSH_MAX_COEFFS];
+    for (size_t k = 0; k < v; k++)
+        memcpy(src + k * nc, src25 + k * VDSH_MAX_COEFFS, nc * sizeof *src);
+    float scales[VDSH_MAX_COEFFS];
+    uint8_t *b = malloc(v * vdsh_encoding_bytes(enc, nc) + 1);
+    vdsh_stream st = {.order = order, .encoding = enc, .scale = 1.0f, .data = b,
+                      .coef_scales = scales};
+    long bad = 0;
+    checks++;
+    if (vdsh_encode_quantised(enc, src, v, nc, scales, b) != VDSH_OK) {
+        bad = 1;
+    } else {
+        for (size_t k = 0; k < v; k++) {
+            vdsh_stream_decode(&st, (uint32_t)k, out);
+            for (uint32_t i = 0; i < nc; i++) {
+                int levels = vdsh_quant_levels(enc, i);
+                float step = vdsh_quant_step(scales[i], levels), c = src[k * nc + i];
+                float tol = 0.5f * step * (1.0f + 1e-6f) + (float)levels * step * 1e-7f +
+                            128.0f * float_of(1);
+                bad += !isfinite(out[i]) || fabsf(out[i] - c) > tol ||
+                       (c == 0.0f && out[i] != 0.0f);
+                if (scales[i] > 0.0f && fabsf(c) == scales[i])
+                    bad += out[i] != (c > 0.0f ? 1.0f : -1.0f) * (float)levels * step;
+            }
+        }
+    }
+    if (bad) {
+        fprintf(stderr, "%s:%d: %s order %u %s: %ld values off\n", __FILE__, __LINE__,
+                vdsh_encoding_name(enc), order, what, bad);
+        failures++;
+    }
+    free(src);
+    free(b);
+}
+
 /* The s8 quantiser's hard cases (VDSH.md, COEF). */
 static void test_encode_s8(void)
 {
@@ -880,9 +945,11 @@ static void test_encode_s8(void)
     static float c[V * NC];
     int8_t b[V * NC];
     float sc[NC];
+    (void)check_quant_roundtrip;
     /* all zero: scales 0, bytes 0, decoded 0 */
     memset(c, 0, sizeof c);
     check_s8_roundtrip(c, V, NC, "all zero");
+    check_quant_roundtrip(VDSH_ENCODING_S8S6, c, V, 5, "s8s6 all zero");
     /* huge and tiny magnitudes, per index, side by side */
     for (int k = 0; k < V * NC; k++) {
         float u = rndf(-1.0f, 1.0f);
@@ -899,6 +966,25 @@ static void test_encode_s8(void)
     check_s8_roundtrip(c, V, NC, "huge and tiny");
     check_s8_roundtrip(c, V, 9, "order 3 view");
     check_s8_roundtrip(c, 1, NC, "one vertex");
+    for (uint32_t o = 1; o <= 5; o++) {
+        check_quant_roundtrip(VDSH_ENCODING_S8, c, V, o, "s8 decoded");
+        check_quant_roundtrip(VDSH_ENCODING_S8S6, c, V, o, "s8s6 huge and tiny");
+    }
+    /* s8s6 rounds bands 2+ to 31 levels: at scale 31, step 1 */
+    {
+        float r6[9 * 2] = {0, 0, 0, 0, 30.5f, 2.5f, -2.5f, 0.49f, -0.51f,
+                           0, 0, 0, 0, 31.0f, 31.0f, 31.0f, 31.0f, -31.0f};
+        uint8_t p6[16];
+        CHECK(vdsh_encode_quantised(VDSH_ENCODING_S8S6, r6, 2, 9, sc, p6) == VDSH_OK &&
+              sc[4] == 31.0f && sc[0] == 0.0f);
+        /* vertex 0's word: 31 (30.5, ties away), 3, -3, 0, -1 in fields
+         * 0..4; vertex 1's: 31, 31, 31, 31, -31 */
+        uint32_t w0 = rd32(p6 + 4), w1 = rd32(p6 + 12);
+        CHECK(w0 == (31u | 3u << 6 | 61u << 12 | 0u << 18 | 63u << 24));
+        CHECK(w1 == (31u | 31u << 6 | 31u << 12 | 31u << 18 | 33u << 24));
+        CHECK(rd32(p6) == 0 && rd32(p6 + 8) == 0);
+    }
+    CHECK(vdsh_encode_quantised(VDSH_ENCODING_F16, c, V, NC, sc, b) == VDSH_ERR_ARGUMENT);
     /* round to nearest, ties away from zero, at scale 127 (step 1) */
     float r[8] = {127.0f, 2.5f, -2.5f, 0.49f, -0.51f, 126.5f, -127.0f, 1e-30f};
     CHECK(vdsh_encode_s8(r, 8, 1, sc, b) == VDSH_OK && sc[0] == 127.0f);
@@ -928,7 +1014,8 @@ static void test_names(void)
     CHECK(!strcmp(vdsh_encoding_name(0), "f32"));
     CHECK(!strcmp(vdsh_encoding_name(1), "f16"));
     CHECK(!strcmp(vdsh_encoding_name(2), "s8"));
-    CHECK(!strcmp(vdsh_encoding_name(3), "?"));
+    CHECK(!strcmp(vdsh_encoding_name(3), "s8s6"));
+    CHECK(!strcmp(vdsh_encoding_name(4), "?"));
     CHECK(!strcmp(vdsh_quantity_name(0), "distance"));
     CHECK(!strcmp(vdsh_quantity_name(1), "distance2"));
     CHECK(!strcmp(vdsh_quantity_name(2), "log-distance"));
@@ -1247,6 +1334,8 @@ static void test_s8_reading(void)
                VDSH_WINDOW_NONE, 0, 0.8f, 1);
     add_stream(&t, 3, VDSH_ENCODING_S8, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_SHADOW,
                VDSH_WINDOW_NONE, 0, 1.1f, 1);
+    add_stream(&t, 3, VDSH_ENCODING_S8S6, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_LSQ,
+               VDSH_WINDOW_NONE, 0, 0, 1);
     void *mem = NULL;
     size_t n = 0;
     vdsh_error err;
@@ -1256,6 +1345,9 @@ static void test_s8_reading(void)
     /* 48-byte header, 25 scales + 12 bytes of padding, 4 x 25 bytes */
     CHECK(coef && rd64(d + coef - 8) == 48 + 112 + 4 * 25);
     CHECK(coef1 && rd64(d + coef1 - 8) == 48 + 48 + 4 * 9);
+    size_t coef2 = payload_of(d, n, "COEF", 2);
+    /* s8s6 order 3: 4 bytes and one word per vertex */
+    CHECK(coef2 && rd64(d + coef2 - 8) == 48 + 48 + 4 * 8);
     vdsh_file *f = NULL;
     CHECK_RES(vdsh_read_memory(d, n, "s.vdsh", &f, &err), VDSH_OK, &err);
     if (f) {
@@ -1287,6 +1379,18 @@ static void test_s8_reading(void)
     expect_patched(d, n, coef + 48 + 112 + 30, "\x80", 1, 1, VDSH_ERR_INVALID,
                    "vertex 1 coefficient 5 is -128", __LINE__);
     expect_patched(d, n, coef + 48 + 112 + 30, "\x81", 1, 1, VDSH_OK, NULL, __LINE__);
+    /* s8s6: vertex 1's word (fields 4..8), a byte, the table */
+    size_t w1 = coef2 + 48 + 48 + 8 + 4;
+    PATCH32(w1, 32u << 6, 1, VDSH_ERR_INVALID, "vertex 1 coefficient 5 is -32 (s8s6 stores -31..31");
+    PATCH32(w1, 1u << 30, 1, VDSH_ERR_INVALID, "vertex 1: unused bits of packed word 0");
+    PATCH32(w1, 1u << 31, 1, VDSH_ERR_INVALID, "unused bits");
+    PATCH32(w1, 0x3fffffffu, 1, VDSH_OK, NULL);   /* every field -1 */
+    PATCH32(w1, 31u | 33u << 24, 1, VDSH_OK, NULL); /* 31 and -31 */
+    expect_patched(d, n, w1 - 4, "\x80", 1, 1, VDSH_ERR_INVALID, "vertex 1 coefficient 0 is -128",
+                   __LINE__);
+    PATCHF(coef2 + 48 + 16, 1e38f, VDSH_OK, NULL);
+    PATCHF(coef2 + 48 + 16, FLT_MAX, VDSH_ERR_INVALID, "31 steps overflow");
+    PATCHF(coef2 + 28, 0.5f, VDSH_ERR_INVALID, "must be 1 for s8s6");
     free(mem);
     sample_free(&t);
 }
@@ -1424,7 +1528,7 @@ static void test_rules(void)
     PATCH32(coef0 + 0, 6, 1, VDSH_ERR_INVALID, "order 6");
     PATCH32(coef0 + 0, 0, 1, VDSH_ERR_INVALID, "order 0");
     PATCH32(coef0 + 0, 1, 1, VDSH_ERR_CHUNK, "need 16");
-    PATCH32(coef0 + 4, 3, 1, VDSH_ERR_INVALID, "encoding 3");
+    PATCH32(coef0 + 4, 4, 1, VDSH_ERR_INVALID, "encoding 4");
     /* f32 -> s8: 16 bytes of table and 32 of data make 48, not 32 + 16 */
     PATCH32(coef0 + 4, 2, 1, VDSH_ERR_CHUNK, "of s8 need 32");
     PATCH32(coef0 + 4, 1, 1, VDSH_ERR_CHUNK, "need 32");
@@ -1800,7 +1904,8 @@ static void test_writer_checks(void)
     REJECT("streams is NULL", s_.f.streams = NULL);
     REJECT("order 0", s_.streams[0].order = 0);
     REJECT("order 6", s_.streams[1].order = 6);
-    REJECT("encoding 3", s_.streams[0].encoding = 3);
+    REJECT("encoding 4", s_.streams[0].encoding = 4);
+    REJECT("s8s6 without coef_scales", s_.streams[0].encoding = VDSH_ENCODING_S8S6);
     REJECT("s8 without coef_scales", s_.streams[0].encoding = VDSH_ENCODING_S8);
     REJECT("quantity 3", s_.streams[0].quantity = 3);
     REJECT("window 3", s_.streams[0].window = 3);

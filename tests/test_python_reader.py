@@ -9,11 +9,12 @@ network, Debian's pip and setuptools), imports it from there, and checks:
   tests/corpus/vdsh: both readers accept or both refuse; where both accept,
   the fields vdsh-info --json prints agree (counts, bake parameters,
   streams, coefficient 0's min/max/mean, statistics);
-- corruption sweeps: a small good file (f16, and s8) with one byte changed
+- corruption sweeps: a small good file (f16, s8, s8s6) with one byte changed
   (xor 0x55) at 400 evenly spread offsets: both readers accept and refuse
   the same files (a changed byte anywhere must be refused: CRCs);
-- the s8 bake against the f16 one: every coefficient within half its
-  index's step (plus f16 rounding), scales the largest |c| per index;
+- the s8 and s8s6 bakes against the f16 one: every coefficient within
+  half its index's step (plus f16 rounding), scales the largest |c| per
+  index;
 - reconstruction: for the default bake's order-5 log stream, distances
   toward 64 directions at 50 vertices equal exp of the SH sum clamped to
   max_distance, and lie in (0, max_distance].
@@ -121,7 +122,9 @@ for name, args in (("default", []), ("paper-f32", ["--method", "paper", "--encod
                    ("hann", ["--method", "lsq", "--window", "hann"]),
                    ("timings", ["--record-timings", "--orders", "3"]),
                    ("s8", ["--encoding", "s8"]),
-                   ("s8-small", ["--encoding", "s8", "--orders", "3"])):
+                   ("s8-small", ["--encoding", "s8", "--orders", "3"]),
+                   ("s8s6", ["--encoding", "s8s6"]),
+                   ("s8s6-small", ["--encoding", "s8s6", "--orders", "3,5"])):
     out = os.path.join(work, name + ".vdsh")
     r = subprocess.run([bake, "builtin:room", "--max-edge", "1.5", "--rays", "256", "-q",
                         "--cube-size", "0", "-o", out] + args, capture_output=True, text=True)
@@ -136,7 +139,7 @@ print("corpus: %d files, %d accepted by both" % (len(corpus), accepted))
 
 # Corruption sweeps on the smallest baked files (f16, and s8 with its
 # scale table).
-for small in ("timings", "s8-small"):
+for small in ("timings", "s8-small", "s8s6-small"):
     good = os.path.join(work, small + ".vdsh")
     data = open(good, "rb").read()
     bad = os.path.join(work, "bad.vdsh")
@@ -154,18 +157,22 @@ for small in ("timings", "s8-small"):
     if refused != 400:
         fail.append("%s: a changed byte was accepted (%d of 400 refused)" % (small, refused))
 
-# s8 against f16 of the same bake: each coefficient within half its step
-# (scale_i / 254) plus f16's own rounding (relative 2^-11 of its scale).
-f16, s8 = baked.get("default"), baked.get("s8")
-if f16 and s8:
-    for a, b in zip(f16.streams, s8.streams):
+# s8 and s8s6 against f16 of the same bake: each coefficient within half
+# its step (scale_i / (2 levels_i)) plus f16's own rounding (relative 2^-11
+# of its scale).
+f16 = baked.get("default")
+for enc in ("s8", "s8s6"):
+    q = baked.get(enc)
+    if not (f16 and q):
+        continue
+    for a, b in zip(f16.streams, q.streams):
         ca, cb = vdsh.coefficients(a).astype(np.float64), vdsh.coefficients(b).astype(np.float64)
-        tol = b["coef_scales"] / 254.0 * (1 + 1e-5) + a["scale"] * 2.0 ** -11
-        if b["encoding"] != "s8" or not (np.abs(ca - cb) <= tol).all():
-            fail.append("s8 order %d: not within half a step of f16" % b["order"])
+        tol = b["coef_scales"] / (2.0 * b["levels"]) * (1 + 1e-5) + a["scale"] * 2.0 ** -11
+        if b["encoding"] != enc or not (np.abs(ca - cb) <= tol).all():
+            fail.append("%s order %d: not within half a step of f16" % (enc, b["order"]))
         if not np.allclose(b["coef_scales"], np.abs(ca).max(axis=0), rtol=1e-3,
                            atol=a["scale"] * 2.0 ** -11):
-            fail.append("s8 order %d: scales are not the largest |c| per index" % b["order"])
+            fail.append("%s order %d: scales are not the largest |c| per index" % (enc, b["order"]))
 
 f = baked.get("default")
 if f:
@@ -182,6 +189,6 @@ if f:
 
 for m in fail:
     print("FAIL:", m)
-print("python reader: %d files compared, %s" % (len(baked) + len(corpus) + 800,
+print("python reader: %d files compared, %s" % (len(baked) + len(corpus) + 1200,
                                                   "agrees with the C reader" if not fail else "DISAGREES"))
 sys.exit(1 if fail else 0)

@@ -7,7 +7,7 @@
  *             each), one receiver per direction, drawn as points from a
  *             camera at the light: each pixel holds one receiver's d_V,
  *             d_L and s. Orders 2 and 3 (vertex stage), order 5 with the
- *             basis cubemaps and with polynomials, f16, f32 and s8, smooth
+ *             basis cubemaps and with polynomials, f16, f32, s8 and s8s6, smooth
  *             and binary, quantities distance, distance^2, log-distance.
  *             Because every direction is a texel centre, the cubemap path
  *             must match to the half-float precision of the basis values:
@@ -27,12 +27,13 @@
  *             against vdsh_shadow_interior, so the vertex's distance is
  *             clamped to the file's max distance as the definition says,
  *             and the light does not leak across the triangle.
- * The f32 and s8 files of "vertex" and "fragment" have a max distance (2)
+ * The f32, s8 and s8s6 files of "vertex" and "fragment" have a max distance (2)
  * that clamps a good share of their distances, so every path is also
  * checked where the clamp acts; the f16 files keep 100, which clamps
- * almost none. The s8 files are drawn with the same tolerances: their
- * coefficients reach the shader as exact integers times the per-index
- * step, the products vdsh_stream_decode computes.
+ * almost none. The s8 and s8s6 files are drawn with the same tolerances:
+ * their coefficients reach the shader as exact integers (s8s6's unpacked
+ * there from its words) times the per-index step, the products
+ * vdsh_stream_decode computes.
  */
 #include "test_runtime_util.h"
 
@@ -60,9 +61,10 @@ static float to_distance(uint32_t q, float md, float sum)
 }
 
 /* The encodings every test draws, and their names in messages. */
-enum { NENC = 3 };
-static const uint32_t ENC[NENC] = {VDSH_ENCODING_F16, VDSH_ENCODING_F32, VDSH_ENCODING_S8};
-static const char *const ENC_NAME[NENC] = {"f16", "f32", "s8"};
+enum { NENC = 4 };
+static const uint32_t ENC[NENC] = {VDSH_ENCODING_F16, VDSH_ENCODING_F32, VDSH_ENCODING_S8,
+                                   VDSH_ENCODING_S8S6};
+static const char *const ENC_NAME[NENC] = {"f16", "f32", "s8", "s8s6"};
 
 /* The max distance of the files of encoding enc (see the top). */
 static float file_max_distance(uint32_t enc)
@@ -214,7 +216,7 @@ static void test_vertex(const char *dir)
         rt_file_bounds(f);
         add_all_streams(f, &rng, ENC[e]);
         char path[512];
-        if (rt_file_write(f, dir, (const char *const[]){"star16", "star32", "star8"}[e], path, sizeof path)) {
+        if (rt_file_write(f, dir, (const char *const[]){"star16", "star32", "star8", "star86"}[e], path, sizeof path)) {
             CHECK(0, "cannot write %s", path);
             return;
         }

@@ -92,8 +92,9 @@ static inline void rt_file_bounds(rt_file *r)
 /* Add a stream whose coefficients coef (vertex-major, order^2 each, taken
  * over) are stored in `enc`: f16 as coef / scale rounded (coef is then
  * replaced by what the file really holds, so references use the exact
- * stored values), f32 as coef / scale too (scale need not be 1), s8 by
- * vdsh_encode_s8 (scale ignored: 1; coef replaced as for f16). */
+ * stored values), f32 as coef / scale too (scale need not be 1), s8 and
+ * s8s6 by vdsh_encode_quantised (scale ignored: 1; coef replaced by the
+ * decoded values as for f16). */
 static inline void rt_file_add_stream(rt_file *r, uint32_t order, uint32_t enc, uint32_t quantity,
                                float *coef, float scale)
 {
@@ -114,18 +115,19 @@ static inline void rt_file_add_stream(rt_file *r, uint32_t order, uint32_t enc, 
             coef[k] = vdsh_f32_from_f16(d[k]) * scale;
         }
         r->data[i] = d;
-    } else if (enc == VDSH_ENCODING_S8) {
-        /* vdsh_encode_s8 picks the scales (scale must be 1) */
-        float *d = malloc(VDSH_MAX_COEFFS * sizeof(float) + n + 1);
-        int8_t *b = (int8_t *)(d + VDSH_MAX_COEFFS);
-        if (vdsh_encode_s8(coef, r->f.header.vertex_count, order * order, d, b) != VDSH_OK)
+    } else if (vdsh_encoding_quantised(enc)) {
+        /* vdsh_encode_quantised picks the scales (scale must be 1) */
+        uint32_t nv = r->f.header.vertex_count, nc = order * order;
+        float *d = malloc(VDSH_MAX_COEFFS * sizeof(float) + nv * vdsh_encoding_bytes(enc, nc) + 1);
+        uint8_t *b = (uint8_t *)(d + VDSH_MAX_COEFFS);
+        if (vdsh_encode_quantised(enc, coef, nv, nc, d, b) != VDSH_OK)
             abort();
         s->scale = 1.0f;
         s->coef_scales = d;
-        for (size_t k = 0; k < n; k++)
-            coef[k] = (float)b[k] * vdsh_s8_step(d[k % (order * order)]);
-        r->data[i] = d;
         s->data = b;
+        for (uint32_t v = 0; v < nv; v++)
+            vdsh_stream_decode(s, v, coef + (size_t)v * nc);
+        r->data[i] = d;
         r->coef[i] = coef;
         return;
     } else {

@@ -53,7 +53,9 @@ typedef struct vb_job_desc {
      * streams, in increasing order. */
     vb_bake_desc bake;
     int f32;                   /* 1: f32 coefficients; 0: f16 (default) */
-    int s8;                    /* 1: s8 coefficients (VDSH.md COEF); f32 then 0 */
+    /* a compact encoding (VDSH.md COEF): VDSH_ENCODING_S8 or _S8S6; 0: none
+     * (f16 or f32 as `f32` says; f32 must be 0 with one) */
+    uint32_t compact;
     int cube_size;             /* basis cubemap face; 0: 64; < 0: none */
     int record_timings;        /* store the timings in the file */
     /* A shard (vdsh-bake --shard I/N): shard_count 0 is the whole bake;

@@ -54,7 +54,7 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encod
     if (order < 1 || order > VDSH_MAX_ORDER || !b->coeffs[order])
         return vb_fail(err, VB_ERR_ARGUMENT, "order %d is not in the bake", order);
     if (encoding != VDSH_ENCODING_F16 && encoding != VDSH_ENCODING_F32 &&
-        encoding != VDSH_ENCODING_S8)
+        !vdsh_encoding_quantised(encoding))
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown encoding %u", encoding);
     const vb_method_info *mi = vb_method_stored(b->method);
     if (!mi)
@@ -76,17 +76,19 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encod
                            order);
         memcpy(f, b->coeffs[order], count * sizeof *f);
         s.data = f;
-    } else if (encoding == VDSH_ENCODING_S8) {
+    } else if (vdsh_encoding_quantised(encoding)) {
         /* One block: the scale table (order^2 floats), then the bytes. */
-        float *block = malloc(VDSH_MAX_COEFFS * sizeof(float) + count + 1);
+        size_t bytes_n = (size_t)b->vertex_count * vdsh_encoding_bytes(encoding, (uint32_t)nc);
+        float *block = malloc(VDSH_MAX_COEFFS * sizeof(float) + bytes_n + 1);
         if (!block)
             return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the order %d stream",
                            order);
-        int8_t *bytes = (int8_t *)(block + VDSH_MAX_COEFFS);
-        if (vdsh_encode_s8(b->coeffs[order], b->vertex_count, (uint32_t)nc, block, bytes) !=
-            VDSH_OK) {
+        uint8_t *bytes = (uint8_t *)(block + VDSH_MAX_COEFFS);
+        if (vdsh_encode_quantised(encoding, b->coeffs[order], b->vertex_count, (uint32_t)nc,
+                                  block, bytes) != VDSH_OK) {
             free(block);
-            return vb_fail(err, VB_ERR_INVALID, "order %d coefficients are not finite", order);
+            return vb_fail(err, VB_ERR_INVALID, "order %d coefficients do not fit %s", order,
+                           vdsh_encoding_name(encoding));
         }
         s.coef_scales = block;
         s.data = bytes;

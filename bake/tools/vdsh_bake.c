@@ -121,9 +121,10 @@ static void usage(FILE *f)
 "  -o, --output FILE       the .vdsh file to write (atomically)\n"
 "      --cubemap-dir DIR   where the SH basis cubemaps go (default: beside OUT)\n"
 "      --cube-size N       cubemap face size in texels (default 64; 0: none)\n"
-"      --encoding E        coefficient encoding: f16 (default), f32, or s8 (signed\n"
+"      --encoding E        coefficient encoding: f16 (default), f32, s8 (signed\n"
 "                          8-bit with a scale per coefficient index: 25 bytes\n"
-"                          per vertex at order 5; docs/ACCURACY.md)\n"
+"                          per vertex at order 5) or s8s6 (bands 2+ in 6 bits:\n"
+"                          8 bytes at order 3, 24 at order 5); docs/ACCURACY.md\n"
 "      --shard I/N         bake shard I (0-based) of N only and write a part\n"
 "                          file; vdsh-merge joins the N parts into the file\n"
 "                          the whole bake writes, byte for byte\n"
@@ -501,7 +502,8 @@ int main(int argc, char **argv)
             if (strcmp(optarg, "f16") == 0) o.encoding = VDSH_ENCODING_F16;
             else if (strcmp(optarg, "f32") == 0) o.encoding = VDSH_ENCODING_F32;
             else if (strcmp(optarg, "s8") == 0) o.encoding = VDSH_ENCODING_S8;
-            else return bad_usage("--encoding takes f16, f32 or s8, not '%s'", optarg);
+            else if (strcmp(optarg, "s8s6") == 0) o.encoding = VDSH_ENCODING_S8S6;
+            else return bad_usage("--encoding takes f16, f32, s8 or s8s6, not '%s'", optarg);
             break;
         case O_MAXDIST:
             if (!parse_float(optarg, &o.max_distance) || o.max_distance == 0.0f)
@@ -623,7 +625,7 @@ int main(int argc, char **argv)
                  .keep_normals = o.keep_normals, .trace_only = o.trace_only,
                  .progress = on_progress, .progress_user = &pr},
         .f32 = o.encoding == VDSH_ENCODING_F32,
-        .s8 = o.encoding == VDSH_ENCODING_S8,
+        .compact = vdsh_encoding_quantised(o.encoding) ? o.encoding : 0,
         .cube_size = o.cube_size > 0 ? o.cube_size : -1,
         .record_timings = o.record_timings,
         .shard_index = shard_index, .shard_count = shard_count,

@@ -249,16 +249,17 @@ int main(int argc, char **argv)
             free(merged[s]);
             merged[s] = NULL;
             streams[s].data = encoded[s];
-        } else if (p0->part.encoding == VDSH_ENCODING_S8) {
-            /* As vb_bake_stream: the one s8 quantiser, vdsh_encode_s8. */
-            streams[s].encoding = VDSH_ENCODING_S8;
+        } else if (vdsh_encoding_quantised(p0->part.encoding)) {
+            /* As vb_bake_stream: the one quantiser, vdsh_encode_quantised. */
+            uint32_t e = p0->part.encoding;
+            streams[s].encoding = e;
             streams[s].scale = 1.0f;
             streams[s].coef_scales = s8_scales[s];
-            if (!(encoded[s] = malloc((size_t)V * nc + 1)) ||
-                vdsh_encode_s8(merged[s], V, (uint32_t)nc, s8_scales[s], encoded[s]) !=
+            if (!(encoded[s] = malloc((size_t)V * vdsh_encoding_bytes(e, (uint32_t)nc) + 1)) ||
+                vdsh_encode_quantised(e, merged[s], V, (uint32_t)nc, s8_scales[s], encoded[s]) !=
                     VDSH_OK) {
-                fprintf(stderr, "vdsh-merge: order %u coefficients do not fit s8\n",
-                        streams[s].order);
+                fprintf(stderr, "vdsh-merge: order %u coefficients do not fit %s\n",
+                        streams[s].order, vdsh_encoding_name(e));
                 goto out;
             }
             free(merged[s]);
