@@ -52,7 +52,7 @@ def accessor(g, binary, i):
     return [vals[k * n:(k + 1) * n] for k in range(a["count"])]
 
 
-scenes = [("room", "builtin:room", ["--rays", "64", "--orders", "2,3,5"]),
+scenes = [("room", "builtin:room", ["--rays", "64", "--orders", "2,3,5", "--encoding", "f16"]),
           ("room-s8", "builtin:room", ["--rays", "64", "--orders", "2,3,5", "--encoding", "s8"])]
 box = os.path.join(models, "glTF2", "BoxTextured-glTF-Binary", "BoxTextured.glb")
 if os.path.exists(box):

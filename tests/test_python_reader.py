@@ -4,8 +4,8 @@ against the C reader (tools/vdsh-info, formats/vdsh.c).
 Installs python/ with pip (--no-build-isolation --no-index, into WORK: no
 network, Debian's pip and setuptools), imports it from there, and checks:
 - the SH basis against formats/VDSH.md's table of values;
-- on files baked here (default, paper f32, lsq with the quantity chosen per
-  order, a Hann window, with --record-timings) and on every file of
+- on files baked here (default (s8s6), f16, s8, paper f32, lsq with the
+  quantity chosen per order, a Hann window, with --record-timings) and on every file of
   tests/corpus/vdsh: both readers accept or both refuse; where both accept,
   the fields vdsh-info --json prints agree (counts, bake parameters,
   streams, coefficient 0's min/max/mean, statistics);
@@ -120,7 +120,8 @@ baked = {}
 for name, args in (("default", []), ("paper-f32", ["--method", "paper", "--encoding", "f32"]),
                    ("lsq-auto", ["--method", "lsq", "--quantity", "auto"]),
                    ("hann", ["--method", "lsq", "--window", "hann"]),
-                   ("timings", ["--record-timings", "--orders", "3"]),
+                   ("timings", ["--record-timings", "--orders", "3", "--encoding", "f16"]),
+                   ("f16", ["--encoding", "f16"]),
                    ("s8", ["--encoding", "s8"]),
                    ("s8-small", ["--encoding", "s8", "--orders", "3"]),
                    ("s8s6", ["--encoding", "s8s6"]),
@@ -160,7 +161,7 @@ for small in ("timings", "s8-small", "s8s6-small"):
 # s8 and s8s6 against f16 of the same bake: each coefficient within half
 # its step (scale_i / (2 levels_i)) plus f16's own rounding (relative 2^-11
 # of its scale).
-f16 = baked.get("default")
+f16 = baked.get("f16")
 for enc in ("s8", "s8s6"):
     q = baked.get(enc)
     if not (f16 and q):

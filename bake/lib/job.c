@@ -110,8 +110,7 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
 /* The encoding of the whole bake's streams (a part's are f32 whatever it is). */
 static vdsh_encoding job_encoding(const vb_job_desc *d)
 {
-    return d->f32 ? VDSH_ENCODING_F32
-           : d->compact ? (vdsh_encoding)d->compact : VDSH_ENCODING_F16;
+    return d->encoding_given ? d->encoding : VB_DEFAULT_ENCODING;
 }
 
 vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
