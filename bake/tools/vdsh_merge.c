@@ -11,8 +11,8 @@
  * range vb_shard_range gives it. A refusal names the part (and, for
  * missing shards, their numbers). The coefficients are then copied range
  * by range and encoded as vdsh-bake encodes them (f16: scaled by the
- * stream's largest |coefficient|; s8: vdsh_encode_s8's scale per
- * coefficient index), the ray counts summed, and the file and
+ * stream's largest |coefficient|; s8, s8s6: vdsh_encode_quantised's scale
+ * per coefficient index), the ray counts summed, and the file and
  * its basis cubemaps written atomically.
  *
  * Memory: every part is read whole (the parts together are about the

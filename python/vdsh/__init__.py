@@ -5,7 +5,7 @@
     f.header["vertex_count"], f.positions (V x 3), f.normals, f.triangles (T x 3)
     s = f.streams[0]                   # dict: order, encoding, method, quantity, ...
     c = vdsh.coefficients(s)           # V x order^2 float32 (stored x scale;
-                                       # s8: stored x float32(scale_i / 127))
+                                       # s8, s8s6: stored x float32(scale_i / levels_i))
     d = vdsh.reconstruct(f, s, v, dirs)    # distances of vertex v toward unit dirs (N x 3)
 
 Every reading rule of the spec is checked; numpy only.
