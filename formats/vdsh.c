@@ -58,6 +58,7 @@ enum {
     STAT_SIZE = 32,
     TIME_SIZE = 64,
     PART_SIZE = 32,
+    ADPT_SIZE = 32,
     SOURCE_FIXED_SIZE = 44, /* sha256, size, name_length */
     MAX_CHUNKS = 64
 };
@@ -830,6 +831,27 @@ static int check_part(const vdsh_part *t, uint32_t vertex_count, why *w)
     return 1;
 }
 
+static int check_adaptive(const vdsh_adaptive *a, uint32_t vertex_count, why *w)
+{
+    if (!(a->tolerance >= 0.0f))
+        return bad(w, "adpt: tolerance %g is not a number >= 0", (double)a->tolerance);
+    if (!(a->min_edge > 0.0f) || !isfinite(a->min_edge))
+        return bad(w, "adpt: min_edge %g is not a finite number > 0", (double)a->min_edge);
+    if (a->lights < 1 || a->max_rounds < 1 || a->rounds > a->max_rounds)
+        return bad(w, "adpt: %u lights, %u of at most %u rounds", a->lights, a->rounds,
+                   a->max_rounds);
+    if (a->start_receivers > vertex_count || a->start_receivers < 1)
+        return bad(w, "adpt: started from %u receivers of %u", a->start_receivers,
+                   vertex_count);
+    if (a->max_receivers && vertex_count > a->max_receivers)
+        return bad(w, "adpt: %u receivers over the budget of %u", vertex_count,
+                   a->max_receivers);
+    if ((uint64_t)a->start_receivers + a->candidates < vertex_count)
+        return bad(w, "adpt: %u receivers from %u and %u midpoints", vertex_count,
+                   a->start_receivers, a->candidates);
+    return 1;
+}
+
 static int check_timings(const vdsh_timings *t, why *w)
 {
     const double v[5] = {t->load, t->refine, t->build, t->trace, t->total};
@@ -919,6 +941,8 @@ typedef struct layout {
     vdsh_timings timings;
     int has_part;
     vdsh_part part;
+    int has_adaptive;
+    vdsh_adaptive adaptive;
 } layout;
 
 typedef struct reader {
@@ -1249,6 +1273,27 @@ static vdsh_result read_time(const reader *r, const chunk_ref *c, layout *L)
     return VDSH_OK;
 }
 
+static vdsh_result read_adpt(const reader *r, const chunk_ref *c, layout *L)
+{
+    const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
+    why w;
+    if (c->size != ADPT_SIZE)
+        return fail(r->err, VDSH_ERR_CHUNK, r->name, "adpt: payload is %llu bytes, must be %d",
+                    (unsigned long long)c->size, ADPT_SIZE);
+    L->adaptive.tolerance = get_f32(p + 0);
+    L->adaptive.min_edge = get_f32(p + 4);
+    L->adaptive.max_receivers = get_u32(p + 8);
+    L->adaptive.lights = get_u32(p + 12);
+    L->adaptive.max_rounds = get_u32(p + 16);
+    L->adaptive.start_receivers = get_u32(p + 20);
+    L->adaptive.rounds = get_u32(p + 24);
+    L->adaptive.candidates = get_u32(p + 28);
+    if (!check_adaptive(&L->adaptive, L->header.vertex_count, &w))
+        return invalid(r, &w);
+    L->has_adaptive = 1;
+    return VDSH_OK;
+}
+
 static vdsh_result read_part(const reader *r, const chunk_ref *c, layout *L)
 {
     const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
@@ -1336,6 +1381,12 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
                              "chunk %u at offset %llu: a second time chunk",
                              i, (unsigned long long)c->offset)
                       : read_time(r, c, L);
+        } else if (memcmp(c->id, "adpt", 4) == 0) {
+            res = L->has_adaptive
+                      ? fail(r->err, VDSH_ERR_CHUNK, r->name,
+                             "chunk %u at offset %llu: a second adpt chunk",
+                             i, (unsigned long long)c->offset)
+                      : read_adpt(r, c, L);
         } else if (memcmp(c->id, "part", 4) == 0) {
             res = L->has_part
                       ? fail(r->err, VDSH_ERR_CHUNK, r->name,
@@ -1433,6 +1484,8 @@ static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name,
     f->timings = L.timings;
     f->has_part = L.has_part;
     f->part = L.part;
+    f->has_adaptive = L.has_adaptive;
+    f->adaptive = L.adaptive;
     *out = f;
     return VDSH_OK;
 }
@@ -1594,6 +1647,7 @@ typedef struct plan {
     uint8_t stat[STAT_SIZE];
     uint8_t time[TIME_SIZE];
     uint8_t part[PART_SIZE];
+    uint8_t adpt[ADPT_SIZE];
     uint8_t *srcs; /* malloc'd SRCS payload */
     out_chunk chunks[MAX_CHUNKS];
     uint32_t count;
@@ -1676,6 +1730,8 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
     if (f->has_timings && !check_timings(&f->timings, &w))
         return argument(err, name, &w);
     if (f->has_part && !check_part(&f->part, h->vertex_count, &w))
+        return argument(err, name, &w);
+    if (f->has_adaptive && !check_adaptive(&f->adaptive, h->vertex_count, &w))
         return argument(err, name, &w);
     return VDSH_OK;
 }
@@ -1800,6 +1856,18 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
         put_u32(p + 12, f->part.range_end);
         put_u32(p + 16, f->part.encoding);
         add_chunk(P, "part", p, PART_SIZE, NULL, 0);
+    }
+    if (f->has_adaptive) {
+        p = P->adpt;
+        put_f32(p + 0, f->adaptive.tolerance);
+        put_f32(p + 4, f->adaptive.min_edge);
+        put_u32(p + 8, f->adaptive.max_receivers);
+        put_u32(p + 12, f->adaptive.lights);
+        put_u32(p + 16, f->adaptive.max_rounds);
+        put_u32(p + 20, f->adaptive.start_receivers);
+        put_u32(p + 24, f->adaptive.rounds);
+        put_u32(p + 28, f->adaptive.candidates);
+        add_chunk(P, "adpt", p, ADPT_SIZE, NULL, 0);
     }
 
     /* Sizes are bounded by the checks above (2^28 vertices, 16 streams of

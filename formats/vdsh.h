@@ -224,6 +224,19 @@ typedef struct vdsh_part {
     uint32_t encoding;         /* vdsh_encoding of the merged file */
 } vdsh_part;
 
+/* Adaptive receivers (`adpt` chunk, VDSH.md): what refined the receivers
+ * (vdsh-bake --adaptive) and what it did. */
+typedef struct vdsh_adaptive {
+    float tolerance;           /* expected shadow error; >= 0, may be +inf */
+    float min_edge;            /* > 0, scene units */
+    uint32_t max_receivers;    /* the budget; 0: none */
+    uint32_t lights;           /* free-space lights scoring the error, >= 1 */
+    uint32_t max_rounds;       /* >= 1 */
+    uint32_t start_receivers;  /* the uniform mesh it started from (max_edge) */
+    uint32_t rounds;           /* rounds run */
+    uint32_t candidates;       /* midpoints baked, split or not */
+} vdsh_adaptive;
+
 typedef struct vdsh_file {
     vdsh_header header;
     uint32_t source_count;
@@ -239,6 +252,8 @@ typedef struct vdsh_file {
     vdsh_timings timings;
     int has_part;              /* `part` chunk present: a shard's part */
     vdsh_part part;
+    int has_adaptive;          /* `adpt` chunk present: adaptive receivers */
+    vdsh_adaptive adaptive;
     void *storage_;            /* owned memory; do not touch */
 } vdsh_file;
 

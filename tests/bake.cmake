@@ -52,3 +52,11 @@ add_test(NAME bake_shard_slurm
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard_slurm.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> ${PROJECT_SOURCE_DIR}/scripts)
 set_tests_properties(bake_shard_slurm PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 300)
+
+# Adaptive receivers (bake/lib/adaptive.h): promises and hard cases, under
+# every Embree ISA.
+add_executable(test_adaptive test_adaptive.c)
+target_link_libraries(test_adaptive PRIVATE vb_core)
+add_test(NAME bake_adaptive
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/with_each_isa.sh $<TARGET_FILE:vdsh-bake>
+                 $<TARGET_FILE:test_adaptive>)

@@ -34,6 +34,15 @@ for k in 09-12 13-16 17-20 21-24; do
   check "cubemaps identical between bakes" cmp -s "$tmp/a.sh$k.exr" "$tmp/b.sh$k.exr"
 done
 
+# Adaptive receivers: identical for 1 and 2 threads, recorded in the file.
+adaptive=(builtin:room --max-edge 1.5 --adaptive 0.08 --rays 256 -q)
+expect_exit 0 "adaptive, 1 thread" "$bake" "${adaptive[@]}" --threads 1 -o "$tmp/ad1.vdsh"
+expect_exit 0 "adaptive, 2 threads" "$bake" "${adaptive[@]}" --threads 2 -o "$tmp/ad2.vdsh"
+check "adaptive: 1 and 2 threads give identical files" cmp -s "$tmp/ad1.vdsh" "$tmp/ad2.vdsh"
+expect_exit 0 "vdsh-info --verify accepts an adaptive bake" "$info" --verify "$tmp/ad1.vdsh"
+"$info" "$tmp/ad1.vdsh" >"$tmp/adinfo.txt" 2>&1
+check "info shows the adaptive tolerance" grep -q "adaptive     tolerance 0.08, min edge 0.1875" "$tmp/adinfo.txt"
+
 # The file verifies and says what it is.
 expect_exit 0 "vdsh-info --verify accepts the bake" "$info" --verify "$tmp/a.vdsh"
 "$info" "$tmp/a.vdsh" >"$tmp/info.txt" 2>&1
@@ -87,6 +96,12 @@ expect_exit 2 "--log-offset with lsq" "$bake" builtin:room --method lsq --log-of
 expect_exit 2 "--log-offset out of range" "$bake" builtin:room --log-offset 7 -o "$tmp/x.vdsh"
 expect_exit 2 "--lambda with shadow" "$bake" builtin:room --lambda 1e-3 -o "$tmp/x.vdsh"
 expect_exit 2 "unknown option" "$bake" builtin:room --frobnicate -o "$tmp/x.vdsh"
+expect_exit 2 "--adaptive without --max-edge" "$bake" builtin:room --adaptive 0.1 -o "$tmp/x.vdsh"
+expect_exit 2 "--adaptive with a negative tolerance" "$bake" builtin:room --max-edge 1 --adaptive -1 -o "$tmp/x.vdsh"
+expect_exit 2 "--min-edge without --adaptive" "$bake" builtin:room --max-edge 1 --min-edge 0.1 -o "$tmp/x.vdsh"
+expect_exit 2 "--max-receivers without --adaptive" "$bake" builtin:room --max-edge 1 --max-receivers 9 -o "$tmp/x.vdsh"
+expect_exit 2 "--adaptive with --shard" "$bake" builtin:room --max-edge 1 --adaptive 0.1 --shard 0/2 -o "$tmp/x.vdsh"
+expect_exit 1 "--max-receivers below the start mesh" "$bake" builtin:room --max-edge 1 --adaptive 0.1 --max-receivers 9 -o "$tmp/x.vdsh"
 check "no output after usage errors" test ! -e "$tmp/x.vdsh"
 expect_exit 0 "--help" "$bake" --help
 check "--help shows usage" grep -q "Usage: vdsh-bake" "$tmp/out.txt"

@@ -410,6 +410,11 @@ static void sample_init(sample *s, int kind, uint32_t v)
         s->f.timings.trace = 351.75;
         s->f.timings.total = 353.2;
         s->f.timings.threads = 2;
+        s->f.has_adaptive = kind == 1;
+        s->f.adaptive = (vdsh_adaptive){.tolerance = 0.08f, .min_edge = 0.1f,
+                                        .max_receivers = 0, .lights = 32, .max_rounds = 8,
+                                        .start_receivers = 1, .rounds = 8,
+                                        .candidates = 100000};
     }
 }
 
@@ -511,6 +516,9 @@ static void check_same_file(const vdsh_file *got, const vdsh_file *want)
         CHECK(memcmp(&got->timings.total, &want->timings.total, 8) == 0);
         CHECK(got->timings.threads == want->timings.threads);
     }
+    CHECK(!!got->has_adaptive == !!want->has_adaptive);
+    if (want->has_adaptive)
+        CHECK(memcmp(&got->adaptive, &want->adaptive, sizeof got->adaptive) == 0);
 }
 
 /* ------------------------------------------------------------------ */
@@ -1872,6 +1880,16 @@ static void test_writer_checks(void)
     long_name[sizeof long_name - 1] = 0;
 
     REJECT("vertex_count 0", s_.f.header.vertex_count = 0);
+    REJECT("adpt: tolerance", s_.f.has_adaptive = 1, s_.f.adaptive.tolerance = NAN);
+    REJECT("adpt: tolerance", s_.f.has_adaptive = 1, s_.f.adaptive.tolerance = -0.5f);
+    REJECT("adpt: min_edge", s_.f.has_adaptive = 1, s_.f.adaptive.min_edge = 0.0f);
+    REJECT("adpt: min_edge", s_.f.has_adaptive = 1, s_.f.adaptive.min_edge = INFINITY);
+    REJECT("over the budget", s_.f.has_adaptive = 1, s_.f.adaptive.max_receivers = 3);
+    REJECT("adpt: started from", s_.f.has_adaptive = 1, s_.f.adaptive.start_receivers = 0);
+    REJECT("adpt: started from", s_.f.has_adaptive = 1, s_.f.adaptive.start_receivers = 5);
+    REJECT("rounds", s_.f.has_adaptive = 1, s_.f.adaptive.rounds = 9);
+    REJECT("lights", s_.f.has_adaptive = 1, s_.f.adaptive.lights = 0);
+    REJECT("midpoints", s_.f.has_adaptive = 1, s_.f.adaptive.candidates = 0);
     REJECT("triangle_count", s_.f.header.triangle_count = (1u << 28) + 1);
     REJECT("rays", s_.f.header.rays = 0);
     REJECT("sampling", s_.f.header.sampling = 2);

@@ -476,11 +476,11 @@ static int part_views(void)
             CHECK(v->set_count == 2 && v->light_count[0] == 1 && v->light_count[1] == 3,
                   "view %s: sets of 1 and 3 lights", v->name);
             if (i > 0)
-                CHECK(vb_eval_free_space(s.occ, v->camera.eye), "view %s: eye in free space",
+                CHECK(vb_scene_free_space(s.occ, v->camera.eye), "view %s: eye in free space",
                       v->name);
             for (int k = 0; k < v->set_count; k++)
                 for (int l = 0; l < v->light_count[k]; l++)
-                    CHECK(vb_eval_free_space(s.occ, v->lights[k][l]),
+                    CHECK(vb_scene_free_space(s.occ, v->lights[k][l]),
                           "view %s: light %d of set %d in free space", v->name, l, k);
             if (i == 0)
                 continue;

@@ -240,6 +240,14 @@ static void print_summary(const char *path, const vdsh_file *f,
                "origins moved %u, normals flipped %u\n", t->degenerate_receivers,
                t->undefined_normals, t->moved_origins, t->flipped_normals);
     }
+    if (f->has_adaptive) {
+        const vdsh_adaptive *a = &f->adaptive;
+        printf("  adaptive     tolerance %g, min edge %g, budget %u (0: none), %u lights\n"
+               "               %u receivers from %u in %u of at most %u rounds, %u midpoints "
+               "baked\n", a->tolerance, a->min_edge, a->max_receivers, a->lights,
+               f->header.vertex_count, a->start_receivers, a->rounds, a->max_rounds,
+               a->candidates);
+    }
     if (f->has_timings) {
         const vdsh_timings *t = &f->timings;
         printf("  timings      load %.3f s, refine %.3f s, build %.3f s, "
@@ -333,6 +341,17 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
         vt_json_null(&j, root, "stats");
     }
 
+    if (f->has_adaptive) {
+        cJSON *ad = vt_json_object(&j, root, "adaptive");
+        vt_json_f32(&j, ad, "tolerance", f->adaptive.tolerance);
+        vt_json_f32(&j, ad, "min_edge", f->adaptive.min_edge);
+        vt_json_u64(&j, ad, "max_receivers", f->adaptive.max_receivers);
+        vt_json_u64(&j, ad, "lights", f->adaptive.lights);
+        vt_json_u64(&j, ad, "max_rounds", f->adaptive.max_rounds);
+        vt_json_u64(&j, ad, "start_receivers", f->adaptive.start_receivers);
+        vt_json_u64(&j, ad, "rounds", f->adaptive.rounds);
+        vt_json_u64(&j, ad, "candidates", f->adaptive.candidates);
+    }
     if (f->has_timings) {
         const vdsh_timings *t = &f->timings;
         cJSON *tm = vt_json_object(&j, root, "timings");

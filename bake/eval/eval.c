@@ -410,57 +410,6 @@ static void eval_progress(void *user, uint32_t done, uint32_t total)
     J->d->progress(J->d->progress_user, done, total);
 }
 
-/* ---- scene lights --------------------------------------------------------- */
-
-int vb_eval_free_space(const vb_scene *s, const float p[3])
-{
-    float dirs[VDSH_FREE_PROBES][3], t[VDSH_FREE_PROBES];
-    int back[VDSH_FREE_PROBES];
-    vdsh_free_probe_dirs(dirs);
-    float o[3];
-    vb_scene_to_local(s, p, o);
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    for (int i = 0; i < VDSH_FREE_PROBES; i++) {
-        struct RTCRayHit rh;
-        rh.ray.org_x = o[0], rh.ray.org_y = o[1], rh.ray.org_z = o[2];
-        rh.ray.dir_x = dirs[i][0], rh.ray.dir_y = dirs[i][1], rh.ray.dir_z = dirs[i][2];
-        rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.time = 0.0f;
-        rh.ray.mask = 0xffffffffu, rh.ray.id = 0, rh.ray.flags = 0;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(s->scene, &ctx, &rh);
-        int hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-        t[i] = hit ? rh.ray.tfar / s->scale : INFINITY;
-        back[i] = hit && rh.hit.Ng_x * dirs[i][0] + rh.hit.Ng_y * dirs[i][1] +
-                                 rh.hit.Ng_z * dirs[i][2] > 0.0f;
-    }
-    return vdsh_free_space(t, back, vdsh_free_clearance(s->diagonal));
-}
-
-vb_result vb_eval_place_lights(const vb_scene *s, uint64_t seed, uint32_t count,
-                               float (*out)[3], uint32_t *tried, vb_error *err)
-{
-    /* Give up when a thousand candidates per light find no room: a scene
-     * without free space (a solid, or everything closer than clearance). */
-    uint32_t n = 0, k = 0;
-    const uint64_t limit = 1000ull * (count ? count : 1);
-    while (n < count && k < limit) {
-        float p[3];
-        vdsh_light_candidate(s->bounds_min, s->bounds_max, seed, k++, p);
-        if (vb_eval_free_space(s, p))
-            memcpy(out[n++], p, sizeof out[0]);
-    }
-    if (tried)
-        *tried = k;
-    if (n < count)
-        return vb_fail(err, VB_ERR_INVALID,
-                       "no free space for lights: %u of %u candidates in the scene's bounds "
-                       "were inside solids or nearer than %g to a surface",
-                       k, k, (double)vdsh_free_clearance(s->diagonal));
-    return VB_OK;
-}
-
 /* ---- public pieces ------------------------------------------------------- */
 
 void vb_eval_interpolate(const vdsh_file *f, const vdsh_stream *s, uint32_t tri,
@@ -1059,7 +1008,7 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the scene lights");
             goto done;
         }
-        r = vb_eval_place_lights(d.scene, purpose_seed(d.seed, PURPOSE_SCENE_LIGHTS), nl,
+        r = vb_scene_place_lights(d.scene, purpose_seed(d.seed, PURPOSE_SCENE_LIGHTS), nl,
                                  o.lights, &o.light_candidates, err);
         if (r != VB_OK)
             goto done;

@@ -306,17 +306,6 @@ int vb_eval_interior_point(const double *cdf, uint32_t triangle_count,
  * malloc'ed; NULL when out of memory). *total gets the total area. */
 double *vb_eval_area_cdf(const vdsh_file *f, double *total);
 
-/* `count` lights placed uniformly in the free space of scene s
- * (vdsh_light.h): the candidates of the sequence `seed` that pass, in
- * order. *tried (may be NULL) gets how many candidates were drawn. Fails
- * (VB_ERR_INVALID) when 1000 candidates per light are not enough. */
-vb_result vb_eval_place_lights(const vb_scene *s, uint64_t seed, uint32_t count,
-                               float (*out)[3], uint32_t *tried, vb_error *err);
-
-/* Whether p (scene units) is in the free space of scene s: vdsh_light.h's
- * rule, its probes cast with Embree. The test vb_eval_place_lights applies
- * to every candidate (vdsh-frames applies it to eyes too). */
-int vb_eval_free_space(const vb_scene *s, const float p[3]);
 
 /* The held-out directions of receiver `id` (a vertex index, or
  * VB_EVAL_INTERIOR_ID(j) for interior point j) with unit normal n: the

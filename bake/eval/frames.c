@@ -683,7 +683,7 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
-    r = vb_eval_place_lights(occ, purpose_seed(d.seed, PURPOSE_LIGHTS), LIGHT_POOL, pool, NULL,
+    r = vb_scene_place_lights(occ, purpose_seed(d.seed, PURPOSE_LIGHTS), LIGHT_POOL, pool, NULL,
                              err);
     if (r != VB_OK)
         goto done;
@@ -721,7 +721,7 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
         st.eyes_tried++;
         float eye[3];
         vdsh_light_candidate(occ->bounds_min, occ->bounds_max, eye_seed, k, eye);
-        if (!vb_eval_free_space(occ, eye))
+        if (!vb_scene_free_space(occ, eye))
             continue;
         st.eyes_free++;
         float u1, u2;

@@ -40,7 +40,7 @@
  * kept when a low-resolution frame shows no surface nearer than 5% of the
  * diagonal and, for each light, at least VB_FRAMES_MIN_SHARE of the
  * frame's pixels lit and as many hard-shadowed. Lights come from one pool
- * placed in free space (vb_eval_place_lights). Everything is a function of
+ * placed in free space (vb_scene_place_lights). Everything is a function of
  * the seed.
  *
  * Does not: read or write files (vdsh-frames does, with tools/), know GL.

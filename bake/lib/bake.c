@@ -409,6 +409,17 @@ float vb_shadow_log_offset(int order)
 /* ---- choosing the quantity (VB_QUANTITY_AUTO) --------------------------- */
 
 #define CHOOSE_RECEIVERS 1024
+
+/* How many receivers the choice samples, and the i-th of them. */
+static uint32_t choose_count(uint32_t receivers)
+{
+    return receivers < CHOOSE_RECEIVERS ? receivers : CHOOSE_RECEIVERS;
+}
+
+static uint32_t choose_receiver(uint32_t i, uint32_t receivers, uint32_t count)
+{
+    return (uint32_t)((uint64_t)i * receivers / count);
+}
 #define CHOOSE_STRIDE VDSH_COEFFS_THROUGH(VDSH_MAX_ORDER) /* coefficients of orders 1..max */
 
 /* Where order o starts among one sample's coefficients of one quantity. */
@@ -475,7 +486,7 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
         buf = NULL;
     }
     for (uint32_t i = begin; i < end && buf; i++) {
-        uint32_t v = (uint32_t)((uint64_t)i * nrec / J->choose_count), count = 0;
+        uint32_t v = choose_receiver(i, nrec, J->choose_count), count = 0;
         float c[2][VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS];
         vertex_sink out = {.x = buf, .y = buf + cap, .z = buf + 2 * cap, .t = buf + 3 * cap,
                            .n = &count};
@@ -506,7 +517,7 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
                    (VDSH_ORDER_SLOTS) * 2 * sizeof(double));
     else /* their coefficients are kept: the main pass skips them */
         for (uint32_t i = begin; i < end; i++)
-            J->done[(uint64_t)i * nrec / J->choose_count] = 1;
+            J->done[choose_receiver(i, nrec, J->choose_count)] = 1;
     atomic_fetch_add(&J->traced, traced);
     atomic_fetch_add(&J->missed, missed);
     atomic_fetch_add(&J->degenerate, degenerate);
@@ -572,6 +583,15 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     }
     if (!choose && !(mi->quantities & VB_QUANTITY_BIT(stored)))
         return vb_fail(err, VB_ERR_ARGUMENT, "%s", mi->refused[stored]);
+    if (d.order_quantity) {
+        choose = 0;
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            if ((d.order_mask & (1u << o) || o == d.max_order) &&
+                (d.order_quantity[o] > VDSH_QUANTITY_LOG_DISTANCE ||
+                 !(mi->quantities & VB_QUANTITY_BIT(d.order_quantity[o]))))
+                return vb_fail(err, VB_ERR_ARGUMENT, "order %d: quantity %u is not the method's", o,
+                               (unsigned)d.order_quantity[o]);
+    }
     if (d.lambda == 0.0f)
         d.lambda = VB_DEFAULT_LAMBDA;
     if (!(d.lambda > 0.0f) || !isfinite(d.lambda))
@@ -623,6 +643,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     if (r != VB_OK)
         return r;
     float *origins = malloc((size_t)R->vertex_count * 3 * sizeof *origins);
+    uint8_t *need = NULL; /* vb_receivers_prepare's, for a range */
     float *near = malloc((size_t)R->vertex_count * sizeof *near + 1);
     float *coeffs[VDSH_ORDER_SLOTS] = {0};
     /* Oriented receivers: a copy of their normals, turned toward free
@@ -647,22 +668,38 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             goto done;
         vb_fit_window(&J->fits[o], d.window);
     }
-    vb_origins_stats ost = {0};
-    uint32_t flipped = 0;
-    r = vb_receivers_prepare(R, d.scene, d.threads, normals, &flipped, origins, near, &ost, err);
-    if (r != VB_OK)
-        goto done;
-    if (normals) {
-        oriented.normals = normals;
-        d.receivers = R = &oriented;
-    }
-
     J->lo = d.range_begin;
     J->hi = d.range_end ? d.range_end : R->vertex_count;
     if (J->lo >= J->hi || J->hi > R->vertex_count) {
         r = vb_fail(err, VB_ERR_ARGUMENT, "receiver range %u..%u is not within 0..%u",
                     d.range_begin, d.range_end, R->vertex_count);
         goto done;
+    }
+    /* A range: only its receivers, and the quantity choice's sample, are
+     * oriented and given origins (counted: the range's). */
+    if (J->lo > 0 || J->hi < R->vertex_count) {
+        if (!(need = calloc((size_t)R->vertex_count + 1, 1))) {
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
+                        R->vertex_count);
+            goto done;
+        }
+        memset(need + J->lo, VB_NEED_COUNT, J->hi - J->lo);
+        uint32_t samples = choose && !d.trace_only ? choose_count(R->vertex_count) : 0;
+        for (uint32_t i = 0; i < samples; i++) {
+            uint32_t v = choose_receiver(i, R->vertex_count, samples);
+            if (!need[v])
+                need[v] = VB_NEED_ONLY;
+        }
+    }
+    vb_origins_stats ost = {0};
+    uint32_t flipped = 0;
+    r = vb_receivers_prepare(R, d.scene, d.threads, need, normals, &flipped, origins, near,
+                             &ost, err);
+    if (r != VB_OK)
+        goto done;
+    if (normals) {
+        oriented.normals = normals;
+        d.receivers = R = &oriented;
     }
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) /* outside a shard's range */
         if (coeffs[o] && (J->lo > 0 || J->hi < R->vertex_count))
@@ -707,8 +744,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
          * distances of a sample of receivers with the lower expected
          * shadow error; sums in sample order, so the choice does not
          * depend on the thread count. */
-        auto_receivers = J->choose_count =
-            R->vertex_count < CHOOSE_RECEIVERS ? R->vertex_count : CHOOSE_RECEIVERS;
+        auto_receivers = J->choose_count = choose_count(R->vertex_count);
         J->choose_error = calloc((size_t)J->choose_count * (VDSH_ORDER_SLOTS) * 2,
                                  sizeof(double));
         J->choose_coeffs = malloc((size_t)J->choose_count * 2 * CHOOSE_STRIDE * sizeof(float));
@@ -734,7 +770,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         }
         /* The sampled receivers are baked: keep the chosen fits. */
         for (uint32_t i = 0; i < J->choose_count; i++) {
-            uint32_t v = (uint32_t)((uint64_t)i * R->vertex_count / J->choose_count);
+            uint32_t v = choose_receiver(i, R->vertex_count, J->choose_count);
             const float *keep = J->choose_coeffs + (size_t)i * 2 * CHOOSE_STRIDE;
             for (int o = 1; o <= VDSH_MAX_ORDER; o++)
                 if (coeffs[o] && J->done[v] && v >= J->lo && v < J->hi)
@@ -745,7 +781,8 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         }
     } else {
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-            J->quantity[o] = choose ? VDSH_QUANTITY_DISTANCE : stored;
+            J->quantity[o] = d.order_quantity ? d.order_quantity[o]
+                             : choose ? VDSH_QUANTITY_DISTANCE : stored;
     }
     unsigned started = vb_parallel_for(d.threads, R->vertex_count, BLOCK, bake_block, J,
                                        d.progress ? bake_progress : NULL, J);
@@ -802,6 +839,7 @@ done:
     free(origins);
     free(near);
     free(normals);
+    free(need);
     vb_dirgrid_destroy(&grid);
     return r;
 }

@@ -101,6 +101,10 @@ typedef struct vb_bake_desc {
     float max_distance;        /* clamp; 0: the occluders' bbox diagonal */
     vb_method method;          /* method.h; 0: shadow (the default) */
     vb_quantity quantity;      /* method.h; 0: auto (the default) */
+    /* Per order (index 1..VDSH_MAX_ORDER): the quantity it stores, over
+     * `quantity` (adaptive receivers bake later rounds with the first
+     * round's choice); NULL: as `quantity` says. */
+    const vdsh_quantity *order_quantity;
     float lambda;              /* lsq and shadow regularisation; 0: 1e-4 */
     const float *log_offsets;  /* method shadow: per order (index 1..5), added
                                 * to the fitted ln d; NULL: vb_shadow_log_offset */

@@ -99,8 +99,20 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
     }
     bd.receivers = &j->receivers;
     bd.scene = j->scene;
-    if ((r = vb_bake_run(&bd, &j->bake, err)) != VB_OK)
+    if (d->adaptive) {
+        if (d->shard_count)
+            return vb_fail(err, VB_ERR_ARGUMENT,
+                           "adaptive receivers cannot be sharded yet (the refinement bakes "
+                           "as it decides): bake them in one process");
+        vb_mesh fine = {0};
+        r = vb_bake_adaptive(&bd, &j->receivers, &d->adapt, &fine, &j->bake, &j->adaptive, err);
+        if (r != VB_OK)
+            return r;
+        vb_mesh_free(&j->receivers);
+        j->receivers = fine;
+    } else if ((r = vb_bake_run(&bd, &j->bake, err)) != VB_OK) {
         return r;
+    }
     j->timings.trace = j->bake.seconds;
     j->timings.threads = j->bake.threads;
     j->timings.total = vb_now() - j->t_start;
@@ -142,6 +154,17 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
     h->max_distance = b->max_distance;
     h->max_edge = d->max_edge;
     h->offset_rule = VDSH_OFFSET_WB_AVG;
+    if (d->adaptive) {
+        f.has_adaptive = 1;
+        f.adaptive = (vdsh_adaptive){.tolerance = d->adapt.tolerance,
+                                     .min_edge = d->adapt.min_edge,
+                                     .max_receivers = d->adapt.max_receivers,
+                                     .lights = j->adaptive.lights,
+                                     .max_rounds = j->adaptive.max_rounds,
+                                     .start_receivers = j->adaptive.start_receivers,
+                                     .rounds = j->adaptive.rounds,
+                                     .candidates = j->adaptive.candidates};
+    }
     h->load_flags = d->weld ? VDSH_LOAD_WELD : 0;
     h->cube_size = (uint32_t)vb_job_cube_size(d);
     h->occluder_vertex_count = j->occluders.vertex_count;

@@ -31,6 +31,7 @@
 #include <pthread.h>
 #include <stdint.h>
 
+#include "adaptive.h"
 #include "bake.h"
 #include "cubemap.h"
 #include "mesh.h"
@@ -51,7 +52,10 @@ typedef struct vb_job_desc {
     const char *output;        /* the .vdsh file; NULL: none (vb_job_write refuses) */
     const char *cubemap_dir;   /* NULL: beside output */
     int weld;                  /* vb_load_desc.weld */
-    float max_edge;            /* receivers refined to it; 0: the vertices as they are */
+    float max_edge;            /* receivers refined to it; 0: the vertices as they are.
+                                * With adaptive: where the refinement starts */
+    int adaptive;              /* 1: adaptive receivers (adaptive.h) from there */
+    vb_adaptive_desc adapt;
     int fast_traversal;        /* 0: Embree's robust traversal (default) */
     /* The bake (receivers and scene are the job's). Its orders give the
      * streams, in increasing order. */
@@ -87,6 +91,7 @@ typedef struct vb_job {
     vdsh_file file;            /* filled by vb_bake_fill_file (borrows the above) */
     uint64_t file_bytes;       /* the written file's size (vb_job_write) */
     vdsh_timings timings;
+    vb_adaptive_stats adaptive; /* with d->adaptive */
     double t_start;
     /* The basis cubemaps' helper thread. */
     pthread_t basis_thread;

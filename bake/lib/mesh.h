@@ -258,6 +258,17 @@ void vb_mesh_compute_normals(vb_mesh *m);
 vb_result vb_mesh_refine(const vb_mesh *in, float max_edge, vb_mesh *out,
                          vb_error *err);
 
+/* One level of chosen splits (adaptive receivers): split each edge
+ * {pairs[2i], pairs[2i+1]} (vertex numbers of `in`) at its midpoint, both
+ * its triangles (conforming), as vb_mesh_refine splits. The new vertex of
+ * pair i is number in->vertex_count + i, its normal interpolated as there;
+ * every other vertex keeps its number. A non-manifold edge (a refused
+ * triangle's copy, coincident faces) is split in every triangle on it.
+ * Errors: VB_ERR_ARGUMENT for a pair that is not an edge or is listed
+ * twice; VB_ERR_INVALID for an index out of range. */
+vb_result vb_mesh_split_edges(const vb_mesh *in, const uint32_t *pairs, uint32_t count,
+                              vb_mesh *out, vb_error *err);
+
 /* Write as OBJ (v, vn, f with v//vn; no vn when normals == NULL), with
  * enough digits (%.9g) that reading it back gives the same floats.
  * Atomically: a temporary file in the same directory, renamed over `path`

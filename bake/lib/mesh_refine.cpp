@@ -171,60 +171,18 @@ void normalize3(float *n)
         n[k] = len > 0.0 && std::isfinite(len) ? (float)(n[k] / len) : 0.0f;
 }
 
-vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
+/* The half-edge mesh of `in`: its vertices, then private copies of the
+ * vertices of each triangle the half-edge structure refuses (as OpenMesh's
+ * ImporterT); copy_of maps them back, kept counts the faces added. */
+vb_result build_mesh(const vb_mesh *in, om_mesh &m, std::vector<uint32_t> &copy_of, uint64_t &kept,
+                     vb_error *err)
 {
     const uint32_t n = in->vertex_count;
-    const double limit2 = (double)max_edge * (double)max_edge;
-
-    /* Input checks: the mesh may come from anywhere, not only a loader. */
-    if (n > refine_max_vertices)
-        return vb_fail(err, VB_ERR_ARGUMENT, "refine: the mesh has %u vertices; refinement handles at most %llu", n,
-                       (unsigned long long)refine_max_vertices);
-    for (uint64_t i = 0; i < 3 * (uint64_t)n; i++)
-        if (!std::isfinite(in->positions[i]))
-            return vb_fail(err, VB_ERR_INVALID, "refine: vertex %llu has a non-finite coordinate",
-                           (unsigned long long)(i / 3));
-    double area = 0.0;
-    for (uint64_t t = 0; t < in->triangle_count; t++) {
-        const uint32_t *tri = in->indices + 3 * t;
-        for (int k = 0; k < 3; k++)
-            if (tri[k] >= n)
-                return vb_fail(err, VB_ERR_INVALID, "refine: triangle %llu: index %u out of range (%u vertices)",
-                               (unsigned long long)t, tri[k], n);
-        const float *a = in->positions + 3 * (size_t)tri[0];
-        const float *b = in->positions + 3 * (size_t)tri[1];
-        const float *c = in->positions + 3 * (size_t)tri[2];
-        double u[3], v[3];
-        for (int k = 0; k < 3; k++) {
-            u[k] = (double)b[k] - a[k];
-            v[k] = (double)c[k] - a[k];
-        }
-        double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2], cz = u[0] * v[1] - u[1] * v[0];
-        area += 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
-    }
-    /* No triangle with all edges <= max_edge is larger than the equilateral
-     * one: a lower bound on the faces needed, checked before any work. */
-    double min_faces = area / (std::sqrt(3.0) / 4.0 * limit2);
-    if (min_faces > 2.0 * (double)refine_max_vertices)
-        return vb_fail(err, VB_ERR_ARGUMENT,
-                       "refine: max_edge %g is too small for this mesh (surface area %g needs over %.3g triangles; "
-                       "the limit is %llu vertices)",
-                       (double)max_edge, area, min_faces, (unsigned long long)refine_max_vertices);
-
-    om_mesh m;
-    /* Longest-edge bisection ends with about 1.3 - 2.3 vertices per
-     * max_edge^2 of area: reserve for the upper end. */
-    size_t est_v = (size_t)std::min<double>((double)n + 2.5 * area / limit2, (double)refine_max_vertices);
-    m.reserve(est_v, est_v * 3, est_v * 2);
-
-    /* Build. A triangle the half-edge structure refuses gets private copies
-     * of its vertices (as OpenMesh's ImporterT); `copy_of` maps them back. */
     for (uint32_t i = 0; i < n; i++) {
         const float *p = in->positions + 3 * (size_t)i;
         m.add_vertex(om_mesh::Point(p[0], p[1], p[2]));
     }
-    std::vector<uint32_t> copy_of;
-    uint64_t kept = 0;
+    kept = 0;
     for (uint64_t t = 0; t < in->triangle_count; t++) {
         const uint32_t *tri = in->indices + 3 * t;
         if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
@@ -247,61 +205,17 @@ vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
         }
         kept++;
     }
+
+    return VB_OK;
+}
+
+/* The output mesh of m, built from `in` (n vertices, copies copy_of) with
+ * new vertices from `parents` (two per vertex added after the copies). */
+vb_result emit_mesh(const vb_mesh *in, const om_mesh &m, const std::vector<uint32_t> &copy_of,
+                    const std::vector<uint32_t> &parents, vb_mesh *out, vb_error *err)
+{
+    const uint32_t n = in->vertex_count;
     const uint64_t first_new = (uint64_t)n + copy_of.size();
-
-    /* Longest edge first. Each entry's length is checked again when it is
-     * taken: an entry whose edge has changed since it was queued (the
-     * change queued it again) or that is short enough is skipped, never
-     * split. OpenMesh's LongestEdgeT splits whatever it pops on the queued
-     * length alone. (Here, as there, every edge is queued once per length,
-     * so in practice entries do not go stale: on the meshes measured both
-     * split the same edges. The check makes it a guarantee.) */
-    std::priority_queue<edge_entry, std::vector<edge_entry>, edge_order> queue;
-    for (om_mesh::EdgeHandle e : m.edges()) {
-        double l2 = edge_len2(m, e);
-        if (l2 > limit2)
-            queue.push(edge_entry{l2, e.idx()});
-    }
-    std::vector<uint32_t> parents;   /* two per new vertex: the split edge's ends */
-    uint64_t faces_added = 0;
-    while (!queue.empty()) {
-        edge_entry top = queue.top();
-        queue.pop();
-        om_mesh::EdgeHandle e(top.edge);
-        double l2 = edge_len2(m, e);
-        if (l2 != top.len2 || l2 <= limit2)
-            continue;
-        if (m.n_vertices() - copy_of.size() >= refine_max_vertices)
-            return vb_fail(err, VB_ERR_ARGUMENT, "refine: max_edge %g would need more than %llu vertices",
-                           (double)max_edge, (unsigned long long)refine_max_vertices);
-        om_mesh::HalfedgeHandle h = m.halfedge_handle(e, 0);
-        om_mesh::VertexHandle a = m.from_vertex_handle(h), b = m.to_vertex_handle(h);
-        const om_mesh::Point pa = m.point(a), pb = m.point(b);
-        om_mesh::Point mid((pa[0] + pb[0]) * 0.5f, (pa[1] + pb[1]) * 0.5f, (pa[2] + pb[2]) * 0.5f);
-        /* Far from the origin with a tiny max_edge, float midpoints stop
-         * halving edges (one lands on an end, the other keeps the whole
-         * length) and refinement would never end. Each half must be clearly
-         * shorter (at most 90% of the edge; exactly 50% when the spacing of
-         * floats is small against the edge). */
-        if (!(dist2(pa, mid) <= 0.81 * l2 && dist2(mid, pb) <= 0.81 * l2))
-            return vb_fail(err, VB_ERR_ARGUMENT,
-                           "refine: max_edge %g is below float precision at (%g, %g, %g)",
-                           (double)max_edge, (double)pa[0], (double)pa[1], (double)pa[2]);
-        faces_added += m.is_boundary(e) ? 1 : 2;
-        om_mesh::VertexHandle vm = m.add_vertex(mid);
-        parents.push_back((uint32_t)a.idx());
-        parents.push_back((uint32_t)b.idx());
-        m.split(e, vm);
-        for (om_mesh::EdgeHandle ve : m.ve_range(vm)) {
-            double nl2 = edge_len2(m, ve);
-            if (nl2 > limit2)
-                queue.push(edge_entry{nl2, ve.idx()});
-        }
-    }
-    if (m.n_faces() != kept + faces_added)
-        return vb_fail(err, VB_ERR_INVALID, "refine: internal error: %zu faces, expected %llu",
-                       (size_t)m.n_faces(), (unsigned long long)(kept + faces_added));
-
     /* Output numbering: originals keep theirs, copies map back, and new
      * vertices follow in creation order. An original edge that a copied
      * triangle shares has been split once per copy: those midpoints sit at
@@ -371,6 +285,181 @@ vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
     return VB_OK;
 }
 
+
+vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
+{
+    const uint32_t n = in->vertex_count;
+    const double limit2 = (double)max_edge * (double)max_edge;
+
+    /* Input checks: the mesh may come from anywhere, not only a loader. */
+    if (n > refine_max_vertices)
+        return vb_fail(err, VB_ERR_ARGUMENT, "refine: the mesh has %u vertices; refinement handles at most %llu", n,
+                       (unsigned long long)refine_max_vertices);
+    for (uint64_t i = 0; i < 3 * (uint64_t)n; i++)
+        if (!std::isfinite(in->positions[i]))
+            return vb_fail(err, VB_ERR_INVALID, "refine: vertex %llu has a non-finite coordinate",
+                           (unsigned long long)(i / 3));
+    double area = 0.0;
+    for (uint64_t t = 0; t < in->triangle_count; t++) {
+        const uint32_t *tri = in->indices + 3 * t;
+        for (int k = 0; k < 3; k++)
+            if (tri[k] >= n)
+                return vb_fail(err, VB_ERR_INVALID, "refine: triangle %llu: index %u out of range (%u vertices)",
+                               (unsigned long long)t, tri[k], n);
+        const float *a = in->positions + 3 * (size_t)tri[0];
+        const float *b = in->positions + 3 * (size_t)tri[1];
+        const float *c = in->positions + 3 * (size_t)tri[2];
+        double u[3], v[3];
+        for (int k = 0; k < 3; k++) {
+            u[k] = (double)b[k] - a[k];
+            v[k] = (double)c[k] - a[k];
+        }
+        double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2], cz = u[0] * v[1] - u[1] * v[0];
+        area += 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
+    }
+    /* No triangle with all edges <= max_edge is larger than the equilateral
+     * one: a lower bound on the faces needed, checked before any work. */
+    double min_faces = area / (std::sqrt(3.0) / 4.0 * limit2);
+    if (min_faces > 2.0 * (double)refine_max_vertices)
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "refine: max_edge %g is too small for this mesh (surface area %g needs over %.3g triangles; "
+                       "the limit is %llu vertices)",
+                       (double)max_edge, area, min_faces, (unsigned long long)refine_max_vertices);
+
+    om_mesh m;
+    /* Longest-edge bisection ends with about 1.3 - 2.3 vertices per
+     * max_edge^2 of area: reserve for the upper end. */
+    size_t est_v = (size_t)std::min<double>((double)n + 2.5 * area / limit2, (double)refine_max_vertices);
+    m.reserve(est_v, est_v * 3, est_v * 2);
+
+    vb_result r = VB_OK;
+    std::vector<uint32_t> copy_of;
+    uint64_t kept = 0;
+    if ((r = build_mesh(in, m, copy_of, kept, err)) != VB_OK)
+        return r;
+
+    /* Longest edge first. Each entry's length is checked again when it is
+     * taken: an entry whose edge has changed since it was queued (the
+     * change queued it again) or that is short enough is skipped, never
+     * split. OpenMesh's LongestEdgeT splits whatever it pops on the queued
+     * length alone. (Here, as there, every edge is queued once per length,
+     * so in practice entries do not go stale: on the meshes measured both
+     * split the same edges. The check makes it a guarantee.) */
+    std::priority_queue<edge_entry, std::vector<edge_entry>, edge_order> queue;
+    for (om_mesh::EdgeHandle e : m.edges()) {
+        double l2 = edge_len2(m, e);
+        if (l2 > limit2)
+            queue.push(edge_entry{l2, e.idx()});
+    }
+    std::vector<uint32_t> parents;   /* two per new vertex: the split edge's ends */
+    uint64_t faces_added = 0;
+    while (!queue.empty()) {
+        edge_entry top = queue.top();
+        queue.pop();
+        om_mesh::EdgeHandle e(top.edge);
+        double l2 = edge_len2(m, e);
+        if (l2 != top.len2 || l2 <= limit2)
+            continue;
+        if (m.n_vertices() - copy_of.size() >= refine_max_vertices)
+            return vb_fail(err, VB_ERR_ARGUMENT, "refine: max_edge %g would need more than %llu vertices",
+                           (double)max_edge, (unsigned long long)refine_max_vertices);
+        om_mesh::HalfedgeHandle h = m.halfedge_handle(e, 0);
+        om_mesh::VertexHandle a = m.from_vertex_handle(h), b = m.to_vertex_handle(h);
+        const om_mesh::Point pa = m.point(a), pb = m.point(b);
+        om_mesh::Point mid((pa[0] + pb[0]) * 0.5f, (pa[1] + pb[1]) * 0.5f, (pa[2] + pb[2]) * 0.5f);
+        /* Far from the origin with a tiny max_edge, float midpoints stop
+         * halving edges (one lands on an end, the other keeps the whole
+         * length) and refinement would never end. Each half must be clearly
+         * shorter (at most 90% of the edge; exactly 50% when the spacing of
+         * floats is small against the edge). */
+        if (!(dist2(pa, mid) <= 0.81 * l2 && dist2(mid, pb) <= 0.81 * l2))
+            return vb_fail(err, VB_ERR_ARGUMENT,
+                           "refine: max_edge %g is below float precision at (%g, %g, %g)",
+                           (double)max_edge, (double)pa[0], (double)pa[1], (double)pa[2]);
+        faces_added += m.is_boundary(e) ? 1 : 2;
+        om_mesh::VertexHandle vm = m.add_vertex(mid);
+        parents.push_back((uint32_t)a.idx());
+        parents.push_back((uint32_t)b.idx());
+        m.split(e, vm);
+        for (om_mesh::EdgeHandle ve : m.ve_range(vm)) {
+            double nl2 = edge_len2(m, ve);
+            if (nl2 > limit2)
+                queue.push(edge_entry{nl2, ve.idx()});
+        }
+    }
+    if (m.n_faces() != kept + faces_added)
+        return vb_fail(err, VB_ERR_INVALID, "refine: internal error: %zu faces, expected %llu",
+                       (size_t)m.n_faces(), (unsigned long long)(kept + faces_added));
+
+    return emit_mesh(in, m, copy_of, parents, out, err);
+}
+
+/* vb_mesh_split_edges: one level of chosen splits. */
+vb_result split_edges(const vb_mesh *in, const uint32_t *pairs, uint32_t count, vb_mesh *out,
+                      vb_error *err)
+{
+    const uint32_t n = in->vertex_count;
+    for (uint64_t t = 0; t < 3 * (uint64_t)in->triangle_count; t++)
+        if (in->indices[t] >= n)
+            return vb_fail(err, VB_ERR_INVALID, "split: triangle %llu: index %u out of range (%u vertices)",
+                           (unsigned long long)(t / 3), in->indices[t], n);
+    om_mesh m;
+    m.reserve((size_t)n + count, 3 * ((size_t)in->triangle_count + 2 * (size_t)count),
+              (size_t)in->triangle_count + 2 * (size_t)count);
+    std::vector<uint32_t> copy_of;
+    uint64_t kept = 0;
+    vb_result r = build_mesh(in, m, copy_of, kept, err);
+    if (r != VB_OK)
+        return r;
+    /* Every half-edge structure edge by its ends' input numbers (a shared
+     * edge of copied triangles, or of coincident ones, is several). */
+    auto number = [&](om_mesh::VertexHandle v) {
+        size_t i = (size_t)v.idx();
+        return i < n ? (uint32_t)i : copy_of[i - n];
+    };
+    auto key_of = [](uint32_t a, uint32_t b) { return (uint64_t)std::min(a, b) << 32 | std::max(a, b); };
+    std::vector<std::pair<uint64_t, int>> edges;
+    edges.reserve(m.n_edges());
+    for (om_mesh::EdgeHandle e : m.edges()) {
+        om_mesh::HalfedgeHandle h = m.halfedge_handle(e, 0);
+        edges.emplace_back(key_of(number(m.from_vertex_handle(h)), number(m.to_vertex_handle(h))), e.idx());
+    }
+    std::sort(edges.begin(), edges.end());
+    std::vector<uint32_t> parents;
+    uint64_t faces_added = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        uint32_t a = pairs[2 * i], b = pairs[2 * i + 1];
+        uint64_t key = key_of(a, b);
+        auto it = std::lower_bound(edges.begin(), edges.end(), std::make_pair(key, -1));
+        if (a == b || it == edges.end() || it->first != key)
+            return vb_fail(err, VB_ERR_ARGUMENT, "split: pair %u (%u, %u) is not an edge of the mesh", i, a, b);
+        if (i > 0 && key == key_of(pairs[2 * i - 2], pairs[2 * i - 1]))
+            return vb_fail(err, VB_ERR_ARGUMENT, "split: edge (%u, %u) listed twice", a, b);
+        for (; it != edges.end() && it->first == key; ++it) {
+            om_mesh::EdgeHandle e(it->second);
+            om_mesh::HalfedgeHandle h = m.halfedge_handle(e, 0);
+            om_mesh::VertexHandle va = m.from_vertex_handle(h), vb = m.to_vertex_handle(h);
+            const om_mesh::Point pa = m.point(va), pb = m.point(vb);
+            om_mesh::Point mid((pa[0] + pb[0]) * 0.5f, (pa[1] + pb[1]) * 0.5f, (pa[2] + pb[2]) * 0.5f);
+            faces_added += m.is_boundary(e) ? 1 : 2;
+            om_mesh::VertexHandle vm = m.add_vertex(mid);
+            parents.push_back((uint32_t)va.idx());
+            parents.push_back((uint32_t)vb.idx());
+            m.split(e, vm);
+        }
+    }
+    if (m.n_faces() != kept + faces_added)
+        return vb_fail(err, VB_ERR_INVALID, "split: internal error: %zu faces, expected %llu",
+                       (size_t)m.n_faces(), (unsigned long long)(kept + faces_added));
+    r = emit_mesh(in, m, copy_of, parents, out, err);
+    if (r == VB_OK && out->vertex_count != n + count) { /* an edge listed twice, out of order */
+        vb_mesh_free(out);
+        return vb_fail(err, VB_ERR_ARGUMENT, "split: %u edges gave %u new vertices (an edge listed twice?)",
+                       count, out->vertex_count - n);
+    }
+    return r;
+}
+
 /* max_edge <= 0: a plain copy (also of meshes with repeated indices). */
 vb_result copy_mesh(const vb_mesh *in, vb_mesh *out, vb_error *err)
 {
@@ -423,5 +512,27 @@ extern "C" vb_result vb_mesh_refine(const vb_mesh *in, float max_edge, vb_mesh *
         return vb_fail(err, VB_ERR_INVALID, "refine: OpenMesh failed: %s", e.what());
     } catch (...) {
         return vb_fail(err, VB_ERR_INVALID, "refine: OpenMesh failed with an unknown exception");
+    }
+}
+
+extern "C" vb_result vb_mesh_split_edges(const vb_mesh *in, const uint32_t *pairs, uint32_t count,
+                                         vb_mesh *out, vb_error *err)
+{
+    if (!in || !out || (count && !pairs))
+        return vb_fail(err, VB_ERR_ARGUMENT, "vb_mesh_split_edges: NULL argument");
+    if ((in->vertex_count && (!in->positions || !in->normals)) || (in->triangle_count && !in->indices))
+        return vb_fail(err, VB_ERR_ARGUMENT, "split: mesh has counts but no arrays");
+    if ((uint64_t)in->vertex_count + count > refine_max_vertices)
+        return vb_fail(err, VB_ERR_ARGUMENT, "split: more than %llu vertices",
+                       (unsigned long long)refine_max_vertices);
+    try {
+        openmesh_session session;
+        return split_edges(in, pairs, count, out, err);
+    } catch (const std::bad_alloc &) {
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "split: out of memory");
+    } catch (const std::exception &e) {
+        return vb_fail(err, VB_ERR_INVALID, "split: OpenMesh failed: %s", e.what());
+    } catch (...) {
+        return vb_fail(err, VB_ERR_INVALID, "split: OpenMesh failed with an unknown exception");
     }
 }

@@ -436,15 +436,18 @@ typedef struct origin_job {
     const vb_mesh *m;
     const frames *F;
     float *out;
+    const uint8_t *need;        /* vb_receivers_prepare's; NULL: all */
     prober P;
     _Atomic uint32_t moved, flagged, ties;
     _Atomic uint64_t rays;
 } origin_job;
 
-static void repair_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
+/* What repairing one receiver did (bits). */
+enum { REPAIR_MOVED = 1, REPAIR_FLAGGED = 2, REPAIR_TIE = 4 };
+
+/* Probe receiver v's origin J->out[v] and repair it if it must be. */
+static unsigned repair_one(origin_job *J, uint32_t v, uint64_t *rays)
 {
-    origin_job *J = ctx;
-    (void)worker;
     const vb_mesh *m = J->m;
     const frames *F = J->F;
     const float scale = J->P.s->scale;
@@ -454,82 +457,93 @@ static void repair_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
      * spread over it: the cost stays bounded at any valence. */
     static const float steps[6] = {0.05f, 0.15f, 0.35f, 0.6f, 0.8f, 0.95f};
     enum { FAN = VB_REPAIR_CANDIDATES / 6 };
+    const float *n = m->normals + 3 * (size_t)v;
+    if (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f)
+        return 0;
+    float *o = J->out + 3 * (size_t)v;
+    const float near = F->near[v] * scale;
+    short_result sr, csr, best_sr = {0, 0, 0};
+    int tie_seen = 0;
+    int state = origin_state(&J->P, m, F, v, o, n, near, &sr, &tie_seen, rays);
+    if (state == ORIGIN_FREE)
+        return tie_seen ? REPAIR_TIE : 0;
+    if (state == ORIGIN_PRESSED) {
+        /* Pressed flat against a surface it faces: no point of its own
+         * surface is free, and the true distances are ~0. The origin
+         * just behind its own surface gives exactly that, instead of
+         * one pushed through the other surface. */
+        standard_origin(J->P.s, m, F, v, -1.0f, o);
+        return REPAIR_FLAGGED | REPAIR_TIE | REPAIR_MOVED;
+    }
+    const float *p = m->positions + 3 * (size_t)v;
+    float best[3] = {o[0], o[1], o[2]}, cand[3], first[3] = {0, 0, 0};
+    int found = 0, have = 0;
+    uint32_t a0 = F->adj_start[v], fan = F->adj_start[v + 1] - a0;
+    uint32_t picks = fan < FAN ? fan : FAN;
+    for (int st = 0; st < 6 && !found; st++)
+        for (uint32_t i = 0; i < picks && !found; i++) {
+            uint32_t a = a0 + (uint32_t)((uint64_t)i * fan / picks);
+            const uint32_t *ix = m->indices + 3 * (size_t)F->adj[a];
+            float q[3], ql[3];
+            for (int c = 0; c < 3; c++) {
+                double ctr = ((double)m->positions[3 * (size_t)ix[0] + c] +
+                              m->positions[3 * (size_t)ix[1] + c] +
+                              m->positions[3 * (size_t)ix[2] + c]) / 3.0;
+                q[c] = (float)(p[c] + steps[st] * (ctr - p[c]));
+            }
+            vb_scene_to_local(J->P.s, q, ql);
+            vb_offset_origin(ql, F->navg + 3 * (size_t)v, cand);
+            int cs = origin_state(&J->P, m, F, v, cand, n, near, &csr, &tie_seen, rays);
+            found = cs != ORIGIN_REPAIR;
+            if (cs == ORIGIN_PRESSED) /* its face lies on another: see above */
+                standard_origin(J->P.s, m, F, v, -1.0f, cand);
+            if (found) { /* in free space, or pressed: take it */
+                memcpy(best, cand, sizeof best);
+            } else if (!have || worse_short(best_sr, csr)) {
+                memcpy(first, cand, sizeof first);
+                best_sr = csr;
+                have = 1;
+            }
+        }
+    if (!found) {
+        /* The least bad of: where it is, the best candidate, and the
+         * origin just behind its own surface (a face pressed against
+         * another without coincident faces, one buried in a solid).
+         * Ties keep the earlier. */
+        badness bb = full_badness(&J->P, o, n, sr, rays), c;
+        if (have && (c = full_badness(&J->P, first, n, best_sr, rays), worse(bb, c))) {
+            memcpy(best, first, sizeof best);
+            bb = c;
+        }
+        standard_origin(J->P.s, m, F, v, -1.0f, cand);
+        csr = short_probe(&J->P, cand, n, near, rays);
+        c = full_badness(&J->P, cand, n, csr, rays);
+        if (worse(bb, c))
+            memcpy(best, cand, sizeof best);
+    }
+    unsigned res = REPAIR_FLAGGED | (tie_seen ? REPAIR_TIE : 0);
+    if (memcmp(best, o, sizeof best) != 0) {
+        memcpy(o, best, sizeof best);
+        res |= REPAIR_MOVED;
+    }
+    return res;
+}
+
+static void repair_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
+{
+    origin_job *J = ctx;
+    (void)worker;
     uint64_t rays = 0;
     uint32_t moved = 0, flagged = 0, ties = 0;
     for (uint32_t v = begin; v < end; v++) {
-        const float *n = m->normals + 3 * (size_t)v;
-        if (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f)
+        if (J->need && !J->need[v])
             continue;
-        float *o = J->out + 3 * (size_t)v;
-        const float near = F->near[v] * scale;
-        short_result sr, csr, best_sr = {0, 0, 0};
-        int tie_seen = 0;
-        int state = origin_state(&J->P, m, F, v, o, n, near, &sr, &tie_seen, &rays);
-        if (state == ORIGIN_FREE) {
-            ties += tie_seen;
-            continue;
-        }
-        flagged++;
-        if (state == ORIGIN_PRESSED) {
-            /* Pressed flat against a surface it faces: no point of its own
-             * surface is free, and the true distances are ~0. The origin
-             * just behind its own surface gives exactly that, instead of
-             * one pushed through the other surface. */
-            standard_origin(J->P.s, m, F, v, -1.0f, o);
-            ties++, moved++;
-            continue;
-        }
-        const float *p = m->positions + 3 * (size_t)v;
-        float best[3] = {o[0], o[1], o[2]}, cand[3], first[3] = {0, 0, 0};
-        int found = 0, have = 0;
-        uint32_t a0 = F->adj_start[v], fan = F->adj_start[v + 1] - a0;
-        uint32_t picks = fan < FAN ? fan : FAN;
-        for (int st = 0; st < 6 && !found; st++)
-            for (uint32_t i = 0; i < picks && !found; i++) {
-                uint32_t a = a0 + (uint32_t)((uint64_t)i * fan / picks);
-                const uint32_t *ix = m->indices + 3 * (size_t)F->adj[a];
-                float q[3], ql[3];
-                for (int c = 0; c < 3; c++) {
-                    double ctr = ((double)m->positions[3 * (size_t)ix[0] + c] +
-                                  m->positions[3 * (size_t)ix[1] + c] +
-                                  m->positions[3 * (size_t)ix[2] + c]) / 3.0;
-                    q[c] = (float)(p[c] + steps[st] * (ctr - p[c]));
-                }
-                vb_scene_to_local(J->P.s, q, ql);
-                vb_offset_origin(ql, F->navg + 3 * (size_t)v, cand);
-                int cs = origin_state(&J->P, m, F, v, cand, n, near, &csr, &tie_seen, &rays);
-                found = cs != ORIGIN_REPAIR;
-                if (cs == ORIGIN_PRESSED) /* its face lies on another: see above */
-                    standard_origin(J->P.s, m, F, v, -1.0f, cand);
-                if (found) { /* in free space, or pressed: take it */
-                    memcpy(best, cand, sizeof best);
-                } else if (!have || worse_short(best_sr, csr)) {
-                    memcpy(first, cand, sizeof first);
-                    best_sr = csr;
-                    have = 1;
-                }
-            }
-        if (!found) {
-            /* The least bad of: where it is, the best candidate, and the
-             * origin just behind its own surface (a face pressed against
-             * another without coincident faces, one buried in a solid).
-             * Ties keep the earlier. */
-            badness bb = full_badness(&J->P, o, n, sr, &rays), c;
-            if (have && (c = full_badness(&J->P, first, n, best_sr, &rays), worse(bb, c))) {
-                memcpy(best, first, sizeof best);
-                bb = c;
-            }
-            standard_origin(J->P.s, m, F, v, -1.0f, cand);
-            csr = short_probe(&J->P, cand, n, near, &rays);
-            c = full_badness(&J->P, cand, n, csr, &rays);
-            if (worse(bb, c))
-                memcpy(best, cand, sizeof best);
-        }
-        ties += tie_seen;
-        if (memcmp(best, o, sizeof best) != 0) {
-            memcpy(o, best, sizeof best);
-            moved++;
-        }
+        unsigned did = repair_one(J, v, &rays);
+        if (J->need && J->need[v] != VB_NEED_COUNT)
+            continue; /* prepared, not counted */
+        moved += (did & REPAIR_MOVED) != 0;
+        flagged += (did & REPAIR_FLAGGED) != 0;
+        ties += (did & REPAIR_TIE) != 0;
     }
     atomic_fetch_add(&J->moved, moved);
     atomic_fetch_add(&J->flagged, flagged);
@@ -538,8 +552,9 @@ static void repair_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
 }
 
 static vb_result place_origins(const vb_mesh *m, const vb_scene *s, const frames *Fp,
-                               unsigned threads, float *out, float *near_out,
-                               vb_origins_stats *stats, double t0, vb_error *err)
+                               unsigned threads, const uint8_t *need, float *out,
+                               float *near_out, vb_origins_stats *stats, double t0,
+                               vb_error *err)
 {
     const frames F = *Fp;
     vb_result r = VB_OK;
@@ -551,7 +566,7 @@ static vb_result place_origins(const vb_mesh *m, const vb_scene *s, const frames
     origin_job *J = calloc(1, sizeof *J);
     if (!J)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for ray origins");
-    J->m = m, J->F = &F, J->out = out;
+    J->m = m, J->F = &F, J->out = out, J->need = need;
     prober_init(&J->P, s);
     if (vb_parallel_for(threads, m->vertex_count, 256, repair_block, J, NULL, NULL) == 0)
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
@@ -576,7 +591,7 @@ vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads, 
     vb_result r = frames_create(m, s, &F, err);
     if (r != VB_OK)
         return r;
-    r = place_origins(m, s, &F, threads, out, near_out, stats, t0, err);
+    r = place_origins(m, s, &F, threads, NULL, out, near_out, stats, t0, err);
     frames_free(&F);
     return r;
 }
@@ -586,6 +601,7 @@ vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads, 
 typedef struct orient_job {
     const vb_mesh *m;
     const frames *F;
+    const uint8_t *need;        /* NULL: all */
     prober P;
     uint8_t *flip;
 } orient_job;
@@ -652,7 +668,7 @@ static void orient_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
     (void)worker;
     for (uint32_t v = begin; v < end; v++) {
         const float *n = J->m->normals + 3 * (size_t)v;
-        if (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f)
+        if ((J->need && !J->need[v]) || (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f))
             continue;
         /* Full-length probes from the standard origins on both sides:
          * toward +n mostly the backs of faces (inside a solid); toward -n
@@ -673,10 +689,10 @@ static void orient_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
 /* Orient m's receivers with frames F of m: flip, in `normals` (m's or a
  * copy of them), those pointing into geometry. */
 static vb_result orient(const vb_mesh *m, const vb_scene *s, const frames *F, unsigned threads,
-                        float *normals, uint32_t *flipped, vb_error *err)
+                        const uint8_t *need, float *normals, uint32_t *flipped, vb_error *err)
 {
     vb_result r = VB_OK;
-    orient_job J = {.m = m, .F = F};
+    orient_job J = {.m = m, .F = F, .need = need};
     J.flip = calloc((size_t)m->vertex_count + 1, 1);
     if (!J.flip)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for receiver normals");
@@ -688,7 +704,7 @@ static vb_result orient(const vb_mesh *m, const vb_scene *s, const frames *F, un
         if (J.flip[v]) {
             for (int i = 0; i < 3; i++)
                 normals[3 * (size_t)v + i] = -normals[3 * (size_t)v + i];
-            count++;
+            count += !need || need[v] == VB_NEED_COUNT;
         }
     free(J.flip);
     if (r == VB_OK)
@@ -704,16 +720,51 @@ vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
     if (r != VB_OK)
         return r;
     uint32_t count = 0;
-    r = orient(m, s, &F, threads, m->normals, &count, err);
+    r = orient(m, s, &F, threads, NULL, m->normals, &count, err);
     frames_free(&F);
     if (r == VB_OK && flipped)
         *flipped = count;
     return r;
 }
 
+/* need expanded to the receivers at the bit-identical position of a needed
+ * one (marked VB_NEED_ONLY): their oriented normals enter the needed
+ * ones' ray-offset normals. A new array, or NULL when out of memory. */
+static uint8_t *need_with_coincident(const vb_mesh *m, const uint8_t *need)
+{
+    uint32_t n = m->vertex_count;
+    uint8_t *out = malloc((size_t)n + 1);
+    pos_key *key = malloc((size_t)n * sizeof *key + 1);
+    if (!out || !key) {
+        free(out);
+        free(key);
+        return NULL;
+    }
+    memcpy(out, need, n);
+    for (uint32_t i = 0; i < n; i++) {
+        for (int c = 0; c < 3; c++) /* + 0.0f folds -0 into +0, as vb_offset_normals */
+            key[i].p[c] = m->positions[3 * (size_t)i + c] + 0.0f;
+        key[i].index = i;
+    }
+    qsort(key, n, sizeof *key, cmp_pos);
+    for (uint32_t a = 0; a < n;) {
+        uint32_t b = a + 1;
+        int any = need[key[a].index] != 0;
+        while (b < n && memcmp(key[a].p, key[b].p, sizeof key[a].p) == 0)
+            any |= need[key[b++].index] != 0;
+        for (uint32_t k = a; k < b && any && b - a > 1; k++)
+            if (!out[key[k].index])
+                out[key[k].index] = VB_NEED_ONLY;
+        a = b;
+    }
+    free(key);
+    return out;
+}
+
 vb_result vb_receivers_prepare(const vb_mesh *m, const vb_scene *s, unsigned threads,
-                               float *normals, uint32_t *flipped, float *out,
-                               float *near_out, vb_origins_stats *stats, vb_error *err)
+                               const uint8_t *need, float *normals, uint32_t *flipped,
+                               float *out, float *near_out, vb_origins_stats *stats,
+                               vb_error *err)
 {
     double t0 = vb_now();
     frames F;
@@ -722,18 +773,24 @@ vb_result vb_receivers_prepare(const vb_mesh *m, const vb_scene *s, unsigned thr
         return r;
     vb_mesh oriented = *m;
     uint32_t count = 0;
+    uint8_t *orient_need = NULL;
+    if (need && normals && !(orient_need = need_with_coincident(m, need))) {
+        frames_free(&F);
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for receiver normals");
+    }
     if (normals) {
         memcpy(normals, m->normals, (size_t)m->vertex_count * 3 * sizeof *normals);
         oriented.normals = normals;
-        r = orient(m, s, &F, threads, normals, &count, err);
+        r = orient(m, s, &F, threads, orient_need, normals, &count, err);
         /* The frames again where they depend on the normals. */
         if (r == VB_OK && count > 0)
             r = frames_normals(&oriented, &F, err);
         t0 = vb_now(); /* the origins' time, as before: not the orientation's */
     }
     if (r == VB_OK)
-        r = place_origins(&oriented, s, &F, threads, out, near_out, stats, t0, err);
+        r = place_origins(&oriented, s, &F, threads, need, out, near_out, stats, t0, err);
     frames_free(&F);
+    free(orient_need);
     if (r == VB_OK && flipped)
         *flipped = count;
     return r;

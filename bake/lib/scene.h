@@ -63,6 +63,18 @@ static inline void vb_scene_to_local(const vb_scene *s, const float p[3],
  * spacing instead of being a fixed world distance. n = 0 leaves p. */
 void vb_offset_origin(const float p[3], const float n[3], float out[3]);
 
+/* `count` lights placed uniformly in the free space of scene s
+ * (vdsh_light.h): the candidates of the sequence `seed` that pass, in
+ * order. *tried (may be NULL) gets how many candidates were drawn. Fails
+ * (VB_ERR_INVALID) when 1000 candidates per light are not enough. */
+vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count,
+                               float (*out)[3], uint32_t *tried, vb_error *err);
+
+/* Whether p (scene units) is in the free space of scene s: vdsh_light.h's
+ * rule, its probes cast with Embree. The test vb_scene_place_lights applies
+ * to every candidate (vdsh-frames applies it to eyes too). */
+int vb_scene_free_space(const vb_scene *s, const float p[3]);
+
 #ifdef __cplusplus
 }
 #endif

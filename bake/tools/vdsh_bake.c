@@ -53,6 +53,10 @@ typedef struct options {
     vdsh_encoding encoding;
     float max_distance;
     float max_edge;
+    int adaptive;              /* --adaptive TOL */
+    float adaptive_tol;
+    float min_edge;            /* --min-edge; 0: max_edge / 8 */
+    uint32_t max_receivers;    /* --max-receivers; 0: none */
     int weld;
     uint64_t seed;
     unsigned threads;
@@ -102,6 +106,13 @@ static const char *method_names(void)
                        i == 0 ? "" : i + 1 == VB_METHOD_COUNT ? " or " : ", ",
                        vb_method_name((vb_method)i));
     return text;
+}
+
+static void on_round(void *user, uint32_t round, uint32_t receivers, uint32_t candidates,
+                     uint32_t split, double seconds)
+{
+    fprintf((FILE *)user, "vdsh-bake: adaptive round %u: %u of %u midpoints split, %u "
+                          "receivers (%.2f s)\n", round, split, candidates, receivers, seconds);
 }
 
 static void usage(FILE *f)
@@ -170,6 +181,15 @@ static void usage(FILE *f)
 "                          scene's bounding-box diagonal)\n"
 "      --max-edge L        refine receivers until no edge is longer than L\n"
 "                          (default 0: the mesh vertices as they are)\n"
+"      --adaptive TOL      adaptive receivers: from --max-edge, split an edge\n"
+"                          where the stream interpolated between its ends\n"
+"                          differs from its midpoint's bake by more than TOL\n"
+"                          in expected shadow error (lights in the scene's\n"
+"                          free space); a split vertex keeps that bake\n"
+"      --min-edge L        with --adaptive: no edge is split below 2 L\n"
+"                          (default: --max-edge / 8)\n"
+"      --max-receivers N   with --adaptive: stop at N receivers, splitting\n"
+"                          the largest errors first\n"
 "      --weld              merge vertices with identical positions\n"
 "      --keep-normals      keep normals that point into geometry (default:\n"
 "                          a receiver blocked at ~0 on its own side and open\n"
@@ -424,7 +444,8 @@ int main(int argc, char **argv)
 
     enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
-           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL, O_SHARD };
+           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL, O_SHARD,
+           O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
@@ -453,6 +474,9 @@ int main(int argc, char **argv)
         {"keep-normals", no_argument, 0, O_KEEP_NORMALS},
         {"window", required_argument, 0, O_WINDOW},
         {"shard", required_argument, 0, O_SHARD},
+        {"adaptive", required_argument, 0, O_ADAPTIVE},
+        {"min-edge", required_argument, 0, O_MIN_EDGE},
+        {"max-receivers", required_argument, 0, O_MAX_RECEIVERS},
         {"quiet", no_argument, 0, 'q'},
         {"help", no_argument, 0, 'h'},
         {"version", no_argument, 0, 'V'},
@@ -513,6 +537,25 @@ int main(int argc, char **argv)
         case O_MAXEDGE:
             if (!parse_float(optarg, &o.max_edge))
                 return bad_usage("--max-edge takes a number >= 0, not '%s'", optarg);
+            break;
+        case O_ADAPTIVE: {
+            char *end = NULL;
+            double t = strtod(optarg, &end);
+            if (end == optarg || *end || !(t >= 0.0))
+                return bad_usage("--adaptive takes a tolerance >= 0 (or inf), not '%s'", optarg);
+            o.adaptive = 1;
+            o.adaptive_tol = (float)t;
+            break;
+        }
+        case O_MIN_EDGE:
+            if (!parse_float(optarg, &o.min_edge) || !(o.min_edge > 0.0f))
+                return bad_usage("--min-edge takes a positive number, not '%s'", optarg);
+            break;
+        case O_MAX_RECEIVERS:
+            if (!vt_parse_u64(optarg, 1, VDSH_MAX_VERTICES, &u))
+                return bad_usage("--max-receivers takes a whole number 1..268435456, not '%s'",
+                                 optarg);
+            o.max_receivers = (uint32_t)u;
             break;
         case O_WELD: o.weld = 1; break;
         case O_SEED:
@@ -586,6 +629,16 @@ int main(int argc, char **argv)
     }
     if (o.have_ray_tolerance && !o.adaptive_rays)
         return bad_usage("%s needs --rays auto", "--ray-tolerance");
+    if ((o.min_edge > 0.0f || o.max_receivers) && !o.adaptive)
+        return bad_usage("%s need --adaptive TOL", "--min-edge and --max-receivers");
+    if (o.adaptive && !(o.max_edge > 0.0f))
+        return bad_usage("%s", "--adaptive needs --max-edge L: the uniform refinement it "
+                               "starts from (the coarsest receivers)");
+    if (o.adaptive && o.min_edge == 0.0f)
+        o.min_edge = o.max_edge / 8.0f;
+    if (o.adaptive && shard_count)
+        return bad_usage("%s", "--adaptive cannot be combined with --shard yet: the "
+                               "refinement bakes as it decides");
     int nmesh = argc - optind;
     if (nmesh < 1)
         return bad_usage("%s", "no mesh given");
@@ -617,6 +670,12 @@ int main(int argc, char **argv)
         .paths = (const char *const *)argv + optind, .path_count = (uint32_t)nmesh,
         .output = o.trace_only ? NULL : o.output, .cubemap_dir = o.cubemap_dir,
         .weld = o.weld, .max_edge = o.max_edge, .fast_traversal = !o.robust,
+        .adaptive = o.adaptive,
+        .adapt = {.tolerance = o.adaptive_tol, .min_edge = o.min_edge,
+                  .max_receivers = o.max_receivers,
+                  .max_rounds = getenv("VDSH_ROUNDS") ? (uint32_t)atoi(getenv("VDSH_ROUNDS")) : 0,
+                  .on_round = log ? on_round : NULL,
+                  .user = log},
         .bake = {.rays = o.rays, .adaptive_rays = o.adaptive_rays,
                  .ray_tolerance = o.ray_tolerance, .seed = o.seed,
                  .max_distance = o.max_distance,
@@ -680,6 +739,12 @@ int main(int argc, char **argv)
         goto out;
     }
     const vb_bake_output *bo = &job.bake;
+    if (log && o.adaptive)
+        fprintf(log, "vdsh-bake: adaptive receivers: %u from %u in %u rounds (%u midpoints "
+                     "baked, tolerance %g, min edge %g%s)\n",
+                job.receivers.vertex_count, job.adaptive.start_receivers, job.adaptive.rounds,
+                job.adaptive.candidates, (double)o.adaptive_tol, (double)o.min_edge,
+                job.adaptive.budget_reached ? ", the budget stopped it" : "");
     if (log && bo->flipped_normals)
         fprintf(log, "vdsh-bake: %u receiver normals pointed into geometry and were "
                      "flipped (--keep-normals keeps them)\n", bo->flipped_normals);

@@ -101,13 +101,10 @@ static const char *mismatch(const vdsh_file *a, const vdsh_file *b)
         return "another --encoding";
     uint64_t v = a->header.vertex_count, t = a->header.triangle_count;
     if (memcmp(a->positions, b->positions, v * 12) != 0 ||
-        memcmp(a->normals, b->normals, v * 12) != 0 ||
         memcmp(a->indices, b->indices, t * 12) != 0)
-        return "other receivers (POSN, NORM or TRIS differ)";
+        return "other receivers (POSN or TRIS differ)";
     if (a->has_stats != b->has_stats ||
-        (a->has_stats && (a->stats.undefined_normals != b->stats.undefined_normals ||
-                          a->stats.moved_origins != b->stats.moved_origins ||
-                          a->stats.flipped_normals != b->stats.flipped_normals)))
+        (a->has_stats && a->stats.undefined_normals != b->stats.undefined_normals))
         return "other statistics of the whole receiver set (stat differs)";
     return NULL;
 }
@@ -140,6 +137,7 @@ int main(int argc, char **argv)
     void *encoded[VDSH_MAX_STREAMS] = {0};
     float s8_scales[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS];
     int *owner = NULL;
+    float *normals = NULL;
     vb_cubemap_basis basis = {0};
     if (!parts) {
         fprintf(stderr, "vdsh-merge: out of memory\n");
@@ -212,12 +210,23 @@ int main(int argc, char **argv)
     f.storage_ = NULL;
     f.streams = streams;
     f.stats.rays_traced = f.stats.rays_missed = 0;
-    f.stats.degenerate_receivers = 0;
+    f.stats.degenerate_receivers = f.stats.moved_origins = f.stats.flipped_normals = 0;
+    /* Each part oriented its own range's normals, and counts its own. */
+    if (!(normals = malloc((size_t)V * 12 + 1))) {
+        fprintf(stderr, "vdsh-merge: out of memory for %u receivers\n", V);
+        goto out;
+    }
     for (int i = 0; i < n; i++) {
+        const vdsh_part *pt = &parts[i]->part;
         f.stats.rays_traced += parts[i]->stats.rays_traced;
         f.stats.rays_missed += parts[i]->stats.rays_missed;
         f.stats.degenerate_receivers += parts[i]->stats.degenerate_receivers;
+        f.stats.moved_origins += parts[i]->stats.moved_origins;
+        f.stats.flipped_normals += parts[i]->stats.flipped_normals;
+        memcpy(normals + 3 * (size_t)pt->range_begin, parts[i]->normals + 3 * (size_t)pt->range_begin,
+               (size_t)(pt->range_end - pt->range_begin) * 12);
     }
+    f.normals = normals;
     for (uint32_t s = 0; s < p0->stream_count; s++) {
         streams[s] = p0->streams[s];
         size_t nc = (size_t)streams[s].order * streams[s].order;
@@ -300,6 +309,7 @@ out:
     for (int s = 0; s < VDSH_MAX_STREAMS; s++)
         free(merged[s]), free(encoded[s]);
     free(owner);
+    free(normals);
     for (int i = 0; i < n; i++)
         vdsh_free(parts[i]);
     free(parts);

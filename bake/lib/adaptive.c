@@ -1,0 +1,362 @@
+/* Adaptive receivers: adaptive.h says what and why. */
+#include "adaptive.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "parallel.h"
+#include "scene.h"
+#include "vdsh_shadow.h"
+
+/* The lights' seed: a fixed sequence of its own, whatever the bake's. */
+#define ADAPTIVE_LIGHT_SEED 0x61646170746976ull /* "adaptiv" */
+
+static uint64_t edge_key(uint32_t a, uint32_t b)
+{
+    return a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a;
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static int contains(const uint64_t *sorted, size_t n, uint64_t key)
+{
+    return n && bsearch(&key, sorted, n, sizeof key, cmp_u64) != NULL;
+}
+
+/* The candidates: each triangle's longest edge (ties: the lower key), if
+ * at least `len` long and not in `judged`; sorted by key (its ends'
+ * numbers). Splitting only longest edges (longest-edge bisection, as
+ * vb_mesh_refine) keeps the triangles' angles bounded: splitting any edge
+ * the error asks for would fan ever thinner slivers around the corner
+ * opposite it. *out is malloc'ed. */
+static vb_result candidate_edges(const vb_mesh *m, float len, const uint64_t *judged,
+                                 size_t judged_n, uint64_t **out, size_t *count, vb_error *err)
+{
+    const double len2 = (double)len * len;
+    uint64_t *k = malloc((size_t)m->triangle_count * sizeof *k + 1);
+    if (!k)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "adaptive: out of memory for edges");
+    size_t n = 0;
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        double best = -1.0;
+        uint64_t best_key = 0;
+        for (int e = 0; e < 3; e++) {
+            uint32_t a = m->indices[3 * (size_t)t + e], b = m->indices[3 * (size_t)t + (e + 1) % 3];
+            const float *pa = m->positions + 3 * (size_t)a, *pb = m->positions + 3 * (size_t)b;
+            double d2 = 0.0;
+            for (int c = 0; c < 3; c++)
+                d2 += ((double)pa[c] - pb[c]) * ((double)pa[c] - pb[c]);
+            uint64_t key = edge_key(a, b);
+            if (a != b && (d2 > best || (d2 == best && key < best_key)))
+                best = d2, best_key = key;
+        }
+        if (best >= len2)
+            k[n++] = best_key;
+    }
+    qsort(k, n, sizeof *k, cmp_u64);
+    size_t u = 0;
+    for (size_t i = 0; i < n; i++)
+        if ((u == 0 || k[i] != k[u - 1]) && !contains(judged, judged_n, k[i]))
+            k[u++] = k[i];
+    *out = k;
+    *count = u;
+    return VB_OK;
+}
+
+/* Scoring the candidates of one round. */
+typedef struct score_job {
+    const vb_mesh *fine;        /* the tentative mesh: candidate i is vertex base + i */
+    uint32_t base;
+    const uint64_t *edges;
+    const vb_bake_output *b;    /* the tentative bake (coefficients of every vertex) */
+    const float *coarse_c;      /* the ends' coefficients (order `order`), vertex-major */
+    int order;
+    uint32_t quantity, interp;
+    const float (*lights)[3];
+    uint32_t light_count;
+    double *error;              /* per candidate */
+} score_job;
+
+static void score_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
+{
+    score_job *J = ctx;
+    (void)worker;
+    const size_t nc = (size_t)J->order * J->order;
+    const float b[3] = {0.5f, 0.5f, 0.0f};
+    for (uint32_t i = begin; i < end; i++) {
+        uint32_t a = (uint32_t)(J->edges[i] >> 32), e = (uint32_t)J->edges[i];
+        uint32_t v = J->base + i;
+        const float *p = J->fine->positions + 3 * (size_t)v;
+        const float *n = J->b->normals ? J->b->normals + 3 * (size_t)v
+                                       : J->fine->normals + 3 * (size_t)v;
+        const float *cm = J->b->coeffs[J->order] + nc * v;
+        const float *c[3] = {J->coarse_c + nc * a, J->coarse_c + nc * e, J->coarse_c + nc * e};
+        const float *pv[3] = {J->fine->positions + 3 * (size_t)a,
+                              J->fine->positions + 3 * (size_t)e,
+                              J->fine->positions + 3 * (size_t)e};
+        double sum = 0.0;
+        uint32_t seen = 0;
+        for (uint32_t l = 0; l < J->light_count; l++) {
+            const float *L = J->lights[l];
+            float dx = L[0] - p[0], dy = L[1] - p[1], dz = L[2] - p[2];
+            if (dx * n[0] + dy * n[1] + dz * n[2] <= 0.0f)
+                continue; /* below its horizon: unlit either way */
+            float s_mid = vdsh_shadow((uint32_t)J->order, J->quantity, J->b->max_distance, cm, p,
+                                      L, VDSH_COMPARE_SMOOTH);
+            float s_int = vdsh_shadow_interior((uint32_t)J->order, J->quantity,
+                                               J->b->max_distance, J->interp, c, pv, b, L,
+                                               VDSH_COMPARE_SMOOTH, NULL);
+            sum += fabs((double)s_mid - s_int);
+            seen++;
+        }
+        J->error[i] = seen ? sum / seen : 0.0;
+    }
+}
+
+typedef struct ranked {
+    double error;
+    uint32_t index;
+} ranked;
+
+/* Largest error first; ties by candidate order. */
+static int cmp_ranked(const void *a, const void *b)
+{
+    const ranked *x = a, *y = b;
+    if (x->error != y->error)
+        return x->error < y->error ? 1 : -1;
+    return (x->index > y->index) - (x->index < y->index);
+}
+
+/* Append `count` rows of `width` floats from src (rows rows[i]) to *dst,
+ * which holds `have` rows. */
+static int append_rows(float **dst, uint32_t have, const float *src, size_t width,
+                       const uint32_t *rows, uint32_t count)
+{
+    float *p = realloc(*dst, ((size_t)have + count) * width * sizeof *p + 1);
+    if (!p)
+        return 0;
+    for (uint32_t i = 0; i < count; i++)
+        memcpy(p + ((size_t)have + i) * width, src + (size_t)rows[i] * width,
+               width * sizeof *p);
+    *dst = p;
+    return 1;
+}
+
+vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
+                           const vb_adaptive_desc *ad, vb_mesh *receivers,
+                           vb_bake_output *out, vb_adaptive_stats *stats, vb_error *err)
+{
+    if (!(ad->tolerance >= 0.0f))
+        return vb_fail(err, VB_ERR_ARGUMENT, "adaptive: the tolerance must be a number >= 0");
+    if (!(ad->min_edge > 0.0f) || !isfinite(ad->min_edge))
+        return vb_fail(err, VB_ERR_ARGUMENT, "adaptive: the minimum edge must be > 0");
+    if (ad->max_receivers && ad->max_receivers < start->vertex_count)
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "adaptive: the budget of %u receivers is below the %u the refinement "
+                       "starts from (raise --max-receivers or --max-edge)",
+                       ad->max_receivers, start->vertex_count);
+    vb_adaptive_stats st = {.start_receivers = start->vertex_count};
+    vb_mesh M = {0}, T = {0}, N = {0};
+    vb_bake_output B = {0}, R = {0};
+    uint64_t *judged = NULL, *cand = NULL;
+    size_t judged_n = 0, cand_n = 0;
+    double *error = NULL;
+    ranked *rank = NULL;
+    uint32_t *rows = NULL;
+    float (*lights)[3] = NULL;
+    const double t_start = vb_now();
+    vb_result r = vb_mesh_refine(start, 0.0f, &M, err); /* a copy */
+    if (r != VB_OK)
+        return r;
+
+    vb_bake_desc bd = *bake;
+    bd.receivers = &M;
+    bd.range_begin = bd.range_end = 0;
+    if ((r = vb_bake_run(&bd, &B, err)) != VB_OK)
+        goto done;
+    if (B.normals) /* the oriented normals: midpoints interpolate them */
+        memcpy(M.normals, B.normals, (size_t)M.vertex_count * 3 * sizeof *M.normals);
+    const int order = B.max_order;
+    vdsh_quantity quantity[VDSH_ORDER_SLOTS];
+    memcpy(quantity, B.quantity, sizeof quantity);
+    bd.order_quantity = quantity;
+    const uint32_t interp = vdsh_runtime_interp((uint32_t)order, quantity[order]);
+
+    st.lights = ad->lights ? ad->lights : VB_ADAPTIVE_LIGHTS;
+    if (!(lights = malloc((size_t)st.lights * sizeof *lights))) {
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+        goto done;
+    }
+    if ((r = vb_scene_place_lights(bake->scene, ADAPTIVE_LIGHT_SEED, st.lights, lights, NULL,
+                                   err)) != VB_OK)
+        goto done;
+
+    const uint32_t max_rounds = st.max_rounds =
+        ad->max_rounds ? ad->max_rounds : VB_ADAPTIVE_ROUNDS;
+    while (isfinite(ad->tolerance) && st.rounds < max_rounds) {
+        const uint32_t V = M.vertex_count;
+        if (ad->max_receivers && V >= ad->max_receivers) {
+            st.budget_reached = 1;
+            break;
+        }
+        free(cand);
+        cand = NULL;
+        if ((r = candidate_edges(&M, 2.0f * ad->min_edge, judged, judged_n, &cand, &cand_n,
+                                 err)) != VB_OK)
+            goto done;
+        if (cand_n == 0)
+            break;
+        /* The tentative mesh: every candidate split; bake the midpoints. */
+        uint32_t *pp = malloc(cand_n * 2 * sizeof *pp + 1);
+        if (!pp) {
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+            goto done;
+        }
+        for (size_t i = 0; i < cand_n; i++)
+            pp[2 * i] = (uint32_t)(cand[i] >> 32), pp[2 * i + 1] = (uint32_t)cand[i];
+        vb_mesh_free(&T);
+        r = vb_mesh_split_edges(&M, pp, (uint32_t)cand_n, &T, err);
+        if (r != VB_OK) {
+            free(pp);
+            goto done;
+        }
+        vb_bake_output_free(&R);
+        bd.receivers = &T;
+        bd.range_begin = V;
+        bd.range_end = T.vertex_count;
+        r = vb_bake_run(&bd, &R, err);
+        if (r != VB_OK) {
+            free(pp);
+            goto done;
+        }
+        st.rounds++;
+        st.candidates += (uint32_t)cand_n;
+        B.rays_traced += R.rays_traced;
+        B.rays_missed += R.rays_missed;
+        B.degenerate_receivers += R.degenerate_receivers;
+        B.flipped_normals += R.flipped_normals;
+        B.moved_origins += R.moved_origins;
+        B.origins.moved += R.origins.moved;
+        B.origins.flagged += R.origins.flagged;
+        B.origins.ties += R.origins.ties;
+        B.origins.probe_rays += R.origins.probe_rays;
+        B.origins.seconds += R.origins.seconds;
+        B.seconds += R.seconds;
+
+        /* Score every candidate. */
+        free(error);
+        free(rank);
+        error = malloc(cand_n * sizeof *error + 1);
+        rank = malloc(cand_n * sizeof *rank + 1);
+        if (!error || !rank) {
+            free(pp);
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+            goto done;
+        }
+        score_job sj = {.fine = &T, .base = V, .edges = cand, .b = &R,
+                        .coarse_c = B.coeffs[order], .order = order,
+                        .quantity = quantity[order], .interp = interp,
+                        .lights = (const float(*)[3])lights, .light_count = st.lights,
+                        .error = error};
+        if (vb_parallel_for(B.threads, (uint32_t)cand_n, 64, score_block, &sj, NULL, NULL) == 0) {
+            free(pp);
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
+            goto done;
+        }
+        /* Split those above the tolerance, largest first within the budget;
+         * the others are judged for good. */
+        uint32_t over = 0;
+        for (size_t i = 0; i < cand_n; i++)
+            if (error[i] > ad->tolerance)
+                rank[over++] = (ranked){error[i], (uint32_t)i};
+        qsort(rank, over, sizeof *rank, cmp_ranked);
+        uint32_t take = over;
+        if (ad->max_receivers && take > ad->max_receivers - V) {
+            take = ad->max_receivers - V;
+            st.budget_reached = 1;
+        }
+        uint8_t *chosen = calloc(cand_n + 1, 1);
+        uint64_t *nj = realloc(judged, (judged_n + cand_n) * sizeof *judged + 1);
+        free(rows);
+        rows = malloc((size_t)take * sizeof *rows + 1);
+        if (!chosen || !nj || !rows) {
+            free(chosen);
+            free(pp);
+            if (nj)
+                judged = nj;
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+            goto done;
+        }
+        judged = nj;
+        for (uint32_t k = 0; k < take; k++)
+            chosen[rank[k].index] = 1;
+        uint32_t s = 0;
+        for (size_t i = 0; i < cand_n; i++) {
+            if (chosen[i]) { /* in key order: the new vertices' order */
+                pp[2 * s] = pp[2 * i], pp[2 * s + 1] = pp[2 * i + 1];
+                rows[s++] = V + (uint32_t)i;
+            } else if (error[i] <= ad->tolerance) {
+                judged[judged_n++] = cand[i];
+            }
+        }
+        free(chosen);
+        qsort(judged, judged_n, sizeof *judged, cmp_u64);
+        if (ad->on_round)
+            ad->on_round(ad->user, st.rounds, V + s, (uint32_t)cand_n, s, vb_now() - t_start);
+        if (s == 0) {
+            free(pp);
+            break;
+        }
+        vb_mesh_free(&N);
+        r = vb_mesh_split_edges(&M, pp, s, &N, err);
+        free(pp);
+        if (r != VB_OK)
+            goto done;
+        /* The new vertices keep their midpoint bakes (and oriented normals). */
+        int ok = 1;
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            if (B.coeffs[o])
+                ok &= append_rows(&B.coeffs[o], V, R.coeffs[o], (size_t)o * o, rows, s);
+        if (B.normals)
+            ok &= append_rows(&B.normals, V, R.normals, 3, rows, s);
+        if (!ok) {
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+            goto done;
+        }
+        for (uint32_t k = 0; k < s; k++)
+            memcpy(N.normals + 3 * ((size_t)V + k),
+                   (R.normals ? R.normals : T.normals) + 3 * (size_t)rows[k], 3 * sizeof(float));
+        vb_mesh_free(&M);
+        M = N;
+        memset(&N, 0, sizeof N);
+        B.vertex_count = M.vertex_count;
+        if (st.budget_reached)
+            break;
+    }
+    B.vertex_count = M.vertex_count;
+    *receivers = M;
+    memset(&M, 0, sizeof M);
+    *out = B;
+    memset(&B, 0, sizeof B);
+    if (stats)
+        *stats = st;
+    r = VB_OK;
+done:
+    vb_mesh_free(&M);
+    vb_mesh_free(&T);
+    vb_mesh_free(&N);
+    vb_bake_output_free(&B);
+    vb_bake_output_free(&R);
+    free(judged);
+    free(cand);
+    free(error);
+    free(rank);
+    free(rows);
+    free(lights);
+    return r;
+}
