@@ -53,6 +53,8 @@ enum {
     CHUNK_HEADER_SIZE = 16,
     HEAD_SIZE = 128,
     STREAM_HEADER_SIZE = 48,
+    /* an s8 stream's scale table, order^2 f32 padded to 16 bytes, at most */
+    S8_TABLE_MAX = (4 * VDSH_MAX_COEFFS + 15) & ~15,
     STAT_SIZE = 32,
     TIME_SIZE = 64,
     PART_SIZE = 32,
@@ -229,7 +231,7 @@ const char *vdsh_method_name(uint32_t method)
 
 const char *vdsh_encoding_name(uint32_t encoding)
 {
-    static const char *const n[] = {"f32", "f16"};
+    static const char *const n[] = {"f32", "f16", "s8", "s8s6"};
     return NAME_OF(encoding, n);
 }
 
@@ -347,9 +349,104 @@ vdsh_result vdsh_encode_f16(const float *src, size_t n, float scale,
     return VDSH_OK;
 }
 
+size_t vdsh_encoding_bytes(uint32_t e, uint32_t nc)
+{
+    switch (e) {
+    case VDSH_ENCODING_F32: return (size_t)nc * 4;
+    case VDSH_ENCODING_F16: return (size_t)nc * 2;
+    case VDSH_ENCODING_S8: return nc;
+    case VDSH_ENCODING_S8S6:
+        return nc <= VDSH_S8S6_BYTES
+                   ? nc
+                   : VDSH_S8S6_BYTES + 4 * (size_t)((nc - VDSH_S8S6_BYTES + VDSH_S8S6_PER_WORD - 1) /
+                                                    VDSH_S8S6_PER_WORD);
+    default: return 0;
+    }
+}
+
+/* s8s6: where coefficient i >= 4 of a vertex lies: its word's byte
+ * offset in the vertex and the field's shift. */
+static void s8s6_field(uint32_t i, size_t *byte, unsigned *shift)
+{
+    uint32_t k = i - VDSH_S8S6_BYTES;
+    *byte = VDSH_S8S6_BYTES + 4 * (size_t)(k / VDSH_S8S6_PER_WORD);
+    *shift = VDSH_S8S6_BITS * (k % VDSH_S8S6_PER_WORD);
+}
+
+/* Stored value of coefficient i of the vertex at p (quantised encoding e). */
+static int32_t quant_stored(uint32_t e, const uint8_t *p, uint32_t i)
+{
+    if (e == VDSH_ENCODING_S8 || i < VDSH_S8S6_BYTES)
+        return (int8_t)p[i];
+    size_t byte;
+    unsigned shift;
+    s8s6_field(i, &byte, &shift);
+    uint32_t f = (get_u32(p + byte) >> shift) & 63u;
+    return f >= 32u ? (int32_t)f - 64 : (int32_t)f;
+}
+
+vdsh_result vdsh_encode_s8(const float *src, size_t vertices, uint32_t nc, float *scales,
+                           int8_t *dst)
+{
+    return vdsh_encode_quantised(VDSH_ENCODING_S8, src, vertices, nc, scales, dst);
+}
+
+vdsh_result vdsh_encode_quantised(uint32_t encoding, const float *src, size_t vertices,
+                                  uint32_t nc, float *scales, void *dst)
+{
+    if (nc < 1 || nc > VDSH_MAX_COEFFS || !vdsh_encoding_quantised(encoding))
+        return VDSH_ERR_ARGUMENT;
+    float amax[VDSH_MAX_COEFFS] = {0};
+    for (size_t v = 0; v < vertices; v++)
+        for (uint32_t i = 0; i < nc; i++) {
+            float a = fabsf(src[v * nc + i]);
+            if (!isfinite(a))
+                return VDSH_ERR_INVALID;
+            amax[i] = a > amax[i] ? a : amax[i];
+        }
+    for (uint32_t i = 0; i < nc; i++) {
+        int levels = vdsh_quant_levels(encoding, i);
+        if (!isfinite((float)levels * vdsh_quant_step(amax[i], levels)))
+            return VDSH_ERR_INVALID; /* near FLT_MAX: `levels` steps would overflow */
+    }
+    /* stored = round(levels c / scale) in double: |c| <= scale, so the
+     * quotient is finite for every finite scale, subnormal ones too. */
+    size_t bpv = vdsh_encoding_bytes(encoding, nc);
+    uint8_t *out = (uint8_t *)dst;
+    if (vertices)
+        memset(out, 0, vertices * bpv);
+    for (size_t v = 0; v < vertices; v++)
+        for (uint32_t i = 0; i < nc; i++) {
+            double l = (double)vdsh_quant_levels(encoding, i);
+            double q = amax[i] > 0.0f ? round(l * ((double)src[v * nc + i] / (double)amax[i]))
+                                      : 0.0;
+            q = q > l ? l : q < -l ? -l : q;
+            uint8_t *p = out + v * bpv;
+            if (encoding == VDSH_ENCODING_S8 || i < VDSH_S8S6_BYTES) {
+                p[i] = (uint8_t)(int8_t)q;
+            } else {
+                size_t byte;
+                unsigned shift;
+                s8s6_field(i, &byte, &shift);
+                put_u32(p + byte, get_u32(p + byte) | ((uint32_t)(int32_t)q & 63u) << shift);
+            }
+        }
+    memcpy(scales, amax, nc * sizeof *scales);
+    return VDSH_OK;
+}
+
 /* ------------------------------------------------------------------ */
 /* Streams                                                             */
 /* ------------------------------------------------------------------ */
+
+/* Bytes between the stream header and the data: an s8 stream's scale
+ * table (order^2 f32), zero-padded to a multiple of 16; else 0. */
+static size_t stream_table_bytes(uint32_t encoding, uint32_t order)
+{
+    if (!vdsh_encoding_quantised(encoding))
+        return 0;
+    return ((size_t)order * order * 4 + 15) & ~(size_t)15;
+}
 
 const vdsh_stream *vdsh_find_stream(const vdsh_file *f, uint32_t order,
                                     uint32_t quantity)
@@ -367,12 +464,7 @@ size_t vdsh_stream_bytes_per_vertex(const vdsh_stream *s)
 {
     if (!s || s->order < 1 || s->order > VDSH_MAX_ORDER)
         return 0;
-    size_t n = (size_t)s->order * s->order;
-    if (s->encoding == VDSH_ENCODING_F32)
-        return n * 4;
-    if (s->encoding == VDSH_ENCODING_F16)
-        return n * 2;
-    return 0;
+    return vdsh_encoding_bytes(s->encoding, s->order * s->order);
 }
 
 void vdsh_stream_decode(const vdsh_stream *s, uint32_t v, float *out)
@@ -388,6 +480,11 @@ void vdsh_stream_decode(const vdsh_stream *s, uint32_t v, float *out)
         const float *d = (const float *)s->data + (size_t)v * n;
         for (uint32_t i = 0; i < n; i++)
             out[i] = d[i] * s->scale;
+    } else if (vdsh_encoding_quantised(s->encoding) && s->coef_scales) {
+        const uint8_t *d = (const uint8_t *)s->data + (size_t)v * vdsh_encoding_bytes(s->encoding, n);
+        for (uint32_t i = 0; i < n; i++)
+            out[i] = (float)quant_stored(s->encoding, d, i) *
+                     vdsh_quant_step(s->coef_scales[i], vdsh_quant_levels(s->encoding, i));
     } else {
         for (uint32_t i = 0; i < n; i++)
             out[i] = 0.0f;
@@ -578,8 +675,8 @@ static int check_stream(const vdsh_stream *s, uint32_t i, why *w)
     if (s->order < 1 || s->order > VDSH_MAX_ORDER)
         return bad(w, "%s: order %u out of range 1..%d", l, s->order,
                    VDSH_MAX_ORDER);
-    if (s->encoding > VDSH_ENCODING_F16)
-        return bad(w, "%s: encoding %u unknown (0 f32, 1 f16)", l,
+    if (s->encoding > VDSH_ENCODING_LAST)
+        return bad(w, "%s: encoding %u unknown (0 f32, 1 f16, 2 s8)", l,
                    s->encoding);
     /* Any method value is allowed: later bakers add methods, and the
      * coefficients still reconstruct `quantity` (VDSH.md, "Methods"). */
@@ -604,12 +701,47 @@ static int check_stream(const vdsh_stream *s, uint32_t i, why *w)
     if (!isfinite(s->scale) || !(s->scale > 0.0f))
         return bad(w, "%s: scale %g must be finite and > 0", l,
                    (double)s->scale);
+    if (vdsh_encoding_quantised(s->encoding) && s->scale != 1.0f)
+        return bad(w, "%s: scale %g must be 1 for %s (its scale table scales)", l,
+                   (double)s->scale, vdsh_encoding_name(s->encoding));
     if (s->quantity == VDSH_QUANTITY_LOG_DISTANCE
             ? !(s->quantity_param > 0.0f) || !isfinite(s->quantity_param)
             : s->quantity_param != 0.0f)
         return bad(w, "%s: quantity_param %g must be %s", l, (double)s->quantity_param,
                    s->quantity == VDSH_QUANTITY_LOG_DISTANCE
                        ? "the log floor, finite and > 0" : "0 for this quantity");
+    return 1;
+}
+
+/* A quantised stream's stored values lie within +-levels, and s8s6's bits
+ * that no coefficient uses (bits 30-31 of every word, the last word's
+ * unused fields) are zero, so every file has one spelling. */
+static int check_quant_data(const vdsh_stream *s, const char *l, uint32_t v, why *w)
+{
+    uint32_t nc = s->order * s->order;
+    size_t bpv = vdsh_encoding_bytes(s->encoding, nc);
+    uint32_t words = s->encoding == VDSH_ENCODING_S8S6 && nc > VDSH_S8S6_BYTES
+                         ? (uint32_t)((bpv - VDSH_S8S6_BYTES) / 4)
+                         : 0;
+    const uint8_t *d = (const uint8_t *)s->data;
+    for (size_t x = 0; x < v; x++) {
+        const uint8_t *p = d + x * bpv;
+        for (uint32_t i = 0; i < nc; i++) {
+            int levels = vdsh_quant_levels(s->encoding, i);
+            int32_t q = quant_stored(s->encoding, p, i);
+            if (q < -levels)
+                return bad(w, "%s: vertex %zu coefficient %u is %d (%s stores %d..%d there)", l,
+                           x, i, (int)q, vdsh_encoding_name(s->encoding), -levels, levels);
+        }
+        for (uint32_t k = 0; k < words; k++) {
+            uint32_t left = nc - VDSH_S8S6_BYTES - k * VDSH_S8S6_PER_WORD;
+            uint32_t fields = left < VDSH_S8S6_PER_WORD ? left : VDSH_S8S6_PER_WORD;
+            uint32_t used = (1u << (VDSH_S8S6_BITS * fields)) - 1u;
+            if (get_u32(p + VDSH_S8S6_BYTES + 4 * k) & ~used)
+                return bad(w, "%s: vertex %zu: unused bits of packed word %u not zero", l, x,
+                           k);
+        }
+    }
     return 1;
 }
 
@@ -623,6 +755,23 @@ static int check_stream_data(const vdsh_stream *s, uint32_t i, uint32_t v,
     size_t n = (size_t)v * nc;
     float maxabs;
     stream_label(s, i, l, sizeof l);
+    if (vdsh_encoding_quantised(s->encoding)) {
+        /* Scales finite and >= 0; stored values within +-levels (-128, or
+         * -32 in 6 bits, would make the range lopsided, and GL's
+         * normalisation rules disagree on -128), so |coefficient| <= about
+         * its scale, finite. */
+        for (uint32_t k = 0; k < nc; k++) {
+            float sc = s->coef_scales[k];
+            int levels = vdsh_quant_levels(s->encoding, k);
+            if (!isfinite(sc) || !(sc >= 0.0f))
+                return bad(w, "%s: scale of coefficient %zu is %g, not finite and >= 0", l,
+                           (size_t)k, (double)sc);
+            if (!isfinite((float)levels * vdsh_quant_step(sc, levels)))
+                return bad(w, "%s: scale of coefficient %zu, %g: %d steps overflow a float",
+                           l, (size_t)k, (double)sc, levels);
+        }
+        return check_quant_data(s, l, v, w);
+    }
     if (s->encoding == VDSH_ENCODING_F16) {
         const uint16_t *d = (const uint16_t *)s->data;
         uint16_t m = 0;
@@ -677,7 +826,7 @@ static int check_part(const vdsh_part *t, uint32_t vertex_count, why *w)
     if (t->range_begin >= t->range_end || t->range_end > vertex_count)
         return bad(w, "part: receivers %u..%u not within 0..%u", t->range_begin,
                    t->range_end, vertex_count);
-    if (t->encoding > VDSH_ENCODING_F16)
+    if (t->encoding > VDSH_ENCODING_LAST)
         return bad(w, "part: unknown encoding %u", t->encoding);
     return 1;
 }
@@ -785,6 +934,7 @@ typedef struct layout {
     uint32_t stream_count;
     vdsh_stream streams[VDSH_MAX_STREAMS]; /* data = offset, as an integer */
     uint64_t stream_data[VDSH_MAX_STREAMS];
+    uint64_t stream_table[VDSH_MAX_STREAMS]; /* s8: offset of the scales; else 0 */
     int has_stats;
     vdsh_stats stats;
     int has_timings;
@@ -1046,14 +1196,21 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
                     "%s: reserved bytes 36..47 not zero", l);
     if (!check_stream(s, i, &w))
         return invalid(r, &w);
-    uint64_t need = (uint64_t)L->header.vertex_count * s->order * s->order *
-                    (s->encoding == VDSH_ENCODING_F16 ? 2 : 4);
+    uint64_t table = stream_table_bytes(s->encoding, s->order);
+    uint64_t need = table + (uint64_t)L->header.vertex_count *
+                                vdsh_stream_bytes_per_vertex(s);
     if (c->size - STREAM_HEADER_SIZE != need)
         return fail(r->err, VDSH_ERR_CHUNK, r->name,
                     "%s: %llu bytes of data, %u vertices of %s need %llu", l,
                     (unsigned long long)(c->size - STREAM_HEADER_SIZE),
                     L->header.vertex_count, vdsh_encoding_name(s->encoding),
                     (unsigned long long)need);
+    if (table) {
+        size_t used = (size_t)s->order * s->order * 4;
+        if (!all_zero(p + STREAM_HEADER_SIZE + used, (size_t)table - used))
+            return fail(r->err, VDSH_ERR_INVALID, r->name,
+                        "%s: padding after the scale table not zero", l);
+    }
     for (uint32_t k = 0; k < i; k++)
         if (L->streams[k].order == s->order &&
             L->streams[k].quantity == s->quantity)
@@ -1061,11 +1218,14 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
                         "%s: a second stream for order %u %s (stream %u is "
                         "the first)", l, s->order,
                         vdsh_quantity_name(s->quantity), k);
-    s->data = p + STREAM_HEADER_SIZE;
+    s->coef_scales = table ? (const float *)(p + STREAM_HEADER_SIZE) : NULL;
+    s->data = p + STREAM_HEADER_SIZE + table;
     if (!check_stream_data(s, i, L->header.vertex_count, &w))
         return invalid(r, &w);
     s->data = NULL;
-    L->stream_data[i] = c->offset + CHUNK_HEADER_SIZE + STREAM_HEADER_SIZE;
+    s->coef_scales = NULL;
+    L->stream_table[i] = table ? c->offset + CHUNK_HEADER_SIZE + STREAM_HEADER_SIZE : 0;
+    L->stream_data[i] = c->offset + CHUNK_HEADER_SIZE + STREAM_HEADER_SIZE + table;
     L->stream_count = i + 1;
     return VDSH_OK;
 }
@@ -1302,6 +1462,8 @@ static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name,
     for (uint32_t i = 0; i < L.stream_count; i++) {
         f->streams[i] = L.streams[i];
         f->streams[i].data = buf + L.stream_data[i];
+        f->streams[i].coef_scales =
+            L.stream_table[i] ? (const float *)(buf + L.stream_table[i]) : NULL;
     }
 
     f->source_count = L.source_count;
@@ -1480,7 +1642,8 @@ typedef struct out_chunk {
 typedef struct plan {
     uint8_t file_header[FILE_HEADER_SIZE];
     uint8_t head[HEAD_SIZE];
-    uint8_t stream_header[VDSH_MAX_STREAMS][STREAM_HEADER_SIZE];
+    /* each stream's header, then an s8 stream's scale table and padding */
+    uint8_t stream_header[VDSH_MAX_STREAMS][STREAM_HEADER_SIZE + S8_TABLE_MAX];
     uint8_t stat[STAT_SIZE];
     uint8_t time[TIME_SIZE];
     uint8_t part[PART_SIZE];
@@ -1548,6 +1711,10 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
         if (!s->data)
             return fail(err, VDSH_ERR_ARGUMENT, name,
                         "not written: COEF stream %u: data is NULL", i);
+        if (vdsh_encoding_quantised(s->encoding) && !s->coef_scales)
+            return fail(err, VDSH_ERR_ARGUMENT, name,
+                        "not written: COEF stream %u: %s without coef_scales", i,
+                        vdsh_encoding_name(s->encoding));
         for (uint32_t k = 0; k < i; k++)
             if (f->streams[k].order == s->order &&
                 f->streams[k].quantity == s->quantity)
@@ -1654,7 +1821,10 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
         put_f32(p + 24, s->method_param);
         put_f32(p + 28, s->scale);
         put_f32(p + 32, s->quantity_param);
-        add_chunk(P, "COEF", p, STREAM_HEADER_SIZE, s->data,
+        size_t table = stream_table_bytes(s->encoding, s->order);
+        for (uint32_t k = 0; table && k < s->order * s->order; k++)
+            put_f32(p + STREAM_HEADER_SIZE + 4 * k, s->coef_scales[k]);
+        add_chunk(P, "COEF", p, STREAM_HEADER_SIZE + table, s->data,
                   v * vdsh_stream_bytes_per_vertex(s));
     }
 

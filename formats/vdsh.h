@@ -115,8 +115,18 @@ enum { VDSH_TRACE_ROBUST = 1u };
 
 typedef enum vdsh_encoding {
     VDSH_ENCODING_F32 = 0,
-    VDSH_ENCODING_F16 = 1
+    VDSH_ENCODING_F16 = 1,
+    VDSH_ENCODING_S8 = 2,    /* signed 8-bit, a scale per coefficient index */
+    VDSH_ENCODING_S8S6 = 3   /* bands 0-1 as s8, bands 2+ signed 6-bit, packed
+                                five to a u32 word; scales as s8 */
 } vdsh_encoding;
+/* The largest encoding value this version reads and writes. */
+#define VDSH_ENCODING_LAST VDSH_ENCODING_S8S6
+/* s8s6: coefficients 0..3 as bytes; coefficient i >= 4 in bits
+ * 6 * ((i - 4) % 5) .. + 5 of u32 word (i - 4) / 5 after them. */
+#define VDSH_S8S6_BYTES 4
+#define VDSH_S8S6_PER_WORD 5
+#define VDSH_S8S6_BITS 6
 
 typedef enum vdsh_method {
     VDSH_METHOD_PAPER = 0,
@@ -180,10 +190,15 @@ typedef struct vdsh_stream {
     uint32_t window;       /* vdsh_window */
     float window_param;
     float method_param;
-    float scale;           /* coefficient = stored value * scale */
+    float scale;           /* coefficient = stored value * scale (f32, f16);
+                              s8: 1, the table below scales */
     float quantity_param;  /* log-distance: the floor (distances below it
                               were clamped to it before the log); else 0 */
     const void *data;      /* vertex_count * order^2 values of `encoding` */
+    const float *coef_scales; /* s8, s8s6 only (else NULL): order^2 scales,
+                                 one per coefficient index, each finite and
+                                 >= 0; coefficient i = stored * vdsh_quant_step(
+                                 coef_scales[i], vdsh_quant_levels(enc, i)) */
 } vdsh_stream;
 
 typedef struct vdsh_stats {
@@ -278,7 +293,9 @@ const vdsh_stream *vdsh_find_stream(const vdsh_file *f, uint32_t order,
  * v must be < vertex_count of the file the stream belongs to. */
 void vdsh_stream_decode(const vdsh_stream *s, uint32_t v, float *out);
 
-/* Bytes of coefficient data per vertex of a stream: order^2 * 4 or * 2. */
+/* Bytes of coefficient data per vertex of a stream: order^2 * 4 (f32),
+ * * 2 (f16) or * 1 (s8); s8s6: min(n^2, 4) + 4 * ceil((n^2 - 4) / 5)
+ * (orders 1..5: 1, 4, 8, 16, 24); 0 for an unknown encoding. */
 size_t vdsh_stream_bytes_per_vertex(const vdsh_stream *s);
 
 /* IEEE binary16 conversion, round to nearest even; overflow gives +-Inf
@@ -290,6 +307,48 @@ float vdsh_f32_from_f16(uint16_t h);
  * input is not finite or a result overflows f16; dst is then unspecified. */
 vdsh_result vdsh_encode_f16(const float *src, size_t n, float scale,
                             uint16_t *dst);
+
+/* s8 (VDSH.md, COEF): the step of coefficient index i, scale_i / 127 in
+ * f32, so that coefficient = stored * step, stored in -127..127. Every
+ * decoder (vdsh_stream_decode, the GL runtime's uniforms, the Python
+ * reader) computes it this way, so they agree to the bit. */
+static inline float vdsh_s8_step(float scale) { return scale / 127.0f; }
+
+/* The quantised encodings (s8, s8s6), which carry a scale table. */
+static inline int vdsh_encoding_quantised(uint32_t e)
+{
+    return e == VDSH_ENCODING_S8 || e == VDSH_ENCODING_S8S6;
+}
+/* The largest stored magnitude of coefficient index i in quantised
+ * encoding e: 127 (8 bits), or 31 for s8s6's 6-bit bands 2+. */
+static inline int vdsh_quant_levels(uint32_t e, uint32_t i)
+{
+    return e == VDSH_ENCODING_S8S6 && i >= VDSH_S8S6_BYTES ? 31 : 127;
+}
+/* Coefficient = stored * vdsh_quant_step(scale_i, levels_i), the step
+ * rounded to f32 first (vdsh_s8_step is levels 127). */
+static inline float vdsh_quant_step(float scale, int levels) { return scale / (float)levels; }
+
+/* vdsh_encode_s8 for any quantised encoding (s8, s8s6): dst receives
+ * vertices * (bytes per vertex of encoding at nc coefficients), unused
+ * bits zero. VDSH_ERR_ARGUMENT also for an encoding that is not one. */
+vdsh_result vdsh_encode_quantised(uint32_t encoding, const float *src, size_t vertices,
+                                  uint32_t nc, float *scales, void *dst);
+
+/* Bytes per vertex of encoding e at nc coefficients (0 if unknown). */
+size_t vdsh_encoding_bytes(uint32_t e, uint32_t nc);
+
+/* Encode an s8 stream: `vertices` vertices of `nc` coefficients (src,
+ * vertex-major) to scales[nc] (per index: the largest |coefficient| over
+ * the vertices, 0 when all are 0) and dst[vertices * nc]: each value
+ * rounded to the nearest multiple of its index's step, ties away from 0,
+ * clamped to -127..127 (an index with scale 0 stores 0). vdsh-bake and
+ * vdsh-merge both call this, so their bytes agree. Returns
+ * VDSH_ERR_INVALID if an input is not finite or an index's largest |c| is
+ * so near FLT_MAX that 127 steps overflow (outputs then unspecified),
+ * VDSH_ERR_ARGUMENT if nc is not 1..VDSH_MAX_COEFFS. */
+vdsh_result vdsh_encode_s8(const float *src, size_t vertices, uint32_t nc, float *scales,
+                           int8_t *dst);
 
 /* The scale every writer of an f16 stream uses (VDSH.md, COEF): the
  * stream's largest |coefficient| `amax`, or 1 for an all-zero stream, so

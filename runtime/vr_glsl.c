@@ -165,11 +165,18 @@ static const char vertex_glsl[] =
     "#if ORDER >= 2\n"
     "layout(location = 2) in vec4 a_c0;   /* coefficients 0..3 */\n"
     "#endif\n"
-    "#if ORDER >= 3\n"
+    "#if ORDER >= 3 && PACKED\n"
+    "/* s8s6: coefficients 4.. six bits each, five to a word: word w holds\n"
+    " * 4 + 5w .. 8 + 5w in bits 0-5, 6-11, ..., 24-29 (two's complement) */\n"
+    "layout(location = 3) in uvec4 a_w0;  /* words 0..3 (order 3: word 0 only) */\n"
+    "#if ORDER >= 5\n"
+    "layout(location = 4) in uint a_w4;   /* word 4 */\n"
+    "#endif\n"
+    "#elif ORDER >= 3\n"
     "layout(location = 3) in vec4 a_c1;   /* 4..7 */\n"
     "layout(location = 4) in float a_c8;  /* 8 */\n"
     "#endif\n"
-    "#if ORDER >= 5\n"
+    "#if ORDER >= 5 && !PACKED\n"
     "layout(location = 5) in vec4 a_c9;   /* 9..12, the first basis cubemap */\n"
     "layout(location = 6) in vec4 a_c13;\n"
     "layout(location = 7) in vec4 a_c17;\n"
@@ -177,6 +184,30 @@ static const char vertex_glsl[] =
     "#endif\n"
     "uniform mat4 u_view_proj;\n"
     "uniform float u_scale;   /* coefficient = stored value * u_scale */\n"
+    "/* and times a factor per coefficient, as the attributes are grouped:\n"
+    " * an s8 stream's steps (vdsh_s8_step), 1 for f16 and f32 (exact) */\n"
+    "uniform vec4 u_coef_step[7];\n"
+    "#define C0 (a_c0 * u_coef_step[0])\n"
+    "#if PACKED\n"
+    "/* field j (0..4) of a packed word, sign-extended: exact, as in C */\n"
+    "float pk(uint w, int j)\n"
+    "{\n"
+    "    return float(int(w << uint(26 - 6 * j)) >> 26);\n"
+    "}\n"
+    "#define C1 (vec4(pk(a_w0.x, 0), pk(a_w0.x, 1), pk(a_w0.x, 2), pk(a_w0.x, 3)) * u_coef_step[1])\n"
+    "#define C8 (pk(a_w0.x, 4) * u_coef_step[2].x)\n"
+    "#define C9 (vec4(pk(a_w0.y, 0), pk(a_w0.y, 1), pk(a_w0.y, 2), pk(a_w0.y, 3)) * u_coef_step[3])\n"
+    "#define C13 (vec4(pk(a_w0.y, 4), pk(a_w0.z, 0), pk(a_w0.z, 1), pk(a_w0.z, 2)) * u_coef_step[4])\n"
+    "#define C17 (vec4(pk(a_w0.z, 3), pk(a_w0.z, 4), pk(a_w0.w, 0), pk(a_w0.w, 1)) * u_coef_step[5])\n"
+    "#define C21 (vec4(pk(a_w0.w, 2), pk(a_w0.w, 3), pk(a_w0.w, 4), pk(a_w4, 0)) * u_coef_step[6])\n"
+    "#else\n"
+    "#define C1 (a_c1 * u_coef_step[1])\n"
+    "#define C8 (a_c8 * u_coef_step[2].x)\n"
+    "#define C9 (a_c9 * u_coef_step[3])\n"
+    "#define C13 (a_c13 * u_coef_step[4])\n"
+    "#define C17 (a_c17 * u_coef_step[5])\n"
+    "#define C21 (a_c21 * u_coef_step[6])\n"
+    "#endif\n"
     "uniform float u_max_distance; /* the clamp of every reconstructed distance */\n"
     "#if NUM_LIGHTS > 0\n"
     "uniform vec3 u_light_pos[NUM_LIGHTS];\n"
@@ -229,14 +260,14 @@ static const char vertex_glsl[] =
     "float vdsh_sh_sum(vec3 d)\n"
     "{\n"
     "#if ORDER == 2\n"
-    "    return u_scale * sh_sum4(a_c0, d);\n"
+    "    return u_scale * sh_sum4(C0, d);\n"
     "#elif ORDER == 3\n"
-    "    return u_scale * sh_sum9(a_c0, a_c1, a_c8, d);\n"
+    "    return u_scale * sh_sum9(C0, C1, C8, d);\n"
     "#else\n"
     "    vec4 b9, b13, b17, b21;\n"
     "    sh_basis16(d, b9, b13, b17, b21);\n"
-    "    return u_scale * (sh_sum9(a_c0, a_c1, a_c8, d) + dot(a_c9, b9) + dot(a_c13, b13) +\n"
-    "                      dot(a_c17, b17) + dot(a_c21, b21));\n"
+    "    return u_scale * (sh_sum9(C0, C1, C8, d) + dot(C9, b9) + dot(C13, b13) +\n"
+    "                      dot(C17, b17) + dot(C21, b21));\n"
     "#endif\n"
     "}\n"
     "#endif\n"
@@ -291,15 +322,15 @@ static const char vertex_glsl[] =
     "#else\n"
     "        /* As above, 0 for a light at the vertex; the fragment stage\n"
     "         * gives such a light visibility 1. */\n"
-    "        v_sum9[i] = dl > 0.0 ? u_scale * sh_sum9(a_c0, a_c1, a_c8, lv / dl) : 0.0;\n"
+    "        v_sum9[i] = dl > 0.0 ? u_scale * sh_sum9(C0, C1, C8, lv / dl) : 0.0;\n"
     "#endif\n"
     "    }\n"
     "#endif\n"
     "#if VDSH_SPLIT\n"
-    "    v_c9 = u_scale * a_c9;\n"
-    "    v_c13 = u_scale * a_c13;\n"
-    "    v_c17 = u_scale * a_c17;\n"
-    "    v_c21 = u_scale * a_c21;\n"
+    "    v_c9 = u_scale * C9;\n"
+    "    v_c13 = u_scale * C13;\n"
+    "    v_c17 = u_scale * C17;\n"
+    "    v_c21 = u_scale * C21;\n"
     "#endif\n"
     "}\n";
 
@@ -504,11 +535,12 @@ static const char depth_fs[] =
 static void key_name(const vr_program_key *k, char *buf, size_t size)
 {
     int interp = vr_mode_interp((vr_mode)k->mode, k->quantity);
-    snprintf(buf, size, "program %s%s%s, %s, %s, output %u, pcf %u, %u lights",
+    snprintf(buf, size, "program %s%s%s, %s, %s, output %u, pcf %u, %u lights%s",
              vr_mode_name((vr_mode)k->mode), interp >= 0 ? " path " : "",
              interp >= 0 ? vdsh_interp_name((uint32_t)interp) : "",
              k->compare == VDSH_COMPARE_BINARY ? "binary" : "smooth",
-             vdsh_quantity_name(k->quantity), k->output, k->pcf, k->lights);
+             vdsh_quantity_name(k->quantity), k->output, k->pcf, k->lights,
+             k->packed ? ", s8s6" : "");
 }
 
 /* The varying components a program passes from the vertex to the
@@ -553,9 +585,9 @@ static void key_defines(const vr_program_key *k, int flat, char *buf, size_t siz
                      "#define CUBEMAP_BASIS %d\n#define SHADOW_CUBE %d\n"
                      "#define QUANTITY %u\n#define COMPARE %u\n#define OUTPUT %u\n"
                      "#define PCF %u\n#define NUM_LIGHTS %u\n#define FLAT_LIGHTS %d\n"
-                     "#define FOR_EACH_LIGHT",
+                     "#define PACKED %d\n#define FOR_EACH_LIGHT",
                      order, visibility, split, distance, cubemap, cube, k->quantity, k->compare,
-                     k->output, k->pcf, k->lights, flat);
+                     k->output, k->pcf, k->lights, flat, k->packed && order >= 3);
     for (unsigned i = 0; i < k->lights && n > 0 && (size_t)n < size; i++)
         n += snprintf(buf + n, size - (size_t)n, " LIGHT(%u)", i);
     if (n > 0 && (size_t)n < size)
@@ -658,6 +690,7 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     vr_program p = {.key = *key, .prog = prog};
     p.u_view_proj = glGetUniformLocation(prog, "u_view_proj");
     p.u_scale = glGetUniformLocation(prog, "u_scale");
+    p.u_coef_step = glGetUniformLocation(prog, "u_coef_step");
     p.u_max_distance = glGetUniformLocation(prog, "u_max_distance");
     p.u_light_pos = glGetUniformLocation(prog, "u_light_pos");
     p.u_light_color = glGetUniformLocation(prog, "u_light_color");

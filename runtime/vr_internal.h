@@ -72,6 +72,9 @@ struct vr_scene {
     vdsh_encoding encoding[VDSH_ORDER_SLOTS];
     vdsh_method method[VDSH_ORDER_SLOTS];
     float scale[VDSH_ORDER_SLOTS];
+    /* Per order: a factor per coefficient, laid out as the attributes
+     * (attribute k's component j at 4k + j): s8 streams' steps, else 1. */
+    float coef_step[VDSH_ORDER_SLOTS][4 * VR_COEF_ATTRIBS];
     GLuint basis[4];            /* cube textures, functions 9+4k..12+4k */
     int cube_size;
     size_t gpu_bytes;
@@ -86,12 +89,13 @@ typedef struct vr_program_key {
     uint8_t output;     /* vr_output */
     uint8_t pcf;        /* 0 or 1 */
     uint8_t lights;     /* lights in this pass, 0..VR_MAX_LIGHTS_PER_PASS */
+    uint8_t packed;     /* 1: the stream is s8s6 (bands 2+ in packed words) */
 } vr_program_key;
 
 typedef struct vr_program {
     vr_program_key key;
     GLuint prog;
-    GLint u_view_proj, u_scale, u_max_distance, u_light_pos, u_light_color, u_light_att;
+    GLint u_view_proj, u_scale, u_coef_step, u_max_distance, u_light_pos, u_light_color, u_light_att;
     GLint u_ambient, u_shadow_nf, u_shadow_texel;
 } vr_program;
 

@@ -618,9 +618,10 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
         }
 
         vr_program_key key = {(uint8_t)mode, (uint8_t)d.compare, (uint8_t)s->quantity,
-                              (uint8_t)d.output, (uint8_t)(d.pcf ? 1 : 0), (uint8_t)n};
+                              (uint8_t)d.output, (uint8_t)(d.pcf ? 1 : 0), (uint8_t)n, 0};
         if (mode != VR_MODE_CUBE)
             key.pcf = 0;
+        key.packed = order && s->encoding[order] == VDSH_ENCODING_S8S6;
         const vr_program *p = NULL;
         res = get_program(r, &key, &p, err);
         if (res != VR_OK)
@@ -643,6 +644,8 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
         glUseProgram(p->prog);
         glUniformMatrix4fv(p->u_view_proj, 1, GL_FALSE, vp);
         glUniform1f(p->u_scale, order ? s->scale[order] : 1.0f);
+        if (order)
+            glUniform4fv(p->u_coef_step, VR_COEF_ATTRIBS, s->coef_step[order]);
         glUniform1f(p->u_max_distance, s->max_distance);
         /* The albedo multiplies the ambient term and the light colours
          * here, once, rather than every fragment. */

@@ -6,7 +6,12 @@
  * Coefficients go to the GPU exactly as stored: f16 streams as
  * GL_HALF_FLOAT attributes, with the stream's scale applied in the shader,
  * so nothing is converted on the CPU and an f16 scene takes half the
- * memory. Each order's stream gets its own VAO; attribute k of a VAO
+ * memory; s8 streams as GL_BYTE attributes read unnormalised (the integer
+ * itself, exact) and multiplied in the shader by a uniform per coefficient
+ * index, vdsh_s8_step of its scale, so the GPU computes the very products
+ * vdsh_stream_decode does. (Normalised bytes would fold the 1/127 into the
+ * fetch, but GL before 4.2 maps a signed byte c to (2c + 1) / 255, where 0
+ * is not 0: the conversion would depend on the context's version.) Each order's stream gets its own VAO; attribute k of a VAO
  * points at coefficients vr_coef_first[k].. of each vertex (vr_internal.h).
  * Triangles and vertices go up in the order of vr_order_triangles
  * (vr_order.c), not the file's.
@@ -114,8 +119,15 @@ static vr_result upload_stream(vr_scene *s, const vdsh_stream *st, size_t vertic
                                const uint32_t *remap, const char *name, vr_error *err)
 {
     int order = (int)st->order;
+    if (st->encoding > VDSH_ENCODING_S8S6 ||
+        (vdsh_encoding_quantised(st->encoding) && !st->coef_scales))
+        return vr_fail(err, VR_ERR_FORMAT, "%s: order %d stream: encoding %u cannot be drawn",
+                       name, order, st->encoding);
+    for (int k = 0; k < 4 * VR_COEF_ATTRIBS; k++)
+        s->coef_step[order][k] = 1.0f;
     size_t bpv = vdsh_stream_bytes_per_vertex(st);
-    size_t elem = st->encoding == VDSH_ENCODING_F16 ? 2 : 4;
+    size_t elem = st->encoding == VDSH_ENCODING_F16 ? 2
+                  : vdsh_encoding_quantised(st->encoding) ? 1 : 4;
     glGenBuffers(1, &s->vbo_stream[order]);
     if (upload_permuted(s->vbo_stream[order], st->data, vertices, bpv, remap))
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory uploading order %d", name,
@@ -126,8 +138,36 @@ static vr_result upload_stream(vr_scene *s, const vdsh_stream *st, size_t vertic
     glBindVertexArray(s->vao[order]);
     set_base_attribs(s);
     glBindBuffer(GL_ARRAY_BUFFER, s->vbo_stream[order]);
-    GLenum type = st->encoding == VDSH_ENCODING_F16 ? GL_HALF_FLOAT : GL_FLOAT;
+    GLenum type = st->encoding == VDSH_ENCODING_F16 ? GL_HALF_FLOAT
+                  : vdsh_encoding_quantised(st->encoding) ? GL_BYTE : GL_FLOAT;
     int n = vr_coef_attrib_count(order);
+    /* Per coefficient the factor the shader applies (s8, s8s6: the step). */
+    for (int k = 0; k < n; k++)
+        for (int j = 0; j < vr_coef_size[k] && vr_coef_first[k] + j < order * order; j++) {
+            int i = vr_coef_first[k] + j;
+            s->coef_step[order][4 * k + j] =
+                vdsh_encoding_quantised(st->encoding)
+                    ? vdsh_quant_step(st->coef_scales[i],
+                                      vdsh_quant_levels(st->encoding, (uint32_t)i))
+                    : 1.0f;
+        }
+    if (st->encoding == VDSH_ENCODING_S8S6) {
+        /* Coefficients 0..3 as bytes (attribute 0), then the packed words
+         * as integer attributes: words 0..3 at attribute 1, word 4 at 2
+         * (the shader unpacks them: vr_glsl.c, PACKED). */
+        int bytes = order * order < VDSH_S8S6_BYTES ? order * order : VDSH_S8S6_BYTES;
+        int words = (int)((bpv - (size_t)bytes) / 4);
+        glVertexAttribPointer(VR_ATTR_COEF0, bytes, GL_BYTE, GL_FALSE, (GLsizei)bpv, NULL);
+        glEnableVertexAttribArray(VR_ATTR_COEF0);
+        for (int a = 0; a < 2 && words > 4 * a; a++) {
+            int size = words - 4 * a < 4 ? words - 4 * a : 4;
+            glVertexAttribIPointer(VR_ATTR_COEF0 + 1 + (GLuint)a, size, GL_UNSIGNED_INT,
+                                   (GLsizei)bpv,
+                                   (const void *)(uintptr_t)(VDSH_S8S6_BYTES + 16 * a));
+            glEnableVertexAttribArray(VR_ATTR_COEF0 + 1 + (GLuint)a);
+        }
+        n = 0;
+    }
     for (int k = 0; k < n; k++) {
         int size = vr_coef_size[k];
         /* Order 1 has one coefficient: only the first component. */

@@ -16,6 +16,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <float.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -241,6 +242,43 @@ static void add_stream(sample *s, uint32_t order, uint32_t enc, uint32_t q,
         if (n > 3)
             d[3] = 0xfbff;
         s->data[i] = d;
+    } else if (vdsh_encoding_quantised(enc)) {
+        /* The scale table, then the bytes (one block, as the baker's). */
+        uint32_t nc = order * order;
+        size_t bpv = vdsh_encoding_bytes(enc, nc);
+        float *t = malloc(VDSH_MAX_COEFFS * sizeof(float) + v * bpv + 1);
+        uint8_t *b = (uint8_t *)(t + VDSH_MAX_COEFFS);
+        for (uint32_t k = 0; k < nc; k++)
+            t[k] = rndf(0.0f, 20.0f);
+        t[0] = 0.0f;               /* an all-zero index */
+        if (nc > 1)
+            t[1] = 3.4e38f;        /* huge: |stored| <= 127 keeps it finite */
+        if (nc > 2)
+            t[2] = float_of(1);    /* subnormal */
+        if (enc == VDSH_ENCODING_S8) {
+            for (size_t k = 0; k < n; k++)
+                b[k] = (uint8_t)(int8_t)((int)(rnd() % 255u) - 127);
+            b[0] = (uint8_t)-127;
+            if (n > 1)
+                b[1] = 127;
+        } else {
+            /* random valid values through the encoder: fields -31..31,
+             * unused bits 0; the extremes from +-scale */
+            float *c = malloc(n * sizeof *c + 4);
+            for (size_t k = 0; k < n; k++)
+                c[k] = rndf(-1.0f, 1.0f);
+            c[0] = -1.0f;
+            c[n - 1] = 1.0f;
+            float sc[VDSH_MAX_COEFFS];
+            if (vdsh_encode_quantised(enc, c, v, nc, sc, b) != VDSH_OK)
+                abort();
+            free(c);
+        }
+        st->scale = 1.0f;
+        st->coef_scales = t;
+        s->data[i] = t;
+        st->data = b;
+        return;
     } else {
         float *d = malloc(n * 4 + 4);
         for (size_t k = 0; k < n; k++)
@@ -326,6 +364,14 @@ static void sample_init(sample *s, int kind, uint32_t v)
                    VDSH_METHOD_FULL, VDSH_WINDOW_NONE, 0, 0, 3);
         add_stream(s, 5, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE2,
                    VDSH_METHOD_PAPER, VDSH_WINDOW_NONE, 0, -1.5f, 1);
+        add_stream(s, 4, VDSH_ENCODING_S8, VDSH_QUANTITY_DISTANCE,
+                   VDSH_METHOD_LSQ, VDSH_WINDOW_NONE, 0, 0, 1);
+        add_stream(s, 3, VDSH_ENCODING_S8, VDSH_QUANTITY_LOG_DISTANCE,
+                   VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1);
+        add_stream(s, 5, VDSH_ENCODING_S8S6, VDSH_QUANTITY_LOG_DISTANCE,
+                   VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1);
+        add_stream(s, 4, VDSH_ENCODING_S8S6, VDSH_QUANTITY_LOG_DISTANCE,
+                   VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1);
         s->long_name = malloc(VDSH_MAX_NAME + 1);
         memset(s->long_name, 'n', VDSH_MAX_NAME);
         s->long_name[VDSH_MAX_NAME] = 0;
@@ -437,7 +483,17 @@ static void check_same_file(const vdsh_file *got, const vdsh_file *want)
         CHECK((uintptr_t)x->data % 16 == 0);
         CHECK(vdsh_stream_bytes_per_vertex(x) ==
               (size_t)y->order * y->order *
-                  (y->encoding == VDSH_ENCODING_F16 ? 2 : 4));
+                  (y->encoding == VDSH_ENCODING_F16 ? 2
+                   : y->encoding == VDSH_ENCODING_S8 ? 1 : 4) ||
+              (y->encoding == VDSH_ENCODING_S8S6 &&
+               vdsh_stream_bytes_per_vertex(x) ==
+                   (size_t[]){0, 1, 4, 8, 16, 24}[y->order]));
+        CHECK(!x->coef_scales == !vdsh_encoding_quantised(y->encoding));
+        if (x->coef_scales && y->coef_scales) {
+            CHECK((uintptr_t)x->coef_scales % 16 == 0);
+            CHECK(memcmp(x->coef_scales, y->coef_scales,
+                         (size_t)y->order * y->order * sizeof(float)) == 0);
+        }
         CHECK(memcmp(x->data, y->data, v * vdsh_stream_bytes_per_vertex(y)) ==
               0);
     }
@@ -807,6 +863,154 @@ static void test_encode(void)
     CHECK(vdsh_encode_f16(NULL, 0, 1.0f, NULL) == VDSH_OK);
 }
 
+/* vdsh_encode_s8 on v vertices of nc coefficients: every decoded value
+ * within half a step of its input (plus what a subnormal step loses),
+ * scales the per-index largest |c|, stored values within -127..127. */
+static void check_s8_roundtrip(const float *src, size_t v, uint32_t nc, const char *what)
+{
+    float scales[VDSH_MAX_COEFFS];
+    int8_t *b = malloc(v * nc + 1);
+    checks++;
+    if (vdsh_encode_s8(src, v, nc, scales, b) != VDSH_OK) {
+        fprintf(stderr, "%s:%d: s8 %s: not encoded\n", __FILE__, __LINE__, what);
+        failures++;
+        free(b);
+        return;
+    }
+    long bad = 0;
+    for (uint32_t i = 0; i < nc; i++) {
+        float m = 0.0f;
+        for (size_t k = 0; k < v; k++)
+            m = fmaxf(m, fabsf(src[k * nc + i]));
+        bad += scales[i] != m;
+    }
+    for (size_t k = 0; k < v * nc; k++) {
+        float sc = scales[k % nc], step = vdsh_s8_step(sc);
+        float dec = (float)b[k] * step;
+        /* half a step, the step's own rounding (127 of them), and the
+         * precision a subnormal step lacks */
+        float tol = 0.5f * step * (1.0f + 1e-6f) + 127.0f * fabsf(step) * 1e-7f +
+                    128.0f * float_of(1);
+        bad += b[k] == -128 || !isfinite(dec) || fabsf(dec - src[k]) > tol ||
+               (src[k] == 0.0f && b[k] != 0) || (sc == 0.0f && b[k] != 0);
+        if (sc > 0.0f && fabsf(src[k]) == sc)
+            bad += b[k] != (src[k] > 0.0f ? 127 : -127); /* the extremes exact */
+    }
+    if (bad) {
+        fprintf(stderr, "%s:%d: s8 %s: %ld values off\n", __FILE__, __LINE__, what, bad);
+        failures++;
+    }
+    free(b);
+}
+
+/* vdsh_encode_quantised of encoding enc at order `order` (the first
+ * order^2 of every NC = 25 values of src), decoded by vdsh_stream_decode:
+ * within half a step of the input (plus what a subnormal step loses), the
+ * extremes +-scale exact to the step's rounding, zeros zero. */
+static void check_quant_roundtrip(uint32_t enc, const float *src25, size_t v, uint32_t order,
+                                  const char *what)
+{
+    uint32_t nc = order * order;
+    float *src = malloc(v * nc * sizeof *src + 4), out[VDSH_MAX_COEFFS];
+    for (size_t k = 0; k < v; k++)
+        memcpy(src + k * nc, src25 + k * VDSH_MAX_COEFFS, nc * sizeof *src);
+    float scales[VDSH_MAX_COEFFS];
+    uint8_t *b = malloc(v * vdsh_encoding_bytes(enc, nc) + 1);
+    vdsh_stream st = {.order = order, .encoding = enc, .scale = 1.0f, .data = b,
+                      .coef_scales = scales};
+    long bad = 0;
+    checks++;
+    if (vdsh_encode_quantised(enc, src, v, nc, scales, b) != VDSH_OK) {
+        bad = 1;
+    } else {
+        for (size_t k = 0; k < v; k++) {
+            vdsh_stream_decode(&st, (uint32_t)k, out);
+            for (uint32_t i = 0; i < nc; i++) {
+                int levels = vdsh_quant_levels(enc, i);
+                float step = vdsh_quant_step(scales[i], levels), c = src[k * nc + i];
+                float tol = 0.5f * step * (1.0f + 1e-6f) + (float)levels * step * 1e-7f +
+                            128.0f * float_of(1);
+                bad += !isfinite(out[i]) || fabsf(out[i] - c) > tol ||
+                       (c == 0.0f && out[i] != 0.0f);
+                if (scales[i] > 0.0f && fabsf(c) == scales[i])
+                    bad += out[i] != (c > 0.0f ? 1.0f : -1.0f) * (float)levels * step;
+            }
+        }
+    }
+    if (bad) {
+        fprintf(stderr, "%s:%d: %s order %u %s: %ld values off\n", __FILE__, __LINE__,
+                vdsh_encoding_name(enc), order, what, bad);
+        failures++;
+    }
+    free(src);
+    free(b);
+}
+
+/* The s8 quantiser's hard cases (VDSH.md, COEF). */
+static void test_encode_s8(void)
+{
+    enum { V = 64, NC = 25 };
+    static float c[V * NC];
+    int8_t b[V * NC];
+    float sc[NC];
+    (void)check_quant_roundtrip;
+    /* all zero: scales 0, bytes 0, decoded 0 */
+    memset(c, 0, sizeof c);
+    check_s8_roundtrip(c, V, NC, "all zero");
+    check_quant_roundtrip(VDSH_ENCODING_S8S6, c, V, 5, "s8s6 all zero");
+    /* huge and tiny magnitudes, per index, side by side */
+    for (int k = 0; k < V * NC; k++) {
+        float u = rndf(-1.0f, 1.0f);
+        switch (k % NC) {
+        case 0: c[k] = u * 3.4e38f; break;
+        case 1: c[k] = u * 1e-40f; break;     /* subnormal */
+        case 2: c[k] = u * float_of(3); break; /* a few ulps of 0 */
+        case 3: c[k] = 0.0f; break;
+        case 4: c[k] = u * 1e30f; break;
+        default: c[k] = u * (float)(k % NC); break;
+        }
+    }
+    c[0] = -3.4e38f;
+    check_s8_roundtrip(c, V, NC, "huge and tiny");
+    check_s8_roundtrip(c, V, 9, "order 3 view");
+    check_s8_roundtrip(c, 1, NC, "one vertex");
+    for (uint32_t o = 1; o <= 5; o++) {
+        check_quant_roundtrip(VDSH_ENCODING_S8, c, V, o, "s8 decoded");
+        check_quant_roundtrip(VDSH_ENCODING_S8S6, c, V, o, "s8s6 huge and tiny");
+    }
+    /* s8s6 rounds bands 2+ to 31 levels: at scale 31, step 1 */
+    {
+        float r6[9 * 2] = {0, 0, 0, 0, 30.5f, 2.5f, -2.5f, 0.49f, -0.51f,
+                           0, 0, 0, 0, 31.0f, 31.0f, 31.0f, 31.0f, -31.0f};
+        uint8_t p6[16];
+        CHECK(vdsh_encode_quantised(VDSH_ENCODING_S8S6, r6, 2, 9, sc, p6) == VDSH_OK &&
+              sc[4] == 31.0f && sc[0] == 0.0f);
+        /* vertex 0's word: 31 (30.5, ties away), 3, -3, 0, -1 in fields
+         * 0..4; vertex 1's: 31, 31, 31, 31, -31 */
+        uint32_t w0 = rd32(p6 + 4), w1 = rd32(p6 + 12);
+        CHECK(w0 == (31u | 3u << 6 | 61u << 12 | 0u << 18 | 63u << 24));
+        CHECK(w1 == (31u | 31u << 6 | 31u << 12 | 31u << 18 | 33u << 24));
+        CHECK(rd32(p6) == 0 && rd32(p6 + 8) == 0);
+    }
+    CHECK(vdsh_encode_quantised(VDSH_ENCODING_F16, c, V, NC, sc, b) == VDSH_ERR_ARGUMENT);
+    /* round to nearest, ties away from zero, at scale 127 (step 1) */
+    float r[8] = {127.0f, 2.5f, -2.5f, 0.49f, -0.51f, 126.5f, -127.0f, 1e-30f};
+    CHECK(vdsh_encode_s8(r, 8, 1, sc, b) == VDSH_OK && sc[0] == 127.0f);
+    CHECK(b[0] == 127 && b[1] == 3 && b[2] == -3 && b[3] == 0 && b[4] == -1 &&
+          b[5] == 127 && b[6] == -127 && b[7] == 0);
+    /* refused: FLT_MAX's step times 127 rounds to infinity */
+    c[0] = -FLT_MAX;
+    CHECK(vdsh_encode_s8(c, V, NC, sc, b) == VDSH_ERR_INVALID);
+    c[0] = 0.0f;
+    c[7] = NAN;
+    CHECK(vdsh_encode_s8(c, V, NC, sc, b) == VDSH_ERR_INVALID);
+    c[7] = -INFINITY;
+    CHECK(vdsh_encode_s8(c, V, NC, sc, b) == VDSH_ERR_INVALID);
+    CHECK(vdsh_encode_s8(c, V, 0, sc, b) == VDSH_ERR_ARGUMENT);
+    CHECK(vdsh_encode_s8(c, V, NC + 1, sc, b) == VDSH_ERR_ARGUMENT);
+    CHECK(vdsh_encode_s8(NULL, 0, 4, sc, NULL) == VDSH_OK && sc[0] == 0.0f);
+}
+
 static void test_names(void)
 {
     CHECK(!strcmp(vdsh_method_name(0), "paper"));
@@ -817,7 +1021,9 @@ static void test_names(void)
     CHECK(!strcmp(vdsh_method_name(5), "?"));
     CHECK(!strcmp(vdsh_encoding_name(0), "f32"));
     CHECK(!strcmp(vdsh_encoding_name(1), "f16"));
-    CHECK(!strcmp(vdsh_encoding_name(2), "?"));
+    CHECK(!strcmp(vdsh_encoding_name(2), "s8"));
+    CHECK(!strcmp(vdsh_encoding_name(3), "s8s6"));
+    CHECK(!strcmp(vdsh_encoding_name(4), "?"));
     CHECK(!strcmp(vdsh_quantity_name(0), "distance"));
     CHECK(!strcmp(vdsh_quantity_name(1), "distance2"));
     CHECK(!strcmp(vdsh_quantity_name(2), "log-distance"));
@@ -880,7 +1086,7 @@ static void test_roundtrip(void)
         CHECK(st == &f->streams[0]);
         CHECK(vdsh_find_stream(f, 5, VDSH_QUANTITY_DISTANCE2) ==
               &f->streams[4]);
-        CHECK(vdsh_find_stream(f, 4, VDSH_QUANTITY_DISTANCE) == NULL);
+        CHECK(vdsh_find_stream(f, 4, VDSH_QUANTITY_DISTANCE2) == NULL);
         CHECK(vdsh_find_stream(NULL, 5, 0) == NULL);
         float c[25];
         int bad = 0;
@@ -961,9 +1167,9 @@ static void test_roundtrip(void)
     vdsh_free(NULL);
     sample_free(&s);
 
-    /* Every order, both encodings, one stream each. */
+    /* Every order, every encoding, one stream each. */
     for (uint32_t order = 1; order <= 5; order++)
-        for (uint32_t enc = 0; enc < 2; enc++) {
+        for (uint32_t enc = 0; enc <= VDSH_ENCODING_LAST; enc++) {
             sample t;
             sample_init(&t, 0, 0);
             for (int i = 0; i < 2; i++) {
@@ -1120,6 +1326,83 @@ static void expect_patched(const uint8_t *d, size_t n, size_t at,
         expect_patched(d, n, (off), b_, 4, 1, (want), (needle), __LINE__);    \
     } while (0)
 
+/* An s8 stream read back (pointers, decode) and what the reader refuses
+ * in one: scale != 1, a scale that is negative or not finite, padding
+ * after the table, a stored -128. */
+static void test_s8_reading(void)
+{
+    sample t;
+    sample_init(&t, 0, 0);
+    for (int i = 0; i < 2; i++) {
+        free(t.data[i]);
+        t.data[i] = NULL;
+    }
+    t.f.stream_count = 0;
+    add_stream(&t, 5, VDSH_ENCODING_S8, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_SHADOW,
+               VDSH_WINDOW_NONE, 0, 0.8f, 1);
+    add_stream(&t, 3, VDSH_ENCODING_S8, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_SHADOW,
+               VDSH_WINDOW_NONE, 0, 1.1f, 1);
+    add_stream(&t, 3, VDSH_ENCODING_S8S6, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_LSQ,
+               VDSH_WINDOW_NONE, 0, 0, 1);
+    void *mem = NULL;
+    size_t n = 0;
+    vdsh_error err;
+    CHECK_RES(vdsh_write_memory(&t.f, &mem, &n, &err), VDSH_OK, &err);
+    uint8_t *d = mem;
+    size_t coef = payload_of(d, n, "COEF", 0), coef1 = payload_of(d, n, "COEF", 1);
+    /* 48-byte header, 25 scales + 12 bytes of padding, 4 x 25 bytes */
+    CHECK(coef && rd64(d + coef - 8) == 48 + 112 + 4 * 25);
+    CHECK(coef1 && rd64(d + coef1 - 8) == 48 + 48 + 4 * 9);
+    size_t coef2 = payload_of(d, n, "COEF", 2);
+    /* s8s6 order 3: 4 bytes and one word per vertex */
+    CHECK(coef2 && rd64(d + coef2 - 8) == 48 + 48 + 4 * 8);
+    vdsh_file *f = NULL;
+    CHECK_RES(vdsh_read_memory(d, n, "s.vdsh", &f, &err), VDSH_OK, &err);
+    if (f) {
+        const vdsh_stream *st = vdsh_find_stream(f, 5, VDSH_QUANTITY_LOG_DISTANCE);
+        CHECK(st && st->encoding == VDSH_ENCODING_S8 && st->scale == 1.0f &&
+              vdsh_stream_bytes_per_vertex(st) == 25);
+        CHECK(st && st->coef_scales && (uintptr_t)st->coef_scales % 16 == 0 &&
+              (uintptr_t)st->data % 16 == 0);
+        for (uint32_t v = 0; st && v < 4; v++) {
+            float out[25];
+            vdsh_stream_decode(st, v, out);
+            const int8_t *b = (const int8_t *)t.streams[0].data + 25 * v;
+            for (int i = 0; i < 25; i++)
+                CHECK(bits_of(out[i]) ==
+                      bits_of((float)b[i] * vdsh_s8_step(t.streams[0].coef_scales[i])));
+        }
+        vdsh_free(f);
+    }
+    PATCHF(coef + 28, 2.0f, VDSH_ERR_INVALID, "scale 2 must be 1 for s8");
+    PATCHF(coef + 48 + 12, NAN, VDSH_ERR_INVALID, "scale of coefficient 3 is nan");
+    PATCHF(coef + 48 + 12, -1.0f, VDSH_ERR_INVALID, "scale of coefficient 3 is -1");
+    PATCHF(coef + 48 + 96, INFINITY, VDSH_ERR_INVALID, "scale of coefficient 24");
+    PATCHF(coef + 48 + 96, FLT_MAX, VDSH_ERR_INVALID, "127 steps overflow");
+    PATCHF(coef + 48 + 96, 3.4e38f, VDSH_OK, NULL);
+    PATCHF(coef + 48 + 12, 0.0f, VDSH_OK, NULL);
+    PATCHF(coef + 48 + 12, -0.0f, VDSH_OK, NULL); /* -0 >= 0 */
+    PATCH32(coef + 48 + 100, 1, 1, VDSH_ERR_INVALID, "padding after the scale table");
+    PATCH32(coef1 + 48 + 44, 0x100, 1, VDSH_ERR_INVALID, "padding after the scale table");
+    expect_patched(d, n, coef + 48 + 112 + 30, "\x80", 1, 1, VDSH_ERR_INVALID,
+                   "vertex 1 coefficient 5 is -128", __LINE__);
+    expect_patched(d, n, coef + 48 + 112 + 30, "\x81", 1, 1, VDSH_OK, NULL, __LINE__);
+    /* s8s6: vertex 1's word (fields 4..8), a byte, the table */
+    size_t w1 = coef2 + 48 + 48 + 8 + 4;
+    PATCH32(w1, 32u << 6, 1, VDSH_ERR_INVALID, "vertex 1 coefficient 5 is -32 (s8s6 stores -31..31");
+    PATCH32(w1, 1u << 30, 1, VDSH_ERR_INVALID, "vertex 1: unused bits of packed word 0");
+    PATCH32(w1, 1u << 31, 1, VDSH_ERR_INVALID, "unused bits");
+    PATCH32(w1, 0x3fffffffu, 1, VDSH_OK, NULL);   /* every field -1 */
+    PATCH32(w1, 31u | 33u << 24, 1, VDSH_OK, NULL); /* 31 and -31 */
+    expect_patched(d, n, w1 - 4, "\x80", 1, 1, VDSH_ERR_INVALID, "vertex 1 coefficient 0 is -128",
+                   __LINE__);
+    PATCHF(coef2 + 48 + 16, 1e38f, VDSH_OK, NULL);
+    PATCHF(coef2 + 48 + 16, FLT_MAX, VDSH_ERR_INVALID, "31 steps overflow");
+    PATCHF(coef2 + 28, 0.5f, VDSH_ERR_INVALID, "must be 1 for s8s6");
+    free(mem);
+    sample_free(&t);
+}
+
 static void expect_tf(const tfile *t, vdsh_result want, const char *needle,
                       int line)
 {
@@ -1253,7 +1536,9 @@ static void test_rules(void)
     PATCH32(coef0 + 0, 6, 1, VDSH_ERR_INVALID, "order 6");
     PATCH32(coef0 + 0, 0, 1, VDSH_ERR_INVALID, "order 0");
     PATCH32(coef0 + 0, 1, 1, VDSH_ERR_CHUNK, "need 16");
-    PATCH32(coef0 + 4, 2, 1, VDSH_ERR_INVALID, "encoding 2");
+    PATCH32(coef0 + 4, 4, 1, VDSH_ERR_INVALID, "encoding 4");
+    /* f32 -> s8: 16 bytes of table and 32 of data make 48, not 32 + 16 */
+    PATCH32(coef0 + 4, 2, 1, VDSH_ERR_CHUNK, "of s8 need 32");
     PATCH32(coef0 + 4, 1, 1, VDSH_ERR_CHUNK, "need 32");
     PATCH32(coef0 + 12, 3, 1, VDSH_ERR_INVALID, "quantity 3");
     /* A log-distance stream needs its floor; a distance stream has none. */
@@ -1637,7 +1922,9 @@ static void test_writer_checks(void)
     REJECT("streams is NULL", s_.f.streams = NULL);
     REJECT("order 0", s_.streams[0].order = 0);
     REJECT("order 6", s_.streams[1].order = 6);
-    REJECT("encoding 2", s_.streams[0].encoding = 2);
+    REJECT("encoding 4", s_.streams[0].encoding = 4);
+    REJECT("s8s6 without coef_scales", s_.streams[0].encoding = VDSH_ENCODING_S8S6);
+    REJECT("s8 without coef_scales", s_.streams[0].encoding = VDSH_ENCODING_S8);
     REJECT("quantity 3", s_.streams[0].quantity = 3);
     REJECT("window 3", s_.streams[0].window = 3);
     REJECT("without a window", s_.streams[0].window_param = 0.5f);
@@ -1864,6 +2151,8 @@ int main(int argc, char **argv)
     test_crc();
     test_f16();
     test_encode();
+    test_encode_s8();
+    test_s8_reading();
     test_names();
     test_roundtrip();
     test_truncation();

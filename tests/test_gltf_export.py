@@ -1,7 +1,9 @@
 """test_gltf_export.py BAKE EXPORT NODE NODE_MODULES WORKDIR ASSIMP_MODELS -
 bake -> vdsh-export -> Khronos glTF Validator (npm gltf-validator).
 
-Bakes builtin:room (orders 2, 3, 5) and Debian assimp-testmodels'
+Bakes builtin:room (orders 2, 3, 5; f16, and s8, which vdsh-export
+decodes: its float export must match the f16 one within half an s8 step)
+and Debian assimp-testmodels'
 BoxTextured.glb (read by the glTF reader), exports each as int16 and as
 float glb, and requires: zero validator errors; the layout of
 formats/GLTF.md (attributes _VDSH<order>_<k>, ceil(order^2/4) VEC4 each,
@@ -50,7 +52,8 @@ def accessor(g, binary, i):
     return [vals[k * n:(k + 1) * n] for k in range(a["count"])]
 
 
-scenes = [("room", "builtin:room", ["--rays", "64", "--orders", "2,3,5"])]
+scenes = [("room", "builtin:room", ["--rays", "64", "--orders", "2,3,5", "--encoding", "f16"]),
+          ("room-s8", "builtin:room", ["--rays", "64", "--orders", "2,3,5", "--encoding", "s8"])]
 box = os.path.join(models, "glTF2", "BoxTextured-glTF-Binary", "BoxTextured.glb")
 if os.path.exists(box):
     scenes.append(("box", box, ["--rays", "64", "--orders", "2,5", "--max-edge", "0.3"]))
@@ -98,6 +101,26 @@ for name, src, opts in scenes:
                     worst = max(worst, abs(max(ca / 32767.0, -1.0) * s["scale"] - cb))
         if worst > 0.5001 * s["scale"] / 32767 + 1e-7:
             fail.append("%s: order %d: int16 and float differ by %g (scale %g)" % (q, s["order"], worst, s["scale"]))
+    if name == "room-s8":
+        # s8 input: exported decoded (vdsh_stream_decode), so its float glb
+        # matches the f16 bake's within half an s8 step (<= scale / 254 of
+        # the stream's largest |c|) plus f16 rounding.
+        g16, b16 = read_glb(os.path.join(work, "room_float.glb"))
+        p16 = g16["meshes"][0]["primitives"][0]
+        for s, s16 in zip(gf["meshes"][0]["extras"]["vdsh"]["streams"],
+                          g16["meshes"][0]["extras"]["vdsh"]["streams"]):
+            if s["source_encoding"] != "s8" or s16["source_encoding"] != "f16":
+                fail.append("%s: source_encoding %s" % (fl, s["source_encoding"]))
+            ref = [accessor(g16, b16, p16["attributes"]["%s%d" % (s16["attribute_prefix"], k)])
+                   for k in range((s["order"] ** 2 + 3) // 4)]
+            got = [accessor(gf, bf, prim_f["attributes"]["%s%d" % (s["attribute_prefix"], k)])
+                   for k in range((s["order"] ** 2 + 3) // 4)]
+            big = max(abs(c) for g in ref for v in g for c in v)
+            worst = max(abs(a - b) for ga, gb in zip(got, ref) for va, vb in zip(ga, gb)
+                        for a, b in zip(va, vb))
+            if worst > big / 254 * 1.0001 + big * 2.0 ** -11:
+                fail.append("%s: order %d: s8 export differs from f16 by %g (largest |c| %g)"
+                            % (fl, s["order"], worst, big))
     pos = accessor(gf, bf, prim_f["attributes"]["POSITION"])
     objv = [struct.unpack("<3f", struct.pack("<3f", *(float(t) for t in line.split()[1:4]))) for line in open(os.path.join(work, name + ".obj"))
             if line.startswith("v ")]

@@ -303,6 +303,35 @@ static void test_f16_range(void)
             CHECK(0, "f16 stream at scale %g", scales[k]);
         }
         free(mem);
+        /* s8 and s8s6: every coefficient within half its index's step,
+         * scale_i / (2 levels_i), at every scene scale; then the same
+         * stream with every coefficient 0 (scales 0, decoded 0). */
+        static const uint32_t quant[2] = {VDSH_ENCODING_S8, VDSH_ENCODING_S8S6};
+        for (int zeroed = 0; zeroed < 2 && b.coeffs[5]; zeroed++)
+            for (int e = 0; e < 2; e++) {
+                if (zeroed)
+                    memset(b.coeffs[5], 0, (size_t)rec.vertex_count * 25 * sizeof(float));
+                mem = NULL;
+                if (vb_bake_stream(&b, 5, quant[e], &s, &mem, &err) != VB_OK) {
+                    CHECK(0, "%s stream at scale %g", vdsh_encoding_name(quant[e]), scales[k]);
+                    continue;
+                }
+                long bad = 0;
+                for (uint32_t v = 0; v < rec.vertex_count; v++) {
+                    float c[25];
+                    vdsh_stream_decode(&s, v, c);
+                    for (int i = 0; i < 25; i++) {
+                        float want = b.coeffs[5][25 * (size_t)v + i];
+                        float half = s.coef_scales[i] / (2.0f * (float)vdsh_quant_levels(quant[e],
+                                                                                     (uint32_t)i));
+                        bad += !isfinite(c[i]) || fabsf(c[i] - want) > half * 1.0001f ||
+                               (zeroed && c[i] != 0.0f);
+                    }
+                }
+                CHECK(bad == 0, "scale %g, %s%s: %ld coefficients beyond half a step", scales[k],
+                      vdsh_encoding_name(quant[e]), zeroed ? " (all zero)" : "", bad);
+                free(mem);
+            }
         vb_bake_output_free(&b);
         test_mesh_free(&occ);
         test_mesh_free(&rec);

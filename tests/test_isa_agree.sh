@@ -9,6 +9,9 @@
 #     |coefficient|, at most 0.05% of the vertices beyond 1e-3 (measured:
 #     0.016 and 3 of 60,848 vertices; with --no-robust 0.13 and 45).
 # The same repair decisions everywhere: the moved-origin counts agree.
+# The bakes store f16: the coefficients are compared, and the compact
+# default (s8s6) would turn a difference of 1e-7 at a rounding boundary
+# into a whole quantisation step.
 # Usage: test_isa_agree.sh VDSH_BAKE VDSH_INFO VDSH_COMPARE WITH_EACH_ISA SCENES_DIR
 set -u
 bake=$1 info=$2 compare=$3 each=$4 scenes=$5
@@ -26,18 +29,18 @@ if [[ ${ISA_ONE:-} == 1 ]]; then
   # One ISA (VDSH_EMBREE_CONFIG is set by with_each_isa.sh).
   isa=${VDSH_EMBREE_CONFIG#isa=}
   fail=0
-  "$bake" builtin:room --max-edge 0.5 --rays 400 --cube-size 4 -q -o "$REF/room-$isa.vdsh" || exit 1
+  "$bake" builtin:room --max-edge 0.5 --rays 400 --cube-size 4 --encoding f16 -q -o "$REF/room-$isa.vdsh" || exit 1
   missed=$(stat "$REF/room-$isa.vdsh" rays_missed)
   moved=$(stat "$REF/room-$isa.vdsh" moved_origins)
   [[ $missed == 0 ]] || { echo "FAIL: $isa: $missed rays escaped the closed room" >&2; fail=1; }
   [[ $moved == "$(stat "$REF/room.vdsh" moved_origins)" ]] ||
     { echo "FAIL: $isa: $moved origins moved, natively $(stat "$REF/room.vdsh" moved_origins)" >&2; fail=1; }
   "$compare" "$REF/room.vdsh" "$REF/room-$isa.vdsh" 1e-3 0 || { echo "FAIL: $isa: room" >&2; fail=1; }
-  "$bake" builtin:room --max-edge 0.5 --rays 400 --method paper --cube-size 4 -q \
+  "$bake" builtin:room --max-edge 0.5 --rays 400 --method paper --cube-size 4 --encoding f16 -q \
     -o "$REF/paper-$isa.vdsh" || exit 1
   "$compare" "$REF/paper.vdsh" "$REF/paper-$isa.vdsh" 1e-3 0 || { echo "FAIL: $isa: room, paper" >&2; fail=1; }
   if [[ -f $REF/sponza.vdsh ]]; then
-    "$bake" "$SPONZA" --rays 256 --cube-size 4 -q -o "$REF/sponza-$isa.vdsh" || exit 1
+    "$bake" "$SPONZA" --rays 256 --cube-size 4 --encoding f16 -q -o "$REF/sponza-$isa.vdsh" || exit 1
     "$compare" "$REF/sponza.vdsh" "$REF/sponza-$isa.vdsh" 0.02 0.0005 ||
       { echo "FAIL: $isa: Sponza" >&2; fail=1; }
     [[ $(stat "$REF/sponza-$isa.vdsh" moved_origins) == "$(stat "$REF/sponza.vdsh" moved_origins)" ]] ||
@@ -47,10 +50,10 @@ if [[ ${ISA_ONE:-} == 1 ]]; then
 fi
 
 export REF=$tmp SPONZA=$scenes/sponza_dabrovic/sponza.obj
-"$bake" builtin:room --max-edge 0.5 --rays 400 --cube-size 4 -q -o "$tmp/room.vdsh" || exit 1
-"$bake" builtin:room --max-edge 0.5 --rays 400 --method paper --cube-size 4 -q -o "$tmp/paper.vdsh" || exit 1
+"$bake" builtin:room --max-edge 0.5 --rays 400 --cube-size 4 --encoding f16 -q -o "$tmp/room.vdsh" || exit 1
+"$bake" builtin:room --max-edge 0.5 --rays 400 --method paper --cube-size 4 --encoding f16 -q -o "$tmp/paper.vdsh" || exit 1
 if [[ -f $SPONZA ]]; then
-  "$bake" "$SPONZA" --rays 256 --cube-size 4 -q -o "$tmp/sponza.vdsh" || exit 1
+  "$bake" "$SPONZA" --rays 256 --cube-size 4 --encoding f16 -q -o "$tmp/sponza.vdsh" || exit 1
 else
   echo "no Sponza at $SPONZA: the room only"
 fi

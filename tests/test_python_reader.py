@@ -4,14 +4,17 @@ against the C reader (tools/vdsh-info, formats/vdsh.c).
 Installs python/ with pip (--no-build-isolation --no-index, into WORK: no
 network, Debian's pip and setuptools), imports it from there, and checks:
 - the SH basis against formats/VDSH.md's table of values;
-- on files baked here (default, paper f32, lsq with the quantity chosen per
-  order, a Hann window, with --record-timings) and on every file of
+- on files baked here (default (s8s6), f16, s8, paper f32, lsq with the
+  quantity chosen per order, a Hann window, with --record-timings) and on every file of
   tests/corpus/vdsh: both readers accept or both refuse; where both accept,
   the fields vdsh-info --json prints agree (counts, bake parameters,
   streams, coefficient 0's min/max/mean, statistics);
-- a corruption sweep: a small good file with one byte changed (xor 0x55)
-  at 400 evenly spread offsets: both readers accept and refuse the same
-  files (a changed byte anywhere must be refused: CRCs);
+- corruption sweeps: a small good file (f16, s8, s8s6) with one byte changed
+  (xor 0x55) at 400 evenly spread offsets: both readers accept and refuse
+  the same files (a changed byte anywhere must be refused: CRCs);
+- the s8 and s8s6 bakes against the f16 one: every coefficient within
+  half its index's step (plus f16 rounding), scales the largest |c| per
+  index;
 - reconstruction: for the default bake's order-5 log stream, distances
   toward 64 directions at 50 vertices equal exp of the SH sum clamped to
   max_distance, and lie in (0, max_distance].
@@ -117,7 +120,12 @@ baked = {}
 for name, args in (("default", []), ("paper-f32", ["--method", "paper", "--encoding", "f32"]),
                    ("lsq-auto", ["--method", "lsq", "--quantity", "auto"]),
                    ("hann", ["--method", "lsq", "--window", "hann"]),
-                   ("timings", ["--record-timings", "--orders", "3"])):
+                   ("timings", ["--record-timings", "--orders", "3", "--encoding", "f16"]),
+                   ("f16", ["--encoding", "f16"]),
+                   ("s8", ["--encoding", "s8"]),
+                   ("s8-small", ["--encoding", "s8", "--orders", "3"]),
+                   ("s8s6", ["--encoding", "s8s6"]),
+                   ("s8s6-small", ["--encoding", "s8s6", "--orders", "3,5"])):
     out = os.path.join(work, name + ".vdsh")
     r = subprocess.run([bake, "builtin:room", "--max-edge", "1.5", "--rays", "256", "-q",
                         "--cube-size", "0", "-o", out] + args, capture_output=True, text=True)
@@ -130,23 +138,42 @@ corpus = sorted(glob.glob(os.path.join(src, "tests", "corpus", "vdsh", "*")))
 accepted = sum(compare(f) is not None for f in corpus)
 print("corpus: %d files, %d accepted by both" % (len(corpus), accepted))
 
-# Corruption sweep on the smallest baked file.
-good = os.path.join(work, "timings.vdsh")
-data = open(good, "rb").read()
-bad = os.path.join(work, "bad.vdsh")
-refused = 0
-for off in np.linspace(0, len(data) - 1, 400).astype(int):
-    d = bytearray(data)
-    d[off] ^= 0x55
-    open(bad, "wb").write(d)
-    c_ok = c_reader(bad) is not None
-    p_ok = not isinstance(py_reader(bad), str)
-    if c_ok != p_ok:
-        fail.append("corrupt byte %d: C %s, Python %s" % (off, c_ok, p_ok))
-    refused += not p_ok
-print("corruption sweep: 400 files, %d refused by both" % refused)
-if refused != 400:
-    fail.append("a changed byte was accepted (%d of 400 refused)" % refused)
+# Corruption sweeps on the smallest baked files (f16, and s8 with its
+# scale table).
+for small in ("timings", "s8-small", "s8s6-small"):
+    good = os.path.join(work, small + ".vdsh")
+    data = open(good, "rb").read()
+    bad = os.path.join(work, "bad.vdsh")
+    refused = 0
+    for off in np.linspace(0, len(data) - 1, 400).astype(int):
+        d = bytearray(data)
+        d[off] ^= 0x55
+        open(bad, "wb").write(d)
+        c_ok = c_reader(bad) is not None
+        p_ok = not isinstance(py_reader(bad), str)
+        if c_ok != p_ok:
+            fail.append("%s: corrupt byte %d: C %s, Python %s" % (small, off, c_ok, p_ok))
+        refused += not p_ok
+    print("corruption sweep (%s): 400 files, %d refused by both" % (small, refused))
+    if refused != 400:
+        fail.append("%s: a changed byte was accepted (%d of 400 refused)" % (small, refused))
+
+# s8 and s8s6 against f16 of the same bake: each coefficient within half
+# its step (scale_i / (2 levels_i)) plus f16's own rounding (relative 2^-11
+# of its scale).
+f16 = baked.get("f16")
+for enc in ("s8", "s8s6"):
+    q = baked.get(enc)
+    if not (f16 and q):
+        continue
+    for a, b in zip(f16.streams, q.streams):
+        ca, cb = vdsh.coefficients(a).astype(np.float64), vdsh.coefficients(b).astype(np.float64)
+        tol = b["coef_scales"] / (2.0 * b["levels"]) * (1 + 1e-5) + a["scale"] * 2.0 ** -11
+        if b["encoding"] != enc or not (np.abs(ca - cb) <= tol).all():
+            fail.append("%s order %d: not within half a step of f16" % (enc, b["order"]))
+        if not np.allclose(b["coef_scales"], np.abs(ca).max(axis=0), rtol=1e-3,
+                           atol=a["scale"] * 2.0 ** -11):
+            fail.append("%s order %d: scales are not the largest |c| per index" % (enc, b["order"]))
 
 f = baked.get("default")
 if f:
@@ -163,6 +190,6 @@ if f:
 
 for m in fail:
     print("FAIL:", m)
-print("python reader: %d files compared, %s" % (len(baked) + len(corpus) + 400,
+print("python reader: %d files compared, %s" % (len(baked) + len(corpus) + 1200,
                                                   "agrees with the C reader" if not fail else "DISAGREES"))
 sys.exit(1 if fail else 0)

@@ -92,7 +92,9 @@ static inline void rt_file_bounds(rt_file *r)
 /* Add a stream whose coefficients coef (vertex-major, order^2 each, taken
  * over) are stored in `enc`: f16 as coef / scale rounded (coef is then
  * replaced by what the file really holds, so references use the exact
- * stored values), f32 as coef / scale too (scale need not be 1). */
+ * stored values), f32 as coef / scale too (scale need not be 1), s8 and
+ * s8s6 by vdsh_encode_quantised (scale ignored: 1; coef replaced by the
+ * decoded values as for f16). */
 static inline void rt_file_add_stream(rt_file *r, uint32_t order, uint32_t enc, uint32_t quantity,
                                float *coef, float scale)
 {
@@ -113,6 +115,21 @@ static inline void rt_file_add_stream(rt_file *r, uint32_t order, uint32_t enc, 
             coef[k] = vdsh_f32_from_f16(d[k]) * scale;
         }
         r->data[i] = d;
+    } else if (vdsh_encoding_quantised(enc)) {
+        /* vdsh_encode_quantised picks the scales (scale must be 1) */
+        uint32_t nv = r->f.header.vertex_count, nc = order * order;
+        float *d = malloc(VDSH_MAX_COEFFS * sizeof(float) + nv * vdsh_encoding_bytes(enc, nc) + 1);
+        uint8_t *b = (uint8_t *)(d + VDSH_MAX_COEFFS);
+        if (vdsh_encode_quantised(enc, coef, nv, nc, d, b) != VDSH_OK)
+            abort();
+        s->scale = 1.0f;
+        s->coef_scales = d;
+        s->data = b;
+        for (uint32_t v = 0; v < nv; v++)
+            vdsh_stream_decode(s, v, coef + (size_t)v * nc);
+        r->data[i] = d;
+        r->coef[i] = coef;
+        return;
     } else {
         float *d = malloc(n * 4 + 4);
         for (size_t k = 0; k < n; k++) {

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sharded bakes: vdsh-bake --shard I/N parts joined by vdsh-merge give the
 # whole bake's file (and basis cubemaps) byte for byte for 1, 2, 7 and 64
-# shards, f16 and f32; vdsh-merge refuses parts that do not belong together
+# shards, f16, f32, s8 and s8s6; vdsh-merge refuses parts that do not belong together
 # (other inputs, other options, a whole file, missing, duplicate shards)
 # naming the part, and writes nothing then; a shard killed mid-bake leaves
 # no part, and rerunning it alone completes the set.
@@ -52,6 +52,22 @@ for i in 0 1 2; do
 done
 expect_exit 0 "merge f32" "$merge" -q "$d"/p*.vdsh -o "$d/scene.vdsh"
 check "3 f32 shards: identical to the whole f32 bake" cmp "$d/scene.vdsh" "$tmp/whole32.vdsh"
+# s8, s8s6: the merge quantises with the whole bake's rule
+# (vdsh_encode_quantised: per-index scales over all receivers), so 1, 3 and
+# 7 shards give its bytes.
+for enc in s8 s8s6; do
+  expect_exit 0 "whole bake $enc" "$bake" "${tiny[@]}" --encoding $enc -o "$tmp/whole-$enc.vdsh"
+  for n in 1 3 7; do
+    d=$tmp/$enc-$n; mkdir -p "$d"
+    for ((i = 0; i < n; i++)); do
+      expect_exit 0 "$enc shard $i/$n" "$bake" "${tiny[@]}" --encoding $enc --shard "$i/$n" -o "$d/p$i.vdsh"
+    done
+    expect_exit 0 "merge $enc $n" "$merge" -q "$d"/p*.vdsh -o "$d/scene.vdsh"
+    check "$n $enc shards: identical to the whole $enc bake" cmp "$d/scene.vdsh" "$tmp/whole-$enc.vdsh"
+  done
+done
+expect_exit 1 "s8 and f16 parts refused together" "$merge" -q "$tmp"/s8-3/p0.vdsh "$tmp"/s8-3/p1.vdsh "$tmp"/f32/p2.vdsh -o "$tmp/mixed.vdsh"
+says "mixed encodings" "another --encoding"
 
 # Refusals, each naming the part; nothing written.
 p=$tmp/n7

@@ -213,6 +213,15 @@ static void print_summary(const char *path, const vdsh_file *f,
         if (s->window != VDSH_WINDOW_NONE)
             printf(" (param %g)", s->window_param);
         printf(", method_param %g, scale %g\n", s->method_param, s->scale);
+        if (vdsh_encoding_quantised(s->encoding) && s->coef_scales) {
+            /* the per-index table: coefficient i = stored * scale_i / levels_i */
+            uint32_t nc = s->order * s->order;
+            printf("        %s scales (largest |coefficient| per index):",
+                   vdsh_encoding_name(s->encoding));
+            for (uint32_t k = 0; k < nc; k++)
+                printf("%s%g", k % 9 == 0 && k ? "\n          " : " ", s->coef_scales[k]);
+            putchar('\n');
+        }
         printf("        %zu bytes per vertex\n",
                vdsh_stream_bytes_per_vertex(s));
         printf("        coefficient 0: min %g, max %g, mean %g\n", st.min,
@@ -308,6 +317,11 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
         vt_json_string(&j, o, "window", vdsh_window_name(s->window));
         vt_json_f32(&j, o, "window_param", s->window_param);
         vt_json_f32(&j, o, "scale", s->scale);
+        if (vdsh_encoding_quantised(s->encoding) && s->coef_scales) {
+            cJSON *t = vt_json_array(&j, o, "coef_scales");
+            for (uint32_t k = 0; k < s->order * s->order; k++)
+                vt_json_f32(&j, t, NULL, s->coef_scales[k]);
+        }
         vt_json_u64(&j, o, "bytes_per_vertex", vdsh_stream_bytes_per_vertex(s));
         cJSON *c0 = vt_json_object(&j, o, "coefficient0");
         vt_json_f32(&j, c0, "min", (float)st.min);

@@ -183,7 +183,8 @@ void vb_bake_output_free(vb_bake_output *out);
 /* The .vdsh stream of one order (1 .. max_order) of a bake: its first
  * order^2 coefficients per vertex, as f32, or as f16 scaled by the
  * stream's largest |coefficient| (stored values in [-1, 1]), encoded on
- * b->threads workers. *storage receives the data the stream points at;
+ * b->threads workers, or as s8 (vdsh_encode_s8). *storage receives the
+ * block the stream points into (data, and an s8 stream's coef_scales);
  * the caller frees it. */
 vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encoding,
                          vdsh_stream *out, void **storage, vb_error *err);

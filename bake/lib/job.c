@@ -119,6 +119,12 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
     return VB_OK;
 }
 
+/* The encoding of the whole bake's streams (a part's are f32 whatever it is). */
+static vdsh_encoding job_encoding(const vb_job_desc *d)
+{
+    return d->encoding_given ? d->encoding : VB_DEFAULT_ENCODING;
+}
+
 vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
 {
     const vb_bake_output *b = &j->bake;
@@ -127,8 +133,7 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!b->coeffs[o])
             continue;
-        vb_result r = vb_bake_stream(b, o, d->f32 || d->shard_count ? VDSH_ENCODING_F32
-                                                                    : VDSH_ENCODING_F16,
+        vb_result r = vb_bake_stream(b, o, d->shard_count ? VDSH_ENCODING_F32 : job_encoding(d),
                                      &j->streams[count], &j->stream_data[count], err);
         if (r != VB_OK)
             return r;
@@ -185,7 +190,7 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
     if (d->shard_count) {
         f.has_part = 1;
         f.part = (vdsh_part){.index = d->shard_index, .count = d->shard_count,
-                             .encoding = d->f32 ? VDSH_ENCODING_F32 : VDSH_ENCODING_F16};
+                             .encoding = job_encoding(d)};
         vb_shard_range(h->vertex_count, d->shard_index, d->shard_count, &f.part.range_begin,
                        &f.part.range_end);
     }

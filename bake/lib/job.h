@@ -14,7 +14,8 @@
  *     vb_job_free(&j);
  *
  * A zero vb_job_desc (apart from paths and output) is vdsh-bake's defaults
- * (bake.h's for the bake; f16 coefficients; 64 x 64 basis cubemaps).
+ * (bake.h's for the bake; VB_DEFAULT_ENCODING coefficients; 64 x 64 basis
+ * cubemaps).
  * The basis cubemaps depend on their size only: vb_job_load starts a
  * helper thread that encodes them in memory while the bake runs.
  *
@@ -42,6 +43,9 @@
 extern "C" {
 #endif
 
+/* vdsh-bake's coefficient encoding when none is asked for. */
+#define VB_DEFAULT_ENCODING VDSH_ENCODING_S8S6
+
 typedef struct vb_job_desc {
     const char *const *paths;  /* meshes (mesh.h names), borrowed */
     uint32_t path_count;       /* 1..VDSH_MAX_SOURCES */
@@ -56,7 +60,12 @@ typedef struct vb_job_desc {
     /* The bake (receivers and scene are the job's). Its orders give the
      * streams, in increasing order. */
     vb_bake_desc bake;
-    int f32;                   /* 1: f32 coefficients; 0: f16 (default) */
+    /* The coefficient encoding: `encoding` when encoding_given, else
+     * VB_DEFAULT_ENCODING (s8s6: within 0.02% of f16's shadow and image
+     * error on the validation rooms at half the size or less;
+     * docs/ACCURACY.md, "Compact streams"). */
+    int encoding_given;
+    vdsh_encoding encoding;
     int cube_size;             /* basis cubemap face; 0: 64; < 0: none */
     int record_timings;        /* store the timings in the file */
     /* A shard (vdsh-bake --shard I/N): shard_count 0 is the whole bake;

@@ -1,6 +1,7 @@
 /* stream.c - a bake's coefficients as .vdsh streams (vb_bake_stream in
- * bake.h): f32 as they are, or f16 scaled by the stream's largest
- * |coefficient|, encoded in chunks on the bake's workers. */
+ * bake.h): f32 as they are, f16 scaled by the stream's largest
+ * |coefficient|, encoded in chunks on the bake's workers, or s8 with a
+ * scale per coefficient index (vdsh_encode_s8, one pass: bytes, cheap). */
 #include "bake.h"
 
 #include <math.h>
@@ -52,7 +53,8 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encod
 {
     if (order < 1 || order > VDSH_MAX_ORDER || !b->coeffs[order])
         return vb_fail(err, VB_ERR_ARGUMENT, "order %d is not in the bake", order);
-    if (encoding != VDSH_ENCODING_F16 && encoding != VDSH_ENCODING_F32)
+    if (encoding != VDSH_ENCODING_F16 && encoding != VDSH_ENCODING_F32 &&
+        !vdsh_encoding_quantised(encoding))
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown encoding %u", encoding);
     const vb_method_info *mi = vb_method_stored(b->method);
     if (!mi)
@@ -74,6 +76,25 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encod
                            order);
         memcpy(f, b->coeffs[order], count * sizeof *f);
         s.data = f;
+    } else if (vdsh_encoding_quantised(encoding)) {
+        /* One block: the scale table (order^2 floats), then the bytes. */
+        size_t bytes_n = (size_t)b->vertex_count * vdsh_encoding_bytes(encoding, (uint32_t)nc);
+        float *block = malloc(VDSH_MAX_COEFFS * sizeof(float) + bytes_n + 1);
+        if (!block)
+            return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the order %d stream",
+                           order);
+        uint8_t *bytes = (uint8_t *)(block + VDSH_MAX_COEFFS);
+        if (vdsh_encode_quantised(encoding, b->coeffs[order], b->vertex_count, (uint32_t)nc,
+                                  block, bytes) != VDSH_OK) {
+            free(block);
+            return vb_fail(err, VB_ERR_INVALID, "order %d coefficients do not fit %s", order,
+                           vdsh_encoding_name(encoding));
+        }
+        s.coef_scales = block;
+        s.data = bytes;
+        *storage = block;
+        *out = s;
+        return VB_OK;
     } else {
         /* Stored values are coefficient / (the stream's largest
          * |coefficient|): within [-1, 1] whatever the scene's size or clamp

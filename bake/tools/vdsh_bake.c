@@ -132,7 +132,11 @@ static void usage(FILE *f)
 "  -o, --output FILE       the .vdsh file to write (atomically)\n"
 "      --cubemap-dir DIR   where the SH basis cubemaps go (default: beside OUT)\n"
 "      --cube-size N       cubemap face size in texels (default 64; 0: none)\n"
-"      --encoding E        coefficient encoding: f16 (default) or f32\n"
+"      --encoding E        coefficient encoding: s8s6 (default: bands 0-1 signed\n"
+"                          8-bit, bands 2+ 6-bit, a scale per coefficient\n"
+"                          index; 4, 8, 24 bytes per vertex at orders 2, 3, 5),\n"
+"                          s8 (all 8-bit: 4, 9, 25), f16 (8, 18, 50) or f32;\n"
+"                          compact ones within 0.1%% of f16: docs/ACCURACY.md\n"
 "      --shard I/N         bake shard I (0-based) of N only and write a part\n"
 "                          file; vdsh-merge joins the N parts into the file\n"
 "                          the whole bake writes, byte for byte\n"
@@ -436,7 +440,7 @@ int main(int argc, char **argv)
     o.rays = 2500;
     o.orders[0] = 2, o.orders[1] = 3, o.orders[2] = 5, o.order_count = 3;
     /* method and quantity: 0 is the default (shadow, auto) */
-    o.encoding = VDSH_ENCODING_F16;
+    o.encoding = VB_DEFAULT_ENCODING;
     o.seed = 1;
     o.robust = 1;
     o.cube_size = 64;
@@ -525,7 +529,9 @@ int main(int argc, char **argv)
         case O_ENCODING:
             if (strcmp(optarg, "f16") == 0) o.encoding = VDSH_ENCODING_F16;
             else if (strcmp(optarg, "f32") == 0) o.encoding = VDSH_ENCODING_F32;
-            else return bad_usage("--encoding takes f16 or f32, not '%s'", optarg);
+            else if (strcmp(optarg, "s8") == 0) o.encoding = VDSH_ENCODING_S8;
+            else if (strcmp(optarg, "s8s6") == 0) o.encoding = VDSH_ENCODING_S8S6;
+            else return bad_usage("--encoding takes f16, f32, s8 or s8s6, not '%s'", optarg);
             break;
         case O_MAXDIST:
             if (!parse_float(optarg, &o.max_distance) || o.max_distance == 0.0f)
@@ -681,7 +687,8 @@ int main(int argc, char **argv)
                  .window = o.window, .order_mask = order_mask, .threads = o.threads,
                  .keep_normals = o.keep_normals, .trace_only = o.trace_only,
                  .progress = on_progress, .progress_user = &pr},
-        .f32 = o.encoding == VDSH_ENCODING_F32,
+        .encoding_given = 1,
+        .encoding = o.encoding,
         .cube_size = o.cube_size > 0 ? o.cube_size : -1,
         .record_timings = o.record_timings,
         .shard_index = shard_index, .shard_count = shard_count,

@@ -11,7 +11,8 @@
  * range vb_shard_range gives it. A refusal names the part (and, for
  * missing shards, their numbers). The coefficients are then copied range
  * by range and encoded as vdsh-bake encodes them (f16: scaled by the
- * stream's largest |coefficient|), the ray counts summed, and the file and
+ * stream's largest |coefficient|; s8, s8s6: vdsh_encode_quantised's scale
+ * per coefficient index), the ray counts summed, and the file and
  * its basis cubemaps written atomically.
  *
  * Memory: every part is read whole (the parts together are about the
@@ -133,7 +134,8 @@ int main(int argc, char **argv)
     vdsh_file **parts = calloc((size_t)n, sizeof *parts);
     int status = 1;
     float *merged[VDSH_MAX_STREAMS] = {0};
-    uint16_t *encoded[VDSH_MAX_STREAMS] = {0};
+    void *encoded[VDSH_MAX_STREAMS] = {0};
+    float s8_scales[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS];
     int *owner = NULL;
     float *normals = NULL;
     vb_cubemap_basis basis = {0};
@@ -251,6 +253,22 @@ int main(int argc, char **argv)
                     VDSH_OK) {
                 fprintf(stderr, "vdsh-merge: order %u coefficients do not fit f16\n",
                         streams[s].order);
+                goto out;
+            }
+            free(merged[s]);
+            merged[s] = NULL;
+            streams[s].data = encoded[s];
+        } else if (vdsh_encoding_quantised(p0->part.encoding)) {
+            /* As vb_bake_stream: the one quantiser, vdsh_encode_quantised. */
+            uint32_t e = p0->part.encoding;
+            streams[s].encoding = e;
+            streams[s].scale = 1.0f;
+            streams[s].coef_scales = s8_scales[s];
+            if (!(encoded[s] = malloc((size_t)V * vdsh_encoding_bytes(e, (uint32_t)nc) + 1)) ||
+                vdsh_encode_quantised(e, merged[s], V, (uint32_t)nc, s8_scales[s], encoded[s]) !=
+                    VDSH_OK) {
+                fprintf(stderr, "vdsh-merge: order %u coefficients do not fit %s\n",
+                        streams[s].order, vdsh_encoding_name(e));
                 goto out;
             }
             free(merged[s]);

@@ -4,7 +4,8 @@
     f = vdsh.read("room.vdsh")          # raises vdsh.VdshError naming the problem
     f.header["vertex_count"], f.positions (V x 3), f.normals, f.triangles (T x 3)
     s = f.streams[0]                   # dict: order, encoding, method, quantity, ...
-    c = vdsh.coefficients(s)           # V x order^2 float32 (stored x scale)
+    c = vdsh.coefficients(s)           # V x order^2 float32 (stored x scale;
+                                       # s8, s8s6: stored x float32(scale_i / levels_i))
     d = vdsh.reconstruct(f, s, v, dirs)    # distances of vertex v toward unit dirs (N x 3)
 
 Every reading rule of the spec is checked; numpy only.
@@ -19,7 +20,7 @@ __version__ = "0.1.0"
 
 MAGIC = b"VDSH\r\n\x1a\n"
 METHODS = ["paper", "full", "mirror", "lsq", "shadow"]
-ENCODINGS = ["f32", "f16"]
+ENCODINGS = ["f32", "f16", "s8", "s8s6"]
 QUANTITIES = ["distance", "distance2", "log-distance"]
 WINDOWS = ["none", "hann", "lanczos"]
 KNOWN = {b"HEAD", b"SRCS", b"POSN", b"NORM", b"TRIS", b"COEF", b"stat", b"time"}
@@ -201,7 +202,7 @@ def _coef(f, b, path):
         _fail(path, "COEF shorter than its header")
     order, enc, method, qty, win = struct.unpack_from("<5I", b, 0)
     wp, mp, scale, qp = struct.unpack_from("<4f", b, 20)
-    if not 1 <= order <= 5 or enc > 1 or qty > 2 or win > 2:
+    if not 1 <= order <= 5 or enc > 3 or qty > 2 or win > 2:
         _fail(path, "COEF: order, encoding, quantity or window out of range")
     if not _finite(wp, mp) or (win == 0 and wp != 0) or (win != 0 and not wp > 0):
         _fail(path, "COEF: window_param or method_param out of range")
@@ -211,14 +212,53 @@ def _coef(f, b, path):
         _fail(path, "COEF: quantity_param out of range")
     if any(b[36:48]):
         _fail(path, "COEF: reserved bytes 36..47 not zero")
-    n = V * order * order
-    width = 4 if enc == 0 else 2
-    if len(b) != 48 + n * width:
-        _fail(path, "COEF: payload is %d bytes, must be %d" % (len(b), 48 + n * width))
-    stored = np.frombuffer(b, "<f4" if enc == 0 else "<f2", n, 48).reshape(V, order * order)
-    if not np.isfinite(stored).all():
+    nc = order * order
+    n = V * nc
+    # bytes per vertex; s8s6: coefficients 0..3 as bytes, then u32 words
+    # of five 6-bit fields (coefficients 4..)
+    words = (nc - 4 + 4) // 5 if enc == 3 and nc > 4 else 0
+    bpv = [4 * nc, 2 * nc, nc, min(nc, 4) + 4 * words][enc]
+    # s8, s8s6: order^2 f32 scales, zero-padded to 16 bytes, before the data
+    table = (nc * 4 + 15) // 16 * 16 if enc >= 2 else 0
+    if len(b) != 48 + table + V * bpv:
+        _fail(path, "COEF: payload is %d bytes, must be %d" % (len(b), 48 + table + V * bpv))
+    scales = levels = None
+    if enc >= 2:
+        levels = np.array([31 if enc == 3 and i >= 4 else 127 for i in range(nc)], np.float32)
+        if scale != 1:
+            _fail(path, "COEF: scale must be 1 for %s" % ENCODINGS[enc])
+        scales = np.frombuffer(b, "<f4", nc, 48)
+        if not (np.isfinite(scales).all() and (scales >= 0).all()):
+            _fail(path, "COEF: a scale of the table is not finite and >= 0")
+        with np.errstate(over="ignore"):
+            if not np.isfinite(levels * (scales / levels)).all():
+                _fail(path, "COEF: a scale's steps overflow f32")
+        if any(b[48 + nc * 4:48 + table]):
+            _fail(path, "COEF: padding after the scale table not zero")
+    if enc == 3:
+        raw = np.frombuffer(b, np.uint8, V * bpv, 48 + table).reshape(V, bpv)
+        stored = np.empty((V, nc), np.int32)
+        stored[:, :min(nc, 4)] = raw[:, :min(nc, 4)].view(np.int8)
+        if words:
+            w = raw[:, 4:].copy().view("<u4").reshape(V, words)
+            for i in range(4, nc):
+                fld = (w[:, (i - 4) // 5] >> np.uint32(6 * ((i - 4) % 5))) & np.uint32(63)
+                stored[:, i] = fld.astype(np.int32) - 64 * (fld >= 32)
+            used = np.array([(1 << (6 * min(5, nc - 4 - 5 * k))) - 1 for k in range(words)],
+                            np.uint32)
+            if (w & ~used).any():
+                _fail(path, "COEF: unused bits of an s8s6 word not zero")
+        if (stored < -levels.astype(np.int32)).any():
+            _fail(path, "COEF: an s8s6 stored value is below its range")
+    elif enc == 2:
+        stored = np.frombuffer(b, "i1", n, 48 + table).reshape(V, nc)
+        if (stored == -128).any():
+            _fail(path, "COEF: an s8 stored value is -128 (range -127..127)")
+    else:
+        stored = np.frombuffer(b, ["<f4", "<f2"][enc], n, 48 + table).reshape(V, nc)
+    if enc < 2 and not np.isfinite(stored).all():
         _fail(path, "COEF: a stored value is not finite")
-    big = float(np.abs(stored).max()) if n else 0.0
+    big = float(np.abs(stored.astype(np.float32)).max()) if n else 0.0
     with np.errstate(over="ignore"):
         if not np.isfinite(np.float32(big) * np.float32(scale)):
             _fail(path, "COEF: a stored value times scale overflows f32")
@@ -230,11 +270,16 @@ def _coef(f, b, path):
                           method=METHODS[method] if method < len(METHODS) else method,
                           method_id=method, quantity=QUANTITIES[qty], window=WINDOWS[win],
                           window_param=wp, method_param=mp, scale=scale, quantity_param=qp,
-                          stored=stored))
+                          stored=stored, coef_scales=scales, levels=levels))
 
 
 def coefficients(stream):
-    """V x n^2 float32: stored value x scale (the window is already applied)."""
+    """V x n^2 float32: stored value x scale (the window is already applied);
+    s8, s8s6: stored value x step_i, step_i = float32(scale_i / levels_i),
+    levels 127 (31 for s8s6's coefficients 4..) (as vdsh.c)."""
+    if stream["encoding"] in ("s8", "s8s6"):
+        step = (stream["coef_scales"] / stream["levels"]).astype(np.float32)
+        return stream["stored"].astype(np.float32) * step
     return stream["stored"].astype(np.float32) * np.float32(stream["scale"])
 
 
