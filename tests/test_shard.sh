@@ -107,4 +107,28 @@ expect_exit 0 "rerun shard 5" "$bake" "${tiny[@]}" --shard 5/7 -o "$k/part-5.vds
 expect_exit 0 "merge after rerun" "$merge" -q "$k"/part-*.vdsh -o "$k/scene.vdsh"
 check "rerun set identical to the whole bake" cmp "$k/scene.vdsh" "$tmp/whole.vdsh"
 
+# Adaptive receivers: planned once (--adaptive ... --plan), the plan baked
+# whole and in 1, 2 and 7 shards (--receivers): byte for byte.
+expect_exit 0 "adaptive plan" "$bake" builtin:room --max-edge 1.5 --adaptive 0.05 --rays 256 -q \
+  --plan "$tmp/plan.obj"
+check "the plan is written, no .vdsh beside it" test -s "$tmp/plan.obj"
+planned=(builtin:room --receivers "$tmp/plan.obj" --rays 32 --cube-size 8 -q)
+expect_exit 0 "whole bake of the plan" "$bake" "${planned[@]}" -o "$tmp/plan-whole.vdsh"
+for n in 1 2 7; do
+  d=$tmp/plan$n; mkdir -p "$d"
+  for ((i = 0; i < n; i++)); do
+    expect_exit 0 "plan shard $i/$n" "$bake" "${planned[@]}" --shard "$i/$n" -o "$d/part-$i.vdsh"
+  done
+  expect_exit 0 "merge plan $n" "$merge" -q "$d"/part-*.vdsh -o "$d/scene.vdsh"
+  check "plan, $n shards: identical to the whole bake of the plan" cmp "$d/scene.vdsh" "$tmp/plan-whole.vdsh"
+done
+expect_exit 2 "--adaptive with --shard is refused" "$bake" builtin:room --max-edge 1.5 --adaptive 0.05 \
+  --shard 0/2 -o "$out"
+says "--adaptive with --shard" "shard the plan"
+expect_exit 2 "--plan without --adaptive" "$bake" "${tiny[@]}" --plan "$tmp/x.obj"
+expect_exit 2 "--receivers with --max-edge" "$bake" builtin:room --receivers "$tmp/plan.obj" --max-edge 1 -o "$out"
+expect_exit 1 "--receivers of a missing file" "$bake" builtin:room --receivers "$tmp/none.obj" -o "$out"
+says "--receivers of a missing file" "none.obj"
+check "no output after refusals" test ! -e "$out"
+
 exit $fail

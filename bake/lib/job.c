@@ -75,7 +75,13 @@ vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err)
 vb_result vb_job_refine(vb_job *j, const vb_job_desc *d, vb_error *err)
 {
     double t = vb_now();
-    vb_result r = vb_mesh_refine(&j->occluders, d->max_edge, &j->receivers, err);
+    vb_result r;
+    if (d->receivers_path) {
+        vb_load_desc ld = {0};
+        r = vb_mesh_load(d->receivers_path, &ld, &j->receivers, NULL, err);
+    } else {
+        r = vb_mesh_refine(&j->occluders, d->max_edge, &j->receivers, err);
+    }
     j->timings.refine = vb_now() - t;
     return r;
 }

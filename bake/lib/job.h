@@ -54,6 +54,8 @@ typedef struct vb_job_desc {
     int weld;                  /* vb_load_desc.weld */
     float max_edge;            /* receivers refined to it; 0: the vertices as they are.
                                 * With adaptive: where the refinement starts */
+    const char *receivers_path; /* receivers read from this mesh as they are (a plan:
+                                * vdsh-bake --receivers); NULL: the occluders, refined */
     int adaptive;              /* 1: adaptive receivers (adaptive.h) from there */
     vb_adaptive_desc adapt;
     int fast_traversal;        /* 0: Embree's robust traversal (default) */
@@ -109,7 +111,8 @@ int vb_job_cube_size(const vb_job_desc *d);
 /* Load every mesh into one occluder scene and record its source. */
 vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err);
 
-/* The receivers: the occluders' vertices, refined to max_edge. */
+/* The receivers: the occluders' vertices, refined to max_edge, or the
+ * mesh at receivers_path as it is. */
 vb_result vb_job_refine(vb_job *j, const vb_job_desc *d, vb_error *err);
 
 /* Build the BVH and bake (bake.h); timings recorded. */

@@ -37,6 +37,8 @@ typedef struct options {
     const char *cubemap_dir;
     const char *report;
     const char *export_obj;
+    const char *plan;          /* --plan: the adaptive receivers, as OBJ */
+    const char *receivers;     /* --receivers: a plan to bake */
     uint32_t rays;
     int adaptive_rays;         /* --rays auto */
     float ray_tolerance;       /* --ray-tolerance; 0: the default */
@@ -193,6 +195,11 @@ static void usage(FILE *f)
 "                          (default: --max-edge / 8)\n"
 "      --max-receivers N   with --adaptive: stop at N receivers, splitting\n"
 "                          the largest errors first\n"
+"      --plan FILE         with --adaptive: also write the receivers (OBJ,\n"
+"                          exact floats), so that shards can bake them\n"
+"                          (without -o: the plan only)\n"
+"      --receivers FILE    bake these receivers (a mesh file, e.g. a plan)\n"
+"                          as they are, instead of the scene's vertices\n"
 "      --weld              merge vertices with identical positions\n"
 "      --keep-normals      keep normals that point into geometry (default:\n"
 "                          a receiver blocked at ~0 on its own side and open\n"
@@ -448,7 +455,7 @@ int main(int argc, char **argv)
     enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
            O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL, O_SHARD,
-           O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS };
+           O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS, O_PLAN, O_RECEIVERS };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
@@ -478,6 +485,8 @@ int main(int argc, char **argv)
         {"window", required_argument, 0, O_WINDOW},
         {"shard", required_argument, 0, O_SHARD},
         {"adaptive", required_argument, 0, O_ADAPTIVE},
+        {"plan", required_argument, 0, O_PLAN},
+        {"receivers", required_argument, 0, O_RECEIVERS},
         {"min-edge", required_argument, 0, O_MIN_EDGE},
         {"max-receivers", required_argument, 0, O_MAX_RECEIVERS},
         {"quiet", no_argument, 0, 'q'},
@@ -581,6 +590,8 @@ int main(int argc, char **argv)
         case O_REPORT: o.report = optarg; break;
         case O_TIMINGS: o.record_timings = 1; break;
         case O_EXPORT: o.export_obj = optarg; break;
+        case O_PLAN: o.plan = optarg; break;
+        case O_RECEIVERS: o.receivers = optarg; break;
         case O_TRACE_ONLY: o.trace_only = 1; break;
         case O_LOG: o.quantity = VB_QUANTITY_LOG; break;
         case O_QUANTITY:
@@ -640,8 +651,14 @@ int main(int argc, char **argv)
     if (o.adaptive && o.min_edge == 0.0f)
         o.min_edge = o.max_edge / 8.0f;
     if (o.adaptive && shard_count)
-        return bad_usage("%s", "--adaptive cannot be combined with --shard yet: the "
-                               "refinement bakes as it decides");
+        return bad_usage("%s", "--adaptive cannot be combined with --shard: the refinement "
+                               "bakes as it decides. Plan it once (--adaptive ... --plan "
+                               "plan.obj), then shard the plan (--receivers plan.obj --shard I/N)");
+    if (o.plan && !o.adaptive)
+        return bad_usage("%s", "--plan needs --adaptive TOL: it writes the adaptive receivers");
+    if (o.receivers && (o.adaptive || o.max_edge > 0.0f || o.weld))
+        return bad_usage("%s", "--receivers takes the receivers as they are: not with "
+                               "--adaptive, --max-edge or --weld");
     int nmesh = argc - optind;
     if (nmesh < 1)
         return bad_usage("%s", "no mesh given");
@@ -657,7 +674,7 @@ int main(int argc, char **argv)
     if (o.lambda != 0.0f && mi->lambda_fixed)
         return bad_usage("--lambda is lsq's: method %s uses lsq's default (its method "
                          "parameter is the log offset)", vb_method_name(o.method));
-    if (!o.output && !o.export_obj && !o.trace_only)
+    if (!o.output && !o.export_obj && !o.trace_only && !o.plan)
         return bad_usage("%s", "no output: give -o OUT.vdsh (or --export-obj FILE)");
     FILE *log = o.quiet ? NULL : stderr;
 
@@ -673,7 +690,7 @@ int main(int argc, char **argv)
         .paths = (const char *const *)argv + optind, .path_count = (uint32_t)nmesh,
         .output = o.trace_only ? NULL : o.output, .cubemap_dir = o.cubemap_dir,
         .weld = o.weld, .max_edge = o.max_edge, .fast_traversal = !o.robust,
-        .adaptive = o.adaptive,
+        .adaptive = o.adaptive, .receivers_path = o.receivers,
         .adapt = {.tolerance = o.adaptive_tol, .min_edge = o.min_edge,
                   .max_receivers = o.max_receivers,
                   .max_rounds = getenv("VDSH_ROUNDS") ? (uint32_t)atoi(getenv("VDSH_ROUNDS")) : 0,
@@ -742,6 +759,26 @@ int main(int argc, char **argv)
         goto out;
     }
     const vb_bake_output *bo = &job.bake;
+    if (o.plan) {
+        /* The plan: the receivers as baked (oriented normals), exact floats. */
+        vb_mesh planned = job.receivers;
+        if (bo->normals)
+            planned.normals = bo->normals;
+        pthread_mutex_lock(&output_lock);
+        vb_result written = vb_mesh_write_obj(&planned, o.plan, &err);
+        pthread_mutex_unlock(&output_lock);
+        if (written != VB_OK) {
+            fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+            goto out;
+        }
+        if (log)
+            fprintf(log, "vdsh-bake: wrote the plan %s (%u receivers, %u triangles)\n", o.plan,
+                    planned.vertex_count, planned.triangle_count);
+        if (!o.output) {
+            status = 0;
+            goto out;
+        }
+    }
     if (log && o.adaptive)
         fprintf(log, "vdsh-bake: adaptive receivers: %u from %u in %u rounds (%u midpoints "
                      "baked, tolerance %g, min edge %g%s)\n",
