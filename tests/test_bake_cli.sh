@@ -37,7 +37,9 @@ done
 # Adaptive receivers: identical for 1 and 2 threads, recorded in the file.
 adaptive=(builtin:room --max-edge 1.5 --adaptive 0.08 --rays 256 -q)
 expect_exit 0 "adaptive, 1 thread" "$bake" "${adaptive[@]}" --threads 1 -o "$tmp/ad1.vdsh"
-expect_exit 0 "adaptive, 2 threads" "$bake" "${adaptive[@]}" --threads 2 -o "$tmp/ad2.vdsh"
+expect_exit 0 "adaptive, 2 threads" "$bake" "${adaptive[@]}" --threads 2 -o "$tmp/ad2.vdsh" \
+  --report "$tmp/ad2.json"
+check "the report says what the refinement did" grep -q '"midpoints_baked"' "$tmp/ad2.json"
 check "adaptive: 1 and 2 threads give identical files" cmp -s "$tmp/ad1.vdsh" "$tmp/ad2.vdsh"
 expect_exit 0 "vdsh-info --verify accepts an adaptive bake" "$info" --verify "$tmp/ad1.vdsh"
 "$info" "$tmp/ad1.vdsh" >"$tmp/adinfo.txt" 2>&1

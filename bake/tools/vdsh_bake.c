@@ -377,6 +377,18 @@ static int write_report(const char *path, const options *o, const vb_job *job,
     vt_json_string(&j, root, "encoding", vdsh_encoding_name(o->encoding));
     vt_json_f32(&j, root, "max_distance", b->max_distance);
     vt_json_f32(&j, root, "max_edge", o->max_edge);
+    if (o->adaptive) {
+        cJSON *ad = vt_json_object(&j, root, "adaptive");
+        vt_json_f32(&j, ad, "tolerance", o->adaptive_tol);
+        vt_json_f32(&j, ad, "min_edge", o->min_edge);
+        vt_json_u64(&j, ad, "max_receivers", o->max_receivers);
+        vt_json_u64(&j, ad, "start_receivers", job->adaptive.start_receivers);
+        vt_json_u64(&j, ad, "rounds", job->adaptive.rounds);
+        vt_json_u64(&j, ad, "midpoints_baked", job->adaptive.candidates);
+        vt_json_bool(&j, ad, "budget_reached", job->adaptive.budget_reached);
+    } else {
+        vt_json_null(&j, root, "adaptive");
+    }
     vt_json_u64(&j, root, "seed", o->seed);
     vt_json_u64(&j, root, "threads", b->threads);
     vt_json_bool(&j, root, "robust", o->robust);
