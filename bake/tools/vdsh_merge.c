@@ -236,9 +236,9 @@ int main(int argc, char **argv)
         }
         for (int i = 0; i < n; i++) {
             const vdsh_part *pt = &parts[i]->part;
+            /* A part's stream holds its range's rows only. */
             size_t a = pt->range_begin * nc, b = pt->range_end * nc;
-            memcpy(merged[s] + a, (const float *)parts[i]->streams[s].data + a,
-                   (b - a) * sizeof(float));
+            memcpy(merged[s] + a, parts[i]->streams[s].data, (b - a) * sizeof(float));
         }
         streams[s].data = merged[s];
         if (p0->part.encoding == VDSH_ENCODING_F16) {
