@@ -935,6 +935,7 @@ typedef struct layout {
     vdsh_stream streams[VDSH_MAX_STREAMS]; /* data = offset, as an integer */
     uint64_t stream_data[VDSH_MAX_STREAMS];
     uint64_t stream_table[VDSH_MAX_STREAMS]; /* s8: offset of the scales; else 0 */
+    uint64_t stream_bytes[VDSH_MAX_STREAMS]; /* COEF payload after the stream header */
     int has_stats;
     vdsh_stats stats;
     int has_timings;
@@ -1197,14 +1198,11 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
     if (!check_stream(s, i, &w))
         return invalid(r, &w);
     uint64_t table = stream_table_bytes(s->encoding, s->order);
-    uint64_t need = table + (uint64_t)L->header.vertex_count *
-                                vdsh_stream_bytes_per_vertex(s);
-    if (c->size - STREAM_HEADER_SIZE != need)
+    if (c->size - STREAM_HEADER_SIZE < table)
         return fail(r->err, VDSH_ERR_CHUNK, r->name,
-                    "%s: %llu bytes of data, %u vertices of %s need %llu", l,
+                    "%s: %llu bytes of data, shorter than its %llu-byte scale table", l,
                     (unsigned long long)(c->size - STREAM_HEADER_SIZE),
-                    L->header.vertex_count, vdsh_encoding_name(s->encoding),
-                    (unsigned long long)need);
+                    (unsigned long long)table);
     if (table) {
         size_t used = (size_t)s->order * s->order * 4;
         if (!all_zero(p + STREAM_HEADER_SIZE + used, (size_t)table - used))
@@ -1218,15 +1216,41 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
                         "%s: a second stream for order %u %s (stream %u is "
                         "the first)", l, s->order,
                         vdsh_quantity_name(s->quantity), k);
-    s->coef_scales = table ? (const float *)(p + STREAM_HEADER_SIZE) : NULL;
-    s->data = p + STREAM_HEADER_SIZE + table;
-    if (!check_stream_data(s, i, L->header.vertex_count, &w))
-        return invalid(r, &w);
-    s->data = NULL;
-    s->coef_scales = NULL;
     L->stream_table[i] = table ? c->offset + CHUNK_HEADER_SIZE + STREAM_HEADER_SIZE : 0;
     L->stream_data[i] = c->offset + CHUNK_HEADER_SIZE + STREAM_HEADER_SIZE + table;
+    L->stream_bytes[i] = c->size - STREAM_HEADER_SIZE;
     L->stream_count = i + 1;
+    return VDSH_OK;
+}
+
+/* Every stream's size and values, once all chunks are read: a part's
+ * streams hold its range's rows only, and `part` may follow the COEF
+ * chunks. */
+static vdsh_result check_coef_sizes(const reader *r, layout *L)
+{
+    uint32_t rows = L->has_part ? L->part.range_end - L->part.range_begin
+                                : L->header.vertex_count;
+    why w;
+    for (uint32_t i = 0; i < L->stream_count; i++) {
+        vdsh_stream *s = &L->streams[i];
+        char l[96];
+        stream_label(s, i, l, sizeof l);
+        uint64_t table = stream_table_bytes(s->encoding, s->order);
+        uint64_t need = table + (uint64_t)rows * vdsh_stream_bytes_per_vertex(s);
+        if (L->stream_bytes[i] != need)
+            return fail(r->err, VDSH_ERR_CHUNK, r->name,
+                        "%s: %llu bytes of data, %u vertices of %s need %llu%s", l,
+                        (unsigned long long)L->stream_bytes[i], rows,
+                        vdsh_encoding_name(s->encoding), (unsigned long long)need,
+                        L->has_part ? " (a part: its range's receivers)" : "");
+        s->coef_scales = table ? (const float *)(r->d + L->stream_table[i]) : NULL;
+        s->data = r->d + L->stream_data[i];
+        int ok = check_stream_data(s, i, rows, &w);
+        s->data = NULL;
+        s->coef_scales = NULL;
+        if (!ok)
+            return invalid(r, &w);
+    }
     return VDSH_OK;
 }
 
@@ -1410,7 +1434,7 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
                         required[k]);
     if (L->stream_count == 0)
         return fail(r->err, VDSH_ERR_CHUNK, r->name, "no COEF chunk");
-    return VDSH_OK;
+    return check_coef_sizes(r, L);
 }
 
 static size_t round16(size_t n) { return (n + 15) & ~(size_t)15; }
@@ -1497,6 +1521,11 @@ static uint8_t *alloc_file_buffer(size_t size)
     if (size > SIZE_MAX - 15)
         return NULL;
     return (uint8_t *)aligned_alloc(16, size ? round16(size) : 16);
+}
+
+uint32_t vdsh_file_stream_vertices(const vdsh_file *f)
+{
+    return f->has_part ? f->part.range_end - f->part.range_begin : f->header.vertex_count;
 }
 
 vdsh_result vdsh_read_memory(const void *data, size_t size, const char *name,
@@ -1697,6 +1726,9 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
             return argument(err, name, &w);
     }
 
+    /* Before the streams: a part's are its range's rows. */
+    if (f->has_part && !check_part(&f->part, h->vertex_count, &w))
+        return argument(err, name, &w);
     if (f->stream_count < 1 || f->stream_count > VDSH_MAX_STREAMS)
         return fail(err, VDSH_ERR_ARGUMENT, name,
                     "not written: stream_count %u out of range 1..%d",
@@ -1722,14 +1754,12 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
                             "not written: streams %u and %u are both order "
                             "%u %s", k, i, s->order,
                             vdsh_quantity_name(s->quantity));
-        if (!check_stream_data(s, i, h->vertex_count, &w))
+        if (!check_stream_data(s, i, vdsh_file_stream_vertices(f), &w))
             return argument(err, name, &w);
     }
     if (f->has_stats && !check_stats(&f->stats, h->vertex_count, &w))
         return argument(err, name, &w);
     if (f->has_timings && !check_timings(&f->timings, &w))
-        return argument(err, name, &w);
-    if (f->has_part && !check_part(&f->part, h->vertex_count, &w))
         return argument(err, name, &w);
     if (f->has_adaptive && !check_adaptive(&f->adaptive, h->vertex_count, &w))
         return argument(err, name, &w);
@@ -1825,7 +1855,7 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
         for (uint32_t k = 0; table && k < s->order * s->order; k++)
             put_f32(p + STREAM_HEADER_SIZE + 4 * k, s->coef_scales[k]);
         add_chunk(P, "COEF", p, STREAM_HEADER_SIZE + table, s->data,
-                  v * vdsh_stream_bytes_per_vertex(s));
+                  (uint64_t)vdsh_file_stream_vertices(f) * vdsh_stream_bytes_per_vertex(s));
     }
 
     if (f->has_stats) {

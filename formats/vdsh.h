@@ -216,8 +216,9 @@ typedef struct vdsh_timings {
 } vdsh_timings;
 
 /* A part of a sharded bake (`part` chunk, VDSH.md "Parts"): shard `index`
- * of `count`, which baked receivers [range_begin, range_end); the merged
- * file's streams use `encoding`. */
+ * of `count`, which baked receivers [range_begin, range_end); its streams
+ * hold those receivers' rows only; the merged file's streams use
+ * `encoding`. */
 typedef struct vdsh_part {
     uint32_t index, count;
     uint32_t range_begin, range_end;
@@ -256,6 +257,11 @@ typedef struct vdsh_file {
     vdsh_adaptive adaptive;
     void *storage_;            /* owned memory; do not touch */
 } vdsh_file;
+
+/* Receivers each COEF stream holds: a part's range (range_end -
+ * range_begin; its first row is receiver range_begin), else vertex_count.
+ * A tool that indexes streams by receiver should refuse parts (has_part). */
+uint32_t vdsh_file_stream_vertices(const vdsh_file *f);
 
 /* Read and validate a whole file (every rule in VDSH.md, all CRCs).
  * On success *out owns everything; on failure *out is untouched. */

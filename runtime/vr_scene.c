@@ -215,6 +215,11 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
         r = vr_fail(err, VR_ERR_FORMAT, "%s: no triangles to draw", name);
         goto done;
     }
+    if (f->has_part) { /* its streams hold one range's receivers */
+        r = vr_fail(err, VR_ERR_FORMAT, "%s: a part of a sharded bake (shard %u of %u): "
+                    "join the parts with vdsh-merge first", name, f->part.index, f->part.count);
+        goto done;
+    }
     /* Checked by the reader for a file, not for one from memory: every
      * reconstructed distance is clamped to it. */
     if (!isfinite(h->max_distance) || !(h->max_distance > 0.0f)) {

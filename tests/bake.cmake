@@ -40,7 +40,8 @@ add_test(NAME bake_isa_agree
 # Sharded bakes (vdsh-bake --shard I/N, vdsh-merge): byte for byte.
 add_test(NAME bake_shard
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard.sh
-                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge>)
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
+                 $<TARGET_FILE:vdsh-eval>)
 # The GNU parallel recipe (scripts/bake-parallel), with Debian's parallel.
 add_test(NAME bake_shard_parallel
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard_parallel.sh

@@ -581,11 +581,16 @@ static void test_ranges(void)
     }
     uint64_t traced = 0, missed = 0;
     for (int i = 0; i < 4 && whole.coeffs[5] && part[i].coeffs[5]; i++) {
+        CHECK(part[i].range_begin == cut[i] && part[i].range_end == cut[i + 1] &&
+                  part[i].vertex_count == NP,
+              "range %d: output range %u..%u of %u", i, part[i].range_begin, part[i].range_end,
+              part[i].vertex_count);
         traced += part[i].rays_traced;
         missed += part[i].rays_missed;
         for (int o = 3; o <= 5; o += 2) {
+            /* A range holds its own rows only, the first receiver cut[i]'s. */
             size_t a = (size_t)cut[i] * o * o, b = (size_t)cut[i + 1] * o * o;
-            CHECK(memcmp(part[i].coeffs[o] + a, whole.coeffs[o] + a, (b - a) * sizeof(float)) == 0,
+            CHECK(memcmp(part[i].coeffs[o], whole.coeffs[o] + a, (b - a) * sizeof(float)) == 0,
                   "range %u..%u order %d: coefficients differ", cut[i], cut[i + 1], o);
             CHECK(part[i].quantity[o] == whole.quantity[o], "range %d order %d: quantity", i, o);
         }

@@ -2135,6 +2135,78 @@ static void test_speed(void)
     sample_free(&s);
 }
 
+/* Parts (VDSH.md "Parts"): COEF streams hold the range's rows only, the
+ * size checked against the `part` chunk wherever it lies; a whole file's
+ * streams hold every vertex. */
+static void test_parts(void)
+{
+    sample s;
+    sample_init(&s, 0, 0);
+    const uint32_t V = s.f.header.vertex_count, b = 1, e = V;
+    vdsh_error err;
+    void *whole = NULL, *mem = NULL;
+    size_t wn = 0, n = 0;
+    CHECK_RES(vdsh_write_memory(&s.f, &whole, &wn, &err), VDSH_OK, &err);
+    CHECK(vdsh_file_stream_vertices(&s.f) == V);
+    s.f.has_part = 1;
+    s.f.part = (vdsh_part){.index = 1, .count = 2, .range_begin = b, .range_end = e,
+                           .encoding = VDSH_ENCODING_F16};
+    CHECK(vdsh_file_stream_vertices(&s.f) == e - b);
+    /* The writer takes the range's rows: the first e - b of each stream. */
+    CHECK_RES(vdsh_write_memory(&s.f, &mem, &n, &err), VDSH_OK, &err);
+    CHECK(mem && whole);
+    vdsh_file *f = NULL;
+    if (mem)
+        CHECK_RES(vdsh_read_memory(mem, n, "part", &f, &err), VDSH_OK, &err);
+    if (f) {
+        CHECK(f->has_part && f->part.range_begin == b && f->part.range_end == e);
+        CHECK(vdsh_file_stream_vertices(f) == e - b);
+        CHECK(f->stream_count == s.f.stream_count);
+        for (uint32_t i = 0; i < f->stream_count && i < s.f.stream_count; i++) {
+            size_t bytes = (size_t)(e - b) * vdsh_stream_bytes_per_vertex(&s.f.streams[i]);
+            CHECK(memcmp(f->streams[i].data, s.f.streams[i].data, bytes) == 0);
+        }
+        vdsh_free(f);
+    }
+    /* `part` before the COEF chunks reads the same. */
+    tfile t;
+    if (mem) {
+        tf_parse(mem, n, &t);
+        int pi = tf_find(&t, "part", 0), ci = tf_find(&t, "COEF", 0);
+        CHECK(pi > ci && ci > 0);
+        for (uint32_t i = 0; i < s.f.stream_count; i++) { /* 48: the stream header */
+            int k = tf_find(&t, "COEF", (int)i);
+            const vdsh_stream *st = &s.f.streams[i];
+            size_t table = vdsh_encoding_quantised(st->encoding)
+                               ? ((size_t)st->order * st->order * 4 + 15) & ~(size_t)15 : 0;
+            CHECK(k >= 0 && t.c[k].size == 48 + table + (e - b) * vdsh_stream_bytes_per_vertex(st));
+        }
+        if (pi > ci && ci > 0) {
+            tchunk moved = t.c[pi];
+            memmove(&t.c[ci + 1], &t.c[ci], (size_t)(pi - ci) * sizeof(tchunk));
+            t.c[ci] = moved;
+            expect_tf(&t, VDSH_OK, NULL, __LINE__);
+        }
+        tf_free(&t);
+    }
+    /* A whole file's streams (every vertex) with a part chunk, after them
+     * or before: refused, naming the part's size. */
+    uint8_t pp[32] = {0};
+    wr32(pp + 0, 1), wr32(pp + 4, 2), wr32(pp + 8, b), wr32(pp + 12, e), wr32(pp + 16, 1);
+    if (whole) {
+        tf_parse(whole, wn, &t);
+        tf_insert(&t, t.n, "part", pp, sizeof pp);
+        expect_tf(&t, VDSH_ERR_CHUNK, "a part: its range's receivers", __LINE__);
+        tf_remove(&t, t.n - 1);
+        tf_insert(&t, tf_find(&t, "COEF", 0), "part", pp, sizeof pp);
+        expect_tf(&t, VDSH_ERR_CHUNK, "a part: its range's receivers", __LINE__);
+        tf_free(&t);
+    }
+    free(mem);
+    free(whole);
+    sample_free(&s);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && !strcmp(argv[1], "--exhaustive-f16"))
@@ -2158,6 +2230,7 @@ int main(int argc, char **argv)
     test_truncation();
     test_byte_changes();
     test_rules();
+    test_parts();
     test_mutations();
     test_scan();
     test_writer_checks();

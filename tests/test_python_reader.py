@@ -15,6 +15,9 @@ network, Debian's pip and setuptools), imports it from there, and checks:
 - the s8 and s8s6 bakes against the f16 one: every coefficient within
   half its index's step (plus f16 rounding), scales the largest |c| per
   index;
+- parts (vdsh-bake --shard I/3, f32): read as parts by both readers, each
+  stream the whole f32 bake's rows of its range, reconstruct refusing a
+  vertex outside it;
 - reconstruction: for the default bake's order-5 log stream, distances
   toward 64 directions at 50 vertices equal exp of the SH sum clamped to
   max_distance, and lie in (0, max_distance].
@@ -113,6 +116,8 @@ def compare(path):
                             % (path, ps["order"], k, cs["coefficient0"][k], v))
     if c.get("stats") and p.stats and c["stats"] != {k: p.stats[k] for k in c["stats"]}:
         fail.append("%s: stats differ" % path)
+    if c.get("part") != p.part:
+        fail.append("%s: part: C %s, Python %s" % (path, c.get("part"), p.part))
     return p
 
 
@@ -122,6 +127,7 @@ for name, args in (("default", []), ("paper-f32", ["--method", "paper", "--encod
                    ("hann", ["--method", "lsq", "--window", "hann"]),
                    ("timings", ["--record-timings", "--orders", "3", "--encoding", "f16"]),
                    ("f16", ["--encoding", "f16"]),
+                   ("f32", ["--encoding", "f32"]),
                    ("s8", ["--encoding", "s8"]),
                    ("s8-small", ["--encoding", "s8", "--orders", "3"]),
                    ("s8s6", ["--encoding", "s8s6"]),
@@ -133,6 +139,39 @@ for name, args in (("default", []), ("paper-f32", ["--method", "paper", "--encod
         fail.append("bake %s: %s" % (name, r.stderr.strip()))
         continue
     baked[name] = compare(out)
+
+# Parts (vdsh-bake --shard I/N): streams of the range's rows only, equal to
+# those rows of the whole bake's f32 streams.
+whole = baked.get("f32")
+for i in range(3):
+    out = os.path.join(work, "part-%d.vdsh" % i)
+    r = subprocess.run([bake, "builtin:room", "--max-edge", "1.5", "--rays", "256", "-q",
+                        "--cube-size", "0", "--encoding", "f32", "--shard", "%d/3" % i,
+                        "-o", out], capture_output=True, text=True)
+    if r.returncode:
+        fail.append("bake part %d: %s" % (i, r.stderr.strip()))
+        continue
+    part = baked["part-%d" % i] = compare(out)
+    if not (part and whole and part.part):
+        fail.append("part %d: not read as a part" % i)
+        continue
+    b, e = part.part["range_begin"], part.part["range_end"]
+    if part.part["index"] != i or part.part["count"] != 3 or not 0 <= b < e:
+        fail.append("part %d: %s" % (i, part.part))
+    for ps, ws in zip(part.streams, whole.streams):
+        if vdsh.coefficients(ps).shape[0] != e - b or \
+                not np.array_equal(vdsh.coefficients(ps), vdsh.coefficients(ws)[b:e]):
+            fail.append("part %d order %d: not the whole bake's rows %d..%d"
+                        % (i, ps["order"], b, e))
+    ps = part.streams[-1]
+    try:
+        vdsh.reconstruct(part, ps, e, np.array([[0.0, 0.0, 1.0]]))
+        fail.append("part %d: reconstruct outside its range accepted" % i)
+    except vdsh.VdshError:
+        pass
+    if not np.allclose(vdsh.reconstruct(part, ps, b, np.array([[0.0, 0.0, 1.0]])),
+                       vdsh.reconstruct(whole, whole.streams[-1], b, np.array([[0.0, 0.0, 1.0]]))):
+        fail.append("part %d: reconstruct at vertex %d" % (i, b))
 
 corpus = sorted(glob.glob(os.path.join(src, "tests", "corpus", "vdsh", "*")))
 accepted = sum(compare(f) is not None for f in corpus)

@@ -4,11 +4,15 @@
 # shards, f16, f32, s8 and s8s6; vdsh-merge refuses parts that do not belong together
 # (other inputs, other options, a whole file, missing, duplicate shards)
 # naming the part, and writes nothing then; a shard killed mid-bake leaves
-# no part, and rerunning it alone completes the set.
-# Usage: test_shard.sh VDSH_BAKE VDSH_MERGE
+# no part, and rerunning it alone completes the set. A part holds its own
+# range's coefficients only (VDSH.md "Parts"): vdsh-info reads it as a part,
+# its COEF chunks are the range's size, and vdsh-eval refuses it.
+# Usage: test_shard.sh VDSH_BAKE VDSH_MERGE VDSH_INFO VDSH_EVAL
 set -u
 bake=$1
 merge=$2
+info=$3
+evaluate=$4
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail=0
@@ -68,6 +72,31 @@ for enc in s8 s8s6; do
 done
 expect_exit 1 "s8 and f16 parts refused together" "$merge" -q "$tmp"/s8-3/p0.vdsh "$tmp"/s8-3/p1.vdsh "$tmp"/f32/p2.vdsh -o "$tmp/mixed.vdsh"
 says "mixed encodings" "another --encoding"
+
+# A part's streams are its range's rows: with 7 parts of f16 orders 2, 3, 5
+# (parts are f32: 38 floats per receiver), part 3's COEF payloads are
+# 48-byte headers plus 152 bytes per receiver of its range.
+p=$tmp/n7
+"$info" --json "$p/part-3.vdsh" >"$tmp/info.json" 2>"$tmp/err.txt"
+check "vdsh-info reads a part" /usr/bin/python3 - "$tmp/info.json" "$p/part-3.vdsh" <<'PY'
+import json, struct, sys
+d = json.load(open(sys.argv[1]))
+pt = d.get("part")
+assert pt and pt["index"] == 3 and pt["count"] == 7, pt
+V = d["vertex_count"]
+assert (pt["range_begin"], pt["range_end"]) == (V * 3 // 7, V * 4 // 7), (pt, V)
+data, off, coef = open(sys.argv[2], "rb").read(), 32, []
+while off < len(data):
+    cid, size = data[off:off + 4], struct.unpack_from("<Q", data, off + 8)[0]
+    if cid == b"COEF":
+        coef.append(size)
+    off += 16 + (size + 15) // 16 * 16
+rows = pt["range_end"] - pt["range_begin"]
+want = sorted(48 + 4 * o * o * rows for o in (2, 3, 5))
+assert sorted(coef) == want, (coef, want)
+PY
+expect_exit 1 "vdsh-eval refuses a part" "$evaluate" "$p/part-3.vdsh"
+says "vdsh-eval on a part" "a part of a sharded bake (shard 3 of 7)"
 
 # Refusals, each naming the part; nothing written.
 p=$tmp/n7

@@ -31,6 +31,12 @@ int main(int argc, char **argv)
         return 2;
     }
     int status = 0;
+    if (a->has_part || b->has_part) { /* streams of one range: compare merged files */
+        fprintf(stderr, "vdsh_compare: a part of a sharded bake: merge it first\n");
+        vdsh_free(a);
+        vdsh_free(b);
+        return 2;
+    }
     uint32_t V = a->header.vertex_count, T = a->header.triangle_count;
     if (V != b->header.vertex_count || T != b->header.triangle_count ||
         memcmp(a->positions, b->positions, 3 * sizeof(float) * V) ||

@@ -144,6 +144,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "vdsh-export: %s\n", verr.msg);
         return 1;
     }
+    if (f->has_part) { /* its streams hold one range's receivers */
+        fprintf(stderr, "vdsh-export: %s: a part of a sharded bake (shard %u of %u): join the "
+                        "parts with vdsh-merge first\n", in, f->part.index, f->part.count);
+        vdsh_free(f);
+        return 1;
+    }
     const uint32_t nv = f->header.vertex_count, nt = f->header.triangle_count;
     int rc = 1;
     blob b = {0};

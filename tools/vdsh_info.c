@@ -98,13 +98,14 @@ static coef0_stats stream_coef0(const vdsh_file *f, const vdsh_stream *s)
     float c[VDSH_MAX_COEFFS];
     coef0_stats st = {INFINITY, -INFINITY, 0.0};
     double sum = 0.0;
-    for (uint32_t v = 0; v < f->header.vertex_count; v++) {
+    const uint32_t rows = vdsh_file_stream_vertices(f); /* a part: its range */
+    for (uint32_t v = 0; v < rows; v++) {
         vdsh_stream_decode(s, v, c);
         st.min = c[0] < st.min ? c[0] : st.min;
         st.max = c[0] > st.max ? c[0] : st.max;
         sum += c[0];
     }
-    st.mean = sum / f->header.vertex_count;
+    st.mean = sum / rows;
     return st;
 }
 
@@ -240,6 +241,10 @@ static void print_summary(const char *path, const vdsh_file *f,
                "origins moved %u, normals flipped %u\n", t->degenerate_receivers,
                t->undefined_normals, t->moved_origins, t->flipped_normals);
     }
+    if (f->has_part)
+        printf("  part         shard %u of %u: receivers %u..%u (its streams' rows), merged "
+               "as %s\n", f->part.index, f->part.count, f->part.range_begin, f->part.range_end,
+               vdsh_encoding_name(f->part.encoding));
     if (f->has_adaptive) {
         const vdsh_adaptive *a = &f->adaptive;
         printf("  adaptive     tolerance %g, min edge %g, budget %u (0: none), %u lights\n"
@@ -341,6 +346,14 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
         vt_json_null(&j, root, "stats");
     }
 
+    if (f->has_part) {
+        cJSON *pt = vt_json_object(&j, root, "part");
+        vt_json_u64(&j, pt, "index", f->part.index);
+        vt_json_u64(&j, pt, "count", f->part.count);
+        vt_json_u64(&j, pt, "range_begin", f->part.range_begin);
+        vt_json_u64(&j, pt, "range_end", f->part.range_end);
+        vt_json_string(&j, pt, "encoding", vdsh_encoding_name(f->part.encoding));
+    }
     if (f->has_adaptive) {
         cJSON *ad = vt_json_object(&j, root, "adaptive");
         vt_json_f32(&j, ad, "tolerance", f->adaptive.tolerance);

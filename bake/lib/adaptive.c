@@ -73,7 +73,7 @@ typedef struct score_job {
     const vb_mesh *fine;        /* the tentative mesh: candidate i is vertex base + i */
     uint32_t base;
     const uint64_t *edges;
-    const vb_bake_output *b;    /* the tentative bake (coefficients of every vertex) */
+    const vb_bake_output *b;    /* the midpoints' bake: range base.., candidate i's row i */
     const float *coarse_c;      /* the ends' coefficients (order `order`), vertex-major */
     int order;
     uint32_t quantity, interp;
@@ -94,7 +94,7 @@ static void score_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker
         const float *p = J->fine->positions + 3 * (size_t)v;
         const float *n = J->b->normals ? J->b->normals + 3 * (size_t)v
                                        : J->fine->normals + 3 * (size_t)v;
-        const float *cm = J->b->coeffs[J->order] + nc * v;
+        const float *cm = J->b->coeffs[J->order] + nc * i; /* the range's row i: vertex v */
         const float *c[3] = {J->coarse_c + nc * a, J->coarse_c + nc * e, J->coarse_c + nc * e};
         const float *pv[3] = {J->fine->positions + 3 * (size_t)a,
                               J->fine->positions + 3 * (size_t)e,
@@ -132,16 +132,16 @@ static int cmp_ranked(const void *a, const void *b)
     return (x->index > y->index) - (x->index < y->index);
 }
 
-/* Append `count` rows of `width` floats from src (rows rows[i]) to *dst,
- * which holds `have` rows. */
-static int append_rows(float **dst, uint32_t have, const float *src, size_t width,
-                       const uint32_t *rows, uint32_t count)
+/* Append `count` rows of `width` floats from src (rows rows[i] - first:
+ * src's first row is row `first`) to *dst, which holds `have` rows. */
+static int append_rows(float **dst, uint32_t have, const float *src, uint32_t first,
+                       size_t width, const uint32_t *rows, uint32_t count)
 {
     float *p = realloc(*dst, ((size_t)have + count) * width * sizeof *p + 1);
     if (!p)
         return 0;
     for (uint32_t i = 0; i < count; i++)
-        memcpy(p + ((size_t)have + i) * width, src + (size_t)rows[i] * width,
+        memcpy(p + ((size_t)have + i) * width, src + (size_t)(rows[i] - first) * width,
                width * sizeof *p);
     *dst = p;
     return 1;
@@ -321,9 +321,10 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         int ok = 1;
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (B.coeffs[o])
-                ok &= append_rows(&B.coeffs[o], V, R.coeffs[o], (size_t)o * o, rows, s);
+                ok &= append_rows(&B.coeffs[o], V, R.coeffs[o], R.range_begin, (size_t)o * o,
+                                  rows, s); /* R holds the midpoints' rows only */
         if (B.normals)
-            ok &= append_rows(&B.normals, V, R.normals, 3, rows, s);
+            ok &= append_rows(&B.normals, V, R.normals, 0, 3, rows, s);
         if (!ok) {
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
             goto done;
@@ -334,11 +335,11 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         vb_mesh_free(&M);
         M = N;
         memset(&N, 0, sizeof N);
-        B.vertex_count = M.vertex_count;
+        B.vertex_count = B.range_end = M.vertex_count;
         if (st.budget_reached)
             break;
     }
-    B.vertex_count = M.vertex_count;
+    B.vertex_count = B.range_end = M.vertex_count;
     *receivers = M;
     memset(&M, 0, sizeof M);
     *out = B;

@@ -40,7 +40,7 @@ typedef struct job {
     const vb_dirgrid *grid;
     const float *origins;  /* per receiver, traced frame */
     const float *near;     /* per receiver: ~0 distance, scene units */
-    float *coeffs[VDSH_ORDER_SLOTS];
+    float *coeffs[VDSH_ORDER_SLOTS]; /* rows lo..hi-1 (the range's) */
     uint32_t quantity[VDSH_ORDER_SLOTS]; /* per order: what coeffs hold */
     vb_fit fits[VDSH_ORDER_SLOTS];
     int order;             /* the projection's order (the highest asked) */
@@ -358,7 +358,7 @@ static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (J->coeffs[o])
                 out.coeffs[J->quantity[o] == VDSH_QUANTITY_LOG_DISTANCE][o] =
-                    J->coeffs[o] + (size_t)v * o * o;
+                    J->coeffs[o] + (size_t)(v - J->lo) * o * o;
         bake_vertex(J, v, &out, &traced, &missed, &degenerate);
     }
     atomic_fetch_add(&J->traced, traced);
@@ -618,6 +618,10 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             return vb_fail(err, VB_ERR_INVALID,
                            "receiver triangle %zu: index %u out of range (%u vertices)", i / 3,
                            R->indices[i], R->vertex_count);
+    const uint32_t lo = d.range_begin, hi = d.range_end ? d.range_end : R->vertex_count;
+    if (lo >= hi || hi > R->vertex_count)
+        return vb_fail(err, VB_ERR_ARGUMENT, "receiver range %u..%u is not within 0..%u",
+                       d.range_begin, d.range_end, R->vertex_count);
     /* The sampling domain (the method's row): the whole sphere (paper's
      * horizon culls half of it), or the hemisphere above each receiver,
      * with half the directions (the same traced budget). */
@@ -652,9 +656,11 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
                                     : malloc((size_t)R->vertex_count * 3 * sizeof *normals + 1);
     vb_mesh oriented = *R;
     int missing = !d.keep_normals && !normals;
+    /* A range: its rows only (bake.h), so a shard's coefficients are its
+     * own range's size. */
     for (int o = 1; o <= VDSH_MAX_ORDER && !d.trace_only; o++)
         if (d.order_mask & (1u << o))
-            missing |= !(coeffs[o] = malloc((size_t)R->vertex_count * o * o * sizeof(float)));
+            missing |= !(coeffs[o] = malloc((size_t)(hi - lo) * o * o * sizeof(float)));
     job *J = calloc(1, sizeof *J);
     if (!origins || !near || missing || !J) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
@@ -668,13 +674,8 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             goto done;
         vb_fit_window(&J->fits[o], d.window);
     }
-    J->lo = d.range_begin;
-    J->hi = d.range_end ? d.range_end : R->vertex_count;
-    if (J->lo >= J->hi || J->hi > R->vertex_count) {
-        r = vb_fail(err, VB_ERR_ARGUMENT, "receiver range %u..%u is not within 0..%u",
-                    d.range_begin, d.range_end, R->vertex_count);
-        goto done;
-    }
+    J->lo = lo;
+    J->hi = hi;
     /* A range: only its receivers, and the quantity choice's sample, are
      * oriented and given origins (counted: the range's). */
     if (J->lo > 0 || J->hi < R->vertex_count) {
@@ -701,9 +702,6 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         oriented.normals = normals;
         d.receivers = R = &oriented;
     }
-    for (int o = 1; o <= VDSH_MAX_ORDER; o++) /* outside a shard's range */
-        if (coeffs[o] && (J->lo > 0 || J->hi < R->vertex_count))
-            memset(coeffs[o], 0, (size_t)R->vertex_count * o * o * sizeof(float));
     J->d = &d;
     J->grid = &grid;
     J->origins = origins;
@@ -774,7 +772,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             const float *keep = J->choose_coeffs + (size_t)i * 2 * CHOOSE_STRIDE;
             for (int o = 1; o <= VDSH_MAX_ORDER; o++)
                 if (coeffs[o] && J->done[v] && v >= J->lo && v < J->hi)
-                    memcpy(coeffs[o] + (size_t)v * o * o,
+                    memcpy(coeffs[o] + (size_t)(v - J->lo) * o * o,
                            keep + (J->quantity[o] == VDSH_QUANTITY_LOG_DISTANCE) * CHOOSE_STRIDE +
                                choose_offset(o),
                            (size_t)o * o * sizeof(float));
@@ -806,6 +804,8 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     o.log_floor = any_log ? d.log_floor : 0.0f;
     o.window = d.window;
     o.vertex_count = R->vertex_count;
+    o.range_begin = J->lo;
+    o.range_end = J->hi;
     memcpy(o.coeffs, coeffs, sizeof coeffs);
     memset(coeffs, 0, sizeof coeffs);
     o.rays = grid.count;

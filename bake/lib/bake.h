@@ -119,7 +119,8 @@ typedef struct vb_bake_desc {
     int keep_normals;
     int trace_only;            /* benchmark: trace the same rays, nothing else */
     /* A shard (vdsh-bake --shard): only receivers [range_begin, range_end)
-     * get coefficients (the others' are zero) and only they count in
+     * get coefficients (vb_bake_output.coeffs holds their rows only) and
+     * only they count in
      * rays_traced, rays_missed and degenerate_receivers; everything decided
      * over all receivers (orientation, origins, the quantity choice) is
      * decided as in the whole bake, so a range's coefficients are the whole
@@ -145,9 +146,14 @@ typedef struct vb_bake_output {
     float log_offset[VDSH_ORDER_SLOTS]; /* method shadow: per order, as used */
     float log_floor;           /* log-distance floor used (0 otherwise) */
     vdsh_window window;        /* applied */
-    uint32_t vertex_count;
-    /* Per order n (1..VDSH_MAX_ORDER): vertex_count * n^2 coefficients, vertex-major, or
-     * NULL where the order was not asked for (and with trace_only). */
+    uint32_t vertex_count;     /* all receivers */
+    /* The receivers baked: vb_bake_desc's range, or 0, vertex_count
+     * (vb_bake_stream reads range_end 0 as every receiver). */
+    uint32_t range_begin, range_end;
+    /* Per order n (1..VDSH_MAX_ORDER): (range_end - range_begin) * n^2
+     * coefficients, vertex-major, the first row receiver range_begin's (a
+     * shard holds its own range only: its memory is its range's); or NULL
+     * where the order was not asked for (and with trace_only). */
     float *coeffs[VDSH_ORDER_SLOTS];
     uint32_t rays;             /* directions per receiver actually used (the
                                 * cap with adaptive rays) */
@@ -181,7 +187,8 @@ float vb_shadow_log_offset(int order);
 void vb_bake_output_free(vb_bake_output *out);
 
 /* The .vdsh stream of one order (1 .. max_order) of a bake: its first
- * order^2 coefficients per vertex, as f32, or as f16 scaled by the
+ * order^2 coefficients per vertex of its range (all receivers but a
+ * shard's), as f32, or as f16 scaled by the
  * stream's largest |coefficient| (stored values in [-1, 1]), encoded on
  * b->threads workers, or as s8 (vdsh_encode_s8). *storage receives the
  * block the stream points into (data, and an s8 stream's coef_scales);

@@ -60,7 +60,9 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encod
     if (!mi)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", b->method);
     int nc = order * order;
-    size_t count = (size_t)b->vertex_count * nc;
+    /* A shard's range (range_end 0, as in a zeroed output: all receivers). */
+    const uint32_t rows = b->range_end ? b->range_end - b->range_begin : b->vertex_count;
+    size_t count = (size_t)rows * nc;
     vdsh_stream s = {.order = (uint32_t)order, .encoding = encoding, .method = b->method,
                      .quantity = b->quantity[order],
                      .method_param = mi->param == VB_PARAM_LOG_OFFSET ? b->log_offset[order]
@@ -78,13 +80,13 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encod
         s.data = f;
     } else if (vdsh_encoding_quantised(encoding)) {
         /* One block: the scale table (order^2 floats), then the bytes. */
-        size_t bytes_n = (size_t)b->vertex_count * vdsh_encoding_bytes(encoding, (uint32_t)nc);
+        size_t bytes_n = (size_t)rows * vdsh_encoding_bytes(encoding, (uint32_t)nc);
         float *block = malloc(VDSH_MAX_COEFFS * sizeof(float) + bytes_n + 1);
         if (!block)
             return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the order %d stream",
                            order);
         uint8_t *bytes = (uint8_t *)(block + VDSH_MAX_COEFFS);
-        if (vdsh_encode_quantised(encoding, b->coeffs[order], b->vertex_count, (uint32_t)nc,
+        if (vdsh_encode_quantised(encoding, b->coeffs[order], rows, (uint32_t)nc,
                                   block, bytes) != VDSH_OK) {
             free(block);
             return vb_fail(err, VB_ERR_INVALID, "order %d coefficients do not fit %s", order,

@@ -799,6 +799,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "vdsh-eval: %s\n", verr.msg);
         return 1;
     }
+    if (f->has_part) { /* its streams hold one range's receivers */
+        fprintf(stderr, "vdsh-eval: %s: a part of a sharded bake (shard %u of %u): join the "
+                        "parts with vdsh-merge first\n", path, f->part.index, f->part.count);
+        vdsh_free(f);
+        return 1;
+    }
     if (nmesh && nmesh != f->source_count) {
         fprintf(stderr, "vdsh-eval: %s: %u mesh(es) given but the bake used %u source(s):",
                 path, nmesh, f->source_count);

@@ -167,6 +167,12 @@ static int load_scene(const char *path, unsigned threads, int traced, loaded *ou
         fprintf(stderr, PROG ": %s\n", verr.msg);
         return -1;
     }
+    if (l.f->has_part) { /* its streams hold one range's receivers */
+        fprintf(stderr, PROG ": %s: a part of a sharded bake (shard %u of %u): join the parts "
+                             "with vdsh-merge first\n", path, l.f->part.index, l.f->part.count);
+        vdsh_free(l.f);
+        return -1;
+    }
     if (!traced) {
         *out = l;
         return 0;

@@ -15,8 +15,9 @@
  * per coefficient index), the ray counts summed, and the file and
  * its basis cubemaps written atomically.
  *
- * Memory: every part is read whole (the parts together are about the
- * merged file in f32 plus the receiver mesh once per part).
+ * Memory: one part at a time is read (the first stays, to check the
+ * others against): the merged coefficients in f32 and one stream's
+ * encoding, plus two parts (each the receiver mesh and its range's rows).
  * Exit status: 0 merged, 1 refused or failed (nothing written), 2 usage.
  */
 #include <getopt.h>
@@ -131,53 +132,74 @@ int main(int argc, char **argv)
     if (!output)
         return vt_usage_error("vdsh-merge", "%s", "no output: give -o OUT.vdsh");
     char **paths = argv + optind;
-    vdsh_file **parts = calloc((size_t)n, sizeof *parts);
     int status = 1;
+    vdsh_file *p0 = NULL, *part = NULL;
     float *merged[VDSH_MAX_STREAMS] = {0};
     void *encoded[VDSH_MAX_STREAMS] = {0};
     float s8_scales[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS];
     int *owner = NULL;
     float *normals = NULL;
     vb_cubemap_basis basis = {0};
-    if (!parts) {
-        fprintf(stderr, "vdsh-merge: out of memory\n");
-        return 1;
-    }
+    vdsh_file f = {0};
+    vdsh_stream streams[VDSH_MAX_STREAMS];
+    uint32_t count = 0, V = 0;
+    /* One part at a time (the first is kept to check the others against):
+     * memory is the merged arrays, the first part and one other. */
     for (int i = 0; i < n; i++) {
         vdsh_error verr;
-        if (vdsh_read(paths[i], &parts[i], &verr) != VDSH_OK) {
+        vdsh_file *p = NULL;
+        if (vdsh_read(paths[i], &p, &verr) != VDSH_OK) {
             fprintf(stderr, "vdsh-merge: %s\n", verr.msg);
             goto out;
         }
-        if (!parts[i]->has_part) {
+        if (i == 0)
+            p0 = p;
+        else
+            part = p;
+        if (!p->has_part) {
             fprintf(stderr, "vdsh-merge: %s: not a part (no part chunk: a whole bake, not "
                             "'vdsh-bake --shard I/N')\n", paths[i]);
             goto out;
         }
-        const char *why = i ? mismatch(parts[0], parts[i]) : NULL;
+        const char *why = i ? mismatch(p0, p) : NULL;
         if (why) {
             fprintf(stderr, "vdsh-merge: %s: does not belong with %s: %s\n", paths[i],
                     paths[0], why);
             goto out;
         }
-        for (uint32_t s = 0; s < parts[i]->stream_count; s++)
-            if (parts[i]->streams[s].encoding != VDSH_ENCODING_F32) {
+        for (uint32_t s = 0; s < p->stream_count; s++)
+            if (p->streams[s].encoding != VDSH_ENCODING_F32) {
                 fprintf(stderr, "vdsh-merge: %s: stream %u is not f32 (parts hold f32)\n",
                         paths[i], s);
                 goto out;
             }
-    }
-    const vdsh_file *p0 = parts[0];
-    uint32_t count = p0->part.count, V = p0->header.vertex_count;
-    owner = malloc((size_t)count * sizeof *owner);
-    if (!owner) {
-        fprintf(stderr, "vdsh-merge: out of memory\n");
-        goto out;
-    }
-    for (uint32_t k = 0; k < count; k++)
-        owner[k] = -1;
-    for (int i = 0; i < n; i++) {
-        const vdsh_part *pt = &parts[i]->part;
+        if (i == 0) {
+            /* The whole file: the first part's, with every shard's
+             * coefficients and oriented normals. */
+            count = p0->part.count;
+            V = p0->header.vertex_count;
+            f = *p0;
+            f.has_part = 0;
+            f.has_timings = 0;
+            f.storage_ = NULL;
+            f.streams = streams;
+            f.stats.rays_traced = f.stats.rays_missed = 0;
+            f.stats.degenerate_receivers = f.stats.moved_origins = f.stats.flipped_normals = 0;
+            int missing = !(owner = malloc((size_t)count * sizeof *owner)) ||
+                          !(normals = malloc((size_t)V * 12 + 1));
+            for (uint32_t s = 0; s < p0->stream_count && !missing; s++) {
+                streams[s] = p0->streams[s];
+                size_t nc = (size_t)streams[s].order * streams[s].order;
+                missing = !(merged[s] = malloc((size_t)V * nc * sizeof(float) + 1));
+            }
+            if (missing) {
+                fprintf(stderr, "vdsh-merge: out of memory for %u receivers\n", V);
+                goto out;
+            }
+            for (uint32_t k = 0; k < count; k++)
+                owner[k] = -1;
+        }
+        const vdsh_part *pt = &p->part;
         uint32_t b, e;
         vb_shard_range(V, pt->index, count, &b, &e);
         if (pt->range_begin != b || pt->range_end != e) {
@@ -191,6 +213,20 @@ int main(int argc, char **argv)
             goto out;
         }
         owner[pt->index] = i;
+        /* Each part oriented its own range's normals, counts its own, and
+         * its streams hold its range's rows only. */
+        f.stats.rays_traced += p->stats.rays_traced;
+        f.stats.rays_missed += p->stats.rays_missed;
+        f.stats.degenerate_receivers += p->stats.degenerate_receivers;
+        f.stats.moved_origins += p->stats.moved_origins;
+        f.stats.flipped_normals += p->stats.flipped_normals;
+        memcpy(normals + 3 * (size_t)b, p->normals + 3 * (size_t)b, (size_t)(e - b) * 12);
+        for (uint32_t s = 0; s < p->stream_count; s++) {
+            size_t nc = (size_t)streams[s].order * streams[s].order;
+            memcpy(merged[s] + b * nc, p->streams[s].data, (e - b) * nc * sizeof(float));
+        }
+        vdsh_free(part);
+        part = NULL;
     }
     if ((uint32_t)n != count) {
         fprintf(stderr, "vdsh-merge: %u of %u shards missing:", count - (uint32_t)n, count);
@@ -201,45 +237,9 @@ int main(int argc, char **argv)
                 count - (uint32_t)n > 32 ? " ..." : "", count);
         goto out;
     }
-
-    /* The whole file: the first part's, with every shard's coefficients. */
-    vdsh_file f = *p0;
-    vdsh_stream streams[VDSH_MAX_STREAMS];
-    f.has_part = 0;
-    f.has_timings = 0;
-    f.storage_ = NULL;
-    f.streams = streams;
-    f.stats.rays_traced = f.stats.rays_missed = 0;
-    f.stats.degenerate_receivers = f.stats.moved_origins = f.stats.flipped_normals = 0;
-    /* Each part oriented its own range's normals, and counts its own. */
-    if (!(normals = malloc((size_t)V * 12 + 1))) {
-        fprintf(stderr, "vdsh-merge: out of memory for %u receivers\n", V);
-        goto out;
-    }
-    for (int i = 0; i < n; i++) {
-        const vdsh_part *pt = &parts[i]->part;
-        f.stats.rays_traced += parts[i]->stats.rays_traced;
-        f.stats.rays_missed += parts[i]->stats.rays_missed;
-        f.stats.degenerate_receivers += parts[i]->stats.degenerate_receivers;
-        f.stats.moved_origins += parts[i]->stats.moved_origins;
-        f.stats.flipped_normals += parts[i]->stats.flipped_normals;
-        memcpy(normals + 3 * (size_t)pt->range_begin, parts[i]->normals + 3 * (size_t)pt->range_begin,
-               (size_t)(pt->range_end - pt->range_begin) * 12);
-    }
     f.normals = normals;
-    for (uint32_t s = 0; s < p0->stream_count; s++) {
-        streams[s] = p0->streams[s];
+    for (uint32_t s = 0; s < f.stream_count; s++) {
         size_t nc = (size_t)streams[s].order * streams[s].order;
-        if (!(merged[s] = malloc((size_t)V * nc * sizeof(float) + 1))) {
-            fprintf(stderr, "vdsh-merge: out of memory for %u receivers\n", V);
-            goto out;
-        }
-        for (int i = 0; i < n; i++) {
-            const vdsh_part *pt = &parts[i]->part;
-            size_t a = pt->range_begin * nc, b = pt->range_end * nc;
-            memcpy(merged[s] + a, (const float *)parts[i]->streams[s].data + a,
-                   (b - a) * sizeof(float));
-        }
         streams[s].data = merged[s];
         if (p0->part.encoding == VDSH_ENCODING_F16) {
             /* As vb_bake_stream: the same scale rule, vdsh_f16_scale. */
@@ -310,8 +310,7 @@ out:
         free(merged[s]), free(encoded[s]);
     free(owner);
     free(normals);
-    for (int i = 0; i < n; i++)
-        vdsh_free(parts[i]);
-    free(parts);
+    vdsh_free(part);
+    vdsh_free(p0);
     return status;
 }

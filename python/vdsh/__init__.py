@@ -7,6 +7,9 @@
     c = vdsh.coefficients(s)           # V x order^2 float32 (stored x scale;
                                        # s8, s8s6: stored x float32(scale_i / levels_i))
     d = vdsh.reconstruct(f, s, v, dirs)    # distances of vertex v toward unit dirs (N x 3)
+    f.part                             # None, or a part of a sharded bake (VDSH.md "Parts"):
+                                       # dict index, count, range_begin, range_end, encoding;
+                                       # its streams hold rows range_begin..range_end - 1 only
 
 Every reading rule of the spec is checked; numpy only.
 """
@@ -23,7 +26,7 @@ METHODS = ["paper", "full", "mirror", "lsq", "shadow"]
 ENCODINGS = ["f32", "f16", "s8", "s8s6"]
 QUANTITIES = ["distance", "distance2", "log-distance"]
 WINDOWS = ["none", "hann", "lanczos"]
-KNOWN = {b"HEAD", b"SRCS", b"POSN", b"NORM", b"TRIS", b"COEF", b"stat", b"time"}
+KNOWN = {b"HEAD", b"SRCS", b"POSN", b"NORM", b"TRIS", b"COEF", b"stat", b"time", b"part"}
 LOG_SUM_MAX = 80.0
 
 
@@ -34,7 +37,8 @@ class VdshError(Exception):
 class VdshFile:
     def __init__(self):
         self.header, self.sources, self.streams = {}, [], []
-        self.stats = self.timings = None
+        self.stats = self.timings = self.part = None
+        self._coef = []  # COEF payloads, read once every chunk is (a part's size them)
         self.positions = self.normals = self.triangles = None
 
 
@@ -98,6 +102,11 @@ def parse(data, path="memory"):
     for req in (b"HEAD", b"SRCS", b"POSN", b"NORM", b"TRIS"):
         if req not in seen:
             _fail(path, "required chunk %r missing" % req)
+    # a part's streams hold its range's rows, and `part` may follow them
+    rows = f.part["range_end"] - f.part["range_begin"] if f.part else f.header["vertex_count"]
+    for body in f._coef:
+        _coef(f, body, rows, path)
+    f._coef = []
     if not f.streams:
         _fail(path, "no COEF chunk")
     if f.stats and f.stats["rays_missed"] > f.stats["rays_traced"]:
@@ -177,7 +186,17 @@ def _chunk(f, cid, b, path):
             _fail(path, "TRIS: an index is out of range")
         f.triangles = t
     elif cid == b"COEF":
-        _coef(f, b, path)
+        f._coef.append(b)
+    elif cid == b"part":
+        if len(b) != 32:
+            _fail(path, "part is %d bytes, must be 32" % len(b))
+        i, n, rb, re, enc = struct.unpack_from("<5I", b, 0)
+        if any(b[20:32]):
+            _fail(path, "part: reserved bytes 20..31 not zero")
+        if not (n >= 1 and i < n and rb < re <= h["vertex_count"] and enc <= 3):
+            _fail(path, "part: shard %d of %d, receivers %d..%d or encoding %d out of range"
+                  % (i, n, rb, re, enc))
+        f.part = dict(index=i, count=n, range_begin=rb, range_end=re, encoding=ENCODINGS[enc])
     elif cid == b"stat":
         if len(b) != 32:
             _fail(path, "stat is %d bytes, must be 32" % len(b))
@@ -196,8 +215,8 @@ def _chunk(f, cid, b, path):
                          threads=struct.unpack_from("<I", b, 40)[0])
 
 
-def _coef(f, b, path):
-    V = f.header["vertex_count"]
+def _coef(f, b, V, path):
+    """One COEF stream of V rows (a part: its range's)."""
     if len(b) < 48:
         _fail(path, "COEF shorter than its header")
     order, enc, method, qty, win = struct.unpack_from("<5I", b, 0)
@@ -274,7 +293,7 @@ def _coef(f, b, path):
 
 
 def coefficients(stream):
-    """V x n^2 float32: stored value x scale (the window is already applied);
+    """V x n^2 float32 (a part's: its range's rows): stored value x scale (the window is already applied);
     s8, s8s6: stored value x step_i, step_i = float32(scale_i / levels_i),
     levels 127 (31 for s8s6's coefficients 4..) (as vdsh.c)."""
     if stream["encoding"] in ("s8", "s8s6"):
@@ -312,8 +331,14 @@ def sh_basis(order, dirs):
 
 
 def reconstruct(f, stream, vertex, dirs):
-    """Distances of one vertex toward unit directions (VDSH.md, Reconstruction rules)."""
-    c = coefficients(stream)[vertex].astype(np.float64)
+    """Distances of one vertex toward unit directions (VDSH.md, Reconstruction rules).
+    In a part, only its range's vertices have coefficients."""
+    row = vertex - (f.part["range_begin"] if f.part else 0)
+    if not 0 <= row < len(stream["stored"]):
+        raise VdshError("vertex %d: not in the file's streams%s" % (
+            vertex, " (a part: receivers %d..%d)" % (f.part["range_begin"], f.part["range_end"])
+            if f.part else ""))
+    c = coefficients(stream)[row].astype(np.float64)
     s = sh_basis(stream["order"], dirs) @ c
     dmax = f.header["max_distance"]
     q = stream["quantity"]
