@@ -151,10 +151,23 @@ for n in 1 2 7; do
   expect_exit 0 "merge plan $n" "$merge" -q "$d"/part-*.vdsh -o "$d/scene.vdsh"
   check "plan, $n shards: identical to the whole bake of the plan" cmp "$d/scene.vdsh" "$tmp/plan-whole.vdsh"
 done
+# A uniform plan in binary PLY (--plan FILE.ply, no bake): read back bit
+# for bit, so its bake is the OBJ plan's bake of the same receivers.
+expect_exit 0 "uniform plan, PLY" "$bake" builtin:room --max-edge 1.5 -q --plan "$tmp/uplan.ply"
+expect_exit 0 "uniform plan, OBJ" "$bake" builtin:room --max-edge 1.5 -q --plan "$tmp/uplan.obj"
+expect_exit 0 "bake of the PLY plan" "$bake" builtin:room --receivers "$tmp/uplan.ply" --rays 32 --cube-size 8 -q -o "$tmp/up.vdsh"
+expect_exit 0 "bake of the OBJ plan" "$bake" builtin:room --receivers "$tmp/uplan.obj" --rays 32 --cube-size 8 -q -o "$tmp/uo.vdsh"
+check "PLY and OBJ plans give the same bake" cmp "$tmp/up.vdsh" "$tmp/uo.vdsh"
+d=$tmp/uplan3; mkdir -p "$d"
+for i in 0 1 2; do
+  expect_exit 0 "PLY plan shard $i/3" "$bake" builtin:room --receivers "$tmp/uplan.ply" --rays 32 --cube-size 8 -q --shard "$i/3" -o "$d/p$i.vdsh"
+done
+expect_exit 0 "merge PLY plan" "$merge" -q "$d"/p*.vdsh -o "$d/scene.vdsh"
+check "PLY plan, 3 shards: identical to its whole bake" cmp "$d/scene.vdsh" "$tmp/up.vdsh"
 expect_exit 2 "--adaptive with --shard is refused" "$bake" builtin:room --max-edge 1.5 --adaptive 0.05 \
   --shard 0/2 -o "$out"
 says "--adaptive with --shard" "shard the plan"
-expect_exit 2 "--plan without --adaptive" "$bake" "${tiny[@]}" --plan "$tmp/x.obj"
+expect_exit 2 "--plan with --receivers" "$bake" builtin:room --receivers "$tmp/plan.obj" --plan "$tmp/x.obj"
 expect_exit 2 "--receivers with --max-edge" "$bake" builtin:room --receivers "$tmp/plan.obj" --max-edge 1 -o "$out"
 expect_exit 1 "--receivers of a missing file" "$bake" builtin:room --receivers "$tmp/none.obj" -o "$out"
 says "--receivers of a missing file" "none.obj"

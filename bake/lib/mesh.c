@@ -491,6 +491,43 @@ vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path, vb_error *err)
     return VB_OK;
 }
 
+vb_result vb_mesh_write_ply(const vb_mesh *m, const char *path, vb_error *err)
+{
+    if (!m || !path || !path[0] || (m->vertex_count && (!m->positions || !m->normals)) ||
+        (m->triangle_count && !m->indices))
+        return vb_fail(err, VB_ERR_ARGUMENT, "write_ply: invalid argument");
+    for (size_t j = 0; j < 3 * (size_t)m->triangle_count; j++)
+        if (m->indices[j] >= m->vertex_count)
+            return vb_fail(err, VB_ERR_INVALID, "%s: triangle %zu: index %u out of range (%u vertices)",
+                           path, j / 3, m->indices[j], m->vertex_count);
+    vdsh_output out;
+    vdsh_error ve;
+    vdsh_result vr = vdsh_output_open(path, &out, &ve);
+    if (vr != VDSH_OK)
+        return vb_fail(err, vr == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_IO,
+                       "%s", ve.msg);
+    FILE *f = out.fp;
+    setvbuf(f, NULL, _IOFBF, 1 << 16);
+    fprintf(f, "ply\nformat binary_little_endian 1.0\ncomment vdsh mesh\n"
+               "element vertex %u\nproperty float x\nproperty float y\nproperty float z\n"
+               "property float nx\nproperty float ny\nproperty float nz\n"
+               "element face %u\nproperty list uchar uint vertex_indices\nend_header\n",
+            m->vertex_count, m->triangle_count);
+    /* Little-endian host (vdsh.h checks it): the floats and indices as they are. */
+    for (uint32_t i = 0; i < m->vertex_count; i++) {
+        fwrite(m->positions + 3 * (size_t)i, sizeof(float), 3, f);
+        fwrite(m->normals + 3 * (size_t)i, sizeof(float), 3, f);
+    }
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        unsigned char three = 3;
+        fwrite(&three, 1, 1, f);
+        fwrite(m->indices + 3 * (size_t)t, sizeof(uint32_t), 3, f);
+    }
+    if (vdsh_output_commit(&out, &ve) != VDSH_OK)
+        return vb_fail(err, VB_ERR_IO, "%s", ve.msg);
+    return VB_OK;
+}
+
 /* ---------------------------------------------------------------------- */
 /* Loading                                                                */
 /* ---------------------------------------------------------------------- */

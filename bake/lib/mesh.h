@@ -277,6 +277,11 @@ vb_result vb_mesh_split_edges(const vb_mesh *in, const uint32_t *pairs, uint32_t
 vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path,
                             vb_error *err);
 
+/* Write as binary little-endian PLY (x y z nx ny nz floats, triangles as
+ * uchar-counted uint lists), read back bit for bit by vb_mesh_load;
+ * atomically, as vb_mesh_write_obj. Needs normals. */
+vb_result vb_mesh_write_ply(const vb_mesh *m, const char *path, vb_error *err);
+
 /* Axis-aligned bounds of all vertices; min = max = (0,0,0) when empty. */
 void vb_mesh_bounds(const vb_mesh *m, float min[3], float max[3]);
 

@@ -20,6 +20,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <unistd.h>
 
 #include "bake.h"
@@ -195,9 +196,10 @@ static void usage(FILE *f)
 "                          (default: --max-edge / 8)\n"
 "      --max-receivers N   with --adaptive: stop at N receivers, splitting\n"
 "                          the largest errors first\n"
-"      --plan FILE         with --adaptive: also write the receivers (OBJ,\n"
-"                          exact floats), so that shards can bake them\n"
-"                          (without -o: the plan only)\n"
+"      --plan FILE         write the receivers (refined, or with --adaptive\n"
+"                          as baked) for shards to read with --receivers:\n"
+"                          FILE.ply binary PLY (fast to read), else OBJ;\n"
+"                          exact floats. Without -o: the plan only\n"
 "      --receivers FILE    bake these receivers (a mesh file, e.g. a plan)\n"
 "                          as they are, instead of the scene's vertices\n"
 "      --weld              merge vertices with identical positions\n"
@@ -452,6 +454,28 @@ static void on_mesh(void *user, const char *path, const vb_mesh *m, const vb_sou
 
 /* ---- main ---------------------------------------------------------------- */
 
+/* Write the receivers as a plan for shards (--plan): binary PLY when the
+ * name ends in .ply, else OBJ; exact floats either way. Nonzero on error
+ * (said on stderr). */
+static int write_plan(const vb_mesh *m, const char *path, FILE *log)
+{
+    vb_error err;
+    size_t n = strlen(path);
+    pthread_mutex_lock(&output_lock);
+    vb_result r = n > 4 && strcasecmp(path + n - 4, ".ply") == 0
+                      ? vb_mesh_write_ply(m, path, &err)
+                      : vb_mesh_write_obj(m, path, &err);
+    pthread_mutex_unlock(&output_lock);
+    if (r != VB_OK) {
+        fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+        return 1;
+    }
+    if (log)
+        fprintf(log, "vdsh-bake: wrote the plan %s (%u receivers, %u triangles)\n", path,
+                m->vertex_count, m->triangle_count);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     defer_interrupts_while_writing(); /* first: before any thread starts */
@@ -666,8 +690,8 @@ int main(int argc, char **argv)
         return bad_usage("%s", "--adaptive cannot be combined with --shard: the refinement "
                                "bakes as it decides. Plan it once (--adaptive ... --plan "
                                "plan.obj), then shard the plan (--receivers plan.obj --shard I/N)");
-    if (o.plan && !o.adaptive)
-        return bad_usage("%s", "--plan needs --adaptive TOL: it writes the adaptive receivers");
+    if (o.plan && o.receivers)
+        return bad_usage("%s", "--plan writes the receivers --receivers reads: not both");
     if (o.receivers && (o.adaptive || o.max_edge > 0.0f || o.weld))
         return bad_usage("%s", "--receivers takes the receivers as they are: not with "
                                "--adaptive, --max-edge or --weld");
@@ -743,6 +767,14 @@ int main(int argc, char **argv)
         fprintf(log, "vdsh-bake: receivers refined to max edge %g: %u vertices, "
                      "%u triangles (%.2f s)\n",
                 (double)o.max_edge, rec->vertex_count, rec->triangle_count, job.timings.refine);
+    if (o.plan && !o.adaptive) { /* uniform: the refined receivers, before any bake */
+        if (write_plan(rec, o.plan, log) != 0)
+            goto out;
+        if (!o.output && !o.export_obj && !o.trace_only) {
+            status = 0;
+            goto out;
+        }
+    }
     if (o.export_obj) {
         pthread_mutex_lock(&output_lock);
         vb_result written = vb_mesh_write_obj(rec, o.export_obj, &err);
@@ -771,21 +803,12 @@ int main(int argc, char **argv)
         goto out;
     }
     const vb_bake_output *bo = &job.bake;
-    if (o.plan) {
-        /* The plan: the receivers as baked (oriented normals), exact floats. */
+    if (o.plan && o.adaptive) { /* the receivers as baked (oriented normals) */
         vb_mesh planned = job.receivers;
         if (bo->normals)
             planned.normals = bo->normals;
-        pthread_mutex_lock(&output_lock);
-        vb_result written = vb_mesh_write_obj(&planned, o.plan, &err);
-        pthread_mutex_unlock(&output_lock);
-        if (written != VB_OK) {
-            fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+        if (write_plan(&planned, o.plan, log) != 0)
             goto out;
-        }
-        if (log)
-            fprintf(log, "vdsh-bake: wrote the plan %s (%u receivers, %u triangles)\n", o.plan,
-                    planned.vertex_count, planned.triangle_count);
         if (!o.output) {
             status = 0;
             goto out;
