@@ -18,6 +18,7 @@ network, Debian's pip and setuptools), imports it from there, and checks:
 - parts (vdsh-bake --shard I/3, f32): read as parts by both readers, each
   stream the whole f32 bake's rows of its range, reconstruct refusing a
   vertex outside it;
+- an adaptive bake (vdsh-bake --adaptive): its `adpt` chunk read alike;
 - reconstruction: for the default bake's order-5 log stream, distances
   toward 64 directions at 50 vertices equal exp of the SH sum clamped to
   max_distance, and lie in (0, max_distance].
@@ -118,6 +119,12 @@ def compare(path):
         fail.append("%s: stats differ" % path)
     if c.get("part") != p.part:
         fail.append("%s: part: C %s, Python %s" % (path, c.get("part"), p.part))
+    ca, pa = c.get("adaptive"), p.adaptive
+    if (ca is None) != (pa is None) or (ca and any(
+            not close(ca[k], pa[k]) for k in ("tolerance", "min_edge")) or ca and any(
+            ca[k] != pa[k] for k in ("max_receivers", "lights", "max_rounds", "start_receivers",
+                                     "rounds", "candidates"))):
+        fail.append("%s: adaptive: C %s, Python %s" % (path, ca, pa))
     return p
 
 
@@ -131,7 +138,8 @@ for name, args in (("default", []), ("paper-f32", ["--method", "paper", "--encod
                    ("s8", ["--encoding", "s8"]),
                    ("s8-small", ["--encoding", "s8", "--orders", "3"]),
                    ("s8s6", ["--encoding", "s8s6"]),
-                   ("s8s6-small", ["--encoding", "s8s6", "--orders", "3,5"])):
+                   ("s8s6-small", ["--encoding", "s8s6", "--orders", "3,5"]),
+                   ("adaptive", ["--adaptive", "0.05"])):
     out = os.path.join(work, name + ".vdsh")
     r = subprocess.run([bake, "builtin:room", "--max-edge", "1.5", "--rays", "256", "-q",
                         "--cube-size", "0", "-o", out] + args, capture_output=True, text=True)

@@ -10,6 +10,9 @@
     f.part                             # None, or a part of a sharded bake (VDSH.md "Parts"):
                                        # dict index, count, range_begin, range_end, encoding;
                                        # its streams hold rows range_begin..range_end - 1 only
+    f.adaptive                         # None, or what refined adaptive receivers (`adpt`):
+                                       # dict tolerance, min_edge, max_receivers, lights,
+                                       # max_rounds, start_receivers, rounds, candidates
 
 Every reading rule of the spec is checked; numpy only.
 """
@@ -26,7 +29,7 @@ METHODS = ["paper", "full", "mirror", "lsq", "shadow"]
 ENCODINGS = ["f32", "f16", "s8", "s8s6"]
 QUANTITIES = ["distance", "distance2", "log-distance"]
 WINDOWS = ["none", "hann", "lanczos"]
-KNOWN = {b"HEAD", b"SRCS", b"POSN", b"NORM", b"TRIS", b"COEF", b"stat", b"time", b"part"}
+KNOWN = {b"HEAD", b"SRCS", b"POSN", b"NORM", b"TRIS", b"COEF", b"stat", b"time", b"part", b"adpt"}
 LOG_SUM_MAX = 80.0
 
 
@@ -37,7 +40,7 @@ class VdshError(Exception):
 class VdshFile:
     def __init__(self):
         self.header, self.sources, self.streams = {}, [], []
-        self.stats = self.timings = self.part = None
+        self.stats = self.timings = self.part = self.adaptive = None
         self._coef = []  # COEF payloads, read once every chunk is (a part's size them)
         self.positions = self.normals = self.triangles = None
 
@@ -197,6 +200,17 @@ def _chunk(f, cid, b, path):
             _fail(path, "part: shard %d of %d, receivers %d..%d or encoding %d out of range"
                   % (i, n, rb, re, enc))
         f.part = dict(index=i, count=n, range_begin=rb, range_end=re, encoding=ENCODINGS[enc])
+    elif cid == b"adpt":
+        if len(b) != 32:
+            _fail(path, "adpt is %d bytes, must be 32" % len(b))
+        tol, me = struct.unpack_from("<2f", b, 0)
+        mr, nl, mx, st, rd, cd = struct.unpack_from("<6I", b, 8)
+        V = h["vertex_count"]
+        if not (tol >= 0 and me > 0 and np.isfinite(me) and nl >= 1 and mx >= 1 and rd <= mx
+                and 1 <= st <= V and (mr == 0 or V <= mr) and st + cd >= V):
+            _fail(path, "adpt: a field is out of range")
+        f.adaptive = dict(tolerance=tol, min_edge=me, max_receivers=mr, lights=nl, max_rounds=mx,
+                          start_receivers=st, rounds=rd, candidates=cd)
     elif cid == b"stat":
         if len(b) != 32:
             _fail(path, "stat is %d bytes, must be 32" % len(b))
