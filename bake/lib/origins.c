@@ -689,7 +689,8 @@ static void orient_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
 /* Orient m's receivers with frames F of m: flip, in `normals` (m's or a
  * copy of them), those pointing into geometry. */
 static vb_result orient(const vb_mesh *m, const vb_scene *s, const frames *F, unsigned threads,
-                        const uint8_t *need, float *normals, uint32_t *flipped, vb_error *err)
+                        const uint8_t *need, float *normals, uint32_t *flipped, uint32_t *any,
+                        vb_error *err)
 {
     vb_result r = VB_OK;
     orient_job J = {.m = m, .F = F, .need = need};
@@ -699,16 +700,19 @@ static vb_result orient(const vb_mesh *m, const vb_scene *s, const frames *F, un
     prober_init(&J.P, s);
     if (vb_parallel_for(threads, m->vertex_count, 256, orient_block, &J, NULL, NULL) == 0)
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
-    uint32_t count = 0;
+    uint32_t count = 0, all = 0;
     for (uint32_t v = 0; v < m->vertex_count && r == VB_OK; v++)
         if (J.flip[v]) {
             for (int i = 0; i < 3; i++)
                 normals[3 * (size_t)v + i] = -normals[3 * (size_t)v + i];
             count += !need || need[v] == VB_NEED_COUNT;
+            all++;
         }
     free(J.flip);
-    if (r == VB_OK)
-        *flipped = count;
+    if (r == VB_OK) {
+        *flipped = count; /* the counted ones */
+        *any = all;       /* every flip: the frames depend on them all */
+    }
     return r;
 }
 
@@ -720,7 +724,8 @@ vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
     if (r != VB_OK)
         return r;
     uint32_t count = 0;
-    r = orient(m, s, &F, threads, NULL, m->normals, &count, err);
+    uint32_t any = 0;
+    r = orient(m, s, &F, threads, NULL, m->normals, &count, &any, err);
     frames_free(&F);
     if (r == VB_OK && flipped)
         *flipped = count;
@@ -772,7 +777,7 @@ vb_result vb_receivers_prepare(const vb_mesh *m, const vb_scene *s, unsigned thr
     if (r != VB_OK)
         return r;
     vb_mesh oriented = *m;
-    uint32_t count = 0;
+    uint32_t count = 0, any = 0;
     uint8_t *orient_need = NULL;
     if (need && normals && !(orient_need = need_with_coincident(m, need))) {
         frames_free(&F);
@@ -781,9 +786,11 @@ vb_result vb_receivers_prepare(const vb_mesh *m, const vb_scene *s, unsigned thr
     if (normals) {
         memcpy(normals, m->normals, (size_t)m->vertex_count * 3 * sizeof *normals);
         oriented.normals = normals;
-        r = orient(m, s, &F, threads, orient_need, normals, &count, err);
-        /* The frames again where they depend on the normals. */
-        if (r == VB_OK && count > 0)
+        r = orient(m, s, &F, threads, orient_need, normals, &count, &any, err);
+        /* The frames again where they depend on the normals: after any flip,
+         * also one of a receiver that is not counted (a shard's neighbour at
+         * the same position). */
+        if (r == VB_OK && any > 0)
             r = frames_normals(&oriented, &F, err);
         t0 = vb_now(); /* the origins' time, as before: not the orientation's */
     }
