@@ -28,25 +28,41 @@ static int cmp_pos(const void *a, const void *b)
     return (x->index > y->index) - (x->index < y->index);
 }
 
-vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err)
+/* m's vertices sorted by the bytes of their positions, which groups
+ * bit-identical positions (+ 0.0f folds -0 into +0); ties are ordered by
+ * index, so a group's sums run in a fixed order. NULL when out of memory. */
+static pos_key *sorted_positions(const vb_mesh *m)
 {
     uint32_t n = m->vertex_count;
     pos_key *key = malloc((size_t)n * sizeof *key + 1);
     if (!key)
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+        return NULL;
     for (uint32_t i = 0; i < n; i++) {
-        for (int c = 0; c < 3; c++) /* + 0.0f folds -0 into +0 */
+        for (int c = 0; c < 3; c++)
             key[i].p[c] = m->positions[3 * (size_t)i + c] + 0.0f;
         key[i].index = i;
     }
-    /* Sorting by the position's bytes groups bit-identical positions; ties
-     * are ordered by index, so each group's sum runs in a fixed order. */
     qsort(key, n, sizeof *key, cmp_pos);
+    return key;
+}
 
+/* The end of the group of equal positions that starts at key[a]. */
+static uint32_t group_end(const pos_key *key, uint32_t n, uint32_t a)
+{
+    uint32_t b = a + 1;
+    while (b < n && memcmp(key[a].p, key[b].p, sizeof key[a].p) == 0)
+        b++;
+    return b;
+}
+
+vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err)
+{
+    uint32_t n = m->vertex_count;
+    pos_key *key = sorted_positions(m);
+    if (!key)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
     for (uint32_t a = 0; a < n;) {
-        uint32_t b = a + 1;
-        while (b < n && memcmp(key[a].p, key[b].p, sizeof key[a].p) == 0)
-            b++;
+        uint32_t b = group_end(key, n, a);
         /* Each vertex of the group sums the normals that face its own side
          * (n_u . n_v >= 0, itself included): an unwelded room corner
          * (floor and walls at right angles) gets one diagonal normal for
@@ -739,24 +755,18 @@ static uint8_t *need_with_coincident(const vb_mesh *m, const uint8_t *need)
 {
     uint32_t n = m->vertex_count;
     uint8_t *out = malloc((size_t)n + 1);
-    pos_key *key = malloc((size_t)n * sizeof *key + 1);
+    pos_key *key = sorted_positions(m);
     if (!out || !key) {
         free(out);
         free(key);
         return NULL;
     }
     memcpy(out, need, n);
-    for (uint32_t i = 0; i < n; i++) {
-        for (int c = 0; c < 3; c++) /* + 0.0f folds -0 into +0, as vb_offset_normals */
-            key[i].p[c] = m->positions[3 * (size_t)i + c] + 0.0f;
-        key[i].index = i;
-    }
-    qsort(key, n, sizeof *key, cmp_pos);
     for (uint32_t a = 0; a < n;) {
-        uint32_t b = a + 1;
-        int any = need[key[a].index] != 0;
-        while (b < n && memcmp(key[a].p, key[b].p, sizeof key[a].p) == 0)
-            any |= need[key[b++].index] != 0;
+        uint32_t b = group_end(key, n, a);
+        int any = 0;
+        for (uint32_t k = a; k < b; k++)
+            any |= need[key[k].index] != 0;
         for (uint32_t k = a; k < b && any && b - a > 1; k++)
             if (!out[key[k].index])
                 out[key[k].index] = VB_NEED_ONLY;
