@@ -446,25 +446,44 @@ vb_result vb_mesh_append(vb_mesh *dst, const vb_mesh *src, vb_error *err)
 /* OBJ output                                                             */
 /* ---------------------------------------------------------------------- */
 
-vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path, vb_error *err)
+/* What both writers do first: check m (normals too with need_normals) and
+ * open the project's atomic output (vdsh_output.h: a temporary file beside
+ * the target, renamed over it once complete and on disk). */
+static vb_result write_begin(const vb_mesh *m, const char *path, const char *what,
+                             int need_normals, vdsh_output *out, vb_error *err)
 {
-    if (!m || !path || !path[0] || (m->vertex_count && !m->positions) || (m->triangle_count && !m->indices))
-        return vb_fail(err, VB_ERR_ARGUMENT, "write_obj: invalid argument");
+    if (!m || !path || !path[0] || (m->vertex_count && !m->positions) ||
+        (m->vertex_count && need_normals && !m->normals) || (m->triangle_count && !m->indices))
+        return vb_fail(err, VB_ERR_ARGUMENT, "%s: invalid argument", what);
     for (size_t j = 0; j < 3 * (size_t)m->triangle_count; j++)
         if (m->indices[j] >= m->vertex_count)
             return vb_fail(err, VB_ERR_INVALID, "%s: triangle %zu: index %u out of range (%u vertices)",
                            path, j / 3, m->indices[j], m->vertex_count);
-
-    /* The project's atomic output (vdsh_output.h): a temporary file
-     * beside the target, renamed over it once complete and on disk. */
-    vdsh_output out;
     vdsh_error ve;
-    vdsh_result vr = vdsh_output_open(path, &out, &ve);
+    vdsh_result vr = vdsh_output_open(path, out, &ve);
     if (vr != VDSH_OK)
         return vb_fail(err, vr == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_IO,
                        "%s", ve.msg);
+    setvbuf(out->fp, NULL, _IOFBF, 1 << 16);
+    return VB_OK;
+}
+
+/* Close what write_begin opened: renamed into place, or removed. */
+static vb_result write_end(vdsh_output *out, vb_error *err)
+{
+    vdsh_error ve;
+    if (vdsh_output_commit(out, &ve) != VDSH_OK)
+        return vb_fail(err, VB_ERR_IO, "%s", ve.msg);
+    return VB_OK;
+}
+
+vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path, vb_error *err)
+{
+    vdsh_output out;
+    vb_result r = write_begin(m, path, "write_obj", 0, &out, err);
+    if (r != VB_OK)
+        return r;
     FILE *f = out.fp;
-    setvbuf(f, NULL, _IOFBF, 1 << 16);
 
     /* %.9g: 9 significant digits read back as the same float. */
     fprintf(f, "# vdsh mesh: %u vertices, %u triangles\n", m->vertex_count, m->triangle_count);
@@ -485,29 +504,16 @@ vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path, vb_error *err)
         else
             fprintf(f, "f %u %u %u\n", tri[0] + 1, tri[1] + 1, tri[2] + 1);
     }
-
-    if (vdsh_output_commit(&out, &ve) != VDSH_OK)
-        return vb_fail(err, VB_ERR_IO, "%s", ve.msg);
-    return VB_OK;
+    return write_end(&out, err);
 }
 
 vb_result vb_mesh_write_ply(const vb_mesh *m, const char *path, vb_error *err)
 {
-    if (!m || !path || !path[0] || (m->vertex_count && (!m->positions || !m->normals)) ||
-        (m->triangle_count && !m->indices))
-        return vb_fail(err, VB_ERR_ARGUMENT, "write_ply: invalid argument");
-    for (size_t j = 0; j < 3 * (size_t)m->triangle_count; j++)
-        if (m->indices[j] >= m->vertex_count)
-            return vb_fail(err, VB_ERR_INVALID, "%s: triangle %zu: index %u out of range (%u vertices)",
-                           path, j / 3, m->indices[j], m->vertex_count);
     vdsh_output out;
-    vdsh_error ve;
-    vdsh_result vr = vdsh_output_open(path, &out, &ve);
-    if (vr != VDSH_OK)
-        return vb_fail(err, vr == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_IO,
-                       "%s", ve.msg);
+    vb_result r = write_begin(m, path, "write_ply", 1, &out, err);
+    if (r != VB_OK)
+        return r;
     FILE *f = out.fp;
-    setvbuf(f, NULL, _IOFBF, 1 << 16);
     fprintf(f, "ply\nformat binary_little_endian 1.0\ncomment vdsh mesh\n"
                "element vertex %u\nproperty float x\nproperty float y\nproperty float z\n"
                "property float nx\nproperty float ny\nproperty float nz\n"
@@ -523,9 +529,7 @@ vb_result vb_mesh_write_ply(const vb_mesh *m, const char *path, vb_error *err)
         fwrite(&three, 1, 1, f);
         fwrite(m->indices + 3 * (size_t)t, sizeof(uint32_t), 3, f);
     }
-    if (vdsh_output_commit(&out, &ve) != VDSH_OK)
-        return vb_fail(err, VB_ERR_IO, "%s", ve.msg);
-    return VB_OK;
+    return write_end(&out, err);
 }
 
 /* ---------------------------------------------------------------------- */
