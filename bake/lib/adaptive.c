@@ -167,7 +167,7 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
     size_t judged_n = 0, cand_n = 0;
     double *error = NULL;
     ranked *rank = NULL;
-    uint32_t *rows = NULL;
+    uint32_t *rows = NULL, *pairs = NULL; /* per round: new rows; the candidates' ends */
     float (*lights)[3] = NULL;
     const double t_start = vb_now();
     vb_result r = vb_mesh_refine(start, 0.0f, &M, err); /* a copy */
@@ -212,28 +212,22 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         if (cand_n == 0)
             break;
         /* The tentative mesh: every candidate split; bake the midpoints. */
-        uint32_t *pp = malloc(cand_n * 2 * sizeof *pp + 1);
-        if (!pp) {
+        free(pairs);
+        if (!(pairs = malloc(cand_n * 2 * sizeof *pairs + 1))) {
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
             goto done;
         }
         for (size_t i = 0; i < cand_n; i++)
-            pp[2 * i] = (uint32_t)(cand[i] >> 32), pp[2 * i + 1] = (uint32_t)cand[i];
+            pairs[2 * i] = (uint32_t)(cand[i] >> 32), pairs[2 * i + 1] = (uint32_t)cand[i];
         vb_mesh_free(&T);
-        r = vb_mesh_split_edges(&M, pp, (uint32_t)cand_n, &T, err);
-        if (r != VB_OK) {
-            free(pp);
+        if ((r = vb_mesh_split_edges(&M, pairs, (uint32_t)cand_n, &T, err)) != VB_OK)
             goto done;
-        }
         vb_bake_output_free(&R);
         bd.receivers = &T;
         bd.range_begin = V;
         bd.range_end = T.vertex_count;
-        r = vb_bake_run(&bd, &R, err);
-        if (r != VB_OK) {
-            free(pp);
+        if ((r = vb_bake_run(&bd, &R, err)) != VB_OK)
             goto done;
-        }
         st.rounds++;
         st.candidates += (uint32_t)cand_n;
         B.rays_traced += R.rays_traced;
@@ -254,7 +248,6 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         error = malloc(cand_n * sizeof *error + 1);
         rank = malloc(cand_n * sizeof *rank + 1);
         if (!error || !rank) {
-            free(pp);
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
             goto done;
         }
@@ -264,7 +257,6 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
                         .lights = (const float(*)[3])lights, .light_count = st.lights,
                         .error = error};
         if (vb_parallel_for(B.threads, (uint32_t)cand_n, 64, score_block, &sj, NULL, NULL) == 0) {
-            free(pp);
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
             goto done;
         }
@@ -286,7 +278,6 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         rows = malloc((size_t)take * sizeof *rows + 1);
         if (!chosen || !nj || !rows) {
             free(chosen);
-            free(pp);
             if (nj)
                 judged = nj;
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
@@ -298,7 +289,7 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         uint32_t s = 0;
         for (size_t i = 0; i < cand_n; i++) {
             if (chosen[i]) { /* in key order: the new vertices' order */
-                pp[2 * s] = pp[2 * i], pp[2 * s + 1] = pp[2 * i + 1];
+                pairs[2 * s] = pairs[2 * i], pairs[2 * s + 1] = pairs[2 * i + 1];
                 rows[s++] = V + (uint32_t)i;
             } else if (error[i] <= ad->tolerance) {
                 judged[judged_n++] = cand[i];
@@ -308,14 +299,10 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         qsort(judged, judged_n, sizeof *judged, cmp_u64);
         if (ad->on_round)
             ad->on_round(ad->user, st.rounds, V + s, (uint32_t)cand_n, s, vb_now() - t_start);
-        if (s == 0) {
-            free(pp);
+        if (s == 0)
             break;
-        }
         vb_mesh_free(&N);
-        r = vb_mesh_split_edges(&M, pp, s, &N, err);
-        free(pp);
-        if (r != VB_OK)
+        if ((r = vb_mesh_split_edges(&M, pairs, s, &N, err)) != VB_OK)
             goto done;
         /* The new vertices keep their midpoint bakes (and oriented normals). */
         int ok = 1;
@@ -358,6 +345,7 @@ done:
     free(error);
     free(rank);
     free(rows);
+    free(pairs);
     free(lights);
     return r;
 }
