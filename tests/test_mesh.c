@@ -13,6 +13,7 @@
 #include "mesh.h"
 #include "origins.h"
 #include "scene.h"
+#include "test_scenes.h"
 #include "test_util.h"
 #include "vdsh.h"
 
@@ -73,23 +74,6 @@ static double max_edge2(const vb_mesh *m)
     return best;
 }
 
-static double total_area(const vb_mesh *m)
-{
-    double a = 0.0;
-    for (uint32_t t = 0; t < m->triangle_count; t++) {
-        const float *p0 = m->positions + 3 * (size_t)m->indices[3 * t];
-        const float *p1 = m->positions + 3 * (size_t)m->indices[3 * t + 1];
-        const float *p2 = m->positions + 3 * (size_t)m->indices[3 * t + 2];
-        double u[3], v[3];
-        for (int k = 0; k < 3; k++) {
-            u[k] = (double)p1[k] - p0[k];
-            v[k] = (double)p2[k] - p0[k];
-        }
-        double c[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-        a += 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    }
-    return a;
-}
 
 /* What mesh.h promises of every mesh it produces. */
 static int check_clean(const vb_mesh *m, const char *what)
@@ -1150,7 +1134,7 @@ static void test_room(void)
            fine.triangle_count, 1e3 * dt);
     CHECK(fine.vertex_count >= 55000 && fine.vertex_count <= 60000, "room at 0.2 m: %u receivers", fine.vertex_count);
     CHECK(max_edge2(&fine) <= 0.2 * 0.2 + 1e-9, "room: edge of %g left", sqrt(max_edge2(&fine)));
-    double a0 = total_area(&room), a1 = total_area(&fine);
+    double a0 = test_mesh_area(&room), a1 = test_mesh_area(&fine);
     CHECK(fabs(a1 - a0) <= 1e-5 * a0, "room area %g -> %g", a0, a1);
     check_clean(&fine, "refined room");
     CHECK(memcmp(fine.positions, room.positions, 3 * sizeof(float) * room.vertex_count) == 0,
@@ -1526,7 +1510,7 @@ static void test_refine(void)
     CHECK(hist[2] == ne, "refined ball: %zu of %zu edges not used exactly twice", ne - hist[2], ne);
     CHECK((long)f1.vertex_count - (long)ne + (long)f1.triangle_count == 2, "refined ball: Euler characteristic");
     CHECK(max_edge2(&f1) <= 0.01 + 1e-12, "ball: edge too long");
-    double a0 = total_area(&ball), a1 = total_area(&f1);
+    double a0 = test_mesh_area(&ball), a1 = test_mesh_area(&f1);
     CHECK(fabs(a1 - a0) <= 1e-5 * a0, "ball area %g -> %g", a0, a1);
     CHECK(memcmp(f1.positions, ball.positions, 12 * 3 * sizeof(float)) == 0 &&
               memcmp(f1.normals, ball.normals, 12 * 3 * sizeof(float)) == 0,
@@ -1546,8 +1530,8 @@ static void test_refine(void)
     vb_mesh book = make_mesh(5, bp, NULL, 6, bi);
     vb_mesh_compute_normals(&book);
     CHECK(vb_mesh_refine(&book, 0.3f, &f1, &err) == VB_OK, "book: %s", err.msg);
-    a0 = total_area(&book);
-    a1 = total_area(&f1);
+    a0 = test_mesh_area(&book);
+    a1 = test_mesh_area(&f1);
     CHECK(fabs(a1 - a0) <= 1e-5 * a0, "book: area %g -> %g (triangles lost?)", a0, a1);
     CHECK(max_edge2(&f1) <= 0.09 + 1e-12, "book: edge too long");
     CHECK(!t_junctions(&f1), "book: T-junction");
@@ -1990,7 +1974,7 @@ static int run_scenes(const char *root)
         vb_error err;
         CHECK(vb_mesh_load(refine_these[i], NULL, &m, NULL, &err) == VB_OK, "%s", err.msg);
         CHECK(vb_mesh_refine(&m, lengths[i], &f, &err) == VB_OK, "%s", err.msg);
-        double a0 = total_area(&m), a1 = total_area(&f);
+        double a0 = test_mesh_area(&m), a1 = test_mesh_area(&f);
         CHECK(fabs(a1 - a0) <= 1e-5 * a0, "%s: area %g -> %g", refine_these[i], a0, a1);
         CHECK(max_edge2(&f) <= (double)lengths[i] * lengths[i], "%s: edge too long", refine_these[i]);
         check_clean(&f, refine_these[i]);
