@@ -36,7 +36,8 @@ static const char usage_text[] =
     "                        map | VDSH order 5 | 3 | 2, labelled, into one image;\n"
     "                        several SCENEs (e.g. the same scene baked two ways)\n"
     "                        give one row each\n"
-    "      --bench           time every shadow mode with 1 and 3 lights on each\n"
+    "      --bench           time every shadow mode with 1, 3, 16 and 64 lights\n"
+    "                        (fewer rounds for 16 and 64) on each\n"
     "                        SCENE, all in this process, each round timing\n"
     "                        every mode of every SCENE once (wall time and\n"
     "                        process CPU time per frame); JSON on stdout\n"
@@ -60,7 +61,8 @@ static const char usage_text[] =
     "      --fit             frame the whole scene from outside, also a room\n"
     "      --fov DEG         vertical field of view (default 60)\n"
     "      --light X,Y,Z[,R,G,B]  a point light (repeatable)\n"
-    "      --lights N        use N default lights, 1..4 (default 1)\n"
+    "      --lights N        use N default lights, 1..64 (default 1; beyond\n"
+    "                        four, positions placed uniformly in free space)\n"
     "      --attenuation A0,A1,A2  for every light: 1/(A0 + A1 d + A2 d^2)\n"
     "                        (default 1, 0, 1/(0.3 * diagonal)^2)\n"
     "      --ambient V       ambient light (default 0.03)\n"
@@ -219,8 +221,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
             break;
         }
         case O_LIGHTS:
-            if (!vt_parse_int(v, 1, 4, &o->default_lights))
-                return usage_error("--lights: expected 1..4, got '%s'", v);
+            if (!vt_parse_int(v, 1, VV_MAX_LIGHTS, &o->default_lights))
+                return usage_error("--lights: expected 1..64, got '%s'", v);
             break;
         case O_ATT:
             if (vt_parse_floats(v, o->att, 3, 3) != 3 || o->att[0] < 0 || o->att[1] < 0 ||

@@ -1,7 +1,11 @@
 /*
  * vdsh_view_bench.c - vdsh-view --bench: frame times of every shadow mode
- * with 1 and 3 lights on each scene, in one process, as one JSON document
- * on stdout (scripts/bench_runtime reads it).
+ * with 1, 3, 16 and 64 lights on each scene, in one process, as one JSON
+ * document on stdout (scripts/bench_runtime reads it). Lights beyond the
+ * scene's four defaults come from its light pool (vr_scene_pool_lights).
+ * Frames with many lights are long (the cube maps re-render six faces per
+ * light), and the work of one such frame averages over many passes: they
+ * get fewer rounds (bench_rounds).
  */
 #include "vdsh_view.h"
 
@@ -35,7 +39,18 @@ static void json_series(vt_json *j, cJSON *o, const char *key, const double *v, 
         vt_json_f64(j, a, NULL, v[i]);
 }
 
-enum { BENCH_MODES = 7, BENCH_ROUNDS = 64 };
+enum { BENCH_MODES = 7, BENCH_ROUNDS = 64, BENCH_SETS = 4 };
+
+/* The light counts timed, and the rounds each gets out of `rounds`: all
+ * for 1 and 3 lights, a third for 16, a fifth for 64, at least 3. */
+static const int bench_light_sets[BENCH_SETS] = {1, 3, 16, 64};
+
+static int bench_rounds(int set, int rounds)
+{
+    static const int divisor[BENCH_SETS] = {1, 1, 3, 5};
+    int n = rounds / divisor[set];
+    return n < 3 ? (rounds < 3 ? rounds : 3) : n;
+}
 
 /* CPU time of the whole process (every thread: llvmpipe's rasterizer
  * threads render in this process), milliseconds. */
@@ -52,12 +67,13 @@ typedef struct bench_scene {
     vr_scene *scene;
     bench_mode modes[BENCH_MODES];
     int nm;
-    vr_light lights[2][4];
-    int nl[2];
+    vr_light lights[BENCH_SETS][VR_MAX_POOL_LIGHTS];
+    int nl[BENCH_SETS];
     /* [light set][mode][round] */
-    double cpu[2][BENCH_MODES][BENCH_ROUNDS], gpu[2][BENCH_MODES][BENCH_ROUNDS];
-    double shadow[2][BENCH_MODES][BENCH_ROUNDS], lighting[2][BENCH_MODES][BENCH_ROUNDS];
-    double proc[2][BENCH_MODES][BENCH_ROUNDS];
+    double cpu[BENCH_SETS][BENCH_MODES][BENCH_ROUNDS], gpu[BENCH_SETS][BENCH_MODES][BENCH_ROUNDS];
+    double shadow[BENCH_SETS][BENCH_MODES][BENCH_ROUNDS];
+    double lighting[BENCH_SETS][BENCH_MODES][BENCH_ROUNDS];
+    double proc[BENCH_SETS][BENCH_MODES][BENCH_ROUNDS];
 } bench_scene;
 
 /* Load a scene and choose the modes it is timed in. */
@@ -68,7 +84,6 @@ static int bench_open(const vv_options *o, const char *path, bench_scene *b)
         {VR_MODE_CUBE, 1, "cube_pcf"}, {VR_MODE_VDSH2, 0, "vdsh2"},
         {VR_MODE_VDSH3, 0, "vdsh3"}, {VR_MODE_VDSH5, 0, "vdsh5"},
         {VR_MODE_VDSH5_POLY, 0, "vdsh5poly"}};
-    static const int light_sets[2] = {1, 3};
     b->path = path;
     if (vv_open_scene(o, path, &b->scene))
         return 1;
@@ -81,13 +96,20 @@ static int bench_open(const vv_options *o, const char *path, bench_scene *b)
         if (vr_scene_supports(b->scene, all[i].mode) && !same)
             b->modes[b->nm++] = all[i];
     }
-    for (int ls = 0; ls < 2; ls++)
-        b->nl[ls] = vv_default_lights(b->scene, o, light_sets[ls], b->lights[ls]);
+    for (int ls = 0; ls < BENCH_SETS; ls++) {
+        b->nl[ls] = vv_default_lights(b->scene, o, bench_light_sets[ls], b->lights[ls]);
+        if (b->nl[ls] < bench_light_sets[ls]) {
+            fprintf(stderr, "vdsh-view: %s: only %d light positions in free space, not %d\n",
+                    path, b->nl[ls], bench_light_sets[ls]);
+            return 1;
+        }
+    }
     return 0;
 }
 
-/* Time every mode of every scene, with 1 light and then 3. Warm-up
- * first: compile every program and allocate every shadow map before
+/* Time every mode of every scene, with 1 light, then 3, 16 and 64.
+ * Warm-up first (two rounds, one for the long frames of 16 and 64
+ * lights): compile every program and allocate every shadow map before
  * anything is timed. Then rounds that each time every (scene, mode) once,
  * starting at a different one each round, so that slow drifts of a shared
  * machine spread over all scenes and modes alike: a ratio between any two
@@ -97,8 +119,8 @@ static int bench_time(const vv_options *o, bench_scene *b, int nb, vr_renderer *
     int total = 0;
     for (int i = 0; i < nb; i++)
         total += b[i].nm;
-    for (int ls = 0; ls < 2; ls++)
-        for (int round = -2; round < rounds; round++)
+    for (int ls = 0; ls < BENCH_SETS; ls++)
+        for (int round = ls < 2 ? -2 : -1; round < bench_rounds(ls, rounds); round++)
             for (int k = 0; k < total; k++) {
                 int j = (k + (round > 0 ? round : 0)) % total, i = 0;
                 while (j >= b[i].nm)
@@ -131,7 +153,7 @@ static int bench_time(const vv_options *o, bench_scene *b, int nb, vr_renderer *
 }
 
 /* One scene's JSON object (and a summary on stderr). */
-static void bench_print(const vv_options *o, const bench_scene *b, int rounds, vt_json *j,
+static void bench_print(const vv_options *o, const bench_scene *b, int all_rounds, vt_json *j,
                         cJSON *list)
 {
     vr_scene_info info;
@@ -147,8 +169,9 @@ static void bench_print(const vv_options *o, const bench_scene *b, int rounds, v
     vt_json_string(j, so, "quantity", vdsh_quantity_name(info.quantity));
     vt_json_string(j, so, "method", vdsh_method_name(method));
     cJSON *results = vt_json_array(j, so, "results");
-    for (int ls = 0; ls < 2; ls++)
+    for (int ls = 0; ls < BENCH_SETS; ls++)
         for (int m = 0; m < b->nm; m++) {
+            int rounds = bench_rounds(ls, all_rounds);
             double sorted[BENCH_ROUNDS];
             memcpy(sorted, b->cpu[ls][m], (size_t)rounds * sizeof(double));
             qsort(sorted, (size_t)rounds, sizeof(double), cmp_double);

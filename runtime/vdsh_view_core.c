@@ -41,13 +41,18 @@ int vv_default_lights(const vr_scene *s, const vv_options *o, int n, vr_light *o
         {1.0f, 0.92f, 0.8f}, {0.55f, 0.7f, 1.0f}, {1.0f, 0.62f, 0.4f}, {0.7f, 1.0f, 0.7f}};
     vr_scene_info info;
     vr_scene_get_info(s, &info);
-    n = vr_scene_default_lights(s, out, n);
+    int want = n;
+    n = vr_scene_default_lights(s, out, want < 4 ? want : 4);
+    /* Beyond the four defaults: the scene's light pool (vv_open_scene
+     * asks for one when more lights are wanted). */
+    if (want > n)
+        n += vr_scene_pool_lights(s, out + n, want - n);
     float r = 0.3f * vv_scene_diagonal(s);
     /* dimmer when there are several, so that their sum stays in range */
     float intensity = 1.6f / (1.0f + 0.6f * (float)(n - 1));
     for (int i = 0; i < n; i++) {
         for (int k = 0; k < 3; k++)
-            out[i].color[k] = intensity * colors[i][k];
+            out[i].color[k] = intensity * colors[i % 4][k];
         if (!info.interior) {
             r = 0.0f;
             for (int k = 0; k < 3; k++) {
@@ -169,7 +174,9 @@ void vv_session_close(vv_session *s)
 int vv_open_scene(const vv_options *o, const char *path, vr_scene **out)
 {
     vr_error err;
-    vr_scene_desc sd = {.path = path, .skip_cubemaps = o->no_cubemaps};
+    /* More than the four default lights come from the scene's pool. */
+    int pool = o->bench ? VR_MAX_POOL_LIGHTS : o->default_lights > 4 ? o->default_lights - 4 : 0;
+    vr_scene_desc sd = {.path = path, .skip_cubemaps = o->no_cubemaps, .light_pool = pool};
     if (vr_scene_create(&sd, out, &err) != VR_OK) {
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
         return 1;

@@ -141,6 +141,11 @@ typedef struct vr_scene_desc {
      * get them: their path has no use for them. No file but the .vdsh is
      * read either way. */
     int skip_cubemaps;
+    /* 0 (default): none. N (1..VR_MAX_POOL_LIGHTS): also place N light
+     * positions uniformly in the scene's free space at load
+     * (vr_scene_pool_lights), for drawing with many lights. Costs a grid
+     * of the triangles and 14 rays per position tried. */
+    int light_pool;
 } vr_scene_desc;
 
 /* Load (when desc->path is set and desc->file is not), validate, upload
@@ -355,6 +360,17 @@ void vr_scene_fit_camera(const vr_scene *s, vr_camera *out);
  * is not (vdsh_view_compute says how). Colours and attenuations are left
  * to the caller. */
 int vr_scene_default_lights(const vr_scene *s, vr_light *out, int max);
+
+enum { VR_MAX_POOL_LIGHTS = 64 };
+
+/* Up to max of the light positions placed at load (vr_scene_desc
+ * light_pool); returns how many were written (0 without a pool). They are
+ * "placed uniformly in free space" as formats/vdsh_light.h defines it:
+ * the candidates of vdsh_light_candidate (seed 1) in the bounds that pass
+ * vdsh_view_free_space against the drawn mesh, in sequence order, at most
+ * 256 tried per position; deterministic. Colours and attenuations are
+ * left zero. */
+int vr_scene_pool_lights(const vr_scene *s, vr_light *out, int max);
 
 /* Draw text (ASCII, stb_easy_font's 7-pixel font scaled by `scale`) on top
  * of the framebuffer at pixel (x, y) from the top-left, on a dark box.

@@ -79,7 +79,13 @@ struct vr_scene {
     int cube_size;
     size_t gpu_bytes;
     vdsh_view view;             /* the default view, decided at load */
+    float pool[VR_MAX_POOL_LIGHTS][3]; /* vr_scene_pool_lights */
+    int pool_count;
 };
+
+/* Place desc->light_pool lights in free space (vr_view.c). */
+vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count,
+                              const char *name, vr_error *err);
 
 /* Which program: everything that changes the shader source. */
 typedef struct vr_program_key {

@@ -194,6 +194,9 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     if ((unsigned)desc->quantity > VDSH_QUANTITY_LOG_DISTANCE)
         return vr_fail(err, VR_ERR_ARGUMENT, "%s: unknown quantity %u", name,
                        (unsigned)desc->quantity);
+    if (desc->light_pool < 0 || desc->light_pool > VR_MAX_POOL_LIGHTS)
+        return vr_fail(err, VR_ERR_ARGUMENT, "%s: light_pool %d not in 0..%d", name,
+                       desc->light_pool, VR_MAX_POOL_LIGHTS);
     if (!glGetString(GL_VERSION))
         return vr_fail(err, VR_ERR_GL, "%s: no current GL context", name);
 
@@ -282,6 +285,10 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
         }
         memcpy(s->bounds_min, s->view.bounds_min, sizeof s->bounds_min);
         memcpy(s->bounds_max, s->view.bounds_max, sizeof s->bounds_max);
+        if (desc->light_pool > 0)
+            r = vr_scene_place_pool(s, &vm, desc->light_pool, name, err);
+        if (r != VR_OK)
+            goto done;
     }
     glGenBuffers(1, &s->vbo_position);
     glGenBuffers(1, &s->vbo_normal);

@@ -275,7 +275,8 @@ test "$(cat "$d/keep.png")" = old
 if ls "$d" | grep -q '\.tmp'; then echo "temporary left: $(ls "$d")"; exit 1; fi
 ]=] sh ${_view} $<TARGET_FILE:vdsh-bake> ${_png} ${_room} ${_rt_dir}/view_frame)
 
-# The benchmark mode: every mode, 1 and 3 lights, two scenes, one process;
+# The benchmark mode: every mode, 1, 3, 16 and 64 lights (fewer rounds for
+# 16 and 64), two scenes, one process;
 # its JSON parses (a scene path with quotes and backslashes too).
 find_package(Python3 COMPONENTS Interpreter QUIET)
 if(Python3_Interpreter_FOUND)
@@ -286,18 +287,20 @@ shutil.rmtree(d, ignore_errors=True)
 os.makedirs(d)
 odd = os.path.join(os.fsencode(d), b'q"x\\r\t\xffoom.vdsh')
 shutil.copy(room_log, odd)
-out = subprocess.run([view, '--bench', '--frames', '1', '--size', '96x72', '--shadow-size', '64',
+out = subprocess.run([view, '--bench', '--frames', '6', '--size', '96x72', '--shadow-size', '64',
                       '-q', room, room, odd], check=True, capture_output=True).stdout
 print(out[:400])
 b = json.loads(out.decode('utf-8'))
-assert b['renderer'] and b['rounds'] == 1 and b['width'] == 96, b
+assert b['renderer'] and b['rounds'] == 6 and b['width'] == 96, b
 shown = os.path.join(d, 'q"x\\r\t\ufffdoom.vdsh')
 assert [s['file'] for s in b['scenes']] == [room, room, shown], [s['file'] for s in b['scenes']]
 modes = {r['mode'] for s in b['scenes'] for r in s['results']}
 assert modes == {'none', 'cube', 'cube_pcf', 'vdsh2', 'vdsh3', 'vdsh5', 'vdsh5poly'}, modes
-assert {r['lights'] for r in b['scenes'][0]['results']} == {1, 3}
+assert {r['lights'] for r in b['scenes'][0]['results']} == {1, 3, 16, 64}
+rounds = {r['lights']: len(r['cpu_ms']) for r in b['scenes'][0]['results']}
+assert rounds == {1: 6, 3: 6, 16: 3, 64: 3}, rounds
 r0 = b['scenes'][0]['results'][0]
-assert len(r0['process_cpu_ms']) == 1 and len(r0['cpu_ms']) == 1
+assert len(r0['process_cpu_ms']) == 6 and len(r0['cpu_ms']) == 6
 # the log-distance scene: its VDSH modes on the distance path
 log = b['scenes'][2]
 assert log['quantity'] == 'log-distance' and log['method'] == 'lsq', log
