@@ -56,8 +56,50 @@ extern const int vr_coef_size[VR_COEF_ATTRIBS];
 int vr_coef_attrib_count(int order);
 
 /* Texture units: the four basis cubemaps, then one shadow cube map per
- * light of a pass. */
-enum { VR_UNIT_BASIS = 0, VR_UNIT_SHADOW = 4 };
+ * light of a pass, then a buffer stream's coefficients and steps. */
+enum {
+    VR_UNIT_BASIS = 0,
+    VR_UNIT_SHADOW = 4,
+    VR_UNIT_COEF = VR_UNIT_SHADOW + VR_MAX_LIGHTS_PER_PASS,
+    VR_UNIT_STEPS
+};
+
+/* A buffer stream's vertex attributes (VR_MODE_VDSH_BUFFER, variable
+ * order): the record's start in 4-byte words, and the vertex's order. */
+enum { VR_ATTR_RECORD = 9, VR_ATTR_ORDER = 10 };
+
+/* What a buffer texture's texels are (vr_buffer.c). */
+typedef enum vr_buf_kind {
+    VR_BUF_F32 = 0,          /* R32F: a coefficient per texel */
+    VR_BUF_F16 = 1,          /* R16F */
+    VR_BUF_S8 = 2,           /* R8I, times u_steps[i] */
+    VR_BUF_S8S6 = 3          /* R32UI words: 4 bytes, then 6-bit fields */
+} vr_buf_kind;
+
+/* A stream drawn from buffer textures (VR_MODE_VDSH_BUFFER). */
+typedef struct vr_buffer {
+    int order;               /* fixed: its order; variable: the cap; 0: none */
+    int variable;            /* 1: an order per vertex */
+    vr_buf_kind kind;
+    vdsh_encoding encoding;  /* the file's */
+    float scale;             /* multiplies the sums (f32, f16), else 1 */
+    int stride;              /* fixed: texels per vertex */
+    GLuint buf, tex;         /* the records, in the GPU vertex order */
+    GLuint steps_buf, steps_tex; /* s8, s8s6: a step per coefficient index */
+    GLuint vbo_record, vbo_order; /* variable: per vertex, u32 and u8 */
+    GLuint vao;
+    size_t bytes;            /* all of the above */
+    float mean_order;        /* variable: over the vertices */
+} vr_buffer;
+
+/* Upload stream st (its quantity drawn) as a buffer stream of s, in the
+ * GPU vertex order (remap[file vertex] = GPU vertex); floats: decoded f32.
+ * VR_ERR_FORMAT, VR_ERR_OUT_OF_MEMORY, VR_ERR_GL naming `name`. */
+vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *remap,
+                           int floats, const char *name, vr_error *err);
+void vr_buffer_destroy(vr_buffer *b);
+/* The positions and normals (and indices) of s into the bound VAO. */
+void vr_scene_base_attribs(const vr_scene *s);
 
 struct vr_scene {
     uint32_t vertex_count, triangle_count;
@@ -81,7 +123,13 @@ struct vr_scene {
     vdsh_view view;             /* the default view, decided at load */
     float pool[VR_MAX_POOL_LIGHTS][3]; /* vr_scene_pool_lights */
     int pool_count;
+    vr_buffer buffer[VDSH_ORDER_SLOTS]; /* fixed orders, by order */
+    vr_buffer variable;                 /* an order per vertex */
 };
+
+/* The buffer stream vr_draw_desc.stream names (vr_scene_buffer_stream),
+ * or NULL. */
+const vr_buffer *vr_scene_buffer(const vr_scene *s, int stream);
 
 /* Place desc->light_pool lights in free space (vr_view.c). */
 vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count,
@@ -96,7 +144,20 @@ typedef struct vr_program_key {
     uint8_t pcf;        /* 0 or 1 */
     uint8_t lights;     /* lights in this pass, 0..VR_MAX_LIGHTS_PER_PASS */
     uint8_t packed;     /* 1: the stream is s8s6 (bands 2+ in packed words) */
+    uint8_t buf_order;  /* VR_MODE_VDSH_BUFFER: order (variable: the cap) */
+    uint8_t buf_kind;   /* vr_buf_kind */
+    uint8_t buf_variable; /* 1: an order per vertex */
 } vr_program_key;
+
+/* Texels per vertex of a fixed buffer stream of this order and kind. */
+int vr_buffer_stride(int order, vr_buf_kind kind);
+
+/* The buffer path's vertex-stage GLSL (vr_glsl_buffer.c), and its table
+ * of normalisations for an order ("const float SH_K[...]"): 0, or -1 when
+ * it does not fit in size. */
+extern const char vr_buffer_glsl[];
+extern const size_t vr_buffer_glsl_size;
+int vr_buffer_table(int order, char *buf, size_t size);
 
 typedef struct vr_program {
     vr_program_key key;

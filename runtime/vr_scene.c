@@ -14,7 +14,9 @@
  * is not 0: the conversion would depend on the context's version.) Each order's stream gets its own VAO; attribute k of a VAO
  * points at coefficients vr_coef_first[k].. of each vertex (vr_internal.h).
  * Triangles and vertices go up in the order of vr_order_triangles
- * (vr_order.c), not the file's.
+ * (vr_order.c), not the file's. Streams above order 5 (and with
+ * desc->buffers every order) also go up as buffer textures for
+ * VR_MODE_VDSH_BUFFER (vr_buffer.c).
  */
 #include "vr_internal.h"
 
@@ -88,7 +90,7 @@ static vr_result make_basis(GLuint tex[4], uint32_t n32, const char *name, vr_er
     return VR_OK;
 }
 
-static void set_base_attribs(const vr_scene *s)
+void vr_scene_base_attribs(const vr_scene *s)
 {
     glBindBuffer(GL_ARRAY_BUFFER, s->vbo_position);
     glVertexAttribPointer(VR_ATTR_POSITION, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), NULL);
@@ -136,7 +138,7 @@ static vr_result upload_stream(vr_scene *s, const vdsh_stream *st, size_t vertic
 
     glGenVertexArrays(1, &s->vao[order]);
     glBindVertexArray(s->vao[order]);
-    set_base_attribs(s);
+    vr_scene_base_attribs(s);
     glBindBuffer(GL_ARRAY_BUFFER, s->vbo_stream[order]);
     GLenum type = st->encoding == VDSH_ENCODING_F16 ? GL_HALF_FLOAT
                   : vdsh_encoding_quantised(st->encoding) ? GL_BYTE : GL_FLOAT;
@@ -303,7 +305,7 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, s->ibo);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(ni * sizeof *gpu_indices), gpu_indices,
                  GL_STATIC_DRAW);
-    set_base_attribs(s);
+    vr_scene_base_attribs(s);
     glBindVertexArray(0);
     s->gpu_bytes = nv * 24 + (size_t)h->triangle_count * 12;
 
@@ -313,6 +315,16 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
             s->vbo_stream[st->order])
             continue;
         r = upload_stream(s, st, nv, remap, name, err);
+    }
+    /* Buffer textures (VR_MODE_VDSH_BUFFER): what attributes cannot
+     * hold, and with desc->buffers orders 1-5 too; the first stream of
+     * each order. */
+    for (uint32_t i = 0; i < f->stream_count && r == VR_OK; i++) {
+        const vdsh_stream *st = &f->streams[i];
+        if (st->quantity != quantity || st->order < 1 || st->order > VDSH_MAX_ORDER ||
+            s->buffer[st->order].order || (st->order <= 5 && !desc->buffers))
+            continue;
+        r = vr_buffer_upload(s, st, remap, desc->buffer_floats, name, err);
     }
     if (r != VR_OK)
         goto done;
@@ -349,6 +361,9 @@ void vr_scene_destroy(vr_scene *s)
     glDeleteBuffers(1, &s->vbo_normal);
     glDeleteBuffers(1, &s->ibo);
     glDeleteTextures(4, s->basis);
+    for (int o = 0; o < VDSH_ORDER_SLOTS; o++)
+        vr_buffer_destroy(&s->buffer[o]);
+    vr_buffer_destroy(&s->variable);
     free(s);
 }
 
@@ -372,6 +387,13 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     i.max_distance = s->max_distance;
     i.gpu_bytes = s->gpu_bytes;
     i.interior = s->view.interior;
+    for (int o = 1; o < VDSH_ORDER_SLOTS; o++) {
+        i.has_buffer[o] = s->buffer[o].order != 0;
+        i.buffer_bytes += s->buffer[o].bytes;
+    }
+    i.variable_order = s->variable.order;
+    i.variable_mean_order = s->variable.mean_order;
+    i.buffer_bytes += s->variable.bytes;
     *out = i;
 }
 
@@ -398,6 +420,7 @@ int vr_scene_supports(const vr_scene *s, vr_mode m)
                (s->basis[0] != 0 || vr_mode_interp(m, s->quantity) != VDSH_INTERP_SPLIT);
     case VR_MODE_DEFAULT: return vr_scene_supports(s, vr_scene_default_mode(s));
     case VR_MODE_VDSH5_POLY: return s->vbo_stream[5] != 0;
+    case VR_MODE_VDSH_BUFFER: return vr_scene_buffer_stream(s, 0) != 0;
     default: return 0;
     }
 }
@@ -407,10 +430,36 @@ int vr_scene_interp(const vr_scene *s, vr_mode m)
     return vr_mode_interp(m == VR_MODE_DEFAULT ? vr_scene_default_mode(s) : m, s->quantity);
 }
 
+int vr_scene_buffer_stream(const vr_scene *s, int stream)
+{
+    if (stream == 0) {
+        if (s->variable.order)
+            return VR_STREAM_VARIABLE;
+        for (int o = VDSH_MAX_ORDER; o >= 1; o--)
+            if (s->buffer[o].order)
+                return o;
+        return 0;
+    }
+    return vr_scene_buffer(s, stream) ? stream : 0;
+}
+
+const vr_buffer *vr_scene_buffer(const vr_scene *s, int stream)
+{
+    if (stream == 0)
+        stream = vr_scene_buffer_stream(s, 0);
+    if (stream == VR_STREAM_VARIABLE)
+        return s->variable.order ? &s->variable : NULL;
+    if (stream >= 1 && stream <= VDSH_MAX_ORDER && s->buffer[stream].order)
+        return &s->buffer[stream];
+    return NULL;
+}
+
 const char *vr_scene_mode_label(const vr_scene *s, vr_mode m)
 {
     if (m == VR_MODE_DEFAULT)
         m = vr_scene_default_mode(s);
+    if (m == VR_MODE_VDSH_BUFFER)
+        return vr_mode_label(m);
     if (vr_scene_interp(s, m) != VDSH_INTERP_DISTANCE ||
         s->quantity != VDSH_QUANTITY_LOG_DISTANCE)
         return vr_mode_label(m);

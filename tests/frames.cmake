@@ -21,7 +21,8 @@ endif()
 # view set against the same streams computed in C on the runtime's path
 # (vdsh-frames truth), for the default bake (log distance, drawn per
 # vertex in every mode) and the paper's (distance; order 5 per fragment,
-# with the basis cubemaps and as polynomials): mean difference <= 0.002 and
+# with the basis cubemaps and as polynomials; and the default bake's streams
+# drawn from buffer textures, VR_MODE_VDSH_BUFFER): mean difference <= 0.002 and
 # at most 0.5% of the pixels off by more than 0.1 in every frame (measured
 # on llvmpipe: <= 1e-4 and 0.003%; one order for another: 0.019 and 3.7%).
 # Skips (77) without GL.
@@ -36,14 +37,17 @@ for m in shadow paper; do
   "$bake" builtin:room --max-edge 0.5 --rays 400 --method $m --cube-size 32 -q -o "$d/$m.vdsh"
   "$frames" truth "$d/$m.vdsh" --views "$views" -o "$d/$m-c" > /dev/null
   set +e
-  "$view" "$d/$m.vdsh" --views "$views" --frames "$d/$m-gl" --modes vdsh2,vdsh3,vdsh5,vdsh5poly -q
+  modes=vdsh2,vdsh3,vdsh5,vdsh5poly
+  [ $m = shadow ] && modes=$modes,buf2,buf3,buf5
+  "$view" "$d/$m.vdsh" --views "$views" --frames "$d/$m-gl" --modes $modes -q
   rc=$?
   set -e
   [ $rc -eq 77 ] && exit 77
   [ $rc -eq 0 ] || exit $rc
 done
 "$cmp" "$views" "$d/shadow-c" "$d/shadow-gl" 0.002 0.005 \
-  vdsh2=c-vdsh2 vdsh3=c-vdsh3 vdsh5=c-vdsh5 vdsh5poly=c-vdsh5
+  vdsh2=c-vdsh2 vdsh3=c-vdsh3 vdsh5=c-vdsh5 vdsh5poly=c-vdsh5 \
+  buf2=c-vdsh2 buf3=c-vdsh3 buf5=c-vdsh5
 "$cmp" "$views" "$d/paper-c" "$d/paper-gl" 0.002 0.005 \
   vdsh2=c-vdsh2 vdsh3=c-vdsh3 vdsh5=c-vdsh5 vdsh5poly=c-vdsh5
 ]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames> $<TARGET_FILE:vdsh-view>

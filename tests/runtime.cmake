@@ -94,6 +94,17 @@ EOF
 ]=] sh $<TARGET_FILE:vdsh-bake> ${_rt_dir}/floor)
 set_tests_properties(runtime_fixture_floor PROPERTIES FIXTURES_SETUP runtime_floor)
 
+# VR_MODE_VDSH_BUFFER: per vertex against the C evaluation at every order
+# the format holds, and against the attribute path on the room.
+_runtime_test(test_runtime_buffer)
+add_test(NAME runtime_buffer_vertex COMMAND test_runtime_buffer vertex -)
+_runtime_props(runtime_buffer_vertex)
+foreach(part frames errors)
+  add_test(NAME runtime_buffer_${part}
+           COMMAND test_runtime_buffer ${part} ${_rt_dir}/room_log/room_log.vdsh)
+  _runtime_props(runtime_buffer_${part} FIXTURES_REQUIRED runtime_room)
+endforeach()
+
 _runtime_test(test_runtime_log)
 add_test(NAME runtime_log COMMAND test_runtime_log ${_rt_dir}/floor/floor.vdsh)
 _runtime_props(runtime_log FIXTURES_REQUIRED runtime_floor)
@@ -167,6 +178,10 @@ expect1 "x/y/z.png" --render "$d/x/y/z.png" "$room"
 "$v" -q --render "$d/ok.png" --size 64x48 --no-cubemaps --mode vdsh5poly "$d/alone.vdsh" || { echo "--no-cubemaps failed"; fail=1; }
 # a log-distance bake needs no cubemaps in any mode
 "$v" -q --render "$d/log.png" --size 64x48 --mode vdsh5 "$4" || { echo "log-distance vdsh5 failed"; fail=1; }
+# the buffer path: an order the file lacks is named; one it has draws
+expect1 "no order-7" --render "$d/x.png" --mode buf7 "$room"
+expect1 "order per vertex" --render "$d/x.png" --mode adaptive "$room"
+"$v" -q --render "$d/buf3.png" --size 64x48 --mode buf3 "$4" || { echo "buf3 failed"; fail=1; }
 exit $fail
 ]=] sh ${_view} ${_room} ${_rt_dir}/view_errors ${_room_log})
 
@@ -295,7 +310,7 @@ assert b['renderer'] and b['rounds'] == 6 and b['width'] == 96, b
 shown = os.path.join(d, 'q"x\\r\t\ufffdoom.vdsh')
 assert [s['file'] for s in b['scenes']] == [room, room, shown], [s['file'] for s in b['scenes']]
 modes = {r['mode'] for s in b['scenes'] for r in s['results']}
-assert modes == {'none', 'cube', 'cube_pcf', 'vdsh2', 'vdsh3', 'vdsh5', 'vdsh5poly'}, modes
+assert modes == {'none', 'cube', 'cube_pcf', 'vdsh2', 'vdsh3', 'vdsh5', 'vdsh5poly', 'buf5'}, modes
 assert {r['lights'] for r in b['scenes'][0]['results']} == {1, 3, 16, 64}
 rounds = {r['lights']: len(r['cpu_ms']) for r in b['scenes'][0]['results']}
 assert rounds == {1: 6, 3: 6, 16: 3, 64: 3}, rounds
@@ -306,6 +321,9 @@ log = b['scenes'][2]
 assert log['quantity'] == 'log-distance' and log['method'] == 'lsq', log
 paths = {(r['mode'], r['path']) for r in log['results']}
 assert ('vdsh5', 'distance') in paths, paths
+# the buffer path at order 5 beside it, on log-distance scenes only
+assert ('buf5', 'distance') in paths, paths
+assert 'buf5' not in {r['mode'] for r in b['scenes'][0]['results']}
 assert ('vdsh5', 'split') in {(r['mode'], r['path']) for r in b['scenes'][0]['results']}
 print('ok')
 ]=] ${_view} ${_room} ${_room_log} ${_rt_dir}/view_bench)
