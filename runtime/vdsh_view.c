@@ -43,6 +43,7 @@ static const char usage_text[] =
     "                        all in this process, each round timing\n"
     "                        every mode of every SCENE once (wall time and\n"
     "                        process CPU time per frame); JSON on stdout\n"
+    "      --bench-lights L  with --bench: only these of 1,3,16,64 lights\n"
     "      --buffer-floats   with --bench: time each buffer mode also from\n"
     "                        buffers of decoded f32 coefficients (MODE-f32)\n"
     "      --views FILE      with --frames DIR: for every view, light set and\n"
@@ -164,7 +165,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
     enum { O_RENDER = 256, O_GRID, O_BENCH, O_CAMERA, O_FIT, O_FOV, O_LIGHT, O_LIGHTS,
            O_ATT, O_AMBIENT, O_MODE, O_COMPARE, O_PCF, O_SHADOW_SIZE, O_SIZE,
            O_NO_CUBEMAPS, O_EGL, O_FRAMES, O_SCREENSHOT, O_NO_OVERLAY, O_KEYS,
-           O_NO_MALLOPT, O_VIEWS, O_MODES, O_BUFFER_FLOATS };
+           O_NO_MALLOPT, O_VIEWS, O_MODES, O_BUFFER_FLOATS, O_BENCH_LIGHTS };
     static const struct option longopts[] = {
         {"render", required_argument, 0, O_RENDER},
         {"grid", required_argument, 0, O_GRID},
@@ -189,6 +190,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
         {"keys", required_argument, 0, O_KEYS},
         {"no-mallopt", no_argument, 0, O_NO_MALLOPT},
         {"buffer-floats", no_argument, 0, O_BUFFER_FLOATS},
+        {"bench-lights", required_argument, 0, O_BENCH_LIGHTS},
         {"views", required_argument, 0, O_VIEWS},
         {"modes", required_argument, 0, O_MODES},
         {"quiet", no_argument, 0, 'q'},
@@ -312,6 +314,16 @@ static int parse_args(int argc, char **argv, vv_options *o)
             break;
         case O_NO_MALLOPT: o->no_mallopt = 1; break;
         case O_BUFFER_FLOATS: o->buffer_floats = 1; break;
+        case O_BENCH_LIGHTS: {
+            float n[4];
+            int k = vt_parse_floats(v, n, 1, 4);
+            o->bench_sets = 0;
+            for (int i = 0; i < k; i++)
+                o->bench_sets |= n[i] == 1 ? 1 : n[i] == 3 ? 2 : n[i] == 16 ? 4 : n[i] == 64 ? 8 : 16;
+            if (k < 1 || o->bench_sets >= 16)
+                return usage_error("--bench-lights: expected some of 1,3,16,64, got '%s'", v);
+            break;
+        }
         default: /* getopt_long said what is wrong */
             fprintf(stderr, "Try 'vdsh-view --help'.\n");
             return VT_EXIT_USAGE;
@@ -341,8 +353,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
     } else {
         if (o->frame_mode_count)
             return usage_error("%s", "--modes: only with --views");
-        if (o->buffer_floats && !o->bench)
-            return usage_error("%s", "--buffer-floats: only with --bench");
+        if ((o->buffer_floats || o->bench_sets) && !o->bench)
+            return usage_error("%s", "--buffer-floats, --bench-lights: only with --bench");
         if (o->frames_arg && !vt_parse_int(o->frames_arg, 1, 1000000, &o->frames))
             return usage_error("--frames: expected a positive count, got '%s'", o->frames_arg);
     }

@@ -55,6 +55,8 @@ typedef struct vv_options {
     int frames;
     int no_mallopt;
     int buffer_floats;         /* --bench: also time buffers of decoded f32 */
+    int bench_sets;            /* --bench-lights: bit i, light set i of
+                                  1, 3, 16, 64; 0: all */
     int quiet;
     const char *screenshot;
     int no_overlay;

@@ -47,6 +47,12 @@ enum { BENCH_MODES = 16, BENCH_ROUNDS = 64, BENCH_SETS = 4 };
  * for 1 and 3 lights, a third for 16, a fifth for 64, at least 3. */
 static const int bench_light_sets[BENCH_SETS] = {1, 3, 16, 64};
 
+/* Whether light set `set` is timed (--bench-lights; none given: all). */
+static int bench_set_on(const vv_options *o, int set)
+{
+    return !o->bench_sets || (o->bench_sets >> set & 1);
+}
+
 static int bench_rounds(int set, int rounds)
 {
     static const int divisor[BENCH_SETS] = {1, 1, 3, 5};
@@ -181,7 +187,8 @@ static int bench_time(const vv_options *o, bench_scene *b, int nb, vr_renderer *
     for (int i = 0; i < nb; i++)
         total += b[i].nm;
     for (int ls = 0; ls < BENCH_SETS; ls++)
-        for (int round = ls < 2 ? -2 : -1; round < bench_rounds(ls, rounds); round++)
+        for (int round = ls < 2 ? -2 : -1; bench_set_on(o, ls) && round < bench_rounds(ls, rounds);
+             round++)
             for (int k = 0; k < total; k++) {
                 int j = (k + (round > 0 ? round : 0)) % total, i = 0;
                 while (j >= b[i].nm)
@@ -237,7 +244,7 @@ static void bench_print(const vv_options *o, const bench_scene *b, int all_round
     vt_json_f64(j, so, "variable_mean_order", info.variable_mean_order);
     cJSON *results = vt_json_array(j, so, "results");
     for (int ls = 0; ls < BENCH_SETS; ls++)
-        for (int m = 0; m < b->nm; m++) {
+        for (int m = 0; m < b->nm && bench_set_on(o, ls); m++) {
             int rounds = bench_rounds(ls, all_rounds);
             double sorted[BENCH_ROUNDS];
             memcpy(sorted, b->cpu[ls][m], (size_t)rounds * sizeof(double));

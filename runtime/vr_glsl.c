@@ -607,12 +607,12 @@ static void key_defines(const vr_program_key *k, int flat, char *buf, size_t siz
                      "#define PCF %u\n#define NUM_LIGHTS %u\n#define FLAT_LIGHTS %d\n"
                      "#define PACKED %d\n#define BUFFER %d\n#define BUF_ORDER %u\n"
                      "#define BUF_KIND %u\n#define BUF_VARIABLE %u\n#define BUF_STRIDE %d\n"
-                     "#define BUF_PER_WORD %d\n#define FOR_EACH_LIGHT",
+                     "#define BUF_KS %d\n#define FOR_EACH_LIGHT",
                      order, visibility, split, distance, cubemap, cube, k->quantity, k->compare,
                      k->output, k->pcf, k->lights, flat, k->packed && order >= 3, buffer,
                      k->buf_order, k->buf_kind, k->buf_variable,
                      buffer ? vr_buffer_stride(k->buf_order, (vr_buf_kind)k->buf_kind) : 0,
-                     k->buf_kind == VR_BUF_F16 ? 2 : k->buf_kind == VR_BUF_S8 ? 4 : 1);
+                     (k->buf_order * k->buf_order + 3) / 4);
     for (unsigned i = 0; i < k->lights && n > 0 && (size_t)n < size; i++)
         n += snprintf(buf + n, size - (size_t)n, " LIGHT(%u)", i);
     if (n > 0 && (size_t)n < size)
@@ -690,12 +690,9 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     glGetIntegerv(GL_MAX_VARYING_COMPONENTS, &max_varying);
     int flat = varying_components(key, 1) <= max_varying;
 
-    /* The buffer path: its normalisation table and code, between the
-     * vertex stage's declarations and its main(). */
-    char table[4096] = "";
-    if (buffer && vr_buffer_table(key->buf_order, table, sizeof table) != 0)
-        return vr_fail(err, VR_ERR_SHADER, "%s: no room for the SH table", name);
-    size_t vs_size = sizeof defines + sizeof common_glsl + sizeof vertex_glsl + sizeof table +
+    /* The buffer path's code goes between the vertex stage's
+     * declarations and its main(). */
+    size_t vs_size = sizeof defines + sizeof common_glsl + sizeof vertex_glsl +
                      vr_buffer_glsl_size + sizeof vertex_main_glsl;
     size_t fs_size = sizeof defines + sizeof common_glsl + sizeof fragment_glsl;
     char *vs = malloc(vs_size), *fs = malloc(fs_size);
@@ -710,8 +707,8 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     vr_result r;
     for (;; flat = 0) {
         key_defines(key, flat, defines, sizeof defines);
-        snprintf(vs, vs_size, "%s%s%s%s%s%s", defines, common_glsl, vertex_glsl,
-                 buffer ? table : "", buffer ? vr_buffer_glsl : "", vertex_main_glsl);
+        snprintf(vs, vs_size, "%s%s%s%s%s", defines, common_glsl, vertex_glsl,
+                 buffer ? vr_buffer_glsl : "", vertex_main_glsl);
         snprintf(fs, fs_size, "%s%s%s", defines, common_glsl, fragment_glsl);
         r = vr_link(name, vs, fs, &prog, err);
         if (r != VR_ERR_SHADER || !flat)
@@ -733,6 +730,7 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     p.u_ambient = glGetUniformLocation(prog, "u_ambient");
     p.u_shadow_nf = glGetUniformLocation(prog, "u_shadow_nf");
     p.u_shadow_texel = glGetUniformLocation(prog, "u_shadow_texel");
+    p.u_ks = glGetUniformLocation(prog, "u_ks");
 
     /* Samplers never change unit: set them once. */
     glUseProgram(prog);
@@ -745,9 +743,6 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     GLint coef = glGetUniformLocation(prog, "u_coef");
     if (coef >= 0)
         glUniform1i(coef, VR_UNIT_COEF);
-    GLint steps = glGetUniformLocation(prog, "u_steps");
-    if (steps >= 0)
-        glUniform1i(steps, VR_UNIT_STEPS);
     GLint shadow = glGetUniformLocation(prog, "u_shadow");
     if (shadow >= 0) {
         GLint units[VR_MAX_LIGHTS_PER_PASS];

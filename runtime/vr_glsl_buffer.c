@@ -14,18 +14,19 @@
  * (1 - z^2)^(m/2) factor carried by (x + iy)^m. It runs over every band
  * here, where the C evaluation uses its closed forms below band 5: the
  * two agree to float rounding (tests/test_runtime_buffer.c measures it).
- * The normalisations K_l^m (sqrt 2 folded in for m != 0) are computed in
- * double on the CPU as the C code does and written into the source as
- * float literals (vr_buffer_table).
+ * The normalisations K_l^m (sqrt 2 folded in for m != 0), times an s8 or
+ * s8s6 stream's steps, come as a uniform per coefficient index (u_ks,
+ * vr_buffer.c).
  *
  * The loops run m outside and l inside, and each light's recurrence state
  * lives in small arrays, so that each coefficient is fetched (and for s8,
- * s8s6 unpacked) once per vertex, not once per light.
+ * s8s6 unpacked) once per vertex, not once per light; the record holds
+ * the coefficients in that very order (vr_buffer_sequence), so it is read
+ * front to back, a texel (four coefficients, or an s8s6 word's five) at a
+ * time (buf_next).
  */
 #include "vr_internal.h"
 
-#include <math.h>
-#include <stdio.h>
 
 const char vr_buffer_glsl[] =
     "#if BUFFER\n"
@@ -36,35 +37,59 @@ const char vr_buffer_glsl[] =
     "#else\n"
     "uniform samplerBuffer u_coef;\n"
     "#endif\n"
-    "#if BUF_KIND >= 2\n"
-    "uniform samplerBuffer u_steps;   /* per coefficient index */\n"
-    "#endif\n"
+    "/* per coefficient index: K_l^m (and an s8, s8s6 stream's step) */\n"
+    "uniform vec4 u_ks[BUF_KS];\n"
     "#if BUF_VARIABLE\n"
-    "layout(location = 9) in uint a_record;  /* start, in 4-byte words */\n"
+    "layout(location = 9) in uint a_record;  /* the record's first texel */\n"
     "layout(location = 10) in uint a_order;  /* this vertex's order */\n"
     "#endif\n"
     "\n"
-    "/* Coefficient i of the record starting at texel base. */\n"
-    "float buf_coef(int base, int i)\n"
-    "{\n"
-    "#if BUF_KIND <= 1\n"
-    "    return texelFetch(u_coef, base + i).r;\n"
-    "#elif BUF_KIND == 2\n"
-    "    return float(texelFetch(u_coef, base + i).r) * texelFetch(u_steps, i).r;\n"
+    "/* A reader of one record, front to back. */\n"
+    "int b_texel;\n"
+    "#if BUF_KIND == 3\n"
+    "uint b_w0, b_w;   /* s8s6: word 0 (coefficients 0-3), the current word */\n"
+    "int b_field;\n"
     "#else\n"
-    "    /* s8s6: bytes 0-3 of word 0 hold coefficients 0-3; word 1 + w\n"
-    "     * holds 4 + 5w .. 8 + 5w, six bits each from bit 0 */\n"
-    "    uint w;\n"
-    "    int q;\n"
-    "    if (i < 4) {\n"
-    "        w = texelFetch(u_coef, base).r;\n"
-    "        q = int(w << uint(24 - 8 * i)) >> 24;\n"
-    "    } else {\n"
-    "        int j = i - 4;\n"
-    "        w = texelFetch(u_coef, base + 1 + j / 5).r;\n"
-    "        q = int(w << uint(26 - 6 * (j - 5 * (j / 5)))) >> 26;\n"
+    "vec4 b_cache;\n"
+    "int b_j;\n"
+    "#endif\n"
+    "\n"
+    "void buf_begin(int first)\n"
+    "{\n"
+    "#if BUF_KIND == 3\n"
+    "    b_w0 = texelFetch(u_coef, first).r;\n"
+    "    b_texel = first + 1;\n"
+    "    b_field = 5;\n"
+    "#else\n"
+    "    b_texel = first;\n"
+    "    b_j = 4;\n"
+    "#endif\n"
+    "}\n"
+    "\n"
+    "/* The next coefficient, whose index is i, times u_ks[i]. */\n"
+    "float buf_next(int i)\n"
+    "{\n"
+    "    float ks = u_ks[i >> 2][i & 3];\n"
+    "#if BUF_KIND == 3\n"
+    "    if (i < 4)\n"
+    "        return ks * float(int(b_w0 << uint(24 - 8 * i)) >> 24);\n"
+    "    if (b_field == 5) {\n"
+    "        b_w = texelFetch(u_coef, b_texel).r;\n"
+    "        b_texel++;\n"
+    "        b_field = 0;\n"
     "    }\n"
-    "    return float(q) * texelFetch(u_steps, i).r;\n"
+    "    int q = int(b_w << uint(26 - 6 * b_field)) >> 26;\n"
+    "    b_field++;\n"
+    "    return ks * float(q);\n"
+    "#else\n"
+    "    if (b_j == 4) {\n"
+    "        b_cache = vec4(texelFetch(u_coef, b_texel));\n"
+    "        b_texel++;\n"
+    "        b_j = 0;\n"
+    "    }\n"
+    "    float c = b_cache[b_j];\n"
+    "    b_j++;\n"
+    "    return ks * c;\n"
     "#endif\n"
     "}\n"
     "\n"
@@ -75,10 +100,10 @@ const char vr_buffer_glsl[] =
     "{\n"
     "#if BUF_VARIABLE\n"
     "    int k = int(a_order);\n"
-    "    int base = int(a_record) * BUF_PER_WORD;\n"
+    "    buf_begin(int(a_record));\n"
     "#else\n"
     "    int k = BUF_ORDER;\n"
-    "    int base = gl_VertexID * BUF_STRIDE;\n"
+    "    buf_begin(gl_VertexID * BUF_STRIDE);\n"
     "#endif\n"
     "    vec3 d[NUM_LIGHTS];\n"
     "    float cs[NUM_LIGHTS], sn[NUM_LIGHTS], pmm[NUM_LIGHTS], p0[NUM_LIGHTS], p1[NUM_LIGHTS];\n"
@@ -103,9 +128,8 @@ const char vr_buffer_glsl[] =
     "            }\n"
     "        for (int l = m; l < k; l++) {\n"
     "            int row = l * (l + 1);\n"
-    "            float kk = SH_K[row / 2 + m];\n"
-    "            float cp = kk * buf_coef(base, row + m);\n"
-    "            float cn = m > 0 ? kk * buf_coef(base, row - m) : 0.0;\n"
+    "            float cp = buf_next(row + m);\n"
+    "            float cn = m > 0 ? buf_next(row - m) : 0.0;\n"
     "            float a = float(2 * l - 1) / float(max(l - m, 1));\n"
     "            float b = float(l + m - 1) / float(max(l - m, 1));\n"
     "            for (int i = 0; i < NUM_LIGHTS; i++) {\n"
@@ -126,20 +150,3 @@ const char vr_buffer_glsl[] =
     "#endif\n";
 
 const size_t vr_buffer_glsl_size = sizeof vr_buffer_glsl;
-
-int vr_buffer_table(int order, char *buf, size_t size)
-{
-    int nk = order * (order + 1) / 2;
-    int n = snprintf(buf, size, "const float SH_K[%d] = float[%d](", nk, nk);
-    for (int l = 0; l < order; l++)
-        for (int m = 0; m <= l && n > 0 && (size_t)n < size; m++) {
-            double kk = (2.0 * l + 1.0) / (4.0 * 3.14159265358979323846);
-            for (int f = l - m + 1; f <= l + m; f++)
-                kk /= f;
-            float k = m == 0 ? (float)sqrt(kk) : (float)sqrt(2.0 * kk);
-            n += snprintf(buf + n, size - (size_t)n, "%s%.9e", l || m ? ", " : "", (double)k);
-        }
-    if (n > 0 && (size_t)n < size)
-        n += snprintf(buf + n, size - (size_t)n, ");\n");
-    return n > 0 && (size_t)n < size ? 0 : -1;
-}

@@ -56,23 +56,22 @@ extern const int vr_coef_size[VR_COEF_ATTRIBS];
 int vr_coef_attrib_count(int order);
 
 /* Texture units: the four basis cubemaps, then one shadow cube map per
- * light of a pass, then a buffer stream's coefficients and steps. */
+ * light of a pass, then a buffer stream's records. */
 enum {
     VR_UNIT_BASIS = 0,
     VR_UNIT_SHADOW = 4,
-    VR_UNIT_COEF = VR_UNIT_SHADOW + VR_MAX_LIGHTS_PER_PASS,
-    VR_UNIT_STEPS
+    VR_UNIT_COEF = VR_UNIT_SHADOW + VR_MAX_LIGHTS_PER_PASS
 };
 
 /* A buffer stream's vertex attributes (VR_MODE_VDSH_BUFFER, variable
- * order): the record's start in 4-byte words, and the vertex's order. */
+ * order): the record's first texel, and the vertex's order. */
 enum { VR_ATTR_RECORD = 9, VR_ATTR_ORDER = 10 };
 
 /* What a buffer texture's texels are (vr_buffer.c). */
 typedef enum vr_buf_kind {
-    VR_BUF_F32 = 0,          /* R32F: a coefficient per texel */
-    VR_BUF_F16 = 1,          /* R16F */
-    VR_BUF_S8 = 2,           /* R8I, times u_steps[i] */
+    VR_BUF_F32 = 0,          /* RGBA32F: four coefficients per texel */
+    VR_BUF_F16 = 1,          /* RGBA16F */
+    VR_BUF_S8 = 2,           /* RGBA8I (times the steps in u_ks) */
     VR_BUF_S8S6 = 3          /* R32UI words: 4 bytes, then 6-bit fields */
 } vr_buf_kind;
 
@@ -85,7 +84,7 @@ typedef struct vr_buffer {
     float scale;             /* multiplies the sums (f32, f16), else 1 */
     int stride;              /* fixed: texels per vertex */
     GLuint buf, tex;         /* the records, in the GPU vertex order */
-    GLuint steps_buf, steps_tex; /* s8, s8s6: a step per coefficient index */
+    float *ks;               /* u_ks: per coefficient index, K_l^m x step */
     GLuint vbo_record, vbo_order; /* variable: per vertex, u32 and u8 */
     GLuint vao;
     size_t bytes;            /* all of the above */
@@ -149,21 +148,22 @@ typedef struct vr_program_key {
     uint8_t buf_variable; /* 1: an order per vertex */
 } vr_program_key;
 
-/* Texels per vertex of a fixed buffer stream of this order and kind. */
+/* Texels of a record of this order and kind. */
 int vr_buffer_stride(int order, vr_buf_kind kind);
+/* The coefficient indices of an order in the order the shader consumes
+ * them (m = 0..order-1, l = m..order-1, index l(l+1)+m then l(l+1)-m);
+ * returns order^2. */
+int vr_buffer_sequence(int order, int *out);
 
-/* The buffer path's vertex-stage GLSL (vr_glsl_buffer.c), and its table
- * of normalisations for an order ("const float SH_K[...]"): 0, or -1 when
- * it does not fit in size. */
+/* The buffer path's vertex-stage GLSL (vr_glsl_buffer.c). */
 extern const char vr_buffer_glsl[];
 extern const size_t vr_buffer_glsl_size;
-int vr_buffer_table(int order, char *buf, size_t size);
 
 typedef struct vr_program {
     vr_program_key key;
     GLuint prog;
     GLint u_view_proj, u_scale, u_coef_step, u_max_distance, u_light_pos, u_light_color, u_light_att;
-    GLint u_ambient, u_shadow_nf, u_shadow_texel;
+    GLint u_ambient, u_shadow_nf, u_shadow_texel, u_ks;
 } vr_program;
 
 /* Compile and link the lighting program for `key`. On failure returns

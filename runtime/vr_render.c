@@ -707,8 +707,7 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
         if (buf) {
             glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
             glBindTexture(GL_TEXTURE_BUFFER, buf->tex);
-            glActiveTexture(GL_TEXTURE0 + VR_UNIT_STEPS);
-            glBindTexture(GL_TEXTURE_BUFFER, buf->steps_tex);
+            glUniform4fv(p->u_ks, (buf->order * buf->order + 3) / 4, buf->ks);
         }
         glActiveTexture(GL_TEXTURE0);
         glBindVertexArray(buf ? buf->vao : s->vao[order]);
