@@ -319,7 +319,11 @@ static int parse_args(int argc, char **argv, vv_options *o)
             int k = vt_parse_floats(v, n, 1, 4);
             o->bench_sets = 0;
             for (int i = 0; i < k; i++)
-                o->bench_sets |= n[i] == 1 ? 1 : n[i] == 3 ? 2 : n[i] == 16 ? 4 : n[i] == 64 ? 8 : 16;
+                o->bench_sets |= n[i] == 1    ? 1
+                                  : n[i] == 3  ? 2
+                                  : n[i] == 16 ? 4
+                                  : n[i] == 64 ? 8
+                                               : 16;
             if (k < 1 || o->bench_sets >= 16)
                 return usage_error("--bench-lights: expected some of 1,3,16,64, got '%s'", v);
             break;
