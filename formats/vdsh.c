@@ -141,6 +141,8 @@ static float f32_from_bits(uint32_t u)
 
 static uint64_t pad16(uint64_t n) { return (16 - (n & 15)) & 15; }
 
+static size_t round16(size_t n) { return (n + 15) & ~(size_t)15; }
+
 static int all_zero(const uint8_t *p, size_t n)
 {
     for (size_t i = 0; i < n; i++)
@@ -391,6 +393,28 @@ vdsh_result vdsh_encode_s8(const float *src, size_t vertices, uint32_t nc, float
     return vdsh_encode_quantised(VDSH_ENCODING_S8, src, vertices, nc, scales, dst);
 }
 
+/* One quantised record: nc coefficients c with per-index scales amax into
+ * p (zeroed by the caller): stored = round(levels c / scale) in double
+ * (|c| <= scale, so the quotient is finite for every finite scale,
+ * subnormal ones too), ties away from 0, clamped to +-levels. */
+static void quantise_record(uint32_t encoding, const float *c, uint32_t nc, const float *amax,
+                            uint8_t *p)
+{
+    for (uint32_t i = 0; i < nc; i++) {
+        double l = (double)vdsh_quant_levels(encoding, i);
+        double q = amax[i] > 0.0f ? round(l * ((double)c[i] / (double)amax[i])) : 0.0;
+        q = q > l ? l : q < -l ? -l : q;
+        if (encoding == VDSH_ENCODING_S8 || i < VDSH_S8S6_BYTES) {
+            p[i] = (uint8_t)(int8_t)q;
+        } else {
+            size_t byte;
+            unsigned shift;
+            s8s6_field(i, &byte, &shift);
+            put_u32(p + byte, get_u32(p + byte) | ((uint32_t)(int32_t)q & 63u) << shift);
+        }
+    }
+}
+
 vdsh_result vdsh_encode_quantised(uint32_t encoding, const float *src, size_t vertices,
                                   uint32_t nc, float *scales, void *dst)
 {
@@ -416,22 +440,61 @@ vdsh_result vdsh_encode_quantised(uint32_t encoding, const float *src, size_t ve
     if (vertices)
         memset(out, 0, vertices * bpv);
     for (size_t v = 0; v < vertices; v++)
-        for (uint32_t i = 0; i < nc; i++) {
-            double l = (double)vdsh_quant_levels(encoding, i);
-            double q = amax[i] > 0.0f ? round(l * ((double)src[v * nc + i] / (double)amax[i]))
-                                      : 0.0;
-            q = q > l ? l : q < -l ? -l : q;
-            uint8_t *p = out + v * bpv;
-            if (encoding == VDSH_ENCODING_S8 || i < VDSH_S8S6_BYTES) {
-                p[i] = (uint8_t)(int8_t)q;
-            } else {
-                size_t byte;
-                unsigned shift;
-                s8s6_field(i, &byte, &shift);
-                put_u32(p + byte, get_u32(p + byte) | ((uint32_t)(int32_t)q & 63u) << shift);
+        quantise_record(encoding, src + v * nc, nc, amax, out + v * bpv);
+    memcpy(scales, amax, nc * sizeof *scales);
+    return VDSH_OK;
+}
+
+vdsh_result vdsh_encode_variable(uint32_t encoding, const float *src, size_t stride,
+                                 const uint8_t *orders, uint32_t rows, uint32_t cap,
+                                 float scale, const uint32_t *offsets, float *scales,
+                                 void *dst)
+{
+    if (cap < 1 || cap > VDSH_MAX_ORDER || stride < (size_t)cap * cap ||
+        encoding > VDSH_ENCODING_LAST || !(scale > 0.0f) || !isfinite(scale))
+        return VDSH_ERR_ARGUMENT;
+    for (uint32_t v = 0; v < rows; v++)
+        if (orders[v] < 1 || orders[v] > cap)
+            return VDSH_ERR_ARGUMENT;
+    uint8_t *out = (uint8_t *)dst;
+    memset(out, 0, 4 * (size_t)offsets[rows]);
+    float amax[VDSH_MAX_COEFFS] = {0};
+    if (vdsh_encoding_quantised(encoding)) {
+        for (uint32_t v = 0; v < rows; v++)
+            for (uint32_t i = 0; i < (uint32_t)orders[v] * orders[v]; i++) {
+                float a = fabsf(src[v * stride + i]);
+                if (!isfinite(a))
+                    return VDSH_ERR_INVALID;
+                amax[i] = a > amax[i] ? a : amax[i];
+            }
+        for (uint32_t i = 0; i < cap * cap; i++) {
+            int levels = vdsh_quant_levels(encoding, i);
+            if (!isfinite((float)levels * vdsh_quant_step(amax[i], levels)))
+                return VDSH_ERR_INVALID;
+        }
+        memcpy(scales, amax, (size_t)cap * cap * sizeof *scales);
+    }
+    for (uint32_t v = 0; v < rows; v++) {
+        const float *c = src + v * stride;
+        uint32_t nc = (uint32_t)orders[v] * orders[v];
+        uint8_t *p = out + 4 * (size_t)offsets[v];
+        if (vdsh_encoding_quantised(encoding)) {
+            quantise_record(encoding, c, nc, amax, p);
+        } else if (encoding == VDSH_ENCODING_F16) {
+            uint16_t h[VDSH_MAX_COEFFS];
+            vdsh_result r = vdsh_encode_f16(c, nc, scale, h);
+            if (r != VDSH_OK)
+                return r;
+            memcpy(p, h, 2 * (size_t)nc);
+        } else {
+            for (uint32_t i = 0; i < nc; i++) {
+                float x = c[i] / scale;
+                if (!isfinite(x))
+                    return VDSH_ERR_INVALID;
+                memcpy(p + 4 * (size_t)i, &x, 4);
             }
         }
-    memcpy(scales, amax, nc * sizeof *scales);
+    }
     return VDSH_OK;
 }
 
@@ -448,23 +511,103 @@ static size_t stream_table_bytes(uint32_t encoding, uint32_t order)
     return ((size_t)order * order * 4 + 15) & ~(size_t)15;
 }
 
-const vdsh_stream *vdsh_find_stream(const vdsh_file *f, uint32_t order,
-                                    uint32_t quantity)
+static int stream_variable(const vdsh_stream *s)
+{
+    return (s->flags & VDSH_STREAM_VARIABLE) != 0;
+}
+
+static const vdsh_stream *find_stream(const vdsh_file *f, uint32_t order, uint32_t quantity,
+                                      uint32_t flags)
 {
     if (!f || !f->streams)
         return NULL;
     for (uint32_t i = 0; i < f->stream_count; i++)
-        if (f->streams[i].order == order &&
-            f->streams[i].quantity == quantity)
+        if ((order == 0 || f->streams[i].order == order) &&
+            f->streams[i].quantity == quantity && f->streams[i].flags == flags)
             return &f->streams[i];
     return NULL;
 }
 
+const vdsh_stream *vdsh_find_stream(const vdsh_file *f, uint32_t order,
+                                    uint32_t quantity)
+{
+    return order ? find_stream(f, order, quantity, 0) : NULL;
+}
+
+const vdsh_stream *vdsh_find_variable_stream(const vdsh_file *f, uint32_t quantity)
+{
+    return find_stream(f, 0, quantity, VDSH_STREAM_VARIABLE);
+}
+
+uint32_t vdsh_stream_vertex_order(const vdsh_stream *s, uint32_t v)
+{
+    return stream_variable(s) ? s->orders[v] : s->order;
+}
+
 size_t vdsh_stream_bytes_per_vertex(const vdsh_stream *s)
 {
-    if (!s || s->order < 1 || s->order > VDSH_MAX_ORDER)
+    if (!s || s->order < 1 || s->order > VDSH_MAX_ORDER || stream_variable(s))
         return 0;
     return vdsh_encoding_bytes(s->encoding, s->order * s->order);
+}
+
+uint32_t vdsh_record_words(uint32_t encoding, uint32_t order)
+{
+    return (uint32_t)((vdsh_encoding_bytes(encoding, order * order) + 3) / 4);
+}
+
+void vdsh_stream_offsets(const uint8_t *orders, uint32_t rows, uint32_t encoding,
+                         uint32_t *offsets)
+{
+    uint32_t words[VDSH_ORDER_SLOTS];
+    for (uint32_t k = 0; k <= VDSH_MAX_ORDER; k++)
+        words[k] = vdsh_record_words(encoding, k);
+    uint32_t at = 0;
+    for (uint32_t v = 0; v < rows; v++) {
+        offsets[v] = at;
+        at += words[orders[v] <= VDSH_MAX_ORDER ? orders[v] : 0];
+    }
+    offsets[rows] = at;
+}
+
+/* Words of all records of a variable-order stream's `rows` rows. */
+static uint64_t records_words(const uint8_t *orders, uint32_t rows, uint32_t encoding)
+{
+    uint32_t words[VDSH_ORDER_SLOTS];
+    for (uint32_t k = 0; k <= VDSH_MAX_ORDER; k++)
+        words[k] = vdsh_record_words(encoding, k);
+    uint64_t at = 0;
+    for (uint32_t v = 0; v < rows; v++)
+        at += words[orders[v] <= VDSH_MAX_ORDER ? orders[v] : 0];
+    return at;
+}
+
+uint64_t vdsh_stream_data_bytes(const vdsh_stream *s, uint32_t rows)
+{
+    if (!stream_variable(s))
+        return (uint64_t)rows * vdsh_stream_bytes_per_vertex(s);
+    return ((uint64_t)rows + 15) / 16 * 16 + 4 * records_words(s->orders, rows, s->encoding);
+}
+
+/* n coefficients of one record at d (`encoding`, the scales of the stream). */
+static void decode_record(const vdsh_stream *s, const void *d, uint32_t n, float *out)
+{
+    if (s->encoding == VDSH_ENCODING_F16) {
+        const uint16_t *h = (const uint16_t *)d;
+        for (uint32_t i = 0; i < n; i++)
+            out[i] = vdsh_f32_from_f16(h[i]) * s->scale;
+    } else if (s->encoding == VDSH_ENCODING_F32) {
+        const float *f = (const float *)d;
+        for (uint32_t i = 0; i < n; i++)
+            out[i] = f[i] * s->scale;
+    } else if (vdsh_encoding_quantised(s->encoding) && s->coef_scales) {
+        for (uint32_t i = 0; i < n; i++)
+            out[i] = (float)quant_stored(s->encoding, (const uint8_t *)d, i) *
+                     vdsh_quant_step(s->coef_scales[i], vdsh_quant_levels(s->encoding, i));
+    } else {
+        for (uint32_t i = 0; i < n; i++)
+            out[i] = 0.0f;
+    }
 }
 
 void vdsh_stream_decode(const vdsh_stream *s, uint32_t v, float *out)
@@ -472,23 +615,16 @@ void vdsh_stream_decode(const vdsh_stream *s, uint32_t v, float *out)
     if (s->order < 1 || s->order > VDSH_MAX_ORDER)
         return; /* programmer error; nothing sensible to write */
     uint32_t n = s->order * s->order;
-    if (s->encoding == VDSH_ENCODING_F16) {
-        const uint16_t *d = (const uint16_t *)s->data + (size_t)v * n;
-        for (uint32_t i = 0; i < n; i++)
-            out[i] = vdsh_f32_from_f16(d[i]) * s->scale;
-    } else if (s->encoding == VDSH_ENCODING_F32) {
-        const float *d = (const float *)s->data + (size_t)v * n;
-        for (uint32_t i = 0; i < n; i++)
-            out[i] = d[i] * s->scale;
-    } else if (vdsh_encoding_quantised(s->encoding) && s->coef_scales) {
-        const uint8_t *d = (const uint8_t *)s->data + (size_t)v * vdsh_encoding_bytes(s->encoding, n);
-        for (uint32_t i = 0; i < n; i++)
-            out[i] = (float)quant_stored(s->encoding, d, i) *
-                     vdsh_quant_step(s->coef_scales[i], vdsh_quant_levels(s->encoding, i));
-    } else {
-        for (uint32_t i = 0; i < n; i++)
+    if (stream_variable(s)) {
+        uint32_t k = s->orders[v];
+        k = k < s->order ? k : s->order;
+        decode_record(s, (const uint32_t *)s->data + s->offsets[v], k * k, out);
+        for (uint32_t i = k * k; i < n; i++)
             out[i] = 0.0f;
+        return;
     }
+    decode_record(s, (const uint8_t *)s->data + (size_t)v * vdsh_encoding_bytes(s->encoding, n),
+                  n, out);
 }
 
 /* ------------------------------------------------------------------ */
@@ -660,12 +796,30 @@ static int check_name(const uint8_t *name, size_t len, uint32_t i, why *w)
     return 1;
 }
 
+/* One fixed-order stream per (order, quantity), one variable-order
+ * stream per quantity. */
+static int same_slot(const vdsh_stream *a, const vdsh_stream *b)
+{
+    return a->quantity == b->quantity && a->flags == b->flags &&
+           (stream_variable(a) || a->order == b->order);
+}
+
+/* "order 5 distance", "variable-order log-distance": a stream's slot. */
+static const char *slot_name(const vdsh_stream *s, char *buf, size_t n)
+{
+    if (stream_variable(s))
+        snprintf(buf, n, "variable-order %s", vdsh_quantity_name(s->quantity));
+    else
+        snprintf(buf, n, "order %u %s", s->order, vdsh_quantity_name(s->quantity));
+    return buf;
+}
+
 /* "COEF order 5 distance": how messages name a stream. */
 static void stream_label(const vdsh_stream *s, uint32_t i, char *buf,
                          size_t n)
 {
-    snprintf(buf, n, "COEF stream %u (order %u, %s)", i, s->order,
-             vdsh_quantity_name(s->quantity));
+    snprintf(buf, n, "COEF stream %u (order %s%u, %s)", i, stream_variable(s) ? "up to " : "",
+             s->order, vdsh_quantity_name(s->quantity));
 }
 
 static int check_stream(const vdsh_stream *s, uint32_t i, why *w)
@@ -676,8 +830,10 @@ static int check_stream(const vdsh_stream *s, uint32_t i, why *w)
         return bad(w, "%s: order %u out of range 1..%d", l, s->order,
                    VDSH_MAX_ORDER);
     if (s->encoding > VDSH_ENCODING_LAST)
-        return bad(w, "%s: encoding %u unknown (0 f32, 1 f16, 2 s8)", l,
+        return bad(w, "%s: encoding %u unknown (0 f32, 1 f16, 2 s8, 3 s8s6)", l,
                    s->encoding);
+    if (s->flags & ~VDSH_STREAM_VARIABLE)
+        return bad(w, "%s: flags 0x%x: unknown bits (bit 0: variable order)", l, s->flags);
     /* Any method value is allowed: later bakers add methods, and the
      * coefficients still reconstruct `quantity` (VDSH.md, "Methods"). */
     if (s->quantity > VDSH_QUANTITY_LOG_DISTANCE)
@@ -713,67 +869,71 @@ static int check_stream(const vdsh_stream *s, uint32_t i, why *w)
     return 1;
 }
 
-/* A quantised stream's stored values lie within +-levels, and s8s6's bits
+/* A quantised record's stored values lie within +-levels, and s8s6's bits
  * that no coefficient uses (bits 30-31 of every word, the last word's
- * unused fields) are zero, so every file has one spelling. */
-static int check_quant_data(const vdsh_stream *s, const char *l, uint32_t v, why *w)
+ * unused fields) are zero, so every file has one spelling. `rows` records
+ * of nc coefficients at d, the first being vertex `first`. */
+static int check_quant_data(const vdsh_stream *s, const char *l, const uint8_t *d, uint32_t nc,
+                            size_t rows, size_t first, why *w)
 {
-    uint32_t nc = s->order * s->order;
     size_t bpv = vdsh_encoding_bytes(s->encoding, nc);
     uint32_t words = s->encoding == VDSH_ENCODING_S8S6 && nc > VDSH_S8S6_BYTES
                          ? (uint32_t)((bpv - VDSH_S8S6_BYTES) / 4)
                          : 0;
-    const uint8_t *d = (const uint8_t *)s->data;
-    for (size_t x = 0; x < v; x++) {
+    for (size_t x = 0; x < rows; x++) {
         const uint8_t *p = d + x * bpv;
         for (uint32_t i = 0; i < nc; i++) {
             int levels = vdsh_quant_levels(s->encoding, i);
             int32_t q = quant_stored(s->encoding, p, i);
             if (q < -levels)
                 return bad(w, "%s: vertex %zu coefficient %u is %d (%s stores %d..%d there)", l,
-                           x, i, (int)q, vdsh_encoding_name(s->encoding), -levels, levels);
+                           first + x, i, (int)q, vdsh_encoding_name(s->encoding), -levels,
+                           levels);
         }
         for (uint32_t k = 0; k < words; k++) {
             uint32_t left = nc - VDSH_S8S6_BYTES - k * VDSH_S8S6_PER_WORD;
             uint32_t fields = left < VDSH_S8S6_PER_WORD ? left : VDSH_S8S6_PER_WORD;
             uint32_t used = (1u << (VDSH_S8S6_BITS * fields)) - 1u;
             if (get_u32(p + VDSH_S8S6_BYTES + 4 * k) & ~used)
-                return bad(w, "%s: vertex %zu: unused bits of packed word %u not zero", l, x,
-                           k);
+                return bad(w, "%s: vertex %zu: unused bits of packed word %u not zero", l,
+                           first + x, k);
         }
     }
     return 1;
 }
 
-/* Stored values must be finite, and so must stored * scale, which is what
- * vdsh_stream_decode() hands out (a huge scale could overflow it). */
-static int check_stream_data(const vdsh_stream *s, uint32_t i, uint32_t v,
-                             why *w)
+/* A quantised stream's scales: finite and >= 0 (0: the index is 0 at
+ * every vertex), and `levels` steps finite, so |coefficient| <= about its
+ * scale, finite. */
+static int check_scales(const vdsh_stream *s, const char *l, why *w)
 {
-    char l[96];
-    size_t nc = (size_t)s->order * s->order;
-    size_t n = (size_t)v * nc;
-    float maxabs;
-    stream_label(s, i, l, sizeof l);
-    if (vdsh_encoding_quantised(s->encoding)) {
-        /* Scales finite and >= 0; stored values within +-levels (-128, or
-         * -32 in 6 bits, would make the range lopsided, and GL's
-         * normalisation rules disagree on -128), so |coefficient| <= about
-         * its scale, finite. */
-        for (uint32_t k = 0; k < nc; k++) {
-            float sc = s->coef_scales[k];
-            int levels = vdsh_quant_levels(s->encoding, k);
-            if (!isfinite(sc) || !(sc >= 0.0f))
-                return bad(w, "%s: scale of coefficient %zu is %g, not finite and >= 0", l,
-                           (size_t)k, (double)sc);
-            if (!isfinite((float)levels * vdsh_quant_step(sc, levels)))
-                return bad(w, "%s: scale of coefficient %zu, %g: %d steps overflow a float",
-                           l, (size_t)k, (double)sc, levels);
-        }
-        return check_quant_data(s, l, v, w);
+    for (uint32_t k = 0; k < s->order * s->order; k++) {
+        float sc = s->coef_scales[k];
+        int levels = vdsh_quant_levels(s->encoding, k);
+        if (!isfinite(sc) || !(sc >= 0.0f))
+            return bad(w, "%s: scale of coefficient %zu is %g, not finite and >= 0", l,
+                       (size_t)k, (double)sc);
+        if (!isfinite((float)levels * vdsh_quant_step(sc, levels)))
+            return bad(w, "%s: scale of coefficient %zu, %g: %d steps overflow a float", l,
+                       (size_t)k, (double)sc, levels);
     }
+    return 1;
+}
+
+/* `rows` records of nc coefficients at d, the first being vertex `first`:
+ * stored values finite, and so must stored * scale be, which is what
+ * vdsh_stream_decode() hands out (a huge scale could overflow it);
+ * quantised ones within +-levels (-128, or -32 in 6 bits, would make the
+ * range lopsided, and GL's normalisation rules disagree on -128). */
+static int check_rows(const vdsh_stream *s, const char *l, const void *data, uint32_t nc,
+                      size_t rows, size_t first, why *w)
+{
+    size_t n = rows * nc;
+    float maxabs;
+    if (vdsh_encoding_quantised(s->encoding))
+        return check_quant_data(s, l, (const uint8_t *)data, nc, rows, first, w);
     if (s->encoding == VDSH_ENCODING_F16) {
-        const uint16_t *d = (const uint16_t *)s->data;
+        const uint16_t *d = (const uint16_t *)data;
         uint16_t m = 0;
         for (size_t k = 0; k < n; k++) {
             uint16_t a = (uint16_t)(d[k] & 0x7fffu);
@@ -784,16 +944,16 @@ static int check_stream_data(const vdsh_stream *s, uint32_t i, uint32_t v,
             while ((d[k] & 0x7c00u) != 0x7c00u)
                 k++;
             return bad(w, "%s: vertex %zu coefficient %zu is not finite "
-                       "(f16 0x%04x)", l, k / nc, k % nc, d[k]);
+                       "(f16 0x%04x)", l, first + k / nc, k % nc, d[k]);
         }
         maxabs = vdsh_f32_from_f16(m);
     } else {
-        const float *d = (const float *)s->data;
+        const float *d = (const float *)data;
         uint32_t m = max_abs_bits_f32(d, n);
         if (m >= 0x7f800000u) {
             size_t k = first_nonfinite_f32(d, n);
             return bad(w, "%s: vertex %zu coefficient %zu is not finite (%g)",
-                       l, k / nc, k % nc, (double)d[k]);
+                       l, first + k / nc, k % nc, (double)d[k]);
         }
         maxabs = f32_from_bits(m);
     }
@@ -801,6 +961,40 @@ static int check_stream_data(const vdsh_stream *s, uint32_t i, uint32_t v,
         return bad(w, "%s: a stored value of %g times scale %g overflows a "
                    "float", l, (double)maxabs, (double)s->scale);
     return 1;
+}
+
+/* A variable-order stream's orders (1..order) and records, each as a
+ * fixed stream's one vertex, their padding zero. */
+static int check_variable_rows(const vdsh_stream *s, const char *l, uint32_t v, why *w)
+{
+    const uint32_t *words = (const uint32_t *)s->data;
+    size_t at = 0;
+    for (uint32_t x = 0; x < v; x++) {
+        uint32_t k = s->orders[x];
+        if (k < 1 || k > s->order)
+            return bad(w, "%s: vertex %u has order %u (1..%u)", l, x, k, s->order);
+        uint32_t nc = k * k;
+        if (!check_rows(s, l, words + at, nc, 1, x, w))
+            return 0;
+        size_t used = vdsh_encoding_bytes(s->encoding, nc);
+        uint32_t rec = vdsh_record_words(s->encoding, k);
+        if (!all_zero((const uint8_t *)(words + at) + used, 4 * (size_t)rec - used))
+            return bad(w, "%s: vertex %u: padding after its record not zero", l, x);
+        at += rec;
+    }
+    return 1;
+}
+
+static int check_stream_data(const vdsh_stream *s, uint32_t i, uint32_t v,
+                             why *w)
+{
+    char l[96];
+    stream_label(s, i, l, sizeof l);
+    if (vdsh_encoding_quantised(s->encoding) && !check_scales(s, l, w))
+        return 0;
+    if (stream_variable(s))
+        return check_variable_rows(s, l, v, w);
+    return check_rows(s, l, s->data, s->order * s->order, v, 0, w);
 }
 
 /* The statistics must describe a bake of vertex_count receivers. */
@@ -936,6 +1130,8 @@ typedef struct layout {
     uint64_t stream_data[VDSH_MAX_STREAMS];
     uint64_t stream_table[VDSH_MAX_STREAMS]; /* s8: offset of the scales; else 0 */
     uint64_t stream_bytes[VDSH_MAX_STREAMS]; /* COEF payload after the stream header */
+    uint64_t stream_orders[VDSH_MAX_STREAMS]; /* variable order: its order table's bytes */
+    uint64_t offset_words; /* the variable-order streams' offsets, rows + 1 each */
     int has_stats;
     vdsh_stats stats;
     int has_timings;
@@ -1168,6 +1364,7 @@ static vdsh_result read_array(const reader *r, const chunk_ref *c,
 
 static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
 {
+    char slot[64];
     const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
     uint32_t i = L->stream_count;
     vdsh_stream *s = &L->streams[i];
@@ -1190,11 +1387,14 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
     s->method_param = get_f32(p + 24);
     s->scale = get_f32(p + 28);
     s->quantity_param = get_f32(p + 32);
+    s->flags = get_u32(p + 36);
     s->data = NULL;
+    s->orders = NULL;
+    s->offsets = NULL;
     stream_label(s, i, l, sizeof l);
-    if (!all_zero(p + 36, 12))
+    if (!all_zero(p + 40, 8))
         return fail(r->err, VDSH_ERR_INVALID, r->name,
-                    "%s: reserved bytes 36..47 not zero", l);
+                    "%s: reserved bytes 40..47 not zero", l);
     if (!check_stream(s, i, &w))
         return invalid(r, &w);
     uint64_t table = stream_table_bytes(s->encoding, s->order);
@@ -1210,12 +1410,10 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
                         "%s: padding after the scale table not zero", l);
     }
     for (uint32_t k = 0; k < i; k++)
-        if (L->streams[k].order == s->order &&
-            L->streams[k].quantity == s->quantity)
+        if (same_slot(&L->streams[k], s))
             return fail(r->err, VDSH_ERR_INVALID, r->name,
-                        "%s: a second stream for order %u %s (stream %u is "
-                        "the first)", l, s->order,
-                        vdsh_quantity_name(s->quantity), k);
+                        "%s: a second stream for %s (stream %u is "
+                        "the first)", l, slot_name(s, slot, sizeof slot), k);
     L->stream_table[i] = table ? c->offset + CHUNK_HEADER_SIZE + STREAM_HEADER_SIZE : 0;
     L->stream_data[i] = c->offset + CHUNK_HEADER_SIZE + STREAM_HEADER_SIZE + table;
     L->stream_bytes[i] = c->size - STREAM_HEADER_SIZE;
@@ -1236,7 +1434,25 @@ static vdsh_result check_coef_sizes(const reader *r, layout *L)
         char l[96];
         stream_label(s, i, l, sizeof l);
         uint64_t table = stream_table_bytes(s->encoding, s->order);
-        uint64_t need = table + (uint64_t)rows * vdsh_stream_bytes_per_vertex(s);
+        uint64_t orders = 0; /* a variable-order stream's order table */
+        if (stream_variable(s)) {
+            orders = round16(rows);
+            if (L->stream_bytes[i] < table + orders)
+                return fail(r->err, VDSH_ERR_CHUNK, r->name,
+                            "%s: %llu bytes of data, shorter than its scale and order "
+                            "tables (%llu bytes)", l, (unsigned long long)L->stream_bytes[i],
+                            (unsigned long long)(table + orders));
+            s->orders = r->d + L->stream_data[i];
+            if (!all_zero(s->orders + rows, orders - rows))
+                return fail(r->err, VDSH_ERR_INVALID, r->name,
+                            "%s: padding after the order table not zero", l);
+            for (uint32_t v = 0; v < rows; v++) /* before the sizes they imply */
+                if (s->orders[v] < 1 || s->orders[v] > s->order)
+                    return fail(r->err, VDSH_ERR_INVALID, r->name,
+                                "%s: vertex %u has order %u (1..%u)", l, v, s->orders[v],
+                                s->order);
+        }
+        uint64_t need = table + vdsh_stream_data_bytes(s, rows);
         if (L->stream_bytes[i] != need)
             return fail(r->err, VDSH_ERR_CHUNK, r->name,
                         "%s: %llu bytes of data, %u vertices of %s need %llu%s", l,
@@ -1244,10 +1460,14 @@ static vdsh_result check_coef_sizes(const reader *r, layout *L)
                         vdsh_encoding_name(s->encoding), (unsigned long long)need,
                         L->has_part ? " (a part: its range's receivers)" : "");
         s->coef_scales = table ? (const float *)(r->d + L->stream_table[i]) : NULL;
-        s->data = r->d + L->stream_data[i];
+        s->data = r->d + L->stream_data[i] + orders;
         int ok = check_stream_data(s, i, rows, &w);
         s->data = NULL;
+        s->orders = NULL;
         s->coef_scales = NULL;
+        L->stream_orders[i] = orders;
+        if (orders)
+            L->offset_words += (uint64_t)rows + 1;
         if (!ok)
             return invalid(r, &w);
     }
@@ -1437,8 +1657,6 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
     return check_coef_sizes(r, L);
 }
 
-static size_t round16(size_t n) { return (n + 15) & ~(size_t)15; }
-
 /*
  * Validate `buf` (which the caller allocated with alloc_file_buffer and
  * hands over: it is owned by the result, or freed on failure) and build
@@ -1468,11 +1686,17 @@ static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name,
         off_streams + round16(L.stream_count * sizeof(vdsh_stream));
     size_t off_names =
         off_sources + round16(L.source_count * sizeof(vdsh_source));
-    uint8_t *block = (uint8_t *)calloc(1, off_names + L.names_bytes);
+    size_t off_offsets = off_names + round16(L.names_bytes);
+    if (L.offset_words > (SIZE_MAX - off_offsets) / 4) {
+        free(buf);
+        return fail(err, VDSH_ERR_OUT_OF_MEMORY, r.name, "out of memory (offsets)");
+    }
+    size_t block_size = off_offsets + (size_t)L.offset_words * 4;
+    uint8_t *block = (uint8_t *)calloc(1, block_size);
     if (!block) {
         free(buf);
         return fail(err, VDSH_ERR_OUT_OF_MEMORY, r.name,
-                    "out of memory (%zu bytes)", off_names + L.names_bytes);
+                    "out of memory (%zu bytes)", block_size);
     }
     vdsh_file *f = (vdsh_file *)block;
     f->storage_ = buf;
@@ -1483,11 +1707,20 @@ static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name,
 
     f->stream_count = L.stream_count;
     f->streams = (vdsh_stream *)(block + off_streams);
+    uint32_t *offsets = (uint32_t *)(block + off_offsets);
+    uint32_t rows = L.has_part ? L.part.range_end - L.part.range_begin : L.header.vertex_count;
     for (uint32_t i = 0; i < L.stream_count; i++) {
-        f->streams[i] = L.streams[i];
-        f->streams[i].data = buf + L.stream_data[i];
-        f->streams[i].coef_scales =
+        vdsh_stream *st = &f->streams[i];
+        *st = L.streams[i];
+        st->data = buf + L.stream_data[i] + L.stream_orders[i];
+        st->coef_scales =
             L.stream_table[i] ? (const float *)(buf + L.stream_table[i]) : NULL;
+        if (stream_variable(st)) {
+            st->orders = buf + L.stream_data[i];
+            vdsh_stream_offsets(st->orders, rows, st->encoding, offsets);
+            st->offsets = offsets;
+            offsets += (size_t)rows + 1;
+        }
     }
 
     f->source_count = L.source_count;
@@ -1663,6 +1896,8 @@ typedef struct out_chunk {
     char id[4];
     const void *pre;
     size_t pre_size;
+    const void *mid; /* then mid_size bytes and mid_pad zeros (or none) */
+    size_t mid_size, mid_pad;
     const void *data;
     uint64_t data_size;
     uint32_t crc;
@@ -1747,13 +1982,16 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
             return fail(err, VDSH_ERR_ARGUMENT, name,
                         "not written: COEF stream %u: %s without coef_scales", i,
                         vdsh_encoding_name(s->encoding));
+        if (stream_variable(s) && !s->orders)
+            return fail(err, VDSH_ERR_ARGUMENT, name,
+                        "not written: COEF stream %u: variable order without orders", i);
         for (uint32_t k = 0; k < i; k++)
-            if (f->streams[k].order == s->order &&
-                f->streams[k].quantity == s->quantity)
+            if (same_slot(&f->streams[k], s)) {
+                char slot[64];
                 return fail(err, VDSH_ERR_ARGUMENT, name,
-                            "not written: streams %u and %u are both order "
-                            "%u %s", k, i, s->order,
-                            vdsh_quantity_name(s->quantity));
+                            "not written: streams %u and %u are both %s", k, i,
+                            slot_name(s, slot, sizeof slot));
+            }
         if (!check_stream_data(s, i, vdsh_file_stream_vertices(f), &w))
             return argument(err, name, &w);
     }
@@ -1851,11 +2089,20 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
         put_f32(p + 24, s->method_param);
         put_f32(p + 28, s->scale);
         put_f32(p + 32, s->quantity_param);
+        put_u32(p + 36, s->flags);
         size_t table = stream_table_bytes(s->encoding, s->order);
         for (uint32_t k = 0; table && k < s->order * s->order; k++)
             put_f32(p + STREAM_HEADER_SIZE + 4 * k, s->coef_scales[k]);
-        add_chunk(P, "COEF", p, STREAM_HEADER_SIZE + table, s->data,
-                  (uint64_t)vdsh_file_stream_vertices(f) * vdsh_stream_bytes_per_vertex(s));
+        uint32_t rows = vdsh_file_stream_vertices(f);
+        uint64_t data = vdsh_stream_data_bytes(s, rows);
+        add_chunk(P, "COEF", p, STREAM_HEADER_SIZE + table, s->data, data);
+        if (stream_variable(s)) { /* the order table, padded, before the records */
+            out_chunk *c = &P->chunks[P->count - 1];
+            c->mid = s->orders;
+            c->mid_size = rows;
+            c->mid_pad = round16(rows) - rows;
+            c->data_size = data - round16(rows);
+        }
     }
 
     if (f->has_stats) {
@@ -1907,11 +2154,13 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
     for (uint32_t i = 0; i < P->count; i++) {
         out_chunk *c = &P->chunks[i];
         uint8_t sz[8];
-        uint64_t n = c->pre_size + c->data_size;
+        uint64_t n = c->pre_size + c->mid_size + c->mid_pad + c->data_size;
         put_u64(sz, n);
         uint32_t crc = vdsh_crc32(0, c->id, 4);
         crc = vdsh_crc32(crc, sz, 8);
         crc = vdsh_crc32(crc, c->pre, c->pre_size);
+        crc = vdsh_crc32(crc, c->mid, c->mid_size);
+        crc = vdsh_crc32(crc, zeros, c->mid_pad);
         crc = vdsh_crc32(crc, c->data, (size_t)c->data_size);
         c->crc = vdsh_crc32(crc, zeros, (size_t)pad16(n));
         total += CHUNK_HEADER_SIZE + n + pad16(n);
@@ -1965,12 +2214,14 @@ static void plan_emit(const plan *P, sink *s)
     for (uint32_t i = 0; i < P->count; i++) {
         const out_chunk *c = &P->chunks[i];
         uint8_t hdr[CHUNK_HEADER_SIZE];
-        uint64_t n = c->pre_size + c->data_size;
+        uint64_t n = c->pre_size + c->mid_size + c->mid_pad + c->data_size;
         memcpy(hdr, c->id, 4);
         put_u32(hdr + 4, c->crc);
         put_u64(hdr + 8, n);
         sink_put(s, hdr, CHUNK_HEADER_SIZE);
         sink_put(s, c->pre, c->pre_size);
+        sink_put(s, c->mid, c->mid_size);
+        sink_put(s, zeros, c->mid_pad);
         sink_put(s, c->data, c->data_size);
         sink_put(s, zeros, pad16(n));
     }

@@ -57,8 +57,10 @@ extern "C" {
 
 #define VDSH_FORMAT_VERSION 1u
 /* The largest SH order a stream stores: every size below, in the bake and
- * in the runtime, is derived from it. */
-#define VDSH_MAX_ORDER 5
+ * in the runtime, is derived from it. Orders 1..5 are the paper's (the
+ * runtime draws them from vertex attributes and, at order 5, cubemaps);
+ * orders 6..16 are for long shadows (issue 16), drawn from buffers. */
+#define VDSH_MAX_ORDER 16
 /* Coefficients of order n (bands 0..n-1). */
 #define VDSH_COEFFS(n) ((n) * (n))
 #define VDSH_MAX_COEFFS VDSH_COEFFS(VDSH_MAX_ORDER)
@@ -199,7 +201,20 @@ typedef struct vdsh_stream {
                                  one per coefficient index, each finite and
                                  >= 0; coefficient i = stored * vdsh_quant_step(
                                  coef_scales[i], vdsh_quant_levels(enc, i)) */
+    uint32_t flags;        /* VDSH_STREAM_VARIABLE or 0 */
+    /* Variable-order streams only (else NULL; VDSH.md "Variable-order
+     * streams"): per vertex row its order k, 1..order (order is the cap);
+     * `data` then holds one record of k^2 coefficients per row, each
+     * padded to a multiple of 4 bytes, and row v's record starts at word
+     * offsets[v] of data (offsets: rows + 1 entries). The reader sets
+     * both; a writer's caller sets orders, and offsets when it decodes
+     * its own stream (vdsh_stream_offsets); the writer ignores offsets. */
+    const uint8_t *orders;
+    const uint32_t *offsets;
 } vdsh_stream;
+
+/* vdsh_stream.flags: each vertex has its own order (issue 16). */
+#define VDSH_STREAM_VARIABLE 1u
 
 typedef struct vdsh_stats {
     uint64_t rays_traced;
@@ -291,18 +306,40 @@ vdsh_result vdsh_write_sized(const char *path, const vdsh_file *f, uint64_t *siz
 vdsh_result vdsh_write_memory(const vdsh_file *f, void **out_data,
                               size_t *out_size, vdsh_error *err);
 
-/* The stream for (order, quantity), or NULL. */
+/* The fixed-order stream for (order, quantity), or NULL. */
 const vdsh_stream *vdsh_find_stream(const vdsh_file *f, uint32_t order,
                                     uint32_t quantity);
 
-/* Decode vertex v's order^2 coefficients of `s` to floats (scale applied).
- * v must be < vertex_count of the file the stream belongs to. */
+/* The variable-order stream of `quantity`, or NULL. */
+const vdsh_stream *vdsh_find_variable_stream(const vdsh_file *f, uint32_t quantity);
+
+/* Vertex row v's order: s->order, or its own in a variable-order stream. */
+uint32_t vdsh_stream_vertex_order(const vdsh_stream *s, uint32_t v);
+
+/* Decode vertex v's coefficients of `s` to floats (scale applied): its
+ * own order's k^2, then zeros up to s->order^2, so that out always holds
+ * order^2 values. v must be < the stream's rows (vdsh_file_stream_vertices). */
 void vdsh_stream_decode(const vdsh_stream *s, uint32_t v, float *out);
 
-/* Bytes of coefficient data per vertex of a stream: order^2 * 4 (f32),
- * * 2 (f16) or * 1 (s8); s8s6: min(n^2, 4) + 4 * ceil((n^2 - 4) / 5)
- * (orders 1..5: 1, 4, 8, 16, 24); 0 for an unknown encoding. */
+/* Bytes of coefficient data per vertex of a fixed-order stream: order^2 *
+ * 4 (f32), * 2 (f16) or * 1 (s8); s8s6: min(n^2, 4) + 4 * ceil((n^2 -
+ * 4) / 5) (orders 1..5: 1, 4, 8, 16, 24); 0 for an unknown encoding and
+ * for a variable-order stream (vdsh_stream_data_bytes). */
 size_t vdsh_stream_bytes_per_vertex(const vdsh_stream *s);
+
+/* Words of one record of order k in a variable-order stream of
+ * `encoding`: vdsh_encoding_bytes(encoding, k^2) rounded up to 4 bytes. */
+uint32_t vdsh_record_words(uint32_t encoding, uint32_t order);
+
+/* Fill offsets[0..rows] of a variable-order stream from its orders (each
+ * 1..VDSH_MAX_ORDER): offsets[v] = words of the records before row v. */
+void vdsh_stream_offsets(const uint8_t *orders, uint32_t rows, uint32_t encoding,
+                         uint32_t *offsets);
+
+/* Bytes of a stream's data for `rows` vertex rows, the scale table not
+ * counted: rows * bytes per vertex, or for a variable-order stream its
+ * order table (rows, padded to 16) and records (from s->orders). */
+uint64_t vdsh_stream_data_bytes(const vdsh_stream *s, uint32_t rows);
 
 /* IEEE binary16 conversion, round to nearest even; overflow gives +-Inf
  * (the caller checks), NaN stays NaN. */
@@ -340,6 +377,20 @@ static inline float vdsh_quant_step(float scale, int levels) { return scale / (f
  * bits zero. VDSH_ERR_ARGUMENT also for an encoding that is not one. */
 vdsh_result vdsh_encode_quantised(uint32_t encoding, const float *src, size_t vertices,
                                   uint32_t nc, float *scales, void *dst);
+
+/* Encode a variable-order stream (VDSH.md "Variable-order streams"):
+ * row v's first orders[v]^2 of its `stride` values in src (stride >=
+ * cap^2) into its record at word offsets[v] of dst (offsets from
+ * vdsh_stream_offsets; dst holds 4 * offsets[rows] bytes and is zeroed
+ * here, so padding is zero). f32 and f16 store c / scale; s8 and s8s6
+ * write scales[cap^2], per index the largest |c| over the rows that
+ * store it, and quantise as vdsh_encode_quantised. VDSH_ERR_INVALID for
+ * a value that is not finite or does not fit; VDSH_ERR_ARGUMENT for an
+ * order outside 1..cap or other bad arguments. */
+vdsh_result vdsh_encode_variable(uint32_t encoding, const float *src, size_t stride,
+                                 const uint8_t *orders, uint32_t rows, uint32_t cap,
+                                 float scale, const uint32_t *offsets, float *scales,
+                                 void *dst);
 
 /* Bytes per vertex of encoding e at nc coefficients (0 if unknown). */
 size_t vdsh_encoding_bytes(uint32_t e, uint32_t nc);

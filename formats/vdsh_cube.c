@@ -63,7 +63,7 @@ void vdsh_cube_gl_to_exr(int face, int i, int j, int n, int *ei, int *ej)
     }
 }
 
-/* The VDSH_MAX_COEFFS basis functions at the centre of OpenEXR texel (i, j) of
+/* The 25 basis functions of order 5 at the centre of OpenEXR texel (i, j) of
  * `face`: the one computation behind both fills below, so the runtime's
  * textures and the bake's files hold the same values. */
 static void exr_texel_basis(int face, int i, int j, int n, float y[VDSH_MAX_COEFFS])
@@ -74,7 +74,7 @@ static void exr_texel_basis(int face, int i, int j, int n, float y[VDSH_MAX_COEF
     d[0] *= inv;
     d[1] *= inv;
     d[2] *= inv;
-    vdsh_sh_eval(VDSH_MAX_ORDER, d, y);
+    vdsh_sh_eval(5, d, y); /* the cubemaps hold functions 9..24 */
 }
 
 void vdsh_cube_fill_basis(int n, int first, float *rgba)

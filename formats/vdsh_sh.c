@@ -50,7 +50,7 @@
 /* The closed forms below are written out for bands 0..KERNEL_ORDER-1: the
  * stored orders (VDSH_MAX_ORDER); eval_high_bands goes further. */
 #define KERNEL_ORDER 5
-_Static_assert(KERNEL_ORDER == VDSH_MAX_ORDER, "sh_kernel covers the stored orders exactly");
+_Static_assert(KERNEL_ORDER <= VDSH_MAX_ORDER, "sh_kernel covers the paper's orders");
 
 static inline __attribute__((always_inline)) void sh_kernel(int order, float x, float y, float z, float *o,
                              size_t s, int acc, float w)
@@ -94,6 +94,10 @@ static inline __attribute__((always_inline)) void sh_kernel(int order, float x, 
 void vdsh_sh_eval(int order, const float d[3], float *out)
 {
     assert(order >= 1 && order <= VDSH_MAX_ORDER);
+    if (order > KERNEL_ORDER) {
+        vdsh_sh_eval_soa(order, 1, &d[0], &d[1], &d[2], out, 1);
+        return;
+    }
     sh_kernel(order, d[0], d[1], d[2], out, 1, 0, 0.0f);
 }
 
@@ -133,7 +137,7 @@ static inline __attribute__((always_inline)) void soa_dispatch(
     }
 }
 
-/* Bands 5 .. order-1 (order <= VDSH_SH_EVAL_MAX_ORDER) by the standard
+/* Bands 5 .. order-1 (order <= VDSH_MAX_ORDER) by the standard
  * recurrence, in the same convention as bands 0-4 (Condon-Shortley phase,
  * sin for m < 0): Y_l^m = K_l^m P_l^|m|(z) (sqrt 2 Re or Im (x + iy)^|m|),
  * P_l^m here without its (1 - z^2)^(m/2) factor, which (x + iy)^m carries.
@@ -198,7 +202,7 @@ static inline __attribute__((always_inline)) void eval_high_bands(
 VDSH_CLONES void vdsh_sh_eval_soa(int order, size_t n, const float *x, const float *y,
                                   const float *z, float *out, size_t out_stride)
 {
-    assert(order >= 1 && order <= VDSH_SH_EVAL_MAX_ORDER);
+    assert(order >= 1 && order <= VDSH_MAX_ORDER);
     soa_dispatch(order < KERNEL_ORDER ? order : KERNEL_ORDER, n, x, y, z, NULL, out, out_stride, 0);
     if (order > KERNEL_ORDER)
         eval_high_bands(order, n, x, y, z, out, out_stride);
@@ -209,7 +213,24 @@ VDSH_CLONES void vdsh_sh_project_soa(int order, size_t n, const float *x, const 
                          size_t acc_stride)
 {
     assert(order >= 1 && order <= VDSH_MAX_ORDER);
-    soa_dispatch(order, n, x, y, z, w, acc, acc_stride, 1);
+    soa_dispatch(order < KERNEL_ORDER ? order : KERNEL_ORDER, n, x, y, z, w, acc, acc_stride, 1);
+    if (order <= KERNEL_ORDER)
+        return;
+    /* Bands 5 and up: evaluated into a block of HIGH_CHUNK directions,
+     * then weighted and added, each sum in direction order. */
+    enum { HIGH_CHUNK = 16 };
+    float t[VDSH_MAX_COEFFS * HIGH_CHUNK];
+    const int lo = KERNEL_ORDER * KERNEL_ORDER, hi = order * order;
+    for (size_t k0 = 0; k0 < n; k0 += HIGH_CHUNK) {
+        size_t cn = n - k0 < HIGH_CHUNK ? n - k0 : HIGH_CHUNK;
+        eval_high_bands(order, cn, x + k0, y + k0, z + k0, t, HIGH_CHUNK);
+        for (int i = lo; i < hi; i++) {
+            float *a = acc + (size_t)i * acc_stride + k0;
+            const float *ti = t + (size_t)i * HIGH_CHUNK;
+            for (size_t k = 0; k < cn; k++)
+                a[k] += w[k0 + k] * ti[k];
+        }
+    }
 }
 
 float vdsh_sh_reconstruct(int order, const float *c, const float d[3])

@@ -2,8 +2,10 @@
  * vdsh_sh.h - the one C evaluation of the real SH basis used everywhere.
  *
  * Purpose: evaluate the real, orthonormal spherical-harmonic basis up to
- * band 4 (order 5, 25 functions) in the D3DX/DirectXMath convention that
- * the paper used (Condon-Shortley phase, index i = l(l+1)+m):
+ * order VDSH_MAX_ORDER in the D3DX/DirectXMath convention that the paper
+ * used (Condon-Shortley phase, index i = l(l+1)+m). Bands 0-4 (order 5,
+ * 25 functions) by the closed forms below; bands 5 and up by the
+ * associated-Legendre recurrence in the same convention:
  *
  *   band 0   0.282095
  *   band 1   0.488603 * (-y, z, -x)
@@ -24,7 +26,8 @@
  * Does not: normalise directions (callers pass unit vectors), rotate or
  * window coefficients.
  *
- * Errors: none; orders outside 1..5 are programmer errors (asserted).
+ * Errors: none; orders outside 1..VDSH_MAX_ORDER are programmer errors
+ * (asserted).
  * Threading: pure functions.
  */
 #ifndef VDSH_SH_H
@@ -68,11 +71,7 @@ void vdsh_sh_eval(int order, const float d[3], float *out);
 /* Batch form for n directions given as separate x, y, z arrays:
  * out[i * out_stride + k] = Y_i(direction k). Same arithmetic as
  * vdsh_sh_eval (one kernel), laid out so the compiler vectorises over k.
- * `out` must not overlap the inputs. Unlike the other functions it also
- * evaluates orders 6..VDSH_SH_EVAL_MAX_ORDER (bands 5 to 8, by the
- * associated-Legendre recurrence in the same convention), for fits and
- * tests beyond the stored orders. */
-#define VDSH_SH_EVAL_MAX_ORDER 9
+ * `out` must not overlap the inputs. */
 void vdsh_sh_eval_soa(int order, size_t n, const float *x, const float *y,
                       const float *z, float *out, size_t out_stride);
 

@@ -91,7 +91,7 @@ expect_exit 1 "variant 0" "$bake" builtin:room:0 -q -o "$tmp/y.vdsh"
 # Usage errors exit 2 and write nothing.
 expect_exit 2 "no mesh" "$bake" -o "$tmp/x.vdsh"
 expect_exit 2 "no output" "$bake" builtin:room
-expect_exit 2 "bad order" "$bake" builtin:room --orders 2,6 -o "$tmp/x.vdsh"
+expect_exit 2 "bad order" "$bake" builtin:room --orders 2,17 -o "$tmp/x.vdsh"
 expect_exit 2 "bad rays" "$bake" builtin:room --rays 0 -o "$tmp/x.vdsh"
 expect_exit 2 "bad method" "$bake" builtin:room --method magic -o "$tmp/x.vdsh"
 expect_exit 2 "--log-offset with lsq" "$bake" builtin:room --method lsq --log-offset 0.2 -o "$tmp/x.vdsh"

@@ -1,6 +1,7 @@
 /* The fit core: SH rotations, the hemisphere Gram matrix, and each
  * method's map on functions it must reproduce exactly. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "fit.h"
@@ -78,25 +79,32 @@ static void test_factored_fit(void)
     vb_error err;
     uint64_t s = 42;
     double worst = 0;
-    for (vb_fit_base method = VB_FIT_MIRROR; method <= VB_FIT_LSQ; method++)
-        for (int order = 1; order <= 5; order++) {
-            vb_fit f, top;
-            CHECK(vb_fit_create(order, method, 1e-3f, &f, &err) == VB_OK, "fit");
-            CHECK(vb_fit_create(5, method, 1e-3f, &top, &err) == VB_OK, "fit");
+    /* The paper's orders, and orders for long shadows (bands 5 and up in
+     * double, with their own rotation samples). */
+    static const int orders[] = {1, 2, 3, 4, 5, 7, 12, 16};
+    vb_fit *f = malloc(sizeof *f), *top = malloc(sizeof *top);
+    double *S = malloc(sizeof(double) * VB_FIT_MAX * VB_FIT_MAX);
+    CHECK(f && top && S, "out of memory");
+    for (vb_fit_base method = VB_FIT_MIRROR; f && top && S && method <= VB_FIT_LSQ; method++)
+        for (size_t oi = 0; oi < sizeof orders / sizeof orders[0]; oi++) {
+            int order = orders[oi], top_order = order <= 5 ? 5 : VDSH_MAX_ORDER;
+            CHECK(vb_fit_create(order, method, vb_fit_lambda(1e-3f, order), f, &err) == VB_OK,
+                  "fit %d: %s", order, err.msg);
+            CHECK(vb_fit_create(top_order, method, 1e-3f, top, &err) == VB_OK, "fit");
             int n = order * order;
-            for (int t = 0; t < 20; t++) {
+            for (int t = 0; t < (order <= 5 ? 20 : 4); t++) {
                 float nrm[3];
                 test_rand_dir(&s, nrm);
                 if (t < 2) /* the poles */
                     nrm[0] = nrm[1] = 0.0f, nrm[2] = t ? -1.0f : 1.0f;
-                double b[25], u[25], S[625], v[25], w[25];
-                for (int i = 0; i < 25; i++)
+                double b[VB_FIT_MAX], u[VB_FIT_MAX], v[VB_FIT_MAX], w[VB_FIT_MAX];
+                for (int i = 0; i < VB_FIT_MAX; i++)
                     b[i] = 2 * test_rand(&s) - 1;
-                float t3[3], b3[3], c[25], ct[25];
+                float t3[3], b3[3], c[VB_FIT_MAX], ct[VB_FIT_MAX];
                 vb_frame(nrm, t3, b3);
                 const double R[9] = {t3[0], b3[0], nrm[0], t3[1], b3[1], nrm[1],
                                      t3[2], b3[2], nrm[2]};
-                vb_sh_rotation(&f, R, S);
+                vb_sh_rotation(f, R, S);
                 for (int i = 0; i < n; i++) { /* v = S^T b */
                     v[i] = 0;
                     for (int j = 0; j < n; j++)
@@ -105,24 +113,80 @@ static void test_factored_fit(void)
                 for (int i = 0; i < n; i++) { /* w = M v */
                     w[i] = 0;
                     for (int j = 0; j < n; j++)
-                        w[i] += f.M[i * n + j] * v[j];
+                        w[i] += f->M[i * n + j] * v[j];
                 }
-                vb_fit_apply(&f, nrm, b, c);
+                vb_fit_apply(f, nrm, b, c);
                 vb_fit_angles a;
-                vb_fit_frame(&top, nrm, &a); /* u from the order 5 fit */
-                vb_fit_unrotate(&top, &a, b, u);
-                vb_fit_finish(&f, &a, u, ct);
+                vb_fit_frame(top, nrm, &a); /* u from the top order's fit */
+                vb_fit_unrotate(top, &a, b, u);
+                vb_fit_finish(f, &a, u, ct);
                 for (int i = 0; i < n; i++) {
                     double want = 0; /* S w */
                     for (int j = 0; j < n; j++)
                         want += S[i * n + j] * w[j];
                     worst = fmax(worst, fabs(c[i] - want) / (1 + fabs(want)));
-                    CHECK(c[i] == ct[i], "order %d from the order 5 rotation: %g vs %g", order,
-                          ct[i], c[i]);
+                    CHECK(c[i] == ct[i], "order %d from the order %d rotation: %g vs %g", order,
+                          top_order, ct[i], c[i]);
                 }
             }
         }
     CHECK(worst < 1e-5, "factored fit differs from S M S^T b by %g", worst);
+    free(f);
+    free(top);
+    free(S);
+}
+
+/* The rotation of bands 5 and up is a rotation: sum c_i Y_i(R^T d) equals
+ * sum (S c)_i Y_i(d) at random directions, to float precision, at the
+ * highest order. */
+static void test_high_rotation(void)
+{
+    vb_error err;
+    uint64_t s = 7;
+    vb_fit *f = malloc(sizeof *f);
+    double *S = malloc(sizeof(double) * VB_FIT_MAX * VB_FIT_MAX);
+    CHECK(f && S && vb_fit_create(VDSH_MAX_ORDER, VB_FIT_IDENTITY, 0, f, &err) == VB_OK,
+          "fit");
+    if (!f || !S) {
+        free(f);
+        free(S);
+        return;
+    }
+    int n = VDSH_MAX_ORDER * VDSH_MAX_ORDER;
+    double worst = 0;
+    for (int t = 0; t < 5; t++) {
+        float a[3], b3[3], c3[3];
+        test_rand_dir(&s, a);
+        vb_frame(a, b3, c3);
+        const double R[9] = {b3[0], c3[0], a[0], b3[1], c3[1], a[1], b3[2], c3[2], a[2]};
+        vb_sh_rotation(f, R, S);
+        double c[VB_FIT_MAX], sc[VB_FIT_MAX];
+        for (int i = 0; i < n; i++)
+            c[i] = 2 * test_rand(&s) - 1;
+        for (int i = 0; i < n; i++) {
+            sc[i] = 0;
+            for (int j = 0; j < n; j++)
+                sc[i] += S[i * n + j] * c[j];
+        }
+        for (int k = 0; k < 20; k++) {
+            float d[3], rd[3], y[VB_FIT_MAX], yr[VB_FIT_MAX];
+            test_rand_dir(&s, d);
+            for (int r = 0; r < 3; r++) /* R^T d */
+                rd[r] = (float)(R[r] * d[0] + R[3 + r] * d[1] + R[6 + r] * d[2]);
+            vdsh_sh_eval(VDSH_MAX_ORDER, d, y);
+            vdsh_sh_eval(VDSH_MAX_ORDER, rd, yr);
+            double lhs = 0, rhs = 0, mag = 0;
+            for (int i = 0; i < n; i++) {
+                lhs += c[i] * yr[i];
+                rhs += sc[i] * y[i];
+                mag += fabs(c[i] * yr[i]);
+            }
+            worst = fmax(worst, fabs(lhs - rhs) / mag);
+        }
+    }
+    CHECK(worst < 1e-5, "order %d rotation off by %g (relative)", VDSH_MAX_ORDER, worst);
+    free(f);
+    free(S);
 }
 
 /* Least squares over the hemisphere recovers any function of the basis
@@ -274,7 +338,7 @@ static void test_errors(void)
 {
     vb_fit f;
     vb_error err;
-    CHECK(vb_fit_create(6, VB_FIT_LSQ, 0, &f, &err) == VB_ERR_ARGUMENT, "order 6");
+    CHECK(vb_fit_create(VDSH_MAX_ORDER + 1, VB_FIT_LSQ, 0, &f, &err) == VB_ERR_ARGUMENT, "order 17");
     CHECK(vb_fit_create(3, VB_FIT_LSQ, -1, &f, &err) == VB_ERR_ARGUMENT, "lambda < 0");
     CHECK(vb_fit_create(3, (vb_fit_base)99, 0, &f, &err) == VB_ERR_ARGUMENT, "unknown base fit");
 }
@@ -323,6 +387,7 @@ int main(void)
 {
     test_rotation();
     test_factored_fit();
+    test_high_rotation();
     test_lsq_recovers();
     test_mirror_and_paper();
     test_window();

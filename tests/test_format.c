@@ -913,7 +913,7 @@ static void check_quant_roundtrip(uint32_t enc, const float *src25, size_t v, ui
     uint32_t nc = order * order;
     float *src = malloc(v * nc * sizeof *src + 4), out[VDSH_MAX_COEFFS];
     for (size_t k = 0; k < v; k++)
-        memcpy(src + k * nc, src25 + k * VDSH_MAX_COEFFS, nc * sizeof *src);
+        memcpy(src + k * nc, src25 + k * 25, nc * sizeof *src);
     float scales[VDSH_MAX_COEFFS];
     uint8_t *b = malloc(v * vdsh_encoding_bytes(enc, nc) + 1);
     vdsh_stream st = {.order = order, .encoding = enc, .scale = 1.0f, .data = b,
@@ -1007,7 +1007,7 @@ static void test_encode_s8(void)
     c[7] = -INFINITY;
     CHECK(vdsh_encode_s8(c, V, NC, sc, b) == VDSH_ERR_INVALID);
     CHECK(vdsh_encode_s8(c, V, 0, sc, b) == VDSH_ERR_ARGUMENT);
-    CHECK(vdsh_encode_s8(c, V, NC + 1, sc, b) == VDSH_ERR_ARGUMENT);
+    CHECK(vdsh_encode_s8(c, V, VDSH_MAX_COEFFS + 1, sc, b) == VDSH_ERR_ARGUMENT);
     CHECK(vdsh_encode_s8(NULL, 0, 4, sc, NULL) == VDSH_OK && sc[0] == 0.0f);
 }
 
@@ -1533,7 +1533,7 @@ static void test_rules(void)
             "index 4294967295 out of range (4 vertices) in triangle 1");
 
     /* Streams. */
-    PATCH32(coef0 + 0, 6, 1, VDSH_ERR_INVALID, "order 6");
+    PATCH32(coef0 + 0, VDSH_MAX_ORDER + 1, 1, VDSH_ERR_INVALID, "order 17");
     PATCH32(coef0 + 0, 0, 1, VDSH_ERR_INVALID, "order 0");
     PATCH32(coef0 + 0, 1, 1, VDSH_ERR_CHUNK, "need 16");
     PATCH32(coef0 + 4, 4, 1, VDSH_ERR_INVALID, "encoding 4");
@@ -1921,7 +1921,7 @@ static void test_writer_checks(void)
     REJECT("stream_count 17", s_.f.stream_count = 17);
     REJECT("streams is NULL", s_.f.streams = NULL);
     REJECT("order 0", s_.streams[0].order = 0);
-    REJECT("order 6", s_.streams[1].order = 6);
+    REJECT("order 17", s_.streams[1].order = VDSH_MAX_ORDER + 1);
     REJECT("encoding 4", s_.streams[0].encoding = 4);
     REJECT("s8s6 without coef_scales", s_.streams[0].encoding = VDSH_ENCODING_S8S6);
     REJECT("s8 without coef_scales", s_.streams[0].encoding = VDSH_ENCODING_S8);
@@ -2207,6 +2207,144 @@ static void test_parts(void)
     sample_free(&s);
 }
 
+/* Variable-order streams (VDSH.md): every encoding written and read back
+ * (orders, offsets, decode within the encoding's error and zeros past a
+ * vertex's own order), the slot rules, and what the reader refuses: an
+ * order 0 or above the cap, padding after the order table or a record that
+ * is not zero, unknown flag bits. */
+#define VCHECK(c, ...)                                                        \
+    do {                                                                      \
+        checks++;                                                             \
+        if (!(c)) {                                                           \
+            fprintf(stderr, "%s:%d: ", __FILE__, __LINE__);                   \
+            fprintf(stderr, __VA_ARGS__);                                     \
+            fputc('\n', stderr);                                              \
+            failures++;                                                       \
+        }                                                                     \
+    } while (0)
+
+static void test_variable_streams(void)
+{
+    enum { V = 53, CAP = 12, NC = CAP * CAP };
+    uint8_t orders[V];
+    float *src = malloc(sizeof(float) * V * NC);
+    for (uint32_t v = 0; v < V; v++) {
+        orders[v] = (uint8_t)(v < 2 ? (v ? CAP : 1) : 1 + rnd() % CAP);
+        for (uint32_t i = 0; i < NC; i++)
+            src[v * NC + i] = i < (uint32_t)orders[v] * orders[v] ? rndf(-3.0f, 3.0f) : 0.0f;
+    }
+    uint32_t offsets[V + 1];
+    for (uint32_t enc = 0; enc <= VDSH_ENCODING_LAST; enc++) {
+        vdsh_stream_offsets(orders, V, enc, offsets);
+        uint32_t words = 0;
+        for (uint32_t v = 0; v < V; v++) {
+            CHECK(offsets[v] == words);
+            words += (uint32_t)((vdsh_encoding_bytes(enc, (uint32_t)orders[v] * orders[v]) + 3) / 4);
+        }
+        CHECK(offsets[V] == words);
+        uint32_t *rec = malloc(4 * (size_t)words + 4);
+        float scales[NC];
+        float scale = enc == VDSH_ENCODING_F16 ? 4.0f : 1.0f;
+        VCHECK(vdsh_encode_variable(enc, src, NC, orders, V, CAP, scale, offsets, scales, rec) ==
+              VDSH_OK, "encode %s", vdsh_encoding_name(enc));
+        sample t;
+        sample_init(&t, 2, V);
+        vdsh_stream *st = &t.streams[t.f.stream_count++];
+        *st = (vdsh_stream){.order = CAP, .encoding = enc, .method = VDSH_METHOD_SHADOW,
+                            .quantity = VDSH_QUANTITY_LOG_DISTANCE, .scale = scale,
+                            .quantity_param = 0.01f, .flags = VDSH_STREAM_VARIABLE,
+                            .orders = orders, .data = rec,
+                            .coef_scales = vdsh_encoding_quantised(enc) ? scales : NULL};
+        void *mem = NULL;
+        size_t n = 0;
+        vdsh_error err;
+        vdsh_file *f = NULL;
+        VCHECK(vdsh_write_memory(&t.f, &mem, &n, &err) == VDSH_OK, "%s", err.msg);
+        VCHECK(mem && vdsh_read_memory(mem, n, "v.vdsh", &f, &err) == VDSH_OK, "%s", err.msg);
+        const vdsh_stream *r = f ? vdsh_find_variable_stream(f, VDSH_QUANTITY_LOG_DISTANCE) : NULL;
+        VCHECK(r && r->order == CAP && r->flags == VDSH_STREAM_VARIABLE &&
+              !vdsh_find_stream(f, CAP, VDSH_QUANTITY_LOG_DISTANCE) &&
+              vdsh_stream_bytes_per_vertex(r) == 0 &&
+              vdsh_stream_data_bytes(r, V) == 64 + 4 * (uint64_t)words, "%s read back",
+              vdsh_encoding_name(enc));
+        double worst = 0.0;
+        for (uint32_t v = 0; r && v < V; v++) {
+            CHECK(vdsh_stream_vertex_order(r, v) == orders[v] && r->offsets[v] == offsets[v]);
+            CHECK((uintptr_t)((const uint32_t *)r->data + r->offsets[v]) % 4 == 0);
+            float out[NC];
+            vdsh_stream_decode(r, v, out);
+            for (uint32_t i = 0; i < NC; i++) {
+                double tol = vdsh_encoding_quantised(enc)
+                                 ? 0.5 * vdsh_quant_step(scales[i], vdsh_quant_levels(enc, i)) * 1.0001
+                             : enc == VDSH_ENCODING_F16 ? fabs(src[v * NC + i]) / 2048.0 + 1e-7
+                                                        : 0.0;
+                worst = fmax(worst, fabs(out[i] - src[v * NC + i]) - tol);
+            }
+        }
+        VCHECK(worst <= 0.0, "%s: decoded values off by %g beyond the encoding's step",
+              vdsh_encoding_name(enc), worst);
+        /* Byte patches of the written file. */
+        const uint8_t *d = mem;
+        size_t coef = payload_of(d, n, "COEF", 1);
+        size_t table = vdsh_encoding_quantised(enc) ? (NC * 4 + 15) / 16 * 16 : 0;
+        size_t otab = coef + 48 + table, recs = otab + 64;
+        CHECK(coef && d[otab] == orders[0] && rd32(d + coef + 36) == VDSH_STREAM_VARIABLE);
+        if (coef) {
+            uint8_t b0 = 0, big = CAP + 1, one = 1;
+            expect_patched(d, n, otab, &b0, 1, 1, VDSH_ERR_INVALID, "vertex 0 has order 0",
+                           __LINE__);
+            expect_patched(d, n, otab + 3, &big, 1, 1, VDSH_ERR_INVALID, "has order 13",
+                           __LINE__);
+            expect_patched(d, n, otab + V, &one, 1, 1, VDSH_ERR_INVALID,
+                           "padding after the order table", __LINE__);
+            PATCH32(coef + 36, 3, 1, VDSH_ERR_INVALID, "flags 0x3");
+            PATCH32(coef + 40, 1, 1, VDSH_ERR_INVALID, "reserved bytes 40..47");
+            /* vertex 0 is order 1: its record's last byte is padding for
+             * every encoding but f32 */
+            if (enc != VDSH_ENCODING_F32)
+                expect_patched(d, n, recs + 3, &one, 1, 1, VDSH_ERR_INVALID,
+                               "vertex 0: padding after its record", __LINE__);
+            /* an order raised within the cap: the records no longer fit */
+            uint8_t three = 3;
+            expect_patched(d, n, otab, &three, 1, 1, VDSH_ERR_CHUNK, "bytes of data", __LINE__);
+        }
+        /* Slots: a second variable stream of the quantity is refused, one
+         * of another quantity and a fixed stream of the same order are not. */
+        t.streams[t.f.stream_count] = *st;
+        t.streams[t.f.stream_count].quantity = VDSH_QUANTITY_DISTANCE;
+        t.streams[t.f.stream_count].quantity_param = 0.0f;
+        t.f.stream_count++;
+        void *m2 = NULL;
+        size_t n2 = 0;
+        VCHECK(vdsh_write_memory(&t.f, &m2, &n2, &err) == VDSH_OK, "%s", err.msg);
+        free(m2);
+        t.streams[t.f.stream_count - 1].quantity = VDSH_QUANTITY_LOG_DISTANCE;
+        t.streams[t.f.stream_count - 1].quantity_param = 0.01f;
+        m2 = NULL;
+        VCHECK(vdsh_write_memory(&t.f, &m2, &n2, &err) == VDSH_ERR_ARGUMENT &&
+                  strstr(err.msg, "both variable-order log-distance"),
+              "two variable streams: %s", err.msg);
+        t.streams[t.f.stream_count - 1].orders = NULL;
+        t.streams[t.f.stream_count - 1].quantity = VDSH_QUANTITY_DISTANCE;
+        t.streams[t.f.stream_count - 1].quantity_param = 0.0f;
+        VCHECK(vdsh_write_memory(&t.f, &m2, &n2, &err) == VDSH_ERR_ARGUMENT &&
+                  strstr(err.msg, "variable order without orders"), "%s", err.msg);
+        t.f.stream_count--;
+        vdsh_free(f);
+        free(mem);
+        t.f.stream_count--; /* the streams' data are not the sample's */
+        sample_free(&t);
+        free(rec);
+    }
+    uint8_t bad[2] = {1, CAP + 1};
+    uint32_t off2[3] = {0, 1, 2};
+    float sc[NC];
+    uint32_t out[8];
+    CHECK(vdsh_encode_variable(VDSH_ENCODING_S8, src, NC, bad, 2, CAP, 1.0f, off2, sc, out) ==
+          VDSH_ERR_ARGUMENT);
+    free(src);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && !strcmp(argv[1], "--exhaustive-f16"))
@@ -2231,6 +2369,7 @@ int main(int argc, char **argv)
     test_byte_changes();
     test_rules();
     test_parts();
+    test_variable_streams();
     test_mutations();
     test_scan();
     test_writer_checks();

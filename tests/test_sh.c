@@ -135,9 +135,9 @@ static void test_recurrence(void)
     }
     CHECK(worst < 5e-6, "largest difference from the recurrence: %g", worst);
 
-    /* Orders 6..9 of the batch form (bands 5-8, the shadow fit's
-     * products): the reference's values, and orthonormal by quadrature. */
-    enum { N = 500, NC = 81 };
+    /* Orders 6..VDSH_MAX_ORDER (bands 5-15, by the recurrence): the
+     * reference's values, and orthonormal by quadrature. */
+    enum { N = 500, NC = VDSH_MAX_COEFFS };
     float x[N], yy[N], z[N], *out = malloc(sizeof(float) * NC * N);
     CHECK(out != NULL, "out of memory");
     if (!out)
@@ -147,7 +147,7 @@ static void test_recurrence(void)
         test_rand_dir(&s, d);
         x[k] = d[0], yy[k] = d[1], z[k] = d[2];
     }
-    vdsh_sh_eval_soa(9, N, x, yy, z, out, N);
+    vdsh_sh_eval_soa(VDSH_MAX_ORDER, N, x, yy, z, out, N);
     worst = 0.0;
     double worst_low = 0.0;
     for (int k = 0; k < N; k++) {
@@ -155,28 +155,34 @@ static void test_recurrence(void)
         vdsh_sh_eval(5, d, y5);
         for (int i = 0; i < 25; i++)
             worst_low = fmax(worst_low, fabs(out[i * N + k] - y5[i]));
-        for (int l = 5; l <= 8; l++)
+        float one[VDSH_MAX_COEFFS];
+        vdsh_sh_eval(VDSH_MAX_ORDER, d, one);
+        for (int i = 0; i < NC; i++)
+            worst_low = fmax(worst_low, fabs(out[i * N + k] - one[i]));
+        for (int l = 5; l < VDSH_MAX_ORDER; l++)
             for (int m = -l; m <= l; m++)
                 worst = fmax(worst, fabs(out[(l * (l + 1) + m) * N + k] - sh_reference(l, m, d)) /
                                         sqrt((2.0 * l + 1.0) / (4.0 * M_PI)));
     }
-    CHECK(worst_low == 0.0, "order 9's first 25 differ from order 5's by %g", worst_low);
-    CHECK(worst < 2e-5, "bands 5-8 differ from the reference by %g (relative to the peak)",
-          worst);
+    CHECK(worst_low == 0.0, "the batch form's first 25 differ from order 5's, or the one-"
+          "direction form from the batch, by %g", worst_low);
+    CHECK(worst < 2e-5, "bands 5-%d differ from the reference by %g (relative to the peak)",
+          VDSH_MAX_ORDER - 1, worst);
     free(out);
 
-    enum { NZ = 12, NP = 24 };
+    enum { NZ = 16, NP = 36 }; /* exact for the products' degree <= 30 */
     double gx[NZ], gw[NZ];
     gauss_legendre(NZ, gx, gw);
     static double G[NC][NC];
     memset(G, 0, sizeof G);
     for (int i = 0; i < NZ; i++) {
-        float qx[NP], qy[NP], qz[NP], q[NC * NP];
+        float qx[NP], qy[NP], qz[NP];
+        static float q[NC * NP];
         for (int j = 0; j < NP; j++) {
             double phi = 2.0 * M_PI * j / NP, r = sqrt(1.0 - gx[i] * gx[i]);
             qx[j] = (float)(r * cos(phi)), qy[j] = (float)(r * sin(phi)), qz[j] = (float)gx[i];
         }
-        vdsh_sh_eval_soa(9, NP, qx, qy, qz, q, NP);
+        vdsh_sh_eval_soa(VDSH_MAX_ORDER, NP, qx, qy, qz, q, NP);
         for (int j = 0; j < NP; j++)
             for (int a = 0; a < NC; a++)
                 for (int b = 0; b < NC; b++)
@@ -186,7 +192,7 @@ static void test_recurrence(void)
     for (int a = 0; a < NC; a++)
         for (int b = 0; b < NC; b++)
             off = fmax(off, fabs(G[a][b] - (a == b)));
-    CHECK(off < 1e-5, "order 9 Gram matrix differs from identity by %g", off);
+    CHECK(off < 1e-5, "order %d Gram matrix differs from identity by %g", VDSH_MAX_ORDER, off);
 }
 
 /* The batch form is the same kernel: bit-identical results, and lower

@@ -556,7 +556,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             if (d.order_mask & (1u << o))
                 d.max_order = o;
     if (d.max_order == 0)
-        d.max_order = VDSH_MAX_ORDER;
+        d.max_order = VB_DEFAULT_ORDER;
     if (d.max_order < 1 || d.max_order > VDSH_MAX_ORDER)
         return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..%d, not %d",
                        VDSH_MAX_ORDER, d.max_order);
@@ -670,7 +670,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!coeffs[o] && o != d.max_order) /* the top one rotates for all */
             continue;
-        if ((r = vb_fit_create(o, mi->fit, d.lambda, &J->fits[o], err)) != VB_OK)
+        if ((r = vb_fit_create(o, mi->fit, vb_fit_lambda(d.lambda, o), &J->fits[o], err)) != VB_OK)
             goto done;
         vb_fit_window(&J->fits[o], d.window);
     }

@@ -82,6 +82,9 @@
 extern "C" {
 #endif
 
+/* The order baked when none is asked: the paper's highest. */
+#define VB_DEFAULT_ORDER 5
+
 typedef struct vb_bake_desc {
     const vb_mesh *receivers;  /* positions and normals (borrowed) */
     const vb_scene *scene;     /* the occluders (borrowed) */
@@ -111,7 +114,8 @@ typedef struct vb_bake_desc {
     float log_floor;           /* log-distance floor; 0: 1% of max_distance */
     vdsh_window window;        /* on each order's bands; 0: none */
     uint32_t order_mask;       /* bit n: produce order n; 0: max_order only */
-    int max_order;             /* 0: the highest order in order_mask, or 5 */
+    int max_order;             /* 0: the highest order in order_mask, or
+                                  VB_DEFAULT_ORDER */
     unsigned threads;          /* 0: every online core */
     /* 0 (the tools' default): receivers whose normals point into geometry
      * are turned toward free space first (vb_orient_receivers, on a copy:

@@ -45,7 +45,10 @@ extern "C" {
 #endif
 
 #define VB_FIT_MAX VDSH_MAX_COEFFS
+/* Rotation samples: bands 0-4, and bands 5 and up (2l + 1 <= 31 functions
+ * each, three times over-determined). */
 #define VB_FIT_ROT_DIRS 36
+#define VB_FIT_ROT_DIRS_HIGH 96
 
 typedef struct vb_fit {
     int order;                        /* coefficients kept: order^2 */
@@ -61,8 +64,16 @@ typedef struct vb_fit {
     /* Rotations: sample directions and, per band l, the pseudo-inverse of
      * the (2l+1) x VB_FIT_ROT_DIRS basis block at them. */
     double rot_dirs[VB_FIT_ROT_DIRS][3];
-    double rot_pinv[VDSH_MAX_ORDER][VB_FIT_ROT_DIRS * VDSH_MAX_BAND_WIDTH];
+    double rot_dirs_high[VB_FIT_ROT_DIRS_HIGH][3];
+    double rot_pinv[VDSH_MAX_ORDER][VB_FIT_ROT_DIRS_HIGH * VDSH_MAX_BAND_WIDTH];
 } vb_fit;
+
+/* The regularisation weight an order's lsq fit uses for a method's
+ * `lambda`: lambda itself at orders 1..5; above, scaled so that the top
+ * band's penalty lambda (l(l+1))^2 stays order 5's (band 4's): the
+ * paper's orders keep their fits, and the high bands that long shadows
+ * need are not damped away (lambda 1e-4 would shrink band 15 to 8%). */
+float vb_fit_lambda(float lambda, int order);
 
 /* Gauss-Legendre nodes and weights on [-1, 1]. */
 void vb_gauss_legendre(int n, double *x, double *w);

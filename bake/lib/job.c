@@ -13,15 +13,11 @@
 
 int vb_job_cube_size(const vb_job_desc *d)
 {
-    int max_order = 0;
-    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-        if (d->bake.order_mask & (1u << o))
-            max_order = o;
-    if (d->bake.max_order > max_order)
-        max_order = d->bake.max_order;
-    if (max_order == 0)
-        max_order = VDSH_MAX_ORDER; /* bake.h: no orders asked, the highest */
-    if (max_order < 4 || d->cube_size < 0)
+    /* The cubemaps serve orders 4 and 5 (functions 9..24; vdsh_cube.h). */
+    uint32_t mask = d->bake.order_mask;
+    if (mask == 0)
+        mask = 1u << (d->bake.max_order ? d->bake.max_order : VB_DEFAULT_ORDER); /* bake.h */
+    if (!(mask & (1u << 4 | 1u << 5)) || d->cube_size < 0)
         return 0;
     return d->cube_size > 0 ? d->cube_size : DEFAULT_CUBE_SIZE;
 }

@@ -10,7 +10,8 @@
  * least-squares fit of ln d the stored distances are (a factor e^offset),
  * trading drawn shadows for fewer false ones. Chosen on the validation
  * scenes by frames (docs/ACCURACY.md). */
-static const float shadow_offsets[] = {0.0f, 1.6f, 1.6f, 1.1f, 0.9f, 0.8f};
+static const float shadow_offsets[] = {0.0f, 1.6f, 1.6f, 1.1f, 0.9f, 0.8f, 0.67f, 0.57f, 0.5f,
+                                       0.44f, 0.4f, 0.36f, 0.33f, 0.31f, 0.29f, 0.27f, 0.25f};
 _Static_assert(sizeof shadow_offsets / sizeof shadow_offsets[0] == VDSH_ORDER_SLOTS,
                "one log offset per order");
 
