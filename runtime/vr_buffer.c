@@ -196,8 +196,60 @@ static unsigned char *fixed_records(const vdsh_stream *st, vr_buffer *b, uint32_
     return dst;
 }
 
+/* The records of a stream with an order per vertex in GPU vertex order,
+ * with each GPU vertex's first texel (start) and order. The file's
+ * records are checked to be where its offsets say (a stream from memory
+ * has not been through the reader). VR_ERR_FORMAT, VR_ERR_OUT_OF_MEMORY. */
+static vr_result variable_records(const vdsh_stream *st, vr_buffer *b, uint32_t nv,
+                                  const uint32_t *remap, int floats, unsigned char **out,
+                                  size_t *bytes, uint32_t *start, uint8_t *order,
+                                  const char *name, vr_error *err)
+{
+    uint32_t *inv = malloc((size_t)nv * sizeof *inv);
+    if (!inv)
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+    size_t texels = 0, tb = texel_bytes(b->kind);
+    double sum = 0.0;
+    for (uint32_t v = 0; v < nv; v++) {
+        uint32_t k = st->orders[v];
+        if (k < 1 || k > st->order ||
+            st->offsets[v + 1] - st->offsets[v] != vdsh_record_words(st->encoding, k)) {
+            free(inv);
+            return vr_fail(err, VR_ERR_FORMAT, "%s: variable-order stream: vertex %u has "
+                           "order %u and a record of %u words", name, v, k,
+                           st->offsets[v + 1] - st->offsets[v]);
+        }
+        inv[remap[v]] = v;
+        texels += (size_t)vr_buffer_stride((int)k, b->kind);
+        sum += k;
+    }
+    unsigned char *dst = malloc(texels * tb + 16);
+    if (!dst) {
+        free(inv);
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+    }
+    float decoded[VDSH_MAX_COEFFS];
+    size_t at = 0;
+    for (uint32_t g = 0; g < nv; g++) {
+        uint32_t v = inv[g];
+        int k = st->orders[v];
+        if (floats)
+            vdsh_stream_decode(st, v, decoded);
+        pack_record(b->kind, floats, (const unsigned char *)st->data + 4 * (size_t)st->offsets[v],
+                    decoded, k, dst + at * tb);
+        start[g] = (uint32_t)at;
+        order[g] = (uint8_t)k;
+        at += (size_t)vr_buffer_stride(k, b->kind);
+    }
+    free(inv);
+    b->mean_order = nv ? (float)(sum / nv) : 0.0f;
+    *out = dst;
+    *bytes = texels * tb;
+    return VR_OK;
+}
+
 /* Create the buffer texture, the VAO and (variable) the per-vertex
- * attributes of b; 0, or 1 on a GL error (reported by the caller). */
+ * attributes of b (GL errors are the caller's to check). */
 static void make_gl(vr_scene *s, vr_buffer *b, const void *rec, size_t bytes,
                     const uint32_t *start, const uint8_t *order)
 {
@@ -252,30 +304,49 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
     if (!b.ks)
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
 
+    b.variable = (st->flags & VDSH_STREAM_VARIABLE) != 0;
+
     uint32_t nv = s->vertex_count;
+    size_t bytes = 0;
+    unsigned char *rec = NULL;
+    uint32_t *start = NULL;
+    uint8_t *korder = NULL;
+    vr_result r = VR_OK;
+    if (b.variable) {
+        start = malloc((size_t)nv * sizeof *start);
+        korder = malloc((size_t)nv + 1);
+        r = start && korder && st->orders && st->offsets
+                ? variable_records(st, &b, nv, remap, floats, &rec, &bytes, start, korder, name,
+                                   err)
+                : vr_fail(err, start && korder ? VR_ERR_FORMAT : VR_ERR_OUT_OF_MEMORY,
+                          "%s: variable-order stream without its orders", name);
+    } else {
+        rec = fixed_records(st, &b, nv, remap, floats, &bytes);
+        if (!rec)
+            r = vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory uploading order %d", name,
+                        order);
+    }
     GLint max_texels = 0;
     glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
-    size_t texels = (size_t)nv * (size_t)b.stride;
-    if (texels > (size_t)max_texels) {
-        vr_buffer_destroy(&b);
-        return vr_fail(err, VR_ERR_GL, "%s: order %d stream: %zu texels, above this GL's "
-                       "GL_MAX_TEXTURE_BUFFER_SIZE (%d)", name, order, texels, (int)max_texels);
+    size_t texels = bytes / texel_bytes(b.kind);
+    if (r == VR_OK && texels > (size_t)max_texels)
+        r = vr_fail(err, VR_ERR_GL, "%s: order %d stream: %zu texels, above this GL's "
+                    "GL_MAX_TEXTURE_BUFFER_SIZE (%d)", name, order, texels, (int)max_texels);
+    if (r == VR_OK) {
+        make_gl(s, &b, rec, bytes, start, korder);
+        r = vr_check_gl(err, name);
     }
-    size_t bytes = 0;
-    unsigned char *rec = fixed_records(st, &b, nv, remap, floats, &bytes);
-    if (!rec) {
-        vr_buffer_destroy(&b);
-        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory uploading order %d",
-                       name, order);
-    }
-    make_gl(s, &b, rec, bytes, NULL, NULL);
     free(rec);
-    vr_result r = vr_check_gl(err, name);
+    free(start);
+    free(korder);
     if (r != VR_OK) {
         vr_buffer_destroy(&b);
         return r;
     }
-    s->buffer[order] = b;
+    if (b.variable)
+        s->variable = b;
+    else
+        s->buffer[order] = b;
     s->gpu_bytes += b.bytes;
     return VR_OK;
 }

@@ -12,7 +12,9 @@
  *             holds them, 7, 9, 12, 16; f16, f32, s8, s8s6 and decoded
  *             floats; quantities distance and log-distance; three lights
  *             in a pass, in turn first (below, beside and far above the
- *             plane, so the directions cover the sphere).
+ *             plane, so the directions cover the sphere). Then streams
+ *             with an order per vertex (1..12, cap 12) in each encoding,
+ *             each vertex against C at its own order.
  *   frames    the built-in room's log-distance bake (argv[2]): the buffer
  *             path at orders 2, 3, 5 draws what the attribute path's
  *             VR_MODE_VDSH2/3/5 draw (both are the distance path): the
@@ -51,9 +53,8 @@ static float to_distance(uint32_t q, float md, float sum)
 
 /* A lattice file: vertex (i, j) at the centre of pixel (i, j) of the
  * orthographic view below, normal +z; one triangle (unused). */
-static void lattice_file(rt_file *f, uint32_t enc, uint64_t *rng)
+static void lattice_file_positions(rt_file *f)
 {
-    rt_file_init(f, NV, 1);
     f->f.header.max_distance = 4.0f;
     for (int j = 0; j < H; j++)
         for (int i = 0; i < W; i++) {
@@ -64,6 +65,12 @@ static void lattice_file(rt_file *f, uint32_t enc, uint64_t *rng)
         }
     f->idx[0] = 0, f->idx[1] = 1, f->idx[2] = 2;
     rt_file_bounds(f);
+}
+
+static void lattice_file(rt_file *f, uint32_t enc, uint64_t *rng)
+{
+    rt_file_init(f, NV, 1);
+    lattice_file_positions(f);
     for (int q = 0; q < 2; q++)
         for (int o = 0; o < NORDERS && ORDERS[o] <= VDSH_MAX_ORDER; o++) {
             int n = ORDERS[o], nc = n * n;
@@ -216,6 +223,136 @@ static void test_vertex(void)
                   t->clamped > t->checked / 100,
               "order %d: the data do not cover shadow, light and the clamp", ORDERS[o]);
     }
+    vr_renderer_destroy(r);
+}
+
+/* A variable-order stream of `quantity` added to f: orders 1..cap drawn
+ * per vertex, coefficients as lattice_file's; *coef gets the decoded
+ * coefficients (cap^2 per vertex, zeros past a vertex's own k^2) and
+ * *ord the orders. The storage goes to f->data / f->coef and `extra`. */
+static void add_variable(rt_file *f, uint32_t enc, uint32_t q, int cap, uint64_t *rng,
+                         void **extra, const float **coef, const uint8_t **ord)
+{
+    uint32_t nv = f->f.header.vertex_count, nc = (uint32_t)(cap * cap);
+    uint8_t *orders = malloc(nv);
+    uint32_t *offsets = malloc(((size_t)nv + 1) * sizeof *offsets);
+    float *c = calloc((size_t)nv * nc, sizeof(float));
+    float lo = q ? -3.0f : 0.0f, hi = q ? 5.5f : 16.0f;
+    for (uint32_t v = 0; v < nv; v++) {
+        orders[v] = (uint8_t)(1 + (int)(test_rand(rng) * cap) % cap);
+        float rest = (q ? 3.0f : 8.0f) / (float)orders[v];
+        c[(size_t)v * nc] = lo + (hi - lo) * (float)test_rand(rng);
+        for (uint32_t k = 1; k < (uint32_t)orders[v] * orders[v]; k++)
+            c[(size_t)v * nc + k] = rest * (2.0f * (float)test_rand(rng) - 1.0f);
+    }
+    vdsh_stream_offsets(orders, nv, enc, offsets);
+    float *scales = calloc(nc, sizeof(float));
+    void *data = calloc(4 * (size_t)offsets[nv] + 4, 1);
+    float scale = vdsh_encoding_quantised(enc) ? 1.0f : enc == VDSH_ENCODING_F16 ? 0.01f : 0.5f;
+    if (vdsh_encode_variable(enc, c, nc, orders, nv, (uint32_t)cap, scale, offsets, scales,
+                             data) != VDSH_OK)
+        abort();
+    uint32_t i = f->f.stream_count++;
+    vdsh_stream *st = &f->streams[i];
+    memset(st, 0, sizeof *st);
+    st->order = (uint32_t)cap;
+    st->encoding = enc;
+    st->quantity = q;
+    st->scale = scale;
+    st->quantity_param = q == VDSH_QUANTITY_LOG_DISTANCE ? 0.01f : 0.0f;
+    st->data = data;
+    st->coef_scales = vdsh_encoding_quantised(enc) ? scales : NULL;
+    st->flags = VDSH_STREAM_VARIABLE;
+    st->orders = orders;
+    st->offsets = offsets;
+    for (uint32_t v = 0; v < nv; v++)
+        vdsh_stream_decode(st, v, c + (size_t)v * nc);
+    f->data[i] = data;
+    f->coef[i] = c;
+    extra[0] = orders;
+    extra[1] = offsets;
+    extra[2] = scales;
+    *coef = c;
+    *ord = orders;
+}
+
+/* Streams with an order per vertex (cap 12), each vertex against C at
+ * its own order, in every encoding and as decoded floats. */
+static void test_variable(void)
+{
+    enum { CAP = 12 };
+    static const uint32_t enc[5] = {VDSH_ENCODING_F16, VDSH_ENCODING_F32, VDSH_ENCODING_S8,
+                                    VDSH_ENCODING_S8S6, VDSH_ENCODING_S8S6};
+    static const char *const enc_name[5] = {"f16", "f32", "s8", "s8s6", "s8s6 as floats"};
+    vr_renderer *r = NULL;
+    vr_error err;
+    vr_renderer_desc rd = {.width = W, .height = H, .color_format = VR_COLOR_RGBA32F};
+    CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
+    if (!r)
+        return;
+    uint64_t rng = 0x7a71;
+    tally t;
+    memset(&t, 0, sizeof t);
+    long per_order[CAP + 1] = {0};
+    for (int e = 0; e < 5; e++)
+        for (int q = 0; q < 2; q++) {
+            rt_file f;
+            rt_file_init(&f, NV, 1);
+            lattice_file_positions(&f);
+            void *extra[3];
+            const float *c;
+            const uint8_t *ord;
+            add_variable(&f, enc[e], QUANT[q], CAP, &rng, extra, &c, &ord);
+            vr_scene *s = NULL;
+            vr_scene_desc sd = {.file = &f.f, .quantity = QUANT[q], .buffer_floats = e == 4};
+            CHECK(vr_scene_create(&sd, &s, &err) == VR_OK, "%s", err.msg);
+            if (s) {
+                vr_scene_info info;
+                vr_scene_get_info(s, &info);
+                double mean = 0.0;
+                for (int v = 0; v < NV; v++)
+                    mean += ord[v];
+                mean /= NV;
+                CHECK(info.variable_order == CAP && fabs(info.variable_mean_order - mean) < 1e-4,
+                      "info: order %d mean %g, not %d %g", info.variable_order,
+                      (double)info.variable_mean_order, CAP, mean);
+                CHECK(vr_scene_buffer_stream(s, 0) == VR_STREAM_VARIABLE, "default stream");
+                for (int first = 0; first < 3; first++) {
+                    vr_light lights[3];
+                    memset(lights, 0, sizeof lights);
+                    for (int i = 0; i < 3; i++)
+                        memcpy(lights[i].position, LIGHTS[(first + i) % 3], sizeof LIGHTS[0]);
+                    vr_draw_desc d = lattice_view();
+                    d.stream = VR_STREAM_VARIABLE;
+                    d.lights = lights;
+                    d.light_count = 3;
+                    rt_draw_or_die(r, s, &d);
+                    float *px = rt_read(r, W, H);
+                    char what[96];
+                    snprintf(what, sizeof what, "variable, %s, %s, light %d", enc_name[e],
+                             vdsh_quantity_name(QUANT[q]), first);
+                    for (int k = 0; k < NV; k++) {
+                        check_vertex(&t, what, QUANT[q], f.f.header.max_distance, ord[k],
+                                     c + (size_t)k * CAP * CAP, f.pos + 3 * k, LIGHTS[first],
+                                     px + 4 * k);
+                        per_order[ord[k]]++;
+                    }
+                    free(px);
+                }
+                vr_scene_destroy(s);
+            }
+            for (int i = 0; i < 3; i++)
+                free(extra[i]);
+            rt_file_free(&f);
+        }
+    printf("variable (cap %d): %ld receivers checked (s = 0: %ld, s = 1: %ld, clamped: %ld), "
+           "%ld wrong; largest |GPU - C| sum / max(1, sum |c_i|): %.2g\n", CAP, t.checked,
+           t.zero, t.one, t.clamped, t.bad, t.worst);
+    CHECK(t.bad == 0, "variable: %ld receivers disagree", t.bad);
+    CHECK(t.zero > t.checked / 50 && t.one > t.checked / 50 && t.clamped > t.checked / 100,
+          "variable: the data do not cover shadow, light and the clamp");
+    for (int k = 1; k <= CAP; k++)
+        CHECK(per_order[k] > 1000, "variable: order %d: %ld vertices", k, per_order[k]);
     vr_renderer_destroy(r);
 }
 
@@ -374,8 +511,10 @@ int main(int argc, char **argv)
         return 2;
     }
     vr_context *ctx = rt_context_or_skip(argv[1]);
-    if (!strcmp(argv[1], "vertex"))
+    if (!strcmp(argv[1], "vertex")) {
         test_vertex();
+        test_variable();
+    }
     else if (!strcmp(argv[1], "frames"))
         test_frames(argv[2]);
     else
