@@ -23,6 +23,8 @@
  *   errors    what a scene holds and says: buffers only where asked,
  *             vr_scene_buffer_stream, the bytes uploaded, VR_ERR_MISSING
  *             for a stream it does not have.
+ *   derive    not a test: writes a file with orders 7, 9, 12 and an
+ *             order per vertex for the frame test (tests/frames.cmake).
  * Exit 77 without a GL context.
  */
 #include "test_runtime_util.h"
@@ -503,11 +505,123 @@ done:
     vr_scene_destroy(floats);
 }
 
+/* A deterministic value in [-1, 1] for (vertex, index). */
+static float hash_unit(uint32_t v, uint32_t i)
+{
+    uint64_t x = ((uint64_t)v << 32 | i) * 0x9e3779b97f4a7c15ull;
+    x ^= x >> 29;
+    x *= 0xbf58476d1ce4e5b9ull;
+    x ^= x >> 32;
+    return (float)(x & 0xffffff) / (float)0x7fffff - 1.0f;
+}
+
+/* derive IN OUT: IN's streams and, from its log-distance order-5 stream,
+ * fixed streams of orders 7 (f16), 9 (s8s6) and 12 (s8) and one with an
+ * order per vertex up to 11 (s8s6; k = 1 + (7v mod 11)): each keeps the
+ * order-5 coefficients and adds small deterministic ones above band 4
+ * (1 / l), so that every band changes the frames. Frames of these (vdsh-frames
+ * truth against vdsh-view's buffer modes) check the GL path at orders the
+ * baker has not made yet. Exit 0, or 1 naming the file. */
+static int derive(const char *in, const char *out)
+{
+    vdsh_file *f = NULL;
+    vdsh_error ve;
+    if (vdsh_read(in, &f, &ve) != VDSH_OK) {
+        fprintf(stderr, "derive: %s\n", ve.msg);
+        return 1;
+    }
+    const vdsh_stream *base = vdsh_find_stream(f, 5, VDSH_QUANTITY_LOG_DISTANCE);
+    if (!base || f->stream_count + 4 > VDSH_MAX_STREAMS) {
+        fprintf(stderr, "derive: %s: no log-distance order-5 stream, or no room\n", in);
+        vdsh_free(f);
+        return 1;
+    }
+    enum { NEW = 4 };
+    static const uint32_t orders[NEW] = {7, 9, 12, 11};
+    static const uint32_t encs[NEW] = {VDSH_ENCODING_F16, VDSH_ENCODING_S8S6, VDSH_ENCODING_S8,
+                                       VDSH_ENCODING_S8S6};
+    uint32_t nv = f->header.vertex_count, cap2 = 12 * 12;
+    vdsh_stream streams[VDSH_MAX_STREAMS];
+    memcpy(streams, f->streams, f->stream_count * sizeof *streams);
+    float *c = malloc((size_t)nv * cap2 * sizeof(float));
+    void *mem[NEW][4] = {{0}};
+    int rc = c ? 0 : 1;
+    for (int n = 0; n < NEW && !rc; n++) {
+        uint32_t k = orders[n], nc = k * k;
+        for (uint32_t v = 0; v < nv; v++) {
+            float c5[VDSH_MAX_COEFFS];
+            vdsh_stream_decode(base, v, c5);
+            for (uint32_t i = 0; i < nc; i++) {
+                int l = (int)sqrtf((float)i);
+                c[(size_t)v * nc + i] = i < 25 ? c5[i] : 1.0f / (float)l * hash_unit(v, i);
+            }
+        }
+        vdsh_stream *st = &streams[f->stream_count + (uint32_t)n];
+        *st = *base;
+        st->order = k;
+        st->encoding = encs[n];
+        float *scales = calloc(nc, sizeof(float));
+        mem[n][0] = scales;
+        if (n < 3) {
+            size_t bytes = (size_t)nv * vdsh_encoding_bytes(encs[n], nc);
+            void *data = calloc(bytes + 4, 1);
+            mem[n][1] = data;
+            float mx = 0.0f;
+            for (size_t i = 0; i < (size_t)nv * nc; i++)
+                mx = fmaxf(mx, fabsf(c[i]));
+            st->scale = encs[n] == VDSH_ENCODING_F16 ? mx : 1.0f;
+            vdsh_result r = encs[n] == VDSH_ENCODING_F16
+                                ? vdsh_encode_f16(c, (size_t)nv * nc, mx, data)
+                                : vdsh_encode_quantised(encs[n], c, nv, nc, scales, data);
+            rc = r != VDSH_OK;
+            st->data = data;
+            st->coef_scales = encs[n] == VDSH_ENCODING_F16 ? NULL : scales;
+        } else {
+            uint8_t *ko = malloc(nv);
+            uint32_t *off = malloc(((size_t)nv + 1) * sizeof *off);
+            mem[n][2] = ko;
+            mem[n][3] = off;
+            for (uint32_t v = 0; v < nv; v++)
+                ko[v] = (uint8_t)(1 + (7 * v) % k);
+            vdsh_stream_offsets(ko, nv, encs[n], off);
+            void *data = calloc(4 * (size_t)off[nv] + 4, 1);
+            mem[n][1] = data;
+            rc = vdsh_encode_variable(encs[n], c, nc, ko, nv, k, 1.0f, off, scales, data) !=
+                 VDSH_OK;
+            st->scale = 1.0f;
+            st->data = data;
+            st->coef_scales = scales;
+            st->flags = VDSH_STREAM_VARIABLE;
+            st->orders = ko;
+            st->offsets = off;
+        }
+    }
+    if (!rc) {
+        vdsh_file g = *f;
+        g.streams = streams;
+        g.stream_count = f->stream_count + NEW;
+        if (vdsh_write(out, &g, &ve) != VDSH_OK) {
+            fprintf(stderr, "derive: %s\n", ve.msg);
+            rc = 1;
+        }
+    } else
+        fprintf(stderr, "derive: %s: cannot encode the derived streams\n", out);
+    for (int n = 0; n < NEW; n++)
+        for (int k = 0; k < 4; k++)
+            free(mem[n][k]);
+    free(c);
+    vdsh_free(f);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 4 && !strcmp(argv[1], "derive"))
+        return derive(argv[2], argv[3]);
     if (argc != 3 || (strcmp(argv[1], "vertex") && strcmp(argv[1], "frames") &&
                       strcmp(argv[1], "errors"))) {
-        fprintf(stderr, "usage: test_runtime_buffer vertex|frames|errors SCENE.vdsh\n");
+        fprintf(stderr, "usage: test_runtime_buffer vertex|frames|errors SCENE.vdsh\n"
+                        "       test_runtime_buffer derive IN.vdsh OUT.vdsh\n");
         return 2;
     }
     vr_context *ctx = rt_context_or_skip(argv[1]);
