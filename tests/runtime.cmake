@@ -424,8 +424,33 @@ expect 2 "positive count" --frames "$d/x" "$room"
 "$t" lights "$room"
 ]=] sh ${_view} $<TARGET_FILE:test_runtime_frames> ${_room} ${_room_log} ${_rt_dir}/view_frames)
 
+# The buffer modes on the command line: a file with orders 7, 9, 12 and an
+# order per vertex (test_runtime_buffer derive); the grid gains its
+# adaptive-order column (6 panels) and says so; --help names the modes.
+add_test(NAME runtime_view_buffer COMMAND sh -c [=[
+set -e
+v=$1; png=$2; derive=$3; log=$4; d=$5
+rm -rf "$d"; mkdir -p "$d"
+"$derive" derive "$log" "$d/high.vdsh"
+for m in buf7 buf12 adaptive buffer; do
+  "$v" -q --render "$d/$m.png" --size 96x72 --mode $m --lights 3 "$d/high.vdsh"
+  "$png" info "$d/$m.png" 96 72
+done
+"$v" --render "$d/a.png" --size 96x72 --mode adaptive "$d/high.vdsh" 2> "$d/render.log"
+cat "$d/render.log"
+grep -q "VDSH adaptive order (up to 11, mean 6.0" "$d/render.log"
+"$v" --grid "$d/grid.png" --size 96x72 "$d/high.vdsh" "$log" 2> "$d/grid.log"
+cat "$d/grid.log"
+"$png" info "$d/grid.png" 576 144
+grep -q "| adaptive" "$d/grid.log"
+"$v" --grid "$d/grid5.png" --size 96x72 "$log" 2> /dev/null
+"$png" info "$d/grid5.png" 480 72
+"$v" --help | grep -q "bufN the stream of order N"
+"$v" --help | grep -q "adaptive-order column\|| adaptive order"
+]=] sh ${_view} ${_png} $<TARGET_FILE:test_runtime_buffer> ${_room_log} ${_rt_dir}/view_buffer)
+
 foreach(t runtime_view_usage runtime_view_errors runtime_view_render runtime_view_bench
-          runtime_view_frame runtime_view_window runtime_view_frames)
+          runtime_view_frame runtime_view_window runtime_view_frames runtime_view_buffer)
   if(TEST ${t})
     _runtime_props(${t} FIXTURES_REQUIRED runtime_room)
   endif()
