@@ -256,6 +256,10 @@ static void bench_print(const vv_options *o, const bench_scene *b, int all_round
             vt_json_string(j, r, "path", interp >= 0 ? vdsh_interp_name((uint32_t)interp)
                                                      : b->modes[m].name);
             vt_json_f64(j, r, "median_cpu_ms", sorted[rounds / 2]);
+            if (b->modes[m].mode == VR_MODE_VDSH_BUFFER)
+                vt_json_u64(j, r, "buffer_bytes",
+                            vr_scene_buffer_bytes(b->modes[m].floats ? b->floats : b->scene,
+                                                  b->modes[m].stream));
             json_series(j, r, "cpu_ms", b->cpu[ls][m], rounds);
             json_series(j, r, "process_cpu_ms", b->proc[ls][m], rounds);
             json_series(j, r, "gpu_ms", b->gpu[ls][m], rounds);

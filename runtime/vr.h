@@ -317,6 +317,9 @@ int vr_scene_supports(const vr_scene *s, vr_mode m);
  * else its highest buffered order; returns that (VR_STREAM_VARIABLE or an
  * order), or 0 when the scene has no such stream. */
 int vr_scene_buffer_stream(const vr_scene *s, int stream);
+/* GPU bytes of that stream's buffers (records, and for a stream with an
+ * order per vertex its 5 bytes of attributes per vertex); 0 without it. */
+size_t vr_scene_buffer_bytes(const vr_scene *s, int stream);
 /* The path (vdsh_interp) a VDSH mode draws this scene's stream with:
  * vdsh_runtime_interp(order, quantity drawn); -1 for modes none and cube. */
 int vr_scene_interp(const vr_scene *s, vr_mode m);

@@ -445,6 +445,12 @@ int vr_scene_buffer_stream(const vr_scene *s, int stream)
     return vr_scene_buffer(s, stream) ? stream : 0;
 }
 
+size_t vr_scene_buffer_bytes(const vr_scene *s, int stream)
+{
+    const vr_buffer *b = vr_scene_buffer(s, stream);
+    return b ? b->bytes : 0;
+}
+
 const vr_buffer *vr_scene_buffer(const vr_scene *s, int stream)
 {
     if (stream == 0)

@@ -319,6 +319,19 @@ static void test_variable(void)
                       "info: order %d mean %g, not %d %g", info.variable_order,
                       (double)info.variable_mean_order, CAP, mean);
                 CHECK(vr_scene_buffer_stream(s, 0) == VR_STREAM_VARIABLE, "default stream");
+                /* records padded to whole texels, plus 5 bytes of attributes */
+                size_t want = 5 * (size_t)NV;
+                for (int v = 0; v < NV; v++) {
+                    size_t nc = (size_t)ord[v] * ord[v], t4 = (nc + 3) / 4;
+                    want += e == 4 ? 16 * t4
+                            : enc[e] == VDSH_ENCODING_S8S6
+                                ? 4 * ((vdsh_encoding_bytes(enc[e], (uint32_t)nc) + 3) / 4)
+                                : t4 * vdsh_encoding_bytes(enc[e], 4);
+                }
+                CHECK(vr_scene_buffer_bytes(s, VR_STREAM_VARIABLE) == want &&
+                          info.buffer_bytes == want,
+                      "%s: %zu buffer bytes, not %zu", enc_name[e],
+                      vr_scene_buffer_bytes(s, VR_STREAM_VARIABLE), want);
                 for (int first = 0; first < 3; first++) {
                     vr_light lights[3];
                     memset(lights, 0, sizeof lights);
@@ -470,6 +483,12 @@ static void test_errors(const char *path)
         top = (int)st->order > top ? (int)st->order : top;
     }
     CHECK(bi.buffer_bytes == want, "buffer bytes %zu, not %zu", bi.buffer_bytes, want);
+    size_t each = 0;
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+        each += vr_scene_buffer_bytes(buffered, o);
+    CHECK(each == want && vr_scene_buffer_bytes(plain, top) == 0 &&
+              vr_scene_buffer_bytes(buffered, VR_STREAM_VARIABLE) == 0,
+          "vr_scene_buffer_bytes: %zu in all, not %zu", each, want);
     CHECK(fi.buffer_bytes == want_f, "float buffer bytes %zu, not %zu", fi.buffer_bytes, want_f);
     CHECK(bi.gpu_bytes == pi.gpu_bytes + want, "gpu bytes %zu, not %zu + %zu", bi.gpu_bytes,
           pi.gpu_bytes, want);
