@@ -60,14 +60,17 @@
  *                       reads its own record from a buffer texture (by
  *                       gl_VertexID; a variable-order stream's vertices
  *                       carry their order and record offset as integer
- *                       attributes), in the file's encoding (f32 and f16
- *                       as R32F / R16F texels, s8 as R8I times a step per
- *                       coefficient index, s8s6 as R32UI words unpacked
- *                       in the shader: vdsh_stream_decode's products), and
- *                       evaluates its k^2 basis functions by the
- *                       associated-Legendre recurrence of formats/vdsh_sh.c
- *                       (bands 0..k-1, the same convention), each
- *                       coefficient fetched once for all lights of a pass.
+ *                       attributes), in the file's encoding and values,
+ *                       reordered as the shader reads them (f32, f16 as
+ *                       RGBA32F / RGBA16F texels, s8 as RGBA8I times a
+ *                       step per coefficient index, s8s6 as R32UI words
+ *                       unpacked in the shader: vdsh_stream_decode's
+ *                       products; runtime/vr_buffer.c), and evaluates its
+ *                       k^2 basis functions by the associated-Legendre
+ *                       recurrence of formats/vdsh_sh.c (bands 0..k-1, the
+ *                       same convention), each coefficient fetched once for
+ *                       all lights of a pass. Streams of orders 1-5 are
+ *                       buffered only with vr_scene_desc.buffers.
  * Log-distance streams (vdsh-bake --log) are drawn differently by every
  * VDSH mode: each vertex sums all its coefficients toward the light and
  * takes exp (its distance toward the light), the distances are
