@@ -18,8 +18,9 @@
  * file's: an f16 order-12 stream is 288 bytes per vertex, against 576 as
  * decoded floats (desc->buffer_floats, kept for comparisons).
  *
- * Per coefficient index i the shader multiplies by a factor (u_ks, a
- * uniform of the program): K_l^|m| of the basis (sqrt 2 folded in for
+ * Per coefficient index i the shader multiplies by a factor (KS, a
+ * constant table in the program's source, one program per table; the
+ * program key holds its hash): K_l^|m| of the basis (sqrt 2 folded in for
  * m != 0, computed in double as formats/vdsh_sh.c does) times, for s8 and
  * s8s6, the step vdsh_quant_step(scale_i, levels_i), so that q_i * step_i
  * is the coefficient vdsh_stream_decode computes.
@@ -303,6 +304,12 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
     b.ks = make_ks(st, order, floats);
     if (!b.ks)
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+    /* FNV-1a over the order and the table's bits */
+    b.ks_hash = 1469598103934665603ull ^ (uint64_t)order;
+    for (size_t i = 0; i < (size_t)order * (size_t)order * sizeof(float); i++) {
+        b.ks_hash ^= ((const unsigned char *)b.ks)[i];
+        b.ks_hash *= 1099511628211ull;
+    }
 
     b.variable = (st->flags & VDSH_STREAM_VARIABLE) != 0;
 

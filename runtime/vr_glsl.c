@@ -607,12 +607,11 @@ static void key_defines(const vr_program_key *k, int flat, char *buf, size_t siz
                      "#define PCF %u\n#define NUM_LIGHTS %u\n#define FLAT_LIGHTS %d\n"
                      "#define PACKED %d\n#define BUFFER %d\n#define BUF_ORDER %u\n"
                      "#define BUF_KIND %u\n#define BUF_VARIABLE %u\n#define BUF_STRIDE %d\n"
-                     "#define BUF_KS %d\n#define FOR_EACH_LIGHT",
+                     "#define FOR_EACH_LIGHT",
                      order, visibility, split, distance, cubemap, cube, k->quantity, k->compare,
                      k->output, k->pcf, k->lights, flat, k->packed && order >= 3, buffer,
                      k->buf_order, k->buf_kind, k->buf_variable,
-                     buffer ? vr_buffer_stride(k->buf_order, (vr_buf_kind)k->buf_kind) : 0,
-                     (k->buf_order * k->buf_order + 3) / 4);
+                     buffer ? vr_buffer_stride(k->buf_order, (vr_buf_kind)k->buf_kind) : 0);
     for (unsigned i = 0; i < k->lights && n > 0 && (size_t)n < size; i++)
         n += snprintf(buf + n, size - (size_t)n, " LIGHT(%u)", i);
     if (n > 0 && (size_t)n < size)
@@ -671,7 +670,22 @@ vr_result vr_link(const char *name, const char *vs, const char *fs,
     return VR_OK;
 }
 
-vr_result vr_program_build(const vr_program_key *key, vr_program *out,
+/* The buffer path's factor table as GLSL: "const float KS[n] = ...". */
+static char *ks_table(const float *ks, int n)
+{
+    size_t size = 64 + 18 * (size_t)n;
+    char *t = malloc(size);
+    if (!t)
+        return NULL;
+    int len = snprintf(t, size, "const float KS[%d] = float[%d](", n, n);
+    for (int i = 0; i < n && len > 0 && (size_t)len < size; i++)
+        len += snprintf(t + len, size - (size_t)len, "%s%.9e", i ? ", " : "", (double)ks[i]);
+    if (len > 0 && (size_t)len < size)
+        snprintf(t + len, size - (size_t)len, ");\n");
+    return t;
+}
+
+vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_program *out,
                            vr_error *err)
 {
     char name[224], defines[1024];
@@ -684,7 +698,7 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
         !(interp == VDSH_INTERP_SPLIT && order == 5))
         return vr_fail(err, VR_ERR_SHADER, "%s: the runtime has no shaders for this path", name);
     int buffer = key->mode == VR_MODE_VDSH_BUFFER;
-    if (buffer && (key->buf_order < 1 || key->buf_order > VDSH_MAX_ORDER))
+    if (buffer && (key->buf_order < 1 || key->buf_order > VDSH_MAX_ORDER || !ks))
         return vr_fail(err, VR_ERR_SHADER, "%s: no buffer order", name);
     GLint max_varying = 0;
     glGetIntegerv(GL_MAX_VARYING_COMPONENTS, &max_varying);
@@ -692,13 +706,15 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
 
     /* The buffer path's code goes between the vertex stage's
      * declarations and its main(). */
+    char *table = buffer ? ks_table(ks, key->buf_order * key->buf_order) : NULL;
     size_t vs_size = sizeof defines + sizeof common_glsl + sizeof vertex_glsl +
-                     vr_buffer_glsl_size + sizeof vertex_main_glsl;
+                     (table ? strlen(table) : 0) + vr_buffer_glsl_size + sizeof vertex_main_glsl;
     size_t fs_size = sizeof defines + sizeof common_glsl + sizeof fragment_glsl;
     char *vs = malloc(vs_size), *fs = malloc(fs_size);
-    if (!vs || !fs) {
+    if (!vs || !fs || (buffer && !table)) {
         free(vs);
         free(fs);
+        free(table);
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
     }
     /* A driver that packs varyings less tightly than the component count
@@ -707,8 +723,8 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     vr_result r;
     for (;; flat = 0) {
         key_defines(key, flat, defines, sizeof defines);
-        snprintf(vs, vs_size, "%s%s%s%s%s", defines, common_glsl, vertex_glsl,
-                 buffer ? vr_buffer_glsl : "", vertex_main_glsl);
+        snprintf(vs, vs_size, "%s%s%s%s%s%s", defines, common_glsl, vertex_glsl,
+                 buffer ? table : "", buffer ? vr_buffer_glsl : "", vertex_main_glsl);
         snprintf(fs, fs_size, "%s%s%s", defines, common_glsl, fragment_glsl);
         r = vr_link(name, vs, fs, &prog, err);
         if (r != VR_ERR_SHADER || !flat)
@@ -716,6 +732,7 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     }
     free(vs);
     free(fs);
+    free(table);
     if (r != VR_OK)
         return r;
 
@@ -730,7 +747,6 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     p.u_ambient = glGetUniformLocation(prog, "u_ambient");
     p.u_shadow_nf = glGetUniformLocation(prog, "u_shadow_nf");
     p.u_shadow_texel = glGetUniformLocation(prog, "u_shadow_texel");
-    p.u_ks = glGetUniformLocation(prog, "u_ks");
 
     /* Samplers never change unit: set them once. */
     glUseProgram(prog);

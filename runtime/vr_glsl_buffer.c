@@ -15,8 +15,12 @@
  * here, where the C evaluation uses its closed forms below band 5: the
  * two agree to float rounding (tests/test_runtime_buffer.c measures it).
  * The normalisations K_l^m (sqrt 2 folded in for m != 0), times an s8 or
- * s8s6 stream's steps, come as a uniform per coefficient index (u_ks,
- * vr_buffer.c).
+ * s8s6 stream's steps, come as a constant table per coefficient index,
+ * written into the source (KS, vr_buffer.c and vr_glsl.c: a program per
+ * table). Read from a uniform array instead, the lookups cost as much as
+ * the texel fetches on llvmpipe (its bounds-checked gathers; about 17 ms
+ * a frame of the paper-sized room at order 12), from the constant table
+ * about 4.
  *
  * The loops run m outside and l inside, and each light's recurrence state
  * lives in small arrays, so that each coefficient is fetched (and for s8,
@@ -37,8 +41,7 @@ const char vr_buffer_glsl[] =
     "#else\n"
     "uniform samplerBuffer u_coef;\n"
     "#endif\n"
-    "/* per coefficient index: K_l^m (and an s8, s8s6 stream's step) */\n"
-    "uniform vec4 u_ks[BUF_KS];\n"
+
     "#if BUF_VARIABLE\n"
     "layout(location = 9) in uint a_record;  /* the record's first texel */\n"
     "layout(location = 10) in uint a_order;  /* this vertex's order */\n"
@@ -66,10 +69,11 @@ const char vr_buffer_glsl[] =
     "#endif\n"
     "}\n"
     "\n"
-    "/* The next coefficient, whose index is i, times u_ks[i]. */\n"
+    "/* The next coefficient, whose index is i, times KS[i]: K_l^m (and an\n"
+    " * s8, s8s6 stream's step), a constant table (vr_glsl.c). */\n"
     "float buf_next(int i)\n"
     "{\n"
-    "    float ks = u_ks[i >> 2][i & 3];\n"
+    "    float ks = KS[i];\n"
     "#if BUF_KIND == 3\n"
     "    if (i < 4)\n"
     "        return ks * float(int(b_w0 << uint(24 - 8 * i)) >> 24);\n"

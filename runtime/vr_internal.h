@@ -84,7 +84,9 @@ typedef struct vr_buffer {
     float scale;             /* multiplies the sums (f32, f16), else 1 */
     int stride;              /* fixed: texels per vertex */
     GLuint buf, tex;         /* the records, in the GPU vertex order */
-    float *ks;               /* u_ks: per coefficient index, K_l^m x step */
+    float *ks;               /* per coefficient index, K_l^m x step: a
+                                constant table of the program (vr_glsl.c) */
+    uint64_t ks_hash;        /* of ks and the order (the program key) */
     GLuint vbo_record, vbo_order; /* variable: per vertex, u32 and u8 */
     GLuint vao;
     size_t bytes;            /* all of the above */
@@ -134,8 +136,10 @@ const vr_buffer *vr_scene_buffer(const vr_scene *s, int stream);
 vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count,
                               const char *name, vr_error *err);
 
-/* Which program: everything that changes the shader source. */
+/* Which program: everything that changes the shader source. Compared
+ * with memcmp: make it with memset(0) first (padding included). */
 typedef struct vr_program_key {
+    uint64_t ks_hash;   /* VR_MODE_VDSH_BUFFER: of its factor table (vr_buffer.ks) */
     uint8_t mode;       /* vr_mode, resolved (never DEFAULT) */
     uint8_t compare;    /* vdsh_compare */
     uint8_t quantity;   /* vdsh_quantity */
@@ -163,12 +167,14 @@ typedef struct vr_program {
     vr_program_key key;
     GLuint prog;
     GLint u_view_proj, u_scale, u_coef_step, u_max_distance, u_light_pos, u_light_color, u_light_att;
-    GLint u_ambient, u_shadow_nf, u_shadow_texel, u_ks;
+    GLint u_ambient, u_shadow_nf, u_shadow_texel;
 } vr_program;
 
-/* Compile and link the lighting program for `key`. On failure returns
- * VR_ERR_SHADER with the info log (and the key) in err; *out untouched. */
-vr_result vr_program_build(const vr_program_key *key, vr_program *out,
+/* Compile and link the lighting program for `key` (ks: the buffer
+ * stream's factor table, buf_order^2 entries; NULL for other modes). On
+ * failure returns VR_ERR_SHADER with the info log (and the key) in err;
+ * *out untouched. */
+vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_program *out,
                            vr_error *err);
 
 /* The depth-only program that renders cube shadow map faces

@@ -352,8 +352,8 @@ void vr_renderer_timings(vr_renderer *r, vr_timings *out)
 /* ------------------------------------------------------------------ */
 /* Programs                                                             */
 
-static vr_result get_program(vr_renderer *r, const vr_program_key *k, const vr_program **out,
-                             vr_error *err)
+static vr_result get_program(vr_renderer *r, const vr_program_key *k, const float *ks,
+                             const vr_program **out, vr_error *err)
 {
     for (int i = 0; i < r->program_count; i++)
         if (memcmp(&r->programs[i].key, k, sizeof *k) == 0) {
@@ -367,7 +367,7 @@ static vr_result get_program(vr_renderer *r, const vr_program_key *k, const vr_p
             glDeleteProgram(r->programs[i].prog);
         r->program_count = 0;
     }
-    vr_result res = vr_program_build(k, &r->programs[r->program_count], err);
+    vr_result res = vr_program_build(k, ks, &r->programs[r->program_count], err);
     if (res != VR_OK)
         return res;
     *out = &r->programs[r->program_count++];
@@ -630,18 +630,23 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                 break;
         }
 
-        vr_program_key key = {(uint8_t)mode, (uint8_t)d.compare, (uint8_t)s->quantity,
-                              (uint8_t)d.output, (uint8_t)(d.pcf ? 1 : 0), (uint8_t)n, 0, 0, 0, 0};
-        if (mode != VR_MODE_CUBE)
-            key.pcf = 0;
+        vr_program_key key;
+        memset(&key, 0, sizeof key);
+        key.mode = (uint8_t)mode;
+        key.compare = (uint8_t)d.compare;
+        key.quantity = (uint8_t)s->quantity;
+        key.output = (uint8_t)d.output;
+        key.pcf = (uint8_t)(d.pcf && mode == VR_MODE_CUBE);
+        key.lights = (uint8_t)n;
         key.packed = order && s->encoding[order] == VDSH_ENCODING_S8S6;
         if (buf) {
             key.buf_order = (uint8_t)buf->order;
             key.buf_kind = (uint8_t)buf->kind;
             key.buf_variable = (uint8_t)buf->variable;
+            key.ks_hash = buf->ks_hash;
         }
         const vr_program *p = NULL;
-        res = get_program(r, &key, &p, err);
+        res = get_program(r, &key, buf ? buf->ks : NULL, &p, err);
         if (res != VR_OK)
             break;
 
@@ -707,7 +712,6 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
         if (buf) {
             glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
             glBindTexture(GL_TEXTURE_BUFFER, buf->tex);
-            glUniform4fv(p->u_ks, (buf->order * buf->order + 3) / 4, buf->ks);
         }
         glActiveTexture(GL_TEXTURE0);
         glBindVertexArray(buf ? buf->vao : s->vao[order]);
