@@ -3,6 +3,7 @@
 
 #include <assert.h>
 #include <math.h>
+#include <pthread.h>
 #include <string.h>
 
 /* An AVX2 clone of the batch loops, chosen at run time where the CPU has
@@ -137,17 +138,35 @@ static inline __attribute__((always_inline)) void soa_dispatch(
     }
 }
 
+/* K_l^m of bands 5 and up (sqrt(2) folded in for m != 0), index
+ * l(l+1)+m for m >= 0, computed once in double. */
+static float k_high[VDSH_MAX_COEFFS];
+static pthread_once_t k_high_once = PTHREAD_ONCE_INIT;
+
+static void k_high_init(void)
+{
+    for (int l = KERNEL_ORDER; l < VDSH_MAX_ORDER; l++)
+        for (int m = 0; m <= l; m++) {
+            double kk = (2.0 * l + 1.0) / (4.0 * 3.14159265358979323846);
+            for (int f = l - m + 1; f <= l + m; f++)
+                kk /= f;
+            k_high[l * (l + 1) + m] = (float)sqrt(m ? 2.0 * kk : kk);
+        }
+}
+
 /* Bands 5 .. order-1 (order <= VDSH_MAX_ORDER) by the standard
  * recurrence, in the same convention as bands 0-4 (Condon-Shortley phase,
- * sin for m < 0): Y_l^m = K_l^m P_l^|m|(z) (sqrt 2 Re or Im (x + iy)^|m|),
+ * sin for m < 0): Y_l^m = K_l^m P_l^m(z) (sqrt 2 Re or Im (x + iy)^m),
  * P_l^m here without its (1 - z^2)^(m/2) factor, which (x + iy)^m carries.
  * Directions in chunks, each step a loop over the chunk, so it vectorises
- * over directions like the kernel above. */
+ * over directions like the kernel above. With acc, out[i] += w Y_i (the
+ * projection), else out[i] = Y_i. */
 static inline __attribute__((always_inline)) void eval_high_bands(
-    int order, size_t n, const float *x, const float *y, const float *z, float *out,
-    size_t stride)
+    int order, size_t n, const float *x, const float *y, const float *z, const float *w,
+    float *out, size_t stride, int acc)
 {
     enum { CHUNK = 64 };
+    pthread_once(&k_high_once, k_high_init);
     for (size_t k0 = 0; k0 < n; k0 += CHUNK) {
         size_t cn = n - k0 < CHUNK ? n - k0 : CHUNK;
         const float *xs = x + k0, *ys = y + k0, *zs = z + k0;
@@ -180,20 +199,30 @@ static inline __attribute__((always_inline)) void eval_high_bands(
                 memcpy(p1, pl, cn * sizeof *p1);
                 if (l < KERNEL_ORDER)
                     continue; /* the closed forms above */
-                double kk = (2.0 * l + 1.0) / (4.0 * 3.14159265358979323846);
-                for (int f = l - m + 1; f <= l + m; f++)
-                    kk /= f;
-                float K = (float)sqrt(kk), K2 = (float)sqrt(2.0 * kk);
+                float K = k_high[l * (l + 1) + m];
                 float *pos = out + (size_t)(l * (l + 1) + m) * stride + k0;
                 float *neg = out + (size_t)(l * (l + 1) - m) * stride + k0;
-                if (m == 0)
+                if (acc) {
+                    const float *ws = w + k0;
+                    if (m == 0)
+                        for (size_t k = 0; k < cn; k++)
+                            pos[k] += ws[k] * (K * pl[k]);
+                    else
+                        for (size_t k = 0; k < cn; k++) {
+                            float kp = K * pl[k];
+                            pos[k] += ws[k] * (kp * c[k]);
+                            neg[k] += ws[k] * (kp * sn[k]);
+                        }
+                } else if (m == 0) {
                     for (size_t k = 0; k < cn; k++)
                         pos[k] = K * pl[k];
-                else
+                } else {
                     for (size_t k = 0; k < cn; k++) {
-                        pos[k] = K2 * pl[k] * c[k];
-                        neg[k] = K2 * pl[k] * sn[k];
+                        float kp = K * pl[k];
+                        pos[k] = kp * c[k];
+                        neg[k] = kp * sn[k];
                     }
+                }
             }
         }
     }
@@ -205,7 +234,7 @@ VDSH_CLONES void vdsh_sh_eval_soa(int order, size_t n, const float *x, const flo
     assert(order >= 1 && order <= VDSH_MAX_ORDER);
     soa_dispatch(order < KERNEL_ORDER ? order : KERNEL_ORDER, n, x, y, z, NULL, out, out_stride, 0);
     if (order > KERNEL_ORDER)
-        eval_high_bands(order, n, x, y, z, out, out_stride);
+        eval_high_bands(order, n, x, y, z, NULL, out, out_stride, 0);
 }
 
 VDSH_CLONES void vdsh_sh_project_soa(int order, size_t n, const float *x, const float *y,
@@ -216,21 +245,7 @@ VDSH_CLONES void vdsh_sh_project_soa(int order, size_t n, const float *x, const 
     soa_dispatch(order < KERNEL_ORDER ? order : KERNEL_ORDER, n, x, y, z, w, acc, acc_stride, 1);
     if (order <= KERNEL_ORDER)
         return;
-    /* Bands 5 and up: evaluated into a block of HIGH_CHUNK directions,
-     * then weighted and added, each sum in direction order. */
-    enum { HIGH_CHUNK = 16 };
-    float t[VDSH_MAX_COEFFS * HIGH_CHUNK];
-    const int lo = KERNEL_ORDER * KERNEL_ORDER, hi = order * order;
-    for (size_t k0 = 0; k0 < n; k0 += HIGH_CHUNK) {
-        size_t cn = n - k0 < HIGH_CHUNK ? n - k0 : HIGH_CHUNK;
-        eval_high_bands(order, cn, x + k0, y + k0, z + k0, t, HIGH_CHUNK);
-        for (int i = lo; i < hi; i++) {
-            float *a = acc + (size_t)i * acc_stride + k0;
-            const float *ti = t + (size_t)i * HIGH_CHUNK;
-            for (size_t k = 0; k < cn; k++)
-                a[k] += w[k0 + k] * ti[k];
-        }
-    }
+    eval_high_bands(order, n, x, y, z, w, acc, acc_stride, 1); /* bands 5 and up */
 }
 
 float vdsh_sh_reconstruct(int order, const float *c, const float d[3])

@@ -613,6 +613,107 @@ static void test_ranges(void)
     test_mesh_free(&rec);
 }
 
+/* Adaptive order (bake.h, order_tolerance): receivers on the ground
+ * around a box. Every receiver's variable-order coefficients are, bit for
+ * bit, the fixed stream's of its chosen order (one projection serves
+ * both); chosen orders are candidates; a tolerance of +inf gives order 1
+ * everywhere and a tiny one the order of least error, which is not order
+ * 1 everywhere next to a box; 1 and 2 threads, and a range, agree bit for
+ * bit; a method without a log distance is refused. */
+static void test_adaptive_order(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    test_make_box(&occ, 1, 2, 1);
+    enum { NP = 160, CAP = 9 };
+    float p[3 * NP], n[3 * NP];
+    uint64_t s = 17;
+    for (int i = 0; i < NP; i++) {
+        double r = 1.2 + 10.0 * test_rand(&s), a = 6.283185307 * test_rand(&s);
+        p[3 * i] = (float)(r * cos(a)), p[3 * i + 1] = 0.0f, p[3 * i + 2] = (float)(r * sin(a));
+        n[3 * i] = 0.0f, n[3 * i + 1] = 1.0f, n[3 * i + 2] = 0.0f;
+    }
+    test_make_points(&rec, NP, p, n);
+    vb_error err;
+    vb_scene *sc = NULL;
+    CHECK(vb_scene_create(&occ, NULL, &sc, &err) == VB_OK, "scene");
+    const float tols[3] = {0.01f, INFINITY, 1e-30f};
+    vb_bake_output b[3] = {{0}}, two = {0}, part = {0};
+    uint32_t mask = 0;
+    for (int k = 1; k <= CAP; k++)
+        if (vb_order_candidate(k, CAP))
+            mask |= 1u << k;
+    for (int i = 0; i < 3 && sc; i++) {
+        vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = sc, .rays = 400,
+                          .seed = 5, .threads = 1, .order_mask = mask,
+                          .order_tolerance = tols[i], .variable_cap = CAP};
+        CHECK(vb_bake_run(&d, &b[i], &err) == VB_OK, "bake %d: %s", i, err.msg);
+        if (i == 0) {
+            d.threads = 2;
+            CHECK(vb_bake_run(&d, &two, &err) == VB_OK, "2 threads: %s", err.msg);
+            d.range_begin = 37, d.range_end = 101;
+            CHECK(vb_bake_run(&d, &part, &err) == VB_OK, "range: %s", err.msg);
+            d.range_begin = d.range_end = 0;
+            d.method = VB_METHOD_PAPER;
+            vb_bake_output x = {0};
+            CHECK(vb_bake_run(&d, &x, &err) == VB_ERR_ARGUMENT &&
+                      strstr(err.msg, "adaptive order fits the log distance"),
+                  "paper: %s", err.msg);
+        }
+    }
+    int hist[3][VDSH_ORDER_SLOTS] = {{0}}, bad = 0;
+    for (int i = 0; i < 3; i++) {
+        if (!b[i].variable_orders)
+            continue;
+        CHECK(b[i].variable_cap == CAP && b[i].order_tolerance == tols[i], "recorded");
+        for (uint32_t v = 0; v < NP; v++) {
+            int k = b[i].variable_orders[v];
+            hist[i][k]++;
+            bad += !vb_order_candidate(k, CAP) || !b[i].coeffs[k];
+            if (b[i].coeffs[k]) {
+                const float *c = b[i].variable_coeffs + (size_t)v * CAP * CAP;
+                bad += memcmp(c, b[i].coeffs[k] + (size_t)v * k * k, (size_t)k * k * 4) != 0;
+                for (int j = k * k; j < CAP * CAP; j++)
+                    bad += c[j] != 0.0f;
+            }
+        }
+    }
+    CHECK(bad == 0, "%d receivers: not a candidate order or not its fixed fit", bad);
+    CHECK(hist[1][1] == NP, "tolerance inf: %d of %d at order 1", hist[1][1], NP);
+    long coef[3] = {0, 0, 0}; /* a larger tolerance never buys more coefficients */
+    for (int i = 0; i < 3; i++)
+        for (int k = 1; k <= CAP; k++)
+            coef[i] += (long)hist[i][k] * k * k;
+    CHECK(coef[2] >= coef[0] && coef[0] > coef[1] && hist[2][CAP] > 0,
+          "coefficients: %ld at least error, %ld at 0.01, %ld at inf", coef[2], coef[0],
+          coef[1]);
+    int low = 0, high = 0; /* the tolerance spends coefficients where they help */
+    for (int k = 1; k <= CAP; k++) {
+        if (k <= 3)
+            low += hist[0][k];
+        else
+            high += hist[0][k];
+    }
+    CHECK(low > 0 && high > 0, "tolerance 0.01: %d receivers at orders 1-3, %d above", low,
+          high);
+    if (b[0].variable_orders && two.variable_orders && part.variable_orders) {
+        CHECK(memcmp(b[0].variable_orders, two.variable_orders, NP) == 0 &&
+                  memcmp(b[0].variable_coeffs, two.variable_coeffs,
+                         (size_t)NP * CAP * CAP * 4) == 0,
+              "1 and 2 threads differ");
+        CHECK(memcmp(b[0].variable_orders + 37, part.variable_orders, 64) == 0 &&
+                  memcmp(b[0].variable_coeffs + (size_t)37 * CAP * CAP, part.variable_coeffs,
+                         (size_t)64 * CAP * CAP * 4) == 0,
+              "a range's rows differ from the whole bake's");
+    }
+    for (int i = 0; i < 3; i++)
+        vb_bake_output_free(&b[i]);
+    vb_bake_output_free(&two);
+    vb_bake_output_free(&part);
+    vb_scene_destroy(sc);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+}
+
 int main(void)
 {
     test_grid();
@@ -624,5 +725,6 @@ int main(void)
     test_nested_grid();
     test_adaptive_rays();
     test_ranges();
+    test_adaptive_order();
     return test_report("test_bake");
 }

@@ -152,4 +152,26 @@ expect_exit 2 "negative --ray-tolerance" "$bake" builtin:room --rays auto --ray-
   -o "$tmp/x.vdsh"
 check "no output after refused tolerances" test ! -e "$tmp/x.vdsh"
 
+# Adaptive order: one variable-order stream alone (no --orders), 1 and 2
+# threads identical, its histogram in vdsh-info; with --orders, beside them.
+ao=(builtin:room --max-edge 1.5 --rays 256 --adaptive-order 0.02 --max-order 9 -q)
+expect_exit 0 "adaptive order, 1 thread" "$bake" "${ao[@]}" --threads 1 -o "$tmp/ao1.vdsh"
+expect_exit 0 "adaptive order, 2 threads" "$bake" "${ao[@]}" --threads 2 -o "$tmp/ao2.vdsh"
+check "adaptive order: 1 and 2 threads identical" cmp -s "$tmp/ao1.vdsh" "$tmp/ao2.vdsh"
+"$info" --json "$tmp/ao1.vdsh" >"$tmp/ao1.json" 2>/dev/null
+check "adaptive order: one variable stream up to 9" json "$tmp/ao1.json" \
+  "len(d['streams']) == 1 and d['streams'][0]['variable_order'] and d['streams'][0]['order'] == 9 and sum(d['streams'][0]['vertices_per_order']) == d['vertex_count'] and 4 <= d['streams'][0]['mean_bytes_per_vertex'] <= d['streams'][0]['max_bytes_per_vertex']"
+expect_exit 0 "adaptive order with --orders" "$bake" "${ao[@]}" --orders 2,3 -o "$tmp/ao3.vdsh"
+"$info" --json "$tmp/ao3.vdsh" >"$tmp/ao3.json" 2>/dev/null
+check "adaptive order beside orders 2 and 3" json "$tmp/ao3.json" \
+  "[s['order'] for s in d['streams']] == [2, 3, 9] and [s['variable_order'] for s in d['streams']] == [False, False, True]"
+expect_exit 2 "--max-order without --adaptive-order" "$bake" builtin:room --max-order 9 \
+  -o "$tmp/y.vdsh"
+expect_exit 2 "--adaptive-order 0" "$bake" builtin:room --adaptive-order 0 -o "$tmp/y.vdsh"
+expect_exit 2 "--max-order 17" "$bake" builtin:room --adaptive-order 0.1 --max-order 17 \
+  -o "$tmp/y.vdsh"
+expect_exit 2 "adaptive order with paper" "$bake" builtin:room --adaptive-order 0.1 \
+  --method paper -o "$tmp/y.vdsh"
+check "no output after refused adaptive orders" test ! -e "$tmp/y.vdsh"
+
 exit $fail

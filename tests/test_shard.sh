@@ -70,6 +70,23 @@ for enc in s8 s8s6; do
     check "$n $enc shards: identical to the whole $enc bake" cmp "$d/scene.vdsh" "$tmp/whole-$enc.vdsh"
   done
 done
+# Adaptive order (a variable-order stream beside order 3), every encoding:
+# parts hold f32 rows of their own orders; the merge encodes as the bake.
+for enc in f16 s8s6 f32; do
+  ao=(builtin:room --max-edge 1.5 --rays 64 --cube-size 8 -q --adaptive-order 0.02
+      --max-order 9 --orders 3 --encoding $enc)
+  expect_exit 0 "whole adaptive-order bake $enc" "$bake" "${ao[@]}" -o "$tmp/ao-$enc.vdsh"
+  for n in 1 2 7; do
+    d=$tmp/ao-$enc-$n; mkdir -p "$d"
+    for ((i = 0; i < n; i++)); do
+      expect_exit 0 "adaptive order $enc shard $i/$n" "$bake" "${ao[@]}" --shard "$i/$n" \
+        -o "$d/p$i.vdsh"
+    done
+    expect_exit 0 "merge adaptive order $enc $n" "$merge" -q "$d"/p*.vdsh -o "$d/scene.vdsh"
+    check "$n adaptive-order $enc shards: identical to the whole bake" cmp "$d/scene.vdsh" \
+      "$tmp/ao-$enc.vdsh"
+  done
+done
 expect_exit 1 "s8 and f16 parts refused together" "$merge" -q "$tmp"/s8-3/p0.vdsh "$tmp"/s8-3/p1.vdsh "$tmp"/f32/p2.vdsh -o "$tmp/mixed.vdsh"
 says "mixed encodings" "another --encoding"
 

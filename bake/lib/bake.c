@@ -60,6 +60,16 @@ typedef struct job {
     int adaptive;          /* adaptive rays: grid is nested */
     float ray_tol;         /* their tolerance (0: every round) */
     uint32_t lo, hi;       /* the range baked (vb_bake_desc.range_*) */
+    /* Adaptive order (order_tolerance > 0): the cap (0: none), the
+     * lights' positions (scene units) and the range's orders and
+     * coefficients (cap^2 per receiver). */
+    int var_cap;
+    float var_tol;
+    float (*lights)[3];
+    uint32_t light_count;
+    uint8_t *var_orders;
+    float *var_coeffs;
+    float *var_scratch;    /* per worker: var_scratch_floats */
     _Atomic uint64_t traced, missed;
     _Atomic uint32_t degenerate;
 } job;
@@ -70,6 +80,7 @@ typedef struct job {
  * directions above its horizon with their distances (scene units). */
 typedef struct vertex_sink {
     float *coeffs[2][VDSH_ORDER_SLOTS];
+    float *var_scratch;    /* adaptive order: the worker's (VAR_SCRATCH floats) */
     float *x, *y, *z, *t;
     uint32_t *n;
 } vertex_sink;
@@ -90,6 +101,123 @@ static inline float fast_log(float x)
     float s = (m - 1.0f) / (m + 1.0f), s2 = s * s;
     float p = s * (2.0f + s2 * (2.0f / 3 + s2 * (2.0f / 5 + s2 * (2.0f / 7 + s2 * (2.0f / 9)))));
     return p + (float)e * 0.69314718f;
+}
+
+/* e^x for x clamped to [-80, 80], to about 2e-7 relative, in plain float
+ * arithmetic (libm's expf may take other paths on other CPUs): the
+ * adaptive order's choice must not depend on the machine. */
+static inline float fast_exp(float x)
+{
+    x = x < -80.0f ? -80.0f : x > 80.0f ? 80.0f : x;
+    float t = x * 1.44269504f; /* log2 e */
+    int i = (int)(t + (t >= 0.0f ? 0.5f : -0.5f));
+    float r = (t - (float)i) * 0.693147181f; /* |r| <= ln2 / 2 */
+    float p = 1.0f + r * (1.0f + r * (0.5f + r * (1.0f / 6 + r * (1.0f / 24 + r * (1.0f / 120 +
+                                                                          r * (1.0f / 720))))));
+    union { uint32_t u; float f; } b = {(uint32_t)(i + 127) << 23};
+    return p * b.f;
+}
+
+int vb_order_candidate(int k, int cap)
+{
+    return k == cap || (k < cap && (k <= 3 || k == 5 || k == 7 || k == 9 || k == 12));
+}
+
+/* Adaptive order (bake.h, order_tolerance): receiver v's order and
+ * coefficients. For each order k = 1..cap in turn, its fit of the log
+ * distance (u: the projection, unrotated; the method's log offset added)
+ * reconstructs the distance D toward up to VB_ORDER_DIRECTIONS of the
+ * receiver's traced directions above its horizon (every step-th), and
+ * its error is the mean over those directions and the scene lights'
+ * distances d_L of |ramp(D / d_L) - ramp(t / d_L)|, t the traced
+ * distance: the expected shadow error of lights at the scene's light
+ * distances, on the receiver's own directions. The first order at most
+ * the tolerance is kept, else the one of least error. Sums run in a fixed
+ * order in float (no libm), so the choice is the same on every CPU and
+ * for any thread count. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+static void choose_order(const job *J, uint32_t v, const vb_fit_angles *a, const double *u,
+                         const float *tx, const float *ty, const float *tz, const float *tt,
+                         uint32_t count, float *scratch)
+{
+    enum { M = VB_ORDER_DIRECTIONS, L = VB_ORDER_LIGHTS };
+    const int cap = J->var_cap;
+    const uint32_t m = count < M ? count : M;
+    const float max_distance = J->d->max_distance;
+    float x[M], y[M], z[M], t[M], sl[L], ideal[M * L], s[M], acc[L];
+    for (uint32_t i = 0; i < m; i++) {
+        uint32_t k = (uint32_t)((uint64_t)i * count / m);
+        x[i] = tx[k], y[i] = ty[k], z[i] = tz[k], t[i] = tt[k];
+    }
+    /* ramp(D / d_L) = saturate(D sl - 1/2), sl = 1.5 / d_L; lights past
+     * the list's end (or at the receiver) get sl = 0: both sides 0. */
+    const float *p = J->d->receivers->positions + 3 * (size_t)v;
+    uint32_t nl = 0;
+    for (uint32_t j = 0; j < L; j++) {
+        sl[j] = 0.0f;
+        if (j < J->light_count) {
+            float dx = J->lights[j][0] - p[0], dy = J->lights[j][1] - p[1],
+                  dz = J->lights[j][2] - p[2];
+            float d = sqrtf(dx * dx + dy * dy + dz * dz);
+            if (d > 0.0f)
+                sl[j] = 1.5f / d, nl++;
+        }
+    }
+    for (uint32_t i = 0; i < m; i++)
+        for (uint32_t j = 0; j < L; j++) {
+            float r = t[i] * sl[j] - 0.5f;
+            ideal[i * L + j] = 0.5f * (fabsf(r) - fabsf(r - 1.0f) + 1.0f);
+        }
+    float *Y = scratch; /* cap^2 x m */
+    if (m)
+        vdsh_sh_eval_soa(cap, m, x, y, z, Y, m);
+    float c[VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS], err[VDSH_ORDER_SLOTS];
+    float least = INFINITY;
+    for (int k = 1; k <= cap; k++) {
+        if (!vb_order_candidate(k, cap))
+            continue;
+        vb_fit_finish(&J->fits[k], a, u, c[k]);
+        c[k][0] += J->log_offset[k] / 0.28209479177387814f;
+        for (uint32_t i = 0; i < m; i++)
+            s[i] = 0.0f;
+        for (int j = 0; j < k * k; j++)
+            for (uint32_t i = 0; i < m; i++)
+                s[i] += c[k][j] * Y[(size_t)j * m + i];
+        for (uint32_t j = 0; j < L; j++)
+            acc[j] = 0.0f;
+        /* Per light, summed over directions in order (lane-wise: the same
+         * bits with or without vectors). */
+        for (uint32_t i = 0; i < m; i++) {
+            float D = fast_exp(s[i]);
+            s[i] = D < max_distance ? D : max_distance;
+        }
+        for (uint32_t i = 0; i < m; i++) {
+            const float D = s[i];
+            for (uint32_t j = 0; j < L; j++) {
+                /* saturate(r) as (|r| - |r - 1| + 1) / 2: no compares, so
+                 * GCC vectorises the loop (it does not if-convert float
+                 * compares that may trap) */
+                float r = D * sl[j] - 0.5f;
+                acc[j] += fabsf(0.5f * (fabsf(r) - fabsf(r - 1.0f) + 1.0f) - ideal[i * L + j]);
+            }
+        }
+        float e = 0.0f;
+        for (uint32_t j = 0; j < L; j++)
+            e += acc[j];
+        err[k] = m && nl ? e / (float)(m * nl) : 0.0f;
+        least = err[k] < least ? err[k] : least;
+    }
+    int best_k = cap;
+    for (int k = cap; k >= 1; k--)
+        if (vb_order_candidate(k, cap) && err[k] <= least + J->var_tol)
+            best_k = k;
+    J->var_orders[v - J->lo] = (uint8_t)best_k;
+    float *dst = J->var_coeffs + (size_t)(v - J->lo) * cap * cap;
+    memset(dst, 0, (size_t)cap * cap * sizeof *dst);
+    memcpy(dst, c[best_k], (size_t)best_k * best_k * sizeof *dst);
 }
 
 static double expected_error(const double *e, double r);
@@ -140,12 +268,19 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
     for (int q = 0; q < 2; q++)
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             want[q] |= out->coeffs[q][o] != NULL;
+    /* Adaptive order: the log distance's fits, chosen on the traced
+     * directions above the horizon (var_buf: x, y, z, t, then scratch). */
+    const int var = J->var_cap && v >= J->lo && v < J->hi && !d->trace_only && !out->n;
+    float *var_buf = var ? out->var_scratch : NULL;
+    uint32_t var_n = 0;
+    want[1] |= var;
     /* Loop invariants in locals: the lane loops below vectorise. */
     const float inv_scale = J->inv_scale, max_distance = d->max_distance;
     const float degenerate_dist = J->near[v], log_floor = J->log_floor;
     const float nx = n[0], ny = n[1], nz = n[2];
     float acc[2][VDSH_MAX_COEFFS][VB_PACKET];
-    memset(acc, 0, sizeof acc);
+    for (int q = 0; q < 2; q++)
+        memset(acc[q], 0, (size_t)J->order * J->order * sizeof acc[q][0]);
     uint32_t near_zero = 0, upper = 0;
 
     /* Packets are traced GROUP at a time, then their lanes are processed
@@ -265,6 +400,16 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
                         out->z[i] = dz[k];
                         out->t[i] = dist[p][k];
                     }
+            if (var_buf)
+                for (int k = 0; k < VB_PACKET; k++)
+                    if (up_lane[p][k]) {
+                        uint32_t c = J->grid->count;
+                        var_buf[var_n] = dx[k];
+                        var_buf[c + var_n] = dy[k];
+                        var_buf[2 * c + var_n] = dz[k];
+                        var_buf[3 * c + var_n] = dist[p][k];
+                        var_n++;
+                    }
             if (J->adaptive)
                 for (int k = 0; k < VB_PACKET; k++)
                     if (up_lane[p][k]) {
@@ -337,6 +482,11 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (out->coeffs[q][o])
                 vb_fit_finish(&J->fits[o], &angles, u, out->coeffs[q][o]);
+        if (q == 1 && var_buf) {
+            uint32_t c = J->grid->count;
+            choose_order(J, v, &angles, u, var_buf, var_buf + c, var_buf + 2 * c,
+                         var_buf + 3 * c, var_n, var_buf + 4 * (size_t)c);
+        }
     }
     /* Method shadow: the log offset, through c0 (Y00 is a constant). */
     for (int o = 1; o <= VDSH_MAX_ORDER; o++)
@@ -344,6 +494,14 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
             out->coeffs[1][o][0] += J->log_offset[o] / 0.28209479177387814f;
     if (upper > 0 && near_zero >= 0.9 * upper)
         (*degenerate)++;
+}
+
+/* Floats of a worker's adaptive-order scratch: a receiver's traced
+ * directions above its horizon (x, y, z, distance), then the basis at the
+ * tested ones. */
+static size_t var_scratch_floats(const job *J)
+{
+    return (size_t)4 * J->grid->count + (size_t)VDSH_MAX_COEFFS * VB_ORDER_DIRECTIONS;
 }
 
 static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
@@ -355,6 +513,8 @@ static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
         if (J->done && J->done[v])
             continue;
         vertex_sink out = {0};
+        if (J->var_scratch)
+            out.var_scratch = J->var_scratch + (size_t)worker * var_scratch_floats(J);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (J->coeffs[o])
                 out.coeffs[J->quantity[o] == VDSH_QUANTITY_LOG_DISTANCE][o] =
@@ -515,7 +675,9 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
         for (uint32_t i = begin; i < end; i++)
             memset(J->choose_error + (size_t)i * (VDSH_ORDER_SLOTS) * 2, 0,
                    (VDSH_ORDER_SLOTS) * 2 * sizeof(double));
-    else /* their coefficients are kept: the main pass skips them */
+    else if (!J->var_cap) /* their coefficients are kept: the main pass skips them
+                             * (with an adaptive order it bakes them again: the
+                             * variable stream's quantity was not chosen yet) */
         for (uint32_t i = begin; i < end; i++)
             J->done[choose_receiver(i, nrec, J->choose_count)] = 1;
     atomic_fetch_add(&J->traced, traced);
@@ -537,6 +699,8 @@ void vb_bake_output_free(vb_bake_output *out)
         return;
     for (int o = 0; o <= VDSH_MAX_ORDER; o++)
         free(out->coeffs[o]);
+    free(out->variable_orders);
+    free(out->variable_coeffs);
     free(out->normals);
     memset(out, 0, sizeof *out);
 }
@@ -551,6 +715,23 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         d.rays = 2500;
     if (d.order_mask & ~(uint32_t)(((1u << VDSH_MAX_ORDER) - 1) << 1))
         return vb_fail(err, VB_ERR_ARGUMENT, "orders must be 1..%d", VDSH_MAX_ORDER);
+    /* Adaptive order: its cap is the projection's order at least; with no
+     * fixed order asked, it is the only stream. */
+    int var_cap = 0;
+    if (isnan(d.order_tolerance) || d.order_tolerance < 0.0f)
+        return vb_fail(err, VB_ERR_ARGUMENT, "the order tolerance must be a number >= 0");
+    if (d.order_tolerance > 0.0f) {
+        var_cap = d.variable_cap ? d.variable_cap : VB_DEFAULT_ORDER_CAP;
+        if (var_cap < 1 || var_cap > VDSH_MAX_ORDER)
+            return vb_fail(err, VB_ERR_ARGUMENT, "the order cap must be 1..%d, not %d",
+                           VDSH_MAX_ORDER, var_cap);
+        if (d.max_order < var_cap)
+            for (int o = var_cap; o <= VDSH_MAX_ORDER; o++)
+                if (d.order_mask >> o)
+                    d.max_order = o; /* the highest fixed order, if above the cap */
+        if (d.max_order < var_cap)
+            d.max_order = var_cap;
+    }
     if (d.max_order == 0)
         for (int o = VDSH_MAX_ORDER; o >= 1 && !d.max_order; o--)
             if (d.order_mask & (1u << o))
@@ -560,7 +741,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     if (d.max_order < 1 || d.max_order > VDSH_MAX_ORDER)
         return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..%d, not %d",
                        VDSH_MAX_ORDER, d.max_order);
-    if (d.order_mask == 0)
+    if (d.order_mask == 0 && !var_cap)
         d.order_mask = 1u << d.max_order;
     if (d.order_mask >> (d.max_order + 1))
         return vb_fail(err, VB_ERR_ARGUMENT, "an order above max_order %d was asked for",
@@ -583,6 +764,10 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     }
     if (!choose && !(mi->quantities & VB_QUANTITY_BIT(stored)))
         return vb_fail(err, VB_ERR_ARGUMENT, "%s", mi->refused[stored]);
+    if (var_cap && !(mi->quantities & VB_QUANTITY_BIT(VDSH_QUANTITY_LOG_DISTANCE)))
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "adaptive order fits the log distance: method %s does not (use shadow)",
+                       vdsh_method_name(mi->stored));
     if (d.order_quantity) {
         choose = 0;
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
@@ -646,6 +831,9 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     }
     if (r != VB_OK)
         return r;
+    uint8_t *var_orders = NULL; /* adaptive order: the range's */
+    float *var_coeffs = NULL;
+    float (*lights)[3] = NULL;
     float *origins = malloc((size_t)R->vertex_count * 3 * sizeof *origins);
     uint8_t *need = NULL; /* vb_receivers_prepare's, for a range */
     float *near = malloc((size_t)R->vertex_count * sizeof *near + 1);
@@ -667,8 +855,21 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
                     R->vertex_count);
         goto done;
     }
+    if (var_cap && !d.trace_only) {
+        var_orders = malloc((size_t)(hi - lo) + 1);
+        var_coeffs = malloc((size_t)(hi - lo) * var_cap * var_cap * sizeof(float));
+        lights = malloc(VB_ORDER_LIGHTS * sizeof *lights);
+        if (!var_orders || !var_coeffs || !lights) {
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
+                        R->vertex_count);
+            goto done;
+        }
+        if ((r = vb_scene_place_lights(d.scene, d.seed, VB_ORDER_LIGHTS, lights, NULL, err)) !=
+            VB_OK)
+            goto done;
+    }
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
-        if (!coeffs[o] && o != d.max_order) /* the top one rotates for all */
+        if (!coeffs[o] && o != d.max_order && o > var_cap) /* the top one rotates for all */
             continue;
         if ((r = vb_fit_create(o, mi->fit, vb_fit_lambda(d.lambda, o), &J->fits[o], err)) != VB_OK)
             goto done;
@@ -714,6 +915,17 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     J->horizon = mi->horizon;
     J->adaptive = d.adaptive_rays != 0;
     J->ray_tol = d.ray_tolerance;
+    J->var_cap = var_orders ? var_cap : 0;
+    J->var_tol = d.order_tolerance;
+    J->lights = lights;
+    J->light_count = VB_ORDER_LIGHTS;
+    J->var_orders = var_orders;
+    J->var_coeffs = var_coeffs;
+    if (var_orders && !(J->var_scratch = malloc(d.threads * var_scratch_floats(J) *
+                                                sizeof(float)))) {
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+        goto done;
+    }
     /* The per-order log offsets, for the methods that have them. */
     for (int o = 1; o <= VDSH_MAX_ORDER && mi->param == VB_PARAM_LOG_OFFSET; o++) {
         J->log_offset[o] = d.log_offsets ? d.log_offsets[o] : mi->default_log_offset[o];
@@ -801,6 +1013,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     memcpy(o.auto_error, auto_error, sizeof auto_error);
     o.lambda = mi->regularised ? d.lambda : 0.0f;
     memcpy(o.log_offset, J->log_offset, sizeof o.log_offset);
+    any_log |= var_orders != NULL;
     o.log_floor = any_log ? d.log_floor : 0.0f;
     o.window = d.window;
     o.vertex_count = R->vertex_count;
@@ -808,6 +1021,12 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     o.range_end = J->hi;
     memcpy(o.coeffs, coeffs, sizeof coeffs);
     memset(coeffs, 0, sizeof coeffs);
+    o.variable_orders = var_orders;
+    o.variable_coeffs = var_coeffs;
+    o.variable_cap = var_orders ? var_cap : 0;
+    o.order_tolerance = var_orders ? d.order_tolerance : 0.0f;
+    var_orders = NULL;
+    var_coeffs = NULL;
     o.rays = grid.count;
     o.ray_tolerance = J->adaptive ? d.ray_tolerance : 0.0f;
     o.hemisphere = grid.hemisphere;
@@ -832,6 +1051,7 @@ done:
         free(J->choose_error);
         free(J->choose_coeffs);
         free(J->done);
+        free(J->var_scratch);
     }
     free(J);
     for (int k = 0; k <= VDSH_MAX_ORDER; k++)
@@ -840,6 +1060,9 @@ done:
     free(near);
     free(normals);
     free(need);
+    free(var_orders);
+    free(var_coeffs);
+    free(lights);
     vb_dirgrid_destroy(&grid);
     return r;
 }

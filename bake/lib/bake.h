@@ -84,6 +84,17 @@ extern "C" {
 
 /* The order baked when none is asked: the paper's highest. */
 #define VB_DEFAULT_ORDER 5
+/* Adaptive order: the cap when none is given, the lights of the error
+ * test (placed with the bake's seed) and how many of a receiver's traced
+ * directions it reads at most. */
+#define VB_DEFAULT_ORDER_CAP 12
+#define VB_ORDER_LIGHTS 32
+#define VB_ORDER_DIRECTIONS 128
+
+/* The orders an adaptive-order receiver may get below the cap: 1, 2, 3,
+ * 5, 7, 9, 12 (and the cap itself): each step about 1.4 to 2 times the
+ * coefficients of the last, so that testing them all costs little. */
+int vb_order_candidate(int k, int cap);
 
 typedef struct vb_bake_desc {
     const vb_mesh *receivers;  /* positions and normals (borrowed) */
@@ -113,7 +124,15 @@ typedef struct vb_bake_desc {
                                 * to the fitted ln d; NULL: vb_shadow_log_offset */
     float log_floor;           /* log-distance floor; 0: 1% of max_distance */
     vdsh_window window;        /* on each order's bands; 0: none */
-    uint32_t order_mask;       /* bit n: produce order n; 0: max_order only */
+    uint32_t order_mask;       /* bit n: produce order n; 0: max_order only
+                                * (none with a variable order and no mask) */
+    /* Adaptive order (issue 16): > 0 adds a variable-order stream of the
+     * quantity of order `variable_cap`: each receiver gets the lowest
+     * order 1..variable_cap whose expected shadow error on its own traced
+     * directions, under VB_ORDER_LIGHTS lights in the scene's free space,
+     * is at most this tolerance, else the order of least error. 0: none. */
+    float order_tolerance;
+    int variable_cap;          /* 0: VB_DEFAULT_ORDER_CAP */
     int max_order;             /* 0: the highest order in order_mask, or
                                   VB_DEFAULT_ORDER */
     unsigned threads;          /* 0: every online core */
@@ -159,6 +178,13 @@ typedef struct vb_bake_output {
      * shard holds its own range only: its memory is its range's); or NULL
      * where the order was not asked for (and with trace_only). */
     float *coeffs[VDSH_ORDER_SLOTS];
+    /* Adaptive order (order_tolerance > 0), else NULL and 0: per receiver
+     * of the range its order 1..variable_cap, and variable_cap^2
+     * coefficients (those past its order 0), vertex-major. */
+    uint8_t *variable_orders;
+    float *variable_coeffs;
+    int variable_cap;
+    float order_tolerance;
     uint32_t rays;             /* directions per receiver actually used (the
                                 * cap with adaptive rays) */
     float ray_tolerance;       /* adaptive rays: the tolerance used, else 0 */
@@ -197,6 +223,11 @@ void vb_bake_output_free(vb_bake_output *out);
  * b->threads workers, or as s8 (vdsh_encode_s8). *storage receives the
  * block the stream points into (data, and an s8 stream's coef_scales);
  * the caller frees it. */
+/* The variable-order stream of an adaptive-order bake (b->variable_orders),
+ * as vb_bake_stream; its offsets point into *storage too. */
+vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encoding,
+                                  vdsh_stream *out, void **storage, vb_error *err);
+
 vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encoding,
                          vdsh_stream *out, void **storage, vb_error *err);
 

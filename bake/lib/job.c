@@ -135,6 +135,8 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!b->coeffs[o])
             continue;
+        if (count == VDSH_MAX_STREAMS - (b->variable_orders != NULL))
+            return vb_fail(err, VB_ERR_ARGUMENT, "more than %d streams", VDSH_MAX_STREAMS);
         vb_result r = vb_bake_stream(b, o, d->shard_count ? VDSH_ENCODING_F32 : job_encoding(d),
                                      &j->streams[count], &j->stream_data[count], err);
         if (r != VB_OK)
@@ -145,6 +147,18 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
          * memory holds one order's two copies, not every order's. */
         free(j->bake.coeffs[o]);
         j->bake.coeffs[o] = NULL;
+    }
+    if (b->variable_orders) { /* adaptive order: its average bytes per vertex */
+        vb_result r = vb_bake_variable_stream(b, d->shard_count ? VDSH_ENCODING_F32
+                                                                : job_encoding(d),
+                                              &j->streams[count], &j->stream_data[count], err);
+        if (r != VB_OK)
+            return r;
+        uint32_t rows = b->range_end ? b->range_end - b->range_begin : b->vertex_count;
+        j->variable_bytes = (double)vdsh_stream_data_bytes(&j->streams[count], rows) / rows;
+        count++;
+        free(j->bake.variable_coeffs);
+        j->bake.variable_coeffs = NULL;
     }
     vdsh_file f = {0};
     vdsh_header *h = &f.header;
@@ -254,7 +268,7 @@ void vb_job_free(vb_job *j)
     if (j->basis_running)
         pthread_join(j->basis_thread, NULL);
     vb_cubemap_basis_free(&j->basis);
-    for (int s = 0; s < VDSH_MAX_ORDER; s++)
+    for (int s = 0; s < VDSH_MAX_STREAMS; s++)
         free(j->stream_data[s]);
     vb_bake_output_free(&j->bake);
     vb_scene_destroy(j->scene);

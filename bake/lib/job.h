@@ -87,9 +87,11 @@ typedef struct vb_job {
     uint32_t source_count;
     vb_scene *scene;
     vb_bake_output bake;
-    vdsh_stream streams[VDSH_MAX_ORDER];
-    void *stream_data[VDSH_MAX_ORDER];
-    size_t coefficient_bytes;  /* per vertex, all streams */
+    vdsh_stream streams[VDSH_MAX_STREAMS];
+    void *stream_data[VDSH_MAX_STREAMS];
+    size_t coefficient_bytes;  /* per vertex, all fixed-order streams */
+    double variable_bytes;     /* per vertex on average, the variable-order
+                                * stream's (order table included; 0: none) */
     vdsh_file file;            /* filled by vb_bake_fill_file (borrows the above) */
     uint64_t file_bytes;       /* the written file's size (vb_job_write) */
     vdsh_timings timings;

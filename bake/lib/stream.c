@@ -130,3 +130,60 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encod
     *out = s;
     return VB_OK;
 }
+
+vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encoding,
+                                  vdsh_stream *out, void **storage, vb_error *err)
+{
+    const int cap = b->variable_cap;
+    if (!b->variable_orders || cap < 1 || cap > VDSH_MAX_ORDER)
+        return vb_fail(err, VB_ERR_ARGUMENT, "the bake has no adaptive order");
+    if (encoding > VDSH_ENCODING_LAST)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown encoding %u", encoding);
+    const vb_method_info *mi = vb_method_stored(b->method);
+    const uint32_t rows = b->range_end ? b->range_end - b->range_begin : b->vertex_count;
+    const size_t nc = (size_t)cap * cap;
+    /* One block: the scale table, the offsets (rows + 1), the orders (in
+     * words), the records: the stream owns copies, so the bake's arrays
+     * may be freed. */
+    uint32_t *offsets = malloc(((size_t)rows + 1) * sizeof *offsets);
+    if (!offsets)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the variable-order stream");
+    vdsh_stream_offsets(b->variable_orders, rows, encoding, offsets);
+    size_t words = offsets[rows];
+    size_t table = VDSH_MAX_COEFFS, head = table + (size_t)rows + 1 + ((size_t)rows + 3) / 4;
+    uint32_t *block = malloc((head + words) * sizeof *block + 1);
+    if (!block) {
+        free(offsets);
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the variable-order stream");
+    }
+    float *scales = (float *)block;
+    memcpy(block + table, offsets, ((size_t)rows + 1) * sizeof *offsets);
+    free(offsets);
+    offsets = block + table;
+    uint8_t *orders = (uint8_t *)(offsets + rows + 1);
+    memcpy(orders, b->variable_orders, rows);
+    float scale = 1.0f;
+    if (encoding == VDSH_ENCODING_F16) { /* stored values within [-1, 1], as vb_bake_stream */
+        float amax = 0.0f;
+        for (size_t i = 0; i < (size_t)rows * nc; i++)
+            amax = fmaxf(amax, fabsf(b->variable_coeffs[i]));
+        scale = vdsh_f16_scale(amax);
+    }
+    if (vdsh_encode_variable(encoding, b->variable_coeffs, nc, b->variable_orders, rows,
+                             (uint32_t)cap, scale, offsets, scales, block + head) != VDSH_OK) {
+        free(block);
+        return vb_fail(err, VB_ERR_INVALID, "adaptive-order coefficients do not fit %s",
+                       vdsh_encoding_name(encoding));
+    }
+    int cap_param = mi && mi->param == VB_PARAM_LOG_OFFSET;
+    *out = (vdsh_stream){.order = (uint32_t)cap, .encoding = encoding, .method = b->method,
+                         .quantity = VDSH_QUANTITY_LOG_DISTANCE,
+                         .method_param = cap_param ? b->log_offset[cap] : b->lambda,
+                         .scale = scale, .quantity_param = b->log_floor, .window = b->window,
+                         .window_param = b->window ? (float)cap : 0.0f,
+                         .coef_scales = vdsh_encoding_quantised(encoding) ? scales : NULL,
+                         .flags = VDSH_STREAM_VARIABLE, .orders = orders,
+                         .offsets = offsets, .data = block + head};
+    *storage = block;
+    return VB_OK;
+}

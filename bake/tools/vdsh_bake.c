@@ -46,6 +46,9 @@ typedef struct options {
     int have_ray_tolerance;
     int orders[VDSH_MAX_ORDER];
     int order_count;
+    int orders_given;          /* --orders */
+    float order_tolerance;     /* --adaptive-order TOL; 0: none */
+    int max_order;             /* --max-order N; 0: VB_DEFAULT_ORDER_CAP */
     vb_method method;
     vb_quantity quantity;
     float lambda;
@@ -160,7 +163,15 @@ static void usage(FILE *f)
 "                          than --ray-tolerance in expected shadow error\n"
 "      --ray-tolerance T   with --rays auto (default 0.06; 0: every round)\n"
 "      --orders LIST       SH orders to store, order n = n bands = n*n\n"
-"                          coefficients (default 2,3,5; each 1..5)\n"
+"                          coefficients (default 2,3,5, or none with\n"
+"                          --adaptive-order; each 1..16: orders above 5 are\n"
+"                          drawn from buffers, for long shadows)\n"
+"      --adaptive-order TOL  one more stream, of variable order: each\n"
+"                          receiver gets the lowest order (1..--max-order)\n"
+"                          whose expected shadow error on its own traced\n"
+"                          directions, under lights in the scene's free\n"
+"                          space, is at most TOL (else its best order)\n"
+"      --max-order N       the adaptive order's cap (default 12)\n"
 "      --method M          the fit:\n"
 "%s"
 "      --quantity Q        what the SH store: auto (default): log for shadow,\n"
@@ -491,12 +502,15 @@ int main(int argc, char **argv)
     enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
            O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL, O_SHARD,
-           O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS, O_PLAN, O_RECEIVERS };
+           O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS, O_PLAN, O_RECEIVERS, O_ADAPTIVE_ORDER,
+           O_MAX_ORDER };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
         {"ray-tolerance", required_argument, 0, O_RAY_TOL},
         {"orders", required_argument, 0, O_ORDERS},
+        {"adaptive-order", required_argument, 0, O_ADAPTIVE_ORDER},
+        {"max-order", required_argument, 0, O_MAX_ORDER},
         {"method", required_argument, 0, O_METHOD},
         {"encoding", required_argument, 0, O_ENCODING},
         {"max-distance", required_argument, 0, O_MAXDIST},
@@ -559,8 +573,26 @@ int main(int argc, char **argv)
         }
         case O_ORDERS:
             if (!parse_orders(optarg, &o))
-                return bad_usage("--orders takes distinct orders 1..5 such as 2,3,5, not '%s'", optarg);
+                return bad_usage("--orders takes distinct orders 1..16 such as 2,3,5, not '%s'",
+                                 optarg);
+            o.orders_given = 1;
             break;
+        case O_ADAPTIVE_ORDER: {
+            char *end = NULL;
+            double t = strtod(optarg, &end);
+            if (end == optarg || *end || !(t > 0.0))
+                return bad_usage("--adaptive-order takes a tolerance > 0 (or inf), not '%s'",
+                                 optarg);
+            o.order_tolerance = (float)t;
+            break;
+        }
+        case O_MAX_ORDER: {
+            uint64_t v;
+            if (!vt_parse_u64(optarg, 1, VDSH_MAX_ORDER, &v))
+                return bad_usage("--max-order takes an order 1..16, not '%s'", optarg);
+            o.max_order = (int)v;
+            break;
+        }
         case O_METHOD: {
             const vb_method_info *m = vb_method_by_name(optarg);
             if (!m) {
@@ -714,6 +746,15 @@ int main(int argc, char **argv)
         return bad_usage("%s", "no output: give -o OUT.vdsh (or --export-obj FILE)");
     FILE *log = o.quiet ? NULL : stderr;
 
+    if (o.max_order && !(o.order_tolerance > 0.0f))
+        return bad_usage("%s", "--max-order is the cap of --adaptive-order TOL");
+    if (o.order_tolerance > 0.0f &&
+        !(mi->quantities & VB_QUANTITY_BIT(VDSH_QUANTITY_LOG_DISTANCE)))
+        return bad_usage("--adaptive-order fits the log distance: method %s does not (use "
+                         "shadow, the default)", vb_method_name(o.method));
+    if (o.order_tolerance > 0.0f && !o.orders_given)
+        o.order_count = 0; /* the variable-order stream alone */
+
     /* The bake, described once: vb_job (job.h) runs it as a straight line. */
     uint32_t order_mask = 0;
     for (int s = 0; s < o.order_count; s++)
@@ -738,6 +779,7 @@ int main(int argc, char **argv)
                  .method = o.method, .quantity = o.quantity, .lambda = o.lambda,
                  .log_floor = o.log_floor, .log_offsets = o.have_log_offset ? offsets : NULL,
                  .window = o.window, .order_mask = order_mask, .threads = o.threads,
+                 .order_tolerance = o.order_tolerance, .variable_cap = o.max_order,
                  .keep_normals = o.keep_normals, .trace_only = o.trace_only,
                  .progress = on_progress, .progress_user = &pr},
         .encoding_given = 1,
@@ -831,6 +873,22 @@ int main(int argc, char **argv)
                 bo->seconds > 0 ? bo->rays_traced / bo->seconds * 1e-6 : 0.0, bo->threads,
                 bo->rays_traced ? 100.0 * bo->rays_missed / bo->rays_traced : 0.0,
                 bo->moved_origins, bo->degenerate_receivers, (double)bo->max_distance);
+    if (log && bo->variable_orders) {
+        uint32_t hist[VDSH_ORDER_SLOTS] = {0};
+        uint32_t rows = bo->range_end - bo->range_begin;
+        double coeffs = 0.0;
+        for (uint32_t v = 0; v < rows; v++) {
+            hist[bo->variable_orders[v]]++;
+            coeffs += (double)bo->variable_orders[v] * bo->variable_orders[v];
+        }
+        fprintf(log, "vdsh-bake: adaptive order (tolerance %g, cap %d): %.1f coefficients per "
+                     "receiver on average; receivers per order:",
+                (double)bo->order_tolerance, bo->variable_cap, rows ? coeffs / rows : 0.0);
+        for (int k = 1; k <= bo->variable_cap; k++)
+            if (hist[k])
+                fprintf(log, " %d: %u (%.1f%%)", k, hist[k], 100.0 * hist[k] / rows);
+        fputc('\n', log);
+    }
     if (log && o.adaptive_rays)
         fprintf(log, "vdsh-bake: adaptive rays: %.1f traced per receiver on average "
                      "(cap %u, tolerance %g)\n",
@@ -887,11 +945,13 @@ int main(int argc, char **argv)
     double write_seconds = vb_now() - t;
     int cube_size = vb_job_cube_size(&jd);
     if (log) {
-        fprintf(log, "vdsh-bake: wrote %s (%.2f MB, %zu bytes of coefficients per "
+        fprintf(log, "vdsh-bake: wrote %s (%.2f MB, %.1f bytes of coefficients per "
                      "vertex for orders",
-                o.output, job.file_bytes / 1e6, job.coefficient_bytes);
+                o.output, job.file_bytes / 1e6, job.coefficient_bytes + job.variable_bytes);
         for (int s = 0; s < o.order_count; s++)
             fprintf(log, "%s%d", s ? "," : " ", o.orders[s]);
+        if (bo->variable_cap)
+            fprintf(log, "%sadaptive 1..%d", o.order_count ? "," : " ", bo->variable_cap);
         fprintf(log, ", %s)", vdsh_encoding_name(o.encoding));
         if (cube_size > 0)
             fprintf(log, " and 4 basis cubemaps %dx%d in %s", cube_size, cube_size,

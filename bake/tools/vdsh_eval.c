@@ -327,6 +327,32 @@ typedef struct context {
     const float *offset;   /* per scored stream: the log offset added (--offsets) */
 } context;
 
+/* A stream's bytes per vertex: fixed, or a variable-order stream's
+ * average (its order table included) and largest record. */
+static double stream_bytes(const vdsh_file *f, const vdsh_stream *st, uint32_t *max_bytes)
+{
+    uint32_t rows = vdsh_file_stream_vertices(f), most = 0;
+    if (!(st->flags & VDSH_STREAM_VARIABLE)) {
+        if (max_bytes)
+            *max_bytes = (uint32_t)vdsh_stream_bytes_per_vertex(st);
+        return (double)vdsh_stream_bytes_per_vertex(st);
+    }
+    for (uint32_t v = 0; v < rows; v++) {
+        uint32_t b = 4 * vdsh_record_words(st->encoding, vdsh_stream_vertex_order(st, v));
+        most = b > most ? b : most;
+    }
+    if (max_bytes)
+        *max_bytes = most;
+    return rows ? (double)vdsh_stream_data_bytes(st, rows) / rows : 0.0;
+}
+
+/* "5", or "a12" for a variable-order stream of cap 12. */
+static const char *order_label(const vdsh_stream *st, char *buf, size_t n)
+{
+    snprintf(buf, n, "%s%u", st->flags & VDSH_STREAM_VARIABLE ? "a" : "", st->order);
+    return buf;
+}
+
 static const char *kind_name(int k) { return k == VB_EVAL_VERTICES ? "vertices" : "interior"; }
 
 static int write_json(const char *out, const context *c, char *msg, size_t cap)
@@ -425,7 +451,10 @@ static int write_json(const char *out, const context *c, char *msg, size_t cap)
         vt_json_string(&j, o, "encoding", vdsh_encoding_name(st->encoding));
         vt_json_string(&j, o, "quantity", vdsh_quantity_name(st->quantity));
         vt_json_string(&j, o, "window", vdsh_window_name(st->window));
-        vt_json_u64(&j, o, "bytes_per_vertex", vdsh_stream_bytes_per_vertex(st));
+        uint32_t most = 0;
+        vt_json_f64(&j, o, "bytes_per_vertex", stream_bytes(f, st, &most));
+        vt_json_u64(&j, o, "max_bytes_per_vertex", most);
+        vt_json_bool(&j, o, "variable_order", (st->flags & VDSH_STREAM_VARIABLE) != 0);
         vt_json_f32(&j, o, "log_offset", c->offset[s]);
         cJSON *sl = vt_json_object(&j, o, "scene_lights");
         for (int k = 0; k < VB_EVAL_KINDS; k++)
@@ -531,8 +560,8 @@ static void print_table(FILE *o, const context *c)
             fprintf(o, " (%.2f%%)", 100.0 * t->degenerate / t->receivers);
         fputc('\n', o);
     }
-    fprintf(o, "\n  order = n bands, n^2 coefficients; B/v = bytes of coefficients per vertex; "
-               "+- = 95%% interval\n");
+    fprintf(o, "\n  order = n bands, n^2 coefficients (aN: adaptive, each vertex 1..N); B/v = "
+               "bytes of coefficients per vertex (adaptive: on average); +- = 95%% interval\n");
     fprintf(o, "\n  SCENE LIGHTS (the primary metric): %u point lights placed uniformly in the "
                "scene's free space, each\n  scored at every receiver it lights; "
                "false = P(s_hat < .5 | d_T >= d_L), recall = P(s_hat < .5 | s_ideal < .5)\n\n",
@@ -554,9 +583,11 @@ static void print_table(FILE *o, const context *c)
             snprintf(fa, sizeof fa, "%.2f+-%.2f%%", 100.0 * m->false_shadow,
                      196.0 * m->false_shadow_se);
             snprintf(rc, sizeof rc, "%.1f+-%.1f%%", 100.0 * m->recall, 196.0 * m->recall_se);
-            fprintf(o, "  %-8s %5u %+6.2f %3zu %3s %-9s | %7.2gM | %-15s %-13s %-12s | %6.4f "
+            char ol[16];
+            fprintf(o, "  %-8s %5s %+6.2f %3.0f %3s %-9s | %7.2gM | %-15s %-13s %-12s | %6.4f "
                        "%5.2f%% %5.1f%%\n",
-                    kind_name(k), st->order, (double)c->offset[s], vdsh_stream_bytes_per_vertex(st),
+                    kind_name(k), order_label(st, ol, sizeof ol), (double)c->offset[s],
+                    stream_bytes(f, st, NULL),
                     vdsh_encoding_name(st->encoding), fit, (double)m->pairs * 1e-6, mae, fa, rc,
                     m->binary_mae, 100.0 * m->binary_false_shadow, 100.0 * m->binary_recall);
         }
@@ -584,9 +615,11 @@ static void print_table(FILE *o, const context *c)
                      196.0 * m->false_shadow_se);
             snprintf(le, sizeof le, "%.2f+-%.2f%%", 100.0 * m->light_leak,
                      196.0 * m->light_leak_se);
-            fprintf(o, "  %-8s %5u %+6.2f %3zu %3s %-9s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s "
+            char ol[16];
+            fprintf(o, "  %-8s %5s %+6.2f %3.0f %3s %-9s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s "
                        "%-13s | %6.4f %5.2f%% %5.2f%%\n",
-                    kind_name(k), st->order, (double)c->offset[s], vdsh_stream_bytes_per_vertex(st),
+                    kind_name(k), order_label(st, ol, sizeof ol), (double)c->offset[s],
+                    stream_bytes(f, st, NULL),
                     vdsh_encoding_name(st->encoding), fit, rms,
                     m->distance_p50, m->distance_p90, m->distance_p99, mae, fa, le,
                     m->binary_mae, 100.0 * m->binary_false_shadow,

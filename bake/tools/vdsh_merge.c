@@ -76,7 +76,8 @@ static int same_sources(const vdsh_file *a, const vdsh_file *b)
 
 static int same_stream(const vdsh_stream *a, const vdsh_stream *b)
 {
-    return a->order == b->order && a->encoding == b->encoding && a->method == b->method &&
+    return a->order == b->order && a->flags == b->flags && a->encoding == b->encoding &&
+           a->method == b->method &&
            a->quantity == b->quantity && a->window == b->window &&
            memcmp(&a->window_param, &b->window_param, 4) == 0 &&
            memcmp(&a->method_param, &b->method_param, 4) == 0 &&
@@ -135,6 +136,8 @@ int main(int argc, char **argv)
     int status = 1;
     vdsh_file *p0 = NULL, *part = NULL;
     float *merged[VDSH_MAX_STREAMS] = {0};
+    uint8_t *orders[VDSH_MAX_STREAMS] = {0};    /* variable-order streams' */
+    uint32_t *offsets[VDSH_MAX_STREAMS] = {0};
     void *encoded[VDSH_MAX_STREAMS] = {0};
     float s8_scales[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS];
     int *owner = NULL;
@@ -191,6 +194,9 @@ int main(int argc, char **argv)
                 streams[s] = p0->streams[s];
                 size_t nc = (size_t)streams[s].order * streams[s].order;
                 missing = !(merged[s] = malloc((size_t)V * nc * sizeof(float) + 1));
+                if (streams[s].flags & VDSH_STREAM_VARIABLE) /* rows of nc, zero-padded */
+                    missing |= !(orders[s] = malloc((size_t)V + 1)) ||
+                                !(offsets[s] = malloc(((size_t)V + 1) * sizeof(uint32_t)));
             }
             if (missing) {
                 fprintf(stderr, "vdsh-merge: out of memory for %u receivers\n", V);
@@ -223,7 +229,13 @@ int main(int argc, char **argv)
         memcpy(normals + 3 * (size_t)b, p->normals + 3 * (size_t)b, (size_t)(e - b) * 12);
         for (uint32_t s = 0; s < p->stream_count; s++) {
             size_t nc = (size_t)streams[s].order * streams[s].order;
-            memcpy(merged[s] + b * nc, p->streams[s].data, (e - b) * nc * sizeof(float));
+            if (orders[s]) { /* each row's own order, decoded with zeros past it */
+                memcpy(orders[s] + b, p->streams[s].orders, e - b);
+                for (uint32_t r = 0; r < e - b; r++)
+                    vdsh_stream_decode(&p->streams[s], r, merged[s] + (b + r) * nc);
+            } else {
+                memcpy(merged[s] + b * nc, p->streams[s].data, (e - b) * nc * sizeof(float));
+            }
         }
         vdsh_free(part);
         part = NULL;
@@ -241,7 +253,32 @@ int main(int argc, char **argv)
     for (uint32_t s = 0; s < f.stream_count; s++) {
         size_t nc = (size_t)streams[s].order * streams[s].order;
         streams[s].data = merged[s];
-        if (p0->part.encoding == VDSH_ENCODING_F16) {
+        if (orders[s]) {
+            /* As vb_bake_variable_stream: the same scale rule, one encoder. */
+            uint32_t e = p0->part.encoding;
+            float scale = 1.0f, amax = 0.0f;
+            if (e == VDSH_ENCODING_F16) {
+                for (size_t k = 0; k < (size_t)V * nc; k++)
+                    amax = fmaxf(amax, fabsf(merged[s][k]));
+                scale = vdsh_f16_scale(amax);
+            }
+            vdsh_stream_offsets(orders[s], V, e, offsets[s]);
+            streams[s].encoding = e;
+            streams[s].scale = scale;
+            streams[s].orders = orders[s];
+            streams[s].offsets = offsets[s];
+            streams[s].coef_scales = vdsh_encoding_quantised(e) ? s8_scales[s] : NULL;
+            if (!(encoded[s] = malloc(4 * (size_t)offsets[s][V] + 1)) ||
+                vdsh_encode_variable(e, merged[s], nc, orders[s], V, streams[s].order, scale,
+                                     offsets[s], s8_scales[s], encoded[s]) != VDSH_OK) {
+                fprintf(stderr, "vdsh-merge: adaptive-order coefficients do not fit %s\n",
+                        vdsh_encoding_name(e));
+                goto out;
+            }
+            free(merged[s]);
+            merged[s] = NULL;
+            streams[s].data = encoded[s];
+        } else if (p0->part.encoding == VDSH_ENCODING_F16) {
             /* As vb_bake_stream: the same scale rule, vdsh_f16_scale. */
             float amax = 0.0f;
             for (size_t k = 0; k < (size_t)V * nc; k++)
@@ -307,7 +344,7 @@ int main(int argc, char **argv)
 out:
     vb_cubemap_basis_free(&basis);
     for (int s = 0; s < VDSH_MAX_STREAMS; s++)
-        free(merged[s]), free(encoded[s]);
+        free(merged[s]), free(encoded[s]), free(orders[s]), free(offsets[s]);
     free(owner);
     free(normals);
     vdsh_free(part);
