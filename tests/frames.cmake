@@ -23,7 +23,8 @@ endif()
 # vertex in every mode) and the paper's (distance; order 5 per fragment,
 # with the basis cubemaps and as polynomials; and the default bake's streams
 # drawn from buffer textures, VR_MODE_VDSH_BUFFER, and streams of orders 7,
-# 9, 12 and with an order per vertex derived from it): mean difference <= 0.002 and
+# 9, 12 and with an order per vertex, derived from it and baked):
+# mean difference <= 0.002 and
 # at most 0.5% of the pixels off by more than 0.1 in every frame (measured
 # on llvmpipe: <= 1e-4 and 0.003%; one order for another: 0.019 and 3.7%).
 # Skips (77) without GL.
@@ -58,6 +59,14 @@ done
 "$frames" truth "$d/high.vdsh" --views "$views" -o "$d/high-c" > /dev/null
 "$view" "$d/high.vdsh" --views "$views" --frames "$d/high-gl" --modes buf7,buf9,buf12,adaptive -q
 "$cmp" "$views" "$d/high-c" "$d/high-gl" 0.002 0.005 \
+  buf7=c-vdsh7 buf9=c-vdsh9 buf12=c-vdsh12 adaptive=c-vdsh11
+# The same from the baker: orders 7, 9, 12 (s8s6) and an adaptive order up
+# to 11 (c-vdsh11 is its C frame).
+"$bake" builtin:room --max-edge 0.5 --rays 400 --cube-size 0 --orders 7,9,12 \
+  --adaptive-order 0.05 --max-order 11 -q -o "$d/baked.vdsh"
+"$frames" truth "$d/baked.vdsh" --views "$views" -o "$d/baked-c" > /dev/null
+"$view" "$d/baked.vdsh" --views "$views" --frames "$d/baked-gl" --modes buf7,buf9,buf12,adaptive -q
+"$cmp" "$views" "$d/baked-c" "$d/baked-gl" 0.002 0.005 \
   buf7=c-vdsh7 buf9=c-vdsh9 buf12=c-vdsh12 adaptive=c-vdsh11
 ]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames> $<TARGET_FILE:vdsh-view>
        $<TARGET_FILE:test_frames_gl> ${CMAKE_CURRENT_BINARY_DIR}/frames_gl
