@@ -47,6 +47,8 @@ int vv_frame_mode_available(const vr_scene *s, const vv_frame_mode *m)
 
 void vv_mode_label(const vr_scene *s, vr_mode mode, int stream, char *out, size_t size)
 {
+    if (mode == VR_MODE_DEFAULT)
+        mode = vr_scene_default_mode(s);
     if (mode != VR_MODE_VDSH_BUFFER) {
         snprintf(out, size, "%s", vr_scene_mode_label(s, mode));
         return;

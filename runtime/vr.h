@@ -307,9 +307,12 @@ const char *vr_mode_label(vr_mode m);
 /* The mode VR_MODE_DEFAULT draws for a scene, the one definition of the
  * default that vdsh-view (no --mode) uses too: order 5 the paper's way
  * (VR_MODE_VDSH5) where the scene supports it, else order 5 with the
- * polynomials, else the highest of orders 3 and 2 the file has. A scene
- * with none of these streams gets VR_MODE_VDSH5, which vr_draw refuses
- * with VR_ERR_MISSING naming the stream. Never VR_MODE_DEFAULT. */
+ * polynomials, else the highest of orders 3 and 2 the file has, else
+ * VR_MODE_VDSH_BUFFER when it has a buffer stream (a bake of orders above 5
+ * or of adaptive order only; vr_draw_desc.stream 0 then draws its
+ * default). A scene with none of these streams gets VR_MODE_VDSH5, which
+ * vr_draw refuses with VR_ERR_MISSING naming the stream. Never
+ * VR_MODE_DEFAULT. */
 vr_mode vr_scene_default_mode(const vr_scene *s);
 /* 1 when the scene has what the mode needs (stream, cubemaps; for
  * VR_MODE_VDSH_BUFFER any buffer stream). Here and below VR_MODE_DEFAULT

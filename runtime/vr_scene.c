@@ -401,9 +401,9 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
 
 vr_mode vr_scene_default_mode(const vr_scene *s)
 {
-    static const vr_mode best_first[4] = {VR_MODE_VDSH5, VR_MODE_VDSH5_POLY, VR_MODE_VDSH3,
-                                          VR_MODE_VDSH2};
-    for (int i = 0; i < 4; i++)
+    static const vr_mode best_first[5] = {VR_MODE_VDSH5, VR_MODE_VDSH5_POLY, VR_MODE_VDSH3,
+                                          VR_MODE_VDSH2, VR_MODE_VDSH_BUFFER};
+    for (int i = 0; i < 5; i++)
         if (vr_scene_supports(s, best_first[i]))
             return best_first[i];
     return VR_MODE_VDSH5;

@@ -447,7 +447,14 @@ grep -q "| adaptive" "$d/grid.log"
 "$png" info "$d/grid5.png" 480 72
 "$v" --help | grep -q "bufN the stream of order N"
 "$v" --help | grep -q "adaptive-order column\|| adaptive order"
-]=] sh ${_view} ${_png} $<TARGET_FILE:test_runtime_buffer> ${_room_log} ${_rt_dir}/view_buffer)
+# A bake of adaptive order alone: the default mode is the buffer's
+"$6" builtin:room --max-edge 1.0 --rays 256 --adaptive-order 0.05 --max-order 9 -q \
+  -o "$d/adaptive.vdsh"
+"$v" --render "$d/default.png" --size 96x72 "$d/adaptive.vdsh" 2> "$d/default.log"
+cat "$d/default.log"
+grep -q "mode buffer: VDSH adaptive order (up to 9" "$d/default.log"
+]=] sh ${_view} ${_png} $<TARGET_FILE:test_runtime_buffer> ${_room_log} ${_rt_dir}/view_buffer
+       $<TARGET_FILE:vdsh-bake>)
 
 foreach(t runtime_view_usage runtime_view_errors runtime_view_render runtime_view_bench
           runtime_view_frame runtime_view_window runtime_view_frames runtime_view_buffer)
