@@ -564,6 +564,10 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
         if (!buf && d.stream == VR_STREAM_VARIABLE)
             return vr_fail(err, VR_ERR_MISSING, "mode buffer: the scene has no %s stream with "
                            "an order per vertex", vdsh_quantity_name(s->quantity));
+        if (!buf && d.stream == 0)
+            return vr_fail(err, VR_ERR_MISSING, "mode buffer: the scene has no %s stream in a "
+                           "buffer (orders above 5, an order per vertex; orders 1-5 with "
+                           "vr_scene_desc.buffers)", vdsh_quantity_name(s->quantity));
         if (!buf)
             return vr_fail(err, VR_ERR_MISSING,
                            "mode buffer: the scene has no order-%d %s stream in a buffer%s",
