@@ -180,8 +180,9 @@ static void test_vertex(void)
             float *pos = rt_read(r, W, H);
             int found = 0;
             for (int k = 0; k < NV; k++)
-                found += pos[4 * k + 3] == 1.0f &&
-                         fabsf(pos[4 * k] - f.pos[3 * k]) + fabsf(pos[4 * k + 1] - f.pos[3 * k + 1]) < 1e-5f;
+                found += pos[4 * k + 3] == 1.0f && fabsf(pos[4 * k] - f.pos[3 * k]) +
+                                                          fabsf(pos[4 * k + 1] - f.pos[3 * k + 1]) <
+                                                      1e-5f;
             free(pos);
             CHECK(found == NV, "%s: %d of %d vertices at their pixels", enc_name[e], found, NV);
             for (int o = 0; o < NORDERS && ORDERS[o] <= VDSH_MAX_ORDER; o++) {
@@ -217,8 +218,8 @@ static void test_vertex(void)
     for (int o = 0; o < NORDERS && ORDERS[o] <= VDSH_MAX_ORDER; o++) {
         tally *t = &all[o];
         printf("vertex order %2d: %ld receivers checked (s = 0: %ld, s = 1: %ld, clamped: %ld), "
-               "%ld wrong; largest |GPU - C| sum / max(1, sum |c_i|): %.2g\n", ORDERS[o], t->checked,
-               t->zero, t->one, t->clamped, t->bad, t->worst);
+               "%ld wrong; largest |GPU - C| sum / max(1, sum |c_i|): %.2g\n", ORDERS[o],
+               t->checked, t->zero, t->one, t->clamped, t->bad, t->worst);
         CHECK(t->bad == 0, "order %d: %ld receivers disagree", ORDERS[o], t->bad);
         CHECK(t->checked == 5L * 2 * 3 * NV, "order %d: %ld checked", ORDERS[o], t->checked);
         CHECK(t->zero > t->checked / 50 && t->one > t->checked / 50 &&
@@ -475,8 +476,9 @@ static void test_errors(const char *path)
          * coefficients (f32, f16, s8; s8s6 words need none) */
         size_t nc = (size_t)st->order * st->order, texels = (nc + 3) / 4;
         size_t bpv = vdsh_stream_bytes_per_vertex(st);
-        size_t rec = st->encoding == VDSH_ENCODING_S8S6 ? (bpv + 3) / 4 * 4
-                                                         : texels * vdsh_encoding_bytes(st->encoding, 4);
+        size_t rec = st->encoding == VDSH_ENCODING_S8S6
+                         ? (bpv + 3) / 4 * 4
+                         : texels * vdsh_encoding_bytes(st->encoding, 4);
         want += (size_t)f->header.vertex_count * rec;
         want_f += (size_t)f->header.vertex_count * 16 * texels;
         CHECK(bi.has_buffer[st->order], "order %u not buffered", st->order);
