@@ -166,16 +166,43 @@ float vdsh_shadow_interior(uint32_t order, uint32_t quantity, float max_distance
         return vdsh_shadow_compare(d, dl, compare);
     }
     /* DISTANCE and VISIBILITY: each vertex toward the light. */
+    float dv[3];
+    for (int k = 0; k < 3; k++)
+        dv[k] = vdsh_vertex_distance(order, quantity, max_distance, c[k], pv[k], l);
+    if (interp == VDSH_INTERP_DISTANCE)
+        return vdsh_shadow_interior_distance(dv, pv, b, l, compare, d_vis);
     float d = 0.0f, s = 0.0f;
     for (int k = 0; k < 3; k++) {
         float dk[3];
         float dlk = toward(pv[k], l, dk);
-        float dvk =
-            dlk > 0.0f ? vdsh_stream_distance(order, quantity, max_distance, c[k], dk) : 0.0f;
-        d += b[k] * dvk;
-        s += b[k] * vdsh_shadow_compare(dvk, dlk, compare);
+        d += b[k] * dv[k];
+        s += b[k] * vdsh_shadow_compare(dv[k], dlk, compare);
     }
     if (d_vis)
         *d_vis = d;
-    return interp == VDSH_INTERP_DISTANCE ? vdsh_shadow_compare(d, dl, compare) : s;
+    return s;
+}
+
+float vdsh_vertex_distance(uint32_t order, uint32_t quantity, float max_distance,
+                           const float *c, const float pv[3], const float l[3])
+{
+    float dk[3];
+    float dlk = toward(pv, l, dk);
+    return dlk > 0.0f ? vdsh_stream_distance(order, quantity, max_distance, c, dk) : 0.0f;
+}
+
+float vdsh_shadow_interior_distance(const float dv[3], const float *const pv[3],
+                                    const float b[3], const float l[3], uint32_t compare,
+                                    float *d_vis)
+{
+    float p[3], w[3];
+    for (int i = 0; i < 3; i++)
+        p[i] = b[0] * pv[0][i] + b[1] * pv[1][i] + b[2] * pv[2][i];
+    const float dl = toward(p, l, w);
+    float d = 0.0f;
+    for (int k = 0; k < 3; k++)
+        d += b[k] * dv[k];
+    if (d_vis)
+        *d_vis = d;
+    return vdsh_shadow_compare(d, dl, compare);
 }

@@ -144,6 +144,23 @@ float vdsh_shadow_interior(uint32_t order, uint32_t quantity, float max_distance
                            const float b[3], const float l[3], uint32_t compare,
                            float *d_vis);
 
+/* The per-vertex half of the DISTANCE and VISIBILITY paths: the distance
+ * vertex pv reconstructs toward the light at l from its order^2
+ * coefficients c (vdsh_stream_distance toward l from pv; 0 for a light at
+ * the vertex). It depends on the vertex and the light only, so a caller
+ * may compute it once per vertex and light, as the runtime's vertex stage
+ * does, and a variable-order stream's vertex with its own order. */
+float vdsh_vertex_distance(uint32_t order, uint32_t quantity, float max_distance,
+                           const float *c, const float pv[3], const float l[3]);
+
+/* The rest of the DISTANCE path: dv[k], vertex k's vdsh_vertex_distance,
+ * interpolated at p = sum b_k pv[k] and compared with p's own light
+ * distance. vdsh_shadow_interior computes its DISTANCE path with these two
+ * functions, so the result is the same to the bit. d_vis as there. */
+float vdsh_shadow_interior_distance(const float dv[3], const float *const pv[3],
+                                    const float b[3], const float l[3], uint32_t compare,
+                                    float *d_vis);
+
 #ifdef __cplusplus
 }
 #endif

@@ -5,12 +5,13 @@
 #   frames_box     a floor, a box and a light: the shadow's pixel count
 #                  against geometry; byte-identical across thread counts
 #   frames_views   views: valid, in free space, lit and shadowed, seeded
+#   frames_orders  order 7 and variable-order streams (c-vdsh7, c-vdsh-var)
 #   frames_errors  bad input: exit 1 naming the file, usage errors exit 2
 if(TARGET vb_frames)
   add_executable(test_frames ${CMAKE_CURRENT_LIST_DIR}/test_frames.c)
   target_link_libraries(test_frames PRIVATE vb_frames vt_tools m)
   add_test(NAME frames_score COMMAND test_frames score)
-  foreach(part oracle box views errors)
+  foreach(part oracle box views orders errors)
     add_test(NAME frames_${part}
              COMMAND test_frames ${part} $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames>
                      ${CMAKE_CURRENT_BINARY_DIR}/frames_${part})

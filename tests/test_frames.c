@@ -17,6 +17,11 @@
  *            view's lights light and shadow a share of it, no surface
  *            nearer than 5% of the diagonal; the same file for the same
  *            seed (on 1 thread and on 2), another for another seed
+ *   orders   orders above 5 and variable-order streams: a stream whose
+ *            every vertex has order 7 scores and draws exactly as the
+ *            fixed order-7 stream (c-vdsh-var = c-vdsh7); with orders 3
+ *            and 7 mixed, a triangle of one order's vertices draws as that
+ *            order's fixed stream
  *   errors   missing and invalid view sets, a frame of another size, a
  *            missing frame: exit 1 naming the file and no output; usage
  *            errors exit 2
@@ -42,6 +47,7 @@
 #include "frames.h"
 #include "test_util.h"
 #include "vdsh.h"
+#include "vdsh_shadow.h"
 #include "vt_image.h"
 #include "vt_json.h"
 #include "vt_views.h"
@@ -585,6 +591,204 @@ static int part_oracle(void)
     return test_report("frames_oracle");
 }
 
+/* ---- orders: orders above 5 and a variable-order stream ------------------------------------- */
+
+/* A copy of file f with one more stream: the variable-order stream (f32,
+ * scale 1) whose vertex v has order orders[v] and the coefficients of f's
+ * fixed stream of that order, to `out`. 0 on success. */
+static int write_variable(const vdsh_file *f, const uint8_t *orders, uint32_t cap,
+                          const char *out)
+{
+    const uint32_t rows = vdsh_file_stream_vertices(f), nc = cap * cap;
+    float *src = calloc((size_t)rows * nc, sizeof *src);
+    uint32_t *offsets = malloc((rows + 1) * sizeof *offsets);
+    vdsh_stream *streams = calloc(f->stream_count + 1, sizeof *streams);
+    float scales[VDSH_MAX_COEFFS], c[VDSH_MAX_COEFFS];
+    void *data = NULL;
+    int rc = -1;
+    if (!src || !offsets || !streams)
+        goto done;
+    const vdsh_stream *base = NULL;
+    for (uint32_t v = 0; v < rows; v++) {
+        const vdsh_stream *st = vdsh_find_stream(f, orders[v], VDSH_QUANTITY_LOG_DISTANCE);
+        if (!st) {
+            fprintf(stderr, "%s: no log-distance stream of order %u\n", out, orders[v]);
+            goto done;
+        }
+        base = base ? base : st;
+        vdsh_stream_decode(st, v, c);
+        memcpy(src + (size_t)v * nc, c, (size_t)orders[v] * orders[v] * sizeof *c);
+    }
+    vdsh_stream_offsets(orders, rows, VDSH_ENCODING_F32, offsets);
+    data = malloc(4 * (size_t)offsets[rows] + 4);
+    if (!data || vdsh_encode_variable(VDSH_ENCODING_F32, src, nc, orders, rows, cap, 1.0f,
+                                      offsets, scales, data) != VDSH_OK)
+        goto done;
+    memcpy(streams, f->streams, f->stream_count * sizeof *streams);
+    vdsh_stream *vs = &streams[f->stream_count];
+    *vs = *base;
+    vs->order = cap;
+    vs->encoding = VDSH_ENCODING_F32;
+    vs->scale = 1.0f;
+    vs->data = data;
+    vs->coef_scales = NULL;
+    vs->flags = VDSH_STREAM_VARIABLE;
+    vs->orders = orders;
+    vs->offsets = offsets;
+    /* What the file will hold decodes to the fixed streams' values. */
+    float d[VDSH_MAX_COEFFS];
+    int same = 1;
+    for (uint32_t v = 0; v < rows; v++) {
+        vdsh_stream_decode(vs, v, d);
+        same &= memcmp(d, src + (size_t)v * nc, nc * sizeof *d) == 0;
+    }
+    CHECK(same, "the variable stream decodes to the fixed streams' coefficients");
+    vdsh_file g = *f;
+    g.streams = streams;
+    g.stream_count = f->stream_count + 1;
+    vdsh_error ve;
+    rc = vdsh_write(out, &g, &ve) == VDSH_OK ? 0 : -1;
+    if (rc)
+        fprintf(stderr, "%s: %s\n", out, ve.msg);
+done:
+    free(src);
+    free(offsets);
+    free(streams);
+    free(data);
+    return rc;
+}
+
+/* c-vdsh-var of a stream whose every vertex has order 7 scores exactly as
+ * c-vdsh7 and draws the same frames; with orders 3 and 7 mixed, a
+ * triangle of order-3 vertices draws as c-vdsh3 and one of order-7
+ * vertices as c-vdsh7 (each vertex takes its own order). */
+static int part_orders(void)
+{
+    char *fixed = path_in("room37.vdsh"), *all7 = path_in("room-all7.vdsh"),
+         *mixed = path_in("room-mixed.vdsh"), *views = path_in("room.views.json"),
+         *truth = path_in("truth"), *json = path_in("orders.json");
+    int rc = run((char *[]){(char *)bake, "builtin:room", "--max-edge", "1", "--rays", "64",
+                            "--orders", "3,7", "--cube-size", "0", "-q", "-o", fixed, NULL});
+    CHECK(rc == 0, "bake orders 3,7: exit %d", rc);
+    if (rc) {
+        show_stderr();
+        return test_report("frames_orders");
+    }
+    vdsh_file *f = NULL;
+    vdsh_error ve;
+    CHECK(vdsh_read(fixed, &f, &ve) == VDSH_OK, "%s", ve.msg);
+    if (!f)
+        return test_report("frames_orders");
+    const uint32_t rows = vdsh_file_stream_vertices(f);
+    uint8_t *o7 = malloc(rows), *o37 = malloc(rows);
+    float mid = 0.0f;
+    for (uint32_t v = 0; v < rows; v++)
+        mid += f->positions[3 * v] / (float)rows;
+    for (uint32_t v = 0; v < rows; v++) {
+        o7[v] = 7;
+        o37[v] = f->positions[3 * v] < mid ? 3 : 7;
+    }
+    CHECK(write_variable(f, o7, 7, all7) == 0, "write %s", all7);
+    CHECK(write_variable(f, o37, 7, mixed) == 0, "write %s", mixed);
+    CHECK(room_views(all7, views, "1", "2") == 0, "views");
+
+    /* All order 7: the same scores and frames as the fixed stream. */
+    rc = run((char *[]){(char *)frames, "truth", all7, "--views", views, "-o", truth, NULL});
+    CHECK(rc == 0, "truth: exit %d", rc);
+    rc = run((char *[]){(char *)frames, "score", all7, "--views", views, "--truth", truth,
+                        "--frames", truth, "--modes", "c-vdsh3,c-vdsh7,c-vdsh-var", "--json",
+                        json, NULL});
+    CHECK(rc == 0, "score: exit %d", rc);
+    if (rc)
+        show_stderr();
+    char msg[4300];
+    cJSON *j = rc == 0 ? vt_json_read_file(json, msg, sizeof msg) : NULL;
+    const cJSON *c3 = mode_scene(j, "c-vdsh3"), *c7 = mode_scene(j, "c-vdsh7"),
+                *cv = mode_scene(j, "c-vdsh-var");
+    CHECK(c3 && c7 && cv, "the JSON has every mode's scene");
+    if (c3 && c7 && cv) {
+        const char *keys[] = {"rmse_ideal", "rmse_hard", "recall", "false_area", "shadowed",
+                              "lit", "blotches", "blotch_area"};
+        for (size_t k = 0; k < sizeof keys / sizeof *keys; k++)
+            CHECK(vt_json_number(c7, keys[k]) == vt_json_number(cv, keys[k]) ||
+                      (isnan(vt_json_number(c7, keys[k])) && isnan(vt_json_number(cv, keys[k]))),
+                  "%s: c-vdsh7 %g, c-vdsh-var %g", keys[k], vt_json_number(c7, keys[k]),
+                  vt_json_number(cv, keys[k]));
+        double r7 = vt_json_number(c7, "rmse_ideal"), r3 = vt_json_number(c3, "rmse_ideal");
+        CHECK(r7 > 0.0 && r7 < 1.0 && r3 > 0.0 && r3 != r7, "rmse c-vdsh3 %g c-vdsh7 %g", r3, r7);
+    }
+    cJSON_Delete(j);
+    vt_views V = {0};
+    CHECK(vt_views_read(views, &V, msg, sizeof msg) == 0, "%s", msg);
+    int frames_same = V.count > 0;
+    for (int vi = 0; vi < V.count; vi++) {
+        float *a = frame(truth, V.views[vi].name, 0, 0, "c-vdsh7", V.width, V.height);
+        float *b = frame(truth, V.views[vi].name, 0, 0, "c-vdsh-var", V.width, V.height);
+        frames_same &= a && b && memcmp(a, b, sizeof *a * V.width * V.height) == 0;
+        free(a);
+        free(b);
+    }
+    CHECK(frames_same, "c-vdsh-var's frames are c-vdsh7's");
+
+    /* Mixed orders, in this process: per triangle, its vertices' order. */
+    scene3 S;
+    if (V.count > 0 && scene_load(mixed, "builtin:room", &S) == 0) {
+        const size_t n = (size_t)V.width * V.height;
+        float *s3 = malloc(n * sizeof *s3), *s7 = malloc(n * sizeof *s7),
+              *sv = malloc(n * sizeof *sv);
+        uint32_t i3 = UINT32_MAX, i7 = UINT32_MAX, iv = UINT32_MAX;
+        for (uint32_t s = 0; s < S.f->stream_count; s++) {
+            const vdsh_stream *st = &S.f->streams[s];
+            if (st->flags & VDSH_STREAM_VARIABLE)
+                iv = s;
+            else if (st->order == 3)
+                i3 = s;
+            else if (st->order == 7)
+                i7 = s;
+        }
+        vb_frames_hits h = {0};
+        vb_error err;
+        uint64_t pure3 = 0, pure7 = 0, bad = 0;
+        for (int vi = 0; vi < V.count && iv != UINT32_MAX; vi++) {
+            const float *L = V.views[vi].lights[0][0];
+            if (vb_frames_trace_primary(S.fs, &V.views[vi].camera, V.width, V.height, 0, &h,
+                                        &err) != VB_OK ||
+                vb_frames_eval_stream(S.fs, &h, i3, L, VDSH_COMPARE_SMOOTH, 0, s3, &err) ||
+                vb_frames_eval_stream(S.fs, &h, i7, L, VDSH_COMPARE_SMOOTH, 0, s7, &err) ||
+                vb_frames_eval_stream(S.fs, &h, iv, L, VDSH_COMPARE_SMOOTH, 0, sv, &err)) {
+                CHECK(0, "%s", err.msg);
+                break;
+            }
+            for (size_t i = 0; i < n; i++) {
+                if (h.triangle[i] == UINT32_MAX)
+                    continue;
+                const uint32_t *ix = S.f->indices + 3 * (size_t)h.triangle[i];
+                int k3 = o37[ix[0]] == 3 && o37[ix[1]] == 3 && o37[ix[2]] == 3;
+                int k7 = o37[ix[0]] == 7 && o37[ix[1]] == 7 && o37[ix[2]] == 7;
+                pure3 += k3;
+                pure7 += k7;
+                bad += (k3 && sv[i] != s3[i]) || (k7 && sv[i] != s7[i]);
+            }
+            vb_frames_hits_free(&h);
+        }
+        CHECK(iv != UINT32_MAX && i3 != UINT32_MAX && i7 != UINT32_MAX, "streams found");
+        CHECK(pure3 > 100 && pure7 > 100 && bad == 0,
+              "mixed orders: %llu order-3 pixels, %llu order-7, %llu not their order's",
+              (unsigned long long)pure3, (unsigned long long)pure7, (unsigned long long)bad);
+        free(s3);
+        free(s7);
+        free(sv);
+        scene_free(&S);
+    } else {
+        CHECK(0, "load %s", mixed);
+    }
+    vt_views_free(&V);
+    free(o7);
+    free(o37);
+    vdsh_free(f);
+    return test_report("frames_orders");
+}
+
 /* ---- errors ---------------------------------------------------------------------------------- */
 
 static int part_errors(void)
@@ -716,6 +920,8 @@ int main(int argc, char **argv)
         return part_oracle();
     if (strcmp(argv[1], "box") == 0)
         return part_box();
+    if (strcmp(argv[1], "orders") == 0)
+        return part_orders();
     if (strcmp(argv[1], "views") == 0)
         return part_views();
     if (strcmp(argv[1], "errors") == 0)

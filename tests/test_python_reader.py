@@ -19,6 +19,8 @@ network, Debian's pip and setuptools), imports it from there, and checks:
   stream the whole f32 bake's rows of its range, reconstruct refusing a
   vertex outside it;
 - an adaptive bake (vdsh-bake --adaptive): its `adpt` chunk read alike;
+- orders 7 and 12, and adaptive-order bakes (variable-order streams) in
+  s8s6, f16 and f32: their per-order vertex counts read alike;
 - reconstruction: for the default bake's order-5 log stream, distances
   toward 64 directions at 50 vertices equal exp of the SH sum clamped to
   max_distance, and lie in (0, max_distance].
@@ -110,6 +112,11 @@ def compare(path):
                 fail.append("%s: stream %s: C %s, Python %s" % (path, k, cs[k], ps[k]))
         if not close(cs["scale"], ps["scale"]):
             fail.append("%s: stream scale" % path)
+        if cs.get("variable_order", False) != ps["variable_order"] or (
+                ps["variable_order"] and list(np.bincount(ps["orders"], minlength=ps["order"] + 1)[1:])
+                != cs["vertices_per_order"]):
+            fail.append("%s: variable order: C %s, Python %s" % (
+                path, cs.get("vertices_per_order"), ps["orders"]))
         c0 = vdsh.coefficients(ps)[:, 0]
         for k, v in (("min", c0.min()), ("max", c0.max()), ("mean", c0.astype(np.float64).mean())):
             if not close(cs["coefficient0"][k], float(v), 1e-5):
@@ -139,7 +146,12 @@ for name, args in (("default", []), ("paper-f32", ["--method", "paper", "--encod
                    ("s8-small", ["--encoding", "s8", "--orders", "3"]),
                    ("s8s6", ["--encoding", "s8s6"]),
                    ("s8s6-small", ["--encoding", "s8s6", "--orders", "3,5"]),
-                   ("adaptive", ["--adaptive", "0.05"])):
+                   ("adaptive", ["--adaptive", "0.05"]),
+                   ("order12", ["--orders", "7,12", "--encoding", "f16"]),
+                   ("adaptive-order", ["--adaptive-order", "0.02", "--max-order", "9",
+                                       "--orders", "3"]),
+                   ("adaptive-order-f16", ["--adaptive-order", "0.02", "--encoding", "f16"]),
+                   ("adaptive-order-f32", ["--adaptive-order", "0.02", "--encoding", "f32"])):
     out = os.path.join(work, name + ".vdsh")
     r = subprocess.run([bake, "builtin:room", "--max-edge", "1.5", "--rays", "256", "-q",
                         "--cube-size", "0", "-o", out] + args, capture_output=True, text=True)

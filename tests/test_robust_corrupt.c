@@ -200,13 +200,14 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *bake = argv[1], *info = argv[2], *dir = argv[3];
-    char obj[4096], a[4096], b[4096], c[4096], room[4096], err_path[4096];
+    char obj[4096], a[4096], b[4096], c[4096], room[4096], var[4096], err_path[4096];
     mkdir(dir, 0755);
     snprintf(obj, sizeof obj, "%s/scene.obj", dir);
     snprintf(a, sizeof a, "%s/scene-f16.vdsh", dir);
     snprintf(b, sizeof b, "%s/scene-f32.vdsh", dir);
     snprintf(c, sizeof c, "%s/scene-s8s6.vdsh", dir);
     snprintf(room, sizeof room, "%s/room.vdsh", dir);
+    snprintf(var, sizeof var, "%s/scene-var.vdsh", dir);
     snprintf(err_path, sizeof err_path, "%s/bake.err", dir);
     if (write_all(obj, (const uint8_t *)scene_obj, sizeof scene_obj - 1) != 0) {
         fprintf(stderr, "cannot write %s\n", obj);
@@ -221,15 +222,20 @@ int main(int argc, char **argv)
                       "--encoding", "f32", "--method", "full", "--record-timings", "--cube-size", "0",
                       "-q", "-o", b, NULL};
     char *bake_room[] = {(char *)bake, "builtin:room", "--rays", "16", "--cube-size", "0", "-q", "-o", room, NULL};
+    /* an adaptive order: the order table and records of every size */
+    char *bake_var[] = {(char *)bake, obj, "--max-edge", "1", "--rays", "64", "--cube-size", "0",
+                        "--adaptive-order", "0.01", "--max-order", "7", "-q", "-o", var, NULL};
     int ok = run(bake_a, err_path) == 0 && run(bake_b, err_path) == 0 &&
-             run(bake_c, err_path) == 0 && run(bake_room, err_path) == 0;
+             run(bake_c, err_path) == 0 && run(bake_room, err_path) == 0 &&
+             run(bake_var, err_path) == 0;
     CHECK(ok, "vdsh-bake failed (see %s)", err_path);
     if (!ok)
         return test_report("robust_corrupt");
 
-    const char *names[4] = {"scene-f16.vdsh", "scene-f32.vdsh", "scene-s8s6.vdsh", "room.vdsh"};
-    const char *paths[4] = {a, b, c, room};
-    for (int k = 0; k < 4; k++) {
+    const char *names[5] = {"scene-f16.vdsh", "scene-f32.vdsh", "scene-s8s6.vdsh", "room.vdsh",
+                            "scene-var.vdsh"};
+    const char *paths[5] = {a, b, c, room, var};
+    for (int k = 0; k < 5; k++) {
         size_t size;
         uint8_t *data = test_read_file(paths[k], &size);
         CHECK(data && size > 64, "cannot read %s", paths[k]);

@@ -396,6 +396,97 @@ static void stream_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
     }
 }
 
+/* The DISTANCE path in two steps, as the runtime draws it: each vertex a
+ * pixel needs reconstructs its distance toward the light once, with its
+ * own order (a variable-order stream's vertices have their own), then
+ * each pixel interpolates its triangle's three. The same bits as
+ * vdsh_shadow_interior (it calls the same two functions), many times
+ * fewer reconstructions: a vertex serves every pixel around it. */
+typedef struct vertex_pass {
+    const vdsh_file *f;
+    const vdsh_stream *st;
+    const uint8_t *need;         /* per vertex: some pixel's triangle has it */
+    const float *light;
+    float *dv;                   /* per vertex: its distance toward the light */
+} vertex_pass;
+
+static void vertex_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
+{
+    (void)worker;
+    const vertex_pass *V = ctx;
+    float c[VDSH_MAX_COEFFS];
+    for (uint32_t v = begin; v < end; v++) {
+        if (!V->need[v])
+            continue;
+        vdsh_stream_decode(V->st, v, c);
+        V->dv[v] = vdsh_vertex_distance(vdsh_stream_vertex_order(V->st, v), V->st->quantity,
+                                        V->f->header.max_distance, c,
+                                        V->f->positions + 3 * (size_t)v, V->light);
+    }
+}
+
+typedef struct distance_pass {
+    const vdsh_file *f;
+    const vb_frames_hits *hits;
+    const float *dv, *light;
+    uint32_t compare;
+    float *out;
+} distance_pass;
+
+static void distance_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
+{
+    (void)worker;
+    const distance_pass *D = ctx;
+    for (uint32_t i = begin; i < end; i++) {
+        uint32_t tri = D->hits->triangle[i];
+        if (tri == NONE) {
+            D->out[i] = 1.0f;
+            continue;
+        }
+        const uint32_t *ix = D->f->indices + 3 * (size_t)tri;
+        const float *pv[3];
+        float dv[3];
+        for (int k = 0; k < 3; k++) {
+            pv[k] = D->f->positions + 3 * (size_t)ix[k];
+            dv[k] = D->dv[ix[k]];
+        }
+        D->out[i] = vdsh_shadow_interior_distance(dv, pv, D->hits->bary + 3 * (size_t)i,
+                                                  D->light, D->compare, NULL);
+    }
+}
+
+static vb_result eval_distance(const vb_frames_scene *s, const vb_frames_hits *h,
+                               const vdsh_stream *st, const float light[3], uint32_t compare,
+                               unsigned threads, float *out, vb_error *err)
+{
+    const vdsh_file *f = s->file;
+    const uint32_t rows = f->header.vertex_count;
+    const uint32_t n = (uint32_t)((size_t)h->width * (size_t)h->height);
+    uint8_t *need = calloc(rows ? rows : 1, 1);
+    float *dv = malloc((rows ? rows : 1) * sizeof *dv);
+    vb_result r = VB_OK;
+    if (!need || !dv) {
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u vertex distances", rows);
+        goto done;
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        if (h->triangle[i] == NONE)
+            continue;
+        const uint32_t *ix = f->indices + 3 * (size_t)h->triangle[i];
+        need[ix[0]] = need[ix[1]] = need[ix[2]] = 1;
+    }
+    vertex_pass V = {.f = f, .st = st, .need = need, .light = light, .dv = dv};
+    distance_pass D = {.f = f, .hits = h, .dv = dv, .light = light, .compare = compare,
+                       .out = out};
+    if (!vb_parallel_for(threads, rows, 256, vertex_block, &V, NULL, NULL) ||
+        !vb_parallel_for(threads, n, 1024, distance_block, &D, NULL, NULL))
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
+done:
+    free(need);
+    free(dv);
+    return r;
+}
+
 vb_result vb_frames_eval_stream(const vb_frames_scene *s, const vb_frames_hits *h,
                                 uint32_t stream, const float light[3], uint32_t compare,
                                 unsigned threads, float *out, vb_error *err)
@@ -403,6 +494,13 @@ vb_result vb_frames_eval_stream(const vb_frames_scene *s, const vb_frames_hits *
     if (stream >= s->file->stream_count)
         return vb_fail(err, VB_ERR_ARGUMENT, "no stream %u (the file has %u)", stream,
                        s->file->stream_count);
+    const vdsh_stream *st = &s->file->streams[stream];
+    if (vdsh_runtime_interp(st->order, st->quantity) == VDSH_INTERP_DISTANCE)
+        return eval_distance(s, h, st, light, compare, threads, out, err);
+    if (st->flags & VDSH_STREAM_VARIABLE)
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "stream %u: a variable-order stream of quantity %u is not drawn per "
+                       "vertex distance (only log-distance ones are)", stream, st->quantity);
     pass P = {.s = s, .hits = h, .out_stream = out, .light = light, .compare = compare,
               .stream = stream};
     uint32_t n = (uint32_t)((size_t)h->width * (size_t)h->height);

@@ -23,7 +23,10 @@
  *           the interpolated normal faces the light (N . (L - p) > 0)
  *   stream  vdsh_shadow_interior with the triangle's three vertices, the
  *           barycentrics and vdsh_runtime_interp(order, quantity): the
- *           shadow the runtime draws there, computed in C
+ *           shadow the runtime draws there, computed in C (orders
+ *           1..16; on the DISTANCE path each vertex's distance is
+ *           reconstructed once per light, with its own order in a
+ *           variable-order stream, which is drawn only on that path)
  * Pixels whose ray meets nothing hold hard = ideal = stream = 1, mask 0.
  *
  * Scores (per frame, over mask pixels, pooled by adding tallies): RMSE

@@ -78,9 +78,12 @@ static void usage(FILE *f)
 "             exact distance through the runtime's comparison (--compare)\n"
 "    mask     1 where the pixel counts: a triangle is hit and its\n"
 "             interpolated normal faces the light (N . L > 0)\n"
-"    c-vdshN  the file's stream of order N, computed in C exactly on the\n"
-"             runtime's path (formats/vdsh_shadow.h: vdsh_shadow_interior\n"
-"             with the triangle's vertices and barycentrics)\n"
+"    c-vdshN  the file's stream of order N (1..16), computed in C exactly\n"
+"             on the runtime's path (formats/vdsh_shadow.h: vdsh_shadow_interior\n"
+"             with the triangle's vertices and barycentrics; log distance,\n"
+"             what method shadow bakes: each vertex's distance, interpolated)\n"
+"    c-vdsh-var  the file's variable-order stream (each vertex its own\n"
+"             order), on the per-vertex distance path\n"
 "  Pixels that meet nothing hold 1 (mask 0). Primary rays go through pixel\n"
 "  centres (formats/vdsh_camera.h, the camera the runtime projects with)\n"
 "  and meet the receiver mesh; normals are interpolated as the GPU does.\n"
@@ -97,7 +100,7 @@ static void usage(FILE *f)
 "\n"
 "score: reads the truth (hard, ideal, mask from --truth DIR) and the frames\n"
 "  of each mode in LIST (comma-separated: vdsh-view's modes cube, cube-pcf,\n"
-"  vdsh2, vdsh3, vdsh5, vdsh5poly, or c-vdshN, or hard and ideal\n"
+"  vdsh2, vdsh3, vdsh5, vdsh5poly, or c-vdshN, c-vdsh-var, or hard and ideal\n"
 "  themselves) from --frames DIR2, with the same names, and scores each\n"
 "  frame over its mask pixels; a light set pools its lights' frames and\n"
 "  the scene pools everything:\n"
@@ -385,6 +388,16 @@ done:
 
 /* ---- truth ----------------------------------------------------------------------------- */
 
+/* The mode a stream's C frames are named by: c-vdshN for a fixed-order
+ * stream of order N, c-vdsh-var for a variable-order stream. */
+static void stream_mode(const vdsh_stream *st, char *name, size_t cap)
+{
+    if (st->flags & VDSH_STREAM_VARIABLE)
+        snprintf(name, cap, "c-vdsh-var");
+    else
+        snprintf(name, cap, "c-vdsh%u", st->order);
+}
+
 static int make_dir(const char *dir)
 {
     struct stat st;
@@ -493,16 +506,23 @@ static int cmd_truth(int argc, char **argv)
     frame_item *items = calloc(3 + (size_t)f->stream_count, sizeof *items);
     uint8_t *rgba = malloc(4 * n);
     vb_error err;
-    /* One c-vdshN per order: the first stream of each. */
+    /* One c-vdshN per order, the first fixed-order stream of each, and one
+     * c-vdsh-var, the first variable-order stream (slot 0 of seen). */
     int use[VDSH_MAX_STREAMS] = {0}, seen[VDSH_ORDER_SLOTS] = {0};
     for (uint32_t s = 0; s < f->stream_count; s++) {
-        uint32_t o = f->streams[s].order;
-        if (o <= VDSH_MAX_ORDER && !seen[o]) {
+        const vdsh_stream *st = &f->streams[s];
+        uint32_t o = st->flags & VDSH_STREAM_VARIABLE ? 0 : st->order;
+        if (o <= VDSH_MAX_ORDER && !seen[o] &&
+            (o || vdsh_runtime_interp(st->order, st->quantity) == VDSH_INTERP_DISTANCE)) {
             use[s] = 1;
             seen[o] = 1;
         } else if (!co.quiet) {
-            fprintf(stderr, PROG ": %s: stream %u repeats order %u: only the first is drawn\n",
-                    path, s, o);
+            char name[32];
+            stream_mode(st, name, sizeof name);
+            fprintf(stderr, PROG ": %s: stream %u (%s): %s\n", path, s, name,
+                    seen[o] ? "a mode of that name is drawn already: only the first is"
+                            : "a variable-order stream is drawn only per vertex distance "
+                              "(log distance): skipped");
         }
     }
     if (!streams || !items || !rgba) {
@@ -567,8 +587,7 @@ static int cmd_truth(int argc, char **argv)
                     tc += vb_now() - t;
                     stream_frames++;
                     memset(&items[count], 0, sizeof items[count]);
-                    snprintf(items[count].mode, sizeof items[count].mode, "c-vdsh%u",
-                             f->streams[s].order);
+                    stream_mode(&f->streams[s], items[count].mode, sizeof items[count].mode);
                     items[count++].values = out;
                 }
                 t = vb_now();

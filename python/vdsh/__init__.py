@@ -6,6 +6,8 @@
     s = f.streams[0]                   # dict: order, encoding, method, quantity, ...
     c = vdsh.coefficients(s)           # V x order^2 float32 (stored x scale;
                                        # s8, s8s6: stored x float32(scale_i / levels_i))
+    s["variable_order"], s["orders"]   # a variable-order stream (VDSH.md): each vertex's
+                                       # order (V ints, 1..order); c is 0 past it
     d = vdsh.reconstruct(f, s, v, dirs)    # distances of vertex v toward unit dirs (N x 3)
     f.part                             # None, or a part of a sharded bake (VDSH.md "Parts"):
                                        # dict index, count, range_begin, range_end, encoding;
@@ -28,6 +30,7 @@ MAGIC = b"VDSH\r\n\x1a\n"
 METHODS = ["paper", "full", "mirror", "lsq", "shadow"]
 ENCODINGS = ["f32", "f16", "s8", "s8s6"]
 QUANTITIES = ["distance", "distance2", "log-distance"]
+MAX_ORDER = 16
 WINDOWS = ["none", "hann", "lanczos"]
 KNOWN = {b"HEAD", b"SRCS", b"POSN", b"NORM", b"TRIS", b"COEF", b"stat", b"time", b"part", b"adpt"}
 LOG_SUM_MAX = 80.0
@@ -229,13 +232,52 @@ def _chunk(f, cid, b, path):
                          threads=struct.unpack_from("<I", b, 40)[0])
 
 
+def _records(raw, nc, enc, levels, path):
+    """R records of nc coefficients (R x bpv bytes) to their stored values
+    (R x nc), with the encoding's rules: finite floats, s8 not -128, s8s6
+    fields within +-31 and unused bits zero."""
+    R = raw.shape[0]
+    if enc == 3:
+        words = (nc - 4 + 4) // 5 if nc > 4 else 0
+        stored = np.empty((R, nc), np.int32)
+        stored[:, :min(nc, 4)] = raw[:, :min(nc, 4)].view(np.int8)
+        if words:
+            w = raw[:, 4:4 + 4 * words].copy().view("<u4").reshape(R, words)
+            for i in range(4, nc):
+                fld = (w[:, (i - 4) // 5] >> np.uint32(6 * ((i - 4) % 5))) & np.uint32(63)
+                stored[:, i] = fld.astype(np.int32) - 64 * (fld >= 32)
+            used = np.array([(1 << (6 * min(5, nc - 4 - 5 * k))) - 1 for k in range(words)],
+                            np.uint32)
+            if (w & ~used).any():
+                _fail(path, "COEF: unused bits of an s8s6 word not zero")
+        if (stored < -levels[:nc].astype(np.int32)).any():
+            _fail(path, "COEF: an s8s6 stored value is below its range")
+    elif enc == 2:
+        stored = raw[:, :nc].copy().view("i1")
+        if (stored == -128).any():
+            _fail(path, "COEF: an s8 stored value is -128 (range -127..127)")
+    else:
+        size = [4, 2][enc]
+        stored = raw[:, :nc * size].copy().view(["<f4", "<f2"][enc]).astype(np.float32)
+        if not np.isfinite(stored).all():
+            _fail(path, "COEF: a stored value is not finite")
+    return stored
+
+
+def _bpv(enc, nc):
+    """Bytes of one record of nc coefficients (VDSH.md, COEF)."""
+    words = (nc - 4 + 4) // 5 if enc == 3 and nc > 4 else 0
+    return [4 * nc, 2 * nc, nc, min(nc, 4) + 4 * words][enc]
+
+
 def _coef(f, b, V, path):
     """One COEF stream of V rows (a part: its range's)."""
     if len(b) < 48:
         _fail(path, "COEF shorter than its header")
     order, enc, method, qty, win = struct.unpack_from("<5I", b, 0)
     wp, mp, scale, qp = struct.unpack_from("<4f", b, 20)
-    if not 1 <= order <= 5 or enc > 3 or qty > 2 or win > 2:
+    flags = struct.unpack_from("<I", b, 36)[0]
+    if not 1 <= order <= MAX_ORDER or enc > 3 or qty > 2 or win > 2:
         _fail(path, "COEF: order, encoding, quantity or window out of range")
     if not _finite(wp, mp) or (win == 0 and wp != 0) or (win != 0 and not wp > 0):
         _fail(path, "COEF: window_param or method_param out of range")
@@ -243,23 +285,21 @@ def _coef(f, b, V, path):
         _fail(path, "COEF: scale must be finite and > 0")
     if (qty == 2 and not (_finite(qp) and qp > 0)) or (qty != 2 and qp != 0):
         _fail(path, "COEF: quantity_param out of range")
-    if any(b[36:48]):
-        _fail(path, "COEF: reserved bytes 36..47 not zero")
+    if flags & ~1:
+        _fail(path, "COEF: flags 0x%x: unknown bits" % flags)
+    if any(b[40:48]):
+        _fail(path, "COEF: reserved bytes 40..47 not zero")
+    variable = bool(flags & 1)
     nc = order * order
-    n = V * nc
-    # bytes per vertex; s8s6: coefficients 0..3 as bytes, then u32 words
-    # of five 6-bit fields (coefficients 4..)
-    words = (nc - 4 + 4) // 5 if enc == 3 and nc > 4 else 0
-    bpv = [4 * nc, 2 * nc, nc, min(nc, 4) + 4 * words][enc]
     # s8, s8s6: order^2 f32 scales, zero-padded to 16 bytes, before the data
     table = (nc * 4 + 15) // 16 * 16 if enc >= 2 else 0
-    if len(b) != 48 + table + V * bpv:
-        _fail(path, "COEF: payload is %d bytes, must be %d" % (len(b), 48 + table + V * bpv))
     scales = levels = None
+    levels = np.array([31 if enc == 3 and i >= 4 else 127 for i in range(nc)], np.float32)
     if enc >= 2:
-        levels = np.array([31 if enc == 3 and i >= 4 else 127 for i in range(nc)], np.float32)
         if scale != 1:
             _fail(path, "COEF: scale must be 1 for %s" % ENCODINGS[enc])
+        if len(b) < 48 + table:
+            _fail(path, "COEF: shorter than its scale table")
         scales = np.frombuffer(b, "<f4", nc, 48)
         if not (np.isfinite(scales).all() and (scales >= 0).all()):
             _fail(path, "COEF: a scale of the table is not finite and >= 0")
@@ -268,42 +308,54 @@ def _coef(f, b, V, path):
                 _fail(path, "COEF: a scale's steps overflow f32")
         if any(b[48 + nc * 4:48 + table]):
             _fail(path, "COEF: padding after the scale table not zero")
-    if enc == 3:
-        raw = np.frombuffer(b, np.uint8, V * bpv, 48 + table).reshape(V, bpv)
-        stored = np.empty((V, nc), np.int32)
-        stored[:, :min(nc, 4)] = raw[:, :min(nc, 4)].view(np.int8)
-        if words:
-            w = raw[:, 4:].copy().view("<u4").reshape(V, words)
-            for i in range(4, nc):
-                fld = (w[:, (i - 4) // 5] >> np.uint32(6 * ((i - 4) % 5))) & np.uint32(63)
-                stored[:, i] = fld.astype(np.int32) - 64 * (fld >= 32)
-            used = np.array([(1 << (6 * min(5, nc - 4 - 5 * k))) - 1 for k in range(words)],
-                            np.uint32)
-            if (w & ~used).any():
-                _fail(path, "COEF: unused bits of an s8s6 word not zero")
-        if (stored < -levels.astype(np.int32)).any():
-            _fail(path, "COEF: an s8s6 stored value is below its range")
-    elif enc == 2:
-        stored = np.frombuffer(b, "i1", n, 48 + table).reshape(V, nc)
-        if (stored == -128).any():
-            _fail(path, "COEF: an s8 stored value is -128 (range -127..127)")
+    data = 48 + table
+    orders = None
+    if variable:
+        # VDSH.md "Variable-order streams": an order table (V bytes, padded
+        # to 16), then each row's record of its own order, padded to 4 bytes
+        otab = (V + 15) // 16 * 16
+        if len(b) < data + otab:
+            _fail(path, "COEF: shorter than its order table")
+        orders = np.frombuffer(b, np.uint8, V, data).astype(np.int64)
+        if any(b[data + V:data + otab]):
+            _fail(path, "COEF: padding after the order table not zero")
+        if ((orders < 1) | (orders > order)).any():
+            _fail(path, "COEF: a vertex order outside 1..%d" % order)
+        rec = np.array([(_bpv(enc, k * k) + 3) // 4 * 4 for k in range(order + 1)])
+        start = data + otab + np.concatenate(([0], np.cumsum(rec[orders])))
+        if len(b) != start[-1]:
+            _fail(path, "COEF: payload is %d bytes, must be %d" % (len(b), start[-1]))
+        buf = np.frombuffer(b, np.uint8)
+        stored = np.zeros((V, nc), np.float32 if enc < 2 else np.int32)
+        for k in np.unique(orders):
+            rows = np.nonzero(orders == k)[0]
+            raw = buf[start[rows][:, None] + np.arange(rec[k])]
+            used = _bpv(enc, k * k)
+            if raw[:, used:].any():
+                _fail(path, "COEF: padding after a record not zero")
+            stored[rows, :k * k] = _records(raw, k * k, enc, levels, path)
     else:
-        stored = np.frombuffer(b, ["<f4", "<f2"][enc], n, 48 + table).reshape(V, nc)
-    if enc < 2 and not np.isfinite(stored).all():
-        _fail(path, "COEF: a stored value is not finite")
-    big = float(np.abs(stored.astype(np.float32)).max()) if n else 0.0
+        bpv = _bpv(enc, nc)
+        if len(b) != data + V * bpv:
+            _fail(path, "COEF: payload is %d bytes, must be %d" % (len(b), data + V * bpv))
+        raw = np.frombuffer(b, np.uint8, V * bpv, data).reshape(V, bpv)
+        stored = _records(raw, nc, enc, levels, path)
+    big = float(np.abs(stored.astype(np.float32)).max()) if stored.size else 0.0
     with np.errstate(over="ignore"):
         if not np.isfinite(np.float32(big) * np.float32(scale)):
             _fail(path, "COEF: a stored value times scale overflows f32")
-    if any(s["order"] == order and s["quantity"] == QUANTITIES[qty] for s in f.streams):
-        _fail(path, "COEF: a second stream of order %d, %s" % (order, QUANTITIES[qty]))
+    if any(s["quantity"] == QUANTITIES[qty] and s["variable_order"] == variable and
+           (variable or s["order"] == order) for s in f.streams):
+        _fail(path, "COEF: a second %s stream, %s" % (
+            "variable-order" if variable else "order %d" % order, QUANTITIES[qty]))
     if len(f.streams) >= 15:
         _fail(path, "more than 15 COEF chunks")
     f.streams.append(dict(order=order, encoding=ENCODINGS[enc],
                           method=METHODS[method] if method < len(METHODS) else method,
                           method_id=method, quantity=QUANTITIES[qty], window=WINDOWS[win],
                           window_param=wp, method_param=mp, scale=scale, quantity_param=qp,
-                          stored=stored, coef_scales=scales, levels=levels))
+                          stored=stored, coef_scales=scales, levels=levels if enc >= 2 else None,
+                          variable_order=variable, orders=orders))
 
 
 def coefficients(stream):
