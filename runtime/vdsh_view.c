@@ -33,13 +33,19 @@ static const char usage_text[] =
     "Output:\n"
     "      --render FILE     render one image headless (no display needed)\n"
     "      --grid FILE       render the comparison row: no shadows | cube shadow\n"
-    "                        map | VDSH order 5 | 3 | 2, labelled, into one image;\n"
-    "                        several SCENEs (e.g. the same scene baked two ways)\n"
-    "                        give one row each\n"
-    "      --bench           time every shadow mode with 1 and 3 lights on each\n"
-    "                        SCENE, all in this process, each round timing\n"
+    "                        map | VDSH order 5 | 3 | 2, labelled, into one image,\n"
+    "                        and | adaptive order when a SCENE has a stream with\n"
+    "                        an order per vertex; several SCENEs (e.g. the same\n"
+    "                        scene baked two ways) give one row each\n"
+    "      --bench           time every shadow mode with 1, 3, 16 and 64 lights\n"
+    "                        (fewer rounds for 16 and 64) on each SCENE (the\n"
+    "                        buffer modes: buf5, each order above 5, adaptive),\n"
+    "                        all in this process, each round timing\n"
     "                        every mode of every SCENE once (wall time and\n"
     "                        process CPU time per frame); JSON on stdout\n"
+    "      --bench-lights L  with --bench: only these of 1,3,16,64 lights\n"
+    "      --buffer-floats   with --bench: time each buffer mode also from\n"
+    "                        buffers of decoded f32 coefficients (MODE-f32)\n"
     "      --views FILE      with --frames DIR: for every view, light set and\n"
     "                        light of the view set FILE (vdsh-frames writes\n"
     "                        one), the shadow of that one light alone as a\n"
@@ -51,8 +57,8 @@ static const char usage_text[] =
     "                        At the view set's size; time per frame on stderr\n"
     "      --modes LIST      with --views: modes to render, comma-separated:\n"
     "                        cube, cube-pcf (4 taps), vdsh2, vdsh3, vdsh5,\n"
-    "                        vdsh5poly, none (default: every one of the first\n"
-    "                        six that the scene has)\n"
+    "                        vdsh5poly, none, bufN, adaptive (default: every\n"
+    "                        one of the first six that the scene has)\n"
     "\n"
     "View (defaults come from the scene's bounds, y up: a room is seen from\n"
     "inside, an object framed from outside, lit from outside):\n"
@@ -60,7 +66,8 @@ static const char usage_text[] =
     "      --fit             frame the whole scene from outside, also a room\n"
     "      --fov DEG         vertical field of view (default 60)\n"
     "      --light X,Y,Z[,R,G,B]  a point light (repeatable)\n"
-    "      --lights N        use N default lights, 1..4 (default 1)\n"
+    "      --lights N        use N default lights, 1..64 (default 1; beyond\n"
+    "                        four, positions placed uniformly in free space)\n"
     "      --attenuation A0,A1,A2  for every light: 1/(A0 + A1 d + A2 d^2)\n"
     "                        (default 1, 0, 1/(0.3 * diagonal)^2)\n"
     "      --ambient V       ambient light (default 0.03)\n"
@@ -68,10 +75,17 @@ static const char usage_text[] =
     "                        cubemaps) or vdsh5poly (order 5, polynomials);\n"
     "                        order n = n bands = n*n coefficients. Default:\n"
     "                        the runtime's, vdsh5 where the scene has it, else\n"
-    "                        vdsh5poly, else the highest order it has.\n"
+    "                        vdsh5poly, else the highest of vdsh3 and vdsh2,\n"
+    "                        else buffer.\n"
     "                        Scenes baked with --log are drawn per vertex in\n"
     "                        every VDSH mode (distances interpolated, no\n"
-    "                        cubemaps; vdsh5 and vdsh5poly are then the same)\n"
+    "                        cubemaps; vdsh5 and vdsh5poly are then the same).\n"
+    "                        From buffer textures, any order, always per\n"
+    "                        vertex: bufN the stream of order N (1..16; orders\n"
+    "                        above 5 only this way), adaptive the stream with\n"
+    "                        an order per vertex (vdsh-bake's adaptive order),\n"
+    "                        buffer the scene's default of these (adaptive if\n"
+    "                        it has it, else its highest order)\n"
     "      --compare C       smooth (the paper's ramp, default) or binary\n"
     "      --pcf             cube shadow maps with PCF (default: 1 tap)\n"
     "      --shadow-size N   cube shadow map face size (default 512)\n"
@@ -112,6 +126,13 @@ static int usage_error(const char *fmt, const char *arg)
     return vt_usage_error("vdsh-view", fmt, arg);
 }
 
+/* A buffer mode asks for its stream; orders 1-5 are buffered on request. */
+static void note_buffer(vv_options *o, const vv_frame_mode *m)
+{
+    if (m->mode == VR_MODE_VDSH_BUFFER && m->stream >= 1 && m->stream <= 5)
+        o->buffers = 1;
+}
+
 /* "cube,vdsh5" into o->frame_modes (each once, in the order given);
  * 0, or -1 for an unknown or empty name. */
 static int parse_modes(const char *list, vv_options *o)
@@ -120,17 +141,16 @@ static int parse_modes(const char *list, vv_options *o)
     const char *p = list;
     for (;;) {
         size_t len = strcspn(p, ",");
-        int found = -1;
-        for (int i = 0; i < VV_FRAME_MODES; i++)
-            if (strlen(vv_frame_modes[i].name) == len && !strncmp(p, vv_frame_modes[i].name, len))
-                found = i;
+        int found = vv_frame_mode_find(p, len);
         if (found < 0)
             return -1;
         int seen = 0;
         for (int i = 0; i < o->frame_mode_count; i++)
             seen |= o->frame_modes[i] == found;
-        if (!seen)
+        if (!seen) {
             o->frame_modes[o->frame_mode_count++] = found;
+            note_buffer(o, &vv_frame_modes[found]);
+        }
         if (!p[len])
             return 0;
         p += len + 1;
@@ -146,7 +166,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
     enum { O_RENDER = 256, O_GRID, O_BENCH, O_CAMERA, O_FIT, O_FOV, O_LIGHT, O_LIGHTS,
            O_ATT, O_AMBIENT, O_MODE, O_COMPARE, O_PCF, O_SHADOW_SIZE, O_SIZE,
            O_NO_CUBEMAPS, O_EGL, O_FRAMES, O_SCREENSHOT, O_NO_OVERLAY, O_KEYS,
-           O_NO_MALLOPT, O_VIEWS, O_MODES };
+           O_NO_MALLOPT, O_VIEWS, O_MODES, O_BUFFER_FLOATS, O_BENCH_LIGHTS };
     static const struct option longopts[] = {
         {"render", required_argument, 0, O_RENDER},
         {"grid", required_argument, 0, O_GRID},
@@ -170,6 +190,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
         {"no-overlay", no_argument, 0, O_NO_OVERLAY},
         {"keys", required_argument, 0, O_KEYS},
         {"no-mallopt", no_argument, 0, O_NO_MALLOPT},
+        {"buffer-floats", no_argument, 0, O_BUFFER_FLOATS},
+        {"bench-lights", required_argument, 0, O_BENCH_LIGHTS},
         {"views", required_argument, 0, O_VIEWS},
         {"modes", required_argument, 0, O_MODES},
         {"quiet", no_argument, 0, 'q'},
@@ -219,8 +241,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
             break;
         }
         case O_LIGHTS:
-            if (!vt_parse_int(v, 1, 4, &o->default_lights))
-                return usage_error("--lights: expected 1..4, got '%s'", v);
+            if (!vt_parse_int(v, 1, VV_MAX_LIGHTS, &o->default_lights))
+                return usage_error("--lights: expected 1..64, got '%s'", v);
             break;
         case O_ATT:
             if (vt_parse_floats(v, o->att, 3, 3) != 3 || o->att[0] < 0 || o->att[1] < 0 ||
@@ -235,9 +257,16 @@ static int parse_args(int argc, char **argv, vv_options *o)
             o->have_ambient = 1;
             break;
         case O_MODE:
-            if (vr_mode_from_name(v, &o->mode))
-                return usage_error("--mode: expected none, cube, vdsh2, vdsh3, vdsh5 or "
-                                   "vdsh5poly, got '%s'", v);
+            if (vr_mode_from_name(v, &o->mode)) {
+                int i = vv_frame_mode_find(v, strlen(v));
+                if (i < 0 || vv_frame_modes[i].mode != VR_MODE_VDSH_BUFFER)
+                    return usage_error("--mode: expected none, cube, vdsh2, vdsh3, vdsh5, "
+                                       "vdsh5poly, buffer, bufN (N = 1..16) or adaptive, "
+                                       "got '%s'", v);
+                o->mode = VR_MODE_VDSH_BUFFER;
+                o->stream = vv_frame_modes[i].stream;
+                note_buffer(o, &vv_frame_modes[i]);
+            }
             o->have_mode = 1;
             break;
         case O_COMPARE:
@@ -272,7 +301,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
         case O_MODES:
             if (parse_modes(v, o))
                 return usage_error("--modes: expected a comma-separated list of cube, cube-pcf, "
-                                   "vdsh2, vdsh3, vdsh5, vdsh5poly and none, got '%s'", v);
+                                   "vdsh2, vdsh3, vdsh5, vdsh5poly, none, bufN (N = 1..16) "
+                                   "and adaptive, got '%s'", v);
             break;
         case O_SCREENSHOT: o->screenshot = v; break;
         case O_NO_OVERLAY: o->no_overlay = 1; break;
@@ -284,6 +314,21 @@ static int parse_args(int argc, char **argv, vv_options *o)
             o->keys = v;
             break;
         case O_NO_MALLOPT: o->no_mallopt = 1; break;
+        case O_BUFFER_FLOATS: o->buffer_floats = 1; break;
+        case O_BENCH_LIGHTS: {
+            float n[4];
+            int k = vt_parse_floats(v, n, 1, 4);
+            o->bench_sets = 0;
+            for (int i = 0; i < k; i++)
+                o->bench_sets |= n[i] == 1    ? 1
+                                  : n[i] == 3  ? 2
+                                  : n[i] == 16 ? 4
+                                  : n[i] == 64 ? 8
+                                               : 16;
+            if (k < 1 || o->bench_sets >= 16)
+                return usage_error("--bench-lights: expected some of 1,3,16,64, got '%s'", v);
+            break;
+        }
         default: /* getopt_long said what is wrong */
             fprintf(stderr, "Try 'vdsh-view --help'.\n");
             return VT_EXIT_USAGE;
@@ -313,6 +358,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
     } else {
         if (o->frame_mode_count)
             return usage_error("%s", "--modes: only with --views");
+        if ((o->buffer_floats || o->bench_sets) && !o->bench)
+            return usage_error("%s", "--buffer-floats, --bench-lights: only with --bench");
         if (o->frames_arg && !vt_parse_int(o->frames_arg, 1, 1000000, &o->frames))
             return usage_error("--frames: expected a positive count, got '%s'", o->frames_arg);
     }
@@ -345,8 +392,10 @@ int main(int argc, char **argv)
         mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
         mallopt(M_TRIM_THRESHOLD, 512 * 1024 * 1024);
     }
-    if (o.bench)
+    if (o.bench) {
+        o.buffers = 1; /* the buffer path at order 5 beside the attribute path */
         return vv_run_bench(&o);
+    }
     if (o.render_path)
         return vv_run_render(&o);
     if (o.grid_path)

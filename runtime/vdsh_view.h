@@ -43,6 +43,7 @@ typedef struct vv_options {
     int have_ambient;
     float ambient;
     vr_mode mode;
+    int stream;                /* VR_MODE_VDSH_BUFFER: vr_draw_desc.stream */
     int have_mode;
     vdsh_compare compare;
     int pcf;
@@ -53,6 +54,9 @@ typedef struct vv_options {
     vr_egl_platform egl;
     int frames;
     int no_mallopt;
+    int buffer_floats;         /* --bench: also time buffers of decoded f32 */
+    int bench_sets;            /* --bench-lights: bit i, light set i of
+                                  1, 3, 16, 64; 0: all */
     int quiet;
     const char *screenshot;
     int no_overlay;
@@ -60,20 +64,34 @@ typedef struct vv_options {
     const char *views_path;    /* --views: frames for a view set */
     const char *frames_arg;    /* --frames: a count, or with --views the folder */
     const char *frames_dir;
-    int frame_modes[16];       /* --modes: indices into vv_frame_modes[] */
+    int frame_modes[32];       /* --modes: indices into vv_frame_modes[] */
     int frame_mode_count;
+    int buffers;               /* load orders 1-5 as buffers too (a bufN mode
+                                  of such an order, or --bench) */
 } vv_options;
 
-/* The modes frames are rendered in, by file name (--modes); the first
- * VV_FRAME_DEFAULT_MODES are the default, where the scene has them. */
+/* The modes frames are rendered in, by file name (--modes; --mode takes
+ * the buffer ones too); the first VV_FRAME_DEFAULT_MODES are the default,
+ * where the scene has them. Then "none", "bufN" (N = 1..16: the fixed
+ * stream of order N from its buffer, VR_MODE_VDSH_BUFFER; only orders up
+ * to VDSH_MAX_ORDER can exist) and "adaptive" (the stream with an order
+ * per vertex). */
 typedef struct vv_frame_mode {
     const char *name;
     vr_mode mode;
     int pcf;
+    int stream;                /* VR_MODE_VDSH_BUFFER: vr_draw_desc.stream */
 } vv_frame_mode;
 
-enum { VV_FRAME_MODES = 7, VV_FRAME_DEFAULT_MODES = 6 };
+enum { VV_FRAME_MODES = 24, VV_FRAME_DEFAULT_MODES = 6 };
 extern const vv_frame_mode vv_frame_modes[VV_FRAME_MODES];
+/* Index of a mode name in vv_frame_modes, or -1. */
+int vv_frame_mode_find(const char *name, size_t len);
+/* 1 when the scene can draw frame mode m (its stream, its cubemaps). */
+int vv_frame_mode_available(const vr_scene *s, const vv_frame_mode *m);
+/* A label for m in this scene: vr_scene_mode_label, or for a buffer
+ * mode its order (cap and mean order of an adaptive stream). */
+void vv_mode_label(const vr_scene *s, vr_mode mode, int stream, char *out, size_t size);
 
 /* The scene's bounds' diagonal (1 for an empty box). */
 float vv_scene_diagonal(const vr_scene *s);

@@ -1,7 +1,11 @@
 /*
  * vdsh_view_bench.c - vdsh-view --bench: frame times of every shadow mode
- * with 1 and 3 lights on each scene, in one process, as one JSON document
- * on stdout (scripts/bench_runtime reads it).
+ * with 1, 3, 16 and 64 lights on each scene, in one process, as one JSON
+ * document on stdout (scripts/bench_runtime reads it). Lights beyond the
+ * scene's four defaults come from its light pool (vr_scene_pool_lights).
+ * Frames with many lights are long (the cube maps re-render six faces per
+ * light), and the work of one such frame averages over many passes: they
+ * get fewer rounds (bench_rounds).
  */
 #include "vdsh_view.h"
 
@@ -20,6 +24,8 @@ typedef struct bench_mode {
     vr_mode mode;
     int pcf;
     const char *name;
+    int stream;              /* VR_MODE_VDSH_BUFFER's */
+    int floats;              /* drawn from the scene's decoded-f32 copy */
 } bench_mode;
 
 static int cmp_double(const void *a, const void *b)
@@ -35,7 +41,24 @@ static void json_series(vt_json *j, cJSON *o, const char *key, const double *v, 
         vt_json_f64(j, a, NULL, v[i]);
 }
 
-enum { BENCH_MODES = 7, BENCH_ROUNDS = 64 };
+enum { BENCH_MODES = 16, BENCH_ROUNDS = 64, BENCH_SETS = 4 };
+
+/* The light counts timed, and the rounds each gets out of `rounds`: all
+ * for 1 and 3 lights, a third for 16, a fifth for 64, at least 3. */
+static const int bench_light_sets[BENCH_SETS] = {1, 3, 16, 64};
+
+/* Whether light set `set` is timed (--bench-lights; none given: all). */
+static int bench_set_on(const vv_options *o, int set)
+{
+    return !o->bench_sets || (o->bench_sets >> set & 1);
+}
+
+static int bench_rounds(int set, int rounds)
+{
+    static const int divisor[BENCH_SETS] = {1, 1, 3, 5};
+    int n = rounds / divisor[set];
+    return n < 3 ? (rounds < 3 ? rounds : 3) : n;
+}
 
 /* CPU time of the whole process (every thread: llvmpipe's rasterizer
  * threads render in this process), milliseconds. */
@@ -50,29 +73,85 @@ static double process_cpu_ms(void)
 typedef struct bench_scene {
     const char *path;
     vr_scene *scene;
+    vr_scene *floats;        /* --buffer-floats: buffers as decoded f32 */
     bench_mode modes[BENCH_MODES];
     int nm;
-    vr_light lights[2][4];
-    int nl[2];
+    vr_light lights[BENCH_SETS][VR_MAX_POOL_LIGHTS];
+    int nl[BENCH_SETS];
     /* [light set][mode][round] */
-    double cpu[2][BENCH_MODES][BENCH_ROUNDS], gpu[2][BENCH_MODES][BENCH_ROUNDS];
-    double shadow[2][BENCH_MODES][BENCH_ROUNDS], lighting[2][BENCH_MODES][BENCH_ROUNDS];
-    double proc[2][BENCH_MODES][BENCH_ROUNDS];
+    double cpu[BENCH_SETS][BENCH_MODES][BENCH_ROUNDS], gpu[BENCH_SETS][BENCH_MODES][BENCH_ROUNDS];
+    double shadow[BENCH_SETS][BENCH_MODES][BENCH_ROUNDS];
+    double lighting[BENCH_SETS][BENCH_MODES][BENCH_ROUNDS];
+    double proc[BENCH_SETS][BENCH_MODES][BENCH_ROUNDS];
 } bench_scene;
+
+/* The buffer modes of a log-distance scene (those are drawn per vertex
+ * by every mode, so buf5 times the buffer's fetches against vdsh5's
+ * attributes): buf5, each order above 5 (at most 6 of them), adaptive. */
+static void add_buffer_modes(bench_scene *b)
+{
+    vr_scene_info info;
+    vr_scene_get_info(b->scene, &info);
+    if (info.quantity != VDSH_QUANTITY_LOG_DISTANCE)
+        return;
+    char name[16];
+    for (int k = 5; k <= VDSH_MAX_ORDER && b->nm < BENCH_MODES - 1; k++) {
+        snprintf(name, sizeof name, "buf%d", k);
+        int i = vv_frame_mode_find(name, strlen(name));
+        if (i >= 0 && vr_scene_buffer_stream(b->scene, k) == k)
+            b->modes[b->nm++] =
+                (bench_mode){VR_MODE_VDSH_BUFFER, 0, vv_frame_modes[i].name, k, 0};
+    }
+    if (vr_scene_buffer_stream(b->scene, VR_STREAM_VARIABLE))
+        b->modes[b->nm++] =
+            (bench_mode){VR_MODE_VDSH_BUFFER, 0, "adaptive", VR_STREAM_VARIABLE, 0};
+}
+
+/* --buffer-floats: each buffer mode again, from a copy of the scene
+ * whose buffers hold decoded f32 ("buf12-f32"): the same images, 2-4x
+ * the bytes, no unpacking in the shader. */
+static int add_float_modes(bench_scene *b)
+{
+    static const char *const names[][2] = {
+        {"buf5", "buf5-f32"},   {"buf6", "buf6-f32"},   {"buf7", "buf7-f32"},
+        {"buf8", "buf8-f32"},   {"buf9", "buf9-f32"},   {"buf10", "buf10-f32"},
+        {"buf11", "buf11-f32"}, {"buf12", "buf12-f32"}, {"buf13", "buf13-f32"},
+        {"buf14", "buf14-f32"}, {"buf15", "buf15-f32"}, {"buf16", "buf16-f32"},
+        {"adaptive", "adaptive-f32"}};
+    int n = b->nm, any = 0;
+    for (int m = 0; m < n; m++)
+        any |= b->modes[m].mode == VR_MODE_VDSH_BUFFER;
+    if (!any)
+        return 0;
+    vr_error err;
+    vr_scene_desc sd = {.path = b->path, .skip_cubemaps = 1, .buffers = 1, .buffer_floats = 1};
+    if (vr_scene_create(&sd, &b->floats, &err) != VR_OK) {
+        fprintf(stderr, "vdsh-view: %s\n", err.msg);
+        return 1;
+    }
+    for (int m = 0; m < n && b->nm < BENCH_MODES; m++)
+        for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
+            if (b->modes[m].mode == VR_MODE_VDSH_BUFFER && !strcmp(b->modes[m].name, names[k][0])) {
+                bench_mode f = b->modes[m];
+                f.name = names[k][1];
+                f.floats = 1;
+                b->modes[b->nm++] = f;
+            }
+    return 0;
+}
 
 /* Load a scene and choose the modes it is timed in. */
 static int bench_open(const vv_options *o, const char *path, bench_scene *b)
 {
-    static const bench_mode all[BENCH_MODES] = {
-        {VR_MODE_NONE, 0, "none"},   {VR_MODE_CUBE, 0, "cube"},
-        {VR_MODE_CUBE, 1, "cube_pcf"}, {VR_MODE_VDSH2, 0, "vdsh2"},
-        {VR_MODE_VDSH3, 0, "vdsh3"}, {VR_MODE_VDSH5, 0, "vdsh5"},
-        {VR_MODE_VDSH5_POLY, 0, "vdsh5poly"}};
-    static const int light_sets[2] = {1, 3};
+    static const bench_mode all[7] = {
+        {VR_MODE_NONE, 0, "none", 0, 0},     {VR_MODE_CUBE, 0, "cube", 0, 0},
+        {VR_MODE_CUBE, 1, "cube_pcf", 0, 0}, {VR_MODE_VDSH2, 0, "vdsh2", 0, 0},
+        {VR_MODE_VDSH3, 0, "vdsh3", 0, 0},   {VR_MODE_VDSH5, 0, "vdsh5", 0, 0},
+        {VR_MODE_VDSH5_POLY, 0, "vdsh5poly", 0, 0}};
     b->path = path;
     if (vv_open_scene(o, path, &b->scene))
         return 1;
-    for (int i = 0; i < BENCH_MODES; i++) {
+    for (int i = 0; i < 7; i++) {
         /* On a log-distance scene both order-5 modes draw the same
          * per-vertex program: time it once, as vdsh5. */
         int same = all[i].mode == VR_MODE_VDSH5_POLY &&
@@ -81,13 +160,23 @@ static int bench_open(const vv_options *o, const char *path, bench_scene *b)
         if (vr_scene_supports(b->scene, all[i].mode) && !same)
             b->modes[b->nm++] = all[i];
     }
-    for (int ls = 0; ls < 2; ls++)
-        b->nl[ls] = vv_default_lights(b->scene, o, light_sets[ls], b->lights[ls]);
+    add_buffer_modes(b);
+    if (o->buffer_floats && add_float_modes(b))
+        return 1;
+    for (int ls = 0; ls < BENCH_SETS; ls++) {
+        b->nl[ls] = vv_default_lights(b->scene, o, bench_light_sets[ls], b->lights[ls]);
+        if (b->nl[ls] < bench_light_sets[ls]) {
+            fprintf(stderr, "vdsh-view: %s: only %d light positions in free space, not %d\n",
+                    path, b->nl[ls], bench_light_sets[ls]);
+            return 1;
+        }
+    }
     return 0;
 }
 
-/* Time every mode of every scene, with 1 light and then 3. Warm-up
- * first: compile every program and allocate every shadow map before
+/* Time every mode of every scene, with 1 light, then 3, 16 and 64.
+ * Warm-up first (two rounds, one for the long frames of 16 and 64
+ * lights): compile every program and allocate every shadow map before
  * anything is timed. Then rounds that each time every (scene, mode) once,
  * starting at a different one each round, so that slow drifts of a shared
  * machine spread over all scenes and modes alike: a ratio between any two
@@ -97,8 +186,9 @@ static int bench_time(const vv_options *o, bench_scene *b, int nb, vr_renderer *
     int total = 0;
     for (int i = 0; i < nb; i++)
         total += b[i].nm;
-    for (int ls = 0; ls < 2; ls++)
-        for (int round = -2; round < rounds; round++)
+    for (int ls = 0; ls < BENCH_SETS; ls++)
+        for (int round = ls < 2 ? -2 : -1; bench_set_on(o, ls) && round < bench_rounds(ls, rounds);
+             round++)
             for (int k = 0; k < total; k++) {
                 int j = (k + (round > 0 ? round : 0)) % total, i = 0;
                 while (j >= b[i].nm)
@@ -107,10 +197,12 @@ static int bench_time(const vv_options *o, bench_scene *b, int nb, vr_renderer *
                 vr_draw_desc d = vv_base_desc(o, bs->lights[ls], bs->nl[ls]);
                 d.mode = bs->modes[j].mode;
                 d.pcf = bs->modes[j].pcf;
+                d.stream = bs->modes[j].stream;
                 vv_scene_camera(bs->scene, o, &d.camera);
                 vr_error err;
                 double proc0 = process_cpu_ms();
-                if (vr_draw(r, bs->scene, &d, &err) != VR_OK) {
+                const vr_scene *drawn = bs->modes[j].floats ? bs->floats : bs->scene;
+                if (vr_draw(r, drawn, &d, &err) != VR_OK) {
                     fprintf(stderr, "vdsh-view: %s: %s: %s\n", bs->path, bs->modes[j].name,
                             err.msg);
                     return 1;
@@ -131,7 +223,7 @@ static int bench_time(const vv_options *o, bench_scene *b, int nb, vr_renderer *
 }
 
 /* One scene's JSON object (and a summary on stderr). */
-static void bench_print(const vv_options *o, const bench_scene *b, int rounds, vt_json *j,
+static void bench_print(const vv_options *o, const bench_scene *b, int all_rounds, vt_json *j,
                         cJSON *list)
 {
     vr_scene_info info;
@@ -146,9 +238,14 @@ static void bench_print(const vv_options *o, const bench_scene *b, int rounds, v
     vt_json_u64(j, so, "triangles", info.triangle_count);
     vt_json_string(j, so, "quantity", vdsh_quantity_name(info.quantity));
     vt_json_string(j, so, "method", vdsh_method_name(method));
+    vt_json_u64(j, so, "gpu_bytes", info.gpu_bytes);
+    vt_json_u64(j, so, "buffer_bytes", info.buffer_bytes);
+    vt_json_i64(j, so, "variable_order", info.variable_order);
+    vt_json_f64(j, so, "variable_mean_order", info.variable_mean_order);
     cJSON *results = vt_json_array(j, so, "results");
-    for (int ls = 0; ls < 2; ls++)
-        for (int m = 0; m < b->nm; m++) {
+    for (int ls = 0; ls < BENCH_SETS; ls++)
+        for (int m = 0; m < b->nm && bench_set_on(o, ls); m++) {
+            int rounds = bench_rounds(ls, all_rounds);
             double sorted[BENCH_ROUNDS];
             memcpy(sorted, b->cpu[ls][m], (size_t)rounds * sizeof(double));
             qsort(sorted, (size_t)rounds, sizeof(double), cmp_double);
@@ -159,6 +256,10 @@ static void bench_print(const vv_options *o, const bench_scene *b, int rounds, v
             vt_json_string(j, r, "path", interp >= 0 ? vdsh_interp_name((uint32_t)interp)
                                                      : b->modes[m].name);
             vt_json_f64(j, r, "median_cpu_ms", sorted[rounds / 2]);
+            if (b->modes[m].mode == VR_MODE_VDSH_BUFFER)
+                vt_json_u64(j, r, "buffer_bytes",
+                            vr_scene_buffer_bytes(b->modes[m].floats ? b->floats : b->scene,
+                                                  b->modes[m].stream));
             json_series(j, r, "cpu_ms", b->cpu[ls][m], rounds);
             json_series(j, r, "process_cpu_ms", b->proc[ls][m], rounds);
             json_series(j, r, "gpu_ms", b->gpu[ls][m], rounds);
@@ -209,8 +310,10 @@ int vv_run_bench(const vv_options *o)
         rc = 1;
     }
     vt_json_free(&j);
-    for (int i = 0; b && i < o->file_count; i++)
+    for (int i = 0; b && i < o->file_count; i++) {
         vr_scene_destroy(b[i].scene);
+        vr_scene_destroy(b[i].floats);
+    }
     free(b);
     vr_renderer_destroy(r);
     vr_context_destroy(ctx);

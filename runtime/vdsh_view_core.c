@@ -16,10 +16,54 @@
 #include <time.h>
 
 const vv_frame_mode vv_frame_modes[VV_FRAME_MODES] = {
-    {"cube", VR_MODE_CUBE, 0},       {"cube-pcf", VR_MODE_CUBE, 1},
-    {"vdsh2", VR_MODE_VDSH2, 0},     {"vdsh3", VR_MODE_VDSH3, 0},
-    {"vdsh5", VR_MODE_VDSH5, 0},     {"vdsh5poly", VR_MODE_VDSH5_POLY, 0},
-    {"none", VR_MODE_NONE, 0}};
+    {"cube", VR_MODE_CUBE, 0, 0},       {"cube-pcf", VR_MODE_CUBE, 1, 0},
+    {"vdsh2", VR_MODE_VDSH2, 0, 0},     {"vdsh3", VR_MODE_VDSH3, 0, 0},
+    {"vdsh5", VR_MODE_VDSH5, 0, 0},     {"vdsh5poly", VR_MODE_VDSH5_POLY, 0, 0},
+    {"none", VR_MODE_NONE, 0, 0},
+    {"buf1", VR_MODE_VDSH_BUFFER, 0, 1},   {"buf2", VR_MODE_VDSH_BUFFER, 0, 2},
+    {"buf3", VR_MODE_VDSH_BUFFER, 0, 3},   {"buf4", VR_MODE_VDSH_BUFFER, 0, 4},
+    {"buf5", VR_MODE_VDSH_BUFFER, 0, 5},   {"buf6", VR_MODE_VDSH_BUFFER, 0, 6},
+    {"buf7", VR_MODE_VDSH_BUFFER, 0, 7},   {"buf8", VR_MODE_VDSH_BUFFER, 0, 8},
+    {"buf9", VR_MODE_VDSH_BUFFER, 0, 9},   {"buf10", VR_MODE_VDSH_BUFFER, 0, 10},
+    {"buf11", VR_MODE_VDSH_BUFFER, 0, 11}, {"buf12", VR_MODE_VDSH_BUFFER, 0, 12},
+    {"buf13", VR_MODE_VDSH_BUFFER, 0, 13}, {"buf14", VR_MODE_VDSH_BUFFER, 0, 14},
+    {"buf15", VR_MODE_VDSH_BUFFER, 0, 15}, {"buf16", VR_MODE_VDSH_BUFFER, 0, 16},
+    {"adaptive", VR_MODE_VDSH_BUFFER, 0, VR_STREAM_VARIABLE}};
+
+int vv_frame_mode_find(const char *name, size_t len)
+{
+    for (int i = 0; i < VV_FRAME_MODES; i++)
+        if (strlen(vv_frame_modes[i].name) == len && !strncmp(name, vv_frame_modes[i].name, len))
+            return i;
+    return -1;
+}
+
+int vv_frame_mode_available(const vr_scene *s, const vv_frame_mode *m)
+{
+    if (m->mode == VR_MODE_VDSH_BUFFER)
+        return vr_scene_buffer_stream(s, m->stream) != 0;
+    return vr_scene_supports(s, m->mode);
+}
+
+void vv_mode_label(const vr_scene *s, vr_mode mode, int stream, char *out, size_t size)
+{
+    if (mode == VR_MODE_DEFAULT)
+        mode = vr_scene_default_mode(s);
+    if (mode != VR_MODE_VDSH_BUFFER) {
+        snprintf(out, size, "%s", vr_scene_mode_label(s, mode));
+        return;
+    }
+    vr_scene_info info;
+    vr_scene_get_info(s, &info);
+    int k = vr_scene_buffer_stream(s, stream);
+    if (k == VR_STREAM_VARIABLE)
+        snprintf(out, size, "VDSH adaptive order (up to %d, mean %.1f; per-vertex)",
+                 info.variable_order, (double)info.variable_mean_order);
+    else if (k > 0)
+        snprintf(out, size, "VDSH order %d (%d coeff., buffer, per-vertex)", k, k * k);
+    else
+        snprintf(out, size, "VDSH from a buffer");
+}
 
 float vv_scene_diagonal(const vr_scene *s)
 {
@@ -41,13 +85,18 @@ int vv_default_lights(const vr_scene *s, const vv_options *o, int n, vr_light *o
         {1.0f, 0.92f, 0.8f}, {0.55f, 0.7f, 1.0f}, {1.0f, 0.62f, 0.4f}, {0.7f, 1.0f, 0.7f}};
     vr_scene_info info;
     vr_scene_get_info(s, &info);
-    n = vr_scene_default_lights(s, out, n);
+    int want = n;
+    n = vr_scene_default_lights(s, out, want < 4 ? want : 4);
+    /* Beyond the four defaults: the scene's light pool (vv_open_scene
+     * asks for one when more lights are wanted). */
+    if (want > n)
+        n += vr_scene_pool_lights(s, out + n, want - n);
     float r = 0.3f * vv_scene_diagonal(s);
     /* dimmer when there are several, so that their sum stays in range */
     float intensity = 1.6f / (1.0f + 0.6f * (float)(n - 1));
     for (int i = 0; i < n; i++) {
         for (int k = 0; k < 3; k++)
-            out[i].color[k] = intensity * colors[i][k];
+            out[i].color[k] = intensity * colors[i % 4][k];
         if (!info.interior) {
             r = 0.0f;
             for (int k = 0; k < 3; k++) {
@@ -105,6 +154,7 @@ vr_draw_desc vv_base_desc(const vv_options *o, const vr_light *lights, int n)
     vr_draw_desc d;
     memset(&d, 0, sizeof d);
     d.mode = o->mode;
+    d.stream = o->stream;
     d.compare = o->compare;
     d.pcf = o->pcf;
     d.lights = lights;
@@ -169,7 +219,10 @@ void vv_session_close(vv_session *s)
 int vv_open_scene(const vv_options *o, const char *path, vr_scene **out)
 {
     vr_error err;
-    vr_scene_desc sd = {.path = path, .skip_cubemaps = o->no_cubemaps};
+    /* More than the four default lights come from the scene's pool. */
+    int pool = o->bench ? VR_MAX_POOL_LIGHTS : o->default_lights > 4 ? o->default_lights - 4 : 0;
+    vr_scene_desc sd = {.path = path, .skip_cubemaps = o->no_cubemaps, .light_pool = pool,
+                        .buffers = o->buffers};
     if (vr_scene_create(&sd, out, &err) != VR_OK) {
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
         return 1;

@@ -54,6 +54,7 @@ static vr_result shadow_frame(vr_renderer *r, const vr_scene *scene, const vv_op
     vr_draw_desc d;
     memset(&d, 0, sizeof d);
     d.mode = m->mode;
+    d.stream = m->stream;
     d.pcf = m->pcf;
     d.compare = o->compare;
     d.lights = &light;
@@ -92,6 +93,7 @@ static vr_result shaded_frame(vr_renderer *r, const vr_scene *scene, const vv_op
     }
     vr_draw_desc d = vv_base_desc(o, lights, nl);
     d.mode = m->mode;
+    d.stream = m->stream;
     d.pcf = m->pcf;
     d.camera = *cam;
     vr_result res = vr_draw(r, scene, &d, err);
@@ -139,7 +141,7 @@ int vv_run_frames(const vv_options *o)
     if (!rc && o->frame_mode_count) {
         for (int i = 0; i < o->frame_mode_count && !rc; i++) {
             const vv_frame_mode *m = &vv_frame_modes[o->frame_modes[i]];
-            if (!vr_scene_supports(s.scene, m->mode)) {
+            if (!vv_frame_mode_available(s.scene, m)) {
                 fprintf(stderr, "vdsh-view: %s: mode %s is not available in this file%s\n",
                         o->files[0], m->name,
                         m->mode == VR_MODE_VDSH5 ? " (order 5 with its basis cubemaps)" : "");

@@ -1,6 +1,7 @@
 /*
  * vdsh_view_render.c - vdsh-view --render (one image) and --grid (the
- * paper's comparison row, one row per scene), headless.
+ * paper's comparison row and an adaptive-order column, one row per
+ * scene), headless.
  */
 #include "vdsh_view.h"
 
@@ -31,12 +32,13 @@ int vv_run_render(const vv_options *o)
     else {
         double ms = vv_now_ms() - t0;
         rc = vv_write_png(o->render_path, w, h, px);
+        char label[160];
+        vv_mode_label(s.scene, o->mode, o->stream, label, sizeof label);
         if (!rc && !o->quiet)
             fprintf(stderr, "vdsh-view: wrote %s (%dx%d, mode %s: %s, %d light%s, %.0f ms, %s; "
                     "%s)\n", o->render_path, w, h,
-                    vr_mode_name(o->mode ? o->mode : vr_scene_default_mode(s.scene)),
-                    vr_scene_mode_label(s.scene, o->mode), n, n == 1 ? "" : "s", ms,
-                    vr_gl_renderer(), vr_context_description(s.ctx));
+                    vr_mode_name(o->mode ? o->mode : vr_scene_default_mode(s.scene)), label, n,
+                    n == 1 ? "" : "s", ms, vr_gl_renderer(), vr_context_description(s.ctx));
     }
     free(px);
     vv_session_close(&s);
@@ -58,9 +60,14 @@ static void bake_label(const char *path, const vr_scene *s, char *out, size_t si
              vdsh_quantity_name(info.quantity));
 }
 
-/* One row of the grid: the five panels of one scene into row (5 w wide). */
+/* The grid's columns: the paper's row, then adaptive order (kept only
+ * when some scene has a stream with an order per vertex). */
+enum { GRID_COLS = 6 };
+
+/* One row of the grid: the panels of one scene into row (GRID_COLS w
+ * wide); *adaptive: 1 when the scene has the adaptive-order stream. */
 static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w, int h,
-                    unsigned char *px, unsigned char *row)
+                    unsigned char *px, unsigned char *row, int *adaptive)
 {
     vr_scene *scene = NULL;
     if (vv_open_scene(o, path, &scene))
@@ -70,31 +77,38 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
     /* The paper's row. Order 5 the paper's way when the cubemaps are
      * there, else with the polynomials (the same image to f16 precision);
      * a log-distance scene draws both per vertex. */
-    vr_mode modes[5] = {VR_MODE_NONE, VR_MODE_CUBE, VR_MODE_VDSH5, VR_MODE_VDSH3, VR_MODE_VDSH2};
+    vr_mode modes[GRID_COLS] = {VR_MODE_NONE,  VR_MODE_CUBE,  VR_MODE_VDSH5,
+                                VR_MODE_VDSH3, VR_MODE_VDSH2, VR_MODE_VDSH_BUFFER};
     if (!vr_scene_supports(scene, VR_MODE_VDSH5))
         modes[2] = VR_MODE_VDSH5_POLY;
+    *adaptive = vr_scene_buffer_stream(scene, VR_STREAM_VARIABLE) != 0;
     size_t panel = (size_t)w * (size_t)h * 4;
     int rc = 0;
-    for (int m = 0; m < 5 && !rc; m++) {
+    for (int m = 0; m < GRID_COLS && !rc; m++) {
         vr_error err;
         vr_draw_desc d = vv_base_desc(o, lights, n);
         d.mode = modes[m];
+        d.stream = VR_STREAM_VARIABLE;
         vv_scene_camera(scene, o, &d.camera);
         char label[320];
         int shadow = o->shadow_size ? o->shadow_size : VR_DEFAULT_SHADOW_MAP_SIZE;
+        int have = modes[m] == VR_MODE_VDSH_BUFFER ? *adaptive : vr_scene_supports(scene, modes[m]);
         if (modes[m] == VR_MODE_CUBE)
             snprintf(label, sizeof label, "cube shadow map (%d^2 x 6, %s)", shadow,
                      o->pcf ? "PCF" : "1 tap");
-        else if (modes[m] >= VR_MODE_VDSH2)
-            snprintf(label, sizeof label, "%s%s", vr_scene_mode_label(scene, modes[m]),
+        else if (modes[m] == VR_MODE_VDSH_BUFFER && !have)
+            snprintf(label, sizeof label, "VDSH adaptive order");
+        else if (modes[m] >= VR_MODE_VDSH2) {
+            vv_mode_label(scene, modes[m], VR_STREAM_VARIABLE, label, sizeof label);
+            snprintf(label + strlen(label), sizeof label - strlen(label), "%s",
                      o->compare == VDSH_COMPARE_BINARY ? ", binary" : "");
-        else {
+        } else {
             char bake[256];
             bake_label(path, scene, bake, sizeof bake);
             snprintf(label, sizeof label, "%s\n%s", vr_mode_label(modes[m]), bake);
         }
         vr_result res = VR_OK;
-        if (!vr_scene_supports(scene, modes[m])) {
+        if (!have) {
             /* A file baked without this order: say so in the panel. */
             vr_draw_desc none = d;
             none.light_count = 0;
@@ -113,13 +127,13 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
             break;
         }
         for (int y = 0; y < h; y++)
-            memcpy(row + ((size_t)y * 5 * (size_t)w + (size_t)m * (size_t)w) * 4,
+            memcpy(row + ((size_t)y * GRID_COLS * (size_t)w + (size_t)m * (size_t)w) * 4,
                    px + (size_t)y * (size_t)w * 4, (size_t)w * 4);
     }
     if (!rc && !o->quiet)
-        fprintf(stderr, "vdsh-view: %s: none | cube | %s | vdsh3 | vdsh2 (%s), %d light%s\n",
-                path, vr_mode_name(modes[2]), vr_scene_mode_label(scene, modes[2]), n,
-                n == 1 ? "" : "s");
+        fprintf(stderr, "vdsh-view: %s: none | cube | %s | vdsh3 | vdsh2%s (%s), %d light%s\n",
+                path, vr_mode_name(modes[2]), *adaptive ? " | adaptive" : "",
+                vr_scene_mode_label(scene, modes[2]), n, n == 1 ? "" : "s");
     vr_scene_destroy(scene);
     return rc;
 }
@@ -133,26 +147,34 @@ int vv_run_grid(const vv_options *o)
     if (vv_open_headless(o, w, h, 1, &ctx, &r) != 0)
         return 1;
     size_t panel = (size_t)w * (size_t)h * 4;
-    unsigned char *px = malloc(panel), *img = calloc(5 * (size_t)rows, panel);
-    int rc = 0;
+    unsigned char *px = malloc(panel), *img = calloc(GRID_COLS * (size_t)rows, panel);
+    int rc = 0, cols = 5;
     if (!px || !img) {
         fprintf(stderr, "vdsh-view: out of memory\n");
         rc = 1;
     }
-    for (int i = 0; i < rows && !rc; i++)
-        rc = grid_row(o, o->files[i], r, w, h, px, img + (size_t)i * 5 * panel);
+    for (int i = 0; i < rows && !rc; i++) {
+        int adaptive = 0;
+        rc = grid_row(o, o->files[i], r, w, h, px, img + (size_t)i * GRID_COLS * panel,
+                      &adaptive);
+        if (adaptive)
+            cols = GRID_COLS;
+    }
     if (!rc) {
-        /* A thin dark line between panels and between rows. */
-        size_t stride = 5 * (size_t)w * 4;
+        /* Keep the first cols panels of each row (in place: the rows
+         * only shrink), with a thin dark line between panels and rows. */
+        size_t wide = GRID_COLS * (size_t)w * 4, stride = (size_t)cols * (size_t)w * 4;
         for (int y = 0; y < rows * h; y++)
-            for (int m = 1; m < 5; m++)
+            memmove(img + (size_t)y * stride, img + (size_t)y * wide, stride);
+        for (int y = 0; y < rows * h; y++)
+            for (int m = 1; m < cols; m++)
                 memset(img + (size_t)y * stride + (size_t)m * (size_t)w * 4, 40, 4);
         for (int i = 1; i < rows; i++)
             memset(img + (size_t)i * (size_t)h * stride, 40, stride);
-        rc = vv_write_png(o->grid_path, 5 * w, rows * h, img);
+        rc = vv_write_png(o->grid_path, cols * w, rows * h, img);
         if (!rc && !o->quiet)
-            fprintf(stderr, "vdsh-view: wrote %s (%dx%d, %d row%s, %s)\n", o->grid_path, 5 * w,
-                    rows * h, rows, rows == 1 ? "" : "s", vr_gl_renderer());
+            fprintf(stderr, "vdsh-view: wrote %s (%dx%d, %d row%s, %s)\n", o->grid_path,
+                    cols * w, rows * h, rows, rows == 1 ? "" : "s", vr_gl_renderer());
     }
     free(px);
     free(img);
@@ -160,4 +182,3 @@ int vv_run_grid(const vv_options *o)
     vr_context_destroy(ctx);
     return rc;
 }
-

@@ -21,8 +21,9 @@ static const char keys_text[] =
     "vdsh-view keys:\n"
     "  mouse left drag   orbit around the target     right drag   look around\n"
     "  wheel             closer / farther            W A S D Q E  fly (shift: faster)\n"
-    "  1 2 3 4 5 6       mode: none, cube shadow map, VDSH order 2, 3, 5 (cubemaps),\n"
-    "                    5 (polynomials)                M  next mode\n"
+    "  1 2 3 4 5 6 7     mode: none, cube shadow map, VDSH order 2, 3, 5 (cubemaps),\n"
+    "                    5 (polynomials), buffer (adaptive order, else the highest)\n"
+    "                                                   M  next mode\n"
     "  C                 comparison smooth / binary   P  cube map PCF on / off\n"
     "  Tab               select the next light        N  new light at the target\n"
     "  arrows, PgUp/PgDn move the selected light      Backspace  remove it\n"
@@ -45,6 +46,7 @@ typedef struct app {
     float fired_pos[3], fired_vel[3];
     double fired_age;
     vr_mode mode;
+    int stream;                  /* VR_MODE_VDSH_BUFFER's */
     vdsh_compare compare;
     int pcf, overlay;
     double mx, my;
@@ -96,9 +98,10 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     if (action != GLFW_PRESS)
         return;
     char msg[200];
-    static const vr_mode by_digit[6] = {VR_MODE_NONE, VR_MODE_CUBE, VR_MODE_VDSH2,
-                                        VR_MODE_VDSH3, VR_MODE_VDSH5, VR_MODE_VDSH5_POLY};
-    if (key >= GLFW_KEY_1 && key <= GLFW_KEY_6) {
+    static const vr_mode by_digit[7] = {VR_MODE_NONE,  VR_MODE_CUBE,       VR_MODE_VDSH2,
+                                        VR_MODE_VDSH3, VR_MODE_VDSH5,      VR_MODE_VDSH5_POLY,
+                                        VR_MODE_VDSH_BUFFER};
+    if (key >= GLFW_KEY_1 && key <= GLFW_KEY_7) {
         vr_mode m = by_digit[key - GLFW_KEY_1];
         if (!vr_scene_supports(a->s.scene, m)) {
             snprintf(msg, sizeof msg, "mode %s: not available in this file", vr_mode_name(m));
@@ -106,7 +109,9 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
             return;
         }
         a->mode = m;
-        snprintf(msg, sizeof msg, "mode: %s", vr_scene_mode_label(a->s.scene, m));
+        char label[160];
+        vv_mode_label(a->s.scene, m, a->stream, label, sizeof label);
+        snprintf(msg, sizeof msg, "mode: %s", label);
         print_status(a, msg);
         return;
     }
@@ -115,14 +120,16 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         glfwSetWindowShouldClose(w, GLFW_TRUE);
         break;
     case GLFW_KEY_M:
-        for (int i = 1; i <= 6; i++) {
-            vr_mode m = by_digit[(a->mode - VR_MODE_NONE + i) % 6];
+        for (int i = 1; i <= 7; i++) {
+            vr_mode m = by_digit[(a->mode - VR_MODE_NONE + i) % 7];
             if (vr_scene_supports(a->s.scene, m)) {
                 a->mode = m;
                 break;
             }
         }
-        snprintf(msg, sizeof msg, "mode: %s", vr_scene_mode_label(a->s.scene, a->mode));
+        char label[160];
+        vv_mode_label(a->s.scene, a->mode, a->stream, label, sizeof label);
+        snprintf(msg, sizeof msg, "mode: %s", label);
         print_status(a, msg);
         break;
     case GLFW_KEY_C:
@@ -373,6 +380,7 @@ int vv_run_window(const vv_options *o)
     vv_scene_camera(a.s.scene, o, &a.home);
     set_view(&a, &a.home);
     a.mode = o->mode;
+    a.stream = o->stream;
     if (a.mode == VR_MODE_DEFAULT || !vr_scene_supports(a.s.scene, a.mode))
         a.mode = vr_scene_default_mode(a.s.scene);
     a.compare = o->compare;
@@ -414,6 +422,7 @@ int vv_run_window(const vv_options *o)
         int n = frame_lights(&a, lights);
         vr_draw_desc d = vv_base_desc(o, lights, n);
         d.mode = a.mode;
+        d.stream = a.stream;
         d.compare = a.compare;
         d.pcf = a.pcf;
         memcpy(d.camera.target, a.target, sizeof a.target);
@@ -427,13 +436,13 @@ int vv_run_window(const vv_options *o)
         if (a.overlay) {
             vr_timings tm;
             vr_renderer_timings(a.s.r, &tm);
-            char text[1024];
+            char text[1024], label[160];
+            vv_mode_label(a.s.scene, a.mode, a.stream, label, sizeof label);
             int len = snprintf(text, sizeof text,
                                "%s, %s\n%d light%s (selected %d)%s\n"
                                "frame %.1f ms (%.1f fps)\n"
                                "GPU: shadow maps %.1f ms, lighting %.1f ms\n%s",
-                               vr_scene_mode_label(a.s.scene, a.mode),
-                               a.mode == VR_MODE_CUBE ? (a.pcf ? "PCF" : "1 tap")
+                               label, a.mode == VR_MODE_CUBE ? (a.pcf ? "PCF" : "1 tap")
                                : a.compare == VDSH_COMPARE_SMOOTH ? "smooth" : "binary",
                                n, n == 1 ? "" : "s", a.n ? a.selected + 1 : 0,
                                a.animate ? ", animated" : "", frame_ms,

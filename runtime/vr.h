@@ -1,7 +1,9 @@
 /*
  * vr.h - the VDSH GL runtime (prefix vr_): load a baked .vdsh scene, upload
  * it, and draw it lit by point lights with precomputed visibility-distance
- * shadows (orders 2, 3, 5) or with the cube-shadow-map baseline, into an
+ * shadows (orders 2, 3, 5 from vertex attributes; any order, and streams
+ * with an order per vertex, from buffer textures) or with the
+ * cube-shadow-map baseline, into an
  * offscreen framebuffer that the caller reads back or blits.
  *
  * Does not: create a GL context or window (vr_context.h does, and only the
@@ -51,13 +53,33 @@
  *                       made at load, texel for texel the bake's files).
  *   VR_MODE_VDSH5_POLY  order 5 with the last 16 basis functions evaluated as
  *                       polynomials in the fragment stage (no cubemaps).
+ *   VR_MODE_VDSH_BUFFER any stored order (1..VDSH_MAX_ORDER), or a stream
+ *                       with an order per vertex, chosen by
+ *                       vr_draw_desc.stream: always the per-vertex distance
+ *                       path below, whatever the quantity. Each vertex
+ *                       reads its own record from a buffer texture (by
+ *                       gl_VertexID; a variable-order stream's vertices
+ *                       carry their order and record offset as integer
+ *                       attributes), in the file's encoding and values,
+ *                       reordered as the shader reads them (f32, f16 as
+ *                       RGBA32F / RGBA16F texels, s8 as RGBA8I times a
+ *                       step per coefficient index, s8s6 as R32UI words
+ *                       unpacked in the shader: vdsh_stream_decode's
+ *                       products; runtime/vr_buffer.c), and evaluates its
+ *                       k^2 basis functions by the associated-Legendre
+ *                       recurrence of formats/vdsh_sh.c (bands 0..k-1, the
+ *                       same convention), each coefficient fetched once for
+ *                       all lights of a pass. Streams of orders 1-5 are
+ *                       buffered only with vr_scene_desc.buffers.
  * Log-distance streams (vdsh-bake --log) are drawn differently by every
  * VDSH mode: each vertex sums all its coefficients toward the light and
  * takes exp (its distance toward the light), the distances are
  * interpolated, and each fragment compares the result with its own light
  * distance; VR_MODE_VDSH5 and VR_MODE_VDSH5_POLY are then the same and need
  * no cubemaps. Which path a mode takes is vdsh_runtime_interp(order,
- * quantity) (vr_scene_interp), and what each path computes inside a
+ * quantity) (vr_scene_interp; VR_MODE_VDSH_BUFFER: always the distance
+ * path, which for log-distance streams is vdsh_runtime_interp's at every
+ * order), and what each path computes inside a
  * triangle is vdsh_shadow_interior: the definitions vdsh-eval scores with.
  * The comparison (vdsh_compare from formats/vdsh_shadow.h: smooth ramp or
  * binary) and the stored quantity mean exactly what formats/vdsh_shadow.h
@@ -141,11 +163,26 @@ typedef struct vr_scene_desc {
      * get them: their path has no use for them. No file but the .vdsh is
      * read either way. */
     int skip_cubemaps;
+    /* 0 (default): none. N (1..VR_MAX_POOL_LIGHTS): also place N light
+     * positions uniformly in the scene's free space at load
+     * (vr_scene_pool_lights), for drawing with many lights. Costs a grid
+     * of the triangles and 14 rays per position tried. */
+    int light_pool;
+    /* Streams for VR_MODE_VDSH_BUFFER. 0 (default): those no attribute
+     * path can draw go up as buffer textures (orders above 5, and streams
+     * with an order per vertex); orders 1-5 only as attributes. 1: orders
+     * 1-5 as buffers too (more GPU memory: both copies). */
+    int buffers;
+    /* 0 (default): buffers hold the file's encoding as stored. 1: decoded
+     * f32 coefficients instead (vdsh_stream_decode; 2x the bytes of f16,
+     * 4x s8), no unpacking in the shader: for comparisons. */
+    int buffer_floats;
 } vr_scene_desc;
 
 /* Load (when desc->path is set and desc->file is not), validate, upload
- * positions, normals, indices, every stream of the chosen quantity (f16
- * streams as GL_HALF_FLOAT attributes, f32 as GL_FLOAT, no conversion) and
+ * positions, normals, indices, every stream of the chosen quantity (orders
+ * 1-5: f16 streams as GL_HALF_FLOAT attributes, f32 as GL_FLOAT, no
+ * conversion; the rest as buffer textures, see desc->buffers) and
  * make the basis cubemaps (vdsh_cube_basis_face_gl_f16). Triangles and
  * vertices are uploaded in an order chosen for the vertex cache (the same
  * triangles, reordered; vertices renumbered), not the file's. On failure
@@ -153,7 +190,8 @@ typedef struct vr_scene_desc {
  * VR_ERR_FORMAT from the .vdsh reader (and VR_ERR_FORMAT for an index out
  * of range or a max_distance that is not finite and > 0 in a desc->file,
  * or a cube_size above GL_MAX_CUBE_MAP_TEXTURE_SIZE),
- * VR_ERR_OUT_OF_MEMORY, VR_ERR_GL. */
+ * VR_ERR_OUT_OF_MEMORY, VR_ERR_GL (also for a buffer stream larger than
+ * GL_MAX_TEXTURE_BUFFER_SIZE texels). */
 vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out,
                           vr_error *err);
 
@@ -178,6 +216,14 @@ typedef struct vr_scene_info {
     int interior;                 /* 1: a room, seen from inside by default;
                                      0: an object, framed from outside (see
                                      vr_scene_default_camera) */
+    /* VR_MODE_VDSH_BUFFER's streams: has_buffer[n], a fixed stream of
+     * order n; variable_order, the cap of the stream with an order per
+     * vertex (0: none) and variable_mean_order its vertices' mean order;
+     * buffer_bytes, their share of gpu_bytes. */
+    int has_buffer[VDSH_ORDER_SLOTS];
+    int variable_order;
+    float variable_mean_order;
+    size_t buffer_bytes;
 } vr_scene_info;
 
 void vr_scene_get_info(const vr_scene *s, vr_scene_info *out);
@@ -243,11 +289,16 @@ typedef enum vr_mode {
     VR_MODE_VDSH3,
     VR_MODE_VDSH5,
     VR_MODE_VDSH5_POLY,
+    VR_MODE_VDSH_BUFFER,
     VR_MODE_COUNT_
 } vr_mode;
 
-/* "none", "cube", "vdsh2", "vdsh3", "vdsh5", "vdsh5poly" (the viewer's
- * --mode names); "?" for others. vr_mode_from_name returns 0 on success
+/* vr_draw_desc.stream for VR_MODE_VDSH_BUFFER: the stream with an order
+ * per vertex (1..VDSH_MAX_ORDER: the fixed stream of that order). */
+enum { VR_STREAM_VARIABLE = -1 };
+
+/* "none", "cube", "vdsh2", "vdsh3", "vdsh5", "vdsh5poly", "buffer" (the
+ * viewer's --mode names); "?" for others. vr_mode_from_name returns 0 on success
  * and leaves *out untouched on an unknown name. */
 const char *vr_mode_name(vr_mode m);
 int vr_mode_from_name(const char *name, vr_mode *out);
@@ -256,13 +307,25 @@ const char *vr_mode_label(vr_mode m);
 /* The mode VR_MODE_DEFAULT draws for a scene, the one definition of the
  * default that vdsh-view (no --mode) uses too: order 5 the paper's way
  * (VR_MODE_VDSH5) where the scene supports it, else order 5 with the
- * polynomials, else the highest of orders 3 and 2 the file has. A scene
- * with none of these streams gets VR_MODE_VDSH5, which vr_draw refuses
- * with VR_ERR_MISSING naming the stream. Never VR_MODE_DEFAULT. */
+ * polynomials, else the highest of orders 3 and 2 the file has, else
+ * VR_MODE_VDSH_BUFFER when it has a buffer stream (a bake of orders above 5
+ * or of adaptive order only; vr_draw_desc.stream 0 then draws its
+ * default). A scene with none of these streams gets VR_MODE_VDSH5, which
+ * vr_draw refuses with VR_ERR_MISSING naming the stream. Never
+ * VR_MODE_DEFAULT. */
 vr_mode vr_scene_default_mode(const vr_scene *s);
-/* 1 when the scene has what the mode needs (stream, cubemaps). Here and
- * below VR_MODE_DEFAULT stands for vr_scene_default_mode(s). */
+/* 1 when the scene has what the mode needs (stream, cubemaps; for
+ * VR_MODE_VDSH_BUFFER any buffer stream). Here and below VR_MODE_DEFAULT
+ * stands for vr_scene_default_mode(s). */
 int vr_scene_supports(const vr_scene *s, vr_mode m);
+/* The stream VR_MODE_VDSH_BUFFER draws for vr_draw_desc.stream: 0 means
+ * the scene's default, its stream with an order per vertex if it has one,
+ * else its highest buffered order; returns that (VR_STREAM_VARIABLE or an
+ * order), or 0 when the scene has no such stream. */
+int vr_scene_buffer_stream(const vr_scene *s, int stream);
+/* GPU bytes of that stream's buffers (records, and for a stream with an
+ * order per vertex its 5 bytes of attributes per vertex); 0 without it. */
+size_t vr_scene_buffer_bytes(const vr_scene *s, int stream);
 /* The path (vdsh_interp) a VDSH mode draws this scene's stream with:
  * vdsh_runtime_interp(order, quantity drawn); -1 for modes none and cube. */
 int vr_scene_interp(const vr_scene *s, vr_mode m);
@@ -318,12 +381,15 @@ typedef struct vr_draw_desc {
     int points;              /* 1: draw the vertices as 1-pixel points, not
                                 triangles (a test aid: each pixel then holds
                                 one vertex's unclipped, uninterpolated value) */
+    int stream;              /* VR_MODE_VDSH_BUFFER: the stream drawn,
+                                vr_scene_buffer_stream's argument (0: the
+                                scene's default); ignored by other modes */
 } vr_draw_desc;
 
 /* Draw one frame into the renderer's framebuffer: for each group of up to
  * max_lights_per_pass lights, render their cube shadow maps (VR_MODE_CUBE)
  * and one lighting pass. Errors: VR_ERR_MISSING when the scene lacks the
- * mode's stream or cubemaps, VR_ERR_ARGUMENT for bad fields, VR_ERR_SHADER
+ * mode's stream (VR_MODE_VDSH_BUFFER: the stream asked for) or cubemaps, VR_ERR_ARGUMENT for bad fields, VR_ERR_SHADER
  * / VR_ERR_GL. On failure the framebuffer contents are undefined. */
 vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *d,
                   vr_error *err);
@@ -355,6 +421,17 @@ void vr_scene_fit_camera(const vr_scene *s, vr_camera *out);
  * is not (vdsh_view_compute says how). Colours and attenuations are left
  * to the caller. */
 int vr_scene_default_lights(const vr_scene *s, vr_light *out, int max);
+
+enum { VR_MAX_POOL_LIGHTS = 64 };
+
+/* Up to max of the light positions placed at load (vr_scene_desc
+ * light_pool); returns how many were written (0 without a pool). They are
+ * "placed uniformly in free space" as formats/vdsh_light.h defines it:
+ * the candidates of vdsh_light_candidate (seed 1) in the bounds that pass
+ * vdsh_view_free_space against the drawn mesh, in sequence order, at most
+ * 256 tried per position; deterministic. Colours and attenuations are
+ * left zero. */
+int vr_scene_pool_lights(const vr_scene *s, vr_light *out, int max);
 
 /* Draw text (ASCII, stb_easy_font's 7-pixel font scaled by `scale`) on top
  * of the framebuffer at pixel (x, y) from the top-left, on a dark box.

@@ -32,6 +32,10 @@
  *                    (exp cannot be split across the stages, and
  *                    interpolating log coefficients would be a geometric
  *                    mean of the vertices' distances).
+ * VR_MODE_VDSH_BUFFER takes the distance path for any stream: its vertex
+ * stage reads the coefficients from a buffer texture and sums them by a
+ * recurrence for any order (vr_glsl_buffer.c, spliced in before main()
+ * when BUFFER is 1; ORDER is then 0: no coefficient attributes).
  * The numbers these functions share with the C definition (the SH
  * constants, the ramp's slope and offset, the log-sum limit) are not
  * copied here: the C headers' macros are written into the source as they
@@ -254,8 +258,12 @@ static const char vertex_glsl[] =
     "#endif\n"
     "out vec4 v_c9, v_c13, v_c17, v_c21;\n"
     "#endif\n"
-    "\n"
-    "#if VDSH_VISIBILITY || VDSH_DISTANCE\n"
+    "\n";
+
+/* The rest of the vertex stage (after the buffer path's code, which
+ * uses the declarations above). */
+static const char vertex_main_glsl[] =
+    "#if (VDSH_VISIBILITY || VDSH_DISTANCE) && !BUFFER\n"
     "/* The stream's whole SH sum toward unit direction d. */\n"
     "float vdsh_sh_sum(vec3 d)\n"
     "{\n"
@@ -300,11 +308,17 @@ static const char vertex_glsl[] =
     "    v_dv = -1.0;\n"
     "    v_dl = 0.0;\n"
     "#endif\n"
+    "#if BUFFER && NUM_LIGHTS > 0\n"
+    "    float b_sum[NUM_LIGHTS];\n"
+    "    buffer_sums(b_sum);\n"
+    "#endif\n"
     "#if (VDSH_VISIBILITY || VDSH_DISTANCE || VDSH_SPLIT) && NUM_LIGHTS > 0\n"
     "    for (int i = 0; i < NUM_LIGHTS; i++) {\n"
     "        vec3 lv = u_light_pos[i] - a_position;\n"
     "        float dl = length(lv);\n"
-    "#if VDSH_VISIBILITY || VDSH_DISTANCE\n"
+    "#if BUFFER\n"
+    "        float dv = dl > 0.0 ? vdsh_distance(b_sum[i], u_max_distance) : 0.0;\n"
+    "#elif VDSH_VISIBILITY || VDSH_DISTANCE\n"
     "        /* A light at the vertex has no direction: distance 0, not NaN,\n"
     "         * which would spread over every triangle around the vertex. */\n"
     "        float dv = dl > 0.0 ? vdsh_distance(vdsh_sh_sum(lv / dl), u_max_distance) : 0.0;\n"
@@ -535,12 +549,17 @@ static const char depth_fs[] =
 static void key_name(const vr_program_key *k, char *buf, size_t size)
 {
     int interp = vr_mode_interp((vr_mode)k->mode, k->quantity);
-    snprintf(buf, size, "program %s%s%s, %s, %s, output %u, pcf %u, %u lights%s",
+    static const char *const kinds[4] = {"f32", "f16", "s8", "s8s6"};
+    char buf_what[64] = "";
+    if (k->mode == VR_MODE_VDSH_BUFFER)
+        snprintf(buf_what, sizeof buf_what, ", order %u%s %s", k->buf_order,
+                 k->buf_variable ? " (cap, variable)" : "", kinds[k->buf_kind & 3]);
+    snprintf(buf, size, "program %s%s%s, %s, %s, output %u, pcf %u, %u lights%s%s",
              vr_mode_name((vr_mode)k->mode), interp >= 0 ? " path " : "",
              interp >= 0 ? vdsh_interp_name((uint32_t)interp) : "",
              k->compare == VDSH_COMPARE_BINARY ? "binary" : "smooth",
              vdsh_quantity_name(k->quantity), k->output, k->pcf, k->lights,
-             k->packed ? ", s8s6" : "");
+             k->packed ? ", s8s6" : "", buf_what);
 }
 
 /* The varying components a program passes from the vertex to the
@@ -568,6 +587,7 @@ static void key_defines(const vr_program_key *k, int flat, char *buf, size_t siz
 {
     int order = vr_mode_order((vr_mode)k->mode), cube = k->mode == VR_MODE_CUBE;
     int visibility = 0, split = 0, distance = 0, cubemap = 0;
+    int buffer = k->mode == VR_MODE_VDSH_BUFFER;
     /* (vr_program_build has checked that the path is one of these.) */
     switch (vr_mode_interp((vr_mode)k->mode, k->quantity)) {
     case VDSH_INTERP_VISIBILITY: visibility = 1; break;
@@ -585,9 +605,13 @@ static void key_defines(const vr_program_key *k, int flat, char *buf, size_t siz
                      "#define CUBEMAP_BASIS %d\n#define SHADOW_CUBE %d\n"
                      "#define QUANTITY %u\n#define COMPARE %u\n#define OUTPUT %u\n"
                      "#define PCF %u\n#define NUM_LIGHTS %u\n#define FLAT_LIGHTS %d\n"
-                     "#define PACKED %d\n#define FOR_EACH_LIGHT",
+                     "#define PACKED %d\n#define BUFFER %d\n#define BUF_ORDER %u\n"
+                     "#define BUF_KIND %u\n#define BUF_VARIABLE %u\n#define BUF_STRIDE %d\n"
+                     "#define FOR_EACH_LIGHT",
                      order, visibility, split, distance, cubemap, cube, k->quantity, k->compare,
-                     k->output, k->pcf, k->lights, flat, k->packed && order >= 3);
+                     k->output, k->pcf, k->lights, flat, k->packed && order >= 3, buffer,
+                     k->buf_order, k->buf_kind, k->buf_variable,
+                     buffer ? vr_buffer_stride(k->buf_order, (vr_buf_kind)k->buf_kind) : 0);
     for (unsigned i = 0; i < k->lights && n > 0 && (size_t)n < size; i++)
         n += snprintf(buf + n, size - (size_t)n, " LIGHT(%u)", i);
     if (n > 0 && (size_t)n < size)
@@ -646,10 +670,25 @@ vr_result vr_link(const char *name, const char *vs, const char *fs,
     return VR_OK;
 }
 
-vr_result vr_program_build(const vr_program_key *key, vr_program *out,
+/* The buffer path's factor table as GLSL: "const float KS[n] = ...". */
+static char *ks_table(const float *ks, int n)
+{
+    size_t size = 64 + 18 * (size_t)n;
+    char *t = malloc(size);
+    if (!t)
+        return NULL;
+    int len = snprintf(t, size, "const float KS[%d] = float[%d](", n, n);
+    for (int i = 0; i < n && len > 0 && (size_t)len < size; i++)
+        len += snprintf(t + len, size - (size_t)len, "%s%.9e", i ? ", " : "", (double)ks[i]);
+    if (len > 0 && (size_t)len < size)
+        snprintf(t + len, size - (size_t)len, ");\n");
+    return t;
+}
+
+vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_program *out,
                            vr_error *err)
 {
-    char name[160], defines[1024];
+    char name[224], defines[1024];
     key_name(key, name, sizeof name);
     /* The shaders implement the paths vdsh_runtime_interp chooses; should
      * it ever choose another, say so rather than draw something else. */
@@ -658,16 +697,24 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     if (interp >= 0 && interp != VDSH_INTERP_VISIBILITY && interp != VDSH_INTERP_DISTANCE &&
         !(interp == VDSH_INTERP_SPLIT && order == 5))
         return vr_fail(err, VR_ERR_SHADER, "%s: the runtime has no shaders for this path", name);
+    int buffer = key->mode == VR_MODE_VDSH_BUFFER;
+    if (buffer && (key->buf_order < 1 || key->buf_order > VDSH_MAX_ORDER || !ks))
+        return vr_fail(err, VR_ERR_SHADER, "%s: no buffer order", name);
     GLint max_varying = 0;
     glGetIntegerv(GL_MAX_VARYING_COMPONENTS, &max_varying);
     int flat = varying_components(key, 1) <= max_varying;
 
-    size_t vs_size = sizeof defines + sizeof common_glsl + sizeof vertex_glsl;
+    /* The buffer path's code goes between the vertex stage's
+     * declarations and its main(). */
+    char *table = buffer ? ks_table(ks, key->buf_order * key->buf_order) : NULL;
+    size_t vs_size = sizeof defines + sizeof common_glsl + sizeof vertex_glsl +
+                     (table ? strlen(table) : 0) + vr_buffer_glsl_size + sizeof vertex_main_glsl;
     size_t fs_size = sizeof defines + sizeof common_glsl + sizeof fragment_glsl;
     char *vs = malloc(vs_size), *fs = malloc(fs_size);
-    if (!vs || !fs) {
+    if (!vs || !fs || (buffer && !table)) {
         free(vs);
         free(fs);
+        free(table);
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
     }
     /* A driver that packs varyings less tightly than the component count
@@ -676,7 +723,8 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     vr_result r;
     for (;; flat = 0) {
         key_defines(key, flat, defines, sizeof defines);
-        snprintf(vs, vs_size, "%s%s%s", defines, common_glsl, vertex_glsl);
+        snprintf(vs, vs_size, "%s%s%s%s%s%s", defines, common_glsl, vertex_glsl,
+                 buffer ? table : "", buffer ? vr_buffer_glsl : "", vertex_main_glsl);
         snprintf(fs, fs_size, "%s%s%s", defines, common_glsl, fragment_glsl);
         r = vr_link(name, vs, fs, &prog, err);
         if (r != VR_ERR_SHADER || !flat)
@@ -684,6 +732,7 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
     }
     free(vs);
     free(fs);
+    free(table);
     if (r != VR_OK)
         return r;
 
@@ -707,6 +756,9 @@ vr_result vr_program_build(const vr_program_key *key, vr_program *out,
                                 VR_UNIT_BASIS + 3};
         glUniform1iv(basis, 4, units);
     }
+    GLint coef = glGetUniformLocation(prog, "u_coef");
+    if (coef >= 0)
+        glUniform1i(coef, VR_UNIT_COEF);
     GLint shadow = glGetUniformLocation(prog, "u_shadow");
     if (shadow >= 0) {
         GLint units[VR_MAX_LIGHTS_PER_PASS];

@@ -56,8 +56,51 @@ extern const int vr_coef_size[VR_COEF_ATTRIBS];
 int vr_coef_attrib_count(int order);
 
 /* Texture units: the four basis cubemaps, then one shadow cube map per
- * light of a pass. */
-enum { VR_UNIT_BASIS = 0, VR_UNIT_SHADOW = 4 };
+ * light of a pass, then a buffer stream's records. */
+enum {
+    VR_UNIT_BASIS = 0,
+    VR_UNIT_SHADOW = 4,
+    VR_UNIT_COEF = VR_UNIT_SHADOW + VR_MAX_LIGHTS_PER_PASS
+};
+
+/* A buffer stream's vertex attributes (VR_MODE_VDSH_BUFFER, variable
+ * order): the record's first texel, and the vertex's order. */
+enum { VR_ATTR_RECORD = 9, VR_ATTR_ORDER = 10 };
+
+/* What a buffer texture's texels are (vr_buffer.c). */
+typedef enum vr_buf_kind {
+    VR_BUF_F32 = 0,          /* RGBA32F: four coefficients per texel */
+    VR_BUF_F16 = 1,          /* RGBA16F */
+    VR_BUF_S8 = 2,           /* RGBA8I (times the steps in u_ks) */
+    VR_BUF_S8S6 = 3          /* R32UI words: 4 bytes, then 6-bit fields */
+} vr_buf_kind;
+
+/* A stream drawn from buffer textures (VR_MODE_VDSH_BUFFER). */
+typedef struct vr_buffer {
+    int order;               /* fixed: its order; variable: the cap; 0: none */
+    int variable;            /* 1: an order per vertex */
+    vr_buf_kind kind;
+    vdsh_encoding encoding;  /* the file's */
+    float scale;             /* multiplies the sums (f32, f16), else 1 */
+    int stride;              /* fixed: texels per vertex */
+    GLuint buf, tex;         /* the records, in the GPU vertex order */
+    float *ks;               /* per coefficient index, K_l^m x step: a
+                                constant table of the program (vr_glsl.c) */
+    uint64_t ks_hash;        /* of ks and the order (the program key) */
+    GLuint vbo_record, vbo_order; /* variable: per vertex, u32 and u8 */
+    GLuint vao;
+    size_t bytes;            /* all of the above */
+    float mean_order;        /* variable: over the vertices */
+} vr_buffer;
+
+/* Upload stream st (its quantity drawn) as a buffer stream of s, in the
+ * GPU vertex order (remap[file vertex] = GPU vertex); floats: decoded f32.
+ * VR_ERR_FORMAT, VR_ERR_OUT_OF_MEMORY, VR_ERR_GL naming `name`. */
+vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *remap,
+                           int floats, const char *name, vr_error *err);
+void vr_buffer_destroy(vr_buffer *b);
+/* The positions and normals (and indices) of s into the bound VAO. */
+void vr_scene_base_attribs(const vr_scene *s);
 
 struct vr_scene {
     uint32_t vertex_count, triangle_count;
@@ -79,10 +122,24 @@ struct vr_scene {
     int cube_size;
     size_t gpu_bytes;
     vdsh_view view;             /* the default view, decided at load */
+    float pool[VR_MAX_POOL_LIGHTS][3]; /* vr_scene_pool_lights */
+    int pool_count;
+    vr_buffer buffer[VDSH_ORDER_SLOTS]; /* fixed orders, by order */
+    vr_buffer variable;                 /* an order per vertex */
 };
 
-/* Which program: everything that changes the shader source. */
+/* The buffer stream vr_draw_desc.stream names (vr_scene_buffer_stream),
+ * or NULL. */
+const vr_buffer *vr_scene_buffer(const vr_scene *s, int stream);
+
+/* Place desc->light_pool lights in free space (vr_view.c). */
+vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count,
+                              const char *name, vr_error *err);
+
+/* Which program: everything that changes the shader source. Compared
+ * with memcmp: make it with memset(0) first (padding included). */
 typedef struct vr_program_key {
+    uint64_t ks_hash;   /* VR_MODE_VDSH_BUFFER: of its factor table (vr_buffer.ks) */
     uint8_t mode;       /* vr_mode, resolved (never DEFAULT) */
     uint8_t compare;    /* vdsh_compare */
     uint8_t quantity;   /* vdsh_quantity */
@@ -90,7 +147,21 @@ typedef struct vr_program_key {
     uint8_t pcf;        /* 0 or 1 */
     uint8_t lights;     /* lights in this pass, 0..VR_MAX_LIGHTS_PER_PASS */
     uint8_t packed;     /* 1: the stream is s8s6 (bands 2+ in packed words) */
+    uint8_t buf_order;  /* VR_MODE_VDSH_BUFFER: order (variable: the cap) */
+    uint8_t buf_kind;   /* vr_buf_kind */
+    uint8_t buf_variable; /* 1: an order per vertex */
 } vr_program_key;
+
+/* Texels of a record of this order and kind. */
+int vr_buffer_stride(int order, vr_buf_kind kind);
+/* The coefficient indices of an order in the order the shader consumes
+ * them (m = 0..order-1, l = m..order-1, index l(l+1)+m then l(l+1)-m);
+ * returns order^2. */
+int vr_buffer_sequence(int order, int *out);
+
+/* The buffer path's vertex-stage GLSL (vr_glsl_buffer.c). */
+extern const char vr_buffer_glsl[];
+extern const size_t vr_buffer_glsl_size;
 
 typedef struct vr_program {
     vr_program_key key;
@@ -99,9 +170,11 @@ typedef struct vr_program {
     GLint u_ambient, u_shadow_nf, u_shadow_texel;
 } vr_program;
 
-/* Compile and link the lighting program for `key`. On failure returns
- * VR_ERR_SHADER with the info log (and the key) in err; *out untouched. */
-vr_result vr_program_build(const vr_program_key *key, vr_program *out,
+/* Compile and link the lighting program for `key` (ks: the buffer
+ * stream's factor table, buf_order^2 entries; NULL for other modes). On
+ * failure returns VR_ERR_SHADER with the info log (and the key) in err;
+ * *out untouched. */
+vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_program *out,
                            vr_error *err);
 
 /* The depth-only program that renders cube shadow map faces

@@ -352,8 +352,8 @@ void vr_renderer_timings(vr_renderer *r, vr_timings *out)
 /* ------------------------------------------------------------------ */
 /* Programs                                                             */
 
-static vr_result get_program(vr_renderer *r, const vr_program_key *k, const vr_program **out,
-                             vr_error *err)
+static vr_result get_program(vr_renderer *r, const vr_program_key *k, const float *ks,
+                             const vr_program **out, vr_error *err)
 {
     for (int i = 0; i < r->program_count; i++)
         if (memcmp(&r->programs[i].key, k, sizeof *k) == 0) {
@@ -367,7 +367,7 @@ static vr_result get_program(vr_renderer *r, const vr_program_key *k, const vr_p
             glDeleteProgram(r->programs[i].prog);
         r->program_count = 0;
     }
-    vr_result res = vr_program_build(k, &r->programs[r->program_count], err);
+    vr_result res = vr_program_build(k, ks, &r->programs[r->program_count], err);
     if (res != VR_OK)
         return res;
     *out = &r->programs[r->program_count++];
@@ -558,7 +558,24 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
             !finite3(d.lights[i].attenuation))
             return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: light %d is not finite", i);
     vr_mode mode = d.mode;
-    if (!vr_scene_supports(s, mode)) {
+    const vr_buffer *buf = NULL;
+    if (mode == VR_MODE_VDSH_BUFFER) {
+        buf = vr_scene_buffer(s, d.stream);
+        if (!buf && d.stream == VR_STREAM_VARIABLE)
+            return vr_fail(err, VR_ERR_MISSING, "mode buffer: the scene has no %s stream with "
+                           "an order per vertex", vdsh_quantity_name(s->quantity));
+        if (!buf && d.stream == 0)
+            return vr_fail(err, VR_ERR_MISSING, "mode buffer: the scene has no %s stream in a "
+                           "buffer (orders above 5, an order per vertex; orders 1-5 with "
+                           "vr_scene_desc.buffers)", vdsh_quantity_name(s->quantity));
+        if (!buf)
+            return vr_fail(err, VR_ERR_MISSING,
+                           "mode buffer: the scene has no order-%d %s stream in a buffer%s",
+                           d.stream, vdsh_quantity_name(s->quantity),
+                           d.stream >= 1 && d.stream <= 5 && s->vbo_stream[d.stream]
+                               ? " (orders 1-5 are buffered with vr_scene_desc.buffers)"
+                               : "");
+    } else if (!vr_scene_supports(s, mode)) {
         if (mode == VR_MODE_VDSH5 && s->vbo_stream[5])
             return vr_fail(err, VR_ERR_MISSING,
                            "mode %s needs the basis cubemaps, which this scene has not "
@@ -617,13 +634,23 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                 break;
         }
 
-        vr_program_key key = {(uint8_t)mode, (uint8_t)d.compare, (uint8_t)s->quantity,
-                              (uint8_t)d.output, (uint8_t)(d.pcf ? 1 : 0), (uint8_t)n, 0};
-        if (mode != VR_MODE_CUBE)
-            key.pcf = 0;
+        vr_program_key key;
+        memset(&key, 0, sizeof key);
+        key.mode = (uint8_t)mode;
+        key.compare = (uint8_t)d.compare;
+        key.quantity = (uint8_t)s->quantity;
+        key.output = (uint8_t)d.output;
+        key.pcf = (uint8_t)(d.pcf && mode == VR_MODE_CUBE);
+        key.lights = (uint8_t)n;
         key.packed = order && s->encoding[order] == VDSH_ENCODING_S8S6;
+        if (buf) {
+            key.buf_order = (uint8_t)buf->order;
+            key.buf_kind = (uint8_t)buf->kind;
+            key.buf_variable = (uint8_t)buf->variable;
+            key.ks_hash = buf->ks_hash;
+        }
         const vr_program *p = NULL;
-        res = get_program(r, &key, &p, err);
+        res = get_program(r, &key, buf ? buf->ks : NULL, &p, err);
         if (res != VR_OK)
             break;
 
@@ -643,7 +670,7 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
         }
         glUseProgram(p->prog);
         glUniformMatrix4fv(p->u_view_proj, 1, GL_FALSE, vp);
-        glUniform1f(p->u_scale, order ? s->scale[order] : 1.0f);
+        glUniform1f(p->u_scale, buf ? buf->scale : order ? s->scale[order] : 1.0f);
         if (order)
             glUniform4fv(p->u_coef_step, VR_COEF_ATTRIBS, s->coef_step[order]);
         glUniform1f(p->u_max_distance, s->max_distance);
@@ -686,8 +713,12 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                 glBindTexture(GL_TEXTURE_CUBE_MAP, s->basis[k]);
             }
         }
+        if (buf) {
+            glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
+            glBindTexture(GL_TEXTURE_BUFFER, buf->tex);
+        }
         glActiveTexture(GL_TEXTURE0);
-        glBindVertexArray(s->vao[order]);
+        glBindVertexArray(buf ? buf->vao : s->vao[order]);
         if (d.points)
             glDrawArrays(GL_POINTS, 0, (GLsizei)s->vertex_count);
         else

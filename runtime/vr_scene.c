@@ -14,7 +14,9 @@
  * is not 0: the conversion would depend on the context's version.) Each order's stream gets its own VAO; attribute k of a VAO
  * points at coefficients vr_coef_first[k].. of each vertex (vr_internal.h).
  * Triangles and vertices go up in the order of vr_order_triangles
- * (vr_order.c), not the file's.
+ * (vr_order.c), not the file's. Streams above order 5 (and with
+ * desc->buffers every order) also go up as buffer textures for
+ * VR_MODE_VDSH_BUFFER (vr_buffer.c).
  */
 #include "vr_internal.h"
 
@@ -88,7 +90,7 @@ static vr_result make_basis(GLuint tex[4], uint32_t n32, const char *name, vr_er
     return VR_OK;
 }
 
-static void set_base_attribs(const vr_scene *s)
+void vr_scene_base_attribs(const vr_scene *s)
 {
     glBindBuffer(GL_ARRAY_BUFFER, s->vbo_position);
     glVertexAttribPointer(VR_ATTR_POSITION, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), NULL);
@@ -136,7 +138,7 @@ static vr_result upload_stream(vr_scene *s, const vdsh_stream *st, size_t vertic
 
     glGenVertexArrays(1, &s->vao[order]);
     glBindVertexArray(s->vao[order]);
-    set_base_attribs(s);
+    vr_scene_base_attribs(s);
     glBindBuffer(GL_ARRAY_BUFFER, s->vbo_stream[order]);
     GLenum type = st->encoding == VDSH_ENCODING_F16 ? GL_HALF_FLOAT
                   : vdsh_encoding_quantised(st->encoding) ? GL_BYTE : GL_FLOAT;
@@ -194,6 +196,9 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     if ((unsigned)desc->quantity > VDSH_QUANTITY_LOG_DISTANCE)
         return vr_fail(err, VR_ERR_ARGUMENT, "%s: unknown quantity %u", name,
                        (unsigned)desc->quantity);
+    if (desc->light_pool < 0 || desc->light_pool > VR_MAX_POOL_LIGHTS)
+        return vr_fail(err, VR_ERR_ARGUMENT, "%s: light_pool %d not in 0..%d", name,
+                       desc->light_pool, VR_MAX_POOL_LIGHTS);
     if (!glGetString(GL_VERSION))
         return vr_fail(err, VR_ERR_GL, "%s: no current GL context", name);
 
@@ -282,6 +287,10 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
         }
         memcpy(s->bounds_min, s->view.bounds_min, sizeof s->bounds_min);
         memcpy(s->bounds_max, s->view.bounds_max, sizeof s->bounds_max);
+        if (desc->light_pool > 0)
+            r = vr_scene_place_pool(s, &vm, desc->light_pool, name, err);
+        if (r != VR_OK)
+            goto done;
     }
     glGenBuffers(1, &s->vbo_position);
     glGenBuffers(1, &s->vbo_normal);
@@ -296,16 +305,28 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, s->ibo);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(ni * sizeof *gpu_indices), gpu_indices,
                  GL_STATIC_DRAW);
-    set_base_attribs(s);
+    vr_scene_base_attribs(s);
     glBindVertexArray(0);
     s->gpu_bytes = nv * 24 + (size_t)h->triangle_count * 12;
 
     for (uint32_t i = 0; i < f->stream_count && r == VR_OK; i++) {
         const vdsh_stream *st = &f->streams[i];
         if (st->quantity != quantity || st->order < 1 || st->order > 5 ||
-            s->vbo_stream[st->order])
+            (st->flags & VDSH_STREAM_VARIABLE) || s->vbo_stream[st->order])
             continue;
         r = upload_stream(s, st, nv, remap, name, err);
+    }
+    /* Buffer textures (VR_MODE_VDSH_BUFFER): what attributes cannot
+     * hold (orders above 5, the stream with an order per vertex), and
+     * with desc->buffers orders 1-5 too; the first stream of each. */
+    for (uint32_t i = 0; i < f->stream_count && r == VR_OK; i++) {
+        const vdsh_stream *st = &f->streams[i];
+        int variable = (st->flags & VDSH_STREAM_VARIABLE) != 0;
+        if (st->quantity != quantity || st->order < 1 || st->order > VDSH_MAX_ORDER ||
+            (variable ? s->variable.order != 0
+                      : s->buffer[st->order].order || (st->order <= 5 && !desc->buffers)))
+            continue;
+        r = vr_buffer_upload(s, st, remap, desc->buffer_floats, name, err);
     }
     if (r != VR_OK)
         goto done;
@@ -342,6 +363,9 @@ void vr_scene_destroy(vr_scene *s)
     glDeleteBuffers(1, &s->vbo_normal);
     glDeleteBuffers(1, &s->ibo);
     glDeleteTextures(4, s->basis);
+    for (int o = 0; o < VDSH_ORDER_SLOTS; o++)
+        vr_buffer_destroy(&s->buffer[o]);
+    vr_buffer_destroy(&s->variable);
     free(s);
 }
 
@@ -365,14 +389,21 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     i.max_distance = s->max_distance;
     i.gpu_bytes = s->gpu_bytes;
     i.interior = s->view.interior;
+    for (int o = 1; o < VDSH_ORDER_SLOTS; o++) {
+        i.has_buffer[o] = s->buffer[o].order != 0;
+        i.buffer_bytes += s->buffer[o].bytes;
+    }
+    i.variable_order = s->variable.order;
+    i.variable_mean_order = s->variable.mean_order;
+    i.buffer_bytes += s->variable.bytes;
     *out = i;
 }
 
 vr_mode vr_scene_default_mode(const vr_scene *s)
 {
-    static const vr_mode best_first[4] = {VR_MODE_VDSH5, VR_MODE_VDSH5_POLY, VR_MODE_VDSH3,
-                                          VR_MODE_VDSH2};
-    for (int i = 0; i < 4; i++)
+    static const vr_mode best_first[5] = {VR_MODE_VDSH5, VR_MODE_VDSH5_POLY, VR_MODE_VDSH3,
+                                          VR_MODE_VDSH2, VR_MODE_VDSH_BUFFER};
+    for (int i = 0; i < 5; i++)
         if (vr_scene_supports(s, best_first[i]))
             return best_first[i];
     return VR_MODE_VDSH5;
@@ -391,6 +422,7 @@ int vr_scene_supports(const vr_scene *s, vr_mode m)
                (s->basis[0] != 0 || vr_mode_interp(m, s->quantity) != VDSH_INTERP_SPLIT);
     case VR_MODE_DEFAULT: return vr_scene_supports(s, vr_scene_default_mode(s));
     case VR_MODE_VDSH5_POLY: return s->vbo_stream[5] != 0;
+    case VR_MODE_VDSH_BUFFER: return vr_scene_buffer_stream(s, 0) != 0;
     default: return 0;
     }
 }
@@ -400,10 +432,42 @@ int vr_scene_interp(const vr_scene *s, vr_mode m)
     return vr_mode_interp(m == VR_MODE_DEFAULT ? vr_scene_default_mode(s) : m, s->quantity);
 }
 
+int vr_scene_buffer_stream(const vr_scene *s, int stream)
+{
+    if (stream == 0) {
+        if (s->variable.order)
+            return VR_STREAM_VARIABLE;
+        for (int o = VDSH_MAX_ORDER; o >= 1; o--)
+            if (s->buffer[o].order)
+                return o;
+        return 0;
+    }
+    return vr_scene_buffer(s, stream) ? stream : 0;
+}
+
+size_t vr_scene_buffer_bytes(const vr_scene *s, int stream)
+{
+    const vr_buffer *b = vr_scene_buffer(s, stream);
+    return b ? b->bytes : 0;
+}
+
+const vr_buffer *vr_scene_buffer(const vr_scene *s, int stream)
+{
+    if (stream == 0)
+        stream = vr_scene_buffer_stream(s, 0);
+    if (stream == VR_STREAM_VARIABLE)
+        return s->variable.order ? &s->variable : NULL;
+    if (stream >= 1 && stream <= VDSH_MAX_ORDER && s->buffer[stream].order)
+        return &s->buffer[stream];
+    return NULL;
+}
+
 const char *vr_scene_mode_label(const vr_scene *s, vr_mode m)
 {
     if (m == VR_MODE_DEFAULT)
         m = vr_scene_default_mode(s);
+    if (m == VR_MODE_VDSH_BUFFER)
+        return vr_mode_label(m);
     if (vr_scene_interp(s, m) != VDSH_INTERP_DISTANCE ||
         s->quantity != VDSH_QUANTITY_LOG_DISTANCE)
         return vr_mode_label(m);

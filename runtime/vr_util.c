@@ -69,7 +69,7 @@ const char *vr_gl_renderer(void)
 /* ------------------------------------------------------------------ */
 
 static const char *const mode_names[VR_MODE_COUNT_] = {
-    "default", "none", "cube", "vdsh2", "vdsh3", "vdsh5", "vdsh5poly"};
+    "default", "none", "cube", "vdsh2", "vdsh3", "vdsh5", "vdsh5poly", "buffer"};
 
 static const char *const mode_labels[VR_MODE_COUNT_] = {
     "the scene's default (VDSH order 5, cubemaps where it has them)",
@@ -78,7 +78,8 @@ static const char *const mode_labels[VR_MODE_COUNT_] = {
     "VDSH order 2 (4 coeff.)",
     "VDSH order 3 (9 coeff.)",
     "VDSH order 5 (25 coeff., cubemaps)",
-    "VDSH order 5 (25 coeff., polynomials)"};
+    "VDSH order 5 (25 coeff., polynomials)",
+    "VDSH from a buffer (any order, per-vertex distance)"};
 
 const char *vr_mode_name(vr_mode m)
 {
@@ -115,6 +116,8 @@ int vr_mode_order(vr_mode m)
 
 int vr_mode_interp(vr_mode m, uint32_t quantity)
 {
+    if (m == VR_MODE_VDSH_BUFFER)
+        return VDSH_INTERP_DISTANCE;
     int order = vr_mode_order(m);
     return order ? (int)vdsh_runtime_interp((uint32_t)order, quantity) : -1;
 }

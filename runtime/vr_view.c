@@ -3,7 +3,9 @@
  * formats/vdsh_scene_view.h, which decides at load (vr_scene_create) from
  * the mesh whether the scene is a room or an object, its camera, and
  * default lights moved into free space; the bake side's tools
- * (vdsh-frames) compute the same view from the same .vdsh mesh.
+ * (vdsh-frames) compute the same view from the same .vdsh mesh. And the
+ * light pool, many lights in free space for benchmarks (vr_scene_pool_lights),
+ * placed at load only when asked for: a second grid of the triangles.
  *
  * Load cost, one core: the interior test's 128 rays and the lights'
  * free-space probes (14 rays per position tried) run against a uniform
@@ -16,6 +18,9 @@
  */
 #include "vr_internal.h"
 
+#include "vdsh_light.h"
+
+#include <math.h>
 #include <string.h>
 
 static void from_vdsh(const vdsh_camera *c, vr_camera *out)
@@ -47,6 +52,42 @@ int vr_scene_default_lights(const vr_scene *s, vr_light *out, int max)
     for (; n < max && n < s->view.light_count; n++) {
         memset(&out[n], 0, sizeof out[n]);
         memcpy(out[n].position, s->view.lights[n], sizeof out[n].position);
+    }
+    return n;
+}
+
+/* The light pool: candidates of the seeded uniform sequence in the
+ * bounds, kept when in free space (vdsh_light.h), in sequence order. */
+vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count,
+                              const char *name, vr_error *err)
+{
+    vdsh_view_tracer *t = NULL;
+    vdsh_error ve;
+    if (vdsh_view_tracer_create(m, &t, &ve) != VDSH_OK)
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: light pool: %s", name, ve.msg);
+    float diag = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        float e = s->bounds_max[a] - s->bounds_min[a];
+        diag += e * e;
+    }
+    diag = sqrtf(diag);
+    s->pool_count = 0;
+    for (uint32_t k = 0; s->pool_count < count && k < 256u * (uint32_t)count; k++) {
+        float p[3];
+        vdsh_light_candidate(s->bounds_min, s->bounds_max, 1, k, p);
+        if (vdsh_view_free_space(t, p, diag))
+            memcpy(s->pool[s->pool_count++], p, sizeof p);
+    }
+    vdsh_view_tracer_destroy(t);
+    return VR_OK;
+}
+
+int vr_scene_pool_lights(const vr_scene *s, vr_light *out, int max)
+{
+    int n = 0;
+    for (; n < max && n < s->pool_count; n++) {
+        memset(&out[n], 0, sizeof out[n]);
+        memcpy(out[n].position, s->pool[n], sizeof out[n].position);
     }
     return n;
 }

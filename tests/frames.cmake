@@ -22,7 +22,10 @@ endif()
 # view set against the same streams computed in C on the runtime's path
 # (vdsh-frames truth), for the default bake (log distance, drawn per
 # vertex in every mode) and the paper's (distance; order 5 per fragment,
-# with the basis cubemaps and as polynomials): mean difference <= 0.002 and
+# with the basis cubemaps and as polynomials; and the default bake's streams
+# drawn from buffer textures, VR_MODE_VDSH_BUFFER, and streams of orders 7,
+# 9, 12 and with an order per vertex, derived from it and baked):
+# mean difference <= 0.002 and
 # at most 0.5% of the pixels off by more than 0.1 in every frame (measured
 # on llvmpipe: <= 1e-4 and 0.003%; one order for another: 0.019 and 3.7%).
 # Skips (77) without GL.
@@ -30,25 +33,44 @@ if(TARGET vb_frames AND TARGET vdsh-view)
   add_executable(test_frames_gl ${CMAKE_CURRENT_LIST_DIR}/test_frames_gl.c)
   target_link_libraries(test_frames_gl PRIVATE vt_tools m)
   add_test(NAME frames_gl_vs_c COMMAND sh -c [=[
-bake=$1; frames=$2; view=$3; cmp=$4; d=$5; views=$6
+bake=$1; frames=$2; view=$3; cmp=$4; d=$5; views=$6; derive=$7
 set -e
 rm -rf "$d"; mkdir -p "$d"
 for m in shadow paper; do
   "$bake" builtin:room --max-edge 0.5 --rays 400 --method $m --cube-size 32 -q -o "$d/$m.vdsh"
   "$frames" truth "$d/$m.vdsh" --views "$views" -o "$d/$m-c" > /dev/null
   set +e
-  "$view" "$d/$m.vdsh" --views "$views" --frames "$d/$m-gl" --modes vdsh2,vdsh3,vdsh5,vdsh5poly -q
+  modes=vdsh2,vdsh3,vdsh5,vdsh5poly
+  [ $m = shadow ] && modes=$modes,buf2,buf3,buf5
+  "$view" "$d/$m.vdsh" --views "$views" --frames "$d/$m-gl" --modes $modes -q
   rc=$?
   set -e
   [ $rc -eq 77 ] && exit 77
   [ $rc -eq 0 ] || exit $rc
 done
 "$cmp" "$views" "$d/shadow-c" "$d/shadow-gl" 0.002 0.005 \
-  vdsh2=c-vdsh2 vdsh3=c-vdsh3 vdsh5=c-vdsh5 vdsh5poly=c-vdsh5
+  vdsh2=c-vdsh2 vdsh3=c-vdsh3 vdsh5=c-vdsh5 vdsh5poly=c-vdsh5 \
+  buf2=c-vdsh2 buf3=c-vdsh3 buf5=c-vdsh5
 "$cmp" "$views" "$d/paper-c" "$d/paper-gl" 0.002 0.005 \
   vdsh2=c-vdsh2 vdsh3=c-vdsh3 vdsh5=c-vdsh5 vdsh5poly=c-vdsh5
+# Orders above 5 and an order per vertex (up to 11; vdsh-frames names its
+# C frame c-vdsh-var), derived from the default bake's order 5 with higher
+# bands added (test_runtime_buffer derive), in f16, s8s6 and s8.
+"$derive" derive "$d/shadow.vdsh" "$d/high.vdsh"
+"$frames" truth "$d/high.vdsh" --views "$views" -o "$d/high-c" > /dev/null
+"$view" "$d/high.vdsh" --views "$views" --frames "$d/high-gl" --modes buf7,buf9,buf12,adaptive -q
+"$cmp" "$views" "$d/high-c" "$d/high-gl" 0.002 0.005 \
+  buf7=c-vdsh7 buf9=c-vdsh9 buf12=c-vdsh12 adaptive=c-vdsh-var
+# The same from the baker: orders 7, 9, 12 (s8s6) and an adaptive order up
+# to 12.
+"$bake" builtin:room --max-edge 0.5 --rays 400 --cube-size 0 --orders 7,9,12 \
+  --adaptive-order 0.05 -q -o "$d/baked.vdsh"
+"$frames" truth "$d/baked.vdsh" --views "$views" -o "$d/baked-c" > /dev/null
+"$view" "$d/baked.vdsh" --views "$views" --frames "$d/baked-gl" --modes buf7,buf9,buf12,adaptive -q
+"$cmp" "$views" "$d/baked-c" "$d/baked-gl" 0.002 0.005 \
+  buf7=c-vdsh7 buf9=c-vdsh9 buf12=c-vdsh12 adaptive=c-vdsh-var
 ]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames> $<TARGET_FILE:vdsh-view>
        $<TARGET_FILE:test_frames_gl> ${CMAKE_CURRENT_BINARY_DIR}/frames_gl
-       ${CMAKE_CURRENT_LIST_DIR}/data/frames_gl.views.json)
+       ${CMAKE_CURRENT_LIST_DIR}/data/frames_gl.views.json $<TARGET_FILE:test_runtime_buffer>)
   set_tests_properties(frames_gl_vs_c PROPERTIES SKIP_RETURN_CODE 77)
 endif()

@@ -94,6 +94,17 @@ EOF
 ]=] sh $<TARGET_FILE:vdsh-bake> ${_rt_dir}/floor)
 set_tests_properties(runtime_fixture_floor PROPERTIES FIXTURES_SETUP runtime_floor)
 
+# VR_MODE_VDSH_BUFFER: per vertex against the C evaluation at every order
+# the format holds, and against the attribute path on the room.
+_runtime_test(test_runtime_buffer)
+add_test(NAME runtime_buffer_vertex COMMAND test_runtime_buffer vertex -)
+_runtime_props(runtime_buffer_vertex)
+foreach(part frames errors)
+  add_test(NAME runtime_buffer_${part}
+           COMMAND test_runtime_buffer ${part} ${_rt_dir}/room_log/room_log.vdsh)
+  _runtime_props(runtime_buffer_${part} FIXTURES_REQUIRED runtime_room)
+endforeach()
+
 _runtime_test(test_runtime_log)
 add_test(NAME runtime_log COMMAND test_runtime_log ${_rt_dir}/floor/floor.vdsh)
 _runtime_props(runtime_log FIXTURES_REQUIRED runtime_floor)
@@ -167,6 +178,10 @@ expect1 "x/y/z.png" --render "$d/x/y/z.png" "$room"
 "$v" -q --render "$d/ok.png" --size 64x48 --no-cubemaps --mode vdsh5poly "$d/alone.vdsh" || { echo "--no-cubemaps failed"; fail=1; }
 # a log-distance bake needs no cubemaps in any mode
 "$v" -q --render "$d/log.png" --size 64x48 --mode vdsh5 "$4" || { echo "log-distance vdsh5 failed"; fail=1; }
+# the buffer path: an order the file lacks is named; one it has draws
+expect1 "no order-7" --render "$d/x.png" --mode buf7 "$room"
+expect1 "order per vertex" --render "$d/x.png" --mode adaptive "$room"
+"$v" -q --render "$d/buf3.png" --size 64x48 --mode buf3 "$4" || { echo "buf3 failed"; fail=1; }
 exit $fail
 ]=] sh ${_view} ${_room} ${_rt_dir}/view_errors ${_room_log})
 
@@ -275,7 +290,8 @@ test "$(cat "$d/keep.png")" = old
 if ls "$d" | grep -q '\.tmp'; then echo "temporary left: $(ls "$d")"; exit 1; fi
 ]=] sh ${_view} $<TARGET_FILE:vdsh-bake> ${_png} ${_room} ${_rt_dir}/view_frame)
 
-# The benchmark mode: every mode, 1 and 3 lights, two scenes, one process;
+# The benchmark mode: every mode, 1, 3, 16 and 64 lights (fewer rounds for
+# 16 and 64), two scenes, one process;
 # its JSON parses (a scene path with quotes and backslashes too).
 find_package(Python3 COMPONENTS Interpreter QUIET)
 if(Python3_Interpreter_FOUND)
@@ -286,23 +302,28 @@ shutil.rmtree(d, ignore_errors=True)
 os.makedirs(d)
 odd = os.path.join(os.fsencode(d), b'q"x\\r\t\xffoom.vdsh')
 shutil.copy(room_log, odd)
-out = subprocess.run([view, '--bench', '--frames', '1', '--size', '96x72', '--shadow-size', '64',
+out = subprocess.run([view, '--bench', '--frames', '6', '--size', '96x72', '--shadow-size', '64',
                       '-q', room, room, odd], check=True, capture_output=True).stdout
 print(out[:400])
 b = json.loads(out.decode('utf-8'))
-assert b['renderer'] and b['rounds'] == 1 and b['width'] == 96, b
+assert b['renderer'] and b['rounds'] == 6 and b['width'] == 96, b
 shown = os.path.join(d, 'q"x\\r\t\ufffdoom.vdsh')
 assert [s['file'] for s in b['scenes']] == [room, room, shown], [s['file'] for s in b['scenes']]
 modes = {r['mode'] for s in b['scenes'] for r in s['results']}
-assert modes == {'none', 'cube', 'cube_pcf', 'vdsh2', 'vdsh3', 'vdsh5', 'vdsh5poly'}, modes
-assert {r['lights'] for r in b['scenes'][0]['results']} == {1, 3}
+assert modes == {'none', 'cube', 'cube_pcf', 'vdsh2', 'vdsh3', 'vdsh5', 'vdsh5poly', 'buf5'}, modes
+assert {r['lights'] for r in b['scenes'][0]['results']} == {1, 3, 16, 64}
+rounds = {r['lights']: len(r['cpu_ms']) for r in b['scenes'][0]['results']}
+assert rounds == {1: 6, 3: 6, 16: 3, 64: 3}, rounds
 r0 = b['scenes'][0]['results'][0]
-assert len(r0['process_cpu_ms']) == 1 and len(r0['cpu_ms']) == 1
+assert len(r0['process_cpu_ms']) == 6 and len(r0['cpu_ms']) == 6
 # the log-distance scene: its VDSH modes on the distance path
 log = b['scenes'][2]
 assert log['quantity'] == 'log-distance' and log['method'] == 'lsq', log
 paths = {(r['mode'], r['path']) for r in log['results']}
 assert ('vdsh5', 'distance') in paths, paths
+# the buffer path at order 5 beside it, on log-distance scenes only
+assert ('buf5', 'distance') in paths, paths
+assert 'buf5' not in {r['mode'] for r in b['scenes'][0]['results']}
 assert ('vdsh5', 'split') in {(r['mode'], r['path']) for r in b['scenes'][0]['results']}
 print('ok')
 ]=] ${_view} ${_room} ${_room_log} ${_rt_dir}/view_bench)
@@ -403,8 +424,40 @@ expect 2 "positive count" --frames "$d/x" "$room"
 "$t" lights "$room"
 ]=] sh ${_view} $<TARGET_FILE:test_runtime_frames> ${_room} ${_room_log} ${_rt_dir}/view_frames)
 
+# The buffer modes on the command line: a file with orders 7, 9, 12 and an
+# order per vertex (test_runtime_buffer derive); the grid gains its
+# adaptive-order column (6 panels) and says so; --help names the modes.
+add_test(NAME runtime_view_buffer COMMAND sh -c [=[
+set -e
+v=$1; png=$2; derive=$3; log=$4; d=$5
+rm -rf "$d"; mkdir -p "$d"
+"$derive" derive "$log" "$d/high.vdsh"
+for m in buf7 buf12 adaptive buffer; do
+  "$v" -q --render "$d/$m.png" --size 96x72 --mode $m --lights 3 "$d/high.vdsh"
+  "$png" info "$d/$m.png" 96 72
+done
+"$v" --render "$d/a.png" --size 96x72 --mode adaptive "$d/high.vdsh" 2> "$d/render.log"
+cat "$d/render.log"
+grep -q "VDSH adaptive order (up to 11, mean 6.0" "$d/render.log"
+"$v" --grid "$d/grid.png" --size 96x72 "$d/high.vdsh" "$log" 2> "$d/grid.log"
+cat "$d/grid.log"
+"$png" info "$d/grid.png" 576 144
+grep -q "| adaptive" "$d/grid.log"
+"$v" --grid "$d/grid5.png" --size 96x72 "$log" 2> /dev/null
+"$png" info "$d/grid5.png" 480 72
+"$v" --help | grep -q "bufN the stream of order N"
+"$v" --help | grep -q "adaptive-order column\|| adaptive order"
+# A bake of adaptive order alone: the default mode is the buffer's
+"$6" builtin:room --max-edge 1.0 --rays 256 --adaptive-order 0.05 --max-order 9 -q \
+  -o "$d/adaptive.vdsh"
+"$v" --render "$d/default.png" --size 96x72 "$d/adaptive.vdsh" 2> "$d/default.log"
+cat "$d/default.log"
+grep -q "mode buffer: VDSH adaptive order (up to 9" "$d/default.log"
+]=] sh ${_view} ${_png} $<TARGET_FILE:test_runtime_buffer> ${_room_log} ${_rt_dir}/view_buffer
+       $<TARGET_FILE:vdsh-bake>)
+
 foreach(t runtime_view_usage runtime_view_errors runtime_view_render runtime_view_bench
-          runtime_view_frame runtime_view_window runtime_view_frames)
+          runtime_view_frame runtime_view_window runtime_view_frames runtime_view_buffer)
   if(TEST ${t})
     _runtime_props(${t} FIXTURES_REQUIRED runtime_room)
   endif()

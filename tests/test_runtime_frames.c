@@ -27,11 +27,17 @@
  *                      not 1 and not a Lambert term)
  *   lights SCENE       the runtime's default camera and four default
  *                      lights (vr_scene_default_camera / _lights) are
- *                      vdsh_view_compute's of the same file
+ *                      vdsh_view_compute's of the same file; its light
+ *                      pool (vr_scene_pool_lights) holds 64 distinct
+ *                      positions in free space (vdsh_view_free_space with
+ *                      a tracer of the file's mesh), inside the bounds,
+ *                      the first free candidates of vdsh_light_candidate
+ *                      seed 1 in order; without a pool it is empty
  */
 #include "test_runtime_util.h"
 
 #include "vdsh_camera.h"
+#include "vdsh_light.h"
 #include "vdsh_scene_view.h"
 #include "vt_image.h"
 #include "vt_views.h"
@@ -366,6 +372,54 @@ static int check_facing(char **argv)
     return test_report("facing");
 }
 
+/* The light pool: 64 free positions, the sequence's first free ones. */
+static void check_pool(const char *path, const vdsh_file *f, const vr_scene *plain)
+{
+    vr_light none[1];
+    CHECK(vr_scene_pool_lights(plain, none, 1) == 0, "a scene loaded without a pool has one");
+    vr_error err;
+    vr_scene *s = NULL;
+    if (vr_scene_create(&(vr_scene_desc){.path = path, .light_pool = VR_MAX_POOL_LIGHTS}, &s,
+                        &err) != VR_OK) {
+        CHECK(0, "%s", err.msg);
+        return;
+    }
+    vdsh_view_mesh m = {f->positions, f->normals, f->indices, f->header.vertex_count,
+                        f->header.triangle_count};
+    vdsh_view_tracer *t = NULL;
+    vdsh_error verr;
+    CHECK(vdsh_view_tracer_create(&m, &t, &verr) == VDSH_OK, "%s", verr.msg);
+    vr_scene_info info;
+    vr_scene_get_info(s, &info);
+    float diag = 0.0f;
+    for (int a = 0; a < 3; a++)
+        diag += (info.bounds_max[a] - info.bounds_min[a]) * (info.bounds_max[a] - info.bounds_min[a]);
+    diag = sqrtf(diag);
+    vr_light l[VR_MAX_POOL_LIGHTS];
+    int n = vr_scene_pool_lights(s, l, VR_MAX_POOL_LIGHTS);
+    CHECK(n == VR_MAX_POOL_LIGHTS, "%d pool lights, not %d", n, VR_MAX_POOL_LIGHTS);
+    uint32_t k = 0;
+    for (int i = 0; i < n && t; i++) {
+        CHECK(vdsh_view_free_space(t, l[i].position, diag), "pool light %d not in free space",
+              i);
+        for (int a = 0; a < 3; a++)
+            CHECK(l[i].position[a] >= info.bounds_min[a] && l[i].position[a] <= info.bounds_max[a],
+                  "pool light %d outside the bounds", i);
+        float p[3];
+        do
+            vdsh_light_candidate(info.bounds_min, info.bounds_max, 1, k++, p);
+        while (!vdsh_view_free_space(t, p, diag) && k < 100000);
+        CHECK(!memcmp(p, l[i].position, sizeof p), "pool light %d is not free candidate %u",
+              i, k - 1);
+        for (int j = 0; j < i; j++)
+            CHECK(memcmp(l[i].position, l[j].position, sizeof p), "pool lights %d and %d equal",
+                  i, j);
+    }
+    printf("light pool: %d positions in free space, %u candidates tried\n", n, k);
+    vdsh_view_tracer_destroy(t);
+    vr_scene_destroy(s);
+}
+
 static int check_lights(const char *path)
 {
     vr_context *ctx = rt_context_or_skip("lights");
@@ -401,6 +455,8 @@ static int check_lights(const char *path)
                        ? " (moved into free space)" : "");
         }
     }
+    if (ok && f)
+        check_pool(path, f, s);
     vdsh_free(f);
     vr_scene_destroy(s);
     vr_context_destroy(ctx);

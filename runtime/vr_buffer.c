@@ -1,0 +1,359 @@
+/*
+ * vr_buffer.c - upload a coefficient stream as a buffer texture for
+ * VR_MODE_VDSH_BUFFER (vr.h): any order, where vertex attributes stop at
+ * order 5 (16 attributes of 4 components at most, 25 coefficients).
+ *
+ * A vertex's record keeps the file's encoding and values; only their
+ * order changes, to the order the shader's recurrence consumes them
+ * (vr_buffer_sequence: m outside, l inside, then +m before -m), so that
+ * the vertex stage reads its record front to back, four coefficients per
+ * texel fetch (RGBA32F for f32, RGBA16F for f16: the texture unit widens
+ * each half exactly, RGBA8I for s8: the integer itself) or five per
+ * R32UI word (s8s6: the first word holds coefficients 0-3 as bytes, as
+ * in the file, then the 6-bit fields of the others, five to a word).
+ * Records are padded to whole texels (f16, s8: to 8 and 4 bytes, at most
+ * 6 and 3 bytes; f32 and s8s6 need none). Measured against one fetch per
+ * coefficient in file order, the texel fetches were most of the buffer
+ * path's cost on llvmpipe (docs/BENCHMARKS.md). GPU bytes are then the
+ * file's: an f16 order-12 stream is 288 bytes per vertex, against 576 as
+ * decoded floats (desc->buffer_floats, kept for comparisons).
+ *
+ * Per coefficient index i the shader multiplies by a factor (KS, a
+ * constant table in the program's source, one program per table; the
+ * program key holds its hash): K_l^|m| of the basis (sqrt 2 folded in for
+ * m != 0, computed in double as formats/vdsh_sh.c does) times, for s8 and
+ * s8s6, the step vdsh_quant_step(scale_i, levels_i), so that q_i * step_i
+ * is the coefficient vdsh_stream_decode computes.
+ *
+ * A fixed stream's vertex v starts at texel v * stride (the shader reads
+ * gl_VertexID); a stream with an order per vertex carries each vertex's
+ * first texel and order as integer attributes.
+ *
+ * Does not: draw (vr_render.c), choose the stream (vr_scene.c), convert
+ * values (only the floats variant decodes).
+ * Errors: VR_ERR_FORMAT for an encoding it cannot draw or a record that
+ * is not where the stream says, VR_ERR_GL for a stream over
+ * GL_MAX_TEXTURE_BUFFER_SIZE texels, VR_ERR_OUT_OF_MEMORY; messages name
+ * the file. On failure nothing stays allocated.
+ */
+#include "vr_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+int vr_buffer_sequence(int order, int *out)
+{
+    int n = 0;
+    for (int m = 0; m < order; m++)
+        for (int l = m; l < order; l++) {
+            out[n++] = l * (l + 1) + m;
+            if (m > 0)
+                out[n++] = l * (l + 1) - m;
+        }
+    return n;
+}
+
+int vr_buffer_stride(int order, vr_buf_kind kind)
+{
+    int nc = order * order;
+    if (kind == VR_BUF_S8S6)
+        return nc <= VDSH_S8S6_BYTES ? 1 : 1 + (nc - VDSH_S8S6_BYTES + 4) / 5;
+    return (nc + 3) / 4;
+}
+
+/* Bytes of a texel, and its texture format. */
+static size_t texel_bytes(vr_buf_kind k)
+{
+    return k == VR_BUF_F32 ? 16 : k == VR_BUF_F16 ? 8 : 4;
+}
+
+static GLenum texel_format(vr_buf_kind k)
+{
+    switch (k) {
+    case VR_BUF_F16: return GL_RGBA16F;
+    case VR_BUF_S8: return GL_RGBA8I;
+    case VR_BUF_S8S6: return GL_R32UI;
+    default: return GL_RGBA32F;
+    }
+}
+
+void vr_buffer_destroy(vr_buffer *b)
+{
+    if (!b)
+        return;
+    glDeleteVertexArrays(1, &b->vao);
+    glDeleteTextures(1, &b->tex);
+    GLuint bufs[3] = {b->buf, b->vbo_record, b->vbo_order};
+    glDeleteBuffers(3, bufs);
+    free(b->ks);
+    memset(b, 0, sizeof *b);
+}
+
+static uint32_t get_u32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static void put_u32(unsigned char *p, uint32_t v)
+{
+    for (int k = 0; k < 4; k++)
+        p[k] = (unsigned char)(v >> (8 * k));
+}
+
+/* Stored value i (>= 4) of an s8s6 record, sign-extended. */
+static int s8s6_field(const unsigned char *rec, int i)
+{
+    int j = i - VDSH_S8S6_BYTES;
+    uint32_t f = get_u32(rec + VDSH_S8S6_BYTES + 4 * (j / 5)) >> (6 * (j % 5)) & 63u;
+    return f >= 32u ? (int)f - 64 : (int)f;
+}
+
+/* One vertex's record of order k (rec: as the file stores it; floats:
+ * the decoded coefficients instead) into dst in the shader's order. */
+static void pack_record(vr_buf_kind kind, int floats, const unsigned char *rec,
+                        const float *decoded, int k, unsigned char *dst)
+{
+    int seq[VDSH_MAX_COEFFS];
+    int n = vr_buffer_sequence(k, seq);
+    memset(dst, 0, (size_t)vr_buffer_stride(k, kind) * texel_bytes(kind));
+    if (floats) {
+        for (int p = 0; p < n; p++)
+            memcpy(dst + 4 * p, &decoded[seq[p]], 4);
+        return;
+    }
+    if (kind != VR_BUF_S8S6) {
+        size_t e = kind == VR_BUF_F32 ? 4 : kind == VR_BUF_F16 ? 2 : 1;
+        for (int p = 0; p < n; p++)
+            memcpy(dst + e * (size_t)p, rec + e * (size_t)seq[p], e);
+        return;
+    }
+    /* s8s6: word 0 as stored (coefficients 0-3, fewer at order 1), then
+     * the 6-bit fields in sequence, 0-3 skipped. */
+    memcpy(dst, rec, (size_t)(n < VDSH_S8S6_BYTES ? n : VDSH_S8S6_BYTES));
+    int f = 0;
+    for (int p = 0; p < n; p++) {
+        if (seq[p] < VDSH_S8S6_BYTES)
+            continue;
+        unsigned char *w = dst + 4 + 4 * (f / 5);
+        put_u32(w, get_u32(w) | ((uint32_t)s8s6_field(rec, seq[p]) & 63u) << (6 * (f % 5)));
+        f++;
+    }
+}
+
+/* The texture kind of a stream as uploaded. */
+static vr_buf_kind kind_of(const vdsh_stream *st, int floats)
+{
+    switch (floats ? VDSH_ENCODING_F32 : st->encoding) {
+    case VDSH_ENCODING_F16: return VR_BUF_F16;
+    case VDSH_ENCODING_S8: return VR_BUF_S8;
+    case VDSH_ENCODING_S8S6: return VR_BUF_S8S6;
+    default: return VR_BUF_F32;
+    }
+}
+
+/* The factors of u_ks per coefficient index (see the top). */
+static float *make_ks(const vdsh_stream *st, int order, int floats)
+{
+    float *ks = calloc((size_t)VDSH_MAX_COEFFS + 4, sizeof *ks);
+    if (!ks)
+        return NULL;
+    for (int l = 0; l < order; l++)
+        for (int m = 0; m <= l; m++) {
+            double kk = (2.0 * l + 1.0) / (4.0 * 3.14159265358979323846);
+            for (int f = l - m + 1; f <= l + m; f++)
+                kk /= f;
+            float K = m == 0 ? (float)sqrt(kk) : (float)sqrt(2.0 * kk);
+            for (int sign = m ? -1 : 1; sign <= 1; sign += 2) {
+                int i = l * (l + 1) + sign * m;
+                float step = 1.0f;
+                if (!floats && vdsh_encoding_quantised(st->encoding))
+                    step = vdsh_quant_step(st->coef_scales[i],
+                                           vdsh_quant_levels(st->encoding, (uint32_t)i));
+                ks[i] = K * step;
+            }
+        }
+    return ks;
+}
+
+/* The records of a fixed stream in GPU vertex order. NULL when out of
+ * memory. */
+static unsigned char *fixed_records(const vdsh_stream *st, vr_buffer *b, uint32_t nv,
+                                    const uint32_t *remap, int floats, size_t *bytes)
+{
+    size_t rec = (size_t)b->stride * texel_bytes(b->kind), bpv = vdsh_stream_bytes_per_vertex(st);
+    unsigned char *dst = malloc((size_t)nv * rec + 16);
+    if (!dst)
+        return NULL;
+    float decoded[VDSH_MAX_COEFFS];
+    for (uint32_t v = 0; v < nv; v++) {
+        if (floats)
+            vdsh_stream_decode(st, v, decoded);
+        pack_record(b->kind, floats, (const unsigned char *)st->data + (size_t)v * bpv, decoded,
+                    b->order, dst + (size_t)remap[v] * rec);
+    }
+    *bytes = (size_t)nv * rec;
+    return dst;
+}
+
+/* The records of a stream with an order per vertex in GPU vertex order,
+ * with each GPU vertex's first texel (start) and order. The file's
+ * records are checked to be where its offsets say (a stream from memory
+ * has not been through the reader). VR_ERR_FORMAT, VR_ERR_OUT_OF_MEMORY. */
+static vr_result variable_records(const vdsh_stream *st, vr_buffer *b, uint32_t nv,
+                                  const uint32_t *remap, int floats, unsigned char **out,
+                                  size_t *bytes, uint32_t *start, uint8_t *order,
+                                  const char *name, vr_error *err)
+{
+    uint32_t *inv = malloc((size_t)nv * sizeof *inv);
+    if (!inv)
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+    size_t texels = 0, tb = texel_bytes(b->kind);
+    double sum = 0.0;
+    for (uint32_t v = 0; v < nv; v++) {
+        uint32_t k = st->orders[v];
+        if (k < 1 || k > st->order ||
+            st->offsets[v + 1] - st->offsets[v] != vdsh_record_words(st->encoding, k)) {
+            free(inv);
+            return vr_fail(err, VR_ERR_FORMAT, "%s: variable-order stream: vertex %u has "
+                           "order %u and a record of %u words", name, v, k,
+                           st->offsets[v + 1] - st->offsets[v]);
+        }
+        inv[remap[v]] = v;
+        texels += (size_t)vr_buffer_stride((int)k, b->kind);
+        sum += k;
+    }
+    unsigned char *dst = malloc(texels * tb + 16);
+    if (!dst) {
+        free(inv);
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+    }
+    float decoded[VDSH_MAX_COEFFS];
+    size_t at = 0;
+    for (uint32_t g = 0; g < nv; g++) {
+        uint32_t v = inv[g];
+        int k = st->orders[v];
+        if (floats)
+            vdsh_stream_decode(st, v, decoded);
+        pack_record(b->kind, floats, (const unsigned char *)st->data + 4 * (size_t)st->offsets[v],
+                    decoded, k, dst + at * tb);
+        start[g] = (uint32_t)at;
+        order[g] = (uint8_t)k;
+        at += (size_t)vr_buffer_stride(k, b->kind);
+    }
+    free(inv);
+    b->mean_order = nv ? (float)(sum / nv) : 0.0f;
+    *out = dst;
+    *bytes = texels * tb;
+    return VR_OK;
+}
+
+/* Create the buffer texture, the VAO and (variable) the per-vertex
+ * attributes of b (GL errors are the caller's to check). */
+static void make_gl(vr_scene *s, vr_buffer *b, const void *rec, size_t bytes,
+                    const uint32_t *start, const uint8_t *order)
+{
+    glGenBuffers(1, &b->buf);
+    glBindBuffer(GL_TEXTURE_BUFFER, b->buf);
+    glBufferData(GL_TEXTURE_BUFFER, (GLsizeiptr)bytes, rec, GL_STATIC_DRAW);
+    glGenTextures(1, &b->tex);
+    glBindTexture(GL_TEXTURE_BUFFER, b->tex);
+    glTexBuffer(GL_TEXTURE_BUFFER, texel_format(b->kind), b->buf);
+    glBindTexture(GL_TEXTURE_BUFFER, 0);
+    glBindBuffer(GL_TEXTURE_BUFFER, 0);
+    glGenVertexArrays(1, &b->vao);
+    glBindVertexArray(b->vao);
+    vr_scene_base_attribs(s);
+    if (start) {
+        size_t nv = s->vertex_count;
+        GLuint vbo[2];
+        glGenBuffers(2, vbo);
+        b->vbo_record = vbo[0];
+        b->vbo_order = vbo[1];
+        glBindBuffer(GL_ARRAY_BUFFER, b->vbo_record);
+        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 4), start, GL_STATIC_DRAW);
+        glVertexAttribIPointer(VR_ATTR_RECORD, 1, GL_UNSIGNED_INT, 4, NULL);
+        glEnableVertexAttribArray(VR_ATTR_RECORD);
+        glBindBuffer(GL_ARRAY_BUFFER, b->vbo_order);
+        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)nv, order, GL_STATIC_DRAW);
+        glVertexAttribIPointer(VR_ATTR_ORDER, 1, GL_UNSIGNED_BYTE, 1, NULL);
+        glEnableVertexAttribArray(VR_ATTR_ORDER);
+        b->bytes += nv * 5;
+    }
+    glBindVertexArray(0);
+    b->bytes += bytes;
+}
+
+vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *remap,
+                           int floats, const char *name, vr_error *err)
+{
+    int order = (int)st->order;
+    if (order < 1 || order > VDSH_MAX_ORDER || st->encoding > VDSH_ENCODING_S8S6 ||
+        (vdsh_encoding_quantised(st->encoding) && !st->coef_scales))
+        return vr_fail(err, VR_ERR_FORMAT, "%s: order %d stream: encoding %u cannot be drawn",
+                       name, order, st->encoding);
+    vr_buffer b;
+    memset(&b, 0, sizeof b);
+    b.order = order;
+    b.encoding = (vdsh_encoding)st->encoding;
+    b.kind = kind_of(st, floats);
+    /* quantised and decoded coefficients carry their scale already */
+    b.scale = floats || vdsh_encoding_quantised(st->encoding) ? 1.0f : st->scale;
+    b.stride = vr_buffer_stride(order, b.kind);
+    b.ks = make_ks(st, order, floats);
+    if (!b.ks)
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+    /* FNV-1a over the order and the table's bits */
+    b.ks_hash = 1469598103934665603ull ^ (uint64_t)order;
+    for (size_t i = 0; i < (size_t)order * (size_t)order * sizeof(float); i++) {
+        b.ks_hash ^= ((const unsigned char *)b.ks)[i];
+        b.ks_hash *= 1099511628211ull;
+    }
+
+    b.variable = (st->flags & VDSH_STREAM_VARIABLE) != 0;
+
+    uint32_t nv = s->vertex_count;
+    size_t bytes = 0;
+    unsigned char *rec = NULL;
+    uint32_t *start = NULL;
+    uint8_t *korder = NULL;
+    vr_result r = VR_OK;
+    if (b.variable) {
+        start = malloc((size_t)nv * sizeof *start);
+        korder = malloc((size_t)nv + 1);
+        r = start && korder && st->orders && st->offsets
+                ? variable_records(st, &b, nv, remap, floats, &rec, &bytes, start, korder, name,
+                                   err)
+                : vr_fail(err, start && korder ? VR_ERR_FORMAT : VR_ERR_OUT_OF_MEMORY,
+                          "%s: variable-order stream without its orders", name);
+    } else {
+        rec = fixed_records(st, &b, nv, remap, floats, &bytes);
+        if (!rec)
+            r = vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory uploading order %d", name,
+                        order);
+    }
+    GLint max_texels = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+    size_t texels = bytes / texel_bytes(b.kind);
+    if (r == VR_OK && texels > (size_t)max_texels)
+        r = vr_fail(err, VR_ERR_GL, "%s: order %d stream: %zu texels, above this GL's "
+                    "GL_MAX_TEXTURE_BUFFER_SIZE (%d)", name, order, texels, (int)max_texels);
+    if (r == VR_OK) {
+        make_gl(s, &b, rec, bytes, start, korder);
+        r = vr_check_gl(err, name);
+    }
+    free(rec);
+    free(start);
+    free(korder);
+    if (r != VR_OK) {
+        vr_buffer_destroy(&b);
+        return r;
+    }
+    if (b.variable)
+        s->variable = b;
+    else
+        s->buffer[order] = b;
+    s->gpu_bytes += b.bytes;
+    return VR_OK;
+}
