@@ -196,7 +196,8 @@ typedef struct vb_bake_output {
     uint32_t degenerate_receivers;
     uint32_t undefined_normals;
     /* The receivers' normals as baked (3 per vertex), turned toward free
-     * space, or NULL with keep_normals (then the receivers' own). */
+     * space, or NULL with keep_normals (then the receivers' own). A range
+     * (vb_bake_desc.range_*): its rows only, like coeffs. */
     float *normals;
     uint32_t flipped_normals;  /* receivers whose normal was turned */
     uint32_t moved_origins;    /* receivers whose origin the repair moved */

@@ -115,6 +115,14 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
     } else if ((r = vb_bake_run(&bd, &j->bake, err)) != VB_OK) {
         return r;
     }
+    if (d->shard_count && j->bake.normals) {
+        /* The part's normals (VDSH.md "Parts"): the range's as oriented, the
+         * others as loaded; the bake returned the range's rows only. */
+        memcpy(j->receivers.normals + 3 * (size_t)bd.range_begin, j->bake.normals,
+               (size_t)(bd.range_end - bd.range_begin) * 3 * sizeof *j->bake.normals);
+        free(j->bake.normals);
+        j->bake.normals = NULL;
+    }
     j->timings.trace = j->bake.seconds;
     j->timings.threads = j->bake.threads;
     j->timings.total = vb_now() - j->t_start;
