@@ -73,8 +73,7 @@ vb_result vb_job_refine(vb_job *j, const vb_job_desc *d, vb_error *err)
     double t = vb_now();
     vb_result r;
     if (d->receivers_path) {
-        vb_load_desc ld = {0};
-        r = vb_mesh_load(d->receivers_path, &ld, &j->receivers, NULL, err);
+        r = vb_mesh_load_plan(d->receivers_path, &j->receivers, err);
     } else {
         r = vb_mesh_refine(&j->occluders, d->max_edge, &j->receivers, err);
     }
