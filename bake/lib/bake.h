@@ -232,6 +232,13 @@ vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encodin
 vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encoding,
                          vdsh_stream *out, void **storage, vb_error *err);
 
+/* vb_bake_stream, then b's coefficients of that order are freed (NULL):
+ * peak memory holds one order's two copies, not every order's. An f32
+ * stream takes the bake's array itself (*storage is it): no second copy
+ * at all (a shard's part). On failure b is unchanged. */
+vb_result vb_bake_stream_take(vb_bake_output *b, int order, vdsh_encoding encoding,
+                              vdsh_stream *out, void **storage, vb_error *err);
+
 
 #ifdef __cplusplus
 }

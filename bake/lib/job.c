@@ -144,16 +144,16 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
             continue;
         if (count == VDSH_MAX_STREAMS - (b->variable_orders != NULL))
             return vb_fail(err, VB_ERR_ARGUMENT, "more than %d streams", VDSH_MAX_STREAMS);
-        vb_result r = vb_bake_stream(b, o, d->shard_count ? VDSH_ENCODING_F32 : job_encoding(d),
-                                     &j->streams[count], &j->stream_data[count], err);
+        /* The stream takes the bake's coefficients (an f32 part's) or a
+         * copy of them, and the bake's are freed now: peak memory holds at
+         * most one order's two copies, not every order's. */
+        vb_result r = vb_bake_stream_take(&j->bake, o,
+                                          d->shard_count ? VDSH_ENCODING_F32 : job_encoding(d),
+                                          &j->streams[count], &j->stream_data[count], err);
         if (r != VB_OK)
             return r;
         j->coefficient_bytes += vdsh_stream_bytes_per_vertex(&j->streams[count]);
         count++;
-        /* The stream holds its own copy: drop the bake's now, so that peak
-         * memory holds one order's two copies, not every order's. */
-        free(j->bake.coeffs[o]);
-        j->bake.coeffs[o] = NULL;
     }
     if (b->variable_orders) { /* adaptive order: its average bytes per vertex */
         vb_result r = vb_bake_variable_stream(b, d->shard_count ? VDSH_ENCODING_F32
