@@ -38,10 +38,10 @@ vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err)
     j->sources = calloc(d->path_count, sizeof *j->sources);
     if (!j->sources)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-    /* The basis cubemaps meanwhile (deflate, most of it). */
+    /* The basis cubemaps meanwhile (deflate, most of it); a part has none. */
     int cube_size = vb_job_cube_size(d);
     j->basis_size = cube_size;
-    j->basis_running = cube_size > 0 && d->output && !d->bake.trace_only &&
+    j->basis_running = cube_size > 0 && d->output && !d->bake.trace_only && !d->shard_count &&
                        pthread_create(&j->basis_thread, NULL, encode_basis, j) == 0;
     vb_load_desc ld = {.weld = d->weld};
     for (uint32_t i = 0; i < d->path_count; i++) {

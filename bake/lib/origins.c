@@ -72,6 +72,34 @@ static void position_key(const vb_mesh *m, uint32_t v, float p[3])
         p[c] = m->positions[3 * (size_t)v + c] + 0.0f;
 }
 
+/* A position's bits (-0 folded into +0) as three words, compared inline:
+ * the coincidence search below makes one binary search per receiver. */
+typedef struct pos_bits {
+    uint32_t w[3];
+} pos_bits;
+
+static pos_bits position_bits(const vb_mesh *m, uint32_t v)
+{
+    float p[3];
+    pos_bits b;
+    position_key(m, v, p);
+    memcpy(b.w, p, sizeof b.w);
+    return b;
+}
+
+static inline int cmp_bits_inline(const pos_bits *x, const pos_bits *y)
+{
+    for (int c = 0; c < 3; c++)
+        if (x->w[c] != y->w[c])
+            return x->w[c] < y->w[c] ? -1 : 1;
+    return 0;
+}
+
+static int cmp_bits(const void *a, const void *b)
+{
+    return cmp_bits_inline(a, b);
+}
+
 /* E: the receivers at the bit-identical position of one of set[0..n) (set
  * itself among them), so that every group of coincident receivers is
  * either all in E or all out: their normals enter each other's ray-offset
@@ -81,7 +109,7 @@ static vb_result subset_coincident(const vb_mesh *m, const uint32_t *set, uint32
     const uint32_t V = m->vertex_count;
     const size_t words = ((size_t)V + 63) / 64;
     memset(E, 0, sizeof *E);
-    pos_key *key = malloc((size_t)n * sizeof *key + 1);
+    pos_bits *key = malloc((size_t)n * sizeof *key + 1);
     E->bits = calloc(words + 1, sizeof *E->bits);
     E->rank = malloc((words + 1) * sizeof *E->rank);
     if (!key || !E->bits || !E->rank) {
@@ -89,24 +117,21 @@ static vb_result subset_coincident(const vb_mesh *m, const uint32_t *set, uint32
         subset_free(E);
         return VB_ERR_OUT_OF_MEMORY;
     }
-    for (uint32_t i = 0; i < n; i++) {
-        position_key(m, set[i], key[i].p);
-        key[i].index = i;
-    }
-    qsort(key, n, sizeof *key, cmp_pos);
+    for (uint32_t i = 0; i < n; i++)
+        key[i] = position_bits(m, set[i]);
+    qsort(key, n, sizeof *key, cmp_bits);
     uint32_t count = 0;
     for (uint32_t v = 0; v < V; v++) {
-        float p[3];
-        position_key(m, v, p);
+        pos_bits p = position_bits(m, v);
         size_t a = 0, b = n; /* the first key >= p */
         while (a < b) {
             size_t mid = (a + b) / 2;
-            if (memcmp(key[mid].p, p, sizeof p) < 0)
+            if (cmp_bits_inline(&key[mid], &p) < 0)
                 a = mid + 1;
             else
                 b = mid;
         }
-        if (a < n && memcmp(key[a].p, p, sizeof p) == 0) {
+        if (a < n && cmp_bits_inline(&key[a], &p) == 0) {
             E->bits[v >> 6] |= 1ull << (v & 63);
             count++;
         }
