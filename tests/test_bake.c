@@ -549,14 +549,17 @@ static void test_adaptive_rays(void)
 }
 
 /* A receiver range (a shard) gets the whole bake's coefficients bit for
- * bit, with the automatic quantity choice and orientation on, and the
- * ranges' ray counts add up to the whole bake's. */
+ * bit, with orientation on, for shadow (one quantity) and lsq (the
+ * automatic quantity choice on a sample of 1024 of the 2501 receivers, most
+ * outside any one range); receivers at one position straddle the cuts (their
+ * normals enter each other's ray origins); and the ranges' ray counts add
+ * up to the whole bake's. */
 static void test_ranges(void)
 {
     vb_mesh occ = {0}, rec = {0};
     test_make_box(&occ, 2, 2, 2);
-    enum { NP = 301 };
-    float p[3 * NP], n[3 * NP];
+    enum { NP = 2501 };
+    static float p[3 * NP], n[3 * NP];
     uint64_t s = 17;
     for (int i = 0; i < NP; i++) {
         p[3 * i] = (float)(1.8 * test_rand(&s) - 0.9);
@@ -564,50 +567,77 @@ static void test_ranges(void)
         p[3 * i + 2] = (float)(1.8 * test_rand(&s) - 0.9);
         test_rand_dir(&s, n + 3 * i);
     }
+    /* Coincident receivers across the cuts: 1249..1251 at one position,
+     * 0 and NP - 1 at another, their normals on one side of each other's
+     * (so each one's ray-offset normal is their mean). */
+    const int same[3][2] = {{1249, 1250}, {1251, 1250}, {NP - 1, 0}};
+    for (int k = 0; k < 3; k++) {
+        float *q = n + 3 * same[k][0];
+        const float *r = n + 3 * same[k][1];
+        memcpy(p + 3 * same[k][0], p + 3 * same[k][1], 3 * sizeof(float));
+        q[0] = r[0], q[1] = r[1] + 0.5f, q[2] = r[2] + 0.25f * k;
+        float len = sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+        for (int c = 0; c < 3; c++)
+            q[c] /= len;
+    }
     test_make_points(&rec, NP, p, n);
     vb_error err;
     vb_scene *sc = NULL;
     CHECK(vb_scene_create(&occ, NULL, &sc, &err) == VB_OK, "scene");
-    const uint32_t cut[5] = {0, 1, 150, 151, NP};
-    vb_bake_output whole = {0}, part[4] = {{0}};
-    uint32_t mask = (1u << 3) | (1u << 5);
-    for (int i = -1; i < 4 && sc; i++) {
-        vb_bake_desc d = {.receivers = &rec, .scene = sc, .rays = 200, .seed = 3,
-                          .order_mask = mask, .threads = 2};
-        if (i >= 0)
-            d.range_begin = cut[i], d.range_end = cut[i + 1];
-        CHECK(vb_bake_run(&d, i < 0 ? &whole : &part[i], &err) == VB_OK, "bake %d: %s", i,
-              err.msg);
-    }
-    uint64_t traced = 0, missed = 0;
-    for (int i = 0; i < 4 && whole.coeffs[5] && part[i].coeffs[5]; i++) {
-        CHECK(part[i].range_begin == cut[i] && part[i].range_end == cut[i + 1] &&
-                  part[i].vertex_count == NP,
-              "range %d: output range %u..%u of %u", i, part[i].range_begin, part[i].range_end,
-              part[i].vertex_count);
-        traced += part[i].rays_traced;
-        missed += part[i].rays_missed;
-        for (int o = 3; o <= 5; o += 2) {
-            /* A range holds its own rows only, the first receiver cut[i]'s. */
-            size_t a = (size_t)cut[i] * o * o, b = (size_t)cut[i + 1] * o * o;
-            CHECK(memcmp(part[i].coeffs[o], whole.coeffs[o] + a, (b - a) * sizeof(float)) == 0,
-                  "range %u..%u order %d: coefficients differ", cut[i], cut[i + 1], o);
-            CHECK(part[i].quantity[o] == whole.quantity[o], "range %d order %d: quantity", i, o);
+    const uint32_t cut[5] = {0, 1, 1250, 1251, NP};
+    const vb_method methods[2] = {VB_METHOD_SHADOW, VB_METHOD_LSQ};
+    for (int m = 0; m < 2 && sc; m++) {
+        vb_bake_output whole = {0}, part[4] = {{0}};
+        uint32_t mask = (1u << 3) | (1u << 5);
+        for (int i = -1; i < 4; i++) {
+            vb_bake_desc d = {.receivers = &rec, .scene = sc, .rays = 200, .seed = 3,
+                              .order_mask = mask, .threads = 2, .method = methods[m]};
+            if (i >= 0)
+                d.range_begin = cut[i], d.range_end = cut[i + 1];
+            CHECK(vb_bake_run(&d, i < 0 ? &whole : &part[i], &err) == VB_OK, "bake %d: %s", i,
+                  err.msg);
         }
-        CHECK(memcmp(part[i].normals, whole.normals, 3 * NP * sizeof(float)) == 0,
-              "range %d: oriented normals differ", i);
+        CHECK(m == 0 || whole.auto_receivers == 1024, "lsq: the quantity chosen on %u receivers",
+              whole.auto_receivers);
+        uint64_t traced = 0, missed = 0;
+        for (int i = 0; i < 4 && whole.coeffs[5] && part[i].coeffs[5]; i++) {
+            CHECK(part[i].range_begin == cut[i] && part[i].range_end == cut[i + 1] &&
+                      part[i].vertex_count == NP,
+                  "range %d: output range %u..%u of %u", i, part[i].range_begin,
+                  part[i].range_end, part[i].vertex_count);
+            traced += part[i].rays_traced;
+            missed += part[i].rays_missed;
+            /* Every range traces the choice's sample as the whole bake does. */
+            CHECK(part[i].auto_receivers == whole.auto_receivers &&
+                      memcmp(part[i].auto_error, whole.auto_error, sizeof whole.auto_error) == 0,
+                  "method %d, range %d: the quantity choice's scores differ", m, i);
+            for (int o = 3; o <= 5; o += 2) {
+                /* A range holds its own rows only, the first receiver cut[i]'s. */
+                size_t a = (size_t)cut[i] * o * o, b = (size_t)cut[i + 1] * o * o;
+                CHECK(memcmp(part[i].coeffs[o], whole.coeffs[o] + a, (b - a) * sizeof(float)) ==
+                          0,
+                      "method %d, range %u..%u order %d: coefficients differ", m, cut[i],
+                      cut[i + 1], o);
+                CHECK(part[i].quantity[o] == whole.quantity[o], "range %d order %d: quantity",
+                      i, o);
+            }
+            /* And its own oriented normals only, as the whole bake's. */
+            CHECK(memcmp(part[i].normals, whole.normals + 3 * (size_t)cut[i],
+                         3 * (size_t)(cut[i + 1] - cut[i]) * sizeof(float)) == 0,
+                  "method %d, range %d: oriented normals differ", m, i);
+        }
+        CHECK(traced == whole.rays_traced && missed == whole.rays_missed,
+              "ranges traced %llu missed %llu, the whole bake %llu %llu",
+              (unsigned long long)traced, (unsigned long long)missed,
+              (unsigned long long)whole.rays_traced, (unsigned long long)whole.rays_missed);
+        vb_bake_output_free(&whole);
+        for (int i = 0; i < 4; i++)
+            vb_bake_output_free(&part[i]);
     }
-    CHECK(traced == whole.rays_traced && missed == whole.rays_missed,
-          "ranges traced %llu missed %llu, the whole bake %llu %llu", (unsigned long long)traced,
-          (unsigned long long)missed, (unsigned long long)whole.rays_traced,
-          (unsigned long long)whole.rays_missed);
     vb_bake_desc bad = {.receivers = &rec, .scene = sc, .range_begin = 5, .range_end = NP + 1};
     vb_bake_output none = {0};
     CHECK(vb_bake_run(&bad, &none, &err) == VB_ERR_ARGUMENT, "a range past the end is refused");
     vb_bake_output_free(&none);
-    vb_bake_output_free(&whole);
-    for (int i = 0; i < 4; i++)
-        vb_bake_output_free(&part[i]);
     vb_scene_destroy(sc);
     test_mesh_free(&occ);
     test_mesh_free(&rec);

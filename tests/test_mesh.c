@@ -1660,6 +1660,59 @@ static void test_write_obj(void)
     vb_mesh_free(&room);
 }
 
+/* vb_mesh_load_plan gives vb_mesh_load's mesh bit for bit: for a plan as
+ * vdsh-bake writes it (read in one pass), and for PLY files of the same
+ * layout that loading changes (an unused vertex, a zero or a long normal,
+ * a triangle repeating a vertex), which it leaves to vb_mesh_load. */
+static void test_load_plan(void)
+{
+    vb_error err;
+    vb_mesh room = {0}, fine = {0}, a = {0}, b = {0};
+    CHECK(vb_builtin_room(&room, &err) == VB_OK, "room: %s", err.msg);
+    CHECK(vb_mesh_refine(&room, 0.5f, &fine, &err) == VB_OK, "refine: %s", err.msg);
+    char *path = join(g_dir, "plan.ply");
+    for (int kind = 0; kind < 5; kind++) {
+        vb_mesh m = fine;
+        float *pos = malloc(3 * sizeof(float) * (fine.vertex_count + 1));
+        float *nrm = malloc(3 * sizeof(float) * (fine.vertex_count + 1));
+        uint32_t *idx = malloc(3 * sizeof(uint32_t) * fine.triangle_count);
+        memcpy(pos, fine.positions, 3 * sizeof(float) * fine.vertex_count);
+        memcpy(nrm, fine.normals, 3 * sizeof(float) * fine.vertex_count);
+        memcpy(idx, fine.indices, 3 * sizeof(uint32_t) * fine.triangle_count);
+        m.positions = pos, m.normals = nrm, m.indices = idx;
+        if (kind == 1) { /* a vertex in no triangle: loading drops it */
+            memcpy(pos + 3 * (size_t)m.vertex_count, pos, 3 * sizeof(float));
+            memcpy(nrm + 3 * (size_t)m.vertex_count, nrm, 3 * sizeof(float));
+            m.vertex_count++;
+        }
+        if (kind == 2) /* a zero normal: computed */
+            nrm[0] = nrm[1] = nrm[2] = 0.0f;
+        if (kind == 3) /* a normal of length 2: scaled */
+            nrm[3] *= 2.0f, nrm[4] *= 2.0f, nrm[5] *= 2.0f;
+        if (kind == 4) /* a triangle repeating a vertex: dropped */
+            idx[1] = idx[0];
+        CHECK(vb_mesh_write_ply(&m, path, &err) == VB_OK, "write %d: %s", kind, err.msg);
+        CHECK(vb_mesh_load(path, NULL, &a, NULL, &err) == VB_OK, "load %d: %s", kind, err.msg);
+        CHECK(vb_mesh_load_plan(path, &b, &err) == VB_OK, "load plan %d: %s", kind, err.msg);
+        CHECK(same_mesh(&a, &b), "plan %d: vb_mesh_load_plan's mesh is not vb_mesh_load's", kind);
+        CHECK(kind != 0 || same_mesh(&fine, &b), "a plan read back is not the mesh written");
+        CHECK(kind != 1 || b.vertex_count == fine.vertex_count, "the unused vertex was kept");
+        vb_mesh_free(&a);
+        vb_mesh_free(&b);
+        free(pos);
+        free(nrm);
+        free(idx);
+    }
+    /* Cut short: vb_mesh_load's error, naming the file. */
+    CHECK(truncate(path, 200) == 0, "truncate");
+    vb_result r = vb_mesh_load_plan(path, &b, &err);
+    CHECK(r != VB_OK && strstr(err.msg, path), "a cut plan: %s %s", vb_result_str(r), err.msg);
+    unlink(path);
+    free(path);
+    vb_mesh_free(&fine);
+    vb_mesh_free(&room);
+}
+
 /* Corrupted input must end in a result, never a crash or a hang: small
  * valid files of each format, each mutated a few hundred times (bytes
  * replaced, digits inserted, cut short), deterministically. The sanitizer
@@ -1780,6 +1833,7 @@ static int run_unit(const char *tmp_parent)
     test_room_variants();
     test_refine();
     test_write_obj();
+    test_load_plan();
     if (!test_failures)
         remove_dir(tmpl);
     free(tmpl);

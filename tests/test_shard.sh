@@ -133,6 +133,9 @@ says "whole file" "$tmp/whole.vdsh: not a part"
 expect_exit 1 "mixed shard counts refused" "$merge" -q "$tmp"/n2/part-0.vdsh "$p"/part-1.vdsh -o "$out"
 says "mixed counts" "$p/part-1.vdsh: does not belong with $tmp/n2/part-0.vdsh"
 check "no output after refusals" test ! -e "$out"
+# vdsh-merge spills f16/s8/s8s6 parts' rows beside the output, unlinked as
+# soon as made: no merge, refused or not, leaves one.
+check "no spill file left by any merge" test -z "$(find "$tmp" -name '*.spill-*')"
 expect_exit 2 "--shard 7/7 is a usage error" "$bake" "${tiny[@]}" --shard 7/7 -o "$out"
 expect_exit 2 "--shard x is a usage error" "$bake" "${tiny[@]}" --shard 1/x -o "$out"
 expect_exit 1 "more shards than receivers" "$bake" builtin:room --rays 8 -q --shard 0/1000000 -o "$out"

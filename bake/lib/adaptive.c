@@ -92,7 +92,7 @@ static void score_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker
         uint32_t a = (uint32_t)(J->edges[i] >> 32), e = (uint32_t)J->edges[i];
         uint32_t v = J->base + i;
         const float *p = J->fine->positions + 3 * (size_t)v;
-        const float *n = J->b->normals ? J->b->normals + 3 * (size_t)v
+        const float *n = J->b->normals ? J->b->normals + 3 * (size_t)i /* the range's row i */
                                        : J->fine->normals + 3 * (size_t)v;
         const float *cm = J->b->coeffs[J->order] + nc * i; /* the range's row i: vertex v */
         const float *c[3] = {J->coarse_c + nc * a, J->coarse_c + nc * e, J->coarse_c + nc * e};
@@ -311,14 +311,16 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
                 ok &= append_rows(&B.coeffs[o], V, R.coeffs[o], R.range_begin, (size_t)o * o,
                                   rows, s); /* R holds the midpoints' rows only */
         if (B.normals)
-            ok &= append_rows(&B.normals, V, R.normals, 0, 3, rows, s);
+            ok &= append_rows(&B.normals, V, R.normals, R.range_begin, 3, rows, s);
         if (!ok) {
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
             goto done;
         }
         for (uint32_t k = 0; k < s; k++)
             memcpy(N.normals + 3 * ((size_t)V + k),
-                   (R.normals ? R.normals : T.normals) + 3 * (size_t)rows[k], 3 * sizeof(float));
+                   R.normals ? R.normals + 3 * (size_t)(rows[k] - R.range_begin)
+                             : T.normals + 3 * (size_t)rows[k],
+                   3 * sizeof(float));
         vb_mesh_free(&M);
         M = N;
         memset(&N, 0, sizeof N);

@@ -38,8 +38,14 @@
 typedef struct job {
     const vb_bake_desc *d;
     const vb_dirgrid *grid;
-    const float *origins;  /* per receiver, traced frame */
-    const float *near;     /* per receiver: ~0 distance, scene units */
+    /* The receivers traced (vb_receivers_prepare's set): set[k] at slot k;
+     * set NULL: every receiver, slot = index. The range lo..hi is slots
+     * set_before.. of it. */
+    const uint32_t *set;
+    uint32_t set_count, set_before;
+    const float *origins;  /* per slot, traced frame */
+    const float *near;     /* per slot: ~0 distance, scene units */
+    const float *normals;  /* per slot: oriented; NULL: the receivers' own */
     float *coeffs[VDSH_ORDER_SLOTS]; /* rows lo..hi-1 (the range's) */
     uint32_t quantity[VDSH_ORDER_SLOTS]; /* per order: what coeffs hold */
     vb_fit fits[VDSH_ORDER_SLOTS];
@@ -56,7 +62,8 @@ typedef struct job {
     uint32_t choose_count;
     double *choose_error;  /* choose_count * (VDSH_ORDER_SLOTS) * 2 */
     float *choose_coeffs;  /* per sample, quantity and order: its fit */
-    uint8_t *done;         /* receivers the choice baked already (or NULL) */
+    uint8_t *done;         /* per receiver of the range (v - lo): baked by the
+                            * choice already (or NULL) */
     int adaptive;          /* adaptive rays: grid is nested */
     float ray_tol;         /* their tolerance (0: every round) */
     uint32_t lo, hi;       /* the range baked (vb_bake_desc.range_*) */
@@ -222,6 +229,24 @@ static void choose_order(const job *J, uint32_t v, const vb_fit_angles *a, const
 
 static double expected_error(const double *e, double r);
 
+/* Receiver v's slot among the traced ones (job.set): v is one of them. */
+static uint32_t slot_of(const job *J, uint32_t v)
+{
+    if (!J->set)
+        return v;
+    if (v >= J->lo && v < J->hi)
+        return J->set_before + (v - J->lo);
+    uint32_t a = 0, b = J->set_count; /* a sample outside the range */
+    while (a < b) {
+        uint32_t mid = a + (b - a) / 2;
+        if (J->set[mid] < v)
+            a = mid + 1;
+        else
+            b = mid;
+    }
+    return a;
+}
+
 /* Adaptive rays: the highest order's fit of accumulated projection `acc`
  * (a quantity's per-lane sums) over `cells` directions, into c. */
 static void adapt_fit(const job *J, const float n[3], float acc[VDSH_MAX_COEFFS][VB_PACKET],
@@ -254,8 +279,10 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
 {
     const vb_bake_desc *d = J->d;
     const vb_scene *S = d->scene;
-    const float *n = d->receivers->normals + 3 * (size_t)v;
-    const float *org = J->origins + 3 * (size_t)v;
+    const uint32_t slot = slot_of(J, v);
+    const float *n = J->normals ? J->normals + 3 * (size_t)slot
+                                : d->receivers->normals + 3 * (size_t)v;
+    const float *org = J->origins + 3 * (size_t)slot;
     static const float pole[3] = {0.0f, 0.0f, 1.0f};
     if (J->grid->hemisphere && n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f)
         n = pole; /* no surface: a hemisphere about +z, fitted as such */
@@ -276,7 +303,7 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
     want[1] |= var;
     /* Loop invariants in locals: the lane loops below vectorise. */
     const float inv_scale = J->inv_scale, max_distance = d->max_distance;
-    const float degenerate_dist = J->near[v], log_floor = J->log_floor;
+    const float degenerate_dist = J->near[slot], log_floor = J->log_floor;
     const float nx = n[0], ny = n[1], nz = n[2];
     float acc[2][VDSH_MAX_COEFFS][VB_PACKET];
     for (int q = 0; q < 2; q++)
@@ -510,7 +537,7 @@ static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
     uint64_t traced = 0, missed = 0;
     uint32_t degenerate = 0;
     for (uint32_t v = begin < J->lo ? J->lo : begin; v < end && v < J->hi; v++) {
-        if (J->done && J->done[v])
+        if (J->done && J->done[v - J->lo])
             continue;
         vertex_sink out = {0};
         if (J->var_scratch)
@@ -678,8 +705,11 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
     else if (!J->var_cap) /* their coefficients are kept: the main pass skips them
                              * (with an adaptive order it bakes them again: the
                              * variable stream's quantity was not chosen yet) */
-        for (uint32_t i = begin; i < end; i++)
-            J->done[choose_receiver(i, nrec, J->choose_count)] = 1;
+        for (uint32_t i = begin; i < end; i++) {
+            uint32_t v = choose_receiver(i, nrec, J->choose_count);
+            if (v >= J->lo && v < J->hi)
+                J->done[v - J->lo] = 1;
+        }
     atomic_fetch_add(&J->traced, traced);
     atomic_fetch_add(&J->missed, missed);
     atomic_fetch_add(&J->degenerate, degenerate);
@@ -834,15 +864,41 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     uint8_t *var_orders = NULL; /* adaptive order: the range's */
     float *var_coeffs = NULL;
     float (*lights)[3] = NULL;
-    float *origins = malloc((size_t)R->vertex_count * 3 * sizeof *origins);
-    uint8_t *need = NULL; /* vb_receivers_prepare's, for a range */
-    float *near = malloc((size_t)R->vertex_count * sizeof *near + 1);
+    /* A range: only its receivers, and the quantity choice's sample, are
+     * oriented and given origins (counted: the range's), and the arrays
+     * below hold them only (vb_receivers_prepare's set), so a shard's
+     * memory is its range's. */
+    uint32_t *set = NULL, set_count = R->vertex_count, set_before = 0;
+    if (lo > 0 || hi < R->vertex_count) {
+        uint32_t samples = choose && !d.trace_only ? choose_count(R->vertex_count) : 0;
+        if (!(set = malloc(((size_t)(hi - lo) + samples) * sizeof *set))) {
+            vb_dirgrid_destroy(&grid);
+            return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
+                           hi - lo);
+        }
+        /* Ascending: the samples before the range, the range, those after. */
+        set_count = 0;
+        for (uint32_t i = 0; i < samples; i++) {
+            uint32_t v = choose_receiver(i, R->vertex_count, samples);
+            if (v < lo)
+                set[set_count++] = v;
+        }
+        set_before = set_count;
+        for (uint32_t v = lo; v < hi; v++)
+            set[set_count++] = v;
+        for (uint32_t i = 0; i < samples; i++) {
+            uint32_t v = choose_receiver(i, R->vertex_count, samples);
+            if (v >= hi)
+                set[set_count++] = v;
+        }
+    }
+    float *origins = malloc((size_t)set_count * 3 * sizeof *origins);
+    float *near = malloc((size_t)set_count * sizeof *near + 1);
     float *coeffs[VDSH_ORDER_SLOTS] = {0};
     /* Oriented receivers: a copy of their normals, turned toward free
      * space (origins.h); the bake then reads the copy. */
     float *normals = d.keep_normals ? NULL
-                                    : malloc((size_t)R->vertex_count * 3 * sizeof *normals + 1);
-    vb_mesh oriented = *R;
+                                    : malloc((size_t)set_count * 3 * sizeof *normals + 1);
     int missing = !d.keep_normals && !normals;
     /* A range: its rows only (bake.h), so a shard's coefficients are its
      * own range's size. */
@@ -877,32 +933,16 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     }
     J->lo = lo;
     J->hi = hi;
-    /* A range: only its receivers, and the quantity choice's sample, are
-     * oriented and given origins (counted: the range's). */
-    if (J->lo > 0 || J->hi < R->vertex_count) {
-        if (!(need = calloc((size_t)R->vertex_count + 1, 1))) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
-                        R->vertex_count);
-            goto done;
-        }
-        memset(need + J->lo, VB_NEED_COUNT, J->hi - J->lo);
-        uint32_t samples = choose && !d.trace_only ? choose_count(R->vertex_count) : 0;
-        for (uint32_t i = 0; i < samples; i++) {
-            uint32_t v = choose_receiver(i, R->vertex_count, samples);
-            if (!need[v])
-                need[v] = VB_NEED_ONLY;
-        }
-    }
+    J->set = set;
+    J->set_count = set_count;
+    J->set_before = set_before;
     vb_origins_stats ost = {0};
     uint32_t flipped = 0;
-    r = vb_receivers_prepare(R, d.scene, d.threads, need, normals, &flipped, origins, near,
-                             &ost, err);
+    r = vb_receivers_prepare(R, d.scene, d.threads, set, set_count, lo, hi, normals, &flipped,
+                             origins, near, &ost, err);
     if (r != VB_OK)
         goto done;
-    if (normals) {
-        oriented.normals = normals;
-        d.receivers = R = &oriented;
-    }
+    J->normals = normals;
     J->d = &d;
     J->grid = &grid;
     J->origins = origins;
@@ -958,7 +998,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         J->choose_error = calloc((size_t)J->choose_count * (VDSH_ORDER_SLOTS) * 2,
                                  sizeof(double));
         J->choose_coeffs = malloc((size_t)J->choose_count * 2 * CHOOSE_STRIDE * sizeof(float));
-        J->done = calloc(R->vertex_count, 1);
+        J->done = calloc((size_t)(hi - lo), 1);
         if (!J->choose_error || !J->choose_coeffs || !J->done) {
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
             goto done;
@@ -983,7 +1023,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             uint32_t v = choose_receiver(i, R->vertex_count, J->choose_count);
             const float *keep = J->choose_coeffs + (size_t)i * 2 * CHOOSE_STRIDE;
             for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-                if (coeffs[o] && J->done[v] && v >= J->lo && v < J->hi)
+                if (coeffs[o] && v >= J->lo && v < J->hi && J->done[v - J->lo])
                     memcpy(coeffs[o] + (size_t)(v - J->lo) * o * o,
                            keep + (J->quantity[o] == VDSH_QUANTITY_LOG_DISTANCE) * CHOOSE_STRIDE +
                                choose_offset(o),
@@ -1036,6 +1076,12 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     o.rays_missed = atomic_load(&J->missed);
     o.degenerate_receivers = atomic_load(&J->degenerate);
     o.undefined_normals = undefined;
+    if (normals && set) { /* the range's rows (bake.h) */
+        memmove(normals, normals + 3 * (size_t)set_before, (size_t)(hi - lo) * 3 * sizeof *normals);
+        float *shrunk = realloc(normals, (size_t)(hi - lo) * 3 * sizeof *normals);
+        if (shrunk)
+            normals = shrunk;
+    }
     o.normals = normals;
     normals = NULL;
     o.flipped_normals = flipped;
@@ -1059,7 +1105,7 @@ done:
     free(origins);
     free(near);
     free(normals);
-    free(need);
+    free(set);
     free(var_orders);
     free(var_coeffs);
     free(lights);

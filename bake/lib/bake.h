@@ -196,7 +196,8 @@ typedef struct vb_bake_output {
     uint32_t degenerate_receivers;
     uint32_t undefined_normals;
     /* The receivers' normals as baked (3 per vertex), turned toward free
-     * space, or NULL with keep_normals (then the receivers' own). */
+     * space, or NULL with keep_normals (then the receivers' own). A range
+     * (vb_bake_desc.range_*): its rows only, like coeffs. */
     float *normals;
     uint32_t flipped_normals;  /* receivers whose normal was turned */
     uint32_t moved_origins;    /* receivers whose origin the repair moved */
@@ -230,6 +231,13 @@ vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encodin
 
 vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encoding,
                          vdsh_stream *out, void **storage, vb_error *err);
+
+/* vb_bake_stream, then b's coefficients of that order are freed (NULL):
+ * peak memory holds one order's two copies, not every order's. An f32
+ * stream takes the bake's array itself (*storage is it): no second copy
+ * at all (a shard's part). On failure b is unchanged. */
+vb_result vb_bake_stream_take(vb_bake_output *b, int order, vdsh_encoding encoding,
+                              vdsh_stream *out, void **storage, vb_error *err);
 
 
 #ifdef __cplusplus

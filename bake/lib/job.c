@@ -38,10 +38,10 @@ vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err)
     j->sources = calloc(d->path_count, sizeof *j->sources);
     if (!j->sources)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-    /* The basis cubemaps meanwhile (deflate, most of it). */
+    /* The basis cubemaps meanwhile (deflate, most of it); a part has none. */
     int cube_size = vb_job_cube_size(d);
     j->basis_size = cube_size;
-    j->basis_running = cube_size > 0 && d->output && !d->bake.trace_only &&
+    j->basis_running = cube_size > 0 && d->output && !d->bake.trace_only && !d->shard_count &&
                        pthread_create(&j->basis_thread, NULL, encode_basis, j) == 0;
     vb_load_desc ld = {.weld = d->weld};
     for (uint32_t i = 0; i < d->path_count; i++) {
@@ -73,8 +73,7 @@ vb_result vb_job_refine(vb_job *j, const vb_job_desc *d, vb_error *err)
     double t = vb_now();
     vb_result r;
     if (d->receivers_path) {
-        vb_load_desc ld = {0};
-        r = vb_mesh_load(d->receivers_path, &ld, &j->receivers, NULL, err);
+        r = vb_mesh_load_plan(d->receivers_path, &j->receivers, err);
     } else {
         r = vb_mesh_refine(&j->occluders, d->max_edge, &j->receivers, err);
     }
@@ -115,6 +114,14 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
     } else if ((r = vb_bake_run(&bd, &j->bake, err)) != VB_OK) {
         return r;
     }
+    if (d->shard_count && j->bake.normals) {
+        /* The part's normals (VDSH.md "Parts"): the range's as oriented, the
+         * others as loaded; the bake returned the range's rows only. */
+        memcpy(j->receivers.normals + 3 * (size_t)bd.range_begin, j->bake.normals,
+               (size_t)(bd.range_end - bd.range_begin) * 3 * sizeof *j->bake.normals);
+        free(j->bake.normals);
+        j->bake.normals = NULL;
+    }
     j->timings.trace = j->bake.seconds;
     j->timings.threads = j->bake.threads;
     j->timings.total = vb_now() - j->t_start;
@@ -137,16 +144,16 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
             continue;
         if (count == VDSH_MAX_STREAMS - (b->variable_orders != NULL))
             return vb_fail(err, VB_ERR_ARGUMENT, "more than %d streams", VDSH_MAX_STREAMS);
-        vb_result r = vb_bake_stream(b, o, d->shard_count ? VDSH_ENCODING_F32 : job_encoding(d),
-                                     &j->streams[count], &j->stream_data[count], err);
+        /* The stream takes the bake's coefficients (an f32 part's) or a
+         * copy of them, and the bake's are freed now: peak memory holds at
+         * most one order's two copies, not every order's. */
+        vb_result r = vb_bake_stream_take(&j->bake, o,
+                                          d->shard_count ? VDSH_ENCODING_F32 : job_encoding(d),
+                                          &j->streams[count], &j->stream_data[count], err);
         if (r != VB_OK)
             return r;
         j->coefficient_bytes += vdsh_stream_bytes_per_vertex(&j->streams[count]);
         count++;
-        /* The stream holds its own copy: drop the bake's now, so that peak
-         * memory holds one order's two copies, not every order's. */
-        free(j->bake.coeffs[o]);
-        j->bake.coeffs[o] = NULL;
     }
     if (b->variable_orders) { /* adaptive order: its average bytes per vertex */
         vb_result r = vb_bake_variable_stream(b, d->shard_count ? VDSH_ENCODING_F32

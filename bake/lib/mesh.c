@@ -507,6 +507,22 @@ vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path, vb_error *err)
     return write_end(&out, err);
 }
 
+/* vb_mesh_write_ply's header for v vertices and t triangles (the plan
+ * reader compares a file's header with it): its length. */
+static int ply_header(char *buf, size_t cap, uint32_t v, uint32_t t)
+{
+    return snprintf(buf, cap,
+                    "ply\nformat binary_little_endian 1.0\ncomment vdsh mesh\n"
+                    "element vertex %u\nproperty float x\nproperty float y\nproperty float z\n"
+                    "property float nx\nproperty float ny\nproperty float nz\n"
+                    "element face %u\nproperty list uchar uint vertex_indices\nend_header\n",
+                    v, t);
+}
+
+#define PLY_HEADER_MAX 512
+#define PLY_VERTEX_BYTES 24 /* x y z nx ny nz, f32 */
+#define PLY_FACE_BYTES 13   /* uchar 3, 3 x u32 */
+
 vb_result vb_mesh_write_ply(const vb_mesh *m, const char *path, vb_error *err)
 {
     vdsh_output out;
@@ -514,11 +530,9 @@ vb_result vb_mesh_write_ply(const vb_mesh *m, const char *path, vb_error *err)
     if (r != VB_OK)
         return r;
     FILE *f = out.fp;
-    fprintf(f, "ply\nformat binary_little_endian 1.0\ncomment vdsh mesh\n"
-               "element vertex %u\nproperty float x\nproperty float y\nproperty float z\n"
-               "property float nx\nproperty float ny\nproperty float nz\n"
-               "element face %u\nproperty list uchar uint vertex_indices\nend_header\n",
-            m->vertex_count, m->triangle_count);
+    char header[PLY_HEADER_MAX];
+    ply_header(header, sizeof header, m->vertex_count, m->triangle_count);
+    fputs(header, f);
     /* Little-endian host (vdsh.h checks it): the floats and indices as they are. */
     for (uint32_t i = 0; i < m->vertex_count; i++) {
         fwrite(m->positions + 3 * (size_t)i, sizeof(float), 3, f);
@@ -1035,6 +1049,101 @@ vb_result vb_mesh_load(const char *path, const vb_load_desc *desc, vb_mesh *out,
         free(bytes);
     }
     return finish_load(r, &m, &si, desc ? desc->weld : 0, out, info, err);
+}
+
+/* ---------------------------------------------------------------------- */
+/* Plans: vb_mesh_write_ply's files, read in one streaming pass            */
+/* ---------------------------------------------------------------------- */
+
+/* Read a file vb_mesh_write_ply wrote (its header byte for byte, its size)
+ * whose mesh the cleaning would leave as it is: every position finite,
+ * every normal finite and not zero (stored as unit_float gives it, as the
+ * PLY reader does), every face a triangle of three distinct vertices, every
+ * vertex in one. Then *out is vb_mesh_load's mesh, read in blocks into its
+ * final arrays: no file buffer, no parser arrays. 0 when the file is not
+ * such a plan, or cannot be read (vb_mesh_load then reads it, or says why
+ * it cannot); *out untouched. */
+static int read_plan(const char *path, vb_mesh *out)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return 0;
+    struct stat st;
+    char head[PLY_HEADER_MAX], want[PLY_HEADER_MAX];
+    size_t got = fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode)
+                     ? fread(head, 1, sizeof head - 1, f) : 0;
+    head[got] = '\0';
+    const char *ve = strstr(head, "element vertex "), *fe = strstr(head, "element face ");
+    unsigned long long V = ve ? strtoull(ve + 15, NULL, 10) : 0;
+    unsigned long long T = fe ? strtoull(fe + 13, NULL, 10) : 0;
+    int hlen = V && T && V <= UINT32_MAX && T <= UINT32_MAX / 3
+                   ? ply_header(want, sizeof want, (uint32_t)V, (uint32_t)T) : 0;
+    vb_mesh m = {0};
+    uint8_t *used = NULL, *buf = NULL;
+    enum { BLOCK = 1 << 16 }; /* records per read */
+    int ok = hlen > 0 && (size_t)hlen <= got && memcmp(head, want, (size_t)hlen) == 0 &&
+             (uint64_t)st.st_size ==
+                 (uint64_t)hlen + V * PLY_VERTEX_BYTES + T * PLY_FACE_BYTES &&
+             fseek(f, hlen, SEEK_SET) == 0;
+    if (ok) {
+        m.vertex_count = (uint32_t)V, m.triangle_count = (uint32_t)T;
+        m.positions = alloc_array(3 * (size_t)V, sizeof(float));
+        m.normals = alloc_array(3 * (size_t)V, sizeof(float));
+        m.indices = alloc_array(3 * (size_t)T, sizeof(uint32_t));
+        used = calloc((size_t)V, 1);
+        buf = malloc((size_t)BLOCK * PLY_VERTEX_BYTES);
+        ok = m.positions && m.normals && m.indices && used && buf;
+    }
+    /* Little-endian host (vdsh.h checks it): the floats and indices as they are. */
+    for (uint64_t a = 0; ok && a < V; a += BLOCK) {
+        size_t n = V - a < BLOCK ? (size_t)(V - a) : BLOCK;
+        ok = fread(buf, PLY_VERTEX_BYTES, n, f) == n;
+        for (size_t i = 0; ok && i < n; i++) {
+            float rec[6];
+            memcpy(rec, buf + i * PLY_VERTEX_BYTES, sizeof rec);
+            float *p = m.positions + 3 * (a + i), *nv = m.normals + 3 * (a + i);
+            memcpy(p, rec, 3 * sizeof(float));
+            ok = isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]) && isfinite(rec[3]) &&
+                 isfinite(rec[4]) && isfinite(rec[5]);
+            if (ok)
+                unit_float(rec + 3, nv);
+            ok = ok && (nv[0] != 0.0f || nv[1] != 0.0f || nv[2] != 0.0f);
+        }
+    }
+    for (uint64_t a = 0; ok && a < T; a += BLOCK) {
+        size_t n = T - a < BLOCK ? (size_t)(T - a) : BLOCK;
+        ok = fread(buf, PLY_FACE_BYTES, n, f) == n;
+        for (size_t i = 0; ok && i < n; i++) {
+            const uint8_t *rec = buf + i * PLY_FACE_BYTES;
+            uint32_t *tri = m.indices + 3 * (a + i);
+            memcpy(tri, rec + 1, 3 * sizeof(uint32_t));
+            ok = rec[0] == 3 && tri[0] < V && tri[1] < V && tri[2] < V && tri[0] != tri[1] &&
+                 tri[1] != tri[2] && tri[0] != tri[2];
+            if (ok)
+                used[tri[0]] = used[tri[1]] = used[tri[2]] = 1;
+        }
+    }
+    for (uint64_t i = 0; ok && i < V; i++)
+        ok = used[i];
+    fclose(f);
+    free(used);
+    free(buf);
+    if (!ok) {
+        vb_mesh_free(&m);
+        return 0;
+    }
+    *out = m;
+    return 1;
+}
+
+vb_result vb_mesh_load_plan(const char *path, vb_mesh *out, vb_error *err)
+{
+    if (!path || !out)
+        return vb_fail(err, VB_ERR_ARGUMENT, "load: NULL path or output");
+    if (has_extension(path, "ply") && read_plan(path, out))
+        return VB_OK;
+    vb_load_desc ld = {0};
+    return vb_mesh_load(path, &ld, out, NULL, err);
 }
 
 vb_result vb_mesh_load_memory(const void *data, size_t size, const char *name, const vb_load_desc *desc,

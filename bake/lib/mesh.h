@@ -184,6 +184,17 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path,
 vb_result vb_mesh_load(const char *path, const vb_load_desc *desc,
                        vb_mesh *out, vb_source_info *info, vb_error *err);
 
+/* Load receivers as they are (vdsh-bake --receivers: a plan): the mesh
+ * vb_mesh_load gives with a zero desc, bit for bit. A binary PLY that
+ * vb_mesh_write_ply wrote, whose mesh loading leaves as it is (positions
+ * and normals finite, no zero normal, every face a triangle of three
+ * distinct vertices, every vertex in a face: every plan vdsh-bake writes),
+ * is read in one pass into the mesh's own arrays: its memory is the mesh's
+ * (48 bytes per vertex with 2 triangles each), where vb_mesh_load holds the
+ * file's bytes and the parser's arrays beside it (~5 times that). Any other
+ * file: vb_mesh_load. */
+vb_result vb_mesh_load_plan(const char *path, vb_mesh *out, vb_error *err);
+
 /* Load a mesh file's bytes from memory (the fuzz targets' entry): exactly
  * as vb_mesh_load would load a file holding them. `name` only names the
  * bytes: it appears in messages and its extension (.obj/.ply/.off/.stl,

@@ -12,7 +12,43 @@
 
 #define VB_PI 3.14159265358979323846
 
-/* ---- ray-offset normals ------------------------------------------------ */
+/* ---- subsets of receivers ----------------------------------------------- */
+
+/* The receivers a pass works on: receiver idx[k] at slot k, idx ascending;
+ * idx NULL: every receiver, slot = index. The bitmap (bit v: receiver v is
+ * in) and the rank (members before each 64-bit word) give a receiver's
+ * slot in constant time, for 1.5 bits per receiver of the mesh: a shard's
+ * passes hold arrays of its own receivers only. */
+typedef struct subset {
+    uint32_t count;
+    uint32_t *idx;
+    uint64_t *bits;
+    uint32_t *rank;
+} subset;
+
+static void subset_free(subset *S)
+{
+    free(S->idx);
+    free(S->bits);
+    free(S->rank);
+    memset(S, 0, sizeof *S);
+}
+
+static inline uint32_t subset_vertex(const subset *S, uint32_t k)
+{
+    return S->idx ? S->idx[k] : k;
+}
+
+/* Receiver v's slot, or UINT32_MAX when it is not in S. */
+static inline uint32_t subset_slot(const subset *S, uint32_t v)
+{
+    if (!S->idx)
+        return v;
+    uint64_t w = S->bits[v >> 6], bit = 1ull << (v & 63);
+    if (!(w & bit))
+        return UINT32_MAX;
+    return S->rank[v >> 6] + (uint32_t)__builtin_popcountll(w & (bit - 1));
+}
 
 typedef struct pos_key {
     float p[3];
@@ -28,19 +64,108 @@ static int cmp_pos(const void *a, const void *b)
     return (x->index > y->index) - (x->index < y->index);
 }
 
-/* m's vertices sorted by the bytes of their positions, which groups
- * bit-identical positions (+ 0.0f folds -0 into +0); ties are ordered by
- * index, so a group's sums run in a fixed order. NULL when out of memory. */
-static pos_key *sorted_positions(const vb_mesh *m)
+/* Receiver v's position with -0 folded into +0 (bit-identical positions
+ * are equal positions). */
+static void position_key(const vb_mesh *m, uint32_t v, float p[3])
 {
-    uint32_t n = m->vertex_count;
+    for (int c = 0; c < 3; c++)
+        p[c] = m->positions[3 * (size_t)v + c] + 0.0f;
+}
+
+/* A position's bits (-0 folded into +0) as three words, compared inline:
+ * the coincidence search below makes one binary search per receiver. */
+typedef struct pos_bits {
+    uint32_t w[3];
+} pos_bits;
+
+static pos_bits position_bits(const vb_mesh *m, uint32_t v)
+{
+    float p[3];
+    pos_bits b;
+    position_key(m, v, p);
+    memcpy(b.w, p, sizeof b.w);
+    return b;
+}
+
+static inline int cmp_bits_inline(const pos_bits *x, const pos_bits *y)
+{
+    for (int c = 0; c < 3; c++)
+        if (x->w[c] != y->w[c])
+            return x->w[c] < y->w[c] ? -1 : 1;
+    return 0;
+}
+
+static int cmp_bits(const void *a, const void *b)
+{
+    return cmp_bits_inline(a, b);
+}
+
+/* E: the receivers at the bit-identical position of one of set[0..n) (set
+ * itself among them), so that every group of coincident receivers is
+ * either all in E or all out: their normals enter each other's ray-offset
+ * normals. One sort of the set's positions, one search per receiver. */
+static vb_result subset_coincident(const vb_mesh *m, const uint32_t *set, uint32_t n, subset *E)
+{
+    const uint32_t V = m->vertex_count;
+    const size_t words = ((size_t)V + 63) / 64;
+    memset(E, 0, sizeof *E);
+    pos_bits *key = malloc((size_t)n * sizeof *key + 1);
+    E->bits = calloc(words + 1, sizeof *E->bits);
+    E->rank = malloc((words + 1) * sizeof *E->rank);
+    if (!key || !E->bits || !E->rank) {
+        free(key);
+        subset_free(E);
+        return VB_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t i = 0; i < n; i++)
+        key[i] = position_bits(m, set[i]);
+    qsort(key, n, sizeof *key, cmp_bits);
+    uint32_t count = 0;
+    for (uint32_t v = 0; v < V; v++) {
+        pos_bits p = position_bits(m, v);
+        size_t a = 0, b = n; /* the first key >= p */
+        while (a < b) {
+            size_t mid = (a + b) / 2;
+            if (cmp_bits_inline(&key[mid], &p) < 0)
+                a = mid + 1;
+            else
+                b = mid;
+        }
+        if (a < n && cmp_bits_inline(&key[a], &p) == 0) {
+            E->bits[v >> 6] |= 1ull << (v & 63);
+            count++;
+        }
+    }
+    free(key);
+    E->idx = malloc((size_t)count * sizeof *E->idx + 1);
+    if (!E->idx) {
+        subset_free(E);
+        return VB_ERR_OUT_OF_MEMORY;
+    }
+    uint32_t k = 0;
+    for (size_t w = 0; w < words; w++) {
+        E->rank[w] = k;
+        for (uint64_t bits = E->bits[w]; bits; bits &= bits - 1)
+            E->idx[k++] = (uint32_t)(w * 64 + (size_t)__builtin_ctzll(bits));
+    }
+    E->count = count;
+    return VB_OK;
+}
+
+/* ---- ray-offset normals ------------------------------------------------ */
+
+/* E's receivers sorted by the bytes of their positions, which groups
+ * bit-identical positions; ties are ordered by slot (= by index), so a
+ * group's sums run in a fixed order. NULL when out of memory. */
+static pos_key *sorted_positions(const vb_mesh *m, const subset *E)
+{
+    uint32_t n = E->count;
     pos_key *key = malloc((size_t)n * sizeof *key + 1);
     if (!key)
         return NULL;
-    for (uint32_t i = 0; i < n; i++) {
-        for (int c = 0; c < 3; c++)
-            key[i].p[c] = m->positions[3 * (size_t)i + c] + 0.0f;
-        key[i].index = i;
+    for (uint32_t k = 0; k < n; k++) {
+        position_key(m, subset_vertex(E, k), key[k].p);
+        key[k].index = k;
     }
     qsort(key, n, sizeof *key, cmp_pos);
     return key;
@@ -55,12 +180,15 @@ static uint32_t group_end(const pos_key *key, uint32_t n, uint32_t a)
     return b;
 }
 
-vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err)
+/* vb_offset_normals for the receivers of E (closed under coincidence):
+ * normals and out per slot. */
+static vb_result offset_normals_in(const vb_mesh *m, const subset *E, const float *normals,
+                                   float *out)
 {
-    uint32_t n = m->vertex_count;
-    pos_key *key = sorted_positions(m);
+    uint32_t n = E->count;
+    pos_key *key = sorted_positions(m, E);
     if (!key)
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+        return VB_ERR_OUT_OF_MEMORY;
     for (uint32_t a = 0; a < n;) {
         uint32_t b = group_end(key, n, a);
         /* Each vertex of the group sums the normals that face its own side
@@ -70,10 +198,10 @@ vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err)
          * crate does not average in the crate's bottom, which faces the
          * other way. Sums run in group (index) order. */
         for (uint32_t k = a; k < b; k++) {
-            const float *nk = m->normals + 3 * (size_t)key[k].index;
+            const float *nk = normals + 3 * (size_t)key[k].index;
             double s[3] = {0, 0, 0};
             for (uint32_t j = a; j < b; j++) {
-                const float *nj = m->normals + 3 * (size_t)key[j].index;
+                const float *nj = normals + 3 * (size_t)key[j].index;
                 if (nj[0] * nk[0] + nj[1] * nk[1] + nj[2] * nk[2] < 0.0f)
                     continue;
                 for (int c = 0; c < 3; c++)
@@ -86,6 +214,14 @@ vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err)
         a = b;
     }
     free(key);
+    return VB_OK;
+}
+
+vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err)
+{
+    subset all = {.count = m->vertex_count};
+    if (offset_normals_in(m, &all, m->normals, out) != VB_OK)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
     return VB_OK;
 }
 
@@ -276,21 +412,26 @@ static int escapes(const prober *J, const float o[3], const float n[3], uint64_t
 
 /* ---- receiver frames ---------------------------------------------------- */
 
-/* What the origin rules need to know about each receiver: the normal
- * averaged over every receiver at its position, the inset vector into its
- * own triangles, the triangles around it and its near distance. Built once
+/* What the origin rules need to know about the receivers of a subset E
+ * (closed under coincidence; per slot): their normals, the normal averaged
+ * over every receiver at the same position, the inset vector into their own
+ * triangles, the triangles around them and their near distance. Built once
  * per bake: the orientation flips normals, and then only the parts that
  * depend on them (navg, inset) are computed again (frames_normals). */
 typedef struct frames {
-    float *navg;                /* 3 per vertex */
-    float *inset;               /* 3 per vertex */
-    float *near;                /* per vertex, scene units */
-    uint32_t *adj_start, *adj;  /* vertex -> its triangles, in triangle order */
-    double *pull;               /* 4 per vertex: the centroids' pull x, y, z, weight */
+    const subset *E;
+    float *normals;             /* 3 per slot: borrowed, or own_normals */
+    float *own_normals;
+    float *navg;                /* 3 per slot */
+    float *inset;               /* 3 per slot */
+    float *near;                /* per slot, scene units */
+    uint32_t *adj_start, *adj;  /* slot -> its triangles, in triangle order */
+    double *pull;               /* 4 per slot: the centroids' pull x, y, z, weight */
 } frames;
 
 static void frames_free(frames *f)
 {
+    free(f->own_normals);
     free(f->navg);
     free(f->inset);
     free(f->near);
@@ -300,90 +441,126 @@ static void frames_free(frames *f)
     memset(f, 0, sizeof *f);
 }
 
-/* The parts of f that depend on m's normals: the averaged normals, and the
+/* The parts of f that depend on the normals: the averaged normals, and the
  * inset (the centroids' pull in the tangent plane of the averaged normal). */
 static vb_result frames_normals(const vb_mesh *m, frames *f, vb_error *err)
 {
-    vb_result r = vb_offset_normals(m, f->navg, err);
-    if (r != VB_OK)
-        return r;
-    for (uint32_t v = 0; v < m->vertex_count; v++) {
-        const float *nv = f->navg + 3 * (size_t)v;
-        const double *a = f->pull + 4 * (size_t)v;
+    if (offset_normals_in(m, f->E, f->normals, f->navg) != VB_OK)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    for (uint32_t k = 0; k < f->E->count; k++) {
+        const float *nv = f->navg + 3 * (size_t)k;
+        const double *a = f->pull + 4 * (size_t)k;
         if (a[3] > 0.0) {
             double dot = a[0] * nv[0] + a[1] * nv[1] + a[2] * nv[2];
             for (int i = 0; i < 3; i++)
-                f->inset[3 * (size_t)v + i] = (float)((a[i] - dot * nv[i]) / a[3]);
+                f->inset[3 * (size_t)k + i] = (float)((a[i] - dot * nv[i]) / a[3]);
         }
     }
     return VB_OK;
 }
 
-static vb_result frames_create(const vb_mesh *m, const vb_scene *s, frames *f, vb_error *err)
+/* The frames of E's receivers. normals: E's normals per slot, borrowed (to
+ * be oriented in place), or NULL: a copy of m's. Every per-receiver sum
+ * (edge lengths, the centroids' pull) runs over the triangles in order, as
+ * over the whole mesh, so a receiver's frame does not depend on E. */
+static vb_result frames_create(const vb_mesh *m, const vb_scene *s, const subset *E,
+                               float *normals, frames *f, vb_error *err)
 {
-    uint32_t n = m->vertex_count;
+    uint32_t n = E->count;
     memset(f, 0, sizeof *f);
+    f->E = E;
+    if (!normals && (normals = f->own_normals = malloc((size_t)n * 3 * sizeof *normals + 1)))
+        for (uint32_t k = 0; k < n; k++)
+            memcpy(normals + 3 * (size_t)k, m->normals + 3 * (size_t)subset_vertex(E, k),
+                   3 * sizeof *normals);
+    f->normals = normals;
     f->navg = malloc((size_t)n * 3 * sizeof *f->navg + 1);
     f->inset = calloc((size_t)n * 3 + 1, sizeof *f->inset);
     f->near = malloc((size_t)n * sizeof *f->near + 1);
     f->adj_start = calloc((size_t)n + 1, sizeof *f->adj_start);
-    f->adj = malloc((size_t)m->triangle_count * 3 * sizeof *f->adj + 1);
     double *acc = f->pull = calloc((size_t)n * 4 + 1, sizeof *acc); /* x, y, z, weight */
-    uint32_t *fill = malloc((size_t)n * sizeof *fill + 1);
+    uint32_t *count = calloc((size_t)n + 1, sizeof *count);
+    double *sum = calloc((size_t)n + 1, sizeof *sum);
     vb_result r = VB_OK;
-    if (!f->navg || !f->inset || !f->near || !f->adj_start || !f->adj || !acc || !fill) {
+    if (!f->normals || !f->navg || !f->inset || !f->near || !f->adj_start || !acc || !count ||
+        !sum) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for ray origins");
         goto done;
     }
-    if ((r = vb_mean_edges(m, f->near, err)) != VB_OK)
-        goto done;
-    for (uint32_t v = 0; v < n; v++)
-        f->near[v] = vb_receiver_near(s->diagonal, f->near[v]);
-    /* Inset: the mean direction from a vertex to the centroids of its own
-     * triangles, weighted by their distance, in the tangent plane.
-     * Interior vertices' pulls cancel (length ~0); a vertex on a boundary
-     * or crease gets a vector of length up to 1 into its own surface. */
+    /* Per triangle with a corner in E: the mean edge length around each
+     * corner (vb_mean_edges) and the inset's pull - the mean direction from
+     * a vertex to the centroids of its own triangles, weighted by their
+     * distance, in the tangent plane. Interior vertices' pulls cancel
+     * (length ~0); a vertex on a boundary or crease gets a vector of length
+     * up to 1 into its own surface. */
     for (uint32_t t = 0; t < m->triangle_count; t++) {
         const uint32_t *ix = m->indices + 3 * (size_t)t;
+        uint32_t sl[3] = {subset_slot(E, ix[0]), subset_slot(E, ix[1]), subset_slot(E, ix[2])};
+        if (sl[0] == UINT32_MAX && sl[1] == UINT32_MAX && sl[2] == UINT32_MAX)
+            continue;
+        for (int k = 0; k < 3; k++) {
+            const float *a = m->positions + 3 * (size_t)ix[k];
+            const float *b = m->positions + 3 * (size_t)ix[(k + 1) % 3];
+            double dx = (double)a[0] - b[0], dy = (double)a[1] - b[1], dz = (double)a[2] - b[2];
+            double len = sqrt(dx * dx + dy * dy + dz * dz);
+            if (sl[k] != UINT32_MAX)
+                sum[sl[k]] += len, count[sl[k]]++;
+            if (sl[(k + 1) % 3] != UINT32_MAX)
+                sum[sl[(k + 1) % 3]] += len, count[sl[(k + 1) % 3]]++;
+        }
         double c[3] = {0, 0, 0};
         for (int k = 0; k < 3; k++)
             for (int i = 0; i < 3; i++)
                 c[i] += m->positions[3 * (size_t)ix[k] + i] / 3.0;
         for (int k = 0; k < 3; k++) {
+            if (sl[k] == UINT32_MAX)
+                continue;
             const float *p = m->positions + 3 * (size_t)ix[k];
             double d[3] = {c[0] - p[0], c[1] - p[1], c[2] - p[2]};
-            double *a = acc + 4 * (size_t)ix[k];
+            double *a = acc + 4 * (size_t)sl[k];
             for (int i = 0; i < 3; i++)
                 a[i] += d[i];
             a[3] += sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-            f->adj_start[ix[k] + 1]++;
+            f->adj_start[sl[k] + 1]++;
         }
     }
-    for (uint32_t v = 0; v < n; v++)
-        f->adj_start[v + 1] += f->adj_start[v];
-    memcpy(fill, f->adj_start, (size_t)n * sizeof *fill);
+    for (uint32_t k = 0; k < n; k++) {
+        f->near[k] = vb_receiver_near(s->diagonal, count[k] ? (float)(sum[k] / count[k]) : 0.0f);
+        f->adj_start[k + 1] += f->adj_start[k];
+    }
+    /* The triangles around each receiver, in triangle order (count reused
+     * as the fill pointer). */
+    if (!(f->adj = malloc((size_t)f->adj_start[n] * sizeof *f->adj + 1))) {
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for ray origins");
+        goto done;
+    }
+    memcpy(count, f->adj_start, (size_t)n * sizeof *count);
     for (uint32_t t = 0; t < m->triangle_count; t++)
-        for (int k = 0; k < 3; k++)
-            f->adj[fill[m->indices[3 * (size_t)t + k]]++] = t;
+        for (int k = 0; k < 3; k++) {
+            uint32_t sk = subset_slot(E, m->indices[3 * (size_t)t + k]);
+            if (sk != UINT32_MAX)
+                f->adj[count[sk]++] = t;
+        }
     r = frames_normals(m, f, err);
 done:
-    free(fill);
+    free(count);
+    free(sum);
     if (r != VB_OK)
         frames_free(f);
     return r;
 }
 
-/* The standard origin of receiver v on side `sign` of its surface (+1:
- * the side its normal points to), in the traced frame: offset along the
- * averaged normal, then along the inset. */
+/* The standard origin of receiver v (slot k of f) on side `sign` of its
+ * surface (+1: the side its normal points to), in the traced frame: offset
+ * along the averaged normal, then along the inset. */
 static void standard_origin(const vb_scene *s, const vb_mesh *m, const frames *f, uint32_t v,
-                            float sign, float out[3])
+                            uint32_t k, float sign, float out[3])
 {
-    const float *nv = f->navg + 3 * (size_t)v;
+    const float *nv = f->navg + 3 * (size_t)k;
     float p[3], o[3], ns[3] = {sign * nv[0], sign * nv[1], sign * nv[2]};
     vb_scene_to_local(s, m->positions + 3 * (size_t)v, p);
     vb_offset_origin(p, ns, o);
-    vb_offset_origin(o, f->inset + 3 * (size_t)v, out);
+    vb_offset_origin(o, f->inset + 3 * (size_t)k, out);
 }
 
 /* What the first probe says of an origin. */
@@ -392,15 +569,16 @@ enum { ORIGIN_FREE, ORIGIN_REPAIR, ORIGIN_PRESSED };
 static int mostly_facing(const prober *J, const float o[3], const float n[3], int back,
                          uint64_t *rays);
 
-/* Whether the origin of receiver v at o must be repaired: squeezed (upper
- * probes at ~0) or behind a surface (back faces at ~0) - or pressed: only
- * coincident faces make the back count, and the receiver's own surface is
- * the skin of a solid (from just behind it, the full-length probes toward
- * -n meet back faces): a box's bottom on a floor, whose origin would look
- * through the floor, where a double-sided sheet's sides are free. */
+/* Whether the origin of receiver v (slot k) at o must be repaired:
+ * squeezed (upper probes at ~0) or behind a surface (back faces at ~0) -
+ * or pressed: only coincident faces make the back count, and the
+ * receiver's own surface is the skin of a solid (from just behind it, the
+ * full-length probes toward -n meet back faces): a box's bottom on a
+ * floor, whose origin would look through the floor, where a double-sided
+ * sheet's sides are free. */
 static int origin_state(const prober *J, const vb_mesh *m, const frames *F, uint32_t v,
-                        const float o[3], const float n[3], float near, short_result *sr,
-                        int *tie_seen, uint64_t *rays)
+                        uint32_t k, const float o[3], const float n[3], float near,
+                        short_result *sr, int *tie_seen, uint64_t *rays)
 {
     *sr = short_probe(J, o, n, near, rays);
     *tie_seen |= sr->tie > 0;
@@ -409,7 +587,7 @@ static int origin_state(const prober *J, const vb_mesh *m, const frames *F, uint
     if (sr->back + sr->tie < PROBE_BACK_LIMIT)
         return ORIGIN_FREE;
     float behind[3], mn[3] = {-n[0], -n[1], -n[2]};
-    standard_origin(J->s, m, F, v, -1.0f, behind);
+    standard_origin(J->s, m, F, v, k, -1.0f, behind);
     int res = mostly_facing(J, behind, mn, 1, rays);
     return res ? ORIGIN_PRESSED : ORIGIN_FREE;
 }
@@ -448,11 +626,14 @@ static badness full_badness(const prober *J, const float o[3], const float n[3],
     return b;
 }
 
+/* The receivers given origins: set[j] at slot j of out (set NULL: every
+ * receiver); those in [count_begin, count_end) counted. */
 typedef struct origin_job {
     const vb_mesh *m;
     const frames *F;
+    const uint32_t *set;
+    uint32_t count_begin, count_end;
     float *out;
-    const uint8_t *need;        /* vb_receivers_prepare's; NULL: all */
     prober P;
     _Atomic uint32_t moved, flagged, ties;
     _Atomic uint64_t rays;
@@ -461,8 +642,9 @@ typedef struct origin_job {
 /* What repairing one receiver did (bits). */
 enum { REPAIR_MOVED = 1, REPAIR_FLAGGED = 2, REPAIR_TIE = 4 };
 
-/* Probe receiver v's origin J->out[v] and repair it if it must be. */
-static unsigned repair_one(origin_job *J, uint32_t v, uint64_t *rays)
+/* Probe receiver v's (slot k of the frames) origin o and repair it if it
+ * must be. */
+static unsigned repair_one(origin_job *J, uint32_t v, uint32_t k, float *o, uint64_t *rays)
 {
     const vb_mesh *m = J->m;
     const frames *F = J->F;
@@ -473,14 +655,13 @@ static unsigned repair_one(origin_job *J, uint32_t v, uint64_t *rays)
      * spread over it: the cost stays bounded at any valence. */
     static const float steps[6] = {0.05f, 0.15f, 0.35f, 0.6f, 0.8f, 0.95f};
     enum { FAN = VB_REPAIR_CANDIDATES / 6 };
-    const float *n = m->normals + 3 * (size_t)v;
+    const float *n = F->normals + 3 * (size_t)k;
     if (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f)
         return 0;
-    float *o = J->out + 3 * (size_t)v;
-    const float near = F->near[v] * scale;
+    const float near = F->near[k] * scale;
     short_result sr, csr, best_sr = {0, 0, 0};
     int tie_seen = 0;
-    int state = origin_state(&J->P, m, F, v, o, n, near, &sr, &tie_seen, rays);
+    int state = origin_state(&J->P, m, F, v, k, o, n, near, &sr, &tie_seen, rays);
     if (state == ORIGIN_FREE)
         return tie_seen ? REPAIR_TIE : 0;
     if (state == ORIGIN_PRESSED) {
@@ -488,13 +669,13 @@ static unsigned repair_one(origin_job *J, uint32_t v, uint64_t *rays)
          * surface is free, and the true distances are ~0. The origin
          * just behind its own surface gives exactly that, instead of
          * one pushed through the other surface. */
-        standard_origin(J->P.s, m, F, v, -1.0f, o);
+        standard_origin(J->P.s, m, F, v, k, -1.0f, o);
         return REPAIR_FLAGGED | REPAIR_TIE | REPAIR_MOVED;
     }
     const float *p = m->positions + 3 * (size_t)v;
     float best[3] = {o[0], o[1], o[2]}, cand[3], first[3] = {0, 0, 0};
     int found = 0, have = 0;
-    uint32_t a0 = F->adj_start[v], fan = F->adj_start[v + 1] - a0;
+    uint32_t a0 = F->adj_start[k], fan = F->adj_start[k + 1] - a0;
     uint32_t picks = fan < FAN ? fan : FAN;
     for (int st = 0; st < 6 && !found; st++)
         for (uint32_t i = 0; i < picks && !found; i++) {
@@ -508,11 +689,11 @@ static unsigned repair_one(origin_job *J, uint32_t v, uint64_t *rays)
                 q[c] = (float)(p[c] + steps[st] * (ctr - p[c]));
             }
             vb_scene_to_local(J->P.s, q, ql);
-            vb_offset_origin(ql, F->navg + 3 * (size_t)v, cand);
-            int cs = origin_state(&J->P, m, F, v, cand, n, near, &csr, &tie_seen, rays);
+            vb_offset_origin(ql, F->navg + 3 * (size_t)k, cand);
+            int cs = origin_state(&J->P, m, F, v, k, cand, n, near, &csr, &tie_seen, rays);
             found = cs != ORIGIN_REPAIR;
             if (cs == ORIGIN_PRESSED) /* its face lies on another: see above */
-                standard_origin(J->P.s, m, F, v, -1.0f, cand);
+                standard_origin(J->P.s, m, F, v, k, -1.0f, cand);
             if (found) { /* in free space, or pressed: take it */
                 memcpy(best, cand, sizeof best);
             } else if (!have || worse_short(best_sr, csr)) {
@@ -531,7 +712,7 @@ static unsigned repair_one(origin_job *J, uint32_t v, uint64_t *rays)
             memcpy(best, first, sizeof best);
             bb = c;
         }
-        standard_origin(J->P.s, m, F, v, -1.0f, cand);
+        standard_origin(J->P.s, m, F, v, k, -1.0f, cand);
         csr = short_probe(&J->P, cand, n, near, rays);
         c = full_badness(&J->P, cand, n, csr, rays);
         if (worse(bb, c))
@@ -551,11 +732,10 @@ static void repair_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
     (void)worker;
     uint64_t rays = 0;
     uint32_t moved = 0, flagged = 0, ties = 0;
-    for (uint32_t v = begin; v < end; v++) {
-        if (J->need && !J->need[v])
-            continue;
-        unsigned did = repair_one(J, v, &rays);
-        if (J->need && J->need[v] != VB_NEED_COUNT)
+    for (uint32_t j = begin; j < end; j++) {
+        uint32_t v = J->set ? J->set[j] : j;
+        unsigned did = repair_one(J, v, subset_slot(J->F->E, v), J->out + 3 * (size_t)j, &rays);
+        if (v < J->count_begin || v >= J->count_end)
             continue; /* prepared, not counted */
         moved += (did & REPAIR_MOVED) != 0;
         flagged += (did & REPAIR_FLAGGED) != 0;
@@ -567,27 +747,33 @@ static void repair_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
     atomic_fetch_add(&J->rays, rays);
 }
 
-static vb_result place_origins(const vb_mesh *m, const vb_scene *s, const frames *Fp,
-                               unsigned threads, const uint8_t *need, float *out,
+/* Origins and near distances of set[0..set_count) (NULL: every receiver)
+ * at their slots of out and near_out, by the standard rule, then the
+ * repair. */
+static vb_result place_origins(const vb_mesh *m, const vb_scene *s, const frames *F,
+                               unsigned threads, const uint32_t *set, uint32_t set_count,
+                               uint32_t count_begin, uint32_t count_end, float *out,
                                float *near_out, vb_origins_stats *stats, double t0,
                                vb_error *err)
 {
-    const frames F = *Fp;
     vb_result r = VB_OK;
     /* 1. The standard rule. */
-    for (uint32_t v = 0; v < m->vertex_count; v++)
-        standard_origin(s, m, &F, v, 1.0f, out + 3 * (size_t)v);
+    for (uint32_t j = 0; j < set_count; j++) {
+        uint32_t v = set ? set[j] : j, k = subset_slot(F->E, v);
+        standard_origin(s, m, F, v, k, 1.0f, out + 3 * (size_t)j);
+        if (near_out)
+            near_out[j] = F->near[k];
+    }
     /* 2. Repair: probe every receiver, move those left inside or behind
      * other geometry. */
     origin_job *J = calloc(1, sizeof *J);
     if (!J)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for ray origins");
-    J->m = m, J->F = &F, J->out = out, J->need = need;
+    J->m = m, J->F = F, J->set = set, J->out = out;
+    J->count_begin = count_begin, J->count_end = count_end;
     prober_init(&J->P, s);
-    if (vb_parallel_for(threads, m->vertex_count, 256, repair_block, J, NULL, NULL) == 0)
+    if (vb_parallel_for(threads, set_count, 256, repair_block, J, NULL, NULL) == 0)
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
-    if (r == VB_OK && near_out)
-        memcpy(near_out, F.near, (size_t)m->vertex_count * sizeof *near_out);
     if (r == VB_OK && stats) {
         stats->moved = atomic_load(&J->moved);
         stats->flagged = atomic_load(&J->flagged);
@@ -603,11 +789,13 @@ vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads, 
                          float *near_out, vb_origins_stats *stats, vb_error *err)
 {
     double t0 = vb_now();
+    subset all = {.count = m->vertex_count};
     frames F;
-    vb_result r = frames_create(m, s, &F, err);
+    vb_result r = frames_create(m, s, &all, NULL, &F, err);
     if (r != VB_OK)
         return r;
-    r = place_origins(m, s, &F, threads, NULL, out, near_out, stats, t0, err);
+    r = place_origins(m, s, &F, threads, NULL, m->vertex_count, 0, m->vertex_count, out,
+                      near_out, stats, t0, err);
     frames_free(&F);
     return r;
 }
@@ -617,9 +805,8 @@ vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads, 
 typedef struct orient_job {
     const vb_mesh *m;
     const frames *F;
-    const uint8_t *need;        /* NULL: all */
     prober P;
-    uint8_t *flip;
+    uint8_t *flip;              /* per slot of F */
 } orient_job;
 
 /* What the ray from o along d meets first: one query for the nearest
@@ -682,9 +869,10 @@ static void orient_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
 {
     orient_job *J = ctx;
     (void)worker;
-    for (uint32_t v = begin; v < end; v++) {
-        const float *n = J->m->normals + 3 * (size_t)v;
-        if ((J->need && !J->need[v]) || (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f))
+    for (uint32_t k = begin; k < end; k++) {
+        uint32_t v = subset_vertex(J->F->E, k);
+        const float *n = J->F->normals + 3 * (size_t)k;
+        if (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f)
             continue;
         /* Full-length probes from the standard origins on both sides:
          * toward +n mostly the backs of faces (inside a solid); toward -n
@@ -694,34 +882,37 @@ static void orient_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
          * below, and its normal is right. */
         float o[3], m[3] = {-n[0], -n[1], -n[2]};
         uint64_t rays = 0;
-        standard_origin(J->P.s, J->m, J->F, v, 1.0f, o);
+        standard_origin(J->P.s, J->m, J->F, v, k, 1.0f, o);
         if (!mostly_facing(&J->P, o, n, 1, &rays))
             continue;
-        standard_origin(J->P.s, J->m, J->F, v, -1.0f, o);
-        J->flip[v] = (uint8_t)mostly_facing(&J->P, o, m, 0, &rays);
+        standard_origin(J->P.s, J->m, J->F, v, k, -1.0f, o);
+        J->flip[k] = (uint8_t)mostly_facing(&J->P, o, m, 0, &rays);
     }
 }
 
-/* Orient m's receivers with frames F of m: flip, in `normals` (m's or a
- * copy of them), those pointing into geometry. */
-static vb_result orient(const vb_mesh *m, const vb_scene *s, const frames *F, unsigned threads,
-                        const uint8_t *need, float *normals, uint32_t *flipped, uint32_t *any,
-                        vb_error *err)
+/* Orient the receivers of F (all of its subset): flip, in F's normals,
+ * those pointing into geometry. `flipped` counts those in
+ * [count_begin, count_end), `any` every flip. */
+static vb_result orient(const vb_mesh *m, const vb_scene *s, frames *F, unsigned threads,
+                        uint32_t count_begin, uint32_t count_end, uint32_t *flipped,
+                        uint32_t *any, vb_error *err)
 {
     vb_result r = VB_OK;
-    orient_job J = {.m = m, .F = F, .need = need};
-    J.flip = calloc((size_t)m->vertex_count + 1, 1);
+    const uint32_t n = F->E->count;
+    orient_job J = {.m = m, .F = F};
+    J.flip = calloc((size_t)n + 1, 1);
     if (!J.flip)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for receiver normals");
     prober_init(&J.P, s);
-    if (vb_parallel_for(threads, m->vertex_count, 256, orient_block, &J, NULL, NULL) == 0)
+    if (vb_parallel_for(threads, n, 256, orient_block, &J, NULL, NULL) == 0)
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
     uint32_t count = 0, all = 0;
-    for (uint32_t v = 0; v < m->vertex_count && r == VB_OK; v++)
-        if (J.flip[v]) {
+    for (uint32_t k = 0; k < n && r == VB_OK; k++)
+        if (J.flip[k]) {
+            uint32_t v = subset_vertex(F->E, k);
             for (int i = 0; i < 3; i++)
-                normals[3 * (size_t)v + i] = -normals[3 * (size_t)v + i];
-            count += !need || need[v] == VB_NEED_COUNT;
+                F->normals[3 * (size_t)k + i] = -F->normals[3 * (size_t)k + i];
+            count += v >= count_begin && v < count_end;
             all++;
         }
     free(J.flip);
@@ -735,79 +926,62 @@ static vb_result orient(const vb_mesh *m, const vb_scene *s, const frames *F, un
 vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
                               uint32_t *flipped, vb_error *err)
 {
+    subset all = {.count = m->vertex_count};
     frames F;
-    vb_result r = frames_create(m, s, &F, err);
+    vb_result r = frames_create(m, s, &all, m->normals, &F, err);
     if (r != VB_OK)
         return r;
     uint32_t count = 0;
     uint32_t any = 0;
-    r = orient(m, s, &F, threads, NULL, m->normals, &count, &any, err);
+    r = orient(m, s, &F, threads, 0, m->vertex_count, &count, &any, err);
     frames_free(&F);
     if (r == VB_OK && flipped)
         *flipped = count;
     return r;
 }
 
-/* need expanded to the receivers at the bit-identical position of a needed
- * one (marked VB_NEED_ONLY): their oriented normals enter the needed
- * ones' ray-offset normals. A new array, or NULL when out of memory. */
-static uint8_t *need_with_coincident(const vb_mesh *m, const uint8_t *need)
-{
-    uint32_t n = m->vertex_count;
-    uint8_t *out = malloc((size_t)n + 1);
-    pos_key *key = sorted_positions(m);
-    if (!out || !key) {
-        free(out);
-        free(key);
-        return NULL;
-    }
-    memcpy(out, need, n);
-    for (uint32_t a = 0; a < n;) {
-        uint32_t b = group_end(key, n, a);
-        int any = 0;
-        for (uint32_t k = a; k < b; k++)
-            any |= need[key[k].index] != 0;
-        for (uint32_t k = a; k < b && any && b - a > 1; k++)
-            if (!out[key[k].index])
-                out[key[k].index] = VB_NEED_ONLY;
-        a = b;
-    }
-    free(key);
-    return out;
-}
-
 vb_result vb_receivers_prepare(const vb_mesh *m, const vb_scene *s, unsigned threads,
-                               const uint8_t *need, float *normals, uint32_t *flipped,
+                               const uint32_t *set, uint32_t set_count, uint32_t count_begin,
+                               uint32_t count_end, float *normals, uint32_t *flipped,
                                float *out, float *near_out, vb_origins_stats *stats,
                                vb_error *err)
 {
     double t0 = vb_now();
+    const uint32_t V = m->vertex_count;
+    if (!set)
+        set_count = V, count_begin = 0, count_end = V;
+    /* The frames of the set and of the receivers at its positions. */
+    subset E = {.count = V};
+    if (set && subset_coincident(m, set, set_count, &E) != VB_OK)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for receiver frames");
+    /* Every receiver: the caller's copy of the normals is oriented in place. */
+    float *in_place = normals && !set ? normals : NULL;
+    if (in_place)
+        memcpy(in_place, m->normals, (size_t)V * 3 * sizeof *in_place);
     frames F;
-    vb_result r = frames_create(m, s, &F, err);
-    if (r != VB_OK)
+    vb_result r = frames_create(m, s, &E, in_place, &F, err);
+    if (r != VB_OK) {
+        subset_free(&E);
         return r;
-    vb_mesh oriented = *m;
-    uint32_t count = 0, any = 0;
-    uint8_t *orient_need = NULL;
-    if (need && normals && !(orient_need = need_with_coincident(m, need))) {
-        frames_free(&F);
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for receiver normals");
     }
+    uint32_t count = 0, any = 0;
     if (normals) {
-        memcpy(normals, m->normals, (size_t)m->vertex_count * 3 * sizeof *normals);
-        oriented.normals = normals;
-        r = orient(m, s, &F, threads, orient_need, normals, &count, &any, err);
+        r = orient(m, s, &F, threads, count_begin, count_end, &count, &any, err);
         /* The frames again where they depend on the normals: after any flip,
          * also one of a receiver that is not counted (a shard's neighbour at
          * the same position). */
         if (r == VB_OK && any > 0)
-            r = frames_normals(&oriented, &F, err);
+            r = frames_normals(m, &F, err);
+        for (uint32_t j = 0; j < set_count && set && r == VB_OK; j++)
+            memcpy(normals + 3 * (size_t)j, F.normals + 3 * (size_t)subset_slot(&E, set[j]),
+                   3 * sizeof *normals);
         t0 = vb_now(); /* the origins' time, as before: not the orientation's */
     }
     if (r == VB_OK)
-        r = place_origins(&oriented, s, &F, threads, need, out, near_out, stats, t0, err);
+        r = place_origins(m, s, &F, threads, set, set_count, count_begin, count_end, out,
+                          near_out, stats, t0, err);
     frames_free(&F);
-    free(orient_need);
+    subset_free(&E);
     if (r == VB_OK && flipped)
         *flipped = count;
     return r;

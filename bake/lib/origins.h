@@ -104,23 +104,24 @@ vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads, 
 vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
                               uint32_t *flipped, vb_error *err);
 
-/* vb_receivers_prepare's `need`, per receiver. */
-enum { VB_NEED_NONE = 0, VB_NEED_COUNT = 1, VB_NEED_ONLY = 2 };
-
 /* The bake's receivers in one pass over their frames (built once):
  * vb_orient_receivers (when `normals` is not NULL: m's normals are copied
  * there and oriented in the copy; m is not changed) then vb_ray_origins
  * with the oriented normals. `flipped` and `stats` may be NULL; stats'
  * seconds count the origins only. The same results as the two calls.
- * need (NULL: every receiver) limits the probes to the receivers a bake
- * traces (a shard's range, the midpoints of adaptive refinement): only
- * those marked get an origin and an oriented normal (the others keep
- * their normal and the standard origin), each bit for bit what the whole
- * set would give them (the receivers at the same position as a marked
- * one are oriented too, since their normals enter its ray-offset
- * normal); `flipped` and `stats` count those marked VB_NEED_COUNT. */
+ * set (NULL: every receiver, set_count ignored) lists, ascending, the
+ * receivers a bake traces (a shard's range and the quantity choice's
+ * sample, the midpoints of adaptive refinement): only they get an origin,
+ * a near distance and an oriented normal, at their slot j (receiver
+ * set[j]) of out (3 floats), near_out and normals (3 floats), each bit for
+ * bit what the whole set would give them. The frames are built for them
+ * and the receivers at their positions only (those are oriented too, since
+ * their normals enter the set's ray-offset normals), so the memory is the
+ * set's, plus 1.5 bits per receiver of m. `flipped` and `stats` count the
+ * receivers in [count_begin, count_end) (with set NULL: every one). */
 vb_result vb_receivers_prepare(const vb_mesh *m, const vb_scene *s, unsigned threads,
-                               const uint8_t *need, float *normals, uint32_t *flipped,
+                               const uint32_t *set, uint32_t set_count, uint32_t count_begin,
+                               uint32_t count_end, float *normals, uint32_t *flipped,
                                float *out, float *near_out, vb_origins_stats *stats,
                                vb_error *err);
 

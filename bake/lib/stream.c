@@ -48,8 +48,9 @@ static void f16_encode_block(void *ctx, uint32_t begin, uint32_t end, unsigned w
     }
 }
 
-vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encoding,
-                         vdsh_stream *out, void **storage, vb_error *err)
+/* The stream of one order of b, without its data: checks and header. */
+static vb_result stream_header(const vb_bake_output *b, int order, vdsh_encoding encoding,
+                               vdsh_stream *out, vb_error *err)
 {
     if (order < 1 || order > VDSH_MAX_ORDER || !b->coeffs[order])
         return vb_fail(err, VB_ERR_ARGUMENT, "order %d is not in the bake", order);
@@ -59,18 +60,28 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encod
     const vb_method_info *mi = vb_method_stored(b->method);
     if (!mi)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", b->method);
+    *out = (vdsh_stream){.order = (uint32_t)order, .encoding = encoding, .method = b->method,
+                         .quantity = b->quantity[order],
+                         .method_param = mi->param == VB_PARAM_LOG_OFFSET ? b->log_offset[order]
+                                                                          : b->lambda,
+                         .scale = 1.0f,
+                         .quantity_param = b->quantity[order] == VDSH_QUANTITY_LOG_DISTANCE
+                                               ? b->log_floor : 0.0f, .window = b->window,
+                         .window_param = b->window ? (float)order : 0.0f};
+    return VB_OK;
+}
+
+vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encoding,
+                         vdsh_stream *out, void **storage, vb_error *err)
+{
+    vdsh_stream s;
+    vb_result hr = stream_header(b, order, encoding, &s, err);
+    if (hr != VB_OK)
+        return hr;
     int nc = order * order;
     /* A shard's range (range_end 0, as in a zeroed output: all receivers). */
     const uint32_t rows = b->range_end ? b->range_end - b->range_begin : b->vertex_count;
     size_t count = (size_t)rows * nc;
-    vdsh_stream s = {.order = (uint32_t)order, .encoding = encoding, .method = b->method,
-                     .quantity = b->quantity[order],
-                     .method_param = mi->param == VB_PARAM_LOG_OFFSET ? b->log_offset[order]
-                                                                      : b->lambda,
-                     .scale = 1.0f,
-                     .quantity_param = b->quantity[order] == VDSH_QUANTITY_LOG_DISTANCE
-                                           ? b->log_floor : 0.0f, .window = b->window,
-                     .window_param = b->window ? (float)order : 0.0f};
     if (encoding == VDSH_ENCODING_F32) {
         float *f = malloc(count * sizeof *f);
         if (!f)
@@ -185,5 +196,25 @@ vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encodin
                          .flags = VDSH_STREAM_VARIABLE, .orders = orders,
                          .offsets = offsets, .data = block + head};
     *storage = block;
+    return VB_OK;
+}
+
+vb_result vb_bake_stream_take(vb_bake_output *b, int order, vdsh_encoding encoding,
+                              vdsh_stream *out, void **storage, vb_error *err)
+{
+    vb_result r;
+    if (encoding != VDSH_ENCODING_F32) {
+        if ((r = vb_bake_stream(b, order, encoding, out, storage, err)) == VB_OK) {
+            free(b->coeffs[order]);
+            b->coeffs[order] = NULL;
+        }
+        return r;
+    }
+    /* f32: the bake's rows as they are, handed over, not copied. */
+    if ((r = stream_header(b, order, encoding, out, err)) != VB_OK)
+        return r;
+    out->data = b->coeffs[order];
+    *storage = b->coeffs[order];
+    b->coeffs[order] = NULL;
     return VB_OK;
 }

@@ -16,10 +16,20 @@
  * its basis cubemaps written atomically.
  *
  * Memory: one part at a time is read (the first stays, to check the
- * others against): the merged coefficients in f32 and one stream's
- * encoding, plus two parts (each the receiver mesh and its range's rows).
+ * others against). For f16, s8 and s8s6, whose scales are largest
+ * |coefficient|s over all receivers, each part's f32 rows go to a spill
+ * file beside the output (unlinked when made) while the largest |c|s are
+ * gathered, then come back range by range to be encoded into the merged
+ * streams. So memory is the merged file (receivers and encoded streams;
+ * f32: the coefficients) plus two parts (each the receiver mesh and its
+ * range's rows), never every receiver's f32 coefficients; the spill holds
+ * them on disk (152 bytes per receiver at orders 2, 3, 5). A variable-order
+ * stream (--adaptive-order) is decoded into f32 rows of every receiver and
+ * encoded at the end, as before: its records' offsets and scales are over
+ * all receivers too, and it is opt-in.
  * Exit status: 0 merged, 1 refused or failed (nothing written), 2 usage.
  */
+#include <errno.h>
 #include <getopt.h>
 #include <libgen.h>
 #include <limits.h>
@@ -27,6 +37,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cubemap.h"
 #include "job.h"
@@ -111,6 +122,113 @@ static const char *mismatch(const vdsh_file *a, const vdsh_file *b)
     return NULL;
 }
 
+/* Read part `path` and check it: a part, belonging with `first` (at
+ * first_path; NULL: it is the first), f32 streams. 0, or 1 after saying why (*out then
+ * NULL). */
+static int read_part(const char *path, const vdsh_file *first, const char *first_path,
+                     vdsh_file **out)
+{
+    vdsh_error verr;
+    vdsh_file *p = NULL;
+    *out = NULL;
+    if (vdsh_read(path, &p, &verr) != VDSH_OK) {
+        fprintf(stderr, "vdsh-merge: %s\n", verr.msg);
+        return 1;
+    }
+    if (!p->has_part) {
+        fprintf(stderr, "vdsh-merge: %s: not a part (no part chunk: a whole bake, not "
+                        "'vdsh-bake --shard I/N')\n", path);
+        vdsh_free(p);
+        return 1;
+    }
+    const char *why = first ? mismatch(first, p) : NULL;
+    if (why) {
+        fprintf(stderr, "vdsh-merge: %s: does not belong with %s: %s\n", path, first_path, why);
+        vdsh_free(p);
+        return 1;
+    }
+    for (uint32_t s = 0; s < p->stream_count; s++)
+        if (p->streams[s].encoding != VDSH_ENCODING_F32) {
+            fprintf(stderr, "vdsh-merge: %s: stream %u is not f32 (parts hold f32)\n", path, s);
+            vdsh_free(p);
+            return 1;
+        }
+    *out = p;
+    return 0;
+}
+
+#define ENCODE_ROWS 4096 /* receivers encoded per call */
+
+/* The spill: every part's f32 rows, in a temporary file beside the output,
+ * unlinked as soon as it is made (no exit, a kill included, leaves it).
+ * NULL after saying why. */
+static FILE *spill_create(const char *output)
+{
+    char path[PATH_MAX];
+    if (snprintf(path, sizeof path, "%s.spill-XXXXXX", output) >= (int)sizeof path) {
+        fprintf(stderr, "vdsh-merge: %s: path too long\n", output);
+        return NULL;
+    }
+    int fd = mkstemp(path);
+    FILE *f = fd >= 0 ? fdopen(fd, "w+b") : NULL;
+    if (!f) {
+        fprintf(stderr, "vdsh-merge: cannot create a temporary file beside %s: %s\n", output,
+                strerror(errno));
+        if (fd >= 0)
+            close(fd);
+        if (fd >= 0)
+            unlink(path);
+        return NULL;
+    }
+    unlink(path);
+    return f;
+}
+
+/* Encode rows b..e-1 of merged stream *s (f16 or quantised), read from
+ * the spill at its position, into dst (every receiver's bytes) with the
+ * largest |coefficient|s of all receivers, amax (f16: amax[0], the
+ * stream's; else per index): the bytes the whole bake's stream has for
+ * them. A quantised encoding's scales are its largest |c|s over the
+ * vertices it is given, so each call gets the rows after one row of amax
+ * itself: the scales are then all receivers' (scales receives them), and a
+ * receiver's bytes depend only on its values and the scales. 0, or 1 after
+ * saying why. */
+static int encode_spilled(FILE *spill, const char *output, const vdsh_stream *s, void *dst,
+                          uint32_t b, uint32_t e, const float *amax, float *scales)
+{
+    const uint32_t nc = s->order * s->order;
+    const size_t bpv = vdsh_encoding_bytes(s->encoding, nc);
+    float *rows = malloc(((size_t)ENCODE_ROWS + 1) * nc * sizeof *rows);
+    uint8_t *bytes = malloc(((size_t)ENCODE_ROWS + 1) * bpv + 1);
+    int bad = !rows || !bytes;
+    if (bad)
+        fprintf(stderr, "vdsh-merge: out of memory\n");
+    for (uint32_t a = b; a < e && !bad; a += ENCODE_ROWS) {
+        uint32_t k = e - a < ENCODE_ROWS ? e - a : ENCODE_ROWS;
+        memcpy(rows, amax, nc * sizeof *rows);
+        if (fread(rows + nc, (size_t)nc * sizeof *rows, k, spill) != k) {
+            fprintf(stderr, "vdsh-merge: cannot read back the temporary file beside %s\n",
+                    output);
+            bad = 1;
+        } else if (s->encoding == VDSH_ENCODING_F16) {
+            bad = vdsh_encode_f16(rows + nc, (size_t)k * nc, s->scale,
+                                  (uint16_t *)dst + (size_t)a * nc) != VDSH_OK;
+        } else {
+            bad = vdsh_encode_quantised(s->encoding, rows, (size_t)k + 1, nc, scales, bytes) !=
+                      VDSH_OK ||
+                  memcmp(scales, amax, nc * sizeof *scales) != 0;
+            if (!bad)
+                memcpy((uint8_t *)dst + (size_t)a * bpv, bytes + bpv, (size_t)k * bpv);
+        }
+        if (bad && rows && bytes && !ferror(spill) && !feof(spill))
+            fprintf(stderr, "vdsh-merge: order %u coefficients do not fit %s\n", s->order,
+                    vdsh_encoding_name(s->encoding));
+    }
+    free(rows);
+    free(bytes);
+    return bad;
+}
+
 int main(int argc, char **argv)
 {
     static const struct option longopts[] = {{"output", required_argument, 0, 'o'},
@@ -135,52 +253,40 @@ int main(int argc, char **argv)
     char **paths = argv + optind;
     int status = 1;
     vdsh_file *p0 = NULL, *part = NULL;
-    float *merged[VDSH_MAX_STREAMS] = {0};
+    float *merged[VDSH_MAX_STREAMS] = {0};  /* f32 and variable: every receiver's rows */
     uint8_t *orders[VDSH_MAX_STREAMS] = {0};    /* variable-order streams' */
     uint32_t *offsets[VDSH_MAX_STREAMS] = {0};
-    void *encoded[VDSH_MAX_STREAMS] = {0};
+    void *encoded[VDSH_MAX_STREAMS] = {0};  /* f16, s8, s8s6: the merged stream */
+    static float amax[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS]; /* largest |c|s, zero */
     float s8_scales[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS];
+    uint32_t target = VDSH_ENCODING_F32; /* the merged encoding */
+    FILE *spill = NULL;                  /* f16, s8, s8s6: the parts' f32 rows */
+    off_t *spill_at = NULL;              /* per shard: where its rows start */
     int *owner = NULL;
     float *normals = NULL;
     vb_cubemap_basis basis = {0};
     vdsh_file f = {0};
     vdsh_stream streams[VDSH_MAX_STREAMS];
     uint32_t count = 0, V = 0;
-    /* One part at a time (the first is kept to check the others against):
-     * memory is the merged arrays, the first part and one other. */
+    /* Pass 1, one part at a time (the first is kept to check the others
+     * against, and for its receivers): check every part, gather the
+     * oriented normals, the counts and, per stream, f32 rows or the
+     * largest |coefficient|s the encoding's scales are (f16: the stream's;
+     * s8, s8s6: per coefficient index). */
     for (int i = 0; i < n; i++) {
-        vdsh_error verr;
         vdsh_file *p = NULL;
-        if (vdsh_read(paths[i], &p, &verr) != VDSH_OK) {
-            fprintf(stderr, "vdsh-merge: %s\n", verr.msg);
+        if (read_part(paths[i], i ? p0 : NULL, paths[0], &p) != 0)
             goto out;
-        }
         if (i == 0)
             p0 = p;
         else
             part = p;
-        if (!p->has_part) {
-            fprintf(stderr, "vdsh-merge: %s: not a part (no part chunk: a whole bake, not "
-                            "'vdsh-bake --shard I/N')\n", paths[i]);
-            goto out;
-        }
-        const char *why = i ? mismatch(p0, p) : NULL;
-        if (why) {
-            fprintf(stderr, "vdsh-merge: %s: does not belong with %s: %s\n", paths[i],
-                    paths[0], why);
-            goto out;
-        }
-        for (uint32_t s = 0; s < p->stream_count; s++)
-            if (p->streams[s].encoding != VDSH_ENCODING_F32) {
-                fprintf(stderr, "vdsh-merge: %s: stream %u is not f32 (parts hold f32)\n",
-                        paths[i], s);
-                goto out;
-            }
         if (i == 0) {
             /* The whole file: the first part's, with every shard's
              * coefficients and oriented normals. */
             count = p0->part.count;
             V = p0->header.vertex_count;
+            target = p0->part.encoding;
             f = *p0;
             f.has_part = 0;
             f.has_timings = 0;
@@ -189,14 +295,22 @@ int main(int argc, char **argv)
             f.stats.rays_traced = f.stats.rays_missed = 0;
             f.stats.degenerate_receivers = f.stats.moved_origins = f.stats.flipped_normals = 0;
             int missing = !(owner = malloc((size_t)count * sizeof *owner)) ||
-                          !(normals = malloc((size_t)V * 12 + 1));
+                          !(normals = malloc((size_t)V * 12 + 1)) ||
+                          !(spill_at = malloc((size_t)count * sizeof *spill_at));
             for (uint32_t s = 0; s < p0->stream_count && !missing; s++) {
                 streams[s] = p0->streams[s];
                 size_t nc = (size_t)streams[s].order * streams[s].order;
-                missing = !(merged[s] = malloc((size_t)V * nc * sizeof(float) + 1));
                 if (streams[s].flags & VDSH_STREAM_VARIABLE) /* rows of nc, zero-padded */
-                    missing |= !(orders[s] = malloc((size_t)V + 1)) ||
-                                !(offsets[s] = malloc(((size_t)V + 1) * sizeof(uint32_t)));
+                    missing = !(merged[s] = malloc((size_t)V * nc * sizeof(float) + 1)) ||
+                              !(orders[s] = malloc((size_t)V + 1)) ||
+                              !(offsets[s] = malloc(((size_t)V + 1) * sizeof(uint32_t)));
+                else if (target == VDSH_ENCODING_F32)
+                    missing = !(merged[s] = malloc((size_t)V * nc * sizeof(float) + 1));
+                else if (target == VDSH_ENCODING_F16)
+                    missing = !(encoded[s] = malloc((size_t)V * nc * sizeof(uint16_t) + 1));
+                else
+                    missing = !(encoded[s] = malloc(
+                                    (size_t)V * vdsh_encoding_bytes(target, (uint32_t)nc) + 1));
             }
             if (missing) {
                 fprintf(stderr, "vdsh-merge: out of memory for %u receivers\n", V);
@@ -204,6 +318,8 @@ int main(int argc, char **argv)
             }
             for (uint32_t k = 0; k < count; k++)
                 owner[k] = -1;
+            if (target != VDSH_ENCODING_F32 && !(spill = spill_create(output)))
+                goto out;
         }
         const vdsh_part *pt = &p->part;
         uint32_t b, e;
@@ -227,18 +343,39 @@ int main(int argc, char **argv)
         f.stats.moved_origins += p->stats.moved_origins;
         f.stats.flipped_normals += p->stats.flipped_normals;
         memcpy(normals + 3 * (size_t)b, p->normals + 3 * (size_t)b, (size_t)(e - b) * 12);
+        if (spill)
+            spill_at[pt->index] = ftello(spill);
         for (uint32_t s = 0; s < p->stream_count; s++) {
             size_t nc = (size_t)streams[s].order * streams[s].order;
+            const float *src = p->streams[s].data;
             if (orders[s]) { /* each row's own order, decoded with zeros past it */
                 memcpy(orders[s] + b, p->streams[s].orders, e - b);
                 for (uint32_t r = 0; r < e - b; r++)
                     vdsh_stream_decode(&p->streams[s], r, merged[s] + (b + r) * nc);
-            } else {
-                memcpy(merged[s] + b * nc, p->streams[s].data, (e - b) * nc * sizeof(float));
+                continue;
             }
+            if (spill && fwrite(src, nc * sizeof(float), e - b, spill) != e - b) {
+                fprintf(stderr, "vdsh-merge: cannot write the temporary file beside %s: %s\n",
+                        output, strerror(errno));
+                goto out;
+            }
+            if (target == VDSH_ENCODING_F32)
+                memcpy(merged[s] + b * nc, src, (e - b) * nc * sizeof(float));
+            else if (target == VDSH_ENCODING_F16)
+                for (size_t k = 0; k < (e - b) * nc; k++)
+                    amax[s][0] = fmaxf(amax[s][0], fabsf(src[k]));
+            else
+                for (size_t r = 0; r < e - b; r++)
+                    for (size_t k = 0; k < nc; k++)
+                        amax[s][k] = fmaxf(amax[s][k], fabsf(src[r * nc + k]));
         }
         vdsh_free(part);
         part = NULL;
+    }
+    if (spill && fflush(spill) != 0) {
+        fprintf(stderr, "vdsh-merge: cannot write the temporary file beside %s: %s\n", output,
+                strerror(errno));
+        goto out;
     }
     if ((uint32_t)n != count) {
         fprintf(stderr, "vdsh-merge: %u of %u shards missing:", count - (uint32_t)n, count);
@@ -252,18 +389,18 @@ int main(int argc, char **argv)
     f.normals = normals;
     for (uint32_t s = 0; s < f.stream_count; s++) {
         size_t nc = (size_t)streams[s].order * streams[s].order;
-        streams[s].data = merged[s];
+        streams[s].data = target == VDSH_ENCODING_F32 ? (void *)merged[s] : encoded[s];
+        streams[s].encoding = target;
         if (orders[s]) {
             /* As vb_bake_variable_stream: the same scale rule, one encoder. */
-            uint32_t e = p0->part.encoding;
-            float scale = 1.0f, amax = 0.0f;
+            uint32_t e = target;
+            float scale = 1.0f, vmax = 0.0f;
             if (e == VDSH_ENCODING_F16) {
                 for (size_t k = 0; k < (size_t)V * nc; k++)
-                    amax = fmaxf(amax, fabsf(merged[s][k]));
-                scale = vdsh_f16_scale(amax);
+                    vmax = fmaxf(vmax, fabsf(merged[s][k]));
+                scale = vdsh_f16_scale(vmax);
             }
             vdsh_stream_offsets(orders[s], V, e, offsets[s]);
-            streams[s].encoding = e;
             streams[s].scale = scale;
             streams[s].orders = orders[s];
             streams[s].offsets = offsets[s];
@@ -278,40 +415,29 @@ int main(int argc, char **argv)
             free(merged[s]);
             merged[s] = NULL;
             streams[s].data = encoded[s];
-        } else if (p0->part.encoding == VDSH_ENCODING_F16) {
+        } else if (target == VDSH_ENCODING_F16) {
             /* As vb_bake_stream: the same scale rule, vdsh_f16_scale. */
-            float amax = 0.0f;
-            for (size_t k = 0; k < (size_t)V * nc; k++)
-                amax = fmaxf(amax, fabsf(merged[s][k]));
-            streams[s].encoding = VDSH_ENCODING_F16;
-            streams[s].scale = vdsh_f16_scale(amax);
-            if (!(encoded[s] = malloc((size_t)V * nc * sizeof(uint16_t) + 1)) ||
-                vdsh_encode_f16(merged[s], (size_t)V * nc, streams[s].scale, encoded[s]) !=
-                    VDSH_OK) {
-                fprintf(stderr, "vdsh-merge: order %u coefficients do not fit f16\n",
-                        streams[s].order);
-                goto out;
-            }
-            free(merged[s]);
-            merged[s] = NULL;
-            streams[s].data = encoded[s];
-        } else if (vdsh_encoding_quantised(p0->part.encoding)) {
-            /* As vb_bake_stream: the one quantiser, vdsh_encode_quantised. */
-            uint32_t e = p0->part.encoding;
-            streams[s].encoding = e;
+            streams[s].scale = vdsh_f16_scale(amax[s][0]);
+        } else if (vdsh_encoding_quantised(target)) {
             streams[s].scale = 1.0f;
             streams[s].coef_scales = s8_scales[s];
-            if (!(encoded[s] = malloc((size_t)V * vdsh_encoding_bytes(e, (uint32_t)nc) + 1)) ||
-                vdsh_encode_quantised(e, merged[s], V, (uint32_t)nc, s8_scales[s], encoded[s]) !=
-                    VDSH_OK) {
-                fprintf(stderr, "vdsh-merge: order %u coefficients do not fit %s\n",
-                        streams[s].order, vdsh_encoding_name(e));
-                goto out;
-            }
-            free(merged[s]);
-            merged[s] = NULL;
-            streams[s].data = encoded[s];
         }
+    }
+    /* Pass 2 (f16, s8, s8s6): each range's rows back from the spill,
+     * encoded into the merged streams with the scales of all receivers, as
+     * vdsh-bake encodes the whole bake's. */
+    for (uint32_t k = 0; k < count && spill; k++) {
+        uint32_t b, e;
+        vb_shard_range(V, k, count, &b, &e);
+        if (fseeko(spill, spill_at[k], SEEK_SET) != 0) {
+            fprintf(stderr, "vdsh-merge: cannot read back the temporary file beside %s\n",
+                    output);
+            goto out;
+        }
+        for (uint32_t s = 0; s < f.stream_count; s++)
+            if (!orders[s] && encode_spilled(spill, output, &streams[s], encoded[s], b, e, amax[s],
+                               s8_scales[s]) != 0)
+                goto out;
     }
 
     /* The basis cubemaps (the whole bake writes them beside its file). */
@@ -345,6 +471,9 @@ out:
     vb_cubemap_basis_free(&basis);
     for (int s = 0; s < VDSH_MAX_STREAMS; s++)
         free(merged[s]), free(encoded[s]), free(orders[s]), free(offsets[s]);
+    if (spill)
+        fclose(spill);
+    free(spill_at);
     free(owner);
     free(normals);
     vdsh_free(part);
