@@ -170,7 +170,8 @@ static inline __attribute__((always_inline)) void eval_high_bands(
     for (size_t k0 = 0; k0 < n; k0 += CHUNK) {
         size_t cn = n - k0 < CHUNK ? n - k0 : CHUNK;
         const float *xs = x + k0, *ys = y + k0, *zs = z + k0;
-        float c[CHUNK], sn[CHUNK], pmm[CHUNK], p0[CHUNK], p1[CHUNK], pl[CHUNK];
+        float c[CHUNK], sn[CHUNK], pmm[CHUNK], pa[CHUNK], pb[CHUNK], pc[CHUNK];
+        float *p0 = pa, *p1 = pb, *pl = pc; /* rotated, not copied */
         for (size_t k = 0; k < cn; k++)
             c[k] = 1.0f, sn[k] = 0.0f, pmm[k] = 1.0f;
         for (int m = 0; m < order; m++) {
@@ -195,8 +196,10 @@ static inline __attribute__((always_inline)) void eval_high_bands(
                     for (size_t k = 0; k < cn; k++)
                         pl[k] = a * zs[k] * p1[k] - b * p0[k];
                 }
-                memcpy(p0, p1, cn * sizeof *p0);
-                memcpy(p1, pl, cn * sizeof *p1);
+                float *old = p0; /* P_{l-2} is done with: P_{l-1}, P_l move down */
+                p0 = p1;
+                p1 = pl;
+                pl = old;
                 if (l < KERNEL_ORDER)
                     continue; /* the closed forms above */
                 float K = k_high[l * (l + 1) + m];
@@ -206,19 +209,19 @@ static inline __attribute__((always_inline)) void eval_high_bands(
                     const float *ws = w + k0;
                     if (m == 0)
                         for (size_t k = 0; k < cn; k++)
-                            pos[k] += ws[k] * (K * pl[k]);
+                            pos[k] += ws[k] * (K * p1[k]);
                     else
                         for (size_t k = 0; k < cn; k++) {
-                            float kp = K * pl[k];
+                            float kp = K * p1[k];
                             pos[k] += ws[k] * (kp * c[k]);
                             neg[k] += ws[k] * (kp * sn[k]);
                         }
                 } else if (m == 0) {
                     for (size_t k = 0; k < cn; k++)
-                        pos[k] = K * pl[k];
+                        pos[k] = K * p1[k];
                 } else {
                     for (size_t k = 0; k < cn; k++) {
-                        float kp = K * pl[k];
+                        float kp = K * p1[k];
                         pos[k] = kp * c[k];
                         neg[k] = kp * sn[k];
                     }
