@@ -556,12 +556,19 @@ uint32_t vdsh_record_words(uint32_t encoding, uint32_t order)
     return (uint32_t)((vdsh_encoding_bytes(encoding, order * order) + 3) / 4);
 }
 
+/* words[k]: a record of order k (0 for order 0; orders above the maximum
+ * index words[0] in the callers, so a damaged table sizes nothing). */
+static void record_words_table(uint32_t encoding, uint32_t words[VDSH_ORDER_SLOTS])
+{
+    for (uint32_t k = 0; k <= VDSH_MAX_ORDER; k++)
+        words[k] = vdsh_record_words(encoding, k);
+}
+
 void vdsh_stream_offsets(const uint8_t *orders, uint32_t rows, uint32_t encoding,
                          uint32_t *offsets)
 {
     uint32_t words[VDSH_ORDER_SLOTS];
-    for (uint32_t k = 0; k <= VDSH_MAX_ORDER; k++)
-        words[k] = vdsh_record_words(encoding, k);
+    record_words_table(encoding, words);
     uint32_t at = 0;
     for (uint32_t v = 0; v < rows; v++) {
         offsets[v] = at;
@@ -574,8 +581,7 @@ void vdsh_stream_offsets(const uint8_t *orders, uint32_t rows, uint32_t encoding
 static uint64_t records_words(const uint8_t *orders, uint32_t rows, uint32_t encoding)
 {
     uint32_t words[VDSH_ORDER_SLOTS];
-    for (uint32_t k = 0; k <= VDSH_MAX_ORDER; k++)
-        words[k] = vdsh_record_words(encoding, k);
+    record_words_table(encoding, words);
     uint64_t at = 0;
     for (uint32_t v = 0; v < rows; v++)
         at += words[orders[v] <= VDSH_MAX_ORDER ? orders[v] : 0];
