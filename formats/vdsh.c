@@ -595,6 +595,25 @@ uint64_t vdsh_stream_data_bytes(const vdsh_stream *s, uint32_t rows)
     return ((uint64_t)rows + 15) / 16 * 16 + 4 * records_words(s->orders, rows, s->encoding);
 }
 
+vdsh_stream_size vdsh_stream_size_of(const vdsh_stream *s, uint32_t rows)
+{
+    vdsh_stream_size z = {{0}, 0.0, 0};
+    if (!stream_variable(s)) {
+        if (s->order <= VDSH_MAX_ORDER)
+            z.rows_per_order[s->order] = rows;
+        z.max_bytes = (uint32_t)vdsh_stream_bytes_per_vertex(s);
+        z.mean_bytes = z.max_bytes;
+        return z;
+    }
+    for (uint32_t v = 0; v < rows; v++)
+        z.rows_per_order[s->orders[v] <= VDSH_MAX_ORDER ? s->orders[v] : 0]++;
+    for (uint32_t k = 1; k <= VDSH_MAX_ORDER; k++) /* records grow with the order */
+        if (z.rows_per_order[k])
+            z.max_bytes = 4 * vdsh_record_words(s->encoding, k);
+    z.mean_bytes = rows ? (double)vdsh_stream_data_bytes(s, rows) / rows : 0.0;
+    return z;
+}
+
 /* n coefficients of one record at d (`encoding`, the scales of the stream). */
 static void decode_record(const vdsh_stream *s, const void *d, uint32_t n, float *out)
 {

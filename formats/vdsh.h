@@ -336,6 +336,16 @@ uint32_t vdsh_record_words(uint32_t encoding, uint32_t order);
 void vdsh_stream_offsets(const uint8_t *orders, uint32_t rows, uint32_t encoding,
                          uint32_t *offsets);
 
+/* What a stream's rows cost: rows per order ([k]: of order k; a fixed
+ * stream's all at its order), bytes per row on average (a variable-order
+ * stream's order table included) and the largest row's record. */
+typedef struct vdsh_stream_size {
+    uint32_t rows_per_order[VDSH_ORDER_SLOTS];
+    double mean_bytes;
+    uint32_t max_bytes;
+} vdsh_stream_size;
+vdsh_stream_size vdsh_stream_size_of(const vdsh_stream *s, uint32_t rows);
+
 /* Bytes of a stream's data for `rows` vertex rows, the scale table not
  * counted: rows * bytes per vertex, or for a variable-order stream its
  * order table (rows, padded to 16) and records (from s->orders). */

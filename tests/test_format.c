@@ -2267,6 +2267,17 @@ static void test_variable_streams(void)
               vdsh_stream_bytes_per_vertex(r) == 0 &&
               vdsh_stream_data_bytes(r, V) == 64 + 4 * (uint64_t)words, "%s read back",
               vdsh_encoding_name(enc));
+        if (r) { /* rows per order, the average as the data's size, the cap's record */
+            vdsh_stream_size z = vdsh_stream_size_of(r, V);
+            uint32_t per[VDSH_ORDER_SLOTS] = {0};
+            for (uint32_t v = 0; v < V; v++)
+                per[orders[v]]++;
+            VCHECK(memcmp(z.rows_per_order, per, sizeof per) == 0 &&
+                       z.mean_bytes == (64.0 + 4.0 * words) / V &&
+                       z.max_bytes == 4 * vdsh_record_words(enc, CAP),
+                   "%s: stream size %g / %u", vdsh_encoding_name(enc), z.mean_bytes,
+                   z.max_bytes);
+        }
         double worst = 0.0;
         for (uint32_t v = 0; r && v < V; v++) {
             CHECK(vdsh_stream_vertex_order(r, v) == orders[v] && r->offsets[v] == offsets[v]);

@@ -109,28 +109,6 @@ static coef0_stats stream_coef0(const vdsh_file *f, const vdsh_stream *s)
     return st;
 }
 
-/* A variable-order stream's receivers per order ([0] unused), and its
- * data's bytes per vertex on average (order table included) and at most. */
-typedef struct order_stats {
-    uint32_t count[VDSH_ORDER_SLOTS];
-    double mean_bytes;
-    uint32_t max_bytes;
-} order_stats;
-
-static order_stats stream_orders(const vdsh_file *f, const vdsh_stream *s)
-{
-    order_stats o = {{0}, 0.0, 0};
-    const uint32_t rows = vdsh_file_stream_vertices(f);
-    for (uint32_t v = 0; v < rows; v++) {
-        uint32_t k = vdsh_stream_vertex_order(s, v);
-        o.count[k]++;
-        uint32_t b = 4 * vdsh_record_words(s->encoding, k);
-        o.max_bytes = b > o.max_bytes ? b : o.max_bytes;
-    }
-    o.mean_bytes = rows ? (double)vdsh_stream_data_bytes(s, rows) / rows : 0.0;
-    return o;
-}
-
 static void receiver_bounds(const vdsh_file *f, float lo[3], float hi[3])
 {
     for (int k = 0; k < 3; k++) {
@@ -247,12 +225,12 @@ static void print_summary(const char *path, const vdsh_file *f,
             putchar('\n');
         }
         if (s->flags & VDSH_STREAM_VARIABLE) {
-            order_stats os = stream_orders(f, s);
+            vdsh_stream_size z = vdsh_stream_size_of(s, vdsh_file_stream_vertices(f));
             printf("        variable order: %.1f bytes per vertex on average, %u at most; "
-                   "vertices per order:", os.mean_bytes, os.max_bytes);
+                   "vertices per order:", z.mean_bytes, z.max_bytes);
             for (uint32_t k = 1; k <= s->order; k++)
-                if (os.count[k])
-                    printf(" %u: %u", k, os.count[k]);
+                if (z.rows_per_order[k])
+                    printf(" %u: %u", k, z.rows_per_order[k]);
             putchar('\n');
         } else {
             printf("        %zu bytes per vertex\n", vdsh_stream_bytes_per_vertex(s));
@@ -362,12 +340,12 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
         vt_json_u64(&j, o, "bytes_per_vertex", vdsh_stream_bytes_per_vertex(s));
         vt_json_bool(&j, o, "variable_order", (s->flags & VDSH_STREAM_VARIABLE) != 0);
         if (s->flags & VDSH_STREAM_VARIABLE) {
-            order_stats os = stream_orders(f, s);
-            vt_json_f64(&j, o, "mean_bytes_per_vertex", os.mean_bytes);
-            vt_json_u64(&j, o, "max_bytes_per_vertex", os.max_bytes);
+            vdsh_stream_size z = vdsh_stream_size_of(s, vdsh_file_stream_vertices(f));
+            vt_json_f64(&j, o, "mean_bytes_per_vertex", z.mean_bytes);
+            vt_json_u64(&j, o, "max_bytes_per_vertex", z.max_bytes);
             cJSON *per = vt_json_array(&j, o, "vertices_per_order"); /* [k - 1]: order k */
             for (uint32_t k = 1; k <= s->order; k++)
-                vt_json_u64(&j, per, NULL, os.count[k]);
+                vt_json_u64(&j, per, NULL, z.rows_per_order[k]);
         }
         cJSON *c0 = vt_json_object(&j, o, "coefficient0");
         vt_json_f32(&j, c0, "min", (float)st.min);

@@ -156,21 +156,16 @@ vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encodin
     /* One block: the scale table, the offsets (rows + 1), the orders (in
      * words), the records: the stream owns copies, so the bake's arrays
      * may be freed. */
-    uint32_t *offsets = malloc(((size_t)rows + 1) * sizeof *offsets);
-    if (!offsets)
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the variable-order stream");
-    vdsh_stream_offsets(b->variable_orders, rows, encoding, offsets);
-    size_t words = offsets[rows];
+    vdsh_stream sized = {.encoding = encoding, .flags = VDSH_STREAM_VARIABLE,
+                         .orders = b->variable_orders};
+    size_t words = (vdsh_stream_data_bytes(&sized, rows) - ((size_t)rows + 15) / 16 * 16) / 4;
     size_t table = VDSH_MAX_COEFFS, head = table + (size_t)rows + 1 + ((size_t)rows + 3) / 4;
     uint32_t *block = malloc((head + words) * sizeof *block + 1);
-    if (!block) {
-        free(offsets);
+    if (!block)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the variable-order stream");
-    }
     float *scales = (float *)block;
-    memcpy(block + table, offsets, ((size_t)rows + 1) * sizeof *offsets);
-    free(offsets);
-    offsets = block + table;
+    uint32_t *offsets = block + table;
+    vdsh_stream_offsets(b->variable_orders, rows, encoding, offsets);
     uint8_t *orders = (uint8_t *)(offsets + rows + 1);
     memcpy(orders, b->variable_orders, rows);
     float scale = 1.0f;

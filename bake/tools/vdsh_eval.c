@@ -327,25 +327,6 @@ typedef struct context {
     const float *offset;   /* per scored stream: the log offset added (--offsets) */
 } context;
 
-/* A stream's bytes per vertex: fixed, or a variable-order stream's
- * average (its order table included) and largest record. */
-static double stream_bytes(const vdsh_file *f, const vdsh_stream *st, uint32_t *max_bytes)
-{
-    uint32_t rows = vdsh_file_stream_vertices(f), most = 0;
-    if (!(st->flags & VDSH_STREAM_VARIABLE)) {
-        if (max_bytes)
-            *max_bytes = (uint32_t)vdsh_stream_bytes_per_vertex(st);
-        return (double)vdsh_stream_bytes_per_vertex(st);
-    }
-    for (uint32_t v = 0; v < rows; v++) {
-        uint32_t b = 4 * vdsh_record_words(st->encoding, vdsh_stream_vertex_order(st, v));
-        most = b > most ? b : most;
-    }
-    if (max_bytes)
-        *max_bytes = most;
-    return rows ? (double)vdsh_stream_data_bytes(st, rows) / rows : 0.0;
-}
-
 /* "5", or "a12" for a variable-order stream of cap 12. */
 static const char *order_label(const vdsh_stream *st, char *buf, size_t n)
 {
@@ -451,9 +432,9 @@ static int write_json(const char *out, const context *c, char *msg, size_t cap)
         vt_json_string(&j, o, "encoding", vdsh_encoding_name(st->encoding));
         vt_json_string(&j, o, "quantity", vdsh_quantity_name(st->quantity));
         vt_json_string(&j, o, "window", vdsh_window_name(st->window));
-        uint32_t most = 0;
-        vt_json_f64(&j, o, "bytes_per_vertex", stream_bytes(f, st, &most));
-        vt_json_u64(&j, o, "max_bytes_per_vertex", most);
+        vdsh_stream_size z = vdsh_stream_size_of(st, vdsh_file_stream_vertices(f));
+        vt_json_f64(&j, o, "bytes_per_vertex", z.mean_bytes);
+        vt_json_u64(&j, o, "max_bytes_per_vertex", z.max_bytes);
         vt_json_bool(&j, o, "variable_order", (st->flags & VDSH_STREAM_VARIABLE) != 0);
         vt_json_f32(&j, o, "log_offset", c->offset[s]);
         cJSON *sl = vt_json_object(&j, o, "scene_lights");
@@ -587,7 +568,7 @@ static void print_table(FILE *o, const context *c)
             fprintf(o, "  %-8s %5s %+6.2f %3.0f %3s %-9s | %7.2gM | %-15s %-13s %-12s | %6.4f "
                        "%5.2f%% %5.1f%%\n",
                     kind_name(k), order_label(st, ol, sizeof ol), (double)c->offset[s],
-                    stream_bytes(f, st, NULL),
+                    vdsh_stream_size_of(st, vdsh_file_stream_vertices(f)).mean_bytes,
                     vdsh_encoding_name(st->encoding), fit, (double)m->pairs * 1e-6, mae, fa, rc,
                     m->binary_mae, 100.0 * m->binary_false_shadow, 100.0 * m->binary_recall);
         }
@@ -619,7 +600,7 @@ static void print_table(FILE *o, const context *c)
             fprintf(o, "  %-8s %5s %+6.2f %3.0f %3s %-9s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s "
                        "%-13s | %6.4f %5.2f%% %5.2f%%\n",
                     kind_name(k), order_label(st, ol, sizeof ol), (double)c->offset[s],
-                    stream_bytes(f, st, NULL),
+                    vdsh_stream_size_of(st, vdsh_file_stream_vertices(f)).mean_bytes,
                     vdsh_encoding_name(st->encoding), fit, rms,
                     m->distance_p50, m->distance_p90, m->distance_p99, mae, fa, le,
                     m->binary_mae, 100.0 * m->binary_false_shadow,
