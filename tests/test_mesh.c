@@ -1277,20 +1277,6 @@ static room_rays check_room_rays(const vb_mesh *m, int rays, uint32_t points, ui
     return out;
 }
 
-static double triangle_area(const vb_mesh *m, uint32_t t)
-{
-    const float *p0 = m->positions + 3 * (size_t)m->indices[3 * t];
-    const float *p1 = m->positions + 3 * (size_t)m->indices[3 * t + 1];
-    const float *p2 = m->positions + 3 * (size_t)m->indices[3 * t + 2];
-    double u[3], v[3];
-    for (int k = 0; k < 3; k++) {
-        u[k] = (double)p1[k] - p0[k];
-        v[k] = (double)p2[k] - p0[k];
-    }
-    double c[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-    return 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-}
-
 /* What the bake itself says of the receivers at 0.2 m (its 64-ray check,
  * `vdsh-bake builtin:room:N --rays 64`): no normal it would flip, no ray
  * missing the room, and degenerate receivers (~0 distance all round) only
@@ -1358,7 +1344,7 @@ static void test_room_variants(void)
         }
         CHECK(negative_zeros == 0, "%s: %u coordinates are -0", name, negative_zeros);
         for (uint32_t t = 0; t < m.triangle_count; t++)
-            flat += !(triangle_area(&m, t) > 1e-6);
+            flat += !(test_triangle_area(&m, t) > 1e-6);
         CHECK(zero_normals == 0 && flat == 0, "%s: %u undefined normals, %u triangles without area", name,
               zero_normals, flat);
         /* the documented size: floor at y = 0, 8-25 m across, 2.5-8 m high */
@@ -1421,7 +1407,7 @@ static void test_room_variants(void)
         for (int k = 0; k < 3 && on_wall; k++)
             on_wall = p[k][0] == lo[0] || p[k][0] == hi[0] || p[k][2] == lo[2] || p[k][2] == hi[2];
         float y = (p[0][1] + p[1][1] + p[2][1]) / 3.0f;
-        double a = triangle_area(&m, t);
+        double a = test_triangle_area(&m, t);
         if (!on_wall && y > 0.2f && y < 1.0f && p[0][1] != p[1][1] && a > best) {
             best = a;
             object = t;

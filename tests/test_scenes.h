@@ -93,22 +93,27 @@ static inline void test_make_room(vb_mesh *m, float a, float h, float b)
     test_add_quad(m, wz1, nz);
 }
 
+/* The area of triangle t of m, in double. */
+static inline double test_triangle_area(const vb_mesh *m, uint32_t t)
+{
+    const float *p0 = m->positions + 3 * (size_t)m->indices[3 * t];
+    const float *p1 = m->positions + 3 * (size_t)m->indices[3 * t + 1];
+    const float *p2 = m->positions + 3 * (size_t)m->indices[3 * t + 2];
+    double u[3], v[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = (double)p1[k] - p0[k];
+        v[k] = (double)p2[k] - p0[k];
+    }
+    double c[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    return 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+}
+
 /* The total area of m's triangles. */
 static inline double test_mesh_area(const vb_mesh *m)
 {
     double a = 0.0;
-    for (uint32_t t = 0; t < m->triangle_count; t++) {
-        const float *p0 = m->positions + 3 * (size_t)m->indices[3 * t];
-        const float *p1 = m->positions + 3 * (size_t)m->indices[3 * t + 1];
-        const float *p2 = m->positions + 3 * (size_t)m->indices[3 * t + 2];
-        double u[3], v[3];
-        for (int k = 0; k < 3; k++) {
-            u[k] = (double)p1[k] - p0[k];
-            v[k] = (double)p2[k] - p0[k];
-        }
-        double c[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-        a += 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    }
+    for (uint32_t t = 0; t < m->triangle_count; t++)
+        a += test_triangle_area(m, t);
     return a;
 }
 
