@@ -227,7 +227,8 @@ const char *vdsh_method_name(uint32_t method)
 {
     static const char *const n[] = {[VDSH_METHOD_PAPER] = "paper", [VDSH_METHOD_FULL] = "full",
                                     [VDSH_METHOD_MIRROR] = "mirror", [VDSH_METHOD_LSQ] = "lsq",
-                                    [VDSH_METHOD_SHADOW] = "shadow"};
+                                    [VDSH_METHOD_SHADOW] = "shadow",
+                                    [VDSH_METHOD_DECISION] = "decision"};
     return NAME_OF(method, n);
 }
 

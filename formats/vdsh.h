@@ -135,7 +135,8 @@ typedef enum vdsh_method {
     VDSH_METHOD_FULL = 1,
     VDSH_METHOD_MIRROR = 2,
     VDSH_METHOD_LSQ = 3,
-    VDSH_METHOD_SHADOW = 4
+    VDSH_METHOD_SHADOW = 4,
+    VDSH_METHOD_DECISION = 5
 } vdsh_method;
 
 typedef enum vdsh_quantity {

@@ -13,6 +13,9 @@ add_test(NAME bake_hard_cases COMMAND test_hard)
 add_executable(test_fit test_fit.c)
 target_link_libraries(test_fit PRIVATE vb_core)
 add_test(NAME bake_fit COMMAND test_fit)
+add_executable(test_decision test_decision.c)
+target_link_libraries(test_decision PRIVATE vb_core)
+add_test(NAME bake_decision_fit COMMAND test_decision)
 
 # --quantity auto: deterministic, and it picks the better quantity per order.
 find_package(Python3 COMPONENTS Interpreter QUIET)

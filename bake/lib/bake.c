@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "decision.h"
 #include "fit.h"
 #include "method.h"
 #include "origins.h"
@@ -77,6 +78,18 @@ typedef struct job {
     uint8_t *var_orders;
     float *var_coeffs;
     float *var_scratch;    /* per worker: var_scratch_floats */
+    /* The decision fit (method.h: decision): the light pool in the traced
+     * frame, lights per receiver, the fit's settings, per-worker scratch
+     * (dec_scratch_bytes); the calibration's held-out margins (per sample,
+     * order and held-out light: lit pairs' margins, NAN otherwise). */
+    int decision;
+    float (*pool)[3];
+    uint32_t pool_count, dec_lights;
+    vb_decision_params dec;
+    unsigned char *dec_scratch;
+    float *cal_margins;
+    _Atomic uint32_t dec_fitted, dec_fallbacks;
+    _Atomic uint64_t dec_pairs;
     _Atomic uint64_t traced, missed;
     _Atomic uint32_t degenerate;
 } job;
@@ -88,6 +101,8 @@ typedef struct job {
 typedef struct vertex_sink {
     float *coeffs[2][VDSH_ORDER_SLOTS];
     float *var_scratch;    /* adaptive order: the worker's (VAR_SCRATCH floats) */
+    unsigned char *dec_scratch; /* decision fit: the worker's */
+    float *cal;            /* decision calibration: margins, VDSH_ORDER_SLOTS x CAL_LIGHTS */
     float *x, *y, *z, *t;
     uint32_t *n;
 } vertex_sink;
@@ -266,6 +281,142 @@ static void adapt_fit(const job *J, const float n[3], float acc[VDSH_MAX_COEFFS]
     vb_fit_frame(top, n, &angles);
     vb_fit_unrotate(top, &angles, b, u);
     vb_fit_finish(top, &angles, u, c);
+}
+
+/* ---- the decision fit's pairs ------------------------------------------- */
+
+/* Held-out lights per calibration receiver, and the least pairs a receiver
+ * needs for its own decision fit (fewer: it keeps its lsq fit). */
+#define CAL_LIGHTS 64
+#define DEC_MIN_PAIRS 16
+#define DEC_POOL 4096
+#define DEC_BOUNDARY -0.40546511f /* ln(2/3) */
+
+/* Bytes of a worker's decision scratch: the pairs (x, y, z, ln d, label),
+ * the basis at them (order^2 rows), the fit's doubles. */
+static size_t dec_scratch_bytes(const job *J)
+{
+    size_t k = VB_DECISION_MAX_PAIRS, n = (size_t)J->order * J->order;
+    return (4 * k + n * k) * sizeof(float) + k + 64 +
+           vb_decision_scratch_doubles(J->order) * sizeof(double);
+}
+
+/* Receiver v's first light in the pool: a hash of (seed, v), so that
+ * neighbours see other lights and no receiver depends on another. */
+static uint32_t dec_start(const job *J, uint32_t v)
+{
+    uint64_t z = J->d->seed * 0x9e3779b97f4a7c15ull + v + 0x632be59bd9b4e019ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return (uint32_t)(z % J->pool_count);
+}
+
+/* Pairs of receiver v (traced origin org, normal n): the pool's lights
+ * from *at on, above the horizon, up to `want`, each with a ray toward it
+ * (its label: shadowed when anything is in the way). x, y, z: the unit
+ * direction; logd: ln of the light's distance (scene units, the fits'
+ * floor); lab: 1 shadowed. *at moves past the lights read. */
+static uint32_t dec_pairs(const job *J, uint32_t *at, uint32_t *scanned, const float *org,
+                          const float n[3], uint32_t want, float *x, float *y, float *z,
+                          float *logd, uint8_t *lab, uint64_t *traced)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    uint32_t m = 0;
+    while (m < want && *scanned < J->pool_count) {
+        struct RTCRay16 r __attribute__((aligned(64)));
+        int ok[VB_PACKET] __attribute__((aligned(64)));
+        float dist[VB_PACKET];
+        uint32_t lanes = 0;
+        while (lanes < VB_PACKET && m + lanes < want && *scanned < J->pool_count) {
+            const float *L = J->pool[*at];
+            *at = *at + 1 == J->pool_count ? 0 : *at + 1;
+            ++*scanned;
+            float dx = L[0] - org[0], dy = L[1] - org[1], dz = L[2] - org[2];
+            float len = sqrtf(dx * dx + dy * dy + dz * dz);
+            if (!(len > 0.0f) || dx * n[0] + dy * n[1] + dz * n[2] <= 0.0f)
+                continue;
+            float inv = 1.0f / len;
+            r.org_x[lanes] = org[0], r.org_y[lanes] = org[1], r.org_z[lanes] = org[2];
+            r.dir_x[lanes] = dx * inv, r.dir_y[lanes] = dy * inv, r.dir_z[lanes] = dz * inv;
+            r.tnear[lanes] = 0.0f;
+            r.tfar[lanes] = len;
+            dist[lanes] = len * J->inv_scale;
+            lanes++;
+        }
+        for (uint32_t k = 0; k < VB_PACKET; k++) {
+            ok[k] = k < lanes ? -1 : 0;
+            if (k >= lanes)
+                r.org_x[k] = r.org_y[k] = r.org_z[k] = 0.0f, r.dir_x[k] = r.dir_y[k] = 0.0f,
+                r.dir_z[k] = 1.0f, r.tnear[k] = 0.0f, r.tfar[k] = 0.0f;
+            r.time[k] = 0.0f;
+            r.mask[k] = 0xffffffffu;
+            r.id[k] = k;
+            r.flags[k] = 0;
+        }
+        if (!lanes)
+            break;
+        rtcOccluded16(ok, J->d->scene->scene, &ctx, &r);
+        *traced += lanes;
+        for (uint32_t k = 0; k < lanes; k++, m++) {
+            x[m] = r.dir_x[k], y[m] = r.dir_y[k], z[m] = r.dir_z[k];
+            /* The margin is read at the drawn boundary: the ramp's s = 1/2
+             * at D = 2/3 d_L (vdsh_shadow.h). */
+            logd[m] = fast_log(dist[k] > J->log_floor ? dist[k] : J->log_floor) + DEC_BOUNDARY;
+            lab[m] = r.tfar[k] < 0.0f; /* Embree sets tfar to -inf on a hit */
+        }
+    }
+    return m;
+}
+
+/* The decision fit of receiver v (decision.h): its pairs, then each asked
+ * order's log fit in `out` refitted from its lsq start. With out->cal
+ * (the calibration's samples), the margins of each order's fit on
+ * CAL_LIGHTS further lights, held out from the fit: lit pairs' ln D - ln
+ * d_L, NAN for shadowed ones and missing lights. */
+static void decision_vertex(job *J, uint32_t v, const float *org, const float n[3],
+                            const vertex_sink *out, uint64_t *traced)
+{
+    const uint32_t K = VB_DECISION_MAX_PAIRS, top = J->order;
+    float *x = (float *)out->dec_scratch, *y = x + K, *z = y + K, *logd = z + K, *Y = logd + K;
+    uint8_t *lab = (uint8_t *)(Y + (size_t)top * top * K);
+    double *ds = (double *)(out->dec_scratch +
+                            (((size_t)(4 * K + (size_t)top * top * K) * sizeof(float) + K + 63) &
+                             ~(size_t)63));
+    uint32_t at = dec_start(J, v), scanned = 0;
+    uint32_t m = dec_pairs(J, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab, traced);
+    if (m >= DEC_MIN_PAIRS) {
+        vdsh_sh_eval_soa((int)top, m, x, y, z, Y, K);
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            if (out->coeffs[1][o])
+                vb_decision_fit(o, m, Y, K, logd, lab, &J->dec, out->coeffs[1][o], ds);
+        atomic_fetch_add(&J->dec_pairs, m);
+        atomic_fetch_add(&J->dec_fitted, 1);
+    } else {
+        atomic_fetch_add(&J->dec_fallbacks, 1);
+    }
+    if (!out->cal)
+        return;
+    for (size_t i = 0; i < (size_t)VDSH_ORDER_SLOTS * CAL_LIGHTS; i++)
+        out->cal[i] = NAN;
+    uint32_t h = dec_pairs(J, &at, &scanned, org, n, CAL_LIGHTS, x, y, z, logd, lab, traced);
+    if (!h)
+        return;
+    vdsh_sh_eval_soa((int)top, h, x, y, z, Y, K);
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
+        const float *c = out->coeffs[1][o];
+        if (!c)
+            continue;
+        for (uint32_t i = 0; i < h; i++) {
+            if (lab[i])
+                continue;
+            float s = 0.0f;
+            for (int j = 0; j < o * o; j++)
+                s += c[j] * Y[(size_t)j * K + i];
+            out->cal[o * CAL_LIGHTS + i] = s - logd[i];
+        }
+    }
 }
 
 /* An AVX2 clone where the CPU has it, for the lane loops (the log's
@@ -515,7 +666,10 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
                          var_buf + 3 * c, var_n, var_buf + 4 * (size_t)c);
         }
     }
-    /* Method shadow: the log offset, through c0 (Y00 is a constant). */
+    if (J->decision && want[1])
+        decision_vertex(J, v, org, n, out, traced);
+    /* Methods shadow and decision: the log offset, through c0 (Y00 is a
+     * constant). */
     for (int o = 1; o <= VDSH_MAX_ORDER; o++)
         if (out->coeffs[1][o] && J->log_offset[o] != 0.0f)
             out->coeffs[1][o][0] += J->log_offset[o] / 0.28209479177387814f;
@@ -542,6 +696,8 @@ static void bake_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
         vertex_sink out = {0};
         if (J->var_scratch)
             out.var_scratch = J->var_scratch + (size_t)worker * var_scratch_floats(J);
+        if (J->dec_scratch)
+            out.dec_scratch = J->dec_scratch + (size_t)worker * dec_scratch_bytes(J);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (J->coeffs[o])
                 out.coeffs[J->quantity[o] == VDSH_QUANTITY_LOG_DISTANCE][o] =
@@ -717,6 +873,40 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
     free(sums);
 }
 
+/* The decision fit's calibration: sampled receiver i baked (kept, when in
+ * the range: the main pass skips it), and its fits' margins on held-out
+ * lights into cal_margins. */
+static void calibrate_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
+{
+    job *J = ctx;
+    uint32_t nrec = J->d->receivers->vertex_count;
+    uint64_t traced = 0, missed = 0;
+    uint32_t degenerate = 0;
+    for (uint32_t i = begin; i < end; i++) {
+        uint32_t v = choose_receiver(i, nrec, J->choose_count);
+        float c[VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS];
+        vertex_sink out = {.dec_scratch = J->dec_scratch + (size_t)worker * dec_scratch_bytes(J),
+                           .cal = J->cal_margins + (size_t)i * VDSH_ORDER_SLOTS * CAL_LIGHTS};
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            if (J->coeffs[o])
+                out.coeffs[1][o] = c[o];
+        uint64_t t = 0, m = 0;
+        uint32_t g = 0;
+        bake_vertex(J, v, &out, &t, &m, &g);
+        if (v < J->lo || v >= J->hi)
+            continue;
+        traced += t, missed += m, degenerate += g; /* a shard counts its own */
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            if (J->coeffs[o])
+                memcpy(J->coeffs[o] + (size_t)(v - J->lo) * o * o, c[o],
+                       (size_t)o * o * sizeof(float));
+        J->done[v - J->lo] = 1;
+    }
+    atomic_fetch_add(&J->traced, traced);
+    atomic_fetch_add(&J->missed, missed);
+    atomic_fetch_add(&J->degenerate, degenerate);
+}
+
 static void bake_progress(void *user, uint32_t done, uint32_t total)
 {
     job *J = user;
@@ -841,6 +1031,26 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
      * horizon culls half of it), or the hemisphere above each receiver,
      * with half the directions (the same traced budget). */
     int hemisphere = mi->hemisphere;
+    /* Method decision: the log offsets calibrated on a sample of receivers
+     * (unless given), whose receivers every shard bakes too. */
+    const int calibrate = mi->decision && !d.log_offsets && !d.trace_only;
+    choose = choose && !d.trace_only;
+    if (d.decision_lights == 0)
+        d.decision_lights = VB_DEFAULT_DECISION_LIGHTS;
+    if (d.decision_lights > VB_DECISION_MAX_PAIRS)
+        return vb_fail(err, VB_ERR_ARGUMENT, "decision lights must be 1..%u, not %u",
+                       VB_DECISION_MAX_PAIRS, d.decision_lights);
+    if (d.false_rate == 0.0f)
+        d.false_rate = VB_DEFAULT_FALSE_RATE;
+    if (!(d.false_rate > 0.0f && d.false_rate < 0.5f))
+        return vb_fail(err, VB_ERR_ARGUMENT, "the false rate must be in (0, 0.5)");
+    vb_decision_params dec;
+    vb_decision_defaults(&dec);
+    if (d.decision)
+        dec = *d.decision;
+    if (!(dec.tau > 0.0f) || !(dec.lit_weight > 0.0f) || !(dec.ridge >= 0.0f) ||
+        !(dec.ridge0 > 0.0f) || dec.steps < 0 || dec.steps > 64)
+        return vb_fail(err, VB_ERR_ARGUMENT, "decision settings out of range");
     vb_dirgrid grid = {0};
     uint32_t domain_rays = hemisphere ? (d.rays + 1) / 2 : d.rays;
     vb_result r;
@@ -870,7 +1080,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
      * memory is its range's. */
     uint32_t *set = NULL, set_count = R->vertex_count, set_before = 0;
     if (lo > 0 || hi < R->vertex_count) {
-        uint32_t samples = choose && !d.trace_only ? choose_count(R->vertex_count) : 0;
+        uint32_t samples = (choose || calibrate) ? choose_count(R->vertex_count) : 0;
         if (!(set = malloc(((size_t)(hi - lo) + samples) * sizeof *set))) {
             vb_dirgrid_destroy(&grid);
             return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
@@ -975,6 +1185,30 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             goto done;
         }
     }
+    /* Method decision: the pool of lights in free space (traced frame),
+     * the workers' scratch; no free space: the lsq fits are kept. */
+    J->dec = dec;
+    J->dec_lights = d.decision_lights;
+    if (mi->decision && !d.trace_only) {
+        J->pool = malloc(DEC_POOL * sizeof *J->pool);
+        if (!J->pool) {
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+            goto done;
+        }
+        vb_error perr;
+        if (vb_scene_place_lights(d.scene, d.seed ^ 0xdec15105ull, DEC_POOL, J->pool, NULL,
+                                  &perr) == VB_OK) {
+            for (uint32_t k = 0; k < DEC_POOL; k++)
+                vb_scene_to_local(d.scene, J->pool[k], J->pool[k]);
+            J->pool_count = DEC_POOL;
+            J->decision = 1;
+            size_t bytes = dec_scratch_bytes(J) * d.threads;
+            if (!(J->dec_scratch = aligned_alloc(64, (bytes + 63) & ~(size_t)63))) {
+                r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+                goto done;
+            }
+        }
+    }
     /* The quantity choice's score: the expected shadow error e(r). */
     if ((choose || J->adaptive) && !(J->error_table = error_table_create())) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
@@ -1034,8 +1268,48 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             J->quantity[o] = d.order_quantity ? d.order_quantity[o]
                              : choose ? VDSH_QUANTITY_DISTANCE : stored;
     }
+    uint32_t cal_count = 0;
+    if (calibrate && J->decision) {
+        /* The decision fit's log offsets: per order, the one that leaves
+         * false_rate of the lit pairs of held-out lights in false shadow,
+         * over a sample of receivers, in sample order. */
+        cal_count = J->choose_count = choose_count(R->vertex_count);
+        J->done = calloc((size_t)(hi - lo), 1);
+        J->cal_margins = malloc((size_t)cal_count * VDSH_ORDER_SLOTS * CAL_LIGHTS * sizeof(float));
+        float *lit = malloc((size_t)cal_count * CAL_LIGHTS * sizeof(float) + 1);
+        if (!J->done || !J->cal_margins || !lit) {
+            free(lit);
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+            goto done;
+        }
+        if (vb_parallel_for(d.threads, cal_count, 4, calibrate_block, J, NULL, NULL) == 0) {
+            free(lit);
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
+            goto done;
+        }
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
+            if (!coeffs[o])
+                continue;
+            uint32_t k = 0;
+            for (uint32_t i = 0; i < cal_count; i++)
+                for (uint32_t j = 0; j < CAL_LIGHTS; j++) {
+                    float m = J->cal_margins[((size_t)i * VDSH_ORDER_SLOTS + o) * CAL_LIGHTS + j];
+                    if (!isnan(m))
+                        lit[k++] = m;
+                }
+            float off = vb_decision_offset(lit, k, d.false_rate);
+            J->log_offset[o] = off < -5.0f ? -5.0f : off > 5.0f ? 5.0f : off;
+        }
+        free(lit);
+    }
     unsigned started = vb_parallel_for(d.threads, R->vertex_count, BLOCK, bake_block, J,
                                        d.progress ? bake_progress : NULL, J);
+    /* The calibration's receivers were baked before their offset. */
+    for (uint32_t v = lo; cal_count && J->done && v < hi; v++)
+        if (J->done[v - lo])
+            for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+                if (coeffs[o])
+                    coeffs[o][(size_t)(v - lo) * o * o] += J->log_offset[o] / 0.28209479177387814f;
     if (started == 0) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
         goto done;
@@ -1055,6 +1329,15 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     memcpy(o.log_offset, J->log_offset, sizeof o.log_offset);
     any_log |= var_orders != NULL;
     o.log_floor = any_log ? d.log_floor : 0.0f;
+    if (mi->decision) {
+        o.decision_lights = J->decision ? d.decision_lights : 0;
+        o.decision_fitted = atomic_load(&J->dec_fitted);
+        o.decision_fallbacks = atomic_load(&J->dec_fallbacks);
+        o.decision_pairs = o.decision_fitted
+                               ? (double)atomic_load(&J->dec_pairs) / o.decision_fitted : 0.0;
+        o.calibration_receivers = cal_count;
+        o.false_rate = cal_count ? d.false_rate : 0.0f;
+    }
     o.window = d.window;
     o.vertex_count = R->vertex_count;
     o.range_begin = J->lo;
@@ -1098,6 +1381,9 @@ done:
         free(J->choose_coeffs);
         free(J->done);
         free(J->var_scratch);
+        free(J->pool);
+        free(J->dec_scratch);
+        free(J->cal_margins);
     }
     free(J);
     for (int k = 0; k <= VDSH_MAX_ORDER; k++)

@@ -71,6 +71,7 @@
 
 #include <stdint.h>
 
+#include "decision.h"
 #include "mesh.h"
 #include "method.h"
 #include "origins.h"
@@ -133,6 +134,15 @@ typedef struct vb_bake_desc {
      * is at most this tolerance, else the order of least error. 0: none. */
     float order_tolerance;
     int variable_cap;          /* 0: VB_DEFAULT_ORDER_CAP */
+    /* Method decision (method.h): the fit's settings (NULL: the
+     * defaults, vb_decision_defaults), training lights per receiver (0:
+     * VB_DEFAULT_DECISION_LIGHTS; at most VB_DECISION_MAX_PAIRS) and the
+     * share of lit pairs the calibrated log offset leaves in false shadow
+     * (0: VB_DEFAULT_FALSE_RATE). An explicit log_offsets skips the
+     * calibration. */
+    const vb_decision_params *decision;
+    uint32_t decision_lights;
+    float false_rate;
     int max_order;             /* 0: the highest order in order_mask, or
                                   VB_DEFAULT_ORDER */
     unsigned threads;          /* 0: every online core */
@@ -157,6 +167,8 @@ typedef struct vb_bake_desc {
 } vb_bake_desc;
 
 #define VB_DEFAULT_RAY_TOLERANCE 0.06f /* validation room: docs/ACCURACY.md */
+#define VB_DEFAULT_DECISION_LIGHTS 256
+#define VB_DEFAULT_FALSE_RATE 0.008f
 
 typedef struct vb_bake_output {
     int max_order;
@@ -168,6 +180,14 @@ typedef struct vb_bake_output {
     float lambda;              /* lsq or shadow regularisation used (0 otherwise) */
     float log_offset[VDSH_ORDER_SLOTS]; /* method shadow: per order, as used */
     float log_floor;           /* log-distance floor used (0 otherwise) */
+    /* Method decision: receivers fitted (the others, with fewer than 16
+     * lights above their horizon, keep the lsq fit), their mean training
+     * pairs, the calibration's target false rate and its receivers (0:
+     * the log offsets were given). decision_lights 0: no free space for
+     * lights, every receiver kept its lsq fit. */
+    uint32_t decision_fitted, decision_fallbacks, decision_lights, calibration_receivers;
+    double decision_pairs;
+    float false_rate;
     vdsh_window window;        /* applied */
     uint32_t vertex_count;     /* all receivers */
     /* The receivers baked: vb_bake_desc's range, or 0, vertex_count

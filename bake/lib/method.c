@@ -17,6 +17,8 @@ static const float shadow_offsets[] = {0.0f, 1.6f, 1.6f, 1.1f, 0.9f, 0.8f, 0.7f,
 _Static_assert(sizeof shadow_offsets / sizeof shadow_offsets[0] == VDSH_ORDER_SLOTS,
                "one log offset per order");
 
+static const float zero_offsets[VDSH_ORDER_SLOTS] = {0};
+
 static const vb_method_info methods[VB_METHOD_COUNT] = {
     [VB_METHOD_SHADOW] = {.method = VB_METHOD_SHADOW, .stored = VDSH_METHOD_SHADOW,
      .hemisphere = 1, .fit = VB_FIT_LSQ, .regularised = 1,
@@ -44,6 +46,16 @@ static const vb_method_info methods[VB_METHOD_COUNT] = {
                      "below the horizon has no meaning for ln(distance)"},
      .help = "the paper's fit, directions below the\n"
              "horizon count as distance 0"},
+    [VB_METHOD_DECISION] = {.method = VB_METHOD_DECISION, .stored = VDSH_METHOD_DECISION,
+     .hemisphere = 1, .fit = VB_FIT_LSQ, .regularised = 1,
+     .lambda_fixed = 1, .param = VB_PARAM_LOG_OFFSET, .quantities = Q_LOG,
+     .refused = {[VDSH_QUANTITY_DISTANCE] = "--method decision fits the log distance: use "
+                                            "--quantity log or auto"},
+     .default_log_offset = zero_offsets, .decision = 1,
+     .help = "the log distance fitted to the shadow\n"
+             "decision under lights in the scene's free\n"
+             "space (traced), its log offset calibrated\n"
+             "per scene and order at bake time"},
     [VB_METHOD_FULL] = {.method = VB_METHOD_FULL, .stored = VDSH_METHOD_FULL,
      .fit = VB_FIT_IDENTITY, .quantities = Q_DIST | Q_LOG,
      .help = "the whole sphere, no horizon"},

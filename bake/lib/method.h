@@ -36,6 +36,7 @@ typedef enum vb_method {
     VB_METHOD_MIRROR,
     VB_METHOD_PAPER,
     VB_METHOD_FULL,
+    VB_METHOD_DECISION,
     VB_METHOD_COUNT
 } vb_method;
 
@@ -93,6 +94,11 @@ typedef struct vb_method_info {
      * (VB_PARAM_LOG_OFFSET), chosen on the validation scenes; NULL
      * otherwise. */
     const float *default_log_offset;
+    /* The decision fit (decision.h): the lsq fit of ln d is the start of a
+     * per-receiver fit of the shadow decision over lights in the scene's
+     * free space, and the log offset is calibrated per scene and order at
+     * bake time (an explicit --log-offset overrides it). */
+    int decision;
     /* Help on the command line, after "NAME: ": lines of at most 48
      * columns, no indentation, no final newline. */
     const char *help;

@@ -54,6 +54,10 @@ typedef struct options {
     float lambda;
     float log_offset;
     int have_log_offset;
+    uint32_t decision_lights;  /* --decision-lights; 0: the default */
+    float false_rate;          /* --false-rate; 0: the default */
+    vb_decision_params decision; /* --decision-params */
+    int have_decision;
     float log_floor;
     vdsh_window window;
     vdsh_encoding encoding;
@@ -503,7 +507,7 @@ int main(int argc, char **argv)
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
            O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL, O_SHARD,
            O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS, O_PLAN, O_RECEIVERS, O_ADAPTIVE_ORDER,
-           O_MAX_ORDER };
+           O_MAX_ORDER, O_DEC_LIGHTS, O_FALSE_RATE, O_DEC_PARAMS };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
@@ -530,6 +534,9 @@ int main(int argc, char **argv)
         {"quantity", required_argument, 0, O_QUANTITY},
         {"lambda", required_argument, 0, O_LAMBDA},
         {"log-offset", required_argument, 0, O_LOG_OFFSET},
+        {"decision-lights", required_argument, 0, O_DEC_LIGHTS},
+        {"false-rate", required_argument, 0, O_FALSE_RATE},
+        {"decision-params", required_argument, 0, O_DEC_PARAMS},
         {"log-floor", required_argument, 0, O_LOG_FLOOR},
         {"keep-normals", no_argument, 0, O_KEEP_NORMALS},
         {"window", required_argument, 0, O_WINDOW},
@@ -677,6 +684,30 @@ int main(int argc, char **argv)
                 return bad_usage("--log-offset takes a number in -5..5, not '%s'", optarg);
             o.have_log_offset = 1;
             break;
+        case O_DEC_LIGHTS: {
+            uint64_t n;
+            if (!vt_parse_u64(optarg, 1, VB_DECISION_MAX_PAIRS, &n))
+                return bad_usage("--decision-lights takes 1..1024, not '%s'", optarg);
+            o.decision_lights = (uint32_t)n;
+            break;
+        }
+        case O_FALSE_RATE:
+            if (!vt_parse_float(optarg, &o.false_rate) || !(o.false_rate > 0.0f) ||
+                !(o.false_rate < 0.5f))
+                return bad_usage("--false-rate takes a number in (0, 0.5), not '%s'", optarg);
+            break;
+        case O_DEC_PARAMS: {
+            vb_decision_params *p = &o.decision;
+            vb_decision_defaults(p);
+            if (sscanf(optarg, "%f,%f,%f,%f,%d", &p->tau, &p->lit_weight, &p->ridge,
+                       &p->ridge0, &p->steps) != 5 || !(p->tau > 0.0f) ||
+                !(p->lit_weight > 0.0f) || !(p->ridge >= 0.0f) || !(p->ridge0 > 0.0f) ||
+                p->steps < 0 || p->steps > 64)
+                return bad_usage("--decision-params takes TAU,LIT_WEIGHT,RIDGE,RIDGE0,STEPS "
+                                 "(positive; ridge >= 0; steps 0..64), not '%s'", optarg);
+            o.have_decision = 1;
+            break;
+        }
         case O_KEEP_NORMALS: o.keep_normals = 1; break;
         case O_WINDOW:
             if (strcmp(optarg, "none") == 0) o.window = VDSH_WINDOW_NONE;
@@ -778,6 +809,8 @@ int main(int argc, char **argv)
                  .max_distance = o.max_distance,
                  .method = o.method, .quantity = o.quantity, .lambda = o.lambda,
                  .log_floor = o.log_floor, .log_offsets = o.have_log_offset ? offsets : NULL,
+                 .decision = o.have_decision ? &o.decision : NULL,
+                 .decision_lights = o.decision_lights, .false_rate = o.false_rate,
                  .window = o.window, .order_mask = order_mask, .threads = o.threads,
                  .order_tolerance = o.order_tolerance, .variable_cap = o.max_order,
                  .keep_normals = o.keep_normals, .trace_only = o.trace_only,

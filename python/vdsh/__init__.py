@@ -27,7 +27,7 @@ __all__ = ["VdshError", "VdshFile", "read", "coefficients", "sh_basis", "reconst
 __version__ = "0.1.0"
 
 MAGIC = b"VDSH\r\n\x1a\n"
-METHODS = ["paper", "full", "mirror", "lsq", "shadow"]
+METHODS = ["paper", "full", "mirror", "lsq", "shadow", "decision"]
 ENCODINGS = ["f32", "f16", "s8", "s8s6"]
 QUANTITIES = ["distance", "distance2", "log-distance"]
 MAX_ORDER = 16

@@ -1,0 +1,371 @@
+/* decision.c - the decision fit (decision.h). */
+#include "decision.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void vb_decision_defaults(vb_decision_params *p)
+{
+    p->tau = 0.5f;
+    p->lit_weight = 8.0f;
+    p->ridge = 1e-5f;
+    p->ridge0 = 1e-4f;
+    p->steps = 6;
+}
+
+/* ---- e^x and ln x, eight at a time --------------------------------------- */
+
+/* GCC's vector extension: each lane is computed as the scalar code would,
+ * mul and add apart (never fused), so SSE, AVX2 and scalar code give the
+ * same bits. */
+typedef float v8f __attribute__((vector_size(32)));
+typedef int32_t v8i __attribute__((vector_size(32)));
+
+#define VINLINE static inline __attribute__((always_inline))
+#pragma GCC diagnostic ignored "-Wpsabi" /* inlined: no vector crosses a call */
+
+VINLINE v8f v8(float x)
+{
+    return (v8f){x, x, x, x, x, x, x, x};
+}
+
+/* a where mask (-1), else b. */
+VINLINE v8f sel(v8i mask, v8f a, v8f b)
+{
+    return (v8f)((mask & (v8i)a) | (~mask & (v8i)b));
+}
+
+/* bake.c's fast_exp per lane: x clamped to [-80, 80]. */
+VINLINE v8f exp8(v8f x)
+{
+    x = sel(x < v8(-80.0f), v8(-80.0f), x);
+    x = sel(x > v8(80.0f), v8(80.0f), x);
+    v8f t = x * v8(1.44269504f);
+    v8i i = __builtin_convertvector(t + v8(128.5f), v8i) - 128; /* round: t + 128.5 > 0 */
+    v8f r = (t - __builtin_convertvector(i, v8f)) * v8(0.693147181f);
+    v8f p = v8(1.0f / 720);
+    p = p * r + v8(1.0f / 120);
+    p = p * r + v8(1.0f / 24);
+    p = p * r + v8(1.0f / 6);
+    p = p * r + v8(0.5f);
+    p = p * r + v8(1.0f);
+    p = p * r + v8(1.0f);
+    v8i b = (i + 127) << 23;
+    return p * (v8f)b;
+}
+
+/* bake.c's fast_log per lane: x finite and > 0. */
+VINLINE v8f log8(v8f x)
+{
+    v8i u = (v8i)x;
+    v8i e = ((u >> 23) & 0xff) - 127;
+    u = (u & 0x007fffff) | 0x3f800000;
+    v8f m = (v8f)u;
+    v8i big = m > v8(1.41421356f); /* -1 or 0 */
+    m = sel(big, m * v8(0.5f), m);
+    e -= big;
+    v8f s = (m - v8(1.0f)) / (m + v8(1.0f)), s2 = s * s;
+    v8f p = v8(2.0f / 9);
+    p = p * s2 + v8(2.0f / 7);
+    p = p * s2 + v8(2.0f / 5);
+    p = p * s2 + v8(2.0f / 3);
+    p = p * s2 + v8(2.0f);
+    return s * p + __builtin_convertvector(e, v8f) * v8(0.69314718f);
+}
+
+/* ---- the fit ---------------------------------------------------------------- */
+
+size_t vb_decision_scratch_doubles(int order)
+{
+    size_t n = (size_t)order * order;
+    /* H, its factor, g, step, c, c0, trial c, r; per pair: margin, q, h */
+    /* then floats: sqrt(h) per pair, Z = sqrt(h) Y (n rows) */
+    return 2 * n * n + 6 * n + 4 * (size_t)VB_DECISION_MAX_PAIRS +
+           ((size_t)VB_DECISION_MAX_PAIRS * (n + 1) + 1) / 2;
+}
+
+enum { LANES = 8 };
+
+/* t_i = sum_j c_j Y_ji - logd_i, in float, coefficient by coefficient. */
+static inline __attribute__((always_inline)) void margins(int n, uint32_t m, const float *Y, uint32_t stride, const float *logd,
+                    const double *c, float *t)
+{
+    for (uint32_t i = 0; i < m; i++)
+        t[i] = -logd[i];
+    for (int j = 0; j < n; j++) {
+        const float cj = (float)c[j];
+        const float *y = Y + (size_t)j * stride;
+        for (uint32_t i = 0; i < m; i++)
+            t[i] += cj * y[i];
+    }
+}
+
+/* Per pair, from its margin: z = s t / tau (s = +1 shadowed, -1 lit);
+ * the weighted softplus(z) into sp; pair_grad also the gradient's and
+ * the Hessian's weights (a sigma(z) s / tau, a sigma(z) (1 - sigma(z)) /
+ * tau^2, a the pair's weight over the weights' sum). One exp and one log
+ * per pair, branch-free: the loops vectorise. */
+/* m8: m rounded up to 8; the arrays hold m8 values (sgn and wt 0 past m,
+ * so those lanes add 0). */
+static inline __attribute__((always_inline)) void pair_loss(uint32_t m8, const float *t,
+                                                           const float *sgn, const float *wt,
+                                                           float inv_tau, float *sp)
+{
+    for (uint32_t i = 0; i < m8; i += 8) {
+        v8f tv, sv, wv;
+        memcpy(&tv, t + i, sizeof tv);
+        memcpy(&sv, sgn + i, sizeof sv);
+        memcpy(&wv, wt + i, sizeof wv);
+        v8f z = sv * tv * v8(inv_tau), az = sel(z < v8(0.0f), -z, z);
+        v8f e = exp8(-az);
+        v8f out = wv * (v8(0.5f) * (z + az) + log8(v8(1.0f) + e));
+        memcpy(sp + i, &out, sizeof out);
+    }
+}
+
+static inline __attribute__((always_inline)) void pair_grad(uint32_t m8, const float *t,
+                                                           const float *sgn, const float *wt,
+                                                           float inv_tau, float *sp, float *q,
+                                                           float *h)
+{
+    for (uint32_t i = 0; i < m8; i += 8) {
+        v8f tv, sv, wv;
+        memcpy(&tv, t + i, sizeof tv);
+        memcpy(&sv, sgn + i, sizeof sv);
+        memcpy(&wv, wt + i, sizeof wv);
+        v8f z = sv * tv * v8(inv_tau), az = sel(z < v8(0.0f), -z, z);
+        v8f e = exp8(-az), one = v8(1.0f) + e;
+        v8f out = wv * (v8(0.5f) * (z + az) + log8(one));
+        /* sigma(z): 1 / (1 + e) for z >= 0, e / (1 + e) below */
+        v8f s = sel(z >= v8(0.0f), v8(1.0f), e) / one;
+        v8f qv = wv * sv * s * v8(inv_tau);
+        v8f hv = wv * s * (v8(1.0f) - s) * v8(inv_tau * inv_tau);
+        memcpy(sp + i, &out, sizeof out);
+        memcpy(q + i, &qv, sizeof qv);
+        memcpy(h + i, &hv, sizeof hv);
+    }
+}
+
+/* The sum of m floats in LANES lane-wise double sums, in lane order. */
+static inline __attribute__((always_inline)) double sum_lanes(uint32_t m, const float *x)
+{
+    double lane[LANES] = {0};
+    uint32_t i = 0;
+    for (; i + LANES <= m; i += LANES)
+        for (int k = 0; k < LANES; k++)
+            lane[k] += x[i + k];
+    for (; i < m; i++)
+        lane[i % LANES] += x[i];
+    double s = 0.0;
+    for (int k = 0; k < LANES; k++)
+        s += lane[k];
+    return s;
+}
+
+static double ridge_term(int n, const double *c, const double *c0, const double *r)
+{
+    double s = 0.0;
+    for (int j = 0; j < n; j++)
+        s += r[j] * (c[j] - c0[j]) * (c[j] - c0[j]);
+    return s;
+}
+
+/* sum_i w_i a_i in LANES lane-wise sums, added in lane order: the same
+ * bits with or without vectors. */
+static inline __attribute__((always_inline)) double dot2(uint32_t m, const float *w, const float *a)
+{
+    double lane[LANES] = {0};
+    uint32_t i = 0;
+    for (; i + LANES <= m; i += LANES)
+        for (int k = 0; k < LANES; k++)
+            lane[k] += w[i + k] * a[i + k];
+    for (; i < m; i++)
+        lane[i % LANES] += w[i] * a[i];
+    double s = 0.0;
+    for (int k = 0; k < LANES; k++)
+        s += lane[k];
+    return s;
+}
+
+/* H = Z Z^T (lower triangle, then mirrored; n x n, double) from the
+ * n rows of Z (float, `stride` apart, zero from m to m8 = m rounded up
+ * to 8). Tiles of 4 x 4 rows, each entry eight lane-wise float sums added
+ * in lane order: vector code (GCC's vector extension, mul and add apart,
+ * never fused) gives the same bits as scalar code on every CPU. */
+static inline __attribute__((always_inline)) void syrk(int n, uint32_t m8, const float *Z,
+                                                      uint32_t stride, double *H)
+{
+    enum { TJ = 2, TK = 4 };
+    static const float zeros[VB_DECISION_MAX_PAIRS] = {0};
+    for (int j0 = 0; j0 < n; j0 += TJ)
+        for (int k0 = 0; k0 <= j0 + TJ - 1 && k0 < n; k0 += TK) {
+            v8f acc[TJ][TK] = {{{0}}};
+            const float *zj[TJ], *zk[TK];
+            for (int a = 0; a < TJ; a++)
+                zj[a] = j0 + a < n ? Z + (size_t)(j0 + a) * stride : zeros;
+            for (int b = 0; b < TK; b++)
+                zk[b] = k0 + b < n ? Z + (size_t)(k0 + b) * stride : zeros;
+            for (uint32_t i = 0; i < m8; i += 8) {
+                v8f x[TJ], y[TK];
+                for (int a = 0; a < TJ; a++)
+                    memcpy(&x[a], zj[a] + i, sizeof x[a]);
+                for (int b = 0; b < TK; b++)
+                    memcpy(&y[b], zk[b] + i, sizeof y[b]);
+                for (int a = 0; a < TJ; a++)
+                    for (int b = 0; b < TK; b++)
+                        acc[a][b] += x[a] * y[b];
+            }
+            for (int a = 0; a < TJ && j0 + a < n; a++)
+                for (int b = 0; b < TK && k0 + b <= j0 + a && k0 + b < n; b++) {
+                    double s = 0.0;
+                    for (int l = 0; l < 8; l++)
+                        s += acc[a][b][l];
+                    H[(j0 + a) * n + k0 + b] = H[(k0 + b) * n + j0 + a] = s;
+                }
+        }
+}
+
+/* Cholesky of the n x n symmetric positive definite A into L (lower);
+ * then solve L L^T x = b. Returns 0 if A is not positive definite. */
+static int cholesky_solve(int n, const double *A, double *L, const double *b, double *x)
+{
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j <= i; j++) {
+            double s = A[i * n + j];
+            for (int k = 0; k < j; k++)
+                s -= L[i * n + k] * L[j * n + k];
+            if (i == j) {
+                if (!(s > 0.0))
+                    return 0;
+                /* sqrt is IEEE-exact on every CPU */
+                L[i * n + i] = __builtin_sqrt(s);
+            } else {
+                L[i * n + j] = s / L[j * n + j];
+            }
+        }
+    for (int i = 0; i < n; i++) {
+        double s = b[i];
+        for (int k = 0; k < i; k++)
+            s -= L[i * n + k] * x[k];
+        x[i] = s / L[i * n + i];
+    }
+    for (int i = n - 1; i >= 0; i--) {
+        double s = x[i];
+        for (int k = i + 1; k < n; k++)
+            s -= L[k * n + i] * x[k];
+        x[i] = s / L[i * n + i];
+    }
+    return 1;
+}
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default"))) /* no FMA: the same bits */
+#endif
+int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
+                    const float *logd, const uint8_t *shadowed,
+                    const vb_decision_params *p, float *cf, double *scratch)
+{
+    const int n = order * order;
+    if (m == 0 || n == 0)
+        return 0;
+    if (m > VB_DECISION_MAX_PAIRS)
+        m = VB_DECISION_MAX_PAIRS;
+    enum { K = VB_DECISION_MAX_PAIRS };
+    double *H = scratch, *L = H + (size_t)n * n, *g = L + (size_t)n * n, *dx = g + n,
+           *c = dx + n, *c0 = c + n, *ct = c0 + n, *r = ct + n;
+    float *t = (float *)(r + n), *tt = t + K, *q = tt + K, *h = q + K, *sp = h + K,
+          *sgn = sp + K, *wt = sgn + K, *sh = wt + K, *Z = sh + K;
+    const uint32_t m8 = (m + 7) & ~7u;
+    const float inv_tau = 1.0f / p->tau;
+    double a = 0.0;
+    for (uint32_t i = 0; i < m; i++)
+        a += shadowed[i] ? 1.0 : p->lit_weight;
+    for (uint32_t i = 0; i < m8; i++) {
+        sgn[i] = i >= m ? 0.0f : shadowed[i] ? 1.0f : -1.0f;
+        wt[i] = i >= m ? 0.0f : (float)((shadowed[i] ? 1.0 : p->lit_weight) / a);
+        t[i] = tt[i] = 0.0f;
+    }
+    for (int j = 0; j < n; j++) {
+        int l = 0;
+        while ((l + 1) * (l + 1) <= j)
+            l++;
+        double ll = (double)l * (l + 1);
+        r[j] = (double)p->ridge * ll * ll + (double)p->ridge0;
+        c[j] = c0[j] = cf[j];
+    }
+    margins(n, m, Y, stride, logd, c, t);
+    pair_grad(m8, t, sgn, wt, inv_tau, sp, q, h);
+    double f = sum_lanes(m, sp);
+    int steps = 0;
+    for (int it = 0; it < p->steps; it++) {
+        /* Newton: H = Y diag(h) Y^T + 2 R, g = Y q + 2 R (c - c0). */
+        for (uint32_t i = 0; i < m; i++)
+            sh[i] = __builtin_sqrtf(h[i]);
+        for (int j = 0; j < n; j++) {
+            const float *yj = Y + (size_t)j * stride;
+            float *zj = Z + (size_t)j * m8;
+            g[j] = dot2(m, q, yj) + 2.0 * r[j] * (c[j] - c0[j]);
+            for (uint32_t i = 0; i < m; i++)
+                zj[i] = sh[i] * yj[i];
+            for (uint32_t i = m; i < m8; i++)
+                zj[i] = 0.0f;
+        }
+        syrk(n, m8, Z, m8, H);
+        for (int j = 0; j < n; j++)
+            H[j * n + j] += 2.0 * r[j];
+        if (!cholesky_solve(n, H, L, g, dx))
+            break;
+        /* Step halving until the loss falls. */
+        double step = 1.0, fn = f;
+        int ok = 0;
+        for (int half = 0; half < 8 && !ok; half++, step *= 0.5) {
+            for (int j = 0; j < n; j++)
+                ct[j] = c[j] - step * dx[j];
+            margins(n, m, Y, stride, logd, ct, tt);
+            pair_loss(m8, tt, sgn, wt, inv_tau, sp);
+            fn = sum_lanes(m, sp) + ridge_term(n, ct, c0, r);
+            ok = fn < f;
+        }
+        if (!ok)
+            break;
+        double biggest = 0.0;
+        for (int j = 0; j < n; j++) {
+            double d = ct[j] - c[j];
+            biggest = d > biggest ? d : -d > biggest ? -d : biggest;
+            c[j] = ct[j];
+        }
+        steps++;
+        double drop = f - fn;
+        f = fn;
+        if (biggest < 1e-3 || drop < 1e-6 * f || it + 1 == p->steps)
+            break;
+        float *swap = t;
+        t = tt;
+        tt = swap;
+        pair_grad(m8, t, sgn, wt, inv_tau, sp, q, h);
+    }
+    for (int j = 0; j < n; j++)
+        cf[j] = (float)c[j];
+    return steps;
+}
+
+/* ---- the offset's calibration --------------------------------------------- */
+
+static int cmp_float(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+float vb_decision_offset(float *margins_, uint32_t count, double rate)
+{
+    if (count == 0)
+        return 0.0f;
+    qsort(margins_, count, sizeof *margins_, cmp_float);
+    double pos = rate * count;
+    uint32_t k = (uint32_t)pos;
+    if (k >= count)
+        k = count - 1;
+    return -margins_[k];
+}

@@ -1,0 +1,120 @@
+/* The decision fit (decision.h) on a synthetic receiver: it lowers its
+ * loss, classifies held-out lights better than its least-squares start,
+ * gives the same bits on every call, and handles the degenerate cases;
+ * and the calibration's quantile. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "decision.h"
+#include "test_util.h"
+#include "vdsh_sh.h"
+
+enum { ORDER = 5, N = ORDER * ORDER, M = 256 };
+
+/* The true distance: a slab of ceiling at 1 above the receiver for
+ * directions within ~45 degrees of +z, open (10) elsewhere. */
+static float truth(const float d[3])
+{
+    return d[2] > 0.7f ? 1.0f : 10.0f;
+}
+
+/* m pairs: directions on the upper hemisphere, light distances uniform
+ * in ln between 0.3 and 30, labels from the truth; Y at stride M. */
+static void pairs(uint64_t *s, uint32_t m, float *Y, float *logd, uint8_t *lab)
+{
+    float x[M], y[M], z[M];
+    for (uint32_t i = 0; i < m; i++) {
+        float d[3];
+        do
+            test_rand_dir(s, d);
+        while (d[2] <= 0.0f);
+        x[i] = d[0], y[i] = d[1], z[i] = d[2];
+        float dl = 0.3f * expf((float)test_rand(s) * logf(100.0f));
+        logd[i] = logf(dl);
+        lab[i] = truth(d) < dl;
+    }
+    vdsh_sh_eval_soa(ORDER, m, x, y, z, Y, M);
+}
+
+/* Weighted misclassification at margin 0 (lit pairs weight 8). */
+static double errors(const float *c, uint32_t m, const float *Y, const float *logd,
+                     const uint8_t *lab)
+{
+    double e = 0.0;
+    for (uint32_t i = 0; i < m; i++) {
+        double s = 0.0;
+        for (int j = 0; j < N; j++)
+            s += c[j] * Y[(size_t)j * M + i];
+        int shadow = s < logd[i];
+        e += shadow != lab[i] ? (lab[i] ? 1.0 : 8.0) : 0.0;
+    }
+    return e;
+}
+
+static void test_fit_beats_start(void)
+{
+    uint64_t s = 12345;
+    static float Y[N * M], Yh[N * M];
+    float logd[M], logdh[M];
+    uint8_t lab[M], labh[M];
+    pairs(&s, M, Y, logd, lab);
+    pairs(&s, M, Yh, logdh, labh);
+    /* The start: the constant fit of the mean ln distance, as a smooth
+     * least-squares fit would give far from the slab's edge. */
+    float c[N] = {0}, start[N];
+    c[0] = (logf(1.0f) * 0.29f + logf(10.0f) * 0.71f) / 0.28209479f;
+    memcpy(start, c, sizeof c);
+    vb_decision_params p;
+    vb_decision_defaults(&p);
+    double *scratch = malloc(vb_decision_scratch_doubles(ORDER) * sizeof *scratch);
+    int steps = vb_decision_fit(ORDER, M, Y, M, logd, lab, &p, c, scratch);
+    CHECK(steps >= 1, "took %d Newton steps", steps);
+    double e0 = errors(start, M, Yh, logdh, labh), e1 = errors(c, M, Yh, logdh, labh);
+    CHECK(e1 < 0.6 * e0, "held-out weighted errors %g, the start's %g", e1, e0);
+    for (int j = 0; j < N; j++)
+        CHECK(isfinite(c[j]), "coefficient %d finite", j);
+
+    /* The same bits on a second call. */
+    float again[N];
+    memcpy(again, start, sizeof again);
+    vb_decision_fit(ORDER, M, Y, M, logd, lab, &p, again, scratch);
+    CHECK(memcmp(again, c, sizeof c) == 0, "a second fit gives the same bits");
+
+    /* No pairs: the start stays. */
+    memcpy(again, start, sizeof again);
+    CHECK(vb_decision_fit(ORDER, 0, Y, M, logd, lab, &p, again, scratch) == 0, "no pairs");
+    CHECK(memcmp(again, start, sizeof start) == 0, "no pairs: the start kept");
+
+    /* Every pair lit: the fit stays finite, near the start (the ridge and
+     * the saturating loss), and no lit pair ends shadowed. */
+    uint8_t lit[M] = {0};
+    memcpy(again, start, sizeof again);
+    vb_decision_fit(ORDER, M, Y, M, logd, lit, &p, again, scratch);
+    double e = errors(again, M, Y, logd, lit);
+    for (int j = 0; j < N; j++)
+        CHECK(isfinite(again[j]) && fabsf(again[j]) < 100.0f, "all lit: coefficient %d %g", j,
+              again[j]);
+    CHECK(e <= errors(start, M, Y, logd, lit), "all lit: no more false shadows (%g)", e);
+    free(scratch);
+}
+
+static void test_offset(void)
+{
+    float m[1000];
+    for (int i = 0; i < 1000; i++)
+        m[i] = (float)((i * 7919) % 1000) / 100.0f; /* 0 .. 9.99, shuffled */
+    /* 1% of 1000 below -offset: the 10th smallest, 0.10 */
+    CHECK(fabsf(vb_decision_offset(m, 1000, 0.01) + 0.10f) < 1e-6f, "offset %g",
+          vb_decision_offset(m, 1000, 0.01));
+    CHECK(vb_decision_offset(m, 0, 0.01) == 0.0f, "no margins: 0");
+}
+
+int main(void)
+{
+    test_fit_beats_start();
+    test_offset();
+    if (test_failures)
+        fprintf(stderr, "%d checks failed\n", test_failures);
+    return test_failures != 0;
+}
