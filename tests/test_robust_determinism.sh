@@ -61,4 +61,5 @@ same bunny-res2   bunny_stanford/bun_zipper_res2.ply --rays 32
 same bunny-res3   bunny_stanford/bun_zipper_res3.ply --max-edge 0.004 --rays 64 --orders 2,3,5 --encoding f32
 same sphere-hole  sphere_with_hole/sphereWithHole.stl --weld --max-edge 0.3 --rays 256 --method full
 same sponza       sponza_dabrovic/sponza.obj --rays 16
+same cornell-decision cornell_box/CornellBox-Original.obj --max-edge 0.1 --rays 256 --method decision
 exit $fail

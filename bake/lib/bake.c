@@ -57,6 +57,10 @@ typedef struct job {
     int horizon;           /* paper: skip w.n < 0 */
     /* Method shadow: per order, added to the fitted ln d (through c0). */
     float log_offset[VDSH_ORDER_SLOTS];
+    /* Adaptive order: the log offset of each candidate order's lsq fit
+     * (the method's; with method decision, shadow's: its variable-order
+     * stream is method shadow's). */
+    float var_offset[VDSH_ORDER_SLOTS];
     double *error_table;   /* e(r), the quantity choice's score (VB_ERROR_TABLE + 1) */
     /* The quantity choice (VB_QUANTITY_AUTO): sampled receivers, and per
      * sample, order and quantity (0 distance, 1 log) its estimated error. */
@@ -202,7 +206,7 @@ static void choose_order(const job *J, uint32_t v, const vb_fit_angles *a, const
         if (!vb_order_candidate(k, cap))
             continue;
         vb_fit_finish(&J->fits[k], a, u, c[k]);
-        c[k][0] += J->log_offset[k] / 0.28209479177387814f;
+        c[k][0] += J->var_offset[k] / 0.28209479177387814f;
         for (uint32_t i = 0; i < m; i++)
             s[i] = 0.0f;
         for (int j = 0; j < k * k; j++)
@@ -1209,6 +1213,10 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             }
         }
     }
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+        J->var_offset[o] = mi->decision && !d.log_offsets
+                               ? vb_method_get(VB_METHOD_SHADOW)->default_log_offset[o]
+                               : J->log_offset[o];
     /* The quantity choice's score: the expected shadow error e(r). */
     if ((choose || J->adaptive) && !(J->error_table = error_table_create())) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
@@ -1348,6 +1356,9 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     o.variable_coeffs = var_coeffs;
     o.variable_cap = var_orders ? var_cap : 0;
     o.order_tolerance = var_orders ? d.order_tolerance : 0.0f;
+    o.variable_method = mi->decision ? VDSH_METHOD_SHADOW : mi->stored;
+    o.variable_param = var_orders && mi->param == VB_PARAM_LOG_OFFSET ? J->var_offset[var_cap]
+                                                                      : o.lambda;
     var_orders = NULL;
     var_coeffs = NULL;
     o.rays = grid.count;

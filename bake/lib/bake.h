@@ -205,6 +205,11 @@ typedef struct vb_bake_output {
     float *variable_coeffs;
     int variable_cap;
     float order_tolerance;
+    /* The variable-order stream's method and parameter as stored (method
+     * decision: shadow's lsq fits and log offsets, the candidates' fits
+     * not refitted; docs/ACCURACY.md). */
+    vdsh_method variable_method;
+    float variable_param;
     uint32_t rays;             /* directions per receiver actually used (the
                                 * cap with adaptive rays) */
     float ray_tolerance;       /* adaptive rays: the tolerance used, else 0 */

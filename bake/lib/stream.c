@@ -150,7 +150,6 @@ vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encodin
         return vb_fail(err, VB_ERR_ARGUMENT, "the bake has no adaptive order");
     if (encoding > VDSH_ENCODING_LAST)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown encoding %u", encoding);
-    const vb_method_info *mi = vb_method_stored(b->method);
     const uint32_t rows = b->range_end ? b->range_end - b->range_begin : b->vertex_count;
     const size_t nc = (size_t)cap * cap;
     /* One block: the scale table, the offsets (rows + 1), the orders (in
@@ -181,10 +180,10 @@ vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encodin
         return vb_fail(err, VB_ERR_INVALID, "adaptive-order coefficients do not fit %s",
                        vdsh_encoding_name(encoding));
     }
-    int cap_param = mi && mi->param == VB_PARAM_LOG_OFFSET;
-    *out = (vdsh_stream){.order = (uint32_t)cap, .encoding = encoding, .method = b->method,
+    *out = (vdsh_stream){.order = (uint32_t)cap, .encoding = encoding,
+                         .method = b->variable_method,
                          .quantity = VDSH_QUANTITY_LOG_DISTANCE,
-                         .method_param = cap_param ? b->log_offset[cap] : b->lambda,
+                         .method_param = b->variable_param,
                          .scale = scale, .quantity_param = b->log_floor, .window = b->window,
                          .window_param = b->window ? (float)cap : 0.0f,
                          .coef_scales = vdsh_encoding_quantised(encoding) ? scales : NULL,
