@@ -79,7 +79,7 @@ try:
 except (ValueError, KeyError, OSError) as e:
     check(False, "bake --report does not parse: %s" % e)
 
-for args in (["--json"], ["--json", "--verify"]):
+for args in (["--json", "-"], ["--json", "-", "--verify"]):
     rc, out, err = run(info, *args, odd)
     try:
         d = strict_json(out)
@@ -87,7 +87,7 @@ for args in (["--json"], ["--json", "--verify"]):
     except (ValueError, KeyError) as e:
         check(False, "vdsh-info %s does not parse: %s" % (args, e))
 # a file that does not read: the error document parses too
-rc, out, err = run(info, "--json", os.path.join(W, b'no"such\\\x03.vdsh'))
+rc, out, err = run(info, "--json", "-", os.path.join(W, b'no"such\\\x03.vdsh'))
 try:
     d = strict_json(out)
     check(rc == 1 and not d["valid"] and "no\"such\\" in d["error"], "vdsh-info error JSON")
@@ -112,7 +112,7 @@ except (ValueError, KeyError, OSError) as ex:
 seeded = os.path.join(W, b"seeded.vdsh")
 rc, _, err = run(bake, *quick, "--seed", "010", "-o", seeded, "--report", seeded + b".json")
 check(rc == 0, "bake --seed 010: %s" % err)
-rc, out, _ = run(info, "--json", seeded)
+rc, out, _ = run(info, "--json", "-", seeded)
 check(rc == 0 and strict_json(out)["bake"]["seed"] == 10, "bake --seed 010 stored as 10")
 check(strict_json(open(seeded + b".json", "rb").read())["seed"] == 10, "bake report: seed 10")
 rc, _, err = run(ev, seeded, "-q", "--seed", "010", "--interior", "0", "--points", "100",
