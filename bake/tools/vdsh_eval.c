@@ -101,7 +101,7 @@ static void usage(FILE *f)
 "\n"
 "Output:\n"
 "      --json FILE         everything as JSON (bake parameters and timings too;\n"
-"                          -: on stdout)\n"
+"                          -: on stdout, instead of the table)\n"
 "      --per-vertex FILE   per-vertex errors for a heat map (layout below)\n"
 "      --bake-report FILE  take the bake time from vdsh-bake --report JSON\n"
 "                          (default: the file's time chunk, if recorded)\n"
@@ -974,7 +974,8 @@ int main(int argc, char **argv)
     struct stat st;
     if (stat(path, &st) == 0)
         ctx.file_bytes = (long long)st.st_size;
-    print_table(stdout, &ctx);
+    if (!json || strcmp(json, "-") != 0) /* stdout is the JSON's */
+        print_table(stdout, &ctx);
     fflush(stdout);
     char msg[PATH_MAX + 256];
     if (json && write_json(json, &ctx, msg, sizeof msg) != 0) {

@@ -118,7 +118,7 @@ static void usage(FILE *f)
 "      --frames DIR2       the frames to score (may be DIR itself)\n"
 "      --modes LIST        the modes to score\n"
 "      --json FILE         everything as JSON (each frame too: per_frame; -:\n"
-"                          on stdout)\n"
+"                          on stdout, instead of the table)\n"
 "\n"
 "Common options:\n"
 "      --threads N         worker threads (default: all cores); the output\n"
@@ -783,6 +783,8 @@ static int cmd_score(int argc, char **argv)
         return bad_usage("%s", "score: no folder of frames given (--frames DIR2)");
     if (!mode_count)
         return bad_usage("%s", "score: no modes given (--modes LIST)");
+    if (json && strcmp(json, "-") == 0)
+        co.quiet = 1; /* stdout is the JSON's: no table */
     {
         const char *ins[] = {path, views_path};
         if (vt_cli_check_outputs(&json, 1, ins, 2) != 0)
