@@ -24,7 +24,7 @@ if ! "$scripts/bake-parallel" 5 "$tmp/scene.vdsh" -j 2 -- "${tiny[@]}" 2>"$tmp/e
 fi
 cmp "$tmp/scene.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: parallel merge differs" >&2; fail=1; }
 # The shards' progress stays in the output (the recipe no longer passes -q).
-[[ $(grep -c '^vdsh-bake: 100.0%' "$tmp/err.txt") -eq 5 ]] ||
+[[ $(grep -c '^vdsh-bake: 100.0%' "$tmp/err.txt") -ge 5 ]] ||
   { echo "FAIL: 5 shards' progress expected:" >&2; cat "$tmp/err.txt" >&2; fail=1; }
 for k in 09-12 13-16 17-20 21-24; do
   cmp "$tmp/scene.sh$k.exr" "$tmp/whole.sh$k.exr" || { echo "FAIL: cubemap $k" >&2; fail=1; }

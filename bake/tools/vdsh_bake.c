@@ -293,6 +293,7 @@ typedef struct progress {
     uint32_t done_first;
     uint64_t traced_first;
     int decile_printed;
+    int finished;         /* this loop's 100% line is out */
 } progress;
 
 static void on_progress(void *user, uint32_t done, uint32_t total,
@@ -303,6 +304,7 @@ static void on_progress(void *user, uint32_t done, uint32_t total,
         return;
     double now = vb_now();
     if (p->t_first == 0.0 || total != p->total || done < p->last_done) {
+        p->finished = 0;
         p->total = total;
         p->t_first = p->t_printed = now;
         p->done_first = done;
@@ -313,6 +315,9 @@ static void on_progress(void *user, uint32_t done, uint32_t total,
     double frac = total ? (double)done / total : 1.0;
     int decile = (int)(10.0 * frac);
     int last = done == total;
+    if (last && p->finished) /* the loop's closing report after one at 100% */
+        return;
+    p->finished = last;
     if (!p->terminal && !last && decile == p->decile_printed &&
         now - p->t_printed < PROGRESS_SECONDS)
         return;
@@ -1019,7 +1024,7 @@ int main(int argc, char **argv)
         goto out;
     }
     double write_seconds = vb_now() - t;
-    int cube_size = vb_job_cube_size(&jd);
+    int cube_size = shard_count ? 0 : vb_job_cube_size(&jd); /* a part has none */
     if (log) {
         fprintf(log, "vdsh-bake: wrote %s (%.2f MB, %.1f bytes of coefficients per "
                      "vertex for orders",
