@@ -22,7 +22,7 @@
 #endif
 
 static const char usage_text[] =
-    "Usage: vdsh-view [options] SCENE.vdsh              (a window)\n"
+    "usage: vdsh-view [options] SCENE.vdsh              (a window)\n"
     "       vdsh-view --render OUT.png [options] SCENE.vdsh\n"
     "       vdsh-view --grid OUT.png [options] SCENE.vdsh...\n"
     "       vdsh-view --bench [options] SCENE.vdsh...\n"
@@ -206,7 +206,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
             fputs(usage_text, stdout);
             return -1;
         case 'V':
-            printf("vdsh-view %s\n", VDSH_VERSION_STRING);
+            vt_cli_version(NULL);
             return -1;
         case 'q': o->quiet = 1; break;
         case O_RENDER: o->render_path = v; break;
@@ -330,7 +330,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
             break;
         }
         default: /* getopt_long said what is wrong */
-            fprintf(stderr, "Try 'vdsh-view --help'.\n");
+            vt_cli_try_help();
             return VT_EXIT_USAGE;
         }
     }
@@ -370,11 +370,16 @@ static int parse_args(int argc, char **argv, vv_options *o)
                            "got '%s'", o->files[1]);
     if (o->fit && o->have_camera)
         return usage_error("%s", "--fit and --camera both choose the view: give one");
+    /* The images it writes: never a scene file, and writable now. */
+    const char *outs[] = {o->render_path, o->grid_path, o->screenshot};
+    if (vt_cli_check_outputs(outs, 3, (const char *const *)o->files, o->file_count) != 0)
+        return 1;
     return 0;
 }
 
 int main(int argc, char **argv)
 {
+    vt_cli_begin("vdsh-view", argv);
     vv_options o;
     int rc = parse_args(argc, argv, &o);
     if (rc)

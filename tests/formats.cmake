@@ -56,7 +56,7 @@ _format_tool_test(format_info_verify 0
 _format_tool_test(format_info_json 0
   --out "\"streams\":" --out "\"sha256\":\t\"000102"
   --out "\\\"quoted\\\"\\\\caf"
-  -- ${_info} --json ${_fx}/good.vdsh)
+  -- ${_info} --json - ${_fx}/good.vdsh)
 _format_tool_test(format_info_corrupt 1
   --out "MISMATCH" --err "corrupt.vdsh: chunk 6 'COEF' at offset"
   --err "CRC mismatch"
@@ -78,7 +78,7 @@ _format_tool_test(format_info_several 1
   --out "good.vdsh\n" --err "corrupt.vdsh"
   -- ${_info} ${_fx}/good.vdsh ${_fx}/corrupt.vdsh ${_fx}/good.vdsh)
 _format_tool_test(format_info_bad_option 2
-  --err "usage:" -- ${_info} --no-such-option ${_fx}/good.vdsh)
+  --err "unrecognized option '--no-such-option'" --err "Try 'vdsh-info --help'" -- ${_info} --no-such-option ${_fx}/good.vdsh)
 _format_tool_test(format_info_no_file 2
   --err "no input file" -- ${_info})
 _format_tool_test(format_info_help 0
@@ -100,14 +100,14 @@ if(Python3_Interpreter_FOUND)
 def run(*a):
     p = subprocess.run([sys.argv[1], *a], capture_output=True, text=True)
     return p.returncode, json.loads(p.stdout)
-rc, d = run('--json', sys.argv[2])
+rc, d = run('--json', '-', sys.argv[2])
 assert rc == 0 and d['valid'] and d['vertex_count'] == 40, d
 assert [s['order'] for s in d['streams']] == [5, 3], d['streams']
 assert d['streams'][0]['coefficients'] == 25
 assert d['sources'][1]['name'] == 'scenes/\"quoted\"\\\\caf\\u00e9.obj', d['sources']
 assert len(d['sources'][0]['sha256']) == 64
 assert d['timings']['threads'] == 2 and d['stats']['rays_missed'] == 2500
-rc, d = run('--json', '--verify', sys.argv[3])
+rc, d = run('--json', '-', '--verify', sys.argv[3])
 assert rc == 1 and not d['valid'] and d['result'] == 'CRC mismatch', d
 assert sum(not c['crc_ok'] for c in d['chunks']) == 1, d['chunks']
 print('ok')"

@@ -74,3 +74,14 @@ done
        ${CMAKE_CURRENT_LIST_DIR}/data/frames_gl.views.json $<TARGET_FILE:test_runtime_buffer>)
   set_tests_properties(frames_gl_vs_c PROPERTIES SKIP_RETURN_CODE 77)
 endif()
+
+# scripts/frames: an unknown scene name is an error; a mesh path is a scene
+# (test_frames_script.py; the mesh part skips, 77, without GL).
+find_package(Python3 COMPONENTS Interpreter QUIET)
+if(Python3_Interpreter_FOUND AND TARGET vb_frames AND TARGET vdsh-view)
+  add_test(NAME frames_script
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_frames_script.py
+                   ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR}
+                   ${CMAKE_CURRENT_BINARY_DIR}/frames_script)
+  set_tests_properties(frames_script PROPERTIES SKIP_RETURN_CODE 77)
+endif()

@@ -127,7 +127,7 @@ set(_room_log ${_rt_dir}/room_log/room_log.vdsh)
 
 add_test(NAME runtime_view_help COMMAND sh -c [=[
 set -e
-"$1" --help | grep -q "^Usage: vdsh-view"
+"$1" --help | grep -q "^usage: vdsh-view"
 "$1" --help | grep -q "order n = n bands = n\*n coefficients"
 "$1" --version | grep -q "^vdsh-view "
 ]=] sh ${_view})

@@ -87,7 +87,7 @@ for name, args in SCENES.items():
     with open(auto1, "rb") as a, open(auto2, "rb") as b:
         check(a.read() == b.read(), "%s: auto, 1 vs 2 threads: identical files" % name)
     chosen = {s["order"]: s["quantity"]
-              for s in json.loads(run([info, "--json", auto1]).stdout)["streams"]}
+              for s in json.loads(run([info, "--json", "-", auto1]).stdout)["streams"]}
     scores = {"auto": evaluate(auto1),
               "distance": evaluate(do_bake(name, args, "distance", ["--quantity", "distance"])),
               "log-distance": evaluate(do_bake(name, args, "log", ["--quantity", "log"]))}

@@ -54,7 +54,7 @@ check "info lists order 5" grep -q "order 5 (25 coefficients)" "$tmp/info.txt"
 # Options land in the file; timings only when asked.
 expect_exit 0 "bake f32 orders 2,3 full" "$bake" "${quick[@]}" --orders 3,2 --encoding f32 \
   --method full --seed 9 -o "$tmp/d.vdsh" --report "$tmp/d.json"
-"$info" --json "$tmp/d.vdsh" >"$tmp/d.info.json"
+"$info" --json - "$tmp/d.vdsh" >"$tmp/d.info.json"
 json() { # json FILE PYTHON_EXPRESSION_OF_d: true when it holds
   /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); sys.exit(0 if eval(sys.argv[2]) else 1)' "$@"
 }
@@ -67,7 +67,7 @@ check "report written" json "$tmp/d.json" "d['rays_traced'] > 0 and d['orders'] 
 check "report: the origins' repair is its own phase" json "$tmp/d.json" \
   "d['origins']['probe_rays'] >= 32 * d['receivers'] and d['seconds']['origins'] >= 0 and d['robust'] is True"
 expect_exit 0 "bake with timings" "$bake" "${quick[@]}" --record-timings -o "$tmp/e.vdsh"
-"$info" --json "$tmp/e.vdsh" >"$tmp/e.info.json"
+"$info" --json - "$tmp/e.vdsh" >"$tmp/e.info.json"
 check "timings stored when asked" json "$tmp/e.info.json" "d['timings']['total'] > 0"
 check "no timings otherwise" json "$tmp/d.info.json" "d['timings'] is None"
 check "--cubemap-dir" bash -c "mkdir -p '$tmp/cubes' && '$bake' ${quick[*]} --cubemap-dir '$tmp/cubes' -o '$tmp/f.vdsh' && test -s '$tmp/cubes/f.sh21-24.exr' && test ! -e '$tmp/f.sh21-24.exr'"
@@ -106,7 +106,7 @@ expect_exit 2 "--adaptive with --shard" "$bake" builtin:room --max-edge 1 --adap
 expect_exit 1 "--max-receivers below the start mesh" "$bake" builtin:room --max-edge 1 --adaptive 0.1 --max-receivers 9 -o "$tmp/x.vdsh"
 check "no output after usage errors" test ! -e "$tmp/x.vdsh"
 expect_exit 0 "--help" "$bake" --help
-check "--help shows usage" grep -q "Usage: vdsh-bake" "$tmp/out.txt"
+check "--help shows usage" grep -q "usage: vdsh-bake" "$tmp/out.txt"
 expect_exit 0 "--version" "$bake" --version
 
 # Data errors exit 1, name the file, and leave no output (nor temp files).
@@ -127,7 +127,7 @@ check "existing output untouched" cmp -s "$tmp/a.vdsh" "$tmp/keep.vdsh"
 
 # The shadow method's log offset: recorded per stream as its method parameter.
 expect_exit 0 "bake --log-offset" "$bake" "${quick[@]}" --log-offset 0.25 -o "$tmp/off.vdsh"
-"$info" --json "$tmp/off.vdsh" >"$tmp/off.json"
+"$info" --json - "$tmp/off.vdsh" >"$tmp/off.json"
 check "log offset recorded" json "$tmp/off.json" \
   "all(s['method'] == 'shadow' and abs(s['method_param'] - 0.25) < 1e-7 for s in d['streams'])"
 
@@ -158,11 +158,11 @@ ao=(builtin:room --max-edge 1.5 --rays 256 --adaptive-order 0.02 --max-order 9 -
 expect_exit 0 "adaptive order, 1 thread" "$bake" "${ao[@]}" --threads 1 -o "$tmp/ao1.vdsh"
 expect_exit 0 "adaptive order, 2 threads" "$bake" "${ao[@]}" --threads 2 -o "$tmp/ao2.vdsh"
 check "adaptive order: 1 and 2 threads identical" cmp -s "$tmp/ao1.vdsh" "$tmp/ao2.vdsh"
-"$info" --json "$tmp/ao1.vdsh" >"$tmp/ao1.json" 2>/dev/null
+"$info" --json - "$tmp/ao1.vdsh" >"$tmp/ao1.json" 2>/dev/null
 check "adaptive order: one variable stream up to 9" json "$tmp/ao1.json" \
   "len(d['streams']) == 1 and d['streams'][0]['variable_order'] and d['streams'][0]['order'] == 9 and sum(d['streams'][0]['vertices_per_order']) == d['vertex_count'] and 4 <= d['streams'][0]['mean_bytes_per_vertex'] <= d['streams'][0]['max_bytes_per_vertex']"
 expect_exit 0 "adaptive order with --orders" "$bake" "${ao[@]}" --orders 2,3 -o "$tmp/ao3.vdsh"
-"$info" --json "$tmp/ao3.vdsh" >"$tmp/ao3.json" 2>/dev/null
+"$info" --json - "$tmp/ao3.vdsh" >"$tmp/ao3.json" 2>/dev/null
 check "adaptive order beside orders 2 and 3" json "$tmp/ao3.json" \
   "[s['order'] for s in d['streams']] == [2, 3, 9] and [s['variable_order'] for s in d['streams']] == [False, False, True]"
 expect_exit 2 "--max-order without --adaptive-order" "$bake" builtin:room --max-order 9 \

@@ -28,7 +28,7 @@ py=/usr/bin/python3
 
 # stat FILE KEY: a field of the file's stats chunk.
 stat() {
-  "$info" --json "$1" | "$py" -c "import json,sys; print(json.load(sys.stdin)['stats']['$2'])"
+  "$info" --json - "$1" | "$py" -c "import json,sys; print(json.load(sys.stdin)['stats']['$2'])"
 }
 
 if [[ ${1:-} == --one ]]; then :; fi

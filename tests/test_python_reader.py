@@ -68,7 +68,7 @@ for d, want in table.items():
 
 
 def c_reader(path):
-    r = subprocess.run([info, "--json", path], capture_output=True, text=True)
+    r = subprocess.run([info, "--json", "-", path], capture_output=True, text=True)
     if r.returncode != 0:
         return None
     d = json.loads(r.stdout)

@@ -94,7 +94,7 @@ says "mixed encodings" "another --encoding"
 # (parts are f32: 38 floats per receiver), part 3's COEF payloads are
 # 48-byte headers plus 152 bytes per receiver of its range.
 p=$tmp/n7
-"$info" --json "$p/part-3.vdsh" >"$tmp/info.json" 2>"$tmp/err.txt"
+"$info" --json - "$p/part-3.vdsh" >"$tmp/info.json" 2>"$tmp/err.txt"
 check "vdsh-info reads a part" /usr/bin/python3 - "$tmp/info.json" "$p/part-3.vdsh" <<'PY'
 import json, struct, sys
 d = json.load(open(sys.argv[1]))

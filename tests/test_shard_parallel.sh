@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # scripts/bake-parallel with real GNU parallel: 5 shards on local job slots
 # merge to the whole bake's file byte for byte; a rerun with one part
-# removed bakes only that one. Installs Debian's parallel when root and it
-# is missing; skips (77) when it cannot be had.
+# removed bakes only that one; each shard's progress is in the output.
+# Installs Debian's parallel when root and it is missing; skips (77) when
+# it cannot be had.
 # Usage: test_shard_parallel.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
@@ -22,6 +23,9 @@ if ! "$scripts/bake-parallel" 5 "$tmp/scene.vdsh" -j 2 -- "${tiny[@]}" 2>"$tmp/e
   echo "FAIL: bake-parallel:" >&2; cat "$tmp/err.txt" >&2; fail=1
 fi
 cmp "$tmp/scene.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: parallel merge differs" >&2; fail=1; }
+# The shards' progress stays in the output (the recipe no longer passes -q).
+[[ $(grep -c '^vdsh-bake: 100.0%' "$tmp/err.txt") -ge 5 ]] ||
+  { echo "FAIL: 5 shards' progress expected:" >&2; cat "$tmp/err.txt" >&2; fail=1; }
 for k in 09-12 13-16 17-20 21-24; do
   cmp "$tmp/scene.sh$k.exr" "$tmp/whole.sh$k.exr" || { echo "FAIL: cubemap $k" >&2; fail=1; }
 done

@@ -106,4 +106,8 @@ for k in 09-12 13-16 17-20 21-24; do
   cmp "$tmp/scene.sh$k.exr" "$tmp/whole.sh$k.exr" || { echo "FAIL: cubemap $k" >&2; fail=1; }
 done
 ls "$tmp"/scene.part-* >/dev/null 2>&1 && { echo "FAIL: parts left behind" >&2; fail=1; }
+# Each shard's log keeps its progress (the recipe no longer passes -q).
+for f in "$tmp"/scene.slurm-*_*.log; do
+  grep -q '^vdsh-bake: 100.0%' "$f" || { echo "FAIL: no progress in $f" >&2; cat "$f" >&2; fail=1; }
+done
 exit $fail

@@ -15,7 +15,25 @@
             leaves the old content and no temporary file; concurrent
             bakes to one target all succeed with identical results
 
-Usage: test_tools_cli.py VDSH_BAKE VDSH_EVAL VDSH_INFO VDSH_VIEW VDSH_RAYDUMP WORK_DIR
+  conventions  every program takes --help and --version (exit 0), starts
+            its help with "usage: PROG", names itself bare (never argv[0]'s
+            path) in every message, getopt's too; vdsh-bake's help names
+            glTF input
+  same file an output that is an input (by device and inode: a hard link,
+            a symbolic link) is refused by every program that writes, exit 1,
+            the input untouched
+  early     a bad output folder (of the .vdsh or of the cubemaps) is found
+            before the meshes load, and the message names that path
+  together  a bake that fails while writing leaves the old basis cubemaps
+  orders    vdsh-export takes orders 1..16
+  strict    every JSON document any program writes parses with a strict
+            parser that also refuses duplicate keys (vdsh-frames views and
+            score too)
+  progress  without a terminal vdsh-bake prints progress as lines of their
+            own (no \\r), ending at 100%, the ETA not far off; -q: nothing
+
+Usage: test_tools_cli.py VDSH_BAKE VDSH_EVAL VDSH_INFO VDSH_VIEW VDSH_MERGE VDSH_EXPORT
+                         VDSH_FRAMES WORK_DIR
 (vdsh-view is only asked to parse options here: no GL needed.)
 """
 import json
@@ -26,7 +44,9 @@ import signal
 import subprocess
 import sys
 
-bake, ev, info, view, work = sys.argv[1:6]
+bake, ev, info, view, merge, export, frames, work = sys.argv[1:9]
+PROGRAMS = {"vdsh-bake": bake, "vdsh-eval": ev, "vdsh-info": info, "vdsh-view": view,
+            "vdsh-merge": merge, "vdsh-export": export, "vdsh-frames": frames}
 failures = []
 
 
@@ -47,10 +67,19 @@ def run(*args, limit_kib=None):
 
 
 def strict_json(data):
-    """JSON as RFC 8259 has it: UTF-8, no NaN or Infinity."""
+    """JSON as RFC 8259 has it: UTF-8, no NaN or Infinity, and no key twice
+    in one object (parsers keep one of the two: the other is lost)."""
     def no_constant(name):
         raise ValueError("non-finite number " + name)
-    return json.loads(data.decode("utf-8"), parse_constant=no_constant)
+
+    def no_duplicates(pairs):
+        keys = [k for k, _ in pairs]
+        dup = sorted({k for k in keys if keys.count(k) > 1})
+        if dup:
+            raise ValueError("duplicate key(s) %s" % dup)
+        return dict(pairs)
+    return json.loads(data.decode("utf-8"), parse_constant=no_constant,
+                      object_pairs_hook=no_duplicates)
 
 
 def temporaries(d):
@@ -79,7 +108,7 @@ try:
 except (ValueError, KeyError, OSError) as e:
     check(False, "bake --report does not parse: %s" % e)
 
-for args in (["--json"], ["--json", "--verify"]):
+for args in (["--json", "-"], ["--json", "-", "--verify"]):
     rc, out, err = run(info, *args, odd)
     try:
         d = strict_json(out)
@@ -87,7 +116,7 @@ for args in (["--json"], ["--json", "--verify"]):
     except (ValueError, KeyError) as e:
         check(False, "vdsh-info %s does not parse: %s" % (args, e))
 # a file that does not read: the error document parses too
-rc, out, err = run(info, "--json", os.path.join(W, b'no"such\\\x03.vdsh'))
+rc, out, err = run(info, "--json", "-", os.path.join(W, b'no"such\\\x03.vdsh'))
 try:
     d = strict_json(out)
     check(rc == 1 and not d["valid"] and "no\"such\\" in d["error"], "vdsh-info error JSON")
@@ -112,7 +141,7 @@ except (ValueError, KeyError, OSError) as ex:
 seeded = os.path.join(W, b"seeded.vdsh")
 rc, _, err = run(bake, *quick, "--seed", "010", "-o", seeded, "--report", seeded + b".json")
 check(rc == 0, "bake --seed 010: %s" % err)
-rc, out, _ = run(info, "--json", seeded)
+rc, out, _ = run(info, "--json", "-", seeded)
 check(rc == 0 and strict_json(out)["bake"]["seed"] == 10, "bake --seed 010 stored as 10")
 check(strict_json(open(seeded + b".json", "rb").read())["seed"] == 10, "bake report: seed 10")
 rc, _, err = run(ev, seeded, "-q", "--seed", "010", "--interior", "0", "--points", "100",
@@ -231,6 +260,192 @@ run(bake, *quick, "-o", ref)
 check(open(target, "rb").read() == open(ref, "rb").read(), "concurrent bakes: a complete file")
 check(strict_json(open(target + b".json", "rb").read())["receivers"] > 0, "concurrent reports")
 check(temporaries(out_dir) == [], "concurrent bakes left temporaries: %s" % temporaries(out_dir))
+
+# ---- conventions: --help, --version, the bare name in every message -----
+for name, prog in PROGRAMS.items():
+    rc, out, err = run(prog, "--help")
+    check(rc == 0 and out.startswith(("usage: %s " % name).encode()),
+          "%s --help: exit %d, first line %r (want 'usage: %s ...')"
+          % (name, rc, out[:60], name))
+    rc, out, err = run(prog, "--version")
+    check(rc == 0 and out.startswith(("%s " % name).encode()) and b"." in out,
+          "%s --version: exit %d, %r" % (name, rc, out[:80]))
+    # getopt's message and ours: the bare name, never the path it ran as
+    args = ["views", "--no-such-option"] if name == "vdsh-frames" else ["--no-such-option"]
+    rc, out, err = run(prog, *args)
+    lines = err.decode("utf-8", "replace").splitlines()
+    check(rc == 2 and lines and all(l.startswith(name + ":") or l.startswith(name + " ")
+                                    or l == "Try '%s --help'." % name for l in lines)
+          and ("Try '%s --help'." % name) in lines and os.path.dirname(prog) not in err.decode(),
+          "%s --no-such-option: exit %d, stderr %r" % (name, rc, err[:300]))
+    rc, out, err = run(prog)  # nothing given: a usage error in the same words
+    check(rc == 2 and err.startswith((name + ": ").encode()) and
+          ("Try '%s --help'." % name).encode() in err,
+          "%s without arguments: exit %d, stderr %r" % (name, rc, err[:200]))
+rc, out, _ = run(bake, "--help")
+check(b"glTF" in out and b".glb" in out, "vdsh-bake --help names glTF input")
+
+# ---- same file: an output that is an input is refused --------------------
+sf = os.path.join(W, b"same")
+os.makedirs(sf)
+mesh = os.path.join(sf, b"m.obj")
+open(mesh, "w").write("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\n")
+os.link(mesh, os.path.join(sf, b"hard.obj"))
+os.symlink(b"m.obj", os.path.join(sf, b"soft.obj"))
+sv = os.path.join(sf, b"s.vdsh")
+rc, _, err = run(bake, *quick, "-o", sv)
+check(rc == 0, "bake s.vdsh: %s" % err)
+os.link(sv, os.path.join(sf, b"s-hard.vdsh"))
+part = os.path.join(sf, b"p.vdsh")
+run(bake, *quick, "--shard", "0/1", "-o", part)
+def same_file_case(what, cmd, inp):
+    before = open(inp, "rb").read()
+    rc, _, err = run(*cmd)
+    after = open(inp, "rb").read()
+    check(rc == 1 and b"same file" in err and after == before,
+          "%s: exit %d (want 1), %r; the input %s" % (
+              what, rc, err[:200], "kept" if after == before else "CHANGED"))
+    if after != before:  # the next case starts from the same input
+        open(inp, "wb").write(before)
+same_file_case("bake m.obj -o m.obj", [bake, mesh, "-q", "-o", mesh], mesh)
+same_file_case("bake m.obj -o hard link", [bake, mesh, "-q", "-o", os.path.join(sf, b"hard.obj")], mesh)
+same_file_case("bake m.obj -o symbolic link", [bake, os.path.join(sf, b"soft.obj"), "-q", "-o", mesh], mesh)
+same_file_case("bake --report m.obj", [bake, mesh, "-q", "-o", os.path.join(sf, b"o.vdsh"),
+                                       "--report", mesh], mesh)
+same_file_case("bake --export-obj m.obj", [bake, mesh, "-q", "--export-obj", mesh], mesh)
+same_file_case("bake --plan over the mesh", [bake, mesh, "-q", "--plan",
+                                             os.path.join(sf, b"hard.obj")], mesh)
+same_file_case("export a.vdsh -o a.vdsh", [export, sv, "-o", sv], sv)
+same_file_case("export a.vdsh -o its hard link", [export, sv, "-o", os.path.join(sf, b"s-hard.vdsh")], sv)
+same_file_case("merge p.vdsh -o p.vdsh", [merge, part, "-q", "-o", part], part)
+same_file_case("eval --json a.vdsh", [ev, sv, "-q", "--json", sv], sv)
+same_file_case("eval --per-vertex a.vdsh", [ev, sv, "-q", "--per-vertex", sv], sv)
+same_file_case("info --json a.vdsh", [info, "--json", sv, sv], sv)
+same_file_case("frames views -o a.vdsh", [frames, "views", sv, "-q", "-o", sv], sv)
+same_file_case("view --render a.vdsh", [view, "--render", sv, sv], sv)
+check(not [n for n in os.listdir(sf) if b".tmp" in n], "same-file refusals left temporaries")
+
+# ---- early: a bad output folder, found before the meshes load ------------
+ed = os.path.join(W, b"early")
+os.makedirs(ed)
+loud = [a for a in quick if a != "-q"]
+for what, extra, named in (
+        (".vdsh in a missing folder", ["-o", os.path.join(ed, b"nodir", b"r.vdsh")],
+         os.path.join(ed, b"nodir", b"r.vdsh")),
+        ("cubemaps in a missing folder", ["-o", os.path.join(ed, b"r.vdsh"), "--cubemap-dir",
+                                          os.path.join(ed, b"nocube")],
+         os.path.join(ed, b"nocube", b"r.sh09-12.exr")),
+        ("report in a missing folder", ["-o", os.path.join(ed, b"r.vdsh"), "--report",
+                                        os.path.join(ed, b"nodir", b"r.json")],
+         os.path.join(ed, b"nodir", b"r.json")),
+        (".vdsh is a folder", ["-o", ed], ed)):
+    rc, _, err = run(bake, *loud, *extra)
+    check(rc == 1 and named in err and b"builtin:room:" not in err and b"tracing" not in err,
+          "bake, %s: exit %d, want 1 before loading, naming %r: %r" % (what, rc, named, err[:300]))
+# the issue's case: --cubemap-dir . -o nodir/r.vdsh left the old cubemaps rewritten
+cube_names = [b"r.sh09-12.exr", b"r.sh13-16.exr", b"r.sh17-20.exr", b"r.sh21-24.exr"]
+for n in cube_names:
+    open(os.path.join(ed, n), "w").write("old")
+rc, _, err = run(bake, *quick, "--cubemap-dir", ed, "-o", os.path.join(ed, b"nodir", b"r.vdsh"))
+check(rc == 1 and all(open(os.path.join(ed, n), "rb").read() == b"old" for n in cube_names),
+      "a bake to a missing folder rewrote the cubemaps: %r" % err[:200])
+# merge: a missing folder, before any part is read
+rc, _, err = run(merge, part, "-o", os.path.join(ed, b"nodir", b"m.vdsh"))
+check(rc == 1 and os.path.join(ed, b"nodir", b"m.vdsh") in err, "merge to a missing folder: %r" % err)
+
+# ---- together: a bake that fails while writing keeps the old cubemaps ----
+# A 16 KiB file size limit: the 8x8 cubemaps (~1.4 KB) fit, the .vdsh does
+# not; the cubemaps were once renamed before the .vdsh failed.
+td = os.path.join(W, b"together")
+os.makedirs(td)
+for n in cube_names:
+    open(os.path.join(td, n), "w").write("old")
+rc, _, err = run(bake, *quick, "--cubemap-dir", td, "-o", os.path.join(td, b"r.vdsh"),
+                 limit_kib=16)
+check(rc == 1 and b"File too large" in err, "bake under a 16 KiB limit: exit %d %r" % (rc, err[:300]))
+check(all(open(os.path.join(td, n), "rb").read() == b"old" for n in cube_names),
+      "a failed bake replaced the basis cubemaps")
+check(not os.path.exists(os.path.join(td, b"r.vdsh")) and temporaries(td) == [],
+      "a failed bake left %s" % os.listdir(td))
+rc, _, err = run(bake, *quick, "--cubemap-dir", td, "-o", os.path.join(td, b"r.vdsh"))
+check(rc == 0 and all(open(os.path.join(td, n), "rb").read() != b"old" for n in cube_names),
+      "the bake without a limit writes them: %r" % err[:200])
+
+# ---- orders: vdsh-export takes 1..16 -------------------------------------
+o16 = os.path.join(W, b"o16.vdsh")
+rc, _, err = run(bake, "builtin:room", "--max-edge", "4", "--rays", "64", "--orders", "2,16",
+                 "-q", "-o", o16)
+check(rc == 0, "bake --orders 2,16: %s" % err)
+rc, _, err = run(export, o16, "--orders", "16", "-q", "-o", os.path.join(W, b"o16.glb"))
+check(rc == 0 and os.path.getsize(os.path.join(W, b"o16.glb")) > 0,
+      "vdsh-export --orders 16: exit %d %r" % (rc, err))
+rc, _, err = run(export, o16, "--orders", "17", "-o", os.path.join(W, b"o17.glb"))
+check(rc == 2 and b"1..16" in err, "vdsh-export --orders 17: exit %d %r" % (rc, err))
+
+# ---- strict: every JSON document the programs write ----------------------
+jd = os.path.join(W, b"json")
+os.makedirs(jd)
+def strict_file(what, path):
+    try:
+        return strict_json(open(path, "rb").read())
+    except (ValueError, OSError) as e:
+        check(False, "%s: not strict JSON: %s" % (what, e))
+        return None
+rc, _, err = run(bake, *quick, "--trace-only", "--report", os.path.join(jd, b"bare.json"))
+check(rc == 0, "bake --trace-only --report: %s" % err)
+strict_file("bake --trace-only --report", os.path.join(jd, b"bare.json"))
+rc, _, err = run(bake, *quick, "--adaptive", "0.02", "--max-edge", "2", "--rays", "64",
+                 "-o", os.path.join(jd, b"ad.vdsh"), "--report", os.path.join(jd, b"ad.json"))
+strict_file("bake --adaptive --report", os.path.join(jd, b"ad.json"))
+rc, out, err = run(info, "--json", "-", sv, seeded)
+try:
+    docs = strict_json(out)
+    check(rc == 0 and isinstance(docs, list) and len(docs) == 2, "vdsh-info --json - A B: an array")
+except ValueError as e:
+    check(False, "vdsh-info --json - of two files: %s" % e)
+rc, _, err = run(info, "--json", os.path.join(jd, b"info.json"), sv)
+d = strict_file("vdsh-info --json FILE", os.path.join(jd, b"info.json"))
+check(rc == 0 and d is not None and d.get("valid"), "vdsh-info --json FILE: %s" % err)
+rc, out, err = run(ev, sv, "-q", "--interior", "0", "--points", "50", "--json", "-")
+try:
+    check(rc == 0 and strict_json(out)["file"], "vdsh-eval --json -")
+except (ValueError, KeyError) as e:
+    check(False, "vdsh-eval --json -: %s" % e)
+views = os.path.join(jd, b"v.json")
+rc, _, err = run(frames, "views", sv, "-q", "--cameras", "1", "--size", "64x48", "-o", views)
+check(rc == 0, "vdsh-frames views: %s" % err)
+strict_file("vdsh-frames views", views)
+truth = os.path.join(jd, b"truth")
+rc, _, err = run(frames, "truth", sv, "-q", "--views", views, "-o", truth)
+check(rc == 0, "vdsh-frames truth: %s" % err)
+score = os.path.join(jd, b"score.json")
+rc, _, err = run(frames, "score", sv, "-q", "--views", views, "--truth", truth, "--frames", truth,
+                 "--modes", "ideal,hard", "--json", score)
+check(rc == 0, "vdsh-frames score: %s" % err)
+d = strict_file("vdsh-frames score --json", score)
+if d:
+    s0 = d["modes"][0]["sets"][0]
+    check(isinstance(s0["frames"], int) and len(s0["per_frame"]) == s0["frames"],
+          "score: a set's frames (count) and per_frame (scores): %r" % list(s0))
+
+# ---- progress: lines in a log, nothing with -q ---------------------------
+import time
+pd = os.path.join(W, b"progress")
+os.makedirs(pd)
+slow = ["builtin:room", "--max-edge", "0.5", "--rays", "256", "--cube-size", "0"]
+t0 = time.monotonic()
+rc, _, err = run(bake, *slow, "-o", os.path.join(pd, b"p.vdsh"))
+took = time.monotonic() - t0
+import re
+prog = [l for l in err.decode().splitlines() if re.match(r"vdsh-bake: +[0-9.]+%  ", l)]
+check(rc == 0 and prog and prog[-1].startswith("vdsh-bake: 100.0%") and b"\r" not in err,
+      "progress without a terminal: lines of their own ending at 100%%: %r" % err[:600])
+for l in prog[:-1]:
+    eta = l.rsplit("ETA ", 1)[-1].split()[0] if "ETA " in l else "-"
+    check(eta == "-" or float(eta) < 10 * took + 1,
+          "an ETA far off: %r (the whole bake took %.1f s)" % (l, took))
+rc, _, err = run(bake, *slow, "-q", "-o", os.path.join(pd, b"q.vdsh"))
+check(rc == 0 and err == b"", "-q: nothing on stderr: %r" % err[:200])
 
 if failures:
     print("%d check(s) failed" % len(failures), file=sys.stderr)

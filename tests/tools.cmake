@@ -4,7 +4,11 @@
 #                exact numbers, NaN as null, the reader
 #   tools_cli    test_tools_cli.py: every program end to end - JSON with odd
 #                paths parses, one value means one number everywhere, bad
-#                numbers exit 2 naming the option, outputs are atomic
+#                numbers exit 2 naming the option, outputs are atomic; the
+#                programs' one convention (--help, --version, messages), an
+#                output that is an input refused, outputs checked before a
+#                bake, cubemaps and .vdsh written together, every JSON
+#                strict (no duplicate keys), progress in logs
 add_executable(test_tools ${CMAKE_CURRENT_LIST_DIR}/test_tools.c)
 target_link_libraries(test_tools PRIVATE vt_tools m)
 add_test(NAME tools_unit COMMAND test_tools ${CMAKE_CURRENT_BINARY_DIR}/tools_unit)
@@ -14,6 +18,7 @@ if(Python3_Interpreter_FOUND)
   add_test(NAME tools_cli
            COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_tools_cli.py
                    $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval> $<TARGET_FILE:vdsh-info>
-                   $<TARGET_FILE:vdsh-view>
+                   $<TARGET_FILE:vdsh-view> $<TARGET_FILE:vdsh-merge>
+                   $<TARGET_FILE:vdsh-export> $<TARGET_FILE:vdsh-frames>
                    ${CMAKE_CURRENT_BINARY_DIR}/tools_cli)
 endif()

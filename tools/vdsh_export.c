@@ -7,12 +7,13 @@
  * float with --float); the bake's method, quantity, order, max distance
  * and source hashes in the mesh's extras.vdsh.
  *
- *     vdsh-export scene.vdsh -o scene.glb [--orders 2,3,5] [--float]
+ *     vdsh-export scene.vdsh -o scene.glb [--orders 2,3,5] [--float] [-q]
  *
  * Errors: a message naming the file and the problem on stderr, exit 1 (2
  * for a usage error); the output is written atomically
  * (formats/vdsh_output.h): a failed export leaves no partial file.
  */
+#include <getopt.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -23,6 +24,7 @@
 
 #include "vdsh.h"
 #include "vdsh_output.h"
+#include "vt_cli.h"
 
 typedef struct blob {
     uint8_t *data;
@@ -85,59 +87,65 @@ static int add_accessor(cJSON *accs, int view, int ctype, int normalized, size_t
 
 static void usage(FILE *fp)
 {
-    fprintf(fp, "usage: vdsh-export IN.vdsh -o OUT.glb [--orders LIST] [--float]\n"
+    fprintf(fp, "usage: vdsh-export [options] IN.vdsh -o OUT.glb\n"
                 "Write a .vdsh as glTF 2.0 binary (layout: formats/GLTF.md): the receiver mesh and\n"
                 "each SH stream as vertex attributes _VDSH<order>_<k> (VEC4).\n"
+                "\n"
                 "  -o, --output FILE  the .glb to write (atomically)\n"
-                "      --orders LIST  orders to export (default: every stream of the file)\n"
-                "      --float        coefficients as float (default: normalised int16, scale in extras)\n");
+                "      --orders LIST  orders to export, each 1..%d (default: every stream of the\n"
+                "                     file)\n"
+                "      --float        coefficients as float (default: normalised int16, scale in\n"
+                "                     extras)\n"
+                "  -q, --quiet        no summary on stderr\n"
+                "  -h, --help         this text\n"
+                "  -V, --version      version\n"
+                "\n"
+                "Exit status: 0 success, 1 error, 2 usage error.\n"
+                "Example: vdsh-export room.vdsh -o room.glb\n",
+            VDSH_MAX_ORDER);
 }
 
 int main(int argc, char **argv)
 {
+    vt_cli_begin("vdsh-export", argv);
+    static const struct option longopts[] = {{"output", required_argument, 0, 'o'},
+                                             {"orders", required_argument, 0, 'O'},
+                                             {"float", no_argument, 0, 'F'},
+                                             {"quiet", no_argument, 0, 'q'},
+                                             {"help", no_argument, 0, 'h'},
+                                             {"version", no_argument, 0, 'V'},
+                                             {0, 0, 0, 0}};
     const char *in = NULL, *out = NULL;
-    int want[16] = {0}, any_order = 0, use_float = 0;
-    for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "-o") || !strcmp(argv[i], "--output")) {
-            if (++i >= argc) {
-                usage(stderr);
-                return 2;
-            }
-            out = argv[i];
-        } else if (!strcmp(argv[i], "--orders")) {
-            if (++i >= argc) {
-                usage(stderr);
-                return 2;
-            }
-            char *s = argv[i];
-            while (*s) {
-                char *end;
-                long o = strtol(s, &end, 10);
-                if (end == s || o < 1 || o > 15 || (*end && *end != ',') || *s == '0') {
-                    fprintf(stderr, "vdsh-export: --orders: bad list '%s' (orders 1..15, comma-separated)\n",
-                            argv[i]);
-                    return 2;
-                }
-                want[o] = any_order = 1;
-                s = *end ? end + 1 : end;
-            }
-        } else if (!strcmp(argv[i], "--float")) {
-            use_float = 1;
-        } else if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
-            usage(stdout);
-            return 0;
-        } else if (argv[i][0] == '-' || in) {
-            fprintf(stderr, "vdsh-export: unexpected argument '%s'\n", argv[i]);
-            usage(stderr);
-            return 2;
-        } else {
-            in = argv[i];
+    int want[VDSH_ORDER_SLOTS] = {0}, any_order = 0, use_float = 0, quiet = 0, opt;
+    while ((opt = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
+        switch (opt) {
+        case 'o': out = optarg; break;
+        case 'O': {
+            uint64_t v[VDSH_MAX_ORDER];
+            int n = vt_parse_u64_list(optarg, 1, VDSH_MAX_ORDER, v, 1, VDSH_MAX_ORDER);
+            if (n == 0)
+                return vt_usage_error("vdsh-export", "--orders takes orders 1..%d such as "
+                                      "2,3,5, not '%s'", VDSH_MAX_ORDER, optarg);
+            for (int i = 0; i < n; i++)
+                want[v[i]] = any_order = 1;
+            break;
+        }
+        case 'F': use_float = 1; break;
+        case 'q': quiet = 1; break;
+        case 'h': usage(stdout); return 0;
+        case 'V': return vt_cli_version(NULL);
+        default: return vt_cli_try_help();
         }
     }
-    if (!in || !out) {
-        usage(stderr);
-        return 2;
-    }
+    if (optind >= argc)
+        return vt_usage_error("vdsh-export", "%s", "no .vdsh file given");
+    if (argc - optind > 1)
+        return vt_usage_error("vdsh-export", "one .vdsh file, not also '%s'", argv[optind + 1]);
+    in = argv[optind];
+    if (!out)
+        return vt_usage_error("vdsh-export", "%s", "no output: give -o OUT.glb");
+    if (vt_cli_check_outputs(&out, 1, &in, 1) != 0)
+        return 1;
     vdsh_file *f = NULL;
     vdsh_error verr;
     if (vdsh_read(in, &f, &verr) != VDSH_OK) {
@@ -241,7 +249,7 @@ int main(int argc, char **argv)
     int exported = 0;
     for (uint32_t si = 0; si < f->stream_count; si++) {
         const vdsh_stream *s = &f->streams[si];
-        if (any_order && (s->order > 15 || !want[s->order]))
+        if (any_order && (s->order > VDSH_MAX_ORDER || !want[s->order]))
             continue;
         const uint32_t nc = s->order * s->order, groups = (nc + 3) / 4;
         /* Two streams of one order (distance and log): the second gets a
@@ -373,8 +381,9 @@ int main(int argc, char **argv)
             fprintf(stderr, "vdsh-export: %s\n", verr.msg);
             goto done;
         }
-        fprintf(stderr, "vdsh-export: wrote %s (%llu bytes, %d stream%s)\n", out, (unsigned long long)total,
-                exported, exported == 1 ? "" : "s");
+        if (!quiet)
+            fprintf(stderr, "vdsh-export: wrote %s (%llu bytes, %d stream%s)\n", out,
+                    (unsigned long long)total, exported, exported == 1 ? "" : "s");
         rc = 0;
         goto done;
     }

@@ -2,7 +2,9 @@
  * vdsh-info - print what a .vdsh file holds, or verify it chunk by chunk.
  *
  *     vdsh-info room.vdsh               summary for people
- *     vdsh-info --json room.vdsh        the same as JSON, one object per file
+ *     vdsh-info --json - room.vdsh      the same as JSON on stdout (--json FILE:
+ *                                       in FILE), one object, an array of
+ *                                       them for several files
  *     vdsh-info --verify *.vdsh         every chunk's CRC, then full validation
  *
  * Exit status: 0 when every file was read (and verified), 1 when any file
@@ -12,6 +14,8 @@
  * the decoded structs (and, for --verify, vdsh_scan_chunks' list).
  */
 #include "vdsh.h"
+#include "vdsh_output.h"
+#include "vt_cli.h"
 #include "vt_json.h"
 
 #include <errno.h>
@@ -33,14 +37,15 @@ static const char *prog = "vdsh-info";
 static void usage(FILE *to)
 {
     fprintf(to,
-            "usage: %s [--json] [--verify] FILE.vdsh...\n"
+            "usage: %s [--json OUT.json] [--verify] FILE.vdsh...\n"
             "\n"
             "Print what a .vdsh file holds: counts, bounds, every bake "
             "parameter,\n"
             "sources, coefficient streams, statistics and timings.\n"
             "\n"
-            "  -j, --json     print the same as JSON on stdout, one object "
-            "per file\n"
+            "  -j, --json OUT.json  write the same as JSON to OUT.json (-: on "
+            "stdout):\n"
+            "                 one object, an array of them for several files\n"
             "      --verify   list every chunk with its stored and computed "
             "CRC, then\n"
             "                 validate the whole file; fail if anything is "
@@ -74,14 +79,54 @@ static void json_bounds(vt_json *j, cJSON *parent, const char *key, const float 
     json_vec3(j, b, "max", hi);
 }
 
-/* Print the document on stdout and free it; 0 if it could not be built. */
+/* --json FILE: the documents of every file, written together at the end
+ * (json_write). */
+static char *json_text;
+static size_t json_len, json_docs;
+
+/* Keep the document for json_write and free it; 0 if it could not be built. */
 static int json_emit(vt_json *j, const char *path)
 {
-    char msg[600];
-    int ok = vt_json_write_stream(j, stdout, "stdout", msg, sizeof msg) == 0;
-    if (!ok)
-        fprintf(stderr, "%s: %s: %s\n", prog, path, msg);
+    char *text = vt_json_print(j);
     vt_json_free(j);
+    size_t n = text ? strlen(text) : 0;
+    char *grown = text ? realloc(json_text, json_len + n + 3) : NULL;
+    if (!grown) {
+        fprintf(stderr, "%s: %s: JSON not built: out of memory\n", prog, path);
+        free(text);
+        return 0;
+    }
+    json_text = grown;
+    if (json_docs++)
+        json_text[json_len++] = ','; /* after the previous document's newline */
+    memcpy(json_text + json_len, text, n + 1);
+    json_len += n;
+    free(text);
+    return 1;
+}
+
+/* One document as it is; several as an array. 0 on a failed write (said). */
+static int json_write(const char *out)
+{
+    const char *open = json_docs > 1 ? "[\n" : "", *close = json_docs > 1 ? "]\n" : "";
+    size_t n = strlen(open) + json_len + strlen(close);
+    char *all = malloc(n + 1);
+    if (!all) {
+        fprintf(stderr, "%s: %s: out of memory\n", prog, out);
+        return 0;
+    }
+    snprintf(all, n + 1, "%s%s%s", open, json_text ? json_text : "", close);
+    int ok = 1;
+    if (strcmp(out, "-") == 0) {
+        ok = fputs(all, stdout) >= 0;
+    } else {
+        vdsh_error err;
+        if (vdsh_output_write(out, all, n, &err) != VDSH_OK) {
+            fprintf(stderr, "%s: %s\n", prog, err.msg);
+            ok = 0;
+        }
+    }
+    free(all);
     return ok;
 }
 
@@ -591,17 +636,20 @@ static int info(const char *path, int json, int first)
 int main(int argc, char **argv)
 {
     static const struct option options[] = {
-        {"json", no_argument, NULL, 'j'},
+        {"json", required_argument, NULL, 'j'},
         {"verify", no_argument, NULL, 'c'},
         {"help", no_argument, NULL, 'h'},
         {"version", no_argument, NULL, 'V'},
         {NULL, 0, NULL, 0},
     };
+    vt_cli_begin(prog, argv);
+    const char *json_out = NULL;
     int json = 0, check = 0, opt;
-    while ((opt = getopt_long(argc, argv, "jhV", options, NULL)) != -1) {
+    while ((opt = getopt_long(argc, argv, "j:hV", options, NULL)) != -1) {
         switch (opt) {
         case 'j':
             json = 1;
+            json_out = optarg;
             break;
         case 'c':
             check = 1;
@@ -610,19 +658,21 @@ int main(int argc, char **argv)
             usage(stdout);
             return 0;
         case 'V':
-            printf("vdsh-info %s (.vdsh format version %u)\n",
-                   VDSH_VERSION_STRING, VDSH_FORMAT_VERSION);
-            return 0;
+            return vt_cli_version(NULL);
         default:
-            usage(stderr);
-            return 2;
+            return vt_cli_try_help();
         }
     }
     if (optind >= argc) {
-        fprintf(stderr, "%s: no input file\n", prog);
-        usage(stderr);
-        return 2;
+        size_t n = json_out ? strlen(json_out) : 0;
+        if (n > 5 && strcmp(json_out + n - 5, ".vdsh") == 0)
+            return vt_usage_error(prog, "no input file (--json takes the JSON file to write: "
+                                  "--json - %s prints it)", json_out);
+        return vt_usage_error(prog, "%s", "no input file");
     }
+    if (json_out && vt_cli_check_outputs(&json_out, 1, (const char *const *)argv + optind,
+                                         argc - optind) != 0)
+        return 1;
 
     int ok = 1;
     for (int i = optind; i < argc; i++) {
@@ -631,6 +681,9 @@ int main(int argc, char **argv)
         ok &= check ? verify(argv[i], json)
                     : info(argv[i], json, i == optind);
     }
+    if (json && !json_write(json_out))
+        ok = 0;
+    free(json_text);
     if (fflush(stdout) != 0 || ferror(stdout)) {
         fprintf(stderr, "%s: cannot write output: %s\n", prog,
                 strerror(errno));

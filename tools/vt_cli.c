@@ -10,6 +10,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+
+#include "vdsh_output.h"
 
 static int is_digit(char c)
 {
@@ -200,4 +203,89 @@ int vt_usage_error(const char *prog, const char *fmt, ...)
     va_end(ap);
     fprintf(stderr, "\nTry '%s --help'.\n", prog);
     return VT_EXIT_USAGE;
+}
+
+/* ---- the programs' shared conventions ------------------------------------ */
+
+static const char *cli_prog = "vdsh";
+
+void vt_cli_begin(const char *prog, char **argv)
+{
+    cli_prog = prog;
+    if (argv && argv[0])
+        argv[0] = (char *)prog;
+}
+
+const char *vt_cli_prog(void)
+{
+    return cli_prog;
+}
+
+int vt_cli_version(const char *detail)
+{
+    printf("%s %s (.vdsh format %u%s%s)\n", cli_prog, VDSH_VERSION_STRING,
+           (unsigned)VDSH_FORMAT_VERSION, detail ? ", " : "", detail ? detail : "");
+    return 0;
+}
+
+int vt_cli_try_help(void)
+{
+    fprintf(stderr, "Try '%s --help'.\n", cli_prog);
+    return VT_EXIT_USAGE;
+}
+
+int vt_cli_same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    return a && b && stat(a, &sa) == 0 && stat(b, &sb) == 0 && S_ISREG(sa.st_mode) &&
+           S_ISREG(sb.st_mode) && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+/* Can `path` be written as vdsh_output writes it? 0, or 1 with the message. */
+static int check_writable(const char *path)
+{
+    struct stat st;
+    if (stat(path, &st) == 0) {
+        if (S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode))
+            return 0; /* written in place as a stream */
+        if (S_ISDIR(st.st_mode)) {
+            fprintf(stderr, "%s: %s: cannot write: is a directory\n", cli_prog, path);
+            return 1;
+        }
+    }
+    vdsh_output o;
+    vdsh_error err;
+    if (vdsh_output_open(path, &o, &err) != VDSH_OK) {
+        fprintf(stderr, "%s: %s\n", cli_prog, err.msg);
+        return 1;
+    }
+    vdsh_output_abort(&o); /* removes the temporary: the target is as it was */
+    return 0;
+}
+
+int vt_cli_check_outputs(const char *const *outputs, int output_count,
+                         const char *const *inputs, int input_count)
+{
+    for (int i = 0; i < output_count; i++) {
+        const char *out = outputs[i];
+        if (!out || strcmp(out, "-") == 0) /* stdout */
+            continue;
+        for (int k = 0; k < input_count; k++)
+            if (inputs[k] && vt_cli_same_file(out, inputs[k])) {
+                fprintf(stderr, "%s: %s is the input %s (the same file): not overwriting it\n",
+                        cli_prog, out, inputs[k]);
+                return 1;
+            }
+        for (int k = 0; k < i; k++)
+            if (outputs[k] && (strcmp(outputs[k], out) == 0 ||
+                               vt_cli_same_file(outputs[k], out))) {
+                fprintf(stderr, "%s: %s is also the output %s (the same file)\n", cli_prog,
+                        out, outputs[k]);
+                return 1;
+            }
+    }
+    for (int i = 0; i < output_count; i++)
+        if (outputs[i] && strcmp(outputs[i], "-") != 0 && check_writable(outputs[i]))
+            return 1;
+    return 0;
 }

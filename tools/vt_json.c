@@ -201,6 +201,8 @@ char *vt_json_print(vt_json *j)
 
 int vt_json_write_file(vt_json *j, const char *path, char *msg, size_t cap)
 {
+    if (path && strcmp(path, "-") == 0)
+        return vt_json_write_stream(j, stdout, "stdout", msg, cap);
     char *text = vt_json_print(j);
     if (!text) {
         snprintf(msg, cap, "%s: not written: out of memory", path);

@@ -79,6 +79,7 @@ char *vt_json_print(vt_json *j);
 
 /* The document to a file, atomically (formats/vdsh_output.h); or to an
  * open stream (stdout). 0, or -1 with a message in msg. */
+/* path "-": stdout (vt_json_write_stream), the --json FILE convention. */
 int vt_json_write_file(vt_json *j, const char *path, char *msg, size_t cap);
 int vt_json_write_stream(vt_json *j, FILE *fp, const char *name, char *msg, size_t cap);
 

@@ -60,6 +60,7 @@
 #define VB_CUBEMAP_H
 
 #include "vb.h"
+#include "vdsh_output.h"
 
 #include <stddef.h>
 
@@ -126,6 +127,15 @@ typedef struct vb_cubemap_basis {
 vb_result vb_cubemap_basis_encode(int n, vb_cubemap_basis *out, vb_error *err);
 vb_result vb_cubemap_basis_write(const vb_cubemap_basis *b, const char *dir,
                                  const char *stem, vb_error *err);
+/* The first half of vb_cubemap_basis_write, for files that must change
+ * together with others (job.h, vb_write_outputs): the four files written
+ * to temporaries beside their targets and on disk, nothing renamed yet.
+ * The caller commits (vdsh_output_commit) or aborts (vdsh_output_abort)
+ * each of staged[0..3]; on failure every one is aborted already. */
+vb_result vb_cubemap_basis_stage(const vb_cubemap_basis *b, const char *dir,
+                                 const char *stem,
+                                 vdsh_output staged[VB_CUBEMAP_BASIS_FILES],
+                                 vb_error *err);
 void vb_cubemap_basis_free(vb_cubemap_basis *b);
 
 /* Read the four basis files. expected_size > 0 requires that face size

@@ -742,21 +742,36 @@ vb_result vb_cubemap_basis_encode(int n, vb_cubemap_basis *out, vb_error *err)
     return r;
 }
 
+vb_result vb_cubemap_basis_stage(const vb_cubemap_basis *b, const char *dir,
+                                 const char *stem,
+                                 vdsh_output staged[VB_CUBEMAP_BASIS_FILES],
+                                 vb_error *err)
+{
+    char *paths[VB_CUBEMAP_BASIS_FILES] = {0};
+    vb_result r = VB_OK;
+    for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
+        staged[k] = (vdsh_output){.fd = -1};
+    for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++)
+        r = basis_path_alloc(dir, stem, k, &paths[k], err);
+    for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++) {
+        exr_io encoded = {.fd = -1, .mem = b->bytes[k], .size = b->length[k]};
+        r = stage(paths[k], b->size, NULL, &encoded, &staged[k], err);
+    }
+    for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++) {
+        if (r != VB_OK)
+            vdsh_output_abort(&staged[k]);
+        free(paths[k]);
+    }
+    return r;
+}
+
 vb_result vb_cubemap_basis_write(const vb_cubemap_basis *b, const char *dir,
                                  const char *stem, vb_error *err)
 {
-    char *paths[VB_CUBEMAP_BASIS_FILES] = {0};
-    vdsh_output st[VB_CUBEMAP_BASIS_FILES] = {{0}};
-    vb_result r = VB_OK;
-    for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++)
-        r = basis_path_alloc(dir, stem, k, &paths[k], err);
-
+    vdsh_output st[VB_CUBEMAP_BASIS_FILES];
     /* Stage all four, then rename: a failure while writing leaves every
      * destination as it was, never a mix of two bakes. */
-    for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++) {
-        exr_io encoded = {.fd = -1, .mem = b->bytes[k], .size = b->length[k]};
-        r = stage(paths[k], b->size, NULL, &encoded, &st[k], err);
-    }
+    vb_result r = vb_cubemap_basis_stage(b, dir, stem, st, err);
     for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++) {
         r = commit(&st[k], err);
         if (r != VB_OK && k > 0 && err) {
@@ -766,10 +781,8 @@ vb_result vb_cubemap_basis_write(const vb_cubemap_basis *b, const char *dir,
         }
     }
 
-    for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++) {
+    for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
         vdsh_output_abort(&st[k]);
-        free(paths[k]);
-    }
     return r;
 }
 

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "origins.h"
+#include "vdsh_output.h"
 
 #define DEFAULT_CUBE_SIZE 64
 
@@ -234,12 +235,73 @@ static void split_output(const char *out, char *dir, char *stem, size_t cap)
         stem[n - 5] = '\0';
 }
 
+vb_result vb_output_cubemap_path(const char *output, const char *cubemap_dir, int k,
+                                 char *buf, size_t cap, vb_error *err)
+{
+    char dir[PATH_MAX], stem[PATH_MAX];
+    if (!output)
+        return vb_fail(err, VB_ERR_ARGUMENT, "no output file");
+    split_output(output, dir, stem, sizeof dir);
+    return vb_cubemap_basis_path(cubemap_dir ? cubemap_dir : dir, stem, k, buf, cap, err);
+}
+
+vb_result vb_write_outputs(const vdsh_file *f, const char *output, const char *cubemap_dir,
+                           const vb_cubemap_basis *b, uint64_t *bytes, vb_error *err)
+{
+    if (!output)
+        return vb_fail(err, VB_ERR_ARGUMENT, "no output file");
+    char dir[PATH_MAX], stem[PATH_MAX];
+    split_output(output, dir, stem, sizeof dir);
+    vdsh_output cubes[VB_CUBEMAP_BASIS_FILES], file = {.fd = -1};
+    for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
+        cubes[k] = (vdsh_output){.fd = -1};
+    /* 1. The .vdsh file, encoded in memory, then staged beside its target. */
+    void *data = NULL;
+    size_t size = 0;
+    vdsh_error verr;
+    vb_result r = VB_OK;
+    if (vdsh_write_memory(f, &data, &size, &verr) != VDSH_OK) {
+        const char *why = strncmp(verr.msg, "memory: ", 8) == 0 ? verr.msg + 8 : verr.msg;
+        return vb_fail(err, VB_ERR_IO, "%s: %s", output, why);
+    }
+    if (vdsh_output_open(output, &file, &verr) != VDSH_OK) {
+        r = vb_fail(err, VB_ERR_IO, "%s", verr.msg);
+    } else {
+        vdsh_output_put(&file, data, size);
+        if (vdsh_output_finish(&file, &verr) != VDSH_OK)
+            r = vb_fail(err, VB_ERR_IO, "%s", verr.msg);
+    }
+    free(data);
+    /* 2. The cubemaps, staged too. */
+    if (r == VB_OK && b)
+        r = vb_cubemap_basis_stage(b, cubemap_dir ? cubemap_dir : dir, stem, cubes, err);
+    /* 3. All complete: rename, the .vdsh file last. */
+    int renamed = 0;
+    for (int k = 0; r == VB_OK && b && k < VB_CUBEMAP_BASIS_FILES; k++) {
+        if (vdsh_output_commit(&cubes[k], &verr) != VDSH_OK)
+            r = vb_fail(err, VB_ERR_IO, "%s", verr.msg);
+        else
+            renamed++;
+    }
+    if (r == VB_OK && vdsh_output_commit(&file, &verr) != VDSH_OK)
+        r = vb_fail(err, VB_ERR_IO, "%s", verr.msg);
+    if (r != VB_OK && renamed > 0 && err) {
+        size_t len = strlen(err->msg);
+        snprintf(err->msg + len, sizeof err->msg - len,
+                 " (%d basis cubemaps were already replaced)", renamed);
+    }
+    for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
+        vdsh_output_abort(&cubes[k]);
+    vdsh_output_abort(&file);
+    if (r == VB_OK && bytes)
+        *bytes = size;
+    return r;
+}
+
 vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vb_error *err)
 {
     if (!d->output)
         return vb_fail(err, VB_ERR_ARGUMENT, "no output file");
-    char dir[PATH_MAX], stem[PATH_MAX];
-    split_output(d->output, dir, stem, sizeof dir);
     int cube_size = d->shard_count ? 0 : vb_job_cube_size(d); /* parts: the merge's */
     if (cube_size > 0) {
         if (j->basis_running)
@@ -251,15 +313,9 @@ vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vb_error *err)
             *err = j->basis_err;
             return j->basis_result;
         }
-        vb_result r = vb_cubemap_basis_write(&j->basis, d->cubemap_dir ? d->cubemap_dir : dir,
-                                             stem, err);
-        if (r != VB_OK)
-            return r;
     }
-    vdsh_error verr;
-    if (vdsh_write_sized(d->output, &j->file, &j->file_bytes, &verr) != VDSH_OK)
-        return vb_fail(err, VB_ERR_IO, "%s", verr.msg);
-    return VB_OK;
+    return vb_write_outputs(&j->file, d->output, d->cubemap_dir,
+                            cube_size > 0 ? &j->basis : NULL, &j->file_bytes, err);
 }
 
 void vb_shard_range(uint32_t v, uint32_t i, uint32_t n, uint32_t *begin, uint32_t *end)

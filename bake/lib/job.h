@@ -126,9 +126,27 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err);
  * if asked, timings. */
 vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err);
 
-/* Write the basis cubemaps (if any), then the .vdsh file, each atomically;
- * j->file_bytes receives the file's size. */
+/* Write the basis cubemaps (if any) and the .vdsh file together
+ * (vb_write_outputs); j->file_bytes receives the file's size. */
 vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vb_error *err);
+
+/* The path of basis cubemap k (0..3) that goes with the .vdsh `output`:
+ * in cubemap_dir, or beside output when it is NULL; the stem is output's
+ * name less ".vdsh" (vb_cubemap_basis_path). For checks before a bake. */
+vb_result vb_output_cubemap_path(const char *output, const char *cubemap_dir, int k,
+                                 char *buf, size_t cap, vb_error *err);
+
+/* A bake's outputs, all or none: the .vdsh file f to `output` and, when b
+ * is not NULL, its basis cubemaps (cubemap_dir, NULL: beside output).
+ * Every file is first written to a temporary beside its target and put on
+ * disk; only when all five are complete are they renamed over their
+ * targets (the cubemaps, then the .vdsh file, last). A failure before
+ * that leaves every target as it was and no temporary behind; only a
+ * failing rename, which the message then says, can leave a mix. *bytes
+ * (may be NULL) receives the .vdsh file's size. The encoded file is held
+ * in memory while staged. */
+vb_result vb_write_outputs(const vdsh_file *f, const char *output, const char *cubemap_dir,
+                           const vb_cubemap_basis *b, uint64_t *bytes, vb_error *err);
 
 void vb_job_free(vb_job *j);
 

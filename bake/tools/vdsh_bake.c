@@ -128,13 +128,14 @@ static void on_round(void *user, uint32_t round, uint32_t receivers, uint32_t ca
 static void usage(FILE *f)
 {
     fprintf(f,
-"Usage: vdsh-bake [options] MESH... -o OUT.vdsh\n"
+"usage: vdsh-bake [options] MESH... -o OUT.vdsh\n"
 "Bake visibility-distance spherical harmonics for a static scene.\n"
 "\n"
-"MESH is an OBJ, PLY, OFF or STL file, builtin:room (a procedural\n"
-"19 x 6 x 19 m room) or builtin:room:N, N >= 1 (seeded variants: furnished\n"
-"rooms of varied size and shape). Several meshes form one scene: they\n"
-"occlude each other.\n"
+"MESH is an OBJ, PLY, OFF or STL file, a glTF 2.0 file (.gltf or .glb:\n"
+"its default scene's triangles), builtin:room (a procedural 19 x 6 x 19 m\n"
+"room) or builtin:room:N, N >= 1 (seeded variants: furnished rooms of\n"
+"varied size and shape). Several meshes form one scene: they occlude each\n"
+"other.\n"
 "Receivers are the mesh vertices (refined with --max-edge); rays are traced\n"
 "against the original triangles.\n"
 "\n"
@@ -228,7 +229,9 @@ static void usage(FILE *f)
 "                          which ones differs between CPUs' kernels)\n"
 "      --threads N         worker threads (default: all cores)\n"
 "\n"
-"  -q, --quiet             no progress or summary on stderr\n"
+"  -q, --quiet             no progress or summary on stderr (progress: a\n"
+"                          line in place on a terminal, else a line every\n"
+"                          5 s or 10%%, for logs)\n"
 "  -h, --help              this text\n"
 "  -V, --version           version\n"
 "\n"
@@ -272,11 +275,29 @@ static int parse_orders(const char *s, options *o)
     return 1;
 }
 
-/* ---- progress on a terminal -------------------------------------------- */
+/* ---- progress ------------------------------------------------------------ */
+
+/* On a terminal one line rewritten in place; otherwise (a log, a pipe, a
+ * Slurm shard's output) a line of its own every PROGRESS_SECONDS or each
+ * 10% of the receivers, whichever comes first, and at the end. The ETA is
+ * the rays still to trace at the rate they have been traced since this
+ * loop's first report: never from the time before it (BVH build, origin
+ * checks, the quantity choice), which made the first estimate 20x too
+ * long. A new loop (adaptive rounds bake again) starts a new estimate. */
+#define PROGRESS_SECONDS 5.0
 
 typedef struct progress {
     int enabled;
-    double t0;
+    int terminal;         /* 1: \r in place; 0: a line each time */
+    uint32_t rays;        /* rays per receiver asked for (the cap with --rays auto) */
+    double t0;            /* the bake's start */
+    /* the current loop: its first report, and the last line printed */
+    uint32_t total, last_done;
+    double t_first, t_printed;
+    uint32_t done_first;
+    uint64_t traced_first;
+    int decile_printed;
+    int finished;         /* this loop's 100% line is out */
 } progress;
 
 static void on_progress(void *user, uint32_t done, uint32_t total,
@@ -285,12 +306,45 @@ static void on_progress(void *user, uint32_t done, uint32_t total,
     progress *p = user;
     if (!p->enabled)
         return;
-    double t = vb_now() - p->t0;
+    double now = vb_now();
+    if (p->t_first == 0.0 || total != p->total || done < p->last_done) {
+        p->finished = 0;
+        p->total = total;
+        p->t_first = p->t_printed = now;
+        p->done_first = done;
+        p->traced_first = traced;
+        p->decile_printed = total ? (int)(10.0 * done / total) : 10;
+    }
+    p->last_done = done;
     double frac = total ? (double)done / total : 1.0;
-    double eta = frac > 0.0 ? t * (1.0 - frac) / frac : 0.0;
-    fprintf(stderr, "\r  %5.1f%%  %u/%u receivers  %.1f Mrays/s  ETA %.1f s   ",
-            100.0 * frac, done, total, t > 0 ? traced / t * 1e-6 : 0.0, eta);
-    if (done == total)
+    int decile = (int)(10.0 * frac);
+    int last = done == total;
+    if (last && p->finished) /* the loop's closing report after one at 100% */
+        return;
+    p->finished = last;
+    if (!p->terminal && !last && decile == p->decile_printed &&
+        now - p->t_printed < PROGRESS_SECONDS)
+        return;
+    p->decile_printed = decile;
+    p->t_printed = now;
+    /* Rays left: the rays per receiver traced so far in this loop (the
+     * nominal count before any finished), times the receivers left. */
+    double dt = now - p->t_first;
+    uint64_t rays_done = traced - p->traced_first;
+    uint32_t recv_done = done - p->done_first;
+    double per_receiver = recv_done > 0 ? (double)rays_done / recv_done : (double)p->rays;
+    double rate = dt > 0.0 ? rays_done / dt : 0.0; /* rays per second */
+    char eta[32] = "ETA -";
+    if (last)
+        snprintf(eta, sizeof eta, "%.1f s", now - p->t0);
+    else if (rate > 0.0)
+        snprintf(eta, sizeof eta, "ETA %.1f s", (total - done) * per_receiver / rate);
+    double t = now - p->t0;
+    fprintf(stderr, "%svdsh-bake: %5.1f%%  %u/%u receivers  %.1f Mrays/s  %s%s",
+            p->terminal ? "\r" : "", 100.0 * frac, done, total,
+            rate > 0.0 ? rate * 1e-6 : (t > 0 ? traced / t * 1e-6 : 0.0), eta,
+            p->terminal ? "   " : "\n");
+    if (p->terminal && last)
         fputc('\n', stderr);
     fflush(stderr);
 }
@@ -491,8 +545,36 @@ static int write_plan(const vb_mesh *m, const char *path, FILE *log)
     return 0;
 }
 
+/* Every file the bake will write (vt_cli_check_outputs): the .vdsh file
+ * and its basis cubemaps, the report, the plan and the OBJ export. */
+static int check_outputs(const options *o, const vb_job_desc *jd, const char *const *meshes,
+                         int nmesh)
+{
+    char cube[VB_CUBEMAP_BASIS_FILES][PATH_MAX];
+    const char *outs[4 + VB_CUBEMAP_BASIS_FILES] = {jd->output, o->report, o->plan,
+                                                    o->export_obj};
+    int n = 4;
+    vb_error err;
+    if (jd->output && !jd->shard_count && vb_job_cube_size(jd) > 0)
+        for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++) {
+            if (vb_output_cubemap_path(jd->output, jd->cubemap_dir, k, cube[k],
+                                       sizeof cube[k], &err) != VB_OK) {
+                fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+                return 1;
+            }
+            outs[n++] = cube[k];
+        }
+    const char *ins[VDSH_MAX_SOURCES + 1];
+    int nin = 0;
+    for (int i = 0; i < nmesh && i < VDSH_MAX_SOURCES; i++)
+        ins[nin++] = meshes[i];
+    ins[nin++] = o->receivers;
+    return vt_cli_check_outputs(outs, n, ins, nin);
+}
+
 int main(int argc, char **argv)
 {
+    vt_cli_begin("vdsh-bake", argv);
     defer_interrupts_while_writing(); /* first: before any thread starts */
     options o = {0};
     o.rays = 2500;
@@ -731,13 +813,8 @@ int main(int argc, char **argv)
         }
         case 'q': o.quiet = 1; break;
         case 'h': usage(stdout); return 0;
-        case 'V':
-            printf("vdsh-bake %s (.vdsh format %u, Embree %s)\n", VDSH_VERSION_STRING,
-                   VDSH_FORMAT_VERSION, RTC_VERSION_STRING);
-            return 0;
-        default:
-            fprintf(stderr, "Try 'vdsh-bake --help'.\n");
-            return VT_EXIT_USAGE;
+        case 'V': return vt_cli_version("Embree " RTC_VERSION_STRING);
+        default: return vt_cli_try_help();
         }
     }
     if (o.have_ray_tolerance && !o.adaptive_rays)
@@ -790,7 +867,7 @@ int main(int argc, char **argv)
     uint32_t order_mask = 0;
     for (int s = 0; s < o.order_count; s++)
         order_mask |= 1u << o.orders[s];
-    progress pr = {.enabled = log && isatty(STDERR_FILENO)};
+    progress pr = {.enabled = log != NULL, .terminal = isatty(STDERR_FILENO), .rays = o.rays};
     float offsets[VDSH_ORDER_SLOTS];
     for (int k = 0; k <= VDSH_MAX_ORDER; k++)
         offsets[k] = o.log_offset;
@@ -825,6 +902,10 @@ int main(int argc, char **argv)
     int writing = 0; /* output_lock held: outputs are being written */
     vb_error err;
     vb_job job = {0};
+
+    /* 0. Every output writable and none of them an input, before any work. */
+    if (check_outputs(&o, &jd, (const char *const *)argv + optind, nmesh) != 0)
+        return 1;
 
     /* 1. Load every mesh into one occluder scene. */
     if (vb_job_load(&job, &jd, &err) != VB_OK) {
@@ -976,7 +1057,7 @@ int main(int argc, char **argv)
         goto out;
     }
     double write_seconds = vb_now() - t;
-    int cube_size = vb_job_cube_size(&jd);
+    int cube_size = shard_count ? 0 : vb_job_cube_size(&jd); /* a part has none */
     if (log) {
         fprintf(log, "vdsh-bake: wrote %s (%.2f MB, %.1f bytes of coefficients per "
                      "vertex for orders",

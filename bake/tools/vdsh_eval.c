@@ -58,7 +58,7 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-"Usage: vdsh-eval [options] FILE.vdsh [MESH...]\n"
+"usage: vdsh-eval [options] FILE.vdsh [MESH...]\n"
 "Measure a bake's error against an independent Embree ray cast.\n"
 "\n"
 "The occluder scene is rebuilt from the sources recorded in FILE (looked\n"
@@ -100,7 +100,8 @@ static void usage(FILE *f)
 "      --allow-mismatch    use sources whose SHA-256 differs (with a warning)\n"
 "\n"
 "Output:\n"
-"      --json FILE         everything as JSON (bake parameters and timings too)\n"
+"      --json FILE         everything as JSON (bake parameters and timings too;\n"
+"                          -: on stdout, instead of the table)\n"
 "      --per-vertex FILE   per-vertex errors for a heat map (layout below)\n"
 "      --bake-report FILE  take the bake time from vdsh-bake --report JSON\n"
 "                          (default: the file's time chunk, if recorded)\n"
@@ -680,6 +681,7 @@ static void print_table(FILE *o, const context *c)
 
 int main(int argc, char **argv)
 {
+    vt_cli_begin("vdsh-eval", argv);
     vb_eval_desc d = {0};
     d.interior = 65536;
     const char *json = NULL, *per_vertex = NULL, *bake_report = NULL;
@@ -783,13 +785,8 @@ int main(int argc, char **argv)
             break;
         case 'q': quiet = 1; break;
         case 'h': usage(stdout); return 0;
-        case 'V':
-            printf("vdsh-eval %s (.vdsh format %u, Embree %s)\n", VDSH_VERSION_STRING,
-                   VDSH_FORMAT_VERSION, RTC_VERSION_STRING);
-            return 0;
-        default:
-            fprintf(stderr, "Try 'vdsh-eval --help'.\n");
-            return VT_EXIT_USAGE;
+        case 'V': return vt_cli_version("Embree " RTC_VERSION_STRING);
+        default: return vt_cli_try_help();
         }
     }
     if (optind >= argc)
@@ -797,6 +794,15 @@ int main(int argc, char **argv)
     const char *path = argv[optind];
     char **meshes = argv + optind + 1;
     uint32_t nmesh = (uint32_t)(argc - optind - 1);
+    {
+        const char *outs[] = {json, per_vertex};
+        const char *ins[VDSH_MAX_SOURCES + 2] = {path, bake_report};
+        int nin = 2;
+        for (uint32_t i = 0; i < nmesh && nin < VDSH_MAX_SOURCES + 2; i++)
+            ins[nin++] = meshes[i];
+        if (vt_cli_check_outputs(outs, 2, ins, nin) != 0)
+            return 1;
+    }
 
     int status = 1;
     vdsh_file *f = NULL;
@@ -968,7 +974,8 @@ int main(int argc, char **argv)
     struct stat st;
     if (stat(path, &st) == 0)
         ctx.file_bytes = (long long)st.st_size;
-    print_table(stdout, &ctx);
+    if (!json || strcmp(json, "-") != 0) /* stdout is the JSON's */
+        print_table(stdout, &ctx);
     fflush(stdout);
     char msg[PATH_MAX + 256];
     if (json && write_json(json, &ctx, msg, sizeof msg) != 0) {

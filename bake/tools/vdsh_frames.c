@@ -43,7 +43,7 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-"Usage: vdsh-frames views SCENE.vdsh -o VIEWS.json [options]\n"
+"usage: vdsh-frames views SCENE.vdsh -o VIEWS.json [options]\n"
 "       vdsh-frames truth SCENE.vdsh --views VIEWS.json -o DIR [options]\n"
 "       vdsh-frames score SCENE.vdsh --views VIEWS.json --truth DIR --frames DIR2\n"
 "                         --modes LIST [--json OUT.json]\n"
@@ -117,7 +117,8 @@ static void usage(FILE *f)
 "      --truth DIR         vdsh-frames truth's output\n"
 "      --frames DIR2       the frames to score (may be DIR itself)\n"
 "      --modes LIST        the modes to score\n"
-"      --json FILE         everything (per frame too) as JSON\n"
+"      --json FILE         everything as JSON (each frame too: per_frame; -:\n"
+"                          on stdout, instead of the table)\n"
 "\n"
 "Common options:\n"
 "      --threads N         worker threads (default: all cores); the output\n"
@@ -249,14 +250,11 @@ static int common_option(int c, common *co, int *exit_code)
         *exit_code = 0;
         return 2;
     case 'V':
-        printf(PROG " %s (.vdsh format %u, Embree %s)\n", VDSH_VERSION_STRING,
-               VDSH_FORMAT_VERSION, RTC_VERSION_STRING);
-        *exit_code = 0;
+        *exit_code = vt_cli_version("Embree " RTC_VERSION_STRING);
         return 2;
     case '?':
     default:
-        fprintf(stderr, "Try '" PROG " --help'.\n");
-        *exit_code = VT_EXIT_USAGE;
+        *exit_code = vt_cli_try_help();
         return 2;
     }
 }
@@ -318,6 +316,8 @@ static int cmd_views(int argc, char **argv)
         return VT_EXIT_USAGE;
     if (!out)
         return bad_usage("%s", "views: no output given (-o VIEWS.json)");
+    if (vt_cli_check_outputs(&out, 1, &path, 1) != 0)
+        return 1;
     d.threads = co.threads;
 
     loaded L;
@@ -783,6 +783,13 @@ static int cmd_score(int argc, char **argv)
         return bad_usage("%s", "score: no folder of frames given (--frames DIR2)");
     if (!mode_count)
         return bad_usage("%s", "score: no modes given (--modes LIST)");
+    if (json && strcmp(json, "-") == 0)
+        co.quiet = 1; /* stdout is the JSON's: no table */
+    {
+        const char *ins[] = {path, views_path};
+        if (vt_cli_check_outputs(&json, 1, ins, 2) != 0)
+            return 1;
+    }
 
     vt_views V = {0};
     if (read_views(views_path, &V))
@@ -874,7 +881,8 @@ static int cmd_score(int argc, char **argv)
                 cJSON *so = vt_json_object(&j, sets, NULL);
                 vt_json_string(&j, so, "view", v->name);
                 vt_json_i64(&j, so, "set", k);
-                cJSON *fr = vt_json_array(&j, so, "frames");
+                /* each frame's scores; "frames" (json_scores) is their count */
+                cJSON *fr = vt_json_array(&j, so, "per_frame");
                 for (int l = 0; l < v->light_count[k]; l++, fi++) {
                     vb_frames_tally_add(&set, &T[fi]);
                     cJSON *o = vt_json_object(&j, fr, NULL);
@@ -923,6 +931,7 @@ done:
 
 int main(int argc, char **argv)
 {
+    vt_cli_begin(PROG, argv);
     if (argc < 2)
         return bad_usage("%s", "no subcommand given (views, truth or score)");
     const char *cmd = argv[1];
@@ -930,11 +939,8 @@ int main(int argc, char **argv)
         usage(stdout);
         return 0;
     }
-    if (strcmp(cmd, "-V") == 0 || strcmp(cmd, "--version") == 0) {
-        printf(PROG " %s (.vdsh format %u, Embree %s)\n", VDSH_VERSION_STRING,
-               VDSH_FORMAT_VERSION, RTC_VERSION_STRING);
-        return 0;
-    }
+    if (strcmp(cmd, "-V") == 0 || strcmp(cmd, "--version") == 0)
+        return vt_cli_version("Embree " RTC_VERSION_STRING);
     /* Each subcommand parses its own options; getopt's messages name it. */
     optind = 1;
     if (strcmp(cmd, "views") == 0) {

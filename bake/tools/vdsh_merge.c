@@ -23,7 +23,9 @@
  * streams. So memory is the merged file (receivers and encoded streams;
  * f32: the coefficients) plus two parts (each the receiver mesh and its
  * range's rows), never every receiver's f32 coefficients; the spill holds
- * them on disk (152 bytes per receiver at orders 2, 3, 5). A variable-order
+ * them on disk (152 bytes per receiver at orders 2, 3, 5); while it is
+ * written, the encoded file is held once more (vb_write_outputs stages it
+ * with the cubemaps, all or none). A variable-order
  * stream (--adaptive-order) is decoded into f32 rows of every receiver and
  * encoded at the end, as before: its records' offsets and scales are over
  * all receivers too, and it is opt-in.
@@ -46,7 +48,7 @@
 
 static void usage(FILE *f)
 {
-    fputs("Usage: vdsh-merge PART.vdsh... -o OUT.vdsh\n"
+    fputs("usage: vdsh-merge PART.vdsh... -o OUT.vdsh\n"
           "Join the parts written by 'vdsh-bake ... --shard I/N' (every I of one N,\n"
           "in any order) into the file the whole bake writes, byte for byte, and\n"
           "its SH basis cubemaps beside it.\n"
@@ -54,6 +56,7 @@ static void usage(FILE *f)
           "  -o, --output FILE   the merged .vdsh (written atomically)\n"
           "  -q, --quiet         no progress on stderr\n"
           "  -h, --help          this help\n"
+          "  -V, --version       version\n"
           "\n"
           "Exit status: 0 merged, 1 refused or failed (nothing written), 2 usage error.\n",
           f);
@@ -231,18 +234,21 @@ static int encode_spilled(FILE *spill, const char *output, const vdsh_stream *s,
 
 int main(int argc, char **argv)
 {
+    vt_cli_begin("vdsh-merge", argv);
     static const struct option longopts[] = {{"output", required_argument, 0, 'o'},
                                              {"quiet", no_argument, 0, 'q'},
                                              {"help", no_argument, 0, 'h'},
+                                             {"version", no_argument, 0, 'V'},
                                              {0, 0, 0, 0}};
     const char *output = NULL;
     int quiet = 0, c;
-    while ((c = getopt_long(argc, argv, "o:qh", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
         switch (c) {
         case 'o': output = optarg; break;
         case 'q': quiet = 1; break;
         case 'h': usage(stdout); return 0;
-        default: fprintf(stderr, "Try 'vdsh-merge --help'.\n"); return VT_EXIT_USAGE;
+        case 'V': return vt_cli_version(NULL);
+        default: return vt_cli_try_help();
         }
     }
     int n = argc - optind;
@@ -251,6 +257,19 @@ int main(int argc, char **argv)
     if (!output)
         return vt_usage_error("vdsh-merge", "%s", "no output: give -o OUT.vdsh");
     char **paths = argv + optind;
+    {
+        /* Every output (the file and the cubemaps that may go beside it)
+         * writable and none of them a part, before any part is read. */
+        char cube[VB_CUBEMAP_BASIS_FILES][PATH_MAX];
+        const char *outs[1 + VB_CUBEMAP_BASIS_FILES] = {output};
+        vb_error e;
+        for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
+            if (vb_output_cubemap_path(output, NULL, k, cube[k], sizeof cube[k], &e) == VB_OK)
+                outs[1 + k] = cube[k];
+        if (vt_cli_check_outputs(outs, 1 + VB_CUBEMAP_BASIS_FILES, (const char *const *)paths,
+                                 n) != 0)
+            return 1;
+    }
     int status = 1;
     vdsh_file *p0 = NULL, *part = NULL;
     float *merged[VDSH_MAX_STREAMS] = {0};  /* f32 and variable: every receiver's rows */
@@ -440,26 +459,18 @@ int main(int argc, char **argv)
                 goto out;
     }
 
-    /* The basis cubemaps (the whole bake writes them beside its file). */
-    if (f.header.cube_size > 0) {
-        char a[PATH_MAX], b[PATH_MAX];
-        snprintf(a, sizeof a, "%s", output);
-        snprintf(b, sizeof b, "%s", output);
-        char *stem = basename(b);
-        size_t len = strlen(stem);
-        if (len > 5 && strcmp(stem + len - 5, ".vdsh") == 0)
-            stem[len - 5] = '\0';
-        vb_error err;
-        if (vb_cubemap_basis_encode((int)f.header.cube_size, &basis, &err) != VB_OK ||
-            vb_cubemap_basis_write(&basis, dirname(a), stem, &err) != VB_OK) {
-            fprintf(stderr, "vdsh-merge: %s\n", err.msg);
-            goto out;
-        }
+    /* The basis cubemaps (the whole bake writes them beside its file) and
+     * the file, all or none. */
+    vb_error err;
+    if (f.header.cube_size > 0 &&
+        vb_cubemap_basis_encode((int)f.header.cube_size, &basis, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-merge: %s\n", err.msg);
+        goto out;
     }
-    vdsh_error verr;
     uint64_t bytes = 0;
-    if (vdsh_write_sized(output, &f, &bytes, &verr) != VDSH_OK) {
-        fprintf(stderr, "vdsh-merge: %s\n", verr.msg);
+    if (vb_write_outputs(&f, output, NULL, f.header.cube_size > 0 ? &basis : NULL, &bytes,
+                         &err) != VB_OK) {
+        fprintf(stderr, "vdsh-merge: %s\n", err.msg);
         goto out;
     }
     if (!quiet)
