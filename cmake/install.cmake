@@ -6,7 +6,8 @@
 #   target_link_libraries(app PRIVATE vdsh::formats)   # .vdsh reader/writer
 #   target_link_libraries(app PRIVATE vdsh::runtime)   # GL runtime (vr.h)
 #   target_link_libraries(app PRIVATE vdsh::context)   # EGL/GLFW contexts
-#   pkg-config --cflags --libs vdsh-formats  (or vdsh-runtime)
+#   pkg-config --cflags --libs vdsh-formats  (or vdsh-runtime, vdsh-context)
+# Shared builds install with RUNPATH $ORIGIN/../lib (top CMakeLists.txt).
 # tests/install.cmake builds and runs a consumer against an installed tree.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
@@ -18,7 +19,20 @@ install(TARGETS vdsh_format vr vr_context EXPORT vdshTargets
         PUBLIC_HEADER DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vdsh)
 install(EXPORT vdshTargets NAMESPACE vdsh:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vdsh)
 
-set(VDSH_HAVE_GLFW ${glfw3_FOUND})
+# What the package config looks up for its consumers: the public link
+# dependencies always; the private ones (zlib, meshoptimizer, GLFW) only
+# for static libraries, whose link interface names them. VDSH_HAVE_GLFW
+# comes from runtime/CMakeLists.txt; both are TRUE or FALSE, never empty.
+if(VDSH_HAVE_GLFW)
+  set(VDSH_CONFIG_GLFW TRUE)
+else()
+  set(VDSH_CONFIG_GLFW FALSE)
+endif()
+if(BUILD_SHARED_LIBS)
+  set(VDSH_CONFIG_STATIC FALSE)
+else()
+  set(VDSH_CONFIG_STATIC TRUE)
+endif()
 configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/vdshConfig.cmake.in
                               ${CMAKE_CURRENT_BINARY_DIR}/vdshConfig.cmake
                               INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vdsh)
@@ -31,7 +45,12 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/vdshConfig.cmake
 # pkg-config: relocatable (prefix from the .pc file's own place, lib/pkgconfig);
 # static builds list their dependencies in Libs.private.
 file(RELATIVE_PATH VDSH_PC_TO_PREFIX /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
-foreach(pc vdsh-formats vdsh-runtime)
+if(VDSH_HAVE_GLFW)
+  set(VDSH_PC_CONTEXT_PRIVATE "egl glfw3")
+else()
+  set(VDSH_PC_CONTEXT_PRIVATE "egl")
+endif()
+foreach(pc vdsh-formats vdsh-runtime vdsh-context)
   configure_file(${CMAKE_CURRENT_LIST_DIR}/${pc}.pc.in ${CMAKE_CURRENT_BINARY_DIR}/${pc}.pc @ONLY)
   install(FILES ${CMAKE_CURRENT_BINARY_DIR}/${pc}.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
 endforeach()

@@ -45,13 +45,15 @@ add_test(NAME bake_shard
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
                  $<TARGET_FILE:vdsh-eval>)
-# The GNU parallel recipe (scripts/bake-parallel), with Debian's parallel.
+# The GNU parallel recipe (scripts/bake-parallel), with Debian's parallel:
+# byte for byte, a name with quotes, a rerun bakes the missing parts only.
 add_test(NAME bake_shard_parallel
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard_parallel.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> ${PROJECT_SOURCE_DIR}/scripts)
 set_tests_properties(bake_shard_parallel PROPERTIES SKIP_RETURN_CODE 77)
 # The Slurm recipe (scripts/bake-slurm) on a real one-node Slurm it starts
-# as root (skipped, 77, otherwise).
+# as root (skipped, 77, otherwise): byte for byte, bad arguments submit
+# nothing, a failed shard cancels the merge job.
 add_test(NAME bake_shard_slurm
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard_slurm.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> ${PROJECT_SOURCE_DIR}/scripts)

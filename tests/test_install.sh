@@ -6,7 +6,11 @@
 # and runs (writes, reads back and checks a .vdsh; links the runtime); the
 # same program builds with `pkg-config --cflags --libs vdsh-runtime`; the
 # installed vdsh-info reads the consumer's file. Then the same with static
-# libraries.
+# libraries. Issue 26: the installed programs and libraries find their
+# shared libraries without LD_LIBRARY_PATH (install RPATH $ORIGIN/../lib),
+# also when the prefix is moved; the CMake package has no empty if() and
+# finds GLFW for vdsh::context (a static consumer links the imported glfw,
+# not a bare -lglfw); vdsh-context.pc builds a consumer of vr_context.h.
 # Usage: test_install.sh CMAKE SOURCE_DIR WORK_DIR C_COMPILER
 set -u
 cmake=$1 src=$2 work=$3 cc=$4
@@ -31,8 +35,25 @@ for kind in shared static; do
   fi
   for f in include/vdsh/vdsh.h include/vdsh/vr.h lib/cmake/vdsh/vdshConfig.cmake \
            lib/cmake/vdsh/vdshConfigVersion.cmake lib/pkgconfig/vdsh-formats.pc \
-           lib/pkgconfig/vdsh-runtime.pc bin/vdsh-info bin/vdsh-view; do
+           lib/pkgconfig/vdsh-runtime.pc lib/pkgconfig/vdsh-context.pc \
+           bin/vdsh-info bin/vdsh-export bin/vdsh-view; do
     [ -e "$p/$f" ] || { echo "FAIL: $kind: $f not installed"; fail=1; }
+  done
+  # Every if() in the package config tests something (issue 26: the GLFW
+  # test was configured empty, `if()`, and GLFW was never looked up).
+  if grep -nE '^[[:space:]]*(if|elseif)[[:space:]]*\([[:space:]]*\)' "$p/lib/cmake/vdsh/vdshConfig.cmake"; then
+    echo "FAIL: $kind: vdshConfig.cmake has an empty if()"; fail=1
+  fi
+  # The installed programs and libraries run as installed, and from a moved
+  # prefix: no LD_LIBRARY_PATH.
+  rm -rf "$work/$kind/moved"
+  cp -a "$p" "$work/$kind/moved"
+  for q in "$p" "$work/$kind/moved"; do
+    for f in "$q"/bin/* "$q"/lib/*.so*; do
+      [ -e "$f" ] || continue
+      missing=$(env -u LD_LIBRARY_PATH ldd "$f" 2>&1 | grep 'not found')
+      [ -z "$missing" ] || { echo "$missing"; echo "FAIL: $kind: ${f#$work/} does not find its libraries"; fail=1; }
+    done
   done
   if [ $kind = shared ]; then
     ls "$p"/lib/libvdsh-formats.so.* > /dev/null 2>&1 || { echo "FAIL: no shared libvdsh-formats"; fail=1; }
@@ -49,8 +70,19 @@ for kind in shared static; do
   echo "$out" | grep -q "read back ok" || { echo "FAIL: $kind: consumer output"; fail=1; }
   echo "$out" | grep -q "^vdsh $(sed -n 's/^project(vdsh VERSION \([0-9.]*\).*/\1/p' "$src/CMakeLists.txt") " ||
     { echo "FAIL: $kind: version"; fail=1; }
-  LD_LIBRARY_PATH="$p/lib" "$p/bin/vdsh-info" --verify "$work/$kind/c.vdsh" > /dev/null ||
-    { echo "FAIL: $kind: installed vdsh-info cannot read the consumer's file"; fail=1; }
+  for q in "$p" "$work/$kind/moved"; do
+    env -u LD_LIBRARY_PATH "$q/bin/vdsh-info" --verify "$work/$kind/c.vdsh" > /dev/null ||
+      { echo "FAIL: $kind: installed ${q#$work/}/bin/vdsh-info cannot read the consumer's file"; fail=1; }
+  done
+  env -u LD_LIBRARY_PATH "$p/bin/vdsh-view" --help > /dev/null 2>&1 ||
+    { echo "FAIL: $kind: installed vdsh-view --help"; fail=1; }
+  out=$(env -u LD_LIBRARY_PATH "$c/context_consumer") && [ "$out" = "context: linked" ] ||
+    { echo "$out"; echo "FAIL: $kind: context consumer (find_package) run"; fail=1; }
+  # GLFW through the package's imported target, not a bare -lglfw that
+  # only the default linker path may satisfy.
+  if grep -qE '(^| )-lglfw( |$)' "$c/CMakeFiles/context_consumer.dir/link.txt"; then
+    echo "FAIL: $kind: vdsh::context links a bare -lglfw: $(cat "$c/CMakeFiles/context_consumer.dir/link.txt")"; fail=1
+  fi
   if command -v pkg-config > /dev/null; then
     flags=$(PKG_CONFIG_PATH="$p/lib/pkgconfig" pkg-config --cflags --libs \
             $([ $kind = static ] && echo --static) vdsh-runtime) ||
@@ -61,7 +93,16 @@ for kind in shared static; do
     fi
     LD_LIBRARY_PATH="$p/lib" "$work/$kind/pc-consumer" "$work/$kind/d.vdsh" | grep -q "read back ok" ||
       { echo "FAIL: $kind: pkg-config consumer run"; fail=1; }
-    echo "$kind, pkg-config: builds and runs"
+    flags=$(PKG_CONFIG_PATH="$p/lib/pkgconfig" pkg-config --cflags --libs \
+            $([ $kind = static ] && echo --static) vdsh-context) ||
+      { echo "FAIL: $kind: pkg-config vdsh-context"; fail=1; continue; }
+    if ! "$cc" -o "$work/$kind/pc-context" "$src/tests/install_consumer/context_consumer.c" $flags \
+         > "$work/$kind.pc-context.log" 2>&1; then
+      cat "$work/$kind.pc-context.log"; echo "FAIL: $kind: context consumer with pkg-config ($flags)"; fail=1; continue
+    fi
+    LD_LIBRARY_PATH="$p/lib" "$work/$kind/pc-context" | grep -q "context: linked" ||
+      { echo "FAIL: $kind: pkg-config context consumer run"; fail=1; }
+    echo "$kind, pkg-config: builds and runs (runtime, context)"
   fi
 done
 [ $fail -eq 0 ] && echo "the package installs, and a consumer builds and runs against it (shared and static)"

@@ -2,7 +2,10 @@
 against the C reader (tools/vdsh-info, formats/vdsh.c).
 
 Installs python/ with pip (--no-build-isolation --no-index, into WORK: no
-network, Debian's pip and setuptools), imports it from there, and checks:
+network, Debian's pip and setuptools) straight from the checkout, as the
+README says, and checks that the install leaves the checkout as it was (no
+python/build/, python/vdsh.egg-info/: issue 26; what it left is reported,
+then removed); imports it from WORK, and checks:
 - the SH basis against formats/VDSH.md's table of values;
 - on files baked here (default (s8s6), f16, s8, paper f32, lsq with the
   quantity chosen per order, a Hann window, with --record-timings) and on every file of
@@ -39,13 +42,44 @@ shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
 fail = []
 
-# Install the package as a user would, from a copy (pip builds in place).
-pkg = os.path.join(work, "python")
-shutil.copytree(os.path.join(src, "python"), pkg)
+# Install the package as a user would, from the checkout itself; the
+# checkout must stay as it was (every file, ignored ones too; and git's
+# view of it where it is a git checkout).
+pkg = os.path.join(src, "python")
+
+
+def tree(top):
+    return {os.path.relpath(os.path.join(d, n), top)
+            for d, dirs, files in os.walk(top) for n in dirs + files}
+
+
+def git_status():
+    try:
+        r = subprocess.run(["git", "-C", src, "status", "--porcelain", "--ignored", "--",
+                            "python"], capture_output=True, text=True)
+    except OSError:
+        return None
+    return r.stdout if r.returncode == 0 else None
+
+
+before, git_before = tree(pkg), git_status()
 target = os.path.join(work, "site")
 r = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-build-isolation",
                     "--no-deps", "--no-index", "--target", target, pkg],
                    capture_output=True, text=True)
+left = sorted(tree(pkg) - before)
+git_after = git_status()
+for rel in left:  # report, then leave the checkout clean
+    path = os.path.join(pkg, rel)
+    if os.path.isdir(path) and not os.path.islink(path):
+        shutil.rmtree(path, ignore_errors=True)
+    elif os.path.lexists(path):
+        os.remove(path)
+if left:
+    fail.append("pip install ./python left in the checkout: %s"
+                % ", ".join(x for x in left if os.sep not in x))
+if git_before is not None and git_after != git_before:
+    fail.append("git status of python/ changed by pip install: %r -> %r" % (git_before, git_after))
 if r.returncode:
     sys.exit("FAIL: pip install ./python: %s" % r.stderr)
 sys.path.insert(0, target)

@@ -1,35 +1,58 @@
 #!/usr/bin/env bash
 # scripts/bake-parallel with real GNU parallel: 5 shards on local job slots
-# merge to the whole bake's file byte for byte; a rerun with one part
-# removed bakes only that one; each shard's progress is in the output.
-# Installs Debian's parallel when root and it is missing; skips (77) when
-# it cannot be had.
+# merge to the whole bake's file byte for byte, into an output whose name
+# has a space, a quote and a dollar sign (issue 26); a rerun with a part
+# already there bakes only the others. The usage text is the header comment
+# only (issue 26: it ended with the script's `set -euo pipefail`). Installs
+# Debian's parallel when root and it is missing; skips (77) when it cannot
+# be had. Each shard's progress is in the output.
 # Usage: test_shard_parallel.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
+fail=0
+# The usage text (needs no parallel).
+usage=$("$scripts/bake-parallel" 2>&1); rc=$?
+[[ $rc -eq 2 ]] || { echo "FAIL: bake-parallel without arguments exits $rc, not 2" >&2; fail=1; }
+grep -q 'scripts/bake-parallel N OUT.vdsh' <<<"$usage" || { echo "FAIL: no usage line: $usage" >&2; fail=1; }
+if grep -qE 'set -e|pipefail|^if |^fi' <<<"$usage"; then
+  echo "FAIL: the usage text shows code:" >&2; echo "$usage" | tail -3 >&2; fail=1
+fi
+"$scripts/bake-parallel" --help 2>/dev/null | grep -q 'scripts/bake-parallel N OUT.vdsh' ||
+  { echo "FAIL: bake-parallel --help" >&2; fail=1; }
 if ! command -v parallel >/dev/null; then
   if [[ $(id -u) -eq 0 ]]; then
     apt-get install -y --no-install-recommends parallel >/dev/null 2>&1 || true
   fi
-  command -v parallel >/dev/null || { echo "SKIP: no GNU parallel"; exit 77; }
+  command -v parallel >/dev/null || { [[ $fail -eq 0 ]] || exit 1; echo "SKIP: no GNU parallel"; exit 77; }
 fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fail=0
 tiny=(builtin:room --max-edge 1.5 --rays 32 --cube-size 8)
 "$bake" "${tiny[@]}" -q -o "$tmp/whole.vdsh" || { echo "FAIL: whole bake" >&2; exit 1; }
 export VDSH_BAKE=$bake VDSH_MERGE=$merge
-if ! "$scripts/bake-parallel" 5 "$tmp/scene.vdsh" -j 2 -- "${tiny[@]}" 2>"$tmp/err.txt"; then
+name="$tmp/it's a \$cene"
+if ! "$scripts/bake-parallel" 5 "$name.vdsh" -j 2 -- "${tiny[@]}" 2>"$tmp/err.txt"; then
   echo "FAIL: bake-parallel:" >&2; cat "$tmp/err.txt" >&2; fail=1
 fi
-cmp "$tmp/scene.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: parallel merge differs" >&2; fail=1; }
+cmp "$name.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: parallel merge differs" >&2; fail=1; }
 # The shards' progress stays in the output (the recipe no longer passes -q).
 [[ $(grep -c '^vdsh-bake: 100.0%' "$tmp/err.txt") -ge 5 ]] ||
   { echo "FAIL: 5 shards' progress expected:" >&2; cat "$tmp/err.txt" >&2; fail=1; }
 for k in 09-12 13-16 17-20 21-24; do
-  cmp "$tmp/scene.sh$k.exr" "$tmp/whole.sh$k.exr" || { echo "FAIL: cubemap $k" >&2; fail=1; }
+  cmp "$name.sh$k.exr" "$tmp/whole.sh$k.exr" || { echo "FAIL: cubemap $k" >&2; fail=1; }
 done
-ls "$tmp"/scene.part-* >/dev/null 2>&1 && { echo "FAIL: parts left behind" >&2; fail=1; }
+ls "$name".part-* >/dev/null 2>&1 && { echo "FAIL: parts left behind" >&2; fail=1; }
+# A rerun after a failure: part 2 is there, the other four are baked (a
+# wrapper logs the shards it runs), and the merge is the whole bake's.
+"$bake" "${tiny[@]}" -q --shard 2/5 -o "$tmp/again.part-2.vdsh" || { echo "FAIL: shard 2/5" >&2; fail=1; }
+printf '#!/bin/sh\nfor a in "$@"; do case $a in */5) echo "$a" >> %q;; esac; done\nexec %q "$@"\n' \
+  "$tmp/shards.log" "$bake" > "$tmp/logging-bake"
+chmod +x "$tmp/logging-bake"
+VDSH_BAKE=$tmp/logging-bake "$scripts/bake-parallel" 5 "$tmp/again.vdsh" -j 2 -- "${tiny[@]}" 2>"$tmp/err.txt" ||
+  { echo "FAIL: bake-parallel rerun:" >&2; cat "$tmp/err.txt" >&2; fail=1; }
+ran=$(sort "$tmp/shards.log" 2>/dev/null | tr '\n' ' ')
+[[ $ran == "0/5 1/5 3/5 4/5 " ]] || { echo "FAIL: the rerun baked shards '$ran', not 0 1 3 4" >&2; fail=1; }
+cmp "$tmp/again.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: rerun merge differs" >&2; fail=1; }
 # A failing shard fails the run and writes no merged file.
 if "$scripts/bake-parallel" 3 "$tmp/bad.vdsh" -- "${tiny[@]}" --rays 0 2>/dev/null; then
   echo "FAIL: a failing shard did not fail the run" >&2; fail=1

@@ -5,10 +5,26 @@
 # submits the shard array and the dependent merge job, compares the merged
 # file with the whole bake byte for byte, then stops the daemons it started
 # by their pids. Skips (77) when not root or when Slurm cannot be had.
+# Issue 26: the usage text is the header comment only (no code line); bad
+# bake arguments are refused before anything is submitted (vdsh-bake's
+# message, its exit status, no job queued); a shard that fails after
+# submission gets the merge job cancelled, not left pending forever; the
+# output's name has a space and a quote.
 # Usage: test_shard_slurm.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
-[[ $(id -u) -eq 0 ]] || { echo "SKIP: needs root to start slurmctld and slurmd"; exit 77; }
+fail=0
+# The usage text (needs no Slurm).
+usage=$("$scripts/bake-slurm" 2>&1); rc=$?
+[[ $rc -eq 2 ]] || { echo "FAIL: bake-slurm without arguments exits $rc, not 2" >&2; fail=1; }
+grep -q 'scripts/bake-slurm N OUT.vdsh' <<<"$usage" || { echo "FAIL: no usage line: $usage" >&2; fail=1; }
+if grep -qE 'set -e|pipefail|^if |^fi' <<<"$usage"; then
+  echo "FAIL: the usage text shows code:" >&2; echo "$usage" | tail -3 >&2; fail=1
+fi
+"$scripts/bake-slurm" --help 2>/dev/null | grep -q 'scripts/bake-slurm N OUT.vdsh' ||
+  { echo "FAIL: bake-slurm --help" >&2; fail=1; }
+skip() { [[ $fail -eq 0 ]] || exit 1; echo "SKIP: $1"; exit 77; }
+[[ $(id -u) -eq 0 ]] || skip "needs root to start slurmctld and slurmd"
 if ! command -v slurmctld >/dev/null || ! command -v slurmd >/dev/null || ! command -v munged >/dev/null; then
   for try in 1 2 3 4 5 6; do # apt's lock may be busy
     apt-get install -y --no-install-recommends slurm-wlm munge >/dev/null 2>&1 && break
@@ -16,12 +32,13 @@ if ! command -v slurmctld >/dev/null || ! command -v slurmd >/dev/null || ! comm
   done
 fi
 for p in munged slurmctld slurmd sbatch squeue; do
-  command -v $p >/dev/null || { echo "SKIP: no $p (slurm-wlm, munge)"; exit 77; }
+  command -v $p >/dev/null || skip "no $p (slurm-wlm, munge)"
 done
 tmp=$(mktemp -d /tmp/vdsh-slurm.XXXXXX)
 chmod 755 "$tmp"
 pids=()
 cleanup() {
+  [[ -n ${SLURM_CONF:-} ]] && scancel --user=root --quiet 2>/dev/null
   for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null; done
   for pid in "${pids[@]}"; do
     for i in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
@@ -30,7 +47,6 @@ cleanup() {
   rm -rf "$tmp"
 }
 trap cleanup EXIT
-fail=0
 # Ports of our own (other test runs may start their own Slurm beside us).
 base=$((20000 + RANDOM % 20000))
 mkdir -p "$tmp/state" "$tmp/spool" "$tmp/munge" "$tmp/run"
@@ -90,24 +106,70 @@ done
 tiny=(builtin:room --max-edge 1.5 --rays 32 --cube-size 8)
 "$bake" "${tiny[@]}" -q -o "$tmp/whole.vdsh" || { echo "FAIL: whole bake" >&2; exit 1; }
 export VDSH_BAKE=$bake VDSH_MERGE=$merge
-job=$("$scripts/bake-slurm" 4 "$tmp/scene.vdsh" --cpus-per-task=1 -- "${tiny[@]}" --threads 1) ||
+# The state a job ends in (or the last seen after ~120 s).
+final_state() {
+  local state=
+  for i in $(seq 600); do
+    state=$(scontrol show job "$1" 2>/dev/null | grep -o 'JobState=[A-Z_]*' | cut -d= -f2)
+    case $state in COMPLETED|FAILED|CANCELLED|TIMEOUT|NODE_FAIL|OUT_OF_MEMORY) break ;; esac
+    sleep 0.2
+  done
+  echo "${state:-unknown}"
+}
+queued() { squeue -h -o %i 2>/dev/null | wc -l; }
+# A name with a space and a quote.
+name="$tmp/it's a scene"
+job=$("$scripts/bake-slurm" 4 "$name.vdsh" --cpus-per-task=1 -- "${tiny[@]}" --threads 1) ||
   { echo "FAIL: bake-slurm" >&2; dump; exit 1; }
-done_=0
-for i in $(seq 600); do
-  state=$(scontrol show job "$job" 2>/dev/null | grep -o 'JobState=[A-Z_]*' | cut -d= -f2)
-  case $state in COMPLETED) done_=1; break ;; FAILED|CANCELLED|TIMEOUT|NODE_FAIL|OUT_OF_MEMORY) break ;; esac
-  sleep 0.2
-done
-if [[ $done_ -ne 1 ]]; then
-  echo "FAIL: merge job $job ended as '${state:-unknown}'" >&2; squeue >&2; cat "$tmp"/scene.slurm-*.log >&2; dump; fail=1
+state=$(final_state "$job")
+if [[ $state != COMPLETED ]]; then
+  echo "FAIL: merge job $job ended as '$state'" >&2; squeue >&2; cat "$name".slurm-*.log >&2; dump; fail=1
 fi
-cmp "$tmp/scene.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: Slurm merge differs from the whole bake" >&2; fail=1; }
+cmp "$name.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: Slurm merge differs from the whole bake" >&2; fail=1; }
 for k in 09-12 13-16 17-20 21-24; do
-  cmp "$tmp/scene.sh$k.exr" "$tmp/whole.sh$k.exr" || { echo "FAIL: cubemap $k" >&2; fail=1; }
+  cmp "$name.sh$k.exr" "$tmp/whole.sh$k.exr" || { echo "FAIL: cubemap $k" >&2; fail=1; }
 done
-ls "$tmp"/scene.part-* >/dev/null 2>&1 && { echo "FAIL: parts left behind" >&2; fail=1; }
+ls "$name".part-* >/dev/null 2>&1 && { echo "FAIL: parts left behind" >&2; fail=1; }
 # Each shard's log keeps its progress (the recipe no longer passes -q).
-for f in "$tmp"/scene.slurm-*_*.log; do
+for f in "$name".slurm-*_*.log; do
   grep -q '^vdsh-bake: 100.0%' "$f" || { echo "FAIL: no progress in $f" >&2; cat "$f" >&2; fail=1; }
 done
+
+# Bad bake arguments: refused before submitting, with vdsh-bake's message
+# and exit status (2: usage); nothing queued.
+before=$(queued)
+if out=$("$scripts/bake-slurm" 4 "$tmp/bad.vdsh" -- "${tiny[@]}" --rays 0 2>"$tmp/bad.err"); then
+  echo "FAIL: bake-slurm submitted a bake with --rays 0 (job $out)" >&2; fail=1
+else
+  rc=$?
+  [[ $rc -eq 2 ]] || { echo "FAIL: bad arguments: exit $rc, not vdsh-bake's 2" >&2; fail=1; }
+  grep -q -- "--rays takes" "$tmp/bad.err" || { echo "FAIL: no vdsh-bake message:" >&2; cat "$tmp/bad.err" >&2; fail=1; }
+fi
+[[ $(queued) -eq $before ]] || { echo "FAIL: jobs queued for bad arguments:" >&2; squeue >&2; fail=1; }
+# A missing mesh: the same.
+"$scripts/bake-slurm" 4 "$tmp/bad.vdsh" -- "$tmp/no such mesh.obj" 2>"$tmp/bad.err" >/dev/null &&
+  { echo "FAIL: bake-slurm submitted a bake of a missing mesh" >&2; fail=1; }
+[[ $(queued) -eq $before ]] || { echo "FAIL: jobs queued for a missing mesh:" >&2; squeue >&2; fail=1; }
+
+# A shard that fails after submission (shard 1 of 4, through a wrapper that
+# passes the check): the merge job is cancelled, not left pending.
+cat > "$tmp/flaky-bake" <<WRAP
+#!/bin/sh
+for a in "\$@"; do [ "\$a" = 1/4 ] && { echo "flaky-bake: shard 1 fails" >&2; exit 1; }; done
+exec "$bake" "\$@"
+WRAP
+chmod +x "$tmp/flaky-bake"
+job=$(VDSH_BAKE=$tmp/flaky-bake "$scripts/bake-slurm" 4 "$tmp/flaky.vdsh" --cpus-per-task=1 -- "${tiny[@]}" --threads 1) ||
+  { echo "FAIL: bake-slurm (flaky shard)" >&2; fail=1; }
+if [[ -n $job ]]; then
+  state=$(final_state "$job")
+  [[ $state == CANCELLED ]] ||
+    { echo "FAIL: merge job $job after a failed shard: '$state', not CANCELLED" >&2; squeue >&2; fail=1; }
+  [[ -e $tmp/flaky.vdsh ]] && { echo "FAIL: merged despite a failed shard" >&2; fail=1; }
+  for i in $(seq 600); do [[ $(queued) -eq 0 ]] && break; sleep 0.2; done
+  # The shards that succeeded keep their parts, for the resubmission.
+  for i in 0 2 3; do
+    [[ -e $tmp/flaky.part-$i.vdsh ]] || { echo "FAIL: part $i of the failed bake removed" >&2; fail=1; }
+  done
+fi
 exit $fail
