@@ -348,8 +348,8 @@ static void test_errors(void)
  * each refused quantity explained, its parameters consistent. */
 static void test_method_table(void)
 {
-    CHECK(vb_method_name((vb_method)0) == vdsh_method_name(VDSH_METHOD_SHADOW),
-          "zero is the default method, shadow");
+    CHECK(vb_method_name((vb_method)0) == vdsh_method_name(VDSH_METHOD_DECISION),
+          "zero is the default method, decision");
     int rows = 0;
     for (uint32_t v = 0; v < 64; v++) {
         const char *name = vdsh_method_name(v);

@@ -503,12 +503,12 @@ static void test_orient_in_bake(void)
     CHECK(memcmp(oa.coeffs[3], ob.coeffs[3], 9 * n * sizeof(float)) == 0,
           "the same coefficients either way");
     CHECK(oa.moved_origins == ob.moved_origins, "the same origins repaired");
-    /* A zeroed description is vdsh-bake's defaults: method shadow, its
+    /* A zeroed description is vdsh-bake's defaults: method decision, its
      * log distance, oriented receivers, order 5. */
     vb_bake_desc z = {.receivers = &rec, .scene = s, .rays = 64, .threads = 2};
     vb_bake_output oz = {0};
     CHECK(vb_bake_run(&z, &oz, &err) == VB_OK, "bake, zeroed description: %s", err.msg);
-    CHECK(oz.method == VDSH_METHOD_SHADOW && oz.quantity[5] == VDSH_QUANTITY_LOG_DISTANCE &&
+    CHECK(oz.method == VDSH_METHOD_DECISION && oz.quantity[5] == VDSH_QUANTITY_LOG_DISTANCE &&
               oz.coeffs[5] && oz.flipped_normals == flipped && oz.normals,
           "zeroed description: method %s, quantity %s, %u flipped",
           vdsh_method_name(oz.method), vdsh_quantity_name(oz.quantity[5]), oz.flipped_normals);

@@ -31,12 +31,12 @@ extern "C" {
  * file stores (vdsh_method, whose numbers never change). The table is in
  * this order, which is also the CLI's. */
 typedef enum vb_method {
-    VB_METHOD_SHADOW = 0, /* the default */
+    VB_METHOD_DECISION = 0, /* the default (issue 25) */
+    VB_METHOD_SHADOW,
     VB_METHOD_LSQ,
     VB_METHOD_MIRROR,
     VB_METHOD_PAPER,
     VB_METHOD_FULL,
-    VB_METHOD_DECISION,
     VB_METHOD_COUNT
 } vb_method;
 

@@ -179,19 +179,32 @@ static void usage(FILE *f)
 "      --max-order N       the adaptive order's cap (default 12)\n"
 "      --method M          the fit:\n"
 "%s"
-"      --quantity Q        what the SH store: auto (default): log for shadow,\n"
+"      --quantity Q        what the SH store: auto (default): log for decision\n"
+"                          and shadow,\n"
 "                          distance for paper, and for the others per order\n"
 "                          the one with the lower expected shadow error on\n"
 "                          1024 sampled receivers; distance; log:\n"
 "                          ln(distance), reconstructed as exp of the SH sum\n"
-"                          (not with paper; the only one with shadow)\n"
+"                          (not with paper; the only one with decision and\n"
+"                          shadow)\n"
 "      --log               the same as --quantity log\n"
-"      --lambda X          lsq regularisation weight (default %g; shadow\n"
-"                          uses lsq's default)\n"
-"      --log-offset X      shadow: added to the fitted ln d at every order\n"
-"                          (default per order 2/3/5: %.2f/%.2f/%.2f, chosen\n"
-"                          on validation scenes); recorded as the stream's\n"
-"                          method parameter\n"
+"      --lambda X          lsq regularisation weight (default %g; decision\n"
+"                          and shadow use lsq's default)\n"
+"      --log-offset X      decision, shadow: added to the fitted ln d at every\n"
+"                          order (decision: calibrated per scene and order at\n"
+"                          bake time; shadow: per order 2/3/5 %.2f/%.2f/%.2f,\n"
+"                          chosen on validation scenes); recorded as the\n"
+"                          stream's method parameter\n"
+"      --false-rate R      decision: the share of lit (light, receiver) pairs\n"
+"                          the calibrated offset leaves in false shadow, on\n"
+"                          held-out lights (default 0.008)\n"
+"      --decision-lights N decision: training lights per receiver, each\n"
+"                          traced (1..1024, default 256)\n"
+"      --decision-params TAU,LIT,RIDGE,RIDGE0,STEPS\n"
+"                          decision: the loss's temperature (ln units), the\n"
+"                          weight of lit pairs, the ridge per (l(l+1))^2 and\n"
+"                          on every coefficient toward the lsq fit, Newton\n"
+"                          steps (default 0.5,8,1e-5,1e-4,6)\n"
 "      --window W          per-band window on the coefficients: none (default),\n"
 "                          hann or lanczos (width: the order)\n"
 "      --log-floor D       log-distance: distances below D count as D\n"
@@ -460,6 +473,23 @@ static int write_report(const char *path, const options *o, const vb_job *job,
     } else {
         vt_json_null(&j, root, "adaptive");
     }
+    if (b->method == VDSH_METHOD_DECISION) {
+        cJSON *dec = vt_json_object(&j, root, "decision");
+        vt_json_u64(&j, dec, "lights", b->decision_lights);
+        vt_json_u64(&j, dec, "fitted", b->decision_fitted);
+        vt_json_u64(&j, dec, "kept_lsq", b->decision_fallbacks);
+        vt_json_f64(&j, dec, "mean_pairs", b->decision_pairs);
+        vt_json_u64(&j, dec, "calibration_receivers", b->calibration_receivers);
+        vt_json_f32(&j, dec, "false_rate", b->false_rate);
+        cJSON *off = vt_json_object(&j, dec, "log_offsets");
+        for (int i = 0; i < o->order_count; i++) {
+            char key[8];
+            snprintf(key, sizeof key, "%d", o->orders[i]);
+            vt_json_f32(&j, off, key, b->log_offset[o->orders[i]]);
+        }
+    } else {
+        vt_json_null(&j, root, "decision");
+    }
     vt_json_u64(&j, root, "seed", o->seed);
     vt_json_u64(&j, root, "threads", b->threads);
     vt_json_bool(&j, root, "robust", o->robust);
@@ -579,7 +609,7 @@ int main(int argc, char **argv)
     options o = {0};
     o.rays = 2500;
     o.orders[0] = 2, o.orders[1] = 3, o.orders[2] = 5, o.order_count = 3;
-    /* method and quantity: 0 is the default (shadow, auto) */
+    /* method and quantity: 0 is the default (decision, auto) */
     o.encoding = VB_DEFAULT_ENCODING;
     o.seed = 1;
     o.robust = 1;
@@ -846,7 +876,10 @@ int main(int argc, char **argv)
     if (o.quantity != VB_QUANTITY_AUTO && !(mi->quantities & VB_QUANTITY_BIT(stored)))
         return bad_usage("%s", mi->refused[stored]);
     if (o.have_log_offset && mi->param != VB_PARAM_LOG_OFFSET)
-        return bad_usage("%s", "--log-offset is method shadow's");
+        return bad_usage("%s", "--log-offset is methods decision's and shadow's");
+    if ((o.false_rate != 0.0f || o.decision_lights || o.have_decision) && !mi->decision)
+        return bad_usage("%s", "--false-rate, --decision-lights and --decision-params are "
+                               "method decision's");
     if (o.lambda != 0.0f && mi->lambda_fixed)
         return bad_usage("--lambda is lsq's: method %s uses lsq's default (its method "
                          "parameter is the log offset)", vb_method_name(o.method));
@@ -859,7 +892,7 @@ int main(int argc, char **argv)
     if (o.order_tolerance > 0.0f &&
         !(mi->quantities & VB_QUANTITY_BIT(VDSH_QUANTITY_LOG_DISTANCE)))
         return bad_usage("--adaptive-order fits the log distance: method %s does not (use "
-                         "shadow, the default)", vb_method_name(o.method));
+                         "decision, the default, or shadow)", vb_method_name(o.method));
     if (o.order_tolerance > 0.0f && !o.orders_given)
         o.order_count = 0; /* the variable-order stream alone */
 
@@ -1014,6 +1047,25 @@ int main(int argc, char **argv)
                 bo->origins.seconds, (unsigned long long)bo->origins.probe_rays,
                 bo->rays_traced ? 100.0 * bo->origins.probe_rays / bo->rays_traced : 0.0,
                 bo->origins.flagged, bo->origins.moved);
+    if (log && bo->method == VDSH_METHOD_DECISION) {
+        if (!bo->decision_lights)
+            fprintf(log, "vdsh-bake: warning: no free space for lights in this scene: every "
+                         "receiver keeps its least-squares fit\n");
+        else
+            fprintf(log, "vdsh-bake: decision fit: %u receivers fitted on %.0f traced lights "
+                         "each on average, %u with fewer than 16 lights above their horizon "
+                         "kept the least-squares fit\n",
+                    bo->decision_fitted, bo->decision_pairs, bo->decision_fallbacks);
+        if (bo->calibration_receivers) {
+            fprintf(log, "vdsh-bake: log offsets calibrated on %u receivers for %.1f%% false "
+                         "shadow on held-out lights:", bo->calibration_receivers,
+                    100.0 * bo->false_rate);
+            for (int s = 0; s < o.order_count; s++)
+                fprintf(log, "%s order %d %+.3f", s ? "," : "", o.orders[s],
+                        (double)bo->log_offset[o.orders[s]]);
+            fputc('\n', log);
+        }
+    }
     if (log && bo->auto_receivers > 0) {
         fprintf(log, "vdsh-bake: quantity chosen on %u sampled receivers (expected shadow "
                      "error, distance / log):", bo->auto_receivers);
