@@ -673,8 +673,11 @@ static void test_adaptive_order(void)
         if (vb_order_candidate(k, CAP))
             mask |= 1u << k;
     for (int i = 0; i < 3 && sc; i++) {
+        /* Method shadow: its fixed orders are the lsq fits the adaptive
+         * order chooses among (method decision refits its fixed orders). */
         vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = sc, .rays = 400,
                           .seed = 5, .threads = 1, .order_mask = mask,
+                          .method = VB_METHOD_SHADOW,
                           .order_tolerance = tols[i], .variable_cap = CAP};
         CHECK(vb_bake_run(&d, &b[i], &err) == VB_OK, "bake %d: %s", i, err.msg);
         if (i == 0) {
@@ -683,6 +686,28 @@ static void test_adaptive_order(void)
             d.range_begin = 37, d.range_end = 101;
             CHECK(vb_bake_run(&d, &part, &err) == VB_OK, "range: %s", err.msg);
             d.range_begin = d.range_end = 0;
+            /* Method decision: the variable-order stream is shadow's, the
+             * same rows for the whole bake and a range of it. */
+            vb_bake_output dw = {0}, dr = {0};
+            d.method = VB_METHOD_DECISION;
+            CHECK(vb_bake_run(&d, &dw, &err) == VB_OK, "decision: %s", err.msg);
+            d.range_begin = 37, d.range_end = 101;
+            CHECK(vb_bake_run(&d, &dr, &err) == VB_OK, "decision, range: %s", err.msg);
+            d.range_begin = d.range_end = 0;
+            if (dw.variable_orders && dr.variable_orders) {
+                CHECK(dw.variable_method == VDSH_METHOD_SHADOW && dw.method == VDSH_METHOD_DECISION,
+                      "decision: variable stream %s", vdsh_method_name(dw.variable_method));
+                CHECK(memcmp(dw.variable_orders, b[0].variable_orders, NP) == 0,
+                      "decision: the adaptive order is shadow's");
+                CHECK(memcmp(dw.variable_orders + 37, dr.variable_orders, 64) == 0 &&
+                          memcmp(dw.variable_coeffs + (size_t)37 * CAP * CAP, dr.variable_coeffs,
+                                 (size_t)64 * CAP * CAP * 4) == 0 &&
+                          memcmp(dw.coeffs[CAP] + (size_t)37 * CAP * CAP, dr.coeffs[CAP],
+                                 (size_t)64 * CAP * CAP * 4) == 0,
+                      "decision: a range's rows differ from the whole bake's");
+            }
+            vb_bake_output_free(&dw);
+            vb_bake_output_free(&dr);
             d.method = VB_METHOD_PAPER;
             vb_bake_output x = {0};
             CHECK(vb_bake_run(&d, &x, &err) == VB_ERR_ARGUMENT &&

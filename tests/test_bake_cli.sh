@@ -125,11 +125,12 @@ cp "$tmp/a.vdsh" "$tmp/keep.vdsh"
 expect_exit 1 "bad input over an existing file" "$bake" "$tmp/empty.obj" -q -o "$tmp/keep.vdsh"
 check "existing output untouched" cmp -s "$tmp/a.vdsh" "$tmp/keep.vdsh"
 
-# The shadow method's log offset: recorded per stream as its method parameter.
+# An explicit log offset (the default method, decision: instead of its
+# calibration): recorded per stream as its method parameter.
 expect_exit 0 "bake --log-offset" "$bake" "${quick[@]}" --log-offset 0.25 -o "$tmp/off.vdsh"
 "$info" --json - "$tmp/off.vdsh" >"$tmp/off.json"
 check "log offset recorded" json "$tmp/off.json" \
-  "all(s['method'] == 'shadow' and abs(s['method_param'] - 0.25) < 1e-7 for s in d['streams'])"
+  "all(s['method'] == 'decision' and abs(s['method_param'] - 0.25) < 1e-7 for s in d['streams'])"
 
 # --rays auto: byte-identical across thread counts, the cap and tolerance in
 # the report, fewer rays than the cap; --ray-tolerance only with it.

@@ -1018,7 +1018,8 @@ static void test_names(void)
     CHECK(!strcmp(vdsh_method_name(2), "mirror"));
     CHECK(!strcmp(vdsh_method_name(3), "lsq"));
     CHECK(!strcmp(vdsh_method_name(4), "shadow"));
-    CHECK(!strcmp(vdsh_method_name(5), "?"));
+    CHECK(!strcmp(vdsh_method_name(5), "decision"));
+    CHECK(!strcmp(vdsh_method_name(6), "?"));
     CHECK(!strcmp(vdsh_encoding_name(0), "f32"));
     CHECK(!strcmp(vdsh_encoding_name(1), "f16"));
     CHECK(!strcmp(vdsh_encoding_name(2), "s8"));

@@ -5,9 +5,12 @@
 #   - the closed built-in room: no ray escapes, with every ISA;
 #   - every stream within 1e-3 of its largest |coefficient| at every
 #     vertex (robust traversal, the default: measured <= 5e-4);
-#   - Sponza (when ../shared/scenes is there): within 0.02 of the largest
-#     |coefficient|, at most 0.05% of the vertices beyond 1e-3 (measured:
-#     0.016 and 3 of 60,848 vertices; with --no-robust 0.13 and 45).
+#   - Sponza (when ../shared/scenes is there): within 0.05 of the largest
+#     |coefficient|, at most 0.05% of the vertices beyond 1e-3 (measured
+#     with the lsq fit: 0.016 and 3 of 60,848 vertices, with --no-robust
+#     0.13 and 45; with the decision fit, the default since issue 25: 0.029
+#     and 3: a training light's label that Embree's kernels see on either
+#     side of a silhouette moves its receiver's fit).
 # The same repair decisions everywhere: the moved-origin counts agree.
 # Adaptive order (issue 16): the room's variable-order stream chooses the
 # same order at all but 0.1% of the vertices (the choice itself is plain
@@ -56,7 +59,7 @@ if [[ ${ISA_ONE:-} == 1 ]]; then
     { echo "FAIL: $isa: room, decision fit" >&2; fail=1; }
   if [[ -f $REF/sponza.vdsh ]]; then
     "$bake" "$SPONZA" --rays 256 --cube-size 4 --encoding f16 -q -o "$REF/sponza-$isa.vdsh" || exit 1
-    "$compare" "$REF/sponza.vdsh" "$REF/sponza-$isa.vdsh" 0.02 0.0005 ||
+    "$compare" "$REF/sponza.vdsh" "$REF/sponza-$isa.vdsh" 0.05 0.0005 ||
       { echo "FAIL: $isa: Sponza" >&2; fail=1; }
     [[ $(stat "$REF/sponza-$isa.vdsh" moved_origins) == "$(stat "$REF/sponza.vdsh" moved_origins)" ]] ||
       { echo "FAIL: $isa: Sponza's moved origins differ" >&2; fail=1; }

@@ -93,7 +93,7 @@ typedef struct job {
     unsigned char *dec_scratch;
     float *cal_margins;
     _Atomic uint32_t dec_fitted, dec_fallbacks;
-    _Atomic uint64_t dec_pairs;
+    _Atomic uint64_t dec_pairs, dec_rays;
     _Atomic uint64_t traced, missed;
     _Atomic uint32_t degenerate;
 } job;
@@ -362,7 +362,7 @@ static uint32_t dec_pairs(const job *J, uint32_t *at, uint32_t *scanned, const f
  * CAL_LIGHTS further lights, held out from the fit: lit pairs' ln D - ln
  * d_L, NAN for shadowed ones and missing lights. */
 static void decision_vertex(job *J, uint32_t v, const float *org, const float n[3],
-                            const vertex_sink *out, uint64_t *traced)
+                            const vertex_sink *out)
 {
     const uint32_t K = VB_DECISION_MAX_PAIRS, top = J->order;
     float *x = (float *)out->dec_scratch, *y = x + K, *z = y + K, *logd = z + K, *Y = logd + K;
@@ -371,8 +371,8 @@ static void decision_vertex(job *J, uint32_t v, const float *org, const float n[
                             (((size_t)(4 * K + (size_t)top * top * K) * sizeof(float) + K + 63) &
                              ~(size_t)63));
     uint32_t at = dec_start(J, v), scanned = 0;
-    uint32_t m = dec_pairs(J, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab,
-                           traced);
+    uint64_t rays = 0;
+    uint32_t m = dec_pairs(J, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab, &rays);
     if (m >= DEC_MIN_PAIRS) {
         vdsh_sh_eval_soa((int)top, m, x, y, z, Y, K);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
@@ -383,11 +383,14 @@ static void decision_vertex(job *J, uint32_t v, const float *org, const float n[
     } else {
         atomic_fetch_add(&J->dec_fallbacks, 1);
     }
-    if (!out->cal)
+    if (!out->cal) {
+        atomic_fetch_add(&J->dec_rays, rays);
         return;
+    }
     for (size_t i = 0; i < (size_t)VDSH_ORDER_SLOTS * CAL_LIGHTS; i++)
         out->cal[i] = NAN;
-    uint32_t h = dec_pairs(J, &at, &scanned, org, n, CAL_LIGHTS, x, y, z, logd, lab, traced);
+    uint32_t h = dec_pairs(J, &at, &scanned, org, n, CAL_LIGHTS, x, y, z, logd, lab, &rays);
+    atomic_fetch_add(&J->dec_rays, rays);
     if (!h)
         return;
     vdsh_sh_eval_soa((int)top, h, x, y, z, Y, K);
@@ -654,7 +657,7 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
         }
     }
     if (J->decision && want[1])
-        decision_vertex(J, v, org, n, out, traced);
+        decision_vertex(J, v, org, n, out);
     /* Methods shadow and decision: the log offset, through c0 (Y00 is a
      * constant). */
     for (int o = 1; o <= VDSH_MAX_ORDER; o++)
@@ -874,6 +877,8 @@ static void calibrate_block(void *ctx, uint32_t begin, uint32_t end, unsigned wo
         float c[VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS];
         vertex_sink out = {.dec_scratch = J->dec_scratch + (size_t)worker * dec_scratch_bytes(J),
                            .cal = J->cal_margins + (size_t)i * VDSH_ORDER_SLOTS * CAL_LIGHTS};
+        if (J->var_scratch) /* its adaptive order too: the main pass skips it */
+            out.var_scratch = J->var_scratch + (size_t)worker * var_scratch_floats(J);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (J->coeffs[o])
                 out.coeffs[1][o] = c[o];
@@ -1327,6 +1332,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
         o.decision_pairs = o.decision_fitted
                                ? (double)atomic_load(&J->dec_pairs) / o.decision_fitted : 0.0;
         o.calibration_receivers = cal_count;
+        o.decision_rays = atomic_load(&J->dec_rays);
         o.false_rate = cal_count ? d.false_rate : 0.0f;
     }
     o.window = d.window;

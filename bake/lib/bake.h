@@ -186,6 +186,7 @@ typedef struct vb_bake_output {
      * the log offsets were given). decision_lights 0: no free space for
      * lights, every receiver kept its lsq fit. */
     uint32_t decision_fitted, decision_fallbacks, decision_lights, calibration_receivers;
+    uint64_t decision_rays;    /* rays toward the lights (not in rays_traced) */
     double decision_pairs;
     float false_rate;
     vdsh_window window;        /* applied */
