@@ -356,11 +356,17 @@ int main(int argc, char **argv)
         double start = now();
         pid_t pid = spawn(calib_args);
         int status;
+        /* The start of the last stretch in which each temporary is there:
+         * the checks before loading (every output writable) make and
+         * remove one of each first. */
+        int cube_on = 0, vdsh_on = 0;
         while (waitpid(pid, &status, WNOHANG) == 0) {
-            if (t_cube < 0 && has_temp(run_dir, ".exr.tmp"))
+            int c = has_temp(run_dir, ".exr.tmp"), v = has_temp(run_dir, ".vdsh.tmp");
+            if (c && !cube_on)
                 t_cube = now() - start;
-            if (t_vdsh < 0 && has_temp(run_dir, ".vdsh.tmp"))
+            if (v && !vdsh_on)
                 t_vdsh = now() - start;
+            cube_on = c, vdsh_on = v;
             sleep_s(50e-6);
         }
         T = now() - start;

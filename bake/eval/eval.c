@@ -1008,8 +1008,9 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the scene lights");
             goto done;
         }
-        r = vb_scene_place_lights(d.scene, purpose_seed(d.seed, PURPOSE_SCENE_LIGHTS), nl,
-                                 o.lights, &o.light_candidates, err);
+        r = vb_scene_place_lights_rule(d.scene, purpose_seed(d.seed, PURPOSE_SCENE_LIGHTS), nl,
+                                       (vb_light_rule)d.light_rule, o.lights,
+                                       &o.light_candidates, err);
         if (r != VB_OK)
             goto done;
         o.light_count = nl;

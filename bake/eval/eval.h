@@ -117,6 +117,7 @@ typedef struct vb_eval_desc {
                                   bake's --rays, rounded down to a grid */
     uint32_t lights;           /* scene lights (VB_EVAL_SCENE_LIGHTS): how many
                                   are placed in free space; 0: 32 */
+    int light_rule;            /* where (vb_light_rule, scene.h); 0: uniform */
     uint32_t worst;            /* worst receivers kept per (kind, stream);
                                   0: 10; at most VB_EVAL_MAX_WORST */
     int oracle;                /* 1: score the truth itself (D := d_T) instead

@@ -164,6 +164,78 @@ int vb_scene_free_space(const vb_scene *s, const float p[3])
     return vdsh_free_space(t, back, vdsh_free_clearance(s->diagonal));
 }
 
+/* The nearest surface along the 14 probe directions from p (scene units),
+ * INFINITY when none is met. */
+static float probe_nearest(const vb_scene *s, const float p[3])
+{
+    float dirs[VDSH_FREE_PROBES][3], o[3], best = INFINITY;
+    vdsh_free_probe_dirs(dirs);
+    vb_scene_to_local(s, p, o);
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    for (int i = 0; i < VDSH_FREE_PROBES; i++) {
+        struct RTCRay r = {.org_x = o[0], .org_y = o[1], .org_z = o[2], .dir_x = dirs[i][0],
+                           .dir_y = dirs[i][1], .dir_z = dirs[i][2], .tnear = 0.0f,
+                           .tfar = INFINITY, .mask = 0xffffffffu};
+        rtcOccluded1(s->scene, &ctx, &r);
+        if (r.tfar < 0.0f) { /* met something: find how far */
+            struct RTCRayHit rh = {.ray = {.org_x = o[0], .org_y = o[1], .org_z = o[2],
+                                           .dir_x = dirs[i][0], .dir_y = dirs[i][1],
+                                           .dir_z = dirs[i][2], .tnear = 0.0f,
+                                           .tfar = INFINITY, .mask = 0xffffffffu},
+                                   .hit = {.geomID = RTC_INVALID_GEOMETRY_ID}};
+            rtcIntersect1(s->scene, &ctx, &rh);
+            float d = rh.ray.tfar / s->scale;
+            best = d < best ? d : best;
+        }
+    }
+    return best;
+}
+
+const char *vb_light_rule_name(vb_light_rule rule)
+{
+    static const char *const names[] = {"uniform", "ceiling", "near", "path"};
+    return (unsigned)rule < sizeof names / sizeof names[0] ? names[rule] : "?";
+}
+
+vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t count,
+                                     vb_light_rule rule, float (*out)[3], uint32_t *tried,
+                                     vb_error *err)
+{
+    if (rule == VB_LIGHTS_UNIFORM)
+        return vb_scene_place_lights(s, seed, count, out, tried, err);
+    if ((unsigned)rule > VB_LIGHTS_PATH)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown light rule %d", (int)rule);
+    const float *lo = s->bounds_min, *hi = s->bounds_max;
+    uint32_t n = 0, k = 0;
+    const uint64_t limit = 1000ull * (count ? count : 1);
+    while (n < count && k < limit) {
+        float p[3];
+        vdsh_light_candidate(lo, hi, seed, k++, p);
+        float u = hi[1] > lo[1] ? (p[1] - lo[1]) / (hi[1] - lo[1]) : 0.5f;
+        if (rule == VB_LIGHTS_CEILING) { /* the top fifth of the height (+y up) */
+            p[1] = lo[1] + (0.8f + 0.2f * u) * (hi[1] - lo[1]);
+        } else if (rule == VB_LIGHTS_PATH) {
+            /* a walk along x at two thirds of the height, swinging across z */
+            float t = hi[0] > lo[0] ? (p[0] - lo[0]) / (hi[0] - lo[0]) : 0.5f;
+            p[1] = lo[1] + 0.66f * (hi[1] - lo[1]);
+            p[2] = 0.5f * (lo[2] + hi[2]) +
+                   0.3f * (hi[2] - lo[2]) * sinf(6.2831853f * t);
+        }
+        if (!vb_scene_free_space(s, p))
+            continue;
+        if (rule == VB_LIGHTS_NEAR && !(probe_nearest(s, p) < 0.05f * s->diagonal))
+            continue;
+        memcpy(out[n++], p, sizeof out[0]);
+    }
+    if (tried)
+        *tried = k;
+    if (n < count)
+        return vb_fail(err, VB_ERR_INVALID, "no room for %u lights by rule %s: %u found in %u "
+                       "candidates", count, vb_light_rule_name(rule), n, k);
+    return VB_OK;
+}
+
 vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count,
                                float (*out)[3], uint32_t *tried, vb_error *err)
 {

@@ -70,6 +70,24 @@ void vb_offset_origin(const float p[3], const float n[3], float out[3]);
 vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count,
                                float (*out)[3], uint32_t *tried, vb_error *err);
 
+/* Other ways to place lights, for reports that a figure does not hang on
+ * one light distribution (issue 25): all in free space, from the same
+ * seeded candidates: uniform (vb_scene_place_lights), near the ceiling
+ * (the top fifth of the bounds' height, +y up), near surfaces (a surface
+ * within 5% of the diagonal along a probe direction), along a path (a
+ * walk along x at two thirds of the height, swinging across z). */
+typedef enum vb_light_rule {
+    VB_LIGHTS_UNIFORM = 0,
+    VB_LIGHTS_CEILING,
+    VB_LIGHTS_NEAR,
+    VB_LIGHTS_PATH
+} vb_light_rule;
+
+vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t count,
+                                     vb_light_rule rule, float (*out)[3], uint32_t *tried,
+                                     vb_error *err);
+const char *vb_light_rule_name(vb_light_rule rule);
+
 /* Whether p (scene units) is in the free space of scene s: vdsh_light.h's
  * rule, its probes cast with Embree. The test vb_scene_place_lights applies
  * to every candidate (vdsh-frames applies it to eyes too). */

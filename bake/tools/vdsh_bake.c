@@ -599,7 +599,12 @@ static int check_outputs(const options *o, const vb_job_desc *jd, const char *co
     for (int i = 0; i < nmesh && i < VDSH_MAX_SOURCES; i++)
         ins[nin++] = meshes[i];
     ins[nin++] = o->receivers;
-    return vt_cli_check_outputs(outs, n, ins, nin);
+    /* The checks make and remove a temporary beside each output: an
+     * interrupt waits for them as for the writes (output_lock). */
+    pthread_mutex_lock(&output_lock);
+    int bad = vt_cli_check_outputs(outs, n, ins, nin);
+    pthread_mutex_unlock(&output_lock);
+    return bad;
 }
 
 int main(int argc, char **argv)

@@ -83,6 +83,10 @@ static void usage(FILE *f)
 "                          default); any seed, even the bake's, gives other\n"
 "                          directions than the bake's\n"
 "      --lights N          scene lights (default 32)\n"
+"      --light-rule R      where they go, all in free space: uniform (default),\n"
+"                          ceiling (the top fifth of the height, +y up), near\n"
+"                          (a surface within 5%% of the diagonal) or path (a\n"
+"                          walk along x at 2/3 of the height, swinging in z)\n"
 "      --orders LIST       only these orders, e.g. 3,5 (default: every stream)\n"
 "      --offsets LIST      the trade between recall and false shadows as a\n"
 "                          curve: each stream is also scored with each\n"
@@ -691,7 +695,7 @@ int main(int argc, char **argv)
 
     enum { O_POINTS = 256, O_INTERIOR, O_DIRECTIONS, O_SEED, O_ORDERS, O_ORACLE, O_INTERP,
            O_FAST, O_ALLOW, O_JSON, O_PV, O_BAKE_REPORT, O_WORST, O_THREADS, O_LIGHTS,
-           O_OFFSETS };
+           O_OFFSETS, O_LIGHT_RULE };
     static const struct option longopts[] = {
         {"points", required_argument, 0, O_POINTS},
         {"interior", required_argument, 0, O_INTERIOR},
@@ -708,6 +712,7 @@ int main(int argc, char **argv)
         {"worst", required_argument, 0, O_WORST},
         {"threads", required_argument, 0, O_THREADS},
         {"lights", required_argument, 0, O_LIGHTS},
+        {"light-rule", required_argument, 0, O_LIGHT_RULE},
         {"offsets", required_argument, 0, O_OFFSETS},
         {"quiet", no_argument, 0, 'q'},
         {"help", no_argument, 0, 'h'},
@@ -769,6 +774,17 @@ int main(int argc, char **argv)
                 return bad_usage("--lights takes a whole number 1..4096, not '%s'", optarg);
             d.lights = (uint32_t)u;
             break;
+        case O_LIGHT_RULE: {
+            int rule = -1;
+            for (int k = VB_LIGHTS_UNIFORM; k <= VB_LIGHTS_PATH; k++)
+                if (!strcmp(optarg, vb_light_rule_name((vb_light_rule)k)))
+                    rule = k;
+            if (rule < 0)
+                return bad_usage("--light-rule takes uniform, ceiling, near or path, not '%s'",
+                                 optarg);
+            d.light_rule = rule;
+            break;
+        }
         case O_OFFSETS:
             noffsets = vt_parse_floats(optarg, offsets, 1, VDSH_MAX_STREAMS - 1);
             for (int i = 0; i < noffsets; i++)
