@@ -31,8 +31,12 @@ if(VDSH_NODE)
 endif()
 
 #   gltf_web_viewer   runtime/web in headless chromium against vdsh-view's
-#                     shadow-only frame of the same view (skips with 77
-#                     without chromium or a GL context)
+#                     shadow-only frame of the same view (orders 2-12 and
+#                     the adaptive order), its default view against
+#                     vdsh-view --render's, quantised and meshopt glb files
+#                     (meshoptimizer from the npm fixture), and its error
+#                     messages on the page (skips with 77 without chromium
+#                     or a GL context)
 find_program(VDSH_CHROMIUM chromium)
 if(NOT VDSH_CHROMIUM)
   set(VDSH_CHROMIUM chromium)
@@ -41,8 +45,8 @@ add_test(NAME gltf_web_viewer
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_web_viewer.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-export> $<TARGET_FILE:vdsh-view>
                  ${VDSH_CHROMIUM} ${PROJECT_SOURCE_DIR}/runtime/web ${CMAKE_CURRENT_BINARY_DIR}/gltf_web
-                 ${VDSH_ASSIMP_MODELS})
-set_tests_properties(gltf_web_viewer PROPERTIES SKIP_RETURN_CODE 77)
+                 ${VDSH_ASSIMP_MODELS} "${VDSH_NODE}" ${CMAKE_BINARY_DIR}/npm/node_modules)
+set_tests_properties(gltf_web_viewer PROPERTIES SKIP_RETURN_CODE 77 FIXTURES_REQUIRED gltf_npm)
 
 #   gltf_robust_load  vb_mesh_load_memory is vb_mesh_load for glTF too: the
 #                     seeds and every assimp-testmodels glTF2 folder

@@ -14,6 +14,36 @@ average; it is also printed over the shadowed pixels alone). The frames
 must hold shadows (so a blank page cannot pass).
 The same for order 5 of Debian assimp-testmodels' 2CylinderEngine.glb
 (read by the glTF reader), seen and lit from outside.
+
+Orders above 5 and the adaptive order (issue 26: the page was blank for
+them): the room's bake also holds an order-12 stream and an adaptive-order
+stream (--adaptive-order, up to 12), drawn by the page's buffer path
+against vdsh-view's buf12 and adaptive modes, same tolerance.
+
+The default view (issue 26: the page looked at a room's outer wall and lit
+an object from inside it): the page opened with no camera and no light
+(shaded, its default stream) must draw vdsh-view --render's default
+picture of the same .vdsh (the camera, light, colours and fall-off of
+vdsh-view, from extras.vdsh.view of the glb), mean absolute RGB difference
+below 2/255, with the default light in free space (lights_free) and the
+picture not black; for the room and for the engine.
+
+Compressed glb (issue 26: the page said "ready" and drew nothing): the room
+rewritten by tests/web_glb_pack.mjs as gltfpack writes it
+(KHR_mesh_quantization: uint16 positions dequantised by the node's
+transform, int8 normals), and that compressed with EXT_meshopt_compression
+(meshoptimizer's encoder, the npm package, installed by
+scripts/npm_gltf_tools into MODULES), must draw the order-5 frame as the
+plain glb does; without meshopt_decoder.cjs beside the page the meshopt
+file must be refused with a visible message (#msg). Skipped without node
+or MODULES.
+
+Errors on the page (issue 26: a GLSL error in the tab title was the only
+sign): a file that is not a glb, a glb without VDSH streams (assimp's
+engine itself) and one that requires an extension the page does not read
+must each show a visible #msg element naming the problem (the DOM as
+chromium --dump-dom prints it).
+Arguments after ASSIMP_MODELS (optional): NODE MODULES.
 Exit 77 when vdsh-view cannot make a GL context or chromium is missing.
 """
 import json
@@ -26,6 +56,8 @@ import numpy as np
 from PIL import Image
 
 bake, export, view, chromium, webdir, work, models = sys.argv[1:8]
+node = sys.argv[8] if len(sys.argv) > 8 else ""
+modules = sys.argv[9] if len(sys.argv) > 9 else ""
 os.makedirs(work, exist_ok=True)
 if not shutil.which(chromium):
     print("no chromium: skipped")
@@ -47,6 +79,39 @@ for f in ("index.html", "vdsh_web.js"):
     shutil.copy(os.path.join(webdir, f), work)
 
 
+CHROME = [chromium, "--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+          "--allow-file-access-from-files", "--hide-scrollbars", "--force-device-scale-factor=1",
+          "--window-size=800,600", "--virtual-time-budget=20000"]
+
+
+def page(query, shot=None):
+    """The page at index.html?QUERY: a screenshot into shot, else the DOM."""
+    url = "file://%s/index.html?%s" % (os.path.abspath(work), query)
+    if shot:
+        if os.path.exists(shot):
+            os.remove(shot)
+        subprocess.run(CHROME + ["--screenshot=" + shot, url], capture_output=True, text=True, timeout=300)
+        return os.path.exists(shot)
+    p = subprocess.run(CHROME + ["--dump-dom", url], capture_output=True, text=True, timeout=300)
+    return p.stdout
+
+
+def message(dom):
+    """The text of a visible #msg element of a dumped DOM, else None."""
+    import re
+    m = re.search(r'<div id="msg"([^>]*)>(.*?)</div>', dom, re.S)
+    if not m or "hidden" in m.group(1) or not m.group(2).strip():
+        return None
+    return m.group(2).strip()
+
+
+def glb_json(glb):
+    import struct
+    d = open(glb, "rb").read()
+    jl = struct.unpack_from("<I", d, 12)[0]
+    return json.loads(d[20:20 + jl])
+
+
 def bounds(glb):
     import struct
     d = open(glb, "rb").read()
@@ -56,55 +121,135 @@ def bounds(glb):
     return np.array(a["min"]), np.array(a["max"])
 
 
-def scene(name, source, opts, orders, place):
+def compare(label, shot, ref, order, rgb=False):
+    """The page's screenshot against vdsh-view's frame: mean |difference|
+    below 2/255 (grey shadow frames, or RGB pictures)."""
+    if rgb:
+        a = np.asarray(Image.open(shot).convert("RGB"), float)[:H, :W] / 255
+        b = np.asarray(Image.open(ref).convert("RGB"), float) / 255
+    else:
+        a = np.asarray(Image.open(shot).convert("L"), float)[:H, :W] / 255
+        b = np.asarray(Image.open(ref)).astype(float) / 65535
+    diff = np.abs(a - b).mean() * 255
+    if rgb:
+        print("%s: mean |web - C| = %.4f/255 (RGB); mean value C %.3f, web %.3f" % (label, diff, b.mean(), a.mean()))
+        if b.mean() < 0.01:
+            fail.append("%s: vdsh-view's default picture is black" % label)
+    else:
+        dark = (1 - b).mean()
+        mask = (a < 0.99) | (b < 0.99)
+        local = np.abs(a - b)[mask].mean() * 255 if mask.any() else 0.0
+        print("%s: mean |web - C| = %.4f/255 (%.3f/255 over the %d pixels shadowed in either); "
+              "mean shadow C %.2f%%, web %.2f%%" % (label, diff, local, mask.sum(), 100 * dark, 100 * (1 - a).mean()))
+        if dark < (0.0002 if order in (2, 3) else 0.005):
+            fail.append("%s: the C frame has too little shadow to compare" % label)
+    if not diff < 2.0:
+        fail.append("%s: mean abs difference %.3f/255 >= 2/255" % (label, diff))
+
+
+def scene(name, source, opts, orders, place, modes=None):
+    """Bake (orders; opts may add an adaptive stream), export, and compare
+    the page with vdsh-view for each of modes: (page's order=, vdsh-view's
+    mode), default the orders as vdshN."""
     vd, glb = os.path.join(work, name + ".vdsh"), os.path.join(work, name + ".glb")
     run([bake, source, "-o", vd, "-q", "--orders", ",".join(map(str, orders))] + opts)
     run([export, vd, "-o", glb])
+    modes = modes or [(str(o), "vdsh%d" % o) for o in orders]
     eye, target, light = place(*bounds(glb))
     views = os.path.join(work, name + "-views.json")
     json.dump({"width": W, "height": H, "views": [{"name": name, "eye": eye, "target": target, "up": [0, 1, 0],
                                                    "fov_y": 60, "light_sets": [[light]]}]}, open(views, "w"))
     frames = os.path.join(work, "c")
     p = subprocess.run([view, "-q", "--views", views, "--frames", frames,
-                        "--modes", ",".join("vdsh%d" % o for o in orders), vd], capture_output=True, text=True)
+                        "--modes", ",".join(m for _, m in modes), vd], capture_output=True, text=True)
     if p.returncode != 0:
         if "EGL" in p.stderr or "context" in p.stderr or "display" in p.stderr:
             print("no GL context: skipped\n" + p.stderr)
             sys.exit(77)
         print("FAIL: vdsh-view: " + p.stderr)
         sys.exit(1)
-    for order in orders:
-        shot = os.path.join(work, "web-%s-%d.png" % (name, order))
-        if os.path.exists(shot):
-            os.remove(shot)
-        url = ("file://%s/index.html?glb=%s.glb&order=%d&output=shadow&size=%dx%d&eye=%s&target=%s&up=0,1,0"
-               "&fov=60&light=%s" % (os.path.abspath(work), name, order, W, H, csv(eye), csv(target), csv(light)))
-        subprocess.run([chromium, "--headless=new", "--no-sandbox", "--use-angle=swiftshader",
-                        "--enable-unsafe-swiftshader", "--allow-file-access-from-files", "--hide-scrollbars",
-                        "--force-device-scale-factor=1", "--window-size=800,600", "--virtual-time-budget=20000",
-                        "--screenshot=" + shot, url], capture_output=True, text=True, timeout=300)
-        if not os.path.exists(shot):
-            fail.append("%s order %d: no screenshot" % (name, order))
+    for order, mode in modes:
+        shot = os.path.join(work, "web-%s-%s.png" % (name, order))
+        q = ("glb=%s.glb&order=%s&output=shadow&size=%dx%d&eye=%s&target=%s&up=0,1,0&fov=60&light=%s"
+             % (name, order, W, H, csv(eye), csv(target), csv(light)))
+        if not page(q, shot):
+            fail.append("%s order %s: no screenshot" % (name, order))
             continue
-        a = np.asarray(Image.open(shot).convert("L"), float)[:H, :W] / 255
-        b = np.asarray(Image.open(os.path.join(frames, "%s-s0-l0-vdsh%d.png" % (name, order)))).astype(float) / 65535
-        diff = np.abs(a - b).mean() * 255
-        dark = (1 - b).mean()
-        mask = (a < 0.99) | (b < 0.99)
-        local = np.abs(a - b)[mask].mean() * 255 if mask.any() else 0.0
-        print("%s order %d: mean |web - C| = %.4f/255 (%.3f/255 over the %d pixels shadowed in either); "
-              "mean shadow C %.2f%%, web %.2f%%" % (name, order, diff, local, mask.sum(), 100 * dark,
-                                                   100 * (1 - a).mean()))
-        if dark < (0.005 if order == 5 else 0.0002):
-            fail.append("%s order %d: the C frame has too little shadow to compare" % (name, order))
-        if not diff < 2.0:
-            fail.append("%s order %d: mean abs difference %.3f/255 >= 2/255" % (name, order, diff))
+        compare("%s order %s" % (name, order), shot, os.path.join(frames, "%s-s0-l0-%s.png" % (name, mode)),
+                int(order) if order.isdigit() else 0)
+    return vd, glb
 
 
-scene("room", "builtin:room", ["--max-edge", "0.5", "--rays", "256"], [2, 3, 5],
-      lambda lo, hi: ([7.5, 4.5, 8.0], [-2.0, 1.0, -2.0], [0.5, 1.2, 0.5]))
+def default_view(name, vd, glb):
+    """The page with no camera, light or order against vdsh-view --render's
+    default picture of the same file."""
+    ref = os.path.join(work, "c-%s-default.png" % name)
+    p = subprocess.run([view, "-q", "--render", ref, "--size", "%dx%d" % (W, H), vd], capture_output=True, text=True)
+    if p.returncode != 0:
+        fail.append("%s: vdsh-view --render: %s" % (name, p.stderr))
+        return
+    v = glb_json(glb)["meshes"][0]["extras"]["vdsh"].get("view")
+    if not v or not v.get("lights_free", [False])[0]:
+        fail.append("%s: the glb has no default view, or its light 0 is not in free space: %r" % (name, v))
+    shot = os.path.join(work, "web-%s-default.png" % name)
+    if not page("glb=%s&size=%dx%d" % (os.path.basename(glb), W, H), shot):
+        fail.append("%s default view: no screenshot" % name)
+        return
+    compare("%s default view" % name, shot, ref, 0, rgb=True)
 
 
+room_vd, room_glb = scene("room", "builtin:room", ["--max-edge", "0.5", "--rays", "256", "--adaptive-order", "0.02",
+                                                   "--max-order", "12"], [2, 3, 5, 12],
+                          lambda lo, hi: ([7.5, 4.5, 8.0], [-2.0, 1.0, -2.0], [0.5, 1.2, 0.5]),
+                          [("2", "vdsh2"), ("3", "vdsh3"), ("5", "vdsh5"), ("12", "buf12"), ("adaptive", "adaptive")])
+default_view("room", room_vd, room_glb)
+
+# Errors on the page itself.
+bad = os.path.join(work, "bad.glb")
+open(bad, "wb").write(b"this is not a glb\n" * 4)
+draco = os.path.join(work, "draco.glb")
+g = glb_json(room_glb)
+g["extensionsUsed"] = g["extensionsRequired"] = ["KHR_draco_mesh_compression"]
+js = json.dumps(g).encode()
+js += b" " * (-len(js) % 4)
+import struct
+open(draco, "wb").write(struct.pack("<III", 0x46546C67, 2, 20 + len(js)) + struct.pack("<II", len(js), 0x4E4F534A) + js)
+errs = [("bad.glb", "not a glb"), ("draco.glb", "KHR_draco_mesh_compression")]
+plain = os.path.join(models, "glTF2", "2CylinderEngine-glTF-Binary", "2CylinderEngine.glb")
+if os.path.exists(plain):
+    shutil.copy(plain, os.path.join(work, "plain.glb"))
+    errs.append(("plain.glb", "no VDSH streams"))
+for f, want in errs:
+    msg = message(page("glb=%s&size=%dx%d" % (f, W, H)))
+    print("%s: the page says: %s" % (f, msg))
+    if not msg or want not in msg:
+        fail.append("%s: no visible message naming '%s' on the page (got %r)" % (f, want, msg))
+
+# Compressed files: quantised (KHR_mesh_quantization), meshopt.
+if node and modules and os.path.exists(os.path.join(modules, "meshoptimizer", "meshopt_encoder.js")):
+    pack = os.path.join(os.path.dirname(os.path.abspath(__file__)), "web_glb_pack.mjs")
+    for how in ("quantise", "meshopt"):
+        out = os.path.join(work, "room-%s.glb" % how)
+        run([node, pack, modules, room_glb, out, how])
+    dec = os.path.join(work, "meshopt_decoder.cjs")
+    if os.path.exists(dec):
+        os.remove(dec)
+    msg = message(page("glb=room-meshopt.glb&size=%dx%d" % (W, H)))
+    print("room-meshopt.glb without the decoder: the page says: %s" % msg)
+    if not msg or "EXT_meshopt_compression" not in msg:
+        fail.append("room-meshopt.glb without meshopt_decoder.cjs: no visible message (got %r)" % msg)
+    shutil.copy(os.path.join(modules, "meshoptimizer", "meshopt_decoder.cjs"), work)
+    eye, target, light = [7.5, 4.5, 8.0], [-2.0, 1.0, -2.0], [0.5, 1.2, 0.5]
+    for how in ("quantise", "meshopt"):
+        shot = os.path.join(work, "web-room-%s.png" % how)
+        q = ("glb=room-%s.glb&order=5&output=shadow&size=%dx%d&eye=%s&target=%s&up=0,1,0&fov=60&light=%s"
+             % (how, W, H, csv(eye), csv(target), csv(light)))
+        if not page(q, shot):
+            fail.append("room-%s.glb: no screenshot" % how)
+            continue
+        compare("room-%s.glb order 5" % how, shot, os.path.join(work, "c", "room-s0-l0-vdsh5.png"), 5)
+else:
+    print("no node or no meshoptimizer in %r: the compressed glb part skipped" % modules)
 def outside(lo, hi):
     c, d = (lo + hi) / 2, np.linalg.norm(hi - lo)
     return (list(c + d * np.array([0.45, 0.35, 0.75])), list(c), list(c + d * np.array([0.2, 0.6, 0.3])))
@@ -112,7 +257,7 @@ def outside(lo, hi):
 
 engine = os.path.join(models, "glTF2", "2CylinderEngine-glTF-Binary", "2CylinderEngine.glb")
 if os.path.exists(engine):
-    scene("engine", engine, ["--rays", "64"], [5], outside)
+    default_view("engine", *scene("engine", engine, ["--rays", "64"], [5], outside))
 else:
     print("no %s: the glTF scene part skipped" % engine)
 

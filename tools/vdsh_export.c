@@ -5,7 +5,10 @@
  * _VDSH<order>_<k> (VEC4, k = 0 .. ceil(order^2 / 4) - 1, the last padded
  * with zeros), normalised int16 with the stream's scale in extras (or
  * float with --float); the bake's method, quantity, order, max distance
- * and source hashes in the mesh's extras.vdsh.
+ * and source hashes in the mesh's extras.vdsh, and the default view
+ * vdsh-view opens the scene with (formats/vdsh_scene_view.h: camera,
+ * default lights in free space, interior or object) in extras.vdsh.view,
+ * so that the web viewer (runtime/web) starts where vdsh-view does.
  *
  *     vdsh-export scene.vdsh -o scene.glb [--orders 2,3,5] [--float] [-q]
  *
@@ -24,6 +27,7 @@
 
 #include "vdsh.h"
 #include "vdsh_output.h"
+#include "vdsh_scene_view.h"
 #include "vt_cli.h"
 
 typedef struct blob {
@@ -234,6 +238,37 @@ int main(int argc, char **argv)
     cJSON_AddNumberToObject(vx, "max_edge", f->header.max_edge);
     cJSON_AddNumberToObject(vx, "rays", f->header.rays);
     cJSON_AddNumberToObject(vx, "seed", (double)f->header.seed);
+    /* The default view: vdsh-view's camera and lights (one definition,
+     * formats/vdsh_scene_view.h), from the same mesh. */
+    {
+        vdsh_view_mesh vm = {f->positions, f->normals, f->indices, nv, nt};
+        vdsh_view view;
+        vdsh_error ve;
+        if (vdsh_view_compute(&vm, &view, &ve) != VDSH_OK) {
+            fprintf(stderr, "vdsh-export: %s: the default view: %s\n", in, ve.msg);
+            goto done;
+        }
+        cJSON *vo = cJSON_AddObjectToObject(vx, "view");
+        double e[3], t[3], u[3];
+        for (int k = 0; k < 3; k++)
+            e[k] = view.camera.eye[k], t[k] = view.camera.target[k],
+            u[k] = view.camera.up[k];
+        if (u[0] == 0 && u[1] == 0 && u[2] == 0)
+            u[1] = 1;
+        cJSON_AddBoolToObject(vo, "interior", view.interior);
+        cJSON_AddNumberToObject(vo, "front_share", view.front_share);
+        cJSON_AddItemToObject(vo, "eye", cJSON_CreateDoubleArray(e, 3));
+        cJSON_AddItemToObject(vo, "target", cJSON_CreateDoubleArray(t, 3));
+        cJSON_AddItemToObject(vo, "up", cJSON_CreateDoubleArray(u, 3));
+        cJSON_AddNumberToObject(vo, "fov_y", view.camera.fov_y > 0 ? view.camera.fov_y : 60);
+        cJSON *ls = cJSON_AddArrayToObject(vo, "lights");
+        cJSON *fr = cJSON_AddArrayToObject(vo, "lights_free");
+        for (int i = 0; i < view.light_count; i++) {
+            double l[3] = {view.lights[i][0], view.lights[i][1], view.lights[i][2]};
+            cJSON_AddItemToArray(ls, cJSON_CreateDoubleArray(l, 3));
+            cJSON_AddItemToArray(fr, cJSON_CreateBool(view.light_free[i]));
+        }
+    }
     cJSON *srcs = cJSON_AddArrayToObject(vx, "sources");
     for (uint32_t s = 0; s < f->source_count; s++) {
         cJSON *o = cJSON_CreateObject();
@@ -280,6 +315,9 @@ int main(int argc, char **argv)
         cJSON_AddStringToObject(so, "window", vdsh_window_name(s->window));
         cJSON_AddNumberToObject(so, "window_param", s->window_param);
         cJSON_AddStringToObject(so, "source_encoding", vdsh_encoding_name(s->encoding));
+        /* an order per vertex (vdsh-bake --adaptive-order): coefficients
+         * past a vertex's own order are exported as 0 */
+        cJSON_AddBoolToObject(so, "variable_order", (s->flags & VDSH_STREAM_VARIABLE) != 0);
         cJSON_AddStringToObject(so, "component", use_float ? "float" : "int16_normalized");
         cJSON_AddNumberToObject(so, "scale", use_float ? 1.0 : scale);
         cJSON_AddItemToArray(streams, so);

@@ -4,21 +4,52 @@
 //   log-distance streams (any order): per vertex the whole SH sum toward
 //     each light, d = min(exp(min(sum, 80)), max_distance), interpolated;
 //     per fragment visibility = compare(d, |light - fragment|);
-//   linear streams (distance, distance^2): per vertex the distance and the
-//     comparison, the visibility interpolated (the C runtime's path for
-//     orders 2 and 3; its order-5 split path is not reproduced here).
+//   linear streams (distance, distance^2) of orders 2 and 3 (and 5): per
+//     vertex the distance and the comparison, the visibility interpolated
+//     (the C runtime's path for orders 2 and 3; its order-5 split path is
+//     not reproduced here).
+// Orders 2, 3 and 5 read their coefficients as vertex attributes. Every
+// other order (1, 4, 6-16) and a stream with an order per vertex
+// (vdsh-bake --adaptive-order) take the buffer path, as vdsh-view's bufN
+// and adaptive modes do (runtime/vr_glsl_buffer.c): each vertex's
+// coefficients in a float texture, read front to back in the vertex stage
+// and summed by the associated-Legendre recurrence for any order, then the
+// distance path above for every quantity. (WebGL2 vertex attributes stop
+// at 16 VEC4, order 5 at most with position and normal.)
 // compare: smooth clamp(1.5 d / dl - 0.5, 0, 1) (formats/vdsh_shadow.h).
 // The camera is formats/vdsh_camera.h's (gluLookAt basis, vertical fov).
+// Shading is vdsh-view's (runtime/vdsh_view_core.c): albedo 0.8, ambient
+// 0.03, light colours and fall-off as its default lights; no gamma.
 //
-// URL parameters (all optional except glb): glb=FILE, order=N, eye=x,y,z,
-// target=x,y,z, up=x,y,z, fov=DEG, light=x,y,z (repeatable, as
-// light=..&light=..), size=WxH (canvas size; default the window),
-// output=shadow (shadow factor of light 0 as grey,
-// white where no surface: vdsh-view's --views frames) or shaded (default).
+// Default view: vdsh-view's, which vdsh-export writes into
+// meshes[0].extras.vdsh.view (formats/vdsh_scene_view.h: a room seen from
+// inside, an object framed from outside, lights moved into free space).
+// A file without it (an older export) is framed from outside, lit from
+// outside its bounding sphere (vdsh_view_fit_camera and an object's
+// preferred lights), as vdsh-view frames an object.
+//
+// Files: glTF 2.0 binary; attributes of any component type, normalised or
+// not, interleaved or not, and the node's transform (KHR_mesh_quantization,
+// as gltfpack and glTF-Transform write it); buffer views compressed with
+// EXT_meshopt_compression (or KHR_meshopt_compression) are decoded with
+// meshoptimizer's decoder, meshopt_decoder.cjs of the npm package
+// meshoptimizer, loaded from next to the page (or meshopt=URL) only when a
+// file needs it. Any other required extension (Draco, ...) is refused.
+//
+// URL parameters (all optional except glb): glb=FILE, order=N or
+// order=adaptive (default: as vdsh-view, order 5, else 3, else 2, else
+// the adaptive stream, else the highest order), path=buffer (the buffer
+// path for orders 2, 3, 5 too: vdsh-view's bufN), eye=x,y,z, target=x,y,z,
+// up=x,y,z, fov=DEG, light=x,y,z (repeatable, as light=..&light=..),
+// lights=N (default lights, 1..4, default 1), size=WxH (canvas size;
+// default the window), output=shadow (shadow factor of light 0 as grey,
+// white where no surface: vdsh-view's --views frames) or shaded (default:
+// vdsh-view --render's picture), meshopt=URL.
 // Mouse: drag orbits the camera around the target, wheel zooms,
 // shift+drag moves light 0 in the view plane. window.vdshReady is set to
-// true (and document.title to "ready") once the first frame is drawn, or
-// document.title to "error: ..." on failure.
+// true (and document.title to "ready") once the first frame is drawn. On
+// failure the message is shown on the page (#msg), in document.title
+// ("error: ...") and in window.vdshError.
 'use strict';
 
 const SH = {
@@ -29,17 +60,57 @@ const SH = {
   C42: 0.9461746957575601, C41: 0.6690465435572892, C40: 0.10578554691520431,
   C42B: 0.47308734787878004, C44B: 0.6258357354491761,
 };
+const MAX_ORDER = 16;
 
-function glsl(order, quantity, lights, output) {
+// A float as a GLSL literal that reads back as the same f32.
+const flit = (x) => {
+  const s = Math.fround(x).toPrecision(9);
+  return /[.e]/.test(s) ? s : s + '.0';
+};
+
+// K_l^|m| per coefficient index l(l+1)+m (sqrt 2 folded in for m != 0),
+// in double and then rounded to f32, as runtime/vr_buffer.c (make_ks).
+function ksTable(order) {
+  const ks = new Float32Array(order * order);
+  for (let l = 0; l < order; l++)
+    for (let m = 0; m <= l; m++) {
+      let kk = (2 * l + 1) / (4 * Math.PI);
+      for (let f = l - m + 1; f <= l + m; f++) kk /= f;
+      const K = m === 0 ? Math.sqrt(kk) : Math.sqrt(2 * kk);
+      ks[l * (l + 1) + m] = K;
+      ks[l * (l + 1) - m] = K;
+    }
+  return ks;
+}
+
+// The order the recurrence consumes coefficients in (vr_buffer_sequence):
+// m outside, l inside, +m before -m.
+function bufferSequence(order) {
+  const out = [];
+  for (let m = 0; m < order; m++)
+    for (let l = m; l < order; l++) {
+      out.push(l * (l + 1) + m);
+      if (m > 0) out.push(l * (l + 1) - m);
+    }
+  return out;
+}
+
+// cfg: order (attribute path), quantity (0 distance, 1 distance2, 2 log),
+// lights, output (0 shaded, 1 shadow), buffer ({order, texWidth} or null).
+function glsl(cfg) {
   const consts = Object.entries(SH).map(([k, v]) => `const float ${k} = ${v.toPrecision(17)};`).join('\n');
-  const groups = Math.ceil(order * order / 4);
+  const buffer = !!cfg.buffer;
+  const order = buffer ? 0 : cfg.order;
+  const groups = buffer ? 0 : Math.ceil(order * order / 4);
   const head = `#version 300 es
 precision highp float;
+precision highp int;
 #define ORDER ${order}
-#define QUANTITY ${quantity}
-#define NUM_LIGHTS ${lights}
-#define OUTPUT ${output}
-#define LOG_PATH ${quantity === 2 ? 1 : 0}
+#define QUANTITY ${cfg.quantity}
+#define NUM_LIGHTS ${cfg.lights}
+#define OUTPUT ${cfg.output}
+#define BUFFER ${buffer ? 1 : 0}
+#define DIST_PATH ${buffer || cfg.quantity === 2 ? 1 : 0}
 ${consts}
 float vdsh_distance(float sum, float md) {
 #if QUANTITY == 1
@@ -57,22 +128,79 @@ float vdsh_compare(float dv, float dl) {
   return clamp(1.5 * (dv / dl) - 0.5, 0.0, 1.0);
 }
 `;
-  let attrs = '';
-  for (let g = 0; g < groups; g++) attrs += `in vec4 a_c${g};\n`;
-  let coef = 'float c[28];\n';
-  for (let g = 0; g < groups; g++)
-    for (let k = 0; k < 4; k++) coef += `  c[${4 * g + k}] = a_c${g}[${k}];\n`;
-  const vs = head + `
-in vec3 a_position;
-in vec3 a_normal;
-${attrs}
-uniform mat4 u_view_proj;
-uniform float u_scale;
-uniform float u_max_distance;
-uniform vec3 u_light_pos[NUM_LIGHTS];
-out vec3 v_position;
-out vec3 v_normal;
-out float v_val[NUM_LIGHTS];
+  let decl = '', sums = '';
+  if (buffer) {
+    const ks = ksTable(cfg.buffer.order);
+    decl = `
+#define TEX_W ${cfg.buffer.texWidth}
+uniform highp sampler2D u_coef;
+in uint a_record;  // the vertex's first texel
+in uint a_order;   // its order
+const float KS[${ks.length}] = float[${ks.length}](${Array.from(ks, flit).join(', ')});
+int b_texel;
+int b_j;
+vec4 b_cache;
+// The next coefficient of the record (index i), times K_l^m.
+float buf_next(int i) {
+  if (b_j == 4) {
+    b_cache = texelFetch(u_coef, ivec2(b_texel % TEX_W, b_texel / TEX_W), 0);
+    b_texel++;
+    b_j = 0;
+  }
+  float c = b_cache[b_j];
+  b_j++;
+  return KS[i] * c;
+}
+// runtime/vr_glsl_buffer.c's buffer_sums: the SH sum toward every light.
+void buffer_sums(out float sums[NUM_LIGHTS]) {
+  int k = int(a_order);
+  b_texel = int(a_record);
+  b_j = 4;
+  vec3 d[NUM_LIGHTS];
+  float cs[NUM_LIGHTS], sn[NUM_LIGHTS], pmm[NUM_LIGHTS], p0[NUM_LIGHTS], p1[NUM_LIGHTS];
+  for (int i = 0; i < NUM_LIGHTS; i++) {
+    vec3 lv = u_light_pos[i] - a_position;
+    float dl = length(lv);
+    d[i] = dl > 0.0 ? lv / dl : vec3(0.0, 0.0, 1.0);
+    cs[i] = 1.0; sn[i] = 0.0; pmm[i] = 1.0; p0[i] = 0.0; p1[i] = 0.0;
+    sums[i] = 0.0;
+  }
+  for (int m = 0; m < k; m++) {
+    if (m > 0)
+      for (int i = 0; i < NUM_LIGHTS; i++) {
+        float c = d[i].x * cs[i] - d[i].y * sn[i];
+        sn[i] = d[i].x * sn[i] + d[i].y * cs[i];
+        cs[i] = c;
+        pmm[i] *= -float(2 * m - 1);
+      }
+    for (int l = m; l < k; l++) {
+      int row = l * (l + 1);
+      float cp = buf_next(row + m);
+      float cn = m > 0 ? buf_next(row - m) : 0.0;
+      float a = float(2 * l - 1) / float(max(l - m, 1));
+      float b = float(l + m - 1) / float(max(l - m, 1));
+      for (int i = 0; i < NUM_LIGHTS; i++) {
+        float pl = l == m ? pmm[i]
+                 : l == m + 1 ? d[i].z * float(2 * m + 1) * pmm[i]
+                 : a * d[i].z * p1[i] - b * p0[i];
+        p0[i] = p1[i];
+        p1[i] = pl;
+        sums[i] += pl * (cp * cs[i] + cn * sn[i]);
+      }
+    }
+  }
+  for (int i = 0; i < NUM_LIGHTS; i++)
+    sums[i] *= u_scale;
+}
+`;
+    sums = `  float b_sum[NUM_LIGHTS];\n  buffer_sums(b_sum);\n`;
+  } else {
+    for (let g = 0; g < groups; g++) decl += `in vec4 a_c${g};\n`;
+    let coef = 'float c[28];\n';
+    for (let i = groups * 4; i < 28; i++) coef += `  c[${i}] = 0.0;\n`;
+    for (let g = 0; g < groups; g++)
+      for (let k = 0; k < 4; k++) coef += `  c[${4 * g + k}] = a_c${g}[${k}];\n`;
+    decl += `
 float sh_sum(float c[28], vec3 d) {
   float x = d.x, y = d.y, z = d.z, x2 = x * x, y2 = y * y, z2 = z * z;
   float s = c[0] * C00 - c[1] * C1 * y + c[2] * C1 * z - c[3] * C1 * x;
@@ -92,16 +220,34 @@ float sh_sum(float c[28], vec3 d) {
 #endif
   return s;
 }
+`;
+    sums = '  ' + coef;
+  }
+  const vs = head + `
+in vec3 a_position;
+in vec3 a_normal;
+uniform mat4 u_view_proj;
+uniform float u_scale;
+uniform float u_max_distance;
+uniform vec3 u_light_pos[NUM_LIGHTS];
+out vec3 v_position;
+out vec3 v_normal;
+out float v_val[NUM_LIGHTS];
+${decl}
 void main() {
-  ${coef}
+${sums}
   v_position = a_position;
   v_normal = a_normal;
   gl_Position = u_view_proj * vec4(a_position, 1.0);
   for (int i = 0; i < NUM_LIGHTS; i++) {
     vec3 lv = u_light_pos[i] - a_position;
     float dl = length(lv);
+#if BUFFER
+    float dv = dl > 0.0 ? vdsh_distance(b_sum[i], u_max_distance) : 0.0;
+#else
     float dv = dl > 0.0 ? vdsh_distance(u_scale * sh_sum(c, lv / dl), u_max_distance) : 0.0;
-#if LOG_PATH
+#endif
+#if DIST_PATH
     v_val[i] = dv;
 #else
     v_val[i] = vdsh_compare(dv, dl);
@@ -113,48 +259,205 @@ in vec3 v_position;
 in vec3 v_normal;
 in float v_val[NUM_LIGHTS];
 uniform vec3 u_light_pos[NUM_LIGHTS];
-uniform vec3 u_light_att;
-uniform float u_ambient;
+uniform vec3 u_light_color[NUM_LIGHTS];  // times the albedo
+uniform vec3 u_light_att[NUM_LIGHTS];
+uniform vec3 u_ambient;                  // times the albedo
 out vec4 o_color;
 void main() {
   vec3 n = normalize(v_normal);
-  vec3 acc = vec3(u_ambient);
+  vec3 acc = vec3(0.0);
   float s0 = 1.0;
   for (int i = 0; i < NUM_LIGHTS; i++) {
     vec3 lv = u_light_pos[i] - v_position;
     float dl = length(lv);
-#if LOG_PATH
+#if DIST_PATH
     float s = vdsh_compare(v_val[i], dl);
 #else
     float s = v_val[i];
 #endif
     if (i == 0) s0 = s;
     float ndl = dl > 0.0 ? max(dot(n, lv) / dl, 0.0) : 1.0;
-    float att = 1.0 / dot(u_light_att, vec3(1.0, dl, dl * dl));
-    acc += vec3(s * ndl * att * 0.8);
+    float att = 1.0 / dot(u_light_att[i], vec3(1.0, dl, dl * dl));
+    acc += s * u_light_color[i] * (ndl * att);
   }
 #if OUTPUT == 1
   o_color = vec4(s0, s0, s0, 1.0);
 #else
-  o_color = vec4(pow(acc, vec3(1.0 / 2.2)), 1.0);
+  o_color = vec4(u_ambient + acc, 1.0);
 #endif
 }`;
   return { vs, fs, groups };
 }
 
+// ---- the file ------------------------------------------------------------
+
 function parseGlb(buf) {
+  if (buf.byteLength < 20) throw new Error('not a glb (binary glTF) file: ' + buf.byteLength + ' bytes');
   const dv = new DataView(buf);
-  if (dv.getUint32(0, true) !== 0x46546C67) throw new Error('not a glb');
+  if (dv.getUint32(0, true) !== 0x46546C67) throw new Error('not a glb (binary glTF) file: no "glTF" magic');
+  if (dv.getUint32(4, true) !== 2) throw new Error('glb version ' + dv.getUint32(4, true) + ', not 2');
+  const total = Math.min(dv.getUint32(8, true), buf.byteLength);
   const jl = dv.getUint32(12, true);
-  const json = JSON.parse(new TextDecoder().decode(new Uint8Array(buf, 20, jl)));
-  const bl = dv.getUint32(20 + jl, true);
-  return { json, bin: new Uint8Array(buf, 28 + jl, bl) };
+  if (dv.getUint32(16, true) !== 0x4E4F534A || 20 + jl > total) throw new Error('glb: no JSON chunk, or a truncated one');
+  let json;
+  try {
+    json = JSON.parse(new TextDecoder().decode(new Uint8Array(buf, 20, jl)));
+  } catch (e) {
+    throw new Error('glb: its JSON chunk does not parse: ' + e.message);
+  }
+  let bin = null;
+  const at = 20 + jl;
+  if (at + 8 <= total && dv.getUint32(at + 4, true) === 0x004E4942) {
+    const bl = dv.getUint32(at, true);
+    if (at + 8 + bl > total) throw new Error('glb: the BIN chunk is truncated (' + bl + ' bytes announced, ' + (total - at - 8) + ' there)');
+    bin = new Uint8Array(buf, at + 8, bl);
+  }
+  return { json, bin };
 }
+
+const READ_EXTENSIONS = ['KHR_mesh_quantization', 'EXT_meshopt_compression', 'KHR_meshopt_compression'];
+const COMPONENTS = {  // componentType: bytes, DataView getter, normalisation divisor, signed
+  5120: [1, 'getInt8', 127, true], 5121: [1, 'getUint8', 255, false],
+  5122: [2, 'getInt16', 32767, true], 5123: [2, 'getUint16', 65535, false],
+  5125: [4, 'getUint32', 0, false], 5126: [4, 'getFloat32', 0, true],
+};
+const TYPES = { SCALAR: 1, VEC2: 2, VEC3: 3, VEC4: 4 };
+
+// meshoptimizer's decoder, loaded once, from next to the page.
+let meshopt = null;
+function meshoptDecoder(url) {
+  if (!meshopt)
+    meshopt = (window.MeshoptDecoder ? Promise.resolve() : new Promise((ok, fail) => {
+      const s = document.createElement('script');
+      s.src = url;
+      s.onload = ok;
+      s.onerror = () => fail(new Error(
+        'this file is compressed with EXT_meshopt_compression, and its decoder ' + url +
+        ' is not next to the page: copy meshopt_decoder.cjs of the npm package meshoptimizer ' +
+        'beside index.html (or give meshopt=URL)'));
+      document.head.appendChild(s);
+    })).then(() => {
+      if (!window.MeshoptDecoder) throw new Error(url + ' did not define MeshoptDecoder');
+      return window.MeshoptDecoder.ready.then(() => window.MeshoptDecoder);
+    });
+  return meshopt;
+}
+
+// The glTF's data: buffer views (decoded when compressed) and accessors
+// as plain arrays.
+class Gltf {
+  constructor(json, bin, meshoptUrl) {
+    this.json = json;
+    this.bin = bin;
+    this.meshoptUrl = meshoptUrl;
+    this.views = [];
+  }
+
+  buffer(i) {
+    const b = (this.json.buffers || [])[i];
+    if (!b) throw new Error('buffer ' + i + ' does not exist');
+    if (i === 0 && b.uri === undefined && this.bin) return this.bin;
+    if (b.uri !== undefined) throw new Error('buffer ' + i + ' is an external file (' + String(b.uri).slice(0, 40) + '): give a .glb that holds its data');
+    throw new Error('buffer ' + i + ' has no data in this glb');
+  }
+
+  // Every buffer view the accessors use, decompressed (async: the decoder).
+  async prepare(accessors) {
+    const json = this.json;
+    for (const ai of accessors) {
+      const a = json.accessors[ai];
+      if (a.bufferView === undefined || this.views[a.bufferView]) continue;
+      const v = json.bufferViews[a.bufferView];
+      if (!v) throw new Error('accessor ' + ai + ': buffer view ' + a.bufferView + ' does not exist');
+      const x = v.extensions && (v.extensions.EXT_meshopt_compression || v.extensions.KHR_meshopt_compression);
+      if (x) {
+        const dec = await meshoptDecoder(this.meshoptUrl);
+        const src = this.buffer(x.buffer).subarray(x.byteOffset || 0, (x.byteOffset || 0) + x.byteLength);
+        const out = new Uint8Array(x.count * x.byteStride);
+        dec.decodeGltfBuffer(out, x.count, x.byteStride, src, x.mode, x.filter || 'NONE');
+        this.views[a.bufferView] = out;
+      } else {
+        const b = this.buffer(v.buffer), o = v.byteOffset || 0;
+        if (o + v.byteLength > b.length) throw new Error('buffer view ' + a.bufferView + ' runs past its buffer');
+        this.views[a.bufferView] = b.subarray(o, o + v.byteLength);
+      }
+    }
+  }
+
+  // Accessor ai as numbers (normalised integers as glTF defines them), in
+  // an array of type T (Float32Array by default).
+  read(ai, T = Float32Array) {
+    const a = this.json.accessors[ai];
+    if (!a) throw new Error('accessor ' + ai + ' does not exist');
+    if (a.sparse) throw new Error('accessor ' + ai + ' is sparse: not read');
+    const c = COMPONENTS[a.componentType], n = TYPES[a.type];
+    if (!c || !n) throw new Error('accessor ' + ai + ': component type ' + a.componentType + ' ' + a.type + ' not read');
+    const out = new T(a.count * n);
+    if (a.bufferView === undefined) return out;  // all zeros
+    const bytes = this.views[a.bufferView];
+    const stride = this.json.bufferViews[a.bufferView].byteStride || c[0] * n;
+    const off = a.byteOffset || 0;
+    if (a.count > 0 && off + (a.count - 1) * stride + n * c[0] > bytes.length)
+      throw new Error('accessor ' + ai + ' runs past its buffer view');
+    const dv = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+    const get = dv[c[1]].bind(dv), norm = a.normalized && c[2];
+    for (let i = 0; i < a.count; i++)
+      for (let k = 0; k < n; k++) {
+        let x = get(off + i * stride + k * c[0], true);
+        if (norm) x = c[3] ? Math.max(x / c[2], -1) : x / c[2];
+        out[i * n + k] = x;
+      }
+    return out;
+  }
+}
+
+// ---- matrices and the view -----------------------------------------------
 
 const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
 const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
 const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 const norm = (a) => { const l = Math.hypot(a[0], a[1], a[2]); return [a[0] / l, a[1] / l, a[2] / l]; };
+const mul4 = (a, b) => {  // column-major a * b
+  const m = new Array(16).fill(0);
+  for (let c = 0; c < 4; c++)
+    for (let r = 0; r < 4; r++)
+      for (let k = 0; k < 4; k++) m[c * 4 + r] += a[k * 4 + r] * b[c * 4 + k];
+  return m;
+};
+const IDENTITY = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
+
+function nodeMatrix(n) {
+  if (n.matrix) return n.matrix.slice();
+  const [x, y, z, w] = n.rotation || [0, 0, 0, 1], [sx, sy, sz] = n.scale || [1, 1, 1], t = n.translation || [0, 0, 0];
+  return [(1 - 2 * (y * y + z * z)) * sx, 2 * (x * y + z * w) * sx, 2 * (x * z - y * w) * sx, 0,
+    2 * (x * y - z * w) * sy, (1 - 2 * (x * x + z * z)) * sy, 2 * (y * z + x * w) * sy, 0,
+    2 * (x * z + y * w) * sz, 2 * (y * z - x * w) * sz, (1 - 2 * (x * x + y * y)) * sz, 0,
+    t[0], t[1], t[2], 1];
+}
+
+// The world matrix of the first node that draws mesh 0 (identity when no
+// node does): KHR_mesh_quantization's dequantisation lives there.
+function meshMatrix(json) {
+  const nodes = json.nodes || [];
+  const scene = (json.scenes || [])[json.scene || 0];
+  const roots = scene ? scene.nodes || [] : nodes.map((_, i) => i);
+  const walk = (i, parent, depth) => {
+    const n = nodes[i];
+    if (!n || depth > 64) return null;
+    const m = mul4(parent, nodeMatrix(n));
+    if (n.mesh === 0) return m;
+    for (const c of n.children || []) {
+      const r = walk(c, m, depth + 1);
+      if (r) return r;
+    }
+    return null;
+  };
+  for (const r of roots) {
+    const m = walk(r, IDENTITY, 0);
+    if (m) return m;
+  }
+  return IDENTITY;
+}
 
 // formats/vdsh_camera.c: view (gluLookAt) and projection, column-major.
 function viewProj(cam, aspect, zn, zf) {
@@ -165,45 +468,175 @@ function viewProj(cam, aspect, zn, zf) {
     -dot(s, cam.eye), -dot(u, cam.eye), dot(f, cam.eye), 1];
   const t = 1 / Math.tan(0.5 * (cam.fov || 60) * Math.PI / 180);
   const p = [t / aspect, 0, 0, 0, 0, t, 0, 0, 0, 0, (zf + zn) / (zn - zf), -1, 0, 0, 2 * zf * zn / (zn - zf), 0];
-  const m = new Float32Array(16);
-  for (let c = 0; c < 4; c++)
-    for (let r = 0; r < 4; r++) {
-      let x = 0;
-      for (let k = 0; k < 4; k++) x += p[k * 4 + r] * v[c * 4 + k];
-      m[c * 4 + r] = x;
-    }
-  return { m, s, u, f };
+  return { m: new Float32Array(mul4(p, v)), s, u, f };
+}
+
+// formats/vdsh_scene_view.c for a file without extras.vdsh.view: the
+// outside camera (vdsh_view_fit_camera) and an object's preferred lights,
+// outside its bounding sphere (so in free space).
+function fallbackView(lo, hi) {
+  const f = Math.fround;
+  const c = [0, 1, 2].map((k) => f(0.5 * (lo[k] + hi[k])));
+  const r = Math.sqrt([0, 1, 2].reduce((a, k) => a + 0.25 * (hi[k] - lo[k]) ** 2, 0)) || 1;
+  const ax = hi[0] - lo[0] >= hi[2] - lo[2] ? 0 : 2, other = 2 - ax;
+  const u = [[0, 0, 0], [0, 1, 0], [0, 0, 0]];
+  u[0][ax] = 1;
+  u[2][other] = 1;
+  const place = (cc, s, a, b, d) => [0, 1, 2].map((k) => cc[k] + s * (a * u[0][k] + b * u[1][k] + d * u[2][k]));
+  let w = norm(place([0, 0, 0], 1, 0.8, 0.45, 0.4));
+  let s = norm([w[2], 0, -w[0]]);
+  const v = cross(w, s);
+  const t = Math.tan(0.5 * 60 * Math.PI / 180);
+  let dist = 0;
+  for (let corner = 0; corner < 8; corner++) {
+    const p = [0, 1, 2].map((k) => ((corner >> k) & 1 ? hi[k] : lo[k]) - c[k]);
+    dist = Math.max(dist, dot(p, w) + Math.max(Math.abs(dot(p, s)), Math.abs(dot(p, v))) / t);
+  }
+  dist = 1.05 * (dist > 0 ? dist : r);
+  const around = [[1.5, 1.5, -0.4], [-1.3, 1.2, 1.4], [0.5, 2.1, 1.5], [1.6, 0.5, 1.2]];
+  return {
+    interior: false, eye: c.map((x, k) => x + dist * w[k]), target: c, up: [0, 1, 0], fov_y: 60,
+    lights: around.map((a) => place(c, r, a[0], a[1], a[2])), fallback: true,
+  };
+}
+
+// ---- the page ------------------------------------------------------------
+
+function load(url) {
+  return new Promise((ok, fail) => {
+    const x = new XMLHttpRequest();  // XHR: works for file:// with --allow-file-access-from-files
+    x.open('GET', url);
+    x.responseType = 'arraybuffer';
+    x.onload = () => (x.status === 200 || x.status === 0) && x.response ? ok(x.response)
+      : fail(new Error('cannot load ' + url + ' (HTTP ' + x.status + ')'));
+    x.onerror = () => fail(new Error('cannot load ' + url));
+    x.send();
+  });
+}
+
+// The stream to draw: order=N, order=adaptive, or vdsh-view's default.
+function chooseStream(streams, want) {
+  const fixed = (o) => streams.find((s) => s.order === o && !s.variable_order);
+  const variable = streams.find((s) => s.variable_order);
+  if (want === 'adaptive') {
+    if (!variable) throw new Error('no stream with an order per vertex (adaptive order) in this file');
+    return variable;
+  }
+  if (want) {
+    const o = Number(want);
+    const s = fixed(o) || streams.find((x) => x.order === o);
+    if (!s) throw new Error('no stream of order ' + want + ' (the file has ' + streams.map((x) => x.order + (x.variable_order ? ' adaptive' : '')).join(', ') + ')');
+    return s;
+  }
+  const best = fixed(5) || fixed(3) || fixed(2) || variable;
+  if (best) return best;
+  return streams.reduce((a, b) => (b.order > a.order ? b : a));
 }
 
 async function main() {
   const q = new URLSearchParams(location.search);
-  const vec = (s) => s.split(',').map(Number);
-  const buf = await new Promise((ok, fail) => {
-    const x = new XMLHttpRequest();  // XHR: works for file:// with --allow-file-access-from-files
-    x.open('GET', q.get('glb') || 'scene.glb');
-    x.responseType = 'arraybuffer';
-    x.onload = () => (x.status === 200 || x.status === 0) && x.response ? ok(x.response) : fail(new Error('load ' + x.status));
-    x.onerror = () => fail(new Error('cannot load ' + q.get('glb')));
-    x.send();
-  });
-  const { json, bin } = parseGlb(buf);
-  const prim = json.meshes[0].primitives[0];
-  const vx = json.meshes[0].extras.vdsh;
-  const want = q.get('order') ? Number(q.get('order')) : Math.max(...vx.streams.map((s) => s.order));
-  const stream = vx.streams.find((s) => s.order === want);
-  if (!stream) throw new Error('no stream of order ' + want);
-  const quantity = { 'distance': 0, 'distance2': 1, 'log-distance': 2 }[stream.quantity];
-  const pmin = json.accessors[prim.attributes.POSITION].min, pmax = json.accessors[prim.attributes.POSITION].max;
-  const centre = [0, 1, 2].map((k) => 0.5 * (pmin[k] + pmax[k]));
-  const diag = Math.hypot(...[0, 1, 2].map((k) => pmax[k] - pmin[k]));
-  const cam = {
-    eye: q.get('eye') ? vec(q.get('eye')) : [centre[0], centre[1], centre[2] + 0.4 * diag],
-    target: q.get('target') ? vec(q.get('target')) : centre,
-    up: q.get('up') ? vec(q.get('up')) : [0, 1, 0],
-    fov: q.get('fov') ? Number(q.get('fov')) : 60,
+  const vec = (name, s) => {
+    const v = s.split(',').map(Number);
+    if (v.length !== 3 || !v.every(Number.isFinite)) throw new Error(name + '=' + s + ': expected x,y,z');
+    return v;
   };
-  const lights = q.getAll('light').length ? q.getAll('light').map(vec) : [[centre[0], pmax[1] - 0.1 * (pmax[1] - pmin[1]), centre[2]]];
+  const url = q.get('glb') || 'scene.glb';
+  const { json, bin } = parseGlb(await load(url));
+  for (const e of json.extensionsRequired || [])
+    if (!READ_EXTENSIONS.includes(e))
+      throw new Error(url + ' needs the glTF extension ' + e + ', which this viewer does not read (it reads ' +
+        READ_EXTENSIONS.join(', ') + ')');
+  const mesh = (json.meshes || [])[0];
+  const vx = mesh && mesh.extras && mesh.extras.vdsh;
+  if (!vx || !Array.isArray(vx.streams) || !vx.streams.length)
+    throw new Error(url + ' holds no VDSH streams (meshes[0].extras.vdsh): not a file of vdsh-export, ' +
+      'or a tool that rewrote it dropped its extras (gltfpack: keep them with -ke -kv)');
+  const prim = mesh.primitives[0];
+  if (prim.mode !== undefined && prim.mode !== 4) throw new Error('primitive mode ' + prim.mode + ': only triangles are drawn');
+  const stream = chooseStream(vx.streams, q.get('order'));
+  if (!(stream.order >= 1 && stream.order <= MAX_ORDER)) throw new Error('stream order ' + stream.order + ' out of range 1..16');
+  const quantity = { 'distance': 0, 'distance2': 1, 'log-distance': 2 }[stream.quantity];
+  if (quantity === undefined) throw new Error('stream quantity ' + stream.quantity + ' unknown');
+  const groups = Math.ceil(stream.order * stream.order / 4);
+  const attrNames = [];
+  for (let g = 0; g < groups; g++) {
+    const name = stream.attribute_prefix + g;
+    if (prim.attributes[name] === undefined) throw new Error('attribute ' + name + ' is missing (a tool dropped it? gltfpack: -kv)');
+    attrNames.push(name);
+  }
+  if (prim.attributes.POSITION === undefined || prim.attributes.NORMAL === undefined)
+    throw new Error('POSITION or NORMAL is missing');
+  const gltf = new Gltf(json, bin, q.get('meshopt') || 'meshopt_decoder.cjs');
+  const used = [prim.attributes.POSITION, prim.attributes.NORMAL, ...attrNames.map((n) => prim.attributes[n])];
+  if (prim.indices !== undefined) used.push(prim.indices);
+  await gltf.prepare(used);
+
+  // Positions and normals in world space (the node's transform applied).
+  const M = meshMatrix(json);
+  const pos = gltf.read(prim.attributes.POSITION), nrm = gltf.read(prim.attributes.NORMAL);
+  const nv = pos.length / 3;
+  if (nrm.length !== 3 * nv) throw new Error('NORMAL and POSITION counts differ');
+  const cof = [  // cofactors of the 3x3 part: normals' matrix up to a scale
+    M[5] * M[10] - M[6] * M[9], M[6] * M[8] - M[4] * M[10], M[4] * M[9] - M[5] * M[8],
+    M[2] * M[9] - M[1] * M[10], M[0] * M[10] - M[2] * M[8], M[1] * M[8] - M[0] * M[9],
+    M[1] * M[6] - M[2] * M[5], M[2] * M[4] - M[0] * M[6], M[0] * M[5] - M[1] * M[4]];
+  const identity = M.every((x, i) => x === IDENTITY[i]);
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < nv; i++) {
+    const p = [pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]];
+    if (!identity) {
+      for (let k = 0; k < 3; k++) pos[3 * i + k] = M[k] * p[0] + M[4 + k] * p[1] + M[8 + k] * p[2] + M[12 + k];
+      const n = [nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]];
+      const w = [0, 1, 2].map((k) => cof[3 * k] * n[0] + cof[3 * k + 1] * n[1] + cof[3 * k + 2] * n[2]);
+      const l = Math.hypot(w[0], w[1], w[2]) || 1;
+      for (let k = 0; k < 3; k++) nrm[3 * i + k] = w[k] / l;
+    }
+    for (let k = 0; k < 3; k++) {
+      lo[k] = Math.min(lo[k], pos[3 * i + k]);
+      hi[k] = Math.max(hi[k], pos[3 * i + k]);
+    }
+  }
+  const indices = prim.indices !== undefined ? gltf.read(prim.indices, Uint32Array) : Uint32Array.from({ length: nv }, (_, i) => i);
+  for (let i = 0; i < indices.length; i++)
+    if (indices[i] >= nv) throw new Error('index ' + indices[i] + ' out of range (' + nv + ' vertices)');
+  const centre = [0, 1, 2].map((k) => 0.5 * (lo[k] + hi[k]));
+  const diag = Math.hypot(...[0, 1, 2].map((k) => hi[k] - lo[k])) || 1;
+
+  // The view: URL, else vdsh-view's default (extras.vdsh.view), else from
+  // outside.
+  const dv = vx.view && Array.isArray(vx.view.eye) && Array.isArray(vx.view.lights) && vx.view.lights.length
+    ? vx.view : fallbackView(lo, hi);
+  const cam = {
+    eye: q.get('eye') ? vec('eye', q.get('eye')) : dv.eye.slice(),
+    target: q.get('target') ? vec('target', q.get('target')) : dv.target.slice(),
+    up: q.get('up') ? vec('up', q.get('up')) : (dv.up || [0, 1, 0]).slice(),
+    fov: q.get('fov') ? Number(q.get('fov')) : dv.fov_y || 60,
+  };
+  // Lights as vdsh-view's (vv_default_lights, vv_scene_lights): colours
+  // and fall-off; the albedo 0.8 folded into colours and ambient.
+  const ALBEDO = 0.8;
+  let lights, colors, atts;
+  const r03 = 0.3 * diag;
+  if (q.getAll('light').length) {
+    lights = q.getAll('light').map((s) => vec('light', s));
+    colors = lights.map(() => [1.6, 1.6, 1.6]);
+    atts = lights.map(() => [1, 0, 1 / (r03 * r03)]);
+  } else {
+    const COLORS = [[1.0, 0.92, 0.8], [0.55, 0.7, 1.0], [1.0, 0.62, 0.4], [0.7, 1.0, 0.7]];
+    const n = Math.max(1, Math.min(dv.lights.length, Number(q.get('lights') || 1)));
+    lights = dv.lights.slice(0, n).map((l) => l.slice());
+    const intensity = Math.fround(1.6 / (1 + 0.6 * (n - 1)));
+    colors = lights.map((_, i) => COLORS[i % 4].map((c) => intensity * c));
+    atts = lights.map((l) => {
+      let r = r03;
+      if (!dv.interior) r = Math.hypot(...sub(l, centre)) || 1;
+      return [1, 0, 1 / (r * r)];
+    });
+  }
   const output = q.get('output') === 'shadow' ? 1 : 0;
+  const buffer = q.get('path') === 'buffer' || stream.variable_order || ![2, 3, 5].includes(stream.order);
+  window.vdshView = { eye: cam.eye, target: cam.target, lights, order: stream.order,
+    adaptive: !!stream.variable_order, path: buffer ? 'buffer' : 'attributes', defaultView: dv.fallback ? 'fallback' : 'file' };
 
   const canvas = document.getElementById('c');
   if (q.get('size')) {  // a fixed size WxH (CSS pixels) instead of the window's
@@ -212,56 +645,102 @@ async function main() {
     canvas.style.height = h + 'px';
   }
   const gl = canvas.getContext('webgl2', { antialias: false, preserveDrawingBuffer: true });
-  if (!gl) throw new Error('no WebGL2');
-  const src = glsl(want, quantity, lights.length, output);
+  if (!gl) throw new Error('this browser gives no WebGL2 context');
+  const coef = attrNames.map((n) => gltf.read(prim.attributes[n]));
+  let bufCfg = null, records = null, orders = null, texels = null;
+  if (buffer) {
+    // Each vertex's record: its coefficients (up to its own order: the
+    // last nonzero band of an adaptive stream) in the recurrence's order.
+    const N = stream.order, nc = N * N;
+    orders = new Uint32Array(nv);
+    records = new Uint32Array(nv);
+    const get = (v, i) => coef[i >> 2][4 * v + (i & 3)];
+    let total = 0;
+    for (let v = 0; v < nv; v++) {
+      let k = N;
+      if (stream.variable_order)
+        for (k = 0; k < N; k++) {
+          let zero = true;
+          for (let i = k * k; i < nc && zero; i++) zero = get(v, i) === 0;
+          if (zero) break;
+        }
+      orders[v] = k;
+      records[v] = total;
+      total += Math.ceil(k * k / 4);
+    }
+    const maxTex = gl.getParameter(gl.MAX_TEXTURE_SIZE);
+    const W = Math.min(maxTex, 4096), H = Math.max(1, Math.ceil(total / W));
+    if (H > maxTex) throw new Error('the coefficients need ' + total + ' texels, over this GPU\'s texture (' + maxTex + ' x ' + maxTex + ')');
+    texels = new Float32Array(W * H * 4);
+    const seqs = [];
+    for (let v = 0; v < nv; v++) {
+      const k = orders[v], seq = seqs[k] || (seqs[k] = bufferSequence(k));
+      const at = 4 * records[v];
+      for (let p = 0; p < seq.length; p++) texels[at + p] = get(v, seq[p]);
+    }
+    bufCfg = { order: N, texWidth: W, texHeight: H };
+  }
+  const src = glsl({ order: stream.order, quantity, lights: lights.length, output, buffer: bufCfg });
   const sh = (type, s) => {
     const o = gl.createShader(type);
     gl.shaderSource(o, s);
     gl.compileShader(o);
-    if (!gl.getShaderParameter(o, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(o));
+    if (!gl.getShaderParameter(o, gl.COMPILE_STATUS))
+      throw new Error('the ' + (type === gl.VERTEX_SHADER ? 'vertex' : 'fragment') + ' shader does not compile: ' + gl.getShaderInfoLog(o));
     return o;
   };
   const prog = gl.createProgram();
   gl.attachShader(prog, sh(gl.VERTEX_SHADER, src.vs));
   gl.attachShader(prog, sh(gl.FRAGMENT_SHADER, src.fs));
   gl.linkProgram(prog);
-  if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
+  if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error('the shaders do not link: ' + gl.getProgramInfoLog(prog));
   gl.useProgram(prog);
   const vao = gl.createVertexArray();
   gl.bindVertexArray(vao);
-  const attrib = (name, ai) => {
+  const attrib = (name, data, size) => {
     const loc = gl.getAttribLocation(prog, name);
     if (loc < 0) return;
-    const a = json.accessors[ai], v = json.bufferViews[a.bufferView];
-    const b = gl.createBuffer();
-    gl.bindBuffer(gl.ARRAY_BUFFER, b);
-    gl.bufferData(gl.ARRAY_BUFFER, bin.subarray(v.byteOffset, v.byteOffset + v.byteLength), gl.STATIC_DRAW);
+    gl.bindBuffer(gl.ARRAY_BUFFER, gl.createBuffer());
+    gl.bufferData(gl.ARRAY_BUFFER, data, gl.STATIC_DRAW);
     gl.enableVertexAttribArray(loc);
-    gl.vertexAttribPointer(loc, { VEC3: 3, VEC4: 4 }[a.type], a.componentType, !!a.normalized, 0, a.byteOffset || 0);
+    if (data instanceof Uint32Array) gl.vertexAttribIPointer(loc, size, gl.UNSIGNED_INT, 0, 0);
+    else gl.vertexAttribPointer(loc, size, gl.FLOAT, false, 0, 0);
   };
-  attrib('a_position', prim.attributes.POSITION);
-  attrib('a_normal', prim.attributes.NORMAL);
-  for (let g = 0; g < src.groups; g++) attrib('a_c' + g, prim.attributes[stream.attribute_prefix + g]);
-  const ia = json.accessors[prim.indices], iv = json.bufferViews[ia.bufferView];
-  const ib = gl.createBuffer();
-  gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, ib);
-  gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, bin.subarray(iv.byteOffset, iv.byteOffset + iv.byteLength), gl.STATIC_DRAW);
+  attrib('a_position', pos, 3);
+  attrib('a_normal', nrm, 3);
   const U = (n) => gl.getUniformLocation(prog, n);
+  if (buffer) {
+    attrib('a_record', records, 1);
+    attrib('a_order', orders, 1);
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D, gl.createTexture());
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, bufCfg.texWidth, bufCfg.texHeight, 0, gl.RGBA, gl.FLOAT, texels);
+    gl.uniform1i(U('u_coef'), 0);
+  } else {
+    for (let g = 0; g < src.groups; g++) attrib('a_c' + g, coef[g], 4);
+  }
+  gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, gl.createBuffer());
+  gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, indices, gl.STATIC_DRAW);
   gl.uniform1f(U('u_scale'), stream.scale);
   gl.uniform1f(U('u_max_distance'), vx.max_distance);
-  gl.uniform3f(U('u_light_att'), 1, 0, 1 / Math.pow(0.3 * diag, 2));
-  gl.uniform1f(U('u_ambient'), 0.03);
+  gl.uniform3fv(U('u_light_color'), new Float32Array(colors.flat().map((c) => ALBEDO * c)));
+  gl.uniform3fv(U('u_light_att'), new Float32Array(atts.flat()));
+  gl.uniform3f(U('u_ambient'), ALBEDO * 0.03, ALBEDO * 0.03, ALBEDO * 0.03);
   gl.enable(gl.DEPTH_TEST);
+  const err = gl.getError();
+  if (err) throw new Error('WebGL error 0x' + err.toString(16) + ' while uploading the scene');
 
   function draw() {
     const W = canvas.width = canvas.clientWidth, H = canvas.height = canvas.clientHeight;
     gl.viewport(0, 0, W, H);
-    if (output) gl.clearColor(1, 1, 1, 1); else gl.clearColor(0.1, 0.1, 0.12, 1);
+    if (output) gl.clearColor(1, 1, 1, 1); else gl.clearColor(0, 0, 0, 1);
     gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
-    const far = 4 * diag;
+    const far = 4 * diag + Math.hypot(...sub(cam.eye, centre));
     gl.uniformMatrix4fv(U('u_view_proj'), false, viewProj(cam, W / H, far / 4000, far).m);
     gl.uniform3fv(U('u_light_pos'), new Float32Array(lights.flat()));
-    gl.drawElements(gl.TRIANGLES, ia.count, ia.componentType, 0);
+    gl.drawElements(gl.TRIANGLES, indices.length, gl.UNSIGNED_INT, 0);
   }
   draw();
   // Orbit (drag), zoom (wheel), move light 0 (shift+drag).
@@ -295,4 +774,16 @@ async function main() {
   document.title = 'ready ' + canvas.width + 'x' + canvas.height;
 }
 
-main().catch((e) => { document.title = 'error: ' + e.message; console.error(e); });
+function showError(e) {
+  const msg = e && e.message ? e.message : String(e);
+  window.vdshError = msg;
+  document.title = 'error: ' + msg;
+  const el = document.getElementById('msg');
+  if (el) {
+    el.textContent = 'VDSH viewer: ' + msg;
+    el.hidden = false;
+  }
+  console.error(e);
+}
+
+main().catch(showError);
