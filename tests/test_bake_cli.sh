@@ -21,6 +21,10 @@ expect_exit() { # expect_exit CODE DESCRIPTION COMMAND...
   fi
 }
 
+json() { # json FILE PYTHON_EXPRESSION_OF_d: true when it holds
+  /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); sys.exit(0 if eval(sys.argv[2]) else 1)' "$@"
+}
+
 quick=(builtin:room --max-edge 1.5 --rays 256 -q)
 
 # Determinism: 1 thread, 2 threads and a repeat give byte-identical files.
@@ -45,6 +49,33 @@ expect_exit 0 "vdsh-info --verify accepts an adaptive bake" "$info" --verify "$t
 "$info" "$tmp/ad1.vdsh" >"$tmp/adinfo.txt" 2>&1
 check "info shows the adaptive tolerance" grep -q "adaptive     tolerance 0.08, min edge 0.1875" "$tmp/adinfo.txt"
 
+# The round cap: --max-rounds N (default 8), in the report; stderr says when
+# it stopped a refinement still splitting; no environment variable moves it.
+check "report: the default round cap" json "$tmp/ad2.json" \
+  "d['adaptive']['max_rounds'] == 8 and d['adaptive']['rounds'] <= 8"
+expect_exit 0 "adaptive, done before the cap" "$bake" builtin:room --max-edge 1.5 --adaptive 0.08 \
+  --min-edge 0.5 --rays 256 --cube-size 0 --max-rounds 2 -o "$tmp/nocap.vdsh" --report "$tmp/nocap.json"
+check "no round-cap warning when the refinement finished" bash -c "! grep -q 'round cap' '$tmp/err.txt'"
+check "report: finished before the cap" json "$tmp/nocap.json" \
+  "d['adaptive']['max_rounds'] == 2 and d['adaptive']['rounds'] == 1 and d['adaptive']['rounds_reached'] is False and d['adaptive']['edges_pending'] == 0"
+capped=(builtin:room --max-edge 1.5 --adaptive 0.08 --rays 256 --cube-size 0 --max-rounds 1)
+expect_exit 0 "adaptive, --max-rounds 1" "$bake" "${capped[@]}" -o "$tmp/cap.vdsh" \
+  --report "$tmp/cap.json"
+check "stderr says the round cap stopped the refinement" \
+  grep -q "adaptive refinement stopped at the round cap (1) while still splitting (.* edges split in the last round, [1-9][0-9]* edges not yet judged): raise --max-rounds" "$tmp/err.txt"
+check "report: the round cap stopped it" json "$tmp/cap.json" \
+  "d['adaptive']['max_rounds'] == 1 and d['adaptive']['rounds'] == 1 and d['adaptive']['rounds_reached'] is True and d['adaptive']['edges_pending'] > 0"
+"$info" --json - "$tmp/cap.vdsh" >"$tmp/cap.info.json" 2>/dev/null
+check "the file records the round cap" json "$tmp/cap.info.json" \
+  "d['adaptive']['max_rounds'] == 1 and d['adaptive']['rounds'] == 1"
+expect_exit 0 "adaptive, default cap, VDSH_ROUNDS=1 set" env VDSH_ROUNDS=1 "$bake" "${adaptive[@]}" \
+  --threads 2 -o "$tmp/ad3.vdsh"
+check "VDSH_ROUNDS no longer changes the bake" cmp -s "$tmp/ad2.vdsh" "$tmp/ad3.vdsh"
+expect_exit 2 "--max-rounds 0" "$bake" builtin:room --max-edge 1 --adaptive 0.1 --max-rounds 0 -o "$tmp/x.vdsh"
+expect_exit 2 "--max-rounds 2x" "$bake" builtin:room --max-edge 1 --adaptive 0.1 --max-rounds 2x -o "$tmp/x.vdsh"
+expect_exit 2 "--max-rounds without --adaptive" "$bake" builtin:room --max-edge 1 --max-rounds 3 -o "$tmp/x.vdsh"
+check "--help lists --max-rounds" bash -c "'$bake' --help | grep -q -- '--max-rounds N'"
+
 # The file verifies and says what it is.
 expect_exit 0 "vdsh-info --verify accepts the bake" "$info" --verify "$tmp/a.vdsh"
 "$info" "$tmp/a.vdsh" >"$tmp/info.txt" 2>&1
@@ -55,9 +86,6 @@ check "info lists order 5" grep -q "order 5 (25 coefficients)" "$tmp/info.txt"
 expect_exit 0 "bake f32 orders 2,3 full" "$bake" "${quick[@]}" --orders 3,2 --encoding f32 \
   --method full --seed 9 -o "$tmp/d.vdsh" --report "$tmp/d.json"
 "$info" --json - "$tmp/d.vdsh" >"$tmp/d.info.json"
-json() { # json FILE PYTHON_EXPRESSION_OF_d: true when it holds
-  /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); sys.exit(0 if eval(sys.argv[2]) else 1)' "$@"
-}
 check "f32 recorded" json "$tmp/d.info.json" "{s['encoding'] for s in d['streams']} == {'f32'}"
 check "method full recorded" json "$tmp/d.info.json" "{s['method'] for s in d['streams']} == {'full'}"
 check "orders 2, 3 and no order 5 stream" json "$tmp/d.info.json" "sorted(s['order'] for s in d['streams']) == [2, 3]"

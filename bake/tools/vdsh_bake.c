@@ -67,6 +67,7 @@ typedef struct options {
     float adaptive_tol;
     float min_edge;            /* --min-edge; 0: max_edge / 8 */
     uint32_t max_receivers;    /* --max-receivers; 0: none */
+    uint32_t max_rounds;       /* --max-rounds; 0: none given (VB_ADAPTIVE_ROUNDS) */
     int weld;
     uint64_t seed;
     unsigned threads;
@@ -225,6 +226,9 @@ static void usage(FILE *f)
 "                          (default: --max-edge / 8)\n"
 "      --max-receivers N   with --adaptive: stop at N receivers, splitting\n"
 "                          the largest errors first\n"
+"      --max-rounds N      with --adaptive: at most N rounds of splits\n"
+"                          (default 8; stderr says when it stops one still\n"
+"                          splitting)\n"
 "      --plan FILE         write the receivers (refined, or with --adaptive\n"
 "                          as baked) for shards to read with --receivers:\n"
 "                          FILE.ply binary PLY (fast to read), else OBJ;\n"
@@ -470,6 +474,9 @@ static int write_report(const char *path, const options *o, const vb_job *job,
         vt_json_u64(&j, ad, "rounds", job->adaptive.rounds);
         vt_json_u64(&j, ad, "midpoints_baked", job->adaptive.candidates);
         vt_json_bool(&j, ad, "budget_reached", job->adaptive.budget_reached);
+        vt_json_u64(&j, ad, "max_rounds", job->adaptive.max_rounds);
+        vt_json_bool(&j, ad, "rounds_reached", job->adaptive.rounds_reached);
+        vt_json_u64(&j, ad, "edges_pending", job->adaptive.pending);
     } else {
         vt_json_null(&j, root, "adaptive");
     }
@@ -623,7 +630,7 @@ int main(int argc, char **argv)
     enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
            O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL, O_SHARD,
-           O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS, O_PLAN, O_RECEIVERS, O_ADAPTIVE_ORDER,
+           O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS, O_MAX_ROUNDS, O_PLAN, O_RECEIVERS, O_ADAPTIVE_ORDER,
            O_MAX_ORDER, O_DEC_LIGHTS, O_FALSE_RATE, O_DEC_PARAMS };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
@@ -663,6 +670,7 @@ int main(int argc, char **argv)
         {"receivers", required_argument, 0, O_RECEIVERS},
         {"min-edge", required_argument, 0, O_MIN_EDGE},
         {"max-receivers", required_argument, 0, O_MAX_RECEIVERS},
+        {"max-rounds", required_argument, 0, O_MAX_ROUNDS},
         {"quiet", no_argument, 0, 'q'},
         {"help", no_argument, 0, 'h'},
         {"version", no_argument, 0, 'V'},
@@ -761,6 +769,11 @@ int main(int argc, char **argv)
                                  optarg);
             o.max_receivers = (uint32_t)u;
             break;
+        case O_MAX_ROUNDS:
+            if (!vt_parse_u64(optarg, 1, 1000, &u))
+                return bad_usage("--max-rounds takes a whole number 1..1000, not '%s'", optarg);
+            o.max_rounds = (uint32_t)u;
+            break;
         case O_WELD: o.weld = 1; break;
         case O_SEED:
             if (!vt_parse_u64(optarg, 0, UINT64_MAX, &o.seed))
@@ -854,8 +867,8 @@ int main(int argc, char **argv)
     }
     if (o.have_ray_tolerance && !o.adaptive_rays)
         return bad_usage("%s needs --rays auto", "--ray-tolerance");
-    if ((o.min_edge > 0.0f || o.max_receivers) && !o.adaptive)
-        return bad_usage("%s need --adaptive TOL", "--min-edge and --max-receivers");
+    if ((o.min_edge > 0.0f || o.max_receivers || o.max_rounds) && !o.adaptive)
+        return bad_usage("%s need --adaptive TOL", "--min-edge, --max-receivers and --max-rounds");
     if (o.adaptive && !(o.max_edge > 0.0f))
         return bad_usage("%s", "--adaptive needs --max-edge L: the uniform refinement it "
                                "starts from (the coarsest receivers)");
@@ -916,7 +929,7 @@ int main(int argc, char **argv)
         .adaptive = o.adaptive, .receivers_path = o.receivers,
         .adapt = {.tolerance = o.adaptive_tol, .min_edge = o.min_edge,
                   .max_receivers = o.max_receivers,
-                  .max_rounds = getenv("VDSH_ROUNDS") ? (uint32_t)atoi(getenv("VDSH_ROUNDS")) : 0,
+                  .max_rounds = o.max_rounds ? o.max_rounds : VB_ADAPTIVE_ROUNDS,
                   .on_round = log ? on_round : NULL,
                   .user = log},
         .bake = {.rays = o.rays, .adaptive_rays = o.adaptive_rays,
@@ -1014,6 +1027,11 @@ int main(int argc, char **argv)
                 job.receivers.vertex_count, job.adaptive.start_receivers, job.adaptive.rounds,
                 job.adaptive.candidates, (double)o.adaptive_tol, (double)o.min_edge,
                 job.adaptive.budget_reached ? ", the budget stopped it" : "");
+    if (log && o.adaptive && job.adaptive.rounds_reached)
+        fprintf(log, "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
+                     "while still splitting (%u edges split in the last round, %u edges not "
+                     "yet judged): raise --max-rounds\n",
+                job.adaptive.max_rounds, job.adaptive.last_split, job.adaptive.pending);
     if (log && bo->flipped_normals)
         fprintf(log, "vdsh-bake: %u receiver normals pointed into geometry and were "
                      "flipped (--keep-normals keeps them)\n", bo->flipped_normals);
