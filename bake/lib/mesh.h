@@ -41,6 +41,11 @@
  * normals over the vertex's own faces, so unwelded hard edges stay hard).
  * Triangles with a repeated index are dropped (they have no area and no
  * effect on rays); zero-area triangles with distinct indices are kept.
+ * Duplicate triangles are dropped: one with the same three positions as
+ * an earlier kept triangle, in any corner order and either winding (a
+ * receiver on one copy would see the other at distance ~0; rays hit
+ * either alike), except the first reversed copy that shares no vertex with
+ * it: the back of a two-sided sheet, whose vertices are its own receivers.
  * What was dropped, removed, split or repaired comes back as counts in
  * vb_source_info.report (vb_mesh_report); loading itself prints nothing.
  *
@@ -64,8 +69,8 @@
  * Files are read into memory once (vb_mesh_load_memory starts from such
  * bytes); those bytes are hashed for vb_source_info and read in one strict
  * pass straight into arrays (mesh_parse.h; no half-edge structure, so
- * non-manifold and duplicate faces are kept as they are: nothing in the
- * file is lost). The readers read what OpenMesh 9's readers read (the
+ * non-manifold faces are kept as they are; duplicate faces are dropped,
+ * as above, and counted). The readers read what OpenMesh 9's readers read (the
  * baker used those until issue 13: the same floats, vertex numbering and
  * normals, so the same bakes) and refuse what those would have skipped or
  * misread: numbers that do not parse or are NaN/Inf, faces with fewer than
@@ -139,6 +144,11 @@ typedef struct vb_mesh_report {
                                     dropped; OBJ faces with fewer than 3
                                     distinct vertices count as their
                                     corners - 2 */
+    uint32_t duplicate_triangles; /* the same three positions as an earlier
+                                    triangle (any corner order, either
+                                    winding), dropped; a reversed copy with
+                                    vertices of its own (a two-sided sheet's
+                                    back) is kept */
     uint32_t removed_vertices;   /* used by no remaining triangle */
     uint32_t split_vertices;     /* split at creases (corner normals) */
     uint32_t split_added;        /* vertices those splits added */
@@ -147,13 +157,22 @@ typedef struct vb_mesh_report {
     uint32_t zero_normals;       /* loaded vertices whose file normal is
                                     zero (or whose given normals cancel) */
     uint32_t zero_repaired;      /* of those, given their own triangles'
-                                    normal (the rest have no area) */
-    uint32_t cancelled_normals;  /* loaded vertices whose computed normal
-                                    cancelled (two-sided triangles): given
-                                    their largest triangle's normal */
+                                    normal */
+    uint32_t zero_cancelled;     /* of those, whose triangles' normals
+                                    cancel (two-sided): given their largest
+                                    triangle's normal */
+    uint32_t zero_undefined;     /* of those, left (0,0,0): their
+                                    triangles have no area (zero_repaired +
+                                    zero_cancelled + zero_undefined =
+                                    zero_normals) */
+    uint32_t cancelled_normals;  /* loaded vertices without a file normal
+                                    whose computed normal cancelled
+                                    (two-sided triangles): given their
+                                    largest triangle's normal */
     uint32_t welded;             /* vertices merged by weld */
     uint32_t undefined_normals;  /* loaded vertices left (0,0,0) at the end:
-                                    their triangles have no area */
+                                    their triangles have no area (those
+                                    with a zero file normal included) */
     uint32_t gltf_skipped_modes; /* glTF: point and line primitives skipped */
     uint32_t gltf_skipped_morph; /* glTF: primitives with morph targets
                                     skipped (their base shape is not what
@@ -175,8 +194,11 @@ typedef struct vb_source_info {
 
 /* One line per non-zero finding of `r` on fp, each "TOOL: PATH: ..."
  * (no "TOOL: " when tool is NULL), e.g. "vdsh-bake: scan.ply: 11160
- * triangles dropped (a repeated vertex index: no area)". Nothing when
- * fp is NULL (a tool's quiet mode) or nothing was found. */
+ * triangles dropped (a repeated vertex index: no area)". A vertex is said
+ * once: the zero file normals' line says what became of them (their own
+ * triangles' normal, their largest triangle's, or none), and the lines on
+ * cancelled and undefined normals count the other vertices only. Nothing
+ * when fp is NULL (a tool's quiet mode) or nothing was found. */
 void vb_mesh_report_print(FILE *fp, const char *tool, const char *path,
                           const vb_mesh_report *r);
 
