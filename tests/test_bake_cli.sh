@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # vdsh-bake end to end: determinism across thread counts and runs, the
 # files it writes, exit codes, and no output left behind on failure.
-# Usage: test_bake_cli.sh VDSH_BAKE VDSH_INFO
+# Usage: test_bake_cli.sh VDSH_BAKE VDSH_INFO [SCENES]
 set -u
 bake=$1
 info=$2
+scenes=${3:-}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail=0
@@ -99,6 +100,48 @@ expect_exit 0 "bake with timings" "$bake" "${quick[@]}" --record-timings -o "$tm
 check "timings stored when asked" json "$tmp/e.info.json" "d['timings']['total'] > 0"
 check "no timings otherwise" json "$tmp/d.info.json" "d['timings'] is None"
 check "--cubemap-dir" bash -c "mkdir -p '$tmp/cubes' && '$bake' ${quick[*]} --cubemap-dir '$tmp/cubes' -o '$tmp/f.vdsh' && test -s '$tmp/cubes/f.sh21-24.exr' && test ! -e '$tmp/f.sh21-24.exr'"
+
+# Receivers far apart against the scene (no --max-edge, --adaptive or
+# --receivers): a warning with figures and a --max-edge to try; none when
+# the receivers were chosen or are dense; the figures in the report.
+awk 'BEGIN { n = 40; s = 10 / n
+  for (j = 0; j <= n; j++) for (i = 0; i <= n; i++) printf "v %g 0 %g\n", i * s, j * s
+  for (j = 0; j < n; j++) for (i = 0; i < n; i++) {
+    a = j * (n + 1) + i + 1; b = a + 1; c = a + n + 1; d = c + 1
+    printf "f %d %d %d\nf %d %d %d\n", a, c, b, b, c, d } }' >"$tmp/grid.obj"
+printf 'v 0 0 0\nv 10 0 0\nv 10 0 10\nv 0 0 10\nv 4 0 4\nv 4.5 0 4\nv 4 0.5 4\nf 1 4 3 2\nf 5 6 7\n' \
+  >"$tmp/coarse.obj"
+far="receivers far apart"
+expect_exit 0 "coarse floor at its vertices" "$bake" "$tmp/coarse.obj" --rays 16 --cube-size 0 \
+  -o "$tmp/coarse.vdsh" --report "$tmp/coarse.json"
+check "warning: receivers far apart, with figures and a --max-edge" grep -q \
+  "warning: $far: 100% of the surface is in triangles whose longest edge exceeds 5% of the scene's diagonal (14.15; longest edges: median 14.1, 90th percentile 14.1, area-weighted).*--max-edge 0.14 (1% of the diagonal)" \
+  "$tmp/err.txt"
+check "report: the receivers' spacing" json "$tmp/coarse.json" \
+  "d['receiver_spacing']['far_apart'] is True and d['receiver_spacing']['long_area_share'] > 0.99 and abs(d['receiver_spacing']['scene_diagonal'] - 200.25 ** 0.5) < 0.001"
+expect_exit 0 "coarse floor with --max-edge" "$bake" "$tmp/coarse.obj" --rays 16 --cube-size 0 \
+  --max-edge 0.5 -o "$tmp/coarse2.vdsh" --report "$tmp/coarse2.json"
+check "no warning with --max-edge" bash -c "! grep -q '$far' '$tmp/err.txt'"
+check "report: refined receivers are close" json "$tmp/coarse2.json" \
+  "d['receiver_spacing']['far_apart'] is False and d['receiver_spacing']['max_longest_edge'] <= 0.5"
+expect_exit 0 "dense grid at its vertices" "$bake" "$tmp/grid.obj" --rays 16 --cube-size 0 -o "$tmp/grid.vdsh"
+check "no warning for a dense mesh" bash -c "! grep -q '$far' '$tmp/err.txt'"
+expect_exit 0 "builtin:room at --max-edge 0.2" "$bake" builtin:room --max-edge 0.2 --rays 16 \
+  --orders 2 --method lsq --cube-size 0 -o "$tmp/room02.vdsh"
+check "no warning for the room at --max-edge 0.2" bash -c "! grep -q '$far' '$tmp/err.txt'"
+expect_exit 0 "builtin:room at its vertices, plan only" "$bake" builtin:room --plan "$tmp/roomplan.ply"
+check "the room at its vertices warns" grep -q "warning: $far: 60% of the surface" "$tmp/err.txt"
+expect_exit 0 "export only" "$bake" builtin:room --export-obj "$tmp/roomx.obj"
+check "no warning when nothing is baked" bash -c "! grep -q '$far' '$tmp/err.txt'"
+sponza=$scenes/sponza_dabrovic/sponza.obj
+if [[ -n $scenes && -f $sponza ]]; then
+  expect_exit 0 "Sponza at its vertices" "$bake" "$sponza" --rays 16 --orders 2 --method lsq \
+    --cube-size 0 -o "$tmp/sponza.vdsh"
+  check "Sponza at its vertices warns, suggesting --max-edge 0.42" grep -q \
+    "warning: $far: 84% of the surface.*--max-edge 0.42 (1% of the diagonal)" "$tmp/err.txt"
+else
+  echo "no Sponza at '$sponza': its spacing warning not checked"
+fi
 
 # Export the built-in scene as OBJ and bake it back: same occluders.
 expect_exit 0 "export OBJ" "$bake" builtin:room -q --export-obj "$tmp/room.obj"

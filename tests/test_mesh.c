@@ -1093,6 +1093,65 @@ static void test_load_report(void)
     vb_mesh_free(&m);
 }
 
+/* Receiver spacing (vb_mesh_spacing_of): a 10 x 10 floor of two
+ * triangles plus a small one is far apart; its 40 x 40 grid is not; the
+ * quantiles are area-weighted; the built-in room at its vertices is, at
+ * --max-edge 0.2 it is not. */
+static void test_spacing(void)
+{
+    static const float fp[] = {0, 0, 0, 10, 0, 0, 10, 0, 10, 0, 0, 10, 4, 0, 4, 4.5f, 0, 4, 4, 0.5f, 4};
+    static const uint32_t fi[] = {0, 3, 2, 0, 2, 1, 4, 5, 6};
+    vb_mesh m = {.vertex_count = 7, .triangle_count = 3, .positions = (float *)fp, .indices = (uint32_t *)fi};
+    vb_mesh_spacing s;
+    vb_mesh_spacing_of(&m, 0.0f, &s);
+    const float diag = sqrtf(200.25f); /* the small triangle reaches y = 0.5 */
+    CHECK(fabsf(s.diagonal - diag) < 1e-4f && fabs(s.area - 100.125) < 1e-3, "floor: diagonal %g, area %g",
+          s.diagonal, s.area);
+    CHECK(s.far_apart && s.long_area > 0.998 && fabsf(s.max_edge - sqrtf(200.0f)) < 1e-4f,
+          "floor: far %d, long %g, max %g", s.far_apart, s.long_area, s.max_edge);
+    CHECK(fabsf(s.median_edge - diag) < 0.02f * diag && fabsf(s.p90_edge - diag) < 0.02f * diag,
+          "floor: median %g, p90 %g, want ~%g (area-weighted: the small triangle hardly counts)", s.median_edge,
+          s.p90_edge, diag);
+    CHECK(fabsf(s.suggest_edge - 0.14f) < 1e-6f, "floor: suggests %g, want 0.14", s.suggest_edge);
+    /* the same floor as a 40 x 40 grid: cells 0.25, diagonals 0.354 = 2.5% */
+    enum { N = 40 };
+    float *gp = malloc(sizeof(float) * 3 * (N + 1) * (N + 1));
+    uint32_t *gi = malloc(sizeof(uint32_t) * 6 * N * N), t = 0;
+    for (int j = 0; j <= N; j++)
+        for (int i = 0; i <= N; i++) {
+            float *p = gp + 3 * (j * (N + 1) + i);
+            p[0] = 10.0f * i / N, p[1] = 0.0f, p[2] = 10.0f * j / N;
+        }
+    for (uint32_t j = 0; j < N; j++)
+        for (uint32_t i = 0; i < N; i++) {
+            uint32_t a = j * (N + 1) + i, c = a + N + 1;
+            uint32_t q[6] = {a, c, a + 1, a + 1, c, c + 1};
+            memcpy(gi + 6 * t++, q, sizeof q);
+        }
+    vb_mesh g = {.vertex_count = (N + 1) * (N + 1), .triangle_count = 2 * N * N, .positions = gp, .indices = gi};
+    vb_mesh_spacing_of(&g, 0.0f, &s);
+    CHECK(!s.far_apart && s.long_area == 0.0 && fabsf(s.median_edge - 0.3536f) < 0.01f,
+          "grid: far %d, long %g, median %g (want 0, 0, 0.354)", s.far_apart, s.long_area, s.median_edge);
+    /* against a larger scene's diagonal, the same grid's edges are shorter still */
+    vb_mesh_spacing_of(&g, 100.0f, &s);
+    CHECK(s.diagonal == 100.0f && !s.far_apart && fabsf(s.suggest_edge - 1.0f) < 1e-6f, "grid in a 100 scene");
+    free(gp);
+    free(gi);
+    vb_mesh room = {0}, fine = {0};
+    vb_error err;
+    CHECK(vb_builtin_room(&room, &err) == VB_OK, "room: %s", err.msg);
+    vb_mesh_spacing_of(&room, 0.0f, &s);
+    CHECK(s.far_apart && s.long_area > 0.5, "room at its vertices: far %d, long %g", s.far_apart, s.long_area);
+    float lo[3], hi[3];
+    vb_mesh_bounds(&room, lo, hi);
+    CHECK(vb_mesh_refine(&room, 0.2f, &fine, &err) == VB_OK, "refine: %s", err.msg);
+    vb_mesh_spacing_of(&fine, s.diagonal, &s);
+    CHECK(!s.far_apart && s.long_area == 0.0 && s.max_edge <= 0.2f, "room at 0.2: far %d, long %g, max %g",
+          s.far_apart, s.long_area, s.max_edge);
+    vb_mesh_free(&room);
+    vb_mesh_free(&fine);
+}
+
 /* ====================================================================== */
 /* Built-in room                                                          */
 /* ====================================================================== */
@@ -1860,6 +1919,7 @@ static int run_unit(const char *tmp_parent)
     test_normals_weld_append();
     test_corner_normals();
     test_load_report();
+    test_spacing();
     test_room();
     test_room_variants();
     test_refine();

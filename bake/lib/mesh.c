@@ -55,6 +55,74 @@ void vb_mesh_bounds(const vb_mesh *m, float min[3], float max[3])
     }
 }
 
+/* Receiver spacing: longest edges in log-spaced bins, 1% wide, from
+ * 1e-6 of the diagonal up (anything longer than the diagonal in the last). */
+#define SPACING_BINS 1400
+#define SPACING_STEP 0.01 /* ln of a bin's width ratio */
+#define SPACING_LOW 1e-6
+
+void vb_mesh_spacing_of(const vb_mesh *m, float diagonal, vb_mesh_spacing *s)
+{
+    memset(s, 0, sizeof *s);
+    if (!(diagonal > 0.0f)) {
+        float lo[3], hi[3];
+        vb_mesh_bounds(m, lo, hi);
+        diagonal = sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    }
+    s->diagonal = diagonal;
+    if (!m || !m->positions || !m->indices || !(diagonal > 0.0f))
+        return;
+    double bin[SPACING_BINS] = {0}; /* area per bin */
+    const double limit = (double)VB_SPACING_WARN_EDGE * diagonal;
+    double area = 0.0, long_area = 0.0, longest = 0.0;
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *tri = m->indices + 3 * (size_t)t;
+        const float *p[3] = {m->positions + 3 * (size_t)tri[0], m->positions + 3 * (size_t)tri[1],
+                             m->positions + 3 * (size_t)tri[2]};
+        double e[3][3], l2 = 0.0;
+        for (int c = 0; c < 3; c++) {
+            double q = 0.0;
+            for (int k = 0; k < 3; k++) {
+                e[c][k] = (double)p[(c + 1) % 3][k] - p[c][k];
+                q += e[c][k] * e[c][k];
+            }
+            l2 = q > l2 ? q : l2;
+        }
+        const double cx = e[0][1] * e[2][2] - e[0][2] * e[2][1], cy = e[0][2] * e[2][0] - e[0][0] * e[2][2],
+                     cz = e[0][0] * e[2][1] - e[0][1] * e[2][0];
+        const double a = 0.5 * sqrt(cx * cx + cy * cy + cz * cz), l = sqrt(l2);
+        area += a;
+        longest = l > longest ? l : longest;
+        if (l > limit)
+            long_area += a;
+        double r = l / diagonal;
+        int b = r > SPACING_LOW ? (int)(log(r / SPACING_LOW) / SPACING_STEP) : 0;
+        bin[b < SPACING_BINS ? b : SPACING_BINS - 1] += a;
+    }
+    s->area = area;
+    s->max_edge = (float)longest;
+    if (!(area > 0.0))
+        return;
+    s->long_area = long_area / area;
+    s->far_apart = s->long_area > VB_SPACING_WARN_AREA;
+    /* quantiles: a bin's geometric middle */
+    double sum = 0.0;
+    for (int b = 0; b < SPACING_BINS && !(s->p90_edge > 0.0f); b++) {
+        sum += bin[b];
+        double mid = SPACING_LOW * exp((b + 0.5) * SPACING_STEP) * diagonal;
+        if (mid > longest)
+            mid = longest;
+        if (!(s->median_edge > 0.0f) && sum >= 0.5 * area)
+            s->median_edge = (float)mid;
+        if (sum >= 0.9 * area)
+            s->p90_edge = (float)mid;
+    }
+    double want = (double)VB_SPACING_SUGGEST * diagonal;
+    double mag = pow(10.0, floor(log10(want)) - 1.0);
+    s->suggest_edge = (float)(round(want / mag) * mag);
+}
+
 void vb_sha256(const void *data, size_t size, uint8_t out[32])
 {
     struct sha256_ctx ctx;

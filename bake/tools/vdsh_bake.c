@@ -436,7 +436,7 @@ static void report_seconds(vt_json *j, cJSON *root, const vdsh_timings *t)
 }
 
 static int write_report(const char *path, const options *o, const vb_job *job,
-                        double write_seconds, char *msg, size_t cap)
+                        const vb_mesh_spacing *sp, double write_seconds, char *msg, size_t cap)
 {
     const vdsh_file *f = &job->file;
     const vb_bake_output *b = &job->bake;
@@ -465,6 +465,14 @@ static int write_report(const char *path, const options *o, const vb_job *job,
     vt_json_string(&j, root, "encoding", vdsh_encoding_name(o->encoding));
     vt_json_f32(&j, root, "max_distance", b->max_distance);
     vt_json_f32(&j, root, "max_edge", o->max_edge);
+    /* The receivers' spacing before any bake (vb_mesh_spacing_of). */
+    cJSON *spc = vt_json_object(&j, root, "receiver_spacing");
+    vt_json_f32(&j, spc, "scene_diagonal", sp->diagonal);
+    vt_json_f32(&j, spc, "median_longest_edge", sp->median_edge);
+    vt_json_f32(&j, spc, "p90_longest_edge", sp->p90_edge);
+    vt_json_f32(&j, spc, "max_longest_edge", sp->max_edge);
+    vt_json_f64(&j, spc, "long_area_share", sp->long_area);
+    vt_json_bool(&j, spc, "far_apart", sp->far_apart);
     if (o->adaptive) {
         cJSON *ad = vt_json_object(&j, root, "adaptive");
         vt_json_f32(&j, ad, "tolerance", o->adaptive_tol);
@@ -951,6 +959,7 @@ int main(int argc, char **argv)
         .on_mesh = log ? on_mesh : NULL, .user = log};
     int status = 1;
     int writing = 0; /* output_lock held: outputs are being written */
+    vb_mesh_spacing spacing = {0};
     vb_error err;
     vb_job job = {0};
 
@@ -974,6 +983,27 @@ int main(int argc, char **argv)
         fprintf(log, "vdsh-bake: receivers refined to max edge %g: %u vertices, "
                      "%u triangles (%.2f s)\n",
                 (double)o.max_edge, rec->vertex_count, rec->triangle_count, job.timings.refine);
+    /* Receivers far apart against the scene draw false shadows inside their
+     * triangles: say so when nothing chose them (no --max-edge, --adaptive
+     * or --receivers) and a bake or plan follows. */
+    const int chosen = o.max_edge > 0.0f || o.adaptive || o.receivers;
+    if ((log && !chosen && (o.output || o.plan)) || o.report) {
+        float lo[3], hi[3];
+        vb_mesh_bounds(&job.occluders, lo, hi);
+        vb_mesh_spacing_of(rec, sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) +
+                                      (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                      (hi[2] - lo[2]) * (hi[2] - lo[2])), &spacing);
+    }
+    if (log && !chosen && (o.output || o.plan) && spacing.far_apart)
+        fprintf(log, "vdsh-bake: warning: receivers far apart: %.0f%% of the surface is in "
+                     "triangles whose longest edge exceeds %.0f%% of the scene's diagonal (%.4g; "
+                     "longest edges: median %.3g, 90th percentile %.3g, area-weighted). The "
+                     "shadows are interpolated between receivers, so these triangles draw false "
+                     "shadows inside them: refine, e.g. --max-edge %g (1%% of the diagonal), "
+                     "or --adaptive from a coarser --max-edge\n",
+                100.0 * spacing.long_area, 100.0 * VB_SPACING_WARN_EDGE, (double)spacing.diagonal,
+                (double)spacing.median_edge, (double)spacing.p90_edge,
+                (double)spacing.suggest_edge);
     if (o.plan && !o.adaptive) { /* uniform: the refined receivers, before any bake */
         if (write_plan(rec, o.plan, log) != 0)
             goto out;
@@ -1147,7 +1177,7 @@ int main(int argc, char **argv)
                     o.cubemap_dir ? o.cubemap_dir : "the output's directory");
         fprintf(log, "\nvdsh-bake: done in %.2f s\n", job.timings.total + write_seconds);
     }
-    if (o.report && write_report(o.report, &o, &job, write_seconds, msg, sizeof msg) != 0) {
+    if (o.report && write_report(o.report, &o, &job, &spacing, write_seconds, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-bake: %s (the report)\n", msg);
         goto out;
     }
