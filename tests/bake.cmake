@@ -4,7 +4,7 @@ add_test(NAME bake_core COMMAND test_bake)
 
 add_test(NAME bake_cli
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_bake_cli.sh
-                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info>)
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info> ${VDSH_SHARED_SCENES})
 
 add_executable(test_hard test_hard.c)
 target_link_libraries(test_hard PRIVATE vb_core)

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # vdsh-bake end to end: determinism across thread counts and runs, the
 # files it writes, exit codes, and no output left behind on failure.
-# Usage: test_bake_cli.sh VDSH_BAKE VDSH_INFO
+# Usage: test_bake_cli.sh VDSH_BAKE VDSH_INFO [SCENES]
 set -u
 bake=$1
 info=$2
+scenes=${3:-}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail=0
@@ -19,6 +20,10 @@ expect_exit() { # expect_exit CODE DESCRIPTION COMMAND...
   if [[ $got -ne $want ]]; then
     echo "FAIL: $what: exit $got, want $want; stderr:" >&2; cat "$tmp/err.txt" >&2; fail=1
   fi
+}
+
+json() { # json FILE PYTHON_EXPRESSION_OF_d: true when it holds
+  /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); sys.exit(0 if eval(sys.argv[2]) else 1)' "$@"
 }
 
 quick=(builtin:room --max-edge 1.5 --rays 256 -q)
@@ -45,6 +50,33 @@ expect_exit 0 "vdsh-info --verify accepts an adaptive bake" "$info" --verify "$t
 "$info" "$tmp/ad1.vdsh" >"$tmp/adinfo.txt" 2>&1
 check "info shows the adaptive tolerance" grep -q "adaptive     tolerance 0.08, min edge 0.1875" "$tmp/adinfo.txt"
 
+# The round cap: --max-rounds N (default 8), in the report; stderr says when
+# it stopped a refinement still splitting; no environment variable moves it.
+check "report: the default round cap" json "$tmp/ad2.json" \
+  "d['adaptive']['max_rounds'] == 8 and d['adaptive']['rounds'] <= 8"
+expect_exit 0 "adaptive, done before the cap" "$bake" builtin:room --max-edge 1.5 --adaptive 0.08 \
+  --min-edge 0.5 --rays 256 --cube-size 0 --max-rounds 2 -o "$tmp/nocap.vdsh" --report "$tmp/nocap.json"
+check "no round-cap warning when the refinement finished" bash -c "! grep -q 'round cap' '$tmp/err.txt'"
+check "report: finished before the cap" json "$tmp/nocap.json" \
+  "d['adaptive']['max_rounds'] == 2 and d['adaptive']['rounds'] == 1 and d['adaptive']['rounds_reached'] is False and d['adaptive']['edges_pending'] == 0"
+capped=(builtin:room --max-edge 1.5 --adaptive 0.08 --rays 256 --cube-size 0 --max-rounds 1)
+expect_exit 0 "adaptive, --max-rounds 1" "$bake" "${capped[@]}" -o "$tmp/cap.vdsh" \
+  --report "$tmp/cap.json"
+check "stderr says the round cap stopped the refinement" \
+  grep -q "adaptive refinement stopped at the round cap (1) while still splitting (.* edges split in the last round, [1-9][0-9]* edges not yet judged): raise --max-rounds" "$tmp/err.txt"
+check "report: the round cap stopped it" json "$tmp/cap.json" \
+  "d['adaptive']['max_rounds'] == 1 and d['adaptive']['rounds'] == 1 and d['adaptive']['rounds_reached'] is True and d['adaptive']['edges_pending'] > 0"
+"$info" --json - "$tmp/cap.vdsh" >"$tmp/cap.info.json" 2>/dev/null
+check "the file records the round cap" json "$tmp/cap.info.json" \
+  "d['adaptive']['max_rounds'] == 1 and d['adaptive']['rounds'] == 1"
+expect_exit 0 "adaptive, default cap, VDSH_ROUNDS=1 set" env VDSH_ROUNDS=1 "$bake" "${adaptive[@]}" \
+  --threads 2 -o "$tmp/ad3.vdsh"
+check "VDSH_ROUNDS no longer changes the bake" cmp -s "$tmp/ad2.vdsh" "$tmp/ad3.vdsh"
+expect_exit 2 "--max-rounds 0" "$bake" builtin:room --max-edge 1 --adaptive 0.1 --max-rounds 0 -o "$tmp/x.vdsh"
+expect_exit 2 "--max-rounds 2x" "$bake" builtin:room --max-edge 1 --adaptive 0.1 --max-rounds 2x -o "$tmp/x.vdsh"
+expect_exit 2 "--max-rounds without --adaptive" "$bake" builtin:room --max-edge 1 --max-rounds 3 -o "$tmp/x.vdsh"
+check "--help lists --max-rounds" bash -c "'$bake' --help | grep -q -- '--max-rounds N'"
+
 # The file verifies and says what it is.
 expect_exit 0 "vdsh-info --verify accepts the bake" "$info" --verify "$tmp/a.vdsh"
 "$info" "$tmp/a.vdsh" >"$tmp/info.txt" 2>&1
@@ -55,9 +87,6 @@ check "info lists order 5" grep -q "order 5 (25 coefficients)" "$tmp/info.txt"
 expect_exit 0 "bake f32 orders 2,3 full" "$bake" "${quick[@]}" --orders 3,2 --encoding f32 \
   --method full --seed 9 -o "$tmp/d.vdsh" --report "$tmp/d.json"
 "$info" --json - "$tmp/d.vdsh" >"$tmp/d.info.json"
-json() { # json FILE PYTHON_EXPRESSION_OF_d: true when it holds
-  /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); sys.exit(0 if eval(sys.argv[2]) else 1)' "$@"
-}
 check "f32 recorded" json "$tmp/d.info.json" "{s['encoding'] for s in d['streams']} == {'f32'}"
 check "method full recorded" json "$tmp/d.info.json" "{s['method'] for s in d['streams']} == {'full'}"
 check "orders 2, 3 and no order 5 stream" json "$tmp/d.info.json" "sorted(s['order'] for s in d['streams']) == [2, 3]"
@@ -71,6 +100,48 @@ expect_exit 0 "bake with timings" "$bake" "${quick[@]}" --record-timings -o "$tm
 check "timings stored when asked" json "$tmp/e.info.json" "d['timings']['total'] > 0"
 check "no timings otherwise" json "$tmp/d.info.json" "d['timings'] is None"
 check "--cubemap-dir" bash -c "mkdir -p '$tmp/cubes' && '$bake' ${quick[*]} --cubemap-dir '$tmp/cubes' -o '$tmp/f.vdsh' && test -s '$tmp/cubes/f.sh21-24.exr' && test ! -e '$tmp/f.sh21-24.exr'"
+
+# Receivers far apart against the scene (no --max-edge, --adaptive or
+# --receivers): a warning with figures and a --max-edge to try; none when
+# the receivers were chosen or are dense; the figures in the report.
+awk 'BEGIN { n = 40; s = 10 / n
+  for (j = 0; j <= n; j++) for (i = 0; i <= n; i++) printf "v %g 0 %g\n", i * s, j * s
+  for (j = 0; j < n; j++) for (i = 0; i < n; i++) {
+    a = j * (n + 1) + i + 1; b = a + 1; c = a + n + 1; d = c + 1
+    printf "f %d %d %d\nf %d %d %d\n", a, c, b, b, c, d } }' >"$tmp/grid.obj"
+printf 'v 0 0 0\nv 10 0 0\nv 10 0 10\nv 0 0 10\nv 4 0 4\nv 4.5 0 4\nv 4 0.5 4\nf 1 4 3 2\nf 5 6 7\n' \
+  >"$tmp/coarse.obj"
+far="receivers far apart"
+expect_exit 0 "coarse floor at its vertices" "$bake" "$tmp/coarse.obj" --rays 16 --cube-size 0 \
+  -o "$tmp/coarse.vdsh" --report "$tmp/coarse.json"
+check "warning: receivers far apart, with figures and a --max-edge" grep -q \
+  "warning: $far: 100% of the surface is in triangles whose longest edge exceeds 5% of the scene's diagonal (14.15; longest edges: median 14.1, 90th percentile 14.1, area-weighted).*--max-edge 0.14 (1% of the diagonal)" \
+  "$tmp/err.txt"
+check "report: the receivers' spacing" json "$tmp/coarse.json" \
+  "d['receiver_spacing']['far_apart'] is True and d['receiver_spacing']['long_area_share'] > 0.99 and abs(d['receiver_spacing']['scene_diagonal'] - 200.25 ** 0.5) < 0.001"
+expect_exit 0 "coarse floor with --max-edge" "$bake" "$tmp/coarse.obj" --rays 16 --cube-size 0 \
+  --max-edge 0.5 -o "$tmp/coarse2.vdsh" --report "$tmp/coarse2.json"
+check "no warning with --max-edge" bash -c "! grep -q '$far' '$tmp/err.txt'"
+check "report: refined receivers are close" json "$tmp/coarse2.json" \
+  "d['receiver_spacing']['far_apart'] is False and d['receiver_spacing']['max_longest_edge'] <= 0.5"
+expect_exit 0 "dense grid at its vertices" "$bake" "$tmp/grid.obj" --rays 16 --cube-size 0 -o "$tmp/grid.vdsh"
+check "no warning for a dense mesh" bash -c "! grep -q '$far' '$tmp/err.txt'"
+expect_exit 0 "builtin:room at --max-edge 0.2" "$bake" builtin:room --max-edge 0.2 --rays 16 \
+  --orders 2 --method lsq --cube-size 0 -o "$tmp/room02.vdsh"
+check "no warning for the room at --max-edge 0.2" bash -c "! grep -q '$far' '$tmp/err.txt'"
+expect_exit 0 "builtin:room at its vertices, plan only" "$bake" builtin:room --plan "$tmp/roomplan.ply"
+check "the room at its vertices warns" grep -q "warning: $far: 60% of the surface" "$tmp/err.txt"
+expect_exit 0 "export only" "$bake" builtin:room --export-obj "$tmp/roomx.obj"
+check "no warning when nothing is baked" bash -c "! grep -q '$far' '$tmp/err.txt'"
+sponza=$scenes/sponza_dabrovic/sponza.obj
+if [[ -n $scenes && -f $sponza ]]; then
+  expect_exit 0 "Sponza at its vertices" "$bake" "$sponza" --rays 16 --orders 2 --method lsq \
+    --cube-size 0 -o "$tmp/sponza.vdsh"
+  check "Sponza at its vertices warns, suggesting --max-edge 0.42" grep -q \
+    "warning: $far: 84% of the surface.*--max-edge 0.42 (1% of the diagonal)" "$tmp/err.txt"
+else
+  echo "no Sponza at '$sponza': its spacing warning not checked"
+fi
 
 # Export the built-in scene as OBJ and bake it back: same occluders.
 expect_exit 0 "export OBJ" "$bake" builtin:room -q --export-obj "$tmp/room.obj"

@@ -297,6 +297,7 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         }
         free(chosen);
         qsort(judged, judged_n, sizeof *judged, cmp_u64);
+        st.last_split = s;
         if (ad->on_round)
             ad->on_round(ad->user, st.rounds, V + s, (uint32_t)cand_n, s, vb_now() - t_start);
         if (s == 0)
@@ -327,6 +328,18 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         B.vertex_count = B.range_end = M.vertex_count;
         if (st.budget_reached)
             break;
+    }
+    if (isfinite(ad->tolerance) && st.rounds == max_rounds && st.last_split > 0 &&
+        !st.budget_reached) {
+        /* The round limit stopped a refinement still splitting: how many
+         * edges the next round would have judged. */
+        free(cand);
+        cand = NULL;
+        if ((r = candidate_edges(&M, 2.0f * ad->min_edge, judged, judged_n, &cand, &cand_n,
+                                 err)) != VB_OK)
+            goto done;
+        st.pending = (uint32_t)cand_n;
+        st.rounds_reached = cand_n > 0;
     }
     B.vertex_count = B.range_end = M.vertex_count;
     *receivers = M;

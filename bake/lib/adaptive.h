@@ -15,9 +15,10 @@
  * (vdsh_light.h, the frames' primary light model). A split vertex keeps
  * its midpoint bake: no ray is traced twice. Edges judged and kept are
  * never judged again (their ends' bakes do not change); new edges are
- * judged in the next round. Rounds end when nothing is split, or when the
+ * judged in the next round. Rounds end when nothing is split, when the
  * receiver budget is reached (the largest errors are split first within
- * the last round).
+ * the last round), or after max_rounds rounds (stats say whether that
+ * limit stopped a refinement that was still splitting).
  *
  * Every round bakes with the first round's quantity per order, so the
  * whole mesh stores one quantity per order, as a uniform bake does.
@@ -65,6 +66,11 @@ typedef struct vb_adaptive_stats {
     uint32_t lights;           /* lights the error was scored with */
     uint32_t max_rounds;       /* the round limit used */
     int budget_reached;        /* the receiver budget stopped it */
+    int rounds_reached;        /* the round limit stopped it while its last round
+                                * still split edges */
+    uint32_t last_split;       /* edges the last round split */
+    uint32_t pending;          /* with rounds_reached: edges not yet judged, long
+                                * enough to split (the next round's midpoints) */
 } vb_adaptive_stats;
 
 /* Bake `start` with `bake` (its receivers and range are ignored), then

@@ -55,6 +55,74 @@ void vb_mesh_bounds(const vb_mesh *m, float min[3], float max[3])
     }
 }
 
+/* Receiver spacing: longest edges in log-spaced bins, 1% wide, from
+ * 1e-6 of the diagonal up (anything longer than the diagonal in the last). */
+#define SPACING_BINS 1400
+#define SPACING_STEP 0.01 /* ln of a bin's width ratio */
+#define SPACING_LOW 1e-6
+
+void vb_mesh_spacing_of(const vb_mesh *m, float diagonal, vb_mesh_spacing *s)
+{
+    memset(s, 0, sizeof *s);
+    if (!(diagonal > 0.0f)) {
+        float lo[3], hi[3];
+        vb_mesh_bounds(m, lo, hi);
+        diagonal = sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    }
+    s->diagonal = diagonal;
+    if (!m || !m->positions || !m->indices || !(diagonal > 0.0f))
+        return;
+    double bin[SPACING_BINS] = {0}; /* area per bin */
+    const double limit = (double)VB_SPACING_WARN_EDGE * diagonal;
+    double area = 0.0, long_area = 0.0, longest = 0.0;
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *tri = m->indices + 3 * (size_t)t;
+        const float *p[3] = {m->positions + 3 * (size_t)tri[0], m->positions + 3 * (size_t)tri[1],
+                             m->positions + 3 * (size_t)tri[2]};
+        double e[3][3], l2 = 0.0;
+        for (int c = 0; c < 3; c++) {
+            double q = 0.0;
+            for (int k = 0; k < 3; k++) {
+                e[c][k] = (double)p[(c + 1) % 3][k] - p[c][k];
+                q += e[c][k] * e[c][k];
+            }
+            l2 = q > l2 ? q : l2;
+        }
+        const double cx = e[0][1] * e[2][2] - e[0][2] * e[2][1], cy = e[0][2] * e[2][0] - e[0][0] * e[2][2],
+                     cz = e[0][0] * e[2][1] - e[0][1] * e[2][0];
+        const double a = 0.5 * sqrt(cx * cx + cy * cy + cz * cz), l = sqrt(l2);
+        area += a;
+        longest = l > longest ? l : longest;
+        if (l > limit)
+            long_area += a;
+        double r = l / diagonal;
+        int b = r > SPACING_LOW ? (int)(log(r / SPACING_LOW) / SPACING_STEP) : 0;
+        bin[b < SPACING_BINS ? b : SPACING_BINS - 1] += a;
+    }
+    s->area = area;
+    s->max_edge = (float)longest;
+    if (!(area > 0.0))
+        return;
+    s->long_area = long_area / area;
+    s->far_apart = s->long_area > VB_SPACING_WARN_AREA;
+    /* quantiles: a bin's geometric middle */
+    double sum = 0.0;
+    for (int b = 0; b < SPACING_BINS && !(s->p90_edge > 0.0f); b++) {
+        sum += bin[b];
+        double mid = SPACING_LOW * exp((b + 0.5) * SPACING_STEP) * diagonal;
+        if (mid > longest)
+            mid = longest;
+        if (!(s->median_edge > 0.0f) && sum >= 0.5 * area)
+            s->median_edge = (float)mid;
+        if (sum >= 0.9 * area)
+            s->p90_edge = (float)mid;
+    }
+    double want = (double)VB_SPACING_SUGGEST * diagonal;
+    double mag = pow(10.0, floor(log10(want)) - 1.0);
+    s->suggest_edge = (float)(round(want / mag) * mag);
+}
+
 void vb_sha256(const void *data, size_t size, uint8_t out[32])
 {
     struct sha256_ctx ctx;
@@ -80,6 +148,10 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
     if (r->dropped_triangles)
         fprintf(fp, "%s%s%s: %u triangle%s dropped (a repeated vertex index: no area)\n", tool, sep, path,
                 r->dropped_triangles, plural(r->dropped_triangles));
+    if (r->duplicate_triangles)
+        fprintf(fp, "%s%s%s: %u duplicate triangle%s dropped (the same three positions as an earlier "
+                    "triangle, in any order)\n",
+                tool, sep, path, r->duplicate_triangles, plural(r->duplicate_triangles));
     if (r->removed_vertices)
         fprintf(fp, "%s%s%s: %u vert%s removed (used by no remaining triangle)\n", tool, sep, path,
                 r->removed_vertices, r->removed_vertices == 1 ? "ex" : "ices");
@@ -92,9 +164,25 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
         fprintf(fp, "%s%s%s: %u used vert%s no normal in the file: every normal computed from the faces "
                     "instead\n",
                 tool, sep, path, r->missing_normals, r->missing_normals == 1 ? "ex has" : "ices have");
-    if (r->zero_normals)
-        fprintf(fp, "%s%s%s: %u vert%s a zero normal in the file: %u repaired from their own triangles\n", tool,
-                sep, path, r->zero_normals, r->zero_normals == 1 ? "ex has" : "ices have", r->zero_repaired);
+    if (r->zero_normals) {
+        /* One line: what became of each of them. */
+        char what[256] = "";
+        size_t at = 0;
+        if (r->zero_repaired)
+            at += (size_t)snprintf(what + at, sizeof what - at, "%s%u given their own triangles' normal",
+                                   at ? ", " : "", r->zero_repaired);
+        if (r->zero_cancelled && at < sizeof what)
+            at += (size_t)snprintf(what + at, sizeof what - at,
+                                   "%s%u their largest triangle's (their triangles' normals cancel: "
+                                   "two-sided)",
+                                   at ? ", " : "", r->zero_cancelled);
+        if (r->zero_undefined && at < sizeof what)
+            at += (size_t)snprintf(what + at, sizeof what - at,
+                                   "%s%u left without a normal (0,0,0: their triangles have no area)",
+                                   at ? ", " : "", r->zero_undefined);
+        fprintf(fp, "%s%s%s: %u vert%s a zero normal in the file: %s\n", tool, sep, path, r->zero_normals,
+                r->zero_normals == 1 ? "ex has" : "ices have", what);
+    }
     if (r->cancelled_normals)
         fprintf(fp, "%s%s%s: %u vert%s face normals cancel (two-sided triangles): each given the normal of "
                     "its largest triangle\n",
@@ -111,9 +199,12 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
     if (r->gltf_skipped_skin)
         fprintf(fp, "%s%s%s: %u glTF primitive%s of skinned nodes skipped (not baked)\n", tool, sep, path,
                 r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
-    if (r->undefined_normals)
+    /* the zero file normals left undefined were said above */
+    uint32_t undefined = r->undefined_normals - (r->zero_undefined < r->undefined_normals
+                                                     ? r->zero_undefined : r->undefined_normals);
+    if (undefined)
         fprintf(fp, "%s%s%s: %u vert%s left without a normal (0,0,0): their triangles have no area\n", tool, sep,
-                path, r->undefined_normals, r->undefined_normals == 1 ? "ex" : "ices");
+                path, undefined, undefined == 1 ? "ex" : "ices");
 }
 
 /* n * size bytes, or NULL when that overflows or malloc fails; never a
@@ -780,6 +871,198 @@ done:
     return r;
 }
 
+/* ---------------------------------------------------------------------- */
+/* Duplicate triangles                                                    */
+/* ---------------------------------------------------------------------- */
+
+/* Position p, -0 as +0 (so that equal coordinates compare and hash equal). */
+static void pos_of(const float *positions, uint32_t v, float out[3])
+{
+    for (int k = 0; k < 3; k++)
+        out[k] = positions[3 * (size_t)v + (size_t)k] + 0.0f;
+}
+
+static int pos_cmp(const float *a, const float *b)
+{
+    for (int k = 0; k < 3; k++)
+        if (a[k] != b[k])
+            return a[k] < b[k] ? -1 : 1;
+    return 0;
+}
+
+/* Triangle tri's three positions, sorted: its key whatever the corner
+ * order. */
+static void tri_key(const float *positions, const uint32_t *tri, float key[9])
+{
+    float p[3][3];
+    for (int c = 0; c < 3; c++)
+        pos_of(positions, tri[c], p[c]);
+    int o[3] = {0, 1, 2};
+    for (int i = 1; i < 3; i++)
+        for (int j = i; j > 0 && pos_cmp(p[o[j - 1]], p[o[j]]) > 0; j--) {
+            int s = o[j];
+            o[j] = o[j - 1];
+            o[j - 1] = s;
+        }
+    for (int c = 0; c < 3; c++)
+        memcpy(key + 3 * c, p[o[c]], 3 * sizeof(float));
+}
+
+static uint64_t key_hash(const float key[9])
+{
+    /* Each word mixed in whole (integer coordinates leave a float's low
+     * bits zero), then murmur3's finaliser: every bit depends on all. */
+    uint64_t h = 0x9e3779b97f4a7c15ull;
+    for (int i = 0; i < 9; i++) {
+        uint32_t u;
+        memcpy(&u, &key[i], 4);
+        h = (h ^ u) * 0xff51afd7ed558ccdull;
+        h ^= h >> 32;
+    }
+    h ^= h >> 33;
+    h *= 0xc4ceb9fe1a85ec53ull;
+    h ^= h >> 33;
+    return h;
+}
+
+/* 1 when triangles a and b (the same three distinct positions) go round
+ * them the same way. */
+static int same_winding(const float *positions, const uint32_t *a, const uint32_t *b)
+{
+    float pa0[3], pa1[3], q[3];
+    pos_of(positions, a[0], pa0);
+    pos_of(positions, a[1], pa1);
+    for (int j = 0; j < 3; j++) {
+        pos_of(positions, b[j], q);
+        if (pos_cmp(q, pa0) == 0) {
+            pos_of(positions, b[(j + 1) % 3], q);
+            return pos_cmp(q, pa1) == 0;
+        }
+    }
+    return 1;
+}
+
+static int share_index(const uint32_t *a, const uint32_t *b)
+{
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            if (a[i] == b[j])
+                return 1;
+    return 0;
+}
+
+/* Drop every triangle whose three positions (any corner order, either
+ * winding) an earlier kept triangle has, keeping the order of the rest in
+ * idx; *count becomes the number kept, *dropped the number dropped.
+ * Exception: the first reversed copy that shares no vertex index with the
+ * kept one is the back of a two-sided sheet (each side its own vertices,
+ * so its own receivers) and is kept. Triangles that repeat an index are
+ * left for compact() to drop. 0 when out of memory.
+ *
+ * The triangles are radix-sorted by a 32-bit hash of their sorted
+ * positions (stable: equal hashes stay in triangle order), and only runs
+ * of equal hashes are compared, position by position: streaming passes,
+ * where a hash table costs a cache miss a triangle (Lost Empire's 225k
+ * triangles: ~5 ms against ~25 ms). */
+static int drop_duplicates(const float *positions, uint32_t *idx, uint32_t *count, uint32_t *dropped)
+{
+    const uint32_t n = *count;
+    *dropped = 0;
+    if (n < 2)
+        return 1;
+    uint64_t *a = alloc_array(n, sizeof *a), *b = alloc_array(n, sizeof *b);
+    uint32_t *hist = calloc(65536, sizeof *hist);
+    uint8_t *drop = calloc(n, 1);
+    uint32_t *keep = NULL; /* the kept triangles of one run */
+    size_t keep_cap = 0;
+    int ok = a && b && hist && drop;
+    uint32_t m = 0; /* triangles with three distinct indices */
+    for (uint32_t t = 0; ok && t < n; t++) {
+        const uint32_t *tri = idx + 3 * (size_t)t;
+        if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+            continue;
+        float key[9];
+        tri_key(positions, tri, key);
+        a[m++] = (uint64_t)(uint32_t)(key_hash(key) >> 32) << 32 | t;
+    }
+    /* LSD radix sort on the hash, 16 bits a pass. */
+    for (int shift = 32; ok && shift < 64; shift += 16) {
+        memset(hist, 0, 65536 * sizeof *hist);
+        for (uint32_t i = 0; i < m; i++)
+            hist[(a[i] >> shift) & 0xffff]++;
+        uint32_t sum = 0;
+        for (uint32_t d = 0; d < 65536; d++) {
+            uint32_t c = hist[d];
+            hist[d] = sum;
+            sum += c;
+        }
+        for (uint32_t i = 0; i < m; i++)
+            b[hist[(a[i] >> shift) & 0xffff]++] = a[i];
+        uint64_t *s = a;
+        a = b;
+        b = s;
+    }
+    for (uint32_t i = 0; ok && i < m;) {
+        uint32_t j = i + 1;
+        while (j < m && a[j] >> 32 == a[i] >> 32)
+            j++;
+        if (j - i > 1) { /* a run of equal hashes, in triangle order */
+            size_t kept = 0;
+            for (uint32_t r = i; r < j; r++) {
+                const uint32_t t = (uint32_t)a[r];
+                const uint32_t *tri = idx + 3 * (size_t)t;
+                float key[9], other[9];
+                tri_key(positions, tri, key);
+                int same = 0, reversed = 0, shares = 0;
+                for (size_t q = 0; q < kept && !same; q++) {
+                    const uint32_t *u = idx + 3 * (size_t)keep[q];
+                    tri_key(positions, u, other);
+                    if (memcmp(key, other, sizeof key) != 0)
+                        continue;
+                    if (same_winding(positions, u, tri)) {
+                        same = 1;
+                    } else {
+                        reversed = 1;
+                        shares |= share_index(u, tri);
+                    }
+                }
+                if (same || (reversed && shares)) {
+                    drop[t] = 1;
+                    continue;
+                }
+                if (kept == keep_cap) {
+                    size_t cap = keep_cap ? 2 * keep_cap : 8;
+                    uint32_t *k = realloc(keep, cap * sizeof *k);
+                    if (!k) {
+                        ok = 0;
+                        break;
+                    }
+                    keep = k;
+                    keep_cap = cap;
+                }
+                keep[kept++] = t;
+            }
+        }
+        i = j;
+    }
+    uint32_t kept = 0;
+    for (uint32_t t = 0; ok && t < n; t++)
+        if (!drop[t]) {
+            memmove(idx + 3 * (size_t)kept, idx + 3 * (size_t)t, 3 * sizeof *idx);
+            kept++;
+        }
+    free(a);
+    free(b);
+    free(hist);
+    free(drop);
+    free(keep);
+    if (!ok)
+        return 0;
+    *dropped = n - kept;
+    *count = kept;
+    return 1;
+}
+
 /* Raw file mesh -> clean vb_mesh (see mesh.h for what clean means). */
 static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mesh_raw *raw,
                            vb_mesh *out, vb_mesh_report *rep, vb_error *err)
@@ -821,9 +1104,19 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
     const float *normals = split ? sv.normals : raw->normals;
     const uint8_t *has_normal = split ? sv.has_normal : raw->has_normal;
 
+    /* Duplicate triangles (the same three positions as an earlier one):
+     * scans and merged exports repeat faces, and a receiver on a copy sees
+     * the other at distance ~0. */
+    uint32_t tri_count = raw->triangle_count, duplicates = 0;
+    if (!drop_duplicates(positions, idx, &tri_count, &duplicates)) {
+        free(idx);
+        split_free(&sv);
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    }
+
     vb_mesh m;
     uint32_t degenerate = 0;
-    r = compact(vertex_count, positions, NULL, raw->triangle_count, idx, &m, &degenerate);
+    r = compact(vertex_count, positions, NULL, tri_count, idx, &m, &degenerate);
     if (r != VB_OK) {
         free(idx);
         split_free(&sv);
@@ -840,6 +1133,7 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
     vb_mesh_report rp;
     memset(&rp, 0, sizeof rp);
     rp.dropped_triangles = degenerate + raw->dropped_triangles;
+    rp.duplicate_triangles = duplicates;
     rp.gltf_skipped_modes = raw->gltf_skipped_modes;
     rp.gltf_skipped_morph = raw->gltf_skipped_morph;
     rp.gltf_skipped_skin = raw->gltf_skipped_skin;
@@ -858,7 +1152,7 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
             vb_mesh_free(&m);
             return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
         }
-        for (uint32_t t = 0; t < raw->triangle_count; t++) {
+        for (uint32_t t = 0; t < tri_count; t++) {
             const uint32_t *tri = idx + 3 * (size_t)t;
             if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
                 continue;
@@ -911,8 +1205,12 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
                 } else {
                     const float *c = m.normals + 3 * (size_t)i;
                     rp.zero_normals++;
-                    rp.zero_repaired += c[0] != 0.0f || c[1] != 0.0f || c[2] != 0.0f;
-                    rp.cancelled_normals += cancelled[i];
+                    if (cancelled[i])
+                        rp.zero_cancelled++;
+                    else if (c[0] != 0.0f || c[1] != 0.0f || c[2] != 0.0f)
+                        rp.zero_repaired++;
+                    else
+                        rp.zero_undefined++;
                 }
             }
             free(given);

@@ -41,6 +41,11 @@
  * normals over the vertex's own faces, so unwelded hard edges stay hard).
  * Triangles with a repeated index are dropped (they have no area and no
  * effect on rays); zero-area triangles with distinct indices are kept.
+ * Duplicate triangles are dropped: one with the same three positions as
+ * an earlier kept triangle, in any corner order and either winding (a
+ * receiver on one copy would see the other at distance ~0; rays hit
+ * either alike), except the first reversed copy that shares no vertex with
+ * it: the back of a two-sided sheet, whose vertices are its own receivers.
  * What was dropped, removed, split or repaired comes back as counts in
  * vb_source_info.report (vb_mesh_report); loading itself prints nothing.
  *
@@ -64,8 +69,8 @@
  * Files are read into memory once (vb_mesh_load_memory starts from such
  * bytes); those bytes are hashed for vb_source_info and read in one strict
  * pass straight into arrays (mesh_parse.h; no half-edge structure, so
- * non-manifold and duplicate faces are kept as they are: nothing in the
- * file is lost). The readers read what OpenMesh 9's readers read (the
+ * non-manifold faces are kept as they are; duplicate faces are dropped,
+ * as above, and counted). The readers read what OpenMesh 9's readers read (the
  * baker used those until issue 13: the same floats, vertex numbering and
  * normals, so the same bakes) and refuse what those would have skipped or
  * misread: numbers that do not parse or are NaN/Inf, faces with fewer than
@@ -139,6 +144,11 @@ typedef struct vb_mesh_report {
                                     dropped; OBJ faces with fewer than 3
                                     distinct vertices count as their
                                     corners - 2 */
+    uint32_t duplicate_triangles; /* the same three positions as an earlier
+                                    triangle (any corner order, either
+                                    winding), dropped; a reversed copy with
+                                    vertices of its own (a two-sided sheet's
+                                    back) is kept */
     uint32_t removed_vertices;   /* used by no remaining triangle */
     uint32_t split_vertices;     /* split at creases (corner normals) */
     uint32_t split_added;        /* vertices those splits added */
@@ -147,13 +157,22 @@ typedef struct vb_mesh_report {
     uint32_t zero_normals;       /* loaded vertices whose file normal is
                                     zero (or whose given normals cancel) */
     uint32_t zero_repaired;      /* of those, given their own triangles'
-                                    normal (the rest have no area) */
-    uint32_t cancelled_normals;  /* loaded vertices whose computed normal
-                                    cancelled (two-sided triangles): given
-                                    their largest triangle's normal */
+                                    normal */
+    uint32_t zero_cancelled;     /* of those, whose triangles' normals
+                                    cancel (two-sided): given their largest
+                                    triangle's normal */
+    uint32_t zero_undefined;     /* of those, left (0,0,0): their
+                                    triangles have no area (zero_repaired +
+                                    zero_cancelled + zero_undefined =
+                                    zero_normals) */
+    uint32_t cancelled_normals;  /* loaded vertices without a file normal
+                                    whose computed normal cancelled
+                                    (two-sided triangles): given their
+                                    largest triangle's normal */
     uint32_t welded;             /* vertices merged by weld */
     uint32_t undefined_normals;  /* loaded vertices left (0,0,0) at the end:
-                                    their triangles have no area */
+                                    their triangles have no area (those
+                                    with a zero file normal included) */
     uint32_t gltf_skipped_modes; /* glTF: point and line primitives skipped */
     uint32_t gltf_skipped_morph; /* glTF: primitives with morph targets
                                     skipped (their base shape is not what
@@ -175,8 +194,11 @@ typedef struct vb_source_info {
 
 /* One line per non-zero finding of `r` on fp, each "TOOL: PATH: ..."
  * (no "TOOL: " when tool is NULL), e.g. "vdsh-bake: scan.ply: 11160
- * triangles dropped (a repeated vertex index: no area)". Nothing when
- * fp is NULL (a tool's quiet mode) or nothing was found. */
+ * triangles dropped (a repeated vertex index: no area)". A vertex is said
+ * once: the zero file normals' line says what became of them (their own
+ * triangles' normal, their largest triangle's, or none), and the lines on
+ * cancelled and undefined normals count the other vertices only. Nothing
+ * when fp is NULL (a tool's quiet mode) or nothing was found. */
 void vb_mesh_report_print(FILE *fp, const char *tool, const char *path,
                           const vb_mesh_report *r);
 
@@ -292,6 +314,44 @@ vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path,
  * uchar-counted uint lists), read back bit for bit by vb_mesh_load;
  * atomically, as vb_mesh_write_obj. Needs normals. */
 vb_result vb_mesh_write_ply(const vb_mesh *m, const char *path, vb_error *err);
+
+/* How far apart a mesh's vertices are, as receivers, relative to a
+ * scene's size: each triangle's longest edge, weighted by the triangle's
+ * area (a viewer sees surface, not triangle counts). VDSH interpolates the
+ * stream between a triangle's corners, so a shadow edge is drawn no finer
+ * than those edges; where they are long against the scene, shadows inside
+ * the triangles are false (issue 26: an interior baked at its vertices,
+ * false shadows on 39-51% of the lit area). vdsh-bake warns, without
+ * --max-edge, --adaptive or --receivers, when more than
+ * VB_SPACING_WARN_AREA of the area has longest edges above
+ * VB_SPACING_WARN_EDGE of the scene's diagonal, and suggests --max-edge
+ * VB_SPACING_SUGGEST of it. Measured (share of the area above 5%): the
+ * built-in room 60% (its bake uses --max-edge 0.2, 0.7% of its diagonal),
+ * Sponza 84%, Cornell box 100%, glTF 2CylinderEngine 50%, builtin:room:5
+ * 12%, builtin:room:3 7%; dense meshes, which their vertices already
+ * serve: Stanford bunnies, fandisk, Lost Empire 0%, rocker arm 2%. */
+#define VB_SPACING_WARN_EDGE 0.05f
+#define VB_SPACING_WARN_AREA 0.10
+#define VB_SPACING_SUGGEST 0.01f
+
+typedef struct vb_mesh_spacing {
+    float diagonal;        /* the scene diagonal the fractions are of */
+    double area;           /* total triangle area */
+    float median_edge;     /* area-weighted median of the triangles' longest
+                            * edges (within 2% of the exact quantile) */
+    float p90_edge;        /* its 90th percentile (likewise) */
+    float max_edge;        /* the longest edge */
+    double long_area;      /* share of the area (0..1) in triangles whose
+                            * longest edge exceeds VB_SPACING_WARN_EDGE x
+                            * diagonal */
+    int far_apart;         /* long_area > VB_SPACING_WARN_AREA */
+    float suggest_edge;    /* VB_SPACING_SUGGEST x diagonal, to 2 significant
+                            * digits */
+} vb_mesh_spacing;
+
+/* The spacing of m's vertices against `diagonal` (<= 0: m's own bounds'
+ * diagonal). One pass, no allocation. */
+void vb_mesh_spacing_of(const vb_mesh *m, float diagonal, vb_mesh_spacing *s);
 
 /* Axis-aligned bounds of all vertices; min = max = (0,0,0) when empty. */
 void vb_mesh_bounds(const vb_mesh *m, float min[3], float max[3]);

@@ -67,6 +67,7 @@ typedef struct options {
     float adaptive_tol;
     float min_edge;            /* --min-edge; 0: max_edge / 8 */
     uint32_t max_receivers;    /* --max-receivers; 0: none */
+    uint32_t max_rounds;       /* --max-rounds; 0: none given (VB_ADAPTIVE_ROUNDS) */
     int weld;
     uint64_t seed;
     unsigned threads;
@@ -225,6 +226,9 @@ static void usage(FILE *f)
 "                          (default: --max-edge / 8)\n"
 "      --max-receivers N   with --adaptive: stop at N receivers, splitting\n"
 "                          the largest errors first\n"
+"      --max-rounds N      with --adaptive: at most N rounds of splits\n"
+"                          (default 8; stderr says when it stops one still\n"
+"                          splitting)\n"
 "      --plan FILE         write the receivers (refined, or with --adaptive\n"
 "                          as baked) for shards to read with --receivers:\n"
 "                          FILE.ply binary PLY (fast to read), else OBJ;\n"
@@ -432,7 +436,7 @@ static void report_seconds(vt_json *j, cJSON *root, const vdsh_timings *t)
 }
 
 static int write_report(const char *path, const options *o, const vb_job *job,
-                        double write_seconds, char *msg, size_t cap)
+                        const vb_mesh_spacing *sp, double write_seconds, char *msg, size_t cap)
 {
     const vdsh_file *f = &job->file;
     const vb_bake_output *b = &job->bake;
@@ -461,6 +465,14 @@ static int write_report(const char *path, const options *o, const vb_job *job,
     vt_json_string(&j, root, "encoding", vdsh_encoding_name(o->encoding));
     vt_json_f32(&j, root, "max_distance", b->max_distance);
     vt_json_f32(&j, root, "max_edge", o->max_edge);
+    /* The receivers' spacing before any bake (vb_mesh_spacing_of). */
+    cJSON *spc = vt_json_object(&j, root, "receiver_spacing");
+    vt_json_f32(&j, spc, "scene_diagonal", sp->diagonal);
+    vt_json_f32(&j, spc, "median_longest_edge", sp->median_edge);
+    vt_json_f32(&j, spc, "p90_longest_edge", sp->p90_edge);
+    vt_json_f32(&j, spc, "max_longest_edge", sp->max_edge);
+    vt_json_f64(&j, spc, "long_area_share", sp->long_area);
+    vt_json_bool(&j, spc, "far_apart", sp->far_apart);
     if (o->adaptive) {
         cJSON *ad = vt_json_object(&j, root, "adaptive");
         vt_json_f32(&j, ad, "tolerance", o->adaptive_tol);
@@ -470,6 +482,9 @@ static int write_report(const char *path, const options *o, const vb_job *job,
         vt_json_u64(&j, ad, "rounds", job->adaptive.rounds);
         vt_json_u64(&j, ad, "midpoints_baked", job->adaptive.candidates);
         vt_json_bool(&j, ad, "budget_reached", job->adaptive.budget_reached);
+        vt_json_u64(&j, ad, "max_rounds", job->adaptive.max_rounds);
+        vt_json_bool(&j, ad, "rounds_reached", job->adaptive.rounds_reached);
+        vt_json_u64(&j, ad, "edges_pending", job->adaptive.pending);
     } else {
         vt_json_null(&j, root, "adaptive");
     }
@@ -623,7 +638,7 @@ int main(int argc, char **argv)
     enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
            O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL, O_SHARD,
-           O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS, O_PLAN, O_RECEIVERS, O_ADAPTIVE_ORDER,
+           O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS, O_MAX_ROUNDS, O_PLAN, O_RECEIVERS, O_ADAPTIVE_ORDER,
            O_MAX_ORDER, O_DEC_LIGHTS, O_FALSE_RATE, O_DEC_PARAMS };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
@@ -663,6 +678,7 @@ int main(int argc, char **argv)
         {"receivers", required_argument, 0, O_RECEIVERS},
         {"min-edge", required_argument, 0, O_MIN_EDGE},
         {"max-receivers", required_argument, 0, O_MAX_RECEIVERS},
+        {"max-rounds", required_argument, 0, O_MAX_ROUNDS},
         {"quiet", no_argument, 0, 'q'},
         {"help", no_argument, 0, 'h'},
         {"version", no_argument, 0, 'V'},
@@ -761,6 +777,11 @@ int main(int argc, char **argv)
                                  optarg);
             o.max_receivers = (uint32_t)u;
             break;
+        case O_MAX_ROUNDS:
+            if (!vt_parse_u64(optarg, 1, 1000, &u))
+                return bad_usage("--max-rounds takes a whole number 1..1000, not '%s'", optarg);
+            o.max_rounds = (uint32_t)u;
+            break;
         case O_WELD: o.weld = 1; break;
         case O_SEED:
             if (!vt_parse_u64(optarg, 0, UINT64_MAX, &o.seed))
@@ -854,8 +875,8 @@ int main(int argc, char **argv)
     }
     if (o.have_ray_tolerance && !o.adaptive_rays)
         return bad_usage("%s needs --rays auto", "--ray-tolerance");
-    if ((o.min_edge > 0.0f || o.max_receivers) && !o.adaptive)
-        return bad_usage("%s need --adaptive TOL", "--min-edge and --max-receivers");
+    if ((o.min_edge > 0.0f || o.max_receivers || o.max_rounds) && !o.adaptive)
+        return bad_usage("%s need --adaptive TOL", "--min-edge, --max-receivers and --max-rounds");
     if (o.adaptive && !(o.max_edge > 0.0f))
         return bad_usage("%s", "--adaptive needs --max-edge L: the uniform refinement it "
                                "starts from (the coarsest receivers)");
@@ -916,7 +937,7 @@ int main(int argc, char **argv)
         .adaptive = o.adaptive, .receivers_path = o.receivers,
         .adapt = {.tolerance = o.adaptive_tol, .min_edge = o.min_edge,
                   .max_receivers = o.max_receivers,
-                  .max_rounds = getenv("VDSH_ROUNDS") ? (uint32_t)atoi(getenv("VDSH_ROUNDS")) : 0,
+                  .max_rounds = o.max_rounds ? o.max_rounds : VB_ADAPTIVE_ROUNDS,
                   .on_round = log ? on_round : NULL,
                   .user = log},
         .bake = {.rays = o.rays, .adaptive_rays = o.adaptive_rays,
@@ -938,6 +959,7 @@ int main(int argc, char **argv)
         .on_mesh = log ? on_mesh : NULL, .user = log};
     int status = 1;
     int writing = 0; /* output_lock held: outputs are being written */
+    vb_mesh_spacing spacing = {0};
     vb_error err;
     vb_job job = {0};
 
@@ -961,6 +983,27 @@ int main(int argc, char **argv)
         fprintf(log, "vdsh-bake: receivers refined to max edge %g: %u vertices, "
                      "%u triangles (%.2f s)\n",
                 (double)o.max_edge, rec->vertex_count, rec->triangle_count, job.timings.refine);
+    /* Receivers far apart against the scene draw false shadows inside their
+     * triangles: say so when nothing chose them (no --max-edge, --adaptive
+     * or --receivers) and a bake or plan follows. */
+    const int chosen = o.max_edge > 0.0f || o.adaptive || o.receivers;
+    if ((log && !chosen && (o.output || o.plan)) || o.report) {
+        float lo[3], hi[3];
+        vb_mesh_bounds(&job.occluders, lo, hi);
+        vb_mesh_spacing_of(rec, sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) +
+                                      (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                      (hi[2] - lo[2]) * (hi[2] - lo[2])), &spacing);
+    }
+    if (log && !chosen && (o.output || o.plan) && spacing.far_apart)
+        fprintf(log, "vdsh-bake: warning: receivers far apart: %.0f%% of the surface is in "
+                     "triangles whose longest edge exceeds %.0f%% of the scene's diagonal (%.4g; "
+                     "longest edges: median %.3g, 90th percentile %.3g, area-weighted). The "
+                     "shadows are interpolated between receivers, so these triangles draw false "
+                     "shadows inside them: refine, e.g. --max-edge %g (1%% of the diagonal), "
+                     "or --adaptive from a coarser --max-edge\n",
+                100.0 * spacing.long_area, 100.0 * VB_SPACING_WARN_EDGE, (double)spacing.diagonal,
+                (double)spacing.median_edge, (double)spacing.p90_edge,
+                (double)spacing.suggest_edge);
     if (o.plan && !o.adaptive) { /* uniform: the refined receivers, before any bake */
         if (write_plan(rec, o.plan, log) != 0)
             goto out;
@@ -1014,6 +1057,11 @@ int main(int argc, char **argv)
                 job.receivers.vertex_count, job.adaptive.start_receivers, job.adaptive.rounds,
                 job.adaptive.candidates, (double)o.adaptive_tol, (double)o.min_edge,
                 job.adaptive.budget_reached ? ", the budget stopped it" : "");
+    if (log && o.adaptive && job.adaptive.rounds_reached)
+        fprintf(log, "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
+                     "while still splitting (%u edges split in the last round, %u edges not "
+                     "yet judged): raise --max-rounds\n",
+                job.adaptive.max_rounds, job.adaptive.last_split, job.adaptive.pending);
     if (log && bo->flipped_normals)
         fprintf(log, "vdsh-bake: %u receiver normals pointed into geometry and were "
                      "flipped (--keep-normals keeps them)\n", bo->flipped_normals);
@@ -1129,7 +1177,7 @@ int main(int argc, char **argv)
                     o.cubemap_dir ? o.cubemap_dir : "the output's directory");
         fprintf(log, "\nvdsh-bake: done in %.2f s\n", job.timings.total + write_seconds);
     }
-    if (o.report && write_report(o.report, &o, &job, write_seconds, msg, sizeof msg) != 0) {
+    if (o.report && write_report(o.report, &o, &job, &spacing, write_seconds, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-bake: %s (the report)\n", msg);
         goto out;
     }
