@@ -106,32 +106,15 @@ static inline __attribute__((always_inline)) void margins(int n, uint32_t m, con
 }
 
 /* Per pair, from its margin: z = s t / tau (s = +1 shadowed, -1 lit);
- * the weighted softplus(z) into sp; pair_grad also the gradient's and
- * the Hessian's weights (a sigma(z) s / tau, a sigma(z) (1 - sigma(z)) /
- * tau^2, a the pair's weight over the weights' sum). One exp and one log
- * per pair, branch-free: the loops vectorise. */
-/* m8: m rounded up to 8; the arrays hold m8 values (sgn and wt 0 past m,
- * so those lanes add 0). */
-static inline __attribute__((always_inline)) void pair_loss(uint32_t m8, const float *t,
-                                                           const float *sgn, const float *wt,
-                                                           float inv_tau, float *sp)
-{
-    for (uint32_t i = 0; i < m8; i += 8) {
-        v8f tv, sv, wv;
-        memcpy(&tv, t + i, sizeof tv);
-        memcpy(&sv, sgn + i, sizeof sv);
-        memcpy(&wv, wt + i, sizeof wv);
-        v8f z = sv * tv * v8(inv_tau), az = sel(z < v8(0.0f), -z, z);
-        v8f e = exp8(-az);
-        v8f out = wv * (v8(0.5f) * (z + az) + log8(v8(1.0f) + e));
-        memcpy(sp + i, &out, sizeof out);
-    }
-}
-
-static inline __attribute__((always_inline)) void pair_grad(uint32_t m8, const float *t,
-                                                           const float *sgn, const float *wt,
-                                                           float inv_tau, float *sp, float *q,
-                                                           float *h)
+ * the weighted softplus(z) into sp and, when q is not NULL, the
+ * gradient's and the Hessian's weights (a sigma(z) s / tau, a sigma(z)
+ * (1 - sigma(z)) / tau^2, a the pair's weight over the weights' sum). One
+ * exp and one log per pair, eight at a time. m8: m rounded up to 8; the
+ * arrays hold m8 values (sgn and wt 0 past m, so those lanes add 0). */
+static inline __attribute__((always_inline)) void pair_terms(uint32_t m8, const float *t,
+                                                            const float *sgn, const float *wt,
+                                                            float inv_tau, float *sp, float *q,
+                                                            float *h)
 {
     for (uint32_t i = 0; i < m8; i += 8) {
         v8f tv, sv, wv;
@@ -141,11 +124,13 @@ static inline __attribute__((always_inline)) void pair_grad(uint32_t m8, const f
         v8f z = sv * tv * v8(inv_tau), az = sel(z < v8(0.0f), -z, z);
         v8f e = exp8(-az), one = v8(1.0f) + e;
         v8f out = wv * (v8(0.5f) * (z + az) + log8(one));
+        memcpy(sp + i, &out, sizeof out);
+        if (!q)
+            continue;
         /* sigma(z): 1 / (1 + e) for z >= 0, e / (1 + e) below */
         v8f s = sel(z >= v8(0.0f), v8(1.0f), e) / one;
         v8f qv = wv * sv * s * v8(inv_tau);
         v8f hv = wv * s * (v8(1.0f) - s) * v8(inv_tau * inv_tau);
-        memcpy(sp + i, &out, sizeof out);
         memcpy(q + i, &qv, sizeof qv);
         memcpy(h + i, &hv, sizeof hv);
     }
@@ -311,7 +296,7 @@ int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
         c[j] = c0[j] = cf[j];
     }
     margins(n, m, Y, stride, logd, c, t);
-    pair_grad(m8, t, sgn, wt, inv_tau, sp, q, h);
+    pair_terms(m8, t, sgn, wt, inv_tau, sp, q, h);
     double f = sum_lanes(m, sp);
     /* Every pair already on its side by a wide margin (sigma(z) < 1/400 in
      * each): the start is the fit to within the ridge. */
@@ -355,7 +340,7 @@ int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
             for (int j = 0; j < n; j++)
                 ct[j] = c[j] - step * dx[j];
             margins(n, m, Y, stride, logd, ct, tt);
-            pair_loss(m8, tt, sgn, wt, inv_tau, sp);
+            pair_terms(m8, tt, sgn, wt, inv_tau, sp, NULL, NULL);
             fn = sum_lanes(m, sp) + ridge_term(n, ct, c0, r);
             ok = fn < f;
         }
@@ -375,7 +360,7 @@ int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
         float *swap = t;
         t = tt;
         tt = swap;
-        pair_grad(m8, t, sgn, wt, inv_tau, sp, q, h);
+        pair_terms(m8, t, sgn, wt, inv_tau, sp, q, h);
     }
     for (int j = 0; j < n; j++)
         cf[j] = (float)c[j];
