@@ -110,6 +110,7 @@ if(EXISTS ${VDSH_SHARED_SCENES})
            COMMAND bash ${_robust_dir}/with_each_isa.sh $<TARGET_FILE:vdsh-bake>
                    bash ${_robust_dir}/test_robust_determinism.sh $<TARGET_FILE:vdsh-bake>
                    ${VDSH_SHARED_SCENES})
+  set_tests_properties(robust_determinism_isa PROPERTIES TIMEOUT 1800)
 endif()
 
 # vb_mesh_load_memory (what the mesh fuzzers call) is vb_mesh_load: the
