@@ -296,13 +296,18 @@ static void adapt_fit(const job *J, const float n[3], float acc[VDSH_MAX_COEFFS]
 #define DEC_POOL 4096
 #define DEC_BOUNDARY -0.40546511f /* ln(2/3) */
 
-/* Bytes of a worker's decision scratch: the pairs (x, y, z, ln d, label),
- * the basis at them (order^2 rows), the fit's doubles. */
-static size_t dec_scratch_bytes(const job *J)
+/* A worker's decision scratch: the pairs (x, y, z, ln d: K floats each),
+ * the basis at them (order^2 rows of K), the labels (K bytes), then, from
+ * dec_doubles_at (64-byte aligned within it), the fit's doubles. */
+static size_t dec_doubles_at(const job *J)
 {
     size_t k = VB_DECISION_MAX_PAIRS, n = (size_t)J->order * J->order;
-    return (4 * k + n * k) * sizeof(float) + k + 64 +
-           vb_decision_scratch_doubles(J->order) * sizeof(double);
+    return ((4 * k + n * k) * sizeof(float) + k + 63) & ~(size_t)63;
+}
+
+static size_t dec_scratch_bytes(const job *J)
+{
+    return dec_doubles_at(J) + vb_decision_scratch_doubles(J->order) * sizeof(double);
 }
 
 /* Receiver v's first light in the pool: a hash of (seed, v), so that
@@ -367,9 +372,7 @@ static void decision_vertex(job *J, uint32_t v, const float *org, const float n[
     const uint32_t K = VB_DECISION_MAX_PAIRS, top = J->order;
     float *x = (float *)out->dec_scratch, *y = x + K, *z = y + K, *logd = z + K, *Y = logd + K;
     uint8_t *lab = (uint8_t *)(Y + (size_t)top * top * K);
-    double *ds = (double *)(out->dec_scratch +
-                            (((size_t)(4 * K + (size_t)top * top * K) * sizeof(float) + K + 63) &
-                             ~(size_t)63));
+    double *ds = (double *)(out->dec_scratch + dec_doubles_at(J));
     uint32_t at = dec_start(J, v), scanned = 0;
     uint64_t rays = 0;
     uint32_t m = dec_pairs(J, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab, &rays);
