@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include <cjson/cJSON.h>
+#include <meshoptimizer.h>
 
 #include "vdsh.h"
 #include "vdsh_output.h"
@@ -58,22 +59,123 @@ static int blob_align4(blob *b)
     return b->size % 4 ? blob_put(b, zero, 4 - b->size % 4) : 0;
 }
 
-/* Append a buffer view over `n` bytes at `p`; returns its index or -1. */
-static int add_view(blob *b, cJSON *views, const void *p, size_t n, int target)
+/* The buffer views, kept until the end: written as they are, or each
+ * compressed with meshoptimizer (--compress: EXT_meshopt_compression,
+ * ATTRIBUTES for vertex data, TRIANGLES for indices). */
+typedef struct pending_view {
+    uint8_t *data;
+    size_t size, stride; /* stride: bytes per element (index size for indices) */
+    int target;
+} pending_view;
+
+typedef struct view_list {
+    pending_view *v;
+    int n, cap;
+} view_list;
+
+/* Append a buffer view over `n` bytes at `p` (copied) with elements of
+ * `stride` bytes; returns its index or -1. */
+static int add_view(view_list *vl, const void *p, size_t n, size_t stride, int target)
 {
-    if (blob_align4(b) || n == 0)
+    if (n == 0)
         return -1;
-    size_t off = b->size;
-    if (blob_put(b, p, n))
+    if (vl->n == vl->cap) {
+        int cap = vl->cap ? 2 * vl->cap : 32;
+        pending_view *v = realloc(vl->v, (size_t)cap * sizeof *v);
+        if (!v)
+            return -1;
+        vl->v = v;
+        vl->cap = cap;
+    }
+    uint8_t *d = malloc(n);
+    if (!d)
         return -1;
-    cJSON *v = cJSON_CreateObject();
-    cJSON_AddNumberToObject(v, "buffer", 0);
-    cJSON_AddNumberToObject(v, "byteOffset", (double)off);
-    cJSON_AddNumberToObject(v, "byteLength", (double)n);
-    if (target)
-        cJSON_AddNumberToObject(v, "target", target);
-    cJSON_AddItemToArray(views, v);
-    return cJSON_GetArraySize(views) - 1;
+    memcpy(d, p, n);
+    vl->v[vl->n] = (pending_view){d, n, stride, target};
+    return vl->n++;
+}
+
+static void view_list_free(view_list *vl)
+{
+    for (int i = 0; i < vl->n; i++)
+        free(vl->v[i].data);
+    free(vl->v);
+}
+
+/* The views into the blob and the JSON: plain, or meshopt-compressed
+ * (the views then live in a fallback buffer 1 that holds no bytes; the
+ * compressed bytes are buffer 0, the BIN chunk). Returns 0, or -1 out of
+ * memory. *raw_size: the uncompressed bytes. */
+static int write_views(const view_list *vl, int compress, blob *b, cJSON *views, size_t *raw_size)
+{
+    size_t raw = 0;
+    for (int i = 0; i < vl->n; i++) {
+        const pending_view *pv = &vl->v[i];
+        cJSON *v = cJSON_CreateObject();
+        cJSON_AddItemToArray(views, v);
+        raw = (raw + 3) & ~(size_t)3;
+        if (!compress) {
+            if (blob_align4(b) || blob_put(b, pv->data, pv->size))
+                return -1;
+            cJSON_AddNumberToObject(v, "buffer", 0);
+            cJSON_AddNumberToObject(v, "byteOffset", (double)(b->size - pv->size));
+            cJSON_AddNumberToObject(v, "byteLength", (double)pv->size);
+            if (pv->target)
+                cJSON_AddNumberToObject(v, "target", pv->target);
+            raw += pv->size;
+            continue;
+        }
+        const int index = pv->target == 34963;
+        const size_t count = pv->size / pv->stride;
+        size_t bound = index ? meshopt_encodeIndexBufferBound(count, count) /* vertex count <= index count */
+                             : meshopt_encodeVertexBufferBound(count, pv->stride);
+        uint8_t *enc = malloc(bound);
+        if (!enc)
+            return -1;
+        size_t got;
+        if (index) {
+            uint32_t *ix = malloc(count * sizeof *ix);
+            if (!ix) {
+                free(enc);
+                return -1;
+            }
+            for (size_t k = 0; k < count; k++) {
+                if (pv->stride == 2) {
+                    uint16_t s16;
+                    memcpy(&s16, pv->data + 2 * k, 2);
+                    ix[k] = s16;
+                } else {
+                    memcpy(&ix[k], pv->data + 4 * k, 4);
+                }
+            }
+            got = meshopt_encodeIndexBuffer(enc, bound, ix, count);
+            free(ix);
+        } else {
+            got = meshopt_encodeVertexBuffer(enc, bound, pv->data, count, pv->stride);
+        }
+        if (got == 0 || blob_align4(b) || blob_put(b, enc, got)) {
+            free(enc);
+            return -1;
+        }
+        free(enc);
+        cJSON_AddNumberToObject(v, "buffer", 1);
+        cJSON_AddNumberToObject(v, "byteOffset", (double)raw);
+        cJSON_AddNumberToObject(v, "byteLength", (double)pv->size);
+        if (!index)
+            cJSON_AddNumberToObject(v, "byteStride", (double)pv->stride);
+        if (pv->target)
+            cJSON_AddNumberToObject(v, "target", pv->target);
+        cJSON *x = cJSON_AddObjectToObject(cJSON_AddObjectToObject(v, "extensions"), "EXT_meshopt_compression");
+        cJSON_AddNumberToObject(x, "buffer", 0);
+        cJSON_AddNumberToObject(x, "byteOffset", (double)(b->size - got));
+        cJSON_AddNumberToObject(x, "byteLength", (double)got);
+        cJSON_AddNumberToObject(x, "byteStride", (double)pv->stride);
+        cJSON_AddNumberToObject(x, "count", (double)count);
+        cJSON_AddStringToObject(x, "mode", index ? "TRIANGLES" : "ATTRIBUTES");
+        raw += pv->size;
+    }
+    *raw_size = (raw + 3) & ~(size_t)3;
+    return 0;
 }
 
 static int add_accessor(cJSON *accs, int view, int ctype, int normalized, size_t count, const char *type)
@@ -100,6 +202,10 @@ static void usage(FILE *fp)
                 "                     file)\n"
                 "      --float        coefficients as float (default: normalised int16, scale in\n"
                 "                     extras)\n"
+                "      --compress     a compact glb: positions uint16 and normals int8\n"
+                "                     (KHR_mesh_quantization), every buffer view compressed with\n"
+                "                     meshoptimizer (EXT_meshopt_compression; lossless: the\n"
+                "                     coefficients and indices decode bit-exact)\n"
                 "  -q, --quiet        no summary on stderr\n"
                 "  -h, --help         this text\n"
                 "  -V, --version      version\n"
@@ -115,12 +221,13 @@ int main(int argc, char **argv)
     static const struct option longopts[] = {{"output", required_argument, 0, 'o'},
                                              {"orders", required_argument, 0, 'O'},
                                              {"float", no_argument, 0, 'F'},
+                                             {"compress", no_argument, 0, 'C'},
                                              {"quiet", no_argument, 0, 'q'},
                                              {"help", no_argument, 0, 'h'},
                                              {"version", no_argument, 0, 'V'},
                                              {0, 0, 0, 0}};
     const char *in = NULL, *out = NULL;
-    int want[VDSH_ORDER_SLOTS] = {0}, any_order = 0, use_float = 0, quiet = 0, opt;
+    int want[VDSH_ORDER_SLOTS] = {0}, any_order = 0, use_float = 0, quiet = 0, compress = 0, opt;
     while ((opt = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
         switch (opt) {
         case 'o': out = optarg; break;
@@ -135,6 +242,7 @@ int main(int argc, char **argv)
             break;
         }
         case 'F': use_float = 1; break;
+        case 'C': compress = 1; break;
         case 'q': quiet = 1; break;
         case 'h': usage(stdout); return 0;
         case 'V': return vt_cli_version(NULL);
@@ -165,6 +273,7 @@ int main(int argc, char **argv)
     const uint32_t nv = f->header.vertex_count, nt = f->header.triangle_count;
     int rc = 1;
     blob b = {0};
+    view_list vl = {0};
     cJSON *root = cJSON_CreateObject();
     cJSON *asset = cJSON_AddObjectToObject(root, "asset");
     cJSON_AddStringToObject(asset, "version", "2.0");
@@ -189,26 +298,65 @@ int main(int argc, char **argv)
         (void)ix;
         for (size_t j = 0; j < 3 * (size_t)nt; j++)
             buf[j] = (uint16_t)f->indices[j];
-        int v = add_view(&b, views, buf, (size_t)nt * 6, 34963);
+        int v = add_view(&vl, buf, (size_t)nt * 6, 2, 34963);
         free(buf);
         ind_acc = add_accessor(accs, v, 5123, 0, 3 * (size_t)nt, "SCALAR");
     } else {
-        int v = add_view(&b, views, f->indices, (size_t)nt * 12, 34963);
+        int v = add_view(&vl, f->indices, (size_t)nt * 12, 4, 34963);
         ind_acc = add_accessor(accs, v, 5125, 0, 3 * (size_t)nt, "SCALAR");
     }
-    /* Positions with their bounds. */
+    /* Positions with their bounds; --compress: uint16 (KHR_mesh_quantization,
+     * as gltfpack writes it: byteStride 8), dequantised by the node's
+     * transform (one scale for the three axes, so normals stay right; a
+     * translation), at most half a step (extent / 131070) from the float. */
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < nv; i++)
+        for (int k = 0; k < 3; k++) {
+            float p = f->positions[3 * i + (size_t)k];
+            lo[k] = p < lo[k] ? p : lo[k];
+            hi[k] = p > hi[k] ? p : hi[k];
+        }
+    double qstep = 0;
     {
-        int v = add_view(&b, views, f->positions, (size_t)nv * 12, 34962);
-        int a = add_accessor(accs, v, 5126, 0, nv, "VEC3");
-        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (size_t i = 0; i < nv; i++)
-            for (int k = 0; k < 3; k++) {
-                float p = f->positions[3 * i + (size_t)k];
-                lo[k] = p < lo[k] ? p : lo[k];
-                hi[k] = p > hi[k] ? p : hi[k];
-            }
-        cJSON *acc = cJSON_GetArrayItem(accs, a);
+        int v, a;
         double dlo[3] = {lo[0], lo[1], lo[2]}, dhi[3] = {hi[0], hi[1], hi[2]};
+        if (compress) {
+            double ext = 0;
+            for (int k = 0; k < 3; k++)
+                ext = dhi[k] - dlo[k] > ext ? dhi[k] - dlo[k] : ext;
+            qstep = ext > 0 ? ext / 65535 : 1;
+            uint16_t *q = (uint16_t *)tmp;
+            for (size_t i = 0; i < nv; i++) {
+                for (int k = 0; k < 3; k++) {
+                    long r = lrint((f->positions[3 * i + (size_t)k] - dlo[k]) / qstep);
+                    q[4 * i + (size_t)k] = (uint16_t)(r < 0 ? 0 : r > 65535 ? 65535 : r);
+                }
+                q[4 * i + 3] = 0;
+            }
+            for (int k = 0; k < 3; k++) {
+                long l = lrint((dhi[k] - dlo[k]) / qstep);
+                dlo[k] = 0;
+                dhi[k] = (double)(l > 65535 ? 65535 : l);
+            }
+            /* the bounds of the stored integers */
+            for (int k = 0; k < 3; k++) {
+                uint16_t mn = 65535, mx = 0;
+                for (size_t i = 0; i < nv; i++) {
+                    uint16_t c = q[4 * i + (size_t)k];
+                    mn = c < mn ? c : mn;
+                    mx = c > mx ? c : mx;
+                }
+                dlo[k] = mn, dhi[k] = mx;
+            }
+            v = add_view(&vl, q, (size_t)nv * 8, 8, 34962);
+            a = add_accessor(accs, v, 5123, 0, nv, "VEC3");
+        } else {
+            v = add_view(&vl, f->positions, (size_t)nv * 12, 12, 34962);
+            a = add_accessor(accs, v, 5126, 0, nv, "VEC3");
+        }
+        if (v < 0)
+            goto oom;
+        cJSON *acc = cJSON_GetArrayItem(accs, a);
         cJSON_AddItemToObject(acc, "min", cJSON_CreateDoubleArray(dlo, 3));
         cJSON_AddItemToObject(acc, "max", cJSON_CreateDoubleArray(dhi, 3));
         cJSON_AddNumberToObject(attrs, "POSITION", a);
@@ -228,8 +376,21 @@ int main(int argc, char **argv)
                     tmp[3 * i + (size_t)k] = (float)(n[k] / l);
             }
         }
-        int v = add_view(&b, views, tmp, (size_t)nv * 12, 34962);
-        cJSON_AddNumberToObject(attrs, "NORMAL", add_accessor(accs, v, 5126, 0, nv, "VEC3"));
+        int v;
+        if (compress) { /* normalised int8 (KHR_mesh_quantization), byteStride 4 */
+            int8_t *q = (int8_t *)(tmp + 3 * (size_t)nv);
+            for (size_t i = 0; i < nv; i++) {
+                for (int k = 0; k < 3; k++)
+                    q[4 * i + (size_t)k] = (int8_t)lrintf(tmp[3 * i + (size_t)k] * 127.0f);
+                q[4 * i + 3] = 0;
+            }
+            v = add_view(&vl, q, (size_t)nv * 4, 4, 34962);
+        } else {
+            v = add_view(&vl, tmp, (size_t)nv * 12, 12, 34962);
+        }
+        if (v < 0)
+            goto oom;
+        cJSON_AddNumberToObject(attrs, "NORMAL", add_accessor(accs, v, compress ? 5120 : 5126, compress, nv, "VEC3"));
         cJSON_AddNumberToObject(vx, "undefined_normals", undefined);
     }
     cJSON_AddNumberToObject(vx, "vertex_count", nv);
@@ -342,7 +503,7 @@ int main(int argc, char **argv)
                 }
                 bytes = (size_t)nv * 8;
             }
-            int view = add_view(&b, views, tmp, bytes, 34962);
+            int view = add_view(&vl, tmp, bytes, use_float ? 16 : 8, 34962);
             if (view < 0)
                 goto oom;
             char name[48];
@@ -356,13 +517,29 @@ int main(int argc, char **argv)
         fprintf(stderr, "vdsh-export: %s: no stream of the orders asked for\n", in);
         goto done;
     }
-    if (blob_align4(&b))
+    size_t raw_size = 0;
+    if (write_views(&vl, compress, &b, views, &raw_size) || blob_align4(&b))
         goto oom;
     {
         cJSON *buffers = cJSON_AddArrayToObject(root, "buffers");
         cJSON *buf = cJSON_CreateObject();
         cJSON_AddNumberToObject(buf, "byteLength", (double)b.size);
         cJSON_AddItemToArray(buffers, buf);
+        if (compress) { /* the uncompressed views: a fallback buffer without bytes */
+            cJSON *fb = cJSON_CreateObject();
+            cJSON_AddNumberToObject(fb, "byteLength", (double)raw_size);
+            cJSON_AddBoolToObject(
+                cJSON_AddObjectToObject(cJSON_AddObjectToObject(fb, "extensions"), "EXT_meshopt_compression"),
+                "fallback", 1);
+            cJSON_AddItemToArray(buffers, fb);
+            cJSON *used = cJSON_AddArrayToObject(root, "extensionsUsed");
+            cJSON *req = cJSON_AddArrayToObject(root, "extensionsRequired");
+            const char *names[2] = {"KHR_mesh_quantization", "EXT_meshopt_compression"};
+            for (int k = 0; k < 2; k++) {
+                cJSON_AddItemToArray(used, cJSON_CreateString(names[k]));
+                cJSON_AddItemToArray(req, cJSON_CreateString(names[k]));
+            }
+        }
         cJSON *prim = cJSON_CreateObject();
         cJSON_AddItemToObject(prim, "attributes", attrs);
         attrs = NULL;
@@ -378,6 +555,11 @@ int main(int argc, char **argv)
         cJSON_AddItemToArray(meshes, mesh);
         cJSON *node = cJSON_CreateObject();
         cJSON_AddNumberToObject(node, "mesh", 0);
+        if (compress) {
+            double t[3] = {lo[0], lo[1], lo[2]}, sc[3] = {qstep, qstep, qstep};
+            cJSON_AddItemToObject(node, "translation", cJSON_CreateDoubleArray(t, 3));
+            cJSON_AddItemToObject(node, "scale", cJSON_CreateDoubleArray(sc, 3));
+        }
         cJSON *nodes = cJSON_AddArrayToObject(root, "nodes");
         cJSON_AddItemToArray(nodes, node);
         cJSON *scene = cJSON_CreateObject();
@@ -432,6 +614,7 @@ done:
     cJSON_Delete(attrs);
     cJSON_Delete(vx);
     free(b.data);
+    view_list_free(&vl);
     free(tmp);
     free(coef);
     vdsh_free(f);
