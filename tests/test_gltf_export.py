@@ -46,10 +46,12 @@ def read_glb(path):
 def accessor(g, binary, i):
     a = g["accessors"][i]
     v = g["bufferViews"][a["bufferView"]]
-    n = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[a["type"]]
-    fmt = {5126: "f", 5122: "h", 5123: "H", 5125: "I"}[a["componentType"]]
-    vals = struct.unpack_from("<%d%s" % (a["count"] * n, fmt), binary, v["byteOffset"])
-    return [vals[k * n:(k + 1) * n] for k in range(a["count"])]
+    n = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}[a["type"]]
+    fmt = {5126: "f", 5122: "h", 5123: "H", 5125: "I", 5120: "b", 5121: "B"}[a["componentType"]]
+    size = struct.calcsize("<" + fmt) * n
+    stride = v.get("byteStride", size)
+    at = v.get("byteOffset", 0) + a.get("byteOffset", 0)
+    return [struct.unpack_from("<%d%s" % (n, fmt), binary, at + k * stride) for k in range(a["count"])]
 
 
 scenes = [("room", "builtin:room", ["--rays", "64", "--orders", "2,3,5", "--encoding", "f16"]),
@@ -126,6 +128,67 @@ for name, src, opts in scenes:
             if line.startswith("v ")]
     if len(objv) != len(pos) or any(abs(a - b) > 0 for p, o in zip(pos, objv) for a, b in zip(p, o)):
         fail.append("%s: positions differ from the bake's mesh (%d vs %d vertices)" % (q, len(pos), len(objv)))
+
+# --compress (KHR_mesh_quantization, EXT_meshopt_compression): decoded by
+# the npm package meshoptimizer's decoder (tests/gltf_meshopt_decode.js),
+# the coefficients (int16 and --float) equal the plain export's bit for
+# bit (the vertices keep their order), and so do the triangles (as a set:
+# reordered for the codec, each up to a rotation of its corners, which
+# meshopt's triangle codec may apply; the winding is kept); positions (uint16 dequantised by the node's scale
+# and translation) within half a step, normals (int8) within half a step
+# of 1/127.
+decoder = os.path.isfile(os.path.join(modules, "meshoptimizer", "meshopt_decoder.cjs"))
+for name, flt in (("room", []), ("room", ["--float"]), ("box", [])):
+    plain = os.path.join(work, name + ("_float" if flt else "") + ".glb")
+    if not os.path.exists(plain) or not decoder:
+        continue
+    packed = plain[:-4] + "_compressed.glb"
+    unpacked = plain[:-4] + "_decoded.glb"
+    run([export, os.path.join(work, name + ".vdsh"), "-o", packed, "--compress"] + flt)
+    run([node, os.path.join(here, "gltf_meshopt_decode.js"), modules, packed, unpacked])
+    if fail:
+        break
+    glbs.append(packed)
+    gp, bp = read_glb(plain)
+    gc, _ = read_glb(packed)
+    gd, bd = read_glb(unpacked)
+    print("%s: %d bytes, compressed %d (%.2f)" % (name + " ".join([""] + flt), os.path.getsize(plain),
+                                                 os.path.getsize(packed), os.path.getsize(packed) / os.path.getsize(plain)))
+    if sorted(gc.get("extensionsRequired", [])) != ["EXT_meshopt_compression", "KHR_mesh_quantization"]:
+        fail.append("%s: extensionsRequired %s" % (packed, gc.get("extensionsRequired")))
+    if not all("EXT_meshopt_compression" in v.get("extensions", {}) for v in gc["bufferViews"]):
+        fail.append("%s: a buffer view is not meshopt-compressed" % packed)
+    pp, pd = gp["meshes"][0]["primitives"][0], gd["meshes"][0]["primitives"][0]
+    if sorted(pp["attributes"]) != sorted(pd["attributes"]):
+        fail.append("%s: attributes %s, plain %s" % (packed, sorted(pd["attributes"]), sorted(pp["attributes"])))
+        continue
+    # the triangles are reordered for meshopt's codec, which may also
+    # rotate a triangle's corners (the same winding): compare the sets, each
+    # triangle in its smallest rotation
+    def tris(ix):
+        flat = [i[0] for i in ix]
+        t = [tuple(flat[k:k + 3]) for k in range(0, len(flat), 3)]
+        return sorted(min(x, x[1:] + x[:1], x[2:] + x[:2]) for x in t)
+    if tris(accessor(gp, bp, pp["indices"])) != tris(accessor(gd, bd, pd["indices"])):
+        fail.append("%s: triangles differ after decoding" % packed)
+    for nm in pp["attributes"]:
+        a, b = accessor(gp, bp, pp["attributes"][nm]), accessor(gd, bd, pd["attributes"][nm])
+        if nm.startswith("_VDSH"):
+            if a != b or gp["accessors"][pp["attributes"][nm]]["componentType"] != \
+                    gd["accessors"][pd["attributes"][nm]]["componentType"]:
+                fail.append("%s: %s not bit-exact after decoding" % (packed, nm))
+            continue
+        node0 = gd["nodes"][0]
+        sc, tr = node0.get("scale", [1, 1, 1]), node0.get("translation", [0, 0, 0])
+        if nm == "POSITION":
+            step = sc[0]
+            worst = max(abs(q[k] * sc[k] + tr[k] - p[k]) for p, q in zip(a, b) for k in range(3))
+            lim = 0.5 * step * 1.001 + 1e-6 * max(abs(c) for p in a for c in p)
+        else:
+            worst = max(abs(q[k] / 127.0 - p[k]) for p, q in zip(a, b) for k in range(3))
+            lim = 0.5 / 127 + 1e-6
+        if worst > lim:
+            fail.append("%s: %s off by %g after decoding (limit %g)" % (packed, nm, worst, lim))
 
 # The validator comes from npm (gltf_npm_setup); where the registry cannot
 # be reached that fixture skips, and so does this test's validation: every

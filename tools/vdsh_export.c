@@ -274,6 +274,7 @@ int main(int argc, char **argv)
     int rc = 1;
     blob b = {0};
     view_list vl = {0};
+    uint32_t *tri_sorted = NULL;
     cJSON *root = cJSON_CreateObject();
     cJSON *asset = cJSON_AddObjectToObject(root, "asset");
     cJSON_AddStringToObject(asset, "version", "2.0");
@@ -288,8 +289,20 @@ int main(int argc, char **argv)
     if (!tmp || !coef)
         goto oom;
 
-    /* Indices: uint16 when they fit, else uint32. */
+    /* Indices: uint16 when they fit, else uint32. --compress: the triangles
+     * in meshoptimizer's vertex cache order first (its index codec needs
+     * that: in the bake's order they grow by 16 %; reordered, the room's
+     * shrink to about a quarter); the vertices keep their order, vertex i
+     * is receiver i of the .vdsh as in the plain export. */
     int ind_acc;
+    const uint32_t *tri = f->indices;
+    if (compress) {
+        tri_sorted = malloc((size_t)nt * 12 + 4);
+        if (!tri_sorted)
+            goto oom;
+        meshopt_optimizeVertexCache(tri_sorted, f->indices, 3 * (size_t)nt, nv);
+        tri = tri_sorted;
+    }
     if (nv <= 65535) {
         uint16_t *ix = (uint16_t *)tmp;
         uint16_t *buf = malloc((size_t)nt * 6 + 2);
@@ -297,12 +310,12 @@ int main(int argc, char **argv)
             goto oom;
         (void)ix;
         for (size_t j = 0; j < 3 * (size_t)nt; j++)
-            buf[j] = (uint16_t)f->indices[j];
+            buf[j] = (uint16_t)tri[j];
         int v = add_view(&vl, buf, (size_t)nt * 6, 2, 34963);
         free(buf);
         ind_acc = add_accessor(accs, v, 5123, 0, 3 * (size_t)nt, "SCALAR");
     } else {
-        int v = add_view(&vl, f->indices, (size_t)nt * 12, 4, 34963);
+        int v = add_view(&vl, tri, (size_t)nt * 12, 4, 34963);
         ind_acc = add_accessor(accs, v, 5125, 0, 3 * (size_t)nt, "SCALAR");
     }
     /* Positions with their bounds; --compress: uint16 (KHR_mesh_quantization,
@@ -615,6 +628,7 @@ done:
     cJSON_Delete(vx);
     free(b.data);
     view_list_free(&vl);
+    free(tri_sorted);
     free(tmp);
     free(coef);
     vdsh_free(f);
