@@ -22,11 +22,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include <cjson/cJSON.h>
 #include <meshoptimizer.h>
 
 #include "vdsh.h"
+#include "vdsh_export_source.h"
 #include "vdsh_output.h"
 #include "vdsh_scene_view.h"
 #include "vt_cli.h"
@@ -191,6 +193,235 @@ static int add_accessor(cJSON *accs, int view, int ctype, int normalized, size_t
     return cJSON_GetArraySize(accs) - 1;
 }
 
+/* --source: the source glTF's JSON becomes *root, its buffers (and the
+ * images it names by file) the one BIN buffer *b, each primitive the bake
+ * reached gets the VDSH attributes of its vertices' receivers (taken from
+ * the per-receiver views in vl, named in attrs), the metadata (*vx) goes
+ * to the root's extension VDSH_visibility_distance. Returns 0, or 1 after
+ * a message. */
+#define VDSH_EXT "VDSH_visibility_distance"
+static int with_source(const char *in, const char *path, const vdsh_file *f, cJSON *root, view_list *vl,
+                       cJSON *attrs, cJSON **vx, blob *b)
+{
+    char msg[1024];
+    vdsh_src src;
+    vdsh_src_prim *prims = NULL;
+    int np = 0, rc = 1;
+    int *node_mesh = NULL, *mesh_node = NULL;
+    cJSON **orig = NULL;
+    int orig_n = 0;
+    view_list nl = {0};
+    if (vdsh_src_load(path, &src, msg, sizeof msg) ||
+        vdsh_src_map(path, &src, f->positions, f->normals, f->header.vertex_count, &prims, &np, msg, sizeof msg)) {
+        fprintf(stderr, "vdsh-export: %s\n", msg);
+        return 1;
+    }
+    cJSON *g = src.json;
+    uint64_t vertices = 0, matched = 0;
+    for (int i = 0; i < np; i++)
+        vertices += prims[i].vertex_count, matched += prims[i].matched;
+    if (np == 0 || matched == 0) {
+        fprintf(stderr, "vdsh-export: %s: no vertex of %s is at a receiver of the bake: not the glTF it was baked "
+                        "from\n", in, path);
+        goto out;
+    }
+    /* one BIN buffer: the source's buffers one after the other */
+    size_t *base = calloc((size_t)src.buffer_count + 1, sizeof *base);
+    if (!base)
+        goto oom;
+    for (int i = 0; i < src.buffer_count; i++) {
+        if (blob_align4(b)) {
+            free(base);
+            goto oom;
+        }
+        base[i] = b->size;
+        if (blob_put(b, src.buffers[i].data, src.buffers[i].size)) {
+            free(base);
+            goto oom;
+        }
+    }
+    cJSON *views = cJSON_GetObjectItemCaseSensitive(g, "bufferViews");
+    if (!views)
+        views = cJSON_AddArrayToObject(g, "bufferViews");
+    cJSON *v;
+    cJSON_ArrayForEach(v, views) {
+        int bi = (int)cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(v, "buffer"));
+        cJSON *off = cJSON_GetObjectItemCaseSensitive(v, "byteOffset");
+        double o = (cJSON_IsNumber(off) ? off->valuedouble : 0) + (double)base[bi >= 0 && bi < src.buffer_count ? bi : 0];
+        cJSON_DeleteItemFromObjectCaseSensitive(v, "byteOffset");
+        cJSON_AddNumberToObject(v, "byteOffset", o);
+        cJSON_ReplaceItemInObjectCaseSensitive(v, "buffer", cJSON_CreateNumber(0));
+    }
+    free(base);
+    /* images named by file: into the BIN (the glb is written elsewhere) */
+    cJSON *img;
+    cJSON_ArrayForEach(img, cJSON_GetObjectItemCaseSensitive(g, "images")) {
+        cJSON *uri = cJSON_GetObjectItemCaseSensitive(img, "uri");
+        if (!cJSON_IsString(uri) || strncmp(uri->valuestring, "data:", 5) == 0)
+            continue;
+        const char *dot = strrchr(uri->valuestring, '.');
+        const char *mime = !dot ? NULL : !strcasecmp(dot, ".png") ? "image/png"
+                         : (!strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg")) ? "image/jpeg" : NULL;
+        char *p = malloc(strlen(src.dir) + strlen(uri->valuestring) + 1);
+        if (!p)
+            goto oom;
+        strcpy(p, src.dir);
+        strcat(p, uri->valuestring);
+        FILE *fp = fopen(p, "rb");
+        free(p);
+        if (!fp || !mime) {
+            if (fp)
+                fclose(fp);
+            fprintf(stderr, "vdsh-export: %s: image %s %s: kept as a URI relative to the output\n", path,
+                    uri->valuestring, fp ? "is neither PNG nor JPEG" : "cannot be read");
+            continue;
+        }
+        if (blob_align4(b)) {
+            fclose(fp);
+            goto oom;
+        }
+        size_t start = b->size, got;
+        uint8_t chunk[65536];
+        while ((got = fread(chunk, 1, sizeof chunk, fp)) > 0)
+            if (blob_put(b, chunk, got)) {
+                fclose(fp);
+                goto oom;
+            }
+        fclose(fp);
+        cJSON *nv = cJSON_CreateObject();
+        cJSON_AddNumberToObject(nv, "buffer", 0);
+        cJSON_AddNumberToObject(nv, "byteOffset", (double)start);
+        cJSON_AddNumberToObject(nv, "byteLength", (double)(b->size - start));
+        cJSON_AddItemToArray(views, nv);
+        cJSON_DeleteItemFromObjectCaseSensitive(img, "uri");
+        cJSON_AddNumberToObject(img, "bufferView", cJSON_GetArraySize(views) - 1);
+        cJSON_AddStringToObject(img, "mimeType", mime);
+    }
+    /* the VDSH attributes per primitive instance; a mesh a second node
+     * uses is copied (each instance has its own receivers) */
+    cJSON *meshes = cJSON_GetObjectItemCaseSensitive(g, "meshes");
+    cJSON *nodes = cJSON_GetObjectItemCaseSensitive(g, "nodes");
+    cJSON *accs = cJSON_GetObjectItemCaseSensitive(g, "accessors");
+    cJSON *my_accs = cJSON_GetObjectItemCaseSensitive(root, "accessors");
+    const int nm = cJSON_GetArraySize(meshes), nn = cJSON_GetArraySize(nodes);
+    node_mesh = malloc(((size_t)nn + 1) * sizeof *node_mesh);
+    mesh_node = malloc(((size_t)nm + 1) * sizeof *mesh_node);
+    orig = calloc((size_t)nm + 1, sizeof *orig);
+    if (!node_mesh || !mesh_node || !orig)
+        goto oom;
+    for (int i = 0; i < nn; i++)
+        node_mesh[i] = -1;
+    for (int i = 0; i < nm; i++) {
+        mesh_node[i] = -1;
+        orig[i] = cJSON_Duplicate(cJSON_GetArrayItem(meshes, i), 1);
+    }
+    orig_n = nm;
+    const int view_base = cJSON_GetArraySize(views);
+    for (int i = 0; i < np; i++) {
+        const vdsh_src_prim *sp = &prims[i];
+        int mi = node_mesh[sp->node];
+        if (mi < 0) {
+            if (mesh_node[sp->mesh] < 0) {
+                mi = sp->mesh;
+                mesh_node[mi] = sp->node;
+            } else {
+                cJSON_AddItemToArray(meshes, cJSON_Duplicate(orig[sp->mesh], 1));
+                mi = cJSON_GetArraySize(meshes) - 1;
+                cJSON_ReplaceItemInObjectCaseSensitive(cJSON_GetArrayItem(nodes, sp->node), "mesh",
+                                                       cJSON_CreateNumber(mi));
+            }
+            node_mesh[sp->node] = mi;
+        }
+        cJSON *prim = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(meshes, mi), "primitives"),
+                                         sp->prim);
+        cJSON *pattrs = cJSON_GetObjectItemCaseSensitive(prim, "attributes");
+        cJSON *a;
+        cJSON_ArrayForEach(a, attrs) {
+            if (strncmp(a->string, "_VDSH", 5) != 0)
+                continue;
+            cJSON *acc = cJSON_GetArrayItem(my_accs, (int)a->valuedouble);
+            const pending_view *pv = &vl->v[(int)cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(acc, "bufferView"))];
+            uint8_t *d = calloc((size_t)sp->vertex_count + 1, pv->stride);
+            if (!d)
+                goto oom;
+            for (uint32_t k = 0; k < sp->vertex_count; k++)
+                if (sp->map[k] != UINT32_MAX)
+                    memcpy(d + (size_t)k * pv->stride, pv->data + (size_t)sp->map[k] * pv->stride, pv->stride);
+            int vi = add_view(&nl, d, (size_t)sp->vertex_count * pv->stride, pv->stride, 34962);
+            free(d);
+            if (vi < 0)
+                goto oom;
+            cJSON *na = cJSON_Duplicate(acc, 1);
+            cJSON_ReplaceItemInObjectCaseSensitive(na, "bufferView", cJSON_CreateNumber(view_base + vi));
+            cJSON_ReplaceItemInObjectCaseSensitive(na, "count", cJSON_CreateNumber(sp->vertex_count));
+            cJSON_AddItemToArray(accs, na);
+            cJSON_DeleteItemFromObjectCaseSensitive(pattrs, a->string);
+            cJSON_AddNumberToObject(pattrs, a->string, cJSON_GetArraySize(accs) - 1);
+        }
+        cJSON *ext = cJSON_GetObjectItemCaseSensitive(prim, "extensions");
+        if (!ext)
+            ext = cJSON_AddObjectToObject(prim, "extensions");
+        cJSON_DeleteItemFromObjectCaseSensitive(ext, VDSH_EXT);
+        cJSON *pe = cJSON_AddObjectToObject(ext, VDSH_EXT);
+        cJSON_AddNumberToObject(pe, "vertices", sp->vertex_count);
+        cJSON_AddNumberToObject(pe, "matched", sp->matched);
+    }
+    size_t raw = 0;
+    if (write_views(&nl, 0, b, views, &raw) || blob_align4(b))
+        goto oom;
+    cJSON_DeleteItemFromObjectCaseSensitive(g, "buffers");
+    cJSON *bufs = cJSON_AddArrayToObject(g, "buffers");
+    cJSON *buf = cJSON_CreateObject();
+    cJSON_AddNumberToObject(buf, "byteLength", (double)b->size);
+    cJSON_AddItemToArray(bufs, buf);
+    cJSON_AddNumberToObject(*vx, "source_vertices", (double)vertices);
+    cJSON_AddNumberToObject(*vx, "source_vertices_matched", (double)matched);
+    cJSON *gext = cJSON_GetObjectItemCaseSensitive(g, "extensions");
+    if (!gext)
+        gext = cJSON_AddObjectToObject(g, "extensions");
+    cJSON_DeleteItemFromObjectCaseSensitive(gext, VDSH_EXT);
+    cJSON_AddItemToObject(gext, VDSH_EXT, *vx);
+    *vx = NULL;
+    cJSON *used = cJSON_GetObjectItemCaseSensitive(g, "extensionsUsed");
+    if (!used)
+        used = cJSON_AddArrayToObject(g, "extensionsUsed");
+    int have = 0;
+    cJSON *u;
+    cJSON_ArrayForEach(u, used)
+        have |= cJSON_IsString(u) && strcmp(u->valuestring, VDSH_EXT) == 0;
+    if (!have)
+        cJSON_AddItemToArray(used, cJSON_CreateString(VDSH_EXT));
+    cJSON *asset = cJSON_GetObjectItemCaseSensitive(g, "asset");
+    if (asset) {
+        cJSON_DeleteItemFromObjectCaseSensitive(asset, "generator");
+        cJSON_AddStringToObject(asset, "generator", "vdsh-export --source (formats/GLTF.md)");
+    }
+    if (matched < vertices)
+        fprintf(stderr, "vdsh-export: %s: %llu of %llu source vertices have no receiver at their position "
+                        "(unreferenced, or dropped by the bake): their VDSH attributes are 0\n", path,
+                (unsigned long long)(vertices - matched), (unsigned long long)vertices);
+    /* root becomes the source's JSON */
+    cJSON *child = root->child;
+    root->child = g->child;
+    g->child = child;
+    rc = 0;
+    goto out;
+oom:
+    fprintf(stderr, "vdsh-export: %s: out of memory\n", path);
+out:
+    for (int i = 0; i < np; i++)
+        free(prims[i].map);
+    free(prims);
+    for (int i = 0; i < orig_n; i++)
+        cJSON_Delete(orig[i]);
+    free(orig);
+    free(node_mesh);
+    free(mesh_node);
+    view_list_free(&nl);
+    vdsh_src_free(&src);
+    return rc;
+}
+
 static void usage(FILE *fp)
 {
     fprintf(fp, "usage: vdsh-export [options] IN.vdsh -o OUT.glb\n"
@@ -206,6 +437,9 @@ static void usage(FILE *fp)
                 "                     (KHR_mesh_quantization), every buffer view compressed with\n"
                 "                     meshoptimizer (EXT_meshopt_compression; lossless: the\n"
                 "                     coefficients and indices decode bit-exact)\n"
+                "      --source FILE  the glTF the .vdsh was baked from: write its own scene (nodes,\n"
+                "                     meshes, materials, textures, UVs...) with the VDSH attributes\n"
+                "                     added to each primitive (formats/GLTF.md)\n"
                 "  -q, --quiet        no summary on stderr\n"
                 "  -h, --help         this text\n"
                 "  -V, --version      version\n"
@@ -222,11 +456,12 @@ int main(int argc, char **argv)
                                              {"orders", required_argument, 0, 'O'},
                                              {"float", no_argument, 0, 'F'},
                                              {"compress", no_argument, 0, 'C'},
+                                             {"source", required_argument, 0, 'S'},
                                              {"quiet", no_argument, 0, 'q'},
                                              {"help", no_argument, 0, 'h'},
                                              {"version", no_argument, 0, 'V'},
                                              {0, 0, 0, 0}};
-    const char *in = NULL, *out = NULL;
+    const char *in = NULL, *out = NULL, *source = NULL;
     int want[VDSH_ORDER_SLOTS] = {0}, any_order = 0, use_float = 0, quiet = 0, compress = 0, opt;
     while ((opt = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
         switch (opt) {
@@ -243,6 +478,7 @@ int main(int argc, char **argv)
         }
         case 'F': use_float = 1; break;
         case 'C': compress = 1; break;
+        case 'S': source = optarg; break;
         case 'q': quiet = 1; break;
         case 'h': usage(stdout); return 0;
         case 'V': return vt_cli_version(NULL);
@@ -256,7 +492,10 @@ int main(int argc, char **argv)
     in = argv[optind];
     if (!out)
         return vt_usage_error("vdsh-export", "%s", "no output: give -o OUT.glb");
-    if (vt_cli_check_outputs(&out, 1, &in, 1) != 0)
+    if (source && compress)
+        return vt_usage_error("vdsh-export", "%s", "--source and --compress do not go together (yet)");
+    const char *ins[2] = {in, source};
+    if (vt_cli_check_outputs(&out, 1, ins, source ? 2 : 1) != 0)
         return 1;
     vdsh_file *f = NULL;
     vdsh_error verr;
@@ -530,6 +769,11 @@ int main(int argc, char **argv)
         fprintf(stderr, "vdsh-export: %s: no stream of the orders asked for\n", in);
         goto done;
     }
+    if (source) {
+        if (with_source(in, source, f, root, &vl, attrs, &vx, &b) != 0)
+            goto done;
+        goto write;
+    }
     size_t raw_size = 0;
     if (write_views(&vl, compress, &b, views, &raw_size) || blob_align4(&b))
         goto oom;
@@ -582,7 +826,7 @@ int main(int argc, char **argv)
         cJSON_AddItemToArray(scenes, scene);
         cJSON_AddNumberToObject(root, "scene", 0);
     }
-    {
+write: {
         char *json = cJSON_PrintUnformatted(root);
         if (!json)
             goto oom;
