@@ -190,6 +190,67 @@ for name, flt in (("room", []), ("room", ["--float"]), ("box", [])):
         if worst > lim:
             fail.append("%s: %s off by %g after decoding (limit %g)" % (packed, nm, worst, lim))
 
+# --source (formats/GLTF.md "Keeping the source scene"): the glTF's own
+# scene comes back with the VDSH attributes on its primitives: its nodes
+# (but for the mesh of a second instance), materials, textures, samplers
+# and every source attribute (values compared) as they were, every vertex
+# at a receiver (a refined bake too: refinement keeps the source's
+# vertices), the metadata in the root's VDSH_visibility_distance.
+srcs = [("box-src", os.path.join(models, "glTF2", "BoxTextured-glTF-Binary", "BoxTextured.glb"), ["--max-edge", "0.3"]),
+        ("boxgltf-src", os.path.join(models, "glTF2", "BoxTextured-glTF", "BoxTextured.gltf"), []),
+        ("engine-src", os.path.join(models, "glTF2", "2CylinderEngine-glTF-Binary", "2CylinderEngine.glb"), ["--rays", "4"])]
+for name, src, opts in srcs:
+    if not os.path.exists(src):
+        continue
+    vd, out = os.path.join(work, name + ".vdsh"), os.path.join(work, name + ".glb")
+    run([bake, src, "-o", vd, "-q", "--rays", "16", "--orders", "2,3"] + opts)
+    run([export, vd, "--source", src, "-o", out, "-q"])
+    if fail:
+        break
+    glbs.append(out)
+    g, bn = read_glb(out)
+    if src.endswith(".glb"):
+        g0, b0 = read_glb(src)
+    else:
+        g0, b0 = json.load(open(src)), None
+    x = g.get("extensions", {}).get("VDSH_visibility_distance")
+    if not x or "VDSH_visibility_distance" not in g.get("extensionsUsed", []):
+        fail.append("%s: no VDSH_visibility_distance extension" % out)
+        continue
+    if x["source_vertices_matched"] != x["source_vertices"] or x["source_vertices"] == 0:
+        fail.append("%s: %s of %s vertices matched" % (out, x["source_vertices_matched"], x["source_vertices"]))
+    for key in ("materials", "textures", "samplers", "scenes"):
+        if g.get(key) != g0.get(key):
+            fail.append("%s: %s differ from the source's" % (out, key))
+    if len(g.get("images", [])) != len(g0.get("images", [])) or any("uri" in i for i in g.get("images", [])):
+        fail.append("%s: images not all embedded" % out)
+    strip = lambda n: {k: v for k, v in n.items() if k != "mesh"}
+    if [strip(n) for n in g["nodes"]] != [strip(n) for n in g0["nodes"]]:
+        fail.append("%s: nodes differ from the source's" % out)
+    names = set()
+    for mi, n in enumerate(g["nodes"]):
+        if "mesh" not in n:
+            continue
+        m, m0 = g["meshes"][n["mesh"]], g0["meshes"][g0["nodes"][mi]["mesh"]]
+        for p, p0 in zip(m["primitives"], m0["primitives"]):
+            vd_attrs = sorted(k for k in p["attributes"] if k.startswith("_VDSH"))
+            names.add(tuple(vd_attrs))
+            if {k: v for k, v in p.items() if k not in ("attributes", "extensions")} != \
+                    {k: v for k, v in p0.items() if k not in ("attributes", "extensions")}:
+                fail.append("%s: node %d: primitive fields differ" % (out, mi))
+            if sorted(k for k in p["attributes"] if not k.startswith("_VDSH")) != sorted(p0["attributes"]):
+                fail.append("%s: node %d: attributes %s, source %s" % (out, mi, sorted(p["attributes"]), sorted(p0["attributes"])))
+            elif b0 is not None:
+                for k in p0["attributes"]:
+                    if accessor(g, bn, p["attributes"][k]) != accessor(g0, b0, p0["attributes"][k]):
+                        fail.append("%s: node %d: %s values differ from the source's" % (out, mi, k))
+            count = g["accessors"][p["attributes"]["POSITION"]]["count"]
+            for k in vd_attrs:
+                if g["accessors"][p["attributes"][k]]["count"] != count:
+                    fail.append("%s: %s count differs from POSITION's" % (out, k))
+    if names != {("_VDSH2_0", "_VDSH3_0", "_VDSH3_1", "_VDSH3_2")}:
+        fail.append("%s: VDSH attributes per primitive %s" % (out, names))
+
 # The validator comes from npm (gltf_npm_setup); where the registry cannot
 # be reached that fixture skips, and so does this test's validation: every
 # other check still runs and fails the test if it fails.

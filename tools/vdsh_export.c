@@ -200,6 +200,32 @@ static int add_accessor(cJSON *accs, int view, int ctype, int normalized, size_t
  * to the root's extension VDSH_visibility_distance. Returns 0, or 1 after
  * a message. */
 #define VDSH_EXT "VDSH_visibility_distance"
+
+/* cJSON prints a number with 15 digits when that is within its epsilon of
+ * the value: the source's numbers (matrices, colours) would lose bits.
+ * Each non-integer number becomes raw text of the fewest digits (15..17)
+ * that read back as the same double. */
+static int exact_numbers(cJSON *n)
+{
+    for (; n; n = n->next) {
+        if (cJSON_IsNumber(n) && n->valuedouble != floor(n->valuedouble) && isfinite(n->valuedouble)) {
+            char t[40];
+            for (int digits = 15; digits <= 17; digits++) {
+                snprintf(t, sizeof t, "%.*g", digits, n->valuedouble);
+                if (strtod(t, NULL) == n->valuedouble)
+                    break;
+            }
+            char *c = strdup(t);
+            if (!c)
+                return -1;
+            n->type = cJSON_Raw;
+            n->valuestring = c;
+        }
+        if (n->child && exact_numbers(n->child))
+            return -1;
+    }
+    return 0;
+}
 static int with_source(const char *in, const char *path, const vdsh_file *f, cJSON *root, view_list *vl,
                        cJSON *attrs, cJSON **vx, blob *b)
 {
@@ -400,6 +426,8 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         fprintf(stderr, "vdsh-export: %s: %llu of %llu source vertices have no receiver at their position "
                         "(unreferenced, or dropped by the bake): their VDSH attributes are 0\n", path,
                 (unsigned long long)(vertices - matched), (unsigned long long)vertices);
+    if (exact_numbers(g->child))
+        goto oom;
     /* root becomes the source's JSON */
     cJSON *child = root->child;
     root->child = g->child;
