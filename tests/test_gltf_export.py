@@ -11,7 +11,11 @@ extras.vdsh with method, quantity, order, max distance and source
 hashes); the int16 coefficients times their scale equal the float ones
 within half a quantisation step; positions identical to the bake's mesh
 (vdsh-bake --export-obj). A missing input fails with exit 1, naming it,
-and leaves no output.
+and leaves no output. --compress: decoded by npm meshoptimizer, the
+coefficients and triangles bit-exact. --source: BoxTextured (.glb refined,
+.gltf with external files) and 2CylinderEngine (82 nodes, 34 materials)
+keep nodes, materials, textures and attribute values, every vertex
+matched; all validator-clean.
 """
 import json
 import math

@@ -10,7 +10,9 @@
  * default lights in free space, interior or object) in extras.vdsh.view,
  * so that the web viewer (runtime/web) starts where vdsh-view does.
  *
- *     vdsh-export scene.vdsh -o scene.glb [--orders 2,3,5] [--float] [-q]
+ *     vdsh-export scene.vdsh -o scene.glb [--orders 2,3,5] [--float] [--compress] [-q]
+ *     vdsh-export scene.vdsh --source scene.gltf -o scene.glb   (the source's own scene:
+ *         vdsh_export_source.h; formats/GLTF.md)
  *
  * Errors: a message naming the file and the problem on stderr, exit 1 (2
  * for a usage error); the output is written atomically
