@@ -528,6 +528,102 @@ int vdsh_view_free_space(const vdsh_view_tracer *t, const float p[3], float diag
     return vdsh_free_space(dist, back, vdsh_free_clearance(diagonal));
 }
 
+/* ---- what a light lights in the default frame ------------------------- */
+
+/* The check frame's surface points: first hits, normals turned toward
+ * the eye. */
+typedef struct frame_pts {
+    uint32_t n, pixels;
+    float (*p)[3];
+    float (*nrm)[3];
+} frame_pts;
+
+static int frame_points(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
+                        const vdsh_camera *c, int width, int height, frame_pts *out)
+{
+    size_t pixels = (size_t)width * (size_t)height;
+    out->n = 0;
+    out->pixels = (uint32_t)pixels;
+    out->p = malloc(pixels * sizeof *out->p + 1);
+    out->nrm = malloc(pixels * sizeof *out->nrm + 1);
+    if (!out->p || !out->nrm) {
+        free(out->p);
+        free(out->nrm);
+        out->p = out->nrm = NULL;
+        return 0;
+    }
+    for (int y = 0; y < height; y++)
+        for (int x = 0; x < width; x++) {
+            float o[3], d[3];
+            vdsh_view_hit h;
+            vdsh_camera_ray(c, width, height, x, y, o, d);
+            if (!vdsh_view_trace(t, o, d, 0.0f, &h))
+                continue;
+            const uint32_t *tri = m->indices + 3 * (size_t)h.triangle;
+            const float *na = m->normals + 3 * (size_t)tri[0],
+                        *nb = m->normals + 3 * (size_t)tri[1],
+                        *nc = m->normals + 3 * (size_t)tri[2];
+            float n[3], dot = 0.0f;
+            for (int k = 0; k < 3; k++) {
+                n[k] = (1.0f - h.u - h.v) * na[k] + h.u * nb[k] + h.v * nc[k];
+                dot += n[k] * d[k];
+            }
+            float *p = out->p[out->n], *q = out->nrm[out->n];
+            for (int k = 0; k < 3; k++) {
+                p[k] = o[k] + h.t * d[k];
+                q[k] = dot > 0.0f ? -n[k] : n[k];
+            }
+            out->n++;
+        }
+    return 1;
+}
+
+static void frame_free(frame_pts *f)
+{
+    free(f->p);
+    free(f->nrm);
+    f->p = f->nrm = NULL;
+}
+
+static void shares_of(const vdsh_view_tracer *t, const frame_pts *f, const float L[3],
+                      float diagonal, float *lit, float *shadowed)
+{
+    const float eps = 1e-4f * diagonal;
+    uint32_t a = 0, b = 0;
+    for (uint32_t i = 0; i < f->n; i++) {
+        const float *p = f->p[i], *n = f->nrm[i];
+        float d[3] = {L[0] - p[0], L[1] - p[1], L[2] - p[2]};
+        if (n[0] * d[0] + n[1] * d[1] + n[2] * d[2] <= 0.0f)
+            continue;
+        float dist = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (!(dist > 2.0f * eps)) {
+            a++;
+            continue;
+        }
+        for (int k = 0; k < 3; k++)
+            d[k] /= dist;
+        vdsh_view_hit h;
+        if (vdsh_view_trace(t, p, d, eps, &h) && h.t < dist - eps)
+            b++;
+        else
+            a++;
+    }
+    *lit = f->pixels ? (float)a / (float)f->pixels : 0.0f;
+    *shadowed = f->pixels ? (float)b / (float)f->pixels : 0.0f;
+}
+
+void vdsh_view_light_shares(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
+                            const vdsh_camera *c, int width, int height, const float light[3],
+                            float diagonal, float *lit, float *shadowed)
+{
+    frame_pts f;
+    *lit = *shadowed = 0.0f;
+    if (width <= 0 || height <= 0 || !frame_points(t, m, c, width, height, &f))
+        return;
+    shares_of(t, &f, light, diagonal, lit, shadowed);
+    frame_free(&f);
+}
+
 /* ---- default lights in free space ------------------------------------ */
 
 /* The 26 directions toward a cube's faces, edges and corners, unit. */
@@ -624,6 +720,92 @@ static int find_free(const vdsh_view_tracer *t, const float p0[3], const float l
     return found;
 }
 
+/* The frame rule (vdsh_view_compute): an interior's lights, found in
+ * free space near the preferred positions, replaced where they do not
+ * light what the camera sees. */
+typedef struct scored {
+    float p[3];
+    float lit, sh;
+    int free, pref;              /* pref: the preferred light's index, or -1 */
+} scored;
+
+/* A light lights the frame when it lights its share of it, and more
+ * than it shadows (a light behind a wall, seen through a door, shadows
+ * most of the frame). 0: a preferred light that lights the frame (kept:
+ * the room's own lights, shadows or not); 1: a seeded one that lights it
+ * and shadows the share; 2: one that lights it; 3: the rest. */
+static int tier(const scored *c)
+{
+    int lights = c->lit >= VDSH_VIEW_MIN_SHARE && c->lit >= c->sh;
+    if (c->pref >= 0)
+        return lights ? 0 : 3;
+    return lights && c->sh >= VDSH_VIEW_MIN_SHARE ? 1 : lights ? 2 : 3;
+}
+
+static vdsh_result choose_lights(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
+                                 vdsh_view *v, float diag)
+{
+    frame_pts f;
+    if (!frame_points(t, m, &v->camera, VDSH_VIEW_CHECK_W, VDSH_VIEW_CHECK_H, &f))
+        return VDSH_ERR_OUT_OF_MEMORY;
+    scored c[VDSH_VIEW_MAX_LIGHTS + VDSH_VIEW_LIGHT_POOL];
+    int n = 0, good = 0;
+    for (int i = 0; i < v->light_count; i++, n++) {
+        memcpy(c[n].p, v->lights[i], sizeof c[n].p);
+        c[n].free = v->light_free[i], c[n].pref = i;
+        shares_of(t, &f, c[n].p, diag, &c[n].lit, &c[n].sh);
+        good += tier(&c[n]) == 0;
+    }
+    /* Too few light the frame: seeded candidates in free space, until enough do. */
+    for (uint32_t k = 0; good < v->light_count && k < VDSH_VIEW_LIGHT_POOL; k++) {
+        float p[3];
+        vdsh_light_candidate(v->bounds_min, v->bounds_max, 2, k, p);
+        v->pool_tried++;
+        if (!vdsh_view_free_space(t, p, diag))
+            continue;
+        memcpy(c[n].p, p, sizeof p);
+        c[n].free = 1, c[n].pref = -1;
+        shares_of(t, &f, p, diag, &c[n].lit, &c[n].sh);
+        good += tier(&c[n]) == 1;
+        n++;
+    }
+    frame_free(&f);
+    /* Tiers in candidate order; the last by the share lit (a stable
+     * selection: ties keep the earlier). */
+    uint8_t taken[VDSH_VIEW_MAX_LIGHTS + VDSH_VIEW_LIGHT_POOL] = {0};
+    vdsh_view out = *v;
+    int k = 0;
+    for (int tr = 0; tr < 3; tr++)
+        for (int i = 0; i < n && k < v->light_count; i++)
+            if (!taken[i] && tier(&c[i]) == tr) {
+                taken[i] = 1;
+                memcpy(out.lights[k], c[i].p, sizeof c[i].p);
+                out.light_free[k] = c[i].free;
+                out.light_lit[k] = c[i].lit, out.light_shadowed[k] = c[i].sh;
+                if (c[i].pref >= 0)
+                    memcpy(out.preferred[k], v->preferred[c[i].pref], sizeof out.preferred[k]);
+                else
+                    memcpy(out.preferred[k], c[i].p, sizeof out.preferred[k]);
+                k++;
+            }
+    for (; k < v->light_count; k++) {
+        int best = -1;
+        for (int i = 0; i < n; i++)
+            if (!taken[i] && (best < 0 || c[i].lit > c[best].lit))
+                best = i;
+        taken[best] = 1;
+        memcpy(out.lights[k], c[best].p, sizeof c[best].p);
+        out.light_free[k] = c[best].free;
+        out.light_lit[k] = c[best].lit, out.light_shadowed[k] = c[best].sh;
+        if (c[best].pref >= 0)
+            memcpy(out.preferred[k], v->preferred[c[best].pref], sizeof out.preferred[k]);
+        else
+            memcpy(out.preferred[k], c[best].p, sizeof out.preferred[k]);
+    }
+    *v = out;
+    return VDSH_OK;
+}
+
 vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_error *err)
 {
     vdsh_view_tracer *t = NULL;
@@ -652,6 +834,10 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
             find_free(t, v.preferred[i], lo, hi, v.interior, diag, &v.light_trials, v.lights[i]);
         if (!v.light_free[i])
             memcpy(v.lights[i], v.preferred[i], sizeof v.lights[i]);
+    }
+    if (v.interior && choose_lights(t, m, &v, diag) != VDSH_OK) {
+        vdsh_view_tracer_destroy(t);
+        return fail(err, VDSH_ERR_OUT_OF_MEMORY, "out of memory for the default lights");
     }
     vdsh_view_tracer_destroy(t);
     *out = v;

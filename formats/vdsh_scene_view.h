@@ -70,6 +70,15 @@ extern "C" {
 #define VDSH_VIEW_RAYS 128
 #define VDSH_VIEW_INTERIOR_SHARE 0.6f
 #define VDSH_VIEW_MAX_LIGHTS 4
+/* The frame rule for an interior's default lights (vdsh-frames' view-set
+ * rule, bake/eval/frames.h): each lights at least this share of a
+ * VDSH_VIEW_CHECK_W x VDSH_VIEW_CHECK_H frame of the default camera and
+ * shadows as many; up to VDSH_VIEW_LIGHT_POOL seeded candidates in free
+ * space are tried when the preferred lights do not. */
+#define VDSH_VIEW_MIN_SHARE 0.05f
+#define VDSH_VIEW_CHECK_W 64
+#define VDSH_VIEW_CHECK_H 48
+#define VDSH_VIEW_LIGHT_POOL 64
 
 typedef struct vdsh_view_mesh {
     const float *positions;      /* vertex_count x 3 */
@@ -87,12 +96,19 @@ typedef struct vdsh_view {
     vdsh_camera camera;          /* the default camera: room or fit */
     int light_count;             /* VDSH_VIEW_MAX_LIGHTS */
     float lights[VDSH_VIEW_MAX_LIGHTS][3];     /* default light positions */
-    float preferred[VDSH_VIEW_MAX_LIGHTS][3];  /* before any move */
+    /* before any move (a light the frame rule took from the seeded
+     * candidates: that candidate) */
+    float preferred[VDSH_VIEW_MAX_LIGHTS][3];
     /* 1: lights[i] is in free space (moved there when preferred[i] was
      * not); 0: no position searched was (a scene without free space), and
      * lights[i] is preferred[i]. */
     int light_free[VDSH_VIEW_MAX_LIGHTS];
     uint32_t light_trials;       /* positions tested for free space */
+    /* An interior's lights in the check frame (vdsh_view_light_shares):
+     * shares of its pixels lit and shadowed; 0 for an object's. */
+    float light_lit[VDSH_VIEW_MAX_LIGHTS];
+    float light_shadowed[VDSH_VIEW_MAX_LIGHTS];
+    uint32_t pool_tried;         /* seeded candidates the frame rule tried */
 } vdsh_view;
 
 /* Everything above from the mesh: bounds, the interior test, the default
@@ -103,8 +119,19 @@ typedef struct vdsh_view {
  * a cube's faces, edges and corners in a fixed order; an interior's
  * candidates must lie inside its bounds. The first in free space is the
  * light. If none is, the first 4096 candidates of vdsh_light_candidate
- * (seed 1) are tried, nearest first. Deterministic: the same mesh gives
- * the same view on every machine. */
+ * (seed 1) are tried, nearest first.
+ * Then an interior's lights must light what the camera sees (a room
+ * behind an internal wall is free space too): each light so found is
+ * scored in the check frame (vdsh_view_light_shares) and kept when it
+ * lights it: at least VDSH_VIEW_MIN_SHARE of it, and more than it
+ * shadows (a light behind a wall seen through a door shadows most). When fewer are kept, the candidates
+ * of vdsh_light_candidate (seed 2) in the bounds that are in free space
+ * are scored, up to VDSH_VIEW_LIGHT_POOL of them or until enough light
+ * and shadow that share each; the lights are, in this order: the kept
+ * ones, the candidates that light the frame and shadow the share, those
+ * that light it, then the rest by the share they light (ties: the earlier). Where
+ * every preferred light lights the frame, nothing changes. Deterministic: the same mesh
+ * gives the same view on every machine. */
 vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_error *err);
 
 /* The bounding box of positions (vertex_count x 3), fminf / fmaxf per
@@ -162,6 +189,16 @@ float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
 /* vdsh_free_space (vdsh_light.h) at p, its probes cast against the mesh,
  * clearance from `diagonal`; back faces by winding. */
 int vdsh_view_free_space(const vdsh_view_tracer *t, const float p[3], float diagonal);
+
+/* The shares of a width x height frame of camera c whose pixels a point
+ * light at `light` lights and shadows: a pixel's first hit, its
+ * interpolated normal turned toward the eye, faces the light (N . (L - p)
+ * > 0); it is shadowed when a surface lies between it and the light
+ * (farther than 1e-4 of `diagonal` from both), lit otherwise. Pixels that
+ * see nothing or face away count as neither. */
+void vdsh_view_light_shares(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
+                            const vdsh_camera *c, int width, int height, const float light[3],
+                            float diagonal, float *lit, float *shadowed);
 
 #ifdef __cplusplus
 }

@@ -14,6 +14,10 @@
  *     object   a sphere is framed from outside, lit from outside it
  *     none     a scene with no free space keeps the preferred lights and
  *              says they are not free
+ *     two-rooms  an internal wall with a door, the camera in one room:
+ *              every default light lights the frame (light 0 from the
+ *              camera's room, lighting a quarter and shadowing some);
+ *              the preferred light 0, behind the wall, does not
  *     errors   an index out of range: VDSH_ERR_INVALID, output untouched
  *   test_scene_view room ROOM.vdsh
  *     the built-in room baked (a CTest fixture): the room camera; every
@@ -381,6 +385,95 @@ static void test_none(void)
     printf("none: %u positions tried\n", v.light_trials);
 }
 
+/* The share of a w x h frame of camera c lit and shadowed by a light at
+ * L, every ray cast at every triangle (vdsh_view_light_shares' rule). */
+static void shares_all(const vdsh_view_mesh *m, const vdsh_camera *c, int w, int h,
+                       const float L[3], float diag, float *lit, float *shadowed)
+{
+    int a = 0, b = 0;
+    float eps = 1e-4f * diag;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            float o[3], d[3], n[3], p[3], l[3];
+            vdsh_view_hit hit;
+            vdsh_camera_ray(c, w, h, x, y, o, d);
+            if (!vdsh_view_trace_all(m, o, d, 0.0f, &hit))
+                continue;
+            const uint32_t *t = m->indices + 3 * (size_t)hit.triangle;
+            float dot = 0.0f, facing = 0.0f, dist = 0.0f;
+            for (int k = 0; k < 3; k++) {
+                n[k] = (1.0f - hit.u - hit.v) * m->normals[3 * t[0] + k] +
+                       hit.u * m->normals[3 * t[1] + k] + hit.v * m->normals[3 * t[2] + k];
+                dot += n[k] * d[k];
+                p[k] = o[k] + hit.t * d[k];
+                l[k] = L[k] - p[k];
+                dist += l[k] * l[k];
+            }
+            for (int k = 0; k < 3; k++)
+                facing += (dot > 0.0f ? -n[k] : n[k]) * l[k];
+            if (facing <= 0.0f)
+                continue;
+            dist = sqrtf(dist);
+            for (int k = 0; k < 3; k++)
+                l[k] /= dist;
+            vdsh_view_hit sh;
+            if (vdsh_view_trace_all(m, p, l, eps, &sh) && sh.t < dist - eps)
+                b++;
+            else
+                a++;
+        }
+    *lit = (float)a / (float)(w * h);
+    *shadowed = (float)b / (float)(w * h);
+}
+
+/* Two rooms, 20 x 4 x 8, split at x = 12 by a wall 0.4 thick with a door
+ * (z 0.4..1.4, 2.2 high), a crate in the camera's room (x > 12: the room
+ * camera stands at 36% of the length past the middle). The preferred
+ * light 0 (42% of the length) is in the other room, in free space, and
+ * lights what the camera sees through the door only: the first picture
+ * was the wall and a dark floor. Every default light must light the frame,
+ * light 0 from the camera's room, and shadow part of it (the crate). */
+static void test_two_rooms(void)
+{
+    memset(&M, 0, sizeof M);
+    box(&M, (float[3]){0, 0, 0}, (float[3]){20, 4, 8}, 1);
+    box(&M, (float[3]){11.8f, 0, 0}, (float[3]){12.2f, 4, 0.4f}, 0);
+    box(&M, (float[3]){11.8f, 0, 1.4f}, (float[3]){12.2f, 4, 8}, 0);
+    box(&M, (float[3]){11.8f, 2.2f, 0.4f}, (float[3]){12.2f, 4, 1.4f}, 0);
+    box(&M, (float[3]){14, 0, 2}, (float[3]){15, 1, 3}, 0);
+    vdsh_view_mesh m = view_mesh(&M);
+    vdsh_view v;
+    vdsh_error err;
+    CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
+    CHECK(v.interior, "two rooms: not an interior (front share %g)", (double)v.front_share);
+    CHECK(v.camera.eye[0] > 12.2f, "the camera is not in the second room (x %g)",
+          (double)v.camera.eye[0]);
+    float diag = diagonal_of(v.bounds_min, v.bounds_max);
+    /* the case: the preferred light 0 is free, behind the wall */
+    float pref[VDSH_VIEW_MAX_LIGHTS][3], lit, sh;
+    vdsh_view_preferred_lights(v.bounds_min, v.bounds_max, 1, pref, VDSH_VIEW_MAX_LIGHTS);
+    shares_all(&m, &v.camera, 32, 24, pref[0], diag, &lit, &sh);
+    printf("two rooms: preferred light 0 (%g, %g, %g) lights %.1f%%, shadows %.1f%%\n",
+           pref[0][0], pref[0][1], pref[0][2], 100.0 * lit, 100.0 * sh);
+    CHECK(pref[0][0] < 11.8f && free_all(&m, pref[0], diag) && lit < sh,
+          "the test has lost its case: preferred light 0 at x %g, lights %g",
+          (double)pref[0][0], (double)lit);
+    for (int i = 0; i < v.light_count; i++) {
+        shares_all(&m, &v.camera, 32, 24, v.lights[i], diag, &lit, &sh);
+        printf("two rooms: light %d (%g, %g, %g) lights %.1f%%, shadows %.1f%% (check frame "
+               "%.1f%%, %.1f%%)\n", i, v.lights[i][0], v.lights[i][1], v.lights[i][2],
+               100.0 * lit, 100.0 * sh, 100.0 * v.light_lit[i], 100.0 * v.light_shadowed[i]);
+        CHECK(v.light_free[i] && free_all(&m, v.lights[i], diag), "light %d is not free", i);
+        CHECK(lit >= VDSH_VIEW_MIN_SHARE && lit >= sh && v.light_lit[i] >= VDSH_VIEW_MIN_SHARE,
+              "light %d lights %g of the frame and shadows %g", i, (double)lit, (double)sh);
+    }
+    CHECK(v.lights[0][0] > 12.2f, "light 0 is not in the camera's room (x %g)",
+          (double)v.lights[0][0]);
+    shares_all(&m, &v.camera, 32, 24, v.lights[0], diag, &lit, &sh);
+    CHECK(lit >= 0.25f && sh > 0.0f, "light 0 lights %g and shadows %g of the frame",
+          (double)lit, (double)sh);
+}
+
 static void test_errors(void)
 {
     memset(&M, 0, sizeof M);
@@ -500,6 +593,7 @@ int main(int argc, char **argv)
     test_room();
     test_object();
     test_none();
+    test_two_rooms();
     test_errors();
     return test_report("scene_view");
 }
