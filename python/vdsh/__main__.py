@@ -54,8 +54,17 @@ def summary(f: VdshFile, path: str) -> Dict[str, Any]:
         if s["coef_scales"] is not None:
             o["coef_scales"] = [float(x) for x in s["coef_scales"]]
         if s["variable_order"]:
-            o["vertices_per_order"] = [int(x) for x in
-                                       np.bincount(s["orders"], minlength=s["order"] + 1)[1:]]
+            # as vdsh_stream_size_of: records padded to 4 bytes, after the
+            # order table (rows padded to 16)
+            per = np.bincount(s["orders"], minlength=s["order"] + 1)
+            rec = [(_bytes_per_vertex(dict(s, order=k)) + 3) // 4 * 4
+                   for k in range(s["order"] + 1)]
+            rows = len(s["orders"])
+            o["bytes_per_vertex"] = 0
+            o["mean_bytes_per_vertex"] = ((rows + 15) // 16 * 16 + sum(
+                int(n) * r for n, r in zip(per, rec))) / rows
+            o["max_bytes_per_vertex"] = max(r for n, r in zip(per, rec) if n)
+            o["vertices_per_order"] = [int(x) for x in per[1:]]
         streams.append(o)
     p = f.positions
     return dict(
@@ -72,8 +81,8 @@ def summary(f: VdshFile, path: str) -> Dict[str, Any]:
                   occluder_triangle_count=h["occluder_triangle_count"],
                   occluder_bounds=dict(min=[float(x) for x in h["bounds_min"]],
                                        max=[float(x) for x in h["bounds_max"]])),
-        sources=f.sources, streams=streams, stats=f.stats, timings=f.timings, part=f.part,
-        adaptive=f.adaptive)
+        sources=f.sources, streams=streams, stats=f.stats, timings=f.timings,
+        **{k: v for k, v in (("part", f.part), ("adaptive", f.adaptive)) if v is not None})
 
 
 def _text(d: Dict[str, Any]) -> str:
@@ -107,7 +116,7 @@ def _text(d: Dict[str, Any]) -> str:
         st = d["stats"]
         lines.append("  stats        rays traced %d, missed %d" % (st["rays_traced"],
                                                                  st["rays_missed"]))
-    if d["part"]:
+    if d.get("part"):
         pt = d["part"]
         lines.append("  part         %d of %d, receivers %d..%d" % (
             pt["index"], pt["count"], pt["range_begin"], pt["range_end"]))
