@@ -297,8 +297,12 @@ def compare(d_vis: ArrayLike, d_light: ArrayLike, compare: str = "smooth") -> np
             s = np.where(dv >= dl, _F(1), _F(0))
         else:
             x = RAMP_SLOPE * (dv / np.where(dl > 0, dl, _F(1))) - RAMP_OFFSET
-            s = np.where(x > 0, np.where(x < 1, x, _F(1)), _F(0))
-            s = np.where(np.isposinf(dv), _F(1), s)
+            s = np.fmin(np.fmax(x, _F(0)), _F(1))  # fmax: NaN gives 0, as vdsh_ramp
+            inf = np.isposinf(dv)
+            if inf.any():
+                s = np.where(inf, _F(1), s)
+    if (dl > 0).all():
+        return s.astype(np.float32, copy=False)
     return np.where(dl > 0, s, np.where(dl == 0, _F(1), _F(0))).astype(np.float32)
 
 
