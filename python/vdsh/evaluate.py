@@ -5,9 +5,10 @@ Every function here computes in float32 with the operations of the C path
 in the same order (formats/vdsh_sh.c: the closed forms of bands 0-4 and
 the recurrence of bands 5-15; formats/vdsh_shadow.c: the sum, the
 quantity, the clamp to max_distance, the comparison), so results equal
-vdsh-eval's and the runtime's reference to the bit (exp is taken in
-float64 and rounded to float32, which is libm's expf but for rare ties:
-tests/test_python_eval.py counts them).
+vdsh-eval's and the runtime's reference to the bit, but for exp: taken in
+float64 and rounded to float32, it is glibc's expf but for about 1 value
+in 2,500, one unit in the last place apart (tests/test_python_eval.py
+counts them); numpy's own float32 exp differs in about a third.
 
     import vdsh
     f = vdsh.read("room.vdsh")
@@ -179,9 +180,9 @@ def _from_sum(quantity: str, max_distance: np.float32, s: np.ndarray) -> np.ndar
         if quantity == "distance2":
             d = np.where(s > 0, np.sqrt(np.where(s > 0, s, _F(0))), _F(0))
         elif quantity == "log-distance":
-            # in float64, then rounded: libm's expf is within 0.502 units in
-            # the last place of exp (correctly rounded but for rare ties);
-            # numpy's own float32 exp is off by one unit in a third of cases
+            # in float64, then rounded: glibc's expf is within 0.502 units
+            # in the last place, so this is its value but for about 1 in
+            # 2,500; numpy's own float32 exp differs in about a third
             d = np.exp(np.where(s < LOG_SUM_MAX, s, LOG_SUM_MAX).astype(np.float64))
             d = d.astype(np.float32)
         else:
