@@ -7,3 +7,19 @@ add_test(NAME python_reader
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_python_reader.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info> ${PROJECT_SOURCE_DIR}
                  ${CMAKE_CURRENT_BINARY_DIR}/python_reader)
+
+# python_eval       python/vdsh/evaluate.py (installed as above) against the
+#                   C library (formats/vdsh_sh.c, vdsh_shadow.c) through
+#                   test_python_eval_ref: the SH basis at orders 1-16, and
+#                   distances and shadows of thousands of vertex-light
+#                   pairs over orders 1-16, the adaptive order, every
+#                   encoding, every quantity, methods paper/lsq/shadow/
+#                   decision, log offsets; `python -m vdsh info` against
+#                   vdsh-info --json
+add_executable(test_python_eval_ref ${CMAKE_CURRENT_LIST_DIR}/test_python_eval_ref.c)
+target_link_libraries(test_python_eval_ref PRIVATE vdsh_format m)
+add_test(NAME python_eval
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_python_eval.py
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info>
+                 $<TARGET_FILE:test_python_eval_ref> ${PROJECT_SOURCE_DIR}
+                 ${CMAKE_CURRENT_BINARY_DIR}/python_eval)

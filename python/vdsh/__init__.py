@@ -16,14 +16,34 @@
                                        # dict tolerance, min_edge, max_receivers, lights,
                                        # max_rounds, start_receivers, rounds, candidates
 
+Evaluation, vectorised over vertices and lights (vdsh.evaluate; float32,
+the C library's numbers to the bit):
+
+    L = [[0, 3, 0], [2, 1, -4]]        # light positions, L x 3
+    d = vdsh.distances(f, s, L)        # V x L distances toward each light
+    v = vdsh.shadows(f, s, L)          # V x L visibility in [0, 1] (smooth ramp;
+                                       # compare_with="binary": 0 or 1)
+    t = vdsh.distances_toward(f, s, dirs, vertices=[0, 5])   # toward directions
+    y = vdsh.sh_eval(16, dirs)         # N x 256 basis, float32 as formats/vdsh_sh.c
+
+    python -m vdsh info FILE [--json OUT]     # vdsh-info's main figures
+
 Every reading rule of the spec is checked; numpy only.
 """
+from __future__ import annotations
+
+import os
 import struct
 import zlib
+from typing import Any, Dict, List, NoReturn, Optional, Union
 
 import numpy as np
 
-__all__ = ["VdshError", "VdshFile", "read", "coefficients", "sh_basis", "reconstruct"]
+from .evaluate import (compare, distances, distances_toward, sh_eval, shadows,  # noqa: F401
+                       vertex_orders)
+
+__all__ = ["VdshError", "VdshFile", "read", "parse", "coefficients", "sh_basis", "reconstruct",
+           "sh_eval", "distances", "distances_toward", "shadows", "compare", "vertex_orders"]
 __version__ = "0.1.0"
 
 MAGIC = b"VDSH\r\n\x1a\n"
@@ -41,14 +61,33 @@ class VdshError(Exception):
 
 
 class VdshFile:
-    def __init__(self):
+    """A .vdsh file as read: `header` (dict of HEAD's fields), `sources`
+    (list of dicts name, size, sha256), `streams` (list of dicts, one per
+    COEF chunk: order, encoding, method, method_id, quantity, window,
+    window_param, method_param, scale, quantity_param, stored, coef_scales,
+    levels, variable_order, orders), `positions`, `normals` (V x 3 float32),
+    `triangles` (T x 3 uint32), and the ancillary `stats`, `timings`,
+    `part`, `adaptive` (dicts, or None when the chunk is absent)."""
+
+    header: Dict[str, Any]
+    sources: List[Dict[str, Any]]
+    streams: List[Dict[str, Any]]
+    stats: Optional[Dict[str, int]]
+    timings: Optional[Dict[str, float]]
+    part: Optional[Dict[str, Any]]
+    adaptive: Optional[Dict[str, Any]]
+    positions: np.ndarray
+    normals: np.ndarray
+    triangles: np.ndarray
+
+    def __init__(self) -> None:
         self.header, self.sources, self.streams = {}, [], []
         self.stats = self.timings = self.part = self.adaptive = None
         self._coef = []  # COEF payloads, read once every chunk is (a part's size them)
         self.positions = self.normals = self.triangles = None
 
 
-def _fail(path, msg):
+def _fail(path: str, msg: str) -> NoReturn:
     raise VdshError("%s: %s" % (path, msg))
 
 
@@ -56,13 +95,19 @@ def _finite(*v):
     return all(np.isfinite(x) for x in v)
 
 
-def read(path):
+def read(path: Union[str, "os.PathLike[str]"]) -> VdshFile:
+    """Read and check a .vdsh file (every reading rule of formats/VDSH.md).
+
+    Returns a VdshFile. Raises VdshError, whose message names the file and
+    what is wrong, for a file that breaks a rule, and OSError when it
+    cannot be opened."""
     with open(path, "rb") as fh:
         data = fh.read()
     return parse(data, path)
 
 
-def parse(data, path="memory"):
+def parse(data: bytes, path: str = "memory") -> VdshFile:
+    """As `read`, from the file's bytes; `path` names it in messages."""
     n = len(data)
     if n < 32 or data[:8] != MAGIC:
         _fail(path, "not a .vdsh file (magic)")
@@ -358,7 +403,7 @@ def _coef(f, b, V, path):
                           variable_order=variable, orders=orders))
 
 
-def coefficients(stream):
+def coefficients(stream: Dict[str, Any]) -> np.ndarray:
     """V x n^2 float32 (a part's: its range's rows): stored value x scale (the window is already applied);
     s8, s8s6: stored value x step_i, step_i = float32(scale_i / levels_i),
     levels 127 (31 for s8s6's coefficients 4..) (as vdsh.c)."""
@@ -368,8 +413,9 @@ def coefficients(stream):
     return stream["stored"].astype(np.float32) * np.float32(stream["scale"])
 
 
-def sh_basis(order, dirs):
-    """N x order^2 real SH (VDSH.md, Conventions) at unit directions (N x 3)."""
+def sh_basis(order: int, dirs: Any) -> np.ndarray:
+    """N x order^2 real SH (VDSH.md, Conventions) at unit directions (N x 3),
+    in float64 (sh_eval: float32, as the C library computes them)."""
     d = np.asarray(dirs, np.float64).reshape(-1, 3)
     x, y, z = d[:, 0], d[:, 1], d[:, 2]
     out = np.zeros((len(d), order * order))
@@ -396,9 +442,11 @@ def sh_basis(order, dirs):
     return out
 
 
-def reconstruct(f, stream, vertex, dirs):
-    """Distances of one vertex toward unit directions (VDSH.md, Reconstruction rules).
-    In a part, only its range's vertices have coefficients."""
+def reconstruct(f: VdshFile, stream: Dict[str, Any], vertex: int, dirs: Any) -> np.ndarray:
+    """Distances (float64, N) of one vertex toward unit directions (N x 3),
+    VDSH.md's Reconstruction rules in float64. In a part, only its range's
+    vertices have coefficients. For many vertices, and the C library's
+    float32 numbers, use distances_toward (or distances, shadows)."""
     row = vertex - (f.part["range_begin"] if f.part else 0)
     if not 0 <= row < len(stream["stored"]):
         raise VdshError("vertex %d: not in the file's streams%s" % (
