@@ -23,10 +23,10 @@
 //
 //   import * as THREE from 'three';
 //   import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-//   import { loadVdshShaders, vdshMaterial } from './vdsh_three.js';
+//   import { loadVdshShaders, vdshInfo, vdshMaterial } from './vdsh_three.js';
 //   const shaders = await loadVdshShaders();
 //   const gltf = await new GLTFLoader().loadAsync('room.glb');
-//   gltf.scene.traverse((o) => { if (o.isMesh) vdshMaterial(o, shaders); });
+//   gltf.scene.traverse((o) => { if (o.isMesh && vdshInfo(o)) vdshMaterial(o, shaders); });
 //   scene.add(gltf.scene, new THREE.PointLight(0xffffff, 20));
 //
 // vdshMaterial(mesh, shaders, options) sets and returns mesh.material;
