@@ -159,7 +159,7 @@ int vr_buffer_stride(int order, vr_buf_kind kind);
  * returns order^2. */
 int vr_buffer_sequence(int order, int *out);
 
-/* The buffer path's vertex-stage GLSL (vr_glsl_buffer.c). */
+/* The buffer path's vertex-stage GLSL (shaders/vdsh_buffer.glsl). */
 extern const char vr_buffer_glsl[];
 extern const size_t vr_buffer_glsl_size;
 

@@ -36,6 +36,12 @@ _runtime_test(test_runtime_glsl)
 add_test(NAME runtime_glsl COMMAND test_runtime_glsl ${_rt_dir}/glsl)
 _runtime_props(runtime_glsl)
 
+# runtime/shaders/*.glsl embedded byte for byte, with the C definition's
+# constants and the documented interface (no GL).
+_runtime_test(test_runtime_shaders)
+target_include_directories(test_runtime_shaders PRIVATE ${PROJECT_BINARY_DIR}/runtime)
+add_test(NAME runtime_shaders COMMAND test_runtime_shaders ${PROJECT_SOURCE_DIR}/runtime/shaders)
+
 # A small bake of the built-in room for the tests below (0.2 s).
 add_test(NAME runtime_fixture_room
          COMMAND vdsh-bake builtin:room --max-edge 0.5 --rays 400 --method paper -q

@@ -1,6 +1,6 @@
 /*
  * test_runtime_buffer.c - VR_MODE_VDSH_BUFFER (runtime/vr_buffer.c,
- * vr_glsl_buffer.c) against the C evaluation, by rendering into a float
+ * shaders/vdsh_buffer.glsl) against the C evaluation, by rendering into a float
  * target and reading back:
  *
  *   vertex    a 64 x 48 lattice of receivers, one per pixel of an

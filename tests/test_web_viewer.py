@@ -77,6 +77,10 @@ csv = lambda v: ",".join("%g" % x for x in v)
 W, H = 320, 240
 for f in ("index.html", "vdsh_web.js"):
     shutil.copy(os.path.join(webdir, f), work)
+# The page's GLSL: runtime/shaders/ (vdsh_common.glsl, vdsh_buffer.glsl),
+# found in shaders/ beside the page.
+shutil.rmtree(os.path.join(work, "shaders"), ignore_errors=True)
+shutil.copytree(os.path.join(webdir, "..", "shaders"), os.path.join(work, "shaders"))
 
 
 CHROME = [chromium, "--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",

@@ -1,6 +1,10 @@
 // vdsh_web.js - a raw WebGL2 viewer of a glb written by vdsh-export
 // (formats/GLTF.md): the receiver mesh lit by point lights with VDSH
-// shadows, by the C runtime's shadow rule (runtime/vr_glsl.c):
+// shadows, by the C runtime's shadow rule and with its GLSL functions
+// (runtime/shaders/vdsh_common.glsl and vdsh_buffer.glsl, loaded from
+// shaders/ beside the page or ../shaders/, or shaders=URL). vdsh-view's
+// shading (Lambert, its lights) so that its default picture is vdsh-view's;
+// a three.js scene uses vdsh_three.js instead (three.html):
 //   log-distance streams (any order): per vertex the whole SH sum toward
 //     each light, d = min(exp(min(sum, 80)), max_distance), interpolated;
 //     per fragment visibility = compare(d, |light - fragment|);
@@ -11,7 +15,7 @@
 // Orders 2, 3 and 5 read their coefficients as vertex attributes. Every
 // other order (1, 4, 6-16) and a stream with an order per vertex
 // (vdsh-bake --adaptive-order) take the buffer path, as vdsh-view's bufN
-// and adaptive modes do (runtime/vr_glsl_buffer.c): each vertex's
+// and adaptive modes do (runtime/shaders/vdsh_buffer.glsl): each vertex's
 // coefficients in a float texture, read front to back in the vertex stage
 // and summed by the associated-Legendre recurrence for any order, then the
 // distance path above for every quantity. (WebGL2 vertex attributes stop
@@ -41,6 +45,7 @@
 // the adaptive stream, else the highest order), path=buffer (the buffer
 // path for orders 2, 3, 5 too: vdsh-view's bufN), eye=x,y,z, target=x,y,z,
 // up=x,y,z, fov=DEG, light=x,y,z (repeatable, as light=..&light=..),
+// shaders=URL (the folder of the shader files),
 // lights=N (default lights, 1..4, default 1), size=WxH (canvas size;
 // default the window), output=shadow (shadow factor of light 0 as grey,
 // white where no surface: vdsh-view's --views frames) or shaded (default:
@@ -52,14 +57,6 @@
 // ("error: ...") and in window.vdshError.
 'use strict';
 
-const SH = {
-  C00: 0.28209479177387814, C1: 0.4886025119029199, C2A: 1.0925484305920792,
-  C20: 0.31539156525252005, C22: 0.5462742152960396, C33: 0.5900435899266435,
-  C32: 2.890611442640554, C31: 0.4570457994644658, C30: 0.3731763325901154,
-  C32B: 1.445305721320277, C44: 2.5033429417967046, C43: 1.7701307697799304,
-  C42: 0.9461746957575601, C41: 0.6690465435572892, C40: 0.10578554691520431,
-  C42B: 0.47308734787878004, C44B: 0.6258357354491761,
-};
 const MAX_ORDER = 16;
 
 // A float as a GLSL literal that reads back as the same f32.
@@ -96,9 +93,11 @@ function bufferSequence(order) {
 }
 
 // cfg: order (attribute path), quantity (0 distance, 1 distance2, 2 log),
-// lights, output (0 shaded, 1 shadow), buffer ({order, texWidth} or null).
-function glsl(cfg) {
-  const consts = Object.entries(SH).map(([k, v]) => `const float ${k} = ${v.toPrecision(17)};`).join('\n');
+// lights, output (0 shaded, 1 shadow), buffer ({order, texWidth} or null);
+// shaders: the texts of runtime/shaders/vdsh_common.glsl (the SH sums,
+// vdsh_distance, vdsh_compare: the C runtime's own) and vdsh_buffer.glsl
+// (the buffer path's recurrence), loaded by loadShaders.
+function glsl(cfg, shaders) {
   const buffer = !!cfg.buffer;
   const order = buffer ? 0 : cfg.order;
   const groups = buffer ? 0 : Math.ceil(order * order / 4);
@@ -107,121 +106,41 @@ precision highp float;
 precision highp int;
 #define ORDER ${order}
 #define QUANTITY ${cfg.quantity}
+#define COMPARE 0
 #define NUM_LIGHTS ${cfg.lights}
 #define OUTPUT ${cfg.output}
 #define BUFFER ${buffer ? 1 : 0}
 #define DIST_PATH ${buffer || cfg.quantity === 2 ? 1 : 0}
-${consts}
-float vdsh_distance(float sum, float md) {
-#if QUANTITY == 1
-  float d = sum > 0.0 ? sqrt(sum) : 0.0;
-#elif QUANTITY == 2
-  float d = exp(min(sum, 80.0));
-#else
-  float d = sum > 0.0 ? sum : 0.0;
-#endif
-  return d > md ? md : d;
-}
-float vdsh_compare(float dv, float dl) {
-  if (!(dl > 0.0)) return 1.0;
-  if (isinf(dv) && dv > 0.0) return 1.0;
-  return clamp(1.5 * (dv / dl) - 0.5, 0.0, 1.0);
-}
+${shaders.common}
 `;
   let decl = '', sums = '';
   if (buffer) {
     const ks = ksTable(cfg.buffer.order);
-    decl = `
-#define TEX_W ${cfg.buffer.texWidth}
-uniform highp sampler2D u_coef;
-in uint a_record;  // the vertex's first texel
-in uint a_order;   // its order
+    // vdsh_buffer.glsl reads a_position, u_light_pos, u_scale (declared
+    // above it) and the record's first texel and order per vertex.
+    decl = `#define BUF_TEXTURE_2D 1
+#define BUF_TEX_WIDTH ${cfg.buffer.texWidth}
+#define BUF_KIND 0
+#define BUF_VARIABLE 1
+#define BUF_ORDER ${cfg.buffer.order}
 const float KS[${ks.length}] = float[${ks.length}](${Array.from(ks, flit).join(', ')});
-int b_texel;
-int b_j;
-vec4 b_cache;
-// The next coefficient of the record (index i), times K_l^m.
-float buf_next(int i) {
-  if (b_j == 4) {
-    b_cache = texelFetch(u_coef, ivec2(b_texel % TEX_W, b_texel / TEX_W), 0);
-    b_texel++;
-    b_j = 0;
-  }
-  float c = b_cache[b_j];
-  b_j++;
-  return KS[i] * c;
-}
-// runtime/vr_glsl_buffer.c's buffer_sums: the SH sum toward every light.
-void buffer_sums(out float sums[NUM_LIGHTS]) {
-  int k = int(a_order);
-  b_texel = int(a_record);
-  b_j = 4;
-  vec3 d[NUM_LIGHTS];
-  float cs[NUM_LIGHTS], sn[NUM_LIGHTS], pmm[NUM_LIGHTS], p0[NUM_LIGHTS], p1[NUM_LIGHTS];
-  for (int i = 0; i < NUM_LIGHTS; i++) {
-    vec3 lv = u_light_pos[i] - a_position;
-    float dl = length(lv);
-    d[i] = dl > 0.0 ? lv / dl : vec3(0.0, 0.0, 1.0);
-    cs[i] = 1.0; sn[i] = 0.0; pmm[i] = 1.0; p0[i] = 0.0; p1[i] = 0.0;
-    sums[i] = 0.0;
-  }
-  for (int m = 0; m < k; m++) {
-    if (m > 0)
-      for (int i = 0; i < NUM_LIGHTS; i++) {
-        float c = d[i].x * cs[i] - d[i].y * sn[i];
-        sn[i] = d[i].x * sn[i] + d[i].y * cs[i];
-        cs[i] = c;
-        pmm[i] *= -float(2 * m - 1);
-      }
-    for (int l = m; l < k; l++) {
-      int row = l * (l + 1);
-      float cp = buf_next(row + m);
-      float cn = m > 0 ? buf_next(row - m) : 0.0;
-      float a = float(2 * l - 1) / float(max(l - m, 1));
-      float b = float(l + m - 1) / float(max(l - m, 1));
-      for (int i = 0; i < NUM_LIGHTS; i++) {
-        float pl = l == m ? pmm[i]
-                 : l == m + 1 ? d[i].z * float(2 * m + 1) * pmm[i]
-                 : a * d[i].z * p1[i] - b * p0[i];
-        p0[i] = p1[i];
-        p1[i] = pl;
-        sums[i] += pl * (cp * cs[i] + cn * sn[i]);
-      }
-    }
-  }
-  for (int i = 0; i < NUM_LIGHTS; i++)
-    sums[i] *= u_scale;
-}
+${shaders.buffer}
 `;
     sums = `  float b_sum[NUM_LIGHTS];\n  buffer_sums(b_sum);\n`;
   } else {
     for (let g = 0; g < groups; g++) decl += `in vec4 a_c${g};\n`;
-    let coef = 'float c[28];\n';
-    for (let i = groups * 4; i < 28; i++) coef += `  c[${i}] = 0.0;\n`;
-    for (let g = 0; g < groups; g++)
-      for (let k = 0; k < 4; k++) coef += `  c[${4 * g + k}] = a_c${g}[${k}];\n`;
     decl += `
-float sh_sum(float c[28], vec3 d) {
-  float x = d.x, y = d.y, z = d.z, x2 = x * x, y2 = y * y, z2 = z * z;
-  float s = c[0] * C00 - c[1] * C1 * y + c[2] * C1 * z - c[3] * C1 * x;
-#if ORDER >= 3
-  s += c[4] * C2A * x * y - c[5] * C2A * y * z + c[6] * C20 * (3.0 * z2 - 1.0) - c[7] * C2A * x * z + c[8] * C22 * (x2 - y2);
+float sh_sum(vec3 d) {
+#if ORDER == 2
+  return sh_sum4(a_c0, d);
+#elif ORDER == 3
+  return sh_sum9(a_c0, a_c1, a_c2.x, d);
+#else
+  vec4 g[7] = vec4[7](${Array.from({ length: 7 }, (_, g) => (g < groups ? 'a_c' + g : 'vec4(0.0)')).join(', ')});
+  return vdsh_sh_sum25(g, d);
 #endif
-#if ORDER >= 4
-  s += -c[9] * C33 * y * (3.0 * x2 - y2) + c[10] * C32 * x * y * z - c[11] * C31 * y * (5.0 * z2 - 1.0)
-       + c[12] * C30 * z * (5.0 * z2 - 3.0) - c[13] * C31 * x * (5.0 * z2 - 1.0) + c[14] * C32B * z * (x2 - y2)
-       - c[15] * C33 * x * (x2 - 3.0 * y2);
-#endif
-#if ORDER >= 5
-  s += c[16] * C44 * x * y * (x2 - y2) - c[17] * C43 * y * z * (3.0 * x2 - y2) + c[18] * C42 * x * y * (7.0 * z2 - 1.0)
-       - c[19] * C41 * y * z * (7.0 * z2 - 3.0) + c[20] * C40 * (35.0 * z2 * z2 - 30.0 * z2 + 3.0)
-       - c[21] * C41 * x * z * (7.0 * z2 - 3.0) + c[22] * C42B * (x2 - y2) * (7.0 * z2 - 1.0)
-       - c[23] * C43 * x * z * (x2 - 3.0 * y2) + c[24] * C44B * (x2 * x2 - 6.0 * x2 * y2 + y2 * y2);
-#endif
-  return s;
 }
 `;
-    sums = '  ' + coef;
   }
   const vs = head + `
 in vec3 a_position;
@@ -245,7 +164,7 @@ ${sums}
 #if BUFFER
     float dv = dl > 0.0 ? vdsh_distance(b_sum[i], u_max_distance) : 0.0;
 #else
-    float dv = dl > 0.0 ? vdsh_distance(u_scale * sh_sum(c, lv / dl), u_max_distance) : 0.0;
+    float dv = dl > 0.0 ? vdsh_distance(u_scale * sh_sum(lv / dl), u_max_distance) : 0.0;
 #endif
 #if DIST_PATH
     v_val[i] = dv;
@@ -514,6 +433,23 @@ function load(url) {
   });
 }
 
+// The shader files (runtime/shaders/): from shaders=URL, else shaders/
+// beside the page, else ../shaders/ (the repository's layout).
+async function loadShaders(where) {
+  const text = (url) => load(url).then((b) => new TextDecoder().decode(b));
+  let last = null;
+  for (const dir of where ? [where.replace(/\/?$/, '/')] : ['shaders/', '../shaders/']) {
+    try {
+      const [common, buffer] = await Promise.all([text(dir + 'vdsh_common.glsl'), text(dir + 'vdsh_buffer.glsl')]);
+      return { common, buffer };
+    } catch (e) {
+      last = e;
+    }
+  }
+  throw new Error('the shader files (runtime/shaders/vdsh_common.glsl, vdsh_buffer.glsl) are not beside the page ' +
+    '(shaders/ or ../shaders/; or give shaders=URL): ' + last.message);
+}
+
 // The stream to draw: order=N, order=adaptive, or vdsh-view's default.
 function chooseStream(streams, want) {
   const fixed = (o) => streams.find((s) => s.order === o && !s.variable_order);
@@ -680,7 +616,7 @@ async function main() {
     }
     bufCfg = { order: N, texWidth: W, texHeight: H };
   }
-  const src = glsl({ order: stream.order, quantity, lights: lights.length, output, buffer: bufCfg });
+  const src = glsl({ order: stream.order, quantity, lights: lights.length, output, buffer: bufCfg }, await loadShaders(q.get('shaders')));
   const sh = (type, s) => {
     const o = gl.createShader(type);
     gl.shaderSource(o, s);

@@ -1,0 +1,189 @@
+/*
+ * vdsh_buffer.glsl - the vertex-stage code of the buffer path
+ * (VR_MODE_VDSH_BUFFER, vr.h; the web page's and vdsh_three.js's orders
+ * other than 2, 3, 5 and the adaptive order): a vertex's coefficients from
+ * a texture, its SH sum toward every light of the pass by the
+ * associated-Legendre recurrence, for any order. The C runtime puts it
+ * between its vertex stage's declarations and its main() (vr_glsl.c),
+ * which turns the sums into distances on the distance path like every
+ * other mode (vdsh_distance, interpolated, compared per fragment).
+ *
+ * Defines it reads (README.md here): BUFFER (1, else nothing is
+ * declared), NUM_LIGHTS, BUF_ORDER, BUF_KIND (0 f32, 1 f16: float texels;
+ * 2 s8: int texels; 3 s8s6: uint words), BUF_VARIABLE (1: attributes
+ * a_record, a_order per vertex; 0: record gl_VertexID * BUF_STRIDE of
+ * order BUF_ORDER), BUF_TEXTURE_2D (1: a 2D texture BUF_TEX_WIDTH texels
+ * wide, for GLSL ES; 0: a buffer texture), a table
+ * const float KS[BUF_ORDER * BUF_ORDER] (the K_l^m, times an s8 stream's
+ * steps) written before it, and BUF_RECEIVER, BUF_LIGHT(i), BUF_SCALE
+ * (default a_position, u_light_pos[i], u_scale).
+ *
+ * The recurrence is formats/vdsh_sh.c's eval_high_bands, step for step
+ * (the same convention as the closed forms of bands 0-4: Condon-Shortley
+ * phase, sin for m < 0, index l(l+1)+m): for each m, (x + iy)^m and
+ * P_m^m = -(2m - 1) P_{m-1}^{m-1}, then P_l^m from the two before it, the
+ * (1 - z^2)^(m/2) factor carried by (x + iy)^m. It runs over every band
+ * here, where the C evaluation uses its closed forms below band 5: the
+ * two agree to float rounding (tests/test_runtime_buffer.c measures it).
+ * The normalisations K_l^m (sqrt 2 folded in for m != 0), times an s8 or
+ * s8s6 stream's steps, come as a constant table per coefficient index,
+ * written into the source (KS, vr_buffer.c and vr_glsl.c: a program per
+ * table). Read from a uniform array instead, the lookups cost as much as
+ * the texel fetches on llvmpipe (its bounds-checked gathers; about 17 ms
+ * a frame of the paper-sized room at order 12), from the constant table
+ * about 4.
+ *
+ * The loops run m outside and l inside, and each light's recurrence state
+ * lives in small arrays, so that each coefficient is fetched (and for s8,
+ * s8s6 unpacked) once per vertex, not once per light; the record holds
+ * the coefficients in that very order (vr_buffer_sequence), so it is read
+ * front to back, a texel (four coefficients, or an s8s6 word's five) at a
+ * time (buf_next).
+ */
+#if BUFFER
+#ifndef BUF_TEXTURE_2D
+#define BUF_TEXTURE_2D 0
+#endif
+#if BUF_TEXTURE_2D
+/* WebGL2 (no buffer textures): the same texels, row by row, in a 2D
+ * texture BUF_TEX_WIDTH texels wide */
+#if BUF_KIND == 2
+uniform highp isampler2D u_coef;
+#elif BUF_KIND == 3
+uniform highp usampler2D u_coef;
+#else
+uniform highp sampler2D u_coef;
+#endif
+#define BUF_FETCH(t) texelFetch(u_coef, ivec2((t) % BUF_TEX_WIDTH, (t) / BUF_TEX_WIDTH), 0)
+#else
+#if BUF_KIND == 2
+uniform isamplerBuffer u_coef;
+#elif BUF_KIND == 3
+uniform usamplerBuffer u_coef;
+#else
+uniform samplerBuffer u_coef;
+#endif
+#define BUF_FETCH(t) texelFetch(u_coef, t)
+#endif
+/* What buffer_sums reads, unless the includer says otherwise: the
+ * receiver's position, light i's position (the bake's frame) and the
+ * stream's scale. */
+#ifndef BUF_RECEIVER
+#define BUF_RECEIVER a_position
+#endif
+#ifndef BUF_LIGHT
+#define BUF_LIGHT(i) u_light_pos[i]
+#endif
+#ifndef BUF_SCALE
+#define BUF_SCALE u_scale
+#endif
+#if BUF_VARIABLE
+layout(location = 9) in uint a_record;  /* the record's first texel */
+layout(location = 10) in uint a_order;  /* this vertex's order */
+#endif
+
+/* A reader of one record, front to back. */
+int b_texel;
+#if BUF_KIND == 3
+uint b_w0, b_w;   /* s8s6: word 0 (coefficients 0-3), the current word */
+int b_field;
+#else
+vec4 b_cache;
+int b_j;
+#endif
+
+void buf_begin(int first)
+{
+#if BUF_KIND == 3
+    b_w0 = BUF_FETCH(first).r;
+    b_texel = first + 1;
+    b_field = 5;
+#else
+    b_texel = first;
+    b_j = 4;
+#endif
+}
+
+/* The next coefficient, whose index is i, times KS[i]: K_l^m (and an
+ * s8, s8s6 stream's step), a constant table (vr_glsl.c). */
+float buf_next(int i)
+{
+    float ks = KS[i];
+#if BUF_KIND == 3
+    if (i < 4)
+        return ks * float(int(b_w0 << uint(24 - 8 * i)) >> 24);
+    if (b_field == 5) {
+        b_w = BUF_FETCH(b_texel).r;
+        b_texel++;
+        b_field = 0;
+    }
+    int q = int(b_w << uint(26 - 6 * b_field)) >> 26;
+    b_field++;
+    return ks * float(q);
+#else
+    if (b_j == 4) {
+        b_cache = vec4(BUF_FETCH(b_texel));
+        b_texel++;
+        b_j = 0;
+    }
+    float c = b_cache[b_j];
+    b_j++;
+    return ks * c;
+#endif
+}
+
+#if NUM_LIGHTS > 0
+/* sums[i]: the stream's SH sum toward light i (any direction for a
+ * light at the vertex: main() ignores it there). */
+void buffer_sums(out float sums[NUM_LIGHTS])
+{
+#if BUF_VARIABLE
+    int k = int(a_order);
+    buf_begin(int(a_record));
+#else
+    int k = BUF_ORDER;
+    buf_begin(gl_VertexID * BUF_STRIDE);
+#endif
+    vec3 d[NUM_LIGHTS];
+    float cs[NUM_LIGHTS], sn[NUM_LIGHTS], pmm[NUM_LIGHTS], p0[NUM_LIGHTS], p1[NUM_LIGHTS];
+    for (int i = 0; i < NUM_LIGHTS; i++) {
+        vec3 lv = BUF_LIGHT(i) - BUF_RECEIVER;
+        float dl = length(lv);
+        d[i] = dl > 0.0 ? lv / dl : vec3(0.0, 0.0, 1.0);
+        cs[i] = 1.0;
+        sn[i] = 0.0;
+        pmm[i] = 1.0;
+        p0[i] = 0.0;
+        p1[i] = 0.0;
+        sums[i] = 0.0;
+    }
+    for (int m = 0; m < k; m++) {
+        if (m > 0)   /* (x + iy)^m, and P_m^m = -(2m - 1) P_{m-1}^{m-1} */
+            for (int i = 0; i < NUM_LIGHTS; i++) {
+                float c = d[i].x * cs[i] - d[i].y * sn[i];
+                sn[i] = d[i].x * sn[i] + d[i].y * cs[i];
+                cs[i] = c;
+                pmm[i] *= -float(2 * m - 1);
+            }
+        for (int l = m; l < k; l++) {
+            int row = l * (l + 1);
+            float cp = buf_next(row + m);
+            float cn = m > 0 ? buf_next(row - m) : 0.0;
+            float a = float(2 * l - 1) / float(max(l - m, 1));
+            float b = float(l + m - 1) / float(max(l - m, 1));
+            for (int i = 0; i < NUM_LIGHTS; i++) {
+                /* P_l^m from P_{l-1}^m (p1) and P_{l-2}^m (p0) */
+                float pl = l == m ? pmm[i]
+                         : l == m + 1 ? d[i].z * float(2 * m + 1) * pmm[i]
+                         : a * d[i].z * p1[i] - b * p0[i];
+                p0[i] = p1[i];
+                p1[i] = pl;
+                sums[i] += pl * (cp * cs[i] + cn * sn[i]);
+            }
+        }
+    }
+    for (int i = 0; i < NUM_LIGHTS; i++)
+        sums[i] *= BUF_SCALE;
+}
+#endif
+#endif

@@ -1,0 +1,4 @@
+/* vr_depth.frag.glsl - the depth pass writes depth only. */
+void main()
+{
+}

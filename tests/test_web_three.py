@@ -1,0 +1,199 @@
+"""test_web_three.py BAKE EXPORT VIEW CHROMIUM RUNTIMEDIR WORKDIR NODE MODULES - the
+three.js module (runtime/web/vdsh_three.js) and the shader files in GLSL
+ES 3.00, in headless Chromium (WebGL2 on SwiftShader).
+
+three.js: builtin:room is baked (orders 2, 3, 5, 12 and an adaptive-order
+stream up to 12; log distance, the default), exported with vdsh-export,
+loaded by three.js's GLTFLoader in runtime/web/three.html (a three.js
+scene with its own PointLights, the material of vdsh_three.js on the
+loaded mesh, output=shadow: the visibility of the first point light as
+grey) and compared with vdsh-view --views' shadow frame of the same camera
+and light (vdsh2, vdsh3, vdsh5, buf12, adaptive): mean absolute difference
+below 2/255, and the C frame must hold shadows (so a page drawing no
+shadow cannot pass). Also:
+  - three lights in the three.js scene (light 0 first): light 0's
+    visibility against vdsh-view's frame of light 0 of the same light set
+    (order 5 and the buffer path at 12: the multi-light code);
+  - the paper method (distance, a linear quantity: the per-vertex
+    visibility path) at orders 2, 3, 5;
+  - the room as gltfpack writes it (KHR_mesh_quantization) and that
+    meshopt-compressed (EXT_meshopt_compression; tests/web_glb_pack.mjs),
+    order 5, against the same frame;
+  - the glTF scene moved: gltf.scene translated and given as `frame`, the
+    camera and light moved with it: the same frame.
+GLSL ES 3.00: runtime/shaders/es_check (this test's page es_check.html)
+compiles and links, as "#version 300 es" with a precision header, the C
+runtime's own programs from the same files (vdsh_common.glsl,
+vr_vertex.glsl, vdsh_buffer.glsl with BUF_TEXTURE_2D, vr_vertex_main.glsl,
+vr_fragment.glsl) for every path and 1 and 4 lights; every one must
+compile and link.
+The pages are served over HTTP (ES modules, fetch) from WORKDIR by a
+Python server on 127.0.0.1. Exit 77 without chromium, node's three.js
+(MODULES from scripts/npm_gltf_tools) or a GL context for vdsh-view.
+"""
+import functools
+import http.server
+import json
+import os
+import shutil
+import subprocess
+import sys
+import threading
+import urllib.parse
+
+import numpy as np
+from PIL import Image
+
+bake, export, view, chromium, rtdir, work, node, modules = sys.argv[1:9]
+if not shutil.which(chromium):
+    print("no chromium: skipped")
+    sys.exit(77)
+three = os.path.join(modules, "three")
+if not os.path.exists(os.path.join(three, "build", "three.module.js")):
+    print("no three.js in %s (scripts/npm_gltf_tools): skipped" % modules)
+    sys.exit(77)
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+shutil.copytree(os.path.join(rtdir, "web"), os.path.join(work, "web"))
+shutil.copytree(os.path.join(rtdir, "shaders"), os.path.join(work, "shaders"))
+os.symlink(os.path.abspath(three), os.path.join(work, "web", "three"))
+shutil.copy(os.path.join(os.path.dirname(os.path.abspath(__file__)), "es_check.html"), os.path.join(work, "web"))
+
+handler = functools.partial(http.server.SimpleHTTPRequestHandler, directory=work)
+handler.func.log_message = lambda *a: None
+server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+threading.Thread(target=server.serve_forever, daemon=True).start()
+base = "http://127.0.0.1:%d/web/" % server.server_address[1]
+
+CHROME = [chromium, "--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+          "--hide-scrollbars", "--force-device-scale-factor=1", "--window-size=800,600",
+          "--virtual-time-budget=30000"]
+W, H = 320, 240
+fail = []
+csv = lambda v: ",".join("%g" % x for x in v)
+
+
+def run(cmd):
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        print("FAIL: %s: rc %d\n%s" % (" ".join(cmd), p.returncode, p.stderr))
+        sys.exit(1)
+    return p
+
+
+def dom(url):
+    return subprocess.run(CHROME + ["--dump-dom", url], capture_output=True, text=True, timeout=300).stdout
+
+
+def shot(query, out):
+    if os.path.exists(out):
+        os.remove(out)
+    subprocess.run(CHROME + ["--screenshot=" + out, base + "three.html?" + query], capture_output=True,
+                   text=True, timeout=300)
+    return os.path.exists(out)
+
+
+def title_error(query):
+    import re
+    m = re.search(r"<title>(.*?)</title>", dom(base + "three.html?" + query), re.S)
+    return m.group(1) if m else "(no title)"
+
+
+def compare(label, png, ref, min_dark):
+    a = np.asarray(Image.open(png).convert("L"), float)[:H, :W] / 255
+    b = np.asarray(Image.open(ref)).astype(float) / 65535
+    diff = np.abs(a - b).mean() * 255
+    dark = (1 - b).mean()
+    print("%s: mean |three.js - C| = %.4f/255; mean shadow C %.2f%%, three.js %.2f%%"
+          % (label, diff, 100 * dark, 100 * (1 - a).mean()))
+    if dark < min_dark:
+        fail.append("%s: the C frame has too little shadow to compare" % label)
+    if not diff < 2.0:
+        fail.append("%s: mean abs difference %.3f/255 >= 2/255" % (label, diff))
+
+
+def frames(name, vd, eye, target, light_set, modes):
+    views = os.path.join(work, name + "-views.json")
+    json.dump({"width": W, "height": H, "views": [{"name": name, "eye": eye, "target": target, "up": [0, 1, 0],
+                                                   "fov_y": 60, "light_sets": [light_set]}]}, open(views, "w"))
+    p = subprocess.run([view, "-q", "--views", views, "--frames", os.path.join(work, "c"), "--modes",
+                        ",".join(modes), vd], capture_output=True, text=True)
+    if p.returncode != 0:
+        if "EGL" in p.stderr or "context" in p.stderr or "display" in p.stderr:
+            print("no GL context: skipped\n" + p.stderr)
+            sys.exit(77)
+        print("FAIL: vdsh-view: " + p.stderr)
+        sys.exit(1)
+    return lambda mode: os.path.join(work, "c", "%s-s0-l0-%s.png" % (name, mode))
+
+
+def check(label, glb, order, eye, target, lights, ref, min_dark, extra=""):
+    q = ("glb=../%s&order=%s&output=shadow&size=%dx%d&eye=%s&target=%s&up=0,1,0&fov=60%s%s"
+         % (glb, order, W, H, csv(eye), csv(target), "".join("&light=" + csv(l) for l in lights), extra))
+    png = os.path.join(work, "three-%s.png" % label.replace(" ", "-"))
+    if not shot(q, png):
+        fail.append("%s: no screenshot" % label)
+        return
+    t = title_error(q)
+    if not t.startswith("ready"):
+        fail.append("%s: the page says %r" % (label, t))
+        return
+    compare(label, png, ref, min_dark)
+
+
+eye, target, light = [7.5, 4.5, 8.0], [-2.0, 1.0, -2.0], [0.5, 1.2, 0.5]
+more = [[2.0, 1.5, -3.0], [-3.0, 2.0, 2.0]]
+
+# The room, log distance: the attribute path (2, 3, 5), the buffer path
+# (12, adaptive); one light, then three.
+vd, glb = os.path.join(work, "room.vdsh"), os.path.join(work, "room.glb")
+run([bake, "builtin:room", "-o", vd, "-q", "--orders", "2,3,5,12", "--max-edge", "0.5", "--rays", "256",
+     "--adaptive-order", "0.02", "--max-order", "12"])
+run([export, vd, "-o", glb])
+modes = [("2", "vdsh2"), ("3", "vdsh3"), ("5", "vdsh5"), ("12", "buf12"), ("adaptive", "adaptive")]
+ref = frames("room", vd, eye, target, [light], [m for _, m in modes])
+for order, mode in modes:
+    check("room order %s" % order, "room.glb", order, eye, target, [light], ref(mode),
+          0.0002 if order in ("2", "3") else 0.005)
+ref3 = frames("room3", vd, eye, target, [light] + more, ["vdsh5", "buf12"])
+for order, mode in (("5", "vdsh5"), ("12", "buf12")):
+    check("room order %s 3 lights" % order, "room.glb", order, eye, target, [light] + more, ref3(mode), 0.005)
+
+# A linear quantity (the paper's distance): per-vertex visibility.
+pvd, pglb = os.path.join(work, "paper.vdsh"), os.path.join(work, "paper.glb")
+run([bake, "builtin:room", "-o", pvd, "-q", "--orders", "2,3,5", "--max-edge", "0.5", "--rays", "256",
+     "--method", "paper"])
+run([export, pvd, "-o", pglb])
+pref = frames("paper", pvd, eye, target, [light], ["vdsh2", "vdsh3", "vdsh5"])
+for order in ("2", "3", "5"):
+    check("paper order %s" % order, "paper.glb", order, eye, target, [light], pref("vdsh" + order), 0.0002)
+
+# The scene moved in three.js: gltf.scene translated (frame=), the camera
+# and light with it.
+shift = [3.0, -1.0, 2.0]
+mv = lambda p: [p[k] + shift[k] for k in range(3)]
+check("room order 5 moved", "room.glb", "5", mv(eye), mv(target), [mv(light)], ref("vdsh5"), 0.005,
+      "&move=" + csv(shift))
+
+# Compressed: quantised, meshopt.
+pack = os.path.join(os.path.dirname(os.path.abspath(__file__)), "web_glb_pack.mjs")
+if node and os.path.exists(os.path.join(modules, "meshoptimizer", "meshopt_encoder.js")):
+    for how in ("quantise", "meshopt"):
+        run([node, pack, modules, glb, os.path.join(work, "room-%s.glb" % how), how])
+        check("room-%s order 5" % how, "room-%s.glb" % how, "5", eye, target, [light], ref("vdsh5"), 0.005)
+else:
+    fail.append("no node or meshoptimizer in %s for the compressed files" % modules)
+
+# GLSL ES 3.00: the C runtime's programs from the same files.
+import re
+d = dom(base + "es_check.html")
+m = re.search(r'<pre id="out">(.*?)</pre>', d, re.S)
+out = m.group(1).strip() if m else ""
+print("es_check: " + (out.splitlines()[-1] if out else "(no output)"))
+if not out.endswith("ok") or "FAIL" in out:
+    fail.append("GLSL ES 3.00 check: %s" % out[-3000:])
+
+server.shutdown()
+for f in fail:
+    print("FAIL:", f)
+sys.exit(1 if fail else 0)
