@@ -481,11 +481,60 @@ int vdsh_view_trace(const vdsh_view_tracer *g, const float org[3], const float d
 
 /* ---- the interior test and free space -------------------------------- */
 
+static float diagonal_of(const float lo[3], const float hi[3])
+{
+    float diag2 = 0.0f;
+    for (int k = 0; k < 3; k++)
+        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    return sqrtf(diag2) > 0.0f ? sqrtf(diag2) : 1.0f;
+}
+
+/* Of a 9 x 7 grid of the camera's rays, how many travel farther than a
+ * tenth of the diagonal before they meet a surface (or meet none). */
+static int open_rays(const vdsh_view_tracer *t, const vdsh_camera *c, float diag)
+{
+    int open = 0;
+    for (int y = 0; y < 7; y++)
+        for (int x = 0; x < 9; x++) {
+            float o[3], d[3];
+            vdsh_camera_ray(c, 9, 7, x, y, o, d);
+            vdsh_view_hit h;
+            open += !vdsh_view_trace(t, o, d, 0.0f, &h) || h.t > 0.1f * diag;
+        }
+    return open;
+}
+
+int vdsh_view_room_camera_free(const vdsh_view_tracer *t, const float lo[3], const float hi[3],
+                               vdsh_camera *out)
+{
+    vdsh_view_room_camera(lo, hi, out);
+    float diag = diagonal_of(lo, hi);
+    /* The standard eye, then higher (over a block on the floor, the
+     * Cornell box's), then across the room at the same heights; the
+     * target stays. */
+    static const float up[5] = {0.28f, 0.4f, 0.55f, 0.7f, 0.85f};
+    static const float across[3] = {0.0f, -0.3f, 0.3f};
+    int ax = hi[0] - lo[0] >= hi[2] - lo[2] ? 0 : 2, other = 2 - ax;
+    float e1 = hi[1] - lo[1], eo = hi[other] - lo[other], co = 0.5f * (lo[other] + hi[other]);
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 5; i++) {
+            vdsh_camera c = *out;
+            c.eye[1] = lo[1] + up[i] * e1;
+            c.eye[other] = co + (0.05f + across[j]) * eo;
+            if (vdsh_view_free_space(t, c.eye, diag) && open_rays(t, &c, diag) >= 48) {
+                int moved = i || j;
+                *out = c;
+                return moved;
+            }
+        }
+    return 0;
+}
+
 float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
                             const float lo[3], const float hi[3])
 {
     vdsh_camera room;
-    vdsh_view_room_camera(lo, hi, &room);
+    vdsh_view_room_camera_free(t, lo, hi, &room);
     float diag2 = 0.0f;
     for (int k = 0; k < 3; k++)
         diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
@@ -819,7 +868,7 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
     v.front_share = vdsh_view_front_share(t, m, lo, hi);
     v.interior = v.front_share >= VDSH_VIEW_INTERIOR_SHARE;
     if (v.interior)
-        vdsh_view_room_camera(lo, hi, &v.camera);
+        vdsh_view_room_camera_free(t, lo, hi, &v.camera);
     else
         vdsh_view_fit_camera(lo, hi, &v.camera);
 

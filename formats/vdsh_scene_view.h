@@ -179,8 +179,19 @@ int vdsh_view_trace(const vdsh_view_tracer *t, const float org[3], const float d
 int vdsh_view_trace_all(const vdsh_view_mesh *m, const float org[3], const float dir[3],
                         float tmin, vdsh_view_hit *hit);
 
+/* The room camera, its eye moved when it is not in free space or stands
+ * against a surface (fewer than 48 of a 9 x 7 grid of its rays travel a
+ * tenth of the diagonal: in front of the Cornell box's short block) to the
+ * first position of a fixed list that is free and open: higher (0.4,
+ * 0.55, 0.7, 0.85 of the height), then across the room (0.3 of its width
+ * to either side); the target stays. Returns 1 when the eye moved (0: the
+ * eye of vdsh_view_room_camera, also when no position of the list is). */
+int vdsh_view_room_camera_free(const vdsh_view_tracer *t, const float lo[3], const float hi[3],
+                               vdsh_camera *out);
+
 /* The share of VDSH_VIEW_RAYS directions (a Fibonacci sphere) from the
- * room camera's eye whose first hit farther than 1e-5 of the diagonal is
+ * room camera's eye (vdsh_view_room_camera_free) whose first hit farther
+ * than 1e-5 of the diagonal is
  * the front of a surface (the interpolated vertex normal against the
  * ray), 0..1. */
 float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m,

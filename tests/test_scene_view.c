@@ -18,6 +18,8 @@
  *              every default light lights the frame (light 0 from the
  *              camera's room, lighting a quarter and shadowing some);
  *              the preferred light 0, behind the wall, does not
+ *     blocked-eye  a block just in front of the room camera's eye: the
+ *              eye rises over it, in free space, its frame open
  *     errors   an index out of range: VDSH_ERR_INVALID, output untouched
  *   test_scene_view room ROOM.vdsh
  *     the built-in room baked (a CTest fixture): the room camera; every
@@ -474,6 +476,50 @@ static void test_two_rooms(void)
           (double)lit, (double)sh);
 }
 
+/* A block on the floor just in front of the room camera's eye (the
+ * Cornell box's short block): the eye is in free space, but most of its
+ * frame is the block's face. The eye moves up until the frame is open. */
+static void test_blocked_eye(void)
+{
+    memset(&M, 0, sizeof M);
+    const float lo[3] = {-1, 0, -1}, hi[3] = {1, 2, 1};
+    box(&M, lo, hi, 1);
+    vdsh_camera room;
+    vdsh_view_room_camera(lo, hi, &room);
+    /* Along z (the camera looks toward -z), the block's face 0.1 in front
+     * of the eye, as wide as the room's middle, 0.6 high. */
+    const float blo[3] = {-0.6f, 0.0f, room.eye[2] - 0.5f},
+                bhi[3] = {0.6f, 0.6f, room.eye[2] - 0.1f};
+    box(&M, blo, bhi, 0);
+    vdsh_view_mesh m = view_mesh(&M);
+    vdsh_view v;
+    vdsh_error err;
+    CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
+    CHECK(v.interior, "the blocked room is not an interior (front share %g)",
+          (double)v.front_share);
+    float diag = diagonal_of(v.bounds_min, v.bounds_max);
+    CHECK(free_all(&m, room.eye, diag), "the test is wrong: the standard eye is not free");
+    CHECK(v.camera.eye[1] > bhi[1], "the eye at height %g, not above the block (%g)",
+          (double)v.camera.eye[1], (double)bhi[1]);
+    CHECK(free_all(&m, v.camera.eye, diag), "the moved eye is not in free space");
+    /* Its frame: most rays travel a tenth of the diagonal (by the plain
+     * loop); the standard eye's do not. */
+    int open_std = 0, open_new = 0;
+    for (int y = 0; y < 7; y++)
+        for (int x = 0; x < 9; x++) {
+            float o[3], d[3];
+            vdsh_view_hit h;
+            vdsh_camera_ray(&room, 9, 7, x, y, o, d);
+            open_std += !vdsh_view_trace_all(&m, o, d, 0.0f, &h) || h.t > 0.1f * diag;
+            vdsh_camera_ray(&v.camera, 9, 7, x, y, o, d);
+            open_new += !vdsh_view_trace_all(&m, o, d, 0.0f, &h) || h.t > 0.1f * diag;
+        }
+    CHECK(open_std < 48, "the test is wrong: the standard eye sees %d of 63 open", open_std);
+    CHECK(open_new >= 48, "the moved eye sees %d of 63 rays open", open_new);
+    printf("blocked eye: moved to height %.2f, open rays %d -> %d of 63\n",
+           (double)v.camera.eye[1], open_std, open_new);
+}
+
 static void test_errors(void)
 {
     memset(&M, 0, sizeof M);
@@ -594,6 +640,7 @@ int main(int argc, char **argv)
     test_object();
     test_none();
     test_two_rooms();
+    test_blocked_eye();
     test_errors();
     return test_report("scene_view");
 }
