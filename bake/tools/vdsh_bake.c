@@ -473,6 +473,9 @@ static int write_report(const char *path, const options *o, const vb_job *job,
     vt_json_f32(&j, spc, "max_longest_edge", sp->max_edge);
     vt_json_f64(&j, spc, "long_area_share", sp->long_area);
     vt_json_bool(&j, spc, "far_apart", sp->far_apart);
+    /* The receivers as baked: their worst triangle (vb_mesh_worst_aspect:
+     * 1 equilateral, 1.73 right isosceles). */
+    vt_json_f64(&j, root, "worst_aspect", vb_mesh_worst_aspect(&job->receivers, NULL));
     if (o->adaptive) {
         cJSON *ad = vt_json_object(&j, root, "adaptive");
         vt_json_f32(&j, ad, "tolerance", o->adaptive_tol);
@@ -981,8 +984,9 @@ int main(int argc, char **argv)
     const vb_mesh *rec = &job.receivers;
     if (log && o.max_edge > 0.0f)
         fprintf(log, "vdsh-bake: receivers refined to max edge %g: %u vertices, "
-                     "%u triangles (%.2f s)\n",
-                (double)o.max_edge, rec->vertex_count, rec->triangle_count, job.timings.refine);
+                     "%u triangles, worst aspect ratio %.1f (%.2f s)\n",
+                (double)o.max_edge, rec->vertex_count, rec->triangle_count,
+                vb_mesh_worst_aspect(rec, NULL), job.timings.refine);
     /* Receivers far apart against the scene draw false shadows inside their
      * triangles: say so when nothing chose them (no --max-edge, --adaptive
      * or --receivers) and a bake or plan follows. */
