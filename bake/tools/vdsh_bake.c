@@ -488,6 +488,8 @@ static int write_report(const char *path, const options *o, const vb_job *job,
         vt_json_u64(&j, ad, "max_rounds", job->adaptive.max_rounds);
         vt_json_bool(&j, ad, "rounds_reached", job->adaptive.rounds_reached);
         vt_json_u64(&j, ad, "edges_pending", job->adaptive.pending);
+        vt_json_u64(&j, ad, "uniform_receivers", job->adaptive.uniform_receivers);
+        vt_json_bool(&j, ad, "uniform_reached", job->adaptive.uniform_reached);
     } else {
         vt_json_null(&j, root, "adaptive");
     }
@@ -1060,7 +1062,10 @@ int main(int argc, char **argv)
                      "baked, tolerance %g, min edge %g%s)\n",
                 job.receivers.vertex_count, job.adaptive.start_receivers, job.adaptive.rounds,
                 job.adaptive.candidates, (double)o.adaptive_tol, (double)o.min_edge,
-                job.adaptive.budget_reached ? ", the budget stopped it" : "");
+                job.adaptive.budget_reached   ? ", the budget stopped it"
+                : job.adaptive.uniform_reached ? ", stopped at the uniform bake's count at the "
+                                                 "min edge"
+                                               : "");
     if (log && o.adaptive && job.adaptive.rounds_reached)
         fprintf(log, "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
                      "while still splitting (%u edges split in the last round, %u edges not "
