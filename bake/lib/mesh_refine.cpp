@@ -129,49 +129,22 @@ double edge_len2(const om_mesh &m, om_mesh::EdgeHandle e)
     return dist2(m.point(m.from_vertex_handle(h)), m.point(m.to_vertex_handle(h)));
 }
 
-/* The unit normal of face f (double; zero for a face without area). */
-void face_normal(const om_mesh &m, om_mesh::FaceHandle f, double n[3])
+/* The cross product (b - a) x (c - a), in double. */
+void cross3(const om_mesh::Point &a, const om_mesh::Point &b, const om_mesh::Point &c, double x[3])
 {
-    om_mesh::ConstFaceVertexIter it = m.cfv_iter(f);
-    const om_mesh::Point a = m.point(*it), b = m.point(*++it), c = m.point(*++it);
     double u[3], v[3];
     for (int k = 0; k < 3; k++) {
         u[k] = (double)b[k] - a[k];
         v[k] = (double)c[k] - a[k];
     }
-    n[0] = u[1] * v[2] - u[2] * v[1];
-    n[1] = u[2] * v[0] - u[0] * v[2];
-    n[2] = u[0] * v[1] - u[1] * v[0];
-    double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    for (int k = 0; k < 3; k++)
-        n[k] = len > 0.0 ? n[k] / len : 0.0;
+    x[0] = u[1] * v[2] - u[2] * v[1];
+    x[1] = u[2] * v[0] - u[0] * v[2];
+    x[2] = u[0] * v[1] - u[1] * v[0];
 }
 
-/* The angle at corner c of triangle (a, c, b): between c->a and c->b. */
-double corner_angle(const om_mesh::Point &c, const om_mesh::Point &a, const om_mesh::Point &b)
+double dot3(const double a[3], const double b[3])
 {
-    double u[3], v[3];
-    for (int k = 0; k < 3; k++) {
-        u[k] = (double)a[k] - c[k];
-        v[k] = (double)b[k] - c[k];
-    }
-    double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2], cz = u[0] * v[1] - u[1] * v[0];
-    return std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), u[0] * v[0] + u[1] * v[1] + u[2] * v[2]);
-}
-
-/* vb_mesh_worst_aspect's measure of triangle (a, b, c): sqrt(3) L^2 / (4 A),
- * 1 for the equilateral triangle; +inf without area. */
-double aspect(const om_mesh::Point &a, const om_mesh::Point &b, const om_mesh::Point &c)
-{
-    double l2 = std::max(dist2(a, b), std::max(dist2(b, c), dist2(c, a)));
-    double u[3], v[3];
-    for (int k = 0; k < 3; k++) {
-        u[k] = (double)b[k] - a[k];
-        v[k] = (double)c[k] - a[k];
-    }
-    double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2], cz = u[0] * v[1] - u[1] * v[0];
-    double area = 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
-    return area > 0.0 ? std::sqrt(3.0) * l2 / (4.0 * area) : HUGE_VAL;
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
 /* Flips mend slivers only: an edge whose two triangles both have an aspect
@@ -189,23 +162,56 @@ const double flat_cos = 1.0 - 1e-6;
 /* Whether flipping e makes its two triangles better shaped: both faces in
  * one plane, and the angles opposite e sum to more than pi (e is not
  * locally Delaunay; the flip then always gives a convex quad's other
- * diagonal, whose opposite angles sum to less than pi: no flip back). */
+ * diagonal, whose opposite angles sum to less than pi: no flip back).
+ *
+ * Only sums, products, divisions and square roots (correctly rounded in
+ * IEEE double, no libm call whose rounding may depend on the CPU), so the
+ * decision is the same on any x86-64 CPU. With alpha, beta the angles at
+ * c0 and c1 (cos = d / l, sin = s / l: d the dot product, s the norm of
+ * the cross product of the sides, l the product of their lengths),
+ * sin(alpha + beta) = (s0 d1 + d0 s1) / (l0 l1), and since both angles
+ * are in (0, pi), alpha + beta > pi + 1e-9 is sin(alpha + beta) <
+ * -sin(1e-9): s0 d1 + d0 s1 < -1e-9 l0 l1 (the margin keeps rounding from
+ * flipping a quad whose corners lie on one circle back and forth).
+ *
+ * The cheap tests come first: most edges of a refinement are between
+ * well-shaped triangles, and OpenMesh's is_flip_ok (a walk around a
+ * vertex) is needed only for an edge that would be flipped. */
 bool should_flip(const om_mesh &m, om_mesh::EdgeHandle e)
 {
-    if (m.is_boundary(e) || !m.is_flip_ok(e))
+    if (m.is_boundary(e))
         return false;
     om_mesh::HalfedgeHandle h0 = m.halfedge_handle(e, 0), h1 = m.halfedge_handle(e, 1);
-    double n0[3], n1[3];
-    face_normal(m, m.face_handle(h0), n0);
-    face_normal(m, m.face_handle(h1), n1);
-    if (n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] < flat_cos)
-        return false; /* a crease, or a face without area */
     const om_mesh::Point a = m.point(m.from_vertex_handle(h0)), b = m.point(m.to_vertex_handle(h0));
     const om_mesh::Point c0 = m.point(m.to_vertex_handle(m.next_halfedge_handle(h0)));
     const om_mesh::Point c1 = m.point(m.to_vertex_handle(m.next_halfedge_handle(h1)));
-    if (std::max(aspect(a, b, c0), aspect(a, b, c1)) <= sliver_aspect)
-        return false; /* both well shaped already: bisection keeps them so */
-    return corner_angle(c0, a, b) + corner_angle(c1, a, b) > 3.14159265358979323846 + 1e-9;
+    /* Face h0 is (a, b, c0), face h1 is (b, a, c1): their normals. */
+    double x0[3], x1[3];
+    cross3(a, b, c0, x0);
+    cross3(b, a, c1, x1);
+    double s0 = std::sqrt(dot3(x0, x0)), s1 = std::sqrt(dot3(x1, x1));
+    if (!(s0 > 0.0) || !(s1 > 0.0) || dot3(x0, x1) < flat_cos * (s0 * s1))
+        return false; /* a crease, or a face without area */
+    /* Aspect (sqrt(3) L^2 / (4 A), A = s / 2) of both: well shaped already,
+     * bisection keeps them so. */
+    double ab2 = dist2(a, b);
+    double l0 = std::max(ab2, std::max(dist2(b, c0), dist2(c0, a)));
+    double l1 = std::max(ab2, std::max(dist2(a, c1), dist2(c1, b)));
+    double k = std::sqrt(3.0) / 2.0;
+    if (k * l0 / s0 <= sliver_aspect && k * l1 / s1 <= sliver_aspect)
+        return false;
+    /* The angles at c0 and c1, between their sides to a and b. */
+    double ca2 = dist2(c0, a), cb2 = dist2(c0, b), da2 = dist2(c1, a), db2 = dist2(c1, b);
+    double d0 = 0.0, d1 = 0.0;
+    for (int i = 0; i < 3; i++) {
+        d0 += ((double)a[i] - c0[i]) * ((double)b[i] - c0[i]);
+        d1 += ((double)a[i] - c1[i]) * ((double)b[i] - c1[i]);
+    }
+    /* |(a - c) x (b - c)| is twice the area: s0 and s1 again. */
+    double len0 = std::sqrt(ca2 * cb2), len1 = std::sqrt(da2 * db2);
+    if (!(s0 * d1 + d0 * s1 < -1e-9 * (len0 * len1)))
+        return false;
+    return m.is_flip_ok(e);
 }
 
 /* Lawson's flips from the edges on `stack` (and those they expose) until

@@ -1063,8 +1063,8 @@ int main(int argc, char **argv)
                 job.receivers.vertex_count, job.adaptive.start_receivers, job.adaptive.rounds,
                 job.adaptive.candidates, (double)o.adaptive_tol, (double)o.min_edge,
                 job.adaptive.budget_reached   ? ", the budget stopped it"
-                : job.adaptive.uniform_reached ? ", stopped at the uniform bake's count at the "
-                                                 "min edge"
+                : job.adaptive.uniform_reached ? ", stopped at the uniform bake's count at 2 x "
+                                                 "the min edge"
                                                : "");
     if (log && o.adaptive && job.adaptive.rounds_reached)
         fprintf(log, "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
