@@ -66,3 +66,10 @@ target_link_libraries(test_adaptive PRIVATE vb_core)
 add_test(NAME bake_adaptive
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/with_each_isa.sh $<TARGET_FILE:vdsh-bake>
                  $<TARGET_FILE:test_adaptive>)
+
+# Refinement of long thin triangles to a maximum edge: receivers near
+# area / edge^2, bounded aspect ratio (issue 26).
+add_executable(test_refine_shape test_refine_shape.c)
+target_link_libraries(test_refine_shape PRIVATE vb_core)
+add_test(NAME bake_refine_shape COMMAND $<TARGET_FILE:test_refine_shape>)
+set_tests_properties(bake_refine_shape PROPERTIES TIMEOUT 60)

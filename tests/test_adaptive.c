@@ -299,8 +299,62 @@ static void test_non_manifold(void)
     fixture_free(&f);
 }
 
+/* Never more work than the uniform bake as fine as splits go (issue 26):
+ * receivers kept and midpoints baked together at most the vertices of
+ * vb_mesh_refine(start, 2 min_edge), even from a start mesh of slivers (a
+ * 6 x 6 floor of strips 0.25 wide, its own triangles), which bisection
+ * alone refines far more densely than the uniform refinement (whose flips
+ * mend the slivers) does; tolerance 0 asks for every split. */
+static void test_uniform_cap(void)
+{
+    fixture f;
+    fixture_make(&f, 1.0f);
+    const float size = 6.0f, w = 0.25f, min_edge = 0.5f;
+    const uint32_t n = (uint32_t)lrintf(size / w) + 1;
+    vb_mesh strips = {0};
+    test_mesh_alloc(&strips, 2 * n, 2 * (n - 1));
+    for (uint32_t i = 0; i < n; i++) {
+        float *p = strips.positions + 3 * (size_t)i, *q = strips.positions + 3 * (size_t)(n + i);
+        p[0] = q[0] = -3.0f + (float)i * w;
+        p[1] = q[1] = 0.01f;
+        p[2] = -3.0f;
+        q[2] = -3.0f + size;
+        strips.normals[3 * i + 1] = strips.normals[3 * (n + i) + 1] = 1.0f;
+    }
+    for (uint32_t i = 0; i + 1 < n; i++) {
+        uint32_t t[6] = {i, n + i, i + 1, i + 1, n + i, n + i + 1};
+        memcpy(strips.indices + 6 * (size_t)i, t, sizeof t);
+    }
+    vb_mesh uniform = {0}, rec = {0};
+    vb_bake_output out = {0};
+    vb_adaptive_stats st = {0};
+    vb_error err;
+    CHECK(vb_mesh_refine(&strips, 2.0f * min_edge, &uniform, &err) == VB_OK, "refine: %s", err.msg);
+    if (run(&f, &strips, 0.0f, min_edge, 0, 2, &rec, &out, &st) == VB_OK) {
+        uint64_t baked = (uint64_t)st.start_receivers + st.candidates;
+        printf("uniform cap: %u receivers, %llu baked from %u; uniform at %g: %u (reached %d)\n",
+               rec.vertex_count, (unsigned long long)baked, st.start_receivers,
+               (double)(2.0f * min_edge), uniform.vertex_count, st.uniform_reached);
+        CHECK(st.uniform_receivers == uniform.vertex_count, "the cap: %u, uniform %u",
+              st.uniform_receivers, uniform.vertex_count);
+        CHECK(rec.vertex_count <= uniform.vertex_count,
+              "%u receivers, more than the uniform bake at 2 x the min edge (%u)", rec.vertex_count,
+              uniform.vertex_count);
+        CHECK(baked <= uniform.vertex_count && out.rays_traced <= (uint64_t)uniform.vertex_count * out.rays,
+              "%llu vertices baked, more than the uniform bake at 2 x the min edge (%u)",
+              (unsigned long long)baked, uniform.vertex_count);
+        CHECK(rec.vertex_count > st.start_receivers, "nothing split");
+    }
+    vb_mesh_free(&rec);
+    vb_mesh_free(&uniform);
+    vb_bake_output_free(&out);
+    test_mesh_free(&strips);
+    fixture_free(&f);
+}
+
 int main(void)
 {
+    test_uniform_cap();
     test_promises();
     test_limits();
     test_non_manifold();

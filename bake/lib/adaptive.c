@@ -118,6 +118,16 @@ static void score_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker
     }
 }
 
+static double edge_len2(const vb_mesh *m, uint64_t key)
+{
+    const float *a = m->positions + 3 * (size_t)(uint32_t)(key >> 32);
+    const float *b = m->positions + 3 * (size_t)(uint32_t)key;
+    double d2 = 0.0;
+    for (int c = 0; c < 3; c++)
+        d2 += ((double)a[c] - b[c]) * ((double)a[c] - b[c]);
+    return d2;
+}
+
 typedef struct ranked {
     double error;
     uint32_t index;
@@ -196,6 +206,18 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
                                    err)) != VB_OK)
         goto done;
 
+    /* The cap: the uniform refinement to 2 min_edge (adaptive.h), the
+     * finest mesh the splits can reach (an edge of at most 2 min_edge is
+     * never split). At min_edge itself it cost 4x the vertices to count:
+     * 13.6 M on 2CylinderEngine.glb from --max-edge 8.4, minutes of the
+     * bake's time, for a cap that never binds there. */
+    {
+        vb_mesh U = {0};
+        vb_error uerr;
+        if (vb_mesh_refine(start, 2.0f * ad->min_edge, &U, &uerr) == VB_OK)
+            st.uniform_receivers = U.vertex_count;
+        vb_mesh_free(&U);
+    }
     const uint32_t max_rounds = st.max_rounds =
         ad->max_rounds ? ad->max_rounds : VB_ADAPTIVE_ROUNDS;
     while (isfinite(ad->tolerance) && st.rounds < max_rounds) {
@@ -211,6 +233,36 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
             goto done;
         if (cand_n == 0)
             break;
+        const uint64_t baked = (uint64_t)st.start_receivers + st.candidates;
+        if (st.uniform_receivers && baked + cand_n > st.uniform_receivers) {
+            /* Bake no more than the uniform bake would: the longest
+             * candidates that fit, in key order. */
+            uint64_t room = st.uniform_receivers > baked ? st.uniform_receivers - baked : 0;
+            st.uniform_reached = 1;
+            if (room == 0)
+                break;
+            free(rank);
+            if (!(rank = malloc(cand_n * sizeof *rank + 1))) {
+                r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+                goto done;
+            }
+            for (size_t i = 0; i < cand_n; i++)
+                rank[i] = (ranked){edge_len2(&M, cand[i]), (uint32_t)i};
+            qsort(rank, cand_n, sizeof *rank, cmp_ranked);
+            uint8_t *keep = calloc(cand_n + 1, 1);
+            if (!keep) {
+                r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+                goto done;
+            }
+            for (uint64_t k = 0; k < room; k++)
+                keep[rank[k].index] = 1;
+            size_t u = 0;
+            for (size_t i = 0; i < cand_n; i++)
+                if (keep[i])
+                    cand[u++] = cand[i];
+            free(keep);
+            cand_n = u;
+        }
         /* The tentative mesh: every candidate split; bake the midpoints. */
         free(pairs);
         if (!(pairs = malloc(cand_n * 2 * sizeof *pairs + 1))) {
@@ -326,11 +378,11 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         M = N;
         memset(&N, 0, sizeof N);
         B.vertex_count = B.range_end = M.vertex_count;
-        if (st.budget_reached)
+        if (st.budget_reached || st.uniform_reached)
             break;
     }
     if (isfinite(ad->tolerance) && st.rounds == max_rounds && st.last_split > 0 &&
-        !st.budget_reached) {
+        !st.budget_reached && !st.uniform_reached) {
         /* The round limit stopped a refinement still splitting: how many
          * edges the next round would have judged. */
         free(cand);

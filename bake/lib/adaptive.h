@@ -20,6 +20,13 @@
  * the last round), or after max_rounds rounds (stats say whether that
  * limit stopped a refinement that was still splitting).
  *
+ * Never more work than the uniform bake as fine as the splits can go: the
+ * receivers kept and every midpoint baked (kept or not) together are at
+ * most the vertices of vb_mesh_refine(start, 2 min_edge)
+ * (stats.uniform_receivers; no edge of at most 2 min_edge is split);
+ * a round that would pass it bakes only its longest candidates (ties: the
+ * lower key) up to it, and the refinement stops there (uniform_reached).
+ *
  * Every round bakes with the first round's quantity per order, so the
  * whole mesh stores one quantity per order, as a uniform bake does.
  *
@@ -71,6 +78,10 @@ typedef struct vb_adaptive_stats {
     uint32_t last_split;       /* edges the last round split */
     uint32_t pending;          /* with rounds_reached: edges not yet judged, long
                                 * enough to split (the next round's midpoints) */
+    uint32_t uniform_receivers; /* the uniform refinement of the start mesh to
+                                 * 2 min_edge: the cap on every vertex baked
+                                 * (0: over vb_mesh_refine's limit, no cap) */
+    int uniform_reached;       /* that cap stopped it */
 } vb_adaptive_stats;
 
 /* Bake `start` with `bake` (its receivers and range are ignored), then

@@ -473,6 +473,9 @@ static int write_report(const char *path, const options *o, const vb_job *job,
     vt_json_f32(&j, spc, "max_longest_edge", sp->max_edge);
     vt_json_f64(&j, spc, "long_area_share", sp->long_area);
     vt_json_bool(&j, spc, "far_apart", sp->far_apart);
+    /* The receivers as baked: their worst triangle (vb_mesh_worst_aspect:
+     * 1 equilateral, 1.73 right isosceles). */
+    vt_json_f64(&j, root, "worst_aspect", vb_mesh_worst_aspect(&job->receivers, NULL));
     if (o->adaptive) {
         cJSON *ad = vt_json_object(&j, root, "adaptive");
         vt_json_f32(&j, ad, "tolerance", o->adaptive_tol);
@@ -485,6 +488,8 @@ static int write_report(const char *path, const options *o, const vb_job *job,
         vt_json_u64(&j, ad, "max_rounds", job->adaptive.max_rounds);
         vt_json_bool(&j, ad, "rounds_reached", job->adaptive.rounds_reached);
         vt_json_u64(&j, ad, "edges_pending", job->adaptive.pending);
+        vt_json_u64(&j, ad, "uniform_receivers", job->adaptive.uniform_receivers);
+        vt_json_bool(&j, ad, "uniform_reached", job->adaptive.uniform_reached);
     } else {
         vt_json_null(&j, root, "adaptive");
     }
@@ -981,8 +986,9 @@ int main(int argc, char **argv)
     const vb_mesh *rec = &job.receivers;
     if (log && o.max_edge > 0.0f)
         fprintf(log, "vdsh-bake: receivers refined to max edge %g: %u vertices, "
-                     "%u triangles (%.2f s)\n",
-                (double)o.max_edge, rec->vertex_count, rec->triangle_count, job.timings.refine);
+                     "%u triangles, worst aspect ratio %.1f (%.2f s)\n",
+                (double)o.max_edge, rec->vertex_count, rec->triangle_count,
+                vb_mesh_worst_aspect(rec, NULL), job.timings.refine);
     /* Receivers far apart against the scene draw false shadows inside their
      * triangles: say so when nothing chose them (no --max-edge, --adaptive
      * or --receivers) and a bake or plan follows. */
@@ -1056,7 +1062,10 @@ int main(int argc, char **argv)
                      "baked, tolerance %g, min edge %g%s)\n",
                 job.receivers.vertex_count, job.adaptive.start_receivers, job.adaptive.rounds,
                 job.adaptive.candidates, (double)o.adaptive_tol, (double)o.min_edge,
-                job.adaptive.budget_reached ? ", the budget stopped it" : "");
+                job.adaptive.budget_reached   ? ", the budget stopped it"
+                : job.adaptive.uniform_reached ? ", stopped at the uniform bake's count at 2 x "
+                                                 "the min edge"
+                                               : "");
     if (log && o.adaptive && job.adaptive.rounds_reached)
         fprintf(log, "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
                      "while still splitting (%u edges split in the last round, %u edges not "
