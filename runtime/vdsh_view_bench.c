@@ -339,6 +339,19 @@ static void bench_print(const vv_options *o, const bench_scene *b, int all_round
             vt_json_string(j, r, "path", interp >= 0 ? vdsh_interp_name((uint32_t)interp)
                                                      : b->modes[m].name);
             vt_json_f64(j, r, "median_cpu_ms", sorted[rounds / 2]);
+            /* Texture lookups per fragment and light, and the texels they
+             * read, from the shaders (runtime/vr_glsl.c): the cube map one
+             * nearest depth compare or with PCF four bilinear ones; order 5
+             * on the paper's path four basis cube maps (bilinear); every
+             * other mode none in the fragment stage. */
+            int lookups = 0, texels = 0;
+            if (b->modes[m].mode == VR_MODE_CUBE)
+                lookups = b->modes[m].pcf ? 4 : 1, texels = b->modes[m].pcf ? 16 : 1;
+            else if (b->modes[m].mode == VR_MODE_VDSH5 && interp >= 0 &&
+                     interp != VDSH_INTERP_DISTANCE)
+                lookups = 4, texels = 16;
+            vt_json_i64(j, r, "texture_lookups_per_fragment_light", lookups);
+            vt_json_i64(j, r, "texels_per_fragment_light", texels);
             if (b->modes[m].mode == VR_MODE_CUBE) {
                 /* Depth cube maps, 32-bit float: one per light of a pass. */
                 int per = b->nl[ls] < VR_MAX_LIGHTS_PER_PASS ? b->nl[ls] : VR_MAX_LIGHTS_PER_PASS;
