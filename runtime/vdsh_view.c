@@ -44,6 +44,17 @@ static const char usage_text[] =
     "                        every mode of every SCENE once (wall time and\n"
     "                        process CPU time per frame); JSON on stdout\n"
     "      --bench-lights L  with --bench: only these of 1,3,16,64 lights\n"
+    "      --bench-cube-sizes LIST  with --bench: time the cube shadow map\n"
+    "                        (1 tap and PCF) at each of these face sizes, as\n"
+    "                        modes cubeN and cube_pcfN, instead of cube and\n"
+    "                        cube_pcf at --shadow-size (e.g. 16,64,256)\n"
+    "      --bench-modes LIST  with --bench: time only the modes of these\n"
+    "                        names (comma-separated, as in the JSON)\n"
+    "      --bench-counts    with --bench: per mode and light set, one more\n"
+    "                        frame with GL queries around it (samples passed,\n"
+    "                        primitives; vertex and fragment shader\n"
+    "                        invocations where the context has pipeline\n"
+    "                        statistics), as \"counts\" in the JSON\n"
     "      --buffer-floats   with --bench: time each buffer mode also from\n"
     "                        buffers of decoded f32 coefficients (MODE-f32)\n"
     "      --views FILE      with --frames DIR: for every view, light set and\n"
@@ -166,7 +177,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
     enum { O_RENDER = 256, O_GRID, O_BENCH, O_CAMERA, O_FIT, O_FOV, O_LIGHT, O_LIGHTS,
            O_ATT, O_AMBIENT, O_MODE, O_COMPARE, O_PCF, O_SHADOW_SIZE, O_SIZE,
            O_NO_CUBEMAPS, O_EGL, O_FRAMES, O_SCREENSHOT, O_NO_OVERLAY, O_KEYS,
-           O_NO_MALLOPT, O_VIEWS, O_MODES, O_BUFFER_FLOATS, O_BENCH_LIGHTS };
+           O_NO_MALLOPT, O_VIEWS, O_MODES, O_BUFFER_FLOATS, O_BENCH_LIGHTS,
+           O_BENCH_CUBE_SIZES, O_BENCH_MODES, O_BENCH_COUNTS };
     static const struct option longopts[] = {
         {"render", required_argument, 0, O_RENDER},
         {"grid", required_argument, 0, O_GRID},
@@ -192,6 +204,9 @@ static int parse_args(int argc, char **argv, vv_options *o)
         {"no-mallopt", no_argument, 0, O_NO_MALLOPT},
         {"buffer-floats", no_argument, 0, O_BUFFER_FLOATS},
         {"bench-lights", required_argument, 0, O_BENCH_LIGHTS},
+        {"bench-cube-sizes", required_argument, 0, O_BENCH_CUBE_SIZES},
+        {"bench-modes", required_argument, 0, O_BENCH_MODES},
+        {"bench-counts", no_argument, 0, O_BENCH_COUNTS},
         {"views", required_argument, 0, O_VIEWS},
         {"modes", required_argument, 0, O_MODES},
         {"quiet", no_argument, 0, 'q'},
@@ -329,6 +344,27 @@ static int parse_args(int argc, char **argv, vv_options *o)
                 return usage_error("--bench-lights: expected some of 1,3,16,64, got '%s'", v);
             break;
         }
+        case O_BENCH_CUBE_SIZES: {
+            float n[8];
+            int k = vt_parse_floats(v, n, 1, 8);
+            o->bench_cube_count = k > 0 ? k : 0;
+            for (int i = 0; i < k; i++) {
+                if (!(n[i] >= 1 && n[i] <= 8192 && n[i] == (float)(int)n[i]))
+                    k = 0;
+                else
+                    o->bench_cube_sizes[i] = (int)n[i];
+            }
+            if (k < 1)
+                return usage_error("--bench-cube-sizes: expected 1 to 8 face sizes of 1..8192, "
+                                   "got '%s'", v);
+            break;
+        }
+        case O_BENCH_MODES:
+            if (!*v)
+                return usage_error("%s", "--bench-modes: expected mode names");
+            o->bench_modes = v;
+            break;
+        case O_BENCH_COUNTS: o->bench_counts = 1; break;
         default: /* getopt_long said what is wrong */
             vt_cli_try_help();
             return VT_EXIT_USAGE;
@@ -358,8 +394,10 @@ static int parse_args(int argc, char **argv, vv_options *o)
     } else {
         if (o->frame_mode_count)
             return usage_error("%s", "--modes: only with --views");
-        if ((o->buffer_floats || o->bench_sets) && !o->bench)
-            return usage_error("%s", "--buffer-floats, --bench-lights: only with --bench");
+        if ((o->buffer_floats || o->bench_sets || o->bench_cube_count || o->bench_modes ||
+             o->bench_counts) && !o->bench)
+            return usage_error("%s", "--buffer-floats, --bench-lights, --bench-cube-sizes, "
+                               "--bench-modes, --bench-counts: only with --bench");
         if (o->frames_arg && !vt_parse_int(o->frames_arg, 1, 1000000, &o->frames))
             return usage_error("--frames: expected a positive count, got '%s'", o->frames_arg);
     }

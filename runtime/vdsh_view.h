@@ -57,6 +57,11 @@ typedef struct vv_options {
     int buffer_floats;         /* --bench: also time buffers of decoded f32 */
     int bench_sets;            /* --bench-lights: bit i, light set i of
                                   1, 3, 16, 64; 0: all */
+    int bench_cube_sizes[8];   /* --bench-cube-sizes: cube and cube_pcf
+                                  timed at each face size (cubeN, cube_pcfN) */
+    int bench_cube_count;
+    const char *bench_modes;   /* --bench-modes: only these names; NULL: all */
+    int bench_counts;          /* --bench-counts: GL counts of each mode */
     int quiet;
     const char *screenshot;
     int no_overlay;

@@ -26,6 +26,9 @@ typedef struct bench_mode {
     const char *name;
     int stream;              /* VR_MODE_VDSH_BUFFER's */
     int floats;              /* drawn from the scene's decoded-f32 copy */
+    int renderer;            /* index into the renderers: 0, or 1 + the
+                                --bench-cube-sizes entry of a sized cube */
+    int cube_size;           /* VR_MODE_CUBE: its face size */
 } bench_mode;
 
 static int cmp_double(const void *a, const void *b)
@@ -41,7 +44,7 @@ static void json_series(vt_json *j, cJSON *o, const char *key, const double *v, 
         vt_json_f64(j, a, NULL, v[i]);
 }
 
-enum { BENCH_MODES = 16, BENCH_ROUNDS = 64, BENCH_SETS = 4 };
+enum { BENCH_MODES = 48, BENCH_ROUNDS = 64, BENCH_SETS = 4 };
 
 /* The light counts timed, and the rounds each gets out of `rounds`: all
  * for 1 and 3 lights, a third for 16, a fifth for 64, at least 3. */
@@ -83,7 +86,47 @@ typedef struct bench_scene {
     double shadow[BENCH_SETS][BENCH_MODES][BENCH_ROUNDS];
     double lighting[BENCH_SETS][BENCH_MODES][BENCH_ROUNDS];
     double proc[BENCH_SETS][BENCH_MODES][BENCH_ROUNDS];
+    vr_counts counts[BENCH_SETS][BENCH_MODES]; /* --bench-counts */
 } bench_scene;
+
+/* Whether --bench-modes keeps the mode `name` (none given: every mode). */
+static int bench_keeps(const vv_options *o, const char *name)
+{
+    if (!o->bench_modes)
+        return 1;
+    size_t len = strlen(name);
+    for (const char *p = o->bench_modes;;) {
+        size_t n = strcspn(p, ",");
+        if (n == len && !strncmp(p, name, len))
+            return 1;
+        if (!p[n])
+            return 0;
+        p += n + 1;
+    }
+}
+
+/* Keep only the modes --bench-modes names. */
+static void bench_filter(const vv_options *o, bench_scene *b)
+{
+    int k = 0;
+    for (int m = 0; m < b->nm; m++)
+        if (bench_keeps(o, b->modes[m].name))
+            b->modes[k++] = b->modes[m];
+    b->nm = k;
+}
+
+/* --bench-cube-sizes: cubeN and cube_pcfN, drawn by renderer 1 + i. */
+static void add_cube_sizes(const vv_options *o, bench_scene *b)
+{
+    static char names[8][2][24];
+    for (int i = 0; i < o->bench_cube_count && b->nm < BENCH_MODES - 1; i++)
+        for (int pcf = 0; pcf < 2; pcf++) {
+            snprintf(names[i][pcf], sizeof names[i][pcf], "%s%d", pcf ? "cube_pcf" : "cube",
+                     o->bench_cube_sizes[i]);
+            b->modes[b->nm++] = (bench_mode){VR_MODE_CUBE, pcf, names[i][pcf], 0, 0, 1 + i,
+                                             o->bench_cube_sizes[i]};
+        }
+}
 
 /* The buffer modes of a log-distance scene (those are drawn per vertex
  * by every mode, so buf5 times the buffer's fetches against vdsh5's
@@ -100,11 +143,11 @@ static void add_buffer_modes(bench_scene *b)
         int i = vv_frame_mode_find(name, strlen(name));
         if (i >= 0 && vr_scene_buffer_stream(b->scene, k) == k)
             b->modes[b->nm++] =
-                (bench_mode){VR_MODE_VDSH_BUFFER, 0, vv_frame_modes[i].name, k, 0};
+                (bench_mode){VR_MODE_VDSH_BUFFER, 0, vv_frame_modes[i].name, k, 0, 0, 0};
     }
     if (vr_scene_buffer_stream(b->scene, VR_STREAM_VARIABLE))
         b->modes[b->nm++] =
-            (bench_mode){VR_MODE_VDSH_BUFFER, 0, "adaptive", VR_STREAM_VARIABLE, 0};
+            (bench_mode){VR_MODE_VDSH_BUFFER, 0, "adaptive", VR_STREAM_VARIABLE, 0, 0, 0};
 }
 
 /* --buffer-floats: each buffer mode again, from a copy of the scene
@@ -144,10 +187,11 @@ static int add_float_modes(bench_scene *b)
 static int bench_open(const vv_options *o, const char *path, bench_scene *b)
 {
     static const bench_mode all[7] = {
-        {VR_MODE_NONE, 0, "none", 0, 0},     {VR_MODE_CUBE, 0, "cube", 0, 0},
-        {VR_MODE_CUBE, 1, "cube_pcf", 0, 0}, {VR_MODE_VDSH2, 0, "vdsh2", 0, 0},
-        {VR_MODE_VDSH3, 0, "vdsh3", 0, 0},   {VR_MODE_VDSH5, 0, "vdsh5", 0, 0},
-        {VR_MODE_VDSH5_POLY, 0, "vdsh5poly", 0, 0}};
+        {VR_MODE_NONE, 0, "none", 0, 0, 0, 0},     {VR_MODE_CUBE, 0, "cube", 0, 0, 0, 0},
+        {VR_MODE_CUBE, 1, "cube_pcf", 0, 0, 0, 0}, {VR_MODE_VDSH2, 0, "vdsh2", 0, 0, 0, 0},
+        {VR_MODE_VDSH3, 0, "vdsh3", 0, 0, 0, 0},   {VR_MODE_VDSH5, 0, "vdsh5", 0, 0, 0, 0},
+        {VR_MODE_VDSH5_POLY, 0, "vdsh5poly", 0, 0, 0, 0}};
+    int shadow = o->shadow_size ? o->shadow_size : VR_DEFAULT_SHADOW_MAP_SIZE;
     b->path = path;
     if (vv_open_scene(o, path, &b->scene))
         return 1;
@@ -157,12 +201,25 @@ static int bench_open(const vv_options *o, const char *path, bench_scene *b)
         int same = all[i].mode == VR_MODE_VDSH5_POLY &&
                    vr_scene_supports(b->scene, VR_MODE_VDSH5) &&
                    vr_scene_interp(b->scene, VR_MODE_VDSH5) == VDSH_INTERP_DISTANCE;
-        if (vr_scene_supports(b->scene, all[i].mode) && !same)
-            b->modes[b->nm++] = all[i];
+        /* --bench-cube-sizes: the sized cubes replace cube and cube_pcf. */
+        int sized = all[i].mode == VR_MODE_CUBE && o->bench_cube_count;
+        if (vr_scene_supports(b->scene, all[i].mode) && !same && !sized) {
+            b->modes[b->nm] = all[i];
+            if (all[i].mode == VR_MODE_CUBE)
+                b->modes[b->nm].cube_size = shadow;
+            b->nm++;
+        }
     }
+    add_cube_sizes(o, b);
     add_buffer_modes(b);
     if (o->buffer_floats && add_float_modes(b))
         return 1;
+    bench_filter(o, b);
+    if (!b->nm) {
+        fprintf(stderr, "vdsh-view: %s: no mode of --bench-modes %s in this file\n", path,
+                o->bench_modes);
+        return 1;
+    }
     for (int ls = 0; ls < BENCH_SETS; ls++) {
         b->nl[ls] = vv_default_lights(b->scene, o, bench_light_sets[ls], b->lights[ls]);
         if (b->nl[ls] < bench_light_sets[ls]) {
@@ -181,7 +238,7 @@ static int bench_open(const vv_options *o, const char *path, bench_scene *b)
  * starting at a different one each round, so that slow drifts of a shared
  * machine spread over all scenes and modes alike: a ratio between any two
  * of them compares frames of the same minutes. */
-static int bench_time(const vv_options *o, bench_scene *b, int nb, vr_renderer *r, int rounds)
+static int bench_time(const vv_options *o, bench_scene *b, int nb, vr_renderer **rs, int rounds)
 {
     int total = 0;
     for (int i = 0; i < nb; i++)
@@ -194,6 +251,7 @@ static int bench_time(const vv_options *o, bench_scene *b, int nb, vr_renderer *
                 while (j >= b[i].nm)
                     j -= b[i++].nm;
                 bench_scene *bs = &b[i];
+                vr_renderer *r = rs[bs->modes[j].renderer];
                 vr_draw_desc d = vv_base_desc(o, bs->lights[ls], bs->nl[ls]);
                 d.mode = bs->modes[j].mode;
                 d.pcf = bs->modes[j].pcf;
@@ -217,6 +275,31 @@ static int bench_time(const vv_options *o, bench_scene *b, int nb, vr_renderer *
                     bs->gpu[ls][j][round] = t.gpu_ms;
                     bs->shadow[ls][j][round] = t.shadow_total_ms;
                     bs->lighting[ls][j][round] = t.lighting_total_ms;
+                }
+            }
+    return 0;
+}
+
+/* --bench-counts: one more frame of every (scene, mode, light set) with
+ * the GL's counters around it (untimed). */
+static int bench_count(const vv_options *o, bench_scene *b, int nb, vr_renderer **rs)
+{
+    for (int i = 0; i < nb; i++)
+        for (int ls = 0; ls < BENCH_SETS; ls++)
+            for (int m = 0; m < b[i].nm && bench_set_on(o, ls); m++) {
+                bench_scene *bs = &b[i];
+                vr_draw_desc d = vv_base_desc(o, bs->lights[ls], bs->nl[ls]);
+                d.mode = bs->modes[m].mode;
+                d.pcf = bs->modes[m].pcf;
+                d.stream = bs->modes[m].stream;
+                vv_scene_camera(bs->scene, o, &d.camera);
+                vr_error err;
+                const vr_scene *drawn = bs->modes[m].floats ? bs->floats : bs->scene;
+                if (vr_draw_counted(rs[bs->modes[m].renderer], drawn, &d, &bs->counts[ls][m],
+                                    &err) != VR_OK) {
+                    fprintf(stderr, "vdsh-view: %s: %s: %s\n", bs->path, bs->modes[m].name,
+                            err.msg);
+                    return 1;
                 }
             }
     return 0;
@@ -256,6 +339,39 @@ static void bench_print(const vv_options *o, const bench_scene *b, int all_round
             vt_json_string(j, r, "path", interp >= 0 ? vdsh_interp_name((uint32_t)interp)
                                                      : b->modes[m].name);
             vt_json_f64(j, r, "median_cpu_ms", sorted[rounds / 2]);
+            /* Texture lookups per fragment and light, and the texels they
+             * read, from the shaders (runtime/vr_glsl.c): the cube map one
+             * nearest depth compare or with PCF four bilinear ones; order 5
+             * on the paper's path four basis cube maps (bilinear); every
+             * other mode none in the fragment stage. */
+            int lookups = 0, texels = 0;
+            if (b->modes[m].mode == VR_MODE_CUBE)
+                lookups = b->modes[m].pcf ? 4 : 1, texels = b->modes[m].pcf ? 16 : 1;
+            else if (b->modes[m].mode == VR_MODE_VDSH5 && interp >= 0 &&
+                     interp != VDSH_INTERP_DISTANCE)
+                lookups = 4, texels = 16;
+            vt_json_i64(j, r, "texture_lookups_per_fragment_light", lookups);
+            vt_json_i64(j, r, "texels_per_fragment_light", texels);
+            if (b->modes[m].mode == VR_MODE_CUBE) {
+                /* Depth cube maps, 32-bit float: one per light of a pass. */
+                int per = b->nl[ls] < VR_MAX_LIGHTS_PER_PASS ? b->nl[ls] : VR_MAX_LIGHTS_PER_PASS;
+                uint64_t face = (uint64_t)b->modes[m].cube_size * (uint64_t)b->modes[m].cube_size;
+                vt_json_i64(j, r, "cube_size", b->modes[m].cube_size);
+                vt_json_u64(j, r, "cube_bytes", (uint64_t)per * 6u * face * 4u);
+            }
+            if (o->bench_counts) {
+                const vr_counts *c = &b->counts[ls][m];
+                cJSON *co = vt_json_object(j, r, "counts");
+                vt_json_bool(j, co, "pipeline_statistics", c->statistics);
+                vt_json_u64(j, co, "samples_passed", c->samples_passed);
+                vt_json_u64(j, co, "primitives_generated", c->primitives_generated);
+                if (c->statistics) {
+                    vt_json_u64(j, co, "vertices_submitted", c->vertices_submitted);
+                    vt_json_u64(j, co, "vertex_shader_invocations", c->vertex_invocations);
+                    vt_json_u64(j, co, "fragment_shader_invocations", c->fragment_invocations);
+                    vt_json_u64(j, co, "clipping_input_primitives", c->clipping_primitives);
+                }
+            }
             if (b->modes[m].mode == VR_MODE_VDSH_BUFFER)
                 vt_json_u64(j, r, "buffer_bytes",
                             vr_scene_buffer_bytes(b->modes[m].floats ? b->floats : b->scene,
@@ -279,9 +395,20 @@ int vv_run_bench(const vv_options *o)
     int w = o->have_size ? o->width : VR_DEFAULT_WIDTH;
     int h = o->have_size ? o->height : VR_DEFAULT_HEIGHT;
     vr_context *ctx = NULL;
-    vr_renderer *r = NULL;
+    vr_renderer *rs[9] = {NULL}, *r = NULL;
     if (vv_open_headless(o, w, h, 0, &ctx, &r) != 0)
         return 1;
+    rs[0] = r;
+    int rc = 0;
+    for (int i = 0; i < o->bench_cube_count && !rc; i++) {
+        vr_renderer_desc rd = {.width = w, .height = h,
+                               .shadow_map_size = o->bench_cube_sizes[i]};
+        vr_error err;
+        if (vr_renderer_create(&rd, &rs[1 + i], &err) != VR_OK) {
+            fprintf(stderr, "vdsh-view: %s\n", err.msg);
+            rc = 1;
+        }
+    }
     int rounds = o->frames ? (o->frames < BENCH_ROUNDS ? o->frames : BENCH_ROUNDS) : 7;
     vt_json j = {0};
     cJSON *root = vt_json_object(&j, NULL, NULL);
@@ -295,13 +422,16 @@ int vv_run_bench(const vv_options *o)
     vt_json_i64(&j, root, "rounds", rounds);
     cJSON *list = vt_json_array(&j, root, "scenes");
     bench_scene *b = calloc((size_t)o->file_count, sizeof *b);
-    int rc = b ? 0 : 1;
+    if (!b)
+        rc = 1;
     if (!b)
         fprintf(stderr, "vdsh-view: out of memory\n");
     for (int i = 0; i < o->file_count && !rc; i++)
         rc = bench_open(o, o->files[i], &b[i]);
     if (!rc)
-        rc = bench_time(o, b, o->file_count, r, rounds);
+        rc = bench_time(o, b, o->file_count, rs, rounds);
+    if (!rc && o->bench_counts)
+        rc = bench_count(o, b, o->file_count, rs);
     for (int i = 0; i < o->file_count && !rc; i++)
         bench_print(o, &b[i], rounds, &j, list);
     char msg[256];
@@ -315,7 +445,8 @@ int vv_run_bench(const vv_options *o)
         vr_scene_destroy(b[i].floats);
     }
     free(b);
-    vr_renderer_destroy(r);
+    for (int i = 0; i < 9; i++)
+        vr_renderer_destroy(rs[i]);
     vr_context_destroy(ctx);
     return rc;
 }

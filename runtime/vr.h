@@ -484,6 +484,28 @@ void vr_renderer_finish(vr_renderer *r);
  * a frame or two behind and never stalls). out->frame is 0 when none. */
 void vr_renderer_timings(vr_renderer *r, vr_timings *out);
 
+/* The work of one frame as the GL counts it, for figures that carry from a
+ * software rasteriser to a GPU: every pass of the frame (cube shadow-map
+ * faces and lighting passes) summed. GL_SAMPLES_PASSED and
+ * GL_PRIMITIVES_GENERATED always; the pipeline statistics (GL 4.6 or
+ * ARB_pipeline_statistics_query) where the context has them
+ * (`statistics` 1), else those fields are 0. */
+typedef struct vr_counts {
+    int statistics;                  /* the pipeline statistics below are valid */
+    uint64_t samples_passed;         /* samples passing the depth test */
+    uint64_t primitives_generated;   /* primitives out of the vertex stage */
+    uint64_t vertices_submitted;     /* vertices read by the draws */
+    uint64_t vertex_invocations;     /* vertex shader runs (after reuse) */
+    uint64_t fragment_invocations;   /* fragment shader runs (depth-only too) */
+    uint64_t clipping_primitives;    /* primitives reaching clipping */
+} vr_counts;
+
+/* vr_draw with the queries of vr_counts around it, then glFinish; the
+ * counts of this frame in *out. Slower than vr_draw (a stall): not for
+ * timed frames. Errors as vr_draw. */
+vr_result vr_draw_counted(vr_renderer *r, const vr_scene *s, const vr_draw_desc *d,
+                          vr_counts *out, vr_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -740,6 +740,59 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
     return res;
 }
 
+/* Whether the context has the pipeline statistics queries: GL 4.6, or
+ * ARB_pipeline_statistics_query. */
+static int has_pipeline_statistics(void)
+{
+    GLint major = 0, minor = 0, n = 0;
+    glGetIntegerv(GL_MAJOR_VERSION, &major);
+    glGetIntegerv(GL_MINOR_VERSION, &minor);
+    if (major > 4 || (major == 4 && minor >= 6))
+        return 1;
+    glGetIntegerv(GL_NUM_EXTENSIONS, &n);
+    for (GLint i = 0; i < n; i++) {
+        const char *e = (const char *)glGetStringi(GL_EXTENSIONS, (GLuint)i);
+        if (e && !strcmp(e, "GL_ARB_pipeline_statistics_query"))
+            return 1;
+    }
+    return 0;
+}
+
+vr_result vr_draw_counted(vr_renderer *r, const vr_scene *s, const vr_draw_desc *d,
+                          vr_counts *out, vr_error *err)
+{
+    static const GLenum targets[6] = {GL_SAMPLES_PASSED,        GL_PRIMITIVES_GENERATED,
+                                      GL_VERTICES_SUBMITTED,    GL_VERTEX_SHADER_INVOCATIONS,
+                                      GL_FRAGMENT_SHADER_INVOCATIONS,
+                                      GL_CLIPPING_INPUT_PRIMITIVES};
+    if (!r || !s || !d || !out)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw_counted: NULL argument");
+    memset(out, 0, sizeof *out);
+    out->statistics = has_pipeline_statistics();
+    int n = out->statistics ? 6 : 2;
+    GLuint q[6] = {0};
+    glGenQueries(n, q);
+    for (int i = 0; i < n; i++)
+        glBeginQuery(targets[i], q[i]);
+    vr_result res = vr_draw(r, s, d, err);
+    for (int i = 0; i < n; i++)
+        glEndQuery(targets[i]);
+    glFinish();
+    uint64_t v[6] = {0};
+    for (int i = 0; i < n; i++)
+        glGetQueryObjectui64v(q[i], GL_QUERY_RESULT, &v[i]);
+    glDeleteQueries(n, q);
+    out->samples_passed = v[0];
+    out->primitives_generated = v[1];
+    out->vertices_submitted = v[2];
+    out->vertex_invocations = v[3];
+    out->fragment_invocations = v[4];
+    out->clipping_primitives = v[5];
+    if (res == VR_OK)
+        res = vr_check_gl(err, "vr_draw_counted");
+    return res;
+}
+
 /* ------------------------------------------------------------------ */
 /* Results                                                              */
 

@@ -85,3 +85,17 @@ if(Python3_Interpreter_FOUND AND TARGET vb_frames AND TARGET vdsh-view)
                    ${CMAKE_CURRENT_BINARY_DIR}/frames_script)
   set_tests_properties(frames_script PROPERTIES SKIP_RETURN_CODE 77)
 endif()
+
+# scripts/pareto --quick: the speed-against-error report at its smallest
+# (the room at --max-edge 1, the 3-view test set, a few modes, 1 and 3
+# lights): its CSV and JSON rows complete and finite, the GL counts of
+# vdsh-view --bench-counts against the mesh (one lighting pass: one
+# primitive per triangle; a cube-map frame with one light: seven draws of
+# the mesh), and its Pareto front on a synthetic input. 77 without GL.
+# The full report (scripts/pareto) is a benchmark, not a test.
+if(Python3_Interpreter_FOUND AND TARGET vb_frames AND TARGET vdsh-view)
+  add_test(NAME pareto_quick
+           COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/scripts/pareto --quick
+                   --build ${PROJECT_BINARY_DIR} --work ${CMAKE_CURRENT_BINARY_DIR}/pareto_quick)
+  set_tests_properties(pareto_quick PROPERTIES SKIP_RETURN_CODE 77)
+endif()

@@ -157,6 +157,12 @@ expect2 --render a.png --grid b.png "$room"
 expect2 --render a.png "$room" "$room"
 expect2 --frames 0 "$room"
 expect2 --fit --camera 1,2,3,4,5,6 "$room"
+expect2 --bench --bench-cube-sizes 16,0 "$room"
+expect2 --bench --bench-cube-sizes 16.5 "$room"
+expect2 --bench --bench-cube-sizes 1,2,3,4,5,6,7,8,9 "$room"
+expect2 --bench-counts "$room"
+expect2 --bench-modes none "$room"
+expect2 --bench --bench-modes "" "$room"
 exit $fail
 ]=] sh ${_view} ${_room})
 
