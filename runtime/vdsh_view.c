@@ -86,15 +86,21 @@ static const char usage_text[] =
     "                        an order per vertex (vdsh-bake's adaptive order),\n"
     "                        buffer the scene's default of these (adaptive if\n"
     "                        it has it, else its highest order)\n"
+    "                        Distance-field shadows: sdf (the scene's signed\n"
+    "                        distance volume, vdsh-bake --sdf N, sphere-traced\n"
+    "                        toward each light per pixel)\n"
+    "      --sdf-k K         mode sdf's softness: min(K h / t) along the trace\n"
+    "                        (default 8; larger: harder shadows)\n"
     "      --compare C       smooth (the paper's ramp, default) or binary\n"
     "      --pcf             cube shadow maps with PCF (default: 1 tap)\n"
     "      --shadow-size N   cube shadow map face size (default 512)\n"
     "      --size WxH        image or window size (default 1024x768; with\n"
     "                        --grid the size of each panel, default 512x384)\n"
     "\n"
-    "Files: only SCENE.vdsh is read (the basis cubemaps of mode vdsh5 are\n"
-    "computed at load, the same as the .exr files vdsh-bake writes for other\n"
-    "engines).\n"
+    "Files: SCENE.vdsh, and its distance volume SCENE.sdf when that file\n"
+    "exists (the basis cubemaps of mode vdsh5 are computed at load, the same\n"
+    "as the .exr files vdsh-bake writes for other engines).\n"
+    "      --sdf FILE        the distance volume to read instead of SCENE.sdf\n"
     "      --no-cubemaps     do not make them (mode vdsh5 is then unavailable,\n"
     "                        except for --log scenes, which never need them)\n"
     "\n"
@@ -166,7 +172,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
     enum { O_RENDER = 256, O_GRID, O_BENCH, O_CAMERA, O_FIT, O_FOV, O_LIGHT, O_LIGHTS,
            O_ATT, O_AMBIENT, O_MODE, O_COMPARE, O_PCF, O_SHADOW_SIZE, O_SIZE,
            O_NO_CUBEMAPS, O_EGL, O_FRAMES, O_SCREENSHOT, O_NO_OVERLAY, O_KEYS,
-           O_NO_MALLOPT, O_VIEWS, O_MODES, O_BUFFER_FLOATS, O_BENCH_LIGHTS };
+           O_NO_MALLOPT, O_VIEWS, O_MODES, O_BUFFER_FLOATS, O_BENCH_LIGHTS, O_SDF, O_SDF_K };
     static const struct option longopts[] = {
         {"render", required_argument, 0, O_RENDER},
         {"grid", required_argument, 0, O_GRID},
@@ -181,6 +187,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
         {"mode", required_argument, 0, O_MODE},
         {"compare", required_argument, 0, O_COMPARE},
         {"pcf", no_argument, 0, O_PCF},
+        {"sdf", required_argument, 0, O_SDF},
+        {"sdf-k", required_argument, 0, O_SDF_K},
         {"shadow-size", required_argument, 0, O_SHADOW_SIZE},
         {"size", required_argument, 0, O_SIZE},
         {"no-cubemaps", no_argument, 0, O_NO_CUBEMAPS},
@@ -278,6 +286,11 @@ static int parse_args(int argc, char **argv, vv_options *o)
                 return usage_error("--compare: expected smooth or binary, got '%s'", v);
             break;
         case O_PCF: o->pcf = 1; break;
+        case O_SDF: o->sdf_path = v; break;
+        case O_SDF_K:
+            if (!vt_parse_float(v, &o->sdf_k) || !(o->sdf_k > 0.0f && o->sdf_k <= 1000.0f))
+                return usage_error("--sdf-k: expected a number > 0 and <= 1000, got '%s'", v);
+            break;
         case O_SHADOW_SIZE:
             if (!vt_parse_int(v, 1, 8192, &o->shadow_size))
                 return usage_error("--shadow-size: expected 1..8192, got '%s'", v);

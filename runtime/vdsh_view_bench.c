@@ -143,15 +143,15 @@ static int add_float_modes(bench_scene *b)
 /* Load a scene and choose the modes it is timed in. */
 static int bench_open(const vv_options *o, const char *path, bench_scene *b)
 {
-    static const bench_mode all[7] = {
+    static const bench_mode all[8] = {
         {VR_MODE_NONE, 0, "none", 0, 0},     {VR_MODE_CUBE, 0, "cube", 0, 0},
         {VR_MODE_CUBE, 1, "cube_pcf", 0, 0}, {VR_MODE_VDSH2, 0, "vdsh2", 0, 0},
         {VR_MODE_VDSH3, 0, "vdsh3", 0, 0},   {VR_MODE_VDSH5, 0, "vdsh5", 0, 0},
-        {VR_MODE_VDSH5_POLY, 0, "vdsh5poly", 0, 0}};
+        {VR_MODE_VDSH5_POLY, 0, "vdsh5poly", 0, 0}, {VR_MODE_SDF, 0, "sdf", 0, 0}};
     b->path = path;
     if (vv_open_scene(o, path, &b->scene))
         return 1;
-    for (int i = 0; i < 7; i++) {
+    for (int i = 0; i < 8; i++) {
         /* On a log-distance scene both order-5 modes draw the same
          * per-vertex program: time it once, as vdsh5. */
         int same = all[i].mode == VR_MODE_VDSH5_POLY &&

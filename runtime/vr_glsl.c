@@ -502,6 +502,8 @@ static const char fragment_glsl[] =
     "#define VISIBILITY(I) distance_visibility(v_dist[I], dl, dv)\n"
     "#elif VDSH_SPLIT\n"
     "#define VISIBILITY(I) split_visibility(v_sum9[I], lv, dl, dv)\n"
+    "#elif SHADOW_SDF\n"
+    "#define VISIBILITY(I) sdf_visibility(v_position, n, LIGHT_POS(I))\n"
     "#elif SHADOW_CUBE\n"
     "#define VISIBILITY(I) cube_visibility(u_shadow[I], SHADOW_NF(I), lv, dl, n)\n"
     "#else\n"
@@ -607,11 +609,13 @@ static void key_defines(const vr_program_key *k, int flat, char *buf, size_t siz
                      "#define PCF %u\n#define NUM_LIGHTS %u\n#define FLAT_LIGHTS %d\n"
                      "#define PACKED %d\n#define BUFFER %d\n#define BUF_ORDER %u\n"
                      "#define BUF_KIND %u\n#define BUF_VARIABLE %u\n#define BUF_STRIDE %d\n"
+                     "#define SHADOW_SDF %d\n"
                      "#define FOR_EACH_LIGHT",
                      order, visibility, split, distance, cubemap, cube, k->quantity, k->compare,
                      k->output, k->pcf, k->lights, flat, k->packed && order >= 3, buffer,
                      k->buf_order, k->buf_kind, k->buf_variable,
-                     buffer ? vr_buffer_stride(k->buf_order, (vr_buf_kind)k->buf_kind) : 0);
+                     buffer ? vr_buffer_stride(k->buf_order, (vr_buf_kind)k->buf_kind) : 0,
+                     k->mode == VR_MODE_SDF);
     for (unsigned i = 0; i < k->lights && n > 0 && (size_t)n < size; i++)
         n += snprintf(buf + n, size - (size_t)n, " LIGHT(%u)", i);
     if (n > 0 && (size_t)n < size)
@@ -709,7 +713,7 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_progra
     char *table = buffer ? ks_table(ks, key->buf_order * key->buf_order) : NULL;
     size_t vs_size = sizeof defines + sizeof common_glsl + sizeof vertex_glsl +
                      (table ? strlen(table) : 0) + vr_buffer_glsl_size + sizeof vertex_main_glsl;
-    size_t fs_size = sizeof defines + sizeof common_glsl + sizeof fragment_glsl;
+    size_t fs_size = sizeof defines + sizeof common_glsl + vr_sdf_glsl_size + sizeof fragment_glsl;
     char *vs = malloc(vs_size), *fs = malloc(fs_size);
     if (!vs || !fs || (buffer && !table)) {
         free(vs);
@@ -725,7 +729,8 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_progra
         key_defines(key, flat, defines, sizeof defines);
         snprintf(vs, vs_size, "%s%s%s%s%s%s", defines, common_glsl, vertex_glsl,
                  buffer ? table : "", buffer ? vr_buffer_glsl : "", vertex_main_glsl);
-        snprintf(fs, fs_size, "%s%s%s", defines, common_glsl, fragment_glsl);
+        snprintf(fs, fs_size, "%s%s%s%s", defines, common_glsl,
+                 key->mode == VR_MODE_SDF ? vr_sdf_glsl : "", fragment_glsl);
         r = vr_link(name, vs, fs, &prog, err);
         if (r != VR_ERR_SHADER || !flat)
             break;
