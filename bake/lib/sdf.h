@@ -10,7 +10,8 @@
  * and for any thread count.
  * Sign: scenes are not always closed (a room is seen from inside, an
  * object from outside), so no parity count: of the 14 probe rays of
- * formats/vdsh_light.h from the sample, a sample is inside a solid
+ * formats/vdsh_light.h from the sample (turned by one fixed rotation, so
+ * that no probe runs along an axis-aligned wall or through its corners), a sample is inside a solid
  * (negative) when more first meet the back of a face than the front;
  * rays that meet nothing count for neither. Free space in an open room,
  * around an object or under a sky is positive; inside a closed object and
