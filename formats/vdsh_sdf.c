@@ -290,7 +290,7 @@ float vdsh_sdf_shadow(const vdsh_sdf *v, const float p[3], const float n[3],
 {
     float o[3], dir[3];
     for (int a = 0; a < 3; a++) {
-        o[a] = p[a] + n[a] * v->cell;
+        o[a] = p[a] + n[a] * (1.5f * v->cell);
         dir[a] = light[a] - o[a];
     }
     float tmax = sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
@@ -298,14 +298,22 @@ float vdsh_sdf_shadow(const vdsh_sdf *v, const float p[3], const float n[3],
         return 1.0f;
     for (int a = 0; a < 3; a++)
         dir[a] /= tmax;
+    /* Quilez's k is for a light at infinity; a point light at distance
+     * tmax of radius diag / k is a cone of k * tmax / diag (Unreal's
+     * source radius). A constant k darkens every receiver of a light
+     * near a wall: the trace ends within its clearance of the wall. */
+    const float kk = k * tmax / v->max_distance;
     float res = 1.0f, t = 0.5f * v->cell;
     const float min_step = v->cell * 0.125f, hit = v->cell * (1.0f / 64.0f);
     for (int i = 0; i < VDSH_SDF_MAX_STEPS && t < tmax; i++) {
         float q[3] = {o[0] + dir[0] * t, o[1] + dir[1] * t, o[2] + dir[2] * t};
-        float h = vdsh_sdf_sample(v, q);
+        /* Surfaces thickened by half a spacing: a sheet of no thickness
+         * between two samples interpolates to up to cell / 2, and would
+         * let every trace through. */
+        float h = vdsh_sdf_sample(v, q) - 0.35f * v->cell;
         if (h < hit)
             return 0.0f;
-        float s = k * h / t;
+        float s = kk * h / t;
         res = s < res ? s : res;
         t += h > min_step ? h : min_step;
     }

@@ -104,7 +104,7 @@ static void usage(FILE *f)
 "                          for ideal and the c-vdshN frames\n"
 "      --sdf FILE          the distance volume for c-sdf (default SCENE.sdf,\n"
 "                          when it exists)\n"
-"      --sdf-k K           c-sdf's softness (default 8, as vdsh-view's)\n"
+"      --sdf-k K           c-sdf's softness (default 400, as vdsh-view's)\n"
 "\n"
 "score: reads the truth (hard, ideal, mask from --truth DIR) and the frames\n"
 "  of each mode in LIST (comma-separated: vdsh-view's modes cube, cube-pcf,\n"
