@@ -53,7 +53,7 @@ enum {
 
 /* The softness k of vdsh_sdf_shadow: a light of radius diagonal / k.
  * 400: chosen on validation room 1 (docs/BENCHMARKS.md, "Distance-field
- * shadows"): RMSE against the ideal falls with k, 0.42 at 50, 0.29 at
+ * shadows"): RMSE against the ideal falls with k, 0.36 at 50, 0.29 at
  * 400, 0.28 at 800; 400 keeps a visible penumbra. */
 #define VDSH_SDF_DEFAULT_K 400.0f
 
