@@ -1,7 +1,7 @@
 # The bake core and the command-line tools (included from bake/CMakeLists.txt).
 add_library(vb_core STATIC lib/sampling.c lib/scene.c lib/origins.c lib/bake.c lib/stream.c
             lib/fit.c lib/decision.c lib/method.c lib/parallel.c
-            lib/adaptive.c)
+            lib/adaptive.c lib/sdf.c)
 target_link_libraries(vb_core PUBLIC vb_mesh vdsh_format embree Threads::Threads m)
 # A whole bake as one straight line (job.h): load, refine, bake, fill the
 # file, write it with its basis cubemaps.

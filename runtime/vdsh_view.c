@@ -35,7 +35,8 @@ static const char usage_text[] =
     "      --grid FILE       render the comparison row: no shadows | cube shadow\n"
     "                        map | VDSH order 5 | 3 | 2, labelled, into one image,\n"
     "                        and | adaptive order when a SCENE has a stream with\n"
-    "                        an order per vertex; several SCENEs (e.g. the same\n"
+    "                        an order per vertex, | sdf when one has a distance\n"
+    "                        volume (SCENE.sdf); several SCENEs (e.g. the same\n"
     "                        scene baked two ways) give one row each\n"
     "      --bench           time every shadow mode with 1, 3, 16 and 64 lights\n"
     "                        (fewer rounds for 16 and 64) on each SCENE (the\n"
@@ -97,15 +98,21 @@ static const char usage_text[] =
     "                        an order per vertex (vdsh-bake's adaptive order),\n"
     "                        buffer the scene's default of these (adaptive if\n"
     "                        it has it, else its highest order)\n"
+    "                        Distance-field shadows: sdf (the scene's signed\n"
+    "                        distance volume, vdsh-bake --sdf N, sphere-traced\n"
+    "                        toward each light per pixel)\n"
+    "      --sdf-k K         mode sdf's softness: a light of radius diagonal / K\n"
+    "                        (default 400; larger: harder shadows)\n"
     "      --compare C       smooth (the paper's ramp, default) or binary\n"
     "      --pcf             cube shadow maps with PCF (default: 1 tap)\n"
     "      --shadow-size N   cube shadow map face size (default 512)\n"
     "      --size WxH        image or window size (default 1024x768; with\n"
     "                        --grid the size of each panel, default 512x384)\n"
     "\n"
-    "Files: only SCENE.vdsh is read (the basis cubemaps of mode vdsh5 are\n"
-    "computed at load, the same as the .exr files vdsh-bake writes for other\n"
-    "engines).\n"
+    "Files: SCENE.vdsh, and its distance volume SCENE.sdf when that file\n"
+    "exists (the basis cubemaps of mode vdsh5 are computed at load, the same\n"
+    "as the .exr files vdsh-bake writes for other engines).\n"
+    "      --sdf FILE        the distance volume to read instead of SCENE.sdf\n"
     "      --no-cubemaps     do not make them (mode vdsh5 is then unavailable,\n"
     "                        except for --log scenes, which never need them)\n"
     "\n"
@@ -178,7 +185,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
            O_ATT, O_AMBIENT, O_MODE, O_COMPARE, O_PCF, O_SHADOW_SIZE, O_SIZE,
            O_NO_CUBEMAPS, O_EGL, O_FRAMES, O_SCREENSHOT, O_NO_OVERLAY, O_KEYS,
            O_NO_MALLOPT, O_VIEWS, O_MODES, O_BUFFER_FLOATS, O_BENCH_LIGHTS,
-           O_BENCH_CUBE_SIZES, O_BENCH_MODES, O_BENCH_COUNTS };
+           O_BENCH_CUBE_SIZES, O_BENCH_MODES, O_BENCH_COUNTS, O_SDF, O_SDF_K };
     static const struct option longopts[] = {
         {"render", required_argument, 0, O_RENDER},
         {"grid", required_argument, 0, O_GRID},
@@ -193,6 +200,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
         {"mode", required_argument, 0, O_MODE},
         {"compare", required_argument, 0, O_COMPARE},
         {"pcf", no_argument, 0, O_PCF},
+        {"sdf", required_argument, 0, O_SDF},
+        {"sdf-k", required_argument, 0, O_SDF_K},
         {"shadow-size", required_argument, 0, O_SHADOW_SIZE},
         {"size", required_argument, 0, O_SIZE},
         {"no-cubemaps", no_argument, 0, O_NO_CUBEMAPS},
@@ -293,6 +302,11 @@ static int parse_args(int argc, char **argv, vv_options *o)
                 return usage_error("--compare: expected smooth or binary, got '%s'", v);
             break;
         case O_PCF: o->pcf = 1; break;
+        case O_SDF: o->sdf_path = v; break;
+        case O_SDF_K:
+            if (!vt_parse_float(v, &o->sdf_k) || !(o->sdf_k > 0.0f && o->sdf_k <= 1000.0f))
+                return usage_error("--sdf-k: expected a number > 0 and <= 1000, got '%s'", v);
+            break;
         case O_SHADOW_SIZE:
             if (!vt_parse_int(v, 1, 8192, &o->shadow_size))
                 return usage_error("--shadow-size: expected 1..8192, got '%s'", v);

@@ -47,6 +47,8 @@ typedef struct vv_options {
     int have_mode;
     vdsh_compare compare;
     int pcf;
+    const char *sdf_path;      /* --sdf FILE: mode sdf's volume (NULL: SCENE.sdf) */
+    float sdf_k;               /* --sdf-k; 0: the runtime's default */
     int shadow_size;
     int have_size;
     int width, height;
@@ -88,7 +90,7 @@ typedef struct vv_frame_mode {
     int stream;                /* VR_MODE_VDSH_BUFFER: vr_draw_desc.stream */
 } vv_frame_mode;
 
-enum { VV_FRAME_MODES = 24, VV_FRAME_DEFAULT_MODES = 6 };
+enum { VV_FRAME_MODES = 25, VV_FRAME_DEFAULT_MODES = 6 };
 extern const vv_frame_mode vv_frame_modes[VV_FRAME_MODES];
 /* Index of a mode name in vv_frame_modes, or -1. */
 int vv_frame_mode_find(const char *name, size_t len);

@@ -186,16 +186,16 @@ static int add_float_modes(bench_scene *b)
 /* Load a scene and choose the modes it is timed in. */
 static int bench_open(const vv_options *o, const char *path, bench_scene *b)
 {
-    static const bench_mode all[7] = {
+    static const bench_mode all[8] = {
         {VR_MODE_NONE, 0, "none", 0, 0, 0, 0},     {VR_MODE_CUBE, 0, "cube", 0, 0, 0, 0},
         {VR_MODE_CUBE, 1, "cube_pcf", 0, 0, 0, 0}, {VR_MODE_VDSH2, 0, "vdsh2", 0, 0, 0, 0},
         {VR_MODE_VDSH3, 0, "vdsh3", 0, 0, 0, 0},   {VR_MODE_VDSH5, 0, "vdsh5", 0, 0, 0, 0},
-        {VR_MODE_VDSH5_POLY, 0, "vdsh5poly", 0, 0, 0, 0}};
+        {VR_MODE_VDSH5_POLY, 0, "vdsh5poly", 0, 0, 0, 0}, {VR_MODE_SDF, 0, "sdf", 0, 0, 0, 0}};
     int shadow = o->shadow_size ? o->shadow_size : VR_DEFAULT_SHADOW_MAP_SIZE;
     b->path = path;
     if (vv_open_scene(o, path, &b->scene))
         return 1;
-    for (int i = 0; i < 7; i++) {
+    for (int i = 0; i < 8; i++) {
         /* On a log-distance scene both order-5 modes draw the same
          * per-vertex program: time it once, as vdsh5. */
         int same = all[i].mode == VR_MODE_VDSH5_POLY &&
@@ -358,6 +358,13 @@ static void bench_print(const vv_options *o, const bench_scene *b, int all_round
                 uint64_t face = (uint64_t)b->modes[m].cube_size * (uint64_t)b->modes[m].cube_size;
                 vt_json_i64(j, r, "cube_size", b->modes[m].cube_size);
                 vt_json_u64(j, r, "cube_bytes", (uint64_t)per * 6u * face * 4u);
+            }
+            if (b->modes[m].mode == VR_MODE_SDF) {
+                /* The distance volume (R16); each trace step reads 8
+                 * texels by texelFetch (shaders/vr_sdf.glsl), at most 64
+                 * steps per fragment and light. */
+                vt_json_u64(j, r, "sdf_bytes", info.sdf_bytes);
+                vt_json_i64(j, r, "texels_per_sdf_step", 8);
             }
             if (o->bench_counts) {
                 const vr_counts *c = &b->counts[ls][m];

@@ -28,7 +28,8 @@ const vv_frame_mode vv_frame_modes[VV_FRAME_MODES] = {
     {"buf11", VR_MODE_VDSH_BUFFER, 0, 11}, {"buf12", VR_MODE_VDSH_BUFFER, 0, 12},
     {"buf13", VR_MODE_VDSH_BUFFER, 0, 13}, {"buf14", VR_MODE_VDSH_BUFFER, 0, 14},
     {"buf15", VR_MODE_VDSH_BUFFER, 0, 15}, {"buf16", VR_MODE_VDSH_BUFFER, 0, 16},
-    {"adaptive", VR_MODE_VDSH_BUFFER, 0, VR_STREAM_VARIABLE}};
+    {"adaptive", VR_MODE_VDSH_BUFFER, 0, VR_STREAM_VARIABLE},
+    {"sdf", VR_MODE_SDF, 0, 0}};
 
 int vv_frame_mode_find(const char *name, size_t len)
 {
@@ -157,6 +158,7 @@ vr_draw_desc vv_base_desc(const vv_options *o, const vr_light *lights, int n)
     d.stream = o->stream;
     d.compare = o->compare;
     d.pcf = o->pcf;
+    d.sdf_k = o->sdf_k;
     d.lights = lights;
     d.light_count = n;
     float amb = o->have_ambient ? o->ambient : 0.03f;
@@ -222,7 +224,7 @@ int vv_open_scene(const vv_options *o, const char *path, vr_scene **out)
     /* More than the four default lights come from the scene's pool. */
     int pool = o->bench ? VR_MAX_POOL_LIGHTS : o->default_lights > 4 ? o->default_lights - 4 : 0;
     vr_scene_desc sd = {.path = path, .skip_cubemaps = o->no_cubemaps, .light_pool = pool,
-                        .buffers = o->buffers};
+                        .buffers = o->buffers, .sdf_path = o->sdf_path};
     if (vr_scene_create(&sd, out, &err) != VR_OK) {
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
         return 1;

@@ -56,6 +56,7 @@ static vr_result shadow_frame(vr_renderer *r, const vr_scene *scene, const vv_op
     d.mode = m->mode;
     d.stream = m->stream;
     d.pcf = m->pcf;
+    d.sdf_k = o->sdf_k;
     d.compare = o->compare;
     d.lights = &light;
     d.light_count = 1;

@@ -3,6 +3,7 @@
  * paper's comparison row and an adaptive-order column, one row per
  * scene), headless.
  */
+#include "vdsh_sdf.h"
 #include "vdsh_view.h"
 
 #include <stdio.h>
@@ -61,13 +62,15 @@ static void bake_label(const char *path, const vr_scene *s, char *out, size_t si
 }
 
 /* The grid's columns: the paper's row, then adaptive order (kept only
- * when some scene has a stream with an order per vertex). */
-enum { GRID_COLS = 6 };
+ * when some scene has a stream with an order per vertex), then
+ * distance-field shadows (kept only when some scene has a volume). */
+enum { GRID_COLS = 7, GRID_PAPER_COLS = 5 };
 
 /* One row of the grid: the panels of one scene into row (GRID_COLS w
- * wide); *adaptive: 1 when the scene has the adaptive-order stream. */
+ * wide); *adaptive: 1 when the scene has the adaptive-order stream,
+ * *sdf when it has a distance volume. */
 static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w, int h,
-                    unsigned char *px, unsigned char *row, int *adaptive)
+                    unsigned char *px, unsigned char *row, int *adaptive, int *sdf)
 {
     vr_scene *scene = NULL;
     if (vv_open_scene(o, path, &scene))
@@ -78,10 +81,12 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
      * there, else with the polynomials (the same image to f16 precision);
      * a log-distance scene draws both per vertex. */
     vr_mode modes[GRID_COLS] = {VR_MODE_NONE,  VR_MODE_CUBE,  VR_MODE_VDSH5,
-                                VR_MODE_VDSH3, VR_MODE_VDSH2, VR_MODE_VDSH_BUFFER};
+                                VR_MODE_VDSH3, VR_MODE_VDSH2, VR_MODE_VDSH_BUFFER,
+                                VR_MODE_SDF};
     if (!vr_scene_supports(scene, VR_MODE_VDSH5))
         modes[2] = VR_MODE_VDSH5_POLY;
     *adaptive = vr_scene_buffer_stream(scene, VR_STREAM_VARIABLE) != 0;
+    *sdf = vr_scene_supports(scene, VR_MODE_SDF);
     size_t panel = (size_t)w * (size_t)h * 4;
     int rc = 0;
     for (int m = 0; m < GRID_COLS && !rc; m++) {
@@ -98,6 +103,9 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
                      o->pcf ? "PCF" : "1 tap");
         else if (modes[m] == VR_MODE_VDSH_BUFFER && !have)
             snprintf(label, sizeof label, "VDSH adaptive order");
+        else if (modes[m] == VR_MODE_SDF)
+            snprintf(label, sizeof label, "%s, k %g", vr_mode_label(VR_MODE_SDF),
+                     (double)(o->sdf_k > 0.0f ? o->sdf_k : VDSH_SDF_DEFAULT_K));
         else if (modes[m] >= VR_MODE_VDSH2) {
             vv_mode_label(scene, modes[m], VR_STREAM_VARIABLE, label, sizeof label);
             snprintf(label + strlen(label), sizeof label - strlen(label), "%s",
@@ -131,8 +139,9 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
                    px + (size_t)y * (size_t)w * 4, (size_t)w * 4);
     }
     if (!rc && !o->quiet)
-        fprintf(stderr, "vdsh-view: %s: none | cube | %s | vdsh3 | vdsh2%s (%s), %d light%s\n",
+        fprintf(stderr, "vdsh-view: %s: none | cube | %s | vdsh3 | vdsh2%s%s (%s), %d light%s\n",
                 path, vr_mode_name(modes[2]), *adaptive ? " | adaptive" : "",
+                *sdf ? " | sdf" : "",
                 vr_scene_mode_label(scene, modes[2]), n, n == 1 ? "" : "s");
     vr_scene_destroy(scene);
     return rc;
@@ -148,24 +157,33 @@ int vv_run_grid(const vv_options *o)
         return 1;
     size_t panel = (size_t)w * (size_t)h * 4;
     unsigned char *px = malloc(panel), *img = calloc(GRID_COLS * (size_t)rows, panel);
-    int rc = 0, cols = 5;
+    int rc = 0, cols = 0, keep[GRID_COLS] = {0};
+    for (int m = 0; m < GRID_PAPER_COLS; m++)
+        keep[m] = 1;
     if (!px || !img) {
         fprintf(stderr, "vdsh-view: out of memory\n");
         rc = 1;
     }
     for (int i = 0; i < rows && !rc; i++) {
-        int adaptive = 0;
+        int adaptive = 0, sdf = 0;
         rc = grid_row(o, o->files[i], r, w, h, px, img + (size_t)i * GRID_COLS * panel,
-                      &adaptive);
-        if (adaptive)
-            cols = GRID_COLS;
+                      &adaptive, &sdf);
+        keep[GRID_PAPER_COLS] |= adaptive;
+        keep[GRID_PAPER_COLS + 1] |= sdf;
     }
+    for (int m = 0; m < GRID_COLS; m++)
+        cols += keep[m];
     if (!rc) {
-        /* Keep the first cols panels of each row (in place: the rows
-         * only shrink), with a thin dark line between panels and rows. */
+        /* Keep the kept panels of each row, in order (in place: the
+         * rows only shrink), with a thin dark line between panels and
+         * rows. */
         size_t wide = GRID_COLS * (size_t)w * 4, stride = (size_t)cols * (size_t)w * 4;
+        size_t pw = (size_t)w * 4;
         for (int y = 0; y < rows * h; y++)
-            memmove(img + (size_t)y * stride, img + (size_t)y * wide, stride);
+            for (int m = 0, c = 0; m < GRID_COLS; m++)
+                if (keep[m])
+                    memmove(img + (size_t)y * stride + (size_t)c++ * pw,
+                            img + (size_t)y * wide + (size_t)m * pw, pw);
         for (int y = 0; y < rows * h; y++)
             for (int m = 1; m < cols; m++)
                 memset(img + (size_t)y * stride + (size_t)m * (size_t)w * 4, 40, 4);

@@ -53,6 +53,13 @@
  *                       made at load, texel for texel the bake's files).
  *   VR_MODE_VDSH5_POLY  order 5 with the last 16 basis functions evaluated as
  *                       polynomials in the fragment stage (no cubemaps).
+ *   VR_MODE_SDF         second baseline: distance-field soft shadows. The
+ *                       scene's signed distance volume (vdsh-bake --sdf N,
+ *                       a companion file) as a 3D texture, sphere-traced
+ *                       from each fragment toward each light with
+ *                       Quilez's soft-shadow estimate min(k h / t):
+ *                       formats/vdsh_sdf.h's vdsh_sdf_shadow, the same in
+ *                       C and GLSL.
  *   VR_MODE_VDSH_BUFFER any stored order (1..VDSH_MAX_ORDER), or a stream
  *                       with an order per vertex, chosen by
  *                       vr_draw_desc.stream: always the per-vertex distance
@@ -177,6 +184,13 @@ typedef struct vr_scene_desc {
      * f32 coefficients instead (vdsh_stream_decode; 2x the bytes of f16,
      * 4x s8), no unpacking in the shader: for comparisons. */
     int buffer_floats;
+    /* VR_MODE_SDF's signed distance volume (formats/vdsh_sdf.h), uploaded
+     * as a 3D texture. NULL (default): the .vdsh's companion file
+     * (vdsh_sdf_path: room.vdsh -> room.sdf) when desc->path is set and
+     * that file exists, else none (VR_MODE_SDF then fails with
+     * VR_ERR_MISSING). A volume that cannot be read, or was baked beside
+     * a scene of other vertex or triangle counts, fails the load. */
+    const char *sdf_path;
 } vr_scene_desc;
 
 /* Load (when desc->path is set and desc->file is not), validate, upload
@@ -224,6 +238,9 @@ typedef struct vr_scene_info {
     int variable_order;
     float variable_mean_order;
     size_t buffer_bytes;
+    int has_sdf;                  /* a distance volume: VR_MODE_SDF */
+    uint32_t sdf_dim[3];          /* its samples per axis */
+    size_t sdf_bytes;             /* its share of gpu_bytes */
 } vr_scene_info;
 
 void vr_scene_get_info(const vr_scene *s, vr_scene_info *out);
@@ -290,6 +307,7 @@ typedef enum vr_mode {
     VR_MODE_VDSH5,
     VR_MODE_VDSH5_POLY,
     VR_MODE_VDSH_BUFFER,
+    VR_MODE_SDF,             /* distance-field shadows (vr_scene_desc.sdf_path) */
     VR_MODE_COUNT_
 } vr_mode;
 
@@ -297,7 +315,7 @@ typedef enum vr_mode {
  * per vertex (1..VDSH_MAX_ORDER: the fixed stream of that order). */
 enum { VR_STREAM_VARIABLE = -1 };
 
-/* "none", "cube", "vdsh2", "vdsh3", "vdsh5", "vdsh5poly", "buffer" (the
+/* "none", "cube", "vdsh2", "vdsh3", "vdsh5", "vdsh5poly", "buffer", "sdf" (the
  * viewer's --mode names); "?" for others. vr_mode_from_name returns 0 on success
  * and leaves *out untouched on an unknown name. */
 const char *vr_mode_name(vr_mode m);
@@ -384,6 +402,8 @@ typedef struct vr_draw_desc {
     int stream;              /* VR_MODE_VDSH_BUFFER: the stream drawn,
                                 vr_scene_buffer_stream's argument (0: the
                                 scene's default); ignored by other modes */
+    float sdf_k;             /* VR_MODE_SDF: the softness k of
+                                vdsh_sdf_shadow; 0: VDSH_SDF_DEFAULT_K */
 } vr_draw_desc;
 
 /* Draw one frame into the renderer's framebuffer: for each group of up to

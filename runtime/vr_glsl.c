@@ -140,11 +140,13 @@ static void key_defines(const vr_program_key *k, int flat, char *buf, size_t siz
                      "#define PCF %u\n#define NUM_LIGHTS %u\n#define FLAT_LIGHTS %d\n"
                      "#define PACKED %d\n#define BUFFER %d\n#define BUF_ORDER %u\n"
                      "#define BUF_KIND %u\n#define BUF_VARIABLE %u\n#define BUF_STRIDE %d\n"
+                     "#define SHADOW_SDF %d\n"
                      "#define FOR_EACH_LIGHT",
                      order, visibility, split, distance, cubemap, cube, k->quantity, k->compare,
                      k->output, k->pcf, k->lights, flat, k->packed && order >= 3, buffer,
                      k->buf_order, k->buf_kind, k->buf_variable,
-                     buffer ? vr_buffer_stride(k->buf_order, (vr_buf_kind)k->buf_kind) : 0);
+                     buffer ? vr_buffer_stride(k->buf_order, (vr_buf_kind)k->buf_kind) : 0,
+                     k->mode == VR_MODE_SDF);
     for (unsigned i = 0; i < k->lights && n > 0 && (size_t)n < size; i++)
         n += snprintf(buf + n, size - (size_t)n, " LIGHT(%u)", i);
     if (n > 0 && (size_t)n < size)
@@ -242,7 +244,8 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_progra
     char *table = buffer ? ks_table(ks, key->buf_order * key->buf_order) : NULL;
     size_t vs_size = sizeof defines + vr_glsl_common_size + vr_glsl_vertex_size +
                      (table ? strlen(table) : 0) + vr_buffer_glsl_size + vr_glsl_vertex_main_size;
-    size_t fs_size = sizeof defines + vr_glsl_common_size + vr_glsl_fragment_size;
+    size_t fs_size = sizeof defines + vr_glsl_common_size + vr_sdf_glsl_size +
+                     vr_glsl_fragment_size;
     char *vs = malloc(vs_size), *fs = malloc(fs_size);
     if (!vs || !fs || (buffer && !table)) {
         free(vs);
@@ -258,7 +261,8 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_progra
         key_defines(key, flat, defines, sizeof defines);
         snprintf(vs, vs_size, "%s%s%s%s%s%s", defines, vr_glsl_common, vr_glsl_vertex,
                  buffer ? table : "", buffer ? vr_buffer_glsl : "", vr_glsl_vertex_main);
-        snprintf(fs, fs_size, "%s%s%s", defines, vr_glsl_common, vr_glsl_fragment);
+        snprintf(fs, fs_size, "%s%s%s%s", defines, vr_glsl_common,
+                 key->mode == VR_MODE_SDF ? vr_sdf_glsl : "", vr_glsl_fragment);
         r = vr_link(name, vs, fs, &prog, err);
         if (r != VR_ERR_SHADER || !flat)
             break;

@@ -10,6 +10,7 @@
 #include <GL/glcorearb.h>
 
 #include "vdsh_scene_view.h"
+#include "vdsh_sdf.h"
 #include "vr.h"
 
 /* Format a message into err (if not NULL) and return r. */
@@ -60,7 +61,8 @@ int vr_coef_attrib_count(int order);
 enum {
     VR_UNIT_BASIS = 0,
     VR_UNIT_SHADOW = 4,
-    VR_UNIT_COEF = VR_UNIT_SHADOW + VR_MAX_LIGHTS_PER_PASS
+    VR_UNIT_COEF = VR_UNIT_SHADOW + VR_MAX_LIGHTS_PER_PASS,
+    VR_UNIT_SDF = VR_UNIT_COEF + 1
 };
 
 /* A buffer stream's vertex attributes (VR_MODE_VDSH_BUFFER, variable
@@ -126,7 +128,17 @@ struct vr_scene {
     int pool_count;
     vr_buffer buffer[VDSH_ORDER_SLOTS]; /* fixed orders, by order */
     vr_buffer variable;                 /* an order per vertex */
+    GLuint sdf_tex;             /* mode sdf: the distance volume (0: none) */
+    vdsh_sdf sdf;               /* its header (samples NULL) */
+    size_t sdf_bytes;
 };
+
+/* Mode sdf (vr_sdf.c): load desc->sdf_path, or the .vdsh's companion when
+ * it exists, into s; a scene without either is fine (no volume). */
+vr_result vr_sdf_load(vr_scene *s, const vr_scene_desc *desc, uint32_t vertex_count,
+                      uint32_t triangle_count, vr_error *err);
+/* Bind the volume and set the trace's uniforms of a bound program. */
+void vr_sdf_bind(const vr_scene *s, GLuint prog, float k);
 
 /* The buffer stream vr_draw_desc.stream names (vr_scene_buffer_stream),
  * or NULL. */

@@ -551,6 +551,11 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                        (unsigned)d.compare);
     if ((unsigned)d.output > VR_OUTPUT_POSITION)
         return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown output %u", (unsigned)d.output);
+    if (d.sdf_k == 0.0f)
+        d.sdf_k = VDSH_SDF_DEFAULT_K;
+    if (!(d.sdf_k > 0.0f && d.sdf_k < 1e6f))
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: sdf_k %g is not a number > 0",
+                       (double)d.sdf_k);
     if (d.light_count < 0 || (d.light_count > 0 && !d.lights))
         return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: %d lights but no array", d.light_count);
     for (int i = 0; i < d.light_count; i++)
@@ -576,6 +581,10 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                                ? " (orders 1-5 are buffered with vr_scene_desc.buffers)"
                                : "");
     } else if (!vr_scene_supports(s, mode)) {
+        if (mode == VR_MODE_SDF)
+            return vr_fail(err, VR_ERR_MISSING, "mode sdf needs the scene's distance volume: "
+                           "none was loaded (bake it with vdsh-bake --sdf N, which writes "
+                           "room.sdf beside room.vdsh)");
         if (mode == VR_MODE_VDSH5 && s->vbo_stream[5])
             return vr_fail(err, VR_ERR_MISSING,
                            "mode %s needs the basis cubemaps, which this scene has not "
@@ -713,6 +722,8 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                 glBindTexture(GL_TEXTURE_CUBE_MAP, s->basis[k]);
             }
         }
+        if (mode == VR_MODE_SDF)
+            vr_sdf_bind(s, p->prog, d.sdf_k);
         if (buf) {
             glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
             glBindTexture(GL_TEXTURE_BUFFER, buf->tex);

@@ -338,6 +338,9 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
         s->cube_size = (int)h->cube_size;
         s->gpu_bytes += 4 * 6 * (size_t)s->cube_size * (size_t)s->cube_size * 8;
     }
+    r = vr_sdf_load(s, desc, h->vertex_count, h->triangle_count, err);
+    if (r != VR_OK)
+        goto done;
     r = vr_check_gl(err, name);
 
 done:
@@ -363,6 +366,7 @@ void vr_scene_destroy(vr_scene *s)
     glDeleteBuffers(1, &s->vbo_normal);
     glDeleteBuffers(1, &s->ibo);
     glDeleteTextures(4, s->basis);
+    glDeleteTextures(1, &s->sdf_tex);
     for (int o = 0; o < VDSH_ORDER_SLOTS; o++)
         vr_buffer_destroy(&s->buffer[o]);
     vr_buffer_destroy(&s->variable);
@@ -388,6 +392,9 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     i.quantity = s->quantity;
     i.max_distance = s->max_distance;
     i.gpu_bytes = s->gpu_bytes;
+    i.has_sdf = s->sdf_tex != 0;
+    memcpy(i.sdf_dim, s->sdf.dim, sizeof i.sdf_dim);
+    i.sdf_bytes = s->sdf_bytes;
     i.interior = s->view.interior;
     for (int o = 1; o < VDSH_ORDER_SLOTS; o++) {
         i.has_buffer[o] = s->buffer[o].order != 0;
@@ -423,6 +430,7 @@ int vr_scene_supports(const vr_scene *s, vr_mode m)
     case VR_MODE_DEFAULT: return vr_scene_supports(s, vr_scene_default_mode(s));
     case VR_MODE_VDSH5_POLY: return s->vbo_stream[5] != 0;
     case VR_MODE_VDSH_BUFFER: return vr_scene_buffer_stream(s, 0) != 0;
+    case VR_MODE_SDF: return s->sdf_tex != 0;
     default: return 0;
     }
 }

@@ -69,7 +69,7 @@ const char *vr_gl_renderer(void)
 /* ------------------------------------------------------------------ */
 
 static const char *const mode_names[VR_MODE_COUNT_] = {
-    "default", "none", "cube", "vdsh2", "vdsh3", "vdsh5", "vdsh5poly", "buffer"};
+    "default", "none", "cube", "vdsh2", "vdsh3", "vdsh5", "vdsh5poly", "buffer", "sdf"};
 
 static const char *const mode_labels[VR_MODE_COUNT_] = {
     "the scene's default (VDSH order 5, cubemaps where it has them)",
@@ -79,7 +79,8 @@ static const char *const mode_labels[VR_MODE_COUNT_] = {
     "VDSH order 3 (9 coeff.)",
     "VDSH order 5 (25 coeff., cubemaps)",
     "VDSH order 5 (25 coeff., polynomials)",
-    "VDSH from a buffer (any order, per-vertex distance)"};
+    "VDSH from a buffer (any order, per-vertex distance)",
+    "distance-field shadows (sphere trace)"};
 
 const char *vr_mode_name(vr_mode m)
 {

@@ -37,11 +37,14 @@ bake=$1; frames=$2; view=$3; cmp=$4; d=$5; views=$6; derive=$7
 set -e
 rm -rf "$d"; mkdir -p "$d"
 for m in shadow paper; do
-  "$bake" builtin:room --max-edge 0.5 --rays 400 --method $m --cube-size 32 -q -o "$d/$m.vdsh"
+  # The shadow bake also gets a distance volume (room.sdf): mode sdf
+  # against vdsh-frames' c-sdf, the same trace in GLSL and C.
+  sdf=; [ $m = shadow ] && sdf="--sdf 32"
+  "$bake" builtin:room --max-edge 0.5 --rays 400 --method $m --cube-size 32 $sdf -q -o "$d/$m.vdsh"
   "$frames" truth "$d/$m.vdsh" --views "$views" -o "$d/$m-c" > /dev/null
   set +e
   modes=vdsh2,vdsh3,vdsh5,vdsh5poly
-  [ $m = shadow ] && modes=$modes,buf2,buf3,buf5
+  [ $m = shadow ] && modes=$modes,buf2,buf3,buf5,sdf
   "$view" "$d/$m.vdsh" --views "$views" --frames "$d/$m-gl" --modes $modes -q
   rc=$?
   set -e
@@ -50,7 +53,7 @@ for m in shadow paper; do
 done
 "$cmp" "$views" "$d/shadow-c" "$d/shadow-gl" 0.002 0.005 \
   vdsh2=c-vdsh2 vdsh3=c-vdsh3 vdsh5=c-vdsh5 vdsh5poly=c-vdsh5 \
-  buf2=c-vdsh2 buf3=c-vdsh3 buf5=c-vdsh5
+  buf2=c-vdsh2 buf3=c-vdsh3 buf5=c-vdsh5 sdf=c-sdf
 "$cmp" "$views" "$d/paper-c" "$d/paper-gl" 0.002 0.005 \
   vdsh2=c-vdsh2 vdsh3=c-vdsh3 vdsh5=c-vdsh5 vdsh5poly=c-vdsh5
 # Orders above 5 and an order per vertex (up to 11; vdsh-frames names its

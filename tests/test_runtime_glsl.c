@@ -739,8 +739,10 @@ static void test_light_at_receiver(void)
             free(pos);
             CHECK(pixel >= 0, "the receiver under the light is not in the image");
 
+            /* (VR_MODE_SDF needs a distance volume, which these files have
+             * not: its trace is checked by test_sdf and frames_gl_vs_c.) */
             for (int m = VR_MODE_NONE; m < VR_MODE_COUNT_; m++)
-                for (uint32_t cmp = 0; cmp < 2; cmp++)
+                for (uint32_t cmp = 0; cmp < 2 && m != VR_MODE_SDF; cmp++)
                     for (int points = 1; points >= 0; points--) {
                         vr_draw_desc ds = grid_view(&light);
                         ds.mode = (uint32_t)m;

@@ -28,6 +28,7 @@
 #include "mesh.h"
 #include "method.h"
 #include "scene.h"
+#include "sdf.h"
 #include "vdsh.h"
 #include "vdsh_output.h"
 #include "vt_cli.h"
@@ -72,6 +73,7 @@ typedef struct options {
     uint64_t seed;
     unsigned threads;
     int cube_size;
+    int sdf;                   /* --sdf N: distance volume, N per longest side */
     int robust;
     int record_timings;
     int trace_only;
@@ -144,6 +146,10 @@ static void usage(FILE *f)
 "  -o, --output FILE       the .vdsh file to write (atomically)\n"
 "      --cubemap-dir DIR   where the SH basis cubemaps go (default: beside OUT)\n"
 "      --cube-size N       cubemap face size in texels (default 64; 0: none)\n"
+"      --sdf N             also bake the signed distance volume of the scene for\n"
+"                          vdsh-view --mode sdf: N samples along the bounds'\n"
+"                          longest side (4..512; 64 is a good start), written\n"
+"                          to OUT's companion file (room.vdsh: room.sdf)\n"
 "      --encoding E        coefficient encoding: s8s6 (default: bands 0-1 signed\n"
 "                          8-bit, bands 2+ 6-bit, a scale per coefficient\n"
 "                          index; 4, 8, 24 bytes per vertex at orders 2, 3, 5),\n"
@@ -644,7 +650,7 @@ int main(int argc, char **argv)
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
            O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL, O_SHARD,
            O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS, O_MAX_ROUNDS, O_PLAN, O_RECEIVERS, O_ADAPTIVE_ORDER,
-           O_MAX_ORDER, O_DEC_LIGHTS, O_FALSE_RATE, O_DEC_PARAMS };
+           O_MAX_ORDER, O_DEC_LIGHTS, O_FALSE_RATE, O_DEC_PARAMS, O_SDF };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
@@ -660,6 +666,7 @@ int main(int argc, char **argv)
         {"seed", required_argument, 0, O_SEED},
         {"threads", required_argument, 0, O_THREADS},
         {"cube-size", required_argument, 0, O_CUBESIZE},
+        {"sdf", required_argument, 0, O_SDF},
         {"cubemap-dir", required_argument, 0, O_CUBEDIR},
         {"robust", no_argument, 0, O_ROBUST},
         {"no-robust", no_argument, 0, O_NO_ROBUST},
@@ -803,6 +810,11 @@ int main(int argc, char **argv)
             o.cube_size = (int)u;
             break;
         case O_CUBEDIR: o.cubemap_dir = optarg; break;
+        case O_SDF:
+            if (!vt_parse_u64(optarg, VB_SDF_MIN_RESOLUTION, VB_SDF_MAX_RESOLUTION, &u))
+                return bad_usage("--sdf takes a whole number 4..512, not '%s'", optarg);
+            o.sdf = (int)u;
+            break;
         case O_ROBUST: o.robust = 1; break;
         case O_NO_ROBUST: o.robust = 0; break;
         case O_REPORT: o.report = optarg; break;
@@ -891,6 +903,9 @@ int main(int argc, char **argv)
         return bad_usage("%s", "--adaptive cannot be combined with --shard: the refinement "
                                "bakes as it decides. Plan it once (--adaptive ... --plan "
                                "plan.obj), then shard the plan (--receivers plan.obj --shard I/N)");
+    if (o.sdf && (shard_count || !o.output || o.trace_only))
+        return bad_usage("%s", "--sdf writes beside the output file: it needs -o OUT.vdsh, "
+                               "and neither --shard nor --trace-only");
     if (o.plan && o.receivers)
         return bad_usage("%s", "--plan writes the receivers --receivers reads: not both");
     if (o.receivers && (o.adaptive || o.max_edge > 0.0f || o.weld))
@@ -1163,9 +1178,43 @@ int main(int argc, char **argv)
         goto out;
     }
 
-    /* 5. Write: the basis cubemaps, then the .vdsh file, last. */
+    /* 5. The distance volume, if asked: baked and written beside the
+     * output before it, so the .vdsh is still the last file to appear. */
+    char sdf_path[PATH_MAX];
+    vdsh_sdf vol = {0};
+    double sdf_seconds = 0.0;
+    if (o.sdf) {
+        double ts = vb_now();
+        if (vdsh_sdf_path(o.output, sdf_path, sizeof sdf_path) != 0) {
+            fprintf(stderr, "vdsh-bake: %s: path too long for its distance volume\n", o.output);
+            goto out;
+        }
+        if (vb_sdf_bake(job.scene, &job.occluders, o.sdf, o.threads, &vol, &err) != VB_OK) {
+            fprintf(stderr, "vdsh-bake: %s: %s\n", sdf_path, err.msg);
+            goto out;
+        }
+        vol.vertex_count = job.file.header.vertex_count;
+        vol.triangle_count = job.file.header.triangle_count;
+        sdf_seconds = vb_now() - ts;
+    }
+
+    /* 6. Write: the basis cubemaps and the distance volume, then the .vdsh
+     * file, last. */
     pthread_mutex_lock(&output_lock);
     writing = 1;
+    if (o.sdf) {
+        vdsh_error verr;
+        vdsh_result vr = vdsh_sdf_write(sdf_path, &vol, &verr);
+        vdsh_sdf_free(&vol);
+        if (vr != VDSH_OK) {
+            fprintf(stderr, "vdsh-bake: %s\n", verr.msg);
+            goto out;
+        }
+        if (log)
+            fprintf(log, "vdsh-bake: distance volume %u x %u x %u (spacing %g) baked in %.2f s, "
+                         "wrote %s (%.2f MB)\n", vol.dim[0], vol.dim[1], vol.dim[2],
+                    (double)vol.cell, sdf_seconds, sdf_path, vdsh_sdf_file_size(&vol) / 1e6);
+    }
     if (vb_job_write(&job, &jd, &err) != VB_OK) {
         fprintf(stderr, "vdsh-bake: %s\n", err.msg);
         goto out;

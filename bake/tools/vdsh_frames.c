@@ -31,6 +31,7 @@
 #include "parallel.h"
 #include "scene.h"
 #include "vdsh.h"
+#include "vdsh_sdf.h"
 #include "vdsh_shadow.h"
 #include "vt_cli.h"
 #include "vt_image.h"
@@ -84,6 +85,10 @@ static void usage(FILE *f)
 "             what method shadow bakes: each vertex's distance, interpolated)\n"
 "    c-vdsh-var  the file's variable-order stream (each vertex its own\n"
 "             order), on the per-vertex distance path\n"
+"    c-sdf    distance-field shadows when the scene has a distance volume\n"
+"             (SCENE.sdf beside it, vdsh-bake --sdf N; or --sdf FILE):\n"
+"             formats/vdsh_sdf.h's sphere trace, what vdsh-view's mode sdf\n"
+"             draws\n"
 "  Pixels that meet nothing hold 1 (mask 0). Primary rays go through pixel\n"
 "  centres (formats/vdsh_camera.h, the camera the runtime projects with)\n"
 "  and meet the receiver mesh; normals are interpolated as the GPU does.\n"
@@ -97,6 +102,9 @@ static void usage(FILE *f)
 "  -o, --output DIR        where the frames go (created if missing)\n"
 "      --compare C         smooth (default, the paper's ramp) or binary,\n"
 "                          for ideal and the c-vdshN frames\n"
+"      --sdf FILE          the distance volume for c-sdf (default SCENE.sdf,\n"
+"                          when it exists)\n"
+"      --sdf-k K           c-sdf's softness (default 400, as vdsh-view's)\n"
 "\n"
 "score: reads the truth (hard, ideal, mask from --truth DIR) and the frames\n"
 "  of each mode in LIST (comma-separated: vdsh-view's modes cube, cube-pcf,\n"
@@ -229,7 +237,7 @@ static int read_views(const char *path, vt_views *v)
 /* Options every subcommand takes; returns 1 if handled, or an exit code
  * + 2 for help, version and errors (so 0 means "not mine"). */
 enum { O_THREADS = 256, O_CAMERAS, O_SEED, O_SIZE, O_VIEWS, O_COMPARE, O_TRUTH, O_FRAMES,
-       O_MODES, O_JSON };
+       O_MODES, O_JSON , O_SDF, O_SDF_K };
 
 static int common_option(int c, common *co, int *exit_code)
 {
@@ -456,6 +464,26 @@ static int write_frames(const frame_batch *b, uint32_t count, unsigned threads)
     return 0;
 }
 
+/* c-sdf: the runtime's mode sdf in C, per pixel (1 where nothing is hit). */
+typedef struct sdf_pass {
+    const vdsh_sdf *v;
+    const vb_frames_hits *hits;
+    const float *light;
+    float k;
+    float *out;
+} sdf_pass;
+
+static void sdf_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
+{
+    (void)worker;
+    const sdf_pass *P = ctx;
+    for (uint32_t i = begin; i < end; i++)
+        P->out[i] = P->hits->triangle[i] == UINT32_MAX
+                        ? 1.0f
+                        : vdsh_sdf_shadow(P->v, P->hits->position + 3 * (size_t)i,
+                                          P->hits->normal + 3 * (size_t)i, P->light, P->k);
+}
+
 static int cmd_truth(int argc, char **argv)
 {
     common co = {0};
@@ -463,12 +491,20 @@ static int cmd_truth(int argc, char **argv)
     uint32_t compare = VDSH_COMPARE_SMOOTH;
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'}, {"views", required_argument, 0, O_VIEWS},
-        {"compare", required_argument, 0, O_COMPARE}, COMMON_OPTIONS, {0, 0, 0, 0}};
+        {"compare", required_argument, 0, O_COMPARE}, {"sdf", required_argument, 0, O_SDF},
+        {"sdf-k", required_argument, 0, O_SDF_K}, COMMON_OPTIONS, {0, 0, 0, 0}};
+    const char *sdf_arg = NULL;
+    float sdf_k = VDSH_SDF_DEFAULT_K;
     int c, code;
     while ((c = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
         switch (c) {
         case 'o': dir = optarg; break;
         case O_VIEWS: views_path = optarg; break;
+        case O_SDF: sdf_arg = optarg; break;
+        case O_SDF_K:
+            if (!vt_parse_float(optarg, &sdf_k) || !(sdf_k > 0.0f && sdf_k <= 1000.0f))
+                return bad_usage("--sdf-k takes a number > 0 and <= 1000, not '%s'", optarg);
+            break;
         case O_COMPARE:
             compare = vdsh_compare_by_name(optarg);
             if (compare == VDSH_COMPARE_COUNT)
@@ -498,12 +534,32 @@ static int cmd_truth(int argc, char **argv)
     int status = 1;
     const vdsh_file *f = L.f;
     const int w = V.width, h = V.height;
+    /* The distance volume: --sdf, else the companion file when it exists. */
+    vdsh_sdf vol = {0};
+    int have_sdf = 0;
+    {
+        char sp[PATH_MAX];
+        struct stat sst;
+        const char *p = sdf_arg;
+        if (!p && vdsh_sdf_path(path, sp, sizeof sp) == 0 && stat(sp, &sst) == 0)
+            p = sp;
+        if (p) {
+            vdsh_error ve;
+            if (vdsh_sdf_read(p, &vol, &ve) != VDSH_OK) {
+                fprintf(stderr, PROG ": %s\n", ve.msg);
+                loaded_free(&L);
+                vt_views_free(&V);
+                return 1;
+            }
+            have_sdf = 1;
+        }
+    }
     const size_t n = (size_t)w * (size_t)h;
     vb_frames_hits hits = {0};
     vb_frames_light lights[VT_VIEWS_MAX_LIGHTS];
     memset(lights, 0, sizeof lights);
-    float *streams = malloc(((size_t)f->stream_count + 1) * n * sizeof *streams);
-    frame_item *items = calloc(3 + (size_t)f->stream_count, sizeof *items);
+    float *streams = malloc(((size_t)f->stream_count + 2) * n * sizeof *streams);
+    frame_item *items = calloc(4 + (size_t)f->stream_count, sizeof *items);
     uint8_t *rgba = malloc(4 * n);
     vb_error err;
     /* One c-vdshN per order, the first fixed-order stream of each, and one
@@ -590,6 +646,21 @@ static int cmd_truth(int argc, char **argv)
                     stream_mode(&f->streams[s], items[count].mode, sizeof items[count].mode);
                     items[count++].values = out;
                 }
+                if (have_sdf) {
+                    float *out = streams + (size_t)(f->stream_count + 1) * n;
+                    t = vb_now();
+                    sdf_pass sp = {.v = &vol, .hits = &hits, .light = L0, .k = sdf_k, .out = out};
+                    if (!vb_parallel_for(co.threads, (uint32_t)n, 1024, sdf_block, &sp, NULL,
+                                         NULL)) {
+                        fprintf(stderr, PROG ": cannot start worker threads\n");
+                        goto done;
+                    }
+                    tc += vb_now() - t;
+                    stream_frames++;
+                    memset(&items[count], 0, sizeof items[count]);
+                    snprintf(items[count].mode, sizeof items[count].mode, "c-sdf");
+                    items[count++].values = out;
+                }
                 t = vb_now();
                 if (write_frames(&fb, count, co.threads))
                     goto done;
@@ -645,6 +716,7 @@ done:
     free(streams);
     free(items);
     free(rgba);
+    vdsh_sdf_free(&vol);
     loaded_free(&L);
     vt_views_free(&V);
     return status;

@@ -155,6 +155,8 @@ vec3 light_term(vec3 color, vec3 att3, vec3 lv, float dl, vec3 n)
 #define VISIBILITY(I) distance_visibility(v_dist[I], dl, dv)
 #elif VDSH_SPLIT
 #define VISIBILITY(I) split_visibility(v_sum9[I], lv, dl, dv)
+#elif SHADOW_SDF
+#define VISIBILITY(I) sdf_visibility(v_position, n, LIGHT_POS(I))
 #elif SHADOW_CUBE
 #define VISIBILITY(I) cube_visibility(u_shadow[I], SHADOW_NF(I), lv, dl, n)
 #else
