@@ -13,7 +13,10 @@ float rounding, so the difference is far below one grey level on
 average; it is also printed over the shadowed pixels alone). The frames
 must hold shadows (so a blank page cannot pass).
 The same for order 5 of Debian assimp-testmodels' 2CylinderEngine.glb
-(read by the glTF reader), seen and lit from outside.
+(read by the glTF reader), seen and lit from outside; its --source export
+(a scene of many meshes, for three.html) is refused with a message naming
+three.html. The page's vertex stage, stream choice and buffer-path data
+are vdsh_core.js's (shared with vdsh_three.js), loaded as ES modules.
 
 Orders above 5 and the adaptive order (issue 26: the page was blank for
 them): the room's bake also holds an order-12 stream and an adaptive-order
@@ -75,7 +78,7 @@ def run(cmd, **kw):
 fail = []
 csv = lambda v: ",".join("%g" % x for x in v)
 W, H = 320, 240
-for f in ("index.html", "vdsh_web.js"):
+for f in ("index.html", "vdsh_web.js", "vdsh_core.js"):
     shutil.copy(os.path.join(webdir, f), work)
 # The page's GLSL: runtime/shaders/ (vdsh_common.glsl, vdsh_buffer.glsl),
 # found in shaders/ beside the page.
@@ -261,7 +264,15 @@ def outside(lo, hi):
 
 engine = os.path.join(models, "glTF2", "2CylinderEngine-glTF-Binary", "2CylinderEngine.glb")
 if os.path.exists(engine):
-    default_view("engine", *scene("engine", engine, ["--rays", "64"], [5], outside))
+    evd, eglb = scene("engine", engine, ["--rays", "64"], [5], outside)
+    default_view("engine", evd, eglb)
+    # A --source export (the glTF's own scene, many meshes): the page
+    # draws the plain export only and says so, naming three.html.
+    run([export, evd, "--source", engine, "-o", os.path.join(work, "engine-source.glb"), "-q"])
+    msg = message(page("glb=engine-source.glb&size=%dx%d" % (W, H)))
+    print("engine-source.glb: the page says: %s" % msg)
+    if not msg or "three.html" not in msg:
+        fail.append("engine-source.glb: no visible message naming three.html (got %r)" % msg)
 else:
     print("no %s: the glTF scene part skipped" % engine)
 
