@@ -22,7 +22,7 @@ install(TARGETS vdsh_format vr vr_context EXPORT vdshTargets
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
         PUBLIC_HEADER DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vdsh)
 install(EXPORT vdshTargets NAMESPACE vdsh:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vdsh)
-file(GLOB VDSH_SHADER_FILES ${PROJECT_SOURCE_DIR}/runtime/shaders/*.glsl)
+file(GLOB VDSH_SHADER_FILES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/runtime/shaders/*.glsl)
 install(FILES ${VDSH_SHADER_FILES} ${PROJECT_SOURCE_DIR}/runtime/shaders/README.md
         DESTINATION ${CMAKE_INSTALL_DATADIR}/vdsh/shaders)
 install(FILES ${PROJECT_SOURCE_DIR}/runtime/web/index.html ${PROJECT_SOURCE_DIR}/runtime/web/vdsh_web.js
