@@ -37,7 +37,8 @@ rewritten by tests/web_glb_pack.mjs as gltfpack writes it
 transform, int8 normals), and that compressed with EXT_meshopt_compression
 (meshoptimizer's encoder, the npm package, installed by
 scripts/npm_gltf_tools into MODULES), must draw the order-5 frame as the
-plain glb does; without meshopt_decoder.cjs beside the page the meshopt
+plain glb does, and so must vdsh-export --compress's own file; without
+meshopt_decoder.cjs beside the page the meshopt
 file must be refused with a visible message (#msg). Skipped without node
 or MODULES.
 
@@ -238,6 +239,7 @@ if node and modules and os.path.exists(os.path.join(modules, "meshoptimizer", "m
     for how in ("quantise", "meshopt"):
         out = os.path.join(work, "room-%s.glb" % how)
         run([node, pack, modules, room_glb, out, how])
+    run([export, room_vd, "-o", os.path.join(work, "room-compress.glb"), "--compress", "-q"])
     dec = os.path.join(work, "meshopt_decoder.cjs")
     if os.path.exists(dec):
         os.remove(dec)
@@ -247,7 +249,7 @@ if node and modules and os.path.exists(os.path.join(modules, "meshoptimizer", "m
         fail.append("room-meshopt.glb without meshopt_decoder.cjs: no visible message (got %r)" % msg)
     shutil.copy(os.path.join(modules, "meshoptimizer", "meshopt_decoder.cjs"), work)
     eye, target, light = [7.5, 4.5, 8.0], [-2.0, 1.0, -2.0], [0.5, 1.2, 0.5]
-    for how in ("quantise", "meshopt"):
+    for how in ("quantise", "meshopt", "compress"):
         shot = os.path.join(work, "web-room-%s.png" % how)
         q = ("glb=room-%s.glb&order=5&output=shadow&size=%dx%d&eye=%s&target=%s&up=0,1,0&fov=60&light=%s"
              % (how, W, H, csv(eye), csv(target), csv(light)))
