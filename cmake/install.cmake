@@ -8,6 +8,10 @@
 #   target_link_libraries(app PRIVATE vdsh::context)   # EGL/GLFW contexts
 #   pkg-config --cflags --libs vdsh-formats  (or vdsh-runtime, vdsh-context)
 # Shared builds install with RUNPATH $ORIGIN/../lib (top CMakeLists.txt).
+# The shader files (runtime/shaders/: for other engines, README.md there)
+# go to share/vdsh/shaders/, the web viewer and the three.js module
+# (runtime/web/) to share/vdsh/web/: they find the shaders at ../shaders/
+# as in the source tree.
 # tests/install.cmake builds and runs a consumer against an installed tree.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
@@ -18,6 +22,13 @@ install(TARGETS vdsh_format vr vr_context EXPORT vdshTargets
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
         PUBLIC_HEADER DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vdsh)
 install(EXPORT vdshTargets NAMESPACE vdsh:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/vdsh)
+file(GLOB VDSH_SHADER_FILES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/runtime/shaders/*.glsl)
+install(FILES ${VDSH_SHADER_FILES} ${PROJECT_SOURCE_DIR}/runtime/shaders/README.md
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/vdsh/shaders)
+install(FILES ${PROJECT_SOURCE_DIR}/runtime/web/index.html ${PROJECT_SOURCE_DIR}/runtime/web/vdsh_web.js
+              ${PROJECT_SOURCE_DIR}/runtime/web/vdsh_core.js ${PROJECT_SOURCE_DIR}/runtime/web/three.html
+              ${PROJECT_SOURCE_DIR}/runtime/web/vdsh_three.js
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/vdsh/web)
 
 # What the package config looks up for its consumers: the public link
 # dependencies always; the private ones (zlib, meshoptimizer, GLFW) only

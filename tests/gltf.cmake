@@ -51,8 +51,10 @@ set_tests_properties(gltf_web_viewer PROPERTIES SKIP_RETURN_CODE 77 FIXTURES_REQ
 #   gltf_web_three    runtime/web/vdsh_three.js: a three.js scene (three.js
 #                     from the npm fixture) with its own point lights draws
 #                     the shadows of an exported glb (orders 2-12, adaptive,
-#                     paper's distance, 3 lights, quantised and meshopt
-#                     glb, a moved scene) against vdsh-view's frames; and
+#                     paper's distance, 3 lights, vdsh-export --compress and
+#                     meshopt glb, a moved scene, a --source export of a
+#                     82-node glTF plain and compressed) against vdsh-view's
+#                     frames; and
 #                     the runtime's programs from runtime/shaders/ compiled
 #                     as GLSL ES 3.00 (skips with 77 without chromium,
 #                     three.js or a GL context)
@@ -60,7 +62,7 @@ add_test(NAME gltf_web_three
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_web_three.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-export> $<TARGET_FILE:vdsh-view>
                  ${VDSH_CHROMIUM} ${PROJECT_SOURCE_DIR}/runtime ${CMAKE_CURRENT_BINARY_DIR}/gltf_three
-                 "${VDSH_NODE}" ${CMAKE_BINARY_DIR}/npm/node_modules)
+                 "${VDSH_NODE}" ${CMAKE_BINARY_DIR}/npm/node_modules ${VDSH_ASSIMP_MODELS})
 set_tests_properties(gltf_web_three PROPERTIES SKIP_RETURN_CODE 77 FIXTURES_REQUIRED gltf_npm)
 
 #   gltf_robust_load  vb_mesh_load_memory is vb_mesh_load for glTF too: the

@@ -36,7 +36,10 @@ for kind in shared static; do
   for f in include/vdsh/vdsh.h include/vdsh/vr.h lib/cmake/vdsh/vdshConfig.cmake \
            lib/cmake/vdsh/vdshConfigVersion.cmake lib/pkgconfig/vdsh-formats.pc \
            lib/pkgconfig/vdsh-runtime.pc lib/pkgconfig/vdsh-context.pc \
-           bin/vdsh-info bin/vdsh-export bin/vdsh-view; do
+           bin/vdsh-info bin/vdsh-export bin/vdsh-view share/vdsh/shaders/vdsh_common.glsl \
+           share/vdsh/shaders/vdsh_buffer.glsl share/vdsh/shaders/README.md share/vdsh/web/index.html \
+           share/vdsh/web/vdsh_web.js share/vdsh/web/vdsh_core.js share/vdsh/web/vdsh_three.js \
+           share/vdsh/web/three.html; do
     [ -e "$p/$f" ] || { echo "FAIL: $kind: $f not installed"; fail=1; }
   done
   # Every if() in the package config tests something (issue 26: the GLFW

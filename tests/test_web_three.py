@@ -1,4 +1,4 @@
-"""test_web_three.py BAKE EXPORT VIEW CHROMIUM RUNTIMEDIR WORKDIR NODE MODULES - the
+"""test_web_three.py BAKE EXPORT VIEW CHROMIUM RUNTIMEDIR WORKDIR NODE MODULES [ASSIMP_MODELS] - the
 three.js module (runtime/web/vdsh_three.js) and the shader files in GLSL
 ES 3.00, in headless Chromium (WebGL2 on SwiftShader).
 
@@ -16,9 +16,14 @@ shadow cannot pass). Also:
     (order 5 and the buffer path at 12: the multi-light code);
   - the paper method (distance, a linear quantity: the per-vertex
     visibility path) at orders 2, 3, 5;
-  - the room as gltfpack writes it (KHR_mesh_quantization) and that
-    meshopt-compressed (EXT_meshopt_compression; tests/web_glb_pack.mjs),
-    order 5, against the same frame;
+  - the room as vdsh-export --compress writes it (KHR_mesh_quantization,
+    EXT_meshopt_compression; orders 5 and 12), and as gltfpack would
+    (tests/web_glb_pack.mjs, meshopt), against the same frames;
+  - a glTF scene of its own: Debian assimp-testmodels' 2CylinderEngine
+    (82 nodes, 34 materials) baked and exported with --source (root
+    extension VDSH_visibility_distance, attributes on every primitive),
+    plain and --compress, drawn with vdshApply and the source's own
+    materials, against vdsh-view's frame of the same bake;
   - the glTF scene moved: gltf.scene translated and given as `frame`, the
     camera and light moved with it: the same frame.
 GLSL ES 3.00: runtime/shaders/es_check (this test's page es_check.html)
@@ -45,6 +50,7 @@ import numpy as np
 from PIL import Image
 
 bake, export, view, chromium, rtdir, work, node, modules = sys.argv[1:9]
+models = sys.argv[9] if len(sys.argv) > 9 else ""
 if not shutil.which(chromium):
     print("no chromium: skipped")
     sys.exit(77)
@@ -175,14 +181,45 @@ mv = lambda p: [p[k] + shift[k] for k in range(3)]
 check("room order 5 moved", "room.glb", "5", mv(eye), mv(target), [mv(light)], ref("vdsh5"), 0.005,
       "&move=" + csv(shift))
 
-# Compressed: quantised, meshopt.
+# Compressed: vdsh-export --compress (KHR_mesh_quantization and
+# EXT_meshopt_compression: GLTFLoader with meshopt's decoder), the
+# attribute path (5) and the buffer path (12); and a third-party writer's
+# layout (tests/web_glb_pack.mjs: gltfpack's quantisation, meshopt).
+cglb = os.path.join(work, "room-compress.glb")
+run([export, vd, "-o", cglb, "--compress", "-q"])
+for order, mode in (("5", "vdsh5"), ("12", "buf12")):
+    check("room-compress order %s" % order, "room-compress.glb", order, eye, target, [light], ref(mode), 0.005)
 pack = os.path.join(os.path.dirname(os.path.abspath(__file__)), "web_glb_pack.mjs")
 if node and os.path.exists(os.path.join(modules, "meshoptimizer", "meshopt_encoder.js")):
-    for how in ("quantise", "meshopt"):
-        run([node, pack, modules, glb, os.path.join(work, "room-%s.glb" % how), how])
-        check("room-%s order 5" % how, "room-%s.glb" % how, "5", eye, target, [light], ref("vdsh5"), 0.005)
+    run([node, pack, modules, glb, os.path.join(work, "room-meshopt.glb"), "meshopt"])
+    check("room-meshopt order 5", "room-meshopt.glb", "5", eye, target, [light], ref("vdsh5"), 0.005)
 else:
     fail.append("no node or meshoptimizer in %s for the compressed files" % modules)
+
+# A glTF scene of its own (vdsh-export --source: 82 nodes, 29 meshes, 34
+# materials; metadata in the root extension VDSH_visibility_distance, VDSH
+# attributes on every primitive), plain and --compress: vdshApply on the
+# loaded scene, the source's materials kept, against vdsh-view's frame of
+# the same bake (the receivers are the source's vertices, in its world
+# frame), seen and lit from outside.
+engine = os.path.join(models, "glTF2", "2CylinderEngine-glTF-Binary", "2CylinderEngine.glb") if models else ""
+if os.path.exists(engine):
+    evd = os.path.join(work, "engine.vdsh")
+    run([bake, engine, "-o", evd, "-q", "--orders", "5", "--rays", "64"])
+    run([export, evd, "-o", os.path.join(work, "engine.glb"), "-q"])
+    d = open(os.path.join(work, "engine.glb"), "rb").read()
+    g = json.loads(d[20:20 + int.from_bytes(d[12:16], "little")])
+    a = g["accessors"][g["meshes"][0]["primitives"][0]["attributes"]["POSITION"]]
+    lo, hi = np.array(a["min"]), np.array(a["max"])
+    c, r = (lo + hi) / 2, np.linalg.norm(hi - lo)
+    eeye, etarget, elight = list(c + r * np.array([0.45, 0.35, 0.75])), list(c), list(c + r * np.array([0.2, 0.6, 0.3]))
+    eref = frames("engine", evd, eeye, etarget, [elight], ["vdsh5"])
+    for tag, opt in (("source", []), ("source-compress", ["--compress"])):
+        out = "engine-%s.glb" % tag
+        run([export, evd, "--source", engine, "-o", os.path.join(work, out), "-q"] + opt)
+        check("engine %s order 5" % tag, out, "5", eeye, etarget, [elight], eref("vdsh5"), 0.005)
+else:
+    print("no %s: the --source part skipped" % engine)
 
 # GLSL ES 3.00: the C runtime's programs from the same files.
 import re

@@ -13,7 +13,10 @@ float rounding, so the difference is far below one grey level on
 average; it is also printed over the shadowed pixels alone). The frames
 must hold shadows (so a blank page cannot pass).
 The same for order 5 of Debian assimp-testmodels' 2CylinderEngine.glb
-(read by the glTF reader), seen and lit from outside.
+(read by the glTF reader), seen and lit from outside; its --source export
+(a scene of many meshes, for three.html) is refused with a message naming
+three.html. The page's vertex stage, stream choice and buffer-path data
+are vdsh_core.js's (shared with vdsh_three.js), loaded as ES modules.
 
 Orders above 5 and the adaptive order (issue 26: the page was blank for
 them): the room's bake also holds an order-12 stream and an adaptive-order
@@ -34,7 +37,8 @@ rewritten by tests/web_glb_pack.mjs as gltfpack writes it
 transform, int8 normals), and that compressed with EXT_meshopt_compression
 (meshoptimizer's encoder, the npm package, installed by
 scripts/npm_gltf_tools into MODULES), must draw the order-5 frame as the
-plain glb does; without meshopt_decoder.cjs beside the page the meshopt
+plain glb does, and so must vdsh-export --compress's own file; without
+meshopt_decoder.cjs beside the page the meshopt
 file must be refused with a visible message (#msg). Skipped without node
 or MODULES.
 
@@ -75,7 +79,7 @@ def run(cmd, **kw):
 fail = []
 csv = lambda v: ",".join("%g" % x for x in v)
 W, H = 320, 240
-for f in ("index.html", "vdsh_web.js"):
+for f in ("index.html", "vdsh_web.js", "vdsh_core.js"):
     shutil.copy(os.path.join(webdir, f), work)
 # The page's GLSL: runtime/shaders/ (vdsh_common.glsl, vdsh_buffer.glsl),
 # found in shaders/ beside the page.
@@ -235,6 +239,7 @@ if node and modules and os.path.exists(os.path.join(modules, "meshoptimizer", "m
     for how in ("quantise", "meshopt"):
         out = os.path.join(work, "room-%s.glb" % how)
         run([node, pack, modules, room_glb, out, how])
+    run([export, room_vd, "-o", os.path.join(work, "room-compress.glb"), "--compress", "-q"])
     dec = os.path.join(work, "meshopt_decoder.cjs")
     if os.path.exists(dec):
         os.remove(dec)
@@ -244,7 +249,7 @@ if node and modules and os.path.exists(os.path.join(modules, "meshoptimizer", "m
         fail.append("room-meshopt.glb without meshopt_decoder.cjs: no visible message (got %r)" % msg)
     shutil.copy(os.path.join(modules, "meshoptimizer", "meshopt_decoder.cjs"), work)
     eye, target, light = [7.5, 4.5, 8.0], [-2.0, 1.0, -2.0], [0.5, 1.2, 0.5]
-    for how in ("quantise", "meshopt"):
+    for how in ("quantise", "meshopt", "compress"):
         shot = os.path.join(work, "web-room-%s.png" % how)
         q = ("glb=room-%s.glb&order=5&output=shadow&size=%dx%d&eye=%s&target=%s&up=0,1,0&fov=60&light=%s"
              % (how, W, H, csv(eye), csv(target), csv(light)))
@@ -261,7 +266,15 @@ def outside(lo, hi):
 
 engine = os.path.join(models, "glTF2", "2CylinderEngine-glTF-Binary", "2CylinderEngine.glb")
 if os.path.exists(engine):
-    default_view("engine", *scene("engine", engine, ["--rays", "64"], [5], outside))
+    evd, eglb = scene("engine", engine, ["--rays", "64"], [5], outside)
+    default_view("engine", evd, eglb)
+    # A --source export (the glTF's own scene, many meshes): the page
+    # draws the plain export only and says so, naming three.html.
+    run([export, evd, "--source", engine, "-o", os.path.join(work, "engine-source.glb"), "-q"])
+    msg = message(page("glb=engine-source.glb&size=%dx%d" % (W, H)))
+    print("engine-source.glb: the page says: %s" % msg)
+    if not msg or "three.html" not in msg:
+        fail.append("engine-source.glb: no visible message naming three.html (got %r)" % msg)
 else:
     print("no %s: the glTF scene part skipped" % engine)
 

@@ -11,8 +11,9 @@
  * so that the web viewer (runtime/web) starts where vdsh-view does.
  *
  *     vdsh-export scene.vdsh -o scene.glb [--orders 2,3,5] [--float] [--compress] [-q]
- *     vdsh-export scene.vdsh --source scene.gltf -o scene.glb   (the source's own scene:
- *         vdsh_export_source.h; formats/GLTF.md)
+ *     vdsh-export scene.vdsh --source scene.gltf -o scene.glb [--compress]  (the source's
+ *         own scene: vdsh_export_source.h; formats/GLTF.md; --compress: its VDSH
+ *         attributes meshopt-compressed)
  *
  * Errors: a message naming the file and the problem on stderr, exit 1 (2
  * for a usage error); the output is written atomically
@@ -229,7 +230,7 @@ static int exact_numbers(cJSON *n)
     return 0;
 }
 static int with_source(const char *in, const char *path, const vdsh_file *f, cJSON *root, view_list *vl,
-                       cJSON *attrs, cJSON **vx, blob *b)
+                       cJSON *attrs, cJSON **vx, blob *b, int compress)
 {
     char msg[1024];
     vdsh_src src;
@@ -394,14 +395,38 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         cJSON_AddNumberToObject(pe, "vertices", sp->vertex_count);
         cJSON_AddNumberToObject(pe, "matched", sp->matched);
     }
+    /* --compress: the VDSH views meshopt-compressed (lossless), living in
+     * a fallback buffer 1 without bytes; the source's own views, images
+     * and geometry stay as they are (no quantisation: the source's
+     * positions are kept bit for bit). */
     size_t raw = 0;
-    if (write_views(&nl, 0, b, views, &raw) || blob_align4(b))
+    if (write_views(&nl, compress, b, views, &raw) || blob_align4(b))
         goto oom;
     cJSON_DeleteItemFromObjectCaseSensitive(g, "buffers");
     cJSON *bufs = cJSON_AddArrayToObject(g, "buffers");
     cJSON *buf = cJSON_CreateObject();
     cJSON_AddNumberToObject(buf, "byteLength", (double)b->size);
     cJSON_AddItemToArray(bufs, buf);
+    if (compress && nl.n > 0) {
+        cJSON *fb = cJSON_CreateObject();
+        cJSON_AddNumberToObject(fb, "byteLength", (double)raw);
+        cJSON_AddBoolToObject(
+            cJSON_AddObjectToObject(cJSON_AddObjectToObject(fb, "extensions"), "EXT_meshopt_compression"),
+            "fallback", 1);
+        cJSON_AddItemToArray(bufs, fb);
+        const char *lists[2] = {"extensionsUsed", "extensionsRequired"};
+        for (int k = 0; k < 2; k++) {
+            cJSON *l = cJSON_GetObjectItemCaseSensitive(g, lists[k]);
+            if (!l)
+                l = cJSON_AddArrayToObject(g, lists[k]);
+            int listed = 0;
+            cJSON *e;
+            cJSON_ArrayForEach(e, l)
+                listed |= cJSON_IsString(e) && strcmp(e->valuestring, "EXT_meshopt_compression") == 0;
+            if (!listed)
+                cJSON_AddItemToArray(l, cJSON_CreateString("EXT_meshopt_compression"));
+        }
+    }
     cJSON_AddNumberToObject(*vx, "source_vertices", (double)vertices);
     cJSON_AddNumberToObject(*vx, "source_vertices_matched", (double)matched);
     cJSON *gext = cJSON_GetObjectItemCaseSensitive(g, "extensions");
@@ -466,7 +491,9 @@ static void usage(FILE *fp)
                 "      --compress     a compact glb: positions uint16 and normals int8\n"
                 "                     (KHR_mesh_quantization), every buffer view compressed with\n"
                 "                     meshoptimizer (EXT_meshopt_compression; lossless: the\n"
-                "                     coefficients and indices decode bit-exact)\n"
+                "                     coefficients and indices decode bit-exact); with\n"
+                "                     --source: the VDSH attributes compressed, the source's own\n"
+                "                     data kept as it is\n"
                 "      --source FILE  the glTF the .vdsh was baked from: write its own scene (nodes,\n"
                 "                     meshes, materials, textures, UVs...) with the VDSH attributes\n"
                 "                     added to each primitive (formats/GLTF.md)\n"
@@ -522,8 +549,6 @@ int main(int argc, char **argv)
     in = argv[optind];
     if (!out)
         return vt_usage_error("vdsh-export", "%s", "no output: give -o OUT.glb");
-    if (source && compress)
-        return vt_usage_error("vdsh-export", "%s", "--source and --compress do not go together (yet)");
     const char *ins[2] = {in, source};
     if (vt_cli_check_outputs(&out, 1, ins, source ? 2 : 1) != 0)
         return 1;
@@ -800,7 +825,7 @@ int main(int argc, char **argv)
         goto done;
     }
     if (source) {
-        if (with_source(in, source, f, root, &vl, attrs, &vx, &b) != 0)
+        if (with_source(in, source, f, root, &vl, attrs, &vx, &b, compress) != 0)
             goto done;
         goto write;
     }

@@ -1,9 +1,12 @@
 // vdsh_three.js - VDSH shadows in three.js: an ES module, no build step.
 //
 // A mesh that three.js's GLTFLoader read from a glb of vdsh-export
-// (formats/GLTF.md: the _VDSH<o>_<k> attributes, the streams in the mesh's
-// extras) gets a MeshStandardMaterial whose point lights -- any number,
-// the three.js scene's own PointLights -- are shadowed by the VDSH
+// (formats/GLTF.md: the _VDSH<o>_<k> attributes; the streams in the mesh's
+// extras.vdsh, or for `vdsh-export --source` in the root extension
+// VDSH_visibility_distance, many meshes each with its attributes; plain or
+// --compress: give GLTFLoader meshopt's decoder) gets a MeshStandardMaterial
+// whose point lights -- any number, the three.js scene's own PointLights --
+// are shadowed by the VDSH
 // visibility, by the C runtime's rule (runtime/shaders/README.md):
 //   log-distance streams, and every stream on the buffer path: per vertex
 //     the SH sum toward each light, d = vdsh_distance(sum, max_distance),
@@ -19,18 +22,22 @@
 //
 // The GLSL is runtime/shaders/vdsh_common.glsl and vdsh_buffer.glsl, the
 // files the C runtime compiles in, fetched at run time from ../shaders/
-// next to this file (loadVdshShaders(url) for another place).
+// next to this file (loadVdshShaders(url) for another place). The vertex
+// stage's VDSH code, the stream choice and the buffer path's data are
+// vdsh_core.js's, shared with the web viewer (vdsh_web.js).
 //
 //   import * as THREE from 'three';
 //   import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-//   import { loadVdshShaders, vdshInfo, vdshMaterial } from './vdsh_three.js';
+//   import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
+//   import { loadVdshShaders, vdshApply } from './vdsh_three.js';
 //   const shaders = await loadVdshShaders();
-//   const gltf = await new GLTFLoader().loadAsync('room.glb');
-//   gltf.scene.traverse((o) => { if (o.isMesh && vdshInfo(o)) vdshMaterial(o, shaders); });
+//   const gltf = await new GLTFLoader().setMeshoptDecoder(MeshoptDecoder).loadAsync('room.glb');
+//   vdshApply(gltf, shaders);
 //   scene.add(gltf.scene, new THREE.PointLight(0xffffff, 20));
 //
-// vdshMaterial(mesh, shaders, options) sets and returns mesh.material;
-// options (all optional):
+// vdshApply(gltf, shaders, options) gives every mesh that has the VDSH
+// attributes its material (below); vdshMaterial(mesh, shaders, options)
+// does one mesh, sets and returns mesh.material; options (all optional):
 //   order      2..16 or 'adaptive' (default as vdsh-view: 5, else 3, else
 //              2, else the adaptive stream, else the highest order)
 //   path       'buffer' for the buffer path at orders 2, 3, 5 too
@@ -41,127 +48,106 @@
 //              with its shadows
 //   output     'shadow': the visibility of the first point light as grey
 //              (vdsh-view --views' frames; tests/test_web_three.py)
+//   info       the metadata (vdshInfo(gltf)) for a mesh of a --source export
 // The stream must have been baked for this mesh in this frame: lights are
 // taken into the bake's frame, where the coefficients' directions live.
 // Only three.js PointLights are shadowed (as vdsh-view's lights); other
 // lights light the mesh unshadowed.
 import * as THREE from 'three';
+import { loadVdshShaders, vdshChooseStream, vdshStreamPlan, vdshBufferData, vdshVertexGlsl, VDSH_EXT } from './vdsh_core.js';
 
-const MAX_ORDER = 16;
+export { loadVdshShaders, vdshChooseStream };
 
-// The shader files, fetched once per URL.
-export async function loadVdshShaders(url = new URL('../shaders/', import.meta.url)) {
-  const get = async (name) => {
-    const u = new URL(name, url);
-    const r = await fetch(u);
-    if (!r.ok) throw new Error('cannot load ' + u + ' (HTTP ' + r.status + ')');
-    return r.text();
-  };
-  const [common, buffer] = await Promise.all([get('vdsh_common.glsl'), get('vdsh_buffer.glsl')]);
-  return { common, buffer };
-}
+const isInfo = (x) => (x && Array.isArray(x.streams) ? x : null);
 
-// The VDSH description of a mesh (formats/GLTF.md: its extras.vdsh, which
-// GLTFLoader puts into userData; or a vendor extension holding streams),
-// looked for on the mesh and its parents; null when there is none.
-export function vdshInfo(mesh) {
-  for (let o = mesh; o; o = o.parent) {
-    const u = o.userData || {};
-    if (u.vdsh && Array.isArray(u.vdsh.streams)) return u.vdsh;
-    for (const x of Object.values(u.gltfExtensions || {}))
-      if (x && Array.isArray(x.streams)) return x;
+// The VDSH description (formats/GLTF.md): of a GLTFLoader result, the
+// root extension VDSH_visibility_distance (vdsh-export --source: the
+// source's scene, VDSH attributes on each primitive), which GLTFLoader
+// puts into gltf.userData.gltfExtensions; of a mesh, the plain export's
+// extras.vdsh (GLTFLoader's userData.vdsh) on the mesh or a parent. Null
+// when there is none.
+export function vdshInfo(o) {
+  if (!o) return null;
+  if (!o.isObject3D && o.scene) {  // a GLTFLoader result
+    const x = isInfo((o.userData && o.userData.gltfExtensions || {})[VDSH_EXT]);
+    if (x) return x;
+    let found = null;
+    o.scene.traverse((m) => { if (!found && m.isMesh) found = vdshInfo(m); });
+    return found;
+  }
+  for (let p = o; p; p = p.parent) {
+    const u = p.userData || {};
+    if (isInfo(u.vdsh)) return u.vdsh;
+    if (isInfo((u.gltfExtensions || {})[VDSH_EXT])) return u.gltfExtensions[VDSH_EXT];
   }
   return null;
 }
 
-// The stream to draw: order N, 'adaptive', or vdsh-view's default.
-export function vdshChooseStream(streams, want) {
-  const fixed = (o) => streams.find((s) => s.order === o && !s.variable_order);
-  const variable = streams.find((s) => s.variable_order);
-  if (want === 'adaptive') {
-    if (!variable) throw new Error('no stream with an order per vertex (adaptive order) in this file');
-    return variable;
+// The three.js names of a stream's attributes in a geometry (GLTFLoader
+// lower-cases custom attribute names), or null when one is missing.
+function streamAttributes(geometry, stream) {
+  const names = [];
+  for (let g = 0; g < Math.ceil(stream.order * stream.order / 4); g++) {
+    const n = (stream.attribute_prefix + g).toLowerCase();
+    if (!geometry || !geometry.getAttribute(n)) return null;
+    names.push(n);
   }
-  if (want !== undefined && want !== null && want !== '') {
-    const o = Number(want);
-    const s = fixed(o) || streams.find((x) => x.order === o);
-    if (!s) throw new Error('no stream of order ' + want + ' (the file has ' +
-      streams.map((x) => x.order + (x.variable_order ? ' adaptive' : '')).join(', ') + ')');
-    return s;
+  return names;
+}
+
+// VDSH shadows on every mesh of a loaded glTF that holds them: `root` is
+// GLTFLoader's result (gltf) or an Object3D (gltf.scene). Each mesh with
+// the chosen stream's attributes gets vdshMaterial; the metadata is the
+// root extension of a --source export, else each mesh's extras.vdsh.
+// options as vdshMaterial's, and:
+//   material  a Material to extend (cloned per mesh); 'own' (the mesh's
+//             own MeshStandardMaterial, cloned: the default for a --source
+//             export, whose materials are the source's); 'grey' (a new
+//             grey one: the default for the plain export, whose glTF
+//             default material is metallic)
+//   frame     default the loaded scene (root.scene, or root): move it and
+//             the shadows follow
+// Returns the meshes it changed.
+export function vdshApply(root, shaders, options = {}) {
+  const top = root && !root.isObject3D && root.scene ? root.scene : root;
+  if (!top || !top.isObject3D) throw new Error('vdshApply: give the result of GLTFLoader or an Object3D');
+  const rootInfo = root !== top ? isInfo((root.userData && root.userData.gltfExtensions || {})[VDSH_EXT]) : null;
+  const meshes = [];
+  top.traverse((o) => { if (o.isMesh) meshes.push(o); });
+  const done = [];
+  for (const mesh of meshes) {
+    const info = options.info || rootInfo || vdshInfo(mesh);
+    if (!info || !info.streams.length) continue;
+    if (!streamAttributes(mesh.geometry, vdshChooseStream(info.streams, options.order))) continue;
+    let material = options.material;
+    const own = mesh.material && !Array.isArray(mesh.material) && mesh.material.isMeshStandardMaterial;
+    if (material === 'own' || (material === undefined && info === rootInfo))
+      material = own ? mesh.material.clone() : undefined;
+    else if (material === 'grey' || material === undefined)
+      material = undefined;
+    else
+      material = material.clone();
+    vdshMaterial(mesh, shaders, Object.assign({}, options, { info, material,
+      frame: options.frame === undefined ? top : options.frame }));
+    done.push(mesh);
   }
-  return fixed(5) || fixed(3) || fixed(2) || variable || streams.reduce((a, b) => (b.order > a.order ? b : a));
+  return done;
 }
 
-// K_l^|m| per coefficient index l(l+1)+m (sqrt 2 folded in for m != 0),
-// in double then rounded to f32, as runtime/vr_buffer.c (make_ks).
-function ksTable(order) {
-  const ks = new Float32Array(order * order);
-  for (let l = 0; l < order; l++)
-    for (let m = 0; m <= l; m++) {
-      let kk = (2 * l + 1) / (4 * Math.PI);
-      for (let f = l - m + 1; f <= l + m; f++) kk /= f;
-      const K = m === 0 ? Math.sqrt(kk) : Math.sqrt(2 * kk);
-      ks[l * (l + 1) + m] = K;
-      ks[l * (l + 1) - m] = K;
-    }
-  return ks;
-}
-
-// A float as a GLSL literal that reads back as the same f32.
-const flit = (x) => {
-  const s = Math.fround(x).toPrecision(9);
-  return /[.e]/.test(s) ? s : s + '.0';
-};
-
-// The order the recurrence consumes coefficients in (vr_buffer_sequence).
-function bufferSequence(order) {
-  const out = [];
-  for (let m = 0; m < order; m++)
-    for (let l = m; l < order; l++) {
-      out.push(l * (l + 1) + m);
-      if (m > 0) out.push(l * (l + 1) - m);
-    }
-  return out;
-}
-
-// The buffer path's texture: each vertex's record (its coefficients up to
-// its own order, in the recurrence's order), four to a texel, row by row;
-// a_record (first texel) and a_order per vertex. Coefficients are read
-// through BufferAttribute.getX.. (normalised or not, interleaved or not).
+// The buffer path's texture (vdsh_core.js's records) and a_record,
+// a_order per vertex. Coefficients are read through BufferAttribute.getX..
+// (normalised or not, interleaved or not).
 function bufferTexture(geometry, names, stream, maxTexture) {
-  const N = stream.order, nc = N * N;
   const attrs = names.map((n) => geometry.getAttribute(n));
-  const nv = attrs[0].count;
   const comp = ['getX', 'getY', 'getZ', 'getW'];
-  const get = (v, i) => attrs[i >> 2][comp[i & 3]](v);
-  const orders = new Uint32Array(nv), records = new Uint32Array(nv);
-  let total = 0;
-  for (let v = 0; v < nv; v++) {
-    let k = N;
-    if (stream.variable_order)  // the vertex's order: its last nonzero band
-      for (k = 0; k < N; k++) {
-        let zero = true;
-        for (let i = k * k; i < nc && zero; i++) zero = get(v, i) === 0;
-        if (zero) break;
-      }
-    orders[v] = k;
-    records[v] = total;
-    total += Math.ceil(k * k / 4);
-  }
-  const W = Math.min(maxTexture, 4096), H = Math.max(1, Math.ceil(total / W));
-  if (H > maxTexture) throw new Error('the coefficients need ' + total + ' texels, over this GPU\'s textures');
-  const texels = new Float32Array(W * H * 4), seqs = [];
-  for (let v = 0; v < nv; v++) {
-    const k = orders[v], seq = seqs[k] || (seqs[k] = bufferSequence(k));
-    for (let p = 0, at = 4 * records[v]; p < seq.length; p++) texels[at + p] = get(v, seq[p]);
-  }
-  const tex = new THREE.DataTexture(texels, W, H, THREE.RGBAFormat, THREE.FloatType);
+  const b = vdshBufferData((v, i) => attrs[i >> 2][comp[i & 3]](v), attrs[0].count, stream, maxTexture);
+  const tex = new THREE.DataTexture(b.texels, b.width, b.height, THREE.RGBAFormat, THREE.FloatType);
   tex.minFilter = tex.magFilter = THREE.NearestFilter;
   tex.generateMipmaps = false;
   tex.needsUpdate = true;
-  geometry.setAttribute('a_record', new THREE.BufferAttribute(records, 1));
-  geometry.setAttribute('a_order', new THREE.BufferAttribute(orders, 1));
-  return { tex, width: W };
+  geometry.setAttribute('a_record', new THREE.BufferAttribute(b.records, 1));
+  geometry.setAttribute('a_order', new THREE.BufferAttribute(b.orders, 1));
+  return { tex, width: b.width };
 }
 
 // Replaces `anchor` in `text` by `by`, or says which three.js shader
@@ -175,66 +161,37 @@ function patch(text, anchor, by, what) {
 
 export function vdshMaterial(mesh, shaders, options = {}) {
   if (!shaders || typeof shaders.common !== 'string') throw new Error('vdshMaterial: give the shaders of loadVdshShaders()');
-  const info = vdshInfo(mesh);
+  const info = isInfo(options.info) || vdshInfo(mesh);
   if (!info || !info.streams.length) throw new Error('vdshMaterial: the mesh ' + (mesh.name || '') +
-    ' holds no VDSH streams (extras.vdsh of a glb written by vdsh-export)');
+    ' holds no VDSH streams (extras.vdsh of a glb written by vdsh-export; for a --source export ' +
+    'give options.info = vdshInfo(gltf), or use vdshApply(gltf, ...))');
   const stream = vdshChooseStream(info.streams, options.order);
-  if (!(stream.order >= 1 && stream.order <= MAX_ORDER)) throw new Error('stream order ' + stream.order + ' out of range 1..16');
-  const quantity = { 'distance': 0, 'distance2': 1, 'log-distance': 2 }[stream.quantity];
-  if (quantity === undefined) throw new Error('stream quantity ' + stream.quantity + ' unknown');
+  const plan = vdshStreamPlan(stream, options.path);
   const geometry = mesh.geometry;
-  const groups = Math.ceil(stream.order * stream.order / 4);
-  const names = [];
-  for (let g = 0; g < groups; g++) {  // GLTFLoader lower-cases custom attribute names
-    const n = (stream.attribute_prefix + g).toLowerCase();
-    if (!geometry.getAttribute(n)) throw new Error('attribute ' + stream.attribute_prefix + g + ' is missing');
-    names.push(n);
-  }
-  const buffer = options.path === 'buffer' || !!stream.variable_order || ![2, 3, 5].includes(stream.order);
-  const distPath = buffer || quantity === 2;
+  const names = streamAttributes(geometry, stream);
+  if (!names) throw new Error('the mesh ' + (mesh.name || '') + ' has no attributes ' + stream.attribute_prefix +
+    '0..' + (plan.groups - 1));
+  const buffer = plan.buffer;
   const output = options.output === 'shadow' ? 1 : 0;
   const frame = options.frame || null;
-
-  let defines = `#define QUANTITY ${quantity}\n#define COMPARE 0\n#define VDSH_DIST_PATH ${distPath ? 1 : 0}\n` +
-    `#define VDSH_OUTPUT ${output}\n`;
   const uniforms = {
     vdshScale: { value: stream.scale },
     vdshMaxDistance: { value: info.max_distance },
     vdshBakeFromWorld: { value: new THREE.Matrix4() },
     vdshBakeFromView: { value: new THREE.Matrix4() },
   };
-  let vsDecl = '', vsSums = '';
+  let width = 0;
   if (buffer) {
-    const maxTex = options.maxTextureSize || 4096;
-    const b = bufferTexture(geometry, names, stream, maxTex);
-    const ks = ksTable(stream.order);
+    const b = bufferTexture(geometry, names, stream, options.maxTextureSize || 4096);
     uniforms.u_coef = { value: b.tex };
-    defines += `#define BUFFER 1\n#define BUF_TEXTURE_2D 1\n#define BUF_TEX_WIDTH ${b.width}\n#define BUF_KIND 0\n` +
-      `#define BUF_VARIABLE 1\n#define BUF_ORDER ${stream.order}\n#define BUF_STRIDE 0\n` +
-      `#define BUF_RECEIVER vdshP\n#define BUF_LIGHT(i) vdshL[i]\n#define BUF_SCALE vdshScale\n`;
-    vsDecl = `vec3 vdshP;\nvec3 vdshL[NUM_LIGHTS];\n` +
-      `const float KS[${ks.length}] = float[${ks.length}](${Array.from(ks, flit).join(', ')});\n` + shaders.buffer;
-    vsSums = '  float vdshSum[NUM_LIGHTS];\n  buffer_sums(vdshSum);\n';
+    width = b.width;
   } else {
     // Aliases of the glb's attributes (the same BufferAttribute objects:
     // uploaded once), so the GLSL names do not depend on the prefix.
-    for (let g = 0; g < groups; g++) {
-      geometry.setAttribute('vdshC' + g, geometry.getAttribute(names[g]));
-      vsDecl += `in vec4 vdshC${g};\n`;
-    }
-    defines += `#define BUFFER 0\n#define VDSH_ORDER ${stream.order}\n`;
-    vsDecl += `float vdshSum(vec3 d) {
-#if VDSH_ORDER == 2
-  return vdshScale * sh_sum4(vdshC0, d);
-#elif VDSH_ORDER == 3
-  return vdshScale * sh_sum9(vdshC0, vdshC1, vdshC2.x, d);
-#else
-  vec4 g[7] = vec4[7](vdshC0, vdshC1, vdshC2, vdshC3, vdshC4, vdshC5, vdshC6);
-  return vdshScale * vdsh_sh_sum25(g, d);
-#endif
-}
-`;
+    for (let g = 0; g < plan.groups; g++) geometry.setAttribute('vdshC' + g, geometry.getAttribute(names[g]));
   }
+  const vg = vdshVertexGlsl(plan, shaders, width);
+  const defines = vg.defines + `#define VDSH_OUTPUT ${output}\n`;
 
   // three.js declares its point lights only in the fragment stage; the
   // vertex stage declares the same uniform (same struct, same name) to
@@ -248,30 +205,16 @@ export function vdshMaterial(mesh, shaders, options = {}) {
   const vsHead = `#define NUM_LIGHTS NUM_POINT_LIGHTS\n${defines}${shaders.common}\n` +
     `uniform float vdshScale;\nuniform float vdshMaxDistance;\nuniform mat4 vdshBakeFromView;\nuniform mat4 vdshBakeFromWorld;\n` +
     `out vec3 vdshPos;\n#if NUM_POINT_LIGHTS > 0\n${struct[0]}\n${decl[0]}\nout float vdshVal[NUM_POINT_LIGHTS];\n` +
-    `${vsDecl}#endif\n`;
+    `${vg.decl}#endif\n`;
   const vsMain = `
   vdshPos = (vdshBakeFromWorld * modelMatrix * vec4(position, 1.0)).xyz;
 #if NUM_POINT_LIGHTS > 0
-#if BUFFER
-  vdshP = vdshPos;
+  vec3 vdshLights[NUM_POINT_LIGHTS];
   for (int i = 0; i < NUM_POINT_LIGHTS; i++)
-    vdshL[i] = (vdshBakeFromView * vec4(pointLights[i].position, 1.0)).xyz;
-${vsSums}#endif
-  for (int i = 0; i < NUM_POINT_LIGHTS; i++) {
-    vec3 lv = (vdshBakeFromView * vec4(pointLights[i].position, 1.0)).xyz - vdshPos;
-    float dl = length(lv);
-    // A light at the vertex has no direction: distance 0, not NaN.
-#if BUFFER
-    float dv = dl > 0.0 ? vdsh_distance(vdshSum[i], vdshMaxDistance) : 0.0;
-#else
-    float dv = dl > 0.0 ? vdsh_distance(vdshSum(lv / dl), vdshMaxDistance) : 0.0;
-#endif
-#if VDSH_DIST_PATH
-    vdshVal[i] = dv;
-#else
-    vdshVal[i] = vdsh_compare(dv, dl);
-#endif
-  }
+    vdshLights[i] = (vdshBakeFromView * vec4(pointLights[i].position, 1.0)).xyz;
+  float vdshV[NUM_POINT_LIGHTS];
+  vdsh_vertex(vdshPos, vdshLights, vdshV);
+  for (int i = 0; i < NUM_POINT_LIGHTS; i++) vdshVal[i] = vdshV[i];
 #endif
 `;
   const fsHead = `#define NUM_LIGHTS NUM_POINT_LIGHTS\n${defines}${shaders.common}\n` +

@@ -1,10 +1,15 @@
-// vdsh_web.js - a raw WebGL2 viewer of a glb written by vdsh-export
+// vdsh_web.js - a WebGL2 viewer of a glb written by vdsh-export
 // (formats/GLTF.md): the receiver mesh lit by point lights with VDSH
 // shadows, by the C runtime's shadow rule and with its GLSL functions
 // (runtime/shaders/vdsh_common.glsl and vdsh_buffer.glsl, loaded from
-// shaders/ beside the page or ../shaders/, or shaders=URL). vdsh-view's
-// shading (Lambert, its lights) so that its default picture is vdsh-view's;
-// a three.js scene uses vdsh_three.js instead (three.html):
+// shaders/ beside the page or ../shaders/, or shaders=URL). An ES module
+// (index.html loads it with type="module"): the vertex stage's VDSH code,
+// the stream choice and the buffer path's data are vdsh_core.js's, the
+// same as the three.js module's (vdsh_three.js); what is the page's own is
+// vdsh-view's shading (Lambert, its lights), so that its default picture
+// is vdsh-view's, and the glb reader (no three.js needed). A three.js
+// scene, and a --source export (the source's own scene), use vdsh_three.js
+// (three.html):
 //   log-distance streams (any order): per vertex the whole SH sum toward
 //     each light, d = min(exp(min(sum, 80)), max_distance), interpolated;
 //     per fragment visibility = compare(d, |light - fragment|);
@@ -55,123 +60,41 @@
 // true (and document.title to "ready") once the first frame is drawn. On
 // failure the message is shown on the page (#msg), in document.title
 // ("error: ...") and in window.vdshError.
-'use strict';
+import { VDSH_EXT, vdshChooseStream, vdshStreamPlan, vdshBufferData, vdshVertexGlsl } from './vdsh_core.js';
 
-const MAX_ORDER = 16;
-
-// A float as a GLSL literal that reads back as the same f32.
-const flit = (x) => {
-  const s = Math.fround(x).toPrecision(9);
-  return /[.e]/.test(s) ? s : s + '.0';
-};
-
-// K_l^|m| per coefficient index l(l+1)+m (sqrt 2 folded in for m != 0),
-// in double and then rounded to f32, as runtime/vr_buffer.c (make_ks).
-function ksTable(order) {
-  const ks = new Float32Array(order * order);
-  for (let l = 0; l < order; l++)
-    for (let m = 0; m <= l; m++) {
-      let kk = (2 * l + 1) / (4 * Math.PI);
-      for (let f = l - m + 1; f <= l + m; f++) kk /= f;
-      const K = m === 0 ? Math.sqrt(kk) : Math.sqrt(2 * kk);
-      ks[l * (l + 1) + m] = K;
-      ks[l * (l + 1) - m] = K;
-    }
-  return ks;
-}
-
-// The order the recurrence consumes coefficients in (vr_buffer_sequence):
-// m outside, l inside, +m before -m.
-function bufferSequence(order) {
-  const out = [];
-  for (let m = 0; m < order; m++)
-    for (let l = m; l < order; l++) {
-      out.push(l * (l + 1) + m);
-      if (m > 0) out.push(l * (l + 1) - m);
-    }
-  return out;
-}
-
-// cfg: order (attribute path), quantity (0 distance, 1 distance2, 2 log),
-// lights, output (0 shaded, 1 shadow), buffer ({order, texWidth} or null);
-// shaders: the texts of runtime/shaders/vdsh_common.glsl (the SH sums,
-// vdsh_distance, vdsh_compare: the C runtime's own) and vdsh_buffer.glsl
-// (the buffer path's recurrence), loaded by loadShaders.
+// The program: vdsh_core.js's vertex stage (the VDSH value per light,
+// interpolated), then vdsh-view's shading per fragment.
+// cfg: plan (vdshStreamPlan), lights, output (0 shaded, 1 shadow),
+// texWidth (buffer path); shaders: the texts of runtime/shaders/
+// vdsh_common.glsl (the SH sums, vdsh_distance, vdsh_compare: the C
+// runtime's own) and vdsh_buffer.glsl (the buffer path's recurrence).
 function glsl(cfg, shaders) {
-  const buffer = !!cfg.buffer;
-  const order = buffer ? 0 : cfg.order;
-  const groups = buffer ? 0 : Math.ceil(order * order / 4);
+  const vg = vdshVertexGlsl(cfg.plan, shaders, cfg.texWidth);
   const head = `#version 300 es
 precision highp float;
 precision highp int;
-#define ORDER ${order}
-#define QUANTITY ${cfg.quantity}
-#define COMPARE 0
 #define NUM_LIGHTS ${cfg.lights}
 #define OUTPUT ${cfg.output}
-#define BUFFER ${buffer ? 1 : 0}
-#define DIST_PATH ${buffer || cfg.quantity === 2 ? 1 : 0}
-${shaders.common}
+${vg.defines}${shaders.common}
 `;
-  let decl = '', sums = '';
-  if (buffer) {
-    const ks = ksTable(cfg.buffer.order);
-    // vdsh_buffer.glsl reads a_position, u_light_pos, u_scale (declared
-    // above it) and the record's first texel and order per vertex.
-    decl = `#define BUF_TEXTURE_2D 1
-#define BUF_TEX_WIDTH ${cfg.buffer.texWidth}
-#define BUF_KIND 0
-#define BUF_VARIABLE 1
-#define BUF_ORDER ${cfg.buffer.order}
-const float KS[${ks.length}] = float[${ks.length}](${Array.from(ks, flit).join(', ')});
-${shaders.buffer}
-`;
-    sums = `  float b_sum[NUM_LIGHTS];\n  buffer_sums(b_sum);\n`;
-  } else {
-    for (let g = 0; g < groups; g++) decl += `in vec4 a_c${g};\n`;
-    decl += `
-float sh_sum(vec3 d) {
-#if ORDER == 2
-  return sh_sum4(a_c0, d);
-#elif ORDER == 3
-  return sh_sum9(a_c0, a_c1, a_c2.x, d);
-#else
-  vec4 g[7] = vec4[7](${Array.from({ length: 7 }, (_, g) => (g < groups ? 'a_c' + g : 'vec4(0.0)')).join(', ')});
-  return vdsh_sh_sum25(g, d);
-#endif
-}
-`;
-  }
   const vs = head + `
 in vec3 a_position;
 in vec3 a_normal;
 uniform mat4 u_view_proj;
-uniform float u_scale;
-uniform float u_max_distance;
+uniform float vdshScale;
+uniform float vdshMaxDistance;
 uniform vec3 u_light_pos[NUM_LIGHTS];
 out vec3 v_position;
 out vec3 v_normal;
 out float v_val[NUM_LIGHTS];
-${decl}
+${vg.decl}
 void main() {
-${sums}
   v_position = a_position;
   v_normal = a_normal;
   gl_Position = u_view_proj * vec4(a_position, 1.0);
-  for (int i = 0; i < NUM_LIGHTS; i++) {
-    vec3 lv = u_light_pos[i] - a_position;
-    float dl = length(lv);
-#if BUFFER
-    float dv = dl > 0.0 ? vdsh_distance(b_sum[i], u_max_distance) : 0.0;
-#else
-    float dv = dl > 0.0 ? vdsh_distance(u_scale * sh_sum(lv / dl), u_max_distance) : 0.0;
-#endif
-#if DIST_PATH
-    v_val[i] = dv;
-#else
-    v_val[i] = vdsh_compare(dv, dl);
-#endif
-  }
+  float val[NUM_LIGHTS];
+  vdsh_vertex(a_position, u_light_pos, val);
+  for (int i = 0; i < NUM_LIGHTS; i++) v_val[i] = val[i];
 }`;
   const fs = head + `
 in vec3 v_position;
@@ -189,7 +112,7 @@ void main() {
   for (int i = 0; i < NUM_LIGHTS; i++) {
     vec3 lv = u_light_pos[i] - v_position;
     float dl = length(lv);
-#if DIST_PATH
+#if VDSH_DIST_PATH
     float s = vdsh_compare(v_val[i], dl);
 #else
     float s = v_val[i];
@@ -205,7 +128,7 @@ void main() {
   o_color = vec4(u_ambient + acc, 1.0);
 #endif
 }`;
-  return { vs, fs, groups };
+  return { vs, fs };
 }
 
 // ---- the file ------------------------------------------------------------
@@ -450,25 +373,6 @@ async function loadShaders(where) {
     '(shaders/ or ../shaders/; or give shaders=URL): ' + last.message);
 }
 
-// The stream to draw: order=N, order=adaptive, or vdsh-view's default.
-function chooseStream(streams, want) {
-  const fixed = (o) => streams.find((s) => s.order === o && !s.variable_order);
-  const variable = streams.find((s) => s.variable_order);
-  if (want === 'adaptive') {
-    if (!variable) throw new Error('no stream with an order per vertex (adaptive order) in this file');
-    return variable;
-  }
-  if (want) {
-    const o = Number(want);
-    const s = fixed(o) || streams.find((x) => x.order === o);
-    if (!s) throw new Error('no stream of order ' + want + ' (the file has ' + streams.map((x) => x.order + (x.variable_order ? ' adaptive' : '')).join(', ') + ')');
-    return s;
-  }
-  const best = fixed(5) || fixed(3) || fixed(2) || variable;
-  if (best) return best;
-  return streams.reduce((a, b) => (b.order > a.order ? b : a));
-}
-
 async function main() {
   const q = new URLSearchParams(location.search);
   const vec = (name, s) => {
@@ -484,18 +388,18 @@ async function main() {
         READ_EXTENSIONS.join(', ') + ')');
   const mesh = (json.meshes || [])[0];
   const vx = mesh && mesh.extras && mesh.extras.vdsh;
+  if ((!vx || !Array.isArray(vx.streams)) && json.extensions && json.extensions[VDSH_EXT])
+    throw new Error(url + ' is a glTF scene of its own with VDSH attributes (vdsh-export --source): ' +
+      'this page draws the plain export (one mesh); open it with three.html (vdsh_three.js)');
   if (!vx || !Array.isArray(vx.streams) || !vx.streams.length)
     throw new Error(url + ' holds no VDSH streams (meshes[0].extras.vdsh): not a file of vdsh-export, ' +
       'or a tool that rewrote it dropped its extras (gltfpack: keep them with -ke -kv)');
   const prim = mesh.primitives[0];
   if (prim.mode !== undefined && prim.mode !== 4) throw new Error('primitive mode ' + prim.mode + ': only triangles are drawn');
-  const stream = chooseStream(vx.streams, q.get('order'));
-  if (!(stream.order >= 1 && stream.order <= MAX_ORDER)) throw new Error('stream order ' + stream.order + ' out of range 1..16');
-  const quantity = { 'distance': 0, 'distance2': 1, 'log-distance': 2 }[stream.quantity];
-  if (quantity === undefined) throw new Error('stream quantity ' + stream.quantity + ' unknown');
-  const groups = Math.ceil(stream.order * stream.order / 4);
+  const stream = vdshChooseStream(vx.streams, q.get('order'));
+  const plan = vdshStreamPlan(stream, q.get('path'));
   const attrNames = [];
-  for (let g = 0; g < groups; g++) {
+  for (let g = 0; g < plan.groups; g++) {
     const name = stream.attribute_prefix + g;
     if (prim.attributes[name] === undefined) throw new Error('attribute ' + name + ' is missing (a tool dropped it? gltfpack: -kv)');
     attrNames.push(name);
@@ -570,7 +474,7 @@ async function main() {
     });
   }
   const output = q.get('output') === 'shadow' ? 1 : 0;
-  const buffer = q.get('path') === 'buffer' || stream.variable_order || ![2, 3, 5].includes(stream.order);
+  const buffer = plan.buffer;
   window.vdshView = { eye: cam.eye, target: cam.target, lights, order: stream.order,
     adaptive: !!stream.variable_order, path: buffer ? 'buffer' : 'attributes', defaultView: dv.fallback ? 'fallback' : 'file' };
 
@@ -583,40 +487,10 @@ async function main() {
   const gl = canvas.getContext('webgl2', { antialias: false, preserveDrawingBuffer: true });
   if (!gl) throw new Error('this browser gives no WebGL2 context');
   const coef = attrNames.map((n) => gltf.read(prim.attributes[n]));
-  let bufCfg = null, records = null, orders = null, texels = null;
-  if (buffer) {
-    // Each vertex's record: its coefficients (up to its own order: the
-    // last nonzero band of an adaptive stream) in the recurrence's order.
-    const N = stream.order, nc = N * N;
-    orders = new Uint32Array(nv);
-    records = new Uint32Array(nv);
-    const get = (v, i) => coef[i >> 2][4 * v + (i & 3)];
-    let total = 0;
-    for (let v = 0; v < nv; v++) {
-      let k = N;
-      if (stream.variable_order)
-        for (k = 0; k < N; k++) {
-          let zero = true;
-          for (let i = k * k; i < nc && zero; i++) zero = get(v, i) === 0;
-          if (zero) break;
-        }
-      orders[v] = k;
-      records[v] = total;
-      total += Math.ceil(k * k / 4);
-    }
-    const maxTex = gl.getParameter(gl.MAX_TEXTURE_SIZE);
-    const W = Math.min(maxTex, 4096), H = Math.max(1, Math.ceil(total / W));
-    if (H > maxTex) throw new Error('the coefficients need ' + total + ' texels, over this GPU\'s texture (' + maxTex + ' x ' + maxTex + ')');
-    texels = new Float32Array(W * H * 4);
-    const seqs = [];
-    for (let v = 0; v < nv; v++) {
-      const k = orders[v], seq = seqs[k] || (seqs[k] = bufferSequence(k));
-      const at = 4 * records[v];
-      for (let p = 0; p < seq.length; p++) texels[at + p] = get(v, seq[p]);
-    }
-    bufCfg = { order: N, texWidth: W, texHeight: H };
-  }
-  const src = glsl({ order: stream.order, quantity, lights: lights.length, output, buffer: bufCfg }, await loadShaders(q.get('shaders')));
+  let bd = null;
+  if (buffer)  // each vertex's coefficients in a float texture (vdsh_core.js)
+    bd = vdshBufferData((v, i) => coef[i >> 2][4 * v + (i & 3)], nv, stream, gl.getParameter(gl.MAX_TEXTURE_SIZE));
+  const src = glsl({ plan, lights: lights.length, output, texWidth: bd ? bd.width : 0 }, await loadShaders(q.get('shaders')));
   const sh = (type, s) => {
     const o = gl.createShader(type);
     gl.shaderSource(o, s);
@@ -646,21 +520,21 @@ async function main() {
   attrib('a_normal', nrm, 3);
   const U = (n) => gl.getUniformLocation(prog, n);
   if (buffer) {
-    attrib('a_record', records, 1);
-    attrib('a_order', orders, 1);
+    attrib('a_record', bd.records, 1);
+    attrib('a_order', bd.orders, 1);
     gl.activeTexture(gl.TEXTURE0);
     gl.bindTexture(gl.TEXTURE_2D, gl.createTexture());
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
-    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, bufCfg.texWidth, bufCfg.texHeight, 0, gl.RGBA, gl.FLOAT, texels);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, bd.width, bd.height, 0, gl.RGBA, gl.FLOAT, bd.texels);
     gl.uniform1i(U('u_coef'), 0);
   } else {
-    for (let g = 0; g < src.groups; g++) attrib('a_c' + g, coef[g], 4);
+    for (let g = 0; g < plan.groups; g++) attrib('vdshC' + g, coef[g], 4);
   }
   gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, gl.createBuffer());
   gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, indices, gl.STATIC_DRAW);
-  gl.uniform1f(U('u_scale'), stream.scale);
-  gl.uniform1f(U('u_max_distance'), vx.max_distance);
+  gl.uniform1f(U('vdshScale'), stream.scale);
+  gl.uniform1f(U('vdshMaxDistance'), vx.max_distance);
   gl.uniform3fv(U('u_light_color'), new Float32Array(colors.flat().map((c) => ALBEDO * c)));
   gl.uniform3fv(U('u_light_att'), new Float32Array(atts.flat()));
   gl.uniform3f(U('u_ambient'), ALBEDO * 0.03, ALBEDO * 0.03, ALBEDO * 0.03);

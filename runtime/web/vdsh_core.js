@@ -1,0 +1,191 @@
+// vdsh_core.js - what the web viewer (vdsh_web.js, raw WebGL2) and the
+// three.js module (vdsh_three.js) share: an ES module without three.js.
+//   - the shader files (runtime/shaders/), fetched;
+//   - the choice of a stream (vdsh-view's default);
+//   - the buffer path's data (each vertex's coefficients in a float
+//     texture, as runtime/vr_buffer.c lays them out) and its K table;
+//   - the vertex stage's VDSH code: per light the value interpolated to
+//     the fragment stage (the C runtime's rule, runtime/shaders/README.md):
+//       log-distance streams, and every stream on the buffer path: the
+//         distance vdsh_distance(sum, max_distance) (the fragment compares
+//         it with |light - fragment|: VDSH_DIST_PATH 1);
+//       linear streams (distance, distance^2) on the attribute path: the
+//         visibility vdsh_compare(distance, |light - vertex|).
+// What each caller adds is its lighting: vdsh_web.js vdsh-view's Lambert
+// and lights (its default picture is vdsh-view --render's), vdsh_three.js
+// three.js's own materials and PointLights.
+
+export const MAX_ORDER = 16;
+export const VDSH_EXT = 'VDSH_visibility_distance';
+
+// The shader files, from the folder `url` (default ../shaders/ next to
+// this file, the source tree's and the installed layout).
+export async function loadVdshShaders(url = new URL('../shaders/', import.meta.url)) {
+  const get = async (name) => {
+    const u = new URL(name, url);
+    const r = await fetch(u);
+    if (!r.ok) throw new Error('cannot load ' + u + ' (HTTP ' + r.status + ')');
+    return r.text();
+  };
+  const [common, buffer] = await Promise.all([get('vdsh_common.glsl'), get('vdsh_buffer.glsl')]);
+  return { common, buffer };
+}
+
+// The stream to draw: order N, 'adaptive', or vdsh-view's default (5,
+// else 3, else 2, else the adaptive stream, else the highest order).
+export function vdshChooseStream(streams, want) {
+  const fixed = (o) => streams.find((s) => s.order === o && !s.variable_order);
+  const variable = streams.find((s) => s.variable_order);
+  if (want === 'adaptive') {
+    if (!variable) throw new Error('no stream with an order per vertex (adaptive order) in this file');
+    return variable;
+  }
+  if (want !== undefined && want !== null && want !== '') {
+    const o = Number(want);
+    const s = fixed(o) || streams.find((x) => x.order === o);
+    if (!s) throw new Error('no stream of order ' + want + ' (the file has ' +
+      streams.map((x) => x.order + (x.variable_order ? ' adaptive' : '')).join(', ') + ')');
+    return s;
+  }
+  return fixed(5) || fixed(3) || fixed(2) || variable || streams.reduce((a, b) => (b.order > a.order ? b : a));
+}
+
+// How a stream is drawn: its quantity's number, attribute groups, the
+// buffer path or not (orders other than 2, 3, 5, an order per vertex, or
+// path 'buffer'), and whether the fragment stage compares distances.
+export function vdshStreamPlan(stream, path) {
+  if (!(stream.order >= 1 && stream.order <= MAX_ORDER)) throw new Error('stream order ' + stream.order + ' out of range 1..16');
+  const quantity = { 'distance': 0, 'distance2': 1, 'log-distance': 2 }[stream.quantity];
+  if (quantity === undefined) throw new Error('stream quantity ' + stream.quantity + ' unknown');
+  const buffer = path === 'buffer' || !!stream.variable_order || ![2, 3, 5].includes(stream.order);
+  return { order: stream.order, quantity, groups: Math.ceil(stream.order * stream.order / 4), buffer,
+    distPath: buffer || quantity === 2 };
+}
+
+// K_l^|m| per coefficient index l(l+1)+m (sqrt 2 folded in for m != 0),
+// in double then rounded to f32, as runtime/vr_buffer.c (make_ks).
+export function ksTable(order) {
+  const ks = new Float32Array(order * order);
+  for (let l = 0; l < order; l++)
+    for (let m = 0; m <= l; m++) {
+      let kk = (2 * l + 1) / (4 * Math.PI);
+      for (let f = l - m + 1; f <= l + m; f++) kk /= f;
+      const K = m === 0 ? Math.sqrt(kk) : Math.sqrt(2 * kk);
+      ks[l * (l + 1) + m] = K;
+      ks[l * (l + 1) - m] = K;
+    }
+  return ks;
+}
+
+// A float as a GLSL literal that reads back as the same f32.
+export const flit = (x) => {
+  const s = Math.fround(x).toPrecision(9);
+  return /[.e]/.test(s) ? s : s + '.0';
+};
+
+// The order the recurrence consumes coefficients in (vr_buffer_sequence):
+// m outside, l inside, +m before -m.
+export function bufferSequence(order) {
+  const out = [];
+  for (let m = 0; m < order; m++)
+    for (let l = m; l < order; l++) {
+      out.push(l * (l + 1) + m);
+      if (m > 0) out.push(l * (l + 1) - m);
+    }
+  return out;
+}
+
+// The buffer path's data: each vertex's record (its coefficients up to
+// its own order -- the last nonzero band of an adaptive stream -- in the
+// recurrence's order), four to a texel, row by row in a width x height
+// RGBA float texture; records (first texel) and orders per vertex.
+// get(v, i): coefficient i of vertex v (as stored: times the scale in the
+// shader).
+export function vdshBufferData(get, nv, stream, maxTexture) {
+  const N = stream.order, nc = N * N;
+  const orders = new Uint32Array(nv), records = new Uint32Array(nv);
+  let total = 0;
+  for (let v = 0; v < nv; v++) {
+    let k = N;
+    if (stream.variable_order)
+      for (k = 0; k < N; k++) {
+        let zero = true;
+        for (let i = k * k; i < nc && zero; i++) zero = get(v, i) === 0;
+        if (zero) break;
+      }
+    orders[v] = k;
+    records[v] = total;
+    total += Math.ceil(k * k / 4);
+  }
+  const width = Math.min(maxTexture, 4096), height = Math.max(1, Math.ceil(total / width));
+  if (height > maxTexture) throw new Error('the coefficients need ' + total + ' texels, over this GPU\'s texture (' +
+    maxTexture + ' x ' + maxTexture + ')');
+  const texels = new Float32Array(width * height * 4), seqs = [];
+  for (let v = 0; v < nv; v++) {
+    const k = orders[v], seq = seqs[k] || (seqs[k] = bufferSequence(k));
+    for (let p = 0, at = 4 * records[v]; p < seq.length; p++) texels[at + p] = get(v, seq[p]);
+  }
+  return { orders, records, texels, width, height };
+}
+
+// The vertex stage's VDSH code for a plan (vdshStreamPlan), after
+// NUM_LIGHTS and vdsh_common.glsl (`defines` goes before vdsh_common.glsl):
+// the caller declares `uniform float vdshScale, vdshMaxDistance;` before
+// `decl`, binds the attributes vdshC0.. (the glb's groups, attribute path)
+// or a_record, a_order and the texture u_coef (buffer path, width
+// texWidth), and calls
+//   void vdsh_vertex(vec3 p, vec3 lights[NUM_LIGHTS], out float val[NUM_LIGHTS])
+// p the vertex and lights in the bake's frame; val: per light the
+// distance (VDSH_DIST_PATH 1) or the visibility, to interpolate.
+export function vdshVertexGlsl(plan, shaders, texWidth) {
+  const defines = `#define QUANTITY ${plan.quantity}\n#define COMPARE 0\n#define VDSH_DIST_PATH ${plan.distPath ? 1 : 0}\n` +
+    `#define BUFFER ${plan.buffer ? 1 : 0}\n#define VDSH_ORDER ${plan.order}\n`;
+  let decl = '';
+  if (plan.buffer) {
+    const ks = ksTable(plan.order);
+    decl = `#define BUF_TEXTURE_2D 1\n#define BUF_TEX_WIDTH ${texWidth}\n#define BUF_KIND 0\n#define BUF_VARIABLE 1\n` +
+      `#define BUF_ORDER ${plan.order}\n#define BUF_STRIDE 0\n` +
+      `#define BUF_RECEIVER vdshP\n#define BUF_LIGHT(i) vdshL[i]\n#define BUF_SCALE vdshScale\n` +
+      `vec3 vdshP;\nvec3 vdshL[NUM_LIGHTS];\n` +
+      `const float KS[${ks.length}] = float[${ks.length}](${Array.from(ks, flit).join(', ')});\n` + shaders.buffer + '\n';
+  } else {
+    for (let g = 0; g < plan.groups; g++) decl += `in vec4 vdshC${g};\n`;
+    const g7 = Array.from({ length: 7 }, (_, g) => (g < plan.groups ? 'vdshC' + g : 'vec4(0.0)')).join(', ');
+    decl += `float vdshSum(vec3 d) {
+#if VDSH_ORDER == 2
+  return vdshScale * sh_sum4(vdshC0, d);
+#elif VDSH_ORDER == 3
+  return vdshScale * sh_sum9(vdshC0, vdshC1, vdshC2.x, d);
+#else
+  vec4 g[7] = vec4[7](${g7});
+  return vdshScale * vdsh_sh_sum25(g, d);
+#endif
+}
+`;
+  }
+  decl += `void vdsh_vertex(vec3 p, vec3 lights[NUM_LIGHTS], out float val[NUM_LIGHTS]) {
+#if BUFFER
+  vdshP = p;
+  for (int i = 0; i < NUM_LIGHTS; i++) vdshL[i] = lights[i];
+  float sums[NUM_LIGHTS];
+  buffer_sums(sums);
+#endif
+  for (int i = 0; i < NUM_LIGHTS; i++) {
+    vec3 lv = lights[i] - p;
+    float dl = length(lv);
+    // a light at the vertex has no direction: distance 0, not NaN
+#if BUFFER
+    float dv = dl > 0.0 ? vdsh_distance(sums[i], vdshMaxDistance) : 0.0;
+#else
+    float dv = dl > 0.0 ? vdsh_distance(vdshSum(lv / dl), vdshMaxDistance) : 0.0;
+#endif
+#if VDSH_DIST_PATH
+    val[i] = dv;
+#else
+    val[i] = vdsh_compare(dv, dl);
+#endif
+  }
+}
+`;
+  return { defines, decl };
+}
