@@ -791,6 +791,16 @@ static int tier(const scored *c)
     return lights && c->sh >= VDSH_VIEW_MIN_SHARE ? 1 : lights ? 2 : 3;
 }
 
+/* Candidate c as out's light k (its preferred position v's, or its own). */
+static void take_light(vdsh_view *out, int k, const scored *c, const vdsh_view *v)
+{
+    memcpy(out->lights[k], c->p, sizeof c->p);
+    out->light_free[k] = c->free;
+    out->light_lit[k] = c->lit, out->light_shadowed[k] = c->sh;
+    memcpy(out->preferred[k], c->pref >= 0 ? v->preferred[c->pref] : c->p,
+           sizeof out->preferred[k]);
+}
+
 static vdsh_result choose_lights(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
                                  vdsh_view *v, float diag)
 {
@@ -828,14 +838,7 @@ static vdsh_result choose_lights(const vdsh_view_tracer *t, const vdsh_view_mesh
         for (int i = 0; i < n && k < v->light_count; i++)
             if (!taken[i] && tier(&c[i]) == tr) {
                 taken[i] = 1;
-                memcpy(out.lights[k], c[i].p, sizeof c[i].p);
-                out.light_free[k] = c[i].free;
-                out.light_lit[k] = c[i].lit, out.light_shadowed[k] = c[i].sh;
-                if (c[i].pref >= 0)
-                    memcpy(out.preferred[k], v->preferred[c[i].pref], sizeof out.preferred[k]);
-                else
-                    memcpy(out.preferred[k], c[i].p, sizeof out.preferred[k]);
-                k++;
+                take_light(&out, k++, &c[i], v);
             }
     for (; k < v->light_count; k++) {
         int best = -1;
@@ -843,13 +846,7 @@ static vdsh_result choose_lights(const vdsh_view_tracer *t, const vdsh_view_mesh
             if (!taken[i] && (best < 0 || c[i].lit > c[best].lit))
                 best = i;
         taken[best] = 1;
-        memcpy(out.lights[k], c[best].p, sizeof c[best].p);
-        out.light_free[k] = c[best].free;
-        out.light_lit[k] = c[best].lit, out.light_shadowed[k] = c[best].sh;
-        if (c[best].pref >= 0)
-            memcpy(out.preferred[k], v->preferred[c[best].pref], sizeof out.preferred[k]);
-        else
-            memcpy(out.preferred[k], c[best].p, sizeof out.preferred[k]);
+        take_light(&out, k, &c[best], v);
     }
     *v = out;
     return VDSH_OK;
