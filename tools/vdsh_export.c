@@ -107,6 +107,39 @@ static void view_list_free(view_list *vl)
     free(vl->v);
 }
 
+/* The "buffers" array of g: buffer 0 (the blob's size) and, with
+ * fallback, buffer 1 of fallback_size bytes that the file does not hold:
+ * the meshopt-compressed views' uncompressed form (EXT_meshopt_compression). */
+static void add_buffers(cJSON *g, size_t size, int fallback, size_t fallback_size)
+{
+    cJSON *bufs = cJSON_AddArrayToObject(g, "buffers");
+    cJSON *buf = cJSON_CreateObject();
+    cJSON_AddNumberToObject(buf, "byteLength", (double)size);
+    cJSON_AddItemToArray(bufs, buf);
+    if (!fallback)
+        return;
+    cJSON *fb = cJSON_CreateObject();
+    cJSON_AddNumberToObject(fb, "byteLength", (double)fallback_size);
+    cJSON_AddBoolToObject(
+        cJSON_AddObjectToObject(cJSON_AddObjectToObject(fb, "extensions"), "EXT_meshopt_compression"),
+        "fallback", 1);
+    cJSON_AddItemToArray(bufs, fb);
+}
+
+/* name in g's array `list` (extensionsUsed, extensionsRequired), made
+ * when absent; once. */
+static void list_extension(cJSON *g, const char *list, const char *name)
+{
+    cJSON *l = cJSON_GetObjectItemCaseSensitive(g, list);
+    if (!l)
+        l = cJSON_AddArrayToObject(g, list);
+    cJSON *e;
+    cJSON_ArrayForEach(e, l)
+        if (cJSON_IsString(e) && strcmp(e->valuestring, name) == 0)
+            return;
+    cJSON_AddItemToArray(l, cJSON_CreateString(name));
+}
+
 /* The views into the blob and the JSON: plain, or meshopt-compressed
  * (the views then live in a fallback buffer 1 that holds no bytes; the
  * compressed bytes are buffer 0, the BIN chunk). Returns 0, or -1 out of
@@ -403,29 +436,10 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
     if (write_views(&nl, compress, b, views, &raw) || blob_align4(b))
         goto oom;
     cJSON_DeleteItemFromObjectCaseSensitive(g, "buffers");
-    cJSON *bufs = cJSON_AddArrayToObject(g, "buffers");
-    cJSON *buf = cJSON_CreateObject();
-    cJSON_AddNumberToObject(buf, "byteLength", (double)b->size);
-    cJSON_AddItemToArray(bufs, buf);
+    add_buffers(g, b->size, compress && nl.n > 0, raw);
     if (compress && nl.n > 0) {
-        cJSON *fb = cJSON_CreateObject();
-        cJSON_AddNumberToObject(fb, "byteLength", (double)raw);
-        cJSON_AddBoolToObject(
-            cJSON_AddObjectToObject(cJSON_AddObjectToObject(fb, "extensions"), "EXT_meshopt_compression"),
-            "fallback", 1);
-        cJSON_AddItemToArray(bufs, fb);
-        const char *lists[2] = {"extensionsUsed", "extensionsRequired"};
-        for (int k = 0; k < 2; k++) {
-            cJSON *l = cJSON_GetObjectItemCaseSensitive(g, lists[k]);
-            if (!l)
-                l = cJSON_AddArrayToObject(g, lists[k]);
-            int listed = 0;
-            cJSON *e;
-            cJSON_ArrayForEach(e, l)
-                listed |= cJSON_IsString(e) && strcmp(e->valuestring, "EXT_meshopt_compression") == 0;
-            if (!listed)
-                cJSON_AddItemToArray(l, cJSON_CreateString("EXT_meshopt_compression"));
-        }
+        list_extension(g, "extensionsUsed", "EXT_meshopt_compression");
+        list_extension(g, "extensionsRequired", "EXT_meshopt_compression");
     }
     cJSON_AddNumberToObject(*vx, "source_vertices", (double)vertices);
     cJSON_AddNumberToObject(*vx, "source_vertices_matched", (double)matched);
@@ -435,15 +449,7 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
     cJSON_DeleteItemFromObjectCaseSensitive(gext, VDSH_EXT);
     cJSON_AddItemToObject(gext, VDSH_EXT, *vx);
     *vx = NULL;
-    cJSON *used = cJSON_GetObjectItemCaseSensitive(g, "extensionsUsed");
-    if (!used)
-        used = cJSON_AddArrayToObject(g, "extensionsUsed");
-    int have = 0;
-    cJSON *u;
-    cJSON_ArrayForEach(u, used)
-        have |= cJSON_IsString(u) && strcmp(u->valuestring, VDSH_EXT) == 0;
-    if (!have)
-        cJSON_AddItemToArray(used, cJSON_CreateString(VDSH_EXT));
+    list_extension(g, "extensionsUsed", VDSH_EXT);
     cJSON *asset = cJSON_GetObjectItemCaseSensitive(g, "asset");
     if (asset) {
         cJSON_DeleteItemFromObjectCaseSensitive(asset, "generator");
@@ -833,23 +839,12 @@ int main(int argc, char **argv)
     if (write_views(&vl, compress, &b, views, &raw_size) || blob_align4(&b))
         goto oom;
     {
-        cJSON *buffers = cJSON_AddArrayToObject(root, "buffers");
-        cJSON *buf = cJSON_CreateObject();
-        cJSON_AddNumberToObject(buf, "byteLength", (double)b.size);
-        cJSON_AddItemToArray(buffers, buf);
-        if (compress) { /* the uncompressed views: a fallback buffer without bytes */
-            cJSON *fb = cJSON_CreateObject();
-            cJSON_AddNumberToObject(fb, "byteLength", (double)raw_size);
-            cJSON_AddBoolToObject(
-                cJSON_AddObjectToObject(cJSON_AddObjectToObject(fb, "extensions"), "EXT_meshopt_compression"),
-                "fallback", 1);
-            cJSON_AddItemToArray(buffers, fb);
-            cJSON *used = cJSON_AddArrayToObject(root, "extensionsUsed");
-            cJSON *req = cJSON_AddArrayToObject(root, "extensionsRequired");
+        add_buffers(root, b.size, compress, raw_size);
+        if (compress) {
             const char *names[2] = {"KHR_mesh_quantization", "EXT_meshopt_compression"};
             for (int k = 0; k < 2; k++) {
-                cJSON_AddItemToArray(used, cJSON_CreateString(names[k]));
-                cJSON_AddItemToArray(req, cJSON_CreateString(names[k]));
+                list_extension(root, "extensionsUsed", names[k]);
+                list_extension(root, "extensionsRequired", names[k]);
             }
         }
         cJSON *prim = cJSON_CreateObject();
