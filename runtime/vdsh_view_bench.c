@@ -231,6 +231,20 @@ static int bench_open(const vv_options *o, const char *path, bench_scene *b)
     return 0;
 }
 
+/* Mode m of scene bs at light set ls: the draw's description (*d) and the
+ * scene it draws (the float-coefficient copy for the buffer modes that
+ * read floats). */
+static const vr_scene *mode_desc(const vv_options *o, const bench_scene *bs, int ls, int m,
+                                 vr_draw_desc *d)
+{
+    *d = vv_base_desc(o, bs->lights[ls], bs->nl[ls]);
+    d->mode = bs->modes[m].mode;
+    d->pcf = bs->modes[m].pcf;
+    d->stream = bs->modes[m].stream;
+    vv_scene_camera(bs->scene, o, &d->camera);
+    return bs->modes[m].floats ? bs->floats : bs->scene;
+}
+
 /* Time every mode of every scene, with 1 light, then 3, 16 and 64.
  * Warm-up first (two rounds, one for the long frames of 16 and 64
  * lights): compile every program and allocate every shadow map before
@@ -252,14 +266,10 @@ static int bench_time(const vv_options *o, bench_scene *b, int nb, vr_renderer *
                     j -= b[i++].nm;
                 bench_scene *bs = &b[i];
                 vr_renderer *r = rs[bs->modes[j].renderer];
-                vr_draw_desc d = vv_base_desc(o, bs->lights[ls], bs->nl[ls]);
-                d.mode = bs->modes[j].mode;
-                d.pcf = bs->modes[j].pcf;
-                d.stream = bs->modes[j].stream;
-                vv_scene_camera(bs->scene, o, &d.camera);
+                vr_draw_desc d;
+                const vr_scene *drawn = mode_desc(o, bs, ls, j, &d);
                 vr_error err;
                 double proc0 = process_cpu_ms();
-                const vr_scene *drawn = bs->modes[j].floats ? bs->floats : bs->scene;
                 if (vr_draw(r, drawn, &d, &err) != VR_OK) {
                     fprintf(stderr, "vdsh-view: %s: %s: %s\n", bs->path, bs->modes[j].name,
                             err.msg);
@@ -288,13 +298,9 @@ static int bench_count(const vv_options *o, bench_scene *b, int nb, vr_renderer 
         for (int ls = 0; ls < BENCH_SETS; ls++)
             for (int m = 0; m < b[i].nm && bench_set_on(o, ls); m++) {
                 bench_scene *bs = &b[i];
-                vr_draw_desc d = vv_base_desc(o, bs->lights[ls], bs->nl[ls]);
-                d.mode = bs->modes[m].mode;
-                d.pcf = bs->modes[m].pcf;
-                d.stream = bs->modes[m].stream;
-                vv_scene_camera(bs->scene, o, &d.camera);
+                vr_draw_desc d;
+                const vr_scene *drawn = mode_desc(o, bs, ls, m, &d);
                 vr_error err;
-                const vr_scene *drawn = bs->modes[m].floats ? bs->floats : bs->scene;
                 if (vr_draw_counted(rs[bs->modes[m].renderer], drawn, &d, &bs->counts[ls][m],
                                     &err) != VR_OK) {
                     fprintf(stderr, "vdsh-view: %s: %s: %s\n", bs->path, bs->modes[m].name,
