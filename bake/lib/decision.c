@@ -78,10 +78,10 @@ VINLINE v8f log8(v8f x)
 size_t vb_decision_scratch_doubles(int order)
 {
     size_t n = (size_t)order * order;
-    /* H, its factor, g, step, c, c0, trial c, r; per pair: margin, q, h */
-    /* then floats: sqrt(h) per pair, Z = sqrt(h) Y (n rows) */
-    return 2 * n * n + 6 * n + 4 * (size_t)VB_DECISION_MAX_PAIRS +
-           ((size_t)VB_DECISION_MAX_PAIRS * (n + 1) + 1) / 2;
+    /* H, its factor, g, step, c, c0, trial c, r; then floats per pair:
+     * margin, trial margin, q, h, loss, sign, weight, sqrt(h), e^-|z|,
+     * then Z = sqrt(h) Y (n rows) */
+    return 2 * n * n + 6 * n + ((size_t)VB_DECISION_MAX_PAIRS * (n + 9) + 1) / 2;
 }
 
 enum { LANES = 8 };
@@ -106,15 +106,12 @@ static inline __attribute__((always_inline)) void margins(int n, uint32_t m, con
 }
 
 /* Per pair, from its margin: z = s t / tau (s = +1 shadowed, -1 lit);
- * the weighted softplus(z) into sp and, when q is not NULL, the
- * gradient's and the Hessian's weights (a sigma(z) s / tau, a sigma(z)
- * (1 - sigma(z)) / tau^2, a the pair's weight over the weights' sum). One
- * exp and one log per pair, eight at a time. m8: m rounded up to 8; the
- * arrays hold m8 values (sgn and wt 0 past m, so those lanes add 0). */
-static inline __attribute__((always_inline)) void pair_terms(uint32_t m8, const float *t,
-                                                            const float *sgn, const float *wt,
-                                                            float inv_tau, float *sp, float *q,
-                                                            float *h)
+ * the weighted softplus(z) into sp and e^-|z| into e (for pair_weights).
+ * One exp and one log per pair, eight at a time. m8: m rounded up to 8;
+ * the arrays hold m8 values (sgn and wt 0 past m, so those lanes add 0). */
+static inline __attribute__((always_inline)) void pair_loss(uint32_t m8, const float *t,
+                                                           const float *sgn, const float *wt,
+                                                           float inv_tau, float *sp, float *e)
 {
     for (uint32_t i = 0; i < m8; i += 8) {
         v8f tv, sv, wv;
@@ -122,13 +119,30 @@ static inline __attribute__((always_inline)) void pair_terms(uint32_t m8, const 
         memcpy(&sv, sgn + i, sizeof sv);
         memcpy(&wv, wt + i, sizeof wv);
         v8f z = sv * tv * v8(inv_tau), az = sel(z < v8(0.0f), -z, z);
-        v8f e = exp8(-az), one = v8(1.0f) + e;
+        v8f ev = exp8(-az), one = v8(1.0f) + ev;
         v8f out = wv * (v8(0.5f) * (z + az) + log8(one));
         memcpy(sp + i, &out, sizeof out);
-        if (!q)
-            continue;
+        memcpy(e + i, &ev, sizeof ev);
+    }
+}
+
+/* The gradient's and the Hessian's weights per pair from its margin t and
+ * pair_loss's e: a sigma(z) s / tau and a sigma(z) (1 - sigma(z)) / tau^2
+ * (a the pair's weight over the weights' sum); no exp or log again. */
+static inline __attribute__((always_inline)) void pair_weights(uint32_t m8, const float *t,
+                                                              const float *sgn, const float *wt,
+                                                              float inv_tau, const float *e,
+                                                              float *q, float *h)
+{
+    for (uint32_t i = 0; i < m8; i += 8) {
+        v8f tv, sv, wv, ev;
+        memcpy(&tv, t + i, sizeof tv);
+        memcpy(&sv, sgn + i, sizeof sv);
+        memcpy(&wv, wt + i, sizeof wv);
+        memcpy(&ev, e + i, sizeof ev);
+        v8f z = sv * tv * v8(inv_tau), one = v8(1.0f) + ev;
         /* sigma(z): 1 / (1 + e) for z >= 0, e / (1 + e) below */
-        v8f s = sel(z >= v8(0.0f), v8(1.0f), e) / one;
+        v8f s = sel(z >= v8(0.0f), v8(1.0f), ev) / one;
         v8f qv = wv * sv * s * v8(inv_tau);
         v8f hv = wv * s * (v8(1.0f) - s) * v8(inv_tau * inv_tau);
         memcpy(q + i, &qv, sizeof qv);
@@ -136,14 +150,26 @@ static inline __attribute__((always_inline)) void pair_terms(uint32_t m8, const 
     }
 }
 
+/* Four floats and four doubles (unaligned loads), for the lane-wise sums
+ * below: lane k of the vector sums is lane k of the scalar loop's. */
+typedef float v4fu __attribute__((vector_size(16), aligned(4)));
+typedef double v4d __attribute__((vector_size(32)));
+
+VINLINE v4d load4d(const float *p)
+{
+    return __builtin_convertvector(*(const v4fu *)p, v4d);
+}
+
 /* The sum of m floats in LANES lane-wise double sums, in lane order. */
 static inline __attribute__((always_inline)) double sum_lanes(uint32_t m, const float *x)
 {
-    double lane[LANES] = {0};
+    v4d lo = {0}, hi = {0};
     uint32_t i = 0;
-    for (; i + LANES <= m; i += LANES)
-        for (int k = 0; k < LANES; k++)
-            lane[k] += x[i + k];
+    for (; i + LANES <= m; i += LANES) {
+        lo += load4d(x + i);
+        hi += load4d(x + i + 4);
+    }
+    double lane[LANES] = {lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]};
     for (; i < m; i++)
         lane[i % LANES] += x[i];
     double s = 0.0;
@@ -161,14 +187,19 @@ static double ridge_term(int n, const double *c, const double *c0, const double 
 }
 
 /* sum_i w_i a_i in LANES lane-wise sums, added in lane order: the same
- * bits with or without vectors. */
+ * bits with or without vectors (each product rounded to float, then
+ * added in double, as the scalar loop would). */
 static inline __attribute__((always_inline)) double dot2(uint32_t m, const float *w, const float *a)
 {
-    double lane[LANES] = {0};
+    v4d lo = {0}, hi = {0};
     uint32_t i = 0;
-    for (; i + LANES <= m; i += LANES)
-        for (int k = 0; k < LANES; k++)
-            lane[k] += w[i + k] * a[i + k];
+    for (; i + LANES <= m; i += LANES) {
+        v4fu w0 = *(const v4fu *)(w + i), w1 = *(const v4fu *)(w + i + 4);
+        v4fu a0 = *(const v4fu *)(a + i), a1 = *(const v4fu *)(a + i + 4);
+        lo += __builtin_convertvector(w0 * a0, v4d);
+        hi += __builtin_convertvector(w1 * a1, v4d);
+    }
+    double lane[LANES] = {lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]};
     for (; i < m; i++)
         lane[i % LANES] += w[i] * a[i];
     double s = 0.0;
@@ -276,7 +307,7 @@ int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
     double *H = scratch, *L = H + (size_t)n * n, *g = L + (size_t)n * n, *dx = g + n,
            *c = dx + n, *c0 = c + n, *ct = c0 + n, *r = ct + n;
     float *t = (float *)(r + n), *tt = t + K, *q = tt + K, *h = q + K, *sp = h + K,
-          *sgn = sp + K, *wt = sgn + K, *sh = wt + K, *Z = sh + K;
+          *sgn = sp + K, *wt = sgn + K, *sh = wt + K, *ex = sh + K, *Z = ex + K;
     const uint32_t m8 = (m + 7) & ~7u;
     const float inv_tau = 1.0f / p->tau;
     double a = 0.0;
@@ -296,7 +327,8 @@ int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
         c[j] = c0[j] = cf[j];
     }
     margins(n, m, Y, stride, logd, c, t);
-    pair_terms(m8, t, sgn, wt, inv_tau, sp, q, h);
+    pair_loss(m8, t, sgn, wt, inv_tau, sp, ex);
+    pair_weights(m8, t, sgn, wt, inv_tau, ex, q, h);
     double f = sum_lanes(m, sp);
     /* Every pair already on its side by a wide margin (sigma(z) < 1/400 in
      * each): the start is the fit to within the ridge. */
@@ -340,7 +372,7 @@ int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
             for (int j = 0; j < n; j++)
                 ct[j] = c[j] - step * dx[j];
             margins(n, m, Y, stride, logd, ct, tt);
-            pair_terms(m8, tt, sgn, wt, inv_tau, sp, NULL, NULL);
+            pair_loss(m8, tt, sgn, wt, inv_tau, sp, ex);
             fn = sum_lanes(m, sp) + ridge_term(n, ct, c0, r);
             ok = fn < f;
         }
@@ -360,7 +392,7 @@ int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
         float *swap = t;
         t = tt;
         tt = swap;
-        pair_terms(m8, t, sgn, wt, inv_tau, sp, q, h);
+        pair_weights(m8, t, sgn, wt, inv_tau, ex, q, h); /* ex: the accepted trial's */
     }
     for (int j = 0; j < n; j++)
         cf[j] = (float)c[j];
