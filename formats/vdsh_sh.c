@@ -129,6 +129,27 @@ static inline __attribute__((always_inline)) void soa_dispatch(
         default: soa_loop(5, 16, x, y, z, w, o, 16, acc); return;
         }
     }
+    /* Evaluation at any stride (the decision fit's rows of 1024): blocks
+     * of 16 through the vectorised loop into a block of rows of 16, then
+     * copied out (the same values: each lane computes what the scalar
+     * loop would). */
+    if (!acc && n >= 16) {
+        const int rows = order * order;
+        float block[KERNEL_ORDER * KERNEL_ORDER * 16];
+        size_t k0 = 0;
+        for (; k0 + 16 <= n; k0 += 16) {
+            switch (order) {
+            case 1: soa_loop(1, 16, x + k0, y + k0, z + k0, NULL, block, 16, 0); break;
+            case 2: soa_loop(2, 16, x + k0, y + k0, z + k0, NULL, block, 16, 0); break;
+            case 3: soa_loop(3, 16, x + k0, y + k0, z + k0, NULL, block, 16, 0); break;
+            case 4: soa_loop(4, 16, x + k0, y + k0, z + k0, NULL, block, 16, 0); break;
+            default: soa_loop(5, 16, x + k0, y + k0, z + k0, NULL, block, 16, 0); break;
+            }
+            for (int i = 0; i < rows; i++)
+                memcpy(o + (size_t)i * stride + k0, block + i * 16, 16 * sizeof *block);
+        }
+        x += k0, y += k0, z += k0, o += k0, n -= k0;
+    }
     switch (order) {
     case 1: soa_loop(1, n, x, y, z, w, o, stride, acc); break;
     case 2: soa_loop(2, n, x, y, z, w, o, stride, acc); break;
