@@ -377,10 +377,15 @@ static void decision_vertex(job *J, uint32_t v, const float *org, const float n[
     uint64_t rays = 0;
     uint32_t m = dec_pairs(J, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab, &rays);
     if (m >= DEC_MIN_PAIRS) {
-        vdsh_sh_eval_soa((int)top, m, x, y, z, Y, K);
+        /* The basis's rows m (rounded up) + 16 floats apart, not K: rows
+         * 4 KiB apart share the L1's sets, and the fit reads them all on
+         * every pass. */
+        uint32_t ys = ((m + 15) & ~15u) + 16;
+        ys = ys < K ? ys : K;
+        vdsh_sh_eval_soa((int)top, m, x, y, z, Y, ys);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (out->coeffs[1][o])
-                vb_decision_fit(o, m, Y, K, logd, lab, &J->dec, out->coeffs[1][o], ds);
+                vb_decision_fit(o, m, Y, ys, logd, lab, &J->dec, out->coeffs[1][o], ds);
         atomic_fetch_add(&J->dec_pairs, m);
         atomic_fetch_add(&J->dec_fitted, 1);
     } else {
