@@ -315,40 +315,67 @@ static inline __attribute__((always_inline)) void syrk(int n, uint32_t m8, const
         }
 }
 
-/* Cholesky of the n x n symmetric positive definite A into L (lower).
- * Returns 0 if A is not positive definite. */
-static int cholesky_factor(int n, const double *A, double *L)
+/* Four doubles, unaligned. */
+typedef double v4du __attribute__((vector_size(32), aligned(8)));
+
+/* Cholesky of the n x n symmetric positive definite A (both triangles
+ * set) into its lower factor L, stored by columns: C[k * n + i] = L_ik.
+ * Each entry is the textbook sum, L_ij = (A_ij - sum_{k<j} L_ik L_jk) /
+ * L_jj with k ascending, four rows i at a time in vector lanes (the same
+ * operations per entry as one at a time). Returns 0 if A is not positive
+ * definite. */
+static inline __attribute__((always_inline)) int cholesky_factor(int n, const double *A,
+                                                                double *C)
 {
-    for (int i = 0; i < n; i++)
-        for (int j = 0; j <= i; j++) {
-            double s = A[i * n + j];
-            for (int k = 0; k < j; k++)
-                s -= L[i * n + k] * L[j * n + k];
-            if (i == j) {
-                if (!(s > 0.0))
-                    return 0;
-                L[i * n + i] = __builtin_sqrt(s); /* IEEE-exact on every CPU */
-            } else {
-                L[i * n + j] = s / L[j * n + j];
+    for (int j = 0; j < n; j++) {
+        double d = A[j * n + j];
+        for (int k = 0; k < j; k++)
+            d -= C[k * n + j] * C[k * n + j];
+        if (!(d > 0.0))
+            return 0;
+        const double ljj = __builtin_sqrt(d); /* IEEE-exact on every CPU */
+        C[j * n + j] = ljj;
+        int i = j + 1;
+        for (; i + 4 <= n; i += 4) {
+            v4d s = *(const v4du *)(A + j * n + i); /* A_ij = A_ji */
+            for (int k = 0; k < j; k++) {
+                const double ljk = C[k * n + j];
+                s -= *(const v4du *)(C + k * n + i) * (v4d){ljk, ljk, ljk, ljk};
             }
+            *(v4du *)(C + j * n + i) = s / (v4d){ljj, ljj, ljj, ljj};
         }
+        for (; i < n; i++) {
+            double s = A[j * n + i];
+            for (int k = 0; k < j; k++)
+                s -= C[k * n + i] * C[k * n + j];
+            C[j * n + i] = s / ljj;
+        }
+    }
     return 1;
 }
 
-/* Solve L L^T x = b. */
-static void cholesky_solve(int n, const double *L, const double *b, double *x)
+/* Solve L L^T x = b, L by columns as cholesky_factor leaves it (C). The
+ * forward pass subtracts column by column, four rows at a time: each x_i
+ * still gets b_i - L_i0 x_0 - L_i1 x_1 - ... in that order. */
+static inline __attribute__((always_inline)) void cholesky_solve(int n, const double *C,
+                                                                const double *b, double *x)
 {
-    for (int i = 0; i < n; i++) {
-        double s = b[i];
-        for (int k = 0; k < i; k++)
-            s -= L[i * n + k] * x[k];
-        x[i] = s / L[i * n + i];
+    for (int i = 0; i < n; i++)
+        x[i] = b[i];
+    for (int k = 0; k < n; k++) {
+        const double xk = x[k] / C[k * n + k];
+        x[k] = xk;
+        int i = k + 1;
+        for (; i + 4 <= n; i += 4)
+            *(v4du *)(x + i) -= *(const v4du *)(C + k * n + i) * (v4d){xk, xk, xk, xk};
+        for (; i < n; i++)
+            x[i] -= C[k * n + i] * xk;
     }
     for (int i = n - 1; i >= 0; i--) {
         double s = x[i];
         for (int k = i + 1; k < n; k++)
-            s -= L[k * n + i] * x[k];
-        x[i] = s / L[i * n + i];
+            s -= C[i * n + k] * x[k];
+        x[i] = s / C[i * n + i];
     }
 }
 
