@@ -402,9 +402,10 @@ int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
     double a = 0.0;
     for (uint32_t i = 0; i < m; i++)
         a += shadowed[i] ? 1.0 : p->lit_weight;
+    const float w_shadowed = (float)(1.0 / a), w_lit = (float)(p->lit_weight / a);
     for (uint32_t i = 0; i < m8; i++) {
         sgn[i] = i >= m ? 0.0f : shadowed[i] ? 1.0f : -1.0f;
-        wt[i] = i >= m ? 0.0f : (float)((shadowed[i] ? 1.0 : p->lit_weight) / a);
+        wt[i] = i >= m ? 0.0f : shadowed[i] ? w_shadowed : w_lit;
         t[i] = tt[i] = 0.0f;
     }
     for (int j = 0; j < n; j++) {
