@@ -341,8 +341,11 @@ static uint32_t dec_pairs(const job *J, uint32_t *at, uint32_t *scanned, const f
         *at = *at + 1 == J->pool_count ? 0 : *at + 1;
         ++*scanned;
         float dx = L[0] - org[0], dy = L[1] - org[1], dz = L[2] - org[2];
+        /* The horizon first: half the pool is below it, and needs no root. */
+        if (dx * n[0] + dy * n[1] + dz * n[2] <= 0.0f)
+            continue;
         float len = sqrtf(dx * dx + dy * dy + dz * dz);
-        if (!(len > 0.0f) || dx * n[0] + dy * n[1] + dz * n[2] <= 0.0f)
+        if (!(len > 0.0f))
             continue;
         float inv = 1.0f / len;
         struct RTCRay r = {.org_x = org[0], .org_y = org[1], .org_z = org[2],
