@@ -110,9 +110,43 @@ static void test_offset(void)
     CHECK(vb_decision_offset(m, 0, 0.01) == 0.0f, "no margins: 0");
 }
 
+/* The fit's result depends on the pairs only: the same bits with the
+ * basis's rows further apart (the bake pads them), and with pair counts
+ * that leave partial blocks of 32, 8 and 4 (the vector loops' tails). */
+static void test_stride_and_tails(void)
+{
+    enum { S = M + 20 };
+    uint64_t s = 777;
+    static float Y[N * M], Ys[N * S];
+    float logd[M];
+    uint8_t lab[M];
+    pairs(&s, M, Y, logd, lab);
+    vb_decision_params p;
+    vb_decision_defaults(&p);
+    double *scratch = malloc(vb_decision_scratch_doubles(ORDER) * sizeof *scratch);
+    const uint32_t counts[] = {M, 250, 37, 19};
+    for (int order = 1; order <= ORDER; order++)
+        for (size_t k = 0; k < sizeof counts / sizeof *counts; k++) {
+            uint32_t m = counts[k];
+            for (int j = 0; j < N; j++) /* NaN past m: never read */
+                for (uint32_t i = 0; i < S; i++)
+                    Ys[j * S + i] = i < m ? Y[j * M + i] : NAN;
+            float a[N] = {0}, b[N] = {0};
+            a[0] = b[0] = 1.5f / 0.28209479f;
+            int sa = vb_decision_fit(order, m, Y, M, logd, lab, &p, a, scratch);
+            int sb = vb_decision_fit(order, m, Ys, S, logd, lab, &p, b, scratch);
+            CHECK(sa == sb && memcmp(a, b, sizeof a) == 0,
+                  "order %d, %u pairs: stride %d and %d differ", order, m, M, S);
+            for (int j = 0; j < order * order; j++)
+                CHECK(isfinite(b[j]), "order %d, %u pairs: coefficient %d finite", order, m, j);
+        }
+    free(scratch);
+}
+
 int main(void)
 {
     test_fit_beats_start();
+    test_stride_and_tails();
     test_offset();
     if (test_failures)
         fprintf(stderr, "%d checks failed\n", test_failures);

@@ -208,6 +208,20 @@ static void test_soa_and_prefix(void)
         x[k] = d[0], y[k] = d[1], z[k] = d[2];
     }
     vdsh_sh_eval_soa(5, N, x, y, z, out, N);
+    /* Rows further apart than the count (the decision fit's layout): the
+     * same values, and nothing written between the rows. */
+    enum { S = N + 11 };
+    float wide[25 * S];
+    for (int order = 1; order <= 5; order++) {
+        for (int i = 0; i < 25 * S; i++)
+            wide[i] = -7.0f;
+        vdsh_sh_eval_soa(order, N, x, y, z, wide, S);
+        for (int i = 0; i < order * order; i++)
+            for (int k = 0; k < S; k++)
+                CHECK(k < N ? memcmp(&wide[i * S + k], &out[i * N + k], sizeof(float)) == 0
+                            : wide[i * S + k] == -7.0f,
+                      "order %d at stride %d: row %d, lane %d", order, S, i, k);
+    }
     for (int k = 0; k < N; k++) {
         float d[3] = {x[k], y[k], z[k]}, a[25], b[9];
         vdsh_sh_eval(5, d, a);
