@@ -73,3 +73,10 @@ add_executable(test_refine_shape test_refine_shape.c)
 target_link_libraries(test_refine_shape PRIVATE vb_core)
 add_test(NAME bake_refine_shape COMMAND $<TARGET_FILE:test_refine_shape>)
 set_tests_properties(bake_refine_shape PROPERTIES TIMEOUT 60)
+
+# Origin repair skips receivers on zero-area triangles only (drawn nowhere):
+# counted, no probe rays, the other receivers' repair unchanged (issue 26).
+add_test(NAME bake_origins_zero_area
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_origins_zero_area.sh
+                 $<TARGET_FILE:vdsh-bake>)
+set_tests_properties(bake_origins_zero_area PROPERTIES TIMEOUT 60)

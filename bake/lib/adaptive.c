@@ -290,6 +290,7 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         B.origins.moved += R.origins.moved;
         B.origins.flagged += R.origins.flagged;
         B.origins.ties += R.origins.ties;
+        B.origins.skipped_zero_area += R.origins.skipped_zero_area;
         B.origins.probe_rays += R.origins.probe_rays;
         B.origins.seconds += R.origins.seconds;
         B.seconds += R.seconds;

@@ -34,6 +34,10 @@
  * a floor) is repaired only if its full-length upper probes all escape:
  * the box bottom looks through the floor into the void, a sheet does not.
  *
+ * A receiver whose triangles all have no area (cross product exactly 0,
+ * the loader's test; its normal came from the file) is drawn nowhere: it
+ * keeps the standard origin and is not probed (stats: skipped_zero_area).
+ *
  * Cost: the first probe is 32 short rays per receiver. A flagged receiver
  * tries at most VB_REPAIR_CANDIDATES points (short probes each), and at
  * most three full-length escape tests; vb_origins_stats counts every ray.
@@ -64,6 +68,8 @@ typedef struct vb_origins_stats {
     uint32_t moved;       /* receivers whose origin the repair moved */
     uint32_t flagged;     /* receivers the first probe sent to the repair */
     uint32_t ties;        /* receivers whose probes met coincident faces */
+    uint32_t skipped_zero_area; /* receivers with a normal whose triangles all have
+                                 * no area: drawn nowhere, not probed */
     uint64_t probe_rays;  /* rays traced by the probes and the repair */
     double seconds;       /* wall time of vb_ray_origins */
 } vb_origins_stats;

@@ -530,6 +530,7 @@ static int write_report(const char *path, const options *o, const vb_job *job,
     vt_json_u64(&j, org, "repaired", b->origins.flagged);
     vt_json_u64(&j, org, "moved", b->origins.moved);
     vt_json_u64(&j, org, "coincident_faces", b->origins.ties);
+    vt_json_u64(&j, org, "skipped_zero_area", b->origins.skipped_zero_area);
     report_seconds(&j, root, t);
     cJSON *sec = cJSON_GetObjectItemCaseSensitive(root, "seconds");
     vt_json_f64(&j, sec, "origins", b->origins.seconds);
@@ -1124,6 +1125,11 @@ int main(int argc, char **argv)
                 bo->origins.seconds, (unsigned long long)bo->origins.probe_rays,
                 bo->rays_traced ? 100.0 * bo->origins.probe_rays / bo->rays_traced : 0.0,
                 bo->origins.flagged, bo->origins.moved);
+    if (log && bo->origins.skipped_zero_area)
+        fprintf(log, "vdsh-bake: %u receiver%s on zero-area triangles only (drawn nowhere): "
+                     "origin%s not probed\n",
+                bo->origins.skipped_zero_area, bo->origins.skipped_zero_area == 1 ? "" : "s",
+                bo->origins.skipped_zero_area == 1 ? "" : "s");
     if (log && bo->method == VDSH_METHOD_DECISION) {
         if (!bo->decision_lights)
             fprintf(log, "vdsh-bake: warning: no free space for lights in this scene: every "
