@@ -89,6 +89,15 @@ if(Python3_Interpreter_FOUND AND TARGET vb_frames AND TARGET vdsh-view)
   set_tests_properties(frames_script PROPERTIES SKIP_RETURN_CODE 77)
 endif()
 
+# scripts/frames_gap at its smallest (test_frames_gap.py): validation room
+# 3 at --max-edge 1, 64 x 48 C frames, order 2; the squared error's split
+# by pixel class adds up, and matches vdsh-frames score's RMSE. No GL.
+if(Python3_Interpreter_FOUND AND TARGET vb_frames)
+  add_test(NAME frames_gap_script
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_frames_gap.py
+                   ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR})
+endif()
+
 # scripts/pareto --quick: the speed-against-error report at its smallest
 # (the room at --max-edge 1, the 3-view test set, a few modes, 1 and 3
 # lights): its CSV and JSON rows complete and finite, the GL counts of
