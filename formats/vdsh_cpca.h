@@ -72,6 +72,14 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
 
 void vdsh_cpca_fit_free(vdsh_cpca_fit *fit);
 
+/* The same for a whole stream: `src` a fixed-order f32 stream of `rows`
+ * rows with scale 1 (a bake's or a merge's), *out its header with
+ * encoding cpca, data and model set; *storage the one block to free()
+ * once written; *rms_error (may be NULL) the fit's coefficient error. */
+vdsh_result vdsh_cpca_encode_stream(const vdsh_stream *src, uint32_t rows, const float *normals,
+                                    const vdsh_cpca_settings *settings, vdsh_stream *out,
+                                    void **storage, double *rms_error, vdsh_error *err);
+
 #ifdef __cplusplus
 }
 #endif
