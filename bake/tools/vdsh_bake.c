@@ -163,7 +163,7 @@ static void usage(FILE *f)
 "                          vertex; docs/ACCURACY.md \"Compressed high orders\")\n"
 "      --cpca K,B,BITS     cpca settings: clusters (1..256), basis vectors per\n"
 "                          cluster (capped at order^2), bits per weight (2..8);\n"
-"                          default 8,52,4\n"
+"                          default 8,54,4\n"
 "      --shard I/N         bake shard I (0-based) of N only and write a part\n"
 "                          file; vdsh-merge joins the N parts into the file\n"
 "                          the whole bake writes, byte for byte\n"
@@ -776,7 +776,7 @@ int main(int argc, char **argv)
         case O_CPCA: {
             if (vdsh_cpca_parse(optarg, &o.cpca, NULL) != VDSH_OK)
                 return bad_usage("--cpca takes K,B,BITS: clusters 1..256, basis vectors "
-                                 "1..256, bits 2..8 (default 8,52,4), not '%s'", optarg);
+                                 "1..256, bits 2..8 (default 8,54,4), not '%s'", optarg);
             o.have_cpca = 1;
             break;
         }
