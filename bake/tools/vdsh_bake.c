@@ -159,7 +159,7 @@ static void usage(FILE *f)
 "                          s8 (all 8-bit: 4, 9, 25), f16 (8, 18, 50) or f32;\n"
 "                          compact ones within 0.1%% of f16: docs/ACCURACY.md;\n"
 "                          or cpca: clustered PCA of each order's coefficients\n"
-"                          (for orders 7..16: order 12 in ~29-31 bytes per\n"
+"                          (for orders 7..16: order 12 in ~30-32 bytes per\n"
 "                          vertex; docs/ACCURACY.md \"Compressed high orders\")\n"
 "      --cpca K,B,BITS     cpca settings: clusters (1..256), basis vectors per\n"
 "                          cluster (capped at order^2), bits per weight (2..8);\n"
