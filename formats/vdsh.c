@@ -234,7 +234,7 @@ const char *vdsh_method_name(uint32_t method)
 
 const char *vdsh_encoding_name(uint32_t encoding)
 {
-    static const char *const n[] = {"f32", "f16", "s8", "s8s6"};
+    static const char *const n[] = {"f32", "f16", "s8", "s8s6", "cpca"};
     return NAME_OF(encoding, n);
 }
 
@@ -512,6 +512,110 @@ static size_t stream_table_bytes(uint32_t encoding, uint32_t order)
     return ((size_t)order * order * 4 + 15) & ~(size_t)15;
 }
 
+/* ---- cpca (VDSH.md "cpca streams") ---- */
+
+enum { CPCA_HEADER_SIZE = 16 };
+
+uint32_t vdsh_cpca_record_words(uint32_t basis, uint32_t bits)
+{
+    if (bits < VDSH_CPCA_MIN_BITS || bits > VDSH_CPCA_MAX_BITS)
+        return 0;
+    uint32_t word = 0, used = VDSH_CPCA_INDEX_BITS;
+    for (uint32_t j = 0; j < basis; j++) {
+        if (used + bits > 32) {
+            word++;
+            used = 0;
+        }
+        used += bits;
+    }
+    return word + 1;
+}
+
+void vdsh_cpca_field(uint32_t bits, uint32_t j, uint32_t *word, uint32_t *shift)
+{
+    /* word 0 holds (32 - 8) / bits fields after the index, later words
+     * 32 / bits each */
+    uint32_t first = (32 - VDSH_CPCA_INDEX_BITS) / bits, per = 32 / bits;
+    if (j < first) {
+        *word = 0;
+        *shift = VDSH_CPCA_INDEX_BITS + j * bits;
+    } else {
+        *word = 1 + (j - first) / per;
+        *shift = ((j - first) % per) * bits;
+    }
+}
+
+uint64_t vdsh_cpca_model_bytes(uint32_t order, uint32_t clusters, uint32_t basis)
+{
+    uint64_t n = (uint64_t)order * order, k = clusters, b = basis;
+    return CPCA_HEADER_SIZE + ((4 * k * b + 15) & ~15ull) + ((2 * k * n + 15) & ~15ull) +
+           ((2 * k * b * n + 15) & ~15ull);
+}
+
+/* Point a cpca stream's model arrays into the model block at `model` (the
+ * 16-byte cpca header first; fields already set). */
+static void cpca_bind(vdsh_stream *s, const uint8_t *model)
+{
+    uint64_t n = (uint64_t)s->order * s->order, k = s->cpca.clusters, b = s->cpca.basis;
+    const uint8_t *q = model + CPCA_HEADER_SIZE;
+    s->cpca.scales = (const float *)q;
+    q += (4 * k * b + 15) & ~15ull;
+    s->cpca.means = (const uint16_t *)q;
+    q += (2 * k * n + 15) & ~15ull;
+    s->cpca.bases = (const uint16_t *)q;
+}
+
+static const uint32_t *cpca_record(const vdsh_stream *s, uint32_t v)
+{
+    return (const uint32_t *)s->data + (size_t)v * s->cpca.record_words;
+}
+
+uint32_t vdsh_cpca_cluster(const vdsh_stream *s, uint32_t v)
+{
+    return cpca_record(s, v)[0] & 0xffu;
+}
+
+/* The signed level of weight j of record r. */
+static int32_t cpca_level(const uint32_t *r, uint32_t bits, uint32_t j)
+{
+    uint32_t word, shift;
+    vdsh_cpca_field(bits, j, &word, &shift);
+    uint32_t u = (r[word] >> shift) & ((1u << bits) - 1u);
+    return (int32_t)u - (int32_t)((u >> (bits - 1)) << bits);
+}
+
+void vdsh_cpca_weights(const vdsh_stream *s, uint32_t v, int32_t *levels, float *weights)
+{
+    const uint32_t *r = cpca_record(s, v);
+    uint32_t c = r[0] & 0xffu, b = s->cpca.basis, bits = s->cpca.bits;
+    for (uint32_t j = 0; j < b; j++) {
+        int32_t q = cpca_level(r, bits, j);
+        if (levels)
+            levels[j] = q;
+        if (weights)
+            weights[j] = (float)q * vdsh_cpca_step(s->cpca.scales[(size_t)c * b + j], bits);
+    }
+}
+
+/* Vertex v's coefficients: mean + sum of weight x basis, in f32, j in
+ * order (VDSH.md's rule, to the bit). */
+static void cpca_decode(const vdsh_stream *s, uint32_t v, float *out)
+{
+    uint32_t n = s->order * s->order, b = s->cpca.basis;
+    uint32_t c = vdsh_cpca_cluster(s, v);
+    float w[VDSH_MAX_COEFFS];
+    vdsh_cpca_weights(s, v, NULL, w);
+    const uint16_t *mean = s->cpca.means + (size_t)c * n;
+    for (uint32_t i = 0; i < n; i++)
+        out[i] = vdsh_f32_from_f16(mean[i]);
+    for (uint32_t j = 0; j < b; j++) {
+        const uint16_t *basis = s->cpca.bases + ((size_t)c * b + j) * n;
+        /* -std=c11: no contraction into a fused multiply-add */
+        for (uint32_t i = 0; i < n; i++)
+            out[i] = out[i] + w[j] * vdsh_f32_from_f16(basis[i]);
+    }
+}
+
 static int stream_variable(const vdsh_stream *s)
 {
     return (s->flags & VDSH_STREAM_VARIABLE) != 0;
@@ -549,6 +653,8 @@ size_t vdsh_stream_bytes_per_vertex(const vdsh_stream *s)
 {
     if (!s || s->order < 1 || s->order > VDSH_MAX_ORDER || stream_variable(s))
         return 0;
+    if (s->encoding == VDSH_ENCODING_CPCA)
+        return 4 * (size_t)s->cpca.record_words;
     return vdsh_encoding_bytes(s->encoding, s->order * s->order);
 }
 
@@ -604,6 +710,9 @@ vdsh_stream_size vdsh_stream_size_of(const vdsh_stream *s, uint32_t rows)
             z.rows_per_order[s->order] = rows;
         z.max_bytes = (uint32_t)vdsh_stream_bytes_per_vertex(s);
         z.mean_bytes = z.max_bytes;
+        if (s->encoding == VDSH_ENCODING_CPCA && rows)
+            z.mean_bytes += (double)vdsh_cpca_model_bytes(s->order, s->cpca.clusters,
+                                                          s->cpca.basis) / rows;
         return z;
     }
     for (uint32_t v = 0; v < rows; v++)
@@ -641,6 +750,10 @@ void vdsh_stream_decode(const vdsh_stream *s, uint32_t v, float *out)
     if (s->order < 1 || s->order > VDSH_MAX_ORDER)
         return; /* programmer error; nothing sensible to write */
     uint32_t n = s->order * s->order;
+    if (s->encoding == VDSH_ENCODING_CPCA) {
+        cpca_decode(s, v, out);
+        return;
+    }
     if (stream_variable(s)) {
         uint32_t k = s->orders[v];
         k = k < s->order ? k : s->order;
@@ -856,7 +969,7 @@ static int check_stream(const vdsh_stream *s, uint32_t i, why *w)
         return bad(w, "%s: order %u out of range 1..%d", l, s->order,
                    VDSH_MAX_ORDER);
     if (s->encoding > VDSH_ENCODING_LAST)
-        return bad(w, "%s: encoding %u unknown (0 f32, 1 f16, 2 s8, 3 s8s6)", l,
+        return bad(w, "%s: encoding %u unknown (0 f32, 1 f16, 2 s8, 3 s8s6, 4 cpca)", l,
                    s->encoding);
     if (s->flags & ~VDSH_STREAM_VARIABLE)
         return bad(w, "%s: flags 0x%x: unknown bits (bit 0: variable order)", l, s->flags);
@@ -886,6 +999,26 @@ static int check_stream(const vdsh_stream *s, uint32_t i, why *w)
     if (vdsh_encoding_quantised(s->encoding) && s->scale != 1.0f)
         return bad(w, "%s: scale %g must be 1 for %s (its scale table scales)", l,
                    (double)s->scale, vdsh_encoding_name(s->encoding));
+    if (s->encoding == VDSH_ENCODING_CPCA) {
+        const vdsh_cpca *m = &s->cpca;
+        if (s->scale != 1.0f)
+            return bad(w, "%s: scale %g must be 1 for cpca", l, (double)s->scale);
+        if (stream_variable(s))
+            return bad(w, "%s: cpca streams cannot have variable order", l);
+        if (m->clusters < 1 || m->clusters > VDSH_CPCA_MAX_CLUSTERS)
+            return bad(w, "%s: cpca clusters %u out of range 1..%d", l, m->clusters,
+                       VDSH_CPCA_MAX_CLUSTERS);
+        if (m->basis < 1 || m->basis > s->order * s->order)
+            return bad(w, "%s: cpca basis %u out of range 1..%u", l, m->basis,
+                       s->order * s->order);
+        if (m->bits < VDSH_CPCA_MIN_BITS || m->bits > VDSH_CPCA_MAX_BITS)
+            return bad(w, "%s: cpca bits %u out of range %d..%d", l, m->bits,
+                       VDSH_CPCA_MIN_BITS, VDSH_CPCA_MAX_BITS);
+        if (m->record_words != vdsh_cpca_record_words(m->basis, m->bits))
+            return bad(w, "%s: cpca record_words %u, %u weights of %u bits need %u", l,
+                       m->record_words, m->basis, m->bits,
+                       vdsh_cpca_record_words(m->basis, m->bits));
+    }
     if (s->quantity == VDSH_QUANTITY_LOG_DISTANCE
             ? !(s->quantity_param > 0.0f) || !isfinite(s->quantity_param)
             : s->quantity_param != 0.0f)
@@ -1011,11 +1144,70 @@ static int check_variable_rows(const vdsh_stream *s, const char *l, uint32_t v, 
     return 1;
 }
 
+/* A cpca stream's model (finite scales, means and bases, decoded values
+ * bounded) and records (index < K, levels within +-L, unused bits 0). */
+static int check_cpca_data(const vdsh_stream *s, const char *l, uint32_t v, why *w)
+{
+    const vdsh_cpca *m = &s->cpca;
+    uint32_t n = s->order * s->order, b = m->basis, bits = m->bits;
+    int L = vdsh_cpca_levels(bits);
+    for (size_t k = 0; k < (size_t)m->clusters * b; k++) {
+        float sc = m->scales[k];
+        if (!isfinite(sc) || !(sc >= 0.0f))
+            return bad(w, "%s: cpca scale %zu (cluster %zu vector %zu) is %g, not finite and "
+                       ">= 0", l, k, k / b, k % b, (double)sc);
+    }
+    for (size_t k = 0; k < (size_t)m->clusters * n; k++)
+        if ((m->means[k] & 0x7c00u) == 0x7c00u)
+            return bad(w, "%s: cpca mean of cluster %zu coefficient %zu is not finite", l,
+                       k / n, k % n);
+    for (size_t k = 0; k < (size_t)m->clusters * b * n; k++)
+        if ((m->bases[k] & 0x7c00u) == 0x7c00u)
+            return bad(w, "%s: cpca basis vector %zu of cluster %zu, coefficient %zu, is "
+                       "not finite", l, (k / n) % b, k / n / b, k % n);
+    for (uint32_t c = 0; c < m->clusters; c++)
+        for (uint32_t i = 0; i < n; i++) {
+            double bound = fabs((double)vdsh_f32_from_f16(m->means[(size_t)c * n + i]));
+            for (uint32_t j = 0; j < b; j++)
+                bound += (double)L * (double)vdsh_cpca_step(m->scales[(size_t)c * b + j], bits) *
+                         fabs((double)vdsh_f32_from_f16(m->bases[((size_t)c * b + j) * n + i]));
+            if (!(bound <= 1e38))
+                return bad(w, "%s: cpca cluster %u coefficient %u can reach %g, beyond 1e38", l,
+                           c, i, bound);
+        }
+    /* the bits the fields use, per word */
+    uint32_t used[VDSH_MAX_COEFFS + 1];
+    for (uint32_t k = 0; k < m->record_words; k++)
+        used[k] = 0;
+    used[0] = (1u << VDSH_CPCA_INDEX_BITS) - 1u;
+    for (uint32_t j = 0; j < b; j++) {
+        uint32_t word, shift;
+        vdsh_cpca_field(bits, j, &word, &shift);
+        used[word] |= (uint32_t)(((1ull << bits) - 1u) << shift);
+    }
+    for (uint32_t x = 0; x < v; x++) {
+        const uint32_t *r = (const uint32_t *)s->data + (size_t)x * m->record_words;
+        if ((r[0] & 0xffu) >= m->clusters)
+            return bad(w, "%s: vertex %u has cluster %u (0..%u)", l, x, r[0] & 0xffu,
+                       m->clusters - 1);
+        for (uint32_t k = 0; k < m->record_words; k++)
+            if (r[k] & ~used[k])
+                return bad(w, "%s: vertex %u: unused bits of record word %u not zero", l, x, k);
+        for (uint32_t j = 0; j < b; j++)
+            if (cpca_level(r, bits, j) < -L)
+                return bad(w, "%s: vertex %u weight %u is %d (%u bits store %d..%d)", l, x, j,
+                           (int)cpca_level(r, bits, j), bits, -L, L);
+    }
+    return 1;
+}
+
 static int check_stream_data(const vdsh_stream *s, uint32_t i, uint32_t v,
                              why *w)
 {
     char l[96];
     stream_label(s, i, l, sizeof l);
+    if (s->encoding == VDSH_ENCODING_CPCA)
+        return check_cpca_data(s, l, v, w);
     if (vdsh_encoding_quantised(s->encoding) && !check_scales(s, l, w))
         return 0;
     if (stream_variable(s))
@@ -1048,6 +1240,18 @@ static int check_part(const vdsh_part *t, uint32_t vertex_count, why *w)
                    t->range_end, vertex_count);
     if (t->encoding > VDSH_ENCODING_LAST)
         return bad(w, "part: unknown encoding %u", t->encoding);
+    if (t->encoding != VDSH_ENCODING_CPCA) {
+        if (t->cpca_clusters || t->cpca_basis || t->cpca_bits)
+            return bad(w, "part: cpca settings %u,%u,%u with encoding %s (must be 0)",
+                       t->cpca_clusters, t->cpca_basis, t->cpca_bits,
+                       vdsh_encoding_name(t->encoding));
+    } else if (t->cpca_clusters < 1 || t->cpca_clusters > VDSH_CPCA_MAX_CLUSTERS ||
+               t->cpca_basis < 1 || t->cpca_basis > VDSH_MAX_COEFFS ||
+               t->cpca_bits < VDSH_CPCA_MIN_BITS || t->cpca_bits > VDSH_CPCA_MAX_BITS) {
+        return bad(w, "part: cpca settings %u,%u,%u out of range (1..%d, 1..%d, %d..%d)",
+                   t->cpca_clusters, t->cpca_basis, t->cpca_bits, VDSH_CPCA_MAX_CLUSTERS,
+                   VDSH_MAX_COEFFS, VDSH_CPCA_MIN_BITS, VDSH_CPCA_MAX_BITS);
+    }
     return 1;
 }
 
@@ -1417,19 +1621,44 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
     s->data = NULL;
     s->orders = NULL;
     s->offsets = NULL;
+    memset(&s->cpca, 0, sizeof s->cpca);
     stream_label(s, i, l, sizeof l);
     if (!all_zero(p + 40, 8))
         return fail(r->err, VDSH_ERR_INVALID, r->name,
                     "%s: reserved bytes 40..47 not zero", l);
+    if (s->encoding == VDSH_ENCODING_CPCA) {
+        if (c->size - STREAM_HEADER_SIZE < CPCA_HEADER_SIZE)
+            return fail(r->err, VDSH_ERR_CHUNK, r->name,
+                        "%s: %llu bytes of data, shorter than the %d-byte cpca header", l,
+                        (unsigned long long)(c->size - STREAM_HEADER_SIZE), CPCA_HEADER_SIZE);
+        s->cpca.clusters = get_u32(p + STREAM_HEADER_SIZE);
+        s->cpca.basis = get_u32(p + STREAM_HEADER_SIZE + 4);
+        s->cpca.bits = get_u32(p + STREAM_HEADER_SIZE + 8);
+        s->cpca.record_words = get_u32(p + STREAM_HEADER_SIZE + 12);
+    }
     if (!check_stream(s, i, &w))
         return invalid(r, &w);
-    uint64_t table = stream_table_bytes(s->encoding, s->order);
+    uint64_t table = s->encoding == VDSH_ENCODING_CPCA
+                         ? vdsh_cpca_model_bytes(s->order, s->cpca.clusters, s->cpca.basis)
+                         : stream_table_bytes(s->encoding, s->order);
     if (c->size - STREAM_HEADER_SIZE < table)
         return fail(r->err, VDSH_ERR_CHUNK, r->name,
                     "%s: %llu bytes of data, shorter than its %llu-byte scale table", l,
                     (unsigned long long)(c->size - STREAM_HEADER_SIZE),
                     (unsigned long long)table);
-    if (table) {
+    if (table && s->encoding == VDSH_ENCODING_CPCA) {
+        uint64_t n = (uint64_t)s->order * s->order, k = s->cpca.clusters, b = s->cpca.basis;
+        uint64_t sizes[3] = {4 * k * b, 2 * k * n, 2 * k * b * n};
+        static const char *const what[3] = {"scales", "means", "bases"};
+        const uint8_t *q = p + STREAM_HEADER_SIZE + CPCA_HEADER_SIZE;
+        for (int a = 0; a < 3; a++) {
+            uint64_t padded = (sizes[a] + 15) & ~15ull;
+            if (!all_zero(q + sizes[a], (size_t)(padded - sizes[a])))
+                return fail(r->err, VDSH_ERR_INVALID, r->name,
+                            "%s: padding after the cpca %s not zero", l, what[a]);
+            q += padded;
+        }
+    } else if (table) {
         size_t used = (size_t)s->order * s->order * 4;
         if (!all_zero(p + STREAM_HEADER_SIZE + used, (size_t)table - used))
             return fail(r->err, VDSH_ERR_INVALID, r->name,
@@ -1459,7 +1688,9 @@ static vdsh_result check_coef_sizes(const reader *r, layout *L)
         vdsh_stream *s = &L->streams[i];
         char l[96];
         stream_label(s, i, l, sizeof l);
-        uint64_t table = stream_table_bytes(s->encoding, s->order);
+        int cpca = s->encoding == VDSH_ENCODING_CPCA;
+        uint64_t table = cpca ? vdsh_cpca_model_bytes(s->order, s->cpca.clusters, s->cpca.basis)
+                              : stream_table_bytes(s->encoding, s->order);
         uint64_t orders = 0; /* a variable-order stream's order table */
         if (stream_variable(s)) {
             orders = round16(rows);
@@ -1485,12 +1716,16 @@ static vdsh_result check_coef_sizes(const reader *r, layout *L)
                         (unsigned long long)L->stream_bytes[i], rows,
                         vdsh_encoding_name(s->encoding), (unsigned long long)need,
                         L->has_part ? " (a part: its range's receivers)" : "");
-        s->coef_scales = table ? (const float *)(r->d + L->stream_table[i]) : NULL;
+        s->coef_scales = table && !cpca ? (const float *)(r->d + L->stream_table[i]) : NULL;
+        if (cpca)
+            cpca_bind(s, r->d + L->stream_table[i]);
         s->data = r->d + L->stream_data[i] + orders;
         int ok = check_stream_data(s, i, rows, &w);
         s->data = NULL;
         s->orders = NULL;
         s->coef_scales = NULL;
+        s->cpca.scales = NULL;
+        s->cpca.means = s->cpca.bases = NULL;
         L->stream_orders[i] = orders;
         if (orders)
             L->offset_words += (uint64_t)rows + 1;
@@ -1571,8 +1806,9 @@ static vdsh_result read_part(const reader *r, const chunk_ref *c, layout *L)
     if (c->size != PART_SIZE)
         return fail(r->err, VDSH_ERR_CHUNK, r->name, "part: payload is %llu bytes, must be %d",
                     (unsigned long long)c->size, PART_SIZE);
-    if (!all_zero(p + 20, 12))
-        return fail(r->err, VDSH_ERR_INVALID, r->name, "part: reserved bytes 20..31 not zero");
+    L->part.cpca_clusters = get_u32(p + 20);
+    L->part.cpca_basis = get_u32(p + 24);
+    L->part.cpca_bits = get_u32(p + 28);
     L->part.index = get_u32(p + 0);
     L->part.count = get_u32(p + 4);
     L->part.range_begin = get_u32(p + 8);
@@ -1739,8 +1975,10 @@ static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name,
         vdsh_stream *st = &f->streams[i];
         *st = L.streams[i];
         st->data = buf + L.stream_data[i] + L.stream_orders[i];
-        st->coef_scales =
-            L.stream_table[i] ? (const float *)(buf + L.stream_table[i]) : NULL;
+        st->coef_scales = L.stream_table[i] && st->encoding != VDSH_ENCODING_CPCA
+                              ? (const float *)(buf + L.stream_table[i]) : NULL;
+        if (st->encoding == VDSH_ENCODING_CPCA)
+            cpca_bind(st, buf + L.stream_table[i]);
         if (stream_variable(st)) {
             st->orders = buf + L.stream_data[i];
             vdsh_stream_offsets(st->orders, rows, st->encoding, offsets);
@@ -1939,6 +2177,7 @@ typedef struct plan {
     uint8_t part[PART_SIZE];
     uint8_t adpt[ADPT_SIZE];
     uint8_t *srcs; /* malloc'd SRCS payload */
+    uint8_t *model[VDSH_MAX_STREAMS]; /* malloc'd cpca models, padded */
     out_chunk chunks[MAX_CHUNKS];
     uint32_t count;
     uint64_t file_size;
@@ -2011,6 +2250,10 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
         if (stream_variable(s) && !s->orders)
             return fail(err, VDSH_ERR_ARGUMENT, name,
                         "not written: COEF stream %u: variable order without orders", i);
+        if (s->encoding == VDSH_ENCODING_CPCA &&
+            (!s->cpca.scales || !s->cpca.means || !s->cpca.bases))
+            return fail(err, VDSH_ERR_ARGUMENT, name,
+                        "not written: COEF stream %u: cpca without scales, means or bases", i);
         for (uint32_t k = 0; k < i; k++)
             if (same_slot(&f->streams[k], s)) {
                 char slot[64];
@@ -2043,8 +2286,11 @@ static void add_chunk(plan *P, const char *id, const void *pre,
 
 static void plan_free(plan *P)
 {
-    if (P)
+    if (P) {
         free(P->srcs);
+        for (int i = 0; i < VDSH_MAX_STREAMS; i++)
+            free(P->model[i]);
+    }
 }
 
 /* Validate `f`, encode every header field and compute every CRC. */
@@ -2121,6 +2367,32 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
             put_f32(p + STREAM_HEADER_SIZE + 4 * k, s->coef_scales[k]);
         uint32_t rows = vdsh_file_stream_vertices(f);
         uint64_t data = vdsh_stream_data_bytes(s, rows);
+        if (s->encoding == VDSH_ENCODING_CPCA) {
+            /* the cpca header in the prefix, the padded arrays as `mid` */
+            const vdsh_cpca *m = &s->cpca;
+            put_u32(p + STREAM_HEADER_SIZE, m->clusters);
+            put_u32(p + STREAM_HEADER_SIZE + 4, m->basis);
+            put_u32(p + STREAM_HEADER_SIZE + 8, m->bits);
+            put_u32(p + STREAM_HEADER_SIZE + 12, m->record_words);
+            size_t mb = (size_t)vdsh_cpca_model_bytes(s->order, m->clusters, m->basis) -
+                        CPCA_HEADER_SIZE;
+            size_t n = (size_t)s->order * s->order, k = m->clusters, b = m->basis;
+            uint8_t *q = P->model[i] = (uint8_t *)calloc(1, mb + 1);
+            if (!q)
+                return fail(err, VDSH_ERR_OUT_OF_MEMORY, name, "out of memory");
+            for (size_t x = 0; x < k * b; x++)
+                put_f32(q + 4 * x, m->scales[x]);
+            q += (4 * k * b + 15) & ~(size_t)15;
+            memcpy(q, m->means, 2 * k * n);
+            q += (2 * k * n + 15) & ~(size_t)15;
+            memcpy(q, m->bases, 2 * k * b * n);
+            add_chunk(P, "COEF", p, STREAM_HEADER_SIZE + CPCA_HEADER_SIZE, s->data, data);
+            out_chunk *c = &P->chunks[P->count - 1];
+            c->mid = P->model[i];
+            c->mid_size = mb;
+            c->mid_pad = 0;
+            continue;
+        }
         add_chunk(P, "COEF", p, STREAM_HEADER_SIZE + table, s->data, data);
         if (stream_variable(s)) { /* the order table, padded, before the records */
             out_chunk *c = &P->chunks[P->count - 1];
@@ -2158,6 +2430,9 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
         put_u32(p + 8, f->part.range_begin);
         put_u32(p + 12, f->part.range_end);
         put_u32(p + 16, f->part.encoding);
+        put_u32(p + 20, f->part.cpca_clusters);
+        put_u32(p + 24, f->part.cpca_basis);
+        put_u32(p + 28, f->part.cpca_bits);
         add_chunk(P, "part", p, PART_SIZE, NULL, 0);
     }
     if (f->has_adaptive) {

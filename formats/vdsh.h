@@ -119,11 +119,14 @@ typedef enum vdsh_encoding {
     VDSH_ENCODING_F32 = 0,
     VDSH_ENCODING_F16 = 1,
     VDSH_ENCODING_S8 = 2,    /* signed 8-bit, a scale per coefficient index */
-    VDSH_ENCODING_S8S6 = 3   /* bands 0-1 as s8, bands 2+ signed 6-bit, packed
+    VDSH_ENCODING_S8S6 = 3,  /* bands 0-1 as s8, bands 2+ signed 6-bit, packed
                                 five to a u32 word; scales as s8 */
+    VDSH_ENCODING_CPCA = 4   /* clustered PCA (issue 29): per cluster a mean
+                                and basis vectors (f16), per vertex a cluster
+                                index and packed weights (vdsh_cpca below) */
 } vdsh_encoding;
 /* The largest encoding value this version reads and writes. */
-#define VDSH_ENCODING_LAST VDSH_ENCODING_S8S6
+#define VDSH_ENCODING_LAST VDSH_ENCODING_CPCA
 /* s8s6: coefficients 0..3 as bytes; coefficient i >= 4 in bits
  * 6 * ((i - 4) % 5) .. + 5 of u32 word (i - 4) / 5 after them. */
 #define VDSH_S8S6_BYTES 4
@@ -185,6 +188,34 @@ typedef struct vdsh_source {
     uint8_t sha256[32];
 } vdsh_source;
 
+/* A `cpca` stream's model (VDSH.md "cpca streams"): K clusters, each a
+ * mean and B basis vectors of order^2 coefficients (f16), per basis
+ * vector a scale; per vertex row a record of record_words u32 words in
+ * vdsh_stream.data: bits 0..7 of word 0 the cluster index, then B
+ * `bits`-wide two's-complement weight levels (vdsh_cpca_field says
+ * where). Decoding (vdsh_stream_decode, to the bit): w_j = level_j *
+ * vdsh_cpca_step(scales[c * B + j], bits) in f32, coefficient i = mean
+ * + sum over j = 0..B-1 in order of w_j * basis_j[i], each product and
+ * sum rounded to f32. */
+typedef struct vdsh_cpca {
+    uint32_t clusters;        /* K, 1..VDSH_CPCA_MAX_CLUSTERS */
+    uint32_t basis;           /* B, 1..order^2 */
+    uint32_t bits;            /* per weight, VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS */
+    uint32_t record_words;    /* W = vdsh_cpca_record_words(basis, bits) */
+    const float *scales;      /* K * B: vector j of cluster c at c * B + j */
+    const uint16_t *means;    /* f16, K * order^2: cluster c's at c * order^2 */
+    const uint16_t *bases;    /* f16, K * B * order^2: vector j of cluster c
+                                 at (c * B + j) * order^2 */
+} vdsh_cpca;
+#define VDSH_CPCA_MAX_CLUSTERS 256
+#define VDSH_CPCA_MIN_BITS 2
+#define VDSH_CPCA_MAX_BITS 8
+#define VDSH_CPCA_INDEX_BITS 8
+/* The baker's defaults (vdsh-bake --cpca K,B,BITS): docs/ACCURACY.md. */
+#define VDSH_CPCA_DEFAULT_CLUSTERS 8
+#define VDSH_CPCA_DEFAULT_BASIS 54
+#define VDSH_CPCA_DEFAULT_BITS 4
+
 typedef struct vdsh_stream {
     uint32_t order;        /* bands n; n*n coefficients per vertex */
     uint32_t encoding;     /* vdsh_encoding */
@@ -212,6 +243,9 @@ typedef struct vdsh_stream {
      * its own stream (vdsh_stream_offsets); the writer ignores offsets. */
     const uint8_t *orders;
     const uint32_t *offsets;
+    /* `cpca` streams only (else all zero): the model; `data` then holds
+     * the rows' records, record_words u32 words each. */
+    vdsh_cpca cpca;
 } vdsh_stream;
 
 /* vdsh_stream.flags: each vertex has its own order (issue 16). */
@@ -239,6 +273,9 @@ typedef struct vdsh_part {
     uint32_t index, count;
     uint32_t range_begin, range_end;
     uint32_t encoding;         /* vdsh_encoding of the merged file */
+    /* encoding cpca: the settings the merge fits with (K, B as asked for,
+     * capped there at V and order^2); else 0. */
+    uint32_t cpca_clusters, cpca_basis, cpca_bits;
 } vdsh_part;
 
 /* Adaptive receivers (`adpt` chunk, VDSH.md): what refined the receivers
@@ -319,13 +356,37 @@ uint32_t vdsh_stream_vertex_order(const vdsh_stream *s, uint32_t v);
 
 /* Decode vertex v's coefficients of `s` to floats (scale applied): its
  * own order's k^2, then zeros up to s->order^2, so that out always holds
- * order^2 values. v must be < the stream's rows (vdsh_file_stream_vertices). */
+ * order^2 values. v must be < the stream's rows (vdsh_file_stream_vertices).
+ * cpca streams decode mean + weights x basis as vdsh_cpca says. */
 void vdsh_stream_decode(const vdsh_stream *s, uint32_t v, float *out);
+
+/* cpca (VDSH.md "cpca streams"). Words of one record: the 8-bit cluster
+ * index, then `basis` fields of `bits` bits, none straddling a word. */
+uint32_t vdsh_cpca_record_words(uint32_t basis, uint32_t bits);
+/* Where weight j's field lies in a record: word *word, bits *shift ..
+ * *shift + bits - 1. */
+void vdsh_cpca_field(uint32_t bits, uint32_t j, uint32_t *word, uint32_t *shift);
+/* Levels each side of 0: 2^(bits-1) - 1 (4 bits: 7). */
+static inline int vdsh_cpca_levels(uint32_t bits) { return (1 << (bits - 1)) - 1; }
+/* Weight = level * step, the step scale / levels rounded to f32. */
+static inline float vdsh_cpca_step(float scale, uint32_t bits)
+{
+    return scale / (float)vdsh_cpca_levels(bits);
+}
+/* Bytes between the 48-byte stream header and the records: the 16-byte
+ * cpca header, the scales, means and bases, each padded to 16. */
+uint64_t vdsh_cpca_model_bytes(uint32_t order, uint32_t clusters, uint32_t basis);
+/* Vertex row v's cluster index (< clusters) of a cpca stream. */
+uint32_t vdsh_cpca_cluster(const vdsh_stream *s, uint32_t v);
+/* Vertex row v's B stored weight levels (-L..L) and weights (level *
+ * step, f32) of a cpca stream; either output may be NULL. */
+void vdsh_cpca_weights(const vdsh_stream *s, uint32_t v, int32_t *levels, float *weights);
 
 /* Bytes of coefficient data per vertex of a fixed-order stream: order^2 *
  * 4 (f32), * 2 (f16) or * 1 (s8); s8s6: min(n^2, 4) + 4 * ceil((n^2 -
- * 4) / 5) (orders 1..5: 1, 4, 8, 16, 24); 0 for an unknown encoding and
- * for a variable-order stream (vdsh_stream_data_bytes). */
+ * 4) / 5) (orders 1..5: 1, 4, 8, 16, 24); cpca: 4 * record_words (the
+ * model not counted); 0 for an unknown encoding and for a variable-order
+ * stream (vdsh_stream_data_bytes). */
 size_t vdsh_stream_bytes_per_vertex(const vdsh_stream *s);
 
 /* Words of one record of order k in a variable-order stream of
@@ -339,7 +400,8 @@ void vdsh_stream_offsets(const uint8_t *orders, uint32_t rows, uint32_t encoding
 
 /* What a stream's rows cost: rows per order ([k]: of order k; a fixed
  * stream's all at its order), bytes per row on average (a variable-order
- * stream's order table included) and the largest row's record. */
+ * stream's order table included; a cpca stream's model spread over the
+ * rows) and the largest row's record. */
 typedef struct vdsh_stream_size {
     uint32_t rows_per_order[VDSH_ORDER_SLOTS];
     double mean_bytes;
@@ -347,9 +409,10 @@ typedef struct vdsh_stream_size {
 } vdsh_stream_size;
 vdsh_stream_size vdsh_stream_size_of(const vdsh_stream *s, uint32_t rows);
 
-/* Bytes of a stream's data for `rows` vertex rows, the scale table not
- * counted: rows * bytes per vertex, or for a variable-order stream its
- * order table (rows, padded to 16) and records (from s->orders). */
+/* Bytes of a stream's data for `rows` vertex rows, the scale table (and
+ * a cpca stream's model) not counted: rows * bytes per vertex, or for a
+ * variable-order stream its order table (rows, padded to 16) and records
+ * (from s->orders). */
 uint64_t vdsh_stream_data_bytes(const vdsh_stream *s, uint32_t rows);
 
 /* IEEE binary16 conversion, round to nearest even; overflow gives +-Inf

@@ -124,3 +124,18 @@ set_tests_properties(${_format_tool_tests} PROPERTIES
 add_executable(test_scene_view ${CMAKE_CURRENT_LIST_DIR}/test_scene_view.c)
 target_link_libraries(test_scene_view PRIVATE vdsh_format m)
 add_test(NAME format_scene_view COMMAND test_scene_view unit)
+
+# format_cpca       the cpca encoding (issue 29): encoder, writer, reader
+#                   and decoder on a synthetic order-7 stream: round trip,
+#                   decode to the bit, error bounded, determinism, every
+#                   reading rule broken (CRCs fixed) and every truncation
+#                   refused, K,B,BITS parsing
+add_executable(test_cpca ${CMAKE_CURRENT_LIST_DIR}/test_cpca.c)
+target_link_libraries(test_cpca PRIVATE vdsh_format m)
+add_test(NAME format_cpca COMMAND test_cpca)
+# format_cpca_python  python/vdsh decodes test_cpca's stream to the C
+#                   decode's floats bit for bit, and refuses a bad index
+add_test(NAME format_cpca_python
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_cpca_python.py
+                 $<TARGET_FILE:test_cpca> ${PROJECT_SOURCE_DIR}
+                 ${CMAKE_CURRENT_BINARY_DIR}/format_cpca_python)

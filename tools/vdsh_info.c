@@ -269,7 +269,23 @@ static void print_summary(const char *path, const vdsh_file *f,
                 printf("%s%g", k % 9 == 0 && k ? "\n          " : " ", s->coef_scales[k]);
             putchar('\n');
         }
-        if (s->flags & VDSH_STREAM_VARIABLE) {
+        if (s->encoding == VDSH_ENCODING_CPCA) {
+            const vdsh_cpca *m = &s->cpca;
+            uint32_t rows = vdsh_file_stream_vertices(f);
+            vdsh_stream_size z = vdsh_stream_size_of(s, rows);
+            printf("        cpca: %u clusters, %u basis vectors of %u-bit weights; %zu bytes "
+                   "per vertex, %.1f with the model (%llu bytes)\n", m->clusters, m->basis,
+                   m->bits, vdsh_stream_bytes_per_vertex(s), z.mean_bytes,
+                   (unsigned long long)vdsh_cpca_model_bytes(s->order, m->clusters, m->basis));
+            printf("        vertices per cluster:");
+            for (uint32_t c = 0; c < m->clusters; c++) {
+                uint32_t count = 0;
+                for (uint32_t v = 0; v < rows; v++)
+                    count += vdsh_cpca_cluster(s, v) == c;
+                printf(" %u", count);
+            }
+            putchar('\n');
+        } else if (s->flags & VDSH_STREAM_VARIABLE) {
             vdsh_stream_size z = vdsh_stream_size_of(s, vdsh_file_stream_vertices(f));
             printf("        variable order: %.1f bytes per vertex on average, %u at most; "
                    "vertices per order:", z.mean_bytes, z.max_bytes);
@@ -300,6 +316,9 @@ static void print_summary(const char *path, const vdsh_file *f,
         printf("  part         shard %u of %u: receivers %u..%u (its streams' rows), merged "
                "as %s\n", f->part.index, f->part.count, f->part.range_begin, f->part.range_end,
                vdsh_encoding_name(f->part.encoding));
+    if (f->has_part && f->part.encoding == VDSH_ENCODING_CPCA)
+        printf("               cpca %u,%u,%u (fitted at the merge)\n", f->part.cpca_clusters,
+               f->part.cpca_basis, f->part.cpca_bits);
     if (f->has_adaptive) {
         const vdsh_adaptive *a = &f->adaptive;
         printf("  adaptive     tolerance %g, min edge %g, budget %u (0: none), %u lights\n"
@@ -383,6 +402,17 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
                 vt_json_f32(&j, t, NULL, s->coef_scales[k]);
         }
         vt_json_u64(&j, o, "bytes_per_vertex", vdsh_stream_bytes_per_vertex(s));
+        if (s->encoding == VDSH_ENCODING_CPCA) {
+            cJSON *cp = vt_json_object(&j, o, "cpca");
+            vt_json_u64(&j, cp, "clusters", s->cpca.clusters);
+            vt_json_u64(&j, cp, "basis", s->cpca.basis);
+            vt_json_u64(&j, cp, "bits", s->cpca.bits);
+            vt_json_u64(&j, cp, "record_words", s->cpca.record_words);
+            vt_json_u64(&j, cp, "model_bytes",
+                        vdsh_cpca_model_bytes(s->order, s->cpca.clusters, s->cpca.basis));
+            vt_json_f64(&j, cp, "mean_bytes_per_vertex",
+                        vdsh_stream_size_of(s, vdsh_file_stream_vertices(f)).mean_bytes);
+        }
         vt_json_bool(&j, o, "variable_order", (s->flags & VDSH_STREAM_VARIABLE) != 0);
         if (s->flags & VDSH_STREAM_VARIABLE) {
             vdsh_stream_size z = vdsh_stream_size_of(s, vdsh_file_stream_vertices(f));
@@ -417,6 +447,11 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
         vt_json_u64(&j, pt, "range_begin", f->part.range_begin);
         vt_json_u64(&j, pt, "range_end", f->part.range_end);
         vt_json_string(&j, pt, "encoding", vdsh_encoding_name(f->part.encoding));
+        if (f->part.encoding == VDSH_ENCODING_CPCA) {
+            vt_json_u64(&j, pt, "cpca_clusters", f->part.cpca_clusters);
+            vt_json_u64(&j, pt, "cpca_basis", f->part.cpca_basis);
+            vt_json_u64(&j, pt, "cpca_bits", f->part.cpca_bits);
+        }
     }
     if (f->has_adaptive) {
         cJSON *ad = vt_json_object(&j, root, "adaptive");

@@ -135,6 +135,11 @@ static vdsh_encoding job_encoding(const vb_job_desc *d)
     return d->encoding_given ? d->encoding : VB_DEFAULT_ENCODING;
 }
 
+static vdsh_cpca_settings job_cpca(const vb_job_desc *d)
+{
+    return d->cpca.clusters ? d->cpca : vdsh_cpca_settings_default();
+}
+
 vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
 {
     const vb_bake_output *b = &j->bake;
@@ -148,14 +153,40 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         /* The stream takes the bake's coefficients (an f32 part's) or a
          * copy of them, and the bake's are freed now: peak memory holds at
          * most one order's two copies, not every order's. */
+        int cpca = !d->shard_count && job_encoding(d) == VDSH_ENCODING_CPCA;
         vb_result r = vb_bake_stream_take(&j->bake, o,
-                                          d->shard_count ? VDSH_ENCODING_F32 : job_encoding(d),
+                                          d->shard_count || cpca ? VDSH_ENCODING_F32
+                                                                 : job_encoding(d),
                                           &j->streams[count], &j->stream_data[count], err);
         if (r != VB_OK)
             return r;
+        if (cpca) {
+            /* The global step over every receiver (vdsh-merge does the
+             * same over the joined parts), with the file's normals. */
+            vdsh_cpca_settings st = job_cpca(d);
+            vdsh_error e;
+            void *storage = NULL;
+            vdsh_stream f32 = j->streams[count];
+            const float *nrm = b->normals ? b->normals : j->receivers.normals;
+            vdsh_result er = vdsh_cpca_encode_stream(&f32, j->receivers.vertex_count, nrm, &st,
+                                                     &j->streams[count], &storage, NULL, &e);
+            free(j->stream_data[count]);
+            j->stream_data[count] = storage;
+            if (er != VDSH_OK) {
+                j->streams[count] = f32;
+                j->streams[count].data = NULL;
+                return vb_fail(err, er == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY
+                                                                 : VB_ERR_INVALID,
+                               "order %d stream: %s", o, e.msg);
+            }
+        }
         j->coefficient_bytes += vdsh_stream_bytes_per_vertex(&j->streams[count]);
         count++;
     }
+    if (b->variable_orders && job_encoding(d) == VDSH_ENCODING_CPCA)
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "--encoding cpca does not encode adaptive-order streams yet: use "
+                       "fixed orders (--orders) with it, or another encoding");
     if (b->variable_orders) { /* adaptive order: its average bytes per vertex */
         vb_result r = vb_bake_variable_stream(b, d->shard_count ? VDSH_ENCODING_F32
                                                                 : job_encoding(d),
@@ -215,6 +246,12 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         f.has_part = 1;
         f.part = (vdsh_part){.index = d->shard_index, .count = d->shard_count,
                              .encoding = job_encoding(d)};
+        if (job_encoding(d) == VDSH_ENCODING_CPCA) {
+            vdsh_cpca_settings st = job_cpca(d);
+            f.part.cpca_clusters = st.clusters;
+            f.part.cpca_basis = st.basis;
+            f.part.cpca_bits = st.bits;
+        }
         vb_shard_range(h->vertex_count, d->shard_index, d->shard_count, &f.part.range_begin,
                        &f.part.range_end);
     }

@@ -38,6 +38,7 @@
 #include "scene.h"
 #include "vb.h"
 #include "vdsh.h"
+#include "vdsh_cpca.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -68,6 +69,8 @@ typedef struct vb_job_desc {
      * docs/ACCURACY.md, "Compact streams"). */
     int encoding_given;
     vdsh_encoding encoding;
+    /* encoding cpca: K, B, bits (zero: vdsh_cpca_settings_default()) */
+    vdsh_cpca_settings cpca;
     int cube_size;             /* basis cubemap face; 0: 64; < 0: none */
     int record_timings;        /* store the timings in the file */
     /* A shard (vdsh-bake --shard I/N): shard_count 0 is the whole bake;

@@ -30,6 +30,7 @@
 #include "scene.h"
 #include "sdf.h"
 #include "vdsh.h"
+#include "vdsh_cpca.h"
 #include "vdsh_output.h"
 #include "vt_cli.h"
 #include "vt_json.h"
@@ -62,6 +63,8 @@ typedef struct options {
     float log_floor;
     vdsh_window window;
     vdsh_encoding encoding;
+    vdsh_cpca_settings cpca;   /* --cpca K,B,BITS (encoding cpca) */
+    int have_cpca;
     float max_distance;
     float max_edge;
     int adaptive;              /* --adaptive TOL */
@@ -154,7 +157,13 @@ static void usage(FILE *f)
 "                          8-bit, bands 2+ 6-bit, a scale per coefficient\n"
 "                          index; 4, 8, 24 bytes per vertex at orders 2, 3, 5),\n"
 "                          s8 (all 8-bit: 4, 9, 25), f16 (8, 18, 50) or f32;\n"
-"                          compact ones within 0.1%% of f16: docs/ACCURACY.md\n"
+"                          compact ones within 0.1%% of f16: docs/ACCURACY.md;\n"
+"                          or cpca: clustered PCA of each order's coefficients\n"
+"                          (for orders 7..16: order 12 in ~30-32 bytes per\n"
+"                          vertex; docs/ACCURACY.md \"Compressed high orders\")\n"
+"      --cpca K,B,BITS     cpca settings: clusters (1..256), basis vectors per\n"
+"                          cluster (capped at order^2), bits per weight (2..8);\n"
+"                          default 8,54,4\n"
 "      --shard I/N         bake shard I (0-based) of N only and write a part\n"
 "                          file; vdsh-merge joins the N parts into the file\n"
 "                          the whole bake writes, byte for byte\n"
@@ -651,7 +660,7 @@ int main(int argc, char **argv)
            O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
            O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL, O_SHARD,
            O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS, O_MAX_ROUNDS, O_PLAN, O_RECEIVERS, O_ADAPTIVE_ORDER,
-           O_MAX_ORDER, O_DEC_LIGHTS, O_FALSE_RATE, O_DEC_PARAMS, O_SDF };
+           O_MAX_ORDER, O_DEC_LIGHTS, O_FALSE_RATE, O_DEC_PARAMS, O_SDF, O_CPCA };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
@@ -661,6 +670,7 @@ int main(int argc, char **argv)
         {"max-order", required_argument, 0, O_MAX_ORDER},
         {"method", required_argument, 0, O_METHOD},
         {"encoding", required_argument, 0, O_ENCODING},
+        {"cpca", required_argument, 0, O_CPCA},
         {"max-distance", required_argument, 0, O_MAXDIST},
         {"max-edge", required_argument, 0, O_MAXEDGE},
         {"weld", no_argument, 0, O_WELD},
@@ -761,8 +771,16 @@ int main(int argc, char **argv)
             else if (strcmp(optarg, "f32") == 0) o.encoding = VDSH_ENCODING_F32;
             else if (strcmp(optarg, "s8") == 0) o.encoding = VDSH_ENCODING_S8;
             else if (strcmp(optarg, "s8s6") == 0) o.encoding = VDSH_ENCODING_S8S6;
-            else return bad_usage("--encoding takes f16, f32, s8 or s8s6, not '%s'", optarg);
+            else if (strcmp(optarg, "cpca") == 0) o.encoding = VDSH_ENCODING_CPCA;
+            else return bad_usage("--encoding takes f16, f32, s8, s8s6 or cpca, not '%s'", optarg);
             break;
+        case O_CPCA: {
+            if (vdsh_cpca_parse(optarg, &o.cpca, NULL) != VDSH_OK)
+                return bad_usage("--cpca takes K,B,BITS: clusters 1..256, basis vectors "
+                                 "1..256, bits 2..8 (default 8,54,4), not '%s'", optarg);
+            o.have_cpca = 1;
+            break;
+        }
         case O_MAXDIST:
             if (!parse_float(optarg, &o.max_distance) || o.max_distance == 0.0f)
                 return bad_usage("--max-distance takes a positive number, not '%s'", optarg);
@@ -891,6 +909,11 @@ int main(int argc, char **argv)
         default: return vt_cli_try_help();
         }
     }
+    if (o.have_cpca && o.encoding != VDSH_ENCODING_CPCA)
+        return bad_usage("--cpca %s needs --encoding cpca", "K,B,BITS");
+    if (o.encoding == VDSH_ENCODING_CPCA && o.order_tolerance > 0.0f)
+        return bad_usage("--encoding cpca does not encode adaptive-order streams (%s): use "
+                         "fixed --orders with it", "--adaptive-order");
     if (o.have_ray_tolerance && !o.adaptive_rays)
         return bad_usage("%s needs --rays auto", "--ray-tolerance");
     if ((o.min_edge > 0.0f || o.max_receivers || o.max_rounds) && !o.adaptive)
@@ -974,6 +997,7 @@ int main(int argc, char **argv)
                  .progress = on_progress, .progress_user = &pr},
         .encoding_given = 1,
         .encoding = o.encoding,
+        .cpca = o.cpca,
         .cube_size = o.cube_size > 0 ? o.cube_size : -1,
         .record_timings = o.record_timings,
         .shard_index = shard_index, .shard_count = shard_count,

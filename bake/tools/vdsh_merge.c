@@ -44,6 +44,7 @@
 #include "cubemap.h"
 #include "job.h"
 #include "vdsh.h"
+#include "vdsh_cpca.h"
 #include "vt_cli.h"
 
 static void usage(FILE *f)
@@ -115,6 +116,9 @@ static const char *mismatch(const vdsh_file *a, const vdsh_file *b)
         return "another shard count";
     if (a->part.encoding != b->part.encoding)
         return "another --encoding";
+    if (a->part.cpca_clusters != b->part.cpca_clusters ||
+        a->part.cpca_basis != b->part.cpca_basis || a->part.cpca_bits != b->part.cpca_bits)
+        return "another --cpca";
     uint64_t v = a->header.vertex_count, t = a->header.triangle_count;
     if (memcmp(a->positions, b->positions, v * 12) != 0 ||
         memcmp(a->indices, b->indices, t * 12) != 0)
@@ -323,7 +327,7 @@ int main(int argc, char **argv)
                     missing = !(merged[s] = malloc((size_t)V * nc * sizeof(float) + 1)) ||
                               !(orders[s] = malloc((size_t)V + 1)) ||
                               !(offsets[s] = malloc(((size_t)V + 1) * sizeof(uint32_t)));
-                else if (target == VDSH_ENCODING_F32)
+                else if (target == VDSH_ENCODING_F32 || target == VDSH_ENCODING_CPCA)
                     missing = !(merged[s] = malloc((size_t)V * nc * sizeof(float) + 1));
                 else if (target == VDSH_ENCODING_F16)
                     missing = !(encoded[s] = malloc((size_t)V * nc * sizeof(uint16_t) + 1));
@@ -337,7 +341,8 @@ int main(int argc, char **argv)
             }
             for (uint32_t k = 0; k < count; k++)
                 owner[k] = -1;
-            if (target != VDSH_ENCODING_F32 && !(spill = spill_create(output)))
+            if (target != VDSH_ENCODING_F32 && target != VDSH_ENCODING_CPCA &&
+                !(spill = spill_create(output)))
                 goto out;
         }
         const vdsh_part *pt = &p->part;
@@ -378,7 +383,7 @@ int main(int argc, char **argv)
                         output, strerror(errno));
                 goto out;
             }
-            if (target == VDSH_ENCODING_F32)
+            if (target == VDSH_ENCODING_F32 || target == VDSH_ENCODING_CPCA)
                 memcpy(merged[s] + b * nc, src, (e - b) * nc * sizeof(float));
             else if (target == VDSH_ENCODING_F16)
                 for (size_t k = 0; k < (e - b) * nc; k++)
@@ -410,7 +415,24 @@ int main(int argc, char **argv)
         size_t nc = (size_t)streams[s].order * streams[s].order;
         streams[s].data = target == VDSH_ENCODING_F32 ? (void *)merged[s] : encoded[s];
         streams[s].encoding = target;
-        if (orders[s]) {
+        if (target == VDSH_ENCODING_CPCA && !orders[s]) {
+            /* As vb_bake_fill_file: the global step over every receiver,
+             * with the merged (oriented) normals, one encoder. */
+            vdsh_cpca_settings st = {p0->part.cpca_clusters, p0->part.cpca_basis,
+                                     p0->part.cpca_bits};
+            vdsh_stream f32 = streams[s];
+            f32.encoding = VDSH_ENCODING_F32;
+            f32.scale = 1.0f;
+            f32.data = merged[s];
+            vdsh_error e;
+            if (vdsh_cpca_encode_stream(&f32, V, normals, &st, &streams[s], &encoded[s], NULL,
+                                        &e) != VDSH_OK) {
+                fprintf(stderr, "vdsh-merge: order %u stream: %s\n", streams[s].order, e.msg);
+                goto out;
+            }
+            free(merged[s]);
+            merged[s] = NULL;
+        } else if (orders[s]) {
             /* As vb_bake_variable_stream: the same scale rule, one encoder. */
             uint32_t e = target;
             float scale = 1.0f, vmax = 0.0f;

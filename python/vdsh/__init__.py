@@ -6,6 +6,10 @@
     s = f.streams[0]                   # dict: order, encoding, method, quantity, ...
     c = vdsh.coefficients(s)           # V x order^2 float32 (stored x scale;
                                        # s8, s8s6: stored x float32(scale_i / levels_i))
+    s["cpca"]                          # a cpca stream (VDSH.md "cpca streams"): dict clusters,
+                                       # basis, bits, record_words, scales (K x B), means
+                                       # (K x n^2), bases (K x B x n^2) float32, cluster (V),
+                                       # levels (V x B ints); c is decoded as vdsh.c does
     s["variable_order"], s["orders"]   # a variable-order stream (VDSH.md): each vertex's
                                        # order (V ints, 1..order); c is 0 past it
     d = vdsh.reconstruct(f, s, v, dirs)    # distances of vertex v toward unit dirs (N x 3)
@@ -48,7 +52,7 @@ __version__ = "0.1.0"
 
 MAGIC = b"VDSH\r\n\x1a\n"
 METHODS = ["paper", "full", "mirror", "lsq", "shadow", "decision"]
-ENCODINGS = ["f32", "f16", "s8", "s8s6"]
+ENCODINGS = ["f32", "f16", "s8", "s8s6", "cpca"]
 QUANTITIES = ["distance", "distance2", "log-distance"]
 MAX_ORDER = 16
 WINDOWS = ["none", "hann", "lanczos"]
@@ -241,13 +245,17 @@ def _chunk(f, cid, b, path):
     elif cid == b"part":
         if len(b) != 32:
             _fail(path, "part is %d bytes, must be 32" % len(b))
-        i, n, rb, re, enc = struct.unpack_from("<5I", b, 0)
-        if any(b[20:32]):
-            _fail(path, "part: reserved bytes 20..31 not zero")
-        if not (n >= 1 and i < n and rb < re <= h["vertex_count"] and enc <= 3):
+        i, n, rb, re, enc, ck, cb, cbits = struct.unpack_from("<8I", b, 0)
+        if not (n >= 1 and i < n and rb < re <= h["vertex_count"] and enc <= 4):
             _fail(path, "part: shard %d of %d, receivers %d..%d or encoding %d out of range"
                   % (i, n, rb, re, enc))
+        if enc != 4 and (ck or cb or cbits):
+            _fail(path, "part: cpca settings with encoding %s (must be 0)" % ENCODINGS[enc])
+        if enc == 4 and not (1 <= ck <= 256 and 1 <= cb <= 256 and 2 <= cbits <= 8):
+            _fail(path, "part: cpca settings %d,%d,%d out of range" % (ck, cb, cbits))
         f.part = dict(index=i, count=n, range_begin=rb, range_end=re, encoding=ENCODINGS[enc])
+        if enc == 4:
+            f.part.update(cpca_clusters=ck, cpca_basis=cb, cpca_bits=cbits)
     elif cid == b"adpt":
         if len(b) != 32:
             _fail(path, "adpt is %d bytes, must be 32" % len(b))
@@ -322,7 +330,7 @@ def _coef(f, b, V, path):
     order, enc, method, qty, win = struct.unpack_from("<5I", b, 0)
     wp, mp, scale, qp = struct.unpack_from("<4f", b, 20)
     flags = struct.unpack_from("<I", b, 36)[0]
-    if not 1 <= order <= MAX_ORDER or enc > 3 or qty > 2 or win > 2:
+    if not 1 <= order <= MAX_ORDER or enc > 4 or qty > 2 or win > 2:
         _fail(path, "COEF: order, encoding, quantity or window out of range")
     if not _finite(wp, mp) or (win == 0 and wp != 0) or (win != 0 and not wp > 0):
         _fail(path, "COEF: window_param or method_param out of range")
@@ -336,6 +344,16 @@ def _coef(f, b, V, path):
         _fail(path, "COEF: reserved bytes 40..47 not zero")
     variable = bool(flags & 1)
     nc = order * order
+    if enc == 4:
+        if variable:
+            _fail(path, "COEF: cpca streams cannot have variable order")
+        if scale != 1:
+            _fail(path, "COEF: scale must be 1 for cpca")
+        stored, cpca = _cpca(b, order, V, path)
+        _append(f, order, enc, method, qty, win, wp, mp, scale, qp, stored, None, None, False,
+                None, path)
+        f.streams[-1]["cpca"] = cpca
+        return
     # s8, s8s6: order^2 f32 scales, zero-padded to 16 bytes, before the data
     table = (nc * 4 + 15) // 16 * 16 if enc >= 2 else 0
     scales = levels = None
@@ -389,6 +407,83 @@ def _coef(f, b, V, path):
     with np.errstate(over="ignore"):
         if not np.isfinite(np.float32(big) * np.float32(scale)):
             _fail(path, "COEF: a stored value times scale overflows f32")
+    _append(f, order, enc, method, qty, win, wp, mp, scale, qp, stored, scales,
+            levels if enc >= 2 else None, variable, orders, path)
+
+
+def _cpca_field(bits, j):
+    """(word, shift) of weight j's field in a cpca record (VDSH.md)."""
+    first, per = (32 - 8) // bits, 32 // bits
+    if j < first:
+        return 0, 8 + j * bits
+    return 1 + (j - first) // per, ((j - first) % per) * bits
+
+
+def _cpca(b, order, V, path):
+    """A cpca stream's model and records (VDSH.md "cpca streams"), every
+    rule checked; the decoded V x n^2 float32 coefficients, as vdsh.c: w_j
+    = level x float32(scale / L), a = mean, then a = a + w_j x basis_j in
+    float32, j in order."""
+    nc = order * order
+    if len(b) < 64:
+        _fail(path, "COEF: shorter than its cpca header")
+    K, B, bits, W = struct.unpack_from("<4I", b, 48)
+    if not (1 <= K <= 256 and 1 <= B <= nc and 2 <= bits <= 8):
+        _fail(path, "COEF: cpca clusters %d, basis %d or bits %d out of range" % (K, B, bits))
+    fields = [_cpca_field(bits, j) for j in range(B)]
+    if W != (fields[-1][0] + 1):
+        _fail(path, "COEF: cpca record_words %d, must be %d" % (W, fields[-1][0] + 1))
+    r16 = lambda n: (n + 15) // 16 * 16  # noqa: E731
+    sizes = [4 * K * B, 2 * K * nc, 2 * K * B * nc]
+    model = 64 + sum(r16(x) for x in sizes)
+    if len(b) != model + 4 * W * V:
+        _fail(path, "COEF: payload is %d bytes, must be %d" % (len(b), model + 4 * W * V))
+    at = 64
+    arrays = []
+    for x, dt, shape in zip(sizes, ["<f4", "<f2", "<f2"], [(K, B), (K, nc), (K, B, nc)]):
+        if any(b[at + x:at + r16(x)]):
+            _fail(path, "COEF: padding after a cpca array not zero")
+        arrays.append(np.frombuffer(b, dt, x // (4 if dt == "<f4" else 2), at).reshape(shape))
+        at += r16(x)
+    scales, means16, bases16 = arrays
+    if not (np.isfinite(scales).all() and (scales >= 0).all()):
+        _fail(path, "COEF: a cpca scale is not finite and >= 0")
+    if not (np.isfinite(means16).all() and np.isfinite(bases16).all()):
+        _fail(path, "COEF: a cpca mean or basis value is not finite")
+    L = (1 << (bits - 1)) - 1
+    step = (scales.astype(np.float32) / np.float32(L)).astype(np.float32)
+    means = means16.astype(np.float32)
+    bases = bases16.astype(np.float32)
+    bound = (np.abs(means.astype(np.float64)) +
+             np.einsum("kb,kbn->kn", L * step.astype(np.float64), np.abs(bases.astype(np.float64))))
+    if not (bound <= 1e38).all():
+        _fail(path, "COEF: a cpca cluster's coefficients can exceed 1e38")
+    rec = np.frombuffer(b, "<u4", W * V, model).reshape(V, W)
+    cluster = (rec[:, 0] & 0xff).astype(np.int64)
+    if (cluster >= K).any():
+        _fail(path, "COEF: a cpca cluster index is >= %d" % K)
+    used = np.zeros(W, np.uint64)
+    used[0] = 0xff
+    levels = np.empty((V, B), np.int32)
+    for j, (w, sh) in enumerate(fields):
+        used[w] |= np.uint64(((1 << bits) - 1) << sh)
+        u = ((rec[:, w] >> np.uint32(sh)) & np.uint32((1 << bits) - 1)).astype(np.int32)
+        levels[:, j] = u - (u >> (bits - 1)) * (1 << bits)
+    if (rec.astype(np.uint64) & ~used).any():
+        _fail(path, "COEF: unused bits of a cpca record not zero")
+    if (levels < -L).any():
+        _fail(path, "COEF: a cpca weight is below -%d" % L)
+    out = means[cluster]
+    wts = levels.astype(np.float32) * step[cluster]
+    for j in range(B):
+        out = out + wts[:, j:j + 1] * bases[cluster, j]
+    return out.astype(np.float32), dict(clusters=K, basis=B, bits=bits, record_words=W,
+                                        scales=scales.astype(np.float32), means=means,
+                                        bases=bases, cluster=cluster, levels=levels)
+
+
+def _append(f, order, enc, method, qty, win, wp, mp, scale, qp, stored, scales, levels, variable,
+            orders, path):
     if any(s["quantity"] == QUANTITIES[qty] and s["variable_order"] == variable and
            (variable or s["order"] == order) for s in f.streams):
         _fail(path, "COEF: a second %s stream, %s" % (
@@ -399,8 +494,8 @@ def _coef(f, b, V, path):
                           method=METHODS[method] if method < len(METHODS) else method,
                           method_id=method, quantity=QUANTITIES[qty], window=WINDOWS[win],
                           window_param=wp, method_param=mp, scale=scale, quantity_param=qp,
-                          stored=stored, coef_scales=scales, levels=levels if enc >= 2 else None,
-                          variable_order=variable, orders=orders))
+                          stored=stored, coef_scales=scales, levels=levels,
+                          variable_order=variable, orders=orders, cpca=None))
 
 
 def coefficients(stream: Dict[str, Any]) -> np.ndarray:

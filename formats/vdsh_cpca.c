@@ -1,0 +1,688 @@
+/* vdsh_cpca.c - the cpca encoder (vdsh_cpca.h; VDSH.md "cpca streams").
+ *
+ * Everything is f64 in a fixed order on one thread, with only +, -, *, /
+ * and sqrt (correctly rounded; no libm transcendental, whose results may
+ * depend on the CPU's code path), and the file is compiled as ISO C
+ * (-std=c11: no fused multiply-add contraction): the same bytes on any
+ * x86-64 CPU and whatever the caller's thread count. */
+#include "vdsh_cpca.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vdsh_sh.h"
+
+enum {
+    KMEANS_ROUNDS = 25,
+    CUBE_N = 37 /* metric directions: 6 * 37^2 = 8214 texel centres of a cube */
+};
+#define NORMAL_WEIGHT 10.0  /* normals at ten times the coefficients' spread */
+#define SPHERE_EPS 0.01     /* the whole sphere's weight in the metric */
+#define KMEANS_SEED 0x5eed5eed12345678ull
+
+vdsh_cpca_settings vdsh_cpca_settings_default(void)
+{
+    vdsh_cpca_settings s = {VDSH_CPCA_DEFAULT_CLUSTERS, VDSH_CPCA_DEFAULT_BASIS,
+                            VDSH_CPCA_DEFAULT_BITS};
+    return s;
+}
+
+static vdsh_result failf(vdsh_error *err, vdsh_result r, const char *fmt, ...)
+{
+    if (err) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+        va_end(ap);
+    }
+    return r;
+}
+
+static int check_settings(const vdsh_cpca_settings *s, vdsh_error *err)
+{
+    if (s->clusters < 1 || s->clusters > VDSH_CPCA_MAX_CLUSTERS) {
+        failf(err, VDSH_ERR_ARGUMENT, "cpca: clusters %u out of range 1..%d", s->clusters,
+              VDSH_CPCA_MAX_CLUSTERS);
+        return 0;
+    }
+    if (s->basis < 1 || s->basis > VDSH_MAX_COEFFS) {
+        failf(err, VDSH_ERR_ARGUMENT, "cpca: basis %u out of range 1..%d", s->basis,
+              VDSH_MAX_COEFFS);
+        return 0;
+    }
+    if (s->bits < VDSH_CPCA_MIN_BITS || s->bits > VDSH_CPCA_MAX_BITS) {
+        failf(err, VDSH_ERR_ARGUMENT, "cpca: bits %u out of range %d..%d", s->bits,
+              VDSH_CPCA_MIN_BITS, VDSH_CPCA_MAX_BITS);
+        return 0;
+    }
+    return 1;
+}
+
+vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_error *err)
+{
+    unsigned long v[3];
+    const char *p = text ? text : "";
+    for (int k = 0; k < 3; k++) {
+        char *end;
+        if (*p < '0' || *p > '9')
+            return failf(err, VDSH_ERR_ARGUMENT,
+                         "cpca settings '%s': expected K,B,BITS (for example 8,54,4)",
+                         text ? text : "");
+        v[k] = strtoul(p, &end, 10);
+        if (v[k] > 100000 || *end != (k < 2 ? ',' : '\0'))
+            return failf(err, VDSH_ERR_ARGUMENT,
+                         "cpca settings '%s': expected K,B,BITS (for example 8,54,4)", text);
+        p = end + (k < 2);
+    }
+    vdsh_cpca_settings s = {(uint32_t)v[0], (uint32_t)v[1], (uint32_t)v[2]};
+    if (!check_settings(&s, err))
+        return VDSH_ERR_ARGUMENT;
+    *out = s;
+    return VDSH_OK;
+}
+
+void vdsh_cpca_fit_free(vdsh_cpca_fit *fit)
+{
+    if (!fit)
+        return;
+    free(fit->storage_);
+    memset(fit, 0, sizeof *fit);
+}
+
+/* ---- linear algebra (f64, fixed order) ---- */
+
+/* Cholesky: G (n x n, symmetric) = L L^T, L lower-triangular in l. 0 when
+ * G is not positive definite. */
+static int cholesky(const double *g, uint32_t n, double *l)
+{
+    memset(l, 0, sizeof(double) * n * n);
+    for (uint32_t j = 0; j < n; j++) {
+        double d = g[(size_t)j * n + j];
+        for (uint32_t k = 0; k < j; k++)
+            d -= l[(size_t)j * n + k] * l[(size_t)j * n + k];
+        if (!(d > 0.0))
+            return 0;
+        double r = sqrt(d);
+        l[(size_t)j * n + j] = r;
+        for (uint32_t i = j + 1; i < n; i++) {
+            double s = g[(size_t)i * n + j];
+            for (uint32_t k = 0; k < j; k++)
+                s -= l[(size_t)i * n + k] * l[(size_t)j * n + k];
+            l[(size_t)i * n + j] = s / r;
+        }
+    }
+    return 1;
+}
+
+/* Cyclic Jacobi: a (n x n, symmetric, destroyed) = V diag(a_ii) V^T; v
+ * receives the eigenvectors as columns. */
+static void jacobi(double *a, uint32_t n, double *v)
+{
+    for (uint32_t i = 0; i < n; i++)
+        for (uint32_t j = 0; j < n; j++)
+            v[(size_t)i * n + j] = i == j;
+    for (int sweep = 0; sweep < 50; sweep++) {
+        double off = 0.0, all = 0.0;
+        for (uint32_t i = 0; i < n; i++)
+            for (uint32_t j = 0; j < n; j++) {
+                double x = a[(size_t)i * n + j] * a[(size_t)i * n + j];
+                all += x;
+                if (i != j)
+                    off += x;
+            }
+        if (!(off > 1e-24 * all))
+            break;
+        for (uint32_t p = 0; p + 1 < n; p++)
+            for (uint32_t q = p + 1; q < n; q++) {
+                double apq = a[(size_t)p * n + q];
+                if (apq == 0.0)
+                    continue;
+                double theta = (a[(size_t)q * n + q] - a[(size_t)p * n + p]) / (2.0 * apq);
+                double t = (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+                for (uint32_t k = 0; k < n; k++) { /* columns p, q */
+                    double kp = a[(size_t)k * n + p], kq = a[(size_t)k * n + q];
+                    a[(size_t)k * n + p] = c * kp - s * kq;
+                    a[(size_t)k * n + q] = s * kp + c * kq;
+                }
+                for (uint32_t k = 0; k < n; k++) { /* rows p, q */
+                    double pk = a[(size_t)p * n + k], qk = a[(size_t)q * n + k];
+                    a[(size_t)p * n + k] = c * pk - s * qk;
+                    a[(size_t)q * n + k] = s * pk + c * qk;
+                }
+                a[(size_t)p * n + q] = a[(size_t)q * n + p] = 0.0;
+                for (uint32_t k = 0; k < n; k++) {
+                    double kp = v[(size_t)k * n + p], kq = v[(size_t)k * n + q];
+                    v[(size_t)k * n + p] = c * kp - s * kq;
+                    v[(size_t)k * n + q] = s * kp + c * kq;
+                }
+            }
+    }
+}
+
+/* ---- the metric: the SH's Gram matrix over cube texel directions ---- */
+
+typedef struct metric_dirs {
+    uint32_t count, n;
+    double *dir;   /* 3 per direction */
+    double *wy;    /* per direction: sqrt(weight) * Y_i, n values */
+    double *full;  /* n x n: sum over all directions of weight * Y Y^T */
+} metric_dirs;
+
+static int metric_init(metric_dirs *m, uint32_t order)
+{
+    uint32_t n = order * order, count = 6 * CUBE_N * CUBE_N;
+    m->count = count;
+    m->n = n;
+    m->dir = malloc(sizeof(double) * 3 * count);
+    m->wy = malloc(sizeof(double) * (size_t)n * count);
+    m->full = calloc((size_t)n * n, sizeof(double));
+    if (!m->dir || !m->wy || !m->full)
+        return 0;
+    float y[VDSH_MAX_COEFFS];
+    uint32_t at = 0;
+    for (uint32_t face = 0; face < 6; face++)
+        for (uint32_t j = 0; j < CUBE_N; j++)
+            for (uint32_t i = 0; i < CUBE_N; i++, at++) {
+                double u = 2.0 * (i + 0.5) / CUBE_N - 1.0, v = 2.0 * (j + 0.5) / CUBE_N - 1.0;
+                double d[3];
+                uint32_t axis = face / 2;
+                double sign = face % 2 ? -1.0 : 1.0;
+                d[axis] = sign;
+                d[(axis + 1) % 3] = u;
+                d[(axis + 2) % 3] = v;
+                double r2 = 1.0 + u * u + v * v, r = sqrt(r2);
+                /* solid angle of the texel, to first order */
+                double w = 4.0 / ((double)CUBE_N * CUBE_N) / (r2 * r);
+                float df[3];
+                for (int k = 0; k < 3; k++) {
+                    m->dir[3 * at + k] = d[k] / r;
+                    df[k] = (float)(d[k] / r);
+                }
+                vdsh_sh_eval((int)order, df, y);
+                double sw = sqrt(w);
+                for (uint32_t k = 0; k < n; k++)
+                    m->wy[(size_t)at * n + k] = sw * (double)y[k];
+            }
+    for (uint32_t d = 0; d < count; d++) {
+        const double *y2 = m->wy + (size_t)d * n;
+        for (uint32_t a = 0; a < n; a++)
+            for (uint32_t b = 0; b <= a; b++)
+                m->full[(size_t)a * n + b] += y2[a] * y2[b];
+    }
+    for (uint32_t a = 0; a < n; a++)
+        for (uint32_t b = 0; b < a; b++)
+            m->full[(size_t)b * n + a] = m->full[(size_t)a * n + b];
+    return 1;
+}
+
+static void metric_free(metric_dirs *m)
+{
+    free(m->dir);
+    free(m->wy);
+    free(m->full);
+}
+
+/* g = sum over directions above the plane of normal nn of weight Y Y^T,
+ * plus SPHERE_EPS times the whole sphere's. */
+static void metric_gram(const metric_dirs *m, const double nn[3], double *g)
+{
+    uint32_t n = m->n;
+    for (size_t k = 0; k < (size_t)n * n; k++)
+        g[k] = SPHERE_EPS * m->full[k];
+    for (uint32_t d = 0; d < m->count; d++) {
+        const double *dd = m->dir + 3 * (size_t)d;
+        if (!(dd[0] * nn[0] + dd[1] * nn[1] + dd[2] * nn[2] > 0.0))
+            continue;
+        const double *y = m->wy + (size_t)d * n;
+        for (uint32_t a = 0; a < n; a++)
+            for (uint32_t b = 0; b <= a; b++)
+                g[(size_t)a * n + b] += y[a] * y[b];
+    }
+    for (uint32_t a = 0; a < n; a++)
+        for (uint32_t b = 0; b < a; b++)
+            g[(size_t)b * n + a] = g[(size_t)a * n + b];
+}
+
+/* ---- k-means ---- */
+
+static uint64_t splitmix(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+/* Squared distance of row v's feature [c, ns * normal] to centre z. */
+static double feature_dist(const float *c, const float *nrm, uint32_t n, double ns,
+                           const double *z)
+{
+    double d = 0.0;
+    for (uint32_t i = 0; i < n; i++) {
+        double e = (double)c[i] - z[i];
+        d += e * e;
+    }
+    for (uint32_t k = 0; k < 3; k++) {
+        double e = ns * (double)nrm[k] - z[n + k];
+        d += e * e;
+    }
+    return d;
+}
+
+static void set_centre(const float *c, const float *nrm, uint32_t n, double ns, double *z)
+{
+    for (uint32_t i = 0; i < n; i++)
+        z[i] = c[i];
+    for (uint32_t k = 0; k < 3; k++)
+        z[n + k] = ns * (double)nrm[k];
+}
+
+/* labels[rows] in 0..k-1; scratch `dist` (rows) and centres k * (n + 3). */
+static void kmeans(const float *src, const float *normals, uint32_t rows, uint32_t n, double ns,
+                   uint32_t k, uint32_t *labels, double *dist, double *cent)
+{
+    const uint32_t dim = n + 3;
+    uint64_t seed = KMEANS_SEED;
+    /* k-means++ seeding */
+    uint32_t first = (uint32_t)(splitmix(&seed) % rows);
+    set_centre(src + (size_t)first * n, normals + 3 * (size_t)first, n, ns, cent);
+    for (uint32_t v = 0; v < rows; v++)
+        dist[v] = feature_dist(src + (size_t)v * n, normals + 3 * (size_t)v, n, ns, cent);
+    for (uint32_t j = 1; j < k; j++) {
+        double total = 0.0;
+        for (uint32_t v = 0; v < rows; v++)
+            total += dist[v];
+        uint32_t pick;
+        if (total > 0.0) {
+            double r = (double)(splitmix(&seed) >> 11) * 0x1.0p-53 * total, acc = 0.0;
+            pick = rows - 1;
+            for (uint32_t v = 0; v < rows; v++) {
+                acc += dist[v];
+                if (acc > r) {
+                    pick = v;
+                    break;
+                }
+            }
+        } else {
+            pick = (uint32_t)(splitmix(&seed) % rows);
+        }
+        double *z = cent + (size_t)j * dim;
+        set_centre(src + (size_t)pick * n, normals + 3 * (size_t)pick, n, ns, z);
+        for (uint32_t v = 0; v < rows; v++) {
+            double d = feature_dist(src + (size_t)v * n, normals + 3 * (size_t)v, n, ns, z);
+            if (d < dist[v])
+                dist[v] = d;
+        }
+    }
+    /* Lloyd rounds until no vertex moves */
+    double *sum = calloc((size_t)k * dim + 1, sizeof(double));
+    uint32_t *count = calloc((size_t)k + 1, sizeof(uint32_t));
+    for (uint32_t round = 0; round < KMEANS_ROUNDS && sum && count; round++) {
+        uint32_t moved = 0;
+        for (uint32_t v = 0; v < rows; v++) {
+            const float *c = src + (size_t)v * n, *nr = normals + 3 * (size_t)v;
+            uint32_t best = 0;
+            double bd = feature_dist(c, nr, n, ns, cent);
+            for (uint32_t j = 1; j < k; j++) {
+                double d = feature_dist(c, nr, n, ns, cent + (size_t)j * dim);
+                if (d < bd) {
+                    bd = d;
+                    best = j;
+                }
+            }
+            if (round == 0 || labels[v] != best)
+                moved++;
+            labels[v] = best;
+            dist[v] = bd;
+        }
+        if (!moved)
+            break;
+        memset(sum, 0, sizeof(double) * k * dim);
+        memset(count, 0, sizeof(uint32_t) * k);
+        for (uint32_t v = 0; v < rows; v++) {
+            double *s = sum + (size_t)labels[v] * dim;
+            const float *c = src + (size_t)v * n, *nr = normals + 3 * (size_t)v;
+            for (uint32_t i = 0; i < n; i++)
+                s[i] += c[i];
+            for (uint32_t q = 0; q < 3; q++)
+                s[n + q] += ns * (double)nr[q];
+            count[labels[v]]++;
+        }
+        for (uint32_t j = 0; j < k; j++) {
+            double *z = cent + (size_t)j * dim;
+            if (count[j]) {
+                for (uint32_t i = 0; i < dim; i++)
+                    z[i] = sum[(size_t)j * dim + i] / count[j];
+                continue;
+            }
+            /* an empty cluster takes the worst-served vertex */
+            uint32_t far = 0;
+            for (uint32_t v = 1; v < rows; v++)
+                if (dist[v] > dist[far])
+                    far = v;
+            set_centre(src + (size_t)far * n, normals + 3 * (size_t)far, n, ns, z);
+            dist[far] = 0.0;
+        }
+    }
+    free(sum);
+    free(count);
+}
+
+/* ---- the fit ---- */
+
+/* Candidate scales of a basis vector: its largest |weight| times 1,
+ * 0.95, ..., 0.35, rounded to f32 as stored. */
+enum { SCALE_CANDIDATES = 14 };
+static double candidate_scale(double wmax, uint32_t t)
+{
+    return (double)(float)(wmax * (1.0 - 0.05 * t));
+}
+
+/* The stored level of weight w with scale s (> 0): round(L w / s), ties
+ * away from 0, clamped to +-L. */
+static double quantise(double w, double s, int levels)
+{
+    if (!(s > 0.0))
+        return 0.0;
+    double q = round((double)levels * w / s);
+    return q > levels ? levels : q < -levels ? -levels : q;
+}
+
+vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t rows,
+                             uint32_t order, const vdsh_cpca_settings *settings,
+                             vdsh_cpca_fit *out, vdsh_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!src || !normals || !settings || rows < 1 || rows > VDSH_MAX_VERTICES || order < 1 ||
+        order > VDSH_MAX_ORDER)
+        return failf(err, VDSH_ERR_ARGUMENT, "cpca: bad arguments (rows %u, order %u)", rows,
+                     order);
+    if (!check_settings(settings, err))
+        return VDSH_ERR_ARGUMENT;
+    const uint32_t n = order * order;
+    const uint32_t k = settings->clusters < rows ? settings->clusters : rows;
+    const uint32_t b = settings->basis < n ? settings->basis : n;
+    const uint32_t bits = settings->bits;
+    const uint32_t words = vdsh_cpca_record_words(b, bits);
+    for (size_t x = 0; x < (size_t)rows * n; x++)
+        if (!isfinite(src[x]))
+            return failf(err, VDSH_ERR_INVALID, "cpca: vertex %zu coefficient %zu is not finite",
+                         x / n, x % n);
+
+    /* one block: scales, means, bases, records */
+    size_t o_means = ((size_t)k * b * 4 + 15) & ~(size_t)15;
+    size_t o_bases = o_means + (((size_t)k * n * 2 + 15) & ~(size_t)15);
+    size_t o_rec = o_bases + (((size_t)k * b * n * 2 + 15) & ~(size_t)15);
+    size_t total = o_rec + (size_t)rows * words * 4;
+    uint8_t *block = calloc(1, total);
+    uint32_t *labels = malloc(sizeof(uint32_t) * rows);
+    double *dist = malloc(sizeof(double) * rows);
+    double *cent = malloc(sizeof(double) * k * (n + 3));
+    double *g = malloc(sizeof(double) * n * n), *l = malloc(sizeof(double) * n * n);
+    double *sc = malloc(sizeof(double) * n * n), *sy = malloc(sizeof(double) * n * n);
+    double *ev = malloc(sizeof(double) * n * n), *proj = malloc(sizeof(double) * n * b);
+    double *tmp = malloc(sizeof(double) * n * n), *mu = malloc(sizeof(double) * n);
+    double *wmax = malloc(sizeof(double) * b);
+    double *cerr = malloc(sizeof(double) * b * SCALE_CANDIDATES);
+    uint32_t *idx = malloc(sizeof(uint32_t) * n);
+    metric_dirs md = {0};
+    vdsh_result res = VDSH_OK;
+    if (!block || !labels || !dist || !cent || !g || !l || !sc || !sy || !ev || !proj || !tmp ||
+        !mu || !wmax || !cerr || !idx || !metric_init(&md, order)) {
+        res = failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory (%zu bytes)", total);
+        goto done;
+    }
+    float *scales = (float *)block;
+    uint16_t *means = (uint16_t *)(block + o_means);
+    uint16_t *bases = (uint16_t *)(block + o_bases);
+    uint32_t *records = (uint32_t *)(block + o_rec);
+
+    /* the coefficients' spread: sqrt(mean over rows of |c - mean c|^2) */
+    for (uint32_t i = 0; i < n; i++)
+        mu[i] = 0.0;
+    for (uint32_t v = 0; v < rows; v++)
+        for (uint32_t i = 0; i < n; i++)
+            mu[i] += src[(size_t)v * n + i];
+    for (uint32_t i = 0; i < n; i++)
+        mu[i] /= rows;
+    double spread = 0.0;
+    for (uint32_t v = 0; v < rows; v++)
+        for (uint32_t i = 0; i < n; i++) {
+            double e = src[(size_t)v * n + i] - mu[i];
+            spread += e * e;
+        }
+    spread = sqrt(spread / rows);
+    kmeans(src, normals, rows, n, NORMAL_WEIGHT * spread, k, labels, dist, cent);
+
+    const int levels = vdsh_cpca_levels(bits);
+    for (uint32_t c = 0; c < k; c++) {
+        /* members' mean (stored as f16) and mean normal */
+        double nn[3] = {0, 0, 0};
+        uint32_t members = 0;
+        for (uint32_t i = 0; i < n; i++)
+            mu[i] = 0.0;
+        for (uint32_t v = 0; v < rows; v++) {
+            if (labels[v] != c)
+                continue;
+            members++;
+            for (uint32_t i = 0; i < n; i++)
+                mu[i] += src[(size_t)v * n + i];
+            for (uint32_t q = 0; q < 3; q++)
+                nn[q] += normals[3 * (size_t)v + q];
+        }
+        if (!members)
+            continue; /* mean, basis and scales 0; no vertex refers to it */
+        for (uint32_t i = 0; i < n; i++) {
+            float m = (float)(mu[i] / members);
+            uint16_t h = vdsh_f16_from_f32(m);
+            if ((h & 0x7c00u) == 0x7c00u) {
+                res = failf(err, VDSH_ERR_INVALID,
+                            "cpca: cluster %u's mean coefficient %u, %g, does not fit f16", c, i,
+                            (double)m);
+                goto done;
+            }
+            means[(size_t)c * n + i] = h;
+            mu[i] = vdsh_f32_from_f16(h);
+        }
+        double len = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+        for (uint32_t q = 0; q < 3; q++)
+            nn[q] = len > 1e-12 ? nn[q] / len : 0.0;
+        metric_gram(&md, nn, g);
+        if (!cholesky(g, n, l)) {
+            res = failf(err, VDSH_ERR_INVALID, "cpca: cluster %u: metric not positive definite", c);
+            goto done;
+        }
+        /* scatter of the deviations from the stored mean (lower half) */
+        memset(sc, 0, sizeof(double) * n * n);
+        for (uint32_t v = 0; v < rows; v++) {
+            if (labels[v] != c)
+                continue;
+            const float *x = src + (size_t)v * n;
+            for (uint32_t a = 0; a < n; a++) {
+                double da = x[a] - mu[a];
+                double *row = sc + (size_t)a * n;
+                for (uint32_t e = 0; e <= a; e++)
+                    row[e] += da * (x[e] - mu[e]);
+            }
+        }
+        for (uint32_t a = 0; a < n; a++)
+            for (uint32_t e = 0; e < a; e++)
+                sc[(size_t)e * n + a] = sc[(size_t)a * n + e];
+        /* in the metric: y = L^T c, so sy = L^T sc L */
+        for (uint32_t a = 0; a < n; a++) /* tmp = sc L */
+            for (uint32_t e = 0; e < n; e++) {
+                double s = 0.0;
+                for (uint32_t q = e; q < n; q++)
+                    s += sc[(size_t)a * n + q] * l[(size_t)q * n + e];
+                tmp[(size_t)a * n + e] = s;
+            }
+        for (uint32_t a = 0; a < n; a++) /* sy = L^T tmp */
+            for (uint32_t e = 0; e < n; e++) {
+                double s = 0.0;
+                for (uint32_t q = a; q < n; q++)
+                    s += l[(size_t)q * n + a] * tmp[(size_t)q * n + e];
+                sy[(size_t)a * n + e] = s;
+            }
+        for (uint32_t a = 0; a < n; a++) /* symmetric to the bit */
+            for (uint32_t e = 0; e < a; e++)
+                sy[(size_t)e * n + a] = sy[(size_t)a * n + e];
+        jacobi(sy, n, ev);
+        /* eigenvalues descending, ties by index */
+        for (uint32_t i = 0; i < n; i++) {
+            uint32_t at = i;
+            while (at > 0 && sy[(size_t)idx[at - 1] * n + idx[at - 1]] < sy[(size_t)i * n + i]) {
+                idx[at] = idx[at - 1];
+                at--;
+            }
+            idx[at] = i;
+        }
+        for (uint32_t j = 0; j < b; j++) {
+            uint32_t col = idx[j];
+            /* projection p = L u; basis vector L^-T u (back substitution) */
+            double *p = proj + (size_t)j * n;
+            for (uint32_t a = 0; a < n; a++) {
+                double s = 0.0;
+                for (uint32_t q = 0; q <= a; q++)
+                    s += l[(size_t)a * n + q] * ev[(size_t)q * n + col];
+                p[a] = s;
+            }
+            double *bv = tmp; /* L^T bv = u */
+            for (uint32_t a = n; a-- > 0;) {
+                double s = ev[(size_t)a * n + col];
+                for (uint32_t q = a + 1; q < n; q++)
+                    s -= l[(size_t)q * n + a] * bv[q];
+                bv[a] = s / l[(size_t)a * n + a];
+            }
+            for (uint32_t a = 0; a < n; a++) {
+                uint16_t h = vdsh_f16_from_f32((float)bv[a]);
+                if ((h & 0x7c00u) == 0x7c00u) {
+                    res = failf(err, VDSH_ERR_INVALID,
+                                "cpca: cluster %u basis vector %u does not fit f16", c, j);
+                    goto done;
+                }
+                bases[((size_t)c * b + j) * n + a] = h;
+            }
+        }
+        /* weights, in three passes: the largest |weight| per vector; the
+         * squared quantisation error of each candidate scale (the largest
+         * times 1, 0.95, ..., 0.35: clipping the few largest weights buys
+         * a finer step for all the others); the levels with the best. The
+         * weights are coordinates of an orthonormal basis of the metric,
+         * so this error is the metric's. */
+        for (uint32_t j = 0; j < b; j++)
+            wmax[j] = 0.0;
+        memset(cerr, 0, sizeof(double) * b * SCALE_CANDIDATES);
+        for (int pass = 0; pass < 3; pass++) {
+            for (uint32_t v = 0; v < rows; v++) {
+                if (labels[v] != c)
+                    continue;
+                const float *x = src + (size_t)v * n;
+                uint32_t *rec = records + (size_t)v * words;
+                if (pass == 2)
+                    rec[0] = c;
+                for (uint32_t j = 0; j < b; j++) {
+                    const double *p = proj + (size_t)j * n;
+                    double w = 0.0;
+                    for (uint32_t a = 0; a < n; a++)
+                        w += (x[a] - mu[a]) * p[a];
+                    if (pass == 0) {
+                        wmax[j] = fabs(w) > wmax[j] ? fabs(w) : wmax[j];
+                        continue;
+                    }
+                    if (pass == 1) {
+                        for (uint32_t t = 0; t < SCALE_CANDIDATES; t++) {
+                            double s = candidate_scale(wmax[j], t), e = w;
+                            if (s > 0.0)
+                                e = w - quantise(w, s, levels) * (double)vdsh_cpca_step(
+                                                                     (float)s, bits);
+                            cerr[(size_t)j * SCALE_CANDIDATES + t] += e * e;
+                        }
+                        continue;
+                    }
+                    double q = quantise(w, scales[(size_t)c * b + j], levels);
+                    uint32_t word, shift;
+                    vdsh_cpca_field(bits, j, &word, &shift);
+                    rec[word] |= ((uint32_t)(int32_t)q & ((1u << bits) - 1u)) << shift;
+                }
+            }
+            if (pass == 1)
+                for (uint32_t j = 0; j < b; j++) {
+                    uint32_t best = 0;
+                    for (uint32_t t = 1; t < SCALE_CANDIDATES; t++)
+                        if (cerr[(size_t)j * SCALE_CANDIDATES + t] <
+                            cerr[(size_t)j * SCALE_CANDIDATES + best])
+                            best = t;
+                    scales[(size_t)c * b + j] = (float)candidate_scale(wmax[j], best);
+                }
+        }
+    }
+    out->model = (vdsh_cpca){.clusters = k, .basis = b, .bits = bits, .record_words = words,
+                             .scales = scales, .means = means, .bases = bases};
+    out->records = records;
+    out->storage_ = block;
+    block = NULL;
+    {
+        /* the decode error, as every reader decodes */
+        vdsh_stream s = {.order = order, .encoding = VDSH_ENCODING_CPCA, .scale = 1.0f,
+                         .data = records, .cpca = out->model};
+        float dec[VDSH_MAX_COEFFS];
+        double e2 = 0.0;
+        for (uint32_t v = 0; v < rows; v++) {
+            vdsh_stream_decode(&s, v, dec);
+            for (uint32_t i = 0; i < n; i++) {
+                double e = (double)dec[i] - src[(size_t)v * n + i];
+                e2 += e * e;
+            }
+        }
+        out->rms_error = sqrt(e2 / rows);
+    }
+done:
+    free(block);
+    free(labels);
+    free(dist);
+    free(cent);
+    free(g);
+    free(l);
+    free(sc);
+    free(sy);
+    free(ev);
+    free(proj);
+    free(tmp);
+    free(mu);
+    free(wmax);
+    free(cerr);
+    free(idx);
+    metric_free(&md);
+    return res;
+}
+
+vdsh_result vdsh_cpca_encode_stream(const vdsh_stream *src, uint32_t rows, const float *normals,
+                                    const vdsh_cpca_settings *settings, vdsh_stream *out,
+                                    void **storage, double *rms_error, vdsh_error *err)
+{
+    if (!src || src->encoding != VDSH_ENCODING_F32 || src->scale != 1.0f ||
+        (src->flags & VDSH_STREAM_VARIABLE) || !src->data)
+        return failf(err, VDSH_ERR_ARGUMENT,
+                     "cpca: the source must be a fixed-order f32 stream with scale 1");
+    vdsh_cpca_fit fit;
+    vdsh_result r = vdsh_cpca_encode((const float *)src->data, normals, rows, src->order,
+                                     settings, &fit, err);
+    if (r != VDSH_OK)
+        return r;
+    *out = *src;
+    out->encoding = VDSH_ENCODING_CPCA;
+    out->scale = 1.0f;
+    out->coef_scales = NULL;
+    out->orders = NULL;
+    out->offsets = NULL;
+    out->data = fit.records;
+    out->cpca = fit.model;
+    *storage = fit.storage_;
+    if (rms_error)
+        *rms_error = fit.rms_error;
+    return VDSH_OK;
+}

@@ -1,0 +1,88 @@
+/*
+ * vdsh_cpca.h - fit a `cpca` stream (clustered principal components,
+ * formats/VDSH.md "cpca streams", issue 29) to a bake's coefficients.
+ *
+ * Purpose: the one encoder of the `cpca` encoding: vdsh-bake calls it
+ * after the fit, over all receivers, and vdsh-merge over the joined parts'
+ * rows, so a merged file is byte-identical with the whole bake's.
+ *
+ * Method (VDSH.md has the rule in words): k-means over [c, 10 sigma n]
+ * (coefficients, then the vertex normal scaled to dominate), k-means++
+ * seeding from a fixed seed, Lloyd rounds until no vertex moves (at most
+ * 25); per cluster the mean (f16) and the B leading principal directions
+ * of the deviations in the metric of the upper hemisphere of the
+ * cluster's mean normal plus 0.01 of the whole sphere; weights quantised
+ * to `bits` bits with a scale per cluster and vector, chosen among the
+ * largest |weight| x 1, 0.95, ..., 0.35 by least squared error. f64, one thread,
+ * fixed order: the same bytes on any x86-64 CPU and thread count.
+ *
+ * Does not: read or write files (vdsh.h does), handle variable-order
+ * streams (callers refuse them).
+ *
+ * Usage:
+ *     vdsh_cpca_fit fit;
+ *     vdsh_cpca_settings st = vdsh_cpca_settings_default();
+ *     if (vdsh_cpca_encode(coefs, normals, rows, order, &st, &fit, &err) != VDSH_OK) ...
+ *     stream.encoding = VDSH_ENCODING_CPCA; stream.scale = 1;
+ *     stream.cpca = fit.model; stream.data = fit.records;
+ *     ... vdsh_write ...
+ *     vdsh_cpca_fit_free(&fit);
+ *
+ * Threading: no shared state.
+ */
+#ifndef VDSH_CPCA_H
+#define VDSH_CPCA_H
+
+#include "vdsh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct vdsh_cpca_settings {
+    uint32_t clusters;   /* K asked for, 1..VDSH_CPCA_MAX_CLUSTERS (capped at rows) */
+    uint32_t basis;      /* B asked for, 1..VDSH_MAX_COEFFS (capped at order^2) */
+    uint32_t bits;       /* VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS */
+} vdsh_cpca_settings;
+
+/* K = 8, B = 54, 4 bits (docs/ACCURACY.md "Compressed high orders"). */
+vdsh_cpca_settings vdsh_cpca_settings_default(void);
+
+/* Parse "K,B,BITS" (for example "8,54,4") into *out; VDSH_ERR_ARGUMENT
+ * with a message for a malformed string or a value out of range. */
+vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_error *err);
+
+/* A fitted stream: model (its pointers into storage_) and records
+ * (rows * model.record_words words). Also the fit's coefficient error,
+ * RMS over rows of |decoded - c| (f32 decode, as vdsh_stream_decode). */
+typedef struct vdsh_cpca_fit {
+    vdsh_cpca model;
+    uint32_t *records;
+    double rms_error;
+    void *storage_;
+} vdsh_cpca_fit;
+
+/* Fit `rows` rows of order^2 coefficients (src, row-major, finite) with
+ * their unit (or zero) normals (3 per row) to a cpca model and records.
+ * VDSH_ERR_ARGUMENT for bad settings, order or rows; VDSH_ERR_INVALID for
+ * a value that is not finite or a model that does not fit f16;
+ * VDSH_ERR_OUT_OF_MEMORY. On failure *out is zeroed. */
+vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t rows,
+                             uint32_t order, const vdsh_cpca_settings *settings,
+                             vdsh_cpca_fit *out, vdsh_error *err);
+
+void vdsh_cpca_fit_free(vdsh_cpca_fit *fit);
+
+/* The same for a whole stream: `src` a fixed-order f32 stream of `rows`
+ * rows with scale 1 (a bake's or a merge's), *out its header with
+ * encoding cpca, data and model set; *storage the one block to free()
+ * once written; *rms_error (may be NULL) the fit's coefficient error. */
+vdsh_result vdsh_cpca_encode_stream(const vdsh_stream *src, uint32_t rows, const float *normals,
+                                    const vdsh_cpca_settings *settings, vdsh_stream *out,
+                                    void **storage, double *rms_error, vdsh_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VDSH_CPCA_H */

@@ -1,0 +1,344 @@
+/*
+ * test_cpca.c - the cpca encoding (formats/VDSH.md "cpca streams", issue
+ * 29): encoder, writer, reader and decoder.
+ *
+ * Usage: test_cpca [OUT_DIR]   (with OUT_DIR: also writes cpca.vdsh and
+ *                               cpca.f32, its C decode, for the Python test)
+ *
+ *   round trip     a synthetic order-7 stream (clusters by normal, low rank
+ *                  plus noise) encoded, written, read: the same model and
+ *                  records, decode = mean + sum of weight x basis in f32 to
+ *                  the bit, the error far below the spread and below one
+ *                  global vector's; the encoder's rms_error is the decode's
+ *   determinism    the same inputs give the same bytes
+ *   reading rules  every cpca rule broken in a valid file (CRCs fixed)
+ *                  is refused with VDSH_ERR_INVALID or _CHUNK naming it;
+ *                  every truncation is refused; the writer refuses a model
+ *                  without arrays
+ *   settings       vdsh_cpca_parse accepts K,B,BITS and refuses the rest
+ */
+#include "vdsh.h"
+#include "vdsh_cpca.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int failures, checks;
+#define CHECK(c, ...)                                                   \
+    do {                                                                \
+        checks++;                                                       \
+        if (!(c)) {                                                     \
+            failures++;                                                 \
+            fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);        \
+            fprintf(stderr, __VA_ARGS__);                               \
+            fputc('\n', stderr);                                        \
+        }                                                               \
+    } while (0)
+
+static uint64_t rng = 0x1234567887654321ull;
+static double rnd(void) /* uniform [-1, 1) */
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return (double)(rng >> 11) * 0x1.0p-52 - 1.0;
+}
+
+static uint32_t rd32(const uint8_t *p) { return p[0] | p[1] << 8 | p[2] << 16 | (uint32_t)p[3] << 24; }
+static void wr32(uint8_t *p, uint32_t v)
+{
+    for (int k = 0; k < 4; k++)
+        p[k] = (uint8_t)(v >> (8 * k));
+}
+
+/* Every chunk CRC and the header CRC recomputed (after a change). */
+static void fix_crcs(uint8_t *d, size_t size)
+{
+    size_t off = 32;
+    while (off + 16 <= size) {
+        uint64_t n = rd32(d + off + 8) | (uint64_t)rd32(d + off + 12) << 32;
+        uint64_t padded = (n + 15) & ~15ull;
+        if (off + 16 + padded > size)
+            break;
+        uint32_t crc = vdsh_crc32(0, d + off, 4);
+        crc = vdsh_crc32(crc, d + off + 8, 8);
+        wr32(d + off + 4, vdsh_crc32(crc, d + off + 16, (size_t)padded));
+        off += 16 + (size_t)padded;
+    }
+    wr32(d + 28, vdsh_crc32(0, d, 28));
+}
+
+/* Offset of the COEF payload in d. */
+static size_t coef_at(const uint8_t *d, size_t size)
+{
+    size_t off = 32;
+    while (off + 16 <= size) {
+        uint64_t n = rd32(d + off + 8) | (uint64_t)rd32(d + off + 12) << 32;
+        if (memcmp(d + off, "COEF", 4) == 0)
+            return off + 16;
+        off += 16 + (size_t)((n + 15) & ~15ull);
+    }
+    return 0;
+}
+
+enum { ORDER = 7, NC = ORDER * ORDER, ROWS = 600, K = 3, B = 13, BITS = 4 };
+
+static float src[ROWS * NC], normals[ROWS * 3], positions[ROWS * 3];
+
+/* Four normal directions; per direction a mean and 5 directions of
+ * variation (rank 5) plus 1% noise. */
+static void make_data(void)
+{
+    static const float dirs[4][3] = {{0, 1, 0}, {0, -1, 0}, {1, 0, 0}, {0, 0, 1}};
+    double mean[4][NC], var[4][5][NC];
+    for (int g = 0; g < 4; g++)
+        for (int i = 0; i < NC; i++) {
+            mean[g][i] = 2.0 * rnd() / (1 + i);
+            for (int r = 0; r < 5; r++)
+                var[g][r][i] = rnd() / (1 + 0.2 * i);
+        }
+    for (int v = 0; v < ROWS; v++) {
+        int g = v % 4;
+        double a[5];
+        for (int r = 0; r < 5; r++)
+            a[r] = rnd() / (1 + r);
+        for (int i = 0; i < NC; i++) {
+            double x = mean[g][i] + 0.01 * rnd();
+            for (int r = 0; r < 5; r++)
+                x += a[r] * var[g][r][i];
+            src[v * NC + i] = (float)x;
+        }
+        memcpy(normals + 3 * v, dirs[g], sizeof dirs[g]);
+        positions[3 * v] = (float)v;
+        positions[3 * v + 1] = positions[3 * v + 2] = 0.0f;
+    }
+}
+
+static double rms_vs(const vdsh_stream *s, const float *want)
+{
+    float c[VDSH_MAX_COEFFS];
+    double e2 = 0.0;
+    for (uint32_t v = 0; v < ROWS; v++) {
+        vdsh_stream_decode(s, v, c);
+        for (int i = 0; i < NC; i++)
+            e2 += ((double)c[i] - want[v * NC + i]) * ((double)c[i] - want[v * NC + i]);
+    }
+    return sqrt(e2 / ROWS);
+}
+
+static vdsh_file file_of(vdsh_stream *s)
+{
+    vdsh_file f;
+    memset(&f, 0, sizeof f);
+    f.header.vertex_count = ROWS;
+    f.header.rays = 64;
+    f.header.max_distance = 10.0f;
+    f.positions = positions;
+    f.normals = normals;
+    f.stream_count = 1;
+    f.streams = s;
+    return f;
+}
+
+/* Change the file image by `edit` (bytes from the COEF payload start), fix
+ * the CRCs, and expect refusal with `want` in the message. */
+static void expect_refused(const uint8_t *good, size_t size, size_t at, const void *bytes,
+                           size_t n, const char *want)
+{
+    uint8_t *d = malloc(size);
+    memcpy(d, good, size);
+    memcpy(d + coef_at(d, size) + at, bytes, n);
+    fix_crcs(d, size);
+    vdsh_file *f = NULL;
+    vdsh_error err = {{0}};
+    vdsh_result r = vdsh_read_memory(d, size, "bad.vdsh", &f, &err);
+    CHECK(r == VDSH_ERR_INVALID || r == VDSH_ERR_CHUNK, "%s: accepted (%d)", want, (int)r);
+    CHECK(strstr(err.msg, want) != NULL, "message '%s' lacks '%s'", err.msg, want);
+    vdsh_free(f);
+    free(d);
+}
+
+int main(int argc, char **argv)
+{
+    make_data();
+    vdsh_cpca_settings st = {K, B, BITS};
+    vdsh_cpca_fit fit, again, one;
+    vdsh_error err;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &fit, &err) == VDSH_OK, "encode: %s",
+          err.msg);
+    CHECK(fit.model.clusters == K && fit.model.basis == B && fit.model.bits == BITS &&
+              fit.model.record_words == vdsh_cpca_record_words(B, BITS) &&
+              fit.model.record_words == 2,
+          "model %u,%u,%u,%u", fit.model.clusters, fit.model.basis, fit.model.bits,
+          fit.model.record_words);
+    /* determinism: the same bytes again */
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &again, &err) == VDSH_OK, "encode 2");
+    size_t mb = (size_t)vdsh_cpca_model_bytes(ORDER, K, B) - 16;
+    CHECK(memcmp(fit.storage_, again.storage_, mb) == 0 &&
+              memcmp(fit.records, again.records, (size_t)ROWS * 4 * fit.model.record_words) == 0,
+          "two encodings of the same input differ");
+    vdsh_cpca_fit_free(&again);
+
+    vdsh_stream s = {.order = ORDER, .encoding = VDSH_ENCODING_CPCA, .method = VDSH_METHOD_LSQ,
+                     .quantity = VDSH_QUANTITY_DISTANCE, .scale = 1.0f, .data = fit.records,
+                     .cpca = fit.model};
+    /* the clusters follow the normals: each cluster's vertices share one */
+    for (uint32_t v = 0; v < ROWS; v++) {
+        uint32_t c = vdsh_cpca_cluster(&s, v);
+        CHECK(c < K, "vertex %u cluster %u", v, c);
+    }
+    /* decode to the bit: mean + sum_j w_j basis_j in f32, j in order */
+    float c[VDSH_MAX_COEFFS], w[VDSH_MAX_COEFFS];
+    int32_t q[VDSH_MAX_COEFFS];
+    int exact = 1;
+    for (uint32_t v = 0; v < ROWS; v += 7) {
+        vdsh_stream_decode(&s, v, c);
+        vdsh_cpca_weights(&s, v, q, w);
+        uint32_t cl = vdsh_cpca_cluster(&s, v);
+        for (int i = 0; i < NC; i++) {
+            float a = vdsh_f32_from_f16(fit.model.means[cl * NC + i]);
+            for (int j = 0; j < B; j++) {
+                float wj = (float)q[j] * (fit.model.scales[cl * B + j] / 7.0f);
+                exact &= wj == w[j];
+                a = a + wj * vdsh_f32_from_f16(fit.model.bases[(cl * B + j) * NC + i]);
+            }
+            exact &= memcmp(&a, &c[i], 4) == 0;
+        }
+        for (int j = 0; j < B; j++)
+            exact &= q[j] >= -7 && q[j] <= 7;
+    }
+    CHECK(exact, "decode is not mean + sum of weight x basis in f32");
+    /* error: far below the spread, the encoder's own figure, and below one
+     * global vector's (K = 1, B = 1) */
+    double mean[NC] = {0}, spread = 0.0;
+    for (int v = 0; v < ROWS; v++)
+        for (int i = 0; i < NC; i++)
+            mean[i] += src[v * NC + i] / (double)ROWS;
+    for (int v = 0; v < ROWS; v++)
+        for (int i = 0; i < NC; i++)
+            spread += (src[v * NC + i] - mean[i]) * (src[v * NC + i] - mean[i]) / ROWS;
+    spread = sqrt(spread);
+    double e = rms_vs(&s, src);
+    CHECK(fabs(e - fit.rms_error) <= 1e-9 * (1 + e), "rms_error %g, decode %g", fit.rms_error, e);
+    CHECK(e < 0.1 * spread, "error %g not below a tenth of the spread %g", e, spread);
+    vdsh_cpca_settings small = {1, 1, 4};
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &small, &one, &err) == VDSH_OK, "K=1");
+    CHECK(one.rms_error > 2.0 * e, "one vector %g, not worse than %g", one.rms_error, e);
+    printf("format_cpca: error %.4g, spread %.4g, one vector %.4g\n", e, spread, one.rms_error);
+    vdsh_cpca_fit_free(&one);
+
+    /* write, read: the same model and records */
+    vdsh_file f = file_of(&s);
+    void *mem = NULL;
+    size_t size = 0;
+    CHECK(vdsh_write_memory(&f, &mem, &size, &err) == VDSH_OK, "write: %s", err.msg);
+    vdsh_file *back = NULL;
+    CHECK(mem && vdsh_read_memory(mem, size, "cpca", &back, &err) == VDSH_OK, "read: %s",
+          err.msg);
+    if (back) {
+        const vdsh_stream *r = &back->streams[0];
+        CHECK(r->encoding == VDSH_ENCODING_CPCA && r->cpca.clusters == K &&
+                  r->cpca.basis == B && r->cpca.bits == BITS &&
+                  memcmp(r->cpca.scales, fit.model.scales, 4 * K * B) == 0 &&
+                  memcmp(r->cpca.means, fit.model.means, 2 * K * NC) == 0 &&
+                  memcmp(r->cpca.bases, fit.model.bases, 2 * K * B * NC) == 0 &&
+                  memcmp(r->data, fit.records, (size_t)ROWS * 8) == 0,
+              "read back differs");
+        CHECK(fabs(rms_vs(r, src) - e) == 0.0, "read-back decode differs");
+        CHECK(vdsh_stream_bytes_per_vertex(r) == 8, "bytes per vertex %zu",
+              vdsh_stream_bytes_per_vertex(r));
+        vdsh_stream_size z = vdsh_stream_size_of(r, ROWS);
+        CHECK(fabs(z.mean_bytes - (8.0 + (double)vdsh_cpca_model_bytes(ORDER, K, B) / ROWS)) <
+                  1e-9, "mean bytes %g", z.mean_bytes);
+        if (argc > 1) { /* for the Python reader's test */
+            char p[4096];
+            snprintf(p, sizeof p, "%s/cpca.vdsh", argv[1]);
+            FILE *o = fopen(p, "wb");
+            CHECK(o && fwrite(mem, 1, size, o) == size, "cannot write %s", p);
+            if (o)
+                fclose(o);
+            snprintf(p, sizeof p, "%s/cpca.f32", argv[1]);
+            o = fopen(p, "wb");
+            for (uint32_t v = 0; o && v < ROWS; v++) {
+                vdsh_stream_decode(r, v, c);
+                fwrite(c, 4, NC, o);
+            }
+            CHECK(o != NULL, "cannot write %s", p);
+            if (o)
+                fclose(o);
+        }
+    }
+    vdsh_free(back);
+
+    /* reading rules (offsets in the COEF payload: header 48, cpca header
+     * 48..63, scales from 64 (K*B*4 = 156, padded to 160), means from 224
+     * (294, padded to 304), bases from 528 (3822, padded to 3824), records
+     * from 4352) */
+    if (mem) {
+        const uint8_t *g = mem;
+        size_t rec = 64 + 160 + 304 + 3824;
+        uint8_t b4[4];
+        wr32(b4, K);
+        expect_refused(g, size, rec, b4, 1, "cluster 3");
+        wr32(b4, (rd32(g + coef_at(g, size) + rec) & ~0xf000u) | 0x8000u); /* weight 1: -8 */
+        expect_refused(g, size, rec, b4, 4, "weight 1 is -8");
+        wr32(b4, rd32(g + coef_at(g, size) + rec + 4) | 0x80000000u); /* past the last field */
+        expect_refused(g, size, rec + 4, b4, 4, "unused bits");
+        wr32(b4, 3);
+        expect_refused(g, size, 60, b4, 4, "record_words");
+        wr32(b4, 9);
+        expect_refused(g, size, 56, b4, 4, "bits 9");
+        wr32(b4, 0);
+        expect_refused(g, size, 48, b4, 4, "clusters 0");
+        wr32(b4, NC + 1);
+        expect_refused(g, size, 52, b4, 4, "basis 50");
+        wr32(b4, 1);
+        expect_refused(g, size, 36, b4, 4, "variable order");
+        const float neg = -1.0f;
+        expect_refused(g, size, 64, &neg, 4, "cpca scale 0");
+        const float big = 3e38f;
+        expect_refused(g, size, 64, &big, 4, "beyond 1e38");
+        const uint8_t nan16[2] = {0x00, 0x7e};
+        expect_refused(g, size, 224, nan16, 2, "mean of cluster 0");
+        expect_refused(g, size, 528 + 2, nan16, 2, "basis vector 0 of cluster 0");
+        const uint8_t one_byte = 1;
+        expect_refused(g, size, 64 + 156, &one_byte, 1, "padding after the cpca scales");
+        expect_refused(g, size, 224 + 294, &one_byte, 1, "padding after the cpca means");
+        expect_refused(g, size, 528 + 3822, &one_byte, 1, "padding after the cpca bases");
+        /* every truncation refused, none read past its buffer */
+        int refused = 0;
+        for (size_t n = 0; n < size; n++) {
+            uint8_t *d = malloc(n + 1);
+            memcpy(d, g, n);
+            vdsh_file *t = NULL;
+            refused += vdsh_read_memory(d, n, "cut", &t, NULL) != VDSH_OK;
+            vdsh_free(t);
+            free(d);
+        }
+        CHECK(refused == (int)size, "%d of %zu truncations refused", refused, size);
+        free(mem);
+    }
+    /* the writer refuses a model without its arrays */
+    vdsh_stream bad = s;
+    bad.cpca.bases = NULL;
+    vdsh_file fb = file_of(&bad);
+    CHECK(vdsh_write_memory(&fb, &mem, &size, &err) == VDSH_ERR_ARGUMENT &&
+              strstr(err.msg, "cpca"), "writer accepted a model without bases");
+    vdsh_cpca_fit_free(&fit);
+
+    /* settings */
+    vdsh_cpca_settings p;
+    CHECK(vdsh_cpca_parse("8,52,4", &p, NULL) == VDSH_OK && p.clusters == 8 && p.basis == 52 &&
+              p.bits == 4, "8,52,4");
+    static const char *const refuse[] = {"", "8,52", "8,52,4,1", "0,52,4", "257,52,4",
+                                         "8,0,4", "8,52,1", "8,52,9", "8,,4", "a,b,c",
+                                         "8,52,4x", "-1,52,4"};
+    for (size_t k = 0; k < sizeof refuse / sizeof *refuse; k++)
+        CHECK(vdsh_cpca_parse(refuse[k], &p, &err) == VDSH_ERR_ARGUMENT, "'%s' accepted",
+              refuse[k]);
+
+    printf("format_cpca: %d checks, %d failures\n", checks, failures);
+    return failures ? 1 : 0;
+}
