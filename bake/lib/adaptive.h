@@ -52,6 +52,8 @@ extern "C" {
 
 #define VB_ADAPTIVE_LIGHTS 32
 #define VB_ADAPTIVE_ROUNDS 8
+#define VB_ADAPTIVE_NOISE_SAMPLE 1024
+#define VB_ADAPTIVE_NOISE_QUANTILE 0.9
 
 typedef struct vb_adaptive_desc {
     float tolerance;        /* split above this expected shadow error (>= 0;
@@ -82,6 +84,10 @@ typedef struct vb_adaptive_stats {
                                  * 2 min_edge: the cap on every vertex baked
                                  * (0: over vb_mesh_refine's limit, no cap) */
     int uniform_reached;       /* that cap stopped it */
+    uint32_t noise_sample;     /* start receivers baked twice for the noise floor */
+    double noise_floor;        /* their two bakes' spread (quantile) */
+    double threshold;          /* what an edge's error had to pass: tolerance +
+                                * noise floor */
 } vb_adaptive_stats;
 
 /* Bake `start` with `bake` (its receivers and range are ignored), then
