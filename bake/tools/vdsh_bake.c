@@ -496,6 +496,9 @@ static int write_report(const char *path, const options *o, const vb_job *job,
         vt_json_u64(&j, ad, "edges_pending", job->adaptive.pending);
         vt_json_u64(&j, ad, "uniform_receivers", job->adaptive.uniform_receivers);
         vt_json_bool(&j, ad, "uniform_reached", job->adaptive.uniform_reached);
+        vt_json_u64(&j, ad, "noise_sample", job->adaptive.noise_sample);
+        vt_json_f64(&j, ad, "noise_floor", job->adaptive.noise_floor);
+        vt_json_f64(&j, ad, "threshold", job->adaptive.threshold);
     } else {
         vt_json_null(&j, root, "adaptive");
     }
