@@ -2,7 +2,6 @@
 #include "adaptive.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -282,14 +281,6 @@ static vb_result noise_floor(const vb_bake_desc *bd0, const vb_mesh *M, const vb
     if (lit)
         *floor_out = spread[(size_t)floor(VB_ADAPTIVE_NOISE_QUANTILE * (lit - 1) + 0.5)];
     *sampled = n;
-    if (getenv("VDSH_ADAPTIVE_DEBUG") && lit) {
-        uint32_t over = 0;
-        for (uint32_t k = 0; k < lit; k++)
-            over += spread[k] > 0.02;
-        fprintf(stderr, "noise: %u sampled, %u lit; q50 %.4f q75 %.4f q90 %.4f q95 %.4f mean-ish; >0.02: %.0f%%\n",
-                n, lit, spread[lit / 2], spread[lit * 3 / 4], spread[lit * 9 / 10],
-                spread[lit * 19 / 20], 100.0 * over / lit);
-    }
 done:
     vb_mesh_free(&P);
     vb_bake_output_free(&R);
@@ -364,7 +355,7 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
     /* The split threshold: the tolerance above the fits' noise floor
      * (tolerance 0 asks for every split: no floor). */
     double threshold = ad->tolerance;
-    if (isfinite(ad->tolerance) && ad->tolerance > 0.0f && !getenv("VDSH_ADAPTIVE_NOFLOOR")) {
+    if (isfinite(ad->tolerance) && ad->tolerance > 0.0f) {
         if ((r = noise_floor(&bd, &M, &B, order, (const float(*)[3])lights, st.lights,
                              &st.noise_floor, &st.noise_sample, &B, err)) != VB_OK)
             goto done;
@@ -472,17 +463,6 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
             if (error[i] > threshold)
                 rank[over++] = (ranked){error[i], (uint32_t)i};
         qsort(rank, over, sizeof *rank, cmp_ranked);
-        if (getenv("VDSH_ADAPTIVE_DEBUG")) {
-            double *e2 = malloc(cand_n * sizeof *e2 + 1);
-            if (e2) {
-                memcpy(e2, error, cand_n * sizeof *e2);
-                qsort(e2, cand_n, sizeof *e2, cmp_double);
-                fprintf(stderr, "round %u: %zu judged, %u over %.4f; error q50 %.4f q75 %.4f q90 %.4f\n",
-                        st.rounds, cand_n, over, threshold, e2[cand_n / 2], e2[cand_n * 3 / 4],
-                        e2[cand_n * 9 / 10]);
-                free(e2);
-            }
-        }
         uint32_t take = over;
         if (ad->max_receivers && take > ad->max_receivers - V) {
             take = ad->max_receivers - V;
