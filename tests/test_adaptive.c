@@ -3,13 +3,15 @@
  * its hard cases. A box on the floor of a closed room (a contact, creases,
  * a shadow to find), receivers from a coarse uniform refinement.
  *   - no ray traced twice: every receiver and every baked midpoint traced
- *     its rays once (rays_traced = (start + candidates) x rays);
+ *     its rays once, the noise floor's sample twice (rays_traced =
+ *     (start + noise sample + candidates) x rays);
  *   - the same output for 1 and 2 threads, byte for byte;
  *   - tolerance +inf splits nothing; tolerance 0 refines down to the
  *     minimum edge and no further (creases and contacts do not run away);
  *   - the budget holds, the largest errors split first;
  *   - it refines where shadows are: the split vertices lie near the box;
  *   - non-manifold input (three triangles on one edge) loses nothing;
+ *   - the fits' noise is not split on (the noise floor, issue 26);
  *   - the new vertices are where the mesh says: midpoints of edges of at
  *     least 2 min_edge.
  * Runs under every Embree ISA (tests/with_each_isa.sh).
