@@ -164,8 +164,8 @@ static int append_rows(float **dst, uint32_t have, const float *src, uint32_t fi
  * receivers (every (V / n)-th, n = VB_ADAPTIVE_NOISE_SAMPLE at most) is
  * baked a second time under other vertex numbers (a copy of the mesh
  * with the sample moved to its end, in reverse order: other rays and
- * lights, the same seed, origins and orientations), and each receiver's two bakes are
- * compared with the split test's own measure. The floor is a quantile of
+ * lights, the same seed, origins and orientations), and each receiver's
+ * two bakes are compared with the split test's own measure. The floor is a quantile of
  * that spread over the receivers that see a light. */
 typedef struct noise_job {
     const vb_mesh *m;
@@ -188,8 +188,10 @@ static void noise_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker
     for (uint32_t k = begin; k < end; k++) {
         const uint32_t v = J->sample[k];
         const float *p = J->m->positions + 3 * (size_t)v;
-        const float *n = J->b->normals ? J->b->normals + 3 * (size_t)v : J->m->normals + 3 * (size_t)v;
-        const float *c1 = J->b->coeffs[J->order] + nc * v, *c2 = J->b2->coeffs[J->order] + nc * (J->n - 1 - k); /* reversed */
+        const float *n = J->b->normals ? J->b->normals + 3 * (size_t)v
+                                       : J->m->normals + 3 * (size_t)v;
+        const float *c1 = J->b->coeffs[J->order] + nc * v;
+        const float *c2 = J->b2->coeffs[J->order] + nc * (J->n - 1 - k); /* reversed */
         double sum = 0.0;
         uint32_t seen = 0;
         for (uint32_t l = 0; l < J->light_count; l++) {
