@@ -150,7 +150,8 @@ static void test_promises(void)
           rec.vertex_count);
     /* No ray traced twice: every receiver of the start mesh and every
      * midpoint traced its grid once (no undefined normals here). */
-    CHECK(out.rays_traced == (uint64_t)(st.start_receivers + st.noise_sample + st.candidates) * out.rays,
+    CHECK(out.rays_traced ==
+              (uint64_t)(st.start_receivers + st.noise_sample + st.candidates) * out.rays,
           "rays traced %llu, expected (%u + %u + %u) x %u", (unsigned long long)out.rays_traced,
           st.start_receivers, st.noise_sample, st.candidates, out.rays);
     /* The first vertices are the start mesh's, unchanged. */
