@@ -3,13 +3,15 @@
  * its hard cases. A box on the floor of a closed room (a contact, creases,
  * a shadow to find), receivers from a coarse uniform refinement.
  *   - no ray traced twice: every receiver and every baked midpoint traced
- *     its rays once (rays_traced = (start + candidates) x rays);
+ *     its rays once, the noise floor's sample twice (rays_traced =
+ *     (start + noise sample + candidates) x rays);
  *   - the same output for 1 and 2 threads, byte for byte;
  *   - tolerance +inf splits nothing; tolerance 0 refines down to the
  *     minimum edge and no further (creases and contacts do not run away);
  *   - the budget holds, the largest errors split first;
  *   - it refines where shadows are: the split vertices lie near the box;
  *   - non-manifold input (three triangles on one edge) loses nothing;
+ *   - the fits' noise is not split on (the noise floor, issue 26);
  *   - the new vertices are where the mesh says: midpoints of edges of at
  *     least 2 min_edge.
  * Runs under every Embree ISA (tests/with_each_isa.sh).
@@ -148,9 +150,10 @@ static void test_promises(void)
           rec.vertex_count);
     /* No ray traced twice: every receiver of the start mesh and every
      * midpoint traced its grid once (no undefined normals here). */
-    CHECK(out.rays_traced == (uint64_t)(st.start_receivers + st.candidates) * out.rays,
-          "rays traced %llu, expected (%u + %u) x %u", (unsigned long long)out.rays_traced,
-          st.start_receivers, st.candidates, out.rays);
+    CHECK(out.rays_traced ==
+              (uint64_t)(st.start_receivers + st.noise_sample + st.candidates) * out.rays,
+          "rays traced %llu, expected (%u + %u + %u) x %u", (unsigned long long)out.rays_traced,
+          st.start_receivers, st.noise_sample, st.candidates, out.rays);
     /* The first vertices are the start mesh's, unchanged. */
     CHECK(memcmp(rec.positions, f.start.positions, f.start.vertex_count * 12) == 0,
           "the start vertices moved");
@@ -352,8 +355,63 @@ static void test_uniform_cap(void)
     fixture_free(&f);
 }
 
+/* The fits' noise is not error (issue 26): the fixture's room and box,
+ * baked from a 1 m start down to a 0.1 m min edge at tolerance 0.02. Each
+ * receiver's fit has its own rays and training lights, so two bakes of
+ * one point differ (the noise floor, measured here: above 0); the split
+ * test's error, three such fits compared, is mostly that noise on open
+ * walls and floor. Before the noise floor it split on it every round:
+ * 2,307 receivers from 548 (3,139 midpoints baked). Now what it splits
+ * must be above tolerance + floor: at most 1.5x the start's receivers and
+ * under 2x as many midpoints baked as the start has. The contact's front still
+ * runs to the round cap (real error), so the cap is not asserted. */
+static void test_noise_floor(void)
+{
+    vb_error err;
+    vb_mesh occ = {0}, start = {0}, rec = {0}, box = {0};
+    test_make_room(&occ, 3.0f, 2.5f, 3.0f);
+    test_make_box(&box, 0.5f, 1.0f, 0.5f);
+    vb_mesh_compute_normals(&box);
+    CHECK(vb_mesh_append(&occ, &box, &err) == VB_OK, "append: %s", err.msg);
+    test_mesh_free(&box);
+    CHECK(vb_mesh_refine(&occ, 1.0f, &start, &err) == VB_OK, "refine: %s", err.msg);
+    vb_scene *scene = NULL;
+    vb_scene_desc sd = {.robust = 1};
+    CHECK(vb_scene_create(&occ, &sd, &scene, &err) == VB_OK, "scene: %s", err.msg);
+    vb_bake_desc d = {.scene = scene, .rays = RAYS, .seed = 5, .threads = 2,
+                      .order_mask = (1u << 3) | (1u << 5)};
+    vb_adaptive_desc ad = {.tolerance = 0.02f, .min_edge = 0.1f};
+    vb_bake_output out = {0};
+    vb_adaptive_stats st = {0};
+    if (vb_bake_adaptive(&d, &start, &ad, &rec, &out, &st, &err) == VB_OK) {
+        printf("noise floor: %u receivers from %u in %u rounds (%u midpoints baked, cap %u); "
+               "noise floor %.4f from %u receivers\n",
+               rec.vertex_count, st.start_receivers, st.rounds, st.candidates, st.max_rounds,
+               st.noise_floor, st.noise_sample);
+        CHECK((uint64_t)rec.vertex_count * 2 <= (uint64_t)st.start_receivers * 3,
+              "noise floor: %u receivers from %u", rec.vertex_count, st.start_receivers);
+        CHECK(st.candidates < 2 * st.start_receivers, "noise floor: %u midpoints baked from %u",
+              st.candidates, st.start_receivers);
+        CHECK(st.threshold >= 0.02 + st.noise_floor - 1e-9, "noise floor: threshold %g",
+              st.threshold);
+        CHECK(st.noise_floor > 0.0 && st.noise_sample == st.start_receivers,
+              "noise floor: floor %g from %u receivers", st.noise_floor, st.noise_sample);
+        CHECK(out.rays_traced ==
+                  (uint64_t)(st.start_receivers + st.noise_sample + st.candidates) * out.rays,
+              "noise floor: rays traced %llu", (unsigned long long)out.rays_traced);
+    } else {
+        CHECK(0, "noise floor: %s", err.msg);
+    }
+    vb_mesh_free(&rec);
+    vb_mesh_free(&start);
+    vb_bake_output_free(&out);
+    vb_scene_destroy(scene);
+    test_mesh_free(&occ);
+}
+
 int main(void)
 {
+    test_noise_floor();
     test_uniform_cap();
     test_promises();
     test_limits();

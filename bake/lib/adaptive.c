@@ -157,6 +157,142 @@ static int append_rows(float **dst, uint32_t have, const float *src, uint32_t fi
     return 1;
 }
 
+/* The noise floor (issue 26): the split test compares three fits of
+ * traced rays (the midpoint's and its ends'), each with its own rays and
+ * training lights, so part of what it measures is the fits' noise, not
+ * interpolation error. Measured per bake: a sample of the start mesh's
+ * receivers (every (V / n)-th, n = VB_ADAPTIVE_NOISE_SAMPLE at most) is
+ * baked a second time under other vertex numbers (a copy of the mesh
+ * with the sample moved to its end, in reverse order: other rays and
+ * lights, the same seed, origins and orientations), and each receiver's
+ * two bakes are compared with the split test's own measure. The floor is a quantile of
+ * that spread over the receivers that see a light. */
+typedef struct noise_job {
+    const vb_mesh *m;
+    const uint32_t *sample;
+    uint32_t n;
+    const vb_bake_output *b;  /* the start's bake (every vertex) */
+    const vb_bake_output *b2; /* the sample's second bake: row n-1-k is sample k's */
+    int order;
+    uint32_t quantity;
+    const float (*lights)[3];
+    uint32_t light_count;
+    double *spread;           /* per sample; -1: no light above its horizon */
+} noise_job;
+
+static void noise_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
+{
+    noise_job *J = ctx;
+    (void)worker;
+    const size_t nc = (size_t)J->order * J->order;
+    for (uint32_t k = begin; k < end; k++) {
+        const uint32_t v = J->sample[k];
+        const float *p = J->m->positions + 3 * (size_t)v;
+        const float *n = J->b->normals ? J->b->normals + 3 * (size_t)v
+                                       : J->m->normals + 3 * (size_t)v;
+        const float *c1 = J->b->coeffs[J->order] + nc * v;
+        const float *c2 = J->b2->coeffs[J->order] + nc * (J->n - 1 - k); /* reversed */
+        double sum = 0.0;
+        uint32_t seen = 0;
+        for (uint32_t l = 0; l < J->light_count; l++) {
+            const float *L = J->lights[l];
+            float dx = L[0] - p[0], dy = L[1] - p[1], dz = L[2] - p[2];
+            if (dx * n[0] + dy * n[1] + dz * n[2] <= 0.0f)
+                continue;
+            float s1 = vdsh_shadow((uint32_t)J->order, J->quantity, J->b->max_distance, c1, p, L,
+                                   VDSH_COMPARE_SMOOTH);
+            float s2 = vdsh_shadow((uint32_t)J->order, J->quantity, J->b2->max_distance, c2, p, L,
+                                   VDSH_COMPARE_SMOOTH);
+            sum += fabs((double)s1 - s2);
+            seen++;
+        }
+        J->spread[k] = seen ? sum / seen : -1.0;
+    }
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* *floor_out: the quantile VB_ADAPTIVE_NOISE_QUANTILE of the spread (0
+ * when no sampled receiver sees a light); *sampled, *rays: what it cost. */
+static vb_result noise_floor(const vb_bake_desc *bd0, const vb_mesh *M, const vb_bake_output *B,
+                             int order, const float (*lights)[3], uint32_t light_count,
+                             double *floor_out, uint32_t *sampled, vb_bake_output *acc,
+                             vb_error *err)
+{
+    *floor_out = 0.0;
+    *sampled = 0;
+    const uint32_t V = M->vertex_count;
+    const uint32_t n = V < VB_ADAPTIVE_NOISE_SAMPLE ? V : VB_ADAPTIVE_NOISE_SAMPLE;
+    if (n == 0)
+        return VB_OK;
+    vb_result r = VB_OK;
+    vb_mesh P = {0};
+    vb_bake_output R = {0};
+    uint32_t *sample = malloc((size_t)n * sizeof *sample + 1);
+    uint32_t *where = malloc((size_t)V * sizeof *where + 1); /* old vertex -> P's */
+    double *spread = malloc((size_t)n * sizeof *spread + 1);
+    uint8_t *in = calloc((size_t)V + 1, 1);
+    if (!sample || !where || !spread || !in ||
+        (r = vb_mesh_refine(M, 0.0f, &P, err)) != VB_OK) { /* a copy */
+        if (r == VB_OK)
+            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "adaptive: out of memory for the noise floor");
+        goto done;
+    }
+    for (uint32_t k = 0; k < n; k++) {
+        sample[k] = (uint32_t)(((uint64_t)2 * k + 1) * V / (2 * (uint64_t)n));
+        in[sample[k]] = 1;
+    }
+    /* P: the other vertices first, in order, then the sample. */
+    uint32_t j = 0;
+    for (uint32_t v = 0; v < V; v++)
+        if (!in[v])
+            where[v] = j++;
+    for (uint32_t k = 0; k < n; k++)
+        where[sample[k]] = V - 1 - k; /* reversed: moved even when n = V */
+    for (uint32_t v = 0; v < V; v++) {
+        memcpy(P.positions + 3 * (size_t)where[v], M->positions + 3 * (size_t)v, 12);
+        memcpy(P.normals + 3 * (size_t)where[v], M->normals + 3 * (size_t)v, 12);
+    }
+    for (size_t i = 0; i < 3 * (size_t)M->triangle_count; i++)
+        P.indices[i] = where[M->indices[i]];
+    vb_bake_desc bd = *bd0;
+    bd.receivers = &P;
+    bd.range_begin = V - n;
+    bd.range_end = V;
+    if ((r = vb_bake_run(&bd, &R, err)) != VB_OK)
+        goto done;
+    acc->rays_traced += R.rays_traced;
+    acc->rays_missed += R.rays_missed;
+    acc->seconds += R.seconds;
+    noise_job nj = {.m = M, .sample = sample, .n = n, .b = B, .b2 = &R, .order = order,
+                    .quantity = B->quantity[order], .lights = lights,
+                    .light_count = light_count, .spread = spread};
+    if (vb_parallel_for(B->threads, n, 64, noise_block, &nj, NULL, NULL) == 0) {
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
+        goto done;
+    }
+    uint32_t lit = 0;
+    for (uint32_t k = 0; k < n; k++)
+        if (spread[k] >= 0.0)
+            spread[lit++] = spread[k];
+    qsort(spread, lit, sizeof *spread, cmp_double);
+    if (lit)
+        *floor_out = spread[(size_t)floor(VB_ADAPTIVE_NOISE_QUANTILE * (lit - 1) + 0.5)];
+    *sampled = n;
+done:
+    vb_mesh_free(&P);
+    vb_bake_output_free(&R);
+    free(sample);
+    free(where);
+    free(spread);
+    free(in);
+    return r;
+}
+
 vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
                            const vb_adaptive_desc *ad, vb_mesh *receivers,
                            vb_bake_output *out, vb_adaptive_stats *stats, vb_error *err)
@@ -218,6 +354,16 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
             st.uniform_receivers = U.vertex_count;
         vb_mesh_free(&U);
     }
+    /* The split threshold: the tolerance above the fits' noise floor
+     * (tolerance 0 asks for every split: no floor). */
+    double threshold = ad->tolerance;
+    if (isfinite(ad->tolerance) && ad->tolerance > 0.0f) {
+        if ((r = noise_floor(&bd, &M, &B, order, (const float(*)[3])lights, st.lights,
+                             &st.noise_floor, &st.noise_sample, &B, err)) != VB_OK)
+            goto done;
+        threshold += st.noise_floor;
+    }
+    st.threshold = threshold;
     const uint32_t max_rounds = st.max_rounds =
         ad->max_rounds ? ad->max_rounds : VB_ADAPTIVE_ROUNDS;
     while (isfinite(ad->tolerance) && st.rounds < max_rounds) {
@@ -317,7 +463,7 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
          * the others are judged for good. */
         uint32_t over = 0;
         for (size_t i = 0; i < cand_n; i++)
-            if (error[i] > ad->tolerance)
+            if (error[i] > threshold)
                 rank[over++] = (ranked){error[i], (uint32_t)i};
         qsort(rank, over, sizeof *rank, cmp_ranked);
         uint32_t take = over;
@@ -344,7 +490,7 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
             if (chosen[i]) { /* in key order: the new vertices' order */
                 pairs[2 * s] = pairs[2 * i], pairs[2 * s + 1] = pairs[2 * i + 1];
                 rows[s++] = V + (uint32_t)i;
-            } else if (error[i] <= ad->tolerance) {
+            } else if (error[i] <= threshold) {
                 judged[judged_n++] = cand[i];
             }
         }

@@ -9,7 +9,14 @@
  * orientation see the triangles it will have); an edge is split for real
  * when the stream interpolated between its ends, on the runtime's own path
  * (vdsh_runtime_interp), differs from the midpoint's own bake by more than
- * `tolerance` in expected shadow error: the mean over the lights above
+ * `tolerance` plus the bake's noise floor in expected shadow error (the
+ * noise floor: up to VB_ADAPTIVE_NOISE_SAMPLE start receivers, evenly
+ * spread over the vertex numbers, baked a second time under other vertex
+ * numbers, so other rays and training lights; the
+ * VB_ADAPTIVE_NOISE_QUANTILE quantile of their two bakes' difference by
+ * the same measure; none at tolerance 0, which asks for every split).
+ * Without it the test split on the fits' noise, which is about 0.02 on
+ * the rooms (docs/ACCURACY.md). The measure: the mean over the lights above
  * the midpoint's horizon of |s_interp - s_mid| (vdsh_shadow.h, smooth
  * comparison), the lights `lights` points in the scene's free space
  * (vdsh_light.h, the frames' primary light model). A split vertex keeps
@@ -52,6 +59,8 @@ extern "C" {
 
 #define VB_ADAPTIVE_LIGHTS 32
 #define VB_ADAPTIVE_ROUNDS 8
+#define VB_ADAPTIVE_NOISE_SAMPLE 1024
+#define VB_ADAPTIVE_NOISE_QUANTILE 0.9
 
 typedef struct vb_adaptive_desc {
     float tolerance;        /* split above this expected shadow error (>= 0;
@@ -82,13 +91,17 @@ typedef struct vb_adaptive_stats {
                                  * 2 min_edge: the cap on every vertex baked
                                  * (0: over vb_mesh_refine's limit, no cap) */
     int uniform_reached;       /* that cap stopped it */
+    uint32_t noise_sample;     /* start receivers baked twice for the noise floor */
+    double noise_floor;        /* their two bakes' spread (quantile) */
+    double threshold;          /* what an edge's error had to pass: tolerance +
+                                * noise floor */
 } vb_adaptive_stats;
 
 /* Bake `start` with `bake` (its receivers and range are ignored), then
  * refine as above: *receivers gets the final mesh (normals as baked:
  * oriented) and *out its bake, as vb_bake_run would give for it (rays,
- * rays_traced and the times sum every round, midpoints not kept
- * included). stats may be NULL. */
+ * rays_traced and the times sum every round, midpoints not kept and the
+ * noise floor's second bakes included). stats may be NULL. */
 vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
                            const vb_adaptive_desc *ad, vb_mesh *receivers,
                            vb_bake_output *out, vb_adaptive_stats *stats, vb_error *err);

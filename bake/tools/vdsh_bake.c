@@ -232,11 +232,11 @@ static void usage(FILE *f)
 "      --adaptive TOL      adaptive receivers: from --max-edge, split an edge\n"
 "                          where the stream interpolated between its ends\n"
 "                          differs from its midpoint's bake by more than TOL\n"
+"                          plus the bake's noise floor (two bakes of a\n"
+"                          sample of its start receivers; none at TOL 0)\n"
 "                          in expected shadow error (lights in the scene's\n"
-"                          free space); a split vertex keeps that bake.\n"
-"                          0.02: within 1%% of the error of the uniform\n"
-"                          refinement to 2 x --min-edge on the validation\n"
-"                          rooms (docs/ACCURACY.md)\n"
+"                          free space); a split vertex keeps that bake\n"
+"                          (docs/ACCURACY.md, \"Adaptive receivers\")\n"
 "      --min-edge L        with --adaptive: no edge is split below 2 L\n"
 "                          (default: --max-edge / 8)\n"
 "      --max-receivers N   with --adaptive: stop at N receivers, splitting\n"
@@ -505,6 +505,9 @@ static int write_report(const char *path, const options *o, const vb_job *job,
         vt_json_u64(&j, ad, "edges_pending", job->adaptive.pending);
         vt_json_u64(&j, ad, "uniform_receivers", job->adaptive.uniform_receivers);
         vt_json_bool(&j, ad, "uniform_reached", job->adaptive.uniform_reached);
+        vt_json_u64(&j, ad, "noise_sample", job->adaptive.noise_sample);
+        vt_json_f64(&j, ad, "noise_floor", job->adaptive.noise_floor);
+        vt_json_f64(&j, ad, "threshold", job->adaptive.threshold);
     } else {
         vt_json_null(&j, root, "adaptive");
     }
@@ -1099,9 +1102,11 @@ int main(int argc, char **argv)
     }
     if (log && o.adaptive)
         fprintf(log, "vdsh-bake: adaptive receivers: %u from %u in %u rounds (%u midpoints "
-                     "baked, tolerance %g, min edge %g%s)\n",
+                     "baked, tolerance %g + noise floor %.3g from %u receivers baked twice, min "
+                "edge %g%s)\n",
                 job.receivers.vertex_count, job.adaptive.start_receivers, job.adaptive.rounds,
-                job.adaptive.candidates, (double)o.adaptive_tol, (double)o.min_edge,
+                job.adaptive.candidates, (double)o.adaptive_tol, job.adaptive.noise_floor,
+                job.adaptive.noise_sample, (double)o.min_edge,
                 job.adaptive.budget_reached   ? ", the budget stopped it"
                 : job.adaptive.uniform_reached ? ", stopped at the uniform bake's count at 2 x "
                                                  "the min edge"
