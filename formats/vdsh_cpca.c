@@ -374,6 +374,24 @@ static void kmeans(const float *src, const float *normals, uint32_t rows, uint32
 
 /* ---- the fit ---- */
 
+/* Candidate scales of a basis vector: its largest |weight| times 1,
+ * 0.95, ..., 0.35, rounded to f32 as stored. */
+enum { SCALE_CANDIDATES = 14 };
+static double candidate_scale(double wmax, uint32_t t)
+{
+    return (double)(float)(wmax * (1.0 - 0.05 * t));
+}
+
+/* The stored level of weight w with scale s (> 0): round(L w / s), ties
+ * away from 0, clamped to +-L. */
+static double quantise(double w, double s, int levels)
+{
+    if (!(s > 0.0))
+        return 0.0;
+    double q = round((double)levels * w / s);
+    return q > levels ? levels : q < -levels ? -levels : q;
+}
+
 vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t rows,
                              uint32_t order, const vdsh_cpca_settings *settings,
                              vdsh_cpca_fit *out, vdsh_error *err)
@@ -409,11 +427,12 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
     double *ev = malloc(sizeof(double) * n * n), *proj = malloc(sizeof(double) * n * b);
     double *tmp = malloc(sizeof(double) * n * n), *mu = malloc(sizeof(double) * n);
     double *wmax = malloc(sizeof(double) * b);
+    double *cerr = malloc(sizeof(double) * b * SCALE_CANDIDATES);
     uint32_t *idx = malloc(sizeof(uint32_t) * n);
     metric_dirs md = {0};
     vdsh_result res = VDSH_OK;
     if (!block || !labels || !dist || !cent || !g || !l || !sc || !sy || !ev || !proj || !tmp ||
-        !mu || !wmax || !idx || !metric_init(&md, order)) {
+        !mu || !wmax || !cerr || !idx || !metric_init(&md, order)) {
         res = failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory (%zu bytes)", total);
         goto done;
     }
@@ -548,37 +567,57 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
                 bases[((size_t)c * b + j) * n + a] = h;
             }
         }
-        /* weights: the scale per vector is the largest |weight| (f32) */
+        /* weights, in three passes: the largest |weight| per vector; the
+         * squared quantisation error of each candidate scale (the largest
+         * times 1, 0.95, ..., 0.35: clipping the few largest weights buys
+         * a finer step for all the others); the levels with the best. The
+         * weights are coordinates of an orthonormal basis of the metric,
+         * so this error is the metric's. */
         for (uint32_t j = 0; j < b; j++)
             wmax[j] = 0.0;
-        for (int pass = 0; pass < 2; pass++) {
+        memset(cerr, 0, sizeof(double) * b * SCALE_CANDIDATES);
+        for (int pass = 0; pass < 3; pass++) {
             for (uint32_t v = 0; v < rows; v++) {
                 if (labels[v] != c)
                     continue;
                 const float *x = src + (size_t)v * n;
                 uint32_t *rec = records + (size_t)v * words;
-                if (pass)
+                if (pass == 2)
                     rec[0] = c;
                 for (uint32_t j = 0; j < b; j++) {
                     const double *p = proj + (size_t)j * n;
                     double w = 0.0;
                     for (uint32_t a = 0; a < n; a++)
                         w += (x[a] - mu[a]) * p[a];
-                    if (!pass) {
+                    if (pass == 0) {
                         wmax[j] = fabs(w) > wmax[j] ? fabs(w) : wmax[j];
                         continue;
                     }
-                    double s = scales[(size_t)c * b + j];
-                    double q = s > 0.0 ? round((double)levels * w / s) : 0.0;
-                    q = q > levels ? levels : q < -levels ? -levels : q;
+                    if (pass == 1) {
+                        for (uint32_t t = 0; t < SCALE_CANDIDATES; t++) {
+                            double s = candidate_scale(wmax[j], t), e = w;
+                            if (s > 0.0)
+                                e = w - quantise(w, s, levels) * (double)vdsh_cpca_step(
+                                                                     (float)s, bits);
+                            cerr[(size_t)j * SCALE_CANDIDATES + t] += e * e;
+                        }
+                        continue;
+                    }
+                    double q = quantise(w, scales[(size_t)c * b + j], levels);
                     uint32_t word, shift;
                     vdsh_cpca_field(bits, j, &word, &shift);
                     rec[word] |= ((uint32_t)(int32_t)q & ((1u << bits) - 1u)) << shift;
                 }
             }
-            if (!pass)
-                for (uint32_t j = 0; j < b; j++)
-                    scales[(size_t)c * b + j] = (float)wmax[j];
+            if (pass == 1)
+                for (uint32_t j = 0; j < b; j++) {
+                    uint32_t best = 0;
+                    for (uint32_t t = 1; t < SCALE_CANDIDATES; t++)
+                        if (cerr[(size_t)j * SCALE_CANDIDATES + t] <
+                            cerr[(size_t)j * SCALE_CANDIDATES + best])
+                            best = t;
+                    scales[(size_t)c * b + j] = (float)candidate_scale(wmax[j], best);
+                }
         }
     }
     out->model = (vdsh_cpca){.clusters = k, .basis = b, .bits = bits, .record_words = words,
@@ -615,6 +654,7 @@ done:
     free(tmp);
     free(mu);
     free(wmax);
+    free(cerr);
     free(idx);
     metric_free(&md);
     return res;

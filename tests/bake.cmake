@@ -45,6 +45,13 @@ add_test(NAME bake_shard
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
                  $<TARGET_FILE:vdsh-eval>)
+# vdsh-bake --encoding cpca (issue 29): 1 and 2 threads, 1, 3 and 7 shards
+# merged give the same bytes; decode error against the f32 bake bounded;
+# bad --cpca settings and mixed parts refused.
+add_test(NAME bake_cpca
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_cpca_bake.sh
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
+                 ${PROJECT_SOURCE_DIR})
 # The GNU parallel recipe (scripts/bake-parallel), with Debian's parallel:
 # byte for byte, a name with quotes, a rerun bakes the missing parts only.
 add_test(NAME bake_shard_parallel

@@ -182,6 +182,7 @@ for name, args in (("default", []), ("paper-f32", ["--method", "paper", "--encod
                    ("s8s6-small", ["--encoding", "s8s6", "--orders", "3,5"]),
                    ("adaptive", ["--adaptive", "0.05"]),
                    ("order12", ["--orders", "7,12", "--encoding", "f16"]),
+                   ("cpca-small", ["--orders", "7", "--encoding", "cpca", "--cpca", "3,9,4"]),
                    ("adaptive-order", ["--adaptive-order", "0.02", "--max-order", "9",
                                        "--orders", "3"]),
                    ("adaptive-order-f16", ["--adaptive-order", "0.02", "--encoding", "f16"]),
@@ -233,7 +234,7 @@ print("corpus: %d files, %d accepted by both" % (len(corpus), accepted))
 
 # Corruption sweeps on the smallest baked files (f16, and s8 with its
 # scale table).
-for small in ("timings", "s8-small", "s8s6-small"):
+for small in ("timings", "s8-small", "s8s6-small", "cpca-small"):
     good = os.path.join(work, small + ".vdsh")
     data = open(good, "rb").read()
     bad = os.path.join(work, "bad.vdsh")

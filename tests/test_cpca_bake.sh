@@ -1,0 +1,83 @@
+#!/usr/bin/env bash
+# vdsh-bake --encoding cpca and vdsh-merge (issue 29): the clustering is one
+# global step over every receiver, so 1 and 2 threads, and 1, 3 and 7
+# shards merged, give the same bytes; the decoded stream stays close to
+# the f32 bake of the same options (with the full basis and 8-bit weights
+# within f16 and quantisation rounding; with the default-like settings
+# well below the coefficients' spread); bad settings are usage errors and
+# parts of other settings are refused by the merge.
+# Usage: test_cpca_bake.sh VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR
+set -u
+bake=$1 merge=$2 info=$3 src=$4
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail=0
+check() { local what=$1; shift; if ! "$@"; then echo "FAIL: $what" >&2; fail=1; fi; }
+expect_exit() { # expect_exit CODE DESCRIPTION COMMAND...
+  local want=$1 what=$2; shift 2
+  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"
+  local got=$?
+  if [[ $got -ne $want ]]; then
+    echo "FAIL: $what: exit $got, want $want; stderr:" >&2; cat "$tmp/err.txt" >&2; fail=1
+  fi
+}
+says() { if ! grep -qF -- "$2" "$tmp/err.txt" "$tmp/out.txt"; then
+  echo "FAIL: $1: output lacks '$2':" >&2; cat "$tmp/err.txt" >&2; fail=1; fi; }
+
+tiny=(builtin:room --max-edge 1.0 --rays 64 --cube-size 0 -q --orders 3,7)
+cp=(--encoding cpca --cpca 4,20,4)
+expect_exit 0 "whole cpca bake, 1 thread" "$bake" "${tiny[@]}" "${cp[@]}" --threads 1 -o "$tmp/w1.vdsh"
+expect_exit 0 "whole cpca bake, 2 threads" "$bake" "${tiny[@]}" "${cp[@]}" --threads 2 -o "$tmp/w2.vdsh"
+check "1 and 2 threads: identical" cmp "$tmp/w1.vdsh" "$tmp/w2.vdsh"
+for n in 1 3 7; do
+  d=$tmp/n$n; mkdir -p "$d"
+  for ((i = 0; i < n; i++)); do
+    expect_exit 0 "cpca shard $i/$n" "$bake" "${tiny[@]}" "${cp[@]}" --shard "$i/$n" -o "$d/p$i.vdsh"
+  done
+  expect_exit 0 "merge $n" "$merge" -q "$d"/p*.vdsh -o "$d/scene.vdsh"
+  check "$n cpca shards: identical to the whole bake" cmp "$d/scene.vdsh" "$tmp/w1.vdsh"
+done
+expect_exit 0 "vdsh-info" "$info" "$tmp/w1.vdsh"
+says "vdsh-info shows the model" "cpca: 4 clusters, 20 basis vectors of 4-bit weights"
+expect_exit 0 "vdsh-info on a part" "$info" "$tmp/n3/p1.vdsh"
+says "vdsh-info shows a part's settings" "cpca 4,20,4 (fitted at the merge)"
+
+# Against the f32 bake of the same options.
+expect_exit 0 "f32 bake" "$bake" "${tiny[@]}" --encoding f32 -o "$tmp/f32.vdsh"
+expect_exit 0 "full basis, 8 bits" "$bake" "${tiny[@]}" --encoding cpca --cpca 2,49,8 -o "$tmp/full.vdsh"
+check "decode error bounded" /usr/bin/python3 - "$src/python" "$tmp" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[1])
+import numpy as np
+import vdsh
+t = sys.argv[2]
+ref = vdsh.read(t + "/f32.vdsh")
+for name, bound in (("w1", 0.5), ("full", 0.02)):
+    f = vdsh.read(t + "/" + name + ".vdsh")
+    for s, r in zip(f.streams, ref.streams):
+        assert s["encoding"] == "cpca" and s["order"] == r["order"], (s["encoding"], s["order"])
+        c, x = vdsh.coefficients(s).astype(np.float64), vdsh.coefficients(r).astype(np.float64)
+        spread = np.sqrt(((x - x.mean(0)) ** 2).sum(1).mean())
+        err = np.sqrt(((c - x) ** 2).sum(1).mean()) / spread
+        print("%s order %d: error %.4f of the spread (bound %g)" % (name, s["order"], err, bound))
+        assert err < bound, (name, s["order"], err)
+PY
+
+# Usage errors and refusals.
+out=$tmp/none.vdsh
+expect_exit 2 "--cpca without --encoding cpca" "$bake" "${tiny[@]}" --cpca 4,20,4 -o "$out"
+says "--cpca alone" "needs --encoding cpca"
+for bad in 0,20,4 4,0,4 4,20,1 4,20,9 4,20 x; do
+  expect_exit 2 "--cpca $bad" "$bake" "${tiny[@]}" --encoding cpca --cpca "$bad" -o "$out"
+  says "--cpca $bad" "--cpca takes K,B,BITS"
+done
+expect_exit 2 "--adaptive-order with cpca" "$bake" "${tiny[@]}" --encoding cpca \
+  --adaptive-order 0.02 -o "$out"
+says "--adaptive-order with cpca" "does not encode adaptive-order streams"
+expect_exit 0 "a part of other settings" "$bake" "${tiny[@]}" --encoding cpca --cpca 4,21,4 \
+  --shard 2/3 -o "$tmp/other-2.vdsh"
+expect_exit 1 "merge refuses other settings" "$merge" -q "$tmp"/n3/p0.vdsh "$tmp"/n3/p1.vdsh \
+  "$tmp/other-2.vdsh" -o "$out"
+says "merge of other settings" "another --cpca"
+check "nothing written after refusals" test ! -e "$out"
+exit $fail
