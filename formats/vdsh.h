@@ -213,7 +213,7 @@ typedef struct vdsh_cpca {
 #define VDSH_CPCA_INDEX_BITS 8
 /* The baker's defaults (vdsh-bake --cpca K,B,BITS): docs/ACCURACY.md. */
 #define VDSH_CPCA_DEFAULT_CLUSTERS 8
-#define VDSH_CPCA_DEFAULT_BASIS 52
+#define VDSH_CPCA_DEFAULT_BASIS 54
 #define VDSH_CPCA_DEFAULT_BITS 4
 
 typedef struct vdsh_stream {

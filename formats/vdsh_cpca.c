@@ -69,12 +69,12 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
         char *end;
         if (*p < '0' || *p > '9')
             return failf(err, VDSH_ERR_ARGUMENT,
-                         "cpca settings '%s': expected K,B,BITS (for example 8,52,4)",
+                         "cpca settings '%s': expected K,B,BITS (for example 8,54,4)",
                          text ? text : "");
         v[k] = strtoul(p, &end, 10);
         if (v[k] > 100000 || *end != (k < 2 ? ',' : '\0'))
             return failf(err, VDSH_ERR_ARGUMENT,
-                         "cpca settings '%s': expected K,B,BITS (for example 8,52,4)", text);
+                         "cpca settings '%s': expected K,B,BITS (for example 8,54,4)", text);
         p = end + (k < 2);
     }
     vdsh_cpca_settings s = {(uint32_t)v[0], (uint32_t)v[1], (uint32_t)v[2]};

@@ -45,10 +45,10 @@ typedef struct vdsh_cpca_settings {
     uint32_t bits;       /* VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS */
 } vdsh_cpca_settings;
 
-/* K = 8, B = 52, 4 bits (docs/ACCURACY.md "Compressed high orders"). */
+/* K = 8, B = 54, 4 bits (docs/ACCURACY.md "Compressed high orders"). */
 vdsh_cpca_settings vdsh_cpca_settings_default(void);
 
-/* Parse "K,B,BITS" (for example "8,52,4") into *out; VDSH_ERR_ARGUMENT
+/* Parse "K,B,BITS" (for example "8,54,4") into *out; VDSH_ERR_ARGUMENT
  * with a message for a malformed string or a value out of range. */
 vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_error *err);
 

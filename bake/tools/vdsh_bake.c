@@ -159,11 +159,11 @@ static void usage(FILE *f)
 "                          s8 (all 8-bit: 4, 9, 25), f16 (8, 18, 50) or f32;\n"
 "                          compact ones within 0.1%% of f16: docs/ACCURACY.md;\n"
 "                          or cpca: clustered PCA of each order's coefficients\n"
-"                          (for orders 7..16: order 12 in ~29-31 bytes per\n"
+"                          (for orders 7..16: order 12 in ~30-32 bytes per\n"
 "                          vertex; docs/ACCURACY.md \"Compressed high orders\")\n"
 "      --cpca K,B,BITS     cpca settings: clusters (1..256), basis vectors per\n"
 "                          cluster (capped at order^2), bits per weight (2..8);\n"
-"                          default 8,52,4\n"
+"                          default 8,54,4\n"
 "      --shard I/N         bake shard I (0-based) of N only and write a part\n"
 "                          file; vdsh-merge joins the N parts into the file\n"
 "                          the whole bake writes, byte for byte\n"
@@ -776,7 +776,7 @@ int main(int argc, char **argv)
         case O_CPCA: {
             if (vdsh_cpca_parse(optarg, &o.cpca, NULL) != VDSH_OK)
                 return bad_usage("--cpca takes K,B,BITS: clusters 1..256, basis vectors "
-                                 "1..256, bits 2..8 (default 8,52,4), not '%s'", optarg);
+                                 "1..256, bits 2..8 (default 8,54,4), not '%s'", optarg);
             o.have_cpca = 1;
             break;
         }
