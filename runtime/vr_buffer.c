@@ -39,7 +39,7 @@
  * vertex stage decodes its coefficients four at a time as mean + sum of
  * level_j * texel_j (vdsh_buffer.glsl, BUF_KIND 4), then sums them as
  * the other kinds do: once per vertex, not once per light. The model is
- * K * (B + 1) * T * 16 bytes (8, 52, 4 at order 12: 244 KB), the records
+ * K * (B + 1) * T * 16 bytes (8, 54, 4 at order 12: 253 KB), the records
  * the file's (28 bytes per vertex at the default).
  *
  * Does not: draw (vr_render.c), choose the stream (vr_scene.c), convert
