@@ -77,7 +77,14 @@
  *                       recurrence of formats/vdsh_sh.c (bands 0..k-1, the
  *                       same convention), each coefficient fetched once for
  *                       all lights of a pass. Streams of orders 1-5 are
- *                       buffered only with vr_scene_desc.buffers.
+ *                       buffered only with vr_scene_desc.buffers. A cpca
+ *                       stream (vdsh-bake --encoding cpca, any order: never
+ *                       on attributes) keeps its records as R32UI words and
+ *                       its model in a second buffer texture, and each
+ *                       vertex decodes its coefficients (mean + weights x
+ *                       basis) in the vertex stage once per pass, four at
+ *                       a time as the recurrence reads them
+ *                       (docs/BENCHMARKS.md "Compressed high orders").
  * Log-distance streams (vdsh-bake --log) are drawn differently by every
  * VDSH mode: each vertex sums all its coefficients toward the light and
  * takes exp (its distance toward the light), the distances are
@@ -176,13 +183,15 @@ typedef struct vr_scene_desc {
      * of the triangles and 14 rays per position tried. */
     int light_pool;
     /* Streams for VR_MODE_VDSH_BUFFER. 0 (default): those no attribute
-     * path can draw go up as buffer textures (orders above 5, and streams
-     * with an order per vertex); orders 1-5 only as attributes. 1: orders
+     * path can draw go up as buffer textures (orders above 5, streams
+     * with an order per vertex, cpca streams); orders 1-5 only as
+     * attributes. 1: orders
      * 1-5 as buffers too (more GPU memory: both copies). */
     int buffers;
     /* 0 (default): buffers hold the file's encoding as stored. 1: decoded
      * f32 coefficients instead (vdsh_stream_decode; 2x the bytes of f16,
-     * 4x s8), no unpacking in the shader: for comparisons. */
+     * 4x s8; a cpca stream decoded at load), no unpacking in the shader:
+     * for comparisons. */
     int buffer_floats;
     /* VR_MODE_SDF's signed distance volume (formats/vdsh_sdf.h), uploaded
      * as a 3D texture. NULL (default): the .vdsh's companion file

@@ -29,6 +29,19 @@
  * gl_VertexID); a stream with an order per vertex carries each vertex's
  * first texel and order as integer attributes.
  *
+ * A cpca stream (VDSH.md "cpca streams") keeps its records as stored,
+ * W u32 words per vertex (R32UI: the cluster index and the packed weight
+ * levels), and its model goes up once as a second buffer texture
+ * (RGBA32F, build_model): per cluster c and record texel t (four
+ * coefficients in the sequence above) B + 1 texels in a row, the mean's
+ * then each basis vector's times its step (scale_{c,j} / L), at
+ * ((c * T + t) * (B + 1) + j), T = stride of the order as f32. The
+ * vertex stage decodes its coefficients four at a time as mean + sum of
+ * level_j * texel_j (vdsh_buffer.glsl, BUF_KIND 4), then sums them as
+ * the other kinds do: once per vertex, not once per light. The model is
+ * K * (B + 1) * T * 16 bytes (8, 54, 4 at order 12: 253 KB), the records
+ * the file's (28 bytes per vertex at the default).
+ *
  * Does not: draw (vr_render.c), choose the stream (vr_scene.c), convert
  * values (only the floats variant decodes).
  * Errors: VR_ERR_FORMAT for an encoding it cannot draw or a record that
@@ -75,6 +88,7 @@ static GLenum texel_format(vr_buf_kind k)
     case VR_BUF_F16: return GL_RGBA16F;
     case VR_BUF_S8: return GL_RGBA8I;
     case VR_BUF_S8S6: return GL_R32UI;
+    case VR_BUF_CPCA: return GL_R32UI;
     default: return GL_RGBA32F;
     }
 }
@@ -84,9 +98,10 @@ void vr_buffer_destroy(vr_buffer *b)
     if (!b)
         return;
     glDeleteVertexArrays(1, &b->vao);
-    glDeleteTextures(1, &b->tex);
-    GLuint bufs[3] = {b->buf, b->vbo_record, b->vbo_order};
-    glDeleteBuffers(3, bufs);
+    GLuint texs[2] = {b->tex, b->model_tex};
+    glDeleteTextures(2, texs);
+    GLuint bufs[4] = {b->buf, b->vbo_record, b->vbo_order, b->model_buf};
+    glDeleteBuffers(4, bufs);
     free(b->ks);
     memset(b, 0, sizeof *b);
 }
@@ -149,6 +164,7 @@ static vr_buf_kind kind_of(const vdsh_stream *st, int floats)
     case VDSH_ENCODING_F16: return VR_BUF_F16;
     case VDSH_ENCODING_S8: return VR_BUF_S8;
     case VDSH_ENCODING_S8S6: return VR_BUF_S8S6;
+    case VDSH_ENCODING_CPCA: return VR_BUF_CPCA;
     default: return VR_BUF_F32;
     }
 }
@@ -186,6 +202,13 @@ static unsigned char *fixed_records(const vdsh_stream *st, vr_buffer *b, uint32_
     unsigned char *dst = malloc((size_t)nv * rec + 16);
     if (!dst)
         return NULL;
+    if (b->kind == VR_BUF_CPCA) {
+        for (uint32_t v = 0; v < nv; v++)
+            memcpy(dst + (size_t)remap[v] * rec, (const unsigned char *)st->data + (size_t)v * bpv,
+                   rec);
+        *bytes = (size_t)nv * rec;
+        return dst;
+    }
     float decoded[VDSH_MAX_COEFFS];
     for (uint32_t v = 0; v < nv; v++) {
         if (floats)
@@ -249,6 +272,32 @@ static vr_result variable_records(const vdsh_stream *st, vr_buffer *b, uint32_t 
     return VR_OK;
 }
 
+/* A cpca stream's model as the vertex stage reads it (see the top): f32
+ * texels, K * T * (B + 1) of them. NULL when out of memory. */
+static float *build_model(const vdsh_stream *st, int order, size_t *bytes)
+{
+    const vdsh_cpca *m = &st->cpca;
+    int seq[VDSH_MAX_COEFFS];
+    int n = vr_buffer_sequence(order, seq), nc = order * order;
+    size_t T = (size_t)(n + 3) / 4, row = (size_t)m->basis + 1;
+    size_t floats = (size_t)m->clusters * T * row * 4;
+    float *dst = calloc(floats + 4, sizeof *dst);
+    if (!dst)
+        return NULL;
+    for (uint32_t c = 0; c < m->clusters; c++)
+        for (int p = 0; p < n; p++) {
+            float *t = dst + (((size_t)c * T + (size_t)p / 4) * row) * 4 + p % 4;
+            t[0] = vdsh_f32_from_f16(m->means[(size_t)c * (size_t)nc + (size_t)seq[p]]);
+            for (uint32_t j = 0; j < m->basis; j++) {
+                size_t v = (size_t)c * m->basis + j;
+                float step = vdsh_cpca_step(m->scales[v], m->bits);
+                t[4 * (j + 1)] = step * vdsh_f32_from_f16(m->bases[v * (size_t)nc + (size_t)seq[p]]);
+            }
+        }
+    *bytes = floats * sizeof *dst;
+    return dst;
+}
+
 /* Create the buffer texture, the VAO and (variable) the per-vertex
  * attributes of b (GL errors are the caller's to check). */
 static void make_gl(vr_scene *s, vr_buffer *b, const void *rec, size_t bytes,
@@ -289,7 +338,11 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
                            int floats, const char *name, vr_error *err)
 {
     int order = (int)st->order;
-    if (order < 1 || order > VDSH_MAX_ORDER || st->encoding > VDSH_ENCODING_S8S6 ||
+    int cpca = st->encoding == VDSH_ENCODING_CPCA;
+    if (order < 1 || order > VDSH_MAX_ORDER ||
+        (st->encoding > VDSH_ENCODING_S8S6 && !cpca) ||
+        (cpca && (!st->cpca.scales || !st->cpca.means || !st->cpca.bases ||
+                  (st->flags & VDSH_STREAM_VARIABLE))) ||
         (vdsh_encoding_quantised(st->encoding) && !st->coef_scales))
         return vr_fail(err, VR_ERR_FORMAT, "%s: order %d stream: encoding %u cannot be drawn",
                        name, order, st->encoding);
@@ -301,6 +354,11 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
     /* quantised and decoded coefficients carry their scale already */
     b.scale = floats || vdsh_encoding_quantised(st->encoding) ? 1.0f : st->scale;
     b.stride = vr_buffer_stride(order, b.kind);
+    if (b.kind == VR_BUF_CPCA) {
+        b.cpca_basis = (int)st->cpca.basis;
+        b.cpca_bits = (int)st->cpca.bits;
+        b.stride = (int)st->cpca.record_words;
+    }
     b.ks = make_ks(st, order, floats);
     if (!b.ks)
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
@@ -339,10 +397,34 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
     if (r == VR_OK && texels > (size_t)max_texels)
         r = vr_fail(err, VR_ERR_GL, "%s: order %d stream: %zu texels, above this GL's "
                     "GL_MAX_TEXTURE_BUFFER_SIZE (%d)", name, order, texels, (int)max_texels);
+    float *model = NULL;
+    size_t model_bytes = 0;
+    if (r == VR_OK && b.kind == VR_BUF_CPCA) {
+        model = build_model(st, order, &model_bytes);
+        if (!model)
+            r = vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory uploading order %d", name,
+                        order);
+        else if (model_bytes / 16 > (size_t)max_texels)
+            r = vr_fail(err, VR_ERR_GL, "%s: order %d cpca model: %zu texels, above this GL's "
+                        "GL_MAX_TEXTURE_BUFFER_SIZE (%d)", name, order, model_bytes / 16,
+                        (int)max_texels);
+    }
     if (r == VR_OK) {
         make_gl(s, &b, rec, bytes, start, korder);
+        if (model) {
+            glGenBuffers(1, &b.model_buf);
+            glBindBuffer(GL_TEXTURE_BUFFER, b.model_buf);
+            glBufferData(GL_TEXTURE_BUFFER, (GLsizeiptr)model_bytes, model, GL_STATIC_DRAW);
+            glGenTextures(1, &b.model_tex);
+            glBindTexture(GL_TEXTURE_BUFFER, b.model_tex);
+            glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, b.model_buf);
+            glBindTexture(GL_TEXTURE_BUFFER, 0);
+            glBindBuffer(GL_TEXTURE_BUFFER, 0);
+            b.bytes += model_bytes;
+        }
         r = vr_check_gl(err, name);
     }
+    free(model);
     free(rec);
     free(start);
     free(korder);

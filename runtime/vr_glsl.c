@@ -82,11 +82,12 @@
 static void key_name(const vr_program_key *k, char *buf, size_t size)
 {
     int interp = vr_mode_interp((vr_mode)k->mode, k->quantity);
-    static const char *const kinds[4] = {"f32", "f16", "s8", "s8s6"};
+    static const char *const kinds[5] = {"f32", "f16", "s8", "s8s6", "cpca"};
     char buf_what[64] = "";
     if (k->mode == VR_MODE_VDSH_BUFFER)
         snprintf(buf_what, sizeof buf_what, ", order %u%s %s", k->buf_order,
-                 k->buf_variable ? " (cap, variable)" : "", kinds[k->buf_kind & 3]);
+                 k->buf_variable ? " (cap, variable)" : "",
+                 kinds[k->buf_kind <= VR_BUF_CPCA ? k->buf_kind : 0]);
     snprintf(buf, size, "program %s%s%s, %s, %s, output %u, pcf %u, %u lights%s%s",
              vr_mode_name((vr_mode)k->mode), interp >= 0 ? " path " : "",
              interp >= 0 ? vdsh_interp_name((uint32_t)interp) : "",
@@ -141,12 +142,18 @@ static void key_defines(const vr_program_key *k, int flat, char *buf, size_t siz
                      "#define PACKED %d\n#define BUFFER %d\n#define BUF_ORDER %u\n"
                      "#define BUF_KIND %u\n#define BUF_VARIABLE %u\n#define BUF_STRIDE %d\n"
                      "#define SHADOW_SDF %d\n"
+                     "#define BUF_CPCA_BASIS %u\n#define BUF_CPCA_BITS %u\n"
+                     "#define BUF_CPCA_T %d\n"
                      "#define FOR_EACH_LIGHT",
                      order, visibility, split, distance, cubemap, cube, k->quantity, k->compare,
                      k->output, k->pcf, k->lights, flat, k->packed && order >= 3, buffer,
                      k->buf_order, k->buf_kind, k->buf_variable,
-                     buffer ? vr_buffer_stride(k->buf_order, (vr_buf_kind)k->buf_kind) : 0,
-                     k->mode == VR_MODE_SDF);
+                     !buffer ? 0
+                     : k->buf_kind == VR_BUF_CPCA
+                         ? (int)vdsh_cpca_record_words(k->cpca_basis, k->cpca_bits)
+                         : vr_buffer_stride(k->buf_order, (vr_buf_kind)k->buf_kind),
+                     k->mode == VR_MODE_SDF, k->cpca_basis, k->cpca_bits,
+                     vr_buffer_stride(k->buf_order, VR_BUF_F32));
     for (unsigned i = 0; i < k->lights && n > 0 && (size_t)n < size; i++)
         n += snprintf(buf + n, size - (size_t)n, " LIGHT(%u)", i);
     if (n > 0 && (size_t)n < size)
@@ -296,6 +303,9 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_progra
     GLint coef = glGetUniformLocation(prog, "u_coef");
     if (coef >= 0)
         glUniform1i(coef, VR_UNIT_COEF);
+    GLint model = glGetUniformLocation(prog, "u_model");
+    if (model >= 0)
+        glUniform1i(model, VR_UNIT_MODEL);
     GLint shadow = glGetUniformLocation(prog, "u_shadow");
     if (shadow >= 0) {
         GLint units[VR_MAX_LIGHTS_PER_PASS];

@@ -62,7 +62,8 @@ enum {
     VR_UNIT_BASIS = 0,
     VR_UNIT_SHADOW = 4,
     VR_UNIT_COEF = VR_UNIT_SHADOW + VR_MAX_LIGHTS_PER_PASS,
-    VR_UNIT_SDF = VR_UNIT_COEF + 1
+    VR_UNIT_SDF = VR_UNIT_COEF + 1,
+    VR_UNIT_MODEL = VR_UNIT_SDF + 1   /* a cpca buffer stream's model */
 };
 
 /* A buffer stream's vertex attributes (VR_MODE_VDSH_BUFFER, variable
@@ -74,7 +75,10 @@ typedef enum vr_buf_kind {
     VR_BUF_F32 = 0,          /* RGBA32F: four coefficients per texel */
     VR_BUF_F16 = 1,          /* RGBA16F */
     VR_BUF_S8 = 2,           /* RGBA8I (times the steps in u_ks) */
-    VR_BUF_S8S6 = 3          /* R32UI words: 4 bytes, then 6-bit fields */
+    VR_BUF_S8S6 = 3,         /* R32UI words: 4 bytes, then 6-bit fields */
+    VR_BUF_CPCA = 4          /* R32UI words: a cpca record as stored (cluster
+                                index, packed weights), decoded per vertex
+                                from the model texture (vr_buffer.model) */
 } vr_buf_kind;
 
 /* A stream drawn from buffer textures (VR_MODE_VDSH_BUFFER). */
@@ -93,6 +97,10 @@ typedef struct vr_buffer {
     GLuint vao;
     size_t bytes;            /* all of the above */
     float mean_order;        /* variable: over the vertices */
+    /* VR_BUF_CPCA: the model as an RGBA32F buffer texture (vr_buffer.c),
+     * basis vectors per cluster and bits per weight */
+    GLuint model_buf, model_tex;
+    int cpca_basis, cpca_bits;
 } vr_buffer;
 
 /* Upload stream st (its quantity drawn) as a buffer stream of s, in the
@@ -162,6 +170,8 @@ typedef struct vr_program_key {
     uint8_t buf_order;  /* VR_MODE_VDSH_BUFFER: order (variable: the cap) */
     uint8_t buf_kind;   /* vr_buf_kind */
     uint8_t buf_variable; /* 1: an order per vertex */
+    uint8_t cpca_bits;  /* VR_BUF_CPCA: bits per weight */
+    uint16_t cpca_basis; /* VR_BUF_CPCA: basis vectors per cluster */
 } vr_program_key;
 
 /* Texels of a record of this order and kind. */

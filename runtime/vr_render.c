@@ -657,6 +657,8 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
             key.buf_kind = (uint8_t)buf->kind;
             key.buf_variable = (uint8_t)buf->variable;
             key.ks_hash = buf->ks_hash;
+            key.cpca_basis = (uint16_t)buf->cpca_basis;
+            key.cpca_bits = (uint8_t)buf->cpca_bits;
         }
         const vr_program *p = NULL;
         res = get_program(r, &key, buf ? buf->ks : NULL, &p, err);
@@ -727,6 +729,10 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
         if (buf) {
             glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
             glBindTexture(GL_TEXTURE_BUFFER, buf->tex);
+            if (buf->model_tex) {
+                glActiveTexture(GL_TEXTURE0 + VR_UNIT_MODEL);
+                glBindTexture(GL_TEXTURE_BUFFER, buf->model_tex);
+            }
         }
         glActiveTexture(GL_TEXTURE0);
         glBindVertexArray(buf ? buf->vao : s->vao[order]);

@@ -24,7 +24,8 @@ endif()
 # vertex in every mode) and the paper's (distance; order 5 per fragment,
 # with the basis cubemaps and as polynomials; and the default bake's streams
 # drawn from buffer textures, VR_MODE_VDSH_BUFFER, and streams of orders 7,
-# 9, 12 and with an order per vertex, derived from it and baked):
+# 9, 12 and with an order per vertex, derived from it and baked; cpca
+# streams of orders 3, 7 and 12, issue 29):
 # mean difference <= 0.002 and
 # at most 0.5% of the pixels off by more than 0.1 in every frame (measured
 # on llvmpipe: <= 1e-4 and 0.003%; one order for another: 0.019 and 3.7%).
@@ -72,6 +73,22 @@ done
 "$view" "$d/baked.vdsh" --views "$views" --frames "$d/baked-gl" --modes buf7,buf9,buf12,adaptive -q
 "$cmp" "$views" "$d/baked-c" "$d/baked-gl" 0.002 0.005 \
   buf7=c-vdsh7 buf9=c-vdsh9 buf12=c-vdsh12 adaptive=c-vdsh-var
+# cpca streams (issue 29), decoded in the vertex stage: order 12 at the
+# baker's default settings (4-bit weights, no bits skipped), and orders 3
+# and 7 with 5-bit weights (fields skip the ends of words; order 3 is drawn
+# from a buffer too: cpca never goes to attributes). The C frames decode
+# through vdsh_stream_decode.
+"$bake" builtin:room --max-edge 0.5 --rays 400 --cube-size 0 --orders 12 --encoding cpca \
+  -q -o "$d/cpca.vdsh"
+"$bake" builtin:room --max-edge 0.5 --rays 400 --cube-size 0 --orders 3,7 --encoding cpca \
+  --cpca 6,20,5 -q -o "$d/cpca5.vdsh"
+for f in cpca cpca5; do
+  "$frames" truth "$d/$f.vdsh" --views "$views" -o "$d/$f-c" > /dev/null
+done
+"$view" "$d/cpca.vdsh" --views "$views" --frames "$d/cpca-gl" --modes buf12 -q
+"$view" "$d/cpca5.vdsh" --views "$views" --frames "$d/cpca5-gl" --modes buf3,buf7 -q
+"$cmp" "$views" "$d/cpca-c" "$d/cpca-gl" 0.002 0.005 buf12=c-vdsh12
+"$cmp" "$views" "$d/cpca5-c" "$d/cpca5-gl" 0.002 0.005 buf3=c-vdsh3 buf7=c-vdsh7
 ]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames> $<TARGET_FILE:vdsh-view>
        $<TARGET_FILE:test_frames_gl> ${CMAKE_CURRENT_BINARY_DIR}/frames_gl
        ${CMAKE_CURRENT_LIST_DIR}/data/frames_gl.views.json $<TARGET_FILE:test_runtime_buffer>)

@@ -16,7 +16,10 @@ coefficients and triangles bit-exact. --source: BoxTextured (.glb refined,
 .gltf with external files) and 2CylinderEngine (82 nodes, 34 materials)
 keep nodes, materials, textures and attribute values, every vertex
 matched; with --compress too (the VDSH attributes meshopt-compressed,
-bit-exact after decoding); all validator-clean.
+bit-exact after decoding); cpca streams (issue 29) exported as stored,
+decoded from the glb by the GLTF.md rule, bit-exact with --decode-cpca's
+coefficients (vdsh_stream_decode), plain and --compress; all
+validator-clean.
 """
 import json
 import math
@@ -296,6 +299,55 @@ for name in ("box-src", "engine-src"):
                     fail.append("%s: %s not bit-exact after decoding" % (packed, k))
             if "indices" in p0 and accessor(gd, bd, p["indices"]) != accessor(gp, bp, p0["indices"]):
                 fail.append("%s: indices differ after decoding" % packed)
+
+# cpca streams (issue 29) exported as stored (formats/GLTF.md "cpca
+# streams"): the cluster and weight attributes and the model view, decoded
+# in f32 in the documented order, must give bit for bit the coefficients
+# of the --decode-cpca --float export (vdsh_stream_decode's); orders 7
+# and 12 with 5-bit weights (fields skipping the ends of words); plain and
+# --compress go to the validator.
+import numpy as np
+cvd = os.path.join(work, "cpca.vdsh")
+run([bake, "builtin:room", "-o", cvd, "-q", "--rays", "64", "--orders", "7,12", "--encoding", "cpca",
+     "--cpca", "6,20,5"])
+cq, cf = os.path.join(work, "cpca.glb"), os.path.join(work, "cpca_decoded.glb")
+run([export, cvd, "-o", cq])
+run([export, cvd, "-o", cf, "--decode-cpca", "--float"])
+run([export, cvd, "-o", os.path.join(work, "cpca_compressed.glb"), "--compress"])
+if not fail:
+    glbs += [cq, cf, os.path.join(work, "cpca_compressed.glb")]
+    gq, bq = read_glb(cq)
+    gf, bf = read_glb(cf)
+    aq, af = gq["meshes"][0]["primitives"][0]["attributes"], gf["meshes"][0]["primitives"][0]["attributes"]
+    sq = gq["meshes"][0]["extras"]["vdsh"]["streams"]
+    for st in sq:
+        cp, n = st.get("cpca"), st["order"]
+        if not cp or st["component"] != "cpca" or st["attributes"] != 0:
+            fail.append("cpca.glb: order %d not exported as cpca: %r" % (n, st))
+            continue
+        nc, K, B = n * n, cp["clusters"], cp["basis"]
+        view = gq["bufferViews"][cp["model_view"]]
+        model = np.frombuffer(bq, "<f4", (view["byteLength"]) // 4, view.get("byteOffset", 0))
+        steps = model[cp["steps_offset"] // 4:][:K * B]
+        means = model[cp["means_offset"] // 4:][:K * nc].reshape(K, nc)
+        bases = model[cp["bases_offset"] // 4:][:K * B * nc].reshape(K, B, nc)
+        cl = np.array(accessor(gq, bq, aq[cp["cluster_attribute"]]))[:, 0]
+        lv = np.concatenate([np.array(accessor(gq, bq, aq[cp["weight_prefix"] + str(g)]))
+                             for g in range(cp["weight_attributes"])], axis=1)
+        w = (lv[:, :B].astype(np.float32) * steps.reshape(K, B)[cl]).astype(np.float32)
+        a = means[cl].copy()
+        for j in range(B):
+            a = (a + (w[:, j:j + 1] * bases[cl, j]).astype(np.float32)).astype(np.float32)
+        ref = np.concatenate([np.array(accessor(gf, bf, af["_VDSH%d_%d" % (n, g)]), np.float32)
+                              for g in range((nc + 3) // 4)], axis=1)[:, :nc]
+        bad = int((a.view(np.uint32) != ref.view(np.uint32)).sum())
+        print("cpca order %d (K %d, B %d, bits %d): %d vertices, %d bytes of attributes per vertex; "
+              "%d coefficients differ from vdsh_stream_decode's" % (n, K, B, cp["bits"], len(cl),
+                                                                     4 + 4 * cp["weight_attributes"], bad))
+        if bad:
+            fail.append("cpca.glb order %d: %d coefficients decode differently from --decode-cpca" % (n, bad))
+    if len(sq) != 2:
+        fail.append("cpca.glb: %d streams, not 2" % len(sq))
 
 # The validator comes from npm (gltf_npm_setup); where the registry cannot
 # be reached that fixture skips, and so does this test's validation: every

@@ -24,6 +24,9 @@ shadow cannot pass). Also:
     extension VDSH_visibility_distance, attributes on every primitive),
     plain and --compress, drawn with vdshApply and the source's own
     materials, against vdsh-view's frame of the same bake;
+  - a cpca stream (issue 29: --encoding cpca, order 12), exported as
+    stored and decoded at load by vdshLoadCpca, plain and --compress, 1
+    and 3 lights, against vdsh-view's buf12 (decoded in its vertex stage);
   - the glTF scene moved: gltf.scene translated and given as `frame`, the
     camera and light moved with it: the same frame.
 GLSL ES 3.00: runtime/shaders/es_check (this test's page es_check.html)
@@ -164,6 +167,19 @@ for order, mode in modes:
 ref3 = frames("room3", vd, eye, target, [light] + more, ["vdsh5", "buf12"])
 for order, mode in (("5", "vdsh5"), ("12", "buf12")):
     check("room order %s 3 lights" % order, "room.glb", order, eye, target, [light] + more, ref3(mode), 0.005)
+
+# A cpca stream (issue 29: vdsh-bake --encoding cpca), exported as stored
+# and decoded at load by vdshLoadCpca (three.html), plain and --compress,
+# against vdsh-view's buf12 (decoded in its vertex stage), 1 and 3 lights.
+cvd = os.path.join(work, "cpca.vdsh")
+run([bake, "builtin:room", "-o", cvd, "-q", "--orders", "12", "--max-edge", "0.5", "--rays", "256",
+     "--encoding", "cpca"])
+run([export, cvd, "-o", os.path.join(work, "cpca.glb")])
+run([export, cvd, "-o", os.path.join(work, "cpca-compress.glb"), "--compress", "-q"])
+cref, cref3 = frames("cpca", cvd, eye, target, [light], ["buf12"]), frames("cpca3", cvd, eye, target, [light] + more, ["buf12"])
+for f in ("cpca", "cpca-compress"):
+    check("%s order 12" % f, f + ".glb", "12", eye, target, [light], cref("buf12"), 0.005)
+check("cpca order 12 3 lights", "cpca.glb", "12", eye, target, [light] + more, cref3("buf12"), 0.005)
 
 # A linear quantity (the paper's distance): per-vertex visibility.
 pvd, pglb = os.path.join(work, "paper.vdsh"), os.path.join(work, "paper.glb")

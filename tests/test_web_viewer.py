@@ -42,6 +42,12 @@ meshopt_decoder.cjs beside the page the meshopt
 file must be refused with a visible message (#msg). Skipped without node
 or MODULES.
 
+A cpca stream (issue 29): the room baked with --encoding cpca at order
+12, exported as stored (cluster and weight attributes, the model in a
+buffer view; plain and --compress), decoded at load by the page, against
+vdsh-view's buf12 (decoded in its vertex stage), same tolerance; a cpca
+glb with 9 bits per weight is refused on the page.
+
 Errors on the page (issue 26: a GLSL error in the tab title was the only
 sign): a file that is not a glb, a glb without VDSH streams (assimp's
 engine itself) and one that requires an extension the page does not read
@@ -211,6 +217,14 @@ room_vd, room_glb = scene("room", "builtin:room", ["--max-edge", "0.5", "--rays"
                           lambda lo, hi: ([7.5, 4.5, 8.0], [-2.0, 1.0, -2.0], [0.5, 1.2, 0.5]),
                           [("2", "vdsh2"), ("3", "vdsh3"), ("5", "vdsh5"), ("12", "buf12"), ("adaptive", "adaptive")])
 default_view("room", room_vd, room_glb)
+# A cpca stream (issue 29; vdsh-bake --encoding cpca): exported as stored
+# (cluster and weight attributes, the model in a buffer view), decoded at
+# load by vdsh_core.js's vdshCpcaDecode into the buffer path, against
+# vdsh-view's buf12 (decoded in its vertex stage), same tolerance.
+cpca_vd, cpca_glb = scene("cpca", "builtin:room", ["--max-edge", "0.5", "--rays", "256", "--encoding", "cpca"], [12],
+                          lambda lo, hi: ([7.5, 4.5, 8.0], [-2.0, 1.0, -2.0], [0.5, 1.2, 0.5]), [("12", "buf12")])
+if "cpca" not in glb_json(cpca_glb)["meshes"][0]["extras"]["vdsh"]["streams"][0]:
+    fail.append("cpca.glb: its stream is not exported as cpca")
 
 # Errors on the page itself.
 bad = os.path.join(work, "bad.glb")
@@ -222,7 +236,17 @@ js = json.dumps(g).encode()
 js += b" " * (-len(js) % 4)
 import struct
 open(draco, "wb").write(struct.pack("<III", 0x46546C67, 2, 20 + len(js)) + struct.pack("<II", len(js), 0x4E4F534A) + js)
-errs = [("bad.glb", "not a glb"), ("draco.glb", "KHR_draco_mesh_compression")]
+# a cpca stream whose model the page cannot read (9 bits per weight)
+g = glb_json(cpca_glb)
+g["meshes"][0]["extras"]["vdsh"]["streams"][0]["cpca"]["bits"] = 9
+js = json.dumps(g).encode()
+js += b" " * (-len(js) % 4)
+d = open(cpca_glb, "rb").read()
+jl = struct.unpack_from("<I", d, 12)[0]
+open(os.path.join(work, "cpca-bad.glb"), "wb").write(
+    struct.pack("<III", 0x46546C67, 2, 20 + len(js) + len(d) - 20 - jl) + struct.pack("<II", len(js), 0x4E4F534A) + js +
+    d[20 + jl:])
+errs = [("bad.glb", "not a glb"), ("draco.glb", "KHR_draco_mesh_compression"), ("cpca-bad.glb", "bits 9 out of range")]
 plain = os.path.join(models, "glTF2", "2CylinderEngine-glTF-Binary", "2CylinderEngine.glb")
 if os.path.exists(plain):
     shutil.copy(plain, os.path.join(work, "plain.glb"))
@@ -257,6 +281,15 @@ if node and modules and os.path.exists(os.path.join(modules, "meshoptimizer", "m
             fail.append("room-%s.glb: no screenshot" % how)
             continue
         compare("room-%s.glb order 5" % how, shot, os.path.join(work, "c", "room-s0-l0-vdsh5.png"), 5)
+    # the cpca file compressed: its model view too (EXT_meshopt_compression)
+    run([export, cpca_vd, "-o", os.path.join(work, "cpca-compress.glb"), "--compress", "-q"])
+    shot = os.path.join(work, "web-cpca-compress.png")
+    q = ("glb=cpca-compress.glb&order=12&output=shadow&size=%dx%d&eye=%s&target=%s&up=0,1,0&fov=60&light=%s"
+         % (W, H, csv(eye), csv(target), csv(light)))
+    if page(q, shot):
+        compare("cpca-compress.glb order 12", shot, os.path.join(work, "c", "cpca-s0-l0-buf12.png"), 12)
+    else:
+        fail.append("cpca-compress.glb: no screenshot")
 else:
     print("no node or no meshoptimizer in %r: the compressed glb part skipped" % modules)
 def outside(lo, hi):

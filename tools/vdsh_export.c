@@ -483,6 +483,94 @@ out:
     return rc;
 }
 
+/* The metadata of stream s common to both layouts (formats/GLTF.md). */
+static cJSON *stream_entry(const vdsh_stream *s, const char *prefix, uint32_t groups)
+{
+    cJSON *so = cJSON_CreateObject();
+    cJSON_AddNumberToObject(so, "order", s->order);
+    cJSON_AddStringToObject(so, "attribute_prefix", prefix);
+    cJSON_AddNumberToObject(so, "attributes", groups);
+    cJSON_AddStringToObject(so, "method", vdsh_method_name(s->method));
+    cJSON_AddNumberToObject(so, "method_param", s->method_param);
+    cJSON_AddStringToObject(so, "quantity", vdsh_quantity_name(s->quantity));
+    cJSON_AddNumberToObject(so, "quantity_param", s->quantity_param);
+    cJSON_AddStringToObject(so, "window", vdsh_window_name(s->window));
+    cJSON_AddNumberToObject(so, "window_param", s->window_param);
+    cJSON_AddStringToObject(so, "source_encoding", vdsh_encoding_name(s->encoding));
+    return so;
+}
+
+/* A cpca stream as stored (formats/GLTF.md "cpca streams"): per vertex
+ * the cluster index (<prefix>C, VEC4 unsigned byte, x) and the weight
+ * levels (<prefix>W<k>, VEC4 byte, levels 4k..4k+3, 0 past B); the model
+ * (steps, means, bases as f32) in one buffer view named by the stream's
+ * extras. tmp: room for nv * 4 bytes. Returns 0, or -1 out of memory. */
+static int export_cpca(const vdsh_stream *s, uint32_t nv, const char *prefix, view_list *vl,
+                       cJSON *accs, cJSON *attrs, cJSON *streams, float *tmp)
+{
+    const vdsh_cpca *m = &s->cpca;
+    const size_t K = m->clusters, B = m->basis, nc = (size_t)s->order * s->order;
+    const uint32_t wgroups = (m->basis + 3) / 4;
+    size_t floats = K * B + K * nc + K * B * nc;
+    float *model = malloc(floats * sizeof *model);
+    int32_t levels[VDSH_MAX_COEFFS];
+    if (!model)
+        return -1;
+    for (size_t i = 0; i < K * B; i++)
+        model[i] = vdsh_cpca_step(m->scales[i], m->bits);
+    for (size_t i = 0; i < K * nc; i++)
+        model[K * B + i] = vdsh_f32_from_f16(m->means[i]);
+    for (size_t i = 0; i < K * B * nc; i++)
+        model[K * B + K * nc + i] = vdsh_f32_from_f16(m->bases[i]);
+    int mview = add_view(vl, model, floats * sizeof *model, 4, 0);
+    free(model);
+    if (mview < 0)
+        return -1;
+    cJSON *so = stream_entry(s, prefix, 0);
+    cJSON_AddBoolToObject(so, "variable_order", 0);
+    cJSON_AddStringToObject(so, "component", "cpca");
+    cJSON_AddNumberToObject(so, "scale", 1.0);
+    cJSON *cp = cJSON_AddObjectToObject(so, "cpca");
+    char name[48];
+    cJSON_AddNumberToObject(cp, "clusters", (double)K);
+    cJSON_AddNumberToObject(cp, "basis", (double)B);
+    cJSON_AddNumberToObject(cp, "bits", m->bits);
+    snprintf(name, sizeof name, "%sC", prefix);
+    cJSON_AddStringToObject(cp, "cluster_attribute", name);
+    snprintf(name, sizeof name, "%sW", prefix);
+    cJSON_AddStringToObject(cp, "weight_prefix", name);
+    cJSON_AddNumberToObject(cp, "weight_attributes", wgroups);
+    cJSON_AddNumberToObject(cp, "model_view", mview);
+    cJSON_AddNumberToObject(cp, "steps_offset", 0);
+    cJSON_AddNumberToObject(cp, "means_offset", (double)(4 * K * B));
+    cJSON_AddNumberToObject(cp, "bases_offset", (double)(4 * (K * B + K * nc)));
+    cJSON_AddItemToArray(streams, so);
+
+    uint8_t *u = (uint8_t *)tmp;
+    memset(u, 0, (size_t)nv * 4);
+    for (uint32_t v = 0; v < nv; v++)
+        u[4 * (size_t)v] = (uint8_t)vdsh_cpca_cluster(s, v);
+    int view = add_view(vl, u, (size_t)nv * 4, 4, 34962);
+    if (view < 0)
+        return -1;
+    snprintf(name, sizeof name, "%sC", prefix);
+    cJSON_AddNumberToObject(attrs, name, add_accessor(accs, view, 5121, 0, nv, "VEC4"));
+    for (uint32_t g = 0; g < wgroups; g++) {
+        int8_t *q = (int8_t *)tmp;
+        for (uint32_t v = 0; v < nv; v++) {
+            vdsh_cpca_weights(s, v, levels, NULL);
+            for (uint32_t k = 0; k < 4; k++)
+                q[4 * (size_t)v + k] = (int8_t)(4 * g + k < B ? levels[4 * g + k] : 0);
+        }
+        view = add_view(vl, q, (size_t)nv * 4, 4, 34962);
+        if (view < 0)
+            return -1;
+        snprintf(name, sizeof name, "%sW%u", prefix, g);
+        cJSON_AddNumberToObject(attrs, name, add_accessor(accs, view, 5120, 0, nv, "VEC4"));
+    }
+    return 0;
+}
+
 static void usage(FILE *fp)
 {
     fprintf(fp, "usage: vdsh-export [options] IN.vdsh -o OUT.glb\n"
@@ -494,6 +582,10 @@ static void usage(FILE *fp)
                 "                     file)\n"
                 "      --float        coefficients as float (default: normalised int16, scale in\n"
                 "                     extras)\n"
+                "      --decode-cpca  cpca streams (vdsh-bake --encoding cpca) as decoded\n"
+                "                     coefficients in the layout above (default: as stored,\n"
+                "                     cluster and weight attributes and the model in a buffer\n"
+                "                     view; always decoded with --source)\n"
                 "      --compress     a compact glb: positions uint16 and normals int8\n"
                 "                     (KHR_mesh_quantization), every buffer view compressed with\n"
                 "                     meshoptimizer (EXT_meshopt_compression; lossless: the\n"
@@ -519,6 +611,7 @@ int main(int argc, char **argv)
                                              {"orders", required_argument, 0, 'O'},
                                              {"float", no_argument, 0, 'F'},
                                              {"compress", no_argument, 0, 'C'},
+                                             {"decode-cpca", no_argument, 0, 'D'},
                                              {"source", required_argument, 0, 'S'},
                                              {"quiet", no_argument, 0, 'q'},
                                              {"help", no_argument, 0, 'h'},
@@ -526,6 +619,7 @@ int main(int argc, char **argv)
                                              {0, 0, 0, 0}};
     const char *in = NULL, *out = NULL, *source = NULL;
     int want[VDSH_ORDER_SLOTS] = {0}, any_order = 0, use_float = 0, quiet = 0, compress = 0, opt;
+    int decode_cpca = 0;
     while ((opt = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
         switch (opt) {
         case 'o': out = optarg; break;
@@ -541,6 +635,7 @@ int main(int argc, char **argv)
         }
         case 'F': use_float = 1; break;
         case 'C': compress = 1; break;
+        case 'D': decode_cpca = 1; break;
         case 'S': source = optarg; break;
         case 'q': quiet = 1; break;
         case 'h': usage(stdout); return 0;
@@ -771,6 +866,12 @@ int main(int argc, char **argv)
             snprintf(prefix, sizeof prefix, "_VDSH%u%c_", s->order, 'a' + dup);
         else
             snprintf(prefix, sizeof prefix, "_VDSH%u_", s->order);
+        if (s->encoding == VDSH_ENCODING_CPCA && !source && !decode_cpca) {
+            if (export_cpca(s, nv, prefix, &vl, accs, attrs, streams, tmp) != 0)
+                goto oom;
+            exported++;
+            continue;
+        }
         double maxabs = 0;
         for (uint32_t v = 0; v < nv; v++) {
             vdsh_stream_decode(s, v, coef);
@@ -778,17 +879,7 @@ int main(int argc, char **argv)
                 maxabs = fabs(coef[c]) > maxabs ? fabs(coef[c]) : maxabs;
         }
         const double scale = maxabs > 0 ? maxabs : 1.0;
-        cJSON *so = cJSON_CreateObject();
-        cJSON_AddNumberToObject(so, "order", s->order);
-        cJSON_AddStringToObject(so, "attribute_prefix", prefix);
-        cJSON_AddNumberToObject(so, "attributes", groups);
-        cJSON_AddStringToObject(so, "method", vdsh_method_name(s->method));
-        cJSON_AddNumberToObject(so, "method_param", s->method_param);
-        cJSON_AddStringToObject(so, "quantity", vdsh_quantity_name(s->quantity));
-        cJSON_AddNumberToObject(so, "quantity_param", s->quantity_param);
-        cJSON_AddStringToObject(so, "window", vdsh_window_name(s->window));
-        cJSON_AddNumberToObject(so, "window_param", s->window_param);
-        cJSON_AddStringToObject(so, "source_encoding", vdsh_encoding_name(s->encoding));
+        cJSON *so = stream_entry(s, prefix, groups);
         /* an order per vertex (vdsh-bake --adaptive-order): coefficients
          * past a vertex's own order are exported as 0 */
         cJSON_AddBoolToObject(so, "variable_order", (s->flags & VDSH_STREAM_VARIABLE) != 0);

@@ -39,6 +39,19 @@
  * the coefficients in that very order (vr_buffer_sequence), so it is read
  * front to back, a texel (four coefficients, or an s8s6 word's five) at a
  * time (buf_next).
+ *
+ * BUF_KIND 4 (cpca, formats/VDSH.md "cpca streams"): the record is the
+ * file's, BUF_STRIDE words (u_coef, uint): cluster c in bits 0-7 of word
+ * 0, then BUF_CPCA_BASIS weight levels of BUF_CPCA_BITS bits each, a
+ * field that does not fit in what is left of a word starting the next.
+ * buf_begin unpacks the levels once; buf_next decodes four coefficients
+ * (a texel of the f32 record) at a time from the model u_model (f32
+ * texels: for cluster c and record texel t, BUF_CPCA_BASIS + 1 texels
+ * from (c * BUF_CPCA_T + t) * (BUF_CPCA_BASIS + 1): the mean, then each
+ * basis vector times its step) as mean + sum_j level_j * texel_j. So a
+ * vertex decodes once for all the lights of its pass; decoding per light
+ * instead (its sum as mean.Y + sum_j w_j (basis_j.Y)) fetches the same
+ * model texels once per light (docs/BENCHMARKS.md "cpca").
  */
 #if BUFFER
 #ifndef BUF_TEXTURE_2D
@@ -49,21 +62,29 @@
  * texture BUF_TEX_WIDTH texels wide */
 #if BUF_KIND == 2
 uniform highp isampler2D u_coef;
-#elif BUF_KIND == 3
+#elif BUF_KIND == 3 || BUF_KIND == 4
 uniform highp usampler2D u_coef;
 #else
 uniform highp sampler2D u_coef;
 #endif
 #define BUF_FETCH(t) texelFetch(u_coef, ivec2((t) % BUF_TEX_WIDTH, (t) / BUF_TEX_WIDTH), 0)
+#if BUF_KIND == 4
+uniform highp sampler2D u_model;
+#define BUF_MODEL(t) texelFetch(u_model, ivec2((t) % BUF_TEX_WIDTH, (t) / BUF_TEX_WIDTH), 0)
+#endif
 #else
 #if BUF_KIND == 2
 uniform isamplerBuffer u_coef;
-#elif BUF_KIND == 3
+#elif BUF_KIND == 3 || BUF_KIND == 4
 uniform usamplerBuffer u_coef;
 #else
 uniform samplerBuffer u_coef;
 #endif
 #define BUF_FETCH(t) texelFetch(u_coef, t)
+#if BUF_KIND == 4
+uniform samplerBuffer u_model;
+#define BUF_MODEL(t) texelFetch(u_model, t)
+#endif
 #endif
 /* What buffer_sums reads, unless the includer says otherwise: the
  * receiver's position, light i's position (the bake's frame) and the
@@ -91,6 +112,9 @@ int b_field;
 vec4 b_cache;
 int b_j;
 #endif
+#if BUF_KIND == 4
+float b_wt[BUF_CPCA_BASIS];   /* the weight levels */
+#endif
 
 void buf_begin(int first)
 {
@@ -98,6 +122,20 @@ void buf_begin(int first)
     b_w0 = BUF_FETCH(first).r;
     b_texel = first + 1;
     b_field = 5;
+#elif BUF_KIND == 4
+    uint w = BUF_FETCH(first).r;
+    int word = first, shift = 8;
+    b_texel = int(w & 255u) * BUF_CPCA_T;
+    b_j = 4;
+    for (int j = 0; j < BUF_CPCA_BASIS; j++) {
+        if (shift + BUF_CPCA_BITS > 32) {
+            word++;
+            w = BUF_FETCH(word).r;
+            shift = 0;
+        }
+        b_wt[j] = float(int(w << uint(32 - shift - BUF_CPCA_BITS)) >> (32 - BUF_CPCA_BITS));
+        shift += BUF_CPCA_BITS;
+    }
 #else
     b_texel = first;
     b_j = 4;
@@ -122,7 +160,15 @@ float buf_next(int i)
     return ks * float(q);
 #else
     if (b_j == 4) {
+#if BUF_KIND == 4
+        int t = b_texel * (BUF_CPCA_BASIS + 1);
+        vec4 a = BUF_MODEL(t);
+        for (int j = 0; j < BUF_CPCA_BASIS; j++)
+            a += b_wt[j] * BUF_MODEL(t + 1 + j);
+        b_cache = a;
+#else
         b_cache = vec4(BUF_FETCH(b_texel));
+#endif
         b_texel++;
         b_j = 0;
     }

@@ -51,13 +51,14 @@ export function vdshChooseStream(streams, want) {
 }
 
 // How a stream is drawn: its quantity's number, attribute groups, the
-// buffer path or not (orders other than 2, 3, 5, an order per vertex, or
-// path 'buffer'), and whether the fragment stage compares distances.
+// buffer path or not (orders other than 2, 3, 5, an order per vertex, a
+// cpca stream, or path 'buffer'), and whether the fragment stage compares
+// distances.
 export function vdshStreamPlan(stream, path) {
   if (!(stream.order >= 1 && stream.order <= MAX_ORDER)) throw new Error('stream order ' + stream.order + ' out of range 1..16');
   const quantity = { 'distance': 0, 'distance2': 1, 'log-distance': 2 }[stream.quantity];
   if (quantity === undefined) throw new Error('stream quantity ' + stream.quantity + ' unknown');
-  const buffer = path === 'buffer' || !!stream.variable_order || ![2, 3, 5].includes(stream.order);
+  const buffer = path === 'buffer' || !!stream.variable_order || !!stream.cpca || ![2, 3, 5].includes(stream.order);
   return { order: stream.order, quantity, groups: Math.ceil(stream.order * stream.order / 4), buffer,
     distPath: buffer || quantity === 2 };
 }
@@ -126,6 +127,58 @@ export function vdshBufferData(get, nv, stream, maxTexture) {
     for (let p = 0, at = 4 * records[v]; p < seq.length; p++) texels[at + p] = get(v, seq[p]);
   }
   return { orders, records, texels, width, height };
+}
+
+// A cpca stream of a glb (formats/GLTF.md "cpca streams") decoded at load
+// into plain coefficients, which then take the buffer path like any other
+// stream: to the bit what the C reader's vdsh_stream_decode gives (w_j =
+// level_j * step_{c,j}, then from the mean a = a + w_j * basis_{c,j}[i] in
+// order, each product and sum rounded to f32: a double result of f32
+// operands rounded once to f32 is the f32 operation's). cluster: the
+// cluster attribute's values (VEC4, x used), levels: the weight
+// attributes' (VEC4 each), model: the bytes of the model's buffer view.
+// Returns a Float32Array, coefficient i of vertex v at v * order^2 + i;
+// throws on a model or record that breaks the layout's rules.
+export function vdshCpcaDecode(stream, nv, cluster, levels, model) {
+  const c = stream.cpca, N = stream.order, nc = N * N;
+  const K = c.clusters, B = c.basis, L = (1 << (c.bits - 1)) - 1;
+  if (!(K >= 1 && K <= 256 && B >= 1 && B <= nc && c.bits >= 2 && c.bits <= 8))
+    throw new Error('cpca stream of order ' + N + ': clusters ' + K + ', basis ' + B + ', bits ' + c.bits + ' out of range');
+  if (levels.length !== Math.ceil(B / 4)) throw new Error('cpca stream of order ' + N + ': ' + levels.length +
+    ' weight attributes, not ' + Math.ceil(B / 4));
+  const dv = new DataView(model.buffer, model.byteOffset, model.byteLength);
+  const floats = (off, n, what) => {
+    if (!(off >= 0 && off % 4 === 0 && off + 4 * n <= model.byteLength))
+      throw new Error('cpca stream of order ' + N + ': its ' + what + ' (' + n + ' floats at byte ' + off +
+        ') are not inside its model view of ' + model.byteLength + ' bytes');
+    const a = new Float32Array(n);
+    for (let i = 0; i < n; i++) {
+      a[i] = dv.getFloat32(off + 4 * i, true);
+      if (!Number.isFinite(a[i])) throw new Error('cpca stream of order ' + N + ': a ' + what + ' value is not finite');
+    }
+    return a;
+  };
+  const steps = floats(c.steps_offset, K * B, 'steps');
+  const means = floats(c.means_offset, K * nc, 'means');
+  const bases = floats(c.bases_offset, K * B * nc, 'bases');
+  const out = new Float32Array(nv * nc), w = new Float32Array(B);
+  for (let v = 0; v < nv; v++) {
+    const k = cluster[4 * v];
+    if (!(k >= 0 && k < K)) throw new Error('cpca stream of order ' + N + ': vertex ' + v + ' has cluster ' + k +
+      ', not below ' + K);
+    for (let j = 0; j < B; j++) {
+      const q = levels[j >> 2][4 * v + (j & 3)];
+      if (!(Math.abs(q) <= L)) throw new Error('cpca stream of order ' + N + ': vertex ' + v + ' has weight level ' +
+        q + ', not within +-' + L);
+      w[j] = q * steps[k * B + j];  // rounded to f32 by the store
+    }
+    for (let i = 0; i < nc; i++) {
+      let a = means[k * nc + i];
+      for (let j = 0; j < B; j++) a = Math.fround(a + Math.fround(w[j] * bases[(k * B + j) * nc + i]));
+      out[v * nc + i] = a;
+    }
+  }
+  return out;
 }
 
 // The vertex stage's VDSH code for a plan (vdshStreamPlan), after

@@ -35,6 +35,9 @@
 //   vdshApply(gltf, shaders);
 //   scene.add(gltf.scene, new THREE.PointLight(0xffffff, 20));
 //
+// A cpca stream (vdsh-bake --encoding cpca) is decoded at load by
+// vdshLoadCpca(gltf) (await it before vdshApply) into the buffer path.
+//
 // vdshApply(gltf, shaders, options) gives every mesh that has the VDSH
 // attributes its material (below); vdshMaterial(mesh, shaders, options)
 // does one mesh, sets and returns mesh.material; options (all optional):
@@ -54,7 +57,8 @@
 // Only three.js PointLights are shadowed (as vdsh-view's lights); other
 // lights light the mesh unshadowed.
 import * as THREE from 'three';
-import { loadVdshShaders, vdshChooseStream, vdshStreamPlan, vdshBufferData, vdshVertexGlsl, VDSH_EXT } from './vdsh_core.js';
+import { loadVdshShaders, vdshChooseStream, vdshStreamPlan, vdshBufferData, vdshVertexGlsl, vdshCpcaDecode,
+  VDSH_EXT } from './vdsh_core.js';
 
 export { loadVdshShaders, vdshChooseStream };
 
@@ -93,6 +97,50 @@ function streamAttributes(geometry, stream) {
     names.push(n);
   }
   return names;
+}
+
+// cpca streams (vdsh-bake --encoding cpca; formats/GLTF.md "cpca
+// streams": cluster and weight attributes, the model in a buffer view)
+// decoded at load: for every mesh of the GLTFLoader result `gltf` whose
+// extras.vdsh has one, the decoded coefficients become its
+// <prefix><k> attributes (float), which vdshApply and vdshMaterial then
+// draw on the buffer path as any stream. Call it (await) before them.
+// Returns the number of streams decoded; throws on a broken stream.
+export async function vdshLoadCpca(gltf) {
+  if (!gltf || !gltf.scene || !gltf.parser) throw new Error('vdshLoadCpca: give the result of GLTFLoader');
+  const meshes = [];
+  gltf.scene.traverse((o) => { if (o.isMesh) meshes.push(o); });
+  let n = 0;
+  for (const mesh of meshes) {
+    const info = vdshInfo(mesh), geometry = mesh.geometry;
+    if (!info || !geometry) continue;
+    for (const stream of info.streams) {
+      const cp = stream.cpca;
+      if (!cp || geometry.getAttribute((stream.attribute_prefix + '0').toLowerCase())) continue;
+      const get = (name) => {
+        const a = geometry.getAttribute(name.toLowerCase());
+        if (!a) throw new Error('the mesh ' + (mesh.name || '') + ' has no attribute ' + name + ' of its cpca stream');
+        const out = new Float32Array(4 * a.count);  // raw values: levels and the cluster index are not normalised
+        for (let v = 0; v < a.count; v++) {
+          out[4 * v] = a.getX(v); out[4 * v + 1] = a.getY(v); out[4 * v + 2] = a.getZ(v); out[4 * v + 3] = a.getW(v);
+        }
+        return out;
+      };
+      const cluster = get(cp.cluster_attribute);
+      const levels = Array.from({ length: cp.weight_attributes }, (_, g) => get(cp.weight_prefix + g));
+      const model = new Uint8Array(await gltf.parser.getDependency('bufferView', cp.model_view));
+      const nv = cluster.length / 4, nc = stream.order * stream.order;
+      const dec = vdshCpcaDecode(stream, nv, cluster, levels, model);
+      for (let g = 0; g < Math.ceil(nc / 4); g++) {
+        const a = new Float32Array(4 * nv);
+        for (let v = 0; v < nv; v++)
+          for (let k = 0; k < 4 && 4 * g + k < nc; k++) a[4 * v + k] = dec[v * nc + 4 * g + k];
+        geometry.setAttribute((stream.attribute_prefix + g).toLowerCase(), new THREE.BufferAttribute(a, 4));
+      }
+      n++;
+    }
+  }
+  return n;
 }
 
 // VDSH shadows on every mesh of a loaded glTF that holds them: `root` is
@@ -170,7 +218,7 @@ export function vdshMaterial(mesh, shaders, options = {}) {
   const geometry = mesh.geometry;
   const names = streamAttributes(geometry, stream);
   if (!names) throw new Error('the mesh ' + (mesh.name || '') + ' has no attributes ' + stream.attribute_prefix +
-    '0..' + (plan.groups - 1));
+    '0..' + (plan.groups - 1) + (stream.cpca ? ' (a cpca stream: decode it first, await vdshLoadCpca(gltf))' : ''));
   const buffer = plan.buffer;
   const output = options.output === 'shadow' ? 1 : 0;
   const frame = options.frame || null;

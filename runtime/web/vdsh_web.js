@@ -60,7 +60,7 @@
 // true (and document.title to "ready") once the first frame is drawn. On
 // failure the message is shown on the page (#msg), in document.title
 // ("error: ...") and in window.vdshError.
-import { VDSH_EXT, vdshChooseStream, vdshStreamPlan, vdshBufferData, vdshVertexGlsl } from './vdsh_core.js';
+import { VDSH_EXT, vdshChooseStream, vdshStreamPlan, vdshBufferData, vdshVertexGlsl, vdshCpcaDecode } from './vdsh_core.js';
 
 // The program: vdsh_core.js's vertex stage (the VDSH value per light,
 // interpolated), then vdsh-view's shading per fragment.
@@ -205,25 +205,31 @@ class Gltf {
 
   // Every buffer view the accessors use, decompressed (async: the decoder).
   async prepare(accessors) {
-    const json = this.json;
     for (const ai of accessors) {
-      const a = json.accessors[ai];
-      if (a.bufferView === undefined || this.views[a.bufferView]) continue;
-      const v = json.bufferViews[a.bufferView];
-      if (!v) throw new Error('accessor ' + ai + ': buffer view ' + a.bufferView + ' does not exist');
-      const x = v.extensions && (v.extensions.EXT_meshopt_compression || v.extensions.KHR_meshopt_compression);
-      if (x) {
-        const dec = await meshoptDecoder(this.meshoptUrl);
-        const src = this.buffer(x.buffer).subarray(x.byteOffset || 0, (x.byteOffset || 0) + x.byteLength);
-        const out = new Uint8Array(x.count * x.byteStride);
-        dec.decodeGltfBuffer(out, x.count, x.byteStride, src, x.mode, x.filter || 'NONE');
-        this.views[a.bufferView] = out;
-      } else {
-        const b = this.buffer(v.buffer), o = v.byteOffset || 0;
-        if (o + v.byteLength > b.length) throw new Error('buffer view ' + a.bufferView + ' runs past its buffer');
-        this.views[a.bufferView] = b.subarray(o, o + v.byteLength);
-      }
+      const a = this.json.accessors[ai];
+      if (!a) throw new Error('accessor ' + ai + ' does not exist');
+      if (a.bufferView !== undefined) await this.viewBytes(a.bufferView, 'accessor ' + ai + ': ');
     }
+  }
+
+  // The bytes of buffer view vi, decompressed.
+  async viewBytes(vi, what = '') {
+    if (this.views[vi]) return this.views[vi];
+    const v = (this.json.bufferViews || [])[vi];
+    if (!v) throw new Error(what + 'buffer view ' + vi + ' does not exist');
+    const x = v.extensions && (v.extensions.EXT_meshopt_compression || v.extensions.KHR_meshopt_compression);
+    if (x) {
+      const dec = await meshoptDecoder(this.meshoptUrl);
+      const src = this.buffer(x.buffer).subarray(x.byteOffset || 0, (x.byteOffset || 0) + x.byteLength);
+      const out = new Uint8Array(x.count * x.byteStride);
+      dec.decodeGltfBuffer(out, x.count, x.byteStride, src, x.mode, x.filter || 'NONE');
+      this.views[vi] = out;
+    } else {
+      const b = this.buffer(v.buffer), o = v.byteOffset || 0;
+      if (o + v.byteLength > b.length) throw new Error('buffer view ' + vi + ' runs past its buffer');
+      this.views[vi] = b.subarray(o, o + v.byteLength);
+    }
+    return this.views[vi];
   }
 
   // Accessor ai as numbers (normalised integers as glTF defines them), in
@@ -399,8 +405,10 @@ async function main() {
   const stream = vdshChooseStream(vx.streams, q.get('order'));
   const plan = vdshStreamPlan(stream, q.get('path'));
   const attrNames = [];
-  for (let g = 0; g < plan.groups; g++) {
-    const name = stream.attribute_prefix + g;
+  const cp = stream.cpca;  // a cpca stream: cluster and weight attributes, decoded at load
+  const want = cp ? [cp.cluster_attribute, ...Array.from({ length: cp.weight_attributes }, (_, g) => cp.weight_prefix + g)]
+    : Array.from({ length: plan.groups }, (_, g) => stream.attribute_prefix + g);
+  for (const name of want) {
     if (prim.attributes[name] === undefined) throw new Error('attribute ' + name + ' is missing (a tool dropped it? gltfpack: -kv)');
     attrNames.push(name);
   }
@@ -410,6 +418,7 @@ async function main() {
   const used = [prim.attributes.POSITION, prim.attributes.NORMAL, ...attrNames.map((n) => prim.attributes[n])];
   if (prim.indices !== undefined) used.push(prim.indices);
   await gltf.prepare(used);
+  const model = cp ? await gltf.viewBytes(cp.model_view) : null;
 
   // Positions and normals in world space (the node's transform applied).
   const M = meshMatrix(json);
@@ -488,7 +497,10 @@ async function main() {
   if (!gl) throw new Error('this browser gives no WebGL2 context');
   const coef = attrNames.map((n) => gltf.read(prim.attributes[n]));
   let bd = null;
-  if (buffer)  // each vertex's coefficients in a float texture (vdsh_core.js)
+  if (cp) {  // decoded at load (vdsh_core.js), then the buffer path
+    const dec = vdshCpcaDecode(stream, nv, coef[0], coef.slice(1), model), nc = stream.order * stream.order;
+    bd = vdshBufferData((v, i) => dec[v * nc + i], nv, stream, gl.getParameter(gl.MAX_TEXTURE_SIZE));
+  } else if (buffer)  // each vertex's coefficients in a float texture (vdsh_core.js)
     bd = vdshBufferData((v, i) => coef[i >> 2][4 * v + (i & 3)], nv, stream, gl.getParameter(gl.MAX_TEXTURE_SIZE));
   const src = glsl({ plan, lights: lights.length, output, texWidth: bd ? bd.width : 0 }, await loadShaders(q.get('shaders')));
   const sh = (type, s) => {
