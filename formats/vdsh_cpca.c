@@ -226,21 +226,43 @@ static void metric_free(metric_dirs *m)
     free(m->full);
 }
 
-/* g = sum over directions above the plane of normal nn of weight Y Y^T,
- * plus SPHERE_EPS times the whole sphere's. */
-static void metric_gram(const metric_dirs *m, const double nn[3], double *g)
+/* g = sum over directions of weight * (the fraction of the cluster's
+ * members whose hemisphere holds the direction) * Y Y^T, plus SPHERE_EPS
+ * times the whole sphere's: the mean of the members' own hemisphere
+ * metrics. `frac` is scratch (count). Members all facing one way (a
+ * room's wall) give metric_gram of their normal; a curved patch's
+ * members each keep weight on their own horizon. */
+static void metric_gram_members(const metric_dirs *m, const float *normals, const uint32_t *labels,
+                                uint32_t rows, uint32_t c, uint32_t members, double *frac,
+                                double *g)
 {
     uint32_t n = m->n;
+    for (uint32_t d = 0; d < m->count; d++)
+        frac[d] = 0.0;
+    for (uint32_t v = 0; v < rows; v++) {
+        if (labels[v] != c)
+            continue;
+        const float *nv = normals + 3 * (size_t)v;
+        double a = nv[0], b = nv[1], e = nv[2];
+        for (uint32_t d = 0; d < m->count; d++) {
+            const double *dd = m->dir + 3 * (size_t)d;
+            if (dd[0] * a + dd[1] * b + dd[2] * e > 0.0)
+                frac[d] += 1.0;
+        }
+    }
     for (size_t k = 0; k < (size_t)n * n; k++)
         g[k] = SPHERE_EPS * m->full[k];
     for (uint32_t d = 0; d < m->count; d++) {
-        const double *dd = m->dir + 3 * (size_t)d;
-        if (!(dd[0] * nn[0] + dd[1] * nn[1] + dd[2] * nn[2] > 0.0))
+        if (!(frac[d] > 0.0))
             continue;
+        double f = frac[d] / members;
         const double *y = m->wy + (size_t)d * n;
-        for (uint32_t a = 0; a < n; a++)
+        for (uint32_t a = 0; a < n; a++) {
+            double fa = f * y[a];
+            double *row = g + (size_t)a * n;
             for (uint32_t b = 0; b <= a; b++)
-                g[(size_t)a * n + b] += y[a] * y[b];
+                row[b] += fa * y[b];
+        }
     }
     for (uint32_t a = 0; a < n; a++)
         for (uint32_t b = 0; b < a; b++)
@@ -429,10 +451,11 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
     double *wmax = malloc(sizeof(double) * b);
     double *cerr = malloc(sizeof(double) * b * SCALE_CANDIDATES);
     uint32_t *idx = malloc(sizeof(uint32_t) * n);
+    double *frac = malloc(sizeof(double) * 6 * CUBE_N * CUBE_N);
     metric_dirs md = {0};
     vdsh_result res = VDSH_OK;
     if (!block || !labels || !dist || !cent || !g || !l || !sc || !sy || !ev || !proj || !tmp ||
-        !mu || !wmax || !cerr || !idx || !metric_init(&md, order)) {
+        !mu || !wmax || !cerr || !idx || !frac || !metric_init(&md, order)) {
         res = failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory (%zu bytes)", total);
         goto done;
     }
@@ -460,8 +483,7 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
 
     const int levels = vdsh_cpca_levels(bits);
     for (uint32_t c = 0; c < k; c++) {
-        /* members' mean (stored as f16) and mean normal */
-        double nn[3] = {0, 0, 0};
+        /* members' mean (stored as f16) */
         uint32_t members = 0;
         for (uint32_t i = 0; i < n; i++)
             mu[i] = 0.0;
@@ -471,8 +493,6 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
             members++;
             for (uint32_t i = 0; i < n; i++)
                 mu[i] += src[(size_t)v * n + i];
-            for (uint32_t q = 0; q < 3; q++)
-                nn[q] += normals[3 * (size_t)v + q];
         }
         if (!members)
             continue; /* mean, basis and scales 0; no vertex refers to it */
@@ -488,10 +508,7 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
             means[(size_t)c * n + i] = h;
             mu[i] = vdsh_f32_from_f16(h);
         }
-        double len = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
-        for (uint32_t q = 0; q < 3; q++)
-            nn[q] = len > 1e-12 ? nn[q] / len : 0.0;
-        metric_gram(&md, nn, g);
+        metric_gram_members(&md, normals, labels, rows, c, members, frac, g);
         if (!cholesky(g, n, l)) {
             res = failf(err, VDSH_ERR_INVALID, "cpca: cluster %u: metric not positive definite", c);
             goto done;
@@ -656,6 +673,7 @@ done:
     free(wmax);
     free(cerr);
     free(idx);
+    free(frac);
     metric_free(&md);
     return res;
 }

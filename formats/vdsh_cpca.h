@@ -10,8 +10,8 @@
  * (coefficients, then the vertex normal scaled to dominate), k-means++
  * seeding from a fixed seed, Lloyd rounds until no vertex moves (at most
  * 25); per cluster the mean (f16) and the B leading principal directions
- * of the deviations in the metric of the upper hemisphere of the
- * cluster's mean normal plus 0.01 of the whole sphere; weights quantised
+ * of the deviations in the mean of the members' own upper-hemisphere
+ * metrics plus 0.01 of the whole sphere; weights quantised
  * to `bits` bits with a scale per cluster and vector, chosen among the
  * largest |weight| x 1, 0.95, ..., 0.35 by least squared error. f64, one thread,
  * fixed order: the same bytes on any x86-64 CPU and thread count.

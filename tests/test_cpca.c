@@ -15,10 +15,18 @@
  *                  is refused with VDSH_ERR_INVALID or _CHUNK naming it;
  *                  every truncation is refused; the writer refuses a model
  *                  without arrays
+ *   curved cluster one cluster whose members face +x, -x and +z, one
+ *                  basis vector: a spike under +z's horizon that only
+ *                  the +x members vary by, and a weaker spike at +z that
+ *                  all vary by. The fit must serve each member in its
+ *                  own hemisphere: its error there, summed, below what
+ *                  capturing the weaker spike leaves (the mean normal's
+ *                  hemisphere, +z, would choose that one)
  *   settings       vdsh_cpca_parse accepts K,B,BITS and refuses the rest
  */
 #include "vdsh.h"
 #include "vdsh_cpca.h"
+#include "vdsh_sh.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -114,6 +122,66 @@ static void make_data(void)
         positions[3 * v] = (float)v;
         positions[3 * v + 1] = positions[3 * v + 2] = 0.0f;
     }
+}
+
+/* Sum over rows of the squared error e (rows x nc) over each row's own
+ * hemisphere (normal n), on a Fibonacci set of directions. */
+enum { CURVED_ORDER = 8, CURVED_NC = 64, CURVED_ROWS = 300, FIB = 4000 };
+static double own_hemisphere(const double *e, const float *n, int rows)
+{
+    double total = 0.0;
+    for (int d = 0; d < FIB; d++) {
+        double z = 1.0 - (2.0 * d + 1.0) / FIB, r = sqrt(1.0 - z * z), phi = 2.39996322972865 * d;
+        float dir[3] = {(float)(r * cos(phi)), (float)(r * sin(phi)), (float)z}, y[CURVED_NC];
+        vdsh_sh_eval(CURVED_ORDER, dir, y);
+        for (int v = 0; v < rows; v++) {
+            const float *nv = n + 3 * v;
+            if (!(nv[0] * dir[0] + nv[1] * dir[1] + nv[2] * dir[2] > 0.0f))
+                continue;
+            double f = 0.0;
+            for (int i = 0; i < CURVED_NC; i++)
+                f += e[(size_t)v * CURVED_NC + i] * y[i];
+            total += f * f * (4.0 * 3.14159265358979 / FIB);
+        }
+    }
+    return total;
+}
+
+static void curved_cluster(void)
+{
+    static float c[CURVED_ROWS * CURVED_NC], nrm[CURVED_ROWS * 3];
+    static double e[CURVED_ROWS * CURVED_NC], left[CURVED_ROWS * CURVED_NC];
+    static const float faces[3][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 0, 1}};
+    float d1[3] = {0.8944272f, 0.0f, -0.4472136f}, d2[3] = {0, 0, 1}, f1[CURVED_NC],
+          f2[CURVED_NC];
+    vdsh_sh_eval(CURVED_ORDER, d1, f1);
+    vdsh_sh_eval(CURVED_ORDER, d2, f2);
+    for (int v = 0; v < CURVED_ROWS; v++) {
+        int g = v % 3;
+        double a = g == 0 ? ((v / 3) % 2 ? 1.0 : -1.0) : 0.0, b = (v / 6) % 2 ? 0.4 : -0.4;
+        for (int i = 0; i < CURVED_NC; i++) {
+            c[v * CURVED_NC + i] = (float)(a * f1[i] + b * f2[i]);
+            left[(size_t)v * CURVED_NC + i] = a * f1[i]; /* what capturing f2 leaves */
+        }
+        memcpy(nrm + 3 * v, faces[g], sizeof faces[g]);
+    }
+    vdsh_cpca_settings st = {1, 1, 8};
+    vdsh_cpca_fit fit;
+    vdsh_error err = {{0}};
+    CHECK(vdsh_cpca_encode(c, nrm, CURVED_ROWS, CURVED_ORDER, &st, &fit, &err) == VDSH_OK,
+          "curved: %s", err.msg);
+    vdsh_stream s = {.order = CURVED_ORDER, .encoding = VDSH_ENCODING_CPCA, .scale = 1.0f,
+                     .data = fit.records, .cpca = fit.model};
+    for (uint32_t v = 0; v < CURVED_ROWS; v++) {
+        float dec[VDSH_MAX_COEFFS];
+        vdsh_stream_decode(&s, v, dec);
+        for (int i = 0; i < CURVED_NC; i++)
+            e[(size_t)v * CURVED_NC + i] = (double)dec[i] - c[v * CURVED_NC + i];
+    }
+    double got = own_hemisphere(e, nrm, CURVED_ROWS), alt = own_hemisphere(left, nrm, CURVED_ROWS);
+    CHECK(got < 0.8 * alt, "curved: own-hemisphere error %g, not below capturing the weak "
+                           "spike's %g", got, alt);
+    vdsh_cpca_fit_free(&fit);
 }
 
 static double rms_vs(const vdsh_stream *s, const float *want)
@@ -327,6 +395,8 @@ int main(int argc, char **argv)
     CHECK(vdsh_write_memory(&fb, &mem, &size, &err) == VDSH_ERR_ARGUMENT &&
               strstr(err.msg, "cpca"), "writer accepted a model without bases");
     vdsh_cpca_fit_free(&fit);
+
+    curved_cluster();
 
     /* settings */
     vdsh_cpca_settings p;
