@@ -396,8 +396,10 @@ vdsh_result vdsh_encode_s8(const float *src, size_t vertices, uint32_t nc, float
 
 /* One quantised record: nc coefficients c with per-index scales amax into
  * p (zeroed by the caller): stored = round(levels c / scale) in double
- * (|c| <= scale, so the quotient is finite for every finite scale,
- * subnormal ones too), ties away from 0, clamped to +-levels. */
+ * (the quotient of two finite floats is finite in double, subnormal
+ * scales too), ties away from 0, clamped to +-levels: a drawn receiver's
+ * |c| <= scale never needs it, an undrawn one's (vdsh_encode_quantised_drawn)
+ * may exceed its scale. */
 static void quantise_record(uint32_t encoding, const float *c, uint32_t nc, const float *amax,
                             uint8_t *p)
 {
@@ -419,6 +421,13 @@ static void quantise_record(uint32_t encoding, const float *c, uint32_t nc, cons
 vdsh_result vdsh_encode_quantised(uint32_t encoding, const float *src, size_t vertices,
                                   uint32_t nc, float *scales, void *dst)
 {
+    return vdsh_encode_quantised_drawn(encoding, src, vertices, nc, NULL, scales, dst);
+}
+
+vdsh_result vdsh_encode_quantised_drawn(uint32_t encoding, const float *src, size_t vertices,
+                                        uint32_t nc, const uint8_t *drawn, float *scales,
+                                        void *dst)
+{
     if (nc < 1 || nc > VDSH_MAX_COEFFS || !vdsh_encoding_quantised(encoding))
         return VDSH_ERR_ARGUMENT;
     float amax[VDSH_MAX_COEFFS] = {0};
@@ -427,15 +436,14 @@ vdsh_result vdsh_encode_quantised(uint32_t encoding, const float *src, size_t ve
             float a = fabsf(src[v * nc + i]);
             if (!isfinite(a))
                 return VDSH_ERR_INVALID;
-            amax[i] = a > amax[i] ? a : amax[i];
+            if (!drawn || drawn[v])
+                amax[i] = a > amax[i] ? a : amax[i];
         }
     for (uint32_t i = 0; i < nc; i++) {
         int levels = vdsh_quant_levels(encoding, i);
         if (!isfinite((float)levels * vdsh_quant_step(amax[i], levels)))
             return VDSH_ERR_INVALID; /* near FLT_MAX: `levels` steps would overflow */
     }
-    /* stored = round(levels c / scale) in double: |c| <= scale, so the
-     * quotient is finite for every finite scale, subnormal ones too. */
     size_t bpv = vdsh_encoding_bytes(encoding, nc);
     uint8_t *out = (uint8_t *)dst;
     if (vertices)
@@ -450,6 +458,15 @@ vdsh_result vdsh_encode_variable(uint32_t encoding, const float *src, size_t str
                                  const uint8_t *orders, uint32_t rows, uint32_t cap,
                                  float scale, const uint32_t *offsets, float *scales,
                                  void *dst)
+{
+    return vdsh_encode_variable_drawn(encoding, src, stride, orders, rows, cap, scale, offsets,
+                                      NULL, scales, dst);
+}
+
+vdsh_result vdsh_encode_variable_drawn(uint32_t encoding, const float *src, size_t stride,
+                                       const uint8_t *orders, uint32_t rows, uint32_t cap,
+                                       float scale, const uint32_t *offsets,
+                                       const uint8_t *drawn, float *scales, void *dst)
 {
     if (cap < 1 || cap > VDSH_MAX_ORDER || stride < (size_t)cap * cap ||
         encoding > VDSH_ENCODING_LAST || !(scale > 0.0f) || !isfinite(scale))
@@ -466,7 +483,8 @@ vdsh_result vdsh_encode_variable(uint32_t encoding, const float *src, size_t str
                 float a = fabsf(src[v * stride + i]);
                 if (!isfinite(a))
                     return VDSH_ERR_INVALID;
-                amax[i] = a > amax[i] ? a : amax[i];
+                if (!drawn || drawn[v])
+                    amax[i] = a > amax[i] ? a : amax[i];
             }
         for (uint32_t i = 0; i < cap * cap; i++) {
             int levels = vdsh_quant_levels(encoding, i);

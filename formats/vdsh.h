@@ -451,6 +451,16 @@ static inline float vdsh_quant_step(float scale, int levels) { return scale / (f
  * bits zero. VDSH_ERR_ARGUMENT also for an encoding that is not one. */
 vdsh_result vdsh_encode_quantised(uint32_t encoding, const float *src, size_t vertices,
                                   uint32_t nc, float *scales, void *dst);
+/* vdsh_encode_quantised with the scales taken over the drawn vertices only
+ * (drawn[v] != 0; NULL: every vertex): the others (receivers no triangle
+ * with area touches, never drawn, whose coefficients may be extreme) are
+ * stored clamped to their index's range, so they do not coarsen every
+ * receiver's steps. vdsh-bake and vdsh-merge both pass the mask of
+ * vb_drawn_receivers (bake/lib/mesh.h). Every value is still checked
+ * finite. */
+vdsh_result vdsh_encode_quantised_drawn(uint32_t encoding, const float *src, size_t vertices,
+                                        uint32_t nc, const uint8_t *drawn, float *scales,
+                                        void *dst);
 
 /* Encode a variable-order stream (VDSH.md "Variable-order streams"):
  * row v's first orders[v]^2 of its `stride` values in src (stride >=
@@ -465,6 +475,12 @@ vdsh_result vdsh_encode_variable(uint32_t encoding, const float *src, size_t str
                                  const uint8_t *orders, uint32_t rows, uint32_t cap,
                                  float scale, const uint32_t *offsets, float *scales,
                                  void *dst);
+/* vdsh_encode_variable whose s8, s8s6 scales are over the drawn rows only
+ * (drawn[v] != 0; NULL: every row), as vdsh_encode_quantised_drawn. */
+vdsh_result vdsh_encode_variable_drawn(uint32_t encoding, const float *src, size_t stride,
+                                       const uint8_t *orders, uint32_t rows, uint32_t cap,
+                                       float scale, const uint32_t *offsets,
+                                       const uint8_t *drawn, float *scales, void *dst);
 
 /* Bytes per vertex of encoding e at nc coefficients (0 if unknown). */
 size_t vdsh_encoding_bytes(uint32_t e, uint32_t nc);

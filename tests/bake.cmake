@@ -87,3 +87,12 @@ add_test(NAME bake_origins_zero_area
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_origins_zero_area.sh
                  $<TARGET_FILE:vdsh-bake>)
 set_tests_properties(bake_origins_zero_area PROPERTIES TIMEOUT 60)
+
+# The s8, s8s6 scales are over the drawn receivers only (receivers whose
+# triangles all have no area do not set them), in the whole bake and in
+# vdsh-merge (byte for byte, 1 and 3 shards).
+add_test(NAME bake_quant_drawn
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_quant_drawn.sh
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
+                 ${PROJECT_SOURCE_DIR}/python)
+set_tests_properties(bake_quant_drawn PROPERTIES TIMEOUT 60)

@@ -199,6 +199,11 @@ typedef struct vb_bake_output {
      * shard holds its own range only: its memory is its range's); or NULL
      * where the order was not asked for (and with trace_only). */
     float *coeffs[VDSH_ORDER_SLOTS];
+    /* Borrowed, may be NULL (every receiver): per receiver (all
+     * vertex_count, not the range's) 1 when drawn (vb_drawn_receivers).
+     * vb_bake_stream's s8, s8s6 scales are over the drawn rows only;
+     * vb_bake_fill_file sets it from the receivers it writes. */
+    const uint8_t *drawn;
     /* Adaptive order (order_tolerance > 0), else NULL and 0: per receiver
      * of the range its order 1..variable_cap, and variable_cap^2
      * coefficients (those past its order 0), vertex-major. */
@@ -247,7 +252,8 @@ void vb_bake_output_free(vb_bake_output *out);
  * order^2 coefficients per vertex of its range (all receivers but a
  * shard's), as f32, or as f16 scaled by the
  * stream's largest |coefficient| (stored values in [-1, 1]), encoded on
- * b->threads workers, or as s8 (vdsh_encode_s8). *storage receives the
+ * b->threads workers, or as s8 or s8s6 (vdsh_encode_quantised_drawn with
+ * b->drawn: scales over the drawn receivers). *storage receives the
  * block the stream points into (data, and an s8 stream's coef_scales);
  * the caller frees it. */
 /* The variable-order stream of an adaptive-order bake (b->variable_orders),

@@ -145,6 +145,17 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
     const vb_bake_output *b = &j->bake;
     uint32_t count = 0;
     j->coefficient_bytes = 0;
+    if (!d->shard_count) {
+        /* The quantised scales are over the drawn receivers (vdsh-merge
+         * derives the same mask from the merged file's POSN and TRIS). */
+        free(j->drawn);
+        if (!(j->drawn = malloc((size_t)j->receivers.vertex_count + 1)))
+            return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
+                           j->receivers.vertex_count);
+        vb_drawn_receivers(j->receivers.positions, j->receivers.vertex_count,
+                           j->receivers.indices, j->receivers.triangle_count, j->drawn);
+        j->bake.drawn = j->drawn;
+    }
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!b->coeffs[o])
             continue;
@@ -371,6 +382,7 @@ void vb_job_free(vb_job *j)
     for (int s = 0; s < VDSH_MAX_STREAMS; s++)
         free(j->stream_data[s]);
     vb_bake_output_free(&j->bake);
+    free(j->drawn);
     vb_scene_destroy(j->scene);
     vb_mesh_free(&j->receivers);
     vb_mesh_free(&j->occluders);

@@ -90,6 +90,7 @@ typedef struct vb_job {
     uint32_t source_count;
     vb_scene *scene;
     vb_bake_output bake;
+    uint8_t *drawn;            /* per receiver (vb_drawn_receivers): bake.drawn */
     vdsh_stream streams[VDSH_MAX_STREAMS];
     void *stream_data[VDSH_MAX_STREAMS];
     size_t coefficient_bytes;  /* per vertex, all fixed-order streams */

@@ -236,6 +236,42 @@ static void *alloc_array(size_t n, size_t size)
  * (may be NULL) marks them. */
 #define CANCEL 1e-5
 
+int vb_triangle_has_area(const float *positions, const uint32_t *ix)
+{
+    const float *a = positions + 3 * (size_t)ix[0];
+    const float *b = positions + 3 * (size_t)ix[1];
+    const float *c = positions + 3 * (size_t)ix[2];
+    double e1[3], e2[3];
+    for (int i = 0; i < 3; i++)
+        e1[i] = (double)b[i] - a[i], e2[i] = (double)c[i] - a[i];
+    double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2],
+           z = e1[0] * e2[1] - e1[1] * e2[0];
+    double len = sqrt(x * x + y * y + z * z);
+    return len > 0.0 && isfinite(len);
+}
+
+uint32_t vb_drawn_receivers(const float *positions, uint32_t vertex_count,
+                            const uint32_t *indices, uint32_t triangle_count, uint8_t *drawn)
+{
+    if (vertex_count)
+        memset(drawn, 0, vertex_count);
+    for (uint32_t t = 0; t < triangle_count; t++) {
+        const uint32_t *ix = indices + 3 * (size_t)t;
+        if (ix[0] >= vertex_count || ix[1] >= vertex_count || ix[2] >= vertex_count ||
+            !vb_triangle_has_area(positions, ix))
+            continue;
+        drawn[ix[0]] = drawn[ix[1]] = drawn[ix[2]] = 1;
+    }
+    uint32_t n = 0;
+    for (uint32_t v = 0; v < vertex_count; v++)
+        n += drawn[v];
+    if (n == 0 && vertex_count) {
+        memset(drawn, 1, vertex_count);
+        n = vertex_count;
+    }
+    return n;
+}
+
 /* Triangle t's corners (double) and unit normal; 0 when its indices are
  * out of range or it has no area, else twice its area. */
 static double triangle_normal(const vb_mesh *m, uint32_t t, double p[3][3], double n[3])

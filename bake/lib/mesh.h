@@ -257,6 +257,27 @@ vb_result vb_mesh_weld(vb_mesh *m, vb_error *err);
  * it NULL if that fails). */
 void vb_mesh_compute_normals(vb_mesh *m);
 
+/* Whether the triangle of corners ix (indices into positions, 3 floats a
+ * vertex) has area: its cross product in double from the float corners
+ * (exact: the differences and products of floats fit a double) is not
+ * zero and finite - vb_mesh_compute_normals' own test, by which a vertex
+ * whose triangles all fail it gets no computed normal. Such a triangle is
+ * drawn nowhere: it covers no pixel, Embree never hits it, and the
+ * evaluators' interior points, area weighted, never fall on it. */
+int vb_triangle_has_area(const float *positions, const uint32_t *ix);
+
+/* The drawn receivers: drawn[v] = 1 when one of the triangles around
+ * vertex v has area (vb_triangle_has_area), else 0 - a receiver drawn
+ * nowhere, whose origin the repair does not probe (origins.c) and whose
+ * coefficients do not set the quantised scales
+ * (vdsh_encode_quantised_drawn). Triangles with an index past
+ * vertex_count are skipped. When no vertex is drawn (no triangle has
+ * area), every one is marked drawn: then nothing is left out. Computed
+ * from positions and triangles only, so vdsh-bake (its receivers) and
+ * vdsh-merge (POSN, TRIS) agree. Returns the count marked drawn. */
+uint32_t vb_drawn_receivers(const float *positions, uint32_t vertex_count,
+                            const uint32_t *indices, uint32_t triangle_count, uint8_t *drawn);
+
 /* Receiver refinement: split edges longer than max_edge (OpenMesh) until
  * none is; conforming (both triangles of an edge are split), deterministic,
  * no edge split that is already short enough. Original vertices keep their

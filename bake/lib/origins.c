@@ -477,27 +477,6 @@ static vb_result frames_normals(const vb_mesh *m, frames *f, vb_error *err)
     return VB_OK;
 }
 
-/* Whether the triangle of corners ix has area: its cross product in
- * double from the float corners (exact: the differences and products of
- * floats fit a double) is not zero - the loader's own test (mesh.c,
- * triangle_normal), by which a vertex whose triangles all fail it gets no
- * computed normal. Such a triangle is drawn nowhere: it covers no pixel,
- * Embree never hits it, and the evaluators' interior points, area
- * weighted, never fall on it. */
-static int has_area(const vb_mesh *m, const uint32_t *ix)
-{
-    const float *a = m->positions + 3 * (size_t)ix[0];
-    const float *b = m->positions + 3 * (size_t)ix[1];
-    const float *c = m->positions + 3 * (size_t)ix[2];
-    double e1[3], e2[3];
-    for (int i = 0; i < 3; i++)
-        e1[i] = (double)b[i] - a[i], e2[i] = (double)c[i] - a[i];
-    double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2],
-           z = e1[0] * e2[1] - e1[1] * e2[0];
-    double len = sqrt(x * x + y * y + z * z);
-    return len > 0.0 && isfinite(len);
-}
-
 /* The frames of E's receivers. normals: E's normals per slot, borrowed (to
  * be oriented in place), or NULL: a copy of m's. Every per-receiver sum
  * (edge lengths, the centroids' pull) runs over the triangles in order, as
@@ -548,7 +527,7 @@ static vb_result frames_create(const vb_mesh *m, const vb_scene *s, const subset
             if (sl[(k + 1) % 3] != UINT32_MAX)
                 sum[sl[(k + 1) % 3]] += len, count[sl[(k + 1) % 3]]++;
         }
-        if (has_area(m, ix))
+        if (vb_triangle_has_area(m->positions, ix)) /* drawn: vb_drawn_receivers */
             for (int k = 0; k < 3; k++)
                 if (sl[k] != UINT32_MAX)
                     f->area[sl[k]] = 1;

@@ -1,7 +1,8 @@
 /* stream.c - a bake's coefficients as .vdsh streams (vb_bake_stream in
  * bake.h): f32 as they are, f16 scaled by the stream's largest
- * |coefficient|, encoded in chunks on the bake's workers, or s8 with a
- * scale per coefficient index (vdsh_encode_s8, one pass: bytes, cheap). */
+ * |coefficient|, encoded in chunks on the bake's workers, or s8, s8s6 with
+ * a scale per coefficient index over the drawn receivers
+ * (vdsh_encode_quantised_drawn, one pass: bytes, cheap). */
 #include "bake.h"
 
 #include <math.h>
@@ -97,8 +98,9 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encod
             return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the order %d stream",
                            order);
         uint8_t *bytes = (uint8_t *)(block + VDSH_MAX_COEFFS);
-        if (vdsh_encode_quantised(encoding, b->coeffs[order], rows, (uint32_t)nc,
-                                  block, bytes) != VDSH_OK) {
+        if (vdsh_encode_quantised_drawn(encoding, b->coeffs[order], rows, (uint32_t)nc,
+                                        b->drawn ? b->drawn + b->range_begin : NULL, block,
+                                        bytes) != VDSH_OK) {
             free(block);
             return vb_fail(err, VB_ERR_INVALID, "order %d coefficients do not fit %s", order,
                            vdsh_encoding_name(encoding));
@@ -174,8 +176,10 @@ vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encodin
             amax = fmaxf(amax, fabsf(b->variable_coeffs[i]));
         scale = vdsh_f16_scale(amax);
     }
-    if (vdsh_encode_variable(encoding, b->variable_coeffs, nc, b->variable_orders, rows,
-                             (uint32_t)cap, scale, offsets, scales, block + head) != VDSH_OK) {
+    if (vdsh_encode_variable_drawn(encoding, b->variable_coeffs, nc, b->variable_orders, rows,
+                                   (uint32_t)cap, scale, offsets,
+                                   b->drawn ? b->drawn + b->range_begin : NULL, scales,
+                                   block + head) != VDSH_OK) {
         free(block);
         return vb_fail(err, VB_ERR_INVALID, "adaptive-order coefficients do not fit %s",
                        vdsh_encoding_name(encoding));

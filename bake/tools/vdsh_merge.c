@@ -11,13 +11,15 @@
  * range vb_shard_range gives it. A refusal names the part (and, for
  * missing shards, their numbers). The coefficients are then copied range
  * by range and encoded as vdsh-bake encodes them (f16: scaled by the
- * stream's largest |coefficient|; s8, s8s6: vdsh_encode_quantised's scale
- * per coefficient index), the ray counts summed, and the file and
- * its basis cubemaps written atomically.
+ * stream's largest |coefficient|; s8, s8s6: vdsh_encode_quantised_drawn's
+ * scale per coefficient index, over the drawn receivers, which
+ * vb_drawn_receivers finds from the merged POSN and TRIS as vdsh-bake does
+ * from its receivers), the ray counts summed, and the file and its basis
+ * cubemaps written atomically.
  *
  * Memory: one part at a time is read (the first stays, to check the
  * others against). For f16, s8 and s8s6, whose scales are largest
- * |coefficient|s over all receivers, each part's f32 rows go to a spill
+ * |coefficient|s over all (s8, s8s6: all drawn) receivers, each part's f32 rows go to a spill
  * file beside the output (unlinked when made) while the largest |c|s are
  * gathered, then come back range by range to be encoded into the merged
  * streams. So memory is the merged file (receivers and encoded streams;
@@ -194,19 +196,22 @@ static FILE *spill_create(const char *output)
 /* Encode rows b..e-1 of merged stream *s (f16 or quantised), read from
  * the spill at its position, into dst (every receiver's bytes) with the
  * largest |coefficient|s of all receivers, amax (f16: amax[0], the
- * stream's; else per index): the bytes the whole bake's stream has for
- * them. A quantised encoding's scales are its largest |c|s over the
- * vertices it is given, so each call gets the rows after one row of amax
- * itself: the scales are then all receivers' (scales receives them), and a
+ * stream's; else per index, over the drawn receivers, drawn[v] != 0): the
+ * bytes the whole bake's stream has for them. A quantised encoding's
+ * scales are its largest |c|s over the drawn vertices it is given, so each
+ * call gets the rows after one row of amax itself, marked drawn: the
+ * scales are then all drawn receivers' (scales receives them), and a
  * receiver's bytes depend only on its values and the scales. 0, or 1 after
  * saying why. */
 static int encode_spilled(FILE *spill, const char *output, const vdsh_stream *s, void *dst,
-                          uint32_t b, uint32_t e, const float *amax, float *scales)
+                          uint32_t b, uint32_t e, const uint8_t *drawn, const float *amax,
+                          float *scales)
 {
     const uint32_t nc = s->order * s->order;
     const size_t bpv = vdsh_encoding_bytes(s->encoding, nc);
     float *rows = malloc(((size_t)ENCODE_ROWS + 1) * nc * sizeof *rows);
     uint8_t *bytes = malloc(((size_t)ENCODE_ROWS + 1) * bpv + 1);
+    uint8_t mask[ENCODE_ROWS + 1];
     int bad = !rows || !bytes;
     if (bad)
         fprintf(stderr, "vdsh-merge: out of memory\n");
@@ -221,8 +226,10 @@ static int encode_spilled(FILE *spill, const char *output, const vdsh_stream *s,
             bad = vdsh_encode_f16(rows + nc, (size_t)k * nc, s->scale,
                                   (uint16_t *)dst + (size_t)a * nc) != VDSH_OK;
         } else {
-            bad = vdsh_encode_quantised(s->encoding, rows, (size_t)k + 1, nc, scales, bytes) !=
-                      VDSH_OK ||
+            mask[0] = 1;
+            memcpy(mask + 1, drawn + a, k);
+            bad = vdsh_encode_quantised_drawn(s->encoding, rows, (size_t)k + 1, nc, mask, scales,
+                                              bytes) != VDSH_OK ||
                   memcmp(scales, amax, nc * sizeof *scales) != 0;
             if (!bad)
                 memcpy((uint8_t *)dst + (size_t)a * bpv, bytes + bpv, (size_t)k * bpv);
@@ -287,6 +294,7 @@ int main(int argc, char **argv)
     off_t *spill_at = NULL;              /* per shard: where its rows start */
     int *owner = NULL;
     float *normals = NULL;
+    uint8_t *drawn = NULL; /* per receiver, from the first part's POSN and TRIS */
     vb_cubemap_basis basis = {0};
     vdsh_file f = {0};
     vdsh_stream streams[VDSH_MAX_STREAMS];
@@ -319,6 +327,7 @@ int main(int argc, char **argv)
             f.stats.degenerate_receivers = f.stats.moved_origins = f.stats.flipped_normals = 0;
             int missing = !(owner = malloc((size_t)count * sizeof *owner)) ||
                           !(normals = malloc((size_t)V * 12 + 1)) ||
+                          !(drawn = malloc((size_t)V + 1)) ||
                           !(spill_at = malloc((size_t)count * sizeof *spill_at));
             for (uint32_t s = 0; s < p0->stream_count && !missing; s++) {
                 streams[s] = p0->streams[s];
@@ -341,6 +350,9 @@ int main(int argc, char **argv)
             }
             for (uint32_t k = 0; k < count; k++)
                 owner[k] = -1;
+            /* As vb_bake_fill_file: the receivers the s8, s8s6 scales are
+             * over (every part has the same POSN and TRIS: mismatch). */
+            vb_drawn_receivers(p0->positions, V, p0->indices, p0->header.triangle_count, drawn);
             if (target != VDSH_ENCODING_F32 && target != VDSH_ENCODING_CPCA &&
                 !(spill = spill_create(output)))
                 goto out;
@@ -390,7 +402,7 @@ int main(int argc, char **argv)
                     amax[s][0] = fmaxf(amax[s][0], fabsf(src[k]));
             else
                 for (size_t r = 0; r < e - b; r++)
-                    for (size_t k = 0; k < nc; k++)
+                    for (size_t k = 0; k < nc && drawn[b + r]; k++)
                         amax[s][k] = fmaxf(amax[s][k], fabsf(src[r * nc + k]));
         }
         vdsh_free(part);
@@ -447,8 +459,9 @@ int main(int argc, char **argv)
             streams[s].offsets = offsets[s];
             streams[s].coef_scales = vdsh_encoding_quantised(e) ? s8_scales[s] : NULL;
             if (!(encoded[s] = malloc(4 * (size_t)offsets[s][V] + 1)) ||
-                vdsh_encode_variable(e, merged[s], nc, orders[s], V, streams[s].order, scale,
-                                     offsets[s], s8_scales[s], encoded[s]) != VDSH_OK) {
+                vdsh_encode_variable_drawn(e, merged[s], nc, orders[s], V, streams[s].order,
+                                           scale, offsets[s], drawn, s8_scales[s],
+                                           encoded[s]) != VDSH_OK) {
                 fprintf(stderr, "vdsh-merge: adaptive-order coefficients do not fit %s\n",
                         vdsh_encoding_name(e));
                 goto out;
@@ -476,8 +489,8 @@ int main(int argc, char **argv)
             goto out;
         }
         for (uint32_t s = 0; s < f.stream_count; s++)
-            if (!orders[s] && encode_spilled(spill, output, &streams[s], encoded[s], b, e, amax[s],
-                               s8_scales[s]) != 0)
+            if (!orders[s] && encode_spilled(spill, output, &streams[s], encoded[s], b, e,
+                                             drawn, amax[s], s8_scales[s]) != 0)
                 goto out;
     }
 
@@ -509,6 +522,7 @@ out:
     free(spill_at);
     free(owner);
     free(normals);
+    free(drawn);
     vdsh_free(part);
     vdsh_free(p0);
     return status;
