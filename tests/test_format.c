@@ -992,6 +992,43 @@ static void test_encode_s8(void)
         CHECK(w1 == (31u | 31u << 6 | 31u << 12 | 31u << 18 | 33u << 24));
         CHECK(rd32(p6) == 0 && rd32(p6 + 8) == 0);
     }
+    /* drawn rows only set the scales; an undrawn row's values are clamped
+     * (huge past a subnormal scale too), the drawn rows' bytes are theirs
+     * alone, and an undrawn row must still be finite */
+    {
+        float q[9 * 3] = {1, -2, 0.5f, 1e-40f, 3, -31, 4, 0, 2,
+                          -3e38f, 7, -5, 3e38f, 1e30f, 62, -62, 0, -1,
+                          -4, 1, -1, 0, -6, 31, 2, 0.5f, -2},
+              d[9 * 2], sq[9], sd[9];
+        memcpy(d, q, sizeof d[0] * 9);
+        memcpy(d + 9, q + 18, sizeof d[0] * 9);
+        const uint8_t drawn[3] = {1, 0, 1};
+        uint8_t pq[3 * 9], pd[2 * 9];
+        for (int e = 0; e < 2; e++) {
+            uint32_t enc = e ? VDSH_ENCODING_S8S6 : VDSH_ENCODING_S8;
+            size_t bpv = vdsh_encoding_bytes(enc, 9);
+            CHECK(vdsh_encode_quantised_drawn(enc, q, 3, 9, drawn, sq, pq) == VDSH_OK &&
+                  vdsh_encode_quantised(enc, d, 2, 9, sd, pd) == VDSH_OK);
+            CHECK(memcmp(sq, sd, sizeof sq) == 0 && sq[0] == 4.0f && sq[3] == 1e-40f &&
+                  sq[4] == 6.0f);
+            CHECK(memcmp(pq, pd, bpv) == 0 && memcmp(pq + 2 * bpv, pd + bpv, bpv) == 0);
+            float row[9];
+            vdsh_stream st = {.order = 3, .encoding = enc, .scale = 1.0f, .coef_scales = sq,
+                              .data = pq};
+            vdsh_stream_decode(&st, 1, row);
+            for (int i = 0; i < 9; i++) {
+                float step = vdsh_quant_step(sq[i], vdsh_quant_levels(enc, i));
+                float want = q[9 + i] == 0.0f ? 0.0f
+                           : (q[9 + i] > 0 ? 1.0f : -1.0f) * fminf(fabsf(q[9 + i]), sq[i]);
+                CHECK(fabsf(row[i] - want) <= 0.5f * step * 1.0001f);
+            }
+            CHECK(vdsh_encode_quantised_drawn(enc, q, 3, 9, NULL, sq, pq) == VDSH_OK &&
+                  sq[0] == 3e38f);
+            q[10] = NAN;
+            CHECK(vdsh_encode_quantised_drawn(enc, q, 3, 9, drawn, sq, pq) == VDSH_ERR_INVALID);
+            q[10] = 7;
+        }
+    }
     CHECK(vdsh_encode_quantised(VDSH_ENCODING_F16, c, V, NC, sc, b) == VDSH_ERR_ARGUMENT);
     /* round to nearest, ties away from zero, at scale 127 (step 1) */
     float r[8] = {127.0f, 2.5f, -2.5f, 0.49f, -0.51f, 126.5f, -127.0f, 1e-30f};
