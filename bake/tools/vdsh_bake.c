@@ -220,7 +220,7 @@ static void usage(FILE *f)
 "                          decision: the loss's temperature (ln units), the\n"
 "                          weight of lit pairs, the ridge per (l(l+1))^2 and\n"
 "                          on every coefficient toward the lsq fit, Newton\n"
-"                          steps (default 0.5,8,1e-5,1e-4,6)\n"
+"                          steps (default 0.5,8,1e-5,1e-4,3)\n"
 "      --window W          per-band window on the coefficients: none (default),\n"
 "                          hann or lanczos (width: the order)\n"
 "      --log-floor D       log-distance: distances below D count as D\n"
