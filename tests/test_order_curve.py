@@ -12,8 +12,9 @@ cpca (4,12,4), C frames at 128 x 96. Checks:
   the same whole number: the model is counted, once per stream;
 - the cpca rows are the cpca file's own frames (not s8s6's: the scores
   differ);
-- an unknown encoding, or cpca with adaptive-order tolerances only, is
-  handled: the first an error naming it, cpca bakes no adaptive rows.
+- the adaptive-order rows: s8s6's variable-order stream (records of
+  orders 1..7, padded to words), cpca's a fixed cpca stream of the cap (order 7's records);
+- an unknown encoding is an error naming it.
 
 Usage: test_order_curve.py SCRIPTS_DIR BUILD_DIR
 """
@@ -75,10 +76,12 @@ with tempfile.TemporaryDirectory() as tmp:
         by = {(x["label"], x["encoding"], x["tolerance"]): x for x in rows}
         keys = sorted(by, key=str)
         want = [("3", "s8s6", None), ("7", "s8s6", None), ("3", "cpca", None),
-                ("7", "cpca", None), ("a7", "s8s6", 0.05)]
+                ("7", "cpca", None), ("a7", "s8s6", 0.05), ("a7", "cpca", 0.05)]
         check(sorted(want, key=str) == keys, "rows %s, want %s" % (keys, want))
-        check(not any(x["encoding"] == "cpca" and x["tolerance"] is not None for x in rows),
-              "cpca has no adaptive-order rows")
+        x = by.get(("a7", "s8s6", 0.05))
+        # the largest record is one of orders 1, 2, 3, 5, 7's (4-byte words)
+        check(x and x["max_bytes"] in (4, 8, 24, 40) and 0 < x["bytes"] <= x["max_bytes"],
+              "adaptive s8s6: %r" % ((x and (x["bytes"], x["max_bytes"])),))
         for key in want:
             x = by.get(key)
             if not x:
@@ -93,20 +96,21 @@ with tempfile.TemporaryDirectory() as tmp:
             check(x and x["bytes"] == want_b and x["max_bytes"] == want_b,
                   "s8s6 order %s: %s bytes per vertex, want %d" % (o, x and x["bytes"], want_b))
         implied = []
-        for o in (3, 7):
-            x = by.get((str(o), "cpca", None))
+        for o, key in ((3, ("3", "cpca", None)), (7, ("7", "cpca", None)),
+                       (7, ("a7", "cpca", 0.05))):
+            x = by.get(key)
             if not x:
                 continue
             b = min(B, o * o)
             rec = 4 * cpca_words(b, BITS)
-            check(x["max_bytes"] == rec, "cpca order %d: records %s bytes, want %d"
-                  % (o, x["max_bytes"], rec))
+            check(x["max_bytes"] == rec, "cpca %s: records %s bytes, want %d"
+                  % (key, x["max_bytes"], rec))
             extra = x["bytes"] - rec
-            check(extra > 0, "cpca order %d: the model is not counted (%s)" % (o, x["bytes"]))
+            check(extra > 0, "cpca %s: the model is not counted (%s)" % (key, x["bytes"]))
             if extra > 0:
                 implied.append(model_bytes(o, K, b) / extra)
-        check(len(implied) == 2 and all(abs(v - round(v)) < 0.01 for v in implied) and
-              round(implied[0]) == round(implied[1]) and implied[0] > 100,
+        check(len(implied) == 3 and all(abs(v - round(v)) < 0.01 for v in implied) and
+              len({round(v) for v in implied}) == 1 and implied[0] > 100,
               "receivers implied by the cpca rows' model bytes: %s" % implied)
         a, c = by.get(("7", "s8s6", None)), by.get(("7", "cpca", None))
         check(a and c and a.get("frames") and c.get("frames") and
