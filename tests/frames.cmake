@@ -115,6 +115,19 @@ if(Python3_Interpreter_FOUND AND TARGET vb_frames)
                    ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR})
 endif()
 
+# scripts/order_curve's encoding axis (issue 29; test_order_curve.py):
+# validation room 3 at --max-edge 0.6, 100 rays, orders 3 and 7 in s8s6
+# and cpca 4,12,4, and an adaptive order (cap 7) in each, C frames at 128
+# x 96: a row per order and encoding with frame scores; bytes per vertex
+# are the spec's records (cpca: plus its model over the receivers; its
+# adaptive order a fixed stream of the cap); an unknown encoding is an
+# error. No GL.
+if(Python3_Interpreter_FOUND AND TARGET vb_frames)
+  add_test(NAME order_curve_script
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_order_curve.py
+                   ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR})
+endif()
+
 # scripts/pareto --quick: the speed-against-error report at its smallest
 # (the room at --max-edge 1, the 3-view test set, a few modes, 1 and 3
 # lights): its CSV and JSON rows complete and finite, the GL counts of

@@ -4,8 +4,10 @@
 # shards merged, give the same bytes; the decoded stream stays close to
 # the f32 bake of the same options (with the full basis and 8-bit weights
 # within f16 and quantisation rounding; with the default-like settings
-# well below the coefficients' spread); bad settings are usage errors and
-# parts of other settings are refused by the merge.
+# well below the coefficients' spread); --adaptive-order's stream, as a
+# fixed cpca stream of its cap, is alike (threads, shards, decode error);
+# bad settings are usage errors and parts of other settings are refused by
+# the merge.
 # Usage: test_cpca_bake.sh VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR
 set -u
 bake=$1 merge=$2 info=$3 src=$4
@@ -63,6 +65,45 @@ for name, bound in (("w1", 0.5), ("full", 0.02)):
         assert err < bound, (name, s["order"], err)
 PY
 
+# --adaptive-order: the variable-order stream's rows (zeros past each
+# vertex's order) as a fixed cpca stream of the cap, whole bake = 2 threads
+# = 3 shards merged; decoded close to the f32 adaptive-order stream.
+ad=(builtin:room --max-edge 1.0 --rays 64 --cube-size 0 -q --adaptive-order 0.02 --max-order 7)
+expect_exit 0 "adaptive cpca, 1 thread" "$bake" "${ad[@]}" "${cp[@]}" --threads 1 -o "$tmp/a1.vdsh"
+expect_exit 0 "adaptive cpca, 2 threads" "$bake" "${ad[@]}" "${cp[@]}" --threads 2 -o "$tmp/a2.vdsh"
+check "adaptive cpca, 1 and 2 threads: identical" cmp "$tmp/a1.vdsh" "$tmp/a2.vdsh"
+mkdir -p "$tmp/a3"
+for i in 0 1 2; do
+  expect_exit 0 "adaptive cpca shard $i/3" "$bake" "${ad[@]}" "${cp[@]}" --shard "$i/3" \
+    -o "$tmp/a3/p$i.vdsh"
+done
+expect_exit 0 "adaptive cpca merge" "$merge" -q "$tmp"/a3/p*.vdsh -o "$tmp/a3/scene.vdsh"
+check "adaptive cpca, 3 shards: identical to the whole bake" cmp "$tmp/a3/scene.vdsh" "$tmp/a1.vdsh"
+expect_exit 0 "adaptive f32" "$bake" "${ad[@]}" --encoding f32 -o "$tmp/af32.vdsh"
+expect_exit 0 "adaptive, full basis" "$bake" "${ad[@]}" --encoding cpca --cpca 2,49,8 \
+  -o "$tmp/afull.vdsh"
+check "adaptive: decode error bounded" /usr/bin/python3 - "$src/python" "$tmp" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[1])
+import numpy as np
+import vdsh
+t = sys.argv[2]
+ref = vdsh.read(t + "/af32.vdsh").streams
+assert len(ref) == 1 and ref[0]["variable_order"] and ref[0]["order"] == 7, ref
+x = vdsh.coefficients(ref[0]).astype(np.float64)  # zero past each vertex's order
+k = ref[0]["orders"]
+assert (x[k < 7][:, 49 - 13:] == 0).all() and len(set(k.tolist())) > 1, "not a mix of orders"
+spread = np.sqrt(((x - x.mean(0)) ** 2).sum(1).mean())
+for name, bound in (("a1", 0.5), ("afull", 0.02)):
+    f = vdsh.read(t + "/" + name + ".vdsh").streams
+    assert len(f) == 1 and f[0]["encoding"] == "cpca" and f[0]["order"] == 7, f
+    assert not f[0]["variable_order"] and f[0]["method"] == ref[0]["method"]
+    c = vdsh.coefficients(f[0]).astype(np.float64)
+    err = np.sqrt(((c - x) ** 2).sum(1).mean()) / spread
+    print("adaptive %s: error %.4f of the spread (bound %g)" % (name, err, bound))
+    assert err < bound, (name, err)
+PY
+
 # Usage errors and refusals.
 out=$tmp/none.vdsh
 expect_exit 2 "--cpca without --encoding cpca" "$bake" "${tiny[@]}" --cpca 4,20,4 -o "$out"
@@ -71,9 +112,9 @@ for bad in 0,20,4 4,0,4 4,20,1 4,20,9 4,20 x; do
   expect_exit 2 "--cpca $bad" "$bake" "${tiny[@]}" --encoding cpca --cpca "$bad" -o "$out"
   says "--cpca $bad" "--cpca takes K,B,BITS"
 done
-expect_exit 2 "--adaptive-order with cpca" "$bake" "${tiny[@]}" --encoding cpca \
-  --adaptive-order 0.02 -o "$out"
-says "--adaptive-order with cpca" "does not encode adaptive-order streams"
+expect_exit 2 "--adaptive-order with cpca and its cap in --orders" "$bake" "${tiny[@]}" \
+  --encoding cpca --adaptive-order 0.02 --max-order 7 -o "$out"
+says "--adaptive-order's cap in --orders" "--orders cannot hold that order too"
 expect_exit 0 "a part of other settings" "$bake" "${tiny[@]}" --encoding cpca --cpca 4,21,4 \
   --shard 2/3 -o "$tmp/other-2.vdsh"
 expect_exit 1 "merge refuses other settings" "$merge" -q "$tmp"/n3/p0.vdsh "$tmp"/n3/p1.vdsh \

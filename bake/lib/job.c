@@ -140,6 +140,47 @@ static vdsh_cpca_settings job_cpca(const vb_job_desc *d)
     return d->cpca.clusters ? d->cpca : vdsh_cpca_settings_default();
 }
 
+/* --encoding cpca with --adaptive-order: the variable-order stream (f32, in
+ * j->streams[s]) becomes a fixed stream of its cap's order whose rows are
+ * each vertex's coefficients with zeros past its own order, cpca-encoded
+ * by the global step, as vdsh-merge does with the joined parts' rows
+ * (formats/VDSH.md, "cpca streams": the cpca layout has no order table). */
+static vb_result cpca_variable(vb_job *j, const vb_job_desc *d, uint32_t s, vb_error *err)
+{
+    const uint32_t V = j->receivers.vertex_count;
+    vdsh_stream var = j->streams[s];
+    const size_t nc = (size_t)var.order * var.order;
+    float *rows = malloc((size_t)V * nc * sizeof *rows + 1);
+    if (!rows)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the adaptive-order rows");
+    for (uint32_t v = 0; v < V; v++)
+        vdsh_stream_decode(&var, v, rows + v * nc); /* zeros past the vertex's order */
+    vdsh_stream f32 = var;
+    f32.flags = 0;
+    f32.orders = NULL;
+    f32.offsets = NULL;
+    f32.coef_scales = NULL;
+    f32.data = rows;
+    vdsh_cpca_settings st = job_cpca(d);
+    vdsh_error e;
+    void *storage = NULL;
+    const float *nrm = j->bake.normals ? j->bake.normals : j->receivers.normals;
+    vdsh_result er = vdsh_cpca_encode_stream(&f32, V, nrm, &st, &j->streams[s], &storage, NULL,
+                                             &e);
+    free(rows);
+    free(j->stream_data[s]);
+    j->stream_data[s] = storage;
+    if (er != VDSH_OK) {
+        j->streams[s] = var; /* its block is freed: nothing of it stays */
+        j->streams[s].data = NULL;
+        j->streams[s].orders = NULL;
+        j->streams[s].offsets = NULL;
+        return vb_fail(err, er == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_INVALID,
+                       "adaptive-order stream: %s", e.msg);
+    }
+    return VB_OK;
+}
+
 vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
 {
     const vb_bake_output *b = &j->bake;
@@ -194,18 +235,18 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         j->coefficient_bytes += vdsh_stream_bytes_per_vertex(&j->streams[count]);
         count++;
     }
-    if (b->variable_orders && job_encoding(d) == VDSH_ENCODING_CPCA)
-        return vb_fail(err, VB_ERR_ARGUMENT,
-                       "--encoding cpca does not encode adaptive-order streams yet: use "
-                       "fixed orders (--orders) with it, or another encoding");
     if (b->variable_orders) { /* adaptive order: its average bytes per vertex */
-        vb_result r = vb_bake_variable_stream(b, d->shard_count ? VDSH_ENCODING_F32
-                                                                : job_encoding(d),
+        int cpca = !d->shard_count && job_encoding(d) == VDSH_ENCODING_CPCA;
+        vb_result r = vb_bake_variable_stream(b, d->shard_count || cpca ? VDSH_ENCODING_F32
+                                                                        : job_encoding(d),
                                               &j->streams[count], &j->stream_data[count], err);
         if (r != VB_OK)
             return r;
         uint32_t rows = b->range_end ? b->range_end - b->range_begin : b->vertex_count;
-        j->variable_bytes = (double)vdsh_stream_data_bytes(&j->streams[count], rows) / rows;
+        if (cpca && (r = cpca_variable(j, d, count, err)) != VB_OK)
+            return r;
+        j->variable_bytes = cpca ? vdsh_stream_size_of(&j->streams[count], rows).mean_bytes
+                                 : (double)vdsh_stream_data_bytes(&j->streams[count], rows) / rows;
         count++;
         free(j->bake.variable_coeffs);
         j->bake.variable_coeffs = NULL;

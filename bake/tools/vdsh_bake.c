@@ -160,7 +160,10 @@ static void usage(FILE *f)
 "                          compact ones within 0.1%% of f16: docs/ACCURACY.md;\n"
 "                          or cpca: clustered PCA of each order's coefficients\n"
 "                          (for orders 7..16: order 12 in ~30-32 bytes per\n"
-"                          vertex; docs/ACCURACY.md \"Compressed high orders\")\n"
+"                          vertex; docs/ACCURACY.md \"Compressed high orders\");\n"
+"                          with --adaptive-order, its stream is written as a\n"
+"                          fixed cpca stream of order --max-order (zeros past\n"
+"                          each vertex's order)\n"
 "      --cpca K,B,BITS     cpca settings: clusters (1..256), basis vectors per\n"
 "                          cluster (capped at order^2), bits per weight (2..8);\n"
 "                          default 8,54,4\n"
@@ -914,9 +917,18 @@ int main(int argc, char **argv)
     }
     if (o.have_cpca && o.encoding != VDSH_ENCODING_CPCA)
         return bad_usage("--cpca %s needs --encoding cpca", "K,B,BITS");
-    if (o.encoding == VDSH_ENCODING_CPCA && o.order_tolerance > 0.0f)
-        return bad_usage("--encoding cpca does not encode adaptive-order streams (%s): use "
-                         "fixed --orders with it", "--adaptive-order");
+    if (o.encoding == VDSH_ENCODING_CPCA && o.order_tolerance > 0.0f && o.orders_given) {
+        /* cpca writes the adaptive-order stream as a fixed stream of its cap */
+        int cap = o.max_order ? o.max_order : VB_DEFAULT_ORDER_CAP;
+        for (int s = 0; s < o.order_count; s++)
+            if (o.orders[s] == cap) {
+                char n[8];
+                snprintf(n, sizeof n, "%d", cap);
+                return bad_usage("--encoding cpca writes --adaptive-order's stream as a "
+                                 "fixed stream of its --max-order, %s: --orders cannot "
+                                 "hold that order too", n);
+            }
+    }
     if (o.have_ray_tolerance && !o.adaptive_rays)
         return bad_usage("%s needs --rays auto", "--ray-tolerance");
     if ((o.min_edge > 0.0f || o.max_receivers || o.max_rounds) && !o.adaptive)

@@ -427,14 +427,21 @@ int main(int argc, char **argv)
         size_t nc = (size_t)streams[s].order * streams[s].order;
         streams[s].data = target == VDSH_ENCODING_F32 ? (void *)merged[s] : encoded[s];
         streams[s].encoding = target;
-        if (target == VDSH_ENCODING_CPCA && !orders[s]) {
+        if (target == VDSH_ENCODING_CPCA) {
             /* As vb_bake_fill_file: the global step over every receiver,
-             * with the merged (oriented) normals, one encoder. */
+             * with the merged (oriented) normals, one encoder. A
+             * variable-order stream's rows (zeros past each vertex's
+             * order) become a fixed stream of its cap, as cpca_variable
+             * (bake/lib/job.c) writes it. */
             vdsh_cpca_settings st = {p0->part.cpca_clusters, p0->part.cpca_basis,
                                      p0->part.cpca_bits};
             vdsh_stream f32 = streams[s];
             f32.encoding = VDSH_ENCODING_F32;
             f32.scale = 1.0f;
+            f32.flags = 0;
+            f32.orders = NULL;
+            f32.offsets = NULL;
+            f32.coef_scales = NULL;
             f32.data = merged[s];
             vdsh_error e;
             if (vdsh_cpca_encode_stream(&f32, V, normals, &st, &streams[s], &encoded[s], NULL,
