@@ -6,6 +6,7 @@
  * (-std=c11: no fused multiply-add contraction): the same bytes on any
  * x86-64 CPU and whatever the caller's thread count. */
 #include "vdsh_cpca.h"
+#include "vdsh_failf.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -30,31 +31,20 @@ vdsh_cpca_settings vdsh_cpca_settings_default(void)
     return s;
 }
 
-static vdsh_result failf(vdsh_error *err, vdsh_result r, const char *fmt, ...)
-{
-    if (err) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err->msg, sizeof err->msg, fmt, ap);
-        va_end(ap);
-    }
-    return r;
-}
-
 static int check_settings(const vdsh_cpca_settings *s, vdsh_error *err)
 {
     if (s->clusters < 1 || s->clusters > VDSH_CPCA_MAX_CLUSTERS) {
-        failf(err, VDSH_ERR_ARGUMENT, "cpca: clusters %u out of range 1..%d", s->clusters,
+        vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: clusters %u out of range 1..%d", s->clusters,
               VDSH_CPCA_MAX_CLUSTERS);
         return 0;
     }
     if (s->basis < 1 || s->basis > VDSH_MAX_COEFFS) {
-        failf(err, VDSH_ERR_ARGUMENT, "cpca: basis %u out of range 1..%d", s->basis,
+        vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: basis %u out of range 1..%d", s->basis,
               VDSH_MAX_COEFFS);
         return 0;
     }
     if (s->bits < VDSH_CPCA_MIN_BITS || s->bits > VDSH_CPCA_MAX_BITS) {
-        failf(err, VDSH_ERR_ARGUMENT, "cpca: bits %u out of range %d..%d", s->bits,
+        vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: bits %u out of range %d..%d", s->bits,
               VDSH_CPCA_MIN_BITS, VDSH_CPCA_MAX_BITS);
         return 0;
     }
@@ -68,12 +58,12 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
     for (int k = 0; k < 3; k++) {
         char *end;
         if (*p < '0' || *p > '9')
-            return failf(err, VDSH_ERR_ARGUMENT,
+            return vdsh_failf(err, VDSH_ERR_ARGUMENT,
                          "cpca settings '%s': expected K,B,BITS (for example 8,54,4)",
                          text ? text : "");
         v[k] = strtoul(p, &end, 10);
         if (v[k] > 100000 || *end != (k < 2 ? ',' : '\0'))
-            return failf(err, VDSH_ERR_ARGUMENT,
+            return vdsh_failf(err, VDSH_ERR_ARGUMENT,
                          "cpca settings '%s': expected K,B,BITS (for example 8,54,4)", text);
         p = end + (k < 2);
     }
@@ -421,7 +411,7 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
     memset(out, 0, sizeof *out);
     if (!src || !normals || !settings || rows < 1 || rows > VDSH_MAX_VERTICES || order < 1 ||
         order > VDSH_MAX_ORDER)
-        return failf(err, VDSH_ERR_ARGUMENT, "cpca: bad arguments (rows %u, order %u)", rows,
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: bad arguments (rows %u, order %u)", rows,
                      order);
     if (!check_settings(settings, err))
         return VDSH_ERR_ARGUMENT;
@@ -432,7 +422,8 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
     const uint32_t words = vdsh_cpca_record_words(b, bits);
     for (size_t x = 0; x < (size_t)rows * n; x++)
         if (!isfinite(src[x]))
-            return failf(err, VDSH_ERR_INVALID, "cpca: vertex %zu coefficient %zu is not finite",
+            return vdsh_failf(err, VDSH_ERR_INVALID,
+                              "cpca: vertex %zu coefficient %zu is not finite",
                          x / n, x % n);
 
     /* one block: scales, means, bases, records */
@@ -456,7 +447,7 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
     vdsh_result res = VDSH_OK;
     if (!block || !labels || !dist || !cent || !g || !l || !sc || !sy || !ev || !proj || !tmp ||
         !mu || !wmax || !cerr || !idx || !frac || !metric_init(&md, order)) {
-        res = failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory (%zu bytes)", total);
+        res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory (%zu bytes)", total);
         goto done;
     }
     float *scales = (float *)block;
@@ -500,7 +491,7 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
             float m = (float)(mu[i] / members);
             uint16_t h = vdsh_f16_from_f32(m);
             if ((h & 0x7c00u) == 0x7c00u) {
-                res = failf(err, VDSH_ERR_INVALID,
+                res = vdsh_failf(err, VDSH_ERR_INVALID,
                             "cpca: cluster %u's mean coefficient %u, %g, does not fit f16", c, i,
                             (double)m);
                 goto done;
@@ -510,7 +501,8 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
         }
         metric_gram_members(&md, normals, labels, rows, c, members, frac, g);
         if (!cholesky(g, n, l)) {
-            res = failf(err, VDSH_ERR_INVALID, "cpca: cluster %u: metric not positive definite", c);
+            res = vdsh_failf(err, VDSH_ERR_INVALID,
+                             "cpca: cluster %u: metric not positive definite", c);
             goto done;
         }
         /* scatter of the deviations from the stored mean (lower half) */
@@ -577,7 +569,7 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
             for (uint32_t a = 0; a < n; a++) {
                 uint16_t h = vdsh_f16_from_f32((float)bv[a]);
                 if ((h & 0x7c00u) == 0x7c00u) {
-                    res = failf(err, VDSH_ERR_INVALID,
+                    res = vdsh_failf(err, VDSH_ERR_INVALID,
                                 "cpca: cluster %u basis vector %u does not fit f16", c, j);
                     goto done;
                 }
@@ -684,7 +676,7 @@ vdsh_result vdsh_cpca_encode_stream(const vdsh_stream *src, uint32_t rows, const
 {
     if (!src || src->encoding != VDSH_ENCODING_F32 || src->scale != 1.0f ||
         (src->flags & VDSH_STREAM_VARIABLE) || !src->data)
-        return failf(err, VDSH_ERR_ARGUMENT,
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT,
                      "cpca: the source must be a fixed-order f32 stream with scale 1");
     vdsh_cpca_fit fit;
     vdsh_result r = vdsh_cpca_encode((const float *)src->data, normals, rows, src->order,

@@ -3,6 +3,7 @@
  * vdsh_output.h for the contract).
  */
 #include "vdsh_output.h"
+#include "vdsh_failf.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -17,10 +18,7 @@
  * (or planted) are skipped, one attempt each. */
 enum { MAX_ATTEMPTS = 1000 };
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 3, 4)))
-#endif
-static vdsh_result fail(vdsh_error *err, vdsh_result r, const char *fmt, ...)
+vdsh_result vdsh_failf(vdsh_error *err, vdsh_result r, const char *fmt, ...)
 {
     if (err) {
         va_list ap;
@@ -54,19 +52,19 @@ static int open_stream(const char *path, vdsh_output *o, vdsh_error *err, vdsh_r
     if (stat(path, &st) != 0 || S_ISREG(st.st_mode))
         return 0;
     if (!S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode)) {
-        *res = fail(err, VDSH_ERR_IO, "%s: cannot write: %s", path,
+        *res = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot write: %s", path,
                     S_ISDIR(st.st_mode) ? "is a directory" : "not a regular file");
         return -1;
     }
     int fd = open(path, O_WRONLY | O_NOCTTY | O_CLOEXEC);
     if (fd < 0) {
-        *res = fail(err, VDSH_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+        *res = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
         return -1;
     }
     /* What was opened, not what stat saw a moment ago, decides. */
     if (fstat(fd, &st) != 0 || (!S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode))) {
         close(fd);
-        *res = fail(err, VDSH_ERR_IO, "%s: cannot write: not a regular file "
+        *res = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot write: not a regular file "
                     "(it changed while being opened)", path);
         return -1;
     }
@@ -81,13 +79,13 @@ vdsh_result vdsh_output_open(const char *path, vdsh_output *out, vdsh_error *err
     if (out)
         *out = o;
     if (!out || !path || !path[0])
-        return fail(err, VDSH_ERR_ARGUMENT, "%s: cannot write: no file name given",
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "%s: cannot write: no file name given",
                     path ? path : "(null)");
     vdsh_result res = VDSH_OK;
     size_t len = strlen(path);
     o.path = malloc(len + 1);
     if (!o.path)
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+        return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
     memcpy(o.path, path, len + 1);
 
     int stream = open_stream(path, &o, err, &res);
@@ -100,7 +98,7 @@ vdsh_result vdsh_output_open(const char *path, vdsh_output *out, vdsh_error *err
         o.tmp = malloc(cap);
         if (!o.tmp) {
             release(&o);
-            return fail(err, VDSH_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+            return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
         }
         int e = 0;
         for (int attempt = 0; attempt < MAX_ATTEMPTS; attempt++) {
@@ -112,7 +110,7 @@ vdsh_result vdsh_output_open(const char *path, vdsh_output *out, vdsh_error *err
                 break;
         }
         if (o.fd < 0) {
-            res = fail(err, VDSH_ERR_IO, "%s: cannot create a temporary file beside it "
+            res = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot create a temporary file beside it "
                        "(%s): %s", path, o.tmp, e == EEXIST ? "every name taken" : strerror(e));
             free(o.tmp); /* not ours: never unlink it */
             o.tmp = NULL;
@@ -124,7 +122,7 @@ vdsh_result vdsh_output_open(const char *path, vdsh_output *out, vdsh_error *err
     if (!o.fp) {
         int e = errno;
         release(&o);
-        return fail(err, VDSH_ERR_IO, "%s: cannot write: %s", path, strerror(e));
+        return vdsh_failf(err, VDSH_ERR_IO, "%s: cannot write: %s", path, strerror(e));
     }
     *out = o;
     return VDSH_OK;
@@ -144,7 +142,7 @@ size_t vdsh_output_put(vdsh_output *o, const void *data, size_t n)
 vdsh_result vdsh_output_finish(vdsh_output *o, vdsh_error *err)
 {
     if (!o || !o->path)
-        return fail(err, VDSH_ERR_ARGUMENT, "vdsh_output_finish: no open output");
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "vdsh_output_finish: no open output");
     if (o->finished)
         return VDSH_OK;
     /* errno of the first step that failed; a write error that stdio only
@@ -173,10 +171,10 @@ vdsh_result vdsh_output_finish(vdsh_output *o, vdsh_error *err)
     if (e) {
         vdsh_result r;
         if (o->tmp)
-            r = fail(err, VDSH_ERR_IO, "%s: cannot %s (temporary file %s): %s", o->path,
+            r = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot %s (temporary file %s): %s", o->path,
                      step, o->tmp, strerror(e));
         else
-            r = fail(err, VDSH_ERR_IO, "%s: cannot %s: %s", o->path, step, strerror(e));
+            r = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot %s: %s", o->path, step, strerror(e));
         release(o);
         return r;
     }
@@ -218,7 +216,7 @@ vdsh_result vdsh_output_commit(vdsh_output *o, vdsh_error *err)
     if (o->tmp) {
         if (rename(o->tmp, o->path) != 0) {
             int e = errno;
-            r = fail(err, VDSH_ERR_IO, "%s: cannot rename %s to it: %s", o->path, o->tmp,
+            r = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot rename %s to it: %s", o->path, o->tmp,
                      strerror(e));
             release(o);
             return r;

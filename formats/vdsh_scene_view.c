@@ -1,5 +1,6 @@
 /* A scene's default view: vdsh_scene_view.h says what and why. */
 #include "vdsh_scene_view.h"
+#include "vdsh_failf.h"
 
 #include "vdsh_light.h"
 
@@ -8,17 +9,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static vdsh_result fail(vdsh_error *err, vdsh_result r, const char *fmt, ...)
-{
-    if (err) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err->msg, sizeof err->msg, fmt, ap);
-        va_end(ap);
-    }
-    return r;
-}
 
 /* ---- cameras and preferred lights, from the bounds ------------------- */
 
@@ -336,12 +326,12 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
 {
     for (size_t i = 0; i < 3 * (size_t)m->triangle_count; i++)
         if (m->indices[i] >= m->vertex_count)
-            return fail(err, VDSH_ERR_INVALID,
+            return vdsh_failf(err, VDSH_ERR_INVALID,
                         "mesh: triangle %zu: vertex index %u not below the %u vertices", i / 3,
                         m->indices[i], m->vertex_count);
     vdsh_view_tracer *g = calloc(1, sizeof *g);
     if (!g)
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, "mesh: out of memory (ray grid)");
+        return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "mesh: out of memory (ray grid)");
     g->positions = m->positions;
     g->indices = m->indices;
     g->triangle_count = m->triangle_count;
@@ -385,7 +375,7 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
             g->tris = malloc((size_t)(refs ? refs : 1) * sizeof *g->tris);
             if (!g->start || !g->tris) {
                 vdsh_view_tracer_destroy(g);
-                return fail(err, VDSH_ERR_OUT_OF_MEMORY, "mesh: out of memory (ray grid)");
+                return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "mesh: out of memory (ray grid)");
             }
             break;
         }
@@ -409,7 +399,7 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
     uint32_t *fill = malloc(cells * sizeof *fill);
     if (!fill) {
         vdsh_view_tracer_destroy(g);
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, "mesh: out of memory (ray grid)");
+        return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "mesh: out of memory (ray grid)");
     }
     memcpy(fill, g->start, cells * sizeof *fill);
     for (uint32_t t = 0; t < m->triangle_count; t++) {
@@ -883,7 +873,7 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
     }
     if (v.interior && choose_lights(t, m, &v, diag) != VDSH_OK) {
         vdsh_view_tracer_destroy(t);
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, "out of memory for the default lights");
+        return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "out of memory for the default lights");
     }
     vdsh_view_tracer_destroy(t);
     *out = v;
