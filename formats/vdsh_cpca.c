@@ -424,7 +424,7 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
         if (!isfinite(src[x]))
             return vdsh_failf(err, VDSH_ERR_INVALID,
                               "cpca: vertex %zu coefficient %zu is not finite",
-                         x / n, x % n);
+                              x / n, x % n);
 
     /* one block: scales, means, bases, records */
     size_t o_means = ((size_t)k * b * 4 + 15) & ~(size_t)15;
