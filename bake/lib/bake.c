@@ -935,7 +935,7 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
     if (!d.receivers || !d.scene || d.receivers->vertex_count == 0)
         return vb_fail(err, VB_ERR_ARGUMENT, "nothing to bake: no receivers or no scene");
     if (d.rays == 0)
-        d.rays = 2500;
+        d.rays = VB_DEFAULT_RAYS;
     if (d.order_mask & ~(uint32_t)(((1u << VDSH_MAX_ORDER) - 1) << 1))
         return vb_fail(err, VB_ERR_ARGUMENT, "orders must be 1..%d", VDSH_MAX_ORDER);
     /* Adaptive order: its cap is the projection's order at least; with no

@@ -42,6 +42,12 @@ vb_result vb_fail(vb_error *err, vb_result r, const char *fmt, ...);
 /* Monotonic wall clock in seconds. */
 double vb_now(void);
 
+/* Named defaults that the bake library and more than one program (or help
+ * text) share: one number each, spelled once. */
+#define VB_DEFAULT_RAYS 2500u    /* directions per receiver, a 50 x 50 grid */
+#define VB_DEFAULT_CUBE_SIZE 64  /* basis cubemap face, texels */
+#define VB_DEFAULT_SEED 1u       /* vdsh-bake --seed */
+
 #ifdef __cplusplus
 }
 #endif
