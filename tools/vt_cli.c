@@ -422,3 +422,20 @@ int vt_opt_orders(const char *option, const char *example, const char *arg, int 
         want[k] = seen[k];
     return 1;
 }
+
+int vt_opt_choice(const char *option, const char *arg, const vt_choice *choices, int *out)
+{
+    int n = 0;
+    for (; choices[n].name; n++)
+        if (strcmp(arg, choices[n].name) == 0) {
+            *out = choices[n].value;
+            return 1;
+        }
+    char list[512];
+    size_t at = 0;
+    for (int i = 0; i < n && at < sizeof list; i++)
+        at += (size_t)snprintf(list + at, sizeof list - at, "%s%s",
+                               i == 0 ? "" : i + 1 == n ? " or " : ", ", choices[i].name);
+    vt_usage_error(cli_prog, "%s takes %s, not '%s'", option, list, arg);
+    return 0;
+}

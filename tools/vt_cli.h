@@ -156,6 +156,14 @@ int vt_opt_nonnegative(const char *option, const char *arg, float *out);
 int vt_opt_tolerance(const char *option, const char *noun, const char *arg, int zero_ok,
                      double *out);
 
+/* One of a list of names, each standing for a value; the list ends with
+ * {NULL, 0}. Says "takes A, B or C". */
+typedef struct vt_choice {
+    const char *name;
+    int value;
+} vt_choice;
+int vt_opt_choice(const char *option, const char *arg, const vt_choice *choices, int *out);
+
 /* Distinct orders 1..max_order, a vt_parse_u64_list list in any order:
  * want[k] = 1 for each order k given, 0 for the others (want holds
  * max_order + 1 entries; want[0] is 0). Says "takes distinct orders

@@ -643,11 +643,22 @@ enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
        O_CPCA };
 enum { OPT_NOT_MINE = -1, OPT_TAKEN = 1 };
 
-/* Options that take a number, each checked on its own. */
+/* The names --encoding, --quantity and --window take. */
+static const vt_choice encodings[] = {
+    {"f16", VDSH_ENCODING_F16}, {"f32", VDSH_ENCODING_F32}, {"s8", VDSH_ENCODING_S8},
+    {"s8s6", VDSH_ENCODING_S8S6}, {"cpca", VDSH_ENCODING_CPCA}, {NULL, 0}};
+static const vt_choice quantities[] = {
+    {"auto", VB_QUANTITY_AUTO}, {"distance", VB_QUANTITY_DISTANCE}, {"log", VB_QUANTITY_LOG},
+    {NULL, 0}};
+static const vt_choice windows[] = {
+    {"none", VDSH_WINDOW_NONE}, {"hann", VDSH_WINDOW_HANN}, {"lanczos", VDSH_WINDOW_LANCZOS},
+    {NULL, 0}};
+
+/* Options that take a number or a name, each checked on its own. */
 static int read_value(int c, const char *arg, options *o)
 {
     double t = 0.0;
-    int ok = 1;
+    int ok = 1, v = 0;
     switch (c) {
     case O_RAYS:
         o->adaptive_rays = strcmp(arg, "auto") == 0;
@@ -702,6 +713,18 @@ static int read_value(int c, const char *arg, options *o)
         ok = vt_opt_u32("--decision-lights", "", arg, 1, VB_DECISION_MAX_PAIRS,
                         &o->decision_lights);
         break;
+    case O_ENCODING:
+        ok = vt_opt_choice("--encoding", arg, encodings, &v);
+        o->encoding = (vdsh_encoding)v;
+        break;
+    case O_QUANTITY:
+        ok = vt_opt_choice("--quantity", arg, quantities, &v);
+        o->quantity = (vb_quantity)v;
+        break;
+    case O_WINDOW:
+        ok = vt_opt_choice("--window", arg, windows, &v);
+        o->window = (vdsh_window)v;
+        break;
     default: return OPT_NOT_MINE;
     }
     return ok ? OPT_TAKEN : VT_EXIT_USAGE;
@@ -721,25 +744,11 @@ static int read_choice(int c, const char *arg, options *o)
         o->method = m->method;
         break;
     }
-    case O_ENCODING:
-        if (strcmp(arg, "f16") == 0) o->encoding = VDSH_ENCODING_F16;
-        else if (strcmp(arg, "f32") == 0) o->encoding = VDSH_ENCODING_F32;
-        else if (strcmp(arg, "s8") == 0) o->encoding = VDSH_ENCODING_S8;
-        else if (strcmp(arg, "s8s6") == 0) o->encoding = VDSH_ENCODING_S8S6;
-        else if (strcmp(arg, "cpca") == 0) o->encoding = VDSH_ENCODING_CPCA;
-        else return bad_usage("--encoding takes f16, f32, s8, s8s6 or cpca, not '%s'", arg);
-        break;
     case O_CPCA:
         if (vdsh_cpca_parse(arg, &o->cpca, NULL) != VDSH_OK)
             return bad_usage("--cpca takes K,B,BITS: clusters 1..256, basis vectors "
                              "1..256, bits 2..8 (default 8,54,4), not '%s'", arg);
         o->have_cpca = 1;
-        break;
-    case O_QUANTITY:
-        if (strcmp(arg, "auto") == 0) o->quantity = VB_QUANTITY_AUTO;
-        else if (strcmp(arg, "distance") == 0) o->quantity = VB_QUANTITY_DISTANCE;
-        else if (strcmp(arg, "log") == 0) o->quantity = VB_QUANTITY_LOG;
-        else return bad_usage("--quantity takes auto, distance or log, not '%s'", arg);
         break;
     case O_LOG_OFFSET:
         if (!vt_parse_float(arg, &o->log_offset) || fabsf(o->log_offset) > 5.0f)
@@ -763,12 +772,6 @@ static int read_choice(int c, const char *arg, options *o)
         o->have_decision = 1;
         break;
     }
-    case O_WINDOW:
-        if (strcmp(arg, "none") == 0) o->window = VDSH_WINDOW_NONE;
-        else if (strcmp(arg, "hann") == 0) o->window = VDSH_WINDOW_HANN;
-        else if (strcmp(arg, "lanczos") == 0) o->window = VDSH_WINDOW_LANCZOS;
-        else return bad_usage("--window takes none, hann or lanczos, not '%s'", arg);
-        break;
     case O_SHARD: {
         unsigned si, sn;
         int used = 0;
