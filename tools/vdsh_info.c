@@ -668,26 +668,37 @@ static int info(const char *path, int json, int first)
     return ok;
 }
 
-int main(int argc, char **argv)
+/* ------------------------------------------------------------------ */
+/* The command line                                                    */
+/* ------------------------------------------------------------------ */
+
+typedef struct options {
+    const char *json_out;      /* --json FILE ('-': stdout), or NULL */
+    int check;                 /* --verify */
+    char **files;              /* FILE.vdsh... */
+    int file_count;
+} options;
+
+/* -1 with *o ready to run, else the exit status (help, version, a usage
+ * error: said). */
+static int parse_args(int argc, char **argv, options *o)
 {
-    static const struct option options[] = {
+    static const struct option longopts[] = {
         {"json", required_argument, NULL, 'j'},
         {"verify", no_argument, NULL, 'c'},
         {"help", no_argument, NULL, 'h'},
         {"version", no_argument, NULL, 'V'},
         {NULL, 0, NULL, 0},
     };
-    vt_cli_begin(prog, argv);
-    const char *json_out = NULL;
-    int json = 0, check = 0, opt;
-    while ((opt = getopt_long(argc, argv, "j:hV", options, NULL)) != -1) {
+    memset(o, 0, sizeof *o);
+    int opt;
+    while ((opt = getopt_long(argc, argv, "j:hV", longopts, NULL)) != -1) {
         switch (opt) {
         case 'j':
-            json = 1;
-            json_out = optarg;
+            o->json_out = optarg;
             break;
         case 'c':
-            check = 1;
+            o->check = 1;
             break;
         case 'h':
             usage(stdout);
@@ -699,24 +710,33 @@ int main(int argc, char **argv)
         }
     }
     if (optind >= argc) {
-        size_t n = json_out ? strlen(json_out) : 0;
-        if (n > 5 && strcmp(json_out + n - 5, ".vdsh") == 0)
+        size_t n = o->json_out ? strlen(o->json_out) : 0;
+        if (n > 5 && strcmp(o->json_out + n - 5, ".vdsh") == 0)
             return vt_usage_error(prog, "no input file (--json takes the JSON file to write: "
-                                  "--json - %s prints it)", json_out);
+                                  "--json - %s prints it)", o->json_out);
         return vt_usage_error(prog, "%s", "no input file");
     }
-    if (json_out && vt_cli_check_outputs(&json_out, 1, (const char *const *)argv + optind,
-                                         argc - optind) != 0)
+    o->files = argv + optind;
+    o->file_count = argc - optind;
+    return -1;
+}
+
+/* Every file in turn (each failure said, the others still done), then
+ * the JSON of them all. */
+static int run(const options *o)
+{
+    const int json = o->json_out != NULL;
+    if (json && vt_cli_check_outputs(&o->json_out, 1, (const char *const *)o->files,
+                                     o->file_count) != 0)
         return 1;
 
     int ok = 1;
-    for (int i = optind; i < argc; i++) {
-        if (check && !json && i > optind)
+    for (int i = 0; i < o->file_count; i++) {
+        if (o->check && !json && i > 0)
             putchar('\n');
-        ok &= check ? verify(argv[i], json)
-                    : info(argv[i], json, i == optind);
+        ok &= o->check ? verify(o->files[i], json) : info(o->files[i], json, i == 0);
     }
-    if (json && !json_write(json_out))
+    if (json && !json_write(o->json_out))
         ok = 0;
     free(json_text);
     if (fflush(stdout) != 0 || ferror(stdout)) {
@@ -725,4 +745,12 @@ int main(int argc, char **argv)
         return 1;
     }
     return ok ? 0 : 1;
+}
+
+int main(int argc, char **argv)
+{
+    vt_cli_begin(prog, argv);
+    options o;
+    int status = parse_args(argc, argv, &o);
+    return status >= 0 ? status : run(&o);
 }
