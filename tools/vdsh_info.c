@@ -17,6 +17,7 @@
 #include "vdsh_output.h"
 #include "vt_cli.h"
 #include "vt_json.h"
+#include "vt_record.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -355,12 +356,7 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
     json_bounds(&j, root, "receiver_bounds", lo, hi);
 
     cJSON *bake = vt_json_object(&j, root, "bake");
-    vt_json_u64(&j, bake, "rays", h->rays);
-    vt_json_string(&j, bake, "sampling", vdsh_sampling_name(h->sampling));
-    vt_json_u64(&j, bake, "seed", h->seed);
-    vt_json_f32(&j, bake, "max_distance", h->max_distance);
-    vt_json_f32(&j, bake, "max_edge", h->max_edge);
-    vt_json_string(&j, bake, "offset_rule", vdsh_offset_rule_name(h->offset_rule));
+    vt_record_params(&j, bake, h);
     vt_json_u64(&j, bake, "load_flags", h->load_flags);
     vt_json_bool(&j, bake, "welded", h->load_flags & VDSH_LOAD_WELD);
     vt_json_u64(&j, bake, "trace_flags", h->trace_flags);
@@ -428,17 +424,7 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
         vt_json_f64(&j, c0, "mean", st.mean);
     }
 
-    if (f->has_stats) {
-        cJSON *st = vt_json_object(&j, root, "stats");
-        vt_json_u64(&j, st, "rays_traced", f->stats.rays_traced);
-        vt_json_u64(&j, st, "rays_missed", f->stats.rays_missed);
-        vt_json_u64(&j, st, "degenerate_receivers", f->stats.degenerate_receivers);
-        vt_json_u64(&j, st, "undefined_normals", f->stats.undefined_normals);
-        vt_json_u64(&j, st, "moved_origins", f->stats.moved_origins);
-        vt_json_u64(&j, st, "flipped_normals", f->stats.flipped_normals);
-    } else {
-        vt_json_null(&j, root, "stats");
-    }
+    vt_record_stats(&j, root, f, 1);
 
     if (f->has_part) {
         cJSON *pt = vt_json_object(&j, root, "part");
@@ -464,18 +450,7 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
         vt_json_u64(&j, ad, "rounds", f->adaptive.rounds);
         vt_json_u64(&j, ad, "candidates", f->adaptive.candidates);
     }
-    if (f->has_timings) {
-        const vdsh_timings *t = &f->timings;
-        cJSON *tm = vt_json_object(&j, root, "timings");
-        vt_json_f64(&j, tm, "load", t->load);
-        vt_json_f64(&j, tm, "refine", t->refine);
-        vt_json_f64(&j, tm, "build", t->build);
-        vt_json_f64(&j, tm, "trace", t->trace);
-        vt_json_f64(&j, tm, "total", t->total);
-        vt_json_u64(&j, tm, "threads", t->threads);
-    } else {
-        vt_json_null(&j, root, "timings");
-    }
+    vt_record_timings(&j, root, f);
     return json_emit(&j, path);
 }
 

@@ -50,6 +50,7 @@
 #include "vt_args.h"
 #include "vt_cli.h"
 #include "vt_json.h"
+#include "vt_record.h"
 
 #define PV_MAGIC "VDSHPVE1"
 #define PV_VERSION 1u
@@ -357,36 +358,12 @@ static int write_json(const char *out, const context *c, char *msg, size_t cap)
     vt_json_f32(&j, scene, "diagonal", r->diagonal);
 
     cJSON *bake = vt_json_object(&j, root, "bake");
-    vt_json_u64(&j, bake, "rays", h->rays);
-    vt_json_string(&j, bake, "sampling", vdsh_sampling_name(h->sampling));
-    vt_json_u64(&j, bake, "seed", h->seed);
-    vt_json_f32(&j, bake, "max_distance", h->max_distance);
-    vt_json_f32(&j, bake, "max_edge", h->max_edge);
-    vt_json_string(&j, bake, "offset_rule", vdsh_offset_rule_name(h->offset_rule));
+    vt_record_params(&j, bake, h);
     vt_json_bool(&j, bake, "welded", h->load_flags & VDSH_LOAD_WELD);
     vt_json_bool(&j, bake, "robust", h->trace_flags & VDSH_TRACE_ROBUST);
     vt_json_u64(&j, bake, "cube_size", h->cube_size);
-    if (f->has_stats) {
-        cJSON *st = vt_json_object(&j, bake, "stats");
-        vt_json_u64(&j, st, "rays_traced", f->stats.rays_traced);
-        vt_json_u64(&j, st, "rays_missed", f->stats.rays_missed);
-        vt_json_u64(&j, st, "degenerate_receivers", f->stats.degenerate_receivers);
-        vt_json_u64(&j, st, "undefined_normals", f->stats.undefined_normals);
-    } else {
-        vt_json_null(&j, bake, "stats");
-    }
-    if (f->has_timings) {
-        const vdsh_timings *t = &f->timings;
-        cJSON *tm = vt_json_object(&j, bake, "timings");
-        vt_json_f64(&j, tm, "load", t->load);
-        vt_json_f64(&j, tm, "refine", t->refine);
-        vt_json_f64(&j, tm, "build", t->build);
-        vt_json_f64(&j, tm, "trace", t->trace);
-        vt_json_f64(&j, tm, "total", t->total);
-        vt_json_u64(&j, tm, "threads", t->threads);
-    } else {
-        vt_json_null(&j, bake, "timings");
-    }
+    vt_record_stats(&j, bake, f, 0);
+    vt_record_timings(&j, bake, f);
     vt_json_f64(&j, bake, "seconds", c->bt.source ? c->bt.total : NAN);
     vt_json_string(&j, bake, "seconds_from", c->bt.source);
 
