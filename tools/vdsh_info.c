@@ -440,15 +440,16 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
         }
     }
     if (f->has_adaptive) {
+        const vdsh_adaptive *a = &f->adaptive;
+        const struct { const char *key; uint64_t v; } count[] = {
+            {"max_receivers", a->max_receivers}, {"lights", a->lights},
+            {"max_rounds", a->max_rounds}, {"start_receivers", a->start_receivers},
+            {"rounds", a->rounds}, {"candidates", a->candidates}};
         cJSON *ad = vt_json_object(&j, root, "adaptive");
-        vt_json_f32(&j, ad, "tolerance", f->adaptive.tolerance);
-        vt_json_f32(&j, ad, "min_edge", f->adaptive.min_edge);
-        vt_json_u64(&j, ad, "max_receivers", f->adaptive.max_receivers);
-        vt_json_u64(&j, ad, "lights", f->adaptive.lights);
-        vt_json_u64(&j, ad, "max_rounds", f->adaptive.max_rounds);
-        vt_json_u64(&j, ad, "start_receivers", f->adaptive.start_receivers);
-        vt_json_u64(&j, ad, "rounds", f->adaptive.rounds);
-        vt_json_u64(&j, ad, "candidates", f->adaptive.candidates);
+        vt_json_f32(&j, ad, "tolerance", a->tolerance);
+        vt_json_f32(&j, ad, "min_edge", a->min_edge);
+        for (size_t i = 0; i < sizeof count / sizeof count[0]; i++)
+            vt_json_u64(&j, ad, count[i].key, count[i].v);
     }
     vt_record_timings(&j, root, f);
     return json_emit(&j, path);

@@ -19,15 +19,16 @@ void vt_record_stats(vt_json *j, cJSON *parent, const vdsh_file *f, int all)
         vt_json_null(j, parent, "stats");
         return;
     }
+    const vdsh_stats *s = &f->stats;
+    const struct { const char *key; uint64_t v; } count[] = {
+        {"rays_traced", s->rays_traced}, {"rays_missed", s->rays_missed},
+        {"degenerate_receivers", s->degenerate_receivers},
+        {"undefined_normals", s->undefined_normals},
+        {"moved_origins", s->moved_origins}, {"flipped_normals", s->flipped_normals}};
+    const size_t n = all ? sizeof count / sizeof count[0] : 4;
     cJSON *st = vt_json_object(j, parent, "stats");
-    vt_json_u64(j, st, "rays_traced", f->stats.rays_traced);
-    vt_json_u64(j, st, "rays_missed", f->stats.rays_missed);
-    vt_json_u64(j, st, "degenerate_receivers", f->stats.degenerate_receivers);
-    vt_json_u64(j, st, "undefined_normals", f->stats.undefined_normals);
-    if (all) {
-        vt_json_u64(j, st, "moved_origins", f->stats.moved_origins);
-        vt_json_u64(j, st, "flipped_normals", f->stats.flipped_normals);
-    }
+    for (size_t i = 0; i < n; i++)
+        vt_json_u64(j, st, count[i].key, count[i].v);
 }
 
 void vt_record_timings(vt_json *j, cJSON *parent, const vdsh_file *f)
@@ -37,11 +38,11 @@ void vt_record_timings(vt_json *j, cJSON *parent, const vdsh_file *f)
         return;
     }
     const vdsh_timings *t = &f->timings;
+    const struct { const char *key; double v; } seconds[] = {
+        {"load", t->load}, {"refine", t->refine}, {"build", t->build},
+        {"trace", t->trace}, {"total", t->total}};
     cJSON *tm = vt_json_object(j, parent, "timings");
-    vt_json_f64(j, tm, "load", t->load);
-    vt_json_f64(j, tm, "refine", t->refine);
-    vt_json_f64(j, tm, "build", t->build);
-    vt_json_f64(j, tm, "trace", t->trace);
-    vt_json_f64(j, tm, "total", t->total);
+    for (size_t i = 0; i < sizeof seconds / sizeof seconds[0]; i++)
+        vt_json_f64(j, tm, seconds[i].key, seconds[i].v);
     vt_json_u64(j, tm, "threads", t->threads);
 }
