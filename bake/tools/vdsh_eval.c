@@ -240,10 +240,22 @@ static void json_receiver(vt_json *j, cJSON *list, const vb_eval_receiver *r, in
     vt_json_f64(j, o, "escaped", r->escaped);
 }
 
+/* Numbers under their keys, in order. */
+typedef struct named_f64 {
+    const char *key;
+    double v;
+} named_f64;
+
+static void json_f64s(vt_json *j, cJSON *o, const named_f64 *x, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        vt_json_f64(j, o, x[i].key, x[i].v);
+}
+
 static void json_metrics(vt_json *j, cJSON *o, const vb_eval_metrics *m, int kind)
 {
     vt_json_u64(j, o, "samples", m->samples);
-    const struct { const char *name; double v; } num[] = {
+    const named_f64 num[] = {
         {"distance_rms", m->distance_rms}, {"distance_rms_se", m->distance_rms_se},
         {"distance_mean", m->distance_mean}, {"distance_p50", m->distance_p50},
         {"distance_p90", m->distance_p90}, {"distance_p99", m->distance_p99},
@@ -257,8 +269,7 @@ static void json_metrics(vt_json *j, cJSON *o, const vb_eval_metrics *m, int kin
         {"binary_light_leak_se", m->binary_light_leak_se}, {"ringing", m->ringing},
         {"receiver_mae_p50", m->receiver_mae_p50}, {"receiver_mae_p90", m->receiver_mae_p90},
         {"receiver_mae_p99", m->receiver_mae_p99}};
-    for (size_t i = 0; i < sizeof num / sizeof num[0]; i++)
-        vt_json_f64(j, o, num[i].name, num[i].v);
+    json_f64s(j, o, num, sizeof num / sizeof num[0]);
     vt_json_u64(j, o, "visible", m->visible);
     vt_json_u64(j, o, "occluded", m->occluded);
     vt_json_u64(j, o, "occluded_binary", m->occluded_binary);
@@ -272,15 +283,14 @@ static void json_scene(vt_json *j, cJSON *o, const vb_eval_scene_metrics *m)
     vt_json_u64(j, o, "pairs", m->pairs);
     vt_json_u64(j, o, "visible", m->visible);
     vt_json_u64(j, o, "occluded", m->occluded);
-    const struct { const char *k; double v; } f[] = {
+    const named_f64 f[] = {
         {"shadow_mae", m->shadow_mae}, {"shadow_mae_se", m->shadow_mae_se},
         {"false_shadow", m->false_shadow}, {"false_shadow_se", m->false_shadow_se},
         {"recall", m->recall}, {"recall_se", m->recall_se},
         {"light_leak", m->light_leak}, {"light_leak_se", m->light_leak_se},
         {"binary_mae", m->binary_mae}, {"binary_false_shadow", m->binary_false_shadow},
         {"binary_recall", m->binary_recall}};
-    for (size_t i = 0; i < sizeof f / sizeof f[0]; i++)
-        vt_json_f64(j, o, f[i].k, f[i].v);
+    json_f64s(j, o, f, sizeof f / sizeof f[0]);
 }
 
 static void json_truth(vt_json *j, cJSON *o, const vb_eval_truth *t, int kind)
@@ -697,27 +707,18 @@ static int parse_args(int argc, char **argv, options *o)
            O_FAST, O_ALLOW, O_JSON, O_PV, O_BAKE_REPORT, O_WORST, O_THREADS, O_LIGHTS,
            O_OFFSETS, O_LIGHT_RULE };
     static const struct option longopts[] = {
-        {"points", required_argument, 0, O_POINTS},
-        {"interior", required_argument, 0, O_INTERIOR},
-        {"directions", required_argument, 0, O_DIRECTIONS},
-        {"seed", required_argument, 0, O_SEED},
-        {"orders", required_argument, 0, O_ORDERS},
-        {"oracle", no_argument, 0, O_ORACLE},
-        {"interp", required_argument, 0, O_INTERP},
-        {"fast-truth", no_argument, 0, O_FAST},
-        {"allow-mismatch", no_argument, 0, O_ALLOW},
-        {"json", required_argument, 0, O_JSON},
+        {"points", required_argument, 0, O_POINTS}, {"interior", required_argument, 0, O_INTERIOR},
+        {"directions", required_argument, 0, O_DIRECTIONS}, {"seed", required_argument, 0, O_SEED},
+        {"orders", required_argument, 0, O_ORDERS}, {"oracle", no_argument, 0, O_ORACLE},
+        {"interp", required_argument, 0, O_INTERP}, {"fast-truth", no_argument, 0, O_FAST},
+        {"allow-mismatch", no_argument, 0, O_ALLOW}, {"json", required_argument, 0, O_JSON},
         {"per-vertex", required_argument, 0, O_PV},
         {"bake-report", required_argument, 0, O_BAKE_REPORT},
-        {"worst", required_argument, 0, O_WORST},
-        {"threads", required_argument, 0, O_THREADS},
+        {"worst", required_argument, 0, O_WORST}, {"threads", required_argument, 0, O_THREADS},
         {"lights", required_argument, 0, O_LIGHTS},
         {"light-rule", required_argument, 0, O_LIGHT_RULE},
-        {"offsets", required_argument, 0, O_OFFSETS},
-        {"quiet", no_argument, 0, 'q'},
-        {"help", no_argument, 0, 'h'},
-        {"version", no_argument, 0, 'V'},
-        {0, 0, 0, 0}};
+        {"offsets", required_argument, 0, O_OFFSETS}, {"quiet", no_argument, 0, 'q'},
+        {"help", no_argument, 0, 'h'}, {"version", no_argument, 0, 'V'}, {0, 0, 0, 0}};
     memset(o, 0, sizeof *o);
     o->d.interior = 65536;
     vb_eval_desc *d = &o->d;
