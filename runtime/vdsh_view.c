@@ -147,7 +147,7 @@ static int usage_error(const char *fmt, const char *arg)
 }
 
 /* A buffer mode asks for its stream; orders 1-5 are buffered on request. */
-static void note_buffer(vv_options *o, const vv_frame_mode *m)
+static void note_buffer(vv_options *o, const vv_mode *m)
 {
     if (m->mode == VR_MODE_VDSH_BUFFER && m->stream >= 1 && m->stream <= 5)
         o->buffers = 1;
@@ -161,7 +161,7 @@ static int parse_modes(const char *list, vv_options *o)
     const char *p = list;
     for (;;) {
         size_t len = strcspn(p, ",");
-        int found = vv_frame_mode_find(p, len);
+        int found = vv_mode_find(p, len, VV_MODE_FRAMES);
         if (found < 0)
             return -1;
         int seen = 0;
@@ -169,7 +169,7 @@ static int parse_modes(const char *list, vv_options *o)
             seen |= o->frame_modes[i] == found;
         if (!seen) {
             o->frame_modes[o->frame_mode_count++] = found;
-            note_buffer(o, &vv_frame_modes[found]);
+            note_buffer(o, &vv_modes[found]);
         }
         if (!p[len])
             return 0;
@@ -282,19 +282,19 @@ static int parse_args(int argc, char **argv, vv_options *o)
                 return usage_error("--ambient: expected a value >= 0, got '%s'", v);
             o->have_ambient = 1;
             break;
-        case O_MODE:
-            if (vr_mode_from_name(v, &o->mode)) {
-                int i = vv_frame_mode_find(v, strlen(v));
-                if (i < 0 || vv_frame_modes[i].mode != VR_MODE_VDSH_BUFFER)
-                    return usage_error("--mode: expected none, cube, vdsh2, vdsh3, vdsh5, "
-                                       "vdsh5poly, buffer, bufN (N = 1..16) or adaptive, "
-                                       "got '%s'", v);
-                o->mode = VR_MODE_VDSH_BUFFER;
-                o->stream = vv_frame_modes[i].stream;
-                note_buffer(o, &vv_frame_modes[i]);
-            }
+        case O_MODE: {
+            int i = vv_mode_find(v, strlen(v), VV_MODE_OPTION);
+            if (i < 0)
+                return usage_error("--mode: expected none, cube, vdsh2, vdsh3, vdsh5, "
+                                   "vdsh5poly, buffer, bufN (N = 1..16) or adaptive, "
+                                   "got '%s'", v);
+            o->mode = vv_modes[i].mode;
+            if (vv_modes[i].stream) /* the others keep a stream given before */
+                o->stream = vv_modes[i].stream;
+            note_buffer(o, &vv_modes[i]);
             o->have_mode = 1;
             break;
+        }
         case O_COMPARE:
             if (!strcmp(v, "smooth"))
                 o->compare = VDSH_COMPARE_SMOOTH;

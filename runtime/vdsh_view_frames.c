@@ -45,7 +45,7 @@ static void view_camera(const vt_view *v, vr_camera *c)
 /* One shadow-only frame: light alone, s of every pixel (1 where nothing
  * was drawn: VR_OUTPUT_SHADOW writes alpha 1, the clear colour 0). */
 static vr_result shadow_frame(vr_renderer *r, const vr_scene *scene, const vv_options *o,
-                              const vv_frame_mode *m, const vr_camera *cam, const float pos[3],
+                              const vv_mode *m, const vr_camera *cam, const float pos[3],
                               float *rgba, float *grey, size_t n, vr_error *err)
 {
     vr_light light;
@@ -74,7 +74,7 @@ static vr_result shadow_frame(vr_renderer *r, const vr_scene *scene, const vv_op
 /* The shaded picture of a light set: the viewer's white lights (dimmer
  * when there are several), fall-off and ambient; opaque. */
 static vr_result shaded_frame(vr_renderer *r, const vr_scene *scene, const vv_options *o,
-                              const vv_frame_mode *m, const vr_camera *cam, const vt_view *v,
+                              const vv_mode *m, const vr_camera *cam, const vt_view *v,
                               int set, unsigned char *px, size_t n, vr_error *err)
 {
     vr_light lights[VT_VIEWS_MAX_LIGHTS];
@@ -138,11 +138,11 @@ int vv_run_frames(const vv_options *o)
 
     /* The modes: those asked for (each must be in the scene), else every
      * shadow mode the scene has. */
-    int modes[VV_FRAME_MODES], nm = 0;
+    int modes[VV_MAX_MODES], nm = 0;
     if (!rc && o->frame_mode_count) {
         for (int i = 0; i < o->frame_mode_count && !rc; i++) {
-            const vv_frame_mode *m = &vv_frame_modes[o->frame_modes[i]];
-            if (!vv_frame_mode_available(s.scene, m)) {
+            const vv_mode *m = &vv_modes[o->frame_modes[i]];
+            if (!vv_mode_available(s.scene, m)) {
                 fprintf(stderr, "vdsh-view: %s: mode %s is not available in this file%s\n",
                         o->files[0], m->name,
                         m->mode == VR_MODE_VDSH5 ? " (order 5 with its basis cubemaps)" : "");
@@ -151,8 +151,9 @@ int vv_run_frames(const vv_options *o)
             modes[nm++] = o->frame_modes[i];
         }
     } else if (!rc) {
-        for (int i = 0; i < VV_FRAME_DEFAULT_MODES; i++)
-            if (vr_scene_supports(s.scene, vv_frame_modes[i].mode))
+        for (int i = 0; vv_modes[i].name; i++)
+            if ((vv_modes[i].flags & VV_MODE_FRAMES_DEFAULT) &&
+                vv_mode_available(s.scene, &vv_modes[i]))
                 modes[nm++] = i;
     }
 
@@ -176,7 +177,7 @@ int vv_run_frames(const vv_options *o)
     /* Mode by mode (one program, its shadow maps re-rendered per frame);
      * the time of a frame is its draw and read-back, without the PNG. */
     for (int mi = 0; mi < nm && !rc; mi++) {
-        const vv_frame_mode *m = &vv_frame_modes[modes[mi]];
+        const vv_mode *m = &vv_modes[modes[mi]];
         double mode_ms = 0.0, first_ms = 0.0, png_ms = 0.0;
         int mode_frames = 0;
         for (int v = 0; v < vs.count && !rc; v++) {

@@ -98,30 +98,39 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     if (action != GLFW_PRESS)
         return;
     char msg[200];
-    static const vr_mode by_digit[7] = {VR_MODE_NONE,  VR_MODE_CUBE,       VR_MODE_VDSH2,
-                                        VR_MODE_VDSH3, VR_MODE_VDSH5,      VR_MODE_VDSH5_POLY,
-                                        VR_MODE_VDSH_BUFFER};
-    if (key >= GLFW_KEY_1 && key <= GLFW_KEY_7) {
-        vr_mode m = by_digit[key - GLFW_KEY_1];
-        if (!vr_scene_supports(a->s.scene, m)) {
-            snprintf(msg, sizeof msg, "mode %s: not available in this file", vr_mode_name(m));
+    /* The modes with a digit key (vv_mode.key), in the order M steps
+     * through them. */
+    const vv_mode *keyed[10];
+    int nk = 0, at = 0;
+    for (int i = 0; vv_modes[i].name && nk < 10; i++)
+        if (vv_modes[i].key) {
+            if (vv_modes[i].mode == a->mode)
+                at = nk;
+            keyed[nk++] = &vv_modes[i];
+        }
+    for (int i = 0; i < nk; i++)
+        if (key == GLFW_KEY_0 + (keyed[i]->key - '0')) {
+            vr_mode m = keyed[i]->mode;
+            if (!vr_scene_supports(a->s.scene, m)) {
+                snprintf(msg, sizeof msg, "mode %s: not available in this file", vr_mode_name(m));
+                print_status(a, msg);
+                return;
+            }
+            a->mode = m;
+            char label[160];
+            vv_mode_label(a->s.scene, m, a->stream, label, sizeof label);
+            snprintf(msg, sizeof msg, "mode: %s", label);
             print_status(a, msg);
             return;
         }
-        a->mode = m;
-        char label[160];
-        vv_mode_label(a->s.scene, m, a->stream, label, sizeof label);
-        snprintf(msg, sizeof msg, "mode: %s", label);
-        print_status(a, msg);
-        return;
-    }
     switch (key) {
     case GLFW_KEY_ESCAPE:
         glfwSetWindowShouldClose(w, GLFW_TRUE);
         break;
     case GLFW_KEY_M:
-        for (int i = 1; i <= 7; i++) {
-            vr_mode m = by_digit[(a->mode - VR_MODE_NONE + i) % 7];
+        /* the next the scene has (after the first when this one has no key) */
+        for (int i = 1; i <= nk; i++) {
+            vr_mode m = keyed[(at + i) % nk]->mode;
             if (vr_scene_supports(a->s.scene, m)) {
                 a->mode = m;
                 break;

@@ -68,28 +68,31 @@ const char *vr_gl_renderer(void)
 
 /* ------------------------------------------------------------------ */
 
-static const char *const mode_names[VR_MODE_COUNT_] = {
-    "default", "none", "cube", "vdsh2", "vdsh3", "vdsh5", "vdsh5poly", "buffer", "sdf"};
-
-static const char *const mode_labels[VR_MODE_COUNT_] = {
-    "the scene's default (VDSH order 5, cubemaps where it has them)",
-    "no shadows",
-    "cube shadow map",
-    "VDSH order 2 (4 coeff.)",
-    "VDSH order 3 (9 coeff.)",
-    "VDSH order 5 (25 coeff., cubemaps)",
-    "VDSH order 5 (25 coeff., polynomials)",
-    "VDSH from a buffer (any order, per-vertex distance)",
-    "distance-field shadows (sphere trace)"};
+/* The runtime's one list of its modes (vr_mode order): name (the
+ * viewer's --mode spelling), label, and the VDSH order drawn (0: none or
+ * any, from the stream). */
+static const struct {
+    const char *name, *label;
+    int order;
+} modes[VR_MODE_COUNT_] = {
+    {"default", "the scene's default (VDSH order 5, cubemaps where it has them)", 0},
+    {"none", "no shadows", 0},
+    {"cube", "cube shadow map", 0},
+    {"vdsh2", "VDSH order 2 (4 coeff.)", 2},
+    {"vdsh3", "VDSH order 3 (9 coeff.)", 3},
+    {"vdsh5", "VDSH order 5 (25 coeff., cubemaps)", 5},
+    {"vdsh5poly", "VDSH order 5 (25 coeff., polynomials)", 5},
+    {"buffer", "VDSH from a buffer (any order, per-vertex distance)", 0},
+    {"sdf", "distance-field shadows (sphere trace)", 0}};
 
 const char *vr_mode_name(vr_mode m)
 {
-    return (unsigned)m < VR_MODE_COUNT_ ? mode_names[m] : "?";
+    return (unsigned)m < VR_MODE_COUNT_ ? modes[m].name : "?";
 }
 
 const char *vr_mode_label(vr_mode m)
 {
-    return (unsigned)m < VR_MODE_COUNT_ ? mode_labels[m] : "?";
+    return (unsigned)m < VR_MODE_COUNT_ ? modes[m].label : "?";
 }
 
 int vr_mode_from_name(const char *name, vr_mode *out)
@@ -97,7 +100,7 @@ int vr_mode_from_name(const char *name, vr_mode *out)
     if (!name)
         return -1;
     for (int m = 1; m < VR_MODE_COUNT_; m++)
-        if (strcmp(name, mode_names[m]) == 0) {
+        if (strcmp(name, modes[m].name) == 0) {
             *out = (vr_mode)m;
             return 0;
         }
@@ -106,13 +109,7 @@ int vr_mode_from_name(const char *name, vr_mode *out)
 
 int vr_mode_order(vr_mode m)
 {
-    switch (m) {
-    case VR_MODE_VDSH2: return 2;
-    case VR_MODE_VDSH3: return 3;
-    case VR_MODE_VDSH5:
-    case VR_MODE_VDSH5_POLY: return 5;
-    default: return 0;
-    }
+    return (unsigned)m < VR_MODE_COUNT_ ? modes[m].order : 0;
 }
 
 int vr_mode_interp(vr_mode m, uint32_t quantity)
