@@ -250,11 +250,6 @@ void vr_renderer_size(const vr_renderer *r, int *width, int *height)
     *height = r->height;
 }
 
-unsigned vr_renderer_framebuffer(const vr_renderer *r)
-{
-    return r->fbo;
-}
-
 /* ------------------------------------------------------------------ */
 /* Timer queries                                                        */
 
