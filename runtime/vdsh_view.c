@@ -146,6 +146,12 @@ static int usage_error(const char *fmt, const char *arg)
     return vt_usage_error("vdsh-view", fmt, arg);
 }
 
+/* 0 when v is a, 1 when it is b, else -1. */
+static int pick(const char *v, const char *a, const char *b)
+{
+    return !strcmp(v, a) ? 0 : !strcmp(v, b) ? 1 : -1;
+}
+
 /* A buffer mode asks for its stream; orders 1-5 are buffered on request. */
 static void note_buffer(vv_options *o, const vv_mode *m)
 {
@@ -295,14 +301,13 @@ static int parse_args(int argc, char **argv, vv_options *o)
             o->have_mode = 1;
             break;
         }
-        case O_COMPARE:
-            if (!strcmp(v, "smooth"))
-                o->compare = VDSH_COMPARE_SMOOTH;
-            else if (!strcmp(v, "binary"))
-                o->compare = VDSH_COMPARE_BINARY;
-            else
+        case O_COMPARE: {
+            int i = pick(v, "smooth", "binary");
+            if (i < 0)
                 return usage_error("--compare: expected smooth or binary, got '%s'", v);
+            o->compare = i ? VDSH_COMPARE_BINARY : VDSH_COMPARE_SMOOTH;
             break;
+        }
         case O_PCF: o->pcf = 1; break;
         case O_SDF: o->sdf_path = v; break;
         case O_SDF_K:
@@ -319,14 +324,13 @@ static int parse_args(int argc, char **argv, vv_options *o)
             o->have_size = 1;
             break;
         case O_NO_CUBEMAPS: o->no_cubemaps = 1; break;
-        case O_EGL:
-            if (!strcmp(v, "device"))
-                o->egl = VR_EGL_DEVICE;
-            else if (!strcmp(v, "surfaceless"))
-                o->egl = VR_EGL_SURFACELESS;
-            else
+        case O_EGL: {
+            int i = pick(v, "device", "surfaceless");
+            if (i < 0)
                 return usage_error("--egl: expected device or surfaceless, got '%s'", v);
+            o->egl = i ? VR_EGL_SURFACELESS : VR_EGL_DEVICE;
             break;
+        }
         case O_FRAMES: o->frames_arg = v; break;
         case O_VIEWS: o->views_path = v; break;
         case O_MODES:

@@ -42,6 +42,18 @@ static void view_camera(const vt_view *v, vr_camera *c)
     c->fov_y = v->camera.fov_y;
 }
 
+/* A draw of mode m from cam: vv_base_desc with m's mode, stream and PCF. */
+static vr_draw_desc frame_desc(const vv_options *o, const vv_mode *m, const vr_camera *cam,
+                               const vr_light *lights, int n)
+{
+    vr_draw_desc d = vv_base_desc(o, lights, n);
+    d.mode = m->mode;
+    d.stream = m->stream;
+    d.pcf = m->pcf;
+    d.camera = *cam;
+    return d;
+}
+
 /* One shadow-only frame: light alone, s of every pixel (1 where nothing
  * was drawn: VR_OUTPUT_SHADOW writes alpha 1, the clear colour 0). */
 static vr_result shadow_frame(vr_renderer *r, const vr_scene *scene, const vv_options *o,
@@ -51,17 +63,8 @@ static vr_result shadow_frame(vr_renderer *r, const vr_scene *scene, const vv_op
     vr_light light;
     memset(&light, 0, sizeof light);
     memcpy(light.position, pos, sizeof light.position);
-    vr_draw_desc d;
-    memset(&d, 0, sizeof d);
-    d.mode = m->mode;
-    d.stream = m->stream;
-    d.pcf = m->pcf;
-    d.sdf_k = o->sdf_k;
-    d.compare = o->compare;
-    d.lights = &light;
-    d.light_count = 1;
-    d.camera = *cam;
-    d.output = VR_OUTPUT_SHADOW;
+    vr_draw_desc d = frame_desc(o, m, cam, &light, 1);
+    d.output = VR_OUTPUT_SHADOW; /* no ambient term, no shading */
     vr_result res = vr_draw(r, scene, &d, err);
     if (res == VR_OK)
         res = vr_read_pixels(r, rgba, n * 4 * sizeof(float), err);
@@ -92,11 +95,7 @@ static vr_result shaded_frame(vr_renderer *r, const vr_scene *scene, const vv_op
             lights[i].attenuation[2] = 1.0f / (fall * fall);
         }
     }
-    vr_draw_desc d = vv_base_desc(o, lights, nl);
-    d.mode = m->mode;
-    d.stream = m->stream;
-    d.pcf = m->pcf;
-    d.camera = *cam;
+    vr_draw_desc d = frame_desc(o, m, cam, lights, nl);
     vr_result res = vr_draw(r, scene, &d, err);
     if (res == VR_OK)
         res = vr_read_pixels(r, px, n * 4, err);

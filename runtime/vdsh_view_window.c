@@ -278,6 +278,31 @@ static void on_scroll(GLFWwindow *w, double xoff, double yoff)
         a->dist = 0.01f * a->diag;
 }
 
+/* Where the held keys point: keys[0]/[1] along +/-fwd, [2]/[3] along
+ * +/-right, [4]/[5] up/down. */
+static void held_move(GLFWwindow *w, const int keys[6], const float fwd[3],
+                      const float right[3], float out[3])
+{
+    int held[6];
+    for (int i = 0; i < 6; i++)
+        held[i] = glfwGetKey(w, keys[i]) == GLFW_PRESS;
+    for (int k = 0; k < 3; k++) {
+        out[k] = 0.0f;
+        if (held[0])
+            out[k] += fwd[k];
+        if (held[1])
+            out[k] -= fwd[k];
+        if (held[2])
+            out[k] += right[k];
+        if (held[3])
+            out[k] -= right[k];
+    }
+    if (held[4])
+        out[1] += 1.0f;
+    if (held[5])
+        out[1] -= 1.0f;
+}
+
 /* Held keys: fly the camera, move the selected light. */
 static void update(app *a, GLFWwindow *w, float dt)
 {
@@ -290,40 +315,18 @@ static void update(app *a, GLFWwindow *w, float dt)
     right[2] = fh[0];
     if (glfwGetKey(w, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS)
         speed *= 4.0f;
-    float move[3] = {0, 0, 0};
-    for (int k = 0; k < 3; k++) {
-        if (glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS)
-            move[k] += f[k];
-        if (glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS)
-            move[k] -= f[k];
-        if (glfwGetKey(w, GLFW_KEY_D) == GLFW_PRESS)
-            move[k] += right[k];
-        if (glfwGetKey(w, GLFW_KEY_A) == GLFW_PRESS)
-            move[k] -= right[k];
-    }
-    if (glfwGetKey(w, GLFW_KEY_E) == GLFW_PRESS)
-        move[1] += 1.0f;
-    if (glfwGetKey(w, GLFW_KEY_Q) == GLFW_PRESS)
-        move[1] -= 1.0f;
+    static const int fly[6] = {GLFW_KEY_W, GLFW_KEY_S, GLFW_KEY_D,
+                               GLFW_KEY_A, GLFW_KEY_E, GLFW_KEY_Q};
+    float move[3];
+    held_move(w, fly, f, right, move);
     for (int k = 0; k < 3; k++)
         a->target[k] += speed * move[k];
 
     if (a->n > 0) {
-        float lm[3] = {0, 0, 0}, ls = 0.15f * a->diag * dt;
-        for (int k = 0; k < 3; k++) {
-            if (glfwGetKey(w, GLFW_KEY_UP) == GLFW_PRESS)
-                lm[k] += fh[k];
-            if (glfwGetKey(w, GLFW_KEY_DOWN) == GLFW_PRESS)
-                lm[k] -= fh[k];
-            if (glfwGetKey(w, GLFW_KEY_RIGHT) == GLFW_PRESS)
-                lm[k] += right[k];
-            if (glfwGetKey(w, GLFW_KEY_LEFT) == GLFW_PRESS)
-                lm[k] -= right[k];
-        }
-        if (glfwGetKey(w, GLFW_KEY_PAGE_UP) == GLFW_PRESS)
-            lm[1] += 1.0f;
-        if (glfwGetKey(w, GLFW_KEY_PAGE_DOWN) == GLFW_PRESS)
-            lm[1] -= 1.0f;
+        static const int keys[6] = {GLFW_KEY_UP,    GLFW_KEY_DOWN,    GLFW_KEY_RIGHT,
+                                    GLFW_KEY_LEFT,  GLFW_KEY_PAGE_UP, GLFW_KEY_PAGE_DOWN};
+        float lm[3], ls = 0.15f * a->diag * dt;
+        held_move(w, keys, fh, right, lm);
         for (int k = 0; k < 3; k++)
             a->base[a->selected].position[k] += ls * lm[k];
     }

@@ -430,9 +430,11 @@ static void face_view_proj(int f, const float eye[3], const float nf[2], float o
                                     {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
     static const float up[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1},
                                    {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
-    float target[3] = {eye[0] + dir[f][0], eye[1] + dir[f][1], eye[2] + dir[f][2]};
+    vdsh_camera c = {{eye[0], eye[1], eye[2]},
+                     {eye[0] + dir[f][0], eye[1] + dir[f][1], eye[2] + dir[f][2]},
+                     {up[f][0], up[f][1], up[f][2]}, 0.0f};
     float view[16], proj[16];
-    vr_mat4_look_at(view, eye, target, up[f]);
+    vdsh_camera_view(&c, view);
     vr_mat4_perspective(proj, 1.5707963267948966f, 1.0f, nf[0], nf[1]);
     vr_mat4_mul(out, proj, view);
 }
