@@ -4,7 +4,6 @@
  */
 #include "vr_internal.h"
 
-#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -149,18 +148,6 @@ void vr_mat4_mul(float out[16], const float a[16], const float b[16])
             r[c * 4 + row] = s;
         }
     memcpy(out, r, sizeof r);
-}
-
-void vr_mat4_perspective(float out[16], float fov_y_rad, float aspect,
-                         float znear, float zfar)
-{
-    float t = 1.0f / tanf(0.5f * fov_y_rad);
-    memset(out, 0, 16 * sizeof(float));
-    out[0] = t / aspect;
-    out[5] = t;
-    out[10] = (zfar + znear) / (znear - zfar);
-    out[11] = -1.0f;
-    out[14] = 2.0f * zfar * znear / (znear - zfar);
 }
 
 void vr_mat4_ortho(float out[16], float half_w, float half_h, float znear,
