@@ -146,10 +146,14 @@ static int usage_error(const char *fmt, const char *arg)
     return vt_usage_error("vdsh-view", fmt, arg);
 }
 
-/* 0 when v is a, 1 when it is b, else -1. */
-static int pick(const char *v, const char *a, const char *b)
+/* Option opt's value v, one of a (*out 0) and b (*out 1): 0, or the
+ * usage error. */
+static int pick(const char *opt, const char *v, const char *a, const char *b, int *out)
 {
-    return !strcmp(v, a) ? 0 : !strcmp(v, b) ? 1 : -1;
+    *out = !strcmp(v, b);
+    if (*out || !strcmp(v, a))
+        return 0;
+    return vt_usage_error("vdsh-view", "%s: expected %s or %s, got '%s'", opt, a, b, v);
 }
 
 /* A buffer mode asks for its stream; orders 1-5 are buffered on request. */
@@ -233,6 +237,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
     int c;
     while ((c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
         const char *v = optarg;
+        int which, rc;
         switch (c) {
         case 'h':
             fputs(usage_text, stdout);
@@ -301,13 +306,11 @@ static int parse_args(int argc, char **argv, vv_options *o)
             o->have_mode = 1;
             break;
         }
-        case O_COMPARE: {
-            int i = pick(v, "smooth", "binary");
-            if (i < 0)
-                return usage_error("--compare: expected smooth or binary, got '%s'", v);
-            o->compare = i ? VDSH_COMPARE_BINARY : VDSH_COMPARE_SMOOTH;
+        case O_COMPARE:
+            if ((rc = pick("--compare", v, "smooth", "binary", &which)) != 0)
+                return rc;
+            o->compare = which ? VDSH_COMPARE_BINARY : VDSH_COMPARE_SMOOTH;
             break;
-        }
         case O_PCF: o->pcf = 1; break;
         case O_SDF: o->sdf_path = v; break;
         case O_SDF_K:
@@ -324,13 +327,11 @@ static int parse_args(int argc, char **argv, vv_options *o)
             o->have_size = 1;
             break;
         case O_NO_CUBEMAPS: o->no_cubemaps = 1; break;
-        case O_EGL: {
-            int i = pick(v, "device", "surfaceless");
-            if (i < 0)
-                return usage_error("--egl: expected device or surfaceless, got '%s'", v);
-            o->egl = i ? VR_EGL_SURFACELESS : VR_EGL_DEVICE;
+        case O_EGL:
+            if ((rc = pick("--egl", v, "device", "surfaceless", &which)) != 0)
+                return rc;
+            o->egl = which ? VR_EGL_SURFACELESS : VR_EGL_DEVICE;
             break;
-        }
         case O_FRAMES: o->frames_arg = v; break;
         case O_VIEWS: o->views_path = v; break;
         case O_MODES:
