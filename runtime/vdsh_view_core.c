@@ -21,6 +21,8 @@ enum {
     OPT = VV_MODE_OPTION, FRM = VV_MODE_FRAMES, DEF = VV_MODE_FRAMES_DEFAULT,
     BEN = VV_MODE_BENCH, LOG = VV_MODE_BENCH_LOG
 };
+/* bufN: the order-N stream from its buffer; --bench times orders 5 and
+ * up (on log-distance scenes, beside vdsh5's attributes). */
 #define BUF(n, flags) {"buf" #n, "buf" #n, VR_MODE_VDSH_BUFFER, 0, n, OPT | FRM | (flags), 0, 0}
 
 const vv_mode vv_modes[] = {
@@ -39,6 +41,7 @@ const vv_mode vv_modes[] = {
     {"adaptive",  "adaptive",  VR_MODE_VDSH_BUFFER, 0, VR_STREAM_VARIABLE, OPT | FRM | LOG, 6, 0},
     {"buffer",    "buffer",    VR_MODE_VDSH_BUFFER, 0, 0, OPT,                   0, '7'},
     {NULL, NULL, VR_MODE_DEFAULT, 0, 0, 0, 0, 0}};
+#undef BUF
 
 _Static_assert(sizeof vv_modes / sizeof vv_modes[0] <= VV_MAX_MODES + 1, "VV_MAX_MODES");
 
