@@ -633,7 +633,7 @@ static int parse_args(int argc, char **argv, options *o)
         switch (opt) {
         case 'o': o->out = optarg; break;
         case 'O':
-            if (!vt_arg_orders(optarg, 0, set))
+            if (!vt_parse_orders(optarg, 0, VDSH_MAX_ORDER, set))
                 return vt_usage_error("vdsh-export", "--orders takes orders 1..%d such as "
                                       "2,3,5, not '%s'", VDSH_MAX_ORDER, optarg);
             for (int k = 1; k <= VDSH_MAX_ORDER; k++)

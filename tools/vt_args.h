@@ -1,11 +1,11 @@
 /*
- * vt_args.h - the option checks several vdsh programs share, each with
- * the one message every program gives for it.
+ * vt_args.h - the .vdsh argument several vdsh programs take, with the
+ * one message every program gives for it.
  *
  * Purpose: vdsh-eval, vdsh-frames and vdsh-export (and any program that
- * takes such options) check a whole-number option, a list of SH orders,
- * the one .vdsh argument and the file it names the same way, so the same
- * mistake gets the same words in each. Numbers follow vt_cli.h's rules.
+ * takes one .vdsh) check the one .vdsh argument and the file it names the
+ * same way, so the same mistake gets the same words in each. Number and
+ * order options are vt_cli.h's (vt_opt_*).
  *
  * Does not: parse the command line (each program's parse_args() does,
  * with getopt), or decide what a program does with the values.
@@ -30,16 +30,6 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/* A whole number lo..hi for `option` ("--threads") into *out: 1, or 0
- * after the usage error "OPTION takes a whole number LO..HI, not 'ARG'". */
-int vt_arg_u32(const char *option, const char *arg, uint32_t lo, uint32_t hi, uint32_t *out);
-
-/* A list of orders 1..VDSH_MAX_ORDER (vt_cli.h's list syntax), each at
- * most once when `distinct`: set[k] = 1 for every order k listed and 0
- * for the others; 1, or 0 (set untouched) when it is not such a list.
- * The message is the caller's: the programs word it differently. */
-int vt_arg_orders(const char *s, int distinct, int set[VDSH_ORDER_SLOTS]);
 
 /* The FILE.vdsh argument at argv[first]: NULL after the usage error
  * "[CMD: ]no .vdsh file given", or, unless `more` (arguments after it

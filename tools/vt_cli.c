@@ -396,31 +396,35 @@ int vt_opt_tolerance(const char *option, const char *noun, const char *arg, int 
     return 0;
 }
 
-int vt_opt_orders(const char *option, const char *example, const char *arg, int max_order,
-                  int *want)
+int vt_parse_orders(const char *s, int distinct, int max_order, int *want)
 {
-    /* A longer list than max_order repeats an order or leaves the range:
-     * refused either way, so 64 entries stand for any max_order <= 64. */
+    /* At most max_order entries (a longer list repeats an order); 64
+     * entries stand for any max_order <= 64. */
     uint64_t v[64];
     int n = max_order >= 1 && max_order <= 64
-                ? vt_parse_u64_list(arg, 1, (uint64_t)max_order, v, 1, max_order)
+                ? vt_parse_u64_list(s, 1, (uint64_t)max_order, v, 1, max_order)
                 : 0;
     int seen[65] = {0};
     for (int i = 0; i < n; i++) {
-        if (seen[v[i]]) {
-            n = 0;
-            break;
-        }
+        if (distinct && seen[v[i]])
+            return 0;
         seen[v[i]] = 1;
     }
-    if (n == 0) {
-        vt_usage_error(cli_prog, "%s takes distinct orders 1..%d such as %s, not '%s'", option,
-                       max_order, example, arg);
+    if (n == 0)
         return 0;
-    }
     for (int k = 0; k <= max_order; k++)
         want[k] = seen[k];
     return 1;
+}
+
+int vt_opt_orders(const char *option, const char *example, const char *arg, int max_order,
+                  int *want)
+{
+    if (vt_parse_orders(arg, 1, max_order, want))
+        return 1;
+    vt_usage_error(cli_prog, "%s takes distinct orders 1..%d such as %s, not '%s'", option,
+                   max_order, example, arg);
+    return 0;
 }
 
 int vt_opt_choice(const char *option, const char *arg, const vt_choice *choices, int *out)

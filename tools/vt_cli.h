@@ -164,6 +164,13 @@ typedef struct vt_choice {
 } vt_choice;
 int vt_opt_choice(const char *option, const char *arg, const vt_choice *choices, int *out);
 
+/* Orders 1..max_order, a vt_parse_u64_list list of at most max_order
+ * entries in any order, each at most once when `distinct`: want[k] = 1
+ * for each order k given, 0 for the others (want holds max_order + 1
+ * entries; want[0] is 0); 1, or 0 (want untouched, no message) when it is
+ * not such a list. */
+int vt_parse_orders(const char *s, int distinct, int max_order, int *want);
+
 /* Distinct orders 1..max_order, a vt_parse_u64_list list in any order:
  * want[k] = 1 for each order k given, 0 for the others (want holds
  * max_order + 1 entries; want[0] is 0). Says "takes distinct orders

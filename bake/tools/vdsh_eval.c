@@ -726,22 +726,22 @@ static int parse_args(int argc, char **argv, options *o)
     while (ok && (c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
         switch (c) {
         case O_POINTS:
-            ok = vt_arg_u32("--points", optarg, 1, VB_EVAL_MAX_RECEIVERS, &d->points);
+            ok = vt_opt_u32("--points", NULL, optarg, 1, VB_EVAL_MAX_RECEIVERS, &d->points);
             break;
         case O_INTERIOR:
-            ok = vt_arg_u32("--interior", optarg, 0, VB_EVAL_MAX_RECEIVERS, &d->interior);
+            ok = vt_opt_u32("--interior", NULL, optarg, 0, VB_EVAL_MAX_RECEIVERS, &d->interior);
             break;
-        case O_DIRECTIONS: ok = vt_arg_u32("--directions", optarg, 1, 65536, &d->directions); break;
-        case O_WORST: ok = vt_arg_u32("--worst", optarg, 1, VB_EVAL_MAX_WORST, &d->worst); break;
-        case O_LIGHTS: ok = vt_arg_u32("--lights", optarg, 1, 4096, &d->lights); break;
-        case O_THREADS: ok = vt_arg_u32("--threads", optarg, 1, 256, &d->threads); break;
+        case O_DIRECTIONS: ok = vt_opt_u32("--directions", NULL, optarg, 1, 65536, &d->directions); break;
+        case O_WORST: ok = vt_opt_u32("--worst", NULL, optarg, 1, VB_EVAL_MAX_WORST, &d->worst); break;
+        case O_LIGHTS: ok = vt_opt_u32("--lights", NULL, optarg, 1, 4096, &d->lights); break;
+        case O_THREADS: ok = vt_opt_u32("--threads", NULL, optarg, 1, 256, &d->threads); break;
         case O_SEED:
             if (!vt_parse_u64(optarg, 0, UINT64_MAX, &d->seed))
                 return bad_usage("--seed takes a whole number, not '%s'", optarg);
             break;
         case O_ORDERS:
-            if (!vt_arg_orders(optarg, 1, o->want_order))
-                return bad_usage("--orders takes distinct orders 1..5 such as 3,5, not '%s'", optarg);
+            if (!vt_opt_orders("--orders", "3,5", optarg, VDSH_MAX_ORDER, o->want_order))
+                return VT_EXIT_USAGE;
             o->filter = 1;
             break;
         case O_INTERP:

@@ -899,7 +899,7 @@ static int take_option(int c, options *o)
     case O_FRAMES: o->frames = optarg; return 1;
     case O_JSON: o->json = optarg; return 1;
     case 'q': o->quiet = 1; return 1;
-    case O_THREADS: return vt_arg_u32("--threads", optarg, 1, 256, &o->threads);
+    case O_THREADS: return vt_opt_u32("--threads", NULL, optarg, 1, 256, &o->threads);
     case O_CAMERAS:
         if (!vt_parse_u64(optarg, 1, VT_VIEWS_MAX - 1, &u))
             return !bad_usage("--cameras takes a whole number 1..255, not '%s'", optarg);
