@@ -2,8 +2,8 @@
  * vt_cli.h - what every vdsh program accepts as a number on its command
  * line, and how it says no.
  *
- * Purpose: one definition of an option's value for vdsh-bake, vdsh-eval,
- * vdsh-info, vdsh-view and vdsh-raydump, so that the same text means the
+ * Purpose: one definition of an option's value for every vdsh program
+ * (vdsh-bake, vdsh-eval, vdsh-view, ...), so that the same text means the
  * same number in each (`--seed 010` is ten everywhere). Numbers are
  * strictly decimal:
  *   whole numbers   digits only ("0", "010"; an int may start with '-'),
