@@ -774,11 +774,8 @@ vb_result vb_cubemap_basis_write(const vb_cubemap_basis *b, const char *dir,
     vb_result r = vb_cubemap_basis_stage(b, dir, stem, st, err);
     for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++) {
         r = commit(&st[k], err);
-        if (r != VB_OK && k > 0 && err) {
-            size_t len = strlen(err->msg);
-            snprintf(err->msg + len, sizeof err->msg - len,
-                     " (the first %d basis files were already replaced)", k);
-        }
+        if (r != VB_OK && k > 0)
+            vb_append(err, " (the first %d basis files were already replaced)", k);
     }
 
     for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)

@@ -39,6 +39,12 @@ __attribute__((format(printf, 3, 4)))
 #endif
 vb_result vb_fail(vb_error *err, vb_result r, const char *fmt, ...);
 
+/* Add to the message in err (if not NULL), after what it says. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+void vb_append(vb_error *err, const char *fmt, ...);
+
 /* Monotonic wall clock in seconds. */
 double vb_now(void);
 
