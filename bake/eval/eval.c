@@ -39,9 +39,8 @@ enum {
     PURPOSE_SCENE_LIGHTS = 0x53434e4cu /* "SCNL" */
 };
 
-static uint64_t purpose_seed(uint64_t seed, uint32_t purpose)
+uint64_t vb_eval_purpose_seed(uint64_t seed, uint32_t purpose)
 {
-    /* splitmix64 finaliser over (seed, purpose) */
     uint64_t z = seed ^ ((uint64_t)purpose * 0x9e3779b97f4a7c15ull);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
@@ -482,7 +481,7 @@ int vb_eval_interior_point(const double *cdf, uint32_t triangle_count,
 {
     if (triangle_count == 0 || !(cdf[triangle_count - 1] > 0.0))
         return 0;
-    uint64_t s = purpose_seed(seed, PURPOSE_INTERIOR);
+    uint64_t s = vb_eval_purpose_seed(seed, PURPOSE_INTERIOR);
     float u1, u2, u3, u4;
     vb_hash2(s, j, 0, &u1, &u2);
     vb_hash2(s, j, 1, &u3, &u4);
@@ -519,7 +518,7 @@ uint32_t vb_eval_directions(uint64_t seed, uint32_t directions, uint32_t id,
     vb_dirgrid g = {0};
     if (vb_dirgrid_create(directions, 1, &g, NULL) != VB_OK)
         return 0;
-    uint64_t ds = purpose_seed(seed, PURPOSE_DIRECTIONS);
+    uint64_t ds = vb_eval_purpose_seed(seed, PURPOSE_DIRECTIONS);
     uint32_t got = 0;
     for (uint32_t pk = 0; pk < g.packet_count; pk++) {
         float x[16], y[16], z[16];
@@ -823,7 +822,7 @@ static vb_result pick_vertices(uint32_t V, uint32_t want, uint64_t seed,
             free(v);
             return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u vertices", V);
         }
-        uint64_t s = purpose_seed(seed, PURPOSE_VERTICES);
+        uint64_t s = vb_eval_purpose_seed(seed, PURPOSE_VERTICES);
         for (uint32_t i = 0; i < V; i++) {
             float a, b;
             vb_hash2(s, i, 0, &a, &b);
@@ -862,7 +861,20 @@ typedef struct eval_run {
     vb_eval_result o;
 } eval_run;
 
-/* The description checked against the file, its defaults filled in. */
+/* The diagonal of the file's bounds; the scene's when they are empty. */
+static float file_diagonal(const vdsh_file *f, const vb_scene *scene)
+{
+    double d2 = 0.0;
+    for (int i = 0; i < 3; i++) {
+        double e = (double)f->header.bounds_max[i] - f->header.bounds_min[i];
+        d2 += e * e;
+    }
+    float diag = (float)sqrt(d2);
+    return diag > 0.0f ? diag : scene->diagonal;
+}
+
+/* The description checked against the file, its defaults filled in; the
+ * run's clock started. */
 static vb_result resolve_desc(eval_run *e, vb_error *err)
 {
     vb_eval_desc *d = &e->d;
@@ -891,19 +903,19 @@ static vb_result resolve_desc(eval_run *e, vb_error *err)
     if (d->interior > 0 && f->header.triangle_count == 0)
         d->interior = 0; /* a point cloud has no inside: vertices only */
     d->threads = vb_parallel_threads(d->threads);
+    e->t0 = vb_now();
+    e->diag = file_diagonal(f, d->scene);
     return VB_OK;
 }
 
-/* The diagonal of the file's bounds; the scene's when they are empty. */
-static float file_diagonal(const vdsh_file *f, const vb_scene *scene)
+/* The held-out directions' grid and the vertices picked. */
+static vb_result pick_receivers(eval_run *e, vb_error *err)
 {
-    double d2 = 0.0;
-    for (int i = 0; i < 3; i++) {
-        double e = (double)f->header.bounds_max[i] - f->header.bounds_min[i];
-        d2 += e * e;
-    }
-    float diag = (float)sqrt(d2);
-    return diag > 0.0f ? diag : scene->diagonal;
+    const vb_eval_desc *d = &e->d;
+    vb_result r = vb_dirgrid_create(d->directions, 1, &e->grid, err);
+    if (r != VB_OK)
+        return r;
+    return pick_vertices(d->file->header.vertex_count, d->points, d->seed, &e->vsel, &e->nv, err);
 }
 
 /* The picked vertices as receivers, with their truth origins (those with
@@ -998,6 +1010,9 @@ static vb_result create_job(eval_run *e, vb_error *err)
 {
     const vb_eval_desc *d = &e->d;
     const uint32_t S = d->file->stream_count, nr = e->nr;
+    free(e->vorigin); /* the receivers have theirs */
+    free(e->vnear);
+    e->vorigin = NULL, e->vnear = NULL;
     job *J = e->J = calloc(1, sizeof *J);
     if (!J)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
@@ -1030,9 +1045,9 @@ static vb_result place_scene_lights(eval_run *e, vb_error *err)
     J->sacc = calloc((size_t)e->nr * (S ? S : 1) + 1, sizeof *J->sacc);
     if (!o->lights || !e->lights_local || !J->sacc)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the scene lights");
-    vb_result r = vb_scene_place_lights_rule(d->scene, purpose_seed(d->seed, PURPOSE_SCENE_LIGHTS),
-                                             nl, (vb_light_rule)d->light_rule, o->lights,
-                                             &o->light_candidates, err);
+    uint64_t seed = vb_eval_purpose_seed(d->seed, PURPOSE_SCENE_LIGHTS);
+    vb_result r = vb_scene_place_lights_rule(d->scene, seed, nl, (vb_light_rule)d->light_rule,
+                                             o->lights, &o->light_candidates, err);
     if (r != VB_OK)
         return r;
     o->light_count = nl;
@@ -1050,8 +1065,8 @@ static vb_result trace_receivers(eval_run *e, vb_error *err)
     const vb_eval_desc *d = &e->d;
     const vdsh_file *f = d->file;
     job *J = e->J;
-    J->dir_seed = purpose_seed(d->seed, PURPOSE_DIRECTIONS);
-    J->light_seed = purpose_seed(d->seed, PURPOSE_LIGHTS);
+    J->dir_seed = vb_eval_purpose_seed(d->seed, PURPOSE_DIRECTIONS);
+    J->light_seed = vb_eval_purpose_seed(d->seed, PURPOSE_LIGHTS);
     J->max_distance = f->header.max_distance;
     J->max_local = f->header.max_distance * d->scene->scale;
     J->inv_scale = 1.0f / d->scene->scale;
@@ -1158,54 +1173,32 @@ static void finish_result(eval_run *e, vb_eval_result *out)
 static void run_free(eval_run *e)
 {
     free(e->lights_local);
+    free(e->rec);
+    free(e->cdf);
+    vb_dirgrid_destroy(&e->grid);
+    free(e->vorigin);
+    free(e->vnear);
+    free(e->vsel);
+    vb_eval_result_free(&e->o);
     if (e->J) {
         free(e->J->sacc);
         free(e->J->acc);
         free(e->J->truth);
         free(e->J->hist);
     }
-    vb_eval_result_free(&e->o);
     free(e->J);
-    free(e->rec);
-    free(e->cdf);
-    free(e->vorigin);
-    free(e->vnear);
-    free(e->vsel);
-    vb_dirgrid_destroy(&e->grid);
 }
 
 vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
                       vb_error *err)
 {
     eval_run e = {.d = *desc};
-    vb_result r = resolve_desc(&e, err);
-    if (r != VB_OK)
-        return r;
-    e.t0 = vb_now();
-    e.diag = file_diagonal(e.d.file, e.d.scene);
-    r = vb_dirgrid_create(e.d.directions, 1, &e.grid, err);
-    if (r == VB_OK)
-        r = pick_vertices(e.d.file->header.vertex_count, e.d.points, e.d.seed, &e.vsel, &e.nv,
-                          err);
-    if (r == VB_OK)
-        r = vertex_receivers(&e, err);
-    if (r == VB_OK)
-        r = interior_receivers(&e, err);
-    if (r == VB_OK) {
-        free(e.vorigin);
-        free(e.vnear);
-        e.vorigin = NULL, e.vnear = NULL;
-        r = create_job(&e, err);
-    }
-    if (r == VB_OK)
-        r = place_scene_lights(&e, err);
-    if (r == VB_OK)
-        r = trace_receivers(&e, err);
-    if (r == VB_OK)
-        r = reduce_kinds(&e, err);
-    if (r == VB_OK)
-        r = per_vertex_errors(&e, err);
-    if (r == VB_OK)
+    vb_result r;
+    if ((r = resolve_desc(&e, err)) == VB_OK && (r = pick_receivers(&e, err)) == VB_OK &&
+        (r = vertex_receivers(&e, err)) == VB_OK && (r = interior_receivers(&e, err)) == VB_OK &&
+        (r = create_job(&e, err)) == VB_OK && (r = place_scene_lights(&e, err)) == VB_OK &&
+        (r = trace_receivers(&e, err)) == VB_OK && (r = reduce_kinds(&e, err)) == VB_OK &&
+        (r = per_vertex_errors(&e, err)) == VB_OK)
         finish_result(&e, out);
     run_free(&e);
     return r;
