@@ -951,10 +951,13 @@ typedef struct bake_run {
     vb_origins_stats ost;
     uint32_t flipped;
     job *J;
-    double t0;
+    double t0;             /* when the tracing began */
     double auto_error[VDSH_ORDER_SLOTS][2];
     uint32_t auto_receivers, cal_count;
+    unsigned started;      /* the workers of the bake */
 } bake_run;
+
+typedef vb_result (*bake_step)(bake_run *b, vb_error *err);
 
 /* The orders: the fixed ones (order_mask), the projection's (max_order)
  * and adaptive order's cap. */
@@ -1208,9 +1211,16 @@ static vb_result allocate_arrays(bake_run *b, vb_error *err)
     return VB_OK;
 }
 
+/* Orient the receivers and place their ray origins (origins.h). */
+static vb_result prepare_receivers(bake_run *b, vb_error *err)
+{
+    return vb_receivers_prepare(b->d.receivers, b->d.scene, b->d.threads, b->set, b->set_count,
+                                b->lo, b->hi, b->normals, &b->flipped, b->origins, b->near,
+                                &b->ost, err);
+}
+
 /* The job the workers read: the run's settings and arrays, adaptive
- * order's scratch, the per-order log offsets, the decision's light pool,
- * the quantity choice's error table. */
+ * order's scratch. */
 static vb_result setup_job(bake_run *b, vb_error *err)
 {
     vb_bake_desc *d = &b->d;
@@ -1243,15 +1253,24 @@ static vb_result setup_job(bake_run *b, vb_error *err)
     if (b->var_orders && !(J->var_scratch = malloc(d->threads * var_scratch_floats(J) *
                                                    sizeof(float))))
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-    /* The per-order log offsets, for the methods that have them. */
+    return VB_OK;
+}
+
+/* The per-order log offsets, for the methods that have them; method
+ * decision: the pool of lights in free space (traced frame) and the
+ * workers' scratch (no free space: the lsq fits are kept); adaptive
+ * order's offsets; the quantity choice's error table. */
+static vb_result setup_offsets(bake_run *b, vb_error *err)
+{
+    const vb_bake_desc *d = &b->d;
+    const vb_method_info *mi = b->mi;
+    job *J = b->J;
     for (int o = 1; o <= VDSH_MAX_ORDER && mi->param == VB_PARAM_LOG_OFFSET; o++) {
         J->log_offset[o] = d->log_offsets ? d->log_offsets[o] : mi->default_log_offset[o];
         if (!isfinite(J->log_offset[o]) || fabsf(J->log_offset[o]) > 5.0f)
             return vb_fail(err, VB_ERR_ARGUMENT, "order %d: log offset %g is not in -5..5", o,
                            (double)J->log_offset[o]);
     }
-    /* Method decision: the pool of lights in free space (traced frame),
-     * the workers' scratch; no free space: the lsq fits are kept. */
     J->dec = b->dec;
     J->dec_lights = d->decision_lights;
     if (mi->decision && !d->trace_only) {
@@ -1289,6 +1308,7 @@ static vb_result choose_quantities(bake_run *b, vb_error *err)
     const vb_bake_desc *d = &b->d;
     job *J = b->J;
     const uint32_t V = d->receivers->vertex_count;
+    b->t0 = vb_now();
     if (!b->choose || d->trace_only) {
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             J->quantity[o] = d->order_quantity ? d->order_quantity[o]
@@ -1366,28 +1386,28 @@ static vb_result calibrate_offsets(bake_run *b, vb_error *err)
 
 /* Trace and project every receiver of the range on the workers; the
  * calibration's receivers were baked before their offset, which is added
- * to them here. *started: the workers that ran. */
-static vb_result bake_receivers(bake_run *b, unsigned *started, vb_error *err)
+ * to them here. */
+static vb_result bake_receivers(bake_run *b, vb_error *err)
 {
     const vb_bake_desc *d = &b->d;
     job *J = b->J;
     const uint32_t lo = b->lo, hi = b->hi;
-    *started = vb_parallel_for(d->threads, d->receivers->vertex_count, BLOCK, bake_block, J,
-                               d->progress ? bake_progress : NULL, J);
+    b->started = vb_parallel_for(d->threads, d->receivers->vertex_count, BLOCK, bake_block, J,
+                                 d->progress ? bake_progress : NULL, J);
     for (uint32_t v = lo; b->cal_count && J->done && v < hi; v++)
         if (J->done[v - lo])
             for (int o = 1; o <= VDSH_MAX_ORDER; o++)
                 if (b->coeffs[o])
                     b->coeffs[o][(size_t)(v - lo) * o * o] +=
                         J->log_offset[o] / 0.28209479177387814f;
-    if (*started == 0)
+    if (b->started == 0)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
     return VB_OK;
 }
 
 /* The output: the settings as resolved, the counts, and the arrays (moved
  * out of the run, so that run_free leaves them). */
-static void fill_output(bake_run *b, unsigned started, vb_bake_output *out)
+static void fill_output(bake_run *b, vb_bake_output *out)
 {
     const vb_bake_desc *d = &b->d;
     const vb_method_info *mi = b->mi;
@@ -1442,7 +1462,7 @@ static void fill_output(bake_run *b, unsigned started, vb_bake_output *out)
     o.ray_tolerance = J->adaptive ? d->ray_tolerance : 0.0f;
     o.hemisphere = b->grid.hemisphere;
     o.max_distance = d->max_distance;
-    o.threads = started;
+    o.threads = b->started;
     o.rays_traced = atomic_load(&J->traced);
     o.rays_missed = atomic_load(&J->missed);
     o.degenerate_receivers = atomic_load(&J->degenerate);
@@ -1489,41 +1509,23 @@ static void run_free(bake_run *b)
     vb_dirgrid_destroy(&b->grid);
 }
 
+/* vb_bake_run's steps, in order. */
+static const bake_step bake_steps[] = {
+    resolve_orders, resolve_quantity,  resolve_parameters, check_receivers,
+    resolve_decision, create_grid,     select_receivers,   allocate_arrays,
+    prepare_receivers, setup_job,      setup_offsets,      choose_quantities,
+    calibrate_offsets, bake_receivers,
+};
+
 vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
                       vb_error *err)
 {
     bake_run b = {.d = *desc};
-    unsigned started = 0;
-    vb_result r = resolve_orders(&b, err);
+    vb_result r = VB_OK;
+    for (size_t k = 0; r == VB_OK && k < sizeof bake_steps / sizeof *bake_steps; k++)
+        r = bake_steps[k](&b, err);
     if (r == VB_OK)
-        r = resolve_quantity(&b, err);
-    if (r == VB_OK)
-        r = resolve_parameters(&b, err);
-    if (r == VB_OK)
-        r = check_receivers(&b, err);
-    if (r == VB_OK)
-        r = resolve_decision(&b, err);
-    if (r == VB_OK)
-        r = create_grid(&b, err);
-    if (r == VB_OK)
-        r = select_receivers(&b, err);
-    if (r == VB_OK)
-        r = allocate_arrays(&b, err);
-    if (r == VB_OK)
-        r = vb_receivers_prepare(b.d.receivers, b.d.scene, b.d.threads, b.set, b.set_count,
-                                 b.lo, b.hi, b.normals, &b.flipped, b.origins, b.near, &b.ost,
-                                 err);
-    if (r == VB_OK)
-        r = setup_job(&b, err);
-    b.t0 = vb_now();
-    if (r == VB_OK)
-        r = choose_quantities(&b, err);
-    if (r == VB_OK)
-        r = calibrate_offsets(&b, err);
-    if (r == VB_OK)
-        r = bake_receivers(&b, &started, err);
-    if (r == VB_OK)
-        fill_output(&b, started, out);
+        fill_output(&b, out);
     run_free(&b);
     return r;
 }
