@@ -597,20 +597,6 @@ static double ratio_se(const ratio *q, uint32_t n)
     return sqrt((double)n / (n - 1) * q->res) / q->b;
 }
 
-typedef struct sort_item {
-    double key;
-    uint32_t index;
-} sort_item;
-
-/* Worst first; ties by receiver order, so the list is reproducible. */
-static int cmp_worst(const void *x, const void *y)
-{
-    const sort_item *a = x, *b = y;
-    if (a->key != b->key)
-        return a->key < b->key ? 1 : -1;
-    return (a->index > b->index) - (a->index < b->index);
-}
-
 static int cmp_double(const void *x, const void *y)
 {
     double a = *(const double *)x, b = *(const double *)y;
@@ -635,7 +621,7 @@ static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind,
 {
     const uint32_t S = J->streams;
     double *mae = malloc(((size_t)count + 1) * sizeof *mae);
-    sort_item *items = malloc(((size_t)count + 1) * sizeof *items);
+    vb_ranked *items = malloc(((size_t)count + 1) * sizeof *items);
     if (!mae || !items) {
         free(mae);
         free(items);
@@ -712,7 +698,7 @@ static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind,
         o->receiver_mae_p50 = quantile_sorted(mae, nm, 0.50);
         o->receiver_mae_p90 = quantile_sorted(mae, nm, 0.90);
         o->receiver_mae_p99 = quantile_sorted(mae, nm, 0.99);
-        qsort(items, nm, sizeof *items, cmp_worst);
+        qsort(items, nm, sizeof *items, vb_ranked_cmp);
         o->worst_count = nm < worst_n ? nm : worst_n;
         for (uint32_t w = 0; w < o->worst_count; w++) {
             uint32_t i = items[w].index;
@@ -766,7 +752,7 @@ static void reduce_scene(const job *J, uint32_t first, uint32_t count,
 static vb_result list_escaping(const job *J, uint32_t first, uint32_t count,
                                uint32_t max, vb_eval_truth *t, vb_error *err)
 {
-    sort_item *items = malloc(((size_t)count + 1) * sizeof *items);
+    vb_ranked *items = malloc(((size_t)count + 1) * sizeof *items);
     if (!items)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the scores");
     uint32_t n = 0;
@@ -777,7 +763,7 @@ static vb_result list_escaping(const job *J, uint32_t first, uint32_t count,
             items[n++].index = i;
         }
     }
-    qsort(items, n, sizeof *items, cmp_worst);
+    qsort(items, n, sizeof *items, vb_ranked_cmp);
     t->escaping_listed = n < max ? n : max;
     for (uint32_t w = 0; w < t->escaping_listed; w++) {
         uint32_t i = items[w].index;
@@ -789,9 +775,9 @@ static vb_result list_escaping(const job *J, uint32_t first, uint32_t count,
 
 /* ---- the run ------------------------------------------------------------- */
 
-static int cmp_sort_item_key(const void *x, const void *y)
+static int cmp_ranked_key(const void *x, const void *y)
 {
-    const sort_item *a = x, *b = y;
+    const vb_ranked *a = x, *b = y;
     if (a->key != b->key)
         return a->key < b->key ? -1 : 1;
     return (a->index > b->index) - (a->index < b->index);
@@ -817,7 +803,7 @@ static vb_result pick_vertices(uint32_t V, uint32_t want, uint64_t seed,
         for (uint32_t i = 0; i < V; i++)
             v[i] = i;
     } else {
-        sort_item *it = malloc((size_t)V * sizeof *it);
+        vb_ranked *it = malloc((size_t)V * sizeof *it);
         if (!it) {
             free(v);
             return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u vertices", V);
@@ -829,7 +815,7 @@ static vb_result pick_vertices(uint32_t V, uint32_t want, uint64_t seed,
             it[i].key = a + b * (1.0 / 16777216.0);
             it[i].index = i;
         }
-        qsort(it, V, sizeof *it, cmp_sort_item_key);
+        qsort(it, V, sizeof *it, cmp_ranked_key);
         for (uint32_t i = 0; i < n; i++)
             v[i] = it[i].index;
         free(it);

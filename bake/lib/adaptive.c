@@ -160,20 +160,6 @@ static double edge_len2(const vb_mesh *m, uint64_t key)
     return d2;
 }
 
-typedef struct ranked {
-    double error;
-    uint32_t index;
-} ranked;
-
-/* Largest error first; ties by candidate order. */
-static int cmp_ranked(const void *a, const void *b)
-{
-    const ranked *x = a, *y = b;
-    if (x->error != y->error)
-        return x->error < y->error ? 1 : -1;
-    return (x->index > y->index) - (x->index < y->index);
-}
-
 /* Append `count` rows of `width` floats from src (rows rows[i] - first:
  * src's first row is row `first`) to *dst, which holds `have` rows. */
 static int append_rows(float **dst, uint32_t have, const float *src, uint32_t first,
@@ -333,7 +319,7 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
     uint64_t *judged = NULL, *cand = NULL;
     size_t judged_n = 0, cand_n = 0;
     double *error = NULL;
-    ranked *rank = NULL;
+    vb_ranked *rank = NULL;
     uint32_t *rows = NULL, *pairs = NULL; /* per round: new rows; the candidates' ends */
     float (*lights)[3] = NULL;
     const double t_start = vb_now();
@@ -414,8 +400,8 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
                 goto done;
             }
             for (size_t i = 0; i < cand_n; i++)
-                rank[i] = (ranked){edge_len2(&M, cand[i]), (uint32_t)i};
-            qsort(rank, cand_n, sizeof *rank, cmp_ranked);
+                rank[i] = (vb_ranked){edge_len2(&M, cand[i]), (uint32_t)i};
+            qsort(rank, cand_n, sizeof *rank, vb_ranked_cmp);
             uint8_t *keep = calloc(cand_n + 1, 1);
             if (!keep) {
                 r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
@@ -485,8 +471,8 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         uint32_t over = 0;
         for (size_t i = 0; i < cand_n; i++)
             if (error[i] > threshold)
-                rank[over++] = (ranked){error[i], (uint32_t)i};
-        qsort(rank, over, sizeof *rank, cmp_ranked);
+                rank[over++] = (vb_ranked){error[i], (uint32_t)i};
+        qsort(rank, over, sizeof *rank, vb_ranked_cmp);
         uint32_t take = over;
         if (ad->max_receivers && take > ad->max_receivers - V) {
             take = ad->max_receivers - V;

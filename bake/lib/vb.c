@@ -43,6 +43,14 @@ void vb_append(vb_error *err, const char *fmt, ...)
     va_end(ap);
 }
 
+int vb_ranked_cmp(const void *a, const void *b)
+{
+    const vb_ranked *x = a, *y = b;
+    if (x->key == y->key)
+        return (x->index > y->index) - (x->index < y->index);
+    return x->key < y->key ? 1 : -1;
+}
+
 double vb_now(void)
 {
     struct timespec ts;
