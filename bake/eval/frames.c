@@ -30,14 +30,6 @@ enum {
     PURPOSE_ORDER = 0x4f524452u   /* "ORDR" */
 };
 
-static uint64_t purpose_seed(uint64_t seed, uint32_t purpose)
-{
-    uint64_t z = seed ^ ((uint64_t)purpose * 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
 static float dot3(const float a[3], const float b[3])
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -781,12 +773,12 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
-    r = vb_scene_place_lights(occ, purpose_seed(d.seed, PURPOSE_LIGHTS), LIGHT_POOL, pool, NULL,
-                             err);
+    r = vb_scene_place_lights(occ, vb_eval_purpose_seed(d.seed, PURPOSE_LIGHTS), LIGHT_POOL, pool,
+                              NULL, err);
     if (r != VB_OK)
         goto done;
     V.pool = (const float(*)[3])pool;
-    const uint64_t order_seed = purpose_seed(d.seed, PURPOSE_ORDER);
+    const uint64_t order_seed = vb_eval_purpose_seed(d.seed, PURPOSE_ORDER);
 
     /* View 0: the viewer's own camera; its lights are the best there are. */
     {
@@ -808,8 +800,8 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
     /* The others: eyes in free space, each looking at a surface point it
      * sees, in a direction between 53 degrees below the horizon and 12
      * above (as a visitor looks: along and down, where shadows fall). */
-    const uint64_t eye_seed = purpose_seed(d.seed, PURPOSE_EYES);
-    const uint64_t look_seed = purpose_seed(d.seed, PURPOSE_LOOK);
+    const uint64_t eye_seed = vb_eval_purpose_seed(d.seed, PURPOSE_EYES);
+    const uint64_t look_seed = vb_eval_purpose_seed(d.seed, PURPOSE_LOOK);
     const float nearest = NEAREST_SHARE * s->diagonal;
     uint32_t have = 0;
     const uint32_t limit = EYE_TRIES_PER_VIEW * d.cameras;
@@ -857,8 +849,8 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
         int ok = 0;
         if (near >= nearest) {
             uint32_t found;
-            r = pick_lights(&V, &h, (uint32_t)(purpose_seed(order_seed, k) % LIGHT_POOL), 1,
-                            v, &found, &ok, err);
+            uint32_t start = (uint32_t)(vb_eval_purpose_seed(order_seed, k) % LIGHT_POOL);
+            r = pick_lights(&V, &h, start, 1, v, &found, &ok, err);
         }
         vb_frames_hits_free(&h);
         if (r != VB_OK)

@@ -372,11 +372,8 @@ vb_result vb_write_outputs(const vdsh_file *f, const char *output, const char *c
     }
     if (r == VB_OK && vdsh_output_commit(&file, &verr) != VDSH_OK)
         r = vb_fail(err, VB_ERR_IO, "%s", verr.msg);
-    if (r != VB_OK && renamed > 0 && err) {
-        size_t len = strlen(err->msg);
-        snprintf(err->msg + len, sizeof err->msg - len,
-                 " (%d basis cubemaps were already replaced)", renamed);
-    }
+    if (r != VB_OK && renamed > 0)
+        vb_append(err, " (%d basis cubemaps were already replaced)", renamed);
     for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
         vdsh_output_abort(&cubes[k]);
     vdsh_output_abort(&file);
