@@ -232,10 +232,69 @@ const char *vdsh_method_name(uint32_t method)
     return NAME_OF(method, n);
 }
 
+static size_t bytes_f32(uint32_t nc) { return (size_t)nc * 4; }
+static size_t bytes_f16(uint32_t nc) { return (size_t)nc * 2; }
+static size_t bytes_s8(uint32_t nc) { return nc; }
+static size_t bytes_s8s6(uint32_t nc)
+{
+    return nc <= VDSH_S8S6_BYTES
+               ? nc
+               : VDSH_S8S6_BYTES + 4 * (size_t)((nc - VDSH_S8S6_BYTES + VDSH_S8S6_PER_WORD - 1) /
+                                                VDSH_S8S6_PER_WORD);
+}
+static size_t bytes_model(uint32_t nc) { (void)nc; return 0; }
+
+static const vdsh_encoding_info encodings[] = {
+    {"f16", VDSH_ENCODING_F16, bytes_f16, "IEEE half floats, one scale per stream"},
+    {"f32", VDSH_ENCODING_F32, bytes_f32, "IEEE floats, one scale per stream"},
+    {"s8", VDSH_ENCODING_S8, bytes_s8, "signed 8-bit, a scale per coefficient index"},
+    {"s8s6", VDSH_ENCODING_S8S6, bytes_s8s6,
+     "bands 0-1 signed 8-bit, bands 2+ signed 6-bit, a scale per coefficient index"},
+    {"cpca", VDSH_ENCODING_CPCA, bytes_model,
+     "clustered PCA: per cluster a mean and basis vectors, per vertex packed weights"},
+};
+enum { ENCODING_COUNT = sizeof encodings / sizeof encodings[0] };
+
+const vdsh_encoding_info *vdsh_encodings(size_t *count)
+{
+    if (count)
+        *count = ENCODING_COUNT;
+    return encodings;
+}
+
+const vdsh_encoding_info *vdsh_encoding_info_of(uint32_t encoding)
+{
+    for (size_t i = 0; i < ENCODING_COUNT; i++)
+        if (encodings[i].encoding == encoding)
+            return &encodings[i];
+    return NULL;
+}
+
+const vdsh_encoding_info *vdsh_encoding_from_name(const char *name)
+{
+    for (size_t i = 0; name && i < ENCODING_COUNT; i++)
+        if (strcmp(encodings[i].name, name) == 0)
+            return &encodings[i];
+    return NULL;
+}
+
+const char *vdsh_encoding_names(void)
+{
+    static char text[8 * ENCODING_COUNT + 64];
+    if (!text[0]) {
+        size_t at = 0;
+        for (size_t i = 0; i < ENCODING_COUNT; i++)
+            at += (size_t)snprintf(text + at, sizeof text - at, "%s%s",
+                                   i == 0 ? "" : i + 1 == ENCODING_COUNT ? " or " : ", ",
+                                   encodings[i].name);
+    }
+    return text;
+}
+
 const char *vdsh_encoding_name(uint32_t encoding)
 {
-    static const char *const n[] = {"f32", "f16", "s8", "s8s6", "cpca"};
-    return NAME_OF(encoding, n);
+    const vdsh_encoding_info *e = vdsh_encoding_info_of(encoding);
+    return e ? e->name : "?";
 }
 
 const char *vdsh_quantity_name(uint32_t quantity)
@@ -354,17 +413,8 @@ vdsh_result vdsh_encode_f16(const float *src, size_t n, float scale,
 
 size_t vdsh_encoding_bytes(uint32_t e, uint32_t nc)
 {
-    switch (e) {
-    case VDSH_ENCODING_F32: return (size_t)nc * 4;
-    case VDSH_ENCODING_F16: return (size_t)nc * 2;
-    case VDSH_ENCODING_S8: return nc;
-    case VDSH_ENCODING_S8S6:
-        return nc <= VDSH_S8S6_BYTES
-                   ? nc
-                   : VDSH_S8S6_BYTES + 4 * (size_t)((nc - VDSH_S8S6_BYTES + VDSH_S8S6_PER_WORD - 1) /
-                                                    VDSH_S8S6_PER_WORD);
-    default: return 0;
-    }
+    const vdsh_encoding_info *info = vdsh_encoding_info_of(e);
+    return info ? info->bytes(nc) : 0;
 }
 
 /* s8s6: where coefficient i >= 4 of a vertex lies: its word's byte
