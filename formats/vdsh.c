@@ -15,6 +15,7 @@
  * without copying them.
  */
 #include "vdsh.h"
+#include "vdsh_failf.h"
 #include "vdsh_output.h"
 
 #include <errno.h>
@@ -155,11 +156,19 @@ static int all_zero(const uint8_t *p, size_t n)
 /* Messages                                                            */
 /* ------------------------------------------------------------------ */
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 4, 5)))
-#endif
-static vdsh_result fail(vdsh_error *err, vdsh_result r, const char *name,
-                        const char *fmt, ...)
+vdsh_result vdsh_failf(vdsh_error *err, vdsh_result r, const char *fmt, ...)
+{
+    if (err) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+        va_end(ap);
+    }
+    return r;
+}
+
+vdsh_result vdsh_failf_at(vdsh_error *err, vdsh_result r, const char *name, const char *fmt,
+                          ...)
 {
     if (err) {
         int n = snprintf(err->msg, sizeof err->msg, "%s: ",
@@ -1449,7 +1458,7 @@ typedef struct reader {
 
 static vdsh_result invalid(const reader *r, const why *w)
 {
-    return fail(r->err, VDSH_ERR_INVALID, r->name, "%s", w->msg);
+    return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name, "%s", w->msg);
 }
 
 /* Pass 1: file header, chunk walk, every CRC and padding. */
@@ -1461,22 +1470,22 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks,
 
     if (size < sizeof vdsh_magic) {
         if (memcmp(d, vdsh_magic, size) != 0)
-            return fail(r->err, VDSH_ERR_NOT_VDSH, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_NOT_VDSH, r->name,
                         "not a .vdsh file (wrong magic)");
-        return fail(r->err, VDSH_ERR_TRUNCATED, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
                     "truncated: %zu bytes, shorter than the %d-byte header",
                     size, FILE_HEADER_SIZE);
     }
     if (memcmp(d, vdsh_magic, sizeof vdsh_magic) != 0) {
         if (memcmp(d, vdsh_magic, 4) == 0)
-            return fail(r->err, VDSH_ERR_NOT_VDSH, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_NOT_VDSH, r->name,
                         "not a .vdsh file: magic bytes 4..7 damaged (a "
                         "text-mode transfer changes CR, LF and ^Z)");
-        return fail(r->err, VDSH_ERR_NOT_VDSH, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_NOT_VDSH, r->name,
                     "not a .vdsh file (wrong magic)");
     }
     if (size < FILE_HEADER_SIZE)
-        return fail(r->err, VDSH_ERR_TRUNCATED, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
                     "truncated: %zu bytes, shorter than the %d-byte header",
                     size, FILE_HEADER_SIZE);
 
@@ -1487,7 +1496,7 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks,
     uint32_t crc_stored = get_u32(d + 28);
     uint32_t crc_computed = vdsh_crc32(0, d, 28);
     if (version != VDSH_FORMAT_VERSION)
-        return fail(r->err, VDSH_ERR_VERSION, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_VERSION, r->name,
                     "format version %u, this reader reads version %u%s",
                     version, VDSH_FORMAT_VERSION,
                     crc_stored == crc_computed
@@ -1495,7 +1504,7 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks,
                         : " (and the header CRC fails: the file may be "
                           "damaged)");
     if (crc_stored != crc_computed)
-        return fail(r->err, VDSH_ERR_CRC, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CRC, r->name,
                     "header CRC mismatch (stored 0x%08x, computed 0x%08x)",
                     crc_stored, crc_computed);
 
@@ -1503,18 +1512,18 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks,
     uint64_t file_size = get_u64(d + 16);
     uint32_t flags = get_u32(d + 24);
     if ((uint64_t)size < file_size)
-        return fail(r->err, VDSH_ERR_TRUNCATED, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
                     "truncated: %zu bytes, the header says %llu", size,
                     (unsigned long long)file_size);
     if ((uint64_t)size > file_size)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "%zu bytes, but the header says %llu (data after the "
                     "end)", size, (unsigned long long)file_size);
     if (flags != 0)
-        return fail(r->err, VDSH_ERR_INVALID, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
                     "header flags 0x%x, must be 0", flags);
     if (chunk_count < 1 || chunk_count > MAX_CHUNKS)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "chunk_count %u out of range 1..%d", chunk_count,
                     MAX_CHUNKS);
 
@@ -1525,38 +1534,38 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks,
         char pid[5];
         int w = walk_chunk(d, size, off, c, &cs, &cc);
         if (w == WALK_NO_HEADER)
-            return fail(r->err, VDSH_ERR_TRUNCATED, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
                         "chunk %u at offset %llu: header runs past the end "
                         "of the file (%u chunks announced)", i,
                         (unsigned long long)off, chunk_count);
         printable_id(d + off, pid);
         if (w == WALK_PAST_END)
-            return fail(r->err, VDSH_ERR_TRUNCATED, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
                         "chunk %u '%s' at offset %llu: payload of %llu bytes "
                         "runs past the end of the file", i, pid,
                         (unsigned long long)off,
                         (unsigned long long)c->size);
         if (cs != cc)
-            return fail(r->err, VDSH_ERR_CRC, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_CRC, r->name,
                         "chunk %u '%s' at offset %llu: CRC mismatch (stored "
                         "0x%08x, computed 0x%08x)", i, pid,
                         (unsigned long long)off, cs, cc);
         for (int k = 0; k < 4; k++)
             if (!is_letter(d[off + k]))
-                return fail(r->err, VDSH_ERR_CHUNK, r->name,
+                return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                             "chunk %u at offset %llu: id %02x %02x %02x %02x "
                             "is not four ASCII letters", i,
                             (unsigned long long)off, d[off], d[off + 1],
                             d[off + 2], d[off + 3]);
         uint64_t payload = off + CHUNK_HEADER_SIZE;
         if (!all_zero(d + payload + c->size, (size_t)pad16(c->size)))
-            return fail(r->err, VDSH_ERR_CHUNK, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                         "chunk %u '%s' at offset %llu: padding byte not "
                         "zero", i, pid, (unsigned long long)off);
         off = payload + c->size + pad16(c->size);
     }
     if (off != size)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "%llu bytes after the last of %u chunks",
                     (unsigned long long)(size - off), chunk_count);
     *count = chunk_count;
@@ -1569,7 +1578,7 @@ static vdsh_result read_head(const reader *r, const chunk_ref *c, layout *L)
     vdsh_header *h = &L->header;
     why w;
     if (c->size != HEAD_SIZE)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "HEAD: payload is %llu bytes, must be %d",
                     (unsigned long long)c->size, HEAD_SIZE);
     h->vertex_count = get_u32(p + 0);
@@ -1590,7 +1599,7 @@ static vdsh_result read_head(const reader *r, const chunk_ref *c, layout *L)
         h->bounds_max[k] = get_f32(p + 68 + 4 * k);
     }
     if (!all_zero(p + 80, 48))
-        return fail(r->err, VDSH_ERR_INVALID, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
                     "HEAD: reserved bytes 80..127 not zero");
     if (!check_header(h, &w))
         return invalid(r, &w);
@@ -1603,18 +1612,18 @@ static vdsh_result read_srcs(const reader *r, const chunk_ref *c, layout *L)
     uint64_t n = c->size, off = 4;
     why w;
     if (n < 4)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "SRCS: payload of %llu bytes has no count",
                     (unsigned long long)n);
     uint32_t count = get_u32(p);
     if (count > VDSH_MAX_SOURCES)
-        return fail(r->err, VDSH_ERR_INVALID, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
                     "SRCS: count %u out of range 0..%d", count,
                     VDSH_MAX_SOURCES);
     L->names_bytes = 0;
     for (uint32_t i = 0; i < count; i++) {
         if (SOURCE_FIXED_SIZE > n - off)
-            return fail(r->err, VDSH_ERR_CHUNK, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                         "SRCS: source %u runs past the end of the payload",
                         i);
         uint32_t len = get_u32(p + off + 40);
@@ -1622,18 +1631,18 @@ static vdsh_result read_srcs(const reader *r, const chunk_ref *c, layout *L)
         L->source_size[i] = get_u64(p + off + 32);
         off += SOURCE_FIXED_SIZE;
         if (len < 1 || len > VDSH_MAX_NAME)
-            return fail(r->err, VDSH_ERR_INVALID, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
                         "SRCS: source %u: name_length %u out of range 1..%d",
                         i, len, VDSH_MAX_NAME);
         uint64_t padded = ((uint64_t)len + 3) & ~(uint64_t)3;
         if (padded > n - off)
-            return fail(r->err, VDSH_ERR_CHUNK, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                         "SRCS: source %u: name runs past the end of the "
                         "payload", i);
         if (!check_name(p + off, len, i, &w))
             return invalid(r, &w);
         if (!all_zero(p + off + len, (size_t)(padded - len)))
-            return fail(r->err, VDSH_ERR_CHUNK, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                         "SRCS: source %u: name padding not zero", i);
         L->source_name[i] = c->offset + CHUNK_HEADER_SIZE + off;
         L->source_name_len[i] = len;
@@ -1641,7 +1650,7 @@ static vdsh_result read_srcs(const reader *r, const chunk_ref *c, layout *L)
         off += padded;
     }
     if (off != n)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "SRCS: %llu bytes after the last source",
                     (unsigned long long)(n - off));
     L->source_count = count;
@@ -1653,7 +1662,7 @@ static vdsh_result read_array(const reader *r, const chunk_ref *c,
                               uint32_t count, const char *what)
 {
     if (c->size != (uint64_t)count * 12)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "%s: payload is %llu bytes, %u %s need %llu", c->id,
                     (unsigned long long)c->size, count, what,
                     (unsigned long long)count * 12);
@@ -1669,10 +1678,10 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
     char l[96];
     why w;
     if (i >= VDSH_MAX_STREAMS)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "more than %d COEF chunks", VDSH_MAX_STREAMS);
     if (c->size < STREAM_HEADER_SIZE)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "COEF stream %u: payload of %llu bytes is shorter than "
                     "the %d-byte stream header", i,
                     (unsigned long long)c->size, STREAM_HEADER_SIZE);
@@ -1692,11 +1701,11 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
     memset(&s->cpca, 0, sizeof s->cpca);
     stream_label(s, i, l, sizeof l);
     if (!all_zero(p + 40, 8))
-        return fail(r->err, VDSH_ERR_INVALID, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
                     "%s: reserved bytes 40..47 not zero", l);
     if (s->encoding == VDSH_ENCODING_CPCA) {
         if (c->size - STREAM_HEADER_SIZE < CPCA_HEADER_SIZE)
-            return fail(r->err, VDSH_ERR_CHUNK, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                         "%s: %llu bytes of data, shorter than the %d-byte cpca header", l,
                         (unsigned long long)(c->size - STREAM_HEADER_SIZE), CPCA_HEADER_SIZE);
         s->cpca.clusters = get_u32(p + STREAM_HEADER_SIZE);
@@ -1710,7 +1719,7 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
                          ? vdsh_cpca_model_bytes(s->order, s->cpca.clusters, s->cpca.basis)
                          : stream_table_bytes(s->encoding, s->order);
     if (c->size - STREAM_HEADER_SIZE < table)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "%s: %llu bytes of data, shorter than its %llu-byte scale table", l,
                     (unsigned long long)(c->size - STREAM_HEADER_SIZE),
                     (unsigned long long)table);
@@ -1722,19 +1731,19 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
         for (int a = 0; a < 3; a++) {
             uint64_t padded = (sizes[a] + 15) & ~15ull;
             if (!all_zero(q + sizes[a], (size_t)(padded - sizes[a])))
-                return fail(r->err, VDSH_ERR_INVALID, r->name,
+                return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
                             "%s: padding after the cpca %s not zero", l, what[a]);
             q += padded;
         }
     } else if (table) {
         size_t used = (size_t)s->order * s->order * 4;
         if (!all_zero(p + STREAM_HEADER_SIZE + used, (size_t)table - used))
-            return fail(r->err, VDSH_ERR_INVALID, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
                         "%s: padding after the scale table not zero", l);
     }
     for (uint32_t k = 0; k < i; k++)
         if (same_slot(&L->streams[k], s))
-            return fail(r->err, VDSH_ERR_INVALID, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
                         "%s: a second stream for %s (stream %u is "
                         "the first)", l, slot_name(s, slot, sizeof slot), k);
     L->stream_table[i] = table ? c->offset + CHUNK_HEADER_SIZE + STREAM_HEADER_SIZE : 0;
@@ -1763,23 +1772,23 @@ static vdsh_result check_coef_sizes(const reader *r, layout *L)
         if (stream_variable(s)) {
             orders = round16(rows);
             if (L->stream_bytes[i] < table + orders)
-                return fail(r->err, VDSH_ERR_CHUNK, r->name,
+                return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                             "%s: %llu bytes of data, shorter than its scale and order "
                             "tables (%llu bytes)", l, (unsigned long long)L->stream_bytes[i],
                             (unsigned long long)(table + orders));
             s->orders = r->d + L->stream_data[i];
             if (!all_zero(s->orders + rows, orders - rows))
-                return fail(r->err, VDSH_ERR_INVALID, r->name,
+                return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
                             "%s: padding after the order table not zero", l);
             for (uint32_t v = 0; v < rows; v++) /* before the sizes they imply */
                 if (s->orders[v] < 1 || s->orders[v] > s->order)
-                    return fail(r->err, VDSH_ERR_INVALID, r->name,
+                    return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
                                 "%s: vertex %u has order %u (1..%u)", l, v, s->orders[v],
                                 s->order);
         }
         uint64_t need = table + vdsh_stream_data_bytes(s, rows);
         if (L->stream_bytes[i] != need)
-            return fail(r->err, VDSH_ERR_CHUNK, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                         "%s: %llu bytes of data, %u vertices of %s need %llu%s", l,
                         (unsigned long long)L->stream_bytes[i], rows,
                         vdsh_encoding_name(s->encoding), (unsigned long long)need,
@@ -1808,7 +1817,7 @@ static vdsh_result read_stat(const reader *r, const chunk_ref *c, layout *L)
     const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
     why w;
     if (c->size != STAT_SIZE)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "stat: payload is %llu bytes, must be %d",
                     (unsigned long long)c->size, STAT_SIZE);
     L->stats.rays_traced = get_u64(p + 0);
@@ -1828,11 +1837,11 @@ static vdsh_result read_time(const reader *r, const chunk_ref *c, layout *L)
     const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
     why w;
     if (c->size != TIME_SIZE)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "time: payload is %llu bytes, must be %d",
                     (unsigned long long)c->size, TIME_SIZE);
     if (!all_zero(p + 44, 20))
-        return fail(r->err, VDSH_ERR_INVALID, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
                     "time: reserved bytes 44..63 not zero");
     L->timings.load = get_f64(p + 0);
     L->timings.refine = get_f64(p + 8);
@@ -1851,7 +1860,7 @@ static vdsh_result read_adpt(const reader *r, const chunk_ref *c, layout *L)
     const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
     why w;
     if (c->size != ADPT_SIZE)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name, "adpt: payload is %llu bytes, must be %d",
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name, "adpt: payload is %llu bytes, must be %d",
                     (unsigned long long)c->size, ADPT_SIZE);
     L->adaptive.tolerance = get_f32(p + 0);
     L->adaptive.min_edge = get_f32(p + 4);
@@ -1872,7 +1881,7 @@ static vdsh_result read_part(const reader *r, const chunk_ref *c, layout *L)
     const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
     why w;
     if (c->size != PART_SIZE)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name, "part: payload is %llu bytes, must be %d",
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name, "part: payload is %llu bytes, must be %d",
                     (unsigned long long)c->size, PART_SIZE);
     L->part.cpca_clusters = get_u32(p + 20);
     L->part.cpca_basis = get_u32(p + 24);
@@ -1898,7 +1907,7 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
     why w;
 
     if (memcmp(chunks[0].id, "HEAD", 4) != 0)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name,
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "chunk 0 is '%s'; HEAD must come first", chunks[0].id);
     if ((res = read_head(r, &chunks[0], L)) != VDSH_OK)
         return res;
@@ -1912,12 +1921,12 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
             if (memcmp(c->id, required[k], 4) == 0)
                 req = k;
         if (req >= 0 && seen[req]++)
-            return fail(r->err, VDSH_ERR_CHUNK, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                         "chunk %u at offset %llu: a second %s chunk", i,
                         (unsigned long long)c->offset, c->id);
 
         if (memcmp(c->id, "HEAD", 4) == 0) {
-            return fail(r->err, VDSH_ERR_CHUNK, r->name,
+            return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                         "chunk %u at offset %llu: a second HEAD chunk", i,
                         (unsigned long long)c->offset);
         } else if (req == 0) {
@@ -1945,30 +1954,30 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
             res = read_coef(r, c, L);
         } else if (memcmp(c->id, "stat", 4) == 0) {
             res = L->has_stats
-                      ? fail(r->err, VDSH_ERR_CHUNK, r->name,
+                      ? vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                              "chunk %u at offset %llu: a second stat chunk",
                              i, (unsigned long long)c->offset)
                       : read_stat(r, c, L);
         } else if (memcmp(c->id, "time", 4) == 0) {
             res = L->has_timings
-                      ? fail(r->err, VDSH_ERR_CHUNK, r->name,
+                      ? vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                              "chunk %u at offset %llu: a second time chunk",
                              i, (unsigned long long)c->offset)
                       : read_time(r, c, L);
         } else if (memcmp(c->id, "adpt", 4) == 0) {
             res = L->has_adaptive
-                      ? fail(r->err, VDSH_ERR_CHUNK, r->name,
+                      ? vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                              "chunk %u at offset %llu: a second adpt chunk",
                              i, (unsigned long long)c->offset)
                       : read_adpt(r, c, L);
         } else if (memcmp(c->id, "part", 4) == 0) {
             res = L->has_part
-                      ? fail(r->err, VDSH_ERR_CHUNK, r->name,
+                      ? vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                              "chunk %u at offset %llu: a second part chunk",
                              i, (unsigned long long)c->offset)
                       : read_part(r, c, L);
         } else if (c->id[0] >= 'A' && c->id[0] <= 'Z') {
-            res = fail(r->err, VDSH_ERR_CHUNK, r->name,
+            res = vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                        "chunk %u '%s' at offset %llu: unknown critical chunk "
                        "(a newer writer?)", i, c->id,
                        (unsigned long long)c->offset);
@@ -1980,10 +1989,10 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
     }
     for (int k = 0; k < 4; k++)
         if (!seen[k])
-            return fail(r->err, VDSH_ERR_CHUNK, r->name, "no %s chunk",
+            return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name, "no %s chunk",
                         required[k]);
     if (L->stream_count == 0)
-        return fail(r->err, VDSH_ERR_CHUNK, r->name, "no COEF chunk");
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name, "no COEF chunk");
     return check_coef_sizes(r, L);
 }
 
@@ -2019,13 +2028,13 @@ static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name,
     size_t off_offsets = off_names + round16(L.names_bytes);
     if (L.offset_words > (SIZE_MAX - off_offsets) / 4) {
         free(buf);
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, r.name, "out of memory (offsets)");
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, r.name, "out of memory (offsets)");
     }
     size_t block_size = off_offsets + (size_t)L.offset_words * 4;
     uint8_t *block = (uint8_t *)calloc(1, block_size);
     if (!block) {
         free(buf);
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, r.name,
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, r.name,
                     "out of memory (%zu bytes)", block_size);
     }
     vdsh_file *f = (vdsh_file *)block;
@@ -2098,11 +2107,11 @@ vdsh_result vdsh_read_memory(const void *data, size_t size, const char *name,
 {
     const char *nm = name ? name : "memory";
     if (!out || (!data && size))
-        return fail(err, VDSH_ERR_ARGUMENT, nm, "vdsh_read_memory: NULL %s",
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, nm, "vdsh_read_memory: NULL %s",
                     out ? "data" : "out");
     uint8_t *buf = alloc_file_buffer(size);
     if (!buf)
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, nm,
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, nm,
                     "out of memory (%zu bytes)", size);
     if (size)
         memcpy(buf, data, size);
@@ -2112,7 +2121,7 @@ vdsh_result vdsh_read_memory(const void *data, size_t size, const char *name,
 vdsh_result vdsh_read(const char *path, vdsh_file **out, vdsh_error *err)
 {
     if (!path || !out)
-        return fail(err, VDSH_ERR_ARGUMENT, path ? path : "(null)",
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, path ? path : "(null)",
                     "vdsh_read: NULL %s", path ? "out" : "path");
     /* O_NONBLOCK: opening a FIFO must not wait for a writer (it is refused
      * below, as anything but a regular file); regular files ignore it. */
@@ -2122,28 +2131,28 @@ vdsh_result vdsh_read(const char *path, vdsh_file **out, vdsh_error *err)
         int e = errno;
         if (fd >= 0)
             close(fd);
-        return fail(err, VDSH_ERR_IO, path, "cannot open: %s", strerror(e));
+        return vdsh_failf_at(err, VDSH_ERR_IO, path, "cannot open: %s", strerror(e));
     }
     struct stat st;
     if (fstat(fileno(fp), &st) != 0) {
         int e = errno;
         fclose(fp);
-        return fail(err, VDSH_ERR_IO, path, "cannot stat: %s", strerror(e));
+        return vdsh_failf_at(err, VDSH_ERR_IO, path, "cannot stat: %s", strerror(e));
     }
     if (!S_ISREG(st.st_mode)) {
         fclose(fp);
-        return fail(err, VDSH_ERR_IO, path, "not a regular file");
+        return vdsh_failf_at(err, VDSH_ERR_IO, path, "not a regular file");
     }
     if ((uintmax_t)st.st_size > (uintmax_t)(SIZE_MAX - 15)) {
         fclose(fp);
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, path,
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, path,
                     "%jd bytes do not fit in memory", (intmax_t)st.st_size);
     }
     size_t size = (size_t)st.st_size;
     uint8_t *buf = alloc_file_buffer(size);
     if (!buf) {
         fclose(fp);
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, path,
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, path,
                     "out of memory (%zu bytes)", size);
     }
     size_t got = size ? fread(buf, 1, size, fp) : 0;
@@ -2155,9 +2164,9 @@ vdsh_result vdsh_read(const char *path, vdsh_file **out, vdsh_error *err)
     if (read_error || got != size || grew) {
         free(buf);
         if (read_error)
-            return fail(err, VDSH_ERR_IO, path, "read error: %s",
+            return vdsh_failf_at(err, VDSH_ERR_IO, path, "read error: %s",
                         strerror(e));
-        return fail(err, VDSH_ERR_IO, path,
+        return vdsh_failf_at(err, VDSH_ERR_IO, path,
                     "the file changed size while it was being read");
     }
     return load_owned(buf, size, path, out, err);
@@ -2182,14 +2191,14 @@ vdsh_result vdsh_scan_chunks(const void *data, size_t size, const char *name,
     const uint8_t *d = (const uint8_t *)data;
     const char *nm = name ? name : "memory";
     if (!count || (!data && size) || (!out && max))
-        return fail(err, VDSH_ERR_ARGUMENT, nm, "vdsh_scan_chunks: NULL "
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, nm, "vdsh_scan_chunks: NULL "
                     "argument");
     if (size && memcmp(d, vdsh_magic,
                        size < sizeof vdsh_magic ? size : sizeof vdsh_magic))
-        return fail(err, VDSH_ERR_NOT_VDSH, nm,
+        return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, nm,
                     "not a .vdsh file (wrong magic)");
     if (size < FILE_HEADER_SIZE)
-        return fail(err, VDSH_ERR_TRUNCATED, nm,
+        return vdsh_failf_at(err, VDSH_ERR_TRUNCATED, nm,
                     "truncated: %zu bytes, shorter than the %d-byte header",
                     size, FILE_HEADER_SIZE);
     uint64_t off = FILE_HEADER_SIZE;
@@ -2253,7 +2262,7 @@ typedef struct plan {
 
 static vdsh_result argument(vdsh_error *err, const char *name, const why *w)
 {
-    return fail(err, VDSH_ERR_ARGUMENT, name, "not written: %s", w->msg);
+    return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name, "not written: %s", w->msg);
 }
 
 /* The reader's rules, applied to the caller's struct. */
@@ -2262,12 +2271,12 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
 {
     why w;
     if (!f)
-        return fail(err, VDSH_ERR_ARGUMENT, name, "not written: no file");
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name, "not written: no file");
     const vdsh_header *h = &f->header;
     if (!check_header(h, &w))
         return argument(err, name, &w);
     if (!f->positions || !f->normals || (!f->indices && h->triangle_count))
-        return fail(err, VDSH_ERR_ARGUMENT, name,
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
                     "not written: %s is NULL",
                     !f->positions ? "positions"
                     : !f->normals ? "normals"
@@ -2278,16 +2287,16 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
         return argument(err, name, &w);
 
     if (f->source_count > VDSH_MAX_SOURCES)
-        return fail(err, VDSH_ERR_ARGUMENT, name,
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
                     "not written: source_count %u out of range 0..%d",
                     f->source_count, VDSH_MAX_SOURCES);
     if (f->source_count && !f->sources)
-        return fail(err, VDSH_ERR_ARGUMENT, name,
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
                     "not written: sources is NULL");
     for (uint32_t i = 0; i < f->source_count; i++) {
         const char *s = f->sources[i].name;
         if (!s)
-            return fail(err, VDSH_ERR_ARGUMENT, name,
+            return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
                         "not written: SRCS: source %u: name is NULL", i);
         if (!check_name((const uint8_t *)s, strnlen(s, VDSH_MAX_NAME + 1), i,
                         &w))
@@ -2298,34 +2307,34 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
     if (f->has_part && !check_part(&f->part, h->vertex_count, &w))
         return argument(err, name, &w);
     if (f->stream_count < 1 || f->stream_count > VDSH_MAX_STREAMS)
-        return fail(err, VDSH_ERR_ARGUMENT, name,
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
                     "not written: stream_count %u out of range 1..%d",
                     f->stream_count, VDSH_MAX_STREAMS);
     if (!f->streams)
-        return fail(err, VDSH_ERR_ARGUMENT, name,
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
                     "not written: streams is NULL");
     for (uint32_t i = 0; i < f->stream_count; i++) {
         const vdsh_stream *s = &f->streams[i];
         if (!check_stream(s, i, &w))
             return argument(err, name, &w);
         if (!s->data)
-            return fail(err, VDSH_ERR_ARGUMENT, name,
+            return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
                         "not written: COEF stream %u: data is NULL", i);
         if (vdsh_encoding_quantised(s->encoding) && !s->coef_scales)
-            return fail(err, VDSH_ERR_ARGUMENT, name,
+            return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
                         "not written: COEF stream %u: %s without coef_scales", i,
                         vdsh_encoding_name(s->encoding));
         if (stream_variable(s) && !s->orders)
-            return fail(err, VDSH_ERR_ARGUMENT, name,
+            return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
                         "not written: COEF stream %u: variable order without orders", i);
         if (s->encoding == VDSH_ENCODING_CPCA &&
             (!s->cpca.scales || !s->cpca.means || !s->cpca.bases))
-            return fail(err, VDSH_ERR_ARGUMENT, name,
+            return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
                         "not written: COEF stream %u: cpca without scales, means or bases", i);
         for (uint32_t k = 0; k < i; k++)
             if (same_slot(&f->streams[k], s)) {
                 char slot[64];
-                return fail(err, VDSH_ERR_ARGUMENT, name,
+                return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
                             "not written: streams %u and %u are both %s", k, i,
                             slot_name(s, slot, sizeof slot));
             }
@@ -2398,7 +2407,7 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
                      ((strlen(f->sources[i].name) + 3) & ~(size_t)3);
     P->srcs = (uint8_t *)calloc(1, srcs_size);
     if (!P->srcs)
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, name, "out of memory");
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, name, "out of memory");
     put_u32(P->srcs, f->source_count);
     size_t off = 4;
     for (uint32_t i = 0; i < f->source_count; i++) {
@@ -2447,7 +2456,7 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
             size_t n = (size_t)s->order * s->order, k = m->clusters, b = m->basis;
             uint8_t *q = P->model[i] = (uint8_t *)calloc(1, mb + 1);
             if (!q)
-                return fail(err, VDSH_ERR_OUT_OF_MEMORY, name, "out of memory");
+                return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, name, "out of memory");
             for (size_t x = 0; x < k * b; x++)
                 put_f32(q + 4 * x, m->scales[x]);
             q += (4 * k * b + 15) & ~(size_t)15;
@@ -2601,7 +2610,7 @@ vdsh_result vdsh_write_memory(const vdsh_file *f, void **out_data,
 {
     plan P;
     if (!out_data || !out_size)
-        return fail(err, VDSH_ERR_ARGUMENT, "memory",
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, "memory",
                     "not written: NULL output pointer");
     vdsh_result res = plan_build(&P, f, "memory", err);
     if (res != VDSH_OK) {
@@ -2610,14 +2619,14 @@ vdsh_result vdsh_write_memory(const vdsh_file *f, void **out_data,
     }
     if (P.file_size > SIZE_MAX) {
         plan_free(&P);
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, "memory",
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, "memory",
                     "%llu bytes do not fit in memory",
                     (unsigned long long)P.file_size);
     }
     uint8_t *buf = (uint8_t *)malloc((size_t)P.file_size);
     if (!buf) {
         plan_free(&P);
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, "memory",
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, "memory",
                     "out of memory (%llu bytes)",
                     (unsigned long long)P.file_size);
     }
@@ -2639,7 +2648,7 @@ vdsh_result vdsh_write_sized(const char *path, const vdsh_file *f, uint64_t *siz
 {
     plan P;
     if (!path)
-        return fail(err, VDSH_ERR_ARGUMENT, "(null)",
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, "(null)",
                     "not written: path is NULL");
     vdsh_result res = plan_build(&P, f, path, err);
     if (res != VDSH_OK) {
@@ -2660,7 +2669,7 @@ vdsh_result vdsh_write_sized(const char *path, const vdsh_file *f, uint64_t *siz
     uint64_t total = P.file_size;
     plan_free(&P);
     if (s.error) {
-        res = fail(err, VDSH_ERR_IO, path, "cannot write%s%s: %s",
+        res = vdsh_failf_at(err, VDSH_ERR_IO, path, "cannot write%s%s: %s",
                    out.tmp ? " temporary file " : "", out.tmp ? out.tmp : "",
                    strerror(s.error));
         vdsh_output_abort(&out);
