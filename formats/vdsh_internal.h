@@ -139,6 +139,29 @@ static inline int all_zero(const uint8_t *p, size_t n)
     return 1;
 }
 
+/* The optional fixed-size chunks: one list of each one's fields, which
+ * the reader decodes (vdsh_fields_get) and the writer encodes
+ * (vdsh_fields_put); in the order the writer emits them. */
+enum { VDSH_FIXED_STAT, VDSH_FIXED_TIME, VDSH_FIXED_PART, VDSH_FIXED_ADPT, VDSH_FIXED_COUNT };
+enum { VDSH_FIELD_U32, VDSH_FIELD_U64, VDSH_FIELD_F32, VDSH_FIELD_F64 };
+typedef struct vdsh_field {
+    uint8_t offset; /* in the payload */
+    uint8_t type;   /* VDSH_FIELD_* */
+    uint16_t at;    /* offsetof in the struct (vdsh_stats, vdsh_timings, ...) */
+} vdsh_field;
+typedef struct vdsh_fixed_chunk {
+    char id[5];
+    uint8_t size;
+    uint8_t reserved, reserved_size; /* bytes that must be zero */
+    uint8_t count;
+    const vdsh_field *fields;
+} vdsh_fixed_chunk;
+extern const vdsh_fixed_chunk vdsh_fixed_chunks[VDSH_FIXED_COUNT];
+/* The VDSH_FIXED_* of a chunk id; -1 for none. */
+int vdsh_fixed_kind(const char *id);
+void vdsh_fields_get(const vdsh_fixed_chunk *k, const uint8_t *p, void *s);
+void vdsh_fields_put(const vdsh_fixed_chunk *k, uint8_t *p, const void *s);
+
 /* A short description of a failed check, filled by the vdsh_check_* functions
  * and turned into a vdsh_error by the reader (VDSH_ERR_INVALID) or the
  * writer (VDSH_ERR_ARGUMENT). */

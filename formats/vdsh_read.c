@@ -467,88 +467,38 @@ static vdsh_result check_coef_sizes(const reader *r, layout *L)
     return VDSH_OK;
 }
 
-static vdsh_result read_stat(const reader *r, const chunk_ref *c, layout *L)
+/* stat, time, part, adpt: at most one each, of a fixed size, decoded by
+ * the table the writer encodes with, then checked as the writer checks. */
+static vdsh_result read_fixed(const reader *r, const chunk_ref *c, uint32_t i, int kind,
+                              layout *L)
 {
+    const vdsh_fixed_chunk *k = &vdsh_fixed_chunks[kind];
+    int *has[VDSH_FIXED_COUNT] = {&L->has_stats, &L->has_timings, &L->has_part,
+                                  &L->has_adaptive};
+    void *out[VDSH_FIXED_COUNT] = {&L->stats, &L->timings, &L->part, &L->adaptive};
     const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
+    uint32_t vc = L->header.vertex_count;
     why w;
-    if (c->size != STAT_SIZE)
+    if (*has[kind])
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                    "stat: payload is %llu bytes, must be %d",
-                    (unsigned long long)c->size, STAT_SIZE);
-    L->stats.rays_traced = get_u64(p + 0);
-    L->stats.rays_missed = get_u64(p + 8);
-    L->stats.degenerate_receivers = get_u32(p + 16);
-    L->stats.undefined_normals = get_u32(p + 20);
-    L->stats.moved_origins = get_u32(p + 24);
-    L->stats.flipped_normals = get_u32(p + 28);
-    if (!vdsh_check_stats(&L->stats, L->header.vertex_count, &w))
-        return invalid(r, &w);
-    L->has_stats = 1;
-    return VDSH_OK;
-}
-
-static vdsh_result read_time(const reader *r, const chunk_ref *c, layout *L)
-{
-    const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
-    why w;
-    if (c->size != TIME_SIZE)
+                             "chunk %u at offset %llu: a second %s chunk", i,
+                             (unsigned long long)c->offset, k->id);
+    if (c->size != k->size)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                    "time: payload is %llu bytes, must be %d",
-                    (unsigned long long)c->size, TIME_SIZE);
-    if (!all_zero(p + 44, 20))
+                             "%s: payload is %llu bytes, must be %d", k->id,
+                             (unsigned long long)c->size, (int)k->size);
+    if (!all_zero(p + k->reserved, k->reserved_size))
         return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
-                    "time: reserved bytes 44..63 not zero");
-    L->timings.load = get_f64(p + 0);
-    L->timings.refine = get_f64(p + 8);
-    L->timings.build = get_f64(p + 16);
-    L->timings.trace = get_f64(p + 24);
-    L->timings.total = get_f64(p + 32);
-    L->timings.threads = get_u32(p + 40);
-    if (!vdsh_check_timings(&L->timings, &w))
+                             "%s: reserved bytes %u..%u not zero", k->id, (unsigned)k->reserved,
+                             k->reserved + k->reserved_size - 1u);
+    vdsh_fields_get(k, p, out[kind]);
+    int ok = kind == VDSH_FIXED_STAT   ? vdsh_check_stats(&L->stats, vc, &w)
+             : kind == VDSH_FIXED_TIME ? vdsh_check_timings(&L->timings, &w)
+             : kind == VDSH_FIXED_PART ? vdsh_check_part(&L->part, vc, &w)
+                                       : vdsh_check_adaptive(&L->adaptive, vc, &w);
+    if (!ok)
         return invalid(r, &w);
-    L->has_timings = 1;
-    return VDSH_OK;
-}
-
-static vdsh_result read_adpt(const reader *r, const chunk_ref *c, layout *L)
-{
-    const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
-    why w;
-    if (c->size != ADPT_SIZE)
-        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name, "adpt: payload is %llu bytes, must be %d",
-                    (unsigned long long)c->size, ADPT_SIZE);
-    L->adaptive.tolerance = get_f32(p + 0);
-    L->adaptive.min_edge = get_f32(p + 4);
-    L->adaptive.max_receivers = get_u32(p + 8);
-    L->adaptive.lights = get_u32(p + 12);
-    L->adaptive.max_rounds = get_u32(p + 16);
-    L->adaptive.start_receivers = get_u32(p + 20);
-    L->adaptive.rounds = get_u32(p + 24);
-    L->adaptive.candidates = get_u32(p + 28);
-    if (!vdsh_check_adaptive(&L->adaptive, L->header.vertex_count, &w))
-        return invalid(r, &w);
-    L->has_adaptive = 1;
-    return VDSH_OK;
-}
-
-static vdsh_result read_part(const reader *r, const chunk_ref *c, layout *L)
-{
-    const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
-    why w;
-    if (c->size != PART_SIZE)
-        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name, "part: payload is %llu bytes, must be %d",
-                    (unsigned long long)c->size, PART_SIZE);
-    L->part.cpca_clusters = get_u32(p + 20);
-    L->part.cpca_basis = get_u32(p + 24);
-    L->part.cpca_bits = get_u32(p + 28);
-    L->part.index = get_u32(p + 0);
-    L->part.count = get_u32(p + 4);
-    L->part.range_begin = get_u32(p + 8);
-    L->part.range_end = get_u32(p + 12);
-    L->part.encoding = get_u32(p + 16);
-    if (!vdsh_check_part(&L->part, L->header.vertex_count, &w))
-        return invalid(r, &w);
-    L->has_part = 1;
+    *has[kind] = 1;
     return VDSH_OK;
 }
 
@@ -571,7 +521,7 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
     for (uint32_t i = 1; i < count; i++) {
         const chunk_ref *c = &chunks[i];
         const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
-        int req = -1;
+        int req = -1, fixed;
         for (int k = 0; k < 4; k++)
             if (memcmp(c->id, required[k], 4) == 0)
                 req = k;
@@ -607,30 +557,8 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
             L->tris = c->offset + CHUNK_HEADER_SIZE;
         } else if (memcmp(c->id, "COEF", 4) == 0) {
             res = read_coef(r, c, L);
-        } else if (memcmp(c->id, "stat", 4) == 0) {
-            res = L->has_stats
-                      ? vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                             "chunk %u at offset %llu: a second stat chunk",
-                             i, (unsigned long long)c->offset)
-                      : read_stat(r, c, L);
-        } else if (memcmp(c->id, "time", 4) == 0) {
-            res = L->has_timings
-                      ? vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                             "chunk %u at offset %llu: a second time chunk",
-                             i, (unsigned long long)c->offset)
-                      : read_time(r, c, L);
-        } else if (memcmp(c->id, "adpt", 4) == 0) {
-            res = L->has_adaptive
-                      ? vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                             "chunk %u at offset %llu: a second adpt chunk",
-                             i, (unsigned long long)c->offset)
-                      : read_adpt(r, c, L);
-        } else if (memcmp(c->id, "part", 4) == 0) {
-            res = L->has_part
-                      ? vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                             "chunk %u at offset %llu: a second part chunk",
-                             i, (unsigned long long)c->offset)
-                      : read_part(r, c, L);
+        } else if ((fixed = vdsh_fixed_kind(c->id)) >= 0) {
+            res = read_fixed(r, c, i, fixed, L);
         } else if (c->id[0] >= 'A' && c->id[0] <= 'Z') {
             res = vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                        "chunk %u '%s' at offset %llu: unknown critical chunk "

@@ -36,10 +36,7 @@ typedef struct plan {
     uint8_t head[HEAD_SIZE];
     /* each stream's header, then an s8 stream's scale table and padding */
     uint8_t stream_header[VDSH_MAX_STREAMS][STREAM_HEADER_SIZE + S8_TABLE_MAX];
-    uint8_t stat[STAT_SIZE];
-    uint8_t time[TIME_SIZE];
-    uint8_t part[PART_SIZE];
-    uint8_t adpt[ADPT_SIZE];
+    uint8_t fixed[VDSH_FIXED_COUNT][TIME_SIZE]; /* stat, time, part, adpt */
     uint8_t *srcs; /* malloc'd SRCS payload */
     uint8_t *model[VDSH_MAX_STREAMS]; /* malloc'd cpca models, padded */
     out_chunk chunks[MAX_CHUNKS];
@@ -267,50 +264,17 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
         }
     }
 
-    if (f->has_stats) {
-        p = P->stat;
-        put_u64(p + 0, f->stats.rays_traced);
-        put_u64(p + 8, f->stats.rays_missed);
-        put_u32(p + 16, f->stats.degenerate_receivers);
-        put_u32(p + 20, f->stats.undefined_normals);
-        put_u32(p + 24, f->stats.moved_origins);
-        put_u32(p + 28, f->stats.flipped_normals);
-        add_chunk(P, "stat", p, STAT_SIZE, NULL, 0);
-    }
-    if (f->has_timings) {
-        p = P->time;
-        put_f64(p + 0, f->timings.load);
-        put_f64(p + 8, f->timings.refine);
-        put_f64(p + 16, f->timings.build);
-        put_f64(p + 24, f->timings.trace);
-        put_f64(p + 32, f->timings.total);
-        put_u32(p + 40, f->timings.threads);
-        add_chunk(P, "time", p, TIME_SIZE, NULL, 0);
-    }
-    if (f->has_part) {
-        p = P->part;
-        put_u32(p + 0, f->part.index);
-        put_u32(p + 4, f->part.count);
-        put_u32(p + 8, f->part.range_begin);
-        put_u32(p + 12, f->part.range_end);
-        put_u32(p + 16, f->part.encoding);
-        put_u32(p + 20, f->part.cpca_clusters);
-        put_u32(p + 24, f->part.cpca_basis);
-        put_u32(p + 28, f->part.cpca_bits);
-        add_chunk(P, "part", p, PART_SIZE, NULL, 0);
-    }
-    if (f->has_adaptive) {
-        p = P->adpt;
-        put_f32(p + 0, f->adaptive.tolerance);
-        put_f32(p + 4, f->adaptive.min_edge);
-        put_u32(p + 8, f->adaptive.max_receivers);
-        put_u32(p + 12, f->adaptive.lights);
-        put_u32(p + 16, f->adaptive.max_rounds);
-        put_u32(p + 20, f->adaptive.start_receivers);
-        put_u32(p + 24, f->adaptive.rounds);
-        put_u32(p + 28, f->adaptive.candidates);
-        add_chunk(P, "adpt", p, ADPT_SIZE, NULL, 0);
-    }
+    const void *fixed[VDSH_FIXED_COUNT] = {
+        f->has_stats ? (const void *)&f->stats : NULL,
+        f->has_timings ? (const void *)&f->timings : NULL,
+        f->has_part ? (const void *)&f->part : NULL,
+        f->has_adaptive ? (const void *)&f->adaptive : NULL};
+    for (int k = 0; k < VDSH_FIXED_COUNT; k++)
+        if (fixed[k]) {
+            const vdsh_fixed_chunk *x = &vdsh_fixed_chunks[k];
+            vdsh_fields_put(x, P->fixed[k], fixed[k]);
+            add_chunk(P, x->id, P->fixed[k], x->size, NULL, 0);
+        }
 
     /* Sizes are bounded by the checks above (2^28 vertices, 16 streams of
      * at most 100 bytes per vertex): well inside 64 bits. */
