@@ -186,36 +186,37 @@ const char *vdsh_offset_rule_name(uint32_t rule)
 /* The optional fixed-size chunks' fields (VDSH.md)                     */
 /* ------------------------------------------------------------------ */
 
-#define FIELD(off, type, st, member) {(off), VDSH_FIELD_##type, (uint16_t)offsetof(st, member)}
+#define FIELD(off, st, member) \
+    {(off), (uint8_t)sizeof(((st *)0)->member), (uint16_t)offsetof(st, member)}
 
 static const vdsh_field stat_fields[] = {
-    FIELD(0, U64, vdsh_stats, rays_traced),
-    FIELD(8, U64, vdsh_stats, rays_missed),
-    FIELD(16, U32, vdsh_stats, degenerate_receivers),
-    FIELD(20, U32, vdsh_stats, undefined_normals),
-    FIELD(24, U32, vdsh_stats, moved_origins),
-    FIELD(28, U32, vdsh_stats, flipped_normals),
+    FIELD(0, vdsh_stats, rays_traced),
+    FIELD(8, vdsh_stats, rays_missed),
+    FIELD(16, vdsh_stats, degenerate_receivers),
+    FIELD(20, vdsh_stats, undefined_normals),
+    FIELD(24, vdsh_stats, moved_origins),
+    FIELD(28, vdsh_stats, flipped_normals),
 };
 static const vdsh_field time_fields[] = {
-    FIELD(0, F64, vdsh_timings, load),   FIELD(8, F64, vdsh_timings, refine),
-    FIELD(16, F64, vdsh_timings, build), FIELD(24, F64, vdsh_timings, trace),
-    FIELD(32, F64, vdsh_timings, total), FIELD(40, U32, vdsh_timings, threads),
+    FIELD(0, vdsh_timings, load),   FIELD(8, vdsh_timings, refine),
+    FIELD(16, vdsh_timings, build), FIELD(24, vdsh_timings, trace),
+    FIELD(32, vdsh_timings, total), FIELD(40, vdsh_timings, threads),
 };
 static const vdsh_field part_fields[] = {
-    FIELD(0, U32, vdsh_part, index),          FIELD(4, U32, vdsh_part, count),
-    FIELD(8, U32, vdsh_part, range_begin),    FIELD(12, U32, vdsh_part, range_end),
-    FIELD(16, U32, vdsh_part, encoding),      FIELD(20, U32, vdsh_part, cpca_clusters),
-    FIELD(24, U32, vdsh_part, cpca_basis),    FIELD(28, U32, vdsh_part, cpca_bits),
+    FIELD(0, vdsh_part, index),          FIELD(4, vdsh_part, count),
+    FIELD(8, vdsh_part, range_begin),    FIELD(12, vdsh_part, range_end),
+    FIELD(16, vdsh_part, encoding),      FIELD(20, vdsh_part, cpca_clusters),
+    FIELD(24, vdsh_part, cpca_basis),    FIELD(28, vdsh_part, cpca_bits),
 };
 static const vdsh_field adpt_fields[] = {
-    FIELD(0, F32, vdsh_adaptive, tolerance),
-    FIELD(4, F32, vdsh_adaptive, min_edge),
-    FIELD(8, U32, vdsh_adaptive, max_receivers),
-    FIELD(12, U32, vdsh_adaptive, lights),
-    FIELD(16, U32, vdsh_adaptive, max_rounds),
-    FIELD(20, U32, vdsh_adaptive, start_receivers),
-    FIELD(24, U32, vdsh_adaptive, rounds),
-    FIELD(28, U32, vdsh_adaptive, candidates),
+    FIELD(0, vdsh_adaptive, tolerance),
+    FIELD(4, vdsh_adaptive, min_edge),
+    FIELD(8, vdsh_adaptive, max_receivers),
+    FIELD(12, vdsh_adaptive, lights),
+    FIELD(16, vdsh_adaptive, max_rounds),
+    FIELD(20, vdsh_adaptive, start_receivers),
+    FIELD(24, vdsh_adaptive, rounds),
+    FIELD(28, vdsh_adaptive, candidates),
 };
 #define FIELDS(f) (uint8_t)(sizeof(f) / sizeof((f)[0])), (f)
 
@@ -234,32 +235,18 @@ int vdsh_fixed_kind(const char *id)
     return -1;
 }
 
+/* The host is little-endian with IEEE floats (vdsh_internal.h): a field's
+ * bytes are its value's. */
 void vdsh_fields_get(const vdsh_fixed_chunk *k, const uint8_t *p, void *s)
 {
-    for (uint32_t i = 0; i < k->count; i++) {
-        const vdsh_field *f = &k->fields[i];
-        char *at = (char *)s + f->at;
-        switch (f->type) {
-        case VDSH_FIELD_U32: *(uint32_t *)(void *)at = get_u32(p + f->offset); break;
-        case VDSH_FIELD_U64: *(uint64_t *)(void *)at = get_u64(p + f->offset); break;
-        case VDSH_FIELD_F32: *(float *)(void *)at = get_f32(p + f->offset); break;
-        default: *(double *)(void *)at = get_f64(p + f->offset); break;
-        }
-    }
+    for (uint32_t i = 0; i < k->count; i++)
+        memcpy((char *)s + k->fields[i].at, p + k->fields[i].offset, k->fields[i].size);
 }
 
 void vdsh_fields_put(const vdsh_fixed_chunk *k, uint8_t *p, const void *s)
 {
-    for (uint32_t i = 0; i < k->count; i++) {
-        const vdsh_field *f = &k->fields[i];
-        const char *at = (const char *)s + f->at;
-        switch (f->type) {
-        case VDSH_FIELD_U32: put_u32(p + f->offset, *(const uint32_t *)(const void *)at); break;
-        case VDSH_FIELD_U64: put_u64(p + f->offset, *(const uint64_t *)(const void *)at); break;
-        case VDSH_FIELD_F32: put_f32(p + f->offset, *(const float *)(const void *)at); break;
-        default: put_f64(p + f->offset, *(const double *)(const void *)at); break;
-        }
-    }
+    for (uint32_t i = 0; i < k->count; i++)
+        memcpy(p + k->fields[i].offset, (const char *)s + k->fields[i].at, k->fields[i].size);
 }
 
 /* ------------------------------------------------------------------ */

@@ -143,10 +143,9 @@ static inline int all_zero(const uint8_t *p, size_t n)
  * the reader decodes (vdsh_fields_get) and the writer encodes
  * (vdsh_fields_put); in the order the writer emits them. */
 enum { VDSH_FIXED_STAT, VDSH_FIXED_TIME, VDSH_FIXED_PART, VDSH_FIXED_ADPT, VDSH_FIXED_COUNT };
-enum { VDSH_FIELD_U32, VDSH_FIELD_U64, VDSH_FIELD_F32, VDSH_FIELD_F64 };
 typedef struct vdsh_field {
     uint8_t offset; /* in the payload */
-    uint8_t type;   /* VDSH_FIELD_* */
+    uint8_t size;   /* bytes: 4 (u32, f32) or 8 (u64, f64) */
     uint16_t at;    /* offsetof in the struct (vdsh_stats, vdsh_timings, ...) */
 } vdsh_field;
 typedef struct vdsh_fixed_chunk {
