@@ -15,17 +15,6 @@
 /* Messages                                                            */
 /* ------------------------------------------------------------------ */
 
-vdsh_result vdsh_failf(vdsh_error *err, vdsh_result r, const char *fmt, ...)
-{
-    if (err) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err->msg, sizeof err->msg, fmt, ap);
-        va_end(ap);
-    }
-    return r;
-}
-
 vdsh_result vdsh_failf_at(vdsh_error *err, vdsh_result r, const char *name, const char *fmt,
                           ...)
 {
@@ -190,12 +179,9 @@ const char *vdsh_offset_rule_name(uint32_t rule)
     {(off), (uint8_t)sizeof(((st *)0)->member), (uint16_t)offsetof(st, member)}
 
 static const vdsh_field stat_fields[] = {
-    FIELD(0, vdsh_stats, rays_traced),
-    FIELD(8, vdsh_stats, rays_missed),
-    FIELD(16, vdsh_stats, degenerate_receivers),
-    FIELD(20, vdsh_stats, undefined_normals),
-    FIELD(24, vdsh_stats, moved_origins),
-    FIELD(28, vdsh_stats, flipped_normals),
+    FIELD(0, vdsh_stats, rays_traced),        FIELD(8, vdsh_stats, rays_missed),
+    FIELD(16, vdsh_stats, degenerate_receivers), FIELD(20, vdsh_stats, undefined_normals),
+    FIELD(24, vdsh_stats, moved_origins),     FIELD(28, vdsh_stats, flipped_normals),
 };
 static const vdsh_field time_fields[] = {
     FIELD(0, vdsh_timings, load),   FIELD(8, vdsh_timings, refine),
@@ -209,14 +195,10 @@ static const vdsh_field part_fields[] = {
     FIELD(24, vdsh_part, cpca_basis),    FIELD(28, vdsh_part, cpca_bits),
 };
 static const vdsh_field adpt_fields[] = {
-    FIELD(0, vdsh_adaptive, tolerance),
-    FIELD(4, vdsh_adaptive, min_edge),
-    FIELD(8, vdsh_adaptive, max_receivers),
-    FIELD(12, vdsh_adaptive, lights),
-    FIELD(16, vdsh_adaptive, max_rounds),
-    FIELD(20, vdsh_adaptive, start_receivers),
-    FIELD(24, vdsh_adaptive, rounds),
-    FIELD(28, vdsh_adaptive, candidates),
+    FIELD(0, vdsh_adaptive, tolerance),      FIELD(4, vdsh_adaptive, min_edge),
+    FIELD(8, vdsh_adaptive, max_receivers),  FIELD(12, vdsh_adaptive, lights),
+    FIELD(16, vdsh_adaptive, max_rounds),    FIELD(20, vdsh_adaptive, start_receivers),
+    FIELD(24, vdsh_adaptive, rounds),        FIELD(28, vdsh_adaptive, candidates),
 };
 #define FIELDS(f) (uint8_t)(sizeof(f) / sizeof((f)[0])), (f)
 

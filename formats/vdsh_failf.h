@@ -1,7 +1,7 @@
 /*
  * vdsh_failf.h - internal to the formats library (not installed): write a
  * printf-style message into err (when not NULL) and return r. The one
- * message helper of the library (vdsh.c holds both).
+ * message helper of the library (vdsh_output.c and vdsh.c hold them).
  */
 #ifndef VDSH_FAILF_H
 #define VDSH_FAILF_H

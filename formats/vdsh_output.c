@@ -7,6 +7,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <stdarg.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,6 +17,17 @@
 /* Temporary names tried before giving up: names taken by other writers
  * (or planted) are skipped, one attempt each. */
 enum { MAX_ATTEMPTS = 1000 };
+
+vdsh_result vdsh_failf(vdsh_error *err, vdsh_result r, const char *fmt, ...)
+{
+    if (err) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+        va_end(ap);
+    }
+    return r;
+}
 
 static void release(vdsh_output *o)
 {

@@ -536,18 +536,13 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
                         (unsigned long long)c->offset);
         } else if (req == 0) {
             res = read_srcs(r, c, L);
-        } else if (req == 1) {
-            if ((res = read_array(r, c, h->vertex_count, "vertices")) ==
-                    VDSH_OK &&
-                !vdsh_check_positions((const float *)p, h->vertex_count, &w))
+        } else if (req == 1 || req == 2) { /* POSN, NORM */
+            int (*check)(const float *, uint32_t, why *) =
+                req == 1 ? vdsh_check_positions : vdsh_check_normals;
+            if ((res = read_array(r, c, h->vertex_count, "vertices")) == VDSH_OK &&
+                !check((const float *)p, h->vertex_count, &w))
                 res = invalid(r, &w);
-            L->posn = c->offset + CHUNK_HEADER_SIZE;
-        } else if (req == 2) {
-            if ((res = read_array(r, c, h->vertex_count, "vertices")) ==
-                    VDSH_OK &&
-                !vdsh_check_normals((const float *)p, h->vertex_count, &w))
-                res = invalid(r, &w);
-            L->norm = c->offset + CHUNK_HEADER_SIZE;
+            *(req == 1 ? &L->posn : &L->norm) = c->offset + CHUNK_HEADER_SIZE;
         } else if (req == 3) {
             if ((res = read_array(r, c, h->triangle_count, "triangles")) ==
                     VDSH_OK &&
