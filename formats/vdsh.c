@@ -1,9 +1,9 @@
 /*
  * vdsh.c - the formats library's messages, the names of the header
- * values, the encoding table and the CRC (see vdsh.h for the API and
- * VDSH.md for the byte layout). The reader and writer are vdsh_read.c
- * and vdsh_write.c; the value checks they share, vdsh_check.c; the
- * coefficient encodings, vdsh_encode.c.
+ * values, the encoding table, the fixed-size chunks' fields and the CRC
+ * (see vdsh.h for the API and VDSH.md for the byte layout). The reader
+ * and writer are vdsh_read.c and vdsh_write.c; the value checks they
+ * share, vdsh_check.c; the coefficient encodings, vdsh_encode.c.
  */
 #include "vdsh_internal.h"
 

@@ -1,7 +1,7 @@
 /*
  * vdsh_internal.h - internal to the formats library (not installed): what
- * the pieces of the .vdsh reader and writer share (vdsh.c: messages, names
- * and the encoding table; vdsh_encode.c: the coefficient encodings and
+ * the pieces of the .vdsh reader and writer share (vdsh.c: messages, names,
+ * the encoding table and the fixed-size chunks' fields; vdsh_encode.c: the coefficient encodings and
  * stream decoding; vdsh_check.c: the value checks the reader and the
  * writer both apply; vdsh_read.c; vdsh_write.c). The byte layout itself
  * is VDSH.md's.
