@@ -200,7 +200,29 @@ static const vdsh_field adpt_fields[] = {
     FIELD(16, vdsh_adaptive, max_rounds),    FIELD(20, vdsh_adaptive, start_receivers),
     FIELD(24, vdsh_adaptive, rounds),        FIELD(28, vdsh_adaptive, candidates),
 };
+static const vdsh_field head_fields[] = {
+    FIELD(0, vdsh_header, vertex_count),   FIELD(4, vdsh_header, triangle_count),
+    FIELD(8, vdsh_header, rays),           FIELD(12, vdsh_header, sampling),
+    FIELD(16, vdsh_header, seed),          FIELD(24, vdsh_header, max_distance),
+    FIELD(28, vdsh_header, max_edge),      FIELD(32, vdsh_header, offset_rule),
+    FIELD(36, vdsh_header, load_flags),    FIELD(40, vdsh_header, cube_size),
+    FIELD(44, vdsh_header, occluder_vertex_count),
+    FIELD(48, vdsh_header, occluder_triangle_count),
+    FIELD(52, vdsh_header, trace_flags),   FIELD(56, vdsh_header, bounds_min),
+    FIELD(68, vdsh_header, bounds_max),
+};
+static const vdsh_field stream_fields[] = {
+    FIELD(0, vdsh_stream, order),          FIELD(4, vdsh_stream, encoding),
+    FIELD(8, vdsh_stream, method),         FIELD(12, vdsh_stream, quantity),
+    FIELD(16, vdsh_stream, window),        FIELD(20, vdsh_stream, window_param),
+    FIELD(24, vdsh_stream, method_param),  FIELD(28, vdsh_stream, scale),
+    FIELD(32, vdsh_stream, quantity_param), FIELD(36, vdsh_stream, flags),
+};
 #define FIELDS(f) (uint8_t)(sizeof(f) / sizeof((f)[0])), (f)
+
+const vdsh_fixed_chunk vdsh_head_chunk = {"HEAD", HEAD_SIZE, 80, 48, FIELDS(head_fields)};
+const vdsh_fixed_chunk vdsh_stream_header = {"COEF", STREAM_HEADER_SIZE, 40, 8,
+                                             FIELDS(stream_fields)};
 
 const vdsh_fixed_chunk vdsh_fixed_chunks[VDSH_FIXED_COUNT] = {
     [VDSH_FIXED_STAT] = {"stat", STAT_SIZE, 0, 0, FIELDS(stat_fields)},

@@ -156,6 +156,9 @@ typedef struct vdsh_fixed_chunk {
     const vdsh_field *fields;
 } vdsh_fixed_chunk;
 extern const vdsh_fixed_chunk vdsh_fixed_chunks[VDSH_FIXED_COUNT];
+/* HEAD's fields (vdsh_header) and a COEF chunk's stream header's
+ * (vdsh_stream), through the same functions. */
+extern const vdsh_fixed_chunk vdsh_head_chunk, vdsh_stream_header;
 /* The VDSH_FIXED_* of a chunk id; -1 for none. */
 int vdsh_fixed_kind(const char *id);
 void vdsh_fields_get(const vdsh_fixed_chunk *k, const uint8_t *p, void *s);

@@ -236,23 +236,7 @@ static vdsh_result read_head(const reader *r, const chunk_ref *c, layout *L)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                     "HEAD: payload is %llu bytes, must be %d",
                     (unsigned long long)c->size, HEAD_SIZE);
-    h->vertex_count = get_u32(p + 0);
-    h->triangle_count = get_u32(p + 4);
-    h->rays = get_u32(p + 8);
-    h->sampling = get_u32(p + 12);
-    h->seed = get_u64(p + 16);
-    h->max_distance = get_f32(p + 24);
-    h->max_edge = get_f32(p + 28);
-    h->offset_rule = get_u32(p + 32);
-    h->load_flags = get_u32(p + 36);
-    h->cube_size = get_u32(p + 40);
-    h->occluder_vertex_count = get_u32(p + 44);
-    h->occluder_triangle_count = get_u32(p + 48);
-    h->trace_flags = get_u32(p + 52);
-    for (int k = 0; k < 3; k++) {
-        h->bounds_min[k] = get_f32(p + 56 + 4 * k);
-        h->bounds_max[k] = get_f32(p + 68 + 4 * k);
-    }
+    vdsh_fields_get(&vdsh_head_chunk, p, h);
     if (!all_zero(p + 80, 48))
         return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
                     "HEAD: reserved bytes 80..127 not zero");
@@ -340,16 +324,7 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
                     "COEF stream %u: payload of %llu bytes is shorter than "
                     "the %d-byte stream header", i,
                     (unsigned long long)c->size, STREAM_HEADER_SIZE);
-    s->order = get_u32(p + 0);
-    s->encoding = get_u32(p + 4);
-    s->method = get_u32(p + 8);
-    s->quantity = get_u32(p + 12);
-    s->window = get_u32(p + 16);
-    s->window_param = get_f32(p + 20);
-    s->method_param = get_f32(p + 24);
-    s->scale = get_f32(p + 28);
-    s->quantity_param = get_f32(p + 32);
-    s->flags = get_u32(p + 36);
+    vdsh_fields_get(&vdsh_stream_header, p, s);
     s->data = NULL;
     s->orders = NULL;
     s->offsets = NULL;

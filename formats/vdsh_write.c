@@ -165,23 +165,7 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
     const vdsh_header *h = &f->header;
 
     uint8_t *p = P->head;
-    put_u32(p + 0, h->vertex_count);
-    put_u32(p + 4, h->triangle_count);
-    put_u32(p + 8, h->rays);
-    put_u32(p + 12, h->sampling);
-    put_u64(p + 16, h->seed);
-    put_f32(p + 24, h->max_distance);
-    put_f32(p + 28, h->max_edge);
-    put_u32(p + 32, h->offset_rule);
-    put_u32(p + 36, h->load_flags);
-    put_u32(p + 40, h->cube_size);
-    put_u32(p + 44, h->occluder_vertex_count);
-    put_u32(p + 48, h->occluder_triangle_count);
-    put_u32(p + 52, h->trace_flags);
-    for (int k = 0; k < 3; k++) {
-        put_f32(p + 56 + 4 * k, h->bounds_min[k]);
-        put_f32(p + 68 + 4 * k, h->bounds_max[k]);
-    }
+    vdsh_fields_put(&vdsh_head_chunk, p, h);
     add_chunk(P, "HEAD", P->head, HEAD_SIZE, NULL, 0);
 
     /* SRCS is small (at most 64 names of 4096 bytes): encode it whole. */
@@ -213,16 +197,7 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
     for (uint32_t i = 0; i < f->stream_count; i++) {
         const vdsh_stream *s = &f->streams[i];
         p = P->stream_header[i];
-        put_u32(p + 0, s->order);
-        put_u32(p + 4, s->encoding);
-        put_u32(p + 8, s->method);
-        put_u32(p + 12, s->quantity);
-        put_u32(p + 16, s->window);
-        put_f32(p + 20, s->window_param);
-        put_f32(p + 24, s->method_param);
-        put_f32(p + 28, s->scale);
-        put_f32(p + 32, s->quantity_param);
-        put_u32(p + 36, s->flags);
+        vdsh_fields_put(&vdsh_stream_header, p, s);
         size_t table = vdsh_stream_table_bytes(s->encoding, s->order);
         for (uint32_t k = 0; table && k < s->order * s->order; k++)
             put_f32(p + STREAM_HEADER_SIZE + 4 * k, s->coef_scales[k]);
