@@ -172,51 +172,49 @@ const char *vdsh_offset_rule_name(uint32_t rule)
 }
 
 /* ------------------------------------------------------------------ */
-/* The optional fixed-size chunks' fields (VDSH.md)                     */
+/* The fixed-size headers' and chunks' fields (VDSH.md)               */
 /* ------------------------------------------------------------------ */
 
 #define FIELD(off, st, member) \
     {(off), (uint8_t)sizeof(((st *)0)->member), (uint16_t)offsetof(st, member)}
 
 static const vdsh_field stat_fields[] = {
-    FIELD(0, vdsh_stats, rays_traced),        FIELD(8, vdsh_stats, rays_missed),
+    FIELD(0, vdsh_stats, rays_traced), FIELD(8, vdsh_stats, rays_missed),
     FIELD(16, vdsh_stats, degenerate_receivers), FIELD(20, vdsh_stats, undefined_normals),
-    FIELD(24, vdsh_stats, moved_origins),     FIELD(28, vdsh_stats, flipped_normals),
+    FIELD(24, vdsh_stats, moved_origins), FIELD(28, vdsh_stats, flipped_normals),
 };
 static const vdsh_field time_fields[] = {
-    FIELD(0, vdsh_timings, load),   FIELD(8, vdsh_timings, refine),
-    FIELD(16, vdsh_timings, build), FIELD(24, vdsh_timings, trace),
-    FIELD(32, vdsh_timings, total), FIELD(40, vdsh_timings, threads),
+    FIELD(0, vdsh_timings, load), FIELD(8, vdsh_timings, refine), FIELD(16, vdsh_timings, build),
+    FIELD(24, vdsh_timings, trace), FIELD(32, vdsh_timings, total),
+    FIELD(40, vdsh_timings, threads),
 };
 static const vdsh_field part_fields[] = {
-    FIELD(0, vdsh_part, index),          FIELD(4, vdsh_part, count),
-    FIELD(8, vdsh_part, range_begin),    FIELD(12, vdsh_part, range_end),
-    FIELD(16, vdsh_part, encoding),      FIELD(20, vdsh_part, cpca_clusters),
-    FIELD(24, vdsh_part, cpca_basis),    FIELD(28, vdsh_part, cpca_bits),
+    FIELD(0, vdsh_part, index), FIELD(4, vdsh_part, count), FIELD(8, vdsh_part, range_begin),
+    FIELD(12, vdsh_part, range_end), FIELD(16, vdsh_part, encoding),
+    FIELD(20, vdsh_part, cpca_clusters), FIELD(24, vdsh_part, cpca_basis),
+    FIELD(28, vdsh_part, cpca_bits),
 };
 static const vdsh_field adpt_fields[] = {
-    FIELD(0, vdsh_adaptive, tolerance),      FIELD(4, vdsh_adaptive, min_edge),
-    FIELD(8, vdsh_adaptive, max_receivers),  FIELD(12, vdsh_adaptive, lights),
-    FIELD(16, vdsh_adaptive, max_rounds),    FIELD(20, vdsh_adaptive, start_receivers),
-    FIELD(24, vdsh_adaptive, rounds),        FIELD(28, vdsh_adaptive, candidates),
+    FIELD(0, vdsh_adaptive, tolerance), FIELD(4, vdsh_adaptive, min_edge),
+    FIELD(8, vdsh_adaptive, max_receivers), FIELD(12, vdsh_adaptive, lights),
+    FIELD(16, vdsh_adaptive, max_rounds), FIELD(20, vdsh_adaptive, start_receivers),
+    FIELD(24, vdsh_adaptive, rounds), FIELD(28, vdsh_adaptive, candidates),
 };
 static const vdsh_field head_fields[] = {
-    FIELD(0, vdsh_header, vertex_count),   FIELD(4, vdsh_header, triangle_count),
-    FIELD(8, vdsh_header, rays),           FIELD(12, vdsh_header, sampling),
-    FIELD(16, vdsh_header, seed),          FIELD(24, vdsh_header, max_distance),
-    FIELD(28, vdsh_header, max_edge),      FIELD(32, vdsh_header, offset_rule),
-    FIELD(36, vdsh_header, load_flags),    FIELD(40, vdsh_header, cube_size),
-    FIELD(44, vdsh_header, occluder_vertex_count),
-    FIELD(48, vdsh_header, occluder_triangle_count),
-    FIELD(52, vdsh_header, trace_flags),   FIELD(56, vdsh_header, bounds_min),
-    FIELD(68, vdsh_header, bounds_max),
+    FIELD(0, vdsh_header, vertex_count), FIELD(4, vdsh_header, triangle_count),
+    FIELD(8, vdsh_header, rays), FIELD(12, vdsh_header, sampling), FIELD(16, vdsh_header, seed),
+    FIELD(24, vdsh_header, max_distance), FIELD(28, vdsh_header, max_edge),
+    FIELD(32, vdsh_header, offset_rule), FIELD(36, vdsh_header, load_flags),
+    FIELD(40, vdsh_header, cube_size), FIELD(44, vdsh_header, occluder_vertex_count),
+    FIELD(48, vdsh_header, occluder_triangle_count), FIELD(52, vdsh_header, trace_flags),
+    FIELD(56, vdsh_header, bounds_min), FIELD(68, vdsh_header, bounds_max),
 };
 static const vdsh_field stream_fields[] = {
-    FIELD(0, vdsh_stream, order),          FIELD(4, vdsh_stream, encoding),
-    FIELD(8, vdsh_stream, method),         FIELD(12, vdsh_stream, quantity),
-    FIELD(16, vdsh_stream, window),        FIELD(20, vdsh_stream, window_param),
-    FIELD(24, vdsh_stream, method_param),  FIELD(28, vdsh_stream, scale),
-    FIELD(32, vdsh_stream, quantity_param), FIELD(36, vdsh_stream, flags),
+    FIELD(0, vdsh_stream, order), FIELD(4, vdsh_stream, encoding), FIELD(8, vdsh_stream, method),
+    FIELD(12, vdsh_stream, quantity), FIELD(16, vdsh_stream, window),
+    FIELD(20, vdsh_stream, window_param), FIELD(24, vdsh_stream, method_param),
+    FIELD(28, vdsh_stream, scale), FIELD(32, vdsh_stream, quantity_param),
+    FIELD(36, vdsh_stream, flags),
 };
 #define FIELDS(f) (uint8_t)(sizeof(f) / sizeof((f)[0])), (f)
 
