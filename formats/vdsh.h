@@ -163,6 +163,30 @@ const char *vdsh_window_name(uint32_t window);
 const char *vdsh_sampling_name(uint32_t sampling);
 const char *vdsh_offset_rule_name(uint32_t rule);
 
+/* The encodings, one row each, in the order command lines list them: the
+ * one table that names, sizes and describes them (vdsh_encoding_name,
+ * vdsh_encoding_bytes, vdsh_encoding_from_name, vdsh_encoding_names and
+ * the programs' options read it). Adding an encoding: a row here, the enum
+ * above, and its own code (encode, decode, check; the runtime's buffer). */
+typedef struct vdsh_encoding_info {
+    const char *name;        /* on command lines, in reports and JSON */
+    uint32_t encoding;       /* vdsh_encoding */
+    /* bytes of one vertex at nc coefficients; 0 where the stream's own
+     * model sizes the record (cpca: vdsh_cpca_record_words) */
+    size_t (*bytes)(uint32_t nc);
+    const char *description; /* one line */
+} vdsh_encoding_info;
+
+/* The table's rows, *count of them (count may be NULL). */
+const vdsh_encoding_info *vdsh_encodings(size_t *count);
+/* The row of an encoding value; NULL for values this version does not know. */
+const vdsh_encoding_info *vdsh_encoding_info_of(uint32_t encoding);
+/* The row named `name` (as vdsh_encoding_name spells it); NULL for none. */
+const vdsh_encoding_info *vdsh_encoding_from_name(const char *name);
+/* The names as a list for messages, "f16, f32, s8, s8s6 or cpca" (a
+ * static string). */
+const char *vdsh_encoding_names(void);
+
 /* HEAD chunk: see VDSH.md for the meaning and range of every field. */
 typedef struct vdsh_header {
     uint32_t vertex_count;

@@ -1,7 +1,7 @@
 /*
  * vdsh_failf.h - internal to the formats library (not installed): write a
- * printf-style message into err (when not NULL) and return r. One helper
- * for vdsh_output.c, vdsh_scene_view.c and vdsh_cpca.c.
+ * printf-style message into err (when not NULL) and return r. The one
+ * message helper of the library (vdsh_output.c and vdsh.c hold them).
  */
 #ifndef VDSH_FAILF_H
 #define VDSH_FAILF_H
@@ -12,5 +12,13 @@
 __attribute__((format(printf, 3, 4)))
 #endif
 vdsh_result vdsh_failf(vdsh_error *err, vdsh_result r, const char *fmt, ...);
+
+/* The same, the message preceded by "NAME: " (the file it is about;
+ * "memory" when name is NULL; dropped when it fills the message). */
+#if defined(__GNUC__)
+__attribute__((format(printf, 4, 5)))
+#endif
+vdsh_result vdsh_failf_at(vdsh_error *err, vdsh_result r, const char *name, const char *fmt,
+                          ...);
 
 #endif

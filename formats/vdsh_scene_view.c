@@ -311,6 +311,27 @@ static uint64_t grid_refs(vdsh_view_tracer *g)
     return refs;
 }
 
+/* Each triangle into the cells its box overlaps, in triangle order:
+ * without `fill`, counted in start[cell + 1]; with it, stored at
+ * tris[fill[cell]++]. */
+static void grid_pass(vdsh_view_tracer *g, uint32_t *fill)
+{
+    size_t nx = (size_t)g->n[0], nxy = nx * (size_t)g->n[1];
+    for (uint32_t t = 0; t < g->triangle_count; t++) {
+        int c0[3], c1[3];
+        tri_cells(g, t, c0, c1);
+        for (int z = c0[2]; z <= c1[2]; z++)
+            for (int y = c0[1]; y <= c1[1]; y++)
+                for (int x = c0[0]; x <= c1[0]; x++) {
+                    size_t c = (size_t)z * nxy + (size_t)y * nx + (size_t)x;
+                    if (fill)
+                        g->tris[fill[c]++] = t;
+                    else
+                        g->start[c + 1]++;
+                }
+    }
+}
+
 static void grid_size(vdsh_view_tracer *g, const float ext[3], float h)
 {
     for (int k = 0; k < 3; k++) {
@@ -384,16 +405,8 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
 
     /* Count, prefix sums, fill (in triangle order: each cell's list is
      * sorted, though nothing depends on it). */
-    size_t nx = (size_t)g->n[0], nxy = nx * (size_t)g->n[1];
-    for (uint32_t t = 0; t < m->triangle_count; t++) {
-        int c0[3], c1[3];
-        tri_cells(g, t, c0, c1);
-        for (int z = c0[2]; z <= c1[2]; z++)
-            for (int y = c0[1]; y <= c1[1]; y++)
-                for (int x = c0[0]; x <= c1[0]; x++)
-                    g->start[(size_t)z * nxy + (size_t)y * nx + (size_t)x + 1]++;
-    }
-    size_t cells = nxy * (size_t)g->n[2];
+    grid_pass(g, NULL);
+    size_t cells = (size_t)g->n[0] * (size_t)g->n[1] * (size_t)g->n[2];
     for (size_t i = 0; i < cells; i++)
         g->start[i + 1] += g->start[i];
     uint32_t *fill = malloc(cells * sizeof *fill);
@@ -402,14 +415,7 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
         return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "mesh: out of memory (ray grid)");
     }
     memcpy(fill, g->start, cells * sizeof *fill);
-    for (uint32_t t = 0; t < m->triangle_count; t++) {
-        int c0[3], c1[3];
-        tri_cells(g, t, c0, c1);
-        for (int z = c0[2]; z <= c1[2]; z++)
-            for (int y = c0[1]; y <= c1[1]; y++)
-                for (int x = c0[0]; x <= c1[0]; x++)
-                    g->tris[fill[(size_t)z * nxy + (size_t)y * nx + (size_t)x]++] = t;
-    }
+    grid_pass(g, fill);
     free(fill);
     *out = g;
     return VDSH_OK;

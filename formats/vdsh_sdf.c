@@ -6,28 +6,15 @@
 
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "vdsh_failf.h"
 #include "vdsh_output.h"
 
 static const uint8_t MAGIC[8] = {'V', 'D', 'S', 'H', 'S', 'D', 'F', 0};
 enum { SDF_VERSION = 1 };
-
-static vdsh_result fail(vdsh_error *err, vdsh_result r, const char *name, const char *fmt, ...)
-{
-    if (err) {
-        char m[400];
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(m, sizeof m, fmt, ap);
-        va_end(ap);
-        snprintf(err->msg, sizeof err->msg, "%s: %s", name ? name : "(memory)", m);
-    }
-    return r;
-}
 
 static uint32_t get_u32(const uint8_t *p)
 {
@@ -96,20 +83,20 @@ static vdsh_result check_header(const vdsh_sdf *v, const char *name, vdsh_error 
 {
     for (int a = 0; a < 3; a++)
         if (v->dim[a] < 2 || v->dim[a] > VDSH_SDF_MAX_DIM)
-            return fail(err, VDSH_ERR_INVALID, name, "distance volume: %u samples along axis "
+            return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: %u samples along axis "
                         "%d, must be 2..%d", v->dim[a], a, VDSH_SDF_MAX_DIM);
     for (int a = 0; a < 3; a++)
         if (!isfinite(v->origin[a]))
-            return fail(err, VDSH_ERR_INVALID, name, "distance volume: origin is not finite");
+            return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: origin is not finite");
     if (!(isfinite(v->cell) && v->cell > 0.0f))
-        return fail(err, VDSH_ERR_INVALID, name, "distance volume: cell %g is not a finite "
+        return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: cell %g is not a finite "
                     "number > 0", (double)v->cell);
     if (!(isfinite(v->max_distance) && v->max_distance > 0.0f))
-        return fail(err, VDSH_ERR_INVALID, name, "distance volume: max_distance %g is not a "
+        return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: max_distance %g is not a "
                     "finite number > 0", (double)v->max_distance);
     for (int a = 0; a < 3; a++)
         if (!isfinite(v->origin[a] + v->cell * (float)(v->dim[a] - 1)))
-            return fail(err, VDSH_ERR_INVALID, name, "distance volume: its box is not finite");
+            return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: its box is not finite");
     return VDSH_OK;
 }
 
@@ -117,17 +104,19 @@ vdsh_result vdsh_sdf_read_memory(const void *data, size_t size, const char *name
                                  vdsh_sdf *out, vdsh_error *err)
 {
     const uint8_t *d = data;
+    if (!name)
+        name = "(memory)";
     if (size < VDSH_SDF_HEADER_SIZE)
-        return fail(err, size >= 8 && memcmp(d, MAGIC, 8) == 0 ? VDSH_ERR_TRUNCATED
+        return vdsh_failf_at(err, size >= 8 && memcmp(d, MAGIC, 8) == 0 ? VDSH_ERR_TRUNCATED
                                                                  : VDSH_ERR_NOT_VDSH,
                     name, "%zu bytes: shorter than the %d-byte distance volume header", size,
                     VDSH_SDF_HEADER_SIZE);
     if (memcmp(d, MAGIC, 8) != 0)
-        return fail(err, VDSH_ERR_NOT_VDSH, name, "not a VDSH distance volume (wrong magic)");
+        return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, name, "not a VDSH distance volume (wrong magic)");
     if (get_u32(d + 60) != vdsh_crc32(0, d, 60))
-        return fail(err, VDSH_ERR_CRC, name, "distance volume header: CRC mismatch");
+        return vdsh_failf_at(err, VDSH_ERR_CRC, name, "distance volume header: CRC mismatch");
     if (get_u32(d + 8) != SDF_VERSION)
-        return fail(err, VDSH_ERR_VERSION, name, "distance volume version %u (this reader "
+        return vdsh_failf_at(err, VDSH_ERR_VERSION, name, "distance volume version %u (this reader "
                     "reads %d)", get_u32(d + 8), SDF_VERSION);
     vdsh_sdf v = {0};
     for (int a = 0; a < 3; a++) {
@@ -139,23 +128,23 @@ vdsh_result vdsh_sdf_read_memory(const void *data, size_t size, const char *name
     v.vertex_count = get_u32(d + 44);
     v.triangle_count = get_u32(d + 48);
     if (get_u32(d + 56) != 0)
-        return fail(err, VDSH_ERR_INVALID, name, "distance volume: reserved bytes not zero");
+        return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: reserved bytes not zero");
     vdsh_result r = check_header(&v, name, err);
     if (r != VDSH_OK)
         return r;
     size_t n = sample_count(&v);
     if (n > (size - VDSH_SDF_HEADER_SIZE) / 2)
-        return fail(err, VDSH_ERR_TRUNCATED, name, "distance volume: %zu bytes of samples, "
+        return vdsh_failf_at(err, VDSH_ERR_TRUNCATED, name, "distance volume: %zu bytes of samples, "
                     "%u x %u x %u need %zu", size - VDSH_SDF_HEADER_SIZE, v.dim[0], v.dim[1],
                     v.dim[2], 2 * n);
     if (size - VDSH_SDF_HEADER_SIZE != 2 * n)
-        return fail(err, VDSH_ERR_INVALID, name, "distance volume: %zu bytes after the "
+        return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: %zu bytes after the "
                     "samples", size - VDSH_SDF_HEADER_SIZE - 2 * n);
     if (get_u32(d + 52) != vdsh_crc32(0, d + VDSH_SDF_HEADER_SIZE, 2 * n))
-        return fail(err, VDSH_ERR_CRC, name, "distance volume samples: CRC mismatch");
+        return vdsh_failf_at(err, VDSH_ERR_CRC, name, "distance volume samples: CRC mismatch");
     v.samples = malloc(2 * n);
     if (!v.samples)
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, name, "out of memory for %zu samples", n);
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, name, "out of memory for %zu samples", n);
     const uint8_t *s = d + VDSH_SDF_HEADER_SIZE;
     for (size_t i = 0; i < n; i++)
         v.samples[i] = (uint16_t)(s[2 * i] | s[2 * i + 1] << 8);
@@ -167,7 +156,7 @@ vdsh_result vdsh_sdf_read(const char *path, vdsh_sdf *out, vdsh_error *err)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
-        return fail(err, VDSH_ERR_IO, path, "cannot open the distance volume: %s",
+        return vdsh_failf_at(err, VDSH_ERR_IO, path, "cannot open the distance volume: %s",
                     strerror(errno));
     uint8_t *buf = NULL;
     size_t size = 0, cap = 0;
@@ -178,7 +167,7 @@ vdsh_result vdsh_sdf_read(const char *path, vdsh_sdf *out, vdsh_error *err)
             if (!nb) {
                 free(buf);
                 fclose(f);
-                return fail(err, VDSH_ERR_OUT_OF_MEMORY, path, "out of memory reading it");
+                return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, path, "out of memory reading it");
             }
             buf = nb;
             cap = nc;
@@ -190,7 +179,7 @@ vdsh_result vdsh_sdf_read(const char *path, vdsh_sdf *out, vdsh_error *err)
     }
     int bad = ferror(f);
     fclose(f);
-    vdsh_result r = bad ? fail(err, VDSH_ERR_IO, path, "read error")
+    vdsh_result r = bad ? vdsh_failf_at(err, VDSH_ERR_IO, path, "read error")
                         : vdsh_sdf_read_memory(buf, size, path, out, err);
     free(buf);
     return r;
@@ -203,11 +192,11 @@ vdsh_result vdsh_sdf_write_memory(const vdsh_sdf *v, void **out, size_t *size,
     if (r != VDSH_OK)
         return r;
     if (!v->samples)
-        return fail(err, VDSH_ERR_ARGUMENT, "distance volume", "no samples");
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, "distance volume", "no samples");
     size_t n = sample_count(v), bytes = vdsh_sdf_file_size(v);
     uint8_t *d = calloc(1, bytes);
     if (!d)
-        return fail(err, VDSH_ERR_OUT_OF_MEMORY, "distance volume", "out of memory");
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, "distance volume", "out of memory");
     memcpy(d, MAGIC, 8);
     put_u32(d + 8, SDF_VERSION);
     for (int a = 0; a < 3; a++) {
@@ -239,7 +228,7 @@ vdsh_result vdsh_sdf_write(const char *path, const vdsh_sdf *v, vdsh_error *err)
         if (err) {
             char m[sizeof err->msg];
             memcpy(m, err->msg, sizeof m);
-            fail(err, r, path, "%.300s", m);
+            vdsh_failf_at(err, r, path, "%.300s", m);
         }
         return r;
     }

@@ -82,12 +82,11 @@
 static void key_name(const vr_program_key *k, char *buf, size_t size)
 {
     int interp = vr_mode_interp((vr_mode)k->mode, k->quantity);
-    static const char *const kinds[5] = {"f32", "f16", "s8", "s8s6", "cpca"};
     char buf_what[64] = "";
     if (k->mode == VR_MODE_VDSH_BUFFER)
         snprintf(buf_what, sizeof buf_what, ", order %u%s %s", k->buf_order,
                  k->buf_variable ? " (cap, variable)" : "",
-                 kinds[k->buf_kind <= VR_BUF_CPCA ? k->buf_kind : 0]);
+                 vdsh_encoding_name(k->buf_kind <= VR_BUF_CPCA ? k->buf_kind : 0));
     snprintf(buf, size, "program %s%s%s, %s, %s, output %u, pcf %u, %u lights%s%s",
              vr_mode_name((vr_mode)k->mode), interp >= 0 ? " path " : "",
              interp >= 0 ? vdsh_interp_name((uint32_t)interp) : "",

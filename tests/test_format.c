@@ -1063,6 +1063,18 @@ static void test_names(void)
     CHECK(!strcmp(vdsh_encoding_name(3), "s8s6"));
     CHECK(!strcmp(vdsh_encoding_name(4), "cpca"));
     CHECK(!strcmp(vdsh_encoding_name(5), "?"));
+    /* The encoding table: every row found by its name and its value. */
+    size_t ne = 0;
+    const vdsh_encoding_info *enc = vdsh_encodings(&ne);
+    CHECK(ne == VDSH_ENCODING_LAST + 1);
+    for (size_t i = 0; i < ne; i++) {
+        CHECK(vdsh_encoding_from_name(enc[i].name) == &enc[i]);
+        CHECK(vdsh_encoding_info_of(enc[i].encoding) == &enc[i]);
+        CHECK(vdsh_encoding_bytes(enc[i].encoding, 25) == enc[i].bytes(25));
+    }
+    CHECK(!vdsh_encoding_from_name("s9") && !vdsh_encoding_from_name(NULL) &&
+          !vdsh_encoding_info_of(VDSH_ENCODING_LAST + 1));
+    CHECK(!strcmp(vdsh_encoding_names(), "f16, f32, s8, s8s6 or cpca"));
     CHECK(!strcmp(vdsh_quantity_name(0), "distance"));
     CHECK(!strcmp(vdsh_quantity_name(1), "distance2"));
     CHECK(!strcmp(vdsh_quantity_name(2), "log-distance"));

@@ -3,7 +3,7 @@
  *
  * With libFuzzer:
  *     clang -g -O1 -fsanitize=fuzzer,address,undefined -DVDSH_LIBFUZZER \
- *         -Iformats tests/test_format_fuzz.c formats/vdsh.c -lm -o fuzz_vdsh
+ *         -Iformats tests/test_format_fuzz.c formats/vdsh*.c -lz -lm -o fuzz_vdsh
  *     ./fuzz_vdsh corpus/     (seed it with the files test_format_tool makes)
  * Without it, main() replays the files named on the command line (ctest
  * runs it on the vdsh-info fixtures), so every crash input can become a

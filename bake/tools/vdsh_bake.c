@@ -643,10 +643,19 @@ enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
        O_CPCA };
 enum { OPT_NOT_MINE = -1, OPT_TAKEN = 1 };
 
-/* The names --encoding, --quantity and --window take. */
-static const vt_choice encodings[] = {
-    {"f16", VDSH_ENCODING_F16}, {"f32", VDSH_ENCODING_F32}, {"s8", VDSH_ENCODING_S8},
-    {"s8s6", VDSH_ENCODING_S8S6}, {"cpca", VDSH_ENCODING_CPCA}, {NULL, 0}};
+/* The names --encoding takes: formats' encoding table (vdsh_encodings), in
+ * its order. */
+static const vt_choice *encodings(void)
+{
+    static vt_choice c[VDSH_ENCODING_LAST + 2];
+    size_t n = 0;
+    const vdsh_encoding_info *e = vdsh_encodings(&n);
+    for (size_t i = 0; i < n && i <= VDSH_ENCODING_LAST; i++)
+        c[i] = (vt_choice){e[i].name, (int)e[i].encoding};
+    return c;
+}
+
+/* The names --quantity and --window take. */
 static const vt_choice quantities[] = {
     {"auto", VB_QUANTITY_AUTO}, {"distance", VB_QUANTITY_DISTANCE}, {"log", VB_QUANTITY_LOG},
     {NULL, 0}};
@@ -714,7 +723,7 @@ static int read_value(int c, const char *arg, options *o)
                         &o->decision_lights);
         break;
     case O_ENCODING:
-        ok = vt_opt_choice("--encoding", arg, encodings, &v);
+        ok = vt_opt_choice("--encoding", arg, encodings(), &v);
         o->encoding = (vdsh_encoding)v;
         break;
     case O_QUANTITY:
