@@ -48,8 +48,9 @@
             o[(i) * s] = (value);                        \
     } while (0)
 
-/* The closed forms below are written out for bands 0..KERNEL_ORDER-1: the
- * stored orders (VDSH_MAX_ORDER); eval_high_bands goes further. */
+/* The closed forms below are written out for bands 0..KERNEL_ORDER-1 (the
+ * paper's orders); eval_high_bands' recurrence gives the bands above, up
+ * to VDSH_MAX_ORDER - 1. */
 #define KERNEL_ORDER 5
 _Static_assert(KERNEL_ORDER <= VDSH_MAX_ORDER, "sh_kernel covers the paper's orders");
 
