@@ -696,19 +696,21 @@ static void test_paths(void)
           "empty stem");
 }
 
+/* Runs test(dir/name) in a new folder dir/name. */
+static void in_sub(const char *dir, const char *name, void (*test)(const char *))
+{
+    char sub[512];
+    join(sub, sizeof sub, dir, name);
+    mkdir_p(sub);
+    test(sub);
+}
+
 static int run_files(const char *dir)
 {
     fresh_dir(dir);
-    char sub[512];
-    join(sub, sizeof sub, dir, "basis");
-    mkdir_p(sub);
-    test_basis_round_trip(sub);
-    join(sub, sizeof sub, dir, "single");
-    mkdir_p(sub);
-    test_single_round_trip(sub);
-    join(sub, sizeof sub, dir, "determinism");
-    mkdir_p(sub);
-    test_basis_determinism(sub);
+    in_sub(dir, "basis", test_basis_round_trip);
+    in_sub(dir, "single", test_single_round_trip);
+    in_sub(dir, "determinism", test_basis_determinism);
     test_paths();
     return failures ? 1 : 0;
 }
@@ -942,13 +944,8 @@ static void test_failed_writes(const char *dir)
 static int run_errors(const char *dir)
 {
     fresh_dir(dir);
-    char sub[512];
-    join(sub, sizeof sub, dir, "bad");
-    mkdir_p(sub);
-    test_bad_files(sub);
-    join(sub, sizeof sub, dir, "writes");
-    mkdir_p(sub);
-    test_failed_writes(sub);
+    in_sub(dir, "bad", test_bad_files);
+    in_sub(dir, "writes", test_failed_writes);
     return failures ? 1 : 0;
 }
 

@@ -45,6 +45,7 @@
 
 #include "eval.h"
 #include "frames.h"
+#include "test_run.h"
 #include "test_util.h"
 #include "vdsh.h"
 #include "vdsh_shadow.h"
@@ -58,31 +59,12 @@ static char out_path[4096], err_path[4096];
 /* Run argv (NULL-terminated) with stdout and stderr to files; exit code. */
 static int run(char *const argv[])
 {
-    pid_t pid = fork();
-    if (pid < 0)
-        return -1;
-    if (pid == 0) {
-        int o = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        int e = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (o < 0 || e < 0)
-            _exit(127);
-        dup2(o, 1);
-        dup2(e, 2);
-        execv(argv[0], argv);
-        _exit(127);
-    }
-    int st;
-    if (waitpid(pid, &st, 0) < 0)
-        return -1;
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    return test_run(argv, out_path, err_path);
 }
 
 static int contains(const char *path, const char *needle)
 {
-    char *b = (char *)test_read_file(path, NULL);
-    int ok = b && strstr(b, needle) != NULL;
-    free(b);
-    return ok;
+    return test_file_contains(path, needle);
 }
 
 static void show_stderr(void)

@@ -469,15 +469,9 @@ static void test_default(vr_renderer *r, vr_scene *room, const char *path)
     /* A floor quad with orders 2 and 3, then order 2 alone. */
     for (int orders = 2; orders >= 1; orders--) {
         rt_file f;
-        rt_file_init(&f, 4, 2);
-        const float p[4][3] = {{-9, 0, -9}, {9, 0, -9}, {9, 0, 9}, {-9, 0, 9}};
-        for (int i = 0; i < 4; i++) {
-            memcpy(f.pos + 3 * i, p[i], sizeof p[i]);
-            f.nrm[3 * i + 1] = 1.0f;
-        }
+        const float p[4][3] = {{-9, 0, -9}, {9, 0, -9}, {9, 0, 9}, {-9, 0, 9}}, n[3] = {0, 1, 0};
         const uint32_t idx[6] = {0, 2, 1, 0, 3, 2};
-        memcpy(f.idx, idx, sizeof idx);
-        rt_file_bounds(&f);
+        rt_file_quad(&f, p, n, idx);
         for (int o = 2; o <= orders + 1; o++) {
             float *c = calloc((size_t)4 * o * o, sizeof(float));
             for (int i = 0; i < 4; i++)
