@@ -13,6 +13,7 @@
  * OpenEXR's own C++ implementation is checked in test_cube_openexr.cpp.
  */
 #include "cubemap.h"
+#include "test_dir.h"
 #include "vdsh.h"
 #include "vdsh_cube.h"
 #include "vdsh_sh.h"
@@ -335,31 +336,13 @@ static void fresh_dir(const char *path)
 
 static int count_entries(const char *dir)
 {
-    DIR *d = opendir(dir);
-    if (!d)
-        return -1;
-    int count = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL)
-        if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
-            count++;
-    closedir(d);
-    return count;
+    return test_count_names(dir, NULL);
 }
 
 /* No "*.tmp.*" leftovers in dir (vdsh_output.h names them NAME.tmp.PID.N). */
 static int count_temp_files(const char *dir)
 {
-    DIR *d = opendir(dir);
-    if (!d)
-        return -1;
-    int count = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL)
-        if (strstr(e->d_name, ".tmp."))
-            count++;
-    closedir(d);
-    return count;
+    return test_count_names(dir, ".tmp.");
 }
 
 static unsigned char *read_all(const char *path, size_t *size)

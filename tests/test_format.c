@@ -11,6 +11,7 @@
  * chunks and CRCs independently of the library) so that it can build the
  * files a buggy or malicious writer would produce.
  */
+#include "test_dir.h"
 #include "vdsh.h"
 
 #include <dirent.h>
@@ -131,16 +132,7 @@ static int file_exists(const char *path)
 /* Names in the directory that contain ".tmp" (left-over temporaries). */
 static int count_tmp_files(const char *dir)
 {
-    DIR *d = opendir(dir);
-    int n = 0;
-    struct dirent *e;
-    if (!d)
-        return -1;
-    while ((e = readdir(d)))
-        if (strstr(e->d_name, ".tmp"))
-            n++;
-    closedir(d);
-    return n;
+    return test_count_names(dir, ".tmp");
 }
 
 static void remove_tree(const char *dir)
