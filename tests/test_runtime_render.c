@@ -496,10 +496,8 @@ int main(int argc, char **argv)
         return 2;
     }
     vr_context *ctx = rt_context_or_skip("test_runtime_render");
-    vr_renderer *r = NULL;
+    vr_renderer *r = rt_float_renderer(W, H);
     vr_error err;
-    vr_renderer_desc rd = {.width = W, .height = H, .color_format = VR_COLOR_RGBA32F};
-    CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
     vr_scene *room = NULL;
     vr_scene_desc sd = {.path = argv[1]};
     CHECK(vr_scene_create(&sd, &room, &err) == VR_OK, "%s", err.msg);

@@ -89,6 +89,17 @@ static inline void rt_file_bounds(rt_file *r)
         }
 }
 
+/* A renderer of w x h float (RGBA32F) pixels; NULL, and a failed check,
+ * when none can be made. */
+static inline vr_renderer *rt_float_renderer(int w, int h)
+{
+    vr_renderer *r = NULL;
+    vr_error err;
+    vr_renderer_desc rd = {.width = w, .height = h, .color_format = VR_COLOR_RGBA32F};
+    CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
+    return r;
+}
+
 /* rt_file_init for one quad: corners p, one normal n at each, triangles
  * idx; bounds set. */
 static inline void rt_file_quad(rt_file *r, const float p[4][3], const float n[3], const uint32_t idx[6])
