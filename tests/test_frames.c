@@ -524,6 +524,22 @@ static const cJSON *mode_scene(const cJSON *root, const char *mode)
     return NULL;
 }
 
+/* vdsh-frames truth of `vdsh` for the view set into `truth`, then its
+ * score with the truth as the frames of `modes` into `json`: that JSON,
+ * read back; NULL (and a failed check) when a step fails. */
+static cJSON *truth_and_score(char *vdsh, char *views, char *truth, char *modes, char *json)
+{
+    int rc = run((char *[]){(char *)frames, "truth", vdsh, "--views", views, "-o", truth, NULL});
+    CHECK(rc == 0, "truth: exit %d", rc);
+    rc = run((char *[]){(char *)frames, "score", vdsh, "--views", views, "--truth", truth,
+                        "--frames", truth, "--modes", modes, "--json", json, NULL});
+    CHECK(rc == 0, "score: exit %d", rc);
+    if (rc)
+        show_stderr();
+    char msg[4300];
+    return rc == 0 ? vt_json_read_file(json, msg, sizeof msg) : NULL;
+}
+
 static int part_oracle(void)
 {
     char *vdsh = path_in("room.vdsh"), *views = path_in("room.views.json"),
@@ -532,16 +548,7 @@ static int part_oracle(void)
         CHECK(0, "views");
         return test_report("frames_oracle");
     }
-    int rc = run((char *[]){(char *)frames, "truth", vdsh, "--views", views, "-o", truth, NULL});
-    CHECK(rc == 0, "truth: exit %d", rc);
-    rc = run((char *[]){(char *)frames, "score", vdsh, "--views", views, "--truth", truth,
-                        "--frames", truth, "--modes", "ideal,hard,c-vdsh3", "--json", json,
-                        NULL});
-    CHECK(rc == 0, "score: exit %d", rc);
-    if (rc)
-        show_stderr();
-    char msg[4300];
-    cJSON *j = rc == 0 ? vt_json_read_file(json, msg, sizeof msg) : NULL;
+    cJSON *j = truth_and_score(vdsh, views, truth, "ideal,hard,c-vdsh3", json);
     const cJSON *id = mode_scene(j, "ideal"), *hd = mode_scene(j, "hard"),
                 *c3 = mode_scene(j, "c-vdsh3");
     CHECK(id && hd && c3, "the JSON has every mode's scene");
@@ -675,16 +682,8 @@ static int part_orders(void)
     CHECK(room_views(all7, views, "1", "2") == 0, "views");
 
     /* All order 7: the same scores and frames as the fixed stream. */
-    rc = run((char *[]){(char *)frames, "truth", all7, "--views", views, "-o", truth, NULL});
-    CHECK(rc == 0, "truth: exit %d", rc);
-    rc = run((char *[]){(char *)frames, "score", all7, "--views", views, "--truth", truth,
-                        "--frames", truth, "--modes", "c-vdsh3,c-vdsh7,c-vdsh-var", "--json",
-                        json, NULL});
-    CHECK(rc == 0, "score: exit %d", rc);
-    if (rc)
-        show_stderr();
+    cJSON *j = truth_and_score(all7, views, truth, "c-vdsh3,c-vdsh7,c-vdsh-var", json);
     char msg[4300];
-    cJSON *j = rc == 0 ? vt_json_read_file(json, msg, sizeof msg) : NULL;
     const cJSON *c3 = mode_scene(j, "c-vdsh3"), *c7 = mode_scene(j, "c-vdsh7"),
                 *cv = mode_scene(j, "c-vdsh-var");
     CHECK(c3 && c7 && cv, "the JSON has every mode's scene");
