@@ -62,11 +62,6 @@ static int run(char *const argv[])
     return test_run(argv, out_path, err_path);
 }
 
-static int contains(const char *path, const char *needle)
-{
-    return test_file_contains(path, needle);
-}
-
 static void show_stderr(void)
 {
     char *e = (char *)test_read_file(err_path, NULL);
@@ -331,7 +326,7 @@ static int part_box(void)
     int rc1 = run((char *[]){(char *)frames, "truth", vdsh, "--views", views, "-o", t1,
                              "--threads", "1", NULL});
     CHECK(rc1 == 0, "truth, 1 thread: exit %d", rc1);
-    CHECK(contains(out_path, "a frame's truth (320 x 240"), "the time per frame is printed");
+    CHECK(test_file_contains(out_path, "a frame's truth (320 x 240"), "the time per frame is printed");
     int rc2 = run((char *[]){(char *)frames, "truth", vdsh, "--views", views, "-o", t2,
                              "--threads", "2", NULL});
     CHECK(rc2 == 0, "truth, 2 threads: exit %d", rc2);
@@ -775,24 +770,24 @@ static int part_orders(void)
 static int part_errors(void)
 {
     char *fr = (char *)frames;
-    CHECK(run((char *[]){fr, "--help", NULL}) == 0 && contains(out_path, "c-vdshN") &&
-              contains(out_path, "blotches") && contains(out_path, "--compare"),
+    CHECK(run((char *[]){fr, "--help", NULL}) == 0 && test_file_contains(out_path, "c-vdshN") &&
+              test_file_contains(out_path, "blotches") && test_file_contains(out_path, "--compare"),
           "--help documents the frames and the scores");
-    CHECK(run((char *[]){fr, "--version", NULL}) == 0 && contains(out_path, "vdsh-frames "),
+    CHECK(run((char *[]){fr, "--version", NULL}) == 0 && test_file_contains(out_path, "vdsh-frames "),
           "--version");
-    CHECK(run((char *[]){fr, NULL}) == 2 && contains(err_path, "no subcommand"), "none");
-    CHECK(run((char *[]){fr, "paint", NULL}) == 2 && contains(err_path, "'paint'"), "unknown");
-    CHECK(run((char *[]){fr, "views", "x.vdsh", NULL}) == 2 && contains(err_path, "-o"),
+    CHECK(run((char *[]){fr, NULL}) == 2 && test_file_contains(err_path, "no subcommand"), "none");
+    CHECK(run((char *[]){fr, "paint", NULL}) == 2 && test_file_contains(err_path, "'paint'"), "unknown");
+    CHECK(run((char *[]){fr, "views", "x.vdsh", NULL}) == 2 && test_file_contains(err_path, "-o"),
           "views without -o");
     CHECK(run((char *[]){fr, "views", "x.vdsh", "-o", "v.json", "--cameras", "0", NULL}) == 2 &&
-              contains(err_path, "--cameras"),
+              test_file_contains(err_path, "--cameras"),
           "--cameras 0");
     CHECK(run((char *[]){fr, "views", "x.vdsh", "-o", "v.json", "--size", "160x", NULL}) == 2 &&
-              contains(err_path, "--size"),
+              test_file_contains(err_path, "--size"),
           "--size 160x");
     CHECK(run((char *[]){fr, "truth", "x.vdsh", "--views", "v", "-o", "d", "--threads", "0",
                          NULL}) == 2 &&
-              contains(err_path, "--threads"),
+              test_file_contains(err_path, "--threads"),
           "--threads 0");
     CHECK(run((char *[]){fr, "truth", "x.vdsh", "--views", "v", "-o", "d", "--compare", "soft",
                          NULL}) == 2,
@@ -801,7 +796,7 @@ static int part_errors(void)
           "two scenes");
     CHECK(run((char *[]){fr, "score", "x.vdsh", "--views", "v", "--truth", "t", "--frames", "f",
                          "--modes", "vdsh5,,cube", NULL}) == 2 &&
-              contains(err_path, "--modes"),
+              test_file_contains(err_path, "--modes"),
           "an empty mode");
     CHECK(run((char *[]){fr, "score", "x.vdsh", "--views", "v", "--truth", "t", "--frames", "f",
                          NULL}) == 2,
@@ -819,16 +814,16 @@ static int part_errors(void)
          *bad = path_in("bad.views.json"), *views = path_in("ok.views.json"),
          *truth = path_in("truth"), *json = path_in("score.json");
     CHECK(run((char *[]){fr, "views", missing, "-o", path_in("v.json"), NULL}) == 1 &&
-              contains(err_path, "no-such.vdsh"),
+              test_file_contains(err_path, "no-such.vdsh"),
           "a missing scene is named");
     CHECK(run((char *[]){fr, "truth", vdsh, "--views", nov, "-o", truth, NULL}) == 1 &&
-              contains(err_path, "no-such.views.json") && !exists(truth),
+              test_file_contains(err_path, "no-such.views.json") && !exists(truth),
           "a missing view set is named, nothing written");
     FILE *f = fopen(bad, "w");
     fprintf(f, "{\"width\": 64, \"height\": 48, \"views\": [{\"name\": \"a b\"}]}\n");
     fclose(f);
     CHECK(run((char *[]){fr, "truth", vdsh, "--views", bad, "-o", truth, NULL}) == 1 &&
-              contains(err_path, "bad.views.json") && contains(err_path, "name"),
+              test_file_contains(err_path, "bad.views.json") && test_file_contains(err_path, "name"),
           "an invalid view set is named with its field");
     f = fopen(views, "w");
     fprintf(f, "{\"width\": 64, \"height\": 48, \"views\": [{\"name\": \"a\", \"eye\": [0, 3, 3], "
@@ -846,7 +841,7 @@ static int part_errors(void)
     unlink(json);
     CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames",
                          truth, "--modes", "c-vdsh2,vdsh5", "--json", json, NULL}) == 1 &&
-              contains(err_path, "a-s0-l0-vdsh5.png") && contains(err_path, "missing") &&
+              test_file_contains(err_path, "a-s0-l0-vdsh5.png") && test_file_contains(err_path, "missing") &&
               !exists(json),
           "a missing frame is named, no JSON written");
     char other[4096];
@@ -856,7 +851,7 @@ static int part_errors(void)
     CHECK(vt_png16_write(other, 32, 24, small, msg, sizeof msg) == 0, "%s", msg);
     CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames",
                          truth, "--modes", "c-vdsh3", "--json", json, NULL}) == 1 &&
-              contains(err_path, "a-s1-l1-c-vdsh3.png") && contains(err_path, "32 x 24") &&
+              test_file_contains(err_path, "a-s1-l1-c-vdsh3.png") && test_file_contains(err_path, "32 x 24") &&
               !exists(json),
           "a frame of another size is named");
     char mask[4096];
@@ -866,11 +861,11 @@ static int part_errors(void)
     fclose(f);
     CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames",
                          truth, "--modes", "c-vdsh2", NULL}) == 1 &&
-              contains(err_path, "a-s0-l0-mask.png"),
+              test_file_contains(err_path, "a-s0-l0-mask.png"),
           "a broken truth frame is named");
     /* A file where the output folder should be. */
     CHECK(run((char *[]){fr, "truth", vdsh, "--views", views, "-o", obj, NULL}) == 1 &&
-              contains(err_path, "floorbox.obj"),
+              test_file_contains(err_path, "floorbox.obj"),
           "an output folder that is a file");
     return test_report("frames_errors");
 }
