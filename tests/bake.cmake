@@ -1,8 +1,8 @@
 add_executable(test_bake test_bake.c)
 target_link_libraries(test_bake PRIVATE vb_core)
-add_test(NAME bake_core COMMAND test_bake)
+add_test(NAME bake_matches_analytic_truth COMMAND test_bake)
 
-add_test(NAME bake_cli
+add_test(NAME bake_cli_deterministic_no_partial_output
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_bake_cli.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info> ${VDSH_SHARED_SCENES})
 
@@ -12,7 +12,7 @@ add_test(NAME bake_hard_cases COMMAND test_hard)
 
 add_executable(test_fit test_fit.c)
 target_link_libraries(test_fit PRIVATE vb_core)
-add_test(NAME bake_fit COMMAND test_fit)
+add_test(NAME bake_fit_reproduces_exact_functions COMMAND test_fit)
 add_executable(test_decision test_decision.c)
 target_link_libraries(test_decision PRIVATE vb_core)
 add_test(NAME bake_decision_fit COMMAND test_decision)

@@ -1,14 +1,21 @@
 # The evaluator (bake/eval/eval.h, vdsh-eval): reconstruction against ray-cast
 # ground truth on generated scenes and builtin:room (no files needed).
-#   eval_<part>  test_eval.c, one part each (see its header)
+#   eval_<name>  test_eval.c, one part each (see its header): the test's
+#                name states what the part checks
 #   eval_cli     vdsh-bake + vdsh-eval end to end: exit codes, messages,
 #                the JSON and the per-vertex file
 #   eval_json    the JSON parses and holds what the sweep reads
 if(TARGET vb_eval)
   add_executable(test_eval ${CMAKE_CURRENT_LIST_DIR}/test_eval.c)
   target_link_libraries(test_eval PRIVATE vb_eval)
-  foreach(part heldout interpolate sources sphere room methods oracle)
-    add_test(NAME eval_${part} COMMAND test_eval ${part})
+  # test name : test_eval part
+  foreach(pair heldout:heldout interpolate:interpolate sources:sources
+               sphere_error_matches_analytic:sphere room_error_falls_with_order:room
+               fits_beat_paper_projection:methods oracle_exact_threads_identical:oracle)
+    string(REPLACE ":" ";" pair ${pair})
+    list(GET pair 0 name)
+    list(GET pair 1 part)
+    add_test(NAME eval_${name} COMMAND test_eval ${part})
   endforeach()
 
   add_executable(test_eval_cli ${CMAKE_CURRENT_LIST_DIR}/test_eval_cli.c)

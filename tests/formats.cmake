@@ -4,12 +4,12 @@
 
 add_executable(test_format ${CMAKE_CURRENT_LIST_DIR}/test_format.c)
 target_link_libraries(test_format PRIVATE vdsh_format)
-add_test(NAME format_unit COMMAND test_format)
+add_test(NAME format_round_trip_and_reader_rules COMMAND test_format)
 
 # formats/vdsh_output.h: atomic output files (every program's writer).
 add_executable(test_output ${CMAKE_CURRENT_LIST_DIR}/test_output.c)
 target_link_libraries(test_output PRIVATE vdsh_format Threads::Threads)
-add_test(NAME format_output COMMAND test_output ${CMAKE_CURRENT_BINARY_DIR}/format_output)
+add_test(NAME format_output_written_atomically COMMAND test_output ${CMAKE_CURRENT_BINARY_DIR}/format_output)
 
 add_executable(test_format_tool ${CMAKE_CURRENT_LIST_DIR}/test_format_tool.c)
 target_link_libraries(test_format_tool PRIVATE vdsh_format)

@@ -1,8 +1,11 @@
 # vdsh-frames and its core (bake/eval/frames.h): ray-traced truth for frames and
 # image scores. test_frames.c, one part each (see its header):
-#   frames_score   the scores on hand-made frames (no files)
-#   frames_oracle  the truth scored as a method is exact (built-in room)
-#   frames_box     a floor, a box and a light: the shadow's pixel count
+#   frames_scores_of_handmade_frames
+#                  the scores on hand-made frames (no files)
+#   frames_oracle_scores_exact
+#                  the truth scored as a method is exact (built-in room)
+#   frames_box_shadow_matches_geometry
+#                  a floor, a box and a light: the shadow's pixel count
 #                  against geometry; byte-identical across thread counts
 #   frames_views   views: valid, in free space, lit and shadowed, seeded
 #   frames_orders  order 7 and variable-order streams (c-vdsh7, c-vdsh-var)
@@ -10,9 +13,14 @@
 if(TARGET vb_frames)
   add_executable(test_frames ${CMAKE_CURRENT_LIST_DIR}/test_frames.c)
   target_link_libraries(test_frames PRIVATE vb_frames vt_tools m)
-  add_test(NAME frames_score COMMAND test_frames score)
-  foreach(part oracle box views orders errors)
-    add_test(NAME frames_${part}
+  add_test(NAME frames_scores_of_handmade_frames COMMAND test_frames score)
+  # test name : test_frames part (its work folder is frames_<part>)
+  foreach(pair oracle_scores_exact:oracle box_shadow_matches_geometry:box views:views
+               orders:orders errors:errors)
+    string(REPLACE ":" ";" pair ${pair})
+    list(GET pair 0 name)
+    list(GET pair 1 part)
+    add_test(NAME frames_${name}
              COMMAND test_frames ${part} $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames>
                      ${CMAKE_CURRENT_BINARY_DIR}/frames_${part})
   endforeach()

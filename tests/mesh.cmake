@@ -1,9 +1,12 @@
 # Mesh input (bake/lib/mesh.h): loading, validation, welding, normals, the
 # built-in room and its variants, refinement, OBJ output, SHA-256.
-#   mesh_unit    no data needed: fixtures are written to a temporary folder
+#   mesh_load_clean_weld_refine
+#                no data needed: fixtures are written to a temporary folder
 #   mesh_parse   the readers alone, on bytes in memory
-#   mesh_scenes  the real scenes in VDSH_SHARED_SCENES (skips when absent)
-#   mesh_assimp  Debian's assimp-testmodels in VDSH_ASSIMP_MODELS, including
+#   mesh_shared_scenes_load_expected_counts
+#                the real scenes in VDSH_SHARED_SCENES (skips when absent)
+#   mesh_assimp_models_load_or_refuse
+#                Debian's assimp-testmodels in VDSH_ASSIMP_MODELS, including
 #                the malformed files (skips when absent)
 # Timings (load of Sponza and lost_empire, refinement of the room and of
 # Sponza to 0.2 m): `test_mesh bench <scenes folder>`, not part of the suite.
@@ -11,10 +14,11 @@ add_executable(test_mesh ${CMAKE_CURRENT_LIST_DIR}/test_mesh.c)
 # vb_core for Embree: the built-in rooms are checked closed by rays.
 target_link_libraries(test_mesh PRIVATE vb_core m)
 
-add_test(NAME mesh_unit COMMAND test_mesh unit ${CMAKE_CURRENT_BINARY_DIR})
-add_test(NAME mesh_scenes COMMAND test_mesh scenes ${VDSH_SHARED_SCENES})
-add_test(NAME mesh_assimp COMMAND test_mesh assimp ${VDSH_ASSIMP_MODELS})
-set_tests_properties(mesh_scenes mesh_assimp PROPERTIES SKIP_RETURN_CODE 77)
+add_test(NAME mesh_load_clean_weld_refine COMMAND test_mesh unit ${CMAKE_CURRENT_BINARY_DIR})
+add_test(NAME mesh_shared_scenes_load_expected_counts COMMAND test_mesh scenes ${VDSH_SHARED_SCENES})
+add_test(NAME mesh_assimp_models_load_or_refuse COMMAND test_mesh assimp ${VDSH_ASSIMP_MODELS})
+set_tests_properties(mesh_shared_scenes_load_expected_counts mesh_assimp_models_load_or_refuse
+                     PROPERTIES SKIP_RETURN_CODE 77)
 
 # The strict readers (bake/lib/mesh_parse.h) on bytes: the values bakes depend
 # on, and the files OpenMesh's readers misread that are now refused.

@@ -1,14 +1,16 @@
-# python_reader     python/ (numpy only) installed with pip from the
+# python_reader_matches_c_reader
+#                   python/ (numpy only) installed with pip from the
 #                   checkout (--no-build-isolation --no-index: Debian's pip
 #                   and setuptools), which it must leave as it was;
 #                   against the C reader: baked files, the
 #                   corpus, a 400-file corruption sweep, the SH table
-add_test(NAME python_reader
+add_test(NAME python_reader_matches_c_reader
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_python_reader.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info> ${PROJECT_SOURCE_DIR}
                  ${CMAKE_CURRENT_BINARY_DIR}/python_reader)
 
-# python_eval       python/vdsh/evaluate.py (installed as above) against the
+# python_eval_matches_c_library
+#                   python/vdsh/evaluate.py (installed as above) against the
 #                   C library (formats/vdsh_sh.c, vdsh_shadow.c) through
 #                   test_python_eval_ref: the SH basis at orders 1-16, and
 #                   distances and shadows of thousands of vertex-light
@@ -18,7 +20,7 @@ add_test(NAME python_reader
 #                   vdsh-info --json
 add_executable(test_python_eval_ref ${CMAKE_CURRENT_LIST_DIR}/test_python_eval_ref.c)
 target_link_libraries(test_python_eval_ref PRIVATE vdsh_format m)
-add_test(NAME python_eval
+add_test(NAME python_eval_matches_c_library
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_python_eval.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info>
                  $<TARGET_FILE:test_python_eval_ref> ${PROJECT_SOURCE_DIR}

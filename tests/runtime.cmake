@@ -21,26 +21,26 @@ endfunction()
 
 # The upload order of a scene (vertex cache), no GL needed.
 _runtime_test(test_runtime_order)
-add_test(NAME runtime_order COMMAND test_runtime_order)
+add_test(NAME runtime_order_permutes_and_cuts_cache_misses COMMAND test_runtime_order)
 
 # The basis cubemaps the runtime makes against its old upload of the bake's
 # .exr files, texel for texel (the one runtime test that links the EXR
 # reader).
 _runtime_test(test_runtime_basis)
 target_link_libraries(test_runtime_basis PRIVATE vb_cubemap)
-add_test(NAME runtime_basis COMMAND test_runtime_basis ${_rt_dir}/basis)
-_runtime_props(runtime_basis)
+add_test(NAME runtime_basis_cubemaps_match_exr_upload COMMAND test_runtime_basis ${_rt_dir}/basis)
+_runtime_props(runtime_basis_cubemaps_match_exr_upload)
 
 # GLSL against the C SH and shadow evaluation (and cubemap orientation).
 _runtime_test(test_runtime_glsl)
-add_test(NAME runtime_glsl COMMAND test_runtime_glsl ${_rt_dir}/glsl)
-_runtime_props(runtime_glsl)
+add_test(NAME runtime_glsl_matches_c_evaluation COMMAND test_runtime_glsl ${_rt_dir}/glsl)
+_runtime_props(runtime_glsl_matches_c_evaluation)
 
 # runtime/shaders/*.glsl embedded byte for byte, with the C definition's
 # constants and the documented interface (no GL).
 _runtime_test(test_runtime_shaders)
 target_include_directories(test_runtime_shaders PRIVATE ${PROJECT_BINARY_DIR}/runtime)
-add_test(NAME runtime_shaders COMMAND test_runtime_shaders ${PROJECT_SOURCE_DIR}/runtime/shaders)
+add_test(NAME runtime_shaders_embedded_byte_for_byte COMMAND test_runtime_shaders ${PROJECT_SOURCE_DIR}/runtime/shaders)
 
 # A small bake of the built-in room for the tests below (0.2 s).
 add_test(NAME runtime_fixture_room
@@ -57,9 +57,9 @@ file(MAKE_DIRECTORY ${_rt_dir}/room_log)
 
 # Rendering sanity: closed sphere, light behind a wall, modes, passes.
 _runtime_test(test_runtime_render)
-add_test(NAME runtime_render
+add_test(NAME runtime_render_shadows_where_expected
          COMMAND test_runtime_render ${_rt_dir}/room/room.vdsh ${_rt_dir}/render)
-_runtime_props(runtime_render FIXTURES_REQUIRED runtime_room)
+_runtime_props(runtime_render_shadows_where_expected FIXTURES_REQUIRED runtime_room)
 
 # Log-distance streams on large triangles: a 20 x 20 floor of two
 # triangles and a box hovering over one corner, baked with --method lsq
@@ -112,14 +112,14 @@ foreach(part frames errors)
 endforeach()
 
 _runtime_test(test_runtime_log)
-add_test(NAME runtime_log COMMAND test_runtime_log ${_rt_dir}/floor/floor.vdsh)
-_runtime_props(runtime_log FIXTURES_REQUIRED runtime_floor)
+add_test(NAME runtime_log_distance_path_no_smear COMMAND test_runtime_log ${_rt_dir}/floor/floor.vdsh)
+_runtime_props(runtime_log_distance_path_no_smear FIXTURES_REQUIRED runtime_floor)
 
 # Bad input: missing, corrupted and truncated files, a cube_size no GL
 # holds; no file but the .vdsh needed.
 _runtime_test(test_runtime_errors)
-add_test(NAME runtime_errors COMMAND test_runtime_errors ${_rt_dir}/errors)
-_runtime_props(runtime_errors)
+add_test(NAME runtime_bad_input_clear_errors COMMAND test_runtime_errors ${_rt_dir}/errors)
+_runtime_props(runtime_bad_input_clear_errors)
 
 # vdsh-view on the command line. PNG checks use test_runtime_png (stb).
 add_executable(test_runtime_png ${CMAKE_CURRENT_LIST_DIR}/test_runtime_png.c)

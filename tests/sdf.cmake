@@ -6,7 +6,7 @@
 add_executable(test_sdf ${CMAKE_CURRENT_LIST_DIR}/test_sdf.c)
 target_link_libraries(test_sdf PRIVATE vb_core)
 file(MAKE_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/sdf_unit)
-add_test(NAME sdf_unit COMMAND test_sdf ${CMAKE_CURRENT_BINARY_DIR}/sdf_unit)
+add_test(NAME sdf_round_trip_exact_distances COMMAND test_sdf ${CMAKE_CURRENT_BINARY_DIR}/sdf_unit)
 
 add_test(NAME sdf_bake_deterministic COMMAND bash -c [=[
 bake=$1; each=$2; d=$3

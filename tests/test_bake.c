@@ -308,6 +308,19 @@ static void test_grid(void)
     CHECK(vb_dirgrid_create(0, 0, &g, &err) == VB_ERR_ARGUMENT, "0 rays accepted");
 }
 
+/* np receivers at random in the box test_make_box(2, 2, 2) makes
+ * (x, z in [-1.8, 1.8], y in [0, 2]), facing random directions. */
+static void random_in_box(uint64_t seed, int np, float *p, float *n)
+{
+    uint64_t s = seed;
+    for (int i = 0; i < np; i++) {
+        p[3 * i] = (float)(3.6 * test_rand(&s) - 1.8);
+        p[3 * i + 1] = (float)(2 * test_rand(&s));
+        p[3 * i + 2] = (float)(3.6 * test_rand(&s) - 1.8);
+        test_rand_dir(&s, n + 3 * i);
+    }
+}
+
 /* 1 and 2 threads give bit-identical coefficients. */
 static void test_threads(void)
 {
@@ -315,13 +328,7 @@ static void test_threads(void)
     test_make_box(&occ, 2, 2, 2);
     enum { NP = 200 };
     float p[3 * NP], n[3 * NP];
-    uint64_t s = 5;
-    for (int i = 0; i < NP; i++) {
-        p[3 * i] = (float)(3.6 * test_rand(&s) - 1.8);
-        p[3 * i + 1] = (float)(2 * test_rand(&s));
-        p[3 * i + 2] = (float)(3.6 * test_rand(&s) - 1.8);
-        test_rand_dir(&s, n + 3 * i);
-    }
+    random_in_box(5, NP, p, n);
     test_make_points(&rec, NP, p, n);
     vb_bake_output one = {0}, two = {0};
     CHECK(bake(&occ, &rec, VB_METHOD_PAPER, 400, 1, &one), "1 thread");
@@ -347,13 +354,7 @@ static void test_shadow_offset(void)
     test_make_box(&occ, 2, 2, 2);
     enum { NP = 64 };
     float p[3 * NP], n[3 * NP];
-    uint64_t s = 9;
-    for (int i = 0; i < NP; i++) {
-        p[3 * i] = (float)(3.6 * test_rand(&s) - 1.8);
-        p[3 * i + 1] = (float)(2 * test_rand(&s));
-        p[3 * i + 2] = (float)(3.6 * test_rand(&s) - 1.8);
-        test_rand_dir(&s, n + 3 * i);
-    }
+    random_in_box(9, NP, p, n);
     test_make_points(&rec, NP, p, n);
     vb_error err;
     vb_scene *sc = NULL;
@@ -495,13 +496,7 @@ static void test_adaptive_rays(void)
     test_make_box(&occ, 2, 2, 2);
     enum { NP = 300 };
     float p[3 * NP], n[3 * NP];
-    uint64_t s = 11;
-    for (int i = 0; i < NP; i++) {
-        p[3 * i] = (float)(3.6 * test_rand(&s) - 1.8);
-        p[3 * i + 1] = (float)(2 * test_rand(&s));
-        p[3 * i + 2] = (float)(3.6 * test_rand(&s) - 1.8);
-        test_rand_dir(&s, n + 3 * i);
-    }
+    random_in_box(11, NP, p, n);
     /* A few on the floor, facing up into the box, and one in a corner. */
     for (int i = 0; i < 20; i++) {
         p[3 * i + 1] = 0.0f;

@@ -6,21 +6,8 @@ set -u
 bake=$1
 info=$2
 scenes=${3:-}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail=0
-check() { # check DESCRIPTION COMMAND...
-  local what=$1; shift
-  if ! "$@"; then echo "FAIL: $what" >&2; fail=1; fi
-}
-expect_exit() { # expect_exit CODE DESCRIPTION COMMAND...
-  local want=$1 what=$2; shift 2
-  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"
-  local got=$?
-  if [[ $got -ne $want ]]; then
-    echo "FAIL: $what: exit $got, want $want; stderr:" >&2; cat "$tmp/err.txt" >&2; fail=1
-  fi
-}
+. "$(dirname "$0")/lib.sh"
+make_tmp
 
 json() { # json FILE PYTHON_EXPRESSION_OF_d: true when it holds
   /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); sys.exit(0 if eval(sys.argv[2]) else 1)' "$@"

@@ -11,19 +11,10 @@
 # Usage: test_cpca_bake.sh VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR
 set -u
 bake=$1 merge=$2 info=$3 src=$4
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail=0
-check() { local what=$1; shift; if ! "$@"; then echo "FAIL: $what" >&2; fail=1; fi; }
-expect_exit() { # expect_exit CODE DESCRIPTION COMMAND...
-  local want=$1 what=$2; shift 2
-  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"
-  local got=$?
-  if [[ $got -ne $want ]]; then
-    echo "FAIL: $what: exit $got, want $want; stderr:" >&2; cat "$tmp/err.txt" >&2; fail=1
-  fi
-}
-says() { if ! grep -qF -- "$2" "$tmp/err.txt" "$tmp/out.txt"; then
+. "$(dirname "$0")/lib.sh"
+make_tmp
+says() { # says DESCRIPTION TEXT: the last command's stderr or stdout holds TEXT
+  if ! grep -qF -- "$2" "$tmp/err.txt" "$tmp/out.txt"; then
   echo "FAIL: $1: output lacks '$2':" >&2; cat "$tmp/err.txt" >&2; fail=1; fi; }
 
 tiny=(builtin:room --max-edge 1.0 --rays 64 --cube-size 0 -q --orders 3,7)

@@ -13,6 +13,7 @@
  * OpenEXR's own C++ implementation is checked in test_cube_openexr.cpp.
  */
 #include "cubemap.h"
+#include "test_dir.h"
 #include "vdsh.h"
 #include "vdsh_cube.h"
 #include "vdsh_sh.h"
@@ -335,31 +336,13 @@ static void fresh_dir(const char *path)
 
 static int count_entries(const char *dir)
 {
-    DIR *d = opendir(dir);
-    if (!d)
-        return -1;
-    int count = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL)
-        if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
-            count++;
-    closedir(d);
-    return count;
+    return test_count_names(dir, NULL);
 }
 
 /* No "*.tmp.*" leftovers in dir (vdsh_output.h names them NAME.tmp.PID.N). */
 static int count_temp_files(const char *dir)
 {
-    DIR *d = opendir(dir);
-    if (!d)
-        return -1;
-    int count = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL)
-        if (strstr(e->d_name, ".tmp."))
-            count++;
-    closedir(d);
-    return count;
+    return test_count_names(dir, ".tmp.");
 }
 
 static unsigned char *read_all(const char *path, size_t *size)
@@ -696,19 +679,21 @@ static void test_paths(void)
           "empty stem");
 }
 
+/* Runs test(dir/name) in a new folder dir/name. */
+static void in_sub(const char *dir, const char *name, void (*test)(const char *))
+{
+    char sub[512];
+    join(sub, sizeof sub, dir, name);
+    mkdir_p(sub);
+    test(sub);
+}
+
 static int run_files(const char *dir)
 {
     fresh_dir(dir);
-    char sub[512];
-    join(sub, sizeof sub, dir, "basis");
-    mkdir_p(sub);
-    test_basis_round_trip(sub);
-    join(sub, sizeof sub, dir, "single");
-    mkdir_p(sub);
-    test_single_round_trip(sub);
-    join(sub, sizeof sub, dir, "determinism");
-    mkdir_p(sub);
-    test_basis_determinism(sub);
+    in_sub(dir, "basis", test_basis_round_trip);
+    in_sub(dir, "single", test_single_round_trip);
+    in_sub(dir, "determinism", test_basis_determinism);
     test_paths();
     return failures ? 1 : 0;
 }
@@ -942,13 +927,8 @@ static void test_failed_writes(const char *dir)
 static int run_errors(const char *dir)
 {
     fresh_dir(dir);
-    char sub[512];
-    join(sub, sizeof sub, dir, "bad");
-    mkdir_p(sub);
-    test_bad_files(sub);
-    join(sub, sizeof sub, dir, "writes");
-    mkdir_p(sub);
-    test_failed_writes(sub);
+    in_sub(dir, "bad", test_bad_files);
+    in_sub(dir, "writes", test_failed_writes);
     return failures ? 1 : 0;
 }
 

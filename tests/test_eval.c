@@ -189,6 +189,34 @@ static int room(float edge, vb_mesh *occ, vb_mesh *rec)
     return 1;
 }
 
+/* room() and its scene; a failed check when either fails. */
+static int room_scene(float edge, vb_mesh *occ, vb_mesh *rec, vb_scene **s)
+{
+    if (!room(edge, occ, rec) || !scene_from(occ, s)) {
+        CHECK(0, "room fixture");
+        return 0;
+    }
+    return 1;
+}
+
+/* Frees what room_scene (or a test's own scene) made. */
+static void free_scene(vb_scene *s, vb_mesh *occ, vb_mesh *rec)
+{
+    vb_scene_destroy(s);
+    free_mesh(occ);
+    free_mesh(rec);
+}
+
+/* Frees n evaluations with their files and bakes. */
+static void free_runs(int n, vb_eval_result *r, memfile *mf, vb_bake_output *b)
+{
+    for (int i = 0; i < n; i++) {
+        vb_eval_result_free(&r[i]);
+        free_file(&mf[i]);
+        vb_bake_output_free(&b[i]);
+    }
+}
+
 /* ---- analytic: the paper fit at the centre of a sphere ------------------- */
 
 static float ramp(double x)
@@ -310,9 +338,7 @@ static void test_sphere(void)
         vb_bake_output_free(&b);
     }
 out:
-    vb_scene_destroy(s);
-    free_mesh(&occ);
-    free_mesh(&rec);
+    free_scene(s, &occ, &rec);
 }
 
 /* ---- the room ------------------------------------------------------------ */
@@ -321,10 +347,8 @@ static void test_room(void)
 {
     vb_mesh occ = {0}, rec = {0};
     vb_scene *s = NULL;
-    if (!room(1.0f, &occ, &rec) || !scene_from(&occ, &s)) {
-        CHECK(0, "room fixture");
+    if (!room_scene(1.0f, &occ, &rec, &s))
         goto out;
-    }
     const int orders[3] = {2, 3, 5};
     vb_bake_output b[3] = {{0}};
     memfile mf[3];
@@ -395,15 +419,9 @@ static void test_room(void)
         }
     }
 done:
-    for (int i = 0; i < 3; i++) {
-        vb_eval_result_free(&r[i]);
-        free_file(&mf[i]);
-        vb_bake_output_free(&b[i]);
-    }
+    free_runs(3, r, mf, b);
 out:
-    vb_scene_destroy(s);
-    free_mesh(&occ);
-    free_mesh(&rec);
+    free_scene(s, &occ, &rec);
 }
 
 /* ---- the fits against each other ------------------------------------------ */
@@ -417,10 +435,8 @@ static void test_methods(void)
 {
     vb_mesh occ = {0}, rec = {0};
     vb_scene *s = NULL;
-    if (!room(0.7f, &occ, &rec) || !scene_from(&occ, &s)) {
-        CHECK(0, "room fixture");
+    if (!room_scene(0.7f, &occ, &rec, &s))
         goto out;
-    }
     const int orders[3] = {2, 3, 5};
     const vb_method methods[3] = {VB_METHOD_PAPER, VB_METHOD_LSQ, VB_METHOD_SHADOW};
     vb_bake_output b[3] = {{0}};
@@ -470,15 +486,9 @@ static void test_methods(void)
                   m[0]->false_shadow);
         }
 done:
-    for (int i = 0; i < 3; i++) {
-        vb_eval_result_free(&r[i]);
-        free_file(&mf[i]);
-        vb_bake_output_free(&b[i]);
-    }
+    free_runs(3, r, mf, b);
 out:
-    vb_scene_destroy(s);
-    free_mesh(&occ);
-    free_mesh(&rec);
+    free_scene(s, &occ, &rec);
 }
 
 /* ---- oracle and threads --------------------------------------------------- */
@@ -487,10 +497,8 @@ static void test_oracle_and_threads(void)
 {
     vb_mesh occ = {0}, rec = {0};
     vb_scene *s = NULL;
-    if (!room(1.0f, &occ, &rec) || !scene_from(&occ, &s)) {
-        CHECK(0, "room fixture");
+    if (!room_scene(1.0f, &occ, &rec, &s))
         goto out;
-    }
     const int orders[2] = {3, 5};
     vb_bake_output b = {0};
     memfile mf;
@@ -581,9 +589,7 @@ static void test_oracle_and_threads(void)
     free_file(&mf);
     vb_bake_output_free(&b);
 out:
-    vb_scene_destroy(s);
-    free_mesh(&occ);
-    free_mesh(&rec);
+    free_scene(s, &occ, &rec);
 }
 
 /* ---- held-out directions --------------------------------------------------- */

@@ -17,6 +17,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "test_run.h"
 #include "test_util.h"
 #include "vt_json.h"
 
@@ -26,31 +27,7 @@ static char out_path[4096], err_path[4096];
 /* Run argv (NULL-terminated) with stdout and stderr to files; exit code. */
 static int run(char *const argv[])
 {
-    pid_t pid = fork();
-    if (pid < 0)
-        return -1;
-    if (pid == 0) {
-        int o = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        int e = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (o < 0 || e < 0)
-            _exit(127);
-        dup2(o, 1);
-        dup2(e, 2);
-        execv(argv[0], argv);
-        _exit(127);
-    }
-    int st;
-    if (waitpid(pid, &st, 0) < 0)
-        return -1;
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static int contains(const char *path, const char *needle)
-{
-    char *b = (char *)test_read_file(path, NULL);
-    int ok = b && strstr(b, needle) != NULL;
-    free(b);
-    return ok;
+    return test_run(argv, out_path, err_path);
 }
 
 static char *path_in(const char *name)
@@ -116,16 +93,16 @@ int main(int argc, char **argv)
 
     /* Usage. */
     CHECK(run((char *[]){ev, "--help", NULL}) == 0, "--help");
-    CHECK(contains(out_path, "--per-vertex") && contains(out_path, "VDSHPVE1"),
+    CHECK(test_file_contains(out_path, "--per-vertex") && test_file_contains(out_path, "VDSHPVE1"),
           "--help documents the per-vertex layout");
-    CHECK(run((char *[]){ev, "--version", NULL}) == 0 && contains(out_path, "vdsh-eval "),
+    CHECK(run((char *[]){ev, "--version", NULL}) == 0 && test_file_contains(out_path, "vdsh-eval "),
           "--version");
-    CHECK(run((char *[]){ev, NULL}) == 2 && contains(err_path, "no .vdsh file"), "no file");
+    CHECK(run((char *[]){ev, NULL}) == 2 && test_file_contains(err_path, "no .vdsh file"), "no file");
     CHECK(run((char *[]){ev, "--no-such-option", "x.vdsh", NULL}) == 2, "bad option");
     CHECK(run((char *[]){ev, "--points", "0", "x.vdsh", NULL}) == 2, "--points 0");
     CHECK(run((char *[]){ev, "--orders", "2,17", "x.vdsh", NULL}) == 2, "--orders 2,17");
     char *missing = path_in("no-such.vdsh");
-    CHECK(run((char *[]){ev, missing, NULL}) == 1 && contains(err_path, "no-such.vdsh"),
+    CHECK(run((char *[]){ev, missing, NULL}) == 1 && test_file_contains(err_path, "no-such.vdsh"),
           "a missing file is named");
 
     /* Bake a box. */
@@ -147,11 +124,11 @@ int main(int argc, char **argv)
     rc = run((char *[]){ev, vdsh, "--json", json, "--per-vertex", pv, "--interior", "1000",
                         "--threads", "2", NULL});
     CHECK(rc == 0, "eval: exit %d", rc);
-    CHECK(contains(out_path, "SHA-256 verified") && contains(out_path, "interior") &&
-              contains(out_path, "(time chunk)") && contains(out_path, "paper"),
+    CHECK(test_file_contains(out_path, "SHA-256 verified") && test_file_contains(out_path, "interior") &&
+              test_file_contains(out_path, "(time chunk)") && test_file_contains(out_path, "paper"),
           "table");
-    CHECK(contains(out_path, " 0.0000% escaped"), "the truth escapes a closed box");
-    CHECK(contains(out_path, "SH sum range <= 0 (read as distance 0)"),
+    CHECK(test_file_contains(out_path, " 0.0000% escaped"), "the truth escapes a closed box");
+    CHECK(test_file_contains(out_path, "SH sum range <= 0 (read as distance 0)"),
           "the ringing line (it said 'rang')");
     /* The JSON parses (the project's reader, vt_json.h) and holds the
      * streams. */
@@ -248,17 +225,17 @@ int main(int argc, char **argv)
         }
         cJSON_Delete(j);
     }
-    CHECK(run((char *[]){ev, vdsh, "--offsets", "9", NULL}) == 2 && contains(err_path, "--offsets"),
+    CHECK(run((char *[]){ev, vdsh, "--offsets", "9", NULL}) == 2 && test_file_contains(err_path, "--offsets"),
           "--offsets 9 refused");
     CHECK(run((char *[]){ev, vdsh, "--offsets", "0.1,0.2,0.3,0.4,0.5", NULL}) == 2 &&
-              contains(err_path, "streams"),
+              test_file_contains(err_path, "streams"),
           "too many offset streams refused");
     CHECK(run((char *[]){ev, vdsh, "--lights", "0", NULL}) == 2, "--lights 0 refused");
 
     /* Bake time from the bake's report. */
     rc = run((char *[]){ev, vdsh, "--bake-report", rep, "--interior", "0", "--orders", "5",
                         NULL});
-    CHECK(rc == 0 && contains(out_path, "(bake report)") && !contains(out_path, "order 2 "),
+    CHECK(rc == 0 && test_file_contains(out_path, "(bake report)") && !test_file_contains(out_path, "order 2 "),
           "--bake-report, --orders");
 
     /* The mesh changes: named; --allow-mismatch goes on with a warning; the
@@ -266,23 +243,23 @@ int main(int argc, char **argv)
     char *moved = path_in("moved.obj");
     rename(obj, moved);
     rc = run((char *[]){ev, vdsh, NULL});
-    CHECK(rc == 1 && contains(err_path, "cannot find source 1 of 1") &&
-              contains(err_path, "box.obj"),
+    CHECK(rc == 1 && test_file_contains(err_path, "cannot find source 1 of 1") &&
+              test_file_contains(err_path, "box.obj"),
           "a missing source is named (exit %d)", rc);
     rc = run((char *[]){ev, vdsh, moved, "--interior", "100", NULL});
     CHECK(rc == 0, "the source under another name: exit %d", rc);
     write_box(obj, "# changed\n");
     rc = run((char *[]){ev, vdsh, NULL});
-    CHECK(rc == 1 && contains(err_path, "source 1 of 1") && contains(err_path, "box.obj") &&
-              contains(err_path, "SHA-256"),
+    CHECK(rc == 1 && test_file_contains(err_path, "source 1 of 1") && test_file_contains(err_path, "box.obj") &&
+              test_file_contains(err_path, "SHA-256"),
           "a changed source is named (exit %d)", rc);
     rc = run((char *[]){ev, vdsh, "--allow-mismatch", "--interior", "100", NULL});
-    CHECK(rc == 0 && contains(err_path, "warning"), "--allow-mismatch (exit %d)", rc);
+    CHECK(rc == 0 && test_file_contains(err_path, "warning"), "--allow-mismatch (exit %d)", rc);
     rc = run((char *[]){ev, vdsh, moved, moved, NULL});
-    CHECK(rc == 2 && contains(err_path, "2 mesh(es) given"), "two meshes for one source");
+    CHECK(rc == 2 && test_file_contains(err_path, "2 mesh(es) given"), "two meshes for one source");
 
     /* A file that is not a .vdsh. */
     rc = run((char *[]){ev, obj, NULL});
-    CHECK(rc == 1 && contains(err_path, "box.obj"), "not a .vdsh: exit %d", rc);
+    CHECK(rc == 1 && test_file_contains(err_path, "box.obj"), "not a .vdsh: exit %d", rc);
     return test_report("test_eval_cli");
 }

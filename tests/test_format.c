@@ -11,6 +11,7 @@
  * chunks and CRCs independently of the library) so that it can build the
  * files a buggy or malicious writer would produce.
  */
+#include "test_dir.h"
 #include "vdsh.h"
 
 #include <dirent.h>
@@ -131,16 +132,7 @@ static int file_exists(const char *path)
 /* Names in the directory that contain ".tmp" (left-over temporaries). */
 static int count_tmp_files(const char *dir)
 {
-    DIR *d = opendir(dir);
-    int n = 0;
-    struct dirent *e;
-    if (!d)
-        return -1;
-    while ((e = readdir(d)))
-        if (strstr(e->d_name, ".tmp"))
-            n++;
-    closedir(d);
-    return n;
+    return test_count_names(dir, ".tmp");
 }
 
 static void remove_tree(const char *dir)
@@ -354,24 +346,26 @@ static void sample_init(sample *s, int kind, uint32_t v)
                    VDSH_METHOD_FULL, VDSH_WINDOW_HANN, 2.5f, 0.01f, 15);
         s->sources[0].name = "a.obj";
     } else if (kind == 1) {
-        add_stream(s, 5, VDSH_ENCODING_F16, VDSH_QUANTITY_DISTANCE,
-                   VDSH_METHOD_PAPER, VDSH_WINDOW_HANN, 2.5f, 0, 15);
-        add_stream(s, 3, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE,
-                   VDSH_METHOD_FULL, VDSH_WINDOW_NONE, 0, 0, 1);
-        add_stream(s, 2, VDSH_ENCODING_F16, VDSH_QUANTITY_LOG_DISTANCE,
-                   VDSH_METHOD_PAPER, VDSH_WINDOW_LANCZOS, 1.0f, 0.01f, 0.5f);
-        add_stream(s, 1, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE2,
-                   VDSH_METHOD_FULL, VDSH_WINDOW_NONE, 0, 0, 3);
-        add_stream(s, 5, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE2,
-                   VDSH_METHOD_PAPER, VDSH_WINDOW_NONE, 0, -1.5f, 1);
-        add_stream(s, 4, VDSH_ENCODING_S8, VDSH_QUANTITY_DISTANCE,
-                   VDSH_METHOD_LSQ, VDSH_WINDOW_NONE, 0, 0, 1);
-        add_stream(s, 3, VDSH_ENCODING_S8, VDSH_QUANTITY_LOG_DISTANCE,
-                   VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1);
-        add_stream(s, 5, VDSH_ENCODING_S8S6, VDSH_QUANTITY_LOG_DISTANCE,
-                   VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1);
-        add_stream(s, 4, VDSH_ENCODING_S8S6, VDSH_QUANTITY_LOG_DISTANCE,
-                   VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1);
+        /* order, encoding, quantity, method, window, its parameter,
+         * method parameter, coefficient scale */
+        static const struct {
+            uint32_t order, enc, q, method, window;
+            float wp, mp, scale;
+        } streams[] = {
+            {5, VDSH_ENCODING_F16, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_PAPER, VDSH_WINDOW_HANN, 2.5f, 0, 15},
+            {3, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_FULL, VDSH_WINDOW_NONE, 0, 0, 1},
+            {2, VDSH_ENCODING_F16, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_PAPER, VDSH_WINDOW_LANCZOS, 1.0f,
+             0.01f, 0.5f},
+            {1, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE2, VDSH_METHOD_FULL, VDSH_WINDOW_NONE, 0, 0, 3},
+            {5, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE2, VDSH_METHOD_PAPER, VDSH_WINDOW_NONE, 0, -1.5f, 1},
+            {4, VDSH_ENCODING_S8, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_LSQ, VDSH_WINDOW_NONE, 0, 0, 1},
+            {3, VDSH_ENCODING_S8, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1},
+            {5, VDSH_ENCODING_S8S6, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1},
+            {4, VDSH_ENCODING_S8S6, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1},
+        };
+        for (size_t i = 0; i < sizeof streams / sizeof streams[0]; i++)
+            add_stream(s, streams[i].order, streams[i].enc, streams[i].q, streams[i].method, streams[i].window,
+                       streams[i].wp, streams[i].mp, streams[i].scale);
         s->long_name = malloc(VDSH_MAX_NAME + 1);
         memset(s->long_name, 'n', VDSH_MAX_NAME);
         s->long_name[VDSH_MAX_NAME] = 0;

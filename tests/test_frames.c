@@ -45,6 +45,7 @@
 
 #include "eval.h"
 #include "frames.h"
+#include "test_run.h"
 #include "test_util.h"
 #include "vdsh.h"
 #include "vdsh_shadow.h"
@@ -58,31 +59,7 @@ static char out_path[4096], err_path[4096];
 /* Run argv (NULL-terminated) with stdout and stderr to files; exit code. */
 static int run(char *const argv[])
 {
-    pid_t pid = fork();
-    if (pid < 0)
-        return -1;
-    if (pid == 0) {
-        int o = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        int e = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (o < 0 || e < 0)
-            _exit(127);
-        dup2(o, 1);
-        dup2(e, 2);
-        execv(argv[0], argv);
-        _exit(127);
-    }
-    int st;
-    if (waitpid(pid, &st, 0) < 0)
-        return -1;
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static int contains(const char *path, const char *needle)
-{
-    char *b = (char *)test_read_file(path, NULL);
-    int ok = b && strstr(b, needle) != NULL;
-    free(b);
-    return ok;
+    return test_run(argv, out_path, err_path);
 }
 
 static void show_stderr(void)
@@ -349,7 +326,7 @@ static int part_box(void)
     int rc1 = run((char *[]){(char *)frames, "truth", vdsh, "--views", views, "-o", t1,
                              "--threads", "1", NULL});
     CHECK(rc1 == 0, "truth, 1 thread: exit %d", rc1);
-    CHECK(contains(out_path, "a frame's truth (320 x 240"), "the time per frame is printed");
+    CHECK(test_file_contains(out_path, "a frame's truth (320 x 240"), "the time per frame is printed");
     int rc2 = run((char *[]){(char *)frames, "truth", vdsh, "--views", views, "-o", t2,
                              "--threads", "2", NULL});
     CHECK(rc2 == 0, "truth, 2 threads: exit %d", rc2);
@@ -542,6 +519,22 @@ static const cJSON *mode_scene(const cJSON *root, const char *mode)
     return NULL;
 }
 
+/* vdsh-frames truth of `vdsh` for the view set into `truth`, then its
+ * score with the truth as the frames of `modes` into `json`: that JSON,
+ * read back; NULL (and a failed check) when a step fails. */
+static cJSON *truth_and_score(char *vdsh, char *views, char *truth, char *modes, char *json)
+{
+    int rc = run((char *[]){(char *)frames, "truth", vdsh, "--views", views, "-o", truth, NULL});
+    CHECK(rc == 0, "truth: exit %d", rc);
+    rc = run((char *[]){(char *)frames, "score", vdsh, "--views", views, "--truth", truth,
+                        "--frames", truth, "--modes", modes, "--json", json, NULL});
+    CHECK(rc == 0, "score: exit %d", rc);
+    if (rc)
+        show_stderr();
+    char msg[4300];
+    return rc == 0 ? vt_json_read_file(json, msg, sizeof msg) : NULL;
+}
+
 static int part_oracle(void)
 {
     char *vdsh = path_in("room.vdsh"), *views = path_in("room.views.json"),
@@ -550,16 +543,7 @@ static int part_oracle(void)
         CHECK(0, "views");
         return test_report("frames_oracle");
     }
-    int rc = run((char *[]){(char *)frames, "truth", vdsh, "--views", views, "-o", truth, NULL});
-    CHECK(rc == 0, "truth: exit %d", rc);
-    rc = run((char *[]){(char *)frames, "score", vdsh, "--views", views, "--truth", truth,
-                        "--frames", truth, "--modes", "ideal,hard,c-vdsh3", "--json", json,
-                        NULL});
-    CHECK(rc == 0, "score: exit %d", rc);
-    if (rc)
-        show_stderr();
-    char msg[4300];
-    cJSON *j = rc == 0 ? vt_json_read_file(json, msg, sizeof msg) : NULL;
+    cJSON *j = truth_and_score(vdsh, views, truth, "ideal,hard,c-vdsh3", json);
     const cJSON *id = mode_scene(j, "ideal"), *hd = mode_scene(j, "hard"),
                 *c3 = mode_scene(j, "c-vdsh3");
     CHECK(id && hd && c3, "the JSON has every mode's scene");
@@ -693,16 +677,8 @@ static int part_orders(void)
     CHECK(room_views(all7, views, "1", "2") == 0, "views");
 
     /* All order 7: the same scores and frames as the fixed stream. */
-    rc = run((char *[]){(char *)frames, "truth", all7, "--views", views, "-o", truth, NULL});
-    CHECK(rc == 0, "truth: exit %d", rc);
-    rc = run((char *[]){(char *)frames, "score", all7, "--views", views, "--truth", truth,
-                        "--frames", truth, "--modes", "c-vdsh3,c-vdsh7,c-vdsh-var", "--json",
-                        json, NULL});
-    CHECK(rc == 0, "score: exit %d", rc);
-    if (rc)
-        show_stderr();
+    cJSON *j = truth_and_score(all7, views, truth, "c-vdsh3,c-vdsh7,c-vdsh-var", json);
     char msg[4300];
-    cJSON *j = rc == 0 ? vt_json_read_file(json, msg, sizeof msg) : NULL;
     const cJSON *c3 = mode_scene(j, "c-vdsh3"), *c7 = mode_scene(j, "c-vdsh7"),
                 *cv = mode_scene(j, "c-vdsh-var");
     CHECK(c3 && c7 && cv, "the JSON has every mode's scene");
@@ -794,24 +770,24 @@ static int part_orders(void)
 static int part_errors(void)
 {
     char *fr = (char *)frames;
-    CHECK(run((char *[]){fr, "--help", NULL}) == 0 && contains(out_path, "c-vdshN") &&
-              contains(out_path, "blotches") && contains(out_path, "--compare"),
+    CHECK(run((char *[]){fr, "--help", NULL}) == 0 && test_file_contains(out_path, "c-vdshN") &&
+              test_file_contains(out_path, "blotches") && test_file_contains(out_path, "--compare"),
           "--help documents the frames and the scores");
-    CHECK(run((char *[]){fr, "--version", NULL}) == 0 && contains(out_path, "vdsh-frames "),
+    CHECK(run((char *[]){fr, "--version", NULL}) == 0 && test_file_contains(out_path, "vdsh-frames "),
           "--version");
-    CHECK(run((char *[]){fr, NULL}) == 2 && contains(err_path, "no subcommand"), "none");
-    CHECK(run((char *[]){fr, "paint", NULL}) == 2 && contains(err_path, "'paint'"), "unknown");
-    CHECK(run((char *[]){fr, "views", "x.vdsh", NULL}) == 2 && contains(err_path, "-o"),
+    CHECK(run((char *[]){fr, NULL}) == 2 && test_file_contains(err_path, "no subcommand"), "none");
+    CHECK(run((char *[]){fr, "paint", NULL}) == 2 && test_file_contains(err_path, "'paint'"), "unknown");
+    CHECK(run((char *[]){fr, "views", "x.vdsh", NULL}) == 2 && test_file_contains(err_path, "-o"),
           "views without -o");
     CHECK(run((char *[]){fr, "views", "x.vdsh", "-o", "v.json", "--cameras", "0", NULL}) == 2 &&
-              contains(err_path, "--cameras"),
+              test_file_contains(err_path, "--cameras"),
           "--cameras 0");
     CHECK(run((char *[]){fr, "views", "x.vdsh", "-o", "v.json", "--size", "160x", NULL}) == 2 &&
-              contains(err_path, "--size"),
+              test_file_contains(err_path, "--size"),
           "--size 160x");
     CHECK(run((char *[]){fr, "truth", "x.vdsh", "--views", "v", "-o", "d", "--threads", "0",
                          NULL}) == 2 &&
-              contains(err_path, "--threads"),
+              test_file_contains(err_path, "--threads"),
           "--threads 0");
     CHECK(run((char *[]){fr, "truth", "x.vdsh", "--views", "v", "-o", "d", "--compare", "soft",
                          NULL}) == 2,
@@ -820,7 +796,7 @@ static int part_errors(void)
           "two scenes");
     CHECK(run((char *[]){fr, "score", "x.vdsh", "--views", "v", "--truth", "t", "--frames", "f",
                          "--modes", "vdsh5,,cube", NULL}) == 2 &&
-              contains(err_path, "--modes"),
+              test_file_contains(err_path, "--modes"),
           "an empty mode");
     CHECK(run((char *[]){fr, "score", "x.vdsh", "--views", "v", "--truth", "t", "--frames", "f",
                          NULL}) == 2,
@@ -838,16 +814,16 @@ static int part_errors(void)
          *bad = path_in("bad.views.json"), *views = path_in("ok.views.json"),
          *truth = path_in("truth"), *json = path_in("score.json");
     CHECK(run((char *[]){fr, "views", missing, "-o", path_in("v.json"), NULL}) == 1 &&
-              contains(err_path, "no-such.vdsh"),
+              test_file_contains(err_path, "no-such.vdsh"),
           "a missing scene is named");
     CHECK(run((char *[]){fr, "truth", vdsh, "--views", nov, "-o", truth, NULL}) == 1 &&
-              contains(err_path, "no-such.views.json") && !exists(truth),
+              test_file_contains(err_path, "no-such.views.json") && !exists(truth),
           "a missing view set is named, nothing written");
     FILE *f = fopen(bad, "w");
     fprintf(f, "{\"width\": 64, \"height\": 48, \"views\": [{\"name\": \"a b\"}]}\n");
     fclose(f);
     CHECK(run((char *[]){fr, "truth", vdsh, "--views", bad, "-o", truth, NULL}) == 1 &&
-              contains(err_path, "bad.views.json") && contains(err_path, "name"),
+              test_file_contains(err_path, "bad.views.json") && test_file_contains(err_path, "name"),
           "an invalid view set is named with its field");
     f = fopen(views, "w");
     fprintf(f, "{\"width\": 64, \"height\": 48, \"views\": [{\"name\": \"a\", \"eye\": [0, 3, 3], "
@@ -865,7 +841,7 @@ static int part_errors(void)
     unlink(json);
     CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames",
                          truth, "--modes", "c-vdsh2,vdsh5", "--json", json, NULL}) == 1 &&
-              contains(err_path, "a-s0-l0-vdsh5.png") && contains(err_path, "missing") &&
+              test_file_contains(err_path, "a-s0-l0-vdsh5.png") && test_file_contains(err_path, "missing") &&
               !exists(json),
           "a missing frame is named, no JSON written");
     char other[4096];
@@ -875,7 +851,7 @@ static int part_errors(void)
     CHECK(vt_png16_write(other, 32, 24, small, msg, sizeof msg) == 0, "%s", msg);
     CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames",
                          truth, "--modes", "c-vdsh3", "--json", json, NULL}) == 1 &&
-              contains(err_path, "a-s1-l1-c-vdsh3.png") && contains(err_path, "32 x 24") &&
+              test_file_contains(err_path, "a-s1-l1-c-vdsh3.png") && test_file_contains(err_path, "32 x 24") &&
               !exists(json),
           "a frame of another size is named");
     char mask[4096];
@@ -885,11 +861,11 @@ static int part_errors(void)
     fclose(f);
     CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames",
                          truth, "--modes", "c-vdsh2", NULL}) == 1 &&
-              contains(err_path, "a-s0-l0-mask.png"),
+              test_file_contains(err_path, "a-s0-l0-mask.png"),
           "a broken truth frame is named");
     /* A file where the output folder should be. */
     CHECK(run((char *[]){fr, "truth", vdsh, "--views", views, "-o", obj, NULL}) == 1 &&
-              contains(err_path, "floorbox.obj"),
+              test_file_contains(err_path, "floorbox.obj"),
           "an output folder that is a file");
     return test_report("frames_errors");
 }

@@ -13,17 +13,14 @@ import shutil
 import subprocess
 import sys
 
+import testlib
+
 scripts, build, work = sys.argv[1:4]
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
 frames = os.path.join(scripts, "frames")
 fails = []
-
-
-def check(ok, what):
-    if not ok:
-        fails.append(what)
-        print("FAIL: " + what, file=sys.stderr)
+check = testlib.checker(fails)
 
 
 def no_duplicates(pairs):

@@ -146,20 +146,33 @@ for name, src, opts in scenes:
 # and translation) within half a step, normals (int8) within half a step
 # of 1/127.
 decoder = os.path.isfile(os.path.join(modules, "meshoptimizer", "meshopt_decoder.cjs"))
+
+
+def compress_decode(plain, packed, unpacked, export_args):
+    """vdsh-export export_args to `packed`, decoded by meshoptimizer to
+    `unpacked`: (JSON, BIN) of the plain export, the JSON of the packed one,
+    and (JSON, BIN) of the decoded one; None when a step failed."""
+    run([export] + export_args)
+    run([node, os.path.join(here, "gltf_meshopt_decode.js"), modules, packed, unpacked])
+    if fail:
+        return None
+    glbs.append(packed)
+    gp, bp = read_glb(plain)
+    gc, _ = read_glb(packed)
+    gd, bd = read_glb(unpacked)
+    return gp, bp, gc, gd, bd
+
+
 for name, flt in (("room", []), ("room", ["--float"]), ("box", [])):
     plain = os.path.join(work, name + ("_float" if flt else "") + ".glb")
     if not os.path.exists(plain) or not decoder:
         continue
     packed = plain[:-4] + "_compressed.glb"
     unpacked = plain[:-4] + "_decoded.glb"
-    run([export, os.path.join(work, name + ".vdsh"), "-o", packed, "--compress"] + flt)
-    run([node, os.path.join(here, "gltf_meshopt_decode.js"), modules, packed, unpacked])
-    if fail:
+    got = compress_decode(plain, packed, unpacked, [os.path.join(work, name + ".vdsh"), "-o", packed, "--compress"] + flt)
+    if got is None:
         break
-    glbs.append(packed)
-    gp, bp = read_glb(plain)
-    gc, _ = read_glb(packed)
-    gd, bd = read_glb(unpacked)
+    gp, bp, gc, gd, bd = got
     print("%s: %d bytes, compressed %d (%.2f)" % (name + " ".join([""] + flt), os.path.getsize(plain),
                                                  os.path.getsize(packed), os.path.getsize(packed) / os.path.getsize(plain)))
     if sorted(gc.get("extensionsRequired", [])) != ["EXT_meshopt_compression", "KHR_mesh_quantization"]:
@@ -269,14 +282,11 @@ for name in ("box-src", "engine-src"):
         continue
     src = dict((n, s) for n, s, _ in srcs)[name]
     packed, unpacked = os.path.join(work, name + "_compressed.glb"), os.path.join(work, name + "_decoded.glb")
-    run([export, os.path.join(work, name + ".vdsh"), "--source", src, "--compress", "-o", packed, "-q"])
-    run([node, os.path.join(here, "gltf_meshopt_decode.js"), modules, packed, unpacked])
-    if fail:
+    got = compress_decode(plain, packed, unpacked,
+                          [os.path.join(work, name + ".vdsh"), "--source", src, "--compress", "-o", packed, "-q"])
+    if got is None:
         break
-    glbs.append(packed)
-    gp, bp = read_glb(plain)
-    gc, _ = read_glb(packed)
-    gd, bd = read_glb(unpacked)
+    gp, bp, gc, gd, bd = got
     print("%s --source: %d bytes, compressed %d (%.2f)" % (name, os.path.getsize(plain), os.path.getsize(packed),
                                                           os.path.getsize(packed) / os.path.getsize(plain)))
     if "EXT_meshopt_compression" not in gc.get("extensionsRequired", []) or \

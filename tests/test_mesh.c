@@ -325,6 +325,38 @@ static void expect_fail(const char *path, vb_result code, const char *needle)
     CHECK(memcmp(&info, &info0, sizeof info) == 0, "%s: info touched on failure", path);
 }
 
+/* expect_load with no welding, the mesh and `path` freed after. */
+static void expect_load_free(char *path, uint32_t nv, uint32_t nt)
+{
+    vb_mesh m = expect_load(path, 0, nv, nt);
+    vb_mesh_free(&m);
+    free(path);
+}
+
+/* expect_fail, `path` freed after. */
+static void expect_fail_free(char *path, vb_result code, const char *needle)
+{
+    expect_fail(path, code, needle);
+    free(path);
+}
+
+/* A file the loader must refuse: its name, its text (after a header the
+ * caller gives), the result and a part of the message. */
+typedef struct {
+    const char *name, *text;
+    vb_result code;
+    const char *needle;
+} bad_file;
+
+static void expect_bad_files(const char *head, const bad_file *bad, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        char text[1024];
+        snprintf(text, sizeof text, "%s%s", head, bad[i].text);
+        expect_fail_free(text_fixture(bad[i].name, text), bad[i].code, bad[i].needle);
+    }
+}
+
 static void put_u32(uint8_t *p, uint32_t v, int big)
 {
     for (int i = 0; i < 4; i++)
@@ -401,12 +433,10 @@ static void test_load_obj(void)
 
     /* the same with positive indices, a pentagon (3 triangles), a
      * degenerate triangle (dropped) and an unreferenced vertex (dropped) */
-    p = text_fixture("clean.obj",
-                     "# comment\nv 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\nv 0 1 0\nv 9 9 9\n"
-                     "o thing\ng group\ns 1\nf 1 2 3 4 5\nf 1 1 2\nf 2/7/1 3//2 4 # inline comment\n");
-    m = expect_load(p, 0, 5, 4);
-    vb_mesh_free(&m);
-    free(p);
+    expect_load_free(text_fixture("clean.obj",
+                                  "# comment\nv 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\nv 0 1 0\nv 9 9 9\n"
+                                  "o thing\ng group\ns 1\nf 1 2 3 4 5\nf 1 1 2\nf 2/7/1 3//2 4 # inline comment\n"),
+                     5, 4);
 
     /* file normals (vn) are used, normalised; a zero one is replaced by
      * the computed normal */
@@ -440,16 +470,11 @@ static void test_load_obj(void)
     free(p);
 
     /* mtllib naming a device: OpenMesh must never open it */
-    p = text_fixture("mtl_dev.obj", "mtllib /dev/zero\nusemtl x\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-    m = expect_load(p, 0, 3, 1); /* reading /dev/zero would never end: the test's time limit */
-    vb_mesh_free(&m);
-    free(p);
+    /* reading /dev/zero would never end: the test's time limit */
+    expect_load_free(text_fixture("mtl_dev.obj", "mtllib /dev/zero\nusemtl x\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+                     3, 1);
 
-    static const struct {
-        const char *name, *text;
-        vb_result code;
-        const char *needle;
-    } bad[] = {
+    static const bad_file bad[] = {
         {"nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", VB_ERR_INVALID, "line 2: vertex 2"},
         {"inf.obj", "v 0 0 0\nv 0 inf 0\nv 0 1 0\nf 1 2 3\n", VB_ERR_INVALID, "not finite"},
         {"huge.obj", "v 0 0 0\nv 0 1e39 0\nv 0 1 0\nf 1 2 3\n", VB_ERR_INVALID, "out of float range"},
@@ -466,15 +491,9 @@ static void test_load_obj(void)
         {"degenerate.obj", "v 0 0 0\nv 1 0 0\nf 1 2 2\nf 1 1 1\n", VB_ERR_INVALID, "empty mesh"},
         {"truncated.obj", "v 0 0 0\nv 1 0 0\nv 0 1", VB_ERR_FORMAT, "line 3"},
     };
-    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-        p = text_fixture(bad[i].name, bad[i].text);
-        expect_fail(p, bad[i].code, bad[i].needle);
-        free(p);
-    }
+    expect_bad_files("", bad, sizeof bad / sizeof bad[0]);
     const uint8_t utf16[] = {0xfe, 0xff, 0, 'v', 0, ' ', 0, '1'};
-    p = fixture("utf16.obj", utf16, sizeof utf16);
-    expect_fail(p, VB_ERR_FORMAT, "UTF-16");
-    free(p);
+    expect_fail_free(fixture("utf16.obj", utf16, sizeof utf16), VB_ERR_FORMAT, "UTF-16");
 }
 
 static void test_load_ply_off_stl(void)
@@ -495,70 +514,41 @@ static void test_load_ply_off_stl(void)
 
     /* binary PLY, both byte orders, and with a comment just before
      * end_header (which OpenMesh alone would misread by a byte) */
-    p = ply_binary("le.ply", 0, 0, -1, 4, 0);
-    m = expect_load(p, 0, 4, 2);
-    if (m.vertex_count == 4)
-        CHECK(m.positions[6] == 1.0f && m.positions[7] == 1.0f, "le.ply: positions misread");
-    vb_mesh_free(&m);
-    free(p);
-    p = ply_binary("be.ply", 1, 0, -1, 4, 0);
-    m = expect_load(p, 0, 4, 2);
-    if (m.vertex_count == 4)
-        CHECK(m.positions[6] == 1.0f && m.positions[7] == 1.0f, "be.ply: positions misread");
-    vb_mesh_free(&m);
-    free(p);
-    p = ply_binary("comment.ply", 0, 1, -1, 4, 0);
-    m = expect_load(p, 0, 4, 2);
-    vb_mesh_free(&m);
-    free(p);
+    for (int big = 0; big < 2; big++) {
+        const char *name = big ? "be.ply" : "le.ply";
+        p = ply_binary(name, big, 0, -1, 4, 0);
+        m = expect_load(p, 0, 4, 2);
+        if (m.vertex_count == 4)
+            CHECK(m.positions[6] == 1.0f && m.positions[7] == 1.0f, "%s: positions misread", name);
+        vb_mesh_free(&m);
+        free(p);
+    }
+    expect_load_free(ply_binary("comment.ply", 0, 1, -1, 4, 0), 4, 2);
 
-    p = ply_binary("nan_bin.ply", 0, 0, 2, 4, 0);
-    expect_fail(p, VB_ERR_INVALID, "vertex 2");
-    free(p);
-    p = ply_binary("trunc_bin.ply", 0, 0, -1, 4, 7);
-    expect_fail(p, VB_ERR_FORMAT, "truncated");
-    free(p);
-    p = ply_binary("huge_bin.ply", 1, 0, -1, 2000000000u, 0);
-    expect_fail(p, VB_ERR_FORMAT, "truncated");
-    free(p);
+    expect_fail_free(ply_binary("nan_bin.ply", 0, 0, 2, 4, 0), VB_ERR_INVALID, "vertex 2");
+    expect_fail_free(ply_binary("trunc_bin.ply", 0, 0, -1, 4, 7), VB_ERR_FORMAT, "truncated");
+    expect_fail_free(ply_binary("huge_bin.ply", 1, 0, -1, 2000000000u, 0), VB_ERR_FORMAT, "truncated");
 
     static const char ply_head[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                                    "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
-    static const struct {
-        const char *name, *body;
-        vb_result code;
-        const char *needle;
-    } bad[] = {
+    static const bad_file bad[] = {
         {"nan.ply", "0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n", VB_ERR_INVALID, "line 11: vertex 1"},
         {"range.ply", "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", VB_ERR_INVALID, "vertex index 3 out of range (3 vertices)"},
         {"trunc.ply", "0 0 0\n1 0 0\n0 1", VB_ERR_FORMAT, "truncated"},
         {"twoface.ply", "0 0 0\n1 0 0\n0 1 0\n2 0 1\n", VB_ERR_FORMAT, "face 0 has 2 vertices"},
     };
-    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-        char text[1024];
-        snprintf(text, sizeof text, "%s%s", ply_head, bad[i].body);
-        p = text_fixture(bad[i].name, text);
-        expect_fail(p, bad[i].code, bad[i].needle);
-        free(p);
-    }
-    p = text_fixture("vlist.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-                                  "property float z\nproperty list uchar int stuff\nend_header\n0 0 0 2 1 1\n");
-    expect_fail(p, VB_ERR_FORMAT, "list property 'stuff'");
-    free(p);
-    p = text_fixture("noply.ply", "solid x\n");
-    expect_fail(p, VB_ERR_FORMAT, "not a PLY");
-    free(p);
+    expect_bad_files(ply_head, bad, sizeof bad / sizeof bad[0]);
+    expect_fail_free(text_fixture("vlist.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                                               "property float z\nproperty list uchar int stuff\nend_header\n0 0 0 2 1 1\n"),
+                     VB_ERR_FORMAT, "list property 'stuff'");
+    expect_fail_free(text_fixture("noply.ply", "solid x\n"), VB_ERR_FORMAT, "not a PLY");
 
     /* OFF: ascii with a quad, NOFF normals, binary (the triangle after the
      * quad repeats its first half: dropped) */
-    p = text_fixture("quad.off", "OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n5 5 5\n4 0 1 2 3\n3 0 1 2\n");
-    m = expect_load(p, 0, 4, 2);
-    vb_mesh_free(&m);
-    free(p);
-    p = text_fixture("normals.off", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n");
-    m = expect_load(p, 0, 3, 1);
-    vb_mesh_free(&m);
-    free(p);
+    expect_load_free(text_fixture("quad.off", "OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n5 5 5\n4 0 1 2 3\n3 0 1 2\n"),
+                     4, 2);
+    expect_load_free(text_fixture("normals.off", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n"),
+                     3, 1);
     {
         uint8_t buf[256];
         size_t n = strlen("OFF BINARY\n");
@@ -573,16 +563,9 @@ static void test_load_ply_off_stl(void)
         const uint32_t f[4] = {3, 0, 1, 2};
         for (int k = 0; k < 4; k++, n += 4)
             put_u32(buf + n, f[k], 0);
-        p = fixture("binary.off", buf, n);
-        m = expect_load(p, 0, 3, 1);
-        vb_mesh_free(&m);
-        free(p);
+        expect_load_free(fixture("binary.off", buf, n), 3, 1);
     }
-    static const struct {
-        const char *name, *text;
-        vb_result code;
-        const char *needle;
-    } bad_off[] = {
+    static const bad_file bad_off[] = {
         {"nan.off", "OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n", VB_ERR_INVALID, "line 4: vertex 1"},
         {"range.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n", VB_ERR_INVALID, "out of range"},
         {"trunc.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1", VB_ERR_FORMAT, "truncated"},
@@ -590,11 +573,7 @@ static void test_load_ply_off_stl(void)
         {"nocounts.off", "OFF\n3 1\n0.5 0 0\n", VB_ERR_FORMAT, "expected three counts"},
         {"4off.off", "4OFF\n1 0 0\n0 0 0 0\n", VB_ERR_FORMAT, "4OFF"},
     };
-    for (size_t i = 0; i < sizeof bad_off / sizeof bad_off[0]; i++) {
-        p = text_fixture(bad_off[i].name, bad_off[i].text);
-        expect_fail(p, bad_off[i].code, bad_off[i].needle);
-        free(p);
-    }
+    expect_bad_files("", bad_off, sizeof bad_off / sizeof bad_off[0]);
 
     /* STL: ascii (vertices merged by OpenMesh's reader), a degenerate facet
      * dropped; binary */
@@ -604,29 +583,15 @@ static void test_load_ply_off_stl(void)
     snprintf(f2, sizeof f2, facet, "0 0 0", "1 1 0", "0 1 0");
     snprintf(f3, sizeof f3, facet, "0 0 0", "0 0 0", "0 1 0");
     snprintf(text, sizeof text, "solid t\n%s%s%sendsolid t\n", f1, f2, f3);
-    p = text_fixture("ascii.stl", text);
-    m = expect_load(p, 0, 4, 2);
-    vb_mesh_free(&m);
-    free(p);
-    p = stl_binary("binary.stl", 0, 2, 0);
-    m = expect_load(p, 0, 4, 2);
-    vb_mesh_free(&m);
-    free(p);
-    p = stl_binary("inf_bin.stl", 1, 2, 0);
-    expect_fail(p, VB_ERR_INVALID, "triangle 1");
-    free(p);
-    p = stl_binary("trunc_bin.stl", 0, 3, 0);
-    expect_fail(p, VB_ERR_FORMAT, "neither ascii STL");
-    free(p);
+    expect_load_free(text_fixture("ascii.stl", text), 4, 2);
+    expect_load_free(stl_binary("binary.stl", 0, 2, 0), 4, 2);
+    expect_fail_free(stl_binary("inf_bin.stl", 1, 2, 0), VB_ERR_INVALID, "triangle 1");
+    expect_fail_free(stl_binary("trunc_bin.stl", 0, 3, 0), VB_ERR_FORMAT, "neither ascii STL");
     snprintf(f2, sizeof f2, facet, "0 0 0", "1 nan 0", "0 1 0");
     snprintf(text, sizeof text, "solid t\n%s%sendsolid t\n", f1, f2);
-    p = text_fixture("nan.stl", text);
-    expect_fail(p, VB_ERR_INVALID, "line 12");
-    free(p);
+    expect_fail_free(text_fixture("nan.stl", text), VB_ERR_INVALID, "line 12");
     snprintf(text, sizeof text, "solid t\n%s facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n", f1);
-    p = text_fixture("trunc.stl", text);
-    expect_fail(p, VB_ERR_FORMAT, "truncated");
-    free(p);
+    expect_fail_free(text_fixture("trunc.stl", text), VB_ERR_FORMAT, "truncated");
 }
 
 static void test_load_misc(void)
@@ -634,12 +599,8 @@ static void test_load_misc(void)
     char *p = text_fixture("empty.obj", "");
     expect_fail(p, VB_ERR_FORMAT, "empty file");
     free(p);
-    p = text_fixture("empty.ply", "");
-    expect_fail(p, VB_ERR_FORMAT, "empty file");
-    free(p);
-    p = text_fixture("model.fbx", "x");
-    expect_fail(p, VB_ERR_FORMAT, "unsupported file type");
-    free(p);
+    expect_fail_free(text_fixture("empty.ply", ""), VB_ERR_FORMAT, "empty file");
+    expect_fail_free(text_fixture("model.fbx", "x"), VB_ERR_FORMAT, "unsupported file type");
     p = join(g_dir, "does_not_exist.obj");
     expect_fail(p, VB_ERR_IO, "cannot open");
     free(p);

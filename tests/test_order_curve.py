@@ -25,15 +25,12 @@ import subprocess
 import sys
 import tempfile
 
+import testlib
+
 scripts, build = sys.argv[1:3]
 script = os.path.join(scripts, "order_curve")
 fails = []
-
-
-def check(ok, what):
-    if not ok:
-        fails.append(what)
-        print("FAIL: " + what, file=sys.stderr)
+check = testlib.checker(fails)
 
 
 def r16(n):

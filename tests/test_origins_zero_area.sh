@@ -9,13 +9,8 @@
 # Usage: test_origins_zero_area.sh VDSH_BAKE
 set -u
 bake=$1
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail=0
-check() { # check DESCRIPTION COMMAND...
-  local what=$1; shift
-  if ! "$@"; then echo "FAIL: $what" >&2; fail=1; fi
-}
+. "$(dirname "$0")/lib.sh"
+make_tmp
 json() { # json PYTHON_EXPRESSION_OF_a_AND_b (the two reports): true when it holds
   /usr/bin/python3 -c 'import json, sys
 a = json.load(open(sys.argv[1]))["origins"]; b = json.load(open(sys.argv[2]))["origins"]
@@ -24,11 +19,8 @@ if not ok: print("  without:", a, "\n  with:   ", b, file=sys.stderr)
 sys.exit(0 if ok else 1)' "$tmp/a.json" "$tmp/b.json" "$1"
 }
 
-room() { # the room: 10 x 4 x 10, faces inward; a unit box on its floor
-  cat "$(dirname "$0")/data/room_box.obj"
-}
-room >"$tmp/a.obj"
-{ room; cat <<'OBJ'
+# the room, and the room with three zero-area triangles
+room_box_pair <<'OBJ'
 v 0 0 2
 v 0 0 5
 v 0 0 8
@@ -42,7 +34,6 @@ f 17//1 18//1 19//1
 f 20//2 21//2 22//2
 f 23//1 24//1 25//1
 OBJ
-} >"$tmp/b.obj"
 
 opts=(--rays 16 --cube-size 0 --threads 2)
 "$bake" "$tmp/a.obj" "${opts[@]}" -o "$tmp/a.vdsh" --report "$tmp/a.json" 2>"$tmp/a.err" ||

@@ -11,6 +11,7 @@
  * that fails half way, /dev/full for a stream target, a directory planted
  * at the target between open and commit for a failing rename.
  */
+#include "test_dir.h"
 #include "test_util.h"
 #include "vdsh_output.h"
 
@@ -58,15 +59,7 @@ static int holds(const char *path, const char *text)
 /* Names in dir that contain ".tmp." (temporaries, vdsh_output.h). */
 static int temporaries(const char *dir)
 {
-    DIR *d = opendir(dir);
-    int n = 0;
-    struct dirent *e;
-    if (!d)
-        return -1;
-    while ((e = readdir(d)))
-        n += strstr(e->d_name, ".tmp.") != NULL;
-    closedir(d);
-    return n;
+    return test_count_names(dir, ".tmp.");
 }
 
 /* 1. A name taken under the temporary naming scheme is skipped, never

@@ -35,14 +35,14 @@ import zlib
 
 import numpy as np
 
+import testlib
+
 bake, info, ref, src, work = sys.argv[1:6]
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
 fail = []
 target = os.path.join(work, "site")
-r = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-build-isolation",
-                    "--no-deps", "--no-index", "--target", target, os.path.join(src, "python")],
-                   capture_output=True, text=True)
+r = testlib.pip_install(os.path.join(src, "python"), target)
 if r.returncode:
     sys.exit("FAIL: pip install ./python: %s" % r.stderr)
 sys.path.insert(0, target)
@@ -162,10 +162,9 @@ bakes = (("default", [], (0.0, 0.4)),
 files = []
 for name, args, offsets in bakes:
     out = os.path.join(work, name + ".vdsh")
-    r = subprocess.run([bake, "builtin:room", "--max-edge", "2", "--rays", "128", "-q",
-                        "--cube-size", "0", "-o", out] + args, capture_output=True, text=True)
-    if r.returncode:
-        fail.append("bake %s: %s" % (name, r.stderr.strip()))
+    e = testlib.bake_room(bake, out, "2", "128", args)
+    if e is not None:
+        fail.append("bake %s: %s" % (name, e))
         continue
     files.append((out, offsets))
 if os.path.exists(os.path.join(work, "paper-f32.vdsh")):

@@ -37,6 +37,8 @@ import sys
 
 import numpy as np
 
+import testlib
+
 bake, info, src, work = sys.argv[1:5]
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
@@ -64,9 +66,7 @@ def git_status():
 
 before, git_before = tree(pkg), git_status()
 target = os.path.join(work, "site")
-r = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-build-isolation",
-                    "--no-deps", "--no-index", "--target", target, pkg],
-                   capture_output=True, text=True)
+r = testlib.pip_install(pkg, target)
 left = sorted(tree(pkg) - before)
 git_after = git_status()
 for rel in left:  # report, then leave the checkout clean
@@ -188,10 +188,9 @@ for name, args in (("default", []), ("paper-f32", ["--method", "paper", "--encod
                    ("adaptive-order-f16", ["--adaptive-order", "0.02", "--encoding", "f16"]),
                    ("adaptive-order-f32", ["--adaptive-order", "0.02", "--encoding", "f32"])):
     out = os.path.join(work, name + ".vdsh")
-    r = subprocess.run([bake, "builtin:room", "--max-edge", "1.5", "--rays", "256", "-q",
-                        "--cube-size", "0", "-o", out] + args, capture_output=True, text=True)
-    if r.returncode:
-        fail.append("bake %s: %s" % (name, r.stderr.strip()))
+    e = testlib.bake_room(bake, out, "1.5", "256", args)
+    if e is not None:
+        fail.append("bake %s: %s" % (name, e))
         continue
     baked[name] = compare(out)
 

@@ -18,23 +18,15 @@ bake=$1
 merge=$2
 info=$3
 pysrc=$4
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail=0
-check() { # check DESCRIPTION COMMAND...
-  local what=$1; shift
-  if ! "$@"; then echo "FAIL: $what" >&2; fail=1; fi
-}
+. "$(dirname "$0")/lib.sh"
+make_tmp
 run() { # run DESCRIPTION COMMAND...: must exit 0
   local what=$1; shift
   "$@" 2>"$tmp/err.txt" || { echo "FAIL: $what" >&2; cat "$tmp/err.txt" >&2; exit 1; }
 }
 
-room() { # the room: 10 x 4 x 10, faces inward; a unit box on its floor
-  cat "$(dirname "$0")/data/room_box.obj"
-}
-room >"$tmp/a.obj"
-{ room; cat <<'OBJ'
+# the room, and the room with three zero-area triangles
+room_box_pair <<'OBJ'
 v 1 0 1
 v 1.5 0 1.5
 v 2 0 2
@@ -48,7 +40,6 @@ f 17//2 18//2 19//2
 f 20//1 21//1 22//1
 f 23//3 24//3 25//3
 OBJ
-} >"$tmp/b.obj"
 
 opts=(--rays 64 --cube-size 0 --threads 2 --orders 2,3,5 -q)
 for m in a b; do

@@ -61,15 +61,7 @@ static void read_face(GLuint tex, int f, int n, uint16_t *out)
 /* A quad with a distance stream of order 5 and the given cube_size. */
 static void quad_file(rt_file *f, uint32_t cube_size)
 {
-    rt_file_init(f, 4, 2);
-    const float p[4][3] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
-    for (int i = 0; i < 4; i++) {
-        memcpy(f->pos + 3 * i, p[i], sizeof p[i]);
-        f->nrm[3 * i + 2] = 1.0f;
-    }
-    const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(f->idx, idx, sizeof idx);
-    rt_file_bounds(f);
+    rt_file_unit_quad(f);
     f->f.header.cube_size = cube_size;
     float *c5 = calloc(4 * 25, sizeof(float));
     for (int i = 0; i < 4; i++)

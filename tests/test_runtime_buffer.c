@@ -153,10 +153,8 @@ static void test_vertex(void)
     static const uint32_t enc[5] = {VDSH_ENCODING_F16, VDSH_ENCODING_F32, VDSH_ENCODING_S8,
                                     VDSH_ENCODING_S8S6, VDSH_ENCODING_F16};
     static const char *const enc_name[5] = {"f16", "f32", "s8", "s8s6", "f16 as floats"};
-    vr_renderer *r = NULL;
+    vr_renderer *r = rt_float_renderer(W, H);
     vr_error err;
-    vr_renderer_desc rd = {.width = W, .height = H, .color_format = VR_COLOR_RGBA32F};
-    CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
     if (!r)
         return;
     uint64_t rng = 0xb0ff;
@@ -287,10 +285,8 @@ static void test_variable(void)
     static const uint32_t enc[5] = {VDSH_ENCODING_F16, VDSH_ENCODING_F32, VDSH_ENCODING_S8,
                                     VDSH_ENCODING_S8S6, VDSH_ENCODING_S8S6};
     static const char *const enc_name[5] = {"f16", "f32", "s8", "s8s6", "s8s6 as floats"};
-    vr_renderer *r = NULL;
+    vr_renderer *r = rt_float_renderer(W, H);
     vr_error err;
-    vr_renderer_desc rd = {.width = W, .height = H, .color_format = VR_COLOR_RGBA32F};
-    CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
     if (!r)
         return;
     uint64_t rng = 0x7a71;

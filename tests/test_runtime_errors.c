@@ -43,15 +43,7 @@ static void expect_fail(const char *what, const vr_scene_desc *sd, vr_result wan
 /* A small valid scene on disk: a quad with orders 3 and 5. */
 static void small_file(rt_file *f, int with5)
 {
-    rt_file_init(f, 4, 2);
-    const float p[4][3] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
-    for (int i = 0; i < 4; i++) {
-        memcpy(f->pos + 3 * i, p[i], sizeof p[i]);
-        f->nrm[3 * i + 2] = 1.0f;
-    }
-    const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(f->idx, idx, sizeof idx);
-    rt_file_bounds(f);
+    rt_file_unit_quad(f);
     float *c3 = calloc(4 * 9, sizeof(float));
     for (int i = 0; i < 4; i++)
         c3[9 * i] = 5.0f;
@@ -211,15 +203,7 @@ static void test_files(const char *dir)
      * corrupt ones beside it, and the default descriptor still loads it
      * and draws order 5 both ways. */
     rt_file lf;
-    rt_file_init(&lf, 4, 2);
-    const float p[4][3] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
-    for (int i = 0; i < 4; i++) {
-        memcpy(lf.pos + 3 * i, p[i], sizeof p[i]);
-        lf.nrm[3 * i + 2] = 1.0f;
-    }
-    const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(lf.idx, idx, sizeof idx);
-    rt_file_bounds(&lf);
+    rt_file_unit_quad(&lf);
     static const int orders[3] = {2, 3, 5};
     for (int o = 0; o < 3; o++) {
         float *c = calloc(4 * 25, sizeof(float));

@@ -469,15 +469,9 @@ static void test_default(vr_renderer *r, vr_scene *room, const char *path)
     /* A floor quad with orders 2 and 3, then order 2 alone. */
     for (int orders = 2; orders >= 1; orders--) {
         rt_file f;
-        rt_file_init(&f, 4, 2);
-        const float p[4][3] = {{-9, 0, -9}, {9, 0, -9}, {9, 0, 9}, {-9, 0, 9}};
-        for (int i = 0; i < 4; i++) {
-            memcpy(f.pos + 3 * i, p[i], sizeof p[i]);
-            f.nrm[3 * i + 1] = 1.0f;
-        }
+        const float p[4][3] = {{-9, 0, -9}, {9, 0, -9}, {9, 0, 9}, {-9, 0, 9}}, n[3] = {0, 1, 0};
         const uint32_t idx[6] = {0, 2, 1, 0, 3, 2};
-        memcpy(f.idx, idx, sizeof idx);
-        rt_file_bounds(&f);
+        rt_file_quad(&f, p, n, idx);
         for (int o = 2; o <= orders + 1; o++) {
             float *c = calloc((size_t)4 * o * o, sizeof(float));
             for (int i = 0; i < 4; i++)
@@ -502,10 +496,8 @@ int main(int argc, char **argv)
         return 2;
     }
     vr_context *ctx = rt_context_or_skip("test_runtime_render");
-    vr_renderer *r = NULL;
+    vr_renderer *r = rt_float_renderer(W, H);
     vr_error err;
-    vr_renderer_desc rd = {.width = W, .height = H, .color_format = VR_COLOR_RGBA32F};
-    CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
     vr_scene *room = NULL;
     vr_scene_desc sd = {.path = argv[1]};
     CHECK(vr_scene_create(&sd, &room, &err) == VR_OK, "%s", err.msg);

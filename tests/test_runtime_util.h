@@ -89,6 +89,38 @@ static inline void rt_file_bounds(rt_file *r)
         }
 }
 
+/* A renderer of w x h float (RGBA32F) pixels; NULL, and a failed check,
+ * when none can be made. */
+static inline vr_renderer *rt_float_renderer(int w, int h)
+{
+    vr_renderer *r = NULL;
+    vr_error err;
+    vr_renderer_desc rd = {.width = w, .height = h, .color_format = VR_COLOR_RGBA32F};
+    CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
+    return r;
+}
+
+/* rt_file_init for one quad: corners p, one normal n at each, triangles
+ * idx; bounds set. */
+static inline void rt_file_quad(rt_file *r, const float p[4][3], const float n[3], const uint32_t idx[6])
+{
+    rt_file_init(r, 4, 2);
+    for (int i = 0; i < 4; i++) {
+        memcpy(r->pos + 3 * i, p[i], 3 * sizeof(float));
+        memcpy(r->nrm + 3 * i, n, 3 * sizeof(float));
+    }
+    memcpy(r->idx, idx, 6 * sizeof(uint32_t));
+    rt_file_bounds(r);
+}
+
+/* The quad [-1, 1]^2 at z = 0, facing +z, as two triangles. */
+static inline void rt_file_unit_quad(rt_file *r)
+{
+    static const float p[4][3] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, n[3] = {0, 0, 1};
+    static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    rt_file_quad(r, p, n, idx);
+}
+
 /* Add a stream whose coefficients coef (vertex-major, order^2 each, taken
  * over) are stored in `enc`: f16 as coef / scale rounded (coef is then
  * replaced by what the file really holds, so references use the exact

@@ -13,26 +13,8 @@ bake=$1
 merge=$2
 info=$3
 evaluate=$4
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail=0
-check() { # check DESCRIPTION COMMAND...
-  local what=$1; shift
-  if ! "$@"; then echo "FAIL: $what" >&2; fail=1; fi
-}
-expect_exit() { # expect_exit CODE DESCRIPTION COMMAND...
-  local want=$1 what=$2; shift 2
-  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"
-  local got=$?
-  if [[ $got -ne $want ]]; then
-    echo "FAIL: $what: exit $got, want $want; stderr:" >&2; cat "$tmp/err.txt" >&2; fail=1
-  fi
-}
-says() { # says DESCRIPTION TEXT: the last command's stderr holds TEXT
-  if ! grep -qF -- "$2" "$tmp/err.txt"; then
-    echo "FAIL: $1: stderr lacks '$2':" >&2; cat "$tmp/err.txt" >&2; fail=1
-  fi
-}
+. "$(dirname "$0")/lib.sh"
+make_tmp
 
 tiny=(builtin:room --max-edge 1.5 --rays 32 --cube-size 8 -q)
 expect_exit 0 "whole bake" "$bake" "${tiny[@]}" -o "$tmp/whole.vdsh"

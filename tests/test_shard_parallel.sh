@@ -9,24 +9,16 @@
 # Usage: test_shard_parallel.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
-fail=0
+. "$(dirname "$0")/lib.sh"
 # The usage text (needs no parallel).
-usage=$("$scripts/bake-parallel" 2>&1); rc=$?
-[[ $rc -eq 2 ]] || { echo "FAIL: bake-parallel without arguments exits $rc, not 2" >&2; fail=1; }
-grep -q 'scripts/bake-parallel N OUT.vdsh' <<<"$usage" || { echo "FAIL: no usage line: $usage" >&2; fail=1; }
-if grep -qE 'set -e|pipefail|^if |^fi' <<<"$usage"; then
-  echo "FAIL: the usage text shows code:" >&2; echo "$usage" | tail -3 >&2; fail=1
-fi
-"$scripts/bake-parallel" --help 2>/dev/null | grep -q 'scripts/bake-parallel N OUT.vdsh' ||
-  { echo "FAIL: bake-parallel --help" >&2; fail=1; }
+check_recipe_usage bake-parallel
 if ! command -v parallel >/dev/null; then
   if [[ $(id -u) -eq 0 ]]; then
     apt-get install -y --no-install-recommends parallel >/dev/null 2>&1 || true
   fi
   command -v parallel >/dev/null || { [[ $fail -eq 0 ]] || exit 1; echo "SKIP: no GNU parallel"; exit 77; }
 fi
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+make_tmp
 tiny=(builtin:room --max-edge 1.5 --rays 32 --cube-size 8)
 "$bake" "${tiny[@]}" -q -o "$tmp/whole.vdsh" || { echo "FAIL: whole bake" >&2; exit 1; }
 export VDSH_BAKE=$bake VDSH_MERGE=$merge

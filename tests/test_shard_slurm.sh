@@ -13,16 +13,9 @@
 # Usage: test_shard_slurm.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
-fail=0
+. "$(dirname "$0")/lib.sh"
 # The usage text (needs no Slurm).
-usage=$("$scripts/bake-slurm" 2>&1); rc=$?
-[[ $rc -eq 2 ]] || { echo "FAIL: bake-slurm without arguments exits $rc, not 2" >&2; fail=1; }
-grep -q 'scripts/bake-slurm N OUT.vdsh' <<<"$usage" || { echo "FAIL: no usage line: $usage" >&2; fail=1; }
-if grep -qE 'set -e|pipefail|^if |^fi' <<<"$usage"; then
-  echo "FAIL: the usage text shows code:" >&2; echo "$usage" | tail -3 >&2; fail=1
-fi
-"$scripts/bake-slurm" --help 2>/dev/null | grep -q 'scripts/bake-slurm N OUT.vdsh' ||
-  { echo "FAIL: bake-slurm --help" >&2; fail=1; }
+check_recipe_usage bake-slurm
 skip() { [[ $fail -eq 0 ]] || exit 1; echo "SKIP: $1"; exit 77; }
 [[ $(id -u) -eq 0 ]] || skip "needs root to start slurmctld and slurmd"
 if ! command -v slurmctld >/dev/null || ! command -v slurmd >/dev/null || ! command -v munged >/dev/null; then

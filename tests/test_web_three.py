@@ -52,6 +52,8 @@ import urllib.parse
 import numpy as np
 from PIL import Image
 
+import testlib
+
 bake, export, view, chromium, rtdir, work, node, modules = sys.argv[1:9]
 models = sys.argv[9] if len(sys.argv) > 9 else ""
 if not shutil.which(chromium):
@@ -123,16 +125,8 @@ def compare(label, png, ref, min_dark):
 
 def frames(name, vd, eye, target, light_set, modes):
     views = os.path.join(work, name + "-views.json")
-    json.dump({"width": W, "height": H, "views": [{"name": name, "eye": eye, "target": target, "up": [0, 1, 0],
-                                                   "fov_y": 60, "light_sets": [light_set]}]}, open(views, "w"))
-    p = subprocess.run([view, "-q", "--views", views, "--frames", os.path.join(work, "c"), "--modes",
-                        ",".join(modes), vd], capture_output=True, text=True)
-    if p.returncode != 0:
-        if "EGL" in p.stderr or "context" in p.stderr or "display" in p.stderr:
-            print("no GL context: skipped\n" + p.stderr)
-            sys.exit(77)
-        print("FAIL: vdsh-view: " + p.stderr)
-        sys.exit(1)
+    testlib.write_view(views, name, W, H, eye, target, [light_set])
+    testlib.view_frames(view, views, os.path.join(work, "c"), modes, vd)
     return lambda mode: os.path.join(work, "c", "%s-s0-l0-%s.png" % (name, mode))
 
 

@@ -65,6 +65,8 @@ import sys
 import numpy as np
 from PIL import Image
 
+import testlib
+
 bake, export, view, chromium, webdir, work, models = sys.argv[1:8]
 node = sys.argv[8] if len(sys.argv) > 8 else ""
 modules = sys.argv[9] if len(sys.argv) > 9 else ""
@@ -171,17 +173,9 @@ def scene(name, source, opts, orders, place, modes=None):
     modes = modes or [(str(o), "vdsh%d" % o) for o in orders]
     eye, target, light = place(*bounds(glb))
     views = os.path.join(work, name + "-views.json")
-    json.dump({"width": W, "height": H, "views": [{"name": name, "eye": eye, "target": target, "up": [0, 1, 0],
-                                                   "fov_y": 60, "light_sets": [[light]]}]}, open(views, "w"))
+    testlib.write_view(views, name, W, H, eye, target, [[light]])
     frames = os.path.join(work, "c")
-    p = subprocess.run([view, "-q", "--views", views, "--frames", frames,
-                        "--modes", ",".join(m for _, m in modes), vd], capture_output=True, text=True)
-    if p.returncode != 0:
-        if "EGL" in p.stderr or "context" in p.stderr or "display" in p.stderr:
-            print("no GL context: skipped\n" + p.stderr)
-            sys.exit(77)
-        print("FAIL: vdsh-view: " + p.stderr)
-        sys.exit(1)
+    testlib.view_frames(view, views, frames, [m for _, m in modes], vd)
     for order, mode in modes:
         shot = os.path.join(work, "web-%s-%s.png" % (name, order))
         q = ("glb=%s.glb&order=%s&output=shadow&size=%dx%d&eye=%s&target=%s&up=0,1,0&fov=60&light=%s"

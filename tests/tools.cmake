@@ -1,6 +1,7 @@
 # Tests of tools/ (what every program shares: vt_cli numbers, vt_json) and
 # of the programs' shared behaviour. Every test name starts with "tools".
-#   tools_unit   test_tools.c: the number rules, JSON strings (any bytes),
+#   tools_numbers_json_png_views
+#                test_tools.c: the number rules, JSON strings (any bytes),
 #                exact numbers, NaN as null, the reader
 #   tools_cli    test_tools_cli.py: every program end to end - JSON with odd
 #                paths parses, one value means one number everywhere, bad
@@ -11,7 +12,7 @@
 #                strict (no duplicate keys), progress in logs
 add_executable(test_tools ${CMAKE_CURRENT_LIST_DIR}/test_tools.c)
 target_link_libraries(test_tools PRIVATE vt_tools m)
-add_test(NAME tools_unit COMMAND test_tools ${CMAKE_CURRENT_BINARY_DIR}/tools_unit)
+add_test(NAME tools_numbers_json_png_views COMMAND test_tools ${CMAKE_CURRENT_BINARY_DIR}/tools_unit)
 
 find_package(Python3 COMPONENTS Interpreter QUIET)
 if(Python3_Interpreter_FOUND)

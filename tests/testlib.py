@@ -1,0 +1,52 @@
+"""testlib - what the Python tests in tests/ share (imported from the
+test's own folder, which Python puts first on sys.path)."""
+import json
+import os
+import subprocess
+import sys
+
+
+def checker(fails):
+    """check(ok, what): a failed check is appended to `fails` and printed."""
+    def check(ok, what):
+        if not ok:
+            fails.append(what)
+            print("FAIL: " + what, file=sys.stderr)
+    return check
+
+
+def pip_install(pkg, target):
+    """python/ (pkg) installed with Debian's pip into `target`: no network,
+    no build isolation, no dependencies. The finished process."""
+    return subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-build-isolation",
+                           "--no-deps", "--no-index", "--target", target, pkg],
+                          capture_output=True, text=True)
+
+
+def bake_room(bake, out, max_edge, rays, args):
+    """vdsh-bake builtin:room at this edge and ray count, no cubemaps, -o
+    out, then args: None when it succeeds, else its stderr."""
+    r = subprocess.run([bake, "builtin:room", "--max-edge", max_edge, "--rays", rays, "-q",
+                        "--cube-size", "0", "-o", out] + args, capture_output=True, text=True)
+    return r.stderr.strip() if r.returncode else None
+
+
+def write_view(path, name, width, height, eye, target, light_sets):
+    """A view set of one view (up +y, 60 degrees) at `path`."""
+    json.dump({"width": width, "height": height,
+               "views": [{"name": name, "eye": eye, "target": target, "up": [0, 1, 0],
+                          "fov_y": 60, "light_sets": light_sets}]}, open(path, "w"))
+
+
+def view_frames(view, views, frames, modes, vd):
+    """vdsh-view's shadow-only frames of `vd` for the view set into
+    `frames`, in each of `modes`; exits 77 without a GL context, 1 when
+    vdsh-view fails otherwise."""
+    p = subprocess.run([view, "-q", "--views", views, "--frames", frames, "--modes", ",".join(modes), vd],
+                       capture_output=True, text=True)
+    if p.returncode != 0:
+        if "EGL" in p.stderr or "context" in p.stderr or "display" in p.stderr:
+            print("no GL context: skipped\n" + p.stderr)
+            sys.exit(77)
+        print("FAIL: vdsh-view: " + p.stderr)
+        sys.exit(1)
