@@ -1,8 +1,8 @@
 /*
  * mesh.c - loading (dispatch, file bytes, hashing, validation and
  * cleaning), welding, normals, appending, bounds and OBJ output for
- * vb_mesh. Reading a file's bytes into arrays is mesh_parse.cpp's
- * (mesh_parse.h); refinement, the one part on OpenMesh, is
+ * vb_mesh. Reading a file's bytes into arrays is mesh_parse.cpp's and
+ * its readers' (mesh_parse.h); refinement, the one part on OpenMesh, is
  * mesh_refine.cpp's; SHA-256 is nettle's.
  */
 #include "mesh.h"

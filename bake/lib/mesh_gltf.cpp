@@ -30,7 +30,7 @@
 
 #include <tiny_gltf.h>
 
-#include "mesh_parse.h"
+#include "mesh_read.h"
 
 namespace {
 
@@ -385,16 +385,6 @@ bool no_images(tinygltf::Image *, const int, std::string *, std::string *, int, 
     return true;
 }
 
-template <class T> T *copy_out(const std::vector<T> &v)
-{
-    T *p = (T *)malloc(v.empty() ? 1 : v.size() * sizeof(T));
-    if (!p)
-        throw std::bad_alloc();
-    if (!v.empty())
-        memcpy(p, v.data(), v.size() * sizeof(T));
-    return p;
-}
-
 vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, size_t size, vb_mesh_raw *out,
                 vb_error *err)
 {
@@ -451,18 +441,18 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     raw.gltf_skipped_morph = o.skipped_morph;
     raw.gltf_skipped_skin = o.skipped_skin;
     try {
-        raw.positions = copy_out(o.pos);
-        raw.indices = copy_out(o.idx);
+        raw.positions = vb_read::malloc_copy(o.pos);
+        raw.indices = vb_read::malloc_copy(o.idx);
         std::vector<uint32_t> faces(raw.triangle_count);
         for (uint32_t t = 0; t < raw.triangle_count; t++)
             faces[t] = t;
-        raw.faces = copy_out(faces);
+        raw.faces = vb_read::malloc_copy(faces);
         bool any = false;
         for (uint8_t h : o.has_n)
             any = any || h;
         if (any) {
-            raw.normals = copy_out(o.nrm);
-            raw.has_normal = copy_out(o.has_n);
+            raw.normals = vb_read::malloc_copy(o.nrm);
+            raw.has_normal = vb_read::malloc_copy(o.has_n);
         }
     } catch (...) {
         vb_mesh_raw_free(&raw);
@@ -480,13 +470,6 @@ extern "C" vb_result vb_mesh_parse_gltf(const char *name, int binary, int scene,
     if (!name || (!bytes && size) || !out)
         return vb_fail(err, VB_ERR_ARGUMENT, "vb_mesh_parse_gltf: NULL argument");
     static const uint8_t nothing = 0;
-    try {
-        return parse(name, binary, scene, bytes ? bytes : &nothing, size, out, err);
-    } catch (const std::bad_alloc &) {
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory while reading", name);
-    } catch (const std::exception &e) {
-        return vb_fail(err, VB_ERR_FORMAT, "%s: reading failed: %s", name, e.what());
-    } catch (...) {
-        return vb_fail(err, VB_ERR_FORMAT, "%s: reading failed with an unknown exception", name);
-    }
+    const uint8_t *b = bytes ? bytes : &nothing;
+    return vb_read::no_throw(name, err, [&] { return parse(name, binary, scene, b, size, out, err); });
 }

@@ -7,7 +7,7 @@
  * (the edges around a vertex, the faces on an edge, splitting an edge and
  * both its triangles), and its refusal of non-manifold faces is what tells
  * which triangles get private vertices. Reading files does not use it
- * (mesh_parse.cpp).
+ * (mesh_parse.cpp, mesh_obj/ply/off/stl.cpp).
  *
  * OpenMesh prints warnings (a refused face: "complex edge") to its
  * omerr/omlog/omout streams, which forward to std::cerr/clog/cout. While
