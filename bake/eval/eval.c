@@ -39,15 +39,6 @@ enum {
     PURPOSE_SCENE_LIGHTS = 0x53434e4cu /* "SCNL" */
 };
 
-static uint64_t purpose_seed(uint64_t seed, uint32_t purpose)
-{
-    /* splitmix64 finaliser over (seed, purpose) */
-    uint64_t z = seed ^ ((uint64_t)purpose * 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
 /* ---- distance-error histogram ------------------------------------------
  * Bin 0: exactly 0; bin 1: (0, 1e-6); then 100 bins per decade up to 1e4;
  * the last bin: 1e4 and above (and NaN). Percentiles are read at a bin's
@@ -482,7 +473,7 @@ int vb_eval_interior_point(const double *cdf, uint32_t triangle_count,
 {
     if (triangle_count == 0 || !(cdf[triangle_count - 1] > 0.0))
         return 0;
-    uint64_t s = purpose_seed(seed, PURPOSE_INTERIOR);
+    uint64_t s = vb_purpose_seed(seed, PURPOSE_INTERIOR);
     float u1, u2, u3, u4;
     vb_hash2(s, j, 0, &u1, &u2);
     vb_hash2(s, j, 1, &u3, &u4);
@@ -519,7 +510,7 @@ uint32_t vb_eval_directions(uint64_t seed, uint32_t directions, uint32_t id,
     vb_dirgrid g = {0};
     if (vb_dirgrid_create(directions, 1, &g, NULL) != VB_OK)
         return 0;
-    uint64_t ds = purpose_seed(seed, PURPOSE_DIRECTIONS);
+    uint64_t ds = vb_purpose_seed(seed, PURPOSE_DIRECTIONS);
     uint32_t got = 0;
     for (uint32_t pk = 0; pk < g.packet_count; pk++) {
         float x[16], y[16], z[16];
@@ -823,7 +814,7 @@ static vb_result pick_vertices(uint32_t V, uint32_t want, uint64_t seed,
             free(v);
             return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u vertices", V);
         }
-        uint64_t s = purpose_seed(seed, PURPOSE_VERTICES);
+        uint64_t s = vb_purpose_seed(seed, PURPOSE_VERTICES);
         for (uint32_t i = 0; i < V; i++) {
             float a, b;
             vb_hash2(s, i, 0, &a, &b);
@@ -1008,7 +999,7 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the scene lights");
             goto done;
         }
-        r = vb_scene_place_lights_rule(d.scene, purpose_seed(d.seed, PURPOSE_SCENE_LIGHTS), nl,
+        r = vb_scene_place_lights_rule(d.scene, vb_purpose_seed(d.seed, PURPOSE_SCENE_LIGHTS), nl,
                                        (vb_light_rule)d.light_rule, o.lights,
                                        &o.light_candidates, err);
         if (r != VB_OK)
@@ -1020,8 +1011,8 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
         J->lights = (const float(*)[3])o.lights;
         J->lights_local = (const float(*)[3])lights_local;
     }
-    J->dir_seed = purpose_seed(d.seed, PURPOSE_DIRECTIONS);
-    J->light_seed = purpose_seed(d.seed, PURPOSE_LIGHTS);
+    J->dir_seed = vb_purpose_seed(d.seed, PURPOSE_DIRECTIONS);
+    J->light_seed = vb_purpose_seed(d.seed, PURPOSE_LIGHTS);
     J->max_distance = f->header.max_distance;
     J->max_local = f->header.max_distance * d.scene->scale;
     J->inv_scale = 1.0f / d.scene->scale;

@@ -31,6 +31,7 @@
 #include <tiny_gltf.h>
 
 #include "mesh_read.h"
+#include "vdsh_math.h"
 
 namespace {
 
@@ -211,14 +212,8 @@ typedef std::array<double, 16> mat4; /* column-major, as glTF */
 
 mat4 mul(const mat4 &a, const mat4 &b)
 {
-    mat4 c{};
-    for (int i = 0; i < 4; i++)
-        for (int j = 0; j < 4; j++) {
-            double s = 0;
-            for (int k = 0; k < 4; k++)
-                s += a[(size_t)(k * 4 + i)] * b[(size_t)(j * 4 + k)];
-            c[(size_t)(j * 4 + i)] = s;
-        }
+    mat4 c;
+    vdsh_mat4d_mul(a.data(), b.data(), c.data());
     return c;
 }
 
@@ -230,19 +225,10 @@ mat4 node_matrix(const tinygltf::Node &n)
             m[i] = n.matrix[i];
         return m;
     }
-    mat4 t = m, r = m, s = m;
-    if (n.translation.size() == 3)
-        t[12] = n.translation[0], t[13] = n.translation[1], t[14] = n.translation[2];
-    if (n.rotation.size() == 4) {
-        double x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
-        r = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0,
-             2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0,
-             2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0,
-             0, 0, 0, 1};
-    }
-    if (n.scale.size() == 3)
-        s[0] = n.scale[0], s[5] = n.scale[1], s[10] = n.scale[2];
-    return mul(t, mul(r, s));
+    vdsh_mat4d_trs(n.translation.size() == 3 ? n.translation.data() : nullptr,
+                   n.rotation.size() == 4 ? n.rotation.data() : nullptr,
+                   n.scale.size() == 3 ? n.scale.data() : nullptr, m.data());
+    return m;
 }
 
 struct out_mesh {
@@ -301,9 +287,9 @@ vb_result add_primitive(const reader &rd, const tinygltf::Primitive &p, const ma
             double t[3];
             for (int r3 = 0; r3 < 3; r3++)
                 t[r3] = cof[3 * r3] * n[0] + cof[3 * r3 + 1] * n[1] + cof[3 * r3 + 2] * n[2];
-            double l = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-            for (int r3 = 0; r3 < 3; r3++)
-                o.nrm.push_back(l > 0 && std::isfinite(l) ? (float)(t[r3] / l) : 0.0f);
+            float u[3];
+            vdsh_unit3d_to_f(t, u);
+            o.nrm.insert(o.nrm.end(), {u[0], u[1], u[2]});
             o.has_n.push_back(1);
         } else {
             o.nrm.insert(o.nrm.end(), {0.0f, 0.0f, 0.0f});

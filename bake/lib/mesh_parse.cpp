@@ -28,6 +28,7 @@
  * difference is refused, never a silently partial mesh.
  */
 #include "mesh_read.h"
+#include "vdsh_math.h"
 
 #include <algorithm>
 #include <array>
@@ -162,22 +163,13 @@ void builder::set_normal(int64_t v, const float n[3])
     if (has_normal[i] == 1) {
         if (sum[0] == n[0] && sum[1] == n[1] && sum[2] == n[2])
             return;
-        unit(sum);
+        vdsh_unit3f_keep(sum);
         has_normal[i] = 2;
     }
     float u[3] = {n[0], n[1], n[2]};
-    unit(u);
+    vdsh_unit3f_keep(u);
     for (int k = 0; k < 3; k++)
         sum[k] += u[k];
-}
-
-void builder::unit(float *n)
-{
-    double len = std::sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-    if (std::fabs(len - 1.0) <= 4.0 * FLT_EPSILON)
-        return;
-    for (int k = 0; k < 3; k++)
-        n[k] = len > 0.0 && std::isfinite(len) ? (float)(n[k] / len) : 0.0f;
 }
 
 void builder::finish(uint64_t dropped, vb_mesh_raw *out)
@@ -195,7 +187,7 @@ void builder::finish(uint64_t dropped, vb_mesh_raw *out)
             normal_sums.resize(3 * nv, 0.0f);
             has_normal.resize(nv, 0);
             for (size_t i = 0; i < nv; i++)
-                unit(&normal_sums[3 * i]);
+                vdsh_unit3f_keep(&normal_sums[3 * i]);
             for (uint8_t &h : has_normal)
                 h = h != 0;
             raw.normals = malloc_copy(normal_sums);

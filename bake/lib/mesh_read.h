@@ -237,13 +237,9 @@ public:
      * normal (or the same one each time) is kept as it is when it is
      * already unit length, so that writing and reading back a mesh
      * reproduces its normals bit for bit. has_normal: 0 none, 1 one value
-     * in normal_sums as given, 2 a sum of unit vectors. Non-finite normals
-     * and vertices that do not exist are ignored. */
+     * in normal_sums as given, 2 a sum of unit vectors (vdsh_unit3f_keep).
+     * Non-finite normals and vertices that do not exist are ignored. */
     void set_normal(int64_t v, const float n[3]);
-
-    /* n scaled to unit length, (0,0,0) if it has none; a vector already
-     * unit to float precision is left alone. */
-    static void unit(float *n);
 
     /* Hand over malloc'ed arrays (mesh.c frees them with free()). */
     void finish(uint64_t dropped, vb_mesh_raw *out);
