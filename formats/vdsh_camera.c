@@ -45,10 +45,5 @@ void vdsh_camera_projection(const vdsh_camera *c, float aspect, float znear, flo
                             float out[16])
 {
     float t = 1.0f / tanf(0.5f * vdsh_camera_fov(c) * 3.14159265358979f / 180.0f);
-    memset(out, 0, 16 * sizeof(float));
-    out[0] = t / aspect;
-    out[5] = t;
-    out[10] = (zfar + znear) / (znear - zfar);
-    out[11] = -1.0f;
-    out[14] = 2.0f * zfar * znear / (znear - zfar);
+    vdsh_perspective(t, aspect, znear, zfar, out);
 }

@@ -100,6 +100,17 @@ static inline void vdsh_view_matrix(const float s[3], const float u[3], const fl
     memcpy(out, m, sizeof m);
 }
 
+/* The GL projection matrix (column-major) for t = 1 / tan(fov_y / 2). */
+static inline void vdsh_perspective(float t, float aspect, float znear, float zfar, float out[16])
+{
+    memset(out, 0, 16 * sizeof(float));
+    out[0] = t / aspect;
+    out[5] = t;
+    out[10] = (zfar + znear) / (znear - zfar);
+    out[11] = -1.0f;
+    out[14] = 2.0f * zfar * znear / (znear - zfar);
+}
+
 /* c = a b for column-major 4 x 4 matrices in double; c may be a or b. */
 static inline void vdsh_mat4d_mul(const double *a, const double *b, double *c)
 {

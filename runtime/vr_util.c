@@ -167,12 +167,7 @@ void vr_mat4_perspective(float out[16], float fov_y_rad, float aspect,
                          float znear, float zfar)
 {
     float t = 1.0f / tanf(0.5f * fov_y_rad);
-    memset(out, 0, 16 * sizeof(float));
-    out[0] = t / aspect;
-    out[5] = t;
-    out[10] = (zfar + znear) / (znear - zfar);
-    out[11] = -1.0f;
-    out[14] = 2.0f * zfar * znear / (znear - zfar);
+    vdsh_perspective(t, aspect, znear, zfar, out);
 }
 
 void vr_mat4_ortho(float out[16], float half_w, float half_h, float znear,

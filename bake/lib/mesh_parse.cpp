@@ -50,15 +50,23 @@ namespace vb_read {
 /* Numbers                                                                */
 /* ====================================================================== */
 
-num_status parse_float(const token &t, float *out)
+/* Where t's number starts after an optional '+' (which std::from_chars
+ * does not take); NULL when nothing follows or a second sign does. */
+static const char *after_plus(const token &t)
 {
     const char *b = t.b;
     if (b < t.e && *b == '+') {
         b++;
         if (b < t.e && (*b == '-' || *b == '+'))
-            return NUM_BAD;
+            return nullptr;
     }
-    if (b >= t.e)
+    return b < t.e ? b : nullptr;
+}
+
+num_status parse_float(const token &t, float *out)
+{
+    const char *b = after_plus(t);
+    if (!b)
         return NUM_BAD;
     float f = 0.0f;
     std::from_chars_result r = std::from_chars(b, t.e, f, std::chars_format::general);
@@ -81,13 +89,8 @@ num_status parse_float(const token &t, float *out)
 
 bool parse_int(const token &t, long long *out)
 {
-    const char *b = t.b;
-    if (b < t.e && *b == '+') {
-        b++;
-        if (b < t.e && (*b == '-' || *b == '+'))
-            return false;
-    }
-    if (b >= t.e)
+    const char *b = after_plus(t);
+    if (!b)
         return false;
     long long v = 0;
     std::from_chars_result r = std::from_chars(b, t.e, v, 10);

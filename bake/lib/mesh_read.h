@@ -82,13 +82,7 @@ struct cursor {
                 line++;
             p++;
         }
-        if (p >= end)
-            return false;
-        t->b = p;
-        while (p < end && !is_blank(*p) && *p != '\n')
-            p++;
-        t->e = p;
-        return true;
+        return p < end && take(t);
     }
 
     /* Next token on the current line only; false at the end of the line. */
@@ -96,13 +90,7 @@ struct cursor {
     {
         while (p < end && is_blank(*p))
             p++;
-        if (p >= end || *p == '\n')
-            return false;
-        t->b = p;
-        while (p < end && !is_blank(*p) && *p != '\n')
-            p++;
-        t->e = p;
-        return true;
+        return p < end && *p != '\n' && take(t);
     }
 
     /* Skip the rest of the current line and its '\n' (std::getline). */
@@ -115,6 +103,17 @@ struct cursor {
         } else {
             p = end;
         }
+    }
+
+private:
+    /* The token starting at p (not a blank). */
+    bool take(token *t)
+    {
+        t->b = p;
+        while (p < end && !is_blank(*p) && *p != '\n')
+            p++;
+        t->e = p;
+        return true;
     }
 };
 

@@ -75,6 +75,19 @@ struct stl_merger {
     }
 };
 
+/* Tiny coordinates (within FLT_MIN of each other but not equal) can
+ * make the merging disagree with the count of triangles whose corners
+ * differ: refused. */
+vb_result merged_as_counted(const char *path, const builder &out, const expectation *ex, vb_error *err)
+{
+    if (out.polygons != ex->faces)
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: coordinates that differ by less than FLT_MIN (%g) make it ambiguous which corners "
+                       "are the same vertex (%llu or %llu triangles)", path, (double)FLT_MIN,
+                       (unsigned long long)out.polygons, (unsigned long long)ex->faces);
+    return VB_OK;
+}
+
 } // namespace
 
 /* Binary when the file is exactly 84 + 50 * (count at byte 80) bytes
@@ -108,12 +121,7 @@ vb_result read_stl(const char *path, const uint8_t *bytes, size_t size, builder 
             }
             merge.facet(v, out);
         }
-        if (out.polygons != ex->faces)
-            return vb_fail(err, VB_ERR_FORMAT,
-                           "%s: coordinates that differ by less than FLT_MIN (%g) make it ambiguous which "
-                           "corners are the same vertex (%llu or %llu triangles)", path, (double)FLT_MIN,
-                           (unsigned long long)out.polygons, (unsigned long long)ex->faces);
-        return VB_OK;
+        return merged_as_counted(path, out, ex, err);
     }
 
     cursor c(bytes, size);
@@ -188,14 +196,7 @@ vb_result read_stl(const char *path, const uint8_t *bytes, size_t size, builder 
         return vb_fail(err, VB_ERR_FORMAT, "%s: ascii STL ends without 'endsolid' after its last facet (truncated?)",
                        path);
     }
-    /* Tiny coordinates (within FLT_MIN of each other but not equal) can
-     * make the merging disagree with the count above. */
-    if (out.polygons != ex->faces)
-        return vb_fail(err, VB_ERR_FORMAT,
-                       "%s: coordinates that differ by less than FLT_MIN (%g) make it ambiguous which corners "
-                       "are the same vertex (%llu or %llu triangles)", path, (double)FLT_MIN,
-                       (unsigned long long)out.polygons, (unsigned long long)ex->faces);
-    return VB_OK;
+    return merged_as_counted(path, out, ex, err);
 }
 
 } // namespace vb_read
