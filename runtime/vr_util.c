@@ -3,7 +3,6 @@
  * matrix arithmetic the runtime needs.
  */
 #include "vr_internal.h"
-#include "vdsh_math.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -155,19 +154,52 @@ void vr_mat4_mul(float out[16], const float a[16], const float b[16])
     memcpy(out, r, sizeof r);
 }
 
+static void normalize3(float v[3])
+{
+    float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (l > 0.0f) {
+        v[0] /= l;
+        v[1] /= l;
+        v[2] /= l;
+    }
+}
+
+static void cross3(float o[3], const float a[3], const float b[3])
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 void vr_mat4_look_at(float out[16], const float eye[3], const float target[3],
                      const float up[3])
 {
-    float s[3], u[3], f[3];
-    vdsh_look_at(eye, target, up, s, u, f);
-    vdsh_view_matrix(s, u, f, eye, out);
+    float f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]};
+    normalize3(f);
+    float s[3], u[3];
+    cross3(s, f, up);
+    normalize3(s);
+    cross3(u, s, f);
+    const float m[16] = {
+        s[0], u[0], -f[0], 0.0f,
+        s[1], u[1], -f[1], 0.0f,
+        s[2], u[2], -f[2], 0.0f,
+        -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]),
+        -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]),
+        f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2], 1.0f};
+    memcpy(out, m, sizeof m);
 }
 
 void vr_mat4_perspective(float out[16], float fov_y_rad, float aspect,
                          float znear, float zfar)
 {
     float t = 1.0f / tanf(0.5f * fov_y_rad);
-    vdsh_perspective(t, aspect, znear, zfar, out);
+    memset(out, 0, 16 * sizeof(float));
+    out[0] = t / aspect;
+    out[5] = t;
+    out[10] = (zfar + znear) / (znear - zfar);
+    out[11] = -1.0f;
+    out[14] = 2.0f * zfar * znear / (znear - zfar);
 }
 
 void vr_mat4_ortho(float out[16], float half_w, float half_h, float znear,
