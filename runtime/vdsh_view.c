@@ -146,8 +146,18 @@ static int usage_error(const char *fmt, const char *arg)
     return vt_usage_error("vdsh-view", fmt, arg);
 }
 
+/* Option opt's value v, one of a (*out 0) and b (*out 1): 0, or the
+ * usage error. */
+static int pick(const char *opt, const char *v, const char *a, const char *b, int *out)
+{
+    *out = !strcmp(v, b);
+    if (*out || !strcmp(v, a))
+        return 0;
+    return vt_usage_error("vdsh-view", "%s: expected %s or %s, got '%s'", opt, a, b, v);
+}
+
 /* A buffer mode asks for its stream; orders 1-5 are buffered on request. */
-static void note_buffer(vv_options *o, const vv_frame_mode *m)
+static void note_buffer(vv_options *o, const vv_mode *m)
 {
     if (m->mode == VR_MODE_VDSH_BUFFER && m->stream >= 1 && m->stream <= 5)
         o->buffers = 1;
@@ -161,7 +171,7 @@ static int parse_modes(const char *list, vv_options *o)
     const char *p = list;
     for (;;) {
         size_t len = strcspn(p, ",");
-        int found = vv_frame_mode_find(p, len);
+        int found = vv_mode_find(p, len, VV_MODE_FRAMES);
         if (found < 0)
             return -1;
         int seen = 0;
@@ -169,7 +179,7 @@ static int parse_modes(const char *list, vv_options *o)
             seen |= o->frame_modes[i] == found;
         if (!seen) {
             o->frame_modes[o->frame_mode_count++] = found;
-            note_buffer(o, &vv_frame_modes[found]);
+            note_buffer(o, &vv_modes[found]);
         }
         if (!p[len])
             return 0;
@@ -227,6 +237,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
     int c;
     while ((c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
         const char *v = optarg;
+        int which, rc;
         switch (c) {
         case 'h':
             fputs(usage_text, stdout);
@@ -282,26 +293,23 @@ static int parse_args(int argc, char **argv, vv_options *o)
                 return usage_error("--ambient: expected a value >= 0, got '%s'", v);
             o->have_ambient = 1;
             break;
-        case O_MODE:
-            if (vr_mode_from_name(v, &o->mode)) {
-                int i = vv_frame_mode_find(v, strlen(v));
-                if (i < 0 || vv_frame_modes[i].mode != VR_MODE_VDSH_BUFFER)
-                    return usage_error("--mode: expected none, cube, vdsh2, vdsh3, vdsh5, "
-                                       "vdsh5poly, buffer, bufN (N = 1..16) or adaptive, "
-                                       "got '%s'", v);
-                o->mode = VR_MODE_VDSH_BUFFER;
-                o->stream = vv_frame_modes[i].stream;
-                note_buffer(o, &vv_frame_modes[i]);
-            }
+        case O_MODE: {
+            int i = vv_mode_find(v, strlen(v), VV_MODE_OPTION);
+            if (i < 0)
+                return usage_error("--mode: expected none, cube, vdsh2, vdsh3, vdsh5, "
+                                   "vdsh5poly, buffer, bufN (N = 1..16) or adaptive, "
+                                   "got '%s'", v);
+            o->mode = vv_modes[i].mode;
+            if (vv_modes[i].stream) /* the others keep a stream given before */
+                o->stream = vv_modes[i].stream;
+            note_buffer(o, &vv_modes[i]);
             o->have_mode = 1;
             break;
+        }
         case O_COMPARE:
-            if (!strcmp(v, "smooth"))
-                o->compare = VDSH_COMPARE_SMOOTH;
-            else if (!strcmp(v, "binary"))
-                o->compare = VDSH_COMPARE_BINARY;
-            else
-                return usage_error("--compare: expected smooth or binary, got '%s'", v);
+            if ((rc = pick("--compare", v, "smooth", "binary", &which)) != 0)
+                return rc;
+            o->compare = which ? VDSH_COMPARE_BINARY : VDSH_COMPARE_SMOOTH;
             break;
         case O_PCF: o->pcf = 1; break;
         case O_SDF: o->sdf_path = v; break;
@@ -320,12 +328,9 @@ static int parse_args(int argc, char **argv, vv_options *o)
             break;
         case O_NO_CUBEMAPS: o->no_cubemaps = 1; break;
         case O_EGL:
-            if (!strcmp(v, "device"))
-                o->egl = VR_EGL_DEVICE;
-            else if (!strcmp(v, "surfaceless"))
-                o->egl = VR_EGL_SURFACELESS;
-            else
-                return usage_error("--egl: expected device or surfaceless, got '%s'", v);
+            if ((rc = pick("--egl", v, "device", "surfaceless", &which)) != 0)
+                return rc;
+            o->egl = which ? VR_EGL_SURFACELESS : VR_EGL_DEVICE;
             break;
         case O_FRAMES: o->frames_arg = v; break;
         case O_VIEWS: o->views_path = v; break;

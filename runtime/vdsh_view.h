@@ -1,6 +1,6 @@
 /*
  * vdsh_view.h - what the files of vdsh-view share (prefix vv_): its
- * options, the frame modes of --views, the scene defaults it draws with
+ * options, its render modes, the scene defaults it draws with
  * (lights, camera, the base draw descriptor), the session (a context, the
  * scene, a renderer) and PNG output. One mode of the program per file,
  * over this small core:
@@ -24,7 +24,7 @@
 #include "vr.h"
 #include "vr_context.h"
 
-enum { VV_MAX_LIGHTS = 64, VV_MAX_FILES = 8 };
+enum { VV_MAX_LIGHTS = 64, VV_MAX_FILES = 8, VV_MAX_MODES = 32 };
 
 typedef struct vv_options {
     const char *render_path, *grid_path;
@@ -71,31 +71,54 @@ typedef struct vv_options {
     const char *views_path;    /* --views: frames for a view set */
     const char *frames_arg;    /* --frames: a count, or with --views the folder */
     const char *frames_dir;
-    int frame_modes[32];       /* --modes: indices into vv_frame_modes[] */
+    int frame_modes[VV_MAX_MODES]; /* --modes: indices into vv_modes[] */
     int frame_mode_count;
     int buffers;               /* load orders 1-5 as buffers too (a bufN mode
                                   of such an order, or --bench) */
 } vv_options;
 
-/* The modes frames are rendered in, by file name (--modes; --mode takes
- * the buffer ones too); the first VV_FRAME_DEFAULT_MODES are the default,
- * where the scene has them. Then "none", "bufN" (N = 1..16: the fixed
- * stream of order N from its buffer, VR_MODE_VDSH_BUFFER; only orders up
- * to VDSH_MAX_ORDER can exist) and "adaptive" (the stream with an order
- * per vertex). */
-typedef struct vv_frame_mode {
-    const char *name;
+/* The viewer's render modes: the one list that --mode, --modes, the frame
+ * file names, --bench (its modes and JSON keys), the --grid columns and
+ * the window's digit keys all read (vdsh_view_core.c). A new render mode
+ * is a row there plus its own code (vr.h and the runtime's mode table in
+ * vr_util.c, vr_scene_supports, its shaders); the help texts
+ * (vdsh_view.c, the window's key list) say it in words.
+ *
+ * Two spellings: `name` is the command line's and the frame files'
+ * (cube-pcf), `json` the --bench JSON's and --bench-modes' (cube_pcf);
+ * they differ for that mode only, and both stay: outputs and the scripts
+ * that read them use each. The buffer modes: "bufN" (N = 1..16: the
+ * fixed stream of order N from its buffer, VR_MODE_VDSH_BUFFER; only
+ * orders up to VDSH_MAX_ORDER can exist), "adaptive" (the stream with an
+ * order per vertex) and "buffer" (the scene's default of those). */
+typedef struct vv_mode {
+    const char *name;          /* --mode, --modes, frame file names */
+    const char *json;          /* --bench's JSON and --bench-modes */
     vr_mode mode;
     int pcf;
     int stream;                /* VR_MODE_VDSH_BUFFER: vr_draw_desc.stream */
-} vv_frame_mode;
+    unsigned flags;            /* VV_MODE_* below */
+    int grid;                  /* --grid: its column, 1..; 0 none. Several
+                                  rows in a column: the first the scene
+                                  has, else the last */
+    char key;                  /* the window: its digit key, 0 none */
+} vv_mode;
 
-enum { VV_FRAME_MODES = 25, VV_FRAME_DEFAULT_MODES = 6 };
-extern const vv_frame_mode vv_frame_modes[VV_FRAME_MODES];
-/* Index of a mode name in vv_frame_modes, or -1. */
-int vv_frame_mode_find(const char *name, size_t len);
-/* 1 when the scene can draw frame mode m (its stream, its cubemaps). */
-int vv_frame_mode_available(const vr_scene *s, const vv_frame_mode *m);
+enum {
+    VV_MODE_OPTION = 1,        /* --mode takes it */
+    VV_MODE_FRAMES = 2,        /* --modes takes it */
+    VV_MODE_FRAMES_DEFAULT = 4, /* --views without --modes, where the scene has it */
+    VV_MODE_BENCH = 8,         /* --bench, where the scene has it */
+    VV_MODE_BENCH_LOG = 16     /* --bench on a log-distance scene, where it has it */
+};
+
+/* The rows, ended by one whose name is NULL; at most VV_MAX_MODES. */
+extern const vv_mode vv_modes[];
+/* Index of the mode called `name` (its first len characters) that has
+ * `flag` (0: any), or -1. */
+int vv_mode_find(const char *name, size_t len, unsigned flag);
+/* 1 when the scene can draw mode m (its stream, its cubemaps). */
+int vv_mode_available(const vr_scene *s, const vv_mode *m);
 /* A label for m in this scene: vr_scene_mode_label, or for a buffer
  * mode its order (cap and mean order of an adaptive stream). */
 void vv_mode_label(const vr_scene *s, vr_mode mode, int stream, char *out, size_t size);

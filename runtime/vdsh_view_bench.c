@@ -115,16 +115,26 @@ static void bench_filter(const vv_options *o, bench_scene *b)
     b->nm = k;
 }
 
-/* --bench-cube-sizes: cubeN and cube_pcfN, drawn by renderer 1 + i. */
+/* A row of vv_modes as a timed mode (its JSON name), drawn by renderer 0. */
+static bench_mode bench_row(const vv_mode *m, const char *name)
+{
+    return (bench_mode){m->mode, m->pcf, name, m->stream, 0, 0, 0};
+}
+
+/* --bench-cube-sizes: each cube mode at each size (cubeN and cube_pcfN),
+ * drawn by renderer 1 + i. */
 static void add_cube_sizes(const vv_options *o, bench_scene *b)
 {
-    static char names[8][2][24];
+    static char names[8][VV_MAX_MODES][24];
     for (int i = 0; i < o->bench_cube_count && b->nm < BENCH_MODES - 1; i++)
-        for (int pcf = 0; pcf < 2; pcf++) {
-            snprintf(names[i][pcf], sizeof names[i][pcf], "%s%d", pcf ? "cube_pcf" : "cube",
-                     o->bench_cube_sizes[i]);
-            b->modes[b->nm++] = (bench_mode){VR_MODE_CUBE, pcf, names[i][pcf], 0, 0, 1 + i,
-                                             o->bench_cube_sizes[i]};
+        for (int k = 0; vv_modes[k].name; k++) {
+            const vv_mode *m = &vv_modes[k];
+            if (!(m->flags & VV_MODE_BENCH) || m->mode != VR_MODE_CUBE)
+                continue;
+            snprintf(names[i][k], sizeof names[i][k], "%s%d", m->json, o->bench_cube_sizes[i]);
+            b->modes[b->nm] = bench_row(m, names[i][k]);
+            b->modes[b->nm].renderer = 1 + i;
+            b->modes[b->nm++].cube_size = o->bench_cube_sizes[i];
         }
 }
 
@@ -137,17 +147,9 @@ static void add_buffer_modes(bench_scene *b)
     vr_scene_get_info(b->scene, &info);
     if (info.quantity != VDSH_QUANTITY_LOG_DISTANCE)
         return;
-    char name[16];
-    for (int k = 5; k <= VDSH_MAX_ORDER && b->nm < BENCH_MODES - 1; k++) {
-        snprintf(name, sizeof name, "buf%d", k);
-        int i = vv_frame_mode_find(name, strlen(name));
-        if (i >= 0 && vr_scene_buffer_stream(b->scene, k) == k)
-            b->modes[b->nm++] =
-                (bench_mode){VR_MODE_VDSH_BUFFER, 0, vv_frame_modes[i].name, k, 0, 0, 0};
-    }
-    if (vr_scene_buffer_stream(b->scene, VR_STREAM_VARIABLE))
-        b->modes[b->nm++] =
-            (bench_mode){VR_MODE_VDSH_BUFFER, 0, "adaptive", VR_STREAM_VARIABLE, 0, 0, 0};
+    for (int k = 0; vv_modes[k].name && b->nm < BENCH_MODES - 1; k++)
+        if ((vv_modes[k].flags & VV_MODE_BENCH_LOG) && vv_mode_available(b->scene, &vv_modes[k]))
+            b->modes[b->nm++] = bench_row(&vv_modes[k], vv_modes[k].json);
 }
 
 /* --buffer-floats: each buffer mode again, from a copy of the scene
@@ -155,12 +157,7 @@ static void add_buffer_modes(bench_scene *b)
  * the bytes, no unpacking in the shader. */
 static int add_float_modes(bench_scene *b)
 {
-    static const char *const names[][2] = {
-        {"buf5", "buf5-f32"},   {"buf6", "buf6-f32"},   {"buf7", "buf7-f32"},
-        {"buf8", "buf8-f32"},   {"buf9", "buf9-f32"},   {"buf10", "buf10-f32"},
-        {"buf11", "buf11-f32"}, {"buf12", "buf12-f32"}, {"buf13", "buf13-f32"},
-        {"buf14", "buf14-f32"}, {"buf15", "buf15-f32"}, {"buf16", "buf16-f32"},
-        {"adaptive", "adaptive-f32"}};
+    static char names[VV_MAX_MODES][32];
     int n = b->nm, any = 0;
     for (int m = 0; m < n; m++)
         any |= b->modes[m].mode == VR_MODE_VDSH_BUFFER;
@@ -172,40 +169,38 @@ static int add_float_modes(bench_scene *b)
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
         return 1;
     }
-    for (int m = 0; m < n && b->nm < BENCH_MODES; m++)
-        for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
-            if (b->modes[m].mode == VR_MODE_VDSH_BUFFER && !strcmp(b->modes[m].name, names[k][0])) {
-                bench_mode f = b->modes[m];
-                f.name = names[k][1];
-                f.floats = 1;
-                b->modes[b->nm++] = f;
-            }
+    for (int m = 0; m < n && b->nm < BENCH_MODES; m++) {
+        int k = vv_mode_find(b->modes[m].name, strlen(b->modes[m].name), VV_MODE_BENCH_LOG);
+        if (b->modes[m].mode != VR_MODE_VDSH_BUFFER || k < 0)
+            continue;
+        snprintf(names[k], sizeof names[k], "%s-f32", vv_modes[k].json);
+        bench_mode f = b->modes[m];
+        f.name = names[k];
+        f.floats = 1;
+        b->modes[b->nm++] = f;
+    }
     return 0;
 }
 
 /* Load a scene and choose the modes it is timed in. */
 static int bench_open(const vv_options *o, const char *path, bench_scene *b)
 {
-    static const bench_mode all[8] = {
-        {VR_MODE_NONE, 0, "none", 0, 0, 0, 0},     {VR_MODE_CUBE, 0, "cube", 0, 0, 0, 0},
-        {VR_MODE_CUBE, 1, "cube_pcf", 0, 0, 0, 0}, {VR_MODE_VDSH2, 0, "vdsh2", 0, 0, 0, 0},
-        {VR_MODE_VDSH3, 0, "vdsh3", 0, 0, 0, 0},   {VR_MODE_VDSH5, 0, "vdsh5", 0, 0, 0, 0},
-        {VR_MODE_VDSH5_POLY, 0, "vdsh5poly", 0, 0, 0, 0}, {VR_MODE_SDF, 0, "sdf", 0, 0, 0, 0}};
     int shadow = o->shadow_size ? o->shadow_size : VR_DEFAULT_SHADOW_MAP_SIZE;
     b->path = path;
     if (vv_open_scene(o, path, &b->scene))
         return 1;
-    for (int i = 0; i < 8; i++) {
+    for (int i = 0; vv_modes[i].name; i++) {
+        const vv_mode *m = &vv_modes[i];
         /* On a log-distance scene both order-5 modes draw the same
          * per-vertex program: time it once, as vdsh5. */
-        int same = all[i].mode == VR_MODE_VDSH5_POLY &&
+        int same = m->mode == VR_MODE_VDSH5_POLY &&
                    vr_scene_supports(b->scene, VR_MODE_VDSH5) &&
                    vr_scene_interp(b->scene, VR_MODE_VDSH5) == VDSH_INTERP_DISTANCE;
         /* --bench-cube-sizes: the sized cubes replace cube and cube_pcf. */
-        int sized = all[i].mode == VR_MODE_CUBE && o->bench_cube_count;
-        if (vr_scene_supports(b->scene, all[i].mode) && !same && !sized) {
-            b->modes[b->nm] = all[i];
-            if (all[i].mode == VR_MODE_CUBE)
+        int sized = m->mode == VR_MODE_CUBE && o->bench_cube_count;
+        if ((m->flags & VV_MODE_BENCH) && vv_mode_available(b->scene, m) && !same && !sized) {
+            b->modes[b->nm] = bench_row(m, m->json);
+            if (m->mode == VR_MODE_CUBE)
                 b->modes[b->nm].cube_size = shadow;
             b->nm++;
         }

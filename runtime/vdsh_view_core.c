@@ -15,31 +15,46 @@
 #include <string.h>
 #include <time.h>
 
-const vv_frame_mode vv_frame_modes[VV_FRAME_MODES] = {
-    {"cube", VR_MODE_CUBE, 0, 0},       {"cube-pcf", VR_MODE_CUBE, 1, 0},
-    {"vdsh2", VR_MODE_VDSH2, 0, 0},     {"vdsh3", VR_MODE_VDSH3, 0, 0},
-    {"vdsh5", VR_MODE_VDSH5, 0, 0},     {"vdsh5poly", VR_MODE_VDSH5_POLY, 0, 0},
-    {"none", VR_MODE_NONE, 0, 0},
-    {"buf1", VR_MODE_VDSH_BUFFER, 0, 1},   {"buf2", VR_MODE_VDSH_BUFFER, 0, 2},
-    {"buf3", VR_MODE_VDSH_BUFFER, 0, 3},   {"buf4", VR_MODE_VDSH_BUFFER, 0, 4},
-    {"buf5", VR_MODE_VDSH_BUFFER, 0, 5},   {"buf6", VR_MODE_VDSH_BUFFER, 0, 6},
-    {"buf7", VR_MODE_VDSH_BUFFER, 0, 7},   {"buf8", VR_MODE_VDSH_BUFFER, 0, 8},
-    {"buf9", VR_MODE_VDSH_BUFFER, 0, 9},   {"buf10", VR_MODE_VDSH_BUFFER, 0, 10},
-    {"buf11", VR_MODE_VDSH_BUFFER, 0, 11}, {"buf12", VR_MODE_VDSH_BUFFER, 0, 12},
-    {"buf13", VR_MODE_VDSH_BUFFER, 0, 13}, {"buf14", VR_MODE_VDSH_BUFFER, 0, 14},
-    {"buf15", VR_MODE_VDSH_BUFFER, 0, 15}, {"buf16", VR_MODE_VDSH_BUFFER, 0, 16},
-    {"adaptive", VR_MODE_VDSH_BUFFER, 0, VR_STREAM_VARIABLE},
-    {"sdf", VR_MODE_SDF, 0, 0}};
+/* Row order is the order --bench times them in and the window's M key
+ * steps through; --views renders its defaults in this order too. */
+enum {
+    OPT = VV_MODE_OPTION, FRM = VV_MODE_FRAMES, DEF = VV_MODE_FRAMES_DEFAULT,
+    BEN = VV_MODE_BENCH, LOG = VV_MODE_BENCH_LOG
+};
+/* bufN: the order-N stream from its buffer; --bench times orders 5 and
+ * up (on log-distance scenes, beside vdsh5's attributes). */
+#define BUF(n, flags) {"buf" #n, "buf" #n, VR_MODE_VDSH_BUFFER, 0, n, OPT | FRM | (flags), 0, 0}
 
-int vv_frame_mode_find(const char *name, size_t len)
+const vv_mode vv_modes[] = {
+    /* name        json        mode                 pcf stream flags            grid key */
+    {"none",      "none",      VR_MODE_NONE,        0, 0, OPT | FRM | BEN,       1, '1'},
+    {"cube",      "cube",      VR_MODE_CUBE,        0, 0, OPT | FRM | DEF | BEN, 2, '2'},
+    {"cube-pcf",  "cube_pcf",  VR_MODE_CUBE,        1, 0, FRM | DEF | BEN,       0, 0},
+    {"vdsh2",     "vdsh2",     VR_MODE_VDSH2,       0, 0, OPT | FRM | DEF | BEN, 5, '3'},
+    {"vdsh3",     "vdsh3",     VR_MODE_VDSH3,       0, 0, OPT | FRM | DEF | BEN, 4, '4'},
+    {"vdsh5",     "vdsh5",     VR_MODE_VDSH5,       0, 0, OPT | FRM | DEF | BEN, 3, '5'},
+    {"vdsh5poly", "vdsh5poly", VR_MODE_VDSH5_POLY,  0, 0, OPT | FRM | DEF | BEN, 3, '6'},
+    {"sdf",       "sdf",       VR_MODE_SDF,         0, 0, OPT | FRM | BEN,       7, 0},
+    BUF(1, 0),   BUF(2, 0),   BUF(3, 0),   BUF(4, 0),   BUF(5, LOG),  BUF(6, LOG),
+    BUF(7, LOG), BUF(8, LOG), BUF(9, LOG), BUF(10, LOG), BUF(11, LOG), BUF(12, LOG),
+    BUF(13, LOG), BUF(14, LOG), BUF(15, LOG), BUF(16, LOG),
+    {"adaptive",  "adaptive",  VR_MODE_VDSH_BUFFER, 0, VR_STREAM_VARIABLE, OPT | FRM | LOG, 6, 0},
+    {"buffer",    "buffer",    VR_MODE_VDSH_BUFFER, 0, 0, OPT,                   0, '7'},
+    {NULL, NULL, VR_MODE_DEFAULT, 0, 0, 0, 0, 0}};
+#undef BUF
+
+_Static_assert(sizeof vv_modes / sizeof vv_modes[0] <= VV_MAX_MODES + 1, "VV_MAX_MODES");
+
+int vv_mode_find(const char *name, size_t len, unsigned flag)
 {
-    for (int i = 0; i < VV_FRAME_MODES; i++)
-        if (strlen(vv_frame_modes[i].name) == len && !strncmp(name, vv_frame_modes[i].name, len))
+    for (int i = 0; vv_modes[i].name; i++)
+        if (strlen(vv_modes[i].name) == len && !strncmp(name, vv_modes[i].name, len) &&
+            (!flag || (vv_modes[i].flags & flag)))
             return i;
     return -1;
 }
 
-int vv_frame_mode_available(const vr_scene *s, const vv_frame_mode *m)
+int vv_mode_available(const vr_scene *s, const vv_mode *m)
 {
     if (m->mode == VR_MODE_VDSH_BUFFER)
         return vr_scene_buffer_stream(s, m->stream) != 0;

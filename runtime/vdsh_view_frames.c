@@ -42,26 +42,29 @@ static void view_camera(const vt_view *v, vr_camera *c)
     c->fov_y = v->camera.fov_y;
 }
 
+/* A draw of mode m from cam: vv_base_desc with m's mode, stream and PCF. */
+static vr_draw_desc frame_desc(const vv_options *o, const vv_mode *m, const vr_camera *cam,
+                               const vr_light *lights, int n)
+{
+    vr_draw_desc d = vv_base_desc(o, lights, n);
+    d.mode = m->mode;
+    d.stream = m->stream;
+    d.pcf = m->pcf;
+    d.camera = *cam;
+    return d;
+}
+
 /* One shadow-only frame: light alone, s of every pixel (1 where nothing
  * was drawn: VR_OUTPUT_SHADOW writes alpha 1, the clear colour 0). */
 static vr_result shadow_frame(vr_renderer *r, const vr_scene *scene, const vv_options *o,
-                              const vv_frame_mode *m, const vr_camera *cam, const float pos[3],
+                              const vv_mode *m, const vr_camera *cam, const float pos[3],
                               float *rgba, float *grey, size_t n, vr_error *err)
 {
     vr_light light;
     memset(&light, 0, sizeof light);
     memcpy(light.position, pos, sizeof light.position);
-    vr_draw_desc d;
-    memset(&d, 0, sizeof d);
-    d.mode = m->mode;
-    d.stream = m->stream;
-    d.pcf = m->pcf;
-    d.sdf_k = o->sdf_k;
-    d.compare = o->compare;
-    d.lights = &light;
-    d.light_count = 1;
-    d.camera = *cam;
-    d.output = VR_OUTPUT_SHADOW;
+    vr_draw_desc d = frame_desc(o, m, cam, &light, 1);
+    d.output = VR_OUTPUT_SHADOW; /* no ambient term, no shading */
     vr_result res = vr_draw(r, scene, &d, err);
     if (res == VR_OK)
         res = vr_read_pixels(r, rgba, n * 4 * sizeof(float), err);
@@ -74,7 +77,7 @@ static vr_result shadow_frame(vr_renderer *r, const vr_scene *scene, const vv_op
 /* The shaded picture of a light set: the viewer's white lights (dimmer
  * when there are several), fall-off and ambient; opaque. */
 static vr_result shaded_frame(vr_renderer *r, const vr_scene *scene, const vv_options *o,
-                              const vv_frame_mode *m, const vr_camera *cam, const vt_view *v,
+                              const vv_mode *m, const vr_camera *cam, const vt_view *v,
                               int set, unsigned char *px, size_t n, vr_error *err)
 {
     vr_light lights[VT_VIEWS_MAX_LIGHTS];
@@ -92,11 +95,7 @@ static vr_result shaded_frame(vr_renderer *r, const vr_scene *scene, const vv_op
             lights[i].attenuation[2] = 1.0f / (fall * fall);
         }
     }
-    vr_draw_desc d = vv_base_desc(o, lights, nl);
-    d.mode = m->mode;
-    d.stream = m->stream;
-    d.pcf = m->pcf;
-    d.camera = *cam;
+    vr_draw_desc d = frame_desc(o, m, cam, lights, nl);
     vr_result res = vr_draw(r, scene, &d, err);
     if (res == VR_OK)
         res = vr_read_pixels(r, px, n * 4, err);
@@ -138,11 +137,11 @@ int vv_run_frames(const vv_options *o)
 
     /* The modes: those asked for (each must be in the scene), else every
      * shadow mode the scene has. */
-    int modes[VV_FRAME_MODES], nm = 0;
+    int modes[VV_MAX_MODES], nm = 0;
     if (!rc && o->frame_mode_count) {
         for (int i = 0; i < o->frame_mode_count && !rc; i++) {
-            const vv_frame_mode *m = &vv_frame_modes[o->frame_modes[i]];
-            if (!vv_frame_mode_available(s.scene, m)) {
+            const vv_mode *m = &vv_modes[o->frame_modes[i]];
+            if (!vv_mode_available(s.scene, m)) {
                 fprintf(stderr, "vdsh-view: %s: mode %s is not available in this file%s\n",
                         o->files[0], m->name,
                         m->mode == VR_MODE_VDSH5 ? " (order 5 with its basis cubemaps)" : "");
@@ -151,8 +150,9 @@ int vv_run_frames(const vv_options *o)
             modes[nm++] = o->frame_modes[i];
         }
     } else if (!rc) {
-        for (int i = 0; i < VV_FRAME_DEFAULT_MODES; i++)
-            if (vr_scene_supports(s.scene, vv_frame_modes[i].mode))
+        for (int i = 0; vv_modes[i].name; i++)
+            if ((vv_modes[i].flags & VV_MODE_FRAMES_DEFAULT) &&
+                vv_mode_available(s.scene, &vv_modes[i]))
                 modes[nm++] = i;
     }
 
@@ -176,7 +176,7 @@ int vv_run_frames(const vv_options *o)
     /* Mode by mode (one program, its shadow maps re-rendered per frame);
      * the time of a frame is its draw and read-back, without the PNG. */
     for (int mi = 0; mi < nm && !rc; mi++) {
-        const vv_frame_mode *m = &vv_frame_modes[modes[mi]];
+        const vv_mode *m = &vv_modes[modes[mi]];
         double mode_ms = 0.0, first_ms = 0.0, png_ms = 0.0;
         int mode_frames = 0;
         for (int v = 0; v < vs.count && !rc; v++) {

@@ -61,62 +61,82 @@ static void bake_label(const char *path, const vr_scene *s, char *out, size_t si
              vdsh_quantity_name(info.quantity));
 }
 
-/* The grid's columns: the paper's row, then adaptive order (kept only
- * when some scene has a stream with an order per vertex), then
- * distance-field shadows (kept only when some scene has a volume). */
-enum { GRID_COLS = 7, GRID_PAPER_COLS = 5 };
+/* The grid's columns (vv_mode.grid): the paper's row, then adaptive
+ * order (kept only when some scene has a stream with an order per
+ * vertex), then distance-field shadows (kept only when some scene has a
+ * volume). The summary line describes the order-5 column. */
+enum { GRID_MAX_COLS = 16, GRID_PAPER_COLS = 5, GRID_ORDER5_COL = 3 };
 
-/* One row of the grid: the panels of one scene into row (GRID_COLS w
- * wide); *adaptive: 1 when the scene has the adaptive-order stream,
- * *sdf when it has a distance volume. */
+/* The number of columns: the highest vv_mode.grid. */
+static int grid_columns(void)
+{
+    int n = 0;
+    for (int i = 0; vv_modes[i].name; i++)
+        n = vv_modes[i].grid > n ? vv_modes[i].grid : n;
+    return n < GRID_MAX_COLS ? n : GRID_MAX_COLS;
+}
+
+/* The mode of column c (1..) for this scene: the first of its rows the
+ * scene has, else the last. Order 5 the paper's way when the cubemaps
+ * are there, else with the polynomials (the same image to f16
+ * precision); a log-distance scene draws both per vertex. */
+static const vv_mode *grid_mode(const vr_scene *s, int c)
+{
+    const vv_mode *last = NULL;
+    for (int i = 0; vv_modes[i].name; i++)
+        if (vv_modes[i].grid == c) {
+            if (vv_mode_available(s, &vv_modes[i]))
+                return &vv_modes[i];
+            last = &vv_modes[i];
+        }
+    return last;
+}
+
+/* One row of the grid: the panels of one scene into row (cols panels w
+ * wide); have[c]: 1 when the scene has column c's mode. */
 static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w, int h,
-                    unsigned char *px, unsigned char *row, int *adaptive, int *sdf)
+                    int cols, unsigned char *px, unsigned char *row, int *have)
 {
     vr_scene *scene = NULL;
     if (vv_open_scene(o, path, &scene))
         return 1;
     vr_light lights[VV_MAX_LIGHTS];
     int n = vv_scene_lights(scene, o, o->default_lights ? o->default_lights : 1, lights);
-    /* The paper's row. Order 5 the paper's way when the cubemaps are
-     * there, else with the polynomials (the same image to f16 precision);
-     * a log-distance scene draws both per vertex. */
-    vr_mode modes[GRID_COLS] = {VR_MODE_NONE,  VR_MODE_CUBE,  VR_MODE_VDSH5,
-                                VR_MODE_VDSH3, VR_MODE_VDSH2, VR_MODE_VDSH_BUFFER,
-                                VR_MODE_SDF};
-    if (!vr_scene_supports(scene, VR_MODE_VDSH5))
-        modes[2] = VR_MODE_VDSH5_POLY;
-    *adaptive = vr_scene_buffer_stream(scene, VR_STREAM_VARIABLE) != 0;
-    *sdf = vr_scene_supports(scene, VR_MODE_SDF);
     size_t panel = (size_t)w * (size_t)h * 4;
     int rc = 0;
-    for (int m = 0; m < GRID_COLS && !rc; m++) {
+    char names[256] = "";
+    for (int m = 0; m < cols && !rc; m++) {
+        const vv_mode *e = grid_mode(scene, m + 1);
         vr_error err;
         vr_draw_desc d = vv_base_desc(o, lights, n);
-        d.mode = modes[m];
-        d.stream = VR_STREAM_VARIABLE;
+        d.mode = e->mode;
+        d.stream = e->stream;
         vv_scene_camera(scene, o, &d.camera);
         char label[320];
         int shadow = o->shadow_size ? o->shadow_size : VR_DEFAULT_SHADOW_MAP_SIZE;
-        int have = modes[m] == VR_MODE_VDSH_BUFFER ? *adaptive : vr_scene_supports(scene, modes[m]);
-        if (modes[m] == VR_MODE_CUBE)
+        have[m] = vv_mode_available(scene, e);
+        if (m < GRID_PAPER_COLS || have[m])
+            snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s",
+                     m ? " | " : "", e->name);
+        if (e->mode == VR_MODE_CUBE)
             snprintf(label, sizeof label, "cube shadow map (%d^2 x 6, %s)", shadow,
                      o->pcf ? "PCF" : "1 tap");
-        else if (modes[m] == VR_MODE_VDSH_BUFFER && !have)
+        else if (e->mode == VR_MODE_VDSH_BUFFER && !have[m])
             snprintf(label, sizeof label, "VDSH adaptive order");
-        else if (modes[m] == VR_MODE_SDF)
+        else if (e->mode == VR_MODE_SDF)
             snprintf(label, sizeof label, "%s, k %g", vr_mode_label(VR_MODE_SDF),
                      (double)(o->sdf_k > 0.0f ? o->sdf_k : VDSH_SDF_DEFAULT_K));
-        else if (modes[m] >= VR_MODE_VDSH2) {
-            vv_mode_label(scene, modes[m], VR_STREAM_VARIABLE, label, sizeof label);
+        else if (e->mode >= VR_MODE_VDSH2) {
+            vv_mode_label(scene, e->mode, e->stream, label, sizeof label);
             snprintf(label + strlen(label), sizeof label - strlen(label), "%s",
                      o->compare == VDSH_COMPARE_BINARY ? ", binary" : "");
         } else {
             char bake[256];
             bake_label(path, scene, bake, sizeof bake);
-            snprintf(label, sizeof label, "%s\n%s", vr_mode_label(modes[m]), bake);
+            snprintf(label, sizeof label, "%s\n%s", vr_mode_label(e->mode), bake);
         }
         vr_result res = VR_OK;
-        if (!have) {
+        if (!have[m]) {
             /* A file baked without this order: say so in the panel. */
             vr_draw_desc none = d;
             none.light_count = 0;
@@ -130,19 +150,18 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
         if (res == VR_OK)
             res = vr_read_pixels(r, px, panel, &err);
         if (res != VR_OK) {
-            fprintf(stderr, "vdsh-view: %s: %s: %s\n", path, vr_mode_name(modes[m]), err.msg);
+            fprintf(stderr, "vdsh-view: %s: %s: %s\n", path, vr_mode_name(e->mode), err.msg);
             rc = 1;
             break;
         }
         for (int y = 0; y < h; y++)
-            memcpy(row + ((size_t)y * GRID_COLS * (size_t)w + (size_t)m * (size_t)w) * 4,
+            memcpy(row + ((size_t)y * (size_t)cols * (size_t)w + (size_t)m * (size_t)w) * 4,
                    px + (size_t)y * (size_t)w * 4, (size_t)w * 4);
     }
     if (!rc && !o->quiet)
-        fprintf(stderr, "vdsh-view: %s: none | cube | %s | vdsh3 | vdsh2%s%s (%s), %d light%s\n",
-                path, vr_mode_name(modes[2]), *adaptive ? " | adaptive" : "",
-                *sdf ? " | sdf" : "",
-                vr_scene_mode_label(scene, modes[2]), n, n == 1 ? "" : "s");
+        fprintf(stderr, "vdsh-view: %s: %s (%s), %d light%s\n", path, names,
+                vr_scene_mode_label(scene, grid_mode(scene, GRID_ORDER5_COL)->mode), n,
+                n == 1 ? "" : "s");
     vr_scene_destroy(scene);
     return rc;
 }
@@ -156,8 +175,9 @@ int vv_run_grid(const vv_options *o)
     if (vv_open_headless(o, w, h, 1, &ctx, &r) != 0)
         return 1;
     size_t panel = (size_t)w * (size_t)h * 4;
-    unsigned char *px = malloc(panel), *img = calloc(GRID_COLS * (size_t)rows, panel);
-    int rc = 0, cols = 0, keep[GRID_COLS] = {0};
+    int all = grid_columns();
+    unsigned char *px = malloc(panel), *img = calloc((size_t)all * (size_t)rows, panel);
+    int rc = 0, cols = 0, keep[GRID_MAX_COLS] = {0};
     for (int m = 0; m < GRID_PAPER_COLS; m++)
         keep[m] = 1;
     if (!px || !img) {
@@ -165,22 +185,22 @@ int vv_run_grid(const vv_options *o)
         rc = 1;
     }
     for (int i = 0; i < rows && !rc; i++) {
-        int adaptive = 0, sdf = 0;
-        rc = grid_row(o, o->files[i], r, w, h, px, img + (size_t)i * GRID_COLS * panel,
-                      &adaptive, &sdf);
-        keep[GRID_PAPER_COLS] |= adaptive;
-        keep[GRID_PAPER_COLS + 1] |= sdf;
+        int have[GRID_MAX_COLS] = {0};
+        rc = grid_row(o, o->files[i], r, w, h, all, px, img + (size_t)i * (size_t)all * panel,
+                      have);
+        for (int m = GRID_PAPER_COLS; m < all; m++)
+            keep[m] |= have[m];
     }
-    for (int m = 0; m < GRID_COLS; m++)
+    for (int m = 0; m < all; m++)
         cols += keep[m];
     if (!rc) {
         /* Keep the kept panels of each row, in order (in place: the
          * rows only shrink), with a thin dark line between panels and
          * rows. */
-        size_t wide = GRID_COLS * (size_t)w * 4, stride = (size_t)cols * (size_t)w * 4;
+        size_t wide = (size_t)all * (size_t)w * 4, stride = (size_t)cols * (size_t)w * 4;
         size_t pw = (size_t)w * 4;
         for (int y = 0; y < rows * h; y++)
-            for (int m = 0, c = 0; m < GRID_COLS; m++)
+            for (int m = 0, c = 0; m < all; m++)
                 if (keep[m])
                     memmove(img + (size_t)y * stride + (size_t)c++ * pw,
                             img + (size_t)y * wide + (size_t)m * pw, pw);

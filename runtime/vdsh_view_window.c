@@ -98,30 +98,39 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     if (action != GLFW_PRESS)
         return;
     char msg[200];
-    static const vr_mode by_digit[7] = {VR_MODE_NONE,  VR_MODE_CUBE,       VR_MODE_VDSH2,
-                                        VR_MODE_VDSH3, VR_MODE_VDSH5,      VR_MODE_VDSH5_POLY,
-                                        VR_MODE_VDSH_BUFFER};
-    if (key >= GLFW_KEY_1 && key <= GLFW_KEY_7) {
-        vr_mode m = by_digit[key - GLFW_KEY_1];
-        if (!vr_scene_supports(a->s.scene, m)) {
-            snprintf(msg, sizeof msg, "mode %s: not available in this file", vr_mode_name(m));
+    /* The modes with a digit key (vv_mode.key), in the order M steps
+     * through them. */
+    const vv_mode *keyed[10];
+    int nk = 0, at = 0;
+    for (int i = 0; vv_modes[i].name && nk < 10; i++)
+        if (vv_modes[i].key) {
+            if (vv_modes[i].mode == a->mode)
+                at = nk;
+            keyed[nk++] = &vv_modes[i];
+        }
+    for (int i = 0; i < nk; i++)
+        if (key == GLFW_KEY_0 + (keyed[i]->key - '0')) {
+            vr_mode m = keyed[i]->mode;
+            if (!vr_scene_supports(a->s.scene, m)) {
+                snprintf(msg, sizeof msg, "mode %s: not available in this file", vr_mode_name(m));
+                print_status(a, msg);
+                return;
+            }
+            a->mode = m;
+            char label[160];
+            vv_mode_label(a->s.scene, m, a->stream, label, sizeof label);
+            snprintf(msg, sizeof msg, "mode: %s", label);
             print_status(a, msg);
             return;
         }
-        a->mode = m;
-        char label[160];
-        vv_mode_label(a->s.scene, m, a->stream, label, sizeof label);
-        snprintf(msg, sizeof msg, "mode: %s", label);
-        print_status(a, msg);
-        return;
-    }
     switch (key) {
     case GLFW_KEY_ESCAPE:
         glfwSetWindowShouldClose(w, GLFW_TRUE);
         break;
     case GLFW_KEY_M:
-        for (int i = 1; i <= 7; i++) {
-            vr_mode m = by_digit[(a->mode - VR_MODE_NONE + i) % 7];
+        /* the next the scene has (after the first when this one has no key) */
+        for (int i = 1; i <= nk; i++) {
+            vr_mode m = keyed[(at + i) % nk]->mode;
             if (vr_scene_supports(a->s.scene, m)) {
                 a->mode = m;
                 break;
@@ -269,6 +278,31 @@ static void on_scroll(GLFWwindow *w, double xoff, double yoff)
         a->dist = 0.01f * a->diag;
 }
 
+/* Where the held keys point: keys[0]/[1] along +/-fwd, [2]/[3] along
+ * +/-right, [4]/[5] up/down. */
+static void held_move(GLFWwindow *w, const int keys[6], const float fwd[3],
+                      const float right[3], float out[3])
+{
+    int held[6];
+    for (int i = 0; i < 6; i++)
+        held[i] = glfwGetKey(w, keys[i]) == GLFW_PRESS;
+    for (int k = 0; k < 3; k++) {
+        out[k] = 0.0f;
+        if (held[0])
+            out[k] += fwd[k];
+        if (held[1])
+            out[k] -= fwd[k];
+        if (held[2])
+            out[k] += right[k];
+        if (held[3])
+            out[k] -= right[k];
+    }
+    if (held[4])
+        out[1] += 1.0f;
+    if (held[5])
+        out[1] -= 1.0f;
+}
+
 /* Held keys: fly the camera, move the selected light. */
 static void update(app *a, GLFWwindow *w, float dt)
 {
@@ -281,40 +315,18 @@ static void update(app *a, GLFWwindow *w, float dt)
     right[2] = fh[0];
     if (glfwGetKey(w, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS)
         speed *= 4.0f;
-    float move[3] = {0, 0, 0};
-    for (int k = 0; k < 3; k++) {
-        if (glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS)
-            move[k] += f[k];
-        if (glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS)
-            move[k] -= f[k];
-        if (glfwGetKey(w, GLFW_KEY_D) == GLFW_PRESS)
-            move[k] += right[k];
-        if (glfwGetKey(w, GLFW_KEY_A) == GLFW_PRESS)
-            move[k] -= right[k];
-    }
-    if (glfwGetKey(w, GLFW_KEY_E) == GLFW_PRESS)
-        move[1] += 1.0f;
-    if (glfwGetKey(w, GLFW_KEY_Q) == GLFW_PRESS)
-        move[1] -= 1.0f;
+    static const int fly[6] = {GLFW_KEY_W, GLFW_KEY_S, GLFW_KEY_D,
+                               GLFW_KEY_A, GLFW_KEY_E, GLFW_KEY_Q};
+    float move[3];
+    held_move(w, fly, f, right, move);
     for (int k = 0; k < 3; k++)
         a->target[k] += speed * move[k];
 
     if (a->n > 0) {
-        float lm[3] = {0, 0, 0}, ls = 0.15f * a->diag * dt;
-        for (int k = 0; k < 3; k++) {
-            if (glfwGetKey(w, GLFW_KEY_UP) == GLFW_PRESS)
-                lm[k] += fh[k];
-            if (glfwGetKey(w, GLFW_KEY_DOWN) == GLFW_PRESS)
-                lm[k] -= fh[k];
-            if (glfwGetKey(w, GLFW_KEY_RIGHT) == GLFW_PRESS)
-                lm[k] += right[k];
-            if (glfwGetKey(w, GLFW_KEY_LEFT) == GLFW_PRESS)
-                lm[k] -= right[k];
-        }
-        if (glfwGetKey(w, GLFW_KEY_PAGE_UP) == GLFW_PRESS)
-            lm[1] += 1.0f;
-        if (glfwGetKey(w, GLFW_KEY_PAGE_DOWN) == GLFW_PRESS)
-            lm[1] -= 1.0f;
+        static const int keys[6] = {GLFW_KEY_UP,    GLFW_KEY_DOWN,    GLFW_KEY_RIGHT,
+                                    GLFW_KEY_LEFT,  GLFW_KEY_PAGE_UP, GLFW_KEY_PAGE_DOWN};
+        float lm[3], ls = 0.15f * a->diag * dt;
+        held_move(w, keys, fh, right, lm);
         for (int k = 0; k < 3; k++)
             a->base[a->selected].position[k] += ls * lm[k];
     }

@@ -297,9 +297,6 @@ vr_result vr_renderer_resize(vr_renderer *r, int width, int height,
 
 void vr_renderer_size(const vr_renderer *r, int *width, int *height);
 
-/* The GL name of the framebuffer vr_draw renders into. */
-unsigned vr_renderer_framebuffer(const vr_renderer *r);
-
 /* "llvmpipe (LLVM 15.0.6, 256 bits)" etc.: GL_RENDERER of the current
  * context; never NULL. */
 const char *vr_gl_renderer(void);

@@ -160,6 +160,28 @@ static void key_defines(const vr_program_key *k, int flat, char *buf, size_t siz
         snprintf(buf + n, size - (size_t)n, "\n");
 }
 
+/* 0 when a shader compiled (is_shader) or a program linked; else 1 with
+ * its info log in log[] and the object deleted. */
+static int failed(GLuint obj, int is_shader, char *log, GLsizei size)
+{
+    GLint ok = 0;
+    if (is_shader)
+        glGetShaderiv(obj, GL_COMPILE_STATUS, &ok);
+    else
+        glGetProgramiv(obj, GL_LINK_STATUS, &ok);
+    if (ok)
+        return 0;
+    log[0] = '\0';
+    if (is_shader) {
+        glGetShaderInfoLog(obj, size, NULL, log);
+        glDeleteShader(obj);
+    } else {
+        glGetProgramInfoLog(obj, size, NULL, log);
+        glDeleteProgram(obj);
+    }
+    return 1;
+}
+
 static vr_result compile(const char *name, GLenum stage, const char *src,
                          GLuint *out, vr_error *err)
 {
@@ -168,15 +190,10 @@ static vr_result compile(const char *name, GLenum stage, const char *src,
         return vr_fail(err, VR_ERR_GL, "%s: glCreateShader failed", name);
     glShaderSource(sh, 1, &src, NULL);
     glCompileShader(sh);
-    GLint ok = 0;
-    glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[768] = "";
-        glGetShaderInfoLog(sh, sizeof log, NULL, log);
-        glDeleteShader(sh);
+    char log[768];
+    if (failed(sh, 1, log, sizeof log))
         return vr_fail(err, VR_ERR_SHADER, "%s: %s shader: %s", name,
                        stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
-    }
     *out = sh;
     return VR_OK;
 }
@@ -200,14 +217,9 @@ vr_result vr_link(const char *name, const char *vs, const char *fs,
     /* The program keeps what it needs; the shaders can go now. */
     glDeleteShader(v);
     glDeleteShader(f);
-    GLint ok = 0;
-    glGetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[768] = "";
-        glGetProgramInfoLog(p, sizeof log, NULL, log);
-        glDeleteProgram(p);
+    char log[768];
+    if (failed(p, 0, log, sizeof log))
         return vr_fail(err, VR_ERR_SHADER, "%s: link: %s", name, log);
-    }
     *out = p;
     return VR_OK;
 }

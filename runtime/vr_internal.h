@@ -209,10 +209,6 @@ vr_result vr_link(const char *name, const char *vs, const char *fs,
 
 /* Column-major 4x4 matrices. */
 void vr_mat4_mul(float out[16], const float a[16], const float b[16]);
-void vr_mat4_look_at(float out[16], const float eye[3], const float target[3],
-                     const float up[3]);
-void vr_mat4_perspective(float out[16], float fov_y_rad, float aspect,
-                         float znear, float zfar);
 void vr_mat4_ortho(float out[16], float half_w, float half_h, float znear,
                    float zfar);
 

@@ -250,11 +250,6 @@ void vr_renderer_size(const vr_renderer *r, int *width, int *height)
     *height = r->height;
 }
 
-unsigned vr_renderer_framebuffer(const vr_renderer *r)
-{
-    return r->fbo;
-}
-
 /* ------------------------------------------------------------------ */
 /* Timer queries                                                        */
 
@@ -428,17 +423,20 @@ static void shadow_planes(const vr_scene *s, const float l[3], float nf[2])
 
 /* GL cube-map face f seen from `eye`: the look-at directions and up
  * vectors that make a 90-degree render land in GL's face orientation
- * (OpenGL 4.6 table 8.19; the face images have t = -y on the side faces). */
+ * (OpenGL 4.6 table 8.19; the face images have t = -y on the side faces);
+ * a 90-degree formats/vdsh_camera.h camera, as the eye's view is one. */
 static void face_view_proj(int f, const float eye[3], const float nf[2], float out[16])
 {
     static const float dir[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
                                     {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
     static const float up[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1},
                                    {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
-    float target[3] = {eye[0] + dir[f][0], eye[1] + dir[f][1], eye[2] + dir[f][2]};
+    vdsh_camera c = {{eye[0], eye[1], eye[2]},
+                     {eye[0] + dir[f][0], eye[1] + dir[f][1], eye[2] + dir[f][2]},
+                     {up[f][0], up[f][1], up[f][2]}, 90.0f};
     float view[16], proj[16];
-    vr_mat4_look_at(view, eye, target, up[f]);
-    vr_mat4_perspective(proj, 1.5707963267948966f, 1.0f, nf[0], nf[1]);
+    vdsh_camera_view(&c, view);
+    vdsh_camera_projection(&c, 1.0f, nf[0], nf[1], proj);
     vr_mat4_mul(out, proj, view);
 }
 

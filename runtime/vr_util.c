@@ -4,7 +4,6 @@
  */
 #include "vr_internal.h"
 
-#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -68,28 +67,31 @@ const char *vr_gl_renderer(void)
 
 /* ------------------------------------------------------------------ */
 
-static const char *const mode_names[VR_MODE_COUNT_] = {
-    "default", "none", "cube", "vdsh2", "vdsh3", "vdsh5", "vdsh5poly", "buffer", "sdf"};
-
-static const char *const mode_labels[VR_MODE_COUNT_] = {
-    "the scene's default (VDSH order 5, cubemaps where it has them)",
-    "no shadows",
-    "cube shadow map",
-    "VDSH order 2 (4 coeff.)",
-    "VDSH order 3 (9 coeff.)",
-    "VDSH order 5 (25 coeff., cubemaps)",
-    "VDSH order 5 (25 coeff., polynomials)",
-    "VDSH from a buffer (any order, per-vertex distance)",
-    "distance-field shadows (sphere trace)"};
+/* The runtime's one list of its modes (vr_mode order): name (the
+ * viewer's --mode spelling), label, and the VDSH order drawn (0: none or
+ * any, from the stream). */
+static const struct {
+    const char *name, *label;
+    int order;
+} modes[VR_MODE_COUNT_] = {
+    {"default", "the scene's default (VDSH order 5, cubemaps where it has them)", 0},
+    {"none", "no shadows", 0},
+    {"cube", "cube shadow map", 0},
+    {"vdsh2", "VDSH order 2 (4 coeff.)", 2},
+    {"vdsh3", "VDSH order 3 (9 coeff.)", 3},
+    {"vdsh5", "VDSH order 5 (25 coeff., cubemaps)", 5},
+    {"vdsh5poly", "VDSH order 5 (25 coeff., polynomials)", 5},
+    {"buffer", "VDSH from a buffer (any order, per-vertex distance)", 0},
+    {"sdf", "distance-field shadows (sphere trace)", 0}};
 
 const char *vr_mode_name(vr_mode m)
 {
-    return (unsigned)m < VR_MODE_COUNT_ ? mode_names[m] : "?";
+    return (unsigned)m < VR_MODE_COUNT_ ? modes[m].name : "?";
 }
 
 const char *vr_mode_label(vr_mode m)
 {
-    return (unsigned)m < VR_MODE_COUNT_ ? mode_labels[m] : "?";
+    return (unsigned)m < VR_MODE_COUNT_ ? modes[m].label : "?";
 }
 
 int vr_mode_from_name(const char *name, vr_mode *out)
@@ -97,7 +99,7 @@ int vr_mode_from_name(const char *name, vr_mode *out)
     if (!name)
         return -1;
     for (int m = 1; m < VR_MODE_COUNT_; m++)
-        if (strcmp(name, mode_names[m]) == 0) {
+        if (strcmp(name, modes[m].name) == 0) {
             *out = (vr_mode)m;
             return 0;
         }
@@ -106,13 +108,7 @@ int vr_mode_from_name(const char *name, vr_mode *out)
 
 int vr_mode_order(vr_mode m)
 {
-    switch (m) {
-    case VR_MODE_VDSH2: return 2;
-    case VR_MODE_VDSH3: return 3;
-    case VR_MODE_VDSH5:
-    case VR_MODE_VDSH5_POLY: return 5;
-    default: return 0;
-    }
+    return (unsigned)m < VR_MODE_COUNT_ ? modes[m].order : 0;
 }
 
 int vr_mode_interp(vr_mode m, uint32_t quantity)
@@ -152,54 +148,6 @@ void vr_mat4_mul(float out[16], const float a[16], const float b[16])
             r[c * 4 + row] = s;
         }
     memcpy(out, r, sizeof r);
-}
-
-static void normalize3(float v[3])
-{
-    float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    if (l > 0.0f) {
-        v[0] /= l;
-        v[1] /= l;
-        v[2] /= l;
-    }
-}
-
-static void cross3(float o[3], const float a[3], const float b[3])
-{
-    o[0] = a[1] * b[2] - a[2] * b[1];
-    o[1] = a[2] * b[0] - a[0] * b[2];
-    o[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-void vr_mat4_look_at(float out[16], const float eye[3], const float target[3],
-                     const float up[3])
-{
-    float f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]};
-    normalize3(f);
-    float s[3], u[3];
-    cross3(s, f, up);
-    normalize3(s);
-    cross3(u, s, f);
-    const float m[16] = {
-        s[0], u[0], -f[0], 0.0f,
-        s[1], u[1], -f[1], 0.0f,
-        s[2], u[2], -f[2], 0.0f,
-        -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]),
-        -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]),
-        f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2], 1.0f};
-    memcpy(out, m, sizeof m);
-}
-
-void vr_mat4_perspective(float out[16], float fov_y_rad, float aspect,
-                         float znear, float zfar)
-{
-    float t = 1.0f / tanf(0.5f * fov_y_rad);
-    memset(out, 0, 16 * sizeof(float));
-    out[0] = t / aspect;
-    out[5] = t;
-    out[10] = (zfar + znear) / (znear - zfar);
-    out[11] = -1.0f;
-    out[14] = 2.0f * zfar * znear / (znear - zfar);
 }
 
 void vr_mat4_ortho(float out[16], float half_w, float half_h, float znear,

@@ -27,9 +27,13 @@
 #   cubemap    vb_cubemap_read of the basis EXR files (test_fuzz_cubemap.c)
 # With -DVDSH_FUZZ=ON (clang only, together with -DVDSH_SANITIZE=ON) each
 # is also built as a libFuzzer binary fuzz_<target>; scripts/fuzz TARGET
-# SECONDS configures build-fuzz/ that way and runs one.
+# SECONDS configures build-fuzz/ that way and runs one. Such a build also
+# has fuzz_run_<target>: scripts/fuzz on it for VDSH_FUZZ_SECONDS, label
+# fuzz, which the default suite leaves out (scripts/test: ctest -LE fuzz);
+# run them with ctest --test-dir build-fuzz -L fuzz.
 
 option(VDSH_FUZZ "Build the libFuzzer targets fuzz_* (clang only)" OFF)
+set(VDSH_FUZZ_SECONDS 60 CACHE STRING "Length of each fuzz_run_* test (libFuzzer -max_total_time)")
 
 set(_robust_dir ${CMAKE_CURRENT_LIST_DIR})
 set(_corpus ${_robust_dir}/corpus)
@@ -70,6 +74,11 @@ function(_robust_fuzz_target name)
     target_compile_options(fuzz_${name} PRIVATE -fsanitize=fuzzer)
     target_link_options(fuzz_${name} PRIVATE -fsanitize=fuzzer)
     target_link_libraries(fuzz_${name} PRIVATE ${F_LIBS})
+    math(EXPR limit "${VDSH_FUZZ_SECONDS} + 300")
+    add_test(NAME fuzz_run_${name}
+             COMMAND bash ${PROJECT_SOURCE_DIR}/scripts/fuzz ${name} ${VDSH_FUZZ_SECONDS})
+    set_tests_properties(fuzz_run_${name} PROPERTIES LABELS fuzz TIMEOUT ${limit}
+                         ENVIRONMENT VDSH_FUZZ_BUILD=${CMAKE_BINARY_DIR})
   endif()
 endfunction()
 

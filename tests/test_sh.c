@@ -4,33 +4,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fit.h" /* vb_gauss_legendre */
 #include "test_util.h"
 #include "vdsh.h"
 #include "vdsh_sh.h"
 #include "vdsh_shadow.h"
-
-/* Gauss-Legendre nodes/weights on [-1, 1] by Newton iteration. */
-static void gauss_legendre(int n, double *x, double *w)
-{
-    for (int i = 0; i < n; i++) {
-        double z = cos(M_PI * (i + 0.75) / (n + 0.5)), pp = 0.0;
-        for (int it = 0; it < 100; it++) {
-            double p1 = 1.0, p2 = 0.0;
-            for (int j = 1; j <= n; j++) {
-                double p3 = p2;
-                p2 = p1;
-                p1 = ((2.0 * j - 1.0) * z * p2 - (j - 1.0) * p3) / j;
-            }
-            pp = n * (z * p1 - p2) / (z * z - 1.0);
-            double z1 = z;
-            z = z1 - p1 / pp;
-            if (fabs(z - z1) < 1e-15)
-                break;
-        }
-        x[i] = z;
-        w[i] = 2.0 / ((1.0 - z * z) * pp * pp);
-    }
-}
 
 /* Orthonormality: Gauss-Legendre in z times uniform phi is exact for the
  * products of two band <= 4 functions (degree 8). */
@@ -39,7 +17,7 @@ static void test_orthonormal(void)
     enum { NZ = 12, NP = 24, NC = 25 };
     double x[NZ], w[NZ], G[NC][NC];
     memset(G, 0, sizeof G);
-    gauss_legendre(NZ, x, w);
+    vb_gauss_legendre(NZ, x, w);
     for (int i = 0; i < NZ; i++)
         for (int j = 0; j < NP; j++) {
             double phi = 2.0 * M_PI * j / NP, r = sqrt(1.0 - x[i] * x[i]);
@@ -172,7 +150,7 @@ static void test_recurrence(void)
 
     enum { NZ = 16, NP = 36 }; /* exact for the products' degree <= 30 */
     double gx[NZ], gw[NZ];
-    gauss_legendre(NZ, gx, gw);
+    vb_gauss_legendre(NZ, gx, gw);
     static double G[NC][NC];
     memset(G, 0, sizeof G);
     for (int i = 0; i < NZ; i++) {

@@ -18,6 +18,7 @@
 #include <stdint.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 static const char *work;
 
@@ -330,6 +331,63 @@ static void test_frames(void)
     }
 }
 
+/* The vt_opt_* checks (parse_args): the value, or the usage error naming
+ * the option and its range, with *out untouched. */
+static void test_options(void)
+{
+    char path[4096], text[2048] = "";
+    snprintf(path, sizeof path, "%s/options.err", work);
+    fflush(stderr);
+    int saved = dup(2);
+    CHECK(saved >= 0 && freopen(path, "w", stderr) != NULL, "stderr to %s", path);
+    uint32_t u = 7;
+    uint64_t s = 9;
+    int i = 3, v = 5, want[17] = {0};
+    float f = 2.0f;
+    double t = 1.0;
+    static const vt_choice names[] = {{"a", 1}, {"bb", 2}, {"c", 3}, {NULL, 0}};
+    const int ok[] = {
+        vt_opt_u32("--n", NULL, "256", 1, 256, &u) && u == 256,
+        !vt_opt_u32("--n", NULL, "257", 1, 256, &u) && u == 256,
+        !vt_opt_u32("--d", "", "0", 1, 1024, &u) && u == 256,
+        !vt_opt_u64("--seed", NULL, "x", 0, UINT64_MAX, &s) && s == 9,
+        !vt_opt_u64("--m", NULL, "0", 1, UINT64_MAX, &s) && s == 9,
+        !vt_opt_int("--k", "an order", "-0", 0, 16, &i) && i == 3,
+        vt_opt_int("--k", NULL, "-2", -5, 5, &i) && i == -2,
+        !vt_opt_positive("--p", "0", &f) && f == 2.0f,
+        vt_opt_nonnegative("--q", "-0", &f) && f == 0.0f,
+        !vt_opt_nonnegative("--q", "-1", &f) && f == 0.0f,
+        vt_opt_tolerance("--t", NULL, "inf", 0, &t) && isinf(t),
+        !vt_opt_tolerance("--t", "a number", "0", 0, &t) && isinf(t),
+        vt_opt_orders("--orders", "2,3,5", "5,2", 16, want) && want[2] && want[5] && !want[3],
+        !vt_opt_orders("--orders", "2,3,5", "2,2", 16, want) && want[5],
+        vt_opt_choice("--c", "bb", names, &v) && v == 2,
+        !vt_opt_choice("--c", "d", names, &v) && v == 2,
+    };
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    for (size_t k = 0; k < sizeof ok / sizeof ok[0]; k++)
+        CHECK(ok[k], "option check %zu", k);
+    FILE *in = fopen(path, "rb");
+    size_t n = in ? fread(text, 1, sizeof text - 1, in) : 0;
+    text[n] = 0;
+    if (in)
+        fclose(in);
+    static const char *const said[] = {
+        "--n takes a whole number 1..256, not '257'", "--d takes 1..1024, not '0'",
+        "--seed takes a whole number, not 'x'", "--m takes a whole number >= 1, not '0'",
+        "--k takes an order 0..16, not '-0'", "--p takes a positive number, not '0'",
+        "--q takes a number >= 0, not '-1'", "--t takes a number > 0 (or inf), not '0'",
+        "--orders takes distinct orders 1..16 such as 2,3,5, not '2,2'",
+        "--c takes a, bb or c, not 'd'"};
+    char want_text[2048] = "";
+    for (size_t k = 0; k < sizeof said / sizeof said[0]; k++)
+        snprintf(want_text + strlen(want_text), sizeof want_text - strlen(want_text),
+                 "%s: %s\nTry '%s --help'.\n", vt_cli_prog(), said[k], vt_cli_prog());
+    CHECK(strcmp(text, want_text) == 0, "option messages:\n%s\nwanted:\n%s", text, want_text);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -345,5 +403,6 @@ int main(int argc, char **argv)
     test_json_files();
     test_camera();
     test_frames();
+    test_options();
     return test_report("test_tools");
 }

@@ -34,6 +34,7 @@
 #include "vdsh_export_source.h"
 #include "vdsh_output.h"
 #include "vdsh_scene_view.h"
+#include "vt_args.h"
 #include "vt_cli.h"
 
 typedef struct blob {
@@ -604,9 +605,18 @@ static void usage(FILE *fp)
             VDSH_MAX_ORDER);
 }
 
-int main(int argc, char **argv)
+/* ---- the command line ------------------------------------------------------------ */
+
+typedef struct options {
+    const char *in, *out, *source;
+    int want[VDSH_ORDER_SLOTS], any_order; /* --orders, each time adding to the set */
+    int use_float, quiet, compress, decode_cpca;
+} options;
+
+/* -1 with *o ready to run, else the exit status (help, version, a usage
+ * error: said). */
+static int parse_args(int argc, char **argv, options *o)
 {
-    vt_cli_begin("vdsh-export", argv);
     static const struct option longopts[] = {{"output", required_argument, 0, 'o'},
                                              {"orders", required_argument, 0, 'O'},
                                              {"float", no_argument, 0, 'F'},
@@ -617,192 +627,231 @@ int main(int argc, char **argv)
                                              {"help", no_argument, 0, 'h'},
                                              {"version", no_argument, 0, 'V'},
                                              {0, 0, 0, 0}};
-    const char *in = NULL, *out = NULL, *source = NULL;
-    int want[VDSH_ORDER_SLOTS] = {0}, any_order = 0, use_float = 0, quiet = 0, compress = 0, opt;
-    int decode_cpca = 0;
+    memset(o, 0, sizeof *o);
+    int opt, set[VDSH_ORDER_SLOTS];
     while ((opt = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
         switch (opt) {
-        case 'o': out = optarg; break;
-        case 'O': {
-            uint64_t v[VDSH_MAX_ORDER];
-            int n = vt_parse_u64_list(optarg, 1, VDSH_MAX_ORDER, v, 1, VDSH_MAX_ORDER);
-            if (n == 0)
+        case 'o': o->out = optarg; break;
+        case 'O':
+            if (!vt_parse_orders(optarg, 0, VDSH_MAX_ORDER, set))
                 return vt_usage_error("vdsh-export", "--orders takes orders 1..%d such as "
                                       "2,3,5, not '%s'", VDSH_MAX_ORDER, optarg);
-            for (int i = 0; i < n; i++)
-                want[v[i]] = any_order = 1;
+            for (int k = 1; k <= VDSH_MAX_ORDER; k++)
+                if (set[k])
+                    o->want[k] = o->any_order = 1;
             break;
-        }
-        case 'F': use_float = 1; break;
-        case 'C': compress = 1; break;
-        case 'D': decode_cpca = 1; break;
-        case 'S': source = optarg; break;
-        case 'q': quiet = 1; break;
+        case 'F': o->use_float = 1; break;
+        case 'C': o->compress = 1; break;
+        case 'D': o->decode_cpca = 1; break;
+        case 'S': o->source = optarg; break;
+        case 'q': o->quiet = 1; break;
         case 'h': usage(stdout); return 0;
         case 'V': return vt_cli_version(NULL);
         default: return vt_cli_try_help();
         }
     }
-    if (optind >= argc)
-        return vt_usage_error("vdsh-export", "%s", "no .vdsh file given");
-    if (argc - optind > 1)
-        return vt_usage_error("vdsh-export", "one .vdsh file, not also '%s'", argv[optind + 1]);
-    in = argv[optind];
-    if (!out)
+    o->in = vt_arg_vdsh(argc, argv, optind, NULL, 0);
+    if (!o->in)
+        return VT_EXIT_USAGE;
+    if (!o->out)
         return vt_usage_error("vdsh-export", "%s", "no output: give -o OUT.glb");
-    const char *ins[2] = {in, source};
-    if (vt_cli_check_outputs(&out, 1, ins, source ? 2 : 1) != 0)
-        return 1;
-    vdsh_file *f = NULL;
-    vdsh_error verr;
-    if (vdsh_read(in, &f, &verr) != VDSH_OK) {
-        fprintf(stderr, "vdsh-export: %s\n", verr.msg);
-        return 1;
-    }
-    if (f->has_part) { /* its streams hold one range's receivers */
-        fprintf(stderr, "vdsh-export: %s: a part of a sharded bake (shard %u of %u): join the "
-                        "parts with vdsh-merge first\n", in, f->part.index, f->part.count);
-        vdsh_free(f);
-        return 1;
-    }
-    const uint32_t nv = f->header.vertex_count, nt = f->header.triangle_count;
-    int rc = 1;
-    blob b = {0};
-    view_list vl = {0};
-    uint32_t *tri_sorted = NULL;
-    cJSON *root = cJSON_CreateObject();
-    cJSON *asset = cJSON_AddObjectToObject(root, "asset");
+    return -1;
+}
+
+/* ---- the steps of an export ------------------------------------------------------------
+ * Each returns 0, 1 after a message, or -1 out of memory (run says it). */
+
+/* What an export builds, freed by exporter_free (also half-built). */
+typedef struct exporter {
+    const options *o;
+    const vdsh_file *f;
+    uint32_t nv, nt;
+    blob b;                    /* the BIN chunk */
+    view_list vl;              /* the buffer views, written at the end */
+    uint32_t *tri_sorted;      /* --compress: the triangles in vertex cache order */
+    cJSON *root, *views, *accs;
+    cJSON *attrs;              /* the primitive's attributes, until the mesh takes them */
+    cJSON *vx;                 /* extras.vdsh, until the mesh (or the source) takes it */
+    float *tmp, *coef;         /* scratch: 16 floats a vertex; one vertex's coefficients */
+    int ind_acc;               /* the indices' accessor */
+    float lo[3], hi[3];        /* the positions' bounds */
+    double qstep;              /* --compress: the positions' quantisation step */
+    int exported;              /* streams written */
+} exporter;
+
+static int exporter_begin(exporter *e, const options *o, const vdsh_file *f)
+{
+    memset(e, 0, sizeof *e);
+    e->o = o;
+    e->f = f;
+    e->nv = f->header.vertex_count;
+    e->nt = f->header.triangle_count;
+    e->root = cJSON_CreateObject();
+    cJSON *asset = cJSON_AddObjectToObject(e->root, "asset");
     cJSON_AddStringToObject(asset, "version", "2.0");
     cJSON_AddStringToObject(asset, "generator", "vdsh-export (formats/GLTF.md)");
-    cJSON *views = cJSON_AddArrayToObject(root, "bufferViews");
-    cJSON *accs = cJSON_AddArrayToObject(root, "accessors");
-    cJSON *attrs = cJSON_CreateObject();
-    cJSON *vx = cJSON_CreateObject();
-    cJSON_AddNumberToObject(vx, "format", 1);
-    float *tmp = malloc((size_t)nv * 4 * sizeof(float) * 4 + 16);
-    float *coef = malloc(sizeof(float) * 256);
-    if (!tmp || !coef)
-        goto oom;
+    e->views = cJSON_AddArrayToObject(e->root, "bufferViews");
+    e->accs = cJSON_AddArrayToObject(e->root, "accessors");
+    e->attrs = cJSON_CreateObject();
+    e->vx = cJSON_CreateObject();
+    cJSON_AddNumberToObject(e->vx, "format", 1);
+    e->tmp = malloc((size_t)e->nv * 4 * sizeof(float) * 4 + 16);
+    e->coef = malloc(sizeof(float) * 256);
+    return e->tmp && e->coef ? 0 : -1;
+}
 
-    /* Indices: uint16 when they fit, else uint32. --compress: the triangles
-     * in meshoptimizer's vertex cache order first (its index codec needs
-     * that: in the bake's order they grow by 16 %; reordered, the room's
-     * shrink to about a quarter); the vertices keep their order, vertex i
-     * is receiver i of the .vdsh as in the plain export. */
-    int ind_acc;
-    const uint32_t *tri = f->indices;
-    if (compress) {
-        tri_sorted = malloc((size_t)nt * 12 + 4);
-        if (!tri_sorted)
-            goto oom;
-        meshopt_optimizeVertexCache(tri_sorted, f->indices, 3 * (size_t)nt, nv);
-        tri = tri_sorted;
+static void exporter_free(exporter *e)
+{
+    cJSON_Delete(e->root);
+    cJSON_Delete(e->attrs);
+    cJSON_Delete(e->vx);
+    free(e->b.data);
+    view_list_free(&e->vl);
+    free(e->tri_sorted);
+    free(e->tmp);
+    free(e->coef);
+}
+
+/* Indices: uint16 when they fit, else uint32. --compress: the triangles
+ * in meshoptimizer's vertex cache order first (its index codec needs
+ * that: in the bake's order they grow by 16 %; reordered, the room's
+ * shrink to about a quarter); the vertices keep their order, vertex i
+ * is receiver i of the .vdsh as in the plain export. */
+static int put_indices(exporter *e)
+{
+    const uint32_t nv = e->nv, nt = e->nt;
+    const uint32_t *tri = e->f->indices;
+    if (e->o->compress) {
+        e->tri_sorted = malloc((size_t)nt * 12 + 4);
+        if (!e->tri_sorted)
+            return -1;
+        meshopt_optimizeVertexCache(e->tri_sorted, e->f->indices, 3 * (size_t)nt, nv);
+        tri = e->tri_sorted;
     }
     if (nv <= 65535) {
-        uint16_t *ix = (uint16_t *)tmp;
         uint16_t *buf = malloc((size_t)nt * 6 + 2);
         if (!buf)
-            goto oom;
-        (void)ix;
+            return -1;
         for (size_t j = 0; j < 3 * (size_t)nt; j++)
             buf[j] = (uint16_t)tri[j];
-        int v = add_view(&vl, buf, (size_t)nt * 6, 2, 34963);
+        int v = add_view(&e->vl, buf, (size_t)nt * 6, 2, 34963);
         free(buf);
-        ind_acc = add_accessor(accs, v, 5123, 0, 3 * (size_t)nt, "SCALAR");
+        e->ind_acc = add_accessor(e->accs, v, 5123, 0, 3 * (size_t)nt, "SCALAR");
     } else {
-        int v = add_view(&vl, tri, (size_t)nt * 12, 4, 34963);
-        ind_acc = add_accessor(accs, v, 5125, 0, 3 * (size_t)nt, "SCALAR");
+        int v = add_view(&e->vl, tri, (size_t)nt * 12, 4, 34963);
+        e->ind_acc = add_accessor(e->accs, v, 5125, 0, 3 * (size_t)nt, "SCALAR");
     }
-    /* Positions with their bounds; --compress: uint16 (KHR_mesh_quantization,
-     * as gltfpack writes it: byteStride 8), dequantised by the node's
-     * transform (one scale for the three axes, so normals stay right; a
-     * translation), at most half a step (extent / 131070) from the float. */
-    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    return 0;
+}
+
+/* Positions with their bounds; --compress: uint16 (KHR_mesh_quantization,
+ * as gltfpack writes it: byteStride 8), dequantised by the node's
+ * transform (one scale for the three axes, so normals stay right; a
+ * translation), at most half a step (extent / 131070) from the float. */
+static int put_positions(exporter *e)
+{
+    const vdsh_file *f = e->f;
+    const uint32_t nv = e->nv;
+    float *lo = e->lo, *hi = e->hi;
+    for (int k = 0; k < 3; k++)
+        lo[k] = INFINITY, hi[k] = -INFINITY;
     for (size_t i = 0; i < nv; i++)
         for (int k = 0; k < 3; k++) {
             float p = f->positions[3 * i + (size_t)k];
             lo[k] = p < lo[k] ? p : lo[k];
             hi[k] = p > hi[k] ? p : hi[k];
         }
-    double qstep = 0;
-    {
-        int v, a;
-        double dlo[3] = {lo[0], lo[1], lo[2]}, dhi[3] = {hi[0], hi[1], hi[2]};
-        if (compress) {
-            double ext = 0;
-            for (int k = 0; k < 3; k++)
-                ext = dhi[k] - dlo[k] > ext ? dhi[k] - dlo[k] : ext;
-            qstep = ext > 0 ? ext / 65535 : 1;
-            uint16_t *q = (uint16_t *)tmp;
-            for (size_t i = 0; i < nv; i++) {
-                for (int k = 0; k < 3; k++) {
-                    long r = lrint((f->positions[3 * i + (size_t)k] - dlo[k]) / qstep);
-                    q[4 * i + (size_t)k] = (uint16_t)(r < 0 ? 0 : r > 65535 ? 65535 : r);
-                }
-                q[4 * i + 3] = 0;
-            }
-            for (int k = 0; k < 3; k++) {
-                long l = lrint((dhi[k] - dlo[k]) / qstep);
-                dlo[k] = 0;
-                dhi[k] = (double)(l > 65535 ? 65535 : l);
-            }
-            /* the bounds of the stored integers */
-            for (int k = 0; k < 3; k++) {
-                uint16_t mn = 65535, mx = 0;
-                for (size_t i = 0; i < nv; i++) {
-                    uint16_t c = q[4 * i + (size_t)k];
-                    mn = c < mn ? c : mn;
-                    mx = c > mx ? c : mx;
-                }
-                dlo[k] = mn, dhi[k] = mx;
-            }
-            v = add_view(&vl, q, (size_t)nv * 8, 8, 34962);
-            a = add_accessor(accs, v, 5123, 0, nv, "VEC3");
-        } else {
-            v = add_view(&vl, f->positions, (size_t)nv * 12, 12, 34962);
-            a = add_accessor(accs, v, 5126, 0, nv, "VEC3");
-        }
-        if (v < 0)
-            goto oom;
-        cJSON *acc = cJSON_GetArrayItem(accs, a);
-        cJSON_AddItemToObject(acc, "min", cJSON_CreateDoubleArray(dlo, 3));
-        cJSON_AddItemToObject(acc, "max", cJSON_CreateDoubleArray(dhi, 3));
-        cJSON_AddNumberToObject(attrs, "POSITION", a);
-    }
-    /* Normals: unit; an undefined (0,0,0) one is written as (0,0,1) and
-     * counted in extras (glTF requires unit normals). */
-    {
-        uint32_t undefined = 0;
+    int v, a;
+    double dlo[3] = {lo[0], lo[1], lo[2]}, dhi[3] = {hi[0], hi[1], hi[2]};
+    if (e->o->compress) {
+        double ext = 0, qstep;
+        for (int k = 0; k < 3; k++)
+            ext = dhi[k] - dlo[k] > ext ? dhi[k] - dlo[k] : ext;
+        qstep = e->qstep = ext > 0 ? ext / 65535 : 1;
+        uint16_t *q = (uint16_t *)e->tmp;
         for (size_t i = 0; i < nv; i++) {
-            const float *n = f->normals + 3 * i;
-            double l = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-            if (l < 1e-6) {
-                tmp[3 * i] = 0, tmp[3 * i + 1] = 0, tmp[3 * i + 2] = 1;
-                undefined++;
-            } else {
-                for (int k = 0; k < 3; k++)
-                    tmp[3 * i + (size_t)k] = (float)(n[k] / l);
+            for (int k = 0; k < 3; k++) {
+                long r = lrint((f->positions[3 * i + (size_t)k] - dlo[k]) / qstep);
+                q[4 * i + (size_t)k] = (uint16_t)(r < 0 ? 0 : r > 65535 ? 65535 : r);
             }
+            q[4 * i + 3] = 0;
         }
-        int v;
-        if (compress) { /* normalised int8 (KHR_mesh_quantization), byteStride 4 */
-            int8_t *q = (int8_t *)(tmp + 3 * (size_t)nv);
+        for (int k = 0; k < 3; k++) {
+            long l = lrint((dhi[k] - dlo[k]) / qstep);
+            dlo[k] = 0;
+            dhi[k] = (double)(l > 65535 ? 65535 : l);
+        }
+        /* the bounds of the stored integers */
+        for (int k = 0; k < 3; k++) {
+            uint16_t mn = 65535, mx = 0;
             for (size_t i = 0; i < nv; i++) {
-                for (int k = 0; k < 3; k++)
-                    q[4 * i + (size_t)k] = (int8_t)lrintf(tmp[3 * i + (size_t)k] * 127.0f);
-                q[4 * i + 3] = 0;
+                uint16_t c = q[4 * i + (size_t)k];
+                mn = c < mn ? c : mn;
+                mx = c > mx ? c : mx;
             }
-            v = add_view(&vl, q, (size_t)nv * 4, 4, 34962);
-        } else {
-            v = add_view(&vl, tmp, (size_t)nv * 12, 12, 34962);
+            dlo[k] = mn, dhi[k] = mx;
         }
-        if (v < 0)
-            goto oom;
-        cJSON_AddNumberToObject(attrs, "NORMAL", add_accessor(accs, v, compress ? 5120 : 5126, compress, nv, "VEC3"));
-        cJSON_AddNumberToObject(vx, "undefined_normals", undefined);
+        v = add_view(&e->vl, q, (size_t)nv * 8, 8, 34962);
+        a = add_accessor(e->accs, v, 5123, 0, nv, "VEC3");
+    } else {
+        v = add_view(&e->vl, f->positions, (size_t)nv * 12, 12, 34962);
+        a = add_accessor(e->accs, v, 5126, 0, nv, "VEC3");
     }
-    cJSON_AddNumberToObject(vx, "vertex_count", nv);
-    cJSON_AddNumberToObject(vx, "triangle_count", nt);
+    if (v < 0)
+        return -1;
+    cJSON *acc = cJSON_GetArrayItem(e->accs, a);
+    cJSON_AddItemToObject(acc, "min", cJSON_CreateDoubleArray(dlo, 3));
+    cJSON_AddItemToObject(acc, "max", cJSON_CreateDoubleArray(dhi, 3));
+    cJSON_AddNumberToObject(e->attrs, "POSITION", a);
+    return 0;
+}
+
+/* Normals: unit; an undefined (0,0,0) one is written as (0,0,1) and
+ * counted in extras (glTF requires unit normals). */
+static int put_normals(exporter *e)
+{
+    const uint32_t nv = e->nv;
+    const int compress = e->o->compress;
+    float *tmp = e->tmp;
+    uint32_t undefined = 0;
+    for (size_t i = 0; i < nv; i++) {
+        const float *n = e->f->normals + 3 * i;
+        double l = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        if (l < 1e-6) {
+            tmp[3 * i] = 0, tmp[3 * i + 1] = 0, tmp[3 * i + 2] = 1;
+            undefined++;
+        } else {
+            for (int k = 0; k < 3; k++)
+                tmp[3 * i + (size_t)k] = (float)(n[k] / l);
+        }
+    }
+    int v;
+    if (compress) { /* normalised int8 (KHR_mesh_quantization), byteStride 4 */
+        int8_t *q = (int8_t *)(tmp + 3 * (size_t)nv);
+        for (size_t i = 0; i < nv; i++) {
+            for (int k = 0; k < 3; k++)
+                q[4 * i + (size_t)k] = (int8_t)lrintf(tmp[3 * i + (size_t)k] * 127.0f);
+            q[4 * i + 3] = 0;
+        }
+        v = add_view(&e->vl, q, (size_t)nv * 4, 4, 34962);
+    } else {
+        v = add_view(&e->vl, tmp, (size_t)nv * 12, 12, 34962);
+    }
+    if (v < 0)
+        return -1;
+    cJSON_AddNumberToObject(e->attrs, "NORMAL",
+                            add_accessor(e->accs, v, compress ? 5120 : 5126, compress, nv, "VEC3"));
+    cJSON_AddNumberToObject(e->vx, "undefined_normals", undefined);
+    return 0;
+}
+
+/* extras.vdsh: the bake's parameters, the default view and the sources. */
+static int describe_bake(exporter *e)
+{
+    const vdsh_file *f = e->f;
+    cJSON *vx = e->vx;
+    cJSON_AddNumberToObject(vx, "vertex_count", e->nv);
+    cJSON_AddNumberToObject(vx, "triangle_count", e->nt);
     cJSON_AddNumberToObject(vx, "max_distance", f->header.max_distance);
     cJSON_AddNumberToObject(vx, "max_edge", f->header.max_edge);
     cJSON_AddNumberToObject(vx, "rays", f->header.rays);
@@ -810,23 +859,23 @@ int main(int argc, char **argv)
     /* The default view: vdsh-view's camera and lights (one definition,
      * formats/vdsh_scene_view.h), from the same mesh. */
     {
-        vdsh_view_mesh vm = {f->positions, f->normals, f->indices, nv, nt};
+        vdsh_view_mesh vm = {f->positions, f->normals, f->indices, e->nv, e->nt};
         vdsh_view view;
         vdsh_error ve;
         if (vdsh_view_compute(&vm, &view, &ve) != VDSH_OK) {
-            fprintf(stderr, "vdsh-export: %s: the default view: %s\n", in, ve.msg);
-            goto done;
+            fprintf(stderr, "vdsh-export: %s: the default view: %s\n", e->o->in, ve.msg);
+            return 1;
         }
         cJSON *vo = cJSON_AddObjectToObject(vx, "view");
-        double e[3], t[3], u[3];
+        double eye[3], t[3], u[3];
         for (int k = 0; k < 3; k++)
-            e[k] = view.camera.eye[k], t[k] = view.camera.target[k],
+            eye[k] = view.camera.eye[k], t[k] = view.camera.target[k],
             u[k] = view.camera.up[k];
         if (u[0] == 0 && u[1] == 0 && u[2] == 0)
             u[1] = 1;
         cJSON_AddBoolToObject(vo, "interior", view.interior);
         cJSON_AddNumberToObject(vo, "front_share", view.front_share);
-        cJSON_AddItemToObject(vo, "eye", cJSON_CreateDoubleArray(e, 3));
+        cJSON_AddItemToObject(vo, "eye", cJSON_CreateDoubleArray(eye, 3));
         cJSON_AddItemToObject(vo, "target", cJSON_CreateDoubleArray(t, 3));
         cJSON_AddItemToObject(vo, "up", cJSON_CreateDoubleArray(u, 3));
         cJSON_AddNumberToObject(vo, "fov_y", view.camera.fov_y > 0 ? view.camera.fov_y : 60);
@@ -849,173 +898,226 @@ int main(int argc, char **argv)
         cJSON_AddStringToObject(o, "sha256", hex);
         cJSON_AddItemToArray(srcs, o);
     }
-    cJSON *streams = cJSON_AddArrayToObject(vx, "streams");
-    int exported = 0;
+    return 0;
+}
+
+/* One stream's coefficients as groups of four: float, or int16
+ * normalised by the stream's largest magnitude (its "scale"). */
+static int put_coefficients(exporter *e, const vdsh_stream *s, const char *prefix,
+                            cJSON *streams)
+{
+    const uint32_t nv = e->nv, nc = s->order * s->order, groups = (nc + 3) / 4;
+    const int use_float = e->o->use_float;
+    float *tmp = e->tmp, *coef = e->coef;
+    double maxabs = 0;
+    for (uint32_t v = 0; v < nv; v++) {
+        vdsh_stream_decode(s, v, coef);
+        for (uint32_t c = 0; c < nc; c++)
+            maxabs = fabs(coef[c]) > maxabs ? fabs(coef[c]) : maxabs;
+    }
+    const double scale = maxabs > 0 ? maxabs : 1.0;
+    cJSON *so = stream_entry(s, prefix, groups);
+    /* an order per vertex (vdsh-bake --adaptive-order): coefficients
+     * past a vertex's own order are exported as 0 */
+    cJSON_AddBoolToObject(so, "variable_order", (s->flags & VDSH_STREAM_VARIABLE) != 0);
+    cJSON_AddStringToObject(so, "component", use_float ? "float" : "int16_normalized");
+    cJSON_AddNumberToObject(so, "scale", use_float ? 1.0 : scale);
+    cJSON_AddItemToArray(streams, so);
+    for (uint32_t g = 0; g < groups; g++) {
+        size_t bytes;
+        if (use_float) {
+            for (uint32_t v = 0; v < nv; v++) {
+                vdsh_stream_decode(s, v, coef);
+                for (uint32_t k = 0; k < 4; k++)
+                    tmp[4 * (size_t)v + k] = 4 * g + k < nc ? coef[4 * g + k] : 0.0f;
+            }
+            bytes = (size_t)nv * 16;
+        } else {
+            int16_t *q = (int16_t *)tmp;
+            for (uint32_t v = 0; v < nv; v++) {
+                vdsh_stream_decode(s, v, coef);
+                for (uint32_t k = 0; k < 4; k++) {
+                    double c = 4 * g + k < nc ? coef[4 * g + k] / scale : 0.0;
+                    long r = lrint(c * 32767.0);
+                    q[4 * (size_t)v + k] = (int16_t)(r > 32767 ? 32767 : r < -32767 ? -32767 : r);
+                }
+            }
+            bytes = (size_t)nv * 8;
+        }
+        int view = add_view(&e->vl, tmp, bytes, use_float ? 16 : 8, 34962);
+        if (view < 0)
+            return -1;
+        char name[48];
+        snprintf(name, sizeof name, "%s%u", prefix, g);
+        cJSON_AddNumberToObject(e->attrs, name,
+                                add_accessor(e->accs, view, use_float ? 5126 : 5122, !use_float, nv, "VEC4"));
+    }
+    return 0;
+}
+
+/* The streams of the orders asked for (every stream without --orders). */
+static int put_streams(exporter *e)
+{
+    const options *o = e->o;
+    const vdsh_file *f = e->f;
+    cJSON *streams = cJSON_AddArrayToObject(e->vx, "streams");
     for (uint32_t si = 0; si < f->stream_count; si++) {
         const vdsh_stream *s = &f->streams[si];
-        if (any_order && (s->order > VDSH_MAX_ORDER || !want[s->order]))
+        if (o->any_order && (s->order > VDSH_MAX_ORDER || !o->want[s->order]))
             continue;
-        const uint32_t nc = s->order * s->order, groups = (nc + 3) / 4;
         /* Two streams of one order (distance and log): the second gets a
          * suffix so attribute names stay unique. */
         int dup = 0;
         for (uint32_t sj = 0; sj < si; sj++)
-            dup += f->streams[sj].order == s->order && (!any_order || want[s->order]);
+            dup += f->streams[sj].order == s->order && (!o->any_order || o->want[s->order]);
         char prefix[32];
         if (dup)
             snprintf(prefix, sizeof prefix, "_VDSH%u%c_", s->order, 'a' + dup);
         else
             snprintf(prefix, sizeof prefix, "_VDSH%u_", s->order);
-        if (s->encoding == VDSH_ENCODING_CPCA && !source && !decode_cpca) {
-            if (export_cpca(s, nv, prefix, &vl, accs, attrs, streams, tmp) != 0)
-                goto oom;
-            exported++;
-            continue;
-        }
-        double maxabs = 0;
-        for (uint32_t v = 0; v < nv; v++) {
-            vdsh_stream_decode(s, v, coef);
-            for (uint32_t c = 0; c < nc; c++)
-                maxabs = fabs(coef[c]) > maxabs ? fabs(coef[c]) : maxabs;
-        }
-        const double scale = maxabs > 0 ? maxabs : 1.0;
-        cJSON *so = stream_entry(s, prefix, groups);
-        /* an order per vertex (vdsh-bake --adaptive-order): coefficients
-         * past a vertex's own order are exported as 0 */
-        cJSON_AddBoolToObject(so, "variable_order", (s->flags & VDSH_STREAM_VARIABLE) != 0);
-        cJSON_AddStringToObject(so, "component", use_float ? "float" : "int16_normalized");
-        cJSON_AddNumberToObject(so, "scale", use_float ? 1.0 : scale);
-        cJSON_AddItemToArray(streams, so);
-        for (uint32_t g = 0; g < groups; g++) {
-            size_t bytes;
-            if (use_float) {
-                for (uint32_t v = 0; v < nv; v++) {
-                    vdsh_stream_decode(s, v, coef);
-                    for (uint32_t k = 0; k < 4; k++)
-                        tmp[4 * (size_t)v + k] = 4 * g + k < nc ? coef[4 * g + k] : 0.0f;
-                }
-                bytes = (size_t)nv * 16;
-            } else {
-                int16_t *q = (int16_t *)tmp;
-                for (uint32_t v = 0; v < nv; v++) {
-                    vdsh_stream_decode(s, v, coef);
-                    for (uint32_t k = 0; k < 4; k++) {
-                        double c = 4 * g + k < nc ? coef[4 * g + k] / scale : 0.0;
-                        long r = lrint(c * 32767.0);
-                        q[4 * (size_t)v + k] = (int16_t)(r > 32767 ? 32767 : r < -32767 ? -32767 : r);
-                    }
-                }
-                bytes = (size_t)nv * 8;
-            }
-            int view = add_view(&vl, tmp, bytes, use_float ? 16 : 8, 34962);
-            if (view < 0)
-                goto oom;
-            char name[48];
-            snprintf(name, sizeof name, "%s%u", prefix, g);
-            cJSON_AddNumberToObject(attrs, name,
-                                    add_accessor(accs, view, use_float ? 5126 : 5122, !use_float, nv, "VEC4"));
-        }
-        exported++;
+        int rc = s->encoding == VDSH_ENCODING_CPCA && !o->source && !o->decode_cpca
+                     ? export_cpca(s, e->nv, prefix, &e->vl, e->accs, e->attrs, streams, e->tmp)
+                     : put_coefficients(e, s, prefix, streams);
+        if (rc)
+            return rc;
+        e->exported++;
     }
-    if (any_order && !exported) {
-        fprintf(stderr, "vdsh-export: %s: no stream of the orders asked for\n", in);
-        goto done;
+    if (o->any_order && !e->exported) {
+        fprintf(stderr, "vdsh-export: %s: no stream of the orders asked for\n", o->in);
+        return 1;
     }
-    if (source) {
-        if (with_source(in, source, f, root, &vl, attrs, &vx, &b, compress) != 0)
-            goto done;
-        goto write;
-    }
+    return 0;
+}
+
+/* The receiver mesh's own scene: the views in the BIN chunk, one mesh of
+ * one primitive with extras.vdsh, one node (--compress: dequantising). */
+static int assemble(exporter *e)
+{
+    const int compress = e->o->compress;
+    cJSON *root = e->root;
     size_t raw_size = 0;
-    if (write_views(&vl, compress, &b, views, &raw_size) || blob_align4(&b))
-        goto oom;
-    {
-        add_buffers(root, b.size, compress, raw_size);
-        if (compress) {
-            const char *names[2] = {"KHR_mesh_quantization", "EXT_meshopt_compression"};
-            for (int k = 0; k < 2; k++) {
-                list_extension(root, "extensionsUsed", names[k]);
-                list_extension(root, "extensionsRequired", names[k]);
-            }
+    if (write_views(&e->vl, compress, &e->b, e->views, &raw_size) || blob_align4(&e->b))
+        return -1;
+    add_buffers(root, e->b.size, compress, raw_size);
+    if (compress) {
+        const char *names[2] = {"KHR_mesh_quantization", "EXT_meshopt_compression"};
+        for (int k = 0; k < 2; k++) {
+            list_extension(root, "extensionsUsed", names[k]);
+            list_extension(root, "extensionsRequired", names[k]);
         }
-        cJSON *prim = cJSON_CreateObject();
-        cJSON_AddItemToObject(prim, "attributes", attrs);
-        attrs = NULL;
-        cJSON_AddNumberToObject(prim, "indices", ind_acc);
-        cJSON_AddNumberToObject(prim, "mode", 4);
-        cJSON *mesh = cJSON_CreateObject();
-        cJSON *prims = cJSON_AddArrayToObject(mesh, "primitives");
-        cJSON_AddItemToArray(prims, prim);
-        cJSON *extras = cJSON_AddObjectToObject(mesh, "extras");
-        cJSON_AddItemToObject(extras, "vdsh", vx);
-        vx = NULL;
-        cJSON *meshes = cJSON_AddArrayToObject(root, "meshes");
-        cJSON_AddItemToArray(meshes, mesh);
-        cJSON *node = cJSON_CreateObject();
-        cJSON_AddNumberToObject(node, "mesh", 0);
-        if (compress) {
-            double t[3] = {lo[0], lo[1], lo[2]}, sc[3] = {qstep, qstep, qstep};
-            cJSON_AddItemToObject(node, "translation", cJSON_CreateDoubleArray(t, 3));
-            cJSON_AddItemToObject(node, "scale", cJSON_CreateDoubleArray(sc, 3));
-        }
-        cJSON *nodes = cJSON_AddArrayToObject(root, "nodes");
-        cJSON_AddItemToArray(nodes, node);
-        cJSON *scene = cJSON_CreateObject();
-        cJSON *sn = cJSON_AddArrayToObject(scene, "nodes");
-        cJSON_AddItemToArray(sn, cJSON_CreateNumber(0));
-        cJSON *scenes = cJSON_AddArrayToObject(root, "scenes");
-        cJSON_AddItemToArray(scenes, scene);
-        cJSON_AddNumberToObject(root, "scene", 0);
     }
-write: {
-        char *json = cJSON_PrintUnformatted(root);
-        if (!json)
-            goto oom;
-        size_t jl = strlen(json), jpad = (4 - jl % 4) % 4;
-        uint64_t total = 12 + 8 + jl + jpad + 8 + b.size;
-        if (total > 0xffffffffu) {
-            fprintf(stderr, "vdsh-export: %s: the glb would be %llu bytes (over glTF's 4 GiB)\n", in,
-                    (unsigned long long)total);
-            free(json);
-            goto done;
-        }
-        vdsh_output o;
-        if (vdsh_output_open(out, &o, &verr) != VDSH_OK) {
-            fprintf(stderr, "vdsh-export: %s\n", verr.msg);
-            free(json);
-            goto done;
-        }
-        uint32_t h[3] = {0x46546C67u, 2, (uint32_t)total};
-        uint32_t jh[2] = {(uint32_t)(jl + jpad), 0x4E4F534Au};
-        uint32_t bh[2] = {(uint32_t)b.size, 0x004E4942u};
-        vdsh_output_put(&o, h, 12);
-        vdsh_output_put(&o, jh, 8);
-        vdsh_output_put(&o, json, jl);
-        vdsh_output_put(&o, "   ", jpad);
-        vdsh_output_put(&o, bh, 8);
-        vdsh_output_put(&o, b.data, b.size);
+    cJSON *prim = cJSON_CreateObject();
+    cJSON_AddItemToObject(prim, "attributes", e->attrs);
+    e->attrs = NULL;
+    cJSON_AddNumberToObject(prim, "indices", e->ind_acc);
+    cJSON_AddNumberToObject(prim, "mode", 4);
+    cJSON *mesh = cJSON_CreateObject();
+    cJSON *prims = cJSON_AddArrayToObject(mesh, "primitives");
+    cJSON_AddItemToArray(prims, prim);
+    cJSON *extras = cJSON_AddObjectToObject(mesh, "extras");
+    cJSON_AddItemToObject(extras, "vdsh", e->vx);
+    e->vx = NULL;
+    cJSON *meshes = cJSON_AddArrayToObject(root, "meshes");
+    cJSON_AddItemToArray(meshes, mesh);
+    cJSON *node = cJSON_CreateObject();
+    cJSON_AddNumberToObject(node, "mesh", 0);
+    if (compress) {
+        double t[3] = {e->lo[0], e->lo[1], e->lo[2]}, sc[3] = {e->qstep, e->qstep, e->qstep};
+        cJSON_AddItemToObject(node, "translation", cJSON_CreateDoubleArray(t, 3));
+        cJSON_AddItemToObject(node, "scale", cJSON_CreateDoubleArray(sc, 3));
+    }
+    cJSON *nodes = cJSON_AddArrayToObject(root, "nodes");
+    cJSON_AddItemToArray(nodes, node);
+    cJSON *scene = cJSON_CreateObject();
+    cJSON *sn = cJSON_AddArrayToObject(scene, "nodes");
+    cJSON_AddItemToArray(sn, cJSON_CreateNumber(0));
+    cJSON *scenes = cJSON_AddArrayToObject(root, "scenes");
+    cJSON_AddItemToArray(scenes, scene);
+    cJSON_AddNumberToObject(root, "scene", 0);
+    return 0;
+}
+
+/* The .glb: header, JSON chunk, BIN chunk, written atomically. */
+static int write_glb(exporter *e)
+{
+    const char *in = e->o->in, *out = e->o->out;
+    char *json = cJSON_PrintUnformatted(e->root);
+    if (!json)
+        return -1;
+    size_t jl = strlen(json), jpad = (4 - jl % 4) % 4;
+    uint64_t total = 12 + 8 + jl + jpad + 8 + e->b.size;
+    if (total > 0xffffffffu) {
+        fprintf(stderr, "vdsh-export: %s: the glb would be %llu bytes (over glTF's 4 GiB)\n", in,
+                (unsigned long long)total);
         free(json);
-        if (vdsh_output_commit(&o, &verr) != VDSH_OK) {
-            fprintf(stderr, "vdsh-export: %s\n", verr.msg);
-            goto done;
-        }
-        if (!quiet)
-            fprintf(stderr, "vdsh-export: wrote %s (%llu bytes, %d stream%s)\n", out,
-                    (unsigned long long)total, exported, exported == 1 ? "" : "s");
-        rc = 0;
-        goto done;
+        return 1;
     }
-oom:
-    fprintf(stderr, "vdsh-export: %s: out of memory\n", in);
-done:
-    cJSON_Delete(root);
-    cJSON_Delete(attrs);
-    cJSON_Delete(vx);
-    free(b.data);
-    view_list_free(&vl);
-    free(tri_sorted);
-    free(tmp);
-    free(coef);
+    vdsh_output o;
+    vdsh_error verr;
+    if (vdsh_output_open(out, &o, &verr) != VDSH_OK) {
+        fprintf(stderr, "vdsh-export: %s\n", verr.msg);
+        free(json);
+        return 1;
+    }
+    uint32_t h[3] = {0x46546C67u, 2, (uint32_t)total};
+    uint32_t jh[2] = {(uint32_t)(jl + jpad), 0x4E4F534Au};
+    uint32_t bh[2] = {(uint32_t)e->b.size, 0x004E4942u};
+    vdsh_output_put(&o, h, 12);
+    vdsh_output_put(&o, jh, 8);
+    vdsh_output_put(&o, json, jl);
+    vdsh_output_put(&o, "   ", jpad);
+    vdsh_output_put(&o, bh, 8);
+    vdsh_output_put(&o, e->b.data, e->b.size);
+    free(json);
+    if (vdsh_output_commit(&o, &verr) != VDSH_OK) {
+        fprintf(stderr, "vdsh-export: %s\n", verr.msg);
+        return 1;
+    }
+    if (!e->o->quiet)
+        fprintf(stderr, "vdsh-export: wrote %s (%llu bytes, %d stream%s)\n", out,
+                (unsigned long long)total, e->exported, e->exported == 1 ? "" : "s");
+    return 0;
+}
+
+/* Read, build the glTF step by step, write. */
+static int run(const options *o)
+{
+    const char *ins[2] = {o->in, o->source};
+    if (vt_cli_check_outputs(&o->out, 1, ins, o->source ? 2 : 1) != 0)
+        return 1;
+    vdsh_file *f = vt_read_whole(o->in);
+    if (!f)
+        return 1;
+    exporter e;
+    int rc = exporter_begin(&e, o, f);
+    if (!rc)
+        rc = put_indices(&e);
+    if (!rc)
+        rc = put_positions(&e);
+    if (!rc)
+        rc = put_normals(&e);
+    if (!rc)
+        rc = describe_bake(&e);
+    if (!rc)
+        rc = put_streams(&e);
+    if (!rc && o->source)
+        rc = with_source(o->in, o->source, f, e.root, &e.vl, e.attrs, &e.vx, &e.b,
+                         o->compress) != 0;
+    else if (!rc)
+        rc = assemble(&e);
+    if (!rc)
+        rc = write_glb(&e);
+    if (rc < 0)
+        fprintf(stderr, "vdsh-export: %s: out of memory\n", o->in);
+    exporter_free(&e);
     vdsh_free(f);
-    return rc;
+    return rc ? 1 : 0;
+}
+
+int main(int argc, char **argv)
+{
+    vt_cli_begin("vdsh-export", argv);
+    options o;
+    int status = parse_args(argc, argv, &o);
+    return status >= 0 ? status : run(&o);
 }

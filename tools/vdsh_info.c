@@ -17,6 +17,7 @@
 #include "vdsh_output.h"
 #include "vt_cli.h"
 #include "vt_json.h"
+#include "vt_record.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -355,12 +356,7 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
     json_bounds(&j, root, "receiver_bounds", lo, hi);
 
     cJSON *bake = vt_json_object(&j, root, "bake");
-    vt_json_u64(&j, bake, "rays", h->rays);
-    vt_json_string(&j, bake, "sampling", vdsh_sampling_name(h->sampling));
-    vt_json_u64(&j, bake, "seed", h->seed);
-    vt_json_f32(&j, bake, "max_distance", h->max_distance);
-    vt_json_f32(&j, bake, "max_edge", h->max_edge);
-    vt_json_string(&j, bake, "offset_rule", vdsh_offset_rule_name(h->offset_rule));
+    vt_record_params(&j, bake, h);
     vt_json_u64(&j, bake, "load_flags", h->load_flags);
     vt_json_bool(&j, bake, "welded", h->load_flags & VDSH_LOAD_WELD);
     vt_json_u64(&j, bake, "trace_flags", h->trace_flags);
@@ -428,17 +424,7 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
         vt_json_f64(&j, c0, "mean", st.mean);
     }
 
-    if (f->has_stats) {
-        cJSON *st = vt_json_object(&j, root, "stats");
-        vt_json_u64(&j, st, "rays_traced", f->stats.rays_traced);
-        vt_json_u64(&j, st, "rays_missed", f->stats.rays_missed);
-        vt_json_u64(&j, st, "degenerate_receivers", f->stats.degenerate_receivers);
-        vt_json_u64(&j, st, "undefined_normals", f->stats.undefined_normals);
-        vt_json_u64(&j, st, "moved_origins", f->stats.moved_origins);
-        vt_json_u64(&j, st, "flipped_normals", f->stats.flipped_normals);
-    } else {
-        vt_json_null(&j, root, "stats");
-    }
+    vt_record_stats(&j, root, f, 1);
 
     if (f->has_part) {
         cJSON *pt = vt_json_object(&j, root, "part");
@@ -454,28 +440,18 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
         }
     }
     if (f->has_adaptive) {
+        const vdsh_adaptive *a = &f->adaptive;
+        const struct { const char *key; uint64_t v; } count[] = {
+            {"max_receivers", a->max_receivers}, {"lights", a->lights},
+            {"max_rounds", a->max_rounds}, {"start_receivers", a->start_receivers},
+            {"rounds", a->rounds}, {"candidates", a->candidates}};
         cJSON *ad = vt_json_object(&j, root, "adaptive");
-        vt_json_f32(&j, ad, "tolerance", f->adaptive.tolerance);
-        vt_json_f32(&j, ad, "min_edge", f->adaptive.min_edge);
-        vt_json_u64(&j, ad, "max_receivers", f->adaptive.max_receivers);
-        vt_json_u64(&j, ad, "lights", f->adaptive.lights);
-        vt_json_u64(&j, ad, "max_rounds", f->adaptive.max_rounds);
-        vt_json_u64(&j, ad, "start_receivers", f->adaptive.start_receivers);
-        vt_json_u64(&j, ad, "rounds", f->adaptive.rounds);
-        vt_json_u64(&j, ad, "candidates", f->adaptive.candidates);
+        vt_json_f32(&j, ad, "tolerance", a->tolerance);
+        vt_json_f32(&j, ad, "min_edge", a->min_edge);
+        for (size_t i = 0; i < sizeof count / sizeof count[0]; i++)
+            vt_json_u64(&j, ad, count[i].key, count[i].v);
     }
-    if (f->has_timings) {
-        const vdsh_timings *t = &f->timings;
-        cJSON *tm = vt_json_object(&j, root, "timings");
-        vt_json_f64(&j, tm, "load", t->load);
-        vt_json_f64(&j, tm, "refine", t->refine);
-        vt_json_f64(&j, tm, "build", t->build);
-        vt_json_f64(&j, tm, "trace", t->trace);
-        vt_json_f64(&j, tm, "total", t->total);
-        vt_json_u64(&j, tm, "threads", t->threads);
-    } else {
-        vt_json_null(&j, root, "timings");
-    }
+    vt_record_timings(&j, root, f);
     return json_emit(&j, path);
 }
 
@@ -668,26 +644,37 @@ static int info(const char *path, int json, int first)
     return ok;
 }
 
-int main(int argc, char **argv)
+/* ------------------------------------------------------------------ */
+/* The command line                                                    */
+/* ------------------------------------------------------------------ */
+
+typedef struct options {
+    const char *json_out;      /* --json FILE ('-': stdout), or NULL */
+    int check;                 /* --verify */
+    char **files;              /* FILE.vdsh... */
+    int file_count;
+} options;
+
+/* -1 with *o ready to run, else the exit status (help, version, a usage
+ * error: said). */
+static int parse_args(int argc, char **argv, options *o)
 {
-    static const struct option options[] = {
+    static const struct option longopts[] = {
         {"json", required_argument, NULL, 'j'},
         {"verify", no_argument, NULL, 'c'},
         {"help", no_argument, NULL, 'h'},
         {"version", no_argument, NULL, 'V'},
         {NULL, 0, NULL, 0},
     };
-    vt_cli_begin(prog, argv);
-    const char *json_out = NULL;
-    int json = 0, check = 0, opt;
-    while ((opt = getopt_long(argc, argv, "j:hV", options, NULL)) != -1) {
+    memset(o, 0, sizeof *o);
+    int opt;
+    while ((opt = getopt_long(argc, argv, "j:hV", longopts, NULL)) != -1) {
         switch (opt) {
         case 'j':
-            json = 1;
-            json_out = optarg;
+            o->json_out = optarg;
             break;
         case 'c':
-            check = 1;
+            o->check = 1;
             break;
         case 'h':
             usage(stdout);
@@ -699,24 +686,33 @@ int main(int argc, char **argv)
         }
     }
     if (optind >= argc) {
-        size_t n = json_out ? strlen(json_out) : 0;
-        if (n > 5 && strcmp(json_out + n - 5, ".vdsh") == 0)
+        size_t n = o->json_out ? strlen(o->json_out) : 0;
+        if (n > 5 && strcmp(o->json_out + n - 5, ".vdsh") == 0)
             return vt_usage_error(prog, "no input file (--json takes the JSON file to write: "
-                                  "--json - %s prints it)", json_out);
+                                  "--json - %s prints it)", o->json_out);
         return vt_usage_error(prog, "%s", "no input file");
     }
-    if (json_out && vt_cli_check_outputs(&json_out, 1, (const char *const *)argv + optind,
-                                         argc - optind) != 0)
+    o->files = argv + optind;
+    o->file_count = argc - optind;
+    return -1;
+}
+
+/* Every file in turn (each failure said, the others still done), then
+ * the JSON of them all. */
+static int run(const options *o)
+{
+    const int json = o->json_out != NULL;
+    if (json && vt_cli_check_outputs(&o->json_out, 1, (const char *const *)o->files,
+                                     o->file_count) != 0)
         return 1;
 
     int ok = 1;
-    for (int i = optind; i < argc; i++) {
-        if (check && !json && i > optind)
+    for (int i = 0; i < o->file_count; i++) {
+        if (o->check && !json && i > 0)
             putchar('\n');
-        ok &= check ? verify(argv[i], json)
-                    : info(argv[i], json, i == optind);
+        ok &= o->check ? verify(o->files[i], json) : info(o->files[i], json, i == 0);
     }
-    if (json && !json_write(json_out))
+    if (json && !json_write(o->json_out))
         ok = 0;
     free(json_text);
     if (fflush(stdout) != 0 || ferror(stdout)) {
@@ -725,4 +721,12 @@ int main(int argc, char **argv)
         return 1;
     }
     return ok ? 0 : 1;
+}
+
+int main(int argc, char **argv)
+{
+    vt_cli_begin(prog, argv);
+    options o;
+    int status = parse_args(argc, argv, &o);
+    return status >= 0 ? status : run(&o);
 }

@@ -289,3 +289,157 @@ int vt_cli_check_outputs(const char *const *outputs, int output_count,
             return 1;
     return 0;
 }
+
+/* ---- option checks for parse_args() ------------------------------------ */
+
+int vt_cli_common_option(int c, void (*usage)(FILE *), const char *version_detail)
+{
+    if (c == 'h') {
+        usage(stdout);
+        return 0;
+    }
+    if (c == 'V')
+        return vt_cli_version(version_detail);
+    return vt_cli_try_help();
+}
+
+/* "OPTION takes WHAT LO..HI, not 'ARG'" (hi NULL: "WHAT >= LO", both NULL:
+ * "WHAT"). Returns 0, for the vt_opt_* functions to return. */
+static int refuse_range(const char *option, const char *what, const char *arg, const char *lo,
+                        const char *hi)
+{
+    const char *w = what ? what : "a whole number";
+    const char *space = *w ? " " : "";
+    if (lo && hi)
+        vt_usage_error(cli_prog, "%s takes %s%s%s..%s, not '%s'", option, w, space, lo, hi,
+                       arg);
+    else if (lo)
+        vt_usage_error(cli_prog, "%s takes %s >= %s, not '%s'", option, w, lo, arg);
+    else
+        vt_usage_error(cli_prog, "%s takes %s, not '%s'", option, w, arg);
+    return 0;
+}
+
+int vt_opt_u64(const char *option, const char *what, const char *arg, uint64_t lo,
+               uint64_t hi, uint64_t *out)
+{
+    if (vt_parse_u64(arg, lo, hi, out))
+        return 1;
+    char l[24], h[24];
+    snprintf(l, sizeof l, "%llu", (unsigned long long)lo);
+    snprintf(h, sizeof h, "%llu", (unsigned long long)hi);
+    return refuse_range(option, what, arg, hi == UINT64_MAX && lo == 0 ? NULL : l,
+                        hi == UINT64_MAX ? NULL : h);
+}
+
+int vt_opt_u32(const char *option, const char *what, const char *arg, uint32_t lo,
+               uint32_t hi, uint32_t *out)
+{
+    uint64_t v;
+    if (!vt_opt_u64(option, what, arg, lo, hi, &v))
+        return 0;
+    *out = (uint32_t)v;
+    return 1;
+}
+
+int vt_opt_int(const char *option, const char *what, const char *arg, int lo, int hi,
+               int *out)
+{
+    if (lo >= 0) {
+        uint64_t u;
+        if (vt_parse_u64(arg, (uint64_t)lo, (uint64_t)hi, &u)) {
+            *out = (int)u;
+            return 1;
+        }
+    } else if (vt_parse_int(arg, lo, hi, out)) {
+        return 1;
+    }
+    char l[16], h[16];
+    snprintf(l, sizeof l, "%d", lo);
+    snprintf(h, sizeof h, "%d", hi);
+    return refuse_range(option, what, arg, l, h);
+}
+
+int vt_opt_positive(const char *option, const char *arg, float *out)
+{
+    float v;
+    if (vt_parse_float(arg, &v) && v > 0.0f) {
+        *out = v;
+        return 1;
+    }
+    vt_usage_error(cli_prog, "%s takes a positive number, not '%s'", option, arg);
+    return 0;
+}
+
+int vt_opt_nonnegative(const char *option, const char *arg, float *out)
+{
+    float v;
+    if (vt_parse_float(arg, &v) && !(v < 0.0f)) {
+        *out = v;
+        return 1;
+    }
+    vt_usage_error(cli_prog, "%s takes a number >= 0, not '%s'", option, arg);
+    return 0;
+}
+
+int vt_opt_tolerance(const char *option, const char *noun, const char *arg, int zero_ok,
+                     double *out)
+{
+    char *end = NULL;
+    double t = strtod(arg, &end);
+    if (end != arg && !*end && (zero_ok ? t >= 0.0 : t > 0.0)) {
+        *out = t;
+        return 1;
+    }
+    vt_usage_error(cli_prog, "%s takes %s %s (or inf), not '%s'", option,
+                   noun ? noun : "a tolerance", zero_ok ? ">= 0" : "> 0", arg);
+    return 0;
+}
+
+int vt_parse_orders(const char *s, int distinct, int max_order, int *want)
+{
+    /* At most max_order entries (a longer list repeats an order); 64
+     * entries stand for any max_order <= 64. */
+    uint64_t v[64];
+    int n = max_order >= 1 && max_order <= 64
+                ? vt_parse_u64_list(s, 1, (uint64_t)max_order, v, 1, max_order)
+                : 0;
+    int seen[65] = {0};
+    for (int i = 0; i < n; i++) {
+        if (distinct && seen[v[i]])
+            return 0;
+        seen[v[i]] = 1;
+    }
+    if (n == 0)
+        return 0;
+    for (int k = 0; k <= max_order; k++)
+        want[k] = seen[k];
+    return 1;
+}
+
+int vt_opt_orders(const char *option, const char *example, const char *arg, int max_order,
+                  int *want)
+{
+    if (vt_parse_orders(arg, 1, max_order, want))
+        return 1;
+    vt_usage_error(cli_prog, "%s takes distinct orders 1..%d such as %s, not '%s'", option,
+                   max_order, example, arg);
+    return 0;
+}
+
+int vt_opt_choice(const char *option, const char *arg, const vt_choice *choices, int *out)
+{
+    int n = 0;
+    for (; choices[n].name; n++)
+        if (strcmp(arg, choices[n].name) == 0) {
+            *out = choices[n].value;
+            return 1;
+        }
+    char list[512];
+    size_t at = 0;
+    for (int i = 0; i < n && at < sizeof list; i++)
+        at += (size_t)snprintf(list + at, sizeof list - at, "%s%s",
+                               i == 0 ? "" : i + 1 == n ? " or " : ", ", choices[i].name);
+    vt_usage_error(cli_prog, "%s takes %s, not '%s'", option, list, arg);
+    return 0;
+}

@@ -2,8 +2,8 @@
  * vt_cli.h - what every vdsh program accepts as a number on its command
  * line, and how it says no.
  *
- * Purpose: one definition of an option's value for vdsh-bake, vdsh-eval,
- * vdsh-info, vdsh-view and vdsh-raydump, so that the same text means the
+ * Purpose: one definition of an option's value for every vdsh program
+ * (vdsh-bake, vdsh-eval, vdsh-view, ...), so that the same text means the
  * same number in each (`--seed 010` is ten everywhere). Numbers are
  * strictly decimal:
  *   whole numbers   digits only ("0", "010"; an int may start with '-'),
@@ -46,6 +46,7 @@
 #define VT_CLI_H
 
 #include <stdint.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -108,6 +109,74 @@ int vt_cli_same_file(const char *a, const char *b);
 __attribute__((format(printf, 2, 3)))
 #endif
 int vt_usage_error(const char *prog, const char *fmt, ...);
+
+/* ---- option checks for parse_args() ------------------------------------
+ * What several programs check the same way, so that each program's
+ * parse_args() says it once. The vt_opt_* functions take the option's
+ * name ("--threads") and its argument; they return 1 with *out written,
+ * or 0 after the usage error on stderr ("PROG: --threads takes a whole
+ * number 1..256, not 'x'" and "Try 'PROG --help'.", as vt_usage_error):
+ * the program then exits VT_EXIT_USAGE. *out is untouched on failure. */
+
+/* What a parse_args() returns when the program is to run; anything else
+ * is the exit status (0 after --help or --version, VT_EXIT_USAGE). */
+enum { VT_CLI_RUN = -1 };
+
+/* The end of every program's getopt_long table: --help, --version, the
+ * terminator (the program includes <getopt.h>). */
+#define VT_CLI_LONGOPTS_END                                                        \
+    {"help", no_argument, 0, 'h'}, {"version", no_argument, 0, 'V'}, { 0, 0, 0, 0 }
+
+/* The getopt switch's default: -h prints usage(stdout) and returns 0, -V
+ * returns vt_cli_version(version_detail), anything else (getopt's '?' or
+ * ':' after its own message) returns vt_cli_try_help(). */
+int vt_cli_common_option(int c, void (*usage)(FILE *), const char *version_detail);
+
+/* A whole number lo..hi. The message says "takes WHAT LO..HI", WHAT being
+ * `what` or, when NULL, "a whole number"; an empty `what` says "takes
+ * LO..HI". With hi UINT64_MAX it says "WHAT >= LO", or just "WHAT" when lo
+ * is 0 too. vt_opt_int with lo >= 0 takes digits only, no sign, as
+ * vt_parse_u64 ("-0" is refused). */
+int vt_opt_u64(const char *option, const char *what, const char *arg, uint64_t lo,
+               uint64_t hi, uint64_t *out);
+int vt_opt_u32(const char *option, const char *what, const char *arg, uint32_t lo,
+               uint32_t hi, uint32_t *out);
+int vt_opt_int(const char *option, const char *what, const char *arg, int lo, int hi,
+               int *out);
+
+/* A real number > 0 ("takes a positive number") or >= 0 ("takes a number
+ * >= 0"); -0 counts as 0. */
+int vt_opt_positive(const char *option, const char *arg, float *out);
+int vt_opt_nonnegative(const char *option, const char *arg, float *out);
+
+/* A tolerance: the one option value that is not strictly decimal, for it
+ * may be "inf" (strtod's syntax, the whole string), > 0, or >= 0 when
+ * zero_ok. Says "takes a tolerance > 0 (or inf)" ("a tolerance >= 0", or
+ * with `noun` "a number": "takes a number >= 0 (or inf)"). */
+int vt_opt_tolerance(const char *option, const char *noun, const char *arg, int zero_ok,
+                     double *out);
+
+/* One of a list of names, each standing for a value; the list ends with
+ * {NULL, 0}. Says "takes A, B or C". */
+typedef struct vt_choice {
+    const char *name;
+    int value;
+} vt_choice;
+int vt_opt_choice(const char *option, const char *arg, const vt_choice *choices, int *out);
+
+/* Orders 1..max_order, a vt_parse_u64_list list of at most max_order
+ * entries in any order, each at most once when `distinct`: want[k] = 1
+ * for each order k given, 0 for the others (want holds max_order + 1
+ * entries; want[0] is 0); 1, or 0 (want untouched, no message) when it is
+ * not such a list. */
+int vt_parse_orders(const char *s, int distinct, int max_order, int *want);
+
+/* Distinct orders 1..max_order, a vt_parse_u64_list list in any order:
+ * want[k] = 1 for each order k given, 0 for the others (want holds
+ * max_order + 1 entries; want[0] is 0). Says "takes distinct orders
+ * 1..MAX such as EXAMPLE". */
+int vt_opt_orders(const char *option, const char *example, const char *arg, int max_order,
+                  int *want);
 
 #ifdef __cplusplus
 }

@@ -39,6 +39,14 @@ enum {
     PURPOSE_SCENE_LIGHTS = 0x53434e4cu /* "SCNL" */
 };
 
+uint64_t vb_eval_purpose_seed(uint64_t seed, uint32_t purpose)
+{
+    uint64_t z = seed ^ ((uint64_t)purpose * 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
 /* ---- distance-error histogram ------------------------------------------
  * Bin 0: exactly 0; bin 1: (0, 1e-6); then 100 bins per decade up to 1e4;
  * the last bin: 1e4 and above (and NaN). Percentiles are read at a bin's
@@ -473,7 +481,7 @@ int vb_eval_interior_point(const double *cdf, uint32_t triangle_count,
 {
     if (triangle_count == 0 || !(cdf[triangle_count - 1] > 0.0))
         return 0;
-    uint64_t s = vb_purpose_seed(seed, PURPOSE_INTERIOR);
+    uint64_t s = vb_eval_purpose_seed(seed, PURPOSE_INTERIOR);
     float u1, u2, u3, u4;
     vb_hash2(s, j, 0, &u1, &u2);
     vb_hash2(s, j, 1, &u3, &u4);
@@ -510,7 +518,7 @@ uint32_t vb_eval_directions(uint64_t seed, uint32_t directions, uint32_t id,
     vb_dirgrid g = {0};
     if (vb_dirgrid_create(directions, 1, &g, NULL) != VB_OK)
         return 0;
-    uint64_t ds = vb_purpose_seed(seed, PURPOSE_DIRECTIONS);
+    uint64_t ds = vb_eval_purpose_seed(seed, PURPOSE_DIRECTIONS);
     uint32_t got = 0;
     for (uint32_t pk = 0; pk < g.packet_count; pk++) {
         float x[16], y[16], z[16];
@@ -589,20 +597,6 @@ static double ratio_se(const ratio *q, uint32_t n)
     return sqrt((double)n / (n - 1) * q->res) / q->b;
 }
 
-typedef struct sort_item {
-    double key;
-    uint32_t index;
-} sort_item;
-
-/* Worst first; ties by receiver order, so the list is reproducible. */
-static int cmp_worst(const void *x, const void *y)
-{
-    const sort_item *a = x, *b = y;
-    if (a->key != b->key)
-        return a->key < b->key ? 1 : -1;
-    return (a->index > b->index) - (a->index < b->index);
-}
-
 static int cmp_double(const void *x, const void *y)
 {
     double a = *(const double *)x, b = *(const double *)y;
@@ -627,7 +621,7 @@ static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind,
 {
     const uint32_t S = J->streams;
     double *mae = malloc(((size_t)count + 1) * sizeof *mae);
-    sort_item *items = malloc(((size_t)count + 1) * sizeof *items);
+    vb_ranked *items = malloc(((size_t)count + 1) * sizeof *items);
     if (!mae || !items) {
         free(mae);
         free(items);
@@ -704,7 +698,7 @@ static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind,
         o->receiver_mae_p50 = quantile_sorted(mae, nm, 0.50);
         o->receiver_mae_p90 = quantile_sorted(mae, nm, 0.90);
         o->receiver_mae_p99 = quantile_sorted(mae, nm, 0.99);
-        qsort(items, nm, sizeof *items, cmp_worst);
+        qsort(items, nm, sizeof *items, vb_ranked_cmp);
         o->worst_count = nm < worst_n ? nm : worst_n;
         for (uint32_t w = 0; w < o->worst_count; w++) {
             uint32_t i = items[w].index;
@@ -758,7 +752,7 @@ static void reduce_scene(const job *J, uint32_t first, uint32_t count,
 static vb_result list_escaping(const job *J, uint32_t first, uint32_t count,
                                uint32_t max, vb_eval_truth *t, vb_error *err)
 {
-    sort_item *items = malloc(((size_t)count + 1) * sizeof *items);
+    vb_ranked *items = malloc(((size_t)count + 1) * sizeof *items);
     if (!items)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the scores");
     uint32_t n = 0;
@@ -769,7 +763,7 @@ static vb_result list_escaping(const job *J, uint32_t first, uint32_t count,
             items[n++].index = i;
         }
     }
-    qsort(items, n, sizeof *items, cmp_worst);
+    qsort(items, n, sizeof *items, vb_ranked_cmp);
     t->escaping_listed = n < max ? n : max;
     for (uint32_t w = 0; w < t->escaping_listed; w++) {
         uint32_t i = items[w].index;
@@ -781,9 +775,9 @@ static vb_result list_escaping(const job *J, uint32_t first, uint32_t count,
 
 /* ---- the run ------------------------------------------------------------- */
 
-static int cmp_sort_item_key(const void *x, const void *y)
+static int cmp_ranked_key(const void *x, const void *y)
 {
-    const sort_item *a = x, *b = y;
+    const vb_ranked *a = x, *b = y;
     if (a->key != b->key)
         return a->key < b->key ? -1 : 1;
     return (a->index > b->index) - (a->index < b->index);
@@ -809,19 +803,19 @@ static vb_result pick_vertices(uint32_t V, uint32_t want, uint64_t seed,
         for (uint32_t i = 0; i < V; i++)
             v[i] = i;
     } else {
-        sort_item *it = malloc((size_t)V * sizeof *it);
+        vb_ranked *it = malloc((size_t)V * sizeof *it);
         if (!it) {
             free(v);
             return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u vertices", V);
         }
-        uint64_t s = vb_purpose_seed(seed, PURPOSE_VERTICES);
+        uint64_t s = vb_eval_purpose_seed(seed, PURPOSE_VERTICES);
         for (uint32_t i = 0; i < V; i++) {
             float a, b;
             vb_hash2(s, i, 0, &a, &b);
             it[i].key = a + b * (1.0 / 16777216.0);
             it[i].index = i;
         }
-        qsort(it, V, sizeof *it, cmp_sort_item_key);
+        qsort(it, V, sizeof *it, cmp_ranked_key);
         for (uint32_t i = 0; i < n; i++)
             v[i] = it[i].index;
         free(it);
@@ -832,14 +826,48 @@ static vb_result pick_vertices(uint32_t V, uint32_t want, uint64_t seed,
     return VB_OK;
 }
 
-vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
-                      vb_error *err)
+/* ---- vb_eval_run, step by step ------------------------------------------- */
+
+/* One vb_eval_run: the resolved description, what the run allocates
+ * (run_free frees it, also half-built) and the result it fills. */
+typedef struct eval_run {
+    vb_eval_desc d;
+    float diag;            /* the file's bounds' diagonal, else the scene's */
+    double t0;
+    vb_dirgrid grid;
+    uint32_t *vsel, nv;    /* the vertices picked */
+    float *vorigin, *vnear; /* per vertex: truth origins, near distances */
+    float (*lights_local)[3];
+    double *cdf;
+    receiver *rec;         /* the vertices', then the interior points' */
+    uint32_t nr;
+    uint32_t count[VB_EVAL_KINDS], skipped[VB_EVAL_KINDS];
+    job *J;
+    unsigned started;
+    vb_eval_result o;
+} eval_run;
+
+/* The diagonal of the file's bounds; the scene's when they are empty. */
+static float file_diagonal(const vdsh_file *f, const vb_scene *scene)
 {
-    vb_eval_desc d = *desc;
-    const vdsh_file *f = d.file;
-    if (!f || !d.scene)
+    double d2 = 0.0;
+    for (int i = 0; i < 3; i++) {
+        double e = (double)f->header.bounds_max[i] - f->header.bounds_min[i];
+        d2 += e * e;
+    }
+    float diag = (float)sqrt(d2);
+    return diag > 0.0f ? diag : scene->diagonal;
+}
+
+/* The description checked against the file, its defaults filled in; the
+ * run's clock started. */
+static vb_result resolve_desc(eval_run *e, vb_error *err)
+{
+    vb_eval_desc *d = &e->d;
+    const vdsh_file *f = d->file;
+    if (!f || !d->scene)
         return vb_fail(err, VB_ERR_ARGUMENT, "nothing to evaluate: no file or no scene");
-    if (f->stream_count == 0 && !d.oracle)
+    if (f->stream_count == 0 && !d->oracle)
         return vb_fail(err, VB_ERR_ARGUMENT, "the file has no coefficient streams");
     if (f->stream_count > VDSH_MAX_STREAMS)
         return vb_fail(err, VB_ERR_ARGUMENT, "too many streams (%u)", f->stream_count);
@@ -847,79 +875,63 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
         if (f->streams[s].order < 1 || f->streams[s].order > VDSH_MAX_ORDER)
             return vb_fail(err, VB_ERR_ARGUMENT, "stream %u: order %u out of range", s,
                            f->streams[s].order);
-    if (d.seed == 0)
-        d.seed = VB_EVAL_DEFAULT_SEED;
-    if (d.directions == 0)
-        d.directions = VB_EVAL_DEFAULT_DIRECTIONS;
-    if (d.worst == 0)
-        d.worst = VB_EVAL_DEFAULT_WORST;
-    if (d.worst > VB_EVAL_MAX_WORST)
-        d.worst = VB_EVAL_MAX_WORST;
-    if (d.interior > VB_EVAL_MAX_RECEIVERS)
+    if (d->seed == 0)
+        d->seed = VB_EVAL_DEFAULT_SEED;
+    if (d->directions == 0)
+        d->directions = VB_EVAL_DEFAULT_DIRECTIONS;
+    if (d->worst == 0)
+        d->worst = VB_EVAL_DEFAULT_WORST;
+    if (d->worst > VB_EVAL_MAX_WORST)
+        d->worst = VB_EVAL_MAX_WORST;
+    if (d->interior > VB_EVAL_MAX_RECEIVERS)
         return vb_fail(err, VB_ERR_ARGUMENT, "at most %u interior points, not %u",
-                       VB_EVAL_MAX_RECEIVERS, d.interior);
-    if (d.interior > 0 && f->header.triangle_count == 0)
-        d.interior = 0; /* a point cloud has no inside: vertices only */
-    d.threads = vb_parallel_threads(d.threads);
-    const double t0 = vb_now();
-    const uint32_t V = f->header.vertex_count, S = f->stream_count;
-    float diag = 0.0f;
-    {
-        double d2 = 0.0;
-        for (int i = 0; i < 3; i++) {
-            double e = (double)f->header.bounds_max[i] - f->header.bounds_min[i];
-            d2 += e * e;
-        }
-        diag = (float)sqrt(d2);
-    }
-    if (!(diag > 0.0f))
-        diag = d.scene->diagonal;
+                       VB_EVAL_MAX_RECEIVERS, d->interior);
+    if (d->interior > 0 && f->header.triangle_count == 0)
+        d->interior = 0; /* a point cloud has no inside: vertices only */
+    d->threads = vb_parallel_threads(d->threads);
+    e->t0 = vb_now();
+    e->diag = file_diagonal(f, d->scene);
+    return VB_OK;
+}
 
-    vb_result r = VB_OK;
-    vb_dirgrid grid = {0};
-    uint32_t *vsel = NULL, nv = 0;
-    float *vorigin = NULL, *vnear = NULL;
-    float (*lights_local)[3] = NULL;
-    double *cdf = NULL;
-    receiver *rec = NULL;
-    job *J = NULL;
-    vb_eval_result o = {0};
-    unsigned started = 0;
-
-    r = vb_dirgrid_create(d.directions, 1, &grid, err);
+/* The held-out directions' grid and the vertices picked. */
+static vb_result pick_receivers(eval_run *e, vb_error *err)
+{
+    const vb_eval_desc *d = &e->d;
+    vb_result r = vb_dirgrid_create(d->directions, 1, &e->grid, err);
     if (r != VB_OK)
-        goto done;
-    r = pick_vertices(V, d.points, d.seed, &vsel, &nv, err);
-    if (r != VB_OK)
-        goto done;
+        return r;
+    return pick_vertices(d->file->header.vertex_count, d->points, d->seed, &e->vsel, &e->nv, err);
+}
 
-    /* 1. Receivers and their truth origins. */
-    vorigin = malloc((size_t)V * 3 * sizeof *vorigin);
-    vnear = malloc((size_t)V * sizeof *vnear + 1);
-    rec = calloc((size_t)nv + d.interior + 1, sizeof *rec);
-    if (!vorigin || !vnear || !rec) {
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
-                    nv + d.interior);
-        goto done;
-    }
-    {
-        vb_mesh m = {.vertex_count = V, .triangle_count = f->header.triangle_count,
-                     .positions = (float *)f->positions, .normals = (float *)f->normals,
-                     .indices = (uint32_t *)f->indices};
-        r = vb_ray_origins(&m, d.scene, d.threads, vorigin, vnear, NULL, err);
-        if (r != VB_OK)
-            goto done;
-    }
-    uint32_t count[VB_EVAL_KINDS] = {0, 0}, skipped[VB_EVAL_KINDS] = {0, 0};
+/* The picked vertices as receivers, with their truth origins (those with
+ * no normal are skipped and counted). */
+static vb_result vertex_receivers(eval_run *e, vb_error *err)
+{
+    const vb_eval_desc *d = &e->d;
+    const vdsh_file *f = d->file;
+    const uint32_t V = f->header.vertex_count;
+    e->vorigin = malloc((size_t)V * 3 * sizeof *e->vorigin);
+    e->vnear = malloc((size_t)V * sizeof *e->vnear + 1);
+    e->rec = calloc((size_t)e->nv + d->interior + 1, sizeof *e->rec);
+    if (!e->vorigin || !e->vnear || !e->rec)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
+                       e->nv + d->interior);
+    vb_mesh m = {.vertex_count = V, .triangle_count = f->header.triangle_count,
+                 .positions = (float *)f->positions, .normals = (float *)f->normals,
+                 .indices = (uint32_t *)f->indices};
+    vb_result r = vb_ray_origins(&m, d->scene, d->threads, e->vorigin, e->vnear, NULL, err);
+    if (r != VB_OK)
+        return r;
     uint32_t nr = 0;
-    for (uint32_t i = 0; i < nv; i++) {
-        uint32_t v = vsel[i];
+    for (uint32_t i = 0; i < e->nv; i++) {
+        uint32_t v = e->vsel[i];
         const float *n = f->normals + 3 * (size_t)v;
         if (is_zero_normal(n)) {
-            skipped[VB_EVAL_VERTICES]++;
+            e->skipped[VB_EVAL_VERTICES]++;
             continue;
         }
-        receiver *x = rec + nr++;
+        receiver *x = e->rec + nr++;
         x->kind = VB_EVAL_VERTICES;
         x->index = v;
         x->id = v;
@@ -927,191 +939,254 @@ vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
         x->bary[0] = 1.0f;
         memcpy(x->position, f->positions + 3 * (size_t)v, sizeof x->position);
         memcpy(x->normal, n, sizeof x->normal);
-        memcpy(x->origin, vorigin + 3 * (size_t)v, sizeof x->origin);
-        x->near = vnear[v];
+        memcpy(x->origin, e->vorigin + 3 * (size_t)v, sizeof x->origin);
+        x->near = e->vnear[v];
     }
-    count[VB_EVAL_VERTICES] = nr;
-    if (d.interior > 0) {
-        double area = 0.0;
-        cdf = vb_eval_area_cdf(f, &area);
-        if (!cdf) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the triangle areas");
-            goto done;
-        }
-        for (uint32_t j = 0; j < d.interior && area > 0.0; j++) {
-            receiver x = {.kind = VB_EVAL_INTERIOR, .index = j, .id = VB_EVAL_INTERIOR_ID(j)};
-            vb_eval_interior_point(cdf, f->header.triangle_count, d.seed, j, &x.triangle,
-                                   x.bary);
-            vb_eval_interpolate(f, NULL, x.triangle, x.bary, x.position, x.normal, NULL);
-            if (is_zero_normal(x.normal)) {
-                skipped[VB_EVAL_INTERIOR]++;
-                continue;
-            }
-            float p[3];
-            vb_scene_to_local(d.scene, x.position, p);
-            vb_offset_origin(p, x.normal, x.origin);
-            double edges = 0.0;
-            for (int k = 0; k < 3; k++) {
-                const float *a = f->positions + 3 * (size_t)f->indices[3 * (size_t)x.triangle + k];
-                const float *b =
-                    f->positions + 3 * (size_t)f->indices[3 * (size_t)x.triangle + (k + 1) % 3];
-                edges += sqrt(((double)a[0] - b[0]) * (a[0] - b[0]) +
-                              ((double)a[1] - b[1]) * (a[1] - b[1]) +
-                              ((double)a[2] - b[2]) * (a[2] - b[2]));
-            }
-            x.near = vb_receiver_near(d.scene->diagonal, (float)(edges / 3.0));
-            rec[nr++] = x;
-        }
-        count[VB_EVAL_INTERIOR] = nr - count[VB_EVAL_VERTICES];
-    }
-    free(vorigin);
-    free(vnear);
-    vorigin = NULL, vnear = NULL;
+    e->nr = e->count[VB_EVAL_VERTICES] = nr;
+    return VB_OK;
+}
 
-    /* 2. Trace and score. */
-    J = calloc(1, sizeof *J);
-    if (!J) {
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-        goto done;
+/* The mean edge length of triangle t, for its interior points' near
+ * distance. */
+static double mean_edge(const vdsh_file *f, uint32_t t)
+{
+    double edges = 0.0;
+    for (int k = 0; k < 3; k++) {
+        const float *a = f->positions + 3 * (size_t)f->indices[3 * (size_t)t + k];
+        const float *b = f->positions + 3 * (size_t)f->indices[3 * (size_t)t + (k + 1) % 3];
+        edges += sqrt(((double)a[0] - b[0]) * (a[0] - b[0]) +
+                      ((double)a[1] - b[1]) * (a[1] - b[1]) +
+                      ((double)a[2] - b[2]) * (a[2] - b[2]));
     }
-    J->d = &d;
-    J->f = f;
-    J->scene = d.scene;
-    J->grid = &grid;
-    J->rec = rec;
+    return edges / 3.0;
+}
+
+/* Area-weighted interior points as receivers, after the vertices. */
+static vb_result interior_receivers(eval_run *e, vb_error *err)
+{
+    const vb_eval_desc *d = &e->d;
+    const vdsh_file *f = d->file;
+    if (d->interior == 0)
+        return VB_OK;
+    double area = 0.0;
+    e->cdf = vb_eval_area_cdf(f, &area);
+    if (!e->cdf)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the triangle areas");
+    for (uint32_t j = 0; j < d->interior && area > 0.0; j++) {
+        receiver x = {.kind = VB_EVAL_INTERIOR, .index = j, .id = VB_EVAL_INTERIOR_ID(j)};
+        vb_eval_interior_point(e->cdf, f->header.triangle_count, d->seed, j, &x.triangle,
+                               x.bary);
+        vb_eval_interpolate(f, NULL, x.triangle, x.bary, x.position, x.normal, NULL);
+        if (is_zero_normal(x.normal)) {
+            e->skipped[VB_EVAL_INTERIOR]++;
+            continue;
+        }
+        float p[3];
+        vb_scene_to_local(d->scene, x.position, p);
+        vb_offset_origin(p, x.normal, x.origin);
+        x.near = vb_receiver_near(d->scene->diagonal, (float)mean_edge(f, x.triangle));
+        e->rec[e->nr++] = x;
+    }
+    e->count[VB_EVAL_INTERIOR] = e->nr - e->count[VB_EVAL_VERTICES];
+    return VB_OK;
+}
+
+/* The job the workers read: the receivers and their sums. */
+static vb_result create_job(eval_run *e, vb_error *err)
+{
+    const vb_eval_desc *d = &e->d;
+    const uint32_t S = d->file->stream_count, nr = e->nr;
+    free(e->vorigin); /* the receivers have theirs */
+    free(e->vnear);
+    e->vorigin = NULL, e->vnear = NULL;
+    job *J = e->J = calloc(1, sizeof *J);
+    if (!J)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    J->d = d;
+    J->f = d->file;
+    J->scene = d->scene;
+    J->grid = &e->grid;
+    J->rec = e->rec;
     J->rec_count = nr;
     J->streams = S;
     J->acc = calloc((size_t)nr * (S ? S : 1) + 1, sizeof *J->acc);
     J->truth = calloc((size_t)nr + 1, sizeof *J->truth);
-    J->hist = calloc((size_t)d.threads * VB_EVAL_KINDS * (S ? S : 1) * HIST_BINS,
+    J->hist = calloc((size_t)d->threads * VB_EVAL_KINDS * (S ? S : 1) * HIST_BINS,
                      sizeof *J->hist);
-    if (!J->acc || !J->truth || !J->hist) {
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers", nr);
-        goto done;
-    }
-    /* The scene lights: placed once, scored at every receiver. */
-    {
-        uint32_t nl = d.lights ? d.lights : 32;
-        o.lights = malloc(((size_t)nl + 1) * sizeof *o.lights);
-        lights_local = malloc(((size_t)nl + 1) * sizeof *lights_local);
-        J->sacc = calloc((size_t)nr * (S ? S : 1) + 1, sizeof *J->sacc);
-        if (!o.lights || !lights_local || !J->sacc) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the scene lights");
-            goto done;
-        }
-        r = vb_scene_place_lights_rule(d.scene, vb_purpose_seed(d.seed, PURPOSE_SCENE_LIGHTS), nl,
-                                       (vb_light_rule)d.light_rule, o.lights,
-                                       &o.light_candidates, err);
-        if (r != VB_OK)
-            goto done;
-        o.light_count = nl;
-        for (uint32_t l = 0; l < nl; l++)
-            vb_scene_to_local(d.scene, o.lights[l], lights_local[l]);
-        J->light_count = nl;
-        J->lights = (const float(*)[3])o.lights;
-        J->lights_local = (const float(*)[3])lights_local;
-    }
-    J->dir_seed = vb_purpose_seed(d.seed, PURPOSE_DIRECTIONS);
-    J->light_seed = vb_purpose_seed(d.seed, PURPOSE_LIGHTS);
-    J->max_distance = f->header.max_distance;
-    J->max_local = f->header.max_distance * d.scene->scale;
-    J->inv_scale = 1.0f / d.scene->scale;
-    J->floor_dist = 0.01f * diag;
-    started = vb_parallel_for(d.threads, nr, BLOCK, eval_block, J,
-                              d.progress ? eval_progress : NULL, J);
-    if (started == 0) {
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
-        goto done;
-    }
+    if (!J->acc || !J->truth || !J->hist)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers", nr);
+    return VB_OK;
+}
 
-    /* 3. Reduce in receiver order. */
-    o.stream_count = S;
+/* The scene lights: placed once, scored at every receiver. */
+static vb_result place_scene_lights(eval_run *e, vb_error *err)
+{
+    const vb_eval_desc *d = &e->d;
+    const uint32_t S = d->file->stream_count;
+    vb_eval_result *o = &e->o;
+    job *J = e->J;
+    uint32_t nl = d->lights ? d->lights : 32;
+    o->lights = malloc(((size_t)nl + 1) * sizeof *o->lights);
+    e->lights_local = malloc(((size_t)nl + 1) * sizeof *e->lights_local);
+    J->sacc = calloc((size_t)e->nr * (S ? S : 1) + 1, sizeof *J->sacc);
+    if (!o->lights || !e->lights_local || !J->sacc)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the scene lights");
+    uint64_t seed = vb_eval_purpose_seed(d->seed, PURPOSE_SCENE_LIGHTS);
+    vb_result r = vb_scene_place_lights_rule(d->scene, seed, nl, (vb_light_rule)d->light_rule,
+                                             o->lights, &o->light_candidates, err);
+    if (r != VB_OK)
+        return r;
+    o->light_count = nl;
+    for (uint32_t l = 0; l < nl; l++)
+        vb_scene_to_local(d->scene, o->lights[l], e->lights_local[l]);
+    J->light_count = nl;
+    J->lights = (const float(*)[3])o->lights;
+    J->lights_local = (const float(*)[3])e->lights_local;
+    return VB_OK;
+}
+
+/* Trace and score every receiver on the workers. */
+static vb_result trace_receivers(eval_run *e, vb_error *err)
+{
+    const vb_eval_desc *d = &e->d;
+    const vdsh_file *f = d->file;
+    job *J = e->J;
+    J->dir_seed = vb_eval_purpose_seed(d->seed, PURPOSE_DIRECTIONS);
+    J->light_seed = vb_eval_purpose_seed(d->seed, PURPOSE_LIGHTS);
+    J->max_distance = f->header.max_distance;
+    J->max_local = f->header.max_distance * d->scene->scale;
+    J->inv_scale = 1.0f / d->scene->scale;
+    J->floor_dist = 0.01f * e->diag;
+    e->started = vb_parallel_for(d->threads, e->nr, BLOCK, eval_block, J,
+                                 d->progress ? eval_progress : NULL, J);
+    if (e->started == 0)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
+    return VB_OK;
+}
+
+/* Per kind of receiver, the truth's counts, the degenerate and escaping
+ * receivers and every stream's scores, reduced in receiver order. */
+static vb_result reduce_kinds(eval_run *e, vb_error *err)
+{
+    const vb_eval_desc *d = &e->d;
+    const uint32_t S = d->file->stream_count;
+    vb_eval_result *o = &e->o;
+    const job *J = e->J;
+    o->stream_count = S;
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
-        o.metrics[k] = calloc(S ? S : 1, sizeof *o.metrics[k]);
-        o.scene[k] = calloc(S ? S : 1, sizeof *o.scene[k]);
-        if (!o.metrics[k] || !o.scene[k]) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-            goto done;
-        }
+        o->metrics[k] = calloc(S ? S : 1, sizeof *o->metrics[k]);
+        o->scene[k] = calloc(S ? S : 1, sizeof *o->scene[k]);
+        if (!o->metrics[k] || !o->scene[k])
+            return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
     }
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
-        uint32_t first = k == VB_EVAL_VERTICES ? 0 : count[VB_EVAL_VERTICES];
-        vb_eval_truth *t = &o.truth[k];
-        t->receivers = count[k];
-        t->skipped = skipped[k];
-        for (uint32_t i = first; i < first + count[k]; i++) {
+        uint32_t first = k == VB_EVAL_VERTICES ? 0 : e->count[VB_EVAL_VERTICES];
+        vb_eval_truth *t = &o->truth[k];
+        t->receivers = e->count[k];
+        t->skipped = e->skipped[k];
+        for (uint32_t i = first; i < first + e->count[k]; i++) {
             const rtruth *x = J->truth + i;
             t->rays += x->n;
             t->escaped += x->escaped;
             t->near_zero += x->near_zero;
             if (x->n > 0 && x->near_zero >= VB_EVAL_DEGENERATE * x->n) {
-                if (t->degenerate_listed < d.worst)
-                    describe(rec + i, x, NULL, &t->degenerate_list[t->degenerate_listed++]);
+                if (t->degenerate_listed < d->worst)
+                    describe(e->rec + i, x, NULL, &t->degenerate_list[t->degenerate_listed++]);
                 t->degenerate++;
             }
         }
-        r = list_escaping(J, first, count[k], d.worst, t, err);
+        vb_result r = list_escaping(J, first, e->count[k], d->worst, t, err);
         if (r != VB_OK)
-            goto done;
-        r = reduce(J, first, count[k], k, started, d.worst, o.metrics[k], err);
+            return r;
+        r = reduce(J, first, e->count[k], k, e->started, d->worst, o->metrics[k], err);
         if (r != VB_OK)
-            goto done;
-        reduce_scene(J, first, count[k], o.scene[k]);
+            return r;
+        reduce_scene(J, first, e->count[k], o->scene[k]);
     }
-    if (d.per_vertex) {
-        o.per_vertex_fields = VB_EVAL_PV_TRUTH_FIELDS + VB_EVAL_PV_STREAM_FIELDS * S;
-        o.per_vertex = malloc(((size_t)V * o.per_vertex_fields + 1) * sizeof *o.per_vertex);
-        if (!o.per_vertex) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the per-vertex errors");
-            goto done;
-        }
-        for (size_t i = 0; i < (size_t)V * o.per_vertex_fields; i++)
-            o.per_vertex[i] = NAN;
-        for (uint32_t i = 0; i < count[VB_EVAL_VERTICES]; i++) {
-            const rtruth *x = J->truth + i;
-            float *pv = o.per_vertex + (size_t)rec[i].index * o.per_vertex_fields;
-            if (x->n == 0)
-                continue;
-            pv[VB_EVAL_PV_NEAR_ZERO] = (float)x->near_zero / (float)x->n;
-            pv[VB_EVAL_PV_ESCAPED] = (float)x->escaped / (float)x->n;
-            for (uint32_t s = 0; s < S; s++) {
-                const racc *a = J->acc + (size_t)i * S + s;
-                float *q = pv + VB_EVAL_PV_TRUTH_FIELDS + VB_EVAL_PV_STREAM_FIELDS * s;
-                q[VB_EVAL_PV_DISTANCE_RMS] = (float)sqrt(a->sq / a->n);
-                q[VB_EVAL_PV_SHADOW_MAE] = (float)(a->mae / a->n);
-                q[VB_EVAL_PV_FALSE_SHADOW] = a->vis ? (float)a->fals / (float)a->vis : NAN;
-                q[VB_EVAL_PV_LIGHT_LEAK] = a->occ ? (float)a->leak / (float)a->occ : NAN;
-                q[VB_EVAL_PV_BINARY_MAE] = (float)(a->mae_bin / a->n);
-            }
-        }
-    }
-    o.seed = d.seed;
-    o.directions = grid.count;
-    o.diagonal = diag;
-    o.max_distance = f->header.max_distance;
-    o.oracle = d.oracle;
-    o.threads = started;
-    o.seconds = vb_now() - t0;
-    *out = o;
-    memset(&o, 0, sizeof o);
-    r = VB_OK;
+    return VB_OK;
+}
 
-done:
-    free(lights_local);
-    if (J) {
-        free(J->sacc);
-        free(J->acc);
-        free(J->truth);
-        free(J->hist);
+/* With per_vertex: each vertex's errors (NaN where it was not picked). */
+static vb_result per_vertex_errors(eval_run *e, vb_error *err)
+{
+    const vb_eval_desc *d = &e->d;
+    const uint32_t V = d->file->header.vertex_count, S = d->file->stream_count;
+    vb_eval_result *o = &e->o;
+    const job *J = e->J;
+    if (!d->per_vertex)
+        return VB_OK;
+    o->per_vertex_fields = VB_EVAL_PV_TRUTH_FIELDS + VB_EVAL_PV_STREAM_FIELDS * S;
+    o->per_vertex = malloc(((size_t)V * o->per_vertex_fields + 1) * sizeof *o->per_vertex);
+    if (!o->per_vertex)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the per-vertex errors");
+    for (size_t i = 0; i < (size_t)V * o->per_vertex_fields; i++)
+        o->per_vertex[i] = NAN;
+    for (uint32_t i = 0; i < e->count[VB_EVAL_VERTICES]; i++) {
+        const rtruth *x = J->truth + i;
+        float *pv = o->per_vertex + (size_t)e->rec[i].index * o->per_vertex_fields;
+        if (x->n == 0)
+            continue;
+        pv[VB_EVAL_PV_NEAR_ZERO] = (float)x->near_zero / (float)x->n;
+        pv[VB_EVAL_PV_ESCAPED] = (float)x->escaped / (float)x->n;
+        for (uint32_t s = 0; s < S; s++) {
+            const racc *a = J->acc + (size_t)i * S + s;
+            float *q = pv + VB_EVAL_PV_TRUTH_FIELDS + VB_EVAL_PV_STREAM_FIELDS * s;
+            q[VB_EVAL_PV_DISTANCE_RMS] = (float)sqrt(a->sq / a->n);
+            q[VB_EVAL_PV_SHADOW_MAE] = (float)(a->mae / a->n);
+            q[VB_EVAL_PV_FALSE_SHADOW] = a->vis ? (float)a->fals / (float)a->vis : NAN;
+            q[VB_EVAL_PV_LIGHT_LEAK] = a->occ ? (float)a->leak / (float)a->occ : NAN;
+            q[VB_EVAL_PV_BINARY_MAE] = (float)(a->mae_bin / a->n);
+        }
     }
-    vb_eval_result_free(&o);
-    free(J);
-    free(rec);
-    free(cdf);
-    free(vorigin);
-    free(vnear);
-    free(vsel);
-    vb_dirgrid_destroy(&grid);
+    return VB_OK;
+}
+
+/* The result's settings, then the result moved out of the run. */
+static void finish_result(eval_run *e, vb_eval_result *out)
+{
+    vb_eval_result *o = &e->o;
+    o->seed = e->d.seed;
+    o->directions = e->grid.count;
+    o->diagonal = e->diag;
+    o->max_distance = e->d.file->header.max_distance;
+    o->oracle = e->d.oracle;
+    o->threads = e->started;
+    o->seconds = vb_now() - e->t0;
+    *out = *o;
+    memset(o, 0, sizeof *o);
+}
+
+static void run_free(eval_run *e)
+{
+    free(e->lights_local);
+    free(e->rec);
+    free(e->cdf);
+    vb_dirgrid_destroy(&e->grid);
+    free(e->vorigin);
+    free(e->vnear);
+    free(e->vsel);
+    vb_eval_result_free(&e->o);
+    if (e->J) {
+        free(e->J->sacc);
+        free(e->J->acc);
+        free(e->J->truth);
+        free(e->J->hist);
+    }
+    free(e->J);
+}
+
+vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
+                      vb_error *err)
+{
+    eval_run e = {.d = *desc};
+    vb_result r;
+    if ((r = resolve_desc(&e, err)) == VB_OK && (r = pick_receivers(&e, err)) == VB_OK &&
+        (r = vertex_receivers(&e, err)) == VB_OK && (r = interior_receivers(&e, err)) == VB_OK &&
+        (r = create_job(&e, err)) == VB_OK && (r = place_scene_lights(&e, err)) == VB_OK &&
+        (r = trace_receivers(&e, err)) == VB_OK && (r = reduce_kinds(&e, err)) == VB_OK &&
+        (r = per_vertex_errors(&e, err)) == VB_OK)
+        finish_result(&e, out);
+    run_free(&e);
     return r;
 }
 

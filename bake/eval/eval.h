@@ -316,6 +316,12 @@ uint32_t vb_eval_directions(uint64_t seed, uint32_t directions, uint32_t id,
                             const float n[3], float *d, uint32_t max);
 #define VB_EVAL_INTERIOR_ID(j) (0x40000000u + (uint32_t)(j))
 
+/* The seed of one purpose's random stream (a tag such as "DIRS" as four
+ * bytes): a splitmix64 finaliser over (seed, purpose), so that each
+ * purpose of the evaluator and of vb_frames gets its own stream from the
+ * one seed. */
+uint64_t vb_eval_purpose_seed(uint64_t seed, uint32_t purpose);
+
 #ifdef __cplusplus
 }
 #endif

@@ -762,12 +762,12 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
-    r = vb_scene_place_lights(occ, vb_purpose_seed(d.seed, PURPOSE_LIGHTS), LIGHT_POOL, pool, NULL,
-                             err);
+    r = vb_scene_place_lights(occ, vb_eval_purpose_seed(d.seed, PURPOSE_LIGHTS), LIGHT_POOL, pool,
+                              NULL, err);
     if (r != VB_OK)
         goto done;
     V.pool = (const float(*)[3])pool;
-    const uint64_t order_seed = vb_purpose_seed(d.seed, PURPOSE_ORDER);
+    const uint64_t order_seed = vb_eval_purpose_seed(d.seed, PURPOSE_ORDER);
 
     /* View 0: the viewer's own camera; its lights are the best there are. */
     {
@@ -789,8 +789,8 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
     /* The others: eyes in free space, each looking at a surface point it
      * sees, in a direction between 53 degrees below the horizon and 12
      * above (as a visitor looks: along and down, where shadows fall). */
-    const uint64_t eye_seed = vb_purpose_seed(d.seed, PURPOSE_EYES);
-    const uint64_t look_seed = vb_purpose_seed(d.seed, PURPOSE_LOOK);
+    const uint64_t eye_seed = vb_eval_purpose_seed(d.seed, PURPOSE_EYES);
+    const uint64_t look_seed = vb_eval_purpose_seed(d.seed, PURPOSE_LOOK);
     const float nearest = NEAREST_SHARE * s->diagonal;
     uint32_t have = 0;
     const uint32_t limit = EYE_TRIES_PER_VIEW * d.cameras;
@@ -838,8 +838,8 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
         int ok = 0;
         if (near >= nearest) {
             uint32_t found;
-            r = pick_lights(&V, &h, (uint32_t)(vb_purpose_seed(order_seed, k) % LIGHT_POOL), 1,
-                            v, &found, &ok, err);
+            uint32_t start = (uint32_t)(vb_eval_purpose_seed(order_seed, k) % LIGHT_POOL);
+            r = pick_lights(&V, &h, start, 1, v, &found, &ok, err);
         }
         vb_frames_hits_free(&h);
         if (r != VB_OK)

@@ -68,6 +68,49 @@ static vb_result candidate_edges(const vb_mesh *m, float len, const uint64_t *ju
     return VB_OK;
 }
 
+/* A shadow to compare at a point: a fit there (c), or else the
+ * interpolation of its triangle's corner fits (corners at pv, barycentric
+ * coordinates bary, vdsh_shadow_interior's interp). */
+typedef struct shadow_fit {
+    const float *c;
+    const float *const *corners;
+    const float *const *pv;
+    const float *bary;
+    uint32_t interp;
+    float max_distance;
+} shadow_fit;
+
+static float fit_shadow(const shadow_fit *s, int order, uint32_t quantity, const float p[3],
+                        const float L[3])
+{
+    if (s->c)
+        return vdsh_shadow((uint32_t)order, quantity, s->max_distance, s->c, p, L,
+                           VDSH_COMPARE_SMOOTH);
+    return vdsh_shadow_interior((uint32_t)order, quantity, s->max_distance, s->interp,
+                                s->corners, s->pv, s->bary, L, VDSH_COMPARE_SMOOTH, NULL);
+}
+
+/* The mean |shadow a - shadow b| at p (normal n) over the lights above its
+ * horizon (below it, unlit either way); `none` when no light is above it.
+ * The split test's measure and the noise floor's. */
+static double mean_shadow_gap(int order, uint32_t quantity, const float (*lights)[3],
+                              uint32_t light_count, const float p[3], const float n[3],
+                              const shadow_fit *a, const shadow_fit *b, double none)
+{
+    double sum = 0.0;
+    uint32_t seen = 0;
+    for (uint32_t l = 0; l < light_count; l++) {
+        const float *L = lights[l];
+        float dx = L[0] - p[0], dy = L[1] - p[1], dz = L[2] - p[2];
+        if (dx * n[0] + dy * n[1] + dz * n[2] <= 0.0f)
+            continue;
+        sum += fabs((double)fit_shadow(a, order, quantity, p, L) -
+                    fit_shadow(b, order, quantity, p, L));
+        seen++;
+    }
+    return seen ? sum / seen : none;
+}
+
 /* Scoring the candidates of one round. */
 typedef struct score_job {
     const vb_mesh *fine;        /* the tentative mesh: candidate i is vertex base + i */
@@ -99,22 +142,11 @@ static void score_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker
         const float *pv[3] = {J->fine->positions + 3 * (size_t)a,
                               J->fine->positions + 3 * (size_t)e,
                               J->fine->positions + 3 * (size_t)e};
-        double sum = 0.0;
-        uint32_t seen = 0;
-        for (uint32_t l = 0; l < J->light_count; l++) {
-            const float *L = J->lights[l];
-            float dx = L[0] - p[0], dy = L[1] - p[1], dz = L[2] - p[2];
-            if (dx * n[0] + dy * n[1] + dz * n[2] <= 0.0f)
-                continue; /* below its horizon: unlit either way */
-            float s_mid = vdsh_shadow((uint32_t)J->order, J->quantity, J->b->max_distance, cm, p,
-                                      L, VDSH_COMPARE_SMOOTH);
-            float s_int = vdsh_shadow_interior((uint32_t)J->order, J->quantity,
-                                               J->b->max_distance, J->interp, c, pv, b, L,
-                                               VDSH_COMPARE_SMOOTH, NULL);
-            sum += fabs((double)s_mid - s_int);
-            seen++;
-        }
-        J->error[i] = seen ? sum / seen : 0.0;
+        const shadow_fit mid = {.c = cm, .max_distance = J->b->max_distance};
+        const shadow_fit ends = {.corners = c, .pv = pv, .bary = b, .interp = J->interp,
+                                 .max_distance = J->b->max_distance};
+        J->error[i] = mean_shadow_gap(J->order, J->quantity, J->lights, J->light_count, p, n,
+                                      &mid, &ends, 0.0);
     }
 }
 
@@ -126,20 +158,6 @@ static double edge_len2(const vb_mesh *m, uint64_t key)
     for (int c = 0; c < 3; c++)
         d2 += ((double)a[c] - b[c]) * ((double)a[c] - b[c]);
     return d2;
-}
-
-typedef struct ranked {
-    double error;
-    uint32_t index;
-} ranked;
-
-/* Largest error first; ties by candidate order. */
-static int cmp_ranked(const void *a, const void *b)
-{
-    const ranked *x = a, *y = b;
-    if (x->error != y->error)
-        return x->error < y->error ? 1 : -1;
-    return (x->index > y->index) - (x->index < y->index);
 }
 
 /* Append `count` rows of `width` floats from src (rows rows[i] - first:
@@ -192,21 +210,10 @@ static void noise_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker
                                        : J->m->normals + 3 * (size_t)v;
         const float *c1 = J->b->coeffs[J->order] + nc * v;
         const float *c2 = J->b2->coeffs[J->order] + nc * (J->n - 1 - k); /* reversed */
-        double sum = 0.0;
-        uint32_t seen = 0;
-        for (uint32_t l = 0; l < J->light_count; l++) {
-            const float *L = J->lights[l];
-            float dx = L[0] - p[0], dy = L[1] - p[1], dz = L[2] - p[2];
-            if (dx * n[0] + dy * n[1] + dz * n[2] <= 0.0f)
-                continue;
-            float s1 = vdsh_shadow((uint32_t)J->order, J->quantity, J->b->max_distance, c1, p, L,
-                                   VDSH_COMPARE_SMOOTH);
-            float s2 = vdsh_shadow((uint32_t)J->order, J->quantity, J->b2->max_distance, c2, p, L,
-                                   VDSH_COMPARE_SMOOTH);
-            sum += fabs((double)s1 - s2);
-            seen++;
-        }
-        J->spread[k] = seen ? sum / seen : -1.0;
+        const shadow_fit first = {.c = c1, .max_distance = J->b->max_distance};
+        const shadow_fit second = {.c = c2, .max_distance = J->b2->max_distance};
+        J->spread[k] = mean_shadow_gap(J->order, J->quantity, J->lights, J->light_count, p, n,
+                                       &first, &second, -1.0);
     }
 }
 
@@ -312,7 +319,7 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
     uint64_t *judged = NULL, *cand = NULL;
     size_t judged_n = 0, cand_n = 0;
     double *error = NULL;
-    ranked *rank = NULL;
+    vb_ranked *rank = NULL;
     uint32_t *rows = NULL, *pairs = NULL; /* per round: new rows; the candidates' ends */
     float (*lights)[3] = NULL;
     const double t_start = vb_now();
@@ -393,8 +400,8 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
                 goto done;
             }
             for (size_t i = 0; i < cand_n; i++)
-                rank[i] = (ranked){edge_len2(&M, cand[i]), (uint32_t)i};
-            qsort(rank, cand_n, sizeof *rank, cmp_ranked);
+                rank[i] = (vb_ranked){edge_len2(&M, cand[i]), (uint32_t)i};
+            qsort(rank, cand_n, sizeof *rank, vb_ranked_cmp);
             uint8_t *keep = calloc(cand_n + 1, 1);
             if (!keep) {
                 r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
@@ -464,8 +471,8 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         uint32_t over = 0;
         for (size_t i = 0; i < cand_n; i++)
             if (error[i] > threshold)
-                rank[over++] = (ranked){error[i], (uint32_t)i};
-        qsort(rank, over, sizeof *rank, cmp_ranked);
+                rank[over++] = (vb_ranked){error[i], (uint32_t)i};
+        qsort(rank, over, sizeof *rank, vb_ranked_cmp);
         uint32_t take = over;
         if (ad->max_receivers && take > ad->max_receivers - V) {
             take = ad->max_receivers - V;

@@ -928,95 +928,144 @@ void vb_bake_output_free(vb_bake_output *out)
     memset(out, 0, sizeof *out);
 }
 
-vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
-                      vb_error *err)
+/* ---- vb_bake_run, step by step ------------------------------------------- */
+
+/* One vb_bake_run: the resolved description, the method's row, what the
+ * run allocates (run_free frees it, also half-built) and what it counts. */
+typedef struct bake_run {
+    vb_bake_desc d;
+    const vb_method_info *mi;
+    int var_cap;           /* adaptive order's cap; 0: none */
+    int choose;            /* each order's quantity chosen on a sample */
+    int calibrate;         /* the decision's log offsets calibrated */
+    vdsh_quantity stored;  /* the quantity when not chosen */
+    vb_decision_params dec;
+    uint32_t lo, hi;       /* the range baked */
+    vb_dirgrid grid;
+    uint32_t *set, set_count, set_before; /* job's */
+    float *origins, *near, *normals;
+    float *coeffs[VDSH_ORDER_SLOTS];
+    uint8_t *var_orders;   /* adaptive order: the range's */
+    float *var_coeffs;
+    float (*lights)[3];
+    vb_origins_stats ost;
+    uint32_t flipped;
+    job *J;
+    double t0;             /* when the tracing began */
+    double auto_error[VDSH_ORDER_SLOTS][2];
+    uint32_t auto_receivers, cal_count;
+    unsigned started;      /* the workers of the bake */
+} bake_run;
+
+typedef vb_result (*bake_step)(bake_run *b, vb_error *err);
+
+/* The orders: the fixed ones (order_mask), the projection's (max_order)
+ * and adaptive order's cap. */
+static vb_result resolve_orders(bake_run *b, vb_error *err)
 {
-    vb_bake_desc d = *desc;
-    if (!d.receivers || !d.scene || d.receivers->vertex_count == 0)
+    vb_bake_desc *d = &b->d;
+    if (!d->receivers || !d->scene || d->receivers->vertex_count == 0)
         return vb_fail(err, VB_ERR_ARGUMENT, "nothing to bake: no receivers or no scene");
-    if (d.rays == 0)
-        d.rays = 2500;
-    if (d.order_mask & ~(uint32_t)(((1u << VDSH_MAX_ORDER) - 1) << 1))
+    if (d->rays == 0)
+        d->rays = VB_DEFAULT_RAYS;
+    if (d->order_mask & ~(uint32_t)(((1u << VDSH_MAX_ORDER) - 1) << 1))
         return vb_fail(err, VB_ERR_ARGUMENT, "orders must be 1..%d", VDSH_MAX_ORDER);
     /* Adaptive order: its cap is the projection's order at least; with no
      * fixed order asked, it is the only stream. */
-    int var_cap = 0;
-    if (isnan(d.order_tolerance) || d.order_tolerance < 0.0f)
+    if (isnan(d->order_tolerance) || d->order_tolerance < 0.0f)
         return vb_fail(err, VB_ERR_ARGUMENT, "the order tolerance must be a number >= 0");
-    if (d.order_tolerance > 0.0f) {
-        var_cap = d.variable_cap ? d.variable_cap : VB_DEFAULT_ORDER_CAP;
-        if (var_cap < 1 || var_cap > VDSH_MAX_ORDER)
+    if (d->order_tolerance > 0.0f) {
+        b->var_cap = d->variable_cap ? d->variable_cap : VB_DEFAULT_ORDER_CAP;
+        if (b->var_cap < 1 || b->var_cap > VDSH_MAX_ORDER)
             return vb_fail(err, VB_ERR_ARGUMENT, "the order cap must be 1..%d, not %d",
-                           VDSH_MAX_ORDER, var_cap);
-        if (d.max_order < var_cap)
-            for (int o = var_cap; o <= VDSH_MAX_ORDER; o++)
-                if (d.order_mask >> o)
-                    d.max_order = o; /* the highest fixed order, if above the cap */
-        if (d.max_order < var_cap)
-            d.max_order = var_cap;
+                           VDSH_MAX_ORDER, b->var_cap);
+        if (d->max_order < b->var_cap)
+            for (int o = b->var_cap; o <= VDSH_MAX_ORDER; o++)
+                if (d->order_mask >> o)
+                    d->max_order = o; /* the highest fixed order, if above the cap */
+        if (d->max_order < b->var_cap)
+            d->max_order = b->var_cap;
     }
-    if (d.max_order == 0)
-        for (int o = VDSH_MAX_ORDER; o >= 1 && !d.max_order; o--)
-            if (d.order_mask & (1u << o))
-                d.max_order = o;
-    if (d.max_order == 0)
-        d.max_order = VB_DEFAULT_ORDER;
-    if (d.max_order < 1 || d.max_order > VDSH_MAX_ORDER)
+    if (d->max_order == 0)
+        for (int o = VDSH_MAX_ORDER; o >= 1 && !d->max_order; o--)
+            if (d->order_mask & (1u << o))
+                d->max_order = o;
+    if (d->max_order == 0)
+        d->max_order = VB_DEFAULT_ORDER;
+    if (d->max_order < 1 || d->max_order > VDSH_MAX_ORDER)
         return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..%d, not %d",
-                       VDSH_MAX_ORDER, d.max_order);
-    if (d.order_mask == 0 && !var_cap)
-        d.order_mask = 1u << d.max_order;
-    if (d.order_mask >> (d.max_order + 1))
+                       VDSH_MAX_ORDER, d->max_order);
+    if (d->order_mask == 0 && !b->var_cap)
+        d->order_mask = 1u << d->max_order;
+    if (d->order_mask >> (d->max_order + 1))
         return vb_fail(err, VB_ERR_ARGUMENT, "an order above max_order %d was asked for",
-                       d.max_order);
-    const vb_method_info *mi = vb_method_get(d.method);
+                       d->max_order);
+    return VB_OK;
+}
+
+/* The method's row, and the quantity: what the method allows; auto is its
+ * only one, if it has one, or the per-order choice (choose_quantities). */
+static vb_result resolve_quantity(bake_run *b, vb_error *err)
+{
+    vb_bake_desc *d = &b->d;
+    const vb_method_info *mi = b->mi = vb_method_get(d->method);
     if (!mi)
-        return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %d", (int)d.method);
-    if (d.window > VDSH_WINDOW_LANCZOS)
-        return vb_fail(err, VB_ERR_ARGUMENT, "unknown window %u", d.window);
-    /* The quantity: what the method allows; auto is its only one, if it
-     * has one, or the per-order choice below. */
-    if (d.quantity != VB_QUANTITY_AUTO && d.quantity != VB_QUANTITY_DISTANCE &&
-        d.quantity != VB_QUANTITY_LOG)
-        return vb_fail(err, VB_ERR_ARGUMENT, "unknown quantity %d", (int)d.quantity);
-    int choose = d.quantity == VB_QUANTITY_AUTO; /* per order, below */
-    vdsh_quantity stored = vb_quantity_stored(d.quantity);
-    if (choose && (mi->quantities & (mi->quantities - 1)) == 0) {
-        choose = 0; /* the method's only one */
-        stored = (vdsh_quantity)__builtin_ctz(mi->quantities);
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %d", (int)d->method);
+    if (d->window > VDSH_WINDOW_LANCZOS)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown window %u", d->window);
+    if (d->quantity != VB_QUANTITY_AUTO && d->quantity != VB_QUANTITY_DISTANCE &&
+        d->quantity != VB_QUANTITY_LOG)
+        return vb_fail(err, VB_ERR_ARGUMENT, "unknown quantity %d", (int)d->quantity);
+    b->choose = d->quantity == VB_QUANTITY_AUTO;
+    b->stored = vb_quantity_stored(d->quantity);
+    if (b->choose && (mi->quantities & (mi->quantities - 1)) == 0) {
+        b->choose = 0; /* the method's only one */
+        b->stored = (vdsh_quantity)__builtin_ctz(mi->quantities);
     }
-    if (!choose && !(mi->quantities & VB_QUANTITY_BIT(stored)))
-        return vb_fail(err, VB_ERR_ARGUMENT, "%s", mi->refused[stored]);
-    if (var_cap && !(mi->quantities & VB_QUANTITY_BIT(VDSH_QUANTITY_LOG_DISTANCE)))
+    if (!b->choose && !(mi->quantities & VB_QUANTITY_BIT(b->stored)))
+        return vb_fail(err, VB_ERR_ARGUMENT, "%s", mi->refused[b->stored]);
+    if (b->var_cap && !(mi->quantities & VB_QUANTITY_BIT(VDSH_QUANTITY_LOG_DISTANCE)))
         return vb_fail(err, VB_ERR_ARGUMENT,
                        "adaptive order fits the log distance: method %s does not (use shadow)",
                        vdsh_method_name(mi->stored));
-    if (d.order_quantity) {
-        choose = 0;
+    if (d->order_quantity) {
+        b->choose = 0;
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-            if ((d.order_mask & (1u << o) || o == d.max_order) &&
-                (d.order_quantity[o] > VDSH_QUANTITY_LOG_DISTANCE ||
-                 !(mi->quantities & VB_QUANTITY_BIT(d.order_quantity[o]))))
+            if ((d->order_mask & (1u << o) || o == d->max_order) &&
+                (d->order_quantity[o] > VDSH_QUANTITY_LOG_DISTANCE ||
+                 !(mi->quantities & VB_QUANTITY_BIT(d->order_quantity[o]))))
                 return vb_fail(err, VB_ERR_ARGUMENT, "order %d: quantity %u is not the method's", o,
-                               (unsigned)d.order_quantity[o]);
+                               (unsigned)d->order_quantity[o]);
     }
-    if (d.lambda == 0.0f)
-        d.lambda = VB_DEFAULT_LAMBDA;
-    if (!(d.lambda > 0.0f) || !isfinite(d.lambda))
+    return VB_OK;
+}
+
+/* The fit's regularisation, the distances and the thread count. */
+static vb_result resolve_parameters(bake_run *b, vb_error *err)
+{
+    vb_bake_desc *d = &b->d;
+    if (d->lambda == 0.0f)
+        d->lambda = VB_DEFAULT_LAMBDA;
+    if (!(d->lambda > 0.0f) || !isfinite(d->lambda))
         return vb_fail(err, VB_ERR_ARGUMENT, "the regularisation must be a positive number");
-    if (d.max_distance == 0.0f)
-        d.max_distance = d.scene->diagonal;
-    if (!(d.max_distance > 0.0f) || !isfinite(d.max_distance))
+    if (d->max_distance == 0.0f)
+        d->max_distance = d->scene->diagonal;
+    if (!(d->max_distance > 0.0f) || !isfinite(d->max_distance))
         return vb_fail(err, VB_ERR_ARGUMENT,
                        "max distance must be finite and > 0 (scene diagonal %g)",
-                       (double)d.scene->diagonal);
-    if (d.log_floor == 0.0f)
-        d.log_floor = 0.01f * d.max_distance;
-    if (!(d.log_floor > 0.0f) || !isfinite(d.log_floor))
+                       (double)d->scene->diagonal);
+    if (d->log_floor == 0.0f)
+        d->log_floor = 0.01f * d->max_distance;
+    if (!(d->log_floor > 0.0f) || !isfinite(d->log_floor))
         return vb_fail(err, VB_ERR_ARGUMENT, "the log-distance floor must be a positive number");
-    d.threads = vb_parallel_threads(d.threads);
+    d->threads = vb_parallel_threads(d->threads);
+    return VB_OK;
+}
 
-    const vb_mesh *R = d.receivers;
+/* Finite receivers, indices in range, and the range baked (lo..hi). */
+static vb_result check_receivers(bake_run *b, vb_error *err)
+{
+    const vb_mesh *R = b->d.receivers;
     for (size_t i = 0; i < 3 * (size_t)R->vertex_count; i++)
         if (!isfinite(R->positions[i]) || !isfinite(R->normals[i]))
             return vb_fail(err, VB_ERR_INVALID,
@@ -1026,366 +1075,417 @@ vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
             return vb_fail(err, VB_ERR_INVALID,
                            "receiver triangle %zu: index %u out of range (%u vertices)", i / 3,
                            R->indices[i], R->vertex_count);
-    const uint32_t lo = d.range_begin, hi = d.range_end ? d.range_end : R->vertex_count;
-    if (lo >= hi || hi > R->vertex_count)
+    b->lo = b->d.range_begin;
+    b->hi = b->d.range_end ? b->d.range_end : R->vertex_count;
+    if (b->lo >= b->hi || b->hi > R->vertex_count)
         return vb_fail(err, VB_ERR_ARGUMENT, "receiver range %u..%u is not within 0..%u",
-                       d.range_begin, d.range_end, R->vertex_count);
-    /* The sampling domain (the method's row): the whole sphere (paper's
-     * horizon culls half of it), or the hemisphere above each receiver,
-     * with half the directions (the same traced budget). */
-    int hemisphere = mi->hemisphere;
-    /* Method decision: the log offsets calibrated on a sample of receivers
-     * (unless given), whose receivers every shard bakes too. */
-    const int calibrate = mi->decision && !d.log_offsets && !d.trace_only;
-    choose = choose && !d.trace_only;
-    if (d.decision_lights == 0)
-        d.decision_lights = VB_DEFAULT_DECISION_LIGHTS;
-    if (d.decision_lights > VB_DECISION_MAX_PAIRS)
+                       b->d.range_begin, b->d.range_end, R->vertex_count);
+    return VB_OK;
+}
+
+/* Method decision: the log offsets calibrated on a sample of receivers
+ * (unless given), whose receivers every shard bakes too; the fit's
+ * settings. */
+static vb_result resolve_decision(bake_run *b, vb_error *err)
+{
+    vb_bake_desc *d = &b->d;
+    b->calibrate = b->mi->decision && !d->log_offsets && !d->trace_only;
+    b->choose = b->choose && !d->trace_only;
+    if (d->decision_lights == 0)
+        d->decision_lights = VB_DEFAULT_DECISION_LIGHTS;
+    if (d->decision_lights > VB_DECISION_MAX_PAIRS)
         return vb_fail(err, VB_ERR_ARGUMENT, "decision lights must be 1..%u, not %u",
-                       VB_DECISION_MAX_PAIRS, d.decision_lights);
-    if (d.false_rate == 0.0f)
-        d.false_rate = VB_DEFAULT_FALSE_RATE;
-    if (!(d.false_rate > 0.0f && d.false_rate < 0.5f))
+                       VB_DECISION_MAX_PAIRS, d->decision_lights);
+    if (d->false_rate == 0.0f)
+        d->false_rate = VB_DEFAULT_FALSE_RATE;
+    if (!(d->false_rate > 0.0f && d->false_rate < 0.5f))
         return vb_fail(err, VB_ERR_ARGUMENT, "the false rate must be in (0, 0.5)");
-    vb_decision_params dec;
-    vb_decision_defaults(&dec);
-    if (d.decision)
-        dec = *d.decision;
-    if (!(dec.tau > 0.0f) || !(dec.lit_weight > 0.0f) || !(dec.ridge >= 0.0f) ||
-        !(dec.ridge0 > 0.0f) || dec.steps < 0 || dec.steps > 64)
+    vb_decision_defaults(&b->dec);
+    if (d->decision)
+        b->dec = *d->decision;
+    const vb_decision_params *dec = &b->dec;
+    if (!(dec->tau > 0.0f) || !(dec->lit_weight > 0.0f) || !(dec->ridge >= 0.0f) ||
+        !(dec->ridge0 > 0.0f) || dec->steps < 0 || dec->steps > 64)
         return vb_fail(err, VB_ERR_ARGUMENT, "decision settings out of range");
-    vb_dirgrid grid = {0};
-    uint32_t domain_rays = hemisphere ? (d.rays + 1) / 2 : d.rays;
-    vb_result r;
-    if (d.adaptive_rays) {
-        if (d.ray_tolerance == 0.0f)
-            d.ray_tolerance = VB_DEFAULT_RAY_TOLERANCE;
-        if (d.ray_tolerance < 0.0f)
-            d.ray_tolerance = 0.0f;
-        if (isnan(d.ray_tolerance))
-            return vb_fail(err, VB_ERR_ARGUMENT, "the ray tolerance must be a number >= 0");
-        if (domain_rays > 4096)
-            return vb_fail(err, VB_ERR_ARGUMENT,
-                           "adaptive rays: the cap must be at most %u rays, not %u",
-                           hemisphere ? 8192u : 4096u, d.rays);
-        r = vb_dirgrid_create_nested(domain_rays, hemisphere, &grid, err);
-    } else {
-        r = vb_dirgrid_create(domain_rays, hemisphere, &grid, err);
+    return VB_OK;
+}
+
+/* The sampling domain (the method's row): the whole sphere (paper's
+ * horizon culls half of it), or the hemisphere above each receiver, with
+ * half the directions (the same traced budget); nested for adaptive rays. */
+static vb_result create_grid(bake_run *b, vb_error *err)
+{
+    vb_bake_desc *d = &b->d;
+    int hemisphere = b->mi->hemisphere;
+    uint32_t domain_rays = hemisphere ? (d->rays + 1) / 2 : d->rays;
+    if (!d->adaptive_rays)
+        return vb_dirgrid_create(domain_rays, hemisphere, &b->grid, err);
+    if (d->ray_tolerance == 0.0f)
+        d->ray_tolerance = VB_DEFAULT_RAY_TOLERANCE;
+    if (d->ray_tolerance < 0.0f)
+        d->ray_tolerance = 0.0f;
+    if (isnan(d->ray_tolerance))
+        return vb_fail(err, VB_ERR_ARGUMENT, "the ray tolerance must be a number >= 0");
+    if (domain_rays > 4096)
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "adaptive rays: the cap must be at most %u rays, not %u",
+                       hemisphere ? 8192u : 4096u, d->rays);
+    return vb_dirgrid_create_nested(domain_rays, hemisphere, &b->grid, err);
+}
+
+/* A range: only its receivers, and the quantity choice's sample, are
+ * oriented and given origins (counted: the range's), and the arrays hold
+ * them only (vb_receivers_prepare's set), so a shard's memory is its
+ * range's. The whole bake: set NULL, every receiver. */
+static vb_result select_receivers(bake_run *b, vb_error *err)
+{
+    const uint32_t V = b->d.receivers->vertex_count, lo = b->lo, hi = b->hi;
+    b->set_count = V;
+    b->set_before = 0;
+    if (lo == 0 && hi >= V)
+        return VB_OK;
+    uint32_t samples = (b->choose || b->calibrate) ? choose_count(V) : 0;
+    if (!(b->set = malloc(((size_t)(hi - lo) + samples) * sizeof *b->set)))
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers", hi - lo);
+    /* Ascending: the samples before the range, the range, those after. */
+    uint32_t *set = b->set, n = 0;
+    for (uint32_t i = 0; i < samples; i++) {
+        uint32_t v = choose_receiver(i, V, samples);
+        if (v < lo)
+            set[n++] = v;
     }
-    if (r != VB_OK)
-        return r;
-    uint8_t *var_orders = NULL; /* adaptive order: the range's */
-    float *var_coeffs = NULL;
-    float (*lights)[3] = NULL;
-    /* A range: only its receivers, and the quantity choice's sample, are
-     * oriented and given origins (counted: the range's), and the arrays
-     * below hold them only (vb_receivers_prepare's set), so a shard's
-     * memory is its range's. */
-    uint32_t *set = NULL, set_count = R->vertex_count, set_before = 0;
-    if (lo > 0 || hi < R->vertex_count) {
-        uint32_t samples = (choose || calibrate) ? choose_count(R->vertex_count) : 0;
-        if (!(set = malloc(((size_t)(hi - lo) + samples) * sizeof *set))) {
-            vb_dirgrid_destroy(&grid);
-            return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
-                           hi - lo);
-        }
-        /* Ascending: the samples before the range, the range, those after. */
-        set_count = 0;
-        for (uint32_t i = 0; i < samples; i++) {
-            uint32_t v = choose_receiver(i, R->vertex_count, samples);
-            if (v < lo)
-                set[set_count++] = v;
-        }
-        set_before = set_count;
-        for (uint32_t v = lo; v < hi; v++)
-            set[set_count++] = v;
-        for (uint32_t i = 0; i < samples; i++) {
-            uint32_t v = choose_receiver(i, R->vertex_count, samples);
-            if (v >= hi)
-                set[set_count++] = v;
-        }
+    b->set_before = n;
+    for (uint32_t v = lo; v < hi; v++)
+        set[n++] = v;
+    for (uint32_t i = 0; i < samples; i++) {
+        uint32_t v = choose_receiver(i, V, samples);
+        if (v >= hi)
+            set[n++] = v;
     }
-    float *origins = malloc((size_t)set_count * 3 * sizeof *origins);
-    float *near = malloc((size_t)set_count * sizeof *near + 1);
-    float *coeffs[VDSH_ORDER_SLOTS] = {0};
+    b->set_count = n;
+    return VB_OK;
+}
+
+/* The per-receiver arrays, the job, adaptive order's arrays and lights,
+ * and the fits of every order the bake projects. */
+static vb_result allocate_arrays(bake_run *b, vb_error *err)
+{
+    const vb_bake_desc *d = &b->d;
+    const uint32_t V = d->receivers->vertex_count, n = b->hi - b->lo;
+    b->origins = malloc((size_t)b->set_count * 3 * sizeof *b->origins);
+    b->near = malloc((size_t)b->set_count * sizeof *b->near + 1);
     /* Oriented receivers: a copy of their normals, turned toward free
      * space (origins.h); the bake then reads the copy. */
-    float *normals = d.keep_normals ? NULL
-                                    : malloc((size_t)set_count * 3 * sizeof *normals + 1);
-    int missing = !d.keep_normals && !normals;
+    b->normals = d->keep_normals ? NULL
+                                 : malloc((size_t)b->set_count * 3 * sizeof *b->normals + 1);
+    int missing = !d->keep_normals && !b->normals;
     /* A range: its rows only (bake.h), so a shard's coefficients are its
      * own range's size. */
-    for (int o = 1; o <= VDSH_MAX_ORDER && !d.trace_only; o++)
-        if (d.order_mask & (1u << o))
-            missing |= !(coeffs[o] = malloc((size_t)(hi - lo) * o * o * sizeof(float)));
-    job *J = calloc(1, sizeof *J);
-    if (!origins || !near || missing || !J) {
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
-                    R->vertex_count);
-        goto done;
-    }
-    if (var_cap && !d.trace_only) {
-        var_orders = malloc((size_t)(hi - lo) + 1);
-        var_coeffs = malloc((size_t)(hi - lo) * var_cap * var_cap * sizeof(float));
-        lights = malloc(VB_ORDER_LIGHTS * sizeof *lights);
-        if (!var_orders || !var_coeffs || !lights) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
-                        R->vertex_count);
-            goto done;
-        }
-        if ((r = vb_scene_place_lights(d.scene, d.seed, VB_ORDER_LIGHTS, lights, NULL, err)) !=
-            VB_OK)
-            goto done;
+    for (int o = 1; o <= VDSH_MAX_ORDER && !d->trace_only; o++)
+        if (d->order_mask & (1u << o))
+            missing |= !(b->coeffs[o] = malloc((size_t)n * o * o * sizeof(float)));
+    b->J = calloc(1, sizeof *b->J);
+    if (!b->origins || !b->near || missing || !b->J)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers", V);
+    const int cap = b->var_cap;
+    if (cap && !d->trace_only) {
+        b->var_orders = malloc((size_t)n + 1);
+        b->var_coeffs = malloc((size_t)n * cap * cap * sizeof(float));
+        b->lights = malloc(VB_ORDER_LIGHTS * sizeof *b->lights);
+        if (!b->var_orders || !b->var_coeffs || !b->lights)
+            return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers", V);
+        vb_result r = vb_scene_place_lights(d->scene, d->seed, VB_ORDER_LIGHTS, b->lights, NULL,
+                                            err);
+        if (r != VB_OK)
+            return r;
     }
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
-        if (!coeffs[o] && o != d.max_order && o > var_cap) /* the top one rotates for all */
+        if (!b->coeffs[o] && o != d->max_order && o > cap) /* the top one rotates for all */
             continue;
-        if ((r = vb_fit_create(o, mi->fit, vb_fit_lambda(d.lambda, o), &J->fits[o], err)) != VB_OK)
-            goto done;
-        vb_fit_window(&J->fits[o], d.window);
+        vb_result r = vb_fit_create(o, b->mi->fit, vb_fit_lambda(d->lambda, o), &b->J->fits[o],
+                                    err);
+        if (r != VB_OK)
+            return r;
+        vb_fit_window(&b->J->fits[o], d->window);
     }
-    J->lo = lo;
-    J->hi = hi;
-    J->set = set;
-    J->set_count = set_count;
-    J->set_before = set_before;
-    vb_origins_stats ost = {0};
-    uint32_t flipped = 0;
-    r = vb_receivers_prepare(R, d.scene, d.threads, set, set_count, lo, hi, normals, &flipped,
-                             origins, near, &ost, err);
-    if (r != VB_OK)
-        goto done;
-    J->normals = normals;
-    J->d = &d;
-    J->grid = &grid;
-    J->origins = origins;
-    J->near = near;
-    memcpy(J->coeffs, coeffs, sizeof coeffs);
-    J->order = d.max_order;
-    J->log_floor = d.log_floor;
-    J->max_local = d.max_distance * d.scene->scale;
-    J->inv_scale = 1.0f / d.scene->scale;
+    return VB_OK;
+}
+
+/* Orient the receivers and place their ray origins (origins.h). */
+static vb_result prepare_receivers(bake_run *b, vb_error *err)
+{
+    return vb_receivers_prepare(b->d.receivers, b->d.scene, b->d.threads, b->set, b->set_count,
+                                b->lo, b->hi, b->normals, &b->flipped, b->origins, b->near,
+                                &b->ost, err);
+}
+
+/* The job the workers read: the run's settings and arrays, adaptive
+ * order's scratch. */
+static vb_result setup_job(bake_run *b, vb_error *err)
+{
+    vb_bake_desc *d = &b->d;
+    const vb_method_info *mi = b->mi;
+    job *J = b->J;
+    J->lo = b->lo;
+    J->hi = b->hi;
+    J->set = b->set;
+    J->set_count = b->set_count;
+    J->set_before = b->set_before;
+    J->normals = b->normals;
+    J->d = d;
+    J->grid = &b->grid;
+    J->origins = b->origins;
+    J->near = b->near;
+    memcpy(J->coeffs, b->coeffs, sizeof b->coeffs);
+    J->order = d->max_order;
+    J->log_floor = d->log_floor;
+    J->max_local = d->max_distance * d->scene->scale;
+    J->inv_scale = 1.0f / d->scene->scale;
     J->horizon = mi->horizon;
-    J->adaptive = d.adaptive_rays != 0;
-    J->ray_tol = d.ray_tolerance;
-    J->var_cap = var_orders ? var_cap : 0;
-    J->var_tol = d.order_tolerance;
-    J->lights = lights;
+    J->adaptive = d->adaptive_rays != 0;
+    J->ray_tol = d->ray_tolerance;
+    J->var_cap = b->var_orders ? b->var_cap : 0;
+    J->var_tol = d->order_tolerance;
+    J->lights = b->lights;
     J->light_count = VB_ORDER_LIGHTS;
-    J->var_orders = var_orders;
-    J->var_coeffs = var_coeffs;
-    if (var_orders && !(J->var_scratch = malloc(d.threads * var_scratch_floats(J) *
-                                                sizeof(float)))) {
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-        goto done;
-    }
-    /* The per-order log offsets, for the methods that have them. */
+    J->var_orders = b->var_orders;
+    J->var_coeffs = b->var_coeffs;
+    if (b->var_orders && !(J->var_scratch = malloc(d->threads * var_scratch_floats(J) *
+                                                   sizeof(float))))
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    return VB_OK;
+}
+
+/* The per-order log offsets, for the methods that have them; method
+ * decision: the pool of lights in free space (traced frame) and the
+ * workers' scratch (no free space: the lsq fits are kept); adaptive
+ * order's offsets; the quantity choice's error table. */
+static vb_result setup_offsets(bake_run *b, vb_error *err)
+{
+    const vb_bake_desc *d = &b->d;
+    const vb_method_info *mi = b->mi;
+    job *J = b->J;
     for (int o = 1; o <= VDSH_MAX_ORDER && mi->param == VB_PARAM_LOG_OFFSET; o++) {
-        J->log_offset[o] = d.log_offsets ? d.log_offsets[o] : mi->default_log_offset[o];
-        if (!isfinite(J->log_offset[o]) || fabsf(J->log_offset[o]) > 5.0f) {
-            r = vb_fail(err, VB_ERR_ARGUMENT, "order %d: log offset %g is not in -5..5", o,
-                        (double)J->log_offset[o]);
-            goto done;
-        }
+        J->log_offset[o] = d->log_offsets ? d->log_offsets[o] : mi->default_log_offset[o];
+        if (!isfinite(J->log_offset[o]) || fabsf(J->log_offset[o]) > 5.0f)
+            return vb_fail(err, VB_ERR_ARGUMENT, "order %d: log offset %g is not in -5..5", o,
+                           (double)J->log_offset[o]);
     }
-    /* Method decision: the pool of lights in free space (traced frame),
-     * the workers' scratch; no free space: the lsq fits are kept. */
-    J->dec = dec;
-    J->dec_lights = d.decision_lights;
-    if (mi->decision && !d.trace_only) {
+    J->dec = b->dec;
+    J->dec_lights = d->decision_lights;
+    if (mi->decision && !d->trace_only) {
         J->pool = malloc(DEC_POOL * sizeof *J->pool);
-        if (!J->pool) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-            goto done;
-        }
+        if (!J->pool)
+            return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         vb_error perr;
-        if (vb_scene_place_lights(d.scene, d.seed ^ 0xdec15105ull, DEC_POOL, J->pool, NULL,
+        if (vb_scene_place_lights(d->scene, d->seed ^ 0xdec15105ull, DEC_POOL, J->pool, NULL,
                                   &perr) == VB_OK) {
             for (uint32_t k = 0; k < DEC_POOL; k++)
-                vb_scene_to_local(d.scene, J->pool[k], J->pool[k]);
+                vb_scene_to_local(d->scene, J->pool[k], J->pool[k]);
             J->pool_count = DEC_POOL;
             J->decision = 1;
-            size_t bytes = dec_scratch_bytes(J) * d.threads;
-            if (!(J->dec_scratch = aligned_alloc(64, (bytes + 63) & ~(size_t)63))) {
-                r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-                goto done;
-            }
+            size_t bytes = dec_scratch_bytes(J) * d->threads;
+            if (!(J->dec_scratch = aligned_alloc(64, (bytes + 63) & ~(size_t)63)))
+                return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         }
     }
     for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-        J->var_offset[o] = mi->decision && !d.log_offsets
+        J->var_offset[o] = mi->decision && !d->log_offsets
                                ? vb_method_get(VB_METHOD_SHADOW)->default_log_offset[o]
                                : J->log_offset[o];
     /* The quantity choice's score: the expected shadow error e(r). */
-    if ((choose || J->adaptive) && !(J->error_table = error_table_create())) {
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-        goto done;
+    if ((b->choose || J->adaptive) && !(J->error_table = error_table_create()))
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    return VB_OK;
+}
+
+/* Per order, the quantity whose fits reconstruct the traced distances of a
+ * sample of receivers with the lower expected shadow error; sums in sample
+ * order, so the choice does not depend on the thread count. Without the
+ * choice: the asked or the method's quantity. */
+static vb_result choose_quantities(bake_run *b, vb_error *err)
+{
+    const vb_bake_desc *d = &b->d;
+    job *J = b->J;
+    const uint32_t V = d->receivers->vertex_count;
+    b->t0 = vb_now();
+    if (!b->choose || d->trace_only) {
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            J->quantity[o] = d->order_quantity ? d->order_quantity[o]
+                             : b->choose ? VDSH_QUANTITY_DISTANCE : b->stored;
+        return VB_OK;
     }
+    b->auto_receivers = J->choose_count = choose_count(V);
+    J->choose_error = calloc((size_t)J->choose_count * (VDSH_ORDER_SLOTS) * 2, sizeof(double));
+    J->choose_coeffs = malloc((size_t)J->choose_count * 2 * CHOOSE_STRIDE * sizeof(float));
+    J->done = calloc((size_t)(b->hi - b->lo), 1);
+    if (!J->choose_error || !J->choose_coeffs || !J->done)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    if (vb_parallel_for(d->threads, J->choose_count, 4, choose_block, J, NULL, NULL) == 0)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
+    double (*auto_error)[2] = b->auto_error;
+    for (uint32_t i = 0; i < J->choose_count; i++)
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            for (int q = 0; q < 2; q++)
+                auto_error[o][q] += J->choose_error[((size_t)i * (VDSH_ORDER_SLOTS) + o) * 2 + q];
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
+        auto_error[o][0] /= J->choose_count;
+        auto_error[o][1] /= J->choose_count;
+        J->quantity[o] = auto_error[o][1] < auto_error[o][0] ? VDSH_QUANTITY_LOG_DISTANCE
+                                                             : VDSH_QUANTITY_DISTANCE;
+    }
+    /* The sampled receivers are baked: keep the chosen fits. */
+    for (uint32_t i = 0; i < J->choose_count; i++) {
+        uint32_t v = choose_receiver(i, V, J->choose_count);
+        const float *keep = J->choose_coeffs + (size_t)i * 2 * CHOOSE_STRIDE;
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            if (b->coeffs[o] && v >= J->lo && v < J->hi && J->done[v - J->lo])
+                memcpy(b->coeffs[o] + (size_t)(v - J->lo) * o * o,
+                       keep + (J->quantity[o] == VDSH_QUANTITY_LOG_DISTANCE) * CHOOSE_STRIDE +
+                           choose_offset(o),
+                       (size_t)o * o * sizeof(float));
+    }
+    return VB_OK;
+}
+
+/* The decision fit's log offsets: per order, the one that leaves
+ * false_rate of the lit pairs of held-out lights in false shadow, over a
+ * sample of receivers, in sample order. */
+static vb_result calibrate_offsets(bake_run *b, vb_error *err)
+{
+    const vb_bake_desc *d = &b->d;
+    job *J = b->J;
+    if (!b->calibrate || !J->decision)
+        return VB_OK;
+    const uint32_t cal_count = b->cal_count = J->choose_count =
+        choose_count(d->receivers->vertex_count);
+    J->done = calloc((size_t)(b->hi - b->lo), 1);
+    J->cal_margins = malloc((size_t)cal_count * VDSH_ORDER_SLOTS * CAL_LIGHTS * sizeof(float));
+    float *lit = malloc((size_t)cal_count * CAL_LIGHTS * sizeof(float) + 1);
+    vb_result r = VB_OK;
+    if (!J->done || !J->cal_margins || !lit)
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    else if (vb_parallel_for(d->threads, cal_count, 4, calibrate_block, J, NULL, NULL) == 0)
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
+    for (int o = 1; o <= VDSH_MAX_ORDER && r == VB_OK; o++) {
+        if (!b->coeffs[o])
+            continue;
+        uint32_t k = 0;
+        for (uint32_t i = 0; i < cal_count; i++)
+            for (uint32_t j = 0; j < CAL_LIGHTS; j++) {
+                float m = J->cal_margins[((size_t)i * VDSH_ORDER_SLOTS + o) * CAL_LIGHTS + j];
+                if (!isnan(m))
+                    lit[k++] = m;
+            }
+        float off = vb_decision_offset(lit, k, d->false_rate);
+        J->log_offset[o] = off < -5.0f ? -5.0f : off > 5.0f ? 5.0f : off;
+    }
+    free(lit);
+    return r;
+}
+
+/* Trace and project every receiver of the range on the workers; the
+ * calibration's receivers were baked before their offset, which is added
+ * to them here. */
+static vb_result bake_receivers(bake_run *b, vb_error *err)
+{
+    const vb_bake_desc *d = &b->d;
+    job *J = b->J;
+    const uint32_t lo = b->lo, hi = b->hi;
+    b->started = vb_parallel_for(d->threads, d->receivers->vertex_count, BLOCK, bake_block, J,
+                                 d->progress ? bake_progress : NULL, J);
+    for (uint32_t v = lo; b->cal_count && J->done && v < hi; v++)
+        if (J->done[v - lo])
+            for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+                if (b->coeffs[o])
+                    b->coeffs[o][(size_t)(v - lo) * o * o] +=
+                        J->log_offset[o] / 0.28209479177387814f;
+    if (b->started == 0)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
+    return VB_OK;
+}
+
+/* The output: the settings as resolved, the counts, and the arrays (moved
+ * out of the run, so that run_free leaves them). */
+static void fill_output(bake_run *b, vb_bake_output *out)
+{
+    const vb_bake_desc *d = &b->d;
+    const vb_method_info *mi = b->mi;
+    const vb_mesh *R = d->receivers;
+    job *J = b->J;
     uint32_t undefined = 0;
     for (uint32_t v = 0; v < R->vertex_count; v++) {
         const float *n = R->normals + 3 * (size_t)v;
         undefined += n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f;
     }
 
-    double t0 = vb_now();
-    double auto_error[VDSH_ORDER_SLOTS][2] = {{0}};
-    uint32_t auto_receivers = 0;
-    if (choose && !d.trace_only) {
-        /* Per order, the quantity whose fits reconstruct the traced
-         * distances of a sample of receivers with the lower expected
-         * shadow error; sums in sample order, so the choice does not
-         * depend on the thread count. */
-        auto_receivers = J->choose_count = choose_count(R->vertex_count);
-        J->choose_error = calloc((size_t)J->choose_count * (VDSH_ORDER_SLOTS) * 2,
-                                 sizeof(double));
-        J->choose_coeffs = malloc((size_t)J->choose_count * 2 * CHOOSE_STRIDE * sizeof(float));
-        J->done = calloc((size_t)(hi - lo), 1);
-        if (!J->choose_error || !J->choose_coeffs || !J->done) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-            goto done;
-        }
-        if (vb_parallel_for(d.threads, J->choose_count, 4, choose_block, J, NULL, NULL) == 0) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
-            goto done;
-        }
-        for (uint32_t i = 0; i < J->choose_count; i++)
-            for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-                for (int q = 0; q < 2; q++)
-                    auto_error[o][q] +=
-                        J->choose_error[((size_t)i * (VDSH_ORDER_SLOTS) + o) * 2 + q];
-        for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
-            auto_error[o][0] /= J->choose_count;
-            auto_error[o][1] /= J->choose_count;
-            J->quantity[o] = auto_error[o][1] < auto_error[o][0] ? VDSH_QUANTITY_LOG_DISTANCE
-                                                                 : VDSH_QUANTITY_DISTANCE;
-        }
-        /* The sampled receivers are baked: keep the chosen fits. */
-        for (uint32_t i = 0; i < J->choose_count; i++) {
-            uint32_t v = choose_receiver(i, R->vertex_count, J->choose_count);
-            const float *keep = J->choose_coeffs + (size_t)i * 2 * CHOOSE_STRIDE;
-            for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-                if (coeffs[o] && v >= J->lo && v < J->hi && J->done[v - J->lo])
-                    memcpy(coeffs[o] + (size_t)(v - J->lo) * o * o,
-                           keep + (J->quantity[o] == VDSH_QUANTITY_LOG_DISTANCE) * CHOOSE_STRIDE +
-                               choose_offset(o),
-                           (size_t)o * o * sizeof(float));
-        }
-    } else {
-        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-            J->quantity[o] = d.order_quantity ? d.order_quantity[o]
-                             : choose ? VDSH_QUANTITY_DISTANCE : stored;
-    }
-    uint32_t cal_count = 0;
-    if (calibrate && J->decision) {
-        /* The decision fit's log offsets: per order, the one that leaves
-         * false_rate of the lit pairs of held-out lights in false shadow,
-         * over a sample of receivers, in sample order. */
-        cal_count = J->choose_count = choose_count(R->vertex_count);
-        J->done = calloc((size_t)(hi - lo), 1);
-        J->cal_margins = malloc((size_t)cal_count * VDSH_ORDER_SLOTS * CAL_LIGHTS * sizeof(float));
-        float *lit = malloc((size_t)cal_count * CAL_LIGHTS * sizeof(float) + 1);
-        if (!J->done || !J->cal_margins || !lit) {
-            free(lit);
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-            goto done;
-        }
-        if (vb_parallel_for(d.threads, cal_count, 4, calibrate_block, J, NULL, NULL) == 0) {
-            free(lit);
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
-            goto done;
-        }
-        for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
-            if (!coeffs[o])
-                continue;
-            uint32_t k = 0;
-            for (uint32_t i = 0; i < cal_count; i++)
-                for (uint32_t j = 0; j < CAL_LIGHTS; j++) {
-                    float m = J->cal_margins[((size_t)i * VDSH_ORDER_SLOTS + o) * CAL_LIGHTS + j];
-                    if (!isnan(m))
-                        lit[k++] = m;
-                }
-            float off = vb_decision_offset(lit, k, d.false_rate);
-            J->log_offset[o] = off < -5.0f ? -5.0f : off > 5.0f ? 5.0f : off;
-        }
-        free(lit);
-    }
-    unsigned started = vb_parallel_for(d.threads, R->vertex_count, BLOCK, bake_block, J,
-                                       d.progress ? bake_progress : NULL, J);
-    /* The calibration's receivers were baked before their offset. */
-    for (uint32_t v = lo; cal_count && J->done && v < hi; v++)
-        if (J->done[v - lo])
-            for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-                if (coeffs[o])
-                    coeffs[o][(size_t)(v - lo) * o * o] += J->log_offset[o] / 0.28209479177387814f;
-    if (started == 0) {
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
-        goto done;
-    }
-
     vb_bake_output o = {0};
-    o.max_order = d.max_order;
+    o.max_order = d->max_order;
     o.method = mi->stored;
     int any_log = 0;
     for (int k = 0; k <= VDSH_MAX_ORDER; k++) {
         o.quantity[k] = J->quantity[k];
-        any_log |= coeffs[k] && J->quantity[k] == VDSH_QUANTITY_LOG_DISTANCE;
+        any_log |= b->coeffs[k] && J->quantity[k] == VDSH_QUANTITY_LOG_DISTANCE;
     }
-    o.auto_receivers = auto_receivers;
-    memcpy(o.auto_error, auto_error, sizeof auto_error);
-    o.lambda = mi->regularised ? d.lambda : 0.0f;
+    o.auto_receivers = b->auto_receivers;
+    memcpy(o.auto_error, b->auto_error, sizeof b->auto_error);
+    o.lambda = mi->regularised ? d->lambda : 0.0f;
     memcpy(o.log_offset, J->log_offset, sizeof o.log_offset);
-    any_log |= var_orders != NULL;
-    o.log_floor = any_log ? d.log_floor : 0.0f;
+    any_log |= b->var_orders != NULL;
+    o.log_floor = any_log ? d->log_floor : 0.0f;
     if (mi->decision) {
-        o.decision_lights = J->decision ? d.decision_lights : 0;
+        o.decision_lights = J->decision ? d->decision_lights : 0;
         o.decision_fitted = atomic_load(&J->dec_fitted);
         o.decision_fallbacks = atomic_load(&J->dec_fallbacks);
         o.decision_pairs = o.decision_fitted
                                ? (double)atomic_load(&J->dec_pairs) / o.decision_fitted : 0.0;
-        o.calibration_receivers = cal_count;
+        o.calibration_receivers = b->cal_count;
         o.decision_rays = atomic_load(&J->dec_rays);
-        o.false_rate = cal_count ? d.false_rate : 0.0f;
+        o.false_rate = b->cal_count ? d->false_rate : 0.0f;
     }
-    o.window = d.window;
+    o.window = d->window;
     o.vertex_count = R->vertex_count;
     o.range_begin = J->lo;
     o.range_end = J->hi;
-    memcpy(o.coeffs, coeffs, sizeof coeffs);
-    memset(coeffs, 0, sizeof coeffs);
-    o.variable_orders = var_orders;
-    o.variable_coeffs = var_coeffs;
-    o.variable_cap = var_orders ? var_cap : 0;
-    o.order_tolerance = var_orders ? d.order_tolerance : 0.0f;
+    memcpy(o.coeffs, b->coeffs, sizeof b->coeffs);
+    memset(b->coeffs, 0, sizeof b->coeffs);
+    o.variable_orders = b->var_orders;
+    o.variable_coeffs = b->var_coeffs;
+    o.variable_cap = b->var_orders ? b->var_cap : 0;
+    o.order_tolerance = b->var_orders ? d->order_tolerance : 0.0f;
     o.variable_method = mi->decision ? VDSH_METHOD_SHADOW : mi->stored;
-    o.variable_param = var_orders && mi->param == VB_PARAM_LOG_OFFSET ? J->var_offset[var_cap]
-                                                                      : o.lambda;
-    var_orders = NULL;
-    var_coeffs = NULL;
-    o.rays = grid.count;
-    o.ray_tolerance = J->adaptive ? d.ray_tolerance : 0.0f;
-    o.hemisphere = grid.hemisphere;
-    o.max_distance = d.max_distance;
-    o.threads = started;
+    o.variable_param = b->var_orders && mi->param == VB_PARAM_LOG_OFFSET
+                           ? J->var_offset[b->var_cap] : o.lambda;
+    b->var_orders = NULL;
+    b->var_coeffs = NULL;
+    o.rays = b->grid.count;
+    o.ray_tolerance = J->adaptive ? d->ray_tolerance : 0.0f;
+    o.hemisphere = b->grid.hemisphere;
+    o.max_distance = d->max_distance;
+    o.threads = b->started;
     o.rays_traced = atomic_load(&J->traced);
     o.rays_missed = atomic_load(&J->missed);
     o.degenerate_receivers = atomic_load(&J->degenerate);
     o.undefined_normals = undefined;
-    if (normals && set) { /* the range's rows (bake.h) */
-        memmove(normals, normals + 3 * (size_t)set_before, (size_t)(hi - lo) * 3 * sizeof *normals);
-        float *shrunk = realloc(normals, (size_t)(hi - lo) * 3 * sizeof *normals);
+    const size_t rows = (size_t)(b->hi - b->lo);
+    if (b->normals && b->set) { /* the range's rows (bake.h) */
+        memmove(b->normals, b->normals + 3 * (size_t)b->set_before, rows * 3 * sizeof *b->normals);
+        float *shrunk = realloc(b->normals, rows * 3 * sizeof *b->normals);
         if (shrunk)
-            normals = shrunk;
+            b->normals = shrunk;
     }
-    o.normals = normals;
-    normals = NULL;
-    o.flipped_normals = flipped;
-    o.moved_origins = ost.moved;
-    o.origins = ost;
-    o.seconds = vb_now() - t0;
+    o.normals = b->normals;
+    b->normals = NULL;
+    o.flipped_normals = b->flipped;
+    o.moved_origins = b->ost.moved;
+    o.origins = b->ost;
+    o.seconds = vb_now() - b->t0;
     *out = o;
-    r = VB_OK;
+}
 
-done:
+static void run_free(bake_run *b)
+{
+    job *J = b->J;
     if (J) {
         free(J->error_table);
         free(J->choose_error);
@@ -1398,14 +1498,34 @@ done:
     }
     free(J);
     for (int k = 0; k <= VDSH_MAX_ORDER; k++)
-        free(coeffs[k]);
-    free(origins);
-    free(near);
-    free(normals);
-    free(set);
-    free(var_orders);
-    free(var_coeffs);
-    free(lights);
-    vb_dirgrid_destroy(&grid);
+        free(b->coeffs[k]);
+    free(b->origins);
+    free(b->near);
+    free(b->normals);
+    free(b->set);
+    free(b->var_orders);
+    free(b->var_coeffs);
+    free(b->lights);
+    vb_dirgrid_destroy(&b->grid);
+}
+
+/* vb_bake_run's steps, in order. */
+static const bake_step bake_steps[] = {
+    resolve_orders, resolve_quantity,  resolve_parameters, check_receivers,
+    resolve_decision, create_grid,     select_receivers,   allocate_arrays,
+    prepare_receivers, setup_job,      setup_offsets,      choose_quantities,
+    calibrate_offsets, bake_receivers,
+};
+
+vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
+                      vb_error *err)
+{
+    bake_run b = {.d = *desc};
+    vb_result r = VB_OK;
+    for (size_t k = 0; r == VB_OK && k < sizeof bake_steps / sizeof *bake_steps; k++)
+        r = bake_steps[k](&b, err);
+    if (r == VB_OK)
+        fill_output(&b, out);
+    run_free(&b);
     return r;
 }

@@ -121,7 +121,7 @@ typedef struct vb_bake_desc {
      * round's choice); NULL: as `quantity` says. */
     const vdsh_quantity *order_quantity;
     float lambda;              /* lsq and shadow regularisation; 0: 1e-4 */
-    const float *log_offsets;  /* method shadow: per order (index 1..5), added
+    const float *log_offsets;  /* method shadow: per order (index 1..VDSH_MAX_ORDER), added
                                 * to the fitted ln d; NULL: vb_shadow_log_offset */
     float log_floor;           /* log-distance floor; 0: 1% of max_distance */
     vdsh_window window;        /* on each order's bands; 0: none */

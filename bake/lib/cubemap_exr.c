@@ -70,39 +70,51 @@ static void on_exr_error(exr_const_context_t ctxt, exr_result_t code,
                  msg ? msg : exr_get_error_code_as_string(code));
 }
 
-static int64_t io_read(exr_const_context_t ctxt, void *ud, void *buffer,
-                       uint64_t size, uint64_t offset,
-                       exr_stream_error_func_ptr_t error_cb)
+/* Read into `to` or write from `from` the whole of [offset, offset +
+ * size) of io's file, at most 1 GiB a call, through interruptions. The
+ * bytes moved (fewer when a read meets the end of the file: OpenEXR
+ * reports the short read), or -1 with the first errno kept in io. */
+static int64_t io_transfer(exr_const_context_t ctxt, exr_io *io, uint8_t *to,
+                           const uint8_t *from, uint64_t size, uint64_t offset,
+                           exr_stream_error_func_ptr_t error_cb)
 {
-    exr_io *io = ud;
-    uint8_t *p = buffer;
     uint64_t done = 0;
-    if (offset > (uint64_t)INT64_MAX || size > (uint64_t)INT64_MAX - offset) {
-        if (error_cb)
-            error_cb(ctxt, EXR_ERR_READ_IO, "read of %" PRIu64
-                     " bytes at offset %" PRIu64 " out of range", size, offset);
-        return -1;
-    }
     while (done < size) {
         uint64_t want = size - done;
         if (want > (1u << 30))
             want = 1u << 30;
-        ssize_t r = pread(io->fd, p + done, (size_t)want, (off_t)(offset + done));
+        ssize_t r = from ? pwrite(io->fd, from + done, (size_t)want, (off_t)(offset + done))
+                         : pread(io->fd, to + done, (size_t)want, (off_t)(offset + done));
         if (r < 0) {
             if (errno == EINTR)
                 continue;
             if (!io->os_errno)
                 io->os_errno = errno;
             if (error_cb)
-                error_cb(ctxt, EXR_ERR_READ_IO, "read failed: %s",
-                         strerror(errno));
+                error_cb(ctxt, from ? EXR_ERR_WRITE_IO : EXR_ERR_READ_IO, "%s failed: %s",
+                         from ? "write" : "read", strerror(errno));
             return -1;
         }
-        if (r == 0)
-            break; /* end of file: OpenEXR reports the short read */
+        if (r == 0 && !from)
+            break;
         done += (uint64_t)r;
     }
     return (int64_t)done;
+}
+
+static int64_t io_read(exr_const_context_t ctxt, void *ud, void *buffer,
+                       uint64_t size, uint64_t offset,
+                       exr_stream_error_func_ptr_t error_cb)
+{
+    exr_io *io = ud;
+    uint8_t *p = buffer;
+    if (offset > (uint64_t)INT64_MAX || size > (uint64_t)INT64_MAX - offset) {
+        if (error_cb)
+            error_cb(ctxt, EXR_ERR_READ_IO, "read of %" PRIu64
+                     " bytes at offset %" PRIu64 " out of range", size, offset);
+        return -1;
+    }
+    return io_transfer(ctxt, io, p, NULL, size, offset, error_cb);
 }
 
 static int64_t io_size(exr_const_context_t ctxt, void *ud)
@@ -121,7 +133,6 @@ static int64_t io_write(exr_const_context_t ctxt, void *ud, const void *buffer,
 {
     exr_io *io = ud;
     const uint8_t *p = buffer;
-    uint64_t done = 0;
     if (offset > (uint64_t)INT64_MAX || size > (uint64_t)INT64_MAX - offset) {
         if (error_cb)
             error_cb(ctxt, EXR_ERR_WRITE_IO, "write out of range");
@@ -149,24 +160,7 @@ static int64_t io_write(exr_const_context_t ctxt, void *ud, const void *buffer,
             io->size = (size_t)end;
         return (int64_t)size;
     }
-    while (done < size) {
-        uint64_t want = size - done;
-        if (want > (1u << 30))
-            want = 1u << 30;
-        ssize_t r = pwrite(io->fd, p + done, (size_t)want, (off_t)(offset + done));
-        if (r < 0) {
-            if (errno == EINTR)
-                continue;
-            if (!io->os_errno)
-                io->os_errno = errno;
-            if (error_cb)
-                error_cb(ctxt, EXR_ERR_WRITE_IO, "write failed: %s",
-                         strerror(errno));
-            return -1;
-        }
-        done += (uint64_t)r;
-    }
-    return (int64_t)done;
+    return io_transfer(ctxt, io, NULL, p, size, offset, error_cb);
 }
 
 /* Turn a failed OpenEXR call into a vb_result and a message:
@@ -203,6 +197,28 @@ static size_t cube_floats(int n)
 /* ------------------------------------------------------------------ */
 /* Writing                                                              */
 
+/* A context's initializer: OpenEXR's messages go to io. */
+static exr_context_initializer_t context_init(exr_io *io)
+{
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = on_exr_error;
+    init.user_data = io;
+    return init;
+}
+
+/* In encode_exr and decode_exr: run an OpenEXR call; when it fails, r is
+ * its vb_result (the function's `otherwise` when neither the OS nor
+ * memory is to blame) and the function goes to its clean-up. */
+#define EXR_TRY(call, what)                                                   \
+    do {                                                                      \
+        io_reset_msg(io);                                                     \
+        rv = (call);                                                          \
+        if (rv != EXR_ERR_SUCCESS) {                                          \
+            r = exr_fail(err, io, rv, otherwise, path, (what));               \
+            goto done;                                                        \
+        }                                                                     \
+    } while (0)
+
 /* Encode the image through *io_out: into its open file descriptor, or
  * into memory when that is -1. `path` is only for messages. */
 static vb_result encode_exr(const char *path, exr_io *io, int n, const float *rgba,
@@ -214,22 +230,11 @@ static vb_result encode_exr(const char *path, exr_io *io, int n, const float *rg
     int32_t lines = 0;
     vb_result r = VB_OK;
     exr_result_t rv;
-
-    memset(&enc, 0, sizeof enc);
-    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = on_exr_error;
-    init.user_data = io;
+    const vb_result otherwise = VB_ERR_IO; /* EXR_TRY's */
+    exr_context_initializer_t init = context_init(io);
     init.write_fn = io_write;
 
-#define EXR_TRY(call, what)                                                   \
-    do {                                                                      \
-        io_reset_msg(io);                                                    \
-        rv = (call);                                                          \
-        if (rv != EXR_ERR_SUCCESS) {                                          \
-            r = exr_fail(err, io, rv, VB_ERR_IO, path, (what));              \
-            goto done;                                                        \
-        }                                                                     \
-    } while (0)
+    memset(&enc, 0, sizeof enc);
 
     /* The header: exactly what cube maps need, nothing that varies from
      * run to run (no date, no software version), so the bytes depend on
@@ -303,7 +308,6 @@ static vb_result encode_exr(const char *path, exr_io *io, int n, const float *rg
         ctxt = NULL;
         EXR_TRY(exr_finish(&c), "cannot finish file");
     }
-#undef EXR_TRY
 
 done:
     if (enc_live)
@@ -459,32 +463,22 @@ static exr_result_t unpack_to_float(exr_decode_pipeline_t *d)
 static vb_result decode_exr(const char *path, exr_io *io, vb_cubemap **out,
                             vb_error *err)
 {
+    const vb_result otherwise = VB_ERR_FORMAT; /* EXR_TRY's */
     exr_context_t ctxt = NULL;
     exr_decode_pipeline_t dec;
     int dec_live = 0;
     vb_cubemap *map = NULL;
     vb_result r = VB_OK;
     exr_result_t rv;
+    exr_context_initializer_t init = context_init(io);
 
     memset(&dec, 0, sizeof dec);
-    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = on_exr_error;
-    init.user_data = io;
     init.read_fn = io_read;
     init.size_fn = io_size;
     /* A damaged offset table is an error, not something to guess around
      * by scanning the file for chunks. */
     init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
 
-#define EXR_TRY(call, what)                                                   \
-    do {                                                                      \
-        io_reset_msg(io);                                                     \
-        rv = (call);                                                          \
-        if (rv != EXR_ERR_SUCCESS) {                                          \
-            r = exr_fail(err, io, rv, VB_ERR_FORMAT, path, (what));           \
-            goto done;                                                        \
-        }                                                                     \
-    } while (0)
 #define BAD(...)                                                              \
     do {                                                                      \
         r = vb_fail(err, VB_ERR_FORMAT, __VA_ARGS__);                         \
@@ -774,11 +768,8 @@ vb_result vb_cubemap_basis_write(const vb_cubemap_basis *b, const char *dir,
     vb_result r = vb_cubemap_basis_stage(b, dir, stem, st, err);
     for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++) {
         r = commit(&st[k], err);
-        if (r != VB_OK && k > 0 && err) {
-            size_t len = strlen(err->msg);
-            snprintf(err->msg + len, sizeof err->msg - len,
-                     " (the first %d basis files were already replaced)", k);
-        }
+        if (r != VB_OK && k > 0)
+            vb_append(err, " (the first %d basis files were already replaced)", k);
     }
 
     for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)

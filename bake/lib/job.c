@@ -10,8 +10,6 @@
 #include "origins.h"
 #include "vdsh_output.h"
 
-#define DEFAULT_CUBE_SIZE 64
-
 int vb_job_cube_size(const vb_job_desc *d)
 {
     /* The cubemaps serve orders 4 and 5 (functions 9..24; vdsh_cube.h). */
@@ -20,7 +18,7 @@ int vb_job_cube_size(const vb_job_desc *d)
         mask = 1u << (d->bake.max_order ? d->bake.max_order : VB_DEFAULT_ORDER); /* bake.h */
     if (!(mask & (1u << 4 | 1u << 5)) || d->cube_size < 0)
         return 0;
-    return d->cube_size > 0 ? d->cube_size : DEFAULT_CUBE_SIZE;
+    return d->cube_size > 0 ? d->cube_size : VB_DEFAULT_CUBE_SIZE;
 }
 
 static void *encode_basis(void *arg)
@@ -374,11 +372,8 @@ vb_result vb_write_outputs(const vdsh_file *f, const char *output, const char *c
     }
     if (r == VB_OK && vdsh_output_commit(&file, &verr) != VDSH_OK)
         r = vb_fail(err, VB_ERR_IO, "%s", verr.msg);
-    if (r != VB_OK && renamed > 0 && err) {
-        size_t len = strlen(err->msg);
-        snprintf(err->msg + len, sizeof err->msg - len,
-                 " (%d basis cubemaps were already replaced)", renamed);
-    }
+    if (r != VB_OK && renamed > 0)
+        vb_append(err, " (%d basis cubemaps were already replaced)", renamed);
     for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
         vdsh_output_abort(&cubes[k]);
     vdsh_output_abort(&file);

@@ -231,33 +231,6 @@ float vb_receiver_near(float diag, float mean_edge)
     return mean_edge > 0.0f && local < global ? local : global;
 }
 
-vb_result vb_mean_edges(const vb_mesh *m, float *out, vb_error *err)
-{
-    uint32_t *count = calloc((size_t)m->vertex_count + 1, sizeof *count);
-    double *sum = calloc((size_t)m->vertex_count + 1, sizeof *sum);
-    if (!count || !sum) {
-        free(count);
-        free(sum);
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for edge lengths");
-    }
-    for (uint32_t t = 0; t < m->triangle_count; t++) {
-        const uint32_t *ix = m->indices + 3 * (size_t)t;
-        for (int k = 0; k < 3; k++) {
-            const float *a = m->positions + 3 * (size_t)ix[k];
-            const float *b = m->positions + 3 * (size_t)ix[(k + 1) % 3];
-            double dx = (double)a[0] - b[0], dy = (double)a[1] - b[1], dz = (double)a[2] - b[2];
-            double len = sqrt(dx * dx + dy * dy + dz * dz);
-            sum[ix[k]] += len, count[ix[k]]++;
-            sum[ix[(k + 1) % 3]] += len, count[ix[(k + 1) % 3]]++;
-        }
-    }
-    for (uint32_t v = 0; v < m->vertex_count; v++)
-        out[v] = count[v] ? (float)(sum[v] / count[v]) : 0.0f;
-    free(count);
-    free(sum);
-    return VB_OK;
-}
-
 /* ---- probes ------------------------------------------------------------- */
 
 /* 16 directions above a receiver's horizon and their mirror images below,
@@ -507,7 +480,7 @@ static vb_result frames_create(const vb_mesh *m, const vb_scene *s, const subset
         goto done;
     }
     /* Per triangle with a corner in E: the mean edge length around each
-     * corner (vb_mean_edges) and the inset's pull - the mean direction from
+     * corner and the inset's pull - the mean direction from
      * a vertex to the centroids of its own triangles, weighted by their
      * distance, in the tangent plane. Interior vertices' pulls cancel
      * (length ~0); a vertex on a boundary or crease gets a vector of length

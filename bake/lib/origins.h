@@ -85,10 +85,6 @@ vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err);
  * `diag`: min(1e-3 diag, 0.1 mean_edge). */
 float vb_receiver_near(float diag, float mean_edge);
 
-/* Mean length of the edges of each vertex's triangles (0 for a vertex in
- * no triangle); out has vertex_count floats. */
-vb_result vb_mean_edges(const vb_mesh *m, float *out, vb_error *err);
-
 /* Ray origins in the scene's traced frame for every receiver (3 floats
  * each) by the rule and the repair above. near_out (may be NULL) receives
  * each receiver's near distance in scene units; stats (may be NULL) what

@@ -105,17 +105,6 @@ static inline int vb_dirgrid_packet_below(const vb_dirgrid *g, uint32_t packet,
  * used by the evaluator (with its own seed) for held-out samples. */
 void vb_hash2(uint64_t seed, uint32_t a, uint32_t b, float *u, float *v);
 
-/* The seed of one purpose's own random stream from a run's seed (the
- * evaluator's and the frames' directions, lights, eyes...): the splitmix64
- * finaliser over (seed, purpose), so that no two purposes share a stream. */
-static inline uint64_t vb_purpose_seed(uint64_t seed, uint32_t purpose)
-{
-    uint64_t z = seed ^ ((uint64_t)purpose * 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
 /* An orthonormal frame (t, b) completing unit n (Duff et al. 2017). */
 void vb_frame(const float n[3], float t[3], float b[3]);
 

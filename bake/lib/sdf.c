@@ -10,80 +10,75 @@
 #include "parallel.h"
 #include "vdsh_light.h"
 
+static double dot3d(const double u[3], const double v[3])
+{
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+}
+
+/* The dot products of ab and of ac with p - x. */
+static void dots_from(const double p[3], const double x[3], const double ab[3],
+                      const double ac[3], double *with_ab, double *with_ac)
+{
+    double xp[3];
+    for (int i = 0; i < 3; i++)
+        xp[i] = p[i] - x[i];
+    *with_ab = dot3d(ab, xp), *with_ac = dot3d(ac, xp);
+}
+
+/* |p - q|^2. */
+static double dist2(const double p[3], const double q[3])
+{
+    double e[3];
+    for (int i = 0; i < 3; i++)
+        e[i] = p[i] - q[i];
+    return dot3d(e, e);
+}
+
+/* |p - (x + t e)|^2. */
+static double dist2_along(const double p[3], const double x[3], double t, const double e[3])
+{
+    double q[3];
+    for (int i = 0; i < 3; i++)
+        q[i] = x[i] + t * e[i];
+    return dist2(p, q);
+}
+
 /* Squared distance from p to triangle abc (Ericson 5.1.5: the Voronoi
  * region of the closest feature, then the point on it). */
 static double tri_dist2(const double p[3], const double a[3], const double b[3],
                         const double c[3])
 {
-    double ab[3], ac[3], ap[3], q[3];
+    double ab[3], ac[3], bc[3];
     for (int i = 0; i < 3; i++)
-        ab[i] = b[i] - a[i], ac[i] = c[i] - a[i], ap[i] = p[i] - a[i];
-#define DOT(u, v) ((u)[0] * (v)[0] + (u)[1] * (v)[1] + (u)[2] * (v)[2])
-    double d1 = DOT(ab, ap), d2 = DOT(ac, ap);
-    if (d1 <= 0.0 && d2 <= 0.0) {
-        memcpy(q, a, sizeof q);
-        goto done;
+        ab[i] = b[i] - a[i], ac[i] = c[i] - a[i], bc[i] = c[i] - b[i];
+    double d1, d2, d3, d4, d5, d6;
+    dots_from(p, a, ab, ac, &d1, &d2);
+    dots_from(p, b, ab, ac, &d3, &d4);
+    dots_from(p, c, ab, ac, &d5, &d6);
+    double va = d3 * d6 - d5 * d4, vb = d5 * d2 - d1 * d6, vc = d1 * d4 - d3 * d2;
+    if (d1 <= 0.0 && d2 <= 0.0)
+        return dist2(p, a);
+    if (d3 >= 0.0 && d4 <= d3)
+        return dist2(p, b);
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0)
+        return dist2_along(p, a, d1 / (d1 - d3), ab);
+    if (d6 >= 0.0 && d5 <= d6)
+        return dist2(p, c);
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0)
+        return dist2_along(p, a, d2 / (d2 - d6), ac);
+    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0)
+        return dist2_along(p, b, (d4 - d3) / ((d4 - d3) + (d5 - d6)), bc);
+    double den = va + vb + vc;
+    if (!(den > 0.0)) { /* no area: the nearest of the three corners */
+        double da = dist2(p, a), db = dist2(p, b), dc = dist2(p, c);
+        double best = da < INFINITY ? da : INFINITY;
+        best = db < best ? db : best;
+        return dc < best ? dc : best;
     }
-    double bp[3];
+    double v = vb / den, w = vc / den, q[3];
     for (int i = 0; i < 3; i++)
-        bp[i] = p[i] - b[i];
-    double d3 = DOT(ab, bp), d4 = DOT(ac, bp);
-    if (d3 >= 0.0 && d4 <= d3) {
-        memcpy(q, b, sizeof q);
-        goto done;
-    }
-    double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-        double v = d1 / (d1 - d3);
-        for (int i = 0; i < 3; i++)
-            q[i] = a[i] + v * ab[i];
-        goto done;
-    }
-    double cp[3];
-    for (int i = 0; i < 3; i++)
-        cp[i] = p[i] - c[i];
-    double d5 = DOT(ab, cp), d6 = DOT(ac, cp);
-    if (d6 >= 0.0 && d5 <= d6) {
-        memcpy(q, c, sizeof q);
-        goto done;
-    }
-    double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-        double w = d2 / (d2 - d6);
-        for (int i = 0; i < 3; i++)
-            q[i] = a[i] + w * ac[i];
-        goto done;
-    }
-    double va = d3 * d6 - d5 * d4;
-    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
-        double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        for (int i = 0; i < 3; i++)
-            q[i] = b[i] + w * (c[i] - b[i]);
-        goto done;
-    }
-    {
-        double den = va + vb + vc;
-        if (!(den > 0.0)) { /* no area: the nearest of the three edges' ends */
-            double best = INFINITY;
-            const double *v3[3] = {a, b, c};
-            for (int k = 0; k < 3; k++) {
-                double e[3];
-                for (int i = 0; i < 3; i++)
-                    e[i] = p[i] - v3[k][i];
-                double dd = DOT(e, e);
-                best = dd < best ? dd : best;
-            }
-            return best;
-        }
-        double v = vb / den, w = vc / den;
-        for (int i = 0; i < 3; i++)
-            q[i] = a[i] + ab[i] * v + ac[i] * w;
-    }
-done:
-    for (int i = 0; i < 3; i++)
-        q[i] = p[i] - q[i];
-    return DOT(q, q);
-#undef DOT
+        q[i] = a[i] + ab[i] * v + ac[i] * w;
+    return dist2(p, q);
 }
 
 typedef struct job {

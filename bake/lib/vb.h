@@ -1,7 +1,7 @@
 /*
  * vb.h - result codes and error messages shared by the whole bake module
  * (prefix vb_): mesh loading, the Embree scene, the bake core, cubemaps,
- * the evaluator.
+ * the evaluator; and the little they all use (a clock, a ranking).
  *
  * Errors: fallible functions return a vb_result (VB_OK = 0) and, when `err`
  * is not NULL, write a message naming the file (or the input) and the
@@ -12,6 +12,7 @@
 #define VB_H
 
 #include <stdarg.h>
+#include <stdint.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -39,8 +40,30 @@ __attribute__((format(printf, 3, 4)))
 #endif
 vb_result vb_fail(vb_error *err, vb_result r, const char *fmt, ...);
 
+/* Add to the message in err (if not NULL), after what it says. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+void vb_append(vb_error *err, const char *fmt, ...);
+
+/* A value and its place in a list. qsort with vb_ranked_cmp ranks the
+ * largest value first and equal values in place order, so that a ranking
+ * is the same on every run. */
+typedef struct vb_ranked {
+    double key;
+    uint32_t index;
+} vb_ranked;
+
+int vb_ranked_cmp(const void *a, const void *b);
+
 /* Monotonic wall clock in seconds. */
 double vb_now(void);
+
+/* Named defaults that the bake library and more than one program (or help
+ * text) share: one number each, spelled once. */
+#define VB_DEFAULT_RAYS 2500u    /* directions per receiver, a 50 x 50 grid */
+#define VB_DEFAULT_CUBE_SIZE 64  /* basis cubemap face, texels */
+#define VB_DEFAULT_SEED 1u       /* vdsh-bake --seed */
 
 #ifdef __cplusplus
 }

@@ -74,7 +74,7 @@ typedef struct options {
     uint32_t max_rounds;       /* --max-rounds; 0: none given (VB_ADAPTIVE_ROUNDS) */
     int weld;
     uint64_t seed;
-    unsigned threads;
+    uint32_t threads;
     int cube_size;
     int sdf;                   /* --sdf N: distance volume, N per longest side */
     int robust;
@@ -82,6 +82,9 @@ typedef struct options {
     int trace_only;
     int keep_normals;
     int quiet;
+    uint32_t shard_index, shard_count; /* --shard I/N; count 0: the whole bake */
+    const char *const *meshes;         /* the MESH arguments */
+    int mesh_count;
 } options;
 
 /* --method's help, from the table: each row's name and help, indented,
@@ -133,6 +136,8 @@ static void on_round(void *user, uint32_t round, uint32_t receivers, uint32_t ca
 
 static void usage(FILE *f)
 {
+    /* The default grid's side: the defaults are square grids. */
+    const unsigned rays_side = (unsigned)lround(sqrt((double)VB_DEFAULT_RAYS));
     fprintf(f,
 "usage: vdsh-bake [options] MESH... -o OUT.vdsh\n"
 "Bake visibility-distance spherical harmonics for a static scene.\n"
@@ -148,10 +153,10 @@ static void usage(FILE *f)
 "Output:\n"
 "  -o, --output FILE       the .vdsh file to write (atomically)\n"
 "      --cubemap-dir DIR   where the SH basis cubemaps go (default: beside OUT)\n"
-"      --cube-size N       cubemap face size in texels (default 64; 0: none)\n"
+"      --cube-size N       cubemap face size in texels (default %d; 0: none)\n"
 "      --sdf N             also bake the signed distance volume of the scene for\n"
 "                          vdsh-view --mode sdf: N samples along the bounds'\n"
-"                          longest side (4..512; 64 is a good start), written\n"
+"                          longest side (%d..%d; 64 is a good start), written\n"
 "                          to OUT's companion file (room.vdsh: room.sdf)\n"
 "      --encoding E        coefficient encoding: s8s6 (default: bands 0-1 signed\n"
 "                          8-bit, bands 2+ 6-bit, a scale per coefficient\n"
@@ -159,7 +164,7 @@ static void usage(FILE *f)
 "                          s8 (all 8-bit: 4, 9, 25), f16 (8, 18, 50) or f32;\n"
 "                          compact ones within 0.1%% of f16: docs/ACCURACY.md;\n"
 "                          or cpca: clustered PCA of each order's coefficients\n"
-"                          (for orders 7..16: order 12 in ~30-32 bytes per\n"
+"                          (for orders 7..%d: order 12 in ~30-32 bytes per\n"
 "                          vertex; docs/ACCURACY.md \"Compressed high orders\");\n"
 "                          with --adaptive-order, its stream is written as a\n"
 "                          fixed cpca stream of order --max-order (zeros past\n"
@@ -180,22 +185,22 @@ static void usage(FILE *f)
 "\n"
 "Bake:\n"
 "      --rays N            directions per receiver, stratified and jittered\n"
-"                          (default 2500 = 50 x 50)\n"
+"                          (default %u = %u x %u)\n"
 "      --rays auto         adaptive: nested stratified rounds (a power-of-two\n"
-"                          grid under 2500, from 1/16 of it), each receiver\n"
+"                          grid under %u, from 1/16 of it), each receiver\n"
 "                          stopping when a round changes its fit by less\n"
 "                          than --ray-tolerance in expected shadow error\n"
-"      --ray-tolerance T   with --rays auto (default 0.06; 0: every round)\n"
+"      --ray-tolerance T   with --rays auto (default %g; 0: every round)\n"
 "      --orders LIST       SH orders to store, order n = n bands = n*n\n"
 "                          coefficients (default 2,3,5, or none with\n"
-"                          --adaptive-order; each 1..16: orders above 5 are\n"
+"                          --adaptive-order; each 1..%d: orders above 5 are\n"
 "                          drawn from buffers, for long shadows)\n"
 "      --adaptive-order TOL  one more stream, of variable order: each\n"
 "                          receiver gets the lowest order (1..--max-order)\n"
 "                          whose expected shadow error on its own traced\n"
 "                          directions, under lights in the scene's free\n"
 "                          space, is at most TOL (else its best order)\n"
-"      --max-order N       the adaptive order's cap (default 12)\n"
+"      --max-order N       the adaptive order's cap (default %d)\n"
 "      --method M          the fit:\n"
 "%s"
 "      --quantity Q        what the SH store: auto (default): log for decision\n"
@@ -216,9 +221,9 @@ static void usage(FILE *f)
 "                          stream's method parameter\n"
 "      --false-rate R      decision: the share of lit (light, receiver) pairs\n"
 "                          the calibrated offset leaves in false shadow, on\n"
-"                          held-out lights (default 0.008)\n"
+"                          held-out lights (default %g)\n"
 "      --decision-lights N decision: training lights per receiver, each\n"
-"                          traced (1..1024, default 256)\n"
+"                          traced (1..%d, default %d)\n"
 "      --decision-params TAU,LIT,RIDGE,RIDGE0,STEPS\n"
 "                          decision: the loss's temperature (ln units), the\n"
 "                          weight of lit pairs, the ridge per (l(l+1))^2 and\n"
@@ -245,7 +250,7 @@ static void usage(FILE *f)
 "      --max-receivers N   with --adaptive: stop at N receivers, splitting\n"
 "                          the largest errors first\n"
 "      --max-rounds N      with --adaptive: at most N rounds of splits\n"
-"                          (default 8; stderr says when it stops one still\n"
+"                          (default %d; stderr says when it stops one still\n"
 "                          splitting)\n"
 "      --plan FILE         write the receivers (refined, or with --adaptive\n"
 "                          as baked) for shards to read with --receivers:\n"
@@ -257,7 +262,7 @@ static void usage(FILE *f)
 "      --keep-normals      keep normals that point into geometry (default:\n"
 "                          a receiver blocked at ~0 on its own side and open\n"
 "                          on the other gets its normal flipped)\n"
-"      --seed N            seed of every random sequence (default 1)\n"
+"      --seed N            seed of every random sequence (default %u)\n"
 "      --no-robust         Embree's fast traversal instead of the robust one\n"
 "                          (default: robust; the fast one is 4-11%% quicker\n"
 "                          but lets grazing rays slip through creases, and\n"
@@ -272,42 +277,18 @@ static void usage(FILE *f)
 "\n"
 "Exit status: 0 success, 1 error, 2 usage error.\n"
 "Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n",
+            VB_DEFAULT_CUBE_SIZE, VB_SDF_MIN_RESOLUTION, VB_SDF_MAX_RESOLUTION, VDSH_MAX_ORDER,
+            VB_DEFAULT_RAYS, rays_side, rays_side, VB_DEFAULT_RAYS,
+            (double)VB_DEFAULT_RAY_TOLERANCE, VDSH_MAX_ORDER, VB_DEFAULT_ORDER_CAP,
             methods_help(), (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
-            (double)vb_shadow_log_offset(3), (double)vb_shadow_log_offset(5));
+            (double)vb_shadow_log_offset(3), (double)vb_shadow_log_offset(5),
+            (double)VB_DEFAULT_FALSE_RATE, VB_DECISION_MAX_PAIRS, VB_DEFAULT_DECISION_LIGHTS,
+            VB_ADAPTIVE_ROUNDS, VB_DEFAULT_SEED);
 }
 
 static int bad_usage(const char *fmt, const char *arg)
 {
     return vt_usage_error("vdsh-bake", fmt, arg);
-}
-
-/* A number >= 0 (vt_cli.h: strictly decimal, finite). */
-static int parse_float(const char *s, float *out)
-{
-    float v;
-    if (!vt_parse_float(s, &v) || v < 0.0f)
-        return 0;
-    *out = v;
-    return 1;
-}
-
-static int parse_orders(const char *s, options *o)
-{
-    uint64_t v[VDSH_MAX_ORDER];
-    int n = vt_parse_u64_list(s, 1, VDSH_MAX_ORDER, v, 1, VDSH_MAX_ORDER);
-    int seen[VDSH_ORDER_SLOTS] = {0};
-    for (int i = 0; i < n; i++) {
-        if (seen[v[i]])
-            return 0;
-        seen[v[i]] = 1;
-    }
-    if (n == 0)
-        return 0;
-    o->order_count = 0;
-    for (int k = 1; k <= VDSH_MAX_ORDER; k++)
-        if (seen[k])
-            o->orders[o->order_count++] = k;
-    return 1;
 }
 
 /* ---- progress ------------------------------------------------------------ */
@@ -649,24 +630,247 @@ static int check_outputs(const options *o, const vb_job_desc *jd, const char *co
     return bad;
 }
 
-int main(int argc, char **argv)
-{
-    vt_cli_begin("vdsh-bake", argv);
-    defer_interrupts_while_writing(); /* first: before any thread starts */
-    options o = {0};
-    o.rays = 2500;
-    o.orders[0] = 2, o.orders[1] = 3, o.orders[2] = 5, o.order_count = 3;
-    /* method and quantity: 0 is the default (decision, auto) */
-    o.encoding = VB_DEFAULT_ENCODING;
-    o.seed = 1;
-    o.robust = 1;
-    o.cube_size = 64;
+/* ---- the command line ---------------------------------------------------- */
 
-    enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
-           O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
-           O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET, O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL, O_SHARD,
-           O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS, O_MAX_ROUNDS, O_PLAN, O_RECEIVERS, O_ADAPTIVE_ORDER,
-           O_MAX_ORDER, O_DEC_LIGHTS, O_FALSE_RATE, O_DEC_PARAMS, O_SDF, O_CPCA };
+/* The long options' codes (getopt_long), and what reading one answers:
+ * taken, not this reader's, or the usage status (said). */
+enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
+       O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
+       O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET,
+       O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL, O_SHARD,
+       O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS, O_MAX_ROUNDS, O_PLAN, O_RECEIVERS,
+       O_ADAPTIVE_ORDER, O_MAX_ORDER, O_DEC_LIGHTS, O_FALSE_RATE, O_DEC_PARAMS, O_SDF,
+       O_CPCA };
+enum { OPT_NOT_MINE = -1, OPT_TAKEN = 1 };
+
+/* The names --encoding, --quantity and --window take. */
+static const vt_choice encodings[] = {
+    {"f16", VDSH_ENCODING_F16}, {"f32", VDSH_ENCODING_F32}, {"s8", VDSH_ENCODING_S8},
+    {"s8s6", VDSH_ENCODING_S8S6}, {"cpca", VDSH_ENCODING_CPCA}, {NULL, 0}};
+static const vt_choice quantities[] = {
+    {"auto", VB_QUANTITY_AUTO}, {"distance", VB_QUANTITY_DISTANCE}, {"log", VB_QUANTITY_LOG},
+    {NULL, 0}};
+static const vt_choice windows[] = {
+    {"none", VDSH_WINDOW_NONE}, {"hann", VDSH_WINDOW_HANN}, {"lanczos", VDSH_WINDOW_LANCZOS},
+    {NULL, 0}};
+
+/* Options that take a number or a name, each checked on its own. */
+static int read_value(int c, const char *arg, options *o)
+{
+    double t = 0.0;
+    int ok = 1, v = 0;
+    switch (c) {
+    case O_RAYS:
+        o->adaptive_rays = strcmp(arg, "auto") == 0;
+        o->rays = VB_DEFAULT_RAYS;
+        if (!o->adaptive_rays)
+            ok = vt_opt_u32("--rays", "auto or a whole number", arg, 1, 1u << 20, &o->rays);
+        break;
+    case O_RAY_TOL:
+        ok = vt_opt_tolerance("--ray-tolerance", "a number", arg, 1, &t);
+        o->ray_tolerance = t == 0.0 ? -1.0f : (float)t;
+        o->have_ray_tolerance = 1;
+        break;
+    case O_ORDERS: {
+        int want[VDSH_ORDER_SLOTS];
+        if (!(ok = vt_opt_orders("--orders", "2,3,5", arg, VDSH_MAX_ORDER, want)))
+            break;
+        o->order_count = 0;
+        for (int k = 1; k <= VDSH_MAX_ORDER; k++)
+            if (want[k])
+                o->orders[o->order_count++] = k;
+        o->orders_given = 1;
+        break;
+    }
+    case O_ADAPTIVE_ORDER:
+        ok = vt_opt_tolerance("--adaptive-order", NULL, arg, 0, &t);
+        o->order_tolerance = (float)t;
+        break;
+    case O_MAX_ORDER:
+        ok = vt_opt_int("--max-order", "an order", arg, 1, VDSH_MAX_ORDER, &o->max_order);
+        break;
+    case O_MAXDIST: ok = vt_opt_positive("--max-distance", arg, &o->max_distance); break;
+    case O_MAXEDGE: ok = vt_opt_nonnegative("--max-edge", arg, &o->max_edge); break;
+    case O_ADAPTIVE:
+        ok = vt_opt_tolerance("--adaptive", NULL, arg, 1, &t);
+        o->adaptive = 1;
+        o->adaptive_tol = (float)t;
+        break;
+    case O_MIN_EDGE: ok = vt_opt_positive("--min-edge", arg, &o->min_edge); break;
+    case O_MAX_RECEIVERS:
+        ok = vt_opt_u32("--max-receivers", NULL, arg, 1, VDSH_MAX_VERTICES, &o->max_receivers);
+        break;
+    case O_MAX_ROUNDS: ok = vt_opt_u32("--max-rounds", NULL, arg, 1, 1000, &o->max_rounds); break;
+    case O_SEED: ok = vt_opt_u64("--seed", NULL, arg, 0, UINT64_MAX, &o->seed); break;
+    case O_THREADS: ok = vt_opt_u32("--threads", NULL, arg, 1, 256, &o->threads); break;
+    case O_CUBESIZE: ok = vt_opt_int("--cube-size", NULL, arg, 0, 4096, &o->cube_size); break;
+    case O_SDF:
+        ok = vt_opt_int("--sdf", NULL, arg, VB_SDF_MIN_RESOLUTION, VB_SDF_MAX_RESOLUTION, &o->sdf);
+        break;
+    case O_LAMBDA: ok = vt_opt_positive("--lambda", arg, &o->lambda); break;
+    case O_LOG_FLOOR: ok = vt_opt_positive("--log-floor", arg, &o->log_floor); break;
+    case O_DEC_LIGHTS:
+        ok = vt_opt_u32("--decision-lights", "", arg, 1, VB_DECISION_MAX_PAIRS,
+                        &o->decision_lights);
+        break;
+    case O_ENCODING:
+        ok = vt_opt_choice("--encoding", arg, encodings, &v);
+        o->encoding = (vdsh_encoding)v;
+        break;
+    case O_QUANTITY:
+        ok = vt_opt_choice("--quantity", arg, quantities, &v);
+        o->quantity = (vb_quantity)v;
+        break;
+    case O_WINDOW:
+        ok = vt_opt_choice("--window", arg, windows, &v);
+        o->window = (vdsh_window)v;
+        break;
+    default: return OPT_NOT_MINE;
+    }
+    return ok ? OPT_TAKEN : VT_EXIT_USAGE;
+}
+
+/* Options that name a choice or take a tuple. */
+static int read_choice(int c, const char *arg, options *o)
+{
+    switch (c) {
+    case O_METHOD: {
+        const vb_method_info *m = vb_method_by_name(arg);
+        if (!m) {
+            char fmt[640];
+            snprintf(fmt, sizeof fmt, "--method takes %s, not '%%s'", method_names());
+            return bad_usage(fmt, arg);
+        }
+        o->method = m->method;
+        break;
+    }
+    case O_CPCA:
+        if (vdsh_cpca_parse(arg, &o->cpca, NULL) != VDSH_OK)
+            return bad_usage("--cpca takes K,B,BITS: clusters 1..256, basis vectors "
+                             "1..256, bits 2..8 (default 8,54,4), not '%s'", arg);
+        o->have_cpca = 1;
+        break;
+    case O_LOG_OFFSET:
+        if (!vt_parse_float(arg, &o->log_offset) || fabsf(o->log_offset) > 5.0f)
+            return bad_usage("--log-offset takes a number in -5..5, not '%s'", arg);
+        o->have_log_offset = 1;
+        break;
+    case O_FALSE_RATE:
+        if (!vt_parse_float(arg, &o->false_rate) || !(o->false_rate > 0.0f) ||
+            !(o->false_rate < 0.5f))
+            return bad_usage("--false-rate takes a number in (0, 0.5), not '%s'", arg);
+        break;
+    case O_DEC_PARAMS: {
+        vb_decision_params *p = &o->decision;
+        vb_decision_defaults(p);
+        if (sscanf(arg, "%f,%f,%f,%f,%d", &p->tau, &p->lit_weight, &p->ridge,
+                   &p->ridge0, &p->steps) != 5 || !(p->tau > 0.0f) ||
+            !(p->lit_weight > 0.0f) || !(p->ridge >= 0.0f) || !(p->ridge0 > 0.0f) ||
+            p->steps < 0 || p->steps > 64)
+            return bad_usage("--decision-params takes TAU,LIT_WEIGHT,RIDGE,RIDGE0,STEPS "
+                             "(positive; ridge >= 0; steps 0..64), not '%s'", arg);
+        o->have_decision = 1;
+        break;
+    }
+    case O_SHARD: {
+        unsigned si, sn;
+        int used = 0;
+        if (sscanf(arg, "%u/%u%n", &si, &sn, &used) != 2 || arg[used] || sn < 1 ||
+            sn > 1u << 20 || si >= sn || !isdigit((unsigned char)arg[0]))
+            return bad_usage("--shard takes I/N with 0 <= I < N <= 1048576, such as 3/8, "
+                             "not '%s'", arg);
+        o->shard_index = si, o->shard_count = sn;
+        break;
+    }
+    default: return OPT_NOT_MINE;
+    }
+    return OPT_TAKEN;
+}
+
+/* The options taken together: what one allows of another. VT_CLI_RUN or
+ * VT_EXIT_USAGE (said). Sets what follows from them (min_edge, the orders
+ * with --adaptive-order alone). */
+static int check_options(options *o)
+{
+    if (o->have_cpca && o->encoding != VDSH_ENCODING_CPCA)
+        return bad_usage("--cpca %s needs --encoding cpca", "K,B,BITS");
+    if (o->encoding == VDSH_ENCODING_CPCA && o->order_tolerance > 0.0f && o->orders_given) {
+        /* cpca writes the adaptive-order stream as a fixed stream of its cap */
+        int cap = o->max_order ? o->max_order : VB_DEFAULT_ORDER_CAP;
+        for (int s = 0; s < o->order_count; s++)
+            if (o->orders[s] == cap) {
+                char n[8];
+                snprintf(n, sizeof n, "%d", cap);
+                return bad_usage("--encoding cpca writes --adaptive-order's stream as a "
+                                 "fixed stream of its --max-order, %s: --orders cannot "
+                                 "hold that order too", n);
+            }
+    }
+    if (o->have_ray_tolerance && !o->adaptive_rays)
+        return bad_usage("%s needs --rays auto", "--ray-tolerance");
+    if ((o->min_edge > 0.0f || o->max_receivers || o->max_rounds) && !o->adaptive)
+        return bad_usage("%s need --adaptive TOL", "--min-edge, --max-receivers and --max-rounds");
+    if (o->adaptive && !(o->max_edge > 0.0f))
+        return bad_usage("%s", "--adaptive needs --max-edge L: the uniform refinement it "
+                               "starts from (the coarsest receivers)");
+    if (o->adaptive && o->min_edge == 0.0f)
+        o->min_edge = o->max_edge / 8.0f;
+    if (o->adaptive && o->shard_count)
+        return bad_usage("%s", "--adaptive cannot be combined with --shard: the refinement "
+                               "bakes as it decides. Plan it once (--adaptive ... --plan "
+                               "plan.obj), then shard the plan (--receivers plan.obj --shard I/N)");
+    if (o->sdf && (o->shard_count || !o->output || o->trace_only))
+        return bad_usage("%s", "--sdf writes beside the output file: it needs -o OUT.vdsh, "
+                               "and neither --shard nor --trace-only");
+    if (o->plan && o->receivers)
+        return bad_usage("%s", "--plan writes the receivers --receivers reads: not both");
+    if (o->receivers && (o->adaptive || o->max_edge > 0.0f || o->weld))
+        return bad_usage("%s", "--receivers takes the receivers as they are: not with "
+                               "--adaptive, --max-edge or --weld");
+    if (o->mesh_count < 1)
+        return bad_usage("%s", "no mesh given");
+    if (o->mesh_count > VDSH_MAX_SOURCES)
+        return bad_usage("%s", "too many meshes (at most 64)");
+    /* What the method's row allows. */
+    const vb_method_info *mi = vb_method_get(o->method);
+    vdsh_quantity stored = vb_quantity_stored(o->quantity);
+    if (o->quantity != VB_QUANTITY_AUTO && !(mi->quantities & VB_QUANTITY_BIT(stored)))
+        return bad_usage("%s", mi->refused[stored]);
+    if (o->have_log_offset && mi->param != VB_PARAM_LOG_OFFSET)
+        return bad_usage("%s", "--log-offset is methods decision's and shadow's");
+    if ((o->false_rate != 0.0f || o->decision_lights || o->have_decision) && !mi->decision)
+        return bad_usage("%s", "--false-rate, --decision-lights and --decision-params are "
+                               "method decision's");
+    if (o->lambda != 0.0f && mi->lambda_fixed)
+        return bad_usage("--lambda is lsq's: method %s uses lsq's default (its method "
+                         "parameter is the log offset)", vb_method_name(o->method));
+    if (!o->output && !o->export_obj && !o->trace_only && !o->plan)
+        return bad_usage("%s", "no output: give -o OUT.vdsh (or --export-obj FILE)");
+    if (o->max_order && !(o->order_tolerance > 0.0f))
+        return bad_usage("%s", "--max-order is the cap of --adaptive-order TOL");
+    if (o->order_tolerance > 0.0f &&
+        !(mi->quantities & VB_QUANTITY_BIT(VDSH_QUANTITY_LOG_DISTANCE)))
+        return bad_usage("--adaptive-order fits the log distance: method %s does not (use "
+                         "decision, the default, or shadow)", vb_method_name(o->method));
+    if (o->order_tolerance > 0.0f && !o->orders_given)
+        o->order_count = 0; /* the variable-order stream alone */
+
+    return VT_CLI_RUN;
+}
+
+/* The command line into *o: VT_CLI_RUN, or the exit status (0 after --help
+ * or --version; VT_EXIT_USAGE after saying what is wrong). */
+static int parse_args(int argc, char **argv, options *o)
+{
+    *o = (options){0};
+    o->rays = VB_DEFAULT_RAYS;
+    o->orders[0] = 2, o->orders[1] = 3, o->orders[2] = 5, o->order_count = 3;
+    /* method and quantity: 0 is the default (decision, auto) */
+    o->encoding = VB_DEFAULT_ENCODING;
+    o->seed = VB_DEFAULT_SEED;
+    o->robust = 1;
+    o->cube_size = VB_DEFAULT_CUBE_SIZE;
+
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"rays", required_argument, 0, O_RAYS},
@@ -709,437 +913,192 @@ int main(int argc, char **argv)
         {"max-receivers", required_argument, 0, O_MAX_RECEIVERS},
         {"max-rounds", required_argument, 0, O_MAX_ROUNDS},
         {"quiet", no_argument, 0, 'q'},
-        {"help", no_argument, 0, 'h'},
-        {"version", no_argument, 0, 'V'},
-        {0, 0, 0, 0}};
+        VT_CLI_LONGOPTS_END};
     int c;
-    uint64_t u;
-    uint32_t shard_index = 0, shard_count = 0;
     while ((c = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
+        int r = read_value(c, optarg, o);
+        if (r == OPT_NOT_MINE)
+            r = read_choice(c, optarg, o);
+        if (r == VT_EXIT_USAGE)
+            return r;
+        if (r == OPT_TAKEN)
+            continue;
         switch (c) {
-        case 'o': o.output = optarg; break;
-        case O_RAYS:
-            if (strcmp(optarg, "auto") == 0) {
-                o.adaptive_rays = 1;
-                o.rays = 2500;
-                break;
-            }
-            if (!vt_parse_u64(optarg, 1, 1u << 20, &u))
-                return bad_usage("--rays takes auto or a whole number 1..1048576, not '%s'",
-                                 optarg);
-            o.adaptive_rays = 0;
-            o.rays = (uint32_t)u;
-            break;
-        case O_RAY_TOL: {
-            char *end = NULL;
-            double t = strtod(optarg, &end);
-            if (end == optarg || *end || !(t >= 0.0))
-                return bad_usage("--ray-tolerance takes a number >= 0 (or inf), not '%s'",
-                                 optarg);
-            o.ray_tolerance = t == 0.0 ? -1.0f : (float)t;
-            o.have_ray_tolerance = 1;
-            break;
-        }
-        case O_ORDERS:
-            if (!parse_orders(optarg, &o))
-                return bad_usage("--orders takes distinct orders 1..16 such as 2,3,5, not '%s'",
-                                 optarg);
-            o.orders_given = 1;
-            break;
-        case O_ADAPTIVE_ORDER: {
-            char *end = NULL;
-            double t = strtod(optarg, &end);
-            if (end == optarg || *end || !(t > 0.0))
-                return bad_usage("--adaptive-order takes a tolerance > 0 (or inf), not '%s'",
-                                 optarg);
-            o.order_tolerance = (float)t;
-            break;
-        }
-        case O_MAX_ORDER: {
-            uint64_t v;
-            if (!vt_parse_u64(optarg, 1, VDSH_MAX_ORDER, &v))
-                return bad_usage("--max-order takes an order 1..16, not '%s'", optarg);
-            o.max_order = (int)v;
-            break;
-        }
-        case O_METHOD: {
-            const vb_method_info *m = vb_method_by_name(optarg);
-            if (!m) {
-                char fmt[640];
-                snprintf(fmt, sizeof fmt, "--method takes %s, not '%%s'", method_names());
-                return bad_usage(fmt, optarg);
-            }
-            o.method = m->method;
-            break;
-        }
-        case O_ENCODING:
-            if (strcmp(optarg, "f16") == 0) o.encoding = VDSH_ENCODING_F16;
-            else if (strcmp(optarg, "f32") == 0) o.encoding = VDSH_ENCODING_F32;
-            else if (strcmp(optarg, "s8") == 0) o.encoding = VDSH_ENCODING_S8;
-            else if (strcmp(optarg, "s8s6") == 0) o.encoding = VDSH_ENCODING_S8S6;
-            else if (strcmp(optarg, "cpca") == 0) o.encoding = VDSH_ENCODING_CPCA;
-            else return bad_usage("--encoding takes f16, f32, s8, s8s6 or cpca, not '%s'", optarg);
-            break;
-        case O_CPCA: {
-            if (vdsh_cpca_parse(optarg, &o.cpca, NULL) != VDSH_OK)
-                return bad_usage("--cpca takes K,B,BITS: clusters 1..256, basis vectors "
-                                 "1..256, bits 2..8 (default 8,54,4), not '%s'", optarg);
-            o.have_cpca = 1;
-            break;
-        }
-        case O_MAXDIST:
-            if (!parse_float(optarg, &o.max_distance) || o.max_distance == 0.0f)
-                return bad_usage("--max-distance takes a positive number, not '%s'", optarg);
-            break;
-        case O_MAXEDGE:
-            if (!parse_float(optarg, &o.max_edge))
-                return bad_usage("--max-edge takes a number >= 0, not '%s'", optarg);
-            break;
-        case O_ADAPTIVE: {
-            char *end = NULL;
-            double t = strtod(optarg, &end);
-            if (end == optarg || *end || !(t >= 0.0))
-                return bad_usage("--adaptive takes a tolerance >= 0 (or inf), not '%s'", optarg);
-            o.adaptive = 1;
-            o.adaptive_tol = (float)t;
-            break;
-        }
-        case O_MIN_EDGE:
-            if (!parse_float(optarg, &o.min_edge) || !(o.min_edge > 0.0f))
-                return bad_usage("--min-edge takes a positive number, not '%s'", optarg);
-            break;
-        case O_MAX_RECEIVERS:
-            if (!vt_parse_u64(optarg, 1, VDSH_MAX_VERTICES, &u))
-                return bad_usage("--max-receivers takes a whole number 1..268435456, not '%s'",
-                                 optarg);
-            o.max_receivers = (uint32_t)u;
-            break;
-        case O_MAX_ROUNDS:
-            if (!vt_parse_u64(optarg, 1, 1000, &u))
-                return bad_usage("--max-rounds takes a whole number 1..1000, not '%s'", optarg);
-            o.max_rounds = (uint32_t)u;
-            break;
-        case O_WELD: o.weld = 1; break;
-        case O_SEED:
-            if (!vt_parse_u64(optarg, 0, UINT64_MAX, &o.seed))
-                return bad_usage("--seed takes a whole number, not '%s'", optarg);
-            break;
-        case O_THREADS:
-            if (!vt_parse_u64(optarg, 1, 256, &u))
-                return bad_usage("--threads takes a whole number 1..256, not '%s'", optarg);
-            o.threads = (unsigned)u;
-            break;
-        case O_CUBESIZE:
-            if (!vt_parse_u64(optarg, 0, 4096, &u))
-                return bad_usage("--cube-size takes a whole number 0..4096, not '%s'", optarg);
-            o.cube_size = (int)u;
-            break;
-        case O_CUBEDIR: o.cubemap_dir = optarg; break;
-        case O_SDF:
-            if (!vt_parse_u64(optarg, VB_SDF_MIN_RESOLUTION, VB_SDF_MAX_RESOLUTION, &u))
-                return bad_usage("--sdf takes a whole number 4..512, not '%s'", optarg);
-            o.sdf = (int)u;
-            break;
-        case O_ROBUST: o.robust = 1; break;
-        case O_NO_ROBUST: o.robust = 0; break;
-        case O_REPORT: o.report = optarg; break;
-        case O_TIMINGS: o.record_timings = 1; break;
-        case O_EXPORT: o.export_obj = optarg; break;
-        case O_PLAN: o.plan = optarg; break;
-        case O_RECEIVERS: o.receivers = optarg; break;
-        case O_TRACE_ONLY: o.trace_only = 1; break;
-        case O_LOG: o.quantity = VB_QUANTITY_LOG; break;
-        case O_QUANTITY:
-            if (strcmp(optarg, "auto") == 0) o.quantity = VB_QUANTITY_AUTO;
-            else if (strcmp(optarg, "distance") == 0) o.quantity = VB_QUANTITY_DISTANCE;
-            else if (strcmp(optarg, "log") == 0) o.quantity = VB_QUANTITY_LOG;
-            else return bad_usage("--quantity takes auto, distance or log, not '%s'", optarg);
-            break;
-        case O_LAMBDA:
-            if (!parse_float(optarg, &o.lambda) || o.lambda == 0.0f)
-                return bad_usage("--lambda takes a positive number, not '%s'", optarg);
-            break;
-        case O_LOG_OFFSET:
-            if (!vt_parse_float(optarg, &o.log_offset) || fabsf(o.log_offset) > 5.0f)
-                return bad_usage("--log-offset takes a number in -5..5, not '%s'", optarg);
-            o.have_log_offset = 1;
-            break;
-        case O_DEC_LIGHTS: {
-            uint64_t n;
-            if (!vt_parse_u64(optarg, 1, VB_DECISION_MAX_PAIRS, &n))
-                return bad_usage("--decision-lights takes 1..1024, not '%s'", optarg);
-            o.decision_lights = (uint32_t)n;
-            break;
-        }
-        case O_FALSE_RATE:
-            if (!vt_parse_float(optarg, &o.false_rate) || !(o.false_rate > 0.0f) ||
-                !(o.false_rate < 0.5f))
-                return bad_usage("--false-rate takes a number in (0, 0.5), not '%s'", optarg);
-            break;
-        case O_DEC_PARAMS: {
-            vb_decision_params *p = &o.decision;
-            vb_decision_defaults(p);
-            if (sscanf(optarg, "%f,%f,%f,%f,%d", &p->tau, &p->lit_weight, &p->ridge,
-                       &p->ridge0, &p->steps) != 5 || !(p->tau > 0.0f) ||
-                !(p->lit_weight > 0.0f) || !(p->ridge >= 0.0f) || !(p->ridge0 > 0.0f) ||
-                p->steps < 0 || p->steps > 64)
-                return bad_usage("--decision-params takes TAU,LIT_WEIGHT,RIDGE,RIDGE0,STEPS "
-                                 "(positive; ridge >= 0; steps 0..64), not '%s'", optarg);
-            o.have_decision = 1;
-            break;
-        }
-        case O_KEEP_NORMALS: o.keep_normals = 1; break;
-        case O_WINDOW:
-            if (strcmp(optarg, "none") == 0) o.window = VDSH_WINDOW_NONE;
-            else if (strcmp(optarg, "hann") == 0) o.window = VDSH_WINDOW_HANN;
-            else if (strcmp(optarg, "lanczos") == 0) o.window = VDSH_WINDOW_LANCZOS;
-            else return bad_usage("--window takes none, hann or lanczos, not '%s'", optarg);
-            break;
-        case O_LOG_FLOOR:
-            if (!parse_float(optarg, &o.log_floor) || o.log_floor == 0.0f)
-                return bad_usage("--log-floor takes a positive number, not '%s'", optarg);
-            break;
-        case O_SHARD: {
-            unsigned si, sn;
-            int used = 0;
-            if (sscanf(optarg, "%u/%u%n", &si, &sn, &used) != 2 || optarg[used] || sn < 1 ||
-                sn > 1u << 20 || si >= sn || !isdigit((unsigned char)optarg[0]))
-                return bad_usage("--shard takes I/N with 0 <= I < N <= 1048576, such as 3/8, "
-                                 "not '%s'", optarg);
-            shard_index = si, shard_count = sn;
-            break;
-        }
-        case 'q': o.quiet = 1; break;
-        case 'h': usage(stdout); return 0;
-        case 'V': return vt_cli_version("Embree " RTC_VERSION_STRING);
-        default: return vt_cli_try_help();
+        case 'o': o->output = optarg; break;
+        case O_WELD: o->weld = 1; break;
+        case O_CUBEDIR: o->cubemap_dir = optarg; break;
+        case O_ROBUST: o->robust = 1; break;
+        case O_NO_ROBUST: o->robust = 0; break;
+        case O_REPORT: o->report = optarg; break;
+        case O_TIMINGS: o->record_timings = 1; break;
+        case O_EXPORT: o->export_obj = optarg; break;
+        case O_PLAN: o->plan = optarg; break;
+        case O_RECEIVERS: o->receivers = optarg; break;
+        case O_TRACE_ONLY: o->trace_only = 1; break;
+        case O_LOG: o->quantity = VB_QUANTITY_LOG; break;
+        case O_KEEP_NORMALS: o->keep_normals = 1; break;
+        case 'q': o->quiet = 1; break;
+        default: return vt_cli_common_option(c, usage, "Embree " RTC_VERSION_STRING);
         }
     }
-    if (o.have_cpca && o.encoding != VDSH_ENCODING_CPCA)
-        return bad_usage("--cpca %s needs --encoding cpca", "K,B,BITS");
-    if (o.encoding == VDSH_ENCODING_CPCA && o.order_tolerance > 0.0f && o.orders_given) {
-        /* cpca writes the adaptive-order stream as a fixed stream of its cap */
-        int cap = o.max_order ? o.max_order : VB_DEFAULT_ORDER_CAP;
-        for (int s = 0; s < o.order_count; s++)
-            if (o.orders[s] == cap) {
-                char n[8];
-                snprintf(n, sizeof n, "%d", cap);
-                return bad_usage("--encoding cpca writes --adaptive-order's stream as a "
-                                 "fixed stream of its --max-order, %s: --orders cannot "
-                                 "hold that order too", n);
-            }
+    o->meshes = (const char *const *)argv + optind;
+    o->mesh_count = argc - optind;
+    return check_options(o);
+}
+
+/* The distance volume (--sdf) of the occluders, for the file at `path`
+ * beside the output. 0, or 1 after saying why. */
+static int bake_sdf(const options *o, const vb_job *job, char *path, size_t cap, vdsh_sdf *vol,
+                    double *seconds)
+{
+    vb_error err;
+    double ts = vb_now();
+    if (vdsh_sdf_path(o->output, path, cap) != 0) {
+        fprintf(stderr, "vdsh-bake: %s: path too long for its distance volume\n", o->output);
+        return 1;
     }
-    if (o.have_ray_tolerance && !o.adaptive_rays)
-        return bad_usage("%s needs --rays auto", "--ray-tolerance");
-    if ((o.min_edge > 0.0f || o.max_receivers || o.max_rounds) && !o.adaptive)
-        return bad_usage("%s need --adaptive TOL", "--min-edge, --max-receivers and --max-rounds");
-    if (o.adaptive && !(o.max_edge > 0.0f))
-        return bad_usage("%s", "--adaptive needs --max-edge L: the uniform refinement it "
-                               "starts from (the coarsest receivers)");
-    if (o.adaptive && o.min_edge == 0.0f)
-        o.min_edge = o.max_edge / 8.0f;
-    if (o.adaptive && shard_count)
-        return bad_usage("%s", "--adaptive cannot be combined with --shard: the refinement "
-                               "bakes as it decides. Plan it once (--adaptive ... --plan "
-                               "plan.obj), then shard the plan (--receivers plan.obj --shard I/N)");
-    if (o.sdf && (shard_count || !o.output || o.trace_only))
-        return bad_usage("%s", "--sdf writes beside the output file: it needs -o OUT.vdsh, "
-                               "and neither --shard nor --trace-only");
-    if (o.plan && o.receivers)
-        return bad_usage("%s", "--plan writes the receivers --receivers reads: not both");
-    if (o.receivers && (o.adaptive || o.max_edge > 0.0f || o.weld))
-        return bad_usage("%s", "--receivers takes the receivers as they are: not with "
-                               "--adaptive, --max-edge or --weld");
-    int nmesh = argc - optind;
-    if (nmesh < 1)
-        return bad_usage("%s", "no mesh given");
-    if (nmesh > VDSH_MAX_SOURCES)
-        return bad_usage("%s", "too many meshes (at most 64)");
-    /* What the method's row allows. */
-    const vb_method_info *mi = vb_method_get(o.method);
-    vdsh_quantity stored = vb_quantity_stored(o.quantity);
-    if (o.quantity != VB_QUANTITY_AUTO && !(mi->quantities & VB_QUANTITY_BIT(stored)))
-        return bad_usage("%s", mi->refused[stored]);
-    if (o.have_log_offset && mi->param != VB_PARAM_LOG_OFFSET)
-        return bad_usage("%s", "--log-offset is methods decision's and shadow's");
-    if ((o.false_rate != 0.0f || o.decision_lights || o.have_decision) && !mi->decision)
-        return bad_usage("%s", "--false-rate, --decision-lights and --decision-params are "
-                               "method decision's");
-    if (o.lambda != 0.0f && mi->lambda_fixed)
-        return bad_usage("--lambda is lsq's: method %s uses lsq's default (its method "
-                         "parameter is the log offset)", vb_method_name(o.method));
-    if (!o.output && !o.export_obj && !o.trace_only && !o.plan)
-        return bad_usage("%s", "no output: give -o OUT.vdsh (or --export-obj FILE)");
-    FILE *log = o.quiet ? NULL : stderr;
+    if (vb_sdf_bake(job->scene, &job->occluders, o->sdf, o->threads, vol, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-bake: %s: %s\n", path, err.msg);
+        return 1;
+    }
+    vol->vertex_count = job->file.header.vertex_count;
+    vol->triangle_count = job->file.header.triangle_count;
+    *seconds = vb_now() - ts;
+    return 0;
+}
 
-    if (o.max_order && !(o.order_tolerance > 0.0f))
-        return bad_usage("%s", "--max-order is the cap of --adaptive-order TOL");
-    if (o.order_tolerance > 0.0f &&
-        !(mi->quantities & VB_QUANTITY_BIT(VDSH_QUANTITY_LOG_DISTANCE)))
-        return bad_usage("--adaptive-order fits the log distance: method %s does not (use "
-                         "decision, the default, or shadow)", vb_method_name(o.method));
-    if (o.order_tolerance > 0.0f && !o.orders_given)
-        o.order_count = 0; /* the variable-order stream alone */
+/* What was written: the file, its orders and encoding, the cubemaps. */
+static void say_written(FILE *log, const options *o, const vb_job *job, const vb_job_desc *jd,
+                        double write_seconds)
+{
+    const vb_bake_output *bo = &job->bake;
+    int cube_size = o->shard_count ? 0 : vb_job_cube_size(jd); /* a part has none */
+    fprintf(log, "vdsh-bake: wrote %s (%.2f MB, %.1f bytes of coefficients per "
+                 "vertex for orders",
+            o->output, job->file_bytes / 1e6, job->coefficient_bytes + job->variable_bytes);
+    for (int s = 0; s < o->order_count; s++)
+        fprintf(log, "%s%d", s ? "," : " ", o->orders[s]);
+    if (bo->variable_cap)
+        fprintf(log, "%sadaptive 1..%d", o->order_count ? "," : " ", bo->variable_cap);
+    fprintf(log, ", %s)", vdsh_encoding_name(o->encoding));
+    if (cube_size > 0)
+        fprintf(log, " and 4 basis cubemaps %dx%d in %s", cube_size, cube_size,
+                o->cubemap_dir ? o->cubemap_dir : "the output's directory");
+    fprintf(log, "\nvdsh-bake: done in %.2f s\n", job->timings.total + write_seconds);
+}
 
-    /* The bake, described once: vb_job (job.h) runs it as a straight line. */
+/* ---- the bake ----------------------------------------------------------- */
+
+/* The bake the options ask for, its messages and its files; the exit
+ * status (0 done, 1 failed: said on stderr). */
+/* The bake, described once: vb_job (job.h) runs it as a straight line.
+ * offsets (VDSH_ORDER_SLOTS) and pr are the caller's, borrowed by it. */
+static vb_job_desc job_desc(const options *o, FILE *log, progress *pr, float *offsets)
+{
     uint32_t order_mask = 0;
-    for (int s = 0; s < o.order_count; s++)
-        order_mask |= 1u << o.orders[s];
-    progress pr = {.enabled = log != NULL, .terminal = isatty(STDERR_FILENO), .rays = o.rays};
-    float offsets[VDSH_ORDER_SLOTS];
+    for (int s = 0; s < o->order_count; s++)
+        order_mask |= 1u << o->orders[s];
     for (int k = 0; k <= VDSH_MAX_ORDER; k++)
-        offsets[k] = o.log_offset;
-    vb_job_desc jd = {
-        .paths = (const char *const *)argv + optind, .path_count = (uint32_t)nmesh,
-        .output = o.trace_only ? NULL : o.output, .cubemap_dir = o.cubemap_dir,
-        .weld = o.weld, .max_edge = o.max_edge, .fast_traversal = !o.robust,
-        .adaptive = o.adaptive, .receivers_path = o.receivers,
-        .adapt = {.tolerance = o.adaptive_tol, .min_edge = o.min_edge,
-                  .max_receivers = o.max_receivers,
-                  .max_rounds = o.max_rounds ? o.max_rounds : VB_ADAPTIVE_ROUNDS,
+        offsets[k] = o->log_offset;
+    return (vb_job_desc){
+        .paths = o->meshes, .path_count = (uint32_t)o->mesh_count,
+        .output = o->trace_only ? NULL : o->output, .cubemap_dir = o->cubemap_dir,
+        .weld = o->weld, .max_edge = o->max_edge, .fast_traversal = !o->robust,
+        .adaptive = o->adaptive, .receivers_path = o->receivers,
+        .adapt = {.tolerance = o->adaptive_tol, .min_edge = o->min_edge,
+                  .max_receivers = o->max_receivers,
+                  .max_rounds = o->max_rounds ? o->max_rounds : VB_ADAPTIVE_ROUNDS,
                   .on_round = log ? on_round : NULL,
                   .user = log},
-        .bake = {.rays = o.rays, .adaptive_rays = o.adaptive_rays,
-                 .ray_tolerance = o.ray_tolerance, .seed = o.seed,
-                 .max_distance = o.max_distance,
-                 .method = o.method, .quantity = o.quantity, .lambda = o.lambda,
-                 .log_floor = o.log_floor, .log_offsets = o.have_log_offset ? offsets : NULL,
-                 .decision = o.have_decision ? &o.decision : NULL,
-                 .decision_lights = o.decision_lights, .false_rate = o.false_rate,
-                 .window = o.window, .order_mask = order_mask, .threads = o.threads,
-                 .order_tolerance = o.order_tolerance, .variable_cap = o.max_order,
-                 .keep_normals = o.keep_normals, .trace_only = o.trace_only,
-                 .progress = on_progress, .progress_user = &pr},
+        .bake = {.rays = o->rays, .adaptive_rays = o->adaptive_rays,
+                 .ray_tolerance = o->ray_tolerance, .seed = o->seed,
+                 .max_distance = o->max_distance,
+                 .method = o->method, .quantity = o->quantity, .lambda = o->lambda,
+                 .log_floor = o->log_floor, .log_offsets = o->have_log_offset ? offsets : NULL,
+                 .decision = o->have_decision ? &o->decision : NULL,
+                 .decision_lights = o->decision_lights, .false_rate = o->false_rate,
+                 .window = o->window, .order_mask = order_mask, .threads = o->threads,
+                 .order_tolerance = o->order_tolerance, .variable_cap = o->max_order,
+                 .keep_normals = o->keep_normals, .trace_only = o->trace_only,
+                 .progress = on_progress, .progress_user = pr},
         .encoding_given = 1,
-        .encoding = o.encoding,
-        .cpca = o.cpca,
-        .cube_size = o.cube_size > 0 ? o.cube_size : -1,
-        .record_timings = o.record_timings,
-        .shard_index = shard_index, .shard_count = shard_count,
+        .encoding = o->encoding,
+        .cpca = o->cpca,
+        .cube_size = o->cube_size > 0 ? o->cube_size : -1,
+        .record_timings = o->record_timings,
+        .shard_index = o->shard_index, .shard_count = o->shard_count,
         .on_mesh = log ? on_mesh : NULL, .user = log};
-    int status = 1;
-    int writing = 0; /* output_lock held: outputs are being written */
-    vb_mesh_spacing spacing = {0};
-    vb_error err;
-    vb_job job = {0};
+}
 
-    /* 0. Every output writable and none of them an input, before any work. */
-    if (check_outputs(&o, &jd, (const char *const *)argv + optind, nmesh) != 0)
-        return 1;
 
-    /* 1. Load every mesh into one occluder scene. */
-    if (vb_job_load(&job, &jd, &err) != VB_OK) {
-        fprintf(stderr, "vdsh-bake: %s\n", err.msg);
-        goto out;
-    }
-
-    /* 2. Receivers: the scene's vertices, refined if asked. */
-    if (vb_job_refine(&job, &jd, &err) != VB_OK) {
-        fprintf(stderr, "vdsh-bake: refining receivers: %s\n", err.msg);
-        goto out;
-    }
-    const vb_mesh *rec = &job.receivers;
-    if (log && o.max_edge > 0.0f)
+/* What the receivers are, and a warning when they are far apart against
+ * the scene; *spacing gets their spacing when a message or the report
+ * needs it. */
+static void say_receivers(FILE *log, const options *o, const vb_job *job, vb_mesh_spacing *spacing)
+{
+    const vb_mesh *rec = &job->receivers;
+    if (log && o->max_edge > 0.0f)
         fprintf(log, "vdsh-bake: receivers refined to max edge %g: %u vertices, "
                      "%u triangles, worst aspect ratio %.1f (%.2f s)\n",
-                (double)o.max_edge, rec->vertex_count, rec->triangle_count,
-                vb_mesh_worst_aspect(rec, NULL), job.timings.refine);
+                (double)o->max_edge, rec->vertex_count, rec->triangle_count,
+                vb_mesh_worst_aspect(rec, NULL), job->timings.refine);
     /* Receivers far apart against the scene draw false shadows inside their
      * triangles: say so when nothing chose them (no --max-edge, --adaptive
      * or --receivers) and a bake or plan follows. */
-    const int chosen = o.max_edge > 0.0f || o.adaptive || o.receivers;
-    if ((log && !chosen && (o.output || o.plan)) || o.report) {
+    const int chosen = o->max_edge > 0.0f || o->adaptive || o->receivers;
+    if ((log && !chosen && (o->output || o->plan)) || o->report) {
         float lo[3], hi[3];
-        vb_mesh_bounds(&job.occluders, lo, hi);
+        vb_mesh_bounds(&job->occluders, lo, hi);
         vb_mesh_spacing_of(rec, sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) +
                                       (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                      (hi[2] - lo[2]) * (hi[2] - lo[2])), &spacing);
+                                      (hi[2] - lo[2]) * (hi[2] - lo[2])),  spacing);
     }
-    if (log && !chosen && (o.output || o.plan) && spacing.far_apart)
+    if (log && !chosen && (o->output || o->plan) && spacing->far_apart)
         fprintf(log, "vdsh-bake: warning: receivers far apart: %.0f%% of the surface is in "
                      "triangles whose longest edge exceeds %.0f%% of the scene's diagonal (%.4g; "
                      "longest edges: median %.3g, 90th percentile %.3g, area-weighted). The "
                      "shadows are interpolated between receivers, so these triangles draw false "
                      "shadows inside them: refine, e.g. --max-edge %g (1%% of the diagonal), "
                      "or --adaptive from a coarser --max-edge\n",
-                100.0 * spacing.long_area, 100.0 * VB_SPACING_WARN_EDGE, (double)spacing.diagonal,
-                (double)spacing.median_edge, (double)spacing.p90_edge,
-                (double)spacing.suggest_edge);
-    if (o.plan && !o.adaptive) { /* uniform: the refined receivers, before any bake */
-        if (write_plan(rec, o.plan, log) != 0)
-            goto out;
-        if (!o.output && !o.export_obj && !o.trace_only) {
-            status = 0;
-            goto out;
-        }
-    }
-    if (o.export_obj) {
-        pthread_mutex_lock(&output_lock);
-        vb_result written = vb_mesh_write_obj(rec, o.export_obj, &err);
-        pthread_mutex_unlock(&output_lock);
-        if (written != VB_OK) {
-            fprintf(stderr, "vdsh-bake: %s\n", err.msg);
-            goto out;
-        }
-        if (log)
-            fprintf(log, "vdsh-bake: wrote %s\n", o.export_obj);
-        if (!o.output && !o.trace_only) {
-            status = 0;
-            goto out;
-        }
-    }
+                100.0 * spacing->long_area, 100.0 * VB_SPACING_WARN_EDGE, (double)spacing->diagonal,
+                (double)spacing->median_edge, (double)spacing->p90_edge,
+                (double)spacing->suggest_edge);
+}
 
-    /* 3. The occluders' BVH, then orient, trace and project. */
-    if (log)
-        fprintf(log, "vdsh-bake: tracing %u rays x %u receivers against %u triangles "
-                     "(method %s)\n",
-                o.rays, rec->vertex_count, job.occluders.triangle_count,
-                vb_method_name(o.method));
-    pr.t0 = vb_now();
-    if (vb_job_bake(&job, &jd, &err) != VB_OK) {
-        fprintf(stderr, "vdsh-bake: %s\n", err.msg);
-        goto out;
-    }
-    const vb_bake_output *bo = &job.bake;
-    if (o.plan && o.adaptive) { /* the receivers as baked (oriented normals) */
-        vb_mesh planned = job.receivers;
-        if (bo->normals)
-            planned.normals = bo->normals;
-        if (write_plan(&planned, o.plan, log) != 0)
-            goto out;
-        if (!o.output) {
-            status = 0;
-            goto out;
-        }
-    }
-    if (log && o.adaptive)
+/* What the bake did: rounds, fits, rays, repairs and warnings. */
+static void say_bake(FILE *log, const options *o, const vb_job *job)
+{
+    const vb_bake_output *bo = &job->bake;
+    const vb_mesh *rec = &job->receivers;
+    if (!log)
+        return;
+    if (o->adaptive)
         fprintf(log, "vdsh-bake: adaptive receivers: %u from %u in %u rounds (%u midpoints "
                      "baked, tolerance %g + noise floor %.3g from %u receivers baked twice, min "
                 "edge %g%s)\n",
-                job.receivers.vertex_count, job.adaptive.start_receivers, job.adaptive.rounds,
-                job.adaptive.candidates, (double)o.adaptive_tol, job.adaptive.noise_floor,
-                job.adaptive.noise_sample, (double)o.min_edge,
-                job.adaptive.budget_reached   ? ", the budget stopped it"
-                : job.adaptive.uniform_reached ? ", stopped at the uniform bake's count at 2 x "
+                job->receivers.vertex_count, job->adaptive.start_receivers, job->adaptive.rounds,
+                job->adaptive.candidates, (double)o->adaptive_tol, job->adaptive.noise_floor,
+                job->adaptive.noise_sample, (double)o->min_edge,
+                job->adaptive.budget_reached   ? ", the budget stopped it"
+                : job->adaptive.uniform_reached ? ", stopped at the uniform bake's count at 2 x "
                                                  "the min edge"
                                                : "");
-    if (log && o.adaptive && job.adaptive.rounds_reached)
+    if (o->adaptive && job->adaptive.rounds_reached)
         fprintf(log, "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
                      "while still splitting (%u edges split in the last round, %u edges not "
                      "yet judged): raise --max-rounds\n",
-                job.adaptive.max_rounds, job.adaptive.last_split, job.adaptive.pending);
-    if (log && bo->flipped_normals)
+                job->adaptive.max_rounds, job->adaptive.last_split, job->adaptive.pending);
+    if (bo->flipped_normals)
         fprintf(log, "vdsh-bake: %u receiver normals pointed into geometry and were "
                      "flipped (--keep-normals keeps them)\n", bo->flipped_normals);
-    if (log)
-        fprintf(log, "vdsh-bake: traced %.1f M rays in %.2f s (%.1f Mrays/s on %u "
-                     "threads), %.2f%% missed, %u ray origins moved off other geometry, "
-                     "%u degenerate receivers (max distance %g)\n",
-                bo->rays_traced * 1e-6, bo->seconds,
-                bo->seconds > 0 ? bo->rays_traced / bo->seconds * 1e-6 : 0.0, bo->threads,
-                bo->rays_traced ? 100.0 * bo->rays_missed / bo->rays_traced : 0.0,
-                bo->moved_origins, bo->degenerate_receivers, (double)bo->max_distance);
-    if (log && bo->variable_orders) {
+    fprintf(log, "vdsh-bake: traced %.1f M rays in %.2f s (%.1f Mrays/s on %u "
+                 "threads), %.2f%% missed, %u ray origins moved off other geometry, "
+                 "%u degenerate receivers (max distance %g)\n",
+            bo->rays_traced * 1e-6, bo->seconds,
+            bo->seconds > 0 ? bo->rays_traced / bo->seconds * 1e-6 : 0.0, bo->threads,
+            bo->rays_traced ? 100.0 * bo->rays_missed / bo->rays_traced : 0.0,
+            bo->moved_origins, bo->degenerate_receivers, (double)bo->max_distance);
+    if (bo->variable_orders) {
         uint32_t hist[VDSH_ORDER_SLOTS] = {0};
         uint32_t rows = bo->range_end - bo->range_begin;
         double coeffs = 0.0;
@@ -1155,23 +1114,22 @@ int main(int argc, char **argv)
                 fprintf(log, " %d: %u (%.1f%%)", k, hist[k], 100.0 * hist[k] / rows);
         fputc('\n', log);
     }
-    if (log && o.adaptive_rays)
+    if (o->adaptive_rays)
         fprintf(log, "vdsh-bake: adaptive rays: %.1f traced per receiver on average "
                      "(cap %u, tolerance %g)\n",
                 bo->vertex_count ? (double)bo->rays_traced / bo->vertex_count : 0.0, bo->rays,
                 (double)bo->ray_tolerance);
-    if (log)
-        fprintf(log, "vdsh-bake: ray origins checked in %.2f s: %llu probe rays (%.1f%% of the "
-                     "traced rays), %u receivers repaired, %u moved\n",
-                bo->origins.seconds, (unsigned long long)bo->origins.probe_rays,
-                bo->rays_traced ? 100.0 * bo->origins.probe_rays / bo->rays_traced : 0.0,
-                bo->origins.flagged, bo->origins.moved);
-    if (log && bo->origins.skipped_zero_area)
+    fprintf(log, "vdsh-bake: ray origins checked in %.2f s: %llu probe rays (%.1f%% of the "
+                 "traced rays), %u receivers repaired, %u moved\n",
+            bo->origins.seconds, (unsigned long long)bo->origins.probe_rays,
+            bo->rays_traced ? 100.0 * bo->origins.probe_rays / bo->rays_traced : 0.0,
+            bo->origins.flagged, bo->origins.moved);
+    if (bo->origins.skipped_zero_area)
         fprintf(log, "vdsh-bake: %u receiver%s on zero-area triangles only (drawn nowhere): "
                      "origin%s not probed\n",
                 bo->origins.skipped_zero_area, bo->origins.skipped_zero_area == 1 ? "" : "s",
                 bo->origins.skipped_zero_area == 1 ? "" : "s");
-    if (log && bo->method == VDSH_METHOD_DECISION) {
+    if (bo->method == VDSH_METHOD_DECISION) {
         if (!bo->decision_lights)
             fprintf(log, "vdsh-bake: warning: no free space for lights in this scene: every "
                          "receiver keeps its least-squares fit\n");
@@ -1184,33 +1142,112 @@ int main(int argc, char **argv)
             fprintf(log, "vdsh-bake: log offsets calibrated on %u receivers for %.1f%% false "
                          "shadow on held-out lights:", bo->calibration_receivers,
                     100.0 * bo->false_rate);
-            for (int s = 0; s < o.order_count; s++)
-                fprintf(log, "%s order %d %+.3f", s ? "," : "", o.orders[s],
-                        (double)bo->log_offset[o.orders[s]]);
+            for (int s = 0; s < o->order_count; s++)
+                fprintf(log, "%s order %d %+.3f", s ? "," : "", o->orders[s],
+                        (double)bo->log_offset[o->orders[s]]);
             fputc('\n', log);
         }
     }
-    if (log && bo->auto_receivers > 0) {
+    if (bo->auto_receivers > 0) {
         fprintf(log, "vdsh-bake: quantity chosen on %u sampled receivers (expected shadow "
                      "error, distance / log):", bo->auto_receivers);
-        for (int s = 0; s < o.order_count; s++) {
-            int k = o.orders[s];
+        for (int s = 0; s < o->order_count; s++) {
+            int k = o->orders[s];
             fprintf(log, "%s order %d %s (%.4f / %.4f)", s ? "," : "", k,
                     bo->quantity[k] == VDSH_QUANTITY_LOG_DISTANCE ? "log" : "distance",
                     bo->auto_error[k][0], bo->auto_error[k][1]);
         }
         fputc('\n', log);
     }
-    if (log && bo->degenerate_receivers > 0)
+    if (bo->degenerate_receivers > 0)
         fprintf(log, "vdsh-bake: warning: %u receivers (%.2f%%) see distance ~0 in almost "
                      "every direction above their horizon: receivers inside or flush "
                      "against other geometry, or inverted normals\n",
                 bo->degenerate_receivers, 100.0 * bo->degenerate_receivers / rec->vertex_count);
+}
+
+static int run(const options *o)
+{
+    FILE *log = o->quiet ? NULL : stderr;
+    progress pr = {.enabled = log != NULL, .terminal = isatty(STDERR_FILENO), .rays = o->rays};
+    float offsets[VDSH_ORDER_SLOTS];
+    const vb_job_desc jd = job_desc(o, log, &pr, offsets);
+    int status = 1;
+    int writing = 0; /* output_lock held: outputs are being written */
+    vb_mesh_spacing spacing = {0};
+    vb_error err;
+    vb_job job = {0};
+
+    /* 0. Every output writable and none of them an input, before any work. */
+    if (check_outputs(o, &jd, o->meshes, o->mesh_count) != 0)
+        return 1;
+
+    /* 1. Load every mesh into one occluder scene. */
+    if (vb_job_load(&job, &jd, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+        goto out;
+    }
+
+    /* 2. Receivers: the scene's vertices, refined if asked. */
+    if (vb_job_refine(&job, &jd, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-bake: refining receivers: %s\n", err.msg);
+        goto out;
+    }
+    const vb_mesh *rec = &job.receivers;
+    say_receivers(log, o, &job, &spacing);
+    if (o->plan && !o->adaptive) { /* uniform: the refined receivers, before any bake */
+        if (write_plan(rec, o->plan, log) != 0)
+            goto out;
+        if (!o->output && !o->export_obj && !o->trace_only) {
+            status = 0;
+            goto out;
+        }
+    }
+    if (o->export_obj) {
+        pthread_mutex_lock(&output_lock);
+        vb_result written = vb_mesh_write_obj(rec, o->export_obj, &err);
+        pthread_mutex_unlock(&output_lock);
+        if (written != VB_OK) {
+            fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+            goto out;
+        }
+        if (log)
+            fprintf(log, "vdsh-bake: wrote %s\n", o->export_obj);
+        if (!o->output && !o->trace_only) {
+            status = 0;
+            goto out;
+        }
+    }
+
+    /* 3. The occluders' BVH, then orient, trace and project. */
+    if (log)
+        fprintf(log, "vdsh-bake: tracing %u rays x %u receivers against %u triangles "
+                     "(method %s)\n",
+                o->rays, rec->vertex_count, job.occluders.triangle_count,
+                vb_method_name(o->method));
+    pr.t0 = vb_now();
+    if (vb_job_bake(&job, &jd, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+        goto out;
+    }
+    const vb_bake_output *bo = &job.bake;
+    if (o->plan && o->adaptive) { /* the receivers as baked (oriented normals) */
+        vb_mesh planned = job.receivers;
+        if (bo->normals)
+            planned.normals = bo->normals;
+        if (write_plan(&planned, o->plan, log) != 0)
+            goto out;
+        if (!o->output) {
+            status = 0;
+            goto out;
+        }
+    }
+    say_bake(log, o, &job);
     char msg[PATH_MAX + 256];
-    if (o.trace_only) {
+    if (o->trace_only) {
         pthread_mutex_lock(&output_lock);
         writing = 1;
-        if (o.report && write_bare_report(o.report, bo, &job.timings, msg, sizeof msg) != 0) {
+        if (o->report && write_bare_report(o->report, bo, &job.timings, msg, sizeof msg) != 0) {
             fprintf(stderr, "vdsh-bake: %s (the report)\n", msg);
             goto out;
         }
@@ -1230,26 +1267,14 @@ int main(int argc, char **argv)
     char sdf_path[PATH_MAX];
     vdsh_sdf vol = {0};
     double sdf_seconds = 0.0;
-    if (o.sdf) {
-        double ts = vb_now();
-        if (vdsh_sdf_path(o.output, sdf_path, sizeof sdf_path) != 0) {
-            fprintf(stderr, "vdsh-bake: %s: path too long for its distance volume\n", o.output);
-            goto out;
-        }
-        if (vb_sdf_bake(job.scene, &job.occluders, o.sdf, o.threads, &vol, &err) != VB_OK) {
-            fprintf(stderr, "vdsh-bake: %s: %s\n", sdf_path, err.msg);
-            goto out;
-        }
-        vol.vertex_count = job.file.header.vertex_count;
-        vol.triangle_count = job.file.header.triangle_count;
-        sdf_seconds = vb_now() - ts;
-    }
+    if (o->sdf && bake_sdf(o, &job, sdf_path, sizeof sdf_path, &vol, &sdf_seconds) != 0)
+        goto out;
 
     /* 6. Write: the basis cubemaps and the distance volume, then the .vdsh
      * file, last. */
     pthread_mutex_lock(&output_lock);
     writing = 1;
-    if (o.sdf) {
+    if (o->sdf) {
         vdsh_error verr;
         vdsh_result vr = vdsh_sdf_write(sdf_path, &vol, &verr);
         vdsh_sdf_free(&vol);
@@ -1267,22 +1292,9 @@ int main(int argc, char **argv)
         goto out;
     }
     double write_seconds = vb_now() - t;
-    int cube_size = shard_count ? 0 : vb_job_cube_size(&jd); /* a part has none */
-    if (log) {
-        fprintf(log, "vdsh-bake: wrote %s (%.2f MB, %.1f bytes of coefficients per "
-                     "vertex for orders",
-                o.output, job.file_bytes / 1e6, job.coefficient_bytes + job.variable_bytes);
-        for (int s = 0; s < o.order_count; s++)
-            fprintf(log, "%s%d", s ? "," : " ", o.orders[s]);
-        if (bo->variable_cap)
-            fprintf(log, "%sadaptive 1..%d", o.order_count ? "," : " ", bo->variable_cap);
-        fprintf(log, ", %s)", vdsh_encoding_name(o.encoding));
-        if (cube_size > 0)
-            fprintf(log, " and 4 basis cubemaps %dx%d in %s", cube_size, cube_size,
-                    o.cubemap_dir ? o.cubemap_dir : "the output's directory");
-        fprintf(log, "\nvdsh-bake: done in %.2f s\n", job.timings.total + write_seconds);
-    }
-    if (o.report && write_report(o.report, &o, &job, &spacing, write_seconds, msg, sizeof msg) != 0) {
+    if (log)
+        say_written(log, o, &job, &jd, write_seconds);
+    if (o->report && write_report(o->report, o, &job, &spacing, write_seconds, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-bake: %s (the report)\n", msg);
         goto out;
     }
@@ -1296,4 +1308,13 @@ out:
     }
     vb_job_free(&job);
     return status;
+}
+
+int main(int argc, char **argv)
+{
+    vt_cli_begin("vdsh-bake", argv);
+    defer_interrupts_while_writing(); /* first: before any thread starts */
+    options o;
+    int status = parse_args(argc, argv, &o);
+    return status == VT_CLI_RUN ? run(&o) : status;
 }

@@ -47,8 +47,10 @@
 #include "scene.h"
 #include "vdsh.h"
 #include "vdsh_output.h"
+#include "vt_args.h"
 #include "vt_cli.h"
 #include "vt_json.h"
+#include "vt_record.h"
 
 #define PV_MAGIC "VDSHPVE1"
 #define PV_VERSION 1u
@@ -91,7 +93,7 @@ static void usage(FILE *f)
 "      --offsets LIST      the trade between recall and false shadows as a\n"
 "                          curve: each stream is also scored with each\n"
 "                          offset added to its ln D (distance streams: D\n"
-"                          times e^offset), e.g. -0.2,0.2,0.4 (at most 16\n"
+"                          times e^offset), e.g. -0.2,0.2,0.4 (at most %d\n"
 "                          streams in all: pick orders with --orders)\n"
 "      --oracle            score the ray-cast truth instead of the streams:\n"
 "                          every error must come out exactly 0\n"
@@ -138,30 +140,12 @@ static void usage(FILE *f)
 "Exit status: 0 success, 1 error, 2 usage error.\n"
 "Example: vdsh-bake builtin:room --max-edge 0.5 -o room.vdsh --record-timings\n"
 "         vdsh-eval room.vdsh --json room.eval.json\n",
-            VB_EVAL_DEFAULT_SEED, PV_MAGIC);
+            VB_EVAL_DEFAULT_SEED, VDSH_MAX_STREAMS, PV_MAGIC);
 }
 
 static int bad_usage(const char *fmt, const char *arg)
 {
     return vt_usage_error("vdsh-eval", fmt, arg);
-}
-
-/* Distinct orders 1..5 (vt_cli.h's list syntax). */
-static int parse_orders(const char *s, int *want)
-{
-    uint64_t v[VDSH_MAX_ORDER];
-    int n = vt_parse_u64_list(s, 1, VDSH_MAX_ORDER, v, 1, VDSH_MAX_ORDER);
-    int seen[VDSH_ORDER_SLOTS] = {0};
-    for (int i = 0; i < n; i++) {
-        if (seen[v[i]])
-            return 0;
-        seen[v[i]] = 1;
-    }
-    if (n == 0)
-        return 0;
-    for (int k = 1; k <= VDSH_MAX_ORDER; k++)
-        want[k] = seen[k];
-    return 1;
 }
 
 /* ---- progress on a terminal -------------------------------------------- */
@@ -256,10 +240,22 @@ static void json_receiver(vt_json *j, cJSON *list, const vb_eval_receiver *r, in
     vt_json_f64(j, o, "escaped", r->escaped);
 }
 
+/* Numbers under their keys, in order. */
+typedef struct named_f64 {
+    const char *key;
+    double v;
+} named_f64;
+
+static void json_f64s(vt_json *j, cJSON *o, const named_f64 *x, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        vt_json_f64(j, o, x[i].key, x[i].v);
+}
+
 static void json_metrics(vt_json *j, cJSON *o, const vb_eval_metrics *m, int kind)
 {
     vt_json_u64(j, o, "samples", m->samples);
-    const struct { const char *name; double v; } num[] = {
+    const named_f64 num[] = {
         {"distance_rms", m->distance_rms}, {"distance_rms_se", m->distance_rms_se},
         {"distance_mean", m->distance_mean}, {"distance_p50", m->distance_p50},
         {"distance_p90", m->distance_p90}, {"distance_p99", m->distance_p99},
@@ -273,8 +269,7 @@ static void json_metrics(vt_json *j, cJSON *o, const vb_eval_metrics *m, int kin
         {"binary_light_leak_se", m->binary_light_leak_se}, {"ringing", m->ringing},
         {"receiver_mae_p50", m->receiver_mae_p50}, {"receiver_mae_p90", m->receiver_mae_p90},
         {"receiver_mae_p99", m->receiver_mae_p99}};
-    for (size_t i = 0; i < sizeof num / sizeof num[0]; i++)
-        vt_json_f64(j, o, num[i].name, num[i].v);
+    json_f64s(j, o, num, sizeof num / sizeof num[0]);
     vt_json_u64(j, o, "visible", m->visible);
     vt_json_u64(j, o, "occluded", m->occluded);
     vt_json_u64(j, o, "occluded_binary", m->occluded_binary);
@@ -288,15 +283,14 @@ static void json_scene(vt_json *j, cJSON *o, const vb_eval_scene_metrics *m)
     vt_json_u64(j, o, "pairs", m->pairs);
     vt_json_u64(j, o, "visible", m->visible);
     vt_json_u64(j, o, "occluded", m->occluded);
-    const struct { const char *k; double v; } f[] = {
+    const named_f64 f[] = {
         {"shadow_mae", m->shadow_mae}, {"shadow_mae_se", m->shadow_mae_se},
         {"false_shadow", m->false_shadow}, {"false_shadow_se", m->false_shadow_se},
         {"recall", m->recall}, {"recall_se", m->recall_se},
         {"light_leak", m->light_leak}, {"light_leak_se", m->light_leak_se},
         {"binary_mae", m->binary_mae}, {"binary_false_shadow", m->binary_false_shadow},
         {"binary_recall", m->binary_recall}};
-    for (size_t i = 0; i < sizeof f / sizeof f[0]; i++)
-        vt_json_f64(j, o, f[i].k, f[i].v);
+    json_f64s(j, o, f, sizeof f / sizeof f[0]);
 }
 
 static void json_truth(vt_json *j, cJSON *o, const vb_eval_truth *t, int kind)
@@ -374,36 +368,12 @@ static int write_json(const char *out, const context *c, char *msg, size_t cap)
     vt_json_f32(&j, scene, "diagonal", r->diagonal);
 
     cJSON *bake = vt_json_object(&j, root, "bake");
-    vt_json_u64(&j, bake, "rays", h->rays);
-    vt_json_string(&j, bake, "sampling", vdsh_sampling_name(h->sampling));
-    vt_json_u64(&j, bake, "seed", h->seed);
-    vt_json_f32(&j, bake, "max_distance", h->max_distance);
-    vt_json_f32(&j, bake, "max_edge", h->max_edge);
-    vt_json_string(&j, bake, "offset_rule", vdsh_offset_rule_name(h->offset_rule));
+    vt_record_params(&j, bake, h);
     vt_json_bool(&j, bake, "welded", h->load_flags & VDSH_LOAD_WELD);
     vt_json_bool(&j, bake, "robust", h->trace_flags & VDSH_TRACE_ROBUST);
     vt_json_u64(&j, bake, "cube_size", h->cube_size);
-    if (f->has_stats) {
-        cJSON *st = vt_json_object(&j, bake, "stats");
-        vt_json_u64(&j, st, "rays_traced", f->stats.rays_traced);
-        vt_json_u64(&j, st, "rays_missed", f->stats.rays_missed);
-        vt_json_u64(&j, st, "degenerate_receivers", f->stats.degenerate_receivers);
-        vt_json_u64(&j, st, "undefined_normals", f->stats.undefined_normals);
-    } else {
-        vt_json_null(&j, bake, "stats");
-    }
-    if (f->has_timings) {
-        const vdsh_timings *t = &f->timings;
-        cJSON *tm = vt_json_object(&j, bake, "timings");
-        vt_json_f64(&j, tm, "load", t->load);
-        vt_json_f64(&j, tm, "refine", t->refine);
-        vt_json_f64(&j, tm, "build", t->build);
-        vt_json_f64(&j, tm, "trace", t->trace);
-        vt_json_f64(&j, tm, "total", t->total);
-        vt_json_u64(&j, tm, "threads", t->threads);
-    } else {
-        vt_json_null(&j, bake, "timings");
-    }
+    vt_record_stats(&j, bake, f, 0);
+    vt_record_timings(&j, bake, f);
     vt_json_f64(&j, bake, "seconds", c->bt.source ? c->bt.total : NAN);
     vt_json_string(&j, bake, "seconds_from", c->bt.source);
 
@@ -681,341 +651,410 @@ static void print_table(FILE *o, const context *c)
     }
 }
 
-/* ---- main -------------------------------------------------------------------- */
+/* ---- the command line ------------------------------------------------------------ */
 
-int main(int argc, char **argv)
+typedef struct options {
+    vb_eval_desc d;            /* the evaluator's settings; file and scene: run's */
+    const char *path;          /* FILE.vdsh */
+    char **meshes;             /* MESH...: the recorded sources, given */
+    uint32_t nmesh;
+    const char *json, *per_vertex, *bake_report;
+    int want_order[VDSH_ORDER_SLOTS], filter; /* --orders */
+    float offsets[VDSH_MAX_STREAMS];          /* --offsets */
+    int noffsets;
+    int quiet, fast_truth, allow_mismatch;
+} options;
+
+/* --interp: runtime, or a path of vdsh_shadow.h (1 + its number). */
+static int parse_interp(const char *s, uint32_t *out)
 {
-    vt_cli_begin("vdsh-eval", argv);
-    vb_eval_desc d = {0};
-    d.interior = 65536;
-    const char *json = NULL, *per_vertex = NULL, *bake_report = NULL;
-    int want_order[VDSH_ORDER_SLOTS] = {0}, filter = 0;
-    int quiet = 0, fast_truth = 0, allow_mismatch = 0, noffsets = 0;
-    float offsets[VDSH_MAX_STREAMS];
+    uint32_t interp = UINT32_MAX;
+    if (strcmp(s, "runtime") == 0)
+        interp = VB_EVAL_INTERP_RUNTIME;
+    for (uint32_t m = 0; m < 4; m++)
+        if (strcmp(s, vdsh_interp_name(m)) == 0)
+            interp = m + 1;
+    *out = interp;
+    return interp != UINT32_MAX;
+}
 
+static int parse_light_rule(const char *s, int *out)
+{
+    for (int k = VB_LIGHTS_UNIFORM; k <= VB_LIGHTS_PATH; k++)
+        if (!strcmp(s, vb_light_rule_name((vb_light_rule)k))) {
+            *out = k;
+            return 1;
+        }
+    return 0;
+}
+
+/* 1..VDSH_MAX_STREAMS - 1 offsets in -5..5 (the copies and the streams
+ * themselves must fit in VDSH_MAX_STREAMS). */
+static int parse_offsets(const char *s, float *out)
+{
+    int n = vt_parse_floats(s, out, 1, VDSH_MAX_STREAMS - 1);
+    for (int i = 0; i < n; i++)
+        if (fabsf(out[i]) > 5.0f)
+            return 0;
+    return n;
+}
+
+/* -1 with *o ready to run, else the exit status (help, version, a usage
+ * error: said). */
+static int parse_args(int argc, char **argv, options *o)
+{
     enum { O_POINTS = 256, O_INTERIOR, O_DIRECTIONS, O_SEED, O_ORDERS, O_ORACLE, O_INTERP,
            O_FAST, O_ALLOW, O_JSON, O_PV, O_BAKE_REPORT, O_WORST, O_THREADS, O_LIGHTS,
            O_OFFSETS, O_LIGHT_RULE };
     static const struct option longopts[] = {
-        {"points", required_argument, 0, O_POINTS},
-        {"interior", required_argument, 0, O_INTERIOR},
-        {"directions", required_argument, 0, O_DIRECTIONS},
-        {"seed", required_argument, 0, O_SEED},
-        {"orders", required_argument, 0, O_ORDERS},
-        {"oracle", no_argument, 0, O_ORACLE},
-        {"interp", required_argument, 0, O_INTERP},
-        {"fast-truth", no_argument, 0, O_FAST},
-        {"allow-mismatch", no_argument, 0, O_ALLOW},
-        {"json", required_argument, 0, O_JSON},
+        {"points", required_argument, 0, O_POINTS}, {"interior", required_argument, 0, O_INTERIOR},
+        {"directions", required_argument, 0, O_DIRECTIONS}, {"seed", required_argument, 0, O_SEED},
+        {"orders", required_argument, 0, O_ORDERS}, {"oracle", no_argument, 0, O_ORACLE},
+        {"interp", required_argument, 0, O_INTERP}, {"fast-truth", no_argument, 0, O_FAST},
+        {"allow-mismatch", no_argument, 0, O_ALLOW}, {"json", required_argument, 0, O_JSON},
         {"per-vertex", required_argument, 0, O_PV},
         {"bake-report", required_argument, 0, O_BAKE_REPORT},
-        {"worst", required_argument, 0, O_WORST},
-        {"threads", required_argument, 0, O_THREADS},
+        {"worst", required_argument, 0, O_WORST}, {"threads", required_argument, 0, O_THREADS},
         {"lights", required_argument, 0, O_LIGHTS},
         {"light-rule", required_argument, 0, O_LIGHT_RULE},
-        {"offsets", required_argument, 0, O_OFFSETS},
-        {"quiet", no_argument, 0, 'q'},
-        {"help", no_argument, 0, 'h'},
-        {"version", no_argument, 0, 'V'},
-        {0, 0, 0, 0}};
-    int c;
-    uint64_t u;
-    while ((c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
+        {"offsets", required_argument, 0, O_OFFSETS}, {"quiet", no_argument, 0, 'q'},
+        {"help", no_argument, 0, 'h'}, {"version", no_argument, 0, 'V'}, {0, 0, 0, 0}};
+    memset(o, 0, sizeof *o);
+    o->d.interior = 65536;
+    vb_eval_desc *d = &o->d;
+    int c, ok = 1;
+    while (ok && (c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
         switch (c) {
         case O_POINTS:
-            if (!vt_parse_u64(optarg, 1, VB_EVAL_MAX_RECEIVERS, &u))
-                return bad_usage("--points takes a whole number 1..268435456, not '%s'", optarg);
-            d.points = (uint32_t)u;
+            ok = vt_opt_u32("--points", NULL, optarg, 1, VB_EVAL_MAX_RECEIVERS, &d->points);
             break;
         case O_INTERIOR:
-            if (!vt_parse_u64(optarg, 0, VB_EVAL_MAX_RECEIVERS, &u))
-                return bad_usage("--interior takes a whole number 0..268435456, not '%s'", optarg);
-            d.interior = (uint32_t)u;
+            ok = vt_opt_u32("--interior", NULL, optarg, 0, VB_EVAL_MAX_RECEIVERS, &d->interior);
             break;
-        case O_DIRECTIONS:
-            if (!vt_parse_u64(optarg, 1, 65536, &u))
-                return bad_usage("--directions takes a whole number 1..65536, not '%s'", optarg);
-            d.directions = (uint32_t)u;
-            break;
+        case O_DIRECTIONS: ok = vt_opt_u32("--directions", NULL, optarg, 1, 65536, &d->directions); break;
+        case O_WORST: ok = vt_opt_u32("--worst", NULL, optarg, 1, VB_EVAL_MAX_WORST, &d->worst); break;
+        case O_LIGHTS: ok = vt_opt_u32("--lights", NULL, optarg, 1, 4096, &d->lights); break;
+        case O_THREADS: ok = vt_opt_u32("--threads", NULL, optarg, 1, 256, &d->threads); break;
         case O_SEED:
-            if (!vt_parse_u64(optarg, 0, UINT64_MAX, &d.seed))
+            if (!vt_parse_u64(optarg, 0, UINT64_MAX, &d->seed))
                 return bad_usage("--seed takes a whole number, not '%s'", optarg);
             break;
         case O_ORDERS:
-            if (!parse_orders(optarg, want_order))
-                return bad_usage("--orders takes distinct orders 1..5 such as 3,5, not '%s'", optarg);
-            filter = 1;
+            if (!vt_opt_orders("--orders", "3,5", optarg, VDSH_MAX_ORDER, o->want_order))
+                return VT_EXIT_USAGE;
+            o->filter = 1;
             break;
-        case O_ORACLE: d.oracle = 1; break;
-        case O_INTERP: {
-            d.interp = UINT32_MAX;
-            if (strcmp(optarg, "runtime") == 0)
-                d.interp = VB_EVAL_INTERP_RUNTIME;
-            for (uint32_t m = 0; m < 4; m++)
-                if (strcmp(optarg, vdsh_interp_name(m)) == 0)
-                    d.interp = m + 1;
-            if (d.interp == UINT32_MAX)
+        case O_INTERP:
+            if (!parse_interp(optarg, &d->interp))
                 return bad_usage("--interp takes runtime, coefficients, distance, "
                                    "visibility or split, not '%s'", optarg);
             break;
-        }
-        case O_FAST: fast_truth = 1; break;
-        case O_ALLOW: allow_mismatch = 1; break;
-        case O_JSON: json = optarg; break;
-        case O_PV: per_vertex = optarg; break;
-        case O_BAKE_REPORT: bake_report = optarg; break;
-        case O_WORST:
-            if (!vt_parse_u64(optarg, 1, VB_EVAL_MAX_WORST, &u))
-                return bad_usage("--worst takes a whole number 1..64, not '%s'", optarg);
-            d.worst = (uint32_t)u;
-            break;
-        case O_LIGHTS:
-            if (!vt_parse_u64(optarg, 1, 4096, &u))
-                return bad_usage("--lights takes a whole number 1..4096, not '%s'", optarg);
-            d.lights = (uint32_t)u;
-            break;
-        case O_LIGHT_RULE: {
-            int rule = -1;
-            for (int k = VB_LIGHTS_UNIFORM; k <= VB_LIGHTS_PATH; k++)
-                if (!strcmp(optarg, vb_light_rule_name((vb_light_rule)k)))
-                    rule = k;
-            if (rule < 0)
+        case O_LIGHT_RULE:
+            if (!parse_light_rule(optarg, &d->light_rule))
                 return bad_usage("--light-rule takes uniform, ceiling, near or path, not '%s'",
                                  optarg);
-            d.light_rule = rule;
             break;
-        }
         case O_OFFSETS:
-            noffsets = vt_parse_floats(optarg, offsets, 1, VDSH_MAX_STREAMS - 1);
-            for (int i = 0; i < noffsets; i++)
-                if (fabsf(offsets[i]) > 5.0f)
-                    noffsets = 0;
-            if (!noffsets)
+            o->noffsets = parse_offsets(optarg, o->offsets);
+            if (!o->noffsets)
                 return bad_usage("--offsets takes 1..15 numbers in -5..5 such as -0.4,-0.2,0.2, "
                                  "not '%s'", optarg);
             break;
-        case O_THREADS:
-            if (!vt_parse_u64(optarg, 1, 256, &u))
-                return bad_usage("--threads takes a whole number 1..256, not '%s'", optarg);
-            d.threads = (unsigned)u;
-            break;
-        case 'q': quiet = 1; break;
+        case O_ORACLE: d->oracle = 1; break;
+        case O_FAST: o->fast_truth = 1; break;
+        case O_ALLOW: o->allow_mismatch = 1; break;
+        case O_JSON: o->json = optarg; break;
+        case O_PV: o->per_vertex = optarg; break;
+        case O_BAKE_REPORT: o->bake_report = optarg; break;
+        case 'q': o->quiet = 1; break;
         case 'h': usage(stdout); return 0;
         case 'V': return vt_cli_version("Embree " RTC_VERSION_STRING);
         default: return vt_cli_try_help();
         }
     }
-    if (optind >= argc)
-        return bad_usage("%s", "no .vdsh file given");
-    const char *path = argv[optind];
-    char **meshes = argv + optind + 1;
-    uint32_t nmesh = (uint32_t)(argc - optind - 1);
+    if (!ok)
+        return VT_EXIT_USAGE;
+    o->path = vt_arg_vdsh(argc, argv, optind, NULL, 1);
+    if (!o->path)
+        return VT_EXIT_USAGE;
+    o->meshes = argv + optind + 1;
+    o->nmesh = (uint32_t)(argc - optind - 1);
+    return -1;
+}
+
+/* ---- the streams to score ------------------------------------------------------------ */
+
+typedef struct scored {
+    vdsh_file view;            /* the file with the streams to score; the file stays as read */
+    vdsh_stream *kept;         /* view.streams when not the file's own (owned) */
+    int copies;                /* 1 + offsets once kept holds --offsets copies, whose data
+                                  (each stream but every copies-th) is ours; else 0 */
+    float offset[VDSH_MAX_STREAMS]; /* per scored stream: the log offset added */
+} scored;
+
+static void scored_free(scored *s)
+{
+    if (s->kept && s->copies)
+        for (uint32_t i = 0; i < s->view.stream_count; i++)
+            if (i % (uint32_t)s->copies != 0)
+                free((void *)s->kept[i].data);
+    free(s->kept);
+}
+
+/* --orders: only the streams of those orders, each order present. */
+static int select_orders(const options *o, const vdsh_file *f, scored *s)
+{
+    vdsh_stream *kept = calloc(f->stream_count + 1, sizeof *kept);
+    if (!kept) {
+        fprintf(stderr, "vdsh-eval: out of memory\n");
+        return 1;
+    }
+    s->kept = kept;
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < f->stream_count; i++)
+        if (f->streams[i].order <= VDSH_MAX_ORDER && o->want_order[f->streams[i].order])
+            kept[n++] = f->streams[i];
+    for (int k = 1; k <= VDSH_MAX_ORDER; k++) {
+        int found = 0;
+        for (uint32_t i = 0; i < n; i++)
+            found |= o->want_order[k] && kept[i].order == (uint32_t)k;
+        if (o->want_order[k] && !found) {
+            fprintf(stderr, "vdsh-eval: %s: no stream of order %d\n", o->path, k);
+            return 1;
+        }
+    }
+    s->view.streams = kept;
+    s->view.stream_count = n;
+    return 0;
+}
+
+/* --offsets, the trade as a curve: each stream again with every offset
+ * added to its log distance (a distance stream: times e^offset), decoded
+ * to f32 in memory. 0, 1 (an error) or VT_EXIT_USAGE (too many streams). */
+static int add_offsets(const options *o, const vdsh_file *f, scored *s)
+{
+    const int noffsets = o->noffsets;
+    uint32_t n0 = s->view.stream_count, total = n0 * (uint32_t)(1 + noffsets);
+    if (total > VDSH_MAX_STREAMS) {
+        fprintf(stderr, "vdsh-eval: %u streams with %d offsets each make %u, more than %d: "
+                        "fewer offsets, or pick orders with --orders\n",
+                n0, noffsets, total, VDSH_MAX_STREAMS);
+        return VT_EXIT_USAGE;
+    }
+    vdsh_stream *all = calloc(total, sizeof *all);
+    if (!all) {
+        fprintf(stderr, "vdsh-eval: out of memory\n");
+        return 1;
+    }
+    uint32_t n = 0, V = f->header.vertex_count;
+    for (uint32_t i = 0; i < n0; i++) {
+        s->offset[n] = 0.0f;
+        all[n++] = s->view.streams[i];
+        for (int k = 0; k < noffsets; k++) {
+            vdsh_stream x = s->view.streams[i];
+            uint32_t nc = x.order * x.order;
+            float *data = malloc((size_t)V * nc * sizeof *data + 1);
+            if (!data) {
+                fprintf(stderr, "vdsh-eval: out of memory\n");
+                for (uint32_t j = 0; j < n; j++)
+                    if (j % (uint32_t)(1 + noffsets) != 0)
+                        free((void *)all[j].data);
+                free(all);
+                return 1;
+            }
+            for (uint32_t v = 0; v < V; v++) {
+                float *cv = data + (size_t)v * nc;
+                vdsh_stream_decode(&s->view.streams[i], v, cv);
+                if (x.quantity == VDSH_QUANTITY_LOG_DISTANCE)
+                    cv[0] += o->offsets[k] / 0.28209479177387814f; /* Y00 */
+                else
+                    for (uint32_t c = 0; c < nc; c++)
+                        cv[c] *= x.quantity == VDSH_QUANTITY_DISTANCE2
+                                     ? expf(2.0f * o->offsets[k]) : expf(o->offsets[k]);
+            }
+            x.encoding = VDSH_ENCODING_F32, x.scale = 1.0f, x.data = data;
+            s->offset[n] = o->offsets[k];
+            all[n++] = x;
+        }
+    }
+    free(s->kept);
+    s->kept = all;
+    s->copies = 1 + noffsets;
+    s->view.streams = all;
+    s->view.stream_count = n;
+    return 0;
+}
+
+/* ---- the steps of an evaluation ------------------------------------------------------- */
+
+/* --bake-report, else the file's time chunk, else none. */
+static int bake_time_of(const options *o, const vdsh_file *f, bake_time *bt)
+{
+    memset(bt, 0, sizeof *bt);
+    if (o->bake_report) {
+        char msg[PATH_MAX + 128];
+        if (!read_bake_report(o->bake_report, bt, msg, sizeof msg)) {
+            fprintf(stderr, "vdsh-eval: %s\n", msg);
+            return 1;
+        }
+    } else if (f->has_timings) {
+        bt->total = f->timings.total;
+        bt->trace = f->timings.trace;
+        bt->threads = f->timings.threads;
+        bt->source = "time chunk";
+    }
+    return 0;
+}
+
+static void sources_free(char **spath, uint32_t n)
+{
+    if (spath)
+        for (uint32_t i = 0; i < n; i++)
+            free(spath[i]);
+    free(spath);
+}
+
+/* The occluders' files: the meshes given, or each recorded source found.
+ * NULL after the message. */
+static char **find_sources(const options *o, const vdsh_file *f)
+{
+    char **spath = calloc(f->source_count + 1, sizeof *spath);
+    if (!spath) {
+        fprintf(stderr, "vdsh-eval: out of memory\n");
+        return NULL;
+    }
+    for (uint32_t i = 0; i < f->source_count; i++) {
+        spath[i] = o->nmesh ? strdup(o->meshes[i])
+                            : vb_eval_find_source(f->sources[i].name, o->path);
+        if (!spath[i]) {
+            fprintf(stderr, "vdsh-eval: %s: cannot find source %u of %u, '%s' (looked as "
+                            "recorded and beside the file); give the bake's meshes after "
+                            "the file name\n",
+                    o->path, i + 1, f->source_count, f->sources[i].name);
+            sources_free(spath, f->source_count);
+            return NULL;
+        }
+    }
+    return spath;
+}
+
+/* The table (unless the JSON has stdout), the JSON and the per-vertex file. */
+static int report(const options *o, const context *ctx)
+{
+    if (!o->json || strcmp(o->json, "-") != 0) /* stdout is the JSON's */
+        print_table(stdout, ctx);
+    fflush(stdout);
+    char msg[PATH_MAX + 256];
+    if (o->json && write_json(o->json, ctx, msg, sizeof msg) != 0) {
+        fprintf(stderr, "vdsh-eval: %s\n", msg);
+        return 1;
+    }
+    if (o->per_vertex && write_per_vertex(o->per_vertex, ctx->f, ctx->r, msg, sizeof msg) != 0) {
+        fprintf(stderr, "vdsh-eval: %s\n", msg);
+        return 1;
+    }
+    return 0;
+}
+
+/* Steps 2 to 5 of run: the bake time, the occluders, the evaluation, the
+ * report. */
+static int evaluate(const options *o, const vdsh_file *f, const scored *sc)
+{
+    int status = 1;
+    vb_scene *scene = NULL;
+    vb_eval_result res = {0};
+    char **spath = NULL;
+    vb_error err;
+
+    /* 2. The bake time. */
+    bake_time bt;
+    if (bake_time_of(o, f, &bt))
+        goto out;
+
+    /* 3. The occluders, as the bake traced them. */
+    spath = find_sources(o, f);
+    if (!spath)
+        goto out;
+    warnings warned = {.path = o->path};
+    vb_eval_scene_desc sd = {.fast = o->fast_truth, .allow_mismatch = o->allow_mismatch,
+                             .threads = o->d.threads, .warn = on_warn, .warn_user = &warned};
+    if (vb_eval_scene_create(f, (const char *const *)spath, f->source_count, &sd, &scene,
+                             &err) != VB_OK) {
+        fprintf(stderr, "vdsh-eval: %s: %s\n", o->path, err.msg);
+        goto out;
+    }
+
+    /* 4. Evaluate. */
+    progress pr = {.enabled = !o->quiet && isatty(STDERR_FILENO), .t0 = vb_now()};
+    vb_eval_desc d = o->d;
+    d.file = &sc->view;
+    d.scene = scene;
+    d.per_vertex = o->per_vertex != NULL;
+    d.progress = on_progress;
+    d.progress_user = &pr;
+    if (vb_eval_run(&d, &res, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-eval: %s: %s\n", o->path, err.msg);
+        goto out;
+    }
+
+    /* 5. Report. */
+    context ctx = {.path = o->path, .f = &sc->view, .source_paths = spath, .file_bytes = -1,
+                   .bt = bt, .r = &res, .d = &d, .fast_truth = o->fast_truth,
+                   .mismatched = warned.count, .offset = sc->offset};
+    struct stat st;
+    if (stat(o->path, &st) == 0)
+        ctx.file_bytes = (long long)st.st_size;
+    status = report(o, &ctx);
+
+out:
+    sources_free(spath, f->source_count);
+    vb_eval_result_free(&res);
+    vb_scene_destroy(scene);
+    return status;
+}
+
+/* The story of an evaluation (the top of this file). */
+static int run(const options *o)
+{
+    /* 0. Every output can be written, and none is an input. */
     {
-        const char *outs[] = {json, per_vertex};
-        const char *ins[VDSH_MAX_SOURCES + 2] = {path, bake_report};
+        const char *outs[] = {o->json, o->per_vertex};
+        const char *ins[VDSH_MAX_SOURCES + 2] = {o->path, o->bake_report};
         int nin = 2;
-        for (uint32_t i = 0; i < nmesh && nin < VDSH_MAX_SOURCES + 2; i++)
-            ins[nin++] = meshes[i];
+        for (uint32_t i = 0; i < o->nmesh && nin < VDSH_MAX_SOURCES + 2; i++)
+            ins[nin++] = o->meshes[i];
         if (vt_cli_check_outputs(outs, 2, ins, nin) != 0)
             return 1;
     }
 
-    int status = 1;
-    vdsh_file *f = NULL;
-    vb_scene *scene = NULL;
-    vb_eval_result res = {0};
-    char **spath = NULL;
-    vdsh_stream *kept = NULL;
-    uint32_t owned_from = UINT32_MAX; /* streams of kept whose data we allocated */
-    vdsh_error verr;
-    vb_error err;
-
-    /* 1. The file. */
-    if (vdsh_read(path, &f, &verr) != VDSH_OK) {
-        fprintf(stderr, "vdsh-eval: %s\n", verr.msg);
+    /* 1. The file, and the streams to score. */
+    vdsh_file *f = vt_read_whole(o->path);
+    if (!f)
         return 1;
-    }
-    if (f->has_part) { /* its streams hold one range's receivers */
-        fprintf(stderr, "vdsh-eval: %s: a part of a sharded bake (shard %u of %u): join the "
-                        "parts with vdsh-merge first\n", path, f->part.index, f->part.count);
-        vdsh_free(f);
-        return 1;
-    }
-    if (nmesh && nmesh != f->source_count) {
+    if (o->nmesh && o->nmesh != f->source_count) {
         fprintf(stderr, "vdsh-eval: %s: %u mesh(es) given but the bake used %u source(s):",
-                path, nmesh, f->source_count);
+                o->path, o->nmesh, f->source_count);
         for (uint32_t i = 0; i < f->source_count; i++)
             fprintf(stderr, " '%s'", f->sources[i].name);
         fputc('\n', stderr);
         vdsh_free(f);
         return VT_EXIT_USAGE;
     }
-    vdsh_file view = *f; /* the streams to score; the file itself stays as read */
-    if (filter) {
-        kept = calloc(f->stream_count + 1, sizeof *kept);
-        if (!kept) {
-            fprintf(stderr, "vdsh-eval: out of memory\n");
-            goto out;
-        }
-        uint32_t n = 0;
-        for (uint32_t s = 0; s < f->stream_count; s++)
-            if (f->streams[s].order <= VDSH_MAX_ORDER && want_order[f->streams[s].order])
-                kept[n++] = f->streams[s];
-        for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
-            int found = 0;
-            for (uint32_t s = 0; s < n; s++)
-                found |= want_order[o] && kept[s].order == (uint32_t)o;
-            if (want_order[o] && !found) {
-                fprintf(stderr, "vdsh-eval: %s: no stream of order %d\n", path, o);
-                goto out;
-            }
-        }
-        view.streams = kept;
-        view.stream_count = n;
-    }
-
-    /* The curve (--offsets): each stream again with every offset added to
-     * its log distance (a distance stream: times e^offset), decoded to f32
-     * in memory. */
-    float soffset[VDSH_MAX_STREAMS] = {0};
-    if (noffsets) {
-        uint32_t n0 = view.stream_count, total = n0 * (uint32_t)(1 + noffsets);
-        if (total > VDSH_MAX_STREAMS) {
-            fprintf(stderr, "vdsh-eval: %u streams with %d offsets each make %u, more than %d: "
-                            "fewer offsets, or pick orders with --orders\n",
-                    n0, noffsets, total, VDSH_MAX_STREAMS);
-            free(kept);
-            vdsh_free(f);
-            return VT_EXIT_USAGE;
-        }
-        vdsh_stream *all = calloc(total, sizeof *all);
-        if (!all) {
-            fprintf(stderr, "vdsh-eval: out of memory\n");
-            goto out;
-        }
-        uint32_t n = 0, V = f->header.vertex_count;
-        for (uint32_t s = 0; s < n0; s++) {
-            soffset[n] = 0.0f;
-            all[n++] = view.streams[s];
-            for (int k = 0; k < noffsets; k++) {
-                vdsh_stream x = view.streams[s];
-                uint32_t nc = x.order * x.order;
-                float *data = malloc((size_t)V * nc * sizeof *data + 1);
-                if (!data) {
-                    fprintf(stderr, "vdsh-eval: out of memory\n");
-                    for (uint32_t i = 0; i < n; i++)
-                        if (i % (uint32_t)(1 + noffsets) != 0)
-                            free((void *)all[i].data);
-                    free(all);
-                    goto out;
-                }
-                for (uint32_t v = 0; v < V; v++) {
-                    float *cv = data + (size_t)v * nc;
-                    vdsh_stream_decode(&view.streams[s], v, cv);
-                    if (x.quantity == VDSH_QUANTITY_LOG_DISTANCE)
-                        cv[0] += offsets[k] / 0.28209479177387814f; /* Y00 */
-                    else
-                        for (uint32_t i = 0; i < nc; i++)
-                            cv[i] *= x.quantity == VDSH_QUANTITY_DISTANCE2
-                                         ? expf(2.0f * offsets[k]) : expf(offsets[k]);
-                }
-                x.encoding = VDSH_ENCODING_F32, x.scale = 1.0f, x.data = data;
-                soffset[n] = offsets[k];
-                all[n++] = x;
-            }
-        }
-        free(kept);
-        kept = all;
-        owned_from = n0;
-        view.streams = all;
-        view.stream_count = n;
-    }
-
-    /* 2. The bake time. */
-    bake_time bt = {0};
-    if (bake_report) {
-        char msg[PATH_MAX + 128];
-        if (!read_bake_report(bake_report, &bt, msg, sizeof msg)) {
-            fprintf(stderr, "vdsh-eval: %s\n", msg);
-            goto out;
-        }
-    } else if (f->has_timings) {
-        bt.total = f->timings.total;
-        bt.trace = f->timings.trace;
-        bt.threads = f->timings.threads;
-        bt.source = "time chunk";
-    }
-
-    /* 3. The occluders, as the bake traced them. */
-    spath = calloc(f->source_count + 1, sizeof *spath);
-    if (!spath) {
-        fprintf(stderr, "vdsh-eval: out of memory\n");
-        goto out;
-    }
-    for (uint32_t i = 0; i < f->source_count; i++) {
-        spath[i] = nmesh ? strdup(meshes[i]) : vb_eval_find_source(f->sources[i].name, path);
-        if (!spath[i]) {
-            fprintf(stderr, "vdsh-eval: %s: cannot find source %u of %u, '%s' (looked as "
-                            "recorded and beside the file); give the bake's meshes after "
-                            "the file name\n",
-                    path, i + 1, f->source_count, f->sources[i].name);
-            goto out;
-        }
-    }
-    warnings warned = {.path = path};
-    vb_eval_scene_desc sd = {.fast = fast_truth, .allow_mismatch = allow_mismatch,
-                             .threads = d.threads, .warn = on_warn, .warn_user = &warned};
-    if (vb_eval_scene_create(f, (const char *const *)spath, f->source_count, &sd, &scene,
-                             &err) != VB_OK) {
-        fprintf(stderr, "vdsh-eval: %s: %s\n", path, err.msg);
-        goto out;
-    }
-
-    /* 4. Evaluate. */
-    progress pr = {.enabled = !quiet && isatty(STDERR_FILENO), .t0 = vb_now()};
-    d.file = &view;
-    d.scene = scene;
-    d.per_vertex = per_vertex != NULL;
-    d.progress = on_progress;
-    d.progress_user = &pr;
-    if (vb_eval_run(&d, &res, &err) != VB_OK) {
-        fprintf(stderr, "vdsh-eval: %s: %s\n", path, err.msg);
-        goto out;
-    }
-
-    /* 5. Report. */
-    context ctx = {.path = path, .f = &view, .source_paths = spath, .file_bytes = -1,
-                   .bt = bt, .r = &res, .d = &d, .fast_truth = fast_truth,
-                   .mismatched = warned.count, .offset = soffset};
-    struct stat st;
-    if (stat(path, &st) == 0)
-        ctx.file_bytes = (long long)st.st_size;
-    if (!json || strcmp(json, "-") != 0) /* stdout is the JSON's */
-        print_table(stdout, &ctx);
-    fflush(stdout);
-    char msg[PATH_MAX + 256];
-    if (json && write_json(json, &ctx, msg, sizeof msg) != 0) {
-        fprintf(stderr, "vdsh-eval: %s\n", msg);
-        goto out;
-    }
-    if (per_vertex && write_per_vertex(per_vertex, &view, &res, msg, sizeof msg) != 0) {
-        fprintf(stderr, "vdsh-eval: %s\n", msg);
-        goto out;
-    }
-    status = 0;
-
-out:
-    if (spath)
-        for (uint32_t i = 0; i < f->source_count; i++)
-            free(spath[i]);
-    free(spath);
-    if (kept && owned_from != UINT32_MAX)
-        for (uint32_t s = 0; s < view.stream_count; s++)
-            if (s % (uint32_t)(1 + noffsets) != 0) /* an offset copy: its data is ours */
-                free((void *)kept[s].data);
-    free(kept);
-    vb_eval_result_free(&res);
-    vb_scene_destroy(scene);
+    scored sc = {.view = *f};
+    int status = o->filter ? select_orders(o, f, &sc) : 0;
+    if (status == 0 && o->noffsets)
+        status = add_offsets(o, f, &sc);
+    if (status == 0)
+        status = evaluate(o, f, &sc);
+    scored_free(&sc);
     vdsh_free(f);
     return status;
+}
+
+int main(int argc, char **argv)
+{
+    vt_cli_begin("vdsh-eval", argv);
+    options o;
+    int status = parse_args(argc, argv, &o);
+    return status >= 0 ? status : run(&o);
 }

@@ -33,6 +33,7 @@
 #include "vdsh.h"
 #include "vdsh_sdf.h"
 #include "vdsh_shadow.h"
+#include "vt_args.h"
 #include "vt_cli.h"
 #include "vt_image.h"
 #include "vt_json.h"
@@ -79,7 +80,7 @@ static void usage(FILE *f)
 "             exact distance through the runtime's comparison (--compare)\n"
 "    mask     1 where the pixel counts: a triangle is hit and its\n"
 "             interpolated normal faces the light (N . L > 0)\n"
-"    c-vdshN  the file's stream of order N (1..16), computed in C exactly\n"
+"    c-vdshN  the file's stream of order N (1..%d), computed in C exactly\n"
 "             on the runtime's path (formats/vdsh_shadow.h: vdsh_shadow_interior\n"
 "             with the triangle's vertices and barycentrics; log distance,\n"
 "             what method shadow bakes: each vertex's distance, interpolated)\n"
@@ -140,7 +141,8 @@ static void usage(FILE *f)
 "         vdsh-frames views room.vdsh -o room.views.json\n"
 "         vdsh-frames truth room.vdsh --views room.views.json -o frames\n"
 "         vdsh-frames score room.vdsh --views room.views.json --truth frames \\\n"
-"             --frames frames --modes c-vdsh2,c-vdsh3,c-vdsh5\n");
+"             --frames frames --modes c-vdsh2,c-vdsh3,c-vdsh5\n",
+            VDSH_MAX_ORDER);
 }
 
 static int bad_usage(const char *fmt, const char *arg)
@@ -150,10 +152,22 @@ static int bad_usage(const char *fmt, const char *arg)
 
 /* ---- what every subcommand shares -------------------------------------------------- */
 
-typedef struct common {
-    unsigned threads;
+/* The command line of every subcommand (parse_args, at the end). */
+typedef struct options {
+    int (*run)(const struct options *); /* the subcommand's */
+    const char *path;                   /* SCENE.vdsh */
+    unsigned threads;                   /* --threads; 0: every core */
     int quiet;
-} common;
+    const char *output;                 /* -o: views' VIEWS.json, truth's DIR */
+    vb_frames_views_desc views;         /* views: --cameras, --seed, --size */
+    const char *views_path;             /* truth, score: --views */
+    uint32_t compare;                   /* truth: --compare */
+    const char *sdf;                    /* truth: --sdf */
+    float sdf_k;                        /* truth: --sdf-k */
+    const char *truth, *frames, *json;  /* score */
+    char modes[MAX_MODES][64];          /* score: --modes */
+    int mode_count;
+} options;
 
 /* The scene: the file, its occluders and the receiver scene. */
 typedef struct loaded {
@@ -173,18 +187,10 @@ static void loaded_free(loaded *l)
 static int load_scene(const char *path, unsigned threads, int traced, loaded *out)
 {
     loaded l = {0};
-    vdsh_error verr;
     vb_error err;
-    if (vdsh_read(path, &l.f, &verr) != VDSH_OK) {
-        fprintf(stderr, PROG ": %s\n", verr.msg);
+    l.f = vt_read_whole(path);
+    if (!l.f)
         return -1;
-    }
-    if (l.f->has_part) { /* its streams hold one range's receivers */
-        fprintf(stderr, PROG ": %s: a part of a sharded bake (shard %u of %u): join the parts "
-                             "with vdsh-merge first\n", path, l.f->part.index, l.f->part.count);
-        vdsh_free(l.f);
-        return -1;
-    }
     if (!traced) {
         *out = l;
         return 0;
@@ -234,102 +240,18 @@ static int read_views(const char *path, vt_views *v)
     return 0;
 }
 
-/* Options every subcommand takes; returns 1 if handled, or an exit code
- * + 2 for help, version and errors (so 0 means "not mine"). */
-enum { O_THREADS = 256, O_CAMERAS, O_SEED, O_SIZE, O_VIEWS, O_COMPARE, O_TRUTH, O_FRAMES,
-       O_MODES, O_JSON , O_SDF, O_SDF_K };
-
-static int common_option(int c, common *co, int *exit_code)
-{
-    uint64_t u;
-    switch (c) {
-    case O_THREADS:
-        if (!vt_parse_u64(optarg, 1, 256, &u)) {
-            *exit_code = bad_usage("--threads takes a whole number 1..256, not '%s'", optarg);
-            return 2;
-        }
-        co->threads = (unsigned)u;
-        return 1;
-    case 'q':
-        co->quiet = 1;
-        return 1;
-    case 'h':
-        usage(stdout);
-        *exit_code = 0;
-        return 2;
-    case 'V':
-        *exit_code = vt_cli_version("Embree " RTC_VERSION_STRING);
-        return 2;
-    case '?':
-    default:
-        *exit_code = vt_cli_try_help();
-        return 2;
-    }
-}
-
-#define COMMON_OPTIONS                                                                       \
-    {"threads", required_argument, 0, O_THREADS}, {"quiet", no_argument, 0, 'q'},           \
-        {"help", no_argument, 0, 'h'}, {"version", no_argument, 0, 'V'}
-
-/* The one positional argument, SCENE.vdsh. */
-static const char *scene_argument(int argc, char **argv, const char *cmd)
-{
-    if (optind >= argc) {
-        vt_usage_error(PROG, "%s: no .vdsh file given", cmd);
-        return NULL;
-    }
-    if (optind + 1 < argc) {
-        vt_usage_error(PROG, "%s: one .vdsh file, not also '%s'", cmd, argv[optind + 1]);
-        return NULL;
-    }
-    return argv[optind];
-}
-
 /* ---- views ------------------------------------------------------------------------------ */
 
-static int cmd_views(int argc, char **argv)
+static int run_views(const options *op)
 {
-    common co = {0};
-    vb_frames_views_desc d = {.cameras = 6, .seed = 1, .width = 512, .height = 384};
-    const char *out = NULL;
-    static const struct option longopts[] = {
-        {"output", required_argument, 0, 'o'}, {"cameras", required_argument, 0, O_CAMERAS},
-        {"seed", required_argument, 0, O_SEED}, {"size", required_argument, 0, O_SIZE},
-        COMMON_OPTIONS, {0, 0, 0, 0}};
-    int c, code;
-    uint64_t u;
-    while ((c = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
-        switch (c) {
-        case 'o': out = optarg; break;
-        case O_CAMERAS:
-            if (!vt_parse_u64(optarg, 1, VT_VIEWS_MAX - 1, &u))
-                return bad_usage("--cameras takes a whole number 1..255, not '%s'", optarg);
-            d.cameras = (uint32_t)u;
-            break;
-        case O_SEED:
-            if (!vt_parse_u64(optarg, 1, UINT64_MAX, &d.seed))
-                return bad_usage("--seed takes a whole number >= 1, not '%s'", optarg);
-            break;
-        case O_SIZE:
-            if (!vt_parse_size(optarg, 16, 16384, &d.width, &d.height))
-                return bad_usage("--size takes WxH, each 16..16384, not '%s'", optarg);
-            break;
-        default:
-            if (common_option(c, &co, &code) == 2)
-                return code;
-        }
-    }
-    const char *path = scene_argument(argc, argv, "views");
-    if (!path)
-        return VT_EXIT_USAGE;
-    if (!out)
-        return bad_usage("%s", "views: no output given (-o VIEWS.json)");
+    const char *path = op->path, *out = op->output;
     if (vt_cli_check_outputs(&out, 1, &path, 1) != 0)
         return 1;
-    d.threads = co.threads;
+    vb_frames_views_desc d = op->views;
+    d.threads = op->threads;
 
     loaded L;
-    if (load_scene(path, co.threads, 1, &L))
+    if (load_scene(path, op->threads, 1, &L))
         return 1;
     int status = 1;
     vb_frames_view *fv = calloc(1 + (size_t)d.cameras, sizeof *fv);
@@ -365,7 +287,7 @@ static int cmd_views(int argc, char **argv)
         fprintf(stderr, PROG ": %s\n", msg);
         goto done;
     }
-    if (!co.quiet) {
+    if (!op->quiet) {
         printf(PROG " views: %s -> %s: %d views, %d x %d, seed %llu; %u candidate eyes "
                     "(%u in free space), %.2f s\n",
                path, out, set.count, d.width, d.height, (unsigned long long)d.seed,
@@ -484,50 +406,17 @@ static void sdf_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
                                           P->hits->normal + 3 * (size_t)i, P->light, P->k);
 }
 
-static int cmd_truth(int argc, char **argv)
+static int run_truth(const options *op)
 {
-    common co = {0};
-    const char *views_path = NULL, *dir = NULL;
-    uint32_t compare = VDSH_COMPARE_SMOOTH;
-    static const struct option longopts[] = {
-        {"output", required_argument, 0, 'o'}, {"views", required_argument, 0, O_VIEWS},
-        {"compare", required_argument, 0, O_COMPARE}, {"sdf", required_argument, 0, O_SDF},
-        {"sdf-k", required_argument, 0, O_SDF_K}, COMMON_OPTIONS, {0, 0, 0, 0}};
-    const char *sdf_arg = NULL;
-    float sdf_k = VDSH_SDF_DEFAULT_K;
-    int c, code;
-    while ((c = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
-        switch (c) {
-        case 'o': dir = optarg; break;
-        case O_VIEWS: views_path = optarg; break;
-        case O_SDF: sdf_arg = optarg; break;
-        case O_SDF_K:
-            if (!vt_parse_float(optarg, &sdf_k) || !(sdf_k > 0.0f && sdf_k <= 1000.0f))
-                return bad_usage("--sdf-k takes a number > 0 and <= 1000, not '%s'", optarg);
-            break;
-        case O_COMPARE:
-            compare = vdsh_compare_by_name(optarg);
-            if (compare == VDSH_COMPARE_COUNT)
-                return bad_usage("--compare takes smooth or binary, not '%s'", optarg);
-            break;
-        default:
-            if (common_option(c, &co, &code) == 2)
-                return code;
-        }
-    }
-    const char *path = scene_argument(argc, argv, "truth");
-    if (!path)
-        return VT_EXIT_USAGE;
-    if (!views_path)
-        return bad_usage("%s", "truth: no view set given (--views VIEWS.json)");
-    if (!dir)
-        return bad_usage("%s", "truth: no output folder given (-o DIR)");
-
+    const char *path = op->path, *views_path = op->views_path, *dir = op->output;
+    const char *sdf_arg = op->sdf;
+    const uint32_t compare = op->compare;
+    const float sdf_k = op->sdf_k;
     vt_views V = {0};
     if (read_views(views_path, &V))
         return 1;
     loaded L;
-    if (load_scene(path, co.threads, 1, &L)) {
+    if (load_scene(path, op->threads, 1, &L)) {
         vt_views_free(&V);
         return 1;
     }
@@ -572,7 +461,7 @@ static int cmd_truth(int argc, char **argv)
             (o || vdsh_runtime_interp(st->order, st->quantity) == VDSH_INTERP_DISTANCE)) {
             use[s] = 1;
             seen[o] = 1;
-        } else if (!co.quiet) {
+        } else if (!op->quiet) {
             char name[32];
             stream_mode(st, name, sizeof name);
             fprintf(stderr, PROG ": %s: stream %u (%s): %s\n", path, s, name,
@@ -590,14 +479,14 @@ static int cmd_truth(int argc, char **argv)
 
     double t_primary = 0.0, t_shadow = 0.0, t_streams = 0.0, t_write = 0.0, t0 = vb_now();
     int light_frames = 0, stream_frames = 0;
-    if (!co.quiet)
+    if (!op->quiet)
         printf(PROG " truth: %s, %d views from %s, %d x %d, %s comparison -> %s\n", path,
                V.count, views_path, w, h, vdsh_compare_name(compare),
                dir);
     for (int vi = 0; vi < V.count; vi++) {
         const vt_view *v = V.views + vi;
         double t = vb_now();
-        if (vb_frames_trace_primary(L.fs, &v->camera, w, h, co.threads, &hits, &err) != VB_OK) {
+        if (vb_frames_trace_primary(L.fs, &v->camera, w, h, op->threads, &hits, &err) != VB_OK) {
             fprintf(stderr, PROG ": %s: view '%s': %s\n", views_path, v->name, err.msg);
             goto done;
         }
@@ -609,7 +498,7 @@ static int cmd_truth(int argc, char **argv)
             for (int j = 0; j < v->light_count[k]; j++) {
                 const float *L0 = v->lights[k][j];
                 t = vb_now();
-                if (vb_frames_trace_light(L.fs, &hits, L0, compare, co.threads, &lights[j],
+                if (vb_frames_trace_light(L.fs, &hits, L0, compare, op->threads, &lights[j],
                                           &err) != VB_OK) {
                     fprintf(stderr, PROG ": view '%s': %s\n", v->name, err.msg);
                     goto done;
@@ -635,7 +524,7 @@ static int cmd_truth(int argc, char **argv)
                         continue;
                     float *out = streams + (size_t)s * n;
                     t = vb_now();
-                    if (vb_frames_eval_stream(L.fs, &hits, s, L0, compare, co.threads, out,
+                    if (vb_frames_eval_stream(L.fs, &hits, s, L0, compare, op->threads, out,
                                               &err) != VB_OK) {
                         fprintf(stderr, PROG ": %s: %s\n", path, err.msg);
                         goto done;
@@ -650,7 +539,7 @@ static int cmd_truth(int argc, char **argv)
                     float *out = streams + (size_t)(f->stream_count + 1) * n;
                     t = vb_now();
                     sdf_pass sp = {.v = &vol, .hits = &hits, .light = L0, .k = sdf_k, .out = out};
-                    if (!vb_parallel_for(co.threads, (uint32_t)n, 1024, sdf_block, &sp, NULL,
+                    if (!vb_parallel_for(op->threads, (uint32_t)n, 1024, sdf_block, &sp, NULL,
                                          NULL)) {
                         fprintf(stderr, PROG ": cannot start worker threads\n");
                         goto done;
@@ -662,7 +551,7 @@ static int cmd_truth(int argc, char **argv)
                     items[count++].values = out;
                 }
                 t = vb_now();
-                if (write_frames(&fb, count, co.threads))
+                if (write_frames(&fb, count, op->threads))
                     goto done;
                 t_write += vb_now() - t;
             }
@@ -690,19 +579,19 @@ static int cmd_truth(int argc, char **argv)
         vb_frames_hits_free(&hits);
         t_shadow += ts;
         t_streams += tc;
-        if (!co.quiet)
+        if (!op->quiet)
             printf("  %-10s primary %6.1f ms; %d lights: shadow %6.1f ms per light, C streams "
                    "%6.1f ms per light\n",
                    v->name, 1e3 * tp, view_lights, 1e3 * ts / (view_lights ? view_lights : 1),
                    1e3 * tc / (view_lights ? view_lights : 1));
     }
-    if (!co.quiet) {
+    if (!op->quiet) {
         double per_view = t_primary / V.count;
         double per_light = light_frames ? t_shadow / light_frames : 0.0;
         printf("  a frame's truth (%d x %d, primary + shadow ray per pixel): %.1f ms "
                "(primary %.1f + shadow %.1f) on %u threads\n",
                w, h, 1e3 * (per_view + per_light), 1e3 * per_view, 1e3 * per_light,
-               vb_parallel_threads(co.threads));
+               vb_parallel_threads(op->threads));
         printf("  C streams: %.1f ms per stream per frame; %d + %d frames written (%.2f s) in "
                "%.2f s in all\n",
                stream_frames ? 1e3 * t_streams / stream_frames : 0.0, 3 * light_frames,
@@ -816,47 +705,12 @@ static void print_row(const char *view, const char *set, int lights, const vb_fr
            100.0 * s.blotch_area);
 }
 
-static int cmd_score(int argc, char **argv)
+static int run_score(const options *op)
 {
-    common co = {0};
-    const char *views_path = NULL, *truth = NULL, *frames = NULL, *json = NULL;
-    char modes[MAX_MODES][64];
-    int mode_count = 0;
-    static const struct option longopts[] = {
-        {"views", required_argument, 0, O_VIEWS}, {"truth", required_argument, 0, O_TRUTH},
-        {"frames", required_argument, 0, O_FRAMES}, {"modes", required_argument, 0, O_MODES},
-        {"json", required_argument, 0, O_JSON}, COMMON_OPTIONS, {0, 0, 0, 0}};
-    int c, code;
-    while ((c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
-        switch (c) {
-        case O_VIEWS: views_path = optarg; break;
-        case O_TRUTH: truth = optarg; break;
-        case O_FRAMES: frames = optarg; break;
-        case O_JSON: json = optarg; break;
-        case O_MODES:
-            mode_count = parse_modes(optarg, modes);
-            if (!mode_count)
-                return bad_usage("--modes takes distinct names of letters, digits, '-' and "
-                                 "'_' separated by commas (at most 32), not '%s'", optarg);
-            break;
-        default:
-            if (common_option(c, &co, &code) == 2)
-                return code;
-        }
-    }
-    const char *path = scene_argument(argc, argv, "score");
-    if (!path)
-        return VT_EXIT_USAGE;
-    if (!views_path)
-        return bad_usage("%s", "score: no view set given (--views VIEWS.json)");
-    if (!truth)
-        return bad_usage("%s", "score: no truth folder given (--truth DIR)");
-    if (!frames)
-        return bad_usage("%s", "score: no folder of frames given (--frames DIR2)");
-    if (!mode_count)
-        return bad_usage("%s", "score: no modes given (--modes LIST)");
-    if (json && strcmp(json, "-") == 0)
-        co.quiet = 1; /* stdout is the JSON's: no table */
+    const char *path = op->path, *views_path = op->views_path, *truth = op->truth;
+    const char *frames = op->frames, *json = op->json;
+    const char(*modes)[64] = op->modes;
+    const int mode_count = op->mode_count;
     {
         const char *ins[] = {path, views_path};
         if (vt_cli_check_outputs(&json, 1, ins, 2) != 0)
@@ -867,7 +721,7 @@ static int cmd_score(int argc, char **argv)
     if (read_views(views_path, &V))
         return 1;
     loaded L = {0};
-    if (load_scene(path, co.threads, 0, &L)) {
+    if (load_scene(path, op->threads, 0, &L)) {
         vt_views_free(&V);
         return 1;
     }
@@ -932,7 +786,7 @@ static int cmd_score(int argc, char **argv)
     vt_json_u64(&j, root, "height", (uint64_t)V.height);
     vt_json_f64(&j, root, "blotch_threshold", VB_FRAMES_BLOTCH);
     cJSON *jm = vt_json_array(&j, root, "modes");
-    if (!co.quiet)
+    if (!op->quiet)
         printf(PROG " score: %s, %d views from %s, %d x %d; truth %s, frames %s\n", path,
                V.count, views_path, V.width, V.height, truth, frames);
     for (int m = 0; m < mode_count; m++) {
@@ -941,7 +795,7 @@ static int cmd_score(int argc, char **argv)
         cJSON *mo = vt_json_object(&j, jm, NULL);
         vt_json_string(&j, mo, "mode", modes[m]);
         cJSON *sets = vt_json_array(&j, mo, "sets");
-        if (!co.quiet)
+        if (!op->quiet)
             printf("\n  mode %s\n  %-10s %-3s %6s %9s  %8s %6s  %8s %6s  %7s %7s  %s\n",
                    modes[m], "view", "set", "lights", "counted", "RMSE/id", "PSNR", "RMSE/hd",
                    "PSNR", "recall", "false", "blotches");
@@ -965,7 +819,7 @@ static int cmd_score(int argc, char **argv)
                 }
                 json_scores(&j, so, &set);
                 vb_frames_tally_add(&scene, &set);
-                if (!co.quiet) {
+                if (!op->quiet) {
                     char sk[16];
                     snprintf(sk, sizeof sk, "%d", k);
                     print_row(v->name, sk, v->light_count[k], &set);
@@ -973,10 +827,10 @@ static int cmd_score(int argc, char **argv)
             }
         }
         json_scores(&j, vt_json_object(&j, mo, "scene"), &scene);
-        if (!co.quiet)
+        if (!op->quiet)
             print_row("scene", "", (int)scene.frames, &scene);
     }
-    if (!co.quiet)
+    if (!op->quiet)
         printf("\n  (over mask pixels; recall: of hard = 0 and ideal < .5, drawn < .5; false: "
                "of hard = 1, drawn < .5;\n   blotches: false-shadow regions above %.2f%% of a "
                "frame, count and area; scene row: lights = frames)\n",
@@ -999,33 +853,158 @@ done:
     return status;
 }
 
-/* ---- main ---------------------------------------------------------------------------------- */
+/* ---- the command line ---------------------------------------------------------------------- */
+
+enum { O_THREADS = 256, O_CAMERAS, O_SEED, O_SIZE, O_VIEWS, O_COMPARE, O_TRUTH, O_FRAMES,
+       O_MODES, O_JSON, O_SDF, O_SDF_K };
+
+#define COMMON_OPTIONS                                                                       \
+    {"threads", required_argument, 0, O_THREADS}, {"quiet", no_argument, 0, 'q'},           \
+        {"help", no_argument, 0, 'h'}, {"version", no_argument, 0, 'V'}
+
+static const struct option views_options[] = {
+    {"output", required_argument, 0, 'o'}, {"cameras", required_argument, 0, O_CAMERAS},
+    {"seed", required_argument, 0, O_SEED}, {"size", required_argument, 0, O_SIZE},
+    COMMON_OPTIONS, {0, 0, 0, 0}};
+static const struct option truth_options[] = {
+    {"output", required_argument, 0, 'o'}, {"views", required_argument, 0, O_VIEWS},
+    {"compare", required_argument, 0, O_COMPARE}, {"sdf", required_argument, 0, O_SDF},
+    {"sdf-k", required_argument, 0, O_SDF_K}, COMMON_OPTIONS, {0, 0, 0, 0}};
+static const struct option score_options[] = {
+    {"views", required_argument, 0, O_VIEWS}, {"truth", required_argument, 0, O_TRUTH},
+    {"frames", required_argument, 0, O_FRAMES}, {"modes", required_argument, 0, O_MODES},
+    {"json", required_argument, 0, O_JSON}, COMMON_OPTIONS, {0, 0, 0, 0}};
+
+/* The subcommands: name, getopt's name for messages, options, run. */
+static const struct command {
+    const char *name, *prog;
+    const char *shortopts;
+    const struct option *longopts;
+    int (*run)(const options *);
+} commands[] = {
+    {"views", PROG " views", "o:qhV", views_options, run_views},
+    {"truth", PROG " truth", "o:qhV", truth_options, run_truth},
+    {"score", PROG " score", "qhV", score_options, run_score},
+};
+
+/* A subcommand's option: 1, or 0 after the usage error. */
+static int take_option(int c, options *o)
+{
+    uint64_t u;
+    switch (c) {
+    case 'o': o->output = optarg; return 1;
+    case O_VIEWS: o->views_path = optarg; return 1;
+    case O_SDF: o->sdf = optarg; return 1;
+    case O_TRUTH: o->truth = optarg; return 1;
+    case O_FRAMES: o->frames = optarg; return 1;
+    case O_JSON: o->json = optarg; return 1;
+    case 'q': o->quiet = 1; return 1;
+    case O_THREADS: return vt_opt_u32("--threads", NULL, optarg, 1, 256, &o->threads);
+    case O_CAMERAS:
+        if (!vt_parse_u64(optarg, 1, VT_VIEWS_MAX - 1, &u))
+            return !bad_usage("--cameras takes a whole number 1..255, not '%s'", optarg);
+        o->views.cameras = (uint32_t)u;
+        return 1;
+    case O_SEED:
+        if (!vt_parse_u64(optarg, 1, UINT64_MAX, &o->views.seed))
+            return !bad_usage("--seed takes a whole number >= 1, not '%s'", optarg);
+        return 1;
+    case O_SIZE:
+        if (!vt_parse_size(optarg, 16, 16384, &o->views.width, &o->views.height))
+            return !bad_usage("--size takes WxH, each 16..16384, not '%s'", optarg);
+        return 1;
+    case O_SDF_K:
+        if (!vt_parse_float(optarg, &o->sdf_k) || !(o->sdf_k > 0.0f && o->sdf_k <= 1000.0f))
+            return !bad_usage("--sdf-k takes a number > 0 and <= 1000, not '%s'", optarg);
+        return 1;
+    case O_COMPARE:
+        o->compare = vdsh_compare_by_name(optarg);
+        if (o->compare == VDSH_COMPARE_COUNT)
+            return !bad_usage("--compare takes smooth or binary, not '%s'", optarg);
+        return 1;
+    case O_MODES:
+        o->mode_count = parse_modes(optarg, o->modes);
+        if (!o->mode_count)
+            return !bad_usage("--modes takes distinct names of letters, digits, '-' and "
+                              "'_' separated by commas (at most 32), not '%s'", optarg);
+        return 1;
+    }
+    return 0;
+}
+
+/* What a subcommand cannot do without: the usage error for the first
+ * missing, or 0. */
+static int missing(const options *o, const char *cmd)
+{
+    const struct { const char *cmd; int given; const char *what; } need[] = {
+        {"views", o->output != NULL, "views: no output given (-o VIEWS.json)"},
+        {"truth", o->views_path != NULL, "truth: no view set given (--views VIEWS.json)"},
+        {"truth", o->output != NULL, "truth: no output folder given (-o DIR)"},
+        {"score", o->views_path != NULL, "score: no view set given (--views VIEWS.json)"},
+        {"score", o->truth != NULL, "score: no truth folder given (--truth DIR)"},
+        {"score", o->frames != NULL, "score: no folder of frames given (--frames DIR2)"},
+        {"score", o->mode_count != 0, "score: no modes given (--modes LIST)"}};
+    for (size_t i = 0; i < sizeof need / sizeof need[0]; i++)
+        if (strcmp(need[i].cmd, cmd) == 0 && !need[i].given)
+            return bad_usage("%s", need[i].what);
+    return 0;
+}
+
+/* -1 with *o ready to run (o->run), else the exit status (help, version,
+ * a usage error: said). Each subcommand parses its own options; getopt's
+ * messages name it. */
+static int parse_args(int argc, char **argv, options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->views = (vb_frames_views_desc){.cameras = 6, .seed = 1, .width = 512, .height = 384};
+    o->compare = VDSH_COMPARE_SMOOTH;
+    o->sdf_k = VDSH_SDF_DEFAULT_K;
+    if (argc < 2)
+        return bad_usage("%s", "no subcommand given (views, truth or score)");
+    const char *name = argv[1];
+    if (strcmp(name, "-h") == 0 || strcmp(name, "--help") == 0) {
+        usage(stdout);
+        return 0;
+    }
+    if (strcmp(name, "-V") == 0 || strcmp(name, "--version") == 0)
+        return vt_cli_version("Embree " RTC_VERSION_STRING);
+    const struct command *cmd = NULL;
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (strcmp(name, commands[i].name) == 0)
+            cmd = &commands[i];
+    if (!cmd)
+        return bad_usage("unknown subcommand '%s' (views, truth or score)", name);
+    argv[1] = (char *)cmd->prog;
+    argc--, argv++;
+    optind = 1;
+    int c;
+    while ((c = getopt_long(argc, argv, cmd->shortopts, cmd->longopts, NULL)) != -1) {
+        if (c == 'h') {
+            usage(stdout);
+            return 0;
+        }
+        if (c == 'V')
+            return vt_cli_version("Embree " RTC_VERSION_STRING);
+        if (c == '?' || c == ':')
+            return vt_cli_try_help();
+        if (!take_option(c, o))
+            return VT_EXIT_USAGE;
+    }
+    o->path = vt_arg_vdsh(argc, argv, optind, cmd->name, 0);
+    if (!o->path)
+        return VT_EXIT_USAGE;
+    if (missing(o, cmd->name))
+        return VT_EXIT_USAGE;
+    if (o->json && strcmp(o->json, "-") == 0)
+        o->quiet = 1; /* stdout is the JSON's: no table */
+    o->run = cmd->run;
+    return -1;
+}
 
 int main(int argc, char **argv)
 {
     vt_cli_begin(PROG, argv);
-    if (argc < 2)
-        return bad_usage("%s", "no subcommand given (views, truth or score)");
-    const char *cmd = argv[1];
-    if (strcmp(cmd, "-h") == 0 || strcmp(cmd, "--help") == 0) {
-        usage(stdout);
-        return 0;
-    }
-    if (strcmp(cmd, "-V") == 0 || strcmp(cmd, "--version") == 0)
-        return vt_cli_version("Embree " RTC_VERSION_STRING);
-    /* Each subcommand parses its own options; getopt's messages name it. */
-    optind = 1;
-    if (strcmp(cmd, "views") == 0) {
-        argv[1] = PROG " views";
-        return cmd_views(argc - 1, argv + 1);
-    }
-    if (strcmp(cmd, "truth") == 0) {
-        argv[1] = PROG " truth";
-        return cmd_truth(argc - 1, argv + 1);
-    }
-    if (strcmp(cmd, "score") == 0) {
-        argv[1] = PROG " score";
-        return cmd_score(argc - 1, argv + 1);
-    }
-    return bad_usage("unknown subcommand '%s' (views, truth or score)", cmd);
+    options o;
+    int status = parse_args(argc, argv, &o);
+    return status >= 0 ? status : o.run(&o);
 }

@@ -243,294 +243,370 @@ static int encode_spilled(FILE *spill, const char *output, const vdsh_stream *s,
     return bad;
 }
 
-int main(int argc, char **argv)
+/* ---- the command line ---------------------------------------------------- */
+
+typedef struct options {
+    const char *output;
+    int quiet;
+    char **parts; /* the PART arguments */
+    int part_count;
+} options;
+
+/* The command line into *o: VT_CLI_RUN, or the exit status (0 after --help
+ * or --version; VT_EXIT_USAGE after saying what is wrong). */
+static int parse_args(int argc, char **argv, options *o)
 {
-    vt_cli_begin("vdsh-merge", argv);
     static const struct option longopts[] = {{"output", required_argument, 0, 'o'},
                                              {"quiet", no_argument, 0, 'q'},
-                                             {"help", no_argument, 0, 'h'},
-                                             {"version", no_argument, 0, 'V'},
-                                             {0, 0, 0, 0}};
-    const char *output = NULL;
-    int quiet = 0, c;
+                                             VT_CLI_LONGOPTS_END};
+    *o = (options){0};
+    int c;
     while ((c = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
         switch (c) {
-        case 'o': output = optarg; break;
-        case 'q': quiet = 1; break;
-        case 'h': usage(stdout); return 0;
-        case 'V': return vt_cli_version(NULL);
-        default: return vt_cli_try_help();
+        case 'o': o->output = optarg; break;
+        case 'q': o->quiet = 1; break;
+        default: return vt_cli_common_option(c, usage, NULL);
         }
     }
-    int n = argc - optind;
-    if (n < 1)
+    o->parts = argv + optind;
+    o->part_count = argc - optind;
+    if (o->part_count < 1)
         return vt_usage_error("vdsh-merge", "%s", "no part given");
-    if (!output)
+    if (!o->output)
         return vt_usage_error("vdsh-merge", "%s", "no output: give -o OUT.vdsh");
-    char **paths = argv + optind;
-    {
-        /* Every output (the file and the cubemaps that may go beside it)
-         * writable and none of them a part, before any part is read. */
-        char cube[VB_CUBEMAP_BASIS_FILES][PATH_MAX];
-        const char *outs[1 + VB_CUBEMAP_BASIS_FILES] = {output};
-        vb_error e;
-        for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
-            if (vb_output_cubemap_path(output, NULL, k, cube[k], sizeof cube[k], &e) == VB_OK)
-                outs[1 + k] = cube[k];
-        if (vt_cli_check_outputs(outs, 1 + VB_CUBEMAP_BASIS_FILES, (const char *const *)paths,
-                                 n) != 0)
-            return 1;
-    }
-    int status = 1;
-    vdsh_file *p0 = NULL, *part = NULL;
-    float *merged[VDSH_MAX_STREAMS] = {0};  /* f32 and variable: every receiver's rows */
-    uint8_t *orders[VDSH_MAX_STREAMS] = {0};    /* variable-order streams' */
-    uint32_t *offsets[VDSH_MAX_STREAMS] = {0};
-    void *encoded[VDSH_MAX_STREAMS] = {0};  /* f16, s8, s8s6: the merged stream */
-    static float amax[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS]; /* largest |c|s, zero */
+    return VT_CLI_RUN;
+}
+
+/* ---- the merge ----------------------------------------------------------- */
+
+/* The merge under way: the first part (kept, to check the others against,
+ * and for its receivers) and what the parts add to the whole file. */
+typedef struct merge {
+    vdsh_file *p0, *part;                      /* the first part; the current other one */
+    float *merged[VDSH_MAX_STREAMS];           /* f32 and variable: every receiver's rows */
+    uint8_t *orders[VDSH_MAX_STREAMS];         /* variable-order streams' */
+    uint32_t *offsets[VDSH_MAX_STREAMS];
+    void *encoded[VDSH_MAX_STREAMS];           /* f16, s8, s8s6: the merged stream */
+    float amax[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS]; /* largest |c|s, zero */
     float s8_scales[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS];
-    uint32_t target = VDSH_ENCODING_F32; /* the merged encoding */
-    FILE *spill = NULL;                  /* f16, s8, s8s6: the parts' f32 rows */
-    off_t *spill_at = NULL;              /* per shard: where its rows start */
-    int *owner = NULL;
-    float *normals = NULL;
-    uint8_t *drawn = NULL; /* per receiver, from the first part's POSN and TRIS */
-    vb_cubemap_basis basis = {0};
-    vdsh_file f = {0};
+    uint32_t target;                           /* the merged encoding */
+    FILE *spill;                               /* f16, s8, s8s6: the parts' f32 rows */
+    off_t *spill_at;                           /* per shard: where its rows start */
+    int *owner;
+    float *normals;
+    uint8_t *drawn; /* per receiver, from the first part's POSN and TRIS */
+    vb_cubemap_basis basis;
+    vdsh_file f;
     vdsh_stream streams[VDSH_MAX_STREAMS];
-    uint32_t count = 0, V = 0;
-    /* Pass 1, one part at a time (the first is kept to check the others
-     * against, and for its receivers): check every part, gather the
-     * oriented normals, the counts and, per stream, f32 rows or the
-     * largest |coefficient|s the encoding's scales are (f16: the stream's;
-     * s8, s8s6: per coefficient index). */
-    for (int i = 0; i < n; i++) {
-        vdsh_file *p = NULL;
-        if (read_part(paths[i], i ? p0 : NULL, paths[0], &p) != 0)
-            goto out;
-        if (i == 0)
-            p0 = p;
+    uint32_t count, V;
+} merge;
+
+/* The whole file from the first part, m->p0: its receivers, with every
+ * shard's coefficients and oriented normals to come. 0, or 1 after saying
+ * why. */
+static int merge_begin(merge *m, const char *output)
+{
+    m->count = m->p0->part.count;
+    m->V = m->p0->header.vertex_count;
+    m->target = m->p0->part.encoding;
+    m->f = *m->p0;
+    m->f.has_part = 0;
+    m->f.has_timings = 0;
+    m->f.storage_ = NULL;
+    m->f.streams = m->streams;
+    m->f.stats.rays_traced = m->f.stats.rays_missed = 0;
+    m->f.stats.degenerate_receivers = m->f.stats.moved_origins = m->f.stats.flipped_normals = 0;
+    int missing = !(m->owner = malloc((size_t)m->count * sizeof *m->owner)) ||
+                  !(m->normals = malloc((size_t)m->V * 12 + 1)) ||
+                  !(m->drawn = malloc((size_t)m->V + 1)) ||
+                  !(m->spill_at = malloc((size_t)m->count * sizeof *m->spill_at));
+    for (uint32_t s = 0; s < m->p0->stream_count && !missing; s++) {
+        m->streams[s] = m->p0->streams[s];
+        size_t nc = (size_t)m->streams[s].order * m->streams[s].order;
+        if (m->streams[s].flags & VDSH_STREAM_VARIABLE) /* rows of nc, zero-padded */
+            missing = !(m->merged[s] = malloc((size_t)m->V * nc * sizeof(float) + 1)) ||
+                      !(m->orders[s] = malloc((size_t)m->V + 1)) ||
+                      !(m->offsets[s] = malloc(((size_t)m->V + 1) * sizeof(uint32_t)));
+        else if (m->target == VDSH_ENCODING_F32 || m->target == VDSH_ENCODING_CPCA)
+            missing = !(m->merged[s] = malloc((size_t)m->V * nc * sizeof(float) + 1));
+        else if (m->target == VDSH_ENCODING_F16)
+            missing = !(m->encoded[s] = malloc((size_t)m->V * nc * sizeof(uint16_t) + 1));
         else
-            part = p;
-        if (i == 0) {
-            /* The whole file: the first part's, with every shard's
-             * coefficients and oriented normals. */
-            count = p0->part.count;
-            V = p0->header.vertex_count;
-            target = p0->part.encoding;
-            f = *p0;
-            f.has_part = 0;
-            f.has_timings = 0;
-            f.storage_ = NULL;
-            f.streams = streams;
-            f.stats.rays_traced = f.stats.rays_missed = 0;
-            f.stats.degenerate_receivers = f.stats.moved_origins = f.stats.flipped_normals = 0;
-            int missing = !(owner = malloc((size_t)count * sizeof *owner)) ||
-                          !(normals = malloc((size_t)V * 12 + 1)) ||
-                          !(drawn = malloc((size_t)V + 1)) ||
-                          !(spill_at = malloc((size_t)count * sizeof *spill_at));
-            for (uint32_t s = 0; s < p0->stream_count && !missing; s++) {
-                streams[s] = p0->streams[s];
-                size_t nc = (size_t)streams[s].order * streams[s].order;
-                if (streams[s].flags & VDSH_STREAM_VARIABLE) /* rows of nc, zero-padded */
-                    missing = !(merged[s] = malloc((size_t)V * nc * sizeof(float) + 1)) ||
-                              !(orders[s] = malloc((size_t)V + 1)) ||
-                              !(offsets[s] = malloc(((size_t)V + 1) * sizeof(uint32_t)));
-                else if (target == VDSH_ENCODING_F32 || target == VDSH_ENCODING_CPCA)
-                    missing = !(merged[s] = malloc((size_t)V * nc * sizeof(float) + 1));
-                else if (target == VDSH_ENCODING_F16)
-                    missing = !(encoded[s] = malloc((size_t)V * nc * sizeof(uint16_t) + 1));
-                else
-                    missing = !(encoded[s] = malloc(
-                                    (size_t)V * vdsh_encoding_bytes(target, (uint32_t)nc) + 1));
-            }
-            if (missing) {
-                fprintf(stderr, "vdsh-merge: out of memory for %u receivers\n", V);
-                goto out;
-            }
-            for (uint32_t k = 0; k < count; k++)
-                owner[k] = -1;
-            /* As vb_bake_fill_file: the receivers the s8, s8s6 scales are
-             * over (every part has the same POSN and TRIS: mismatch). */
-            vb_drawn_receivers(p0->positions, V, p0->indices, p0->header.triangle_count, drawn);
-            if (target != VDSH_ENCODING_F32 && target != VDSH_ENCODING_CPCA &&
-                !(spill = spill_create(output)))
-                goto out;
-        }
-        const vdsh_part *pt = &p->part;
-        uint32_t b, e;
-        vb_shard_range(V, pt->index, count, &b, &e);
-        if (pt->range_begin != b || pt->range_end != e) {
-            fprintf(stderr, "vdsh-merge: %s: receivers %u..%u, but shard %u of %u is %u..%u\n",
-                    paths[i], pt->range_begin, pt->range_end, pt->index, count, b, e);
-            goto out;
-        }
-        if (owner[pt->index] >= 0) {
-            fprintf(stderr, "vdsh-merge: %s: shard %u of %u again (also %s)\n", paths[i],
-                    pt->index, count, paths[owner[pt->index]]);
-            goto out;
-        }
-        owner[pt->index] = i;
-        /* Each part oriented its own range's normals, counts its own, and
-         * its streams hold its range's rows only. */
-        f.stats.rays_traced += p->stats.rays_traced;
-        f.stats.rays_missed += p->stats.rays_missed;
-        f.stats.degenerate_receivers += p->stats.degenerate_receivers;
-        f.stats.moved_origins += p->stats.moved_origins;
-        f.stats.flipped_normals += p->stats.flipped_normals;
-        memcpy(normals + 3 * (size_t)b, p->normals + 3 * (size_t)b, (size_t)(e - b) * 12);
-        if (spill)
-            spill_at[pt->index] = ftello(spill);
-        for (uint32_t s = 0; s < p->stream_count; s++) {
-            size_t nc = (size_t)streams[s].order * streams[s].order;
-            const float *src = p->streams[s].data;
-            if (orders[s]) { /* each row's own order, decoded with zeros past it */
-                memcpy(orders[s] + b, p->streams[s].orders, e - b);
-                for (uint32_t r = 0; r < e - b; r++)
-                    vdsh_stream_decode(&p->streams[s], r, merged[s] + (b + r) * nc);
-                continue;
-            }
-            if (spill && fwrite(src, nc * sizeof(float), e - b, spill) != e - b) {
-                fprintf(stderr, "vdsh-merge: cannot write the temporary file beside %s: %s\n",
-                        output, strerror(errno));
-                goto out;
-            }
-            if (target == VDSH_ENCODING_F32 || target == VDSH_ENCODING_CPCA)
-                memcpy(merged[s] + b * nc, src, (e - b) * nc * sizeof(float));
-            else if (target == VDSH_ENCODING_F16)
-                for (size_t k = 0; k < (e - b) * nc; k++)
-                    amax[s][0] = fmaxf(amax[s][0], fabsf(src[k]));
-            else
-                for (size_t r = 0; r < e - b; r++)
-                    for (size_t k = 0; k < nc && drawn[b + r]; k++)
-                        amax[s][k] = fmaxf(amax[s][k], fabsf(src[r * nc + k]));
-        }
-        vdsh_free(part);
-        part = NULL;
+            missing = !(m->encoded[s] = malloc(
+                            (size_t)m->V * vdsh_encoding_bytes(m->target, (uint32_t)nc) + 1));
     }
-    if (spill && fflush(spill) != 0) {
-        fprintf(stderr, "vdsh-merge: cannot write the temporary file beside %s: %s\n", output,
+    if (missing) {
+        fprintf(stderr, "vdsh-merge: out of memory for %u receivers\n", m->V);
+        return 1;
+    }
+    for (uint32_t k = 0; k < m->count; k++)
+        m->owner[k] = -1;
+    /* As vb_bake_fill_file: the receivers the s8, s8s6 scales are over
+     * (every part has the same POSN and TRIS: mismatch). */
+    vb_drawn_receivers(m->p0->positions, m->V, m->p0->indices, m->p0->header.triangle_count,
+                       m->drawn);
+    if (m->target != VDSH_ENCODING_F32 && m->target != VDSH_ENCODING_CPCA &&
+        !(m->spill = spill_create(output)))
+        return 1;
+    return 0;
+}
+
+/* Part i, p (read_part checked it against the first): its receiver range,
+ * once, and what it adds: counts, oriented normals and, per stream, f32
+ * rows or the largest |coefficient|s the encoding's scales are (f16: the
+ * stream's; s8, s8s6: per coefficient index). 0, or 1 after saying why. */
+static int merge_part(merge *m, const options *o, int i, const vdsh_file *p)
+{
+    const vdsh_part *pt = &p->part;
+    uint32_t b, e;
+    vb_shard_range(m->V, pt->index, m->count, &b, &e);
+    if (pt->range_begin != b || pt->range_end != e) {
+        fprintf(stderr, "vdsh-merge: %s: receivers %u..%u, but shard %u of %u is %u..%u\n",
+                o->parts[i], pt->range_begin, pt->range_end, pt->index, m->count, b, e);
+        return 1;
+    }
+    if (m->owner[pt->index] >= 0) {
+        fprintf(stderr, "vdsh-merge: %s: shard %u of %u again (also %s)\n", o->parts[i],
+                pt->index, m->count, o->parts[m->owner[pt->index]]);
+        return 1;
+    }
+    m->owner[pt->index] = i;
+    /* Each part oriented its own range's normals, counts its own, and its
+     * streams hold its range's rows only. */
+    m->f.stats.rays_traced += p->stats.rays_traced;
+    m->f.stats.rays_missed += p->stats.rays_missed;
+    m->f.stats.degenerate_receivers += p->stats.degenerate_receivers;
+    m->f.stats.moved_origins += p->stats.moved_origins;
+    m->f.stats.flipped_normals += p->stats.flipped_normals;
+    memcpy(m->normals + 3 * (size_t)b, p->normals + 3 * (size_t)b, (size_t)(e - b) * 12);
+    if (m->spill)
+        m->spill_at[pt->index] = ftello(m->spill);
+    for (uint32_t s = 0; s < p->stream_count; s++) {
+        size_t nc = (size_t)m->streams[s].order * m->streams[s].order;
+        const float *src = p->streams[s].data;
+        if (m->orders[s]) { /* each row's own order, decoded with zeros past it */
+            memcpy(m->orders[s] + b, p->streams[s].orders, e - b);
+            for (uint32_t r = 0; r < e - b; r++)
+                vdsh_stream_decode(&p->streams[s], r, m->merged[s] + (b + r) * nc);
+            continue;
+        }
+        if (m->spill && fwrite(src, nc * sizeof(float), e - b, m->spill) != e - b) {
+            fprintf(stderr, "vdsh-merge: cannot write the temporary file beside %s: %s\n",
+                    o->output, strerror(errno));
+            return 1;
+        }
+        if (m->target == VDSH_ENCODING_F32 || m->target == VDSH_ENCODING_CPCA)
+            memcpy(m->merged[s] + b * nc, src, (e - b) * nc * sizeof(float));
+        else if (m->target == VDSH_ENCODING_F16)
+            for (size_t k = 0; k < (e - b) * nc; k++)
+                m->amax[s][0] = fmaxf(m->amax[s][0], fabsf(src[k]));
+        else
+            for (size_t r = 0; r < e - b; r++)
+                for (size_t k = 0; k < nc && m->drawn[b + r]; k++)
+                    m->amax[s][k] = fmaxf(m->amax[s][k], fabsf(src[r * nc + k]));
+    }
+    return 0;
+}
+
+/* After the last part: the spill complete, and every shard there. 0, or 1
+ * after saying why. */
+static int merge_complete(merge *m, const options *o)
+{
+    if (m->spill && fflush(m->spill) != 0) {
+        fprintf(stderr, "vdsh-merge: cannot write the temporary file beside %s: %s\n", o->output,
                 strerror(errno));
-        goto out;
+        return 1;
     }
-    if ((uint32_t)n != count) {
-        fprintf(stderr, "vdsh-merge: %u of %u shards missing:", count - (uint32_t)n, count);
-        for (uint32_t k = 0, shown = 0; k < count; k++)
-            if (owner[k] < 0 && shown++ < 32)
+    if ((uint32_t)o->part_count != m->count) {
+        fprintf(stderr, "vdsh-merge: %u of %u shards missing:",
+                m->count - (uint32_t)o->part_count, m->count);
+        for (uint32_t k = 0, shown = 0; k < m->count; k++)
+            if (m->owner[k] < 0 && shown++ < 32)
                 fprintf(stderr, " %u", k);
         fprintf(stderr, "%s (rerun 'vdsh-bake ... --shard I/%u' for each)\n",
-                count - (uint32_t)n > 32 ? " ..." : "", count);
-        goto out;
+                m->count - (uint32_t)o->part_count > 32 ? " ..." : "", m->count);
+        return 1;
     }
-    f.normals = normals;
-    for (uint32_t s = 0; s < f.stream_count; s++) {
-        size_t nc = (size_t)streams[s].order * streams[s].order;
-        streams[s].data = target == VDSH_ENCODING_F32 ? (void *)merged[s] : encoded[s];
-        streams[s].encoding = target;
-        if (target == VDSH_ENCODING_CPCA) {
+    return 0;
+}
+
+/* The merged streams: cpca and variable-order streams encoded, the f16,
+ * s8 and s8s6 scales set. 0, or 1 after saying why. */
+static int merge_streams(merge *m)
+{
+    m->f.normals = m->normals;
+    for (uint32_t s = 0; s < m->f.stream_count; s++) {
+        size_t nc = (size_t)m->streams[s].order * m->streams[s].order;
+        m->streams[s].data =
+            m->target == VDSH_ENCODING_F32 ? (void *)m->merged[s] : m->encoded[s];
+        m->streams[s].encoding = m->target;
+        if (m->target == VDSH_ENCODING_CPCA) {
             /* As vb_bake_fill_file: the global step over every receiver,
              * with the merged (oriented) normals, one encoder. A
              * variable-order stream's rows (zeros past each vertex's
              * order) become a fixed stream of its cap, as cpca_variable
              * (bake/lib/job.c) writes it. */
-            vdsh_cpca_settings st = {p0->part.cpca_clusters, p0->part.cpca_basis,
-                                     p0->part.cpca_bits};
-            vdsh_stream f32 = streams[s];
+            vdsh_cpca_settings st = {m->p0->part.cpca_clusters, m->p0->part.cpca_basis,
+                                     m->p0->part.cpca_bits};
+            vdsh_stream f32 = m->streams[s];
             f32.encoding = VDSH_ENCODING_F32;
             f32.scale = 1.0f;
             f32.flags = 0;
             f32.orders = NULL;
             f32.offsets = NULL;
             f32.coef_scales = NULL;
-            f32.data = merged[s];
+            f32.data = m->merged[s];
             vdsh_error e;
-            if (vdsh_cpca_encode_stream(&f32, V, normals, &st, &streams[s], &encoded[s], NULL,
-                                        &e) != VDSH_OK) {
-                fprintf(stderr, "vdsh-merge: order %u stream: %s\n", streams[s].order, e.msg);
-                goto out;
+            if (vdsh_cpca_encode_stream(&f32, m->V, m->normals, &st, &m->streams[s],
+                                        &m->encoded[s], NULL, &e) != VDSH_OK) {
+                fprintf(stderr, "vdsh-merge: order %u stream: %s\n", m->streams[s].order, e.msg);
+                return 1;
             }
-            free(merged[s]);
-            merged[s] = NULL;
-        } else if (orders[s]) {
+            free(m->merged[s]);
+            m->merged[s] = NULL;
+        } else if (m->orders[s]) {
             /* As vb_bake_variable_stream: the same scale rule, one encoder. */
-            uint32_t e = target;
+            uint32_t e = m->target;
             float scale = 1.0f, vmax = 0.0f;
             if (e == VDSH_ENCODING_F16) {
-                for (size_t k = 0; k < (size_t)V * nc; k++)
-                    vmax = fmaxf(vmax, fabsf(merged[s][k]));
+                for (size_t k = 0; k < (size_t)m->V * nc; k++)
+                    vmax = fmaxf(vmax, fabsf(m->merged[s][k]));
                 scale = vdsh_f16_scale(vmax);
             }
-            vdsh_stream_offsets(orders[s], V, e, offsets[s]);
-            streams[s].scale = scale;
-            streams[s].orders = orders[s];
-            streams[s].offsets = offsets[s];
-            streams[s].coef_scales = vdsh_encoding_quantised(e) ? s8_scales[s] : NULL;
-            if (!(encoded[s] = malloc(4 * (size_t)offsets[s][V] + 1)) ||
-                vdsh_encode_variable_drawn(e, merged[s], nc, orders[s], V, streams[s].order,
-                                           scale, offsets[s], drawn, s8_scales[s],
-                                           encoded[s]) != VDSH_OK) {
+            vdsh_stream_offsets(m->orders[s], m->V, e, m->offsets[s]);
+            m->streams[s].scale = scale;
+            m->streams[s].orders = m->orders[s];
+            m->streams[s].offsets = m->offsets[s];
+            m->streams[s].coef_scales = vdsh_encoding_quantised(e) ? m->s8_scales[s] : NULL;
+            if (!(m->encoded[s] = malloc(4 * (size_t)m->offsets[s][m->V] + 1)) ||
+                vdsh_encode_variable_drawn(e, m->merged[s], nc, m->orders[s], m->V,
+                                           m->streams[s].order, scale, m->offsets[s], m->drawn,
+                                           m->s8_scales[s], m->encoded[s]) != VDSH_OK) {
                 fprintf(stderr, "vdsh-merge: adaptive-order coefficients do not fit %s\n",
                         vdsh_encoding_name(e));
-                goto out;
+                return 1;
             }
-            free(merged[s]);
-            merged[s] = NULL;
-            streams[s].data = encoded[s];
-        } else if (target == VDSH_ENCODING_F16) {
+            free(m->merged[s]);
+            m->merged[s] = NULL;
+            m->streams[s].data = m->encoded[s];
+        } else if (m->target == VDSH_ENCODING_F16) {
             /* As vb_bake_stream: the same scale rule, vdsh_f16_scale. */
-            streams[s].scale = vdsh_f16_scale(amax[s][0]);
-        } else if (vdsh_encoding_quantised(target)) {
-            streams[s].scale = 1.0f;
-            streams[s].coef_scales = s8_scales[s];
+            m->streams[s].scale = vdsh_f16_scale(m->amax[s][0]);
+        } else if (vdsh_encoding_quantised(m->target)) {
+            m->streams[s].scale = 1.0f;
+            m->streams[s].coef_scales = m->s8_scales[s];
         }
     }
-    /* Pass 2 (f16, s8, s8s6): each range's rows back from the spill,
-     * encoded into the merged streams with the scales of all receivers, as
-     * vdsh-bake encodes the whole bake's. */
-    for (uint32_t k = 0; k < count && spill; k++) {
+    return 0;
+}
+
+/* Pass 2 (f16, s8, s8s6): each range's rows back from the spill, encoded
+ * into the merged streams with the scales of all receivers, as vdsh-bake
+ * encodes the whole bake's. 0, or 1 after saying why. */
+static int merge_spilled(merge *m, const char *output)
+{
+    for (uint32_t k = 0; k < m->count && m->spill; k++) {
         uint32_t b, e;
-        vb_shard_range(V, k, count, &b, &e);
-        if (fseeko(spill, spill_at[k], SEEK_SET) != 0) {
+        vb_shard_range(m->V, k, m->count, &b, &e);
+        if (fseeko(m->spill, m->spill_at[k], SEEK_SET) != 0) {
             fprintf(stderr, "vdsh-merge: cannot read back the temporary file beside %s\n",
                     output);
-            goto out;
+            return 1;
         }
-        for (uint32_t s = 0; s < f.stream_count; s++)
-            if (!orders[s] && encode_spilled(spill, output, &streams[s], encoded[s], b, e,
-                                             drawn, amax[s], s8_scales[s]) != 0)
-                goto out;
+        for (uint32_t s = 0; s < m->f.stream_count; s++)
+            if (!m->orders[s] && encode_spilled(m->spill, output, &m->streams[s], m->encoded[s],
+                                                b, e, m->drawn, m->amax[s],
+                                                m->s8_scales[s]) != 0)
+                return 1;
     }
+    return 0;
+}
 
-    /* The basis cubemaps (the whole bake writes them beside its file) and
-     * the file, all or none. */
+/* The basis cubemaps (the whole bake writes them beside its file) and the
+ * file, all or none. 0, or 1 after saying why. */
+static int merge_write(merge *m, const options *o)
+{
     vb_error err;
-    if (f.header.cube_size > 0 &&
-        vb_cubemap_basis_encode((int)f.header.cube_size, &basis, &err) != VB_OK) {
+    if (m->f.header.cube_size > 0 &&
+        vb_cubemap_basis_encode((int)m->f.header.cube_size, &m->basis, &err) != VB_OK) {
         fprintf(stderr, "vdsh-merge: %s\n", err.msg);
-        goto out;
+        return 1;
     }
     uint64_t bytes = 0;
-    if (vb_write_outputs(&f, output, NULL, f.header.cube_size > 0 ? &basis : NULL, &bytes,
-                         &err) != VB_OK) {
+    if (vb_write_outputs(&m->f, o->output, NULL, m->f.header.cube_size > 0 ? &m->basis : NULL,
+                         &bytes, &err) != VB_OK) {
         fprintf(stderr, "vdsh-merge: %s\n", err.msg);
-        goto out;
+        return 1;
     }
-    if (!quiet)
-        fprintf(stderr, "vdsh-merge: wrote %s (%u shards, %u receivers, %.2f MB)\n", output,
-                count, V, bytes / 1e6);
-    status = 0;
+    if (!o->quiet)
+        fprintf(stderr, "vdsh-merge: wrote %s (%u shards, %u receivers, %.2f MB)\n", o->output,
+                m->count, m->V, bytes / 1e6);
+    return 0;
+}
 
-out:
-    vb_cubemap_basis_free(&basis);
+static void merge_free(merge *m)
+{
+    vb_cubemap_basis_free(&m->basis);
     for (int s = 0; s < VDSH_MAX_STREAMS; s++)
-        free(merged[s]), free(encoded[s]), free(orders[s]), free(offsets[s]);
-    if (spill)
-        fclose(spill);
-    free(spill_at);
-    free(owner);
-    free(normals);
-    free(drawn);
-    vdsh_free(part);
-    vdsh_free(p0);
+        free(m->merged[s]), free(m->encoded[s]), free(m->orders[s]), free(m->offsets[s]);
+    if (m->spill)
+        fclose(m->spill);
+    free(m->spill_at);
+    free(m->owner);
+    free(m->normals);
+    free(m->drawn);
+    vdsh_free(m->part);
+    vdsh_free(m->p0);
+}
+
+/* Every output (the file and the cubemaps that may go beside it) writable
+ * and none of them a part, before any part is read. 0, or 1 after saying
+ * why. */
+static int check_outputs(const options *o)
+{
+    char cube[VB_CUBEMAP_BASIS_FILES][PATH_MAX];
+    const char *outs[1 + VB_CUBEMAP_BASIS_FILES] = {o->output};
+    vb_error e;
+    for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
+        if (vb_output_cubemap_path(o->output, NULL, k, cube[k], sizeof cube[k], &e) == VB_OK)
+            outs[1 + k] = cube[k];
+    return vt_cli_check_outputs(outs, 1 + VB_CUBEMAP_BASIS_FILES,
+                                (const char *const *)o->parts, o->part_count) != 0;
+}
+
+/* Pass 1, one part at a time, then the streams, pass 2 and the files: the
+ * exit status (0 merged, 1 refused or failed: said on stderr). */
+static int run(const options *o)
+{
+    if (check_outputs(o) != 0)
+        return 1;
+    merge m = {0};
+    int status = 1;
+    for (int i = 0; i < o->part_count; i++) {
+        vdsh_file *p = NULL;
+        if (read_part(o->parts[i], i ? m.p0 : NULL, o->parts[0], &p) != 0)
+            goto out;
+        if (i == 0)
+            m.p0 = p;
+        else
+            m.part = p;
+        if ((i == 0 && merge_begin(&m, o->output) != 0) || merge_part(&m, o, i, p) != 0)
+            goto out;
+        vdsh_free(m.part);
+        m.part = NULL;
+    }
+    if (merge_complete(&m, o) == 0 && merge_streams(&m) == 0 &&
+        merge_spilled(&m, o->output) == 0 && merge_write(&m, o) == 0)
+        status = 0;
+out:
+    merge_free(&m);
     return status;
+}
+
+int main(int argc, char **argv)
+{
+    vt_cli_begin("vdsh-merge", argv);
+    options o;
+    int status = parse_args(argc, argv, &o);
+    return status == VT_CLI_RUN ? run(&o) : status;
 }

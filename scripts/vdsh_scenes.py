@@ -1,0 +1,49 @@
+"""The test and validation scenes: one list that the scripts share.
+
+Test scenes are the ones docs/ACCURACY.md reports (the built-in room,
+Cornell-Original, Sponza); defaults are chosen on the validation scenes
+only (never on a test scene): the seeded rooms builtin:room:N and meshes of
+other kinds. Each scene is (name, mesh, max_edge): the name the tables
+use, what vdsh-bake reads, and the receivers' refinement as vdsh-bake's
+--max-edge text ("0": the mesh's own vertices). A script that needs a
+subset or another edge derives it from these lists, so that a scene is
+named and found in one place.
+
+Third-party meshes live outside the repository (../shared/scenes, Debian's
+assimp-testmodels); scripts skip or refuse those that are absent.
+"""
+import os
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SHARED = os.path.join(ROOT, "..", "shared", "scenes")
+ASSIMP = "/usr/share/assimp/models"
+
+CORNELL = os.path.join(SHARED, "cornell_box", "CornellBox-Original.obj")
+SPONZA = os.path.join(SHARED, "sponza_dabrovic", "sponza.obj")
+LOST_EMPIRE = os.path.join(SHARED, "lost_empire", "lost_empire.obj")
+ENGINE = os.path.join(ASSIMP, "glTF2", "2CylinderEngine-glTF-Binary", "2CylinderEngine.glb")
+
+# The reported scenes.
+TEST = [("room", "builtin:room", "0.2"),
+        ("cornell", CORNELL, "0.05"),
+        ("sponza", SPONZA, "0.5")]
+
+# Validation: the seeded rooms (furnished interiors of other sizes and
+# layouts) ...
+ROOMS = [("val-room-%d" % n, "builtin:room:%d" % n, "0.25") for n in range(1, 9)]
+# ... and meshes unlike them.
+MESHES = [
+    ("teapot", os.path.join(SHARED, "teapot_newell", "teapot.obj"), "0.1"),
+    ("rocker-arm", os.path.join(SHARED, "rocker_arm", "rocker-arm.obj"), "0.02"),
+    ("fandisk", os.path.join(SHARED, "fandisk", "fandisk.obj"), "0.1"),
+    ("lost-empire", LOST_EMPIRE, "0"),
+    ("cornell-sphere", os.path.join(SHARED, "cornell_box", "CornellBox-Sphere.obj"), "0.1"),
+    ("bunny", os.path.join(SHARED, "bunny_stanford", "bun_zipper_res2.ply"), "0"),
+    ("spider", os.path.join(ASSIMP, "OBJ", "spider.obj"), "0"),
+]
+VALIDATION = ROOMS + MESHES
+
+
+def by_name(scenes):
+    """{name: (mesh, max_edge)} of a list above."""
+    return {name: (mesh, edge) for name, mesh, edge in scenes}
