@@ -4,6 +4,7 @@
  * receivers (vdsh_export_source.h).
  */
 #include "vdsh_export_source.h"
+#include "vdsh_math.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -253,19 +254,6 @@ static double *read_vec3(const char *path, const vdsh_src *s, int ai, size_t *co
 
 typedef double mat4[16];
 
-static void mul(const double *a, const double *b, double *c)
-{
-    double t[16];
-    for (int i = 0; i < 4; i++)
-        for (int j = 0; j < 4; j++) {
-            double s = 0;
-            for (int k = 0; k < 4; k++)
-                s += a[k * 4 + i] * b[j * 4 + k];
-            t[j * 4 + i] = s;
-        }
-    memcpy(c, t, sizeof t);
-}
-
 /* mesh_gltf.cpp's node_matrix, the same operations in the same order. */
 static void node_matrix(const cJSON *n, double *m)
 {
@@ -277,28 +265,18 @@ static void node_matrix(const cJSON *n, double *m)
             m[i] = cJSON_GetNumberValue(cJSON_GetArrayItem(mx, i));
         return;
     }
-    double t[16], r[16], s[16], rs[16];
-    memcpy(t, id, sizeof id), memcpy(r, id, sizeof id), memcpy(s, id, sizeof id);
+    double t[3], q[4], s[3];
     const cJSON *tr = cJSON_GetObjectItemCaseSensitive(n, "translation");
     const cJSON *ro = cJSON_GetObjectItemCaseSensitive(n, "rotation");
     const cJSON *sc = cJSON_GetObjectItemCaseSensitive(n, "scale");
-    if (cJSON_GetArraySize(tr) == 3)
-        for (int k = 0; k < 3; k++)
-            t[12 + k] = cJSON_GetNumberValue(cJSON_GetArrayItem(tr, k));
-    if (cJSON_GetArraySize(ro) == 4) {
-        double x = cJSON_GetNumberValue(cJSON_GetArrayItem(ro, 0)), y = cJSON_GetNumberValue(cJSON_GetArrayItem(ro, 1));
-        double z = cJSON_GetNumberValue(cJSON_GetArrayItem(ro, 2)), w = cJSON_GetNumberValue(cJSON_GetArrayItem(ro, 3));
-        const double q[16] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0,
-                              2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0,
-                              2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0,
-                              0, 0, 0, 1};
-        memcpy(r, q, sizeof q);
+    for (int k = 0; k < 3; k++) {
+        t[k] = cJSON_GetNumberValue(cJSON_GetArrayItem(tr, k));
+        s[k] = cJSON_GetNumberValue(cJSON_GetArrayItem(sc, k));
     }
-    if (cJSON_GetArraySize(sc) == 3)
-        for (int k = 0; k < 3; k++)
-            s[5 * k] = cJSON_GetNumberValue(cJSON_GetArrayItem(sc, k));
-    mul(r, s, rs);
-    mul(t, rs, m);
+    for (int k = 0; k < 4; k++)
+        q[k] = cJSON_GetNumberValue(cJSON_GetArrayItem(ro, k));
+    vdsh_mat4d_trs(cJSON_GetArraySize(tr) == 3 ? t : NULL, cJSON_GetArraySize(ro) == 4 ? q : NULL,
+                   cJSON_GetArraySize(sc) == 3 ? s : NULL, m);
 }
 
 typedef struct walk {
@@ -373,9 +351,7 @@ static int map_prim(walk *w, int node, int mesh, int pi, const cJSON *prim, cons
             double t[3];
             for (int r = 0; r < 3; r++)
                 t[r] = cof[3 * r] * nq[0] + cof[3 * r + 1] * nq[1] + cof[3 * r + 2] * nq[2];
-            double l = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-            for (int r = 0; r < 3; r++)
-                nv[r] = l > 0 && isfinite(l) ? (float)(t[r] / l) : 0.0f;
+            vdsh_unit3d_to_f(t, nv);
         }
         /* the receivers at this exact position: the closest normal, an
          * unused one first among equals (duplicated vertices in order) */
@@ -412,7 +388,7 @@ static int visit(walk *w, int node, const double *parent, uint8_t *on_path, int 
     on_path[node] = 1;
     double local[16], m[16];
     node_matrix(n, local);
-    mul(parent, local, m);
+    vdsh_mat4d_mul(parent, local, m);
     int mesh = (int)num(n, "mesh", -1);
     if (mesh >= 0 && cJSON_GetObjectItemCaseSensitive(n, "skin") == NULL) {
         cJSON *me = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(w->s->json, "meshes"), mesh);

@@ -16,6 +16,7 @@
 #include "parallel.h"
 #include "sampling.h"
 #include "vdsh_light.h"
+#include "vdsh_math.h"
 #include "vdsh_shadow.h"
 
 #define NONE UINT32_MAX
@@ -29,18 +30,6 @@ enum {
     PURPOSE_LIGHTS = 0x4c475453u, /* "LGTS" */
     PURPOSE_ORDER = 0x4f524452u   /* "ORDR" */
 };
-
-static float dot3(const float a[3], const float b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(float o[3], const float a[3], const float b[3])
-{
-    o[0] = a[1] * b[2] - a[2] * b[1];
-    o[1] = a[2] * b[0] - a[0] * b[2];
-    o[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 /* ---- the receiver scene ---------------------------------------------------- */
 
@@ -202,9 +191,9 @@ static void primary_block(void *ctx, uint32_t begin, uint32_t end, unsigned work
             float e1[3], e2[3], ng[3];
             for (int q = 0; q < 3; q++)
                 e1[q] = bb[q] - a[q], e2[q] = c[q] - a[q];
-            cross3(ng, e1, e2);
-            float len = sqrtf(dot3(ng, ng));
-            float sign = dot3(ng, dirs[k]) > 0.0f ? -1.0f : 1.0f;
+            vdsh_cross3f(ng, e1, e2);
+            float len = sqrtf(vdsh_dot3f(ng, ng));
+            float sign = vdsh_dot3f(ng, dirs[k]) > 0.0f ? -1.0f : 1.0f;
             for (int q = 0; q < 3; q++)
                 ng[q] = len > 0.0f ? sign * ng[q] / len : 0.0f;
             float local[3];
@@ -293,10 +282,10 @@ static void light_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker
                 continue;
             const float *p = h->position + 3 * i, *o = h->origin + 3 * i;
             float v[3] = {L[0] - p[0], L[1] - p[1], L[2] - p[2]};
-            dl[k] = sqrtf(dot3(v, v));
+            dl[k] = sqrtf(vdsh_dot3f(v, v));
             /* The truth ray runs from the origin to the light itself. */
             float ol[3] = {Ll[0] - o[0], Ll[1] - o[1], Ll[2] - o[2]};
-            float dlocal = sqrtf(dot3(ol, ol));
+            float dlocal = sqrtf(vdsh_dot3f(ol, ol));
             if (!(dl[k] > 0.0f) || !(dlocal > 0.0f))
                 continue;
             rh.ray.org_x[k] = o[0], rh.ray.org_y[k] = o[1], rh.ray.org_z[k] = o[2];
@@ -328,7 +317,7 @@ static void light_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker
             l->dt[i] = dt;
             l->hard[i] = vdsh_shadow_compare(dt, dl[k], VDSH_COMPARE_BINARY);
             l->ideal[i] = vdsh_shadow_compare(dt, dl[k], P->compare);
-            l->mask[i] = dot3(n, v) > 0.0f ? 1.0f : 0.0f;
+            l->mask[i] = vdsh_dot3f(n, v) > 0.0f ? 1.0f : 0.0f;
         }
     }
 }
@@ -527,9 +516,9 @@ void vb_frames_shade(const vb_frames_hits *h, const float (*lights)[3], int n,
         float acc = 0.0f;
         for (int j = 0; j < n; j++) {
             float lv[3] = {lights[j][0] - p[0], lights[j][1] - p[1], lights[j][2] - p[2]};
-            float dl = sqrtf(dot3(lv, lv));
+            float dl = sqrtf(vdsh_dot3f(lv, lv));
             /* runtime/vr_glsl.c's light_term, attenuation (1, 0, 1 / r^2) */
-            float ndl = dl > 0.0f ? fmaxf(dot3(nn, lv) / dl, 0.0f) : 1.0f;
+            float ndl = dl > 0.0f ? fmaxf(vdsh_dot3f(nn, lv) / dl, 0.0f) : 1.0f;
             float att = 1.0f / (1.0f + dl * dl * inv_r2);
             acc += vis[j][i] * sh->intensity * ndl * att;
         }

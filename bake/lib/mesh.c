@@ -1,12 +1,13 @@
 /*
  * mesh.c - loading (dispatch, file bytes, hashing, validation and
  * cleaning), welding, normals, appending, bounds and OBJ output for
- * vb_mesh. Reading a file's bytes into arrays is mesh_parse.cpp's
- * (mesh_parse.h); refinement, the one part on OpenMesh, is
+ * vb_mesh. Reading a file's bytes into arrays is mesh_parse.cpp's and
+ * its readers' (mesh_parse.h); refinement, the one part on OpenMesh, is
  * mesh_refine.cpp's; SHA-256 is nettle's.
  */
 #include "mesh.h"
 #include "mesh_parse.h"
+#include "vdsh_math.h"
 #include "vdsh_output.h"
 
 #include <nettle/sha2.h>
@@ -737,13 +738,8 @@ static void unit_double(const float *n, double u[3])
  * unit to float precision, else scaled to unit length. */
 static void unit_float(const float *n, float out[3])
 {
-    double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-    if (fabs(len - 1.0) <= 4.0 * FLT_EPSILON) {
-        memcpy(out, n, 3 * sizeof(float));
-        return;
-    }
-    for (int k = 0; k < 3; k++)
-        out[k] = len > 0.0 && isfinite(len) ? (float)(n[k] / len) : 0.0f;
+    memcpy(out, n, 3 * sizeof(float));
+    vdsh_unit3f_keep(out);
 }
 
 #define MAX_GROUPS 256

@@ -30,7 +30,8 @@
 
 #include <tiny_gltf.h>
 
-#include "mesh_parse.h"
+#include "mesh_read.h"
+#include "vdsh_math.h"
 
 namespace {
 
@@ -211,14 +212,8 @@ typedef std::array<double, 16> mat4; /* column-major, as glTF */
 
 mat4 mul(const mat4 &a, const mat4 &b)
 {
-    mat4 c{};
-    for (int i = 0; i < 4; i++)
-        for (int j = 0; j < 4; j++) {
-            double s = 0;
-            for (int k = 0; k < 4; k++)
-                s += a[(size_t)(k * 4 + i)] * b[(size_t)(j * 4 + k)];
-            c[(size_t)(j * 4 + i)] = s;
-        }
+    mat4 c;
+    vdsh_mat4d_mul(a.data(), b.data(), c.data());
     return c;
 }
 
@@ -230,19 +225,10 @@ mat4 node_matrix(const tinygltf::Node &n)
             m[i] = n.matrix[i];
         return m;
     }
-    mat4 t = m, r = m, s = m;
-    if (n.translation.size() == 3)
-        t[12] = n.translation[0], t[13] = n.translation[1], t[14] = n.translation[2];
-    if (n.rotation.size() == 4) {
-        double x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
-        r = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0,
-             2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0,
-             2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0,
-             0, 0, 0, 1};
-    }
-    if (n.scale.size() == 3)
-        s[0] = n.scale[0], s[5] = n.scale[1], s[10] = n.scale[2];
-    return mul(t, mul(r, s));
+    vdsh_mat4d_trs(n.translation.size() == 3 ? n.translation.data() : nullptr,
+                   n.rotation.size() == 4 ? n.rotation.data() : nullptr,
+                   n.scale.size() == 3 ? n.scale.data() : nullptr, m.data());
+    return m;
 }
 
 struct out_mesh {
@@ -301,9 +287,9 @@ vb_result add_primitive(const reader &rd, const tinygltf::Primitive &p, const ma
             double t[3];
             for (int r3 = 0; r3 < 3; r3++)
                 t[r3] = cof[3 * r3] * n[0] + cof[3 * r3 + 1] * n[1] + cof[3 * r3 + 2] * n[2];
-            double l = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-            for (int r3 = 0; r3 < 3; r3++)
-                o.nrm.push_back(l > 0 && std::isfinite(l) ? (float)(t[r3] / l) : 0.0f);
+            float u[3];
+            vdsh_unit3d_to_f(t, u);
+            o.nrm.insert(o.nrm.end(), {u[0], u[1], u[2]});
             o.has_n.push_back(1);
         } else {
             o.nrm.insert(o.nrm.end(), {0.0f, 0.0f, 0.0f});
@@ -385,16 +371,6 @@ bool no_images(tinygltf::Image *, const int, std::string *, std::string *, int, 
     return true;
 }
 
-template <class T> T *copy_out(const std::vector<T> &v)
-{
-    T *p = (T *)malloc(v.empty() ? 1 : v.size() * sizeof(T));
-    if (!p)
-        throw std::bad_alloc();
-    if (!v.empty())
-        memcpy(p, v.data(), v.size() * sizeof(T));
-    return p;
-}
-
 vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, size_t size, vb_mesh_raw *out,
                 vb_error *err)
 {
@@ -451,18 +427,18 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     raw.gltf_skipped_morph = o.skipped_morph;
     raw.gltf_skipped_skin = o.skipped_skin;
     try {
-        raw.positions = copy_out(o.pos);
-        raw.indices = copy_out(o.idx);
+        raw.positions = vb_read::malloc_copy(o.pos);
+        raw.indices = vb_read::malloc_copy(o.idx);
         std::vector<uint32_t> faces(raw.triangle_count);
         for (uint32_t t = 0; t < raw.triangle_count; t++)
             faces[t] = t;
-        raw.faces = copy_out(faces);
+        raw.faces = vb_read::malloc_copy(faces);
         bool any = false;
         for (uint8_t h : o.has_n)
             any = any || h;
         if (any) {
-            raw.normals = copy_out(o.nrm);
-            raw.has_normal = copy_out(o.has_n);
+            raw.normals = vb_read::malloc_copy(o.nrm);
+            raw.has_normal = vb_read::malloc_copy(o.has_n);
         }
     } catch (...) {
         vb_mesh_raw_free(&raw);
@@ -480,13 +456,6 @@ extern "C" vb_result vb_mesh_parse_gltf(const char *name, int binary, int scene,
     if (!name || (!bytes && size) || !out)
         return vb_fail(err, VB_ERR_ARGUMENT, "vb_mesh_parse_gltf: NULL argument");
     static const uint8_t nothing = 0;
-    try {
-        return parse(name, binary, scene, bytes ? bytes : &nothing, size, out, err);
-    } catch (const std::bad_alloc &) {
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory while reading", name);
-    } catch (const std::exception &e) {
-        return vb_fail(err, VB_ERR_FORMAT, "%s: reading failed: %s", name, e.what());
-    } catch (...) {
-        return vb_fail(err, VB_ERR_FORMAT, "%s: reading failed with an unknown exception", name);
-    }
+    const uint8_t *b = bytes ? bytes : &nothing;
+    return vb_read::no_throw(name, err, [&] { return parse(name, binary, scene, b, size, out, err); });
 }

@@ -7,7 +7,7 @@
  * (the edges around a vertex, the faces on an edge, splitting an edge and
  * both its triangles), and its refusal of non-manifold faces is what tells
  * which triangles get private vertices. Reading files does not use it
- * (mesh_parse.cpp).
+ * (mesh_parse.cpp, mesh_obj/ply/off/stl.cpp).
  *
  * OpenMesh prints warnings (a refused face: "complex edge") to its
  * omerr/omlog/omout streams, which forward to std::cerr/clog/cout. While
@@ -40,6 +40,8 @@
 #include <queue>
 #include <string>
 #include <vector>
+
+#include "vdsh_math.h"
 
 namespace {
 
@@ -142,11 +144,6 @@ void cross3(const om_mesh::Point &a, const om_mesh::Point &b, const om_mesh::Poi
     x[2] = u[0] * v[1] - u[1] * v[0];
 }
 
-double dot3(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
 /* Flips mend slivers only: an edge whose two triangles both have an aspect
  * of at most this is left as it is. Longest-edge bisection of a
  * well-shaped triangle stays well shaped (its right-isosceles halves are
@@ -189,8 +186,8 @@ bool should_flip(const om_mesh &m, om_mesh::EdgeHandle e)
     double x0[3], x1[3];
     cross3(a, b, c0, x0);
     cross3(b, a, c1, x1);
-    double s0 = std::sqrt(dot3(x0, x0)), s1 = std::sqrt(dot3(x1, x1));
-    if (!(s0 > 0.0) || !(s1 > 0.0) || dot3(x0, x1) < flat_cos * (s0 * s1))
+    double s0 = std::sqrt(vdsh_dot3d(x0, x0)), s1 = std::sqrt(vdsh_dot3d(x1, x1));
+    if (!(s0 > 0.0) || !(s1 > 0.0) || vdsh_dot3d(x0, x1) < flat_cos * (s0 * s1))
         return false; /* a crease, or a face without area */
     /* Aspect (sqrt(3) L^2 / (4 A), A = s / 2) of both: well shaped already,
      * bisection keeps them so. */
@@ -274,13 +271,6 @@ private:
     std::vector<uint32_t> vals_;
     size_t mask_ = 0;
 };
-
-void normalize3(float *n)
-{
-    double len = std::sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-    for (int k = 0; k < 3; k++)
-        n[k] = len > 0.0 && std::isfinite(len) ? (float)(n[k] / len) : 0.0f;
-}
 
 /* The half-edge mesh of `in`: its vertices, then private copies of the
  * vertices of each triangle the half-edge structure refuses (as OpenMesh's
@@ -366,7 +356,7 @@ vb_result emit_mesh(const vb_mesh *in, const om_mesh &m, const std::vector<uint3
         float nn[3];
         for (int q = 0; q < 3; q++)
             nn[q] = nrm[3 * (size_t)pa + (size_t)q] + nrm[3 * (size_t)pb + (size_t)q];
-        normalize3(nn);
+        vdsh_normalize3f_in_double(nn);
         nrm.insert(nrm.end(), nn, nn + 3);
     }
     std::vector<uint32_t> idx;

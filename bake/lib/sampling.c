@@ -1,4 +1,5 @@
 #include "sampling.h"
+#include "vdsh_math.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -77,7 +78,7 @@ static void sphere_dir(const vb_dirgrid *g, double w, double c, double d[3])
 
 static double angle(const double a[3], const double b[3])
 {
-    double d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    double d = vdsh_dot3d(a, b);
     return acos(fmax(-1.0, fmin(1.0, d)));
 }
 
