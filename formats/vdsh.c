@@ -15,12 +15,10 @@
 /* Messages                                                            */
 /* ------------------------------------------------------------------ */
 
-vdsh_result vdsh_failf_at(vdsh_error *err, vdsh_result r, const char *name, const char *fmt,
-                          ...)
+vdsh_result vdsh_failf_at(vdsh_error *err, vdsh_result r, const char *name, const char *fmt, ...)
 {
     if (err) {
-        int n = snprintf(err->msg, sizeof err->msg, "%s: ",
-                         name ? name : "memory");
+        int n = snprintf(err->msg, sizeof err->msg, "%s: ", name ? name : "memory");
         if (n < 0 || (size_t)n >= sizeof err->msg)
             n = 0;
         va_list ap;
@@ -75,16 +73,25 @@ static const char *name_of(uint32_t v, const char *const *names, size_t n)
 
 const char *vdsh_method_name(uint32_t method)
 {
-    static const char *const n[] = {[VDSH_METHOD_PAPER] = "paper", [VDSH_METHOD_FULL] = "full",
-                                    [VDSH_METHOD_MIRROR] = "mirror", [VDSH_METHOD_LSQ] = "lsq",
-                                    [VDSH_METHOD_SHADOW] = "shadow",
-                                    [VDSH_METHOD_DECISION] = "decision"};
+    static const char *const n[] = {
+        [VDSH_METHOD_PAPER] = "paper",   [VDSH_METHOD_FULL] = "full",
+        [VDSH_METHOD_MIRROR] = "mirror", [VDSH_METHOD_LSQ] = "lsq",
+        [VDSH_METHOD_SHADOW] = "shadow", [VDSH_METHOD_DECISION] = "decision"};
     return NAME_OF(method, n);
 }
 
-static size_t bytes_f32(uint32_t nc) { return (size_t)nc * 4; }
-static size_t bytes_f16(uint32_t nc) { return (size_t)nc * 2; }
-static size_t bytes_s8(uint32_t nc) { return nc; }
+static size_t bytes_f32(uint32_t nc)
+{
+    return (size_t)nc * 4;
+}
+static size_t bytes_f16(uint32_t nc)
+{
+    return (size_t)nc * 2;
+}
+static size_t bytes_s8(uint32_t nc)
+{
+    return nc;
+}
 static size_t bytes_s8s6(uint32_t nc)
 {
     return nc <= VDSH_S8S6_BYTES
@@ -92,7 +99,11 @@ static size_t bytes_s8s6(uint32_t nc)
                : VDSH_S8S6_BYTES + 4 * (size_t)((nc - VDSH_S8S6_BYTES + VDSH_S8S6_PER_WORD - 1) /
                                                 VDSH_S8S6_PER_WORD);
 }
-static size_t bytes_model(uint32_t nc) { (void)nc; return 0; }
+static size_t bytes_model(uint32_t nc)
+{
+    (void)nc;
+    return 0;
+}
 
 static const vdsh_encoding_info encodings[] = {
     {"f16", VDSH_ENCODING_F16, bytes_f16, "IEEE half floats, one scale per stream"},
@@ -135,7 +146,9 @@ const char *vdsh_encoding_names(void)
         size_t at = 0;
         for (size_t i = 0; i < ENCODING_COUNT; i++)
             at += (size_t)snprintf(text + at, sizeof text - at, "%s%s",
-                                   i == 0 ? "" : i + 1 == ENCODING_COUNT ? " or " : ", ",
+                                   i == 0                    ? ""
+                                   : i + 1 == ENCODING_COUNT ? " or "
+                                                             : ", ",
                                    encodings[i].name);
     }
     return text;
@@ -175,46 +188,56 @@ const char *vdsh_offset_rule_name(uint32_t rule)
 /* The fixed-size headers' and chunks' fields (VDSH.md)               */
 /* ------------------------------------------------------------------ */
 
-#define FIELD(off, st, member) \
-    {(off), (uint8_t)sizeof(((st *)0)->member), (uint16_t)offsetof(st, member)}
+#define FIELD(off, st, member)                                                                     \
+    {                                                                                              \
+        (off), (uint8_t)sizeof(((st *)0)->member), (uint16_t)offsetof(st, member)                  \
+    }
 
 static const vdsh_field stat_fields[] = {
-    FIELD(0, vdsh_stats, rays_traced), FIELD(8, vdsh_stats, rays_missed),
+    FIELD(0, vdsh_stats, rays_traced),           FIELD(8, vdsh_stats, rays_missed),
     FIELD(16, vdsh_stats, degenerate_receivers), FIELD(20, vdsh_stats, undefined_normals),
-    FIELD(24, vdsh_stats, moved_origins), FIELD(28, vdsh_stats, flipped_normals),
+    FIELD(24, vdsh_stats, moved_origins),        FIELD(28, vdsh_stats, flipped_normals),
 };
 static const vdsh_field time_fields[] = {
-    FIELD(0, vdsh_timings, load), FIELD(8, vdsh_timings, refine), FIELD(16, vdsh_timings, build),
-    FIELD(24, vdsh_timings, trace), FIELD(32, vdsh_timings, total),
-    FIELD(40, vdsh_timings, threads),
+    FIELD(0, vdsh_timings, load),   FIELD(8, vdsh_timings, refine),
+    FIELD(16, vdsh_timings, build), FIELD(24, vdsh_timings, trace),
+    FIELD(32, vdsh_timings, total), FIELD(40, vdsh_timings, threads),
 };
 static const vdsh_field part_fields[] = {
-    FIELD(0, vdsh_part, index), FIELD(4, vdsh_part, count), FIELD(8, vdsh_part, range_begin),
-    FIELD(12, vdsh_part, range_end), FIELD(16, vdsh_part, encoding),
-    FIELD(20, vdsh_part, cpca_clusters), FIELD(24, vdsh_part, cpca_basis),
-    FIELD(28, vdsh_part, cpca_bits),
+    FIELD(0, vdsh_part, index),       FIELD(4, vdsh_part, count),
+    FIELD(8, vdsh_part, range_begin), FIELD(12, vdsh_part, range_end),
+    FIELD(16, vdsh_part, encoding),   FIELD(20, vdsh_part, cpca_clusters),
+    FIELD(24, vdsh_part, cpca_basis), FIELD(28, vdsh_part, cpca_bits),
 };
 static const vdsh_field adpt_fields[] = {
-    FIELD(0, vdsh_adaptive, tolerance), FIELD(4, vdsh_adaptive, min_edge),
+    FIELD(0, vdsh_adaptive, tolerance),     FIELD(4, vdsh_adaptive, min_edge),
     FIELD(8, vdsh_adaptive, max_receivers), FIELD(12, vdsh_adaptive, lights),
-    FIELD(16, vdsh_adaptive, max_rounds), FIELD(20, vdsh_adaptive, start_receivers),
-    FIELD(24, vdsh_adaptive, rounds), FIELD(28, vdsh_adaptive, candidates),
+    FIELD(16, vdsh_adaptive, max_rounds),   FIELD(20, vdsh_adaptive, start_receivers),
+    FIELD(24, vdsh_adaptive, rounds),       FIELD(28, vdsh_adaptive, candidates),
 };
 static const vdsh_field head_fields[] = {
-    FIELD(0, vdsh_header, vertex_count), FIELD(4, vdsh_header, triangle_count),
-    FIELD(8, vdsh_header, rays), FIELD(12, vdsh_header, sampling), FIELD(16, vdsh_header, seed),
-    FIELD(24, vdsh_header, max_distance), FIELD(28, vdsh_header, max_edge),
-    FIELD(32, vdsh_header, offset_rule), FIELD(36, vdsh_header, load_flags),
-    FIELD(40, vdsh_header, cube_size), FIELD(44, vdsh_header, occluder_vertex_count),
-    FIELD(48, vdsh_header, occluder_triangle_count), FIELD(52, vdsh_header, trace_flags),
-    FIELD(56, vdsh_header, bounds_min), FIELD(68, vdsh_header, bounds_max),
+    FIELD(0, vdsh_header, vertex_count),
+    FIELD(4, vdsh_header, triangle_count),
+    FIELD(8, vdsh_header, rays),
+    FIELD(12, vdsh_header, sampling),
+    FIELD(16, vdsh_header, seed),
+    FIELD(24, vdsh_header, max_distance),
+    FIELD(28, vdsh_header, max_edge),
+    FIELD(32, vdsh_header, offset_rule),
+    FIELD(36, vdsh_header, load_flags),
+    FIELD(40, vdsh_header, cube_size),
+    FIELD(44, vdsh_header, occluder_vertex_count),
+    FIELD(48, vdsh_header, occluder_triangle_count),
+    FIELD(52, vdsh_header, trace_flags),
+    FIELD(56, vdsh_header, bounds_min),
+    FIELD(68, vdsh_header, bounds_max),
 };
 static const vdsh_field stream_fields[] = {
-    FIELD(0, vdsh_stream, order), FIELD(4, vdsh_stream, encoding), FIELD(8, vdsh_stream, method),
-    FIELD(12, vdsh_stream, quantity), FIELD(16, vdsh_stream, window),
-    FIELD(20, vdsh_stream, window_param), FIELD(24, vdsh_stream, method_param),
-    FIELD(28, vdsh_stream, scale), FIELD(32, vdsh_stream, quantity_param),
-    FIELD(36, vdsh_stream, flags),
+    FIELD(0, vdsh_stream, order),           FIELD(4, vdsh_stream, encoding),
+    FIELD(8, vdsh_stream, method),          FIELD(12, vdsh_stream, quantity),
+    FIELD(16, vdsh_stream, window),         FIELD(20, vdsh_stream, window_param),
+    FIELD(24, vdsh_stream, method_param),   FIELD(28, vdsh_stream, scale),
+    FIELD(32, vdsh_stream, quantity_param), FIELD(36, vdsh_stream, flags),
 };
 #define FIELDS(f) (uint8_t)(sizeof(f) / sizeof((f)[0])), (f)
 

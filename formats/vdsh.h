@@ -78,16 +78,16 @@ extern "C" {
 
 typedef enum vdsh_result {
     VDSH_OK = 0,
-    VDSH_ERR_IO,            /* could not open, read, write or rename (errno in msg) */
+    VDSH_ERR_IO, /* could not open, read, write or rename (errno in msg) */
     VDSH_ERR_OUT_OF_MEMORY,
-    VDSH_ERR_NOT_VDSH,      /* wrong magic: not a .vdsh file */
-    VDSH_ERR_VERSION,       /* a version this reader does not support */
-    VDSH_ERR_TRUNCATED,     /* shorter than its header or a chunk says */
-    VDSH_ERR_CRC,           /* header or chunk CRC mismatch */
-    VDSH_ERR_CHUNK,         /* chunk structure: unknown critical id, missing,
+    VDSH_ERR_NOT_VDSH,  /* wrong magic: not a .vdsh file */
+    VDSH_ERR_VERSION,   /* a version this reader does not support */
+    VDSH_ERR_TRUNCATED, /* shorter than its header or a chunk says */
+    VDSH_ERR_CRC,       /* header or chunk CRC mismatch */
+    VDSH_ERR_CHUNK,     /* chunk structure: unknown critical id, missing,
                                repeated or misplaced chunk, bad size, padding */
-    VDSH_ERR_INVALID,       /* a value out of range: count, enum, index, NaN */
-    VDSH_ERR_ARGUMENT       /* the caller passed an inconsistent vdsh_file */
+    VDSH_ERR_INVALID,   /* a value out of range: count, enum, index, NaN */
+    VDSH_ERR_ARGUMENT   /* the caller passed an inconsistent vdsh_file */
 } vdsh_result;
 
 /* A static string such as "CRC mismatch"; never NULL. */
@@ -102,15 +102,9 @@ typedef struct vdsh_error {
     char msg[512];
 } vdsh_error;
 
-typedef enum vdsh_sampling {
-    VDSH_SAMPLING_SPHERE = 0,
-    VDSH_SAMPLING_HEMISPHERE = 1
-} vdsh_sampling;
+typedef enum vdsh_sampling { VDSH_SAMPLING_SPHERE = 0, VDSH_SAMPLING_HEMISPHERE = 1 } vdsh_sampling;
 
-typedef enum vdsh_offset_rule {
-    VDSH_OFFSET_NONE = 0,
-    VDSH_OFFSET_WB_AVG = 1
-} vdsh_offset_rule;
+typedef enum vdsh_offset_rule { VDSH_OFFSET_NONE = 0, VDSH_OFFSET_WB_AVG = 1 } vdsh_offset_rule;
 
 enum { VDSH_LOAD_WELD = 1u };
 enum { VDSH_TRACE_ROBUST = 1u };
@@ -118,10 +112,10 @@ enum { VDSH_TRACE_ROBUST = 1u };
 typedef enum vdsh_encoding {
     VDSH_ENCODING_F32 = 0,
     VDSH_ENCODING_F16 = 1,
-    VDSH_ENCODING_S8 = 2,    /* signed 8-bit, a scale per coefficient index */
-    VDSH_ENCODING_S8S6 = 3,  /* bands 0-1 as s8, bands 2+ signed 6-bit, packed
+    VDSH_ENCODING_S8 = 2,   /* signed 8-bit, a scale per coefficient index */
+    VDSH_ENCODING_S8S6 = 3, /* bands 0-1 as s8, bands 2+ signed 6-bit, packed
                                 five to a u32 word; scales as s8 */
-    VDSH_ENCODING_CPCA = 4   /* clustered PCA (issue 29): per cluster a mean
+    VDSH_ENCODING_CPCA = 4  /* clustered PCA (issue 29): per cluster a mean
                                 and basis vectors (f16), per vertex a cluster
                                 index and packed weights (vdsh_cpca below) */
 } vdsh_encoding;
@@ -169,8 +163,8 @@ const char *vdsh_offset_rule_name(uint32_t rule);
  * the programs' options read it). Adding an encoding: a row here, the enum
  * above, and its own code (encode, decode, check; the runtime's buffer). */
 typedef struct vdsh_encoding_info {
-    const char *name;        /* on command lines, in reports and JSON */
-    uint32_t encoding;       /* vdsh_encoding */
+    const char *name;  /* on command lines, in reports and JSON */
+    uint32_t encoding; /* vdsh_encoding */
     /* bytes of one vertex at nc coefficients; 0 where the stream's own
      * model sizes the record (cpca: vdsh_cpca_record_words) */
     size_t (*bytes)(uint32_t nc);
@@ -207,7 +201,7 @@ typedef struct vdsh_header {
 } vdsh_header;
 
 typedef struct vdsh_source {
-    char *name;            /* NUL-terminated copy of the stored name */
+    char *name; /* NUL-terminated copy of the stored name */
     uint64_t size;
     uint8_t sha256[32];
 } vdsh_source;
@@ -222,13 +216,13 @@ typedef struct vdsh_source {
  * + sum over j = 0..B-1 in order of w_j * basis_j[i], each product and
  * sum rounded to f32. */
 typedef struct vdsh_cpca {
-    uint32_t clusters;        /* K, 1..VDSH_CPCA_MAX_CLUSTERS */
-    uint32_t basis;           /* B, 1..order^2 */
-    uint32_t bits;            /* per weight, VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS */
-    uint32_t record_words;    /* W = vdsh_cpca_record_words(basis, bits) */
-    const float *scales;      /* K * B: vector j of cluster c at c * B + j */
-    const uint16_t *means;    /* f16, K * order^2: cluster c's at c * order^2 */
-    const uint16_t *bases;    /* f16, K * B * order^2: vector j of cluster c
+    uint32_t clusters;     /* K, 1..VDSH_CPCA_MAX_CLUSTERS */
+    uint32_t basis;        /* B, 1..order^2 */
+    uint32_t bits;         /* per weight, VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS */
+    uint32_t record_words; /* W = vdsh_cpca_record_words(basis, bits) */
+    const float *scales;   /* K * B: vector j of cluster c at c * B + j */
+    const uint16_t *means; /* f16, K * order^2: cluster c's at c * order^2 */
+    const uint16_t *bases; /* f16, K * B * order^2: vector j of cluster c
                                  at (c * B + j) * order^2 */
 } vdsh_cpca;
 #define VDSH_CPCA_MAX_CLUSTERS 256
@@ -241,23 +235,23 @@ typedef struct vdsh_cpca {
 #define VDSH_CPCA_DEFAULT_BITS 4
 
 typedef struct vdsh_stream {
-    uint32_t order;        /* bands n; n*n coefficients per vertex */
-    uint32_t encoding;     /* vdsh_encoding */
-    uint32_t method;       /* vdsh_method */
-    uint32_t quantity;     /* vdsh_quantity */
-    uint32_t window;       /* vdsh_window */
+    uint32_t order;    /* bands n; n*n coefficients per vertex */
+    uint32_t encoding; /* vdsh_encoding */
+    uint32_t method;   /* vdsh_method */
+    uint32_t quantity; /* vdsh_quantity */
+    uint32_t window;   /* vdsh_window */
     float window_param;
     float method_param;
-    float scale;           /* coefficient = stored value * scale (f32, f16);
+    float scale;              /* coefficient = stored value * scale (f32, f16);
                               s8: 1, the table below scales */
-    float quantity_param;  /* log-distance: the floor (distances below it
+    float quantity_param;     /* log-distance: the floor (distances below it
                               were clamped to it before the log); else 0 */
-    const void *data;      /* vertex_count * order^2 values of `encoding` */
+    const void *data;         /* vertex_count * order^2 values of `encoding` */
     const float *coef_scales; /* s8, s8s6 only (else NULL): order^2 scales,
                                  one per coefficient index, each finite and
                                  >= 0; coefficient i = stored * vdsh_quant_step(
                                  coef_scales[i], vdsh_quant_levels(enc, i)) */
-    uint32_t flags;        /* VDSH_STREAM_VARIABLE or 0 */
+    uint32_t flags;           /* VDSH_STREAM_VARIABLE or 0 */
     /* Variable-order streams only (else NULL; VDSH.md "Variable-order
      * streams"): per vertex row its order k, 1..order (order is the cap);
      * `data` then holds one record of k^2 coefficients per row, each
@@ -280,8 +274,8 @@ typedef struct vdsh_stats {
     uint64_t rays_missed;
     uint32_t degenerate_receivers;
     uint32_t undefined_normals;
-    uint32_t moved_origins;    /* receivers whose ray origin was repaired */
-    uint32_t flipped_normals;  /* receivers whose normal was turned to free space */
+    uint32_t moved_origins;   /* receivers whose ray origin was repaired */
+    uint32_t flipped_normals; /* receivers whose normal was turned to free space */
 } vdsh_stats;
 
 typedef struct vdsh_timings {
@@ -296,7 +290,7 @@ typedef struct vdsh_timings {
 typedef struct vdsh_part {
     uint32_t index, count;
     uint32_t range_begin, range_end;
-    uint32_t encoding;         /* vdsh_encoding of the merged file */
+    uint32_t encoding; /* vdsh_encoding of the merged file */
     /* encoding cpca: the settings the merge fits with (K, B as asked for,
      * capped there at V and order^2); else 0. */
     uint32_t cpca_clusters, cpca_basis, cpca_bits;
@@ -305,34 +299,34 @@ typedef struct vdsh_part {
 /* Adaptive receivers (`adpt` chunk, VDSH.md): what refined the receivers
  * (vdsh-bake --adaptive) and what it did. */
 typedef struct vdsh_adaptive {
-    float tolerance;           /* expected shadow error; >= 0, may be +inf */
-    float min_edge;            /* > 0, scene units */
-    uint32_t max_receivers;    /* the budget; 0: none */
-    uint32_t lights;           /* free-space lights scoring the error, >= 1 */
-    uint32_t max_rounds;       /* >= 1 */
-    uint32_t start_receivers;  /* the uniform mesh it started from (max_edge) */
-    uint32_t rounds;           /* rounds run */
-    uint32_t candidates;       /* midpoints baked, split or not */
+    float tolerance;          /* expected shadow error; >= 0, may be +inf */
+    float min_edge;           /* > 0, scene units */
+    uint32_t max_receivers;   /* the budget; 0: none */
+    uint32_t lights;          /* free-space lights scoring the error, >= 1 */
+    uint32_t max_rounds;      /* >= 1 */
+    uint32_t start_receivers; /* the uniform mesh it started from (max_edge) */
+    uint32_t rounds;          /* rounds run */
+    uint32_t candidates;      /* midpoints baked, split or not */
 } vdsh_adaptive;
 
 typedef struct vdsh_file {
     vdsh_header header;
     uint32_t source_count;
     vdsh_source *sources;
-    const float *positions;    /* 3 * vertex_count */
-    const float *normals;      /* 3 * vertex_count */
-    const uint32_t *indices;   /* 3 * triangle_count */
+    const float *positions;  /* 3 * vertex_count */
+    const float *normals;    /* 3 * vertex_count */
+    const uint32_t *indices; /* 3 * triangle_count */
     uint32_t stream_count;
     vdsh_stream *streams;
-    int has_stats;             /* `stat` chunk present */
+    int has_stats; /* `stat` chunk present */
     vdsh_stats stats;
-    int has_timings;           /* `time` chunk present */
+    int has_timings; /* `time` chunk present */
     vdsh_timings timings;
-    int has_part;              /* `part` chunk present: a shard's part */
+    int has_part; /* `part` chunk present: a shard's part */
     vdsh_part part;
-    int has_adaptive;          /* `adpt` chunk present: adaptive receivers */
+    int has_adaptive; /* `adpt` chunk present: adaptive receivers */
     vdsh_adaptive adaptive;
-    void *storage_;            /* owned memory; do not touch */
+    void *storage_; /* owned memory; do not touch */
 } vdsh_file;
 
 /* Receivers each COEF stream holds: a part's range (range_end -
@@ -346,8 +340,8 @@ vdsh_result vdsh_read(const char *path, vdsh_file **out, vdsh_error *err);
 
 /* The same from memory (the bytes are copied; `name` is used in messages
  * and may be NULL). This is what the fuzz target calls. */
-vdsh_result vdsh_read_memory(const void *data, size_t size, const char *name,
-                             vdsh_file **out, vdsh_error *err);
+vdsh_result vdsh_read_memory(const void *data, size_t size, const char *name, vdsh_file **out,
+                             vdsh_error *err);
 
 void vdsh_free(vdsh_file *f);
 
@@ -360,17 +354,15 @@ vdsh_result vdsh_write(const char *path, const vdsh_file *f, vdsh_error *err);
 
 /* vdsh_write, and on success the file's size in bytes in *size (may be
  * NULL; untouched on failure): a caller need not open the file again. */
-vdsh_result vdsh_write_sized(const char *path, const vdsh_file *f, uint64_t *size,
-                             vdsh_error *err);
+vdsh_result vdsh_write_sized(const char *path, const vdsh_file *f, uint64_t *size, vdsh_error *err);
 
 /* Serialise to memory. On success *out_data is a malloc'd buffer the
  * caller frees with free(). */
-vdsh_result vdsh_write_memory(const vdsh_file *f, void **out_data,
-                              size_t *out_size, vdsh_error *err);
+vdsh_result vdsh_write_memory(const vdsh_file *f, void **out_data, size_t *out_size,
+                              vdsh_error *err);
 
 /* The fixed-order stream for (order, quantity), or NULL. */
-const vdsh_stream *vdsh_find_stream(const vdsh_file *f, uint32_t order,
-                                    uint32_t quantity);
+const vdsh_stream *vdsh_find_stream(const vdsh_file *f, uint32_t order, uint32_t quantity);
 
 /* The variable-order stream of `quantity`, or NULL. */
 const vdsh_stream *vdsh_find_variable_stream(const vdsh_file *f, uint32_t quantity);
@@ -391,7 +383,10 @@ uint32_t vdsh_cpca_record_words(uint32_t basis, uint32_t bits);
  * *shift + bits - 1. */
 void vdsh_cpca_field(uint32_t bits, uint32_t j, uint32_t *word, uint32_t *shift);
 /* Levels each side of 0: 2^(bits-1) - 1 (4 bits: 7). */
-static inline int vdsh_cpca_levels(uint32_t bits) { return (1 << (bits - 1)) - 1; }
+static inline int vdsh_cpca_levels(uint32_t bits)
+{
+    return (1 << (bits - 1)) - 1;
+}
 /* Weight = level * step, the step scale / levels rounded to f32. */
 static inline float vdsh_cpca_step(float scale, uint32_t bits)
 {
@@ -446,14 +441,16 @@ float vdsh_f32_from_f16(uint16_t h);
 
 /* Encode n floats to f16 as value / scale. Returns VDSH_ERR_INVALID if an
  * input is not finite or a result overflows f16; dst is then unspecified. */
-vdsh_result vdsh_encode_f16(const float *src, size_t n, float scale,
-                            uint16_t *dst);
+vdsh_result vdsh_encode_f16(const float *src, size_t n, float scale, uint16_t *dst);
 
 /* s8 (VDSH.md, COEF): the step of coefficient index i, scale_i / 127 in
  * f32, so that coefficient = stored * step, stored in -127..127. Every
  * decoder (vdsh_stream_decode, the GL runtime's uniforms, the Python
  * reader) computes it this way, so they agree to the bit. */
-static inline float vdsh_s8_step(float scale) { return scale / 127.0f; }
+static inline float vdsh_s8_step(float scale)
+{
+    return scale / 127.0f;
+}
 
 /* The quantised encodings (s8, s8s6), which carry a scale table. */
 static inline int vdsh_encoding_quantised(uint32_t e)
@@ -468,13 +465,16 @@ static inline int vdsh_quant_levels(uint32_t e, uint32_t i)
 }
 /* Coefficient = stored * vdsh_quant_step(scale_i, levels_i), the step
  * rounded to f32 first (vdsh_s8_step is levels 127). */
-static inline float vdsh_quant_step(float scale, int levels) { return scale / (float)levels; }
+static inline float vdsh_quant_step(float scale, int levels)
+{
+    return scale / (float)levels;
+}
 
 /* vdsh_encode_s8 for any quantised encoding (s8, s8s6): dst receives
  * vertices * (bytes per vertex of encoding at nc coefficients), unused
  * bits zero. VDSH_ERR_ARGUMENT also for an encoding that is not one. */
-vdsh_result vdsh_encode_quantised(uint32_t encoding, const float *src, size_t vertices,
-                                  uint32_t nc, float *scales, void *dst);
+vdsh_result vdsh_encode_quantised(uint32_t encoding, const float *src, size_t vertices, uint32_t nc,
+                                  float *scales, void *dst);
 /* vdsh_encode_quantised with the scales taken over the drawn vertices only
  * (drawn[v] != 0; NULL: every vertex): the others (receivers no triangle
  * with area touches, never drawn, whose coefficients may be extreme) are
@@ -496,15 +496,14 @@ vdsh_result vdsh_encode_quantised_drawn(uint32_t encoding, const float *src, siz
  * a value that is not finite or does not fit; VDSH_ERR_ARGUMENT for an
  * order outside 1..cap or other bad arguments. */
 vdsh_result vdsh_encode_variable(uint32_t encoding, const float *src, size_t stride,
-                                 const uint8_t *orders, uint32_t rows, uint32_t cap,
-                                 float scale, const uint32_t *offsets, float *scales,
-                                 void *dst);
+                                 const uint8_t *orders, uint32_t rows, uint32_t cap, float scale,
+                                 const uint32_t *offsets, float *scales, void *dst);
 /* vdsh_encode_variable whose s8, s8s6 scales are over the drawn rows only
  * (drawn[v] != 0; NULL: every row), as vdsh_encode_quantised_drawn. */
 vdsh_result vdsh_encode_variable_drawn(uint32_t encoding, const float *src, size_t stride,
                                        const uint8_t *orders, uint32_t rows, uint32_t cap,
-                                       float scale, const uint32_t *offsets,
-                                       const uint8_t *drawn, float *scales, void *dst);
+                                       float scale, const uint32_t *offsets, const uint8_t *drawn,
+                                       float *scales, void *dst);
 
 /* Bytes per vertex of encoding e at nc coefficients (0 if unknown). */
 size_t vdsh_encoding_bytes(uint32_t e, uint32_t nc);
@@ -525,7 +524,10 @@ vdsh_result vdsh_encode_s8(const float *src, size_t vertices, uint32_t nc, float
  * stream's largest |coefficient| `amax`, or 1 for an all-zero stream, so
  * stored values lie in [-1, 1]. vdsh-bake and vdsh-merge must agree on it
  * to the bit (merged files are byte-identical to whole bakes). */
-static inline float vdsh_f16_scale(float amax) { return amax > 0.0f ? amax : 1.0f; }
+static inline float vdsh_f16_scale(float amax)
+{
+    return amax > 0.0f ? amax : 1.0f;
+}
 
 /* CRC-32 (zlib/PNG), continuing from `crc` (start with 0). */
 uint32_t vdsh_crc32(uint32_t crc, const void *data, size_t size);
@@ -533,11 +535,11 @@ uint32_t vdsh_crc32(uint32_t crc, const void *data, size_t size);
 /* One chunk as it lies in a file image, for tools that list and check
  * chunks (vdsh-info --verify). */
 typedef struct vdsh_chunk_info {
-    char id[5];            /* the 4 id bytes + NUL; non-letters read as '?' */
-    int complete;          /* payload and padding lie inside the data; if 0,
+    char id[5];      /* the 4 id bytes + NUL; non-letters read as '?' */
+    int complete;    /* payload and padding lie inside the data; if 0,
                               crc_computed is 0 and this is the last entry */
-    uint64_t offset;       /* of the 16-byte chunk header */
-    uint64_t size;         /* payload bytes the header states (no padding) */
+    uint64_t offset; /* of the 16-byte chunk header */
+    uint64_t size;   /* payload bytes the header states (no padding) */
     uint32_t crc_stored;
     uint32_t crc_computed; /* over id, size, payload and padding */
 } vdsh_chunk_info;
@@ -553,9 +555,8 @@ typedef struct vdsh_chunk_info {
  * the data does not start with the magic and a 32-byte header, else
  * VDSH_OK: CRC mismatches and incomplete chunks are in the entries for the
  * caller to report. Whether the file is valid is vdsh_read_memory's call. */
-vdsh_result vdsh_scan_chunks(const void *data, size_t size, const char *name,
-                             vdsh_chunk_info *out, uint32_t max,
-                             uint32_t *count, vdsh_error *err);
+vdsh_result vdsh_scan_chunks(const void *data, size_t size, const char *name, vdsh_chunk_info *out,
+                             uint32_t max, uint32_t *count, vdsh_error *err);
 
 #ifdef __cplusplus
 }

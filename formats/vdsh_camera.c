@@ -18,8 +18,8 @@ float vdsh_camera_fov(const vdsh_camera *c)
     return c->fov_y > 0.0f ? c->fov_y : 60.0f;
 }
 
-void vdsh_camera_ray(const vdsh_camera *c, int width, int height, int x, int y,
-                     float org[3], float dir[3])
+void vdsh_camera_ray(const vdsh_camera *c, int width, int height, int x, int y, float org[3],
+                     float dir[3])
 {
     float s[3], u[3], f[3];
     vdsh_camera_basis(c, s, u, f);

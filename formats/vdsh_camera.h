@@ -31,8 +31,8 @@ extern "C" {
 typedef struct vdsh_camera {
     float eye[3];
     float target[3];
-    float up[3];       /* zero: (0, 1, 0) */
-    float fov_y;       /* degrees; 0: 60 */
+    float up[3]; /* zero: (0, 1, 0) */
+    float fov_y; /* degrees; 0: 60 */
 } vdsh_camera;
 
 /* The basis (s, u, f): right, up and forward unit vectors. */
@@ -43,8 +43,8 @@ float vdsh_camera_fov(const vdsh_camera *c);
 
 /* The primary ray through the centre of pixel (x, y): origin (the eye)
  * and unit direction. */
-void vdsh_camera_ray(const vdsh_camera *c, int width, int height, int x, int y,
-                     float org[3], float dir[3]);
+void vdsh_camera_ray(const vdsh_camera *c, int width, int height, int x, int y, float org[3],
+                     float dir[3]);
 
 /* The view matrix (column-major, as GL takes it): world to eye space. */
 void vdsh_camera_view(const vdsh_camera *c, float out[16]);

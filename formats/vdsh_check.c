@@ -20,37 +20,32 @@
 int vdsh_check_header(const vdsh_header *h, why *w)
 {
     if (h->vertex_count < 1 || h->vertex_count > VDSH_MAX_VERTICES)
-        return vdsh_bad(w, "HEAD: vertex_count %u out of range 1..%u",
-                   h->vertex_count, VDSH_MAX_VERTICES);
+        return vdsh_bad(w, "HEAD: vertex_count %u out of range 1..%u", h->vertex_count,
+                        VDSH_MAX_VERTICES);
     if (h->triangle_count > VDSH_MAX_TRIANGLES)
-        return vdsh_bad(w, "HEAD: triangle_count %u out of range 0..%u",
-                   h->triangle_count, VDSH_MAX_TRIANGLES);
+        return vdsh_bad(w, "HEAD: triangle_count %u out of range 0..%u", h->triangle_count,
+                        VDSH_MAX_TRIANGLES);
     if (h->rays < 1)
         return vdsh_bad(w, "HEAD: rays is 0, must be at least 1");
     if (h->sampling > VDSH_SAMPLING_HEMISPHERE)
-        return vdsh_bad(w, "HEAD: sampling %u unknown (0 sphere, 1 hemisphere)",
-                   h->sampling);
+        return vdsh_bad(w, "HEAD: sampling %u unknown (0 sphere, 1 hemisphere)", h->sampling);
     if (!isfinite(h->max_distance) || !(h->max_distance > 0.0f))
-        return vdsh_bad(w, "HEAD: max_distance %g must be finite and > 0",
-                   (double)h->max_distance);
+        return vdsh_bad(w, "HEAD: max_distance %g must be finite and > 0", (double)h->max_distance);
     if (!isfinite(h->max_edge) || !(h->max_edge >= 0.0f))
-        return vdsh_bad(w, "HEAD: max_edge %g must be finite and >= 0",
-                   (double)h->max_edge);
+        return vdsh_bad(w, "HEAD: max_edge %g must be finite and >= 0", (double)h->max_edge);
     if (h->offset_rule > VDSH_OFFSET_WB_AVG)
-        return vdsh_bad(w, "HEAD: offset_rule %u unknown (0 none, 1 wb-avg)",
-                   h->offset_rule);
+        return vdsh_bad(w, "HEAD: offset_rule %u unknown (0 none, 1 wb-avg)", h->offset_rule);
     if (h->load_flags & ~(uint32_t)VDSH_LOAD_WELD)
         return vdsh_bad(w, "HEAD: load_flags 0x%x has unknown bits", h->load_flags);
     if (h->trace_flags & ~(uint32_t)VDSH_TRACE_ROBUST)
-        return vdsh_bad(w, "HEAD: trace_flags 0x%x has unknown bits",
-                   h->trace_flags);
+        return vdsh_bad(w, "HEAD: trace_flags 0x%x has unknown bits", h->trace_flags);
     for (int k = 0; k < 3; k++) {
         if (!isfinite(h->bounds_min[k]) || !isfinite(h->bounds_max[k]))
             return vdsh_bad(w, "HEAD: bounds axis %d (%g .. %g) not finite", k,
-                       (double)h->bounds_min[k], (double)h->bounds_max[k]);
+                            (double)h->bounds_min[k], (double)h->bounds_max[k]);
         if (h->bounds_min[k] > h->bounds_max[k])
             return vdsh_bad(w, "HEAD: bounds_min[%d] %g > bounds_max[%d] %g", k,
-                       (double)h->bounds_min[k], k, (double)h->bounds_max[k]);
+                            (double)h->bounds_min[k], k, (double)h->bounds_max[k]);
     }
     return 1;
 }
@@ -83,8 +78,8 @@ int vdsh_check_positions(const float *p, uint32_t v, why *w)
     size_t n = (size_t)v * 3;
     if (max_abs_bits_f32(p, n) >= 0x7f800000u) {
         size_t i = first_nonfinite_f32(p, n);
-        return vdsh_bad(w, "POSN: vertex %zu has a non-finite coordinate (%g)",
-                   i / 3, (double)p[i]);
+        return vdsh_bad(w, "POSN: vertex %zu has a non-finite coordinate (%g)", i / 3,
+                        (double)p[i]);
     }
     return 1;
 }
@@ -94,8 +89,10 @@ int vdsh_check_normals(const float *nrm, uint32_t v, why *w)
     size_t n = (size_t)v * 3;
     if (max_abs_bits_f32(nrm, n) >= 0x7f800000u) {
         size_t i = first_nonfinite_f32(nrm, n);
-        return vdsh_bad(w, "NORM: normal of vertex %zu has a non-finite component "
-                   "(%g)", i / 3, (double)nrm[i]);
+        return vdsh_bad(w,
+                        "NORM: normal of vertex %zu has a non-finite component "
+                        "(%g)",
+                        i / 3, (double)nrm[i]);
     }
     /* |len - 1| < 1e-3 without a square root: compare len^2 against the
      * squared bounds, in double so float rounding cannot move the edge. */
@@ -103,13 +100,12 @@ int vdsh_check_normals(const float *nrm, uint32_t v, why *w)
     const double hi = (1.0 + 1e-3) * (1.0 + 1e-3);
     for (size_t i = 0; i < v; i++) {
         const float *q = nrm + 3 * i;
-        double l2 = (double)q[0] * q[0] + (double)q[1] * q[1] +
-                    (double)q[2] * q[2];
-        if (!(l2 > lo && l2 < hi) &&
-            !(q[0] == 0.0f && q[1] == 0.0f && q[2] == 0.0f))
-            return vdsh_bad(w, "NORM: normal of vertex %zu (%g, %g, %g) has length "
-                       "%g; must be 1 within 1e-3, or exactly (0, 0, 0)", i,
-                       (double)q[0], (double)q[1], (double)q[2], sqrt(l2));
+        double l2 = (double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2];
+        if (!(l2 > lo && l2 < hi) && !(q[0] == 0.0f && q[1] == 0.0f && q[2] == 0.0f))
+            return vdsh_bad(w,
+                            "NORM: normal of vertex %zu (%g, %g, %g) has length "
+                            "%g; must be 1 within 1e-3, or exactly (0, 0, 0)",
+                            i, (double)q[0], (double)q[1], (double)q[2], sqrt(l2));
     }
     return 1;
 }
@@ -124,8 +120,10 @@ int vdsh_check_indices(const uint32_t *idx, uint32_t t, uint32_t v, why *w)
         size_t i = 0;
         while (idx[i] < v)
             i++;
-        return vdsh_bad(w, "TRIS: index %u out of range (%u vertices) in "
-                   "triangle %zu", idx[i], v, i / 3);
+        return vdsh_bad(w,
+                        "TRIS: index %u out of range (%u vertices) in "
+                        "triangle %zu",
+                        idx[i], v, i / 3);
     }
     return 1;
 }
@@ -167,14 +165,13 @@ static size_t utf8_error_at(const uint8_t *s, size_t n)
 int vdsh_check_name(const uint8_t *name, size_t len, uint32_t i, why *w)
 {
     if (len < 1 || len > VDSH_MAX_NAME)
-        return vdsh_bad(w, "SRCS: source %u: name length %zu out of range 1..%d",
-                   i, len, VDSH_MAX_NAME);
+        return vdsh_bad(w, "SRCS: source %u: name length %zu out of range 1..%d", i, len,
+                        VDSH_MAX_NAME);
     if (memchr(name, 0, len))
         return vdsh_bad(w, "SRCS: source %u: name contains a NUL byte", i);
     size_t at = utf8_error_at(name, len);
     if (at != len)
-        return vdsh_bad(w, "SRCS: source %u: name is not valid UTF-8 (byte %zu)",
-                   i, at);
+        return vdsh_bad(w, "SRCS: source %u: name is not valid UTF-8 (byte %zu)", i, at);
     return 1;
 }
 
@@ -197,8 +194,7 @@ const char *vdsh_slot_name(const vdsh_stream *s, char *buf, size_t n)
 }
 
 /* "COEF order 5 distance": how messages name a stream. */
-void vdsh_stream_label(const vdsh_stream *s, uint32_t i, char *buf,
-                         size_t n)
+void vdsh_stream_label(const vdsh_stream *s, uint32_t i, char *buf, size_t n)
 {
     snprintf(buf, n, "COEF stream %u (order %s%u, %s)", i, vdsh_stream_variable(s) ? "up to " : "",
              s->order, vdsh_quantity_name(s->quantity));
@@ -209,39 +205,36 @@ int vdsh_check_stream(const vdsh_stream *s, uint32_t i, why *w)
     char l[96];
     vdsh_stream_label(s, i, l, sizeof l);
     if (s->order < 1 || s->order > VDSH_MAX_ORDER)
-        return vdsh_bad(w, "%s: order %u out of range 1..%d", l, s->order,
-                   VDSH_MAX_ORDER);
+        return vdsh_bad(w, "%s: order %u out of range 1..%d", l, s->order, VDSH_MAX_ORDER);
     if (s->encoding > VDSH_ENCODING_LAST)
         return vdsh_bad(w, "%s: encoding %u unknown (0 f32, 1 f16, 2 s8, 3 s8s6, 4 cpca)", l,
-                   s->encoding);
+                        s->encoding);
     if (s->flags & ~VDSH_STREAM_VARIABLE)
         return vdsh_bad(w, "%s: flags 0x%x: unknown bits (bit 0: variable order)", l, s->flags);
     /* Any method value is allowed: later bakers add methods, and the
      * coefficients still reconstruct `quantity` (VDSH.md, "Methods"). */
     if (s->quantity > VDSH_QUANTITY_LOG_DISTANCE)
-        return vdsh_bad(w, "%s: quantity %u unknown (0 distance, 1 distance2, "
-                   "2 log-distance)", l, s->quantity);
+        return vdsh_bad(w,
+                        "%s: quantity %u unknown (0 distance, 1 distance2, "
+                        "2 log-distance)",
+                        l, s->quantity);
     if (s->window > VDSH_WINDOW_LANCZOS)
-        return vdsh_bad(w, "%s: window %u unknown (0 none, 1 hann, 2 lanczos)", l,
-                   s->window);
+        return vdsh_bad(w, "%s: window %u unknown (0 none, 1 hann, 2 lanczos)", l, s->window);
     if (!isfinite(s->window_param))
-        return vdsh_bad(w, "%s: window_param %g not finite", l,
-                   (double)s->window_param);
+        return vdsh_bad(w, "%s: window_param %g not finite", l, (double)s->window_param);
     if (s->window == VDSH_WINDOW_NONE && s->window_param != 0.0f)
         return vdsh_bad(w, "%s: window_param %g must be 0 without a window", l,
-                   (double)s->window_param);
+                        (double)s->window_param);
     if (s->window != VDSH_WINDOW_NONE && !(s->window_param > 0.0f))
         return vdsh_bad(w, "%s: window_param %g must be > 0 with a window", l,
-                   (double)s->window_param);
+                        (double)s->window_param);
     if (!isfinite(s->method_param))
-        return vdsh_bad(w, "%s: method_param %g not finite", l,
-                   (double)s->method_param);
+        return vdsh_bad(w, "%s: method_param %g not finite", l, (double)s->method_param);
     if (!isfinite(s->scale) || !(s->scale > 0.0f))
-        return vdsh_bad(w, "%s: scale %g must be finite and > 0", l,
-                   (double)s->scale);
+        return vdsh_bad(w, "%s: scale %g must be finite and > 0", l, (double)s->scale);
     if (vdsh_encoding_quantised(s->encoding) && s->scale != 1.0f)
         return vdsh_bad(w, "%s: scale %g must be 1 for %s (its scale table scales)", l,
-                   (double)s->scale, vdsh_encoding_name(s->encoding));
+                        (double)s->scale, vdsh_encoding_name(s->encoding));
     if (s->encoding == VDSH_ENCODING_CPCA) {
         const vdsh_cpca *m = &s->cpca;
         if (s->scale != 1.0f)
@@ -250,24 +243,24 @@ int vdsh_check_stream(const vdsh_stream *s, uint32_t i, why *w)
             return vdsh_bad(w, "%s: cpca streams cannot have variable order", l);
         if (m->clusters < 1 || m->clusters > VDSH_CPCA_MAX_CLUSTERS)
             return vdsh_bad(w, "%s: cpca clusters %u out of range 1..%d", l, m->clusters,
-                       VDSH_CPCA_MAX_CLUSTERS);
+                            VDSH_CPCA_MAX_CLUSTERS);
         if (m->basis < 1 || m->basis > s->order * s->order)
             return vdsh_bad(w, "%s: cpca basis %u out of range 1..%u", l, m->basis,
-                       s->order * s->order);
+                            s->order * s->order);
         if (m->bits < VDSH_CPCA_MIN_BITS || m->bits > VDSH_CPCA_MAX_BITS)
             return vdsh_bad(w, "%s: cpca bits %u out of range %d..%d", l, m->bits,
-                       VDSH_CPCA_MIN_BITS, VDSH_CPCA_MAX_BITS);
+                            VDSH_CPCA_MIN_BITS, VDSH_CPCA_MAX_BITS);
         if (m->record_words != vdsh_cpca_record_words(m->basis, m->bits))
             return vdsh_bad(w, "%s: cpca record_words %u, %u weights of %u bits need %u", l,
-                       m->record_words, m->basis, m->bits,
-                       vdsh_cpca_record_words(m->basis, m->bits));
+                            m->record_words, m->basis, m->bits,
+                            vdsh_cpca_record_words(m->basis, m->bits));
     }
     if (s->quantity == VDSH_QUANTITY_LOG_DISTANCE
             ? !(s->quantity_param > 0.0f) || !isfinite(s->quantity_param)
             : s->quantity_param != 0.0f)
         return vdsh_bad(w, "%s: quantity_param %g must be %s", l, (double)s->quantity_param,
-                   s->quantity == VDSH_QUANTITY_LOG_DISTANCE
-                       ? "the log floor, finite and > 0" : "0 for this quantity");
+                        s->quantity == VDSH_QUANTITY_LOG_DISTANCE ? "the log floor, finite and > 0"
+                                                                  : "0 for this quantity");
     return 1;
 }
 
@@ -288,9 +281,9 @@ static int check_quant_data(const vdsh_stream *s, const char *l, const uint8_t *
             int levels = vdsh_quant_levels(s->encoding, i);
             int32_t q = vdsh_quant_stored(s->encoding, p, i);
             if (q < -levels)
-                return vdsh_bad(w, "%s: vertex %zu coefficient %u is %d (%s stores %d..%d there)", l,
-                           first + x, i, (int)q, vdsh_encoding_name(s->encoding), -levels,
-                           levels);
+                return vdsh_bad(w, "%s: vertex %zu coefficient %u is %d (%s stores %d..%d there)",
+                                l, first + x, i, (int)q, vdsh_encoding_name(s->encoding), -levels,
+                                levels);
         }
         for (uint32_t k = 0; k < words; k++) {
             uint32_t left = nc - VDSH_S8S6_BYTES - k * VDSH_S8S6_PER_WORD;
@@ -298,7 +291,7 @@ static int check_quant_data(const vdsh_stream *s, const char *l, const uint8_t *
             uint32_t used = (1u << (VDSH_S8S6_BITS * fields)) - 1u;
             if (get_u32(p + VDSH_S8S6_BYTES + 4 * k) & ~used)
                 return vdsh_bad(w, "%s: vertex %zu: unused bits of packed word %u not zero", l,
-                           first + x, k);
+                                first + x, k);
         }
     }
     return 1;
@@ -314,10 +307,10 @@ static int check_scales(const vdsh_stream *s, const char *l, why *w)
         int levels = vdsh_quant_levels(s->encoding, k);
         if (!isfinite(sc) || !(sc >= 0.0f))
             return vdsh_bad(w, "%s: scale of coefficient %zu is %g, not finite and >= 0", l,
-                       (size_t)k, (double)sc);
+                            (size_t)k, (double)sc);
         if (!isfinite((float)levels * vdsh_quant_step(sc, levels)))
             return vdsh_bad(w, "%s: scale of coefficient %zu, %g: %d steps overflow a float", l,
-                       (size_t)k, (double)sc, levels);
+                            (size_t)k, (double)sc, levels);
     }
     return 1;
 }
@@ -345,8 +338,10 @@ static int check_rows(const vdsh_stream *s, const char *l, const void *data, uin
             size_t k = 0;
             while ((d[k] & 0x7c00u) != 0x7c00u)
                 k++;
-            return vdsh_bad(w, "%s: vertex %zu coefficient %zu is not finite "
-                       "(f16 0x%04x)", l, first + k / nc, k % nc, d[k]);
+            return vdsh_bad(w,
+                            "%s: vertex %zu coefficient %zu is not finite "
+                            "(f16 0x%04x)",
+                            l, first + k / nc, k % nc, d[k]);
         }
         maxabs = vdsh_f32_from_f16(m);
     } else {
@@ -354,14 +349,16 @@ static int check_rows(const vdsh_stream *s, const char *l, const void *data, uin
         uint32_t m = max_abs_bits_f32(d, n);
         if (m >= 0x7f800000u) {
             size_t k = first_nonfinite_f32(d, n);
-            return vdsh_bad(w, "%s: vertex %zu coefficient %zu is not finite (%g)",
-                       l, first + k / nc, k % nc, (double)d[k]);
+            return vdsh_bad(w, "%s: vertex %zu coefficient %zu is not finite (%g)", l,
+                            first + k / nc, k % nc, (double)d[k]);
         }
         maxabs = f32_from_bits(m);
     }
     if (!isfinite(maxabs * s->scale))
-        return vdsh_bad(w, "%s: a stored value of %g times scale %g overflows a "
-                   "float", l, (double)maxabs, (double)s->scale);
+        return vdsh_bad(w,
+                        "%s: a stored value of %g times scale %g overflows a "
+                        "float",
+                        l, (double)maxabs, (double)s->scale);
     return 1;
 }
 
@@ -397,17 +394,21 @@ static int check_cpca_data(const vdsh_stream *s, const char *l, uint32_t v, why 
     for (size_t k = 0; k < (size_t)m->clusters * b; k++) {
         float sc = m->scales[k];
         if (!isfinite(sc) || !(sc >= 0.0f))
-            return vdsh_bad(w, "%s: cpca scale %zu (cluster %zu vector %zu) is %g, not finite and "
-                       ">= 0", l, k, k / b, k % b, (double)sc);
+            return vdsh_bad(w,
+                            "%s: cpca scale %zu (cluster %zu vector %zu) is %g, not finite and "
+                            ">= 0",
+                            l, k, k / b, k % b, (double)sc);
     }
     for (size_t k = 0; k < (size_t)m->clusters * n; k++)
         if ((m->means[k] & 0x7c00u) == 0x7c00u)
             return vdsh_bad(w, "%s: cpca mean of cluster %zu coefficient %zu is not finite", l,
-                       k / n, k % n);
+                            k / n, k % n);
     for (size_t k = 0; k < (size_t)m->clusters * b * n; k++)
         if ((m->bases[k] & 0x7c00u) == 0x7c00u)
-            return vdsh_bad(w, "%s: cpca basis vector %zu of cluster %zu, coefficient %zu, is "
-                       "not finite", l, (k / n) % b, k / n / b, k % n);
+            return vdsh_bad(w,
+                            "%s: cpca basis vector %zu of cluster %zu, coefficient %zu, is "
+                            "not finite",
+                            l, (k / n) % b, k / n / b, k % n);
     for (uint32_t c = 0; c < m->clusters; c++)
         for (uint32_t i = 0; i < n; i++) {
             double bound = fabs((double)vdsh_f32_from_f16(m->means[(size_t)c * n + i]));
@@ -415,8 +416,8 @@ static int check_cpca_data(const vdsh_stream *s, const char *l, uint32_t v, why 
                 bound += (double)L * (double)vdsh_cpca_step(m->scales[(size_t)c * b + j], bits) *
                          fabs((double)vdsh_f32_from_f16(m->bases[((size_t)c * b + j) * n + i]));
             if (!(bound <= 1e38))
-                return vdsh_bad(w, "%s: cpca cluster %u coefficient %u can reach %g, beyond 1e38", l,
-                           c, i, bound);
+                return vdsh_bad(w, "%s: cpca cluster %u coefficient %u can reach %g, beyond 1e38",
+                                l, c, i, bound);
         }
     /* the bits the fields use, per word */
     uint32_t used[VDSH_MAX_COEFFS + 1];
@@ -432,20 +433,20 @@ static int check_cpca_data(const vdsh_stream *s, const char *l, uint32_t v, why 
         const uint32_t *r = (const uint32_t *)s->data + (size_t)x * m->record_words;
         if ((r[0] & 0xffu) >= m->clusters)
             return vdsh_bad(w, "%s: vertex %u has cluster %u (0..%u)", l, x, r[0] & 0xffu,
-                       m->clusters - 1);
+                            m->clusters - 1);
         for (uint32_t k = 0; k < m->record_words; k++)
             if (r[k] & ~used[k])
-                return vdsh_bad(w, "%s: vertex %u: unused bits of record word %u not zero", l, x, k);
+                return vdsh_bad(w, "%s: vertex %u: unused bits of record word %u not zero", l, x,
+                                k);
         for (uint32_t j = 0; j < b; j++)
             if (vdsh_cpca_record_level(r, bits, j) < -L)
                 return vdsh_bad(w, "%s: vertex %u weight %u is %d (%u bits store %d..%d)", l, x, j,
-                           (int)vdsh_cpca_record_level(r, bits, j), bits, -L, L);
+                                (int)vdsh_cpca_record_level(r, bits, j), bits, -L, L);
     }
     return 1;
 }
 
-int vdsh_check_stream_data(const vdsh_stream *s, uint32_t i, uint32_t v,
-                             why *w)
+int vdsh_check_stream_data(const vdsh_stream *s, uint32_t i, uint32_t v, why *w)
 {
     char l[96];
     vdsh_stream_label(s, i, l, sizeof l);
@@ -463,11 +464,11 @@ int vdsh_check_stats(const vdsh_stats *t, uint32_t vertex_count, why *w)
 {
     if (t->rays_missed > t->rays_traced)
         return vdsh_bad(w, "stat: %llu rays missed of %llu traced",
-                   (unsigned long long)t->rays_missed, (unsigned long long)t->rays_traced);
+                        (unsigned long long)t->rays_missed, (unsigned long long)t->rays_traced);
     const uint32_t v[4] = {t->degenerate_receivers, t->undefined_normals, t->moved_origins,
                            t->flipped_normals};
-    static const char *const n[4] = {"degenerate_receivers", "undefined_normals",
-                                     "moved_origins", "flipped_normals"};
+    static const char *const n[4] = {"degenerate_receivers", "undefined_normals", "moved_origins",
+                                     "flipped_normals"};
     for (int k = 0; k < 4; k++)
         if (v[k] > vertex_count)
             return vdsh_bad(w, "stat: %s %u exceeds the %u receivers", n[k], v[k], vertex_count);
@@ -479,21 +480,21 @@ int vdsh_check_part(const vdsh_part *t, uint32_t vertex_count, why *w)
     if (t->count < 1 || t->index >= t->count)
         return vdsh_bad(w, "part: shard %u of %u", t->index, t->count);
     if (t->range_begin >= t->range_end || t->range_end > vertex_count)
-        return vdsh_bad(w, "part: receivers %u..%u not within 0..%u", t->range_begin,
-                   t->range_end, vertex_count);
+        return vdsh_bad(w, "part: receivers %u..%u not within 0..%u", t->range_begin, t->range_end,
+                        vertex_count);
     if (t->encoding > VDSH_ENCODING_LAST)
         return vdsh_bad(w, "part: unknown encoding %u", t->encoding);
     if (t->encoding != VDSH_ENCODING_CPCA) {
         if (t->cpca_clusters || t->cpca_basis || t->cpca_bits)
             return vdsh_bad(w, "part: cpca settings %u,%u,%u with encoding %s (must be 0)",
-                       t->cpca_clusters, t->cpca_basis, t->cpca_bits,
-                       vdsh_encoding_name(t->encoding));
+                            t->cpca_clusters, t->cpca_basis, t->cpca_bits,
+                            vdsh_encoding_name(t->encoding));
     } else if (t->cpca_clusters < 1 || t->cpca_clusters > VDSH_CPCA_MAX_CLUSTERS ||
                t->cpca_basis < 1 || t->cpca_basis > VDSH_MAX_COEFFS ||
                t->cpca_bits < VDSH_CPCA_MIN_BITS || t->cpca_bits > VDSH_CPCA_MAX_BITS) {
         return vdsh_bad(w, "part: cpca settings %u,%u,%u out of range (1..%d, 1..%d, %d..%d)",
-                   t->cpca_clusters, t->cpca_basis, t->cpca_bits, VDSH_CPCA_MAX_CLUSTERS,
-                   VDSH_MAX_COEFFS, VDSH_CPCA_MIN_BITS, VDSH_CPCA_MAX_BITS);
+                        t->cpca_clusters, t->cpca_basis, t->cpca_bits, VDSH_CPCA_MAX_CLUSTERS,
+                        VDSH_MAX_COEFFS, VDSH_CPCA_MIN_BITS, VDSH_CPCA_MAX_BITS);
     }
     return 1;
 }
@@ -506,24 +507,23 @@ int vdsh_check_adaptive(const vdsh_adaptive *a, uint32_t vertex_count, why *w)
         return vdsh_bad(w, "adpt: min_edge %g is not a finite number > 0", (double)a->min_edge);
     if (a->lights < 1 || a->max_rounds < 1 || a->rounds > a->max_rounds)
         return vdsh_bad(w, "adpt: %u lights, %u of at most %u rounds", a->lights, a->rounds,
-                   a->max_rounds);
+                        a->max_rounds);
     if (a->start_receivers > vertex_count || a->start_receivers < 1)
         return vdsh_bad(w, "adpt: started from %u receivers of %u", a->start_receivers,
-                   vertex_count);
+                        vertex_count);
     if (a->max_receivers && vertex_count > a->max_receivers)
         return vdsh_bad(w, "adpt: %u receivers over the budget of %u", vertex_count,
-                   a->max_receivers);
+                        a->max_receivers);
     if ((uint64_t)a->start_receivers + a->candidates < vertex_count)
         return vdsh_bad(w, "adpt: %u receivers from %u and %u midpoints", vertex_count,
-                   a->start_receivers, a->candidates);
+                        a->start_receivers, a->candidates);
     return 1;
 }
 
 int vdsh_check_timings(const vdsh_timings *t, why *w)
 {
     const double v[5] = {t->load, t->refine, t->build, t->trace, t->total};
-    static const char *const n[5] = {"load", "refine", "build", "trace",
-                                     "total"};
+    static const char *const n[5] = {"load", "refine", "build", "trace", "total"};
     for (int k = 0; k < 5; k++)
         if (!isfinite(v[k]) || !(v[k] >= 0.0))
             return vdsh_bad(w, "time: %s %g must be finite and >= 0", n[k], v[k]);

@@ -20,8 +20,8 @@ enum {
     KMEANS_ROUNDS = 25,
     CUBE_N = 37 /* metric directions: 6 * 37^2 = 8214 texel centres of a cube */
 };
-#define NORMAL_WEIGHT 10.0  /* normals at ten times the coefficients' spread */
-#define SPHERE_EPS 0.01     /* the whole sphere's weight in the metric */
+#define NORMAL_WEIGHT 10.0 /* normals at ten times the coefficients' spread */
+#define SPHERE_EPS 0.01    /* the whole sphere's weight in the metric */
 #define KMEANS_SEED 0x5eed5eed12345678ull
 
 vdsh_cpca_settings vdsh_cpca_settings_default(void)
@@ -35,17 +35,17 @@ static int check_settings(const vdsh_cpca_settings *s, vdsh_error *err)
 {
     if (s->clusters < 1 || s->clusters > VDSH_CPCA_MAX_CLUSTERS) {
         vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: clusters %u out of range 1..%d", s->clusters,
-              VDSH_CPCA_MAX_CLUSTERS);
+                   VDSH_CPCA_MAX_CLUSTERS);
         return 0;
     }
     if (s->basis < 1 || s->basis > VDSH_MAX_COEFFS) {
         vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: basis %u out of range 1..%d", s->basis,
-              VDSH_MAX_COEFFS);
+                   VDSH_MAX_COEFFS);
         return 0;
     }
     if (s->bits < VDSH_CPCA_MIN_BITS || s->bits > VDSH_CPCA_MAX_BITS) {
         vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: bits %u out of range %d..%d", s->bits,
-              VDSH_CPCA_MIN_BITS, VDSH_CPCA_MAX_BITS);
+                   VDSH_CPCA_MIN_BITS, VDSH_CPCA_MAX_BITS);
         return 0;
     }
     return 1;
@@ -59,12 +59,12 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
         char *end;
         if (*p < '0' || *p > '9')
             return vdsh_failf(err, VDSH_ERR_ARGUMENT,
-                         "cpca settings '%s': expected K,B,BITS (for example 8,54,4)",
-                         text ? text : "");
+                              "cpca settings '%s': expected K,B,BITS (for example 8,54,4)",
+                              text ? text : "");
         v[k] = strtoul(p, &end, 10);
         if (v[k] > 100000 || *end != (k < 2 ? ',' : '\0'))
             return vdsh_failf(err, VDSH_ERR_ARGUMENT,
-                         "cpca settings '%s': expected K,B,BITS (for example 8,54,4)", text);
+                              "cpca settings '%s': expected K,B,BITS (for example 8,54,4)", text);
         p = end + (k < 2);
     }
     vdsh_cpca_settings s = {(uint32_t)v[0], (uint32_t)v[1], (uint32_t)v[2]};
@@ -157,9 +157,9 @@ static void jacobi(double *a, uint32_t n, double *v)
 
 typedef struct metric_dirs {
     uint32_t count, n;
-    double *dir;   /* 3 per direction */
-    double *wy;    /* per direction: sqrt(weight) * Y_i, n values */
-    double *full;  /* n x n: sum over all directions of weight * Y Y^T */
+    double *dir;  /* 3 per direction */
+    double *wy;   /* per direction: sqrt(weight) * Y_i, n values */
+    double *full; /* n x n: sum over all directions of weight * Y Y^T */
 } metric_dirs;
 
 static int metric_init(metric_dirs *m, uint32_t order)
@@ -270,8 +270,7 @@ static uint64_t splitmix(uint64_t *s)
 }
 
 /* Squared distance of row v's feature [c, ns * normal] to centre z. */
-static double feature_dist(const float *c, const float *nrm, uint32_t n, double ns,
-                           const double *z)
+static double feature_dist(const float *c, const float *nrm, uint32_t n, double ns, const double *z)
 {
     double d = 0.0;
     for (uint32_t i = 0; i < n; i++) {
@@ -404,15 +403,15 @@ static double quantise(double w, double s, int levels)
     return q > levels ? levels : q < -levels ? -levels : q;
 }
 
-vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t rows,
-                             uint32_t order, const vdsh_cpca_settings *settings,
-                             vdsh_cpca_fit *out, vdsh_error *err)
+vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t rows, uint32_t order,
+                             const vdsh_cpca_settings *settings, vdsh_cpca_fit *out,
+                             vdsh_error *err)
 {
     memset(out, 0, sizeof *out);
     if (!src || !normals || !settings || rows < 1 || rows > VDSH_MAX_VERTICES || order < 1 ||
         order > VDSH_MAX_ORDER)
         return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: bad arguments (rows %u, order %u)", rows,
-                     order);
+                          order);
     if (!check_settings(settings, err))
         return VDSH_ERR_ARGUMENT;
     const uint32_t n = order * order;
@@ -423,8 +422,7 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
     for (size_t x = 0; x < (size_t)rows * n; x++)
         if (!isfinite(src[x]))
             return vdsh_failf(err, VDSH_ERR_INVALID,
-                              "cpca: vertex %zu coefficient %zu is not finite",
-                              x / n, x % n);
+                              "cpca: vertex %zu coefficient %zu is not finite", x / n, x % n);
 
     /* one block: scales, means, bases, records */
     size_t o_means = ((size_t)k * b * 4 + 15) & ~(size_t)15;
@@ -492,8 +490,8 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
             uint16_t h = vdsh_f16_from_f32(m);
             if ((h & 0x7c00u) == 0x7c00u) {
                 res = vdsh_failf(err, VDSH_ERR_INVALID,
-                            "cpca: cluster %u's mean coefficient %u, %g, does not fit f16", c, i,
-                            (double)m);
+                                 "cpca: cluster %u's mean coefficient %u, %g, does not fit f16", c,
+                                 i, (double)m);
                 goto done;
             }
             means[(size_t)c * n + i] = h;
@@ -570,7 +568,7 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
                 uint16_t h = vdsh_f16_from_f32((float)bv[a]);
                 if ((h & 0x7c00u) == 0x7c00u) {
                     res = vdsh_failf(err, VDSH_ERR_INVALID,
-                                "cpca: cluster %u basis vector %u does not fit f16", c, j);
+                                     "cpca: cluster %u basis vector %u does not fit f16", c, j);
                     goto done;
                 }
                 bases[((size_t)c * b + j) * n + a] = h;
@@ -606,8 +604,8 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
                         for (uint32_t t = 0; t < SCALE_CANDIDATES; t++) {
                             double s = candidate_scale(wmax[j], t), e = w;
                             if (s > 0.0)
-                                e = w - quantise(w, s, levels) * (double)vdsh_cpca_step(
-                                                                     (float)s, bits);
+                                e = w -
+                                    quantise(w, s, levels) * (double)vdsh_cpca_step((float)s, bits);
                             cerr[(size_t)j * SCALE_CANDIDATES + t] += e * e;
                         }
                         continue;
@@ -629,15 +627,23 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
                 }
         }
     }
-    out->model = (vdsh_cpca){.clusters = k, .basis = b, .bits = bits, .record_words = words,
-                             .scales = scales, .means = means, .bases = bases};
+    out->model = (vdsh_cpca){.clusters = k,
+                             .basis = b,
+                             .bits = bits,
+                             .record_words = words,
+                             .scales = scales,
+                             .means = means,
+                             .bases = bases};
     out->records = records;
     out->storage_ = block;
     block = NULL;
     {
         /* the decode error, as every reader decodes */
-        vdsh_stream s = {.order = order, .encoding = VDSH_ENCODING_CPCA, .scale = 1.0f,
-                         .data = records, .cpca = out->model};
+        vdsh_stream s = {.order = order,
+                         .encoding = VDSH_ENCODING_CPCA,
+                         .scale = 1.0f,
+                         .data = records,
+                         .cpca = out->model};
         float dec[VDSH_MAX_COEFFS];
         double e2 = 0.0;
         for (uint32_t v = 0; v < rows; v++) {
@@ -677,10 +683,10 @@ vdsh_result vdsh_cpca_encode_stream(const vdsh_stream *src, uint32_t rows, const
     if (!src || src->encoding != VDSH_ENCODING_F32 || src->scale != 1.0f ||
         (src->flags & VDSH_STREAM_VARIABLE) || !src->data)
         return vdsh_failf(err, VDSH_ERR_ARGUMENT,
-                     "cpca: the source must be a fixed-order f32 stream with scale 1");
+                          "cpca: the source must be a fixed-order f32 stream with scale 1");
     vdsh_cpca_fit fit;
-    vdsh_result r = vdsh_cpca_encode((const float *)src->data, normals, rows, src->order,
-                                     settings, &fit, err);
+    vdsh_result r =
+        vdsh_cpca_encode((const float *)src->data, normals, rows, src->order, settings, &fit, err);
     if (r != VDSH_OK)
         return r;
     *out = *src;

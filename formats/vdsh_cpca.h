@@ -40,9 +40,9 @@ extern "C" {
 #endif
 
 typedef struct vdsh_cpca_settings {
-    uint32_t clusters;   /* K asked for, 1..VDSH_CPCA_MAX_CLUSTERS (capped at rows) */
-    uint32_t basis;      /* B asked for, 1..VDSH_MAX_COEFFS (capped at order^2) */
-    uint32_t bits;       /* VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS */
+    uint32_t clusters; /* K asked for, 1..VDSH_CPCA_MAX_CLUSTERS (capped at rows) */
+    uint32_t basis;    /* B asked for, 1..VDSH_MAX_COEFFS (capped at order^2) */
+    uint32_t bits;     /* VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS */
 } vdsh_cpca_settings;
 
 /* K = 8, B = 54, 4 bits (docs/ACCURACY.md "Compressed high orders"). */
@@ -67,9 +67,9 @@ typedef struct vdsh_cpca_fit {
  * VDSH_ERR_ARGUMENT for bad settings, order or rows; VDSH_ERR_INVALID for
  * a value that is not finite or a model that does not fit f16;
  * VDSH_ERR_OUT_OF_MEMORY. On failure *out is zeroed. */
-vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t rows,
-                             uint32_t order, const vdsh_cpca_settings *settings,
-                             vdsh_cpca_fit *out, vdsh_error *err);
+vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t rows, uint32_t order,
+                             const vdsh_cpca_settings *settings, vdsh_cpca_fit *out,
+                             vdsh_error *err);
 
 void vdsh_cpca_fit_free(vdsh_cpca_fit *fit);
 

@@ -27,12 +27,36 @@ void vdsh_cube_exr_dir(int face, int i, int j, int n, float dir[3])
     float u = centre(i, n), v = centre(j, n);
     /* The rows of the table in vdsh_cube.h, in face order. */
     switch (face) {
-    case 0: dir[0] = 1.0f; dir[1] = -v; dir[2] = u; break;
-    case 1: dir[0] = -1.0f; dir[1] = -v; dir[2] = -u; break;
-    case 2: dir[0] = u; dir[1] = 1.0f; dir[2] = -v; break;
-    case 3: dir[0] = u; dir[1] = -1.0f; dir[2] = v; break;
-    case 4: dir[0] = -u; dir[1] = -v; dir[2] = 1.0f; break;
-    default: dir[0] = u; dir[1] = -v; dir[2] = -1.0f; break;
+    case 0:
+        dir[0] = 1.0f;
+        dir[1] = -v;
+        dir[2] = u;
+        break;
+    case 1:
+        dir[0] = -1.0f;
+        dir[1] = -v;
+        dir[2] = -u;
+        break;
+    case 2:
+        dir[0] = u;
+        dir[1] = 1.0f;
+        dir[2] = -v;
+        break;
+    case 3:
+        dir[0] = u;
+        dir[1] = -1.0f;
+        dir[2] = v;
+        break;
+    case 4:
+        dir[0] = -u;
+        dir[1] = -v;
+        dir[2] = 1.0f;
+        break;
+    default:
+        dir[0] = u;
+        dir[1] = -v;
+        dir[2] = -1.0f;
+        break;
     }
 }
 
@@ -41,12 +65,36 @@ void vdsh_cube_gl_dir(int face, int i, int j, int n, float dir[3])
     check_texel(face, i, j, n);
     float s = centre(i, n), t = centre(j, n);
     switch (face) {
-    case 0: dir[0] = 1.0f; dir[1] = -t; dir[2] = -s; break;
-    case 1: dir[0] = -1.0f; dir[1] = -t; dir[2] = s; break;
-    case 2: dir[0] = s; dir[1] = 1.0f; dir[2] = t; break;
-    case 3: dir[0] = s; dir[1] = -1.0f; dir[2] = -t; break;
-    case 4: dir[0] = s; dir[1] = -t; dir[2] = 1.0f; break;
-    default: dir[0] = -s; dir[1] = -t; dir[2] = -1.0f; break;
+    case 0:
+        dir[0] = 1.0f;
+        dir[1] = -t;
+        dir[2] = -s;
+        break;
+    case 1:
+        dir[0] = -1.0f;
+        dir[1] = -t;
+        dir[2] = s;
+        break;
+    case 2:
+        dir[0] = s;
+        dir[1] = 1.0f;
+        dir[2] = t;
+        break;
+    case 3:
+        dir[0] = s;
+        dir[1] = -1.0f;
+        dir[2] = -t;
+        break;
+    case 4:
+        dir[0] = s;
+        dir[1] = -t;
+        dir[2] = 1.0f;
+        break;
+    default:
+        dir[0] = -s;
+        dir[1] = -t;
+        dir[2] = -1.0f;
+        break;
     }
 }
 
@@ -86,7 +134,8 @@ void vdsh_cube_fill_basis(int n, int first, float *rgba)
             for (int i = 0; i < n; i++) {
                 float y[VDSH_MAX_COEFFS];
                 exr_texel_basis(face, i, j, n, y);
-                float *o = rgba + (((size_t)face * (size_t)n + (size_t)j) * (size_t)n + (size_t)i) * 4;
+                float *o =
+                    rgba + (((size_t)face * (size_t)n + (size_t)j) * (size_t)n + (size_t)i) * 4;
                 o[0] = y[first];
                 o[1] = y[first + 1];
                 o[2] = y[first + 2];

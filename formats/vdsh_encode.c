@@ -68,8 +68,7 @@ float vdsh_f32_from_f16(uint16_t h)
     return f32_from_bits(sign | (e << 23) | ((m & 0x3ffu) << 13));
 }
 
-vdsh_result vdsh_encode_f16(const float *src, size_t n, float scale,
-                            uint16_t *dst)
+vdsh_result vdsh_encode_f16(const float *src, size_t n, float scale, uint16_t *dst)
 {
     if (!(scale > 0.0f) || !isfinite(scale))
         return VDSH_ERR_ARGUMENT;
@@ -141,15 +140,14 @@ static void quantise_record(uint32_t encoding, const float *c, uint32_t nc, cons
     }
 }
 
-vdsh_result vdsh_encode_quantised(uint32_t encoding, const float *src, size_t vertices,
-                                  uint32_t nc, float *scales, void *dst)
+vdsh_result vdsh_encode_quantised(uint32_t encoding, const float *src, size_t vertices, uint32_t nc,
+                                  float *scales, void *dst)
 {
     return vdsh_encode_quantised_drawn(encoding, src, vertices, nc, NULL, scales, dst);
 }
 
 vdsh_result vdsh_encode_quantised_drawn(uint32_t encoding, const float *src, size_t vertices,
-                                        uint32_t nc, const uint8_t *drawn, float *scales,
-                                        void *dst)
+                                        uint32_t nc, const uint8_t *drawn, float *scales, void *dst)
 {
     if (nc < 1 || nc > VDSH_MAX_COEFFS || !vdsh_encoding_quantised(encoding))
         return VDSH_ERR_ARGUMENT;
@@ -178,9 +176,8 @@ vdsh_result vdsh_encode_quantised_drawn(uint32_t encoding, const float *src, siz
 }
 
 vdsh_result vdsh_encode_variable(uint32_t encoding, const float *src, size_t stride,
-                                 const uint8_t *orders, uint32_t rows, uint32_t cap,
-                                 float scale, const uint32_t *offsets, float *scales,
-                                 void *dst)
+                                 const uint8_t *orders, uint32_t rows, uint32_t cap, float scale,
+                                 const uint32_t *offsets, float *scales, void *dst)
 {
     return vdsh_encode_variable_drawn(encoding, src, stride, orders, rows, cap, scale, offsets,
                                       NULL, scales, dst);
@@ -188,8 +185,8 @@ vdsh_result vdsh_encode_variable(uint32_t encoding, const float *src, size_t str
 
 vdsh_result vdsh_encode_variable_drawn(uint32_t encoding, const float *src, size_t stride,
                                        const uint8_t *orders, uint32_t rows, uint32_t cap,
-                                       float scale, const uint32_t *offsets,
-                                       const uint8_t *drawn, float *scales, void *dst)
+                                       float scale, const uint32_t *offsets, const uint8_t *drawn,
+                                       float *scales, void *dst)
 {
     if (cap < 1 || cap > VDSH_MAX_ORDER || stride < (size_t)cap * cap ||
         encoding > VDSH_ENCODING_LAST || !(scale > 0.0f) || !isfinite(scale))
@@ -366,14 +363,13 @@ static const vdsh_stream *find_stream(const vdsh_file *f, uint32_t order, uint32
     if (!f || !f->streams)
         return NULL;
     for (uint32_t i = 0; i < f->stream_count; i++)
-        if ((order == 0 || f->streams[i].order == order) &&
-            f->streams[i].quantity == quantity && f->streams[i].flags == flags)
+        if ((order == 0 || f->streams[i].order == order) && f->streams[i].quantity == quantity &&
+            f->streams[i].flags == flags)
             return &f->streams[i];
     return NULL;
 }
 
-const vdsh_stream *vdsh_find_stream(const vdsh_file *f, uint32_t order,
-                                    uint32_t quantity)
+const vdsh_stream *vdsh_find_stream(const vdsh_file *f, uint32_t order, uint32_t quantity)
 {
     return order ? find_stream(f, order, quantity, 0) : NULL;
 }
@@ -410,8 +406,7 @@ static void record_words_table(uint32_t encoding, uint32_t words[VDSH_ORDER_SLOT
         words[k] = vdsh_record_words(encoding, k);
 }
 
-void vdsh_stream_offsets(const uint8_t *orders, uint32_t rows, uint32_t encoding,
-                         uint32_t *offsets)
+void vdsh_stream_offsets(const uint8_t *orders, uint32_t rows, uint32_t encoding, uint32_t *offsets)
 {
     uint32_t words[VDSH_ORDER_SLOTS];
     record_words_table(encoding, words);
@@ -450,8 +445,8 @@ vdsh_stream_size vdsh_stream_size_of(const vdsh_stream *s, uint32_t rows)
         z.max_bytes = (uint32_t)vdsh_stream_bytes_per_vertex(s);
         z.mean_bytes = z.max_bytes;
         if (s->encoding == VDSH_ENCODING_CPCA && rows)
-            z.mean_bytes += (double)vdsh_cpca_model_bytes(s->order, s->cpca.clusters,
-                                                          s->cpca.basis) / rows;
+            z.mean_bytes +=
+                (double)vdsh_cpca_model_bytes(s->order, s->cpca.clusters, s->cpca.basis) / rows;
         return z;
     }
     for (uint32_t v = 0; v < rows; v++)
@@ -501,6 +496,6 @@ void vdsh_stream_decode(const vdsh_stream *s, uint32_t v, float *out)
             out[i] = 0.0f;
         return;
     }
-    decode_record(s, (const uint8_t *)s->data + (size_t)v * vdsh_encoding_bytes(s->encoding, n),
-                  n, out);
+    decode_record(s, (const uint8_t *)s->data + (size_t)v * vdsh_encoding_bytes(s->encoding, n), n,
+                  out);
 }

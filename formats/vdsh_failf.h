@@ -11,14 +11,15 @@
 #if defined(__GNUC__)
 __attribute__((format(printf, 3, 4)))
 #endif
-vdsh_result vdsh_failf(vdsh_error *err, vdsh_result r, const char *fmt, ...);
+vdsh_result
+vdsh_failf(vdsh_error *err, vdsh_result r, const char *fmt, ...);
 
 /* The same, the message preceded by "NAME: " (the file it is about;
  * "memory" when name is NULL; dropped when it fills the message). */
 #if defined(__GNUC__)
 __attribute__((format(printf, 4, 5)))
 #endif
-vdsh_result vdsh_failf_at(vdsh_error *err, vdsh_result r, const char *name, const char *fmt,
-                          ...);
+vdsh_result
+vdsh_failf_at(vdsh_error *err, vdsh_result r, const char *name, const char *fmt, ...);
 
 #endif

@@ -32,8 +32,7 @@
 #endif
 _Static_assert(sizeof(float) == 4 && FLT_MANT_DIG == 24 && FLT_MAX_EXP == 128,
                "float must be IEEE-754 binary32");
-_Static_assert(sizeof(double) == 8 && DBL_MANT_DIG == 53,
-               "double must be IEEE-754 binary64");
+_Static_assert(sizeof(double) == 8 && DBL_MANT_DIG == 53, "double must be IEEE-754 binary64");
 
 enum {
     FILE_HEADER_SIZE = 32,
@@ -51,8 +50,7 @@ enum {
     CPCA_HEADER_SIZE = 16 /* clusters, basis, bits, record_words */
 };
 
-static const uint8_t vdsh_magic[8] = {0x56, 0x44, 0x53, 0x48,
-                                      0x0D, 0x0A, 0x1A, 0x0A};
+static const uint8_t vdsh_magic[8] = {0x56, 0x44, 0x53, 0x48, 0x0D, 0x0A, 0x1A, 0x0A};
 
 /* ------------------------------------------------------------------ */
 /* Little-endian field access                                          */
@@ -60,8 +58,7 @@ static const uint8_t vdsh_magic[8] = {0x56, 0x44, 0x53, 0x48,
 
 static inline uint32_t get_u32(const uint8_t *p)
 {
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 |
-           (uint32_t)p[3] << 24;
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
 }
 
 static inline uint64_t get_u64(const uint8_t *p)
@@ -127,9 +124,15 @@ static inline float f32_from_bits(uint32_t u)
     return f;
 }
 
-static inline uint64_t pad16(uint64_t n) { return (16 - (n & 15)) & 15; }
+static inline uint64_t pad16(uint64_t n)
+{
+    return (16 - (n & 15)) & 15;
+}
 
-static inline size_t round16(size_t n) { return (n + 15) & ~(size_t)15; }
+static inline size_t round16(size_t n)
+{
+    return (n + 15) & ~(size_t)15;
+}
 
 static inline int all_zero(const uint8_t *p, size_t n)
 {
@@ -200,8 +203,7 @@ int vdsh_same_slot(const vdsh_stream *a, const vdsh_stream *b);
 const char *vdsh_slot_name(const vdsh_stream *s, char *buf, size_t n);
 
 /* "COEF order 5 distance": how messages name a stream. */
-void vdsh_stream_label(const vdsh_stream *s, uint32_t i, char *buf,
-                         size_t n);
+void vdsh_stream_label(const vdsh_stream *s, uint32_t i, char *buf, size_t n);
 
 int vdsh_check_header(const vdsh_header *h, why *w);
 
@@ -215,8 +217,7 @@ int vdsh_check_name(const uint8_t *name, size_t len, uint32_t i, why *w);
 
 int vdsh_check_stream(const vdsh_stream *s, uint32_t i, why *w);
 
-int vdsh_check_stream_data(const vdsh_stream *s, uint32_t i, uint32_t v,
-                             why *w);
+int vdsh_check_stream_data(const vdsh_stream *s, uint32_t i, uint32_t v, why *w);
 
 /* The statistics must describe a bake of vertex_count receivers. */
 int vdsh_check_stats(const vdsh_stats *t, uint32_t vertex_count, why *w);

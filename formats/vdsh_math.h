@@ -74,8 +74,8 @@ static inline void vdsh_unit3f_keep(float n[3])
 
 /* The right-handed view basis of a camera at `eye` looking at `target`:
  * f forward, s right, u up (all unit unless degenerate). */
-static inline void vdsh_look_at(const float eye[3], const float target[3], const float up[3], float s[3],
-                                float u[3], float f[3])
+static inline void vdsh_look_at(const float eye[3], const float target[3], const float up[3],
+                                float s[3], float u[3], float f[3])
 {
     f[0] = target[0] - eye[0];
     f[1] = target[1] - eye[1];
@@ -87,16 +87,25 @@ static inline void vdsh_look_at(const float eye[3], const float target[3], const
 }
 
 /* The GL view matrix (column-major) of that basis and eye. */
-static inline void vdsh_view_matrix(const float s[3], const float u[3], const float f[3], const float e[3],
-                                    float out[16])
+static inline void vdsh_view_matrix(const float s[3], const float u[3], const float f[3],
+                                    const float e[3], float out[16])
 {
-    const float m[16] = {
-        s[0], u[0], -f[0], 0.0f,
-        s[1], u[1], -f[1], 0.0f,
-        s[2], u[2], -f[2], 0.0f,
-        -(s[0] * e[0] + s[1] * e[1] + s[2] * e[2]),
-        -(u[0] * e[0] + u[1] * e[1] + u[2] * e[2]),
-        f[0] * e[0] + f[1] * e[1] + f[2] * e[2], 1.0f};
+    const float m[16] = {s[0],
+                         u[0],
+                         -f[0],
+                         0.0f,
+                         s[1],
+                         u[1],
+                         -f[1],
+                         0.0f,
+                         s[2],
+                         u[2],
+                         -f[2],
+                         0.0f,
+                         -(s[0] * e[0] + s[1] * e[1] + s[2] * e[2]),
+                         -(u[0] * e[0] + u[1] * e[1] + u[2] * e[2]),
+                         f[0] * e[0] + f[1] * e[1] + f[2] * e[2],
+                         1.0f};
     memcpy(out, m, sizeof m);
 }
 
@@ -136,10 +145,22 @@ static inline void vdsh_mat4d_trs(const double *t, const double *q, const double
         mt[12] = t[0], mt[13] = t[1], mt[14] = t[2];
     if (q) {
         const double x = q[0], y = q[1], z = q[2], w = q[3];
-        const double r[16] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0,
-                              2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0,
-                              2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0,
-                              0, 0, 0, 1};
+        const double r[16] = {1 - 2 * (y * y + z * z),
+                              2 * (x * y + z * w),
+                              2 * (x * z - y * w),
+                              0,
+                              2 * (x * y - z * w),
+                              1 - 2 * (x * x + z * z),
+                              2 * (y * z + x * w),
+                              0,
+                              2 * (x * z + y * w),
+                              2 * (y * z - x * w),
+                              1 - 2 * (x * x + y * y),
+                              0,
+                              0,
+                              0,
+                              0,
+                              1};
         memcpy(mr, r, sizeof r);
     }
     if (s)

@@ -53,7 +53,7 @@ static int open_stream(const char *path, vdsh_output *o, vdsh_error *err, vdsh_r
         return 0;
     if (!S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode)) {
         *res = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot write: %s", path,
-                    S_ISDIR(st.st_mode) ? "is a directory" : "not a regular file");
+                          S_ISDIR(st.st_mode) ? "is a directory" : "not a regular file");
         return -1;
     }
     int fd = open(path, O_WRONLY | O_NOCTTY | O_CLOEXEC);
@@ -64,8 +64,10 @@ static int open_stream(const char *path, vdsh_output *o, vdsh_error *err, vdsh_r
     /* What was opened, not what stat saw a moment ago, decides. */
     if (fstat(fd, &st) != 0 || (!S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode))) {
         close(fd);
-        *res = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot write: not a regular file "
-                    "(it changed while being opened)", path);
+        *res = vdsh_failf(err, VDSH_ERR_IO,
+                          "%s: cannot write: not a regular file "
+                          "(it changed while being opened)",
+                          path);
         return -1;
     }
     o->fd = fd;
@@ -80,7 +82,7 @@ vdsh_result vdsh_output_open(const char *path, vdsh_output *out, vdsh_error *err
         *out = o;
     if (!out || !path || !path[0])
         return vdsh_failf(err, VDSH_ERR_ARGUMENT, "%s: cannot write: no file name given",
-                    path ? path : "(null)");
+                          path ? path : "(null)");
     vdsh_result res = VDSH_OK;
     size_t len = strlen(path);
     o.path = malloc(len + 1);
@@ -110,8 +112,10 @@ vdsh_result vdsh_output_open(const char *path, vdsh_output *out, vdsh_error *err
                 break;
         }
         if (o.fd < 0) {
-            res = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot create a temporary file beside it "
-                       "(%s): %s", path, o.tmp, e == EEXIST ? "every name taken" : strerror(e));
+            res = vdsh_failf(err, VDSH_ERR_IO,
+                             "%s: cannot create a temporary file beside it "
+                             "(%s): %s",
+                             path, o.tmp, e == EEXIST ? "every name taken" : strerror(e));
             free(o.tmp); /* not ours: never unlink it */
             o.tmp = NULL;
             release(&o);
@@ -171,8 +175,8 @@ vdsh_result vdsh_output_finish(vdsh_output *o, vdsh_error *err)
     if (e) {
         vdsh_result r;
         if (o->tmp)
-            r = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot %s (temporary file %s): %s", o->path,
-                     step, o->tmp, strerror(e));
+            r = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot %s (temporary file %s): %s", o->path, step,
+                           o->tmp, strerror(e));
         else
             r = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot %s: %s", o->path, step, strerror(e));
         release(o);
@@ -217,7 +221,7 @@ vdsh_result vdsh_output_commit(vdsh_output *o, vdsh_error *err)
         if (rename(o->tmp, o->path) != 0) {
             int e = errno;
             r = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot rename %s to it: %s", o->path, o->tmp,
-                     strerror(e));
+                           strerror(e));
             release(o);
             return r;
         }
@@ -237,8 +241,7 @@ void vdsh_output_abort(vdsh_output *o)
         o->fd = -1;
 }
 
-vdsh_result vdsh_output_write(const char *path, const void *data, size_t size,
-                              vdsh_error *err)
+vdsh_result vdsh_output_write(const char *path, const void *data, size_t size, vdsh_error *err)
 {
     vdsh_output o;
     vdsh_result r = vdsh_output_open(path, &o, err);

@@ -71,12 +71,12 @@ extern "C" {
 #endif
 
 typedef struct vdsh_output {
-    char *path;      /* the target (a copy) */
-    char *tmp;       /* the temporary file; NULL for a stream target */
-    int fd;          /* open for writing until finished; -1 after */
-    FILE *fp;        /* a buffered stream on fd; NULL after finishing */
-    int error;       /* errno of the first failed vdsh_output_put, or 0 */
-    int finished;    /* data flushed, synced and closed */
+    char *path;   /* the target (a copy) */
+    char *tmp;    /* the temporary file; NULL for a stream target */
+    int fd;       /* open for writing until finished; -1 after */
+    FILE *fp;     /* a buffered stream on fd; NULL after finishing */
+    int error;    /* errno of the first failed vdsh_output_put, or 0 */
+    int finished; /* data flushed, synced and closed */
 } vdsh_output;
 
 /* Create the temporary file beside `path` (or open a stream target).
@@ -101,8 +101,7 @@ vdsh_result vdsh_output_commit(vdsh_output *o, vdsh_error *err);
 void vdsh_output_abort(vdsh_output *o);
 
 /* The whole file from memory: open, write `size` bytes, commit. */
-vdsh_result vdsh_output_write(const char *path, const void *data, size_t size,
-                              vdsh_error *err);
+vdsh_result vdsh_output_write(const char *path, const void *data, size_t size, vdsh_error *err);
 
 #ifdef __cplusplus
 }

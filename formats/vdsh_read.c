@@ -39,9 +39,8 @@ enum { WALK_OK, WALK_NO_HEADER, WALK_PAST_END };
  * past `size` (then only the id, size and stored CRC are filled).
  * Every comparison is written as `need > size - have` so nothing can wrap.
  */
-static int walk_chunk(const uint8_t *d, size_t size, uint64_t off,
-                      chunk_ref *c, uint32_t *crc_stored,
-                      uint32_t *crc_computed)
+static int walk_chunk(const uint8_t *d, size_t size, uint64_t off, chunk_ref *c,
+                      uint32_t *crc_stored, uint32_t *crc_computed)
 {
     if (CHUNK_HEADER_SIZE > size - off)
         return WALK_NO_HEADER;
@@ -57,8 +56,7 @@ static int walk_chunk(const uint8_t *d, size_t size, uint64_t off,
         return WALK_PAST_END;
     uint32_t crc = vdsh_crc32(0, h, 4);
     crc = vdsh_crc32(crc, h + 8, 8);
-    crc = vdsh_crc32(crc, h + CHUNK_HEADER_SIZE,
-                     (size_t)(c->size + pad16(c->size)));
+    crc = vdsh_crc32(crc, h + CHUNK_HEADER_SIZE, (size_t)(c->size + pad16(c->size)));
     *crc_computed = crc;
     return WALK_OK;
 }
@@ -90,8 +88,8 @@ typedef struct layout {
     uint32_t stream_count;
     vdsh_stream streams[VDSH_MAX_STREAMS]; /* data = offset, as an integer */
     uint64_t stream_data[VDSH_MAX_STREAMS];
-    uint64_t stream_table[VDSH_MAX_STREAMS]; /* s8: offset of the scales; else 0 */
-    uint64_t stream_bytes[VDSH_MAX_STREAMS]; /* COEF payload after the stream header */
+    uint64_t stream_table[VDSH_MAX_STREAMS];  /* s8: offset of the scales; else 0 */
+    uint64_t stream_bytes[VDSH_MAX_STREAMS];  /* COEF payload after the stream header */
     uint64_t stream_orders[VDSH_MAX_STREAMS]; /* variable order: its order table's bytes */
     uint64_t offset_words; /* the variable-order streams' offsets, rows + 1 each */
     int has_stats;
@@ -117,8 +115,7 @@ static vdsh_result invalid(const reader *r, const why *w)
 }
 
 /* Pass 1: file header, chunk walk, every CRC and padding. */
-static vdsh_result read_structure(const reader *r, chunk_ref *chunks,
-                                  uint32_t *count)
+static vdsh_result read_structure(const reader *r, chunk_ref *chunks, uint32_t *count)
 {
     const uint8_t *d = r->d;
     size_t size = r->size;
@@ -126,23 +123,22 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks,
     if (size < sizeof vdsh_magic) {
         if (memcmp(d, vdsh_magic, size) != 0)
             return vdsh_failf_at(r->err, VDSH_ERR_NOT_VDSH, r->name,
-                        "not a .vdsh file (wrong magic)");
+                                 "not a .vdsh file (wrong magic)");
         return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
-                    "truncated: %zu bytes, shorter than the %d-byte header",
-                    size, FILE_HEADER_SIZE);
+                             "truncated: %zu bytes, shorter than the %d-byte header", size,
+                             FILE_HEADER_SIZE);
     }
     if (memcmp(d, vdsh_magic, sizeof vdsh_magic) != 0) {
         if (memcmp(d, vdsh_magic, 4) == 0)
             return vdsh_failf_at(r->err, VDSH_ERR_NOT_VDSH, r->name,
-                        "not a .vdsh file: magic bytes 4..7 damaged (a "
-                        "text-mode transfer changes CR, LF and ^Z)");
-        return vdsh_failf_at(r->err, VDSH_ERR_NOT_VDSH, r->name,
-                    "not a .vdsh file (wrong magic)");
+                                 "not a .vdsh file: magic bytes 4..7 damaged (a "
+                                 "text-mode transfer changes CR, LF and ^Z)");
+        return vdsh_failf_at(r->err, VDSH_ERR_NOT_VDSH, r->name, "not a .vdsh file (wrong magic)");
     }
     if (size < FILE_HEADER_SIZE)
         return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
-                    "truncated: %zu bytes, shorter than the %d-byte header",
-                    size, FILE_HEADER_SIZE);
+                             "truncated: %zu bytes, shorter than the %d-byte header", size,
+                             FILE_HEADER_SIZE);
 
     /* The version comes before the header CRC: a later version may lay its
      * header out differently, and "unsupported version" is then the useful
@@ -151,36 +147,35 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks,
     uint32_t crc_stored = get_u32(d + 28);
     uint32_t crc_computed = vdsh_crc32(0, d, 28);
     if (version != VDSH_FORMAT_VERSION)
-        return vdsh_failf_at(r->err, VDSH_ERR_VERSION, r->name,
-                    "format version %u, this reader reads version %u%s",
-                    version, VDSH_FORMAT_VERSION,
-                    crc_stored == crc_computed
-                        ? ""
-                        : " (and the header CRC fails: the file may be "
-                          "damaged)");
+        return vdsh_failf_at(
+            r->err, VDSH_ERR_VERSION, r->name, "format version %u, this reader reads version %u%s",
+            version, VDSH_FORMAT_VERSION,
+            crc_stored == crc_computed ? ""
+                                       : " (and the header CRC fails: the file may be "
+                                         "damaged)");
     if (crc_stored != crc_computed)
         return vdsh_failf_at(r->err, VDSH_ERR_CRC, r->name,
-                    "header CRC mismatch (stored 0x%08x, computed 0x%08x)",
-                    crc_stored, crc_computed);
+                             "header CRC mismatch (stored 0x%08x, computed 0x%08x)", crc_stored,
+                             crc_computed);
 
     uint32_t chunk_count = get_u32(d + 12);
     uint64_t file_size = get_u64(d + 16);
     uint32_t flags = get_u32(d + 24);
     if ((uint64_t)size < file_size)
         return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
-                    "truncated: %zu bytes, the header says %llu", size,
-                    (unsigned long long)file_size);
+                             "truncated: %zu bytes, the header says %llu", size,
+                             (unsigned long long)file_size);
     if ((uint64_t)size > file_size)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                    "%zu bytes, but the header says %llu (data after the "
-                    "end)", size, (unsigned long long)file_size);
+                             "%zu bytes, but the header says %llu (data after the "
+                             "end)",
+                             size, (unsigned long long)file_size);
     if (flags != 0)
-        return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
-                    "header flags 0x%x, must be 0", flags);
+        return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name, "header flags 0x%x, must be 0",
+                             flags);
     if (chunk_count < 1 || chunk_count > MAX_CHUNKS)
-        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                    "chunk_count %u out of range 1..%d", chunk_count,
-                    MAX_CHUNKS);
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name, "chunk_count %u out of range 1..%d",
+                             chunk_count, MAX_CHUNKS);
 
     uint64_t off = FILE_HEADER_SIZE;
     for (uint32_t i = 0; i < chunk_count; i++) {
@@ -190,39 +185,39 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks,
         int w = walk_chunk(d, size, off, c, &cs, &cc);
         if (w == WALK_NO_HEADER)
             return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
-                        "chunk %u at offset %llu: header runs past the end "
-                        "of the file (%u chunks announced)", i,
-                        (unsigned long long)off, chunk_count);
+                                 "chunk %u at offset %llu: header runs past the end "
+                                 "of the file (%u chunks announced)",
+                                 i, (unsigned long long)off, chunk_count);
         printable_id(d + off, pid);
         if (w == WALK_PAST_END)
             return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
-                        "chunk %u '%s' at offset %llu: payload of %llu bytes "
-                        "runs past the end of the file", i, pid,
-                        (unsigned long long)off,
-                        (unsigned long long)c->size);
+                                 "chunk %u '%s' at offset %llu: payload of %llu bytes "
+                                 "runs past the end of the file",
+                                 i, pid, (unsigned long long)off, (unsigned long long)c->size);
         if (cs != cc)
             return vdsh_failf_at(r->err, VDSH_ERR_CRC, r->name,
-                        "chunk %u '%s' at offset %llu: CRC mismatch (stored "
-                        "0x%08x, computed 0x%08x)", i, pid,
-                        (unsigned long long)off, cs, cc);
+                                 "chunk %u '%s' at offset %llu: CRC mismatch (stored "
+                                 "0x%08x, computed 0x%08x)",
+                                 i, pid, (unsigned long long)off, cs, cc);
         for (int k = 0; k < 4; k++)
             if (!is_letter(d[off + k]))
                 return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                            "chunk %u at offset %llu: id %02x %02x %02x %02x "
-                            "is not four ASCII letters", i,
-                            (unsigned long long)off, d[off], d[off + 1],
-                            d[off + 2], d[off + 3]);
+                                     "chunk %u at offset %llu: id %02x %02x %02x %02x "
+                                     "is not four ASCII letters",
+                                     i, (unsigned long long)off, d[off], d[off + 1], d[off + 2],
+                                     d[off + 3]);
         uint64_t payload = off + CHUNK_HEADER_SIZE;
         if (!all_zero(d + payload + c->size, (size_t)pad16(c->size)))
             return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                        "chunk %u '%s' at offset %llu: padding byte not "
-                        "zero", i, pid, (unsigned long long)off);
+                                 "chunk %u '%s' at offset %llu: padding byte not "
+                                 "zero",
+                                 i, pid, (unsigned long long)off);
         off = payload + c->size + pad16(c->size);
     }
     if (off != size)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                    "%llu bytes after the last of %u chunks",
-                    (unsigned long long)(size - off), chunk_count);
+                             "%llu bytes after the last of %u chunks",
+                             (unsigned long long)(size - off), chunk_count);
     *count = chunk_count;
     return VDSH_OK;
 }
@@ -234,12 +229,12 @@ static vdsh_result read_head(const reader *r, const chunk_ref *c, layout *L)
     why w;
     if (c->size != HEAD_SIZE)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                    "HEAD: payload is %llu bytes, must be %d",
-                    (unsigned long long)c->size, HEAD_SIZE);
+                             "HEAD: payload is %llu bytes, must be %d", (unsigned long long)c->size,
+                             HEAD_SIZE);
     vdsh_fields_get(&vdsh_head_chunk, p, h);
     if (!all_zero(p + 80, 48))
         return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
-                    "HEAD: reserved bytes 80..127 not zero");
+                             "HEAD: reserved bytes 80..127 not zero");
     if (!vdsh_check_header(h, &w))
         return invalid(r, &w);
     return VDSH_OK;
@@ -252,37 +247,35 @@ static vdsh_result read_srcs(const reader *r, const chunk_ref *c, layout *L)
     why w;
     if (n < 4)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                    "SRCS: payload of %llu bytes has no count",
-                    (unsigned long long)n);
+                             "SRCS: payload of %llu bytes has no count", (unsigned long long)n);
     uint32_t count = get_u32(p);
     if (count > VDSH_MAX_SOURCES)
-        return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
-                    "SRCS: count %u out of range 0..%d", count,
-                    VDSH_MAX_SOURCES);
+        return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name, "SRCS: count %u out of range 0..%d",
+                             count, VDSH_MAX_SOURCES);
     L->names_bytes = 0;
     for (uint32_t i = 0; i < count; i++) {
         if (SOURCE_FIXED_SIZE > n - off)
             return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                        "SRCS: source %u runs past the end of the payload",
-                        i);
+                                 "SRCS: source %u runs past the end of the payload", i);
         uint32_t len = get_u32(p + off + 40);
         L->source_sha[i] = c->offset + CHUNK_HEADER_SIZE + off;
         L->source_size[i] = get_u64(p + off + 32);
         off += SOURCE_FIXED_SIZE;
         if (len < 1 || len > VDSH_MAX_NAME)
             return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
-                        "SRCS: source %u: name_length %u out of range 1..%d",
-                        i, len, VDSH_MAX_NAME);
+                                 "SRCS: source %u: name_length %u out of range 1..%d", i, len,
+                                 VDSH_MAX_NAME);
         uint64_t padded = ((uint64_t)len + 3) & ~(uint64_t)3;
         if (padded > n - off)
             return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                        "SRCS: source %u: name runs past the end of the "
-                        "payload", i);
+                                 "SRCS: source %u: name runs past the end of the "
+                                 "payload",
+                                 i);
         if (!vdsh_check_name(p + off, len, i, &w))
             return invalid(r, &w);
         if (!all_zero(p + off + len, (size_t)(padded - len)))
             return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                        "SRCS: source %u: name padding not zero", i);
+                                 "SRCS: source %u: name padding not zero", i);
         L->source_name[i] = c->offset + CHUNK_HEADER_SIZE + off;
         L->source_name_len[i] = len;
         L->names_bytes += (size_t)len + 1;
@@ -290,21 +283,19 @@ static vdsh_result read_srcs(const reader *r, const chunk_ref *c, layout *L)
     }
     if (off != n)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                    "SRCS: %llu bytes after the last source",
-                    (unsigned long long)(n - off));
+                             "SRCS: %llu bytes after the last source",
+                             (unsigned long long)(n - off));
     L->source_count = count;
     return VDSH_OK;
 }
 
 /* POSN, NORM and TRIS: 12 bytes per vertex or triangle. */
-static vdsh_result read_array(const reader *r, const chunk_ref *c,
-                              uint32_t count, const char *what)
+static vdsh_result read_array(const reader *r, const chunk_ref *c, uint32_t count, const char *what)
 {
     if (c->size != (uint64_t)count * 12)
-        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                    "%s: payload is %llu bytes, %u %s need %llu", c->id,
-                    (unsigned long long)c->size, count, what,
-                    (unsigned long long)count * 12);
+        return vdsh_failf_at(
+            r->err, VDSH_ERR_CHUNK, r->name, "%s: payload is %llu bytes, %u %s need %llu", c->id,
+            (unsigned long long)c->size, count, what, (unsigned long long)count * 12);
     return VDSH_OK;
 }
 
@@ -317,13 +308,13 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
     char l[96];
     why w;
     if (i >= VDSH_MAX_STREAMS)
-        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                    "more than %d COEF chunks", VDSH_MAX_STREAMS);
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name, "more than %d COEF chunks",
+                             VDSH_MAX_STREAMS);
     if (c->size < STREAM_HEADER_SIZE)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                    "COEF stream %u: payload of %llu bytes is shorter than "
-                    "the %d-byte stream header", i,
-                    (unsigned long long)c->size, STREAM_HEADER_SIZE);
+                             "COEF stream %u: payload of %llu bytes is shorter than "
+                             "the %d-byte stream header",
+                             i, (unsigned long long)c->size, STREAM_HEADER_SIZE);
     vdsh_fields_get(&vdsh_stream_header, p, s);
     s->data = NULL;
     s->orders = NULL;
@@ -332,12 +323,13 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
     vdsh_stream_label(s, i, l, sizeof l);
     if (!all_zero(p + 40, 8))
         return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
-                    "%s: reserved bytes 40..47 not zero", l);
+                             "%s: reserved bytes 40..47 not zero", l);
     if (s->encoding == VDSH_ENCODING_CPCA) {
         if (c->size - STREAM_HEADER_SIZE < CPCA_HEADER_SIZE)
             return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                        "%s: %llu bytes of data, shorter than the %d-byte cpca header", l,
-                        (unsigned long long)(c->size - STREAM_HEADER_SIZE), CPCA_HEADER_SIZE);
+                                 "%s: %llu bytes of data, shorter than the %d-byte cpca header", l,
+                                 (unsigned long long)(c->size - STREAM_HEADER_SIZE),
+                                 CPCA_HEADER_SIZE);
         s->cpca.clusters = get_u32(p + STREAM_HEADER_SIZE);
         s->cpca.basis = get_u32(p + STREAM_HEADER_SIZE + 4);
         s->cpca.bits = get_u32(p + STREAM_HEADER_SIZE + 8);
@@ -350,9 +342,9 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
                          : vdsh_stream_table_bytes(s->encoding, s->order);
     if (c->size - STREAM_HEADER_SIZE < table)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                    "%s: %llu bytes of data, shorter than its %llu-byte scale table", l,
-                    (unsigned long long)(c->size - STREAM_HEADER_SIZE),
-                    (unsigned long long)table);
+                             "%s: %llu bytes of data, shorter than its %llu-byte scale table", l,
+                             (unsigned long long)(c->size - STREAM_HEADER_SIZE),
+                             (unsigned long long)table);
     if (table && s->encoding == VDSH_ENCODING_CPCA) {
         uint64_t n = (uint64_t)s->order * s->order, k = s->cpca.clusters, b = s->cpca.basis;
         uint64_t sizes[3] = {4 * k * b, 2 * k * n, 2 * k * b * n};
@@ -362,20 +354,21 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
             uint64_t padded = (sizes[a] + 15) & ~15ull;
             if (!all_zero(q + sizes[a], (size_t)(padded - sizes[a])))
                 return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
-                            "%s: padding after the cpca %s not zero", l, what[a]);
+                                     "%s: padding after the cpca %s not zero", l, what[a]);
             q += padded;
         }
     } else if (table) {
         size_t used = (size_t)s->order * s->order * 4;
         if (!all_zero(p + STREAM_HEADER_SIZE + used, (size_t)table - used))
             return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
-                        "%s: padding after the scale table not zero", l);
+                                 "%s: padding after the scale table not zero", l);
     }
     for (uint32_t k = 0; k < i; k++)
         if (vdsh_same_slot(&L->streams[k], s))
             return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
-                        "%s: a second stream for %s (stream %u is "
-                        "the first)", l, vdsh_slot_name(s, slot, sizeof slot), k);
+                                 "%s: a second stream for %s (stream %u is "
+                                 "the first)",
+                                 l, vdsh_slot_name(s, slot, sizeof slot), k);
     L->stream_table[i] = table ? c->offset + CHUNK_HEADER_SIZE + STREAM_HEADER_SIZE : 0;
     L->stream_data[i] = c->offset + CHUNK_HEADER_SIZE + STREAM_HEADER_SIZE + table;
     L->stream_bytes[i] = c->size - STREAM_HEADER_SIZE;
@@ -388,8 +381,7 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
  * chunks. */
 static vdsh_result check_coef_sizes(const reader *r, layout *L)
 {
-    uint32_t rows = L->has_part ? L->part.range_end - L->part.range_begin
-                                : L->header.vertex_count;
+    uint32_t rows = L->has_part ? L->part.range_end - L->part.range_begin : L->header.vertex_count;
     why w;
     for (uint32_t i = 0; i < L->stream_count; i++) {
         vdsh_stream *s = &L->streams[i];
@@ -403,26 +395,27 @@ static vdsh_result check_coef_sizes(const reader *r, layout *L)
             orders = round16(rows);
             if (L->stream_bytes[i] < table + orders)
                 return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                            "%s: %llu bytes of data, shorter than its scale and order "
-                            "tables (%llu bytes)", l, (unsigned long long)L->stream_bytes[i],
-                            (unsigned long long)(table + orders));
+                                     "%s: %llu bytes of data, shorter than its scale and order "
+                                     "tables (%llu bytes)",
+                                     l, (unsigned long long)L->stream_bytes[i],
+                                     (unsigned long long)(table + orders));
             s->orders = r->d + L->stream_data[i];
             if (!all_zero(s->orders + rows, orders - rows))
                 return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
-                            "%s: padding after the order table not zero", l);
+                                     "%s: padding after the order table not zero", l);
             for (uint32_t v = 0; v < rows; v++) /* before the sizes they imply */
                 if (s->orders[v] < 1 || s->orders[v] > s->order)
                     return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
-                                "%s: vertex %u has order %u (1..%u)", l, v, s->orders[v],
-                                s->order);
+                                         "%s: vertex %u has order %u (1..%u)", l, v, s->orders[v],
+                                         s->order);
         }
         uint64_t need = table + vdsh_stream_data_bytes(s, rows);
         if (L->stream_bytes[i] != need)
             return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                        "%s: %llu bytes of data, %u vertices of %s need %llu%s", l,
-                        (unsigned long long)L->stream_bytes[i], rows,
-                        vdsh_encoding_name(s->encoding), (unsigned long long)need,
-                        L->has_part ? " (a part: its range's receivers)" : "");
+                                 "%s: %llu bytes of data, %u vertices of %s need %llu%s", l,
+                                 (unsigned long long)L->stream_bytes[i], rows,
+                                 vdsh_encoding_name(s->encoding), (unsigned long long)need,
+                                 L->has_part ? " (a part: its range's receivers)" : "");
         s->coef_scales = table && !cpca ? (const float *)(r->d + L->stream_table[i]) : NULL;
         if (cpca)
             vdsh_cpca_bind(s, r->d + L->stream_table[i]);
@@ -444,12 +437,10 @@ static vdsh_result check_coef_sizes(const reader *r, layout *L)
 
 /* stat, time, part, adpt: at most one each, of a fixed size, decoded by
  * the table the writer encodes with, then checked as the writer checks. */
-static vdsh_result read_fixed(const reader *r, const chunk_ref *c, uint32_t i, int kind,
-                              layout *L)
+static vdsh_result read_fixed(const reader *r, const chunk_ref *c, uint32_t i, int kind, layout *L)
 {
     const vdsh_fixed_chunk *k = &vdsh_fixed_chunks[kind];
-    int *has[VDSH_FIXED_COUNT] = {&L->has_stats, &L->has_timings, &L->has_part,
-                                  &L->has_adaptive};
+    int *has[VDSH_FIXED_COUNT] = {&L->has_stats, &L->has_timings, &L->has_part, &L->has_adaptive};
     void *out[VDSH_FIXED_COUNT] = {&L->stats, &L->timings, &L->part, &L->adaptive};
     const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
     uint32_t vc = L->header.vertex_count;
@@ -478,8 +469,8 @@ static vdsh_result read_fixed(const reader *r, const chunk_ref *c, uint32_t i, i
 }
 
 /* Pass 2: which chunks, in which numbers, with which contents. */
-static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
-                                 uint32_t count, layout *L)
+static vdsh_result read_contents(const reader *r, const chunk_ref *chunks, uint32_t count,
+                                 layout *L)
 {
     const char *required[4] = {"SRCS", "POSN", "NORM", "TRIS"};
     int seen[4] = {0, 0, 0, 0};
@@ -488,7 +479,7 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
 
     if (memcmp(chunks[0].id, "HEAD", 4) != 0)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                    "chunk 0 is '%s'; HEAD must come first", chunks[0].id);
+                             "chunk 0 is '%s'; HEAD must come first", chunks[0].id);
     if ((res = read_head(r, &chunks[0], L)) != VDSH_OK)
         return res;
     const vdsh_header *h = &L->header;
@@ -502,13 +493,13 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
                 req = k;
         if (req >= 0 && seen[req]++)
             return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                        "chunk %u at offset %llu: a second %s chunk", i,
-                        (unsigned long long)c->offset, c->id);
+                                 "chunk %u at offset %llu: a second %s chunk", i,
+                                 (unsigned long long)c->offset, c->id);
 
         if (memcmp(c->id, "HEAD", 4) == 0) {
             return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                        "chunk %u at offset %llu: a second HEAD chunk", i,
-                        (unsigned long long)c->offset);
+                                 "chunk %u at offset %llu: a second HEAD chunk", i,
+                                 (unsigned long long)c->offset);
         } else if (req == 0) {
             res = read_srcs(r, c, L);
         } else if (req == 1 || req == 2) { /* POSN, NORM */
@@ -519,10 +510,8 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
                 res = invalid(r, &w);
             *(req == 1 ? &L->posn : &L->norm) = c->offset + CHUNK_HEADER_SIZE;
         } else if (req == 3) {
-            if ((res = read_array(r, c, h->triangle_count, "triangles")) ==
-                    VDSH_OK &&
-                !vdsh_check_indices((const uint32_t *)p, h->triangle_count,
-                               h->vertex_count, &w))
+            if ((res = read_array(r, c, h->triangle_count, "triangles")) == VDSH_OK &&
+                !vdsh_check_indices((const uint32_t *)p, h->triangle_count, h->vertex_count, &w))
                 res = invalid(r, &w);
             L->tris = c->offset + CHUNK_HEADER_SIZE;
         } else if (memcmp(c->id, "COEF", 4) == 0) {
@@ -531,9 +520,9 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
             res = read_fixed(r, c, i, fixed, L);
         } else if (c->id[0] >= 'A' && c->id[0] <= 'Z') {
             res = vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                       "chunk %u '%s' at offset %llu: unknown critical chunk "
-                       "(a newer writer?)", i, c->id,
-                       (unsigned long long)c->offset);
+                                "chunk %u '%s' at offset %llu: unknown critical chunk "
+                                "(a newer writer?)",
+                                i, c->id, (unsigned long long)c->offset);
         } else {
             res = VDSH_OK; /* unknown ancillary: its CRC was checked; skip */
         }
@@ -542,8 +531,7 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
     }
     for (int k = 0; k < 4; k++)
         if (!seen[k])
-            return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name, "no %s chunk",
-                        required[k]);
+            return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name, "no %s chunk", required[k]);
     if (L->stream_count == 0)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name, "no COEF chunk");
     return check_coef_sizes(r, L);
@@ -554,8 +542,8 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks,
  * hands over: it is owned by the result, or freed on failure) and build
  * the vdsh_file around it.
  */
-static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name,
-                              vdsh_file **out, vdsh_error *err)
+static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name, vdsh_file **out,
+                              vdsh_error *err)
 {
     reader r = {buf, size, name ? name : "memory", err};
     chunk_ref chunks[MAX_CHUNKS];
@@ -574,10 +562,8 @@ static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name,
     /* One block for the vdsh_file, its stream and source arrays and the
      * names; the file bytes stay in `buf`, which becomes storage_. */
     size_t off_streams = round16(sizeof(vdsh_file));
-    size_t off_sources =
-        off_streams + round16(L.stream_count * sizeof(vdsh_stream));
-    size_t off_names =
-        off_sources + round16(L.source_count * sizeof(vdsh_source));
+    size_t off_sources = off_streams + round16(L.stream_count * sizeof(vdsh_stream));
+    size_t off_names = off_sources + round16(L.source_count * sizeof(vdsh_source));
     size_t off_offsets = off_names + round16(L.names_bytes);
     if (L.offset_words > (SIZE_MAX - off_offsets) / 4) {
         free(buf);
@@ -587,8 +573,8 @@ static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name,
     uint8_t *block = (uint8_t *)calloc(1, block_size);
     if (!block) {
         free(buf);
-        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, r.name,
-                    "out of memory (%zu bytes)", block_size);
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, r.name, "out of memory (%zu bytes)",
+                             block_size);
     }
     vdsh_file *f = (vdsh_file *)block;
     f->storage_ = buf;
@@ -606,7 +592,8 @@ static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name,
         *st = L.streams[i];
         st->data = buf + L.stream_data[i] + L.stream_orders[i];
         st->coef_scales = L.stream_table[i] && st->encoding != VDSH_ENCODING_CPCA
-                              ? (const float *)(buf + L.stream_table[i]) : NULL;
+                              ? (const float *)(buf + L.stream_table[i])
+                              : NULL;
         if (st->encoding == VDSH_ENCODING_CPCA)
             vdsh_cpca_bind(st, buf + L.stream_table[i]);
         if (vdsh_stream_variable(st)) {
@@ -655,17 +642,16 @@ uint32_t vdsh_file_stream_vertices(const vdsh_file *f)
     return f->has_part ? f->part.range_end - f->part.range_begin : f->header.vertex_count;
 }
 
-vdsh_result vdsh_read_memory(const void *data, size_t size, const char *name,
-                             vdsh_file **out, vdsh_error *err)
+vdsh_result vdsh_read_memory(const void *data, size_t size, const char *name, vdsh_file **out,
+                             vdsh_error *err)
 {
     const char *nm = name ? name : "memory";
     if (!out || (!data && size))
         return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, nm, "vdsh_read_memory: NULL %s",
-                    out ? "data" : "out");
+                             out ? "data" : "out");
     uint8_t *buf = alloc_file_buffer(size);
     if (!buf)
-        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, nm,
-                    "out of memory (%zu bytes)", size);
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, nm, "out of memory (%zu bytes)", size);
     if (size)
         memcpy(buf, data, size);
     return load_owned(buf, size, nm, out, err);
@@ -674,8 +660,8 @@ vdsh_result vdsh_read_memory(const void *data, size_t size, const char *name,
 vdsh_result vdsh_read(const char *path, vdsh_file **out, vdsh_error *err)
 {
     if (!path || !out)
-        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, path ? path : "(null)",
-                    "vdsh_read: NULL %s", path ? "out" : "path");
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, path ? path : "(null)", "vdsh_read: NULL %s",
+                             path ? "out" : "path");
     /* O_NONBLOCK: opening a FIFO must not wait for a writer (it is refused
      * below, as anything but a regular file); regular files ignore it. */
     int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
@@ -698,15 +684,14 @@ vdsh_result vdsh_read(const char *path, vdsh_file **out, vdsh_error *err)
     }
     if ((uintmax_t)st.st_size > (uintmax_t)(SIZE_MAX - 15)) {
         fclose(fp);
-        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, path,
-                    "%jd bytes do not fit in memory", (intmax_t)st.st_size);
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, path, "%jd bytes do not fit in memory",
+                             (intmax_t)st.st_size);
     }
     size_t size = (size_t)st.st_size;
     uint8_t *buf = alloc_file_buffer(size);
     if (!buf) {
         fclose(fp);
-        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, path,
-                    "out of memory (%zu bytes)", size);
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, path, "out of memory (%zu bytes)", size);
     }
     size_t got = size ? fread(buf, 1, size, fp) : 0;
     int read_error = ferror(fp), e = errno;
@@ -717,10 +702,9 @@ vdsh_result vdsh_read(const char *path, vdsh_file **out, vdsh_error *err)
     if (read_error || got != size || grew) {
         free(buf);
         if (read_error)
-            return vdsh_failf_at(err, VDSH_ERR_IO, path, "read error: %s",
-                        strerror(e));
+            return vdsh_failf_at(err, VDSH_ERR_IO, path, "read error: %s", strerror(e));
         return vdsh_failf_at(err, VDSH_ERR_IO, path,
-                    "the file changed size while it was being read");
+                             "the file changed size while it was being read");
     }
     return load_owned(buf, size, path, out, err);
 }
@@ -737,23 +721,21 @@ void vdsh_free(vdsh_file *f)
 /* Chunk listing (vdsh-info --verify)                                  */
 /* ------------------------------------------------------------------ */
 
-vdsh_result vdsh_scan_chunks(const void *data, size_t size, const char *name,
-                             vdsh_chunk_info *out, uint32_t max,
-                             uint32_t *count, vdsh_error *err)
+vdsh_result vdsh_scan_chunks(const void *data, size_t size, const char *name, vdsh_chunk_info *out,
+                             uint32_t max, uint32_t *count, vdsh_error *err)
 {
     const uint8_t *d = (const uint8_t *)data;
     const char *nm = name ? name : "memory";
     if (!count || (!data && size) || (!out && max))
-        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, nm, "vdsh_scan_chunks: NULL "
-                    "argument");
-    if (size && memcmp(d, vdsh_magic,
-                       size < sizeof vdsh_magic ? size : sizeof vdsh_magic))
-        return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, nm,
-                    "not a .vdsh file (wrong magic)");
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, nm,
+                             "vdsh_scan_chunks: NULL "
+                             "argument");
+    if (size && memcmp(d, vdsh_magic, size < sizeof vdsh_magic ? size : sizeof vdsh_magic))
+        return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, nm, "not a .vdsh file (wrong magic)");
     if (size < FILE_HEADER_SIZE)
         return vdsh_failf_at(err, VDSH_ERR_TRUNCATED, nm,
-                    "truncated: %zu bytes, shorter than the %d-byte header",
-                    size, FILE_HEADER_SIZE);
+                             "truncated: %zu bytes, shorter than the %d-byte header", size,
+                             FILE_HEADER_SIZE);
     uint64_t off = FILE_HEADER_SIZE;
     uint32_t n = 0;
     while (off < size && n < UINT32_MAX) {

@@ -126,8 +126,8 @@ void vdsh_view_fit_camera(const float lo[3], const float hi[3], vdsh_camera *out
     *out = cam;
 }
 
-int vdsh_view_preferred_lights(const float lo[3], const float hi[3], int interior,
-                               float (*out)[3], int max)
+int vdsh_view_preferred_lights(const float lo[3], const float hi[3], int interior, float (*out)[3],
+                               int max)
 {
     /* A room: in bounds fractions (x, y, z), light 0 a little off centre
      * at 40% of the height, the others toward the corners, so that props
@@ -159,9 +159,8 @@ int vdsh_view_preferred_lights(const float lo[3], const float hi[3], int interio
  * distance, barycentrics and determinant (< 0: the back of the face), or
  * 0. The arithmetic is written once, so that the grid and the plain loop
  * compute the same bits. */
-static inline int intersect(const float o[3], const float d[3], const float *a,
-                            const float *b, const float *c, float *dist, float *uu,
-                            float *vv, float *det_out)
+static inline int intersect(const float o[3], const float d[3], const float *a, const float *b,
+                            const float *c, float *dist, float *uu, float *vv, float *det_out)
 {
     float e1[3], e2[3], s[3], q[3];
     for (int k = 0; k < 3; k++) {
@@ -240,8 +239,8 @@ static inline void test_triangle(const float *positions, const uint32_t *indices
     best->back = det < 0.0f;
 }
 
-int vdsh_view_trace_all(const vdsh_view_mesh *m, const float org[3], const float dir[3],
-                        float tmin, vdsh_view_hit *hit)
+int vdsh_view_trace_all(const vdsh_view_mesh *m, const float org[3], const float dir[3], float tmin,
+                        vdsh_view_hit *hit)
 {
     vdsh_view_hit best = {INFINITY, 0.0f, 0.0f, UINT32_MAX, 0};
     for (uint32_t t = 0; t < m->triangle_count; t++)
@@ -348,8 +347,8 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
     for (size_t i = 0; i < 3 * (size_t)m->triangle_count; i++)
         if (m->indices[i] >= m->vertex_count)
             return vdsh_failf(err, VDSH_ERR_INVALID,
-                        "mesh: triangle %zu: vertex index %u not below the %u vertices", i / 3,
-                        m->indices[i], m->vertex_count);
+                              "mesh: triangle %zu: vertex index %u not below the %u vertices",
+                              i / 3, m->indices[i], m->vertex_count);
     vdsh_view_tracer *g = calloc(1, sizeof *g);
     if (!g)
         return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "mesh: out of memory (ray grid)");
@@ -389,8 +388,8 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
     for (;;) {
         grid_size(g, ext, h);
         uint64_t refs = grid_refs(g);
-        if (refs <= 8ull * m->triangle_count + 1024 || (g->n[0] == 1 && g->n[1] == 1 &&
-                                                        g->n[2] == 1)) {
+        if (refs <= 8ull * m->triangle_count + 1024 ||
+            (g->n[0] == 1 && g->n[1] == 1 && g->n[2] == 1)) {
             size_t cells = (size_t)g->n[0] * (size_t)g->n[1] * (size_t)g->n[2];
             g->start = calloc(cells + 1, sizeof *g->start);
             g->tris = malloc((size_t)(refs ? refs : 1) * sizeof *g->tris);
@@ -421,8 +420,8 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
     return VDSH_OK;
 }
 
-int vdsh_view_trace(const vdsh_view_tracer *g, const float org[3], const float dir[3],
-                    float tmin, vdsh_view_hit *hit)
+int vdsh_view_trace(const vdsh_view_tracer *g, const float org[3], const float dir[3], float tmin,
+                    vdsh_view_hit *hit)
 {
     /* The ray's stretch inside the grid's box (slabs). */
     float t0 = tmin > 0.0f ? tmin : 0.0f, t1 = INFINITY;
@@ -456,9 +455,9 @@ int vdsh_view_trace(const vdsh_view_tracer *g, const float org[3], const float d
         float next[3];
         int axis = 0;
         for (int k = 0; k < 3; k++) {
-            next[k] = step[k] ? (g->lo[k] + (float)(c[k] + (step[k] > 0)) * g->cell[k] -
-                                 org[k]) / dir[k]
-                              : INFINITY;
+            next[k] =
+                step[k] ? (g->lo[k] + (float)(c[k] + (step[k] > 0)) * g->cell[k] - org[k]) / dir[k]
+                        : INFINITY;
             if (next[k] < next[axis])
                 axis = k;
         }
@@ -526,8 +525,8 @@ int vdsh_view_room_camera_free(const vdsh_view_tracer *t, const float lo[3], con
     return 0;
 }
 
-float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
-                            const float lo[3], const float hi[3])
+float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m, const float lo[3],
+                            const float hi[3])
 {
     vdsh_camera room;
     vdsh_view_room_camera_free(t, lo, hi, &room);
@@ -583,8 +582,8 @@ typedef struct frame_pts {
     float (*nrm)[3];
 } frame_pts;
 
-static int frame_points(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
-                        const vdsh_camera *c, int width, int height, frame_pts *out)
+static int frame_points(const vdsh_view_tracer *t, const vdsh_view_mesh *m, const vdsh_camera *c,
+                        int width, int height, frame_pts *out)
 {
     size_t pixels = (size_t)width * (size_t)height;
     out->n = 0;
@@ -771,7 +770,7 @@ static int find_free(const vdsh_view_tracer *t, const float p0[3], const float l
 typedef struct scored {
     float p[3];
     float lit, sh;
-    int free, pref;              /* pref: the preferred light's index, or -1 */
+    int free, pref; /* pref: the preferred light's index, or -1 */
 } scored;
 
 /* A light lights the frame when it lights its share of it, and more
@@ -797,8 +796,8 @@ static void take_light(vdsh_view *out, int k, const scored *c, const vdsh_view *
            sizeof out->preferred[k]);
 }
 
-static vdsh_result choose_lights(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
-                                 vdsh_view *v, float diag)
+static vdsh_result choose_lights(const vdsh_view_tracer *t, const vdsh_view_mesh *m, vdsh_view *v,
+                                 float diag)
 {
     frame_pts f;
     if (!frame_points(t, m, &v->camera, VDSH_VIEW_CHECK_W, VDSH_VIEW_CHECK_H, &f))
@@ -869,8 +868,8 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
     for (int k = 0; k < 3; k++)
         diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
     diag = sqrtf(diag) > 0.0f ? sqrtf(diag) : 1.0f;
-    v.light_count = vdsh_view_preferred_lights(lo, hi, v.interior, v.preferred,
-                                               VDSH_VIEW_MAX_LIGHTS);
+    v.light_count =
+        vdsh_view_preferred_lights(lo, hi, v.interior, v.preferred, VDSH_VIEW_MAX_LIGHTS);
     for (int i = 0; i < v.light_count; i++) {
         v.light_free[i] =
             find_free(t, v.preferred[i], lo, hi, v.interior, diag, &v.light_trials, v.lights[i]);

@@ -81,21 +81,21 @@ extern "C" {
 #define VDSH_VIEW_LIGHT_POOL 64
 
 typedef struct vdsh_view_mesh {
-    const float *positions;      /* vertex_count x 3 */
-    const float *normals;        /* vertex_count x 3: the front side */
-    const uint32_t *indices;     /* triangle_count x 3 */
+    const float *positions;  /* vertex_count x 3 */
+    const float *normals;    /* vertex_count x 3: the front side */
+    const uint32_t *indices; /* triangle_count x 3 */
     uint32_t vertex_count;
     uint32_t triangle_count;
 } vdsh_view_mesh;
 
 typedef struct vdsh_view {
-    float bounds_min[3];         /* of all vertices (vdsh_view_bounds) */
+    float bounds_min[3]; /* of all vertices (vdsh_view_bounds) */
     float bounds_max[3];
-    float front_share;           /* vdsh_view_front_share, 0..1 */
-    int interior;                /* front_share >= VDSH_VIEW_INTERIOR_SHARE */
-    vdsh_camera camera;          /* the default camera: room or fit */
-    int light_count;             /* VDSH_VIEW_MAX_LIGHTS */
-    float lights[VDSH_VIEW_MAX_LIGHTS][3];     /* default light positions */
+    float front_share;                     /* vdsh_view_front_share, 0..1 */
+    int interior;                          /* front_share >= VDSH_VIEW_INTERIOR_SHARE */
+    vdsh_camera camera;                    /* the default camera: room or fit */
+    int light_count;                       /* VDSH_VIEW_MAX_LIGHTS */
+    float lights[VDSH_VIEW_MAX_LIGHTS][3]; /* default light positions */
     /* before any move (a light the frame rule took from the seeded
      * candidates: that candidate) */
     float preferred[VDSH_VIEW_MAX_LIGHTS][3];
@@ -103,12 +103,12 @@ typedef struct vdsh_view {
      * not); 0: no position searched was (a scene without free space), and
      * lights[i] is preferred[i]. */
     int light_free[VDSH_VIEW_MAX_LIGHTS];
-    uint32_t light_trials;       /* positions tested for free space */
+    uint32_t light_trials; /* positions tested for free space */
     /* An interior's lights in the check frame (vdsh_view_light_shares):
      * shares of its pixels lit and shadowed; 0 for an object's. */
     float light_lit[VDSH_VIEW_MAX_LIGHTS];
     float light_shadowed[VDSH_VIEW_MAX_LIGHTS];
-    uint32_t pool_tried;         /* seeded candidates the frame rule tried */
+    uint32_t pool_tried; /* seeded candidates the frame rule tried */
 } vdsh_view;
 
 /* Everything above from the mesh: bounds, the interior test, the default
@@ -147,18 +147,18 @@ void vdsh_view_fit_camera(const float lo[3], const float hi[3], vdsh_camera *out
 
 /* Up to max (at most VDSH_VIEW_MAX_LIGHTS) preferred light positions from
  * the bounds only; returns how many. Not checked for free space. */
-int vdsh_view_preferred_lights(const float lo[3], const float hi[3], int interior,
-                               float (*out)[3], int max);
+int vdsh_view_preferred_lights(const float lo[3], const float hi[3], int interior, float (*out)[3],
+                               int max);
 
 /* ---- rays against the mesh ------------------------------------------ */
 
 typedef struct vdsh_view_tracer vdsh_view_tracer;
 
 typedef struct vdsh_view_hit {
-    float t;                     /* distance along the unit direction */
-    float u, v;                  /* barycentrics of vertices 1 and 2 */
+    float t;    /* distance along the unit direction */
+    float u, v; /* barycentrics of vertices 1 and 2 */
     uint32_t triangle;
-    int back;                    /* the ray met the face from behind: its
+    int back; /* the ray met the face from behind: its
                                     winding normal (v1 - v0) x (v2 - v0)
                                     points along the ray */
 } vdsh_view_hit;
@@ -171,13 +171,13 @@ void vdsh_view_tracer_destroy(vdsh_view_tracer *t);
 /* The nearest hit with t >= tmin along org + t dir (Moller-Trumbore,
  * edges and vertices included): 1 and *hit, or 0 (nothing; *hit
  * untouched). Equal t: the lower triangle index. */
-int vdsh_view_trace(const vdsh_view_tracer *t, const float org[3], const float dir[3],
-                    float tmin, vdsh_view_hit *hit);
+int vdsh_view_trace(const vdsh_view_tracer *t, const float org[3], const float dir[3], float tmin,
+                    vdsh_view_hit *hit);
 
 /* vdsh_view_trace for every triangle in index order, no grid: the
  * reference the grid is tested against (and the cost it saves). */
-int vdsh_view_trace_all(const vdsh_view_mesh *m, const float org[3], const float dir[3],
-                        float tmin, vdsh_view_hit *hit);
+int vdsh_view_trace_all(const vdsh_view_mesh *m, const float org[3], const float dir[3], float tmin,
+                        vdsh_view_hit *hit);
 
 /* The room camera, its eye moved when it is not in free space or stands
  * against a surface (fewer than 48 of a 9 x 7 grid of its rays travel a
@@ -194,8 +194,8 @@ int vdsh_view_room_camera_free(const vdsh_view_tracer *t, const float lo[3], con
  * than 1e-5 of the diagonal is
  * the front of a surface (the interpolated vertex normal against the
  * ray), 0..1. */
-float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
-                            const float lo[3], const float hi[3]);
+float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m, const float lo[3],
+                            const float hi[3]);
 
 /* vdsh_free_space (vdsh_light.h) at p, its probes cast against the mesh,
  * clearance from `diagonal`; back faces by winding. */

@@ -83,41 +83,52 @@ static vdsh_result check_header(const vdsh_sdf *v, const char *name, vdsh_error 
 {
     for (int a = 0; a < 3; a++)
         if (v->dim[a] < 2 || v->dim[a] > VDSH_SDF_MAX_DIM)
-            return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: %u samples along axis "
-                        "%d, must be 2..%d", v->dim[a], a, VDSH_SDF_MAX_DIM);
+            return vdsh_failf_at(err, VDSH_ERR_INVALID, name,
+                                 "distance volume: %u samples along axis "
+                                 "%d, must be 2..%d",
+                                 v->dim[a], a, VDSH_SDF_MAX_DIM);
     for (int a = 0; a < 3; a++)
         if (!isfinite(v->origin[a]))
-            return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: origin is not finite");
+            return vdsh_failf_at(err, VDSH_ERR_INVALID, name,
+                                 "distance volume: origin is not finite");
     if (!(isfinite(v->cell) && v->cell > 0.0f))
-        return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: cell %g is not a finite "
-                    "number > 0", (double)v->cell);
+        return vdsh_failf_at(err, VDSH_ERR_INVALID, name,
+                             "distance volume: cell %g is not a finite "
+                             "number > 0",
+                             (double)v->cell);
     if (!(isfinite(v->max_distance) && v->max_distance > 0.0f))
-        return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: max_distance %g is not a "
-                    "finite number > 0", (double)v->max_distance);
+        return vdsh_failf_at(err, VDSH_ERR_INVALID, name,
+                             "distance volume: max_distance %g is not a "
+                             "finite number > 0",
+                             (double)v->max_distance);
     for (int a = 0; a < 3; a++)
         if (!isfinite(v->origin[a] + v->cell * (float)(v->dim[a] - 1)))
-            return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: its box is not finite");
+            return vdsh_failf_at(err, VDSH_ERR_INVALID, name,
+                                 "distance volume: its box is not finite");
     return VDSH_OK;
 }
 
-vdsh_result vdsh_sdf_read_memory(const void *data, size_t size, const char *name,
-                                 vdsh_sdf *out, vdsh_error *err)
+vdsh_result vdsh_sdf_read_memory(const void *data, size_t size, const char *name, vdsh_sdf *out,
+                                 vdsh_error *err)
 {
     const uint8_t *d = data;
     if (!name)
         name = "(memory)";
     if (size < VDSH_SDF_HEADER_SIZE)
-        return vdsh_failf_at(err, size >= 8 && memcmp(d, MAGIC, 8) == 0 ? VDSH_ERR_TRUNCATED
-                                                                 : VDSH_ERR_NOT_VDSH,
-                    name, "%zu bytes: shorter than the %d-byte distance volume header", size,
-                    VDSH_SDF_HEADER_SIZE);
+        return vdsh_failf_at(
+            err, size >= 8 && memcmp(d, MAGIC, 8) == 0 ? VDSH_ERR_TRUNCATED : VDSH_ERR_NOT_VDSH,
+            name, "%zu bytes: shorter than the %d-byte distance volume header", size,
+            VDSH_SDF_HEADER_SIZE);
     if (memcmp(d, MAGIC, 8) != 0)
-        return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, name, "not a VDSH distance volume (wrong magic)");
+        return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, name,
+                             "not a VDSH distance volume (wrong magic)");
     if (get_u32(d + 60) != vdsh_crc32(0, d, 60))
         return vdsh_failf_at(err, VDSH_ERR_CRC, name, "distance volume header: CRC mismatch");
     if (get_u32(d + 8) != SDF_VERSION)
-        return vdsh_failf_at(err, VDSH_ERR_VERSION, name, "distance volume version %u (this reader "
-                    "reads %d)", get_u32(d + 8), SDF_VERSION);
+        return vdsh_failf_at(err, VDSH_ERR_VERSION, name,
+                             "distance volume version %u (this reader "
+                             "reads %d)",
+                             get_u32(d + 8), SDF_VERSION);
     vdsh_sdf v = {0};
     for (int a = 0; a < 3; a++) {
         v.dim[a] = get_u32(d + 12 + 4 * a);
@@ -128,18 +139,22 @@ vdsh_result vdsh_sdf_read_memory(const void *data, size_t size, const char *name
     v.vertex_count = get_u32(d + 44);
     v.triangle_count = get_u32(d + 48);
     if (get_u32(d + 56) != 0)
-        return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: reserved bytes not zero");
+        return vdsh_failf_at(err, VDSH_ERR_INVALID, name,
+                             "distance volume: reserved bytes not zero");
     vdsh_result r = check_header(&v, name, err);
     if (r != VDSH_OK)
         return r;
     size_t n = sample_count(&v);
     if (n > (size - VDSH_SDF_HEADER_SIZE) / 2)
-        return vdsh_failf_at(err, VDSH_ERR_TRUNCATED, name, "distance volume: %zu bytes of samples, "
-                    "%u x %u x %u need %zu", size - VDSH_SDF_HEADER_SIZE, v.dim[0], v.dim[1],
-                    v.dim[2], 2 * n);
+        return vdsh_failf_at(err, VDSH_ERR_TRUNCATED, name,
+                             "distance volume: %zu bytes of samples, "
+                             "%u x %u x %u need %zu",
+                             size - VDSH_SDF_HEADER_SIZE, v.dim[0], v.dim[1], v.dim[2], 2 * n);
     if (size - VDSH_SDF_HEADER_SIZE != 2 * n)
-        return vdsh_failf_at(err, VDSH_ERR_INVALID, name, "distance volume: %zu bytes after the "
-                    "samples", size - VDSH_SDF_HEADER_SIZE - 2 * n);
+        return vdsh_failf_at(err, VDSH_ERR_INVALID, name,
+                             "distance volume: %zu bytes after the "
+                             "samples",
+                             size - VDSH_SDF_HEADER_SIZE - 2 * n);
     if (get_u32(d + 52) != vdsh_crc32(0, d + VDSH_SDF_HEADER_SIZE, 2 * n))
         return vdsh_failf_at(err, VDSH_ERR_CRC, name, "distance volume samples: CRC mismatch");
     v.samples = malloc(2 * n);
@@ -157,7 +172,7 @@ vdsh_result vdsh_sdf_read(const char *path, vdsh_sdf *out, vdsh_error *err)
     FILE *f = fopen(path, "rb");
     if (!f)
         return vdsh_failf_at(err, VDSH_ERR_IO, path, "cannot open the distance volume: %s",
-                    strerror(errno));
+                             strerror(errno));
     uint8_t *buf = NULL;
     size_t size = 0, cap = 0;
     for (;;) {
@@ -185,8 +200,7 @@ vdsh_result vdsh_sdf_read(const char *path, vdsh_sdf *out, vdsh_error *err)
     return r;
 }
 
-vdsh_result vdsh_sdf_write_memory(const vdsh_sdf *v, void **out, size_t *size,
-                                  vdsh_error *err)
+vdsh_result vdsh_sdf_write_memory(const vdsh_sdf *v, void **out, size_t *size, vdsh_error *err)
 {
     vdsh_result r = check_header(v, "distance volume", err);
     if (r != VDSH_OK)
@@ -274,8 +288,8 @@ float vdsh_sdf_sample(const vdsh_sdf *v, const float p[3])
     return y0 + (y1 - y0) * f[2];
 }
 
-float vdsh_sdf_shadow(const vdsh_sdf *v, const float p[3], const float n[3],
-                      const float light[3], float k)
+float vdsh_sdf_shadow(const vdsh_sdf *v, const float p[3], const float n[3], const float light[3],
+                      float k)
 {
     float o[3], dir[3];
     for (int a = 0; a < 3; a++) {

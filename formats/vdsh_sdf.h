@@ -47,8 +47,8 @@ extern "C" {
 
 enum {
     VDSH_SDF_HEADER_SIZE = 64,
-    VDSH_SDF_MAX_DIM = 1024,        /* samples along one axis */
-    VDSH_SDF_MAX_STEPS = 64         /* sphere-trace steps per light */
+    VDSH_SDF_MAX_DIM = 1024, /* samples along one axis */
+    VDSH_SDF_MAX_STEPS = 64  /* sphere-trace steps per light */
 };
 
 /* The softness k of vdsh_sdf_shadow: a light of radius diagonal / k.
@@ -58,13 +58,13 @@ enum {
 #define VDSH_SDF_DEFAULT_K 400.0f
 
 typedef struct vdsh_sdf {
-    uint32_t dim[3];                /* nx, ny, nz: 2..VDSH_SDF_MAX_DIM */
-    float origin[3];                /* sample (0,0,0), scene units */
-    float cell;                     /* sample spacing, > 0 */
-    float max_distance;             /* distances clamped to +-this, > 0 */
-    uint32_t vertex_count;          /* of the .vdsh it was baked beside */
-    uint32_t triangle_count;        /* (0, 0: not recorded) */
-    uint16_t *samples;              /* nx * ny * nz, unorm16 as above */
+    uint32_t dim[3];         /* nx, ny, nz: 2..VDSH_SDF_MAX_DIM */
+    float origin[3];         /* sample (0,0,0), scene units */
+    float cell;              /* sample spacing, > 0 */
+    float max_distance;      /* distances clamped to +-this, > 0 */
+    uint32_t vertex_count;   /* of the .vdsh it was baked beside */
+    uint32_t triangle_count; /* (0, 0: not recorded) */
+    uint16_t *samples;       /* nx * ny * nz, unorm16 as above */
 } vdsh_sdf;
 
 /* The companion path of a .vdsh: "X.vdsh" -> "X.sdf", anything else gets
@@ -77,13 +77,12 @@ float vdsh_sdf_decode(uint16_t u, float max_distance);
 
 vdsh_result vdsh_sdf_read(const char *path, vdsh_sdf *out, vdsh_error *err);
 /* From memory (what the fuzz target calls); name for messages, may be NULL. */
-vdsh_result vdsh_sdf_read_memory(const void *data, size_t size, const char *name,
-                                 vdsh_sdf *out, vdsh_error *err);
+vdsh_result vdsh_sdf_read_memory(const void *data, size_t size, const char *name, vdsh_sdf *out,
+                                 vdsh_error *err);
 /* Atomically (vdsh_output.h); validates with the reader's rules first. */
 vdsh_result vdsh_sdf_write(const char *path, const vdsh_sdf *v, vdsh_error *err);
 /* The file's bytes in a malloc'd buffer. */
-vdsh_result vdsh_sdf_write_memory(const vdsh_sdf *v, void **out, size_t *size,
-                                  vdsh_error *err);
+vdsh_result vdsh_sdf_write_memory(const vdsh_sdf *v, void **out, size_t *size, vdsh_error *err);
 void vdsh_sdf_free(vdsh_sdf *v);
 
 /* The volume's bytes on disk (header and samples). */
@@ -108,8 +107,8 @@ float vdsh_sdf_sample(const vdsh_sdf *v, const float p[3]);
  * light at o (|light - o| = 0) lights: 1. The normal offset is 1.5 cell
  * (the thickening plus a spacing: the surface does not shadow itself).
  */
-float vdsh_sdf_shadow(const vdsh_sdf *v, const float p[3], const float n[3],
-                      const float light[3], float k);
+float vdsh_sdf_shadow(const vdsh_sdf *v, const float p[3], const float n[3], const float light[3],
+                      float k);
 
 #ifdef __cplusplus
 }

@@ -10,7 +10,7 @@
  * it (Debian builds for baseline x86-64, i.e. SSE2). No FMA: every lane
  * does the same IEEE operations in the same order either way, so results
  * are bit-identical whichever clone runs. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) &&                             \
     !defined(__SANITIZE_ADDRESS__)
 #define VDSH_CLONES __attribute__((target_clones("avx2", "default")))
 #else
@@ -40,12 +40,12 @@
 /* The one kernel. With acc = 0, o[i * s] = Y_i; with acc = 1,
  * o[i * s] += w * Y_i (the callers pass constants, so each use compiles to
  * straight-line code). */
-#define EMIT(i, value)                                   \
-    do {                                                 \
-        if (acc)                                         \
-            o[(i) * s] += w * (value);                   \
-        else                                             \
-            o[(i) * s] = (value);                        \
+#define EMIT(i, value)                                                                             \
+    do {                                                                                           \
+        if (acc)                                                                                   \
+            o[(i)*s] += w * (value);                                                               \
+        else                                                                                       \
+            o[(i)*s] = (value);                                                                    \
     } while (0)
 
 /* The closed forms below are written out for bands 0..KERNEL_ORDER-1 (the
@@ -54,8 +54,8 @@
 #define KERNEL_ORDER 5
 _Static_assert(KERNEL_ORDER <= VDSH_MAX_ORDER, "sh_kernel covers the paper's orders");
 
-static inline __attribute__((always_inline)) void sh_kernel(int order, float x, float y, float z, float *o,
-                             size_t s, int acc, float w)
+static inline __attribute__((always_inline)) void sh_kernel(int order, float x, float y, float z,
+                                                            float *o, size_t s, int acc, float w)
 {
     EMIT(0, C00);
     if (order < 2)
@@ -106,17 +106,17 @@ void vdsh_sh_eval(int order, const float d[3], float *out)
 /* The batch loops. `order` is a constant in every call below, so each
  * compiles to a straight-line, vectorised loop over k. */
 static inline __attribute__((always_inline)) void soa_loop(
-    int order, size_t n, const float *restrict x, const float *restrict y,
-    const float *restrict z, const float *restrict w, float *restrict o,
-    size_t stride, int acc)
+    int order, size_t n, const float *restrict x, const float *restrict y, const float *restrict z,
+    const float *restrict w, float *restrict o, size_t stride, int acc)
 {
     for (size_t k = 0; k < n; k++)
         sh_kernel(order, x[k], y[k], z[k], o + k, stride, acc, acc ? w[k] : 0.0f);
 }
 
-static inline __attribute__((always_inline)) void soa_dispatch(
-    int order, size_t n, const float *x, const float *y, const float *z,
-    const float *w, float *o, size_t stride, int acc)
+static inline __attribute__((always_inline)) void soa_dispatch(int order, size_t n, const float *x,
+                                                               const float *y, const float *z,
+                                                               const float *w, float *o,
+                                                               size_t stride, int acc)
 {
     /* Packets of 16 with rows of 16 (the bake's layout) get their own
      * loops: with constant sizes the compiler can see that the output
@@ -183,9 +183,11 @@ static void k_high_init(void)
  * Directions in chunks, each step a loop over the chunk, so it vectorises
  * over directions like the kernel above. With acc, out[i] += w Y_i (the
  * projection), else out[i] = Y_i. */
-static inline __attribute__((always_inline)) void eval_high_bands(
-    int order, size_t n, const float *x, const float *y, const float *z, const float *w,
-    float *out, size_t stride, int acc)
+static inline __attribute__((always_inline)) void eval_high_bands(int order, size_t n,
+                                                                  const float *x, const float *y,
+                                                                  const float *z, const float *w,
+                                                                  float *out, size_t stride,
+                                                                  int acc)
 {
     enum { CHUNK = 64 };
     pthread_once(&k_high_once, k_high_init);
@@ -263,8 +265,7 @@ VDSH_CLONES void vdsh_sh_eval_soa(int order, size_t n, const float *x, const flo
 }
 
 VDSH_CLONES void vdsh_sh_project_soa(int order, size_t n, const float *x, const float *y,
-                         const float *z, const float *w, float *acc,
-                         size_t acc_stride)
+                                     const float *z, const float *w, float *acc, size_t acc_stride)
 {
     assert(order >= 1 && order <= VDSH_MAX_ORDER);
     soa_dispatch(order < KERNEL_ORDER ? order : KERNEL_ORDER, n, x, y, z, w, acc, acc_stride, 1);

@@ -63,7 +63,10 @@ extern "C" {
 #define VDSH_SH_C44B 0.6258357354491761f
 
 /* Number of coefficients of an order (bands): order * order. */
-static inline int vdsh_sh_count(int order) { return order * order; }
+static inline int vdsh_sh_count(int order)
+{
+    return order * order;
+}
 
 /* out[0 .. order^2-1] = Y_i(d) for a unit direction d. */
 void vdsh_sh_eval(int order, const float d[3], float *out);
@@ -72,16 +75,15 @@ void vdsh_sh_eval(int order, const float d[3], float *out);
  * out[i * out_stride + k] = Y_i(direction k). Same arithmetic as
  * vdsh_sh_eval (one kernel), laid out so the compiler vectorises over k.
  * `out` must not overlap the inputs. */
-void vdsh_sh_eval_soa(int order, size_t n, const float *x, const float *y,
-                      const float *z, float *out, size_t out_stride);
+void vdsh_sh_eval_soa(int order, size_t n, const float *x, const float *y, const float *z,
+                      float *out, size_t out_stride);
 
 /* Projection step for n directions with weights w (the bake's distances):
  * acc[i * acc_stride + k] += w[k] * Y_i(direction k). The same kernel;
  * the caller sums acc over k (in a fixed order) and scales. `acc` must not
  * overlap the inputs. */
-void vdsh_sh_project_soa(int order, size_t n, const float *x, const float *y,
-                         const float *z, const float *w, float *acc,
-                         size_t acc_stride);
+void vdsh_sh_project_soa(int order, size_t n, const float *x, const float *y, const float *z,
+                         const float *w, float *acc, size_t acc_stride);
 
 /* Reconstruct sum_i c[i] * Y_i(d). */
 float vdsh_sh_reconstruct(int order, const float *c, const float d[3]);

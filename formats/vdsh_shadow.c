@@ -20,21 +20,17 @@ static float from_sum(uint32_t quantity, float max_distance, float sum)
 {
     float d;
     switch (quantity) {
-    case VDSH_QUANTITY_DISTANCE2:
-        d = sum > 0.0f ? sqrtf(sum) : 0.0f;
-        break;
+    case VDSH_QUANTITY_DISTANCE2: d = sum > 0.0f ? sqrtf(sum) : 0.0f; break;
     case VDSH_QUANTITY_LOG_DISTANCE:
         d = expf(sum < VDSH_LOG_SUM_MAX ? sum : VDSH_LOG_SUM_MAX);
         break;
-    default:
-        d = sum > 0.0f ? sum : 0.0f;
-        break;
+    default: d = sum > 0.0f ? sum : 0.0f; break;
     }
     return d > max_distance ? max_distance : d;
 }
 
-float vdsh_stream_distance(uint32_t order, uint32_t quantity, float max_distance,
-                           const float *c, const float d[3])
+float vdsh_stream_distance(uint32_t order, uint32_t quantity, float max_distance, const float *c,
+                           const float d[3])
 {
     return from_sum(quantity, max_distance, vdsh_sh_reconstruct((int)order, c, d));
 }
@@ -83,8 +79,8 @@ float vdsh_shadow_compare(float d_vis, float d_light, uint32_t compare)
                                                                                      d_light);
 }
 
-float vdsh_shadow(uint32_t order, uint32_t quantity, float max_distance,
-                  const float *c, const float p[3], const float l[3], uint32_t compare)
+float vdsh_shadow(uint32_t order, uint32_t quantity, float max_distance, const float *c,
+                  const float p[3], const float l[3], uint32_t compare)
 {
     float v[3] = {l[0] - p[0], l[1] - p[1], l[2] - p[2]};
     float dl = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
@@ -119,10 +115,9 @@ static float toward(const float a[3], const float b[3], float d[3])
     return len;
 }
 
-float vdsh_shadow_interior(uint32_t order, uint32_t quantity, float max_distance,
-                           uint32_t interp, const float *const c[3], const float *const pv[3],
-                           const float b[3], const float l[3], uint32_t compare,
-                           float *d_vis)
+float vdsh_shadow_interior(uint32_t order, uint32_t quantity, float max_distance, uint32_t interp,
+                           const float *const c[3], const float *const pv[3], const float b[3],
+                           const float l[3], uint32_t compare, float *d_vis)
 {
     const int n = (int)(order * order);
     float p[3], w[3];
@@ -183,17 +178,16 @@ float vdsh_shadow_interior(uint32_t order, uint32_t quantity, float max_distance
     return s;
 }
 
-float vdsh_vertex_distance(uint32_t order, uint32_t quantity, float max_distance,
-                           const float *c, const float pv[3], const float l[3])
+float vdsh_vertex_distance(uint32_t order, uint32_t quantity, float max_distance, const float *c,
+                           const float pv[3], const float l[3])
 {
     float dk[3];
     float dlk = toward(pv, l, dk);
     return dlk > 0.0f ? vdsh_stream_distance(order, quantity, max_distance, c, dk) : 0.0f;
 }
 
-float vdsh_shadow_interior_distance(const float dv[3], const float *const pv[3],
-                                    const float b[3], const float l[3], uint32_t compare,
-                                    float *d_vis)
+float vdsh_shadow_interior_distance(const float dv[3], const float *const pv[3], const float b[3],
+                                    const float l[3], uint32_t compare, float *d_vis)
 {
     float p[3], w[3];
     for (int i = 0; i < 3; i++)

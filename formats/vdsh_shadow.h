@@ -89,16 +89,16 @@ static inline float vdsh_light_u_f(float t)
  * anything above max_distance gives max_distance. max_distance is the
  * file's vdsh_header.max_distance (> 0), here and in every function
  * below; +INFINITY clamps nothing. */
-float vdsh_stream_distance(uint32_t order, uint32_t quantity, float max_distance,
-                           const float *c, const float d[3]);
+float vdsh_stream_distance(uint32_t order, uint32_t quantity, float max_distance, const float *c,
+                           const float d[3]);
 
 /* Visibility in [0, 1] of a light at distance d_light when the stored
  * distance toward it is d_vis (see the top of this file). */
 float vdsh_shadow_compare(float d_vis, float d_light, uint32_t compare);
 
 /* The whole evaluation for one receiver p and light position l. */
-float vdsh_shadow(uint32_t order, uint32_t quantity, float max_distance,
-                  const float *c, const float p[3], const float l[3], uint32_t compare);
+float vdsh_shadow(uint32_t order, uint32_t quantity, float max_distance, const float *c,
+                  const float p[3], const float l[3], uint32_t compare);
 
 /* How a renderer carries the stream from a triangle's vertices to a point
  * p = sum b_k p_k inside it (the GPU interpolates linearly):
@@ -139,10 +139,9 @@ uint32_t vdsh_runtime_interp(uint32_t order, uint32_t quantity);
  * it receives the distance compared (for VISIBILITY: the interpolated
  * vertex distances, for scoring). Defined for every input as vdsh_shadow
  * is. */
-float vdsh_shadow_interior(uint32_t order, uint32_t quantity, float max_distance,
-                           uint32_t interp, const float *const c[3], const float *const pv[3],
-                           const float b[3], const float l[3], uint32_t compare,
-                           float *d_vis);
+float vdsh_shadow_interior(uint32_t order, uint32_t quantity, float max_distance, uint32_t interp,
+                           const float *const c[3], const float *const pv[3], const float b[3],
+                           const float l[3], uint32_t compare, float *d_vis);
 
 /* The per-vertex half of the DISTANCE and VISIBILITY paths: the distance
  * vertex pv reconstructs toward the light at l from its order^2
@@ -150,16 +149,15 @@ float vdsh_shadow_interior(uint32_t order, uint32_t quantity, float max_distance
  * the vertex). It depends on the vertex and the light only, so a caller
  * may compute it once per vertex and light, as the runtime's vertex stage
  * does, and a variable-order stream's vertex with its own order. */
-float vdsh_vertex_distance(uint32_t order, uint32_t quantity, float max_distance,
-                           const float *c, const float pv[3], const float l[3]);
+float vdsh_vertex_distance(uint32_t order, uint32_t quantity, float max_distance, const float *c,
+                           const float pv[3], const float l[3]);
 
 /* The rest of the DISTANCE path: dv[k], vertex k's vdsh_vertex_distance,
  * interpolated at p = sum b_k pv[k] and compared with p's own light
  * distance. vdsh_shadow_interior computes its DISTANCE path with these two
  * functions, so the result is the same to the bit. d_vis as there. */
-float vdsh_shadow_interior_distance(const float dv[3], const float *const pv[3],
-                                    const float b[3], const float l[3], uint32_t compare,
-                                    float *d_vis);
+float vdsh_shadow_interior_distance(const float dv[3], const float *const pv[3], const float b[3],
+                                    const float l[3], uint32_t compare, float *d_vis);
 
 #ifdef __cplusplus
 }

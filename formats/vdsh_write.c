@@ -37,8 +37,8 @@ typedef struct plan {
     /* each stream's header, then an s8 stream's scale table and padding */
     uint8_t stream_header[VDSH_MAX_STREAMS][STREAM_HEADER_SIZE + S8_TABLE_MAX];
     uint8_t fixed[VDSH_FIXED_COUNT][TIME_SIZE]; /* stat, time, part, adpt */
-    uint8_t *srcs; /* malloc'd SRCS payload */
-    uint8_t *model[VDSH_MAX_STREAMS]; /* malloc'd cpca models, padded */
+    uint8_t *srcs;                              /* malloc'd SRCS payload */
+    uint8_t *model[VDSH_MAX_STREAMS];           /* malloc'd cpca models, padded */
     out_chunk chunks[MAX_CHUNKS];
     uint32_t count;
     uint64_t file_size;
@@ -50,8 +50,7 @@ static vdsh_result argument(vdsh_error *err, const char *name, const why *w)
 }
 
 /* The reader's rules, applied to the caller's struct. */
-static vdsh_result check_file(const vdsh_file *f, const char *name,
-                              vdsh_error *err)
+static vdsh_result check_file(const vdsh_file *f, const char *name, vdsh_error *err)
 {
     why w;
     if (!f)
@@ -60,11 +59,10 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
     if (!vdsh_check_header(h, &w))
         return argument(err, name, &w);
     if (!f->positions || !f->normals || (!f->indices && h->triangle_count))
-        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
-                    "not written: %s is NULL",
-                    !f->positions ? "positions"
-                    : !f->normals ? "normals"
-                                  : "indices");
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name, "not written: %s is NULL",
+                             !f->positions ? "positions"
+                             : !f->normals ? "normals"
+                                           : "indices");
     if (!vdsh_check_positions(f->positions, h->vertex_count, &w) ||
         !vdsh_check_normals(f->normals, h->vertex_count, &w) ||
         !vdsh_check_indices(f->indices, h->triangle_count, h->vertex_count, &w))
@@ -72,18 +70,16 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
 
     if (f->source_count > VDSH_MAX_SOURCES)
         return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
-                    "not written: source_count %u out of range 0..%d",
-                    f->source_count, VDSH_MAX_SOURCES);
+                             "not written: source_count %u out of range 0..%d", f->source_count,
+                             VDSH_MAX_SOURCES);
     if (f->source_count && !f->sources)
-        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
-                    "not written: sources is NULL");
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name, "not written: sources is NULL");
     for (uint32_t i = 0; i < f->source_count; i++) {
         const char *s = f->sources[i].name;
         if (!s)
             return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
-                        "not written: SRCS: source %u: name is NULL", i);
-        if (!vdsh_check_name((const uint8_t *)s, strnlen(s, VDSH_MAX_NAME + 1), i,
-                        &w))
+                                 "not written: SRCS: source %u: name is NULL", i);
+        if (!vdsh_check_name((const uint8_t *)s, strnlen(s, VDSH_MAX_NAME + 1), i, &w))
             return argument(err, name, &w);
     }
 
@@ -92,35 +88,35 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
         return argument(err, name, &w);
     if (f->stream_count < 1 || f->stream_count > VDSH_MAX_STREAMS)
         return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
-                    "not written: stream_count %u out of range 1..%d",
-                    f->stream_count, VDSH_MAX_STREAMS);
+                             "not written: stream_count %u out of range 1..%d", f->stream_count,
+                             VDSH_MAX_STREAMS);
     if (!f->streams)
-        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
-                    "not written: streams is NULL");
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name, "not written: streams is NULL");
     for (uint32_t i = 0; i < f->stream_count; i++) {
         const vdsh_stream *s = &f->streams[i];
         if (!vdsh_check_stream(s, i, &w))
             return argument(err, name, &w);
         if (!s->data)
             return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
-                        "not written: COEF stream %u: data is NULL", i);
+                                 "not written: COEF stream %u: data is NULL", i);
         if (vdsh_encoding_quantised(s->encoding) && !s->coef_scales)
             return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
-                        "not written: COEF stream %u: %s without coef_scales", i,
-                        vdsh_encoding_name(s->encoding));
+                                 "not written: COEF stream %u: %s without coef_scales", i,
+                                 vdsh_encoding_name(s->encoding));
         if (vdsh_stream_variable(s) && !s->orders)
             return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
-                        "not written: COEF stream %u: variable order without orders", i);
+                                 "not written: COEF stream %u: variable order without orders", i);
         if (s->encoding == VDSH_ENCODING_CPCA &&
             (!s->cpca.scales || !s->cpca.means || !s->cpca.bases))
             return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
-                        "not written: COEF stream %u: cpca without scales, means or bases", i);
+                                 "not written: COEF stream %u: cpca without scales, means or bases",
+                                 i);
         for (uint32_t k = 0; k < i; k++)
             if (vdsh_same_slot(&f->streams[k], s)) {
                 char slot[64];
                 return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
-                            "not written: streams %u and %u are both %s", k, i,
-                            vdsh_slot_name(s, slot, sizeof slot));
+                                     "not written: streams %u and %u are both %s", k, i,
+                                     vdsh_slot_name(s, slot, sizeof slot));
             }
         if (!vdsh_check_stream_data(s, i, vdsh_file_stream_vertices(f), &w))
             return argument(err, name, &w);
@@ -134,8 +130,8 @@ static vdsh_result check_file(const vdsh_file *f, const char *name,
     return VDSH_OK;
 }
 
-static void add_chunk(plan *P, const char *id, const void *pre,
-                      size_t pre_size, const void *data, uint64_t data_size)
+static void add_chunk(plan *P, const char *id, const void *pre, size_t pre_size, const void *data,
+                      uint64_t data_size)
 {
     out_chunk *c = &P->chunks[P->count++];
     memcpy(c->id, id, 4);
@@ -155,8 +151,7 @@ static void plan_free(plan *P)
 }
 
 /* Validate `f`, encode every header field and compute every CRC. */
-static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
-                              vdsh_error *err)
+static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name, vdsh_error *err)
 {
     memset(P, 0, sizeof *P);
     vdsh_result res = check_file(f, name, err);
@@ -171,8 +166,7 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
     /* SRCS is small (at most 64 names of 4096 bytes): encode it whole. */
     size_t srcs_size = 4;
     for (uint32_t i = 0; i < f->source_count; i++)
-        srcs_size += SOURCE_FIXED_SIZE +
-                     ((strlen(f->sources[i].name) + 3) & ~(size_t)3);
+        srcs_size += SOURCE_FIXED_SIZE + ((strlen(f->sources[i].name) + 3) & ~(size_t)3);
     P->srcs = (uint8_t *)calloc(1, srcs_size);
     if (!P->srcs)
         return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, name, "out of memory");
@@ -210,8 +204,8 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
             put_u32(p + STREAM_HEADER_SIZE + 4, m->basis);
             put_u32(p + STREAM_HEADER_SIZE + 8, m->bits);
             put_u32(p + STREAM_HEADER_SIZE + 12, m->record_words);
-            size_t mb = (size_t)vdsh_cpca_model_bytes(s->order, m->clusters, m->basis) -
-                        CPCA_HEADER_SIZE;
+            size_t mb =
+                (size_t)vdsh_cpca_model_bytes(s->order, m->clusters, m->basis) - CPCA_HEADER_SIZE;
             size_t n = (size_t)s->order * s->order, k = m->clusters, b = m->basis;
             uint8_t *q = P->model[i] = (uint8_t *)calloc(1, mb + 1);
             if (!q)
@@ -239,11 +233,10 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name,
         }
     }
 
-    const void *fixed[VDSH_FIXED_COUNT] = {
-        f->has_stats ? (const void *)&f->stats : NULL,
-        f->has_timings ? (const void *)&f->timings : NULL,
-        f->has_part ? (const void *)&f->part : NULL,
-        f->has_adaptive ? (const void *)&f->adaptive : NULL};
+    const void *fixed[VDSH_FIXED_COUNT] = {f->has_stats ? (const void *)&f->stats : NULL,
+                                           f->has_timings ? (const void *)&f->timings : NULL,
+                                           f->has_part ? (const void *)&f->part : NULL,
+                                           f->has_adaptive ? (const void *)&f->adaptive : NULL};
     for (int k = 0; k < VDSH_FIXED_COUNT; k++)
         if (fixed[k]) {
             const vdsh_fixed_chunk *x = &vdsh_fixed_chunks[k];
@@ -331,13 +324,12 @@ static void plan_emit(const plan *P, sink *s)
     }
 }
 
-vdsh_result vdsh_write_memory(const vdsh_file *f, void **out_data,
-                              size_t *out_size, vdsh_error *err)
+vdsh_result vdsh_write_memory(const vdsh_file *f, void **out_data, size_t *out_size,
+                              vdsh_error *err)
 {
     plan P;
     if (!out_data || !out_size)
-        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, "memory",
-                    "not written: NULL output pointer");
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, "memory", "not written: NULL output pointer");
     vdsh_result res = plan_build(&P, f, "memory", err);
     if (res != VDSH_OK) {
         plan_free(&P);
@@ -346,15 +338,13 @@ vdsh_result vdsh_write_memory(const vdsh_file *f, void **out_data,
     if (P.file_size > SIZE_MAX) {
         plan_free(&P);
         return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, "memory",
-                    "%llu bytes do not fit in memory",
-                    (unsigned long long)P.file_size);
+                             "%llu bytes do not fit in memory", (unsigned long long)P.file_size);
     }
     uint8_t *buf = (uint8_t *)malloc((size_t)P.file_size);
     if (!buf) {
         plan_free(&P);
-        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, "memory",
-                    "out of memory (%llu bytes)",
-                    (unsigned long long)P.file_size);
+        return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, "memory", "out of memory (%llu bytes)",
+                             (unsigned long long)P.file_size);
     }
     sink s = {buf, NULL, 0, 0};
     plan_emit(&P, &s);
@@ -369,13 +359,11 @@ vdsh_result vdsh_write(const char *path, const vdsh_file *f, vdsh_error *err)
     return vdsh_write_sized(path, f, NULL, err);
 }
 
-vdsh_result vdsh_write_sized(const char *path, const vdsh_file *f, uint64_t *size,
-                             vdsh_error *err)
+vdsh_result vdsh_write_sized(const char *path, const vdsh_file *f, uint64_t *size, vdsh_error *err)
 {
     plan P;
     if (!path)
-        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, "(null)",
-                    "not written: path is NULL");
+        return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, "(null)", "not written: path is NULL");
     vdsh_result res = plan_build(&P, f, path, err);
     if (res != VDSH_OK) {
         plan_free(&P);
@@ -396,8 +384,8 @@ vdsh_result vdsh_write_sized(const char *path, const vdsh_file *f, uint64_t *siz
     plan_free(&P);
     if (s.error) {
         res = vdsh_failf_at(err, VDSH_ERR_IO, path, "cannot write%s%s: %s",
-                   out.tmp ? " temporary file " : "", out.tmp ? out.tmp : "",
-                   strerror(s.error));
+                            out.tmp ? " temporary file " : "", out.tmp ? out.tmp : "",
+                            strerror(s.error));
         vdsh_output_abort(&out);
         return res;
     }

@@ -193,11 +193,39 @@ static int parse_args(int argc, char **argv, vv_options *o)
     memset(o, 0, sizeof *o);
     o->mode = VR_MODE_DEFAULT; /* the runtime's, vr_scene_default_mode */
     o->egl = VR_EGL_AUTO;
-    enum { O_RENDER = 256, O_GRID, O_BENCH, O_CAMERA, O_FIT, O_FOV, O_LIGHT, O_LIGHTS,
-           O_ATT, O_AMBIENT, O_MODE, O_COMPARE, O_PCF, O_SHADOW_SIZE, O_SIZE,
-           O_NO_CUBEMAPS, O_EGL, O_FRAMES, O_SCREENSHOT, O_NO_OVERLAY, O_KEYS,
-           O_NO_MALLOPT, O_VIEWS, O_MODES, O_BUFFER_FLOATS, O_BENCH_LIGHTS,
-           O_BENCH_CUBE_SIZES, O_BENCH_MODES, O_BENCH_COUNTS, O_SDF, O_SDF_K };
+    enum {
+        O_RENDER = 256,
+        O_GRID,
+        O_BENCH,
+        O_CAMERA,
+        O_FIT,
+        O_FOV,
+        O_LIGHT,
+        O_LIGHTS,
+        O_ATT,
+        O_AMBIENT,
+        O_MODE,
+        O_COMPARE,
+        O_PCF,
+        O_SHADOW_SIZE,
+        O_SIZE,
+        O_NO_CUBEMAPS,
+        O_EGL,
+        O_FRAMES,
+        O_SCREENSHOT,
+        O_NO_OVERLAY,
+        O_KEYS,
+        O_NO_MALLOPT,
+        O_VIEWS,
+        O_MODES,
+        O_BUFFER_FLOATS,
+        O_BENCH_LIGHTS,
+        O_BENCH_CUBE_SIZES,
+        O_BENCH_MODES,
+        O_BENCH_COUNTS,
+        O_SDF,
+        O_SDF_K
+    };
     static const struct option longopts[] = {
         {"render", required_argument, 0, O_RENDER},
         {"grid", required_argument, 0, O_GRID},
@@ -239,12 +267,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
         const char *v = optarg;
         int which, rc;
         switch (c) {
-        case 'h':
-            fputs(usage_text, stdout);
-            return -1;
-        case 'V':
-            vt_cli_version(NULL);
-            return -1;
+        case 'h': fputs(usage_text, stdout); return -1;
+        case 'V': vt_cli_version(NULL); return -1;
         case 'q': o->quiet = 1; break;
         case O_RENDER: o->render_path = v; break;
         case O_GRID: o->grid_path = v; break;
@@ -284,8 +308,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
         case O_ATT:
             if (vt_parse_floats(v, o->att, 3, 3) != 3 || o->att[0] < 0 || o->att[1] < 0 ||
                 o->att[2] < 0 || !(o->att[0] + o->att[1] + o->att[2] > 0))
-                return usage_error("--attenuation: expected A0,A1,A2 >= 0, not all 0, got '%s'",
-                                   v);
+                return usage_error("--attenuation: expected A0,A1,A2 >= 0, not all 0, got '%s'", v);
             o->have_att = 1;
             break;
         case O_AMBIENT:
@@ -298,7 +321,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
             if (i < 0)
                 return usage_error("--mode: expected none, cube, vdsh2, vdsh3, vdsh5, "
                                    "vdsh5poly, buffer, bufN (N = 1..16) or adaptive, "
-                                   "got '%s'", v);
+                                   "got '%s'",
+                                   v);
             o->mode = vv_modes[i].mode;
             if (vv_modes[i].stream) /* the others keep a stream given before */
                 o->stream = vv_modes[i].stream;
@@ -338,7 +362,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
             if (parse_modes(v, o))
                 return usage_error("--modes: expected a comma-separated list of cube, cube-pcf, "
                                    "vdsh2, vdsh3, vdsh5, vdsh5poly, none, bufN (N = 1..16) "
-                                   "and adaptive, got '%s'", v);
+                                   "and adaptive, got '%s'",
+                                   v);
             break;
         case O_SCREENSHOT: o->screenshot = v; break;
         case O_NO_OVERLAY: o->no_overlay = 1; break;
@@ -346,7 +371,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
             for (const char *k = v; *k; k++)
                 if (!strchr("abcdefghijklmnopqrstuvwxyz0123456789 <>", *k))
                     return usage_error("--keys: letters, digits, space, '<' and '>' only, "
-                                       "got '%s'", v);
+                                       "got '%s'",
+                                       v);
             o->keys = v;
             break;
         case O_NO_MALLOPT: o->no_mallopt = 1; break;
@@ -357,10 +383,10 @@ static int parse_args(int argc, char **argv, vv_options *o)
             o->bench_sets = 0;
             for (int i = 0; i < k; i++)
                 o->bench_sets |= n[i] == 1    ? 1
-                                  : n[i] == 3  ? 2
-                                  : n[i] == 16 ? 4
-                                  : n[i] == 64 ? 8
-                                               : 16;
+                                 : n[i] == 3  ? 2
+                                 : n[i] == 16 ? 4
+                                 : n[i] == 64 ? 8
+                                              : 16;
             if (k < 1 || o->bench_sets >= 16)
                 return usage_error("--bench-lights: expected some of 1,3,16,64, got '%s'", v);
             break;
@@ -377,7 +403,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
             }
             if (k < 1)
                 return usage_error("--bench-cube-sizes: expected 1 to 8 face sizes of 1..8192, "
-                                   "got '%s'", v);
+                                   "got '%s'",
+                                   v);
             break;
         }
         case O_BENCH_MODES:
@@ -386,9 +413,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
             o->bench_modes = v;
             break;
         case O_BENCH_COUNTS: o->bench_counts = 1; break;
-        default: /* getopt_long said what is wrong */
-            vt_cli_try_help();
-            return VT_EXIT_USAGE;
+        default: /* getopt_long said what is wrong */ vt_cli_try_help(); return VT_EXIT_USAGE;
         }
     }
     for (int i = optind; i < argc; i++) {
@@ -408,17 +433,18 @@ static int parse_args(int argc, char **argv, vv_options *o)
         if (o->have_camera || o->fit || o->fov > 0.0f || o->light_count || o->default_lights ||
             o->have_size)
             return usage_error("%s", "--views gives the cameras, lights and size: not with "
-                               "--camera, --fit, --fov, --light, --lights or --size");
+                                     "--camera, --fit, --fov, --light, --lights or --size");
         if (o->have_mode || o->pcf)
             return usage_error("%s", "--views renders the modes of --modes (cube-pcf: the cube "
-                               "map with PCF): not with --mode or --pcf");
+                                     "map with PCF): not with --mode or --pcf");
     } else {
         if (o->frame_mode_count)
             return usage_error("%s", "--modes: only with --views");
         if ((o->buffer_floats || o->bench_sets || o->bench_cube_count || o->bench_modes ||
-             o->bench_counts) && !o->bench)
+             o->bench_counts) &&
+            !o->bench)
             return usage_error("%s", "--buffer-floats, --bench-lights, --bench-cube-sizes, "
-                               "--bench-modes, --bench-counts: only with --bench");
+                                     "--bench-modes, --bench-counts: only with --bench");
         if (o->frames_arg && !vt_parse_int(o->frames_arg, 1, 1000000, &o->frames))
             return usage_error("--frames: expected a positive count, got '%s'", o->frames_arg);
     }
@@ -426,7 +452,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
         return usage_error("%s", "choose one of --render, --grid and --bench");
     if (o->file_count > 1 && !o->bench && !o->grid_path)
         return usage_error("one scene file at a time (several only with --grid and --bench), "
-                           "got '%s'", o->files[1]);
+                           "got '%s'",
+                           o->files[1]);
     if (o->fit && o->have_camera)
         return usage_error("%s", "--fit and --camera both choose the view: give one");
     /* The images it writes: never a scene file, and writable now. */
@@ -468,4 +495,3 @@ int main(int argc, char **argv)
         return vv_run_frames(&o);
     return vv_run_window(&o);
 }
-

@@ -33,22 +33,22 @@ typedef struct vv_options {
     int file_count;
     int have_camera;
     float camera[6];
-    int fit;                   /* --fit: frame the bounds from outside */
+    int fit; /* --fit: frame the bounds from outside */
     float fov;
     vr_light lights[VV_MAX_LIGHTS];
     int light_count;
-    int default_lights;        /* --lights N; 0: 1 (3 for --bench's second set) */
+    int default_lights; /* --lights N; 0: 1 (3 for --bench's second set) */
     int have_att;
     float att[3];
     int have_ambient;
     float ambient;
     vr_mode mode;
-    int stream;                /* VR_MODE_VDSH_BUFFER: vr_draw_desc.stream */
+    int stream; /* VR_MODE_VDSH_BUFFER: vr_draw_desc.stream */
     int have_mode;
     vdsh_compare compare;
     int pcf;
-    const char *sdf_path;      /* --sdf FILE: mode sdf's volume (NULL: SCENE.sdf) */
-    float sdf_k;               /* --sdf-k; 0: the runtime's default */
+    const char *sdf_path; /* --sdf FILE: mode sdf's volume (NULL: SCENE.sdf) */
+    float sdf_k;          /* --sdf-k; 0: the runtime's default */
     int shadow_size;
     int have_size;
     int width, height;
@@ -56,24 +56,24 @@ typedef struct vv_options {
     vr_egl_platform egl;
     int frames;
     int no_mallopt;
-    int buffer_floats;         /* --bench: also time buffers of decoded f32 */
-    int bench_sets;            /* --bench-lights: bit i, light set i of
+    int buffer_floats;       /* --bench: also time buffers of decoded f32 */
+    int bench_sets;          /* --bench-lights: bit i, light set i of
                                   1, 3, 16, 64; 0: all */
-    int bench_cube_sizes[8];   /* --bench-cube-sizes: cube and cube_pcf
+    int bench_cube_sizes[8]; /* --bench-cube-sizes: cube and cube_pcf
                                   timed at each face size (cubeN, cube_pcfN) */
     int bench_cube_count;
-    const char *bench_modes;   /* --bench-modes: only these names; NULL: all */
-    int bench_counts;          /* --bench-counts: GL counts of each mode */
+    const char *bench_modes; /* --bench-modes: only these names; NULL: all */
+    int bench_counts;        /* --bench-counts: GL counts of each mode */
     int quiet;
     const char *screenshot;
     int no_overlay;
     const char *keys;
-    const char *views_path;    /* --views: frames for a view set */
-    const char *frames_arg;    /* --frames: a count, or with --views the folder */
+    const char *views_path; /* --views: frames for a view set */
+    const char *frames_arg; /* --frames: a count, or with --views the folder */
     const char *frames_dir;
     int frame_modes[VV_MAX_MODES]; /* --modes: indices into vv_modes[] */
     int frame_mode_count;
-    int buffers;               /* load orders 1-5 as buffers too (a bufN mode
+    int buffers; /* load orders 1-5 as buffers too (a bufN mode
                                   of such an order, or --bench) */
 } vv_options;
 
@@ -92,24 +92,24 @@ typedef struct vv_options {
  * orders up to VDSH_MAX_ORDER can exist), "adaptive" (the stream with an
  * order per vertex) and "buffer" (the scene's default of those). */
 typedef struct vv_mode {
-    const char *name;          /* --mode, --modes, frame file names */
-    const char *json;          /* --bench's JSON and --bench-modes */
+    const char *name; /* --mode, --modes, frame file names */
+    const char *json; /* --bench's JSON and --bench-modes */
     vr_mode mode;
     int pcf;
-    int stream;                /* VR_MODE_VDSH_BUFFER: vr_draw_desc.stream */
-    unsigned flags;            /* VV_MODE_* below */
-    int grid;                  /* --grid: its column, 1..; 0 none. Several
+    int stream;     /* VR_MODE_VDSH_BUFFER: vr_draw_desc.stream */
+    unsigned flags; /* VV_MODE_* below */
+    int grid;       /* --grid: its column, 1..; 0 none. Several
                                   rows in a column: the first the scene
                                   has, else the last */
-    char key;                  /* the window: its digit key, 0 none */
+    char key;       /* the window: its digit key, 0 none */
 } vv_mode;
 
 enum {
-    VV_MODE_OPTION = 1,        /* --mode takes it */
-    VV_MODE_FRAMES = 2,        /* --modes takes it */
+    VV_MODE_OPTION = 1,         /* --mode takes it */
+    VV_MODE_FRAMES = 2,         /* --modes takes it */
     VV_MODE_FRAMES_DEFAULT = 4, /* --views without --modes, where the scene has it */
-    VV_MODE_BENCH = 8,         /* --bench, where the scene has it */
-    VV_MODE_BENCH_LOG = 16     /* --bench on a log-distance scene, where it has it */
+    VV_MODE_BENCH = 8,          /* --bench, where the scene has it */
+    VV_MODE_BENCH_LOG = 16      /* --bench on a log-distance scene, where it has it */
 };
 
 /* The rows, ended by one whose name is NULL; at most VV_MAX_MODES. */

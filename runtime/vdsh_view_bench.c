@@ -24,11 +24,11 @@ typedef struct bench_mode {
     vr_mode mode;
     int pcf;
     const char *name;
-    int stream;              /* VR_MODE_VDSH_BUFFER's */
-    int floats;              /* drawn from the scene's decoded-f32 copy */
-    int renderer;            /* index into the renderers: 0, or 1 + the
+    int stream;    /* VR_MODE_VDSH_BUFFER's */
+    int floats;    /* drawn from the scene's decoded-f32 copy */
+    int renderer;  /* index into the renderers: 0, or 1 + the
                                 --bench-cube-sizes entry of a sized cube */
-    int cube_size;           /* VR_MODE_CUBE: its face size */
+    int cube_size; /* VR_MODE_CUBE: its face size */
 } bench_mode;
 
 static int cmp_double(const void *a, const void *b)
@@ -76,7 +76,7 @@ static double process_cpu_ms(void)
 typedef struct bench_scene {
     const char *path;
     vr_scene *scene;
-    vr_scene *floats;        /* --buffer-floats: buffers as decoded f32 */
+    vr_scene *floats; /* --buffer-floats: buffers as decoded f32 */
     bench_mode modes[BENCH_MODES];
     int nm;
     vr_light lights[BENCH_SETS][VR_MAX_POOL_LIGHTS];
@@ -193,8 +193,7 @@ static int bench_open(const vv_options *o, const char *path, bench_scene *b)
         const vv_mode *m = &vv_modes[i];
         /* On a log-distance scene both order-5 modes draw the same
          * per-vertex program: time it once, as vdsh5. */
-        int same = m->mode == VR_MODE_VDSH5_POLY &&
-                   vr_scene_supports(b->scene, VR_MODE_VDSH5) &&
+        int same = m->mode == VR_MODE_VDSH5_POLY && vr_scene_supports(b->scene, VR_MODE_VDSH5) &&
                    vr_scene_interp(b->scene, VR_MODE_VDSH5) == VDSH_INTERP_DISTANCE;
         /* --bench-cube-sizes: the sized cubes replace cube and cube_pcf. */
         int sized = m->mode == VR_MODE_CUBE && o->bench_cube_count;
@@ -218,8 +217,8 @@ static int bench_open(const vv_options *o, const char *path, bench_scene *b)
     for (int ls = 0; ls < BENCH_SETS; ls++) {
         b->nl[ls] = vv_default_lights(b->scene, o, bench_light_sets[ls], b->lights[ls]);
         if (b->nl[ls] < bench_light_sets[ls]) {
-            fprintf(stderr, "vdsh-view: %s: only %d light positions in free space, not %d\n",
-                    path, b->nl[ls], bench_light_sets[ls]);
+            fprintf(stderr, "vdsh-view: %s: only %d light positions in free space, not %d\n", path,
+                    b->nl[ls], bench_light_sets[ls]);
             return 1;
         }
     }
@@ -337,8 +336,8 @@ static void bench_print(const vv_options *o, const bench_scene *b, int all_round
             cJSON *r = vt_json_object(j, results, NULL);
             vt_json_i64(j, r, "lights", b->nl[ls]);
             vt_json_string(j, r, "mode", b->modes[m].name);
-            vt_json_string(j, r, "path", interp >= 0 ? vdsh_interp_name((uint32_t)interp)
-                                                     : b->modes[m].name);
+            vt_json_string(j, r, "path",
+                           interp >= 0 ? vdsh_interp_name((uint32_t)interp) : b->modes[m].name);
             vt_json_f64(j, r, "median_cpu_ms", sorted[rounds / 2]);
             /* Texture lookups per fragment and light, and the texels they
              * read, from the shaders (runtime/vr_glsl.c): the cube map one
@@ -391,8 +390,7 @@ static void bench_print(const vv_options *o, const bench_scene *b, int all_round
             json_series(j, r, "lighting_ms", b->lighting[ls][m], rounds);
             if (!o->quiet)
                 fprintf(stderr, "vdsh-view: %s, %d light%s, %-9s median %.1f ms\n", b->path,
-                        b->nl[ls], b->nl[ls] == 1 ? "" : "s", b->modes[m].name,
-                        sorted[rounds / 2]);
+                        b->nl[ls], b->nl[ls] == 1 ? "" : "s", b->modes[m].name, sorted[rounds / 2]);
         }
 }
 
@@ -409,8 +407,7 @@ int vv_run_bench(const vv_options *o)
     rs[0] = r;
     int rc = 0;
     for (int i = 0; i < o->bench_cube_count && !rc; i++) {
-        vr_renderer_desc rd = {.width = w, .height = h,
-                               .shadow_map_size = o->bench_cube_sizes[i]};
+        vr_renderer_desc rd = {.width = w, .height = h, .shadow_map_size = o->bench_cube_sizes[i]};
         vr_error err;
         if (vr_renderer_create(&rd, &rs[1 + i], &err) != VR_OK) {
             fprintf(stderr, "vdsh-view: %s\n", err.msg);
@@ -425,7 +422,8 @@ int vv_run_bench(const vv_options *o)
     vt_json_string(&j, root, "context", vr_context_description(ctx));
     vt_json_i64(&j, root, "width", w);
     vt_json_i64(&j, root, "height", h);
-    vt_json_i64(&j, root, "shadow_size", o->shadow_size ? o->shadow_size : VR_DEFAULT_SHADOW_MAP_SIZE);
+    vt_json_i64(&j, root, "shadow_size",
+                o->shadow_size ? o->shadow_size : VR_DEFAULT_SHADOW_MAP_SIZE);
     vt_json_bool(&j, root, "mallopt", !o->no_mallopt);
     vt_json_i64(&j, root, "rounds", rounds);
     cJSON *list = vt_json_array(&j, root, "scenes");
@@ -458,4 +456,3 @@ int vv_run_bench(const vv_options *o)
     vr_context_destroy(ctx);
     return rc;
 }
-

@@ -18,28 +18,47 @@
 /* Row order is the order --bench times them in and the window's M key
  * steps through; --views renders its defaults in this order too. */
 enum {
-    OPT = VV_MODE_OPTION, FRM = VV_MODE_FRAMES, DEF = VV_MODE_FRAMES_DEFAULT,
-    BEN = VV_MODE_BENCH, LOG = VV_MODE_BENCH_LOG
+    OPT = VV_MODE_OPTION,
+    FRM = VV_MODE_FRAMES,
+    DEF = VV_MODE_FRAMES_DEFAULT,
+    BEN = VV_MODE_BENCH,
+    LOG = VV_MODE_BENCH_LOG
 };
 /* bufN: the order-N stream from its buffer; --bench times orders 5 and
  * up (on log-distance scenes, beside vdsh5's attributes). */
-#define BUF(n, flags) {"buf" #n, "buf" #n, VR_MODE_VDSH_BUFFER, 0, n, OPT | FRM | (flags), 0, 0}
+#define BUF(n, flags)                                                                              \
+    {                                                                                              \
+        "buf" #n, "buf" #n, VR_MODE_VDSH_BUFFER, 0, n, OPT | FRM | (flags), 0, 0                   \
+    }
 
 const vv_mode vv_modes[] = {
     /* name        json        mode                 pcf stream flags            grid key */
-    {"none",      "none",      VR_MODE_NONE,        0, 0, OPT | FRM | BEN,       1, '1'},
-    {"cube",      "cube",      VR_MODE_CUBE,        0, 0, OPT | FRM | DEF | BEN, 2, '2'},
-    {"cube-pcf",  "cube_pcf",  VR_MODE_CUBE,        1, 0, FRM | DEF | BEN,       0, 0},
-    {"vdsh2",     "vdsh2",     VR_MODE_VDSH2,       0, 0, OPT | FRM | DEF | BEN, 5, '3'},
-    {"vdsh3",     "vdsh3",     VR_MODE_VDSH3,       0, 0, OPT | FRM | DEF | BEN, 4, '4'},
-    {"vdsh5",     "vdsh5",     VR_MODE_VDSH5,       0, 0, OPT | FRM | DEF | BEN, 3, '5'},
-    {"vdsh5poly", "vdsh5poly", VR_MODE_VDSH5_POLY,  0, 0, OPT | FRM | DEF | BEN, 3, '6'},
-    {"sdf",       "sdf",       VR_MODE_SDF,         0, 0, OPT | FRM | BEN,       7, 0},
-    BUF(1, 0),   BUF(2, 0),   BUF(3, 0),   BUF(4, 0),   BUF(5, LOG),  BUF(6, LOG),
-    BUF(7, LOG), BUF(8, LOG), BUF(9, LOG), BUF(10, LOG), BUF(11, LOG), BUF(12, LOG),
-    BUF(13, LOG), BUF(14, LOG), BUF(15, LOG), BUF(16, LOG),
-    {"adaptive",  "adaptive",  VR_MODE_VDSH_BUFFER, 0, VR_STREAM_VARIABLE, OPT | FRM | LOG, 6, 0},
-    {"buffer",    "buffer",    VR_MODE_VDSH_BUFFER, 0, 0, OPT,                   0, '7'},
+    {"none", "none", VR_MODE_NONE, 0, 0, OPT | FRM | BEN, 1, '1'},
+    {"cube", "cube", VR_MODE_CUBE, 0, 0, OPT | FRM | DEF | BEN, 2, '2'},
+    {"cube-pcf", "cube_pcf", VR_MODE_CUBE, 1, 0, FRM | DEF | BEN, 0, 0},
+    {"vdsh2", "vdsh2", VR_MODE_VDSH2, 0, 0, OPT | FRM | DEF | BEN, 5, '3'},
+    {"vdsh3", "vdsh3", VR_MODE_VDSH3, 0, 0, OPT | FRM | DEF | BEN, 4, '4'},
+    {"vdsh5", "vdsh5", VR_MODE_VDSH5, 0, 0, OPT | FRM | DEF | BEN, 3, '5'},
+    {"vdsh5poly", "vdsh5poly", VR_MODE_VDSH5_POLY, 0, 0, OPT | FRM | DEF | BEN, 3, '6'},
+    {"sdf", "sdf", VR_MODE_SDF, 0, 0, OPT | FRM | BEN, 7, 0},
+    BUF(1, 0),
+    BUF(2, 0),
+    BUF(3, 0),
+    BUF(4, 0),
+    BUF(5, LOG),
+    BUF(6, LOG),
+    BUF(7, LOG),
+    BUF(8, LOG),
+    BUF(9, LOG),
+    BUF(10, LOG),
+    BUF(11, LOG),
+    BUF(12, LOG),
+    BUF(13, LOG),
+    BUF(14, LOG),
+    BUF(15, LOG),
+    BUF(16, LOG),
+    {"adaptive", "adaptive", VR_MODE_VDSH_BUFFER, 0, VR_STREAM_VARIABLE, OPT | FRM | LOG, 6, 0},
+    {"buffer", "buffer", VR_MODE_VDSH_BUFFER, 0, 0, OPT, 0, '7'},
     {NULL, NULL, VR_MODE_DEFAULT, 0, 0, 0, 0, 0}};
 #undef BUF
 
@@ -238,8 +257,11 @@ int vv_open_scene(const vv_options *o, const char *path, vr_scene **out)
     vr_error err;
     /* More than the four default lights come from the scene's pool. */
     int pool = o->bench ? VR_MAX_POOL_LIGHTS : o->default_lights > 4 ? o->default_lights - 4 : 0;
-    vr_scene_desc sd = {.path = path, .skip_cubemaps = o->no_cubemaps, .light_pool = pool,
-                        .buffers = o->buffers, .sdf_path = o->sdf_path};
+    vr_scene_desc sd = {.path = path,
+                        .skip_cubemaps = o->no_cubemaps,
+                        .light_pool = pool,
+                        .buffers = o->buffers,
+                        .sdf_path = o->sdf_path};
     if (vr_scene_create(&sd, out, &err) != VR_OK) {
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
         return 1;
@@ -275,8 +297,10 @@ int vv_open_headless(const vv_options *o, int w, int h, int sized, vr_context **
                      vr_renderer **r)
 {
     vr_error err;
-    vr_context_desc cd = {.kind = VR_CONTEXT_HEADLESS, .egl_platform = o->egl,
-                          .width = sized ? w : 0, .height = sized ? h : 0};
+    vr_context_desc cd = {.kind = VR_CONTEXT_HEADLESS,
+                          .egl_platform = o->egl,
+                          .width = sized ? w : 0,
+                          .height = sized ? h : 0};
     if (vr_context_create(&cd, ctx, &err) != VR_OK) {
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
         return 1;

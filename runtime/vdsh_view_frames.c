@@ -77,8 +77,8 @@ static vr_result shadow_frame(vr_renderer *r, const vr_scene *scene, const vv_op
 /* The shaded picture of a light set: the viewer's white lights (dimmer
  * when there are several), fall-off and ambient; opaque. */
 static vr_result shaded_frame(vr_renderer *r, const vr_scene *scene, const vv_options *o,
-                              const vv_mode *m, const vr_camera *cam, const vt_view *v,
-                              int set, unsigned char *px, size_t n, vr_error *err)
+                              const vv_mode *m, const vr_camera *cam, const vt_view *v, int set,
+                              unsigned char *px, size_t n, vr_error *err)
 {
     vr_light lights[VT_VIEWS_MAX_LIGHTS];
     int nl = v->light_count[set];
@@ -128,7 +128,9 @@ int vv_run_frames(const vv_options *o)
         return 1;
     }
     int rc = 0;
-    vr_renderer_desc rd = {.width = w, .height = h, .color_format = VR_COLOR_RGBA32F,
+    vr_renderer_desc rd = {.width = w,
+                           .height = h,
+                           .color_format = VR_COLOR_RGBA32F,
                            .shadow_map_size = o->shadow_size};
     if (vr_renderer_create(&rd, &rf, &err) != VR_OK) {
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
@@ -168,10 +170,11 @@ int vv_run_frames(const vv_options *o)
             total += vs.views[v].light_count[k];
     total *= nm;
     if (!rc && !o->quiet)
-        fprintf(stderr, "vdsh-view: %s: %d view%s of %s, %d shadow frames of %dx%d in %d "
-                "mode%s, into %s (%s)\n", o->files[0], vs.count, vs.count == 1 ? "" : "s",
-                o->views_path, total, w, h, nm, nm == 1 ? "" : "s", o->frames_dir,
-                vr_gl_renderer());
+        fprintf(stderr,
+                "vdsh-view: %s: %d view%s of %s, %d shadow frames of %dx%d in %d "
+                "mode%s, into %s (%s)\n",
+                o->files[0], vs.count, vs.count == 1 ? "" : "s", o->views_path, total, w, h, nm,
+                nm == 1 ? "" : "s", o->frames_dir, vr_gl_renderer());
 
     /* Mode by mode (one program, its shadow maps re-rendered per frame);
      * the time of a frame is its draw and read-back, without the PNG. */
@@ -222,8 +225,7 @@ int vv_run_frames(const vv_options *o)
                 if (vt_shaded_path(path, sizeof path, o->frames_dir, view->name, k, m->name)) {
                     fprintf(stderr, "vdsh-view: %s: frame path too long\n", o->frames_dir);
                     rc = 1;
-                } else if (shaded_frame(s.r, s.scene, o, m, &cam, view, k, px, n, &err) !=
-                           VR_OK) {
+                } else if (shaded_frame(s.r, s.scene, o, m, &cam, view, k, px, n, &err) != VR_OK) {
                     fprintf(stderr, "vdsh-view: %s: %s: %s\n", o->files[0], path, err.msg);
                     rc = 1;
                 } else if (vt_png_rgba_write(path, w, h, px, msg, sizeof msg) != 0) {
@@ -234,9 +236,11 @@ int vv_run_frames(const vv_options *o)
         }
         /* The first frame of a mode compiles its program. */
         if (!rc && !o->quiet && mode_frames > 1)
-            fprintf(stderr, "vdsh-view: mode %s: %d frames of %dx%d, %.1f ms per frame after "
+            fprintf(stderr,
+                    "vdsh-view: mode %s: %d frames of %dx%d, %.1f ms per frame after "
                     "the first (%.1f ms: compiling), draw and read-back; PNG %.1f ms per "
-                    "frame\n", m->name, mode_frames, w, h, mode_ms / (mode_frames - 1), first_ms,
+                    "frame\n",
+                    m->name, mode_frames, w, h, mode_ms / (mode_frames - 1), first_ms,
                     png_ms / mode_frames);
         else if (!rc && !o->quiet && mode_frames == 1)
             fprintf(stderr, "vdsh-view: mode %s: 1 frame of %dx%d, %.1f ms (with compiling)\n",
@@ -250,4 +254,3 @@ int vv_run_frames(const vv_options *o)
     vt_views_free(&vs);
     return rc;
 }
-

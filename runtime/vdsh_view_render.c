@@ -36,8 +36,10 @@ int vv_run_render(const vv_options *o)
         char label[160];
         vv_mode_label(s.scene, o->mode, o->stream, label, sizeof label);
         if (!rc && !o->quiet)
-            fprintf(stderr, "vdsh-view: wrote %s (%dx%d, mode %s: %s, %d light%s, %.0f ms, %s; "
-                    "%s)\n", o->render_path, w, h,
+            fprintf(stderr,
+                    "vdsh-view: wrote %s (%dx%d, mode %s: %s, %d light%s, %.0f ms, %s; "
+                    "%s)\n",
+                    o->render_path, w, h,
                     vr_mode_name(o->mode ? o->mode : vr_scene_default_mode(s.scene)), label, n,
                     n == 1 ? "" : "s", ms, vr_gl_renderer(), vr_context_description(s.ctx));
     }
@@ -94,8 +96,8 @@ static const vv_mode *grid_mode(const vr_scene *s, int c)
 
 /* One row of the grid: the panels of one scene into row (cols panels w
  * wide); have[c]: 1 when the scene has column c's mode. */
-static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w, int h,
-                    int cols, unsigned char *px, unsigned char *row, int *have)
+static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w, int h, int cols,
+                    unsigned char *px, unsigned char *row, int *have)
 {
     vr_scene *scene = NULL;
     if (vv_open_scene(o, path, &scene))
@@ -116,8 +118,8 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
         int shadow = o->shadow_size ? o->shadow_size : VR_DEFAULT_SHADOW_MAP_SIZE;
         have[m] = vv_mode_available(scene, e);
         if (m < GRID_PAPER_COLS || have[m])
-            snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s",
-                     m ? " | " : "", e->name);
+            snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", m ? " | " : "",
+                     e->name);
         if (e->mode == VR_MODE_CUBE)
             snprintf(label, sizeof label, "cube shadow map (%d^2 x 6, %s)", shadow,
                      o->pcf ? "PCF" : "1 tap");
@@ -186,8 +188,8 @@ int vv_run_grid(const vv_options *o)
     }
     for (int i = 0; i < rows && !rc; i++) {
         int have[GRID_MAX_COLS] = {0};
-        rc = grid_row(o, o->files[i], r, w, h, all, px, img + (size_t)i * (size_t)all * panel,
-                      have);
+        rc =
+            grid_row(o, o->files[i], r, w, h, all, px, img + (size_t)i * (size_t)all * panel, have);
         for (int m = GRID_PAPER_COLS; m < all; m++)
             keep[m] |= have[m];
     }
@@ -211,8 +213,8 @@ int vv_run_grid(const vv_options *o)
             memset(img + (size_t)i * (size_t)h * stride, 40, stride);
         rc = vv_write_png(o->grid_path, cols * w, rows * h, img);
         if (!rc && !o->quiet)
-            fprintf(stderr, "vdsh-view: wrote %s (%dx%d, %d row%s, %s)\n", o->grid_path,
-                    cols * w, rows * h, rows, rows == 1 ? "" : "s", vr_gl_renderer());
+            fprintf(stderr, "vdsh-view: wrote %s (%dx%d, %d row%s, %s)\n", o->grid_path, cols * w,
+                    rows * h, rows, rows == 1 ? "" : "s", vr_gl_renderer());
     }
     free(px);
     free(img);

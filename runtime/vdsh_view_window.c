@@ -35,22 +35,22 @@ static const char keys_text[] =
 typedef struct app {
     const vv_options *o;
     vv_session s;
-    vr_light base[VV_MAX_LIGHTS];   /* user lights before animation */
+    vr_light base[VV_MAX_LIGHTS]; /* user lights before animation */
     int n;
     int selected;
     float target[3], yaw, pitch, dist, diag;
     vr_camera home;
     int animate;
     double anim_t;
-    int fired;                   /* a short-lived light is alive */
+    int fired; /* a short-lived light is alive */
     float fired_pos[3], fired_vel[3];
     double fired_age;
     vr_mode mode;
-    int stream;                  /* VR_MODE_VDSH_BUFFER's */
+    int stream; /* VR_MODE_VDSH_BUFFER's */
     vdsh_compare compare;
     int pcf, overlay;
     double mx, my;
-    int drag;                    /* 1 left (orbit), 2 right (look) */
+    int drag; /* 1 left (orbit), 2 right (look) */
     int shots;
     char status[256];
 } app;
@@ -124,9 +124,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
             return;
         }
     switch (key) {
-    case GLFW_KEY_ESCAPE:
-        glfwSetWindowShouldClose(w, GLFW_TRUE);
-        break;
+    case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(w, GLFW_TRUE); break;
     case GLFW_KEY_M:
         /* the next the scene has (after the first when this one has no key) */
         for (int i = 1; i <= nk; i++) {
@@ -205,9 +203,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         set_view(a, &a->home);
         print_status(a, "view reset");
         break;
-    case GLFW_KEY_O:
-        a->overlay = !a->overlay;
-        break;
+    case GLFW_KEY_O: a->overlay = !a->overlay; break;
     case GLFW_KEY_H:
         fputs(keys_text, stdout);
         a->overlay = 2;
@@ -227,8 +223,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         free(px);
         break;
     }
-    default:
-        break;
+    default: break;
     }
 }
 
@@ -280,8 +275,8 @@ static void on_scroll(GLFWwindow *w, double xoff, double yoff)
 
 /* Where the held keys point: keys[0]/[1] along +/-fwd, [2]/[3] along
  * +/-right, [4]/[5] up/down. */
-static void held_move(GLFWwindow *w, const int keys[6], const float fwd[3],
-                      const float right[3], float out[3])
+static void held_move(GLFWwindow *w, const int keys[6], const float fwd[3], const float right[3],
+                      float out[3])
 {
     int held[6];
     for (int i = 0; i < 6; i++)
@@ -323,8 +318,8 @@ static void update(app *a, GLFWwindow *w, float dt)
         a->target[k] += speed * move[k];
 
     if (a->n > 0) {
-        static const int keys[6] = {GLFW_KEY_UP,    GLFW_KEY_DOWN,    GLFW_KEY_RIGHT,
-                                    GLFW_KEY_LEFT,  GLFW_KEY_PAGE_UP, GLFW_KEY_PAGE_DOWN};
+        static const int keys[6] = {GLFW_KEY_UP,   GLFW_KEY_DOWN,    GLFW_KEY_RIGHT,
+                                    GLFW_KEY_LEFT, GLFW_KEY_PAGE_UP, GLFW_KEY_PAGE_DOWN};
         float lm[3], ls = 0.15f * a->diag * dt;
         held_move(w, keys, fh, right, lm);
         for (int k = 0; k < 3; k++)
@@ -412,9 +407,11 @@ int vv_run_window(const vv_options *o)
         glfwPollEvents();
         if (frames < keys_len) {
             char k = o->keys[frames];
-            int key = k == ' ' ? GLFW_KEY_SPACE : k == '>' ? GLFW_KEY_TAB
-                    : k == '<' ? GLFW_KEY_BACKSPACE
-                    : k >= '0' && k <= '9' ? GLFW_KEY_0 + (k - '0') : GLFW_KEY_A + (k - 'a');
+            int key = k == ' '               ? GLFW_KEY_SPACE
+                      : k == '>'             ? GLFW_KEY_TAB
+                      : k == '<'             ? GLFW_KEY_BACKSPACE
+                      : k >= '0' && k <= '9' ? GLFW_KEY_0 + (k - '0')
+                                             : GLFW_KEY_A + (k - 'a');
             on_key(win, key, 0, GLFW_PRESS, 0);
         }
         double t = vv_now_ms();
@@ -454,8 +451,10 @@ int vv_run_window(const vv_options *o)
                                "%s, %s\n%d light%s (selected %d)%s\n"
                                "frame %.1f ms (%.1f fps)\n"
                                "GPU: shadow maps %.1f ms, lighting %.1f ms\n%s",
-                               label, a.mode == VR_MODE_CUBE ? (a.pcf ? "PCF" : "1 tap")
-                               : a.compare == VDSH_COMPARE_SMOOTH ? "smooth" : "binary",
+                               label,
+                               a.mode == VR_MODE_CUBE             ? (a.pcf ? "PCF" : "1 tap")
+                               : a.compare == VDSH_COMPARE_SMOOTH ? "smooth"
+                                                                  : "binary",
                                n, n == 1 ? "" : "s", a.n ? a.selected + 1 : 0,
                                a.animate ? ", animated" : "", frame_ms,
                                frame_ms > 0 ? 1e3 / frame_ms : 0.0, tm.shadow_total_ms,

@@ -137,13 +137,13 @@ extern "C" {
 
 typedef enum vr_result {
     VR_OK = 0,
-    VR_ERR_IO,             /* a file cannot be opened or read */
-    VR_ERR_FORMAT,         /* a .vdsh file is corrupt or unsupported */
-    VR_ERR_MISSING,        /* a needed stream or the cubemaps are absent */
-    VR_ERR_GL,             /* GL error, incomplete framebuffer, no context */
-    VR_ERR_SHADER,         /* a shader failed to compile or link (log in msg) */
+    VR_ERR_IO,      /* a file cannot be opened or read */
+    VR_ERR_FORMAT,  /* a .vdsh file is corrupt or unsupported */
+    VR_ERR_MISSING, /* a needed stream or the cubemaps are absent */
+    VR_ERR_GL,      /* GL error, incomplete framebuffer, no context */
+    VR_ERR_SHADER,  /* a shader failed to compile or link (log in msg) */
     VR_ERR_OUT_OF_MEMORY,
-    VR_ERR_ARGUMENT        /* a bad descriptor field or argument */
+    VR_ERR_ARGUMENT /* a bad descriptor field or argument */
 } vr_result;
 
 /* A static string such as "missing stream or file"; never NULL. */
@@ -215,8 +215,7 @@ typedef struct vr_scene_desc {
  * or a cube_size above GL_MAX_CUBE_MAP_TEXTURE_SIZE),
  * VR_ERR_OUT_OF_MEMORY, VR_ERR_GL (also for a buffer stream larger than
  * GL_MAX_TEXTURE_BUFFER_SIZE texels). */
-vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out,
-                          vr_error *err);
+vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *err);
 
 /* NULL is fine. */
 void vr_scene_destroy(vr_scene *s);
@@ -224,19 +223,19 @@ void vr_scene_destroy(vr_scene *s);
 typedef struct vr_scene_info {
     uint32_t vertex_count;
     uint32_t triangle_count;
-    float bounds_min[3];          /* of the receiver vertices */
+    float bounds_min[3]; /* of the receiver vertices */
     float bounds_max[3];
     int has_order[VDSH_ORDER_SLOTS];          /* has_order[n]: a stream of order n */
     vdsh_encoding encoding[VDSH_ORDER_SLOTS]; /* its encoding */
     vdsh_method method[VDSH_ORDER_SLOTS];     /* how it was baked */
     float scale[VDSH_ORDER_SLOTS];            /* its stream scale */
-    int has_cubemaps;             /* basis cubemaps made */
-    int cube_size;                /* their face size, or 0 */
-    vdsh_quantity quantity;       /* the quantity drawn */
-    float max_distance;           /* the file's: no reconstructed distance
+    int has_cubemaps;                         /* basis cubemaps made */
+    int cube_size;                            /* their face size, or 0 */
+    vdsh_quantity quantity;                   /* the quantity drawn */
+    float max_distance;                       /* the file's: no reconstructed distance
                                      exceeds it (vdsh_shadow.h) */
-    size_t gpu_bytes;             /* buffers and textures uploaded */
-    int interior;                 /* 1: a room, seen from inside by default;
+    size_t gpu_bytes;                         /* buffers and textures uploaded */
+    int interior;                             /* 1: a room, seen from inside by default;
                                      0: an object, framed from outside (see
                                      vr_scene_default_camera) */
     /* VR_MODE_VDSH_BUFFER's streams: has_buffer[n], a fixed stream of
@@ -247,9 +246,9 @@ typedef struct vr_scene_info {
     int variable_order;
     float variable_mean_order;
     size_t buffer_bytes;
-    int has_sdf;                  /* a distance volume: VR_MODE_SDF */
-    uint32_t sdf_dim[3];          /* its samples per axis */
-    size_t sdf_bytes;             /* its share of gpu_bytes */
+    int has_sdf;         /* a distance volume: VR_MODE_SDF */
+    uint32_t sdf_dim[3]; /* its samples per axis */
+    size_t sdf_bytes;    /* its share of gpu_bytes */
 } vr_scene_info;
 
 void vr_scene_get_info(const vr_scene *s, vr_scene_info *out);
@@ -263,37 +262,31 @@ enum { VR_MAX_LIGHTS_PER_PASS = 8 };
 
 /* The defaults of zero sizes, here and in vr_context_desc; the viewer's
  * too (it names them, it does not repeat them). */
-enum {
-    VR_DEFAULT_WIDTH = 1024,
-    VR_DEFAULT_HEIGHT = 768,
-    VR_DEFAULT_SHADOW_MAP_SIZE = 512
-};
+enum { VR_DEFAULT_WIDTH = 1024, VR_DEFAULT_HEIGHT = 768, VR_DEFAULT_SHADOW_MAP_SIZE = 512 };
 
 typedef enum vr_color_format {
-    VR_COLOR_RGBA8 = 0,      /* default: an image to look at */
-    VR_COLOR_RGBA32F = 1     /* exact values for tests and debug outputs */
+    VR_COLOR_RGBA8 = 0,  /* default: an image to look at */
+    VR_COLOR_RGBA32F = 1 /* exact values for tests and debug outputs */
 } vr_color_format;
 
 typedef struct vr_renderer_desc {
-    int width, height;          /* 0: VR_DEFAULT_WIDTH x _HEIGHT, 1024 x 768 */
+    int width, height;            /* 0: VR_DEFAULT_WIDTH x _HEIGHT, 1024 x 768 */
     vr_color_format color_format; /* 0: RGBA8 */
-    int shadow_map_size;        /* cube shadow map face size; 0:
+    int shadow_map_size;          /* cube shadow map face size; 0:
                                    VR_DEFAULT_SHADOW_MAP_SIZE, 512 */
-    int max_lights_per_pass;    /* 1..VR_MAX_LIGHTS_PER_PASS; 0: 8 */
+    int max_lights_per_pass;      /* 1..VR_MAX_LIGHTS_PER_PASS; 0: 8 */
 } vr_renderer_desc;
 
 /* Create the offscreen framebuffer (colour texture + 32-bit float depth)
  * and the timer queries. Programs are compiled when first needed. */
-vr_result vr_renderer_create(const vr_renderer_desc *desc, vr_renderer **out,
-                             vr_error *err);
+vr_result vr_renderer_create(const vr_renderer_desc *desc, vr_renderer **out, vr_error *err);
 
 /* NULL and half-built renderers are fine. */
 void vr_renderer_destroy(vr_renderer *r);
 
 /* Resize the framebuffer (contents undefined afterwards). On failure the
  * old size stays. */
-vr_result vr_renderer_resize(vr_renderer *r, int width, int height,
-                             vr_error *err);
+vr_result vr_renderer_resize(vr_renderer *r, int width, int height, vr_error *err);
 
 void vr_renderer_size(const vr_renderer *r, int *width, int *height);
 
@@ -305,7 +298,7 @@ const char *vr_gl_renderer(void);
 /* Drawing                                                               */
 
 typedef enum vr_mode {
-    VR_MODE_DEFAULT = 0,     /* vr_scene_default_mode: every tool's default */
+    VR_MODE_DEFAULT = 0, /* vr_scene_default_mode: every tool's default */
     VR_MODE_NONE,
     VR_MODE_CUBE,
     VR_MODE_VDSH2,
@@ -313,7 +306,7 @@ typedef enum vr_mode {
     VR_MODE_VDSH5,
     VR_MODE_VDSH5_POLY,
     VR_MODE_VDSH_BUFFER,
-    VR_MODE_SDF,             /* distance-field shadows (vr_scene_desc.sdf_path) */
+    VR_MODE_SDF, /* distance-field shadows (vr_scene_desc.sdf_path) */
     VR_MODE_COUNT_
 } vr_mode;
 
@@ -359,23 +352,23 @@ const char *vr_scene_mode_label(const vr_scene *s, vr_mode m);
 
 typedef struct vr_light {
     float position[3];
-    float color[3];          /* linear RGB; all zero: white (1, 1, 1) */
-    float attenuation[3];    /* 1 / (a0 + a1 d + a2 d^2); all zero: (1, 0, 0) */
+    float color[3];       /* linear RGB; all zero: white (1, 1, 1) */
+    float attenuation[3]; /* 1 / (a0 + a1 d + a2 d^2); all zero: (1, 0, 0) */
 } vr_light;
 
 typedef struct vr_camera {
     float eye[3];
-    float target[3];         /* eye == target (e.g. both zero): the scene's
+    float target[3];    /* eye == target (e.g. both zero): the scene's
                                 default view (vr_scene_default_camera) */
-    float up[3];             /* zero: (0, 1, 0) */
-    float fov_y;             /* degrees; 0: 60 */
-    float znear, zfar;       /* 0: from the scene bounds */
-    float ortho_height;      /* > 0: orthographic, this many units tall */
+    float up[3];        /* zero: (0, 1, 0) */
+    float fov_y;        /* degrees; 0: 60 */
+    float znear, zfar;  /* 0: from the scene bounds */
+    float ortho_height; /* > 0: orthographic, this many units tall */
 } vr_camera;
 
 typedef enum vr_output {
-    VR_OUTPUT_COLOR = 0,     /* albedo * (ambient + sum lambert * shadow) */
-    VR_OUTPUT_SHADOW = 1,    /* light 0: (s, d_V, d_L, 1): s the shadow
+    VR_OUTPUT_COLOR = 0,   /* albedo * (ambient + sum lambert * shadow) */
+    VR_OUTPUT_SHADOW = 1,  /* light 0: (s, d_V, d_L, 1): s the shadow
                                 factor alone (0 shadowed .. 1 lit; no
                                 Lambert term, no attenuation, also where
                                 the surface faces away from the light:
@@ -388,27 +381,27 @@ typedef enum vr_output {
                                 in modes none and cube. Alpha 1 where a
                                 surface was drawn: the clear colour's
                                 alpha elsewhere */
-    VR_OUTPUT_POSITION = 2   /* (world x, y, z, 1) */
+    VR_OUTPUT_POSITION = 2 /* (world x, y, z, 1) */
 } vr_output;
 
 typedef struct vr_draw_desc {
-    vr_mode mode;            /* 0: vr_scene_default_mode of the scene */
-    vdsh_compare compare;    /* 0: smooth (the paper's ramp) */
-    int pcf;                 /* VR_MODE_CUBE: 0 one nearest tap, 1 PCF */
-    const vr_light *lights;  /* light_count entries, borrowed */
-    int light_count;         /* 0: no lights (ambient only) */
+    vr_mode mode;           /* 0: vr_scene_default_mode of the scene */
+    vdsh_compare compare;   /* 0: smooth (the paper's ramp) */
+    int pcf;                /* VR_MODE_CUBE: 0 one nearest tap, 1 PCF */
+    const vr_light *lights; /* light_count entries, borrowed */
+    int light_count;        /* 0: no lights (ambient only) */
     vr_camera camera;
-    float ambient[3];        /* added before the albedo multiply; zero: none */
-    float albedo[3];         /* all zero: 0.8 grey */
-    float clear_color[4];    /* zero: black, alpha 0 */
-    vr_output output;        /* 0: colour */
-    int points;              /* 1: draw the vertices as 1-pixel points, not
+    float ambient[3];     /* added before the albedo multiply; zero: none */
+    float albedo[3];      /* all zero: 0.8 grey */
+    float clear_color[4]; /* zero: black, alpha 0 */
+    vr_output output;     /* 0: colour */
+    int points;           /* 1: draw the vertices as 1-pixel points, not
                                 triangles (a test aid: each pixel then holds
                                 one vertex's unclipped, uninterpolated value) */
-    int stream;              /* VR_MODE_VDSH_BUFFER: the stream drawn,
+    int stream;           /* VR_MODE_VDSH_BUFFER: the stream drawn,
                                 vr_scene_buffer_stream's argument (0: the
                                 scene's default); ignored by other modes */
-    float sdf_k;             /* VR_MODE_SDF: the softness k of
+    float sdf_k;          /* VR_MODE_SDF: the softness k of
                                 vdsh_sdf_shadow; 0: VDSH_SDF_DEFAULT_K */
 } vr_draw_desc;
 
@@ -417,8 +410,7 @@ typedef struct vr_draw_desc {
  * and one lighting pass. Errors: VR_ERR_MISSING when the scene lacks the
  * mode's stream (VR_MODE_VDSH_BUFFER: the stream asked for) or cubemaps, VR_ERR_ARGUMENT for bad fields, VR_ERR_SHADER
  * / VR_ERR_GL. On failure the framebuffer contents are undefined. */
-vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *d,
-                  vr_error *err);
+vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *d, vr_error *err);
 
 /* The default camera for a scene (y up). An interior (a room, a
  * courtyard: vr_scene_info.interior) is seen from inside its bounds near
@@ -462,24 +454,21 @@ int vr_scene_pool_lights(const vr_scene *s, vr_light *out, int max);
 /* Draw text (ASCII, stb_easy_font's 7-pixel font scaled by `scale`) on top
  * of the framebuffer at pixel (x, y) from the top-left, on a dark box.
  * color NULL: white. Lines break at '\n'. */
-vr_result vr_draw_text(vr_renderer *r, int x, int y, float scale,
-                       const float color[4], const char *text, vr_error *err);
+vr_result vr_draw_text(vr_renderer *r, int x, int y, float scale, const float color[4],
+                       const char *text, vr_error *err);
 
 /* Read the framebuffer, top row first: RGBA8 gives width*height*4 bytes,
  * RGBA32F width*height*4 floats. size is the byte size of dst; too small
  * gives VR_ERR_ARGUMENT and dst untouched. */
-vr_result vr_read_pixels(vr_renderer *r, void *dst, size_t size,
-                         vr_error *err);
+vr_result vr_read_pixels(vr_renderer *r, void *dst, size_t size, vr_error *err);
 
 /* Copy the framebuffer to framebuffer `dst` (0: the window), scaled to
  * dst_width x dst_height. */
-void vr_renderer_blit(vr_renderer *r, unsigned dst, int dst_width,
-                      int dst_height);
+void vr_renderer_blit(vr_renderer *r, unsigned dst, int dst_width, int dst_height);
 
 /* Read width x height RGBA8 pixels of the window's back buffer
  * (framebuffer 0), top row first: what the next swap will show. */
-vr_result vr_read_window(int width, int height, void *dst, size_t size,
-                         vr_error *err);
+vr_result vr_read_window(int width, int height, void *dst, size_t size, vr_error *err);
 
 /* ------------------------------------------------------------------ */
 /* Timings                                                               */
@@ -487,15 +476,15 @@ vr_result vr_read_window(int width, int height, void *dst, size_t size,
 enum { VR_TIMING_MAX_GROUPS = 8 };
 
 typedef struct vr_timings {
-    uint64_t frame;          /* 1 for the first vr_draw; 0: none available */
-    int groups;              /* light groups (passes) drawn */
+    uint64_t frame; /* 1 for the first vr_draw; 0: none available */
+    int groups;     /* light groups (passes) drawn */
     /* GPU time (GL_TIME_ELAPSED), milliseconds. Per group g: the cube
      * shadow maps of its lights and its lighting pass (groups beyond the
      * last slot add into the last). */
     double shadow_ms[VR_TIMING_MAX_GROUPS];
     double lighting_ms[VR_TIMING_MAX_GROUPS];
     double shadow_total_ms, lighting_total_ms;
-    double gpu_ms;           /* sum of the above */
+    double gpu_ms; /* sum of the above */
     /* CPU wall time from the start of vr_draw to the end of
      * vr_renderer_finish (glFinish); 0 if the frame was not finished. */
     double cpu_ms;
@@ -517,20 +506,20 @@ void vr_renderer_timings(vr_renderer *r, vr_timings *out);
  * ARB_pipeline_statistics_query) where the context has them
  * (`statistics` 1), else those fields are 0. */
 typedef struct vr_counts {
-    int statistics;                  /* the pipeline statistics below are valid */
-    uint64_t samples_passed;         /* samples passing the depth test */
-    uint64_t primitives_generated;   /* primitives out of the vertex stage */
-    uint64_t vertices_submitted;     /* vertices read by the draws */
-    uint64_t vertex_invocations;     /* vertex shader runs (after reuse) */
-    uint64_t fragment_invocations;   /* fragment shader runs (depth-only too) */
-    uint64_t clipping_primitives;    /* primitives reaching clipping */
+    int statistics;                /* the pipeline statistics below are valid */
+    uint64_t samples_passed;       /* samples passing the depth test */
+    uint64_t primitives_generated; /* primitives out of the vertex stage */
+    uint64_t vertices_submitted;   /* vertices read by the draws */
+    uint64_t vertex_invocations;   /* vertex shader runs (after reuse) */
+    uint64_t fragment_invocations; /* fragment shader runs (depth-only too) */
+    uint64_t clipping_primitives;  /* primitives reaching clipping */
 } vr_counts;
 
 /* vr_draw with the queries of vr_counts around it, then glFinish; the
  * counts of this frame in *out. Slower than vr_draw (a stall): not for
  * timed frames. Errors as vr_draw. */
-vr_result vr_draw_counted(vr_renderer *r, const vr_scene *s, const vr_draw_desc *d,
-                          vr_counts *out, vr_error *err);
+vr_result vr_draw_counted(vr_renderer *r, const vr_scene *s, const vr_draw_desc *d, vr_counts *out,
+                          vr_error *err);
 
 #ifdef __cplusplus
 }

@@ -226,8 +226,8 @@ static unsigned char *fixed_records(const vdsh_stream *st, vr_buffer *b, uint32_
  * has not been through the reader). VR_ERR_FORMAT, VR_ERR_OUT_OF_MEMORY. */
 static vr_result variable_records(const vdsh_stream *st, vr_buffer *b, uint32_t nv,
                                   const uint32_t *remap, int floats, unsigned char **out,
-                                  size_t *bytes, uint32_t *start, uint8_t *order,
-                                  const char *name, vr_error *err)
+                                  size_t *bytes, uint32_t *start, uint8_t *order, const char *name,
+                                  vr_error *err)
 {
     uint32_t *inv = malloc((size_t)nv * sizeof *inv);
     if (!inv)
@@ -239,9 +239,10 @@ static vr_result variable_records(const vdsh_stream *st, vr_buffer *b, uint32_t 
         if (k < 1 || k > st->order ||
             st->offsets[v + 1] - st->offsets[v] != vdsh_record_words(st->encoding, k)) {
             free(inv);
-            return vr_fail(err, VR_ERR_FORMAT, "%s: variable-order stream: vertex %u has "
-                           "order %u and a record of %u words", name, v, k,
-                           st->offsets[v + 1] - st->offsets[v]);
+            return vr_fail(err, VR_ERR_FORMAT,
+                           "%s: variable-order stream: vertex %u has "
+                           "order %u and a record of %u words",
+                           name, v, k, st->offsets[v + 1] - st->offsets[v]);
         }
         inv[remap[v]] = v;
         texels += (size_t)vr_buffer_stride((int)k, b->kind);
@@ -291,7 +292,8 @@ static float *build_model(const vdsh_stream *st, int order, size_t *bytes)
             for (uint32_t j = 0; j < m->basis; j++) {
                 size_t v = (size_t)c * m->basis + j;
                 float step = vdsh_cpca_step(m->scales[v], m->bits);
-                t[4 * (j + 1)] = step * vdsh_f32_from_f16(m->bases[v * (size_t)nc + (size_t)seq[p]]);
+                t[4 * (j + 1)] =
+                    step * vdsh_f32_from_f16(m->bases[v * (size_t)nc + (size_t)seq[p]]);
             }
         }
     *bytes = floats * sizeof *dst;
@@ -300,8 +302,8 @@ static float *build_model(const vdsh_stream *st, int order, size_t *bytes)
 
 /* Create the buffer texture, the VAO and (variable) the per-vertex
  * attributes of b (GL errors are the caller's to check). */
-static void make_gl(vr_scene *s, vr_buffer *b, const void *rec, size_t bytes,
-                    const uint32_t *start, const uint8_t *order)
+static void make_gl(vr_scene *s, vr_buffer *b, const void *rec, size_t bytes, const uint32_t *start,
+                    const uint8_t *order)
 {
     glGenBuffers(1, &b->buf);
     glBindBuffer(GL_TEXTURE_BUFFER, b->buf);
@@ -334,18 +336,17 @@ static void make_gl(vr_scene *s, vr_buffer *b, const void *rec, size_t bytes,
     b->bytes += bytes;
 }
 
-vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *remap,
-                           int floats, const char *name, vr_error *err)
+vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *remap, int floats,
+                           const char *name, vr_error *err)
 {
     int order = (int)st->order;
     int cpca = st->encoding == VDSH_ENCODING_CPCA;
-    if (order < 1 || order > VDSH_MAX_ORDER ||
-        (st->encoding > VDSH_ENCODING_S8S6 && !cpca) ||
+    if (order < 1 || order > VDSH_MAX_ORDER || (st->encoding > VDSH_ENCODING_S8S6 && !cpca) ||
         (cpca && (!st->cpca.scales || !st->cpca.means || !st->cpca.bases ||
                   (st->flags & VDSH_STREAM_VARIABLE))) ||
         (vdsh_encoding_quantised(st->encoding) && !st->coef_scales))
-        return vr_fail(err, VR_ERR_FORMAT, "%s: order %d stream: encoding %u cannot be drawn",
-                       name, order, st->encoding);
+        return vr_fail(err, VR_ERR_FORMAT, "%s: order %d stream: encoding %u cannot be drawn", name,
+                       order, st->encoding);
     vr_buffer b;
     memset(&b, 0, sizeof b);
     b.order = order;
@@ -395,8 +396,10 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
     glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
     size_t texels = bytes / texel_bytes(b.kind);
     if (r == VR_OK && texels > (size_t)max_texels)
-        r = vr_fail(err, VR_ERR_GL, "%s: order %d stream: %zu texels, above this GL's "
-                    "GL_MAX_TEXTURE_BUFFER_SIZE (%d)", name, order, texels, (int)max_texels);
+        r = vr_fail(err, VR_ERR_GL,
+                    "%s: order %d stream: %zu texels, above this GL's "
+                    "GL_MAX_TEXTURE_BUFFER_SIZE (%d)",
+                    name, order, texels, (int)max_texels);
     float *model = NULL;
     size_t model_bytes = 0;
     if (r == VR_OK && b.kind == VR_BUF_CPCA) {
@@ -405,9 +408,10 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
             r = vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory uploading order %d", name,
                         order);
         else if (model_bytes / 16 > (size_t)max_texels)
-            r = vr_fail(err, VR_ERR_GL, "%s: order %d cpca model: %zu texels, above this GL's "
-                        "GL_MAX_TEXTURE_BUFFER_SIZE (%d)", name, order, model_bytes / 16,
-                        (int)max_texels);
+            r = vr_fail(err, VR_ERR_GL,
+                        "%s: order %d cpca model: %zu texels, above this GL's "
+                        "GL_MAX_TEXTURE_BUFFER_SIZE (%d)",
+                        name, order, model_bytes / 16, (int)max_texels);
     }
     if (r == VR_OK) {
         make_gl(s, &b, rec, bytes, start, korder);

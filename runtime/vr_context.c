@@ -54,8 +54,8 @@ static void pin_libraries(void)
 struct vr_context {
     EGLDisplay display;
     EGLContext context;
-    EGLSurface surface;       /* pbuffer, only without surfaceless support */
-    void *window;             /* GLFWwindow */
+    EGLSurface surface; /* pbuffer, only without surfaceless support */
+    void *window;       /* GLFWwindow */
     char description[160];
 };
 
@@ -100,9 +100,13 @@ static vr_result egl_make_context(vr_context *c, const char *what, vr_error *err
         if (!eglChooseConfig(c->display, want, &config, 1, &n) || n < 1)
             return vr_fail(err, VR_ERR_GL, "%s: no EGL config for desktop OpenGL", what);
     }
-    const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
+    const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                              3,
+                              EGL_CONTEXT_MINOR_VERSION,
+                              3,
                               EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                              EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+                              EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                              EGL_NONE};
     c->context = eglCreateContext(c->display, config, EGL_NO_CONTEXT, attribs);
     if (c->context == EGL_NO_CONTEXT)
         return vr_fail(err, VR_ERR_GL, "%s: cannot create a GL 3.3 core context (%s)", what,
@@ -173,8 +177,8 @@ static vr_result try_device(vr_context *c, vr_error *err)
             r = egl_make_context(c, "EGL device platform", err);
             if (r == VR_OK) {
                 snprintf(c->description, sizeof c->description,
-                         "EGL %d.%d device platform, device %d%s", (int)major, (int)minor,
-                         (int)i, software ? " (EGL_MESA_device_software)" : "");
+                         "EGL %d.%d device platform, device %d%s", (int)major, (int)minor, (int)i,
+                         software ? " (EGL_MESA_device_software)" : "");
                 return VR_OK;
             }
             egl_release(c);
@@ -204,8 +208,8 @@ static vr_result try_surfaceless(vr_context *c, vr_error *err)
         egl_release(c);
         return r;
     }
-    snprintf(c->description, sizeof c->description, "EGL %d.%d surfaceless platform",
-             (int)major, (int)minor);
+    snprintf(c->description, sizeof c->description, "EGL %d.%d surfaceless platform", (int)major,
+             (int)minor);
     return VR_OK;
 }
 
@@ -257,8 +261,8 @@ static vr_result create_window(vr_context *c, const vr_context_desc *d, vr_error
     c->window = w;
     int major = 0, minor = 0, rev = 0;
     glfwGetVersion(&major, &minor, &rev);
-    snprintf(c->description, sizeof c->description, "GLFW %d.%d.%d window, EGL context",
-             major, minor, rev);
+    snprintf(c->description, sizeof c->description, "GLFW %d.%d.%d window, EGL context", major,
+             minor, rev);
     return VR_OK;
 }
 #endif
@@ -273,8 +277,7 @@ vr_result vr_context_create(const vr_context_desc *desc, vr_context **out, vr_er
     if (!d.title)
         d.title = "vdsh-view";
     if (!out || (unsigned)d.kind > VR_CONTEXT_WINDOW ||
-        (unsigned)d.egl_platform > VR_EGL_SURFACELESS ||
-        d.width < 1 || d.height < 1)
+        (unsigned)d.egl_platform > VR_EGL_SURFACELESS || d.width < 1 || d.height < 1)
         return vr_fail(err, VR_ERR_ARGUMENT, "vr_context_create: bad descriptor");
     vr_context *c = calloc(1, sizeof *c);
     if (!c)

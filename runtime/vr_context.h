@@ -38,27 +38,23 @@ extern "C" {
 
 typedef struct vr_context vr_context;
 
-typedef enum vr_context_kind {
-    VR_CONTEXT_HEADLESS = 0,
-    VR_CONTEXT_WINDOW = 1
-} vr_context_kind;
+typedef enum vr_context_kind { VR_CONTEXT_HEADLESS = 0, VR_CONTEXT_WINDOW = 1 } vr_context_kind;
 
 typedef enum vr_egl_platform {
-    VR_EGL_AUTO = 0,          /* device, then surfaceless */
+    VR_EGL_AUTO = 0, /* device, then surfaceless */
     VR_EGL_DEVICE = 1,
     VR_EGL_SURFACELESS = 2
 } vr_egl_platform;
 
 typedef struct vr_context_desc {
-    vr_context_kind kind;     /* 0: headless */
+    vr_context_kind kind;         /* 0: headless */
     vr_egl_platform egl_platform; /* headless only; 0: auto */
-    int width, height;        /* window size; 0: VR_DEFAULT_WIDTH x _HEIGHT */
-    const char *title;        /* window title; NULL: "vdsh-view" */
-    int vsync;                /* window: 1 waits for vertical sync */
+    int width, height;            /* window size; 0: VR_DEFAULT_WIDTH x _HEIGHT */
+    const char *title;            /* window title; NULL: "vdsh-view" */
+    int vsync;                    /* window: 1 waits for vertical sync */
 } vr_context_desc;
 
-vr_result vr_context_create(const vr_context_desc *desc, vr_context **out,
-                            vr_error *err);
+vr_result vr_context_create(const vr_context_desc *desc, vr_context **out, vr_error *err);
 
 void vr_context_destroy(vr_context *c);
 

@@ -100,9 +100,9 @@ static void key_name(const vr_program_key *k, char *buf, size_t size)
 static int varying_components(const vr_program_key *k, int flat)
 {
     int interp = vr_mode_interp((vr_mode)k->mode, k->quantity), n = k->lights;
-    int c = 6;   /* position, normal */
+    int c = 6; /* position, normal */
     if (interp >= 0)
-        c += n;  /* a visibility, distance or band 0-2 sum per light */
+        c += n; /* a visibility, distance or band 0-2 sum per light */
     if (interp == VDSH_INTERP_SPLIT)
         c += 16;
     if (interp == VDSH_INTERP_VISIBILITY && k->output == VR_OUTPUT_SHADOW)
@@ -181,8 +181,8 @@ static int failed(GLuint obj, int is_shader, char *log, GLsizei size)
     return 1;
 }
 
-static vr_result compile(const char *name, GLenum stage, const char *src,
-                         GLuint *out, vr_error *err)
+static vr_result compile(const char *name, GLenum stage, const char *src, GLuint *out,
+                         vr_error *err)
 {
     GLuint sh = glCreateShader(stage);
     if (!sh)
@@ -197,8 +197,7 @@ static vr_result compile(const char *name, GLenum stage, const char *src,
     return VR_OK;
 }
 
-vr_result vr_link(const char *name, const char *vs, const char *fs,
-                  GLuint *out, vr_error *err)
+vr_result vr_link(const char *name, const char *vs, const char *fs, GLuint *out, vr_error *err)
 {
     GLuint v = 0, f = 0;
     vr_result r = compile(name, GL_VERTEX_SHADER, vs, &v, err);
@@ -262,8 +261,8 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_progra
     char *table = buffer ? ks_table(ks, key->buf_order * key->buf_order) : NULL;
     size_t vs_size = sizeof defines + vr_glsl_common_size + vr_glsl_vertex_size +
                      (table ? strlen(table) : 0) + vr_buffer_glsl_size + vr_glsl_vertex_main_size;
-    size_t fs_size = sizeof defines + vr_glsl_common_size + vr_sdf_glsl_size +
-                     vr_glsl_fragment_size;
+    size_t fs_size =
+        sizeof defines + vr_glsl_common_size + vr_sdf_glsl_size + vr_glsl_fragment_size;
     char *vs = malloc(vs_size), *fs = malloc(fs_size);
     if (!vs || !fs || (buffer && !table)) {
         free(vs);

@@ -17,7 +17,8 @@
 #if defined(__GNUC__)
 __attribute__((format(printf, 3, 4)))
 #endif
-vr_result vr_fail(vr_error *err, vr_result r, const char *fmt, ...);
+vr_result
+vr_fail(vr_error *err, vr_result r, const char *fmt, ...);
 
 /* VR_OK when glGetError reports nothing; else VR_ERR_GL naming `what`.
  * Drains every pending error so that the next check starts clean. */
@@ -37,20 +38,14 @@ int vr_mode_interp(vr_mode m, uint32_t quantity);
  * permutation; vertices no triangle uses go last). VR_ERR_FORMAT when an
  * index is not below nv, VR_ERR_OUT_OF_MEMORY; `name` for messages;
  * outputs are undefined on failure. */
-vr_result vr_order_triangles(const uint32_t *indices, uint32_t nt, uint32_t nv,
-                             uint32_t *out, uint32_t *remap, const char *name,
-                             vr_error *err);
+vr_result vr_order_triangles(const uint32_t *indices, uint32_t nt, uint32_t nv, uint32_t *out,
+                             uint32_t *remap, const char *name, vr_error *err);
 
 /* Attribute locations, the same in every program. Coefficient attribute
  * k covers coefficients first[k] .. first[k] + size[k] - 1 of the stream
  * (vr_coef_attribs): grouped so that bands 0-2 (0..8) and the four
  * cubemap groups (9..12, ..., 21..24) each map to whole attributes. */
-enum {
-    VR_ATTR_POSITION = 0,
-    VR_ATTR_NORMAL = 1,
-    VR_ATTR_COEF0 = 2,
-    VR_COEF_ATTRIBS = 7
-};
+enum { VR_ATTR_POSITION = 0, VR_ATTR_NORMAL = 1, VR_ATTR_COEF0 = 2, VR_COEF_ATTRIBS = 7 };
 extern const int vr_coef_first[VR_COEF_ATTRIBS];
 extern const int vr_coef_size[VR_COEF_ATTRIBS];
 /* How many coefficient attributes an order uses (2: 1, 3: 3, 5: 7). */
@@ -63,7 +58,7 @@ enum {
     VR_UNIT_SHADOW = 4,
     VR_UNIT_COEF = VR_UNIT_SHADOW + VR_MAX_LIGHTS_PER_PASS,
     VR_UNIT_SDF = VR_UNIT_COEF + 1,
-    VR_UNIT_MODEL = VR_UNIT_SDF + 1   /* a cpca buffer stream's model */
+    VR_UNIT_MODEL = VR_UNIT_SDF + 1 /* a cpca buffer stream's model */
 };
 
 /* A buffer stream's vertex attributes (VR_MODE_VDSH_BUFFER, variable
@@ -72,31 +67,31 @@ enum { VR_ATTR_RECORD = 9, VR_ATTR_ORDER = 10 };
 
 /* What a buffer texture's texels are (vr_buffer.c). */
 typedef enum vr_buf_kind {
-    VR_BUF_F32 = 0,          /* RGBA32F: four coefficients per texel */
-    VR_BUF_F16 = 1,          /* RGBA16F */
-    VR_BUF_S8 = 2,           /* RGBA8I (times the steps in u_ks) */
-    VR_BUF_S8S6 = 3,         /* R32UI words: 4 bytes, then 6-bit fields */
-    VR_BUF_CPCA = 4          /* R32UI words: a cpca record as stored (cluster
+    VR_BUF_F32 = 0,  /* RGBA32F: four coefficients per texel */
+    VR_BUF_F16 = 1,  /* RGBA16F */
+    VR_BUF_S8 = 2,   /* RGBA8I (times the steps in u_ks) */
+    VR_BUF_S8S6 = 3, /* R32UI words: 4 bytes, then 6-bit fields */
+    VR_BUF_CPCA = 4  /* R32UI words: a cpca record as stored (cluster
                                 index, packed weights), decoded per vertex
                                 from the model texture (vr_buffer.model) */
 } vr_buf_kind;
 
 /* A stream drawn from buffer textures (VR_MODE_VDSH_BUFFER). */
 typedef struct vr_buffer {
-    int order;               /* fixed: its order; variable: the cap; 0: none */
-    int variable;            /* 1: an order per vertex */
+    int order;    /* fixed: its order; variable: the cap; 0: none */
+    int variable; /* 1: an order per vertex */
     vr_buf_kind kind;
-    vdsh_encoding encoding;  /* the file's */
-    float scale;             /* multiplies the sums (f32, f16), else 1 */
-    int stride;              /* fixed: texels per vertex */
-    GLuint buf, tex;         /* the records, in the GPU vertex order */
-    float *ks;               /* per coefficient index, K_l^m x step: a
+    vdsh_encoding encoding;       /* the file's */
+    float scale;                  /* multiplies the sums (f32, f16), else 1 */
+    int stride;                   /* fixed: texels per vertex */
+    GLuint buf, tex;              /* the records, in the GPU vertex order */
+    float *ks;                    /* per coefficient index, K_l^m x step: a
                                 constant table of the program (vr_glsl.c) */
-    uint64_t ks_hash;        /* of ks and the order (the program key) */
+    uint64_t ks_hash;             /* of ks and the order (the program key) */
     GLuint vbo_record, vbo_order; /* variable: per vertex, u32 and u8 */
     GLuint vao;
-    size_t bytes;            /* all of the above */
-    float mean_order;        /* variable: over the vertices */
+    size_t bytes;     /* all of the above */
+    float mean_order; /* variable: over the vertices */
     /* VR_BUF_CPCA: the model as an RGBA32F buffer texture (vr_buffer.c),
      * basis vectors per cluster and bits per weight */
     GLuint model_buf, model_tex;
@@ -106,8 +101,8 @@ typedef struct vr_buffer {
 /* Upload stream st (its quantity drawn) as a buffer stream of s, in the
  * GPU vertex order (remap[file vertex] = GPU vertex); floats: decoded f32.
  * VR_ERR_FORMAT, VR_ERR_OUT_OF_MEMORY, VR_ERR_GL naming `name`. */
-vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *remap,
-                           int floats, const char *name, vr_error *err);
+vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *remap, int floats,
+                           const char *name, vr_error *err);
 void vr_buffer_destroy(vr_buffer *b);
 /* The positions and normals (and indices) of s into the bound VAO. */
 void vr_scene_base_attribs(const vr_scene *s);
@@ -116,7 +111,7 @@ struct vr_scene {
     uint32_t vertex_count, triangle_count;
     float bounds_min[3], bounds_max[3];
     vdsh_quantity quantity;
-    float max_distance;         /* the file's: clamps reconstructed distances */
+    float max_distance; /* the file's: clamps reconstructed distances */
     GLuint vbo_position, vbo_normal, ibo;
     /* Per order 1..VDSH_MAX_ORDER: the stream's buffer and a VAO with positions,
      * normals and its coefficients; vao[0] has positions and normals only. */
@@ -128,16 +123,16 @@ struct vr_scene {
     /* Per order: a factor per coefficient, laid out as the attributes
      * (attribute k's component j at 4k + j): s8 streams' steps, else 1. */
     float coef_step[VDSH_ORDER_SLOTS][4 * VR_COEF_ATTRIBS];
-    GLuint basis[4];            /* cube textures, functions 9+4k..12+4k */
+    GLuint basis[4]; /* cube textures, functions 9+4k..12+4k */
     int cube_size;
     size_t gpu_bytes;
-    vdsh_view view;             /* the default view, decided at load */
+    vdsh_view view;                    /* the default view, decided at load */
     float pool[VR_MAX_POOL_LIGHTS][3]; /* vr_scene_pool_lights */
     int pool_count;
     vr_buffer buffer[VDSH_ORDER_SLOTS]; /* fixed orders, by order */
     vr_buffer variable;                 /* an order per vertex */
-    GLuint sdf_tex;             /* mode sdf: the distance volume (0: none) */
-    vdsh_sdf sdf;               /* its header (samples NULL) */
+    GLuint sdf_tex;                     /* mode sdf: the distance volume (0: none) */
+    vdsh_sdf sdf;                       /* its header (samples NULL) */
     size_t sdf_bytes;
 };
 
@@ -153,25 +148,25 @@ void vr_sdf_bind(const vr_scene *s, GLuint prog, float k);
 const vr_buffer *vr_scene_buffer(const vr_scene *s, int stream);
 
 /* Place desc->light_pool lights in free space (vr_view.c). */
-vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count,
-                              const char *name, vr_error *err);
+vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count, const char *name,
+                              vr_error *err);
 
 /* Which program: everything that changes the shader source. Compared
  * with memcmp: make it with memset(0) first (padding included). */
 typedef struct vr_program_key {
-    uint64_t ks_hash;   /* VR_MODE_VDSH_BUFFER: of its factor table (vr_buffer.ks) */
-    uint8_t mode;       /* vr_mode, resolved (never DEFAULT) */
-    uint8_t compare;    /* vdsh_compare */
-    uint8_t quantity;   /* vdsh_quantity */
-    uint8_t output;     /* vr_output */
-    uint8_t pcf;        /* 0 or 1 */
-    uint8_t lights;     /* lights in this pass, 0..VR_MAX_LIGHTS_PER_PASS */
-    uint8_t packed;     /* 1: the stream is s8s6 (bands 2+ in packed words) */
-    uint8_t buf_order;  /* VR_MODE_VDSH_BUFFER: order (variable: the cap) */
-    uint8_t buf_kind;   /* vr_buf_kind */
+    uint64_t ks_hash;     /* VR_MODE_VDSH_BUFFER: of its factor table (vr_buffer.ks) */
+    uint8_t mode;         /* vr_mode, resolved (never DEFAULT) */
+    uint8_t compare;      /* vdsh_compare */
+    uint8_t quantity;     /* vdsh_quantity */
+    uint8_t output;       /* vr_output */
+    uint8_t pcf;          /* 0 or 1 */
+    uint8_t lights;       /* lights in this pass, 0..VR_MAX_LIGHTS_PER_PASS */
+    uint8_t packed;       /* 1: the stream is s8s6 (bands 2+ in packed words) */
+    uint8_t buf_order;    /* VR_MODE_VDSH_BUFFER: order (variable: the cap) */
+    uint8_t buf_kind;     /* vr_buf_kind */
     uint8_t buf_variable; /* 1: an order per vertex */
-    uint8_t cpca_bits;  /* VR_BUF_CPCA: bits per weight */
-    uint16_t cpca_basis; /* VR_BUF_CPCA: basis vectors per cluster */
+    uint8_t cpca_bits;    /* VR_BUF_CPCA: bits per weight */
+    uint16_t cpca_basis;  /* VR_BUF_CPCA: basis vectors per cluster */
 } vr_program_key;
 
 /* Texels of a record of this order and kind. */
@@ -188,7 +183,8 @@ extern const size_t vr_buffer_glsl_size;
 typedef struct vr_program {
     vr_program_key key;
     GLuint prog;
-    GLint u_view_proj, u_scale, u_coef_step, u_max_distance, u_light_pos, u_light_color, u_light_att;
+    GLint u_view_proj, u_scale, u_coef_step, u_max_distance, u_light_pos, u_light_color,
+        u_light_att;
     GLint u_ambient, u_shadow_nf, u_shadow_texel;
 } vr_program;
 
@@ -204,13 +200,11 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_progra
 vr_result vr_program_build_depth(GLuint *out, vr_error *err);
 
 /* Compile and link vertex + fragment source; `name` for messages. */
-vr_result vr_link(const char *name, const char *vs, const char *fs,
-                  GLuint *out, vr_error *err);
+vr_result vr_link(const char *name, const char *vs, const char *fs, GLuint *out, vr_error *err);
 
 /* Column-major 4x4 matrices. */
 void vr_mat4_mul(float out[16], const float a[16], const float b[16]);
-void vr_mat4_ortho(float out[16], float half_w, float half_h, float znear,
-                   float zfar);
+void vr_mat4_ortho(float out[16], float half_w, float half_h, float znear, float zfar);
 
 /* Text (vr_text.c): lazily created GL objects owned by the renderer. */
 typedef struct vr_text_state {
@@ -220,8 +214,7 @@ typedef struct vr_text_state {
 } vr_text_state;
 void vr_text_destroy(vr_text_state *t);
 /* Draw text into framebuffer fbo of size w x h (vr_draw_text). */
-vr_result vr_text_draw_impl(vr_text_state *t, GLuint fbo, int w, int h, int x, int y,
-                            float scale, const float color[4], const char *text,
-                            vr_error *err);
+vr_result vr_text_draw_impl(vr_text_state *t, GLuint fbo, int w, int h, int x, int y, float scale,
+                            const float color[4], const char *text, vr_error *err);
 
 #endif /* VR_INTERNAL_H */

@@ -61,21 +61,20 @@
 
 enum { CACHE = 32 };
 
-vr_result vr_order_triangles(const uint32_t *indices, uint32_t nt, uint32_t nv,
-                             uint32_t *out, uint32_t *remap, const char *name,
-                             vr_error *err)
+vr_result vr_order_triangles(const uint32_t *indices, uint32_t nt, uint32_t nv, uint32_t *out,
+                             uint32_t *remap, const char *name, vr_error *err)
 {
     size_t ni = 3 * (size_t)nt;
     /* meshoptimizer asserts this (or reads out of bounds without asserts):
      * data from a file is checked here. */
     for (size_t i = 0; i < ni; i++)
         if (indices[i] >= nv)
-            return vr_fail(err, VR_ERR_FORMAT, "%s: triangle %zu uses vertex %u of %u", name,
-                           i / 3, indices[i], nv);
+            return vr_fail(err, VR_ERR_FORMAT, "%s: triangle %zu uses vertex %u of %u", name, i / 3,
+                           indices[i], nv);
     uint32_t *order = malloc((ni ? ni : 1) * sizeof *order);
     if (!order)
-        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory ordering %u triangles",
-                       name, nt);
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory ordering %u triangles", name,
+                       nt);
     meshopt_optimizeVertexCacheFifo(order, indices, ni, nv, CACHE);
     /* First use numbers the used vertices 0..used-1 and marks the others
      * ~0u: they follow, in file order. */

@@ -26,14 +26,14 @@ enum { FRAMES_IN_FLIGHT = 4, MAX_PROGRAMS = 96 };
 
 /* Timer queries of one frame. */
 typedef struct frame_slot {
-    uint64_t frame;          /* 0: slot unused */
-    int pending;             /* queries issued, results not collected */
+    uint64_t frame; /* 0: slot unused */
+    int pending;    /* queries issued, results not collected */
     int count, cap;
     GLuint *queries;
-    uint8_t *kind;           /* 0 shadow, 1 lighting */
+    uint8_t *kind; /* 0 shadow, 1 lighting */
     uint8_t *group;
     int groups;
-    double cpu_start;        /* seconds, CLOCK_MONOTONIC */
+    double cpu_start; /* seconds, CLOCK_MONOTONIC */
 } frame_slot;
 
 struct vr_renderer {
@@ -49,7 +49,7 @@ struct vr_renderer {
     GLuint sampler_nearest, sampler_linear;
     vr_program programs[MAX_PROGRAMS];
     int program_count;
-    int timers;              /* GL_TIME_ELAPSED available */
+    int timers; /* GL_TIME_ELAPSED available */
     frame_slot slots[FRAMES_IN_FLIGHT];
     uint64_t frame;
     vr_timings last;
@@ -108,8 +108,8 @@ static vr_result make_targets(vr_renderer *r, int w, int h, vr_error *err)
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     vr_result res = vr_check_gl(err, "framebuffer");
     if (res == VR_OK && st != GL_FRAMEBUFFER_COMPLETE)
-        res = vr_fail(err, VR_ERR_GL, "framebuffer %dx%d: %s (0x%04x)", w, h,
-                      fbo_status_name(st), (unsigned)st);
+        res = vr_fail(err, VR_ERR_GL, "framebuffer %dx%d: %s (0x%04x)", w, h, fbo_status_name(st),
+                      (unsigned)st);
     if (res != VR_OK) {
         glDeleteFramebuffers(1, &fbo);
         glDeleteTextures(1, &color);
@@ -130,13 +130,11 @@ static vr_result check_size(int w, int h, vr_error *err)
     GLint max = 0;
     glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max);
     if (w < 1 || h < 1 || w > max || h > max)
-        return vr_fail(err, VR_ERR_ARGUMENT, "framebuffer size %dx%d not in 1..%d", w, h,
-                       (int)max);
+        return vr_fail(err, VR_ERR_ARGUMENT, "framebuffer size %dx%d not in 1..%d", w, h, (int)max);
     return VR_OK;
 }
 
-vr_result vr_renderer_create(const vr_renderer_desc *desc, vr_renderer **out,
-                             vr_error *err)
+vr_result vr_renderer_create(const vr_renderer_desc *desc, vr_renderer **out, vr_error *err)
 {
     vr_renderer_desc d = desc ? *desc : (vr_renderer_desc){0};
     /* Defaults, in one place. */
@@ -153,16 +151,15 @@ vr_result vr_renderer_create(const vr_renderer_desc *desc, vr_renderer **out,
     if (!glGetString(GL_VERSION))
         return vr_fail(err, VR_ERR_GL, "vr_renderer_create: no current GL context");
     if ((unsigned)d.color_format > VR_COLOR_RGBA32F)
-        return vr_fail(err, VR_ERR_ARGUMENT, "unknown colour format %u",
-                       (unsigned)d.color_format);
+        return vr_fail(err, VR_ERR_ARGUMENT, "unknown colour format %u", (unsigned)d.color_format);
     if (d.max_lights_per_pass < 1 || d.max_lights_per_pass > VR_MAX_LIGHTS_PER_PASS)
         return vr_fail(err, VR_ERR_ARGUMENT, "max_lights_per_pass %d not in 1..%d",
                        d.max_lights_per_pass, VR_MAX_LIGHTS_PER_PASS);
     GLint max_cube = 0;
     glGetIntegerv(GL_MAX_CUBE_MAP_TEXTURE_SIZE, &max_cube);
     if (d.shadow_map_size < 1 || d.shadow_map_size > max_cube)
-        return vr_fail(err, VR_ERR_ARGUMENT, "shadow map size %d not in 1..%d",
-                       d.shadow_map_size, (int)max_cube);
+        return vr_fail(err, VR_ERR_ARGUMENT, "shadow map size %d not in 1..%d", d.shadow_map_size,
+                       (int)max_cube);
     vr_result res = check_size(d.width, d.height, err);
     if (res != VR_OK)
         return res;
@@ -427,13 +424,14 @@ static void shadow_planes(const vr_scene *s, const float l[3], float nf[2])
  * a 90-degree formats/vdsh_camera.h camera, as the eye's view is one. */
 static void face_view_proj(int f, const float eye[3], const float nf[2], float out[16])
 {
-    static const float dir[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
-                                    {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    static const float dir[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                    {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
     static const float up[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1},
                                    {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
     vdsh_camera c = {{eye[0], eye[1], eye[2]},
                      {eye[0] + dir[f][0], eye[1] + dir[f][1], eye[2] + dir[f][2]},
-                     {up[f][0], up[f][1], up[f][2]}, 90.0f};
+                     {up[f][0], up[f][1], up[f][2]},
+                     90.0f};
     float view[16], proj[16];
     vdsh_camera_view(&c, view);
     vdsh_camera_projection(&c, 1.0f, nf[0], nf[1], proj);
@@ -545,8 +543,7 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
     if ((unsigned)d.mode >= VR_MODE_COUNT_)
         return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown mode %u", (unsigned)d.mode);
     if ((unsigned)d.compare > VDSH_COMPARE_BINARY)
-        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown comparison %u",
-                       (unsigned)d.compare);
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown comparison %u", (unsigned)d.compare);
     if ((unsigned)d.output > VR_OUTPUT_POSITION)
         return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown output %u", (unsigned)d.output);
     if (d.sdf_k == 0.0f)
@@ -565,12 +562,16 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
     if (mode == VR_MODE_VDSH_BUFFER) {
         buf = vr_scene_buffer(s, d.stream);
         if (!buf && d.stream == VR_STREAM_VARIABLE)
-            return vr_fail(err, VR_ERR_MISSING, "mode buffer: the scene has no %s stream with "
-                           "an order per vertex", vdsh_quantity_name(s->quantity));
+            return vr_fail(err, VR_ERR_MISSING,
+                           "mode buffer: the scene has no %s stream with "
+                           "an order per vertex",
+                           vdsh_quantity_name(s->quantity));
         if (!buf && d.stream == 0)
-            return vr_fail(err, VR_ERR_MISSING, "mode buffer: the scene has no %s stream in a "
+            return vr_fail(err, VR_ERR_MISSING,
+                           "mode buffer: the scene has no %s stream in a "
                            "buffer (orders above 5, an order per vertex; orders 1-5 with "
-                           "vr_scene_desc.buffers)", vdsh_quantity_name(s->quantity));
+                           "vr_scene_desc.buffers)",
+                           vdsh_quantity_name(s->quantity));
         if (!buf)
             return vr_fail(err, VR_ERR_MISSING,
                            "mode buffer: the scene has no order-%d %s stream in a buffer%s",
@@ -580,14 +581,16 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                                : "");
     } else if (!vr_scene_supports(s, mode)) {
         if (mode == VR_MODE_SDF)
-            return vr_fail(err, VR_ERR_MISSING, "mode sdf needs the scene's distance volume: "
+            return vr_fail(err, VR_ERR_MISSING,
+                           "mode sdf needs the scene's distance volume: "
                            "none was loaded (bake it with vdsh-bake --sdf N, which writes "
                            "room.sdf beside room.vdsh)");
         if (mode == VR_MODE_VDSH5 && s->vbo_stream[5])
             return vr_fail(err, VR_ERR_MISSING,
                            "mode %s needs the basis cubemaps, which this scene has not "
                            "(its file's cube_size is 0, or they were skipped; vdsh5poly "
-                           "needs none)", vr_mode_name(mode));
+                           "needs none)",
+                           vr_mode_name(mode));
         return vr_fail(err, VR_ERR_MISSING, "mode %s: the scene has no order-%d %s stream",
                        vr_mode_name(mode), vr_mode_order(mode), vdsh_quantity_name(s->quantity));
     }
@@ -773,11 +776,13 @@ static int has_pipeline_statistics(void)
     return 0;
 }
 
-vr_result vr_draw_counted(vr_renderer *r, const vr_scene *s, const vr_draw_desc *d,
-                          vr_counts *out, vr_error *err)
+vr_result vr_draw_counted(vr_renderer *r, const vr_scene *s, const vr_draw_desc *d, vr_counts *out,
+                          vr_error *err)
 {
-    static const GLenum targets[6] = {GL_SAMPLES_PASSED,        GL_PRIMITIVES_GENERATED,
-                                      GL_VERTICES_SUBMITTED,    GL_VERTEX_SHADER_INVOCATIONS,
+    static const GLenum targets[6] = {GL_SAMPLES_PASSED,
+                                      GL_PRIMITIVES_GENERATED,
+                                      GL_VERTICES_SUBMITTED,
+                                      GL_VERTEX_SHADER_INVOCATIONS,
                                       GL_FRAGMENT_SHADER_INVOCATIONS,
                                       GL_CLIPPING_INPUT_PRIMITIVES};
     if (!r || !s || !d || !out)
@@ -818,8 +823,8 @@ static vr_result read_framebuffer(GLuint fbo, GLenum buffer, int w, int h, int f
     size_t px = floats ? 16 : 4;
     size_t row = (size_t)w * px, need = row * (size_t)h;
     if (!dst || w < 1 || h < 1 || size < need)
-        return vr_fail(err, VR_ERR_ARGUMENT, "read pixels: buffer of %zu bytes, need %zu",
-                       size, need);
+        return vr_fail(err, VR_ERR_ARGUMENT, "read pixels: buffer of %zu bytes, need %zu", size,
+                       need);
     unsigned char *tmp = malloc(row);
     if (!tmp)
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "read pixels: out of memory");
@@ -856,8 +861,8 @@ void vr_renderer_blit(vr_renderer *r, unsigned dst, int dst_width, int dst_heigh
     glBindFramebuffer(GL_READ_FRAMEBUFFER, r->fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, dst);
     int same = dst_width == r->width && dst_height == r->height;
-    glBlitFramebuffer(0, 0, r->width, r->height, 0, 0, dst_width, dst_height,
-                      GL_COLOR_BUFFER_BIT, same ? GL_NEAREST : GL_LINEAR);
+    glBlitFramebuffer(0, 0, r->width, r->height, 0, 0, dst_width, dst_height, GL_COLOR_BUFFER_BIT,
+                      same ? GL_NEAREST : GL_LINEAR);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
@@ -866,6 +871,5 @@ vr_result vr_draw_text(vr_renderer *r, int x, int y, float scale, const float co
 {
     if (!r || !text)
         return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw_text: NULL argument");
-    return vr_text_draw_impl(&r->text, r->fbo, r->width, r->height, x, y, scale, color, text,
-                             err);
+    return vr_text_draw_impl(&r->text, r->fbo, r->width, r->height, x, y, scale, color, text, err);
 }

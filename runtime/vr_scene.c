@@ -64,8 +64,7 @@ static vr_result make_basis(GLuint tex[4], uint32_t n32, const char *name, vr_er
     size_t face = (size_t)n * (size_t)n * 4;
     uint16_t *buf = malloc(4 * face * sizeof *buf);
     if (!buf)
-        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory for the basis cubemaps",
-                       name);
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory for the basis cubemaps", name);
     uint16_t *const out[4] = {buf, buf + face, buf + 2 * face, buf + 3 * face};
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     for (int f = 0; f < 6; f++) {
@@ -123,13 +122,14 @@ static vr_result upload_stream(vr_scene *s, const vdsh_stream *st, size_t vertic
     int order = (int)st->order;
     if (st->encoding > VDSH_ENCODING_S8S6 ||
         (vdsh_encoding_quantised(st->encoding) && !st->coef_scales))
-        return vr_fail(err, VR_ERR_FORMAT, "%s: order %d stream: encoding %u cannot be drawn",
-                       name, order, st->encoding);
+        return vr_fail(err, VR_ERR_FORMAT, "%s: order %d stream: encoding %u cannot be drawn", name,
+                       order, st->encoding);
     for (int k = 0; k < 4 * VR_COEF_ATTRIBS; k++)
         s->coef_step[order][k] = 1.0f;
     size_t bpv = vdsh_stream_bytes_per_vertex(st);
-    size_t elem = st->encoding == VDSH_ENCODING_F16 ? 2
-                  : vdsh_encoding_quantised(st->encoding) ? 1 : 4;
+    size_t elem = st->encoding == VDSH_ENCODING_F16       ? 2
+                  : vdsh_encoding_quantised(st->encoding) ? 1
+                                                          : 4;
     glGenBuffers(1, &s->vbo_stream[order]);
     if (upload_permuted(s->vbo_stream[order], st->data, vertices, bpv, remap))
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory uploading order %d", name,
@@ -140,8 +140,9 @@ static vr_result upload_stream(vr_scene *s, const vdsh_stream *st, size_t vertic
     glBindVertexArray(s->vao[order]);
     vr_scene_base_attribs(s);
     glBindBuffer(GL_ARRAY_BUFFER, s->vbo_stream[order]);
-    GLenum type = st->encoding == VDSH_ENCODING_F16 ? GL_HALF_FLOAT
-                  : vdsh_encoding_quantised(st->encoding) ? GL_BYTE : GL_FLOAT;
+    GLenum type = st->encoding == VDSH_ENCODING_F16       ? GL_HALF_FLOAT
+                  : vdsh_encoding_quantised(st->encoding) ? GL_BYTE
+                                                          : GL_FLOAT;
     int n = vr_coef_attrib_count(order);
     /* Per coefficient the factor the shader applies (s8, s8s6: the step). */
     for (int k = 0; k < n; k++)
@@ -221,8 +222,10 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
         goto done;
     }
     if (f->has_part) { /* its streams hold one range's receivers */
-        r = vr_fail(err, VR_ERR_FORMAT, "%s: a part of a sharded bake (shard %u of %u): "
-                    "join the parts with vdsh-merge first", name, f->part.index, f->part.count);
+        r = vr_fail(err, VR_ERR_FORMAT,
+                    "%s: a part of a sharded bake (shard %u of %u): "
+                    "join the parts with vdsh-merge first",
+                    name, f->part.index, f->part.count);
         goto done;
     }
     /* Checked by the reader for a file, not for one from memory: every
@@ -247,8 +250,8 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
      * split path; a log-distance stream is summed whole per vertex), at
      * the face size the bake chose (0: none). */
     int want_basis = vdsh_find_stream(f, 5, quantity) &&
-                     vdsh_runtime_interp(5, quantity) == VDSH_INTERP_SPLIT &&
-                     h->cube_size > 0 && !desc->skip_cubemaps;
+                     vdsh_runtime_interp(5, quantity) == VDSH_INTERP_SPLIT && h->cube_size > 0 &&
+                     !desc->skip_cubemaps;
 
     /* 4. Upload. */
     s = calloc(1, sizeof *s);
@@ -270,8 +273,8 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
         r = vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
         goto done;
     }
-    r = vr_order_triangles(f->indices, h->triangle_count, h->vertex_count, gpu_indices, remap,
-                           name, err);
+    r = vr_order_triangles(f->indices, h->triangle_count, h->vertex_count, gpu_indices, remap, name,
+                           err);
     if (r != VR_OK)
         goto done;
     /* The default view (room or object, camera, lights in free space),
@@ -326,9 +329,8 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
         int variable = (st->flags & VDSH_STREAM_VARIABLE) != 0;
         if (st->quantity != quantity || st->order < 1 || st->order > VDSH_MAX_ORDER ||
             (variable ? s->variable.order != 0
-                      : s->buffer[st->order].order ||
-                            (st->order <= 5 && !desc->buffers &&
-                             st->encoding != VDSH_ENCODING_CPCA)))
+                      : s->buffer[st->order].order || (st->order <= 5 && !desc->buffers &&
+                                                       st->encoding != VDSH_ENCODING_CPCA)))
             continue;
         r = vr_buffer_upload(s, st, remap, desc->buffer_floats, name, err);
     }
@@ -480,8 +482,7 @@ const char *vr_scene_mode_label(const vr_scene *s, vr_mode m)
         m = vr_scene_default_mode(s);
     if (m == VR_MODE_VDSH_BUFFER)
         return vr_mode_label(m);
-    if (vr_scene_interp(s, m) != VDSH_INTERP_DISTANCE ||
-        s->quantity != VDSH_QUANTITY_LOG_DISTANCE)
+    if (vr_scene_interp(s, m) != VDSH_INTERP_DISTANCE || s->quantity != VDSH_QUANTITY_LOG_DISTANCE)
         return vr_mode_label(m);
     /* Orders 2, 3 and both order-5 modes: the same per-vertex path. */
     switch (vr_mode_order(m)) {

@@ -30,7 +30,8 @@ vr_result vr_sdf_load(vr_scene *s, const vr_scene_desc *desc, uint32_t vertex_co
     if ((v.vertex_count || v.triangle_count) &&
         (v.vertex_count != vertex_count || v.triangle_count != triangle_count)) {
         vdsh_sdf_free(&v);
-        return vr_fail(err, VR_ERR_FORMAT, "%s: the distance volume was baked beside a scene "
+        return vr_fail(err, VR_ERR_FORMAT,
+                       "%s: the distance volume was baked beside a scene "
                        "of %u vertices and %u triangles, not this one (%u, %u): bake it again",
                        path, v.vertex_count, v.triangle_count, vertex_count, triangle_count);
     }
@@ -38,14 +39,16 @@ vr_result vr_sdf_load(vr_scene *s, const vr_scene_desc *desc, uint32_t vertex_co
     glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3d);
     if ((GLint)v.dim[0] > max3d || (GLint)v.dim[1] > max3d || (GLint)v.dim[2] > max3d) {
         vdsh_sdf_free(&v);
-        return vr_fail(err, VR_ERR_GL, "%s: a %u x %u x %u volume exceeds "
-                       "GL_MAX_3D_TEXTURE_SIZE %d", path, v.dim[0], v.dim[1], v.dim[2], max3d);
+        return vr_fail(err, VR_ERR_GL,
+                       "%s: a %u x %u x %u volume exceeds "
+                       "GL_MAX_3D_TEXTURE_SIZE %d",
+                       path, v.dim[0], v.dim[1], v.dim[2], max3d);
     }
     glGenTextures(1, &s->sdf_tex);
     glBindTexture(GL_TEXTURE_3D, s->sdf_tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 2);
-    glTexImage3D(GL_TEXTURE_3D, 0, GL_R16, (GLsizei)v.dim[0], (GLsizei)v.dim[1],
-                 (GLsizei)v.dim[2], 0, GL_RED, GL_UNSIGNED_SHORT, v.samples);
+    glTexImage3D(GL_TEXTURE_3D, 0, GL_R16, (GLsizei)v.dim[0], (GLsizei)v.dim[1], (GLsizei)v.dim[2],
+                 0, GL_RED, GL_UNSIGNED_SHORT, v.samples);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
@@ -66,7 +69,7 @@ void vr_sdf_bind(const vr_scene *s, GLuint prog, float k)
     glUniform3fv(glGetUniformLocation(prog, "u_sdf_origin"), 1, s->sdf.origin);
     glUniform1f(glGetUniformLocation(prog, "u_sdf_cell"), s->sdf.cell);
     glUniform1f(glGetUniformLocation(prog, "u_sdf_max"), s->sdf.max_distance);
-    glUniform3i(glGetUniformLocation(prog, "u_sdf_dim"), (GLint)s->sdf.dim[0],
-                (GLint)s->sdf.dim[1], (GLint)s->sdf.dim[2]);
+    glUniform3i(glGetUniformLocation(prog, "u_sdf_dim"), (GLint)s->sdf.dim[0], (GLint)s->sdf.dim[1],
+                (GLint)s->sdf.dim[2]);
     glUniform1f(glGetUniformLocation(prog, "u_sdf_k"), k > 0.0f ? k : VDSH_SDF_DEFAULT_K);
 }

@@ -23,14 +23,13 @@ static const char text_vs[] =
     "                       1.0 - 2.0 * a_pos.y / u_viewport.y, 0.0, 1.0);\n"
     "}\n";
 
-static const char text_fs[] =
-    "#version 330 core\n"
-    "uniform vec4 u_color;\n"
-    "out vec4 o_color;\n"
-    "void main()\n"
-    "{\n"
-    "    o_color = u_color;\n"
-    "}\n";
+static const char text_fs[] = "#version 330 core\n"
+                              "uniform vec4 u_color;\n"
+                              "out vec4 o_color;\n"
+                              "void main()\n"
+                              "{\n"
+                              "    o_color = u_color;\n"
+                              "}\n";
 
 void vr_text_destroy(vr_text_state *t)
 {
@@ -68,9 +67,8 @@ typedef struct easy_vertex {
     unsigned char rgba[4];
 } easy_vertex;
 
-vr_result vr_text_draw_impl(vr_text_state *t, GLuint fbo, int w, int h, int x, int y,
-                            float scale, const float color[4], const char *text,
-                            vr_error *err)
+vr_result vr_text_draw_impl(vr_text_state *t, GLuint fbo, int w, int h, int x, int y, float scale,
+                            const float color[4], const char *text, vr_error *err)
 {
     vr_result r = text_init(t, err);
     if (r != VR_OK)
@@ -100,8 +98,18 @@ vr_result vr_text_draw_impl(vr_text_state *t, GLuint fbo, int w, int h, int x, i
 
     /* The box first, then each quad (a, b, c, d) as (a, b, c) (a, c, d). */
     float x0 = (float)x, y0 = (float)y;
-    const float box[12] = {x0, y0, x0 + bw + 2 * pad, y0, x0 + bw + 2 * pad, y0 + bh + 2 * pad,
-                           x0, y0, x0 + bw + 2 * pad, y0 + bh + 2 * pad, x0, y0 + bh + 2 * pad};
+    const float box[12] = {x0,
+                           y0,
+                           x0 + bw + 2 * pad,
+                           y0,
+                           x0 + bw + 2 * pad,
+                           y0 + bh + 2 * pad,
+                           x0,
+                           y0,
+                           x0 + bw + 2 * pad,
+                           y0 + bh + 2 * pad,
+                           x0,
+                           y0 + bh + 2 * pad};
     memcpy(tri, box, sizeof box);
     for (int q = 0; q < nq; q++) {
         static const int order[6] = {0, 1, 2, 0, 2, 3};

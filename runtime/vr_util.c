@@ -127,10 +127,10 @@ const int vr_coef_size[VR_COEF_ATTRIBS] = {4, 4, 1, 4, 4, 4, 4};
 int vr_coef_attrib_count(int order)
 {
     switch (order) {
-    case 1: return 1;   /* never drawn; uploaded as one float */
+    case 1: return 1; /* never drawn; uploaded as one float */
     case 2: return 1;
     case 3: return 3;
-    case 4: return 3;   /* bands 0-2 only: no mode draws order 4 */
+    case 4: return 3; /* bands 0-2 only: no mode draws order 4 */
     default: return VR_COEF_ATTRIBS;
     }
 }
@@ -150,8 +150,7 @@ void vr_mat4_mul(float out[16], const float a[16], const float b[16])
     memcpy(out, r, sizeof r);
 }
 
-void vr_mat4_ortho(float out[16], float half_w, float half_h, float znear,
-                   float zfar)
+void vr_mat4_ortho(float out[16], float half_w, float half_h, float znear, float zfar)
 {
     memset(out, 0, 16 * sizeof(float));
     out[0] = 1.0f / half_w;

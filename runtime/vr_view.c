@@ -58,8 +58,8 @@ int vr_scene_default_lights(const vr_scene *s, vr_light *out, int max)
 
 /* The light pool: candidates of the seeded uniform sequence in the
  * bounds, kept when in free space (vdsh_light.h), in sequence order. */
-vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count,
-                              const char *name, vr_error *err)
+vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count, const char *name,
+                              vr_error *err)
 {
     vdsh_view_tracer *t = NULL;
     vdsh_error ve;

@@ -30,8 +30,8 @@
 #define RAYS 256
 
 typedef struct fixture {
-    vb_mesh occ;       /* room + box */
-    vb_mesh start;     /* receivers: uniform refinement */
+    vb_mesh occ;   /* room + box */
+    vb_mesh start; /* receivers: uniform refinement */
     vb_scene *scene;
 } fixture;
 
@@ -62,7 +62,10 @@ static vb_result run(const fixture *f, const vb_mesh *start, float tol, float mi
                      vb_adaptive_stats *st)
 {
     vb_error err;
-    vb_bake_desc d = {.scene = f->scene, .rays = RAYS, .seed = 5, .threads = threads,
+    vb_bake_desc d = {.scene = f->scene,
+                      .rays = RAYS,
+                      .seed = 5,
+                      .threads = threads,
                       .order_mask = (1u << 3) | (1u << 5)};
     vb_adaptive_desc ad = {.tolerance = tol, .min_edge = min_edge, .max_receivers = budget};
     vb_result r = vb_bake_adaptive(&d, start, &ad, rec, out, st, &err);
@@ -78,7 +81,6 @@ static double len3(const float *a, const float *b)
         s += ((double)a[c] - b[c]) * ((double)a[c] - b[c]);
     return sqrt(s);
 }
-
 
 typedef struct keyed {
     float p[3];
@@ -116,8 +118,9 @@ static int midpoints_ok(const vb_mesh *m, uint32_t first, float min_edge)
             for (int c = 0; c < 3; c++)
                 want.p[c] = (2.0f * p[c] - pa[c]) + 0.0f;
             const keyed *hit = bsearch(&want, k, m->vertex_count, sizeof *k, cmp_keyed);
-            found = hit && hit->index < v && hit->index != a &&
-                    len3(pa, m->positions + 3 * (size_t)hit->index) >= 2.0 * min_edge * (1.0 - 1e-6);
+            found =
+                hit && hit->index < v && hit->index != a &&
+                len3(pa, m->positions + 3 * (size_t)hit->index) >= 2.0 * min_edge * (1.0 - 1e-6);
         }
         if (!found) {
             fprintf(stderr, "vertex %u at (%g, %g, %g) is no midpoint of an edge >= 2 min_edge\n",
@@ -230,8 +233,8 @@ static void test_limits(void)
         /* No edge split below 2 min_edge: never denser than the uniform
          * refinement to min_edge (every edge < ~min_edge). */
         CHECK(rec.vertex_count <= bound.vertex_count,
-              "tolerance 0: %u receivers, the uniform refinement to %g has %u",
-              rec.vertex_count, (double)min_edge, bound.vertex_count);
+              "tolerance 0: %u receivers, the uniform refinement to %g has %u", rec.vertex_count,
+              (double)min_edge, bound.vertex_count);
     }
     vb_mesh_free(&rec);
     vb_mesh_free(&bound);
@@ -240,8 +243,7 @@ static void test_limits(void)
     uint32_t budget = f.start.vertex_count + 25;
     if (run(&f, &f.start, 0.0f, 0.05f, budget, 2, &rec, &out, &st) == VB_OK)
         CHECK(rec.vertex_count <= budget && st.budget_reached,
-              "budget %u: %u receivers (reached %d)", budget, rec.vertex_count,
-              st.budget_reached);
+              "budget %u: %u receivers (reached %d)", budget, rec.vertex_count, st.budget_reached);
     vb_mesh_free(&rec);
     vb_bake_output_free(&out);
 
@@ -273,8 +275,8 @@ static void test_non_manifold(void)
     vb_adaptive_stats st = {0};
     /* Start: the floor as two triangles, plus two fins on its diagonal. */
     test_mesh_alloc(&start, 6, 4);
-    const float p[6][3] = {{-3, 0, -3}, {3, 0, -3}, {3, 0, 3}, {-3, 0, 3}, {0, 1.5f, 0},
-                           {0, 1.0f, 0.2f}};
+    const float p[6][3] = {{-3, 0, -3}, {3, 0, -3},   {3, 0, 3},
+                           {-3, 0, 3},  {0, 1.5f, 0}, {0, 1.0f, 0.2f}};
     const float up[3] = {0, 1, 0};
     for (int v = 0; v < 6; v++)
         for (int c = 0; c < 3; c++) {
@@ -343,7 +345,8 @@ static void test_uniform_cap(void)
         CHECK(rec.vertex_count <= uniform.vertex_count,
               "%u receivers, more than the uniform bake at 2 x the min edge (%u)", rec.vertex_count,
               uniform.vertex_count);
-        CHECK(baked <= uniform.vertex_count && out.rays_traced <= (uint64_t)uniform.vertex_count * out.rays,
+        CHECK(baked <= uniform.vertex_count &&
+                  out.rays_traced <= (uint64_t)uniform.vertex_count * out.rays,
               "%llu vertices baked, more than the uniform bake at 2 x the min edge (%u)",
               (unsigned long long)baked, uniform.vertex_count);
         CHECK(rec.vertex_count > st.start_receivers, "nothing split");
@@ -378,8 +381,8 @@ static void test_noise_floor(void)
     vb_scene *scene = NULL;
     vb_scene_desc sd = {.robust = 1};
     CHECK(vb_scene_create(&occ, &sd, &scene, &err) == VB_OK, "scene: %s", err.msg);
-    vb_bake_desc d = {.scene = scene, .rays = RAYS, .seed = 5, .threads = 2,
-                      .order_mask = (1u << 3) | (1u << 5)};
+    vb_bake_desc d = {
+        .scene = scene, .rays = RAYS, .seed = 5, .threads = 2, .order_mask = (1u << 3) | (1u << 5)};
     vb_adaptive_desc ad = {.tolerance = 0.02f, .min_edge = 0.1f};
     vb_bake_output out = {0};
     vb_adaptive_stats st = {0};

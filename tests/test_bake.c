@@ -27,8 +27,7 @@ static void make_sphere(vb_mesh *m, float r, const float c[3])
         for (int j = 0; j < NP; j++) {
             double th = M_PI * i / NT, ph = 2 * M_PI * j / NP;
             float *p = m->positions + 3 * (i * NP + j);
-            float d[3] = {(float)(sin(th) * cos(ph)), (float)(sin(th) * sin(ph)),
-                          (float)cos(th)};
+            float d[3] = {(float)(sin(th) * cos(ph)), (float)(sin(th) * sin(ph)), (float)cos(th)};
             for (int k = 0; k < 3; k++) {
                 p[k] = c[k] + r * d[k];
                 m->normals[3 * (i * NP + j) + k] = -d[k];
@@ -45,8 +44,8 @@ static void make_sphere(vb_mesh *m, float r, const float c[3])
         }
 }
 
-static int bake(const vb_mesh *occ, const vb_mesh *rec, vb_method method,
-                uint32_t rays, unsigned threads, vb_bake_output *out)
+static int bake(const vb_mesh *occ, const vb_mesh *rec, vb_method method, uint32_t rays,
+                unsigned threads, vb_bake_output *out)
 {
     vb_error err;
     vb_scene *s = NULL;
@@ -54,8 +53,13 @@ static int bake(const vb_mesh *occ, const vb_mesh *rec, vb_method method,
         fprintf(stderr, "scene: %s\n", err.msg);
         return 0;
     }
-    vb_bake_desc d = {.keep_normals = 1, .receivers = rec, .scene = s, .rays = rays, .seed = 5,
-                      .method = method, .threads = threads};
+    vb_bake_desc d = {.keep_normals = 1,
+                      .receivers = rec,
+                      .scene = s,
+                      .rays = rays,
+                      .seed = 5,
+                      .method = method,
+                      .threads = threads};
     vb_result r = vb_bake_run(&d, out, &err);
     if (r != VB_OK)
         fprintf(stderr, "bake: %s\n", err.msg);
@@ -92,8 +96,8 @@ static void test_sphere_centre(void)
      * The higher coefficients carry the jittered sampling's noise, which
      * grows with the band (measured: RMS 0.3% of R at order 3, 0.9% at
      * order 5 over many seeds), so the bound loosens with the order. */
-    CHECK(fabs(full.coeffs[5][0] - R * sqrt(4 * M_PI)) < 2e-4 * R * sqrt(4 * M_PI), "c0 = %g, want %g",
-          full.coeffs[5][0], R * sqrt(4 * M_PI));
+    CHECK(fabs(full.coeffs[5][0] - R * sqrt(4 * M_PI)) < 2e-4 * R * sqrt(4 * M_PI),
+          "c0 = %g, want %g", full.coeffs[5][0], R * sqrt(4 * M_PI));
     uint64_t s = 1;
     const double bound[6] = {0, 0, 0.002, 0.006, 0.012, 0.018};
     for (int order = 2; order <= 5; order++) {
@@ -135,8 +139,7 @@ out:
 }
 
 /* Distance from p (inside the box) along unit d to the box's walls. */
-static double box_exit(const float p[3], const float d[3], const float lo[3],
-                       const float hi[3])
+static double box_exit(const float p[3], const float d[3], const float lo[3], const float hi[3])
 {
     double t = INFINITY;
     for (int i = 0; i < 3; i++) {
@@ -191,13 +194,13 @@ static void test_box_floor(void)
                 cnt++;
             }
         rms[oi] = sqrt(se / cnt);
-        CHECK(rms[oi] < bound[oi], "order %d: relative RMS %g above %g", orders[oi],
-              rms[oi], bound[oi]);
+        CHECK(rms[oi] < bound[oi], "order %d: relative RMS %g above %g", orders[oi], rms[oi],
+              bound[oi]);
     }
-    printf("box floor relative RMS: order 2 %.4f, order 3 %.4f, order 5 %.4f\n", rms[0],
-           rms[1], rms[2]);
-    CHECK(rms[2] < rms[1] && rms[1] < rms[0], "error must fall with order: %g %g %g",
-          rms[0], rms[1], rms[2]);
+    printf("box floor relative RMS: order 2 %.4f, order 3 %.4f, order 5 %.4f\n", rms[0], rms[1],
+           rms[2]);
+    CHECK(rms[2] < rms[1] && rms[1] < rms[0], "error must fall with order: %g %g %g", rms[0],
+          rms[1], rms[2]);
 done:
     vb_bake_output_free(&out);
     test_mesh_free(&occ);
@@ -277,7 +280,8 @@ static void test_grid(void)
     CHECK(culled > considered / 3, "culled only %u of %u packets", culled, considered);
     printf("horizon culling skips %.1f%% of packets\n", 100.0 * culled / considered);
     /* Morton order: 144 packets are exact 4x4 blocks, the rest compact. */
-    CHECK(blocks_ok == (int)g.packet_count, "only %d of %u packets are compact", blocks_ok, g.packet_count);
+    CHECK(blocks_ok == (int)g.packet_count, "only %d of %u packets are compact", blocks_ok,
+          g.packet_count);
     CHECK(full_blocks >= 144, "only %d packets are 4x4 blocks", full_blocks);
 
     /* Jitter differs between vertices, repeats for the same vertex. */
@@ -362,9 +366,14 @@ static void test_shadow_offset(void)
     const float mine[VDSH_MAX_ORDER + 1] = {0, -0.3f, -0.3f, -0.3f, -0.3f, -0.3f};
     vb_bake_output b[3] = {{0}};
     for (int i = 0; i < 3 && sc; i++) {
-        vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = sc, .rays = 400, .seed = 5,
+        vb_bake_desc d = {.keep_normals = 1,
+                          .receivers = &rec,
+                          .scene = sc,
+                          .rays = 400,
+                          .seed = 5,
                           .method = i ? VB_METHOD_SHADOW : VB_METHOD_LSQ,
-                          .quantity = VB_QUANTITY_LOG, .log_offsets = i == 2 ? mine : NULL,
+                          .quantity = VB_QUANTITY_LOG,
+                          .log_offsets = i == 2 ? mine : NULL,
                           .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
         CHECK(vb_bake_run(&d, &b[i], &err) == VB_OK, "bake %d: %s", i, err.msg);
     }
@@ -411,7 +420,8 @@ static void test_offset_normals(void)
      * away from its own: 0 takes (1,0,0) + (0,1,0) + (0,-1,0); 1 takes
      * (1,0,0) + (0,1,0); 3 takes (1,0,0) + (0,-1,0). Vertex 2 is alone. */
     float r = 1.0f / sqrtf(2.0f);
-    CHECK(out[0] == 1 && out[1] == 0 && out[2] == 0, "vertex 0: (%g %g %g)", out[0], out[1], out[2]);
+    CHECK(out[0] == 1 && out[1] == 0 && out[2] == 0, "vertex 0: (%g %g %g)", out[0], out[1],
+          out[2]);
     CHECK(fabsf(out[3] - r) < 1e-6f && fabsf(out[4] - r) < 1e-6f && out[5] == 0,
           "vertex 1: (%g %g %g)", out[3], out[4], out[5]);
     CHECK(out[6] == 0 && out[7] == 0 && out[8] == 1, "distinct position changed");
@@ -419,7 +429,6 @@ static void test_offset_normals(void)
           "vertex 3: (%g %g %g)", out[9], out[10], out[11]);
     test_mesh_free(&m);
 }
-
 
 /* Adaptive rays' nested grid: a 1250-direction hemisphere gives 32 x 32
  * cells in 5 rounds (64, 128, ..., 1024 cells); for a receiver, every
@@ -431,8 +440,8 @@ static void test_nested_grid(void)
     vb_dirgrid g = {0};
     vb_error err;
     CHECK(vb_dirgrid_create_nested(1250, 1, &g, &err) == VB_OK, "nested grid: %s", err.msg);
-    CHECK(g.nu == 32 && g.nv == 32 && g.count == 1024 && g.rounds == 5, "%ux%u, %u rounds",
-          g.nu, g.nv, g.rounds);
+    CHECK(g.nu == 32 && g.nv == 32 && g.count == 1024 && g.rounds == 5, "%ux%u, %u rounds", g.nu,
+          g.nv, g.rounds);
     for (uint32_t r = 0; r < g.rounds && r < 5; r++)
         CHECK(g.round_end[r] == (64u << r) / 16, "round %u ends at packet %u", r, g.round_end[r]);
     const float n[3] = {0, 0, 1};
@@ -449,7 +458,8 @@ static void test_nested_grid(void)
                     double phi = atan2(y[k], x[k]);
                     if (phi < 0)
                         phi += 2 * M_PI;
-                    uint32_t row = (uint32_t)((1.0 - z[k]) * 32), col = (uint32_t)(phi / (2 * M_PI) * 32);
+                    uint32_t row = (uint32_t)((1.0 - z[k]) * 32),
+                             col = (uint32_t)(phi / (2 * M_PI) * 32);
                     bad += valid[k] != -1 || row > 31 || col > 31;
                     if (x[k] * x[k] + y[k] * y[k] < 1e-8f) { /* at the pole: no column */
                         pole++;
@@ -511,8 +521,13 @@ static void test_adaptive_rays(void)
     const unsigned threads[4] = {1, 3, 2, 2};
     vb_bake_output b[4] = {{0}};
     for (int i = 0; i < 4 && sc; i++) {
-        vb_bake_desc d = {.receivers = &rec, .scene = sc, .rays = 2500, .adaptive_rays = 1,
-                          .ray_tolerance = tol[i], .seed = 3, .threads = threads[i],
+        vb_bake_desc d = {.receivers = &rec,
+                          .scene = sc,
+                          .rays = 2500,
+                          .adaptive_rays = 1,
+                          .ray_tolerance = tol[i],
+                          .seed = 3,
+                          .threads = threads[i],
                           .order_mask = (1u << 3) | (1u << 5)};
         CHECK(vb_bake_run(&d, &b[i], &err) == VB_OK, "adaptive bake %d: %s", i, err.msg);
     }
@@ -585,8 +600,13 @@ static void test_ranges(void)
         vb_bake_output whole = {0}, part[4] = {{0}};
         uint32_t mask = (1u << 3) | (1u << 5);
         for (int i = -1; i < 4; i++) {
-            vb_bake_desc d = {.receivers = &rec, .scene = sc, .rays = 200, .seed = 3,
-                              .order_mask = mask, .threads = 2, .method = methods[m]};
+            vb_bake_desc d = {.receivers = &rec,
+                              .scene = sc,
+                              .rays = 200,
+                              .seed = 3,
+                              .order_mask = mask,
+                              .threads = 2,
+                              .method = methods[m]};
             if (i >= 0)
                 d.range_begin = cut[i], d.range_end = cut[i + 1];
             CHECK(vb_bake_run(&d, i < 0 ? &whole : &part[i], &err) == VB_OK, "bake %d: %s", i,
@@ -598,8 +618,8 @@ static void test_ranges(void)
         for (int i = 0; i < 4 && whole.coeffs[5] && part[i].coeffs[5]; i++) {
             CHECK(part[i].range_begin == cut[i] && part[i].range_end == cut[i + 1] &&
                       part[i].vertex_count == NP,
-                  "range %d: output range %u..%u of %u", i, part[i].range_begin,
-                  part[i].range_end, part[i].vertex_count);
+                  "range %d: output range %u..%u of %u", i, part[i].range_begin, part[i].range_end,
+                  part[i].vertex_count);
             traced += part[i].rays_traced;
             missed += part[i].rays_missed;
             /* Every range traces the choice's sample as the whole bake does. */
@@ -609,12 +629,11 @@ static void test_ranges(void)
             for (int o = 3; o <= 5; o += 2) {
                 /* A range holds its own rows only, the first receiver cut[i]'s. */
                 size_t a = (size_t)cut[i] * o * o, b = (size_t)cut[i + 1] * o * o;
-                CHECK(memcmp(part[i].coeffs[o], whole.coeffs[o] + a, (b - a) * sizeof(float)) ==
-                          0,
+                CHECK(memcmp(part[i].coeffs[o], whole.coeffs[o] + a, (b - a) * sizeof(float)) == 0,
                       "method %d, range %u..%u order %d: coefficients differ", m, cut[i],
                       cut[i + 1], o);
-                CHECK(part[i].quantity[o] == whole.quantity[o], "range %d order %d: quantity",
-                      i, o);
+                CHECK(part[i].quantity[o] == whole.quantity[o], "range %d order %d: quantity", i,
+                      o);
             }
             /* And its own oriented normals only, as the whole bake's. */
             CHECK(memcmp(part[i].normals, whole.normals + 3 * (size_t)cut[i],
@@ -670,10 +689,16 @@ static void test_adaptive_order(void)
     for (int i = 0; i < 3 && sc; i++) {
         /* Method shadow: its fixed orders are the lsq fits the adaptive
          * order chooses among (method decision refits its fixed orders). */
-        vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = sc, .rays = 400,
-                          .seed = 5, .threads = 1, .order_mask = mask,
+        vb_bake_desc d = {.keep_normals = 1,
+                          .receivers = &rec,
+                          .scene = sc,
+                          .rays = 400,
+                          .seed = 5,
+                          .threads = 1,
+                          .order_mask = mask,
                           .method = VB_METHOD_SHADOW,
-                          .order_tolerance = tols[i], .variable_cap = CAP};
+                          .order_tolerance = tols[i],
+                          .variable_cap = CAP};
         CHECK(vb_bake_run(&d, &b[i], &err) == VB_OK, "bake %d: %s", i, err.msg);
         if (i == 0) {
             d.threads = 2;
@@ -734,8 +759,7 @@ static void test_adaptive_order(void)
         for (int k = 1; k <= CAP; k++)
             coef[i] += (long)hist[i][k] * k * k;
     CHECK(coef[2] >= coef[0] && coef[0] > coef[1] && hist[2][CAP] > 0,
-          "coefficients: %ld at least error, %ld at 0.01, %ld at inf", coef[2], coef[0],
-          coef[1]);
+          "coefficients: %ld at least error, %ld at 0.01, %ld at inf", coef[2], coef[0], coef[1]);
     int low = 0, high = 0; /* the tolerance spends coefficients where they help */
     for (int k = 1; k <= CAP; k++) {
         if (k <= 3)
@@ -743,12 +767,11 @@ static void test_adaptive_order(void)
         else
             high += hist[0][k];
     }
-    CHECK(low > 0 && high > 0, "tolerance 0.01: %d receivers at orders 1-3, %d above", low,
-          high);
+    CHECK(low > 0 && high > 0, "tolerance 0.01: %d receivers at orders 1-3, %d above", low, high);
     if (b[0].variable_orders && two.variable_orders && part.variable_orders) {
         CHECK(memcmp(b[0].variable_orders, two.variable_orders, NP) == 0 &&
-                  memcmp(b[0].variable_coeffs, two.variable_coeffs,
-                         (size_t)NP * CAP * CAP * 4) == 0,
+                  memcmp(b[0].variable_coeffs, two.variable_coeffs, (size_t)NP * CAP * CAP * 4) ==
+                      0,
               "1 and 2 threads differ");
         CHECK(memcmp(b[0].variable_orders + 37, part.variable_orders, 64) == 0 &&
                   memcmp(b[0].variable_coeffs + (size_t)37 * CAP * CAP, part.variable_coeffs,

@@ -34,15 +34,15 @@
 #include <string.h>
 
 static int failures, checks;
-#define CHECK(c, ...)                                                   \
-    do {                                                                \
-        checks++;                                                       \
-        if (!(c)) {                                                     \
-            failures++;                                                 \
-            fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);        \
-            fprintf(stderr, __VA_ARGS__);                               \
-            fputc('\n', stderr);                                        \
-        }                                                               \
+#define CHECK(c, ...)                                                                              \
+    do {                                                                                           \
+        checks++;                                                                                  \
+        if (!(c)) {                                                                                \
+            failures++;                                                                            \
+            fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);                                   \
+            fprintf(stderr, __VA_ARGS__);                                                          \
+            fputc('\n', stderr);                                                                   \
+        }                                                                                          \
     } while (0)
 
 static uint64_t rng = 0x1234567887654321ull;
@@ -54,7 +54,10 @@ static double rnd(void) /* uniform [-1, 1) */
     return (double)(rng >> 11) * 0x1.0p-52 - 1.0;
 }
 
-static uint32_t rd32(const uint8_t *p) { return p[0] | p[1] << 8 | p[2] << 16 | (uint32_t)p[3] << 24; }
+static uint32_t rd32(const uint8_t *p)
+{
+    return p[0] | p[1] << 8 | p[2] << 16 | (uint32_t)p[3] << 24;
+}
 static void wr32(uint8_t *p, uint32_t v)
 {
     for (int k = 0; k < 4; k++)
@@ -152,8 +155,7 @@ static void curved_cluster(void)
     static float c[CURVED_ROWS * CURVED_NC], nrm[CURVED_ROWS * 3];
     static double e[CURVED_ROWS * CURVED_NC], left[CURVED_ROWS * CURVED_NC];
     static const float faces[3][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 0, 1}};
-    float d1[3] = {0.8944272f, 0.0f, -0.4472136f}, d2[3] = {0, 0, 1}, f1[CURVED_NC],
-          f2[CURVED_NC];
+    float d1[3] = {0.8944272f, 0.0f, -0.4472136f}, d2[3] = {0, 0, 1}, f1[CURVED_NC], f2[CURVED_NC];
     vdsh_sh_eval(CURVED_ORDER, d1, f1);
     vdsh_sh_eval(CURVED_ORDER, d2, f2);
     for (int v = 0; v < CURVED_ROWS; v++) {
@@ -170,8 +172,11 @@ static void curved_cluster(void)
     vdsh_error err = {{0}};
     CHECK(vdsh_cpca_encode(c, nrm, CURVED_ROWS, CURVED_ORDER, &st, &fit, &err) == VDSH_OK,
           "curved: %s", err.msg);
-    vdsh_stream s = {.order = CURVED_ORDER, .encoding = VDSH_ENCODING_CPCA, .scale = 1.0f,
-                     .data = fit.records, .cpca = fit.model};
+    vdsh_stream s = {.order = CURVED_ORDER,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .scale = 1.0f,
+                     .data = fit.records,
+                     .cpca = fit.model};
     for (uint32_t v = 0; v < CURVED_ROWS; v++) {
         float dec[VDSH_MAX_COEFFS];
         vdsh_stream_decode(&s, v, dec);
@@ -179,8 +184,10 @@ static void curved_cluster(void)
             e[(size_t)v * CURVED_NC + i] = (double)dec[i] - c[v * CURVED_NC + i];
     }
     double got = own_hemisphere(e, nrm, CURVED_ROWS), alt = own_hemisphere(left, nrm, CURVED_ROWS);
-    CHECK(got < 0.8 * alt, "curved: own-hemisphere error %g, not below capturing the weak "
-                           "spike's %g", got, alt);
+    CHECK(got < 0.8 * alt,
+          "curved: own-hemisphere error %g, not below capturing the weak "
+          "spike's %g",
+          got, alt);
     vdsh_cpca_fit_free(&fit);
 }
 
@@ -212,8 +219,8 @@ static vdsh_file file_of(vdsh_stream *s)
 
 /* Change the file image by `edit` (bytes from the COEF payload start), fix
  * the CRCs, and expect refusal with `want` in the message. */
-static void expect_refused(const uint8_t *good, size_t size, size_t at, const void *bytes,
-                           size_t n, const char *want)
+static void expect_refused(const uint8_t *good, size_t size, size_t at, const void *bytes, size_t n,
+                           const char *want)
 {
     uint8_t *d = malloc(size);
     memcpy(d, good, size);
@@ -249,8 +256,12 @@ int main(int argc, char **argv)
           "two encodings of the same input differ");
     vdsh_cpca_fit_free(&again);
 
-    vdsh_stream s = {.order = ORDER, .encoding = VDSH_ENCODING_CPCA, .method = VDSH_METHOD_LSQ,
-                     .quantity = VDSH_QUANTITY_DISTANCE, .scale = 1.0f, .data = fit.records,
+    vdsh_stream s = {.order = ORDER,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .method = VDSH_METHOD_LSQ,
+                     .quantity = VDSH_QUANTITY_DISTANCE,
+                     .scale = 1.0f,
+                     .data = fit.records,
                      .cpca = fit.model};
     /* the clusters follow the normals: each cluster's vertices share one */
     for (uint32_t v = 0; v < ROWS; v++) {
@@ -303,12 +314,11 @@ int main(int argc, char **argv)
     size_t size = 0;
     CHECK(vdsh_write_memory(&f, &mem, &size, &err) == VDSH_OK, "write: %s", err.msg);
     vdsh_file *back = NULL;
-    CHECK(mem && vdsh_read_memory(mem, size, "cpca", &back, &err) == VDSH_OK, "read: %s",
-          err.msg);
+    CHECK(mem && vdsh_read_memory(mem, size, "cpca", &back, &err) == VDSH_OK, "read: %s", err.msg);
     if (back) {
         const vdsh_stream *r = &back->streams[0];
-        CHECK(r->encoding == VDSH_ENCODING_CPCA && r->cpca.clusters == K &&
-                  r->cpca.basis == B && r->cpca.bits == BITS &&
+        CHECK(r->encoding == VDSH_ENCODING_CPCA && r->cpca.clusters == K && r->cpca.basis == B &&
+                  r->cpca.bits == BITS &&
                   memcmp(r->cpca.scales, fit.model.scales, 4 * K * B) == 0 &&
                   memcmp(r->cpca.means, fit.model.means, 2 * K * NC) == 0 &&
                   memcmp(r->cpca.bases, fit.model.bases, 2 * K * B * NC) == 0 &&
@@ -318,8 +328,8 @@ int main(int argc, char **argv)
         CHECK(vdsh_stream_bytes_per_vertex(r) == 8, "bytes per vertex %zu",
               vdsh_stream_bytes_per_vertex(r));
         vdsh_stream_size z = vdsh_stream_size_of(r, ROWS);
-        CHECK(fabs(z.mean_bytes - (8.0 + (double)vdsh_cpca_model_bytes(ORDER, K, B) / ROWS)) <
-                  1e-9, "mean bytes %g", z.mean_bytes);
+        CHECK(fabs(z.mean_bytes - (8.0 + (double)vdsh_cpca_model_bytes(ORDER, K, B) / ROWS)) < 1e-9,
+              "mean bytes %g", z.mean_bytes);
         if (argc > 1) { /* for the Python reader's test */
             char p[4096];
             snprintf(p, sizeof p, "%s/cpca.vdsh", argv[1]);
@@ -392,8 +402,8 @@ int main(int argc, char **argv)
     vdsh_stream bad = s;
     bad.cpca.bases = NULL;
     vdsh_file fb = file_of(&bad);
-    CHECK(vdsh_write_memory(&fb, &mem, &size, &err) == VDSH_ERR_ARGUMENT &&
-              strstr(err.msg, "cpca"), "writer accepted a model without bases");
+    CHECK(vdsh_write_memory(&fb, &mem, &size, &err) == VDSH_ERR_ARGUMENT && strstr(err.msg, "cpca"),
+          "writer accepted a model without bases");
     vdsh_cpca_fit_free(&fit);
 
     curved_cluster();
@@ -401,10 +411,11 @@ int main(int argc, char **argv)
     /* settings */
     vdsh_cpca_settings p;
     CHECK(vdsh_cpca_parse("8,52,4", &p, NULL) == VDSH_OK && p.clusters == 8 && p.basis == 52 &&
-              p.bits == 4, "8,52,4");
-    static const char *const refuse[] = {"", "8,52", "8,52,4,1", "0,52,4", "257,52,4",
-                                         "8,0,4", "8,52,1", "8,52,9", "8,,4", "a,b,c",
-                                         "8,52,4x", "-1,52,4"};
+              p.bits == 4,
+          "8,52,4");
+    static const char *const refuse[] = {"",         "8,52",  "8,52,4,1", "0,52,4",
+                                         "257,52,4", "8,0,4", "8,52,1",   "8,52,9",
+                                         "8,,4",     "a,b,c", "8,52,4x",  "-1,52,4"};
     for (size_t k = 0; k < sizeof refuse / sizeof *refuse; k++)
         CHECK(vdsh_cpca_parse(refuse[k], &p, &err) == VDSH_ERR_ARGUMENT, "'%s' accepted",
               refuse[k]);

@@ -32,15 +32,14 @@
 
 static int failures;
 
-#define CHECK(cond, ...)                                                      \
-    do {                                                                      \
-        if (!(cond)) {                                                        \
-            failures++;                                                       \
-            fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__, __LINE__,  \
-                    #cond);                                                   \
-            fprintf(stderr, __VA_ARGS__);                                     \
-            fputc('\n', stderr);                                              \
-        }                                                                     \
+#define CHECK(cond, ...)                                                                           \
+    do {                                                                                           \
+        if (!(cond)) {                                                                             \
+            failures++;                                                                            \
+            fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__, __LINE__, #cond);               \
+            fprintf(stderr, __VA_ARGS__);                                                          \
+            fputc('\n', stderr);                                                                   \
+        }                                                                                          \
     } while (0)
 
 static const int sizes[] = {1, 2, 3, 8, 64};
@@ -150,20 +149,44 @@ static void test_gl_table(void)
                     float g[3];
                     vdsh_cube_gl_dir(face, i, j, n, g);
                     /* Major axis: strictly the face's, with its sign. */
-                    CHECK(g[axis] == sign, "n %d face %d (%d,%d): major %g",
-                          n, face, i, j, (double)g[axis]);
+                    CHECK(g[axis] == sign, "n %d face %d (%d,%d): major %g", n, face, i, j,
+                          (double)g[axis]);
                     for (int k = 0; k < 3; k++)
                         if (k != axis)
                             CHECK(fabsf(g[k]) < 1.0f, "n %d face %d minor", n, face);
                     /* GL 4.6 table 8.19: sc, tc, ma per major axis. */
                     float rx = g[0], ry = g[1], rz = g[2], sc, tc, ma;
                     switch (face) {
-                    case 0: sc = -rz; tc = -ry; ma = rx; break;
-                    case 1: sc = rz; tc = -ry; ma = rx; break;
-                    case 2: sc = rx; tc = rz; ma = ry; break;
-                    case 3: sc = rx; tc = -rz; ma = ry; break;
-                    case 4: sc = rx; tc = -ry; ma = rz; break;
-                    default: sc = -rx; tc = -ry; ma = rz; break;
+                    case 0:
+                        sc = -rz;
+                        tc = -ry;
+                        ma = rx;
+                        break;
+                    case 1:
+                        sc = rz;
+                        tc = -ry;
+                        ma = rx;
+                        break;
+                    case 2:
+                        sc = rx;
+                        tc = rz;
+                        ma = ry;
+                        break;
+                    case 3:
+                        sc = rx;
+                        tc = -rz;
+                        ma = ry;
+                        break;
+                    case 4:
+                        sc = rx;
+                        tc = -ry;
+                        ma = rz;
+                        break;
+                    default:
+                        sc = -rx;
+                        tc = -ry;
+                        ma = rz;
+                        break;
                     }
                     float s = 0.5f * (sc / fabsf(ma) + 1.0f);
                     float t = 0.5f * (tc / fabsf(ma) + 1.0f);
@@ -189,8 +212,8 @@ static void test_gl_exr_agree(void)
                 for (int i = 0; i < n; i++) {
                     int ei = -1, ej = -1;
                     vdsh_cube_gl_to_exr(face, i, j, n, &ei, &ej);
-                    CHECK(ei >= 0 && ei < n && ej >= 0 && ej < n,
-                          "n %d face %d (%d,%d) -> (%d,%d)", n, face, i, j, ei, ej);
+                    CHECK(ei >= 0 && ei < n && ej >= 0 && ej < n, "n %d face %d (%d,%d) -> (%d,%d)",
+                          n, face, i, j, ei, ej);
                     if (ei < 0 || ei >= n || ej < 0 || ej >= n)
                         continue;
                     hit[ej * n + ei]++;
@@ -203,27 +226,25 @@ static void test_gl_exr_agree(void)
                     float cz = g[0] * e[1] - g[1] * e[0];
                     float dot = g[0] * e[0] + g[1] * e[1] + g[2] * e[2];
                     CHECK(fabsf(cx) + fabsf(cy) + fabsf(cz) < 1e-6f && dot > 0,
-                          "n %d face %d GL (%d,%d) vs EXR (%d,%d) not parallel",
-                          n, face, i, j, ei, ej);
+                          "n %d face %d GL (%d,%d) vs EXR (%d,%d) not parallel", n, face, i, j, ei,
+                          ej);
                     /* ...and, as the mirrored centres are exact, equal. */
                     CHECK(g[0] == e[0] && g[1] == e[1] && g[2] == e[2],
-                          "n %d face %d (%d,%d): (%g %g %g) vs (%g %g %g)", n,
-                          face, i, j, (double)g[0], (double)g[1], (double)g[2],
-                          (double)e[0], (double)e[1], (double)e[2]);
+                          "n %d face %d (%d,%d): (%g %g %g) vs (%g %g %g)", n, face, i, j,
+                          (double)g[0], (double)g[1], (double)g[2], (double)e[0], (double)e[1],
+                          (double)e[2]);
                     /* The EXR direction is the header's table. */
                     float u = texel_centre(ei, n), v = texel_centre(ej, n);
-                    float want[6][3] = {{1, -v, u},  {-1, -v, -u}, {u, 1, -v},
-                                        {u, -1, v},  {-u, -v, 1},  {u, -v, -1}};
+                    float want[6][3] = {{1, -v, u}, {-1, -v, -u}, {u, 1, -v},
+                                        {u, -1, v}, {-u, -v, 1},  {u, -v, -1}};
                     for (int k = 0; k < 3; k++)
                         CHECK(fabsf(e[k] - want[face][k]) < 1e-6f,
-                              "n %d face %d EXR (%d,%d) component %d", n, face,
-                              ei, ej, k);
+                              "n %d face %d EXR (%d,%d) component %d", n, face, ei, ej, k);
                 }
             }
             /* A bijection per face: every EXR texel is used exactly once. */
             for (int k = 0; k < n * n; k++)
-                CHECK(hit[k] == 1, "n %d face %d EXR texel %d hit %d times", n,
-                      face, k, hit[k]);
+                CHECK(hit[k] == 1, "n %d face %d EXR texel %d hit %d times", n, face, k, hit[k]);
         }
         free(hit);
     }
@@ -245,8 +266,8 @@ static void test_fill_basis(void)
                     for (int i = 0; i < n; i++) {
                         float d[3], y[25];
                         vdsh_cube_exr_dir(face, i, j, n, d);
-                        double len = sqrt((double)d[0] * d[0] + (double)d[1] * d[1] +
-                                          (double)d[2] * d[2]);
+                        double len =
+                            sqrt((double)d[0] * d[0] + (double)d[1] * d[1] + (double)d[2] * d[2]);
                         for (int k = 0; k < 3; k++)
                             d[k] = (float)(d[k] / len);
                         vdsh_sh_eval(5, d, y);
@@ -259,8 +280,8 @@ static void test_fill_basis(void)
                     }
                 }
             }
-            CHECK(maxdiff < 2e-6f, "n %d first %d: max |fill - eval| %g", n,
-                  first, (double)maxdiff);
+            CHECK(maxdiff < 2e-6f, "n %d first %d: max |fill - eval| %g", n, first,
+                  (double)maxdiff);
         }
         free(rgba);
     }
@@ -402,8 +423,7 @@ static int write_odd_exr(const char *path, int w, int h, const char *channels,
         if (exr_add_channel(ctxt, part, name, type, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1))
             goto done;
     }
-    if (envmap >= 0 &&
-        exr_attr_set_envmap(ctxt, part, "envmap", (exr_envmap_t)envmap))
+    if (envmap >= 0 && exr_attr_set_envmap(ctxt, part, "envmap", (exr_envmap_t)envmap))
         goto done;
     if (exr_write_header(ctxt))
         goto done;
@@ -448,16 +468,16 @@ static void check_header(const char *path, int n)
     if (!ctxt)
         return;
     exr_envmap_t em = EXR_ENVMAP_LAST_TYPE;
-    CHECK(exr_attr_get_envmap(ctxt, 0, "envmap", &em) == EXR_ERR_SUCCESS &&
-              em == EXR_ENVMAP_CUBE, "%s: envmap %d", path, (int)em);
+    CHECK(exr_attr_get_envmap(ctxt, 0, "envmap", &em) == EXR_ERR_SUCCESS && em == EXR_ENVMAP_CUBE,
+          "%s: envmap %d", path, (int)em);
     exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
     exr_get_storage(ctxt, 0, &storage);
     CHECK(storage == EXR_STORAGE_SCANLINE, "%s: storage %d", path, (int)storage);
     exr_attr_box2i_t dw;
     memset(&dw, 0, sizeof dw);
     exr_get_data_window(ctxt, 0, &dw);
-    CHECK(dw.min.x == 0 && dw.min.y == 0 && dw.max.x == n - 1 &&
-              dw.max.y == 6 * n - 1, "%s: data window", path);
+    CHECK(dw.min.x == 0 && dw.min.y == 0 && dw.max.x == n - 1 && dw.max.y == 6 * n - 1,
+          "%s: data window", path);
     const exr_attr_chlist_t *chl = NULL;
     exr_get_channels(ctxt, 0, &chl);
     CHECK(chl && chl->num_channels == 4, "%s: channel count", path);
@@ -477,9 +497,8 @@ static void check_header(const char *path, int n)
         const exr_attribute_t *at = NULL;
         exr_get_attribute_by_index(ctxt, 0, EXR_ATTR_LIST_FILE_ORDER, a, &at);
         static const char *const allowed[] = {
-            "channels", "compression", "dataWindow", "displayWindow", "envmap",
-            "lineOrder", "pixelAspectRatio", "screenWindowCenter",
-            "screenWindowWidth", "type"};
+            "channels",  "compression",      "dataWindow",         "displayWindow",     "envmap",
+            "lineOrder", "pixelAspectRatio", "screenWindowCenter", "screenWindowWidth", "type"};
         int ok = 0;
         for (size_t k = 0; at && k < sizeof allowed / sizeof allowed[0]; k++)
             ok |= strcmp(at->name, allowed[k]) == 0;
@@ -496,8 +515,7 @@ static void test_basis_round_trip(const char *dir)
         vb_error err = {{0}};
         vb_result r = vb_cubemap_write_basis(dir, "room", n, &err);
         CHECK(r == VB_OK, "write_basis n %d: %s", n, err.msg);
-        CHECK(count_entries(dir) == 4, "n %d: %d entries in %s", n,
-              count_entries(dir), dir);
+        CHECK(count_entries(dir) == 4, "n %d: %d entries in %s", n, count_entries(dir), dir);
         vb_cubemap *maps[VB_CUBEMAP_BASIS_FILES] = {0};
         r = vb_cubemap_read_basis(dir, "room", n, maps, &err);
         CHECK(r == VB_OK, "read_basis n %d: %s", n, err.msg);
@@ -512,8 +530,7 @@ static void test_basis_round_trip(const char *dir)
             for (size_t x = 0; x < count; x++)
                 if (maps[k]->rgba[x] != half_round(want[x]))
                     bad++;
-            CHECK(bad == 0, "n %d file %d: %zu values differ from half rounding",
-                  n, k, bad);
+            CHECK(bad == 0, "n %d file %d: %zu values differ from half rounding", n, k, bad);
             /* What the runtime uploads instead of reading the file: the
              * file's half of every texel, bit for bit (signed zeros
              * too), at the texel vdsh_cube_gl_to_exr names. */
@@ -528,15 +545,15 @@ static void test_basis_round_trip(const char *dir)
                     for (int i = 0; i < n; i++) {
                         int ei, ej;
                         vdsh_cube_gl_to_exr(f, i, j, n, &ei, &ej);
-                        const float *file = maps[k]->rgba +
+                        const float *file =
+                            maps[k]->rgba +
                             (((size_t)f * (size_t)n + (size_t)ej) * (size_t)n + (size_t)ei) * 4;
                         for (int c = 0; c < 4; c++)
                             bad += out[k][((size_t)j * (size_t)n + (size_t)i) * 4 + (size_t)c] !=
                                    vdsh_f16_from_f32(file[c]);
                     }
             }
-            CHECK(bad == 0, "n %d file %d: %zu GL half texels differ from the file's", n, k,
-                  bad);
+            CHECK(bad == 0, "n %d file %d: %zu GL half texels differ from the file's", n, k, bad);
             free(gl);
             char path[512];
             vb_cubemap_basis_path(dir, "room", k, path, sizeof path, NULL);
@@ -556,10 +573,13 @@ static void test_single_round_trip(const char *dir)
 {
     /* Values that separate round-to-nearest-even from truncation and
      * from round-half-up, subnormals, signed zero, the largest half. */
-    const float special[] = {
-        1.0f + 0x1p-11f, 1.0f + 3 * 0x1p-11f, -(1.0f + 0x1p-11f), 0x1p-24f,
-        0x1p-25f, 3 * 0x1p-25f, 0x1p-14f, -0.0f, 65504.0f, 65519.0f,
-        -65519.0f, 0.1f, 1.0f / 3.0f, 2.0f - 0x1p-12f};
+    const float special[] = {1.0f + 0x1p-11f,    1.0f + 3 * 0x1p-11f,
+                             -(1.0f + 0x1p-11f), 0x1p-24f,
+                             0x1p-25f,           3 * 0x1p-25f,
+                             0x1p-14f,           -0.0f,
+                             65504.0f,           65519.0f,
+                             -65519.0f,          0.1f,
+                             1.0f / 3.0f,        2.0f - 0x1p-12f};
     const int n = 5;
     size_t count = (size_t)n * 6 * n * 4;
     float *rgba = malloc(count * sizeof(float));
@@ -585,8 +605,8 @@ static void test_single_round_trip(const char *dir)
             float want = half_round(rgba[k]);
             if (memcmp(&m->rgba[k], &want, 4) != 0) {
                 if (bad++ < 5)
-                    fprintf(stderr, "value %zu: wrote %a read %a want %a\n", k,
-                            (double)rgba[k], (double)m->rgba[k], (double)want);
+                    fprintf(stderr, "value %zu: wrote %a read %a want %a\n", k, (double)rgba[k],
+                            (double)m->rgba[k], (double)want);
             }
         }
         CHECK(bad == 0, "%zu values not rounded to nearest even half", bad);
@@ -600,8 +620,8 @@ static void test_single_round_trip(const char *dir)
     CHECK(vb_cubemap_write(path2, n, rgba, &err) == VB_OK, "%s", err.msg);
     CHECK(vb_cubemap_write(path, n, rgba, &err) == VB_OK, "overwrite: %s", err.msg);
     unsigned char *b2 = read_all(path2, &s2), *b3 = read_all(path, &s3);
-    CHECK(b1 && b2 && b3 && s1 == s2 && s1 == s3 && !memcmp(b1, b2, s1) &&
-              !memcmp(b1, b3, s1), "writes differ (%zu %zu %zu bytes)", s1, s2, s3);
+    CHECK(b1 && b2 && b3 && s1 == s2 && s1 == s3 && !memcmp(b1, b2, s1) && !memcmp(b1, b3, s1),
+          "writes differ (%zu %zu %zu bytes)", s1, s2, s3);
     free(b1);
     free(b2);
     free(b3);
@@ -659,19 +679,25 @@ static void test_paths(void)
     char buf[64];
     vb_error err = {{0}};
     CHECK(vb_cubemap_basis_path("out", "room", 0, buf, sizeof buf, &err) == VB_OK &&
-              !strcmp(buf, "out/room.sh09-12.exr"), "%s", buf);
+              !strcmp(buf, "out/room.sh09-12.exr"),
+          "%s", buf);
     CHECK(vb_cubemap_basis_path("out/", "room", 1, buf, sizeof buf, &err) == VB_OK &&
-              !strcmp(buf, "out/room.sh13-16.exr"), "%s", buf);
+              !strcmp(buf, "out/room.sh13-16.exr"),
+          "%s", buf);
     CHECK(vb_cubemap_basis_path(NULL, "room", 2, buf, sizeof buf, &err) == VB_OK &&
-              !strcmp(buf, "room.sh17-20.exr"), "%s", buf);
+              !strcmp(buf, "room.sh17-20.exr"),
+          "%s", buf);
     CHECK(vb_cubemap_basis_path("", "a.b", 3, buf, sizeof buf, &err) == VB_OK &&
-              !strcmp(buf, "a.b.sh21-24.exr"), "%s", buf);
+              !strcmp(buf, "a.b.sh21-24.exr"),
+          "%s", buf);
     CHECK(vb_cubemap_basis_path("/", "r", 3, buf, sizeof buf, &err) == VB_OK &&
-              !strcmp(buf, "/r.sh21-24.exr"), "%s", buf);
+              !strcmp(buf, "/r.sh21-24.exr"),
+          "%s", buf);
     /* Too small: exactly one byte short; buf untouched. */
     strcpy(buf, "untouched");
-    CHECK(vb_cubemap_basis_path("out", "room", 0, buf, strlen("out/room.sh09-12.exr"),
-                                &err) == VB_ERR_ARGUMENT && !strcmp(buf, "untouched"),
+    CHECK(vb_cubemap_basis_path("out", "room", 0, buf, strlen("out/room.sh09-12.exr"), &err) ==
+                  VB_ERR_ARGUMENT &&
+              !strcmp(buf, "untouched"),
           "short buffer");
     CHECK(vb_cubemap_basis_path("out", "room", 4, buf, sizeof buf, &err) == VB_ERR_ARGUMENT,
           "k = 4");
@@ -709,20 +735,16 @@ static void expect_read_fails(const char *path, vb_result want, const char *need
     vb_error err = {{0}};
     vb_result r = vb_cubemap_read(path, &m, &err);
     printf("rejected (%s): %s\n", vb_result_str(r), err.msg);
-    CHECK(r != VB_OK && (want == VB_OK || r == want),
-          "%s: result %d (%s), want %d: %s", path, (int)r, vb_result_str(r),
-          (int)want, err.msg);
+    CHECK(r != VB_OK && (want == VB_OK || r == want), "%s: result %d (%s), want %d: %s", path,
+          (int)r, vb_result_str(r), (int)want, err.msg);
     CHECK(m == sentinel, "%s: output changed on failure", path);
-    CHECK(strstr(err.msg, path) != NULL, "%s: message does not name the file: %s",
-          path, err.msg);
+    CHECK(strstr(err.msg, path) != NULL, "%s: message does not name the file: %s", path, err.msg);
     if (needle)
-        CHECK(strstr(err.msg, needle) != NULL, "%s: message lacks '%s': %s", path,
-              needle, err.msg);
+        CHECK(strstr(err.msg, needle) != NULL, "%s: message lacks '%s': %s", path, needle, err.msg);
 }
 
 /* Patch the first int32 after "<name>\0<type>\0<size>" in an EXR header. */
-static int patch_box2i(unsigned char *buf, size_t size, const char *name,
-                       const int32_t box[4])
+static int patch_box2i(unsigned char *buf, size_t size, const char *name, const int32_t box[4])
 {
     size_t nl = strlen(name) + 1;
     for (size_t k = 0; k + nl + 6 + 4 + 16 <= size; k++) {
@@ -757,12 +779,10 @@ static void test_bad_files(const char *dir)
     CHECK(write_odd_exr(path, 4, 24, "RGBA", EXR_PIXEL_HALF, -1, 0), "plain");
     expect_read_fails(path, VB_ERR_FORMAT, "no envmap attribute");
     join(path, sizeof path, dir, "latlong.exr");
-    CHECK(write_odd_exr(path, 8, 4, "RGBA", EXR_PIXEL_HALF, EXR_ENVMAP_LATLONG, 0),
-          "latlong");
+    CHECK(write_odd_exr(path, 8, 4, "RGBA", EXR_PIXEL_HALF, EXR_ENVMAP_LATLONG, 0), "latlong");
     expect_read_fails(path, VB_ERR_FORMAT, "latitude-longitude");
     join(path, sizeof path, dir, "aspect.exr");
-    CHECK(write_odd_exr(path, 4, 20, "RGBA", EXR_PIXEL_HALF, EXR_ENVMAP_CUBE, 0),
-          "aspect");
+    CHECK(write_odd_exr(path, 4, 20, "RGBA", EXR_PIXEL_HALF, EXR_ENVMAP_CUBE, 0), "aspect");
     expect_read_fails(path, VB_ERR_FORMAT, "n x 6n");
     join(path, sizeof path, dir, "rgb.exr");
     CHECK(write_odd_exr(path, 4, 24, "RGB", EXR_PIXEL_HALF, EXR_ENVMAP_CUBE, 0), "rgb");
@@ -771,8 +791,7 @@ static void test_bad_files(const char *dir)
     CHECK(write_odd_exr(path, 4, 24, "RGBA", EXR_PIXEL_UINT, EXR_ENVMAP_CUBE, 0), "uint");
     expect_read_fails(path, VB_ERR_FORMAT, "not half or float");
     join(path, sizeof path, dir, "nan.exr");
-    CHECK(write_odd_exr(path, 4, 24, "RGBA", EXR_PIXEL_FLOAT, EXR_ENVMAP_CUBE, NAN),
-          "nan");
+    CHECK(write_odd_exr(path, 4, 24, "RGBA", EXR_PIXEL_FLOAT, EXR_ENVMAP_CUBE, NAN), "nan");
     expect_read_fails(path, VB_ERR_INVALID, "not finite");
 
     /* A good file, then damaged copies of it. */
@@ -790,7 +809,8 @@ static void test_bad_files(const char *dir)
     memcpy(copy, bytes, size);
     const int32_t huge[4] = {0, 0, 4096, 6 * 4097 - 1};
     CHECK(patch_box2i(copy, size, "dataWindow", huge) &&
-              patch_box2i(copy, size, "displayWindow", huge), "patch windows");
+              patch_box2i(copy, size, "displayWindow", huge),
+          "patch windows");
     write_all(path, copy, size);
     expect_read_fails(path, VB_ERR_FORMAT, NULL);
 
@@ -806,8 +826,7 @@ static void test_bad_files(const char *dir)
             ok_count++;
             vb_cubemap_free(m);
         } else {
-            CHECK(strstr(err.msg, path) && m == NULL,
-                  "truncated to %zu: message %s", len, err.msg);
+            CHECK(strstr(err.msg, path) && m == NULL, "truncated to %zu: message %s", len, err.msg);
         }
     }
     CHECK(ok_count == 0, "%zu truncated files were accepted", ok_count);
@@ -836,8 +855,7 @@ static void test_bad_files(const char *dir)
             vb_cubemap_free(m);
         } else {
             errors++;
-            CHECK(strstr(err.msg, path) != NULL, "corrupt trial %d: %s", trial,
-                  err.msg);
+            CHECK(strstr(err.msg, path) != NULL, "corrupt trial %d: %s", trial, err.msg);
         }
     }
     printf("corrupted files: %d rejected, %d accepted\n", errors, accepted);
@@ -850,8 +868,8 @@ static void test_bad_files(const char *dir)
     char p2[512];
     vb_cubemap_basis_path(dir, "good", 2, p2, sizeof p2, NULL);
     unlink(p2);
-    CHECK(vb_cubemap_read_basis(dir, "good", 8, maps, &err) == VB_ERR_IO &&
-              strstr(err.msg, p2), "missing third file: %s", err.msg);
+    CHECK(vb_cubemap_read_basis(dir, "good", 8, maps, &err) == VB_ERR_IO && strstr(err.msg, p2),
+          "missing third file: %s", err.msg);
     CHECK(maps[0] == sentinel && maps[3] == sentinel, "outputs changed");
     float *small = malloc(4 * 6 * 4 * 4 * sizeof(float));
     vdsh_cube_fill_basis(4, 17, small);
@@ -861,7 +879,8 @@ static void test_bad_files(const char *dir)
               strstr(err.msg, p2) && strstr(err.msg, "face size 4"),
           "mixed sizes: %s", err.msg);
     CHECK(vb_cubemap_read_basis(dir, "good", 16, maps, &err) == VB_ERR_FORMAT &&
-              strstr(err.msg, "expected 16"), "expected size: %s", err.msg);
+              strstr(err.msg, "expected 16"),
+          "expected size: %s", err.msg);
     CHECK(maps[0] == sentinel && maps[3] == sentinel, "outputs changed");
 }
 
@@ -876,14 +895,13 @@ static void test_failed_writes(const char *dir)
     join(missing, sizeof missing, dir, "no/such/dir");
     join(path, sizeof path, missing, "x.exr");
     int before = count_entries(dir);
-    CHECK(vb_cubemap_write(path, 2, rgba, &err) == VB_ERR_IO &&
-              strstr(err.msg, path) && strstr(err.msg, "No such file or directory"),
+    CHECK(vb_cubemap_write(path, 2, rgba, &err) == VB_ERR_IO && strstr(err.msg, path) &&
+              strstr(err.msg, "No such file or directory"),
           "missing dir: %s", err.msg);
     printf("missing directory: %s\n", err.msg);
-    CHECK(vb_cubemap_write_basis(missing, "room", 8, &err) == VB_ERR_IO &&
-              strstr(err.msg, missing), "basis into missing dir: %s", err.msg);
-    CHECK(count_entries(dir) == before && count_entries(missing) < 0,
-          "something was created");
+    CHECK(vb_cubemap_write_basis(missing, "room", 8, &err) == VB_ERR_IO && strstr(err.msg, missing),
+          "basis into missing dir: %s", err.msg);
+    CHECK(count_entries(dir) == before && count_entries(missing) < 0, "something was created");
 
     /* Destination is a directory: the rename fails, the temporary file
      * is removed. */
@@ -892,8 +910,7 @@ static void test_failed_writes(const char *dir)
     before = count_entries(dir);
     CHECK(vb_cubemap_write(path, 2, rgba, &err) == VB_ERR_IO && strstr(err.msg, path),
           "rename over a directory: %s", err.msg);
-    CHECK(count_entries(dir) == before && count_temp_files(dir) == 0,
-          "temporary file left behind");
+    CHECK(count_entries(dir) == before && count_temp_files(dir) == 0, "temporary file left behind");
 
     /* Set: the first destination is a directory, so its rename fails
      * after all four were staged; the three other temporary files must
@@ -902,8 +919,8 @@ static void test_failed_writes(const char *dir)
     vb_cubemap_basis_path(dir, "set", 0, p0, sizeof p0, NULL);
     mkdir(p0, 0777);
     before = count_entries(dir);
-    CHECK(vb_cubemap_write_basis(dir, "set", 2, &err) == VB_ERR_IO &&
-              strstr(err.msg, p0), "set with a directory in the way: %s", err.msg);
+    CHECK(vb_cubemap_write_basis(dir, "set", 2, &err) == VB_ERR_IO && strstr(err.msg, p0),
+          "set with a directory in the way: %s", err.msg);
     CHECK(count_entries(dir) == before && count_temp_files(dir) == 0,
           "set left files behind (%d entries, %d before)", count_entries(dir), before);
 
@@ -911,7 +928,8 @@ static void test_failed_writes(const char *dir)
     join(path, sizeof path, dir, "inf.exr");
     rgba[13] = 70000.0f;
     CHECK(vb_cubemap_write(path, 2, rgba, &err) == VB_ERR_INVALID &&
-              strstr(err.msg, "face 0 texel (1, 1) channel G"), "%s", err.msg);
+              strstr(err.msg, "face 0 texel (1, 1) channel G"),
+          "%s", err.msg);
     rgba[13] = NAN;
     CHECK(vb_cubemap_write(path, 2, rgba, &err) == VB_ERR_INVALID, "%s", err.msg);
     rgba[13] = 0.0f;

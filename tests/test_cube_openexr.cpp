@@ -28,15 +28,14 @@
 
 static int failures;
 
-#define CHECK(cond, ...)                                                      \
-    do {                                                                      \
-        if (!(cond)) {                                                        \
-            failures++;                                                       \
-            std::fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__,       \
-                         __LINE__, #cond);                                    \
-            std::fprintf(stderr, __VA_ARGS__);                                \
-            std::fputc('\n', stderr);                                         \
-        }                                                                     \
+#define CHECK(cond, ...)                                                                           \
+    do {                                                                                           \
+        if (!(cond)) {                                                                             \
+            failures++;                                                                            \
+            std::fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__, __LINE__, #cond);          \
+            std::fprintf(stderr, __VA_ARGS__);                                                     \
+            std::fputc('\n', stderr);                                                              \
+        }                                                                                          \
     } while (0)
 
 static Imath::Box2i cube_window(int n)
@@ -57,16 +56,15 @@ static void test_lookup_lands_in_texel(int n)
                 vdsh_cube_exr_dir(face, i, j, n, d);
                 Imf::CubeMapFace f;
                 Imath::V2f pif;
-                Imf::CubeMap::faceAndPixelPosition(Imath::V3f(d[0], d[1], d[2]),
-                                                   dw, f, pif);
+                Imf::CubeMap::faceAndPixelPosition(Imath::V3f(d[0], d[1], d[2]), dw, f, pif);
                 Imath::V2f pos = Imf::CubeMap::pixelPosition(f, dw, pif);
                 bool ok = int(f) == face && std::fabs(pos.x - float(i)) < 0.5f &&
                           std::fabs(pos.y - float(face * n + j)) < 0.5f;
                 if (!ok && bad++ < 5)
                     std::fprintf(stderr,
                                  "n %d face %d texel (%d,%d): OpenEXR face %d "
-                                 "pixel (%g,%g)\n", n, face, i, j, int(f),
-                                 double(pos.x), double(pos.y));
+                                 "pixel (%g,%g)\n",
+                                 n, face, i, j, int(f), double(pos.x), double(pos.y));
             }
         }
     }
@@ -100,25 +98,23 @@ static void test_direction_table(int n)
                 for (int k = 0; k < 3; k++) {
                     if (k == axis)
                         continue;
-                    float want = n == 1 ? 0.0f
-                                        : theirs[k] * float(n - 1) / float(n);
+                    float want = n == 1 ? 0.0f : theirs[k] * float(n - 1) / float(n);
                     ok = ok && std::fabs(ours[k] - want) < 1e-5f;
                 }
                 if (!ok && bad++ < 5)
                     std::fprintf(stderr,
                                  "n %d face %d pixel (%d,%d): OpenEXR (%g %g %g) "
-                                 "ours (%g %g %g)\n", n, face, px, py,
-                                 double(theirs.x), double(theirs.y),
-                                 double(theirs.z), double(ours[0]),
-                                 double(ours[1]), double(ours[2]));
+                                 "ours (%g %g %g)\n",
+                                 n, face, px, py, double(theirs.x), double(theirs.y),
+                                 double(theirs.z), double(ours[0]), double(ours[1]),
+                                 double(ours[2]));
             }
         }
     }
     CHECK(bad == 0, "n %d: %d pixels disagree with CubeMap::direction", n, bad);
 }
 
-static bool read_rgba(const std::string &path, int &n, std::vector<float> &out,
-                      Imf::Envmap &envmap)
+static bool read_rgba(const std::string &path, int &n, std::vector<float> &out, Imf::Envmap &envmap)
 {
     Imf::RgbaInputFile in(path.c_str());
     Imath::Box2i dw = in.dataWindow();
@@ -126,8 +122,7 @@ static bool read_rgba(const std::string &path, int &n, std::vector<float> &out,
     if (h != 6 * w)
         return false;
     n = w;
-    envmap = Imf::hasEnvmap(in.header()) ? Imf::envmap(in.header())
-                                         : Imf::NUM_ENVMAPTYPES;
+    envmap = Imf::hasEnvmap(in.header()) ? Imf::envmap(in.header()) : Imf::NUM_ENVMAPTYPES;
     Imf::Array2D<Imf::Rgba> px(h, w);
     in.setFrameBuffer(&px[0][0] - dw.min.x - dw.min.y * w, 1, size_t(w));
     in.readPixels(dw.min.y, dw.max.y);
@@ -166,8 +161,7 @@ static void test_our_files(const std::string &dir)
         size_t differ = 0;
         for (size_t x = 0; x < cpp.size(); x++)
             differ += std::memcmp(&cpp[x], &m->rgba[x], sizeof(float)) != 0;
-        CHECK(differ == 0, "%s: %zu values differ between C++ and our reader",
-              path, differ);
+        CHECK(differ == 0, "%s: %zu values differ between C++ and our reader", path, differ);
 
         Imath::Box2i dw = cube_window(n);
         uint32_t state = 7u + uint32_t(k);
@@ -180,8 +174,7 @@ static void test_our_files(const std::string &dir)
             }
             Imf::CubeMapFace f;
             Imath::V2f pif;
-            Imf::CubeMap::faceAndPixelPosition(Imath::V3f(d[0], d[1], d[2]), dw,
-                                               f, pif);
+            Imf::CubeMap::faceAndPixelPosition(Imath::V3f(d[0], d[1], d[2]), dw, f, pif);
             Imath::V2f pos = Imf::CubeMap::pixelPosition(f, dw, pif);
             int px = int(std::lround(pos.x)), py = int(std::lround(pos.y));
             int face = py / n, j = py % n;
@@ -195,9 +188,10 @@ static void test_our_files(const std::string &dir)
             for (int q = 0; q < 3; q++)
                 dist = std::fmax(dist, std::fabs(d[q] * scale - c[q]));
             if (!(dist <= 2.0f / float(n) + 1e-5f) && far++ < 5)
-                std::fprintf(stderr, "d (%g %g %g) -> face %d texel (%d,%d), "
-                             "%g from its centre\n", double(d[0]), double(d[1]),
-                             double(d[2]), face, px, j, double(dist));
+                std::fprintf(stderr,
+                             "d (%g %g %g) -> face %d texel (%d,%d), "
+                             "%g from its centre\n",
+                             double(d[0]), double(d[1]), double(d[2]), face, px, j, double(dist));
             // The value OpenEXR returns there is the basis at that centre.
             float len = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
             float cu[3] = {c[0] / len, c[1] / len, c[2] / len}, y[25];
@@ -248,15 +242,15 @@ static void test_their_files(const std::string &dir)
 
     std::string tiled = dir + "/cpp_tiled.exr";
     {
-        Imf::TiledRgbaOutputFile out(tiled.c_str(), header, Imf::WRITE_RGBA, 4, 4,
-                                     Imf::ONE_LEVEL);
+        Imf::TiledRgbaOutputFile out(tiled.c_str(), header, Imf::WRITE_RGBA, 4, 4, Imf::ONE_LEVEL);
         out.setFrameBuffer(&px[0][0], 1, size_t(n));
         out.writeTiles(0, out.numXTiles() - 1, 0, out.numYTiles() - 1);
     }
     m = nullptr;
     vb_result r = vb_cubemap_read(tiled.c_str(), &m, &err);
     CHECK(r == VB_ERR_FORMAT && m == nullptr && std::strstr(err.msg, tiled.c_str()) &&
-              std::strstr(err.msg, "tiled"), "tiled: %d %s", int(r), err.msg);
+              std::strstr(err.msg, "tiled"),
+          "tiled: %d %s", int(r), err.msg);
 }
 
 int main(int argc, char **argv)

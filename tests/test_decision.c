@@ -194,8 +194,8 @@ static void test_converges(void)
             memcpy(c, start, sizeof c);
             vb_decision_fit(order, M, Y, M, logd, lab, &q, c, scratch);
             double f = loss(&q, order, c, start, M, Y, logd, lab);
-            CHECK(f <= prev * (1.0 + 1e-6), "order %d: %d steps' loss %g above %d steps' %g",
-                  order, steps, f, steps - 1, prev);
+            CHECK(f <= prev * (1.0 + 1e-6), "order %d: %d steps' loss %g above %d steps' %g", order,
+                  steps, f, steps - 1, prev);
             prev = f;
             if (steps == p.steps)
                 fdef = f;
@@ -209,8 +209,8 @@ static void test_converges(void)
         CHECK(fdef - fmin <= 0.005 * (f0 - fmin),
               "order %d: %d steps leave %g of the decrease %g (start %g)", order, p.steps,
               fdef - fmin, f0 - fmin, f0);
-        fprintf(stderr, "order %d: start %g, %d steps %g, 64 steps %g\n", order, f0, p.steps,
-                fdef, fmin);
+        fprintf(stderr, "order %d: start %g, %d steps %g, 64 steps %g\n", order, f0, p.steps, fdef,
+                fmin);
     }
     free(scratch);
 }

@@ -17,7 +17,8 @@ static inline int test_count_names(const char *dir, const char *part)
     int count = 0;
     struct dirent *e;
     while ((e = readdir(d)) != NULL)
-        if (part ? strstr(e->d_name, part) != NULL : strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
+        if (part ? strstr(e->d_name, part) != NULL
+                 : strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
             count++;
     closedir(d);
     return count;

@@ -53,8 +53,7 @@ static void make_sphere(vb_mesh *m, float r, const float c[3])
     for (int i = 0; i <= NT; i++)
         for (int j = 0; j < NP; j++) {
             double th = M_PI * i / NT, ph = 2 * M_PI * j / NP;
-            float d[3] = {(float)(sin(th) * cos(ph)), (float)(sin(th) * sin(ph)),
-                          (float)cos(th)};
+            float d[3] = {(float)(sin(th) * cos(ph)), (float)(sin(th) * sin(ph)), (float)cos(th)};
             for (int k = 0; k < 3; k++) {
                 m->positions[3 * (i * NP + j) + k] = c[k] + r * d[k];
                 m->normals[3 * (i * NP + j) + k] = -d[k];
@@ -102,9 +101,8 @@ typedef struct memfile {
     void *data[VDSH_MAX_ORDER];
 } memfile;
 
-static void make_file(memfile *mf, const vb_mesh *rec, const vb_scene *s,
-                      const vb_bake_output *b, vb_method method, uint32_t encoding,
-                      const int *orders, int norders)
+static void make_file(memfile *mf, const vb_mesh *rec, const vb_scene *s, const vb_bake_output *b,
+                      vb_method method, uint32_t encoding, const int *orders, int norders)
 {
     memset(mf, 0, sizeof *mf);
     vdsh_file *f = &mf->f;
@@ -123,8 +121,7 @@ static void make_file(memfile *mf, const vb_mesh *rec, const vb_scene *s,
     /* The streams exactly as vdsh-bake writes them (vb_bake_stream). */
     for (int i = 0; i < norders; i++) {
         vb_error err;
-        CHECK(vb_bake_stream(b, orders[i], encoding, &mf->streams[i], &mf->data[i], &err) ==
-                  VB_OK,
+        CHECK(vb_bake_stream(b, orders[i], encoding, &mf->streams[i], &mf->data[i], &err) == VB_OK,
               "stream of order %d: %s", orders[i], err.msg);
         mf->streams[i].method = vb_method_get(method)->stored;
     }
@@ -143,8 +140,13 @@ static int bake(const vb_mesh *rec, const vb_scene *s, vb_method method, uint32_
                 uint64_t seed, vb_bake_output *out)
 {
     vb_error err;
-    vb_bake_desc d = {.keep_normals = 1, .receivers = rec, .scene = s, .rays = rays, .seed = seed,
-                      .method = method, .threads = 2,
+    vb_bake_desc d = {.keep_normals = 1,
+                      .receivers = rec,
+                      .scene = s,
+                      .rays = rays,
+                      .seed = seed,
+                      .method = method,
+                      .threads = 2,
                       .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
     vb_result r = vb_bake_run(&d, out, &err);
     if (r != VB_OK)
@@ -152,8 +154,7 @@ static int bake(const vb_mesh *rec, const vb_scene *s, vb_method method, uint32_
     return r == VB_OK;
 }
 
-static int evaluate(const vdsh_file *f, const vb_scene *s, vb_eval_desc d,
-                    vb_eval_result *out)
+static int evaluate(const vdsh_file *f, const vb_scene *s, vb_eval_desc d, vb_eval_result *out)
 {
     vb_error err;
     d.file = f;
@@ -325,11 +326,11 @@ static void test_sphere(void)
                        "MAE %.4f (analytic %.4f)\n",
                        orders[i], mv->distance_rms, rms, mv->shadow_mae, mae);
                 CHECK(fabs(mv->distance_rms - rms) < 0.03 * rms + 0.003,
-                      "paper, order %d: distance RMS %g, analytic %g", orders[i],
-                      mv->distance_rms, rms);
+                      "paper, order %d: distance RMS %g, analytic %g", orders[i], mv->distance_rms,
+                      rms);
                 CHECK(fabs(mv->shadow_mae - mae) < 0.03 * mae + 0.003,
-                      "paper, order %d: shadow MAE %g, analytic %g", orders[i],
-                      mv->shadow_mae, mae);
+                      "paper, order %d: shadow MAE %g, analytic %g", orders[i], mv->shadow_mae,
+                      mae);
             }
         }
     next:
@@ -374,15 +375,14 @@ static void test_room(void)
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         const vb_eval_metrics *m = r[2].metrics[k];
         printf("room %s, 1024 rays: distance RMS order 2 %.4f, 3 %.4f, 5 %.4f (se %.4f)\n",
-               k ? "interior" : "vertices", m[0].distance_rms, m[1].distance_rms,
-               m[2].distance_rms, m[2].distance_rms_se);
+               k ? "interior" : "vertices", m[0].distance_rms, m[1].distance_rms, m[2].distance_rms,
+               m[2].distance_rms_se);
         for (int i = 0; i < 2; i++)
             CHECK(m[i + 1].distance_rms + 2 * m[i + 1].distance_rms_se <
                       m[i].distance_rms - 2 * m[i].distance_rms_se,
                   "%s: order %d RMS %g (se %g) not below order %d's %g (se %g)",
                   k ? "interior" : "vertices", orders[i + 1], m[i + 1].distance_rms,
-                  m[i + 1].distance_rms_se, orders[i], m[i].distance_rms,
-                  m[i].distance_rms_se);
+                  m[i + 1].distance_rms_se, orders[i], m[i].distance_rms, m[i].distance_rms_se);
     }
     /* Doubling the rays never raises the error beyond noise (3 combined
      * standard errors: the runs share receivers and lights, so this is
@@ -393,14 +393,12 @@ static void test_room(void)
                 const vb_eval_metrics *a = &r[i].metrics[k][o], *c = &r[i + 1].metrics[k][o];
                 double tol = 3 * hypot(a->distance_rms_se, c->distance_rms_se);
                 CHECK(c->distance_rms <= a->distance_rms + tol,
-                      "%u -> %u rays, %s order %d: distance RMS %g -> %g", rays[i],
-                      rays[i + 1], k ? "interior" : "vertices", orders[o], a->distance_rms,
-                      c->distance_rms);
+                      "%u -> %u rays, %s order %d: distance RMS %g -> %g", rays[i], rays[i + 1],
+                      k ? "interior" : "vertices", orders[o], a->distance_rms, c->distance_rms);
                 tol = 3 * hypot(a->shadow_mae_se, c->shadow_mae_se);
                 CHECK(c->shadow_mae <= a->shadow_mae + tol,
-                      "%u -> %u rays, %s order %d: shadow MAE %g -> %g", rays[i],
-                      rays[i + 1], k ? "interior" : "vertices", orders[o], a->shadow_mae,
-                      c->shadow_mae);
+                      "%u -> %u rays, %s order %d: shadow MAE %g -> %g", rays[i], rays[i + 1],
+                      k ? "interior" : "vertices", orders[o], a->shadow_mae, c->shadow_mae);
             }
     /* A closed room: the robust truth from interior points never escapes. */
     CHECK(r[0].truth[VB_EVAL_INTERIOR].escaped == 0, "%llu interior truth rays escaped",
@@ -446,12 +444,17 @@ static void test_methods(void)
     memset(mf, 0, sizeof mf);
     for (int i = 0; i < 3; i++) {
         vb_error err;
-        vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = s, .rays = 1024, .seed = 5,
-                          .method = methods[i], .threads = 2,
+        vb_bake_desc d = {.keep_normals = 1,
+                          .receivers = &rec,
+                          .scene = s,
+                          .rays = 1024,
+                          .seed = 5,
+                          .method = methods[i],
+                          .threads = 2,
                           .quantity = i ? VB_QUANTITY_LOG : VB_QUANTITY_DISTANCE,
                           .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
-        CHECK(vb_bake_run(&d, &b[i], &err) == VB_OK, "bake %s: %s",
-              vb_method_name(methods[i]), err.msg);
+        CHECK(vb_bake_run(&d, &b[i], &err) == VB_OK, "bake %s: %s", vb_method_name(methods[i]),
+              err.msg);
         if (!b[i].coeffs[5])
             goto done;
         make_file(&mf[i], &rec, s, &b[i], methods[i], VDSH_ENCODING_F16, orders, 3);
@@ -480,7 +483,8 @@ static void test_methods(void)
                           k ? "interior" : "vertices", orders[o], vb_method_name(methods[j]),
                           m[j]->shadow_mae, vb_method_name(methods[i]), m[i]->shadow_mae, tol);
                 }
-            CHECK(m[2]->false_shadow < m[1]->false_shadow && m[2]->false_shadow < m[0]->false_shadow,
+            CHECK(m[2]->false_shadow < m[1]->false_shadow &&
+                      m[2]->false_shadow < m[0]->false_shadow,
                   "%s order %d: shadow's false shadows %g not below lsq's %g and paper's %g",
                   k ? "interior" : "vertices", orders[o], m[2]->false_shadow, m[1]->false_shadow,
                   m[0]->false_shadow);
@@ -517,9 +521,9 @@ static void test_oracle_and_threads(void)
             CHECK(m->distance_rms == 0 && m->distance_p99 == 0 && m->shadow_mae == 0 &&
                       m->false_shadow == 0 && m->light_leak == 0 && m->binary_mae == 0 &&
                       m->binary_false_shadow == 0 && m->binary_light_leak == 0,
-                  "oracle %d/%d: errors %g %g %g %g %g %g %g", k, i, m->distance_rms,
-                  m->shadow_mae, m->false_shadow, m->light_leak, m->binary_mae,
-                  m->binary_false_shadow, m->binary_light_leak);
+                  "oracle %d/%d: errors %g %g %g %g %g %g %g", k, i, m->distance_rms, m->shadow_mae,
+                  m->false_shadow, m->light_leak, m->binary_mae, m->binary_false_shadow,
+                  m->binary_light_leak);
             /* Lights: P(d_T >= d_L) = P(u <= 1/2) = 0.45 / 0.95, and
              * P(s_ideal < 1/2) = P(u > 3/4) = 0.25 / 0.95. */
             double vis = (double)m->visible / m->samples, occ_ = (double)m->occluded / m->samples;
@@ -535,8 +539,8 @@ static void test_oracle_and_threads(void)
     for (uint32_t l = 0; l < oracle.light_count; l++) {
         const float *L = oracle.lights[l];
         const float cl = 0.01f * s->diagonal;
-        int inside = !(L[1] > cl && L[1] < 6.0f - cl && fabsf(L[0]) < 9.5f - cl &&
-                       fabsf(L[2]) < 9.5f - cl);
+        int inside =
+            !(L[1] > cl && L[1] < 6.0f - cl && fabsf(L[0]) < 9.5f - cl && fabsf(L[2]) < 9.5f - cl);
         /* Not inside builtin:room's pillars (0.4 m square at (+-5.5,
          * +-5.5), not at (-5.5, -5.5)) or its big crate (bake/lib/builtin.c).
          * (The clearance is checked along the 14 probes only: near a
@@ -630,8 +634,8 @@ static void test_heldout(void)
                 const float *w = e + 3 * i;
                 float len = sqrtf(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
                 float up = w[0] * n[0] + w[1] * n[1] + w[2] * n[2];
-                CHECK(fabsf(len - 1) < 1e-5f && up > -1e-6f, "direction %u: length %g, w.n %g",
-                      i, len, up);
+                CHECK(fabsf(len - 1) < 1e-5f && up > -1e-6f, "direction %u: length %g, w.n %g", i,
+                      len, up);
                 double best = 4.0;
                 for (uint32_t j = 0; j < nb; j++) {
                     const float *q = bake_dirs + 3 * j;
@@ -639,8 +643,7 @@ static void test_heldout(void)
                     double a = acos(fmin(1.0, fmax(-1.0, dot)));
                     best = a < best ? a : best;
                 }
-                CHECK(best > 1e-4, "held-out direction within %g rad of a bake direction",
-                      best);
+                CHECK(best > 1e-4, "held-out direction within %g rad of a bake direction", best);
                 mean_nearest += best;
                 count++;
             }
@@ -651,7 +654,8 @@ static void test_heldout(void)
     mean_nearest /= count;
     double spacing = sqrt(4 * M_PI / 2500);
     printf("held-out directions: mean angle to the nearest bake direction %.4f rad "
-           "(grid spacing %.4f)\n", mean_nearest, spacing);
+           "(grid spacing %.4f)\n",
+           mean_nearest, spacing);
     CHECK(mean_nearest > 0.25 * spacing, "held-out directions hug the bake's: %g", mean_nearest);
     /* Different receivers get different directions; interior ids are apart. */
     float a[3 * 64], b[3 * 64], n[3] = {0, 1, 0};
@@ -676,9 +680,8 @@ static void test_interpolation(void)
         coef[i] = (float)(20 * test_rand(&rs) - 5);
     uint16_t half[100];
     CHECK(vdsh_encode_f16(coef, 100, 8.0f, half) == VDSH_OK, "f16");
-    vdsh_stream st[2] = {
-        {.order = 5, .encoding = VDSH_ENCODING_F32, .scale = 1.0f, .data = coef},
-        {.order = 5, .encoding = VDSH_ENCODING_F16, .scale = 8.0f, .data = half}};
+    vdsh_stream st[2] = {{.order = 5, .encoding = VDSH_ENCODING_F32, .scale = 1.0f, .data = coef},
+                         {.order = 5, .encoding = VDSH_ENCODING_F16, .scale = 8.0f, .data = half}};
     vdsh_file f = {0};
     f.header.vertex_count = 4;
     f.header.triangle_count = 2;
@@ -700,8 +703,8 @@ static void test_interpolation(void)
             vdsh_stream_decode(&st[si], tri[3 * t + 1], cb);
             vdsh_stream_decode(&st[si], tri[3 * t + 2], cc);
             for (int i = 0; i < 25; i++) {
-                double want = (double)bary[0] * ca[i] + (double)bary[1] * cb[i] +
-                              (double)bary[2] * cc[i];
+                double want =
+                    (double)bary[0] * ca[i] + (double)bary[1] * cb[i] + (double)bary[2] * cc[i];
                 CHECK(fabs(got[i] - want) <= 1e-5 * (1 + fabs(want)),
                       "stream %d coefficient %d: %g, hand mix %g", si, i, got[i], want);
             }
@@ -799,8 +802,8 @@ static void test_sources(void)
 int main(int argc, char **argv)
 {
     const char *only = argc > 1 ? argv[1] : NULL;
-#define RUN(name, fn)                                                          \
-    if (!only || strcmp(only, name) == 0)                                      \
+#define RUN(name, fn)                                                                              \
+    if (!only || strcmp(only, name) == 0)                                                          \
     fn()
     RUN("heldout", test_heldout);
     RUN("interpolate", test_interpolation);

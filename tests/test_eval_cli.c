@@ -97,7 +97,8 @@ int main(int argc, char **argv)
           "--help documents the per-vertex layout");
     CHECK(run((char *[]){ev, "--version", NULL}) == 0 && test_file_contains(out_path, "vdsh-eval "),
           "--version");
-    CHECK(run((char *[]){ev, NULL}) == 2 && test_file_contains(err_path, "no .vdsh file"), "no file");
+    CHECK(run((char *[]){ev, NULL}) == 2 && test_file_contains(err_path, "no .vdsh file"),
+          "no file");
     CHECK(run((char *[]){ev, "--no-such-option", "x.vdsh", NULL}) == 2, "bad option");
     CHECK(run((char *[]){ev, "--points", "0", "x.vdsh", NULL}) == 2, "--points 0");
     CHECK(run((char *[]){ev, "--orders", "2,17", "x.vdsh", NULL}) == 2, "--orders 2,17");
@@ -108,9 +109,9 @@ int main(int argc, char **argv)
     /* Bake a box. */
     char *obj = path_in("box.obj"), *vdsh = path_in("box.vdsh"), *rep = path_in("box.bake.json");
     write_box(obj, NULL);
-    int rc = run((char *[]){bake, obj, "--max-edge", "0.5", "--rays", "256", "--method", "paper", "--orders", "2,3,5",
-                            "--record-timings", "--cube-size", "0", "-q", "--report", rep,
-                            "-o", vdsh, NULL});
+    int rc = run((char *[]){bake, obj, "--max-edge", "0.5", "--rays", "256", "--method", "paper",
+                            "--orders", "2,3,5", "--record-timings", "--cube-size", "0", "-q",
+                            "--report", rep, "-o", vdsh, NULL});
     CHECK(rc == 0, "bake: exit %d", rc);
     if (rc != 0) {
         char *e = (char *)test_read_file(err_path, NULL);
@@ -124,7 +125,8 @@ int main(int argc, char **argv)
     rc = run((char *[]){ev, vdsh, "--json", json, "--per-vertex", pv, "--interior", "1000",
                         "--threads", "2", NULL});
     CHECK(rc == 0, "eval: exit %d", rc);
-    CHECK(test_file_contains(out_path, "SHA-256 verified") && test_file_contains(out_path, "interior") &&
+    CHECK(test_file_contains(out_path, "SHA-256 verified") &&
+              test_file_contains(out_path, "interior") &&
               test_file_contains(out_path, "(time chunk)") && test_file_contains(out_path, "paper"),
           "table");
     CHECK(test_file_contains(out_path, " 0.0000% escaped"), "the truth escapes a closed box");
@@ -156,8 +158,8 @@ int main(int argc, char **argv)
                 float x[32];
                 memcpy(x, b + off + (size_t)v * F * 4, F * 4);
                 for (uint32_t i = 0; i < F; i++)
-                    if (i != 2 + 2 && i != 2 + 3 && i != 7 + 2 && i != 7 + 3 &&
-                        i != 12 + 2 && i != 12 + 3)
+                    if (i != 2 + 2 && i != 2 + 3 && i != 7 + 2 && i != 7 + 3 && i != 12 + 2 &&
+                        i != 12 + 3)
                         finite &= isfinite(x[i]) && x[i] >= 0;
             }
             CHECK(finite, "every vertex evaluated (no --points), values >= 0");
@@ -172,7 +174,8 @@ int main(int argc, char **argv)
         cJSON *j = rc == 0 ? vt_json_read_file(json, msg, sizeof msg) : NULL;
         const cJSON *st;
         int streams = 0, zero = 1;
-        cJSON_ArrayForEach(st, cJSON_GetObjectItemCaseSensitive(j, "streams")) {
+        cJSON_ArrayForEach(st, cJSON_GetObjectItemCaseSensitive(j, "streams"))
+        {
             streams++;
             zero &= vt_json_number(cJSON_GetObjectItemCaseSensitive(st, "vertices"),
                                    "shadow_mae") == 0.0 &&
@@ -198,7 +201,8 @@ int main(int argc, char **argv)
         double rec[4], fa[4], mae[4], off[4];
         int n = 0;
         const cJSON *st;
-        cJSON_ArrayForEach(st, cJSON_GetObjectItemCaseSensitive(j, "streams")) {
+        cJSON_ArrayForEach(st, cJSON_GetObjectItemCaseSensitive(j, "streams"))
+        {
             if (n < 4) {
                 const cJSON *sl = cJSON_GetObjectItemCaseSensitive(
                     cJSON_GetObjectItemCaseSensitive(st, "scene_lights"), "interior");
@@ -209,12 +213,12 @@ int main(int argc, char **argv)
             }
             n++;
         }
-        CHECK(rc == 0 && n == 4 && vt_json_number(cJSON_GetObjectItemCaseSensitive(j, "eval"),
-                                                  "scene_lights") == 16,
+        CHECK(rc == 0 && n == 4 &&
+                  vt_json_number(cJSON_GetObjectItemCaseSensitive(j, "eval"), "scene_lights") == 16,
               "--offsets: %d streams (rc %d)", n, rc);
         if (n == 4) {
-            CHECK(off[0] == 0 && off[1] == -0.5 && off[2] == 0 && off[3] == 0.5, "offsets %g %g %g %g",
-                  off[0], off[1], off[2], off[3]);
+            CHECK(off[0] == 0 && off[1] == -0.5 && off[2] == 0 && off[3] == 0.5,
+                  "offsets %g %g %g %g", off[0], off[1], off[2], off[3]);
             CHECK(rec[1] >= rec[0] && rec[0] >= rec[3] && fa[1] >= fa[0] && fa[0] >= fa[3] &&
                       rec[1] > rec[3] && fa[1] > fa[3],
                   "recall %g %g %g and false shadows %g %g %g must fall with the offset", rec[1],
@@ -225,7 +229,8 @@ int main(int argc, char **argv)
         }
         cJSON_Delete(j);
     }
-    CHECK(run((char *[]){ev, vdsh, "--offsets", "9", NULL}) == 2 && test_file_contains(err_path, "--offsets"),
+    CHECK(run((char *[]){ev, vdsh, "--offsets", "9", NULL}) == 2 &&
+              test_file_contains(err_path, "--offsets"),
           "--offsets 9 refused");
     CHECK(run((char *[]){ev, vdsh, "--offsets", "0.1,0.2,0.3,0.4,0.5", NULL}) == 2 &&
               test_file_contains(err_path, "streams"),
@@ -233,9 +238,9 @@ int main(int argc, char **argv)
     CHECK(run((char *[]){ev, vdsh, "--lights", "0", NULL}) == 2, "--lights 0 refused");
 
     /* Bake time from the bake's report. */
-    rc = run((char *[]){ev, vdsh, "--bake-report", rep, "--interior", "0", "--orders", "5",
-                        NULL});
-    CHECK(rc == 0 && test_file_contains(out_path, "(bake report)") && !test_file_contains(out_path, "order 2 "),
+    rc = run((char *[]){ev, vdsh, "--bake-report", rep, "--interior", "0", "--orders", "5", NULL});
+    CHECK(rc == 0 && test_file_contains(out_path, "(bake report)") &&
+              !test_file_contains(out_path, "order 2 "),
           "--bake-report, --orders");
 
     /* The mesh changes: named; --allow-mismatch goes on with a warning; the
@@ -250,8 +255,8 @@ int main(int argc, char **argv)
     CHECK(rc == 0, "the source under another name: exit %d", rc);
     write_box(obj, "# changed\n");
     rc = run((char *[]){ev, vdsh, NULL});
-    CHECK(rc == 1 && test_file_contains(err_path, "source 1 of 1") && test_file_contains(err_path, "box.obj") &&
-              test_file_contains(err_path, "SHA-256"),
+    CHECK(rc == 1 && test_file_contains(err_path, "source 1 of 1") &&
+              test_file_contains(err_path, "box.obj") && test_file_contains(err_path, "SHA-256"),
           "a changed source is named (exit %d)", rc);
     rc = run((char *[]){ev, vdsh, "--allow-mismatch", "--interior", "100", NULL});
     CHECK(rc == 0 && test_file_contains(err_path, "warning"), "--allow-mismatch (exit %d)", rc);

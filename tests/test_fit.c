@@ -19,9 +19,9 @@ static void rand_rotation(uint64_t *s, double R[9])
         q[i] = 2 * test_rand(s) - 1, len += q[i] * q[i];
     len = sqrt(len);
     double w = q[0] / len, x = q[1] / len, y = q[2] / len, z = q[3] / len;
-    double m[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-                   2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                   2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)};
+    double m[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+                   2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                   2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
     memcpy(R, m, sizeof m);
 }
 
@@ -102,8 +102,8 @@ static void test_factored_fit(void)
                     b[i] = 2 * test_rand(&s) - 1;
                 float t3[3], b3[3], c[VB_FIT_MAX], ct[VB_FIT_MAX];
                 vb_frame(nrm, t3, b3);
-                const double R[9] = {t3[0], b3[0], nrm[0], t3[1], b3[1], nrm[1],
-                                     t3[2], b3[2], nrm[2]};
+                const double R[9] = {t3[0],  b3[0], nrm[0], t3[1], b3[1],
+                                     nrm[1], t3[2], b3[2],  nrm[2]};
                 vb_sh_rotation(f, R, S);
                 for (int i = 0; i < n; i++) { /* v = S^T b */
                     v[i] = 0;
@@ -145,8 +145,7 @@ static void test_high_rotation(void)
     uint64_t s = 7;
     vb_fit *f = malloc(sizeof *f);
     double *S = malloc(sizeof(double) * VB_FIT_MAX * VB_FIT_MAX);
-    CHECK(f && S && vb_fit_create(VDSH_MAX_ORDER, VB_FIT_IDENTITY, 0, f, &err) == VB_OK,
-          "fit");
+    CHECK(f && S && vb_fit_create(VDSH_MAX_ORDER, VB_FIT_IDENTITY, 0, f, &err) == VB_OK, "fit");
     if (!f || !S) {
         free(f);
         free(S);
@@ -201,8 +200,8 @@ static void test_lsq_recovers(void)
     for (int order = 2; order <= 5; order++) {
         vb_fit f;
         float lambda = order == 5 ? 1e-4f : 0.0f;
-        CHECK(vb_fit_create(order, VB_FIT_LSQ, lambda, &f, &err) == VB_OK, "lsq %d: %s",
-              order, err.msg);
+        CHECK(vb_fit_create(order, VB_FIT_LSQ, lambda, &f, &err) == VB_OK, "lsq %d: %s", order,
+              err.msg);
         int n = order * order;
         uint64_t s = 10 + order;
         double c[25] = {0};
@@ -274,7 +273,8 @@ static void test_mirror_and_paper(void)
                 d[k] = (float)(lx * t[k] + ly * bt[k] + z * nrm[k]);
             float y[25];
             vdsh_sh_eval(5, d, y);
-            double fv = 1.0 + 0.5 * lx * ly + 0.3 * z * z + 0.2 * lx, w = 2 * M_PI / ((double)NZ * NP);
+            double fv = 1.0 + 0.5 * lx * ly + 0.3 * z * z + 0.2 * lx,
+                   w = 2 * M_PI / ((double)NZ * NP);
             for (int i = 0; i < 25; i++)
                 b[i] += w * fv * y[i];
         }
@@ -325,11 +325,12 @@ static void test_window(void)
                 int l = i < 1 ? 0 : i < 4 ? 1 : i < 9 ? 2 : i < 16 ? 3 : 4;
                 double w = vb_window_weight(win, l, 5);
                 CHECK(fabs(c[i] - w * a[i]) < 1e-5 * (1 + fabs(a[i])),
-                      "method %u window %u coefficient %d: %g vs %g x %g", method, win, i, c[i],
-                      w, a[i]);
+                      "method %u window %u coefficient %d: %g vs %g x %g", method, win, i, c[i], w,
+                      a[i]);
             }
         }
-    CHECK(vb_window_weight(VDSH_WINDOW_HANN, 0, 3) == 1 && vb_window_weight(VDSH_WINDOW_LANCZOS, 0, 3) == 1,
+    CHECK(vb_window_weight(VDSH_WINDOW_HANN, 0, 3) == 1 &&
+              vb_window_weight(VDSH_WINDOW_LANCZOS, 0, 3) == 1,
           "band 0 untouched");
     CHECK(fabs(vb_window_weight(VDSH_WINDOW_HANN, 2, 4) - 0.5) < 1e-12, "Hann at half width");
 }
@@ -338,11 +339,11 @@ static void test_errors(void)
 {
     vb_fit f;
     vb_error err;
-    CHECK(vb_fit_create(VDSH_MAX_ORDER + 1, VB_FIT_LSQ, 0, &f, &err) == VB_ERR_ARGUMENT, "order 17");
+    CHECK(vb_fit_create(VDSH_MAX_ORDER + 1, VB_FIT_LSQ, 0, &f, &err) == VB_ERR_ARGUMENT,
+          "order 17");
     CHECK(vb_fit_create(3, VB_FIT_LSQ, -1, &f, &err) == VB_ERR_ARGUMENT, "lambda < 0");
     CHECK(vb_fit_create(3, (vb_fit_base)99, 0, &f, &err) == VB_ERR_ARGUMENT, "unknown base fit");
 }
-
 
 /* method.h's table: one row per known method, found by value and by name,
  * each refused quantity explained, its parameters consistent. */

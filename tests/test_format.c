@@ -31,29 +31,26 @@
 static int failures;
 static int checks;
 
-#define CHECK(c)                                                              \
-    do {                                                                      \
-        checks++;                                                             \
-        if (!(c)) {                                                           \
-            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__,  \
-                    #c);                                                      \
-            failures++;                                                       \
-        }                                                                     \
+#define CHECK(c)                                                                                   \
+    do {                                                                                           \
+        checks++;                                                                                  \
+        if (!(c)) {                                                                                \
+            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #c);                  \
+            failures++;                                                                            \
+        }                                                                                          \
     } while (0)
 
 /* Expect result `want` from `expr`; print the message when it differs. */
-#define CHECK_RES(expr, want, err)                                            \
-    do {                                                                      \
-        vdsh_result got_ = (expr);                                            \
-        checks++;                                                             \
-        if (got_ != (want)) {                                                 \
-            fprintf(stderr, "%s:%d: %s gave %d (%s), want %d (%s): %s\n",     \
-                    __FILE__, __LINE__, #expr, (int)got_,                     \
-                    vdsh_result_str(got_), (int)(want),                       \
-                    vdsh_result_str(want),                                    \
-                    got_ != VDSH_OK ? (err)->msg : "");                       \
-            failures++;                                                       \
-        }                                                                     \
+#define CHECK_RES(expr, want, err)                                                                 \
+    do {                                                                                           \
+        vdsh_result got_ = (expr);                                                                 \
+        checks++;                                                                                  \
+        if (got_ != (want)) {                                                                      \
+            fprintf(stderr, "%s:%d: %s gave %d (%s), want %d (%s): %s\n", __FILE__, __LINE__,      \
+                    #expr, (int)got_, vdsh_result_str(got_), (int)(want), vdsh_result_str(want),   \
+                    got_ != VDSH_OK ? (err)->msg : "");                                            \
+            failures++;                                                                            \
+        }                                                                                          \
     } while (0)
 
 static double now_s(void)
@@ -93,8 +90,7 @@ static float float_of(uint32_t u)
 /* Test-side little-endian access, independent of the library's. */
 static uint32_t rd32(const uint8_t *p)
 {
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 |
-           (uint32_t)p[3] << 24;
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
 }
 static uint64_t rd64(const uint8_t *p)
 {
@@ -110,7 +106,10 @@ static void wr64(uint8_t *p, uint64_t v)
     wr32(p, (uint32_t)v);
     wr32(p + 4, (uint32_t)(v >> 32));
 }
-static void wrf32(uint8_t *p, float f) { wr32(p, bits_of(f)); }
+static void wrf32(uint8_t *p, float f)
+{
+    wr32(p, bits_of(f));
+}
 
 /* ------------------------------------------------------------------ */
 /* Temporary directory                                                 */
@@ -203,9 +202,8 @@ static void random_unit(float *n)
     n[0] = (float)(x / l), n[1] = (float)(y / l), n[2] = (float)(z / l);
 }
 
-static void add_stream(sample *s, uint32_t order, uint32_t enc, uint32_t q,
-                       uint32_t method, uint32_t window, float wp, float mp,
-                       float scale)
+static void add_stream(sample *s, uint32_t order, uint32_t enc, uint32_t q, uint32_t method,
+                       uint32_t window, float wp, float mp, float scale)
 {
     uint32_t i = s->f.stream_count++;
     uint32_t v = s->f.header.vertex_count;
@@ -242,11 +240,11 @@ static void add_stream(sample *s, uint32_t order, uint32_t enc, uint32_t q,
         uint8_t *b = (uint8_t *)(t + VDSH_MAX_COEFFS);
         for (uint32_t k = 0; k < nc; k++)
             t[k] = rndf(0.0f, 20.0f);
-        t[0] = 0.0f;               /* an all-zero index */
+        t[0] = 0.0f; /* an all-zero index */
         if (nc > 1)
-            t[1] = 3.4e38f;        /* huge: |stored| <= 127 keeps it finite */
+            t[1] = 3.4e38f; /* huge: |stored| <= 127 keeps it finite */
         if (nc > 2)
-            t[2] = float_of(1);    /* subnormal */
+            t[2] = float_of(1); /* subnormal */
         if (enc == VDSH_ENCODING_S8) {
             for (size_t k = 0; k < n; k++)
                 b[k] = (uint8_t)(int8_t)((int)(rnd() % 255u) - 127);
@@ -313,8 +311,7 @@ static void sample_init(sample *s, int kind, uint32_t v)
     h->occluder_vertex_count = 1200;
     h->occluder_triangle_count = 2400;
     h->trace_flags = VDSH_TRACE_ROBUST;
-    h->bounds_min[0] = -9.5f, h->bounds_min[1] = 0.0f,
-    h->bounds_min[2] = -9.5f;
+    h->bounds_min[0] = -9.5f, h->bounds_min[1] = 0.0f, h->bounds_min[2] = -9.5f;
     h->bounds_max[0] = 9.5f, h->bounds_max[1] = 6.0f, h->bounds_max[2] = 9.5f;
 
     s->pos = malloc((size_t)v * 12);
@@ -326,7 +323,7 @@ static void sample_init(sample *s, int kind, uint32_t v)
         random_unit(s->nrm + 3 * i);
     }
     s->pos[0] = -0.0f;
-    s->pos[1] = float_of(3); /* subnormal */
+    s->pos[1] = float_of(3);                              /* subnormal */
     s->nrm[3] = 0.0f, s->nrm[4] = 0.0f, s->nrm[5] = 0.0f; /* undefined */
     if (v > 2)
         s->nrm[6] = -0.0f, s->nrm[7] = 0.0f, s->nrm[8] = 0.0f;
@@ -340,10 +337,10 @@ static void sample_init(sample *s, int kind, uint32_t v)
     s->f.sources = s->sources;
 
     if (kind == 0) {
-        add_stream(s, 2, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE,
-                   VDSH_METHOD_PAPER, VDSH_WINDOW_NONE, 0, 0, 1);
-        add_stream(s, 1, VDSH_ENCODING_F16, VDSH_QUANTITY_LOG_DISTANCE,
-                   VDSH_METHOD_FULL, VDSH_WINDOW_HANN, 2.5f, 0.01f, 15);
+        add_stream(s, 2, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_PAPER,
+                   VDSH_WINDOW_NONE, 0, 0, 1);
+        add_stream(s, 1, VDSH_ENCODING_F16, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_FULL,
+                   VDSH_WINDOW_HANN, 2.5f, 0.01f, 15);
         s->sources[0].name = "a.obj";
     } else if (kind == 1) {
         /* order, encoding, quantity, method, window, its parameter,
@@ -352,33 +349,42 @@ static void sample_init(sample *s, int kind, uint32_t v)
             uint32_t order, enc, q, method, window;
             float wp, mp, scale;
         } streams[] = {
-            {5, VDSH_ENCODING_F16, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_PAPER, VDSH_WINDOW_HANN, 2.5f, 0, 15},
-            {3, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_FULL, VDSH_WINDOW_NONE, 0, 0, 1},
-            {2, VDSH_ENCODING_F16, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_PAPER, VDSH_WINDOW_LANCZOS, 1.0f,
-             0.01f, 0.5f},
-            {1, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE2, VDSH_METHOD_FULL, VDSH_WINDOW_NONE, 0, 0, 3},
-            {5, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE2, VDSH_METHOD_PAPER, VDSH_WINDOW_NONE, 0, -1.5f, 1},
-            {4, VDSH_ENCODING_S8, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_LSQ, VDSH_WINDOW_NONE, 0, 0, 1},
-            {3, VDSH_ENCODING_S8, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1},
-            {5, VDSH_ENCODING_S8S6, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1},
-            {4, VDSH_ENCODING_S8S6, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE, 0, 0.8f, 1},
+            {5, VDSH_ENCODING_F16, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_PAPER, VDSH_WINDOW_HANN,
+             2.5f, 0, 15},
+            {3, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_FULL, VDSH_WINDOW_NONE, 0, 0,
+             1},
+            {2, VDSH_ENCODING_F16, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_PAPER,
+             VDSH_WINDOW_LANCZOS, 1.0f, 0.01f, 0.5f},
+            {1, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE2, VDSH_METHOD_FULL, VDSH_WINDOW_NONE, 0,
+             0, 3},
+            {5, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE2, VDSH_METHOD_PAPER, VDSH_WINDOW_NONE, 0,
+             -1.5f, 1},
+            {4, VDSH_ENCODING_S8, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_LSQ, VDSH_WINDOW_NONE, 0, 0,
+             1},
+            {3, VDSH_ENCODING_S8, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_SHADOW, VDSH_WINDOW_NONE,
+             0, 0.8f, 1},
+            {5, VDSH_ENCODING_S8S6, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_SHADOW,
+             VDSH_WINDOW_NONE, 0, 0.8f, 1},
+            {4, VDSH_ENCODING_S8S6, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_SHADOW,
+             VDSH_WINDOW_NONE, 0, 0.8f, 1},
         };
         for (size_t i = 0; i < sizeof streams / sizeof streams[0]; i++)
-            add_stream(s, streams[i].order, streams[i].enc, streams[i].q, streams[i].method, streams[i].window,
-                       streams[i].wp, streams[i].mp, streams[i].scale);
+            add_stream(s, streams[i].order, streams[i].enc, streams[i].q, streams[i].method,
+                       streams[i].window, streams[i].wp, streams[i].mp, streams[i].scale);
         s->long_name = malloc(VDSH_MAX_NAME + 1);
         memset(s->long_name, 'n', VDSH_MAX_NAME);
         s->long_name[VDSH_MAX_NAME] = 0;
-        s->sources[0].name = "builtin:room";          /* 12: no padding */
-        s->sources[1].name = "x";                     /* 1 */
-        s->sources[2].name = "scenes/\xc3\xbc" "bung/\xe2\x82\xac.obj";
-        s->sources[3].name = "ab";                    /* 2 */
-        s->sources[4].name = "abc";                   /* 3 */
+        s->sources[0].name = "builtin:room"; /* 12: no padding */
+        s->sources[1].name = "x";            /* 1 */
+        s->sources[2].name = "scenes/\xc3\xbc"
+                             "bung/\xe2\x82\xac.obj";
+        s->sources[3].name = "ab";  /* 2 */
+        s->sources[4].name = "abc"; /* 3 */
         s->sources[5].name = s->long_name;
         s->f.source_count = 6;
     } else {
-        add_stream(s, 5, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE,
-                   VDSH_METHOD_PAPER, VDSH_WINDOW_NONE, 0, 0, 1);
+        add_stream(s, 5, VDSH_ENCODING_F32, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_PAPER,
+                   VDSH_WINDOW_NONE, 0, 0, 1);
         s->sources[0].name = "big";
     }
     if (kind != 1)
@@ -405,9 +411,13 @@ static void sample_init(sample *s, int kind, uint32_t v)
         s->f.timings.total = 353.2;
         s->f.timings.threads = 2;
         s->f.has_adaptive = kind == 1;
-        s->f.adaptive = (vdsh_adaptive){.tolerance = 0.08f, .min_edge = 0.1f,
-                                        .max_receivers = 0, .lights = 32, .max_rounds = 8,
-                                        .start_receivers = 1, .rounds = 8,
+        s->f.adaptive = (vdsh_adaptive){.tolerance = 0.08f,
+                                        .min_edge = 0.1f,
+                                        .max_receivers = 0,
+                                        .lights = 32,
+                                        .max_rounds = 8,
+                                        .start_receivers = 1,
+                                        .rounds = 8,
                                         .candidates = 100000};
     }
 }
@@ -422,7 +432,10 @@ static void sample_free(sample *s)
     free(s->long_name);
 }
 
-static int same_f32(float a, float b) { return bits_of(a) == bits_of(b); }
+static int same_f32(float a, float b)
+{
+    return bits_of(a) == bits_of(b);
+}
 
 /* Every field and every array of `got` against what was written. */
 static void check_same_file(const vdsh_file *got, const vdsh_file *want)
@@ -455,16 +468,13 @@ static void check_same_file(const vdsh_file *got, const vdsh_file *want)
     CHECK((uintptr_t)got->indices % 16 == 0);
 
     CHECK(got->source_count == want->source_count);
-    for (uint32_t i = 0; i < got->source_count && i < want->source_count;
-         i++) {
+    for (uint32_t i = 0; i < got->source_count && i < want->source_count; i++) {
         CHECK(strcmp(got->sources[i].name, want->sources[i].name) == 0);
         CHECK(got->sources[i].size == want->sources[i].size);
-        CHECK(memcmp(got->sources[i].sha256, want->sources[i].sha256, 32) ==
-              0);
+        CHECK(memcmp(got->sources[i].sha256, want->sources[i].sha256, 32) == 0);
     }
     CHECK(got->stream_count == want->stream_count);
-    for (uint32_t i = 0; i < got->stream_count && i < want->stream_count;
-         i++) {
+    for (uint32_t i = 0; i < got->stream_count && i < want->stream_count; i++) {
         const vdsh_stream *x = &got->streams[i], *y = &want->streams[i];
         CHECK(x->order == y->order);
         CHECK(x->encoding == y->encoding);
@@ -475,28 +485,25 @@ static void check_same_file(const vdsh_file *got, const vdsh_file *want)
         CHECK(same_f32(x->method_param, y->method_param));
         CHECK(same_f32(x->scale, y->scale));
         CHECK((uintptr_t)x->data % 16 == 0);
-        CHECK(vdsh_stream_bytes_per_vertex(x) ==
-              (size_t)y->order * y->order *
-                  (y->encoding == VDSH_ENCODING_F16 ? 2
-                   : y->encoding == VDSH_ENCODING_S8 ? 1 : 4) ||
+        CHECK(vdsh_stream_bytes_per_vertex(x) == (size_t)y->order * y->order *
+                                                     (y->encoding == VDSH_ENCODING_F16  ? 2
+                                                      : y->encoding == VDSH_ENCODING_S8 ? 1
+                                                                                        : 4) ||
               (y->encoding == VDSH_ENCODING_S8S6 &&
-               vdsh_stream_bytes_per_vertex(x) ==
-                   (size_t[]){0, 1, 4, 8, 16, 24}[y->order]));
+               vdsh_stream_bytes_per_vertex(x) == (size_t[]){0, 1, 4, 8, 16, 24}[y->order]));
         CHECK(!x->coef_scales == !vdsh_encoding_quantised(y->encoding));
         if (x->coef_scales && y->coef_scales) {
             CHECK((uintptr_t)x->coef_scales % 16 == 0);
             CHECK(memcmp(x->coef_scales, y->coef_scales,
                          (size_t)y->order * y->order * sizeof(float)) == 0);
         }
-        CHECK(memcmp(x->data, y->data, v * vdsh_stream_bytes_per_vertex(y)) ==
-              0);
+        CHECK(memcmp(x->data, y->data, v * vdsh_stream_bytes_per_vertex(y)) == 0);
     }
     CHECK(!!got->has_stats == !!want->has_stats);
     if (want->has_stats) {
         CHECK(got->stats.rays_traced == want->stats.rays_traced);
         CHECK(got->stats.rays_missed == want->stats.rays_missed);
-        CHECK(got->stats.degenerate_receivers ==
-              want->stats.degenerate_receivers);
+        CHECK(got->stats.degenerate_receivers == want->stats.degenerate_receivers);
         CHECK(got->stats.undefined_normals == want->stats.undefined_normals);
         CHECK(got->stats.moved_origins == want->stats.moved_origins);
         CHECK(got->stats.flipped_normals == want->stats.flipped_normals);
@@ -561,8 +568,7 @@ static int tf_find(const tfile *t, const char *id, int nth)
     return -1;
 }
 
-static void tf_insert(tfile *t, int at, const char *id, const void *p,
-                      size_t n)
+static void tf_insert(tfile *t, int at, const char *id, const void *p, size_t n)
 {
     memmove(&t->c[at + 1], &t->c[at], (size_t)(t->n - at) * sizeof(tchunk));
     t->n++;
@@ -576,13 +582,11 @@ static void tf_insert(tfile *t, int at, const char *id, const void *p,
 static void tf_remove(tfile *t, int at)
 {
     free(t->c[at].data);
-    memmove(&t->c[at], &t->c[at + 1], (size_t)(t->n - at - 1) *
-                                          sizeof(tchunk));
+    memmove(&t->c[at], &t->c[at + 1], (size_t)(t->n - at - 1) * sizeof(tchunk));
     t->n--;
 }
 
-static uint32_t chunk_crc(const uint8_t *hdr, const uint8_t *payload,
-                          size_t padded)
+static uint32_t chunk_crc(const uint8_t *hdr, const uint8_t *payload, size_t padded)
 {
     uint32_t crc = vdsh_crc32(0, hdr, 4);
     crc = vdsh_crc32(crc, hdr + 8, 8);
@@ -596,8 +600,7 @@ static uint8_t *tf_build(const tfile *t, size_t *size)
     for (int i = 0; i < t->n; i++)
         total += 16 + ((t->c[i].size + 15) & ~(size_t)15);
     uint8_t *d = calloc(1, total);
-    static const uint8_t magic[8] = {0x56, 0x44, 0x53, 0x48,
-                                     0x0D, 0x0A, 0x1A, 0x0A};
+    static const uint8_t magic[8] = {0x56, 0x44, 0x53, 0x48, 0x0D, 0x0A, 0x1A, 0x0A};
     memcpy(d, magic, 8);
     wr32(d + 8, 1);
     wr32(d + 12, (uint32_t)t->n);
@@ -637,8 +640,7 @@ static void fix_crcs(uint8_t *d, size_t size)
 }
 
 /* Offset of the payload of the nth chunk with this id, or 0. */
-static size_t payload_of(const uint8_t *d, size_t size, const char *id,
-                         int nth)
+static size_t payload_of(const uint8_t *d, size_t size, const char *id, int nth)
 {
     size_t off = 32;
     while (off + 16 <= size) {
@@ -701,8 +703,7 @@ static void test_crc(void)
     uint32_t whole = vdsh_crc32(0, buf, sizeof buf);
     bad = 0;
     for (size_t k = 0; k <= sizeof buf; k++)
-        bad += vdsh_crc32(vdsh_crc32(0, buf, k), buf + k, sizeof buf - k) !=
-               whole;
+        bad += vdsh_crc32(vdsh_crc32(0, buf, k), buf + k, sizeof buf - k) != whole;
     CHECK(bad == 0);
 }
 
@@ -733,14 +734,12 @@ static void test_f16(void)
             uint16_t back = vdsh_f16_from_f32(f);
             /* NaN stays NaN, keeps its sign and payload, becomes quiet. */
             bad_nan += !isnan(f) ||
-                       bits_of(f) != ((h & 0x8000u) << 16 | 0x7f800000u |
-                                      (h & 1023u) << 13) ||
+                       bits_of(f) != ((h & 0x8000u) << 16 | 0x7f800000u | (h & 1023u) << 13) ||
                        back != (h | 0x0200u);
             continue;
         }
         double want = half_value((uint16_t)h);
-        bad_decode += !same_f32(f, (float)want) ||
-                      !!signbit(f) != !!(h & 0x8000);
+        bad_decode += !same_f32(f, (float)want) || !!signbit(f) != !!(h & 0x8000);
         bad_roundtrip += vdsh_f16_from_f32(f) != h;
     }
     CHECK(nan_count == 2046);
@@ -762,10 +761,8 @@ static void test_f16(void)
             float s = sgn ? -1.0f : 1.0f;
             uint16_t sb = sgn ? 0x8000 : 0;
             bad_round += vdsh_f16_from_f32(s * mid) != (even | sb);
-            bad_round += vdsh_f16_from_f32(s * nextafterf(mid, (float)a)) !=
-                         (h | sb);
-            bad_round += vdsh_f16_from_f32(s * nextafterf(mid, (float)b)) !=
-                         ((h + 1) | sb);
+            bad_round += vdsh_f16_from_f32(s * nextafterf(mid, (float)a)) != (h | sb);
+            bad_round += vdsh_f16_from_f32(s * nextafterf(mid, (float)b)) != ((h + 1) | sb);
         }
     }
     CHECK(bad_round == 0);
@@ -781,8 +778,7 @@ static void test_f16(void)
     CHECK(vdsh_f16_from_f32(-3.4e38f) == 0xfc00);
     CHECK(vdsh_f16_from_f32(INFINITY) == 0x7c00);
     CHECK(vdsh_f16_from_f32(-INFINITY) == 0xfc00);
-    CHECK((vdsh_f16_from_f32(NAN) & 0x7c00) == 0x7c00 &&
-          (vdsh_f16_from_f32(NAN) & 0x3ff) != 0);
+    CHECK((vdsh_f16_from_f32(NAN) & 0x7c00) == 0x7c00 && (vdsh_f16_from_f32(NAN) & 0x3ff) != 0);
     CHECK(vdsh_f16_from_f32(0x1p-14f) == 0x0400);
     CHECK(vdsh_f16_from_f32(0x1p-24f) == 0x0001);
     CHECK(vdsh_f16_from_f32(0x1p-25f) == 0x0000);
@@ -790,7 +786,7 @@ static void test_f16(void)
     CHECK(vdsh_f16_from_f32(0x3p-25f) == 0x0002);
     CHECK(vdsh_f16_from_f32(0x1.ffcp-15f) == 0x0400); /* 1023.5 units: even */
     CHECK(vdsh_f16_from_f32(-0.0f) == 0x8000);
-    CHECK(vdsh_f16_from_f32(float_of(1)) == 0x0000);  /* float subnormals */
+    CHECK(vdsh_f16_from_f32(float_of(1)) == 0x0000); /* float subnormals */
     CHECK(vdsh_f16_from_f32(-float_of(0x7fffff)) == 0x8000);
     CHECK(vdsh_f16_from_f32(1.0009765625f) == 0x3c01);
     CHECK(vdsh_f16_from_f32(1.00048828125f) == 0x3c00); /* tie to even */
@@ -833,8 +829,7 @@ static int exhaustive_f16(void)
         double v = (double)vdsh_f32_from_f16(got);
         bad += fabs(v) != want || !!signbit(v) != !!signbit(f);
     }
-    printf("exhaustive f32 -> f16: %llu mismatches in 2^32 floats\n",
-           (unsigned long long)bad);
+    printf("exhaustive f32 -> f16: %llu mismatches in 2^32 floats\n", (unsigned long long)bad);
     return bad == 0;
 }
 
@@ -842,8 +837,7 @@ static void test_encode(void)
 {
     float src[6] = {0.0f, 1.5f, -15.0f, 30.0f, 1e-3f, 65504.0f * 15};
     uint16_t dst[6];
-    CHECK_RES(vdsh_encode_f16(src, 6, 15.0f, dst), VDSH_OK,
-              &(vdsh_error){""});
+    CHECK_RES(vdsh_encode_f16(src, 6, 15.0f, dst), VDSH_OK, &(vdsh_error){""});
     CHECK(dst[1] == vdsh_f16_from_f32(0.1f));
     CHECK(dst[2] == 0xbc00 && dst[3] == 0x4000);
     CHECK(dst[5] == 0x7bff);
@@ -883,8 +877,8 @@ static void check_s8_roundtrip(const float *src, size_t v, uint32_t nc, const ch
         float dec = (float)b[k] * step;
         /* half a step, the step's own rounding (127 of them), and the
          * precision a subnormal step lacks */
-        float tol = 0.5f * step * (1.0f + 1e-6f) + 127.0f * fabsf(step) * 1e-7f +
-                    128.0f * float_of(1);
+        float tol =
+            0.5f * step * (1.0f + 1e-6f) + 127.0f * fabsf(step) * 1e-7f + 128.0f * float_of(1);
         bad += b[k] == -128 || !isfinite(dec) || fabsf(dec - src[k]) > tol ||
                (src[k] == 0.0f && b[k] != 0) || (sc == 0.0f && b[k] != 0);
         if (sc > 0.0f && fabsf(src[k]) == sc)
@@ -910,8 +904,8 @@ static void check_quant_roundtrip(uint32_t enc, const float *src25, size_t v, ui
         memcpy(src + k * nc, src25 + k * 25, nc * sizeof *src);
     float scales[VDSH_MAX_COEFFS];
     uint8_t *b = malloc(v * vdsh_encoding_bytes(enc, nc) + 1);
-    vdsh_stream st = {.order = order, .encoding = enc, .scale = 1.0f, .data = b,
-                      .coef_scales = scales};
+    vdsh_stream st = {
+        .order = order, .encoding = enc, .scale = 1.0f, .data = b, .coef_scales = scales};
     long bad = 0;
     checks++;
     if (vdsh_encode_quantised(enc, src, v, nc, scales, b) != VDSH_OK) {
@@ -924,8 +918,8 @@ static void check_quant_roundtrip(uint32_t enc, const float *src25, size_t v, ui
                 float step = vdsh_quant_step(scales[i], levels), c = src[k * nc + i];
                 float tol = 0.5f * step * (1.0f + 1e-6f) + (float)levels * step * 1e-7f +
                             128.0f * float_of(1);
-                bad += !isfinite(out[i]) || fabsf(out[i] - c) > tol ||
-                       (c == 0.0f && out[i] != 0.0f);
+                bad +=
+                    !isfinite(out[i]) || fabsf(out[i] - c) > tol || (c == 0.0f && out[i] != 0.0f);
                 if (scales[i] > 0.0f && fabsf(c) == scales[i])
                     bad += out[i] != (c > 0.0f ? 1.0f : -1.0f) * (float)levels * step;
             }
@@ -957,7 +951,7 @@ static void test_encode_s8(void)
         float u = rndf(-1.0f, 1.0f);
         switch (k % NC) {
         case 0: c[k] = u * 3.4e38f; break;
-        case 1: c[k] = u * 1e-40f; break;     /* subnormal */
+        case 1: c[k] = u * 1e-40f; break;      /* subnormal */
         case 2: c[k] = u * float_of(3); break; /* a few ulps of 0 */
         case 3: c[k] = 0.0f; break;
         case 4: c[k] = u * 1e30f; break;
@@ -974,7 +968,7 @@ static void test_encode_s8(void)
     }
     /* s8s6 rounds bands 2+ to 31 levels: at scale 31, step 1 */
     {
-        float r6[9 * 2] = {0, 0, 0, 0, 30.5f, 2.5f, -2.5f, 0.49f, -0.51f,
+        float r6[9 * 2] = {0, 0, 0, 0, 30.5f, 2.5f,  -2.5f, 0.49f, -0.51f,
                            0, 0, 0, 0, 31.0f, 31.0f, 31.0f, 31.0f, -31.0f};
         uint8_t p6[16];
         CHECK(vdsh_encode_quantised(VDSH_ENCODING_S8S6, r6, 2, 9, sc, p6) == VDSH_OK &&
@@ -990,10 +984,9 @@ static void test_encode_s8(void)
      * (huge past a subnormal scale too), the drawn rows' bytes are theirs
      * alone, and an undrawn row must still be finite */
     {
-        float q[9 * 3] = {1, -2, 0.5f, 1e-40f, 3, -31, 4, 0, 2,
-                          -3e38f, 7, -5, 3e38f, 1e30f, 62, -62, 0, -1,
-                          -4, 1, -1, 0, -6, 31, 2, 0.5f, -2},
-              d[9 * 2], sq[9], sd[9];
+        float q[9 * 3] = {1,  -2,  0.5f, 1e-40f, 3,  -31, 4,  0, 2,  -3e38f, 7, -5,   3e38f, 1e30f,
+                          62, -62, 0,    -1,     -4, 1,   -1, 0, -6, 31,     2, 0.5f, -2},
+                    d[9 * 2], sq[9], sd[9];
         memcpy(d, q, sizeof d[0] * 9);
         memcpy(d + 9, q + 18, sizeof d[0] * 9);
         const uint8_t drawn[3] = {1, 0, 1};
@@ -1007,13 +1000,14 @@ static void test_encode_s8(void)
                   sq[4] == 6.0f);
             CHECK(memcmp(pq, pd, bpv) == 0 && memcmp(pq + 2 * bpv, pd + bpv, bpv) == 0);
             float row[9];
-            vdsh_stream st = {.order = 3, .encoding = enc, .scale = 1.0f, .coef_scales = sq,
-                              .data = pq};
+            vdsh_stream st = {
+                .order = 3, .encoding = enc, .scale = 1.0f, .coef_scales = sq, .data = pq};
             vdsh_stream_decode(&st, 1, row);
             for (int i = 0; i < 9; i++) {
                 float step = vdsh_quant_step(sq[i], vdsh_quant_levels(enc, i));
-                float want = q[9 + i] == 0.0f ? 0.0f
-                           : (q[9 + i] > 0 ? 1.0f : -1.0f) * fminf(fabsf(q[9 + i]), sq[i]);
+                float want = q[9 + i] == 0.0f
+                                 ? 0.0f
+                                 : (q[9 + i] > 0 ? 1.0f : -1.0f) * fminf(fabsf(q[9 + i]), sq[i]);
                 CHECK(fabsf(row[i] - want) <= 0.5f * step * 1.0001f);
             }
             CHECK(vdsh_encode_quantised_drawn(enc, q, 3, 9, NULL, sq, pq) == VDSH_OK &&
@@ -1027,8 +1021,8 @@ static void test_encode_s8(void)
     /* round to nearest, ties away from zero, at scale 127 (step 1) */
     float r[8] = {127.0f, 2.5f, -2.5f, 0.49f, -0.51f, 126.5f, -127.0f, 1e-30f};
     CHECK(vdsh_encode_s8(r, 8, 1, sc, b) == VDSH_OK && sc[0] == 127.0f);
-    CHECK(b[0] == 127 && b[1] == 3 && b[2] == -3 && b[3] == 0 && b[4] == -1 &&
-          b[5] == 127 && b[6] == -127 && b[7] == 0);
+    CHECK(b[0] == 127 && b[1] == 3 && b[2] == -3 && b[3] == 0 && b[4] == -1 && b[5] == 127 &&
+          b[6] == -127 && b[7] == 0);
     /* refused: FLT_MAX's step times 127 rounds to infinity */
     c[0] = -FLT_MAX;
     CHECK(vdsh_encode_s8(c, V, NC, sc, b) == VDSH_ERR_INVALID);
@@ -1129,8 +1123,7 @@ static void test_roundtrip(void)
          * conversion. */
         const vdsh_stream *st = vdsh_find_stream(f, 5, VDSH_QUANTITY_DISTANCE);
         CHECK(st == &f->streams[0]);
-        CHECK(vdsh_find_stream(f, 5, VDSH_QUANTITY_DISTANCE2) ==
-              &f->streams[4]);
+        CHECK(vdsh_find_stream(f, 5, VDSH_QUANTITY_DISTANCE2) == &f->streams[4]);
         CHECK(vdsh_find_stream(f, 4, VDSH_QUANTITY_DISTANCE2) == NULL);
         CHECK(vdsh_find_stream(NULL, 5, 0) == NULL);
         float c[25];
@@ -1223,14 +1216,13 @@ static void test_roundtrip(void)
                 t.data[i] = NULL;
             }
             t.f.stream_count = 0;
-            add_stream(&t, order, enc, VDSH_QUANTITY_DISTANCE2,
-                       VDSH_METHOD_FULL, VDSH_WINDOW_NONE, 0, 0, 2.0f);
+            add_stream(&t, order, enc, VDSH_QUANTITY_DISTANCE2, VDSH_METHOD_FULL, VDSH_WINDOW_NONE,
+                       0, 0, 2.0f);
             void *mem = NULL;
             size_t n = 0;
             CHECK_RES(vdsh_write_memory(&t.f, &mem, &n, &err), VDSH_OK, &err);
             f = NULL;
-            CHECK_RES(vdsh_read_memory(mem, n, "o.vdsh", &f, &err), VDSH_OK,
-                      &err);
+            CHECK_RES(vdsh_read_memory(mem, n, "o.vdsh", &f, &err), VDSH_OK, &err);
             if (f)
                 check_same_file(f, &t.f);
             vdsh_free(f);
@@ -1277,7 +1269,8 @@ static void test_truncation(void)
         file_rejected += r == VDSH_ERR_TRUNCATED && f == (vdsh_file *)&err;
     }
     printf("truncation: %d of %zu lengths rejected (%d as TRUNCATED; "
-           "%d through files)\n", rejected, n, truncated, file_rejected);
+           "%d through files)\n",
+           rejected, n, truncated, file_rejected);
     CHECK(rejected == (int)n);
     CHECK(truncated == (int)n);
     CHECK(file_rejected == (int)n);
@@ -1323,9 +1316,8 @@ static void test_byte_changes(void)
     printf("byte changes: %ld of %ld rejected in a %zu-byte file "
            "(NOT_VDSH %ld, VERSION %ld, CRC %ld, TRUNCATED %ld, CHUNK %ld, "
            "INVALID %ld); single-bit flips: %ld of %ld rejected\n",
-           rejected, cases, n, by_result[VDSH_ERR_NOT_VDSH],
-           by_result[VDSH_ERR_VERSION], by_result[VDSH_ERR_CRC],
-           by_result[VDSH_ERR_TRUNCATED], by_result[VDSH_ERR_CHUNK],
+           rejected, cases, n, by_result[VDSH_ERR_NOT_VDSH], by_result[VDSH_ERR_VERSION],
+           by_result[VDSH_ERR_CRC], by_result[VDSH_ERR_TRUNCATED], by_result[VDSH_ERR_CHUNK],
            by_result[VDSH_ERR_INVALID], bit_rejected, bit_cases);
     CHECK(cases == (long)n * 255);
     CHECK(rejected == cases);
@@ -1337,9 +1329,8 @@ static void test_byte_changes(void)
 
 /* Patch the small file, fix the CRCs, expect `want`; `needle`, when not
  * NULL, must appear in the message. */
-static void expect_patched(const uint8_t *d, size_t n, size_t at,
-                           const void *bytes, size_t k, int fix,
-                           vdsh_result want, const char *needle, int line)
+static void expect_patched(const uint8_t *d, size_t n, size_t at, const void *bytes, size_t k,
+                           int fix, vdsh_result want, const char *needle, int line)
 {
     uint8_t *c = malloc(n);
     vdsh_error err = {""};
@@ -1350,26 +1341,27 @@ static void expect_patched(const uint8_t *d, size_t n, size_t at,
     vdsh_result r = read_bytes(c, n, &err);
     checks++;
     if (r != want || (needle && !strstr(err.msg, needle))) {
-        fprintf(stderr, "%s:%d: patch at %zu gave %s (\"%s\"), want %s "
-                "with \"%s\"\n", __FILE__, line, at, vdsh_result_str(r),
-                err.msg, vdsh_result_str(want), needle ? needle : "");
+        fprintf(stderr,
+                "%s:%d: patch at %zu gave %s (\"%s\"), want %s "
+                "with \"%s\"\n",
+                __FILE__, line, at, vdsh_result_str(r), err.msg, vdsh_result_str(want),
+                needle ? needle : "");
         failures++;
     }
     free(c);
 }
 
-#define PATCH32(off, v, fix, want, needle)                                    \
-    do {                                                                      \
-        uint8_t b_[4];                                                        \
-        wr32(b_, (v));                                                        \
-        expect_patched(d, n, (off), b_, 4, (fix), (want), (needle),           \
-                       __LINE__);                                             \
+#define PATCH32(off, v, fix, want, needle)                                                         \
+    do {                                                                                           \
+        uint8_t b_[4];                                                                             \
+        wr32(b_, (v));                                                                             \
+        expect_patched(d, n, (off), b_, 4, (fix), (want), (needle), __LINE__);                     \
     } while (0)
-#define PATCHF(off, v, want, needle)                                          \
-    do {                                                                      \
-        uint8_t b_[4];                                                        \
-        wrf32(b_, (v));                                                       \
-        expect_patched(d, n, (off), b_, 4, 1, (want), (needle), __LINE__);    \
+#define PATCHF(off, v, want, needle)                                                               \
+    do {                                                                                           \
+        uint8_t b_[4];                                                                             \
+        wrf32(b_, (v));                                                                            \
+        expect_patched(d, n, (off), b_, 4, 1, (want), (needle), __LINE__);                         \
     } while (0)
 
 /* An s8 stream read back (pointers, decode) and what the reader refuses
@@ -1388,8 +1380,8 @@ static void test_s8_reading(void)
                VDSH_WINDOW_NONE, 0, 0.8f, 1);
     add_stream(&t, 3, VDSH_ENCODING_S8, VDSH_QUANTITY_LOG_DISTANCE, VDSH_METHOD_SHADOW,
                VDSH_WINDOW_NONE, 0, 1.1f, 1);
-    add_stream(&t, 3, VDSH_ENCODING_S8S6, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_LSQ,
-               VDSH_WINDOW_NONE, 0, 0, 1);
+    add_stream(&t, 3, VDSH_ENCODING_S8S6, VDSH_QUANTITY_DISTANCE, VDSH_METHOD_LSQ, VDSH_WINDOW_NONE,
+               0, 0, 1);
     void *mem = NULL;
     size_t n = 0;
     vdsh_error err;
@@ -1435,10 +1427,11 @@ static void test_s8_reading(void)
     expect_patched(d, n, coef + 48 + 112 + 30, "\x81", 1, 1, VDSH_OK, NULL, __LINE__);
     /* s8s6: vertex 1's word (fields 4..8), a byte, the table */
     size_t w1 = coef2 + 48 + 48 + 8 + 4;
-    PATCH32(w1, 32u << 6, 1, VDSH_ERR_INVALID, "vertex 1 coefficient 5 is -32 (s8s6 stores -31..31");
+    PATCH32(w1, 32u << 6, 1, VDSH_ERR_INVALID,
+            "vertex 1 coefficient 5 is -32 (s8s6 stores -31..31");
     PATCH32(w1, 1u << 30, 1, VDSH_ERR_INVALID, "vertex 1: unused bits of packed word 0");
     PATCH32(w1, 1u << 31, 1, VDSH_ERR_INVALID, "unused bits");
-    PATCH32(w1, 0x3fffffffu, 1, VDSH_OK, NULL);   /* every field -1 */
+    PATCH32(w1, 0x3fffffffu, 1, VDSH_OK, NULL);     /* every field -1 */
     PATCH32(w1, 31u | 33u << 24, 1, VDSH_OK, NULL); /* 31 and -31 */
     expect_patched(d, n, w1 - 4, "\x80", 1, 1, VDSH_ERR_INVALID, "vertex 1 coefficient 0 is -128",
                    __LINE__);
@@ -1449,8 +1442,7 @@ static void test_s8_reading(void)
     sample_free(&t);
 }
 
-static void expect_tf(const tfile *t, vdsh_result want, const char *needle,
-                      int line)
+static void expect_tf(const tfile *t, vdsh_result want, const char *needle, int line)
 {
     size_t n;
     uint8_t *c = tf_build(t, &n);
@@ -1458,9 +1450,11 @@ static void expect_tf(const tfile *t, vdsh_result want, const char *needle,
     vdsh_result r = read_bytes(c, n, &err);
     checks++;
     if (r != want || (needle && !strstr(err.msg, needle))) {
-        fprintf(stderr, "%s:%d: crafted file gave %s (\"%s\"), want %s with "
-                "\"%s\"\n", __FILE__, line, vdsh_result_str(r), err.msg,
-                vdsh_result_str(want), needle ? needle : "");
+        fprintf(stderr,
+                "%s:%d: crafted file gave %s (\"%s\"), want %s with "
+                "\"%s\"\n",
+                __FILE__, line, vdsh_result_str(r), err.msg, vdsh_result_str(want),
+                needle ? needle : "");
         failures++;
     }
     free(c);
@@ -1483,16 +1477,13 @@ static void test_rules(void)
     size_t coef1 = payload_of(d, n, "COEF", 1);
     size_t stat = payload_of(d, n, "stat", 0);
     size_t tim = payload_of(d, n, "time", 0);
-    CHECK(head == 48 && srcs && posn && norm && tris && coef0 && coef1 &&
-          stat && tim);
+    CHECK(head == 48 && srcs && posn && norm && tris && coef0 && coef1 && stat && tim);
 
     /* File header. */
-    expect_patched(d, n, 0, "X", 1, 0, VDSH_ERR_NOT_VDSH, "wrong magic",
-                   __LINE__);
-    expect_patched(d, n, 4, "\n", 1, 0, VDSH_ERR_NOT_VDSH, "text-mode",
-                   __LINE__);
-    CHECK(read_bytes((const uint8_t *)"PK\3\4 not a vdsh file at all, no", 32,
-                     &err) == VDSH_ERR_NOT_VDSH);
+    expect_patched(d, n, 0, "X", 1, 0, VDSH_ERR_NOT_VDSH, "wrong magic", __LINE__);
+    expect_patched(d, n, 4, "\n", 1, 0, VDSH_ERR_NOT_VDSH, "text-mode", __LINE__);
+    CHECK(read_bytes((const uint8_t *)"PK\3\4 not a vdsh file at all, no", 32, &err) ==
+          VDSH_ERR_NOT_VDSH);
     CHECK(read_bytes((const uint8_t *)"V", 1, &err) == VDSH_ERR_TRUNCATED);
     CHECK(read_bytes((const uint8_t *)"W", 1, &err) == VDSH_ERR_NOT_VDSH);
     PATCH32(8, 2, 1, VDSH_ERR_VERSION, "format version 2");
@@ -1509,11 +1500,9 @@ static void test_rules(void)
     {
         uint8_t b[8];
         wr64(b, n + 16);
-        expect_patched(d, n, 16, b, 8, 1, VDSH_ERR_TRUNCATED, "header says",
-                       __LINE__);
+        expect_patched(d, n, 16, b, 8, 1, VDSH_ERR_TRUNCATED, "header says", __LINE__);
         wr64(b, n - 16);
-        expect_patched(d, n, 16, b, 8, 1, VDSH_ERR_CHUNK, "after the end",
-                       __LINE__);
+        expect_patched(d, n, 16, b, 8, 1, VDSH_ERR_CHUNK, "after the end", __LINE__);
         /* Trailing bytes that the header counts but no chunk covers. */
         uint8_t *c = calloc(1, n + 16);
         memcpy(c, d, n);
@@ -1524,32 +1513,27 @@ static void test_rules(void)
         free(c);
         /* A chunk size that would wrap any unchecked sum. */
         wr64(b, UINT64_MAX - 7);
-        expect_patched(d, n, coef0 - 8, b, 8, 1, VDSH_ERR_TRUNCATED,
-                       "runs past the end", __LINE__);
+        expect_patched(d, n, coef0 - 8, b, 8, 1, VDSH_ERR_TRUNCATED, "runs past the end", __LINE__);
         wr64(b, (uint64_t)n);
-        expect_patched(d, n, coef0 - 8, b, 8, 1, VDSH_ERR_TRUNCATED,
-                       "runs past the end", __LINE__);
+        expect_patched(d, n, coef0 - 8, b, 8, 1, VDSH_ERR_TRUNCATED, "runs past the end", __LINE__);
     }
 
     /* A flipped payload byte: CRC, and the message says where. */
-    snprintf(want, sizeof want, "t.vdsh: chunk 5 'COEF' at offset %zu: CRC "
-             "mismatch", coef0 - 16);
-    expect_patched(d, n, coef0 + 50, "\x55", 1, 0, VDSH_ERR_CRC, want,
-                   __LINE__);
-    expect_patched(d, n, coef0 - 12, "\1\2\3\4", 4, 0, VDSH_ERR_CRC,
-                   "CRC mismatch", __LINE__);
+    snprintf(want, sizeof want,
+             "t.vdsh: chunk 5 'COEF' at offset %zu: CRC "
+             "mismatch",
+             coef0 - 16);
+    expect_patched(d, n, coef0 + 50, "\x55", 1, 0, VDSH_ERR_CRC, want, __LINE__);
+    expect_patched(d, n, coef0 - 12, "\1\2\3\4", 4, 0, VDSH_ERR_CRC, "CRC mismatch", __LINE__);
     /* Padding: TRIS has 24 bytes of payload, then 8 of padding. */
-    expect_patched(d, n, tris + 24, "\1", 1, 1, VDSH_ERR_CHUNK,
-                   "TRIS' at offset", __LINE__);
-    expect_patched(d, n, tris - 16, "TR1S", 4, 1, VDSH_ERR_CHUNK,
-                   "not four ASCII letters", __LINE__);
+    expect_patched(d, n, tris + 24, "\1", 1, 1, VDSH_ERR_CHUNK, "TRIS' at offset", __LINE__);
+    expect_patched(d, n, tris - 16, "TR1S", 4, 1, VDSH_ERR_CHUNK, "not four ASCII letters",
+                   __LINE__);
 
     /* HEAD values. */
     PATCH32(head + 0, 0, 1, VDSH_ERR_INVALID, "vertex_count 0");
-    PATCH32(head + 0, VDSH_MAX_VERTICES + 1, 1, VDSH_ERR_INVALID,
-            "vertex_count");
-    PATCH32(head + 4, VDSH_MAX_TRIANGLES + 1, 1, VDSH_ERR_INVALID,
-            "triangle_count");
+    PATCH32(head + 0, VDSH_MAX_VERTICES + 1, 1, VDSH_ERR_INVALID, "vertex_count");
+    PATCH32(head + 4, VDSH_MAX_TRIANGLES + 1, 1, VDSH_ERR_INVALID, "triangle_count");
     PATCH32(head + 8, 0, 1, VDSH_ERR_INVALID, "rays");
     PATCH32(head + 12, 2, 1, VDSH_ERR_INVALID, "sampling 2");
     PATCHF(head + 24, NAN, VDSH_ERR_INVALID, "max_distance");
@@ -1567,8 +1551,7 @@ static void test_rules(void)
     PATCH32(head + 4, 3, 1, VDSH_ERR_CHUNK, "TRIS: payload is 24 bytes");
 
     /* Arrays. */
-    PATCHF(posn + 12, NAN, VDSH_ERR_INVALID,
-           "t.vdsh: POSN: vertex 1 has a non-finite coordinate");
+    PATCHF(posn + 12, NAN, VDSH_ERR_INVALID, "t.vdsh: POSN: vertex 1 has a non-finite coordinate");
     PATCHF(posn + 44, -INFINITY, VDSH_ERR_INVALID, "POSN: vertex 3");
     PATCHF(norm + 0, INFINITY, VDSH_ERR_INVALID, "NORM");
     PATCHF(norm + 0, 0.5f, VDSH_ERR_INVALID, "NORM: normal of vertex 0");
@@ -1598,15 +1581,13 @@ static void test_rules(void)
     PATCHF(coef0 + 28, -1.0f, VDSH_ERR_INVALID, "scale");
     PATCHF(coef0 + 28, 1e30f, VDSH_ERR_INVALID, "overflows"); /* 1e30 data */
     PATCH32(coef0 + 44, 1, 1, VDSH_ERR_INVALID, "reserved");
-    PATCHF(coef0 + 48 + 4 * 5, NAN, VDSH_ERR_INVALID,
-           "vertex 1 coefficient 1 is not finite");
+    PATCHF(coef0 + 48 + 4 * 5, NAN, VDSH_ERR_INVALID, "vertex 1 coefficient 1 is not finite");
     {
         uint8_t h[2] = {0x00, 0x7c}; /* f16 +Inf */
         expect_patched(d, n, coef1 + 48 + 2 * 3, h, 2, 1, VDSH_ERR_INVALID,
                        "vertex 3 coefficient 0 is not finite", __LINE__);
         h[0] = 0x01; /* f16 NaN */
-        expect_patched(d, n, coef1 + 48, h, 2, 1, VDSH_ERR_INVALID,
-                       "not finite", __LINE__);
+        expect_patched(d, n, coef1 + 48, h, 2, 1, VDSH_ERR_INVALID, "not finite", __LINE__);
     }
     /* A method this reader does not know is still readable. */
     PATCH32(coef0 + 8, 7, 1, VDSH_OK, NULL);
@@ -1620,19 +1601,15 @@ static void test_rules(void)
     PATCH32(srcs + 44, UINT32_MAX, 1, VDSH_ERR_INVALID, "name_length");
     PATCH32(srcs + 44, 9, 1, VDSH_ERR_CHUNK, "name runs past");
     PATCH32(srcs + 44, 4, 1, VDSH_ERR_CHUNK, "after the last source");
-    expect_patched(d, n, srcs + 49, "", 1, 1, VDSH_ERR_INVALID, "NUL",
-                   __LINE__);
-    expect_patched(d, n, srcs + 48, "\xff", 1, 1, VDSH_ERR_INVALID, "UTF-8",
-                   __LINE__);
-    expect_patched(d, n, srcs + 48, "\xc0\xaf", 2, 1, VDSH_ERR_INVALID,
-                   "UTF-8", __LINE__);
-    expect_patched(d, n, srcs + 48, "\xed\xa0\x80", 3, 1, VDSH_ERR_INVALID,
-                   "UTF-8", __LINE__);
-    expect_patched(d, n, srcs + 48 + 5, "z", 1, 1, VDSH_ERR_CHUNK,
-                   "name padding", __LINE__);
+    expect_patched(d, n, srcs + 49, "", 1, 1, VDSH_ERR_INVALID, "NUL", __LINE__);
+    expect_patched(d, n, srcs + 48, "\xff", 1, 1, VDSH_ERR_INVALID, "UTF-8", __LINE__);
+    expect_patched(d, n, srcs + 48, "\xc0\xaf", 2, 1, VDSH_ERR_INVALID, "UTF-8", __LINE__);
+    expect_patched(d, n, srcs + 48, "\xed\xa0\x80", 3, 1, VDSH_ERR_INVALID, "UTF-8", __LINE__);
+    expect_patched(d, n, srcs + 48 + 5, "z", 1, 1, VDSH_ERR_CHUNK, "name padding", __LINE__);
 
     /* Ancillary chunks we know. */
-    PATCH32(stat + 28, 0xffffffffu, 1, VDSH_ERR_INVALID, "stat: flipped_normals 4294967295 exceeds");
+    PATCH32(stat + 28, 0xffffffffu, 1, VDSH_ERR_INVALID,
+            "stat: flipped_normals 4294967295 exceeds");
     PATCH32(stat + 12, 0x7fffffffu, 1, VDSH_ERR_INVALID, "rays missed of");
     PATCH32(tim + 4, 0x7ff80000u, 1, VDSH_ERR_INVALID, "time: load"); /* NaN */
     PATCH32(tim + 20, 0x7ff00000u, 1, VDSH_ERR_INVALID, "time: build");
@@ -1641,8 +1618,7 @@ static void test_rules(void)
         uint8_t b[8];
         double neg = -1.0;
         memcpy(b, &neg, 8);
-        expect_patched(d, n, tim + 32, b, 8, 1, VDSH_ERR_INVALID,
-                       "time: total", __LINE__);
+        expect_patched(d, n, tim + 32, b, 8, 1, VDSH_ERR_INVALID, "time: total", __LINE__);
     }
 
     /* Chunk structure, rebuilt with correct CRCs. */
@@ -1701,8 +1677,7 @@ static void test_rules(void)
     {
         int c0 = tf_find(&t, "COEF", 0);
         tf_insert(&t, c0, "COEF", t.c[c0].data, t.c[c0].size);
-        expect_tf(&t, VDSH_ERR_INVALID, "second stream for order 2 distance",
-                  __LINE__);
+        expect_tf(&t, VDSH_ERR_INVALID, "second stream for order 2 distance", __LINE__);
         tf_remove(&t, c0);
         int c1 = tf_find(&t, "COEF", 1);
         t.c[c1].id[0] = 'c';
@@ -1793,8 +1768,7 @@ static void test_mutations(void)
              * care about, rather than uniform noise. */
             static const uint8_t special[] = {0x00, 0x01, 0x02, 0x7f, 0x80,
                                               0xff, 0x7c, 0xfe, 0x3f, 0xc0};
-            c[at] = (r & 1) ? special[(r >> 8) % sizeof special]
-                            : (uint8_t)(r >> 16);
+            c[at] = (r & 1) ? special[(r >> 8) % sizeof special] : (uint8_t)(r >> 16);
         }
         fix_crcs(c, n);
         vdsh_file *f = NULL;
@@ -1810,8 +1784,10 @@ static void test_mutations(void)
             memcmp(mem, mem2, m) == 0) {
             consistent++;
         } else {
-            fprintf(stderr, "mutation %ld: accepted but not rewritable: "
-                    "%s\n", i, err.msg);
+            fprintf(stderr,
+                    "mutation %ld: accepted but not rewritable: "
+                    "%s\n",
+                    i, err.msg);
         }
         vdsh_free(g);
         vdsh_free(f);
@@ -1819,8 +1795,8 @@ static void test_mutations(void)
         free(mem2);
     }
     printf("mutations with fixed CRCs: %ld rounds, %ld accepted, all "
-           "rewritable: %s\n", rounds, accepted,
-           consistent == accepted ? "yes" : "NO");
+           "rewritable: %s\n",
+           rounds, accepted, consistent == accepted ? "yes" : "NO");
     CHECK(consistent == accepted);
     CHECK(accepted > 0 && accepted < rounds);
     free(c);
@@ -1836,8 +1812,7 @@ static void test_scan(void)
     uint32_t count = 0;
     static const char *const ids[9] = {"HEAD", "SRCS", "POSN", "NORM", "TRIS",
                                        "COEF", "COEF", "stat", "time"};
-    CHECK_RES(vdsh_scan_chunks(d, n, "s.vdsh", info, 16, &count, &err),
-              VDSH_OK, &err);
+    CHECK_RES(vdsh_scan_chunks(d, n, "s.vdsh", info, 16, &count, &err), VDSH_OK, &err);
     CHECK(count == 9);
     uint64_t off = 32;
     for (uint32_t i = 0; i < count && i < 9; i++) {
@@ -1865,19 +1840,15 @@ static void test_scan(void)
     int mism = 0;
     for (uint32_t i = 0; i < count; i++)
         mism += info[i].crc_stored != info[i].crc_computed;
-    CHECK(count == 9 && mism == 1 &&
-          info[3].crc_stored != info[3].crc_computed);
+    CHECK(count == 9 && mism == 1 && info[3].crc_stored != info[3].crc_computed);
     /* Cut in the middle of a chunk: listed as incomplete, walk stops. */
     size_t cut = payload_of(d, n, "TRIS", 0) + 4;
     CHECK(vdsh_scan_chunks(d, cut, NULL, info, 16, &count, &err) == VDSH_OK);
     CHECK(count == 5 && !info[4].complete && info[4].crc_computed == 0);
     count = 1234;
-    CHECK(vdsh_scan_chunks(d, 20, NULL, info, 16, &count, &err) ==
-          VDSH_ERR_TRUNCATED);
-    CHECK(vdsh_scan_chunks("hello", 5, NULL, info, 16, &count, &err) ==
-          VDSH_ERR_NOT_VDSH);
-    CHECK(vdsh_scan_chunks(NULL, 0, NULL, info, 16, &count, &err) ==
-          VDSH_ERR_TRUNCATED);
+    CHECK(vdsh_scan_chunks(d, 20, NULL, info, 16, &count, &err) == VDSH_ERR_TRUNCATED);
+    CHECK(vdsh_scan_chunks("hello", 5, NULL, info, 16, &count, &err) == VDSH_ERR_NOT_VDSH);
+    CHECK(vdsh_scan_chunks(NULL, 0, NULL, info, 16, &count, &err) == VDSH_ERR_TRUNCATED);
     CHECK(count == 1234); /* untouched on failure */
     CHECK(vdsh_scan_chunks(d, 32, NULL, info, 16, &count, &err) == VDSH_OK);
     CHECK(count == 0);
@@ -1899,11 +1870,12 @@ static void expect_rejected(sample *s, const char *needle, int line)
     vdsh_result r = vdsh_write(path, &s->f, &err);
     checks++;
     if (r != VDSH_ERR_ARGUMENT || !strstr(err.msg, needle) ||
-        !strstr(err.msg, "rejected.vdsh: not written: ") ||
-        file_exists(path) || count_tmp_files(tmpdir) != 0) {
-        fprintf(stderr, "%s:%d: writer gave %s (\"%s\"), want ARGUMENT with "
-                "\"%s\" and no file\n", __FILE__, line, vdsh_result_str(r),
-                err.msg, needle);
+        !strstr(err.msg, "rejected.vdsh: not written: ") || file_exists(path) ||
+        count_tmp_files(tmpdir) != 0) {
+        fprintf(stderr,
+                "%s:%d: writer gave %s (\"%s\"), want ARGUMENT with "
+                "\"%s\" and no file\n",
+                __FILE__, line, vdsh_result_str(r), err.msg, needle);
         failures++;
     }
     r = vdsh_write_memory(&s->f, &mem, &size, &err);
@@ -1911,12 +1883,12 @@ static void expect_rejected(sample *s, const char *needle, int line)
     sample_free(s);
 }
 
-#define REJECT(needle, ...)                                                   \
-    do {                                                                      \
-        sample s_;                                                            \
-        sample_init(&s_, 0, 0);                                               \
-        __VA_ARGS__;                                                          \
-        expect_rejected(&s_, (needle), __LINE__);                             \
+#define REJECT(needle, ...)                                                                        \
+    do {                                                                                           \
+        sample s_;                                                                                 \
+        sample_init(&s_, 0, 0);                                                                    \
+        __VA_ARGS__;                                                                               \
+        expect_rejected(&s_, (needle), __LINE__);                                                  \
     } while (0)
 
 static void test_writer_checks(void)
@@ -1952,10 +1924,8 @@ static void test_writer_checks(void)
     REJECT("indices is NULL", s_.f.indices = NULL);
     REJECT("POSN: vertex 2", s_.pos[7] = NAN);
     REJECT("NORM: normal of vertex 1", s_.nrm[4] = INFINITY);
-    REJECT("NORM: normal of vertex 3", s_.nrm[9] = 0.5f; s_.nrm[10] = 0.5f;
-           s_.nrm[11] = 0.5f);
-    REJECT("TRIS: index 4 out of range (4 vertices) in triangle 1",
-           s_.idx[4] = 4);
+    REJECT("NORM: normal of vertex 3", s_.nrm[9] = 0.5f; s_.nrm[10] = 0.5f; s_.nrm[11] = 0.5f);
+    REJECT("TRIS: index 4 out of range (4 vertices) in triangle 1", s_.idx[4] = 4);
     REJECT("source_count 65", s_.f.source_count = 65);
     REJECT("sources is NULL", s_.f.sources = NULL);
     REJECT("name is NULL", s_.sources[0].name = NULL);
@@ -1974,10 +1944,10 @@ static void test_writer_checks(void)
     REJECT("quantity 3", s_.streams[0].quantity = 3);
     REJECT("window 3", s_.streams[0].window = 3);
     REJECT("without a window", s_.streams[0].window_param = 0.5f);
-    REJECT("with a window", (s_.streams[0].window = VDSH_WINDOW_HANN,
-                             s_.streams[0].window_param = 0.0f));
-    REJECT("with a window", (s_.streams[0].window = VDSH_WINDOW_LANCZOS,
-                             s_.streams[0].window_param = -3.0f));
+    REJECT("with a window",
+           (s_.streams[0].window = VDSH_WINDOW_HANN, s_.streams[0].window_param = 0.0f));
+    REJECT("with a window",
+           (s_.streams[0].window = VDSH_WINDOW_LANCZOS, s_.streams[0].window_param = -3.0f));
     REJECT("window_param", s_.streams[1].window_param = NAN);
     REJECT("method_param", s_.streams[1].method_param = -INFINITY);
     REJECT("scale", s_.streams[0].scale = 0);
@@ -1985,15 +1955,12 @@ static void test_writer_checks(void)
     REJECT("scale", s_.streams[0].scale = INFINITY);
     REJECT("quantity_param 0.5 must be 0", s_.streams[0].quantity_param = 0.5f);
     REJECT("data is NULL", s_.streams[1].data = NULL);
-    REJECT("streams 0 and 1 are both order 2 distance",
-           s_.streams[1] = s_.streams[0]);
-    REJECT("vertex 2 coefficient 3 is not finite",
-           ((float *)s_.data[0])[11] = NAN);
+    REJECT("streams 0 and 1 are both order 2 distance", s_.streams[1] = s_.streams[0]);
+    REJECT("vertex 2 coefficient 3 is not finite", ((float *)s_.data[0])[11] = NAN);
     REJECT("vertex 3 coefficient 0 is not finite (f16 0x7c00)",
            ((uint16_t *)s_.data[1])[3] = 0x7c00);
     REJECT("not finite", ((uint16_t *)s_.data[1])[0] = 0xfe00);
-    REJECT("overflows", ((float *)s_.data[0])[5] = 3e38f;
-           s_.streams[0].scale = 10);
+    REJECT("overflows", ((float *)s_.data[0])[5] = 3e38f; s_.streams[0].scale = 10);
     REJECT("time: trace", s_.f.timings.trace = NAN);
     REJECT("time: load", s_.f.timings.load = -0.5);
 
@@ -2195,8 +2162,8 @@ static void test_parts(void)
     CHECK_RES(vdsh_write_memory(&s.f, &whole, &wn, &err), VDSH_OK, &err);
     CHECK(vdsh_file_stream_vertices(&s.f) == V);
     s.f.has_part = 1;
-    s.f.part = (vdsh_part){.index = 1, .count = 2, .range_begin = b, .range_end = e,
-                           .encoding = VDSH_ENCODING_F16};
+    s.f.part = (vdsh_part){
+        .index = 1, .count = 2, .range_begin = b, .range_end = e, .encoding = VDSH_ENCODING_F16};
     CHECK(vdsh_file_stream_vertices(&s.f) == e - b);
     /* The writer takes the range's rows: the first e - b of each stream. */
     CHECK_RES(vdsh_write_memory(&s.f, &mem, &n, &err), VDSH_OK, &err);
@@ -2224,7 +2191,8 @@ static void test_parts(void)
             int k = tf_find(&t, "COEF", (int)i);
             const vdsh_stream *st = &s.f.streams[i];
             size_t table = vdsh_encoding_quantised(st->encoding)
-                               ? ((size_t)st->order * st->order * 4 + 15) & ~(size_t)15 : 0;
+                               ? ((size_t)st->order * st->order * 4 + 15) & ~(size_t)15
+                               : 0;
             CHECK(k >= 0 && t.c[k].size == 48 + table + (e - b) * vdsh_stream_bytes_per_vertex(st));
         }
         if (pi > ci && ci > 0) {
@@ -2258,15 +2226,15 @@ static void test_parts(void)
  * vertex's own order), the slot rules, and what the reader refuses: an
  * order 0 or above the cap, padding after the order table or a record that
  * is not zero, unknown flag bits. */
-#define VCHECK(c, ...)                                                        \
-    do {                                                                      \
-        checks++;                                                             \
-        if (!(c)) {                                                           \
-            fprintf(stderr, "%s:%d: ", __FILE__, __LINE__);                   \
-            fprintf(stderr, __VA_ARGS__);                                     \
-            fputc('\n', stderr);                                              \
-            failures++;                                                       \
-        }                                                                     \
+#define VCHECK(c, ...)                                                                             \
+    do {                                                                                           \
+        checks++;                                                                                  \
+        if (!(c)) {                                                                                \
+            fprintf(stderr, "%s:%d: ", __FILE__, __LINE__);                                        \
+            fprintf(stderr, __VA_ARGS__);                                                          \
+            fputc('\n', stderr);                                                                   \
+            failures++;                                                                            \
+        }                                                                                          \
     } while (0)
 
 static void test_variable_streams(void)
@@ -2285,21 +2253,28 @@ static void test_variable_streams(void)
         uint32_t words = 0;
         for (uint32_t v = 0; v < V; v++) {
             CHECK(offsets[v] == words);
-            words += (uint32_t)((vdsh_encoding_bytes(enc, (uint32_t)orders[v] * orders[v]) + 3) / 4);
+            words +=
+                (uint32_t)((vdsh_encoding_bytes(enc, (uint32_t)orders[v] * orders[v]) + 3) / 4);
         }
         CHECK(offsets[V] == words);
         uint32_t *rec = malloc(4 * (size_t)words + 4);
         float scales[NC];
         float scale = enc == VDSH_ENCODING_F16 ? 4.0f : 1.0f;
         VCHECK(vdsh_encode_variable(enc, src, NC, orders, V, CAP, scale, offsets, scales, rec) ==
-              VDSH_OK, "encode %s", vdsh_encoding_name(enc));
+                   VDSH_OK,
+               "encode %s", vdsh_encoding_name(enc));
         sample t;
         sample_init(&t, 2, V);
         vdsh_stream *st = &t.streams[t.f.stream_count++];
-        *st = (vdsh_stream){.order = CAP, .encoding = enc, .method = VDSH_METHOD_SHADOW,
-                            .quantity = VDSH_QUANTITY_LOG_DISTANCE, .scale = scale,
-                            .quantity_param = 0.01f, .flags = VDSH_STREAM_VARIABLE,
-                            .orders = orders, .data = rec,
+        *st = (vdsh_stream){.order = CAP,
+                            .encoding = enc,
+                            .method = VDSH_METHOD_SHADOW,
+                            .quantity = VDSH_QUANTITY_LOG_DISTANCE,
+                            .scale = scale,
+                            .quantity_param = 0.01f,
+                            .flags = VDSH_STREAM_VARIABLE,
+                            .orders = orders,
+                            .data = rec,
                             .coef_scales = vdsh_encoding_quantised(enc) ? scales : NULL};
         void *mem = NULL;
         size_t n = 0;
@@ -2309,10 +2284,10 @@ static void test_variable_streams(void)
         VCHECK(mem && vdsh_read_memory(mem, n, "v.vdsh", &f, &err) == VDSH_OK, "%s", err.msg);
         const vdsh_stream *r = f ? vdsh_find_variable_stream(f, VDSH_QUANTITY_LOG_DISTANCE) : NULL;
         VCHECK(r && r->order == CAP && r->flags == VDSH_STREAM_VARIABLE &&
-              !vdsh_find_stream(f, CAP, VDSH_QUANTITY_LOG_DISTANCE) &&
-              vdsh_stream_bytes_per_vertex(r) == 0 &&
-              vdsh_stream_data_bytes(r, V) == 64 + 4 * (uint64_t)words, "%s read back",
-              vdsh_encoding_name(enc));
+                   !vdsh_find_stream(f, CAP, VDSH_QUANTITY_LOG_DISTANCE) &&
+                   vdsh_stream_bytes_per_vertex(r) == 0 &&
+                   vdsh_stream_data_bytes(r, V) == 64 + 4 * (uint64_t)words,
+               "%s read back", vdsh_encoding_name(enc));
         if (r) { /* rows per order, the average as the data's size, the cap's record */
             vdsh_stream_size z = vdsh_stream_size_of(r, V);
             uint32_t per[VDSH_ORDER_SLOTS] = {0};
@@ -2321,8 +2296,7 @@ static void test_variable_streams(void)
             VCHECK(memcmp(z.rows_per_order, per, sizeof per) == 0 &&
                        z.mean_bytes == (64.0 + 4.0 * words) / V &&
                        z.max_bytes == 4 * vdsh_record_words(enc, CAP),
-                   "%s: stream size %g / %u", vdsh_encoding_name(enc), z.mean_bytes,
-                   z.max_bytes);
+                   "%s: stream size %g / %u", vdsh_encoding_name(enc), z.mean_bytes, z.max_bytes);
         }
         double worst = 0.0;
         for (uint32_t v = 0; r && v < V; v++) {
@@ -2331,15 +2305,16 @@ static void test_variable_streams(void)
             float out[NC];
             vdsh_stream_decode(r, v, out);
             for (uint32_t i = 0; i < NC; i++) {
-                double tol = vdsh_encoding_quantised(enc)
-                                 ? 0.5 * vdsh_quant_step(scales[i], vdsh_quant_levels(enc, i)) * 1.0001
-                             : enc == VDSH_ENCODING_F16 ? fabs(src[v * NC + i]) / 2048.0 + 1e-7
-                                                        : 0.0;
+                double tol =
+                    vdsh_encoding_quantised(enc)
+                        ? 0.5 * vdsh_quant_step(scales[i], vdsh_quant_levels(enc, i)) * 1.0001
+                    : enc == VDSH_ENCODING_F16 ? fabs(src[v * NC + i]) / 2048.0 + 1e-7
+                                               : 0.0;
                 worst = fmax(worst, fabs(out[i] - src[v * NC + i]) - tol);
             }
         }
         VCHECK(worst <= 0.0, "%s: decoded values off by %g beyond the encoding's step",
-              vdsh_encoding_name(enc), worst);
+               vdsh_encoding_name(enc), worst);
         /* Byte patches of the written file. */
         const uint8_t *d = mem;
         size_t coef = payload_of(d, n, "COEF", 1);
@@ -2350,8 +2325,7 @@ static void test_variable_streams(void)
             uint8_t b0 = 0, big = CAP + 1, one = 1;
             expect_patched(d, n, otab, &b0, 1, 1, VDSH_ERR_INVALID, "vertex 0 has order 0",
                            __LINE__);
-            expect_patched(d, n, otab + 3, &big, 1, 1, VDSH_ERR_INVALID, "has order 13",
-                           __LINE__);
+            expect_patched(d, n, otab + 3, &big, 1, 1, VDSH_ERR_INVALID, "has order 13", __LINE__);
             expect_patched(d, n, otab + V, &one, 1, 1, VDSH_ERR_INVALID,
                            "padding after the order table", __LINE__);
             PATCH32(coef + 36, 3, 1, VDSH_ERR_INVALID, "flags 0x3");
@@ -2379,13 +2353,14 @@ static void test_variable_streams(void)
         t.streams[t.f.stream_count - 1].quantity_param = 0.01f;
         m2 = NULL;
         VCHECK(vdsh_write_memory(&t.f, &m2, &n2, &err) == VDSH_ERR_ARGUMENT &&
-                  strstr(err.msg, "both variable-order log-distance"),
-              "two variable streams: %s", err.msg);
+                   strstr(err.msg, "both variable-order log-distance"),
+               "two variable streams: %s", err.msg);
         t.streams[t.f.stream_count - 1].orders = NULL;
         t.streams[t.f.stream_count - 1].quantity = VDSH_QUANTITY_DISTANCE;
         t.streams[t.f.stream_count - 1].quantity_param = 0.0f;
         VCHECK(vdsh_write_memory(&t.f, &m2, &n2, &err) == VDSH_ERR_ARGUMENT &&
-                  strstr(err.msg, "variable order without orders"), "%s", err.msg);
+                   strstr(err.msg, "variable order without orders"),
+               "%s", err.msg);
         t.f.stream_count--;
         vdsh_free(f);
         free(mem);
@@ -2408,8 +2383,7 @@ int main(int argc, char **argv)
         return exhaustive_f16() ? 0 : 1;
 
     const char *base = getenv("TMPDIR");
-    snprintf(tmpdir, sizeof tmpdir, "%s/vdsh_test_format_XXXXXX",
-             base && *base ? base : "/tmp");
+    snprintf(tmpdir, sizeof tmpdir, "%s/vdsh_test_format_XXXXXX", base && *base ? base : "/tmp");
     if (!mkdtemp(tmpdir)) {
         fprintf(stderr, "mkdtemp %s: %s\n", tmpdir, strerror(errno));
         return 1;

@@ -26,8 +26,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static uint32_t rd32(const uint8_t *p)
 {
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 |
-           (uint32_t)p[3] << 24;
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
 }
 
 static void wr32(uint8_t *p, uint32_t v)
@@ -74,10 +73,8 @@ static void one_input(const uint8_t *data, size_t size)
         vdsh_stream_decode(&f->streams[i], f->header.vertex_count - 1, c);
     if (vdsh_write_memory(f, &mem, &n, &err) != VDSH_OK ||
         vdsh_read_memory(mem, n, "fuzz-rewritten", &g, &err) != VDSH_OK ||
-        vdsh_write_memory(g, &mem2, &n2, &err) != VDSH_OK || n != n2 ||
-        memcmp(mem, mem2, n) != 0) {
-        fprintf(stderr, "accepted input does not survive a rewrite: %s\n",
-                err.msg);
+        vdsh_write_memory(g, &mem2, &n2, &err) != VDSH_OK || n != n2 || memcmp(mem, mem2, n) != 0) {
+        fprintf(stderr, "accepted input does not survive a rewrite: %s\n", err.msg);
         abort();
     }
     free(mem);

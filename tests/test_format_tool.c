@@ -52,8 +52,8 @@ static int write_fixtures(const char *dir)
         nrm[3 * v + 1] = 0.0f;
         nrm[3 * v + 2] = (float)-sin(a);
         for (int i = 0; i < 25; i++)
-            c5[25 * v + i] = vdsh_f16_from_f32(i == 0 ? 0.5f + 0.01f * (float)v
-                                                      : 0.001f * (float)(i - v));
+            c5[25 * v + i] =
+                vdsh_f16_from_f32(i == 0 ? 0.5f + 0.01f * (float)v : 0.001f * (float)(i - v));
         for (int i = 0; i < 9; i++)
             c3[9 * v + i] = i == 0 ? 7.5f + 0.1f * (float)v : 0.01f * (float)i;
     }
@@ -90,13 +90,21 @@ static int write_fixtures(const char *dir)
     }
     f.source_count = 2;
     f.sources = src;
-    st[0] = (vdsh_stream){.order = 5, .encoding = VDSH_ENCODING_F16,
-                          .method = VDSH_METHOD_PAPER, .quantity = VDSH_QUANTITY_DISTANCE,
-                          .window = VDSH_WINDOW_HANN, .window_param = 2.5f,
-                          .scale = 15.0f, .data = c5};
-    st[1] = (vdsh_stream){.order = 3, .encoding = VDSH_ENCODING_F32,
-                          .method = VDSH_METHOD_FULL, .quantity = VDSH_QUANTITY_LOG_DISTANCE,
-                          .scale = 1.0f, .quantity_param = 0.25f, .data = c3};
+    st[0] = (vdsh_stream){.order = 5,
+                          .encoding = VDSH_ENCODING_F16,
+                          .method = VDSH_METHOD_PAPER,
+                          .quantity = VDSH_QUANTITY_DISTANCE,
+                          .window = VDSH_WINDOW_HANN,
+                          .window_param = 2.5f,
+                          .scale = 15.0f,
+                          .data = c5};
+    st[1] = (vdsh_stream){.order = 3,
+                          .encoding = VDSH_ENCODING_F32,
+                          .method = VDSH_METHOD_FULL,
+                          .quantity = VDSH_QUANTITY_LOG_DISTANCE,
+                          .scale = 1.0f,
+                          .quantity_param = 0.25f,
+                          .data = c3};
     f.stream_count = 2;
     f.streams = st;
     f.has_stats = 1;
@@ -124,8 +132,7 @@ static int write_fixtures(const char *dir)
     struct {
         const char *name;
         size_t size;
-    } out[3] = {{"corrupt.vdsh", n}, {"truncated.vdsh", n - 100},
-                {"text.vdsh", 0}};
+    } out[3] = {{"corrupt.vdsh", n}, {"truncated.vdsh", n - 100}, {"text.vdsh", 0}};
     static const char text[] = "solid cube\n  facet normal 0 0 1\n";
     for (int i = 0; i < 3; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, out[i].name);
@@ -149,8 +156,7 @@ static int write_fixtures(const char *dir)
 
 static int clean_fixtures(const char *dir)
 {
-    static const char *const names[] = {"good.vdsh", "corrupt.vdsh",
-                                        "truncated.vdsh", "text.vdsh"};
+    static const char *const names[] = {"good.vdsh", "corrupt.vdsh", "truncated.vdsh", "text.vdsh"};
     char path[4096];
     for (int i = 0; i < 4; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, names[i]);
@@ -214,13 +220,11 @@ static int expect(int argc, char **argv)
     for (int k = 1; k < i; k += 2) {
         const char *hay = !strcmp(argv[k], "--out") ? out : err;
         if (!strstr(hay, argv[k + 1])) {
-            fprintf(stderr, "expected %s to contain \"%s\"\n",
-                    argv[k] + 2, argv[k + 1]);
+            fprintf(stderr, "expected %s to contain \"%s\"\n", argv[k] + 2, argv[k + 1]);
             ok = 0;
         }
     }
-    printf("--- exit %d (want %d); stdout:\n%s--- stderr:\n%s", code, want,
-           out, err);
+    printf("--- exit %d (want %d); stdout:\n%s--- stderr:\n%s", code, want, out, err);
     free(out);
     free(err);
     return ok ? 0 : 1;
@@ -234,7 +238,9 @@ int main(int argc, char **argv)
         return clean_fixtures(argv[2]);
     if (argc >= 5 && !strcmp(argv[1], "expect"))
         return expect(argc - 2, argv + 2);
-    fprintf(stderr, "usage: %s make DIR | clean DIR | expect CODE "
-            "[--out TEXT] [--err TEXT] -- PROG ARG...\n", argv[0]);
+    fprintf(stderr,
+            "usage: %s make DIR | clean DIR | expect CODE "
+            "[--out TEXT] [--err TEXT] -- PROG ARG...\n",
+            argv[0]);
     return 2;
 }

@@ -111,8 +111,8 @@ static int part_score(void)
           (unsigned long long)t.counted);
     CHECK(t.lit == 50 * 99 && t.shadowed == 49 * 99, "lit %llu shadowed %llu",
           (unsigned long long)t.lit, (unsigned long long)t.shadowed);
-    CHECK(r.rmse_ideal == 0.0 && isinf(r.psnr_ideal) && r.recall == 1.0 &&
-              r.false_area == 0.0 && r.blotches == 0,
+    CHECK(r.rmse_ideal == 0.0 && isinf(r.psnr_ideal) && r.recall == 1.0 && r.false_area == 0.0 &&
+              r.blotches == 0,
           "ideal scored as itself: rmse %g recall %g false %g", r.rmse_ideal, r.recall,
           r.false_area);
     /* Against hard: only column 99 differs, by .75, on 99 rows. */
@@ -127,11 +127,11 @@ static int part_score(void)
      * shadowed pixels drawn lit. */
     for (int i = 0; i < N; i++)
         s[i] = ideal[i];
-    const int region[][2] = {{2, 2}, {3, 2}, {4, 2}, {2, 3}, {3, 3}, {4, 3},           /* 6 */
-                             {10, 10}, {9, 10}, {11, 10}, {10, 9}, {10, 11},           /* 5 */
+    const int region[][2] = {{2, 2},   {3, 2},   {4, 2},   {2, 3},   {3, 3},   {4, 3}, /* 6 */
+                             {10, 10}, {9, 10},  {11, 10}, {10, 9},  {10, 11},         /* 5 */
                              {20, 20}, {21, 21},                                       /* 1+1 */
                              {30, 30}, {30, 31}, {30, 32}, {30, 33}, {31, 33}, {32, 33},
-                             {33, 33},                                                 /* 7 */
+                             {33, 33}, /* 7 */
                              {40, 0}};
     for (size_t k = 0; k < sizeof region / sizeof region[0]; k++)
         s[region[k][1] * W + region[k][0]] = 0.25f;
@@ -212,8 +212,9 @@ static int bake_to(char *const *sources, const char *out, const char *max_edge)
     argv[n++] = (char *)bake;
     for (; *sources; sources++)
         argv[n++] = *sources;
-    char *rest[] = {"--max-edge", (char *)max_edge, "--rays", "64", "--orders", "2,3",
-                    "--cube-size", "0", "-q", "-o", (char *)out, NULL};
+    char *rest[] = {
+        "--max-edge", (char *)max_edge, "--rays", "64", "--orders", "2,3", "--cube-size", "0", "-q",
+        "-o",         (char *)out,      NULL};
     for (char **r = rest; *r; r++)
         argv[n++] = *r;
     argv[n] = NULL;
@@ -255,8 +256,8 @@ static void scene_free(scene3 *s)
     vdsh_free(s->f);
 }
 
-static float *frame(const char *dir, const char *view, int set, int light, const char *mode,
-                    int w, int h)
+static float *frame(const char *dir, const char *view, int set, int light, const char *mode, int w,
+                    int h)
 {
     char p[4096], msg[4300];
     int fw = 0, fh = 0;
@@ -317,18 +318,20 @@ static int part_box(void)
     const double fov = 30.0, eye_h = 8.0, light_h = 3.0;
     char *views = path_in("floorbox.views.json");
     FILE *f = fopen(views, "w");
-    fprintf(f, "{\"width\": %d, \"height\": %d, \"views\": [{\"name\": \"top\", "
-               "\"eye\": [0, %g, 0], \"target\": [0, 0, 0], \"up\": [0, 0, -1], "
-               "\"fov_y\": %g, \"light_sets\": [[[0, %g, 0]]]}]}\n",
+    fprintf(f,
+            "{\"width\": %d, \"height\": %d, \"views\": [{\"name\": \"top\", "
+            "\"eye\": [0, %g, 0], \"target\": [0, 0, 0], \"up\": [0, 0, -1], "
+            "\"fov_y\": %g, \"light_sets\": [[[0, %g, 0]]]}]}\n",
             W, H, eye_h, fov, light_h);
     fclose(f);
     char *t1 = path_in("truth1"), *t2 = path_in("truth2");
-    int rc1 = run((char *[]){(char *)frames, "truth", vdsh, "--views", views, "-o", t1,
-                             "--threads", "1", NULL});
+    int rc1 = run((char *[]){(char *)frames, "truth", vdsh, "--views", views, "-o", t1, "--threads",
+                             "1", NULL});
     CHECK(rc1 == 0, "truth, 1 thread: exit %d", rc1);
-    CHECK(test_file_contains(out_path, "a frame's truth (320 x 240"), "the time per frame is printed");
-    int rc2 = run((char *[]){(char *)frames, "truth", vdsh, "--views", views, "-o", t2,
-                             "--threads", "2", NULL});
+    CHECK(test_file_contains(out_path, "a frame's truth (320 x 240"),
+          "the time per frame is printed");
+    int rc2 = run((char *[]){(char *)frames, "truth", vdsh, "--views", views, "-o", t2, "--threads",
+                             "2", NULL});
     CHECK(rc2 == 0, "truth, 2 threads: exit %d", rc2);
     if (rc1 || rc2) {
         show_stderr();
@@ -363,10 +366,10 @@ static int part_box(void)
             lit += hard[i] >= 0.5f;
             dark_ideal += ideal[i] < 0.5f;
         }
-        printf("box: %ld hard-shadowed pixels (geometry: %.0f), %ld lit (%.0f)\n", dark,
-               want_dark, lit, want_lit);
-        CHECK(fabs(dark - want_dark) < 0.03 * want_dark, "shadow: %ld pixels, geometry %.1f",
-              dark, want_dark);
+        printf("box: %ld hard-shadowed pixels (geometry: %.0f), %ld lit (%.0f)\n", dark, want_dark,
+               lit, want_lit);
+        CHECK(fabs(dark - want_dark) < 0.03 * want_dark, "shadow: %ld pixels, geometry %.1f", dark,
+              want_dark);
         CHECK(fabs(lit - want_lit) < 0.01 * want_lit, "lit: %ld pixels, geometry %.1f", lit,
               want_lit);
         /* Every shadowed pixel is at d_T / d_L <= .5 / 3: ideal 0 there. */
@@ -412,14 +415,13 @@ static int part_box(void)
 
 /* ---- the built-in room: views and the oracle --------------------------------------------- */
 
-static int room_views(const char *vdsh, const char *views, const char *seed,
-                      const char *threads)
+static int room_views(const char *vdsh, const char *views, const char *seed, const char *threads)
 {
     if (!exists(vdsh) && bake_to((char *[]){"builtin:room", NULL}, vdsh, "1") != 0)
         return -1;
-    int rc = run((char *[]){(char *)frames, "views", (char *)vdsh, "-o", (char *)views,
-                            "--cameras", "3", "--size", "160x120", "--seed", (char *)seed,
-                            "--threads", (char *)threads, NULL});
+    int rc = run((char *[]){(char *)frames, "views", (char *)vdsh, "-o", (char *)views, "--cameras",
+                            "3", "--size", "160x120", "--seed", (char *)seed, "--threads",
+                            (char *)threads, NULL});
     if (rc != 0)
         show_stderr();
     return rc;
@@ -427,8 +429,8 @@ static int room_views(const char *vdsh, const char *views, const char *seed,
 
 static int part_views(void)
 {
-    char *vdsh = path_in("room.vdsh"), *v1 = path_in("a.views.json"),
-         *v2 = path_in("b.views.json"), *v3 = path_in("c.views.json");
+    char *vdsh = path_in("room.vdsh"), *v1 = path_in("a.views.json"), *v2 = path_in("b.views.json"),
+         *v3 = path_in("c.views.json");
     CHECK(room_views(vdsh, v1, "5", "2") == 0, "views, seed 5");
     CHECK(room_views(vdsh, v2, "5", "1") == 0, "views, seed 5 again, one thread");
     CHECK(room_views(vdsh, v3, "6", "2") == 0, "views, seed 6");
@@ -493,8 +495,8 @@ static int part_views(void)
                         }
                     double n = V.width * V.height;
                     CHECK(lit >= 0.03 * n && dark >= 0.03 * n,
-                          "view %s, set %d, light %d: %.1f%% lit, %.1f%% shadowed", v->name, k,
-                          l, 100.0 * lit / n, 100.0 * dark / n);
+                          "view %s, set %d, light %d: %.1f%% lit, %.1f%% shadowed", v->name, k, l,
+                          100.0 * lit / n, 100.0 * dark / n);
                     vb_frames_light_free(&L);
                 }
             vb_frames_hits_free(&h);
@@ -553,16 +555,13 @@ static int part_oracle(void)
         double shadowed = vt_json_number(id, "shadowed"), lit = vt_json_number(id, "lit");
         CHECK(shadowed > 1000 && lit > 1000, "shadowed %g, lit %g", shadowed, lit);
         CHECK(vt_json_number(id, "rmse_ideal") == 0.0 && vt_json_number(id, "recall") == 1.0 &&
-                  vt_json_number(id, "false_area") == 0.0 &&
-                  vt_json_number(id, "blotches") == 0.0,
-              "ideal as a method: rmse %g recall %g false %g",
-              vt_json_number(id, "rmse_ideal"), vt_json_number(id, "recall"),
-              vt_json_number(id, "false_area"));
+                  vt_json_number(id, "false_area") == 0.0 && vt_json_number(id, "blotches") == 0.0,
+              "ideal as a method: rmse %g recall %g false %g", vt_json_number(id, "rmse_ideal"),
+              vt_json_number(id, "recall"), vt_json_number(id, "false_area"));
         /* PSNR of no error is +inf, written as null. */
         CHECK(cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(id, "psnr_ideal")), "psnr null");
         CHECK(vt_json_number(hd, "rmse_hard") == 0.0 && vt_json_number(hd, "recall") == 1.0 &&
-                  vt_json_number(hd, "false_area") == 0.0 &&
-                  vt_json_number(hd, "blotches") == 0.0,
+                  vt_json_number(hd, "false_area") == 0.0 && vt_json_number(hd, "blotches") == 0.0,
               "hard as a method: rmse %g recall %g false %g", vt_json_number(hd, "rmse_hard"),
               vt_json_number(hd, "recall"), vt_json_number(hd, "false_area"));
         /* ideal differs from hard (lights near occluders ramp). */
@@ -580,8 +579,7 @@ static int part_oracle(void)
 /* A copy of file f with one more stream: the variable-order stream (f32,
  * scale 1) whose vertex v has order orders[v] and the coefficients of f's
  * fixed stream of that order, to `out`. 0 on success. */
-static int write_variable(const vdsh_file *f, const uint8_t *orders, uint32_t cap,
-                          const char *out)
+static int write_variable(const vdsh_file *f, const uint8_t *orders, uint32_t cap, const char *out)
 {
     const uint32_t rows = vdsh_file_stream_vertices(f), nc = cap * cap;
     float *src = calloc((size_t)rows * nc, sizeof *src);
@@ -605,8 +603,8 @@ static int write_variable(const vdsh_file *f, const uint8_t *orders, uint32_t ca
     }
     vdsh_stream_offsets(orders, rows, VDSH_ENCODING_F32, offsets);
     data = malloc(4 * (size_t)offsets[rows] + 4);
-    if (!data || vdsh_encode_variable(VDSH_ENCODING_F32, src, nc, orders, rows, cap, 1.0f,
-                                      offsets, scales, data) != VDSH_OK)
+    if (!data || vdsh_encode_variable(VDSH_ENCODING_F32, src, nc, orders, rows, cap, 1.0f, offsets,
+                                      scales, data) != VDSH_OK)
         goto done;
     memcpy(streams, f->streams, f->stream_count * sizeof *streams);
     vdsh_stream *vs = &streams[f->stream_count];
@@ -683,8 +681,8 @@ static int part_orders(void)
                 *cv = mode_scene(j, "c-vdsh-var");
     CHECK(c3 && c7 && cv, "the JSON has every mode's scene");
     if (c3 && c7 && cv) {
-        const char *keys[] = {"rmse_ideal", "rmse_hard", "recall", "false_area", "shadowed",
-                              "lit", "blotches", "blotch_area"};
+        const char *keys[] = {"rmse_ideal", "rmse_hard", "recall",   "false_area",
+                              "shadowed",   "lit",       "blotches", "blotch_area"};
         for (size_t k = 0; k < sizeof keys / sizeof *keys; k++)
             CHECK(vt_json_number(c7, keys[k]) == vt_json_number(cv, keys[k]) ||
                       (isnan(vt_json_number(c7, keys[k])) && isnan(vt_json_number(cv, keys[k]))),
@@ -773,10 +771,12 @@ static int part_errors(void)
     CHECK(run((char *[]){fr, "--help", NULL}) == 0 && test_file_contains(out_path, "c-vdshN") &&
               test_file_contains(out_path, "blotches") && test_file_contains(out_path, "--compare"),
           "--help documents the frames and the scores");
-    CHECK(run((char *[]){fr, "--version", NULL}) == 0 && test_file_contains(out_path, "vdsh-frames "),
+    CHECK(run((char *[]){fr, "--version", NULL}) == 0 &&
+              test_file_contains(out_path, "vdsh-frames "),
           "--version");
     CHECK(run((char *[]){fr, NULL}) == 2 && test_file_contains(err_path, "no subcommand"), "none");
-    CHECK(run((char *[]){fr, "paint", NULL}) == 2 && test_file_contains(err_path, "'paint'"), "unknown");
+    CHECK(run((char *[]){fr, "paint", NULL}) == 2 && test_file_contains(err_path, "'paint'"),
+          "unknown");
     CHECK(run((char *[]){fr, "views", "x.vdsh", NULL}) == 2 && test_file_contains(err_path, "-o"),
           "views without -o");
     CHECK(run((char *[]){fr, "views", "x.vdsh", "-o", "v.json", "--cameras", "0", NULL}) == 2 &&
@@ -823,44 +823,46 @@ static int part_errors(void)
     fprintf(f, "{\"width\": 64, \"height\": 48, \"views\": [{\"name\": \"a b\"}]}\n");
     fclose(f);
     CHECK(run((char *[]){fr, "truth", vdsh, "--views", bad, "-o", truth, NULL}) == 1 &&
-              test_file_contains(err_path, "bad.views.json") && test_file_contains(err_path, "name"),
+              test_file_contains(err_path, "bad.views.json") &&
+              test_file_contains(err_path, "name"),
           "an invalid view set is named with its field");
     f = fopen(views, "w");
-    fprintf(f, "{\"width\": 64, \"height\": 48, \"views\": [{\"name\": \"a\", \"eye\": [0, 3, 3], "
-               "\"target\": [0, 0, 0], \"light_sets\": [[[0, 3, 0]], [[1, 2, 0], [-1, 2, 0]]]}]}\n");
+    fprintf(f,
+            "{\"width\": 64, \"height\": 48, \"views\": [{\"name\": \"a\", \"eye\": [0, 3, 3], "
+            "\"target\": [0, 0, 0], \"light_sets\": [[[0, 3, 0]], [[1, 2, 0], [-1, 2, 0]]]}]}\n");
     fclose(f);
     int rc = run((char *[]){fr, "truth", vdsh, "--views", views, "-o", truth, NULL});
     CHECK(rc == 0, "truth: exit %d", rc);
     if (rc)
         show_stderr();
     /* The truth is there and scores; then break it one way at a time. */
-    CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames",
-                         truth, "--modes", "c-vdsh2", "--json", json, NULL}) == 0 &&
+    CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames", truth,
+                         "--modes", "c-vdsh2", "--json", json, NULL}) == 0 &&
               exists(json),
           "score");
     unlink(json);
-    CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames",
-                         truth, "--modes", "c-vdsh2,vdsh5", "--json", json, NULL}) == 1 &&
-              test_file_contains(err_path, "a-s0-l0-vdsh5.png") && test_file_contains(err_path, "missing") &&
-              !exists(json),
+    CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames", truth,
+                         "--modes", "c-vdsh2,vdsh5", "--json", json, NULL}) == 1 &&
+              test_file_contains(err_path, "a-s0-l0-vdsh5.png") &&
+              test_file_contains(err_path, "missing") && !exists(json),
           "a missing frame is named, no JSON written");
     char other[4096];
     vt_frame_path(other, sizeof other, truth, "a", 1, 1, "c-vdsh3");
     float small[32 * 24] = {0};
     char msg[4300];
     CHECK(vt_png16_write(other, 32, 24, small, msg, sizeof msg) == 0, "%s", msg);
-    CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames",
-                         truth, "--modes", "c-vdsh3", "--json", json, NULL}) == 1 &&
-              test_file_contains(err_path, "a-s1-l1-c-vdsh3.png") && test_file_contains(err_path, "32 x 24") &&
-              !exists(json),
+    CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames", truth,
+                         "--modes", "c-vdsh3", "--json", json, NULL}) == 1 &&
+              test_file_contains(err_path, "a-s1-l1-c-vdsh3.png") &&
+              test_file_contains(err_path, "32 x 24") && !exists(json),
           "a frame of another size is named");
     char mask[4096];
     vt_frame_path(mask, sizeof mask, truth, "a", 0, 0, "mask");
     f = fopen(mask, "w");
     fputs("not a PNG", f);
     fclose(f);
-    CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames",
-                         truth, "--modes", "c-vdsh2", NULL}) == 1 &&
+    CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames", truth,
+                         "--modes", "c-vdsh2", NULL}) == 1 &&
               test_file_contains(err_path, "a-s0-l0-mask.png"),
           "a broken truth frame is named");
     /* A file where the output folder should be. */

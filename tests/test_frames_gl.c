@@ -22,8 +22,8 @@
 #include "vt_image.h"
 #include "vt_views.h"
 
-static float *load(const char *dir, const char *view, int set, int light, const char *mode,
-                   int w, int h)
+static float *load(const char *dir, const char *view, int set, int light, const char *mode, int w,
+                   int h)
 {
     char path[4096], msg[4400];
     int fw, fh;
@@ -93,8 +93,7 @@ int main(int argc, char **argv)
         int ok = n > 0 && worst_mean <= mean_max && worst_share <= share_max;
         printf("%-10s vs %-8s: %zu mask pixels, mean |GL - C| %.5f (worst frame %.5f), "
                "differing by > 0.1: %.3f%% (worst frame %.3f%%)%s\n",
-               gl, cm, n, mean, worst_mean, 100.0 * share, 100.0 * worst_share,
-               ok ? "" : "  FAIL");
+               gl, cm, n, mean, worst_mean, 100.0 * share, 100.0 * worst_share, ok ? "" : "  FAIL");
         fail |= !ok;
     }
     vt_views_free(&vs);

@@ -35,7 +35,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (!path[0]) {
         const char *dir = getenv("TMPDIR");
-        snprintf(path, sizeof path, "%s/vdsh-fuzz-cubemap-%ld.exr", dir && dir[0] ? dir : "/tmp", (long)getpid());
+        snprintf(path, sizeof path, "%s/vdsh-fuzz-cubemap-%ld.exr", dir && dir[0] ? dir : "/tmp",
+                 (long)getpid());
         atexit(remove_temp);
     }
     FILE *fp = fopen(path, "wb");

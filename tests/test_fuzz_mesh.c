@@ -32,12 +32,12 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-#define REQUIRE(cond, what)                                                   \
-    do {                                                                      \
-        if (!(cond)) {                                                        \
-            fprintf(stderr, "%s: %s\n", NAME, what);                          \
-            abort();                                                          \
-        }                                                                     \
+#define REQUIRE(cond, what)                                                                        \
+    do {                                                                                           \
+        if (!(cond)) {                                                                             \
+            fprintf(stderr, "%s: %s\n", NAME, what);                                               \
+            abort();                                                                               \
+        }                                                                                          \
     } while (0)
 
 /* mesh.h's promise for loaded meshes (refined ones may keep the input's
@@ -75,7 +75,8 @@ static void check_raw(const vb_mesh_raw *r)
     REQUIRE(r->positions && r->indices && r->faces, "arrays missing");
     for (size_t i = 0; i < 3 * (size_t)r->vertex_count; i++)
         REQUIRE(isfinite(r->positions[i]), "non-finite position");
-    REQUIRE((r->normals == NULL) == (r->has_normal == NULL), "normals without has_normal or the reverse");
+    REQUIRE((r->normals == NULL) == (r->has_normal == NULL),
+            "normals without has_normal or the reverse");
     for (uint32_t i = 0; r->normals && i < r->vertex_count; i++) {
         const float *n = r->normals + 3 * (size_t)i;
         double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
@@ -83,14 +84,16 @@ static void check_raw(const vb_mesh_raw *r)
         REQUIRE(len == 0.0 || fabs(len - 1.0) < 1e-3, "file normal neither unit nor zero");
         REQUIRE(r->has_normal[i] || len == 0.0, "a normal where none was given");
     }
-    REQUIRE((r->corner_normals == NULL) == (r->corner_given == NULL), "corner normals without flags");
+    REQUIRE((r->corner_normals == NULL) == (r->corner_given == NULL),
+            "corner normals without flags");
     for (size_t c = 0; r->corner_normals && c < 3 * (size_t)r->triangle_count; c++)
         for (int k = 0; k < 3; k++)
             REQUIRE(isfinite(r->corner_normals[3 * c + (size_t)k]), "non-finite corner normal");
     for (size_t t = 0; t < r->triangle_count; t++) {
         REQUIRE(t == 0 || r->faces[t] >= r->faces[t - 1], "faces out of order");
         for (int k = 0; k < 3; k++)
-            REQUIRE(r->indices[3 * t + (size_t)k] >= 0 && r->indices[3 * t + (size_t)k] < (int64_t)r->vertex_count,
+            REQUIRE(r->indices[3 * t + (size_t)k] >= 0 &&
+                        r->indices[3 * t + (size_t)k] < (int64_t)r->vertex_count,
                     "raw index out of range");
     }
 }
@@ -102,16 +105,19 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     vb_mesh_raw raw;
     memset(&raw, 0, sizeof raw);
     vb_mesh_format format = format_of_name();
-    int parsed = size > 0 && (format == VB_MESH_GLTF || format == VB_MESH_GLB
-                                  ? vb_mesh_parse_gltf(NAME, format == VB_MESH_GLB, -1, data, size, &raw, &err)
-                                  : vb_mesh_parse(NAME, format, data, size, &raw, &err)) == VB_OK;
+    int parsed = size > 0 &&
+                 (format == VB_MESH_GLTF || format == VB_MESH_GLB
+                      ? vb_mesh_parse_gltf(NAME, format == VB_MESH_GLB, -1, data, size, &raw, &err)
+                      : vb_mesh_parse(NAME, format, data, size, &raw, &err)) == VB_OK;
     if (parsed)
         check_raw(&raw);
     else if (size > 0)
-        REQUIRE(strncmp(err.msg, NAME ":", strlen(NAME ":")) == 0, "reader's message does not name the input");
+        REQUIRE(strncmp(err.msg, NAME ":", strlen(NAME ":")) == 0,
+                "reader's message does not name the input");
     vb_mesh_raw_free(&raw);
     if (vb_mesh_load_memory(data, size, NAME, NULL, &m, NULL, &err) != VB_OK) {
-        REQUIRE(strncmp(err.msg, NAME ":", strlen(NAME ":")) == 0, "message does not name the input");
+        REQUIRE(strncmp(err.msg, NAME ":", strlen(NAME ":")) == 0,
+                "message does not name the input");
         return 0;
     }
     REQUIRE(parsed, "loading accepted what the reader refused");

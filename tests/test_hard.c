@@ -25,7 +25,8 @@ static int bake_with(const vb_mesh *occ, const vb_mesh *rec, vb_method method, u
         fprintf(stderr, "scene: %s\n", err.msg);
         return 0;
     }
-    vb_bake_desc d = {.keep_normals = 1, .receivers = rec, .scene = s, .rays = rays, .seed = 3, .method = method};
+    vb_bake_desc d = {
+        .keep_normals = 1, .receivers = rec, .scene = s, .rays = rays, .seed = 3, .method = method};
     vb_result r = vb_bake_run(&d, out, &err);
     if (r != VB_OK)
         fprintf(stderr, "bake: %s\n", err.msg);
@@ -100,8 +101,8 @@ static void test_corners(void)
                 open += D, no++;
         }
         blocked /= nb, open /= no;
-        CHECK(blocked < 0.3 * open, "corner (%g, %g): mean D toward the walls %g vs %g open",
-              p[0], p[2], blocked, open);
+        CHECK(blocked < 0.3 * open, "corner (%g, %g): mean D toward the walls %g vs %g open", p[0],
+              p[2], blocked, open);
     }
     CHECK(corners == 4, "found %d floor corners", corners);
 done:
@@ -133,7 +134,8 @@ static void test_degenerate_triangles(void)
         float dir[3];
         test_rand_dir(&s, dir);
         for (int k = 0; k < 3; k++) {
-            float f = t % 2 ? (float)k * 0.4f : (k == 2 ? 0.0f : 0.5f * k); /* collinear / repeated */
+            float f =
+                t % 2 ? (float)k * 0.4f : (k == 2 ? 0.0f : 0.5f * k); /* collinear / repeated */
             for (int c = 0; c < 3; c++) {
                 junk.positions[3 * (nv0 + 3 * t + k) + c] = a[c] + f * dir[c];
                 junk.normals[3 * (nv0 + 3 * t + k) + c] = 0;
@@ -219,12 +221,15 @@ static void test_scale_and_offset(void)
     CHECK(bake_with(&occ, &rec, VB_METHOD_PAPER, 400, 1, &ref), "reference bake");
     size_t n = (size_t)rec.vertex_count * 25;
 
-    struct { float scale, off; int exact; const char *what; } cases[] = {
-        {1.0f, 1e5f, 1, "moved to 1e5"},
-        {1.0f, -3e5f, 1, "moved to -3e5"},
-        {1.0f / 16384, 0.0f, 1, "scaled by 2^-14"},
-        {1e-4f, 0.0f, 0, "scaled by 1e-4"},
-        {1e4f, 0.0f, 0, "scaled by 1e4"}};
+    struct {
+        float scale, off;
+        int exact;
+        const char *what;
+    } cases[] = {{1.0f, 1e5f, 1, "moved to 1e5"},
+                 {1.0f, -3e5f, 1, "moved to -3e5"},
+                 {1.0f / 16384, 0.0f, 1, "scaled by 2^-14"},
+                 {1e-4f, 0.0f, 0, "scaled by 1e-4"},
+                 {1e4f, 0.0f, 0, "scaled by 1e4"}};
     for (size_t c = 0; c < sizeof cases / sizeof cases[0] && ref.coeffs[5]; c++) {
         vb_mesh o2 = {0}, r2 = {0};
         refined_room(&o2, &r2, 4.0f, 3.0f, 2.5f);
@@ -252,8 +257,8 @@ static void test_scale_and_offset(void)
             if (cases[c].exact) {
                 CHECK(worst == 0.0, "%s: coefficients differ by %g", cases[c].what, worst);
             } else {
-                CHECK(sum / n < 1e-5 * ref.max_distance, "%s: mean difference %g",
-                      cases[c].what, sum / n);
+                CHECK(sum / n < 1e-5 * ref.max_distance, "%s: mean difference %g", cases[c].what,
+                      sum / n);
                 CHECK(moved * 100 <= rec.vertex_count, "%s: %u of %u receivers moved",
                       cases[c].what, moved, rec.vertex_count);
             }
@@ -283,8 +288,7 @@ static void test_f16_range(void)
         vdsh_stream s;
         void *mem = NULL;
         vb_error err;
-        if (b.coeffs[5] &&
-            vb_bake_stream(&b, 5, VDSH_ENCODING_F16, &s, &mem, &err) == VB_OK) {
+        if (b.coeffs[5] && vb_bake_stream(&b, 5, VDSH_ENCODING_F16, &s, &mem, &err) == VB_OK) {
             double worst = 0, amax = 0;
             for (uint32_t v = 0; v < rec.vertex_count; v++) {
                 float c[25];
@@ -297,8 +301,8 @@ static void test_f16_range(void)
             }
             /* Half precision: 2^-11 relative to the value, so at most
              * 2^-11 of the largest coefficient. */
-            CHECK(worst <= amax / 2048.0 * 1.0001, "scale %g: f16 error %g of %g", scales[k],
-                  worst, amax);
+            CHECK(worst <= amax / 2048.0 * 1.0001, "scale %g: f16 error %g of %g", scales[k], worst,
+                  amax);
         } else {
             CHECK(0, "f16 stream at scale %g", scales[k]);
         }
@@ -322,8 +326,8 @@ static void test_f16_range(void)
                     vdsh_stream_decode(&s, v, c);
                     for (int i = 0; i < 25; i++) {
                         float want = b.coeffs[5][25 * (size_t)v + i];
-                        float half = s.coef_scales[i] / (2.0f * (float)vdsh_quant_levels(quant[e],
-                                                                                     (uint32_t)i));
+                        float half = s.coef_scales[i] /
+                                     (2.0f * (float)vdsh_quant_levels(quant[e], (uint32_t)i));
                         bad += !isfinite(c[i]) || fabsf(c[i] - want) > half * 1.0001f ||
                                (zeroed && c[i] != 0.0f);
                     }
@@ -416,8 +420,8 @@ static void add_box(vb_mesh *m, float x0, float x1, float y0, float y1, float z0
                            {x0, y0, z1}, {x1, y0, z1}, {x0, y1, z1}, {x1, y1, z1}};
     static const int q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
                                 {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    static const float nrm[6][3] = {{0, 0, -1}, {0, 0, 1}, {0, -1, 0},
-                                    {0, 1, 0}, {-1, 0, 0}, {1, 0, 0}};
+    static const float nrm[6][3] = {{0, 0, -1}, {0, 0, 1},  {0, -1, 0},
+                                    {0, 1, 0},  {-1, 0, 0}, {1, 0, 0}};
     for (int f = 0; f < 6; f++) {
         const float quad[4][3] = {{c[q[f][0]][0], c[q[f][0]][1], c[q[f][0]][2]},
                                   {c[q[f][1]][0], c[q[f][1]][1], c[q[f][1]][2]},
@@ -437,7 +441,7 @@ static void test_inverted_normals(void)
     vb_mesh m = {0}, rec = {0};
     test_make_room(&m, 4.0f, 3.0f, 2.5f);
     uint32_t room_vertices = m.vertex_count;
-    add_box(&m, -1, 1, 1, 2, -0.5f, 0.5f, 1);  /* floating, normals inverted */
+    add_box(&m, -1, 1, 1, 2, -0.5f, 0.5f, 1); /* floating, normals inverted */
     add_box(&m, 2, 3, 0, 1, -1, 0, 0);        /* a crate on the floor, right */
     vb_error err;
     CHECK(vb_mesh_refine(&m, 0.5f, &rec, &err) == VB_OK, "refine");
@@ -450,8 +454,8 @@ static void test_inverted_normals(void)
     uint32_t box = 0, wrong = 0;
     for (uint32_t v = 0; v < rec.vertex_count; v++) {
         const float *p = rec.positions + 3 * (size_t)v, *n = rec.normals + 3 * (size_t)v;
-        int in_box = p[0] >= -1 && p[0] <= 1 && p[1] >= 1 && p[1] <= 2 && p[2] >= -0.5f &&
-                     p[2] <= 0.5f;
+        int in_box =
+            p[0] >= -1 && p[0] <= 1 && p[1] >= 1 && p[1] <= 2 && p[2] >= -0.5f && p[2] <= 0.5f;
         /* A box vertex's normal must now point out: away from its centre. */
         if (in_box && v >= room_vertices) {
             box++;
@@ -461,8 +465,9 @@ static void test_inverted_normals(void)
             wrong += memcmp(n, before + 3 * (size_t)v, 3 * sizeof(float)) != 0;
         }
     }
-    CHECK(box > 0 && wrong == 0, "%u of %u box or other receivers wrong after orienting (%u flipped)",
-          wrong, rec.vertex_count, flipped);
+    CHECK(box > 0 && wrong == 0,
+          "%u of %u box or other receivers wrong after orienting (%u flipped)", wrong,
+          rec.vertex_count, flipped);
     CHECK(flipped == box, "flipped %u, the inverted box has %u receivers", flipped, box);
     free(before);
     vb_scene_destroy(s);
@@ -487,8 +492,13 @@ static void test_orient_in_bake(void)
     uint32_t flipped = 0;
     CHECK(vb_orient_receivers(&mine, s, 2, &flipped, &err) == VB_OK, "orient: %s", err.msg);
     CHECK(flipped > 0, "the inverted box has receivers to flip");
-    vb_bake_desc a = {.receivers = &rec, .scene = s, .rays = 256, .seed = 3, .threads = 2,
-                      .order_mask = 1u << 3, .method = VB_METHOD_LSQ};
+    vb_bake_desc a = {.receivers = &rec,
+                      .scene = s,
+                      .rays = 256,
+                      .seed = 3,
+                      .threads = 2,
+                      .order_mask = 1u << 3,
+                      .method = VB_METHOD_LSQ};
     vb_bake_desc b = a;
     b.receivers = &mine;
     b.keep_normals = 1;
@@ -510,8 +520,8 @@ static void test_orient_in_bake(void)
     CHECK(vb_bake_run(&z, &oz, &err) == VB_OK, "bake, zeroed description: %s", err.msg);
     CHECK(oz.method == VDSH_METHOD_DECISION && oz.quantity[5] == VDSH_QUANTITY_LOG_DISTANCE &&
               oz.coeffs[5] && oz.flipped_normals == flipped && oz.normals,
-          "zeroed description: method %s, quantity %s, %u flipped",
-          vdsh_method_name(oz.method), vdsh_quantity_name(oz.quantity[5]), oz.flipped_normals);
+          "zeroed description: method %s, quantity %s, %u flipped", vdsh_method_name(oz.method),
+          vdsh_quantity_name(oz.quantity[5]), oz.flipped_normals);
     vb_bake_output_free(&oz);
     vb_bake_output_free(&oa);
     vb_bake_output_free(&ob);
@@ -533,11 +543,11 @@ static void test_contact_and_embedded(void)
 {
     vb_mesh m = {0}, rec = {0};
     test_make_room(&m, 4.0f, 3.0f, 2.5f);
-    add_box(&m, -2, -1, 0, 1, -1, 0, 0);             /* bottom face on the floor */
-    add_box(&m, 1.5f, 2.5f, 0, 3, 0.5f, 1.5f, 0);    /* a pillar */
+    add_box(&m, -2, -1, 0, 1, -1, 0, 0);          /* bottom face on the floor */
+    add_box(&m, 1.5f, 2.5f, 0, 3, 0.5f, 1.5f, 0); /* a pillar */
     const float panel[4][3] = {{0.3f, 0.5f, 1}, {0.3f, 2.5f, 1}, {1.7f, 2.5f, 1}, {1.7f, 0.5f, 1}};
     const float pn[3] = {0, 0, -1};
-    test_add_quad(&m, panel, pn);                    /* its edge x = 1.7 inside the pillar */
+    test_add_quad(&m, panel, pn); /* its edge x = 1.7 inside the pillar */
     vb_error err;
     CHECK(vb_mesh_refine(&m, 0.5f, &rec, &err) == VB_OK, "refine");
     vb_bake_output b = {0};
@@ -616,8 +626,8 @@ static void test_coincident_faces(void)
     memcpy(before, rec.normals, 3 * (size_t)rec.vertex_count * sizeof(float));
     uint32_t flipped = 0;
     CHECK(vb_orient_receivers(&rec, s, 2, &flipped, &err) == VB_OK, "orient");
-    CHECK(flipped == 0 && memcmp(before, rec.normals, 3 * (size_t)rec.vertex_count *
-                                                          sizeof(float)) == 0,
+    CHECK(flipped == 0 &&
+              memcmp(before, rec.normals, 3 * (size_t)rec.vertex_count * sizeof(float)) == 0,
           "%u normals flipped", flipped);
     float *org = malloc(3 * (size_t)rec.vertex_count * sizeof(float));
     vb_origins_stats st = {0};
@@ -636,8 +646,8 @@ static void test_coincident_faces(void)
             sheet_wrong += n[1] > 0 ? !(world_y > 2.0f) : !(world_y < 2.0f);
         }
     }
-    CHECK(bottoms > 0 && escaped == 0, "%u of %u box-bottom receivers look into the void",
-          escaped, bottoms);
+    CHECK(bottoms > 0 && escaped == 0, "%u of %u box-bottom receivers look into the void", escaped,
+          bottoms);
     CHECK(sheet > 0 && sheet_wrong == 0, "%u of %u sheet receivers moved to the other side",
           sheet_wrong, sheet);
     CHECK(st.moved == bottoms, "%u origins moved, %u box-bottom receivers", st.moved, bottoms);
@@ -676,12 +686,16 @@ static void test_small_parts(void)
     vb_error err;
     vb_scene *s = NULL;
     CHECK(vb_scene_create(&m, NULL, &s, &err) == VB_OK, "scene");
-    vb_bake_desc d = {.keep_normals = 1, .receivers = &m, .scene = s, .rays = 1024, .seed = 3,
-                      .method = VB_METHOD_LSQ, .quantity = VB_QUANTITY_LOG};
+    vb_bake_desc d = {.keep_normals = 1,
+                      .receivers = &m,
+                      .scene = s,
+                      .rays = 1024,
+                      .seed = 3,
+                      .method = VB_METHOD_LSQ,
+                      .quantity = VB_QUANTITY_LOG};
     vb_bake_output b = {0};
     CHECK(vb_bake_run(&d, &b, &err) == VB_OK, "bake: %s", err.msg);
-    CHECK(b.degenerate_receivers <= 100 * 4 + 8, "%u degenerate receivers",
-          b.degenerate_receivers);
+    CHECK(b.degenerate_receivers <= 100 * 4 + 8, "%u degenerate receivers", b.degenerate_receivers);
     CHECK(b.origins.flagged <= 100 * 12 + 8 && b.origins.moved <= b.origins.flagged,
           "%u receivers sent to the repair, %u moved", b.origins.flagged, b.origins.moved);
     CHECK(b.origins.probe_rays <= b.rays_traced / 8, "the probes traced %llu rays, the bake %llu",
@@ -708,14 +722,18 @@ static void test_default_fit(vb_method method)
     CHECK(vb_mesh_refine(&m, 0.5f, &rec, &err) == VB_OK, "refine");
     vb_scene *s = NULL;
     CHECK(vb_scene_create(&m, NULL, &s, &err) == VB_OK, "scene");
-    vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = s, .rays = 512, .seed = 3,
-                      .method = method, .quantity = VB_QUANTITY_AUTO,
+    vb_bake_desc d = {.keep_normals = 1,
+                      .receivers = &rec,
+                      .scene = s,
+                      .rays = 512,
+                      .seed = 3,
+                      .method = method,
+                      .quantity = VB_QUANTITY_AUTO,
                       .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
     vb_bake_output b = {0};
-    CHECK(s && vb_bake_run(&d, &b, &err) == VB_OK, "%s bake: %s", vb_method_name(method),
-          err.msg);
-    uint32_t sampled = method == VB_METHOD_LSQ ? (rec.vertex_count < 1024 ? rec.vertex_count
-                                                                             : 1024) : 0;
+    CHECK(s && vb_bake_run(&d, &b, &err) == VB_OK, "%s bake: %s", vb_method_name(method), err.msg);
+    uint32_t sampled =
+        method == VB_METHOD_LSQ ? (rec.vertex_count < 1024 ? rec.vertex_count : 1024) : 0;
     CHECK(b.auto_receivers == sampled, "%s: %u receivers sampled for the choice",
           vb_method_name(method), b.auto_receivers);
     long bad = 0, checked = 0, runaway = 0;
@@ -773,8 +791,13 @@ static void test_lit_walls(void)
     vb_scene *sc = NULL;
     CHECK(vb_scene_create(&occ, NULL, &sc, &err) == VB_OK, "scene: %s", err.msg);
     /* The default bake: what vdsh-bake does with no method or quantity. */
-    vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = sc, .rays = 625, .seed = 3,
-                      .method = VB_METHOD_SHADOW, .quantity = VB_QUANTITY_AUTO,
+    vb_bake_desc d = {.keep_normals = 1,
+                      .receivers = &rec,
+                      .scene = sc,
+                      .rays = 625,
+                      .seed = 3,
+                      .method = VB_METHOD_SHADOW,
+                      .quantity = VB_QUANTITY_AUTO,
                       .order_mask = (1u << 2) | (1u << 3) | (1u << 5)};
     vb_bake_output out = {0};
     CHECK(sc && vb_bake_run(&d, &out, &err) == VB_OK, "bake: %s", err.msg);
@@ -788,13 +811,11 @@ static void test_lit_walls(void)
         for (uint32_t v = 0; v < rec.vertex_count; v++) {
             const float *p = rec.positions + 3 * v;
             int on_x = fabsf(fabsf(p[0]) - 9.5f) < 1e-4f, on_z = fabsf(fabsf(p[2]) - 9.5f) < 1e-4f;
-            if (on_x == on_z || p[1] < 0.75f || p[1] > 5.25f ||
-                fabsf(on_x ? p[2] : p[0]) > 8.75f)
+            if (on_x == on_z || p[1] < 0.75f || p[1] > 5.25f || fabsf(on_x ? p[2] : p[0]) > 8.75f)
                 continue;
             walls++;
             float s = vdsh_shadow(o, out.quantity[o], out.max_distance,
-                                  out.coeffs[o] + (size_t)o * o * v, p, light,
-                                  VDSH_COMPARE_SMOOTH);
+                                  out.coeffs[o] + (size_t)o * o * v, p, light, VDSH_COMPARE_SMOOTH);
             dark += s < 1.0f;
             worst = s < worst ? s : worst;
         }

@@ -16,15 +16,16 @@
 #include <math.h>
 #include <string.h>
 
-static vb_result parse(const char *name, vb_mesh_format f, const void *bytes, size_t size, vb_mesh_raw *raw,
-                       vb_error *err)
+static vb_result parse(const char *name, vb_mesh_format f, const void *bytes, size_t size,
+                       vb_mesh_raw *raw, vb_error *err)
 {
     memset(raw, 0, sizeof *raw);
     err->msg[0] = 0;
     return vb_mesh_parse(name, f, (const uint8_t *)bytes, size, raw, err);
 }
 
-static vb_result parse_text(const char *name, vb_mesh_format f, const char *text, vb_mesh_raw *raw, vb_error *err)
+static vb_result parse_text(const char *name, vb_mesh_format f, const char *text, vb_mesh_raw *raw,
+                            vb_error *err)
 {
     return parse(name, f, text, strlen(text), raw, err);
 }
@@ -37,13 +38,15 @@ static uint32_t bits(float f)
 }
 
 /* Refused, naming the input, with `needle` in the message. */
-static void expect_refused(const char *name, vb_mesh_format f, const void *bytes, size_t size, const char *needle)
+static void expect_refused(const char *name, vb_mesh_format f, const void *bytes, size_t size,
+                           const char *needle)
 {
     vb_mesh_raw raw;
     vb_error err;
     vb_result r = parse(name, f, bytes, size, &raw, &err);
     CHECK(r != VB_OK, "%s: accepted", name);
-    CHECK(strncmp(err.msg, name, strlen(name)) == 0, "%s: message does not name it: %s", name, err.msg);
+    CHECK(strncmp(err.msg, name, strlen(name)) == 0, "%s: message does not name it: %s", name,
+          err.msg);
     CHECK(strstr(err.msg, needle) != NULL, "%s: message lacks '%s': %s", name, needle, err.msg);
     vb_mesh_raw_free(&raw);
 }
@@ -56,8 +59,9 @@ static void test_numbers(void)
     vb_error err;
     const char *obj = "v 1e-50 -1e-50 1e-40\nv 3.4028235e38 0.1 -0\nv +5 007 1e+05\nf 1 2 3\n";
     CHECK(parse_text("n.obj", VB_MESH_OBJ, obj, &raw, &err) == VB_OK, "%s", err.msg);
-    static const uint32_t want[9] = {0x00000000u, 0x80000000u, 0x000116c2u, 0x7f7fffffu, 0x3dcccccdu,
-                                     0x80000000u, 0x40a00000u, 0x40e00000u, 0x47c35000u};
+    static const uint32_t want[9] = {0x00000000u, 0x80000000u, 0x000116c2u,
+                                     0x7f7fffffu, 0x3dcccccdu, 0x80000000u,
+                                     0x40a00000u, 0x40e00000u, 0x47c35000u};
     for (int i = 0; i < 9 && raw.vertex_count == 3; i++)
         CHECK(bits(raw.positions[i]) == want[i], "n.obj: coordinate %d: bits %08x, want %08x", i,
               bits(raw.positions[i]), want[i]);
@@ -75,43 +79,48 @@ static void test_obj_normals(void)
     vb_mesh_raw raw;
     vb_error err;
     const char *obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
-                      "f 1//1 2//-1 3//0\n"   /* -1: the last normal so far, none yet: no normal */
+                      "f 1//1 2//-1 3//0\n" /* -1: the last normal so far, none yet: no normal */
                       "vn 0 0 1\nvn 1 0 0\n"
-                      "f 2//2 4//9 3//-2\n";  /* 9: past the normals (2): none */
+                      "f 2//2 4//9 3//-2\n"; /* 9: past the normals (2): none */
     CHECK(parse_text("c.obj", VB_MESH_OBJ, obj, &raw, &err) == VB_OK, "%s", err.msg);
     if (raw.triangle_count == 2 && raw.corner_given && raw.has_normal) {
         static const uint8_t given[6] = {1, 0, 0, 1, 0, 1};
         for (int c = 0; c < 6; c++)
-            CHECK(raw.corner_given[c] == given[c], "c.obj: corner %d given %u", c, raw.corner_given[c]);
+            CHECK(raw.corner_given[c] == given[c], "c.obj: corner %d given %u", c,
+                  raw.corner_given[c]);
         CHECK(raw.corner_normals[2] == 1.0f, "c.obj: corner 0 takes normal 1 (forward)");
         CHECK(raw.corner_normals[9] == 1.0f && raw.corner_normals[17] == 1.0f,
               "c.obj: corner 3 normal 2, corner 5 normal -2 = 1");
         /* vertex 2 (index 1): given normal 1 nowhere, normal 2 once */
         CHECK(raw.has_normal[0] && raw.has_normal[1] && raw.has_normal[2] && !raw.has_normal[3],
-              "c.obj: has_normal %u %u %u %u", raw.has_normal[0], raw.has_normal[1], raw.has_normal[2],
-              raw.has_normal[3]);
+              "c.obj: has_normal %u %u %u %u", raw.has_normal[0], raw.has_normal[1],
+              raw.has_normal[2], raw.has_normal[3]);
         CHECK(raw.normals[3] == 1.0f && raw.normals[8] == 1.0f, "c.obj: per-vertex normals");
     } else {
-        CHECK(0, "c.obj: %u triangles, corner normals %p", raw.triangle_count, (void *)raw.corner_given);
+        CHECK(0, "c.obj: %u triangles, corner normals %p", raw.triangle_count,
+              (void *)raw.corner_given);
     }
     vb_mesh_raw_free(&raw);
 
     /* A line that starts with a vertical tab (after blanks) is skipped; a
      * vertex or face skipped that way is refused. */
-    CHECK(parse_text("vt.obj", VB_MESH_OBJ, "v 0 0 0\nv 1 0 0\nv 0 1 0\n\vvn 0 0 1\nf 1//1 2 3\n", &raw, &err) ==
-              VB_OK && raw.normals == NULL,
+    CHECK(parse_text("vt.obj", VB_MESH_OBJ, "v 0 0 0\nv 1 0 0\nv 0 1 0\n\vvn 0 0 1\nf 1//1 2 3\n",
+                     &raw, &err) == VB_OK &&
+              raw.normals == NULL,
           "vt.obj: %s", err.msg);
     vb_mesh_raw_free(&raw);
     const char *vline = "v 0 0 0\nv 1 0 0\n \vv 0 1 0\nf 1 2 3\n";
-    expect_refused("vl.obj", VB_MESH_OBJ, vline, strlen(vline), "line 3: a vertex line starting with a vertical tab");
+    expect_refused("vl.obj", VB_MESH_OBJ, vline, strlen(vline),
+                   "line 3: a vertex line starting with a vertical tab");
     /* Text after '#' on a face line that names another vertex. */
     const char *hash = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3 # 4\n";
-    expect_refused("h.obj", VB_MESH_OBJ, hash, strlen(hash), "line 5: the text after '#' reads as further");
+    expect_refused("h.obj", VB_MESH_OBJ, hash, strlen(hash),
+                   "line 5: the text after '#' reads as further");
 }
 
 static void put_f32(uint8_t *p, float f)
 {
-    memcpy(p, &f, 4);   /* little-endian hosts only, as the tests run */
+    memcpy(p, &f, 4); /* little-endian hosts only, as the tests run */
 }
 
 /* STL: corners within FLT_MIN of each other (+0 and -0, 0 and 1e-40) are
@@ -133,8 +142,8 @@ static void test_stl_merge(void)
     vb_mesh_raw raw;
     vb_error err;
     CHECK(parse("m.stl", VB_MESH_STL, b, sizeof b, &raw, &err) == VB_OK, "%s", err.msg);
-    CHECK(raw.vertex_count == 7 && raw.triangle_count == 3, "m.stl: %u vertices, %u triangles (want 7, 3)",
-          raw.vertex_count, raw.triangle_count);
+    CHECK(raw.vertex_count == 7 && raw.triangle_count == 3,
+          "m.stl: %u vertices, %u triangles (want 7, 3)", raw.vertex_count, raw.triangle_count);
     CHECK(raw.triangle_count == 3 && raw.indices[3] == 0 && raw.indices[6] == 2,
           "m.stl: 1e-40 and -0 merged with earlier vertices");
     vb_mesh_raw_free(&raw);
@@ -143,8 +152,10 @@ static void test_stl_merge(void)
 /* A binary PLY as a byte string: header, then `body`. */
 static size_t ply_bytes(uint8_t *out, const char *props, const uint8_t *body, size_t n)
 {
-    int h = sprintf((char *)out, "ply\nformat binary_little_endian 1.0\nelement vertex 3\n%selement face 1\n"
-                                 "property list uchar int vertex_indices\nend_header\n", props);
+    int h = sprintf((char *)out,
+                    "ply\nformat binary_little_endian 1.0\nelement vertex 3\n%selement face 1\n"
+                    "property list uchar int vertex_indices\nend_header\n",
+                    props);
     memcpy(out + h, body, n);
     return (size_t)h + n;
 }
@@ -176,7 +187,8 @@ static void test_ply_layouts(void)
     for (int i = 0; i < 9; i++, n += 8)
         memcpy(body + n, &xyz[i], 8);
     n += put_face(body + n);
-    size_t size = ply_bytes(file, "property double x\nproperty double y\nproperty double z\n", body, n);
+    size_t size =
+        ply_bytes(file, "property double x\nproperty double y\nproperty double z\n", body, n);
     CHECK(parse("d.ply", VB_MESH_PLY, file, size, &raw, &err) == VB_OK, "%s", err.msg);
     CHECK(raw.vertex_count == 3 && raw.positions[0] == 0.1f && bits(raw.positions[8]) == 0,
           "d.ply: doubles not rounded to float");
@@ -193,9 +205,12 @@ static void test_ply_layouts(void)
         n += 4;
     }
     n += put_face(body + n);
-    size = ply_bytes(file, "property float x\nproperty float y\nproperty float z\nproperty int float\n", body, n);
+    size = ply_bytes(file,
+                     "property float x\nproperty float y\nproperty float z\nproperty int float\n",
+                     body, n);
     CHECK(parse("f.ply", VB_MESH_PLY, file, size, &raw, &err) == VB_OK, "%s", err.msg);
-    CHECK(raw.vertex_count == 3 && raw.positions[3] == 1.0f && raw.positions[7] == 1.0f, "f.ply: misread");
+    CHECK(raw.vertex_count == 3 && raw.positions[3] == 1.0f && raw.positions[7] == 1.0f,
+          "f.ply: misread");
     vb_mesh_raw_free(&raw);
 
     /* x, "uint16 int" (read as 4 bytes), y, "ushort s" (a texture
@@ -212,8 +227,10 @@ static void test_ply_layouts(void)
         n += 16;
     }
     n += put_face(body + n);
-    size = ply_bytes(file, "property float x\nproperty uint16 int\nproperty float y\nproperty ushort s\n"
-                           "property float z\n", body, n);
+    size = ply_bytes(file,
+                     "property float x\nproperty uint16 int\nproperty float y\nproperty ushort s\n"
+                     "property float z\n",
+                     body, n);
     expect_refused("shifted.ply", VB_MESH_PLY, file, size, "binary property 'int' of type uint16");
 
     /* an integer z */
@@ -237,23 +254,27 @@ static void test_ply_layouts(void)
  * now refused. In the last face nothing used follows: read as before. */
 static void test_ply_colours(void)
 {
-    static const char head[] = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
-                               "property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
-                               "property %s red\nend_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2 %s\n3 1 3 2 %s\n";
+    static const char head[] =
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+        "property %s red\nend_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2 %s\n3 1 3 2 %s\n";
     char text[1024];
     vb_mesh_raw raw;
     vb_error err;
     snprintf(text, sizeof text, head, "uint", "4294967295", "5");
-    expect_refused("copy.ply", VB_MESH_PLY, text, strlen(text), "line 15: face 0: red '4294967295'");
+    expect_refused("copy.ply", VB_MESH_PLY, text, strlen(text),
+                   "line 15: face 0: red '4294967295'");
     snprintf(text, sizeof text, head, "double", "0.5", "5");
     expect_refused("half.ply", VB_MESH_PLY, text, strlen(text), "line 15: face 0: red '0.5'");
 
     snprintf(text, sizeof text, head, "uint", "5", "4294967295");
     CHECK(parse_text("last.ply", VB_MESH_PLY, text, &raw, &err) == VB_OK, "last.ply: %s", err.msg);
-    CHECK(raw.triangle_count == 2 && raw.indices[3] == 1 && raw.indices[4] == 3, "last.ply: faces misread");
+    CHECK(raw.triangle_count == 2 && raw.indices[3] == 1 && raw.indices[4] == 3,
+          "last.ply: faces misread");
     vb_mesh_raw_free(&raw);
     snprintf(text, sizeof text, head, "double", "255", "-7");
-    CHECK(parse_text("whole.ply", VB_MESH_PLY, text, &raw, &err) == VB_OK, "whole.ply: %s", err.msg);
+    CHECK(parse_text("whole.ply", VB_MESH_PLY, text, &raw, &err) == VB_OK, "whole.ply: %s",
+          err.msg);
     vb_mesh_raw_free(&raw);
 }
 
@@ -265,8 +286,8 @@ static void test_off(void)
     expect_refused("e.off", VB_MESH_OFF, off, strlen(off), "edge count 4294967296 is too large");
     vb_mesh_raw raw;
     vb_error err;
-    CHECK(parse_text("ok.off", VB_MESH_OFF, "OFF\n3 1 4294967295\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", &raw, &err) ==
-              VB_OK,
+    CHECK(parse_text("ok.off", VB_MESH_OFF, "OFF\n3 1 4294967295\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+                     &raw, &err) == VB_OK,
           "ok.off: %s", err.msg);
     vb_mesh_raw_free(&raw);
 }
@@ -276,9 +297,12 @@ static void test_arguments(void)
     vb_mesh_raw raw;
     vb_error err;
     memset(&raw, 0, sizeof raw);
-    CHECK(vb_mesh_parse(NULL, VB_MESH_OBJ, (const uint8_t *)"v", 1, &raw, &err) == VB_ERR_ARGUMENT, "NULL name");
-    CHECK(vb_mesh_parse("a.obj", VB_MESH_OBJ, NULL, 1, &raw, &err) == VB_ERR_ARGUMENT, "NULL bytes");
-    CHECK(vb_mesh_parse("a.obj", (vb_mesh_format)9, (const uint8_t *)"v", 1, &raw, &err) == VB_ERR_ARGUMENT,
+    CHECK(vb_mesh_parse(NULL, VB_MESH_OBJ, (const uint8_t *)"v", 1, &raw, &err) == VB_ERR_ARGUMENT,
+          "NULL name");
+    CHECK(vb_mesh_parse("a.obj", VB_MESH_OBJ, NULL, 1, &raw, &err) == VB_ERR_ARGUMENT,
+          "NULL bytes");
+    CHECK(vb_mesh_parse("a.obj", (vb_mesh_format)9, (const uint8_t *)"v", 1, &raw, &err) ==
+              VB_ERR_ARGUMENT,
           "unknown format");
     vb_mesh_raw_free(&raw);
     vb_mesh_raw_free(NULL);

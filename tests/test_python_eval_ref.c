@@ -134,17 +134,17 @@ int main(int argc, char **argv)
                 c[0] += offset / 0.28209479177387814f; /* Y00 */
             else
                 for (uint32_t i = 0; i < nc; i++)
-                    c[i] *= s->quantity == VDSH_QUANTITY_DISTANCE2 ? expf(2.0f * offset)
-                                                                    : expf(offset);
+                    c[i] *=
+                        s->quantity == VDSH_QUANTITY_DISTANCE2 ? expf(2.0f * offset) : expf(offset);
         }
         uint32_t order = vdsh_stream_vertex_order(s, v);
         const float *p = f->positions + 3 * (size_t)v;
         if (lights) {
             out[3 * k] = vdsh_vertex_distance(order, s->quantity, maxd, c, p, r[k].v);
-            out[3 * k + 1] = vdsh_shadow(order, s->quantity, maxd, c, p, r[k].v,
-                                         VDSH_COMPARE_SMOOTH);
-            out[3 * k + 2] = vdsh_shadow(order, s->quantity, maxd, c, p, r[k].v,
-                                         VDSH_COMPARE_BINARY);
+            out[3 * k + 1] =
+                vdsh_shadow(order, s->quantity, maxd, c, p, r[k].v, VDSH_COMPARE_SMOOTH);
+            out[3 * k + 2] =
+                vdsh_shadow(order, s->quantity, maxd, c, p, r[k].v, VDSH_COMPARE_BINARY);
         } else {
             out[k] = vdsh_stream_distance(order, s->quantity, maxd, c, r[k].v);
         }

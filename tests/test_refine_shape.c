@@ -57,8 +57,7 @@ static double longest_edge(const vb_mesh *m)
     return best;
 }
 
-static void check_refined(const char *what, const vb_mesh *in, double max_ratio,
-                          double max_aspect)
+static void check_refined(const char *what, const vb_mesh *in, double max_ratio, double max_aspect)
 {
     vb_mesh out = {0};
     vb_error err;
@@ -71,8 +70,7 @@ static void check_refined(const char *what, const vb_mesh *in, double max_ratio,
            what, out.vertex_count, out.triangle_count, ratio, aspect,
            vb_mesh_worst_aspect(in, NULL));
     CHECK(fabs(a1 - a0) < 1e-4 * a0, "%s: area %g, was %g", what, a1, a0);
-    CHECK(longest_edge(&out) <= EDGE * (1.0 + 1e-6), "%s: an edge of %g", what,
-          longest_edge(&out));
+    CHECK(longest_edge(&out) <= EDGE * (1.0 + 1e-6), "%s: an edge of %g", what, longest_edge(&out));
     CHECK(ratio <= max_ratio, "%s: %u receivers, %.2fx area / edge^2 (at most %.1fx)", what,
           out.vertex_count, ratio, max_ratio);
     CHECK(aspect < max_aspect, "%s: worst aspect ratio %.1f (triangle %u; below %.0f)", what,

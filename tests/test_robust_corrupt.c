@@ -93,7 +93,8 @@ static void expect_rejected(const uint8_t *data, size_t size, counts *c, const c
     c->tried++;
     if (r != VDSH_OK) {
         c->rejected++;
-        CHECK(strstr(err.msg, "corrupt") != NULL, "%s: message does not name the file: %s", what, err.msg);
+        CHECK(strstr(err.msg, "corrupt") != NULL, "%s: message does not name the file: %s", what,
+              err.msg);
     } else {
         CHECK(0, "%s: accepted", what);
         vdsh_free(f);
@@ -119,8 +120,8 @@ static void expect_info_rejects(const char *info, const char *dir, const uint8_t
     c->tried++;
     c->rejected += rc == 1;
     CHECK(rc == 1, "vdsh-info --verify on %s: exit %d, want 1", what, rc);
-    CHECK(msg && strstr((char *)msg, "changed.vdsh") != NULL, "vdsh-info on %s: stderr does not name the file",
-          what);
+    CHECK(msg && strstr((char *)msg, "changed.vdsh") != NULL,
+          "vdsh-info on %s: stderr does not name the file", what);
     free(msg);
 }
 
@@ -152,7 +153,8 @@ static void sweep(const char *name, const uint8_t *orig, size_t size, size_t str
 
     uint64_t s = 0x9e3779b97f4a7c15ull ^ size;
     for (int k = 0; k < pair_count; k++) {
-        size_t i = (size_t)(test_rand(&s) * (double)size), j = (size_t)(test_rand(&s) * (double)size);
+        size_t i = (size_t)(test_rand(&s) * (double)size),
+               j = (size_t)(test_rand(&s) * (double)size);
         uint8_t a = (uint8_t)(1 + test_rand(&s) * 255), b = (uint8_t)(1 + test_rand(&s) * 255);
         if (i == j)
             continue;
@@ -182,17 +184,17 @@ static void sweep(const char *name, const uint8_t *orig, size_t size, size_t str
 
     printf("%s (%zu bytes%s): single-byte changes %lu/%lu rejected, two-byte changes %lu/%lu, "
            "truncations %lu/%lu, extensions %lu/%lu, vdsh-info --verify exit 1: %lu/%lu\n",
-           name, size, stride > 1 ? ", sampled" : "", single.rejected, single.tried, pairs.rejected, pairs.tried,
-           cut.rejected, cut.tried, longer.rejected, longer.tried, tool.rejected, tool.tried);
+           name, size, stride > 1 ? ", sampled" : "", single.rejected, single.tried, pairs.rejected,
+           pairs.tried, cut.rejected, cut.tried, longer.rejected, longer.tried, tool.rejected,
+           tool.tried);
 }
 
 /* A floor and a box on it: small, but with the occlusion a real scene has. */
-static const char scene_obj[] =
-    "v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\n"
-    "v -0.5 0 -0.5\nv 0.5 0 -0.5\nv 0.5 0 0.5\nv -0.5 0 0.5\n"
-    "v -0.5 1 -0.5\nv 0.5 1 -0.5\nv 0.5 1 0.5\nv -0.5 1 0.5\n"
-    "f 1 4 3 2\n"
-    "f 9 12 11 10\nf 5 6 10 9\nf 6 7 11 10\nf 7 8 12 11\nf 8 5 9 12\n";
+static const char scene_obj[] = "v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\n"
+                                "v -0.5 0 -0.5\nv 0.5 0 -0.5\nv 0.5 0 0.5\nv -0.5 0 0.5\n"
+                                "v -0.5 1 -0.5\nv 0.5 1 -0.5\nv 0.5 1 0.5\nv -0.5 1 0.5\n"
+                                "f 1 4 3 2\n"
+                                "f 9 12 11 10\nf 5 6 10 9\nf 6 7 11 10\nf 7 8 12 11\nf 8 5 9 12\n";
 
 int main(int argc, char **argv)
 {
@@ -215,22 +217,40 @@ int main(int argc, char **argv)
         fprintf(stderr, "cannot write %s\n", obj);
         return 1;
     }
-    char *bake_a[] = {(char *)bake, obj, "--max-edge", "1", "--rays", "64", "--cube-size", "0",
-                      "--encoding", "f16", "-q", "-o", a, NULL};
+    char *bake_a[] = {(char *)bake, obj,          "--max-edge", "1",  "--rays", "64", "--cube-size",
+                      "0",          "--encoding", "f16",        "-q", "-o",     a,    NULL};
     /* the default encoding: scale tables and packed words */
-    char *bake_c[] = {(char *)bake, obj, "--max-edge", "1", "--rays", "64", "--cube-size", "0",
-                      "-q", "-o", c, NULL};
-    char *bake_b[] = {(char *)bake, obj, "--max-edge", "1", "--rays", "64", "--orders", "1,4",
-                      "--encoding", "f32", "--method", "full", "--record-timings", "--cube-size", "0",
-                      "-q", "-o", b, NULL};
-    char *bake_room[] = {(char *)bake, "builtin:room", "--rays", "16", "--cube-size", "0", "-q", "-o", room, NULL};
+    char *bake_c[] = {(char *)bake,  obj, "--max-edge", "1",  "--rays", "64",
+                      "--cube-size", "0", "-q",         "-o", c,        NULL};
+    char *bake_b[] = {(char *)bake,
+                      obj,
+                      "--max-edge",
+                      "1",
+                      "--rays",
+                      "64",
+                      "--orders",
+                      "1,4",
+                      "--encoding",
+                      "f32",
+                      "--method",
+                      "full",
+                      "--record-timings",
+                      "--cube-size",
+                      "0",
+                      "-q",
+                      "-o",
+                      b,
+                      NULL};
+    char *bake_room[] = {(char *)bake, "builtin:room", "--rays", "16", "--cube-size",
+                         "0",          "-q",           "-o",     room, NULL};
     /* an adaptive order: the order table and records of every size */
-    char *bake_var[] = {(char *)bake, obj, "--max-edge", "1", "--rays", "64", "--cube-size", "0",
-                        "--adaptive-order", "0.01", "--max-order", "7", "-q", "-o", var, NULL};
+    char *bake_var[] = {
+        (char *)bake,       obj,    "--max-edge",  "1", "--rays", "64", "--cube-size", "0",
+        "--adaptive-order", "0.01", "--max-order", "7", "-q",     "-o", var,           NULL};
     /* cpca (issue 29): a model (scales, means, bases) and packed records */
-    char *bake_cp[] = {(char *)bake, obj, "--max-edge", "1", "--rays", "64", "--cube-size", "0",
-                       "--orders", "6", "--encoding", "cpca", "--cpca", "3,7,5", "-q", "-o", cp,
-                       NULL};
+    char *bake_cp[] = {(char *)bake,  obj,     "--max-edge", "1",  "--rays",     "64",
+                       "--cube-size", "0",     "--orders",   "6",  "--encoding", "cpca",
+                       "--cpca",      "3,7,5", "-q",         "-o", cp,           NULL};
     int ok = run(bake_a, err_path) == 0 && run(bake_b, err_path) == 0 &&
              run(bake_c, err_path) == 0 && run(bake_room, err_path) == 0 &&
              run(bake_var, err_path) == 0 && run(bake_cp, err_path) == 0;
@@ -238,8 +258,8 @@ int main(int argc, char **argv)
     if (!ok)
         return test_report("robust_corrupt");
 
-    const char *names[6] = {"scene-f16.vdsh", "scene-f32.vdsh", "scene-s8s6.vdsh", "room.vdsh",
-                            "scene-var.vdsh", "scene-cpca.vdsh"};
+    const char *names[6] = {"scene-f16.vdsh", "scene-f32.vdsh", "scene-s8s6.vdsh",
+                            "room.vdsh",      "scene-var.vdsh", "scene-cpca.vdsh"};
     const char *paths[6] = {a, b, c, room, var, cp};
     for (int k = 0; k < 6; k++) {
         size_t size;

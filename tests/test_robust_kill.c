@@ -55,8 +55,9 @@
 extern char **environ;
 
 #define OUTPUTS 5
-static const char *const output_names[OUTPUTS] = {
-    "scene.vdsh", "scene.sh09-12.exr", "scene.sh13-16.exr", "scene.sh17-20.exr", "scene.sh21-24.exr"};
+static const char *const output_names[OUTPUTS] = {"scene.vdsh", "scene.sh09-12.exr",
+                                                  "scene.sh13-16.exr", "scene.sh17-20.exr",
+                                                  "scene.sh21-24.exr"};
 
 typedef struct blob {
     uint8_t *data;
@@ -240,7 +241,8 @@ static int trials(const kill_setup *ks, int sig, int timed, int cubes, int vdsh)
             sleep_s(delay - (now() - start));
         } else {
             const char *kind = trial < timed + cubes ? ".exr.tmp" : ".vdsh.tmp";
-            while (!has_temp(ks->run_dir, kind) && !(exited = waitpid(pid, &status, WNOHANG) == pid))
+            while (!has_temp(ks->run_dir, kind) &&
+                   !(exited = waitpid(pid, &status, WNOHANG) == pid))
                 sleep_s(50e-6);
             sleep_s(2e-3 * test_rand(&seed));
         }
@@ -260,7 +262,7 @@ static int trials(const kill_setup *ks, int sig, int timed, int cubes, int vdsh)
         else if (trial >= timed)
             phase_counts[trial < timed + cubes ? 2 : 3]++;
         else
-            phase_counts[killed_at < ks->t_load  ? 0
+            phase_counts[killed_at < ks->t_load   ? 0
                          : killed_at < ks->t_cube ? 1
                          : killed_at < ks->t_vdsh ? 2
                          : killed_at < ks->T      ? 3
@@ -271,12 +273,18 @@ static int trials(const kill_setup *ks, int sig, int timed, int cubes, int vdsh)
         for (int k = 0; k < OUTPUTS; k++) {
             blob b;
             load(ks->run_dir, output_names[k], &b);
-            state[k] = !b.present ? 0 : same(&b, &ks->new_files[k]) ? 2 : same(&b, &ks->old_files[k]) ? 1 : -1;
-            CHECK(state[k] >= 0, "trial %d (signal at %.3f s): %s is neither the previous nor the new file (%zu bytes)",
-                  trial, killed_at, output_names[k], b.size);
-            CHECK(state[k] != 1 || with_old, "trial %d: %s appeared with old content", trial, output_names[k]);
-            CHECK(state[k] != 0 || !with_old, "trial %d (signal at %.3f s): %s was removed", trial, killed_at,
+            state[k] = !b.present                    ? 0
+                       : same(&b, &ks->new_files[k]) ? 2
+                       : same(&b, &ks->old_files[k]) ? 1
+                                                     : -1;
+            CHECK(
+                state[k] >= 0,
+                "trial %d (signal at %.3f s): %s is neither the previous nor the new file (%zu bytes)",
+                trial, killed_at, output_names[k], b.size);
+            CHECK(state[k] != 1 || with_old, "trial %d: %s appeared with old content", trial,
                   output_names[k]);
+            CHECK(state[k] != 0 || !with_old, "trial %d (signal at %.3f s): %s was removed", trial,
+                  killed_at, output_names[k]);
             free(b.data);
         }
         CHECK(state[0] != 2 || (state[1] == 2 && state[2] == 2 && state[3] == 2 && state[4] == 2),
@@ -289,15 +297,19 @@ static int trials(const kill_setup *ks, int sig, int timed, int cubes, int vdsh)
         clean_dir(ks->run_dir, &temps, temp_example, sizeof temp_example);
     }
     const char *name = sig == SIGKILL ? "SIGKILL" : "SIGTERM/SIGINT";
-    printf("%s, %d times: %d while starting and loading, %d while refining, building and tracing, %d while "
-           "writing cubemaps, %d while writing the .vdsh, %d at or after the end\n",
-           name, total, phase_counts[0], phase_counts[1], phase_counts[2], phase_counts[3], phase_counts[4]);
-    printf("  .vdsh afterwards: %d previous, %d new, %d absent (none before); cubemap sets left mixed "
-           "old/new: %d; temporary files left: %d%s%s%s\n",
-           outcome_old, outcome_new, outcome_absent, mixed_cubes, temps, temps ? " (e.g. " : "", temp_example,
-           temps ? ")" : "");
+    printf(
+        "%s, %d times: %d while starting and loading, %d while refining, building and tracing, %d while "
+        "writing cubemaps, %d while writing the .vdsh, %d at or after the end\n",
+        name, total, phase_counts[0], phase_counts[1], phase_counts[2], phase_counts[3],
+        phase_counts[4]);
+    printf(
+        "  .vdsh afterwards: %d previous, %d new, %d absent (none before); cubemap sets left mixed "
+        "old/new: %d; temporary files left: %d%s%s%s\n",
+        outcome_old, outcome_new, outcome_absent, mixed_cubes, temps, temps ? " (e.g. " : "",
+        temp_example, temps ? ")" : "");
     CHECK(phase_counts[2] > 0 && phase_counts[3] > 0, "%s: no signal landed while writing", name);
-    CHECK(sig != SIGKILL || phase_counts[0] + phase_counts[1] > 0, "SIGKILL: no kill landed before writing");
+    CHECK(sig != SIGKILL || phase_counts[0] + phase_counts[1] > 0,
+          "SIGKILL: no kill landed before writing");
     return temps;
 }
 
@@ -327,11 +339,14 @@ int main(int argc, char **argv)
     clean_dir(run_dir, &t0, none, 0);
 
     /* The scene, the previous outputs, and the reference new outputs. */
-    char *export_args[] = {bake, "builtin:room", "--max-edge", "0.4", "-q", "--export-obj", obj, NULL};
-    char *old_args[] = {bake, obj, "--rays", "16", "--seed", "2", "--cube-size", "64", "--threads", "2",
-                        "-q", "-o", old_out, NULL};
-    char *new_args[] = {bake, obj, "--rays", "32", "--cube-size", "96", "--threads", "2", "-q", "-o", new_out, NULL};
-    char *run_args[] = {bake, obj, "--rays", "32", "--cube-size", "96", "--threads", "2", "-q", "-o", run_out, NULL};
+    char *export_args[] = {bake, "builtin:room", "--max-edge", "0.4",
+                           "-q", "--export-obj", obj,          NULL};
+    char *old_args[] = {bake, obj,         "--rays", "16", "--seed", "2",     "--cube-size",
+                        "64", "--threads", "2",      "-q", "-o",     old_out, NULL};
+    char *new_args[] = {bake,        obj, "--rays", "32", "--cube-size", "96",
+                        "--threads", "2", "-q",     "-o", new_out,       NULL};
+    char *run_args[] = {bake,        obj, "--rays", "32", "--cube-size", "96",
+                        "--threads", "2", "-q",     "-o", run_out,       NULL};
     CHECK(run(export_args) == 0, "export of the room failed");
     CHECK(run(old_args) == 0, "bake of the previous outputs failed");
     CHECK(run(new_args) == 0, "reference bake failed");
@@ -351,8 +366,8 @@ int main(int argc, char **argv)
     {
         char report[4096];
         snprintf(report, sizeof report, "%s/calibration.json", work);
-        char *calib_args[] = {bake, obj, "--rays", "32", "--cube-size", "96", "--threads", "2", "-q",
-                              "-o", run_out, "--report", report, NULL};
+        char *calib_args[] = {bake, obj,  "--rays", "32",    "--cube-size", "96",   "--threads",
+                              "2",  "-q", "-o",     run_out, "--report",    report, NULL};
         double start = now();
         pid_t pid = spawn(calib_args);
         int status;
@@ -391,8 +406,9 @@ int main(int argc, char **argv)
         }
         clean_dir(run_dir, &t0, none, 0);
     }
-    printf("bake: %.3f s; loaded by %.3f s, first cubemap temporary at %.3f s, .vdsh temporary at %.3f s\n",
-           T, t_load, t_cube, t_vdsh);
+    printf(
+        "bake: %.3f s; loaded by %.3f s, first cubemap temporary at %.3f s, .vdsh temporary at %.3f s\n",
+        T, t_load, t_cube, t_vdsh);
 
     /* The kills: SIGKILL, then the signals the bake defers while it
      * writes (SIGTERM and SIGINT alternately), which must leave no

@@ -23,8 +23,9 @@
 static int is_mesh_name(const char *name)
 {
     const char *dot = strrchr(name, '.');
-    return dot && (!strcasecmp(dot, ".obj") || !strcasecmp(dot, ".ply") || !strcasecmp(dot, ".off") ||
-                   !strcasecmp(dot, ".stl") || !strcasecmp(dot, ".gltf") || !strcasecmp(dot, ".glb"));
+    return dot &&
+           (!strcasecmp(dot, ".obj") || !strcasecmp(dot, ".ply") || !strcasecmp(dot, ".off") ||
+            !strcasecmp(dot, ".stl") || !strcasecmp(dot, ".gltf") || !strcasecmp(dot, ".glb"));
 }
 
 static int same_mesh(const vb_mesh *a, const vb_mesh *b)
@@ -63,8 +64,8 @@ static void compare(const char *path)
             CHECK(ia.size == ib.size && ia.size == size && !memcmp(ia.sha256, ib.sha256, 32),
                   "%s: different source info", path);
         } else if (ra != VB_OK && rb != VB_OK) {
-            CHECK(strcmp(ea.msg, eb.msg) == 0, "%s: messages differ:\n  file:   %s\n  memory: %s", path, ea.msg,
-                  eb.msg);
+            CHECK(strcmp(ea.msg, eb.msg) == 0, "%s: messages differ:\n  file:   %s\n  memory: %s",
+                  path, ea.msg, eb.msg);
         }
         vb_mesh_free(&a);
         vb_mesh_free(&b);
@@ -127,17 +128,22 @@ int main(int argc, char **argv)
     vb_mesh m = {0};
     vb_error err;
     static const char tri[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-    CHECK(vb_mesh_load_memory(NULL, 4, "x.obj", NULL, &m, NULL, &err) == VB_ERR_ARGUMENT, "NULL data");
-    CHECK(vb_mesh_load_memory(tri, sizeof tri - 1, NULL, NULL, &m, NULL, &err) == VB_ERR_ARGUMENT, "NULL name");
-    CHECK(vb_mesh_load_memory(tri, sizeof tri - 1, "x.obj", NULL, NULL, NULL, &err) == VB_ERR_ARGUMENT,
+    CHECK(vb_mesh_load_memory(NULL, 4, "x.obj", NULL, &m, NULL, &err) == VB_ERR_ARGUMENT,
+          "NULL data");
+    CHECK(vb_mesh_load_memory(tri, sizeof tri - 1, NULL, NULL, &m, NULL, &err) == VB_ERR_ARGUMENT,
+          "NULL name");
+    CHECK(vb_mesh_load_memory(tri, sizeof tri - 1, "x.obj", NULL, NULL, NULL, &err) ==
+              VB_ERR_ARGUMENT,
           "NULL output");
     CHECK(vb_mesh_load_memory(NULL, 0, "x.obj", NULL, &m, NULL, &err) == VB_ERR_FORMAT &&
               strcmp(err.msg, "x.obj: empty file") == 0,
           "no bytes: %s", err.msg);
-    CHECK(vb_mesh_load_memory(tri, sizeof tri - 1, "builtin:room", NULL, &m, NULL, &err) == VB_ERR_FORMAT &&
+    CHECK(vb_mesh_load_memory(tri, sizeof tri - 1, "builtin:room", NULL, &m, NULL, &err) ==
+                  VB_ERR_FORMAT &&
               strstr(err.msg, "unsupported file type") != NULL,
           "builtin name: %s", err.msg);
-    CHECK(vb_mesh_load_memory(tri, sizeof tri - 1, "dir.obj/mesh", NULL, &m, NULL, &err) == VB_ERR_FORMAT,
+    CHECK(vb_mesh_load_memory(tri, sizeof tri - 1, "dir.obj/mesh", NULL, &m, NULL, &err) ==
+              VB_ERR_FORMAT,
           "extension of a folder, not of the name");
     CHECK(vb_mesh_load_memory(tri, sizeof tri - 1, "A.OBJ", NULL, &m, NULL, &err) == VB_OK &&
               m.triangle_count == 1,
@@ -167,9 +173,11 @@ int main(int argc, char **argv)
     setenv("TMPDIR", tmp, 1);
     CHECK(dir_is_empty(tmp), "files left in %s", tmp);
 
-    printf("%u files: loading the bytes gives what loading the file gives (%u accepted, %u refused, each "
-           "without and with welding)\n",
-           files, accepted, files - accepted);
-    CHECK(files >= 100 && accepted >= 30, "too few inputs (%u files, %u accepted)", files, accepted);
+    printf(
+        "%u files: loading the bytes gives what loading the file gives (%u accepted, %u refused, each "
+        "without and with welding)\n",
+        files, accepted, files - accepted);
+    CHECK(files >= 100 && accepted >= 30, "too few inputs (%u files, %u accepted)", files,
+          accepted);
     return test_report("robust_load");
 }

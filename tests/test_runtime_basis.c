@@ -35,12 +35,12 @@ static GLuint upload_from_file(const vb_cubemap *m)
             for (int i = 0; i < n; i++) {
                 int ei, ej;
                 vdsh_cube_gl_to_exr(f, i, j, n, &ei, &ej);
-                const float *src = m->rgba + (((size_t)f * (size_t)n + (size_t)ej) * (size_t)n +
-                                              (size_t)ei) * 4;
+                const float *src =
+                    m->rgba + (((size_t)f * (size_t)n + (size_t)ej) * (size_t)n + (size_t)ei) * 4;
                 memcpy(face + ((size_t)j * (size_t)n + (size_t)i) * 4, src, 4 * sizeof(float));
             }
-        glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, 0, GL_RGBA16F, n, n, 0,
-                     GL_RGBA, GL_FLOAT, face);
+        glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, 0, GL_RGBA16F, n, n, 0, GL_RGBA,
+                     GL_FLOAT, face);
     }
     glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAX_LEVEL, 0);
     glBindTexture(GL_TEXTURE_CUBE_MAP, 0);
@@ -110,8 +110,8 @@ int main(int argc, char **argv)
             glDeleteTextures(1, &ref);
         }
         CHECK(vr_check_gl(&err, "read back") == VR_OK, "%s", err.msg);
-        CHECK(differ == 0, "n %d: %ld of %ld half values differ from the files' upload", n,
-              differ, 4 * texels);
+        CHECK(differ == 0, "n %d: %ld of %ld half values differ from the files' upload", n, differ,
+              4 * texels);
         printf("n = %2d: %ld texels x 4 functions, every half identical to the upload from "
                "the .exr files (%ld zeros of either sign among them), %ld differ\n",
                n, texels, zeros, differ);

@@ -103,7 +103,7 @@ static vr_draw_desc lattice_view(void)
 
 typedef struct tally {
     long checked, bad, clamped, zero, one;
-    double worst;   /* max |sum_gpu - sum_c| / max(1, sum |c_i|) where measurable */
+    double worst; /* max |sum_gpu - sum_c| / max(1, sum |c_i|) where measurable */
 } tally;
 
 /* One vertex: GPU (s, dv, dl) for light l against C. */
@@ -135,9 +135,10 @@ static void check_vertex(tally *t, const char *what, uint32_t q, float md, int o
             t->worst = e;
     }
     if (!ok && t->bad++ < 5)
-        fprintf(stderr, "%s: vertex (%g %g): GPU s %.7g dv %.7g dl %.7g; C s [%.7g, %.7g] "
-                "dv [%.7g, %.7g] (sum %.7g) dl %.7g\n", what, p[0], p[1], gpu[0], gpu[1],
-                gpu[2], s_lo, s_hi, dv_lo, dv_hi, sum, dl);
+        fprintf(stderr,
+                "%s: vertex (%g %g): GPU s %.7g dv %.7g dl %.7g; C s [%.7g, %.7g] "
+                "dv [%.7g, %.7g] (sum %.7g) dl %.7g\n",
+                what, p[0], p[1], gpu[0], gpu[1], gpu[2], s_lo, s_hi, dv_lo, dv_hi, sum, dl);
 }
 
 static const float *coefs_of(const rt_file *f, int order, uint32_t q)
@@ -165,8 +166,8 @@ static void test_vertex(void)
         lattice_file(&f, enc[e], &rng);
         for (int q = 0; q < 2; q++) {
             vr_scene *s = NULL;
-            vr_scene_desc sd = {.file = &f.f, .quantity = QUANT[q], .buffers = 1,
-                                .buffer_floats = e == 4};
+            vr_scene_desc sd = {
+                .file = &f.f, .quantity = QUANT[q], .buffers = 1, .buffer_floats = e == 4};
             CHECK(vr_scene_create(&sd, &s, &err) == VR_OK, "%s", err.msg);
             if (!s)
                 continue;
@@ -178,9 +179,10 @@ static void test_vertex(void)
             float *pos = rt_read(r, W, H);
             int found = 0;
             for (int k = 0; k < NV; k++)
-                found += pos[4 * k + 3] == 1.0f && fabsf(pos[4 * k] - f.pos[3 * k]) +
-                                                          fabsf(pos[4 * k + 1] - f.pos[3 * k + 1]) <
-                                                      1e-5f;
+                found +=
+                    pos[4 * k + 3] == 1.0f &&
+                    fabsf(pos[4 * k] - f.pos[3 * k]) + fabsf(pos[4 * k + 1] - f.pos[3 * k + 1]) <
+                        1e-5f;
             free(pos);
             CHECK(found == NV, "%s: %d of %d vertices at their pixels", enc_name[e], found, NV);
             for (int o = 0; o < NORDERS && ORDERS[o] <= VDSH_MAX_ORDER; o++) {
@@ -216,8 +218,8 @@ static void test_vertex(void)
     for (int o = 0; o < NORDERS && ORDERS[o] <= VDSH_MAX_ORDER; o++) {
         tally *t = &all[o];
         printf("vertex order %2d: %ld receivers checked (s = 0: %ld, s = 1: %ld, clamped: %ld), "
-               "%ld wrong; largest |GPU - C| sum / max(1, sum |c_i|): %.2g\n", ORDERS[o],
-               t->checked, t->zero, t->one, t->clamped, t->bad, t->worst);
+               "%ld wrong; largest |GPU - C| sum / max(1, sum |c_i|): %.2g\n",
+               ORDERS[o], t->checked, t->zero, t->one, t->clamped, t->bad, t->worst);
         CHECK(t->bad == 0, "order %d: %ld receivers disagree", ORDERS[o], t->bad);
         CHECK(t->checked == 5L * 2 * 3 * NV, "order %d: %ld checked", ORDERS[o], t->checked);
         CHECK(t->zero > t->checked / 50 && t->one > t->checked / 50 &&
@@ -231,8 +233,8 @@ static void test_vertex(void)
  * per vertex, coefficients as lattice_file's; *coef gets the decoded
  * coefficients (cap^2 per vertex, zeros past a vertex's own k^2) and
  * *ord the orders. The storage goes to f->data / f->coef and `extra`. */
-static void add_variable(rt_file *f, uint32_t enc, uint32_t q, int cap, uint64_t *rng,
-                         void **extra, const float **coef, const uint8_t **ord)
+static void add_variable(rt_file *f, uint32_t enc, uint32_t q, int cap, uint64_t *rng, void **extra,
+                         const float **coef, const uint8_t **ord)
 {
     uint32_t nv = f->f.header.vertex_count, nc = (uint32_t)(cap * cap);
     uint8_t *orders = malloc(nv);
@@ -250,8 +252,8 @@ static void add_variable(rt_file *f, uint32_t enc, uint32_t q, int cap, uint64_t
     float *scales = calloc(nc, sizeof(float));
     void *data = calloc(4 * (size_t)offsets[nv] + 4, 1);
     float scale = vdsh_encoding_quantised(enc) ? 1.0f : enc == VDSH_ENCODING_F16 ? 0.01f : 0.5f;
-    if (vdsh_encode_variable(enc, c, nc, orders, nv, (uint32_t)cap, scale, offsets, scales,
-                             data) != VDSH_OK)
+    if (vdsh_encode_variable(enc, c, nc, orders, nv, (uint32_t)cap, scale, offsets, scales, data) !=
+        VDSH_OK)
         abort();
     uint32_t i = f->f.stream_count++;
     vdsh_stream *st = &f->streams[i];
@@ -358,8 +360,8 @@ static void test_variable(void)
             rt_file_free(&f);
         }
     printf("variable (cap %d): %ld receivers checked (s = 0: %ld, s = 1: %ld, clamped: %ld), "
-           "%ld wrong; largest |GPU - C| sum / max(1, sum |c_i|): %.2g\n", CAP, t.checked,
-           t.zero, t.one, t.clamped, t.bad, t.worst);
+           "%ld wrong; largest |GPU - C| sum / max(1, sum |c_i|): %.2g\n",
+           CAP, t.checked, t.zero, t.one, t.clamped, t.bad, t.worst);
     CHECK(t.bad == 0, "variable: %ld receivers disagree", t.bad);
     CHECK(t.zero > t.checked / 50 && t.one > t.checked / 50 && t.clamped > t.checked / 100,
           "variable: the data do not cover shadow, light and the clamp");
@@ -374,8 +376,8 @@ static void test_frames(const char *path)
     enum { FW = 160, FH = 120 };
     vr_error err;
     vr_scene *s = NULL;
-    CHECK(vr_scene_create(&(vr_scene_desc){.path = path, .buffers = 1}, &s, &err) == VR_OK,
-          "%s", err.msg);
+    CHECK(vr_scene_create(&(vr_scene_desc){.path = path, .buffers = 1}, &s, &err) == VR_OK, "%s",
+          err.msg);
     vr_renderer *r = NULL;
     vr_renderer_desc rd = {.width = FW, .height = FH, .color_format = VR_COLOR_RGBA32F};
     CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
@@ -399,7 +401,9 @@ static void test_frames(const char *path)
     static const int orders[3] = {2, 3, 5};
     for (int m = 0; m < 3; m++)
         for (int v = 0; v < 3; v++) {
-            vr_draw_desc d = {.mode = modes[m], .lights = lights, .light_count = v == 2 ? 9 : 3,
+            vr_draw_desc d = {.mode = modes[m],
+                              .lights = lights,
+                              .light_count = v == 2 ? 9 : 3,
                               .output = v == 0 ? VR_OUTPUT_SHADOW : VR_OUTPUT_COLOR,
                               .ambient = {0.05f, 0.05f, 0.05f}};
             rt_draw_or_die(r, s, &d);
@@ -423,13 +427,15 @@ static void test_frames(const char *path)
                 }
             }
             printf("frames order %d, %s: largest difference %.3g, mean %.3g\n", orders[m],
-                   v == 0 ? "shadow of light 0" : v == 1 ? "colour, 3 lights" : "colour, 9 lights",
+                   v == 0   ? "shadow of light 0"
+                   : v == 1 ? "colour, 3 lights"
+                            : "colour, 9 lights",
                    worst, sum / (FW * FH * 4));
             CHECK(worst <= 5e-4, "order %d view %d: buffer and attribute paths differ by %g",
                   orders[m], v, worst);
             if (v == 0)
-                CHECK(lit > 100 && dark > 100, "the view shows too little: %ld lit, %ld dark",
-                      lit, dark);
+                CHECK(lit > 100 && dark > 100, "the view shows too little: %ld lit, %ld dark", lit,
+                      dark);
             free(a);
             free(b);
         }
@@ -444,8 +450,9 @@ static void test_errors(const char *path)
     CHECK(vr_scene_create(&(vr_scene_desc){.path = path}, &plain, &err) == VR_OK, "%s", err.msg);
     CHECK(vr_scene_create(&(vr_scene_desc){.path = path, .buffers = 1}, &buffered, &err) == VR_OK,
           "%s", err.msg);
-    CHECK(vr_scene_create(&(vr_scene_desc){.path = path, .buffers = 1, .buffer_floats = 1},
-                          &floats, &err) == VR_OK, "%s", err.msg);
+    CHECK(vr_scene_create(&(vr_scene_desc){.path = path, .buffers = 1, .buffer_floats = 1}, &floats,
+                          &err) == VR_OK,
+          "%s", err.msg);
     vdsh_file *f = NULL;
     vdsh_error ve;
     CHECK(vdsh_read(path, &f, &ve) == VDSH_OK, "%s", ve.msg);
@@ -603,8 +610,8 @@ static int derive(const char *in, const char *out)
             vdsh_stream_offsets(ko, nv, encs[n], off);
             void *data = calloc(4 * (size_t)off[nv] + 4, 1);
             mem[n][1] = data;
-            rc = vdsh_encode_variable(encs[n], c, nc, ko, nv, k, 1.0f, off, scales, data) !=
-                 VDSH_OK;
+            rc =
+                vdsh_encode_variable(encs[n], c, nc, ko, nv, k, 1.0f, off, scales, data) != VDSH_OK;
             st->scale = 1.0f;
             st->data = data;
             st->coef_scales = scales;
@@ -635,8 +642,8 @@ int main(int argc, char **argv)
 {
     if (argc == 4 && !strcmp(argv[1], "derive"))
         return derive(argv[2], argv[3]);
-    if (argc != 3 || (strcmp(argv[1], "vertex") && strcmp(argv[1], "frames") &&
-                      strcmp(argv[1], "errors"))) {
+    if (argc != 3 ||
+        (strcmp(argv[1], "vertex") && strcmp(argv[1], "frames") && strcmp(argv[1], "errors"))) {
         fprintf(stderr, "usage: test_runtime_buffer vertex|frames|errors SCENE.vdsh\n"
                         "       test_runtime_buffer derive IN.vdsh OUT.vdsh\n");
         return 2;
@@ -645,8 +652,7 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "vertex")) {
         test_vertex();
         test_variable();
-    }
-    else if (!strcmp(argv[1], "frames"))
+    } else if (!strcmp(argv[1], "frames"))
         test_frames(argv[2]);
     else
         test_errors(argv[2]);

@@ -33,8 +33,8 @@ static void expect_fail(const char *what, const vr_scene_desc *sd, vr_result wan
     CHECK(r == want, "%s: got %s (%s), want %s", what, vr_result_str(r), err.msg,
           vr_result_str(want));
     CHECK(s == SENTINEL, "%s: output changed on failure", what);
-    CHECK(!needle || strstr(err.msg, needle), "%s: message '%s' does not name '%s'", what,
-          err.msg, needle);
+    CHECK(!needle || strstr(err.msg, needle), "%s: message '%s' does not name '%s'", what, err.msg,
+          needle);
     if (r == VR_OK && s != SENTINEL)
         vr_scene_destroy(s);
     printf("%-28s -> %s: %s\n", what, vr_result_str(r), err.msg);
@@ -108,7 +108,8 @@ static void test_files(const char *dir)
         memcpy(copy, data, size);
         int flips = 1 + (int)(test_rand(&rng) * 4);
         for (int k = 0; k < flips; k++)
-            copy[(size_t)(test_rand(&rng) * (double)size)] ^= (unsigned char)(1 + test_rand(&rng) * 255);
+            copy[(size_t)(test_rand(&rng) * (double)size)] ^=
+                (unsigned char)(1 + test_rand(&rng) * 255);
         size_t n = test_rand(&rng) < 0.2 ? (size_t)(test_rand(&rng) * (double)size) : size;
         spit(bad, copy, n);
         free(copy);
@@ -209,8 +210,8 @@ static void test_files(const char *dir)
         float *c = calloc(4 * 25, sizeof(float));
         for (int i = 0; i < 4; i++)
             c[orders[o] * orders[o] * i] = 3.0f;
-        rt_file_add_stream(&lf, (uint32_t)orders[o], VDSH_ENCODING_F16,
-                           VDSH_QUANTITY_LOG_DISTANCE, c, 0.01f);
+        rt_file_add_stream(&lf, (uint32_t)orders[o], VDSH_ENCODING_F16, VDSH_QUANTITY_LOG_DISTANCE,
+                           c, 0.01f);
     }
     char logpath[600];
     snprintf(logpath, sizeof logpath, "%s/log.vdsh", dir);
@@ -231,7 +232,8 @@ static void test_files(const char *dir)
         vr_scene_info info;
         vr_scene_get_info(s, &info);
         CHECK(info.quantity == VDSH_QUANTITY_LOG_DISTANCE && !info.has_cubemaps &&
-              info.has_order[2] && info.has_order[3] && info.has_order[5], "log-distance info");
+                  info.has_order[2] && info.has_order[3] && info.has_order[5],
+              "log-distance info");
         vr_renderer *r = NULL;
         vr_renderer_desc rd = {.width = 8, .height = 8};
         CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
@@ -239,15 +241,16 @@ static void test_files(const char *dir)
         for (int m = VR_MODE_VDSH2; m <= VR_MODE_VDSH5_POLY && r; m++) {
             vr_draw_desc d = {.mode = (uint32_t)m, .lights = &light, .light_count = 1};
             CHECK(vr_scene_supports(s, (vr_mode)m) &&
-                  vr_scene_interp(s, (vr_mode)m) == VDSH_INTERP_DISTANCE,
+                      vr_scene_interp(s, (vr_mode)m) == VDSH_INTERP_DISTANCE,
                   "log-distance %s: supported, distance path", vr_mode_name((vr_mode)m));
-            CHECK(vr_draw(r, s, &d, &err) == VR_OK, "log-distance %s: %s",
-                  vr_mode_name((vr_mode)m), err.msg);
-            CHECK(strstr(vr_scene_mode_label(s, (vr_mode)m), "log, per-vertex") != NULL,
-                  "label %s", vr_scene_mode_label(s, (vr_mode)m));
+            CHECK(vr_draw(r, s, &d, &err) == VR_OK, "log-distance %s: %s", vr_mode_name((vr_mode)m),
+                  err.msg);
+            CHECK(strstr(vr_scene_mode_label(s, (vr_mode)m), "log, per-vertex") != NULL, "label %s",
+                  vr_scene_mode_label(s, (vr_mode)m));
         }
         CHECK(strcmp(vr_scene_mode_label(s, VR_MODE_VDSH5),
-                     "VDSH order 5 (25 coeff., log, per-vertex)") == 0, "label");
+                     "VDSH order 5 (25 coeff., log, per-vertex)") == 0,
+              "label");
         CHECK(vr_scene_interp(s, VR_MODE_CUBE) == -1, "cube has no path");
         vr_renderer_destroy(r);
         vr_scene_destroy(s);
@@ -302,7 +305,8 @@ static void test_streams_and_arguments(const char *dir)
         CHECK(vr_scene_create(&d1, &s1, &err) == VR_OK, "order 1 alone: %s", err.msg);
         if (s1) {
             CHECK(vr_scene_default_mode(s1) == VR_MODE_VDSH5 &&
-                      !vr_scene_supports(s1, VR_MODE_DEFAULT), "order 1 alone: default");
+                      !vr_scene_supports(s1, VR_MODE_DEFAULT),
+                  "order 1 alone: default");
             d.mode = VR_MODE_DEFAULT;
             vr_result res = vr_draw(r, s1, &d, &err);
             CHECK(res == VR_ERR_MISSING && strstr(err.msg, "order-5"),

@@ -121,8 +121,8 @@ static int check_names(const char *views, const char *dir, const char *modes)
                           vs.width, vs.height);
                     /* grey is colour type 0, RGBA 6 */
                     if (j < 0)
-                        CHECK(depth == 8 && type == 6, "%s: depth %d type %d, not 8-bit RGBA",
-                              path, depth, type);
+                        CHECK(depth == 8 && type == 6, "%s: depth %d type %d, not 8-bit RGBA", path,
+                              depth, type);
                     else
                         CHECK(depth == 16 && type == 0, "%s: depth %d type %d, not 16-bit grey",
                               path, depth, type);
@@ -133,8 +133,8 @@ static int check_names(const char *views, const char *dir, const char *modes)
     for (struct dirent *e; d && (e = readdir(d));)
         if (e->d_name[0] != '.') {
             found++;
-            CHECK(strstr(e->d_name, ".png") && !strstr(e->d_name, ".tmp"),
-                  "%s: unexpected file %s", dir, e->d_name);
+            CHECK(strstr(e->d_name, ".png") && !strstr(e->d_name, ".tmp"), "%s: unexpected file %s",
+                  dir, e->d_name);
         }
     if (d)
         closedir(d);
@@ -231,8 +231,8 @@ static int check_values(char **argv)
             int x, y;
             if (project(&v->camera, w, h, pts[k], &x, &y) || x < r || y < r || x >= w - r ||
                 y >= h - r) {
-                CHECK(0, "%s point (%g, %g, %g) is not in view %s", k ? "lit" : "dark",
-                      pts[k][0], pts[k][1], pts[k][2], v->name);
+                CHECK(0, "%s point (%g, %g, %g) is not in view %s", k ? "lit" : "dark", pts[k][0],
+                      pts[k][1], pts[k][2], v->name);
                 continue;
             }
             float lo, hi, med;
@@ -240,8 +240,7 @@ static int check_values(char **argv)
             printf("%s: %s point at pixel (%d, %d): s %.4f .. %.4f, median %.4f\n", path,
                    k ? "lit" : "shadowed", x, y, lo, hi, med);
             if (k == 0)
-                CHECK(med <= 0.3f, "%s: the shadowed point is not low (median %.4f)", path,
-                      med);
+                CHECK(med <= 0.3f, "%s: the shadowed point is not low (median %.4f)", path, med);
             else
                 CHECK(med >= 0.999f, "%s: the lit point is not 1 (median %.4f)", path, med);
         }
@@ -275,7 +274,8 @@ static int check_empty(char **argv)
                            f->header.triangle_count};
     vdsh_view_tracer *tr = NULL;
     CHECK(vdsh_view_tracer_create(&mesh, &tr, &err) == VDSH_OK, "%s", err.msg);
-    unsigned char *miss = calloc((size_t)w * (size_t)h, 1), *empty = calloc((size_t)w * (size_t)h, 1);
+    unsigned char *miss = calloc((size_t)w * (size_t)h, 1),
+                  *empty = calloc((size_t)w * (size_t)h, 1);
     size_t empties = 0;
     for (int y = 0; tr && y < h; y++)
         for (int x = 0; x < w; x++) {
@@ -316,7 +316,8 @@ static int check_empty(char **argv)
                     }
                 }
                 printf("%s: %zu pixels without a surface, %zu of them not 1; %zu of %zu "
-                       "surface pixels are 1\n", path, empties, bad, surface_ones, surfaces);
+                       "surface pixels are 1\n",
+                       path, empties, bad, surface_ones, surfaces);
                 CHECK(bad == 0, "%s: %zu of %zu pixels without a surface are not 1", path, bad,
                       empties);
                 /* the control: not a frame of all ones */
@@ -354,17 +355,19 @@ static int check_facing(char **argv)
         int x, y;
         if (!px)
             continue;
-        if (project(&v->camera, w, h, p, &x, &y) || x < r || y < r || x >= w - r ||
-            y >= h - r) {
+        if (project(&v->camera, w, h, p, &x, &y) || x < r || y < r || x >= w - r || y >= h - r) {
             CHECK(0, "point (%g, %g, %g) is not in view %s", p[0], p[1], p[2], v->name);
         } else {
             float lo, hi, med;
             window(px, w, h, x, y, r, &lo, &hi, &med);
             printf("%s: facing away from the light at pixel (%d, %d): s %.4f .. %.4f, "
-                   "median %.4f\n", path, x, y, lo, hi, med);
+                   "median %.4f\n",
+                   path, x, y, lo, hi, med);
             if (!strncmp(mode[m], "cube", 4))
-                CHECK(hi <= 0.05f, "%s: the cube map does not hide a surface facing away "
-                      "(s up to %.4f)", path, hi);
+                CHECK(hi <= 0.05f,
+                      "%s: the cube map does not hide a surface facing away "
+                      "(s up to %.4f)",
+                      path, hi);
         }
         free(px);
     }
@@ -393,15 +396,15 @@ static void check_pool(const char *path, const vdsh_file *f, const vr_scene *pla
     vr_scene_get_info(s, &info);
     float diag = 0.0f;
     for (int a = 0; a < 3; a++)
-        diag += (info.bounds_max[a] - info.bounds_min[a]) * (info.bounds_max[a] - info.bounds_min[a]);
+        diag +=
+            (info.bounds_max[a] - info.bounds_min[a]) * (info.bounds_max[a] - info.bounds_min[a]);
     diag = sqrtf(diag);
     vr_light l[VR_MAX_POOL_LIGHTS];
     int n = vr_scene_pool_lights(s, l, VR_MAX_POOL_LIGHTS);
     CHECK(n == VR_MAX_POOL_LIGHTS, "%d pool lights, not %d", n, VR_MAX_POOL_LIGHTS);
     uint32_t k = 0;
     for (int i = 0; i < n && t; i++) {
-        CHECK(vdsh_view_free_space(t, l[i].position, diag), "pool light %d not in free space",
-              i);
+        CHECK(vdsh_view_free_space(t, l[i].position, diag), "pool light %d not in free space", i);
         for (int a = 0; a < 3; a++)
             CHECK(l[i].position[a] >= info.bounds_min[a] && l[i].position[a] <= info.bounds_max[a],
                   "pool light %d outside the bounds", i);
@@ -409,11 +412,11 @@ static void check_pool(const char *path, const vdsh_file *f, const vr_scene *pla
         do
             vdsh_light_candidate(info.bounds_min, info.bounds_max, 1, k++, p);
         while (!vdsh_view_free_space(t, p, diag) && k < 100000);
-        CHECK(!memcmp(p, l[i].position, sizeof p), "pool light %d is not free candidate %u",
-              i, k - 1);
+        CHECK(!memcmp(p, l[i].position, sizeof p), "pool light %d is not free candidate %u", i,
+              k - 1);
         for (int j = 0; j < i; j++)
-            CHECK(memcmp(l[i].position, l[j].position, sizeof p), "pool lights %d and %d equal",
-                  i, j);
+            CHECK(memcmp(l[i].position, l[j].position, sizeof p), "pool lights %d and %d equal", i,
+                  j);
     }
     printf("light pool: %d positions in free space, %u candidates tried\n", n, k);
     vdsh_view_tracer_destroy(t);
@@ -446,13 +449,13 @@ static int check_lights(const char *path)
         CHECK(n == v.light_count, "%d default lights, not %d", n, v.light_count);
         for (int i = 0; i < n && i < v.light_count; i++) {
             CHECK(!memcmp(l[i].position, v.lights[i], sizeof v.lights[i]),
-                  "light %d: (%g, %g, %g), not (%g, %g, %g)", i, l[i].position[0],
-                  l[i].position[1], l[i].position[2], v.lights[i][0], v.lights[i][1],
-                  v.lights[i][2]);
+                  "light %d: (%g, %g, %g), not (%g, %g, %g)", i, l[i].position[0], l[i].position[1],
+                  l[i].position[2], v.lights[i][0], v.lights[i][1], v.lights[i][2]);
             printf("default light %d: (%g, %g, %g)%s\n", i, l[i].position[0], l[i].position[1],
                    l[i].position[2],
                    memcmp(v.lights[i], v.preferred[i], sizeof v.lights[i])
-                       ? " (moved into free space)" : "");
+                       ? " (moved into free space)"
+                       : "");
         }
     }
     if (ok && f)

@@ -155,17 +155,19 @@ static void check_receiver(tally *t, const char *what, uint32_t q, float md, uin
         t->one++;
     else
         t->partial++;
-    int ok = fabsf(gpu[2] - dl) <= dl_tol && gpu[1] >= dv_lo - eps_dv &&
-             gpu[1] <= dv_hi + eps_dv && gpu[1] <= md;
+    int ok = fabsf(gpu[2] - dl) <= dl_tol && gpu[1] >= dv_lo - eps_dv && gpu[1] <= dv_hi + eps_dv &&
+             gpu[1] <= md;
     if (cmp == VDSH_COMPARE_BINARY && s_lo != s_hi)
         t->ambiguous++; /* d_V within rounding of d_L: either answer is right */
     else
         ok = ok && gpu[0] >= s_lo - 2e-5f && gpu[0] <= s_hi + 2e-5f;
     if (!ok) {
         if (t->bad++ < 5)
-            fprintf(stderr, "%s: receiver (%g %g %g): GPU s %.7g dv %.7g dl %.7g; C s %.7g "
-                    "[%.7g, %.7g] dv %.7g [%.7g, %.7g] dl %.7g\n", what, p[0], p[1], p[2],
-                    gpu[0], gpu[1], gpu[2], s, s_lo, s_hi, dv, dv_lo, dv_hi, dl);
+            fprintf(stderr,
+                    "%s: receiver (%g %g %g): GPU s %.7g dv %.7g dl %.7g; C s %.7g "
+                    "[%.7g, %.7g] dv %.7g [%.7g, %.7g] dl %.7g\n",
+                    what, p[0], p[1], p[2], gpu[0], gpu[1], gpu[2], s, s_lo, s_hi, dv, dv_lo, dv_hi,
+                    dl);
     }
 }
 
@@ -175,12 +177,30 @@ static void gl_face_st(int f, const float d[3], float *s, float *t)
 {
     float ax = fabsf(d[0]), ay = fabsf(d[1]), az = fabsf(d[2]);
     switch (f) {
-    case 0: *s = -d[2] / ax; *t = -d[1] / ax; break;
-    case 1: *s = d[2] / ax; *t = -d[1] / ax; break;
-    case 2: *s = d[0] / ay; *t = d[2] / ay; break;
-    case 3: *s = d[0] / ay; *t = -d[2] / ay; break;
-    case 4: *s = d[0] / az; *t = -d[1] / az; break;
-    default: *s = -d[0] / az; *t = -d[1] / az; break;
+    case 0:
+        *s = -d[2] / ax;
+        *t = -d[1] / ax;
+        break;
+    case 1:
+        *s = d[2] / ax;
+        *t = -d[1] / ax;
+        break;
+    case 2:
+        *s = d[0] / ay;
+        *t = d[2] / ay;
+        break;
+    case 3:
+        *s = d[0] / ay;
+        *t = -d[2] / ay;
+        break;
+    case 4:
+        *s = d[0] / az;
+        *t = -d[1] / az;
+        break;
+    default:
+        *s = -d[0] / az;
+        *t = -d[1] / az;
+        break;
     }
 }
 
@@ -216,7 +236,8 @@ static void test_vertex(const char *dir)
         rt_file_bounds(f);
         add_all_streams(f, &rng, ENC[e]);
         char path[512];
-        if (rt_file_write(f, dir, (const char *const[]){"star16", "star32", "star8", "star86"}[e], path, sizeof path)) {
+        if (rt_file_write(f, dir, (const char *const[]){"star16", "star32", "star8", "star86"}[e],
+                          path, sizeof path)) {
             CHECK(0, "cannot write %s", path);
             return;
         }
@@ -246,10 +267,13 @@ static void test_vertex(const char *dir)
     for (int face = 0; face < 6; face++) {
         /* A 90-degree camera at the light looking away from face's texel
          * directions: the receivers of this face, one per pixel. */
-        static const float axis[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
-                                         {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-        vr_draw_desc d = {.mode = VR_MODE_NONE, .output = VR_OUTPUT_POSITION, .points = 1,
-                          .lights = &light, .light_count = 1};
+        static const float axis[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                         {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+        vr_draw_desc d = {.mode = VR_MODE_NONE,
+                          .output = VR_OUTPUT_POSITION,
+                          .points = 1,
+                          .lights = &light,
+                          .light_count = 1};
         for (int k = 0; k < 3; k++) {
             d.camera.eye[k] = LIGHT[k];
             d.camera.target[k] = LIGHT[k] - axis[face][k];
@@ -270,7 +294,8 @@ static void test_vertex(const char *dir)
                 continue;
             float dd[3] = {LIGHT[0] - p[0], LIGHT[1] - p[1], LIGHT[2] - p[2]}, s, t;
             gl_face_st(face, dd, &s, &t);
-            int i = (int)floorf((s + 1.0f) * 0.5f * CUBE_N), j = (int)floorf((t + 1.0f) * 0.5f * CUBE_N);
+            int i = (int)floorf((s + 1.0f) * 0.5f * CUBE_N),
+                j = (int)floorf((t + 1.0f) * 0.5f * CUBE_N);
             if (i < 0 || j < 0 || i >= CUBE_N || j >= CUBE_N)
                 continue;
             int v = face * (int)per_face + j * CUBE_N + i;
@@ -281,8 +306,8 @@ static void test_vertex(const char *dir)
             }
         }
         free(pos);
-        CHECK(found == (int)per_face, "face %d: %d of %u receivers found in the image", face,
-              found, per_face);
+        CHECK(found == (int)per_face, "face %d: %d of %u receivers found in the image", face, found,
+              per_face);
 
         for (int e = 0; e < NENC; e++)
             for (uint32_t q = 0; q < 3; q++)
@@ -302,8 +327,8 @@ static void test_vertex(const char *dir)
                               vdsh_interp_name(interp));
                         char what[128];
                         snprintf(what, sizeof what, "face %d, %s, %s, %s, %s", face,
-                                 vr_mode_name(modes[m]), ENC_NAME[e],
-                                 vdsh_quantity_name(q), cmp ? "binary" : "smooth");
+                                 vr_mode_name(modes[m]), ENC_NAME[e], vdsh_quantity_name(q),
+                                 cmp ? "binary" : "smooth");
                         int nc = mode_order[m] * mode_order[m];
                         for (int k = 0; k < CUBE_N * CUBE_N; k++) {
                             int v = vert[k];
@@ -394,7 +419,7 @@ static void grid_locate(float x, float y, uint32_t v[3], float w[3])
     if (u >= t) { /* triangle a, b, c */
         v[0] = a, v[1] = a + 1, v[2] = a + n + 1;
         w[0] = 1.0f - u, w[1] = u - t, w[2] = t;
-    } else {      /* triangle a, c, d */
+    } else { /* triangle a, c, d */
         v[0] = a, v[1] = a + n + 1, v[2] = a + n;
         w[0] = 1.0f - t, w[1] = u, w[2] = t - u;
     }
@@ -418,7 +443,9 @@ static void distance_interval(uint32_t q, float md, float d, float delta, float 
         *hi = q == VDSH_QUANTITY_LOG_DISTANCE ? 0.0f : to_distance(q, md, delta);
         return;
     }
-    float sum = q == VDSH_QUANTITY_DISTANCE2 ? d * d : q == VDSH_QUANTITY_LOG_DISTANCE ? logf(d) : d;
+    float sum = q == VDSH_QUANTITY_DISTANCE2      ? d * d
+                : q == VDSH_QUANTITY_LOG_DISTANCE ? logf(d)
+                                                  : d;
     *lo = to_distance(q, md, sum - delta);
     *hi = to_distance(q, md, sum + delta);
 }
@@ -433,8 +460,8 @@ typedef struct bracket {
 } bracket;
 
 static bracket interior_bracket(uint32_t order, uint32_t q, float md, uint32_t interp,
-                                const float *const c[3], const float *const pv[3],
-                                const float b[3], const float l[3], uint32_t cmp, float delta)
+                                const float *const c[3], const float *const pv[3], const float b[3],
+                                const float l[3], uint32_t cmp, float delta)
 {
     const float c00 = 0.28209479177387814f;
     int nc = (int)(order * order);
@@ -461,10 +488,10 @@ typedef struct frag_tally {
 /* One fragment: GPU (s, d_V, d_L) in g against the definition on the
  * runtime's path. p: the fragment's position (read back), v, w: its
  * triangle and barycentrics. */
-static void check_fragment(frag_tally *t, const char *what, const rt_file *f, int order,
-                           uint32_t q, vr_mode mode, uint32_t cmp, const float *coefs,
-                           const float p[3], const uint32_t v[3], const float w[3],
-                           const float l[3], const float *g, int at_light)
+static void check_fragment(frag_tally *t, const char *what, const rt_file *f, int order, uint32_t q,
+                           vr_mode mode, uint32_t cmp, const float *coefs, const float p[3],
+                           const uint32_t v[3], const float w[3], const float l[3], const float *g,
+                           int at_light)
 {
     int nc = order * order;
     uint32_t interp = vdsh_runtime_interp((uint32_t)order, q);
@@ -530,8 +557,8 @@ static void check_fragment(frag_tally *t, const char *what, const rt_file *f, in
     if (s_hi - s_lo > 0.5f)
         t->ties++; /* binary, d_V within rounding of d_L: either answer */
     if (q == VDSH_QUANTITY_LOG_DISTANCE) {
-        float sc = vdsh_shadow_interior((uint32_t)order, q, md, VDSH_INTERP_COEFFICIENTS, c, pv,
-                                        w, l, cmp, NULL);
+        float sc = vdsh_shadow_interior((uint32_t)order, q, md, VDSH_INTERP_COEFFICIENTS, c, pv, w,
+                                        l, cmp, NULL);
         t->differ += fabsf(sc - s_ref) > 0.1f;
     }
     int ok = g[0] >= s_lo && g[0] <= s_hi && g[1] >= d_lo - 1e-6f * fabsf(d_lo) &&
@@ -547,15 +574,16 @@ static void check_fragment(frag_tally *t, const char *what, const rt_file *f, in
          * and the split path reports d_V = 0 for d_L = 0. The definition
          * there: visible. */
         ok = g[0] == 1.0f && g[2] == 0.0f &&
-             (interp == VDSH_INTERP_SPLIT ? g[1] == 0.0f
-                                          : g[1] >= d_lo - 1e-6f * fabsf(d_lo) &&
-                                                g[1] <= d_hi + 1e-6f * fabsf(d_hi));
+             (interp == VDSH_INTERP_SPLIT
+                  ? g[1] == 0.0f
+                  : g[1] >= d_lo - 1e-6f * fabsf(d_lo) && g[1] <= d_hi + 1e-6f * fabsf(d_hi));
     }
     if (!ok && t->bad++ < 5)
-        fprintf(stderr, "fragment %s at (%g, %g, %g), path %s: GPU s %.7g dv %.7g dl %.7g; C s "
-                "%.7g [%.7g, %.7g] dv %.7g [%.7g, %.7g] dl %.7g\n", what, p[0], p[1], p[2],
-                vdsh_interp_name(interp), g[0], g[1], g[2], s_ref, s_lo, s_hi, d_ref, d_lo, d_hi,
-                dl);
+        fprintf(stderr,
+                "fragment %s at (%g, %g, %g), path %s: GPU s %.7g dv %.7g dl %.7g; C s "
+                "%.7g [%.7g, %.7g] dv %.7g [%.7g, %.7g] dl %.7g\n",
+                what, p[0], p[1], p[2], vdsh_interp_name(interp), g[0], g[1], g[2], s_ref, s_lo,
+                s_hi, d_ref, d_lo, d_hi, dl);
 }
 
 static void test_fragment(void)
@@ -575,8 +603,7 @@ static void test_fragment(void)
         }
     }
     vr_renderer *r = NULL;
-    vr_renderer_desc rd = {.width = GRID_PX, .height = GRID_PX,
-                           .color_format = VR_COLOR_RGBA32F};
+    vr_renderer_desc rd = {.width = GRID_PX, .height = GRID_PX, .color_format = VR_COLOR_RGBA32F};
     CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
     if (!r)
         return;
@@ -624,12 +651,12 @@ static void test_fragment(void)
                         rt_draw_or_die(r, scenes[e][q], &ds);
                         float *px = rt_read(r, GRID_PX, GRID_PX);
                         int order = mode_order[m];
-                                            uint32_t interp = vdsh_runtime_interp((uint32_t)order, q);
+                        uint32_t interp = vdsh_runtime_interp((uint32_t)order, q);
                         const float *coefs = stream_coefs(&files[e], order, q);
                         char what[160];
-                        snprintf(what, sizeof what, "%s %s %s %s, light %s",
-                                 vr_mode_name(modes[m]), ENC_NAME[e], vdsh_quantity_name(q),
-                                 cmp ? "binary" : "smooth", light_names[li]);
+                        snprintf(what, sizeof what, "%s %s %s %s, light %s", vr_mode_name(modes[m]),
+                                 ENC_NAME[e], vdsh_quantity_name(q), cmp ? "binary" : "smooth",
+                                 light_names[li]);
                         frag_tally t;
                         memset(&t, 0, sizeof t);
                         for (int k = 0; k < GRID_PX * GRID_PX; k++) {
@@ -639,8 +666,8 @@ static void test_fragment(void)
                             uint32_t v[3];
                             float w[3];
                             grid_locate(p[0], p[1], v, w);
-                            check_fragment(&t, what, &files[e], order, q, modes[m], cmp, coefs,
-                                           p, v, w, lights[li], px + 4 * k,
+                            check_fragment(&t, what, &files[e], order, q, modes[m], cmp, coefs, p,
+                                           v, w, lights[li], px + 4 * k,
                                            li == 2 && k == light_pixel);
                         }
                         free(px);
@@ -659,8 +686,8 @@ static void test_fragment(void)
         if (!t->checked)
             continue;
         printf("fragment, path %-10s: %ld pixels checked (%ld in the ramp, %ld binary ties, "
-               "%ld clamped), %ld wrong\n", vdsh_interp_name(i), t->checked, t->ramp, t->ties,
-               t->clamped, t->bad);
+               "%ld clamped), %ld wrong\n",
+               vdsh_interp_name(i), t->checked, t->ramp, t->ties, t->clamped, t->bad);
         CHECK(t->bad == 0, "path %s: %ld fragments disagree", vdsh_interp_name(i), t->bad);
         CHECK(t->ramp > t->checked / 50, "path %s: ramp coverage %ld", vdsh_interp_name(i),
               t->ramp);
@@ -672,11 +699,12 @@ static void test_fragment(void)
               vdsh_interp_name(i), t->ties);
     }
     CHECK(paths[VDSH_INTERP_VISIBILITY].checked && paths[VDSH_INTERP_SPLIT].checked &&
-          paths[VDSH_INTERP_DISTANCE].checked, "a path was not drawn");
+              paths[VDSH_INTERP_DISTANCE].checked,
+          "a path was not drawn");
     for (int li = 0; li < 3; li++) {
         printf("fragment, light %-13s: %ld pixels checked, %ld wrong; log-distance: %ld where "
-               "interpolating coefficients would differ by > 0.1\n", light_names[li],
-               lt[li].checked, lt[li].bad, lt[li].differ);
+               "interpolating coefficients would differ by > 0.1\n",
+               light_names[li], lt[li].checked, lt[li].bad, lt[li].differ);
         CHECK(lt[li].checked > 20L * GRID_PX * GRID_PX, "only %ld fragments checked",
               lt[li].checked);
     }
@@ -700,8 +728,7 @@ static void test_light_at_receiver(void)
     uint64_t rng = 0xa7;
     vr_renderer *r = NULL;
     vr_error err;
-    vr_renderer_desc rd = {.width = GRID_PX, .height = GRID_PX,
-                           .color_format = VR_COLOR_RGBA32F};
+    vr_renderer_desc rd = {.width = GRID_PX, .height = GRID_PX, .color_format = VR_COLOR_RGBA32F};
     CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
     if (!r)
         return;
@@ -756,13 +783,16 @@ static void test_light_at_receiver(void)
                             long nan = 0;
                             for (int k = 0; k < 4 * GRID_PX * GRID_PX; k++)
                                 nan += !isfinite(px[k]);
-                            CHECK(nan == 0, "%s %s %s %s points %d output %d: %ld values not "
-                                  "finite", vr_mode_name((vr_mode)m), ENC_NAME[e],
-                                  vdsh_quantity_name(q), cmp ? "binary" : "smooth", points, out,
-                                  nan);
+                            CHECK(nan == 0,
+                                  "%s %s %s %s points %d output %d: %ld values not "
+                                  "finite",
+                                  vr_mode_name((vr_mode)m), ENC_NAME[e], vdsh_quantity_name(q),
+                                  cmp ? "binary" : "smooth", points, out, nan);
                             if (points && out == VR_OUTPUT_SHADOW && pixel >= 0) {
-                                CHECK(px[4 * pixel] == 1.0f, "%s %s %s: light at the receiver: "
-                                      "s = %g", vr_mode_name((vr_mode)m), vdsh_quantity_name(q),
+                                CHECK(px[4 * pixel] == 1.0f,
+                                      "%s %s %s: light at the receiver: "
+                                      "s = %g",
+                                      vr_mode_name((vr_mode)m), vdsh_quantity_name(q),
                                       cmp ? "binary" : "smooth", px[4 * pixel]);
                                 CHECK(px[4 * pixel + 2] == 0.0f, "d_L = %g", px[4 * pixel + 2]);
                             }
@@ -774,7 +804,8 @@ static void test_light_at_receiver(void)
         rt_file_free(&f);
     }
     printf("light at a receiver: %ld draws (every mode, quantity, encoding, comparison, "
-           "points and triangles), no NaN, s = 1 there\n", draws);
+           "points and triangles), no NaN, s = 1 there\n",
+           draws);
     vr_renderer_destroy(r);
 }
 
@@ -827,8 +858,8 @@ static void test_horizon(void)
         c[1] = -beta * u[1] / c1; /* Y_1-1 = -C1 y, Y_10 = C1 z, Y_11 = -C1 x */
         c[2] = beta * u[2] / c1;
         c[3] = -beta * u[0] / c1;
-        rt_file_add_stream(&f, (uint32_t)orders[o], VDSH_ENCODING_F32,
-                           VDSH_QUANTITY_LOG_DISTANCE, c, 1.0f);
+        rt_file_add_stream(&f, (uint32_t)orders[o], VDSH_ENCODING_F32, VDSH_QUANTITY_LOG_DISTANCE,
+                           c, 1.0f);
     }
     float cosn = 0.0f;
     for (int k = 0; k < 3; k++)
@@ -843,8 +874,7 @@ static void test_horizon(void)
     vr_error err;
     vr_scene_desc sd = {.file = &f.f};
     CHECK(vr_scene_create(&sd, &s, &err) == VR_OK, "%s", err.msg);
-    vr_renderer_desc rd = {.width = GRID_PX, .height = GRID_PX,
-                           .color_format = VR_COLOR_RGBA32F};
+    vr_renderer_desc rd = {.width = GRID_PX, .height = GRID_PX, .color_format = VR_COLOR_RGBA32F};
     CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
     if (!s || !r) {
         vr_scene_destroy(s);
@@ -892,12 +922,11 @@ static void test_horizon(void)
                 /* barycentrics in the right triangle a, b, c */
                 float b[3] = {0.0f, 0.5f * (p[0] + 1.0f), 0.5f * (p[1] + 1.0f)};
                 b[0] = 1.0f - b[1] - b[2];
-                check_fragment(&t, what, &f, mode_order[m], q, modes[m], cmp, coefs, p, tri, b,
-                               L, g, 0);
+                check_fragment(&t, what, &f, mode_order[m], q, modes[m], cmp, coefs, p, tri, b, L,
+                               g, 0);
                 worst = fmaxf(worst, g[1]);
                 float s_wild = vdsh_shadow_interior((uint32_t)mode_order[m], q, INFINITY,
-                                                    VDSH_INTERP_DISTANCE, cv, pv, b, L, cmp,
-                                                    NULL);
+                                                    VDSH_INTERP_DISTANCE, cv, pv, b, L, cmp, NULL);
                 dark += g[0] < 0.5f;
                 leak_stopped += g[0] < 0.5f && s_wild > 0.5f;
             }
@@ -912,8 +941,8 @@ static void test_horizon(void)
             /* the side near b-c, where a's weight is small (about half
              * the triangle), is dark, and was lit unclamped */
             CHECK(leak_stopped > t.checked / 5 && leak_stopped == dark,
-                  "%s: %ld of %ld fragments dark, %ld of them lit unclamped", what, dark,
-                  t.checked, leak_stopped);
+                  "%s: %ld of %ld fragments dark, %ld of them lit unclamped", what, dark, t.checked,
+                  leak_stopped);
         }
     free(pos);
     vr_renderer_destroy(r);

@@ -181,14 +181,13 @@ int main(int argc, char **argv)
                     if (near < 4.0f)
                         continue; /* only fragments far from every vertex */
                     float dv;
-                    float s_dist = vdsh_shadow_interior((uint32_t)order, q, h->max_distance,
-                                                        interp, cp, pv, b, lights[li], cmp, &dv);
+                    float s_dist = vdsh_shadow_interior((uint32_t)order, q, h->max_distance, interp,
+                                                        cp, pv, b, lights[li], cmp, &dv);
                     float sc = vdsh_shadow_interior((uint32_t)order, q, h->max_distance,
-                                                    VDSH_INTERP_COEFFICIENTS, cp, pv, b,
-                                                    lights[li], cmp, NULL);
+                                                    VDSH_INTERP_COEFFICIENTS, cp, pv, b, lights[li],
+                                                    cmp, NULL);
                     /* the truth: the box toward the light, or nothing */
-                    float w[3] = {lights[li][0] - p[0], lights[li][1] - p[1],
-                                  lights[li][2] - p[2]};
+                    float w[3] = {lights[li][0] - p[0], lights[li][1] - p[1], lights[li][2] - p[2]};
                     float dl = sqrtf(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
                     for (int a = 0; a < 3; a++)
                         w[a] /= dl;
@@ -197,15 +196,16 @@ int main(int argc, char **argv)
                     /* GPU against the definition: float rounding of a
                      * 25-term sum and its exp, and of the interpolation */
                     int tie = cmp == VDSH_COMPARE_BINARY && fabsf(dv - dl) <= 1e-3f * dl;
-                    int ok = fabsf(g[1] - dv) <= 1e-4f * dv + 1e-6f &&
-                             fabsf(g[2] - dl) <= 1e-5f * dl;
+                    int ok =
+                        fabsf(g[1] - dv) <= 1e-4f * dv + 1e-6f && fabsf(g[2] - dl) <= 1e-5f * dl;
                     if (!tie)
                         ok = ok && fabsf(g[0] - s_dist) <= 2e-4f * (dv / dl) + 1e-5f;
                     if (!ok && t.bad++ < 5)
-                        fprintf(stderr, "%s light %d %s at (%g, %g): GPU s %g d %g dl %g, "
-                                "distance path s %g d %g dl %g\n", vr_mode_name(modes[m]), li,
-                                cmp ? "binary" : "smooth", p[0], p[2], g[0], g[1], g[2], s_dist, dv,
-                                dl);
+                        fprintf(stderr,
+                                "%s light %d %s at (%g, %g): GPU s %g d %g dl %g, "
+                                "distance path s %g d %g dl %g\n",
+                                vr_mode_name(modes[m]), li, cmp ? "binary" : "smooth", p[0], p[2],
+                                g[0], g[1], g[2], s_dist, dv, dl);
                     if (fabsf(s_dist - sc) > 0.5f) {
                         t.differ++;
                         t.wrong_side += fabsf(g[0] - sc) < fabsf(g[0] - s_dist);
@@ -226,12 +226,15 @@ int main(int argc, char **argv)
                 CHECK(t.bad == 0, "%s light %d: %ld fragments off the distance path",
                       vr_mode_name(modes[m]), li, t.bad);
                 CHECK(t.wrong_side == 0, "%ld fragments on the coefficient side", t.wrong_side);
-                CHECK(mae_gpu < mae_coef, "%s light %d %s: the distance path is no closer to the "
-                      "truth (%.4f) than coefficients (%.4f)", vr_mode_name(modes[m]), li,
-                      cmp ? "binary" : "smooth", mae_gpu, mae_coef);
+                CHECK(mae_gpu < mae_coef,
+                      "%s light %d %s: the distance path is no closer to the "
+                      "truth (%.4f) than coefficients (%.4f)",
+                      vr_mode_name(modes[m]), li, cmp ? "binary" : "smooth", mae_gpu, mae_coef);
                 /* the case must tell the two apart, strongly */
-                CHECK(t.differ > t.far / 20, "%s light %d: the interpolations differ in only "
-                      "%ld fragments", vr_mode_name(modes[m]), li, t.differ);
+                CHECK(t.differ > t.far / 20,
+                      "%s light %d: the interpolations differ in only "
+                      "%ld fragments",
+                      vr_mode_name(modes[m]), li, t.differ);
             }
     free(pos);
     vr_renderer_destroy(r);

@@ -129,7 +129,8 @@ static void test_grid(void)
     r = vr_order_triangles(idx, NT, NV, out, remap, "grid", &err);
     double before = fifo_misses(idx, NT, NV, 32), after = fifo_misses(out, NT, NV, 32);
     printf("order: grid of %d triangles, FIFO(32) vertex transforms per triangle: scrambled "
-           "%.3f, ordered %.3f (ideal about 0.5)\n", NT, before, after);
+           "%.3f, ordered %.3f (ideal about 0.5)\n",
+           NT, before, after);
     CHECK(r == VR_OK && after < 0.8 && after < 0.5 * before, "transforms per triangle %.3f -> %.3f",
           before, after);
 }

@@ -121,15 +121,17 @@ static int shadow_check(char **argv)
         }
         double a = window_mean(img, w, (int)x, (int)y, r);
         double b = window_mean(none, w, (int)x, (int)y, r);
-        printf("%s: %s point (%g, %g, %g) at pixel (%d, %d): %.1f, without shadows %.1f\n",
-               argv[2], name[k], pts[k][0], pts[k][1], pts[k][2], (int)x, (int)y, a, b);
+        printf("%s: %s point (%g, %g, %g) at pixel (%d, %d): %.1f, without shadows %.1f\n", argv[2],
+               name[k], pts[k][0], pts[k][1], pts[k][2], (int)x, (int)y, a, b);
         if (b < 40.0) {
-            fprintf(stderr, "%s point: only %.1f without shadows: the light does not reach "
-                    "it, the check would prove nothing\n", name[k], b);
+            fprintf(stderr,
+                    "%s point: only %.1f without shadows: the light does not reach "
+                    "it, the check would prove nothing\n",
+                    name[k], b);
             rc = 1;
         } else if (k == 0 && !(a <= 0.5 * b)) {
-            fprintf(stderr, "%s: the shadowed point is not darkened (%.1f of %.1f)\n", argv[2],
-                    a, b);
+            fprintf(stderr, "%s: the shadowed point is not darkened (%.1f of %.1f)\n", argv[2], a,
+                    b);
             rc = 1;
         } else if (k == 1 && !(a >= 0.8 * b)) {
             fprintf(stderr, "%s: the lit point is darkened (%.1f of %.1f)\n", argv[2], a, b);

@@ -36,9 +36,9 @@ static void icosphere(float (*pos)[3], uint32_t *nv, uint32_t (*tri)[3], uint32_
                                {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
                                {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
     static const uint32_t faces[20][3] = {
-        {0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-        {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-        {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+        {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+        {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+        {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
     float len = sqrtf(1.0f + t * t);
     for (int i = 0; i < 12; i++)
         for (int k = 0; k < 3; k++)
@@ -70,8 +70,10 @@ static void icosphere(float (*pos)[3], uint32_t *nv, uint32_t (*tri)[3], uint32_
                 }
                 mid[e] = m;
             }
-            uint32_t split[4][3] = {{tri[f][0], mid[0], mid[2]}, {tri[f][1], mid[1], mid[0]},
-                                    {tri[f][2], mid[2], mid[1]}, {mid[0], mid[1], mid[2]}};
+            uint32_t split[4][3] = {{tri[f][0], mid[0], mid[2]},
+                                    {tri[f][1], mid[1], mid[0]},
+                                    {tri[f][2], mid[2], mid[1]},
+                                    {mid[0], mid[1], mid[2]}};
             memcpy(next[nn], split, sizeof split);
             nn += 4;
         }
@@ -135,8 +137,8 @@ static void sphere_file(rt_file *f, float R)
 }
 
 /* Fraction of drawn pixels with s >= thr, the mean and the minimum s. */
-static void shadow_stats(const float *px, int n, float thr, float *frac, float *mean,
-                         float *min, long *drawn)
+static void shadow_stats(const float *px, int n, float thr, float *frac, float *mean, float *min,
+                         long *drawn)
 {
     long d = 0, hit = 0;
     double sum = 0.0;
@@ -154,8 +156,8 @@ static void shadow_stats(const float *px, int n, float thr, float *frac, float *
     *mean = d ? (float)(sum / (double)d) : 0.0f;
 }
 
-static const vr_mode shadow_modes[5] = {VR_MODE_CUBE, VR_MODE_VDSH2, VR_MODE_VDSH3,
-                                        VR_MODE_VDSH5, VR_MODE_VDSH5_POLY};
+static const vr_mode shadow_modes[5] = {VR_MODE_CUBE, VR_MODE_VDSH2, VR_MODE_VDSH3, VR_MODE_VDSH5,
+                                        VR_MODE_VDSH5_POLY};
 
 static void test_sphere(const char *dir, vr_renderer *r)
 {
@@ -184,8 +186,10 @@ static void test_sphere(const char *dir, vr_renderer *r)
                     if (shadow_modes[m] == VR_MODE_CUBE && cmp)
                         continue;
                     vr_light light = {.position = {lights[l][0], lights[l][1], lights[l][2]}};
-                    vr_draw_desc d = {.mode = shadow_modes[m], .compare = cmp,
-                                      .output = VR_OUTPUT_SHADOW, .lights = &light,
+                    vr_draw_desc d = {.mode = shadow_modes[m],
+                                      .compare = cmp,
+                                      .output = VR_OUTPUT_SHADOW,
+                                      .lights = &light,
                                       .light_count = 1};
                     memcpy(d.camera.eye, views[v], 3 * sizeof(float));
                     memcpy(d.camera.target, views[v] + 3, 3 * sizeof(float));
@@ -202,8 +206,8 @@ static void test_sphere(const char *dir, vr_renderer *r)
                         /* Every pixel sees the inside of the sphere. */
                         CHECK(frac >= 0.999f && mean >= 0.999f,
                               "sphere, light %d, view %d, %s %s: %.2f%% of pixels "
-                              "unshadowed, mean %.4f", l, v, what, cmp ? "binary" : "smooth",
-                              100.0 * frac, mean);
+                              "unshadowed, mean %.4f",
+                              l, v, what, cmp ? "binary" : "smooth", 100.0 * frac, mean);
                     } else if (cmp == VDSH_COMPARE_SMOOTH) {
                         /* Order 2 reconstructs the chord 2R cos(t) as
                          * R/2 + R cos(t) (bands 0-1 of it): short toward
@@ -213,13 +217,13 @@ static void test_sphere(const char *dir, vr_renderer *r)
                          * false shadows (the paper's known failure), so
                          * it is only reported. */
                         CHECK(mean >= 0.97f && min >= 0.6f,
-                              "sphere, light %d, view %d, vdsh2: mean %.4f, min %.4f", l, v,
-                              mean, min);
+                              "sphere, light %d, view %d, vdsh2: mean %.4f, min %.4f", l, v, mean,
+                              min);
                     }
                     if (l == 2 && v == 1)
                         printf("sphere, light %d, %-9s %s: %.2f%% of pixels unshadowed, mean "
-                               "s %.4f, min %.4f\n", l, what, cmp ? "binary" : "smooth",
-                               100.0 * frac, mean, min);
+                               "s %.4f, min %.4f\n",
+                               l, what, cmp ? "binary" : "smooth", 100.0 * frac, mean, min);
                 }
     vr_scene_destroy(s);
     rt_file_free(&f);
@@ -292,8 +296,8 @@ static void test_wall(vr_renderer *r, vr_scene *room)
                 float limit = mode == VR_MODE_VDSH2 ? 0.15f : 0.05f;
                 CHECK(mean <= limit && mean_lum < 0.1f * limit + 0.01f,
                       "%s %s: the floor behind the wall has mean visibility %g (limit %g), "
-                      "luminance %g", vr_mode_name(mode), cmp ? "binary" : "smooth", mean,
-                      limit, mean_lum);
+                      "luminance %g",
+                      vr_mode_name(mode), cmp ? "binary" : "smooth", mean, limit, mean_lum);
             }
             free(sh);
             free(col);
@@ -303,8 +307,7 @@ static void test_wall(vr_renderer *r, vr_scene *room)
 
 /* Mean absolute difference and the fraction of pixels differing by more
  * than thr, over RGB. */
-static void image_diff(const float *a, const float *b, int n, float thr, double *mad,
-                       double *frac)
+static void image_diff(const float *a, const float *b, int n, float thr, double *mad, double *frac)
 {
     double s = 0.0;
     long big = 0;
@@ -326,8 +329,7 @@ static void image_diff(const float *a, const float *b, int n, float thr, double 
 static float *render_color(vr_renderer *r, vr_scene *s, vr_mode mode, uint32_t cmp, int pcf,
                            const vr_light *lights, int n)
 {
-    vr_draw_desc d = {.mode = mode, .compare = cmp, .pcf = pcf, .lights = lights,
-                      .light_count = n};
+    vr_draw_desc d = {.mode = mode, .compare = cmp, .pcf = pcf, .lights = lights, .light_count = n};
     const float eye[3] = {-3.0f, 5.5f, 1.0f}, target[3] = {-5.0f, 0.0f, -3.5f};
     memcpy(d.camera.eye, eye, sizeof eye);
     memcpy(d.camera.target, target, sizeof target);
@@ -375,7 +377,8 @@ static void test_differ(vr_renderer *r, vr_scene *room)
      * basis cubemaps and their bilinear filtering. */
     image_diff(v5, v5p, W * H, 0.01f, &mad, &frac);
     printf("differ: vdsh5 cubemaps vs polynomials: %.3f%% of pixels differ by > 0.01, mean "
-           "|d| %.6f\n", 100 * frac, mad);
+           "|d| %.6f\n",
+           100 * frac, mad);
     CHECK(frac < 0.002 && mad < 5e-4, "order 5 paths disagree: %.3f%%, %g", 100 * frac, mad);
     free(none), free(cube), free(pcf), free(v2), free(v5), free(v5p), free(v5b);
 }
@@ -401,7 +404,9 @@ static void test_passes(vr_scene *room)
         for (int p = 0; p < 3; p++) {
             vr_renderer *r = NULL;
             vr_error err;
-            vr_renderer_desc rd = {.width = W, .height = H, .color_format = VR_COLOR_RGBA32F,
+            vr_renderer_desc rd = {.width = W,
+                                   .height = H,
+                                   .color_format = VR_COLOR_RGBA32F,
                                    .max_lights_per_pass = per[p]};
             CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
             if (!r)
@@ -438,8 +443,7 @@ static void test_passes(vr_scene *room)
 static void expect_default(vr_renderer *r, vr_scene *s, vr_mode want, const char *what)
 {
     vr_mode got = vr_scene_default_mode(s);
-    CHECK(got == want, "%s: default mode %s, want %s", what, vr_mode_name(got),
-          vr_mode_name(want));
+    CHECK(got == want, "%s: default mode %s, want %s", what, vr_mode_name(got), vr_mode_name(want));
     CHECK(vr_scene_supports(s, VR_MODE_DEFAULT) == vr_scene_supports(s, want), "%s", what);
     CHECK(vr_scene_interp(s, VR_MODE_DEFAULT) == vr_scene_interp(s, want), "%s", what);
     CHECK(!strcmp(vr_scene_mode_label(s, VR_MODE_DEFAULT), vr_scene_mode_label(s, want)), "%s",
@@ -447,8 +451,8 @@ static void expect_default(vr_renderer *r, vr_scene *s, vr_mode want, const char
     vr_light light = {.position = {-2.4f, 0.8f, -2.0f}, .attenuation = {1.0f, 0.0f, 0.01f}};
     float *zero = render_color(r, s, VR_MODE_DEFAULT, 0, 0, &light, 1);
     float *named = render_color(r, s, want, 0, 0, &light, 1);
-    CHECK(!memcmp(zero, named, (size_t)W * H * 4 * sizeof(float)),
-          "%s: mode 0 does not draw %s", what, vr_mode_name(want));
+    CHECK(!memcmp(zero, named, (size_t)W * H * 4 * sizeof(float)), "%s: mode 0 does not draw %s",
+          what, vr_mode_name(want));
     printf("default: %s: mode 0 draws %s (%s)\n", what, vr_mode_name(want),
            vr_scene_mode_label(s, VR_MODE_DEFAULT));
     free(zero);

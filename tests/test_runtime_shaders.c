@@ -103,7 +103,8 @@ int main(int argc, char **argv)
     /* The documented interface (shaders/README.md). */
     check_has("vdsh_common.glsl", vr_glsl_common, "float vdsh_distance(float sum, float md)\n");
     check_has("vdsh_common.glsl", vr_glsl_common, "float vdsh_compare(float dv, float dl)\n");
-    check_has("vdsh_common.glsl", vr_glsl_common, "float vdsh_shadow(float sum, float md, float dl)\n");
+    check_has("vdsh_common.glsl", vr_glsl_common,
+              "float vdsh_shadow(float sum, float md, float dl)\n");
     check_has("vdsh_common.glsl", vr_glsl_common, "float vdsh_sh_sum25(vec4 g[7], vec3 d)\n");
     check_has("vdsh_buffer.glsl", vr_buffer_glsl, "void buffer_sums(out float sums[NUM_LIGHTS])\n");
     /* No #version line: the includer writes it (330 core or 300 es). */

@@ -42,8 +42,8 @@ typedef struct rt_file {
     float *pos, *nrm;
     uint32_t *idx;
     vdsh_stream streams[VDSH_MAX_STREAMS];
-    float *coef[VDSH_MAX_STREAMS];   /* the coefficients as floats */
-    void *data[VDSH_MAX_STREAMS];    /* as stored */
+    float *coef[VDSH_MAX_STREAMS]; /* the coefficients as floats */
+    void *data[VDSH_MAX_STREAMS];  /* as stored */
     vdsh_source source;
 } rt_file;
 
@@ -102,7 +102,8 @@ static inline vr_renderer *rt_float_renderer(int w, int h)
 
 /* rt_file_init for one quad: corners p, one normal n at each, triangles
  * idx; bounds set. */
-static inline void rt_file_quad(rt_file *r, const float p[4][3], const float n[3], const uint32_t idx[6])
+static inline void rt_file_quad(rt_file *r, const float p[4][3], const float n[3],
+                                const uint32_t idx[6])
 {
     rt_file_init(r, 4, 2);
     for (int i = 0; i < 4; i++) {
@@ -128,7 +129,7 @@ static inline void rt_file_unit_quad(rt_file *r)
  * s8s6 by vdsh_encode_quantised (scale ignored: 1; coef replaced by the
  * decoded values as for f16). */
 static inline void rt_file_add_stream(rt_file *r, uint32_t order, uint32_t enc, uint32_t quantity,
-                               float *coef, float scale)
+                                      float *coef, float scale)
 {
     uint32_t i = r->f.stream_count++;
     size_t n = (size_t)r->f.header.vertex_count * order * order;
@@ -188,7 +189,7 @@ static inline void rt_file_free(rt_file *r)
 
 /* Write dir/stem.vdsh (the .vdsh alone). */
 static inline int rt_file_write(const rt_file *r, const char *dir, const char *stem, char *path,
-                         size_t path_size)
+                                size_t path_size)
 {
     mkdir(dir, 0777);
     snprintf(path, path_size, "%s/%s.vdsh", dir, stem);

@@ -160,8 +160,9 @@ static float dist3(const float a[3], const float b[3])
 
 static int same_camera(const vdsh_camera *a, const vdsh_camera *b)
 {
-    return !memcmp(a->eye, b->eye, sizeof a->eye) && !memcmp(a->target, b->target, sizeof a->target) &&
-           !memcmp(a->up, b->up, sizeof a->up) && a->fov_y == b->fov_y;
+    return !memcmp(a->eye, b->eye, sizeof a->eye) &&
+           !memcmp(a->target, b->target, sizeof a->target) && !memcmp(a->up, b->up, sizeof a->up) &&
+           a->fov_y == b->fov_y;
 }
 
 /* ---- unit tests --------------------------------------------------------- */
@@ -206,16 +207,17 @@ static void rays_agree(const mesh *mm, const char *name, uint64_t seed, int n)
         backs += hb && b.back;
         if (ha != hb || memcmp(&a, &b, sizeof a)) {
             if (differ++ < 5)
-                fprintf(stderr, "%s: ray %d: grid %d (t %g, triangle %u), loop %d (t %g, "
-                        "triangle %u)\n", name, i, ha, (double)a.t, a.triangle, hb,
-                        (double)b.t, b.triangle);
+                fprintf(stderr,
+                        "%s: ray %d: grid %d (t %g, triangle %u), loop %d (t %g, "
+                        "triangle %u)\n",
+                        name, i, ha, (double)a.t, a.triangle, hb, (double)b.t, b.triangle);
         }
     }
     printf("rays: %s (%u triangles): %d rays, %d hits (%d from behind), %d differ\n", name,
            m.triangle_count, n, hits, backs, differ);
     CHECK(differ == 0, "%s: %d of %d rays hit differently through the grid", name, differ, n);
-    CHECK(hits > n / 10 && hits < n, "%s: %d hits of %d rays: the test proves little", name,
-          hits, n);
+    CHECK(hits > n / 10 && hits < n, "%s: %d hits of %d rays: the test proves little", name, hits,
+          n);
     vdsh_view_tracer_destroy(t);
 }
 
@@ -318,8 +320,8 @@ static void test_room(void)
     for (int i = 0; i < v.light_count; i++) {
         int was_free = free_all(&m, v.preferred[i], diag);
         CHECK(v.light_free[i] && free_all(&m, v.lights[i], diag),
-              "light %d at (%g, %g, %g) is not in free space", i, v.lights[i][0],
-              v.lights[i][1], v.lights[i][2]);
+              "light %d at (%g, %g, %g) is not in free space", i, v.lights[i][0], v.lights[i][1],
+              v.lights[i][2]);
         if (i == 2) {
             CHECK(!was_free, "light 2's preferred position is free: the pillar misses it");
             float moved = dist3(v.lights[i], v.preferred[i]);
@@ -330,9 +332,9 @@ static void test_room(void)
             for (int k = 0; k < 3; k++)
                 in_pillar &= v.lights[i][k] >= plo[k] && v.lights[i][k] <= phi[k];
             CHECK(!in_pillar, "light 2 is still in the pillar");
-            printf("room: light 2 moved %.3f from (%g, %g, %g) to (%g, %g, %g)\n",
-                   (double)moved, v.preferred[i][0], v.preferred[i][1], v.preferred[i][2],
-                   v.lights[i][0], v.lights[i][1], v.lights[i][2]);
+            printf("room: light 2 moved %.3f from (%g, %g, %g) to (%g, %g, %g)\n", (double)moved,
+                   v.preferred[i][0], v.preferred[i][1], v.preferred[i][2], v.lights[i][0],
+                   v.lights[i][1], v.lights[i][2]);
         } else {
             CHECK(was_free, "light %d's preferred position is not free", i);
             CHECK(!memcmp(v.lights[i], v.preferred[i], sizeof v.lights[i]),
@@ -350,16 +352,15 @@ static void test_object(void)
     vdsh_view v;
     vdsh_error err;
     CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
-    CHECK(!v.interior && v.front_share == 0.0f, "a sphere: interior %d, front share %g",
-          v.interior, (double)v.front_share);
+    CHECK(!v.interior && v.front_share == 0.0f, "a sphere: interior %d, front share %g", v.interior,
+          (double)v.front_share);
     vdsh_camera fit;
     vdsh_view_fit_camera(v.bounds_min, v.bounds_max, &fit);
     CHECK(same_camera(&v.camera, &fit), "an object is not framed by the fit camera");
     float diag = diagonal_of(v.bounds_min, v.bounds_max);
     for (int i = 0; i < v.light_count; i++) {
         float r = dist3(v.lights[i], c);
-        CHECK(r > 1.0f + vdsh_free_clearance(diag), "light %d is %g from the centre", i,
-              (double)r);
+        CHECK(r > 1.0f + vdsh_free_clearance(diag), "light %d is %g from the centre", i, (double)r);
         CHECK(v.light_free[i] && free_all(&m, v.lights[i], diag), "light %d is not free", i);
         CHECK(!memcmp(v.lights[i], v.preferred[i], sizeof v.lights[i]), "light %d moved", i);
     }
@@ -455,16 +456,17 @@ static void test_two_rooms(void)
     float pref[VDSH_VIEW_MAX_LIGHTS][3], lit, sh;
     vdsh_view_preferred_lights(v.bounds_min, v.bounds_max, 1, pref, VDSH_VIEW_MAX_LIGHTS);
     shares_all(&m, &v.camera, 32, 24, pref[0], diag, &lit, &sh);
-    printf("two rooms: preferred light 0 (%g, %g, %g) lights %.1f%%, shadows %.1f%%\n",
-           pref[0][0], pref[0][1], pref[0][2], 100.0 * lit, 100.0 * sh);
+    printf("two rooms: preferred light 0 (%g, %g, %g) lights %.1f%%, shadows %.1f%%\n", pref[0][0],
+           pref[0][1], pref[0][2], 100.0 * lit, 100.0 * sh);
     CHECK(pref[0][0] < 11.8f && free_all(&m, pref[0], diag) && lit < sh,
-          "the test has lost its case: preferred light 0 at x %g, lights %g",
-          (double)pref[0][0], (double)lit);
+          "the test has lost its case: preferred light 0 at x %g, lights %g", (double)pref[0][0],
+          (double)lit);
     for (int i = 0; i < v.light_count; i++) {
         shares_all(&m, &v.camera, 32, 24, v.lights[i], diag, &lit, &sh);
         printf("two rooms: light %d (%g, %g, %g) lights %.1f%%, shadows %.1f%% (check frame "
-               "%.1f%%, %.1f%%)\n", i, v.lights[i][0], v.lights[i][1], v.lights[i][2],
-               100.0 * lit, 100.0 * sh, 100.0 * v.light_lit[i], 100.0 * v.light_shadowed[i]);
+               "%.1f%%, %.1f%%)\n",
+               i, v.lights[i][0], v.lights[i][1], v.lights[i][2], 100.0 * lit, 100.0 * sh,
+               100.0 * v.light_lit[i], 100.0 * v.light_shadowed[i]);
         CHECK(v.light_free[i] && free_all(&m, v.lights[i], diag), "light %d is not free", i);
         CHECK(lit >= VDSH_VIEW_MIN_SHARE && lit >= sh && v.light_lit[i] >= VDSH_VIEW_MIN_SHARE,
               "light %d lights %g of the frame and shadows %g", i, (double)lit, (double)sh);
@@ -472,8 +474,8 @@ static void test_two_rooms(void)
     CHECK(v.lights[0][0] > 12.2f, "light 0 is not in the camera's room (x %g)",
           (double)v.lights[0][0]);
     shares_all(&m, &v.camera, 32, 24, v.lights[0], diag, &lit, &sh);
-    CHECK(lit >= 0.25f && sh > 0.0f, "light 0 lights %g and shadows %g of the frame",
-          (double)lit, (double)sh);
+    CHECK(lit >= 0.25f && sh > 0.0f, "light 0 lights %g and shadows %g of the frame", (double)lit,
+          (double)sh);
 }
 
 /* A block on the floor just in front of the room camera's eye (the
@@ -516,8 +518,8 @@ static void test_blocked_eye(void)
         }
     CHECK(open_std < 48, "the test is wrong: the standard eye sees %d of 63 open", open_std);
     CHECK(open_new >= 48, "the moved eye sees %d of 63 rays open", open_new);
-    printf("blocked eye: moved to height %.2f, open rays %d -> %d of 63\n",
-           (double)v.camera.eye[1], open_std, open_new);
+    printf("blocked eye: moved to height %.2f, open rays %d -> %d of 63\n", (double)v.camera.eye[1],
+           open_std, open_new);
 }
 
 static void test_errors(void)
@@ -586,10 +588,11 @@ static int test_builtin_room(const char *path)
     /* the room camera as it was written before it moved to formats/: a
      * third of the way along x, 28% up, looking at the far half */
     const float *lo = v.bounds_min, *hi = v.bounds_max;
-    vdsh_camera c = {{0.5f * (lo[0] + hi[0]) + 0.36f * (hi[0] - lo[0]), lo[1] + 0.28f * (hi[1] - lo[1]),
+    vdsh_camera c = {{0.5f * (lo[0] + hi[0]) + 0.36f * (hi[0] - lo[0]),
+                      lo[1] + 0.28f * (hi[1] - lo[1]),
                       0.5f * (lo[2] + hi[2]) + 0.05f * (hi[2] - lo[2])},
-                     {0.5f * (lo[0] + hi[0]) - 0.2f * (hi[0] - lo[0]), lo[1] + 0.13f * (hi[1] - lo[1]),
-                      0.5f * (lo[2] + hi[2])},
+                     {0.5f * (lo[0] + hi[0]) - 0.2f * (hi[0] - lo[0]),
+                      lo[1] + 0.13f * (hi[1] - lo[1]), 0.5f * (lo[2] + hi[2])},
                      {0, 1, 0},
                      60.0f};
     CHECK(same_camera(&v.camera, &c), "%s: the default camera is not the room camera", path);
@@ -600,20 +603,20 @@ static int test_builtin_room(const char *path)
         float moved = dist3(v.lights[i], v.preferred[i]);
         printf("light %d: preferred (%g, %g, %g)%s, now (%g, %g, %g), moved %.3f\n", i,
                v.preferred[i][0], v.preferred[i][1], v.preferred[i][2],
-               pref_free ? " free" : " not free", v.lights[i][0], v.lights[i][1],
-               v.lights[i][2], (double)moved);
-        CHECK(v.light_free[i] && free_all(&m, v.lights[i], diag),
-              "light %d is not in free space", i);
-        CHECK(!in_solid(v.lights[i], 0.0f, what, sizeof what), "light %d is inside %s", i,
-              what);
+               pref_free ? " free" : " not free", v.lights[i][0], v.lights[i][1], v.lights[i][2],
+               (double)moved);
+        CHECK(v.light_free[i] && free_all(&m, v.lights[i], diag), "light %d is not in free space",
+              i);
+        CHECK(!in_solid(v.lights[i], 0.0f, what, sizeof what), "light %d is inside %s", i, what);
         /* the axis probes keep it clear of the faces it is in front of:
          * no closer than the clearance to a pillar's or crate's sides */
         CHECK(!in_solid(v.lights[i], 0.5f * clear, what, sizeof what),
-              "light %d is within half the clearance (%g) of %s", i, (double)(0.5f * clear),
-              what);
+              "light %d is within half the clearance (%g) of %s", i, (double)(0.5f * clear), what);
         if (i == 1 || i == 2) {
-            CHECK(!pref_free, "light %d's preferred position is in free space: the test has "
-                  "lost its pillar", i);
+            CHECK(!pref_free,
+                  "light %d's preferred position is in free space: the test has "
+                  "lost its pillar",
+                  i);
             CHECK(in_solid(v.preferred[i], 0.01f, what, sizeof what),
                   "light %d's preferred position is not at a pillar", i);
             CHECK(moved > 0.0f && moved < 1.0f, "light %d moved %g", i, (double)moved);

@@ -83,8 +83,8 @@ static inline void test_make_room(vb_mesh *m, float a, float h, float b)
     const float wx1[4][3] = {{a, 0, -b}, {a, 0, b}, {a, h, b}, {a, h, -b}};
     const float wz0[4][3] = {{-a, 0, -b}, {a, 0, -b}, {a, h, -b}, {-a, h, -b}};
     const float wz1[4][3] = {{-a, 0, b}, {-a, h, b}, {a, h, b}, {a, 0, b}};
-    const float up[3] = {0, 1, 0}, down[3] = {0, -1, 0}, px[3] = {1, 0, 0},
-                nx[3] = {-1, 0, 0}, pz[3] = {0, 0, 1}, nz[3] = {0, 0, -1};
+    const float up[3] = {0, 1, 0}, down[3] = {0, -1, 0}, px[3] = {1, 0, 0}, nx[3] = {-1, 0, 0},
+                pz[3] = {0, 0, 1}, nz[3] = {0, 0, -1};
     test_add_quad(m, fl, up);
     test_add_quad(m, ce, down);
     test_add_quad(m, wx0, px);

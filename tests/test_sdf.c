@@ -16,12 +16,12 @@
 #include "vdsh_sdf.h"
 
 static int failures;
-#define CHECK(c)                                                                   \
-    do {                                                                           \
-        if (!(c)) {                                                                \
-            fprintf(stderr, "%s:%d: FAIL: %s\n", __FILE__, __LINE__, #c);          \
-            failures++;                                                            \
-        }                                                                          \
+#define CHECK(c)                                                                                   \
+    do {                                                                                           \
+        if (!(c)) {                                                                                \
+            fprintf(stderr, "%s:%d: FAIL: %s\n", __FILE__, __LINE__, #c);                          \
+            failures++;                                                                            \
+        }                                                                                          \
     } while (0)
 
 /* A cube [-1,1]^3: 8 corners, 12 triangles wound counter-clockwise seen
@@ -173,8 +173,12 @@ static void replay(const uint8_t *d, size_t size)
 
 static void test_format(const char *dir)
 {
-    vdsh_sdf v = {.dim = {3, 4, 5}, .origin = {-1, 2, 3}, .cell = 0.5f, .max_distance = 4.0f,
-                  .vertex_count = 10, .triangle_count = 7};
+    vdsh_sdf v = {.dim = {3, 4, 5},
+                  .origin = {-1, 2, 3},
+                  .cell = 0.5f,
+                  .max_distance = 4.0f,
+                  .vertex_count = 10,
+                  .triangle_count = 7};
     v.samples = malloc(60 * sizeof *v.samples);
     for (int i = 0; i < 60; i++)
         v.samples[i] = vdsh_sdf_encode((float)(i - 30) * 0.1f, v.max_distance);

@@ -46,13 +46,17 @@ static void test_design_values(void)
         vdsh_sh_eval(3, d, y);
         double x = d[0], yy = d[1], z = d[2];
         double want[9] = {0.282095,
-                          -0.488603 * yy, 0.488603 * z, -0.488603 * x,
-                          1.092548 * x * yy, -1.092548 * yy * z,
-                          0.315392 * (3 * z * z - 1), -1.092548 * x * z,
+                          -0.488603 * yy,
+                          0.488603 * z,
+                          -0.488603 * x,
+                          1.092548 * x * yy,
+                          -1.092548 * yy * z,
+                          0.315392 * (3 * z * z - 1),
+                          -1.092548 * x * z,
                           0.546274 * (x * x - yy * yy)};
         for (int i = 0; i < 9; i++)
-            CHECK(fabs(y[i] - want[i]) < 2e-6, "Y_%d(%g,%g,%g) = %g, docs/DESIGN.md gives %g",
-                  i, x, yy, z, y[i], want[i]);
+            CHECK(fabs(y[i] - want[i]) < 2e-6, "Y_%d(%g,%g,%g) = %g, docs/DESIGN.md gives %g", i, x,
+                  yy, z, y[i], want[i]);
     }
 }
 
@@ -142,8 +146,10 @@ static void test_recurrence(void)
                 worst = fmax(worst, fabs(out[(l * (l + 1) + m) * N + k] - sh_reference(l, m, d)) /
                                         sqrt((2.0 * l + 1.0) / (4.0 * M_PI)));
     }
-    CHECK(worst_low == 0.0, "the batch form's first 25 differ from order 5's, or the one-"
-          "direction form from the batch, by %g", worst_low);
+    CHECK(worst_low == 0.0,
+          "the batch form's first 25 differ from order 5's, or the one-"
+          "direction form from the batch, by %g",
+          worst_low);
     CHECK(worst < 2e-5, "bands 5-%d differ from the reference by %g (relative to the peak)",
           VDSH_MAX_ORDER - 1, worst);
     free(out);
@@ -205,8 +211,8 @@ static void test_soa_and_prefix(void)
         vdsh_sh_eval(5, d, a);
         vdsh_sh_eval(3, d, b);
         for (int i = 0; i < 25; i++)
-            CHECK(memcmp(&a[i], &out[i * N + k], sizeof(float)) == 0,
-                  "soa differs at i=%d k=%d", i, k);
+            CHECK(memcmp(&a[i], &out[i * N + k], sizeof(float)) == 0, "soa differs at i=%d k=%d", i,
+                  k);
         for (int i = 0; i < 9; i++)
             CHECK(a[i] == b[i], "order 3 is not a prefix of order 5 at %d", i);
         float c[25];
@@ -242,7 +248,8 @@ static void test_shadow(void)
     CHECK(vdsh_shadow_compare(NAN, 5.0f, VDSH_COMPARE_SMOOTH) == 0.0f, "NaN distance");
     CHECK(vdsh_shadow_compare(1.0f, NAN, VDSH_COMPARE_SMOOTH) == 0.0f, "NaN light distance");
     CHECK(vdsh_shadow_compare(2.0f, 2.0f, VDSH_COMPARE_BINARY) == 1.0f &&
-          vdsh_shadow_compare(1.99f, 2.0f, VDSH_COMPARE_BINARY) == 0.0f, "binary step");
+              vdsh_shadow_compare(1.99f, 2.0f, VDSH_COMPARE_BINARY) == 0.0f,
+          "binary step");
 
     /* D = 4 everywhere: c0 = 4 sqrt(4 pi). */
     float c[25] = {0};
@@ -252,8 +259,8 @@ static void test_shadow(void)
           "light at 2 < D = 4 must be lit");
     CHECK(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, INFINITY, c, p, far, VDSH_COMPARE_SMOOTH) == 0.0f,
           "light at 20 > 3 D must be dark");
-    CHECK(fabsf(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, INFINITY, c, p, mid,
-                            VDSH_COMPARE_SMOOTH) - 0.5f) < 1e-5f,
+    CHECK(fabsf(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, INFINITY, c, p, mid, VDSH_COMPARE_SMOOTH) -
+                0.5f) < 1e-5f,
           "light at 6 = 1.5 D gives ramp(2/3) = 0.5");
     CHECK(vdsh_shadow(5, VDSH_QUANTITY_DISTANCE, INFINITY, c, p, p, VDSH_COMPARE_SMOOTH) == 1.0f,
           "light exactly at the receiver");
@@ -294,8 +301,8 @@ static void test_interior(void)
                 float b[3] = {0, 0, 0};
                 b[k] = 1.0f;
                 float want = vdsh_shadow(5, q, INFINITY, c[k], pv[k], l, VDSH_COMPARE_SMOOTH);
-                float got = vdsh_shadow_interior(5, q, INFINITY, m, c, pv, b, l,
-                                                 VDSH_COMPARE_SMOOTH, NULL);
+                float got =
+                    vdsh_shadow_interior(5, q, INFINITY, m, c, pv, b, l, VDSH_COMPARE_SMOOTH, NULL);
                 CHECK(fabsf(got - want) < 1e-5f, "%s, quantity %u, vertex %d: %g vs %g",
                       vdsh_interp_name(m), q, k, got, want);
             }
@@ -327,7 +334,8 @@ static void test_interior(void)
         float at_a[3] = {1, 0, 0};
         float v = vdsh_shadow_interior(5, VDSH_QUANTITY_DISTANCE, INFINITY, m, c, pv, at_a, pa,
                                        VDSH_COMPARE_SMOOTH, &dd);
-        CHECK(v == 1.0f && isfinite(dd), "%s: light at the vertex gives %g", vdsh_interp_name(m), v);
+        CHECK(v == 1.0f && isfinite(dd), "%s: light at the vertex gives %g", vdsh_interp_name(m),
+              v);
         float mid[3] = {0.25f, 0.25f, 0.5f};
         v = vdsh_shadow_interior(5, VDSH_QUANTITY_DISTANCE, INFINITY, m, c, pv, mid, pa,
                                  VDSH_COMPARE_SMOOTH, &dd);
@@ -335,8 +343,8 @@ static void test_interior(void)
               vdsh_interp_name(m), v);
     }
     CHECK(vdsh_runtime_interp(2, VDSH_QUANTITY_DISTANCE) == VDSH_INTERP_VISIBILITY &&
-          vdsh_runtime_interp(5, VDSH_QUANTITY_DISTANCE) == VDSH_INTERP_SPLIT &&
-          vdsh_runtime_interp(5, VDSH_QUANTITY_LOG_DISTANCE) == VDSH_INTERP_DISTANCE,
+              vdsh_runtime_interp(5, VDSH_QUANTITY_DISTANCE) == VDSH_INTERP_SPLIT &&
+              vdsh_runtime_interp(5, VDSH_QUANTITY_LOG_DISTANCE) == VDSH_INTERP_DISTANCE,
           "runtime paths");
 }
 
@@ -431,8 +439,8 @@ static void test_clamp_horizon(void)
         /* the runaway, and the clamp */
         float wild = vdsh_stream_distance(order, q, INFINITY, ca, to_light);
         float d = vdsh_stream_distance(order, q, HZ_MAX, ca, to_light);
-        CHECK(wild > 1e5f && d == HZ_MAX, "order %u: toward the light %g, clamped %g", order,
-              wild, d);
+        CHECK(wild > 1e5f && d == HZ_MAX, "order %u: toward the light %g, clamped %g", order, wild,
+              d);
         /* Near the edge b-c, which sees the occluder: dark. Unclamped,
          * a's distance interpolated over the triangle lit it. */
         const float *c[3] = {ca, cb, cb}, *pv[3] = {HZ_A, HZ_B, HZ_C};
@@ -497,8 +505,8 @@ static void test_clamp_never_exceeds(void)
             l[k] *= 4.0f * (float)test_rand(&s);
         for (uint32_t m = 0; m < 4; m++) {
             float dvis = -1.0f;
-            float vis = vdsh_shadow_interior(order, q, md, m, cp, pv, b, l, VDSH_COMPARE_SMOOTH,
-                                             &dvis);
+            float vis =
+                vdsh_shadow_interior(order, q, md, m, cp, pv, b, l, VDSH_COMPARE_SMOOTH, &dvis);
             CHECK(dvis >= 0.0f && dvis <= md * (1.0f + 1e-6f) && vis >= 0.0f && vis <= 1.0f,
                   "%s quantity %u order %u: distance %g, visibility %g", vdsh_interp_name(m), q,
                   order, dvis, vis);

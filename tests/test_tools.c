@@ -28,15 +28,25 @@ static void test_integers(void)
     CHECK(vt_parse_u64("010", 0, 100, &u) && u == 10, "010 is ten (decimal), got %llu",
           (unsigned long long)u);
     CHECK(vt_parse_u64("0", 0, 5, &u) && u == 0, "0");
-    CHECK(vt_parse_u64("18446744073709551615", 0, UINT64_MAX, &u) && u == UINT64_MAX,
-          "2^64 - 1");
-    static const char *const bad[] = {"", "18446744073709551616", "99999999999999999999999",
-                                      "0x10", "1e3", "12abc", " 12", "12 ", "+1", "-1",
-                                      "1,2", "1.0", "\t1", "１"};
+    CHECK(vt_parse_u64("18446744073709551615", 0, UINT64_MAX, &u) && u == UINT64_MAX, "2^64 - 1");
+    static const char *const bad[] = {"",
+                                      "18446744073709551616",
+                                      "99999999999999999999999",
+                                      "0x10",
+                                      "1e3",
+                                      "12abc",
+                                      " 12",
+                                      "12 ",
+                                      "+1",
+                                      "-1",
+                                      "1,2",
+                                      "1.0",
+                                      "\t1",
+                                      "１"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         u = 7;
-        CHECK(!vt_parse_u64(bad[i], 0, UINT64_MAX, &u) && u == 7,
-              "'%s' refused, output untouched", bad[i]);
+        CHECK(!vt_parse_u64(bad[i], 0, UINT64_MAX, &u) && u == 7, "'%s' refused, output untouched",
+              bad[i]);
     }
     CHECK(!vt_parse_u64("0", 1, 10, &u) && !vt_parse_u64("11", 1, 10, &u) &&
               vt_parse_u64("10", 1, 10, &u),
@@ -58,15 +68,17 @@ static void test_integers(void)
 static void test_reals(void)
 {
     float f = 9.0f;
-    static const struct { const char *s; float v; } good[] = {
-        {"0", 0.0f}, {"1.5", 1.5f}, {"-2", -2.0f}, {"+3.25", 3.25f}, {".5", 0.5f},
-        {"5.", 5.0f}, {"1e-4", 1e-4f}, {"2.5E+3", 2500.0f}, {"010", 10.0f}, {"-0", -0.0f}};
+    static const struct {
+        const char *s;
+        float v;
+    } good[] = {{"0", 0.0f},    {"1.5", 1.5f}, {"-2", -2.0f},   {"+3.25", 3.25f},
+                {".5", 0.5f},   {"5.", 5.0f},  {"1e-4", 1e-4f}, {"2.5E+3", 2500.0f},
+                {"010", 10.0f}, {"-0", -0.0f}};
     for (size_t i = 0; i < sizeof good / sizeof good[0]; i++)
-        CHECK(vt_parse_float(good[i].s, &f) && f == good[i].v, "'%s' -> %g", good[i].s,
-              (double)f);
-    static const char *const bad[] = {"", ".", "-", "e5", "1e", "1e+", "0x1p3", "inf", "nan",
-                                      "1e39", "1e-50", "1.5x", " 1", "1 ", "1,5", "--1",
-                                      "1..2", "1e5.5"};
+        CHECK(vt_parse_float(good[i].s, &f) && f == good[i].v, "'%s' -> %g", good[i].s, (double)f);
+    static const char *const bad[] = {"",      ".",   "-",   "e5",   "1e",    "1e+",
+                                      "0x1p3", "inf", "nan", "1e39", "1e-50", "1.5x",
+                                      " 1",    "1 ",  "1,5", "--1",  "1..2",  "1e5.5"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         f = 9.0f;
         CHECK(!vt_parse_float(bad[i], &f) && f == 9.0f, "'%s' refused", bad[i]);
@@ -75,24 +87,24 @@ static void test_reals(void)
     CHECK(vt_parse_floats("1,-2.5,3e1", l, 3, 6) == 3 && l[0] == 1 && l[1] == -2.5f &&
               l[2] == 30.0f,
           "a list");
-    static const char *const bad_lists[] = {"1,2", "1,2,3,", ",1,2,3", "1,,2,3", "1,2,x",
-                                            "1,2,3,4,5,6,7", "1;2;3", "1, 2, 3"};
+    static const char *const bad_lists[] = {"1,2",   "1,2,3,",        ",1,2,3", "1,,2,3",
+                                            "1,2,x", "1,2,3,4,5,6,7", "1;2;3",  "1, 2, 3"};
     for (size_t i = 0; i < sizeof bad_lists / sizeof bad_lists[0]; i++)
         CHECK(vt_parse_floats(bad_lists[i], l, 3, 6) == 0, "list '%s' refused", bad_lists[i]);
     uint64_t o[5];
     CHECK(vt_parse_u64_list("2,3,05", 1, 5, o, 1, 5) == 3 && o[2] == 5, "u64 list");
-    CHECK(vt_parse_u64_list("2,6", 1, 5, o, 1, 5) == 0 && vt_parse_u64_list("", 1, 5, o, 1, 5) == 0 &&
+    CHECK(vt_parse_u64_list("2,6", 1, 5, o, 1, 5) == 0 &&
+              vt_parse_u64_list("", 1, 5, o, 1, 5) == 0 &&
               vt_parse_u64_list("2,", 1, 5, o, 1, 5) == 0 &&
               vt_parse_u64_list("1,2,3,4,5,1", 1, 5, o, 1, 5) == 0,
           "bad u64 lists refused");
     int w = 0, h = 0;
     CHECK(vt_parse_size("640x480", 1, 16384, &w, &h) && w == 640 && h == 480, "WxH");
     CHECK(vt_parse_size("08X09", 1, 16384, &w, &h) && w == 8 && h == 9, "WXH, decimal");
-    static const char *const bad_sizes[] = {"640", "640x", "x480", "0x480", "640x0",
+    static const char *const bad_sizes[] = {"640",       "640x",    "x480",     "0x480",   "640x0",
                                             "640x480x2", "16385x2", "-640x480", "640 x480"};
     for (size_t i = 0; i < sizeof bad_sizes / sizeof bad_sizes[0]; i++)
-        CHECK(!vt_parse_size(bad_sizes[i], 1, 16384, &w, &h), "size '%s' refused",
-              bad_sizes[i]);
+        CHECK(!vt_parse_size(bad_sizes[i], 1, 16384, &w, &h), "size '%s' refused", bad_sizes[i]);
 }
 
 /* Build a document, print it, parse it back with cJSON. */
@@ -108,13 +120,25 @@ static cJSON *round_trip(vt_json *j)
 
 static void test_json_strings(void)
 {
-    static const char *const s[] = {"plain", "q\"uote", "back\\slash", "tab\tnew\nline",
-                                    "ctl\x01\x1f", "caf\xc3\xa9", "bad \xff byte",
-                                    "cut \xc3", "overlong \xc0\xaf", "surrogate \xed\xa0\x80",
+    static const char *const s[] = {"plain",
+                                    "q\"uote",
+                                    "back\\slash",
+                                    "tab\tnew\nline",
+                                    "ctl\x01\x1f",
+                                    "caf\xc3\xa9",
+                                    "bad \xff byte",
+                                    "cut \xc3",
+                                    "overlong \xc0\xaf",
+                                    "surrogate \xed\xa0\x80",
                                     "emoji \xf0\x9f\x99\x82"};
-    static const char *const want[] = {"plain", "q\"uote", "back\\slash", "tab\tnew\nline",
-                                       "ctl\x01\x1f", "caf\xc3\xa9",
-                                       "bad \xef\xbf\xbd byte", "cut \xef\xbf\xbd",
+    static const char *const want[] = {"plain",
+                                       "q\"uote",
+                                       "back\\slash",
+                                       "tab\tnew\nline",
+                                       "ctl\x01\x1f",
+                                       "caf\xc3\xa9",
+                                       "bad \xef\xbf\xbd byte",
+                                       "cut \xef\xbf\xbd",
                                        "overlong \xef\xbf\xbd\xef\xbf\xbd",
                                        "surrogate \xef\xbf\xbd\xef\xbf\xbd\xef\xbf\xbd",
                                        "emoji \xf0\x9f\x99\x82"};
@@ -189,8 +213,8 @@ static void test_json_numbers(void)
         exact_f &= memcmp(&g, &f[i], sizeof g) == 0;
         exact_d &= cJSON_GetArrayItem(bd, i)->valuedouble == d[i];
         if (!exact_f || !exact_d)
-            fprintf(stderr, "item %d: %.9g -> %.9g, %.17g -> %.17g\n", i, (double)f[i],
-                    (double)g, d[i], cJSON_GetArrayItem(bd, i)->valuedouble);
+            fprintf(stderr, "item %d: %.9g -> %.9g, %.17g -> %.17g\n", i, (double)f[i], (double)g,
+                    d[i], cJSON_GetArrayItem(bd, i)->valuedouble);
     }
     CHECK(exact_f, "every float reads back as the same float");
     CHECK(exact_d, "every double reads back as the same double");
@@ -220,8 +244,8 @@ static void test_json_files(void)
     CHECK(vt_json_write_file(&j, path, msg, sizeof msg) == 0, "%s", msg);
     vt_json_free(&j);
     cJSON *back = vt_json_read_file(path, msg, sizeof msg);
-    CHECK(back && vt_json_number(cJSON_GetObjectItemCaseSensitive(back, "seconds"), "total") ==
-                      1.25,
+    CHECK(back &&
+              vt_json_number(cJSON_GetObjectItemCaseSensitive(back, "seconds"), "total") == 1.25,
           "read back: %s", back ? "" : msg);
     CHECK(isnan(vt_json_number(back, "absent")) && isnan(vt_json_number(back, "seconds")),
           "absent or not a number: NaN");
@@ -263,7 +287,8 @@ static void test_camera(void)
         vdsh_camera_ray(&c, w, h, x, y, o, d);
         vdsh_camera_view(&c, view);
         vdsh_camera_projection(&c, (float)w / (float)h, 0.01f, 100.0f, proj);
-        float t = 3.0f, p[4] = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2], 1.0f}, e[4], q[4];
+        float t = 3.0f, p[4] = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2], 1.0f}, e[4],
+              q[4];
         for (int r = 0; r < 4; r++) {
             e[r] = 0.0f;
             for (int k = 0; k < 4; k++)
@@ -274,7 +299,8 @@ static void test_camera(void)
             for (int k = 0; k < 4; k++)
                 q[r] += proj[k * 4 + r] * e[k];
         }
-        float px = (q[0] / q[3] * 0.5f + 0.5f) * (float)w, py = (0.5f - q[1] / q[3] * 0.5f) * (float)h;
+        float px = (q[0] / q[3] * 0.5f + 0.5f) * (float)w,
+              py = (0.5f - q[1] / q[3] * 0.5f) * (float)h;
         CHECK(fabsf(px - (x + 0.5f)) < 2e-3f && fabsf(py - (y + 0.5f)) < 2e-3f,
               "camera %d: pixel (%d, %d) of %dx%d projects to (%g, %g)", trial, x, y, w, h, px, py);
     }
@@ -291,8 +317,7 @@ static void test_frames(void)
     v[5] = -1.0f, v[6] = 2.0f, v[7] = NAN;
     CHECK(vt_png16_write(path, W, H, v, msg, sizeof msg) == 0, "%s", msg);
     int w = 0, h = 0;
-    CHECK(vt_png16_read(path, &w, &h, &back, msg, sizeof msg) == 0 && w == W && h == H, "%s",
-          msg);
+    CHECK(vt_png16_read(path, &w, &h, &back, msg, sizeof msg) == 0 && w == W && h == H, "%s", msg);
     if (back) {
         float worst = 0.0f;
         v[5] = 0.0f, v[6] = 1.0f, v[7] = 0.0f; /* clamped; NaN reads 0 */
@@ -302,8 +327,10 @@ static void test_frames(void)
         free(back);
     }
     snprintf(path, sizeof path, "%s/views.json", work);
-    vt_view one = {.name = "a-1", .camera = {{1, 2, 3}, {0, 1, 0}, {0, 1, 0}, 50},
-                   .set_count = 2, .light_count = {1, 3},
+    vt_view one = {.name = "a-1",
+                   .camera = {{1, 2, 3}, {0, 1, 0}, {0, 1, 0}, 50},
+                   .set_count = 2,
+                   .light_count = {1, 3},
                    .lights = {{{1, 1, 1}}, {{2, 2, 2}, {3, 3, 3}, {4, 4.5f, 4}}}};
     vt_views vs = {.width = 320, .height = 200, .count = 1, .views = &one}, in = {0};
     CHECK(vt_views_write(path, &vs, msg, sizeof msg) == 0, "%s", msg);
@@ -375,10 +402,14 @@ static void test_options(void)
     if (in)
         fclose(in);
     static const char *const said[] = {
-        "--n takes a whole number 1..256, not '257'", "--d takes 1..1024, not '0'",
-        "--seed takes a whole number, not 'x'", "--m takes a whole number >= 1, not '0'",
-        "--k takes an order 0..16, not '-0'", "--p takes a positive number, not '0'",
-        "--q takes a number >= 0, not '-1'", "--t takes a number > 0 (or inf), not '0'",
+        "--n takes a whole number 1..256, not '257'",
+        "--d takes 1..1024, not '0'",
+        "--seed takes a whole number, not 'x'",
+        "--m takes a whole number >= 1, not '0'",
+        "--k takes an order 0..16, not '-0'",
+        "--p takes a positive number, not '0'",
+        "--q takes a number >= 0, not '-1'",
+        "--t takes a number > 0 (or inf), not '0'",
         "--orders takes distinct orders 1..16 such as 2,3,5, not '2,2'",
         "--c takes a, bb or c, not 'd'"};
     char want_text[2048] = "";

@@ -121,9 +121,9 @@ static void add_buffers(cJSON *g, size_t size, int fallback, size_t fallback_siz
         return;
     cJSON *fb = cJSON_CreateObject();
     cJSON_AddNumberToObject(fb, "byteLength", (double)fallback_size);
-    cJSON_AddBoolToObject(
-        cJSON_AddObjectToObject(cJSON_AddObjectToObject(fb, "extensions"), "EXT_meshopt_compression"),
-        "fallback", 1);
+    cJSON_AddBoolToObject(cJSON_AddObjectToObject(cJSON_AddObjectToObject(fb, "extensions"),
+                                                  "EXT_meshopt_compression"),
+                          "fallback", 1);
     cJSON_AddItemToArray(bufs, fb);
 }
 
@@ -135,9 +135,7 @@ static void list_extension(cJSON *g, const char *list, const char *name)
     if (!l)
         l = cJSON_AddArrayToObject(g, list);
     cJSON *e;
-    cJSON_ArrayForEach(e, l)
-        if (cJSON_IsString(e) && strcmp(e->valuestring, name) == 0)
-            return;
+    cJSON_ArrayForEach(e, l) if (cJSON_IsString(e) && strcmp(e->valuestring, name) == 0) return;
     cJSON_AddItemToArray(l, cJSON_CreateString(name));
 }
 
@@ -166,8 +164,9 @@ static int write_views(const view_list *vl, int compress, blob *b, cJSON *views,
         }
         const int index = pv->target == 34963;
         const size_t count = pv->size / pv->stride;
-        size_t bound = index ? meshopt_encodeIndexBufferBound(count, count) /* vertex count <= index count */
-                             : meshopt_encodeVertexBufferBound(count, pv->stride);
+        size_t bound =
+            index ? meshopt_encodeIndexBufferBound(count, count) /* vertex count <= index count */
+                  : meshopt_encodeVertexBufferBound(count, pv->stride);
         uint8_t *enc = malloc(bound);
         if (!enc)
             return -1;
@@ -204,7 +203,8 @@ static int write_views(const view_list *vl, int compress, blob *b, cJSON *views,
             cJSON_AddNumberToObject(v, "byteStride", (double)pv->stride);
         if (pv->target)
             cJSON_AddNumberToObject(v, "target", pv->target);
-        cJSON *x = cJSON_AddObjectToObject(cJSON_AddObjectToObject(v, "extensions"), "EXT_meshopt_compression");
+        cJSON *x = cJSON_AddObjectToObject(cJSON_AddObjectToObject(v, "extensions"),
+                                           "EXT_meshopt_compression");
         cJSON_AddNumberToObject(x, "buffer", 0);
         cJSON_AddNumberToObject(x, "byteOffset", (double)(b->size - got));
         cJSON_AddNumberToObject(x, "byteLength", (double)got);
@@ -217,7 +217,8 @@ static int write_views(const view_list *vl, int compress, blob *b, cJSON *views,
     return 0;
 }
 
-static int add_accessor(cJSON *accs, int view, int ctype, int normalized, size_t count, const char *type)
+static int add_accessor(cJSON *accs, int view, int ctype, int normalized, size_t count,
+                        const char *type)
 {
     cJSON *a = cJSON_CreateObject();
     cJSON_AddNumberToObject(a, "bufferView", view);
@@ -245,7 +246,8 @@ static int add_accessor(cJSON *accs, int view, int ctype, int normalized, size_t
 static int exact_numbers(cJSON *n)
 {
     for (; n; n = n->next) {
-        if (cJSON_IsNumber(n) && n->valuedouble != floor(n->valuedouble) && isfinite(n->valuedouble)) {
+        if (cJSON_IsNumber(n) && n->valuedouble != floor(n->valuedouble) &&
+            isfinite(n->valuedouble)) {
             char t[40];
             for (int digits = 15; digits <= 17; digits++) {
                 snprintf(t, sizeof t, "%.*g", digits, n->valuedouble);
@@ -263,8 +265,8 @@ static int exact_numbers(cJSON *n)
     }
     return 0;
 }
-static int with_source(const char *in, const char *path, const vdsh_file *f, cJSON *root, view_list *vl,
-                       cJSON *attrs, cJSON **vx, blob *b, int compress)
+static int with_source(const char *in, const char *path, const vdsh_file *f, cJSON *root,
+                       view_list *vl, cJSON *attrs, cJSON **vx, blob *b, int compress)
 {
     char msg[1024];
     vdsh_src src;
@@ -275,7 +277,8 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
     int orig_n = 0;
     view_list nl = {0};
     if (vdsh_src_load(path, &src, msg, sizeof msg) ||
-        vdsh_src_map(path, &src, f->positions, f->normals, f->header.vertex_count, &prims, &np, msg, sizeof msg)) {
+        vdsh_src_map(path, &src, f->positions, f->normals, f->header.vertex_count, &prims, &np, msg,
+                     sizeof msg)) {
         fprintf(stderr, "vdsh-export: %s\n", msg);
         return 1;
     }
@@ -284,8 +287,11 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
     for (int i = 0; i < np; i++)
         vertices += prims[i].vertex_count, matched += prims[i].matched;
     if (np == 0 || matched == 0) {
-        fprintf(stderr, "vdsh-export: %s: no vertex of %s is at a receiver of the bake: not the glTF it was baked "
-                        "from\n", in, path);
+        fprintf(
+            stderr,
+            "vdsh-export: %s: no vertex of %s is at a receiver of the bake: not the glTF it was baked "
+            "from\n",
+            in, path);
         goto out;
     }
     /* one BIN buffer: the source's buffers one after the other */
@@ -307,10 +313,12 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
     if (!views)
         views = cJSON_AddArrayToObject(g, "bufferViews");
     cJSON *v;
-    cJSON_ArrayForEach(v, views) {
+    cJSON_ArrayForEach(v, views)
+    {
         int bi = (int)cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(v, "buffer"));
         cJSON *off = cJSON_GetObjectItemCaseSensitive(v, "byteOffset");
-        double o = (cJSON_IsNumber(off) ? off->valuedouble : 0) + (double)base[bi >= 0 && bi < src.buffer_count ? bi : 0];
+        double o = (cJSON_IsNumber(off) ? off->valuedouble : 0) +
+                   (double)base[bi >= 0 && bi < src.buffer_count ? bi : 0];
         cJSON_DeleteItemFromObjectCaseSensitive(v, "byteOffset");
         cJSON_AddNumberToObject(v, "byteOffset", o);
         cJSON_ReplaceItemInObjectCaseSensitive(v, "buffer", cJSON_CreateNumber(0));
@@ -318,13 +326,16 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
     free(base);
     /* images named by file: into the BIN (the glb is written elsewhere) */
     cJSON *img;
-    cJSON_ArrayForEach(img, cJSON_GetObjectItemCaseSensitive(g, "images")) {
+    cJSON_ArrayForEach(img, cJSON_GetObjectItemCaseSensitive(g, "images"))
+    {
         cJSON *uri = cJSON_GetObjectItemCaseSensitive(img, "uri");
         if (!cJSON_IsString(uri) || strncmp(uri->valuestring, "data:", 5) == 0)
             continue;
         const char *dot = strrchr(uri->valuestring, '.');
-        const char *mime = !dot ? NULL : !strcasecmp(dot, ".png") ? "image/png"
-                         : (!strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg")) ? "image/jpeg" : NULL;
+        const char *mime = !dot                                                      ? NULL
+                           : !strcasecmp(dot, ".png")                                ? "image/png"
+                           : (!strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg")) ? "image/jpeg"
+                                                                                     : NULL;
         char *p = malloc(strlen(src.dir) + strlen(uri->valuestring) + 1);
         if (!p)
             goto oom;
@@ -335,8 +346,8 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         if (!fp || !mime) {
             if (fp)
                 fclose(fp);
-            fprintf(stderr, "vdsh-export: %s: image %s %s: kept as a URI relative to the output\n", path,
-                    uri->valuestring, fp ? "is neither PNG nor JPEG" : "cannot be read");
+            fprintf(stderr, "vdsh-export: %s: image %s %s: kept as a URI relative to the output\n",
+                    path, uri->valuestring, fp ? "is neither PNG nor JPEG" : "cannot be read");
             continue;
         }
         if (blob_align4(b)) {
@@ -395,28 +406,34 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
             }
             node_mesh[sp->node] = mi;
         }
-        cJSON *prim = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(meshes, mi), "primitives"),
-                                         sp->prim);
+        cJSON *prim = cJSON_GetArrayItem(
+            cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(meshes, mi), "primitives"),
+            sp->prim);
         cJSON *pattrs = cJSON_GetObjectItemCaseSensitive(prim, "attributes");
         cJSON *a;
-        cJSON_ArrayForEach(a, attrs) {
+        cJSON_ArrayForEach(a, attrs)
+        {
             if (strncmp(a->string, "_VDSH", 5) != 0)
                 continue;
             cJSON *acc = cJSON_GetArrayItem(my_accs, (int)a->valuedouble);
-            const pending_view *pv = &vl->v[(int)cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(acc, "bufferView"))];
+            const pending_view *pv = &vl->v[(int)cJSON_GetNumberValue(
+                cJSON_GetObjectItemCaseSensitive(acc, "bufferView"))];
             uint8_t *d = calloc((size_t)sp->vertex_count + 1, pv->stride);
             if (!d)
                 goto oom;
             for (uint32_t k = 0; k < sp->vertex_count; k++)
                 if (sp->map[k] != UINT32_MAX)
-                    memcpy(d + (size_t)k * pv->stride, pv->data + (size_t)sp->map[k] * pv->stride, pv->stride);
+                    memcpy(d + (size_t)k * pv->stride, pv->data + (size_t)sp->map[k] * pv->stride,
+                           pv->stride);
             int vi = add_view(&nl, d, (size_t)sp->vertex_count * pv->stride, pv->stride, 34962);
             free(d);
             if (vi < 0)
                 goto oom;
             cJSON *na = cJSON_Duplicate(acc, 1);
-            cJSON_ReplaceItemInObjectCaseSensitive(na, "bufferView", cJSON_CreateNumber(view_base + vi));
-            cJSON_ReplaceItemInObjectCaseSensitive(na, "count", cJSON_CreateNumber(sp->vertex_count));
+            cJSON_ReplaceItemInObjectCaseSensitive(na, "bufferView",
+                                                   cJSON_CreateNumber(view_base + vi));
+            cJSON_ReplaceItemInObjectCaseSensitive(na, "count",
+                                                   cJSON_CreateNumber(sp->vertex_count));
             cJSON_AddItemToArray(accs, na);
             cJSON_DeleteItemFromObjectCaseSensitive(pattrs, a->string);
             cJSON_AddNumberToObject(pattrs, a->string, cJSON_GetArraySize(accs) - 1);
@@ -457,9 +474,10 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         cJSON_AddStringToObject(asset, "generator", "vdsh-export --source (formats/GLTF.md)");
     }
     if (matched < vertices)
-        fprintf(stderr, "vdsh-export: %s: %llu of %llu source vertices have no receiver at their position "
-                        "(unreferenced, or dropped by the bake): their VDSH attributes are 0\n", path,
-                (unsigned long long)(vertices - matched), (unsigned long long)vertices);
+        fprintf(stderr,
+                "vdsh-export: %s: %llu of %llu source vertices have no receiver at their position "
+                "(unreferenced, or dropped by the bake): their VDSH attributes are 0\n",
+                path, (unsigned long long)(vertices - matched), (unsigned long long)vertices);
     if (exact_numbers(g->child))
         goto oom;
     /* root becomes the source's JSON */
@@ -574,34 +592,35 @@ static int export_cpca(const vdsh_stream *s, uint32_t nv, const char *prefix, vi
 
 static void usage(FILE *fp)
 {
-    fprintf(fp, "usage: vdsh-export [options] IN.vdsh -o OUT.glb\n"
-                "Write a .vdsh as glTF 2.0 binary (layout: formats/GLTF.md): the receiver mesh and\n"
-                "each SH stream as vertex attributes _VDSH<order>_<k> (VEC4).\n"
-                "\n"
-                "  -o, --output FILE  the .glb to write (atomically)\n"
-                "      --orders LIST  orders to export, each 1..%d (default: every stream of the\n"
-                "                     file)\n"
-                "      --float        coefficients as float (default: normalised int16, scale in\n"
-                "                     extras)\n"
-                "      --decode-cpca  cpca streams (vdsh-bake --encoding cpca) as decoded\n"
-                "                     coefficients in the layout above (default: as stored,\n"
-                "                     cluster and weight attributes and the model in a buffer\n"
-                "                     view; always decoded with --source)\n"
-                "      --compress     a compact glb: positions uint16 and normals int8\n"
-                "                     (KHR_mesh_quantization), every buffer view compressed with\n"
-                "                     meshoptimizer (EXT_meshopt_compression; lossless: the\n"
-                "                     coefficients and indices decode bit-exact); with\n"
-                "                     --source: the VDSH attributes compressed, the source's own\n"
-                "                     data kept as it is\n"
-                "      --source FILE  the glTF the .vdsh was baked from: write its own scene (nodes,\n"
-                "                     meshes, materials, textures, UVs...) with the VDSH attributes\n"
-                "                     added to each primitive (formats/GLTF.md)\n"
-                "  -q, --quiet        no summary on stderr\n"
-                "  -h, --help         this text\n"
-                "  -V, --version      version\n"
-                "\n"
-                "Exit status: 0 success, 1 error, 2 usage error.\n"
-                "Example: vdsh-export room.vdsh -o room.glb\n",
+    fprintf(fp,
+            "usage: vdsh-export [options] IN.vdsh -o OUT.glb\n"
+            "Write a .vdsh as glTF 2.0 binary (layout: formats/GLTF.md): the receiver mesh and\n"
+            "each SH stream as vertex attributes _VDSH<order>_<k> (VEC4).\n"
+            "\n"
+            "  -o, --output FILE  the .glb to write (atomically)\n"
+            "      --orders LIST  orders to export, each 1..%d (default: every stream of the\n"
+            "                     file)\n"
+            "      --float        coefficients as float (default: normalised int16, scale in\n"
+            "                     extras)\n"
+            "      --decode-cpca  cpca streams (vdsh-bake --encoding cpca) as decoded\n"
+            "                     coefficients in the layout above (default: as stored,\n"
+            "                     cluster and weight attributes and the model in a buffer\n"
+            "                     view; always decoded with --source)\n"
+            "      --compress     a compact glb: positions uint16 and normals int8\n"
+            "                     (KHR_mesh_quantization), every buffer view compressed with\n"
+            "                     meshoptimizer (EXT_meshopt_compression; lossless: the\n"
+            "                     coefficients and indices decode bit-exact); with\n"
+            "                     --source: the VDSH attributes compressed, the source's own\n"
+            "                     data kept as it is\n"
+            "      --source FILE  the glTF the .vdsh was baked from: write its own scene (nodes,\n"
+            "                     meshes, materials, textures, UVs...) with the VDSH attributes\n"
+            "                     added to each primitive (formats/GLTF.md)\n"
+            "  -q, --quiet        no summary on stderr\n"
+            "  -h, --help         this text\n"
+            "  -V, --version      version\n"
+            "\n"
+            "Exit status: 0 success, 1 error, 2 usage error.\n"
+            "Example: vdsh-export room.vdsh -o room.glb\n",
             VDSH_MAX_ORDER);
 }
 
@@ -617,16 +636,12 @@ typedef struct options {
  * error: said). */
 static int parse_args(int argc, char **argv, options *o)
 {
-    static const struct option longopts[] = {{"output", required_argument, 0, 'o'},
-                                             {"orders", required_argument, 0, 'O'},
-                                             {"float", no_argument, 0, 'F'},
-                                             {"compress", no_argument, 0, 'C'},
-                                             {"decode-cpca", no_argument, 0, 'D'},
-                                             {"source", required_argument, 0, 'S'},
-                                             {"quiet", no_argument, 0, 'q'},
-                                             {"help", no_argument, 0, 'h'},
-                                             {"version", no_argument, 0, 'V'},
-                                             {0, 0, 0, 0}};
+    static const struct option longopts[] = {
+        {"output", required_argument, 0, 'o'}, {"orders", required_argument, 0, 'O'},
+        {"float", no_argument, 0, 'F'},        {"compress", no_argument, 0, 'C'},
+        {"decode-cpca", no_argument, 0, 'D'},  {"source", required_argument, 0, 'S'},
+        {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
+        {"version", no_argument, 0, 'V'},      {0, 0, 0, 0}};
     memset(o, 0, sizeof *o);
     int opt, set[VDSH_ORDER_SLOTS];
     while ((opt = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
@@ -634,8 +649,10 @@ static int parse_args(int argc, char **argv, options *o)
         case 'o': o->out = optarg; break;
         case 'O':
             if (!vt_parse_orders(optarg, 0, VDSH_MAX_ORDER, set))
-                return vt_usage_error("vdsh-export", "--orders takes orders 1..%d such as "
-                                      "2,3,5, not '%s'", VDSH_MAX_ORDER, optarg);
+                return vt_usage_error("vdsh-export",
+                                      "--orders takes orders 1..%d such as "
+                                      "2,3,5, not '%s'",
+                                      VDSH_MAX_ORDER, optarg);
             for (int k = 1; k <= VDSH_MAX_ORDER; k++)
                 if (set[k])
                     o->want[k] = o->any_order = 1;
@@ -666,17 +683,17 @@ typedef struct exporter {
     const options *o;
     const vdsh_file *f;
     uint32_t nv, nt;
-    blob b;                    /* the BIN chunk */
-    view_list vl;              /* the buffer views, written at the end */
-    uint32_t *tri_sorted;      /* --compress: the triangles in vertex cache order */
+    blob b;               /* the BIN chunk */
+    view_list vl;         /* the buffer views, written at the end */
+    uint32_t *tri_sorted; /* --compress: the triangles in vertex cache order */
     cJSON *root, *views, *accs;
-    cJSON *attrs;              /* the primitive's attributes, until the mesh takes them */
-    cJSON *vx;                 /* extras.vdsh, until the mesh (or the source) takes it */
-    float *tmp, *coef;         /* scratch: 16 floats a vertex; one vertex's coefficients */
-    int ind_acc;               /* the indices' accessor */
-    float lo[3], hi[3];        /* the positions' bounds */
-    double qstep;              /* --compress: the positions' quantisation step */
-    int exported;              /* streams written */
+    cJSON *attrs;       /* the primitive's attributes, until the mesh takes them */
+    cJSON *vx;          /* extras.vdsh, until the mesh (or the source) takes it */
+    float *tmp, *coef;  /* scratch: 16 floats a vertex; one vertex's coefficients */
+    int ind_acc;        /* the indices' accessor */
+    float lo[3], hi[3]; /* the positions' bounds */
+    double qstep;       /* --compress: the positions' quantisation step */
+    int exported;       /* streams written */
 } exporter;
 
 static int exporter_begin(exporter *e, const options *o, const vdsh_file *f)
@@ -869,8 +886,7 @@ static int describe_bake(exporter *e)
         cJSON *vo = cJSON_AddObjectToObject(vx, "view");
         double eye[3], t[3], u[3];
         for (int k = 0; k < 3; k++)
-            eye[k] = view.camera.eye[k], t[k] = view.camera.target[k],
-            u[k] = view.camera.up[k];
+            eye[k] = view.camera.eye[k], t[k] = view.camera.target[k], u[k] = view.camera.up[k];
         if (u[0] == 0 && u[1] == 0 && u[2] == 0)
             u[1] = 1;
         cJSON_AddBoolToObject(vo, "interior", view.interior);
@@ -903,8 +919,7 @@ static int describe_bake(exporter *e)
 
 /* One stream's coefficients as groups of four: float, or int16
  * normalised by the stream's largest magnitude (its "scale"). */
-static int put_coefficients(exporter *e, const vdsh_stream *s, const char *prefix,
-                            cJSON *streams)
+static int put_coefficients(exporter *e, const vdsh_stream *s, const char *prefix, cJSON *streams)
 {
     const uint32_t nv = e->nv, nc = s->order * s->order, groups = (nc + 3) / 4;
     const int use_float = e->o->use_float;
@@ -949,8 +964,9 @@ static int put_coefficients(exporter *e, const vdsh_stream *s, const char *prefi
             return -1;
         char name[48];
         snprintf(name, sizeof name, "%s%u", prefix, g);
-        cJSON_AddNumberToObject(e->attrs, name,
-                                add_accessor(e->accs, view, use_float ? 5126 : 5122, !use_float, nv, "VEC4"));
+        cJSON_AddNumberToObject(
+            e->attrs, name,
+            add_accessor(e->accs, view, use_float ? 5126 : 5122, !use_float, nv, "VEC4"));
     }
     return 0;
 }
@@ -1101,8 +1117,8 @@ static int run(const options *o)
     if (!rc)
         rc = put_streams(&e);
     if (!rc && o->source)
-        rc = with_source(o->in, o->source, f, e.root, &e.vl, e.attrs, &e.vx, &e.b,
-                         o->compress) != 0;
+        rc =
+            with_source(o->in, o->source, f, e.root, &e.vl, e.attrs, &e.vx, &e.b, o->compress) != 0;
     else if (!rc)
         rc = assemble(&e);
     if (!rc)

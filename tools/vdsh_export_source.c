@@ -45,11 +45,16 @@ static uint8_t *slurp(const char *path, size_t *size)
 
 static int b64(int c)
 {
-    if (c >= 'A' && c <= 'Z') return c - 'A';
-    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
-    if (c >= '0' && c <= '9') return c - '0' + 52;
-    if (c == '+') return 62;
-    if (c == '/') return 63;
+    if (c >= 'A' && c <= 'Z')
+        return c - 'A';
+    if (c >= 'a' && c <= 'z')
+        return c - 'a' + 26;
+    if (c >= '0' && c <= '9')
+        return c - '0' + 52;
+    if (c == '+')
+        return 62;
+    if (c == '/')
+        return 63;
     return -1;
 }
 
@@ -115,7 +120,8 @@ int vdsh_src_load(const char *path, vdsh_src *s, char *msg, size_t cap)
         s->json = cJSON_ParseWithLength((const char *)d + 20, h[3]);
         size_t at = 20 + (size_t)h[3];
         uint32_t bh[2];
-        if (at + 8 <= h[2] && memcpy(bh, d + at, 8) && bh[1] == 0x004E4942u && bh[0] <= h[2] - at - 8) {
+        if (at + 8 <= h[2] && memcpy(bh, d + at, 8) && bh[1] == 0x004E4942u &&
+            bh[0] <= h[2] - at - 8) {
             bin = d + at + 8;
             bin_size = bh[0];
         }
@@ -163,7 +169,8 @@ int vdsh_src_load(const char *path, vdsh_src *s, char *msg, size_t cap)
             goto out;
         }
         if (!(want >= 0) || want > (double)sb->size) {
-            fail(msg, cap, "%s: buffer %d is %zu bytes, shorter than its byteLength %.0f", path, i, sb->size, want);
+            fail(msg, cap, "%s: buffer %d is %zu bytes, shorter than its byteLength %.0f", path, i,
+                 sb->size, want);
             goto out;
         }
     }
@@ -184,9 +191,12 @@ static double num(const cJSON *o, const char *k, double dflt)
 static size_t csize(int t)
 {
     switch (t) {
-    case 5120: case 5121: return 1;
-    case 5122: case 5123: return 2;
-    case 5125: case 5126: return 4;
+    case 5120:
+    case 5121: return 1;
+    case 5122:
+    case 5123: return 2;
+    case 5125:
+    case 5126: return 4;
     default: return 0;
     }
 }
@@ -194,18 +204,39 @@ static size_t csize(int t)
 static double comp(const uint8_t *p, int t, int normalized)
 {
     switch (t) {
-    case 5120: { int8_t v; memcpy(&v, p, 1); return normalized ? fmax(v / 127.0, -1.0) : v; }
+    case 5120: {
+        int8_t v;
+        memcpy(&v, p, 1);
+        return normalized ? fmax(v / 127.0, -1.0) : v;
+    }
     case 5121: return normalized ? p[0] / 255.0 : p[0];
-    case 5122: { int16_t v; memcpy(&v, p, 2); return normalized ? fmax(v / 32767.0, -1.0) : v; }
-    case 5123: { uint16_t v; memcpy(&v, p, 2); return normalized ? v / 65535.0 : v; }
-    case 5125: { uint32_t v; memcpy(&v, p, 4); return v; }
-    default: { float v; memcpy(&v, p, 4); return v; }
+    case 5122: {
+        int16_t v;
+        memcpy(&v, p, 2);
+        return normalized ? fmax(v / 32767.0, -1.0) : v;
+    }
+    case 5123: {
+        uint16_t v;
+        memcpy(&v, p, 2);
+        return normalized ? v / 65535.0 : v;
+    }
+    case 5125: {
+        uint32_t v;
+        memcpy(&v, p, 4);
+        return v;
+    }
+    default: {
+        float v;
+        memcpy(&v, p, 4);
+        return v;
+    }
     }
 }
 
 /* A VEC3 accessor as 3 * count doubles (as mesh_gltf.cpp reads it; sparse
  * accessors are refused here). */
-static double *read_vec3(const char *path, const vdsh_src *s, int ai, size_t *count, char *msg, size_t cap)
+static double *read_vec3(const char *path, const vdsh_src *s, int ai, size_t *count, char *msg,
+                         size_t cap)
 {
     cJSON *a = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(s->json, "accessors"), ai);
     if (!a || ai < 0) {
@@ -237,7 +268,8 @@ static double *read_vec3(const char *path, const vdsh_src *s, int ai, size_t *co
         size_t len = (size_t)num(v, "byteLength", 0);
         if (!stride)
             stride = elem;
-        if (!v || b < 0 || b >= s->buffer_count || (size_t)num(v, "byteOffset", 0) + len > s->buffers[b].size ||
+        if (!v || b < 0 || b >= s->buffer_count ||
+            (size_t)num(v, "byteOffset", 0) + len > s->buffers[b].size ||
             (size_t)num(a, "byteOffset", 0) + (n - 1) * stride + elem > len) {
             free(out);
             fail(msg, cap, "%s: accessor %d overruns its buffer view", path, ai);
@@ -311,10 +343,12 @@ static int map_prim(walk *w, int node, int mesh, int pi, const cJSON *prim, cons
     if (!cJSON_IsNumber(pa))
         return fail(w->msg, w->cap_msg, "%s: a triangle primitive has no POSITION", w->path);
     size_t n = 0, nn = 0;
-    double *pos = read_vec3(w->path, w->s, (int)pa->valuedouble, &n, w->msg, w->cap_msg), *nrm = NULL;
+    double *pos = read_vec3(w->path, w->s, (int)pa->valuedouble, &n, w->msg, w->cap_msg),
+           *nrm = NULL;
     if (!pos)
         return -1;
-    if (cJSON_IsNumber(na) && !(nrm = read_vec3(w->path, w->s, (int)na->valuedouble, &nn, w->msg, w->cap_msg))) {
+    if (cJSON_IsNumber(na) &&
+        !(nrm = read_vec3(w->path, w->s, (int)na->valuedouble, &nn, w->msg, w->cap_msg))) {
         free(pos);
         return -1;
     }
@@ -338,9 +372,11 @@ static int map_prim(walk *w, int node, int mesh, int pi, const cJSON *prim, cons
         return fail(w->msg, w->cap_msg, "%s: out of memory", w->path);
     }
     /* mesh_gltf.cpp's world position and normal (cofactor matrix) */
-    const double a = m[0], b = m[4], c = m[8], d = m[1], e = m[5], f = m[9], g = m[2], h = m[6], k = m[10];
-    const double cof[9] = {e * k - f * h, -(d * k - f * g), d * h - e * g, -(b * k - c * h), a * k - c * g,
-                           -(a * h - b * g), b * f - c * e, -(a * f - c * d), a * e - b * d};
+    const double a = m[0], b = m[4], c = m[8], d = m[1], e = m[5], f = m[9], g = m[2], h = m[6],
+                 k = m[10];
+    const double cof[9] = {e * k - f * h,    -(d * k - f * g), d * h - e * g,
+                           -(b * k - c * h), a * k - c * g,    -(a * h - b * g),
+                           b * f - c * e,    -(a * f - c * d), a * e - b * d};
     for (size_t i = 0; i < n; i++) {
         const double *q = &pos[3 * i];
         float p[3], nv[3] = {0, 0, 0};
@@ -391,29 +427,32 @@ static int visit(walk *w, int node, const double *parent, uint8_t *on_path, int 
     vdsh_mat4d_mul(parent, local, m);
     int mesh = (int)num(n, "mesh", -1);
     if (mesh >= 0 && cJSON_GetObjectItemCaseSensitive(n, "skin") == NULL) {
-        cJSON *me = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(w->s->json, "meshes"), mesh);
+        cJSON *me =
+            cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(w->s->json, "meshes"), mesh);
         if (!me)
-            return fail(w->msg, w->cap_msg, "%s: node %d: mesh %d does not exist", w->path, node, mesh);
+            return fail(w->msg, w->cap_msg, "%s: node %d: mesh %d does not exist", w->path, node,
+                        mesh);
         cJSON *prims = cJSON_GetObjectItemCaseSensitive(me, "primitives");
         for (int pi = 0; pi < cJSON_GetArraySize(prims); pi++) {
             cJSON *p = cJSON_GetArrayItem(prims, pi);
             int mode = (int)num(p, "mode", 4);
-            if (cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(p, "targets")) > 0 || mode < 4 || mode > 6)
+            if (cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(p, "targets")) > 0 ||
+                mode < 4 || mode > 6)
                 continue; /* skipped by the baker too */
             if (map_prim(w, node, mesh, pi, p, m))
                 return -1;
         }
     }
     cJSON *ch;
-    cJSON_ArrayForEach(ch, cJSON_GetObjectItemCaseSensitive(n, "children"))
-        if (visit(w, (int)cJSON_GetNumberValue(ch), m, on_path, depth + 1))
-            return -1;
+    cJSON_ArrayForEach(ch, cJSON_GetObjectItemCaseSensitive(
+                               n, "children")) if (visit(w, (int)cJSON_GetNumberValue(ch), m,
+                                                         on_path, depth + 1)) return -1;
     on_path[node] = 0;
     return 0;
 }
 
-int vdsh_src_map(const char *path, vdsh_src *s, const float *positions, const float *normals, uint32_t nv,
-                 vdsh_src_prim **prims, int *prim_count, char *msg, size_t cap)
+int vdsh_src_map(const char *path, vdsh_src *s, const float *positions, const float *normals,
+                 uint32_t nv, vdsh_src_prim **prims, int *prim_count, char *msg, size_t cap)
 {
     walk w = {path, s, positions, normals, nv, NULL, NULL, 0, NULL, NULL, 0, 0, msg, cap};
     uint32_t hs = 1;
@@ -445,9 +484,9 @@ int vdsh_src_map(const char *path, vdsh_src *s, const float *positions, const fl
     }
     static const double id[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     cJSON *ni;
-    cJSON_ArrayForEach(ni, cJSON_GetObjectItemCaseSensitive(scene, "nodes"))
-        if (visit(&w, (int)cJSON_GetNumberValue(ni), id, on_path, 0))
-            goto out;
+    cJSON_ArrayForEach(ni, cJSON_GetObjectItemCaseSensitive(
+                               scene, "nodes")) if (visit(&w, (int)cJSON_GetNumberValue(ni), id,
+                                                          on_path, 0)) goto out;
     rc = 0;
 out:
     free(w.head), free(w.next), free(w.used), free(on_path);

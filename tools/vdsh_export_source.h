@@ -33,7 +33,7 @@ typedef struct vdsh_src {
     cJSON *json;              /* the source's glTF JSON, modified in place */
     vdsh_src_buffer *buffers; /* its buffers' bytes, one per buffers[] */
     int buffer_count;
-    char *dir;                /* the source's directory, for relative URIs */
+    char *dir; /* the source's directory, for relative URIs */
 } vdsh_src;
 
 /* One primitive instance reached by the walk: node, its mesh, primitive
@@ -50,7 +50,7 @@ void vdsh_src_free(vdsh_src *s);
 
 /* Walk the default scene and map each primitive's vertices to receivers
  * (positions/normals: 3 floats per receiver). *prims is malloc'ed. */
-int vdsh_src_map(const char *path, vdsh_src *s, const float *positions, const float *normals, uint32_t nv,
-                 vdsh_src_prim **prims, int *prim_count, char *msg, size_t cap);
+int vdsh_src_map(const char *path, vdsh_src *s, const float *positions, const float *normals,
+                 uint32_t nv, vdsh_src_prim **prims, int *prim_count, char *msg, size_t cap);
 
 #endif

@@ -198,38 +198,33 @@ static uint64_t file_size_of(const char *path)
 /* Summary                                                             */
 /* ------------------------------------------------------------------ */
 
-static void print_summary(const char *path, const vdsh_file *f,
-                          uint64_t size)
+static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
 {
     const vdsh_header *h = &f->header;
     float lo[3], hi[3];
     receiver_bounds(f, lo, hi);
 
     printf("%s\n", path);
-    printf("  receivers    %u vertices, %u triangles\n", h->vertex_count,
-           h->triangle_count);
+    printf("  receivers    %u vertices, %u triangles\n", h->vertex_count, h->triangle_count);
     printf("               bounds (%g, %g, %g) .. (%g, %g, %g), diagonal "
-           "%g\n", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2],
-           diagonal(lo, hi));
-    printf("  occluders    %u vertices, %u triangles\n",
-           h->occluder_vertex_count, h->occluder_triangle_count);
+           "%g\n",
+           lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], diagonal(lo, hi));
+    printf("  occluders    %u vertices, %u triangles\n", h->occluder_vertex_count,
+           h->occluder_triangle_count);
     printf("               bounds (%g, %g, %g) .. (%g, %g, %g), diagonal "
-           "%g\n", h->bounds_min[0], h->bounds_min[1], h->bounds_min[2],
-           h->bounds_max[0], h->bounds_max[1], h->bounds_max[2],
-           diagonal(h->bounds_min, h->bounds_max));
-    printf("  bake         rays %u per receiver, sampling %s, seed %llu\n",
-           h->rays, or_unknown(vdsh_sampling_name(h->sampling)),
-           (unsigned long long)h->seed);
-    printf("               max_distance %g, max_edge %g%s\n",
-           h->max_distance, h->max_edge,
+           "%g\n",
+           h->bounds_min[0], h->bounds_min[1], h->bounds_min[2], h->bounds_max[0], h->bounds_max[1],
+           h->bounds_max[2], diagonal(h->bounds_min, h->bounds_max));
+    printf("  bake         rays %u per receiver, sampling %s, seed %llu\n", h->rays,
+           or_unknown(vdsh_sampling_name(h->sampling)), (unsigned long long)h->seed);
+    printf("               max_distance %g, max_edge %g%s\n", h->max_distance, h->max_edge,
            h->max_edge == 0.0f ? " (not refined)" : "");
     printf("               offset_rule %s, welded %s, robust trace %s\n",
            or_unknown(vdsh_offset_rule_name(h->offset_rule)),
            (h->load_flags & VDSH_LOAD_WELD) ? "yes" : "no",
            (h->trace_flags & VDSH_TRACE_ROBUST) ? "yes" : "no");
     if (h->cube_size)
-        printf("               basis cubemaps %u x %u per face\n",
-               h->cube_size, h->cube_size);
+        printf("               basis cubemaps %u x %u per face\n", h->cube_size, h->cube_size);
     else
         printf("               basis cubemaps none\n");
 
@@ -237,9 +232,8 @@ static void print_summary(const char *path, const vdsh_file *f,
     for (uint32_t i = 0; i < f->source_count; i++) {
         char hex[65];
         sha_hex(f->sources[i].sha256, hex);
-        printf("    [%u] %s\n        %llu bytes, sha256 %s\n", i,
-               f->sources[i].name, (unsigned long long)f->sources[i].size,
-               hex);
+        printf("    [%u] %s\n        %llu bytes, sha256 %s\n", i, f->sources[i].name,
+               (unsigned long long)f->sources[i].size, hex);
     }
 
     printf("  streams      %u\n", f->stream_count);
@@ -248,8 +242,7 @@ static void print_summary(const char *path, const vdsh_file *f,
         coef0_stats st = stream_coef0(f, s);
         printf("    [%u] order %s%u (%u coefficients%s), %s, method %s", i,
                s->flags & VDSH_STREAM_VARIABLE ? "1.." : "", s->order, s->order * s->order,
-               s->flags & VDSH_STREAM_VARIABLE ? " at most" : "",
-               vdsh_encoding_name(s->encoding),
+               s->flags & VDSH_STREAM_VARIABLE ? " at most" : "", vdsh_encoding_name(s->encoding),
                or_unknown(vdsh_method_name(s->method)));
         if (strcmp(vdsh_method_name(s->method), "?") == 0)
             printf(" (%u)", s->method);
@@ -275,8 +268,8 @@ static void print_summary(const char *path, const vdsh_file *f,
             uint32_t rows = vdsh_file_stream_vertices(f);
             vdsh_stream_size z = vdsh_stream_size_of(s, rows);
             printf("        cpca: %u clusters, %u basis vectors of %u-bit weights; %zu bytes "
-                   "per vertex, %.1f with the model (%llu bytes)\n", m->clusters, m->basis,
-                   m->bits, vdsh_stream_bytes_per_vertex(s), z.mean_bytes,
+                   "per vertex, %.1f with the model (%llu bytes)\n",
+                   m->clusters, m->basis, m->bits, vdsh_stream_bytes_per_vertex(s), z.mean_bytes,
                    (unsigned long long)vdsh_cpca_model_bytes(s->order, m->clusters, m->basis));
             printf("        vertices per cluster:");
             for (uint32_t c = 0; c < m->clusters; c++) {
@@ -289,7 +282,8 @@ static void print_summary(const char *path, const vdsh_file *f,
         } else if (s->flags & VDSH_STREAM_VARIABLE) {
             vdsh_stream_size z = vdsh_stream_size_of(s, vdsh_file_stream_vertices(f));
             printf("        variable order: %.1f bytes per vertex on average, %u at most; "
-                   "vertices per order:", z.mean_bytes, z.max_bytes);
+                   "vertices per order:",
+                   z.mean_bytes, z.max_bytes);
             for (uint32_t k = 1; k <= s->order; k++)
                 if (z.rows_per_order[k])
                     printf(" %u: %u", k, z.rows_per_order[k]);
@@ -297,25 +291,23 @@ static void print_summary(const char *path, const vdsh_file *f,
         } else {
             printf("        %zu bytes per vertex\n", vdsh_stream_bytes_per_vertex(s));
         }
-        printf("        coefficient 0: min %g, max %g, mean %g\n", st.min,
-               st.max, st.mean);
+        printf("        coefficient 0: min %g, max %g, mean %g\n", st.min, st.max, st.mean);
     }
 
     if (f->has_stats) {
         const vdsh_stats *t = &f->stats;
-        printf("  stats        rays traced %llu, missed %llu",
-               (unsigned long long)t->rays_traced,
+        printf("  stats        rays traced %llu, missed %llu", (unsigned long long)t->rays_traced,
                (unsigned long long)t->rays_missed);
         if (t->rays_traced)
-            printf(" (%.2f%%)", 100.0 * (double)t->rays_missed /
-                                    (double)t->rays_traced);
+            printf(" (%.2f%%)", 100.0 * (double)t->rays_missed / (double)t->rays_traced);
         printf("\n               degenerate receivers %u, undefined normals %u, "
-               "origins moved %u, normals flipped %u\n", t->degenerate_receivers,
-               t->undefined_normals, t->moved_origins, t->flipped_normals);
+               "origins moved %u, normals flipped %u\n",
+               t->degenerate_receivers, t->undefined_normals, t->moved_origins, t->flipped_normals);
     }
     if (f->has_part)
         printf("  part         shard %u of %u: receivers %u..%u (its streams' rows), merged "
-               "as %s\n", f->part.index, f->part.count, f->part.range_begin, f->part.range_end,
+               "as %s\n",
+               f->part.index, f->part.count, f->part.range_begin, f->part.range_end,
                vdsh_encoding_name(f->part.encoding));
     if (f->has_part && f->part.encoding == VDSH_ENCODING_CPCA)
         printf("               cpca %u,%u,%u (fitted at the merge)\n", f->part.cpca_clusters,
@@ -324,9 +316,9 @@ static void print_summary(const char *path, const vdsh_file *f,
         const vdsh_adaptive *a = &f->adaptive;
         printf("  adaptive     tolerance %g, min edge %g, budget %u (0: none), %u lights\n"
                "               %u receivers from %u in %u of at most %u rounds, %u midpoints "
-               "baked\n", a->tolerance, a->min_edge, a->max_receivers, a->lights,
-               f->header.vertex_count, a->start_receivers, a->rounds, a->max_rounds,
-               a->candidates);
+               "baked\n",
+               a->tolerance, a->min_edge, a->max_receivers, a->lights, f->header.vertex_count,
+               a->start_receivers, a->rounds, a->max_rounds, a->candidates);
     }
     if (f->has_timings) {
         const vdsh_timings *t = &f->timings;
@@ -334,8 +326,8 @@ static void print_summary(const char *path, const vdsh_file *f,
                "trace %.3f s\n               total %.3f s, %u threads\n",
                t->load, t->refine, t->build, t->trace, t->total, t->threads);
     }
-    printf("  size         %llu bytes, %.2f bytes per vertex\n",
-           (unsigned long long)size, (double)size / h->vertex_count);
+    printf("  size         %llu bytes, %.2f bytes per vertex\n", (unsigned long long)size,
+           (double)size / h->vertex_count);
 }
 
 static int print_json(const char *path, const vdsh_file *f, uint64_t size)
@@ -441,10 +433,15 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
     }
     if (f->has_adaptive) {
         const vdsh_adaptive *a = &f->adaptive;
-        const struct { const char *key; uint64_t v; } count[] = {
-            {"max_receivers", a->max_receivers}, {"lights", a->lights},
-            {"max_rounds", a->max_rounds}, {"start_receivers", a->start_receivers},
-            {"rounds", a->rounds}, {"candidates", a->candidates}};
+        const struct {
+            const char *key;
+            uint64_t v;
+        } count[] = {{"max_receivers", a->max_receivers},
+                     {"lights", a->lights},
+                     {"max_rounds", a->max_rounds},
+                     {"start_receivers", a->start_receivers},
+                     {"rounds", a->rounds},
+                     {"candidates", a->candidates}};
         cJSON *ad = vt_json_object(&j, root, "adaptive");
         vt_json_f32(&j, ad, "tolerance", a->tolerance);
         vt_json_f32(&j, ad, "min_edge", a->min_edge);
@@ -472,16 +469,14 @@ static int print_json_error(const char *path, vdsh_result r, const char *msg)
 
 /* The whole file, for the chunk walk and the validation of the same bytes.
  * Plain stdio, no knowledge of the layout. */
-static int slurp(const char *path, uint8_t **out, size_t *out_size,
-                 char *msg, size_t msg_size)
+static int slurp(const char *path, uint8_t **out, size_t *out_size, char *msg, size_t msg_size)
 {
     /* Only regular files: /dev/zero would be read until memory runs out,
      * and opening a FIFO would wait for a writer (hence O_NONBLOCK, which
      * regular files ignore). */
     int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) {
-        snprintf(msg, msg_size, "%s: cannot open: %s", path,
-                 strerror(errno));
+        snprintf(msg, msg_size, "%s: cannot open: %s", path, strerror(errno));
         return 0;
     }
     struct stat st;
@@ -490,8 +485,7 @@ static int slurp(const char *path, uint8_t **out, size_t *out_size,
     if (!fp) {
         if (!bad)
             bad = errno;
-        snprintf(msg, msg_size, "%s: %s", path,
-                 bad < 0 ? "not a regular file" : strerror(bad));
+        snprintf(msg, msg_size, "%s: %s", path, bad < 0 ? "not a regular file" : strerror(bad));
         close(fd);
         return 0;
     }
@@ -514,8 +508,7 @@ static int slurp(const char *path, uint8_t **out, size_t *out_size,
     int e = errno;
     fclose(fp);
     if (failed) {
-        snprintf(msg, msg_size, "%s: %s", path,
-                 buf ? strerror(e) : "out of memory");
+        snprintf(msg, msg_size, "%s: %s", path, buf ? strerror(e) : "out of memory");
         free(buf);
         return 0;
     }
@@ -542,16 +535,14 @@ static int verify(const char *path, int json)
     vdsh_result r = vdsh_scan_chunks(data, size, path, NULL, 0, &count, &err);
     if (r == VDSH_OK && count) {
         chunks = calloc(count, sizeof *chunks);
-        r = chunks ? vdsh_scan_chunks(data, size, path, chunks, count, &count,
-                                      &err)
+        r = chunks ? vdsh_scan_chunks(data, size, path, chunks, count, &count, &err)
                    : VDSH_ERR_OUT_OF_MEMORY;
         if (!chunks)
             snprintf(err.msg, sizeof err.msg, "%s: out of memory", path);
     }
     int bad_chunks = 0;
     for (uint32_t i = 0; r == VDSH_OK && i < count; i++)
-        bad_chunks += !chunks[i].complete ||
-                      chunks[i].crc_stored != chunks[i].crc_computed;
+        bad_chunks += !chunks[i].complete || chunks[i].crc_stored != chunks[i].crc_computed;
 
     /* The walk lists what is there; the reader judges every rule. */
     vdsh_file *f = NULL;
@@ -592,9 +583,8 @@ static int verify(const char *path, int json)
             printf("  chunk  id        offset          size  crc\n");
         for (uint32_t i = 0; r == VDSH_OK && i < count; i++) {
             const vdsh_chunk_info *c = &chunks[i];
-            printf("  %5u  %-4s  %12llu  %12llu  0x%08x ", i, c->id,
-                   (unsigned long long)c->offset, (unsigned long long)c->size,
-                   c->crc_stored);
+            printf("  %5u  %-4s  %12llu  %12llu  0x%08x ", i, c->id, (unsigned long long)c->offset,
+                   (unsigned long long)c->size, c->crc_stored);
             if (!c->complete)
                 printf("incomplete: runs past the end of the file\n");
             else if (c->crc_stored == c->crc_computed)
@@ -603,16 +593,14 @@ static int verify(const char *path, int json)
                 printf("MISMATCH (computed 0x%08x)\n", c->crc_computed);
         }
         if (valid == VDSH_OK)
-            printf("  valid: every rule of format version %u holds\n",
-                   VDSH_FORMAT_VERSION);
+            printf("  valid: every rule of format version %u holds\n", VDSH_FORMAT_VERSION);
         else
             printf("  INVALID (%s): %s\n", vdsh_result_str(valid), err.msg);
     }
     if (valid != VDSH_OK)
         fprintf(stderr, "%s: %s\n", prog, err.msg);
     else if (bad_chunks > 0) /* cannot happen for a file the reader accepts */
-        fprintf(stderr, "%s: %s: %d chunks fail their CRC\n", prog, path,
-                bad_chunks);
+        fprintf(stderr, "%s: %s: %d chunks fail their CRC\n", prog, path, bad_chunks);
     free(chunks);
     free(data);
     return valid == VDSH_OK && bad_chunks == 0;
@@ -649,9 +637,9 @@ static int info(const char *path, int json, int first)
 /* ------------------------------------------------------------------ */
 
 typedef struct options {
-    const char *json_out;      /* --json FILE ('-': stdout), or NULL */
-    int check;                 /* --verify */
-    char **files;              /* FILE.vdsh... */
+    const char *json_out; /* --json FILE ('-': stdout), or NULL */
+    int check;            /* --verify */
+    char **files;         /* FILE.vdsh... */
     int file_count;
 } options;
 
@@ -670,26 +658,20 @@ static int parse_args(int argc, char **argv, options *o)
     int opt;
     while ((opt = getopt_long(argc, argv, "j:hV", longopts, NULL)) != -1) {
         switch (opt) {
-        case 'j':
-            o->json_out = optarg;
-            break;
-        case 'c':
-            o->check = 1;
-            break;
-        case 'h':
-            usage(stdout);
-            return 0;
-        case 'V':
-            return vt_cli_version(NULL);
-        default:
-            return vt_cli_try_help();
+        case 'j': o->json_out = optarg; break;
+        case 'c': o->check = 1; break;
+        case 'h': usage(stdout); return 0;
+        case 'V': return vt_cli_version(NULL);
+        default: return vt_cli_try_help();
         }
     }
     if (optind >= argc) {
         size_t n = o->json_out ? strlen(o->json_out) : 0;
         if (n > 5 && strcmp(o->json_out + n - 5, ".vdsh") == 0)
-            return vt_usage_error(prog, "no input file (--json takes the JSON file to write: "
-                                  "--json - %s prints it)", o->json_out);
+            return vt_usage_error(prog,
+                                  "no input file (--json takes the JSON file to write: "
+                                  "--json - %s prints it)",
+                                  o->json_out);
         return vt_usage_error(prog, "%s", "no input file");
     }
     o->files = argv + optind;
@@ -702,8 +684,8 @@ static int parse_args(int argc, char **argv, options *o)
 static int run(const options *o)
 {
     const int json = o->json_out != NULL;
-    if (json && vt_cli_check_outputs(&o->json_out, 1, (const char *const *)o->files,
-                                     o->file_count) != 0)
+    if (json &&
+        vt_cli_check_outputs(&o->json_out, 1, (const char *const *)o->files, o->file_count) != 0)
         return 1;
 
     int ok = 1;
@@ -716,8 +698,7 @@ static int run(const options *o)
         ok = 0;
     free(json_text);
     if (fflush(stdout) != 0 || ferror(stdout)) {
-        fprintf(stderr, "%s: cannot write output: %s\n", prog,
-                strerror(errno));
+        fprintf(stderr, "%s: cannot write output: %s\n", prog, strerror(errno));
         return 1;
     }
     return ok ? 0 : 1;

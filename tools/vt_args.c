@@ -33,8 +33,9 @@ vdsh_file *vt_read_whole(const char *path)
         return NULL;
     }
     if (f->has_part) {
-        fprintf(stderr, "%s: %s: a part of a sharded bake (shard %u of %u): join the parts "
-                        "with vdsh-merge first\n",
+        fprintf(stderr,
+                "%s: %s: a part of a sharded bake (shard %u of %u): join the parts "
+                "with vdsh-merge first\n",
                 vt_cli_prog(), path, f->part.index, f->part.count);
         vdsh_free(f);
         return NULL;

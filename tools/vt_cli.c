@@ -157,8 +157,7 @@ int vt_parse_floats(const char *s, float *out, int min, int max)
     return n >= min ? n : 0;
 }
 
-int vt_parse_u64_list(const char *s, uint64_t lo, uint64_t hi, uint64_t *out, int min,
-                      int max)
+int vt_parse_u64_list(const char *s, uint64_t lo, uint64_t hi, uint64_t *out, int min, int max)
 {
     if (!s)
         return 0;
@@ -186,8 +185,7 @@ int vt_parse_size(const char *s, int lo, int hi, int *w, int *h)
     uint64_t a, b;
     if (!x || !digits_u64(s, (size_t)(x - s), &a) || !digits_u64(x + 1, strlen(x + 1), &b))
         return 0;
-    if (lo < 0 || a < (uint64_t)lo || a > (uint64_t)hi || b < (uint64_t)lo ||
-        b > (uint64_t)hi)
+    if (lo < 0 || a < (uint64_t)lo || a > (uint64_t)hi || b < (uint64_t)lo || b > (uint64_t)hi)
         return 0;
     *w = (int)a;
     *h = (int)b;
@@ -263,8 +261,8 @@ static int check_writable(const char *path)
     return 0;
 }
 
-int vt_cli_check_outputs(const char *const *outputs, int output_count,
-                         const char *const *inputs, int input_count)
+int vt_cli_check_outputs(const char *const *outputs, int output_count, const char *const *inputs,
+                         int input_count)
 {
     for (int i = 0; i < output_count; i++) {
         const char *out = outputs[i];
@@ -277,10 +275,9 @@ int vt_cli_check_outputs(const char *const *outputs, int output_count,
                 return 1;
             }
         for (int k = 0; k < i; k++)
-            if (outputs[k] && (strcmp(outputs[k], out) == 0 ||
-                               vt_cli_same_file(outputs[k], out))) {
-                fprintf(stderr, "%s: %s is also the output %s (the same file)\n", cli_prog,
-                        out, outputs[k]);
+            if (outputs[k] && (strcmp(outputs[k], out) == 0 || vt_cli_same_file(outputs[k], out))) {
+                fprintf(stderr, "%s: %s is also the output %s (the same file)\n", cli_prog, out,
+                        outputs[k]);
                 return 1;
             }
     }
@@ -311,8 +308,7 @@ static int refuse_range(const char *option, const char *what, const char *arg, c
     const char *w = what ? what : "a whole number";
     const char *space = *w ? " " : "";
     if (lo && hi)
-        vt_usage_error(cli_prog, "%s takes %s%s%s..%s, not '%s'", option, w, space, lo, hi,
-                       arg);
+        vt_usage_error(cli_prog, "%s takes %s%s%s..%s, not '%s'", option, w, space, lo, hi, arg);
     else if (lo)
         vt_usage_error(cli_prog, "%s takes %s >= %s, not '%s'", option, w, lo, arg);
     else
@@ -320,8 +316,8 @@ static int refuse_range(const char *option, const char *what, const char *arg, c
     return 0;
 }
 
-int vt_opt_u64(const char *option, const char *what, const char *arg, uint64_t lo,
-               uint64_t hi, uint64_t *out)
+int vt_opt_u64(const char *option, const char *what, const char *arg, uint64_t lo, uint64_t hi,
+               uint64_t *out)
 {
     if (vt_parse_u64(arg, lo, hi, out))
         return 1;
@@ -332,8 +328,8 @@ int vt_opt_u64(const char *option, const char *what, const char *arg, uint64_t l
                         hi == UINT64_MAX ? NULL : h);
 }
 
-int vt_opt_u32(const char *option, const char *what, const char *arg, uint32_t lo,
-               uint32_t hi, uint32_t *out)
+int vt_opt_u32(const char *option, const char *what, const char *arg, uint32_t lo, uint32_t hi,
+               uint32_t *out)
 {
     uint64_t v;
     if (!vt_opt_u64(option, what, arg, lo, hi, &v))
@@ -342,8 +338,7 @@ int vt_opt_u32(const char *option, const char *what, const char *arg, uint32_t l
     return 1;
 }
 
-int vt_opt_int(const char *option, const char *what, const char *arg, int lo, int hi,
-               int *out)
+int vt_opt_int(const char *option, const char *what, const char *arg, int lo, int hi, int *out)
 {
     if (lo >= 0) {
         uint64_t u;
@@ -439,7 +434,10 @@ int vt_opt_choice(const char *option, const char *arg, const vt_choice *choices,
     size_t at = 0;
     for (int i = 0; i < n && at < sizeof list; i++)
         at += (size_t)snprintf(list + at, sizeof list - at, "%s%s",
-                               i == 0 ? "" : i + 1 == n ? " or " : ", ", choices[i].name);
+                               i == 0       ? ""
+                               : i + 1 == n ? " or "
+                                            : ", ",
+                               choices[i].name);
     vt_usage_error(cli_prog, "%s takes %s, not '%s'", option, list, arg);
     return 0;
 }

@@ -67,8 +67,7 @@ int vt_parse_float(const char *s, float *out);
 int vt_parse_floats(const char *s, float *out, int min, int max);
 
 /* min..max comma-separated whole numbers lo..hi; returns the count or 0. */
-int vt_parse_u64_list(const char *s, uint64_t lo, uint64_t hi, uint64_t *out, int min,
-                      int max);
+int vt_parse_u64_list(const char *s, uint64_t lo, uint64_t hi, uint64_t *out, int min, int max);
 
 /* WxH, each lo..hi. */
 int vt_parse_size(const char *s, int lo, int hi, int *w, int *h);
@@ -98,8 +97,8 @@ int vt_cli_try_help(void);
  *     so a missing or read-only folder is found now; the message names
  *     the path. Character devices and FIFOs (/dev/stdout) pass as they are.
  * Returns 0 when all is well, else 1 (the message said on stderr). */
-int vt_cli_check_outputs(const char *const *outputs, int output_count,
-                         const char *const *inputs, int input_count);
+int vt_cli_check_outputs(const char *const *outputs, int output_count, const char *const *inputs,
+                         int input_count);
 
 /* 1 when a and b name one existing regular file (device and inode). */
 int vt_cli_same_file(const char *a, const char *b);
@@ -124,8 +123,11 @@ enum { VT_CLI_RUN = -1 };
 
 /* The end of every program's getopt_long table: --help, --version, the
  * terminator (the program includes <getopt.h>). */
-#define VT_CLI_LONGOPTS_END                                                        \
-    {"help", no_argument, 0, 'h'}, {"version", no_argument, 0, 'V'}, { 0, 0, 0, 0 }
+#define VT_CLI_LONGOPTS_END                                                                        \
+    {"help", no_argument, 0, 'h'}, {"version", no_argument, 0, 'V'},                               \
+    {                                                                                              \
+        0, 0, 0, 0                                                                                 \
+    }
 
 /* The getopt switch's default: -h prints usage(stdout) and returns 0, -V
  * returns vt_cli_version(version_detail), anything else (getopt's '?' or
@@ -137,12 +139,11 @@ int vt_cli_common_option(int c, void (*usage)(FILE *), const char *version_detai
  * LO..HI". With hi UINT64_MAX it says "WHAT >= LO", or just "WHAT" when lo
  * is 0 too. vt_opt_int with lo >= 0 takes digits only, no sign, as
  * vt_parse_u64 ("-0" is refused). */
-int vt_opt_u64(const char *option, const char *what, const char *arg, uint64_t lo,
-               uint64_t hi, uint64_t *out);
-int vt_opt_u32(const char *option, const char *what, const char *arg, uint32_t lo,
-               uint32_t hi, uint32_t *out);
-int vt_opt_int(const char *option, const char *what, const char *arg, int lo, int hi,
-               int *out);
+int vt_opt_u64(const char *option, const char *what, const char *arg, uint64_t lo, uint64_t hi,
+               uint64_t *out);
+int vt_opt_u32(const char *option, const char *what, const char *arg, uint32_t lo, uint32_t hi,
+               uint32_t *out);
+int vt_opt_int(const char *option, const char *what, const char *arg, int lo, int hi, int *out);
 
 /* A real number > 0 ("takes a positive number") or >= 0 ("takes a number
  * >= 0"); -0 counts as 0. */

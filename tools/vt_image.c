@@ -22,8 +22,8 @@ static void flush(png_structp p)
 }
 
 /* Write rows (png_bytep each) of the given colour type and depth. */
-static int write_png(const char *path, int width, int height, int color, int depth,
-                     png_bytep *rows, char *msg, size_t cap)
+static int write_png(const char *path, int width, int height, int color, int depth, png_bytep *rows,
+                     char *msg, size_t cap)
 {
     vdsh_output o;
     vdsh_error e;
@@ -40,8 +40,8 @@ static int write_png(const char *path, int width, int height, int color, int dep
         return -1;
     }
     png_set_write_fn(p, &o, put, flush);
-    png_set_IHDR(p, info, (png_uint_32)width, (png_uint_32)height, depth, color,
-                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_IHDR(p, info, (png_uint_32)width, (png_uint_32)height, depth, color, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     if (depth == 16)
         png_set_gAMA_fixed(p, info, PNG_GAMMA_LINEAR); /* values, not colours */
     png_write_info(p, info);
@@ -101,8 +101,7 @@ int vt_png_rgba_write(const char *path, int width, int height, const uint8_t *rg
     return r;
 }
 
-int vt_png16_read(const char *path, int *width, int *height, float **out, char *msg,
-                  size_t cap)
+int vt_png16_read(const char *path, int *width, int *height, float **out, char *msg, size_t cap)
 {
     png_image img;
     memset(&img, 0, sizeof img);

@@ -24,8 +24,7 @@ int vt_png16_write(const char *path, int width, int height, const float *values,
                    size_t cap);
 
 /* A 16-bit (or 8-bit) greyscale PNG as floats in [0, 1]. */
-int vt_png16_read(const char *path, int *width, int *height, float **out, char *msg,
-                  size_t cap);
+int vt_png16_read(const char *path, int *width, int *height, float **out, char *msg, size_t cap);
 
 /* 8-bit RGBA, row 0 at the top. */
 int vt_png_rgba_write(const char *path, int width, int height, const uint8_t *rgba, char *msg,

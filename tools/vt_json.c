@@ -258,8 +258,10 @@ cJSON *vt_json_read_file(const char *path, char *msg, size_t cap)
     struct stat st;
     int e = fstat(fd, &st) != 0 ? errno : 0;
     if (e || !S_ISREG(st.st_mode) || st.st_size > MAX_BYTES) {
-        snprintf(msg, cap, "%s: %s", path, e ? strerror(e)
-                 : !S_ISREG(st.st_mode) ? "not a regular file" : "larger than 64 MiB");
+        snprintf(msg, cap, "%s: %s", path,
+                 e                      ? strerror(e)
+                 : !S_ISREG(st.st_mode) ? "not a regular file"
+                                        : "larger than 64 MiB");
         close(fd);
         return NULL;
     }
@@ -270,8 +272,8 @@ cJSON *vt_json_read_file(const char *path, char *msg, size_t cap)
         if (k < 0 && errno == EINTR)
             continue;
         if (k <= 0) {
-            snprintf(msg, cap, "%s: cannot read: %s", path, k < 0 ? strerror(errno)
-                                                                   : "shorter than its size");
+            snprintf(msg, cap, "%s: cannot read: %s", path,
+                     k < 0 ? strerror(errno) : "shorter than its size");
             free(buf);
             close(fd);
             return NULL;

@@ -54,7 +54,7 @@ extern "C" {
 
 typedef struct vt_json {
     cJSON *root;
-    int failed;      /* an allocation failed: nothing will be printed */
+    int failed; /* an allocation failed: nothing will be printed */
 } vt_json;
 
 /* Containers. parent NULL (and key NULL): the document's root, once.

@@ -20,11 +20,15 @@ void vt_record_stats(vt_json *j, cJSON *parent, const vdsh_file *f, int all)
         return;
     }
     const vdsh_stats *s = &f->stats;
-    const struct { const char *key; uint64_t v; } count[] = {
-        {"rays_traced", s->rays_traced}, {"rays_missed", s->rays_missed},
-        {"degenerate_receivers", s->degenerate_receivers},
-        {"undefined_normals", s->undefined_normals},
-        {"moved_origins", s->moved_origins}, {"flipped_normals", s->flipped_normals}};
+    const struct {
+        const char *key;
+        uint64_t v;
+    } count[] = {{"rays_traced", s->rays_traced},
+                 {"rays_missed", s->rays_missed},
+                 {"degenerate_receivers", s->degenerate_receivers},
+                 {"undefined_normals", s->undefined_normals},
+                 {"moved_origins", s->moved_origins},
+                 {"flipped_normals", s->flipped_normals}};
     const size_t n = all ? sizeof count / sizeof count[0] : 4;
     cJSON *st = vt_json_object(j, parent, "stats");
     for (size_t i = 0; i < n; i++)
@@ -38,9 +42,14 @@ void vt_record_timings(vt_json *j, cJSON *parent, const vdsh_file *f)
         return;
     }
     const vdsh_timings *t = &f->timings;
-    const struct { const char *key; double v; } seconds[] = {
-        {"load", t->load}, {"refine", t->refine}, {"build", t->build},
-        {"trace", t->trace}, {"total", t->total}};
+    const struct {
+        const char *key;
+        double v;
+    } seconds[] = {{"load", t->load},
+                   {"refine", t->refine},
+                   {"build", t->build},
+                   {"trace", t->trace},
+                   {"total", t->total}};
     cJSON *tm = vt_json_object(j, parent, "timings");
     for (size_t i = 0; i < sizeof seconds / sizeof seconds[0]; i++)
         vt_json_f64(j, tm, seconds[i].key, seconds[i].v);

@@ -35,7 +35,11 @@ static int good_name(const char *s)
     return 1;
 }
 
-#define FAIL(...) do { snprintf(msg, cap, __VA_ARGS__); goto fail; } while (0)
+#define FAIL(...)                                                                                  \
+    do {                                                                                           \
+        snprintf(msg, cap, __VA_ARGS__);                                                           \
+        goto fail;                                                                                 \
+    } while (0)
 
 int vt_views_read(const char *path, vt_views *out, char *msg, size_t cap)
 {

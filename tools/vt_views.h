@@ -43,7 +43,7 @@ extern "C" {
 #define VT_VIEWS_MAX 256
 
 typedef struct vt_view {
-    char name[64];               /* letters, digits, '-', '_' */
+    char name[64]; /* letters, digits, '-', '_' */
     vdsh_camera camera;
     int set_count;
     int light_count[VT_VIEWS_MAX_SETS];
@@ -53,7 +53,7 @@ typedef struct vt_view {
 typedef struct vt_views {
     int width, height;
     int count;
-    vt_view *views;              /* count entries */
+    vt_view *views; /* count entries */
 } vt_views;
 
 int vt_views_read(const char *path, vt_views *out, char *msg, size_t cap);

@@ -32,10 +32,10 @@
  * adding directions does not move the lights, and so that no stream can
  * coincide with the bake's jitter even when the seeds are equal. */
 enum {
-    PURPOSE_DIRECTIONS = 0x44495253u, /* "DIRS" */
-    PURPOSE_LIGHTS = 0x4c474854u,     /* "LGHT" */
-    PURPOSE_VERTICES = 0x56525453u,   /* "VRTS" */
-    PURPOSE_INTERIOR = 0x494e5452u,   /* "INTR" */
+    PURPOSE_DIRECTIONS = 0x44495253u,  /* "DIRS" */
+    PURPOSE_LIGHTS = 0x4c474854u,      /* "LGHT" */
+    PURPOSE_VERTICES = 0x56525453u,    /* "VRTS" */
+    PURPOSE_INTERIOR = 0x494e5452u,    /* "INTR" */
     PURPOSE_SCENE_LIGHTS = 0x53434e4cu /* "SCNL" */
 };
 
@@ -66,8 +66,7 @@ static inline int hist_bin(float e)
     if (!(e < 1e4f))
         return HIST_BINS - 1;
     int b = (int)floorf((log10f(e) - HIST_LOG_MIN) * HIST_PER_DECADE);
-    b = b < 0 ? 0 : b > HIST_PER_DECADE * HIST_DECADES - 1
-                        ? HIST_PER_DECADE * HIST_DECADES - 1 : b;
+    b = b < 0 ? 0 : b > HIST_PER_DECADE * HIST_DECADES - 1 ? HIST_PER_DECADE * HIST_DECADES - 1 : b;
     return 2 + b;
 }
 
@@ -105,8 +104,8 @@ static double hist_quantile(const uint64_t *h, double q)
  * run and vb_eval_directions (which the tests compare with the bake's
  * directions) both call this. */
 static inline void heldout_packet(const vb_dirgrid *g, uint32_t packet, uint64_t dir_seed,
-                                  uint32_t id, const float n[3], float *dx, float *dy,
-                                  float *dz, int *valid)
+                                  uint32_t id, const float n[3], float *dx, float *dy, float *dz,
+                                  int *valid)
 {
     vb_dirgrid_packet(g, packet, dir_seed, id, n, dx, dy, dz, valid);
 }
@@ -115,35 +114,35 @@ static inline void heldout_packet(const vb_dirgrid *g, uint32_t packet, uint64_t
 
 typedef struct receiver {
     uint32_t kind;
-    uint32_t index;        /* vertex, or interior point number */
-    uint32_t id;           /* the random streams' receiver number */
+    uint32_t index; /* vertex, or interior point number */
+    uint32_t id;    /* the random streams' receiver number */
     uint32_t triangle;
     float bary[3];
-    float position[3];     /* scene units */
-    float normal[3];       /* unit */
-    float origin[3];       /* truth ray origin, traced frame */
-    float near;            /* ~0 distance (origins.h), scene units */
+    float position[3]; /* scene units */
+    float normal[3];   /* unit */
+    float origin[3];   /* truth ray origin, traced frame */
+    float near;        /* ~0 distance (origins.h), scene units */
 } receiver;
 
 /* One receiver's sums for one stream, in a fixed order. */
 typedef struct racc {
-    double sq;             /* squared relative distance errors */
-    double abs;            /* relative distance errors */
-    double mae, mae_bin;   /* |s_hat - s_ideal| */
-    uint32_t n;            /* samples */
-    uint32_t vis, fals, fals_bin;     /* d_T >= d_L; s_hat < .5; D < d_L */
-    uint32_t occ, leak;               /* s_ideal < .5; s_hat > .5 */
-    uint32_t occ_bin, leak_bin;       /* d_T < d_L; D >= d_L */
-    uint32_t ringing;                 /* D == 0: the sum rang to <= 0 */
+    double sq;                    /* squared relative distance errors */
+    double abs;                   /* relative distance errors */
+    double mae, mae_bin;          /* |s_hat - s_ideal| */
+    uint32_t n;                   /* samples */
+    uint32_t vis, fals, fals_bin; /* d_T >= d_L; s_hat < .5; D < d_L */
+    uint32_t occ, leak;           /* s_ideal < .5; s_hat > .5 */
+    uint32_t occ_bin, leak_bin;   /* d_T < d_L; D >= d_L */
+    uint32_t ringing;             /* D == 0: the sum rang to <= 0 */
 } racc;
 
 /* One receiver's sums for one stream under the scene lights. */
 typedef struct sacc {
     double mae, mae_bin;
     uint32_t n;
-    uint32_t vis, fals, fals_bin;     /* d_T >= d_L; s_hat < .5; D < d_L */
-    uint32_t occ, hit, leak;          /* s_ideal < .5; s_hat < .5; s_hat > .5 */
-    uint32_t occ_bin, hit_bin;        /* d_T < d_L; D < d_L */
+    uint32_t vis, fals, fals_bin; /* d_T >= d_L; s_hat < .5; D < d_L */
+    uint32_t occ, hit, leak;      /* s_ideal < .5; s_hat < .5; s_hat > .5 */
+    uint32_t occ_bin, hit_bin;    /* d_T < d_L; D < d_L */
 } sacc;
 
 typedef struct rtruth {
@@ -158,21 +157,20 @@ typedef struct job {
     const receiver *rec;
     uint32_t rec_count;
     uint32_t streams;
-    racc *acc;             /* rec_count * streams */
-    sacc *sacc;            /* rec_count * streams: scene lights */
+    racc *acc;  /* rec_count * streams */
+    sacc *sacc; /* rec_count * streams: scene lights */
     uint32_t light_count;
     const float (*lights)[3];       /* scene units */
     const float (*lights_local)[3]; /* traced frame */
-    rtruth *truth;         /* rec_count */
-    uint64_t *hist;        /* per worker: KINDS * streams * HIST_BINS */
+    rtruth *truth;                  /* rec_count */
+    uint64_t *hist;                 /* per worker: KINDS * streams * HIST_BINS */
     uint64_t dir_seed, light_seed;
     float max_local, inv_scale, max_distance, floor_dist;
 } job;
 
 /* The stream's coefficients at a receiver: decoded at a vertex,
  * interpolated inside a triangle. */
-static void receiver_coeffs(const vdsh_file *f, const vdsh_stream *s,
-                            const receiver *r, float *c)
+static void receiver_coeffs(const vdsh_file *f, const vdsh_stream *s, const receiver *r, float *c)
 {
     if (r->kind == VB_EVAL_VERTICES)
         vdsh_stream_decode(s, r->index, c);
@@ -211,7 +209,8 @@ static void eval_scene_lights(job *J, uint32_t ri, const float coef[][VDSH_MAX_C
             const float *L = J->lights[l], *Ll = J->lights_local[l];
             float v[3] = {L[0] - r->position[0], L[1] - r->position[1], L[2] - r->position[2]};
             float d = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-            if (!(d > 0.0f) || v[0] * r->normal[0] + v[1] * r->normal[1] + v[2] * r->normal[2] <= 0.0f)
+            if (!(d > 0.0f) ||
+                v[0] * r->normal[0] + v[1] * r->normal[1] + v[2] * r->normal[2] <= 0.0f)
                 continue; /* at the receiver, or below its horizon: not lit */
             for (int a = 0; a < 3; a++)
                 w[k][a] = v[a] / d;
@@ -237,8 +236,8 @@ static void eval_scene_lights(job *J, uint32_t ri, const float coef[][VDSH_MAX_C
             if (!valid[k])
                 continue;
             /* Nothing before the light: visible (d_T is larger than d_L). */
-            const float dt = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID
-                                 ? rh.ray.tfar[k] / scale : INFINITY;
+            const float dt =
+                rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID ? rh.ray.tfar[k] / scale : INFINITY;
             const float L0 = dl[k];
             const float s_ideal = vdsh_shadow_compare(dt, L0, VDSH_COMPARE_SMOOTH);
             const int vis = dt >= L0, occ = s_ideal < 0.5f, occ_bin = dt < L0;
@@ -255,9 +254,9 @@ static void eval_scene_lights(job *J, uint32_t ri, const float coef[][VDSH_MAX_C
                     s_hat = vdsh_shadow_compare(D, L0, VDSH_COMPARE_SMOOTH);
                 } else {
                     const float *cv[3] = {vc[s][0], vc[s][1], vc[s][2]};
-                    s_hat = vdsh_shadow_interior(st->order, st->quantity, J->max_distance,
-                                                 interp[s], cv, pv, r->bary, L,
-                                                 VDSH_COMPARE_SMOOTH, &D);
+                    s_hat =
+                        vdsh_shadow_interior(st->order, st->quantity, J->max_distance, interp[s],
+                                             cv, pv, r->bary, L, VDSH_COMPARE_SMOOTH, &D);
                 }
                 const int b_dark = D < L0;
                 sacc *a = acc + s;
@@ -312,8 +311,8 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
     for (uint32_t pk = 0; pk < J->grid->packet_count; pk++) {
         struct RTCRayHit16 rh __attribute__((aligned(64)));
         int valid[VB_PACKET] __attribute__((aligned(64)));
-        heldout_packet(J->grid, pk, J->dir_seed, r->id, r->normal, rh.ray.dir_x,
-                       rh.ray.dir_y, rh.ray.dir_z, valid);
+        heldout_packet(J->grid, pk, J->dir_seed, r->id, r->normal, rh.ray.dir_x, rh.ray.dir_y,
+                       rh.ray.dir_z, valid);
         for (int k = 0; k < VB_PACKET; k++) {
             rh.ray.org_x[k] = r->origin[0];
             rh.ray.org_y[k] = r->origin[1];
@@ -364,12 +363,12 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
                     b_hat = vdsh_shadow_compare(D, dl, VDSH_COMPARE_BINARY);
                 } else {
                     const float *cv[3] = {vc[s][0], vc[s][1], vc[s][2]};
-                    s_hat = vdsh_shadow_interior(st->order, st->quantity, J->max_distance,
-                                                 interp[s], cv, pv, r->bary, lp,
-                                                 VDSH_COMPARE_SMOOTH, &D);
-                    b_hat = vdsh_shadow_interior(st->order, st->quantity, J->max_distance,
-                                                 interp[s], cv, pv, r->bary, lp,
-                                                 VDSH_COMPARE_BINARY, NULL);
+                    s_hat =
+                        vdsh_shadow_interior(st->order, st->quantity, J->max_distance, interp[s],
+                                             cv, pv, r->bary, lp, VDSH_COMPARE_SMOOTH, &D);
+                    b_hat =
+                        vdsh_shadow_interior(st->order, st->quantity, J->max_distance, interp[s],
+                                             cv, pv, r->bary, lp, VDSH_COMPARE_BINARY, NULL);
                 }
                 const float e = fabsf(D - dt) / floor_;
                 racc *a = acc + s;
@@ -412,8 +411,7 @@ static void eval_progress(void *user, uint32_t done, uint32_t total)
 /* ---- public pieces ------------------------------------------------------- */
 
 void vb_eval_interpolate(const vdsh_file *f, const vdsh_stream *s, uint32_t tri,
-                         const float bary[3], float position[3],
-                         float normal[3], float *coeffs)
+                         const float bary[3], float position[3], float normal[3], float *coeffs)
 {
     const uint32_t *ix = f->indices + 3 * (size_t)tri;
     if (position || normal) {
@@ -475,9 +473,8 @@ double *vb_eval_area_cdf(const vdsh_file *f, double *total)
     return cdf;
 }
 
-int vb_eval_interior_point(const double *cdf, uint32_t triangle_count,
-                           uint64_t seed, uint32_t j, uint32_t *tri,
-                           float bary[3])
+int vb_eval_interior_point(const double *cdf, uint32_t triangle_count, uint64_t seed, uint32_t j,
+                           uint32_t *tri, float bary[3])
 {
     if (triangle_count == 0 || !(cdf[triangle_count - 1] > 0.0))
         return 0;
@@ -508,8 +505,8 @@ int vb_eval_interior_point(const double *cdf, uint32_t triangle_count,
     return 1;
 }
 
-uint32_t vb_eval_directions(uint64_t seed, uint32_t directions, uint32_t id,
-                            const float n[3], float *d, uint32_t max)
+uint32_t vb_eval_directions(uint64_t seed, uint32_t directions, uint32_t id, const float n[3],
+                            float *d, uint32_t max)
 {
     if (seed == 0)
         seed = VB_EVAL_DEFAULT_SEED;
@@ -557,8 +554,7 @@ static int is_zero_normal(const float n[3])
     return n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f;
 }
 
-static void describe(const receiver *r, const rtruth *t, const racc *a,
-                     vb_eval_receiver *out)
+static void describe(const receiver *r, const rtruth *t, const racc *a, vb_eval_receiver *out)
 {
     memset(out, 0, sizeof *out);
     out->index = r->index;
@@ -583,8 +579,14 @@ typedef struct ratio {
     double a, b, res;
 } ratio;
 
-static void ratio_add(ratio *q, double a, double b) { q->a += a, q->b += b; }
-static double ratio_value(const ratio *q) { return q->b > 0 ? q->a / q->b : NAN; }
+static void ratio_add(ratio *q, double a, double b)
+{
+    q->a += a, q->b += b;
+}
+static double ratio_value(const ratio *q)
+{
+    return q->b > 0 ? q->a / q->b : NAN;
+}
 static void ratio_res(ratio *q, double a, double b)
 {
     double r = q->b > 0 ? q->a / q->b : 0.0, e = a - r * b;
@@ -615,9 +617,8 @@ static double quantile_sorted(const double *v, size_t n, double q)
     return v[i] + (pos - (double)i) * (v[i + 1] - v[i]);
 }
 
-static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind,
-                        unsigned workers, uint32_t worst_n, vb_eval_metrics *m,
-                        vb_error *err)
+static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind, unsigned workers,
+                        uint32_t worst_n, vb_eval_metrics *m, vb_error *err)
 {
     const uint32_t S = J->streams;
     double *mae = malloc(((size_t)count + 1) * sizeof *mae);
@@ -672,8 +673,8 @@ static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind,
         double ms = ratio_value(&sq);
         o->distance_rms = sqrt(ms);
         /* Delta method: se(sqrt(x)) = se(x) / (2 sqrt(x)). */
-        o->distance_rms_se = ms > 0 ? ratio_se(&sq, n_used) / (2.0 * o->distance_rms)
-                                    : (n_used > 1 ? 0.0 : NAN);
+        o->distance_rms_se =
+            ms > 0 ? ratio_se(&sq, n_used) / (2.0 * o->distance_rms) : (n_used > 1 ? 0.0 : NAN);
         o->distance_mean = ratio_value(&ab);
         o->shadow_mae = ratio_value(&mae_r), o->shadow_mae_se = ratio_se(&mae_r, n_used);
         o->binary_mae = ratio_value(&mb), o->binary_mae_se = ratio_se(&mb, n_used);
@@ -686,7 +687,8 @@ static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind,
 
         uint64_t h[HIST_BINS] = {0};
         for (unsigned w = 0; w < workers; w++) {
-            const uint64_t *src = J->hist + (((size_t)w * VB_EVAL_KINDS + kind) * S + s) * HIST_BINS;
+            const uint64_t *src =
+                J->hist + (((size_t)w * VB_EVAL_KINDS + kind) * S + s) * HIST_BINS;
             for (int b = 0; b < HIST_BINS; b++)
                 h[b] += src[b];
         }
@@ -712,8 +714,7 @@ static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind,
 
 /* The scene-light scores of one kind of receiver, summed in receiver
  * order. */
-static void reduce_scene(const job *J, uint32_t first, uint32_t count,
-                         vb_eval_scene_metrics *m)
+static void reduce_scene(const job *J, uint32_t first, uint32_t count, vb_eval_scene_metrics *m)
 {
     const uint32_t S = J->streams;
     for (uint32_t s = 0; s < S; s++) {
@@ -749,8 +750,8 @@ static void reduce_scene(const job *J, uint32_t first, uint32_t count,
     }
 }
 
-static vb_result list_escaping(const job *J, uint32_t first, uint32_t count,
-                               uint32_t max, vb_eval_truth *t, vb_error *err)
+static vb_result list_escaping(const job *J, uint32_t first, uint32_t count, uint32_t max,
+                               vb_eval_truth *t, vb_error *err)
 {
     vb_ranked *items = malloc(((size_t)count + 1) * sizeof *items);
     if (!items)
@@ -792,8 +793,8 @@ static int cmp_u32(const void *x, const void *y)
 /* The vertices to evaluate, in index order: all, or the `want` whose hash
  * is smallest (a uniform sample without replacement that does not depend
  * on anything but the seed and the vertex count). */
-static vb_result pick_vertices(uint32_t V, uint32_t want, uint64_t seed,
-                               uint32_t **out, uint32_t *count, vb_error *err)
+static vb_result pick_vertices(uint32_t V, uint32_t want, uint64_t seed, uint32_t **out,
+                               uint32_t *count, vb_error *err)
 {
     uint32_t n = (want == 0 || want >= V) ? V : want;
     uint32_t *v = malloc(((size_t)n + 1) * sizeof *v);
@@ -832,14 +833,14 @@ static vb_result pick_vertices(uint32_t V, uint32_t want, uint64_t seed,
  * (run_free frees it, also half-built) and the result it fills. */
 typedef struct eval_run {
     vb_eval_desc d;
-    float diag;            /* the file's bounds' diagonal, else the scene's */
+    float diag; /* the file's bounds' diagonal, else the scene's */
     double t0;
     vb_dirgrid grid;
-    uint32_t *vsel, nv;    /* the vertices picked */
+    uint32_t *vsel, nv;     /* the vertices picked */
     float *vorigin, *vnear; /* per vertex: truth origins, near distances */
     float (*lights_local)[3];
     double *cdf;
-    receiver *rec;         /* the vertices', then the interior points' */
+    receiver *rec; /* the vertices', then the interior points' */
     uint32_t nr;
     uint32_t count[VB_EVAL_KINDS], skipped[VB_EVAL_KINDS];
     job *J;
@@ -917,8 +918,10 @@ static vb_result vertex_receivers(eval_run *e, vb_error *err)
     if (!e->vorigin || !e->vnear || !e->rec)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
                        e->nv + d->interior);
-    vb_mesh m = {.vertex_count = V, .triangle_count = f->header.triangle_count,
-                 .positions = (float *)f->positions, .normals = (float *)f->normals,
+    vb_mesh m = {.vertex_count = V,
+                 .triangle_count = f->header.triangle_count,
+                 .positions = (float *)f->positions,
+                 .normals = (float *)f->normals,
                  .indices = (uint32_t *)f->indices};
     vb_result r = vb_ray_origins(&m, d->scene, d->threads, e->vorigin, e->vnear, NULL, err);
     if (r != VB_OK)
@@ -954,9 +957,9 @@ static double mean_edge(const vdsh_file *f, uint32_t t)
     for (int k = 0; k < 3; k++) {
         const float *a = f->positions + 3 * (size_t)f->indices[3 * (size_t)t + k];
         const float *b = f->positions + 3 * (size_t)f->indices[3 * (size_t)t + (k + 1) % 3];
-        edges += sqrt(((double)a[0] - b[0]) * (a[0] - b[0]) +
-                      ((double)a[1] - b[1]) * (a[1] - b[1]) +
-                      ((double)a[2] - b[2]) * (a[2] - b[2]));
+        edges +=
+            sqrt(((double)a[0] - b[0]) * (a[0] - b[0]) + ((double)a[1] - b[1]) * (a[1] - b[1]) +
+                 ((double)a[2] - b[2]) * (a[2] - b[2]));
     }
     return edges / 3.0;
 }
@@ -974,8 +977,7 @@ static vb_result interior_receivers(eval_run *e, vb_error *err)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the triangle areas");
     for (uint32_t j = 0; j < d->interior && area > 0.0; j++) {
         receiver x = {.kind = VB_EVAL_INTERIOR, .index = j, .id = VB_EVAL_INTERIOR_ID(j)};
-        vb_eval_interior_point(e->cdf, f->header.triangle_count, d->seed, j, &x.triangle,
-                               x.bary);
+        vb_eval_interior_point(e->cdf, f->header.triangle_count, d->seed, j, &x.triangle, x.bary);
         vb_eval_interpolate(f, NULL, x.triangle, x.bary, x.position, x.normal, NULL);
         if (is_zero_normal(x.normal)) {
             e->skipped[VB_EVAL_INTERIOR]++;
@@ -1011,8 +1013,7 @@ static vb_result create_job(eval_run *e, vb_error *err)
     J->streams = S;
     J->acc = calloc((size_t)nr * (S ? S : 1) + 1, sizeof *J->acc);
     J->truth = calloc((size_t)nr + 1, sizeof *J->truth);
-    J->hist = calloc((size_t)d->threads * VB_EVAL_KINDS * (S ? S : 1) * HIST_BINS,
-                     sizeof *J->hist);
+    J->hist = calloc((size_t)d->threads * VB_EVAL_KINDS * (S ? S : 1) * HIST_BINS, sizeof *J->hist);
     if (!J->acc || !J->truth || !J->hist)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers", nr);
     return VB_OK;
@@ -1175,8 +1176,7 @@ static void run_free(eval_run *e)
     free(e->J);
 }
 
-vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
-                      vb_error *err)
+vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out, vb_error *err)
 {
     eval_run e = {.d = *desc};
     vb_result r;
@@ -1229,15 +1229,13 @@ char *vb_eval_find_source(const char *name, const char *vdsh_path)
     return NULL;
 }
 
-vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths,
-                               uint32_t count, const vb_eval_scene_desc *desc,
-                               vb_scene **out, vb_error *err)
+vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths, uint32_t count,
+                               const vb_eval_scene_desc *desc, vb_scene **out, vb_error *err)
 {
     vb_eval_scene_desc d = desc ? *desc : (vb_eval_scene_desc){0};
     if (count != f->source_count)
-        return vb_fail(err, VB_ERR_ARGUMENT,
-                       "%u mesh(es) given but the bake used %u source(s)", count,
-                       f->source_count);
+        return vb_fail(err, VB_ERR_ARGUMENT, "%u mesh(es) given but the bake used %u source(s)",
+                       count, f->source_count);
     if (count == 0)
         return vb_fail(err, VB_ERR_INVALID,
                        "the file records no source meshes: give the bake's meshes");
@@ -1274,14 +1272,13 @@ vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths,
         if (r != VB_OK)
             goto fail;
     }
-    if (!d.allow_mismatch &&
-        (occ.vertex_count != f->header.occluder_vertex_count ||
-         occ.triangle_count != f->header.occluder_triangle_count)) {
+    if (!d.allow_mismatch && (occ.vertex_count != f->header.occluder_vertex_count ||
+                              occ.triangle_count != f->header.occluder_triangle_count)) {
         r = vb_fail(err, VB_ERR_INVALID,
                     "the sources load as %u vertices and %u triangles, but the bake traced "
                     "%u and %u (the mesh loader changed since the bake?)",
-                    occ.vertex_count, occ.triangle_count,
-                    f->header.occluder_vertex_count, f->header.occluder_triangle_count);
+                    occ.vertex_count, occ.triangle_count, f->header.occluder_vertex_count,
+                    f->header.occluder_triangle_count);
         goto fail;
     }
     float lo[3], hi[3];
@@ -1290,8 +1287,8 @@ vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths,
                               memcmp(hi, f->header.bounds_max, sizeof hi) != 0)) {
         r = vb_fail(err, VB_ERR_INVALID,
                     "the sources' bounds (%g %g %g .. %g %g %g) differ from the bake's",
-                    (double)lo[0], (double)lo[1], (double)lo[2], (double)hi[0],
-                    (double)hi[1], (double)hi[2]);
+                    (double)lo[0], (double)lo[1], (double)lo[2], (double)hi[0], (double)hi[1],
+                    (double)hi[2]);
         goto fail;
     }
     vb_scene_desc sd = {.robust = !d.fast, .threads = d.threads};

@@ -87,7 +87,7 @@
 extern "C" {
 #endif
 
-#define VB_EVAL_DEFAULT_SEED 0x65766131u  /* "eva1"; the bake's default is 1 */
+#define VB_EVAL_DEFAULT_SEED 0x65766131u /* "eva1"; the bake's default is 1 */
 #define VB_EVAL_DEFAULT_DIRECTIONS 64u
 #define VB_EVAL_DEFAULT_WORST 10u
 #define VB_EVAL_MAX_WORST 64u
@@ -99,37 +99,37 @@ enum { VB_EVAL_VERTICES = 0, VB_EVAL_INTERIOR = 1, VB_EVAL_KINDS = 2 };
 /* Near-zero truth: below the receiver's near distance (origins.h); a
  * receiver is degenerate when this share of its truth is near zero (the
  * bake's rule). */
-#define VB_EVAL_DEGENERATE 0.9     /* of a receiver's directions */
+#define VB_EVAL_DEGENERATE 0.9 /* of a receiver's directions */
 
 enum { VB_EVAL_INTERP_RUNTIME = 0 };
 
 typedef struct vb_eval_desc {
-    const vdsh_file *file;     /* receivers and streams (borrowed) */
-    const vb_scene *scene;     /* occluders as the bake traced them (borrowed) */
-    uint64_t seed;             /* 0: VB_EVAL_DEFAULT_SEED. Mixed with a
+    const vdsh_file *file; /* receivers and streams (borrowed) */
+    const vb_scene *scene; /* occluders as the bake traced them (borrowed) */
+    uint64_t seed;         /* 0: VB_EVAL_DEFAULT_SEED. Mixed with a
                                   per-purpose constant, so even the bake's
                                   seed gives other directions */
-    uint32_t points;           /* vertices evaluated: a deterministic sample
+    uint32_t points;       /* vertices evaluated: a deterministic sample
                                   of this many; 0 or >= vertex_count: all */
-    uint32_t interior;         /* random interior points; 0: none */
-    uint32_t directions;       /* held-out directions per receiver, each with
+    uint32_t interior;     /* random interior points; 0: none */
+    uint32_t directions;   /* held-out directions per receiver, each with
                                   one light; 0: 64 (an 8 x 8 grid). Like the
                                   bake's --rays, rounded down to a grid */
-    uint32_t lights;           /* scene lights (VB_EVAL_SCENE_LIGHTS): how many
+    uint32_t lights;       /* scene lights (VB_EVAL_SCENE_LIGHTS): how many
                                   are placed in free space; 0: 32 */
-    int light_rule;            /* where (vb_light_rule, scene.h); 0: uniform */
-    uint32_t worst;            /* worst receivers kept per (kind, stream);
+    int light_rule;        /* where (vb_light_rule, scene.h); 0: uniform */
+    uint32_t worst;        /* worst receivers kept per (kind, stream);
                                   0: 10; at most VB_EVAL_MAX_WORST */
-    int oracle;                /* 1: score the truth itself (D := d_T) instead
+    int oracle;            /* 1: score the truth itself (D := d_T) instead
                                   of the streams: every error must be exactly
                                   0 (tests the scoring and the sampling) */
-    int per_vertex;            /* 1: fill result.per_vertex */
+    int per_vertex;        /* 1: fill result.per_vertex */
     /* How interior points get a stream's value from their triangle's
      * vertices (vdsh_shadow.h): VB_EVAL_INTERP_RUNTIME (0, the default) is
      * the path runtime/ draws that stream with (vdsh_runtime_interp), what a
      * viewer sees; or 1 + a vdsh_interp for the same mode on every stream. */
     uint32_t interp;
-    unsigned threads;          /* 0: every online core */
+    unsigned threads; /* 0: every online core */
     /* Called from the calling thread a few times a second with receivers
      * done and total. May be NULL. */
     void (*progress)(void *user, uint32_t done, uint32_t total);
@@ -138,40 +138,40 @@ typedef struct vb_eval_desc {
 
 /* A receiver worth a look: where it is and how bad. */
 typedef struct vb_eval_receiver {
-    uint32_t index;            /* vertex index, or interior point number */
-    uint32_t triangle;         /* interior: its triangle; vertex: UINT32_MAX */
-    float bary[3];             /* interior: barycentrics of the triangle's
+    uint32_t index;               /* vertex index, or interior point number */
+    uint32_t triangle;            /* interior: its triangle; vertex: UINT32_MAX */
+    float bary[3];                /* interior: barycentrics of the triangle's
                                   vertices a, b, c; vertex: 1, 0, 0 */
-    float position[3], normal[3];  /* scene units; interpolated normal */
-    double shadow_mae;         /* smooth, over its directions */
+    float position[3], normal[3]; /* scene units; interpolated normal */
+    double shadow_mae;            /* smooth, over its directions */
     double distance_rms;
-    double false_shadow;       /* NaN when it had no truly visible light */
-    double near_zero;          /* fraction of its truth at ~0 distance */
-    double escaped;            /* fraction of its truth rays that hit nothing */
+    double false_shadow; /* NaN when it had no truly visible light */
+    double near_zero;    /* fraction of its truth at ~0 distance */
+    double escaped;      /* fraction of its truth rays that hit nothing */
 } vb_eval_receiver;
 
 /* One stream scored on one kind of receiver. `_se` is the standard error
  * (receiver-clustered); a 95% interval is +-1.96 se. Rates are fractions. */
 typedef struct vb_eval_metrics {
-    uint64_t samples;          /* (receiver, direction) pairs */
+    uint64_t samples; /* (receiver, direction) pairs */
     double distance_rms, distance_rms_se;
     double distance_mean;
     double distance_p50, distance_p90, distance_p99;
     double shadow_mae, shadow_mae_se;
-    double false_shadow, false_shadow_se;   /* P(s_hat < .5 | d_T >= d_L) */
-    double light_leak, light_leak_se;       /* P(s_hat > .5 | s_ideal < .5) */
+    double false_shadow, false_shadow_se; /* P(s_hat < .5 | d_T >= d_L) */
+    double light_leak, light_leak_se;     /* P(s_hat > .5 | s_ideal < .5) */
     double binary_mae, binary_mae_se;
     double binary_false_shadow, binary_false_shadow_se;
     double binary_light_leak, binary_light_leak_se; /* given d_T < d_L */
-    double ringing;            /* fraction of samples whose SH sum was <= 0
+    double ringing;                                 /* fraction of samples whose SH sum was <= 0
                                   (negative ringing, read as distance 0) */
-    uint64_t visible;          /* samples with d_T >= d_L */
-    uint64_t occluded;         /* samples with s_ideal < 0.5 */
-    uint64_t occluded_binary;  /* samples with d_T < d_L */
+    uint64_t visible;                               /* samples with d_T >= d_L */
+    uint64_t occluded;                              /* samples with s_ideal < 0.5 */
+    uint64_t occluded_binary;                       /* samples with d_T < d_L */
     /* Per-receiver smooth shadow MAE: percentiles over receivers. */
     double receiver_mae_p50, receiver_mae_p90, receiver_mae_p99;
     uint32_t worst_count;
-    vb_eval_receiver worst[VB_EVAL_MAX_WORST];  /* by shadow MAE, worst first */
+    vb_eval_receiver worst[VB_EVAL_MAX_WORST]; /* by shadow MAE, worst first */
 } vb_eval_metrics;
 
 /* Scene lights, the primary shadow metric (docs/DESIGN.md §3): point
@@ -181,27 +181,27 @@ typedef struct vb_eval_metrics {
  * ray from the receiver toward the light, d_T (none before the light: the
  * light is visible). Rates are fractions. */
 typedef struct vb_eval_scene_metrics {
-    uint64_t pairs;            /* (receiver, light) pairs scored */
-    double shadow_mae, shadow_mae_se;       /* |s_hat - s_ideal|, smooth */
-    double false_shadow, false_shadow_se;   /* P(s_hat < .5 | d_T >= d_L) */
-    double recall, recall_se;               /* P(s_hat < .5 | s_ideal < .5):
+    uint64_t pairs;                       /* (receiver, light) pairs scored */
+    double shadow_mae, shadow_mae_se;     /* |s_hat - s_ideal|, smooth */
+    double false_shadow, false_shadow_se; /* P(s_hat < .5 | d_T >= d_L) */
+    double recall, recall_se;             /* P(s_hat < .5 | s_ideal < .5):
                                                the shadows drawn */
-    double light_leak, light_leak_se;       /* P(s_hat > .5 | s_ideal < .5) */
+    double light_leak, light_leak_se;     /* P(s_hat > .5 | s_ideal < .5) */
     double binary_mae;
-    double binary_false_shadow;             /* P(D < d_L | d_T >= d_L) */
-    double binary_recall;                   /* P(D < d_L | d_T < d_L) */
-    uint64_t visible;          /* pairs with d_T >= d_L */
-    uint64_t occluded;         /* pairs with s_ideal < 0.5 */
+    double binary_false_shadow; /* P(D < d_L | d_T >= d_L) */
+    double binary_recall;       /* P(D < d_L | d_T < d_L) */
+    uint64_t visible;           /* pairs with d_T >= d_L */
+    uint64_t occluded;          /* pairs with s_ideal < 0.5 */
 } vb_eval_scene_metrics;
 
 /* The truth's own record for one kind of receiver. */
 typedef struct vb_eval_truth {
-    uint32_t receivers;        /* evaluated */
-    uint32_t skipped;          /* undefined (zero) normal: no hemisphere */
-    uint64_t rays;             /* traced */
-    uint64_t escaped;          /* hit nothing within max_distance */
-    uint64_t near_zero;        /* d_T < 1e-3 diag */
-    uint32_t degenerate;       /* receivers with >= 90% near-zero truth */
+    uint32_t receivers;  /* evaluated */
+    uint32_t skipped;    /* undefined (zero) normal: no hemisphere */
+    uint64_t rays;       /* traced */
+    uint64_t escaped;    /* hit nothing within max_distance */
+    uint64_t near_zero;  /* d_T < 1e-3 diag */
+    uint32_t degenerate; /* receivers with >= 90% near-zero truth */
     uint32_t degenerate_listed;
     vb_eval_receiver degenerate_list[VB_EVAL_MAX_WORST]; /* first ones, by index */
     /* The receivers whose truth escapes most (escaped > 0 only), most
@@ -214,8 +214,8 @@ typedef struct vb_eval_truth {
 /* Fields of one per-vertex record (vb_eval_result.per_vertex): two for the
  * truth, then five per stream, in the file's stream order. */
 enum {
-    VB_EVAL_PV_NEAR_ZERO = 0,  /* fraction of the truth at ~0 distance */
-    VB_EVAL_PV_ESCAPED = 1,    /* fraction of truth rays that hit nothing */
+    VB_EVAL_PV_NEAR_ZERO = 0, /* fraction of the truth at ~0 distance */
+    VB_EVAL_PV_ESCAPED = 1,   /* fraction of truth rays that hit nothing */
     VB_EVAL_PV_TRUTH_FIELDS = 2,
     VB_EVAL_PV_DISTANCE_RMS = 0, /* + 2 + 5 * stream */
     VB_EVAL_PV_SHADOW_MAE = 1,
@@ -226,42 +226,41 @@ enum {
 };
 
 typedef struct vb_eval_result {
-    uint32_t stream_count;     /* = the file's; metrics[k][i] is stream i */
-    vb_eval_metrics *metrics[VB_EVAL_KINDS];  /* stream_count each: lights
+    uint32_t stream_count;                       /* = the file's; metrics[k][i] is stream i */
+    vb_eval_metrics *metrics[VB_EVAL_KINDS];     /* stream_count each: lights
                                   relative to each direction's truth
                                   (d_L = 2u d_T), the secondary metric */
     vb_eval_scene_metrics *scene[VB_EVAL_KINDS]; /* stream_count each: scene
                                   lights, the primary metric */
-    uint32_t light_count;      /* scene lights placed */
-    float (*lights)[3];        /* their positions, scene units */
-    uint32_t light_candidates; /* candidates tried to place them */
+    uint32_t light_count;                        /* scene lights placed */
+    float (*lights)[3];                          /* their positions, scene units */
+    uint32_t light_candidates;                   /* candidates tried to place them */
     vb_eval_truth truth[VB_EVAL_KINDS];
-    uint64_t seed;             /* as used */
-    uint32_t directions;       /* per receiver, as used */
-    float diagonal;            /* of the occluders' bounds (error floor 1%) */
-    float max_distance;        /* the file's clamp, also the truth's */
+    uint64_t seed;       /* as used */
+    uint32_t directions; /* per receiver, as used */
+    float diagonal;      /* of the occluders' bounds (error floor 1%) */
+    float max_distance;  /* the file's clamp, also the truth's */
     int oracle;
     unsigned threads;
-    double seconds;            /* wall time of the run */
+    double seconds; /* wall time of the run */
     /* With desc.per_vertex: vertex_count records of per_vertex_fields
      * floats (2 + 5 * stream_count), NaN for vertices not evaluated. */
     uint32_t per_vertex_fields;
     float *per_vertex;
 } vb_eval_result;
 
-vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out,
-                      vb_error *err);
+vb_result vb_eval_run(const vb_eval_desc *desc, vb_eval_result *out, vb_error *err);
 void vb_eval_result_free(vb_eval_result *r);
 
 /* ---- scene reconstruction --------------------------------------------- */
 
 typedef struct vb_eval_scene_desc {
-    int fast;                  /* 1: Embree's default traversal; 0 (default):
+    int fast;           /* 1: Embree's default traversal; 0 (default):
                                   RTC_SCENE_FLAG_ROBUST, so the truth does not
                                   leak through shared edges */
-    int allow_mismatch;        /* 1: a source whose SHA-256 or size differs
+    int allow_mismatch; /* 1: a source whose SHA-256 or size differs
                                   from the file's is used anyway */
-    unsigned threads;          /* Embree build threads; 0 = all cores */
+    unsigned threads;   /* Embree build threads; 0 = all cores */
     /* With allow_mismatch, called once per mismatching source. May be NULL. */
     void (*warn)(void *user, const char *message);
     void *warn_user;
@@ -274,9 +273,8 @@ typedef struct vb_eval_scene_desc {
  * totals against the file's occluder counts and bounds, then build the
  * scene. `desc` may be NULL (defaults). count must equal the file's
  * source_count. */
-vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths,
-                               uint32_t count, const vb_eval_scene_desc *desc,
-                               vb_scene **out, vb_error *err);
+vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths, uint32_t count,
+                               const vb_eval_scene_desc *desc, vb_scene **out, vb_error *err);
 
 /* Where source `name`, as a .vdsh records it, is now: "builtin:..." as it
  * is; a path as recorded (relative to the working directory), else beside
@@ -292,28 +290,25 @@ char *vb_eval_find_source(const char *name, const char *vdsh_path);
  * vertex values (f16 is decoded first, then mixed in float). `coeffs` gets
  * order^2 floats; any output may be NULL. tri < triangle_count. */
 void vb_eval_interpolate(const vdsh_file *f, const vdsh_stream *s, uint32_t tri,
-                         const float bary[3], float position[3],
-                         float normal[3], float *coeffs);
+                         const float bary[3], float position[3], float normal[3], float *coeffs);
 
 /* Interior point `j` of a run with this seed: its triangle (area-weighted
  * over the file's triangles) and barycentrics. `cdf` is the normalised
  * cumulative triangle area (vb_eval_area_cdf). Returns 0 when the mesh has
  * no area. */
-int vb_eval_interior_point(const double *cdf, uint32_t triangle_count,
-                           uint64_t seed, uint32_t j, uint32_t *tri,
-                           float bary[3]);
+int vb_eval_interior_point(const double *cdf, uint32_t triangle_count, uint64_t seed, uint32_t j,
+                           uint32_t *tri, float bary[3]);
 
 /* cdf[t] = area of triangles 0..t / total area (triangle_count doubles,
  * malloc'ed; NULL when out of memory). *total gets the total area. */
 double *vb_eval_area_cdf(const vdsh_file *f, double *total);
 
-
 /* The held-out directions of receiver `id` (a vertex index, or
  * VB_EVAL_INTERIOR_ID(j) for interior point j) with unit normal n: the
  * first `max` of the run's directions (d must hold 3 * max floats). Returns
  * how many the run uses per receiver. */
-uint32_t vb_eval_directions(uint64_t seed, uint32_t directions, uint32_t id,
-                            const float n[3], float *d, uint32_t max);
+uint32_t vb_eval_directions(uint64_t seed, uint32_t directions, uint32_t id, const float n[3],
+                            float *d, uint32_t max);
 #define VB_EVAL_INTERIOR_ID(j) (0x40000000u + (uint32_t)(j))
 
 /* The seed of one purpose's random stream (a tag such as "DIRS" as four

@@ -20,8 +20,8 @@
 #include "vdsh_shadow.h"
 
 #define NONE UINT32_MAX
-#define TILE 4               /* pixels a side: 16 rays, one packet */
-#define TILES_PER_BLOCK 16   /* work item of the pool */
+#define TILE 4             /* pixels a side: 16 rays, one packet */
+#define TILES_PER_BLOCK 16 /* work item of the pool */
 
 /* Every purpose gets its own random stream from the one seed. */
 enum {
@@ -41,8 +41,8 @@ void vb_frames_scene_destroy(vb_frames_scene *s)
     free(s);
 }
 
-vb_result vb_frames_scene_create(const vdsh_file *f, const vb_scene *occluders,
-                                 unsigned threads, vb_frames_scene **out, vb_error *err)
+vb_result vb_frames_scene_create(const vdsh_file *f, const vb_scene *occluders, unsigned threads,
+                                 vb_frames_scene **out, vb_error *err)
 {
     const vdsh_header *h = &f->header;
     if (h->triangle_count == 0 || h->vertex_count == 0)
@@ -69,8 +69,10 @@ vb_result vb_frames_scene_create(const vdsh_file *f, const vb_scene *occluders,
     /* The scene only reads the arrays (vb_scene_create copies them). The
      * robust traversal, as a rasteriser's coverage rules: no primary ray
      * slips between two triangles that share an edge. */
-    vb_mesh m = {.vertex_count = h->vertex_count, .triangle_count = h->triangle_count,
-                 .positions = (float *)f->positions, .normals = (float *)f->normals,
+    vb_mesh m = {.vertex_count = h->vertex_count,
+                 .triangle_count = h->triangle_count,
+                 .positions = (float *)f->positions,
+                 .normals = (float *)f->normals,
                  .indices = (uint32_t *)f->indices};
     vb_scene_desc sd = {.robust = 1, .threads = threads};
     vb_error e;
@@ -210,8 +212,7 @@ static int tiles(int width, int height, int *tiles_x)
 }
 
 vb_result vb_frames_trace_primary(const vb_frames_scene *s, const vdsh_camera *c, int width,
-                                  int height, unsigned threads, vb_frames_hits *out,
-                                  vb_error *err)
+                                  int height, unsigned threads, vb_frames_hits *out, vb_error *err)
 {
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
         return vb_fail(err, VB_ERR_ARGUMENT, "frame size %d x %d is not in 1..16384", width,
@@ -370,10 +371,9 @@ static void stream_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
             vdsh_stream_decode(st, ix[k], c[k]);
             pv[k] = f->positions + 3 * (size_t)ix[k];
         }
-        P->out_stream[i] = vdsh_shadow_interior(st->order, st->quantity,
-                                                f->header.max_distance, interp, cp, pv,
-                                                h->bary + 3 * (size_t)i, P->light, P->compare,
-                                                NULL);
+        P->out_stream[i] =
+            vdsh_shadow_interior(st->order, st->quantity, f->header.max_distance, interp, cp, pv,
+                                 h->bary + 3 * (size_t)i, P->light, P->compare, NULL);
     }
 }
 
@@ -386,9 +386,9 @@ static void stream_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
 typedef struct vertex_pass {
     const vdsh_file *f;
     const vdsh_stream *st;
-    const uint8_t *need;         /* per vertex: some pixel's triangle has it */
+    const uint8_t *need; /* per vertex: some pixel's triangle has it */
     const float *light;
-    float *dv;                   /* per vertex: its distance toward the light */
+    float *dv; /* per vertex: its distance toward the light */
 } vertex_pass;
 
 static void vertex_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
@@ -431,8 +431,8 @@ static void distance_block(void *ctx, uint32_t begin, uint32_t end, unsigned wor
             pv[k] = D->f->positions + 3 * (size_t)ix[k];
             dv[k] = D->dv[ix[k]];
         }
-        D->out[i] = vdsh_shadow_interior_distance(dv, pv, D->hits->bary + 3 * (size_t)i,
-                                                  D->light, D->compare, NULL);
+        D->out[i] = vdsh_shadow_interior_distance(dv, pv, D->hits->bary + 3 * (size_t)i, D->light,
+                                                  D->compare, NULL);
     }
 }
 
@@ -457,8 +457,7 @@ static vb_result eval_distance(const vb_frames_scene *s, const vb_frames_hits *h
         need[ix[0]] = need[ix[1]] = need[ix[2]] = 1;
     }
     vertex_pass V = {.f = f, .st = st, .need = need, .light = light, .dv = dv};
-    distance_pass D = {.f = f, .hits = h, .dv = dv, .light = light, .compare = compare,
-                       .out = out};
+    distance_pass D = {.f = f, .hits = h, .dv = dv, .light = light, .compare = compare, .out = out};
     if (!vb_parallel_for(threads, rows, 256, vertex_block, &V, NULL, NULL) ||
         !vb_parallel_for(threads, n, 1024, distance_block, &D, NULL, NULL))
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
@@ -468,9 +467,9 @@ done:
     return r;
 }
 
-vb_result vb_frames_eval_stream(const vb_frames_scene *s, const vb_frames_hits *h,
-                                uint32_t stream, const float light[3], uint32_t compare,
-                                unsigned threads, float *out, vb_error *err)
+vb_result vb_frames_eval_stream(const vb_frames_scene *s, const vb_frames_hits *h, uint32_t stream,
+                                const float light[3], uint32_t compare, unsigned threads,
+                                float *out, vb_error *err)
 {
     if (stream >= s->file->stream_count)
         return vb_fail(err, VB_ERR_ARGUMENT, "no stream %u (the file has %u)", stream,
@@ -481,9 +480,10 @@ vb_result vb_frames_eval_stream(const vb_frames_scene *s, const vb_frames_hits *
     if (st->flags & VDSH_STREAM_VARIABLE)
         return vb_fail(err, VB_ERR_ARGUMENT,
                        "stream %u: a variable-order stream of quantity %u is not drawn per "
-                       "vertex distance (only log-distance ones are)", stream, st->quantity);
-    pass P = {.s = s, .hits = h, .out_stream = out, .light = light, .compare = compare,
-              .stream = stream};
+                       "vertex distance (only log-distance ones are)",
+                       stream, st->quantity);
+    pass P = {
+        .s = s, .hits = h, .out_stream = out, .light = light, .compare = compare, .stream = stream};
     uint32_t n = (uint32_t)((size_t)h->width * (size_t)h->height);
     if (!vb_parallel_for(threads, n, 1024, stream_block, &P, NULL, NULL))
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
@@ -654,23 +654,22 @@ static vb_result default_camera(const vb_frames_scene *s, vdsh_camera *out, vb_e
 
 #define LIGHT_POOL 128u
 #define EYE_TRIES_PER_VIEW 400u
-#define CHECK_SIZE 64        /* the check frame's longer side, pixels */
-#define NEAREST_SHARE 0.05f  /* of the diagonal: no surface nearer to the eye */
+#define CHECK_SIZE 64       /* the check frame's longer side, pixels */
+#define NEAREST_SHARE 0.05f /* of the diagonal: no surface nearer to the eye */
 
 typedef struct view_check {
     const vb_frames_scene *s;
     const float (*pool)[3];
-    int width, height;       /* the check frame */
+    int width, height; /* the check frame */
     unsigned threads;
 } view_check;
 
 /* Light `light`'s shares of the check frame lit and hard-shadowed. */
-static vb_result light_shares(const view_check *V, const vb_frames_hits *h,
-                              const float light[3], float *lit, float *shadowed, vb_error *err)
+static vb_result light_shares(const view_check *V, const vb_frames_hits *h, const float light[3],
+                              float *lit, float *shadowed, vb_error *err)
 {
     vb_frames_light l = {0};
-    vb_result r = vb_frames_trace_light(V->s, h, light, VDSH_COMPARE_SMOOTH, V->threads, &l,
-                                        err);
+    vb_result r = vb_frames_trace_light(V->s, h, light, VDSH_COMPARE_SMOOTH, V->threads, &l, err);
     if (r != VB_OK)
         return r;
     size_t n = (size_t)h->width * (size_t)h->height, a = 0, b = 0;
@@ -718,8 +717,7 @@ static vb_result pick_lights(const view_check *V, const vb_frames_hits *h, uint3
         for (uint32_t j = 0; j < LIGHT_POOL; j++) {
             if (taken[j])
                 continue;
-            if (best == UINT32_MAX ||
-                fminf(lit[j], sh[j]) > fminf(lit[best], sh[best]))
+            if (best == UINT32_MAX || fminf(lit[j], sh[j]) > fminf(lit[best], sh[best]))
                 best = j;
         }
         taken[best] = 1;
@@ -731,8 +729,7 @@ static vb_result pick_lights(const view_check *V, const vb_frames_hits *h, uint3
 }
 
 vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_desc *desc,
-                               vb_frames_view *out, vb_frames_views_stats *stats,
-                               vb_error *err)
+                               vb_frames_view *out, vb_frames_views_stats *stats, vb_error *err)
 {
     vb_frames_views_desc d = *desc;
     if (d.cameras == 0)
@@ -754,7 +751,7 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
     V.height = V.height < 4 ? 4 : V.height;
 
     const vb_scene *occ = s->occluders;
-    float (*pool)[3] = malloc(LIGHT_POOL * sizeof *pool);
+    float(*pool)[3] = malloc(LIGHT_POOL * sizeof *pool);
     vb_frames_view *views = calloc(1 + (size_t)d.cameras, sizeof *views);
     vb_frames_hits h = {0};
     vb_result r = VB_OK;
@@ -852,8 +849,8 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
                     "views show at least %.0f%% of their pixels lit and as many "
                     "hard-shadowed by one light with no surface nearer than %.0f%% of the "
                     "diagonal; ask for fewer cameras or try another seed",
-                    have, d.cameras, st.eyes_tried, st.eyes_free,
-                    100.0 * VB_FRAMES_MIN_SHARE, 100.0 * NEAREST_SHARE);
+                    have, d.cameras, st.eyes_tried, st.eyes_free, 100.0 * VB_FRAMES_MIN_SHARE,
+                    100.0 * NEAREST_SHARE);
         goto done;
     }
     memcpy(out, views, (1 + (size_t)d.cameras) * sizeof *views);

@@ -95,39 +95,38 @@ extern "C" {
 #define VB_FRAMES_VIEW_LIGHTS 4
 
 typedef struct vb_frames_scene {
-    const vdsh_file *file;       /* borrowed */
-    const vb_scene *occluders;   /* borrowed */
-    vb_scene *receivers;         /* owned: the drawn mesh */
+    const vdsh_file *file;              /* borrowed */
+    const vb_scene *occluders;          /* borrowed */
+    vb_scene *receivers;                /* owned: the drawn mesh */
     float bounds_min[3], bounds_max[3]; /* of the receivers (the runtime's) */
-    float diagonal;              /* of the receivers' bounds */
+    float diagonal;                     /* of the receivers' bounds */
 } vb_frames_scene;
 
-vb_result vb_frames_scene_create(const vdsh_file *f, const vb_scene *occluders,
-                                 unsigned threads, vb_frames_scene **out, vb_error *err);
+vb_result vb_frames_scene_create(const vdsh_file *f, const vb_scene *occluders, unsigned threads,
+                                 vb_frames_scene **out, vb_error *err);
 void vb_frames_scene_destroy(vb_frames_scene *s);
 
 /* What each pixel's primary ray meets; arrays of width * height (times 3),
  * row 0 at the top. */
 typedef struct vb_frames_hits {
     int width, height;
-    uint32_t *triangle;          /* UINT32_MAX: nothing */
-    float *bary;                 /* 3 per pixel */
-    float *position;             /* 3 per pixel, scene units */
-    float *normal;               /* 3: interpolated vertex normal, unit (0: cancels) */
-    float *origin;               /* 3: shadow-ray origin, occluders' traced frame */
-    float *depth;                /* distance from the eye (INFINITY: nothing) */
+    uint32_t *triangle; /* UINT32_MAX: nothing */
+    float *bary;        /* 3 per pixel */
+    float *position;    /* 3 per pixel, scene units */
+    float *normal;      /* 3: interpolated vertex normal, unit (0: cancels) */
+    float *origin;      /* 3: shadow-ray origin, occluders' traced frame */
+    float *depth;       /* distance from the eye (INFINITY: nothing) */
 } vb_frames_hits;
 
 /* width and height 1..16384. */
 vb_result vb_frames_trace_primary(const vb_frames_scene *s, const vdsh_camera *c, int width,
-                                  int height, unsigned threads, vb_frames_hits *out,
-                                  vb_error *err);
+                                  int height, unsigned threads, vb_frames_hits *out, vb_error *err);
 void vb_frames_hits_free(vb_frames_hits *h);
 
 /* The truth of one light (scene units) at every pixel of h. */
 typedef struct vb_frames_light {
-    float *hard, *ideal, *mask;  /* width * height each */
-    float *dt;                   /* d_T (INFINITY: visible / nothing hit) */
+    float *hard, *ideal, *mask; /* width * height each */
+    float *dt;                  /* d_T (INFINITY: visible / nothing hit) */
 } vb_frames_light;
 
 vb_result vb_frames_trace_light(const vb_frames_scene *s, const vb_frames_hits *h,
@@ -137,9 +136,9 @@ void vb_frames_light_free(vb_frames_light *l);
 
 /* Stream `stream` of the file, evaluated on the runtime's path toward the
  * light at every pixel of h, into out (width * height floats). */
-vb_result vb_frames_eval_stream(const vb_frames_scene *s, const vb_frames_hits *h,
-                                uint32_t stream, const float light[3], uint32_t compare,
-                                unsigned threads, float *out, vb_error *err);
+vb_result vb_frames_eval_stream(const vb_frames_scene *s, const vb_frames_hits *h, uint32_t stream,
+                                const float light[3], uint32_t compare, unsigned threads,
+                                float *out, vb_error *err);
 
 /* The runtime's colour output (runtime/vr_glsl.c) for white point lights:
  *   albedo * (ambient + sum_i intensity * max(N . l_i, 0) * att_i * vis_i)
@@ -147,10 +146,10 @@ vb_result vb_frames_eval_stream(const vb_frames_scene *s, const vb_frames_hits *
  * RGBA (grey, alpha 255; black where nothing is hit). vis[i] holds light
  * i's visibility per pixel. */
 typedef struct vb_frames_shading {
-    float albedo;                /* 0.8, the runtime's default */
-    float ambient;               /* 0.03, vdsh-view's default */
-    float intensity;             /* per light */
-    float radius;                /* r of the attenuation */
+    float albedo;    /* 0.8, the runtime's default */
+    float ambient;   /* 0.03, vdsh-view's default */
+    float intensity; /* per light */
+    float radius;    /* r of the attenuation */
 } vb_frames_shading;
 
 /* vdsh-view's defaults for n lights: intensity 1.6 / (1 + 0.6 (n - 1))
@@ -174,12 +173,12 @@ typedef struct vb_frames_tally {
 } vb_frames_tally;
 
 typedef struct vb_frames_scores {
-    double rmse_ideal, psnr_ideal;   /* PSNR +INFINITY for no error */
+    double rmse_ideal, psnr_ideal; /* PSNR +INFINITY for no error */
     double rmse_hard, psnr_hard;
-    double recall;                   /* NaN: nothing shadowed */
-    double false_area;               /* NaN: nothing lit */
+    double recall;     /* NaN: nothing shadowed */
+    double false_area; /* NaN: nothing lit */
     uint64_t blotches;
-    double blotch_area;              /* blotch pixels / frame pixels */
+    double blotch_area; /* blotch pixels / frame pixels */
 } vb_frames_scores;
 
 /* Add one frame (s: the frame scored; hard, ideal, mask: the truth; all
@@ -203,24 +202,23 @@ typedef struct vb_frames_view {
 } vb_frames_view;
 
 typedef struct vb_frames_views_desc {
-    uint32_t cameras;            /* views besides the default; 0: 6 */
-    uint64_t seed;               /* 0: 1 */
-    int width, height;           /* the frames' size (only the aspect
+    uint32_t cameras;  /* views besides the default; 0: 6 */
+    uint64_t seed;     /* 0: 1 */
+    int width, height; /* the frames' size (only the aspect
                                     matters here); 0: 512 x 384 */
     unsigned threads;
 } vb_frames_views_desc;
 
 typedef struct vb_frames_views_stats {
-    uint32_t eyes_tried;         /* candidate eyes drawn */
-    uint32_t eyes_free;          /* of those in free space */
-    uint32_t default_lights_ok;  /* default view's lights meeting the share */
+    uint32_t eyes_tried;        /* candidate eyes drawn */
+    uint32_t eyes_free;         /* of those in free space */
+    uint32_t default_lights_ok; /* default view's lights meeting the share */
 } vb_frames_views_stats;
 
 /* 1 + cameras views into out (caller's array). VB_ERR_INVALID when the
  * scene does not give that many views (the message says how many). */
 vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_desc *d,
-                               vb_frames_view *out, vb_frames_views_stats *stats,
-                               vb_error *err);
+                               vb_frames_view *out, vb_frames_views_stats *stats, vb_error *err);
 
 #ifdef __cplusplus
 }

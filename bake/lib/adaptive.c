@@ -86,8 +86,8 @@ static float fit_shadow(const shadow_fit *s, int order, uint32_t quantity, const
     if (s->c)
         return vdsh_shadow((uint32_t)order, quantity, s->max_distance, s->c, p, L,
                            VDSH_COMPARE_SMOOTH);
-    return vdsh_shadow_interior((uint32_t)order, quantity, s->max_distance, s->interp,
-                                s->corners, s->pv, s->bary, L, VDSH_COMPARE_SMOOTH, NULL);
+    return vdsh_shadow_interior((uint32_t)order, quantity, s->max_distance, s->interp, s->corners,
+                                s->pv, s->bary, L, VDSH_COMPARE_SMOOTH, NULL);
 }
 
 /* The mean |shadow a - shadow b| at p (normal n) over the lights above its
@@ -113,16 +113,16 @@ static double mean_shadow_gap(int order, uint32_t quantity, const float (*lights
 
 /* Scoring the candidates of one round. */
 typedef struct score_job {
-    const vb_mesh *fine;        /* the tentative mesh: candidate i is vertex base + i */
+    const vb_mesh *fine; /* the tentative mesh: candidate i is vertex base + i */
     uint32_t base;
     const uint64_t *edges;
-    const vb_bake_output *b;    /* the midpoints' bake: range base.., candidate i's row i */
-    const float *coarse_c;      /* the ends' coefficients (order `order`), vertex-major */
+    const vb_bake_output *b; /* the midpoints' bake: range base.., candidate i's row i */
+    const float *coarse_c;   /* the ends' coefficients (order `order`), vertex-major */
     int order;
     uint32_t quantity, interp;
     const float (*lights)[3];
     uint32_t light_count;
-    double *error;              /* per candidate */
+    double *error; /* per candidate */
 } score_job;
 
 static void score_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
@@ -143,10 +143,13 @@ static void score_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker
                               J->fine->positions + 3 * (size_t)e,
                               J->fine->positions + 3 * (size_t)e};
         const shadow_fit mid = {.c = cm, .max_distance = J->b->max_distance};
-        const shadow_fit ends = {.corners = c, .pv = pv, .bary = b, .interp = J->interp,
+        const shadow_fit ends = {.corners = c,
+                                 .pv = pv,
+                                 .bary = b,
+                                 .interp = J->interp,
                                  .max_distance = J->b->max_distance};
-        J->error[i] = mean_shadow_gap(J->order, J->quantity, J->lights, J->light_count, p, n,
-                                      &mid, &ends, 0.0);
+        J->error[i] = mean_shadow_gap(J->order, J->quantity, J->lights, J->light_count, p, n, &mid,
+                                      &ends, 0.0);
     }
 }
 
@@ -162,8 +165,8 @@ static double edge_len2(const vb_mesh *m, uint64_t key)
 
 /* Append `count` rows of `width` floats from src (rows rows[i] - first:
  * src's first row is row `first`) to *dst, which holds `have` rows. */
-static int append_rows(float **dst, uint32_t have, const float *src, uint32_t first,
-                       size_t width, const uint32_t *rows, uint32_t count)
+static int append_rows(float **dst, uint32_t have, const float *src, uint32_t first, size_t width,
+                       const uint32_t *rows, uint32_t count)
 {
     float *p = realloc(*dst, ((size_t)have + count) * width * sizeof *p + 1);
     if (!p)
@@ -195,7 +198,7 @@ typedef struct noise_job {
     uint32_t quantity;
     const float (*lights)[3];
     uint32_t light_count;
-    double *spread;           /* per sample; -1: no light above its horizon */
+    double *spread; /* per sample; -1: no light above its horizon */
 } noise_job;
 
 static void noise_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
@@ -206,8 +209,8 @@ static void noise_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker
     for (uint32_t k = begin; k < end; k++) {
         const uint32_t v = J->sample[k];
         const float *p = J->m->positions + 3 * (size_t)v;
-        const float *n = J->b->normals ? J->b->normals + 3 * (size_t)v
-                                       : J->m->normals + 3 * (size_t)v;
+        const float *n =
+            J->b->normals ? J->b->normals + 3 * (size_t)v : J->m->normals + 3 * (size_t)v;
         const float *c1 = J->b->coeffs[J->order] + nc * v;
         const float *c2 = J->b2->coeffs[J->order] + nc * (J->n - 1 - k); /* reversed */
         const shadow_fit first = {.c = c1, .max_distance = J->b->max_distance};
@@ -275,9 +278,16 @@ static vb_result noise_floor(const vb_bake_desc *bd0, const vb_mesh *M, const vb
     acc->rays_traced += R.rays_traced;
     acc->rays_missed += R.rays_missed;
     acc->seconds += R.seconds;
-    noise_job nj = {.m = M, .sample = sample, .n = n, .b = B, .b2 = &R, .order = order,
-                    .quantity = B->quantity[order], .lights = lights,
-                    .light_count = light_count, .spread = spread};
+    noise_job nj = {.m = M,
+                    .sample = sample,
+                    .n = n,
+                    .b = B,
+                    .b2 = &R,
+                    .order = order,
+                    .quantity = B->quantity[order],
+                    .lights = lights,
+                    .light_count = light_count,
+                    .spread = spread};
     if (vb_parallel_for(B->threads, n, 64, noise_block, &nj, NULL, NULL) == 0) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
         goto done;
@@ -301,8 +311,8 @@ done:
 }
 
 vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
-                           const vb_adaptive_desc *ad, vb_mesh *receivers,
-                           vb_bake_output *out, vb_adaptive_stats *stats, vb_error *err)
+                           const vb_adaptive_desc *ad, vb_mesh *receivers, vb_bake_output *out,
+                           vb_adaptive_stats *stats, vb_error *err)
 {
     if (!(ad->tolerance >= 0.0f))
         return vb_fail(err, VB_ERR_ARGUMENT, "adaptive: the tolerance must be a number >= 0");
@@ -321,7 +331,7 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
     double *error = NULL;
     vb_ranked *rank = NULL;
     uint32_t *rows = NULL, *pairs = NULL; /* per round: new rows; the candidates' ends */
-    float (*lights)[3] = NULL;
+    float(*lights)[3] = NULL;
     const double t_start = vb_now();
     vb_result r = vb_mesh_refine(start, 0.0f, &M, err); /* a copy */
     if (r != VB_OK)
@@ -381,8 +391,8 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         }
         free(cand);
         cand = NULL;
-        if ((r = candidate_edges(&M, 2.0f * ad->min_edge, judged, judged_n, &cand, &cand_n,
-                                 err)) != VB_OK)
+        if ((r = candidate_edges(&M, 2.0f * ad->min_edge, judged, judged_n, &cand, &cand_n, err)) !=
+            VB_OK)
             goto done;
         if (cand_n == 0)
             break;
@@ -457,10 +467,16 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
             goto done;
         }
-        score_job sj = {.fine = &T, .base = V, .edges = cand, .b = &R,
-                        .coarse_c = B.coeffs[order], .order = order,
-                        .quantity = quantity[order], .interp = interp,
-                        .lights = (const float(*)[3])lights, .light_count = st.lights,
+        score_job sj = {.fine = &T,
+                        .base = V,
+                        .edges = cand,
+                        .b = &R,
+                        .coarse_c = B.coeffs[order],
+                        .order = order,
+                        .quantity = quantity[order],
+                        .interp = interp,
+                        .lights = (const float(*)[3])lights,
+                        .light_count = st.lights,
                         .error = error};
         if (vb_parallel_for(B.threads, (uint32_t)cand_n, 64, score_block, &sj, NULL, NULL) == 0) {
             r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
@@ -515,8 +531,8 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
         int ok = 1;
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (B.coeffs[o])
-                ok &= append_rows(&B.coeffs[o], V, R.coeffs[o], R.range_begin, (size_t)o * o,
-                                  rows, s); /* R holds the midpoints' rows only */
+                ok &= append_rows(&B.coeffs[o], V, R.coeffs[o], R.range_begin, (size_t)o * o, rows,
+                                  s); /* R holds the midpoints' rows only */
         if (B.normals)
             ok &= append_rows(&B.normals, V, R.normals, R.range_begin, 3, rows, s);
         if (!ok) {
@@ -541,8 +557,8 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
          * edges the next round would have judged. */
         free(cand);
         cand = NULL;
-        if ((r = candidate_edges(&M, 2.0f * ad->min_edge, judged, judged_n, &cand, &cand_n,
-                                 err)) != VB_OK)
+        if ((r = candidate_edges(&M, 2.0f * ad->min_edge, judged, judged_n, &cand, &cand_n, err)) !=
+            VB_OK)
             goto done;
         st.pending = (uint32_t)cand_n;
         st.rounds_reached = cand_n > 0;

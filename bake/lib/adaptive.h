@@ -76,24 +76,24 @@ typedef struct vb_adaptive_desc {
 } vb_adaptive_desc;
 
 typedef struct vb_adaptive_stats {
-    uint32_t start_receivers;  /* the start mesh's vertices */
-    uint32_t rounds;           /* rounds that baked midpoints */
-    uint32_t candidates;       /* midpoints baked (split or not) */
-    uint32_t lights;           /* lights the error was scored with */
-    uint32_t max_rounds;       /* the round limit used */
-    int budget_reached;        /* the receiver budget stopped it */
-    int rounds_reached;        /* the round limit stopped it while its last round
+    uint32_t start_receivers;   /* the start mesh's vertices */
+    uint32_t rounds;            /* rounds that baked midpoints */
+    uint32_t candidates;        /* midpoints baked (split or not) */
+    uint32_t lights;            /* lights the error was scored with */
+    uint32_t max_rounds;        /* the round limit used */
+    int budget_reached;         /* the receiver budget stopped it */
+    int rounds_reached;         /* the round limit stopped it while its last round
                                 * still split edges */
-    uint32_t last_split;       /* edges the last round split */
-    uint32_t pending;          /* with rounds_reached: edges not yet judged, long
+    uint32_t last_split;        /* edges the last round split */
+    uint32_t pending;           /* with rounds_reached: edges not yet judged, long
                                 * enough to split (the next round's midpoints) */
     uint32_t uniform_receivers; /* the uniform refinement of the start mesh to
                                  * 2 min_edge: the cap on every vertex baked
                                  * (0: over vb_mesh_refine's limit, no cap) */
-    int uniform_reached;       /* that cap stopped it */
-    uint32_t noise_sample;     /* start receivers baked twice for the noise floor */
-    double noise_floor;        /* their two bakes' spread (quantile) */
-    double threshold;          /* what an edge's error had to pass: tolerance +
+    int uniform_reached;        /* that cap stopped it */
+    uint32_t noise_sample;      /* start receivers baked twice for the noise floor */
+    double noise_floor;         /* their two bakes' spread (quantile) */
+    double threshold;           /* what an edge's error had to pass: tolerance +
                                 * noise floor */
 } vb_adaptive_stats;
 
@@ -103,8 +103,8 @@ typedef struct vb_adaptive_stats {
  * rays_traced and the times sum every round, midpoints not kept and the
  * noise floor's second bakes included). stats may be NULL. */
 vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
-                           const vb_adaptive_desc *ad, vb_mesh *receivers,
-                           vb_bake_output *out, vb_adaptive_stats *stats, vb_error *err);
+                           const vb_adaptive_desc *ad, vb_mesh *receivers, vb_bake_output *out,
+                           vb_adaptive_stats *stats, vb_error *err);
 
 #ifdef __cplusplus
 }

@@ -44,34 +44,34 @@ typedef struct job {
      * set_before.. of it. */
     const uint32_t *set;
     uint32_t set_count, set_before;
-    const float *origins;  /* per slot, traced frame */
-    const float *near;     /* per slot: ~0 distance, scene units */
-    const float *normals;  /* per slot: oriented; NULL: the receivers' own */
-    float *coeffs[VDSH_ORDER_SLOTS]; /* rows lo..hi-1 (the range's) */
+    const float *origins;                /* per slot, traced frame */
+    const float *near;                   /* per slot: ~0 distance, scene units */
+    const float *normals;                /* per slot: oriented; NULL: the receivers' own */
+    float *coeffs[VDSH_ORDER_SLOTS];     /* rows lo..hi-1 (the range's) */
     uint32_t quantity[VDSH_ORDER_SLOTS]; /* per order: what coeffs hold */
     vb_fit fits[VDSH_ORDER_SLOTS];
-    int order;             /* the projection's order (the highest asked) */
+    int order; /* the projection's order (the highest asked) */
     float log_floor;
-    float max_local;       /* max distance in the traced frame */
+    float max_local; /* max distance in the traced frame */
     float inv_scale;
-    int horizon;           /* paper: skip w.n < 0 */
+    int horizon; /* paper: skip w.n < 0 */
     /* Method shadow: per order, added to the fitted ln d (through c0). */
     float log_offset[VDSH_ORDER_SLOTS];
     /* Adaptive order: the log offset of each candidate order's lsq fit
      * (the method's; with method decision, shadow's: its variable-order
      * stream is method shadow's). */
     float var_offset[VDSH_ORDER_SLOTS];
-    double *error_table;   /* e(r), the quantity choice's score (VB_ERROR_TABLE + 1) */
+    double *error_table; /* e(r), the quantity choice's score (VB_ERROR_TABLE + 1) */
     /* The quantity choice (VB_QUANTITY_AUTO): sampled receivers, and per
      * sample, order and quantity (0 distance, 1 log) its estimated error. */
     uint32_t choose_count;
-    double *choose_error;  /* choose_count * (VDSH_ORDER_SLOTS) * 2 */
-    float *choose_coeffs;  /* per sample, quantity and order: its fit */
-    uint8_t *done;         /* per receiver of the range (v - lo): baked by the
+    double *choose_error; /* choose_count * (VDSH_ORDER_SLOTS) * 2 */
+    float *choose_coeffs; /* per sample, quantity and order: its fit */
+    uint8_t *done;        /* per receiver of the range (v - lo): baked by the
                             * choice already (or NULL) */
-    int adaptive;          /* adaptive rays: grid is nested */
-    float ray_tol;         /* their tolerance (0: every round) */
-    uint32_t lo, hi;       /* the range baked (vb_bake_desc.range_*) */
+    int adaptive;         /* adaptive rays: grid is nested */
+    float ray_tol;        /* their tolerance (0: every round) */
+    uint32_t lo, hi;      /* the range baked (vb_bake_desc.range_*) */
     /* Adaptive order (order_tolerance > 0): the cap (0: none), the
      * lights' positions (scene units) and the range's orders and
      * coefficients (cap^2 per receiver). */
@@ -81,7 +81,7 @@ typedef struct job {
     uint32_t light_count;
     uint8_t *var_orders;
     float *var_coeffs;
-    float *var_scratch;    /* per worker: var_scratch_floats */
+    float *var_scratch; /* per worker: var_scratch_floats */
     /* The decision fit (method.h: decision): the light pool in the traced
      * frame, lights per receiver, the fit's settings, per-worker scratch
      * (dec_scratch_bytes); the calibration's held-out margins (per sample,
@@ -98,15 +98,14 @@ typedef struct job {
     _Atomic uint32_t degenerate;
 } job;
 
-
 /* Where one receiver's results go: per quantity (0 distance, 1 log) and
  * order, its coefficients or NULL; and, when `n` is not NULL, the traced
  * directions above its horizon with their distances (scene units). */
 typedef struct vertex_sink {
     float *coeffs[2][VDSH_ORDER_SLOTS];
-    float *var_scratch;    /* adaptive order: the worker's (VAR_SCRATCH floats) */
+    float *var_scratch;         /* adaptive order: the worker's (VAR_SCRATCH floats) */
     unsigned char *dec_scratch; /* decision fit: the worker's */
-    float *cal;            /* decision calibration: margins, VDSH_ORDER_SLOTS x CAL_LIGHTS */
+    float *cal;                 /* decision calibration: margins, VDSH_ORDER_SLOTS x CAL_LIGHTS */
     float *x, *y, *z, *t;
     uint32_t *n;
 } vertex_sink;
@@ -117,7 +116,10 @@ typedef struct vertex_sink {
  * the series of 2 atanh(s), s = (m - 1)/(m + 1), |s| <= 0.172. */
 static inline float fast_log(float x)
 {
-    union { float f; uint32_t u; } v = {x};
+    union {
+        float f;
+        uint32_t u;
+    } v = {x};
     int32_t e = (int32_t)((v.u >> 23) & 0xffu) - 127;
     v.u = (v.u & 0x007fffffu) | 0x3f800000u; /* m in [1, 2) */
     float m = v.f;
@@ -138,9 +140,14 @@ static inline float fast_exp(float x)
     float t = x * 1.44269504f; /* log2 e */
     int i = (int)(t + (t >= 0.0f ? 0.5f : -0.5f));
     float r = (t - (float)i) * 0.693147181f; /* |r| <= ln2 / 2 */
-    float p = 1.0f + r * (1.0f + r * (0.5f + r * (1.0f / 6 + r * (1.0f / 24 + r * (1.0f / 120 +
-                                                                          r * (1.0f / 720))))));
-    union { uint32_t u; float f; } b = {(uint32_t)(i + 127) << 23};
+    float p =
+        1.0f +
+        r * (1.0f +
+             r * (0.5f + r * (1.0f / 6 + r * (1.0f / 24 + r * (1.0f / 120 + r * (1.0f / 720))))));
+    union {
+        uint32_t u;
+        float f;
+    } b = {(uint32_t)(i + 127) << 23};
     return p * b.f;
 }
 
@@ -161,13 +168,13 @@ int vb_order_candidate(int k, int cap)
  * the tolerance is kept, else the one of least error. Sums run in a fixed
  * order in float (no libm), so the choice is the same on every CPU and
  * for any thread count. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) &&                             \
     !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("avx2", "default")))
 #endif
-static void choose_order(const job *J, uint32_t v, const vb_fit_angles *a, const double *u,
-                         const float *tx, const float *ty, const float *tz, const float *tt,
-                         uint32_t count, float *scratch)
+static void
+choose_order(const job *J, uint32_t v, const vb_fit_angles *a, const double *u, const float *tx,
+             const float *ty, const float *tz, const float *tt, uint32_t count, float *scratch)
 {
     enum { M = VB_ORDER_DIRECTIONS, L = VB_ORDER_LIGHTS };
     const int cap = J->var_cap;
@@ -348,9 +355,15 @@ static uint32_t dec_pairs(const job *J, uint32_t *at, uint32_t *scanned, const f
         if (!(len > 0.0f))
             continue;
         float inv = 1.0f / len;
-        struct RTCRay r = {.org_x = org[0], .org_y = org[1], .org_z = org[2],
-                           .dir_x = dx * inv, .dir_y = dy * inv, .dir_z = dz * inv,
-                           .tnear = 0.0f, .tfar = len, .mask = 0xffffffffu};
+        struct RTCRay r = {.org_x = org[0],
+                           .org_y = org[1],
+                           .org_z = org[2],
+                           .dir_x = dx * inv,
+                           .dir_y = dy * inv,
+                           .dir_z = dz * inv,
+                           .tnear = 0.0f,
+                           .tfar = len,
+                           .mask = 0xffffffffu};
         rtcOccluded1(J->d->scene->scene, &ctx, &r);
         ++*traced;
         x[m] = r.dir_x, y[m] = r.dir_y, z[m] = r.dir_z;
@@ -422,18 +435,19 @@ static void decision_vertex(job *J, uint32_t v, const float *org, const float n[
 
 /* An AVX2 clone where the CPU has it, for the lane loops (the log's
  * division above all): no FMA, so the same bits either way. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) &&                             \
     !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("avx2", "default")))
 #endif
-static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced,
-                        uint64_t *missed, uint32_t *degenerate)
+static void
+bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64_t *missed,
+            uint32_t *degenerate)
 {
     const vb_bake_desc *d = J->d;
     const vb_scene *S = d->scene;
     const uint32_t slot = slot_of(J, v);
-    const float *n = J->normals ? J->normals + 3 * (size_t)slot
-                                : d->receivers->normals + 3 * (size_t)v;
+    const float *n =
+        J->normals ? J->normals + 3 * (size_t)slot : d->receivers->normals + 3 * (size_t)v;
     const float *org = J->origins + 3 * (size_t)slot;
     static const float pole[3] = {0.0f, 0.0f, 1.0f};
     if (J->grid->hemisphere && n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f)
@@ -480,160 +494,160 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
         az = ay + J->grid->count;
     }
     for (uint32_t round = 0, pk = 0; round < rounds; round++) {
-    const uint32_t pk_end = J->adaptive ? J->grid->round_end[round] : J->grid->packet_count;
-    for (; pk < pk_end;) {
-        struct RTCRayHit16 rh[GROUP] __attribute__((aligned(64)));
-        int valid[GROUP][VB_PACKET] __attribute__((aligned(64)));
-        int np = 0;
-        for (; pk < pk_end && np < GROUP; pk++) {
-            if (J->horizon && !J->adaptive && vb_dirgrid_packet_below(J->grid, pk, n))
-                continue;
-            struct RTCRayHit16 *r = &rh[np];
-            int *ok = valid[np];
-            if (J->adaptive)
-                vb_dirgrid_packet_nested(J->grid, pk, d->seed, v, n, r->ray.dir_x,
-                                         r->ray.dir_y, r->ray.dir_z, ok);
-            else
-                vb_dirgrid_packet(J->grid, pk, d->seed, v, n, r->ray.dir_x, r->ray.dir_y,
-                                  r->ray.dir_z, ok);
-            int any = 0;
-            for (int k = 0; k < VB_PACKET; k++) {
-                if (J->horizon && ok[k]) {
-                    float c = r->ray.dir_x[k] * n[0] + r->ray.dir_y[k] * n[1] +
-                              r->ray.dir_z[k] * n[2];
-                    if (c < 0.0f)
-                        ok[k] = 0;
-                }
-                any |= ok[k];
-                r->ray.org_x[k] = org[0];
-                r->ray.org_y[k] = org[1];
-                r->ray.org_z[k] = org[2];
-                r->ray.tnear[k] = 0.0f;
-                r->ray.tfar[k] = J->max_local;
-                r->ray.time[k] = 0.0f;
-                r->ray.mask[k] = 0xffffffffu;
-                r->ray.id[k] = (unsigned)k;
-                r->ray.flags[k] = 0;
-                r->hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-                r->hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-            }
-            if (!any)
-                continue;
-            rtcIntersect16(ok, S->scene, &ctx, r);
-            for (int k = 0; k < VB_PACKET; k++)
-                *traced += ok[k] != 0;
-            np++;
-        }
-        if (d->trace_only)
-            continue;
-
-        /* Branch-free over the lanes, so it vectorises. Lanes not traced
-         * (empty, or below the horizon) count as distance 0. */
-        float dist[GROUP][VB_PACKET], logd[GROUP][VB_PACKET];
-        int up_lane[GROUP][VB_PACKET];
-        for (int p = 0; p < np; p++) {
-            int miss = 0, upper_pk = 0, near_pk = 0;
-            const int *ok = valid[p];
-            const uint32_t *gid = rh[p].hit.geomID;
-            const float *tfar = rh[p].ray.tfar, *dx = rh[p].ray.dir_x, *dy = rh[p].ray.dir_y,
-                        *dz = rh[p].ray.dir_z;
-            for (int k = 0; k < VB_PACKET; k++) {
-                /* Selects as arithmetic (exact for these finite values), in
-                 * int: GCC if-converts and vectorises this loop only so. */
-                int live = ok[k] & 1; /* valid: 0 or -1 */
-                int hit = gid[k] != RTC_INVALID_GEOMETRY_ID;
-                float fh = (float)hit, fl = (float)live;
-                float t = tfar[k] * inv_scale * fh + max_distance * (1.0f - fh);
-                float c = dx[k] * nx + dy[k] * ny + dz[k] * nz;
-                int up = live & (c > 0.0f);
-                dist[p][k] = t * fl;
-                up_lane[p][k] = up;
-                miss += live & (hit ^ 1);
-                upper_pk += up;
-                near_pk += up & (t < degenerate_dist);
-            }
-            upper += (uint32_t)upper_pk;
-            near_zero += (uint32_t)near_pk;
-            *missed += (uint64_t)miss;
-        }
-        if (want[1])
-            for (int p = 0; p < np; p++)
+        const uint32_t pk_end = J->adaptive ? J->grid->round_end[round] : J->grid->packet_count;
+        for (; pk < pk_end;) {
+            struct RTCRayHit16 rh[GROUP] __attribute__((aligned(64)));
+            int valid[GROUP][VB_PACKET] __attribute__((aligned(64)));
+            int np = 0;
+            for (; pk < pk_end && np < GROUP; pk++) {
+                if (J->horizon && !J->adaptive && vb_dirgrid_packet_below(J->grid, pk, n))
+                    continue;
+                struct RTCRayHit16 *r = &rh[np];
+                int *ok = valid[np];
+                if (J->adaptive)
+                    vb_dirgrid_packet_nested(J->grid, pk, d->seed, v, n, r->ray.dir_x, r->ray.dir_y,
+                                             r->ray.dir_z, ok);
+                else
+                    vb_dirgrid_packet(J->grid, pk, d->seed, v, n, r->ray.dir_x, r->ray.dir_y,
+                                      r->ray.dir_z, ok);
+                int any = 0;
                 for (int k = 0; k < VB_PACKET; k++) {
-                    float l = fast_log(dist[p][k] > log_floor ? dist[p][k] : log_floor);
-                    logd[p][k] = l * (float)(valid[p][k] & 1);
+                    if (J->horizon && ok[k]) {
+                        float c = r->ray.dir_x[k] * n[0] + r->ray.dir_y[k] * n[1] +
+                                  r->ray.dir_z[k] * n[2];
+                        if (c < 0.0f)
+                            ok[k] = 0;
+                    }
+                    any |= ok[k];
+                    r->ray.org_x[k] = org[0];
+                    r->ray.org_y[k] = org[1];
+                    r->ray.org_z[k] = org[2];
+                    r->ray.tnear[k] = 0.0f;
+                    r->ray.tfar[k] = J->max_local;
+                    r->ray.time[k] = 0.0f;
+                    r->ray.mask[k] = 0xffffffffu;
+                    r->ray.id[k] = (unsigned)k;
+                    r->ray.flags[k] = 0;
+                    r->hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+                    r->hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
                 }
-        for (int p = 0; p < np; p++) {
-            const float *dx = rh[p].ray.dir_x, *dy = rh[p].ray.dir_y, *dz = rh[p].ray.dir_z;
-            if (want[0])
-                vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, dist[p], &acc[0][0][0],
-                                    VB_PACKET);
+                if (!any)
+                    continue;
+                rtcIntersect16(ok, S->scene, &ctx, r);
+                for (int k = 0; k < VB_PACKET; k++)
+                    *traced += ok[k] != 0;
+                np++;
+            }
+            if (d->trace_only)
+                continue;
+
+            /* Branch-free over the lanes, so it vectorises. Lanes not traced
+         * (empty, or below the horizon) count as distance 0. */
+            float dist[GROUP][VB_PACKET], logd[GROUP][VB_PACKET];
+            int up_lane[GROUP][VB_PACKET];
+            for (int p = 0; p < np; p++) {
+                int miss = 0, upper_pk = 0, near_pk = 0;
+                const int *ok = valid[p];
+                const uint32_t *gid = rh[p].hit.geomID;
+                const float *tfar = rh[p].ray.tfar, *dx = rh[p].ray.dir_x, *dy = rh[p].ray.dir_y,
+                            *dz = rh[p].ray.dir_z;
+                for (int k = 0; k < VB_PACKET; k++) {
+                    /* Selects as arithmetic (exact for these finite values), in
+                 * int: GCC if-converts and vectorises this loop only so. */
+                    int live = ok[k] & 1; /* valid: 0 or -1 */
+                    int hit = gid[k] != RTC_INVALID_GEOMETRY_ID;
+                    float fh = (float)hit, fl = (float)live;
+                    float t = tfar[k] * inv_scale * fh + max_distance * (1.0f - fh);
+                    float c = dx[k] * nx + dy[k] * ny + dz[k] * nz;
+                    int up = live & (c > 0.0f);
+                    dist[p][k] = t * fl;
+                    up_lane[p][k] = up;
+                    miss += live & (hit ^ 1);
+                    upper_pk += up;
+                    near_pk += up & (t < degenerate_dist);
+                }
+                upper += (uint32_t)upper_pk;
+                near_zero += (uint32_t)near_pk;
+                *missed += (uint64_t)miss;
+            }
             if (want[1])
-                vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, logd[p], &acc[1][0][0],
-                                    VB_PACKET);
-            if (out->n)
-                for (int k = 0; k < VB_PACKET; k++)
-                    if (up_lane[p][k]) {
-                        uint32_t i = (*out->n)++;
-                        out->x[i] = dx[k];
-                        out->y[i] = dy[k];
-                        out->z[i] = dz[k];
-                        out->t[i] = dist[p][k];
+                for (int p = 0; p < np; p++)
+                    for (int k = 0; k < VB_PACKET; k++) {
+                        float l = fast_log(dist[p][k] > log_floor ? dist[p][k] : log_floor);
+                        logd[p][k] = l * (float)(valid[p][k] & 1);
                     }
-            if (var_buf)
-                for (int k = 0; k < VB_PACKET; k++)
-                    if (up_lane[p][k]) {
-                        uint32_t c = J->grid->count;
-                        var_buf[var_n] = dx[k];
-                        var_buf[c + var_n] = dy[k];
-                        var_buf[2 * c + var_n] = dz[k];
-                        var_buf[3 * c + var_n] = dist[p][k];
-                        var_n++;
-                    }
-            if (J->adaptive)
-                for (int k = 0; k < VB_PACKET; k++)
-                    if (up_lane[p][k]) {
-                        ax[adapt_n] = dx[k];
-                        ay[adapt_n] = dy[k];
-                        az[adapt_n] = dz[k];
-                        adapt_n++;
-                    }
+            for (int p = 0; p < np; p++) {
+                const float *dx = rh[p].ray.dir_x, *dy = rh[p].ray.dir_y, *dz = rh[p].ray.dir_z;
+                if (want[0])
+                    vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, dist[p], &acc[0][0][0],
+                                        VB_PACKET);
+                if (want[1])
+                    vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, logd[p], &acc[1][0][0],
+                                        VB_PACKET);
+                if (out->n)
+                    for (int k = 0; k < VB_PACKET; k++)
+                        if (up_lane[p][k]) {
+                            uint32_t i = (*out->n)++;
+                            out->x[i] = dx[k];
+                            out->y[i] = dy[k];
+                            out->z[i] = dz[k];
+                            out->t[i] = dist[p][k];
+                        }
+                if (var_buf)
+                    for (int k = 0; k < VB_PACKET; k++)
+                        if (up_lane[p][k]) {
+                            uint32_t c = J->grid->count;
+                            var_buf[var_n] = dx[k];
+                            var_buf[c + var_n] = dy[k];
+                            var_buf[2 * c + var_n] = dz[k];
+                            var_buf[3 * c + var_n] = dist[p][k];
+                            var_n++;
+                        }
+                if (J->adaptive)
+                    for (int k = 0; k < VB_PACKET; k++)
+                        if (up_lane[p][k]) {
+                            ax[adapt_n] = dx[k];
+                            ay[adapt_n] = dy[k];
+                            az[adapt_n] = dz[k];
+                            adapt_n++;
+                        }
+            }
         }
-    }
-    if (!J->adaptive || d->trace_only)
-        continue;
-    /* The round's fit of the highest order, and, from the second round,
+        if (!J->adaptive || d->trace_only)
+            continue;
+        /* The round's fit of the highest order, and, from the second round,
      * the expected shadow error between it and the last round's on this
      * round's directions: below the tolerance, the receiver stops. */
-    cells_used = pk * VB_PACKET;
-    if (round + 1 < rounds && (want[0] || want[1])) {
-        float cur[VDSH_MAX_COEFFS];
-        adapt_fit(J, n, acc[aq], cells_used, cur);
-        int stop = 0;
-        if (round > 0) {
-            double sum = 0.0;
-            for (uint32_t i = adapt_from; i < adapt_n; i++) {
-                float dir[3] = {ax[i], ay[i], az[i]}, y[VDSH_MAX_COEFFS];
-                vdsh_sh_eval(J->order, dir, y);
-                double s1 = 0.0, s0 = 0.0;
-                for (int j = 0; j < J->order * J->order; j++)
-                    s1 += (double)cur[j] * y[j], s0 += (double)adapt_prev[j] * y[j];
-                double ratio;
-                if (aq)
-                    ratio = exp(s1 - s0);
-                else {
-                    double tmin = 1e-4 * d->max_distance;
-                    ratio = (s1 > tmin ? s1 : tmin) / (s0 > tmin ? s0 : tmin);
+        cells_used = pk * VB_PACKET;
+        if (round + 1 < rounds && (want[0] || want[1])) {
+            float cur[VDSH_MAX_COEFFS];
+            adapt_fit(J, n, acc[aq], cells_used, cur);
+            int stop = 0;
+            if (round > 0) {
+                double sum = 0.0;
+                for (uint32_t i = adapt_from; i < adapt_n; i++) {
+                    float dir[3] = {ax[i], ay[i], az[i]}, y[VDSH_MAX_COEFFS];
+                    vdsh_sh_eval(J->order, dir, y);
+                    double s1 = 0.0, s0 = 0.0;
+                    for (int j = 0; j < J->order * J->order; j++)
+                        s1 += (double)cur[j] * y[j], s0 += (double)adapt_prev[j] * y[j];
+                    double ratio;
+                    if (aq)
+                        ratio = exp(s1 - s0);
+                    else {
+                        double tmin = 1e-4 * d->max_distance;
+                        ratio = (s1 > tmin ? s1 : tmin) / (s0 > tmin ? s0 : tmin);
+                    }
+                    sum += expected_error(J->error_table, ratio);
                 }
-                sum += expected_error(J->error_table, ratio);
+                uint32_t m = adapt_n - adapt_from;
+                stop = m == 0 || sum / m < J->ray_tol;
             }
-            uint32_t m = adapt_n - adapt_from;
-            stop = m == 0 || sum / m < J->ray_tol;
+            memcpy(adapt_prev, cur, sizeof cur);
+            adapt_from = adapt_n;
+            if (stop)
+                break;
         }
-        memcpy(adapt_prev, cur, sizeof cur);
-        adapt_from = adapt_n;
-        if (stop)
-            break;
-    }
     }
     if (d->trace_only)
         return;
@@ -663,8 +677,8 @@ static void bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *tr
                 vb_fit_finish(&J->fits[o], &angles, u, out->coeffs[q][o]);
         if (q == 1 && var_buf) {
             uint32_t c = J->grid->count;
-            choose_order(J, v, &angles, u, var_buf, var_buf + c, var_buf + 2 * c,
-                         var_buf + 3 * c, var_n, var_buf + 4 * (size_t)c);
+            choose_order(J, v, &angles, u, var_buf, var_buf + c, var_buf + 2 * c, var_buf + 3 * c,
+                         var_n, var_buf + 4 * (size_t)c);
         }
     }
     if (J->decision && want[1])
@@ -778,13 +792,14 @@ static size_t choose_offset(int o)
  * is still accumulated in the same order as one direction at a time
  * would, so the scores keep their bits. Scratch: `basis` holds
  * VDSH_MAX_COEFFS * grid count floats, `t` and `s` grid count doubles each. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) &&                             \
     !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("avx2", "default")))
 #endif
-static void score_fits(const job *J, uint32_t count, const vertex_sink *out,
-                       float c[2][VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS], float *basis,
-                       double *t, double *s, double e[VDSH_ORDER_SLOTS][2])
+static void
+score_fits(const job *J, uint32_t count, const vertex_sink *out,
+           float c[2][VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS], float *basis, double *t, double *s,
+           double e[VDSH_ORDER_SLOTS][2])
 {
     const uint32_t cap = J->grid->count;
     const float tmin = 1e-4f * J->d->max_distance;
@@ -832,8 +847,8 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
     for (uint32_t i = begin; i < end && buf; i++) {
         uint32_t v = choose_receiver(i, nrec, J->choose_count), count = 0;
         float c[2][VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS];
-        vertex_sink out = {.x = buf, .y = buf + cap, .z = buf + 2 * cap, .t = buf + 3 * cap,
-                           .n = &count};
+        vertex_sink out = {
+            .x = buf, .y = buf + cap, .z = buf + 2 * cap, .t = buf + 3 * cap, .n = &count};
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (J->coeffs[o])
                 out.coeffs[0][o] = c[0][o], out.coeffs[1][o] = c[1][o];
@@ -850,15 +865,15 @@ static void choose_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
                            (size_t)o * o * sizeof(float));
         double e[VDSH_ORDER_SLOTS][2] = {{0}};
         score_fits(J, count, &out, c, buf + 4 * (size_t)cap, sums, sums + cap, e);
-        double *dst = J->choose_error + (size_t)i * (VDSH_ORDER_SLOTS) * 2;
+        double *dst = J->choose_error + (size_t)i * (VDSH_ORDER_SLOTS)*2;
         for (int o = 0; o <= VDSH_MAX_ORDER; o++)
             for (int q = 0; q < 2; q++)
                 dst[2 * o + q] = count ? e[o][q] / count : 0.0;
     }
     if (!buf) /* out of memory: no vote from these receivers */
         for (uint32_t i = begin; i < end; i++)
-            memset(J->choose_error + (size_t)i * (VDSH_ORDER_SLOTS) * 2, 0,
-                   (VDSH_ORDER_SLOTS) * 2 * sizeof(double));
+            memset(J->choose_error + (size_t)i * (VDSH_ORDER_SLOTS)*2, 0,
+                   (VDSH_ORDER_SLOTS)*2 * sizeof(double));
     else if (!J->var_cap) /* their coefficients are kept: the main pass skips them
                              * (with an adaptive order it bakes them again: the
                              * variable stream's quantity was not chosen yet) */
@@ -935,26 +950,26 @@ void vb_bake_output_free(vb_bake_output *out)
 typedef struct bake_run {
     vb_bake_desc d;
     const vb_method_info *mi;
-    int var_cap;           /* adaptive order's cap; 0: none */
-    int choose;            /* each order's quantity chosen on a sample */
-    int calibrate;         /* the decision's log offsets calibrated */
-    vdsh_quantity stored;  /* the quantity when not chosen */
+    int var_cap;          /* adaptive order's cap; 0: none */
+    int choose;           /* each order's quantity chosen on a sample */
+    int calibrate;        /* the decision's log offsets calibrated */
+    vdsh_quantity stored; /* the quantity when not chosen */
     vb_decision_params dec;
-    uint32_t lo, hi;       /* the range baked */
+    uint32_t lo, hi; /* the range baked */
     vb_dirgrid grid;
     uint32_t *set, set_count, set_before; /* job's */
     float *origins, *near, *normals;
     float *coeffs[VDSH_ORDER_SLOTS];
-    uint8_t *var_orders;   /* adaptive order: the range's */
+    uint8_t *var_orders; /* adaptive order: the range's */
     float *var_coeffs;
     float (*lights)[3];
     vb_origins_stats ost;
     uint32_t flipped;
     job *J;
-    double t0;             /* when the tracing began */
+    double t0; /* when the tracing began */
     double auto_error[VDSH_ORDER_SLOTS][2];
     uint32_t auto_receivers, cal_count;
-    unsigned started;      /* the workers of the bake */
+    unsigned started; /* the workers of the bake */
 } bake_run;
 
 typedef vb_result (*bake_step)(bake_run *b, vb_error *err);
@@ -993,8 +1008,8 @@ static vb_result resolve_orders(bake_run *b, vb_error *err)
     if (d->max_order == 0)
         d->max_order = VB_DEFAULT_ORDER;
     if (d->max_order < 1 || d->max_order > VDSH_MAX_ORDER)
-        return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..%d, not %d",
-                       VDSH_MAX_ORDER, d->max_order);
+        return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..%d, not %d", VDSH_MAX_ORDER,
+                       d->max_order);
     if (d->order_mask == 0 && !b->var_cap)
         d->order_mask = 1u << d->max_order;
     if (d->order_mask >> (d->max_order + 1))
@@ -1068,8 +1083,8 @@ static vb_result check_receivers(bake_run *b, vb_error *err)
     const vb_mesh *R = b->d.receivers;
     for (size_t i = 0; i < 3 * (size_t)R->vertex_count; i++)
         if (!isfinite(R->positions[i]) || !isfinite(R->normals[i]))
-            return vb_fail(err, VB_ERR_INVALID,
-                           "receiver %zu has a non-finite position or normal", i / 3);
+            return vb_fail(err, VB_ERR_INVALID, "receiver %zu has a non-finite position or normal",
+                           i / 3);
     for (size_t i = 0; i < 3 * (size_t)R->triangle_count; i++)
         if (R->indices[i] >= R->vertex_count)
             return vb_fail(err, VB_ERR_INVALID,
@@ -1176,8 +1191,7 @@ static vb_result allocate_arrays(bake_run *b, vb_error *err)
     b->near = malloc((size_t)b->set_count * sizeof *b->near + 1);
     /* Oriented receivers: a copy of their normals, turned toward free
      * space (origins.h); the bake then reads the copy. */
-    b->normals = d->keep_normals ? NULL
-                                 : malloc((size_t)b->set_count * 3 * sizeof *b->normals + 1);
+    b->normals = d->keep_normals ? NULL : malloc((size_t)b->set_count * 3 * sizeof *b->normals + 1);
     int missing = !d->keep_normals && !b->normals;
     /* A range: its rows only (bake.h), so a shard's coefficients are its
      * own range's size. */
@@ -1194,16 +1208,16 @@ static vb_result allocate_arrays(bake_run *b, vb_error *err)
         b->lights = malloc(VB_ORDER_LIGHTS * sizeof *b->lights);
         if (!b->var_orders || !b->var_coeffs || !b->lights)
             return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers", V);
-        vb_result r = vb_scene_place_lights(d->scene, d->seed, VB_ORDER_LIGHTS, b->lights, NULL,
-                                            err);
+        vb_result r =
+            vb_scene_place_lights(d->scene, d->seed, VB_ORDER_LIGHTS, b->lights, NULL, err);
         if (r != VB_OK)
             return r;
     }
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!b->coeffs[o] && o != d->max_order && o > cap) /* the top one rotates for all */
             continue;
-        vb_result r = vb_fit_create(o, b->mi->fit, vb_fit_lambda(d->lambda, o), &b->J->fits[o],
-                                    err);
+        vb_result r =
+            vb_fit_create(o, b->mi->fit, vb_fit_lambda(d->lambda, o), &b->J->fits[o], err);
         if (r != VB_OK)
             return r;
         vb_fit_window(&b->J->fits[o], d->window);
@@ -1215,8 +1229,8 @@ static vb_result allocate_arrays(bake_run *b, vb_error *err)
 static vb_result prepare_receivers(bake_run *b, vb_error *err)
 {
     return vb_receivers_prepare(b->d.receivers, b->d.scene, b->d.threads, b->set, b->set_count,
-                                b->lo, b->hi, b->normals, &b->flipped, b->origins, b->near,
-                                &b->ost, err);
+                                b->lo, b->hi, b->normals, &b->flipped, b->origins, b->near, &b->ost,
+                                err);
 }
 
 /* The job the workers read: the run's settings and arrays, adaptive
@@ -1250,8 +1264,8 @@ static vb_result setup_job(bake_run *b, vb_error *err)
     J->light_count = VB_ORDER_LIGHTS;
     J->var_orders = b->var_orders;
     J->var_coeffs = b->var_coeffs;
-    if (b->var_orders && !(J->var_scratch = malloc(d->threads * var_scratch_floats(J) *
-                                                   sizeof(float))))
+    if (b->var_orders &&
+        !(J->var_scratch = malloc(d->threads * var_scratch_floats(J) * sizeof(float))))
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
     return VB_OK;
 }
@@ -1312,18 +1326,19 @@ static vb_result choose_quantities(bake_run *b, vb_error *err)
     if (!b->choose || d->trace_only) {
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             J->quantity[o] = d->order_quantity ? d->order_quantity[o]
-                             : b->choose ? VDSH_QUANTITY_DISTANCE : b->stored;
+                             : b->choose       ? VDSH_QUANTITY_DISTANCE
+                                               : b->stored;
         return VB_OK;
     }
     b->auto_receivers = J->choose_count = choose_count(V);
-    J->choose_error = calloc((size_t)J->choose_count * (VDSH_ORDER_SLOTS) * 2, sizeof(double));
+    J->choose_error = calloc((size_t)J->choose_count * (VDSH_ORDER_SLOTS)*2, sizeof(double));
     J->choose_coeffs = malloc((size_t)J->choose_count * 2 * CHOOSE_STRIDE * sizeof(float));
     J->done = calloc((size_t)(b->hi - b->lo), 1);
     if (!J->choose_error || !J->choose_coeffs || !J->done)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
     if (vb_parallel_for(d->threads, J->choose_count, 4, choose_block, J, NULL, NULL) == 0)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
-    double (*auto_error)[2] = b->auto_error;
+    double(*auto_error)[2] = b->auto_error;
     for (uint32_t i = 0; i < J->choose_count; i++)
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             for (int q = 0; q < 2; q++)
@@ -1437,8 +1452,8 @@ static void fill_output(bake_run *b, vb_bake_output *out)
         o.decision_lights = J->decision ? d->decision_lights : 0;
         o.decision_fitted = atomic_load(&J->dec_fitted);
         o.decision_fallbacks = atomic_load(&J->dec_fallbacks);
-        o.decision_pairs = o.decision_fitted
-                               ? (double)atomic_load(&J->dec_pairs) / o.decision_fitted : 0.0;
+        o.decision_pairs =
+            o.decision_fitted ? (double)atomic_load(&J->dec_pairs) / o.decision_fitted : 0.0;
         o.calibration_receivers = b->cal_count;
         o.decision_rays = atomic_load(&J->dec_rays);
         o.false_rate = b->cal_count ? d->false_rate : 0.0f;
@@ -1454,8 +1469,8 @@ static void fill_output(bake_run *b, vb_bake_output *out)
     o.variable_cap = b->var_orders ? b->var_cap : 0;
     o.order_tolerance = b->var_orders ? d->order_tolerance : 0.0f;
     o.variable_method = mi->decision ? VDSH_METHOD_SHADOW : mi->stored;
-    o.variable_param = b->var_orders && mi->param == VB_PARAM_LOG_OFFSET
-                           ? J->var_offset[b->var_cap] : o.lambda;
+    o.variable_param =
+        b->var_orders && mi->param == VB_PARAM_LOG_OFFSET ? J->var_offset[b->var_cap] : o.lambda;
     b->var_orders = NULL;
     b->var_coeffs = NULL;
     o.rays = b->grid.count;
@@ -1511,14 +1526,12 @@ static void run_free(bake_run *b)
 
 /* vb_bake_run's steps, in order. */
 static const bake_step bake_steps[] = {
-    resolve_orders, resolve_quantity,  resolve_parameters, check_receivers,
-    resolve_decision, create_grid,     select_receivers,   allocate_arrays,
-    prepare_receivers, setup_job,      setup_offsets,      choose_quantities,
-    calibrate_offsets, bake_receivers,
+    resolve_orders, resolve_quantity,  resolve_parameters, check_receivers,   resolve_decision,
+    create_grid,    select_receivers,  allocate_arrays,    prepare_receivers, setup_job,
+    setup_offsets,  choose_quantities, calibrate_offsets,  bake_receivers,
 };
 
-vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
-                      vb_error *err)
+vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out, vb_error *err)
 {
     bake_run b = {.d = *desc};
     vb_result r = VB_OK;

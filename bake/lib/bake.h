@@ -98,9 +98,9 @@ extern "C" {
 int vb_order_candidate(int k, int cap);
 
 typedef struct vb_bake_desc {
-    const vb_mesh *receivers;  /* positions and normals (borrowed) */
-    const vb_scene *scene;     /* the occluders (borrowed) */
-    uint32_t rays;             /* directions per receiver; 0: 2500. With
+    const vb_mesh *receivers; /* positions and normals (borrowed) */
+    const vb_scene *scene;    /* the occluders (borrowed) */
+    uint32_t rays;            /* directions per receiver; 0: 2500. With
                                 * adaptive_rays: the cap */
     /* Adaptive rays (--rays auto): 1 traces nested stratified rounds
      * (vb_dirgrid_create_nested: 1/16, 1/8, ... of the cap's power-of-two
@@ -110,22 +110,22 @@ typedef struct vb_bake_desc {
      * the new fit's distance over the last one's: the quantity choice's
      * score below). The decision reads the receiver's own rays only. */
     int adaptive_rays;
-    float ray_tolerance;       /* 0: VB_DEFAULT_RAY_TOLERANCE; < 0: tolerance 0
+    float ray_tolerance;  /* 0: VB_DEFAULT_RAY_TOLERANCE; < 0: tolerance 0
                                 * (every round); inf: stop at the first check */
-    uint64_t seed;             /* 0 is a valid seed */
-    float max_distance;        /* clamp; 0: the occluders' bbox diagonal */
-    vb_method method;          /* method.h; 0: shadow (the default) */
-    vb_quantity quantity;      /* method.h; 0: auto (the default) */
+    uint64_t seed;        /* 0 is a valid seed */
+    float max_distance;   /* clamp; 0: the occluders' bbox diagonal */
+    vb_method method;     /* method.h; 0: shadow (the default) */
+    vb_quantity quantity; /* method.h; 0: auto (the default) */
     /* Per order (index 1..VDSH_MAX_ORDER): the quantity it stores, over
      * `quantity` (adaptive receivers bake later rounds with the first
      * round's choice); NULL: as `quantity` says. */
     const vdsh_quantity *order_quantity;
-    float lambda;              /* lsq and shadow regularisation; 0: 1e-4 */
-    const float *log_offsets;  /* method shadow: per order (index 1..VDSH_MAX_ORDER), added
+    float lambda;             /* lsq and shadow regularisation; 0: 1e-4 */
+    const float *log_offsets; /* method shadow: per order (index 1..VDSH_MAX_ORDER), added
                                 * to the fitted ln d; NULL: vb_shadow_log_offset */
-    float log_floor;           /* log-distance floor; 0: 1% of max_distance */
-    vdsh_window window;        /* on each order's bands; 0: none */
-    uint32_t order_mask;       /* bit n: produce order n; 0: max_order only
+    float log_floor;          /* log-distance floor; 0: 1% of max_distance */
+    vdsh_window window;       /* on each order's bands; 0: none */
+    uint32_t order_mask;      /* bit n: produce order n; 0: max_order only
                                 * (none with a variable order and no mask) */
     /* Adaptive order (issue 16): > 0 adds a variable-order stream of the
      * quantity of order `variable_cap`: each receiver gets the lowest
@@ -133,7 +133,7 @@ typedef struct vb_bake_desc {
      * directions, under VB_ORDER_LIGHTS lights in the scene's free space,
      * is at most this tolerance, else the order of least error. 0: none. */
     float order_tolerance;
-    int variable_cap;          /* 0: VB_DEFAULT_ORDER_CAP */
+    int variable_cap; /* 0: VB_DEFAULT_ORDER_CAP */
     /* Method decision (method.h): the fit's settings (NULL: the
      * defaults, vb_decision_defaults), training lights per receiver (0:
      * VB_DEFAULT_DECISION_LIGHTS; at most VB_DECISION_MAX_PAIRS) and the
@@ -143,14 +143,14 @@ typedef struct vb_bake_desc {
     const vb_decision_params *decision;
     uint32_t decision_lights;
     float false_rate;
-    int max_order;             /* 0: the highest order in order_mask, or
+    int max_order;    /* 0: the highest order in order_mask, or
                                   VB_DEFAULT_ORDER */
-    unsigned threads;          /* 0: every online core */
+    unsigned threads; /* 0: every online core */
     /* 0 (the tools' default): receivers whose normals point into geometry
      * are turned toward free space first (vb_orient_receivers, on a copy:
      * vb_bake_output.normals); 1: the normals as given. */
     int keep_normals;
-    int trace_only;            /* benchmark: trace the same rays, nothing else */
+    int trace_only; /* benchmark: trace the same rays, nothing else */
     /* A shard (vdsh-bake --shard): only receivers [range_begin, range_end)
      * get coefficients (vb_bake_output.coeffs holds their rows only) and
      * only they count in
@@ -161,8 +161,7 @@ typedef struct vb_bake_desc {
     uint32_t range_begin, range_end;
     /* Called from the calling thread a few times a second, and once at the
      * end, with receivers done and rays traced so far. May be NULL. */
-    void (*progress)(void *user, uint32_t done, uint32_t total,
-                     uint64_t rays_traced);
+    void (*progress)(void *user, uint32_t done, uint32_t total, uint64_t rays_traced);
     void *progress_user;
 } vb_bake_desc;
 
@@ -172,25 +171,25 @@ typedef struct vb_bake_desc {
 
 typedef struct vb_bake_output {
     int max_order;
-    vdsh_method method;        /* the method as stored */
+    vdsh_method method;                       /* the method as stored */
     vdsh_quantity quantity[VDSH_ORDER_SLOTS]; /* per order: the quantity stored */
-    uint32_t auto_receivers;   /* VB_QUANTITY_AUTO: receivers sampled (else 0) */
-    double auto_error[VDSH_ORDER_SLOTS][2]; /* their expected shadow error
+    uint32_t auto_receivers;                  /* VB_QUANTITY_AUTO: receivers sampled (else 0) */
+    double auto_error[VDSH_ORDER_SLOTS][2];   /* their expected shadow error
                                 * per order, distance [0] and log [1] */
-    float lambda;              /* lsq or shadow regularisation used (0 otherwise) */
-    float log_offset[VDSH_ORDER_SLOTS]; /* method shadow: per order, as used */
-    float log_floor;           /* log-distance floor used (0 otherwise) */
+    float lambda;                             /* lsq or shadow regularisation used (0 otherwise) */
+    float log_offset[VDSH_ORDER_SLOTS];       /* method shadow: per order, as used */
+    float log_floor;                          /* log-distance floor used (0 otherwise) */
     /* Method decision: receivers fitted (the others, with fewer than 16
      * lights above their horizon, keep the lsq fit), their mean training
      * pairs, the calibration's target false rate and its receivers (0:
      * the log offsets were given). decision_lights 0: no free space for
      * lights, every receiver kept its lsq fit. */
     uint32_t decision_fitted, decision_fallbacks, decision_lights, calibration_receivers;
-    uint64_t decision_rays;    /* rays toward the lights (not in rays_traced) */
+    uint64_t decision_rays; /* rays toward the lights (not in rays_traced) */
     double decision_pairs;
     float false_rate;
-    vdsh_window window;        /* applied */
-    uint32_t vertex_count;     /* all receivers */
+    vdsh_window window;    /* applied */
+    uint32_t vertex_count; /* all receivers */
     /* The receivers baked: vb_bake_desc's range, or 0, vertex_count
      * (vb_bake_stream reads range_end 0 as every receiver). */
     uint32_t range_begin, range_end;
@@ -216,12 +215,12 @@ typedef struct vb_bake_output {
      * not refitted; docs/ACCURACY.md). */
     vdsh_method variable_method;
     float variable_param;
-    uint32_t rays;             /* directions per receiver actually used (the
+    uint32_t rays;       /* directions per receiver actually used (the
                                 * cap with adaptive rays) */
-    float ray_tolerance;       /* adaptive rays: the tolerance used, else 0 */
-    int hemisphere;            /* sampling domain: 0 sphere, 1 hemisphere */
-    float max_distance;        /* the clamp used, scene units */
-    unsigned threads;          /* workers used */
+    float ray_tolerance; /* adaptive rays: the tolerance used, else 0 */
+    int hemisphere;      /* sampling domain: 0 sphere, 1 hemisphere */
+    float max_distance;  /* the clamp used, scene units */
+    unsigned threads;    /* workers used */
     uint64_t rays_traced;
     uint64_t rays_missed;
     uint32_t degenerate_receivers;
@@ -230,15 +229,14 @@ typedef struct vb_bake_output {
      * space, or NULL with keep_normals (then the receivers' own). A range
      * (vb_bake_desc.range_*): its rows only, like coeffs. */
     float *normals;
-    uint32_t flipped_normals;  /* receivers whose normal was turned */
-    uint32_t moved_origins;    /* receivers whose origin the repair moved */
-    vb_origins_stats origins;  /* the ray origins' repair: what it did and cost */
-    double seconds;            /* wall time of the trace-and-project loop
+    uint32_t flipped_normals; /* receivers whose normal was turned */
+    uint32_t moved_origins;   /* receivers whose origin the repair moved */
+    vb_origins_stats origins; /* the ray origins' repair: what it did and cost */
+    double seconds;           /* wall time of the trace-and-project loop
                                 * (the origins' time is origins.seconds) */
 } vb_bake_output;
 
-vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out,
-                      vb_error *err);
+vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out, vb_error *err);
 
 /* Method shadow's default log offset for an order: how much longer than
  * the least-squares fit of ln d the stored distances are (a factor
@@ -258,8 +256,8 @@ void vb_bake_output_free(vb_bake_output *out);
  * the caller frees it. */
 /* The variable-order stream of an adaptive-order bake (b->variable_orders),
  * as vb_bake_stream; its offsets point into *storage too. */
-vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encoding,
-                                  vdsh_stream *out, void **storage, vb_error *err);
+vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encoding, vdsh_stream *out,
+                                  void **storage, vb_error *err);
 
 vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encoding,
                          vdsh_stream *out, void **storage, vb_error *err);
@@ -270,7 +268,6 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encod
  * at all (a shard's part). On failure b is unchanged. */
 vb_result vb_bake_stream_take(vb_bake_output *b, int order, vdsh_encoding encoding,
                               vdsh_stream *out, void **storage, vb_error *err);
-
 
 #ifdef __cplusplus
 }

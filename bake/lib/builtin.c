@@ -75,7 +75,7 @@
 #define FLOOR_ROWS 7
 #define WALL_COLS 24
 #define WALL_ROWS 9
-#define PILLAR_COLS 5    /* along the pillar's height */
+#define PILLAR_COLS 5 /* along the pillar's height */
 #define PILLAR_ROWS 1
 
 /* Icosahedron subdivided twice: 320 triangles. */
@@ -93,8 +93,8 @@ enum {
 
 typedef struct room_builder {
     vb_mesh *m;
-    uint32_t vertex_cap, triangle_cap;  /* of m's arrays; they grow as needed */
-    int failed;                         /* out of memory: stop adding */
+    uint32_t vertex_cap, triangle_cap; /* of m's arrays; they grow as needed */
+    int failed;                        /* out of memory: stop adding */
     /* The variants' turned objects: a vertex p is placed at
      * (tx + c p.x + s p.z, p.y, tz - s p.x + c p.z). Off for builtin:room. */
     int turned;
@@ -164,7 +164,7 @@ static void add_triangle(room_builder *b, uint32_t i0, uint32_t i1, uint32_t i2)
 typedef struct panel_frame {
     const float *o, *u, *v;
     int exact;
-    int an, au, av;          /* axes of the normal, the width, the height */
+    int an, au, av; /* axes of the normal, the width, the height */
     float plane, u0, u1, v0, v1;
 } panel_frame;
 
@@ -248,9 +248,11 @@ static void add_panel(room_builder *b, const float o[3], const float u[3], const
 
 /* A planar quad a, b, c, d (counter-clockwise seen from the front) with
  * its own four vertices. */
-static void add_quad(room_builder *b, const float *a, const float *c1, const float *c2, const float *d)
+static void add_quad(room_builder *b, const float *a, const float *c1, const float *c2,
+                     const float *d)
 {
-    uint32_t i0 = add_vertex(b, a), i1 = add_vertex(b, c1), i2 = add_vertex(b, c2), i3 = add_vertex(b, d);
+    uint32_t i0 = add_vertex(b, a), i1 = add_vertex(b, c1), i2 = add_vertex(b, c2),
+             i3 = add_vertex(b, d);
     add_triangle(b, i0, i1, i2);
     add_triangle(b, i0, i2, i3);
 }
@@ -263,12 +265,12 @@ static void add_shell(room_builder *b)
     const float pz[3] = {0, 0, 1}, nz[3] = {0, 0, -1};
     const float c000[3] = {-h, 0, -h}, c0y0[3] = {-h, y, -h};
     const float c100[3] = {h, 0, -h}, c001[3] = {-h, 0, h}, c101[3] = {h, 0, h};
-    add_panel(b, c000, pz, px, side, side, FLOOR_COLS, FLOOR_ROWS);   /* floor: +y */
-    add_panel(b, c0y0, px, pz, side, side, FLOOR_COLS, FLOOR_ROWS);   /* ceiling: -y */
-    add_panel(b, c000, px, py, side, y, WALL_COLS, WALL_ROWS);        /* z = -h: +z */
-    add_panel(b, c101, nx, py, side, y, WALL_COLS, WALL_ROWS);        /* z = +h: -z */
-    add_panel(b, c100, pz, py, side, y, WALL_COLS, WALL_ROWS);        /* x = +h: -x */
-    add_panel(b, c001, nz, py, side, y, WALL_COLS, WALL_ROWS);        /* x = -h: +x */
+    add_panel(b, c000, pz, px, side, side, FLOOR_COLS, FLOOR_ROWS); /* floor: +y */
+    add_panel(b, c0y0, px, pz, side, side, FLOOR_COLS, FLOOR_ROWS); /* ceiling: -y */
+    add_panel(b, c000, px, py, side, y, WALL_COLS, WALL_ROWS);      /* z = -h: +z */
+    add_panel(b, c101, nx, py, side, y, WALL_COLS, WALL_ROWS);      /* z = +h: -z */
+    add_panel(b, c100, pz, py, side, y, WALL_COLS, WALL_ROWS);      /* x = +h: -x */
+    add_panel(b, c001, nz, py, side, y, WALL_COLS, WALL_ROWS);      /* x = -h: +x */
 }
 
 enum { FACE_BOTTOM = 1, FACE_TOP = 2, AS_PILLAR = 4 };
@@ -304,10 +306,10 @@ static void add_box(room_builder *b, float cx, float cz, float y0, float sx, flo
             add_panel(b, a, up, d, sy, len, PILLAR_COLS, PILLAR_ROWS);
         }
     } else {
-        add_quad(b, p[1], p[5], p[7], p[3]);   /* +x */
-        add_quad(b, p[0], p[2], p[6], p[4]);   /* -x */
-        add_quad(b, p[2], p[3], p[7], p[6]);   /* +z */
-        add_quad(b, p[1], p[0], p[4], p[5]);   /* -z */
+        add_quad(b, p[1], p[5], p[7], p[3]); /* +x */
+        add_quad(b, p[0], p[2], p[6], p[4]); /* -x */
+        add_quad(b, p[2], p[3], p[7], p[6]); /* +z */
+        add_quad(b, p[1], p[0], p[4], p[5]); /* -z */
     }
     if (!(flags & FACE_TOP))
         add_quad(b, p[4], p[6], p[7], p[5]);
@@ -323,13 +325,14 @@ static void icosphere(float pos[][3], uint32_t *nv, uint32_t tri[][3], uint32_t 
 {
     const float t = 1.6180339887f;
     static const float base[12][3] = {
-        {-1, 1.6180339887f, 0}, {1, 1.6180339887f, 0}, {-1, -1.6180339887f, 0}, {1, -1.6180339887f, 0},
-        {0, -1, 1.6180339887f}, {0, 1, 1.6180339887f}, {0, -1, -1.6180339887f}, {0, 1, -1.6180339887f},
-        {1.6180339887f, 0, -1}, {1.6180339887f, 0, 1}, {-1.6180339887f, 0, -1}, {-1.6180339887f, 0, 1}};
+        {-1, 1.6180339887f, 0},  {1, 1.6180339887f, 0},   {-1, -1.6180339887f, 0},
+        {1, -1.6180339887f, 0},  {0, -1, 1.6180339887f},  {0, 1, 1.6180339887f},
+        {0, -1, -1.6180339887f}, {0, 1, -1.6180339887f},  {1.6180339887f, 0, -1},
+        {1.6180339887f, 0, 1},   {-1.6180339887f, 0, -1}, {-1.6180339887f, 0, 1}};
     static const uint32_t faces[20][3] = {
-        {0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-        {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-        {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+        {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+        {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+        {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
     float len = sqrtf(1.0f + t * t);
     for (int i = 0; i < 12; i++)
         for (int k = 0; k < 3; k++)
@@ -366,8 +369,10 @@ static void icosphere(float pos[][3], uint32_t *nv, uint32_t tri[][3], uint32_t 
                 }
                 mid[e] = found;
             }
-            const uint32_t split[4][3] = {{tri[f][0], mid[0], mid[2]}, {tri[f][1], mid[1], mid[0]},
-                                          {tri[f][2], mid[2], mid[1]}, {mid[0], mid[1], mid[2]}};
+            const uint32_t split[4][3] = {{tri[f][0], mid[0], mid[2]},
+                                          {tri[f][1], mid[1], mid[0]},
+                                          {tri[f][2], mid[2], mid[1]},
+                                          {mid[0], mid[1], mid[2]}};
             memcpy(next[nn], split, sizeof split);
             nn += 4;
         }
@@ -528,7 +533,8 @@ static int choose_lattice(float W, float H, int *nc, int *nr)
  * plane p[an] = plane, facing +an (sign > 0) or -an. Its width runs
  * horizontally (along z for the floor and ceiling) and its height along y
  * (along x for the floor and ceiling). */
-static void add_rect(room_builder *b, int an, int sign, float plane, const float lo[3], const float hi[3])
+static void add_rect(room_builder *b, int an, int sign, float plane, const float lo[3],
+                     const float hi[3])
 {
     panel_frame f = {.exact = 1, .an = an, .plane = plane};
     int flip;
@@ -565,8 +571,14 @@ static void add_rect(room_builder *b, int an, int sign, float plane, const float
 /* Faces of a block to leave out: those resting on or pressed against
  * something (bit 2 * axis for the - side, bit 2 * axis + 1 for +). */
 enum {
-    OMIT_XN = 1, OMIT_XP = 2, OMIT_YN = 4, OMIT_YP = 8, OMIT_ZN = 16, OMIT_ZP = 32,
-    OMIT_BOTTOM = OMIT_YN, OMIT_TOP = OMIT_YP
+    OMIT_XN = 1,
+    OMIT_XP = 2,
+    OMIT_YN = 4,
+    OMIT_YP = 8,
+    OMIT_ZN = 16,
+    OMIT_ZP = 32,
+    OMIT_BOTTOM = OMIT_YN,
+    OMIT_TOP = OMIT_YP
 };
 
 /* The outward-facing axis-aligned block lo..hi (in the builder's frame). */
@@ -686,12 +698,12 @@ typedef struct room_wall {
 typedef struct room_plan {
     room_builder *b;
     room_rng rng;
-    float hx, hz, height;        /* half width (x), half depth (z), height */
-    room_aabb free[2];           /* the floor: an object lies within one */
+    float hx, hz, height; /* half width (x), half depth (z), height */
+    room_aabb free[2];    /* the floor: an object lies within one */
     int free_count;
     room_wall walls[MAX_WALLS];
     int wall_count;
-    room_aabb taken[MAX_TAKEN];  /* what is placed (and the doorway) */
+    room_aabb taken[MAX_TAKEN]; /* what is placed (and the doorway) */
     int taken_count;
 } room_plan;
 
@@ -738,8 +750,8 @@ enum { W_BACK = 1, W_FRONT = 2, W_START = 4, W_END = 8, W_BOTTOM = 16, W_TOP = 3
 /* The box s0..s1 along wall w, d0..d1 out from it, y0..y1, as world
  * bounds; *omit (may be NULL) gets the wall-terms faces `w_omit` as
  * block faces. d = 0 gives exactly the wall's plane. */
-static room_aabb wall_box(const room_wall *w, float s0, float s1, float d0, float d1, float y0, float y1,
-                          int w_omit, int *omit)
+static room_aabb wall_box(const room_wall *w, float s0, float s1, float d0, float d1, float y0,
+                          float y1, int w_omit, int *omit)
 {
     room_aabb r;
     int a = w->axis, o = 2 - a;
@@ -751,7 +763,8 @@ static room_aabb wall_box(const room_wall *w, float s0, float s1, float d0, floa
     r.lo[1] = y0;
     r.hi[1] = y1;
     if (omit) {
-        int back = w->in > 0 ? 1 << (2 * a) : 2 << (2 * a), front = w->in > 0 ? 2 << (2 * a) : 1 << (2 * a);
+        int back = w->in > 0 ? 1 << (2 * a) : 2 << (2 * a),
+            front = w->in > 0 ? 2 << (2 * a) : 1 << (2 * a);
         *omit = ((w_omit & W_BACK) ? back : 0) | ((w_omit & W_FRONT) ? front : 0) |
                 ((w_omit & W_START) ? 1 << (2 * o) : 0) | ((w_omit & W_END) ? 2 << (2 * o) : 0) |
                 ((w_omit & W_BOTTOM) ? OMIT_BOTTOM : 0) | ((w_omit & W_TOP) ? OMIT_TOP : 0);
@@ -759,8 +772,8 @@ static room_aabb wall_box(const room_wall *w, float s0, float s1, float d0, floa
     return r;
 }
 
-static void add_wall_block(room_plan *p, const room_wall *w, float s0, float s1, float d0, float d1, float y0,
-                           float y1, int w_omit)
+static void add_wall_block(room_plan *p, const room_wall *w, float s0, float s1, float d0, float d1,
+                           float y0, float y1, int w_omit)
 {
     int omit = 0;
     room_aabb a = wall_box(w, s0, s1, d0, d1, y0, y1, w_omit, &omit);
@@ -770,8 +783,8 @@ static void add_wall_block(room_plan *p, const room_wall *w, float s0, float s1,
 /* A free stretch len long, dep deep and hgt high against some wall: the
  * wall, where it starts (s0) and W_START / W_END where it is pushed into
  * a corner. Returns 0 when nothing was found. */
-static int find_wall_spot(room_plan *p, float len, float dep, float hgt, const room_wall **wall, float *s0,
-                          int *corner)
+static int find_wall_spot(room_plan *p, float len, float dep, float hgt, const room_wall **wall,
+                          float *s0, int *corner)
 {
     for (int attempt = 0; attempt < 40; attempt++) {
         const room_wall *w = &p->walls[rng_int(&p->rng, 0, p->wall_count - 1)];
@@ -811,15 +824,19 @@ static int find_wall_spot(room_plan *p, float len, float dep, float hgt, const r
 
 /* A free spot for a free-standing footprint sx by sz, y0..y1: its centre.
  * Positions are whole centimetres. */
-static int find_floor_spot(room_plan *p, float sx, float sz, float y0, float y1, float *cx, float *cz)
+static int find_floor_spot(room_plan *p, float sx, float sz, float y0, float y1, float *cx,
+                           float *cz)
 {
     for (int attempt = 0; attempt < 40; attempt++) {
         const room_aabb *f = &p->free[rng_int(&p->rng, 0, p->free_count - 1)];
-        float span_x = f->hi[0] - f->lo[0] - 2.0f * WALL_GAP - sx, span_z = f->hi[2] - f->lo[2] - 2.0f * WALL_GAP - sz;
+        float span_x = f->hi[0] - f->lo[0] - 2.0f * WALL_GAP - sx,
+              span_z = f->hi[2] - f->lo[2] - 2.0f * WALL_GAP - sz;
         if (span_x <= 0.0f || span_z <= 0.0f)
             continue;
-        float x = f->lo[0] + WALL_GAP + 0.5f * sx + (float)rng_int(&p->rng, 0, (int)(span_x * 100.0f)) / 100.0f;
-        float z = f->lo[2] + WALL_GAP + 0.5f * sz + (float)rng_int(&p->rng, 0, (int)(span_z * 100.0f)) / 100.0f;
+        float x = f->lo[0] + WALL_GAP + 0.5f * sx +
+                  (float)rng_int(&p->rng, 0, (int)(span_x * 100.0f)) / 100.0f;
+        float z = f->lo[2] + WALL_GAP + 0.5f * sz +
+                  (float)rng_int(&p->rng, 0, (int)(span_z * 100.0f)) / 100.0f;
         room_aabb box = aabb(x - 0.5f * sx, y0, z - 0.5f * sz, x + 0.5f * sx, y1, z + 0.5f * sz);
         if (!fits(p, &box, GAP, WALL_GAP))
             continue;
@@ -832,7 +849,8 @@ static int find_floor_spot(room_plan *p, float sx, float sz, float y0, float y1,
 
 /* ---- The shell --------------------------------------------------------- */
 
-static void add_wall(room_plan *p, int axis, int in, float at, float e0, float e1, int corner0, int corner1)
+static void add_wall(room_plan *p, int axis, int in, float at, float e0, float e1, int corner0,
+                     int corner1)
 {
     room_wall w = {axis, in, at, e0, e1, corner0, corner1};
     p->walls[p->wall_count++] = w;
@@ -901,7 +919,7 @@ static void add_room_shell(room_plan *p, int shape)
     float zb = zw + t;
     add_floor_and_ceiling(p, -hx, -hz, hx, zw, 1);
     add_floor_and_ceiling(p, -hx, zb, hx, hz, 1);
-    add_floor_and_ceiling(p, d0, zw, d1, zb, 0);    /* the threshold */
+    add_floor_and_ceiling(p, d0, zw, d1, zb, 0); /* the threshold */
     add_wall(p, 0, 1, -hx, -hz, zw, 1, 1);
     add_wall(p, 0, 1, -hx, zb, hz, 1, 1);
     add_wall(p, 0, -1, hx, -hz, zw, 1, 1);
@@ -974,7 +992,8 @@ static float add_on_top(room_plan *p, const float lo[3], const float hi[3], floa
     float ox = (sx - size) * 0.5f, oz = (sz - size) * 0.5f;
     float cx = lo[0] + 0.5f * size + (float)rng_int(r, 0, (int)(ox * 100.0f)) / 100.0f;
     float cz = lo[2] + 0.5f * size + (float)rng_int(r, 0, (int)(oz * 100.0f)) / 100.0f;
-    room_aabb box = aabb(cx - 0.5f * size, y, cz - 0.5f * size, cx + 0.5f * size, y + size, cz + 0.5f * size);
+    room_aabb box =
+        aabb(cx - 0.5f * size, y, cz - 0.5f * size, cx + 0.5f * size, y + size, cz + 0.5f * size);
     if (box.lo[0] < lo[0] || box.hi[0] > hi[0] || box.lo[2] < lo[2] || box.hi[2] > hi[2])
         return 0.0f;
     if (kind == 0) {
@@ -1011,7 +1030,8 @@ static int add_shelves(room_plan *p)
     int boards = rng_int(r, 3, 6);
     float first = rng_cm(r, 6, 15), spacing = (hgt - t - first) / (float)(boards - 1);
     for (int i = 0; i < boards; i++) {
-        float y0 = i == boards - 1 ? hgt - t : first + spacing * (float)i, y1 = i == boards - 1 ? hgt : y0 + t;
+        float y0 = i == boards - 1 ? hgt - t : first + spacing * (float)i,
+              y1 = i == boards - 1 ? hgt : y0 + t;
         add_wall_block(p, w, a, e, 0.0f, dep, y0, y1, W_BACK | W_START | W_END);
         if (i == boards - 1 || spacing < 0.2f)
             continue;
@@ -1019,13 +1039,15 @@ static int add_shelves(room_plan *p)
          * the wall or standing off it */
         float s = a + rng_cm(r, 6, 20);
         while (s < e - 0.12f) {
-            float wide = rng_cm(r, 6, 30), tall = rng_cm(r, 12, (int)((spacing - t - 0.06f) * 100.0f));
+            float wide = rng_cm(r, 6, 30),
+                  tall = rng_cm(r, 12, (int)((spacing - t - 0.06f) * 100.0f));
             if (s + wide > e - 0.06f || tall < 0.12f)
                 break;
             float d0 = rng_percent(r, 60) ? 0.0f : rng_cm(r, 6, 8);
             float d1 = d0 + rng_cm(r, 12, (int)((dep - d0) * 100.0f));
             if (rng_percent(r, 75))
-                add_wall_block(p, w, s, s + wide, d0, d1, y1, y1 + tall, W_BOTTOM | (d0 == 0.0f ? W_BACK : 0));
+                add_wall_block(p, w, s, s + wide, d0, d1, y1, y1 + tall,
+                               W_BOTTOM | (d0 == 0.0f ? W_BACK : 0));
             s += wide + rng_cm(r, 6, 40);
         }
     }
@@ -1071,8 +1093,10 @@ static int add_sofa(room_plan *p)
     float s1 = s0 + len;
     add_wall_block(p, w, s0, s1, 0.0f, dep, 0.0f, seat, W_BACK | W_BOTTOM | corner);
     add_wall_block(p, w, s0, s1, 0.0f, back_d, seat, back, W_BACK | W_BOTTOM | corner);
-    add_wall_block(p, w, s0, s0 + arm_w, back_d, dep, seat, arm, W_BACK | W_BOTTOM | (corner & W_START));
-    add_wall_block(p, w, s1 - arm_w, s1, back_d, dep, seat, arm, W_BACK | W_BOTTOM | (corner & W_END));
+    add_wall_block(p, w, s0, s0 + arm_w, back_d, dep, seat, arm,
+                   W_BACK | W_BOTTOM | (corner & W_START));
+    add_wall_block(p, w, s1 - arm_w, s1, back_d, dep, seat, arm,
+                   W_BACK | W_BOTTOM | (corner & W_END));
     room_aabb box = wall_box(w, s0, s1, 0.0f, dep, 0.0f, back, 0, NULL);
     take(p, &box);
     return 1;
@@ -1080,13 +1104,14 @@ static int add_sofa(room_plan *p)
 
 /* A table: a top t thick at height h over four legs (long thin shadows),
  * footprint lo..hi in the builder's frame. */
-static void add_table_at(room_builder *b, float x0, float z0, float x1, float z1, float h, float t, float leg,
-                         float inset)
+static void add_table_at(room_builder *b, float x0, float z0, float x1, float z1, float h, float t,
+                         float leg, float inset)
 {
     float top_lo[3] = {x0, h - t, z0}, top_hi[3] = {x1, h, z1};
     add_block(b, top_lo, top_hi, 0);
     for (int i = 0; i < 4; i++) {
-        float lx = (i & 1) ? x1 - inset - leg : x0 + inset, lz = (i & 2) ? z1 - inset - leg : z0 + inset;
+        float lx = (i & 1) ? x1 - inset - leg : x0 + inset,
+              lz = (i & 2) ? z1 - inset - leg : z0 + inset;
         float lo[3] = {lx, 0.0f, lz}, hi[3] = {lx + leg, h - t, lz + leg};
         add_block(b, lo, hi, OMIT_BOTTOM | OMIT_TOP);
     }
@@ -1095,15 +1120,16 @@ static void add_table_at(room_builder *b, float x0, float z0, float x1, float z1
 /* A chair facing (fx, fz) (a unit axis direction), its seat centred on
  * (cx, cz): four legs, the seat, a thin back standing on the seat. Its
  * footprint is w (across) by d (deep). */
-static void add_chair_at(room_builder *b, float cx, float cz, float fx, float fz, float w, float d, float seat,
-                         float back)
+static void add_chair_at(room_builder *b, float cx, float cz, float fx, float fz, float w, float d,
+                         float seat, float back)
 {
     /* local +z is the chair's front: turned so that it maps to (fx, fz) */
     turn(b, fz, fx, cx, cz);
     float x0 = -0.5f * w, x1 = 0.5f * w, z0 = -0.5f * d, z1 = 0.5f * d;
     const float t = 0.04f, leg = 0.035f;
     for (int i = 0; i < 4; i++) {
-        float lx = (i & 1) ? x1 - leg - 0.01f : x0 + 0.01f, lz = (i & 2) ? z1 - leg - 0.01f : z0 + 0.01f;
+        float lx = (i & 1) ? x1 - leg - 0.01f : x0 + 0.01f,
+              lz = (i & 2) ? z1 - leg - 0.01f : z0 + 0.01f;
         float lo[3] = {lx, 0.0f, lz}, hi[3] = {lx + leg, seat - t, lz + leg};
         add_block(b, lo, hi, OMIT_BOTTOM | OMIT_TOP);
     }
@@ -1128,7 +1154,8 @@ static int try_chair(room_plan *p, float cx, float cz, float fx, float fz)
     float w, d, seat, back;
     chair_dims(&p->rng, &w, &d, &seat, &back);
     float ex = fx != 0.0f ? d : w, ez = fx != 0.0f ? w : d;
-    room_aabb box = aabb(cx - 0.5f * ex, 0.0f, cz - 0.5f * ez, cx + 0.5f * ex, back, cz + 0.5f * ez);
+    room_aabb box =
+        aabb(cx - 0.5f * ex, 0.0f, cz - 0.5f * ez, cx + 0.5f * ex, back, cz + 0.5f * ez);
     if (!fits(p, &box, 0.05f, 0.1f))
         return 0;
     add_chair_at(p->b, cx, cz, fx, fz, w, d, seat, back);
@@ -1165,8 +1192,10 @@ static int add_desk(room_plan *p)
     /* the chair: half under the desk's front edge would bury it; in
      * front, facing the wall */
     float out = gap + dep + rng_cm(r, 12, 35) + 0.25f;
-    float s = s0 + 0.5f * len, fx = w->axis == 0 ? (float)-w->in : 0.0f, fz = w->axis == 2 ? (float)-w->in : 0.0f;
-    float cx = w->axis == 0 ? w->at + (float)w->in * out : s, cz = w->axis == 2 ? w->at + (float)w->in * out : s;
+    float s = s0 + 0.5f * len, fx = w->axis == 0 ? (float)-w->in : 0.0f,
+          fz = w->axis == 2 ? (float)-w->in : 0.0f;
+    float cx = w->axis == 0 ? w->at + (float)w->in * out : s,
+          cz = w->axis == 2 ? w->at + (float)w->in * out : s;
     try_chair(p, cx, cz, fx, fz);
     return 1;
 }
@@ -1270,7 +1299,8 @@ static int add_dining(room_plan *p)
 static int add_round_table(room_plan *p)
 {
     room_rng *r = &p->rng;
-    float rad = rng_cm(r, 35, 65), h = rng_cm(r, 55, 76), t = rng_cm(r, 3, 5), leg = rng_cm(r, 4, 8);
+    float rad = rng_cm(r, 35, 65), h = rng_cm(r, 55, 76), t = rng_cm(r, 3, 5),
+          leg = rng_cm(r, 4, 8);
     float cx, cz;
     if (!find_floor_spot(p, 2.0f * rad, 2.0f * rad, 0.0f, h, &cx, &cz))
         return 0;
@@ -1353,7 +1383,8 @@ static int add_screen(room_plan *p)
     float cx, cz;
     if (!find_floor_spot(p, sx, sz, 0.0f, h, &cx, &cz))
         return 0;
-    float lo[3] = {cx - 0.5f * sx, 0.0f, cz - 0.5f * sz}, hi[3] = {cx + 0.5f * sx, h, cz + 0.5f * sz};
+    float lo[3] = {cx - 0.5f * sx, 0.0f, cz - 0.5f * sz},
+          hi[3] = {cx + 0.5f * sx, h, cz + 0.5f * sz};
     add_block(p->b, lo, hi, OMIT_BOTTOM);
     room_aabb box = aabb(lo[0], 0.0f, lo[2], hi[0], h, hi[2]);
     take(p, &box);
@@ -1389,8 +1420,8 @@ static int add_door_frame(room_plan *p)
     }
     float lo[3] = {x0, h, z0}, hi[3] = {x1, h + beam, z1};
     add_block(p->b, lo, hi, 0);
-    room_aabb box = aabb(along_x ? x0 : cx - 0.8f, 0.0f, along_x ? cz - 0.8f : z0, along_x ? x1 : cx + 0.8f,
-                         h + beam, along_x ? cz + 0.8f : z1);
+    room_aabb box = aabb(along_x ? x0 : cx - 0.8f, 0.0f, along_x ? cz - 0.8f : z0,
+                         along_x ? x1 : cx + 0.8f, h + beam, along_x ? cz + 0.8f : z1);
     take(p, &box);
     return 1;
 }
@@ -1401,7 +1432,8 @@ static int add_lamp(room_plan *p)
 {
     room_rng *r = &p->rng;
     int drum = rng_percent(r, 40);
-    float size = drum ? rng_cm(r, 30, 70) : rng_cm(r, 50, 140), t = drum ? rng_cm(r, 20, 40) : 0.02f;
+    float size = drum ? rng_cm(r, 30, 70) : rng_cm(r, 50, 140),
+          t = drum ? rng_cm(r, 20, 40) : 0.02f;
     float low = p->height - 2.3f < 2.05f ? 2.05f : p->height - 2.3f;
     if (low + t > p->height - 0.3f)
         return 0;
@@ -1413,12 +1445,14 @@ static int add_lamp(room_plan *p)
     if (drum) {
         add_cylinder(p->b, cx, cz, y0, y1, 0.5f * size, 0);
     } else {
-        float lo[3] = {cx - 0.5f * size, y0, cz - 0.5f * size}, hi[3] = {cx + 0.5f * size, y1, cz + 0.5f * size};
+        float lo[3] = {cx - 0.5f * size, y0, cz - 0.5f * size},
+              hi[3] = {cx + 0.5f * size, y1, cz + 0.5f * size};
         add_block(p->b, lo, hi, 0);
     }
     float c_lo[3] = {cx - 0.006f, y1, cz - 0.006f}, c_hi[3] = {cx + 0.006f, p->height, cz + 0.006f};
     add_block(p->b, c_lo, c_hi, OMIT_BOTTOM | OMIT_TOP);
-    room_aabb box = aabb(cx - 0.5f * size, y0, cz - 0.5f * size, cx + 0.5f * size, p->height, cz + 0.5f * size);
+    room_aabb box =
+        aabb(cx - 0.5f * size, y0, cz - 0.5f * size, cx + 0.5f * size, p->height, cz + 0.5f * size);
     take(p, &box);
     return 1;
 }
@@ -1436,10 +1470,12 @@ static int add_pillar(room_plan *p)
     if (round) {
         add_cylinder(p->b, cx, cz, 0.0f, p->height, 0.5f * a, OMIT_BOTTOM | OMIT_TOP);
     } else {
-        float lo[3] = {cx - 0.5f * a, 0.0f, cz - 0.5f * a}, hi[3] = {cx + 0.5f * a, p->height, cz + 0.5f * a};
+        float lo[3] = {cx - 0.5f * a, 0.0f, cz - 0.5f * a},
+              hi[3] = {cx + 0.5f * a, p->height, cz + 0.5f * a};
         add_block(p->b, lo, hi, OMIT_BOTTOM | OMIT_TOP);
     }
-    room_aabb box = aabb(cx - 0.5f * a, 0.0f, cz - 0.5f * a, cx + 0.5f * a, p->height, cz + 0.5f * a);
+    room_aabb box =
+        aabb(cx - 0.5f * a, 0.0f, cz - 0.5f * a, cx + 0.5f * a, p->height, cz + 0.5f * a);
     take(p, &box);
     return 1;
 }
@@ -1453,8 +1489,9 @@ static void furnish(room_plan *p)
     int pillars = area > 150.0f ? rng_int(r, 0, 4) : rng_int(r, 0, 2);
     for (int i = 0; i < pillars; i++)
         add_pillar(p);
-    int (*const against_wall[])(room_plan *) = {add_shelves, add_shelves, add_cabinet, add_cabinet, add_sofa,
-                                                add_desk,    add_desk,    add_corner_crates, add_pilaster};
+    int (*const against_wall[])(room_plan *) = {add_shelves, add_shelves,       add_cabinet,
+                                                add_cabinet, add_sofa,          add_desk,
+                                                add_desk,    add_corner_crates, add_pilaster};
     const int kinds = (int)(sizeof against_wall / sizeof against_wall[0]);
     /* roughly one item per 3 m of wall */
     int items = (int)(4.0f * (p->hx + p->hz) / 3.0f);
@@ -1463,8 +1500,9 @@ static void furnish(room_plan *p)
     int lamps = rng_int(r, 1, 3);
     for (int i = 0; i < lamps; i++)
         add_lamp(p);
-    int (*const standing[])(room_plan *) = {add_dining, add_dining, add_round_table, add_crate_stack,
-                                            add_crate_stack, add_ball, add_barrel, add_screen, add_door_frame};
+    int (*const standing[])(room_plan *) = {add_dining,      add_dining,      add_round_table,
+                                            add_crate_stack, add_crate_stack, add_ball,
+                                            add_barrel,      add_screen,      add_door_frame};
     const int free_kinds = (int)(sizeof standing / sizeof standing[0]);
     /* most kinds once (where they fit), then more at random */
     for (int i = 0; i < free_kinds; i++)
@@ -1490,7 +1528,8 @@ vb_result vb_builtin_room_variant(uint32_t n, vb_mesh *out, vb_error *err)
      * 46 per m^2 of shell, plus the furniture). */
     float W = 12.0f, D = 10.0f, H = 4.0f;
     for (int attempt = 0; attempt < 1000; attempt++) {
-        float w = rng_cm(&p.rng, 800, 2500), d = rng_cm(&p.rng, 800, 2500), h = rng_cm(&p.rng, 250, 800);
+        float w = rng_cm(&p.rng, 800, 2500), d = rng_cm(&p.rng, 800, 2500),
+              h = rng_cm(&p.rng, 250, 800);
         float shell = 2.0f * w * d + 2.0f * h * (w + d);
         if (shell >= 300.0f && shell <= 850.0f) {
             W = w, D = d, H = h;
@@ -1558,13 +1597,15 @@ vb_result vb_builtin_load(const char *name, vb_mesh *out, vb_error *err)
             n = 10 * n + (uint64_t)(d[i] - '0');
         }
         if (!ok || n > UINT32_MAX)
-            return vb_fail(err, VB_ERR_ARGUMENT,
-                           "%s: unknown built-in scene: N in builtin:room:N is a whole number from 1 to "
-                           "4294967295, without leading zeros",
-                           name);
+            return vb_fail(
+                err, VB_ERR_ARGUMENT,
+                "%s: unknown built-in scene: N in builtin:room:N is a whole number from 1 to "
+                "4294967295, without leading zeros",
+                name);
         return vb_builtin_room_variant((uint32_t)n, out, err);
     }
-    return vb_fail(err, VB_ERR_ARGUMENT,
-                   "%s: unknown built-in scene (known: builtin:room, builtin:room:N for N = 1 .. 4294967295)",
-                   name);
+    return vb_fail(
+        err, VB_ERR_ARGUMENT,
+        "%s: unknown built-in scene (known: builtin:room, builtin:room:N for N = 1 .. 4294967295)",
+        name);
 }

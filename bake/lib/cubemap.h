@@ -76,16 +76,15 @@ extern "C" {
 
 /* A cube map in memory. */
 typedef struct vb_cubemap {
-    int size;       /* n: texels per face edge */
-    float *rgba;    /* n * 6n * 4 floats, layout above; owned */
+    int size;    /* n: texels per face edge */
+    float *rgba; /* n * 6n * 4 floats, layout above; owned */
 } vb_cubemap;
 
 /* Write one cube map of face size n (1..VB_CUBEMAP_MAX_SIZE) to `path`,
  * atomically. Every value must be finite and round to a finite half
  * (|v| < 65520), else VB_ERR_INVALID names the texel and nothing is
  * written. */
-vb_result vb_cubemap_write(const char *path, int n, const float *rgba,
-                           vb_error *err);
+vb_result vb_cubemap_write(const char *path, int n, const float *rgba, vb_error *err);
 
 /* Read one cube map. The file must be a single-level scanline OpenEXR
  * image with envmap = cube, height == 6 * width, width in
@@ -102,16 +101,15 @@ void vb_cubemap_free(vb_cubemap *map);
  * working directory); a trailing '/' in dir is not doubled. Writes the
  * NUL-terminated path into buf[size]; VB_ERR_ARGUMENT if it does not
  * fit (buf untouched). */
-vb_result vb_cubemap_basis_path(const char *dir, const char *stem, int k,
-                                char *buf, size_t size, vb_error *err);
+vb_result vb_cubemap_basis_path(const char *dir, const char *stem, int k, char *buf, size_t size,
+                                vb_error *err);
 
 /* Fill (vdsh_cube_fill_basis) and write the four basis files of face
  * size n into dir. All four are written to temporary files first and
  * renamed only when all four succeeded, so a failure leaves every
  * destination as it was (only a failing rename, after the first one
  * succeeded, can leave a mix; the message says so). */
-vb_result vb_cubemap_write_basis(const char *dir, const char *stem, int n,
-                                 vb_error *err);
+vb_result vb_cubemap_write_basis(const char *dir, const char *stem, int n, vb_error *err);
 
 /* vb_cubemap_write_basis in two steps, so that the encoding (mostly
  * deflate) can run while the caller does other work: the four files of
@@ -119,33 +117,29 @@ vb_result vb_cubemap_write_basis(const char *dir, const char *stem, int n,
  * dir, staged and renamed as vb_cubemap_write_basis does.
  * vb_cubemap_basis_free frees an encoded or zeroed set. */
 typedef struct vb_cubemap_basis {
-    int size;                                      /* n */
-    unsigned char *bytes[VB_CUBEMAP_BASIS_FILES];  /* the files; owned */
+    int size;                                     /* n */
+    unsigned char *bytes[VB_CUBEMAP_BASIS_FILES]; /* the files; owned */
     size_t length[VB_CUBEMAP_BASIS_FILES];
 } vb_cubemap_basis;
 
 vb_result vb_cubemap_basis_encode(int n, vb_cubemap_basis *out, vb_error *err);
-vb_result vb_cubemap_basis_write(const vb_cubemap_basis *b, const char *dir,
-                                 const char *stem, vb_error *err);
+vb_result vb_cubemap_basis_write(const vb_cubemap_basis *b, const char *dir, const char *stem,
+                                 vb_error *err);
 /* The first half of vb_cubemap_basis_write, for files that must change
  * together with others (job.h, vb_write_outputs): the four files written
  * to temporaries beside their targets and on disk, nothing renamed yet.
  * The caller commits (vdsh_output_commit) or aborts (vdsh_output_abort)
  * each of staged[0..3]; on failure every one is aborted already. */
-vb_result vb_cubemap_basis_stage(const vb_cubemap_basis *b, const char *dir,
-                                 const char *stem,
-                                 vdsh_output staged[VB_CUBEMAP_BASIS_FILES],
-                                 vb_error *err);
+vb_result vb_cubemap_basis_stage(const vb_cubemap_basis *b, const char *dir, const char *stem,
+                                 vdsh_output staged[VB_CUBEMAP_BASIS_FILES], vb_error *err);
 void vb_cubemap_basis_free(vb_cubemap_basis *b);
 
 /* Read the four basis files. expected_size > 0 requires that face size
  * (the cube_size of the .vdsh header); 0 accepts any size as long as all
  * four agree. On success out[k] holds SH functions 9+4k .. 12+4k; on
  * failure out is untouched and nothing stays allocated. */
-vb_result vb_cubemap_read_basis(const char *dir, const char *stem,
-                                int expected_size,
-                                vb_cubemap *out[VB_CUBEMAP_BASIS_FILES],
-                                vb_error *err);
+vb_result vb_cubemap_read_basis(const char *dir, const char *stem, int expected_size,
+                                vb_cubemap *out[VB_CUBEMAP_BASIS_FILES], vb_error *err);
 
 #ifdef __cplusplus
 }

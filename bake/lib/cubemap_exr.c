@@ -42,10 +42,10 @@
 /* I/O callbacks and error capture                                      */
 
 typedef struct exr_io {
-    int fd;             /* -1: writes go to mem */
-    int os_errno;       /* errno of the first failed read or write, or 0 */
-    char msg[256];      /* first message OpenEXR reported since reset */
-    uint8_t *mem;       /* a file written to memory: size bytes, cap allocated */
+    int fd;        /* -1: writes go to mem */
+    int os_errno;  /* errno of the first failed read or write, or 0 */
+    char msg[256]; /* first message OpenEXR reported since reset */
+    uint8_t *mem;  /* a file written to memory: size bytes, cap allocated */
     size_t size, cap;
 } exr_io;
 
@@ -54,8 +54,7 @@ static void io_reset_msg(exr_io *io)
     io->msg[0] = '\0';
 }
 
-static void on_exr_error(exr_const_context_t ctxt, exr_result_t code,
-                         const char *msg)
+static void on_exr_error(exr_const_context_t ctxt, exr_result_t code, const char *msg)
 {
     void *ud = NULL;
     /* A NULL context only happens when OpenEXR cannot allocate one; the
@@ -66,17 +65,15 @@ static void on_exr_error(exr_const_context_t ctxt, exr_result_t code,
     /* The first message of a failing step is the specific one; later
      * ones tend to be consequences ("failed to read chunk"). */
     if (io->msg[0] == '\0')
-        snprintf(io->msg, sizeof io->msg, "%s",
-                 msg ? msg : exr_get_error_code_as_string(code));
+        snprintf(io->msg, sizeof io->msg, "%s", msg ? msg : exr_get_error_code_as_string(code));
 }
 
 /* Read into `to` or write from `from` the whole of [offset, offset +
  * size) of io's file, at most 1 GiB a call, through interruptions. The
  * bytes moved (fewer when a read meets the end of the file: OpenEXR
  * reports the short read), or -1 with the first errno kept in io. */
-static int64_t io_transfer(exr_const_context_t ctxt, exr_io *io, uint8_t *to,
-                           const uint8_t *from, uint64_t size, uint64_t offset,
-                           exr_stream_error_func_ptr_t error_cb)
+static int64_t io_transfer(exr_const_context_t ctxt, exr_io *io, uint8_t *to, const uint8_t *from,
+                           uint64_t size, uint64_t offset, exr_stream_error_func_ptr_t error_cb)
 {
     uint64_t done = 0;
     while (done < size) {
@@ -102,16 +99,15 @@ static int64_t io_transfer(exr_const_context_t ctxt, exr_io *io, uint8_t *to,
     return (int64_t)done;
 }
 
-static int64_t io_read(exr_const_context_t ctxt, void *ud, void *buffer,
-                       uint64_t size, uint64_t offset,
-                       exr_stream_error_func_ptr_t error_cb)
+static int64_t io_read(exr_const_context_t ctxt, void *ud, void *buffer, uint64_t size,
+                       uint64_t offset, exr_stream_error_func_ptr_t error_cb)
 {
     exr_io *io = ud;
     uint8_t *p = buffer;
     if (offset > (uint64_t)INT64_MAX || size > (uint64_t)INT64_MAX - offset) {
         if (error_cb)
-            error_cb(ctxt, EXR_ERR_READ_IO, "read of %" PRIu64
-                     " bytes at offset %" PRIu64 " out of range", size, offset);
+            error_cb(ctxt, EXR_ERR_READ_IO,
+                     "read of %" PRIu64 " bytes at offset %" PRIu64 " out of range", size, offset);
         return -1;
     }
     return io_transfer(ctxt, io, p, NULL, size, offset, error_cb);
@@ -127,9 +123,8 @@ static int64_t io_size(exr_const_context_t ctxt, void *ud)
     return (int64_t)st.st_size;
 }
 
-static int64_t io_write(exr_const_context_t ctxt, void *ud, const void *buffer,
-                        uint64_t size, uint64_t offset,
-                        exr_stream_error_func_ptr_t error_cb)
+static int64_t io_write(exr_const_context_t ctxt, void *ud, const void *buffer, uint64_t size,
+                        uint64_t offset, exr_stream_error_func_ptr_t error_cb)
 {
     exr_io *io = ud;
     const uint8_t *p = buffer;
@@ -166,9 +161,8 @@ static int64_t io_write(exr_const_context_t ctxt, void *ud, const void *buffer,
 /* Turn a failed OpenEXR call into a vb_result and a message:
  * "<path>: <what>: <OpenEXR's message>". `otherwise` is the code when
  * neither the OS nor memory is to blame (FORMAT when reading). */
-static vb_result exr_fail(vb_error *err, const exr_io *io, exr_result_t rv,
-                          vb_result otherwise, const char *path,
-                          const char *what)
+static vb_result exr_fail(vb_error *err, const exr_io *io, exr_result_t rv, vb_result otherwise,
+                          const char *path, const char *what)
 {
     vb_result r = otherwise;
     if (rv == EXR_ERR_OUT_OF_MEMORY)
@@ -209,20 +203,19 @@ static exr_context_initializer_t context_init(exr_io *io)
 /* In encode_exr and decode_exr: run an OpenEXR call; when it fails, r is
  * its vb_result (the function's `otherwise` when neither the OS nor
  * memory is to blame) and the function goes to its clean-up. */
-#define EXR_TRY(call, what)                                                   \
-    do {                                                                      \
-        io_reset_msg(io);                                                     \
-        rv = (call);                                                          \
-        if (rv != EXR_ERR_SUCCESS) {                                          \
-            r = exr_fail(err, io, rv, otherwise, path, (what));               \
-            goto done;                                                        \
-        }                                                                     \
+#define EXR_TRY(call, what)                                                                        \
+    do {                                                                                           \
+        io_reset_msg(io);                                                                          \
+        rv = (call);                                                                               \
+        if (rv != EXR_ERR_SUCCESS) {                                                               \
+            r = exr_fail(err, io, rv, otherwise, path, (what));                                    \
+            goto done;                                                                             \
+        }                                                                                          \
     } while (0)
 
 /* Encode the image through *io_out: into its open file descriptor, or
  * into memory when that is -1. `path` is only for messages. */
-static vb_result encode_exr(const char *path, exr_io *io, int n, const float *rgba,
-                            vb_error *err)
+static vb_result encode_exr(const char *path, exr_io *io, int n, const float *rgba, vb_error *err)
 {
     exr_context_t ctxt = NULL;
     exr_encode_pipeline_t enc;
@@ -239,24 +232,20 @@ static vb_result encode_exr(const char *path, exr_io *io, int n, const float *rg
     /* The header: exactly what cube maps need, nothing that varies from
      * run to run (no date, no software version), so the bytes depend on
      * the pixels only. */
-    EXR_TRY(exr_start_write(&ctxt, path, EXR_WRITE_FILE_DIRECTLY, &init),
-            "cannot start writing");
-    EXR_TRY(exr_add_part(ctxt, NULL, EXR_STORAGE_SCANLINE, &part),
-            "cannot add image part");
-    EXR_TRY(exr_initialize_required_attr_simple(ctxt, part, n, 6 * n,
-                                                EXR_COMPRESSION_ZIP),
+    EXR_TRY(exr_start_write(&ctxt, path, EXR_WRITE_FILE_DIRECTLY, &init), "cannot start writing");
+    EXR_TRY(exr_add_part(ctxt, NULL, EXR_STORAGE_SCANLINE, &part), "cannot add image part");
+    EXR_TRY(exr_initialize_required_attr_simple(ctxt, part, n, 6 * n, EXR_COMPRESSION_ZIP),
             "cannot set header");
     /* OpenEXR keeps the channel list sorted (A, B, G, R in the file). */
     static const char *const names[4] = {"R", "G", "B", "A"};
     for (int c = 0; c < 4; c++)
-        EXR_TRY(exr_add_channel(ctxt, part, names[c], EXR_PIXEL_HALF,
-                                EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1),
+        EXR_TRY(exr_add_channel(ctxt, part, names[c], EXR_PIXEL_HALF, EXR_PERCEPTUALLY_LOGARITHMIC,
+                                1, 1),
                 "cannot add channel");
     EXR_TRY(exr_attr_set_envmap(ctxt, part, "envmap", EXR_ENVMAP_CUBE),
             "cannot set envmap attribute");
     EXR_TRY(exr_write_header(ctxt), "cannot write header");
-    EXR_TRY(exr_get_scanlines_per_chunk(ctxt, part, &lines),
-            "cannot query chunk size");
+    EXR_TRY(exr_get_scanlines_per_chunk(ctxt, part, &lines), "cannot query chunk size");
 
     /* One chunk of `lines` scanlines at a time; OpenEXR converts our
      * floats to half (round to nearest even) while packing. Unlike its
@@ -266,23 +255,20 @@ static vb_result encode_exr(const char *path, exr_io *io, int n, const float *rg
      * against vdsh_f16_from_f32. */
     for (int y = 0; y < 6 * n; y += lines) {
         exr_chunk_info_t ci;
-        EXR_TRY(exr_write_scanline_chunk_info(ctxt, part, y, &ci),
-                "cannot prepare scanline chunk");
+        EXR_TRY(exr_write_scanline_chunk_info(ctxt, part, y, &ci), "cannot prepare scanline chunk");
         if (!enc_live) {
-            EXR_TRY(exr_encoding_initialize(ctxt, part, &ci, &enc),
-                    "cannot start encoder");
+            EXR_TRY(exr_encoding_initialize(ctxt, part, &ci, &enc), "cannot start encoder");
             enc_live = 1;
         } else {
-            EXR_TRY(exr_encoding_update(ctxt, part, &ci, &enc),
-                    "cannot update encoder");
+            EXR_TRY(exr_encoding_update(ctxt, part, &ci, &enc), "cannot update encoder");
         }
         for (int c = 0; c < enc.channel_count; c++) {
             exr_coding_channel_info_t *ch = &enc.channels[c];
             int comp = channel_component(ch->channel_name);
             /* We declared exactly R, G, B, A. */
             if (comp < 0) {
-                r = vb_fail(err, VB_ERR_IO, "%s: unexpected channel '%s'",
-                            path, ch->channel_name ? ch->channel_name : "?");
+                r = vb_fail(err, VB_ERR_IO, "%s: unexpected channel '%s'", path,
+                            ch->channel_name ? ch->channel_name : "?");
                 goto done;
             }
             ch->user_data_type = EXR_PIXEL_FLOAT;
@@ -326,8 +312,10 @@ static vb_result stage(const char *path, int n, const float *rgba, const exr_io 
     vdsh_error ve;
     vdsh_result vr = vdsh_output_open(path, out, &ve);
     if (vr != VDSH_OK)
-        return vb_fail(err, vr == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY
-                            : vr == VDSH_ERR_ARGUMENT ? VB_ERR_ARGUMENT : VB_ERR_IO,
+        return vb_fail(err,
+                       vr == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY
+                       : vr == VDSH_ERR_ARGUMENT    ? VB_ERR_ARGUMENT
+                                                    : VB_ERR_IO,
                        "%s", ve.msg);
     /* OpenEXR writes at offsets: straight to the descriptor, never
      * through the (unused) stream. */
@@ -337,8 +325,7 @@ static vb_result stage(const char *path, int n, const float *rgba, const exr_io 
     if (!encoded)
         r = encode_exr(path, &io, n, rgba, err);
     else if (io_write(NULL, &io, encoded->mem, encoded->size, 0, NULL) < 0)
-        r = vb_fail(err, VB_ERR_IO, "%s: cannot write %s: %s", path, tmp,
-                    strerror(io.os_errno));
+        r = vb_fail(err, VB_ERR_IO, "%s: cannot write %s: %s", path, tmp, strerror(io.os_errno));
     if (r != VB_OK) {
         vdsh_output_abort(out);
         return r;
@@ -359,14 +346,12 @@ static vb_result commit(vdsh_output *s, vb_error *err)
 static vb_result check_size(const char *what, int n, vb_error *err)
 {
     if (n < 1 || n > VB_CUBEMAP_MAX_SIZE)
-        return vb_fail(err, VB_ERR_ARGUMENT,
-                       "%s: cube map face size %d not in 1..%d", what, n,
+        return vb_fail(err, VB_ERR_ARGUMENT, "%s: cube map face size %d not in 1..%d", what, n,
                        VB_CUBEMAP_MAX_SIZE);
     return VB_OK;
 }
 
-vb_result vb_cubemap_write(const char *path, int n, const float *rgba,
-                           vb_error *err)
+vb_result vb_cubemap_write(const char *path, int n, const float *rgba, vb_error *err)
 {
     if (!path || !path[0] || !rgba)
         return vb_fail(err, VB_ERR_ARGUMENT, "vb_cubemap_write: %s is NULL",
@@ -384,8 +369,8 @@ vb_result vb_cubemap_write(const char *path, int n, const float *rgba,
             return vb_fail(err, VB_ERR_INVALID,
                            "%s: value %g at face %zu texel (%zu, %zu) channel "
                            "%c is not representable as a finite half",
-                           path, (double)rgba[k], row / (size_t)n,
-                           texel % (size_t)n, row % (size_t)n, "RGBA"[k % 4]);
+                           path, (double)rgba[k], row / (size_t)n, texel % (size_t)n,
+                           row % (size_t)n, "RGBA"[k % 4]);
         }
     }
 
@@ -460,8 +445,7 @@ static exr_result_t unpack_to_float(exr_decode_pipeline_t *d)
     return EXR_ERR_SUCCESS;
 }
 
-static vb_result decode_exr(const char *path, exr_io *io, vb_cubemap **out,
-                            vb_error *err)
+static vb_result decode_exr(const char *path, exr_io *io, vb_cubemap **out, vb_error *err)
 {
     const vb_result otherwise = VB_ERR_FORMAT; /* EXR_TRY's */
     exr_context_t ctxt = NULL;
@@ -479,10 +463,10 @@ static vb_result decode_exr(const char *path, exr_io *io, vb_cubemap **out,
      * by scanning the file for chunks. */
     init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
 
-#define BAD(...)                                                              \
-    do {                                                                      \
-        r = vb_fail(err, VB_ERR_FORMAT, __VA_ARGS__);                         \
-        goto done;                                                            \
+#define BAD(...)                                                                                   \
+    do {                                                                                           \
+        r = vb_fail(err, VB_ERR_FORMAT, __VA_ARGS__);                                              \
+        goto done;                                                                                 \
     } while (0)
 
     EXR_TRY(exr_start_read(&ctxt, path, &init), "not a readable OpenEXR file");
@@ -491,8 +475,8 @@ static vb_result decode_exr(const char *path, exr_io *io, vb_cubemap **out,
     EXR_TRY(exr_get_storage(ctxt, 0, &storage), "cannot read storage type");
     if (storage != EXR_STORAGE_SCANLINE)
         BAD("%s: %s OpenEXR images are not supported (cube maps are read "
-            "from scanline images)", path,
-            storage == EXR_STORAGE_TILED ? "tiled" : "deep");
+            "from scanline images)",
+            path, storage == EXR_STORAGE_TILED ? "tiled" : "deep");
 
     /* Is it a cube map at all? */
     const exr_attribute_t *attr = NULL;
@@ -509,10 +493,8 @@ static vb_result decode_exr(const char *path, exr_io *io, vb_cubemap **out,
             attr->type_name ? attr->type_name : "?");
     if (attr->uc != EXR_ENVMAP_CUBE) {
         if (attr->uc == EXR_ENVMAP_LATLONG)
-            BAD("%s: not a cube environment map (envmap is latitude-longitude)",
-                path);
-        BAD("%s: not a cube environment map (envmap value %u)", path,
-            (unsigned)attr->uc);
+            BAD("%s: not a cube environment map (envmap is latitude-longitude)", path);
+        BAD("%s: not a cube environment map (envmap value %u)", path, (unsigned)attr->uc);
     }
 
     /* Shape: n wide, 6n tall. */
@@ -523,11 +505,9 @@ static vb_result decode_exr(const char *path, exr_io *io, vb_cubemap **out,
     if (w < 1 || h < 1)
         BAD("%s: empty data window", path);
     if (h != 6 * w)
-        BAD("%s: image is %" PRId64 " x %" PRId64 "; a cube map is n x 6n", path,
-            w, h);
+        BAD("%s: image is %" PRId64 " x %" PRId64 "; a cube map is n x 6n", path, w, h);
     if (w > VB_CUBEMAP_MAX_SIZE)
-        BAD("%s: cube map face size %" PRId64 " not in 1..%d", path, w,
-            VB_CUBEMAP_MAX_SIZE);
+        BAD("%s: cube map face size %" PRId64 " not in 1..%d", path, w, VB_CUBEMAP_MAX_SIZE);
     int n = (int)w;
 
     /* Channels R, G, B, A, half or float, full resolution. */
@@ -561,27 +541,24 @@ static vb_result decode_exr(const char *path, exr_io *io, vb_cubemap **out,
     if (map)
         map->rgba = calloc(cube_floats(n), sizeof(float));
     if (!map || !map->rgba) {
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY,
-                    "%s: out of memory for a %d x %d cube map", path, n, 6 * n);
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory for a %d x %d cube map", path, n,
+                    6 * n);
         goto done;
     }
     map->size = n;
 
     for (int64_t y = dw.min.y; y <= dw.max.y; y += lines) {
         exr_chunk_info_t ci;
-        EXR_TRY(exr_read_scanline_chunk_info(ctxt, 0, (int)y, &ci),
-                "cannot read scanline chunk");
+        EXR_TRY(exr_read_scanline_chunk_info(ctxt, 0, (int)y, &ci), "cannot read scanline chunk");
         /* The chunk must lie inside our buffer whatever the file says. */
         int64_t row = (int64_t)ci.start_y - dw.min.y;
         if (row < 0 || ci.height < 1 || row + ci.height > h || ci.width != w)
             BAD("%s: chunk for scanline %" PRId64 " has bad extent", path, y);
         if (!dec_live) {
-            EXR_TRY(exr_decoding_initialize(ctxt, 0, &ci, &dec),
-                    "cannot start decoder");
+            EXR_TRY(exr_decoding_initialize(ctxt, 0, &ci, &dec), "cannot start decoder");
             dec_live = 1;
         } else {
-            EXR_TRY(exr_decoding_update(ctxt, 0, &ci, &dec),
-                    "cannot update decoder");
+            EXR_TRY(exr_decoding_update(ctxt, 0, &ci, &dec), "cannot update decoder");
         }
         for (int c = 0; c < dec.channel_count; c++) {
             exr_coding_channel_info_t *ch = &dec.channels[c];
@@ -594,13 +571,11 @@ static vb_result decode_exr(const char *path, exr_io *io, vb_cubemap **out,
             ch->user_bytes_per_element = 4;
             ch->user_pixel_stride = 4 * (int32_t)sizeof(float);
             ch->user_line_stride = n * 4 * (int32_t)sizeof(float);
-            ch->decode_to_ptr =
-                (uint8_t *)(map->rgba + (size_t)row * (size_t)n * 4 + comp);
+            ch->decode_to_ptr = (uint8_t *)(map->rgba + (size_t)row * (size_t)n * 4 + comp);
         }
         if (y == dw.min.y) {
             /* OpenEXR's reader and decompressor, our unpacker. */
-            EXR_TRY(exr_decoding_choose_default_routines(ctxt, 0, &dec),
-                    "cannot choose decoder");
+            EXR_TRY(exr_decoding_choose_default_routines(ctxt, 0, &dec), "cannot choose decoder");
             dec.unpack_and_convert_fn = unpack_to_float;
         }
         EXR_TRY(exr_decoding_run(ctxt, 0, &dec), "cannot decode chunk");
@@ -614,8 +589,8 @@ static vb_result decode_exr(const char *path, exr_io *io, vb_cubemap **out,
             size_t texel = k / 4, yrow = texel / (size_t)n;
             r = vb_fail(err, VB_ERR_INVALID,
                         "%s: value at face %zu texel (%zu, %zu) channel %c is "
-                        "not finite", path, yrow / (size_t)n, texel % (size_t)n,
-                        yrow % (size_t)n, "RGBA"[k % 4]);
+                        "not finite",
+                        path, yrow / (size_t)n, texel % (size_t)n, yrow % (size_t)n, "RGBA"[k % 4]);
             goto done;
         }
     }
@@ -637,15 +612,13 @@ done:
 vb_result vb_cubemap_read(const char *path, vb_cubemap **out, vb_error *err)
 {
     if (!path || !path[0] || !out)
-        return vb_fail(err, VB_ERR_ARGUMENT, "vb_cubemap_read: %s is NULL",
-                       !out ? "out" : "path");
+        return vb_fail(err, VB_ERR_ARGUMENT, "vb_cubemap_read: %s is NULL", !out ? "out" : "path");
     exr_io io = {.fd = -1};
     /* O_NONBLOCK: opening a FIFO must not wait for a writer (it is refused
      * below); regular files ignore the flag. */
     io.fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (io.fd < 0)
-        return vb_fail(err, VB_ERR_IO, "%s: cannot open: %s", path,
-                       strerror(errno));
+        return vb_fail(err, VB_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
     struct stat st;
     if (fstat(io.fd, &st) == 0 && !S_ISREG(st.st_mode)) {
         close(io.fd);
@@ -667,41 +640,37 @@ void vb_cubemap_free(vb_cubemap *map)
 /* ------------------------------------------------------------------ */
 /* The set of four basis files                                          */
 
-vb_result vb_cubemap_basis_path(const char *dir, const char *stem, int k,
-                                char *buf, size_t size, vb_error *err)
+vb_result vb_cubemap_basis_path(const char *dir, const char *stem, int k, char *buf, size_t size,
+                                vb_error *err)
 {
     if (!stem || !stem[0] || !buf)
-        return vb_fail(err, VB_ERR_ARGUMENT,
-                       "vb_cubemap_basis_path: %s is NULL or empty",
+        return vb_fail(err, VB_ERR_ARGUMENT, "vb_cubemap_basis_path: %s is NULL or empty",
                        !buf ? "buf" : "stem");
     if (k < 0 || k >= VB_CUBEMAP_BASIS_FILES)
-        return vb_fail(err, VB_ERR_ARGUMENT,
-                       "vb_cubemap_basis_path: file index %d not in 0..%d", k,
+        return vb_fail(err, VB_ERR_ARGUMENT, "vb_cubemap_basis_path: file index %d not in 0..%d", k,
                        VB_CUBEMAP_BASIS_FILES - 1);
     const char *d = dir ? dir : "";
     size_t dl = strlen(d);
     const char *sep = (dl > 0 && d[dl - 1] != '/') ? "/" : "";
     int first = 9 + 4 * k;
     /* Measure first: buf must stay untouched on failure. */
-    int len = snprintf(NULL, 0, "%s%s%s.sh%02d-%02d.exr", d, sep, stem, first,
-                       first + 3);
+    int len = snprintf(NULL, 0, "%s%s%s.sh%02d-%02d.exr", d, sep, stem, first, first + 3);
     if (len < 0 || (size_t)len >= size)
         return vb_fail(err, VB_ERR_ARGUMENT,
-                       "%s%s%s: basis cubemap path too long (%d bytes, buffer %zu)",
-                       d, sep, stem, len, size);
+                       "%s%s%s: basis cubemap path too long (%d bytes, buffer %zu)", d, sep, stem,
+                       len, size);
     snprintf(buf, size, "%s%s%s.sh%02d-%02d.exr", d, sep, stem, first, first + 3);
     return VB_OK;
 }
 
 /* malloc'd path of basis file k. */
-static vb_result basis_path_alloc(const char *dir, const char *stem, int k,
-                                  char **out, vb_error *err)
+static vb_result basis_path_alloc(const char *dir, const char *stem, int k, char **out,
+                                  vb_error *err)
 {
     size_t size = (dir ? strlen(dir) : 0) + (stem ? strlen(stem) : 0) + 32;
     char *p = malloc(size);
     if (!p)
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory",
-                       stem ? stem : "basis path");
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory", stem ? stem : "basis path");
     vb_result r = vb_cubemap_basis_path(dir, stem, k, p, size, err);
     if (r != VB_OK) {
         free(p);
@@ -717,8 +686,7 @@ vb_result vb_cubemap_basis_encode(int n, vb_cubemap_basis *out, vb_error *err)
     float *rgba = NULL;
     vb_result r = check_size("vb_cubemap_basis_encode", n, err);
     if (r == VB_OK && !(rgba = malloc(cube_floats(n) * sizeof(float))))
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for a %d x %d cube map", n,
-                    6 * n);
+        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for a %d x %d cube map", n, 6 * n);
     for (int k = 0; r == VB_OK && k < VB_CUBEMAP_BASIS_FILES; k++) {
         char name[32];
         snprintf(name, sizeof name, "basis cubemap sh%02d-%02d", 9 + 4 * k, 12 + 4 * k);
@@ -736,10 +704,8 @@ vb_result vb_cubemap_basis_encode(int n, vb_cubemap_basis *out, vb_error *err)
     return r;
 }
 
-vb_result vb_cubemap_basis_stage(const vb_cubemap_basis *b, const char *dir,
-                                 const char *stem,
-                                 vdsh_output staged[VB_CUBEMAP_BASIS_FILES],
-                                 vb_error *err)
+vb_result vb_cubemap_basis_stage(const vb_cubemap_basis *b, const char *dir, const char *stem,
+                                 vdsh_output staged[VB_CUBEMAP_BASIS_FILES], vb_error *err)
 {
     char *paths[VB_CUBEMAP_BASIS_FILES] = {0};
     vb_result r = VB_OK;
@@ -759,8 +725,8 @@ vb_result vb_cubemap_basis_stage(const vb_cubemap_basis *b, const char *dir,
     return r;
 }
 
-vb_result vb_cubemap_basis_write(const vb_cubemap_basis *b, const char *dir,
-                                 const char *stem, vb_error *err)
+vb_result vb_cubemap_basis_write(const vb_cubemap_basis *b, const char *dir, const char *stem,
+                                 vb_error *err)
 {
     vdsh_output st[VB_CUBEMAP_BASIS_FILES];
     /* Stage all four, then rename: a failure while writing leaves every
@@ -786,8 +752,7 @@ void vb_cubemap_basis_free(vb_cubemap_basis *b)
     memset(b, 0, sizeof *b);
 }
 
-vb_result vb_cubemap_write_basis(const char *dir, const char *stem, int n,
-                                 vb_error *err)
+vb_result vb_cubemap_write_basis(const char *dir, const char *stem, int n, vb_error *err)
 {
     /* The arguments first, so that a bad one costs no encoding. */
     char *path = NULL;
@@ -804,10 +769,8 @@ vb_result vb_cubemap_write_basis(const char *dir, const char *stem, int n,
     return r;
 }
 
-vb_result vb_cubemap_read_basis(const char *dir, const char *stem,
-                                int expected_size,
-                                vb_cubemap *out[VB_CUBEMAP_BASIS_FILES],
-                                vb_error *err)
+vb_result vb_cubemap_read_basis(const char *dir, const char *stem, int expected_size,
+                                vb_cubemap *out[VB_CUBEMAP_BASIS_FILES], vb_error *err)
 {
     vb_cubemap *maps[VB_CUBEMAP_BASIS_FILES] = {0};
     vb_result r = VB_OK;
@@ -824,8 +787,7 @@ vb_result vb_cubemap_read_basis(const char *dir, const char *stem,
         if (r == VB_OK) {
             int want = expected_size ? expected_size : maps[0]->size;
             if (maps[k]->size != want)
-                r = vb_fail(err, VB_ERR_FORMAT,
-                            "%s: face size %d, expected %d%s", path,
+                r = vb_fail(err, VB_ERR_FORMAT, "%s: face size %d, expected %d%s", path,
                             maps[k]->size, want,
                             expected_size ? " (cube_size of the bake)"
                                           : " (as the first basis file)");

@@ -103,8 +103,9 @@ VINLINE void store8(float *p, v8f x)
  * (-logd_i, then + c_j Y_ji for j = 0, 1, ...). 32 pairs at a time held
  * in registers across the coefficients (Y's rows are read once, t not
  * at all): the same operations per pair as the plain loop. */
-static inline __attribute__((always_inline)) void margins(int n, uint32_t m, const float *Y, uint32_t stride, const float *logd,
-                    const double *c, float *t)
+static inline __attribute__((always_inline)) void margins(int n, uint32_t m, const float *Y,
+                                                          uint32_t stride, const float *logd,
+                                                          const double *c, float *t)
 {
     float cf[VDSH_MAX_COEFFS];
     for (int j = 0; j < n; j++)
@@ -141,8 +142,8 @@ static inline __attribute__((always_inline)) void margins(int n, uint32_t m, con
  * One exp and one log per pair, eight at a time. m8: m rounded up to 8;
  * the arrays hold m8 values (sgn and wt 0 past m, so those lanes add 0). */
 static inline __attribute__((always_inline)) void pair_loss(uint32_t m8, const float *t,
-                                                           const float *sgn, const float *wt,
-                                                           float inv_tau, float *sp, float *e)
+                                                            const float *sgn, const float *wt,
+                                                            float inv_tau, float *sp, float *e)
 {
     for (uint32_t i = 0; i < m8; i += 8) {
         v8f tv, sv, wv;
@@ -161,9 +162,9 @@ static inline __attribute__((always_inline)) void pair_loss(uint32_t m8, const f
  * pair_loss's e: a sigma(z) s / tau and a sigma(z) (1 - sigma(z)) / tau^2
  * (a the pair's weight over the weights' sum); no exp or log again. */
 static inline __attribute__((always_inline)) void pair_weights(uint32_t m8, const float *t,
-                                                              const float *sgn, const float *wt,
-                                                              float inv_tau, const float *e,
-                                                              float *q, float *h)
+                                                               const float *sgn, const float *wt,
+                                                               float inv_tau, const float *e,
+                                                               float *q, float *h)
 {
     for (uint32_t i = 0; i < m8; i += 8) {
         v8f tv, sv, wv, ev;
@@ -241,15 +242,14 @@ static inline __attribute__((always_inline)) double dot2(uint32_t m, const float
 
 /* dot2 of w with four rows a, a + stride, ... at once into out[0..3]:
  * each the same bits as dot2 (w read once for the four). */
-static inline __attribute__((always_inline)) void dot2x4(uint32_t m, const float *w,
-                                                        const float *a, uint32_t stride,
-                                                        double *out)
+static inline __attribute__((always_inline)) void dot2x4(uint32_t m, const float *w, const float *a,
+                                                         uint32_t stride, double *out)
 {
     const float *a0 = a, *a1 = a0 + stride, *a2 = a1 + stride, *a3 = a2 + stride;
     v4d l0 = {0}, h0 = {0}, l1 = {0}, h1 = {0}, l2 = {0}, h2 = {0}, l3 = {0}, h3 = {0};
     uint32_t i = 0;
-#define DOT2_ROW(lo, hi, ar)                                                              \
-    lo += __builtin_convertvector(w0 * *(const v4fu *)(ar + i), v4d),                     \
+#define DOT2_ROW(lo, hi, ar)                                                                       \
+    lo += __builtin_convertvector(w0 * *(const v4fu *)(ar + i), v4d),                              \
         hi += __builtin_convertvector(w1 * *(const v4fu *)(ar + i + 4), v4d)
     for (; i + LANES <= m; i += LANES) {
         v4fu w0 = *(const v4fu *)(w + i), w1 = *(const v4fu *)(w + i + 4);
@@ -279,7 +279,7 @@ static inline __attribute__((always_inline)) void dot2x4(uint32_t m, const float
  * in lane order: vector code (GCC's vector extension, mul and add apart,
  * never fused) gives the same bits as scalar code on every CPU. */
 static inline __attribute__((always_inline)) void syrk(int n, uint32_t m8, const float *Z,
-                                                      uint32_t stride, double *H)
+                                                       uint32_t stride, double *H)
 {
     static const float zeros[VB_DECISION_MAX_PAIRS] = {0};
     for (int j0 = 0; j0 < n; j0 += 2)
@@ -294,8 +294,7 @@ static inline __attribute__((always_inline)) void syrk(int n, uint32_t m8, const
             v8f s10 = s00, s11 = s00, s12 = s00, s13 = s00;
             for (uint32_t i = 0; i < m8; i += 8) {
                 v8f x0 = load8(a0 + i), x1 = load8(a1 + i);
-                v8f y0 = load8(b0 + i), y1 = load8(b1 + i), y2 = load8(b2 + i),
-                    y3 = load8(b3 + i);
+                v8f y0 = load8(b0 + i), y1 = load8(b1 + i), y2 = load8(b2 + i), y3 = load8(b3 + i);
                 s00 += x0 * y0, s01 += x0 * y1, s02 += x0 * y2, s03 += x0 * y3;
                 s10 += x1 * y0, s11 += x1 * y1, s12 += x1 * y2, s13 += x1 * y3;
             }
@@ -319,8 +318,7 @@ typedef double v4du __attribute__((vector_size(32), aligned(8)));
  * L_jj with k ascending, four rows i at a time in vector lanes (the same
  * operations per entry as one at a time). Returns 0 if A is not positive
  * definite. */
-static inline __attribute__((always_inline)) int cholesky_factor(int n, const double *A,
-                                                                double *C)
+static inline __attribute__((always_inline)) int cholesky_factor(int n, const double *A, double *C)
 {
     for (int j = 0; j < n; j++) {
         double d = A[j * n + j];
@@ -353,7 +351,7 @@ static inline __attribute__((always_inline)) int cholesky_factor(int n, const do
  * forward pass subtracts column by column, four rows at a time: each x_i
  * still gets b_i - L_i0 x_0 - L_i1 x_1 - ... in that order. */
 static inline __attribute__((always_inline)) void cholesky_solve(int n, const double *C,
-                                                                const double *b, double *x)
+                                                                 const double *b, double *x)
 {
     for (int i = 0; i < n; i++)
         x[i] = b[i];
@@ -374,7 +372,7 @@ static inline __attribute__((always_inline)) void cholesky_solve(int n, const do
     }
 }
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) &&                             \
     !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("avx2", "default"))) /* no FMA: the same bits */
 #endif
@@ -388,10 +386,10 @@ int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
     if (m > VB_DECISION_MAX_PAIRS)
         m = VB_DECISION_MAX_PAIRS;
     enum { K = VB_DECISION_MAX_PAIRS };
-    double *H = scratch, *L = H + (size_t)n * n, *g = L + (size_t)n * n, *dx = g + n,
-           *c = dx + n, *c0 = c + n, *ct = c0 + n, *r = ct + n;
-    float *t = (float *)(r + n), *tt = t + K, *q = tt + K, *h = q + K, *sp = h + K,
-          *sgn = sp + K, *wt = sgn + K, *sh = wt + K, *ex = sh + K, *Z = ex + K;
+    double *H = scratch, *L = H + (size_t)n * n, *g = L + (size_t)n * n, *dx = g + n, *c = dx + n,
+           *c0 = c + n, *ct = c0 + n, *r = ct + n;
+    float *t = (float *)(r + n), *tt = t + K, *q = tt + K, *h = q + K, *sp = h + K, *sgn = sp + K,
+          *wt = sgn + K, *sh = wt + K, *ex = sh + K, *Z = ex + K;
     const uint32_t m8 = (m + 7) & ~7u;
     const float inv_tau = 1.0f / p->tau;
     double a = 0.0;

@@ -38,11 +38,11 @@ extern "C" {
 
 /* The settings (docs/ACCURACY.md, "The decision fit: settings"). */
 typedef struct vb_decision_params {
-    float tau;         /* softplus temperature, ln units */
-    float lit_weight;  /* a_i of lit pairs (shadowed: 1) */
-    float ridge;       /* times (l(l+1))^2, toward the lsq fit */
-    float ridge0;      /* on every coefficient, toward the lsq fit */
-    int steps;         /* Newton steps at most */
+    float tau;        /* softplus temperature, ln units */
+    float lit_weight; /* a_i of lit pairs (shadowed: 1) */
+    float ridge;      /* times (l(l+1))^2, toward the lsq fit */
+    float ridge0;     /* on every coefficient, toward the lsq fit */
+    int steps;        /* Newton steps at most */
 } vb_decision_params;
 
 /* The defaults: chosen on the validation scenes. */
@@ -57,9 +57,9 @@ void vb_decision_defaults(vb_decision_params *p);
  * shadowed pair, 0 for a lit one. c: in, the start (the least-squares
  * fit); out, the fit. scratch: vb_decision_scratch_floats(order) floats.
  * Returns the Newton steps taken (0: the start kept). */
-int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
-                    const float *logd, const uint8_t *shadowed,
-                    const vb_decision_params *p, float *c, double *scratch);
+int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride, const float *logd,
+                    const uint8_t *shadowed, const vb_decision_params *p, float *c,
+                    double *scratch);
 
 /* Doubles of scratch for vb_decision_fit at this order. */
 size_t vb_decision_scratch_doubles(int order);

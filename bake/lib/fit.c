@@ -69,7 +69,7 @@ static void eval_d(int order, const double d[3], double *y)
  * Returns 0 if singular. */
 static int invert(int n, const double *a, double *inv)
 {
-    double (*m)[2 * VB_FIT_MAX] = malloc((size_t)n * sizeof *m);
+    double(*m)[2 * VB_FIT_MAX] = malloc((size_t)n * sizeof *m);
     if (!m)
         return -1;
     for (int i = 0; i < n; i++)
@@ -143,12 +143,9 @@ double vb_window_weight(vdsh_window window, int l, int order)
 {
     double x = (double)l / order;
     switch (window) {
-    case VDSH_WINDOW_HANN:
-        return 0.5 * (1.0 + cos(PI * x));
-    case VDSH_WINDOW_LANCZOS:
-        return l == 0 ? 1.0 : sin(PI * x) / (PI * x);
-    default:
-        return 1.0;
+    case VDSH_WINDOW_HANN: return 0.5 * (1.0 + cos(PI * x));
+    case VDSH_WINDOW_LANCZOS: return l == 0 ? 1.0 : sin(PI * x) / (PI * x);
+    default: return 1.0;
     }
 }
 
@@ -246,12 +243,10 @@ float vb_fit_lambda(float lambda, int order)
     return (float)(lambda * s * s);
 }
 
-vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out,
-                        vb_error *err)
+vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out, vb_error *err)
 {
     if (order < 1 || order > VDSH_MAX_ORDER)
-        return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..%d, not %d", VDSH_MAX_ORDER,
-                       order);
+        return vb_fail(err, VB_ERR_ARGUMENT, "order must be 1..%d, not %d", VDSH_MAX_ORDER, order);
     if (base != VB_FIT_IDENTITY && base != VB_FIT_MIRROR && base != VB_FIT_LSQ)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown base fit %d", (int)base);
     if (!(lambda >= 0.0f) || !isfinite(lambda))
@@ -289,8 +284,7 @@ vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out,
         ok = invert(n, G, f->M);
         if (ok == 0) {
             r = vb_fail(err, VB_ERR_ARGUMENT,
-                        "least squares at order %d is singular: use a regularisation > 0",
-                        order);
+                        "least squares at order %d is singular: use a regularisation > 0", order);
             goto done;
         }
         break;
@@ -439,7 +433,7 @@ static inline void rotate_x(const vb_fit *f, int order, int transpose, double *v
     }
 }
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) &&                             \
     !defined(__SANITIZE_ADDRESS__)
 #define VB_CLONES __attribute__((target_clones("avx2", "default"))) /* no FMA: same bits */
 #else

@@ -51,10 +51,10 @@ extern "C" {
 #define VB_FIT_ROT_DIRS_HIGH 96
 
 typedef struct vb_fit {
-    int order;                        /* coefficients kept: order^2 */
-    vb_fit_base base;                 /* the map (a method's row, method.h) */
-    float lambda;                     /* lsq regularisation */
-    double window[VB_FIT_MAX];        /* per coefficient: its band's weight */
+    int order;                          /* coefficients kept: order^2 */
+    vb_fit_base base;                   /* the map (a method's row, method.h) */
+    float lambda;                       /* lsq regularisation */
+    double window[VB_FIT_MAX];          /* per coefficient: its band's weight */
     double M[VB_FIT_MAX * VB_FIT_MAX];  /* local-frame map, order^2 square */
     double NT[VB_FIT_MAX * VB_FIT_MAX]; /* N = X M X^T, order^2 square,
                                        * column-major */
@@ -82,8 +82,7 @@ void vb_gauss_legendre(int n, double *x, double *w);
  * VB_FIT_LSQ only. A method's base fit is its row's (method.h). The
  * hemisphere Gram matrix is computed by Gauss-Legendre x uniform-azimuth
  * quadrature (exact for these polynomials). */
-vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out,
-                        vb_error *err);
+vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out, vb_error *err);
 
 /* The per-band window applied to a fit's coefficients: Hann
  * (1 + cos(pi l / order)) / 2, Lanczos sinc(l / order), 1 for none; band

@@ -92,10 +92,10 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
     if (d->shard_count) {
         if (d->shard_index >= d->shard_count || d->shard_count > j->receivers.vertex_count)
             return vb_fail(err, VB_ERR_ARGUMENT,
-                           "shard %u/%u: needs shard < count <= the %u receivers",
-                           d->shard_index, d->shard_count, j->receivers.vertex_count);
-        vb_shard_range(j->receivers.vertex_count, d->shard_index, d->shard_count,
-                       &bd.range_begin, &bd.range_end);
+                           "shard %u/%u: needs shard < count <= the %u receivers", d->shard_index,
+                           d->shard_count, j->receivers.vertex_count);
+        vb_shard_range(j->receivers.vertex_count, d->shard_index, d->shard_count, &bd.range_begin,
+                       &bd.range_end);
     }
     bd.receivers = &j->receivers;
     bd.scene = j->scene;
@@ -163,8 +163,7 @@ static vb_result cpca_variable(vb_job *j, const vb_job_desc *d, uint32_t s, vb_e
     vdsh_error e;
     void *storage = NULL;
     const float *nrm = j->bake.normals ? j->bake.normals : j->receivers.normals;
-    vdsh_result er = vdsh_cpca_encode_stream(&f32, V, nrm, &st, &j->streams[s], &storage, NULL,
-                                             &e);
+    vdsh_result er = vdsh_cpca_encode_stream(&f32, V, nrm, &st, &j->streams[s], &storage, NULL, &e);
     free(rows);
     free(j->stream_data[s]);
     j->stream_data[s] = storage;
@@ -191,8 +190,8 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         if (!(j->drawn = malloc((size_t)j->receivers.vertex_count + 1)))
             return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u receivers",
                            j->receivers.vertex_count);
-        vb_drawn_receivers(j->receivers.positions, j->receivers.vertex_count,
-                           j->receivers.indices, j->receivers.triangle_count, j->drawn);
+        vb_drawn_receivers(j->receivers.positions, j->receivers.vertex_count, j->receivers.indices,
+                           j->receivers.triangle_count, j->drawn);
         j->bake.drawn = j->drawn;
     }
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
@@ -204,10 +203,9 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
          * copy of them, and the bake's are freed now: peak memory holds at
          * most one order's two copies, not every order's. */
         int cpca = !d->shard_count && job_encoding(d) == VDSH_ENCODING_CPCA;
-        vb_result r = vb_bake_stream_take(&j->bake, o,
-                                          d->shard_count || cpca ? VDSH_ENCODING_F32
-                                                                 : job_encoding(d),
-                                          &j->streams[count], &j->stream_data[count], err);
+        vb_result r = vb_bake_stream_take(
+            &j->bake, o, d->shard_count || cpca ? VDSH_ENCODING_F32 : job_encoding(d),
+            &j->streams[count], &j->stream_data[count], err);
         if (r != VB_OK)
             return r;
         if (cpca) {
@@ -225,8 +223,8 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
             if (er != VDSH_OK) {
                 j->streams[count] = f32;
                 j->streams[count].data = NULL;
-                return vb_fail(err, er == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY
-                                                                 : VB_ERR_INVALID,
+                return vb_fail(err,
+                               er == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_INVALID,
                                "order %d stream: %s", o, e.msg);
             }
         }
@@ -235,9 +233,9 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
     }
     if (b->variable_orders) { /* adaptive order: its average bytes per vertex */
         int cpca = !d->shard_count && job_encoding(d) == VDSH_ENCODING_CPCA;
-        vb_result r = vb_bake_variable_stream(b, d->shard_count || cpca ? VDSH_ENCODING_F32
-                                                                        : job_encoding(d),
-                                              &j->streams[count], &j->stream_data[count], err);
+        vb_result r =
+            vb_bake_variable_stream(b, d->shard_count || cpca ? VDSH_ENCODING_F32 : job_encoding(d),
+                                    &j->streams[count], &j->stream_data[count], err);
         if (r != VB_OK)
             return r;
         uint32_t rows = b->range_end ? b->range_end - b->range_begin : b->vertex_count;
@@ -285,7 +283,8 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
     f.stream_count = count;
     f.streams = j->streams;
     f.has_stats = 1;
-    f.stats = (vdsh_stats){.rays_traced = b->rays_traced, .rays_missed = b->rays_missed,
+    f.stats = (vdsh_stats){.rays_traced = b->rays_traced,
+                           .rays_missed = b->rays_missed,
                            .degenerate_receivers = b->degenerate_receivers,
                            .undefined_normals = b->undefined_normals,
                            .moved_origins = b->moved_origins,
@@ -294,8 +293,8 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
     f.timings = j->timings;
     if (d->shard_count) {
         f.has_part = 1;
-        f.part = (vdsh_part){.index = d->shard_index, .count = d->shard_count,
-                             .encoding = job_encoding(d)};
+        f.part = (vdsh_part){
+            .index = d->shard_index, .count = d->shard_count, .encoding = job_encoding(d)};
         if (job_encoding(d) == VDSH_ENCODING_CPCA) {
             vdsh_cpca_settings st = job_cpca(d);
             f.part.cpca_clusters = st.clusters;
@@ -322,8 +321,8 @@ static void split_output(const char *out, char *dir, char *stem, size_t cap)
         stem[n - 5] = '\0';
 }
 
-vb_result vb_output_cubemap_path(const char *output, const char *cubemap_dir, int k,
-                                 char *buf, size_t cap, vb_error *err)
+vb_result vb_output_cubemap_path(const char *output, const char *cubemap_dir, int k, char *buf,
+                                 size_t cap, vb_error *err)
 {
     char dir[PATH_MAX], stem[PATH_MAX];
     if (!output)
@@ -398,8 +397,8 @@ vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vb_error *err)
             return j->basis_result;
         }
     }
-    return vb_write_outputs(&j->file, d->output, d->cubemap_dir,
-                            cube_size > 0 ? &j->basis : NULL, &j->file_bytes, err);
+    return vb_write_outputs(&j->file, d->output, d->cubemap_dir, cube_size > 0 ? &j->basis : NULL,
+                            &j->file_bytes, err);
 }
 
 void vb_shard_range(uint32_t v, uint32_t i, uint32_t n, uint32_t *begin, uint32_t *end)

@@ -48,18 +48,18 @@ extern "C" {
 #define VB_DEFAULT_ENCODING VDSH_ENCODING_S8S6
 
 typedef struct vb_job_desc {
-    const char *const *paths;  /* meshes (mesh.h names), borrowed */
-    uint32_t path_count;       /* 1..VDSH_MAX_SOURCES */
-    const char *output;        /* the .vdsh file; NULL: none (vb_job_write refuses) */
-    const char *cubemap_dir;   /* NULL: beside output */
-    int weld;                  /* vb_load_desc.weld */
-    float max_edge;            /* receivers refined to it; 0: the vertices as they are.
+    const char *const *paths;   /* meshes (mesh.h names), borrowed */
+    uint32_t path_count;        /* 1..VDSH_MAX_SOURCES */
+    const char *output;         /* the .vdsh file; NULL: none (vb_job_write refuses) */
+    const char *cubemap_dir;    /* NULL: beside output */
+    int weld;                   /* vb_load_desc.weld */
+    float max_edge;             /* receivers refined to it; 0: the vertices as they are.
                                 * With adaptive: where the refinement starts */
     const char *receivers_path; /* receivers read from this mesh as they are (a plan:
                                 * vdsh-bake --receivers); NULL: the occluders, refined */
-    int adaptive;              /* 1: adaptive receivers (adaptive.h) from there */
+    int adaptive;               /* 1: adaptive receivers (adaptive.h) from there */
     vb_adaptive_desc adapt;
-    int fast_traversal;        /* 0: Embree's robust traversal (default) */
+    int fast_traversal; /* 0: Embree's robust traversal (default) */
     /* The bake (receivers and scene are the job's). Its orders give the
      * streams, in increasing order. */
     vb_bake_desc bake;
@@ -71,33 +71,33 @@ typedef struct vb_job_desc {
     vdsh_encoding encoding;
     /* encoding cpca: K, B, bits (zero: vdsh_cpca_settings_default()) */
     vdsh_cpca_settings cpca;
-    int cube_size;             /* basis cubemap face; 0: 64; < 0: none */
-    int record_timings;        /* store the timings in the file */
+    int cube_size;      /* basis cubemap face; 0: 64; < 0: none */
+    int record_timings; /* store the timings in the file */
     /* A shard (vdsh-bake --shard I/N): shard_count 0 is the whole bake;
      * else receivers vb_shard_range(V, shard_index, shard_count) only, and
      * the file is a part (VDSH.md "Parts": f32 streams, a `part` chunk, no
      * basis cubemaps; vdsh-merge joins the parts). */
     uint32_t shard_index, shard_count;
     /* Called after each mesh loads (may be NULL). */
-    void (*on_mesh)(void *user, const char *path, const vb_mesh *m,
-                    const vb_source_info *info, double seconds);
+    void (*on_mesh)(void *user, const char *path, const vb_mesh *m, const vb_source_info *info,
+                    double seconds);
     void *user;
 } vb_job_desc;
 
 typedef struct vb_job {
     vb_mesh occluders, receivers;
-    vdsh_source *sources;      /* names borrowed from the desc's paths */
+    vdsh_source *sources; /* names borrowed from the desc's paths */
     uint32_t source_count;
     vb_scene *scene;
     vb_bake_output bake;
-    uint8_t *drawn;            /* per receiver (vb_drawn_receivers): bake.drawn */
+    uint8_t *drawn; /* per receiver (vb_drawn_receivers): bake.drawn */
     vdsh_stream streams[VDSH_MAX_STREAMS];
     void *stream_data[VDSH_MAX_STREAMS];
-    size_t coefficient_bytes;  /* per vertex, all fixed-order streams */
-    double variable_bytes;     /* per vertex on average, the variable-order
+    size_t coefficient_bytes; /* per vertex, all fixed-order streams */
+    double variable_bytes;    /* per vertex on average, the variable-order
                                 * stream's (order table included; 0: none) */
-    vdsh_file file;            /* filled by vb_bake_fill_file (borrows the above) */
-    uint64_t file_bytes;       /* the written file's size (vb_job_write) */
+    vdsh_file file;           /* filled by vb_bake_fill_file (borrows the above) */
+    uint64_t file_bytes;      /* the written file's size (vb_job_write) */
     vdsh_timings timings;
     vb_adaptive_stats adaptive; /* with d->adaptive */
     double t_start;
@@ -137,8 +137,8 @@ vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vb_error *err);
 /* The path of basis cubemap k (0..3) that goes with the .vdsh `output`:
  * in cubemap_dir, or beside output when it is NULL; the stem is output's
  * name less ".vdsh" (vb_cubemap_basis_path). For checks before a bake. */
-vb_result vb_output_cubemap_path(const char *output, const char *cubemap_dir, int k,
-                                 char *buf, size_t cap, vb_error *err);
+vb_result vb_output_cubemap_path(const char *output, const char *cubemap_dir, int k, char *buf,
+                                 size_t cap, vb_error *err);
 
 /* A bake's outputs, all or none: the .vdsh file f to `output` and, when b
  * is not NULL, its basis cubemaps (cubemap_dir, NULL: beside output).

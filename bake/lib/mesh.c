@@ -90,7 +90,8 @@ void vb_mesh_spacing_of(const vb_mesh *m, float diagonal, vb_mesh_spacing *s)
             }
             l2 = q > l2 ? q : l2;
         }
-        const double cx = e[0][1] * e[2][2] - e[0][2] * e[2][1], cy = e[0][2] * e[2][0] - e[0][0] * e[2][2],
+        const double cx = e[0][1] * e[2][2] - e[0][2] * e[2][1],
+                     cy = e[0][2] * e[2][0] - e[0][0] * e[2][2],
                      cz = e[0][0] * e[2][1] - e[0][1] * e[2][0];
         const double a = 0.5 * sqrt(cx * cx + cy * cy + cz * cz), l = sqrt(l2);
         area += a;
@@ -147,65 +148,76 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
     tool = tool ? tool : "";
     path = path ? path : "(mesh)";
     if (r->dropped_triangles)
-        fprintf(fp, "%s%s%s: %u triangle%s dropped (a repeated vertex index: no area)\n", tool, sep, path,
-                r->dropped_triangles, plural(r->dropped_triangles));
+        fprintf(fp, "%s%s%s: %u triangle%s dropped (a repeated vertex index: no area)\n", tool, sep,
+                path, r->dropped_triangles, plural(r->dropped_triangles));
     if (r->duplicate_triangles)
-        fprintf(fp, "%s%s%s: %u duplicate triangle%s dropped (the same three positions as an earlier "
-                    "triangle, in any order)\n",
+        fprintf(fp,
+                "%s%s%s: %u duplicate triangle%s dropped (the same three positions as an earlier "
+                "triangle, in any order)\n",
                 tool, sep, path, r->duplicate_triangles, plural(r->duplicate_triangles));
     if (r->removed_vertices)
         fprintf(fp, "%s%s%s: %u vert%s removed (used by no remaining triangle)\n", tool, sep, path,
                 r->removed_vertices, r->removed_vertices == 1 ? "ex" : "ices");
     if (r->split_vertices)
-        fprintf(fp, "%s%s%s: %u vert%s split at creases (their face corners give normals more than %g "
-                    "degrees apart): %u vert%s added\n",
-                tool, sep, path, r->split_vertices, r->split_vertices == 1 ? "ex" : "ices", VB_MESH_NORMAL_AGREE_DEG,
-                r->split_added, r->split_added == 1 ? "ex" : "ices");
+        fprintf(fp,
+                "%s%s%s: %u vert%s split at creases (their face corners give normals more than %g "
+                "degrees apart): %u vert%s added\n",
+                tool, sep, path, r->split_vertices, r->split_vertices == 1 ? "ex" : "ices",
+                VB_MESH_NORMAL_AGREE_DEG, r->split_added, r->split_added == 1 ? "ex" : "ices");
     if (r->missing_normals)
-        fprintf(fp, "%s%s%s: %u used vert%s no normal in the file: every normal computed from the faces "
-                    "instead\n",
-                tool, sep, path, r->missing_normals, r->missing_normals == 1 ? "ex has" : "ices have");
+        fprintf(
+            fp,
+            "%s%s%s: %u used vert%s no normal in the file: every normal computed from the faces "
+            "instead\n",
+            tool, sep, path, r->missing_normals, r->missing_normals == 1 ? "ex has" : "ices have");
     if (r->zero_normals) {
         /* One line: what became of each of them. */
         char what[256] = "";
         size_t at = 0;
         if (r->zero_repaired)
-            at += (size_t)snprintf(what + at, sizeof what - at, "%s%u given their own triangles' normal",
-                                   at ? ", " : "", r->zero_repaired);
+            at += (size_t)snprintf(what + at, sizeof what - at,
+                                   "%s%u given their own triangles' normal", at ? ", " : "",
+                                   r->zero_repaired);
         if (r->zero_cancelled && at < sizeof what)
-            at += (size_t)snprintf(what + at, sizeof what - at,
-                                   "%s%u their largest triangle's (their triangles' normals cancel: "
-                                   "two-sided)",
-                                   at ? ", " : "", r->zero_cancelled);
+            at +=
+                (size_t)snprintf(what + at, sizeof what - at,
+                                 "%s%u their largest triangle's (their triangles' normals cancel: "
+                                 "two-sided)",
+                                 at ? ", " : "", r->zero_cancelled);
         if (r->zero_undefined && at < sizeof what)
-            at += (size_t)snprintf(what + at, sizeof what - at,
-                                   "%s%u left without a normal (0,0,0: their triangles have no area)",
-                                   at ? ", " : "", r->zero_undefined);
-        fprintf(fp, "%s%s%s: %u vert%s a zero normal in the file: %s\n", tool, sep, path, r->zero_normals,
-                r->zero_normals == 1 ? "ex has" : "ices have", what);
+            at +=
+                (size_t)snprintf(what + at, sizeof what - at,
+                                 "%s%u left without a normal (0,0,0: their triangles have no area)",
+                                 at ? ", " : "", r->zero_undefined);
+        fprintf(fp, "%s%s%s: %u vert%s a zero normal in the file: %s\n", tool, sep, path,
+                r->zero_normals, r->zero_normals == 1 ? "ex has" : "ices have", what);
     }
     if (r->cancelled_normals)
-        fprintf(fp, "%s%s%s: %u vert%s face normals cancel (two-sided triangles): each given the normal of "
-                    "its largest triangle\n",
-                tool, sep, path, r->cancelled_normals, r->cancelled_normals == 1 ? "ex's" : "ices'");
+        fprintf(
+            fp,
+            "%s%s%s: %u vert%s face normals cancel (two-sided triangles): each given the normal of "
+            "its largest triangle\n",
+            tool, sep, path, r->cancelled_normals, r->cancelled_normals == 1 ? "ex's" : "ices'");
     if (r->welded)
-        fprintf(fp, "%s%s%s: %u vert%s merged by welding (normals then computed from the faces)\n", tool, sep,
-                path, r->welded, r->welded == 1 ? "ex" : "ices");
+        fprintf(fp, "%s%s%s: %u vert%s merged by welding (normals then computed from the faces)\n",
+                tool, sep, path, r->welded, r->welded == 1 ? "ex" : "ices");
     if (r->gltf_skipped_modes)
-        fprintf(fp, "%s%s%s: %u glTF primitive%s of points or lines skipped (no surface)\n", tool, sep, path,
-                r->gltf_skipped_modes, plural(r->gltf_skipped_modes));
+        fprintf(fp, "%s%s%s: %u glTF primitive%s of points or lines skipped (no surface)\n", tool,
+                sep, path, r->gltf_skipped_modes, plural(r->gltf_skipped_modes));
     if (r->gltf_skipped_morph)
-        fprintf(fp, "%s%s%s: %u glTF primitive%s with morph targets skipped (not baked)\n", tool, sep, path,
-                r->gltf_skipped_morph, plural(r->gltf_skipped_morph));
+        fprintf(fp, "%s%s%s: %u glTF primitive%s with morph targets skipped (not baked)\n", tool,
+                sep, path, r->gltf_skipped_morph, plural(r->gltf_skipped_morph));
     if (r->gltf_skipped_skin)
-        fprintf(fp, "%s%s%s: %u glTF primitive%s of skinned nodes skipped (not baked)\n", tool, sep, path,
-                r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
+        fprintf(fp, "%s%s%s: %u glTF primitive%s of skinned nodes skipped (not baked)\n", tool, sep,
+                path, r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
     /* the zero file normals left undefined were said above */
-    uint32_t undefined = r->undefined_normals - (r->zero_undefined < r->undefined_normals
-                                                     ? r->zero_undefined : r->undefined_normals);
+    uint32_t undefined =
+        r->undefined_normals -
+        (r->zero_undefined < r->undefined_normals ? r->zero_undefined : r->undefined_normals);
     if (undefined)
-        fprintf(fp, "%s%s%s: %u vert%s left without a normal (0,0,0): their triangles have no area\n", tool, sep,
-                path, undefined, undefined == 1 ? "ex" : "ices");
+        fprintf(fp,
+                "%s%s%s: %u vert%s left without a normal (0,0,0): their triangles have no area\n",
+                tool, sep, path, undefined, undefined == 1 ? "ex" : "ices");
 }
 
 /* n * size bytes, or NULL when that overflows or malloc fails; never a
@@ -251,8 +263,8 @@ int vb_triangle_has_area(const float *positions, const uint32_t *ix)
     return len > 0.0 && isfinite(len);
 }
 
-uint32_t vb_drawn_receivers(const float *positions, uint32_t vertex_count,
-                            const uint32_t *indices, uint32_t triangle_count, uint8_t *drawn)
+uint32_t vb_drawn_receivers(const float *positions, uint32_t vertex_count, const uint32_t *indices,
+                            uint32_t triangle_count, uint8_t *drawn)
 {
     if (vertex_count)
         memset(drawn, 0, vertex_count);
@@ -330,7 +342,8 @@ static void compute_normals(vb_mesh *m, uint8_t *cancelled)
             }
             double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2],
                    cz = u[0] * v[1] - u[1] * v[0];
-            double angle = atan2(sqrt(cx * cx + cy * cy + cz * cz), u[0] * v[0] + u[1] * v[1] + u[2] * v[2]);
+            double angle =
+                atan2(sqrt(cx * cx + cy * cy + cz * cz), u[0] * v[0] + u[1] * v[1] + u[2] * v[2]);
             float *out = m->normals + 3 * (size_t)tri[c];
             for (int k = 0; k < 3; k++)
                 out[k] += (float)(n[k] * angle);
@@ -344,7 +357,8 @@ static void compute_normals(vb_mesh *m, uint8_t *cancelled)
     uint32_t any = 0;
     for (uint32_t i = 0; i < m->vertex_count; i++) {
         float *out = m->normals + 3 * (size_t)i;
-        double len = sqrt((double)out[0] * out[0] + (double)out[1] * out[1] + (double)out[2] * out[2]);
+        double len =
+            sqrt((double)out[0] * out[0] + (double)out[1] * out[1] + (double)out[2] * out[2]);
         if (weight && weight[i] > 0.0f && !(len > CANCEL * weight[i])) {
             weight[i] = -1.0f;
             any++;
@@ -454,7 +468,7 @@ static uint32_t position_key(const float *p, uint32_t bits[3])
 {
     uint32_t h = 2166136261u;
     for (int k = 0; k < 3; k++) {
-        float f = p[k] == 0.0f ? 0.0f : p[k];   /* -0 and +0 weld */
+        float f = p[k] == 0.0f ? 0.0f : p[k]; /* -0 and +0 weld */
         memcpy(&bits[k], &f, sizeof f);
         h = (h ^ bits[k]) * 16777619u;
         h ^= h >> 15;
@@ -468,8 +482,9 @@ vb_result vb_mesh_weld(vb_mesh *m, vb_error *err)
         return vb_fail(err, VB_ERR_ARGUMENT, "weld: invalid mesh");
     for (size_t j = 0; j < 3 * (size_t)m->triangle_count; j++)
         if (m->indices[j] >= m->vertex_count)
-            return vb_fail(err, VB_ERR_INVALID, "weld: triangle %zu: index %u out of range (%u vertices)",
-                           j / 3, m->indices[j], m->vertex_count);
+            return vb_fail(err, VB_ERR_INVALID,
+                           "weld: triangle %zu: index %u out of range (%u vertices)", j / 3,
+                           m->indices[j], m->vertex_count);
 
     /* Open addressing keyed by position bits; the first vertex with a
      * position represents it, so the result does not depend on hashing. */
@@ -527,14 +542,16 @@ vb_result vb_mesh_weld(vb_mesh *m, vb_error *err)
 
 vb_result vb_mesh_append(vb_mesh *dst, const vb_mesh *src, vb_error *err)
 {
-    if (!dst || !src || (src->vertex_count && !src->positions) || (src->triangle_count && !src->indices) ||
-        (dst->vertex_count && !dst->positions) || (dst->triangle_count && !dst->indices))
+    if (!dst || !src || (src->vertex_count && !src->positions) ||
+        (src->triangle_count && !src->indices) || (dst->vertex_count && !dst->positions) ||
+        (dst->triangle_count && !dst->indices))
         return vb_fail(err, VB_ERR_ARGUMENT, "append: invalid mesh");
     if (src->vertex_count > UINT32_MAX - dst->vertex_count ||
         src->triangle_count > UINT32_MAX / 3 - dst->triangle_count ||
         dst->triangle_count > UINT32_MAX / 3)
-        return vb_fail(err, VB_ERR_ARGUMENT, "append: too many vertices or triangles (%u + %u, %u + %u)",
-                       dst->vertex_count, src->vertex_count, dst->triangle_count, src->triangle_count);
+        return vb_fail(
+            err, VB_ERR_ARGUMENT, "append: too many vertices or triangles (%u + %u, %u + %u)",
+            dst->vertex_count, src->vertex_count, dst->triangle_count, src->triangle_count);
     uint32_t nv = dst->vertex_count + src->vertex_count;
     uint32_t nt = dst->triangle_count + src->triangle_count;
     vb_mesh res = {0};
@@ -577,21 +594,22 @@ vb_result vb_mesh_append(vb_mesh *dst, const vb_mesh *src, vb_error *err)
 /* What both writers do first: check m (normals too with need_normals) and
  * open the project's atomic output (vdsh_output.h: a temporary file beside
  * the target, renamed over it once complete and on disk). */
-static vb_result write_begin(const vb_mesh *m, const char *path, const char *what,
-                             int need_normals, vdsh_output *out, vb_error *err)
+static vb_result write_begin(const vb_mesh *m, const char *path, const char *what, int need_normals,
+                             vdsh_output *out, vb_error *err)
 {
     if (!m || !path || !path[0] || (m->vertex_count && !m->positions) ||
         (m->vertex_count && need_normals && !m->normals) || (m->triangle_count && !m->indices))
         return vb_fail(err, VB_ERR_ARGUMENT, "%s: invalid argument", what);
     for (size_t j = 0; j < 3 * (size_t)m->triangle_count; j++)
         if (m->indices[j] >= m->vertex_count)
-            return vb_fail(err, VB_ERR_INVALID, "%s: triangle %zu: index %u out of range (%u vertices)",
-                           path, j / 3, m->indices[j], m->vertex_count);
+            return vb_fail(err, VB_ERR_INVALID,
+                           "%s: triangle %zu: index %u out of range (%u vertices)", path, j / 3,
+                           m->indices[j], m->vertex_count);
     vdsh_error ve;
     vdsh_result vr = vdsh_output_open(path, out, &ve);
     if (vr != VDSH_OK)
-        return vb_fail(err, vr == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_IO,
-                       "%s", ve.msg);
+        return vb_fail(err, vr == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_IO, "%s",
+                       ve.msg);
     setvbuf(out->fp, NULL, _IOFBF, 1 << 16);
     return VB_OK;
 }
@@ -866,10 +884,12 @@ static vb_result split_creases(const vb_mesh_raw *raw, uint32_t *idx, split_vert
     for (uint32_t v = 0; v < nv; v++) {
         base[v] = next;
         for (uint32_t g = 0; g < groups[v]; g++)
-            memcpy(sv->positions + 3 * (size_t)(next + g), raw->positions + 3 * (size_t)v, 3 * sizeof(float));
+            memcpy(sv->positions + 3 * (size_t)(next + g), raw->positions + 3 * (size_t)v,
+                   3 * sizeof(float));
         if (groups[v] == 1) {
             if (raw->normals && raw->has_normal) {
-                memcpy(sv->normals + 3 * (size_t)next, raw->normals + 3 * (size_t)v, 3 * sizeof(float));
+                memcpy(sv->normals + 3 * (size_t)next, raw->normals + 3 * (size_t)v,
+                       3 * sizeof(float));
                 sv->has_normal[next] = raw->has_normal[v];
             }
         } else {
@@ -882,7 +902,8 @@ static vb_result split_creases(const vb_mesh_raw *raw, uint32_t *idx, split_vert
                     sv->has_normal[w] = 1;
                     unit_float(raw->corner_normals + 3 * c, sv->normals + 3 * (size_t)w);
                 } else if (raw->corner_given[c] && sv->normals[3 * (size_t)w] == 0.0f &&
-                           sv->normals[3 * (size_t)w + 1] == 0.0f && sv->normals[3 * (size_t)w + 2] == 0.0f) {
+                           sv->normals[3 * (size_t)w + 1] == 0.0f &&
+                           sv->normals[3 * (size_t)w + 2] == 0.0f) {
                     /* group 0 may have met a zero normal before its first */
                     unit_float(raw->corner_normals + 3 * c, sv->normals + 3 * (size_t)w);
                 }
@@ -996,7 +1017,8 @@ static int share_index(const uint32_t *a, const uint32_t *b)
  * of equal hashes are compared, position by position: streaming passes,
  * where a hash table costs a cache miss a triangle (Lost Empire's 225k
  * triangles: ~5 ms against ~25 ms). */
-static int drop_duplicates(const float *positions, uint32_t *idx, uint32_t *count, uint32_t *dropped)
+static int drop_duplicates(const float *positions, uint32_t *idx, uint32_t *count,
+                           uint32_t *dropped)
 {
     const uint32_t n = *count;
     *dropped = 0;
@@ -1104,8 +1126,9 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
     for (uint32_t i = 0; i < raw->vertex_count; i++) {
         const float *p = raw->positions + 3 * (size_t)i;
         if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
-            return vb_fail(err, VB_ERR_INVALID, "%s: vertex %llu has a non-finite coordinate (%g, %g, %g)",
-                           path, (unsigned long long)i + base, (double)p[0], (double)p[1], (double)p[2]);
+            return vb_fail(err, VB_ERR_INVALID,
+                           "%s: vertex %llu has a non-finite coordinate (%g, %g, %g)", path,
+                           (unsigned long long)i + base, (double)p[0], (double)p[1], (double)p[2]);
     }
     uint32_t *idx = alloc_array(3 * (size_t)raw->triangle_count, sizeof(uint32_t));
     if (!idx)
@@ -1114,8 +1137,9 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
         int64_t v = raw->indices[j];
         if (v < 0 || v >= (int64_t)raw->vertex_count) {
             free(idx);
-            return vb_fail(err, VB_ERR_INVALID, "%s: face %llu: vertex index %lld out of range (%u vertices)",
-                           path, (unsigned long long)raw->faces[j / 3] + base, (long long)v + base,
+            return vb_fail(err, VB_ERR_INVALID,
+                           "%s: face %llu: vertex index %lld out of range (%u vertices)", path,
+                           (unsigned long long)raw->faces[j / 3] + base, (long long)v + base,
                            raw->vertex_count);
         }
         idx[j] = (uint32_t)v;
@@ -1127,8 +1151,9 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
     vb_result r = split_creases(raw, idx, &sv);
     if (r != VB_OK) {
         free(idx);
-        return r == VB_ERR_OUT_OF_MEMORY ? vb_fail(err, r, "%s: out of memory", path)
-                                         : vb_fail(err, r, "%s: too many vertices after splitting at creases", path);
+        return r == VB_ERR_OUT_OF_MEMORY
+                   ? vb_fail(err, r, "%s: out of memory", path)
+                   : vb_fail(err, r, "%s: too many vertices after splitting at creases", path);
     }
     const int split = sv.positions != NULL;
     const uint32_t vertex_count = split ? sv.vertex_count : raw->vertex_count;
@@ -1159,7 +1184,8 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
         split_free(&sv);
         vb_mesh_free(&m);
         if (degenerate)
-            return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh (all %u triangles repeat a vertex)", path, degenerate);
+            return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh (all %u triangles repeat a vertex)",
+                           path, degenerate);
         return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh (no faces)", path);
     }
     vb_mesh_report rp;
@@ -1303,13 +1329,15 @@ static vb_result format_of(const char *name, vb_mesh_format *format, vb_error *e
         *format = VB_MESH_GLB;
     else
         return vb_fail(err, VB_ERR_FORMAT,
-                       "%s: unsupported file type (expected .obj, .ply, .off, .stl, .gltf or .glb)", name);
+                       "%s: unsupported file type (expected .obj, .ply, .off, .stl, .gltf or .glb)",
+                       name);
     return VB_OK;
 }
 
 /* A file's bytes -> clean mesh and source info. */
-static vb_result load_bytes(const char *name, vb_mesh_format format, int gltf_scene, const uint8_t *bytes,
-                            size_t size, vb_mesh *m, vb_source_info *si, vb_error *err)
+static vb_result load_bytes(const char *name, vb_mesh_format format, int gltf_scene,
+                            const uint8_t *bytes, size_t size, vb_mesh *m, vb_source_info *si,
+                            vb_error *err)
 {
     if (size == 0)
         return vb_fail(err, VB_ERR_FORMAT, "%s: empty file", name);
@@ -1318,7 +1346,8 @@ static vb_result load_bytes(const char *name, vb_mesh_format format, int gltf_sc
     vb_mesh_raw raw;
     memset(&raw, 0, sizeof raw);
     vb_result r = format == VB_MESH_GLTF || format == VB_MESH_GLB
-                      ? vb_mesh_parse_gltf(name, format == VB_MESH_GLB, gltf_scene - 1, bytes, size, &raw, err)
+                      ? vb_mesh_parse_gltf(name, format == VB_MESH_GLB, gltf_scene - 1, bytes, size,
+                                           &raw, err)
                       : vb_mesh_parse(name, format, bytes, size, &raw, err);
     if (r == VB_OK)
         r = clean_raw(name, format, &raw, m, &si->report, err);
@@ -1400,20 +1429,20 @@ static int read_plan(const char *path, vb_mesh *out)
         return 0;
     struct stat st;
     char head[PLY_HEADER_MAX], want[PLY_HEADER_MAX];
-    size_t got = fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode)
-                     ? fread(head, 1, sizeof head - 1, f) : 0;
+    size_t got =
+        fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) ? fread(head, 1, sizeof head - 1, f) : 0;
     head[got] = '\0';
     const char *ve = strstr(head, "element vertex "), *fe = strstr(head, "element face ");
     unsigned long long V = ve ? strtoull(ve + 15, NULL, 10) : 0;
     unsigned long long T = fe ? strtoull(fe + 13, NULL, 10) : 0;
     int hlen = V && T && V <= UINT32_MAX && T <= UINT32_MAX / 3
-                   ? ply_header(want, sizeof want, (uint32_t)V, (uint32_t)T) : 0;
+                   ? ply_header(want, sizeof want, (uint32_t)V, (uint32_t)T)
+                   : 0;
     vb_mesh m = {0};
     uint8_t *used = NULL, *buf = NULL;
     enum { BLOCK = 1 << 16 }; /* records per read */
     int ok = hlen > 0 && (size_t)hlen <= got && memcmp(head, want, (size_t)hlen) == 0 &&
-             (uint64_t)st.st_size ==
-                 (uint64_t)hlen + V * PLY_VERTEX_BYTES + T * PLY_FACE_BYTES &&
+             (uint64_t)st.st_size == (uint64_t)hlen + V * PLY_VERTEX_BYTES + T * PLY_FACE_BYTES &&
              fseek(f, hlen, SEEK_SET) == 0;
     if (ok) {
         m.vertex_count = (uint32_t)V, m.triangle_count = (uint32_t)T;
@@ -1476,8 +1505,9 @@ vb_result vb_mesh_load_plan(const char *path, vb_mesh *out, vb_error *err)
     return vb_mesh_load(path, &ld, out, NULL, err);
 }
 
-vb_result vb_mesh_load_memory(const void *data, size_t size, const char *name, const vb_load_desc *desc,
-                              vb_mesh *out, vb_source_info *info, vb_error *err)
+vb_result vb_mesh_load_memory(const void *data, size_t size, const char *name,
+                              const vb_load_desc *desc, vb_mesh *out, vb_source_info *info,
+                              vb_error *err)
 {
     if (!name || !out || (!data && size))
         return vb_fail(err, VB_ERR_ARGUMENT, "load_memory: NULL name, data or output");
@@ -1488,6 +1518,7 @@ vb_result vb_mesh_load_memory(const void *data, size_t size, const char *name, c
     vb_mesh m = {0};
     vb_source_info si;
     memset(&si, 0, sizeof si);
-    r = load_bytes(name, format, desc ? desc->gltf_scene : 0, (const uint8_t *)data, size, &m, &si, err);
+    r = load_bytes(name, format, desc ? desc->gltf_scene : 0, (const uint8_t *)data, size, &m, &si,
+                   err);
     return finish_load(r, &m, &si, desc ? desc->weld : 0, out, info, err);
 }

@@ -122,17 +122,17 @@ extern "C" {
 typedef struct vb_mesh {
     uint32_t vertex_count;
     uint32_t triangle_count;
-    float *positions;      /* 3 * vertex_count */
-    float *normals;        /* 3 * vertex_count; unit, or 0,0,0 = undefined */
-    uint32_t *indices;     /* 3 * triangle_count */
+    float *positions;  /* 3 * vertex_count */
+    float *normals;    /* 3 * vertex_count; unit, or 0,0,0 = undefined */
+    uint32_t *indices; /* 3 * triangle_count */
 } vb_mesh;
 
 typedef struct vb_load_desc {
-    int weld;              /* 1: merge vertices with bit-identical positions
+    int weld;       /* 1: merge vertices with bit-identical positions
                               (-0 and +0 count as equal; normals then
                               recomputed); 0 (default): keep the file's
                               vertices */
-    int gltf_scene;        /* glTF: 0 (default) = the file's default scene
+    int gltf_scene; /* glTF: 0 (default) = the file's default scene
                               (or its first); N + 1 = scene N */
 } vb_load_desc;
 
@@ -140,7 +140,7 @@ typedef struct vb_load_desc {
  * the built-in scene and for a file with nothing to say). Counts of
  * vertices are of the file's vertices unless said otherwise. */
 typedef struct vb_mesh_report {
-    uint32_t dropped_triangles;  /* repeated a vertex index (no area),
+    uint32_t dropped_triangles;   /* repeated a vertex index (no area),
                                     dropped; OBJ faces with fewer than 3
                                     distinct vertices count as their
                                     corners - 2 */
@@ -149,42 +149,42 @@ typedef struct vb_mesh_report {
                                     winding), dropped; a reversed copy with
                                     vertices of its own (a two-sided sheet's
                                     back) is kept */
-    uint32_t removed_vertices;   /* used by no remaining triangle */
-    uint32_t split_vertices;     /* split at creases (corner normals) */
-    uint32_t split_added;        /* vertices those splits added */
-    uint32_t missing_normals;    /* used vertices with no file normal while
+    uint32_t removed_vertices;    /* used by no remaining triangle */
+    uint32_t split_vertices;      /* split at creases (corner normals) */
+    uint32_t split_added;         /* vertices those splits added */
+    uint32_t missing_normals;     /* used vertices with no file normal while
                                     others have one: all normals computed */
-    uint32_t zero_normals;       /* loaded vertices whose file normal is
+    uint32_t zero_normals;        /* loaded vertices whose file normal is
                                     zero (or whose given normals cancel) */
-    uint32_t zero_repaired;      /* of those, given their own triangles'
+    uint32_t zero_repaired;       /* of those, given their own triangles'
                                     normal */
-    uint32_t zero_cancelled;     /* of those, whose triangles' normals
+    uint32_t zero_cancelled;      /* of those, whose triangles' normals
                                     cancel (two-sided): given their largest
                                     triangle's normal */
-    uint32_t zero_undefined;     /* of those, left (0,0,0): their
+    uint32_t zero_undefined;      /* of those, left (0,0,0): their
                                     triangles have no area (zero_repaired +
                                     zero_cancelled + zero_undefined =
                                     zero_normals) */
-    uint32_t cancelled_normals;  /* loaded vertices without a file normal
+    uint32_t cancelled_normals;   /* loaded vertices without a file normal
                                     whose computed normal cancelled
                                     (two-sided triangles): given their
                                     largest triangle's normal */
-    uint32_t welded;             /* vertices merged by weld */
-    uint32_t undefined_normals;  /* loaded vertices left (0,0,0) at the end:
+    uint32_t welded;              /* vertices merged by weld */
+    uint32_t undefined_normals;   /* loaded vertices left (0,0,0) at the end:
                                     their triangles have no area (those
                                     with a zero file normal included) */
-    uint32_t gltf_skipped_modes; /* glTF: point and line primitives skipped */
-    uint32_t gltf_skipped_morph; /* glTF: primitives with morph targets
+    uint32_t gltf_skipped_modes;  /* glTF: point and line primitives skipped */
+    uint32_t gltf_skipped_morph;  /* glTF: primitives with morph targets
                                     skipped (their base shape is not what
                                     the file shows once animated) */
-    uint32_t gltf_skipped_skin;  /* glTF: primitives of skinned nodes
+    uint32_t gltf_skipped_skin;   /* glTF: primitives of skinned nodes
                                     skipped */
 } vb_mesh_report;
 
 /* What a loaded source was: size and hash for the .vdsh SRCS chunk, and
  * what loading found. */
 typedef struct vb_source_info {
-    uint64_t size;         /* bytes of the file (or of the built-in arrays) */
+    uint64_t size; /* bytes of the file (or of the built-in arrays) */
     uint8_t sha256[32];
     vb_mesh_report report;
 } vb_source_info;
@@ -199,12 +199,11 @@ typedef struct vb_source_info {
  * triangles' normal, their largest triangle's, or none), and the lines on
  * cancelled and undefined normals count the other vertices only. Nothing
  * when fp is NULL (a tool's quiet mode) or nothing was found. */
-void vb_mesh_report_print(FILE *fp, const char *tool, const char *path,
-                          const vb_mesh_report *r);
+void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb_mesh_report *r);
 
 /* Load one file or built-in scene. `info` may be NULL. */
-vb_result vb_mesh_load(const char *path, const vb_load_desc *desc,
-                       vb_mesh *out, vb_source_info *info, vb_error *err);
+vb_result vb_mesh_load(const char *path, const vb_load_desc *desc, vb_mesh *out,
+                       vb_source_info *info, vb_error *err);
 
 /* Load receivers as they are (vdsh-bake --receivers: a plan): the mesh
  * vb_mesh_load gives with a zero desc, bit for bit. A binary PLY that
@@ -224,8 +223,8 @@ vb_result vb_mesh_load_plan(const char *path, vb_mesh *out, vb_error *err);
  * "builtin:" names are refused. `data` is borrowed (may be NULL when size
  * is 0); `info` may be NULL. Nothing is written anywhere. */
 vb_result vb_mesh_load_memory(const void *data, size_t size, const char *name,
-                              const vb_load_desc *desc, vb_mesh *out,
-                              vb_source_info *info, vb_error *err);
+                              const vb_load_desc *desc, vb_mesh *out, vb_source_info *info,
+                              vb_error *err);
 
 /* The built-in room, coarse (before refinement). */
 vb_result vb_builtin_room(vb_mesh *out, vb_error *err);
@@ -275,8 +274,8 @@ int vb_triangle_has_area(const float *positions, const uint32_t *ix);
  * area), every one is marked drawn: then nothing is left out. Computed
  * from positions and triangles only, so vdsh-bake (its receivers) and
  * vdsh-merge (POSN, TRIS) agree. Returns the count marked drawn. */
-uint32_t vb_drawn_receivers(const float *positions, uint32_t vertex_count,
-                            const uint32_t *indices, uint32_t triangle_count, uint8_t *drawn);
+uint32_t vb_drawn_receivers(const float *positions, uint32_t vertex_count, const uint32_t *indices,
+                            uint32_t triangle_count, uint8_t *drawn);
 
 /* Receiver refinement: split edges longer than max_edge (OpenMesh) until
  * none is; conforming (both triangles of an edge are split), deterministic,
@@ -315,8 +314,7 @@ uint32_t vb_drawn_receivers(const float *positions, uint32_t vertex_count,
  * or when max_edge is below the float spacing of the coordinates (far from
  * the origin); VB_ERR_INVALID for an index out of range or a non-finite
  * position. */
-vb_result vb_mesh_refine(const vb_mesh *in, float max_edge, vb_mesh *out,
-                         vb_error *err);
+vb_result vb_mesh_refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err);
 
 /* The worst aspect ratio of m's triangles: the longest edge squared over
  * the area, scaled so that the equilateral triangle is 1 (sqrt(3) L^2 /
@@ -341,8 +339,7 @@ vb_result vb_mesh_split_edges(const vb_mesh *in, const uint32_t *pairs, uint32_t
  * Atomically: a temporary file in the same directory, renamed over `path`
  * when complete; on failure no partial file is left and `path` keeps its
  * old content. */
-vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path,
-                            vb_error *err);
+vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path, vb_error *err);
 
 /* Write as binary little-endian PLY (x y z nx ny nz floats, triangles as
  * uchar-counted uint lists), read back bit for bit by vb_mesh_load;
@@ -369,17 +366,17 @@ vb_result vb_mesh_write_ply(const vb_mesh *m, const char *path, vb_error *err);
 #define VB_SPACING_SUGGEST 0.01f
 
 typedef struct vb_mesh_spacing {
-    float diagonal;        /* the scene diagonal the fractions are of */
-    double area;           /* total triangle area */
-    float median_edge;     /* area-weighted median of the triangles' longest
+    float diagonal;     /* the scene diagonal the fractions are of */
+    double area;        /* total triangle area */
+    float median_edge;  /* area-weighted median of the triangles' longest
                             * edges (within 2% of the exact quantile) */
-    float p90_edge;        /* its 90th percentile (likewise) */
-    float max_edge;        /* the longest edge */
-    double long_area;      /* share of the area (0..1) in triangles whose
+    float p90_edge;     /* its 90th percentile (likewise) */
+    float max_edge;     /* the longest edge */
+    double long_area;   /* share of the area (0..1) in triangles whose
                             * longest edge exceeds VB_SPACING_WARN_EDGE x
                             * diagonal */
-    int far_apart;         /* long_area > VB_SPACING_WARN_AREA */
-    float suggest_edge;    /* VB_SPACING_SUGGEST x diagonal, to 2 significant
+    int far_apart;      /* long_area > VB_SPACING_WARN_AREA */
+    float suggest_edge; /* VB_SPACING_SUGGEST x diagonal, to 2 significant
                             * digits */
 } vb_mesh_spacing;
 

@@ -33,7 +33,8 @@
 #include "mesh_read.h"
 #include "vdsh_math.h"
 
-namespace {
+namespace
+{
 
 /* Elements of one accessor, and vertices of the whole mesh: 2^24, the
  * refinement's limit (mesh.h). */
@@ -63,24 +64,29 @@ double read_component(const uint8_t *p, int t, bool normalized)
 {
     switch (t) {
     case TINYGLTF_COMPONENT_TYPE_BYTE: {
-        int8_t v; memcpy(&v, p, 1);
+        int8_t v;
+        memcpy(&v, p, 1);
         return normalized ? std::fmax(v / 127.0, -1.0) : v;
     }
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
     case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        int16_t v; memcpy(&v, p, 2);
+        int16_t v;
+        memcpy(&v, p, 2);
         return normalized ? std::fmax(v / 32767.0, -1.0) : v;
     }
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        uint16_t v; memcpy(&v, p, 2);
+        uint16_t v;
+        memcpy(&v, p, 2);
         return normalized ? v / 65535.0 : v;
     }
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-        uint32_t v; memcpy(&v, p, 4);
+        uint32_t v;
+        memcpy(&v, p, 4);
         return v;
     }
     default: {
-        float v; memcpy(&v, p, 4);
+        float v;
+        memcpy(&v, p, 4);
         return v;
     }
     }
@@ -88,39 +94,44 @@ double read_component(const uint8_t *p, int t, bool normalized)
 
 /* Bytes [offset, offset + count * stride) of a buffer view, checked:
  * returns a pointer to the first element or NULL after vb_fail. */
-const uint8_t *view_span(const reader &rd, int view, size_t offset, size_t count, size_t elem, size_t stride,
-                         const char *what, vb_result *r)
+const uint8_t *view_span(const reader &rd, int view, size_t offset, size_t count, size_t elem,
+                         size_t stride, const char *what, vb_result *r)
 {
     const tinygltf::Model &m = rd.m;
     if (view < 0 || (size_t)view >= m.bufferViews.size()) {
-        *r = vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: buffer view %d does not exist", rd.name, what, view);
+        *r = vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: buffer view %d does not exist", rd.name, what,
+                     view);
         return nullptr;
     }
     const tinygltf::BufferView &bv = m.bufferViews[(size_t)view];
     if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size()) {
-        *r = vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: buffer view %d names buffer %d, which does not exist", rd.name,
-                     what, view, bv.buffer);
+        *r = vb_fail(rd.err, VB_ERR_FORMAT,
+                     "%s: %s: buffer view %d names buffer %d, which does not exist", rd.name, what,
+                     view, bv.buffer);
         return nullptr;
     }
     const std::vector<unsigned char> &data = m.buffers[(size_t)bv.buffer].data;
     if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset) {
-        *r = vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: buffer view %d (offset %zu, length %zu) overruns its buffer "
-                     "(%zu bytes)", rd.name, what, view, bv.byteOffset, bv.byteLength, data.size());
+        *r = vb_fail(rd.err, VB_ERR_FORMAT,
+                     "%s: %s: buffer view %d (offset %zu, length %zu) overruns its buffer "
+                     "(%zu bytes)",
+                     rd.name, what, view, bv.byteOffset, bv.byteLength, data.size());
         return nullptr;
     }
     if (bv.byteStride)
         stride = bv.byteStride;
     if (count && (stride < elem || stride > 252)) {
         if (!(bv.byteStride == 0 && stride == elem)) {
-            *r = vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: byte stride %zu with %zu-byte elements", rd.name, what,
-                         stride, elem);
+            *r = vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: byte stride %zu with %zu-byte elements",
+                         rd.name, what, stride, elem);
             return nullptr;
         }
     }
     /* offset + (count - 1) * stride + elem <= byteLength, without overflow */
     if (count && (offset > bv.byteLength || (count - 1) > (bv.byteLength - offset) / stride ||
                   (count - 1) * stride + elem > bv.byteLength - offset)) {
-        *r = vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: %zu elements at offset %zu overrun buffer view %d (%zu bytes)",
+        *r = vb_fail(rd.err, VB_ERR_FORMAT,
+                     "%s: %s: %zu elements at offset %zu overrun buffer view %d (%zu bytes)",
                      rd.name, what, count, offset, view, bv.byteLength);
         return nullptr;
     }
@@ -129,31 +140,36 @@ const uint8_t *view_span(const reader &rd, int view, size_t offset, size_t count
 
 /* Accessor `index` as count x ncomp doubles (sparse applied). `types`
  * lists the allowed TINYGLTF_TYPE_ (element shape). */
-vb_result read_accessor(const reader &rd, int index, int want_type, bool integer_only, const char *what,
-                        std::vector<double> &out, size_t *count_out)
+vb_result read_accessor(const reader &rd, int index, int want_type, bool integer_only,
+                        const char *what, std::vector<double> &out, size_t *count_out)
 {
     const tinygltf::Model &m = rd.m;
     if (index < 0 || (size_t)index >= m.accessors.size())
-        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d does not exist", rd.name, what, index);
+        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d does not exist", rd.name, what,
+                       index);
     const tinygltf::Accessor &a = m.accessors[(size_t)index];
     if (a.type != want_type)
-        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d has the wrong type (%d, expected %d)", rd.name,
-                       what, index, a.type, want_type);
+        return vb_fail(rd.err, VB_ERR_FORMAT,
+                       "%s: %s: accessor %d has the wrong type (%d, expected %d)", rd.name, what,
+                       index, a.type, want_type);
     size_t cs = component_size(a.componentType);
     if (cs == 0)
-        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d has an unknown component type %d", rd.name,
-                       what, index, a.componentType);
+        return vb_fail(rd.err, VB_ERR_FORMAT,
+                       "%s: %s: accessor %d has an unknown component type %d", rd.name, what, index,
+                       a.componentType);
     if (integer_only && (a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || a.normalized ||
                          a.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
                          a.componentType == TINYGLTF_COMPONENT_TYPE_SHORT))
-        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: indices must be unsigned integers", rd.name,
-                       what, index);
+        return vb_fail(rd.err, VB_ERR_FORMAT,
+                       "%s: %s: accessor %d: indices must be unsigned integers", rd.name, what,
+                       index);
     int nc = tinygltf::GetNumComponentsInType((uint32_t)a.type);
     if (nc <= 0)
-        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: bad type", rd.name, what, index);
+        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: bad type", rd.name, what,
+                       index);
     if (a.count > max_vertices)
-        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: too many elements (%zu)", rd.name, what, index,
-                       a.count);
+        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: too many elements (%zu)",
+                       rd.name, what, index, a.count);
     size_t elem = cs * (size_t)nc;
     vb_result r = VB_OK;
     /* Bytes first, memory after: a count the buffer cannot hold is refused
@@ -176,28 +192,31 @@ vb_result read_accessor(const reader &rd, int index, int want_type, bool integer
     }
     if (a.sparse.isSparse) {
         if (a.sparse.count < 0 || (size_t)a.sparse.count > a.count)
-            return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: sparse count %d out of range", rd.name,
-                           what, index, a.sparse.count);
+            return vb_fail(rd.err, VB_ERR_FORMAT,
+                           "%s: %s: accessor %d: sparse count %d out of range", rd.name, what,
+                           index, a.sparse.count);
         size_t sc = (size_t)a.sparse.count;
         size_t ics = component_size(a.sparse.indices.componentType);
         if (ics < 1 || a.sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT ||
             a.sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
             a.sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_SHORT ||
             a.sparse.indices.byteOffset < 0 || a.sparse.values.byteOffset < 0)
-            return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: bad sparse indices", rd.name, what, index);
-        const uint8_t *pi = view_span(rd, a.sparse.indices.bufferView, (size_t)a.sparse.indices.byteOffset, sc, ics,
-                                      ics, what, &r);
+            return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: bad sparse indices",
+                           rd.name, what, index);
+        const uint8_t *pi = view_span(rd, a.sparse.indices.bufferView,
+                                      (size_t)a.sparse.indices.byteOffset, sc, ics, ics, what, &r);
         if (!pi && sc)
             return r;
-        const uint8_t *pv = view_span(rd, a.sparse.values.bufferView, (size_t)a.sparse.values.byteOffset, sc, elem,
-                                      elem, what, &r);
+        const uint8_t *pv = view_span(rd, a.sparse.values.bufferView,
+                                      (size_t)a.sparse.values.byteOffset, sc, elem, elem, what, &r);
         if (!pv && sc)
             return r;
         for (size_t k = 0; k < sc; k++) {
             double di = read_component(pi + k * ics, a.sparse.indices.componentType, false);
             if (di >= (double)a.count)
-                return vb_fail(rd.err, VB_ERR_FORMAT, "%s: %s: accessor %d: sparse index %.0f out of range (%zu)",
-                               rd.name, what, index, di, a.count);
+                return vb_fail(rd.err, VB_ERR_FORMAT,
+                               "%s: %s: accessor %d: sparse index %.0f out of range (%zu)", rd.name,
+                               what, index, di, a.count);
             size_t i = (size_t)di;
             for (int c = 0; c < nc; c++)
                 out[i * (size_t)nc + (size_t)c] =
@@ -254,7 +273,8 @@ vb_result add_primitive(const reader &rd, const tinygltf::Primitive &p, const ma
         if (r != VB_OK)
             return r;
         if (nn != nv)
-            return vb_fail(rd.err, VB_ERR_FORMAT, "%s: NORMAL has %zu elements, POSITION %zu", rd.name, nn, nv);
+            return vb_fail(rd.err, VB_ERR_FORMAT, "%s: NORMAL has %zu elements, POSITION %zu",
+                           rd.name, nn, nv);
     }
     if (p.indices >= 0) {
         r = read_accessor(rd, p.indices, TINYGLTF_TYPE_SCALAR, true, "indices", ind, &ni);
@@ -268,20 +288,23 @@ vb_result add_primitive(const reader &rd, const tinygltf::Primitive &p, const ma
     }
     for (size_t i = 0; i < ni; i++)
         if (ind[i] >= (double)nv)
-            return vb_fail(rd.err, VB_ERR_INVALID, "%s: index %.0f out of range (%zu vertices)", rd.name, ind[i], nv);
+            return vb_fail(rd.err, VB_ERR_INVALID, "%s: index %.0f out of range (%zu vertices)",
+                           rd.name, ind[i], nv);
     if (o.pos.size() / 3 + nv > max_vertices)
         return vb_fail(rd.err, VB_ERR_FORMAT, "%s: too many vertices", rd.name);
     /* Normal matrix: inverse transpose of the upper 3x3 (cofactors). */
-    const double a = w[0], b = w[4], c = w[8], d = w[1], e = w[5], f = w[9], g = w[2], h = w[6], k = w[10];
+    const double a = w[0], b = w[4], c = w[8], d = w[1], e = w[5], f = w[9], g = w[2], h = w[6],
+                 k = w[10];
     const double det = a * (e * k - f * h) - b * (d * k - f * g) + c * (d * h - e * g);
-    const double cof[9] = {e * k - f * h, -(d * k - f * g), d * h - e * g, -(b * k - c * h), a * k - c * g,
-                           -(a * h - b * g), b * f - c * e, -(a * f - c * d), a * e - b * d};
+    const double cof[9] = {e * k - f * h,    -(d * k - f * g), d * h - e * g,
+                           -(b * k - c * h), a * k - c * g,    -(a * h - b * g),
+                           b * f - c * e,    -(a * f - c * d), a * e - b * d};
     const int64_t base = (int64_t)(o.pos.size() / 3);
     for (size_t i = 0; i < nv; i++) {
         const double *q = &pos[3 * i];
         for (int r3 = 0; r3 < 3; r3++)
-            o.pos.push_back((float)(w[(size_t)r3] * q[0] + w[(size_t)(4 + r3)] * q[1] + w[(size_t)(8 + r3)] * q[2] +
-                                    w[(size_t)(12 + r3)]));
+            o.pos.push_back((float)(w[(size_t)r3] * q[0] + w[(size_t)(4 + r3)] * q[1] +
+                                    w[(size_t)(8 + r3)] * q[2] + w[(size_t)(12 + r3)]));
         if (!nrm.empty()) {
             const double *n = &nrm[3 * i];
             double t[3];
@@ -298,7 +321,8 @@ vb_result add_primitive(const reader &rd, const tinygltf::Primitive &p, const ma
     }
     const bool flip = det < 0;
     auto tri = [&](size_t i0, size_t i1, size_t i2) {
-        int64_t v0 = base + (int64_t)ind[i0], v1 = base + (int64_t)ind[i1], v2 = base + (int64_t)ind[i2];
+        int64_t v0 = base + (int64_t)ind[i0], v1 = base + (int64_t)ind[i1],
+                v2 = base + (int64_t)ind[i2];
         if (flip)
             std::swap(v1, v2);
         o.idx.insert(o.idx.end(), {v0, v1, v2});
@@ -319,24 +343,26 @@ vb_result add_primitive(const reader &rd, const tinygltf::Primitive &p, const ma
     return VB_OK;
 }
 
-vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint8_t> &on_path, int depth,
-                out_mesh &o)
+vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint8_t> &on_path,
+                int depth, out_mesh &o)
 {
     const tinygltf::Model &m = rd.m;
     if (node < 0 || (size_t)node >= m.nodes.size())
         return vb_fail(rd.err, VB_ERR_FORMAT, "%s: node %d does not exist", rd.name, node);
     if (on_path[(size_t)node] || depth > 1000)
-        return vb_fail(rd.err, VB_ERR_FORMAT, "%s: node %d is its own ancestor (a cycle in the node tree)", rd.name,
-                       node);
+        return vb_fail(rd.err, VB_ERR_FORMAT,
+                       "%s: node %d is its own ancestor (a cycle in the node tree)", rd.name, node);
     on_path[(size_t)node] = 1;
     const tinygltf::Node &n = m.nodes[(size_t)node];
     mat4 w = mul(parent, node_matrix(n));
     for (double v : w)
         if (!std::isfinite(v))
-            return vb_fail(rd.err, VB_ERR_INVALID, "%s: node %d: non-finite transform", rd.name, node);
+            return vb_fail(rd.err, VB_ERR_INVALID, "%s: node %d: non-finite transform", rd.name,
+                           node);
     if (n.mesh >= 0) {
         if ((size_t)n.mesh >= m.meshes.size())
-            return vb_fail(rd.err, VB_ERR_FORMAT, "%s: node %d: mesh %d does not exist", rd.name, node, n.mesh);
+            return vb_fail(rd.err, VB_ERR_FORMAT, "%s: node %d: mesh %d does not exist", rd.name,
+                           node, n.mesh);
         for (const tinygltf::Primitive &p : m.meshes[(size_t)n.mesh].primitives) {
             if (n.skin >= 0) {
                 o.skipped_skin++;
@@ -346,8 +372,8 @@ vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint
                 o.skipped_morph++;
                 continue;
             }
-            if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES && p.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
-                p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+            if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES &&
+                p.mode != TINYGLTF_MODE_TRIANGLE_STRIP && p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
                 o.skipped_modes++;
                 continue;
             }
@@ -365,14 +391,14 @@ vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint
     return VB_OK;
 }
 
-bool no_images(tinygltf::Image *, const int, std::string *, std::string *, int, int, const unsigned char *, int,
-               void *)
+bool no_images(tinygltf::Image *, const int, std::string *, std::string *, int, int,
+               const unsigned char *, int, void *)
 {
     return true;
 }
 
-vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, size_t size, vb_mesh_raw *out,
-                vb_error *err)
+vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, size_t size,
+                vb_mesh_raw *out, vb_error *err)
 {
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(no_images, nullptr);
@@ -384,7 +410,8 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     if (size > 0xffffffffu)
         return vb_fail(err, VB_ERR_FORMAT, "%s: file too large", name);
     bool ok = binary ? loader.LoadBinaryFromMemory(&model, &e, &w, bytes, (unsigned)size, dir)
-                     : loader.LoadASCIIFromString(&model, &e, &w, (const char *)bytes, (unsigned)size, dir);
+                     : loader.LoadASCIIFromString(&model, &e, &w, (const char *)bytes,
+                                                  (unsigned)size, dir);
     if (!ok) {
         while (!e.empty() && (e.back() == '\n' || e.back() == ' '))
             e.pop_back();
@@ -395,7 +422,8 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
                        e.empty() ? "(no reason given)" : e.c_str());
     }
     for (const std::string &x : model.extensionsRequired)
-        return vb_fail(err, VB_ERR_FORMAT, "%s: requires the extension %s, which the baker does not read", name,
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: requires the extension %s, which the baker does not read", name,
                        x.c_str());
     if (model.scenes.empty())
         return vb_fail(err, VB_ERR_FORMAT, "%s: no scene", name);
@@ -416,9 +444,10 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
         if (!std::isfinite(v))
             return vb_fail(err, VB_ERR_INVALID, "%s: a vertex has a non-finite coordinate", name);
     if (o.idx.empty() && o.skipped_modes + o.skipped_morph + o.skipped_skin)
-        return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh: no triangles left after skipping %u point/line, %u "
-                       "morph-target and %u skinned primitives", name, o.skipped_modes, o.skipped_morph,
-                       o.skipped_skin);
+        return vb_fail(err, VB_ERR_INVALID,
+                       "%s: empty mesh: no triangles left after skipping %u point/line, %u "
+                       "morph-target and %u skinned primitives",
+                       name, o.skipped_modes, o.skipped_morph, o.skipped_skin);
     vb_mesh_raw raw;
     memset(&raw, 0, sizeof raw);
     raw.vertex_count = (uint32_t)(o.pos.size() / 3);
@@ -450,12 +479,14 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
 
 } // namespace
 
-extern "C" vb_result vb_mesh_parse_gltf(const char *name, int binary, int scene, const uint8_t *bytes, size_t size,
-                                        vb_mesh_raw *out, vb_error *err)
+extern "C" vb_result vb_mesh_parse_gltf(const char *name, int binary, int scene,
+                                        const uint8_t *bytes, size_t size, vb_mesh_raw *out,
+                                        vb_error *err)
 {
     if (!name || (!bytes && size) || !out)
         return vb_fail(err, VB_ERR_ARGUMENT, "vb_mesh_parse_gltf: NULL argument");
     static const uint8_t nothing = 0;
     const uint8_t *b = bytes ? bytes : &nothing;
-    return vb_read::no_throw(name, err, [&] { return parse(name, binary, scene, b, size, out, err); });
+    return vb_read::no_throw(name, err,
+                             [&] { return parse(name, binary, scene, b, size, out, err); });
 }

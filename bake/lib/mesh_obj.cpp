@@ -19,9 +19,11 @@
 #include <utility>
 #include <vector>
 
-namespace vb_read {
+namespace vb_read
+{
 
-namespace {
+namespace
+{
 
 /* One face line's corners as OpenMesh's OBJ reader reads them; appended
  * to `verts` (0-based vertex handles, possibly out of range) and `nsets`
@@ -32,8 +34,9 @@ namespace {
  * normal goes to the vertex read last on the line. Negative numbers count
  * back from the "v" (or "vn") lines so far. False if a normal comes before
  * any vertex (OpenMesh's behaviour is undefined there). */
-bool obj_corner(const char *b, const char *e, int64_t lines_v, int64_t lines_vn, std::vector<int64_t> &verts,
-                size_t face_first, std::vector<std::pair<int64_t, int64_t>> &nsets)
+bool obj_corner(const char *b, const char *e, int64_t lines_v, int64_t lines_vn,
+                std::vector<int64_t> &verts, size_t face_first,
+                std::vector<std::pair<int64_t, int64_t>> &nsets)
 {
     int component = 0;
     const char *s = b;
@@ -116,11 +119,13 @@ void remove_repeated(std::vector<int64_t> &v)
  * "v" line skipped that way always makes them differ), and the text after
  * '#' on a face line is read on as corners (a new vertex there makes them
  * differ; a repeated one may give its vertex a normal). */
-vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder &out, expectation *ex,
-                   vb_error *err)
+vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder &out,
+                   expectation *ex, vb_error *err)
 {
-    if (size >= 2 && ((bytes[0] == 0xfe && bytes[1] == 0xff) || (bytes[0] == 0xff && bytes[1] == 0xfe)))
-        return vb_fail(err, VB_ERR_FORMAT, "%s: UTF-16 text is not supported (save as UTF-8 or ASCII)", path);
+    if (size >= 2 &&
+        ((bytes[0] == 0xfe && bytes[1] == 0xff) || (bytes[0] == 0xff && bytes[1] == 0xfe)))
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: UTF-16 text is not supported (save as UTF-8 or ASCII)", path);
 
     /* Positive indices may point forward, so count the "v" lines before
      * checking faces. */
@@ -144,8 +149,8 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
     out.positions.reserve(3 * (size_t)std::min<uint64_t>(total, 1u << 24));
 
     cursor c(bytes, size);
-    uint64_t nv = 0, nn = 0;          /* "v", "vn" lines so far */
-    int64_t read_v = 0, read_vn = 0;  /* of those, the lines not skipped */
+    uint64_t nv = 0, nn = 0;         /* "v", "vn" lines so far */
+    int64_t read_v = 0, read_vn = 0; /* of those, the lines not skipped */
     std::vector<long long> corners;
     std::string &hint = ex->hint;
     while (!c.at_end()) {
@@ -170,13 +175,15 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
             for (int i = 0; i < 3; i++) {
                 token t;
                 if (!c.next_on_line(&t) || t.b[0] == '#')
-                    return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: %s %llu has fewer than 3 numbers",
-                                   path, c.line, what, (unsigned long long)number);
+                    return vb_fail(err, VB_ERR_FORMAT,
+                                   "%s: line %lu: %s %llu has fewer than 3 numbers", path, c.line,
+                                   what, (unsigned long long)number);
                 num_status s = parse_float(t, &xyz[i]);
                 if (s != NUM_OK)
                     return vb_fail(err, s == NUM_BAD ? VB_ERR_FORMAT : VB_ERR_INVALID,
-                                   "%s: line %lu: %s %llu: coordinate '%.*s' %s", path, c.line, what,
-                                   (unsigned long long)number, t.show_len(), t.b, num_problem(s));
+                                   "%s: line %lu: %s %llu: coordinate '%.*s' %s", path, c.line,
+                                   what, (unsigned long long)number, t.show_len(), t.b,
+                                   num_problem(s));
             }
             if (is_v) {
                 nv++;
@@ -184,7 +191,8 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
                     out.add_vertex(xyz[0], xyz[1], xyz[2]);
                     read_v++;
                 } else if (hint.empty()) {
-                    hint = "line " + std::to_string(line_no) + ": a vertex line starting with a vertical tab or "
+                    hint = "line " + std::to_string(line_no) +
+                           ": a vertex line starting with a vertical tab or "
                            "form feed is skipped";
                 }
             } else {
@@ -206,25 +214,30 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
                 token idx{t.b, slash ? slash : t.e};
                 long long v = 0;
                 if (!parse_int(idx, &v) || v == 0)
-                    return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: face corner '%.*s' has no valid vertex index",
+                    return vb_fail(err, VB_ERR_FORMAT,
+                                   "%s: line %lu: face corner '%.*s' has no valid vertex index",
                                    path, c.line, t.show_len(), t.b);
                 if (v < 0) {
                     if (v < -(long long)nv)
-                        return vb_fail(err, VB_ERR_INVALID,
-                                       "%s: line %lu: face index %lld out of range (%llu vertices so far)",
-                                       path, c.line, v, (unsigned long long)nv);
+                        return vb_fail(
+                            err, VB_ERR_INVALID,
+                            "%s: line %lu: face index %lld out of range (%llu vertices so far)",
+                            path, c.line, v, (unsigned long long)nv);
                     v = (long long)nv + v + 1;
                 } else if ((unsigned long long)v > total) {
-                    return vb_fail(err, VB_ERR_INVALID, "%s: line %lu: face index %lld out of range (%llu vertices)",
+                    return vb_fail(err, VB_ERR_INVALID,
+                                   "%s: line %lu: face index %lld out of range (%llu vertices)",
                                    path, c.line, v, (unsigned long long)total);
                 }
                 corners.push_back(v);
             }
             if (corners.size() < 3)
-                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: face has %zu vertices (needs at least 3)",
-                               path, c.line, corners.size());
+                return vb_fail(err, VB_ERR_FORMAT,
+                               "%s: line %lu: face has %zu vertices (needs at least 3)", path,
+                               c.line, corners.size());
             std::sort(corners.begin(), corners.end());
-            size_t distinct = (size_t)(std::unique(corners.begin(), corners.end()) - corners.begin());
+            size_t distinct =
+                (size_t)(std::unique(corners.begin(), corners.end()) - corners.begin());
             if (distinct >= 3) {
                 ex->faces++;
                 ex->triangles += distinct - 2;
@@ -235,7 +248,8 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
             /* The reading: every token of the line, '#' or not. */
             if (skipped) {
                 if (distinct >= 3 && hint.empty())
-                    hint = "line " + std::to_string(line_no) + ": a face line starting with a vertical tab or "
+                    hint = "line " + std::to_string(line_no) +
+                           ": a face line starting with a vertical tab or "
                            "form feed is skipped";
             } else {
                 size_t face_first = verts.size();
@@ -243,14 +257,18 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
                 line_c.p = rest;
                 while (line_c.next_on_line(&t))
                     if (!obj_corner(t.b, t.e, read_v, read_vn, verts, face_first, nsets))
-                        return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: face corner '%.*s' gives a normal "
-                                                           "before any vertex", path, line_no, t.show_len(), t.b);
+                        return vb_fail(err, VB_ERR_FORMAT,
+                                       "%s: line %lu: face corner '%.*s' gives a normal "
+                                       "before any vertex",
+                                       path, line_no, t.show_len(), t.b);
                 faces.push_back(face_rec{verts.size(), nsets.size()});
                 std::vector<int64_t> mine(verts.begin() + (ptrdiff_t)face_first, verts.end());
                 remove_repeated(mine);
-                if (((mine.size() >= 3) != (distinct >= 3) || (distinct >= 3 && mine.size() != distinct)) &&
+                if (((mine.size() >= 3) != (distinct >= 3) ||
+                     (distinct >= 3 && mine.size() != distinct)) &&
                     hint.empty())
-                    hint = "line " + std::to_string(line_no) + ": the text after '#' reads as further face corners";
+                    hint = "line " + std::to_string(line_no) +
+                           ": the text after '#' reads as further face corners";
             }
         }
         /* "vt", "mtllib", "usemtl", groups, ...: not used */
@@ -269,7 +287,7 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
     std::vector<int64_t> polygon;
     for (const face_rec &f : faces) {
         for (size_t i = nb; i < f.nsets_end; i++) {
-            uint32_t k = (uint32_t)(nsets[i].second - 1);   /* as OpenMesh: unsigned compare */
+            uint32_t k = (uint32_t)(nsets[i].second - 1); /* as OpenMesh: unsigned compare */
             if (!normals.empty() && k < normals.size() / 3)
                 out.set_normal(nsets[i].first, &normals[3 * (size_t)k]);
         }

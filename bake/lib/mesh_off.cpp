@@ -11,7 +11,8 @@
 #include <cstring>
 #include <vector>
 
-namespace vb_read {
+namespace vb_read
+{
 
 /* Header line [ST][C][N]OFF [BINARY] ("4OFF"/"nOFF" unsupported; BINARY
  * exactly one character after OFF, as OpenMesh's reader decided); counts
@@ -20,8 +21,8 @@ namespace vb_read {
  * face is a count and that many indices as tokens, then (only with C) the
  * rest of its line. Binary: little-endian uint32 counts, float32
  * coordinates, uint32 face sizes and indices, no colours. */
-vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder &out, expectation *ex,
-                   vb_error *err)
+vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder &out,
+                   expectation *ex, vb_error *err)
 {
     cursor c(bytes, size);
     const char *p = c.p;
@@ -42,9 +43,11 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
         p++;
     }
     if (p < le && (*p == '4' || *p == 'n'))
-        return vb_fail(err, VB_ERR_FORMAT, "%s: 4OFF/nOFF (vertex dimension other than 3) is not supported", path);
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: 4OFF/nOFF (vertex dimension other than 3) is not supported", path);
     if (le - p < 3 || memcmp(p, "OFF", 3) != 0)
-        return vb_fail(err, VB_ERR_FORMAT, "%s: not an OFF file (first line must be [ST][C][N]OFF)", path);
+        return vb_fail(err, VB_ERR_FORMAT, "%s: not an OFF file (first line must be [ST][C][N]OFF)",
+                       path);
     /* Exactly one character after "OFF", whatever it is, then BINARY:
      * "OFFxBINARY" is binary and "OFF  BINARY" is not (OpenMesh's rule,
      * kept: files were baked by it). */
@@ -58,7 +61,9 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
     std::vector<int64_t> polygon;
     if (binary) {
         if (tex || color)
-            return vb_fail(err, VB_ERR_FORMAT, "%s: binary OFF with colours or texture coordinates is not supported", path);
+            return vb_fail(err, VB_ERR_FORMAT,
+                           "%s: binary OFF with colours or texture coordinates is not supported",
+                           path);
         const uint8_t *b = (const uint8_t *)c.p;
         size_t left = (size_t)(c.end - c.p);
         if (left < 12)
@@ -68,21 +73,24 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
         left -= 12;
         size_t vsize = normal ? 24 : 12;
         if (nv > max_count || nf > max_count || nv > left / vsize)
-            return vb_fail(err, VB_ERR_FORMAT,
-                           "%s: header declares %llu vertices, more than the file's %zu bytes can hold",
-                           path, (unsigned long long)nv, size);
+            return vb_fail(
+                err, VB_ERR_FORMAT,
+                "%s: header declares %llu vertices, more than the file's %zu bytes can hold", path,
+                (unsigned long long)nv, size);
         out.positions.reserve(3 * (size_t)nv);
         for (uint64_t i = 0; i < nv; i++) {
             float v[3];
             for (int k = 0; k < 3; k++) {
                 v[k] = load_f32(b + 4 * k, false);
                 if (!std::isfinite(v[k]))
-                    return vb_fail(err, VB_ERR_INVALID, "%s: vertex %llu has a non-finite coordinate",
-                                   path, (unsigned long long)i);
+                    return vb_fail(err, VB_ERR_INVALID,
+                                   "%s: vertex %llu has a non-finite coordinate", path,
+                                   (unsigned long long)i);
             }
             out.add_vertex(v[0], v[1], v[2]);
             if (normal) {
-                const float n[3] = {load_f32(b + 12, false), load_f32(b + 16, false), load_f32(b + 20, false)};
+                const float n[3] = {load_f32(b + 12, false), load_f32(b + 16, false),
+                                    load_f32(b + 20, false)};
                 out.set_normal((int64_t)i, n);
             }
             b += vsize;
@@ -96,17 +104,22 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
             b += 4;
             left -= 4;
             if (n > left / 4)
-                return vb_fail(err, VB_ERR_FORMAT, "%s: truncated: face %llu has %llu vertices past the end of the file",
-                               path, (unsigned long long)f, (unsigned long long)n);
+                return vb_fail(
+                    err, VB_ERR_FORMAT,
+                    "%s: truncated: face %llu has %llu vertices past the end of the file", path,
+                    (unsigned long long)f, (unsigned long long)n);
             if (n < 3)
-                return vb_fail(err, VB_ERR_FORMAT, "%s: face %llu has %llu vertices (needs at least 3)",
-                               path, (unsigned long long)f, (unsigned long long)n);
+                return vb_fail(err, VB_ERR_FORMAT,
+                               "%s: face %llu has %llu vertices (needs at least 3)", path,
+                               (unsigned long long)f, (unsigned long long)n);
             polygon.clear();
             for (uint64_t k = 0; k < n; k++) {
                 uint64_t idx = load_u32(b + 4 * k, false);
                 if (idx >= nv)
-                    return vb_fail(err, VB_ERR_INVALID, "%s: face %llu: vertex index %llu out of range (%llu vertices)",
-                                   path, (unsigned long long)f, (unsigned long long)idx, (unsigned long long)nv);
+                    return vb_fail(err, VB_ERR_INVALID,
+                                   "%s: face %llu: vertex index %llu out of range (%llu vertices)",
+                                   path, (unsigned long long)f, (unsigned long long)idx,
+                                   (unsigned long long)nv);
                 polygon.push_back((int64_t)idx);
             }
             b += 4 * n;
@@ -126,23 +139,26 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
     for (int i = 0; i < 3; i++) {
         token t;
         if (!c.next(&t) || !parse_int(t, &counts[i]) || counts[i] < 0)
-            return vb_fail(err, VB_ERR_FORMAT,
-                           "%s: line %lu: expected three counts (vertices faces edges) after the OFF line",
-                           path, c.line);
+            return vb_fail(
+                err, VB_ERR_FORMAT,
+                "%s: line %lu: expected three counts (vertices faces edges) after the OFF line",
+                path, c.line);
     }
     /* The edge count is not used, but OpenMesh read it as an unsigned
      * int: a larger one failed its stream and every later number read as
      * garbage. */
     if (counts[2] > (long long)UINT32_MAX)
-        return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: edge count %lld is too large", path, c.line, counts[2]);
+        return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: edge count %lld is too large", path,
+                       c.line, counts[2]);
     uint64_t nv = (uint64_t)counts[0], nf = (uint64_t)counts[1];
     /* Every vertex needs at least "0 0 0\n" and every face "3 0 0 0\n": a
      * header promising more than the file holds is rejected before any
      * loop runs over its counts. */
     if (nv > max_count || nf > max_count || nv > size / 6 || nf > size / 8)
-        return vb_fail(err, VB_ERR_FORMAT,
-                       "%s: header declares %llu vertices and %llu faces, more than the file's %zu bytes can hold",
-                       path, (unsigned long long)nv, (unsigned long long)nf, size);
+        return vb_fail(
+            err, VB_ERR_FORMAT,
+            "%s: header declares %llu vertices and %llu faces, more than the file's %zu bytes can hold",
+            path, (unsigned long long)nv, (unsigned long long)nf, size);
     int per_vertex = normal ? 6 : 3;
     out.positions.reserve(3 * (size_t)nv);
     for (uint64_t i = 0; i < nv; i++) {
@@ -150,8 +166,9 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
         for (int k = 0; k < per_vertex; k++) {
             token t;
             if (!c.next(&t))
-                return vb_fail(err, VB_ERR_FORMAT, "%s: truncated: file ends in vertex %llu of %llu",
-                               path, (unsigned long long)i, (unsigned long long)nv);
+                return vb_fail(err, VB_ERR_FORMAT,
+                               "%s: truncated: file ends in vertex %llu of %llu", path,
+                               (unsigned long long)i, (unsigned long long)nv);
             num_status s = parse_float(t, &v[k]);
             if (s != NUM_OK)
                 return vb_fail(err, s == NUM_BAD ? VB_ERR_FORMAT : VB_ERR_INVALID,
@@ -171,25 +188,31 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
             return vb_fail(err, VB_ERR_FORMAT, "%s: truncated: file ends before face %llu of %llu",
                            path, (unsigned long long)f, (unsigned long long)nf);
         if (!parse_int(t, &n) || n < 0)
-            return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: face %llu: vertex count '%.*s' is not a number",
-                           path, c.line, (unsigned long long)f, t.show_len(), t.b);
+            return vb_fail(err, VB_ERR_FORMAT,
+                           "%s: line %lu: face %llu: vertex count '%.*s' is not a number", path,
+                           c.line, (unsigned long long)f, t.show_len(), t.b);
         if (n < 3)
-            return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: face %llu has %lld vertices (needs at least 3)",
-                           path, c.line, (unsigned long long)f, n);
+            return vb_fail(err, VB_ERR_FORMAT,
+                           "%s: line %lu: face %llu has %lld vertices (needs at least 3)", path,
+                           c.line, (unsigned long long)f, n);
         if ((uint64_t)n > size || (uint64_t)n > max_count)
-            return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: face %llu claims %lld vertices",
-                           path, c.line, (unsigned long long)f, n);
+            return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: face %llu claims %lld vertices", path,
+                           c.line, (unsigned long long)f, n);
         polygon.clear();
         for (long long k = 0; k < n; k++) {
             long long idx = 0;
             if (!c.next(&t))
-                return vb_fail(err, VB_ERR_FORMAT, "%s: truncated: file ends in face %llu", path, (unsigned long long)f);
+                return vb_fail(err, VB_ERR_FORMAT, "%s: truncated: file ends in face %llu", path,
+                               (unsigned long long)f);
             if (!parse_int(t, &idx))
-                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: face %llu: vertex index '%.*s' is not a number",
-                               path, c.line, (unsigned long long)f, t.show_len(), t.b);
+                return vb_fail(err, VB_ERR_FORMAT,
+                               "%s: line %lu: face %llu: vertex index '%.*s' is not a number", path,
+                               c.line, (unsigned long long)f, t.show_len(), t.b);
             if (idx < 0 || (uint64_t)idx >= nv)
-                return vb_fail(err, VB_ERR_INVALID, "%s: line %lu: face %llu: vertex index %lld out of range (%llu vertices)",
-                               path, c.line, (unsigned long long)f, idx, (unsigned long long)nv);
+                return vb_fail(
+                    err, VB_ERR_INVALID,
+                    "%s: line %lu: face %llu: vertex index %lld out of range (%llu vertices)", path,
+                    c.line, (unsigned long long)f, idx, (unsigned long long)nv);
             polygon.push_back((int64_t)idx);
         }
         if (color)

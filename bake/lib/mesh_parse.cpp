@@ -44,7 +44,8 @@
 #include <utility>
 #include <vector>
 
-namespace vb_read {
+namespace vb_read
+{
 
 /* ====================================================================== */
 /* Numbers                                                                */
@@ -226,14 +227,13 @@ void builder::add_corner_normals(const int64_t *v, size_t n)
                     break;
                 }
     } else {
-        std::vector<std::pair<int64_t, size_t>> last;   /* vertex, latest pending entry */
+        std::vector<std::pair<int64_t, size_t>> last; /* vertex, latest pending entry */
         last.reserve(pending.size());
         for (size_t p = 0; p < pending.size(); p++)
             last.emplace_back(pending[p].first, p);
         std::stable_sort(last.begin(), last.end(),
-                         [](const std::pair<int64_t, size_t> &a, const std::pair<int64_t, size_t> &b) {
-                             return a.first < b.first;
-                         });
+                         [](const std::pair<int64_t, size_t> &a,
+                            const std::pair<int64_t, size_t> &b) { return a.first < b.first; });
         for (size_t c = 0; c < n; c++) {
             auto it = std::upper_bound(last.begin(), last.end(), std::make_pair(v[c], SIZE_MAX));
             if (it != last.begin() && (it - 1)->first == v[c])
@@ -254,12 +254,13 @@ void builder::add_corner_normals(const int64_t *v, size_t n)
 
 } // namespace vb_read
 
-namespace {
+namespace
+{
 
 using namespace vb_read;
 
-vb_result parse(const char *name, vb_mesh_format format, const uint8_t *bytes, size_t size, vb_mesh_raw *out,
-                vb_error *err)
+vb_result parse(const char *name, vb_mesh_format format, const uint8_t *bytes, size_t size,
+                vb_mesh_raw *out, vb_error *err)
 {
     builder b;
     expectation ex;
@@ -277,18 +278,21 @@ vb_result parse(const char *name, vb_mesh_format format, const uint8_t *bytes, s
     if ((ex.vertices_known && b.vertex_count() != ex.vertices) || b.polygons != ex.faces ||
         b.triangle_count() != ex.triangles) {
         if (!ex.hint.empty())
-            return vb_fail(err, VB_ERR_FORMAT,
-                           "%s: %s by other readers: the file reads as %llu vertices, %llu faces, %llu triangles "
-                           "or as %llu, %llu, %llu (refused)", name, ex.hint.c_str(),
-                           (unsigned long long)b.vertex_count(), (unsigned long long)b.polygons,
-                           (unsigned long long)b.triangle_count(), (unsigned long long)ex.vertices,
-                           (unsigned long long)ex.faces, (unsigned long long)ex.triangles);
-        return vb_fail(err, VB_ERR_FORMAT,
-                       "%s: read %llu vertices, %llu faces, %llu triangles, but the file has %llu, %llu, %llu; "
-                       "refusing a partial mesh", name, (unsigned long long)b.vertex_count(),
-                       (unsigned long long)b.polygons, (unsigned long long)b.triangle_count(),
-                       (unsigned long long)ex.vertices, (unsigned long long)ex.faces,
-                       (unsigned long long)ex.triangles);
+            return vb_fail(
+                err, VB_ERR_FORMAT,
+                "%s: %s by other readers: the file reads as %llu vertices, %llu faces, %llu triangles "
+                "or as %llu, %llu, %llu (refused)",
+                name, ex.hint.c_str(), (unsigned long long)b.vertex_count(),
+                (unsigned long long)b.polygons, (unsigned long long)b.triangle_count(),
+                (unsigned long long)ex.vertices, (unsigned long long)ex.faces,
+                (unsigned long long)ex.triangles);
+        return vb_fail(
+            err, VB_ERR_FORMAT,
+            "%s: read %llu vertices, %llu faces, %llu triangles, but the file has %llu, %llu, %llu; "
+            "refusing a partial mesh",
+            name, (unsigned long long)b.vertex_count(), (unsigned long long)b.polygons,
+            (unsigned long long)b.triangle_count(), (unsigned long long)ex.vertices,
+            (unsigned long long)ex.faces, (unsigned long long)ex.triangles);
     }
     if (b.vertex_count() > max_count)
         return vb_fail(err, VB_ERR_FORMAT, "%s: too many vertices", name);
@@ -300,15 +304,17 @@ vb_result parse(const char *name, vb_mesh_format format, const uint8_t *bytes, s
     for (uint64_t i = 0; i < nv; i++) {
         const float *p = &b.positions[3 * (size_t)i];
         if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-            return vb_fail(err, VB_ERR_INVALID, "%s: vertex %llu has a non-finite coordinate (%g, %g, %g)", name,
+            return vb_fail(err, VB_ERR_INVALID,
+                           "%s: vertex %llu has a non-finite coordinate (%g, %g, %g)", name,
                            (unsigned long long)i + base, (double)p[0], (double)p[1], (double)p[2]);
     }
     for (size_t j = 0; j < b.indices.size(); j++) {
         int64_t v = b.indices[j];
         if (v < 0 || (uint64_t)v >= nv)
-            return vb_fail(err, VB_ERR_INVALID, "%s: face %llu: vertex index %lld out of range (%u vertices)", name,
-                           (unsigned long long)b.tri_face[j / 3] + base, (long long)v + (long long)base,
-                           (unsigned)nv);
+            return vb_fail(err, VB_ERR_INVALID,
+                           "%s: face %llu: vertex index %lld out of range (%u vertices)", name,
+                           (unsigned long long)b.tri_face[j / 3] + base,
+                           (long long)v + (long long)base, (unsigned)nv);
     }
     b.finish(ex.dropped, out);
     return VB_OK;
@@ -320,8 +326,8 @@ vb_result parse(const char *name, vb_mesh_format format, const uint8_t *bytes, s
 /* C entry points: no exception passes these                              */
 /* ====================================================================== */
 
-extern "C" vb_result vb_mesh_parse(const char *name, vb_mesh_format format, const uint8_t *bytes, size_t size,
-                                   vb_mesh_raw *out, vb_error *err)
+extern "C" vb_result vb_mesh_parse(const char *name, vb_mesh_format format, const uint8_t *bytes,
+                                   size_t size, vb_mesh_raw *out, vb_error *err)
 {
     if (!name || (!bytes && size) || !out)
         return vb_fail(err, VB_ERR_ARGUMENT, "vb_mesh_parse: NULL argument");

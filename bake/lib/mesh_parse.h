@@ -52,7 +52,7 @@ typedef enum vb_mesh_format {
     VB_MESH_PLY,
     VB_MESH_OFF,
     VB_MESH_STL,
-    VB_MESH_GLTF,          /* mesh_gltf.cpp (vb_mesh_parse_gltf) */
+    VB_MESH_GLTF, /* mesh_gltf.cpp (vb_mesh_parse_gltf) */
     VB_MESH_GLB
 } vb_mesh_format;
 
@@ -64,14 +64,14 @@ typedef enum vb_mesh_format {
 typedef struct vb_mesh_raw {
     uint32_t vertex_count;
     uint32_t triangle_count;
-    float *positions;      /* 3 * vertex_count */
-    float *normals;        /* 3 * vertex_count or NULL (file has none) */
-    uint8_t *has_normal;   /* vertex_count or NULL: file gave a normal */
-    int64_t *indices;      /* 3 * triangle_count */
-    uint32_t *faces;       /* triangle_count: 0-based polygon in the file */
-    float *corner_normals; /* 9 * triangle_count or NULL (none given) */
-    uint8_t *corner_given; /* 3 * triangle_count or NULL: corner has one */
-    uint32_t dropped_triangles; /* OBJ faces dropped for fewer than 3
+    float *positions;            /* 3 * vertex_count */
+    float *normals;              /* 3 * vertex_count or NULL (file has none) */
+    uint8_t *has_normal;         /* vertex_count or NULL: file gave a normal */
+    int64_t *indices;            /* 3 * triangle_count */
+    uint32_t *faces;             /* triangle_count: 0-based polygon in the file */
+    float *corner_normals;       /* 9 * triangle_count or NULL (none given) */
+    uint8_t *corner_given;       /* 3 * triangle_count or NULL: corner has one */
+    uint32_t dropped_triangles;  /* OBJ faces dropped for fewer than 3
                                    distinct vertices (see vb_mesh_report) */
     uint32_t gltf_skipped_modes; /* glTF primitives skipped: points, lines */
     uint32_t gltf_skipped_morph; /* glTF primitives skipped: morph targets */
@@ -86,8 +86,8 @@ void vb_mesh_raw_free(vb_mesh_raw *raw);
 
 /* glTF 2.0 (binary = 0: .gltf JSON, 1: .glb) from mesh_gltf.cpp: scene
  * `scene`, or the default scene when < 0; see that file's top comment. */
-vb_result vb_mesh_parse_gltf(const char *name, int binary, int scene, const uint8_t *bytes, size_t size,
-                             vb_mesh_raw *out, vb_error *err);
+vb_result vb_mesh_parse_gltf(const char *name, int binary, int scene, const uint8_t *bytes,
+                             size_t size, vb_mesh_raw *out, vb_error *err);
 
 #ifdef __cplusplus
 }

@@ -16,9 +16,11 @@
 #include <string>
 #include <vector>
 
-namespace vb_read {
+namespace vb_read
+{
 
-namespace {
+namespace
+{
 
 struct ply_type {
     const char *name;
@@ -29,11 +31,11 @@ struct ply_type {
 
 /* In OpenMesh's order of preference (see ply_role). */
 const ply_type ply_types[] = {
-    {"float32", 4, true, true},  {"float64", 8, true, true},   {"float", 4, true, true},
-    {"double", 8, true, true},   {"int8", 1, false, true},     {"uint8", 1, false, false},
-    {"char", 1, false, true},    {"uchar", 1, false, false},   {"int32", 4, false, true},
-    {"uint32", 4, false, false}, {"int", 4, false, true},      {"uint", 4, false, false},
-    {"int16", 2, false, true},   {"uint16", 2, false, false},  {"short", 2, false, true},
+    {"float32", 4, true, true},  {"float64", 8, true, true},  {"float", 4, true, true},
+    {"double", 8, true, true},   {"int8", 1, false, true},    {"uint8", 1, false, false},
+    {"char", 1, false, true},    {"uchar", 1, false, false},  {"int32", 4, false, true},
+    {"uint32", 4, false, false}, {"int", 4, false, true},     {"uint", 4, false, false},
+    {"int16", 2, false, true},   {"uint16", 2, false, false}, {"short", 2, false, true},
     {"ushort", 2, false, false},
 };
 
@@ -55,13 +57,24 @@ const ply_type *find_ply_type(const std::string &s)
 
 /* What a property is read as (OpenMesh's PLY reader decided by the
  * element's and the property's names). */
-enum ply_role { PLY_OTHER, PLY_X, PLY_Y, PLY_Z, PLY_NX, PLY_NY, PLY_NZ, PLY_TEX, PLY_COLOR, PLY_INDICES };
+enum ply_role {
+    PLY_OTHER,
+    PLY_X,
+    PLY_Y,
+    PLY_Z,
+    PLY_NX,
+    PLY_NY,
+    PLY_NZ,
+    PLY_TEX,
+    PLY_COLOR,
+    PLY_INDICES
+};
 
 struct ply_property {
     std::string name;
     const ply_type *type = nullptr;
-    const ply_type *count_type = nullptr;   /* lists only */
-    const ply_type *read_type = nullptr;    /* OpenMesh's reading of "property TYPE NAME" */
+    const ply_type *count_type = nullptr; /* lists only */
+    const ply_type *read_type = nullptr;  /* OpenMesh's reading of "property TYPE NAME" */
     ply_role role = PLY_OTHER;
 };
 
@@ -77,8 +90,8 @@ struct ply_element {
  * two comes first in ply_types. */
 void ply_roles(ply_element &e)
 {
-    static const char *const colours[] = {"red", "green", "blue", "diffuse_red", "diffuse_green", "diffuse_blue",
-                                          "alpha"};
+    static const char *const colours[] = {"red",           "green",        "blue", "diffuse_red",
+                                          "diffuse_green", "diffuse_blue", "alpha"};
     for (ply_property &p : e.props) {
         p.read_type = p.type;
         if (!p.count_type) {
@@ -137,9 +150,9 @@ int ply_read_size(const ply_property &p, bool in_vertex, bool in_face)
  * the counts, ranges and values are then checked like any others (usually
  * the file is refused; where the shifts cancel it reads as it always did).
  * Reading past the end refuses the file. */
-vb_result ply_binary_read(const char *path, const std::vector<ply_element> &elems, size_t last, int vertex_elem,
-                          int face_elem, bool has_normals, bool big, const uint8_t *b, size_t left, builder &out,
-                          vb_error *err)
+vb_result ply_binary_read(const char *path, const std::vector<ply_element> &elems, size_t last,
+                          int vertex_elem, int face_elem, bool has_normals, bool big,
+                          const uint8_t *b, size_t left, builder &out, vb_error *err)
 {
     bool past_end = false;
     auto take = [&](size_t n) -> const uint8_t * {
@@ -183,8 +196,10 @@ vb_result ply_binary_read(const char *path, const std::vector<ply_element> &elem
                     if (past_end)
                         break;
                     if (polygon.size() < 3)
-                        return vb_fail(err, VB_ERR_FORMAT, "%s: face %llu has %zu vertices as the binary data is "
-                                                           "read", path, (unsigned long long)n, polygon.size());
+                        return vb_fail(err, VB_ERR_FORMAT,
+                                       "%s: face %llu has %zu vertices as the binary data is "
+                                       "read",
+                                       path, (unsigned long long)n, polygon.size());
                     out.add_face(polygon.data(), polygon.size());
                 } else if (is_vertex && p.role >= PLY_X && p.role <= PLY_TEX) {
                     float f = 0.0f;
@@ -213,9 +228,11 @@ vb_result ply_binary_read(const char *path, const std::vector<ply_element> &elem
         }
     }
     if (past_end)
-        return vb_fail(err, VB_ERR_FORMAT, "%s: the binary data ends early as its properties' types are read "
-                                           "(x, y, z and normals of an integer type, colours of type double and "
-                                           "properties named after a type are read otherwise than declared)", path);
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: the binary data ends early as its properties' types are read "
+                       "(x, y, z and normals of an integer type, colours of type double and "
+                       "properties named after a type are read otherwise than declared)",
+                       path);
     return VB_OK;
 }
 
@@ -238,8 +255,8 @@ vb_result ply_binary_read(const char *path, const std::vector<ply_element> &elem
  * file declares; ascii colours that are not whole numbers of int range
  * unless their type is float (read as integers: the rest failed or shifted
  * into the next value), unless nothing used follows (the last face). */
-vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder &out, expectation *ex,
-                   vb_error *err)
+vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder &out,
+                   expectation *ex, vb_error *err)
 {
     cursor c(bytes, size);
     token t;
@@ -282,42 +299,50 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
             else if (args[0].is("binary_big_endian"))
                 format = 2;
             else
-                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: unknown PLY format '%.*s'",
-                               path, line, args[0].show_len(), args[0].b);
+                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: unknown PLY format '%.*s'", path,
+                               line, args[0].show_len(), args[0].b);
         } else if (kw.is("element")) {
             long long n = 0;
             if (args.size() != 2 || !parse_int(args[1], &n) || n < 0)
                 return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: bad element line", path, line);
             if ((uint64_t)n > max_count)
-                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: element count %lld is too large", path, line, n);
+                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: element count %lld is too large",
+                               path, line, n);
             ply_element e;
             e.name.assign(args[0].b, args[0].e);
             e.count = (uint64_t)n;
             elems.push_back(e);
         } else if (kw.is("property")) {
             if (elems.empty())
-                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: property before any element", path, line);
+                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: property before any element",
+                               path, line);
             ply_property p;
             if (!args.empty() && args[0].is("list")) {
                 if (args.size() != 4)
-                    return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: bad list property", path, line);
+                    return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: bad list property", path,
+                                   line);
                 p.count_type = find_ply_type(args[1]);
                 p.type = find_ply_type(args[2]);
                 p.name.assign(args[3].b, args[3].e);
                 if (!p.count_type || !p.type)
-                    return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: unknown type in list property", path, line);
-                if (!(args[1].is("uint8") || args[1].is("uchar") || args[1].is("uint16") || args[1].is("int")))
                     return vb_fail(err, VB_ERR_FORMAT,
-                                   "%s: line %lu: list count type '%.*s' is not supported (uint8, uchar, uint16, int)",
-                                   path, line, args[1].show_len(), args[1].b);
+                                   "%s: line %lu: unknown type in list property", path, line);
+                if (!(args[1].is("uint8") || args[1].is("uchar") || args[1].is("uint16") ||
+                      args[1].is("int")))
+                    return vb_fail(
+                        err, VB_ERR_FORMAT,
+                        "%s: line %lu: list count type '%.*s' is not supported (uint8, uchar, uint16, int)",
+                        path, line, args[1].show_len(), args[1].b);
             } else {
                 if (args.size() != 2)
-                    return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: bad property line", path, line);
+                    return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: bad property line", path,
+                                   line);
                 /* "property float x" and "property x float" */
                 int ti = find_ply_type(args[0]) ? 0 : 1;
                 p.type = find_ply_type(args[ti]);
                 if (!p.type)
-                    return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: unknown property type", path, line);
+                    return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: unknown property type", path,
+                                   line);
                 p.name.assign(args[1 - ti].b, args[1 - ti].e);
             }
             elems.back().props.push_back(p);
@@ -341,14 +366,17 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
             last = i + 1;
             break;
         } else if (elems[i].name == "vertex") {
-            return vb_fail(err, VB_ERR_FORMAT, "%s: a second vertex element (or one after the faces) is not supported", path);
+            return vb_fail(err, VB_ERR_FORMAT,
+                           "%s: a second vertex element (or one after the faces) is not supported",
+                           path);
         }
     }
     if (vertex_elem < 0)
         return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh (no vertex element)", path);
     /* OpenMesh's ascii reader read the first face element as many times as
      * the last "element face" line said. */
-    if (std::count_if(elems.begin(), elems.end(), [](const ply_element &e) { return e.name == "face"; }) > 1)
+    if (std::count_if(elems.begin(), elems.end(),
+                      [](const ply_element &e) { return e.name == "face"; }) > 1)
         return vb_fail(err, VB_ERR_FORMAT, "%s: a second face element is not supported", path);
     int xyz[3] = {-1, -1, -1};
     int indices_prop = -1;
@@ -362,21 +390,24 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                 for (int a = 0; a < 3; a++)
                     if (p.name == std::string(1, (char)('x' + a))) {
                         if (xyz[a] >= 0)
-                            return vb_fail(err, VB_ERR_FORMAT, "%s: vertex property %s appears twice", path, p.name.c_str());
+                            return vb_fail(err, VB_ERR_FORMAT,
+                                           "%s: vertex property %s appears twice", path,
+                                           p.name.c_str());
                         xyz[a] = (int)k;
                     }
                 has_normals |= p.role == PLY_NX || p.role == PLY_NY || p.role == PLY_NZ;
             }
             if (!p.count_type)
                 continue;
-            if ((int)i == face_elem && (p.name == "vertex_indices" || p.name == "vertex_index") && indices_prop < 0 &&
-                !p.type->is_float) {
+            if ((int)i == face_elem && (p.name == "vertex_indices" || p.name == "vertex_index") &&
+                indices_prop < 0 && !p.type->is_float) {
                 indices_prop = (int)k;
                 continue;
             }
-            return vb_fail(err, VB_ERR_FORMAT,
-                           "%s: list property '%s' of element '%s' is not supported (it would be misread)",
-                           path, p.name.c_str(), e.name.c_str());
+            return vb_fail(
+                err, VB_ERR_FORMAT,
+                "%s: list property '%s' of element '%s' is not supported (it would be misread)",
+                path, p.name.c_str(), e.name.c_str());
         }
     }
     if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0)
@@ -384,9 +415,11 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
     /* OpenMesh dropped the face properties declared before vertex_indices
      * from its list but not from the data, and misread every face. */
     if (indices_prop > 0)
-        return vb_fail(err, VB_ERR_FORMAT,
-                       "%s: face property '%s' before vertex_indices is not supported (the faces would be "
-                       "misread)", path, elems[(size_t)face_elem].props[0].name.c_str());
+        return vb_fail(
+            err, VB_ERR_FORMAT,
+            "%s: face property '%s' before vertex_indices is not supported (the faces would be "
+            "misread)",
+            path, elems[(size_t)face_elem].props[0].name.c_str());
     /* ascii: a value OpenMesh's reader would have read otherwise than the
      * checks below is refused once they have passed (before, the file
      * failed after them, or was read as garbage). */
@@ -417,7 +450,8 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
             float v[3] = {0.0f, 0.0f, 0.0f}, nrm[3] = {0.0f, 0.0f, 0.0f};
             for (size_t k = 0; k < e.props.size(); k++) {
                 const ply_property &p = e.props[k];
-                bool is_xyz = is_vertex && ((int)k == xyz[0] || (int)k == xyz[1] || (int)k == xyz[2]);
+                bool is_xyz =
+                    is_vertex && ((int)k == xyz[0] || (int)k == xyz[1] || (int)k == xyz[2]);
                 bool is_indices = is_face && (int)k == indices_prop;
                 /* the value of a coordinate or normal, once read */
                 float *into = nullptr;
@@ -431,7 +465,8 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                         int cs = p.count_type->size;
                         if (left < (size_t)cs)
                             return vb_fail(err, VB_ERR_FORMAT, "%s: truncated in %s %llu of %llu",
-                                           path, e.name.c_str(), (unsigned long long)n, (unsigned long long)e.count);
+                                           path, e.name.c_str(), (unsigned long long)n,
+                                           (unsigned long long)e.count);
                         uint64_t cnt = 0;
                         if (cs == 1)
                             cnt = b[0];
@@ -440,21 +475,24 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                         else {
                             uint32_t u = load_u32(b, big);
                             if (p.count_type->is_signed && (int32_t)u < 0)
-                                return vb_fail(err, VB_ERR_FORMAT, "%s: %s %llu: negative list size",
-                                               path, e.name.c_str(), (unsigned long long)n);
+                                return vb_fail(err, VB_ERR_FORMAT,
+                                               "%s: %s %llu: negative list size", path,
+                                               e.name.c_str(), (unsigned long long)n);
                             cnt = u;
                         }
                         b += cs;
                         left -= (size_t)cs;
                         items = cnt;
                         if (is_indices && cnt < 3)
-                            return vb_fail(err, VB_ERR_FORMAT, "%s: face %llu has %llu vertices (needs at least 3)",
+                            return vb_fail(err, VB_ERR_FORMAT,
+                                           "%s: face %llu has %llu vertices (needs at least 3)",
                                            path, (unsigned long long)n, (unsigned long long)cnt);
                     }
                     int ts = p.type->size;
                     if (items > left / (size_t)ts)
-                        return vb_fail(err, VB_ERR_FORMAT, "%s: truncated in %s %llu of %llu",
-                                       path, e.name.c_str(), (unsigned long long)n, (unsigned long long)e.count);
+                        return vb_fail(err, VB_ERR_FORMAT, "%s: truncated in %s %llu of %llu", path,
+                                       e.name.c_str(), (unsigned long long)n,
+                                       (unsigned long long)e.count);
                     if (into) {
                         double d = 0.0;
                         if (p.type->is_float)
@@ -462,15 +500,17 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                         else if (ts == 1)
                             d = p.type->is_signed ? (double)(int8_t)b[0] : (double)b[0];
                         else if (ts == 2) {
-                            uint16_t u = big ? (uint16_t)(b[0] << 8 | b[1]) : (uint16_t)(b[1] << 8 | b[0]);
+                            uint16_t u =
+                                big ? (uint16_t)(b[0] << 8 | b[1]) : (uint16_t)(b[1] << 8 | b[0]);
                             d = p.type->is_signed ? (double)(int16_t)u : (double)u;
                         } else {
                             uint32_t u = load_u32(b, big);
                             d = p.type->is_signed ? (double)(int32_t)u : (double)u;
                         }
                         if (is_xyz && (!std::isfinite(d) || std::fabs(d) > (double)FLT_MAX))
-                            return vb_fail(err, VB_ERR_INVALID, "%s: vertex %llu has a non-finite coordinate",
-                                           path, (unsigned long long)n);
+                            return vb_fail(err, VB_ERR_INVALID,
+                                           "%s: vertex %llu has a non-finite coordinate", path,
+                                           (unsigned long long)n);
                         *into = ts == 4 && p.type->is_float ? load_f32(b, big) : (float)d;
                     }
                     if (is_indices) {
@@ -478,17 +518,21 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                             const uint8_t *ip = b + q * (size_t)ts;
                             long long idx = 0;
                             if (ts == 1)
-                                idx = p.type->is_signed ? (long long)(int8_t)ip[0] : (long long)ip[0];
+                                idx =
+                                    p.type->is_signed ? (long long)(int8_t)ip[0] : (long long)ip[0];
                             else if (ts == 2) {
-                                uint16_t u = big ? (uint16_t)(ip[0] << 8 | ip[1]) : (uint16_t)(ip[1] << 8 | ip[0]);
+                                uint16_t u = big ? (uint16_t)(ip[0] << 8 | ip[1])
+                                                 : (uint16_t)(ip[1] << 8 | ip[0]);
                                 idx = p.type->is_signed ? (long long)(int16_t)u : (long long)u;
                             } else {
                                 uint32_t u = load_u32(ip, big);
                                 idx = p.type->is_signed ? (long long)(int32_t)u : (long long)u;
                             }
                             if (idx < 0 || (uint64_t)idx >= nv)
-                                return vb_fail(err, VB_ERR_INVALID, "%s: face %llu: vertex index %lld out of range (%llu vertices)",
-                                               path, (unsigned long long)n, idx, (unsigned long long)nv);
+                                return vb_fail(
+                                    err, VB_ERR_INVALID,
+                                    "%s: face %llu: vertex index %lld out of range (%llu vertices)",
+                                    path, (unsigned long long)n, idx, (unsigned long long)nv);
                             polygon.push_back(idx);
                         }
                     }
@@ -498,20 +542,28 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                     if (p.count_type) {
                         long long cnt = 0;
                         if (!c.next(&t))
-                            return vb_fail(err, VB_ERR_FORMAT, "%s: truncated: file ends in %s %llu of %llu",
-                                           path, e.name.c_str(), (unsigned long long)n, (unsigned long long)e.count);
+                            return vb_fail(err, VB_ERR_FORMAT,
+                                           "%s: truncated: file ends in %s %llu of %llu", path,
+                                           e.name.c_str(), (unsigned long long)n,
+                                           (unsigned long long)e.count);
                         if (!parse_int(t, &cnt) || cnt < 0 || (uint64_t)cnt > size)
-                            return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: %s %llu: bad list size '%.*s'",
-                                           path, c.line, e.name.c_str(), (unsigned long long)n, t.show_len(), t.b);
+                            return vb_fail(err, VB_ERR_FORMAT,
+                                           "%s: line %lu: %s %llu: bad list size '%.*s'", path,
+                                           c.line, e.name.c_str(), (unsigned long long)n,
+                                           t.show_len(), t.b);
                         if (is_indices && cnt < 3)
-                            return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: face %llu has %lld vertices (needs at least 3)",
-                                           path, c.line, (unsigned long long)n, cnt);
+                            return vb_fail(
+                                err, VB_ERR_FORMAT,
+                                "%s: line %lu: face %llu has %lld vertices (needs at least 3)",
+                                path, c.line, (unsigned long long)n, cnt);
                         items = (uint64_t)cnt;
                     }
                     for (uint64_t q = 0; q < items; q++) {
                         if (!c.next(&t))
-                            return vb_fail(err, VB_ERR_FORMAT, "%s: truncated: file ends in %s %llu of %llu",
-                                           path, e.name.c_str(), (unsigned long long)n, (unsigned long long)e.count);
+                            return vb_fail(err, VB_ERR_FORMAT,
+                                           "%s: truncated: file ends in %s %llu of %llu", path,
+                                           e.name.c_str(), (unsigned long long)n,
+                                           (unsigned long long)e.count);
                         long long iv = 0;
                         float f = 0.0f;
                         if (p.type->is_float) {
@@ -519,17 +571,20 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                             if (s != NUM_OK)
                                 return vb_fail(err, s == NUM_BAD ? VB_ERR_FORMAT : VB_ERR_INVALID,
                                                "%s: line %lu: %s %llu: %s '%.*s' %s", path, c.line,
-                                               e.name.c_str(), (unsigned long long)n, p.name.c_str(),
-                                               t.show_len(), t.b, num_problem(s));
+                                               e.name.c_str(), (unsigned long long)n,
+                                               p.name.c_str(), t.show_len(), t.b, num_problem(s));
                         } else {
                             if (!parse_int(t, &iv))
-                                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: %s %llu: %s '%.*s' is not an integer",
-                                               path, c.line, e.name.c_str(), (unsigned long long)n, p.name.c_str(),
-                                               t.show_len(), t.b);
+                                return vb_fail(err, VB_ERR_FORMAT,
+                                               "%s: line %lu: %s %llu: %s '%.*s' is not an integer",
+                                               path, c.line, e.name.c_str(), (unsigned long long)n,
+                                               p.name.c_str(), t.show_len(), t.b);
                             if (is_indices && (iv < 0 || (uint64_t)iv >= nv))
-                                return vb_fail(err, VB_ERR_INVALID,
-                                               "%s: line %lu: face %llu: vertex index %lld out of range (%llu vertices)",
-                                               path, c.line, (unsigned long long)n, iv, (unsigned long long)nv);
+                                return vb_fail(
+                                    err, VB_ERR_INVALID,
+                                    "%s: line %lu: face %llu: vertex index %lld out of range (%llu vertices)",
+                                    path, c.line, (unsigned long long)n, iv,
+                                    (unsigned long long)nv);
                         }
                         /* Colours not of type float were read as an int:
                          * anything else would shift (or stop) the rest,
@@ -537,15 +592,18 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                          * last face, after its vertex_indices). */
                         long long cv = 0;
                         bool last_read = is_face && n + 1 == e.count;
-                        if (p.role == PLY_COLOR && !(p.read_type->is_float && p.read_type->size == 4) &&
-                            !last_read && !differs.msg[0] && (!parse_int(t, &cv) || cv < INT_MIN || cv > INT_MAX))
-                            vb_fail(&differs, VB_ERR_FORMAT,
-                                    "%s: line %lu: %s %llu: %s '%.*s': a colour of type %s must be a whole number "
-                                    "of int range", path, c.line, e.name.c_str(), (unsigned long long)n,
-                                    p.name.c_str(), t.show_len(), t.b, p.type->name);
+                        if (p.role == PLY_COLOR &&
+                            !(p.read_type->is_float && p.read_type->size == 4) && !last_read &&
+                            !differs.msg[0] && (!parse_int(t, &cv) || cv < INT_MIN || cv > INT_MAX))
+                            vb_fail(
+                                &differs, VB_ERR_FORMAT,
+                                "%s: line %lu: %s %llu: %s '%.*s': a colour of type %s must be a whole number "
+                                "of int range",
+                                path, c.line, e.name.c_str(), (unsigned long long)n, p.name.c_str(),
+                                t.show_len(), t.b, p.type->name);
                         if (into) {
                             if (!p.type->is_float)
-                                parse_float(t, &f);   /* an integer, checked above */
+                                parse_float(t, &f); /* an integer, checked above */
                             *into = f;
                         }
                         if (is_indices)
@@ -580,7 +638,8 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
     const ply_element *odd_elem = nullptr;
     for (size_t i = 0; i < last && format != 0 && !odd; i++)
         for (const ply_property &p : elems[i].props)
-            if (!p.count_type && ply_read_size(p, (int)i == vertex_elem, (int)i == face_elem) != p.type->size) {
+            if (!p.count_type &&
+                ply_read_size(p, (int)i == vertex_elem, (int)i == face_elem) != p.type->size) {
                 odd = &p;
                 odd_elem = &elems[i];
                 break;
@@ -588,15 +647,16 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
     if (odd) {
         builder as_read;
         vb_error why;
-        if (ply_binary_read(path, elems, last, vertex_elem, face_elem, has_normals, big, (const uint8_t *)c.p,
-                            (size_t)(c.end - c.p), as_read, &why) != VB_OK ||
+        if (ply_binary_read(path, elems, last, vertex_elem, face_elem, has_normals, big,
+                            (const uint8_t *)c.p, (size_t)(c.end - c.p), as_read, &why) != VB_OK ||
             as_read.positions != out.positions || as_read.normal_sums != out.normal_sums ||
             as_read.has_normal != out.has_normal || as_read.indices != out.indices)
-            return vb_fail(err, VB_ERR_FORMAT,
-                           "%s: binary property '%s' of type %s in element '%s' is not supported (x, y, z, "
-                           "normals and texture coordinates must be float or double, colours float or an integer "
-                           "type, and a property must not be named after another type)",
-                           path, odd->name.c_str(), odd->type->name, odd_elem->name.c_str());
+            return vb_fail(
+                err, VB_ERR_FORMAT,
+                "%s: binary property '%s' of type %s in element '%s' is not supported (x, y, z, "
+                "normals and texture coordinates must be float or double, colours float or an integer "
+                "type, and a property must not be named after another type)",
+                path, odd->name.c_str(), odd->type->name, odd_elem->name.c_str());
     }
     return VB_OK;
 }

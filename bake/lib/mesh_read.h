@@ -32,7 +32,8 @@
 #include <utility>
 #include <vector>
 
-namespace vb_read {
+namespace vb_read
+{
 
 /* ====================================================================== */
 /* Text scanning                                                          */
@@ -53,14 +54,20 @@ inline bool is_digit(char c)
 struct token {
     const char *b = nullptr;
     const char *e = nullptr;
-    size_t size() const { return (size_t)(e - b); }
+    size_t size() const
+    {
+        return (size_t)(e - b);
+    }
     bool is(const char *s) const
     {
         size_t n = strlen(s);
         return size() == n && memcmp(b, s, n) == 0;
     }
     /* For messages: at most 40 characters of the token. */
-    int show_len() const { return (int)std::min<size_t>(size(), 40); }
+    int show_len() const
+    {
+        return (int)std::min<size_t>(size(), 40);
+    }
 };
 
 /* A cursor over the file's bytes that counts lines (1-based). */
@@ -70,9 +77,14 @@ struct cursor {
     unsigned long line;
 
     cursor(const uint8_t *bytes, size_t size)
-        : p((const char *)bytes), end((const char *)bytes + size), line(1) {}
+        : p((const char *)bytes), end((const char *)bytes + size), line(1)
+    {
+    }
 
-    bool at_end() const { return p >= end; }
+    bool at_end() const
+    {
+        return p >= end;
+    }
 
     /* Next whitespace-separated token, crossing lines (as operator>>). */
     bool next(token *t)
@@ -105,7 +117,7 @@ struct cursor {
         }
     }
 
-private:
+  private:
     /* The token starting at p (not a blank). */
     bool take(token *t)
     {
@@ -175,8 +187,7 @@ inline double load_f64(const uint8_t *p, bool big_endian)
 
 /* v's elements in a malloc'ed array (at least one byte), for vb_mesh_raw,
  * which mesh.c frees with free(); throws std::bad_alloc. */
-template <typename T>
-T *malloc_copy(const std::vector<T> &v)
+template <typename T> T *malloc_copy(const std::vector<T> &v)
 {
     T *p = (T *)malloc(std::max<size_t>(v.size(), 1) * sizeof(T));
     if (!p)
@@ -186,12 +197,13 @@ T *malloc_copy(const std::vector<T> &v)
     return p;
 }
 
-class builder {
-public:
+class builder
+{
+  public:
     std::vector<float> positions;
-    std::vector<float> normal_sums;    /* empty until the first normal */
+    std::vector<float> normal_sums; /* empty until the first normal */
     std::vector<uint8_t> has_normal;
-    std::vector<int64_t> indices;      /* fan-triangulated */
+    std::vector<int64_t> indices; /* fan-triangulated */
     std::vector<uint32_t> tri_face;
     uint64_t polygons = 0;
 
@@ -207,8 +219,14 @@ public:
     std::vector<float> corner_normals; /* 9 per triangle, once one is given */
     std::vector<uint8_t> corner_given; /* 3 per triangle */
 
-    uint64_t vertex_count() const { return positions.size() / 3; }
-    uint64_t triangle_count() const { return indices.size() / 3; }
+    uint64_t vertex_count() const
+    {
+        return positions.size() / 3;
+    }
+    uint64_t triangle_count() const
+    {
+        return indices.size() / 3;
+    }
 
     void add_vertex(float x, float y, float z)
     {
@@ -243,7 +261,7 @@ public:
     /* Hand over malloc'ed arrays (mesh.c frees them with free()). */
     void finish(uint64_t dropped, vb_mesh_raw *out);
 
-private:
+  private:
     /* The corners of the polygon just fanned: its vertices' pending
      * normals, onto each of its triangles' corners. */
     void add_corner_normals(const int64_t *v, size_t n);
@@ -252,11 +270,11 @@ private:
 /* What the checks counted: the file must deliver exactly this. */
 struct expectation {
     uint64_t vertices = 0;
-    bool vertices_known = true;   /* STL: merged, count not known ahead */
-    uint64_t faces = 0;           /* polygons with >= 3 vertices */
-    uint64_t triangles = 0;       /* after fan triangulation */
-    uint64_t dropped = 0;         /* OBJ: triangles of faces with < 3 distinct */
-    std::string hint;             /* why the two might differ: the first line
+    bool vertices_known = true; /* STL: merged, count not known ahead */
+    uint64_t faces = 0;         /* polygons with >= 3 vertices */
+    uint64_t triangles = 0;     /* after fan triangulation */
+    uint64_t dropped = 0;       /* OBJ: triangles of faces with < 3 distinct */
+    std::string hint;           /* why the two might differ: the first line
                                      OpenMesh's reader read otherwise */
 };
 
@@ -266,14 +284,14 @@ struct expectation {
 
 /* Each reads the whole file `bytes` into `out`, counting in `ex` what the
  * file must deliver; `path` is for messages. */
-vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder &out, expectation *ex,
-                   vb_error *err);
-vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder &out, expectation *ex,
-                   vb_error *err);
-vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder &out, expectation *ex,
-                   vb_error *err);
-vb_result read_stl(const char *path, const uint8_t *bytes, size_t size, builder &out, expectation *ex,
-                   vb_error *err);
+vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder &out,
+                   expectation *ex, vb_error *err);
+vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder &out,
+                   expectation *ex, vb_error *err);
+vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder &out,
+                   expectation *ex, vb_error *err);
+vb_result read_stl(const char *path, const uint8_t *bytes, size_t size, builder &out,
+                   expectation *ex, vb_error *err);
 
 /* ====================================================================== */
 /* C entry points: no exception passes these                              */
@@ -281,8 +299,7 @@ vb_result read_stl(const char *path, const uint8_t *bytes, size_t size, builder 
 
 /* read() (returning vb_result) with every C++ exception turned into a
  * vb_result and a message that names `name`. */
-template <typename F>
-vb_result no_throw(const char *name, vb_error *err, F read)
+template <typename F> vb_result no_throw(const char *name, vb_error *err, F read)
 {
     try {
         return read();

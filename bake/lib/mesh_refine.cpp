@@ -43,7 +43,8 @@
 
 #include "vdsh_math.h"
 
-namespace {
+namespace
+{
 
 /* ====================================================================== */
 /* OpenMesh session: one at a time, output discarded                      */
@@ -57,14 +58,22 @@ std::mutex &openmesh_mutex()
 
 /* A stream buffer that drops what is written to it: OpenMesh can print one
  * warning per refused face, and nothing of it is used. */
-class discard_buf : public std::streambuf {
-protected:
-    int_type overflow(int_type c) override { return traits_type::not_eof(c); }
-    std::streamsize xsputn(const char *, std::streamsize n) override { return n; }
+class discard_buf : public std::streambuf
+{
+  protected:
+    int_type overflow(int_type c) override
+    {
+        return traits_type::not_eof(c);
+    }
+    std::streamsize xsputn(const char *, std::streamsize n) override
+    {
+        return n;
+    }
 };
 
-class openmesh_session {
-public:
+class openmesh_session
+{
+  public:
     openmesh_session() : lock_(openmesh_mutex())
     {
         err_ = std::cerr.rdbuf(&buf_);
@@ -85,7 +94,7 @@ public:
     openmesh_session(const openmesh_session &) = delete;
     openmesh_session &operator=(const openmesh_session &) = delete;
 
-private:
+  private:
     std::lock_guard<std::mutex> lock_;
     discard_buf buf_;
     std::streambuf *err_;
@@ -239,8 +248,9 @@ void legalize(om_mesh &m, std::vector<int> &stack, double limit2, Queue &queue, 
 
 /* uint64 key -> uint32 value, open addressing: std::unordered_map's node
  * per entry cost more than the whole refinement on large meshes. */
-class pair_table {
-public:
+class pair_table
+{
+  public:
     explicit pair_table(size_t n)
     {
         size_t cap = 16;
@@ -265,8 +275,8 @@ public:
         return value;
     }
 
-private:
-    static constexpr uint64_t empty = ~(uint64_t)0;   /* min < max: never a key */
+  private:
+    static constexpr uint64_t empty = ~(uint64_t)0; /* min < max: never a key */
     std::vector<uint64_t> keys_;
     std::vector<uint32_t> vals_;
     size_t mask_ = 0;
@@ -301,7 +311,8 @@ vb_result build_mesh(const vb_mesh *in, om_mesh &m, std::vector<uint32_t> &copy_
             }
             fh = m.add_face(c[0], c[1], c[2]);
             if (!fh.is_valid())
-                return vb_fail(err, VB_ERR_INVALID, "refine: OpenMesh refused triangle %llu even with its own vertices",
+                return vb_fail(err, VB_ERR_INVALID,
+                               "refine: OpenMesh refused triangle %llu even with its own vertices",
                                (unsigned long long)t);
         }
         kept++;
@@ -386,7 +397,6 @@ vb_result emit_mesh(const vb_mesh *in, const om_mesh &m, const std::vector<uint3
     return VB_OK;
 }
 
-
 vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
 {
     const uint32_t n = in->vertex_count;
@@ -394,7 +404,8 @@ vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
 
     /* Input checks: the mesh may come from anywhere, not only a loader. */
     if (n > refine_max_vertices)
-        return vb_fail(err, VB_ERR_ARGUMENT, "refine: the mesh has %u vertices; refinement handles at most %llu", n,
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "refine: the mesh has %u vertices; refinement handles at most %llu", n,
                        (unsigned long long)refine_max_vertices);
     for (uint64_t i = 0; i < 3 * (uint64_t)n; i++)
         if (!std::isfinite(in->positions[i]))
@@ -405,7 +416,8 @@ vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
         const uint32_t *tri = in->indices + 3 * t;
         for (int k = 0; k < 3; k++)
             if (tri[k] >= n)
-                return vb_fail(err, VB_ERR_INVALID, "refine: triangle %llu: index %u out of range (%u vertices)",
+                return vb_fail(err, VB_ERR_INVALID,
+                               "refine: triangle %llu: index %u out of range (%u vertices)",
                                (unsigned long long)t, tri[k], n);
         const float *a = in->positions + 3 * (size_t)tri[0];
         const float *b = in->positions + 3 * (size_t)tri[1];
@@ -415,22 +427,25 @@ vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
             u[k] = (double)b[k] - a[k];
             v[k] = (double)c[k] - a[k];
         }
-        double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2], cz = u[0] * v[1] - u[1] * v[0];
+        double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2],
+               cz = u[0] * v[1] - u[1] * v[0];
         area += 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
     }
     /* No triangle with all edges <= max_edge is larger than the equilateral
      * one: a lower bound on the faces needed, checked before any work. */
     double min_faces = area / (std::sqrt(3.0) / 4.0 * limit2);
     if (min_faces > 2.0 * (double)refine_max_vertices)
-        return vb_fail(err, VB_ERR_ARGUMENT,
-                       "refine: max_edge %g is too small for this mesh (surface area %g needs over %.3g triangles; "
-                       "the limit is %llu vertices)",
-                       (double)max_edge, area, min_faces, (unsigned long long)refine_max_vertices);
+        return vb_fail(
+            err, VB_ERR_ARGUMENT,
+            "refine: max_edge %g is too small for this mesh (surface area %g needs over %.3g triangles; "
+            "the limit is %llu vertices)",
+            (double)max_edge, area, min_faces, (unsigned long long)refine_max_vertices);
 
     om_mesh m;
     /* Longest-edge bisection ends with about 1.3 - 2.3 vertices per
      * max_edge^2 of area: reserve for the upper end. */
-    size_t est_v = (size_t)std::min<double>((double)n + 2.5 * area / limit2, (double)refine_max_vertices);
+    size_t est_v =
+        (size_t)std::min<double>((double)n + 2.5 * area / limit2, (double)refine_max_vertices);
     m.reserve(est_v, est_v * 3, est_v * 2);
 
     vb_result r = VB_OK;
@@ -466,7 +481,7 @@ vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
             stack.push_back(i);
         legalize(m, stack, limit2, queue, flip_budget);
     }
-    std::vector<uint32_t> parents;   /* two per new vertex: the split edge's ends */
+    std::vector<uint32_t> parents; /* two per new vertex: the split edge's ends */
     uint64_t faces_added = 0;
     while (!queue.empty()) {
         edge_entry top = queue.top();
@@ -476,7 +491,8 @@ vb_result refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
         if (l2 != top.len2 || l2 <= limit2)
             continue;
         if (m.n_vertices() - copy_of.size() >= refine_max_vertices)
-            return vb_fail(err, VB_ERR_ARGUMENT, "refine: max_edge %g would need more than %llu vertices",
+            return vb_fail(err, VB_ERR_ARGUMENT,
+                           "refine: max_edge %g would need more than %llu vertices",
                            (double)max_edge, (unsigned long long)refine_max_vertices);
         om_mesh::HalfedgeHandle h = m.halfedge_handle(e, 0);
         om_mesh::VertexHandle a = m.from_vertex_handle(h), b = m.to_vertex_handle(h);
@@ -520,7 +536,8 @@ vb_result split_edges(const vb_mesh *in, const uint32_t *pairs, uint32_t count, 
     const uint32_t n = in->vertex_count;
     for (uint64_t t = 0; t < 3 * (uint64_t)in->triangle_count; t++)
         if (in->indices[t] >= n)
-            return vb_fail(err, VB_ERR_INVALID, "split: triangle %llu: index %u out of range (%u vertices)",
+            return vb_fail(err, VB_ERR_INVALID,
+                           "split: triangle %llu: index %u out of range (%u vertices)",
                            (unsigned long long)(t / 3), in->indices[t], n);
     om_mesh m;
     m.reserve((size_t)n + count, 3 * ((size_t)in->triangle_count + 2 * (size_t)count),
@@ -536,12 +553,15 @@ vb_result split_edges(const vb_mesh *in, const uint32_t *pairs, uint32_t count, 
         size_t i = (size_t)v.idx();
         return i < n ? (uint32_t)i : copy_of[i - n];
     };
-    auto key_of = [](uint32_t a, uint32_t b) { return (uint64_t)std::min(a, b) << 32 | std::max(a, b); };
+    auto key_of = [](uint32_t a, uint32_t b) {
+        return (uint64_t)std::min(a, b) << 32 | std::max(a, b);
+    };
     std::vector<std::pair<uint64_t, int>> edges;
     edges.reserve(m.n_edges());
     for (om_mesh::EdgeHandle e : m.edges()) {
         om_mesh::HalfedgeHandle h = m.halfedge_handle(e, 0);
-        edges.emplace_back(key_of(number(m.from_vertex_handle(h)), number(m.to_vertex_handle(h))), e.idx());
+        edges.emplace_back(key_of(number(m.from_vertex_handle(h)), number(m.to_vertex_handle(h))),
+                           e.idx());
     }
     std::sort(edges.begin(), edges.end());
     std::vector<uint32_t> parents;
@@ -551,7 +571,8 @@ vb_result split_edges(const vb_mesh *in, const uint32_t *pairs, uint32_t count, 
         uint64_t key = key_of(a, b);
         auto it = std::lower_bound(edges.begin(), edges.end(), std::make_pair(key, -1));
         if (a == b || it == edges.end() || it->first != key)
-            return vb_fail(err, VB_ERR_ARGUMENT, "split: pair %u (%u, %u) is not an edge of the mesh", i, a, b);
+            return vb_fail(err, VB_ERR_ARGUMENT,
+                           "split: pair %u (%u, %u) is not an edge of the mesh", i, a, b);
         if (i > 0 && key == key_of(pairs[2 * i - 2], pairs[2 * i - 1]))
             return vb_fail(err, VB_ERR_ARGUMENT, "split: edge (%u, %u) listed twice", a, b);
         for (; it != edges.end() && it->first == key; ++it) {
@@ -559,7 +580,8 @@ vb_result split_edges(const vb_mesh *in, const uint32_t *pairs, uint32_t count, 
             om_mesh::HalfedgeHandle h = m.halfedge_handle(e, 0);
             om_mesh::VertexHandle va = m.from_vertex_handle(h), vb = m.to_vertex_handle(h);
             const om_mesh::Point pa = m.point(va), pb = m.point(vb);
-            om_mesh::Point mid((pa[0] + pb[0]) * 0.5f, (pa[1] + pb[1]) * 0.5f, (pa[2] + pb[2]) * 0.5f);
+            om_mesh::Point mid((pa[0] + pb[0]) * 0.5f, (pa[1] + pb[1]) * 0.5f,
+                               (pa[2] + pb[2]) * 0.5f);
             faces_added += m.is_boundary(e) ? 1 : 2;
             om_mesh::VertexHandle vm = m.add_vertex(mid);
             parents.push_back((uint32_t)va.idx());
@@ -573,8 +595,9 @@ vb_result split_edges(const vb_mesh *in, const uint32_t *pairs, uint32_t count, 
     r = emit_mesh(in, m, copy_of, parents, out, err);
     if (r == VB_OK && out->vertex_count != n + count) { /* an edge listed twice, out of order */
         vb_mesh_free(out);
-        return vb_fail(err, VB_ERR_ARGUMENT, "split: %u edges gave %u new vertices (an edge listed twice?)",
-                       count, out->vertex_count - n);
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "split: %u edges gave %u new vertices (an edge listed twice?)", count,
+                       out->vertex_count - n);
     }
     return r;
 }
@@ -611,8 +634,7 @@ vb_result copy_mesh(const vb_mesh *in, vb_mesh *out, vb_error *err)
 /* C entry points: no exception passes these                              */
 /* ====================================================================== */
 
-extern "C" vb_result vb_mesh_refine(const vb_mesh *in, float max_edge, vb_mesh *out,
-                                    vb_error *err)
+extern "C" vb_result vb_mesh_refine(const vb_mesh *in, float max_edge, vb_mesh *out, vb_error *err)
 {
     if (!in || !out)
         return vb_fail(err, VB_ERR_ARGUMENT, "vb_mesh_refine: NULL argument");
@@ -639,7 +661,8 @@ extern "C" vb_result vb_mesh_split_edges(const vb_mesh *in, const uint32_t *pair
 {
     if (!in || !out || (count && !pairs))
         return vb_fail(err, VB_ERR_ARGUMENT, "vb_mesh_split_edges: NULL argument");
-    if ((in->vertex_count && (!in->positions || !in->normals)) || (in->triangle_count && !in->indices))
+    if ((in->vertex_count && (!in->positions || !in->normals)) ||
+        (in->triangle_count && !in->indices))
         return vb_fail(err, VB_ERR_ARGUMENT, "split: mesh has counts but no arrays");
     if ((uint64_t)in->vertex_count + count > refine_max_vertices)
         return vb_fail(err, VB_ERR_ARGUMENT, "split: more than %llu vertices",
@@ -679,7 +702,8 @@ extern "C" double vb_mesh_worst_aspect(const vb_mesh *m, uint32_t *worst)
             u[c] = p[1][c] - p[0][c];
             v[c] = p[2][c] - p[0][c];
         }
-        double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2], cz = u[0] * v[1] - u[1] * v[0];
+        double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2],
+               cz = u[0] * v[1] - u[1] * v[0];
         double area = 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
         if (!(l2max > 0.0) || !(area > 0.0))
             continue; /* no shape: counted by the bake as degenerate */

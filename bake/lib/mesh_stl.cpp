@@ -20,9 +20,11 @@
 
 #include <strings.h>
 
-namespace vb_read {
+namespace vb_read
+{
 
-namespace {
+namespace
+{
 
 /* Equal positions as OpenMesh's STL reader compares them (its CmpVec with
  * eps = FLT_MIN): components within FLT_MIN are equal. Not a strict weak
@@ -78,13 +80,15 @@ struct stl_merger {
 /* Tiny coordinates (within FLT_MIN of each other but not equal) can
  * make the merging disagree with the count of triangles whose corners
  * differ: refused. */
-vb_result merged_as_counted(const char *path, const builder &out, const expectation *ex, vb_error *err)
+vb_result merged_as_counted(const char *path, const builder &out, const expectation *ex,
+                            vb_error *err)
 {
     if (out.polygons != ex->faces)
-        return vb_fail(err, VB_ERR_FORMAT,
-                       "%s: coordinates that differ by less than FLT_MIN (%g) make it ambiguous which corners "
-                       "are the same vertex (%llu or %llu triangles)", path, (double)FLT_MIN,
-                       (unsigned long long)out.polygons, (unsigned long long)ex->faces);
+        return vb_fail(
+            err, VB_ERR_FORMAT,
+            "%s: coordinates that differ by less than FLT_MIN (%g) make it ambiguous which corners "
+            "are the same vertex (%llu or %llu triangles)",
+            path, (double)FLT_MIN, (unsigned long long)out.polygons, (unsigned long long)ex->faces);
     return VB_OK;
 }
 
@@ -96,8 +100,8 @@ vb_result merged_as_counted(const char *path, const builder &out, const expectat
  * refused here). Stricter than a lenient reader: an ascii file must have
  * an "endsolid" line after its last facet, or it may have been cut between
  * two facets. */
-vb_result read_stl(const char *path, const uint8_t *bytes, size_t size, builder &out, expectation *ex,
-                   vb_error *err)
+vb_result read_stl(const char *path, const uint8_t *bytes, size_t size, builder &out,
+                   expectation *ex, vb_error *err)
 {
     ex->vertices_known = false;
     stl_merger merge;
@@ -112,8 +116,8 @@ vb_result read_stl(const char *path, const uint8_t *bytes, size_t size, builder 
                 v[i] = load_f32(rec + 12 + 4 * i, false);
                 if (!std::isfinite(v[i]))
                     return vb_fail(err, VB_ERR_INVALID,
-                                   "%s: triangle %llu: vertex %d has a non-finite coordinate",
-                                   path, (unsigned long long)t, i / 3);
+                                   "%s: triangle %llu: vertex %d has a non-finite coordinate", path,
+                                   (unsigned long long)t, i / 3);
             }
             if (!stl_same(v, v + 3) && !stl_same(v, v + 6) && !stl_same(v + 3, v + 6)) {
                 ex->faces++;
@@ -135,28 +139,34 @@ vb_result read_stl(const char *path, const uint8_t *bytes, size_t size, builder 
         c.skip_line();
         size_t first = line.find_first_not_of(" \t\r\v\f");
         const char *word = first == std::string::npos ? "" : line.c_str() + first;
-        bool name_line = strncasecmp(word, "solid", 5) == 0 || strncasecmp(word, "endsolid", 8) == 0;
+        bool name_line =
+            strncasecmp(word, "solid", 5) == 0 || strncasecmp(word, "endsolid", 8) == 0;
         if (line.find("outer") == std::string::npos && line.find("OUTER") == std::string::npos) {
             if (strncasecmp(word, "endsolid", 8) == 0)
                 ended = true;
             continue;
         }
         if (name_line)
-            return vb_fail(err, VB_ERR_FORMAT,
-                           "%s: line %lu: the solid's name contains 'outer', which STL readers take for the "
-                           "start of a facet (rename the solid)", path, line_no);
+            return vb_fail(
+                err, VB_ERR_FORMAT,
+                "%s: line %lu: the solid's name contains 'outer', which STL readers take for the "
+                "start of a facet (rename the solid)",
+                path, line_no);
         ended = false;
         float v[9];
         for (int i = 0; i < 3; i++) {
             if (c.at_end())
-                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: file ends inside a facet (truncated?)",
-                               path, line_no);
+                return vb_fail(err, VB_ERR_FORMAT,
+                               "%s: line %lu: file ends inside a facet (truncated?)", path,
+                               line_no);
             token t;
             if (!c.next_on_line(&t))
-                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: expected 'vertex x y z'", path, c.line);
+                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: expected 'vertex x y z'", path,
+                               c.line);
             for (int k = 0; k < 3; k++) {
                 if (!c.next_on_line(&t))
-                    return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: expected 'vertex x y z'", path, c.line);
+                    return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: expected 'vertex x y z'",
+                                   path, c.line);
                 num_status s = parse_float(t, &v[3 * i + k]);
                 if (s != NUM_OK)
                     return vb_fail(err, s == NUM_BAD ? VB_ERR_FORMAT : VB_ERR_INVALID,
@@ -189,11 +199,13 @@ vb_result read_stl(const char *path, const uint8_t *bytes, size_t size, builder 
      * facets. */
     if (!ended) {
         if (facets == 0)
-            return vb_fail(err, VB_ERR_FORMAT,
-                           "%s: neither ascii STL (no facets and no 'endsolid': truncated?) nor binary STL "
-                           "(%zu bytes, but 84 + 50 x %llu triangles = %llu)",
-                           path, size, (unsigned long long)declared, (unsigned long long)(84 + 50 * declared));
-        return vb_fail(err, VB_ERR_FORMAT, "%s: ascii STL ends without 'endsolid' after its last facet (truncated?)",
+            return vb_fail(
+                err, VB_ERR_FORMAT,
+                "%s: neither ascii STL (no facets and no 'endsolid': truncated?) nor binary STL "
+                "(%zu bytes, but 84 + 50 x %llu triangles = %llu)",
+                path, size, (unsigned long long)declared, (unsigned long long)(84 + 50 * declared));
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: ascii STL ends without 'endsolid' after its last facet (truncated?)",
                        path);
     }
     return merged_as_counted(path, out, ex, err);

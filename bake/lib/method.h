@@ -61,9 +61,9 @@ typedef enum vb_fit_base {
 
 /* What a stream's method_param records (VDSH.md). */
 typedef enum vb_method_param {
-    VB_PARAM_NONE = 0,   /* 0 */
-    VB_PARAM_LAMBDA,     /* the regularisation weight */
-    VB_PARAM_LOG_OFFSET  /* the per-order offset added to the fitted ln d */
+    VB_PARAM_NONE = 0,  /* 0 */
+    VB_PARAM_LAMBDA,    /* the regularisation weight */
+    VB_PARAM_LOG_OFFSET /* the per-order offset added to the fitted ln d */
 } vb_method_param;
 
 /* Bits of vb_method_info.quantities. */
@@ -71,7 +71,7 @@ typedef enum vb_method_param {
 
 typedef struct vb_method_info {
     vb_method method;
-    vdsh_method stored;        /* the value in the file's streams */
+    vdsh_method stored; /* the value in the file's streams */
     /* Sampling: the upper hemisphere about each receiver's normal, with
      * half the directions; otherwise the whole sphere. */
     int hemisphere;

@@ -236,8 +236,8 @@ float vb_receiver_near(float diag, float mean_edge)
 /* 16 directions above a receiver's horizon and their mirror images below,
  * on a staggered 4 x 4 grid in its normal's frame. */
 #define PROBES 16
-#define PROBE_UP_LIMIT 14   /* ~90% of the upper probes at ~0: squeezed or embedded */
-#define PROBE_BACK_LIMIT 8  /* a quarter of all probes on a back face at ~0: behind a surface */
+#define PROBE_UP_LIMIT 14  /* ~90% of the upper probes at ~0: squeezed or embedded */
+#define PROBE_BACK_LIMIT 8 /* a quarter of all probes on a back face at ~0: behind a surface */
 /* Faces this close along a ray coincide: a few ulps of the traced frame's
  * unit coordinates, and 1e-5 of the distance. Two faces in one plane
  * differ by an ulp or two; a ray passing near an edge where two faces
@@ -288,8 +288,8 @@ static void collect_filter(const struct RTCFilterFunctionNArguments *a)
             continue;
         unsigned k = id[i] % PROBES;
         float t = ray[8 * N + i];
-        float facing = hit[i] * ray[4 * N + i] + hit[N + i] * ray[5 * N + i] +
-                       hit[2 * N + i] * ray[6 * N + i];
+        float facing =
+            hit[i] * ray[4 * N + i] + hit[N + i] * ray[5 * N + i] + hit[2 * N + i] * ray[6 * N + i];
         float *slot = facing > 0.0f ? &C->tb[k] : &C->tf[k];
         if (t < *slot)
             *slot = t;
@@ -318,8 +318,8 @@ static int classify(float tf, float tb)
 
 /* A packet of the 16 probe directions around unit normal n (sz = -1: the
  * mirror images below the horizon) from o, in [0, tfar]. */
-static void probe_packet(const prober *J, const float o[3], const float n[3], float sz,
-                         float tfar, struct RTCRayHit16 *rh, int valid[16])
+static void probe_packet(const prober *J, const float o[3], const float n[3], float sz, float tfar,
+                         struct RTCRayHit16 *rh, int valid[16])
 {
     float t[3], b[3];
     vb_frame(n, t, b);
@@ -352,8 +352,8 @@ typedef struct short_result {
  * rays took 0.4-0.6x the packets' time, with the same faces found (the
  * collecting filter sees every face in the window either way; the bakes
  * are byte-identical). */
-static short_result short_probe(const prober *J, const float o[3], const float n[3],
-                                float near, uint64_t *rays)
+static short_result short_probe(const prober *J, const float o[3], const float n[3], float near,
+                                uint64_t *rays)
 {
     short_result r = {0, 0, 0};
     for (int side = 0; side < 2; side++) {
@@ -409,14 +409,14 @@ static int escapes(const prober *J, const float o[3], const float n[3], uint64_t
  * depend on them (navg, inset) are computed again (frames_normals). */
 typedef struct frames {
     const subset *E;
-    float *normals;             /* 3 per slot: borrowed, or own_normals */
+    float *normals; /* 3 per slot: borrowed, or own_normals */
     float *own_normals;
-    float *navg;                /* 3 per slot */
-    float *inset;               /* 3 per slot */
-    float *near;                /* per slot, scene units */
-    uint32_t *adj_start, *adj;  /* slot -> its triangles, in triangle order */
-    double *pull;               /* 4 per slot: the centroids' pull x, y, z, weight */
-    uint8_t *area;              /* per slot: 1 when one of its triangles has area */
+    float *navg;               /* 3 per slot */
+    float *inset;              /* 3 per slot */
+    float *near;               /* per slot, scene units */
+    uint32_t *adj_start, *adj; /* slot -> its triangles, in triangle order */
+    double *pull;              /* 4 per slot: the centroids' pull x, y, z, weight */
+    uint8_t *area;             /* per slot: 1 when one of its triangles has area */
 } frames;
 
 static void frames_free(frames *f)
@@ -454,8 +454,8 @@ static vb_result frames_normals(const vb_mesh *m, frames *f, vb_error *err)
  * be oriented in place), or NULL: a copy of m's. Every per-receiver sum
  * (edge lengths, the centroids' pull) runs over the triangles in order, as
  * over the whole mesh, so a receiver's frame does not depend on E. */
-static vb_result frames_create(const vb_mesh *m, const vb_scene *s, const subset *E,
-                               float *normals, frames *f, vb_error *err)
+static vb_result frames_create(const vb_mesh *m, const vb_scene *s, const subset *E, float *normals,
+                               frames *f, vb_error *err)
 {
     uint32_t n = E->count;
     memset(f, 0, sizeof *f);
@@ -572,9 +572,9 @@ static int mostly_facing(const prober *J, const float o[3], const float n[3], in
  * full-length probes toward -n meet back faces): a box's bottom on a
  * floor, whose origin would look through the floor, where a double-sided
  * sheet's sides are free. */
-static int origin_state(const prober *J, const vb_mesh *m, const frames *F, uint32_t v,
-                        uint32_t k, const float o[3], const float n[3], float near,
-                        short_result *sr, int *tie_seen, uint64_t *rays)
+static int origin_state(const prober *J, const vb_mesh *m, const frames *F, uint32_t v, uint32_t k,
+                        const float o[3], const float n[3], float near, short_result *sr,
+                        int *tie_seen, uint64_t *rays)
 {
     *sr = short_probe(J, o, n, near, rays);
     *tie_seen |= sr->tie > 0;
@@ -615,8 +615,8 @@ static int worse(badness a, badness b)
     return a.up > b.up;
 }
 
-static badness full_badness(const prober *J, const float o[3], const float n[3],
-                            short_result sr, uint64_t *rays)
+static badness full_badness(const prober *J, const float o[3], const float n[3], short_result sr,
+                            uint64_t *rays)
 {
     badness b = {escapes(J, o, n, rays), sr.back + sr.tie, sr.up};
     return b;
@@ -687,9 +687,10 @@ static unsigned repair_one(origin_job *J, uint32_t v, uint32_t k, float *o, uint
             const uint32_t *ix = m->indices + 3 * (size_t)F->adj[a];
             float q[3], ql[3];
             for (int c = 0; c < 3; c++) {
-                double ctr = ((double)m->positions[3 * (size_t)ix[0] + c] +
-                              m->positions[3 * (size_t)ix[1] + c] +
-                              m->positions[3 * (size_t)ix[2] + c]) / 3.0;
+                double ctr =
+                    ((double)m->positions[3 * (size_t)ix[0] + c] +
+                     m->positions[3 * (size_t)ix[1] + c] + m->positions[3 * (size_t)ix[2] + c]) /
+                    3.0;
                 q[c] = (float)(p[c] + steps[st] * (ctr - p[c]));
             }
             vb_scene_to_local(J->P.s, q, ql);
@@ -759,8 +760,7 @@ static void repair_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
 static vb_result place_origins(const vb_mesh *m, const vb_scene *s, const frames *F,
                                unsigned threads, const uint32_t *set, uint32_t set_count,
                                uint32_t count_begin, uint32_t count_end, float *out,
-                               float *near_out, vb_origins_stats *stats, double t0,
-                               vb_error *err)
+                               float *near_out, vb_origins_stats *stats, double t0, vb_error *err)
 {
     vb_result r = VB_OK;
     /* 1. The standard rule. */
@@ -801,8 +801,8 @@ vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads, 
     vb_result r = frames_create(m, s, &all, NULL, &F, err);
     if (r != VB_OK)
         return r;
-    r = place_origins(m, s, &F, threads, NULL, m->vertex_count, 0, m->vertex_count, out,
-                      near_out, stats, t0, err);
+    r = place_origins(m, s, &F, threads, NULL, m->vertex_count, 0, m->vertex_count, out, near_out,
+                      stats, t0, err);
     frames_free(&F);
     return r;
 }
@@ -813,7 +813,7 @@ typedef struct orient_job {
     const vb_mesh *m;
     const frames *F;
     prober P;
-    uint8_t *flip;              /* per slot of F */
+    uint8_t *flip; /* per slot of F */
 } orient_job;
 
 /* What the ray from o along d meets first: one query for the nearest
@@ -901,8 +901,8 @@ static void orient_block(void *ctx, uint32_t begin, uint32_t end, unsigned worke
  * those pointing into geometry. `flipped` counts those in
  * [count_begin, count_end), `any` every flip. */
 static vb_result orient(const vb_mesh *m, const vb_scene *s, frames *F, unsigned threads,
-                        uint32_t count_begin, uint32_t count_end, uint32_t *flipped,
-                        uint32_t *any, vb_error *err)
+                        uint32_t count_begin, uint32_t count_end, uint32_t *flipped, uint32_t *any,
+                        vb_error *err)
 {
     vb_result r = VB_OK;
     const uint32_t n = F->E->count;
@@ -930,8 +930,8 @@ static vb_result orient(const vb_mesh *m, const vb_scene *s, frames *F, unsigned
     return r;
 }
 
-vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
-                              uint32_t *flipped, vb_error *err)
+vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads, uint32_t *flipped,
+                              vb_error *err)
 {
     subset all = {.count = m->vertex_count};
     frames F;
@@ -949,9 +949,8 @@ vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
 
 vb_result vb_receivers_prepare(const vb_mesh *m, const vb_scene *s, unsigned threads,
                                const uint32_t *set, uint32_t set_count, uint32_t count_begin,
-                               uint32_t count_end, float *normals, uint32_t *flipped,
-                               float *out, float *near_out, vb_origins_stats *stats,
-                               vb_error *err)
+                               uint32_t count_end, float *normals, uint32_t *flipped, float *out,
+                               float *near_out, vb_origins_stats *stats, vb_error *err)
 {
     double t0 = vb_now();
     const uint32_t V = m->vertex_count;
@@ -985,8 +984,8 @@ vb_result vb_receivers_prepare(const vb_mesh *m, const vb_scene *s, unsigned thr
         t0 = vb_now(); /* the origins' time, as before: not the orientation's */
     }
     if (r == VB_OK)
-        r = place_origins(m, s, &F, threads, set, set_count, count_begin, count_end, out,
-                          near_out, stats, t0, err);
+        r = place_origins(m, s, &F, threads, set, set_count, count_begin, count_end, out, near_out,
+                          stats, t0, err);
     frames_free(&F);
     subset_free(&E);
     if (r == VB_OK && flipped)

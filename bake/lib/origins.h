@@ -65,13 +65,13 @@ extern "C" {
 #define VB_REPAIR_CANDIDATES 24
 
 typedef struct vb_origins_stats {
-    uint32_t moved;       /* receivers whose origin the repair moved */
-    uint32_t flagged;     /* receivers the first probe sent to the repair */
-    uint32_t ties;        /* receivers whose probes met coincident faces */
+    uint32_t moved;             /* receivers whose origin the repair moved */
+    uint32_t flagged;           /* receivers the first probe sent to the repair */
+    uint32_t ties;              /* receivers whose probes met coincident faces */
     uint32_t skipped_zero_area; /* receivers with a normal whose triangles all have
                                  * no area: drawn nowhere, not probed */
-    uint64_t probe_rays;  /* rays traced by the probes and the repair */
-    double seconds;       /* wall time of vb_ray_origins */
+    uint64_t probe_rays;        /* rays traced by the probes and the repair */
+    double seconds;             /* wall time of vb_ray_origins */
 } vb_origins_stats;
 
 /* The ray-offset normals: for every receiver vertex, the normalised sum of
@@ -103,8 +103,8 @@ vb_result vb_ray_origins(const vb_mesh *m, const vb_scene *s, unsigned threads, 
  * a mesh turned inside out as a whole (winding and normals both inverted)
  * is left alone; a ray meeting coincident faces of both orientations sees
  * a front face. `flipped` (may be NULL) receives how many. */
-vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
-                              uint32_t *flipped, vb_error *err);
+vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads, uint32_t *flipped,
+                              vb_error *err);
 
 /* The bake's receivers in one pass over their frames (built once):
  * vb_orient_receivers (when `normals` is not NULL: m's normals are copied
@@ -123,9 +123,8 @@ vb_result vb_orient_receivers(vb_mesh *m, const vb_scene *s, unsigned threads,
  * receivers in [count_begin, count_end) (with set NULL: every one). */
 vb_result vb_receivers_prepare(const vb_mesh *m, const vb_scene *s, unsigned threads,
                                const uint32_t *set, uint32_t set_count, uint32_t count_begin,
-                               uint32_t count_end, float *normals, uint32_t *flipped,
-                               float *out, float *near_out, vb_origins_stats *stats,
-                               vb_error *err);
+                               uint32_t count_end, float *normals, uint32_t *flipped, float *out,
+                               float *near_out, vb_origins_stats *stats, vb_error *err);
 
 #ifdef __cplusplus
 }

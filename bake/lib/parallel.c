@@ -16,7 +16,7 @@ typedef struct pool {
     void *ctx;
     _Atomic uint32_t next, done;
     _Atomic unsigned worker_id;
-    int running;               /* under lock */
+    int running; /* under lock */
     pthread_mutex_t lock;
     pthread_cond_t cond;
 } pool;
@@ -53,9 +53,8 @@ static void *worker(void *arg)
     return NULL;
 }
 
-unsigned vb_parallel_for(unsigned threads, uint32_t count, uint32_t block,
-                         vb_parallel_fn fn, void *ctx,
-                         vb_parallel_progress progress, void *user)
+unsigned vb_parallel_for(unsigned threads, uint32_t count, uint32_t block, vb_parallel_fn fn,
+                         void *ctx, vb_parallel_progress progress, void *user)
 {
     threads = vb_parallel_threads(threads);
     pool P = {.count = count, .block = block ? block : 1, .fn = fn, .ctx = ctx};

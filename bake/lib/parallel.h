@@ -31,9 +31,8 @@ typedef void (*vb_parallel_progress)(void *user, uint32_t done, uint32_t total);
 /* 0 means every online core; capped at 256. */
 unsigned vb_parallel_threads(unsigned threads);
 
-unsigned vb_parallel_for(unsigned threads, uint32_t count, uint32_t block,
-                         vb_parallel_fn fn, void *ctx,
-                         vb_parallel_progress progress, void *user);
+unsigned vb_parallel_for(unsigned threads, uint32_t count, uint32_t block, vb_parallel_fn fn,
+                         void *ctx, vb_parallel_progress progress, void *user);
 
 #ifdef __cplusplus
 }

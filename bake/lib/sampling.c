@@ -136,12 +136,10 @@ static void packet_cone(const vb_dirgrid *g, const uint32_t *cells, float cone[4
     cone[3] = alpha >= VB_PI / 2 ? 2.0f : (float)sin(alpha);
 }
 
-vb_result vb_dirgrid_create(uint32_t rays, int hemisphere, vb_dirgrid *out,
-                            vb_error *err)
+vb_result vb_dirgrid_create(uint32_t rays, int hemisphere, vb_dirgrid *out, vb_error *err)
 {
     if (rays == 0 || rays > VB_MAX_RAYS)
-        return vb_fail(err, VB_ERR_ARGUMENT,
-                       "rays per receiver must be 1..%u, not %u", VB_MAX_RAYS,
+        return vb_fail(err, VB_ERR_ARGUMENT, "rays per receiver must be 1..%u, not %u", VB_MAX_RAYS,
                        rays);
     vb_dirgrid g = {0};
     g.nu = (uint32_t)floor(sqrt((double)rays));
@@ -161,8 +159,7 @@ vb_result vb_dirgrid_create(uint32_t rays, int hemisphere, vb_dirgrid *out,
     g.lane_sin = malloc(lanes * sizeof *g.lane_sin);
     if (!g.cells || !g.cone || !g.lane_row || !g.lane_cos || !g.lane_sin) {
         vb_dirgrid_destroy(&g);
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY,
-                       "out of memory for %u ray directions", rays);
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u ray directions", rays);
     }
     /* Morton order over (row, column): any 16 consecutive cells are a
      * compact patch (a 4 x 4 block where the grid allows), also in grids
@@ -209,7 +206,7 @@ void vb_dirgrid_destroy(vb_dirgrid *g)
 
 /* An AVX2 clone where the CPU has it (as formats/vdsh_sh.c does): no FMA
  * (-std=c11 does not contract), so the same bits either way. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) &&                             \
     !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("avx2", "default")))
 #endif
@@ -238,10 +235,13 @@ void vb_dirgrid_packet(const vb_dirgrid *g, uint32_t packet, uint64_t seed,
         float q = 1.0f - zz * zz;
         float r = sqrtf(q > 0.0f ? q : 0.0f); /* not fmaxf: it blocks vectorising */
         float d = jv * dphi, d2 = d * d;
-        float cd = 1.0f - d2 * (1.0f / 2) * (1.0f - d2 * (1.0f / 12) *
-                   (1.0f - d2 * (1.0f / 30) * (1.0f - d2 * (1.0f / 56))));
-        float sd = d * (1.0f - d2 * (1.0f / 6) * (1.0f - d2 * (1.0f / 20) *
-                   (1.0f - d2 * (1.0f / 42) * (1.0f - d2 * (1.0f / 72)))));
+        float cd = 1.0f - d2 * (1.0f / 2) *
+                              (1.0f - d2 * (1.0f / 12) *
+                                          (1.0f - d2 * (1.0f / 30) * (1.0f - d2 * (1.0f / 56))));
+        float sd =
+            d * (1.0f - d2 * (1.0f / 6) *
+                            (1.0f - d2 * (1.0f / 20) *
+                                        (1.0f - d2 * (1.0f / 42) * (1.0f - d2 * (1.0f / 72)))));
         x[k] = r * (c0[k] * cd - s0[k] * sd);
         y[k] = r * (s0[k] * cd + c0[k] * sd);
         z[k] = zz;
@@ -287,13 +287,11 @@ static uint32_t bit_reverse(uint32_t x, int bits)
     return r;
 }
 
-vb_result vb_dirgrid_create_nested(uint32_t rays, int hemisphere, vb_dirgrid *out,
-                                   vb_error *err)
+vb_result vb_dirgrid_create_nested(uint32_t rays, int hemisphere, vb_dirgrid *out, vb_error *err)
 {
     if (rays < 128 || rays > VB_MAX_RAYS)
         return vb_fail(err, VB_ERR_ARGUMENT,
-                       "adaptive rays need a cap of 128..%u directions, not %u", VB_MAX_RAYS,
-                       rays);
+                       "adaptive rays need a cap of 128..%u directions, not %u", VB_MAX_RAYS, rays);
     int a = 0, b = 0; /* nu = 2^a rows, nv = 2^b columns, b = a or a + 1 */
     while (((uint64_t)1 << (a + b + 1)) <= rays) {
         if (b == a)
@@ -324,8 +322,7 @@ vb_result vb_dirgrid_create_nested(uint32_t rays, int hemisphere, vb_dirgrid *ou
             uint32_t round = 0;
             while (rank >= (1u << (first + round)))
                 round++;
-            key[u * g.nv + v] = ((uint64_t)round << 56) | ((uint64_t)code << 24) |
-                                (u * g.nv + v);
+            key[u * g.nv + v] = ((uint64_t)round << 56) | ((uint64_t)code << 24) | (u * g.nv + v);
         }
     qsort(key, g.count, sizeof *key, cmp_u64);
     for (uint32_t k = 0; k < g.count; k++)
@@ -338,9 +335,9 @@ vb_result vb_dirgrid_create_nested(uint32_t rays, int hemisphere, vb_dirgrid *ou
     return VB_OK;
 }
 
-void vb_dirgrid_packet_nested(const vb_dirgrid *g, uint32_t packet, uint64_t seed,
-                              uint32_t vertex, const float n[3], float dx[16],
-                              float dy[16], float dz[16], int valid[16])
+void vb_dirgrid_packet_nested(const vb_dirgrid *g, uint32_t packet, uint64_t seed, uint32_t vertex,
+                              const float n[3], float dx[16], float dy[16], float dz[16],
+                              int valid[16])
 {
     const uint32_t *cells = g->cells + (size_t)packet * VB_PACKET;
     const uint32_t key = hash_key(seed, vertex);

@@ -43,25 +43,24 @@ extern "C" {
 #define VB_MAX_ROUNDS 24
 
 typedef struct vb_dirgrid {
-    uint32_t nu, nv;         /* rows (cos theta) x columns (phi) */
-    uint32_t count;          /* nu * nv directions per receiver */
-    uint32_t packet_count;   /* ceil(count / 16) */
-    int hemisphere;          /* 0: whole sphere; 1: hemisphere around n */
-    uint32_t *cells;         /* packet_count * 16 cell indices (row * nv +
+    uint32_t nu, nv;            /* rows (cos theta) x columns (phi) */
+    uint32_t count;             /* nu * nv directions per receiver */
+    uint32_t packet_count;      /* ceil(count / 16) */
+    int hemisphere;             /* 0: whole sphere; 1: hemisphere around n */
+    uint32_t *cells;            /* packet_count * 16 cell indices (row * nv +
                                 column) in packet order; UINT32_MAX = empty */
-    float *cone;             /* per packet: axis x, y, z, sin(half-angle) or 2
+    float *cone;                /* per packet: axis x, y, z, sin(half-angle) or 2
                                 if the half-angle reaches 90 degrees (sphere
                                 domain only) */
-    float *lane_row;         /* per lane (packet order): the cell's row */
-    float *lane_cos, *lane_sin;  /* per lane: cos, sin of the cell's first phi */
+    float *lane_row;            /* per lane (packet order): the cell's row */
+    float *lane_cos, *lane_sin; /* per lane: cos, sin of the cell's first phi */
     /* Nested grids (vb_dirgrid_create_nested) only, else 0: the packets
      * end of each round (round r is packets [round_end[r-1], round_end[r])). */
     uint32_t rounds;
     uint32_t round_end[VB_MAX_ROUNDS];
 } vb_dirgrid;
 
-vb_result vb_dirgrid_create(uint32_t rays, int hemisphere, vb_dirgrid *out,
-                            vb_error *err);
+vb_result vb_dirgrid_create(uint32_t rays, int hemisphere, vb_dirgrid *out, vb_error *err);
 void vb_dirgrid_destroy(vb_dirgrid *g);
 
 /* A nested grid for adaptive rays: nu x nv = 2^a x 2^b cells (b = a or
@@ -74,28 +73,25 @@ void vb_dirgrid_destroy(vb_dirgrid *g);
  * round the cells are in Morton order (packets are compact patches of the
  * sub-grid); every round is a whole number of full packets. Packets:
  * vb_dirgrid_packet_nested (not vb_dirgrid_packet, nor packet cones). */
-vb_result vb_dirgrid_create_nested(uint32_t rays, int hemisphere, vb_dirgrid *out,
-                                   vb_error *err);
+vb_result vb_dirgrid_create_nested(uint32_t rays, int hemisphere, vb_dirgrid *out, vb_error *err);
 
 /* vb_dirgrid_packet for a nested grid: the grid's cells XORed with the
  * receiver's shift (a hash of seed and vertex), so that the sub-grids
  * differ from one receiver to the next. Every lane valid. */
-void vb_dirgrid_packet_nested(const vb_dirgrid *g, uint32_t packet, uint64_t seed,
-                              uint32_t vertex, const float n[3], float dx[16],
-                              float dy[16], float dz[16], int valid[16]);
+void vb_dirgrid_packet_nested(const vb_dirgrid *g, uint32_t packet, uint64_t seed, uint32_t vertex,
+                              const float n[3], float dx[16], float dy[16], float dz[16],
+                              int valid[16]);
 
 /* The 16 directions of `packet` for receiver `vertex`. For the hemisphere
  * domain, `n` is the receiver's unit normal (the local pole); for the
  * sphere it is ignored and the pole is +z. Empty lanes get valid = 0 and a
  * zero direction; the others valid = -1 (Embree's convention). */
-void vb_dirgrid_packet(const vb_dirgrid *g, uint32_t packet, uint64_t seed,
-                       uint32_t vertex, const float n[3], float dx[16],
-                       float dy[16], float dz[16], int valid[16]);
+void vb_dirgrid_packet(const vb_dirgrid *g, uint32_t packet, uint64_t seed, uint32_t vertex,
+                       const float n[3], float dx[16], float dy[16], float dz[16], int valid[16]);
 
 /* 1 if every direction the packet can produce (whatever the jitter) has
  * w.n < 0: it lies wholly below the horizon of normal n. Sphere domain. */
-static inline int vb_dirgrid_packet_below(const vb_dirgrid *g, uint32_t packet,
-                                          const float n[3])
+static inline int vb_dirgrid_packet_below(const vb_dirgrid *g, uint32_t packet, const float n[3])
 {
     const float *c = g->cone + 4 * (size_t)packet;
     return c[0] * n[0] + c[1] * n[1] + c[2] * n[2] < -c[3];

@@ -10,8 +10,8 @@
 static void on_embree_error(void *user, enum RTCError code, const char *str)
 {
     vb_scene *s = user;
-    snprintf(s->embree_error, sizeof s->embree_error, "Embree error %d: %s",
-             (int)code, str ? str : "(no message)");
+    snprintf(s->embree_error, sizeof s->embree_error, "Embree error %d: %s", (int)code,
+             str ? str : "(no message)");
 }
 
 void vb_scene_destroy(vb_scene *s)
@@ -25,8 +25,8 @@ void vb_scene_destroy(vb_scene *s)
     free(s);
 }
 
-vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc,
-                          vb_scene **out, vb_error *err)
+vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc, vb_scene **out,
+                          vb_error *err)
 {
     vb_scene_desc d = desc ? *desc : (vb_scene_desc){0};
     if (!occ || occ->triangle_count == 0)
@@ -76,20 +76,17 @@ vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc,
     if (!s->device) {
         enum RTCError code = rtcGetDeviceError(NULL);
         vb_scene_destroy(s);
-        return vb_fail(err, VB_ERR_EMBREE, "cannot create Embree device (error %d)",
-                       (int)code);
+        return vb_fail(err, VB_ERR_EMBREE, "cannot create Embree device (error %d)", (int)code);
     }
     rtcSetDeviceErrorFunction(s->device, on_embree_error, s);
 
     s->scene = rtcNewScene(s->device);
     RTCGeometry geom = s->scene ? rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE) : NULL;
-    float *v = geom ? rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
-                                              RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                              occ->vertex_count)
+    float *v = geom ? rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                              3 * sizeof(float), occ->vertex_count)
                     : NULL;
-    unsigned *ix = v ? rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0,
-                                               RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-                                               occ->triangle_count)
+    unsigned *ix = v ? rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                               3 * sizeof(unsigned), occ->triangle_count)
                      : NULL;
     if (!ix) {
         if (geom)
@@ -105,12 +102,12 @@ vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc,
     rtcCommitGeometry(geom);
     rtcAttachGeometry(s->scene, geom);
     rtcReleaseGeometry(geom);
-    rtcSetSceneFlags(s->scene, (d.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE) | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+    rtcSetSceneFlags(s->scene, (d.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE) |
+                                   RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(s->scene, RTC_BUILD_QUALITY_HIGH);
     rtcCommitScene(s->scene);
     if (s->embree_error[0]) {
-        vb_result r = vb_fail(err, VB_ERR_EMBREE, "building the BVH failed: %s",
-                              s->embree_error);
+        vb_result r = vb_fail(err, VB_ERR_EMBREE, "building the BVH failed: %s", s->embree_error);
         vb_scene_destroy(s);
         return r;
     }
@@ -158,8 +155,9 @@ int vb_scene_free_space(const vb_scene *s, const float p[3])
         rtcIntersect1(s->scene, &ctx, &rh);
         int hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
         t[i] = hit ? rh.ray.tfar / s->scale : INFINITY;
-        back[i] = hit && rh.hit.Ng_x * dirs[i][0] + rh.hit.Ng_y * dirs[i][1] +
-                                 rh.hit.Ng_z * dirs[i][2] > 0.0f;
+        back[i] =
+            hit &&
+            rh.hit.Ng_x * dirs[i][0] + rh.hit.Ng_y * dirs[i][1] + rh.hit.Ng_z * dirs[i][2] > 0.0f;
     }
     return vdsh_free_space(t, back, vdsh_free_clearance(s->diagonal));
 }
@@ -174,15 +172,26 @@ static float probe_nearest(const vb_scene *s, const float p[3])
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     for (int i = 0; i < VDSH_FREE_PROBES; i++) {
-        struct RTCRay r = {.org_x = o[0], .org_y = o[1], .org_z = o[2], .dir_x = dirs[i][0],
-                           .dir_y = dirs[i][1], .dir_z = dirs[i][2], .tnear = 0.0f,
-                           .tfar = INFINITY, .mask = 0xffffffffu};
+        struct RTCRay r = {.org_x = o[0],
+                           .org_y = o[1],
+                           .org_z = o[2],
+                           .dir_x = dirs[i][0],
+                           .dir_y = dirs[i][1],
+                           .dir_z = dirs[i][2],
+                           .tnear = 0.0f,
+                           .tfar = INFINITY,
+                           .mask = 0xffffffffu};
         rtcOccluded1(s->scene, &ctx, &r);
         if (r.tfar < 0.0f) { /* met something: find how far */
-            struct RTCRayHit rh = {.ray = {.org_x = o[0], .org_y = o[1], .org_z = o[2],
-                                           .dir_x = dirs[i][0], .dir_y = dirs[i][1],
-                                           .dir_z = dirs[i][2], .tnear = 0.0f,
-                                           .tfar = INFINITY, .mask = 0xffffffffu},
+            struct RTCRayHit rh = {.ray = {.org_x = o[0],
+                                           .org_y = o[1],
+                                           .org_z = o[2],
+                                           .dir_x = dirs[i][0],
+                                           .dir_y = dirs[i][1],
+                                           .dir_z = dirs[i][2],
+                                           .tnear = 0.0f,
+                                           .tfar = INFINITY,
+                                           .mask = 0xffffffffu},
                                    .hit = {.geomID = RTC_INVALID_GEOMETRY_ID}};
             rtcIntersect1(s->scene, &ctx, &rh);
             float d = rh.ray.tfar / s->scale;
@@ -219,8 +228,7 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
             /* a walk along x at two thirds of the height, swinging across z */
             float t = hi[0] > lo[0] ? (p[0] - lo[0]) / (hi[0] - lo[0]) : 0.5f;
             p[1] = lo[1] + 0.66f * (hi[1] - lo[1]);
-            p[2] = 0.5f * (lo[2] + hi[2]) +
-                   0.3f * (hi[2] - lo[2]) * sinf(6.2831853f * t);
+            p[2] = 0.5f * (lo[2] + hi[2]) + 0.3f * (hi[2] - lo[2]) * sinf(6.2831853f * t);
         }
         if (!vb_scene_free_space(s, p))
             continue;
@@ -231,13 +239,15 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
     if (tried)
         *tried = k;
     if (n < count)
-        return vb_fail(err, VB_ERR_INVALID, "no room for %u lights by rule %s: %u found in %u "
-                       "candidates", count, vb_light_rule_name(rule), n, k);
+        return vb_fail(err, VB_ERR_INVALID,
+                       "no room for %u lights by rule %s: %u found in %u "
+                       "candidates",
+                       count, vb_light_rule_name(rule), n, k);
     return VB_OK;
 }
 
-vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count,
-                               float (*out)[3], uint32_t *tried, vb_error *err)
+vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
+                                uint32_t *tried, vb_error *err)
 {
     /* Give up when a thousand candidates per light find no room: a scene
      * without free space (a solid, or everything closer than clearance). */

@@ -30,28 +30,27 @@ extern "C" {
 #endif
 
 typedef struct vb_scene_desc {
-    int robust;              /* 1: RTC_SCENE_FLAG_ROBUST (default 0) */
-    unsigned threads;        /* Embree build threads; 0 = all cores */
+    int robust;       /* 1: RTC_SCENE_FLAG_ROBUST (default 0) */
+    unsigned threads; /* Embree build threads; 0 = all cores */
 } vb_scene_desc;
 
 typedef struct vb_scene {
     RTCDevice device;
     RTCScene scene;
-    float centre[3];         /* subtracted before scaling */
-    float scale;             /* power of two */
-    float bounds_min[3], bounds_max[3];  /* occluders, scene units */
-    float diagonal;          /* of the bounds, scene units */
+    float centre[3];                    /* subtracted before scaling */
+    float scale;                        /* power of two */
+    float bounds_min[3], bounds_max[3]; /* occluders, scene units */
+    float diagonal;                     /* of the bounds, scene units */
     uint32_t vertex_count, triangle_count;
-    char embree_error[256];  /* last Embree error reported on this device */
+    char embree_error[256]; /* last Embree error reported on this device */
 } vb_scene;
 
-vb_result vb_scene_create(const vb_mesh *occluders, const vb_scene_desc *desc,
-                          vb_scene **out, vb_error *err);
+vb_result vb_scene_create(const vb_mesh *occluders, const vb_scene_desc *desc, vb_scene **out,
+                          vb_error *err);
 void vb_scene_destroy(vb_scene *s);
 
 /* Scene units to the traced frame (a point, not a direction). */
-static inline void vb_scene_to_local(const vb_scene *s, const float p[3],
-                                     float out[3])
+static inline void vb_scene_to_local(const vb_scene *s, const float p[3], float out[3])
 {
     for (int i = 0; i < 3; i++)
         out[i] = (p[i] - s->centre[i]) * s->scale;
@@ -67,8 +66,8 @@ void vb_offset_origin(const float p[3], const float n[3], float out[3]);
  * (vdsh_light.h): the candidates of the sequence `seed` that pass, in
  * order. *tried (may be NULL) gets how many candidates were drawn. Fails
  * (VB_ERR_INVALID) when 1000 candidates per light are not enough. */
-vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count,
-                               float (*out)[3], uint32_t *tried, vb_error *err);
+vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
+                                uint32_t *tried, vb_error *err);
 
 /* Other ways to place lights, for reports that a figure does not hang on
  * one light distribution (issue 25): all in free space, from the same

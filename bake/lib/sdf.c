@@ -16,8 +16,8 @@ static double dot3d(const double u[3], const double v[3])
 }
 
 /* The dot products of ab and of ac with p - x. */
-static void dots_from(const double p[3], const double x[3], const double ab[3],
-                      const double ac[3], double *with_ab, double *with_ac)
+static void dots_from(const double p[3], const double x[3], const double ab[3], const double ac[3],
+                      double *with_ab, double *with_ac)
 {
     double xp[3];
     for (int i = 0; i < 3; i++)
@@ -45,8 +45,7 @@ static double dist2_along(const double p[3], const double x[3], double t, const 
 
 /* Squared distance from p to triangle abc (Ericson 5.1.5: the Voronoi
  * region of the closest feature, then the point on it). */
-static double tri_dist2(const double p[3], const double a[3], const double b[3],
-                        const double c[3])
+static double tri_dist2(const double p[3], const double a[3], const double b[3], const double c[3])
 {
     double ab[3], ac[3], bc[3];
     for (int i = 0; i < 3; i++)
@@ -83,7 +82,7 @@ static double tri_dist2(const double p[3], const double a[3], const double b[3],
 
 typedef struct job {
     const vb_scene *s;
-    const float *local;        /* occluder vertices, traced frame */
+    const float *local; /* occluder vertices, traced frame */
     const uint32_t *indices;
     vdsh_sdf *v;
     float dirs[VDSH_FREE_PROBES][3];
@@ -124,8 +123,7 @@ static float sample_at(const job *J, uint32_t i, uint32_t j, uint32_t k)
     float o[3];
     vb_scene_to_local(J->s, p, o);
     query q = {.J = J, .p = {o[0], o[1], o[2]}, .best2 = INFINITY};
-    struct RTCPointQuery pq = {.x = o[0], .y = o[1], .z = o[2], .time = 0.0f,
-                               .radius = INFINITY};
+    struct RTCPointQuery pq = {.x = o[0], .y = o[1], .z = o[2], .time = 0.0f, .radius = INFINITY};
     struct RTCPointQueryContext ctx;
     rtcInitPointQueryContext(&ctx);
     rtcPointQuery(J->s->scene, &pq, &ctx, on_triangle, &q);
@@ -147,7 +145,8 @@ static float sample_at(const job *J, uint32_t i, uint32_t j, uint32_t k)
         if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
             continue;
         if (rh.hit.Ng_x * J->dirs[r][0] + rh.hit.Ng_y * J->dirs[r][1] +
-            rh.hit.Ng_z * J->dirs[r][2] > 0.0f)
+                rh.hit.Ng_z * J->dirs[r][2] >
+            0.0f)
             back++;
         else
             front++;
@@ -168,8 +167,8 @@ static void bake_rows(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
     }
 }
 
-vb_result vb_sdf_bake(const vb_scene *s, const vb_mesh *occluders, int resolution,
-                      unsigned threads, vdsh_sdf *out, vb_error *err)
+vb_result vb_sdf_bake(const vb_scene *s, const vb_mesh *occluders, int resolution, unsigned threads,
+                      vdsh_sdf *out, vb_error *err)
 {
     if (resolution < VB_SDF_MIN_RESOLUTION || resolution > VB_SDF_MAX_RESOLUTION)
         return vb_fail(err, VB_ERR_ARGUMENT, "distance volume resolution %d is not %d..%d",

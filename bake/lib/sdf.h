@@ -37,8 +37,8 @@ extern "C" {
 enum { VB_SDF_MIN_RESOLUTION = 4, VB_SDF_MAX_RESOLUTION = 512 };
 
 /* s must have been created from `occluders` (vb_scene_create). */
-vb_result vb_sdf_bake(const vb_scene *s, const vb_mesh *occluders, int resolution,
-                      unsigned threads, vdsh_sdf *out, vb_error *err);
+vb_result vb_sdf_bake(const vb_scene *s, const vb_mesh *occluders, int resolution, unsigned threads,
+                      vdsh_sdf *out, vb_error *err);
 
 #ifdef __cplusplus
 }

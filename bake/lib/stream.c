@@ -21,9 +21,9 @@ typedef struct f16_job {
     const float *src;
     size_t count;
     float scale;
-    float *amax;          /* per chunk */
+    float *amax; /* per chunk */
     uint16_t *dst;
-    vdsh_result *result;  /* per chunk */
+    vdsh_result *result; /* per chunk */
 } f16_job;
 
 static void f16_amax_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
@@ -61,14 +61,16 @@ static vb_result stream_header(const vb_bake_output *b, int order, vdsh_encoding
     const vb_method_info *mi = vb_method_stored(b->method);
     if (!mi)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown method %u", b->method);
-    *out = (vdsh_stream){.order = (uint32_t)order, .encoding = encoding, .method = b->method,
-                         .quantity = b->quantity[order],
-                         .method_param = mi->param == VB_PARAM_LOG_OFFSET ? b->log_offset[order]
-                                                                          : b->lambda,
-                         .scale = 1.0f,
-                         .quantity_param = b->quantity[order] == VDSH_QUANTITY_LOG_DISTANCE
-                                               ? b->log_floor : 0.0f, .window = b->window,
-                         .window_param = b->window ? (float)order : 0.0f};
+    *out = (vdsh_stream){
+        .order = (uint32_t)order,
+        .encoding = encoding,
+        .method = b->method,
+        .quantity = b->quantity[order],
+        .method_param = mi->param == VB_PARAM_LOG_OFFSET ? b->log_offset[order] : b->lambda,
+        .scale = 1.0f,
+        .quantity_param = b->quantity[order] == VDSH_QUANTITY_LOG_DISTANCE ? b->log_floor : 0.0f,
+        .window = b->window,
+        .window_param = b->window ? (float)order : 0.0f};
     return VB_OK;
 }
 
@@ -144,8 +146,8 @@ vb_result vb_bake_stream(const vb_bake_output *b, int order, vdsh_encoding encod
     return VB_OK;
 }
 
-vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encoding,
-                                  vdsh_stream *out, void **storage, vb_error *err)
+vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encoding, vdsh_stream *out,
+                                  void **storage, vb_error *err)
 {
     const int cap = b->variable_cap;
     if (!b->variable_orders || cap < 1 || cap > VDSH_MAX_ORDER)
@@ -157,8 +159,8 @@ vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encodin
     /* One block: the scale table, the offsets (rows + 1), the orders (in
      * words), the records: the stream owns copies, so the bake's arrays
      * may be freed. */
-    vdsh_stream sized = {.encoding = encoding, .flags = VDSH_STREAM_VARIABLE,
-                         .orders = b->variable_orders};
+    vdsh_stream sized = {
+        .encoding = encoding, .flags = VDSH_STREAM_VARIABLE, .orders = b->variable_orders};
     size_t words = (vdsh_stream_data_bytes(&sized, rows) - ((size_t)rows + 15) / 16 * 16) / 4;
     size_t table = VDSH_MAX_COEFFS, head = table + (size_t)rows + 1 + ((size_t)rows + 3) / 4;
     uint32_t *block = malloc((head + words) * sizeof *block + 1);
@@ -184,15 +186,20 @@ vb_result vb_bake_variable_stream(const vb_bake_output *b, vdsh_encoding encodin
         return vb_fail(err, VB_ERR_INVALID, "adaptive-order coefficients do not fit %s",
                        vdsh_encoding_name(encoding));
     }
-    *out = (vdsh_stream){.order = (uint32_t)cap, .encoding = encoding,
+    *out = (vdsh_stream){.order = (uint32_t)cap,
+                         .encoding = encoding,
                          .method = b->variable_method,
                          .quantity = VDSH_QUANTITY_LOG_DISTANCE,
                          .method_param = b->variable_param,
-                         .scale = scale, .quantity_param = b->log_floor, .window = b->window,
+                         .scale = scale,
+                         .quantity_param = b->log_floor,
+                         .window = b->window,
                          .window_param = b->window ? (float)cap : 0.0f,
                          .coef_scales = vdsh_encoding_quantised(encoding) ? scales : NULL,
-                         .flags = VDSH_STREAM_VARIABLE, .orders = orders,
-                         .offsets = offsets, .data = block + head};
+                         .flags = VDSH_STREAM_VARIABLE,
+                         .orders = orders,
+                         .offsets = offsets,
+                         .data = block + head};
     *storage = block;
     return VB_OK;
 }

@@ -20,12 +20,12 @@ extern "C" {
 
 typedef enum vb_result {
     VB_OK = 0,
-    VB_ERR_IO,             /* cannot open, read, write or rename a file */
+    VB_ERR_IO, /* cannot open, read, write or rename a file */
     VB_ERR_OUT_OF_MEMORY,
-    VB_ERR_FORMAT,         /* a file's content cannot be parsed / unsupported */
-    VB_ERR_INVALID,        /* parsed but unusable: NaN/Inf, bad index, empty */
-    VB_ERR_EMBREE,         /* Embree device or scene failure */
-    VB_ERR_ARGUMENT        /* bad option value or inconsistent request */
+    VB_ERR_FORMAT,  /* a file's content cannot be parsed / unsupported */
+    VB_ERR_INVALID, /* parsed but unusable: NaN/Inf, bad index, empty */
+    VB_ERR_EMBREE,  /* Embree device or scene failure */
+    VB_ERR_ARGUMENT /* bad option value or inconsistent request */
 } vb_result;
 
 const char *vb_result_str(vb_result r);
@@ -38,7 +38,8 @@ typedef struct vb_error {
 #if defined(__GNUC__)
 __attribute__((format(printf, 3, 4)))
 #endif
-vb_result vb_fail(vb_error *err, vb_result r, const char *fmt, ...);
+vb_result
+vb_fail(vb_error *err, vb_result r, const char *fmt, ...);
 
 /* Add to the message in err (if not NULL), after what it says. */
 #if defined(__GNUC__)
@@ -61,9 +62,9 @@ double vb_now(void);
 
 /* Named defaults that the bake library and more than one program (or help
  * text) share: one number each, spelled once. */
-#define VB_DEFAULT_RAYS 2500u    /* directions per receiver, a 50 x 50 grid */
-#define VB_DEFAULT_CUBE_SIZE 64  /* basis cubemap face, texels */
-#define VB_DEFAULT_SEED 1u       /* vdsh-bake --seed */
+#define VB_DEFAULT_RAYS 2500u   /* directions per receiver, a 50 x 50 grid */
+#define VB_DEFAULT_CUBE_SIZE 64 /* basis cubemap face, texels */
+#define VB_DEFAULT_SEED 1u      /* vdsh-bake --seed */
 
 #ifdef __cplusplus
 }

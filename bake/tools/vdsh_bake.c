@@ -40,43 +40,43 @@ typedef struct options {
     const char *cubemap_dir;
     const char *report;
     const char *export_obj;
-    const char *plan;          /* --plan: the adaptive receivers, as OBJ */
-    const char *receivers;     /* --receivers: a plan to bake */
+    const char *plan;      /* --plan: the adaptive receivers, as OBJ */
+    const char *receivers; /* --receivers: a plan to bake */
     uint32_t rays;
-    int adaptive_rays;         /* --rays auto */
-    float ray_tolerance;       /* --ray-tolerance; 0: the default */
+    int adaptive_rays;   /* --rays auto */
+    float ray_tolerance; /* --ray-tolerance; 0: the default */
     int have_ray_tolerance;
     int orders[VDSH_MAX_ORDER];
     int order_count;
-    int orders_given;          /* --orders */
-    float order_tolerance;     /* --adaptive-order TOL; 0: none */
-    int max_order;             /* --max-order N; 0: VB_DEFAULT_ORDER_CAP */
+    int orders_given;      /* --orders */
+    float order_tolerance; /* --adaptive-order TOL; 0: none */
+    int max_order;         /* --max-order N; 0: VB_DEFAULT_ORDER_CAP */
     vb_method method;
     vb_quantity quantity;
     float lambda;
     float log_offset;
     int have_log_offset;
-    uint32_t decision_lights;  /* --decision-lights; 0: the default */
-    float false_rate;          /* --false-rate; 0: the default */
+    uint32_t decision_lights;    /* --decision-lights; 0: the default */
+    float false_rate;            /* --false-rate; 0: the default */
     vb_decision_params decision; /* --decision-params */
     int have_decision;
     float log_floor;
     vdsh_window window;
     vdsh_encoding encoding;
-    vdsh_cpca_settings cpca;   /* --cpca K,B,BITS (encoding cpca) */
+    vdsh_cpca_settings cpca; /* --cpca K,B,BITS (encoding cpca) */
     int have_cpca;
     float max_distance;
     float max_edge;
-    int adaptive;              /* --adaptive TOL */
+    int adaptive; /* --adaptive TOL */
     float adaptive_tol;
-    float min_edge;            /* --min-edge; 0: max_edge / 8 */
-    uint32_t max_receivers;    /* --max-receivers; 0: none */
-    uint32_t max_rounds;       /* --max-rounds; 0: none given (VB_ADAPTIVE_ROUNDS) */
+    float min_edge;         /* --min-edge; 0: max_edge / 8 */
+    uint32_t max_receivers; /* --max-receivers; 0: none */
+    uint32_t max_rounds;    /* --max-rounds; 0: none given (VB_ADAPTIVE_ROUNDS) */
     int weld;
     uint64_t seed;
     uint32_t threads;
     int cube_size;
-    int sdf;                   /* --sdf N: distance volume, N per longest side */
+    int sdf; /* --sdf N: distance volume, N per longest side */
     int robust;
     int record_timings;
     int trace_only;
@@ -122,7 +122,9 @@ static const char *method_names(void)
     int at = 0;
     for (int i = 0; i < VB_METHOD_COUNT; i++)
         at += snprintf(text + at, sizeof text - (size_t)at, "%s%s",
-                       i == 0 ? "" : i + 1 == VB_METHOD_COUNT ? " or " : ", ",
+                       i == 0                     ? ""
+                       : i + 1 == VB_METHOD_COUNT ? " or "
+                                                  : ", ",
                        vb_method_name((vb_method)i));
     return text;
 }
@@ -130,8 +132,10 @@ static const char *method_names(void)
 static void on_round(void *user, uint32_t round, uint32_t receivers, uint32_t candidates,
                      uint32_t split, double seconds)
 {
-    fprintf((FILE *)user, "vdsh-bake: adaptive round %u: %u of %u midpoints split, %u "
-                          "receivers (%.2f s)\n", round, split, candidates, receivers, seconds);
+    fprintf((FILE *)user,
+            "vdsh-bake: adaptive round %u: %u of %u midpoints split, %u "
+            "receivers (%.2f s)\n",
+            round, split, candidates, receivers, seconds);
 }
 
 static void usage(FILE *f)
@@ -139,148 +143,148 @@ static void usage(FILE *f)
     /* The default grid's side: the defaults are square grids. */
     const unsigned rays_side = (unsigned)lround(sqrt((double)VB_DEFAULT_RAYS));
     fprintf(f,
-"usage: vdsh-bake [options] MESH... -o OUT.vdsh\n"
-"Bake visibility-distance spherical harmonics for a static scene.\n"
-"\n"
-"MESH is an OBJ, PLY, OFF or STL file, a glTF 2.0 file (.gltf or .glb:\n"
-"its default scene's triangles), builtin:room (a procedural 19 x 6 x 19 m\n"
-"room) or builtin:room:N, N >= 1 (seeded variants: furnished rooms of\n"
-"varied size and shape). Several meshes form one scene: they occlude each\n"
-"other.\n"
-"Receivers are the mesh vertices (refined with --max-edge); rays are traced\n"
-"against the original triangles.\n"
-"\n"
-"Output:\n"
-"  -o, --output FILE       the .vdsh file to write (atomically)\n"
-"      --cubemap-dir DIR   where the SH basis cubemaps go (default: beside OUT)\n"
-"      --cube-size N       cubemap face size in texels (default %d; 0: none)\n"
-"      --sdf N             also bake the signed distance volume of the scene for\n"
-"                          vdsh-view --mode sdf: N samples along the bounds'\n"
-"                          longest side (%d..%d; 64 is a good start), written\n"
-"                          to OUT's companion file (room.vdsh: room.sdf)\n"
-"      --encoding E        coefficient encoding: s8s6 (default: bands 0-1 signed\n"
-"                          8-bit, bands 2+ 6-bit, a scale per coefficient\n"
-"                          index; 4, 8, 24 bytes per vertex at orders 2, 3, 5),\n"
-"                          s8 (all 8-bit: 4, 9, 25), f16 (8, 18, 50) or f32;\n"
-"                          compact ones within 0.1%% of f16: docs/ACCURACY.md;\n"
-"                          or cpca: clustered PCA of each order's coefficients\n"
-"                          (for orders 7..%d: order 12 in ~30-32 bytes per\n"
-"                          vertex; docs/ACCURACY.md \"Compressed high orders\");\n"
-"                          with --adaptive-order, its stream is written as a\n"
-"                          fixed cpca stream of order --max-order (zeros past\n"
-"                          each vertex's order)\n"
-"      --cpca K,B,BITS     cpca settings: clusters (1..256), basis vectors per\n"
-"                          cluster (capped at order^2), bits per weight (2..8);\n"
-"                          default 8,54,4\n"
-"      --shard I/N         bake shard I (0-based) of N only and write a part\n"
-"                          file; vdsh-merge joins the N parts into the file\n"
-"                          the whole bake writes, byte for byte\n"
-"      --report FILE       write timings and throughput as JSON\n"
-"      --record-timings    also store timings in the .vdsh (the file is then\n"
-"                          no longer byte-identical between runs)\n"
-"      --export-obj FILE   write the receiver mesh as OBJ and exit (no bake)\n"
-"      --trace-only        benchmark: build the BVH and trace the same rays,\n"
-"                          nothing else; no file is written (with --report,\n"
-"                          the bare loop's time is the build + trace time)\n"
-"\n"
-"Bake:\n"
-"      --rays N            directions per receiver, stratified and jittered\n"
-"                          (default %u = %u x %u)\n"
-"      --rays auto         adaptive: nested stratified rounds (a power-of-two\n"
-"                          grid under %u, from 1/16 of it), each receiver\n"
-"                          stopping when a round changes its fit by less\n"
-"                          than --ray-tolerance in expected shadow error\n"
-"      --ray-tolerance T   with --rays auto (default %g; 0: every round)\n"
-"      --orders LIST       SH orders to store, order n = n bands = n*n\n"
-"                          coefficients (default 2,3,5, or none with\n"
-"                          --adaptive-order; each 1..%d: orders above 5 are\n"
-"                          drawn from buffers, for long shadows)\n"
-"      --adaptive-order TOL  one more stream, of variable order: each\n"
-"                          receiver gets the lowest order (1..--max-order)\n"
-"                          whose expected shadow error on its own traced\n"
-"                          directions, under lights in the scene's free\n"
-"                          space, is at most TOL (else its best order)\n"
-"      --max-order N       the adaptive order's cap (default %d)\n"
-"      --method M          the fit:\n"
-"%s"
-"      --quantity Q        what the SH store: auto (default): log for decision\n"
-"                          and shadow,\n"
-"                          distance for paper, and for the others per order\n"
-"                          the one with the lower expected shadow error on\n"
-"                          1024 sampled receivers; distance; log:\n"
-"                          ln(distance), reconstructed as exp of the SH sum\n"
-"                          (not with paper; the only one with decision and\n"
-"                          shadow)\n"
-"      --log               the same as --quantity log\n"
-"      --lambda X          lsq regularisation weight (default %g; decision\n"
-"                          and shadow use lsq's default)\n"
-"      --log-offset X      decision, shadow: added to the fitted ln d at every\n"
-"                          order (decision: calibrated per scene and order at\n"
-"                          bake time; shadow: per order 2/3/5 %.2f/%.2f/%.2f,\n"
-"                          chosen on validation scenes); recorded as the\n"
-"                          stream's method parameter\n"
-"      --false-rate R      decision: the share of lit (light, receiver) pairs\n"
-"                          the calibrated offset leaves in false shadow, on\n"
-"                          held-out lights (default %g)\n"
-"      --decision-lights N decision: training lights per receiver, each\n"
-"                          traced (1..%d, default %d)\n"
-"      --decision-params TAU,LIT,RIDGE,RIDGE0,STEPS\n"
-"                          decision: the loss's temperature (ln units), the\n"
-"                          weight of lit pairs, the ridge per (l(l+1))^2 and\n"
-"                          on every coefficient toward the lsq fit, Newton\n"
-"                          steps (default 0.5,8,1e-5,1e-4,3)\n"
-"      --window W          per-band window on the coefficients: none (default),\n"
-"                          hann or lanczos (width: the order)\n"
-"      --log-floor D       log-distance: distances below D count as D\n"
-"                          (default: 1%% of the max distance)\n"
-"      --max-distance D    clamp distance; misses get it (default: the\n"
-"                          scene's bounding-box diagonal)\n"
-"      --max-edge L        refine receivers until no edge is longer than L\n"
-"                          (default 0: the mesh vertices as they are)\n"
-"      --adaptive TOL      adaptive receivers: from --max-edge, split an edge\n"
-"                          where the stream interpolated between its ends\n"
-"                          differs from its midpoint's bake by more than TOL\n"
-"                          plus the bake's noise floor (two bakes of a\n"
-"                          sample of its start receivers; none at TOL 0)\n"
-"                          in expected shadow error (lights in the scene's\n"
-"                          free space); a split vertex keeps that bake\n"
-"                          (docs/ACCURACY.md, \"Adaptive receivers\")\n"
-"      --min-edge L        with --adaptive: no edge is split below 2 L\n"
-"                          (default: --max-edge / 8)\n"
-"      --max-receivers N   with --adaptive: stop at N receivers, splitting\n"
-"                          the largest errors first\n"
-"      --max-rounds N      with --adaptive: at most N rounds of splits\n"
-"                          (default %d; stderr says when it stops one still\n"
-"                          splitting)\n"
-"      --plan FILE         write the receivers (refined, or with --adaptive\n"
-"                          as baked) for shards to read with --receivers:\n"
-"                          FILE.ply binary PLY (fast to read), else OBJ;\n"
-"                          exact floats. Without -o: the plan only\n"
-"      --receivers FILE    bake these receivers (a mesh file, e.g. a plan)\n"
-"                          as they are, instead of the scene's vertices\n"
-"      --weld              merge vertices with identical positions\n"
-"      --keep-normals      keep normals that point into geometry (default:\n"
-"                          a receiver blocked at ~0 on its own side and open\n"
-"                          on the other gets its normal flipped)\n"
-"      --seed N            seed of every random sequence (default %u)\n"
-"      --no-robust         Embree's fast traversal instead of the robust one\n"
-"                          (default: robust; the fast one is 4-11%% quicker\n"
-"                          but lets grazing rays slip through creases, and\n"
-"                          which ones differs between CPUs' kernels)\n"
-"      --threads N         worker threads (default: all cores)\n"
-"\n"
-"  -q, --quiet             no progress or summary on stderr (progress: a\n"
-"                          line in place on a terminal, else a line every\n"
-"                          5 s or 10%%, for logs)\n"
-"  -h, --help              this text\n"
-"  -V, --version           version\n"
-"\n"
-"Exit status: 0 success, 1 error, 2 usage error.\n"
-"Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n",
+            "usage: vdsh-bake [options] MESH... -o OUT.vdsh\n"
+            "Bake visibility-distance spherical harmonics for a static scene.\n"
+            "\n"
+            "MESH is an OBJ, PLY, OFF or STL file, a glTF 2.0 file (.gltf or .glb:\n"
+            "its default scene's triangles), builtin:room (a procedural 19 x 6 x 19 m\n"
+            "room) or builtin:room:N, N >= 1 (seeded variants: furnished rooms of\n"
+            "varied size and shape). Several meshes form one scene: they occlude each\n"
+            "other.\n"
+            "Receivers are the mesh vertices (refined with --max-edge); rays are traced\n"
+            "against the original triangles.\n"
+            "\n"
+            "Output:\n"
+            "  -o, --output FILE       the .vdsh file to write (atomically)\n"
+            "      --cubemap-dir DIR   where the SH basis cubemaps go (default: beside OUT)\n"
+            "      --cube-size N       cubemap face size in texels (default %d; 0: none)\n"
+            "      --sdf N             also bake the signed distance volume of the scene for\n"
+            "                          vdsh-view --mode sdf: N samples along the bounds'\n"
+            "                          longest side (%d..%d; 64 is a good start), written\n"
+            "                          to OUT's companion file (room.vdsh: room.sdf)\n"
+            "      --encoding E        coefficient encoding: s8s6 (default: bands 0-1 signed\n"
+            "                          8-bit, bands 2+ 6-bit, a scale per coefficient\n"
+            "                          index; 4, 8, 24 bytes per vertex at orders 2, 3, 5),\n"
+            "                          s8 (all 8-bit: 4, 9, 25), f16 (8, 18, 50) or f32;\n"
+            "                          compact ones within 0.1%% of f16: docs/ACCURACY.md;\n"
+            "                          or cpca: clustered PCA of each order's coefficients\n"
+            "                          (for orders 7..%d: order 12 in ~30-32 bytes per\n"
+            "                          vertex; docs/ACCURACY.md \"Compressed high orders\");\n"
+            "                          with --adaptive-order, its stream is written as a\n"
+            "                          fixed cpca stream of order --max-order (zeros past\n"
+            "                          each vertex's order)\n"
+            "      --cpca K,B,BITS     cpca settings: clusters (1..256), basis vectors per\n"
+            "                          cluster (capped at order^2), bits per weight (2..8);\n"
+            "                          default 8,54,4\n"
+            "      --shard I/N         bake shard I (0-based) of N only and write a part\n"
+            "                          file; vdsh-merge joins the N parts into the file\n"
+            "                          the whole bake writes, byte for byte\n"
+            "      --report FILE       write timings and throughput as JSON\n"
+            "      --record-timings    also store timings in the .vdsh (the file is then\n"
+            "                          no longer byte-identical between runs)\n"
+            "      --export-obj FILE   write the receiver mesh as OBJ and exit (no bake)\n"
+            "      --trace-only        benchmark: build the BVH and trace the same rays,\n"
+            "                          nothing else; no file is written (with --report,\n"
+            "                          the bare loop's time is the build + trace time)\n"
+            "\n"
+            "Bake:\n"
+            "      --rays N            directions per receiver, stratified and jittered\n"
+            "                          (default %u = %u x %u)\n"
+            "      --rays auto         adaptive: nested stratified rounds (a power-of-two\n"
+            "                          grid under %u, from 1/16 of it), each receiver\n"
+            "                          stopping when a round changes its fit by less\n"
+            "                          than --ray-tolerance in expected shadow error\n"
+            "      --ray-tolerance T   with --rays auto (default %g; 0: every round)\n"
+            "      --orders LIST       SH orders to store, order n = n bands = n*n\n"
+            "                          coefficients (default 2,3,5, or none with\n"
+            "                          --adaptive-order; each 1..%d: orders above 5 are\n"
+            "                          drawn from buffers, for long shadows)\n"
+            "      --adaptive-order TOL  one more stream, of variable order: each\n"
+            "                          receiver gets the lowest order (1..--max-order)\n"
+            "                          whose expected shadow error on its own traced\n"
+            "                          directions, under lights in the scene's free\n"
+            "                          space, is at most TOL (else its best order)\n"
+            "      --max-order N       the adaptive order's cap (default %d)\n"
+            "      --method M          the fit:\n"
+            "%s"
+            "      --quantity Q        what the SH store: auto (default): log for decision\n"
+            "                          and shadow,\n"
+            "                          distance for paper, and for the others per order\n"
+            "                          the one with the lower expected shadow error on\n"
+            "                          1024 sampled receivers; distance; log:\n"
+            "                          ln(distance), reconstructed as exp of the SH sum\n"
+            "                          (not with paper; the only one with decision and\n"
+            "                          shadow)\n"
+            "      --log               the same as --quantity log\n"
+            "      --lambda X          lsq regularisation weight (default %g; decision\n"
+            "                          and shadow use lsq's default)\n"
+            "      --log-offset X      decision, shadow: added to the fitted ln d at every\n"
+            "                          order (decision: calibrated per scene and order at\n"
+            "                          bake time; shadow: per order 2/3/5 %.2f/%.2f/%.2f,\n"
+            "                          chosen on validation scenes); recorded as the\n"
+            "                          stream's method parameter\n"
+            "      --false-rate R      decision: the share of lit (light, receiver) pairs\n"
+            "                          the calibrated offset leaves in false shadow, on\n"
+            "                          held-out lights (default %g)\n"
+            "      --decision-lights N decision: training lights per receiver, each\n"
+            "                          traced (1..%d, default %d)\n"
+            "      --decision-params TAU,LIT,RIDGE,RIDGE0,STEPS\n"
+            "                          decision: the loss's temperature (ln units), the\n"
+            "                          weight of lit pairs, the ridge per (l(l+1))^2 and\n"
+            "                          on every coefficient toward the lsq fit, Newton\n"
+            "                          steps (default 0.5,8,1e-5,1e-4,3)\n"
+            "      --window W          per-band window on the coefficients: none (default),\n"
+            "                          hann or lanczos (width: the order)\n"
+            "      --log-floor D       log-distance: distances below D count as D\n"
+            "                          (default: 1%% of the max distance)\n"
+            "      --max-distance D    clamp distance; misses get it (default: the\n"
+            "                          scene's bounding-box diagonal)\n"
+            "      --max-edge L        refine receivers until no edge is longer than L\n"
+            "                          (default 0: the mesh vertices as they are)\n"
+            "      --adaptive TOL      adaptive receivers: from --max-edge, split an edge\n"
+            "                          where the stream interpolated between its ends\n"
+            "                          differs from its midpoint's bake by more than TOL\n"
+            "                          plus the bake's noise floor (two bakes of a\n"
+            "                          sample of its start receivers; none at TOL 0)\n"
+            "                          in expected shadow error (lights in the scene's\n"
+            "                          free space); a split vertex keeps that bake\n"
+            "                          (docs/ACCURACY.md, \"Adaptive receivers\")\n"
+            "      --min-edge L        with --adaptive: no edge is split below 2 L\n"
+            "                          (default: --max-edge / 8)\n"
+            "      --max-receivers N   with --adaptive: stop at N receivers, splitting\n"
+            "                          the largest errors first\n"
+            "      --max-rounds N      with --adaptive: at most N rounds of splits\n"
+            "                          (default %d; stderr says when it stops one still\n"
+            "                          splitting)\n"
+            "      --plan FILE         write the receivers (refined, or with --adaptive\n"
+            "                          as baked) for shards to read with --receivers:\n"
+            "                          FILE.ply binary PLY (fast to read), else OBJ;\n"
+            "                          exact floats. Without -o: the plan only\n"
+            "      --receivers FILE    bake these receivers (a mesh file, e.g. a plan)\n"
+            "                          as they are, instead of the scene's vertices\n"
+            "      --weld              merge vertices with identical positions\n"
+            "      --keep-normals      keep normals that point into geometry (default:\n"
+            "                          a receiver blocked at ~0 on its own side and open\n"
+            "                          on the other gets its normal flipped)\n"
+            "      --seed N            seed of every random sequence (default %u)\n"
+            "      --no-robust         Embree's fast traversal instead of the robust one\n"
+            "                          (default: robust; the fast one is 4-11%% quicker\n"
+            "                          but lets grazing rays slip through creases, and\n"
+            "                          which ones differs between CPUs' kernels)\n"
+            "      --threads N         worker threads (default: all cores)\n"
+            "\n"
+            "  -q, --quiet             no progress or summary on stderr (progress: a\n"
+            "                          line in place on a terminal, else a line every\n"
+            "                          5 s or 10%%, for logs)\n"
+            "  -h, --help              this text\n"
+            "  -V, --version           version\n"
+            "\n"
+            "Exit status: 0 success, 1 error, 2 usage error.\n"
+            "Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n",
             VB_DEFAULT_CUBE_SIZE, VB_SDF_MIN_RESOLUTION, VB_SDF_MAX_RESOLUTION, VDSH_MAX_ORDER,
             VB_DEFAULT_RAYS, rays_side, rays_side, VB_DEFAULT_RAYS,
-            (double)VB_DEFAULT_RAY_TOLERANCE, VDSH_MAX_ORDER, VB_DEFAULT_ORDER_CAP,
-            methods_help(), (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
+            (double)VB_DEFAULT_RAY_TOLERANCE, VDSH_MAX_ORDER, VB_DEFAULT_ORDER_CAP, methods_help(),
+            (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
             (double)vb_shadow_log_offset(3), (double)vb_shadow_log_offset(5),
             (double)VB_DEFAULT_FALSE_RATE, VB_DECISION_MAX_PAIRS, VB_DEFAULT_DECISION_LIGHTS,
             VB_ADAPTIVE_ROUNDS, VB_DEFAULT_SEED);
@@ -304,20 +308,19 @@ static int bad_usage(const char *fmt, const char *arg)
 
 typedef struct progress {
     int enabled;
-    int terminal;         /* 1: \r in place; 0: a line each time */
-    uint32_t rays;        /* rays per receiver asked for (the cap with --rays auto) */
-    double t0;            /* the bake's start */
+    int terminal;  /* 1: \r in place; 0: a line each time */
+    uint32_t rays; /* rays per receiver asked for (the cap with --rays auto) */
+    double t0;     /* the bake's start */
     /* the current loop: its first report, and the last line printed */
     uint32_t total, last_done;
     double t_first, t_printed;
     uint32_t done_first;
     uint64_t traced_first;
     int decile_printed;
-    int finished;         /* this loop's 100% line is out */
+    int finished; /* this loop's 100% line is out */
 } progress;
 
-static void on_progress(void *user, uint32_t done, uint32_t total,
-                        uint64_t traced)
+static void on_progress(void *user, uint32_t done, uint32_t total, uint64_t traced)
 {
     progress *p = user;
     if (!p->enabled)
@@ -535,8 +538,8 @@ static int write_report(const char *path, const options *o, const vb_job *job,
     vt_json_f64(&j, root, "mrays_per_second_trace",
                 t->trace > 0 ? b->rays_traced / t->trace * 1e-6 : 0.0);
     vt_json_f64(&j, root, "mrays_per_second_total",
-                t->total + write_seconds > 0
-                    ? b->rays_traced / (t->total + write_seconds) * 1e-6 : 0.0);
+                t->total + write_seconds > 0 ? b->rays_traced / (t->total + write_seconds) * 1e-6
+                                             : 0.0);
     vt_json_u64(&j, root, "coefficient_bytes_per_vertex", coef_bytes);
     vt_json_i64(&j, root, "file_bytes", file_size);
     int r = vt_json_write_file(&j, path, msg, cap);
@@ -545,8 +548,8 @@ static int write_report(const char *path, const options *o, const vb_job *job,
 }
 
 /* The bare loop's record: what the benchmark compares the bake against. */
-static int write_bare_report(const char *path, const vb_bake_output *b,
-                             const vdsh_timings *t, char *msg, size_t cap)
+static int write_bare_report(const char *path, const vb_bake_output *b, const vdsh_timings *t,
+                             char *msg, size_t cap)
 {
     vt_json j = {0};
     cJSON *root = vt_json_object(&j, NULL, NULL);
@@ -556,8 +559,7 @@ static int write_bare_report(const char *path, const vb_bake_output *b,
     vt_json_u64(&j, root, "threads", b->threads);
     vt_json_u64(&j, root, "rays_traced", b->rays_traced);
     report_seconds(&j, root, t);
-    vt_json_f64(&j, cJSON_GetObjectItemCaseSensitive(root, "seconds"), "bare",
-                t->build + t->trace);
+    vt_json_f64(&j, cJSON_GetObjectItemCaseSensitive(root, "seconds"), "bare", t->build + t->trace);
     int r = vt_json_write_file(&j, path, msg, cap);
     vt_json_free(&j);
     return r;
@@ -584,9 +586,8 @@ static int write_plan(const vb_mesh *m, const char *path, FILE *log)
     vb_error err;
     size_t n = strlen(path);
     pthread_mutex_lock(&output_lock);
-    vb_result r = n > 4 && strcasecmp(path + n - 4, ".ply") == 0
-                      ? vb_mesh_write_ply(m, path, &err)
-                      : vb_mesh_write_obj(m, path, &err);
+    vb_result r = n > 4 && strcasecmp(path + n - 4, ".ply") == 0 ? vb_mesh_write_ply(m, path, &err)
+                                                                 : vb_mesh_write_obj(m, path, &err);
     pthread_mutex_unlock(&output_lock);
     if (r != VB_OK) {
         fprintf(stderr, "vdsh-bake: %s\n", err.msg);
@@ -604,14 +605,13 @@ static int check_outputs(const options *o, const vb_job_desc *jd, const char *co
                          int nmesh)
 {
     char cube[VB_CUBEMAP_BASIS_FILES][PATH_MAX];
-    const char *outs[4 + VB_CUBEMAP_BASIS_FILES] = {jd->output, o->report, o->plan,
-                                                    o->export_obj};
+    const char *outs[4 + VB_CUBEMAP_BASIS_FILES] = {jd->output, o->report, o->plan, o->export_obj};
     int n = 4;
     vb_error err;
     if (jd->output && !jd->shard_count && vb_job_cube_size(jd) > 0)
         for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++) {
-            if (vb_output_cubemap_path(jd->output, jd->cubemap_dir, k, cube[k],
-                                       sizeof cube[k], &err) != VB_OK) {
+            if (vb_output_cubemap_path(jd->output, jd->cubemap_dir, k, cube[k], sizeof cube[k],
+                                       &err) != VB_OK) {
                 fprintf(stderr, "vdsh-bake: %s\n", err.msg);
                 return 1;
             }
@@ -634,13 +634,47 @@ static int check_outputs(const options *o, const vb_job_desc *jd, const char *co
 
 /* The long options' codes (getopt_long), and what reading one answers:
  * taken, not this reader's, or the usage status (said). */
-enum { O_RAYS = 256, O_ORDERS, O_METHOD, O_ENCODING, O_MAXDIST, O_MAXEDGE,
-       O_WELD, O_SEED, O_THREADS, O_CUBESIZE, O_CUBEDIR, O_ROBUST, O_NO_ROBUST,
-       O_REPORT, O_TIMINGS, O_EXPORT, O_TRACE_ONLY, O_LOG, O_LAMBDA, O_LOG_OFFSET,
-       O_LOG_FLOOR, O_KEEP_NORMALS, O_WINDOW, O_QUANTITY, O_RAY_TOL, O_SHARD,
-       O_ADAPTIVE, O_MIN_EDGE, O_MAX_RECEIVERS, O_MAX_ROUNDS, O_PLAN, O_RECEIVERS,
-       O_ADAPTIVE_ORDER, O_MAX_ORDER, O_DEC_LIGHTS, O_FALSE_RATE, O_DEC_PARAMS, O_SDF,
-       O_CPCA };
+enum {
+    O_RAYS = 256,
+    O_ORDERS,
+    O_METHOD,
+    O_ENCODING,
+    O_MAXDIST,
+    O_MAXEDGE,
+    O_WELD,
+    O_SEED,
+    O_THREADS,
+    O_CUBESIZE,
+    O_CUBEDIR,
+    O_ROBUST,
+    O_NO_ROBUST,
+    O_REPORT,
+    O_TIMINGS,
+    O_EXPORT,
+    O_TRACE_ONLY,
+    O_LOG,
+    O_LAMBDA,
+    O_LOG_OFFSET,
+    O_LOG_FLOOR,
+    O_KEEP_NORMALS,
+    O_WINDOW,
+    O_QUANTITY,
+    O_RAY_TOL,
+    O_SHARD,
+    O_ADAPTIVE,
+    O_MIN_EDGE,
+    O_MAX_RECEIVERS,
+    O_MAX_ROUNDS,
+    O_PLAN,
+    O_RECEIVERS,
+    O_ADAPTIVE_ORDER,
+    O_MAX_ORDER,
+    O_DEC_LIGHTS,
+    O_FALSE_RATE,
+    O_DEC_PARAMS,
+    O_SDF,
+    O_CPCA
+};
 enum { OPT_NOT_MINE = -1, OPT_TAKEN = 1 };
 
 /* The names --encoding takes: formats' encoding table (vdsh_encodings), in
@@ -656,12 +690,14 @@ static const vt_choice *encodings(void)
 }
 
 /* The names --quantity and --window take. */
-static const vt_choice quantities[] = {
-    {"auto", VB_QUANTITY_AUTO}, {"distance", VB_QUANTITY_DISTANCE}, {"log", VB_QUANTITY_LOG},
-    {NULL, 0}};
-static const vt_choice windows[] = {
-    {"none", VDSH_WINDOW_NONE}, {"hann", VDSH_WINDOW_HANN}, {"lanczos", VDSH_WINDOW_LANCZOS},
-    {NULL, 0}};
+static const vt_choice quantities[] = {{"auto", VB_QUANTITY_AUTO},
+                                       {"distance", VB_QUANTITY_DISTANCE},
+                                       {"log", VB_QUANTITY_LOG},
+                                       {NULL, 0}};
+static const vt_choice windows[] = {{"none", VDSH_WINDOW_NONE},
+                                    {"hann", VDSH_WINDOW_HANN},
+                                    {"lanczos", VDSH_WINDOW_LANCZOS},
+                                    {NULL, 0}};
 
 /* Options that take a number or a name, each checked on its own. */
 static int read_value(int c, const char *arg, options *o)
@@ -719,8 +755,8 @@ static int read_value(int c, const char *arg, options *o)
     case O_LAMBDA: ok = vt_opt_positive("--lambda", arg, &o->lambda); break;
     case O_LOG_FLOOR: ok = vt_opt_positive("--log-floor", arg, &o->log_floor); break;
     case O_DEC_LIGHTS:
-        ok = vt_opt_u32("--decision-lights", "", arg, 1, VB_DECISION_MAX_PAIRS,
-                        &o->decision_lights);
+        ok =
+            vt_opt_u32("--decision-lights", "", arg, 1, VB_DECISION_MAX_PAIRS, &o->decision_lights);
         break;
     case O_ENCODING:
         ok = vt_opt_choice("--encoding", arg, encodings(), &v);
@@ -756,7 +792,8 @@ static int read_choice(int c, const char *arg, options *o)
     case O_CPCA:
         if (vdsh_cpca_parse(arg, &o->cpca, NULL) != VDSH_OK)
             return bad_usage("--cpca takes K,B,BITS: clusters 1..256, basis vectors "
-                             "1..256, bits 2..8 (default 8,54,4), not '%s'", arg);
+                             "1..256, bits 2..8 (default 8,54,4), not '%s'",
+                             arg);
         o->have_cpca = 1;
         break;
     case O_LOG_OFFSET:
@@ -772,22 +809,24 @@ static int read_choice(int c, const char *arg, options *o)
     case O_DEC_PARAMS: {
         vb_decision_params *p = &o->decision;
         vb_decision_defaults(p);
-        if (sscanf(arg, "%f,%f,%f,%f,%d", &p->tau, &p->lit_weight, &p->ridge,
-                   &p->ridge0, &p->steps) != 5 || !(p->tau > 0.0f) ||
-            !(p->lit_weight > 0.0f) || !(p->ridge >= 0.0f) || !(p->ridge0 > 0.0f) ||
-            p->steps < 0 || p->steps > 64)
+        if (sscanf(arg, "%f,%f,%f,%f,%d", &p->tau, &p->lit_weight, &p->ridge, &p->ridge0,
+                   &p->steps) != 5 ||
+            !(p->tau > 0.0f) || !(p->lit_weight > 0.0f) || !(p->ridge >= 0.0f) ||
+            !(p->ridge0 > 0.0f) || p->steps < 0 || p->steps > 64)
             return bad_usage("--decision-params takes TAU,LIT_WEIGHT,RIDGE,RIDGE0,STEPS "
-                             "(positive; ridge >= 0; steps 0..64), not '%s'", arg);
+                             "(positive; ridge >= 0; steps 0..64), not '%s'",
+                             arg);
         o->have_decision = 1;
         break;
     }
     case O_SHARD: {
         unsigned si, sn;
         int used = 0;
-        if (sscanf(arg, "%u/%u%n", &si, &sn, &used) != 2 || arg[used] || sn < 1 ||
-            sn > 1u << 20 || si >= sn || !isdigit((unsigned char)arg[0]))
+        if (sscanf(arg, "%u/%u%n", &si, &sn, &used) != 2 || arg[used] || sn < 1 || sn > 1u << 20 ||
+            si >= sn || !isdigit((unsigned char)arg[0]))
             return bad_usage("--shard takes I/N with 0 <= I < N <= 1048576, such as 3/8, "
-                             "not '%s'", arg);
+                             "not '%s'",
+                             arg);
         o->shard_index = si, o->shard_count = sn;
         break;
     }
@@ -812,7 +851,8 @@ static int check_options(options *o)
                 snprintf(n, sizeof n, "%d", cap);
                 return bad_usage("--encoding cpca writes --adaptive-order's stream as a "
                                  "fixed stream of its --max-order, %s: --orders cannot "
-                                 "hold that order too", n);
+                                 "hold that order too",
+                                 n);
             }
     }
     if (o->have_ray_tolerance && !o->adaptive_rays)
@@ -852,7 +892,8 @@ static int check_options(options *o)
                                "method decision's");
     if (o->lambda != 0.0f && mi->lambda_fixed)
         return bad_usage("--lambda is lsq's: method %s uses lsq's default (its method "
-                         "parameter is the log offset)", vb_method_name(o->method));
+                         "parameter is the log offset)",
+                         vb_method_name(o->method));
     if (!o->output && !o->export_obj && !o->trace_only && !o->plan)
         return bad_usage("%s", "no output: give -o OUT.vdsh (or --export-obj FILE)");
     if (o->max_order && !(o->order_tolerance > 0.0f))
@@ -860,7 +901,8 @@ static int check_options(options *o)
     if (o->order_tolerance > 0.0f &&
         !(mi->quantities & VB_QUANTITY_BIT(VDSH_QUANTITY_LOG_DISTANCE)))
         return bad_usage("--adaptive-order fits the log distance: method %s does not (use "
-                         "decision, the default, or shadow)", vb_method_name(o->method));
+                         "decision, the default, or shadow)",
+                         vb_method_name(o->method));
     if (o->order_tolerance > 0.0f && !o->orders_given)
         o->order_count = 0; /* the variable-order stream alone */
 
@@ -982,8 +1024,9 @@ static void say_written(FILE *log, const options *o, const vb_job *job, const vb
 {
     const vb_bake_output *bo = &job->bake;
     int cube_size = o->shard_count ? 0 : vb_job_cube_size(jd); /* a part has none */
-    fprintf(log, "vdsh-bake: wrote %s (%.2f MB, %.1f bytes of coefficients per "
-                 "vertex for orders",
+    fprintf(log,
+            "vdsh-bake: wrote %s (%.2f MB, %.1f bytes of coefficients per "
+            "vertex for orders",
             o->output, job->file_bytes / 1e6, job->coefficient_bytes + job->variable_bytes);
     for (int s = 0; s < o->order_count; s++)
         fprintf(log, "%s%d", s ? "," : " ", o->orders[s]);
@@ -1009,36 +1052,53 @@ static vb_job_desc job_desc(const options *o, FILE *log, progress *pr, float *of
         order_mask |= 1u << o->orders[s];
     for (int k = 0; k <= VDSH_MAX_ORDER; k++)
         offsets[k] = o->log_offset;
-    return (vb_job_desc){
-        .paths = o->meshes, .path_count = (uint32_t)o->mesh_count,
-        .output = o->trace_only ? NULL : o->output, .cubemap_dir = o->cubemap_dir,
-        .weld = o->weld, .max_edge = o->max_edge, .fast_traversal = !o->robust,
-        .adaptive = o->adaptive, .receivers_path = o->receivers,
-        .adapt = {.tolerance = o->adaptive_tol, .min_edge = o->min_edge,
-                  .max_receivers = o->max_receivers,
-                  .max_rounds = o->max_rounds ? o->max_rounds : VB_ADAPTIVE_ROUNDS,
-                  .on_round = log ? on_round : NULL,
-                  .user = log},
-        .bake = {.rays = o->rays, .adaptive_rays = o->adaptive_rays,
-                 .ray_tolerance = o->ray_tolerance, .seed = o->seed,
-                 .max_distance = o->max_distance,
-                 .method = o->method, .quantity = o->quantity, .lambda = o->lambda,
-                 .log_floor = o->log_floor, .log_offsets = o->have_log_offset ? offsets : NULL,
-                 .decision = o->have_decision ? &o->decision : NULL,
-                 .decision_lights = o->decision_lights, .false_rate = o->false_rate,
-                 .window = o->window, .order_mask = order_mask, .threads = o->threads,
-                 .order_tolerance = o->order_tolerance, .variable_cap = o->max_order,
-                 .keep_normals = o->keep_normals, .trace_only = o->trace_only,
-                 .progress = on_progress, .progress_user = pr},
-        .encoding_given = 1,
-        .encoding = o->encoding,
-        .cpca = o->cpca,
-        .cube_size = o->cube_size > 0 ? o->cube_size : -1,
-        .record_timings = o->record_timings,
-        .shard_index = o->shard_index, .shard_count = o->shard_count,
-        .on_mesh = log ? on_mesh : NULL, .user = log};
+    return (vb_job_desc){.paths = o->meshes,
+                         .path_count = (uint32_t)o->mesh_count,
+                         .output = o->trace_only ? NULL : o->output,
+                         .cubemap_dir = o->cubemap_dir,
+                         .weld = o->weld,
+                         .max_edge = o->max_edge,
+                         .fast_traversal = !o->robust,
+                         .adaptive = o->adaptive,
+                         .receivers_path = o->receivers,
+                         .adapt = {.tolerance = o->adaptive_tol,
+                                   .min_edge = o->min_edge,
+                                   .max_receivers = o->max_receivers,
+                                   .max_rounds = o->max_rounds ? o->max_rounds : VB_ADAPTIVE_ROUNDS,
+                                   .on_round = log ? on_round : NULL,
+                                   .user = log},
+                         .bake = {.rays = o->rays,
+                                  .adaptive_rays = o->adaptive_rays,
+                                  .ray_tolerance = o->ray_tolerance,
+                                  .seed = o->seed,
+                                  .max_distance = o->max_distance,
+                                  .method = o->method,
+                                  .quantity = o->quantity,
+                                  .lambda = o->lambda,
+                                  .log_floor = o->log_floor,
+                                  .log_offsets = o->have_log_offset ? offsets : NULL,
+                                  .decision = o->have_decision ? &o->decision : NULL,
+                                  .decision_lights = o->decision_lights,
+                                  .false_rate = o->false_rate,
+                                  .window = o->window,
+                                  .order_mask = order_mask,
+                                  .threads = o->threads,
+                                  .order_tolerance = o->order_tolerance,
+                                  .variable_cap = o->max_order,
+                                  .keep_normals = o->keep_normals,
+                                  .trace_only = o->trace_only,
+                                  .progress = on_progress,
+                                  .progress_user = pr},
+                         .encoding_given = 1,
+                         .encoding = o->encoding,
+                         .cpca = o->cpca,
+                         .cube_size = o->cube_size > 0 ? o->cube_size : -1,
+                         .record_timings = o->record_timings,
+                         .shard_index = o->shard_index,
+                         .shard_count = o->shard_count,
+                         .on_mesh = log ? on_mesh : NULL,
+                         .user = log};
 }
-
 
 /* What the receivers are, and a warning when they are far apart against
  * the scene; *spacing gets their spacing when a message or the report
@@ -1047,8 +1107,9 @@ static void say_receivers(FILE *log, const options *o, const vb_job *job, vb_mes
 {
     const vb_mesh *rec = &job->receivers;
     if (log && o->max_edge > 0.0f)
-        fprintf(log, "vdsh-bake: receivers refined to max edge %g: %u vertices, "
-                     "%u triangles, worst aspect ratio %.1f (%.2f s)\n",
+        fprintf(log,
+                "vdsh-bake: receivers refined to max edge %g: %u vertices, "
+                "%u triangles, worst aspect ratio %.1f (%.2f s)\n",
                 (double)o->max_edge, rec->vertex_count, rec->triangle_count,
                 vb_mesh_worst_aspect(rec, NULL), job->timings.refine);
     /* Receivers far apart against the scene draw false shadows inside their
@@ -1058,17 +1119,20 @@ static void say_receivers(FILE *log, const options *o, const vb_job *job, vb_mes
     if ((log && !chosen && (o->output || o->plan)) || o->report) {
         float lo[3], hi[3];
         vb_mesh_bounds(&job->occluders, lo, hi);
-        vb_mesh_spacing_of(rec, sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) +
-                                      (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                      (hi[2] - lo[2]) * (hi[2] - lo[2])),  spacing);
+        vb_mesh_spacing_of(rec,
+                           sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) +
+                                 (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                 (hi[2] - lo[2]) * (hi[2] - lo[2])),
+                           spacing);
     }
     if (log && !chosen && (o->output || o->plan) && spacing->far_apart)
-        fprintf(log, "vdsh-bake: warning: receivers far apart: %.0f%% of the surface is in "
-                     "triangles whose longest edge exceeds %.0f%% of the scene's diagonal (%.4g; "
-                     "longest edges: median %.3g, 90th percentile %.3g, area-weighted). The "
-                     "shadows are interpolated between receivers, so these triangles draw false "
-                     "shadows inside them: refine, e.g. --max-edge %g (1%% of the diagonal), "
-                     "or --adaptive from a coarser --max-edge\n",
+        fprintf(log,
+                "vdsh-bake: warning: receivers far apart: %.0f%% of the surface is in "
+                "triangles whose longest edge exceeds %.0f%% of the scene's diagonal (%.4g; "
+                "longest edges: median %.3g, 90th percentile %.3g, area-weighted). The "
+                "shadows are interpolated between receivers, so these triangles draw false "
+                "shadows inside them: refine, e.g. --max-edge %g (1%% of the diagonal), "
+                "or --adaptive from a coarser --max-edge\n",
                 100.0 * spacing->long_area, 100.0 * VB_SPACING_WARN_EDGE, (double)spacing->diagonal,
                 (double)spacing->median_edge, (double)spacing->p90_edge,
                 (double)spacing->suggest_edge);
@@ -1082,31 +1146,36 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
     if (!log)
         return;
     if (o->adaptive)
-        fprintf(log, "vdsh-bake: adaptive receivers: %u from %u in %u rounds (%u midpoints "
-                     "baked, tolerance %g + noise floor %.3g from %u receivers baked twice, min "
+        fprintf(log,
+                "vdsh-bake: adaptive receivers: %u from %u in %u rounds (%u midpoints "
+                "baked, tolerance %g + noise floor %.3g from %u receivers baked twice, min "
                 "edge %g%s)\n",
                 job->receivers.vertex_count, job->adaptive.start_receivers, job->adaptive.rounds,
                 job->adaptive.candidates, (double)o->adaptive_tol, job->adaptive.noise_floor,
                 job->adaptive.noise_sample, (double)o->min_edge,
-                job->adaptive.budget_reached   ? ", the budget stopped it"
+                job->adaptive.budget_reached    ? ", the budget stopped it"
                 : job->adaptive.uniform_reached ? ", stopped at the uniform bake's count at 2 x "
-                                                 "the min edge"
-                                               : "");
+                                                  "the min edge"
+                                                : "");
     if (o->adaptive && job->adaptive.rounds_reached)
-        fprintf(log, "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
-                     "while still splitting (%u edges split in the last round, %u edges not "
-                     "yet judged): raise --max-rounds\n",
+        fprintf(log,
+                "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
+                "while still splitting (%u edges split in the last round, %u edges not "
+                "yet judged): raise --max-rounds\n",
                 job->adaptive.max_rounds, job->adaptive.last_split, job->adaptive.pending);
     if (bo->flipped_normals)
-        fprintf(log, "vdsh-bake: %u receiver normals pointed into geometry and were "
-                     "flipped (--keep-normals keeps them)\n", bo->flipped_normals);
-    fprintf(log, "vdsh-bake: traced %.1f M rays in %.2f s (%.1f Mrays/s on %u "
-                 "threads), %.2f%% missed, %u ray origins moved off other geometry, "
-                 "%u degenerate receivers (max distance %g)\n",
+        fprintf(log,
+                "vdsh-bake: %u receiver normals pointed into geometry and were "
+                "flipped (--keep-normals keeps them)\n",
+                bo->flipped_normals);
+    fprintf(log,
+            "vdsh-bake: traced %.1f M rays in %.2f s (%.1f Mrays/s on %u "
+            "threads), %.2f%% missed, %u ray origins moved off other geometry, "
+            "%u degenerate receivers (max distance %g)\n",
             bo->rays_traced * 1e-6, bo->seconds,
             bo->seconds > 0 ? bo->rays_traced / bo->seconds * 1e-6 : 0.0, bo->threads,
-            bo->rays_traced ? 100.0 * bo->rays_missed / bo->rays_traced : 0.0,
-            bo->moved_origins, bo->degenerate_receivers, (double)bo->max_distance);
+            bo->rays_traced ? 100.0 * bo->rays_missed / bo->rays_traced : 0.0, bo->moved_origins,
+            bo->degenerate_receivers, (double)bo->max_distance);
     if (bo->variable_orders) {
         uint32_t hist[VDSH_ORDER_SLOTS] = {0};
         uint32_t rows = bo->range_end - bo->range_begin;
@@ -1115,8 +1184,9 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
             hist[bo->variable_orders[v]]++;
             coeffs += (double)bo->variable_orders[v] * bo->variable_orders[v];
         }
-        fprintf(log, "vdsh-bake: adaptive order (tolerance %g, cap %d): %.1f coefficients per "
-                     "receiver on average; receivers per order:",
+        fprintf(log,
+                "vdsh-bake: adaptive order (tolerance %g, cap %d): %.1f coefficients per "
+                "receiver on average; receivers per order:",
                 (double)bo->order_tolerance, bo->variable_cap, rows ? coeffs / rows : 0.0);
         for (int k = 1; k <= bo->variable_cap; k++)
             if (hist[k])
@@ -1124,18 +1194,21 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
         fputc('\n', log);
     }
     if (o->adaptive_rays)
-        fprintf(log, "vdsh-bake: adaptive rays: %.1f traced per receiver on average "
-                     "(cap %u, tolerance %g)\n",
+        fprintf(log,
+                "vdsh-bake: adaptive rays: %.1f traced per receiver on average "
+                "(cap %u, tolerance %g)\n",
                 bo->vertex_count ? (double)bo->rays_traced / bo->vertex_count : 0.0, bo->rays,
                 (double)bo->ray_tolerance);
-    fprintf(log, "vdsh-bake: ray origins checked in %.2f s: %llu probe rays (%.1f%% of the "
-                 "traced rays), %u receivers repaired, %u moved\n",
+    fprintf(log,
+            "vdsh-bake: ray origins checked in %.2f s: %llu probe rays (%.1f%% of the "
+            "traced rays), %u receivers repaired, %u moved\n",
             bo->origins.seconds, (unsigned long long)bo->origins.probe_rays,
             bo->rays_traced ? 100.0 * bo->origins.probe_rays / bo->rays_traced : 0.0,
             bo->origins.flagged, bo->origins.moved);
     if (bo->origins.skipped_zero_area)
-        fprintf(log, "vdsh-bake: %u receiver%s on zero-area triangles only (drawn nowhere): "
-                     "origin%s not probed\n",
+        fprintf(log,
+                "vdsh-bake: %u receiver%s on zero-area triangles only (drawn nowhere): "
+                "origin%s not probed\n",
                 bo->origins.skipped_zero_area, bo->origins.skipped_zero_area == 1 ? "" : "s",
                 bo->origins.skipped_zero_area == 1 ? "" : "s");
     if (bo->method == VDSH_METHOD_DECISION) {
@@ -1143,14 +1216,16 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
             fprintf(log, "vdsh-bake: warning: no free space for lights in this scene: every "
                          "receiver keeps its least-squares fit\n");
         else
-            fprintf(log, "vdsh-bake: decision fit: %u receivers fitted on %.0f traced lights "
-                         "each on average, %u with fewer than 16 lights above their horizon "
-                         "kept the least-squares fit\n",
+            fprintf(log,
+                    "vdsh-bake: decision fit: %u receivers fitted on %.0f traced lights "
+                    "each on average, %u with fewer than 16 lights above their horizon "
+                    "kept the least-squares fit\n",
                     bo->decision_fitted, bo->decision_pairs, bo->decision_fallbacks);
         if (bo->calibration_receivers) {
-            fprintf(log, "vdsh-bake: log offsets calibrated on %u receivers for %.1f%% false "
-                         "shadow on held-out lights:", bo->calibration_receivers,
-                    100.0 * bo->false_rate);
+            fprintf(log,
+                    "vdsh-bake: log offsets calibrated on %u receivers for %.1f%% false "
+                    "shadow on held-out lights:",
+                    bo->calibration_receivers, 100.0 * bo->false_rate);
             for (int s = 0; s < o->order_count; s++)
                 fprintf(log, "%s order %d %+.3f", s ? "," : "", o->orders[s],
                         (double)bo->log_offset[o->orders[s]]);
@@ -1158,8 +1233,10 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
         }
     }
     if (bo->auto_receivers > 0) {
-        fprintf(log, "vdsh-bake: quantity chosen on %u sampled receivers (expected shadow "
-                     "error, distance / log):", bo->auto_receivers);
+        fprintf(log,
+                "vdsh-bake: quantity chosen on %u sampled receivers (expected shadow "
+                "error, distance / log):",
+                bo->auto_receivers);
         for (int s = 0; s < o->order_count; s++) {
             int k = o->orders[s];
             fprintf(log, "%s order %d %s (%.4f / %.4f)", s ? "," : "", k,
@@ -1169,9 +1246,10 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
         fputc('\n', log);
     }
     if (bo->degenerate_receivers > 0)
-        fprintf(log, "vdsh-bake: warning: %u receivers (%.2f%%) see distance ~0 in almost "
-                     "every direction above their horizon: receivers inside or flush "
-                     "against other geometry, or inverted normals\n",
+        fprintf(log,
+                "vdsh-bake: warning: %u receivers (%.2f%%) see distance ~0 in almost "
+                "every direction above their horizon: receivers inside or flush "
+                "against other geometry, or inverted normals\n",
                 bo->degenerate_receivers, 100.0 * bo->degenerate_receivers / rec->vertex_count);
 }
 
@@ -1230,8 +1308,9 @@ static int run(const options *o)
 
     /* 3. The occluders' BVH, then orient, trace and project. */
     if (log)
-        fprintf(log, "vdsh-bake: tracing %u rays x %u receivers against %u triangles "
-                     "(method %s)\n",
+        fprintf(log,
+                "vdsh-bake: tracing %u rays x %u receivers against %u triangles "
+                "(method %s)\n",
                 o->rays, rec->vertex_count, job.occluders.triangle_count,
                 vb_method_name(o->method));
     pr.t0 = vb_now();
@@ -1292,9 +1371,11 @@ static int run(const options *o)
             goto out;
         }
         if (log)
-            fprintf(log, "vdsh-bake: distance volume %u x %u x %u (spacing %g) baked in %.2f s, "
-                         "wrote %s (%.2f MB)\n", vol.dim[0], vol.dim[1], vol.dim[2],
-                    (double)vol.cell, sdf_seconds, sdf_path, vdsh_sdf_file_size(&vol) / 1e6);
+            fprintf(log,
+                    "vdsh-bake: distance volume %u x %u x %u (spacing %g) baked in %.2f s, "
+                    "wrote %s (%.2f MB)\n",
+                    vol.dim[0], vol.dim[1], vol.dim[2], (double)vol.cell, sdf_seconds, sdf_path,
+                    vdsh_sdf_file_size(&vol) / 1e6);
     }
     if (vb_job_write(&job, &jd, &err) != VB_OK) {
         fprintf(stderr, "vdsh-bake: %s\n", err.msg);
@@ -1303,7 +1384,8 @@ static int run(const options *o)
     double write_seconds = vb_now() - t;
     if (log)
         say_written(log, o, &job, &jd, write_seconds);
-    if (o->report && write_report(o->report, o, &job, &spacing, write_seconds, msg, sizeof msg) != 0) {
+    if (o->report &&
+        write_report(o->report, o, &job, &spacing, write_seconds, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-bake: %s (the report)\n", msg);
         goto out;
     }

@@ -60,86 +60,86 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-"usage: vdsh-eval [options] FILE.vdsh [MESH...]\n"
-"Measure a bake's error against an independent Embree ray cast.\n"
-"\n"
-"The occluder scene is rebuilt from the sources recorded in FILE (looked\n"
-"up as recorded, then beside FILE), or from the MESHes given, one per\n"
-"recorded source and in the same order; each must have the SHA-256 the\n"
-"bake recorded. Receivers are vertices and random points inside triangles\n"
-"(coefficients interpolated as the GPU does). The primary shadow metric:\n"
-"point lights placed uniformly in the scene's free space (formats/\n"
-"vdsh_light.h), each scored at every receiver it lights, as a viewer sees\n"
-"them. Secondary (earlier figures): each receiver's own held-out upper-\n"
-"hemisphere directions (never the bake's), one light per direction at\n"
-"d_L = u * 2 * d_T, u uniform in (0.05, 1]; also the distance error.\n"
-"\n"
-"Sampling:\n"
-"      --points N          vertices evaluated: a deterministic sample of N\n"
-"                          (default: all)\n"
-"      --interior N        random points inside triangles (default 65536;\n"
-"                          0: none)\n"
-"      --directions N      held-out directions (and lights) per receiver\n"
-"                          (default 64 = 8 x 8 grid over the hemisphere)\n"
-"      --seed N            the evaluator's seed (default %u; 0 is the\n"
-"                          default); any seed, even the bake's, gives other\n"
-"                          directions than the bake's\n"
-"      --lights N          scene lights (default 32)\n"
-"      --light-rule R      where they go, all in free space: uniform (default),\n"
-"                          ceiling (the top fifth of the height, +y up), near\n"
-"                          (a surface within 5%% of the diagonal) or path (a\n"
-"                          walk along x at 2/3 of the height, swinging in z)\n"
-"      --orders LIST       only these orders, e.g. 3,5 (default: every stream)\n"
-"      --offsets LIST      the trade between recall and false shadows as a\n"
-"                          curve: each stream is also scored with each\n"
-"                          offset added to its ln D (distance streams: D\n"
-"                          times e^offset), e.g. -0.2,0.2,0.4 (at most %d\n"
-"                          streams in all: pick orders with --orders)\n"
-"      --oracle            score the ray-cast truth instead of the streams:\n"
-"                          every error must come out exactly 0\n"
-"      --interp M          how interior points get a stream's value from the\n"
-"                          triangle's vertices: runtime (default: the path\n"
-"                          vdsh-view draws the stream with), coefficients,\n"
-"                          distance, visibility or split (vdsh_shadow.h)\n"
-"      --fast-truth        Embree's default traversal for the truth (default:\n"
-"                          robust, so truth rays do not leak through edges)\n"
-"      --allow-mismatch    use sources whose SHA-256 differs (with a warning)\n"
-"\n"
-"Output:\n"
-"      --json FILE         everything as JSON (bake parameters and timings too;\n"
-"                          -: on stdout, instead of the table)\n"
-"      --per-vertex FILE   per-vertex errors for a heat map (layout below)\n"
-"      --bake-report FILE  take the bake time from vdsh-bake --report JSON\n"
-"                          (default: the file's time chunk, if recorded)\n"
-"      --worst N           worst receivers listed (default 10, at most 64)\n"
-"      --threads N         worker threads (default: all cores)\n"
-"  -q, --quiet             no progress on stderr\n"
-"  -h, --help              this text\n"
-"  -V, --version           version\n"
-"\n"
-"Errors (per stream, for vertices and interior points separately):\n"
-"  scene     smooth shadow MAE, false-shadow rate P(s_hat < .5 | d_T >= d_L),\n"
-"            recall P(s_hat < .5 | s_ideal < .5) (the shadows a viewer sees\n"
-"            drawn); binary: P(D < d_L | d_T >= d_L), P(D < d_L | d_T < d_L)\n"
-"  distance  |D - d_T| / max(d_T, 0.01 diag): RMS, p50, p90, p99\n"
-"  shadow    smooth ramp(d / d_L): MAE |s_hat - s_ideal|, false-shadow rate\n"
-"            P(s_hat < .5 | d_T >= d_L), light-leak rate P(s_hat > .5 |\n"
-"            s_ideal < .5); and the same with the binary comparison\n"
-"  +- is a 95%% interval (1.96 standard errors, receivers as clusters).\n"
-"\n"
-"--per-vertex layout (little-endian): a 64-byte header: magic \"%s\",\n"
-"u32 version (1), u32 vertex_count V, u32 stream_count K, u32 fields F\n"
-"(= 2 + 5K), u32 data_offset (= 64 + 16K), zero to 64; then K stream\n"
-"descriptors of 4 u32: order, quantity, method, encoding; then V records\n"
-"of F f32 at data_offset, vertex-major: [0] fraction of the truth at ~0\n"
-"distance, [1] fraction of truth rays that escaped, then per stream k at\n"
-"2 + 5k: distance RMS, smooth shadow MAE, false-shadow rate, light-leak\n"
-"rate, binary shadow MAE. NaN: vertex not evaluated (or, for the two\n"
-"rates, no light of that kind).\n"
-"\n"
-"Exit status: 0 success, 1 error, 2 usage error.\n"
-"Example: vdsh-bake builtin:room --max-edge 0.5 -o room.vdsh --record-timings\n"
-"         vdsh-eval room.vdsh --json room.eval.json\n",
+            "usage: vdsh-eval [options] FILE.vdsh [MESH...]\n"
+            "Measure a bake's error against an independent Embree ray cast.\n"
+            "\n"
+            "The occluder scene is rebuilt from the sources recorded in FILE (looked\n"
+            "up as recorded, then beside FILE), or from the MESHes given, one per\n"
+            "recorded source and in the same order; each must have the SHA-256 the\n"
+            "bake recorded. Receivers are vertices and random points inside triangles\n"
+            "(coefficients interpolated as the GPU does). The primary shadow metric:\n"
+            "point lights placed uniformly in the scene's free space (formats/\n"
+            "vdsh_light.h), each scored at every receiver it lights, as a viewer sees\n"
+            "them. Secondary (earlier figures): each receiver's own held-out upper-\n"
+            "hemisphere directions (never the bake's), one light per direction at\n"
+            "d_L = u * 2 * d_T, u uniform in (0.05, 1]; also the distance error.\n"
+            "\n"
+            "Sampling:\n"
+            "      --points N          vertices evaluated: a deterministic sample of N\n"
+            "                          (default: all)\n"
+            "      --interior N        random points inside triangles (default 65536;\n"
+            "                          0: none)\n"
+            "      --directions N      held-out directions (and lights) per receiver\n"
+            "                          (default 64 = 8 x 8 grid over the hemisphere)\n"
+            "      --seed N            the evaluator's seed (default %u; 0 is the\n"
+            "                          default); any seed, even the bake's, gives other\n"
+            "                          directions than the bake's\n"
+            "      --lights N          scene lights (default 32)\n"
+            "      --light-rule R      where they go, all in free space: uniform (default),\n"
+            "                          ceiling (the top fifth of the height, +y up), near\n"
+            "                          (a surface within 5%% of the diagonal) or path (a\n"
+            "                          walk along x at 2/3 of the height, swinging in z)\n"
+            "      --orders LIST       only these orders, e.g. 3,5 (default: every stream)\n"
+            "      --offsets LIST      the trade between recall and false shadows as a\n"
+            "                          curve: each stream is also scored with each\n"
+            "                          offset added to its ln D (distance streams: D\n"
+            "                          times e^offset), e.g. -0.2,0.2,0.4 (at most %d\n"
+            "                          streams in all: pick orders with --orders)\n"
+            "      --oracle            score the ray-cast truth instead of the streams:\n"
+            "                          every error must come out exactly 0\n"
+            "      --interp M          how interior points get a stream's value from the\n"
+            "                          triangle's vertices: runtime (default: the path\n"
+            "                          vdsh-view draws the stream with), coefficients,\n"
+            "                          distance, visibility or split (vdsh_shadow.h)\n"
+            "      --fast-truth        Embree's default traversal for the truth (default:\n"
+            "                          robust, so truth rays do not leak through edges)\n"
+            "      --allow-mismatch    use sources whose SHA-256 differs (with a warning)\n"
+            "\n"
+            "Output:\n"
+            "      --json FILE         everything as JSON (bake parameters and timings too;\n"
+            "                          -: on stdout, instead of the table)\n"
+            "      --per-vertex FILE   per-vertex errors for a heat map (layout below)\n"
+            "      --bake-report FILE  take the bake time from vdsh-bake --report JSON\n"
+            "                          (default: the file's time chunk, if recorded)\n"
+            "      --worst N           worst receivers listed (default 10, at most 64)\n"
+            "      --threads N         worker threads (default: all cores)\n"
+            "  -q, --quiet             no progress on stderr\n"
+            "  -h, --help              this text\n"
+            "  -V, --version           version\n"
+            "\n"
+            "Errors (per stream, for vertices and interior points separately):\n"
+            "  scene     smooth shadow MAE, false-shadow rate P(s_hat < .5 | d_T >= d_L),\n"
+            "            recall P(s_hat < .5 | s_ideal < .5) (the shadows a viewer sees\n"
+            "            drawn); binary: P(D < d_L | d_T >= d_L), P(D < d_L | d_T < d_L)\n"
+            "  distance  |D - d_T| / max(d_T, 0.01 diag): RMS, p50, p90, p99\n"
+            "  shadow    smooth ramp(d / d_L): MAE |s_hat - s_ideal|, false-shadow rate\n"
+            "            P(s_hat < .5 | d_T >= d_L), light-leak rate P(s_hat > .5 |\n"
+            "            s_ideal < .5); and the same with the binary comparison\n"
+            "  +- is a 95%% interval (1.96 standard errors, receivers as clusters).\n"
+            "\n"
+            "--per-vertex layout (little-endian): a 64-byte header: magic \"%s\",\n"
+            "u32 version (1), u32 vertex_count V, u32 stream_count K, u32 fields F\n"
+            "(= 2 + 5K), u32 data_offset (= 64 + 16K), zero to 64; then K stream\n"
+            "descriptors of 4 u32: order, quantity, method, encoding; then V records\n"
+            "of F f32 at data_offset, vertex-major: [0] fraction of the truth at ~0\n"
+            "distance, [1] fraction of truth rays that escaped, then per stream k at\n"
+            "2 + 5k: distance RMS, smooth shadow MAE, false-shadow rate, light-leak\n"
+            "rate, binary shadow MAE. NaN: vertex not evaluated (or, for the two\n"
+            "rates, no light of that kind).\n"
+            "\n"
+            "Exit status: 0 success, 1 error, 2 usage error.\n"
+            "Example: vdsh-bake builtin:room --max-edge 0.5 -o room.vdsh --record-timings\n"
+            "         vdsh-eval room.vdsh --json room.eval.json\n",
             VB_EVAL_DEFAULT_SEED, VDSH_MAX_STREAMS, PV_MAGIC);
 }
 
@@ -163,8 +163,7 @@ static void on_progress(void *user, uint32_t done, uint32_t total)
     double t = vb_now() - p->t0;
     double frac = total ? (double)done / total : 1.0;
     double eta = frac > 0.0 ? t * (1.0 - frac) / frac : 0.0;
-    fprintf(stderr, "\r  %5.1f%%  %u/%u receivers  ETA %.1f s   ", 100.0 * frac, done,
-            total, eta);
+    fprintf(stderr, "\r  %5.1f%%  %u/%u receivers  ETA %.1f s   ", 100.0 * frac, done, total, eta);
     if (done == total)
         fputs("\r                                                        \r", stderr);
     fflush(stderr);
@@ -187,7 +186,7 @@ static void on_warn(void *user, const char *msg)
 typedef struct bake_time {
     double total, trace;
     unsigned threads;
-    const char *source;    /* "time chunk", "bake report" or NULL */
+    const char *source; /* "time chunk", "bake report" or NULL */
 } bake_time;
 
 /* vdsh-bake --report: "seconds": {..., "trace": T, ..., "total": T} and
@@ -255,20 +254,28 @@ static void json_f64s(vt_json *j, cJSON *o, const named_f64 *x, size_t n)
 static void json_metrics(vt_json *j, cJSON *o, const vb_eval_metrics *m, int kind)
 {
     vt_json_u64(j, o, "samples", m->samples);
-    const named_f64 num[] = {
-        {"distance_rms", m->distance_rms}, {"distance_rms_se", m->distance_rms_se},
-        {"distance_mean", m->distance_mean}, {"distance_p50", m->distance_p50},
-        {"distance_p90", m->distance_p90}, {"distance_p99", m->distance_p99},
-        {"shadow_mae", m->shadow_mae}, {"shadow_mae_se", m->shadow_mae_se},
-        {"false_shadow", m->false_shadow}, {"false_shadow_se", m->false_shadow_se},
-        {"light_leak", m->light_leak}, {"light_leak_se", m->light_leak_se},
-        {"binary_mae", m->binary_mae}, {"binary_mae_se", m->binary_mae_se},
-        {"binary_false_shadow", m->binary_false_shadow},
-        {"binary_false_shadow_se", m->binary_false_shadow_se},
-        {"binary_light_leak", m->binary_light_leak},
-        {"binary_light_leak_se", m->binary_light_leak_se}, {"ringing", m->ringing},
-        {"receiver_mae_p50", m->receiver_mae_p50}, {"receiver_mae_p90", m->receiver_mae_p90},
-        {"receiver_mae_p99", m->receiver_mae_p99}};
+    const named_f64 num[] = {{"distance_rms", m->distance_rms},
+                             {"distance_rms_se", m->distance_rms_se},
+                             {"distance_mean", m->distance_mean},
+                             {"distance_p50", m->distance_p50},
+                             {"distance_p90", m->distance_p90},
+                             {"distance_p99", m->distance_p99},
+                             {"shadow_mae", m->shadow_mae},
+                             {"shadow_mae_se", m->shadow_mae_se},
+                             {"false_shadow", m->false_shadow},
+                             {"false_shadow_se", m->false_shadow_se},
+                             {"light_leak", m->light_leak},
+                             {"light_leak_se", m->light_leak_se},
+                             {"binary_mae", m->binary_mae},
+                             {"binary_mae_se", m->binary_mae_se},
+                             {"binary_false_shadow", m->binary_false_shadow},
+                             {"binary_false_shadow_se", m->binary_false_shadow_se},
+                             {"binary_light_leak", m->binary_light_leak},
+                             {"binary_light_leak_se", m->binary_light_leak_se},
+                             {"ringing", m->ringing},
+                             {"receiver_mae_p50", m->receiver_mae_p50},
+                             {"receiver_mae_p90", m->receiver_mae_p90},
+                             {"receiver_mae_p99", m->receiver_mae_p99}};
     json_f64s(j, o, num, sizeof num / sizeof num[0]);
     vt_json_u64(j, o, "visible", m->visible);
     vt_json_u64(j, o, "occluded", m->occluded);
@@ -283,13 +290,17 @@ static void json_scene(vt_json *j, cJSON *o, const vb_eval_scene_metrics *m)
     vt_json_u64(j, o, "pairs", m->pairs);
     vt_json_u64(j, o, "visible", m->visible);
     vt_json_u64(j, o, "occluded", m->occluded);
-    const named_f64 f[] = {
-        {"shadow_mae", m->shadow_mae}, {"shadow_mae_se", m->shadow_mae_se},
-        {"false_shadow", m->false_shadow}, {"false_shadow_se", m->false_shadow_se},
-        {"recall", m->recall}, {"recall_se", m->recall_se},
-        {"light_leak", m->light_leak}, {"light_leak_se", m->light_leak_se},
-        {"binary_mae", m->binary_mae}, {"binary_false_shadow", m->binary_false_shadow},
-        {"binary_recall", m->binary_recall}};
+    const named_f64 f[] = {{"shadow_mae", m->shadow_mae},
+                           {"shadow_mae_se", m->shadow_mae_se},
+                           {"false_shadow", m->false_shadow},
+                           {"false_shadow_se", m->false_shadow_se},
+                           {"recall", m->recall},
+                           {"recall_se", m->recall_se},
+                           {"light_leak", m->light_leak},
+                           {"light_leak_se", m->light_leak_se},
+                           {"binary_mae", m->binary_mae},
+                           {"binary_false_shadow", m->binary_false_shadow},
+                           {"binary_recall", m->binary_recall}};
     json_f64s(j, o, f, sizeof f / sizeof f[0]);
 }
 
@@ -303,8 +314,7 @@ static void json_truth(vt_json *j, cJSON *o, const vb_eval_truth *t, int kind)
     vt_json_u64(j, o, "near_zero", t->near_zero);
     vt_json_f64(j, o, "near_zero_rate", t->rays ? (double)t->near_zero / t->rays : NAN);
     vt_json_u64(j, o, "degenerate", t->degenerate);
-    vt_json_f64(j, o, "degenerate_rate",
-                t->receivers ? (double)t->degenerate / t->receivers : NAN);
+    vt_json_f64(j, o, "degenerate_rate", t->receivers ? (double)t->degenerate / t->receivers : NAN);
     cJSON *deg = vt_json_array(j, o, "degenerate_list");
     for (uint32_t i = 0; i < t->degenerate_listed; i++)
         json_receiver(j, deg, &t->degenerate_list[i], kind);
@@ -322,8 +332,8 @@ typedef struct context {
     const vb_eval_result *r;
     const vb_eval_desc *d;
     int fast_truth;
-    int mismatched;        /* sources used despite a different SHA-256 */
-    const float *offset;   /* per scored stream: the log offset added (--offsets) */
+    int mismatched;      /* sources used despite a different SHA-256 */
+    const float *offset; /* per scored stream: the log offset added (--offsets) */
 } context;
 
 /* "5", or "a12" for a variable-order stream of cap 12. */
@@ -333,7 +343,10 @@ static const char *order_label(const vdsh_stream *st, char *buf, size_t n)
     return buf;
 }
 
-static const char *kind_name(int k) { return k == VB_EVAL_VERTICES ? "vertices" : "interior"; }
+static const char *kind_name(int k)
+{
+    return k == VB_EVAL_VERTICES ? "vertices" : "interior";
+}
 
 static int write_json(const char *out, const context *c, char *msg, size_t cap)
 {
@@ -431,8 +444,8 @@ static void put_u32(unsigned char *p, uint32_t v)
     p[2] = (unsigned char)(v >> 16), p[3] = (unsigned char)(v >> 24);
 }
 
-static int write_per_vertex(const char *out, const vdsh_file *f, const vb_eval_result *r,
-                            char *msg, size_t cap)
+static int write_per_vertex(const char *out, const vdsh_file *f, const vb_eval_result *r, char *msg,
+                            size_t cap)
 {
     vdsh_output o;
     vdsh_error err;
@@ -483,10 +496,10 @@ static void print_table(FILE *o, const context *c)
         fprintf(o, " (%d source(s) DIFFER from the bake's: --allow-mismatch)\n", c->mismatched);
     else
         fprintf(o, " (SHA-256 verified)\n");
-    fprintf(o, "            %u receiver vertices, %u triangles; %u occluder triangles; "
-               "diagonal %.4g\n",
-            h->vertex_count, h->triangle_count, h->occluder_triangle_count,
-            (double)r->diagonal);
+    fprintf(o,
+            "            %u receiver vertices, %u triangles; %u occluder triangles; "
+            "diagonal %.4g\n",
+            h->vertex_count, h->triangle_count, h->occluder_triangle_count, (double)r->diagonal);
     fprintf(o, "  bake      %u rays/receiver (%s), seed %llu, max distance %.4g, max edge %g",
             h->rays, vdsh_sampling_name(h->sampling), (unsigned long long)h->seed,
             (double)h->max_distance, (double)h->max_edge);
@@ -495,13 +508,14 @@ static void print_table(FILE *o, const context *c)
     else
         fprintf(o, "; time not recorded (bake with --record-timings or pass --bake-report)\n");
     if (f->has_stats)
-        fprintf(o, "            bake's own rays: %.4f%% missed, %u degenerate receivers, "
-                   "%u undefined normals\n",
-                f->stats.rays_traced ? 100.0 * f->stats.rays_missed / f->stats.rays_traced
-                                     : 0.0,
+        fprintf(o,
+                "            bake's own rays: %.4f%% missed, %u degenerate receivers, "
+                "%u undefined normals\n",
+                f->stats.rays_traced ? 100.0 * f->stats.rays_missed / f->stats.rays_traced : 0.0,
                 f->stats.degenerate_receivers, f->stats.undefined_normals);
-    fprintf(o, "  eval      seed %llu, %u held-out directions/receiver (one light each), "
-               "%s truth traversal%s; %.2f s on %u threads\n",
+    fprintf(o,
+            "  eval      seed %llu, %u held-out directions/receiver (one light each), "
+            "%s truth traversal%s; %.2f s on %u threads\n",
             (unsigned long long)r->seed, r->directions, c->fast_truth ? "default" : "robust",
             r->oracle ? ", ORACLE (truth scored against itself)" : "", r->seconds, r->threads);
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
@@ -518,9 +532,10 @@ static void print_table(FILE *o, const context *c)
     }
     fprintf(o, "\n  order = n bands, n^2 coefficients (aN: adaptive, each vertex 1..N); B/v = "
                "bytes of coefficients per vertex (adaptive: on average); +- = 95%% interval\n");
-    fprintf(o, "\n  SCENE LIGHTS (the primary metric): %u point lights placed uniformly in the "
-               "scene's free space, each\n  scored at every receiver it lights; "
-               "false = P(s_hat < .5 | d_T >= d_L), recall = P(s_hat < .5 | s_ideal < .5)\n\n",
+    fprintf(o,
+            "\n  SCENE LIGHTS (the primary metric): %u point lights placed uniformly in the "
+            "scene's free space, each\n  scored at every receiver it lights; "
+            "false = P(s_hat < .5 | d_T >= d_L), recall = P(s_hat < .5 | s_ideal < .5)\n\n",
             r->light_count);
     fprintf(o, "  %-8s %5s %6s %3s %3s %-9s | %7s | %-15s %-13s %-12s | %-6s %6s %6s\n", "",
             "order", "offset", "B/v", "enc", "fit", "pairs", "smooth: MAE", "false", "recall",
@@ -534,14 +549,16 @@ static void print_table(FILE *o, const context *c)
             char mae[32], fa[32], rc[32], fit[32];
             snprintf(fit, sizeof fit, "%s%s", vdsh_method_name(st->method),
                      st->quantity == VDSH_QUANTITY_LOG_DISTANCE ? "+log"
-                     : st->quantity == VDSH_QUANTITY_DISTANCE2  ? "+d2" : "");
+                     : st->quantity == VDSH_QUANTITY_DISTANCE2  ? "+d2"
+                                                                : "");
             snprintf(mae, sizeof mae, "%.4f+-%.4f", m->shadow_mae, 1.96 * m->shadow_mae_se);
             snprintf(fa, sizeof fa, "%.2f+-%.2f%%", 100.0 * m->false_shadow,
                      196.0 * m->false_shadow_se);
             snprintf(rc, sizeof rc, "%.1f+-%.1f%%", 100.0 * m->recall, 196.0 * m->recall_se);
             char ol[16];
-            fprintf(o, "  %-8s %5s %+6.2f %3.0f %3s %-9s | %7.2gM | %-15s %-13s %-12s | %6.4f "
-                       "%5.2f%% %5.1f%%\n",
+            fprintf(o,
+                    "  %-8s %5s %+6.2f %3.0f %3s %-9s | %7.2gM | %-15s %-13s %-12s | %6.4f "
+                    "%5.2f%% %5.1f%%\n",
                     kind_name(k), order_label(st, ol, sizeof ol), (double)c->offset[s],
                     vdsh_stream_size_of(st, vdsh_file_stream_vertices(f)).mean_bytes,
                     vdsh_encoding_name(st->encoding), fit, (double)m->pairs * 1e-6, mae, fa, rc,
@@ -552,7 +569,8 @@ static void print_table(FILE *o, const context *c)
                "direction at d_L = 2u d_T,\n  u uniform in (0.05, 1]\n");
     fprintf(o, "  distance = |D - d_T| / max(d_T, 0.01 diag); false = P(s_hat < .5 | d_T >= d_L), "
                "leak = P(s_hat > .5 | s_ideal < .5)\n\n");
-    fprintf(o, "  %-8s %5s %6s %3s %3s %-9s | %-14s %6s %6s %6s | %-15s %-13s %-13s | %-6s %6s %6s\n",
+    fprintf(o,
+            "  %-8s %5s %6s %3s %3s %-9s | %-14s %6s %6s %6s | %-15s %-13s %-13s | %-6s %6s %6s\n",
             "", "order", "offset", "B/v", "enc", "fit", "distance RMS", "p50", "p90", "p99",
             "smooth: MAE", "false", "leak", "binary", "false", "leak");
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
@@ -564,7 +582,8 @@ static void print_table(FILE *o, const context *c)
             char rms[32], mae[32], fa[32], le[32], fit[32];
             snprintf(fit, sizeof fit, "%s%s", vdsh_method_name(st->method),
                      st->quantity == VDSH_QUANTITY_LOG_DISTANCE ? "+log"
-                     : st->quantity == VDSH_QUANTITY_DISTANCE2  ? "+d2" : "");
+                     : st->quantity == VDSH_QUANTITY_DISTANCE2  ? "+d2"
+                                                                : "");
             snprintf(rms, sizeof rms, "%.3f+-%.3f", m->distance_rms, 1.96 * m->distance_rms_se);
             snprintf(mae, sizeof mae, "%.4f+-%.4f", m->shadow_mae, 1.96 * m->shadow_mae_se);
             snprintf(fa, sizeof fa, "%.2f+-%.2f%%", 100.0 * m->false_shadow,
@@ -572,13 +591,13 @@ static void print_table(FILE *o, const context *c)
             snprintf(le, sizeof le, "%.2f+-%.2f%%", 100.0 * m->light_leak,
                      196.0 * m->light_leak_se);
             char ol[16];
-            fprintf(o, "  %-8s %5s %+6.2f %3.0f %3s %-9s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s "
-                       "%-13s | %6.4f %5.2f%% %5.2f%%\n",
+            fprintf(o,
+                    "  %-8s %5s %+6.2f %3.0f %3s %-9s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s "
+                    "%-13s | %6.4f %5.2f%% %5.2f%%\n",
                     kind_name(k), order_label(st, ol, sizeof ol), (double)c->offset[s],
                     vdsh_stream_size_of(st, vdsh_file_stream_vertices(f)).mean_bytes,
-                    vdsh_encoding_name(st->encoding), fit, rms,
-                    m->distance_p50, m->distance_p90, m->distance_p99, mae, fa, le,
-                    m->binary_mae, 100.0 * m->binary_false_shadow,
+                    vdsh_encoding_name(st->encoding), fit, rms, m->distance_p50, m->distance_p90,
+                    m->distance_p99, mae, fa, le, m->binary_mae, 100.0 * m->binary_false_shadow,
                     100.0 * m->binary_light_leak);
         }
     }
@@ -600,10 +619,11 @@ static void print_table(FILE *o, const context *c)
         const vb_eval_metrics *m = &r->metrics[k][best];
         if (m->worst_count == 0)
             continue;
-        fprintf(o, "\n  worst %s, order %u (shadow MAE; per-receiver p50 %.4f, p90 %.4f, "
-                   "p99 %.4f):\n",
-                kind_name(k), f->streams[best].order, m->receiver_mae_p50,
-                m->receiver_mae_p90, m->receiver_mae_p99);
+        fprintf(o,
+                "\n  worst %s, order %u (shadow MAE; per-receiver p50 %.4f, p90 %.4f, "
+                "p99 %.4f):\n",
+                kind_name(k), f->streams[best].order, m->receiver_mae_p50, m->receiver_mae_p90,
+                m->receiver_mae_p99);
         uint32_t n = m->worst_count < 5 ? m->worst_count : 5;
         for (uint32_t i = 0; i < n; i++) {
             const vb_eval_receiver *w = &m->worst[i];
@@ -611,11 +631,12 @@ static void print_table(FILE *o, const context *c)
                 fprintf(o, "    vertex %-9u", w->index);
             else
                 fprintf(o, "    point %-6u tri %-8u", w->index, w->triangle);
-            fprintf(o, " at (%.4g, %.4g, %.4g) n (%.2f, %.2f, %.2f): shadow MAE %.3f, "
-                       "distance RMS %.3f, %.0f%% truth at ~0\n",
+            fprintf(o,
+                    " at (%.4g, %.4g, %.4g) n (%.2f, %.2f, %.2f): shadow MAE %.3f, "
+                    "distance RMS %.3f, %.0f%% truth at ~0\n",
                     (double)w->position[0], (double)w->position[1], (double)w->position[2],
-                    (double)w->normal[0], (double)w->normal[1], (double)w->normal[2],
-                    w->shadow_mae, w->distance_rms, 100.0 * w->near_zero);
+                    (double)w->normal[0], (double)w->normal[1], (double)w->normal[2], w->shadow_mae,
+                    w->distance_rms, 100.0 * w->near_zero);
         }
     }
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
@@ -629,24 +650,25 @@ static void print_table(FILE *o, const context *c)
             if (w->escaped < 0.5)
                 break;
             fprintf(o, "    %s %u at (%.4g, %.4g, %.4g) n (%.2f, %.2f, %.2f): %.0f%% escaped\n",
-                    k == VB_EVAL_VERTICES ? "vertex" : "point", w->index,
-                    (double)w->position[0], (double)w->position[1], (double)w->position[2],
-                    (double)w->normal[0], (double)w->normal[1], (double)w->normal[2],
-                    100.0 * w->escaped);
+                    k == VB_EVAL_VERTICES ? "vertex" : "point", w->index, (double)w->position[0],
+                    (double)w->position[1], (double)w->position[2], (double)w->normal[0],
+                    (double)w->normal[1], (double)w->normal[2], 100.0 * w->escaped);
         }
     }
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         const vb_eval_truth *t = &r->truth[k];
         if (t->degenerate_listed == 0)
             continue;
-        fprintf(o, "\n  degenerate %s (truth almost all at ~0 distance: a bake defect), "
-                   "first %u:\n", kind_name(k), t->degenerate_listed < 5 ? t->degenerate_listed : 5);
+        fprintf(o,
+                "\n  degenerate %s (truth almost all at ~0 distance: a bake defect), "
+                "first %u:\n",
+                kind_name(k), t->degenerate_listed < 5 ? t->degenerate_listed : 5);
         for (uint32_t i = 0; i < t->degenerate_listed && i < 5; i++) {
             const vb_eval_receiver *w = &t->degenerate_list[i];
             fprintf(o, "    %s %u at (%.4g, %.4g, %.4g) n (%.2f, %.2f, %.2f)\n",
-                    k == VB_EVAL_VERTICES ? "vertex" : "point", w->index,
-                    (double)w->position[0], (double)w->position[1], (double)w->position[2],
-                    (double)w->normal[0], (double)w->normal[1], (double)w->normal[2]);
+                    k == VB_EVAL_VERTICES ? "vertex" : "point", w->index, (double)w->position[0],
+                    (double)w->position[1], (double)w->position[2], (double)w->normal[0],
+                    (double)w->normal[1], (double)w->normal[2]);
         }
     }
 }
@@ -654,9 +676,9 @@ static void print_table(FILE *o, const context *c)
 /* ---- the command line ------------------------------------------------------------ */
 
 typedef struct options {
-    vb_eval_desc d;            /* the evaluator's settings; file and scene: run's */
-    const char *path;          /* FILE.vdsh */
-    char **meshes;             /* MESH...: the recorded sources, given */
+    vb_eval_desc d;   /* the evaluator's settings; file and scene: run's */
+    const char *path; /* FILE.vdsh */
+    char **meshes;    /* MESH...: the recorded sources, given */
     uint32_t nmesh;
     const char *json, *per_vertex, *bake_report;
     int want_order[VDSH_ORDER_SLOTS], filter; /* --orders */
@@ -703,22 +725,46 @@ static int parse_offsets(const char *s, float *out)
  * error: said). */
 static int parse_args(int argc, char **argv, options *o)
 {
-    enum { O_POINTS = 256, O_INTERIOR, O_DIRECTIONS, O_SEED, O_ORDERS, O_ORACLE, O_INTERP,
-           O_FAST, O_ALLOW, O_JSON, O_PV, O_BAKE_REPORT, O_WORST, O_THREADS, O_LIGHTS,
-           O_OFFSETS, O_LIGHT_RULE };
-    static const struct option longopts[] = {
-        {"points", required_argument, 0, O_POINTS}, {"interior", required_argument, 0, O_INTERIOR},
-        {"directions", required_argument, 0, O_DIRECTIONS}, {"seed", required_argument, 0, O_SEED},
-        {"orders", required_argument, 0, O_ORDERS}, {"oracle", no_argument, 0, O_ORACLE},
-        {"interp", required_argument, 0, O_INTERP}, {"fast-truth", no_argument, 0, O_FAST},
-        {"allow-mismatch", no_argument, 0, O_ALLOW}, {"json", required_argument, 0, O_JSON},
-        {"per-vertex", required_argument, 0, O_PV},
-        {"bake-report", required_argument, 0, O_BAKE_REPORT},
-        {"worst", required_argument, 0, O_WORST}, {"threads", required_argument, 0, O_THREADS},
-        {"lights", required_argument, 0, O_LIGHTS},
-        {"light-rule", required_argument, 0, O_LIGHT_RULE},
-        {"offsets", required_argument, 0, O_OFFSETS}, {"quiet", no_argument, 0, 'q'},
-        {"help", no_argument, 0, 'h'}, {"version", no_argument, 0, 'V'}, {0, 0, 0, 0}};
+    enum {
+        O_POINTS = 256,
+        O_INTERIOR,
+        O_DIRECTIONS,
+        O_SEED,
+        O_ORDERS,
+        O_ORACLE,
+        O_INTERP,
+        O_FAST,
+        O_ALLOW,
+        O_JSON,
+        O_PV,
+        O_BAKE_REPORT,
+        O_WORST,
+        O_THREADS,
+        O_LIGHTS,
+        O_OFFSETS,
+        O_LIGHT_RULE
+    };
+    static const struct option longopts[] = {{"points", required_argument, 0, O_POINTS},
+                                             {"interior", required_argument, 0, O_INTERIOR},
+                                             {"directions", required_argument, 0, O_DIRECTIONS},
+                                             {"seed", required_argument, 0, O_SEED},
+                                             {"orders", required_argument, 0, O_ORDERS},
+                                             {"oracle", no_argument, 0, O_ORACLE},
+                                             {"interp", required_argument, 0, O_INTERP},
+                                             {"fast-truth", no_argument, 0, O_FAST},
+                                             {"allow-mismatch", no_argument, 0, O_ALLOW},
+                                             {"json", required_argument, 0, O_JSON},
+                                             {"per-vertex", required_argument, 0, O_PV},
+                                             {"bake-report", required_argument, 0, O_BAKE_REPORT},
+                                             {"worst", required_argument, 0, O_WORST},
+                                             {"threads", required_argument, 0, O_THREADS},
+                                             {"lights", required_argument, 0, O_LIGHTS},
+                                             {"light-rule", required_argument, 0, O_LIGHT_RULE},
+                                             {"offsets", required_argument, 0, O_OFFSETS},
+                                             {"quiet", no_argument, 0, 'q'},
+                                             {"help", no_argument, 0, 'h'},
+                                             {"version", no_argument, 0, 'V'},
+                                             {0, 0, 0, 0}};
     memset(o, 0, sizeof *o);
     o->d.interior = 65536;
     vb_eval_desc *d = &o->d;
@@ -731,8 +777,12 @@ static int parse_args(int argc, char **argv, options *o)
         case O_INTERIOR:
             ok = vt_opt_u32("--interior", NULL, optarg, 0, VB_EVAL_MAX_RECEIVERS, &d->interior);
             break;
-        case O_DIRECTIONS: ok = vt_opt_u32("--directions", NULL, optarg, 1, 65536, &d->directions); break;
-        case O_WORST: ok = vt_opt_u32("--worst", NULL, optarg, 1, VB_EVAL_MAX_WORST, &d->worst); break;
+        case O_DIRECTIONS:
+            ok = vt_opt_u32("--directions", NULL, optarg, 1, 65536, &d->directions);
+            break;
+        case O_WORST:
+            ok = vt_opt_u32("--worst", NULL, optarg, 1, VB_EVAL_MAX_WORST, &d->worst);
+            break;
         case O_LIGHTS: ok = vt_opt_u32("--lights", NULL, optarg, 1, 4096, &d->lights); break;
         case O_THREADS: ok = vt_opt_u32("--threads", NULL, optarg, 1, 256, &d->threads); break;
         case O_SEED:
@@ -747,7 +797,8 @@ static int parse_args(int argc, char **argv, options *o)
         case O_INTERP:
             if (!parse_interp(optarg, &d->interp))
                 return bad_usage("--interp takes runtime, coefficients, distance, "
-                                   "visibility or split, not '%s'", optarg);
+                                 "visibility or split, not '%s'",
+                                 optarg);
             break;
         case O_LIGHT_RULE:
             if (!parse_light_rule(optarg, &d->light_rule))
@@ -758,7 +809,8 @@ static int parse_args(int argc, char **argv, options *o)
             o->noffsets = parse_offsets(optarg, o->offsets);
             if (!o->noffsets)
                 return bad_usage("--offsets takes 1..15 numbers in -5..5 such as -0.4,-0.2,0.2, "
-                                 "not '%s'", optarg);
+                                 "not '%s'",
+                                 optarg);
             break;
         case O_ORACLE: d->oracle = 1; break;
         case O_FAST: o->fast_truth = 1; break;
@@ -785,9 +837,9 @@ static int parse_args(int argc, char **argv, options *o)
 /* ---- the streams to score ------------------------------------------------------------ */
 
 typedef struct scored {
-    vdsh_file view;            /* the file with the streams to score; the file stays as read */
-    vdsh_stream *kept;         /* view.streams when not the file's own (owned) */
-    int copies;                /* 1 + offsets once kept holds --offsets copies, whose data
+    vdsh_file view;                 /* the file with the streams to score; the file stays as read */
+    vdsh_stream *kept;              /* view.streams when not the file's own (owned) */
+    int copies;                     /* 1 + offsets once kept holds --offsets copies, whose data
                                   (each stream but every copies-th) is ours; else 0 */
     float offset[VDSH_MAX_STREAMS]; /* per scored stream: the log offset added */
 } scored;
@@ -836,8 +888,9 @@ static int add_offsets(const options *o, const vdsh_file *f, scored *s)
     const int noffsets = o->noffsets;
     uint32_t n0 = s->view.stream_count, total = n0 * (uint32_t)(1 + noffsets);
     if (total > VDSH_MAX_STREAMS) {
-        fprintf(stderr, "vdsh-eval: %u streams with %d offsets each make %u, more than %d: "
-                        "fewer offsets, or pick orders with --orders\n",
+        fprintf(stderr,
+                "vdsh-eval: %u streams with %d offsets each make %u, more than %d: "
+                "fewer offsets, or pick orders with --orders\n",
                 n0, noffsets, total, VDSH_MAX_STREAMS);
         return VT_EXIT_USAGE;
     }
@@ -869,8 +922,8 @@ static int add_offsets(const options *o, const vdsh_file *f, scored *s)
                     cv[0] += o->offsets[k] / 0.28209479177387814f; /* Y00 */
                 else
                     for (uint32_t c = 0; c < nc; c++)
-                        cv[c] *= x.quantity == VDSH_QUANTITY_DISTANCE2
-                                     ? expf(2.0f * o->offsets[k]) : expf(o->offsets[k]);
+                        cv[c] *= x.quantity == VDSH_QUANTITY_DISTANCE2 ? expf(2.0f * o->offsets[k])
+                                                                       : expf(o->offsets[k]);
             }
             x.encoding = VDSH_ENCODING_F32, x.scale = 1.0f, x.data = data;
             s->offset[n] = o->offsets[k];
@@ -924,12 +977,13 @@ static char **find_sources(const options *o, const vdsh_file *f)
         return NULL;
     }
     for (uint32_t i = 0; i < f->source_count; i++) {
-        spath[i] = o->nmesh ? strdup(o->meshes[i])
-                            : vb_eval_find_source(f->sources[i].name, o->path);
+        spath[i] =
+            o->nmesh ? strdup(o->meshes[i]) : vb_eval_find_source(f->sources[i].name, o->path);
         if (!spath[i]) {
-            fprintf(stderr, "vdsh-eval: %s: cannot find source %u of %u, '%s' (looked as "
-                            "recorded and beside the file); give the bake's meshes after "
-                            "the file name\n",
+            fprintf(stderr,
+                    "vdsh-eval: %s: cannot find source %u of %u, '%s' (looked as "
+                    "recorded and beside the file); give the bake's meshes after "
+                    "the file name\n",
                     o->path, i + 1, f->source_count, f->sources[i].name);
             sources_free(spath, f->source_count);
             return NULL;
@@ -976,10 +1030,13 @@ static int evaluate(const options *o, const vdsh_file *f, const scored *sc)
     if (!spath)
         goto out;
     warnings warned = {.path = o->path};
-    vb_eval_scene_desc sd = {.fast = o->fast_truth, .allow_mismatch = o->allow_mismatch,
-                             .threads = o->d.threads, .warn = on_warn, .warn_user = &warned};
-    if (vb_eval_scene_create(f, (const char *const *)spath, f->source_count, &sd, &scene,
-                             &err) != VB_OK) {
+    vb_eval_scene_desc sd = {.fast = o->fast_truth,
+                             .allow_mismatch = o->allow_mismatch,
+                             .threads = o->d.threads,
+                             .warn = on_warn,
+                             .warn_user = &warned};
+    if (vb_eval_scene_create(f, (const char *const *)spath, f->source_count, &sd, &scene, &err) !=
+        VB_OK) {
         fprintf(stderr, "vdsh-eval: %s: %s\n", o->path, err.msg);
         goto out;
     }
@@ -998,9 +1055,16 @@ static int evaluate(const options *o, const vdsh_file *f, const scored *sc)
     }
 
     /* 5. Report. */
-    context ctx = {.path = o->path, .f = &sc->view, .source_paths = spath, .file_bytes = -1,
-                   .bt = bt, .r = &res, .d = &d, .fast_truth = o->fast_truth,
-                   .mismatched = warned.count, .offset = sc->offset};
+    context ctx = {.path = o->path,
+                   .f = &sc->view,
+                   .source_paths = spath,
+                   .file_bytes = -1,
+                   .bt = bt,
+                   .r = &res,
+                   .d = &d,
+                   .fast_truth = o->fast_truth,
+                   .mismatched = warned.count,
+                   .offset = sc->offset};
     struct stat st;
     if (stat(o->path, &st) == 0)
         ctx.file_bytes = (long long)st.st_size;
@@ -1032,8 +1096,8 @@ static int run(const options *o)
     if (!f)
         return 1;
     if (o->nmesh && o->nmesh != f->source_count) {
-        fprintf(stderr, "vdsh-eval: %s: %u mesh(es) given but the bake used %u source(s):",
-                o->path, o->nmesh, f->source_count);
+        fprintf(stderr, "vdsh-eval: %s: %u mesh(es) given but the bake used %u source(s):", o->path,
+                o->nmesh, f->source_count);
         for (uint32_t i = 0; i < f->source_count; i++)
             fprintf(stderr, " '%s'", f->sources[i].name);
         fputc('\n', stderr);

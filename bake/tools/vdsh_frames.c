@@ -45,103 +45,103 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-"usage: vdsh-frames views SCENE.vdsh -o VIEWS.json [options]\n"
-"       vdsh-frames truth SCENE.vdsh --views VIEWS.json -o DIR [options]\n"
-"       vdsh-frames score SCENE.vdsh --views VIEWS.json --truth DIR --frames DIR2\n"
-"                         --modes LIST [--json OUT.json]\n"
-"What a viewer sees: ray-traced truth for frames, and image error against it.\n"
-"\n"
-"The scene is rebuilt as vdsh-eval does: the occluders from the sources\n"
-"recorded in SCENE.vdsh (looked up as recorded, then beside the file; each\n"
-"must have the SHA-256 the bake recorded), the receivers (what the GL\n"
-"draws) from the file's own positions and triangles.\n"
-"\n"
-"views: a view set (JSON, tools/vt_views.h) for the scene. View 'default'\n"
-"  is the camera vdsh-view opens the scene with; views v1..vN look from\n"
-"  eyes in the scene's free space (the rule for lights: formats/\n"
-"  vdsh_light.h) at a surface point they see, between 53 degrees below the\n"
-"  horizon and 12 above, and are kept when a 64-pixel-wide frame shows no\n"
-"  surface nearer than 5%% of the diagonal and each of its lights lights\n"
-"  at least 5%% of the frame's pixels and hard-shadows as many. Every view\n"
-"  gets light set 0 (one light) and set 1 (three), drawn from 128 lights\n"
-"  placed in free space (vdsh-eval's rule); the default view takes the\n"
-"  best it can get. Deterministic for a seed.\n"
-"  -o, --output FILE       the view set to write\n"
-"      --cameras N         views besides the default (default 6)\n"
-"      --seed N            seed of the eyes, directions and lights (default 1)\n"
-"      --size WxH          frame size recorded in the set (default 512x384)\n"
-"\n"
-"truth: for every view, light set K and light J, frames DIR/NAME-sK-lJ-MODE.png\n"
-"  (16-bit grey, value round(v * 65535)), MODE:\n"
-"    hard     1 light visible, 0 blocked: the first hit toward the light\n"
-"             from the surface point (offset toward the camera) against the\n"
-"             occluders, d_T, against the light's distance d_L\n"
-"    ideal    ramp(d_T / d_L), ramp(x) = saturate((x - 1/3) * 1.5): the\n"
-"             exact distance through the runtime's comparison (--compare)\n"
-"    mask     1 where the pixel counts: a triangle is hit and its\n"
-"             interpolated normal faces the light (N . L > 0)\n"
-"    c-vdshN  the file's stream of order N (1..%d), computed in C exactly\n"
-"             on the runtime's path (formats/vdsh_shadow.h: vdsh_shadow_interior\n"
-"             with the triangle's vertices and barycentrics; log distance,\n"
-"             what method shadow bakes: each vertex's distance, interpolated)\n"
-"    c-vdsh-var  the file's variable-order stream (each vertex its own\n"
-"             order), on the per-vertex distance path\n"
-"    c-sdf    distance-field shadows when the scene has a distance volume\n"
-"             (SCENE.sdf beside it, vdsh-bake --sdf N; or --sdf FILE):\n"
-"             formats/vdsh_sdf.h's sphere trace, what vdsh-view's mode sdf\n"
-"             draws\n"
-"  Pixels that meet nothing hold 1 (mask 0). Primary rays go through pixel\n"
-"  centres (formats/vdsh_camera.h, the camera the runtime projects with)\n"
-"  and meet the receiver mesh; normals are interpolated as the GPU does.\n"
-"  Also DIR/NAME-sK-shaded-hard.png and -shaded-ideal.png: 8-bit RGBA\n"
-"  pictures of the set with the runtime's colour output: albedo 0.8 x\n"
-"  (ambient 0.03 + sum of 1.6 / (1 + 0.6 (n - 1)) x max(N . l, 0) /\n"
-"  (1 + d^2 / r^2) x shadow), r = 0.3 x the scene's diagonal, n lights.\n"
-"  Prints the time of each pass; a frame's truth is the primary pass plus\n"
-"  one light's shadow pass.\n"
-"      --views FILE        the view set\n"
-"  -o, --output DIR        where the frames go (created if missing)\n"
-"      --compare C         smooth (default, the paper's ramp) or binary,\n"
-"                          for ideal and the c-vdshN frames\n"
-"      --sdf FILE          the distance volume for c-sdf (default SCENE.sdf,\n"
-"                          when it exists)\n"
-"      --sdf-k K           c-sdf's softness (default 400, as vdsh-view's)\n"
-"\n"
-"score: reads the truth (hard, ideal, mask from --truth DIR) and the frames\n"
-"  of each mode in LIST (comma-separated: vdsh-view's modes cube, cube-pcf,\n"
-"  vdsh2, vdsh3, vdsh5, vdsh5poly, or c-vdshN, c-vdsh-var, or hard and ideal\n"
-"  themselves) from --frames DIR2, with the same names, and scores each\n"
-"  frame over its mask pixels; a light set pools its lights' frames and\n"
-"  the scene pools everything:\n"
-"    RMSE, PSNR   against ideal and against hard (PSNR peak 1; inf: equal)\n"
-"    recall       of the pixels with hard = 0 and ideal < .5, the share\n"
-"                 drawn at s < .5\n"
-"    false        false-shadow area: of the pixels with hard = 1, the share\n"
-"                 drawn at s < .5\n"
-"    blotches     4-connected regions of false shadow larger than 0.05%%\n"
-"                 of the frame's pixels: their count and area (share of\n"
-"                 the frames' pixels)\n"
-"  A missing frame or one of another size is an error naming the file.\n"
-"      --views FILE        the view set the frames were made for\n"
-"      --truth DIR         vdsh-frames truth's output\n"
-"      --frames DIR2       the frames to score (may be DIR itself)\n"
-"      --modes LIST        the modes to score\n"
-"      --json FILE         everything as JSON (each frame too: per_frame; -:\n"
-"                          on stdout, instead of the table)\n"
-"\n"
-"Common options:\n"
-"      --threads N         worker threads (default: all cores); the output\n"
-"                          does not depend on it\n"
-"  -q, --quiet             print nothing but errors\n"
-"  -h, --help              this text\n"
-"  -V, --version           version\n"
-"\n"
-"Exit status: 0 success, 1 error, 2 usage error.\n"
-"Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n"
-"         vdsh-frames views room.vdsh -o room.views.json\n"
-"         vdsh-frames truth room.vdsh --views room.views.json -o frames\n"
-"         vdsh-frames score room.vdsh --views room.views.json --truth frames \\\n"
-"             --frames frames --modes c-vdsh2,c-vdsh3,c-vdsh5\n",
+            "usage: vdsh-frames views SCENE.vdsh -o VIEWS.json [options]\n"
+            "       vdsh-frames truth SCENE.vdsh --views VIEWS.json -o DIR [options]\n"
+            "       vdsh-frames score SCENE.vdsh --views VIEWS.json --truth DIR --frames DIR2\n"
+            "                         --modes LIST [--json OUT.json]\n"
+            "What a viewer sees: ray-traced truth for frames, and image error against it.\n"
+            "\n"
+            "The scene is rebuilt as vdsh-eval does: the occluders from the sources\n"
+            "recorded in SCENE.vdsh (looked up as recorded, then beside the file; each\n"
+            "must have the SHA-256 the bake recorded), the receivers (what the GL\n"
+            "draws) from the file's own positions and triangles.\n"
+            "\n"
+            "views: a view set (JSON, tools/vt_views.h) for the scene. View 'default'\n"
+            "  is the camera vdsh-view opens the scene with; views v1..vN look from\n"
+            "  eyes in the scene's free space (the rule for lights: formats/\n"
+            "  vdsh_light.h) at a surface point they see, between 53 degrees below the\n"
+            "  horizon and 12 above, and are kept when a 64-pixel-wide frame shows no\n"
+            "  surface nearer than 5%% of the diagonal and each of its lights lights\n"
+            "  at least 5%% of the frame's pixels and hard-shadows as many. Every view\n"
+            "  gets light set 0 (one light) and set 1 (three), drawn from 128 lights\n"
+            "  placed in free space (vdsh-eval's rule); the default view takes the\n"
+            "  best it can get. Deterministic for a seed.\n"
+            "  -o, --output FILE       the view set to write\n"
+            "      --cameras N         views besides the default (default 6)\n"
+            "      --seed N            seed of the eyes, directions and lights (default 1)\n"
+            "      --size WxH          frame size recorded in the set (default 512x384)\n"
+            "\n"
+            "truth: for every view, light set K and light J, frames DIR/NAME-sK-lJ-MODE.png\n"
+            "  (16-bit grey, value round(v * 65535)), MODE:\n"
+            "    hard     1 light visible, 0 blocked: the first hit toward the light\n"
+            "             from the surface point (offset toward the camera) against the\n"
+            "             occluders, d_T, against the light's distance d_L\n"
+            "    ideal    ramp(d_T / d_L), ramp(x) = saturate((x - 1/3) * 1.5): the\n"
+            "             exact distance through the runtime's comparison (--compare)\n"
+            "    mask     1 where the pixel counts: a triangle is hit and its\n"
+            "             interpolated normal faces the light (N . L > 0)\n"
+            "    c-vdshN  the file's stream of order N (1..%d), computed in C exactly\n"
+            "             on the runtime's path (formats/vdsh_shadow.h: vdsh_shadow_interior\n"
+            "             with the triangle's vertices and barycentrics; log distance,\n"
+            "             what method shadow bakes: each vertex's distance, interpolated)\n"
+            "    c-vdsh-var  the file's variable-order stream (each vertex its own\n"
+            "             order), on the per-vertex distance path\n"
+            "    c-sdf    distance-field shadows when the scene has a distance volume\n"
+            "             (SCENE.sdf beside it, vdsh-bake --sdf N; or --sdf FILE):\n"
+            "             formats/vdsh_sdf.h's sphere trace, what vdsh-view's mode sdf\n"
+            "             draws\n"
+            "  Pixels that meet nothing hold 1 (mask 0). Primary rays go through pixel\n"
+            "  centres (formats/vdsh_camera.h, the camera the runtime projects with)\n"
+            "  and meet the receiver mesh; normals are interpolated as the GPU does.\n"
+            "  Also DIR/NAME-sK-shaded-hard.png and -shaded-ideal.png: 8-bit RGBA\n"
+            "  pictures of the set with the runtime's colour output: albedo 0.8 x\n"
+            "  (ambient 0.03 + sum of 1.6 / (1 + 0.6 (n - 1)) x max(N . l, 0) /\n"
+            "  (1 + d^2 / r^2) x shadow), r = 0.3 x the scene's diagonal, n lights.\n"
+            "  Prints the time of each pass; a frame's truth is the primary pass plus\n"
+            "  one light's shadow pass.\n"
+            "      --views FILE        the view set\n"
+            "  -o, --output DIR        where the frames go (created if missing)\n"
+            "      --compare C         smooth (default, the paper's ramp) or binary,\n"
+            "                          for ideal and the c-vdshN frames\n"
+            "      --sdf FILE          the distance volume for c-sdf (default SCENE.sdf,\n"
+            "                          when it exists)\n"
+            "      --sdf-k K           c-sdf's softness (default 400, as vdsh-view's)\n"
+            "\n"
+            "score: reads the truth (hard, ideal, mask from --truth DIR) and the frames\n"
+            "  of each mode in LIST (comma-separated: vdsh-view's modes cube, cube-pcf,\n"
+            "  vdsh2, vdsh3, vdsh5, vdsh5poly, or c-vdshN, c-vdsh-var, or hard and ideal\n"
+            "  themselves) from --frames DIR2, with the same names, and scores each\n"
+            "  frame over its mask pixels; a light set pools its lights' frames and\n"
+            "  the scene pools everything:\n"
+            "    RMSE, PSNR   against ideal and against hard (PSNR peak 1; inf: equal)\n"
+            "    recall       of the pixels with hard = 0 and ideal < .5, the share\n"
+            "                 drawn at s < .5\n"
+            "    false        false-shadow area: of the pixels with hard = 1, the share\n"
+            "                 drawn at s < .5\n"
+            "    blotches     4-connected regions of false shadow larger than 0.05%%\n"
+            "                 of the frame's pixels: their count and area (share of\n"
+            "                 the frames' pixels)\n"
+            "  A missing frame or one of another size is an error naming the file.\n"
+            "      --views FILE        the view set the frames were made for\n"
+            "      --truth DIR         vdsh-frames truth's output\n"
+            "      --frames DIR2       the frames to score (may be DIR itself)\n"
+            "      --modes LIST        the modes to score\n"
+            "      --json FILE         everything as JSON (each frame too: per_frame; -:\n"
+            "                          on stdout, instead of the table)\n"
+            "\n"
+            "Common options:\n"
+            "      --threads N         worker threads (default: all cores); the output\n"
+            "                          does not depend on it\n"
+            "  -q, --quiet             print nothing but errors\n"
+            "  -h, --help              this text\n"
+            "  -V, --version           version\n"
+            "\n"
+            "Exit status: 0 success, 1 error, 2 usage error.\n"
+            "Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n"
+            "         vdsh-frames views room.vdsh -o room.views.json\n"
+            "         vdsh-frames truth room.vdsh --views room.views.json -o frames\n"
+            "         vdsh-frames score room.vdsh --views room.views.json --truth frames \\\n"
+            "             --frames frames --modes c-vdsh2,c-vdsh3,c-vdsh5\n",
             VDSH_MAX_ORDER);
 }
 
@@ -158,14 +158,14 @@ typedef struct options {
     const char *path;                   /* SCENE.vdsh */
     unsigned threads;                   /* --threads; 0: every core */
     int quiet;
-    const char *output;                 /* -o: views' VIEWS.json, truth's DIR */
-    vb_frames_views_desc views;         /* views: --cameras, --seed, --size */
-    const char *views_path;             /* truth, score: --views */
-    uint32_t compare;                   /* truth: --compare */
-    const char *sdf;                    /* truth: --sdf */
-    float sdf_k;                        /* truth: --sdf-k */
-    const char *truth, *frames, *json;  /* score */
-    char modes[MAX_MODES][64];          /* score: --modes */
+    const char *output;                /* -o: views' VIEWS.json, truth's DIR */
+    vb_frames_views_desc views;        /* views: --cameras, --seed, --size */
+    const char *views_path;            /* truth, score: --views */
+    uint32_t compare;                  /* truth: --compare */
+    const char *sdf;                   /* truth: --sdf */
+    float sdf_k;                       /* truth: --sdf-k */
+    const char *truth, *frames, *json; /* score */
+    char modes[MAX_MODES][64];         /* score: --modes */
     int mode_count;
 } options;
 
@@ -204,8 +204,9 @@ static int load_scene(const char *path, unsigned threads, int traced, loaded *ou
     for (uint32_t i = 0; i < l.f->source_count; i++) {
         spath[i] = vb_eval_find_source(l.f->sources[i].name, path);
         if (!spath[i]) {
-            fprintf(stderr, PROG ": %s: cannot find source %u of %u, '%s' (looked as "
-                            "recorded and beside the file)\n",
+            fprintf(stderr,
+                    PROG ": %s: cannot find source %u of %u, '%s' (looked as "
+                         "recorded and beside the file)\n",
                     path, i + 1, l.f->source_count, l.f->sources[i].name);
             goto done;
         }
@@ -290,8 +291,8 @@ static int run_views(const options *op)
     if (!op->quiet) {
         printf(PROG " views: %s -> %s: %d views, %d x %d, seed %llu; %u candidate eyes "
                     "(%u in free space), %.2f s\n",
-               path, out, set.count, d.width, d.height, (unsigned long long)d.seed,
-               st.eyes_tried, st.eyes_free, vb_now() - t0);
+               path, out, set.count, d.width, d.height, (unsigned long long)d.seed, st.eyes_tried,
+               st.eyes_free, vb_now() - t0);
         if (st.default_lights_ok < VB_FRAMES_VIEW_LIGHTS)
             printf("  note: only %u of the default view's 4 lights light and shadow %.0f%% "
                    "of it each; the best others fill in\n",
@@ -300,9 +301,8 @@ static int run_views(const options *op)
             const vdsh_camera *cam = &fv[i].camera;
             printf("  %-8s eye (%.3g, %.3g, %.3g) target (%.3g, %.3g, %.3g); lit / shadowed "
                    "per light:",
-                   set.views[i].name, (double)cam->eye[0], (double)cam->eye[1],
-                   (double)cam->eye[2], (double)cam->target[0], (double)cam->target[1],
-                   (double)cam->target[2]);
+                   set.views[i].name, (double)cam->eye[0], (double)cam->eye[1], (double)cam->eye[2],
+                   (double)cam->target[0], (double)cam->target[1], (double)cam->target[2]);
             for (int j = 0; j < VB_FRAMES_VIEW_LIGHTS; j++)
                 printf(" %.0f/%.0f%%", 100.0 * fv[i].lit[j], 100.0 * fv[i].shadowed[j]);
             printf("\n");
@@ -480,9 +480,8 @@ static int run_truth(const options *op)
     double t_primary = 0.0, t_shadow = 0.0, t_streams = 0.0, t_write = 0.0, t0 = vb_now();
     int light_frames = 0, stream_frames = 0;
     if (!op->quiet)
-        printf(PROG " truth: %s, %d views from %s, %d x %d, %s comparison -> %s\n", path,
-               V.count, views_path, w, h, vdsh_compare_name(compare),
-               dir);
+        printf(PROG " truth: %s, %d views from %s, %d x %d, %s comparison -> %s\n", path, V.count,
+               views_path, w, h, vdsh_compare_name(compare), dir);
     for (int vi = 0; vi < V.count; vi++) {
         const vt_view *v = V.views + vi;
         double t = vb_now();
@@ -508,12 +507,16 @@ static int run_truth(const options *op)
                 view_lights++;
                 vis_hard[j] = lights[j].hard;
                 vis_ideal[j] = lights[j].ideal;
-                frame_batch fb = {.dir = dir, .view = v->name, .set = k, .light = j, .w = w,
-                                  .h = h, .items = items};
+                frame_batch fb = {.dir = dir,
+                                  .view = v->name,
+                                  .set = k,
+                                  .light = j,
+                                  .w = w,
+                                  .h = h,
+                                  .items = items};
                 uint32_t count = 0;
                 const char *truth_modes[3] = {"hard", "ideal", "mask"};
-                const float *truth_values[3] = {lights[j].hard, lights[j].ideal,
-                                                lights[j].mask};
+                const float *truth_values[3] = {lights[j].hard, lights[j].ideal, lights[j].mask};
                 for (int m = 0; m < 3; m++, count++) {
                     memset(&items[count], 0, sizeof items[count]);
                     snprintf(items[count].mode, sizeof items[count].mode, "%s", truth_modes[m]);
@@ -646,9 +649,8 @@ static int parse_modes(const char *s, char modes[MAX_MODES][64])
 }
 
 /* A frame of the view set's size, or -1 with the file named. */
-static int read_frame(const char *dir, const vt_views *V, const char *views_path,
-                      const char *view, int set, int light, const char *mode, float **out,
-                      char *path, size_t cap)
+static int read_frame(const char *dir, const vt_views *V, const char *views_path, const char *view,
+                      int set, int light, const char *mode, float **out, char *path, size_t cap)
 {
     char msg[PATH_MAX + 256];
     int w, h;
@@ -667,8 +669,8 @@ static int read_frame(const char *dir, const vt_views *V, const char *views_path
         return -1;
     }
     if (w != V->width || h != V->height) {
-        fprintf(stderr, PROG ": %s: %d x %d pixels, but the view set %s is %d x %d\n", path, w,
-                h, views_path, V->width, V->height);
+        fprintf(stderr, PROG ": %s: %d x %d pixels, but the view set %s is %d x %d\n", path, w, h,
+                views_path, V->width, V->height);
         free(*out);
         *out = NULL;
         return -1;
@@ -699,9 +701,9 @@ static void print_row(const char *view, const char *set, int lights, const vb_fr
 {
     vb_frames_scores s;
     vb_frames_scores_get(t, &s);
-    printf("  %-10s %-3s %6d %9llu  %8.4f %6.2f  %8.4f %6.2f  %7.4f %7.4f  %4llu %7.3f%%\n",
-           view, set, lights, (unsigned long long)t->counted, s.rmse_ideal, s.psnr_ideal,
-           s.rmse_hard, s.psnr_hard, s.recall, s.false_area, (unsigned long long)s.blotches,
+    printf("  %-10s %-3s %6d %9llu  %8.4f %6.2f  %8.4f %6.2f  %7.4f %7.4f  %4llu %7.3f%%\n", view,
+           set, lights, (unsigned long long)t->counted, s.rmse_ideal, s.psnr_ideal, s.rmse_hard,
+           s.psnr_hard, s.recall, s.false_area, (unsigned long long)s.blotches,
            100.0 * s.blotch_area);
 }
 
@@ -746,12 +748,10 @@ static int run_score(const options *op)
         const vt_view *v = V.views + vi;
         for (int k = 0; k < v->set_count; k++)
             for (int l = 0; l < v->light_count[k]; l++, fi++) {
-                if (read_frame(truth, &V, views_path, v->name, k, l, "hard", &hard, p,
-                               sizeof p) ||
+                if (read_frame(truth, &V, views_path, v->name, k, l, "hard", &hard, p, sizeof p) ||
                     read_frame(truth, &V, views_path, v->name, k, l, "ideal", &ideal, p,
                                sizeof p) ||
-                    read_frame(truth, &V, views_path, v->name, k, l, "mask", &mask, p,
-                               sizeof p))
+                    read_frame(truth, &V, views_path, v->name, k, l, "mask", &mask, p, sizeof p))
                     goto done;
                 for (int m = 0; m < mode_count; m++) {
                     if (read_frame(frames, &V, views_path, v->name, k, l, modes[m], &s, p,
@@ -787,8 +787,8 @@ static int run_score(const options *op)
     vt_json_f64(&j, root, "blotch_threshold", VB_FRAMES_BLOTCH);
     cJSON *jm = vt_json_array(&j, root, "modes");
     if (!op->quiet)
-        printf(PROG " score: %s, %d views from %s, %d x %d; truth %s, frames %s\n", path,
-               V.count, views_path, V.width, V.height, truth, frames);
+        printf(PROG " score: %s, %d views from %s, %d x %d; truth %s, frames %s\n", path, V.count,
+               views_path, V.width, V.height, truth, frames);
     for (int m = 0; m < mode_count; m++) {
         const vb_frames_tally *T = tally + (size_t)m * frame_count;
         vb_frames_tally scene = {0};
@@ -796,9 +796,9 @@ static int run_score(const options *op)
         vt_json_string(&j, mo, "mode", modes[m]);
         cJSON *sets = vt_json_array(&j, mo, "sets");
         if (!op->quiet)
-            printf("\n  mode %s\n  %-10s %-3s %6s %9s  %8s %6s  %8s %6s  %7s %7s  %s\n",
-                   modes[m], "view", "set", "lights", "counted", "RMSE/id", "PSNR", "RMSE/hd",
-                   "PSNR", "recall", "false", "blotches");
+            printf("\n  mode %s\n  %-10s %-3s %6s %9s  %8s %6s  %8s %6s  %7s %7s  %s\n", modes[m],
+                   "view", "set", "lights", "counted", "RMSE/id", "PSNR", "RMSE/hd", "PSNR",
+                   "recall", "false", "blotches");
         fi = 0;
         for (int vi = 0; vi < V.count; vi++) {
             const vt_view *v = V.views + vi;
@@ -855,25 +855,48 @@ done:
 
 /* ---- the command line ---------------------------------------------------------------------- */
 
-enum { O_THREADS = 256, O_CAMERAS, O_SEED, O_SIZE, O_VIEWS, O_COMPARE, O_TRUTH, O_FRAMES,
-       O_MODES, O_JSON, O_SDF, O_SDF_K };
+enum {
+    O_THREADS = 256,
+    O_CAMERAS,
+    O_SEED,
+    O_SIZE,
+    O_VIEWS,
+    O_COMPARE,
+    O_TRUTH,
+    O_FRAMES,
+    O_MODES,
+    O_JSON,
+    O_SDF,
+    O_SDF_K
+};
 
-#define COMMON_OPTIONS                                                                       \
-    {"threads", required_argument, 0, O_THREADS}, {"quiet", no_argument, 0, 'q'},           \
-        {"help", no_argument, 0, 'h'}, {"version", no_argument, 0, 'V'}
+#define COMMON_OPTIONS                                                                             \
+    {"threads", required_argument, 0, O_THREADS}, {"quiet", no_argument, 0, 'q'},                  \
+        {"help", no_argument, 0, 'h'},                                                             \
+    {                                                                                              \
+        "version", no_argument, 0, 'V'                                                             \
+    }
 
-static const struct option views_options[] = {
-    {"output", required_argument, 0, 'o'}, {"cameras", required_argument, 0, O_CAMERAS},
-    {"seed", required_argument, 0, O_SEED}, {"size", required_argument, 0, O_SIZE},
-    COMMON_OPTIONS, {0, 0, 0, 0}};
-static const struct option truth_options[] = {
-    {"output", required_argument, 0, 'o'}, {"views", required_argument, 0, O_VIEWS},
-    {"compare", required_argument, 0, O_COMPARE}, {"sdf", required_argument, 0, O_SDF},
-    {"sdf-k", required_argument, 0, O_SDF_K}, COMMON_OPTIONS, {0, 0, 0, 0}};
-static const struct option score_options[] = {
-    {"views", required_argument, 0, O_VIEWS}, {"truth", required_argument, 0, O_TRUTH},
-    {"frames", required_argument, 0, O_FRAMES}, {"modes", required_argument, 0, O_MODES},
-    {"json", required_argument, 0, O_JSON}, COMMON_OPTIONS, {0, 0, 0, 0}};
+static const struct option views_options[] = {{"output", required_argument, 0, 'o'},
+                                              {"cameras", required_argument, 0, O_CAMERAS},
+                                              {"seed", required_argument, 0, O_SEED},
+                                              {"size", required_argument, 0, O_SIZE},
+                                              COMMON_OPTIONS,
+                                              {0, 0, 0, 0}};
+static const struct option truth_options[] = {{"output", required_argument, 0, 'o'},
+                                              {"views", required_argument, 0, O_VIEWS},
+                                              {"compare", required_argument, 0, O_COMPARE},
+                                              {"sdf", required_argument, 0, O_SDF},
+                                              {"sdf-k", required_argument, 0, O_SDF_K},
+                                              COMMON_OPTIONS,
+                                              {0, 0, 0, 0}};
+static const struct option score_options[] = {{"views", required_argument, 0, O_VIEWS},
+                                              {"truth", required_argument, 0, O_TRUTH},
+                                              {"frames", required_argument, 0, O_FRAMES},
+                                              {"modes", required_argument, 0, O_MODES},
+                                              {"json", required_argument, 0, O_JSON},
+                                              COMMON_OPTIONS,
+                                              {0, 0, 0, 0}};
 
 /* The subcommands: name, getopt's name for messages, options, run. */
 static const struct command {
@@ -926,7 +949,8 @@ static int take_option(int c, options *o)
         o->mode_count = parse_modes(optarg, o->modes);
         if (!o->mode_count)
             return !bad_usage("--modes takes distinct names of letters, digits, '-' and "
-                              "'_' separated by commas (at most 32), not '%s'", optarg);
+                              "'_' separated by commas (at most 32), not '%s'",
+                              optarg);
         return 1;
     }
     return 0;
@@ -936,14 +960,17 @@ static int take_option(int c, options *o)
  * missing, or 0. */
 static int missing(const options *o, const char *cmd)
 {
-    const struct { const char *cmd; int given; const char *what; } need[] = {
-        {"views", o->output != NULL, "views: no output given (-o VIEWS.json)"},
-        {"truth", o->views_path != NULL, "truth: no view set given (--views VIEWS.json)"},
-        {"truth", o->output != NULL, "truth: no output folder given (-o DIR)"},
-        {"score", o->views_path != NULL, "score: no view set given (--views VIEWS.json)"},
-        {"score", o->truth != NULL, "score: no truth folder given (--truth DIR)"},
-        {"score", o->frames != NULL, "score: no folder of frames given (--frames DIR2)"},
-        {"score", o->mode_count != 0, "score: no modes given (--modes LIST)"}};
+    const struct {
+        const char *cmd;
+        int given;
+        const char *what;
+    } need[] = {{"views", o->output != NULL, "views: no output given (-o VIEWS.json)"},
+                {"truth", o->views_path != NULL, "truth: no view set given (--views VIEWS.json)"},
+                {"truth", o->output != NULL, "truth: no output folder given (-o DIR)"},
+                {"score", o->views_path != NULL, "score: no view set given (--views VIEWS.json)"},
+                {"score", o->truth != NULL, "score: no truth folder given (--truth DIR)"},
+                {"score", o->frames != NULL, "score: no folder of frames given (--frames DIR2)"},
+                {"score", o->mode_count != 0, "score: no modes given (--modes LIST)"}};
     for (size_t i = 0; i < sizeof need / sizeof need[0]; i++)
         if (strcmp(need[i].cmd, cmd) == 0 && !need[i].given)
             return bad_usage("%s", need[i].what);

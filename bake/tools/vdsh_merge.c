@@ -94,8 +94,7 @@ static int same_sources(const vdsh_file *a, const vdsh_file *b)
 static int same_stream(const vdsh_stream *a, const vdsh_stream *b)
 {
     return a->order == b->order && a->flags == b->flags && a->encoding == b->encoding &&
-           a->method == b->method &&
-           a->quantity == b->quantity && a->window == b->window &&
+           a->method == b->method && a->quantity == b->quantity && a->window == b->window &&
            memcmp(&a->window_param, &b->window_param, 4) == 0 &&
            memcmp(&a->method_param, &b->method_param, 4) == 0 &&
            memcmp(&a->scale, &b->scale, 4) == 0 &&
@@ -145,8 +144,10 @@ static int read_part(const char *path, const vdsh_file *first, const char *first
         return 1;
     }
     if (!p->has_part) {
-        fprintf(stderr, "vdsh-merge: %s: not a part (no part chunk: a whole bake, not "
-                        "'vdsh-bake --shard I/N')\n", path);
+        fprintf(stderr,
+                "vdsh-merge: %s: not a part (no part chunk: a whole bake, not "
+                "'vdsh-bake --shard I/N')\n",
+                path);
         vdsh_free(p);
         return 1;
     }
@@ -219,8 +220,7 @@ static int encode_spilled(FILE *spill, const char *output, const vdsh_stream *s,
         uint32_t k = e - a < ENCODE_ROWS ? e - a : ENCODE_ROWS;
         memcpy(rows, amax, nc * sizeof *rows);
         if (fread(rows + nc, (size_t)nc * sizeof *rows, k, spill) != k) {
-            fprintf(stderr, "vdsh-merge: cannot read back the temporary file beside %s\n",
-                    output);
+            fprintf(stderr, "vdsh-merge: cannot read back the temporary file beside %s\n", output);
             bad = 1;
         } else if (s->encoding == VDSH_ENCODING_F16) {
             bad = vdsh_encode_f16(rows + nc, (size_t)k * nc, s->scale,
@@ -256,9 +256,8 @@ typedef struct options {
  * or --version; VT_EXIT_USAGE after saying what is wrong). */
 static int parse_args(int argc, char **argv, options *o)
 {
-    static const struct option longopts[] = {{"output", required_argument, 0, 'o'},
-                                             {"quiet", no_argument, 0, 'q'},
-                                             VT_CLI_LONGOPTS_END};
+    static const struct option longopts[] = {
+        {"output", required_argument, 0, 'o'}, {"quiet", no_argument, 0, 'q'}, VT_CLI_LONGOPTS_END};
     *o = (options){0};
     int c;
     while ((c = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
@@ -282,16 +281,16 @@ static int parse_args(int argc, char **argv, options *o)
 /* The merge under way: the first part (kept, to check the others against,
  * and for its receivers) and what the parts add to the whole file. */
 typedef struct merge {
-    vdsh_file *p0, *part;                      /* the first part; the current other one */
-    float *merged[VDSH_MAX_STREAMS];           /* f32 and variable: every receiver's rows */
-    uint8_t *orders[VDSH_MAX_STREAMS];         /* variable-order streams' */
+    vdsh_file *p0, *part;              /* the first part; the current other one */
+    float *merged[VDSH_MAX_STREAMS];   /* f32 and variable: every receiver's rows */
+    uint8_t *orders[VDSH_MAX_STREAMS]; /* variable-order streams' */
     uint32_t *offsets[VDSH_MAX_STREAMS];
-    void *encoded[VDSH_MAX_STREAMS];           /* f16, s8, s8s6: the merged stream */
+    void *encoded[VDSH_MAX_STREAMS];               /* f16, s8, s8s6: the merged stream */
     float amax[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS]; /* largest |c|s, zero */
     float s8_scales[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS];
-    uint32_t target;                           /* the merged encoding */
-    FILE *spill;                               /* f16, s8, s8s6: the parts' f32 rows */
-    off_t *spill_at;                           /* per shard: where its rows start */
+    uint32_t target; /* the merged encoding */
+    FILE *spill;     /* f16, s8, s8s6: the parts' f32 rows */
+    off_t *spill_at; /* per shard: where its rows start */
     int *owner;
     float *normals;
     uint8_t *drawn; /* per receiver, from the first part's POSN and TRIS */
@@ -366,8 +365,8 @@ static int merge_part(merge *m, const options *o, int i, const vdsh_file *p)
         return 1;
     }
     if (m->owner[pt->index] >= 0) {
-        fprintf(stderr, "vdsh-merge: %s: shard %u of %u again (also %s)\n", o->parts[i],
-                pt->index, m->count, o->parts[m->owner[pt->index]]);
+        fprintf(stderr, "vdsh-merge: %s: shard %u of %u again (also %s)\n", o->parts[i], pt->index,
+                m->count, o->parts[m->owner[pt->index]]);
         return 1;
     }
     m->owner[pt->index] = i;
@@ -418,8 +417,8 @@ static int merge_complete(merge *m, const options *o)
         return 1;
     }
     if ((uint32_t)o->part_count != m->count) {
-        fprintf(stderr, "vdsh-merge: %u of %u shards missing:",
-                m->count - (uint32_t)o->part_count, m->count);
+        fprintf(stderr, "vdsh-merge: %u of %u shards missing:", m->count - (uint32_t)o->part_count,
+                m->count);
         for (uint32_t k = 0, shown = 0; k < m->count; k++)
             if (m->owner[k] < 0 && shown++ < 32)
                 fprintf(stderr, " %u", k);
@@ -437,8 +436,7 @@ static int merge_streams(merge *m)
     m->f.normals = m->normals;
     for (uint32_t s = 0; s < m->f.stream_count; s++) {
         size_t nc = (size_t)m->streams[s].order * m->streams[s].order;
-        m->streams[s].data =
-            m->target == VDSH_ENCODING_F32 ? (void *)m->merged[s] : m->encoded[s];
+        m->streams[s].data = m->target == VDSH_ENCODING_F32 ? (void *)m->merged[s] : m->encoded[s];
         m->streams[s].encoding = m->target;
         if (m->target == VDSH_ENCODING_CPCA) {
             /* As vb_bake_fill_file: the global step over every receiver,
@@ -457,8 +455,8 @@ static int merge_streams(merge *m)
             f32.coef_scales = NULL;
             f32.data = m->merged[s];
             vdsh_error e;
-            if (vdsh_cpca_encode_stream(&f32, m->V, m->normals, &st, &m->streams[s],
-                                        &m->encoded[s], NULL, &e) != VDSH_OK) {
+            if (vdsh_cpca_encode_stream(&f32, m->V, m->normals, &st, &m->streams[s], &m->encoded[s],
+                                        NULL, &e) != VDSH_OK) {
                 fprintf(stderr, "vdsh-merge: order %u stream: %s\n", m->streams[s].order, e.msg);
                 return 1;
             }
@@ -509,14 +507,12 @@ static int merge_spilled(merge *m, const char *output)
         uint32_t b, e;
         vb_shard_range(m->V, k, m->count, &b, &e);
         if (fseeko(m->spill, m->spill_at[k], SEEK_SET) != 0) {
-            fprintf(stderr, "vdsh-merge: cannot read back the temporary file beside %s\n",
-                    output);
+            fprintf(stderr, "vdsh-merge: cannot read back the temporary file beside %s\n", output);
             return 1;
         }
         for (uint32_t s = 0; s < m->f.stream_count; s++)
-            if (!m->orders[s] && encode_spilled(m->spill, output, &m->streams[s], m->encoded[s],
-                                                b, e, m->drawn, m->amax[s],
-                                                m->s8_scales[s]) != 0)
+            if (!m->orders[s] && encode_spilled(m->spill, output, &m->streams[s], m->encoded[s], b,
+                                                e, m->drawn, m->amax[s], m->s8_scales[s]) != 0)
                 return 1;
     }
     return 0;
@@ -570,8 +566,8 @@ static int check_outputs(const options *o)
     for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
         if (vb_output_cubemap_path(o->output, NULL, k, cube[k], sizeof cube[k], &e) == VB_OK)
             outs[1 + k] = cube[k];
-    return vt_cli_check_outputs(outs, 1 + VB_CUBEMAP_BASIS_FILES,
-                                (const char *const *)o->parts, o->part_count) != 0;
+    return vt_cli_check_outputs(outs, 1 + VB_CUBEMAP_BASIS_FILES, (const char *const *)o->parts,
+                                o->part_count) != 0;
 }
 
 /* Pass 1, one part at a time, then the streams, pass 2 and the files: the
@@ -595,8 +591,8 @@ static int run(const options *o)
         vdsh_free(m.part);
         m.part = NULL;
     }
-    if (merge_complete(&m, o) == 0 && merge_streams(&m) == 0 &&
-        merge_spilled(&m, o->output) == 0 && merge_write(&m, o) == 0)
+    if (merge_complete(&m, o) == 0 && merge_streams(&m) == 0 && merge_spilled(&m, o->output) == 0 &&
+        merge_write(&m, o) == 0)
         status = 0;
 out:
     merge_free(&m);

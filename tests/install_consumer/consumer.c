@@ -19,8 +19,12 @@ int main(int argc, char **argv)
     float coef[3 * 4] = {0};
     for (int v = 0; v < 3; v++)
         coef[4 * v] = 2.0f / 0.28209479177387814f; /* D = 2 everywhere */
-    vdsh_stream st = {.order = 2, .encoding = VDSH_ENCODING_F32, .method = VDSH_METHOD_LSQ,
-                      .quantity = VDSH_QUANTITY_DISTANCE, .scale = 1.0f, .data = coef};
+    vdsh_stream st = {.order = 2,
+                      .encoding = VDSH_ENCODING_F32,
+                      .method = VDSH_METHOD_LSQ,
+                      .quantity = VDSH_QUANTITY_DISTANCE,
+                      .scale = 1.0f,
+                      .data = coef};
     vdsh_source src = {.name = (char *)"consumer", .size = 0};
     vdsh_file f = {0};
     f.header.vertex_count = 3;
@@ -45,9 +49,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "read: %s\n", err.msg);
         return 1;
     }
-    int ok = g->header.vertex_count == 3 && g->header.triangle_count == 1 &&
-             g->stream_count == 1 && g->streams[0].order == 2 &&
-             memcmp(g->positions, pos, sizeof pos) == 0;
+    int ok = g->header.vertex_count == 3 && g->header.triangle_count == 1 && g->stream_count == 1 &&
+             g->streams[0].order == 2 && memcmp(g->positions, pos, sizeof pos) == 0;
     printf("vdsh %s (format %u): read back %s\n", vdsh_library_version(), VDSH_FORMAT_VERSION,
            ok ? "ok" : "WRONG");
     vdsh_free(g);
