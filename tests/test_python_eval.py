@@ -238,7 +238,13 @@ def same(a, b, where):
         fail.append("info %s: %r, vdsh-info %r" % (where, a, b))
 
 
-checked = [p for p, _ in files[:3]] + [os.path.join(work, "adaptive-order.vdsh"), part]
+cpca = os.path.join(work, "cpca.vdsh")
+r = subprocess.run([bake, "builtin:room", "--max-edge", "2", "--rays", "64", "-q", "--cube-size",
+                    "0", "--orders", "7", "--encoding", "cpca", "--cpca", "3,9,4", "-o", cpca],
+                   capture_output=True, text=True)
+if r.returncode:
+    fail.append("bake cpca: %s" % r.stderr.strip())
+checked = [p for p, _ in files[:3]] + [os.path.join(work, "adaptive-order.vdsh"), part, cpca]
 for path in checked:
     if not os.path.exists(path):
         continue

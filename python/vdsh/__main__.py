@@ -31,6 +31,8 @@ error.
 def _bytes_per_vertex(s: Dict[str, Any]) -> int:
     """Bytes of one record at the stream's order (vdsh_stream_bytes_per_vertex)."""
     nc = s["order"] ** 2
+    if s["encoding"] == "cpca":
+        return 4 * s["cpca"]["record_words"]
     words = (nc - 4 + 4) // 5 if s["encoding"] == "s8s6" and nc > 4 else 0
     return {"f32": 4 * nc, "f16": 2 * nc, "s8": nc, "s8s6": min(nc, 4) + 4 * words}[s["encoding"]]
 
