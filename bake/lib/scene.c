@@ -172,27 +172,19 @@ static float probe_nearest(const vb_scene *s, const float p[3])
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     for (int i = 0; i < VDSH_FREE_PROBES; i++) {
-        struct RTCRay r = {.org_x = o[0],
-                           .org_y = o[1],
-                           .org_z = o[2],
-                           .dir_x = dirs[i][0],
-                           .dir_y = dirs[i][1],
-                           .dir_z = dirs[i][2],
-                           .tnear = 0.0f,
-                           .tfar = INFINITY,
-                           .mask = 0xffffffffu};
+        const struct RTCRay ray = {.org_x = o[0],
+                                   .org_y = o[1],
+                                   .org_z = o[2],
+                                   .dir_x = dirs[i][0],
+                                   .dir_y = dirs[i][1],
+                                   .dir_z = dirs[i][2],
+                                   .tnear = 0.0f,
+                                   .tfar = INFINITY,
+                                   .mask = 0xffffffffu};
+        struct RTCRay r = ray;
         rtcOccluded1(s->scene, &ctx, &r);
         if (r.tfar < 0.0f) { /* met something: find how far */
-            struct RTCRayHit rh = {.ray = {.org_x = o[0],
-                                           .org_y = o[1],
-                                           .org_z = o[2],
-                                           .dir_x = dirs[i][0],
-                                           .dir_y = dirs[i][1],
-                                           .dir_z = dirs[i][2],
-                                           .tnear = 0.0f,
-                                           .tfar = INFINITY,
-                                           .mask = 0xffffffffu},
-                                   .hit = {.geomID = RTC_INVALID_GEOMETRY_ID}};
+            struct RTCRayHit rh = {.ray = ray, .hit = {.geomID = RTC_INVALID_GEOMETRY_ID}};
             rtcIntersect1(s->scene, &ctx, &rh);
             float d = rh.ray.tfar / s->scale;
             best = d < best ? d : best;
