@@ -333,7 +333,14 @@ extern "C" vb_result vb_mesh_parse(const char *name, vb_mesh_format format, cons
         return vb_fail(err, VB_ERR_ARGUMENT, "vb_mesh_parse: NULL argument");
     static const uint8_t nothing = 0;
     const uint8_t *b = bytes ? bytes : &nothing;
-    return vb_read::no_throw(name, err, [&] { return parse(name, format, b, size, out, err); });
+    /* A value outside the enum is refused here, as an int: it is never
+     * loaded as a vb_mesh_format (UBSan's enum check reports such a load
+     * through the lambda's reference). */
+    const int fmt = format;
+    if (fmt < VB_MESH_OBJ || fmt > VB_MESH_GLB)
+        return vb_fail(err, VB_ERR_ARGUMENT, "%s: unknown mesh format", name);
+    const vb_mesh_format f = static_cast<vb_mesh_format>(fmt);
+    return vb_read::no_throw(name, err, [&] { return parse(name, f, b, size, out, err); });
 }
 
 extern "C" void vb_mesh_raw_free(vb_mesh_raw *raw)
