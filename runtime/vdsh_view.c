@@ -259,9 +259,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
         {"views", required_argument, 0, O_VIEWS},
         {"modes", required_argument, 0, O_MODES},
         {"quiet", no_argument, 0, 'q'},
-        {"help", no_argument, 0, 'h'},
-        {"version", no_argument, 0, 'V'},
-        {0, 0, 0, 0}};
+        VT_CLI_LONGOPTS_END};
     int c;
     while ((c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
         const char *v = optarg;

@@ -640,8 +640,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"output", required_argument, 0, 'o'}, {"orders", required_argument, 0, 'O'},
         {"float", no_argument, 0, 'F'},        {"compress", no_argument, 0, 'C'},
         {"decode-cpca", no_argument, 0, 'D'},  {"source", required_argument, 0, 'S'},
-        {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
-        {"version", no_argument, 0, 'V'},      {0, 0, 0, 0}};
+        {"quiet", no_argument, 0, 'q'},        VT_CLI_LONGOPTS_END};
     memset(o, 0, sizeof *o);
     int opt, set[VDSH_ORDER_SLOTS];
     while ((opt = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {

@@ -762,9 +762,7 @@ static int parse_args(int argc, char **argv, options *o)
                                              {"light-rule", required_argument, 0, O_LIGHT_RULE},
                                              {"offsets", required_argument, 0, O_OFFSETS},
                                              {"quiet", no_argument, 0, 'q'},
-                                             {"help", no_argument, 0, 'h'},
-                                             {"version", no_argument, 0, 'V'},
-                                             {0, 0, 0, 0}};
+                                             VT_CLI_LONGOPTS_END};
     memset(o, 0, sizeof *o);
     o->d.interior = 65536;
     vb_eval_desc *d = &o->d;
