@@ -40,6 +40,17 @@ add_test(NAME bake_isa_agree
                  $<TARGET_FILE:vdsh-info> $<TARGET_FILE:vdsh_compare>
                  ${CMAKE_CURRENT_SOURCE_DIR}/with_each_isa.sh ${VDSH_SHARED_SCENES})
 
+# The same bytes on any x86-64 CPU: glibc's libm paths of a CPU without
+# AVX2 and FMA, and (VDSH_REFERENCE_BAKE: another build's vdsh-bake, set by
+# scripts/test for the sanitizer build, which has no target_clones) the
+# baseline clones against the AVX2 ones.
+set(VDSH_REFERENCE_BAKE "" CACHE FILEPATH
+    "Another build's vdsh-bake whose bytes bake_same_bytes_any_cpu compares")
+add_test(NAME bake_same_bytes_any_cpu
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_same_bytes_any_cpu.sh
+                 $<TARGET_FILE:vdsh-bake> ${VDSH_SHARED_SCENES} ${VDSH_REFERENCE_BAKE})
+set_tests_properties(bake_same_bytes_any_cpu PROPERTIES TIMEOUT 900)
+
 # Sharded bakes (vdsh-bake --shard I/N, vdsh-merge): byte for byte.
 add_test(NAME bake_shard
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard.sh

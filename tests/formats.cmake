@@ -125,6 +125,13 @@ add_executable(test_scene_view ${CMAKE_CURRENT_LIST_DIR}/test_scene_view.c)
 target_link_libraries(test_scene_view PRIVATE vdsh_format m)
 add_test(NAME format_scene_view COMMAND test_scene_view unit)
 
+# format_det_math   formats/vdsh_det.h (the bake's sin, cos, exp, log, atan2,
+#                   acos, the same bits on every CPU) within 1-4 ulp of libm
+add_executable(test_det_math ${CMAKE_CURRENT_LIST_DIR}/test_det_math.c)
+target_include_directories(test_det_math PRIVATE ${PROJECT_SOURCE_DIR}/formats)
+target_link_libraries(test_det_math PRIVATE m)
+add_test(NAME format_det_math_matches_libm COMMAND test_det_math)
+
 # format_cpca       the cpca encoding (issue 29): encoder, writer, reader
 #                   and decoder on a synthetic order-7 stream: round trip,
 #                   decode to the bit, error bounded, determinism, every

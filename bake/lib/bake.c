@@ -29,6 +29,7 @@
 #include "vdsh.h"
 #include "vdsh_sh.h"
 #include "vdsh_shadow.h"
+#include "vdsh_det.h"
 
 #define VB_PI 3.14159265358979323846
 #define BLOCK 16 /* receivers per work item */
@@ -633,7 +634,7 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
                         s1 += (double)cur[j] * y[j], s0 += (double)adapt_prev[j] * y[j];
                     double ratio;
                     if (aq)
-                        ratio = exp(s1 - s0);
+                        ratio = vdsh_det_exp(s1 - s0);
                     else {
                         double tmin = 1e-4 * d->max_distance;
                         ratio = (s1 > tmin ? s1 : tmin) / (s0 > tmin ? s0 : tmin);
@@ -820,7 +821,7 @@ score_fits(const job *J, uint32_t count, const vertex_sink *out,
             }
             double sum = 0.0;
             for (uint32_t k = 0; k < count; k++) {
-                double dv = q ? exp(s[k]) : (s[k] > 0.0 ? s[k] : 0.0);
+                double dv = q ? vdsh_det_exp(s[k]) : (s[k] > 0.0 ? s[k] : 0.0);
                 sum += expected_error(J->error_table, dv / t[k]);
             }
             e[o][q] += sum;

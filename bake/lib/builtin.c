@@ -61,6 +61,7 @@
  * contraction), so N gives the same bytes on any machine and compiler.
  */
 #include "mesh.h"
+#include "vdsh_det.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -282,7 +283,7 @@ enum { FACE_BOTTOM = 1, FACE_TOP = 2, AS_PILLAR = 4 };
 static void add_box(room_builder *b, float cx, float cz, float y0, float sx, float sy, float sz,
                     float angle, int flags)
 {
-    float c = cosf(angle), s = sinf(angle);
+    float c = (float)vdsh_det_cos(angle), s = (float)vdsh_det_sin(angle);
     float p[8][3];
     /* corner i: bit 0 = +x, bit 1 = +z, bit 2 = top (box axes) */
     for (int i = 0; i < 8; i++) {

@@ -6,6 +6,7 @@
 
 #include "vdsh.h"
 #include "vdsh_sh.h"
+#include "vdsh_det.h"
 
 #define PI 3.14159265358979323846
 
@@ -110,7 +111,7 @@ static int invert(int n, const double *a, double *inv)
 void vb_gauss_legendre(int n, double *x, double *w)
 {
     for (int i = 0; i < n; i++) {
-        double z = cos(PI * (i + 0.75) / (n + 0.5)), pp = 1.0;
+        double z = vdsh_det_cos(PI * (i + 0.75) / (n + 0.5)), pp = 1.0;
         for (int it = 0; it < 100; it++) {
             double p1 = 1.0, p2 = 0.0;
             for (int j = 1; j <= n; j++) {
@@ -143,8 +144,8 @@ double vb_window_weight(vdsh_window window, int l, int order)
 {
     double x = (double)l / order;
     switch (window) {
-    case VDSH_WINDOW_HANN: return 0.5 * (1.0 + cos(PI * x));
-    case VDSH_WINDOW_LANCZOS: return l == 0 ? 1.0 : sin(PI * x) / (PI * x);
+    case VDSH_WINDOW_HANN: return 0.5 * (1.0 + vdsh_det_cos(PI * x));
+    case VDSH_WINDOW_LANCZOS: return l == 0 ? 1.0 : vdsh_det_sin(PI * x) / (PI * x);
     default: return 1.0;
     }
 }
@@ -155,7 +156,7 @@ static void fibonacci(int K, double (*d)[3])
     for (int j = 0; j < K; j++) {
         double z = 1.0 - (2.0 * j + 1.0) / K, r = sqrt(1.0 - z * z);
         double phi = j * PI * (3.0 - sqrt(5.0));
-        d[j][0] = r * cos(phi), d[j][1] = r * sin(phi), d[j][2] = z;
+        d[j][0] = r * vdsh_det_cos(phi), d[j][1] = r * vdsh_det_sin(phi), d[j][2] = z;
     }
 }
 
@@ -184,7 +185,7 @@ static void hemisphere_gram(int order, double lambda, double *G)
     for (int a = 0; a < NZ; a++)
         for (int b = 0; b < NP; b++) {
             double r = sqrt(1.0 - zx[a] * zx[a]), phi = 2.0 * PI * (b + 0.5) / NP;
-            double d[3] = {r * cos(phi), r * sin(phi), zx[a]};
+            double d[3] = {r * vdsh_det_cos(phi), r * vdsh_det_sin(phi), zx[a]};
             eval_d(order, d, y);
             double w = zw[a] * 2.0 * PI / NP;
             for (int i = 0; i < n; i++)

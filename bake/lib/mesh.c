@@ -9,6 +9,7 @@
 #include "mesh_parse.h"
 #include "vdsh_math.h"
 #include "vdsh_output.h"
+#include "vdsh_det.h"
 
 #include <nettle/sha2.h>
 
@@ -62,6 +63,26 @@ void vb_mesh_bounds(const vb_mesh *m, float min[3], float max[3])
 #define SPACING_STEP 0.01 /* ln of a bin's width ratio */
 #define SPACING_LOW 1e-6
 
+/* 10^(n - 1) for the largest n with 10^n <= x, the step of x's second
+ * digit (0.1 for x not positive and finite): by exact products and one
+ * correctly rounded division, the same bits on every CPU (libm's log10
+ * differs between CPUs, vdsh_det.h) */
+static double second_digit_step(double x)
+{
+    double q = 1.0; /* 10^|n - 1| */
+    if (!(x > 0.0 && x < 1e300))
+        return 0.1;
+    if (x >= 10.0) {
+        while (q * 100.0 <= x)
+            q *= 10.0;
+        return q;
+    }
+    q = 10.0; /* x in [10^n, 10^(n+1)) with n <= 0: 1 / 10^(1 - n) */
+    while (10.0 / q > x)
+        q *= 10.0;
+    return 1.0 / q;
+}
+
 void vb_mesh_spacing_of(const vb_mesh *m, float diagonal, vb_mesh_spacing *s)
 {
     memset(s, 0, sizeof *s);
@@ -99,7 +120,7 @@ void vb_mesh_spacing_of(const vb_mesh *m, float diagonal, vb_mesh_spacing *s)
         if (l > limit)
             long_area += a;
         double r = l / diagonal;
-        int b = r > SPACING_LOW ? (int)(log(r / SPACING_LOW) / SPACING_STEP) : 0;
+        int b = r > SPACING_LOW ? (int)(vdsh_det_log(r / SPACING_LOW) / SPACING_STEP) : 0;
         bin[b < SPACING_BINS ? b : SPACING_BINS - 1] += a;
     }
     s->area = area;
@@ -112,7 +133,7 @@ void vb_mesh_spacing_of(const vb_mesh *m, float diagonal, vb_mesh_spacing *s)
     double sum = 0.0;
     for (int b = 0; b < SPACING_BINS && !(s->p90_edge > 0.0f); b++) {
         sum += bin[b];
-        double mid = SPACING_LOW * exp((b + 0.5) * SPACING_STEP) * diagonal;
+        double mid = SPACING_LOW * vdsh_det_exp((b + 0.5) * SPACING_STEP) * diagonal;
         if (mid > longest)
             mid = longest;
         if (!(s->median_edge > 0.0f) && sum >= 0.5 * area)
@@ -121,7 +142,7 @@ void vb_mesh_spacing_of(const vb_mesh *m, float diagonal, vb_mesh_spacing *s)
             s->p90_edge = (float)mid;
     }
     double want = (double)VB_SPACING_SUGGEST * diagonal;
-    double mag = pow(10.0, floor(log10(want)) - 1.0);
+    double mag = second_digit_step(want);
     s->suggest_edge = (float)(round(want / mag) * mag);
 }
 
@@ -342,8 +363,8 @@ static void compute_normals(vb_mesh *m, uint8_t *cancelled)
             }
             double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2],
                    cz = u[0] * v[1] - u[1] * v[0];
-            double angle =
-                atan2(sqrt(cx * cx + cy * cy + cz * cz), u[0] * v[0] + u[1] * v[1] + u[2] * v[2]);
+            double angle = vdsh_det_atan2(sqrt(cx * cx + cy * cy + cz * cz),
+                                          u[0] * v[0] + u[1] * v[1] + u[2] * v[2]);
             float *out = m->normals + 3 * (size_t)tri[c];
             for (int k = 0; k < 3; k++)
                 out[k] += (float)(n[k] * angle);
@@ -791,7 +812,7 @@ static vb_result split_creases(const vb_mesh_raw *raw, uint32_t *idx, split_vert
         return VB_OK;
     const uint32_t nv = raw->vertex_count;
     const size_t corners = 3 * (size_t)raw->triangle_count;
-    const double agree = cos(VB_MESH_NORMAL_AGREE_DEG * 3.14159265358979323846 / 180.0);
+    const double agree = vdsh_det_cos(VB_MESH_NORMAL_AGREE_DEG * 3.14159265358979323846 / 180.0);
 
     /* Every vertex's corners, in triangle order (counting sort). */
     size_t *start = calloc((size_t)nv + 1, sizeof *start);

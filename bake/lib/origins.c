@@ -9,6 +9,7 @@
 #include "bake.h"
 #include "parallel.h"
 #include "sampling.h"
+#include "vdsh_det.h"
 
 #define VB_PI 3.14159265358979323846
 
@@ -258,7 +259,8 @@ static void prober_init(prober *P, const vb_scene *s)
             double z = 1.0 - (i + 0.5) / 4.0, rr = sqrt(1.0 - z * z);
             double phi = 2.0 * VB_PI * (j + 0.5 + 0.25 * i) / 4.0;
             float *l = P->local_dir[4 * i + j];
-            l[0] = (float)(rr * cos(phi)), l[1] = (float)(rr * sin(phi)), l[2] = (float)z;
+            l[0] = (float)(rr * vdsh_det_cos(phi)), l[1] = (float)(rr * vdsh_det_sin(phi)),
+            l[2] = (float)z;
         }
 }
 

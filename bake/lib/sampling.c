@@ -1,5 +1,6 @@
 #include "sampling.h"
 #include "vdsh_math.h"
+#include "vdsh_det.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -73,13 +74,13 @@ static void sphere_dir(const vb_dirgrid *g, double w, double c, double d[3])
 {
     double z = 1.0 - 2.0 * w / g->nu, r = sqrt(fmax(0.0, 1.0 - z * z));
     double phi = 2.0 * VB_PI * c / g->nv;
-    d[0] = r * cos(phi), d[1] = r * sin(phi), d[2] = z;
+    d[0] = r * vdsh_det_cos(phi), d[1] = r * vdsh_det_sin(phi), d[2] = z;
 }
 
 static double angle(const double a[3], const double b[3])
 {
     double d = vdsh_dot3d(a, b);
-    return acos(fmax(-1.0, fmin(1.0, d)));
+    return vdsh_det_acos(fmax(-1.0, fmin(1.0, d)));
 }
 
 /* A cone containing every direction a packet can produce. Each cell is
@@ -133,7 +134,7 @@ static void packet_cone(const vb_dirgrid *g, const uint32_t *cells, float cone[4
     }
     double alpha = worst + diag + 1e-4;
     cone[0] = (float)axis[0], cone[1] = (float)axis[1], cone[2] = (float)axis[2];
-    cone[3] = alpha >= VB_PI / 2 ? 2.0f : (float)sin(alpha);
+    cone[3] = alpha >= VB_PI / 2 ? 2.0f : (float)vdsh_det_sin(alpha);
 }
 
 vb_result vb_dirgrid_create(uint32_t rays, int hemisphere, vb_dirgrid *out, vb_error *err)
@@ -183,8 +184,8 @@ vb_result vb_dirgrid_create(uint32_t rays, int hemisphere, vb_dirgrid *out, vb_e
         uint32_t cell = g.cells[i] == UINT32_MAX ? 0 : g.cells[i];
         double phi = 2.0 * VB_PI * (cell % g.nv) / g.nv;
         g.lane_row[i] = (float)(cell / g.nv);
-        g.lane_cos[i] = (float)cos(phi);
-        g.lane_sin[i] = (float)sin(phi);
+        g.lane_cos[i] = (float)vdsh_det_cos(phi);
+        g.lane_sin[i] = (float)vdsh_det_sin(phi);
     }
     for (uint32_t p = 0; p < g.packet_count; p++)
         packet_cone(&g, g.cells + (size_t)p * VB_PACKET, g.cone + 4 * (size_t)p);
@@ -252,8 +253,8 @@ void vb_dirgrid_packet(const vb_dirgrid *g, uint32_t packet, uint64_t seed,
             hash_uv(key, cells[k], &ju, &jv);
             float r = sqrtf(fmaxf(0.0f, 1.0f - z[k] * z[k]));
             float phi = (float)(2.0 * VB_PI) * ((float)(cells[k] % g->nv) + jv) / (float)g->nv;
-            x[k] = r * cosf(phi);
-            y[k] = r * sinf(phi);
+            x[k] = r * (float)vdsh_det_cos(phi);
+            y[k] = r * (float)vdsh_det_sin(phi);
         }
     }
     if (g->hemisphere) {
@@ -354,7 +355,7 @@ void vb_dirgrid_packet_nested(const vb_dirgrid *g, uint32_t packet, uint64_t see
         float z = 1.0f - zscale * ((float)row + ju) / (float)g->nu;
         float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
         float phi = (float)(2.0 * VB_PI) * ((float)col + jv) / (float)g->nv;
-        float x = r * cosf(phi), y = r * sinf(phi);
+        float x = r * (float)vdsh_det_cos(phi), y = r * (float)vdsh_det_sin(phi);
         if (g->hemisphere) {
             dx[k] = x * t[0] + y * b[0] + z * n[0];
             dy[k] = x * t[1] + y * b[1] + z * n[1];

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "vdsh_light.h"
+#include "vdsh_det.h"
 
 static void on_embree_error(void *user, enum RTCError code, const char *str)
 {
@@ -220,7 +221,8 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
             /* a walk along x at two thirds of the height, swinging across z */
             float t = hi[0] > lo[0] ? (p[0] - lo[0]) / (hi[0] - lo[0]) : 0.5f;
             p[1] = lo[1] + 0.66f * (hi[1] - lo[1]);
-            p[2] = 0.5f * (lo[2] + hi[2]) + 0.3f * (hi[2] - lo[2]) * sinf(6.2831853f * t);
+            p[2] = 0.5f * (lo[2] + hi[2]) +
+                   0.3f * (hi[2] - lo[2]) * (float)vdsh_det_sin(6.2831853f * t);
         }
         if (!vb_scene_free_space(s, p))
             continue;
