@@ -105,10 +105,6 @@ void vr_buffer_destroy(vr_buffer *b)
     glDeleteBuffers(5, bufs);
     if (b->decode_prog)
         glDeleteProgram(b->decode_prog);
-    glDeleteVertexArrays(1, &b->decode_vao);
-    GLuint more[2] = {b->model_ubo, b->sorted_ibo};
-    glDeleteBuffers(2, more);
-    free(b->cluster_first);
     free(b->ks);
     memset(b, 0, sizeof *b);
 }
@@ -343,64 +339,33 @@ static void make_gl(vr_scene *s, vr_buffer *b, const void *rec, size_t bytes, co
     b->bytes += bytes;
 }
 
-/* Texels a draw of the uniform-block decode writes per vertex, at most
- * (docs/BENCHMARKS.md: more costs compile time, fewer draw overhead). */
-enum { DEC_MAX_CHUNK = 4 };
-
-/* The decode written out for a uniform-block model, for the chunk
- * texels from u_t0 (a uniform: the draw's; see
- * shaders/vdsh_cpca_decode.glsl): "#define DEC_UNROLLED" and
- * dec_unrolled(v), buf_begin's unpacking and the loops of main() with the
- * same operations in the same order, every bit position and weight index
- * a constant and every model index u_t0 * (B + 1) plus a constant. As
- * loops, llvmpipe keeps the weights in memory, a scatter and a gather per
- * vertex for each, and reads the model with a gather per vertex where a
- * constant offset is one load for all the vertices of a batch
- * (docs/BENCHMARKS.md). NULL when out of memory. */
-static char *unrolled_decode(int chunk, int B, int bits, int words)
+/* "#define BUF_CPCA_DOT(m) (BUF_MODEL(m) + b_wt[0] * BUF_MODEL((m) + 1)
+ * + ...)\n" for a cpca stream of `basis` vectors: the decode's sum of a
+ * model texel (shaders/vdsh_cpca_decode.glsl) written out, the same
+ * operations in the same order with constant weight indices. As a loop
+ * it cost twice the decode's time on llvmpipe; in the per-pass decode
+ * (vdsh_buffer.glsl's buf_next) the same macro made the pass 2.6x slower,
+ * so only the decode once per frame uses it (docs/BENCHMARKS.md).
+ * Malloc'd; NULL when out of memory. */
+static char *vr_cpca_dot_define(int basis)
 {
-    size_t size = 512 + (size_t)words * 64 + (size_t)B * 96 + (size_t)chunk * ((size_t)B * 48 + 96);
-    char *src = malloc(size);
-    if (!src)
+    size_t size = 64 + (size_t)basis * 40;
+    char *d = malloc(size);
+    if (!d)
         return NULL;
-    size_t n = (size_t)snprintf(src, size,
-                                "#define DEC_UNROLLED 1\nuniform int u_t0;\n"
-                                "void dec_unrolled(int v)\n{\n");
-    for (int k = 0; k < words; k++)
-        n += (size_t)snprintf(src + n, size - n, "    uint r%d = BUF_FETCH(v * %d + %d).r;\n", k,
-                              words, k);
-    int word = 0, shift = 8;
-    for (int j = 0; j < B; j++) {
-        if (shift + bits > 32) {
-            word++;
-            shift = 0;
-        }
-        n += (size_t)snprintf(src + n, size - n,
-                              "    float w%d = float(int(r%d << %du) >> %d);\n", j, word,
-                              32 - shift - bits, 32 - bits);
-        shift += bits;
-    }
-    n += (size_t)snprintf(src + n, size - n, "    vec4 a;\n    int m = u_t0 * %d;\n", B + 1);
-    for (int t = 0; t < chunk; t++) {
-        int m = t * (B + 1);
-        n += (size_t)snprintf(src + n, size - n, "    a = u_m[m + %d];\n", m);
-        for (int j = 0; j < B; j++)
-            n += (size_t)snprintf(src + n, size - n, "    a += w%d * u_m[m + %d];\n", j,
-                                  m + 1 + j);
-        n += (size_t)snprintf(src + n, size - n, "    d_out[v * BUF_CPCA_T + u_t0 + %d] = a;\n",
-                              t);
-    }
-    snprintf(src + n, size - n, "}\n");
-    return src;
+    size_t n = (size_t)snprintf(d, size, "#define BUF_CPCA_DOT(m) (BUF_MODEL(m)");
+    for (int j = 0; j < basis && n < size; j++)
+        n += (size_t)snprintf(d + n, size - n, " + b_wt[%d] * BUF_MODEL((m) + %d)", j, j + 1);
+    if (n < size)
+        snprintf(d + n, size - n, ")\n");
+    return d;
 }
 
 /* VR_CPCA_PER_FRAME: the decode program and the scratch of b (see
  * vr.h, shaders/vdsh_cpca_decode.glsl). VR_ERR_GL where the vertex stage
  * has no shader storage buffers or the scratch is over this GL's limits,
  * VR_ERR_SHADER, VR_ERR_OUT_OF_MEMORY. */
-static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const unsigned char *rec,
-                              const float *model, uint32_t clusters, const char *name,
-                              vr_error *err)
+static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const char *name, vr_error *err)
 {
     GLint major = 0, minor = 0, blocks = 0, max_block = 0, max_texels = 0, ext = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &major);
@@ -415,10 +380,6 @@ static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const unsigned ch
         glGetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
     }
     glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
-    GLint max_ubo = 0, ubo_blocks = 0, ubo_align = 0;
-    glGetIntegerv(GL_MAX_UNIFORM_BLOCK_SIZE, &max_ubo);
-    glGetIntegerv(GL_MAX_VERTEX_UNIFORM_BLOCKS, &ubo_blocks);
-    glGetIntegerv(GL_UNIFORM_BUFFER_OFFSET_ALIGNMENT, &ubo_align);
     glGetError();
     b->scratch_stride = vr_buffer_stride(b->order, VR_BUF_F32);
     size_t texels = (size_t)s->vertex_count * (size_t)b->scratch_stride;
@@ -432,39 +393,24 @@ static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const unsigned ch
                        "%s: order %d cpca stream: a scratch of %zu texels is above this GL's "
                        "limits (GL_MAX_TEXTURE_BUFFER_SIZE %d, GL_MAX_SHADER_STORAGE_BLOCK_SIZE %d)",
                        name, b->order, texels, (int)max_texels, (int)max_block);
-    size_t cluster_bytes = (size_t)b->scratch_stride * (size_t)(b->cpca_basis + 1) * 16;
-    int ubo = ubo_blocks >= 1 && cluster_bytes <= (size_t)(unsigned)max_ubo && ubo_align > 0;
+    char *dot = vr_cpca_dot_define(b->cpca_basis);
     char defines[512];
     snprintf(defines, sizeof defines,
              "#version 330 core\n#extension GL_ARB_shader_storage_buffer_object : require\n"
              "#define BUFFER 1\n#define NUM_LIGHTS 0\n#define BUF_ORDER %d\n#define BUF_KIND 4\n"
              "#define BUF_VARIABLE 0\n#define BUF_STRIDE %d\n#define BUF_CPCA_BASIS %d\n"
-             "#define BUF_CPCA_BITS %d\n#define BUF_CPCA_T %d\n#define BUF_CPCA_UBO %d\n"
+             "#define BUF_CPCA_BITS %d\n#define BUF_CPCA_T %d\n"
              "const float KS[1] = float[1](1.0);\n",
-             b->order, b->stride, b->cpca_basis, b->cpca_bits, b->scratch_stride, ubo);
-    b->dec_chunk = 1;
-    for (int d = 2; d <= DEC_MAX_CHUNK; d++)
-        if (b->scratch_stride % d == 0)
-            b->dec_chunk = d;
-    char *unrolled = ubo ? unrolled_decode(b->dec_chunk, b->cpca_basis, b->cpca_bits, b->stride) : NULL;
-    size_t size = strlen(defines) + vr_buffer_glsl_size + vr_cpca_decode_glsl_size +
-                  (unrolled ? strlen(unrolled) : 0) + 1;
-    char *vs = malloc(size);
-    if (!vs || (ubo && !unrolled)) {
-        free(vs);
-        free(unrolled);
+             b->order, b->stride, b->cpca_basis, b->cpca_bits, b->scratch_stride);
+    size_t size = strlen(defines) + (dot ? strlen(dot) : 0) + vr_buffer_glsl_size +
+                  vr_cpca_decode_glsl_size + 1;
+    char *vs = dot ? malloc(size) : NULL;
+    if (!vs) {
+        free(dot);
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
     }
-    /* the unrolled function goes right after the block's declaration
-     * (the line defining DEC_MODEL for it follows); without it, the
-     * file's loops */
-    const char *cut = ubo ? strstr(vr_cpca_decode_glsl, "#define DEC_MODEL(k) u_m[k]") : NULL;
-    if (cut)
-        snprintf(vs, size, "%s%s%.*s%s%s", defines, vr_buffer_glsl,
-                 (int)(cut - vr_cpca_decode_glsl), vr_cpca_decode_glsl, unrolled, cut);
-    else
-        snprintf(vs, size, "%s%s%s", defines, vr_buffer_glsl, vr_cpca_decode_glsl);
-    free(unrolled);
+    snprintf(vs, size, "%s%s%s%s", defines, dot, vr_buffer_glsl, vr_cpca_decode_glsl);
+    free(dot);
     static const char fs[] = "#version 330 core\nout vec4 o;\nvoid main() { o = vec4(0.0); }\n";
     char what[256];
     snprintf(what, sizeof what, "%s: cpca decode program", name);
@@ -475,65 +421,7 @@ static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const unsigned ch
     glUseProgram(b->decode_prog);
     glUniform1i(glGetUniformLocation(b->decode_prog, "u_coef"), VR_UNIT_COEF);
     glUniform1i(glGetUniformLocation(b->decode_prog, "u_model"), VR_UNIT_MODEL);
-    b->u_t0 = glGetUniformLocation(b->decode_prog, "u_t0");
     glUseProgram(0);
-    if (ubo) {
-        /* the vertices by cluster (counting sort: GPU vertex order within
-         * a cluster), and the model a cluster per aligned block */
-        uint32_t nv = s->vertex_count;
-        size_t rec_bytes = (size_t)b->stride * 4;
-        b->clusters = (int)clusters;
-        b->cluster_first = calloc(2 * (size_t)clusters + 2, sizeof *b->cluster_first);
-        uint32_t *sorted = malloc((size_t)nv * sizeof *sorted + 4);
-        b->ubo_stride = (cluster_bytes + (size_t)ubo_align - 1) / (size_t)ubo_align *
-                        (size_t)ubo_align;
-        unsigned char *ublocks = calloc((size_t)clusters * b->ubo_stride + 16, 1);
-        if (!b->cluster_first || !sorted || !ublocks) {
-            free(sorted);
-            free(ublocks);
-            return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
-        }
-        for (uint32_t v = 0; v < nv; v++) {
-            uint32_t c = get_u32(rec + v * rec_bytes) & 255u;
-            if (c >= clusters) {
-                free(sorted);
-                free(ublocks);
-                return vr_fail(err, VR_ERR_FORMAT,
-                               "%s: cpca stream: a vertex has cluster %u of %u", name, c,
-                               clusters);
-            }
-            b->cluster_first[c + 1]++;
-        }
-        for (uint32_t c = 0; c < clusters; c++)
-            b->cluster_first[c + 1] += b->cluster_first[c];
-        /* cluster_first[clusters + 1 ..] as the fill counters */
-        uint32_t *at = b->cluster_first + clusters + 1;
-        memcpy(at, b->cluster_first, (size_t)clusters * sizeof *at);
-        for (uint32_t v = 0; v < nv; v++)
-            sorted[at[get_u32(rec + v * rec_bytes) & 255u]++] = v;
-        for (uint32_t c = 0; c < clusters; c++)
-            memcpy(ublocks + c * b->ubo_stride, model + (size_t)c * cluster_bytes / 4,
-                   cluster_bytes);
-        glGenBuffers(1, &b->model_ubo);
-        glBindBuffer(GL_UNIFORM_BUFFER, b->model_ubo);
-        glBufferData(GL_UNIFORM_BUFFER, (GLsizeiptr)(clusters * b->ubo_stride), ublocks,
-                     GL_STATIC_DRAW);
-        glBindBuffer(GL_UNIFORM_BUFFER, 0);
-        glGenVertexArrays(1, &b->decode_vao);
-        glBindVertexArray(b->decode_vao);
-        glGenBuffers(1, &b->sorted_ibo);
-        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, b->sorted_ibo);
-        glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)((size_t)nv * 4), sorted,
-                     GL_STATIC_DRAW);
-        glBindVertexArray(0);
-        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
-        GLuint block = glGetUniformBlockIndex(b->decode_prog, "vr_model");
-        if (block != GL_INVALID_INDEX)
-            glUniformBlockBinding(b->decode_prog, block, 0);
-        b->bytes += (size_t)clusters * b->ubo_stride + (size_t)nv * 4;
-        free(sorted);
-        free(ublocks);
-    }
     glGenBuffers(1, &b->scratch_buf);
     glBindBuffer(GL_TEXTURE_BUFFER, b->scratch_buf);
     glBufferData(GL_TEXTURE_BUFFER, (GLsizeiptr)(texels * 16), NULL, GL_DYNAMIC_COPY);
@@ -555,26 +443,10 @@ void vr_buffer_decode(const vr_scene *s, const vr_buffer *b)
     glBindTexture(GL_TEXTURE_BUFFER, b->model_tex);
     glActiveTexture(GL_TEXTURE0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, b->scratch_buf);
+    (void)s;
+    glBindVertexArray(b->vao);
     glEnable(GL_RASTERIZER_DISCARD);
-    if (b->model_ubo) {
-        glBindVertexArray(b->decode_vao);
-        for (int c = 0; c < b->clusters; c++) {
-            uint32_t first = b->cluster_first[c], n = b->cluster_first[c + 1] - first;
-            if (!n)
-                continue;
-            glBindBufferRange(GL_UNIFORM_BUFFER, 0, b->model_ubo,
-                              (GLintptr)((size_t)c * b->ubo_stride), (GLsizeiptr)b->ubo_stride);
-            for (int t0 = 0; t0 < b->scratch_stride; t0 += b->dec_chunk) {
-                glUniform1i(b->u_t0, t0);
-                glDrawElements(GL_POINTS, (GLsizei)n, GL_UNSIGNED_INT,
-                               (const void *)((size_t)first * 4));
-            }
-        }
-        glBindBufferBase(GL_UNIFORM_BUFFER, 0, 0);
-    } else {
-        glBindVertexArray(b->vao);
-        glDrawArrays(GL_POINTS, 0, (GLsizei)s->vertex_count);
-    }
+    glDrawArrays(GL_POINTS, 0, (GLsizei)s->vertex_count);
     glDisable(GL_RASTERIZER_DISCARD);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
     /* the passes read the scratch as a buffer texture */
@@ -673,7 +545,7 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
         }
         r = vr_check_gl(err, name);
         if (r == VR_OK && model && cpca_decode == VR_CPCA_PER_FRAME)
-            r = make_decoder(s, &b, rec, model, st->cpca.clusters, name, err);
+            r = make_decoder(s, &b, name, err);
     }
     free(model);
     free(rec);

@@ -102,18 +102,6 @@ typedef struct vr_buffer {
      * passes read as VR_BUF_F32 (vr_render.c); 0: decoded per pass */
     GLuint decode_prog, scratch_buf, scratch_tex;
     int scratch_stride;
-    /* ... and where a cluster's model fits a uniform block: the model
-     * again, a cluster every ubo_stride bytes, and the vertices sorted by
-     * cluster (sorted_ibo in decode_vao), cluster c's from index
-     * cluster_first[c] to cluster_first[c + 1], dec_chunk texels per draw
-     * (unrolled: vr_buffer.c); else model_ubo is 0 and
-     * the decode reads model_tex */
-    GLuint model_ubo, sorted_ibo, decode_vao;
-    size_t ubo_stride;
-    int dec_chunk; /* texels per vertex per draw, from uniform u_t0 */
-    GLint u_t0;
-    int clusters;
-    uint32_t *cluster_first;
 } vr_buffer;
 
 /* Upload stream st (its quantity drawn) as a buffer stream of s, in the

@@ -10,35 +10,25 @@
  * 4, NUM_LIGHTS 0): buf_begin unpacks the weight levels, and each texel is
  * mean + sum_j level_j * texel_j in the same order of operations as
  * buf_next, so the passes sum the same coefficients the per-pass decode
- * does.
+ * does. BUF_CPCA_DOT(m), where the includer defines it (vr_buffer.c
+ * does), is that sum written out with constant weight indices: half the
+ * decode's time on llvmpipe, which keeps a loop's weights in memory.
  */
 layout(std430) writeonly buffer vr_decoded { vec4 d_out[]; };
-#if BUF_CPCA_UBO
-/* One cluster's model, the vertices drawn grouped by cluster (a draw per
- * cluster, this block bound to that cluster's range): the same texels as
- * u_model's, at indices the same for every vertex of the draw. */
-layout(std140) uniform vr_model { vec4 u_m[BUF_CPCA_T * (BUF_CPCA_BASIS + 1)]; };
-#define DEC_MODEL(k) u_m[k]
-#else
-#define DEC_MODEL(k) BUF_MODEL(b_texel * (BUF_CPCA_BASIS + 1) + (k))
-#endif
 
 void main()
 {
-#ifdef DEC_UNROLLED
-    /* the includer's (vr_buffer.c): the loops below written out for the
-     * draw's texels u_t0 .. u_t0 + chunk - 1, every u_m index u_t0 *
-     * (BUF_CPCA_BASIS + 1) plus a constant */
-    dec_unrolled(gl_VertexID);
-#else
     buf_begin(gl_VertexID * BUF_STRIDE);
     for (int t = 0; t < BUF_CPCA_T; t++) {
-        int m = t * (BUF_CPCA_BASIS + 1);
-        vec4 a = DEC_MODEL(m);
+        int m = (b_texel + t) * (BUF_CPCA_BASIS + 1);
+#ifdef BUF_CPCA_DOT
+        vec4 a = BUF_CPCA_DOT(m);
+#else
+        vec4 a = BUF_MODEL(m);
         for (int j = 0; j < BUF_CPCA_BASIS; j++)
-            a += b_wt[j] * DEC_MODEL(m + 1 + j);
+            a += b_wt[j] * BUF_MODEL(m + 1 + j);
+#endif
         d_out[gl_VertexID * BUF_CPCA_T + t] = a;
     }
-#endif
     gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
 }
