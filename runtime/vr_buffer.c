@@ -42,6 +42,13 @@
  * K * (B + 1) * T * 16 bytes (8, 54, 4 at order 12: 253 KB), the records
  * the file's (28 bytes per vertex at the default).
  *
+ * With desc->cpca_decode = VR_CPCA_PER_FRAME a cpca stream also gets a
+ * scratch of T f32 texels per vertex and a decode program (make_decoder:
+ * shaders/vdsh_cpca_decode.glsl with the sums written out,
+ * cpca_dot_define) that vr_draw runs once before its passes
+ * (vr_buffer_decode: a draw of points, the rasteriser off), the passes
+ * then reading the scratch as an f32 stream.
+ *
  * Does not: draw (vr_render.c), choose the stream (vr_scene.c), convert
  * values (only the floats variant decodes).
  * Errors: VR_ERR_FORMAT for an encoding it cannot draw or a record that
@@ -347,7 +354,7 @@ static void make_gl(vr_scene *s, vr_buffer *b, const void *rec, size_t bytes, co
  * (vdsh_buffer.glsl's buf_next) the same macro made the pass 2.6x slower,
  * so only the decode once per frame uses it (docs/BENCHMARKS.md).
  * Malloc'd; NULL when out of memory. */
-static char *vr_cpca_dot_define(int basis)
+static char *cpca_dot_define(int basis)
 {
     size_t size = 64 + (size_t)basis * 40;
     char *d = malloc(size);
@@ -367,7 +374,8 @@ static char *vr_cpca_dot_define(int basis)
  * VR_ERR_SHADER, VR_ERR_OUT_OF_MEMORY. */
 static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const char *name, vr_error *err)
 {
-    GLint major = 0, minor = 0, blocks = 0, max_block = 0, max_texels = 0, ext = 0;
+    GLint major = 0, minor = 0, blocks = 0, max_texels = 0, ext = 0;
+    GLint64 max_block = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &major);
     glGetIntegerv(GL_MINOR_VERSION, &minor);
     int ssbo = major > 4 || (major == 4 && minor >= 3);
@@ -377,7 +385,7 @@ static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const char *name,
                        "GL_ARB_shader_storage_buffer_object");
     if (ssbo) {
         glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &blocks);
-        glGetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+        glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
     }
     glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
     glGetError();
@@ -388,12 +396,13 @@ static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const char *name,
                        "%s: order %d cpca stream: decoding once per frame needs shader storage "
                        "buffers in the vertex stage (GL 4.3), which this GL has not",
                        name, b->order);
-    if (texels > (size_t)max_texels || texels * 16 > (size_t)(unsigned)max_block)
+    if (texels > (size_t)max_texels || (double)texels * 16.0 > (double)max_block)
         return vr_fail(err, VR_ERR_GL,
                        "%s: order %d cpca stream: a scratch of %zu texels is above this GL's "
-                       "limits (GL_MAX_TEXTURE_BUFFER_SIZE %d, GL_MAX_SHADER_STORAGE_BLOCK_SIZE %d)",
-                       name, b->order, texels, (int)max_texels, (int)max_block);
-    char *dot = vr_cpca_dot_define(b->cpca_basis);
+                       "limits (GL_MAX_TEXTURE_BUFFER_SIZE %d, GL_MAX_SHADER_STORAGE_BLOCK_SIZE "
+                       "%lld)",
+                       name, b->order, texels, (int)max_texels, (long long)max_block);
+    char *dot = cpca_dot_define(b->cpca_basis);
     char defines[512];
     snprintf(defines, sizeof defines,
              "#version 330 core\n#extension GL_ARB_shader_storage_buffer_object : require\n"
@@ -443,7 +452,6 @@ void vr_buffer_decode(const vr_scene *s, const vr_buffer *b)
     glBindTexture(GL_TEXTURE_BUFFER, b->model_tex);
     glActiveTexture(GL_TEXTURE0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, b->scratch_buf);
-    (void)s;
     glBindVertexArray(b->vao);
     glEnable(GL_RASTERIZER_DISCARD);
     glDrawArrays(GL_POINTS, 0, (GLsizei)s->vertex_count);
