@@ -58,6 +58,11 @@ static const char usage_text[] =
     "                        statistics), as \"counts\" in the JSON\n"
     "      --buffer-floats   with --bench: time each buffer mode also from\n"
     "                        buffers of decoded f32 coefficients (MODE-f32)\n"
+    "      --cpca-frame      decode a cpca stream once per frame into a scratch\n"
+    "                        buffer (576 more GPU bytes per vertex at order\n"
+    "                        12; GL 4.3) instead of in every pass of 8 lights;\n"
+    "                        with --bench: time its buffer modes both ways\n"
+    "                        (MODE-frame)\n"
     "      --views FILE      with --frames DIR: for every view, light set and\n"
     "                        light of the view set FILE (vdsh-frames writes\n"
     "                        one), the shadow of that one light alone as a\n"
@@ -219,6 +224,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
         O_VIEWS,
         O_MODES,
         O_BUFFER_FLOATS,
+        O_CPCA_FRAME,
         O_BENCH_LIGHTS,
         O_BENCH_CUBE_SIZES,
         O_BENCH_MODES,
@@ -252,6 +258,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
         {"keys", required_argument, 0, O_KEYS},
         {"no-mallopt", no_argument, 0, O_NO_MALLOPT},
         {"buffer-floats", no_argument, 0, O_BUFFER_FLOATS},
+        {"cpca-frame", no_argument, 0, O_CPCA_FRAME},
         {"bench-lights", required_argument, 0, O_BENCH_LIGHTS},
         {"bench-cube-sizes", required_argument, 0, O_BENCH_CUBE_SIZES},
         {"bench-modes", required_argument, 0, O_BENCH_MODES},
@@ -375,6 +382,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
             break;
         case O_NO_MALLOPT: o->no_mallopt = 1; break;
         case O_BUFFER_FLOATS: o->buffer_floats = 1; break;
+        case O_CPCA_FRAME: o->cpca_frame = 1; break;
         case O_BENCH_LIGHTS: {
             float n[4];
             int k = vt_parse_floats(v, n, 1, 4);

@@ -57,6 +57,7 @@ typedef struct vv_options {
     int frames;
     int no_mallopt;
     int buffer_floats;       /* --bench: also time buffers of decoded f32 */
+    int cpca_frame;          /* cpca decoded once per frame (--cpca-frame) */
     int bench_sets;          /* --bench-lights: bit i, light set i of
                                   1, 3, 16, 64; 0: all */
     int bench_cube_sizes[8]; /* --bench-cube-sizes: cube and cube_pcf

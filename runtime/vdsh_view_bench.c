@@ -25,7 +25,8 @@ typedef struct bench_mode {
     int pcf;
     const char *name;
     int stream;    /* VR_MODE_VDSH_BUFFER's */
-    int floats;    /* drawn from the scene's decoded-f32 copy */
+    int floats;    /* drawn from a copy of the scene: 1 decoded-f32,
+                                2 cpca decoded once per frame */
     int renderer;  /* index into the renderers: 0, or 1 + the
                                 --bench-cube-sizes entry of a sized cube */
     int cube_size; /* VR_MODE_CUBE: its face size */
@@ -77,6 +78,7 @@ typedef struct bench_scene {
     const char *path;
     vr_scene *scene;
     vr_scene *floats; /* --buffer-floats: buffers as decoded f32 */
+    vr_scene *frame;  /* --cpca-frame: cpca decoded once per frame */
     bench_mode modes[BENCH_MODES];
     int nm;
     vr_light lights[BENCH_SETS][VR_MAX_POOL_LIGHTS];
@@ -152,31 +154,41 @@ static void add_buffer_modes(bench_scene *b)
             b->modes[b->nm++] = bench_row(&vv_modes[k], vv_modes[k].json);
 }
 
-/* --buffer-floats: each buffer mode again, from a copy of the scene
- * whose buffers hold decoded f32 ("buf12-f32"): the same images, 2-4x
- * the bytes, no unpacking in the shader. */
-static int add_float_modes(bench_scene *b)
+/* --buffer-floats (copy 1): each buffer mode again, from a copy of the
+ * scene whose buffers hold decoded f32 ("buf12-f32"): the same images,
+ * 2-4x the bytes, no unpacking in the shader. --cpca-frame (copy 2): each
+ * buffer mode of a cpca stream again, from a copy that decodes it once
+ * per frame into a scratch (vr_scene_desc.cpca_decode, "buf12-frame"). */
+static int add_copy_modes(bench_scene *b, int copy)
 {
-    static char names[VV_MAX_MODES][32];
+    static char names[2][VV_MAX_MODES][32];
     int n = b->nm, any = 0;
+    vr_scene_info info;
+    vr_scene_get_info(b->scene, &info);
     for (int m = 0; m < n; m++)
-        any |= b->modes[m].mode == VR_MODE_VDSH_BUFFER;
+        any |= b->modes[m].mode == VR_MODE_VDSH_BUFFER && !b->modes[m].floats;
     if (!any)
         return 0;
     vr_error err;
-    vr_scene_desc sd = {.path = b->path, .skip_cubemaps = 1, .buffers = 1, .buffer_floats = 1};
-    if (vr_scene_create(&sd, &b->floats, &err) != VR_OK) {
+    vr_scene_desc sd = {.path = b->path, .skip_cubemaps = 1, .buffers = 1,
+                        .buffer_floats = copy == 1,
+                        .cpca_decode = copy == 2 ? VR_CPCA_PER_FRAME : VR_CPCA_PER_PASS};
+    if (vr_scene_create(&sd, copy == 1 ? &b->floats : &b->frame, &err) != VR_OK) {
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
         return 1;
     }
     for (int m = 0; m < n && b->nm < BENCH_MODES; m++) {
         int k = vv_mode_find(b->modes[m].name, strlen(b->modes[m].name), VV_MODE_BENCH_LOG);
-        if (b->modes[m].mode != VR_MODE_VDSH_BUFFER || k < 0)
+        int st = b->modes[m].stream;
+        if (b->modes[m].mode != VR_MODE_VDSH_BUFFER || b->modes[m].floats || k < 0 ||
+            (copy == 2 && (st < 1 || st >= VDSH_ORDER_SLOTS ||
+                           info.buffer_encoding[st] != VDSH_ENCODING_CPCA)))
             continue;
-        snprintf(names[k], sizeof names[k], "%s-f32", vv_modes[k].json);
+        snprintf(names[copy - 1][k], sizeof names[copy - 1][k], "%s-%s", vv_modes[k].json,
+                 copy == 1 ? "f32" : "frame");
         bench_mode f = b->modes[m];
-        f.name = names[k];
-        f.floats = 1;
+        f.name = names[copy - 1][k];
+        f.floats = copy;
         b->modes[b->nm++] = f;
     }
     return 0;
@@ -206,7 +218,9 @@ static int bench_open(const vv_options *o, const char *path, bench_scene *b)
     }
     add_cube_sizes(o, b);
     add_buffer_modes(b);
-    if (o->buffer_floats && add_float_modes(b))
+    if (o->buffer_floats && add_copy_modes(b, 1))
+        return 1;
+    if (o->cpca_frame && add_copy_modes(b, 2))
         return 1;
     bench_filter(o, b);
     if (!b->nm) {
@@ -236,7 +250,7 @@ static const vr_scene *mode_desc(const vv_options *o, const bench_scene *bs, int
     d->pcf = bs->modes[m].pcf;
     d->stream = bs->modes[m].stream;
     vv_scene_camera(bs->scene, o, &d->camera);
-    return bs->modes[m].floats ? bs->floats : bs->scene;
+    return bs->modes[m].floats == 2 ? bs->frame : bs->modes[m].floats ? bs->floats : bs->scene;
 }
 
 /* Time every mode of every scene, with 1 light, then 3, 16 and 64.
@@ -381,7 +395,9 @@ static void bench_print(const vv_options *o, const bench_scene *b, int all_round
             }
             if (b->modes[m].mode == VR_MODE_VDSH_BUFFER)
                 vt_json_u64(j, r, "buffer_bytes",
-                            vr_scene_buffer_bytes(b->modes[m].floats ? b->floats : b->scene,
+                            vr_scene_buffer_bytes(b->modes[m].floats == 2 ? b->frame
+                                                  : b->modes[m].floats ? b->floats
+                                                                       : b->scene,
                                                   b->modes[m].stream));
             json_series(j, r, "cpu_ms", b->cpu[ls][m], rounds);
             json_series(j, r, "process_cpu_ms", b->proc[ls][m], rounds);
@@ -449,6 +465,7 @@ int vv_run_bench(const vv_options *o)
     for (int i = 0; b && i < o->file_count; i++) {
         vr_scene_destroy(b[i].scene);
         vr_scene_destroy(b[i].floats);
+        vr_scene_destroy(b[i].frame);
     }
     free(b);
     for (int i = 0; i < 9; i++)

@@ -158,6 +158,8 @@ typedef struct vr_error {
 
 typedef struct vr_scene vr_scene;
 
+enum { VR_CPCA_PER_PASS = 0, VR_CPCA_PER_FRAME = 1 };
+
 typedef struct vr_scene_desc {
     /* The .vdsh file to load. Either path or file must be set. */
     const char *path;
@@ -193,6 +195,16 @@ typedef struct vr_scene_desc {
      * 4x s8; a cpca stream decoded at load), no unpacking in the shader:
      * for comparisons. */
     int buffer_floats;
+    /* Where a cpca stream is decoded. VR_CPCA_PER_PASS (0, default): in
+     * the vertex stage of every pass of up to VR_MAX_LIGHTS_PER_PASS
+     * lights, from the records as stored (their bytes and the model's
+     * only). VR_CPCA_PER_FRAME: once per vr_draw, by a draw of points
+     * that writes every vertex's f32 coefficients into a scratch buffer
+     * that all the passes then read (16 bytes per 4 coefficients per
+     * vertex more: 576 at order 12; needs shader storage buffers in the
+     * vertex stage, GL 4.3 or GL_ARB_shader_storage_buffer_object, else
+     * the load fails with VR_ERR_GL). docs/BENCHMARKS.md has both. */
+    int cpca_decode;
     /* VR_MODE_SDF's signed distance volume (formats/vdsh_sdf.h), uploaded
      * as a 3D texture. NULL (default): the .vdsh's companion file
      * (vdsh_sdf_path: room.vdsh -> room.sdf) when desc->path is set and
@@ -241,8 +253,12 @@ typedef struct vr_scene_info {
     /* VR_MODE_VDSH_BUFFER's streams: has_buffer[n], a fixed stream of
      * order n; variable_order, the cap of the stream with an order per
      * vertex (0: none) and variable_mean_order its vertices' mean order;
-     * buffer_bytes, their share of gpu_bytes. */
+     * buffer_bytes, their share of gpu_bytes; buffer_encoding[n], the
+     * file's encoding of the fixed stream of order n (cpca: decoded per
+     * pass, or once per frame where buffer_per_frame[n]). */
     int has_buffer[VDSH_ORDER_SLOTS];
+    vdsh_encoding buffer_encoding[VDSH_ORDER_SLOTS];
+    int buffer_per_frame[VDSH_ORDER_SLOTS];
     int variable_order;
     float variable_mean_order;
     size_t buffer_bytes;

@@ -42,6 +42,13 @@
  * K * (B + 1) * T * 16 bytes (8, 54, 4 at order 12: 253 KB), the records
  * the file's (28 bytes per vertex at the default).
  *
+ * With desc->cpca_decode = VR_CPCA_PER_FRAME a cpca stream also gets a
+ * scratch of T f32 texels per vertex and a decode program (make_decoder:
+ * shaders/vdsh_cpca_decode.glsl with the sums written out,
+ * cpca_dot_define) that vr_draw runs once before its passes
+ * (vr_buffer_decode: a draw of points, the rasteriser off), the passes
+ * then reading the scratch as an f32 stream.
+ *
  * Does not: draw (vr_render.c), choose the stream (vr_scene.c), convert
  * values (only the floats variant decodes).
  * Errors: VR_ERR_FORMAT for an encoding it cannot draw or a record that
@@ -50,6 +57,7 @@
  * the file. On failure nothing stays allocated.
  */
 #include "vr_internal.h"
+#include "vr_glsl_files.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -98,10 +106,12 @@ void vr_buffer_destroy(vr_buffer *b)
     if (!b)
         return;
     glDeleteVertexArrays(1, &b->vao);
-    GLuint texs[2] = {b->tex, b->model_tex};
-    glDeleteTextures(2, texs);
-    GLuint bufs[4] = {b->buf, b->vbo_record, b->vbo_order, b->model_buf};
-    glDeleteBuffers(4, bufs);
+    GLuint texs[3] = {b->tex, b->model_tex, b->scratch_tex};
+    glDeleteTextures(3, texs);
+    GLuint bufs[5] = {b->buf, b->vbo_record, b->vbo_order, b->model_buf, b->scratch_buf};
+    glDeleteBuffers(5, bufs);
+    if (b->decode_prog)
+        glDeleteProgram(b->decode_prog);
     free(b->ks);
     memset(b, 0, sizeof *b);
 }
@@ -336,8 +346,123 @@ static void make_gl(vr_scene *s, vr_buffer *b, const void *rec, size_t bytes, co
     b->bytes += bytes;
 }
 
+/* "#define BUF_CPCA_DOT(m) (BUF_MODEL(m) + b_wt[0] * BUF_MODEL((m) + 1)
+ * + ...)\n" for a cpca stream of `basis` vectors: the decode's sum of a
+ * model texel (shaders/vdsh_cpca_decode.glsl) written out, the same
+ * operations in the same order with constant weight indices. As a loop
+ * it cost twice the decode's time on llvmpipe; in the per-pass decode
+ * (vdsh_buffer.glsl's buf_next) the same macro made the pass 2.6x slower,
+ * so only the decode once per frame uses it (docs/BENCHMARKS.md).
+ * Malloc'd; NULL when out of memory. */
+static char *cpca_dot_define(int basis)
+{
+    size_t size = 64 + (size_t)basis * 40;
+    char *d = malloc(size);
+    if (!d)
+        return NULL;
+    size_t n = (size_t)snprintf(d, size, "#define BUF_CPCA_DOT(m) (BUF_MODEL(m)");
+    for (int j = 0; j < basis && n < size; j++)
+        n += (size_t)snprintf(d + n, size - n, " + b_wt[%d] * BUF_MODEL((m) + %d)", j, j + 1);
+    if (n < size)
+        snprintf(d + n, size - n, ")\n");
+    return d;
+}
+
+/* VR_CPCA_PER_FRAME: the decode program and the scratch of b (see
+ * vr.h, shaders/vdsh_cpca_decode.glsl). VR_ERR_GL where the vertex stage
+ * has no shader storage buffers or the scratch is over this GL's limits,
+ * VR_ERR_SHADER, VR_ERR_OUT_OF_MEMORY. */
+static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const char *name, vr_error *err)
+{
+    GLint major = 0, minor = 0, blocks = 0, max_texels = 0, ext = 0;
+    GLint64 max_block = 0;
+    glGetIntegerv(GL_MAJOR_VERSION, &major);
+    glGetIntegerv(GL_MINOR_VERSION, &minor);
+    int ssbo = major > 4 || (major == 4 && minor >= 3);
+    glGetIntegerv(GL_NUM_EXTENSIONS, &ext);
+    for (GLint i = 0; i < ext && !ssbo; i++)
+        ssbo = !strcmp((const char *)glGetStringi(GL_EXTENSIONS, (GLuint)i),
+                       "GL_ARB_shader_storage_buffer_object");
+    if (ssbo) {
+        glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &blocks);
+        glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+    }
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+    glGetError();
+    b->scratch_stride = vr_buffer_stride(b->order, VR_BUF_F32);
+    size_t texels = (size_t)s->vertex_count * (size_t)b->scratch_stride;
+    if (!ssbo || blocks < 1)
+        return vr_fail(err, VR_ERR_GL,
+                       "%s: order %d cpca stream: decoding once per frame needs shader storage "
+                       "buffers in the vertex stage (GL 4.3), which this GL has not",
+                       name, b->order);
+    if (texels > (size_t)max_texels || (double)texels * 16.0 > (double)max_block)
+        return vr_fail(err, VR_ERR_GL,
+                       "%s: order %d cpca stream: a scratch of %zu texels is above this GL's "
+                       "limits (GL_MAX_TEXTURE_BUFFER_SIZE %d, GL_MAX_SHADER_STORAGE_BLOCK_SIZE "
+                       "%lld)",
+                       name, b->order, texels, (int)max_texels, (long long)max_block);
+    char *dot = cpca_dot_define(b->cpca_basis);
+    char defines[512];
+    snprintf(defines, sizeof defines,
+             "#version 330 core\n#extension GL_ARB_shader_storage_buffer_object : require\n"
+             "#define BUFFER 1\n#define NUM_LIGHTS 0\n#define BUF_ORDER %d\n#define BUF_KIND 4\n"
+             "#define BUF_VARIABLE 0\n#define BUF_STRIDE %d\n#define BUF_CPCA_BASIS %d\n"
+             "#define BUF_CPCA_BITS %d\n#define BUF_CPCA_T %d\n"
+             "const float KS[1] = float[1](1.0);\n",
+             b->order, b->stride, b->cpca_basis, b->cpca_bits, b->scratch_stride);
+    size_t size = strlen(defines) + (dot ? strlen(dot) : 0) + vr_buffer_glsl_size +
+                  vr_cpca_decode_glsl_size + 1;
+    char *vs = dot ? malloc(size) : NULL;
+    if (!vs) {
+        free(dot);
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+    }
+    snprintf(vs, size, "%s%s%s%s", defines, dot, vr_buffer_glsl, vr_cpca_decode_glsl);
+    free(dot);
+    static const char fs[] = "#version 330 core\nout vec4 o;\nvoid main() { o = vec4(0.0); }\n";
+    char what[256];
+    snprintf(what, sizeof what, "%s: cpca decode program", name);
+    vr_result r = vr_link(what, vs, fs, &b->decode_prog, err);
+    free(vs);
+    if (r != VR_OK)
+        return r;
+    glUseProgram(b->decode_prog);
+    glUniform1i(glGetUniformLocation(b->decode_prog, "u_coef"), VR_UNIT_COEF);
+    glUniform1i(glGetUniformLocation(b->decode_prog, "u_model"), VR_UNIT_MODEL);
+    glUseProgram(0);
+    glGenBuffers(1, &b->scratch_buf);
+    glBindBuffer(GL_TEXTURE_BUFFER, b->scratch_buf);
+    glBufferData(GL_TEXTURE_BUFFER, (GLsizeiptr)(texels * 16), NULL, GL_DYNAMIC_COPY);
+    glGenTextures(1, &b->scratch_tex);
+    glBindTexture(GL_TEXTURE_BUFFER, b->scratch_tex);
+    glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, b->scratch_buf);
+    glBindTexture(GL_TEXTURE_BUFFER, 0);
+    glBindBuffer(GL_TEXTURE_BUFFER, 0);
+    b->bytes += texels * 16;
+    return vr_check_gl(err, name);
+}
+
+void vr_buffer_decode(const vr_scene *s, const vr_buffer *b)
+{
+    glUseProgram(b->decode_prog);
+    glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
+    glBindTexture(GL_TEXTURE_BUFFER, b->tex);
+    glActiveTexture(GL_TEXTURE0 + VR_UNIT_MODEL);
+    glBindTexture(GL_TEXTURE_BUFFER, b->model_tex);
+    glActiveTexture(GL_TEXTURE0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, b->scratch_buf);
+    glBindVertexArray(b->vao);
+    glEnable(GL_RASTERIZER_DISCARD);
+    glDrawArrays(GL_POINTS, 0, (GLsizei)s->vertex_count);
+    glDisable(GL_RASTERIZER_DISCARD);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
+    /* the passes read the scratch as a buffer texture */
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+}
+
 vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *remap, int floats,
-                           const char *name, vr_error *err)
+                           int cpca_decode, const char *name, vr_error *err)
 {
     int order = (int)st->order;
     int cpca = st->encoding == VDSH_ENCODING_CPCA;
@@ -427,6 +552,8 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
             b.bytes += model_bytes;
         }
         r = vr_check_gl(err, name);
+        if (r == VR_OK && model && cpca_decode == VR_CPCA_PER_FRAME)
+            r = make_decoder(s, &b, name, err);
     }
     free(model);
     free(rec);

@@ -96,13 +96,22 @@ typedef struct vr_buffer {
      * basis vectors per cluster and bits per weight */
     GLuint model_buf, model_tex;
     int cpca_basis, cpca_bits;
+    /* VR_CPCA_PER_FRAME (vr_scene_desc.cpca_decode): the decode program
+     * (shaders/vdsh_cpca_decode.glsl) and the scratch it writes once per
+     * frame, f32 records of stride scratch_stride texels that the light
+     * passes read as VR_BUF_F32 (vr_render.c); 0: decoded per pass */
+    GLuint decode_prog, scratch_buf, scratch_tex;
+    int scratch_stride;
 } vr_buffer;
 
 /* Upload stream st (its quantity drawn) as a buffer stream of s, in the
  * GPU vertex order (remap[file vertex] = GPU vertex); floats: decoded f32.
  * VR_ERR_FORMAT, VR_ERR_OUT_OF_MEMORY, VR_ERR_GL naming `name`. */
 vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *remap, int floats,
-                           const char *name, vr_error *err);
+                           int cpca_decode, const char *name, vr_error *err);
+/* VR_CPCA_PER_FRAME: decode b's records into its scratch (a draw of
+ * points, the rasteriser off), before the frame's light passes. */
+void vr_buffer_decode(const vr_scene *s, const vr_buffer *b);
 void vr_buffer_destroy(vr_buffer *b);
 /* The positions and normals (and indices) of s into the bound VAO. */
 void vr_scene_base_attribs(const vr_scene *s);

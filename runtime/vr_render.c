@@ -626,6 +626,12 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
     glDisable(GL_BLEND);
     glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
 
+    /* A cpca stream decoded once per frame: into its scratch, which
+     * the passes read as f32 records (vr_buffer_decode). */
+    int scratch = buf && buf->decode_prog;
+    if (scratch)
+        vr_buffer_decode(s, buf);
+
     vr_result res = VR_OK;
     for (int g = 0; g < groups && res == VR_OK; g++) {
         const vr_light *group = d.lights ? d.lights + g * per : NULL;
@@ -655,11 +661,11 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
         key.packed = order && s->encoding[order] == VDSH_ENCODING_S8S6;
         if (buf) {
             key.buf_order = (uint8_t)buf->order;
-            key.buf_kind = (uint8_t)buf->kind;
+            key.buf_kind = (uint8_t)(scratch ? VR_BUF_F32 : buf->kind);
             key.buf_variable = (uint8_t)buf->variable;
             key.ks_hash = buf->ks_hash;
-            key.cpca_basis = (uint16_t)buf->cpca_basis;
-            key.cpca_bits = (uint8_t)buf->cpca_bits;
+            key.cpca_basis = (uint16_t)(scratch ? 0 : buf->cpca_basis);
+            key.cpca_bits = (uint8_t)(scratch ? 0 : buf->cpca_bits);
         }
         const vr_program *p = NULL;
         res = get_program(r, &key, buf ? buf->ks : NULL, &p, err);
@@ -729,8 +735,8 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
             vr_sdf_bind(s, p->prog, d.sdf_k);
         if (buf) {
             glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
-            glBindTexture(GL_TEXTURE_BUFFER, buf->tex);
-            if (buf->model_tex) {
+            glBindTexture(GL_TEXTURE_BUFFER, scratch ? buf->scratch_tex : buf->tex);
+            if (buf->model_tex && !scratch) {
                 glActiveTexture(GL_TEXTURE0 + VR_UNIT_MODEL);
                 glBindTexture(GL_TEXTURE_BUFFER, buf->model_tex);
             }

@@ -332,7 +332,7 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
                       : s->buffer[st->order].order || (st->order <= 5 && !desc->buffers &&
                                                        st->encoding != VDSH_ENCODING_CPCA)))
             continue;
-        r = vr_buffer_upload(s, st, remap, desc->buffer_floats, name, err);
+        r = vr_buffer_upload(s, st, remap, desc->buffer_floats, desc->cpca_decode, name, err);
     }
     if (r != VR_OK)
         goto done;
@@ -404,6 +404,8 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     i.interior = s->view.interior;
     for (int o = 1; o < VDSH_ORDER_SLOTS; o++) {
         i.has_buffer[o] = s->buffer[o].order != 0;
+        i.buffer_encoding[o] = s->buffer[o].encoding;
+        i.buffer_per_frame[o] = s->buffer[o].decode_prog != 0;
         i.buffer_bytes += s->buffer[o].bytes;
     }
     i.variable_order = s->variable.order;

@@ -33,7 +33,8 @@ endif()
 # with the basis cubemaps and as polynomials; and the default bake's streams
 # drawn from buffer textures, VR_MODE_VDSH_BUFFER, and streams of orders 7,
 # 9, 12 and with an order per vertex, derived from it and baked; cpca
-# streams of orders 3, 7 and 12, issue 29):
+# streams of orders 3, 7 and 12, issue 29, decoded per pass and once per
+# frame):
 # mean difference <= 0.002 and
 # at most 0.5% of the pixels off by more than 0.1 in every frame (measured
 # on llvmpipe: <= 1e-4 and 0.003%; one order for another: 0.019 and 3.7%).
@@ -97,6 +98,17 @@ done
 "$view" "$d/cpca5.vdsh" --views "$views" --frames "$d/cpca5-gl" --modes buf3,buf7 -q
 "$cmp" "$views" "$d/cpca-c" "$d/cpca-gl" 0.002 0.005 buf12=c-vdsh12
 "$cmp" "$views" "$d/cpca5-c" "$d/cpca5-gl" 0.002 0.005 buf3=c-vdsh3 buf7=c-vdsh7
+# The same streams decoded once per frame into a scratch (--cpca-frame,
+# vr_scene_desc.cpca_decode; skipped where the GL has no shader storage
+# buffers in the vertex stage, which vdsh-view reports as a failed load).
+if "$view" "$d/cpca.vdsh" --cpca-frame --views "$views" --frames "$d/cpcaf-gl" --modes buf12 -q \
+    2> "$d/cpcaf.err"; then
+  "$view" "$d/cpca5.vdsh" --cpca-frame --views "$views" --frames "$d/cpca5f-gl" --modes buf3,buf7 -q
+  "$cmp" "$views" "$d/cpca-c" "$d/cpcaf-gl" 0.002 0.005 buf12=c-vdsh12
+  "$cmp" "$views" "$d/cpca5-c" "$d/cpca5f-gl" 0.002 0.005 buf3=c-vdsh3 buf7=c-vdsh7
+else
+  grep -q "shader storage" "$d/cpcaf.err" || { cat "$d/cpcaf.err"; exit 1; }
+fi
 ]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames> $<TARGET_FILE:vdsh-view>
        $<TARGET_FILE:test_frames_gl> ${CMAKE_CURRENT_BINARY_DIR}/frames_gl
        ${CMAKE_CURRENT_LIST_DIR}/data/frames_gl.views.json $<TARGET_FILE:test_runtime_buffer>)

@@ -468,6 +468,39 @@ grep -q "mode buffer: VDSH adaptive order (up to 9" "$d/default.log"
 ]=] sh ${_view} ${_png} $<TARGET_FILE:test_runtime_buffer> ${_room_log} ${_rt_dir}/view_buffer
        $<TARGET_FILE:vdsh-bake>)
 
+# A cpca stream decoded once per frame (--cpca-frame, issue 29): at 16
+# lights (two passes of 8, both reading the scratch) the frame is the one
+# decoded in every pass, and with 3 lights it is not (the control: the
+# comparison can fail); a file without a cpca stream draws as before.
+if(TARGET vdsh-bake)
+add_test(NAME runtime_view_cpca_frame COMMAND sh -c [=[
+v=$1; png=$2; bake=$3; log=$4; d=$5
+rm -rf "$d"; mkdir -p "$d"
+set -e
+"$bake" builtin:room --max-edge 1.0 --rays 256 --cube-size 0 --orders 12 --encoding cpca -q \
+  -o "$d/c.vdsh"
+set +e
+"$v" -q --render "$d/pass.png" --size 96x72 --mode buf12 --lights 16 "$d/c.vdsh"
+rc=$?
+[ $rc -eq 77 ] && exit 77
+[ $rc -eq 0 ] || exit 1
+if ! "$v" -q --render "$d/frame.png" --size 96x72 --mode buf12 --lights 16 --cpca-frame \
+    "$d/c.vdsh" 2> "$d/frame.err"; then
+  cat "$d/frame.err"
+  grep -q "shader storage" "$d/frame.err" && exit 77
+  exit 1
+fi
+set -e
+"$v" -q --render "$d/frame3.png" --size 96x72 --mode buf12 --lights 3 --cpca-frame "$d/c.vdsh"
+"$png" info "$d/pass.png" 96 72
+"$png" same "$d/pass.png" "$d/frame.png" 2
+if "$png" same "$d/pass.png" "$d/frame3.png" 2; then echo "control: 3 and 16 lights the same"; exit 1; fi
+"$v" -q --render "$d/log.png" --size 96x72 --mode vdsh5 --cpca-frame "$log"
+"$png" info "$d/log.png" 96 72
+]=] sh ${_view} ${_png} $<TARGET_FILE:vdsh-bake> ${_room_log} ${_rt_dir}/view_cpca_frame)
+_runtime_props(runtime_view_cpca_frame FIXTURES_REQUIRED runtime_room)
+endif()
+
 foreach(t runtime_view_usage runtime_view_errors runtime_view_render runtime_view_bench
           runtime_view_frame runtime_view_window runtime_view_frames runtime_view_buffer)
   if(TEST ${t})

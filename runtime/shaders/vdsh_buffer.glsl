@@ -51,7 +51,17 @@
  * basis vector times its step) as mean + sum_j level_j * texel_j. So a
  * vertex decodes once for all the lights of its pass; decoding per light
  * instead (its sum as mean.Y + sum_j w_j (basis_j.Y)) fetches the same
- * model texels once per light (docs/BENCHMARKS.md "cpca").
+ * model texels once per light (docs/BENCHMARKS.md "cpca"). Per pass the
+ * decode is most of the frame on llvmpipe: (B + 1) * T model texels per
+ * vertex (1980 at order 12, 8,54,4), each a bounds-checked gather, in
+ * every pass of 8 lights, and indexed triangles shade a vertex 1.19
+ * times a pass (GL_VERTEX_SHADER_INVOCATIONS over the vertex count, the
+ * built-in room at --max-edge 0.2). The C runtime can instead decode once
+ * per frame (vr_scene_desc.cpca_decode, vdsh_cpca_decode.glsl, which
+ * includes this file for buf_begin and BUF_MODEL): a draw of points
+ * writes every vertex's f32 record into a scratch, and the passes read
+ * it as BUF_KIND 0, at 576 more GPU bytes per vertex at order 12 and half
+ * the frame at 16 lights (docs/BENCHMARKS.md "Decoding once per frame").
  */
 #if BUFFER
 #ifndef BUF_TEXTURE_2D
