@@ -1,7 +1,8 @@
 /*
  * Bake core against analytic truth: the centre of a closed sphere, points
- * on the floor of a closed box; the direction grid; thread determinism.
- * Scenes are generated here, so the test needs no files.
+ * on the floor of a closed box; the direction grid; thread determinism;
+ * neighbours' decision fits. Scenes are generated here, so the test needs
+ * no files.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -841,8 +842,7 @@ static void test_decision_neighbours(void)
                           .order_mask = 1u << O,
                           .method = methods[mi]};
         vb_bake_output out = {0};
-        CHECK(vb_bake_run(&d, &out, &err) == VB_OK, "%s: %s",
-              mi ? "decision" : "shadow", err.msg);
+        CHECK(vb_bake_run(&d, &out, &err) == VB_OK, "%s: %s", mi ? "decision" : "shadow", err.msg);
         if (out.coeffs[O]) {
             if (mi)
                 CHECK(out.decision_fitted > 0, "decision: no receiver fitted");
@@ -864,12 +864,12 @@ static void test_decision_neighbours(void)
         }
         vb_bake_output_free(&out);
     }
-    printf("neighbours' ln D, RMS difference at order %d: shadow %.4f, decision %.4f\n", O,
-           diff[0], diff[1]);
+    printf("neighbours' ln D, RMS difference at order %d: shadow %.4f, decision %.4f\n", O, diff[0],
+           diff[1]);
     CHECK(diff[0] > 0.0, "shadow: neighbours' fits are equal (no ray noise to compare with)");
     CHECK(diff[1] <= 2.0 * diff[0],
-          "decision: neighbours' fits differ by %.4f, more than twice the lsq fit's %.4f",
-          diff[1], diff[0]);
+          "decision: neighbours' fits differ by %.4f, more than twice the lsq fit's %.4f", diff[1],
+          diff[0]);
     vb_scene_destroy(sc);
     test_mesh_free(&occ);
     test_mesh_free(&rec);
