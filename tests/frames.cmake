@@ -135,6 +135,16 @@ if(Python3_Interpreter_FOUND AND TARGET vb_frames)
                    ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR})
 endif()
 
+# scripts/mottling at its smallest (test_mottling.py): validation room 3
+# at --max-edge 1, 64 x 48 C frames, order 3; a twin bake's row is the
+# same with noise 0, the figures in range, a test scene refused. No GL.
+if(Python3_Interpreter_FOUND AND TARGET vb_frames)
+  add_test(NAME mottling_script
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_mottling.py
+                   ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR}
+                   ${CMAKE_CURRENT_BINARY_DIR}/mottling_script)
+endif()
+
 # scripts/order_curve's encoding axis (issue 29; test_order_curve.py):
 # validation room 3 at --max-edge 0.6, 100 rays, orders 3 and 7 in s8s6
 # and cpca 4,12,4, and an adaptive order (cap 7) in each, C frames at 128

@@ -1,7 +1,8 @@
 /*
  * Bake core against analytic truth: the centre of a closed sphere, points
- * on the floor of a closed box; the direction grid; thread determinism.
- * Scenes are generated here, so the test needs no files.
+ * on the floor of a closed box; the direction grid; thread determinism;
+ * neighbours' decision fits. Scenes are generated here, so the test needs
+ * no files.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -787,6 +788,93 @@ static void test_adaptive_order(void)
     test_mesh_free(&rec);
 }
 
+/* Method decision: receivers a millimetre apart on a floor, lit by the
+ * same free space, get nearly the same fit. The fit of ln D to the shadow
+ * decision must not add noise of its own between neighbours beyond the
+ * least-squares fit's ray noise (method shadow: the same rays, the same
+ * offset for every receiver): a pool start per receiver gave each its own
+ * training lights, and drew order 12 mottled on lit walls
+ * (docs/ACCURACY.md, "Order 12 mottling"). */
+static void test_decision_neighbours(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    test_make_room(&occ, 4, 3, 2.5f);
+    /* A pillar: four quads, facing out. */
+    const float w = 0.3f, h = 3.0f;
+    const float px0[4][3] = {{-w, 0, -w}, {-w, 0, w}, {-w, h, w}, {-w, h, -w}};
+    const float px1[4][3] = {{w, 0, -w}, {w, h, -w}, {w, h, w}, {w, 0, w}};
+    const float pz0[4][3] = {{-w, 0, -w}, {-w, h, -w}, {w, h, -w}, {w, 0, -w}};
+    const float pz1[4][3] = {{-w, 0, w}, {w, 0, w}, {w, h, w}, {-w, h, w}};
+    const float nx[3] = {-1, 0, 0}, pxn[3] = {1, 0, 0}, nz[3] = {0, 0, -1}, pzn[3] = {0, 0, 1};
+    test_add_quad(&occ, px0, nx);
+    test_add_quad(&occ, px1, pxn);
+    test_add_quad(&occ, pz0, nz);
+    test_add_quad(&occ, pz1, pzn);
+    enum { NP = 24, O = 7 };
+    float p[3 * 2 * NP], n[3 * 2 * NP];
+    uint64_t s = 23;
+    for (int i = 0; i < NP; i++) {
+        float x, z;
+        do {
+            x = (float)(7.0 * test_rand(&s) - 3.5), z = (float)(4.0 * test_rand(&s) - 2.0);
+        } while (fabsf(x) < 0.6f && fabsf(z) < 0.6f);
+        for (int k = 0; k < 2; k++) {
+            float *q = p + 3 * (2 * i + k), *m = n + 3 * (2 * i + k);
+            q[0] = x + 0.001f * (float)k, q[1] = 0.0f, q[2] = z;
+            m[0] = 0.0f, m[1] = 1.0f, m[2] = 0.0f;
+        }
+    }
+    test_make_points(&rec, 2 * NP, p, n);
+    vb_error err;
+    vb_scene *sc = NULL;
+    CHECK(vb_scene_create(&occ, NULL, &sc, &err) == VB_OK, "scene: %s", err.msg);
+    /* RMS over the pairs and directions above the horizon of the
+     * difference of the two fits' ln D. */
+    double diff[2] = {0, 0};
+    const vb_method methods[2] = {VB_METHOD_SHADOW, VB_METHOD_DECISION};
+    for (int mi = 0; mi < 2 && sc; mi++) {
+        vb_bake_desc d = {.keep_normals = 1,
+                          .receivers = &rec,
+                          .scene = sc,
+                          .rays = 2500,
+                          .seed = 5,
+                          .threads = 2,
+                          .order_mask = 1u << O,
+                          .method = methods[mi]};
+        vb_bake_output out = {0};
+        CHECK(vb_bake_run(&d, &out, &err) == VB_OK, "%s: %s", mi ? "decision" : "shadow", err.msg);
+        if (out.coeffs[O]) {
+            if (mi)
+                CHECK(out.decision_fitted > 0, "decision: no receiver fitted");
+            double se = 0.0;
+            int cnt = 0;
+            uint64_t r = 41;
+            for (int i = 0; i < NP; i++)
+                for (int k = 0; k < 200; k++) {
+                    float dir[3];
+                    test_rand_dir(&r, dir);
+                    if (dir[1] < 0.0f)
+                        dir[1] = -dir[1];
+                    double a = vdsh_sh_reconstruct(O, out.coeffs[O] + O * O * (2 * i), dir);
+                    double b = vdsh_sh_reconstruct(O, out.coeffs[O] + O * O * (2 * i + 1), dir);
+                    se += (a - b) * (a - b);
+                    cnt++;
+                }
+            diff[mi] = sqrt(se / cnt);
+        }
+        vb_bake_output_free(&out);
+    }
+    printf("neighbours' ln D, RMS difference at order %d: shadow %.4f, decision %.4f\n", O, diff[0],
+           diff[1]);
+    CHECK(diff[0] > 0.0, "shadow: neighbours' fits are equal (no ray noise to compare with)");
+    CHECK(diff[1] <= 2.0 * diff[0],
+          "decision: neighbours' fits differ by %.4f, more than twice the lsq fit's %.4f", diff[1],
+          diff[0]);
+    vb_scene_destroy(sc);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+}
+
 int main(void)
 {
     test_grid();
@@ -799,5 +887,6 @@ int main(void)
     test_adaptive_rays();
     test_ranges();
     test_adaptive_order();
+    test_decision_neighbours();
     return test_report("test_bake");
 }

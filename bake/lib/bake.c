@@ -318,15 +318,33 @@ static size_t dec_scratch_bytes(const job *J)
     return dec_doubles_at(J) + vb_decision_scratch_doubles(J->order) * sizeof(double);
 }
 
-/* Receiver v's first light in the pool: a hash of (seed, v), so that
- * neighbours see other lights and no receiver depends on another. */
-static uint32_t dec_start(const job *J, uint32_t v)
+/* A hash of (seed, k). */
+static uint64_t dec_hash(const job *J, uint64_t k)
 {
-    uint64_t z = J->d->seed * 0x9e3779b97f4a7c15ull + v + 0x632be59bd9b4e019ull;
+    uint64_t z = J->d->seed * 0x9e3779b97f4a7c15ull + k + 0x632be59bd9b4e019ull;
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    z ^= z >> 31;
-    return (uint32_t)(z % J->pool_count);
+    return z ^ (z >> 31);
+}
+
+/* Every receiver's first training light in the pool: one start for the
+ * bake, so that neighbours fit the same lights and their fits differ
+ * where the scene does, not by which lights each drew (a start per
+ * receiver drew order 12 mottled on lit surfaces: docs/ACCURACY.md,
+ * "Order 12 mottling"). */
+static uint32_t dec_start(const job *J)
+{
+    return (uint32_t)(dec_hash(J, 0) % J->pool_count);
+}
+
+/* Receiver v's held-out lights start this many lights past its training
+ * lights (scanned of the pool read so far): per receiver, so that the
+ * calibration sees many lights, and within the first half of the rest,
+ * so that they are never training lights and enough remain. */
+static uint32_t dec_skip(const job *J, uint32_t v, uint32_t scanned)
+{
+    uint32_t span = (J->pool_count - scanned) / 2;
+    return span ? (uint32_t)(dec_hash(J, (uint64_t)v + 1) % span) : 0;
 }
 
 /* Pairs of receiver v (traced origin org, normal n): the pool's lights
@@ -390,7 +408,7 @@ static void decision_vertex(job *J, uint32_t v, const float *org, const float n[
     float *x = (float *)out->dec_scratch, *y = x + K, *z = y + K, *logd = z + K, *Y = logd + K;
     uint8_t *lab = (uint8_t *)(Y + (size_t)top * top * K);
     double *ds = (double *)(out->dec_scratch + dec_doubles_at(J));
-    uint32_t at = dec_start(J, v), scanned = 0;
+    uint32_t at = dec_start(J), scanned = 0;
     uint64_t rays = 0;
     uint32_t m = dec_pairs(J, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab, &rays);
     if (m >= DEC_MIN_PAIRS) {
@@ -414,6 +432,9 @@ static void decision_vertex(job *J, uint32_t v, const float *org, const float n[
     }
     for (size_t i = 0; i < (size_t)VDSH_ORDER_SLOTS * CAL_LIGHTS; i++)
         out->cal[i] = NAN;
+    uint32_t skip = dec_skip(J, v, scanned);
+    at = (uint32_t)(((uint64_t)at + skip) % J->pool_count);
+    scanned += skip;
     uint32_t h = dec_pairs(J, &at, &scanned, org, n, CAL_LIGHTS, x, y, z, logd, lab, &rays);
     atomic_fetch_add(&J->dec_rays, rays);
     if (!h)
