@@ -170,7 +170,9 @@ static int add_copy_modes(bench_scene *b, int copy)
     if (!any)
         return 0;
     vr_error err;
-    vr_scene_desc sd = {.path = b->path, .skip_cubemaps = 1, .buffers = 1,
+    vr_scene_desc sd = {.path = b->path,
+                        .skip_cubemaps = 1,
+                        .buffers = 1,
                         .buffer_floats = copy == 1,
                         .cpca_decode = copy == 2 ? VR_CPCA_PER_FRAME : VR_CPCA_PER_PASS};
     if (vr_scene_create(&sd, copy == 1 ? &b->floats : &b->frame, &err) != VR_OK) {
@@ -181,8 +183,8 @@ static int add_copy_modes(bench_scene *b, int copy)
         int k = vv_mode_find(b->modes[m].name, strlen(b->modes[m].name), VV_MODE_BENCH_LOG);
         int st = b->modes[m].stream;
         if (b->modes[m].mode != VR_MODE_VDSH_BUFFER || b->modes[m].floats || k < 0 ||
-            (copy == 2 && (st < 1 || st >= VDSH_ORDER_SLOTS ||
-                           info.buffer_encoding[st] != VDSH_ENCODING_CPCA)))
+            (copy == 2 &&
+             (st < 1 || st >= VDSH_ORDER_SLOTS || info.buffer_encoding[st] != VDSH_ENCODING_CPCA)))
             continue;
         snprintf(names[copy - 1][k], sizeof names[copy - 1][k], "%s-%s", vv_modes[k].json,
                  copy == 1 ? "f32" : "frame");
@@ -396,8 +398,8 @@ static void bench_print(const vv_options *o, const bench_scene *b, int all_round
             if (b->modes[m].mode == VR_MODE_VDSH_BUFFER)
                 vt_json_u64(j, r, "buffer_bytes",
                             vr_scene_buffer_bytes(b->modes[m].floats == 2 ? b->frame
-                                                  : b->modes[m].floats ? b->floats
-                                                                       : b->scene,
+                                                  : b->modes[m].floats    ? b->floats
+                                                                          : b->scene,
                                                   b->modes[m].stream));
             json_series(j, r, "cpu_ms", b->cpu[ls][m], rounds);
             json_series(j, r, "process_cpu_ms", b->proc[ls][m], rounds);

@@ -261,8 +261,8 @@ int vv_open_scene(const vv_options *o, const char *path, vr_scene **out)
                         .skip_cubemaps = o->no_cubemaps,
                         .light_pool = pool,
                         .buffers = o->buffers,
-                        .cpca_decode = o->cpca_frame && !o->bench ? VR_CPCA_PER_FRAME
-                                                                  : VR_CPCA_PER_PASS,
+                        .cpca_decode =
+                            o->cpca_frame && !o->bench ? VR_CPCA_PER_FRAME : VR_CPCA_PER_PASS,
                         .sdf_path = o->sdf_path};
     if (vr_scene_create(&sd, out, &err) != VR_OK) {
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
