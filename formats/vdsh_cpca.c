@@ -540,7 +540,7 @@ typedef struct refine_ctx {
     double *mval;   /* k x count: each cluster's mean at each direction */
     double *bval;   /* k x count x b: its basis vectors at each direction */
     double *xval;   /* count: the vertex's function */
-    double *w, *y;  /* b, n */
+    double *w;      /* b */
     uint32_t *hemi; /* count: the directions in the vertex's hemisphere */
     uint32_t *next; /* rows: the new labels */
 } refine_ctx;
@@ -550,15 +550,14 @@ static int refine_init(refine_ctx *r, uint32_t order, uint32_t k, uint32_t b, ui
     memset(r, 0, sizeof *r);
     if (!metric_init(&r->rd, order, REFINE_CUBE_N))
         return 0;
-    uint32_t count = r->rd.count, n = r->rd.n;
+    uint32_t count = r->rd.count;
     r->mval = malloc(sizeof(double) * k * count);
     r->bval = malloc(sizeof(double) * k * count * b);
     r->xval = malloc(sizeof(double) * count);
     r->w = malloc(sizeof(double) * b);
-    r->y = malloc(sizeof(double) * n);
     r->hemi = malloc(sizeof(uint32_t) * count);
     r->next = malloc(sizeof(uint32_t) * rows);
-    return r->mval && r->bval && r->xval && r->w && r->y && r->hemi && r->next;
+    return r->mval && r->bval && r->xval && r->w && r->hemi && r->next;
 }
 
 static void refine_free(refine_ctx *r)
@@ -568,7 +567,6 @@ static void refine_free(refine_ctx *r)
     free(r->bval);
     free(r->xval);
     free(r->w);
-    free(r->y);
     free(r->hemi);
     free(r->next);
 }
