@@ -18,7 +18,12 @@
 
 enum {
     KMEANS_ROUNDS = 25,
-    CUBE_N = 37 /* metric directions: 6 * 37^2 = 8214 texel centres of a cube */
+    CUBE_N = 37, /* metric directions: 6 * 37^2 = 8214 texel centres of a cube */
+    /* CPCA refinement after k-means: rounds of reassigning each vertex to
+     * the cluster that reconstructs it best in its own hemisphere, on a
+     * coarser cube of directions (6 * 12^2 = 864), then fitting again */
+    REFINE_ROUNDS = 3,
+    REFINE_CUBE_N = 12
 };
 #define NORMAL_WEIGHT 10.0 /* normals at ten times the coefficients' spread */
 #define SPHERE_EPS 0.01    /* the whole sphere's weight in the metric */
@@ -162,9 +167,9 @@ typedef struct metric_dirs {
     double *full; /* n x n: sum over all directions of weight * Y Y^T */
 } metric_dirs;
 
-static int metric_init(metric_dirs *m, uint32_t order)
+static int metric_init(metric_dirs *m, uint32_t order, uint32_t cube_n)
 {
-    uint32_t n = order * order, count = 6 * CUBE_N * CUBE_N;
+    uint32_t n = order * order, count = 6 * cube_n * cube_n;
     m->count = count;
     m->n = n;
     m->dir = malloc(sizeof(double) * 3 * count);
@@ -175,9 +180,9 @@ static int metric_init(metric_dirs *m, uint32_t order)
     float y[VDSH_MAX_COEFFS];
     uint32_t at = 0;
     for (uint32_t face = 0; face < 6; face++)
-        for (uint32_t j = 0; j < CUBE_N; j++)
-            for (uint32_t i = 0; i < CUBE_N; i++, at++) {
-                double u = 2.0 * (i + 0.5) / CUBE_N - 1.0, v = 2.0 * (j + 0.5) / CUBE_N - 1.0;
+        for (uint32_t j = 0; j < cube_n; j++)
+            for (uint32_t i = 0; i < cube_n; i++, at++) {
+                double u = 2.0 * (i + 0.5) / cube_n - 1.0, v = 2.0 * (j + 0.5) / cube_n - 1.0;
                 double d[3];
                 uint32_t axis = face / 2;
                 double sign = face % 2 ? -1.0 : 1.0;
@@ -186,7 +191,7 @@ static int metric_init(metric_dirs *m, uint32_t order)
                 d[(axis + 2) % 3] = v;
                 double r2 = 1.0 + u * u + v * v, r = sqrt(r2);
                 /* solid angle of the texel, to first order */
-                double w = 4.0 / ((double)CUBE_N * CUBE_N) / (r2 * r);
+                double w = 4.0 / ((double)cube_n * cube_n) / (r2 * r);
                 float df[3];
                 for (int k = 0; k < 3; k++) {
                     m->dir[3 * at + k] = d[k] / r;
@@ -383,6 +388,272 @@ static void kmeans(const float *src, const float *normals, uint32_t rows, uint32
     free(count);
 }
 
+/* ---- the fit: per cluster the stored mean and the basis ---- */
+
+typedef struct fit_ctx {
+    const float *src, *normals;
+    uint32_t rows, n, k, b;
+    const metric_dirs *md;
+    uint32_t *labels;
+    uint16_t *means, *bases;               /* as stored */
+    uint32_t *members;                     /* k */
+    double *mus;                           /* k x n: the stored means, decoded */
+    double *l;                             /* n x n: the metric's Cholesky factor */
+    double *proj;                          /* k x b x n: the weights' projections */
+    double *g, *sc, *sy, *ev, *tmp, *frac; /* scratch */
+    uint32_t *idx;
+} fit_ctx;
+
+/* Cluster c's mean and basis from its members (labels): the mean stored
+ * as f16, the basis the leading principal directions of the deviations
+ * from it in the members' metric, stored as f16. */
+static vdsh_result fit_cluster(fit_ctx *f, uint32_t c, vdsh_error *err)
+{
+    const float *src = f->src, *normals = f->normals;
+    const uint32_t rows = f->rows, n = f->n, b = f->b;
+    const uint32_t *labels = f->labels;
+    double *mu = f->mus + (size_t)c * n, *l = f->l;
+    double *proj = f->proj + (size_t)c * b * n;
+    double *g = f->g, *sc = f->sc, *sy = f->sy, *ev = f->ev, *tmp = f->tmp, *frac = f->frac;
+    uint32_t *idx = f->idx;
+    /* members' mean (stored as f16) */
+    uint32_t members = 0;
+    for (uint32_t i = 0; i < n; i++)
+        mu[i] = 0.0;
+    for (uint32_t v = 0; v < rows; v++) {
+        if (labels[v] != c)
+            continue;
+        members++;
+        for (uint32_t i = 0; i < n; i++)
+            mu[i] += src[(size_t)v * n + i];
+    }
+    f->members[c] = members;
+    if (!members) { /* mean, basis and scales 0; no vertex refers to it */
+        memset(f->means + (size_t)c * n, 0, sizeof(uint16_t) * n);
+        memset(f->bases + (size_t)c * b * n, 0, sizeof(uint16_t) * b * n);
+        memset(proj, 0, sizeof(double) * b * n);
+        return VDSH_OK;
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        float m = (float)(mu[i] / members);
+        uint16_t h = vdsh_f16_from_f32(m);
+        if ((h & 0x7c00u) == 0x7c00u) {
+            return vdsh_failf(err, VDSH_ERR_INVALID,
+                              "cpca: cluster %u's mean coefficient %u, %g, does not fit f16", c, i,
+                              (double)m);
+        }
+        f->means[(size_t)c * n + i] = h;
+        mu[i] = vdsh_f32_from_f16(h);
+    }
+    metric_gram_members(f->md, normals, labels, rows, c, members, frac, g);
+    if (!cholesky(g, n, l)) {
+        return vdsh_failf(err, VDSH_ERR_INVALID, "cpca: cluster %u: metric not positive definite",
+                          c);
+    }
+    /* scatter of the deviations from the stored mean (lower half) */
+    memset(sc, 0, sizeof(double) * n * n);
+    for (uint32_t v = 0; v < rows; v++) {
+        if (labels[v] != c)
+            continue;
+        const float *x = src + (size_t)v * n;
+        for (uint32_t a = 0; a < n; a++) {
+            double da = x[a] - mu[a];
+            double *row = sc + (size_t)a * n;
+            for (uint32_t e = 0; e <= a; e++)
+                row[e] += da * (x[e] - mu[e]);
+        }
+    }
+    for (uint32_t a = 0; a < n; a++)
+        for (uint32_t e = 0; e < a; e++)
+            sc[(size_t)e * n + a] = sc[(size_t)a * n + e];
+    /* in the metric: y = L^T c, so sy = L^T sc L */
+    for (uint32_t a = 0; a < n; a++) /* tmp = sc L */
+        for (uint32_t e = 0; e < n; e++) {
+            double s = 0.0;
+            for (uint32_t q = e; q < n; q++)
+                s += sc[(size_t)a * n + q] * l[(size_t)q * n + e];
+            tmp[(size_t)a * n + e] = s;
+        }
+    for (uint32_t a = 0; a < n; a++) /* sy = L^T tmp */
+        for (uint32_t e = 0; e < n; e++) {
+            double s = 0.0;
+            for (uint32_t q = a; q < n; q++)
+                s += l[(size_t)q * n + a] * tmp[(size_t)q * n + e];
+            sy[(size_t)a * n + e] = s;
+        }
+    for (uint32_t a = 0; a < n; a++) /* symmetric to the bit */
+        for (uint32_t e = 0; e < a; e++)
+            sy[(size_t)e * n + a] = sy[(size_t)a * n + e];
+    jacobi(sy, n, ev);
+    /* eigenvalues descending, ties by index */
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t at = i;
+        while (at > 0 && sy[(size_t)idx[at - 1] * n + idx[at - 1]] < sy[(size_t)i * n + i]) {
+            idx[at] = idx[at - 1];
+            at--;
+        }
+        idx[at] = i;
+    }
+    for (uint32_t j = 0; j < b; j++) {
+        uint32_t col = idx[j];
+        /* projection p = L u; basis vector L^-T u (back substitution) */
+        double *p = proj + (size_t)j * n;
+        for (uint32_t a = 0; a < n; a++) {
+            double s = 0.0;
+            for (uint32_t q = 0; q <= a; q++)
+                s += l[(size_t)a * n + q] * ev[(size_t)q * n + col];
+            p[a] = s;
+        }
+        double *bv = tmp; /* L^T bv = u */
+        for (uint32_t a = n; a-- > 0;) {
+            double s = ev[(size_t)a * n + col];
+            for (uint32_t q = a + 1; q < n; q++)
+                s -= l[(size_t)q * n + a] * bv[q];
+            bv[a] = s / l[(size_t)a * n + a];
+        }
+        for (uint32_t a = 0; a < n; a++) {
+            uint16_t h = vdsh_f16_from_f32((float)bv[a]);
+            if ((h & 0x7c00u) == 0x7c00u) {
+                return vdsh_failf(err, VDSH_ERR_INVALID,
+                                  "cpca: cluster %u basis vector %u does not fit f16", c, j);
+            }
+            f->bases[((size_t)c * b + j) * n + a] = h;
+        }
+    }
+    return VDSH_OK;
+}
+
+static vdsh_result fit_all(fit_ctx *f, vdsh_error *err)
+{
+    for (uint32_t c = 0; c < f->k; c++) {
+        vdsh_result r = fit_cluster(f, c, err);
+        if (r != VDSH_OK)
+            return r;
+    }
+    return VDSH_OK;
+}
+
+/* ---- refinement (CPCA; Sloan et al. 2003) ---- */
+
+typedef struct refine_ctx {
+    metric_dirs rd; /* a coarser cube of directions than the fit's */
+    double *mval;   /* k x count: each cluster's mean at each direction */
+    double *bval;   /* k x count x b: its basis vectors at each direction */
+    double *xval;   /* count: the vertex's function */
+    double *w;      /* b */
+    uint32_t *hemi; /* count: the directions in the vertex's hemisphere */
+    uint32_t *next; /* rows: the new labels */
+} refine_ctx;
+
+static int refine_init(refine_ctx *r, uint32_t order, uint32_t k, uint32_t b, uint32_t rows)
+{
+    memset(r, 0, sizeof *r);
+    if (!metric_init(&r->rd, order, REFINE_CUBE_N))
+        return 0;
+    uint32_t count = r->rd.count;
+    r->mval = malloc(sizeof(double) * k * count);
+    r->bval = malloc(sizeof(double) * k * count * b);
+    r->xval = malloc(sizeof(double) * count);
+    r->w = malloc(sizeof(double) * b);
+    r->hemi = malloc(sizeof(uint32_t) * count);
+    r->next = malloc(sizeof(uint32_t) * rows);
+    return r->mval && r->bval && r->xval && r->w && r->hemi && r->next;
+}
+
+static void refine_free(refine_ctx *r)
+{
+    metric_free(&r->rd);
+    free(r->mval);
+    free(r->bval);
+    free(r->xval);
+    free(r->w);
+    free(r->hemi);
+    free(r->next);
+}
+
+/* The squared error of vertex x's reconstruction by cluster c (the
+ * weights the fit's projections, unquantised) over x's own hemisphere:
+ * the nh directions in r->hemi, x's values there in r->xval. */
+static double refine_error(const fit_ctx *f, refine_ctx *r, uint32_t c, const float *x, uint32_t nh)
+{
+    const uint32_t n = f->n, b = f->b, count = r->rd.count;
+    const double *mu = f->mus + (size_t)c * n, *proj = f->proj + (size_t)c * b * n;
+    for (uint32_t j = 0; j < b; j++) {
+        const double *p = proj + (size_t)j * n;
+        double w = 0.0;
+        for (uint32_t a = 0; a < n; a++)
+            w += ((double)x[a] - mu[a]) * p[a];
+        r->w[j] = w;
+    }
+    const double *mv = r->mval + (size_t)c * count, *bv = r->bval + (size_t)c * count * b;
+    double e = 0.0;
+    for (uint32_t h = 0; h < nh; h++) {
+        uint32_t d = r->hemi[h];
+        double s = r->xval[d] - mv[d];
+        const double *bd = bv + (size_t)d * b;
+        for (uint32_t j = 0; j < b; j++)
+            s -= r->w[j] * bd[j];
+        e += s * s;
+    }
+    return e;
+}
+
+/* One round of reassignment: the number of vertices that moved. */
+static uint32_t reassign(fit_ctx *f, refine_ctx *r)
+{
+    const uint32_t n = f->n, b = f->b, k = f->k, count = r->rd.count;
+    for (uint32_t c = 0; c < k; c++) {
+        if (!f->members[c])
+            continue;
+        const double *mu = f->mus + (size_t)c * n;
+        for (uint32_t d = 0; d < count; d++) {
+            const double *y = r->rd.wy + (size_t)d * n;
+            double s = 0.0;
+            for (uint32_t a = 0; a < n; a++)
+                s += y[a] * mu[a];
+            r->mval[(size_t)c * count + d] = s;
+            for (uint32_t j = 0; j < b; j++) {
+                const uint16_t *bj = f->bases + ((size_t)c * b + j) * n;
+                double t = 0.0;
+                for (uint32_t a = 0; a < n; a++)
+                    t += y[a] * (double)vdsh_f32_from_f16(bj[a]);
+                r->bval[((size_t)c * count + d) * b + j] = t;
+            }
+        }
+    }
+    uint32_t moved = 0;
+    for (uint32_t v = 0; v < f->rows; v++) {
+        const float *x = f->src + (size_t)v * n, *nv = f->normals + 3 * (size_t)v;
+        uint32_t nh = 0;
+        for (uint32_t d = 0; d < count; d++) {
+            const double *dd = r->rd.dir + 3 * (size_t)d;
+            if (!(dd[0] * nv[0] + dd[1] * nv[1] + dd[2] * nv[2] > 0.0))
+                continue;
+            r->hemi[nh++] = d;
+            const double *y = r->rd.wy + (size_t)d * n;
+            double s = 0.0;
+            for (uint32_t a = 0; a < n; a++)
+                s += y[a] * (double)x[a];
+            r->xval[d] = s;
+        }
+        uint32_t best = f->labels[v];
+        double be = refine_error(f, r, best, x, nh);
+        for (uint32_t c = 0; c < k; c++) {
+            if (c == f->labels[v] || !f->members[c])
+                continue;
+            double e = refine_error(f, r, c, x, nh);
+            if (e < be || (e == be && c < best)) {
+                be = e;
+                best = c;
+            }
+        }
+        r->next[v] = best;
+        moved += best != f->labels[v];
+    }
+    memcpy(f->labels, r->next, sizeof(uint32_t) * f->rows);
+    return moved;
+}
+
 /* ---- the fit ---- */
 
 /* Candidate scales of a basis vector: its largest |weight| times 1,
@@ -435,16 +706,21 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
     double *cent = malloc(sizeof(double) * k * (n + 3));
     double *g = malloc(sizeof(double) * n * n), *l = malloc(sizeof(double) * n * n);
     double *sc = malloc(sizeof(double) * n * n), *sy = malloc(sizeof(double) * n * n);
-    double *ev = malloc(sizeof(double) * n * n), *proj = malloc(sizeof(double) * n * b);
+    double *ev = malloc(sizeof(double) * n * n), *proj = malloc(sizeof(double) * k * n * b);
     double *tmp = malloc(sizeof(double) * n * n), *mu = malloc(sizeof(double) * n);
+    double *mus = malloc(sizeof(double) * k * n);
+    uint32_t *members = malloc(sizeof(uint32_t) * k);
     double *wmax = malloc(sizeof(double) * b);
     double *cerr = malloc(sizeof(double) * b * SCALE_CANDIDATES);
     uint32_t *idx = malloc(sizeof(uint32_t) * n);
     double *frac = malloc(sizeof(double) * 6 * CUBE_N * CUBE_N);
     metric_dirs md = {0};
+    refine_ctx rd = {0};
+    const uint32_t rounds = k > 1 ? REFINE_ROUNDS : 0;
     vdsh_result res = VDSH_OK;
     if (!block || !labels || !dist || !cent || !g || !l || !sc || !sy || !ev || !proj || !tmp ||
-        !mu || !wmax || !cerr || !idx || !frac || !metric_init(&md, order)) {
+        !mu || !mus || !members || !wmax || !cerr || !idx || !frac ||
+        !metric_init(&md, order, CUBE_N) || (rounds && !refine_init(&rd, order, k, b, rows))) {
         res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory (%zu bytes)", total);
         goto done;
     }
@@ -452,6 +728,27 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
     uint16_t *means = (uint16_t *)(block + o_means);
     uint16_t *bases = (uint16_t *)(block + o_bases);
     uint32_t *records = (uint32_t *)(block + o_rec);
+    fit_ctx fc = {.src = src,
+                  .normals = normals,
+                  .rows = rows,
+                  .n = n,
+                  .k = k,
+                  .b = b,
+                  .md = &md,
+                  .labels = labels,
+                  .means = means,
+                  .bases = bases,
+                  .members = members,
+                  .mus = mus,
+                  .l = l,
+                  .proj = proj,
+                  .g = g,
+                  .sc = sc,
+                  .sy = sy,
+                  .ev = ev,
+                  .tmp = tmp,
+                  .frac = frac,
+                  .idx = idx};
 
     /* the coefficients' spread: sqrt(mean over rows of |c - mean c|^2) */
     for (uint32_t i = 0; i < n; i++)
@@ -470,110 +767,20 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
     spread = sqrt(spread / rows);
     kmeans(src, normals, rows, n, NORMAL_WEIGHT * spread, k, labels, dist, cent);
 
+    res = fit_all(&fc, err);
+    for (uint32_t round = 0; res == VDSH_OK && round < rounds; round++) {
+        if (!reassign(&fc, &rd))
+            break; /* no vertex moved: the fit is the last one's */
+        res = fit_all(&fc, err);
+    }
+    if (res != VDSH_OK)
+        goto done;
+
     const int levels = vdsh_cpca_levels(bits);
     for (uint32_t c = 0; c < k; c++) {
-        /* members' mean (stored as f16) */
-        uint32_t members = 0;
-        for (uint32_t i = 0; i < n; i++)
-            mu[i] = 0.0;
-        for (uint32_t v = 0; v < rows; v++) {
-            if (labels[v] != c)
-                continue;
-            members++;
-            for (uint32_t i = 0; i < n; i++)
-                mu[i] += src[(size_t)v * n + i];
-        }
-        if (!members)
+        if (!fc.members[c])
             continue; /* mean, basis and scales 0; no vertex refers to it */
-        for (uint32_t i = 0; i < n; i++) {
-            float m = (float)(mu[i] / members);
-            uint16_t h = vdsh_f16_from_f32(m);
-            if ((h & 0x7c00u) == 0x7c00u) {
-                res = vdsh_failf(err, VDSH_ERR_INVALID,
-                                 "cpca: cluster %u's mean coefficient %u, %g, does not fit f16", c,
-                                 i, (double)m);
-                goto done;
-            }
-            means[(size_t)c * n + i] = h;
-            mu[i] = vdsh_f32_from_f16(h);
-        }
-        metric_gram_members(&md, normals, labels, rows, c, members, frac, g);
-        if (!cholesky(g, n, l)) {
-            res = vdsh_failf(err, VDSH_ERR_INVALID,
-                             "cpca: cluster %u: metric not positive definite", c);
-            goto done;
-        }
-        /* scatter of the deviations from the stored mean (lower half) */
-        memset(sc, 0, sizeof(double) * n * n);
-        for (uint32_t v = 0; v < rows; v++) {
-            if (labels[v] != c)
-                continue;
-            const float *x = src + (size_t)v * n;
-            for (uint32_t a = 0; a < n; a++) {
-                double da = x[a] - mu[a];
-                double *row = sc + (size_t)a * n;
-                for (uint32_t e = 0; e <= a; e++)
-                    row[e] += da * (x[e] - mu[e]);
-            }
-        }
-        for (uint32_t a = 0; a < n; a++)
-            for (uint32_t e = 0; e < a; e++)
-                sc[(size_t)e * n + a] = sc[(size_t)a * n + e];
-        /* in the metric: y = L^T c, so sy = L^T sc L */
-        for (uint32_t a = 0; a < n; a++) /* tmp = sc L */
-            for (uint32_t e = 0; e < n; e++) {
-                double s = 0.0;
-                for (uint32_t q = e; q < n; q++)
-                    s += sc[(size_t)a * n + q] * l[(size_t)q * n + e];
-                tmp[(size_t)a * n + e] = s;
-            }
-        for (uint32_t a = 0; a < n; a++) /* sy = L^T tmp */
-            for (uint32_t e = 0; e < n; e++) {
-                double s = 0.0;
-                for (uint32_t q = a; q < n; q++)
-                    s += l[(size_t)q * n + a] * tmp[(size_t)q * n + e];
-                sy[(size_t)a * n + e] = s;
-            }
-        for (uint32_t a = 0; a < n; a++) /* symmetric to the bit */
-            for (uint32_t e = 0; e < a; e++)
-                sy[(size_t)e * n + a] = sy[(size_t)a * n + e];
-        jacobi(sy, n, ev);
-        /* eigenvalues descending, ties by index */
-        for (uint32_t i = 0; i < n; i++) {
-            uint32_t at = i;
-            while (at > 0 && sy[(size_t)idx[at - 1] * n + idx[at - 1]] < sy[(size_t)i * n + i]) {
-                idx[at] = idx[at - 1];
-                at--;
-            }
-            idx[at] = i;
-        }
-        for (uint32_t j = 0; j < b; j++) {
-            uint32_t col = idx[j];
-            /* projection p = L u; basis vector L^-T u (back substitution) */
-            double *p = proj + (size_t)j * n;
-            for (uint32_t a = 0; a < n; a++) {
-                double s = 0.0;
-                for (uint32_t q = 0; q <= a; q++)
-                    s += l[(size_t)a * n + q] * ev[(size_t)q * n + col];
-                p[a] = s;
-            }
-            double *bv = tmp; /* L^T bv = u */
-            for (uint32_t a = n; a-- > 0;) {
-                double s = ev[(size_t)a * n + col];
-                for (uint32_t q = a + 1; q < n; q++)
-                    s -= l[(size_t)q * n + a] * bv[q];
-                bv[a] = s / l[(size_t)a * n + a];
-            }
-            for (uint32_t a = 0; a < n; a++) {
-                uint16_t h = vdsh_f16_from_f32((float)bv[a]);
-                if ((h & 0x7c00u) == 0x7c00u) {
-                    res = vdsh_failf(err, VDSH_ERR_INVALID,
-                                     "cpca: cluster %u basis vector %u does not fit f16", c, j);
-                    goto done;
-                }
-                bases[((size_t)c * b + j) * n + a] = h;
-            }
-        }
+        const double *cmu = mus + (size_t)c * n, *cproj = proj + (size_t)c * b * n;
         /* weights, in three passes: the largest |weight| per vector; the
          * squared quantisation error of each candidate scale (the largest
          * times 1, 0.95, ..., 0.35: clipping the few largest weights buys
@@ -592,10 +799,10 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
                 if (pass == 2)
                     rec[0] = c;
                 for (uint32_t j = 0; j < b; j++) {
-                    const double *p = proj + (size_t)j * n;
+                    const double *p = cproj + (size_t)j * n;
                     double w = 0.0;
                     for (uint32_t a = 0; a < n; a++)
-                        w += (x[a] - mu[a]) * p[a];
+                        w += (x[a] - cmu[a]) * p[a];
                     if (pass == 0) {
                         wmax[j] = fabs(w) > wmax[j] ? fabs(w) : wmax[j];
                         continue;
@@ -662,6 +869,8 @@ done:
     free(cent);
     free(g);
     free(l);
+    free(mus);
+    free(members);
     free(sc);
     free(sy);
     free(ev);
@@ -673,6 +882,8 @@ done:
     free(idx);
     free(frac);
     metric_free(&md);
+    if (rounds)
+        refine_free(&rd);
     return res;
 }
 

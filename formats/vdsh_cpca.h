@@ -11,7 +11,10 @@
  * seeding from a fixed seed, Lloyd rounds until no vertex moves (at most
  * 25); per cluster the mean (f16) and the B leading principal directions
  * of the deviations in the mean of the members' own upper-hemisphere
- * metrics plus 0.01 of the whole sphere; weights quantised
+ * metrics plus 0.01 of the whole sphere; then 3 rounds of CPCA refinement
+ * (each vertex to the cluster whose mean and basis reconstruct it with the
+ * least error over its own hemisphere, then every cluster fitted again,
+ * stopping early when no vertex moves); weights quantised
  * to `bits` bits with a scale per cluster and vector, chosen among the
  * largest |weight| x 1, 0.95, ..., 0.35 by least squared error. f64, one thread,
  * fixed order: the same bytes on any x86-64 CPU and thread count.
