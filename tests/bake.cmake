@@ -46,9 +46,12 @@ add_test(NAME bake_isa_agree
 # baseline clones against the AVX2 ones.
 set(VDSH_REFERENCE_BAKE "" CACHE FILEPATH
     "Another build's vdsh-bake whose bytes bake_same_bytes_any_cpu compares")
+add_executable(libm_probe libm_probe.c)
+target_link_libraries(libm_probe PRIVATE m)
 add_test(NAME bake_same_bytes_any_cpu
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_same_bytes_any_cpu.sh
-                 $<TARGET_FILE:vdsh-bake> ${VDSH_SHARED_SCENES} ${VDSH_REFERENCE_BAKE})
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:libm_probe> ${VDSH_SHARED_SCENES}
+                 ${VDSH_REFERENCE_BAKE})
 set_tests_properties(bake_same_bytes_any_cpu PROPERTIES TIMEOUT 900)
 
 # Sharded bakes (vdsh-bake --shard I/N, vdsh-merge): byte for byte.

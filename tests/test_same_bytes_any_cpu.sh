@@ -13,13 +13,24 @@
 # Each case is baked natively and with glibc's baseline paths (or, given
 # REF_BAKE, natively by both builds), one thread, and every output file
 # compared byte for byte.
-# Usage: test_same_bytes_any_cpu.sh VDSH_BAKE SCENES_DIR [REF_BAKE]
+# On a CPU with FMA, LIBM_PROBE (a hash of libm results) must differ under
+# the tunable: else glibc ignored it and the comparison would prove nothing.
+# Usage: test_same_bytes_any_cpu.sh VDSH_BAKE LIBM_PROBE SCENES_DIR [REF_BAKE]
 set -u
-bake=$1 scenes=$2 ref=${3:-}
+bake=$1 probe=$2 scenes=$3 ref=${4:-}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 baseline=glibc.cpu.hwcaps=-AVX2,-FMA,-AVX
 export ASAN_OPTIONS=${ASAN_OPTIONS:-}${ASAN_OPTIONS:+:}detect_leaks=0
+
+if [[ -z $ref ]] && grep -qw fma /proc/cpuinfo 2>/dev/null; then
+  if [[ $("$probe") == "$(GLIBC_TUNABLES=$baseline "$probe")" ]]; then
+    echo "FAIL: GLIBC_TUNABLES=$baseline did not change libm's results on this FMA CPU:" \
+      "the baseline comparison would prove nothing" >&2
+    exit 1
+  fi
+  echo "libm: the baseline paths give other bits than the native ones (as expected)"
+fi
 
 cases=(
   "builtin:room --max-edge 0.8 --rays 196"
