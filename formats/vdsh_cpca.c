@@ -388,6 +388,16 @@ static void kmeans(const float *src, const float *normals, uint32_t rows, uint32
     free(count);
 }
 
+/* The weight of vertex x (n coefficients) on the basis vector whose
+ * projection is p, in a cluster of decoded mean mu: (x - mu) . p. */
+static double weight_of(const float *x, const double *mu, const double *p, uint32_t n)
+{
+    double w = 0.0;
+    for (uint32_t a = 0; a < n; a++)
+        w += ((double)x[a] - mu[a]) * p[a];
+    return w;
+}
+
 /* ---- the fit: per cluster the stored mean and the basis ---- */
 
 typedef struct fit_ctx {
@@ -578,13 +588,8 @@ static double refine_error(const fit_ctx *f, refine_ctx *r, uint32_t c, const fl
 {
     const uint32_t n = f->n, b = f->b, count = r->rd.count;
     const double *mu = f->mus + (size_t)c * n, *proj = f->proj + (size_t)c * b * n;
-    for (uint32_t j = 0; j < b; j++) {
-        const double *p = proj + (size_t)j * n;
-        double w = 0.0;
-        for (uint32_t a = 0; a < n; a++)
-            w += ((double)x[a] - mu[a]) * p[a];
-        r->w[j] = w;
-    }
+    for (uint32_t j = 0; j < b; j++)
+        r->w[j] = weight_of(x, mu, proj + (size_t)j * n, n);
     const double *mv = r->mval + (size_t)c * count, *bv = r->bval + (size_t)c * count * b;
     double e = 0.0;
     for (uint32_t h = 0; h < nh; h++) {
@@ -799,10 +804,7 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
                 if (pass == 2)
                     rec[0] = c;
                 for (uint32_t j = 0; j < b; j++) {
-                    const double *p = cproj + (size_t)j * n;
-                    double w = 0.0;
-                    for (uint32_t a = 0; a < n; a++)
-                        w += (x[a] - cmu[a]) * p[a];
+                    double w = weight_of(x, cmu, cproj + (size_t)j * n, n);
                     if (pass == 0) {
                         wmax[j] = fabs(w) > wmax[j] ? fabs(w) : wmax[j];
                         continue;
