@@ -517,6 +517,8 @@ static int write_report(const char *path, const options *o, const vb_job *job,
             snprintf(key, sizeof key, "%d", o->orders[i]);
             vt_json_f32(&j, off, key, b->log_offset[o->orders[i]]);
         }
+        if (b->variable_cap && b->variable_method == VDSH_METHOD_DECISION)
+            vt_json_f32(&j, off, "adaptive", b->variable_param);
     } else {
         vt_json_null(&j, root, "decision");
     }
@@ -1234,6 +1236,9 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
             for (int s = 0; s < o->order_count; s++)
                 fprintf(log, "%s order %d %+.3f", s ? "," : "", o->orders[s],
                         (double)bo->log_offset[o->orders[s]]);
+            if (bo->variable_cap && bo->variable_method == VDSH_METHOD_DECISION)
+                fprintf(log, "%s adaptive order %+.3f", o->order_count ? "," : "",
+                        (double)bo->variable_param);
             fputc('\n', log);
         }
     }
