@@ -215,12 +215,69 @@ static void test_converges(void)
     free(scratch);
 }
 
+/* vb_decision_score: the loss without the ridge at the coefficients with
+ * one offset b added to every margin (through c0), b the minimum (the loss
+ * no lower at b +- 0.05), and the score at most the loss at b = 0. And
+ * the fit with one fresh Hessian (the adaptive order's refit): each step
+ * more never raises the loss, and it ends below the start. */
+static void test_score_and_kept_hessian(void)
+{
+    uint64_t s = 99;
+    static float Y[N * M];
+    float logd[M];
+    uint8_t lab[M];
+    pairs(&s, M, Y, logd, lab);
+    vb_decision_params p, flat;
+    vb_decision_defaults(&p);
+    flat = p;
+    flat.ridge = flat.ridge0 = 0.0f;
+    double *scratch = malloc(vb_decision_scratch_doubles(ORDER) * sizeof *scratch);
+    for (int order = 1; order <= ORDER; order++) {
+        float c[N] = {0}, at[N];
+        c[0] = 1.5f / 0.28209479f;
+        for (int j = 1; j < order * order; j++)
+            c[j] = 0.3f * (float)((j * 37) % 11 - 5) / (float)(j + 1);
+        float b = 0.0f;
+        float sc = vb_decision_score(order, M, Y, M, logd, lab, &p, c, &b, scratch);
+        memcpy(at, c, sizeof at);
+        double f0 = loss(&flat, order, at, c, M, Y, logd, lab);
+        at[0] = c[0] + b / 0.28209479f;
+        double fb = loss(&flat, order, at, c, M, Y, logd, lab);
+        CHECK(fabs(sc - fb) <= 1e-4 * fb, "order %d: score %g, the loss at its offset %g", order,
+              (double)sc, fb);
+        CHECK(sc <= f0 * (1.0 + 1e-6), "order %d: score %g above the loss at 0, %g", order,
+              (double)sc, f0);
+        for (int side = -1; side <= 1; side += 2) {
+            at[0] = c[0] + (b + 0.05f * side) / 0.28209479f;
+            double f = loss(&flat, order, at, c, M, Y, logd, lab);
+            CHECK(f >= fb * (1.0 - 1e-5), "order %d: offset %g +- 0.05 lowers the loss %g to %g",
+                  order, (double)b, fb, f);
+        }
+        vb_decision_params q = p;
+        q.hessians = 1;
+        double prev = loss(&q, order, c, c, M, Y, logd, lab), start = prev;
+        for (int steps = 1; steps <= 4; steps++) {
+            q.steps = steps;
+            memcpy(at, c, sizeof at);
+            vb_decision_fit(order, M, Y, M, logd, lab, &q, at, scratch);
+            double f = loss(&q, order, at, c, M, Y, logd, lab);
+            CHECK(f <= prev * (1.0 + 1e-6), "order %d, one Hessian: %d steps' loss %g above %g",
+                  order, steps, f, prev);
+            prev = f;
+        }
+        CHECK(prev < start, "order %d, one Hessian: loss %g not below the start's %g", order, prev,
+              start);
+    }
+    free(scratch);
+}
+
 int main(void)
 {
     test_fit_beats_start();
     test_stride_and_tails();
     test_converges();
     test_offset();
+    test_score_and_kept_hessian();
     if (test_failures)
         fprintf(stderr, "%d checks failed\n", test_failures);
     return test_failures != 0;

@@ -83,6 +83,13 @@ typedef struct job {
     uint8_t *var_orders;
     float *var_coeffs;
     float *var_scratch; /* per worker: var_scratch_floats */
+    /* Adaptive order with the decision fit (var_decision): per receiver of
+     * the range, 1 where it kept the lsq choice (too few training pairs:
+     * the offsets already in), and per order, the log offset added to
+     * the decision-fitted rows (calibrated: one for the stream). */
+    int var_decision;
+    uint8_t *var_lsq;
+    float var_dec_offset[VDSH_ORDER_SLOTS];
     /* The decision fit (method.h: decision): the light pool in the traced
      * frame, lights per receiver, the fit's settings, per-worker scratch
      * (dec_scratch_bytes); the calibration's held-out margins (per sample,
@@ -106,7 +113,8 @@ typedef struct vertex_sink {
     float *coeffs[2][VDSH_ORDER_SLOTS];
     float *var_scratch;         /* adaptive order: the worker's (VAR_SCRATCH floats) */
     unsigned char *dec_scratch; /* decision fit: the worker's */
-    float *cal;                 /* decision calibration: margins, VDSH_ORDER_SLOTS x CAL_LIGHTS */
+    float *cal;                 /* decision calibration: margins, VDSH_ORDER_SLOTS x CAL_LIGHTS
+                                 * (slot 0: the adaptive order's chosen fit) */
     float *x, *y, *z, *t;
     uint32_t *n;
 } vertex_sink;
@@ -396,13 +404,51 @@ static uint32_t dec_pairs(const job *J, uint32_t *at, uint32_t *scanned, const f
     return m;
 }
 
+/* Adaptive order with the decision fit: each candidate order's lsq fit
+ * (varc[k], no offset) scored by the decision loss on the receiver's
+ * training pairs at the offset that suits it best (vb_decision_score:
+ * one number per candidate, no Newton fit), then the lowest candidate
+ * within the tolerance of the least loss refitted to the decision from
+ * its lsq fit (vb_decision_fit, as a fixed order is, but with one fresh
+ * Hessian), into varc[k]. Returns k. Deterministic as the decision fit
+ * is (decision.h). */
+static int choose_decision(const job *J, uint32_t m, const float *Y, uint32_t ys, const float *logd,
+                           const uint8_t *lab, float (*varc)[VDSH_MAX_COEFFS], double *ds)
+{
+    const int cap = J->var_cap;
+    float err[VDSH_ORDER_SLOTS], least = INFINITY;
+    for (int k = 1; k <= cap; k++) {
+        if (!vb_order_candidate(k, cap))
+            continue;
+        float b;
+        err[k] = vb_decision_score(k, m, Y, ys, logd, lab, &J->dec, varc[k], &b, ds);
+        least = err[k] < least ? err[k] : least;
+    }
+    int best_k = cap;
+    for (int k = cap; k >= 1; k--)
+        if (vb_order_candidate(k, cap) && err[k] <= least + J->var_tol)
+            best_k = k;
+    /* One fresh Hessian, then its factor kept for the other steps: as
+     * good per sample as a fresh one at every step on the validation
+     * rooms, for a third of the Hessians (docs/ACCURACY.md, "Adaptive
+     * order by the decision loss"). */
+    vb_decision_params p = J->dec;
+    p.hessians = 1;
+    vb_decision_fit(best_k, m, Y, ys, logd, lab, &p, varc[best_k], ds);
+    return best_k;
+}
+
 /* The decision fit of receiver v (decision.h): its pairs, then each asked
  * order's log fit in `out` refitted from its lsq start. With out->cal
  * (the calibration's samples), the margins of each order's fit on
  * CAL_LIGHTS further lights, held out from the fit: lit pairs' ln D - ln
- * d_L, NAN for shadowed ones and missing lights. */
-static void decision_vertex(job *J, uint32_t v, const float *org, const float n[3],
-                            const vertex_sink *out)
+ * d_L, NAN for shadowed ones and missing lights. With varc (the adaptive
+ * order: its candidates' lsq fits), the chosen order into *var_k and its
+ * fit into varc[*var_k] (choose_decision), its margins in slot 0.
+ * Returns 1 if the receiver had enough pairs to fit, 0 if it keeps its
+ * lsq fits. */
+static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3],
+                           const vertex_sink *out, float (*varc)[VDSH_MAX_COEFFS], int *var_k)
 {
     const uint32_t K = VB_DECISION_MAX_PAIRS, top = J->order;
     float *x = (float *)out->dec_scratch, *y = x + K, *z = y + K, *logd = z + K, *Y = logd + K;
@@ -421,14 +467,17 @@ static void decision_vertex(job *J, uint32_t v, const float *org, const float n[
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (out->coeffs[1][o])
                 vb_decision_fit(o, m, Y, ys, logd, lab, &J->dec, out->coeffs[1][o], ds);
+        if (varc)
+            *var_k = choose_decision(J, m, Y, ys, logd, lab, varc, ds);
         atomic_fetch_add(&J->dec_pairs, m);
         atomic_fetch_add(&J->dec_fitted, 1);
     } else {
         atomic_fetch_add(&J->dec_fallbacks, 1);
     }
+    const int fitted = m >= DEC_MIN_PAIRS;
     if (!out->cal) {
         atomic_fetch_add(&J->dec_rays, rays);
-        return;
+        return fitted;
     }
     for (size_t i = 0; i < (size_t)VDSH_ORDER_SLOTS * CAL_LIGHTS; i++)
         out->cal[i] = NAN;
@@ -438,21 +487,23 @@ static void decision_vertex(job *J, uint32_t v, const float *org, const float n[
     uint32_t h = dec_pairs(J, &at, &scanned, org, n, CAL_LIGHTS, x, y, z, logd, lab, &rays);
     atomic_fetch_add(&J->dec_rays, rays);
     if (!h)
-        return;
+        return fitted;
     vdsh_sh_eval_soa((int)top, h, x, y, z, Y, K);
-    for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
-        const float *c = out->coeffs[1][o];
+    for (int o = 0; o <= VDSH_MAX_ORDER; o++) {
+        const float *c = o ? out->coeffs[1][o] : varc && fitted ? varc[*var_k] : NULL;
+        const int k = o ? o : varc && fitted ? *var_k : 0;
         if (!c)
             continue;
         for (uint32_t i = 0; i < h; i++) {
             if (lab[i])
                 continue;
             float s = 0.0f;
-            for (int j = 0; j < o * o; j++)
+            for (int j = 0; j < k * k; j++)
                 s += c[j] * Y[(size_t)j * K + i];
             out->cal[o * CAL_LIGHTS + i] = s - logd[i];
         }
     }
+    return fitted;
 }
 
 /* An AVX2 clone where the CPU has it, for the lane loops (the log's
@@ -488,7 +539,12 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
     const int var = J->var_cap && v >= J->lo && v < J->hi && !d->trace_only && !out->n;
     float *var_buf = var ? out->var_scratch : NULL;
     uint32_t var_n = 0;
-    want[1] |= var;
+    /* With the decision fit, the choice is made on the training pairs
+     * (choose_decision), also for a calibration sample outside the range
+     * (its held-out margins count toward the stream's offset). */
+    const int dvar =
+        J->var_decision && !d->trace_only && !out->n && (var || (out->cal && out->var_scratch));
+    want[1] |= var | dvar;
     /* Loop invariants in locals: the lane loops below vectorise. */
     const float inv_scale = J->inv_scale, max_distance = d->max_distance;
     const float degenerate_dist = J->near[slot], log_floor = J->log_floor;
@@ -683,10 +739,12 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
     const vb_fit *top = &J->fits[J->order];
     vb_fit_angles angles;
     vb_fit_frame(top, n, &angles);
+    double u[VDSH_MAX_COEFFS];
+    float varc[VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS];
     for (int q = 0; q < 2; q++) {
         if (!want[q])
             continue;
-        double b[VDSH_MAX_COEFFS], u[VDSH_MAX_COEFFS];
+        double b[VDSH_MAX_COEFFS];
         for (int i = 0; i < nb; i++) {
             double s = 0.0;
             for (int k = 0; k < VB_PACKET; k++)
@@ -697,14 +755,33 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (out->coeffs[q][o])
                 vb_fit_finish(&J->fits[o], &angles, u, out->coeffs[q][o]);
-        if (q == 1 && var_buf) {
+        if (q == 1 && dvar)
+            for (int k = 1; k <= J->var_cap; k++)
+                if (vb_order_candidate(k, J->var_cap))
+                    vb_fit_finish(&J->fits[k], &angles, u, varc[k]);
+        if (q == 1 && var_buf && !dvar) {
             uint32_t c = J->grid->count;
             choose_order(J, v, &angles, u, var_buf, var_buf + c, var_buf + 2 * c, var_buf + 3 * c,
                          var_n, var_buf + 4 * (size_t)c);
         }
     }
-    if (J->decision && want[1])
-        decision_vertex(J, v, org, n, out);
+    int var_k = 0;
+    const int fitted =
+        J->decision && want[1] ? decision_vertex(J, v, org, n, out, dvar ? varc : NULL, &var_k) : 0;
+    if (var && dvar) {
+        uint32_t r = v - J->lo;
+        J->var_lsq[r] = !fitted;
+        if (fitted) { /* the decision's choice; its offset added after the bake */
+            J->var_orders[r] = (uint8_t)var_k;
+            float *dst = J->var_coeffs + (size_t)r * J->var_cap * J->var_cap;
+            memset(dst, 0, (size_t)J->var_cap * J->var_cap * sizeof *dst);
+            memcpy(dst, varc[var_k], (size_t)var_k * var_k * sizeof *dst);
+        } else { /* too few training pairs: the lsq choice, shadow's offsets */
+            uint32_t c = J->grid->count;
+            choose_order(J, v, &angles, u, var_buf, var_buf + c, var_buf + 2 * c, var_buf + 3 * c,
+                         var_n, var_buf + 4 * (size_t)c);
+        }
+    }
     /* Methods shadow and decision: the log offset, through c0 (Y00 is a
      * constant). */
     for (int o = 1; o <= VDSH_MAX_ORDER; o++)
@@ -1325,6 +1402,14 @@ static vb_result setup_offsets(bake_run *b, vb_error *err)
                 return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         }
     }
+    /* Adaptive order with the decision fit: its choice and fits are the
+     * decision's (choose_decision), with the decision's offsets (one
+     * calibrated for the stream, else the given ones). */
+    J->var_decision = J->var_cap && J->decision;
+    if (J->var_decision && !(J->var_lsq = calloc((size_t)(b->hi - b->lo), 1)))
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+        J->var_dec_offset[o] = J->log_offset[o];
     for (int o = 1; o <= VDSH_MAX_ORDER; o++)
         J->var_offset[o] = mi->decision && !d->log_offsets
                                ? vb_method_get(VB_METHOD_SHADOW)->default_log_offset[o]
@@ -1417,6 +1502,21 @@ static vb_result calibrate_offsets(bake_run *b, vb_error *err)
         float off = vb_decision_offset(lit, k, d->false_rate);
         J->log_offset[o] = off < -5.0f ? -5.0f : off > 5.0f ? 5.0f : off;
     }
+    /* The adaptive order's stream: one offset, from each sample's chosen
+     * fit (slot 0), whatever its order. */
+    if (J->var_decision && r == VB_OK) {
+        uint32_t k = 0;
+        for (uint32_t i = 0; i < cal_count; i++)
+            for (uint32_t j = 0; j < CAL_LIGHTS; j++) {
+                float m = J->cal_margins[(size_t)i * VDSH_ORDER_SLOTS * CAL_LIGHTS + j];
+                if (!isnan(m))
+                    lit[k++] = m;
+            }
+        float off = vb_decision_offset(lit, k, d->false_rate);
+        off = off < -5.0f ? -5.0f : off > 5.0f ? 5.0f : off;
+        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+            J->var_dec_offset[o] = off;
+    }
     free(lit);
     return r;
 }
@@ -1437,6 +1537,11 @@ static vb_result bake_receivers(bake_run *b, vb_error *err)
                 if (b->coeffs[o])
                     b->coeffs[o][(size_t)(v - lo) * o * o] +=
                         J->log_offset[o] / 0.28209479177387814f;
+    /* The adaptive order's decision fits: their offset, now known. */
+    for (uint32_t v = lo; J->var_decision && v < hi; v++)
+        if (!J->var_lsq[v - lo])
+            b->var_coeffs[(size_t)(v - lo) * b->var_cap * b->var_cap] +=
+                J->var_dec_offset[b->var_orders[v - lo]] / 0.28209479177387814f;
     if (b->started == 0)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
     return VB_OK;
@@ -1490,9 +1595,13 @@ static void fill_output(bake_run *b, vb_bake_output *out)
     o.variable_coeffs = b->var_coeffs;
     o.variable_cap = b->var_orders ? b->var_cap : 0;
     o.order_tolerance = b->var_orders ? d->order_tolerance : 0.0f;
-    o.variable_method = mi->decision ? VDSH_METHOD_SHADOW : mi->stored;
-    o.variable_param =
-        b->var_orders && mi->param == VB_PARAM_LOG_OFFSET ? J->var_offset[b->var_cap] : o.lambda;
+    o.variable_method = J->var_decision ? VDSH_METHOD_DECISION
+                        : mi->decision  ? VDSH_METHOD_SHADOW
+                                        : mi->stored;
+    o.variable_param = J->var_decision ? J->var_dec_offset[b->var_cap]
+                       : b->var_orders && mi->param == VB_PARAM_LOG_OFFSET
+                           ? J->var_offset[b->var_cap]
+                           : o.lambda;
     b->var_orders = NULL;
     b->var_coeffs = NULL;
     o.rays = b->grid.count;
@@ -1529,6 +1638,7 @@ static void run_free(bake_run *b)
         free(J->choose_coeffs);
         free(J->done);
         free(J->var_scratch);
+        free(J->var_lsq);
         free(J->pool);
         free(J->dec_scratch);
         free(J->cal_margins);

@@ -11,6 +11,7 @@ void vb_decision_defaults(vb_decision_params *p)
     p->ridge = 1e-5f;
     p->ridge0 = 1e-4f;
     p->steps = 3;
+    p->hessians = 0;
 }
 
 /* ---- e^x and ln x, eight at a time --------------------------------------- */
@@ -436,21 +437,23 @@ int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
             g[j4] = dot2(m, q, Y + (size_t)j4 * stride);
         for (int j = 0; j < n; j++)
             g[j] += 2.0 * r[j] * (c[j] - c0[j]);
-        for (uint32_t i = 0; i < m; i++)
-            sh[i] = __builtin_sqrtf(h[i]);
-        for (int j = 0; j < n; j++) {
-            const float *yj = Y + (size_t)j * stride;
-            float *zj = Z + (size_t)j * m8;
+        if (p->hessians <= 0 || it < p->hessians) {
             for (uint32_t i = 0; i < m; i++)
-                zj[i] = sh[i] * yj[i];
-            for (uint32_t i = m; i < m8; i++)
-                zj[i] = 0.0f;
+                sh[i] = __builtin_sqrtf(h[i]);
+            for (int j = 0; j < n; j++) {
+                const float *yj = Y + (size_t)j * stride;
+                float *zj = Z + (size_t)j * m8;
+                for (uint32_t i = 0; i < m; i++)
+                    zj[i] = sh[i] * yj[i];
+                for (uint32_t i = m; i < m8; i++)
+                    zj[i] = 0.0f;
+            }
+            syrk(n, m8, Z, m8, H);
+            for (int j = 0; j < n; j++)
+                H[j * n + j] += 2.0 * r[j];
+            if (!cholesky_factor(n, H, L))
+                break;
         }
-        syrk(n, m8, Z, m8, H);
-        for (int j = 0; j < n; j++)
-            H[j * n + j] += 2.0 * r[j];
-        if (!cholesky_factor(n, H, L))
-            break;
         cholesky_solve(n, L, g, dx);
         /* Step halving until the loss falls. */
         double step = 1.0, fn = f;
@@ -484,6 +487,75 @@ int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
     for (int j = 0; j < n; j++)
         cf[j] = (float)c[j];
     return steps;
+}
+
+/* The loss at the start c alone, its offset free: the same pairs and
+ * weights as vb_decision_fit, no ridge, minimised over b added to every
+ * margin by 1-D Newton steps (convex in b; step halving keeps each a
+ * descent). */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) &&                             \
+    !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default"))) /* no FMA: the same bits */
+#endif
+float vb_decision_score(int order, uint32_t m, const float *Y, uint32_t stride, const float *logd,
+                        const uint8_t *shadowed, const vb_decision_params *p, const float *cf,
+                        float *offset, double *scratch)
+{
+    const int n = order * order;
+    *offset = 0.0f;
+    if (m == 0 || n == 0)
+        return 0.0f;
+    if (m > VB_DECISION_MAX_PAIRS)
+        m = VB_DECISION_MAX_PAIRS;
+    enum { K = VB_DECISION_MAX_PAIRS };
+    double *c = scratch;
+    float *t = (float *)(c + VDSH_MAX_COEFFS), *tt = t + K, *q = tt + K, *h = q + K, *sp = h + K,
+          *sgn = sp + K, *wt = sgn + K, *ex = wt + K;
+    const uint32_t m8 = (m + 7) & ~7u;
+    const float inv_tau = 1.0f / p->tau;
+    double a = 0.0;
+    for (uint32_t i = 0; i < m; i++)
+        a += shadowed[i] ? 1.0 : p->lit_weight;
+    const float w_shadowed = (float)(1.0 / a), w_lit = (float)(p->lit_weight / a);
+    for (uint32_t i = 0; i < m8; i++) {
+        sgn[i] = i >= m ? 0.0f : shadowed[i] ? 1.0f : -1.0f;
+        wt[i] = i >= m ? 0.0f : shadowed[i] ? w_shadowed : w_lit;
+        t[i] = tt[i] = 0.0f;
+    }
+    for (int j = 0; j < n; j++)
+        c[j] = cf[j];
+    margins(n, m, Y, stride, logd, c, t);
+    float b = 0.0f;
+    pair_loss(m8, t, sgn, wt, inv_tau, sp, ex);
+    pair_weights(m8, t, sgn, wt, inv_tau, ex, q, h);
+    double f = sum_lanes(m, sp);
+    for (int it = 0; it < 6; it++) {
+        double g = sum_lanes(m, q), hh = sum_lanes(m, h);
+        if (!(hh > 1e-12))
+            break;
+        double step = g / hh, fn = f;
+        float bt = b;
+        int ok = 0;
+        for (int half = 0; half < 8 && !ok; half++, step *= 0.5) {
+            bt = b - (float)step;
+            for (uint32_t i = 0; i < m8; i++)
+                tt[i] = t[i] + bt;
+            pair_loss(m8, tt, sgn, wt, inv_tau, sp, ex);
+            fn = sum_lanes(m, sp);
+            ok = fn < f;
+        }
+        if (!ok)
+            break;
+        float moved = bt - b;
+        double drop = f - fn;
+        b = bt;
+        f = fn;
+        if ((moved < 1e-3f && moved > -1e-3f) || drop < 1e-6 * f)
+            break;
+        pair_weights(m8, tt, sgn, wt, inv_tau, ex, q, h); /* the accepted trial's */
+    }
+    *offset = b;
+    return (float)f;
 }
 
 /* ---- the offset's calibration --------------------------------------------- */

@@ -43,6 +43,8 @@ typedef struct vb_decision_params {
     float ridge;      /* times (l(l+1))^2, toward the lsq fit */
     float ridge0;     /* on every coefficient, toward the lsq fit */
     int steps;        /* Newton steps at most */
+    int hessians;     /* steps with a fresh Hessian (0: every step); later
+                       * steps keep the last one's factor */
 } vb_decision_params;
 
 /* The defaults: chosen on the validation scenes. */
@@ -60,6 +62,16 @@ void vb_decision_defaults(vb_decision_params *p);
 int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride, const float *logd,
                     const uint8_t *shadowed, const vb_decision_params *p, float *c,
                     double *scratch);
+
+/* The decision loss of the coefficients c (order^2 of them, as
+ * vb_decision_fit's start) on the same pairs, without the ridge, at the
+ * offset b added to every margin that minimises it (into *offset): how
+ * well the shape of c alone draws the pairs' decisions. The adaptive
+ * order scores its least-squares candidates so. scratch:
+ * vb_decision_scratch_doubles(order) doubles suffice. */
+float vb_decision_score(int order, uint32_t m, const float *Y, uint32_t stride, const float *logd,
+                        const uint8_t *shadowed, const vb_decision_params *p, const float *c,
+                        float *offset, double *scratch);
 
 /* Doubles of scratch for vb_decision_fit at this order. */
 size_t vb_decision_scratch_doubles(int order);

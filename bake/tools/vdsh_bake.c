@@ -200,10 +200,15 @@ static void usage(FILE *f)
             "                          --adaptive-order; each 1..%d: orders above 5 are\n"
             "                          drawn from buffers, for long shadows)\n"
             "      --adaptive-order TOL  one more stream, of variable order: each\n"
-            "                          receiver gets the lowest order (1..--max-order)\n"
-            "                          whose expected shadow error on its own traced\n"
-            "                          directions, under lights in the scene's free\n"
-            "                          space, is at most TOL (else its best order)\n"
+            "                          receiver gets the lowest candidate order (1, 2,\n"
+            "                          3, 5, 7, 9, 12, up to --max-order) whose error is\n"
+            "                          within TOL of the least of them; decision (the\n"
+            "                          default): the decision loss of each order's lsq\n"
+            "                          fit on the receiver's training lights, the chosen\n"
+            "                          order then fitted to the decision, one offset\n"
+            "                          calibrated for the stream; shadow: the expected\n"
+            "                          shadow error on its own traced directions, under\n"
+            "                          lights in the scene's free space\n"
             "      --max-order N       the adaptive order's cap (default %d)\n"
             "      --method M          the fit:\n"
             "%s"
@@ -512,6 +517,8 @@ static int write_report(const char *path, const options *o, const vb_job *job,
             snprintf(key, sizeof key, "%d", o->orders[i]);
             vt_json_f32(&j, off, key, b->log_offset[o->orders[i]]);
         }
+        if (b->variable_cap && b->variable_method == VDSH_METHOD_DECISION)
+            vt_json_f32(&j, off, "adaptive", b->variable_param);
     } else {
         vt_json_null(&j, root, "decision");
     }
@@ -1229,6 +1236,9 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
             for (int s = 0; s < o->order_count; s++)
                 fprintf(log, "%s order %d %+.3f", s ? "," : "", o->orders[s],
                         (double)bo->log_offset[o->orders[s]]);
+            if (bo->variable_cap && bo->variable_method == VDSH_METHOD_DECISION)
+                fprintf(log, "%s adaptive order %+.3f", o->order_count ? "," : "",
+                        (double)bo->variable_param);
             fputc('\n', log);
         }
     }
