@@ -56,3 +56,11 @@ print('ok')"
              $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval>)
   endif()
 endif()
+
+#   eval_offsets    vdsh-eval --offsets: a copy at offset 0 scores as the
+#                   stream (fixed and adaptive order) and reports its bytes
+if(TARGET vdsh-eval AND Python3_Interpreter_FOUND)
+  add_test(NAME eval_offsets
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_eval_offsets.py
+                   $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval> ${CMAKE_CURRENT_BINARY_DIR}/eval_offsets)
+endif()

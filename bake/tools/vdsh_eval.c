@@ -334,7 +334,15 @@ typedef struct context {
     int fast_truth;
     int mismatched;      /* sources used despite a different SHA-256 */
     const float *offset; /* per scored stream: the log offset added (--offsets) */
+    int copies;          /* 1 + offsets with --offsets (scored.copies), else 0 */
 } context;
+
+/* Scored stream s as the file stores it: an --offsets copy (f32 in
+ * memory) is its original's, whose bytes and encoding it reports. */
+static const vdsh_stream *stored(const context *c, uint32_t s)
+{
+    return &c->f->streams[c->copies ? s - s % (uint32_t)c->copies : s];
+}
 
 /* "5", or "a12" for a variable-order stream of cap 12. */
 static const char *order_label(const vdsh_stream *st, char *buf, size_t n)
@@ -417,10 +425,10 @@ static int write_json(const char *out, const context *c, char *msg, size_t cap)
         vt_json_u64(&j, o, "order", st->order);
         vt_json_u64(&j, o, "coefficients", st->order * st->order);
         vt_json_string(&j, o, "method", vdsh_method_name(st->method));
-        vt_json_string(&j, o, "encoding", vdsh_encoding_name(st->encoding));
+        vt_json_string(&j, o, "encoding", vdsh_encoding_name(stored(c, s)->encoding));
         vt_json_string(&j, o, "quantity", vdsh_quantity_name(st->quantity));
         vt_json_string(&j, o, "window", vdsh_window_name(st->window));
-        vdsh_stream_size z = vdsh_stream_size_of(st, vdsh_file_stream_vertices(f));
+        vdsh_stream_size z = vdsh_stream_size_of(stored(c, s), vdsh_file_stream_vertices(f));
         vt_json_f64(&j, o, "bytes_per_vertex", z.mean_bytes);
         vt_json_u64(&j, o, "max_bytes_per_vertex", z.max_bytes);
         vt_json_bool(&j, o, "variable_order", (st->flags & VDSH_STREAM_VARIABLE) != 0);
@@ -560,9 +568,10 @@ static void print_table(FILE *o, const context *c)
                     "  %-8s %5s %+6.2f %3.0f %3s %-9s | %7.2gM | %-15s %-13s %-12s | %6.4f "
                     "%5.2f%% %5.1f%%\n",
                     kind_name(k), order_label(st, ol, sizeof ol), (double)c->offset[s],
-                    vdsh_stream_size_of(st, vdsh_file_stream_vertices(f)).mean_bytes,
-                    vdsh_encoding_name(st->encoding), fit, (double)m->pairs * 1e-6, mae, fa, rc,
-                    m->binary_mae, 100.0 * m->binary_false_shadow, 100.0 * m->binary_recall);
+                    vdsh_stream_size_of(stored(c, s), vdsh_file_stream_vertices(f)).mean_bytes,
+                    vdsh_encoding_name(stored(c, s)->encoding), fit, (double)m->pairs * 1e-6, mae,
+                    fa, rc, m->binary_mae, 100.0 * m->binary_false_shadow,
+                    100.0 * m->binary_recall);
         }
     }
     fprintf(o, "\n  RELATIVE LIGHTS (secondary, as in earlier figures): one light per held-out "
@@ -595,10 +604,10 @@ static void print_table(FILE *o, const context *c)
                     "  %-8s %5s %+6.2f %3.0f %3s %-9s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s "
                     "%-13s | %6.4f %5.2f%% %5.2f%%\n",
                     kind_name(k), order_label(st, ol, sizeof ol), (double)c->offset[s],
-                    vdsh_stream_size_of(st, vdsh_file_stream_vertices(f)).mean_bytes,
-                    vdsh_encoding_name(st->encoding), fit, rms, m->distance_p50, m->distance_p90,
-                    m->distance_p99, mae, fa, le, m->binary_mae, 100.0 * m->binary_false_shadow,
-                    100.0 * m->binary_light_leak);
+                    vdsh_stream_size_of(stored(c, s), vdsh_file_stream_vertices(f)).mean_bytes,
+                    vdsh_encoding_name(stored(c, s)->encoding), fit, rms, m->distance_p50,
+                    m->distance_p90, m->distance_p99, mae, fa, le, m->binary_mae,
+                    100.0 * m->binary_false_shadow, 100.0 * m->binary_light_leak);
         }
     }
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
@@ -880,7 +889,9 @@ static int select_orders(const options *o, const vdsh_file *f, scored *s)
 
 /* --offsets, the trade as a curve: each stream again with every offset
  * added to its log distance (a distance stream: times e^offset), decoded
- * to f32 in memory. 0, 1 (an error) or VT_EXIT_USAGE (too many streams). */
+ * to f32 in memory (a variable-order stream's copy keeps its orders: f32
+ * records of k^2 coefficients, its own record offsets after them in the
+ * same block). 0, 1 (an error) or VT_EXIT_USAGE (too many streams). */
 static int add_offsets(const options *o, const vdsh_file *f, scored *s)
 {
     const int noffsets = o->noffsets;
@@ -903,8 +914,13 @@ static int add_offsets(const options *o, const vdsh_file *f, scored *s)
         all[n++] = s->view.streams[i];
         for (int k = 0; k < noffsets; k++) {
             vdsh_stream x = s->view.streams[i];
+            const int variable = (x.flags & VDSH_STREAM_VARIABLE) != 0;
             uint32_t nc = x.order * x.order;
-            float *data = malloc((size_t)V * nc * sizeof *data + 1);
+            uint64_t words = 0; /* an f32 record of order k: k^2 words */
+            for (uint32_t v = 0; v < V; v++)
+                words += variable ? (uint64_t)x.orders[v] * x.orders[v] : nc;
+            float *data = malloc((size_t)words * sizeof *data +
+                                 (variable ? ((size_t)V + 1) * sizeof(uint32_t) : 1));
             if (!data) {
                 fprintf(stderr, "vdsh-eval: out of memory\n");
                 for (uint32_t j = 0; j < n; j++)
@@ -913,8 +929,11 @@ static int add_offsets(const options *o, const vdsh_file *f, scored *s)
                 free(all);
                 return 1;
             }
+            uint32_t *offs = variable ? (uint32_t *)(data + words) : NULL;
+            if (offs)
+                vdsh_stream_offsets(x.orders, V, VDSH_ENCODING_F32, offs);
             for (uint32_t v = 0; v < V; v++) {
-                float *cv = data + (size_t)v * nc;
+                float cv[VDSH_MAX_COEFFS];
                 vdsh_stream_decode(&s->view.streams[i], v, cv);
                 if (x.quantity == VDSH_QUANTITY_LOG_DISTANCE)
                     cv[0] += o->offsets[k] / 0.28209479177387814f; /* Y00 */
@@ -922,8 +941,12 @@ static int add_offsets(const options *o, const vdsh_file *f, scored *s)
                     for (uint32_t c = 0; c < nc; c++)
                         cv[c] *= x.quantity == VDSH_QUANTITY_DISTANCE2 ? expf(2.0f * o->offsets[k])
                                                                        : expf(o->offsets[k]);
+                uint32_t kv = variable ? (uint32_t)x.orders[v] * x.orders[v] : nc;
+                memcpy(data + (variable ? offs[v] : (size_t)v * nc), cv, kv * sizeof *cv);
             }
-            x.encoding = VDSH_ENCODING_F32, x.scale = 1.0f, x.data = data;
+            x.encoding = VDSH_ENCODING_F32, x.scale = 1.0f, x.data = data, x.offsets = offs;
+            x.coef_scales = NULL;
+            x.cpca = (vdsh_cpca){0};
             s->offset[n] = o->offsets[k];
             all[n++] = x;
         }
@@ -1062,7 +1085,8 @@ static int evaluate(const options *o, const vdsh_file *f, const scored *sc)
                    .d = &d,
                    .fast_truth = o->fast_truth,
                    .mismatched = warned.count,
-                   .offset = sc->offset};
+                   .offset = sc->offset,
+                   .copies = sc->copies};
     struct stat st;
     if (stat(o->path, &st) == 0)
         ctx.file_bytes = (long long)st.st_size;
