@@ -378,7 +378,9 @@ static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const char *name,
     GLint64 max_block = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &major);
     glGetIntegerv(GL_MINOR_VERSION, &minor);
-    int ssbo = major > 4 || (major == 4 && minor >= 3);
+    /* GL 4.3 has storage buffers in core; before it, only the extension. */
+    const int core = major > 4 || (major == 4 && minor >= 3);
+    int ssbo = core;
     glGetIntegerv(GL_NUM_EXTENSIONS, &ext);
     for (GLint i = 0; i < ext && !ssbo; i++)
         ssbo = !strcmp((const char *)glGetStringi(GL_EXTENSIONS, (GLuint)i),
@@ -405,11 +407,13 @@ static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const char *name,
     char *dot = cpca_dot_define(b->cpca_basis);
     char defines[512];
     snprintf(defines, sizeof defines,
-             "#version 330 core\n#extension GL_ARB_shader_storage_buffer_object : require\n"
+             "%s"
              "#define BUFFER 1\n#define NUM_LIGHTS 0\n#define BUF_ORDER %d\n#define BUF_KIND 4\n"
              "#define BUF_VARIABLE 0\n#define BUF_STRIDE %d\n#define BUF_CPCA_BASIS %d\n"
              "#define BUF_CPCA_BITS %d\n#define BUF_CPCA_T %d\n"
              "const float KS[1] = float[1](1.0);\n",
+             core ? "#version 430 core\n"
+                  : "#version 330 core\n#extension GL_ARB_shader_storage_buffer_object : require\n",
              b->order, b->stride, b->cpca_basis, b->cpca_bits, b->scratch_stride);
     size_t size = strlen(defines) + (dot ? strlen(dot) : 0) + vr_buffer_glsl_size +
                   vr_cpca_decode_glsl_size + 1;

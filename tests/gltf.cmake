@@ -28,6 +28,13 @@ if(VDSH_NODE)
                    ${CMAKE_BINARY_DIR}/npm/node_modules ${CMAKE_CURRENT_BINARY_DIR}/gltf_export
                    ${VDSH_ASSIMP_MODELS})
   set_tests_properties(gltf_export PROPERTIES FIXTURES_REQUIRED gltf_npm SKIP_RETURN_CODE 77)
+  # web_cpca_pack   runtime/web/vdsh_core.js: a cpca stream packed for the
+  #                 vertex-stage decode (vdshCpcaBufferData) and decoded as
+  #                 vdsh_buffer.glsl does, against the load decode, random
+  #                 streams of orders 1-16 (node alone, under a second)
+  add_test(NAME web_cpca_pack
+           COMMAND ${VDSH_NODE} ${CMAKE_CURRENT_SOURCE_DIR}/web_cpca_pack.mjs
+                   ${PROJECT_SOURCE_DIR}/runtime/web/vdsh_core.js)
 endif()
 
 #   gltf_web_viewer   runtime/web in headless chromium against vdsh-view's

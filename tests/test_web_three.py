@@ -25,8 +25,10 @@ shadow cannot pass). Also:
     plain and --compress, drawn with vdshApply and the source's own
     materials, against vdsh-view's frame of the same bake;
   - a cpca stream (issue 29: --encoding cpca, order 12), exported as
-    stored and decoded at load by vdshLoadCpca, plain and --compress, 1
-    and 3 lights, against vdsh-view's buf12 (decoded in its vertex stage);
+    stored, kept compressed by vdshLoadCpca and decoded in the vertex
+    stage (plain and --compress, 1 and 3 lights) or decoded at load
+    (cpca=load), against vdsh-view's buf12 (decoded in its vertex stage),
+    the page's title naming the path taken;
   - the glTF scene moved: gltf.scene translated and given as `frame`, the
     camera and light moved with it: the same frame.
 GLSL ES 3.00: runtime/shaders/es_check (this test's page es_check.html)
@@ -130,7 +132,7 @@ def frames(name, vd, eye, target, light_set, modes):
     return lambda mode: os.path.join(work, "c", "%s-s0-l0-%s.png" % (name, mode))
 
 
-def check(label, glb, order, eye, target, lights, ref, min_dark, extra=""):
+def check(label, glb, order, eye, target, lights, ref, min_dark, extra="", path=None):
     q = ("glb=../%s&order=%s&output=shadow&size=%dx%d&eye=%s&target=%s&up=0,1,0&fov=60%s%s"
          % (glb, order, W, H, csv(eye), csv(target), "".join("&light=" + csv(l) for l in lights), extra))
     png = os.path.join(work, "three-%s.png" % label.replace(" ", "-"))
@@ -141,6 +143,8 @@ def check(label, glb, order, eye, target, lights, ref, min_dark, extra=""):
     if not t.startswith("ready"):
         fail.append("%s: the page says %r" % (label, t))
         return
+    if path and t.split()[-1] != path:
+        fail.append("%s: drawn on the path %r, not %r" % (label, t.split()[-1], path))
     compare(label, png, ref, min_dark)
 
 
@@ -162,9 +166,11 @@ ref3 = frames("room3", vd, eye, target, [light] + more, ["vdsh5", "buf12"])
 for order, mode in (("5", "vdsh5"), ("12", "buf12")):
     check("room order %s 3 lights" % order, "room.glb", order, eye, target, [light] + more, ref3(mode), 0.005)
 
-# A cpca stream (issue 29: vdsh-bake --encoding cpca), exported as stored
-# and decoded at load by vdshLoadCpca (three.html), plain and --compress,
-# against vdsh-view's buf12 (decoded in its vertex stage), 1 and 3 lights.
+# A cpca stream (issue 29: vdsh-bake --encoding cpca), exported as stored,
+# kept compressed by vdshLoadCpca and decoded in the vertex stage
+# (three.html's default), plain and --compress, and decoded at load
+# (cpca=load), against vdsh-view's buf12 (decoded in its vertex stage), 1
+# and 3 lights; the page's title names the path taken.
 cvd = os.path.join(work, "cpca.vdsh")
 run([bake, "builtin:room", "-o", cvd, "-q", "--orders", "12", "--max-edge", "0.5", "--rays", "256",
      "--encoding", "cpca"])
@@ -172,8 +178,10 @@ run([export, cvd, "-o", os.path.join(work, "cpca.glb")])
 run([export, cvd, "-o", os.path.join(work, "cpca-compress.glb"), "--compress", "-q"])
 cref, cref3 = frames("cpca", cvd, eye, target, [light], ["buf12"]), frames("cpca3", cvd, eye, target, [light] + more, ["buf12"])
 for f in ("cpca", "cpca-compress"):
-    check("%s order 12" % f, f + ".glb", "12", eye, target, [light], cref("buf12"), 0.005)
-check("cpca order 12 3 lights", "cpca.glb", "12", eye, target, [light] + more, cref3("buf12"), 0.005)
+    check("%s order 12" % f, f + ".glb", "12", eye, target, [light], cref("buf12"), 0.005, path="cpca")
+check("cpca order 12 decoded at load", "cpca.glb", "12", eye, target, [light], cref("buf12"), 0.005, "&cpca=load",
+      path="buffer")
+check("cpca order 12 3 lights", "cpca.glb", "12", eye, target, [light] + more, cref3("buf12"), 0.005, path="cpca")
 
 # A linear quantity (the paper's distance): per-vertex visibility.
 pvd, pglb = os.path.join(work, "paper.vdsh"), os.path.join(work, "paper.glb")

@@ -44,9 +44,11 @@ or MODULES.
 
 A cpca stream (issue 29): the room baked with --encoding cpca at order
 12, exported as stored (cluster and weight attributes, the model in a
-buffer view; plain and --compress), decoded at load by the page, against
-vdsh-view's buf12 (decoded in its vertex stage), same tolerance; a cpca
-glb with 9 bits per weight is refused on the page.
+buffer view; plain and --compress), decoded by the page in its vertex
+stage (the default, compressed on the GPU; the page's title says so) and
+at load (cpca=load), against vdsh-view's buf12 (decoded in its vertex
+stage), same tolerance; a cpca glb with 9 bits per weight and an unknown
+cpca= are refused on the page.
 
 Errors on the page (issue 26: a GLSL error in the tab title was the only
 sign): a file that is not a glb, a glb without VDSH streams (assimp's
@@ -175,15 +177,16 @@ def scene(name, source, opts, orders, place, modes=None):
     views = os.path.join(work, name + "-views.json")
     testlib.write_view(views, name, W, H, eye, target, [[light]])
     frames = os.path.join(work, "c")
-    testlib.view_frames(view, views, frames, [m for _, m in modes], vd)
-    for order, mode in modes:
-        shot = os.path.join(work, "web-%s-%s.png" % (name, order))
+    testlib.view_frames(view, views, frames, sorted({m[1] for m in modes}), vd)
+    for order, mode, *extra in modes:
+        label = "%s order %s%s" % (name, order, "".join(" " + e for e in extra))
+        shot = os.path.join(work, "web-%s-%s%s.png" % (name, order, "".join("-" + e.replace("=", "-") for e in extra)))
         q = ("glb=%s.glb&order=%s&output=shadow&size=%dx%d&eye=%s&target=%s&up=0,1,0&fov=60&light=%s"
-             % (name, order, W, H, csv(eye), csv(target), csv(light)))
+             % (name, order, W, H, csv(eye), csv(target), csv(light))) + "".join("&" + e for e in extra)
         if not page(q, shot):
-            fail.append("%s order %s: no screenshot" % (name, order))
+            fail.append("%s: no screenshot" % label)
             continue
-        compare("%s order %s" % (name, order), shot, os.path.join(frames, "%s-s0-l0-%s.png" % (name, mode)),
+        compare(label, shot, os.path.join(frames, "%s-s0-l0-%s.png" % (name, mode)),
                 int(order) if order.isdigit() else 0)
     return vd, glb
 
@@ -212,13 +215,21 @@ room_vd, room_glb = scene("room", "builtin:room", ["--max-edge", "0.5", "--rays"
                           [("2", "vdsh2"), ("3", "vdsh3"), ("5", "vdsh5"), ("12", "buf12"), ("adaptive", "adaptive")])
 default_view("room", room_vd, room_glb)
 # A cpca stream (issue 29; vdsh-bake --encoding cpca): exported as stored
-# (cluster and weight attributes, the model in a buffer view), decoded at
-# load by vdsh_core.js's vdshCpcaDecode into the buffer path, against
-# vdsh-view's buf12 (decoded in its vertex stage), same tolerance.
+# (cluster and weight attributes, the model in a buffer view), kept
+# compressed and decoded in the page's vertex stage (vdsh_core.js's
+# vdshCpcaBufferData, vdsh_buffer.glsl's BUF_KIND 4; the default), and
+# decoded at load by vdshCpcaDecode (cpca=load), each against vdsh-view's
+# buf12 (decoded in its vertex stage), same tolerance; the page's title
+# names the path it took.
 cpca_vd, cpca_glb = scene("cpca", "builtin:room", ["--max-edge", "0.5", "--rays", "256", "--encoding", "cpca"], [12],
-                          lambda lo, hi: ([7.5, 4.5, 8.0], [-2.0, 1.0, -2.0], [0.5, 1.2, 0.5]), [("12", "buf12")])
+                          lambda lo, hi: ([7.5, 4.5, 8.0], [-2.0, 1.0, -2.0], [0.5, 1.2, 0.5]),
+                          [("12", "buf12"), ("12", "buf12", "cpca=load")])
 if "cpca" not in glb_json(cpca_glb)["meshes"][0]["extras"]["vdsh"]["streams"][0]:
     fail.append("cpca.glb: its stream is not exported as cpca")
+for query, want in (("", "cpca vertex"), ("&cpca=load", "cpca load")):
+    dom = page("glb=cpca.glb&order=12&size=%dx%d%s" % (W, H, query))
+    if "<title>ready %dx%d %s</title>" % (W, H, want) not in dom:
+        fail.append("cpca.glb%s: the page's title does not say '%s' (a different decode path?)" % (query, want))
 
 # Errors on the page itself.
 bad = os.path.join(work, "bad.glb")
@@ -240,7 +251,8 @@ jl = struct.unpack_from("<I", d, 12)[0]
 open(os.path.join(work, "cpca-bad.glb"), "wb").write(
     struct.pack("<III", 0x46546C67, 2, 20 + len(js) + len(d) - 20 - jl) + struct.pack("<II", len(js), 0x4E4F534A) + js +
     d[20 + jl:])
-errs = [("bad.glb", "not a glb"), ("draco.glb", "KHR_draco_mesh_compression"), ("cpca-bad.glb", "bits 9 out of range")]
+errs = [("bad.glb", "not a glb"), ("draco.glb", "KHR_draco_mesh_compression"), ("cpca-bad.glb", "bits 9 out of range"),
+        ("cpca.glb&cpca=gpu", "give cpca=vertex or cpca=load")]
 plain = os.path.join(models, "glTF2", "2CylinderEngine-glTF-Binary", "2CylinderEngine.glb")
 if os.path.exists(plain):
     shutil.copy(plain, os.path.join(work, "plain.glb"))

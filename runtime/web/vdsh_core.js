@@ -129,56 +129,117 @@ export function vdshBufferData(get, nv, stream, maxTexture) {
   return { orders, records, texels, width, height };
 }
 
-// A cpca stream of a glb (formats/GLTF.md "cpca streams") decoded at load
-// into plain coefficients, which then take the buffer path like any other
-// stream: to the bit what the C reader's vdsh_stream_decode gives (w_j =
-// level_j * step_{c,j}, then from the mean a = a + w_j * basis_{c,j}[i] in
-// order, each product and sum rounded to f32: a double result of f32
-// operands rounded once to f32 is the f32 operation's). cluster: the
-// cluster attribute's values (VEC4, x used), levels: the weight
-// attributes' (VEC4 each), model: the bytes of the model's buffer view.
-// Returns a Float32Array, coefficient i of vertex v at v * order^2 + i;
-// throws on a model or record that breaks the layout's rules.
-export function vdshCpcaDecode(stream, nv, cluster, levels, model) {
+// A cpca stream's model (formats/GLTF.md "cpca streams"): its steps,
+// means and bases as f32, read from the bytes of its buffer view and
+// checked. cluster, levels: the cluster attribute's values (VEC4, x used)
+// and the weight attributes' (VEC4 each). at(v, j): vertex v's cluster
+// (j < 0) or weight level j, checked against the stream's ranges.
+function cpcaModel(stream, cluster, levels, model) {
   const c = stream.cpca, N = stream.order, nc = N * N;
   const K = c.clusters, B = c.basis, L = (1 << (c.bits - 1)) - 1;
+  const bad = (what) => new Error('cpca stream of order ' + N + ': ' + what);
   if (!(K >= 1 && K <= 256 && B >= 1 && B <= nc && c.bits >= 2 && c.bits <= 8))
-    throw new Error('cpca stream of order ' + N + ': clusters ' + K + ', basis ' + B + ', bits ' + c.bits + ' out of range');
-  if (levels.length !== Math.ceil(B / 4)) throw new Error('cpca stream of order ' + N + ': ' + levels.length +
-    ' weight attributes, not ' + Math.ceil(B / 4));
+    throw bad('clusters ' + K + ', basis ' + B + ', bits ' + c.bits + ' out of range');
+  if (levels.length !== Math.ceil(B / 4)) throw bad(levels.length + ' weight attributes, not ' + Math.ceil(B / 4));
   const dv = new DataView(model.buffer, model.byteOffset, model.byteLength);
   const floats = (off, n, what) => {
     if (!(off >= 0 && off % 4 === 0 && off + 4 * n <= model.byteLength))
-      throw new Error('cpca stream of order ' + N + ': its ' + what + ' (' + n + ' floats at byte ' + off +
-        ') are not inside its model view of ' + model.byteLength + ' bytes');
+      throw bad('its ' + what + ' (' + n + ' floats at byte ' + off + ') are not inside its model view of ' +
+        model.byteLength + ' bytes');
     const a = new Float32Array(n);
     for (let i = 0; i < n; i++) {
       a[i] = dv.getFloat32(off + 4 * i, true);
-      if (!Number.isFinite(a[i])) throw new Error('cpca stream of order ' + N + ': a ' + what + ' value is not finite');
+      if (!Number.isFinite(a[i])) throw bad('a ' + what + ' value is not finite');
     }
     return a;
   };
-  const steps = floats(c.steps_offset, K * B, 'steps');
-  const means = floats(c.means_offset, K * nc, 'means');
-  const bases = floats(c.bases_offset, K * B * nc, 'bases');
+  const at = (v, j) => {
+    if (j < 0) {
+      const k = cluster[4 * v];
+      if (!(k >= 0 && k < K && Number.isInteger(k))) throw bad('vertex ' + v + ' has cluster ' + k + ', not below ' + K);
+      return k;
+    }
+    const q = levels[j >> 2][4 * v + (j & 3)];
+    if (!(Math.abs(q) <= L && Number.isInteger(q))) throw bad('vertex ' + v + ' has weight level ' + q + ', not within +-' + L);
+    return q;
+  };
+  return { N, nc, K, B, bits: c.bits, at, steps: floats(c.steps_offset, K * B, 'steps'),
+    means: floats(c.means_offset, K * nc, 'means'), bases: floats(c.bases_offset, K * B * nc, 'bases') };
+}
+
+// A cpca stream of a glb decoded at load into plain coefficients, which
+// then take the buffer path like any other stream: to the bit what the C
+// reader's vdsh_stream_decode gives (w_j = level_j * step_{c,j}, then from
+// the mean a = a + w_j * basis_{c,j}[i] in order, each product and sum
+// rounded to f32: a double result of f32 operands rounded once to f32 is
+// the f32 operation's). Arguments as cpcaModel's; nv vertices.
+// Returns a Float32Array, coefficient i of vertex v at v * order^2 + i;
+// throws on a model or record that breaks the layout's rules.
+export function vdshCpcaDecode(stream, nv, cluster, levels, model) {
+  const m = cpcaModel(stream, cluster, levels, model), { nc, B } = m;
   const out = new Float32Array(nv * nc), w = new Float32Array(B);
   for (let v = 0; v < nv; v++) {
-    const k = cluster[4 * v];
-    if (!(k >= 0 && k < K)) throw new Error('cpca stream of order ' + N + ': vertex ' + v + ' has cluster ' + k +
-      ', not below ' + K);
-    for (let j = 0; j < B; j++) {
-      const q = levels[j >> 2][4 * v + (j & 3)];
-      if (!(Math.abs(q) <= L)) throw new Error('cpca stream of order ' + N + ': vertex ' + v + ' has weight level ' +
-        q + ', not within +-' + L);
-      w[j] = q * steps[k * B + j];  // rounded to f32 by the store
-    }
+    const k = m.at(v, -1);
+    for (let j = 0; j < B; j++) w[j] = m.at(v, j) * m.steps[k * B + j];  // rounded to f32 by the store
     for (let i = 0; i < nc; i++) {
-      let a = means[k * nc + i];
-      for (let j = 0; j < B; j++) a = Math.fround(a + Math.fround(w[j] * bases[(k * B + j) * nc + i]));
+      let a = m.means[k * nc + i];
+      for (let j = 0; j < B; j++) a = Math.fround(a + Math.fround(w[j] * m.bases[(k * B + j) * nc + i]));
       out[v * nc + i] = a;
     }
   }
   return out;
+}
+
+// A cpca stream kept compressed on the GPU and decoded in the vertex
+// stage (vdsh_buffer.glsl's BUF_KIND 4, as vdsh-view draws it): each
+// vertex's record as the file stores it (formats/VDSH.md "cpca streams":
+// the cluster in bits 0-7 of word 0, then the weight levels of `bits`
+// bits each, two's complement, a field that does not fit in what is left
+// of a word starting the next), `stride` words from vertex v * stride,
+// one word per texel of an R32UI texture; and the model as RGBA32F
+// texels (runtime/vr_buffer.c's build_model): for cluster c and record
+// texel t (four coefficients in bufferSequence's order), B + 1 texels from
+// (c * T + t) * (B + 1), the mean and then each basis vector times its
+// step. Both textures are `width` texels wide. Arguments as
+// vdshCpcaDecode's; maxTexture: the GPU's MAX_TEXTURE_SIZE.
+export function vdshCpcaBufferData(stream, nv, cluster, levels, model, maxTexture) {
+  const m = cpcaModel(stream, cluster, levels, model), { N, nc, K, B, bits } = m;
+  let stride = 1;
+  for (let j = 0, shift = 8; j < B; j++, shift += bits)
+    if (shift + bits > 32) {
+      stride++;
+      shift = 0;
+    }
+  const width = Math.min(maxTexture, 4096);
+  const seq = bufferSequence(N), T = Math.ceil(seq.length / 4), row = B + 1;
+  const rows = (texels, what) => {
+    const h = Math.max(1, Math.ceil(texels / width));
+    if (h > maxTexture) throw new Error('cpca stream of order ' + N + ': its ' + what + ' need ' + texels +
+      ' texels, over this GPU\'s texture (' + maxTexture + ' x ' + maxTexture + ')');
+    return h;
+  };
+  const height = rows(nv * stride, 'records'), modelHeight = rows(K * T * row, 'model');
+  const words = new Uint32Array(width * height);
+  for (let v = 0; v < nv; v++) {
+    let at = v * stride, shift = 8;
+    words[at] = m.at(v, -1);
+    for (let j = 0; j < B; j++, shift += bits) {
+      if (shift + bits > 32) {
+        at++;
+        shift = 0;
+      }
+      words[at] |= ((m.at(v, j) & ((1 << bits) - 1)) << shift) >>> 0;
+    }
+  }
+  const texels = new Float32Array(width * modelHeight * 4);
+  for (let c = 0; c < K; c++)
+    for (let p = 0; p < seq.length; p++) {
+      const t = ((c * T + (p >> 2)) * row) * 4 + (p & 3);
+      texels[t] = m.means[c * nc + seq[p]];
+      for (let j = 0; j < B; j++)
+        texels[t + 4 * (j + 1)] = Math.fround(m.steps[c * B + j] * m.bases[(c * B + j) * nc + seq[p]]);
+    }
+  return { stride, words, width, height, model: texels, modelHeight, basis: B, bits, T };
 }
 
 // The vertex stage's VDSH code for a plan (vdshStreamPlan), after
@@ -186,18 +247,22 @@ export function vdshCpcaDecode(stream, nv, cluster, levels, model) {
 // the caller declares `uniform float vdshScale, vdshMaxDistance;` before
 // `decl`, binds the attributes vdshC0.. (the glb's groups, attribute path)
 // or a_record, a_order and the texture u_coef (buffer path, width
-// texWidth), and calls
+// texWidth), or, given cpca (vdshCpcaBufferData's result: a cpca stream
+// decoded in the vertex stage), the textures u_coef (its words) and
+// u_model (its model), and calls
 //   void vdsh_vertex(vec3 p, vec3 lights[NUM_LIGHTS], out float val[NUM_LIGHTS])
 // p the vertex and lights in the bake's frame; val: per light the
 // distance (VDSH_DIST_PATH 1) or the visibility, to interpolate.
-export function vdshVertexGlsl(plan, shaders, texWidth) {
+export function vdshVertexGlsl(plan, shaders, texWidth, cpca) {
   const defines = `#define QUANTITY ${plan.quantity}\n#define COMPARE 0\n#define VDSH_DIST_PATH ${plan.distPath ? 1 : 0}\n` +
     `#define BUFFER ${plan.buffer ? 1 : 0}\n#define VDSH_ORDER ${plan.order}\n`;
   let decl = '';
   if (plan.buffer) {
     const ks = ksTable(plan.order);
-    decl = `#define BUF_TEXTURE_2D 1\n#define BUF_TEX_WIDTH ${texWidth}\n#define BUF_KIND 0\n#define BUF_VARIABLE 1\n` +
-      `#define BUF_ORDER ${plan.order}\n#define BUF_STRIDE 0\n` +
+    const kind = cpca ? `#define BUF_KIND 4\n#define BUF_VARIABLE 0\n#define BUF_STRIDE ${cpca.stride}\n` +
+      `#define BUF_CPCA_BASIS ${cpca.basis}\n#define BUF_CPCA_BITS ${cpca.bits}\n#define BUF_CPCA_T ${cpca.T}\n`
+      : '#define BUF_KIND 0\n#define BUF_VARIABLE 1\n#define BUF_STRIDE 0\n';
+    decl = `#define BUF_TEXTURE_2D 1\n#define BUF_TEX_WIDTH ${texWidth}\n${kind}#define BUF_ORDER ${plan.order}\n` +
       `#define BUF_RECEIVER vdshP\n#define BUF_LIGHT(i) vdshL[i]\n#define BUF_SCALE vdshScale\n` +
       `vec3 vdshP;\nvec3 vdshL[NUM_LIGHTS];\n` +
       `const float KS[${ks.length}] = float[${ks.length}](${Array.from(ks, flit).join(', ')});\n` + shaders.buffer + '\n';

@@ -35,8 +35,10 @@
 //   vdshApply(gltf, shaders);
 //   scene.add(gltf.scene, new THREE.PointLight(0xffffff, 20));
 //
-// A cpca stream (vdsh-bake --encoding cpca) is decoded at load by
-// vdshLoadCpca(gltf) (await it before vdshApply) into the buffer path.
+// A cpca stream (vdsh-bake --encoding cpca) is prepared by
+// vdshLoadCpca(gltf) (await it before vdshApply): kept compressed and
+// decoded in the vertex stage (default), or decoded at load into the
+// buffer path (vdshLoadCpca(gltf, { decode: 'load' })).
 //
 // vdshApply(gltf, shaders, options) gives every mesh that has the VDSH
 // attributes its material (below); vdshMaterial(mesh, shaders, options)
@@ -58,7 +60,7 @@
 // lights light the mesh unshadowed.
 import * as THREE from 'three';
 import { loadVdshShaders, vdshChooseStream, vdshStreamPlan, vdshBufferData, vdshVertexGlsl, vdshCpcaDecode,
-  VDSH_EXT } from './vdsh_core.js';
+  vdshCpcaBufferData, VDSH_EXT } from './vdsh_core.js';
 
 export { loadVdshShaders, vdshChooseStream };
 
@@ -88,8 +90,11 @@ export function vdshInfo(o) {
 }
 
 // The three.js names of a stream's attributes in a geometry (GLTFLoader
-// lower-cases custom attribute names), or null when one is missing.
+// lower-cases custom attribute names), or null when one is missing; a
+// cpca stream kept compressed by vdshLoadCpca: [] (its data is
+// cpcaData's).
 function streamAttributes(geometry, stream) {
+  if (cpcaData(geometry, stream)) return [];
   const names = [];
   for (let g = 0; g < Math.ceil(stream.order * stream.order / 4); g++) {
     const n = (stream.attribute_prefix + g).toLowerCase();
@@ -99,15 +104,27 @@ function streamAttributes(geometry, stream) {
   return names;
 }
 
+// A cpca stream's data for the vertex-stage decode (vdshCpcaBufferData's
+// result), kept by vdshLoadCpca in the geometry's userData; or undefined.
+const cpcaData = (geometry, stream) =>
+  stream.cpca && geometry && ((geometry.userData || {}).vdshCpca || {})[stream.attribute_prefix];
+
 // cpca streams (vdsh-bake --encoding cpca; formats/GLTF.md "cpca
-// streams": cluster and weight attributes, the model in a buffer view)
-// decoded at load: for every mesh of the GLTFLoader result `gltf` whose
-// extras.vdsh has one, the decoded coefficients become its
-// <prefix><k> attributes (float), which vdshApply and vdshMaterial then
-// draw on the buffer path as any stream. Call it (await) before them.
-// Returns the number of streams decoded; throws on a broken stream.
-export async function vdshLoadCpca(gltf) {
+// streams": cluster and weight attributes, the model in a buffer view),
+// for every mesh of the GLTFLoader result `gltf` whose extras.vdsh has
+// one. options.decode 'vertex' (default): kept compressed (about 32 GPU
+// bytes per vertex at order 12 and the model) and decoded in the vertex
+// stage, as vdsh-view does (vdsh_buffer.glsl's BUF_KIND 4; the data in
+// geometry.userData.vdshCpca); 'load': decoded here, the coefficients
+// becoming its <prefix><k> attributes (float; 576 GPU bytes per vertex
+// at order 12), drawn on the buffer path as any stream. Call it (await)
+// before vdshApply and vdshMaterial. Returns the number of streams
+// prepared; throws on a broken stream or an unknown options.decode.
+export async function vdshLoadCpca(gltf, options = {}) {
   if (!gltf || !gltf.scene || !gltf.parser) throw new Error('vdshLoadCpca: give the result of GLTFLoader');
+  const decode = options.decode || 'vertex';
+  if (decode !== 'vertex' && decode !== 'load')
+    throw new Error("vdshLoadCpca: options.decode '" + decode + "': give 'vertex' or 'load'");
   const meshes = [];
   gltf.scene.traverse((o) => { if (o.isMesh) meshes.push(o); });
   let n = 0;
@@ -116,7 +133,8 @@ export async function vdshLoadCpca(gltf) {
     if (!info || !geometry) continue;
     for (const stream of info.streams) {
       const cp = stream.cpca;
-      if (!cp || geometry.getAttribute((stream.attribute_prefix + '0').toLowerCase())) continue;
+      if (!cp || geometry.getAttribute((stream.attribute_prefix + '0').toLowerCase()) || cpcaData(geometry, stream))
+        continue;
       const get = (name) => {
         const a = geometry.getAttribute(name.toLowerCase());
         if (!a) throw new Error('the mesh ' + (mesh.name || '') + ' has no attribute ' + name + ' of its cpca stream');
@@ -130,6 +148,12 @@ export async function vdshLoadCpca(gltf) {
       const levels = Array.from({ length: cp.weight_attributes }, (_, g) => get(cp.weight_prefix + g));
       const model = new Uint8Array(await gltf.parser.getDependency('bufferView', cp.model_view));
       const nv = cluster.length / 4, nc = stream.order * stream.order;
+      if (decode === 'vertex') {
+        geometry.userData.vdshCpca = Object.assign(geometry.userData.vdshCpca || {}, {
+          [stream.attribute_prefix]: vdshCpcaBufferData(stream, nv, cluster, levels, model, options.maxTextureSize || 4096) });
+        n++;
+        continue;
+      }
       const dec = vdshCpcaDecode(stream, nv, cluster, levels, model);
       for (let g = 0; g < Math.ceil(nc / 4); g++) {
         const a = new Float32Array(4 * nv);
@@ -229,7 +253,21 @@ export function vdshMaterial(mesh, shaders, options = {}) {
     vdshBakeFromView: { value: new THREE.Matrix4() },
   };
   let width = 0;
-  if (buffer) {
+  const cd = cpcaData(geometry, stream);
+  const texture = (data, w, h, format, type) => {
+    const tex = new THREE.DataTexture(data, w, h, format, type);
+    tex.minFilter = tex.magFilter = THREE.NearestFilter;
+    tex.generateMipmaps = false;
+    tex.needsUpdate = true;
+    return tex;
+  };
+  if (cd) {  // kept compressed: decoded in the vertex stage
+    const words = texture(cd.words, cd.width, cd.height, THREE.RedIntegerFormat, THREE.UnsignedIntType);
+    words.internalFormat = 'R32UI';
+    uniforms.u_coef = { value: words };
+    uniforms.u_model = { value: texture(cd.model, cd.width, cd.modelHeight, THREE.RGBAFormat, THREE.FloatType) };
+    width = cd.width;
+  } else if (buffer) {
     const b = bufferTexture(geometry, names, stream, options.maxTextureSize || 4096);
     uniforms.u_coef = { value: b.tex };
     width = b.width;
@@ -238,7 +276,7 @@ export function vdshMaterial(mesh, shaders, options = {}) {
     // uploaded once), so the GLSL names do not depend on the prefix.
     for (let g = 0; g < plan.groups; g++) geometry.setAttribute('vdshC' + g, geometry.getAttribute(names[g]));
   }
-  const vg = vdshVertexGlsl(plan, shaders, width);
+  const vg = vdshVertexGlsl(plan, shaders, width, cd);
   const defines = vg.defines + `#define VDSH_OUTPUT ${output}\n`;
 
   // three.js declares its point lights only in the fragment stage; the
@@ -296,7 +334,7 @@ float vdshVisibility(float val, vec3 pv, int index) {
     shader.vertexShader = vs;
     shader.fragmentShader = fs;
   };
-  const key = 'vdsh:' + stream.attribute_prefix + ':' + (buffer ? 'buffer' : 'attr') + ':' + output;
+  const key = 'vdsh:' + stream.attribute_prefix + ':' + (cd ? 'cpca' : buffer ? 'buffer' : 'attr') + ':' + output;
   const prevKey = material.customProgramCacheKey.bind(material);
   material.customProgramCacheKey = () => prevKey() + key;
   // The bake's frame: world -> bake, view -> bake, before every draw.
@@ -312,7 +350,8 @@ float vdshVisibility(float val, vec3 pv, int index) {
     if (prevBefore) prevBefore.call(this, renderer, scene, camera, ...rest);
   };
   material.needsUpdate = true;
-  material.userData.vdsh = { order: stream.order, adaptive: !!stream.variable_order, path: buffer ? 'buffer' : 'attributes',
+  material.userData.vdsh = { order: stream.order, adaptive: !!stream.variable_order,
+    path: cd ? 'cpca' : buffer ? 'buffer' : 'attributes',
     quantity: stream.quantity };
   mesh.material = material;
   return material;

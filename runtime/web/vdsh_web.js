@@ -24,7 +24,12 @@
 // coefficients in a float texture, read front to back in the vertex stage
 // and summed by the associated-Legendre recurrence for any order, then the
 // distance path above for every quantity. (WebGL2 vertex attributes stop
-// at 16 VEC4, order 5 at most with position and normal.)
+// at 16 VEC4, order 5 at most with position and normal.) A cpca stream
+// (vdsh-bake --encoding cpca) stays compressed on the GPU: its records in
+// an integer texture and its model in a float one, each vertex's
+// coefficients decoded in the vertex stage as vdsh-view does
+// (vdsh_buffer.glsl's BUF_KIND 4); cpca=load decodes it at load instead
+// (576 GPU bytes per vertex at order 12 against about 32).
 // compare: smooth clamp(1.5 d / dl - 0.5, 0, 1) (formats/vdsh_shadow.h).
 // The camera is formats/vdsh_camera.h's (gluLookAt basis, vertical fov).
 // Shading is vdsh-view's (runtime/vdsh_view_core.c): albedo 0.8, ambient
@@ -54,13 +59,15 @@
 // lights=N (default lights, 1..4, default 1), size=WxH (canvas size;
 // default the window), output=shadow (shadow factor of light 0 as grey,
 // white where no surface: vdsh-view's --views frames) or shaded (default:
-// vdsh-view --render's picture), meshopt=URL.
+// vdsh-view --render's picture), meshopt=URL, cpca=vertex (default) or
+// cpca=load (a cpca stream decoded in the vertex stage, or at load).
 // Mouse: drag orbits the camera around the target, wheel zooms,
 // shift+drag moves light 0 in the view plane. window.vdshReady is set to
 // true (and document.title to "ready") once the first frame is drawn. On
 // failure the message is shown on the page (#msg), in document.title
 // ("error: ...") and in window.vdshError.
-import { VDSH_EXT, vdshChooseStream, vdshStreamPlan, vdshBufferData, vdshVertexGlsl, vdshCpcaDecode } from './vdsh_core.js';
+import { VDSH_EXT, vdshChooseStream, vdshStreamPlan, vdshBufferData, vdshVertexGlsl, vdshCpcaDecode,
+  vdshCpcaBufferData } from './vdsh_core.js';
 
 // The program: vdsh_core.js's vertex stage (the VDSH value per light,
 // interpolated), then vdsh-view's shading per fragment.
@@ -69,7 +76,7 @@ import { VDSH_EXT, vdshChooseStream, vdshStreamPlan, vdshBufferData, vdshVertexG
 // vdsh_common.glsl (the SH sums, vdsh_distance, vdsh_compare: the C
 // runtime's own) and vdsh_buffer.glsl (the buffer path's recurrence).
 function glsl(cfg, shaders) {
-  const vg = vdshVertexGlsl(cfg.plan, shaders, cfg.texWidth);
+  const vg = vdshVertexGlsl(cfg.plan, shaders, cfg.texWidth, cfg.cpca);
   const head = `#version 300 es
 precision highp float;
 precision highp int;
@@ -405,7 +412,7 @@ async function main() {
   const stream = vdshChooseStream(vx.streams, q.get('order'));
   const plan = vdshStreamPlan(stream, q.get('path'));
   const attrNames = [];
-  const cp = stream.cpca;  // a cpca stream: cluster and weight attributes, decoded at load
+  const cp = stream.cpca;  // a cpca stream: cluster and weight attributes (and the model)
   const want = cp ? [cp.cluster_attribute, ...Array.from({ length: cp.weight_attributes }, (_, g) => cp.weight_prefix + g)]
     : Array.from({ length: plan.groups }, (_, g) => stream.attribute_prefix + g);
   for (const name of want) {
@@ -485,7 +492,8 @@ async function main() {
   const output = q.get('output') === 'shadow' ? 1 : 0;
   const buffer = plan.buffer;
   window.vdshView = { eye: cam.eye, target: cam.target, lights, order: stream.order,
-    adaptive: !!stream.variable_order, path: buffer ? 'buffer' : 'attributes', defaultView: dv.fallback ? 'fallback' : 'file' };
+    adaptive: !!stream.variable_order, path: buffer ? 'buffer' : 'attributes',
+    cpca: cp ? (q.get('cpca') === 'load' ? 'load' : 'vertex') : null, defaultView: dv.fallback ? 'fallback' : 'file' };
 
   const canvas = document.getElementById('c');
   if (q.get('size')) {  // a fixed size WxH (CSS pixels) instead of the window's
@@ -496,13 +504,20 @@ async function main() {
   const gl = canvas.getContext('webgl2', { antialias: false, preserveDrawingBuffer: true });
   if (!gl) throw new Error('this browser gives no WebGL2 context');
   const coef = attrNames.map((n) => gltf.read(prim.attributes[n]));
-  let bd = null;
-  if (cp) {  // decoded at load (vdsh_core.js), then the buffer path
+  let bd = null, cd = null;
+  const maxTexture = gl.getParameter(gl.MAX_TEXTURE_SIZE);
+  const cpcaLoad = q.get('cpca') === 'load';
+  if (q.get('cpca') !== null && !cpcaLoad && q.get('cpca') !== 'vertex')
+    throw new Error('cpca=' + q.get('cpca') + ': give cpca=vertex or cpca=load');
+  if (cp && !cpcaLoad)  // kept compressed, decoded in the vertex stage (vdsh_core.js)
+    cd = vdshCpcaBufferData(stream, nv, coef[0], coef.slice(1), model, maxTexture);
+  else if (cp) {  // decoded at load (vdsh_core.js), then the buffer path
     const dec = vdshCpcaDecode(stream, nv, coef[0], coef.slice(1), model), nc = stream.order * stream.order;
-    bd = vdshBufferData((v, i) => dec[v * nc + i], nv, stream, gl.getParameter(gl.MAX_TEXTURE_SIZE));
+    bd = vdshBufferData((v, i) => dec[v * nc + i], nv, stream, maxTexture);
   } else if (buffer)  // each vertex's coefficients in a float texture (vdsh_core.js)
-    bd = vdshBufferData((v, i) => coef[i >> 2][4 * v + (i & 3)], nv, stream, gl.getParameter(gl.MAX_TEXTURE_SIZE));
-  const src = glsl({ plan, lights: lights.length, output, texWidth: bd ? bd.width : 0 }, await loadShaders(q.get('shaders')));
+    bd = vdshBufferData((v, i) => coef[i >> 2][4 * v + (i & 3)], nv, stream, maxTexture);
+  const src = glsl({ plan, lights: lights.length, output, texWidth: bd ? bd.width : cd ? cd.width : 0, cpca: cd },
+    await loadShaders(q.get('shaders')));
   const sh = (type, s) => {
     const o = gl.createShader(type);
     gl.shaderSource(o, s);
@@ -531,14 +546,22 @@ async function main() {
   attrib('a_position', pos, 3);
   attrib('a_normal', nrm, 3);
   const U = (n) => gl.getUniformLocation(prog, n);
-  if (buffer) {
-    attrib('a_record', bd.records, 1);
-    attrib('a_order', bd.orders, 1);
-    gl.activeTexture(gl.TEXTURE0);
+  const texture = (unit, format, w, h, fmt, type, data) => {
+    gl.activeTexture(gl.TEXTURE0 + unit);
     gl.bindTexture(gl.TEXTURE_2D, gl.createTexture());
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
-    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, bd.width, bd.height, 0, gl.RGBA, gl.FLOAT, bd.texels);
+    gl.texImage2D(gl.TEXTURE_2D, 0, format, w, h, 0, fmt, type, data);
+  };
+  if (cd) {
+    texture(0, gl.R32UI, cd.width, cd.height, gl.RED_INTEGER, gl.UNSIGNED_INT, cd.words);
+    texture(1, gl.RGBA32F, cd.width, cd.modelHeight, gl.RGBA, gl.FLOAT, cd.model);
+    gl.uniform1i(U('u_coef'), 0);
+    gl.uniform1i(U('u_model'), 1);
+  } else if (buffer) {
+    attrib('a_record', bd.records, 1);
+    attrib('a_order', bd.orders, 1);
+    texture(0, gl.RGBA32F, bd.width, bd.height, gl.RGBA, gl.FLOAT, bd.texels);
     gl.uniform1i(U('u_coef'), 0);
   } else {
     for (let g = 0; g < plan.groups; g++) attrib('vdshC' + g, coef[g], 4);
@@ -593,7 +616,7 @@ async function main() {
   });
   gl.finish();
   window.vdshReady = true;
-  document.title = 'ready ' + canvas.width + 'x' + canvas.height;
+  document.title = 'ready ' + canvas.width + 'x' + canvas.height + (cp ? ' cpca ' + window.vdshView.cpca : '');
 }
 
 function showError(e) {
