@@ -8,9 +8,9 @@
 # default 32); a part names the budget; bad budgets are usage
 # errors, a budget no setting fits is refused naming it with nothing
 # written, and the merge refuses parts of auto and fixed settings mixed.
-# Usage: test_cpca_auto.sh VDSH_BAKE VDSH_MERGE VDSH_INFO
+# Usage: test_cpca_auto.sh VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR
 set -u
-bake=$1 merge=$2 info=$3
+bake=$1 merge=$2 info=$3 src=$4
 . "$(dirname "$0")/lib.sh"
 make_tmp
 says() { # says DESCRIPTION TEXT: the last command's stderr or stdout holds TEXT
@@ -45,6 +45,13 @@ expect_exit 0 "auto:12 merge" "$merge" -q "$d"/p*.vdsh -o "$d/m.vdsh"
 check "auto:12: 3 shards merged identical to the whole bake" cmp "$d/m.vdsh" "$d/w1.vdsh"
 expect_exit 0 "vdsh-info on an auto part" "$info" "$d/p1.vdsh"
 says "vdsh-info shows the part's budget" "cpca auto:12 (fitted at the merge)"
+check "the Python reader reads an auto part" /usr/bin/python3 -c '
+import sys
+sys.path.insert(0, sys.argv[1])
+import vdsh
+p = vdsh.read(sys.argv[2]).part
+assert (p["cpca_clusters"], p["cpca_basis"], p["cpca_bits"]) == (0, 12, 0), p
+' "$src/python" "$d/p1.vdsh"
 expect_exit 0 "vdsh-info on the auto file" "$info" "$d/w1.vdsh"
 says "vdsh-info shows what auto chose" "basis vectors of 4-bit weights"
 expect_exit 0 "auto (32)" "$bake" "${tiny[@]}" --encoding cpca --cpca auto -o "$tmp/a32.vdsh"
