@@ -179,7 +179,7 @@ static void usage(FILE *f)
             "                          K = 4, 8, 16 at 4 bits with the largest B within\n"
             "                          BYTES per vertex (1..4096, default 32; the model\n"
             "                          included), the one with the least fit error\n"
-            "                          (about 3x the encode time of one setting)\n"
+            "                          (2-4x the encode time of one setting)\n"
             "      --shard I/N         bake shard I (0-based) of N only and write a part\n"
             "                          file; vdsh-merge joins the N parts into the file\n"
             "                          the whole bake writes, byte for byte\n"
