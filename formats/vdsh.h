@@ -233,6 +233,9 @@ typedef struct vdsh_cpca {
 #define VDSH_CPCA_DEFAULT_CLUSTERS 8
 #define VDSH_CPCA_DEFAULT_BASIS 54
 #define VDSH_CPCA_DEFAULT_BITS 4
+/* --cpca auto[:BYTES]: bytes per vertex, the model included */
+#define VDSH_CPCA_DEFAULT_BUDGET 32
+#define VDSH_CPCA_MAX_BUDGET 4096
 
 typedef struct vdsh_stream {
     uint32_t order;    /* bands n; n*n coefficients per vertex */

@@ -7,6 +7,7 @@
  * x86-64 CPU and whatever the caller's thread count. */
 #include "vdsh_cpca.h"
 #include "vdsh_failf.h"
+#include "vdsh_internal.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -32,12 +33,20 @@ enum {
 vdsh_cpca_settings vdsh_cpca_settings_default(void)
 {
     vdsh_cpca_settings s = {VDSH_CPCA_DEFAULT_CLUSTERS, VDSH_CPCA_DEFAULT_BASIS,
-                            VDSH_CPCA_DEFAULT_BITS};
+                            VDSH_CPCA_DEFAULT_BITS, 0};
     return s;
 }
 
 static int check_settings(const vdsh_cpca_settings *s, vdsh_error *err)
 {
+    if (s->budget) {
+        if (s->budget > VDSH_CPCA_MAX_BUDGET) {
+            vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: auto budget %u out of range 1..%d", s->budget,
+                       VDSH_CPCA_MAX_BUDGET);
+            return 0;
+        }
+        return 1;
+    }
     if (s->clusters < 1 || s->clusters > VDSH_CPCA_MAX_CLUSTERS) {
         vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: clusters %u out of range 1..%d", s->clusters,
                    VDSH_CPCA_MAX_CLUSTERS);
@@ -60,6 +69,24 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
 {
     unsigned long v[3];
     const char *p = text ? text : "";
+    if (strncmp(p, "auto", 4) == 0) {
+        unsigned long budget = VDSH_CPCA_DEFAULT_BUDGET;
+        if (p[4] == ':') {
+            char *end;
+            budget = p[5] >= '0' && p[5] <= '9' ? strtoul(p + 5, &end, 10) : 0;
+            if (!budget || *end || budget > VDSH_CPCA_MAX_BUDGET)
+                return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                                  "cpca settings '%s': expected auto:BYTES, bytes per vertex "
+                                  "1..%d (for example auto:32)",
+                                  text, VDSH_CPCA_MAX_BUDGET);
+        } else if (p[4]) {
+            return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                              "cpca settings '%s': expected auto or auto:BYTES", text);
+        }
+        vdsh_cpca_settings s = {0, 0, 0, (uint32_t)budget};
+        *out = s;
+        return VDSH_OK;
+    }
     for (int k = 0; k < 3; k++) {
         char *end;
         if (*p < '0' || *p > '9')
@@ -72,7 +99,7 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
                               "cpca settings '%s': expected K,B,BITS (for example 8,54,4)", text);
         p = end + (k < 2);
     }
-    vdsh_cpca_settings s = {(uint32_t)v[0], (uint32_t)v[1], (uint32_t)v[2]};
+    vdsh_cpca_settings s = {(uint32_t)v[0], (uint32_t)v[1], (uint32_t)v[2], 0};
     if (!check_settings(&s, err))
         return VDSH_ERR_ARGUMENT;
     *out = s;
@@ -581,15 +608,12 @@ static void refine_free(refine_ctx *r)
     free(r->next);
 }
 
-/* The squared error of vertex x's reconstruction by cluster c (the
- * weights the fit's projections, unquantised) over x's own hemisphere:
- * the nh directions in r->hemi, x's values there in r->xval. */
-static double refine_error(const fit_ctx *f, refine_ctx *r, uint32_t c, const float *x, uint32_t nh)
+/* The squared error of a vertex's reconstruction by cluster c with the
+ * weights r->w over the vertex's own hemisphere: the nh directions in
+ * r->hemi, its values there in r->xval (vertex_hemisphere). */
+static double hemi_error(const fit_ctx *f, const refine_ctx *r, uint32_t c, uint32_t nh)
 {
-    const uint32_t n = f->n, b = f->b, count = r->rd.count;
-    const double *mu = f->mus + (size_t)c * n, *proj = f->proj + (size_t)c * b * n;
-    for (uint32_t j = 0; j < b; j++)
-        r->w[j] = weight_of(x, mu, proj + (size_t)j * n, n);
+    const uint32_t b = f->b, count = r->rd.count;
     const double *mv = r->mval + (size_t)c * count, *bv = r->bval + (size_t)c * count * b;
     double e = 0.0;
     for (uint32_t h = 0; h < nh; h++) {
@@ -603,8 +627,19 @@ static double refine_error(const fit_ctx *f, refine_ctx *r, uint32_t c, const fl
     return e;
 }
 
-/* One round of reassignment: the number of vertices that moved. */
-static uint32_t reassign(fit_ctx *f, refine_ctx *r)
+/* hemi_error of vertex x by cluster c, the weights the fit's projections
+ * (unquantised). */
+static double refine_error(const fit_ctx *f, refine_ctx *r, uint32_t c, const float *x, uint32_t nh)
+{
+    const uint32_t n = f->n, b = f->b;
+    const double *mu = f->mus + (size_t)c * n, *proj = f->proj + (size_t)c * b * n;
+    for (uint32_t j = 0; j < b; j++)
+        r->w[j] = weight_of(x, mu, proj + (size_t)j * n, n);
+    return hemi_error(f, r, c, nh);
+}
+
+/* Each fitted cluster's stored mean and basis at r's directions. */
+static void cluster_values(const fit_ctx *f, refine_ctx *r)
 {
     const uint32_t n = f->n, b = f->b, k = f->k, count = r->rd.count;
     for (uint32_t c = 0; c < k; c++) {
@@ -626,21 +661,38 @@ static uint32_t reassign(fit_ctx *f, refine_ctx *r)
             }
         }
     }
+}
+
+/* Vertex v's hemisphere of r's directions (r->hemi) and its function's
+ * values there (r->xval): the count of directions. */
+static uint32_t vertex_hemisphere(const fit_ctx *f, refine_ctx *r, uint32_t v)
+{
+    const uint32_t n = f->n, count = r->rd.count;
+    const float *x = f->src + (size_t)v * n, *nv = f->normals + 3 * (size_t)v;
+    uint32_t nh = 0;
+    for (uint32_t d = 0; d < count; d++) {
+        const double *dd = r->rd.dir + 3 * (size_t)d;
+        if (!(dd[0] * nv[0] + dd[1] * nv[1] + dd[2] * nv[2] > 0.0))
+            continue;
+        r->hemi[nh++] = d;
+        const double *y = r->rd.wy + (size_t)d * n;
+        double s = 0.0;
+        for (uint32_t a = 0; a < n; a++)
+            s += y[a] * (double)x[a];
+        r->xval[d] = s;
+    }
+    return nh;
+}
+
+/* One round of reassignment: the number of vertices that moved. */
+static uint32_t reassign(fit_ctx *f, refine_ctx *r)
+{
+    const uint32_t n = f->n, k = f->k;
+    cluster_values(f, r);
     uint32_t moved = 0;
     for (uint32_t v = 0; v < f->rows; v++) {
-        const float *x = f->src + (size_t)v * n, *nv = f->normals + 3 * (size_t)v;
-        uint32_t nh = 0;
-        for (uint32_t d = 0; d < count; d++) {
-            const double *dd = r->rd.dir + 3 * (size_t)d;
-            if (!(dd[0] * nv[0] + dd[1] * nv[1] + dd[2] * nv[2] > 0.0))
-                continue;
-            r->hemi[nh++] = d;
-            const double *y = r->rd.wy + (size_t)d * n;
-            double s = 0.0;
-            for (uint32_t a = 0; a < n; a++)
-                s += y[a] * (double)x[a];
-            r->xval[d] = s;
-        }
+        const float *x = f->src + (size_t)v * n;
+        uint32_t nh = vertex_hemisphere(f, r, v);
         uint32_t best = f->labels[v];
         double be = refine_error(f, r, best, x, nh);
         for (uint32_t c = 0; c < k; c++) {
@@ -657,6 +709,26 @@ static uint32_t reassign(fit_ctx *f, refine_ctx *r)
     }
     memcpy(f->labels, r->next, sizeof(uint32_t) * f->rows);
     return moved;
+}
+
+/* The stored fit's error: the sum over vertices of hemi_error by their
+ * own cluster with the weights their records decode to (quantised), the
+ * same directions as the refinement's. */
+static double stored_error(const fit_ctx *f, refine_ctx *r, const float *scales,
+                           const uint32_t *records, uint32_t bits, uint32_t words)
+{
+    const uint32_t b = f->b;
+    cluster_values(f, r);
+    double e = 0.0;
+    for (uint32_t v = 0; v < f->rows; v++) {
+        uint32_t nh = vertex_hemisphere(f, r, v), c = f->labels[v];
+        const uint32_t *rec = records + (size_t)v * words;
+        for (uint32_t j = 0; j < b; j++)
+            r->w[j] = (double)vdsh_cpca_record_level(rec, bits, j) *
+                      (double)vdsh_cpca_step(scales[(size_t)c * b + j], bits);
+        e += hemi_error(f, r, c, nh);
+    }
+    return e;
 }
 
 /* ---- the fit ---- */
@@ -679,26 +751,18 @@ static double quantise(double w, double s, int levels)
     return q > levels ? levels : q < -levels ? -levels : q;
 }
 
-vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t rows, uint32_t order,
-                             const vdsh_cpca_settings *settings, vdsh_cpca_fit *out,
-                             vdsh_error *err)
+/* One fit with fixed settings (checked; the sources finite); *proxy (may
+ * be NULL) the stored fit's hemisphere error (stored_error). */
+static vdsh_result encode_fixed(const float *src, const float *normals, uint32_t rows,
+                                uint32_t order, const vdsh_cpca_settings *settings,
+                                vdsh_cpca_fit *out, double *proxy, vdsh_error *err)
 {
     memset(out, 0, sizeof *out);
-    if (!src || !normals || !settings || rows < 1 || rows > VDSH_MAX_VERTICES || order < 1 ||
-        order > VDSH_MAX_ORDER)
-        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: bad arguments (rows %u, order %u)", rows,
-                          order);
-    if (!check_settings(settings, err))
-        return VDSH_ERR_ARGUMENT;
     const uint32_t n = order * order;
     const uint32_t k = settings->clusters < rows ? settings->clusters : rows;
     const uint32_t b = settings->basis < n ? settings->basis : n;
     const uint32_t bits = settings->bits;
     const uint32_t words = vdsh_cpca_record_words(b, bits);
-    for (size_t x = 0; x < (size_t)rows * n; x++)
-        if (!isfinite(src[x]))
-            return vdsh_failf(err, VDSH_ERR_INVALID,
-                              "cpca: vertex %zu coefficient %zu is not finite", x / n, x % n);
 
     /* one block: scales, means, bases, records */
     size_t o_means = ((size_t)k * b * 4 + 15) & ~(size_t)15;
@@ -722,10 +786,11 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
     metric_dirs md = {0};
     refine_ctx rd = {0};
     const uint32_t rounds = k > 1 ? REFINE_ROUNDS : 0;
+    const int need_rd = rounds || proxy;
     vdsh_result res = VDSH_OK;
     if (!block || !labels || !dist || !cent || !g || !l || !sc || !sy || !ev || !proj || !tmp ||
         !mu || !mus || !members || !wmax || !cerr || !idx || !frac ||
-        !metric_init(&md, order, CUBE_N) || (rounds && !refine_init(&rd, order, k, b, rows))) {
+        !metric_init(&md, order, CUBE_N) || (need_rd && !refine_init(&rd, order, k, b, rows))) {
         res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory (%zu bytes)", total);
         goto done;
     }
@@ -864,6 +929,8 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
         }
         out->rms_error = sqrt(e2 / rows);
     }
+    if (proxy)
+        *proxy = stored_error(&fc, &rd, scales, records, bits, words);
 done:
     free(block);
     free(labels);
@@ -884,9 +951,88 @@ done:
     free(idx);
     free(frac);
     metric_free(&md);
-    if (rounds)
+    if (need_rd)
         refine_free(&rd);
     return res;
+}
+
+/* Bytes of a stream of `rows` rows with settings s, the model included. */
+static uint64_t fit_bytes(uint32_t rows, uint32_t order, const vdsh_cpca_settings *s)
+{
+    return (uint64_t)rows * 4 * vdsh_cpca_record_words(s->basis, s->bits) +
+           vdsh_cpca_model_bytes(order, s->clusters, s->basis);
+}
+
+/* auto: the candidates vdsh_cpca.h names, the least stored_error kept. */
+static vdsh_result encode_auto(const float *src, const float *normals, uint32_t rows,
+                               uint32_t order, uint32_t budget, vdsh_cpca_fit *out, vdsh_error *err)
+{
+    static const uint32_t ks[] = {4, 8, 16};
+    const uint32_t n = order * order, bits = 4;
+    const uint64_t limit = (uint64_t)budget * rows;
+    double best_e = 0.0;
+    uint32_t last_k = 0;
+    int have = 0;
+    for (size_t i = 0; i < sizeof ks / sizeof ks[0]; i++) {
+        vdsh_cpca_settings st = {ks[i] < rows ? ks[i] : rows, 0, bits, 0};
+        if (st.clusters == last_k)
+            continue; /* capped at rows: the same as the last */
+        last_k = st.clusters;
+        for (uint32_t b = n; b >= 1 && !st.basis; b--) {
+            vdsh_cpca_settings t = st;
+            t.basis = b;
+            if (fit_bytes(rows, order, &t) <= limit)
+                st.basis = b;
+        }
+        if (!st.basis)
+            continue;
+        vdsh_cpca_fit fit;
+        double e;
+        vdsh_result r = encode_fixed(src, normals, rows, order, &st, &fit, &e, err);
+        if (r != VDSH_OK) {
+            if (have)
+                vdsh_cpca_fit_free(out);
+            return r;
+        }
+        if (!have || e < best_e) {
+            if (have)
+                vdsh_cpca_fit_free(out);
+            *out = fit;
+            best_e = e;
+            have = 1;
+        } else {
+            vdsh_cpca_fit_free(&fit);
+        }
+    }
+    if (!have) {
+        vdsh_cpca_settings least = {1, 1, bits, 0};
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                          "cpca: auto budget %u bytes per vertex too small for %u rows of order "
+                          "%u (the least model, 1,1,%u, takes %.1f)",
+                          budget, rows, order, bits, (double)fit_bytes(rows, order, &least) / rows);
+    }
+    return VDSH_OK;
+}
+
+vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t rows, uint32_t order,
+                             const vdsh_cpca_settings *settings, vdsh_cpca_fit *out,
+                             vdsh_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!src || !normals || !settings || rows < 1 || rows > VDSH_MAX_VERTICES || order < 1 ||
+        order > VDSH_MAX_ORDER)
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: bad arguments (rows %u, order %u)", rows,
+                          order);
+    if (!check_settings(settings, err))
+        return VDSH_ERR_ARGUMENT;
+    const uint32_t n = order * order;
+    for (size_t x = 0; x < (size_t)rows * n; x++)
+        if (!isfinite(src[x]))
+            return vdsh_failf(err, VDSH_ERR_INVALID,
+                              "cpca: vertex %zu coefficient %zu is not finite", x / n, x % n);
+    if (settings->budget)
+        return encode_auto(src, normals, rows, order, settings->budget, out, err);
+    return encode_fixed(src, normals, rows, order, settings, out, NULL, err);
 }
 
 vdsh_result vdsh_cpca_encode_stream(const vdsh_stream *src, uint32_t rows, const float *normals,

@@ -6,7 +6,7 @@
  * after the fit, over all receivers, and vdsh-merge over the joined parts'
  * rows, so a merged file is byte-identical with the whole bake's.
  *
- * Method (VDSH.md has the rule in words): k-means over [c, 10 sigma n]
+ * Method (VDSH.md has the rule in words; auto: vdsh_cpca_encode): k-means over [c, 10 sigma n]
  * (coefficients, then the vertex normal scaled to dominate), k-means++
  * seeding from a fixed seed, Lloyd rounds until no vertex moves (at most
  * 25); per cluster the mean (f16) and the B leading principal directions
@@ -46,13 +46,18 @@ typedef struct vdsh_cpca_settings {
     uint32_t clusters; /* K asked for, 1..VDSH_CPCA_MAX_CLUSTERS (capped at rows) */
     uint32_t basis;    /* B asked for, 1..VDSH_MAX_COEFFS (capped at order^2) */
     uint32_t bits;     /* VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS */
+    /* auto (vdsh-bake --cpca auto[:BYTES]): 1..VDSH_CPCA_MAX_BUDGET bytes
+     * per vertex, the model included; K, B and bits are then ignored and
+     * the encoder picks them (vdsh_cpca_encode). 0: the fixed K, B, bits. */
+    uint32_t budget;
 } vdsh_cpca_settings;
 
 /* K = 8, B = 54, 4 bits (docs/ACCURACY.md "Compressed high orders"). */
 vdsh_cpca_settings vdsh_cpca_settings_default(void);
 
-/* Parse "K,B,BITS" (for example "8,54,4") into *out; VDSH_ERR_ARGUMENT
- * with a message for a malformed string or a value out of range. */
+/* Parse "K,B,BITS" (for example "8,54,4"), "auto" (budget 32) or
+ * "auto:BYTES" (1..VDSH_CPCA_MAX_BUDGET) into *out; VDSH_ERR_ARGUMENT with
+ * a message for a malformed string or a value out of range. */
 vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_error *err);
 
 /* A fitted stream: model (its pointers into storage_) and records
@@ -67,6 +72,12 @@ typedef struct vdsh_cpca_fit {
 
 /* Fit `rows` rows of order^2 coefficients (src, row-major, finite) with
  * their unit (or zero) normals (3 per row) to a cpca model and records.
+ * With settings->budget (auto): for each K of 4, 8, 16 (capped at rows)
+ * and 4 bits, the largest B whose records and model take at most `budget`
+ * bytes per vertex; each such K,B fitted in full, and the one kept whose
+ * decoded (quantised) functions differ least from the sources over each
+ * vertex's own hemisphere (the refinement's error; first in that order on
+ * a tie). VDSH_ERR_ARGUMENT when none fits the budget.
  * VDSH_ERR_ARGUMENT for bad settings, order or rows; VDSH_ERR_INVALID for
  * a value that is not finite or a model that does not fit f16;
  * VDSH_ERR_OUT_OF_MEMORY. On failure *out is zeroed. */

@@ -66,6 +66,12 @@ add_test(NAME bake_cpca
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_cpca_bake.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
                  ${PROJECT_SOURCE_DIR})
+# vdsh-bake --cpca auto[:BYTES] (issue 29): within the budget, the same
+# bytes at 1 and 2 threads and 3 shards merged; bad budgets refused.
+add_test(NAME bake_cpca_auto
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_cpca_auto.sh
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
+                 ${PROJECT_SOURCE_DIR})
 # The GNU parallel recipe (scripts/bake-parallel), with Debian's parallel:
 # byte for byte, a name with quotes, a rerun bakes the missing parts only.
 add_test(NAME bake_shard_parallel

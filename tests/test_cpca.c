@@ -27,7 +27,12 @@
  *                  end; the refinement (reassignment by reconstruction
  *                  error) must split them: error under 2% of the spread
  *                  (0.25% refined, 7.6% with k-means alone)
- *   settings       vdsh_cpca_parse accepts K,B,BITS and refuses the rest
+ *   auto           --cpca auto:BYTES (the round trip's data): within the
+ *                  budget, model included; K one of 4, 8, 16 at 4 bits with
+ *                  the largest B that fits; the same bytes twice; a budget
+ *                  no K,B fits is refused with VDSH_ERR_ARGUMENT
+ *   settings       vdsh_cpca_parse accepts K,B,BITS, auto and auto:BYTES
+ *                  and refuses the rest
  */
 #include "vdsh.h"
 #include "vdsh_cpca.h"
@@ -172,7 +177,7 @@ static void curved_cluster(void)
         }
         memcpy(nrm + 3 * v, faces[g], sizeof faces[g]);
     }
-    vdsh_cpca_settings st = {1, 1, 8};
+    vdsh_cpca_settings st = {1, 1, 8, 0};
     vdsh_cpca_fit fit;
     vdsh_error err = {{0}};
     CHECK(vdsh_cpca_encode(c, nrm, CURVED_ROWS, CURVED_ORDER, &st, &fit, &err) == VDSH_OK,
@@ -231,7 +236,7 @@ static void line_and_blob(void)
         for (int i = 0; i < LINE_NC; i++)
             spread += (c[v * LINE_NC + i] - mean[i]) * (c[v * LINE_NC + i] - mean[i]) / LINE_ROWS;
     spread = sqrt(spread);
-    vdsh_cpca_settings st = {2, 1, 8};
+    vdsh_cpca_settings st = {2, 1, 8, 0};
     vdsh_cpca_fit fit;
     vdsh_error err = {{0}};
     CHECK(vdsh_cpca_encode(c, nrm, LINE_ROWS, LINE_ORDER, &st, &fit, &err) == VDSH_OK,
@@ -253,6 +258,51 @@ static double rms_vs(const vdsh_stream *s, const float *want)
             e2 += ((double)c[i] - want[v * NC + i]) * ((double)c[i] - want[v * NC + i]);
     }
     return sqrt(e2 / ROWS);
+}
+
+/* Bytes of a fit of `rows` rows, the model included. */
+static uint64_t fit_bytes(const vdsh_cpca *m, uint32_t rows, uint32_t order)
+{
+    return (uint64_t)rows * 4 * vdsh_cpca_record_words(m->basis, m->bits) +
+           vdsh_cpca_model_bytes(order, m->clusters, m->basis);
+}
+
+static void auto_settings(void)
+{
+    vdsh_error err = {{0}};
+    static const uint32_t budgets[] = {12, 20, 32};
+    for (size_t i = 0; i < sizeof budgets / sizeof *budgets; i++) {
+        vdsh_cpca_settings st = {0, 0, 0, budgets[i]};
+        vdsh_cpca_fit a, b;
+        CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &a, &err) == VDSH_OK, "auto:%u: %s",
+              budgets[i], err.msg);
+        CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &b, &err) == VDSH_OK, "auto:%u: %s",
+              budgets[i], err.msg);
+        const vdsh_cpca *m = &a.model;
+        uint64_t bytes = fit_bytes(m, ROWS, ORDER);
+        CHECK(bytes <= (uint64_t)budgets[i] * ROWS, "auto:%u: %.2f bytes per vertex", budgets[i],
+              (double)bytes / ROWS);
+        CHECK((m->clusters == 4 || m->clusters == 8 || m->clusters == 16) && m->bits == 4,
+              "auto:%u chose %u,%u,%u", budgets[i], m->clusters, m->basis, m->bits);
+        vdsh_cpca more = *m;
+        more.basis++;
+        CHECK(m->basis == NC || fit_bytes(&more, ROWS, ORDER) > (uint64_t)budgets[i] * ROWS,
+              "auto:%u: B %u not the largest that fits", budgets[i], m->basis);
+        uint64_t model = vdsh_cpca_model_bytes(ORDER, m->clusters, m->basis) - 16;
+        CHECK(b.model.clusters == m->clusters && b.model.basis == m->basis &&
+                  memcmp(a.storage_, b.storage_, (size_t)model) == 0 &&
+                  memcmp(a.records, b.records, (size_t)ROWS * 4 * m->record_words) == 0,
+              "auto:%u: other bytes the second time", budgets[i]);
+        printf("auto:%u: %u,%u,%u, %.2f bytes per vertex, rms error %.4f\n", budgets[i],
+               m->clusters, m->basis, m->bits, (double)bytes / ROWS, a.rms_error);
+        vdsh_cpca_fit_free(&a);
+        vdsh_cpca_fit_free(&b);
+    }
+    vdsh_cpca_settings tiny = {0, 0, 0, 1};
+    vdsh_cpca_fit f;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &tiny, &f, &err) == VDSH_ERR_ARGUMENT &&
+              strstr(err.msg, "budget") && !f.storage_,
+          "auto:1 not refused (%s)", err.msg);
 }
 
 static vdsh_file file_of(vdsh_stream *s)
@@ -290,7 +340,7 @@ static void expect_refused(const uint8_t *good, size_t size, size_t at, const vo
 int main(int argc, char **argv)
 {
     make_data();
-    vdsh_cpca_settings st = {K, B, BITS};
+    vdsh_cpca_settings st = {K, B, BITS, 0};
     vdsh_cpca_fit fit, again, one;
     vdsh_error err;
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &fit, &err) == VDSH_OK, "encode: %s",
@@ -354,7 +404,7 @@ int main(int argc, char **argv)
     double e = rms_vs(&s, src);
     CHECK(fabs(e - fit.rms_error) <= 1e-9 * (1 + e), "rms_error %g, decode %g", fit.rms_error, e);
     CHECK(e < 0.1 * spread, "error %g not below a tenth of the spread %g", e, spread);
-    vdsh_cpca_settings small = {1, 1, 4};
+    vdsh_cpca_settings small = {1, 1, 4, 0};
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &small, &one, &err) == VDSH_OK, "K=1");
     CHECK(one.rms_error > 2.0 * e, "one vector %g, not worse than %g", one.rms_error, e);
     printf("format_cpca: error %.4g, spread %.4g, one vector %.4g\n", e, spread, one.rms_error);
@@ -460,6 +510,7 @@ int main(int argc, char **argv)
 
     curved_cluster();
     line_and_blob();
+    auto_settings();
 
     /* settings */
     vdsh_cpca_settings p;
@@ -469,6 +520,18 @@ int main(int argc, char **argv)
     static const char *const refuse[] = {"",         "8,52",  "8,52,4,1", "0,52,4",
                                          "257,52,4", "8,0,4", "8,52,1",   "8,52,9",
                                          "8,,4",     "a,b,c", "8,52,4x",  "-1,52,4"};
+    CHECK(vdsh_cpca_parse("auto", &p, NULL) == VDSH_OK && p.budget == VDSH_CPCA_DEFAULT_BUDGET,
+          "auto");
+    CHECK(vdsh_cpca_parse("auto:24", &p, NULL) == VDSH_OK && p.budget == 24, "auto:24");
+    CHECK(vdsh_cpca_parse("auto:4096", &p, NULL) == VDSH_OK && p.budget == 4096, "auto:4096");
+    CHECK(vdsh_cpca_parse("8,52,4", &p, NULL) == VDSH_OK && p.budget == 0, "8,52,4 not auto");
+    static const char *const refuse_auto[] = {"auto:0",  "auto:x",   "auto:",   "auto:4097",
+                                              "auto32",  "autox",    "auto:-1", "auto: 5",
+                                              "auto:5x", "auto:32,", "Auto"};
+    for (size_t k = 0; k < sizeof refuse_auto / sizeof *refuse_auto; k++)
+        CHECK(vdsh_cpca_parse(refuse_auto[k], &p, &err) == VDSH_ERR_ARGUMENT &&
+                  strstr(err.msg, refuse_auto[k]),
+              "'%s' accepted or not named", refuse_auto[k]);
     for (size_t k = 0; k < sizeof refuse / sizeof *refuse; k++)
         CHECK(vdsh_cpca_parse(refuse[k], &p, &err) == VDSH_ERR_ARGUMENT, "'%s' accepted",
               refuse[k]);

@@ -309,7 +309,9 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
                "as %s\n",
                f->part.index, f->part.count, f->part.range_begin, f->part.range_end,
                vdsh_encoding_name(f->part.encoding));
-    if (f->has_part && f->part.encoding == VDSH_ENCODING_CPCA)
+    if (f->has_part && f->part.encoding == VDSH_ENCODING_CPCA && !f->part.cpca_clusters)
+        printf("               cpca auto:%u (fitted at the merge)\n", f->part.cpca_basis);
+    else if (f->has_part && f->part.encoding == VDSH_ENCODING_CPCA)
         printf("               cpca %u,%u,%u (fitted at the merge)\n", f->part.cpca_clusters,
                f->part.cpca_basis, f->part.cpca_bits);
     if (f->has_adaptive) {

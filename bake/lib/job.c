@@ -135,7 +135,7 @@ static vdsh_encoding job_encoding(const vb_job_desc *d)
 
 static vdsh_cpca_settings job_cpca(const vb_job_desc *d)
 {
-    return d->cpca.clusters ? d->cpca : vdsh_cpca_settings_default();
+    return d->cpca.clusters || d->cpca.budget ? d->cpca : vdsh_cpca_settings_default();
 }
 
 /* --encoding cpca with --adaptive-order: the variable-order stream (f32, in
@@ -296,10 +296,11 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         f.part = (vdsh_part){
             .index = d->shard_index, .count = d->shard_count, .encoding = job_encoding(d)};
         if (job_encoding(d) == VDSH_ENCODING_CPCA) {
+            /* auto: 0, budget, 0 (VDSH.md "Parts") */
             vdsh_cpca_settings st = job_cpca(d);
-            f.part.cpca_clusters = st.clusters;
-            f.part.cpca_basis = st.basis;
-            f.part.cpca_bits = st.bits;
+            f.part.cpca_clusters = st.budget ? 0 : st.clusters;
+            f.part.cpca_basis = st.budget ? st.budget : st.basis;
+            f.part.cpca_bits = st.budget ? 0 : st.bits;
         }
         vb_shard_range(h->vertex_count, d->shard_index, d->shard_count, &f.part.range_begin,
                        &f.part.range_end);

@@ -175,7 +175,11 @@ static void usage(FILE *f)
             "                          each vertex's order)\n"
             "      --cpca K,B,BITS     cpca settings: clusters (1..256), basis vectors per\n"
             "                          cluster (capped at order^2), bits per weight (2..8);\n"
-            "                          default 8,54,4\n"
+            "                          default 8,54,4; or auto[:BYTES]: per stream, of\n"
+            "                          K = 4, 8, 16 at 4 bits with the largest B within\n"
+            "                          BYTES per vertex (1..4096, default 32; the model\n"
+            "                          included), the one with the least fit error\n"
+            "                          (2-4x the encode time of one setting)\n"
             "      --shard I/N         bake shard I (0-based) of N only and write a part\n"
             "                          file; vdsh-merge joins the N parts into the file\n"
             "                          the whole bake writes, byte for byte\n"
@@ -799,7 +803,8 @@ static int read_choice(int c, const char *arg, options *o)
     case O_CPCA:
         if (vdsh_cpca_parse(arg, &o->cpca, NULL) != VDSH_OK)
             return bad_usage("--cpca takes K,B,BITS: clusters 1..256, basis vectors "
-                             "1..256, bits 2..8 (default 8,54,4), not '%s'",
+                             "1..256, bits 2..8 (default 8,54,4), or auto or auto:BYTES, "
+                             "bytes per vertex 1..4096, not '%s'",
                              arg);
         o->have_cpca = 1;
         break;

@@ -251,7 +251,10 @@ def _chunk(f, cid, b, path):
                   % (i, n, rb, re, enc))
         if enc != 4 and (ck or cb or cbits):
             _fail(path, "part: cpca settings with encoding %s (must be 0)" % ENCODINGS[enc])
-        if enc == 4 and not (1 <= ck <= 256 and 1 <= cb <= 256 and 2 <= cbits <= 8):
+        if enc == 4 and ck == 0:  # auto: 0, budget, 0
+            if not (1 <= cb <= 4096 and cbits == 0):
+                _fail(path, "part: cpca auto settings 0,%d,%d out of range" % (cb, cbits))
+        elif enc == 4 and not (1 <= ck <= 256 and 1 <= cb <= 256 and 2 <= cbits <= 8):
             _fail(path, "part: cpca settings %d,%d,%d out of range" % (ck, cb, cbits))
         f.part = dict(index=i, count=n, range_begin=rb, range_end=re, encoding=ENCODINGS[enc])
         if enc == 4:
