@@ -31,6 +31,12 @@ says() { # says DESCRIPTION TEXT: the last command's stderr holds TEXT
   fi
 }
 
+says_any() { # says_any DESCRIPTION TEXT: the last command's stderr or stdout holds TEXT
+  if ! grep -qF -- "$2" "$tmp/err.txt" "$tmp/out.txt"; then
+    echo "FAIL: $1: output lacks '$2':" >&2; cat "$tmp/err.txt" >&2; fail=1
+  fi
+}
+
 room_box_pair() { # room_box_pair < OBJ_LINES: $tmp/a.obj the room (10 x 4 x
   # 10, faces inward; a unit box on its floor), $tmp/b.obj the same with
   # the lines read from stdin added

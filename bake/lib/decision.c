@@ -211,6 +211,25 @@ static inline __attribute__((always_inline)) double sum_lanes(uint32_t m, const 
     return s;
 }
 
+/* The pairs' signs (+1 shadowed, -1 lit) and weights (lit ones
+ * lit_weight times a shadowed one's, all summing to 1), zero from m to
+ * m8, and the margins t and tt cleared. */
+static inline __attribute__((always_inline)) void pair_setup(uint32_t m, uint32_t m8,
+                                                             const uint8_t *shadowed,
+                                                             float lit_weight, float *sgn,
+                                                             float *wt, float *t, float *tt)
+{
+    double a = 0.0;
+    for (uint32_t i = 0; i < m; i++)
+        a += shadowed[i] ? 1.0 : lit_weight;
+    const float w_shadowed = (float)(1.0 / a), w_lit = (float)(lit_weight / a);
+    for (uint32_t i = 0; i < m8; i++) {
+        sgn[i] = i >= m ? 0.0f : shadowed[i] ? 1.0f : -1.0f;
+        wt[i] = i >= m ? 0.0f : shadowed[i] ? w_shadowed : w_lit;
+        t[i] = tt[i] = 0.0f;
+    }
+}
+
 static double ridge_term(int n, const double *c, const double *c0, const double *r)
 {
     double s = 0.0;
@@ -393,15 +412,7 @@ int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
           *wt = sgn + K, *sh = wt + K, *ex = sh + K, *Z = ex + K;
     const uint32_t m8 = (m + 7) & ~7u;
     const float inv_tau = 1.0f / p->tau;
-    double a = 0.0;
-    for (uint32_t i = 0; i < m; i++)
-        a += shadowed[i] ? 1.0 : p->lit_weight;
-    const float w_shadowed = (float)(1.0 / a), w_lit = (float)(p->lit_weight / a);
-    for (uint32_t i = 0; i < m8; i++) {
-        sgn[i] = i >= m ? 0.0f : shadowed[i] ? 1.0f : -1.0f;
-        wt[i] = i >= m ? 0.0f : shadowed[i] ? w_shadowed : w_lit;
-        t[i] = tt[i] = 0.0f;
-    }
+    pair_setup(m, m8, shadowed, p->lit_weight, sgn, wt, t, tt);
     for (int j = 0; j < n; j++) {
         int l = 0;
         while ((l + 1) * (l + 1) <= j)
@@ -513,15 +524,7 @@ float vb_decision_score(int order, uint32_t m, const float *Y, uint32_t stride, 
           *sgn = sp + K, *wt = sgn + K, *ex = wt + K;
     const uint32_t m8 = (m + 7) & ~7u;
     const float inv_tau = 1.0f / p->tau;
-    double a = 0.0;
-    for (uint32_t i = 0; i < m; i++)
-        a += shadowed[i] ? 1.0 : p->lit_weight;
-    const float w_shadowed = (float)(1.0 / a), w_lit = (float)(p->lit_weight / a);
-    for (uint32_t i = 0; i < m8; i++) {
-        sgn[i] = i >= m ? 0.0f : shadowed[i] ? 1.0f : -1.0f;
-        wt[i] = i >= m ? 0.0f : shadowed[i] ? w_shadowed : w_lit;
-        t[i] = tt[i] = 0.0f;
-    }
+    pair_setup(m, m8, shadowed, p->lit_weight, sgn, wt, t, tt);
     for (int j = 0; j < n; j++)
         c[j] = cf[j];
     margins(n, m, Y, stride, logd, c, t);
