@@ -10,8 +10,17 @@
 // (level * (step * basis) there, (level * step) * basis here): a field or
 // texel out of place is off by whole values. Also: a level out of range
 // and a model view too short are refused by both.
+// vdsh_core.js is an ES module named .js (browsers do not mind); node 18
+// reads a .js outside a "type": "module" package as CommonJS, so it is
+// imported from a copy named .mjs.
+import { copyFileSync, mkdtempSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
 import { pathToFileURL } from 'node:url';
-const { vdshCpcaDecode, vdshCpcaBufferData, bufferSequence } = await import(pathToFileURL(process.argv[2]).href);
+const dir = mkdtempSync(join(tmpdir(), 'vdsh-core-'));
+copyFileSync(process.argv[2], join(dir, 'vdsh_core.mjs'));
+const { vdshCpcaDecode, vdshCpcaBufferData, bufferSequence } = await import(pathToFileURL(join(dir, 'vdsh_core.mjs')).href);
+rmSync(dir, { recursive: true });
 
 let seed = 12345;
 const rnd = () => (seed = (Math.imul(seed, 1103515245) + 12345) >>> 0) / 4294967296;
