@@ -1470,6 +1470,24 @@ static vb_result choose_quantities(bake_run *b, vb_error *err)
     return VB_OK;
 }
 
+/* The calibrated log offset of margin slot `slot` (an order; 0: the
+ * adaptive order's chosen fits): the lit held-out margins of the
+ * cal_count samples gathered into lit, offset for false_rate, within
+ * -5..5. */
+static float slot_offset(const job *J, uint32_t cal_count, int slot, float false_rate, float *lit)
+{
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < cal_count; i++)
+        for (uint32_t j = 0; j < CAL_LIGHTS; j++) {
+            float m =
+                J->cal_margins[((size_t)i * VDSH_ORDER_SLOTS + (size_t)slot) * CAL_LIGHTS + j];
+            if (!isnan(m))
+                lit[k++] = m;
+        }
+    float off = vb_decision_offset(lit, k, false_rate);
+    return off < -5.0f ? -5.0f : off > 5.0f ? 5.0f : off;
+}
+
 /* The decision fit's log offsets: per order, the one that leaves
  * false_rate of the lit pairs of held-out lights in false shadow, over a
  * sample of receivers, in sample order. */
@@ -1489,31 +1507,13 @@ static vb_result calibrate_offsets(bake_run *b, vb_error *err)
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
     else if (vb_parallel_for(d->threads, cal_count, 4, calibrate_block, J, NULL, NULL) == 0)
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
-    for (int o = 1; o <= VDSH_MAX_ORDER && r == VB_OK; o++) {
-        if (!b->coeffs[o])
-            continue;
-        uint32_t k = 0;
-        for (uint32_t i = 0; i < cal_count; i++)
-            for (uint32_t j = 0; j < CAL_LIGHTS; j++) {
-                float m = J->cal_margins[((size_t)i * VDSH_ORDER_SLOTS + o) * CAL_LIGHTS + j];
-                if (!isnan(m))
-                    lit[k++] = m;
-            }
-        float off = vb_decision_offset(lit, k, d->false_rate);
-        J->log_offset[o] = off < -5.0f ? -5.0f : off > 5.0f ? 5.0f : off;
-    }
+    for (int o = 1; o <= VDSH_MAX_ORDER && r == VB_OK; o++)
+        if (b->coeffs[o])
+            J->log_offset[o] = slot_offset(J, cal_count, o, d->false_rate, lit);
     /* The adaptive order's stream: one offset, from each sample's chosen
      * fit (slot 0), whatever its order. */
     if (J->var_decision && r == VB_OK) {
-        uint32_t k = 0;
-        for (uint32_t i = 0; i < cal_count; i++)
-            for (uint32_t j = 0; j < CAL_LIGHTS; j++) {
-                float m = J->cal_margins[(size_t)i * VDSH_ORDER_SLOTS * CAL_LIGHTS + j];
-                if (!isnan(m))
-                    lit[k++] = m;
-            }
-        float off = vb_decision_offset(lit, k, d->false_rate);
-        off = off < -5.0f ? -5.0f : off > 5.0f ? 5.0f : off;
+        float off = slot_offset(J, cal_count, 0, d->false_rate, lit);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             J->var_dec_offset[o] = off;
     }
