@@ -49,13 +49,14 @@ int vv_run_render(const vv_options *o)
 }
 
 /* What a scene's file holds, for a row label: "room.vdsh: paper bake,
- * distance" (the method of its highest order drawn). */
+ * distance" (the method of its highest fixed order, else of its stream
+ * with an order per vertex). */
 static void bake_label(const char *path, const vr_scene *s, char *out, size_t size)
 {
     vr_scene_info info;
     vr_scene_get_info(s, &info);
     const char *slash = strrchr(path, '/');
-    uint32_t method = 0;
+    uint32_t method = info.variable_method;
     for (int k = 1; k <= VDSH_MAX_ORDER; k++)
         if (info.has_order[k])
             method = info.method[k];
@@ -106,7 +107,8 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
     int n = vv_scene_lights(scene, o, o->default_lights ? o->default_lights : 1, lights);
     size_t panel = (size_t)w * (size_t)h * 4;
     int rc = 0;
-    char names[256] = "";
+    char names[256] = "", bake[256];
+    bake_label(path, scene, bake, sizeof bake);
     for (int m = 0; m < cols && !rc; m++) {
         const vv_mode *e = grid_mode(scene, m + 1);
         vr_error err;
@@ -133,8 +135,6 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
             snprintf(label + strlen(label), sizeof label - strlen(label), "%s",
                      o->compare == VDSH_COMPARE_BINARY ? ", binary" : "");
         } else {
-            char bake[256];
-            bake_label(path, scene, bake, sizeof bake);
             snprintf(label, sizeof label, "%s\n%s", vr_mode_label(e->mode), bake);
         }
         vr_result res = VR_OK;
@@ -161,7 +161,7 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
                    px + (size_t)y * (size_t)w * 4, (size_t)w * 4);
     }
     if (!rc && !o->quiet)
-        fprintf(stderr, "vdsh-view: %s: %s (%s), %d light%s\n", path, names,
+        fprintf(stderr, "vdsh-view: %s: %s (%s), %d light%s\n", bake, names,
                 vr_scene_mode_label(scene, grid_mode(scene, GRID_ORDER5_COL)->mode), n,
                 n == 1 ? "" : "s");
     vr_scene_destroy(scene);

@@ -252,7 +252,8 @@ typedef struct vr_scene_info {
                                      vr_scene_default_camera) */
     /* VR_MODE_VDSH_BUFFER's streams: has_buffer[n], a fixed stream of
      * order n; variable_order, the cap of the stream with an order per
-     * vertex (0: none) and variable_mean_order its vertices' mean order;
+     * vertex (0: none), variable_mean_order its vertices' mean order and
+     * variable_method how it was baked;
      * buffer_bytes, their share of gpu_bytes; buffer_encoding[n], the
      * file's encoding of the fixed stream of order n (cpca: decoded per
      * pass, or once per frame where buffer_per_frame[n]). */
@@ -261,6 +262,7 @@ typedef struct vr_scene_info {
     int buffer_per_frame[VDSH_ORDER_SLOTS];
     int variable_order;
     float variable_mean_order;
+    vdsh_method variable_method;
     size_t buffer_bytes;
     int has_sdf;         /* a distance volume: VR_MODE_SDF */
     uint32_t sdf_dim[3]; /* its samples per axis */

@@ -500,6 +500,7 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
     }
 
     b.variable = (st->flags & VDSH_STREAM_VARIABLE) != 0;
+    b.method = (vdsh_method)st->method;
 
     uint32_t nv = s->vertex_count;
     size_t bytes = 0;

@@ -78,8 +78,9 @@ typedef enum vr_buf_kind {
 
 /* A stream drawn from buffer textures (VR_MODE_VDSH_BUFFER). */
 typedef struct vr_buffer {
-    int order;    /* fixed: its order; variable: the cap; 0: none */
-    int variable; /* 1: an order per vertex */
+    int order;          /* fixed: its order; variable: the cap; 0: none */
+    int variable;       /* 1: an order per vertex */
+    vdsh_method method; /* how it was baked */
     vr_buf_kind kind;
     vdsh_encoding encoding;       /* the file's */
     float scale;                  /* multiplies the sums (f32, f16), else 1 */

@@ -410,6 +410,7 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     }
     i.variable_order = s->variable.order;
     i.variable_mean_order = s->variable.mean_order;
+    i.variable_method = s->variable.method;
     i.buffer_bytes += s->variable.bytes;
     *out = i;
 }

@@ -438,7 +438,9 @@ expect 2 "positive count" --frames "$d/x" "$room"
 
 # The buffer modes on the command line: a file with orders 7, 9, 12 and an
 # order per vertex (test_runtime_buffer derive); the grid gains its
-# adaptive-order column (6 panels) and says so; --help names the modes.
+# adaptive-order column (6 panels) and says so; --help names the modes;
+# a file of adaptive order alone draws its buffer and its grid row names
+# its method.
 add_test(NAME runtime_view_buffer COMMAND sh -c [=[
 set -e
 v=$1; png=$2; derive=$3; log=$4; d=$5
@@ -465,6 +467,11 @@ grep -q "| adaptive" "$d/grid.log"
 "$v" --render "$d/default.png" --size 96x72 "$d/adaptive.vdsh" 2> "$d/default.log"
 cat "$d/default.log"
 grep -q "mode buffer: VDSH adaptive order (up to 9" "$d/default.log"
+# its grid row names the adaptive stream's method (it had no fixed order
+# and was labelled a paper bake)
+"$v" --grid "$d/agrid.png" --size 96x72 "$d/adaptive.vdsh" 2> "$d/agrid.log"
+cat "$d/agrid.log"
+grep -q "adaptive.vdsh: decision bake" "$d/agrid.log"
 ]=] sh ${_view} ${_png} $<TARGET_FILE:test_runtime_buffer> ${_room_log} ${_rt_dir}/view_buffer
        $<TARGET_FILE:vdsh-bake>)
 
