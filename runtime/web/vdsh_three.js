@@ -206,6 +206,15 @@ export function vdshApply(root, shaders, options = {}) {
   return done;
 }
 
+// A texture of exact texels: no filtering, no mipmaps.
+function dataTexture(data, w, h, format, type) {
+  const tex = new THREE.DataTexture(data, w, h, format, type);
+  tex.minFilter = tex.magFilter = THREE.NearestFilter;
+  tex.generateMipmaps = false;
+  tex.needsUpdate = true;
+  return tex;
+}
+
 // The buffer path's texture (vdsh_core.js's records) and a_record,
 // a_order per vertex. Coefficients are read through BufferAttribute.getX..
 // (normalised or not, interleaved or not).
@@ -213,10 +222,7 @@ function bufferTexture(geometry, names, stream, maxTexture) {
   const attrs = names.map((n) => geometry.getAttribute(n));
   const comp = ['getX', 'getY', 'getZ', 'getW'];
   const b = vdshBufferData((v, i) => attrs[i >> 2][comp[i & 3]](v), attrs[0].count, stream, maxTexture);
-  const tex = new THREE.DataTexture(b.texels, b.width, b.height, THREE.RGBAFormat, THREE.FloatType);
-  tex.minFilter = tex.magFilter = THREE.NearestFilter;
-  tex.generateMipmaps = false;
-  tex.needsUpdate = true;
+  const tex = dataTexture(b.texels, b.width, b.height, THREE.RGBAFormat, THREE.FloatType);
   geometry.setAttribute('a_record', new THREE.BufferAttribute(b.records, 1));
   geometry.setAttribute('a_order', new THREE.BufferAttribute(b.orders, 1));
   return { tex, width: b.width };
@@ -254,18 +260,11 @@ export function vdshMaterial(mesh, shaders, options = {}) {
   };
   let width = 0;
   const cd = cpcaData(geometry, stream);
-  const texture = (data, w, h, format, type) => {
-    const tex = new THREE.DataTexture(data, w, h, format, type);
-    tex.minFilter = tex.magFilter = THREE.NearestFilter;
-    tex.generateMipmaps = false;
-    tex.needsUpdate = true;
-    return tex;
-  };
   if (cd) {  // kept compressed: decoded in the vertex stage
-    const words = texture(cd.words, cd.width, cd.height, THREE.RedIntegerFormat, THREE.UnsignedIntType);
+    const words = dataTexture(cd.words, cd.width, cd.height, THREE.RedIntegerFormat, THREE.UnsignedIntType);
     words.internalFormat = 'R32UI';
     uniforms.u_coef = { value: words };
-    uniforms.u_model = { value: texture(cd.model, cd.width, cd.modelHeight, THREE.RGBAFormat, THREE.FloatType) };
+    uniforms.u_model = { value: dataTexture(cd.model, cd.width, cd.modelHeight, THREE.RGBAFormat, THREE.FloatType) };
     width = cd.width;
   } else if (buffer) {
     const b = bufferTexture(geometry, names, stream, options.maxTextureSize || 4096);
