@@ -85,11 +85,12 @@ typedef struct job {
     float *var_scratch; /* per worker: var_scratch_floats */
     /* Adaptive order with the decision fit (var_decision): per receiver of
      * the range, 1 where it kept the lsq choice (too few training pairs:
-     * the offsets already in), and per order, the log offset added to
-     * the decision-fitted rows (calibrated: one for the stream). */
+     * the offsets already in), and the log offset added to the
+     * decision-fitted rows: one for the stream, calibrated, else the
+     * given one of the cap's order (the one the file records). */
     int var_decision;
     uint8_t *var_lsq;
-    float var_dec_offset[VDSH_ORDER_SLOTS];
+    float var_dec_offset;
     /* The decision fit (method.h: decision): the light pool in the traced
      * frame, lights per receiver, the fit's settings, per-worker scratch
      * (dec_scratch_bytes); the calibration's held-out margins (per sample,
@@ -1408,8 +1409,7 @@ static vb_result setup_offsets(bake_run *b, vb_error *err)
     J->var_decision = J->var_cap && J->decision;
     if (J->var_decision && !(J->var_lsq = calloc((size_t)(b->hi - b->lo), 1)))
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-        J->var_dec_offset[o] = J->log_offset[o];
+    J->var_dec_offset = J->log_offset[J->var_cap];
     for (int o = 1; o <= VDSH_MAX_ORDER; o++)
         J->var_offset[o] = mi->decision && !d->log_offsets
                                ? vb_method_get(VB_METHOD_SHADOW)->default_log_offset[o]
@@ -1512,11 +1512,8 @@ static vb_result calibrate_offsets(bake_run *b, vb_error *err)
             J->log_offset[o] = slot_offset(J, cal_count, o, d->false_rate, lit);
     /* The adaptive order's stream: one offset, from each sample's chosen
      * fit (slot 0), whatever its order. */
-    if (J->var_decision && r == VB_OK) {
-        float off = slot_offset(J, cal_count, 0, d->false_rate, lit);
-        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-            J->var_dec_offset[o] = off;
-    }
+    if (J->var_decision && r == VB_OK)
+        J->var_dec_offset = slot_offset(J, cal_count, 0, d->false_rate, lit);
     free(lit);
     return r;
 }
@@ -1541,7 +1538,7 @@ static vb_result bake_receivers(bake_run *b, vb_error *err)
     for (uint32_t v = lo; J->var_decision && v < hi; v++)
         if (!J->var_lsq[v - lo])
             b->var_coeffs[(size_t)(v - lo) * b->var_cap * b->var_cap] +=
-                J->var_dec_offset[b->var_orders[v - lo]] / 0.28209479177387814f;
+                J->var_dec_offset / 0.28209479177387814f;
     if (b->started == 0)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
     return VB_OK;
@@ -1598,7 +1595,7 @@ static void fill_output(bake_run *b, vb_bake_output *out)
     o.variable_method = J->var_decision ? VDSH_METHOD_DECISION
                         : mi->decision  ? VDSH_METHOD_SHADOW
                                         : mi->stored;
-    o.variable_param = J->var_decision ? J->var_dec_offset[b->var_cap]
+    o.variable_param = J->var_decision ? J->var_dec_offset
                        : b->var_orders && mi->param == VB_PARAM_LOG_OFFSET
                            ? J->var_offset[b->var_cap]
                            : o.lambda;
