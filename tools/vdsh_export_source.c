@@ -4,6 +4,7 @@
  * receivers (vdsh_export_source.h).
  */
 #include "vdsh_export_source.h"
+#include "vdsh_gltf_component.h"
 #include "vdsh_math.h"
 
 #include <math.h>
@@ -188,51 +189,6 @@ static double num(const cJSON *o, const char *k, double dflt)
     return cJSON_IsNumber(v) ? v->valuedouble : dflt;
 }
 
-static size_t csize(int t)
-{
-    switch (t) {
-    case 5120:
-    case 5121: return 1;
-    case 5122:
-    case 5123: return 2;
-    case 5125:
-    case 5126: return 4;
-    default: return 0;
-    }
-}
-
-static double comp(const uint8_t *p, int t, int normalized)
-{
-    switch (t) {
-    case 5120: {
-        int8_t v;
-        memcpy(&v, p, 1);
-        return normalized ? fmax(v / 127.0, -1.0) : v;
-    }
-    case 5121: return normalized ? p[0] / 255.0 : p[0];
-    case 5122: {
-        int16_t v;
-        memcpy(&v, p, 2);
-        return normalized ? fmax(v / 32767.0, -1.0) : v;
-    }
-    case 5123: {
-        uint16_t v;
-        memcpy(&v, p, 2);
-        return normalized ? v / 65535.0 : v;
-    }
-    case 5125: {
-        uint32_t v;
-        memcpy(&v, p, 4);
-        return v;
-    }
-    default: {
-        float v;
-        memcpy(&v, p, 4);
-        return v;
-    }
-    }
-}
-
 /* A VEC3 accessor as 3 * count doubles (as mesh_gltf.cpp reads it; sparse
  * accessors are refused here). */
 static double *read_vec3(const char *path, const vdsh_src *s, int ai, size_t *count, char *msg,
@@ -245,7 +201,7 @@ static double *read_vec3(const char *path, const vdsh_src *s, int ai, size_t *co
     }
     const cJSON *ty = cJSON_GetObjectItemCaseSensitive(a, "type");
     int ct = (int)num(a, "componentType", 0), bv = (int)num(a, "bufferView", -1);
-    size_t n = (size_t)num(a, "count", 0), cs = csize(ct);
+    size_t n = (size_t)num(a, "count", 0), cs = vdsh_gltf_component_size(ct);
     if (!cJSON_IsString(ty) || strcmp(ty->valuestring, "VEC3") != 0 || !cs) {
         fail(msg, cap, "%s: accessor %d is not a VEC3 of a known component type", path, ai);
         return NULL;
@@ -278,7 +234,7 @@ static double *read_vec3(const char *path, const vdsh_src *s, int ai, size_t *co
         const uint8_t *p = s->buffers[b].data + off;
         for (size_t i = 0; i < n; i++)
             for (size_t c = 0; c < 3; c++)
-                out[3 * i + c] = comp(p + i * stride + c * cs, ct, normalized);
+                out[3 * i + c] = vdsh_gltf_component(p + i * stride + c * cs, ct, normalized);
     }
     *count = n;
     return out;

@@ -31,6 +31,7 @@
 #include <tiny_gltf.h>
 
 #include "mesh_read.h"
+#include "vdsh_gltf_component.h"
 #include "vdsh_math.h"
 
 namespace
@@ -45,52 +46,6 @@ struct reader {
     const tinygltf::Model &m;
     vb_error *err;
 };
-
-/* Element size of a component type, 0 for an unknown one. */
-size_t component_size(int t)
-{
-    switch (t) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0;
-    }
-}
-
-double read_component(const uint8_t *p, int t, bool normalized)
-{
-    switch (t) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: {
-        int8_t v;
-        memcpy(&v, p, 1);
-        return normalized ? std::fmax(v / 127.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
-    case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        int16_t v;
-        memcpy(&v, p, 2);
-        return normalized ? std::fmax(v / 32767.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        uint16_t v;
-        memcpy(&v, p, 2);
-        return normalized ? v / 65535.0 : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-        uint32_t v;
-        memcpy(&v, p, 4);
-        return v;
-    }
-    default: {
-        float v;
-        memcpy(&v, p, 4);
-        return v;
-    }
-    }
-}
 
 /* Bytes [offset, offset + count * stride) of a buffer view, checked:
  * returns a pointer to the first element or NULL after vb_fail. */
@@ -152,7 +107,7 @@ vb_result read_accessor(const reader &rd, int index, int want_type, bool integer
         return vb_fail(rd.err, VB_ERR_FORMAT,
                        "%s: %s: accessor %d has the wrong type (%d, expected %d)", rd.name, what,
                        index, a.type, want_type);
-    size_t cs = component_size(a.componentType);
+    size_t cs = vdsh_gltf_component_size(a.componentType);
     if (cs == 0)
         return vb_fail(rd.err, VB_ERR_FORMAT,
                        "%s: %s: accessor %d has an unknown component type %d", rd.name, what, index,
@@ -187,8 +142,8 @@ vb_result read_accessor(const reader &rd, int index, int want_type, bool integer
             stride = elem;
         for (size_t i = 0; i < a.count; i++)
             for (int c = 0; c < nc; c++)
-                out[i * (size_t)nc + (size_t)c] =
-                    read_component(p + i * stride + (size_t)c * cs, a.componentType, a.normalized);
+                out[i * (size_t)nc + (size_t)c] = vdsh_gltf_component(
+                    p + i * stride + (size_t)c * cs, a.componentType, a.normalized);
     }
     if (a.sparse.isSparse) {
         if (a.sparse.count < 0 || (size_t)a.sparse.count > a.count)
@@ -196,7 +151,7 @@ vb_result read_accessor(const reader &rd, int index, int want_type, bool integer
                            "%s: %s: accessor %d: sparse count %d out of range", rd.name, what,
                            index, a.sparse.count);
         size_t sc = (size_t)a.sparse.count;
-        size_t ics = component_size(a.sparse.indices.componentType);
+        size_t ics = vdsh_gltf_component_size(a.sparse.indices.componentType);
         if (ics < 1 || a.sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT ||
             a.sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
             a.sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_SHORT ||
@@ -212,15 +167,15 @@ vb_result read_accessor(const reader &rd, int index, int want_type, bool integer
         if (!pv && sc)
             return r;
         for (size_t k = 0; k < sc; k++) {
-            double di = read_component(pi + k * ics, a.sparse.indices.componentType, false);
+            double di = vdsh_gltf_component(pi + k * ics, a.sparse.indices.componentType, false);
             if (di >= (double)a.count)
                 return vb_fail(rd.err, VB_ERR_FORMAT,
                                "%s: %s: accessor %d: sparse index %.0f out of range (%zu)", rd.name,
                                what, index, di, a.count);
             size_t i = (size_t)di;
             for (int c = 0; c < nc; c++)
-                out[i * (size_t)nc + (size_t)c] =
-                    read_component(pv + k * elem + (size_t)c * cs, a.componentType, a.normalized);
+                out[i * (size_t)nc + (size_t)c] = vdsh_gltf_component(
+                    pv + k * elem + (size_t)c * cs, a.componentType, a.normalized);
         }
     }
     *count_out = a.count;
