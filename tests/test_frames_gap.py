@@ -1,23 +1,29 @@
 #!/usr/bin/python3
 """scripts/frames_gap at its smallest: validation room 3 at --max-edge 1,
-64 x 48 frames, order 2. The paper's rows are 1.00 against themselves;
-every row's split of the squared error adds up to 100% (the script itself
-checks the split against vdsh-frames score's RMSE); an unknown scene is
-an error naming it.
+64 x 48 frames, order 2, with a `shadow` variant. The paper's rows are
+1.00 against themselves, shadow's recall 1.00 against itself; every row's
+split of the squared error adds up to 100% (the script itself checks the
+split against vdsh-frames score's RMSE); an unknown scene is an error
+naming it; a validation mesh runs by its view set's name (val-spider at
+64 x 48, where assimp's spider is installed).
 
 Usage: test_frames_gap.py SCRIPTS_DIR BUILD_DIR"""
+import os
 import subprocess
 import sys
 
 script, build = sys.argv[1] + "/frames_gap", sys.argv[2]
+sys.path.insert(0, sys.argv[1])
+import vdsh_scenes  # noqa: E402
 r = subprocess.run([sys.executable, script, "--build", build, "--scenes", "val-room-3",
-                    "--max-edge", "1", "--size", "64x48", "--orders", "2"],
+                    "--max-edge", "1", "--size", "64x48", "--orders", "2",
+                    "--variant", "shadow=--method shadow"],
                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 if r.returncode:
     sys.exit("frames_gap failed (%d): %s" % (r.returncode, r.stderr))
 rows = [l.split("|")[1:-1] for l in r.stdout.splitlines() if l.startswith("| val-room-3")]
-if len(rows) != 4:
-    sys.exit("expected 4 rows (paper, default x 1, 3 lights), got:\n" + r.stdout)
+if len(rows) != 6:
+    sys.exit("expected 6 rows (paper, default, shadow x 1, 3 lights), got:\n" + r.stdout)
 for row in rows:
     c = [x.strip() for x in row]
     parts = [float(x.rstrip("%")) for x in c[9].split(",")]
@@ -25,10 +31,29 @@ for row in rows:
         sys.exit("split does not add up to 100%%: %s" % c)
     if c[1] == "paper" and (c[5] != "1.00" or c[8] != "1.00"):
         sys.exit("paper against itself is not 1.00: %s" % c)
+    if c[1] == "shadow" and c[10] != ("-" if c[6] == "0.0%" else "1.00"):
+        sys.exit("shadow's recall against itself is not 1.00: %s" % c)
+    if c[1] == "default" and c[10] != "-" and float(c[10]) <= 0:
+        sys.exit("recall over shadow's out of range: %s" % c)
     if not 0 < float(c[4]) < 1:
         sys.exit("RMSE out of range: %s" % c)
 r = subprocess.run([sys.executable, script, "--build", build, "--scenes", "no-such-scene"],
                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 if r.returncode == 0 or "no-such-scene" not in r.stderr:
     sys.exit("an unknown scene was not an error naming it: %d %s" % (r.returncode, r.stderr))
+# A validation mesh by its view set's name (val-spider: assimp's spider at
+# its own vertices, the smallest), where the mesh is installed.
+if os.path.exists(vdsh_scenes.by_name(vdsh_scenes.MESHES)["spider"][0]):
+    r = subprocess.run([sys.executable, script, "--build", build, "--scenes", "val-spider",
+                        "--size", "64x48", "--orders", "2"],
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    rows = [l.split("|")[1:-1] for l in r.stdout.splitlines() if l.startswith("| val-spider")]
+    if r.returncode or len(rows) != 4:
+        sys.exit("val-spider: expected 4 rows (%d): %s %s" % (r.returncode, r.stdout, r.stderr))
+    for row in rows:
+        c = [x.strip() for x in row]
+        if c[1] == "paper" and c[5] != "1.00":
+            sys.exit("val-spider: paper against itself is not 1.00: %s" % c)
+        if c[10] != "-":
+            sys.exit("val-spider: a recall over shadow's without a shadow variant: %s" % c)
 print("ok")
