@@ -302,6 +302,13 @@ static void json_scene(vt_json *j, cJSON *o, const vb_eval_scene_metrics *m)
                            {"binary_false_shadow", m->binary_false_shadow},
                            {"binary_recall", m->binary_recall}};
     json_f64s(j, o, f, sizeof f / sizeof f[0]);
+    cJSON *parts = vt_json_object(j, o, "mae_parts");
+    const named_f64 p[] = {{"false", m->mae_part[VB_EVAL_PART_FALSE]},
+                           {"lit_partial", m->mae_part[VB_EVAL_PART_LIT_PARTIAL]},
+                           {"missed", m->mae_part[VB_EVAL_PART_MISSED]},
+                           {"drawn", m->mae_part[VB_EVAL_PART_DRAWN]},
+                           {"penumbra", m->mae_part[VB_EVAL_PART_PENUMBRA]}};
+    json_f64s(j, parts, p, sizeof p / sizeof p[0]);
 }
 
 static void json_truth(vt_json *j, cJSON *o, const vb_eval_truth *t, int kind)
