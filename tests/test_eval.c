@@ -483,6 +483,22 @@ static void test_methods(void)
                           k ? "interior" : "vertices", orders[o], vb_method_name(methods[j]),
                           m[j]->shadow_mae, vb_method_name(methods[i]), m[i]->shadow_mae, tol);
                 }
+            /* The MAE's parts by pair class add up to it, and a fit that
+             * draws false shadows has a false part. */
+            for (int i = 0; i < 3; i++) {
+                double sum = 0.0;
+                for (int c = 0; c < VB_EVAL_MAE_PARTS; c++) {
+                    CHECK(m[i]->mae_part[c] >= 0.0, "%s order %d: part %d is %g",
+                          vb_method_name(methods[i]), orders[o], c, m[i]->mae_part[c]);
+                    sum += m[i]->mae_part[c];
+                }
+                CHECK(fabs(sum - m[i]->shadow_mae) < 1e-9 * (1.0 + m[i]->shadow_mae),
+                      "%s order %d: parts add up to %.9g, MAE %.9g", vb_method_name(methods[i]),
+                      orders[o], sum, m[i]->shadow_mae);
+                CHECK((m[i]->false_shadow > 0.0) == (m[i]->mae_part[VB_EVAL_PART_FALSE] > 0.0),
+                      "%s order %d: false rate %g, false part %g", vb_method_name(methods[i]),
+                      orders[o], m[i]->false_shadow, m[i]->mae_part[VB_EVAL_PART_FALSE]);
+            }
             CHECK(m[2]->false_shadow < m[1]->false_shadow &&
                       m[2]->false_shadow < m[0]->false_shadow,
                   "%s order %d: shadow's false shadows %g not below lsq's %g and paper's %g",
@@ -559,6 +575,8 @@ static void test_oracle_and_threads(void)
                   "oracle scene lights %d/%d: %llu pairs, errors %g %g %g", k, i,
                   (unsigned long long)m->pairs, m->shadow_mae, m->false_shadow, m->light_leak);
             CHECK(m->occluded == 0 || m->recall == 1.0, "oracle recall %g", m->recall);
+            for (int c = 0; c < VB_EVAL_MAE_PARTS; c++)
+                CHECK(m->mae_part[c] == 0.0, "oracle MAE part %d: %g", c, m->mae_part[c]);
         }
 
     d.oracle = 0;

@@ -143,6 +143,7 @@ typedef struct sacc {
     uint32_t vis, fals, fals_bin; /* d_T >= d_L; s_hat < .5; D < d_L */
     uint32_t occ, hit, leak;      /* s_ideal < .5; s_hat < .5; s_hat > .5 */
     uint32_t occ_bin, hit_bin;    /* d_T < d_L; D < d_L */
+    double part[VB_EVAL_MAE_PARTS]; /* mae split by pair class (eval.h) */
 } sacc;
 
 typedef struct rtruth {
@@ -176,6 +177,16 @@ static void receiver_coeffs(const vdsh_file *f, const vdsh_stream *s, const rece
         vdsh_stream_decode(s, r->index, c);
     else
         vb_eval_interpolate(f, s, r->triangle, r->bary, NULL, NULL, c);
+}
+
+/* A scene-light pair's class (vb_eval_scene_metrics.mae_part). */
+static inline int mae_part(int vis, int occ, float s_hat)
+{
+    if (vis)
+        return s_hat < 0.5f ? VB_EVAL_PART_FALSE : VB_EVAL_PART_LIT_PARTIAL;
+    if (occ)
+        return s_hat < 0.5f ? VB_EVAL_PART_DRAWN : VB_EVAL_PART_MISSED;
+    return VB_EVAL_PART_PENUMBRA;
 }
 
 /* The scene lights at one receiver: every light above its horizon, the
@@ -260,8 +271,10 @@ static void eval_scene_lights(job *J, uint32_t ri, const float coef[][VDSH_MAX_C
                 }
                 const int b_dark = D < L0;
                 sacc *a = acc + s;
+                const float err_ = fabsf(s_hat - s_ideal);
                 a->n++;
-                a->mae += fabsf(s_hat - s_ideal);
+                a->mae += err_;
+                a->part[mae_part(vis, occ, s_hat)] += err_;
                 a->mae_bin += fabsf((float)!b_dark - (float)vis);
                 a->vis += vis;
                 a->fals += vis && s_hat < 0.5f;
@@ -736,9 +749,14 @@ static void reduce_scene(const job *J, uint32_t first, uint32_t count, vb_eval_s
                 f(&mb, a->mae_bin, a->n);
                 f(&fb, a->fals_bin, a->vis);
                 f(&rb, a->hit_bin, a->occ_bin);
-                if (!pass)
+                if (!pass) {
                     o->visible += a->vis, o->occluded += a->occ;
+                    for (int c = 0; c < VB_EVAL_MAE_PARTS; c++)
+                        o->mae_part[c] += a->part[c];
+                }
             }
+        for (int c = 0; c < VB_EVAL_MAE_PARTS; c++)
+            o->mae_part[c] = mae.b > 0 ? o->mae_part[c] / mae.b : NAN;
         o->pairs = (uint64_t)mae.b;
         o->shadow_mae = ratio_value(&mae), o->shadow_mae_se = ratio_se(&mae, n_used);
         o->false_shadow = ratio_value(&fa), o->false_shadow_se = ratio_se(&fa, n_used);

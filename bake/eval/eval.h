@@ -174,6 +174,15 @@ typedef struct vb_eval_metrics {
     vb_eval_receiver worst[VB_EVAL_MAX_WORST]; /* by shadow MAE, worst first */
 } vb_eval_metrics;
 
+enum {
+    VB_EVAL_PART_FALSE,
+    VB_EVAL_PART_LIT_PARTIAL,
+    VB_EVAL_PART_MISSED,
+    VB_EVAL_PART_DRAWN,
+    VB_EVAL_PART_PENUMBRA,
+    VB_EVAL_MAE_PARTS
+};
+
 /* Scene lights, the primary shadow metric (docs/DESIGN.md §3): point
  * lights placed uniformly in the scene's free space (vdsh_light.h), as a
  * user places them, each scored at every receiver it lights (above the
@@ -192,6 +201,12 @@ typedef struct vb_eval_scene_metrics {
     double binary_recall;       /* P(D < d_L | d_T < d_L) */
     uint64_t visible;           /* pairs with d_T >= d_L */
     uint64_t occluded;          /* pairs with s_ideal < 0.5 */
+    /* shadow_mae split by pair class, each a sum of |s_hat - s_ideal| over
+     * its pairs divided by all pairs (the parts add up to shadow_mae):
+     * false (lit, s_hat < .5), lit_partial (lit, s_hat >= .5), missed
+     * (s_ideal < .5, s_hat >= .5), drawn (s_ideal < .5, s_hat < .5),
+     * penumbra (.5 <= s_ideal < 1). NaN: no pairs. */
+    double mae_part[VB_EVAL_MAE_PARTS];
 } vb_eval_scene_metrics;
 
 /* The truth's own record for one kind of receiver. */

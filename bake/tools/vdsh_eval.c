@@ -120,7 +120,9 @@ static void usage(FILE *f)
             "Errors (per stream, for vertices and interior points separately):\n"
             "  scene     smooth shadow MAE, false-shadow rate P(s_hat < .5 | d_T >= d_L),\n"
             "            recall P(s_hat < .5 | s_ideal < .5) (the shadows a viewer sees\n"
-            "            drawn); binary: P(D < d_L | d_T >= d_L), P(D < d_L | d_T < d_L)\n"
+            "            drawn); binary: P(D < d_L | d_T >= d_L), P(D < d_L | d_T < d_L);\n"
+            "            the JSON's mae_parts split the MAE by pair class (false, lit\n"
+            "            partial, missed, drawn, penumbra: they add up to it)\n"
             "  distance  |D - d_T| / max(d_T, 0.01 diag): RMS, p50, p90, p99\n"
             "  shadow    smooth ramp(d / d_L): MAE |s_hat - s_ideal|, false-shadow rate\n"
             "            P(s_hat < .5 | d_T >= d_L), light-leak rate P(s_hat > .5 |\n"
@@ -302,6 +304,13 @@ static void json_scene(vt_json *j, cJSON *o, const vb_eval_scene_metrics *m)
                            {"binary_false_shadow", m->binary_false_shadow},
                            {"binary_recall", m->binary_recall}};
     json_f64s(j, o, f, sizeof f / sizeof f[0]);
+    cJSON *parts = vt_json_object(j, o, "mae_parts");
+    const named_f64 p[] = {{"false", m->mae_part[VB_EVAL_PART_FALSE]},
+                           {"lit_partial", m->mae_part[VB_EVAL_PART_LIT_PARTIAL]},
+                           {"missed", m->mae_part[VB_EVAL_PART_MISSED]},
+                           {"drawn", m->mae_part[VB_EVAL_PART_DRAWN]},
+                           {"penumbra", m->mae_part[VB_EVAL_PART_PENUMBRA]}};
+    json_f64s(j, parts, p, sizeof p / sizeof p[0]);
 }
 
 static void json_truth(vt_json *j, cJSON *o, const vb_eval_truth *t, int kind)
