@@ -137,6 +137,19 @@ if(Python3_Interpreter_FOUND AND TARGET vb_frames)
                    ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR})
 endif()
 
+# scripts/false_probe at its smallest (test_false_probe.py): on
+# frames_gap --keep's run of validation room 3 (--max-edge 1, 64 x 48,
+# order 2), a default frame with false shadow is probed; its numpy path
+# redraws every false pixel of the C frame in false shadow, the split by
+# false vertices adds up, a missing run is an error naming the file.
+# About 20 seconds. No GL.
+if(Python3_Interpreter_FOUND AND TARGET vb_frames)
+  add_test(NAME false_probe_script
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_false_probe.py
+                   ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR}
+                   ${CMAKE_CURRENT_BINARY_DIR}/false_probe_script)
+endif()
+
 # scripts/mottling at its smallest (test_mottling.py): validation room 3
 # at --max-edge 1, 64 x 48 C frames, order 3; a twin bake's row is the
 # same with noise 0, the figures in range, a test scene refused. No GL.
