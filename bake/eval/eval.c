@@ -140,9 +140,9 @@ typedef struct racc {
 typedef struct sacc {
     double mae, mae_bin;
     uint32_t n;
-    uint32_t vis, fals, fals_bin; /* d_T >= d_L; s_hat < .5; D < d_L */
-    uint32_t occ, hit, leak;      /* s_ideal < .5; s_hat < .5; s_hat > .5 */
-    uint32_t occ_bin, hit_bin;    /* d_T < d_L; D < d_L */
+    uint32_t vis, fals, fals_bin;   /* d_T >= d_L; s_hat < .5; D < d_L */
+    uint32_t occ, hit, leak;        /* s_ideal < .5; s_hat < .5; s_hat > .5 */
+    uint32_t occ_bin, hit_bin;      /* d_T < d_L; D < d_L */
     double part[VB_EVAL_MAE_PARTS]; /* mae split by pair class (eval.h) */
 } sacc;
 
