@@ -6,6 +6,7 @@
  * (-std=c11: no fused multiply-add contraction): the same bytes on any
  * x86-64 CPU and whatever the caller's thread count. */
 #include "vdsh_cpca.h"
+#include "vdsh_cpca_study.h"
 #include "vdsh_failf.h"
 #include "vdsh_internal.h"
 
@@ -1060,4 +1061,335 @@ vdsh_result vdsh_cpca_encode_stream(const vdsh_stream *src, uint32_t rows, const
     if (rms_error)
         *rms_error = fit.rms_error;
     return VDSH_OK;
+}
+
+/* ---- a width per basis vector (measurement only: vdsh_cpca_study.h) ---- */
+
+enum { NWIDTHS = 8 };
+static const uint32_t WIDTH_SET[NWIDTHS] = {0, 2, 3, 4, 5, 6, 7, 8};
+
+uint32_t vdsh_cpca_widths_words(const uint8_t *widths, uint32_t b)
+{
+    uint32_t word = 0, used = VDSH_CPCA_INDEX_BITS;
+    for (uint32_t j = 0; j < b; j++) {
+        if (!widths[j])
+            continue;
+        if (used + widths[j] > 32) {
+            word++;
+            used = 0;
+        }
+        used += widths[j];
+    }
+    return word + 1;
+}
+
+/* Greedy marginal allocation of `bits` bits over m vectors: dist[j *
+ * NWIDTHS + i] is vector j's squared error at width WIDTH_SET[i]; level[j]
+ * the chosen index into WIDTH_SET. */
+static void allocate_widths(const double *dist, uint32_t m, uint32_t bits, uint32_t *level)
+{
+    for (uint32_t j = 0; j < m; j++)
+        level[j] = 0;
+    uint32_t left = bits;
+    for (;;) {
+        uint32_t best = m;
+        double gain = 0.0;
+        for (uint32_t j = 0; j < m; j++) {
+            uint32_t i = level[j];
+            if (i + 1 >= NWIDTHS)
+                continue;
+            uint32_t cost = WIDTH_SET[i + 1] - WIDTH_SET[i];
+            if (cost > left)
+                continue;
+            double g = (dist[(size_t)j * NWIDTHS + i] - dist[(size_t)j * NWIDTHS + i + 1]) / cost;
+            if (g > gain) {
+                best = j;
+                gain = g;
+            }
+        }
+        if (best == m)
+            break;
+        left -= WIDTH_SET[level[best] + 1] - WIDTH_SET[level[best]];
+        level[best]++;
+    }
+}
+
+/* Bytes of the model of k clusters and m vectors with a width table. */
+static uint64_t widths_model_bytes(uint32_t order, uint32_t k, uint32_t m)
+{
+    return vdsh_cpca_model_bytes(order, k, m) + ((m + 15u) & ~15u);
+}
+
+vdsh_result vdsh_cpca_encode_widths(const float *src, const float *normals, uint32_t rows,
+                                    uint32_t order, const vdsh_cpca_settings *settings,
+                                    uint32_t fit_basis, double budget, const uint8_t *widths,
+                                    float *decoded, vdsh_cpca_widths_fit *out, vdsh_error *err)
+{
+    memset(out, 0, sizeof *out);
+    const uint32_t n = order * order;
+    if (!src || !normals || !settings || !decoded || rows < 1 || rows > VDSH_MAX_VERTICES ||
+        order < 1 || order > VDSH_MAX_ORDER || settings->budget || !(budget >= 0.0) ||
+        (budget == 0.0 && !widths))
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca widths: bad arguments (rows %u, order %u)",
+                          rows, order);
+    if (!check_settings(settings, err))
+        return VDSH_ERR_ARGUMENT;
+    const uint32_t k = settings->clusters < rows ? settings->clusters : rows;
+    const uint32_t b = settings->basis < n ? settings->basis : n;
+    if (fit_basis < b || fit_basis > n)
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca widths: fit basis %u out of range %u..%u",
+                          fit_basis, b, n);
+    if (widths && budget == 0.0)
+        for (uint32_t j = 0; j < fit_basis; j++)
+            if (widths[j] == 1 || widths[j] > 8)
+                return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                                  "cpca widths: vector %u's width %u (0 or 2..8)", j, widths[j]);
+    for (size_t x = 0; x < (size_t)rows * n; x++)
+        if (!isfinite(src[x]))
+            return vdsh_failf(err, VDSH_ERR_INVALID,
+                              "cpca: vertex %zu coefficient %zu is not finite", x / n, x % n);
+    const uint32_t bf = fit_basis;
+    uint16_t *means = malloc(sizeof(uint16_t) * k * n);
+    uint16_t *bases = malloc(sizeof(uint16_t) * k * bf * n);
+    uint32_t *labels = malloc(sizeof(uint32_t) * rows);
+    double *dist = malloc(sizeof(double) * rows);
+    double *cent = malloc(sizeof(double) * k * (n + 3));
+    double *g = malloc(sizeof(double) * n * n), *l = malloc(sizeof(double) * n * n);
+    double *sc = malloc(sizeof(double) * n * n), *sy = malloc(sizeof(double) * n * n);
+    double *ev = malloc(sizeof(double) * n * n), *proj = malloc(sizeof(double) * k * n * bf);
+    double *tmp = malloc(sizeof(double) * n * n), *mu = malloc(sizeof(double) * n);
+    double *mus = malloc(sizeof(double) * k * n);
+    uint32_t *members = malloc(sizeof(uint32_t) * k);
+    uint32_t *idx = malloc(sizeof(uint32_t) * n);
+    double *frac = malloc(sizeof(double) * 6 * CUBE_N * CUBE_N);
+    double *wts = malloc(sizeof(double) * rows * bf);          /* each row's weights */
+    double *cdist = malloc(sizeof(double) * k * bf * NWIDTHS); /* per cluster */
+    float *cscale = malloc(sizeof(float) * k * bf * NWIDTHS);  /* the best scale */
+    double *tot = malloc(sizeof(double) * bf * NWIDTHS);       /* over clusters */
+    uint32_t *level = malloc(sizeof(uint32_t) * bf), *best_level = malloc(sizeof(uint32_t) * bf);
+    metric_dirs md = {0};
+    refine_ctx rd = {0};
+    const uint32_t rounds = k > 1 ? REFINE_ROUNDS : 0;
+    vdsh_result res = VDSH_OK;
+    if (!means || !bases || !labels || !dist || !cent || !g || !l || !sc || !sy || !ev || !proj ||
+        !tmp || !mu || !mus || !members || !idx || !frac || !wts || !cdist || !cscale || !tot ||
+        !level || !best_level || !metric_init(&md, order, CUBE_N) ||
+        (rounds && !refine_init(&rd, order, k, b, rows))) {
+        res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca widths: out of memory");
+        goto done;
+    }
+    fit_ctx fc = {.src = src,
+                  .normals = normals,
+                  .rows = rows,
+                  .n = n,
+                  .k = k,
+                  .b = b,
+                  .md = &md,
+                  .labels = labels,
+                  .means = means,
+                  .bases = bases,
+                  .members = members,
+                  .mus = mus,
+                  .l = l,
+                  .proj = proj,
+                  .g = g,
+                  .sc = sc,
+                  .sy = sy,
+                  .ev = ev,
+                  .tmp = tmp,
+                  .frac = frac,
+                  .idx = idx};
+    /* k-means, fit and refinement exactly as encode_fixed */
+    for (uint32_t i = 0; i < n; i++)
+        mu[i] = 0.0;
+    for (uint32_t v = 0; v < rows; v++)
+        for (uint32_t i = 0; i < n; i++)
+            mu[i] += src[(size_t)v * n + i];
+    for (uint32_t i = 0; i < n; i++)
+        mu[i] /= rows;
+    double spread = 0.0;
+    for (uint32_t v = 0; v < rows; v++)
+        for (uint32_t i = 0; i < n; i++) {
+            double e = src[(size_t)v * n + i] - mu[i];
+            spread += e * e;
+        }
+    spread = sqrt(spread / rows);
+    kmeans(src, normals, rows, n, NORMAL_WEIGHT * spread, k, labels, dist, cent);
+    res = fit_all(&fc, err);
+    for (uint32_t round = 0; res == VDSH_OK && round < rounds; round++) {
+        if (!reassign(&fc, &rd))
+            break;
+        res = fit_all(&fc, err);
+    }
+    /* the final labels' fit with bf vectors (its first b the same) */
+    fc.b = bf;
+    if (res == VDSH_OK)
+        res = fit_all(&fc, err);
+    if (res != VDSH_OK)
+        goto done;
+
+    /* weights; per cluster, vector and width the least squared error over
+     * the candidate scales */
+    for (uint32_t v = 0; v < rows; v++) {
+        uint32_t c = labels[v];
+        for (uint32_t j = 0; j < bf; j++)
+            wts[(size_t)v * bf + j] = weight_of(src + (size_t)v * n, mus + (size_t)c * n,
+                                                proj + ((size_t)c * bf + j) * n, n);
+    }
+    memset(cdist, 0, sizeof(double) * k * bf * NWIDTHS);
+    memset(cscale, 0, sizeof(float) * k * bf * NWIDTHS);
+    for (uint32_t c = 0; c < k; c++) {
+        if (!members[c])
+            continue;
+        for (uint32_t j = 0; j < bf; j++) {
+            double wmax = 0.0, e0 = 0.0;
+            for (uint32_t v = 0; v < rows; v++)
+                if (labels[v] == c) {
+                    double w = wts[(size_t)v * bf + j];
+                    wmax = fabs(w) > wmax ? fabs(w) : wmax;
+                    e0 += w * w;
+                }
+            double *cd = cdist + ((size_t)c * bf + j) * NWIDTHS;
+            float *cs = cscale + ((size_t)c * bf + j) * NWIDTHS;
+            cd[0] = e0;
+            for (uint32_t i = 1; i < NWIDTHS; i++) {
+                const int levels = (1 << (WIDTH_SET[i] - 1)) - 1;
+                cd[i] = e0;
+                for (uint32_t t = 0; t < SCALE_CANDIDATES; t++) {
+                    double s = candidate_scale(wmax, t), e = 0.0;
+                    if (!(s > 0.0))
+                        break;
+                    double step = (double)((float)s / (float)levels);
+                    for (uint32_t v = 0; v < rows; v++)
+                        if (labels[v] == c) {
+                            double w = wts[(size_t)v * bf + j];
+                            double d = w - quantise(w, s, levels) * step;
+                            e += d * d;
+                        }
+                    if (t == 0 || e < cd[i]) {
+                        cd[i] = e;
+                        cs[i] = (float)s;
+                    }
+                }
+            }
+        }
+    }
+    for (uint32_t x = 0; x < bf * NWIDTHS; x++) {
+        double s = 0.0;
+        for (uint32_t c = 0; c < k; c++)
+            s += cdist[(size_t)c * bf * NWIDTHS + x];
+        tot[x] = s;
+    }
+
+    /* the width table */
+    if (budget > 0.0) {
+        const double limit = budget * rows;
+        double best_e = 0.0;
+        int have = 0;
+        for (uint32_t words = 1; words <= 64; words++) {
+            uint32_t m = 0;
+            while (m < bf &&
+                   (double)rows * 4.0 * words + (double)widths_model_bytes(order, k, m + 1) <=
+                       limit)
+                m++;
+            if (!m)
+                break;
+            uint32_t bits = 32 * words - VDSH_CPCA_INDEX_BITS;
+            uint8_t wd[VDSH_MAX_COEFFS];
+            for (;;) {
+                allocate_widths(tot, m, bits, level);
+                for (uint32_t j = 0; j < m; j++)
+                    wd[j] = (uint8_t)WIDTH_SET[level[j]];
+                if (vdsh_cpca_widths_words(wd, m) <= words || !bits)
+                    break;
+                bits--;
+            }
+            double e = 0.0;
+            for (uint32_t j = 0; j < bf; j++)
+                e += tot[(size_t)j * NWIDTHS + (j < m ? level[j] : 0)];
+            if (!have || e < best_e) {
+                best_e = e;
+                have = 1;
+                for (uint32_t j = 0; j < bf; j++)
+                    best_level[j] = j < m ? level[j] : 0;
+            }
+        }
+        if (!have) {
+            res = vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                             "cpca widths: %g bytes per vertex: nothing fits", budget);
+            goto done;
+        }
+        for (uint32_t j = 0; j < bf; j++)
+            out->widths[j] = (uint8_t)WIDTH_SET[best_level[j]];
+    } else {
+        for (uint32_t j = 0; j < bf; j++) {
+            out->widths[j] = widths[j];
+            uint32_t i = 0;
+            while (WIDTH_SET[i] != widths[j])
+                i++;
+            best_level[j] = i;
+        }
+    }
+    out->clusters = k;
+    out->basis = 0;
+    for (uint32_t j = 0; j < bf; j++)
+        if (out->widths[j])
+            out->basis = j + 1;
+    out->words = vdsh_cpca_widths_words(out->widths, bf);
+    out->bytes_per_vertex =
+        ((double)rows * 4.0 * out->words + (double)widths_model_bytes(order, k, out->basis)) / rows;
+
+    /* decode as the format's rule: f32, mean + sum_j weight_j x basis_j */
+    double e2 = 0.0;
+    for (uint32_t v = 0; v < rows; v++) {
+        uint32_t c = labels[v];
+        float *o = decoded + (size_t)v * n;
+        for (uint32_t i = 0; i < n; i++)
+            o[i] = vdsh_f32_from_f16(means[(size_t)c * n + i]);
+        for (uint32_t j = 0; j < bf; j++) {
+            uint32_t i = best_level[j];
+            if (!i)
+                continue;
+            const int levels = (1 << (WIDTH_SET[i] - 1)) - 1;
+            float s = cscale[((size_t)c * bf + j) * NWIDTHS + i];
+            float step = s / (float)levels;
+            float w = (float)quantise(wts[(size_t)v * bf + j], s, levels) * step;
+            const uint16_t *bj = bases + ((size_t)c * bf + j) * n;
+            for (uint32_t a = 0; a < n; a++)
+                o[a] = o[a] + w * vdsh_f32_from_f16(bj[a]);
+        }
+        for (uint32_t i = 0; i < n; i++) {
+            double e = (double)o[i] - src[(size_t)v * n + i];
+            e2 += e * e;
+        }
+    }
+    out->rms_error = sqrt(e2 / rows);
+done:
+    free(means);
+    free(bases);
+    free(labels);
+    free(dist);
+    free(cent);
+    free(g);
+    free(l);
+    free(sc);
+    free(sy);
+    free(ev);
+    free(proj);
+    free(tmp);
+    free(mu);
+    free(mus);
+    free(members);
+    free(idx);
+    free(frac);
+    free(wts);
+    free(cdist);
+    free(cscale);
+    free(tot);
+    free(level);
+    free(best_level);
+    metric_free(&md);
+    if (rounds)
+        refine_free(&rd);
+    return res;
 }

@@ -31,11 +31,17 @@
  *                  budget, model included; K one of 4, 8, 16 at 4 bits with
  *                  the largest B that fits; the same bytes twice; a budget
  *                  no K,B fits is refused with VDSH_ERR_ARGUMENT
+ *   widths         the study's width per vector (vdsh_cpca_study.h): 4 bits
+ *                  on each of the B vectors decode as vdsh_cpca_encode's
+ *                  stream to the bit; a table allocated for that file's
+ *                  bytes stays within them and its words, the same twice;
+ *                  widths of 1 and a budget nothing fits are refused
  *   settings       vdsh_cpca_parse accepts K,B,BITS, auto and auto:BYTES
  *                  and refuses the rest
  */
 #include "vdsh.h"
 #include "vdsh_cpca.h"
+#include "vdsh_cpca_study.h"
 #include "vdsh_sh.h"
 
 #include <math.h>
@@ -305,6 +311,72 @@ static void auto_settings(void)
           "auto:1 not refused (%s)", err.msg);
 }
 
+/* Widths (vdsh_cpca_study.h, measurement only): the uniform table
+ * reproduces vdsh_cpca_encode's decode to the bit; an allocated table
+ * fits its budget and its words, and is no worse in the fit's own
+ * measure than the uniform record of the same bytes. */
+static void widths_study(void)
+{
+    vdsh_error err = {{0}};
+    vdsh_cpca_settings st = {K, B, BITS, 0};
+    vdsh_cpca_fit fit;
+    static float dec[ROWS * NC], dec2[ROWS * NC];
+    vdsh_cpca_widths_fit wf, wf2;
+    uint8_t uni[VDSH_MAX_COEFFS] = {0};
+    for (int j = 0; j < B; j++)
+        uni[j] = BITS;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &fit, &err) == VDSH_OK, "%s", err.msg);
+    CHECK(vdsh_cpca_encode_widths(src, normals, ROWS, ORDER, &st, 2 * B, 0.0, uni, dec, &wf,
+                                  &err) == VDSH_OK,
+          "widths, uniform: %s", err.msg);
+    vdsh_stream s = {.order = ORDER,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .scale = 1.0f,
+                     .data = fit.records,
+                     .cpca = fit.model};
+    int same = wf.basis == B && wf.words == fit.model.record_words;
+    for (uint32_t v = 0; v < ROWS; v++) {
+        float c[VDSH_MAX_COEFFS];
+        vdsh_stream_decode(&s, v, c);
+        same &= memcmp(c, dec + (size_t)v * NC, sizeof(float) * NC) == 0;
+    }
+    CHECK(same, "uniform widths do not decode as vdsh_cpca_encode's stream");
+    CHECK(fabs(wf.rms_error - fit.rms_error) <= 1e-12 * (1 + fit.rms_error), "rms %g against %g",
+          wf.rms_error, fit.rms_error);
+    /* allocated for the uniform file's bytes */
+    double budget = (double)fit_bytes(&fit.model, ROWS, ORDER) / ROWS;
+    CHECK(vdsh_cpca_encode_widths(src, normals, ROWS, ORDER, &st, 2 * B, budget, NULL, dec, &wf,
+                                  &err) == VDSH_OK,
+          "widths, budget: %s", err.msg);
+    CHECK(vdsh_cpca_encode_widths(src, normals, ROWS, ORDER, &st, 2 * B, budget, NULL, dec2, &wf2,
+                                  &err) == VDSH_OK &&
+              memcmp(dec, dec2, sizeof dec) == 0 && memcmp(wf.widths, wf2.widths, B * 2) == 0,
+          "widths: other results the second time");
+    int range = wf.basis >= 1 && wf.widths[wf.basis - 1] >= 2;
+    for (uint32_t j = 0; j < 2 * B; j++)
+        range &= wf.widths[j] == 0 || (wf.widths[j] >= 2 && wf.widths[j] <= 8);
+    CHECK(range, "widths out of range");
+    CHECK(wf.bytes_per_vertex <= budget && wf.words == vdsh_cpca_widths_words(wf.widths, 2 * B),
+          "widths: %.3f bytes per vertex over the budget %.3f, or %u words", wf.bytes_per_vertex,
+          budget, wf.words);
+    printf("widths: uniform %.3f B rms %.4f; allocated %.3f B, %u vectors, %u words, rms %.4f\n",
+           budget, fit.rms_error, wf.bytes_per_vertex, wf.basis, wf.words, wf.rms_error);
+    /* no field straddles a word: eight 7-bit fields and the index are 64
+     * bits but three words (3 fields, then 4, then 1) */
+    uint8_t w7[8] = {7, 7, 7, 7, 7, 7, 7, 7}, w8[4] = {8, 8, 8, 8};
+    CHECK(vdsh_cpca_widths_words(w7, 8) == 3 && vdsh_cpca_widths_words(w7, 7) == 2 &&
+              vdsh_cpca_widths_words(w8, 3) == 1 && vdsh_cpca_widths_words(w8, 4) == 2,
+          "widths_words");
+    uint8_t bad[2 * B] = {1};
+    CHECK(vdsh_cpca_encode_widths(src, normals, ROWS, ORDER, &st, 2 * B, 0.0, bad, dec, &wf,
+                                  &err) == VDSH_ERR_ARGUMENT,
+          "a width of 1 not refused");
+    CHECK(vdsh_cpca_encode_widths(src, normals, ROWS, ORDER, &st, 2 * B, 0.5, NULL, dec, &wf,
+                                  &err) == VDSH_ERR_ARGUMENT,
+          "a budget nothing fits not refused");
+    vdsh_cpca_fit_free(&fit);
+}
+
 static vdsh_file file_of(vdsh_stream *s)
 {
     vdsh_file f;
@@ -511,6 +583,7 @@ int main(int argc, char **argv)
     curved_cluster();
     line_and_blob();
     auto_settings();
+    widths_study();
 
     /* settings */
     vdsh_cpca_settings p;
