@@ -1068,21 +1068,6 @@ vdsh_result vdsh_cpca_encode_stream(const vdsh_stream *src, uint32_t rows, const
 enum { NWIDTHS = 8 };
 static const uint32_t WIDTH_SET[NWIDTHS] = {0, 2, 3, 4, 5, 6, 7, 8};
 
-uint32_t vdsh_cpca_widths_words(const uint8_t *widths, uint32_t b)
-{
-    uint32_t word = 0, used = VDSH_CPCA_INDEX_BITS;
-    for (uint32_t j = 0; j < b; j++) {
-        if (!widths[j])
-            continue;
-        if (used + widths[j] > 32) {
-            word++;
-            used = 0;
-        }
-        used += widths[j];
-    }
-    return word + 1;
-}
-
 /* Greedy marginal allocation of `bits` bits over m vectors: dist[j *
  * NWIDTHS + i] is vector j's squared error at width WIDTH_SET[i]; level[j]
  * the chosen index into WIDTH_SET. */

@@ -48,10 +48,6 @@ typedef struct vdsh_cpca_widths_fit {
     double rms_error;                /* RMS over rows of |decoded - c| */
 } vdsh_cpca_widths_fit;
 
-/* Record words of fields widths[0..b) (0: no field) after the 8-bit index,
- * none straddling two words. */
-uint32_t vdsh_cpca_widths_words(const uint8_t *widths, uint32_t b);
-
 /* Fit src (rows x order^2, finite) with settings' K and B (bits ignored;
  * no auto), refit with fit_basis vectors (B..order^2) and allocate widths:
  * budget > 0 bytes per vertex as above, else the fixed table `widths`

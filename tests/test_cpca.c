@@ -36,6 +36,10 @@
  *                  stream to the bit; a table allocated for that file's
  *                  bytes stays within them and its words, the same twice;
  *                  widths of 1 and a budget nothing fits are refused
+ *   widths stream  a width per basis vector (bits 0 and the widths
+ *                  table): mixed widths written and read back unchanged,
+ *                  decoded to the bit, widths of 1 and 9, padding, W and a
+ *                  field's -L - 1 refused
  *   settings       vdsh_cpca_parse accepts K,B,BITS, auto and auto:BYTES
  *                  and refuses the rest
  */
@@ -409,6 +413,112 @@ static void expect_refused(const uint8_t *good, size_t size, size_t at, const vo
     free(d);
 }
 
+/* A stream with a width per basis vector (bits 0, VDSH.md "cpca
+ * streams"): the fit's levels repacked into mixed widths (clamped to each
+ * width's levels) are written and read back unchanged, decode to the bit
+ * as mean + sum of level x scale / L_j x basis in f32, and every widths
+ * rule broken is refused. */
+static void widths_stream(const vdsh_cpca_fit *fit)
+{
+    static const uint8_t wd[B] = {8, 7, 6, 5, 4, 4, 4, 3, 3, 3, 2, 2, 2};
+    vdsh_cpca m = fit->model;
+    m.bits = 0;
+    m.widths = wd;
+    m.record_words = vdsh_cpca_widths_words(wd, B);
+    CHECK(m.record_words == 2, "widths words %u (8,7,6 in word 0, the rest in word 1)",
+          m.record_words);
+    static uint32_t rec[ROWS * 2];
+    static int32_t lv[ROWS][B];
+    memset(rec, 0, sizeof rec);
+    vdsh_stream u = {.order = ORDER,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .scale = 1.0f,
+                     .data = fit->records,
+                     .cpca = fit->model};
+    for (uint32_t v = 0; v < ROWS; v++) {
+        int32_t q[VDSH_MAX_COEFFS];
+        vdsh_cpca_weights(&u, v, q, NULL);
+        rec[v * 2] = vdsh_cpca_cluster(&u, v);
+        for (uint32_t j = 0; j < B; j++) {
+            int L = vdsh_cpca_levels(wd[j]);
+            lv[v][j] = q[j] > L ? L : q[j] < -L ? -L : q[j];
+            uint32_t word, shift;
+            vdsh_cpca_model_field(&m, j, &word, &shift);
+            rec[v * 2 + word] |= ((uint32_t)lv[v][j] & ((1u << wd[j]) - 1u)) << shift;
+        }
+    }
+    vdsh_stream s = {.order = ORDER,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .method = VDSH_METHOD_LSQ,
+                     .quantity = VDSH_QUANTITY_DISTANCE,
+                     .scale = 1.0f,
+                     .data = rec,
+                     .cpca = m};
+    vdsh_file f = file_of(&s);
+    void *mem = NULL;
+    size_t size = 0;
+    vdsh_error err = {{0}};
+    CHECK(vdsh_write_memory(&f, &mem, &size, &err) == VDSH_OK, "widths: write: %s", err.msg);
+    vdsh_file *back = NULL;
+    CHECK(mem && vdsh_read_memory(mem, size, "widths", &back, &err) == VDSH_OK, "widths: read: %s",
+          err.msg);
+    if (back) {
+        const vdsh_stream *r = &back->streams[0];
+        CHECK(r->cpca.bits == 0 && r->cpca.widths && memcmp(r->cpca.widths, wd, B) == 0 &&
+                  r->cpca.record_words == 2 && memcmp(r->data, rec, sizeof rec) == 0 &&
+                  memcmp(r->cpca.scales, m.scales, 4 * K * B) == 0 &&
+                  memcmp(r->cpca.bases, m.bases, 2 * K * B * NC) == 0,
+              "widths: read back differs");
+        vdsh_stream_size z = vdsh_stream_size_of(r, ROWS);
+        CHECK(fabs(z.mean_bytes -
+                   (8.0 + (double)(vdsh_cpca_model_bytes(ORDER, K, B) + 16) / ROWS)) < 1e-9,
+              "widths: mean bytes %g", z.mean_bytes);
+        int exact = 1;
+        for (uint32_t v = 0; v < ROWS; v += 5) {
+            float c[VDSH_MAX_COEFFS];
+            int32_t q[VDSH_MAX_COEFFS];
+            vdsh_stream_decode(r, v, c);
+            vdsh_cpca_weights(r, v, q, NULL);
+            uint32_t cl = vdsh_cpca_cluster(r, v);
+            for (int i = 0; i < NC; i++) {
+                float a = vdsh_f32_from_f16(m.means[cl * NC + i]);
+                for (int j = 0; j < B; j++) {
+                    float wj =
+                        (float)lv[v][j] * (m.scales[cl * B + j] / (float)vdsh_cpca_levels(wd[j]));
+                    a = a + wj * vdsh_f32_from_f16(m.bases[(cl * B + j) * NC + i]);
+                }
+                exact &= memcmp(&a, &c[i], 4) == 0;
+            }
+            for (int j = 0; j < B; j++)
+                exact &= q[j] == lv[v][j];
+        }
+        CHECK(exact, "widths: decode is not mean + sum of level x step_j x basis in f32");
+    }
+    vdsh_free(back);
+    if (mem) { /* widths table at payload 64, scales from 80 */
+        const uint8_t *g = mem;
+        uint8_t b1 = 1, b9 = 9, b4[4];
+        expect_refused(g, size, 64, &b1, 1, "width of vector 0 is 1");
+        expect_refused(g, size, 64 + 12, &b9, 1, "width of vector 12 is 9");
+        expect_refused(g, size, 64 + B, &b1, 1, "padding after the cpca widths");
+        wr32(b4, 3);
+        expect_refused(g, size, 60, b4, 4, "record_words 3, its widths need 2");
+        size_t recs = 64 + 16 + 160 + 304 + 3824;
+        /* vector 10 (2 bits) at word 1 bits 26..27: -2 is out of -1..1 */
+        wr32(b4, (rd32(g + coef_at(g, size) + recs + 4) & ~(3u << 26)) | (2u << 26));
+        expect_refused(g, size, recs + 4, b4, 4, "weight 10 is -2 (2 bits");
+    }
+    free(mem);
+    /* the writer refuses bits 0 without a table */
+    m.widths = NULL;
+    s.cpca = m;
+    f = file_of(&s);
+    mem = NULL;
+    CHECK(vdsh_write_memory(&f, &mem, &size, &err) != VDSH_OK && strstr(err.msg, "widths"),
+          "widths: bits 0 without a table written (%s)", err.msg);
+    free(mem);
+}
+
 int main(int argc, char **argv)
 {
     make_data();
@@ -523,6 +633,7 @@ int main(int argc, char **argv)
         }
     }
     vdsh_free(back);
+    widths_stream(&fit);
 
     /* reading rules (offsets in the COEF payload: header 48, cpca header
      * 48..63, scales from 64 (K*B*4 = 156, padded to 160), means from 224
