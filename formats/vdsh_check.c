@@ -503,10 +503,14 @@ int vdsh_check_part(const vdsh_part *t, uint32_t vertex_count, why *w)
             return vdsh_bad(w, "part: cpca settings %u,%u,%u with encoding %s (must be 0)",
                             t->cpca_clusters, t->cpca_basis, t->cpca_bits,
                             vdsh_encoding_name(t->encoding));
-    } else if (!t->cpca_clusters) { /* auto: 0, budget, 0 */
-        if (t->cpca_basis < 1 || t->cpca_basis > VDSH_CPCA_MAX_BUDGET || t->cpca_bits)
-            return vdsh_bad(w, "part: cpca auto settings 0,%u,%u out of range (budget 1..%d, 0)",
-                            t->cpca_basis, t->cpca_bits, VDSH_CPCA_MAX_BUDGET);
+    } else if (!t->cpca_clusters || !t->cpca_bits) { /* auto: 0, budget, 0; alloc: K, budget, 0 */
+        if (t->cpca_basis < 1 || t->cpca_basis > VDSH_CPCA_MAX_BUDGET || t->cpca_bits ||
+            t->cpca_clusters > VDSH_CPCA_MAX_CLUSTERS)
+            return vdsh_bad(w,
+                            "part: cpca auto settings %u,%u,%u out of range (K 0..%d, budget "
+                            "1..%d, 0)",
+                            t->cpca_clusters, t->cpca_basis, t->cpca_bits, VDSH_CPCA_MAX_CLUSTERS,
+                            VDSH_CPCA_MAX_BUDGET);
     } else if (t->cpca_clusters > VDSH_CPCA_MAX_CLUSTERS || t->cpca_basis < 1 ||
                t->cpca_basis > VDSH_MAX_COEFFS || t->cpca_bits < VDSH_CPCA_MIN_BITS ||
                t->cpca_bits > VDSH_CPCA_MAX_BITS) {

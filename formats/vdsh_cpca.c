@@ -46,6 +46,11 @@ static int check_settings(const vdsh_cpca_settings *s, vdsh_error *err)
                        VDSH_CPCA_MAX_BUDGET);
             return 0;
         }
+        if (s->clusters > VDSH_CPCA_MAX_CLUSTERS) {
+            vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: clusters %u out of range 1..%d", s->clusters,
+                       VDSH_CPCA_MAX_CLUSTERS);
+            return 0;
+        }
         return 1;
     }
     if (s->clusters < 1 || s->clusters > VDSH_CPCA_MAX_CLUSTERS) {
@@ -87,6 +92,25 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
         vdsh_cpca_settings s = {0, 0, 0, (uint32_t)budget};
         *out = s;
         return VDSH_OK;
+    }
+    {
+        /* K,alloc:BYTES: a width per basis vector */
+        char *end;
+        const char *comma = strchr(p, ',');
+        if (*p >= '0' && *p <= '9' && comma && strncmp(comma + 1, "alloc:", 6) == 0) {
+            unsigned long k = strtoul(p, &end, 10);
+            const char *q = comma + 7;
+            unsigned long budget = *q >= '0' && *q <= '9' ? strtoul(q, &end, 10) : 0;
+            if (end == q || *end || !budget || budget > VDSH_CPCA_MAX_BUDGET || k < 1 ||
+                k > VDSH_CPCA_MAX_CLUSTERS)
+                return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                                  "cpca settings '%s': expected K,alloc:BYTES, K 1..%d, bytes "
+                                  "per vertex 1..%d (for example 8,alloc:32)",
+                                  text, VDSH_CPCA_MAX_CLUSTERS, VDSH_CPCA_MAX_BUDGET);
+            vdsh_cpca_settings s = {(uint32_t)k, 0, 0, (uint32_t)budget};
+            *out = s;
+            return VDSH_OK;
+        }
     }
     for (int k = 0; k < 3; k++) {
         char *end;
@@ -964,6 +988,10 @@ static uint64_t fit_bytes(uint32_t rows, uint32_t order, const vdsh_cpca_setting
            vdsh_cpca_model_bytes(order, s->clusters, s->basis);
 }
 
+static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t rows,
+                                uint32_t order, const vdsh_cpca_settings *settings,
+                                vdsh_cpca_fit *out, vdsh_error *err);
+
 /* auto: the candidates vdsh_cpca.h names, the least stored_error kept. */
 static vdsh_result encode_auto(const float *src, const float *normals, uint32_t rows,
                                uint32_t order, uint32_t budget, vdsh_cpca_fit *out, vdsh_error *err)
@@ -1031,6 +1059,8 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
         if (!isfinite(src[x]))
             return vdsh_failf(err, VDSH_ERR_INVALID,
                               "cpca: vertex %zu coefficient %zu is not finite", x / n, x % n);
+    if (settings->budget && settings->clusters)
+        return encode_alloc(src, normals, rows, order, settings, out, err);
     if (settings->budget)
         return encode_auto(src, normals, rows, order, settings->budget, out, err);
     return encode_fixed(src, normals, rows, order, settings, out, NULL, err);
@@ -1105,15 +1135,63 @@ static uint64_t widths_model_bytes(uint32_t order, uint32_t k, uint32_t m)
     return vdsh_cpca_model_bytes(order, k, m) + ((m + 15u) & ~15u);
 }
 
+static vdsh_result encode_widths(const float *src, const float *normals, uint32_t rows,
+                                 uint32_t order, const vdsh_cpca_settings *settings,
+                                 uint32_t fit_basis, double budget, const uint8_t *widths,
+                                 float *decoded, vdsh_cpca_widths_fit *out, vdsh_cpca_fit *fit,
+                                 vdsh_error *err);
+
 vdsh_result vdsh_cpca_encode_widths(const float *src, const float *normals, uint32_t rows,
                                     uint32_t order, const vdsh_cpca_settings *settings,
                                     uint32_t fit_basis, double budget, const uint8_t *widths,
                                     float *decoded, vdsh_cpca_widths_fit *out, vdsh_error *err)
 {
     memset(out, 0, sizeof *out);
+    if (!decoded || !settings || settings->budget)
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca widths: bad arguments");
+    return encode_widths(src, normals, rows, order, settings, fit_basis, budget, widths, decoded,
+                         out, NULL, err);
+}
+
+/* --cpca K,alloc:BYTES (settings K and budget): refined with the largest
+ * B whose 4-bit records and model fit the budget, widths allocated over
+ * min(2B, n) vectors; *out the stream (bits 0, the widths table). */
+static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t rows,
+                                uint32_t order, const vdsh_cpca_settings *settings,
+                                vdsh_cpca_fit *out, vdsh_error *err)
+{
     const uint32_t n = order * order;
-    if (!src || !normals || !settings || !decoded || rows < 1 || rows > VDSH_MAX_VERTICES ||
-        order < 1 || order > VDSH_MAX_ORDER || settings->budget || !(budget >= 0.0) ||
+    const uint64_t limit = (uint64_t)settings->budget * rows;
+    vdsh_cpca_settings st = {settings->clusters < rows ? settings->clusters : rows, 0, 4, 0};
+    for (uint32_t b = n; b >= 1 && !st.basis; b--) {
+        vdsh_cpca_settings t = st;
+        t.basis = b;
+        if (fit_bytes(rows, order, &t) <= limit)
+            st.basis = b;
+    }
+    if (!st.basis)
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                          "cpca: alloc budget %u bytes per vertex too small for %u rows of order "
+                          "%u at %u clusters",
+                          settings->budget, rows, order, st.clusters);
+    uint32_t fb = 2 * st.basis < n ? 2 * st.basis : n;
+    vdsh_cpca_widths_fit wf;
+    return encode_widths(src, normals, rows, order, &st, fb, (double)settings->budget, NULL, NULL,
+                         &wf, out, err);
+}
+
+static vdsh_result encode_widths(const float *src, const float *normals, uint32_t rows,
+                                 uint32_t order, const vdsh_cpca_settings *settings,
+                                 uint32_t fit_basis, double budget, const uint8_t *widths,
+                                 float *decoded, vdsh_cpca_widths_fit *out, vdsh_cpca_fit *fit,
+                                 vdsh_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (fit)
+        memset(fit, 0, sizeof *fit);
+    const uint32_t n = order * order;
+    if (!src || !normals || !settings || rows < 1 || rows > VDSH_MAX_VERTICES || order < 1 ||
+        order > VDSH_MAX_ORDER || settings->budget || !(budget >= 0.0) ||
         (budget == 0.0 && !widths))
         return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca widths: bad arguments (rows %u, order %u)",
                           rows, order);
@@ -1323,6 +1401,76 @@ vdsh_result vdsh_cpca_encode_widths(const float *src, const float *normals, uint
     out->words = vdsh_cpca_widths_words(out->widths, bf);
     out->bytes_per_vertex =
         ((double)rows * 4.0 * out->words + (double)widths_model_bytes(order, k, out->basis)) / rows;
+
+    if (fit) { /* the stream: the vectors of width > 0, in order */
+        uint32_t kb = 0, keep[VDSH_MAX_COEFFS];
+        for (uint32_t j = 0; j < bf; j++)
+            if (best_level[j])
+                keep[kb++] = j;
+        uint8_t wd[VDSH_MAX_COEFFS];
+        for (uint32_t q = 0; q < kb; q++)
+            wd[q] = (uint8_t)WIDTH_SET[best_level[keep[q]]];
+        const uint32_t words = vdsh_cpca_widths_words(wd, kb);
+        size_t o_sc = ((size_t)kb + 15) & ~(size_t)15;
+        size_t o_means = o_sc + (((size_t)k * kb * 4 + 15) & ~(size_t)15);
+        size_t o_bases = o_means + (((size_t)k * n * 2 + 15) & ~(size_t)15);
+        size_t o_rec = o_bases + (((size_t)k * kb * n * 2 + 15) & ~(size_t)15);
+        uint8_t *block = kb ? calloc(1, o_rec + (size_t)rows * words * 4) : NULL;
+        if (!block) {
+            res = vdsh_failf(err, kb ? VDSH_ERR_OUT_OF_MEMORY : VDSH_ERR_ARGUMENT,
+                             kb ? "cpca: out of memory" : "cpca: alloc kept no basis vector");
+            goto done;
+        }
+        memcpy(block, wd, kb);
+        float *sc_out = (float *)(block + o_sc);
+        uint16_t *me_out = (uint16_t *)(block + o_means), *ba_out = (uint16_t *)(block + o_bases);
+        uint32_t *rec = (uint32_t *)(block + o_rec);
+        memcpy(me_out, means, sizeof(uint16_t) * k * n);
+        for (uint32_t c = 0; c < k; c++)
+            for (uint32_t q = 0; q < kb; q++) {
+                uint32_t j = keep[q];
+                sc_out[(size_t)c * kb + q] = cscale[((size_t)c * bf + j) * NWIDTHS + best_level[j]];
+                memcpy(ba_out + ((size_t)c * kb + q) * n, bases + ((size_t)c * bf + j) * n,
+                       sizeof(uint16_t) * n);
+            }
+        fit->model = (vdsh_cpca){.clusters = k,
+                                 .basis = kb,
+                                 .bits = 0,
+                                 .record_words = words,
+                                 .widths = block,
+                                 .scales = sc_out,
+                                 .means = me_out,
+                                 .bases = ba_out};
+        for (uint32_t v = 0; v < rows; v++) {
+            uint32_t *r = rec + (size_t)v * words, c = labels[v];
+            r[0] = c;
+            for (uint32_t q = 0; q < kb; q++) {
+                uint32_t j = keep[q], word, shift;
+                const int levels = vdsh_cpca_levels(wd[q]);
+                double lq = quantise(wts[(size_t)v * bf + j], sc_out[(size_t)c * kb + q], levels);
+                vdsh_cpca_model_field(&fit->model, q, &word, &shift);
+                r[word] |= ((uint32_t)(int32_t)lq & ((1u << wd[q]) - 1u)) << shift;
+            }
+        }
+        fit->records = rec;
+        fit->storage_ = block;
+        vdsh_stream s = {.order = order,
+                         .encoding = VDSH_ENCODING_CPCA,
+                         .scale = 1.0f,
+                         .data = rec,
+                         .cpca = fit->model};
+        float dec[VDSH_MAX_COEFFS];
+        double e2 = 0.0;
+        for (uint32_t v = 0; v < rows; v++) {
+            vdsh_stream_decode(&s, v, dec);
+            for (uint32_t i = 0; i < n; i++) {
+                double e = (double)dec[i] - src[(size_t)v * n + i];
+                e2 += e * e;
+            }
+        }
+        fit->rms_error = out->rms_error = sqrt(e2 / rows);
+        goto done;
+    }
 
     /* decode as the format's rule: f32, mean + sum_j weight_j x basis_j */
     double e2 = 0.0;

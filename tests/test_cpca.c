@@ -40,6 +40,8 @@
  *                  table): mixed widths written and read back unchanged,
  *                  decoded to the bit, widths of 1 and 9, padding, W and a
  *                  field's -L - 1 refused
+ *   alloc          --cpca K,alloc:BYTES: widths 2..8 within the budget,
+ *                  the same bytes twice, read back, too small refused
  *   settings       vdsh_cpca_parse accepts K,B,BITS, auto and auto:BYTES
  *                  and refuses the rest
  */
@@ -519,6 +521,68 @@ static void widths_stream(const vdsh_cpca_fit *fit)
     free(mem);
 }
 
+/* --cpca K,alloc:BYTES: a stream with a width per vector within the
+ * budget (model and widths table included), the same bytes twice, its
+ * rms_error its decode's, written and read back; a budget the 1-vector
+ * record cannot meet refused. */
+static void alloc_settings(void)
+{
+    vdsh_error err = {{0}};
+    vdsh_cpca_settings st;
+    CHECK(vdsh_cpca_parse("3,alloc:16", &st, &err) == VDSH_OK && st.clusters == 3 &&
+              st.budget == 16 && !st.bits && !st.basis,
+          "parse 3,alloc:16: %s", err.msg);
+    vdsh_cpca_fit a, b;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &a, &err) == VDSH_OK, "alloc: %s",
+          err.msg);
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &b, &err) == VDSH_OK, "alloc 2: %s",
+          err.msg);
+    const vdsh_cpca *m = &a.model;
+    vdsh_stream s = {.order = ORDER,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .method = VDSH_METHOD_LSQ,
+                     .quantity = VDSH_QUANTITY_DISTANCE,
+                     .scale = 1.0f,
+                     .data = a.records,
+                     .cpca = *m};
+    uint64_t bytes = (uint64_t)ROWS * 4 * m->record_words + vdsh_cpca_stream_model_bytes(m, ORDER);
+    int ok = m->bits == 0 && m->widths && m->clusters == 3 && m->basis >= 1 &&
+             m->record_words == vdsh_cpca_widths_words(m->widths, m->basis);
+    for (uint32_t j = 0; ok && j < m->basis; j++)
+        ok = m->widths[j] >= 2 && m->widths[j] <= 8;
+    CHECK(ok, "alloc: model %u,%u,%u, W %u", m->clusters, m->basis, m->bits, m->record_words);
+    CHECK(bytes <= 16u * ROWS, "alloc: %.2f bytes per vertex over 16", (double)bytes / ROWS);
+    size_t all = (size_t)vdsh_cpca_stream_model_bytes(m, ORDER) - 16;
+    CHECK(b.model.basis == m->basis && memcmp(a.storage_, b.storage_, all) == 0 &&
+              memcmp(a.records, b.records, (size_t)ROWS * 4 * m->record_words) == 0,
+          "alloc: other bytes the second time");
+    CHECK(fabs(rms_vs(&s, src) - a.rms_error) <= 1e-9 * (1 + a.rms_error), "alloc: rms %g vs %g",
+          a.rms_error, rms_vs(&s, src));
+    vdsh_file f = file_of(&s);
+    void *mem = NULL;
+    size_t size = 0;
+    vdsh_file *back = NULL;
+    CHECK(vdsh_write_memory(&f, &mem, &size, &err) == VDSH_OK &&
+              vdsh_read_memory(mem, size, "alloc", &back, &err) == VDSH_OK &&
+              rms_vs(&back->streams[0], src) == rms_vs(&s, src),
+          "alloc: write and read back: %s", err.msg);
+    printf("alloc:16 at K 3: %u vectors, %u words, %.2f bytes per vertex, rms error %.4f\n",
+           m->basis, m->record_words, (double)bytes / ROWS, a.rms_error);
+    vdsh_free(back);
+    free(mem);
+    vdsh_cpca_fit_free(&a);
+    vdsh_cpca_fit_free(&b);
+    vdsh_cpca_settings tiny = {3, 0, 0, 1};
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &tiny, &a, &err) == VDSH_ERR_ARGUMENT &&
+              strstr(err.msg, "budget") && !a.storage_,
+          "alloc:1 not refused (%s)", err.msg);
+    CHECK(vdsh_cpca_parse("3,alloc:0", &st, &err) == VDSH_ERR_ARGUMENT &&
+              vdsh_cpca_parse("0,alloc:16", &st, &err) == VDSH_ERR_ARGUMENT &&
+              vdsh_cpca_parse("3,alloc:", &st, &err) == VDSH_ERR_ARGUMENT &&
+              vdsh_cpca_parse("3,alloc:16x", &st, &err) == VDSH_ERR_ARGUMENT,
+          "bad alloc settings accepted");
+}
+
 int main(int argc, char **argv)
 {
     make_data();
@@ -695,6 +759,7 @@ int main(int argc, char **argv)
     line_and_blob();
     auto_settings();
     widths_study();
+    alloc_settings();
 
     /* settings */
     vdsh_cpca_settings p;
