@@ -32,6 +32,26 @@ says_any "vdsh-info shows the model" "cpca: 4 clusters, 20 basis vectors of 4-bi
 expect_exit 0 "vdsh-info on a part" "$info" "$tmp/n3/p1.vdsh"
 says_any "vdsh-info shows a part's settings" "cpca 4,20,4 (fitted at the merge)"
 
+# A width per basis vector (--cpca K,alloc:BYTES): whole bake = 2 threads
+# = 3 shards merged, byte for byte; vdsh-info shows the widths and a
+# part's settings.
+ca=(--encoding cpca --cpca 4,alloc:40)
+expect_exit 0 "alloc cpca, 1 thread" "$bake" "${tiny[@]}" "${ca[@]}" --threads 1 -o "$tmp/c1.vdsh"
+expect_exit 0 "alloc cpca, 2 threads" "$bake" "${tiny[@]}" "${ca[@]}" --threads 2 -o "$tmp/c2.vdsh"
+check "alloc cpca, 1 and 2 threads: identical" cmp "$tmp/c1.vdsh" "$tmp/c2.vdsh"
+mkdir -p "$tmp/c3"
+for i in 0 1 2; do
+  expect_exit 0 "alloc cpca shard $i/3" "$bake" "${tiny[@]}" "${ca[@]}" --shard "$i/3" \
+    -o "$tmp/c3/p$i.vdsh"
+done
+expect_exit 0 "alloc cpca merge" "$merge" -q "$tmp"/c3/p*.vdsh -o "$tmp/c3/scene.vdsh"
+check "alloc cpca, 3 shards: identical to the whole bake" cmp "$tmp/c3/scene.vdsh" "$tmp/c1.vdsh"
+expect_exit 0 "vdsh-info, alloc" "$info" "$tmp/c1.vdsh"
+says_any "vdsh-info shows per-vector weights" "basis vectors of per-vector weights"
+says_any "vdsh-info shows the widths" "widths: "
+expect_exit 0 "vdsh-info on an alloc part" "$info" "$tmp/c3/p1.vdsh"
+says_any "vdsh-info shows an alloc part's settings" "cpca 4,alloc:40 (fitted at the merge)"
+
 # Against the f32 bake of the same options.
 expect_exit 0 "f32 bake" "$bake" "${tiny[@]}" --encoding f32 -o "$tmp/f32.vdsh"
 expect_exit 0 "full basis, 8 bits" "$bake" "${tiny[@]}" --encoding cpca --cpca 2,49,8 -o "$tmp/full.vdsh"

@@ -536,7 +536,7 @@ static int export_cpca(const vdsh_stream *s, uint32_t nv, const char *prefix, vi
     if (!model)
         return -1;
     for (size_t i = 0; i < K * B; i++)
-        model[i] = vdsh_cpca_step(m->scales[i], m->bits);
+        model[i] = vdsh_cpca_step(m->scales[i], vdsh_cpca_width(m, (uint32_t)(i % B)));
     for (size_t i = 0; i < K * nc; i++)
         model[K * B + i] = vdsh_f32_from_f16(m->means[i]);
     for (size_t i = 0; i < K * B * nc; i++)
