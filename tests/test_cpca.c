@@ -3,7 +3,9 @@
  * 29): encoder, writer, reader and decoder.
  *
  * Usage: test_cpca [OUT_DIR]   (with OUT_DIR: also writes cpca.vdsh and
- *                               cpca.f32, its C decode, for the Python test)
+ *                               cpca.f32, its C decode, and the same of the
+ *                               widths stream, cpca-widths.vdsh and
+ *                               cpca-widths.f32, for the Python test)
  *
  *   round trip     a synthetic order-7 stream (clusters by normal, low rank
  *                  plus noise) encoded, written, read: the same model and
@@ -420,7 +422,7 @@ static void expect_refused(const uint8_t *good, size_t size, size_t at, const vo
  * width's levels) are written and read back unchanged, decode to the bit
  * as mean + sum of level x scale / L_j x basis in f32, and every widths
  * rule broken is refused. */
-static void widths_stream(const vdsh_cpca_fit *fit)
+static void widths_stream(const vdsh_cpca_fit *fit, const char *out_dir)
 {
     static const uint8_t wd[B] = {8, 7, 6, 5, 4, 4, 4, 3, 3, 3, 2, 2, 2};
     vdsh_cpca m = fit->model;
@@ -495,6 +497,24 @@ static void widths_stream(const vdsh_cpca_fit *fit)
                 exact &= q[j] == lv[v][j];
         }
         CHECK(exact, "widths: decode is not mean + sum of level x step_j x basis in f32");
+        if (out_dir) { /* for the Python reader's test */
+            char p[4096];
+            snprintf(p, sizeof p, "%s/cpca-widths.vdsh", out_dir);
+            FILE *o = fopen(p, "wb");
+            CHECK(o && fwrite(mem, 1, size, o) == size, "cannot write %s", p);
+            if (o)
+                fclose(o);
+            snprintf(p, sizeof p, "%s/cpca-widths.f32", out_dir);
+            o = fopen(p, "wb");
+            for (uint32_t v = 0; o && v < ROWS; v++) {
+                float c[VDSH_MAX_COEFFS];
+                vdsh_stream_decode(r, v, c);
+                CHECK(fwrite(c, 4, NC, o) == NC, "cannot write %s", p);
+            }
+            CHECK(o != NULL, "cannot write %s", p);
+            if (o)
+                fclose(o);
+        }
     }
     vdsh_free(back);
     if (mem) { /* widths table at payload 64, scales from 80 */
@@ -697,7 +717,7 @@ int main(int argc, char **argv)
         }
     }
     vdsh_free(back);
-    widths_stream(&fit);
+    widths_stream(&fit, argc > 1 ? argv[1] : NULL);
 
     /* reading rules (offsets in the COEF payload: header 48, cpca header
      * 48..63, scales from 64 (K*B*4 = 156, padded to 160), means from 224
