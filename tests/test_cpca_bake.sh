@@ -51,6 +51,15 @@ says_any "vdsh-info shows per-vector weights" "basis vectors of per-vector weigh
 says_any "vdsh-info shows the widths" "widths: "
 expect_exit 0 "vdsh-info on an alloc part" "$info" "$tmp/c3/p1.vdsh"
 says_any "vdsh-info shows an alloc part's settings" "cpca 4,alloc:40 (fitted at the merge)"
+check "the Python reader reads an alloc part and the merged widths" /usr/bin/python3 -c '
+import sys
+sys.path.insert(0, sys.argv[1])
+import vdsh
+p = vdsh.read(sys.argv[2]).part
+assert (p["cpca_clusters"], p["cpca_basis"], p["cpca_bits"]) == (4, 40, 0), p
+c = vdsh.read(sys.argv[3]).streams[0]["cpca"]
+assert c["bits"] == 0 and len(c["widths"]) == c["basis"] and 2 <= min(c["widths"]), c["widths"]
+' "$src/python" "$tmp/c3/p1.vdsh" "$tmp/c1.vdsh"
 
 # Against the f32 bake of the same options.
 expect_exit 0 "f32 bake" "$bake" "${tiny[@]}" --encoding f32 -o "$tmp/f32.vdsh"
@@ -122,10 +131,13 @@ PY
 out=$tmp/none.vdsh
 expect_exit 2 "--cpca without --encoding cpca" "$bake" "${tiny[@]}" --cpca 4,20,4 -o "$out"
 says_any "--cpca alone" "needs --encoding cpca"
-for bad in 0,20,4 4,0,4 4,20,1 4,20,9 4,20 x; do
+for bad in 0,20,4 4,0,4 4,20,1 4,20,9 4,20 x 4,alloc:0 0,alloc:32 4,alloc:; do
   expect_exit 2 "--cpca $bad" "$bake" "${tiny[@]}" --encoding cpca --cpca "$bad" -o "$out"
   says_any "--cpca $bad" "--cpca takes K,B,BITS"
+  says_any "--cpca $bad names alloc" "K,alloc:BYTES (a width per basis vector)"
 done
+expect_exit 0 "vdsh-bake --help" "$bake" --help
+says_any "--help shows K,alloc:BYTES" "K,alloc:BYTES: K clusters, a width per basis vector"
 expect_exit 2 "--adaptive-order with cpca and its cap in --orders" "$bake" "${tiny[@]}" \
   --encoding cpca --adaptive-order 0.02 --max-order 7 -o "$out"
 says_any "--adaptive-order's cap in --orders" "--orders cannot hold that order too"
