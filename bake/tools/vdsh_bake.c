@@ -808,7 +808,7 @@ static int read_choice(int c, const char *arg, options *o)
     case O_CPCA:
         if (vdsh_cpca_parse(arg, &o->cpca, NULL) != VDSH_OK)
             return bad_usage("--cpca takes K,B,BITS: clusters 1..256, basis vectors "
-                             "1..256, bits 2..8 (default 8,54,4), auto or auto:BYTES, or "
+                             "1..256, bits 2..8 (default 8,54,4), or auto or auto:BYTES, or "
                              "K,alloc:BYTES (a width per basis vector), bytes per vertex "
                              "1..4096, not '%s'",
                              arg);
