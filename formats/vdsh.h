@@ -210,16 +210,20 @@ typedef struct vdsh_source {
  * mean and B basis vectors of order^2 coefficients (f16), per basis
  * vector a scale; per vertex row a record of record_words u32 words in
  * vdsh_stream.data: bits 0..7 of word 0 the cluster index, then B
- * `bits`-wide two's-complement weight levels (vdsh_cpca_field says
- * where). Decoding (vdsh_stream_decode, to the bit): w_j = level_j *
- * vdsh_cpca_step(scales[c * B + j], bits) in f32, coefficient i = mean
+ * two's-complement weight levels, weight j vdsh_cpca_width(m, j) bits
+ * wide (`bits`, or with bits 0 the widths table's; vdsh_cpca_model_field
+ * says where). Decoding (vdsh_stream_decode, to the bit): w_j = level_j *
+ * vdsh_cpca_step(scales[c * B + j], width_j) in f32, coefficient i = mean
  * + sum over j = 0..B-1 in order of w_j * basis_j[i], each product and
  * sum rounded to f32. */
 typedef struct vdsh_cpca {
     uint32_t clusters;     /* K, 1..VDSH_CPCA_MAX_CLUSTERS */
     uint32_t basis;        /* B, 1..order^2 */
-    uint32_t bits;         /* per weight, VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS */
-    uint32_t record_words; /* W = vdsh_cpca_record_words(basis, bits) */
+    uint32_t bits;         /* per weight, VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS, or 0:
+                              a width per basis vector (widths) */
+    uint32_t record_words; /* W = vdsh_cpca_record_words(basis, bits), or with
+                              bits 0 vdsh_cpca_widths_words(widths, basis) */
+    const uint8_t *widths; /* bits 0: B widths, each 2..8; else NULL */
     const float *scales;   /* K * B: vector j of cluster c at c * B + j */
     const uint16_t *means; /* f16, K * order^2: cluster c's at c * order^2 */
     const uint16_t *bases; /* f16, K * B * order^2: vector j of cluster c
@@ -385,6 +389,16 @@ uint32_t vdsh_cpca_record_words(uint32_t basis, uint32_t bits);
 /* Where weight j's field lies in a record: word *word, bits *shift ..
  * *shift + bits - 1. */
 void vdsh_cpca_field(uint32_t bits, uint32_t j, uint32_t *word, uint32_t *shift);
+/* Words of a record whose weight j is widths[j] bits wide (0: no field),
+ * none straddling a word. */
+uint32_t vdsh_cpca_widths_words(const uint8_t *widths, uint32_t basis);
+/* Weight j's width in bits: `bits`, or with bits 0 widths[j]. */
+static inline uint32_t vdsh_cpca_width(const vdsh_cpca *m, uint32_t j)
+{
+    return m->bits ? m->bits : m->widths[j];
+}
+/* Where weight j's field lies in a record of model m (either form). */
+void vdsh_cpca_model_field(const vdsh_cpca *m, uint32_t j, uint32_t *word, uint32_t *shift);
 /* Levels each side of 0: 2^(bits-1) - 1 (4 bits: 7). */
 static inline int vdsh_cpca_levels(uint32_t bits)
 {
@@ -398,6 +412,9 @@ static inline float vdsh_cpca_step(float scale, uint32_t bits)
 /* Bytes between the 48-byte stream header and the records: the 16-byte
  * cpca header, the scales, means and bases, each padded to 16. */
 uint64_t vdsh_cpca_model_bytes(uint32_t order, uint32_t clusters, uint32_t basis);
+/* The same for model m (either form: with bits 0 the widths table, B
+ * bytes padded to 16, too). */
+uint64_t vdsh_cpca_stream_model_bytes(const vdsh_cpca *m, uint32_t order);
 /* Vertex row v's cluster index (< clusters) of a cpca stream. */
 uint32_t vdsh_cpca_cluster(const vdsh_stream *s, uint32_t v);
 /* Vertex row v's B stored weight levels (-L..L) and weights (level *

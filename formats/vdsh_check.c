@@ -247,10 +247,20 @@ int vdsh_check_stream(const vdsh_stream *s, uint32_t i, why *w)
         if (m->basis < 1 || m->basis > s->order * s->order)
             return vdsh_bad(w, "%s: cpca basis %u out of range 1..%u", l, m->basis,
                             s->order * s->order);
-        if (m->bits < VDSH_CPCA_MIN_BITS || m->bits > VDSH_CPCA_MAX_BITS)
-            return vdsh_bad(w, "%s: cpca bits %u out of range %d..%d", l, m->bits,
-                            VDSH_CPCA_MIN_BITS, VDSH_CPCA_MAX_BITS);
-        if (m->record_words != vdsh_cpca_record_words(m->basis, m->bits))
+        if (m->bits && (m->bits < VDSH_CPCA_MIN_BITS || m->bits > VDSH_CPCA_MAX_BITS))
+            return vdsh_bad(w, "%s: cpca bits %u out of range %d..%d (or 0: a width per vector)", l,
+                            m->bits, VDSH_CPCA_MIN_BITS, VDSH_CPCA_MAX_BITS);
+        if (!m->bits) {
+            if (!m->widths)
+                return vdsh_bad(w, "%s: cpca bits 0 without a widths table", l);
+            for (uint32_t j = 0; j < m->basis; j++)
+                if (m->widths[j] < VDSH_CPCA_MIN_BITS || m->widths[j] > VDSH_CPCA_MAX_BITS)
+                    return vdsh_bad(w, "%s: cpca width of vector %u is %u, out of range %d..%d", l,
+                                    j, m->widths[j], VDSH_CPCA_MIN_BITS, VDSH_CPCA_MAX_BITS);
+            if (m->record_words != vdsh_cpca_widths_words(m->widths, m->basis))
+                return vdsh_bad(w, "%s: cpca record_words %u, its widths need %u", l,
+                                m->record_words, vdsh_cpca_widths_words(m->widths, m->basis));
+        } else if (m->record_words != vdsh_cpca_record_words(m->basis, m->bits))
             return vdsh_bad(w, "%s: cpca record_words %u, %u weights of %u bits need %u", l,
                             m->record_words, m->basis, m->bits,
                             vdsh_cpca_record_words(m->basis, m->bits));
@@ -389,8 +399,7 @@ static int check_variable_rows(const vdsh_stream *s, const char *l, uint32_t v, 
 static int check_cpca_data(const vdsh_stream *s, const char *l, uint32_t v, why *w)
 {
     const vdsh_cpca *m = &s->cpca;
-    uint32_t n = s->order * s->order, b = m->basis, bits = m->bits;
-    int L = vdsh_cpca_levels(bits);
+    uint32_t n = s->order * s->order, b = m->basis;
     for (size_t k = 0; k < (size_t)m->clusters * b; k++) {
         float sc = m->scales[k];
         if (!isfinite(sc) || !(sc >= 0.0f))
@@ -413,8 +422,10 @@ static int check_cpca_data(const vdsh_stream *s, const char *l, uint32_t v, why 
         for (uint32_t i = 0; i < n; i++) {
             double bound = fabs((double)vdsh_f32_from_f16(m->means[(size_t)c * n + i]));
             for (uint32_t j = 0; j < b; j++)
-                bound += (double)L * (double)vdsh_cpca_step(m->scales[(size_t)c * b + j], bits) *
-                         fabs((double)vdsh_f32_from_f16(m->bases[((size_t)c * b + j) * n + i]));
+                bound +=
+                    (double)vdsh_cpca_levels(vdsh_cpca_width(m, j)) *
+                    (double)vdsh_cpca_step(m->scales[(size_t)c * b + j], vdsh_cpca_width(m, j)) *
+                    fabs((double)vdsh_f32_from_f16(m->bases[((size_t)c * b + j) * n + i]));
             if (!(bound <= 1e38))
                 return vdsh_bad(w, "%s: cpca cluster %u coefficient %u can reach %g, beyond 1e38",
                                 l, c, i, bound);
@@ -424,10 +435,10 @@ static int check_cpca_data(const vdsh_stream *s, const char *l, uint32_t v, why 
     for (uint32_t k = 0; k < m->record_words; k++)
         used[k] = 0;
     used[0] = (1u << VDSH_CPCA_INDEX_BITS) - 1u;
+    uint32_t fword[VDSH_MAX_COEFFS], fshift[VDSH_MAX_COEFFS];
     for (uint32_t j = 0; j < b; j++) {
-        uint32_t word, shift;
-        vdsh_cpca_field(bits, j, &word, &shift);
-        used[word] |= (uint32_t)(((1ull << bits) - 1u) << shift);
+        vdsh_cpca_model_field(m, j, &fword[j], &fshift[j]);
+        used[fword[j]] |= (uint32_t)(((1ull << vdsh_cpca_width(m, j)) - 1u) << fshift[j]);
     }
     for (uint32_t x = 0; x < v; x++) {
         const uint32_t *r = (const uint32_t *)s->data + (size_t)x * m->record_words;
@@ -438,10 +449,13 @@ static int check_cpca_data(const vdsh_stream *s, const char *l, uint32_t v, why 
             if (r[k] & ~used[k])
                 return vdsh_bad(w, "%s: vertex %u: unused bits of record word %u not zero", l, x,
                                 k);
-        for (uint32_t j = 0; j < b; j++)
-            if (vdsh_cpca_record_level(r, bits, j) < -L)
+        for (uint32_t j = 0; j < b; j++) {
+            uint32_t bits = vdsh_cpca_width(m, j);
+            int L = vdsh_cpca_levels(bits), q = vdsh_cpca_field_level(r, fword[j], fshift[j], bits);
+            if (q < -L)
                 return vdsh_bad(w, "%s: vertex %u weight %u is %d (%u bits store %d..%d)", l, x, j,
-                                (int)vdsh_cpca_record_level(r, bits, j), bits, -L, L);
+                                q, bits, -L, L);
+        }
     }
     return 1;
 }
@@ -489,10 +503,14 @@ int vdsh_check_part(const vdsh_part *t, uint32_t vertex_count, why *w)
             return vdsh_bad(w, "part: cpca settings %u,%u,%u with encoding %s (must be 0)",
                             t->cpca_clusters, t->cpca_basis, t->cpca_bits,
                             vdsh_encoding_name(t->encoding));
-    } else if (!t->cpca_clusters) { /* auto: 0, budget, 0 */
-        if (t->cpca_basis < 1 || t->cpca_basis > VDSH_CPCA_MAX_BUDGET || t->cpca_bits)
-            return vdsh_bad(w, "part: cpca auto settings 0,%u,%u out of range (budget 1..%d, 0)",
-                            t->cpca_basis, t->cpca_bits, VDSH_CPCA_MAX_BUDGET);
+    } else if (!t->cpca_clusters || !t->cpca_bits) { /* auto: 0, budget, 0; alloc: K, budget, 0 */
+        if (t->cpca_basis < 1 || t->cpca_basis > VDSH_CPCA_MAX_BUDGET || t->cpca_bits ||
+            t->cpca_clusters > VDSH_CPCA_MAX_CLUSTERS)
+            return vdsh_bad(w,
+                            "part: cpca auto settings %u,%u,%u out of range (K 0..%d, budget "
+                            "1..%d, 0)",
+                            t->cpca_clusters, t->cpca_basis, t->cpca_bits, VDSH_CPCA_MAX_CLUSTERS,
+                            VDSH_CPCA_MAX_BUDGET);
     } else if (t->cpca_clusters > VDSH_CPCA_MAX_CLUSTERS || t->cpca_basis < 1 ||
                t->cpca_basis > VDSH_MAX_COEFFS || t->cpca_bits < VDSH_CPCA_MIN_BITS ||
                t->cpca_bits > VDSH_CPCA_MAX_BITS) {

@@ -6,6 +6,7 @@
  * (-std=c11: no fused multiply-add contraction): the same bytes on any
  * x86-64 CPU and whatever the caller's thread count. */
 #include "vdsh_cpca.h"
+#include "vdsh_cpca_study.h"
 #include "vdsh_failf.h"
 #include "vdsh_internal.h"
 
@@ -43,6 +44,11 @@ static int check_settings(const vdsh_cpca_settings *s, vdsh_error *err)
         if (s->budget > VDSH_CPCA_MAX_BUDGET) {
             vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: auto budget %u out of range 1..%d", s->budget,
                        VDSH_CPCA_MAX_BUDGET);
+            return 0;
+        }
+        if (s->clusters > VDSH_CPCA_MAX_CLUSTERS) {
+            vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: clusters %u out of range 1..%d", s->clusters,
+                       VDSH_CPCA_MAX_CLUSTERS);
             return 0;
         }
         return 1;
@@ -86,6 +92,25 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
         vdsh_cpca_settings s = {0, 0, 0, (uint32_t)budget};
         *out = s;
         return VDSH_OK;
+    }
+    {
+        /* K,alloc:BYTES: a width per basis vector */
+        char *end;
+        const char *comma = strchr(p, ',');
+        if (*p >= '0' && *p <= '9' && comma && strncmp(comma + 1, "alloc:", 6) == 0) {
+            unsigned long k = strtoul(p, &end, 10);
+            const char *q = comma + 7;
+            unsigned long budget = *q >= '0' && *q <= '9' ? strtoul(q, &end, 10) : 0;
+            if (end == q || *end || !budget || budget > VDSH_CPCA_MAX_BUDGET || k < 1 ||
+                k > VDSH_CPCA_MAX_CLUSTERS)
+                return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                                  "cpca settings '%s': expected K,alloc:BYTES, K 1..%d, bytes "
+                                  "per vertex 1..%d (for example 8,alloc:32)",
+                                  text, VDSH_CPCA_MAX_CLUSTERS, VDSH_CPCA_MAX_BUDGET);
+            vdsh_cpca_settings s = {(uint32_t)k, 0, 0, (uint32_t)budget};
+            *out = s;
+            return VDSH_OK;
+        }
     }
     for (int k = 0; k < 3; k++) {
         char *end;
@@ -963,6 +988,10 @@ static uint64_t fit_bytes(uint32_t rows, uint32_t order, const vdsh_cpca_setting
            vdsh_cpca_model_bytes(order, s->clusters, s->basis);
 }
 
+static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t rows,
+                                uint32_t order, const vdsh_cpca_settings *settings,
+                                vdsh_cpca_fit *out, vdsh_error *err);
+
 /* auto: the candidates vdsh_cpca.h names, the least stored_error kept. */
 static vdsh_result encode_auto(const float *src, const float *normals, uint32_t rows,
                                uint32_t order, uint32_t budget, vdsh_cpca_fit *out, vdsh_error *err)
@@ -1030,6 +1059,8 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
         if (!isfinite(src[x]))
             return vdsh_failf(err, VDSH_ERR_INVALID,
                               "cpca: vertex %zu coefficient %zu is not finite", x / n, x % n);
+    if (settings->budget && settings->clusters)
+        return encode_alloc(src, normals, rows, order, settings, out, err);
     if (settings->budget)
         return encode_auto(src, normals, rows, order, settings->budget, out, err);
     return encode_fixed(src, normals, rows, order, settings, out, NULL, err);
@@ -1060,4 +1091,438 @@ vdsh_result vdsh_cpca_encode_stream(const vdsh_stream *src, uint32_t rows, const
     if (rms_error)
         *rms_error = fit.rms_error;
     return VDSH_OK;
+}
+
+/* ---- a width per basis vector (measurement only: vdsh_cpca_study.h) ---- */
+
+enum { NWIDTHS = 8 };
+static const uint32_t WIDTH_SET[NWIDTHS] = {0, 2, 3, 4, 5, 6, 7, 8};
+
+/* Greedy marginal allocation of `bits` bits over m vectors: dist[j *
+ * NWIDTHS + i] is vector j's squared error at width WIDTH_SET[i]; level[j]
+ * the chosen index into WIDTH_SET. */
+static void allocate_widths(const double *dist, uint32_t m, uint32_t bits, uint32_t *level)
+{
+    for (uint32_t j = 0; j < m; j++)
+        level[j] = 0;
+    uint32_t left = bits;
+    for (;;) {
+        uint32_t best = m;
+        double gain = 0.0;
+        for (uint32_t j = 0; j < m; j++) {
+            uint32_t i = level[j];
+            if (i + 1 >= NWIDTHS)
+                continue;
+            uint32_t cost = WIDTH_SET[i + 1] - WIDTH_SET[i];
+            if (cost > left)
+                continue;
+            double g = (dist[(size_t)j * NWIDTHS + i] - dist[(size_t)j * NWIDTHS + i + 1]) / cost;
+            if (g > gain) {
+                best = j;
+                gain = g;
+            }
+        }
+        if (best == m)
+            break;
+        left -= WIDTH_SET[level[best] + 1] - WIDTH_SET[level[best]];
+        level[best]++;
+    }
+}
+
+/* Bytes of the model of k clusters and m vectors with a width table. */
+static uint64_t widths_model_bytes(uint32_t order, uint32_t k, uint32_t m)
+{
+    return vdsh_cpca_model_bytes(order, k, m) + ((m + 15u) & ~15u);
+}
+
+static vdsh_result encode_widths(const float *src, const float *normals, uint32_t rows,
+                                 uint32_t order, const vdsh_cpca_settings *settings,
+                                 uint32_t fit_basis, double budget, const uint8_t *widths,
+                                 float *decoded, vdsh_cpca_widths_fit *out, vdsh_cpca_fit *fit,
+                                 vdsh_error *err);
+
+vdsh_result vdsh_cpca_encode_widths(const float *src, const float *normals, uint32_t rows,
+                                    uint32_t order, const vdsh_cpca_settings *settings,
+                                    uint32_t fit_basis, double budget, const uint8_t *widths,
+                                    float *decoded, vdsh_cpca_widths_fit *out, vdsh_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!decoded || !settings || settings->budget)
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca widths: bad arguments");
+    return encode_widths(src, normals, rows, order, settings, fit_basis, budget, widths, decoded,
+                         out, NULL, err);
+}
+
+/* --cpca K,alloc:BYTES (settings K and budget): refined with the largest
+ * B whose 4-bit records and model fit the budget, widths allocated over
+ * min(2B, n) vectors; *out the stream (bits 0, the widths table). */
+static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t rows,
+                                uint32_t order, const vdsh_cpca_settings *settings,
+                                vdsh_cpca_fit *out, vdsh_error *err)
+{
+    const uint32_t n = order * order;
+    const uint64_t limit = (uint64_t)settings->budget * rows;
+    vdsh_cpca_settings st = {settings->clusters < rows ? settings->clusters : rows, 0, 4, 0};
+    for (uint32_t b = n; b >= 1 && !st.basis; b--) {
+        vdsh_cpca_settings t = st;
+        t.basis = b;
+        if (fit_bytes(rows, order, &t) <= limit)
+            st.basis = b;
+    }
+    if (!st.basis)
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                          "cpca: alloc budget %u bytes per vertex too small for %u rows of order "
+                          "%u at %u clusters",
+                          settings->budget, rows, order, st.clusters);
+    uint32_t fb = 2 * st.basis < n ? 2 * st.basis : n;
+    vdsh_cpca_widths_fit wf;
+    return encode_widths(src, normals, rows, order, &st, fb, (double)settings->budget, NULL, NULL,
+                         &wf, out, err);
+}
+
+static vdsh_result encode_widths(const float *src, const float *normals, uint32_t rows,
+                                 uint32_t order, const vdsh_cpca_settings *settings,
+                                 uint32_t fit_basis, double budget, const uint8_t *widths,
+                                 float *decoded, vdsh_cpca_widths_fit *out, vdsh_cpca_fit *fit,
+                                 vdsh_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (fit)
+        memset(fit, 0, sizeof *fit);
+    const uint32_t n = order * order;
+    if (!src || !normals || !settings || rows < 1 || rows > VDSH_MAX_VERTICES || order < 1 ||
+        order > VDSH_MAX_ORDER || settings->budget || !(budget >= 0.0) ||
+        (budget == 0.0 && !widths))
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca widths: bad arguments (rows %u, order %u)",
+                          rows, order);
+    if (!check_settings(settings, err))
+        return VDSH_ERR_ARGUMENT;
+    const uint32_t k = settings->clusters < rows ? settings->clusters : rows;
+    const uint32_t b = settings->basis < n ? settings->basis : n;
+    if (fit_basis < b || fit_basis > n)
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca widths: fit basis %u out of range %u..%u",
+                          fit_basis, b, n);
+    if (widths && budget == 0.0)
+        for (uint32_t j = 0; j < fit_basis; j++)
+            if (widths[j] == 1 || widths[j] > 8)
+                return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                                  "cpca widths: vector %u's width %u (0 or 2..8)", j, widths[j]);
+    for (size_t x = 0; x < (size_t)rows * n; x++)
+        if (!isfinite(src[x]))
+            return vdsh_failf(err, VDSH_ERR_INVALID,
+                              "cpca: vertex %zu coefficient %zu is not finite", x / n, x % n);
+    const uint32_t bf = fit_basis;
+    uint16_t *means = malloc(sizeof(uint16_t) * k * n);
+    uint16_t *bases = malloc(sizeof(uint16_t) * k * bf * n);
+    uint32_t *labels = malloc(sizeof(uint32_t) * rows);
+    double *dist = malloc(sizeof(double) * rows);
+    double *cent = malloc(sizeof(double) * k * (n + 3));
+    double *g = malloc(sizeof(double) * n * n), *l = malloc(sizeof(double) * n * n);
+    double *sc = malloc(sizeof(double) * n * n), *sy = malloc(sizeof(double) * n * n);
+    double *ev = malloc(sizeof(double) * n * n), *proj = malloc(sizeof(double) * k * n * bf);
+    double *tmp = malloc(sizeof(double) * n * n), *mu = malloc(sizeof(double) * n);
+    double *mus = malloc(sizeof(double) * k * n);
+    uint32_t *members = malloc(sizeof(uint32_t) * k);
+    uint32_t *idx = malloc(sizeof(uint32_t) * n);
+    double *frac = malloc(sizeof(double) * 6 * CUBE_N * CUBE_N);
+    double *wts = malloc(sizeof(double) * rows * bf);          /* each row's weights */
+    double *cdist = malloc(sizeof(double) * k * bf * NWIDTHS); /* per cluster */
+    float *cscale = malloc(sizeof(float) * k * bf * NWIDTHS);  /* the best scale */
+    double *tot = malloc(sizeof(double) * bf * NWIDTHS);       /* over clusters */
+    uint32_t *level = malloc(sizeof(uint32_t) * bf), *best_level = malloc(sizeof(uint32_t) * bf);
+    metric_dirs md = {0};
+    refine_ctx rd = {0};
+    const uint32_t rounds = k > 1 ? REFINE_ROUNDS : 0;
+    vdsh_result res = VDSH_OK;
+    if (!means || !bases || !labels || !dist || !cent || !g || !l || !sc || !sy || !ev || !proj ||
+        !tmp || !mu || !mus || !members || !idx || !frac || !wts || !cdist || !cscale || !tot ||
+        !level || !best_level || !metric_init(&md, order, CUBE_N) ||
+        (rounds && !refine_init(&rd, order, k, b, rows))) {
+        res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca widths: out of memory");
+        goto done;
+    }
+    fit_ctx fc = {.src = src,
+                  .normals = normals,
+                  .rows = rows,
+                  .n = n,
+                  .k = k,
+                  .b = b,
+                  .md = &md,
+                  .labels = labels,
+                  .means = means,
+                  .bases = bases,
+                  .members = members,
+                  .mus = mus,
+                  .l = l,
+                  .proj = proj,
+                  .g = g,
+                  .sc = sc,
+                  .sy = sy,
+                  .ev = ev,
+                  .tmp = tmp,
+                  .frac = frac,
+                  .idx = idx};
+    /* k-means, fit and refinement exactly as encode_fixed */
+    for (uint32_t i = 0; i < n; i++)
+        mu[i] = 0.0;
+    for (uint32_t v = 0; v < rows; v++)
+        for (uint32_t i = 0; i < n; i++)
+            mu[i] += src[(size_t)v * n + i];
+    for (uint32_t i = 0; i < n; i++)
+        mu[i] /= rows;
+    double spread = 0.0;
+    for (uint32_t v = 0; v < rows; v++)
+        for (uint32_t i = 0; i < n; i++) {
+            double e = src[(size_t)v * n + i] - mu[i];
+            spread += e * e;
+        }
+    spread = sqrt(spread / rows);
+    kmeans(src, normals, rows, n, NORMAL_WEIGHT * spread, k, labels, dist, cent);
+    res = fit_all(&fc, err);
+    for (uint32_t round = 0; res == VDSH_OK && round < rounds; round++) {
+        if (!reassign(&fc, &rd))
+            break;
+        res = fit_all(&fc, err);
+    }
+    /* the final labels' fit with bf vectors (its first b the same) */
+    fc.b = bf;
+    if (res == VDSH_OK)
+        res = fit_all(&fc, err);
+    if (res != VDSH_OK)
+        goto done;
+
+    /* weights; per cluster, vector and width the least squared error over
+     * the candidate scales */
+    for (uint32_t v = 0; v < rows; v++) {
+        uint32_t c = labels[v];
+        for (uint32_t j = 0; j < bf; j++)
+            wts[(size_t)v * bf + j] = weight_of(src + (size_t)v * n, mus + (size_t)c * n,
+                                                proj + ((size_t)c * bf + j) * n, n);
+    }
+    memset(cdist, 0, sizeof(double) * k * bf * NWIDTHS);
+    memset(cscale, 0, sizeof(float) * k * bf * NWIDTHS);
+    for (uint32_t c = 0; c < k; c++) {
+        if (!members[c])
+            continue;
+        for (uint32_t j = 0; j < bf; j++) {
+            double wmax = 0.0, e0 = 0.0;
+            for (uint32_t v = 0; v < rows; v++)
+                if (labels[v] == c) {
+                    double w = wts[(size_t)v * bf + j];
+                    wmax = fabs(w) > wmax ? fabs(w) : wmax;
+                    e0 += w * w;
+                }
+            double *cd = cdist + ((size_t)c * bf + j) * NWIDTHS;
+            float *cs = cscale + ((size_t)c * bf + j) * NWIDTHS;
+            cd[0] = e0;
+            for (uint32_t i = 1; i < NWIDTHS; i++) {
+                const int levels = (1 << (WIDTH_SET[i] - 1)) - 1;
+                cd[i] = e0;
+                for (uint32_t t = 0; t < SCALE_CANDIDATES; t++) {
+                    double s = candidate_scale(wmax, t), e = 0.0;
+                    if (!(s > 0.0))
+                        break;
+                    double step = (double)((float)s / (float)levels);
+                    for (uint32_t v = 0; v < rows; v++)
+                        if (labels[v] == c) {
+                            double w = wts[(size_t)v * bf + j];
+                            double d = w - quantise(w, s, levels) * step;
+                            e += d * d;
+                        }
+                    if (t == 0 || e < cd[i]) {
+                        cd[i] = e;
+                        cs[i] = (float)s;
+                    }
+                }
+            }
+        }
+    }
+    for (uint32_t x = 0; x < bf * NWIDTHS; x++) {
+        double s = 0.0;
+        for (uint32_t c = 0; c < k; c++)
+            s += cdist[(size_t)c * bf * NWIDTHS + x];
+        tot[x] = s;
+    }
+
+    /* the width table */
+    if (budget > 0.0) {
+        const double limit = budget * rows;
+        double best_e = 0.0;
+        int have = 0;
+        for (uint32_t words = 1; words <= 64; words++) {
+            uint32_t m = 0;
+            while (m < bf &&
+                   (double)rows * 4.0 * words + (double)widths_model_bytes(order, k, m + 1) <=
+                       limit)
+                m++;
+            if (!m)
+                break;
+            uint32_t bits = 32 * words - VDSH_CPCA_INDEX_BITS;
+            uint8_t wd[VDSH_MAX_COEFFS];
+            for (;;) {
+                allocate_widths(tot, m, bits, level);
+                for (uint32_t j = 0; j < m; j++)
+                    wd[j] = (uint8_t)WIDTH_SET[level[j]];
+                if (vdsh_cpca_widths_words(wd, m) <= words || !bits)
+                    break;
+                bits--;
+            }
+            double e = 0.0;
+            for (uint32_t j = 0; j < bf; j++)
+                e += tot[(size_t)j * NWIDTHS + (j < m ? level[j] : 0)];
+            if (!have || e < best_e) {
+                best_e = e;
+                have = 1;
+                for (uint32_t j = 0; j < bf; j++)
+                    best_level[j] = j < m ? level[j] : 0;
+            }
+        }
+        if (!have) {
+            res = vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                             "cpca widths: %g bytes per vertex: nothing fits", budget);
+            goto done;
+        }
+        for (uint32_t j = 0; j < bf; j++)
+            out->widths[j] = (uint8_t)WIDTH_SET[best_level[j]];
+    } else {
+        for (uint32_t j = 0; j < bf; j++) {
+            out->widths[j] = widths[j];
+            uint32_t i = 0;
+            while (WIDTH_SET[i] != widths[j])
+                i++;
+            best_level[j] = i;
+        }
+    }
+    out->clusters = k;
+    out->basis = 0;
+    for (uint32_t j = 0; j < bf; j++)
+        if (out->widths[j])
+            out->basis = j + 1;
+    out->words = vdsh_cpca_widths_words(out->widths, bf);
+    out->bytes_per_vertex =
+        ((double)rows * 4.0 * out->words + (double)widths_model_bytes(order, k, out->basis)) / rows;
+
+    if (fit) { /* the stream: the vectors of width > 0, in order */
+        uint32_t kb = 0, keep[VDSH_MAX_COEFFS];
+        for (uint32_t j = 0; j < bf; j++)
+            if (best_level[j])
+                keep[kb++] = j;
+        uint8_t wd[VDSH_MAX_COEFFS];
+        for (uint32_t q = 0; q < kb; q++)
+            wd[q] = (uint8_t)WIDTH_SET[best_level[keep[q]]];
+        const uint32_t words = vdsh_cpca_widths_words(wd, kb);
+        size_t o_sc = ((size_t)kb + 15) & ~(size_t)15;
+        size_t o_means = o_sc + (((size_t)k * kb * 4 + 15) & ~(size_t)15);
+        size_t o_bases = o_means + (((size_t)k * n * 2 + 15) & ~(size_t)15);
+        size_t o_rec = o_bases + (((size_t)k * kb * n * 2 + 15) & ~(size_t)15);
+        uint8_t *block = kb ? calloc(1, o_rec + (size_t)rows * words * 4) : NULL;
+        if (!block) {
+            res = vdsh_failf(err, kb ? VDSH_ERR_OUT_OF_MEMORY : VDSH_ERR_ARGUMENT,
+                             kb ? "cpca: out of memory" : "cpca: alloc kept no basis vector");
+            goto done;
+        }
+        memcpy(block, wd, kb);
+        float *sc_out = (float *)(block + o_sc);
+        uint16_t *me_out = (uint16_t *)(block + o_means), *ba_out = (uint16_t *)(block + o_bases);
+        uint32_t *rec = (uint32_t *)(block + o_rec);
+        memcpy(me_out, means, sizeof(uint16_t) * k * n);
+        for (uint32_t c = 0; c < k; c++)
+            for (uint32_t q = 0; q < kb; q++) {
+                uint32_t j = keep[q];
+                sc_out[(size_t)c * kb + q] = cscale[((size_t)c * bf + j) * NWIDTHS + best_level[j]];
+                memcpy(ba_out + ((size_t)c * kb + q) * n, bases + ((size_t)c * bf + j) * n,
+                       sizeof(uint16_t) * n);
+            }
+        fit->model = (vdsh_cpca){.clusters = k,
+                                 .basis = kb,
+                                 .bits = 0,
+                                 .record_words = words,
+                                 .widths = block,
+                                 .scales = sc_out,
+                                 .means = me_out,
+                                 .bases = ba_out};
+        for (uint32_t v = 0; v < rows; v++) {
+            uint32_t *r = rec + (size_t)v * words, c = labels[v];
+            r[0] = c;
+            for (uint32_t q = 0; q < kb; q++) {
+                uint32_t j = keep[q], word, shift;
+                const int levels = vdsh_cpca_levels(wd[q]);
+                double lq = quantise(wts[(size_t)v * bf + j], sc_out[(size_t)c * kb + q], levels);
+                vdsh_cpca_model_field(&fit->model, q, &word, &shift);
+                r[word] |= ((uint32_t)(int32_t)lq & ((1u << wd[q]) - 1u)) << shift;
+            }
+        }
+        fit->records = rec;
+        fit->storage_ = block;
+        vdsh_stream s = {.order = order,
+                         .encoding = VDSH_ENCODING_CPCA,
+                         .scale = 1.0f,
+                         .data = rec,
+                         .cpca = fit->model};
+        float dec[VDSH_MAX_COEFFS];
+        double e2 = 0.0;
+        for (uint32_t v = 0; v < rows; v++) {
+            vdsh_stream_decode(&s, v, dec);
+            for (uint32_t i = 0; i < n; i++) {
+                double e = (double)dec[i] - src[(size_t)v * n + i];
+                e2 += e * e;
+            }
+        }
+        fit->rms_error = out->rms_error = sqrt(e2 / rows);
+        goto done;
+    }
+
+    /* decode as the format's rule: f32, mean + sum_j weight_j x basis_j */
+    double e2 = 0.0;
+    for (uint32_t v = 0; v < rows; v++) {
+        uint32_t c = labels[v];
+        float *o = decoded + (size_t)v * n;
+        for (uint32_t i = 0; i < n; i++)
+            o[i] = vdsh_f32_from_f16(means[(size_t)c * n + i]);
+        for (uint32_t j = 0; j < bf; j++) {
+            uint32_t i = best_level[j];
+            if (!i)
+                continue;
+            const int levels = (1 << (WIDTH_SET[i] - 1)) - 1;
+            float s = cscale[((size_t)c * bf + j) * NWIDTHS + i];
+            float step = s / (float)levels;
+            float w = (float)quantise(wts[(size_t)v * bf + j], s, levels) * step;
+            const uint16_t *bj = bases + ((size_t)c * bf + j) * n;
+            for (uint32_t a = 0; a < n; a++)
+                o[a] = o[a] + w * vdsh_f32_from_f16(bj[a]);
+        }
+        for (uint32_t i = 0; i < n; i++) {
+            double e = (double)o[i] - src[(size_t)v * n + i];
+            e2 += e * e;
+        }
+    }
+    out->rms_error = sqrt(e2 / rows);
+done:
+    free(means);
+    free(bases);
+    free(labels);
+    free(dist);
+    free(cent);
+    free(g);
+    free(l);
+    free(sc);
+    free(sy);
+    free(ev);
+    free(proj);
+    free(tmp);
+    free(mu);
+    free(mus);
+    free(members);
+    free(idx);
+    free(frac);
+    free(wts);
+    free(cdist);
+    free(cscale);
+    free(tot);
+    free(level);
+    free(best_level);
+    metric_free(&md);
+    if (rounds)
+        refine_free(&rd);
+    return res;
 }

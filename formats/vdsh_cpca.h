@@ -46,17 +46,19 @@ typedef struct vdsh_cpca_settings {
     uint32_t clusters; /* K asked for, 1..VDSH_CPCA_MAX_CLUSTERS (capped at rows) */
     uint32_t basis;    /* B asked for, 1..VDSH_MAX_COEFFS (capped at order^2) */
     uint32_t bits;     /* VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS */
-    /* auto (vdsh-bake --cpca auto[:BYTES]): 1..VDSH_CPCA_MAX_BUDGET bytes
-     * per vertex, the model included; K, B and bits are then ignored and
-     * the encoder picks them (vdsh_cpca_encode). 0: the fixed K, B, bits. */
+    /* auto (vdsh-bake --cpca auto[:BYTES], clusters 0): 1..VDSH_CPCA_MAX_BUDGET
+     * bytes per vertex, the model included; B and bits are then ignored and
+     * the encoder picks K, B (vdsh_cpca_encode). With clusters K
+     * (--cpca K,alloc:BYTES): a width per basis vector within the budget
+     * (bits 0 in the stream). 0: the fixed K, B, bits. */
     uint32_t budget;
 } vdsh_cpca_settings;
 
 /* K = 8, B = 54, 4 bits (docs/ACCURACY.md "Compressed high orders"). */
 vdsh_cpca_settings vdsh_cpca_settings_default(void);
 
-/* Parse "K,B,BITS" (for example "8,54,4"), "auto" (budget 32) or
- * "auto:BYTES" (1..VDSH_CPCA_MAX_BUDGET) into *out; VDSH_ERR_ARGUMENT with
+/* Parse "K,B,BITS" (for example "8,54,4"), "auto" (budget 32),
+ * "auto:BYTES" (1..VDSH_CPCA_MAX_BUDGET) or "K,alloc:BYTES" into *out; VDSH_ERR_ARGUMENT with
  * a message for a malformed string or a value out of range. */
 vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_error *err);
 
@@ -77,7 +79,11 @@ typedef struct vdsh_cpca_fit {
  * bytes per vertex; each such K,B fitted in full, and the one kept whose
  * decoded (quantised) functions differ least from the sources over each
  * vertex's own hemisphere (the refinement's error; first in that order on
- * a tie). VDSH_ERR_ARGUMENT when none fits the budget.
+ * a tie). VDSH_ERR_ARGUMENT when none fits the budget. With K and a
+ * budget (alloc): K, B refined as above with the largest B whose 4-bit
+ * records and model fit, then a width per vector over min(2B, n) vectors
+ * (vdsh_cpca_study.h's allocation; VDSH.md "cpca streams"), vectors of
+ * width 0 dropped: model.bits 0 and model.widths set.
  * VDSH_ERR_ARGUMENT for bad settings, order or rows; VDSH_ERR_INVALID for
  * a value that is not finite or a model that does not fit f16;
  * VDSH_ERR_OUT_OF_MEMORY. On failure *out is zeroed. */

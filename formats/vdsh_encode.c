@@ -281,6 +281,47 @@ void vdsh_cpca_field(uint32_t bits, uint32_t j, uint32_t *word, uint32_t *shift)
     }
 }
 
+uint32_t vdsh_cpca_widths_words(const uint8_t *widths, uint32_t basis)
+{
+    uint32_t word = 0, used = VDSH_CPCA_INDEX_BITS;
+    for (uint32_t j = 0; j < basis; j++) {
+        if (!widths[j])
+            continue;
+        if (used + widths[j] > 32) {
+            word++;
+            used = 0;
+        }
+        used += widths[j];
+    }
+    return word + 1;
+}
+
+void vdsh_cpca_model_field(const vdsh_cpca *m, uint32_t j, uint32_t *word, uint32_t *shift)
+{
+    if (m->bits) {
+        vdsh_cpca_field(m->bits, j, word, shift);
+        return;
+    }
+    uint32_t wd = 0, used = VDSH_CPCA_INDEX_BITS;
+    for (uint32_t q = 0;; q++) {
+        if (used + m->widths[q] > 32) {
+            wd++;
+            used = 0;
+        }
+        if (q == j)
+            break;
+        used += m->widths[q];
+    }
+    *word = wd;
+    *shift = used;
+}
+
+uint64_t vdsh_cpca_stream_model_bytes(const vdsh_cpca *m, uint32_t order)
+{
+    return vdsh_cpca_model_bytes(order, m->clusters, m->basis) +
+           (m->bits ? 0 : ((uint64_t)m->basis + 15) & ~15ull);
+}
+
 uint64_t vdsh_cpca_model_bytes(uint32_t order, uint32_t clusters, uint32_t basis)
 {
     uint64_t n = (uint64_t)order * order, k = clusters, b = basis;
@@ -294,6 +335,9 @@ void vdsh_cpca_bind(vdsh_stream *s, const uint8_t *model)
 {
     uint64_t n = (uint64_t)s->order * s->order, k = s->cpca.clusters, b = s->cpca.basis;
     const uint8_t *q = model + CPCA_HEADER_SIZE;
+    s->cpca.widths = s->cpca.bits ? NULL : q;
+    if (!s->cpca.bits)
+        q += (b + 15) & ~15ull;
     s->cpca.scales = (const float *)q;
     q += (4 * k * b + 15) & ~15ull;
     s->cpca.means = (const uint16_t *)q;
@@ -316,6 +360,11 @@ int32_t vdsh_cpca_record_level(const uint32_t *r, uint32_t bits, uint32_t j)
 {
     uint32_t word, shift;
     vdsh_cpca_field(bits, j, &word, &shift);
+    return vdsh_cpca_field_level(r, word, shift, bits);
+}
+
+int32_t vdsh_cpca_field_level(const uint32_t *r, uint32_t word, uint32_t shift, uint32_t bits)
+{
     uint32_t u = (r[word] >> shift) & ((1u << bits) - 1u);
     return (int32_t)u - (int32_t)((u >> (bits - 1)) << bits);
 }
@@ -323,13 +372,20 @@ int32_t vdsh_cpca_record_level(const uint32_t *r, uint32_t bits, uint32_t j)
 void vdsh_cpca_weights(const vdsh_stream *s, uint32_t v, int32_t *levels, float *weights)
 {
     const uint32_t *r = cpca_record(s, v);
-    uint32_t c = r[0] & 0xffu, b = s->cpca.basis, bits = s->cpca.bits;
+    const vdsh_cpca *m = &s->cpca;
+    uint32_t c = r[0] & 0xffu, b = m->basis, word = 0, used = VDSH_CPCA_INDEX_BITS;
     for (uint32_t j = 0; j < b; j++) {
-        int32_t q = vdsh_cpca_record_level(r, bits, j);
+        uint32_t bits = vdsh_cpca_width(m, j);
+        if (used + bits > 32) { /* no field straddles two words */
+            word++;
+            used = 0;
+        }
+        int32_t q = vdsh_cpca_field_level(r, word, used, bits);
+        used += bits;
         if (levels)
             levels[j] = q;
         if (weights)
-            weights[j] = (float)q * vdsh_cpca_step(s->cpca.scales[(size_t)c * b + j], bits);
+            weights[j] = (float)q * vdsh_cpca_step(m->scales[(size_t)c * b + j], bits);
     }
 }
 
@@ -445,8 +501,7 @@ vdsh_stream_size vdsh_stream_size_of(const vdsh_stream *s, uint32_t rows)
         z.max_bytes = (uint32_t)vdsh_stream_bytes_per_vertex(s);
         z.mean_bytes = z.max_bytes;
         if (s->encoding == VDSH_ENCODING_CPCA && rows)
-            z.mean_bytes +=
-                (double)vdsh_cpca_model_bytes(s->order, s->cpca.clusters, s->cpca.basis) / rows;
+            z.mean_bytes += (double)vdsh_cpca_stream_model_bytes(&s->cpca, s->order) / rows;
         return z;
     }
     for (uint32_t v = 0; v < rows; v++)

@@ -181,6 +181,8 @@ int vdsh_bad(why *w, const char *fmt, ...);
 
 /* The signed level of weight j of record r. */
 int32_t vdsh_cpca_record_level(const uint32_t *r, uint32_t bits, uint32_t j);
+/* The signed level of the `bits`-wide field at word, shift of record r. */
+int32_t vdsh_cpca_field_level(const uint32_t *r, uint32_t word, uint32_t shift, uint32_t bits);
 
 /* Bytes between the stream header and the data: an s8 stream's scale
  * table (order^2 f32), zero-padded to a multiple of 16; else 0. */

@@ -334,11 +334,21 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
         s->cpca.basis = get_u32(p + STREAM_HEADER_SIZE + 4);
         s->cpca.bits = get_u32(p + STREAM_HEADER_SIZE + 8);
         s->cpca.record_words = get_u32(p + STREAM_HEADER_SIZE + 12);
+        /* bits 0: the widths table follows the cpca header (checked with
+         * the header; B out of range is refused there first) */
+        uint64_t b = s->cpca.basis;
+        if (!s->cpca.bits && b >= 1 && b <= VDSH_MAX_COEFFS) {
+            if (c->size - STREAM_HEADER_SIZE - CPCA_HEADER_SIZE < ((b + 15) & ~15ull))
+                return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
+                                     "%s: %llu bytes of data, shorter than the cpca widths table",
+                                     l, (unsigned long long)(c->size - STREAM_HEADER_SIZE));
+            s->cpca.widths = p + STREAM_HEADER_SIZE + CPCA_HEADER_SIZE;
+        }
     }
     if (!vdsh_check_stream(s, i, &w))
         return invalid(r, &w);
     uint64_t table = s->encoding == VDSH_ENCODING_CPCA
-                         ? vdsh_cpca_model_bytes(s->order, s->cpca.clusters, s->cpca.basis)
+                         ? vdsh_cpca_stream_model_bytes(&s->cpca, s->order)
                          : vdsh_stream_table_bytes(s->encoding, s->order);
     if (c->size - STREAM_HEADER_SIZE < table)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
@@ -347,10 +357,10 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
                              (unsigned long long)table);
     if (table && s->encoding == VDSH_ENCODING_CPCA) {
         uint64_t n = (uint64_t)s->order * s->order, k = s->cpca.clusters, b = s->cpca.basis;
-        uint64_t sizes[3] = {4 * k * b, 2 * k * n, 2 * k * b * n};
-        static const char *const what[3] = {"scales", "means", "bases"};
+        uint64_t sizes[4] = {s->cpca.bits ? 0 : b, 4 * k * b, 2 * k * n, 2 * k * b * n};
+        static const char *const what[4] = {"widths", "scales", "means", "bases"};
         const uint8_t *q = p + STREAM_HEADER_SIZE + CPCA_HEADER_SIZE;
-        for (int a = 0; a < 3; a++) {
+        for (int a = 0; a < 4; a++) {
             uint64_t padded = (sizes[a] + 15) & ~15ull;
             if (!all_zero(q + sizes[a], (size_t)(padded - sizes[a])))
                 return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
@@ -388,7 +398,7 @@ static vdsh_result check_coef_sizes(const reader *r, layout *L)
         char l[96];
         vdsh_stream_label(s, i, l, sizeof l);
         int cpca = s->encoding == VDSH_ENCODING_CPCA;
-        uint64_t table = cpca ? vdsh_cpca_model_bytes(s->order, s->cpca.clusters, s->cpca.basis)
+        uint64_t table = cpca ? vdsh_cpca_stream_model_bytes(&s->cpca, s->order)
                               : vdsh_stream_table_bytes(s->encoding, s->order);
         uint64_t orders = 0; /* a variable-order stream's order table */
         if (vdsh_stream_variable(s)) {

@@ -204,12 +204,15 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name, vds
             put_u32(p + STREAM_HEADER_SIZE + 4, m->basis);
             put_u32(p + STREAM_HEADER_SIZE + 8, m->bits);
             put_u32(p + STREAM_HEADER_SIZE + 12, m->record_words);
-            size_t mb =
-                (size_t)vdsh_cpca_model_bytes(s->order, m->clusters, m->basis) - CPCA_HEADER_SIZE;
+            size_t mb = (size_t)vdsh_cpca_stream_model_bytes(m, s->order) - CPCA_HEADER_SIZE;
             size_t n = (size_t)s->order * s->order, k = m->clusters, b = m->basis;
             uint8_t *q = P->model[i] = (uint8_t *)calloc(1, mb + 1);
             if (!q)
                 return vdsh_failf_at(err, VDSH_ERR_OUT_OF_MEMORY, name, "out of memory");
+            if (!m->bits) { /* the widths table, padded */
+                memcpy(q, m->widths, b);
+                q += (b + 15) & ~(size_t)15;
+            }
             for (size_t x = 0; x < k * b; x++)
                 put_f32(q + 4 * x, m->scales[x]);
             q += (4 * k * b + 15) & ~(size_t)15;

@@ -38,7 +38,11 @@
  * ((c * T + t) * (B + 1) + j), T = stride of the order as f32. The
  * vertex stage decodes its coefficients four at a time as mean + sum of
  * level_j * texel_j (vdsh_buffer.glsl, BUF_KIND 4), then sums them as
- * the other kinds do: once per vertex, not once per light. The model is
+ * the other kinds do: once per vertex, not once per light. A stream with
+ * a width per basis vector (bits 0) gets each step from its vector's
+ * width and its unpacking written out into the programs
+ * (cpca_unpack_define, BUF_CPCA_UNPACK), one program per widths table
+ * (ks_hash covers it). The model is
  * K * (B + 1) * T * 16 bytes (8, 54, 4 at order 12: 253 KB), the records
  * the file's (28 bytes per vertex at the default).
  *
@@ -113,6 +117,7 @@ void vr_buffer_destroy(vr_buffer *b)
     if (b->decode_prog)
         glDeleteProgram(b->decode_prog);
     free(b->ks);
+    free(b->cpca_unpack);
     memset(b, 0, sizeof *b);
 }
 
@@ -301,7 +306,7 @@ static float *build_model(const vdsh_stream *st, int order, size_t *bytes)
             t[0] = vdsh_f32_from_f16(m->means[(size_t)c * (size_t)nc + (size_t)seq[p]]);
             for (uint32_t j = 0; j < m->basis; j++) {
                 size_t v = (size_t)c * m->basis + j;
-                float step = vdsh_cpca_step(m->scales[v], m->bits);
+                float step = vdsh_cpca_step(m->scales[v], vdsh_cpca_width(m, j));
                 t[4 * (j + 1)] =
                     step * vdsh_f32_from_f16(m->bases[v * (size_t)nc + (size_t)seq[p]]);
             }
@@ -344,6 +349,35 @@ static void make_gl(vr_scene *s, vr_buffer *b, const void *rec, size_t bytes, co
     }
     glBindVertexArray(0);
     b->bytes += bytes;
+}
+
+/* "#define BUF_CPCA_UNPACK(f) w = BUF_FETCH((f) + 1).r; b_wt[0] = ...;\n"
+ * for a cpca stream with a width per basis vector (bits 0): buf_begin's
+ * unpacking (shaders/vdsh_buffer.glsl; word 0, already in w, holds the
+ * cluster) written out, each field's word, shifts and width constants
+ * (vdsh_cpca_model_field), a word fetched once. Malloc'd; NULL when out
+ * of memory. */
+static char *cpca_unpack_define(const vdsh_cpca *m)
+{
+    size_t size = 64 + (size_t)m->basis * 64;
+    char *d = malloc(size);
+    if (!d)
+        return NULL;
+    size_t n = (size_t)snprintf(d, size, "#define BUF_CPCA_UNPACK(f)");
+    uint32_t last = 0;
+    for (uint32_t j = 0; j < m->basis && n < size; j++) {
+        uint32_t word = 0, shift = 0, width = vdsh_cpca_width(m, j);
+        vdsh_cpca_model_field(m, j, &word, &shift);
+        if (word != last && n < size)
+            n += (size_t)snprintf(d + n, size - n, " w = BUF_FETCH((f) + %u).r;", word);
+        last = word;
+        if (n < size)
+            n += (size_t)snprintf(d + n, size - n, " b_wt[%u] = float(int(w << %uu) >> %u);", j,
+                                  32 - shift - width, 32 - width);
+    }
+    if (n < size)
+        snprintf(d + n, size - n, "\n");
+    return d;
 }
 
 /* "#define BUF_CPCA_DOT(m) (BUF_MODEL(m) + b_wt[0] * BUF_MODEL((m) + 1)
@@ -415,14 +449,16 @@ static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const char *name,
              core ? "#version 430 core\n"
                   : "#version 330 core\n#extension GL_ARB_shader_storage_buffer_object : require\n",
              b->order, b->stride, b->cpca_basis, b->cpca_bits, b->scratch_stride);
-    size_t size = strlen(defines) + (dot ? strlen(dot) : 0) + vr_buffer_glsl_size +
+    size_t size = strlen(defines) + (dot ? strlen(dot) : 0) +
+                  (b->cpca_unpack ? strlen(b->cpca_unpack) : 0) + vr_buffer_glsl_size +
                   vr_cpca_decode_glsl_size + 1;
     char *vs = dot ? malloc(size) : NULL;
     if (!vs) {
         free(dot);
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
     }
-    snprintf(vs, size, "%s%s%s%s", defines, dot, vr_buffer_glsl, vr_cpca_decode_glsl);
+    snprintf(vs, size, "%s%s%s%s%s", defines, dot, b->cpca_unpack ? b->cpca_unpack : "",
+             vr_buffer_glsl, vr_cpca_decode_glsl);
     free(dot);
     static const char fs[] = "#version 330 core\nout vec4 o;\nvoid main() { o = vec4(0.0); }\n";
     char what[256];
@@ -489,13 +525,29 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
         b.cpca_bits = (int)st->cpca.bits;
         b.stride = (int)st->cpca.record_words;
     }
+    if (b.kind == VR_BUF_CPCA && !b.cpca_bits) {
+        /* a width per vector: each checked 2..8 by the reader; the words
+         * they fill are the stream's (vdsh_check_stream) */
+        b.cpca_unpack = st->cpca.widths ? cpca_unpack_define(&st->cpca) : NULL;
+        if (!b.cpca_unpack)
+            return vr_fail(err, st->cpca.widths ? VR_ERR_OUT_OF_MEMORY : VR_ERR_FORMAT,
+                           "%s: order %d cpca stream: %s", name, order,
+                           st->cpca.widths ? "out of memory" : "bits 0 without its widths table");
+    }
     b.ks = make_ks(st, order, floats);
-    if (!b.ks)
+    if (!b.ks) {
+        free(b.cpca_unpack);
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
-    /* FNV-1a over the order and the table's bits */
+    }
+    /* FNV-1a over the order, the table's bits and (a width per vector)
+     * the unpacking, which the program's source holds too */
     b.ks_hash = 1469598103934665603ull ^ (uint64_t)order;
     for (size_t i = 0; i < (size_t)order * (size_t)order * sizeof(float); i++) {
         b.ks_hash ^= ((const unsigned char *)b.ks)[i];
+        b.ks_hash *= 1099511628211ull;
+    }
+    for (const char *c = b.cpca_unpack; c && *c; c++) {
+        b.ks_hash ^= (unsigned char)*c;
         b.ks_hash *= 1099511628211ull;
     }
 

@@ -149,7 +149,7 @@ static void key_defines(const vr_program_key *k, int flat, char *buf, size_t siz
                      k->buf_order, k->buf_kind, k->buf_variable,
                      !buffer ? 0
                      : k->buf_kind == VR_BUF_CPCA
-                         ? (int)vdsh_cpca_record_words(k->cpca_basis, k->cpca_bits)
+                         ? (int)k->cpca_words
                          : vr_buffer_stride(k->buf_order, (vr_buf_kind)k->buf_kind),
                      k->mode == VR_MODE_SDF, k->cpca_basis, k->cpca_bits,
                      vr_buffer_stride(k->buf_order, VR_BUF_F32));
@@ -237,8 +237,8 @@ static char *ks_table(const float *ks, int n)
     return t;
 }
 
-vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_program *out,
-                           vr_error *err)
+vr_result vr_program_build(const vr_program_key *key, const float *ks, const char *cpca_unpack,
+                           vr_program *out, vr_error *err)
 {
     char name[224], defines[1024];
     key_name(key, name, sizeof name);
@@ -252,6 +252,11 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_progra
     int buffer = key->mode == VR_MODE_VDSH_BUFFER;
     if (buffer && (key->buf_order < 1 || key->buf_order > VDSH_MAX_ORDER || !ks))
         return vr_fail(err, VR_ERR_SHADER, "%s: no buffer order", name);
+    /* a cpca stream with a width per vector brings its unpacking */
+    if (buffer && key->buf_kind == VR_BUF_CPCA && !key->cpca_bits && !cpca_unpack)
+        return vr_fail(err, VR_ERR_SHADER, "%s: cpca widths without their unpacking", name);
+    if (!buffer || key->buf_kind != VR_BUF_CPCA || key->cpca_bits)
+        cpca_unpack = "";
     GLint max_varying = 0;
     glGetIntegerv(GL_MAX_VARYING_COMPONENTS, &max_varying);
     int flat = varying_components(key, 1) <= max_varying;
@@ -260,7 +265,8 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_progra
      * declarations and its main(). */
     char *table = buffer ? ks_table(ks, key->buf_order * key->buf_order) : NULL;
     size_t vs_size = sizeof defines + vr_glsl_common_size + vr_glsl_vertex_size +
-                     (table ? strlen(table) : 0) + vr_buffer_glsl_size + vr_glsl_vertex_main_size;
+                     (table ? strlen(table) : 0) + strlen(cpca_unpack) + vr_buffer_glsl_size +
+                     vr_glsl_vertex_main_size;
     size_t fs_size =
         sizeof defines + vr_glsl_common_size + vr_sdf_glsl_size + vr_glsl_fragment_size;
     char *vs = malloc(vs_size), *fs = malloc(fs_size);
@@ -276,8 +282,9 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_progra
     vr_result r;
     for (;; flat = 0) {
         key_defines(key, flat, defines, sizeof defines);
-        snprintf(vs, vs_size, "%s%s%s%s%s%s", defines, vr_glsl_common, vr_glsl_vertex,
-                 buffer ? table : "", buffer ? vr_buffer_glsl : "", vr_glsl_vertex_main);
+        snprintf(vs, vs_size, "%s%s%s%s%s%s%s", defines, vr_glsl_common, vr_glsl_vertex,
+                 buffer ? table : "", cpca_unpack, buffer ? vr_buffer_glsl : "",
+                 vr_glsl_vertex_main);
         snprintf(fs, fs_size, "%s%s%s%s", defines, vr_glsl_common,
                  key->mode == VR_MODE_SDF ? vr_sdf_glsl : "", vr_glsl_fragment);
         r = vr_link(name, vs, fs, &prog, err);

@@ -97,6 +97,10 @@ typedef struct vr_buffer {
      * basis vectors per cluster and bits per weight */
     GLuint model_buf, model_tex;
     int cpca_basis, cpca_bits;
+    /* cpca_bits 0 (a width per basis vector, VDSH.md "cpca streams"): the
+     * unpacking written out, "#define BUF_CPCA_UNPACK(f) ...\n"
+     * (vr_buffer_cpca_unpack), malloc'd and in ks_hash; else NULL */
+    char *cpca_unpack;
     /* VR_CPCA_PER_FRAME (vr_scene_desc.cpca_decode): the decode program
      * (shaders/vdsh_cpca_decode.glsl) and the scratch it writes once per
      * frame, f32 records of stride scratch_stride texels that the light
@@ -175,7 +179,9 @@ typedef struct vr_program_key {
     uint8_t buf_order;    /* VR_MODE_VDSH_BUFFER: order (variable: the cap) */
     uint8_t buf_kind;     /* vr_buf_kind */
     uint8_t buf_variable; /* 1: an order per vertex */
-    uint8_t cpca_bits;    /* VR_BUF_CPCA: bits per weight */
+    uint8_t cpca_bits;    /* VR_BUF_CPCA: bits per weight, 0: a width per
+                             vector (vr_buffer.cpca_unpack, in ks_hash) */
+    uint8_t cpca_words;   /* VR_BUF_CPCA: u32 words per record */
     uint16_t cpca_basis;  /* VR_BUF_CPCA: basis vectors per cluster */
 } vr_program_key;
 
@@ -199,11 +205,12 @@ typedef struct vr_program {
 } vr_program;
 
 /* Compile and link the lighting program for `key` (ks: the buffer
- * stream's factor table, buf_order^2 entries; NULL for other modes). On
- * failure returns VR_ERR_SHADER with the info log (and the key) in err;
- * *out untouched. */
-vr_result vr_program_build(const vr_program_key *key, const float *ks, vr_program *out,
-                           vr_error *err);
+ * stream's factor table, buf_order^2 entries; NULL for other modes;
+ * cpca_unpack: a cpca stream's with a width per vector, vr_buffer's, else
+ * NULL). On failure returns VR_ERR_SHADER with the info log (and the key)
+ * in err; *out untouched. */
+vr_result vr_program_build(const vr_program_key *key, const float *ks, const char *cpca_unpack,
+                           vr_program *out, vr_error *err);
 
 /* The depth-only program that renders cube shadow map faces
  * (uniform u_view_proj). */

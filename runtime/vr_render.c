@@ -345,7 +345,7 @@ void vr_renderer_timings(vr_renderer *r, vr_timings *out)
 /* Programs                                                             */
 
 static vr_result get_program(vr_renderer *r, const vr_program_key *k, const float *ks,
-                             const vr_program **out, vr_error *err)
+                             const char *cpca_unpack, const vr_program **out, vr_error *err)
 {
     for (int i = 0; i < r->program_count; i++)
         if (memcmp(&r->programs[i].key, k, sizeof *k) == 0) {
@@ -359,7 +359,7 @@ static vr_result get_program(vr_renderer *r, const vr_program_key *k, const floa
             glDeleteProgram(r->programs[i].prog);
         r->program_count = 0;
     }
-    vr_result res = vr_program_build(k, ks, &r->programs[r->program_count], err);
+    vr_result res = vr_program_build(k, ks, cpca_unpack, &r->programs[r->program_count], err);
     if (res != VR_OK)
         return res;
     *out = &r->programs[r->program_count++];
@@ -666,9 +666,12 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
             key.ks_hash = buf->ks_hash;
             key.cpca_basis = (uint16_t)(scratch ? 0 : buf->cpca_basis);
             key.cpca_bits = (uint8_t)(scratch ? 0 : buf->cpca_bits);
+            key.cpca_words = (uint8_t)(scratch || buf->kind != VR_BUF_CPCA ? 0 : buf->stride);
         }
         const vr_program *p = NULL;
-        res = get_program(r, &key, buf ? buf->ks : NULL, &p, err);
+        res = get_program(r, &key, buf ? buf->ks : NULL,
+                          buf && !scratch && buf->kind == VR_BUF_CPCA ? buf->cpca_unpack : NULL, &p,
+                          err);
         if (res != VR_OK)
             break;
 

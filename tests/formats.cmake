@@ -140,6 +140,10 @@ add_test(NAME format_det_math_matches_libm COMMAND test_det_math)
 add_executable(test_cpca ${CMAKE_CURRENT_LIST_DIR}/test_cpca.c)
 target_link_libraries(test_cpca PRIVATE vdsh_format m)
 add_test(NAME format_cpca COMMAND test_cpca)
+# cpca_widths_tool: scripts/cpca_study's `K.B.wTe` settings (a width per
+# basis vector, measurement only; not a test)
+add_executable(cpca_widths_tool ${CMAKE_CURRENT_LIST_DIR}/cpca_widths_tool.c)
+target_link_libraries(cpca_widths_tool PRIVATE vdsh_format m)
 # format_cpca_python  python/vdsh decodes test_cpca's stream to the C
 #                   decode's floats bit for bit, and refuses a bad index
 add_test(NAME format_cpca_python

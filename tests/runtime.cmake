@@ -478,7 +478,8 @@ grep -q "adaptive.vdsh: decision bake" "$d/agrid.log"
 # A cpca stream decoded once per frame (--cpca-frame, issue 29): at 16
 # lights (two passes of 8, both reading the scratch) the frame is the one
 # decoded in every pass, and with 3 lights it is not (the control: the
-# comparison can fail); a file without a cpca stream draws as before.
+# comparison can fail); a file without a cpca stream draws as before; a
+# stream with a width per basis vector draws the same both ways.
 if(TARGET vdsh-bake)
 add_test(NAME runtime_view_cpca_frame COMMAND sh -c [=[
 v=$1; png=$2; bake=$3; log=$4; d=$5
@@ -504,6 +505,15 @@ set -e
 if "$png" same "$d/pass.png" "$d/frame3.png" 2; then echo "control: 3 and 16 lights the same"; exit 1; fi
 "$v" -q --render "$d/log.png" --size 96x72 --mode vdsh5 --cpca-frame "$log"
 "$png" info "$d/log.png" 96 72
+# A width per basis vector (--cpca K,alloc:BYTES, bits 0): the same, and
+# its frame is not the uniform stream's (the control)
+"$bake" builtin:room --max-edge 1.0 --rays 256 --cube-size 0 --orders 12 --encoding cpca \
+  --cpca 8,alloc:32 -q -o "$d/w.vdsh"
+"$v" -q --render "$d/wpass.png" --size 96x72 --mode buf12 --lights 16 "$d/w.vdsh"
+"$v" -q --render "$d/wframe.png" --size 96x72 --mode buf12 --lights 16 --cpca-frame "$d/w.vdsh"
+"$png" info "$d/wpass.png" 96 72
+"$png" same "$d/wpass.png" "$d/wframe.png" 2
+if "$png" same "$d/wpass.png" "$d/pass.png" 0; then echo "control: widths as uniform"; exit 1; fi
 ]=] sh ${_view} ${_png} $<TARGET_FILE:vdsh-bake> ${_room_log} ${_rt_dir}/view_cpca_frame)
 _runtime_props(runtime_view_cpca_frame FIXTURES_REQUIRED runtime_room)
 endif()

@@ -3,7 +3,9 @@
  * 29): encoder, writer, reader and decoder.
  *
  * Usage: test_cpca [OUT_DIR]   (with OUT_DIR: also writes cpca.vdsh and
- *                               cpca.f32, its C decode, for the Python test)
+ *                               cpca.f32, its C decode, and the same of the
+ *                               widths stream, cpca-widths.vdsh and
+ *                               cpca-widths.f32, for the Python test)
  *
  *   round trip     a synthetic order-7 stream (clusters by normal, low rank
  *                  plus noise) encoded, written, read: the same model and
@@ -31,11 +33,23 @@
  *                  budget, model included; K one of 4, 8, 16 at 4 bits with
  *                  the largest B that fits; the same bytes twice; a budget
  *                  no K,B fits is refused with VDSH_ERR_ARGUMENT
+ *   widths         the study's width per vector (vdsh_cpca_study.h): 4 bits
+ *                  on each of the B vectors decode as vdsh_cpca_encode's
+ *                  stream to the bit; a table allocated for that file's
+ *                  bytes stays within them and its words, the same twice;
+ *                  widths of 1 and a budget nothing fits are refused
+ *   widths stream  a width per basis vector (bits 0 and the widths
+ *                  table): mixed widths written and read back unchanged,
+ *                  decoded to the bit, widths of 1 and 9, padding, W and a
+ *                  field's -L - 1 refused
+ *   alloc          --cpca K,alloc:BYTES: widths 2..8 within the budget,
+ *                  the same bytes twice, read back, too small refused
  *   settings       vdsh_cpca_parse accepts K,B,BITS, auto and auto:BYTES
  *                  and refuses the rest
  */
 #include "vdsh.h"
 #include "vdsh_cpca.h"
+#include "vdsh_cpca_study.h"
 #include "vdsh_sh.h"
 
 #include <math.h>
@@ -305,6 +319,72 @@ static void auto_settings(void)
           "auto:1 not refused (%s)", err.msg);
 }
 
+/* Widths (vdsh_cpca_study.h, measurement only): the uniform table
+ * reproduces vdsh_cpca_encode's decode to the bit; an allocated table
+ * fits its budget and its words, and is no worse in the fit's own
+ * measure than the uniform record of the same bytes. */
+static void widths_study(void)
+{
+    vdsh_error err = {{0}};
+    vdsh_cpca_settings st = {K, B, BITS, 0};
+    vdsh_cpca_fit fit;
+    static float dec[ROWS * NC], dec2[ROWS * NC];
+    vdsh_cpca_widths_fit wf, wf2;
+    uint8_t uni[VDSH_MAX_COEFFS] = {0};
+    for (int j = 0; j < B; j++)
+        uni[j] = BITS;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &fit, &err) == VDSH_OK, "%s", err.msg);
+    CHECK(vdsh_cpca_encode_widths(src, normals, ROWS, ORDER, &st, 2 * B, 0.0, uni, dec, &wf,
+                                  &err) == VDSH_OK,
+          "widths, uniform: %s", err.msg);
+    vdsh_stream s = {.order = ORDER,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .scale = 1.0f,
+                     .data = fit.records,
+                     .cpca = fit.model};
+    int same = wf.basis == B && wf.words == fit.model.record_words;
+    for (uint32_t v = 0; v < ROWS; v++) {
+        float c[VDSH_MAX_COEFFS];
+        vdsh_stream_decode(&s, v, c);
+        same &= memcmp(c, dec + (size_t)v * NC, sizeof(float) * NC) == 0;
+    }
+    CHECK(same, "uniform widths do not decode as vdsh_cpca_encode's stream");
+    CHECK(fabs(wf.rms_error - fit.rms_error) <= 1e-12 * (1 + fit.rms_error), "rms %g against %g",
+          wf.rms_error, fit.rms_error);
+    /* allocated for the uniform file's bytes */
+    double budget = (double)fit_bytes(&fit.model, ROWS, ORDER) / ROWS;
+    CHECK(vdsh_cpca_encode_widths(src, normals, ROWS, ORDER, &st, 2 * B, budget, NULL, dec, &wf,
+                                  &err) == VDSH_OK,
+          "widths, budget: %s", err.msg);
+    CHECK(vdsh_cpca_encode_widths(src, normals, ROWS, ORDER, &st, 2 * B, budget, NULL, dec2, &wf2,
+                                  &err) == VDSH_OK &&
+              memcmp(dec, dec2, sizeof dec) == 0 && memcmp(wf.widths, wf2.widths, B * 2) == 0,
+          "widths: other results the second time");
+    int range = wf.basis >= 1 && wf.widths[wf.basis - 1] >= 2;
+    for (uint32_t j = 0; j < 2 * B; j++)
+        range &= wf.widths[j] == 0 || (wf.widths[j] >= 2 && wf.widths[j] <= 8);
+    CHECK(range, "widths out of range");
+    CHECK(wf.bytes_per_vertex <= budget && wf.words == vdsh_cpca_widths_words(wf.widths, 2 * B),
+          "widths: %.3f bytes per vertex over the budget %.3f, or %u words", wf.bytes_per_vertex,
+          budget, wf.words);
+    printf("widths: uniform %.3f B rms %.4f; allocated %.3f B, %u vectors, %u words, rms %.4f\n",
+           budget, fit.rms_error, wf.bytes_per_vertex, wf.basis, wf.words, wf.rms_error);
+    /* no field straddles a word: eight 7-bit fields and the index are 64
+     * bits but three words (3 fields, then 4, then 1) */
+    uint8_t w7[8] = {7, 7, 7, 7, 7, 7, 7, 7}, w8[4] = {8, 8, 8, 8};
+    CHECK(vdsh_cpca_widths_words(w7, 8) == 3 && vdsh_cpca_widths_words(w7, 7) == 2 &&
+              vdsh_cpca_widths_words(w8, 3) == 1 && vdsh_cpca_widths_words(w8, 4) == 2,
+          "widths_words");
+    uint8_t bad[2 * B] = {1};
+    CHECK(vdsh_cpca_encode_widths(src, normals, ROWS, ORDER, &st, 2 * B, 0.0, bad, dec, &wf,
+                                  &err) == VDSH_ERR_ARGUMENT,
+          "a width of 1 not refused");
+    CHECK(vdsh_cpca_encode_widths(src, normals, ROWS, ORDER, &st, 2 * B, 0.5, NULL, dec, &wf,
+                                  &err) == VDSH_ERR_ARGUMENT,
+          "a budget nothing fits not refused");
+    vdsh_cpca_fit_free(&fit);
+}
+
 static vdsh_file file_of(vdsh_stream *s)
 {
     vdsh_file f;
@@ -335,6 +415,192 @@ static void expect_refused(const uint8_t *good, size_t size, size_t at, const vo
     CHECK(strstr(err.msg, want) != NULL, "message '%s' lacks '%s'", err.msg, want);
     vdsh_free(f);
     free(d);
+}
+
+/* A stream with a width per basis vector (bits 0, VDSH.md "cpca
+ * streams"): the fit's levels repacked into mixed widths (clamped to each
+ * width's levels) are written and read back unchanged, decode to the bit
+ * as mean + sum of level x scale / L_j x basis in f32, and every widths
+ * rule broken is refused. */
+static void widths_stream(const vdsh_cpca_fit *fit, const char *out_dir)
+{
+    static const uint8_t wd[B] = {8, 7, 6, 5, 4, 4, 4, 3, 3, 3, 2, 2, 2};
+    vdsh_cpca m = fit->model;
+    m.bits = 0;
+    m.widths = wd;
+    m.record_words = vdsh_cpca_widths_words(wd, B);
+    CHECK(m.record_words == 2, "widths words %u (8,7,6 in word 0, the rest in word 1)",
+          m.record_words);
+    static uint32_t rec[ROWS * 2];
+    static int32_t lv[ROWS][B];
+    memset(rec, 0, sizeof rec);
+    vdsh_stream u = {.order = ORDER,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .scale = 1.0f,
+                     .data = fit->records,
+                     .cpca = fit->model};
+    for (uint32_t v = 0; v < ROWS; v++) {
+        int32_t q[VDSH_MAX_COEFFS];
+        vdsh_cpca_weights(&u, v, q, NULL);
+        rec[v * 2] = vdsh_cpca_cluster(&u, v);
+        for (uint32_t j = 0; j < B; j++) {
+            int L = vdsh_cpca_levels(wd[j]);
+            lv[v][j] = q[j] > L ? L : q[j] < -L ? -L : q[j];
+            uint32_t word, shift;
+            vdsh_cpca_model_field(&m, j, &word, &shift);
+            rec[v * 2 + word] |= ((uint32_t)lv[v][j] & ((1u << wd[j]) - 1u)) << shift;
+        }
+    }
+    vdsh_stream s = {.order = ORDER,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .method = VDSH_METHOD_LSQ,
+                     .quantity = VDSH_QUANTITY_DISTANCE,
+                     .scale = 1.0f,
+                     .data = rec,
+                     .cpca = m};
+    vdsh_file f = file_of(&s);
+    void *mem = NULL;
+    size_t size = 0;
+    vdsh_error err = {{0}};
+    CHECK(vdsh_write_memory(&f, &mem, &size, &err) == VDSH_OK, "widths: write: %s", err.msg);
+    vdsh_file *back = NULL;
+    CHECK(mem && vdsh_read_memory(mem, size, "widths", &back, &err) == VDSH_OK, "widths: read: %s",
+          err.msg);
+    if (back) {
+        const vdsh_stream *r = &back->streams[0];
+        CHECK(r->cpca.bits == 0 && r->cpca.widths && memcmp(r->cpca.widths, wd, B) == 0 &&
+                  r->cpca.record_words == 2 && memcmp(r->data, rec, sizeof rec) == 0 &&
+                  memcmp(r->cpca.scales, m.scales, 4 * K * B) == 0 &&
+                  memcmp(r->cpca.bases, m.bases, 2 * K * B * NC) == 0,
+              "widths: read back differs");
+        vdsh_stream_size z = vdsh_stream_size_of(r, ROWS);
+        CHECK(fabs(z.mean_bytes -
+                   (8.0 + (double)(vdsh_cpca_model_bytes(ORDER, K, B) + 16) / ROWS)) < 1e-9,
+              "widths: mean bytes %g", z.mean_bytes);
+        int exact = 1;
+        for (uint32_t v = 0; v < ROWS; v += 5) {
+            float c[VDSH_MAX_COEFFS];
+            int32_t q[VDSH_MAX_COEFFS];
+            vdsh_stream_decode(r, v, c);
+            vdsh_cpca_weights(r, v, q, NULL);
+            uint32_t cl = vdsh_cpca_cluster(r, v);
+            for (int i = 0; i < NC; i++) {
+                float a = vdsh_f32_from_f16(m.means[cl * NC + i]);
+                for (int j = 0; j < B; j++) {
+                    float wj =
+                        (float)lv[v][j] * (m.scales[cl * B + j] / (float)vdsh_cpca_levels(wd[j]));
+                    a = a + wj * vdsh_f32_from_f16(m.bases[(cl * B + j) * NC + i]);
+                }
+                exact &= memcmp(&a, &c[i], 4) == 0;
+            }
+            for (int j = 0; j < B; j++)
+                exact &= q[j] == lv[v][j];
+        }
+        CHECK(exact, "widths: decode is not mean + sum of level x step_j x basis in f32");
+        if (out_dir) { /* for the Python reader's test */
+            char p[4096];
+            snprintf(p, sizeof p, "%s/cpca-widths.vdsh", out_dir);
+            FILE *o = fopen(p, "wb");
+            CHECK(o && fwrite(mem, 1, size, o) == size, "cannot write %s", p);
+            if (o)
+                fclose(o);
+            snprintf(p, sizeof p, "%s/cpca-widths.f32", out_dir);
+            o = fopen(p, "wb");
+            for (uint32_t v = 0; o && v < ROWS; v++) {
+                float c[VDSH_MAX_COEFFS];
+                vdsh_stream_decode(r, v, c);
+                CHECK(fwrite(c, 4, NC, o) == NC, "cannot write %s", p);
+            }
+            CHECK(o != NULL, "cannot write %s", p);
+            if (o)
+                fclose(o);
+        }
+    }
+    vdsh_free(back);
+    if (mem) { /* widths table at payload 64, scales from 80 */
+        const uint8_t *g = mem;
+        uint8_t b1 = 1, b9 = 9, b4[4];
+        expect_refused(g, size, 64, &b1, 1, "width of vector 0 is 1");
+        expect_refused(g, size, 64 + 12, &b9, 1, "width of vector 12 is 9");
+        expect_refused(g, size, 64 + B, &b1, 1, "padding after the cpca widths");
+        wr32(b4, 3);
+        expect_refused(g, size, 60, b4, 4, "record_words 3, its widths need 2");
+        size_t recs = 64 + 16 + 160 + 304 + 3824;
+        /* vector 10 (2 bits) at word 1 bits 26..27: -2 is out of -1..1 */
+        wr32(b4, (rd32(g + coef_at(g, size) + recs + 4) & ~(3u << 26)) | (2u << 26));
+        expect_refused(g, size, recs + 4, b4, 4, "weight 10 is -2 (2 bits");
+    }
+    free(mem);
+    /* the writer refuses bits 0 without a table */
+    m.widths = NULL;
+    s.cpca = m;
+    f = file_of(&s);
+    mem = NULL;
+    CHECK(vdsh_write_memory(&f, &mem, &size, &err) != VDSH_OK && strstr(err.msg, "widths"),
+          "widths: bits 0 without a table written (%s)", err.msg);
+    free(mem);
+}
+
+/* --cpca K,alloc:BYTES: a stream with a width per vector within the
+ * budget (model and widths table included), the same bytes twice, its
+ * rms_error its decode's, written and read back; a budget the 1-vector
+ * record cannot meet refused. */
+static void alloc_settings(void)
+{
+    vdsh_error err = {{0}};
+    vdsh_cpca_settings st;
+    CHECK(vdsh_cpca_parse("3,alloc:16", &st, &err) == VDSH_OK && st.clusters == 3 &&
+              st.budget == 16 && !st.bits && !st.basis,
+          "parse 3,alloc:16: %s", err.msg);
+    vdsh_cpca_fit a, b;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &a, &err) == VDSH_OK, "alloc: %s",
+          err.msg);
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &b, &err) == VDSH_OK, "alloc 2: %s",
+          err.msg);
+    const vdsh_cpca *m = &a.model;
+    vdsh_stream s = {.order = ORDER,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .method = VDSH_METHOD_LSQ,
+                     .quantity = VDSH_QUANTITY_DISTANCE,
+                     .scale = 1.0f,
+                     .data = a.records,
+                     .cpca = *m};
+    uint64_t bytes = (uint64_t)ROWS * 4 * m->record_words + vdsh_cpca_stream_model_bytes(m, ORDER);
+    int ok = m->bits == 0 && m->widths && m->clusters == 3 && m->basis >= 1 &&
+             m->record_words == vdsh_cpca_widths_words(m->widths, m->basis);
+    for (uint32_t j = 0; ok && j < m->basis; j++)
+        ok = m->widths[j] >= 2 && m->widths[j] <= 8;
+    CHECK(ok, "alloc: model %u,%u,%u, W %u", m->clusters, m->basis, m->bits, m->record_words);
+    CHECK(bytes <= 16u * ROWS, "alloc: %.2f bytes per vertex over 16", (double)bytes / ROWS);
+    size_t all = (size_t)vdsh_cpca_stream_model_bytes(m, ORDER) - 16;
+    CHECK(b.model.basis == m->basis && memcmp(a.storage_, b.storage_, all) == 0 &&
+              memcmp(a.records, b.records, (size_t)ROWS * 4 * m->record_words) == 0,
+          "alloc: other bytes the second time");
+    CHECK(fabs(rms_vs(&s, src) - a.rms_error) <= 1e-9 * (1 + a.rms_error), "alloc: rms %g vs %g",
+          a.rms_error, rms_vs(&s, src));
+    vdsh_file f = file_of(&s);
+    void *mem = NULL;
+    size_t size = 0;
+    vdsh_file *back = NULL;
+    CHECK(vdsh_write_memory(&f, &mem, &size, &err) == VDSH_OK &&
+              vdsh_read_memory(mem, size, "alloc", &back, &err) == VDSH_OK &&
+              rms_vs(&back->streams[0], src) == rms_vs(&s, src),
+          "alloc: write and read back: %s", err.msg);
+    printf("alloc:16 at K 3: %u vectors, %u words, %.2f bytes per vertex, rms error %.4f\n",
+           m->basis, m->record_words, (double)bytes / ROWS, a.rms_error);
+    vdsh_free(back);
+    free(mem);
+    vdsh_cpca_fit_free(&a);
+    vdsh_cpca_fit_free(&b);
+    vdsh_cpca_settings tiny = {3, 0, 0, 1};
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &tiny, &a, &err) == VDSH_ERR_ARGUMENT &&
+              strstr(err.msg, "budget") && !a.storage_,
+          "alloc:1 not refused (%s)", err.msg);
+    CHECK(vdsh_cpca_parse("3,alloc:0", &st, &err) == VDSH_ERR_ARGUMENT &&
+              vdsh_cpca_parse("0,alloc:16", &st, &err) == VDSH_ERR_ARGUMENT &&
+              vdsh_cpca_parse("3,alloc:", &st, &err) == VDSH_ERR_ARGUMENT &&
+              vdsh_cpca_parse("3,alloc:16x", &st, &err) == VDSH_ERR_ARGUMENT,
+          "bad alloc settings accepted");
 }
 
 int main(int argc, char **argv)
@@ -451,6 +717,7 @@ int main(int argc, char **argv)
         }
     }
     vdsh_free(back);
+    widths_stream(&fit, argc > 1 ? argv[1] : NULL);
 
     /* reading rules (offsets in the COEF payload: header 48, cpca header
      * 48..63, scales from 64 (K*B*4 = 156, padded to 160), means from 224
@@ -511,6 +778,8 @@ int main(int argc, char **argv)
     curved_cluster();
     line_and_blob();
     auto_settings();
+    widths_study();
+    alloc_settings();
 
     /* settings */
     vdsh_cpca_settings p;

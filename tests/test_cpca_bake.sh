@@ -32,6 +32,35 @@ says_any "vdsh-info shows the model" "cpca: 4 clusters, 20 basis vectors of 4-bi
 expect_exit 0 "vdsh-info on a part" "$info" "$tmp/n3/p1.vdsh"
 says_any "vdsh-info shows a part's settings" "cpca 4,20,4 (fitted at the merge)"
 
+# A width per basis vector (--cpca K,alloc:BYTES): whole bake = 2 threads
+# = 3 shards merged, byte for byte; vdsh-info shows the widths and a
+# part's settings.
+ca=(--encoding cpca --cpca 4,alloc:40)
+expect_exit 0 "alloc cpca, 1 thread" "$bake" "${tiny[@]}" "${ca[@]}" --threads 1 -o "$tmp/c1.vdsh"
+expect_exit 0 "alloc cpca, 2 threads" "$bake" "${tiny[@]}" "${ca[@]}" --threads 2 -o "$tmp/c2.vdsh"
+check "alloc cpca, 1 and 2 threads: identical" cmp "$tmp/c1.vdsh" "$tmp/c2.vdsh"
+mkdir -p "$tmp/c3"
+for i in 0 1 2; do
+  expect_exit 0 "alloc cpca shard $i/3" "$bake" "${tiny[@]}" "${ca[@]}" --shard "$i/3" \
+    -o "$tmp/c3/p$i.vdsh"
+done
+expect_exit 0 "alloc cpca merge" "$merge" -q "$tmp"/c3/p*.vdsh -o "$tmp/c3/scene.vdsh"
+check "alloc cpca, 3 shards: identical to the whole bake" cmp "$tmp/c3/scene.vdsh" "$tmp/c1.vdsh"
+expect_exit 0 "vdsh-info, alloc" "$info" "$tmp/c1.vdsh"
+says_any "vdsh-info shows per-vector weights" "basis vectors of per-vector weights"
+says_any "vdsh-info shows the widths" "widths: "
+expect_exit 0 "vdsh-info on an alloc part" "$info" "$tmp/c3/p1.vdsh"
+says_any "vdsh-info shows an alloc part's settings" "cpca 4,alloc:40 (fitted at the merge)"
+check "the Python reader reads an alloc part and the merged widths" /usr/bin/python3 -c '
+import sys
+sys.path.insert(0, sys.argv[1])
+import vdsh
+p = vdsh.read(sys.argv[2]).part
+assert (p["cpca_clusters"], p["cpca_basis"], p["cpca_bits"]) == (4, 40, 0), p
+c = vdsh.read(sys.argv[3]).streams[0]["cpca"]
+assert c["bits"] == 0 and len(c["widths"]) == c["basis"] and 2 <= min(c["widths"]), c["widths"]
+' "$src/python" "$tmp/c3/p1.vdsh" "$tmp/c1.vdsh"
+
 # Against the f32 bake of the same options.
 expect_exit 0 "f32 bake" "$bake" "${tiny[@]}" --encoding f32 -o "$tmp/f32.vdsh"
 expect_exit 0 "full basis, 8 bits" "$bake" "${tiny[@]}" --encoding cpca --cpca 2,49,8 -o "$tmp/full.vdsh"
@@ -102,10 +131,13 @@ PY
 out=$tmp/none.vdsh
 expect_exit 2 "--cpca without --encoding cpca" "$bake" "${tiny[@]}" --cpca 4,20,4 -o "$out"
 says_any "--cpca alone" "needs --encoding cpca"
-for bad in 0,20,4 4,0,4 4,20,1 4,20,9 4,20 x; do
+for bad in 0,20,4 4,0,4 4,20,1 4,20,9 4,20 x 4,alloc:0 0,alloc:32 4,alloc:; do
   expect_exit 2 "--cpca $bad" "$bake" "${tiny[@]}" --encoding cpca --cpca "$bad" -o "$out"
   says_any "--cpca $bad" "--cpca takes K,B,BITS"
+  says_any "--cpca $bad names alloc" "K,alloc:BYTES (a width per basis vector)"
 done
+expect_exit 0 "vdsh-bake --help" "$bake" --help
+says_any "--help shows K,alloc:BYTES" "K,alloc:BYTES: K clusters, a width per basis vector"
 expect_exit 2 "--adaptive-order with cpca and its cap in --orders" "$bake" "${tiny[@]}" \
   --encoding cpca --adaptive-order 0.02 --max-order 7 -o "$out"
 says_any "--adaptive-order's cap in --orders" "--orders cannot hold that order too"

@@ -1,6 +1,10 @@
 #!/usr/bin/python3
 """The Python reader decodes a cpca stream (VDSH.md "cpca streams") to the
-C reader's floats, bit for bit: test_cpca writes a file and its C decode.
+C reader's floats, bit for bit: test_cpca writes a file and its C decode,
+and the same of a stream with a width per basis vector (bits 0 and the
+widths table: 8, 7, 6, 5, 4, 4, 4, 3, 3, 3, 2, 2, 2), whose broken widths,
+padding and 2-bit weight -2 Python refuses as C does, and whose part chunk
+of --cpca K,alloc:BYTES (K, budget, 0) it reads.
 
 Usage: test_cpca_python.py TEST_CPCA SOURCE_DIR WORK_DIR
 """
@@ -43,6 +47,92 @@ try:
 except vdsh.VdshError as e:
     if "cluster" not in str(e):
         fail.append("refused for another reason: %s" % e)
+
+
+def chunks(d):
+    """(offset, id, size) of each chunk of file bytes d."""
+    off = 32
+    while off + 16 <= len(d):
+        n = int.from_bytes(d[off + 8:off + 16], "little")
+        yield off, bytes(d[off:off + 4]), n
+        off += 16 + (n + 15) // 16 * 16
+
+
+def fix_crc(d, off, n):
+    import zlib
+    pad = (n + 15) // 16 * 16
+    crc = zlib.crc32(d[off + 8:off + 16], zlib.crc32(d[off:off + 4]))
+    d[off + 4:off + 8] = zlib.crc32(d[off + 16:off + 16 + pad], crc).to_bytes(4, "little")
+
+
+def refused(d, what, name):
+    try:
+        vdsh.parse(bytes(d), name)
+        fail.append("%s accepted" % name)
+    except vdsh.VdshError as e:
+        if what not in str(e):
+            fail.append("%s refused for another reason: %s" % (name, e))
+
+
+# a width per basis vector
+wpath = os.path.join(work, "cpca-widths.vdsh")
+fw = vdsh.read(wpath)
+sw = fw.streams[0]
+gw = vdsh.coefficients(sw)
+ww = np.fromfile(os.path.join(work, "cpca-widths.f32"), "<f4").reshape(gw.shape)
+want_widths = [8, 7, 6, 5, 4, 4, 4, 3, 3, 3, 2, 2, 2]
+if sw["cpca"]["bits"] != 0 or list(sw["cpca"]["widths"]) != want_widths or \
+        sw["cpca"]["record_words"] != 2:
+    fail.append("widths stream header: %s" % {k: sw["cpca"][k] for k in
+                                              ("bits", "widths", "record_words")})
+if not np.array_equal(gw.view(np.uint32), ww.view(np.uint32)):
+    fail.append("widths: decode differs from C at %d of %d values" % ((gw != ww).sum(), gw.size))
+L = (1 << (np.array(want_widths) - 1)) - 1
+lv = np.abs(sw["cpca"]["levels"])
+if not ((lv <= L).all() and (lv[:, want_widths.index(2):] == 1).any()):
+    fail.append("widths: levels outside each width's -L..L, or no 2-bit weight at +-1")
+dw = bytearray(open(wpath, "rb").read())
+coef = [(o, n) for o, c, n in chunks(dw) if c == b"COEF"][0]
+o, n = coef
+for at, val, what, name in [(64, 1, "width", "width 1"), (64 + 12, 9, "width", "width 9"),
+                            (64 + 13, 1, "padding", "widths padding"),
+                            (60, 3, "record_words", "record_words 3")]:
+    d = bytearray(dw)
+    d[o + 16 + at:o + 16 + at + (4 if at == 60 else 1)] = \
+        val.to_bytes(4 if at == 60 else 1, "little")
+    fix_crc(d, o, n)
+    refused(d, what, name)
+# vector 10 (2 bits) at word 1 bits 26..27 of vertex 0's record: -2
+recs = 64 + 16 + 160 + 304 + 3824
+d = bytearray(dw)
+w1 = int.from_bytes(d[o + 16 + recs + 4:o + 16 + recs + 8], "little")
+d[o + 16 + recs + 4:o + 16 + recs + 8] = ((w1 & ~(3 << 26)) | (2 << 26)).to_bytes(4, "little")
+fix_crc(d, o, n)
+refused(d, "below -1", "2-bit weight -2")
+# the part chunk --cpca K,alloc:BYTES writes: clusters K, budget, bits 0
+V = fw.header["vertex_count"]
+
+
+def with_part(ck, cb, cbits):
+    import struct
+    body = struct.pack("<8I", 0, 1, 0, V, 4, ck, cb, cbits)
+    c = bytearray(b"part" + b"\0" * 4 + len(body).to_bytes(8, "little") + body)
+    fix_crc(c, 0, len(body))
+    d = bytearray(dw) + c  # one more chunk: the file header's count, size and CRC
+    d[12:16] = (int.from_bytes(d[12:16], "little") + 1).to_bytes(4, "little")
+    d[16:24] = len(d).to_bytes(8, "little")
+    import zlib
+    d[28:32] = zlib.crc32(d[:28]).to_bytes(4, "little")
+    return d
+
+
+try:
+    fp = vdsh.parse(bytes(with_part(3, 16, 0)), "alloc-part.vdsh")
+    if (fp.part or {}).get("cpca_clusters") != 3 or fp.part.get("cpca_basis") != 16:
+        fail.append("alloc part read as %s" % fp.part)
+except vdsh.VdshError as e:
+    fail.append("alloc part refused: %s" % e)
+refused(with_part(3, 0, 0), "out of range", "alloc part of budget 0")
 for m in fail:
     print("FAIL:", m)
 print("cpca python: %d values compared, %s" % (got.size, "bit-identical" if not fail else "FAILED"))

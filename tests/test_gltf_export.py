@@ -314,26 +314,36 @@ for name in ("box-src", "engine-src"):
 # streams"): the cluster and weight attributes and the model view, decoded
 # in f32 in the documented order, must give bit for bit the coefficients
 # of the --decode-cpca --float export (vdsh_stream_decode's); orders 7
-# and 12 with 5-bit weights (fields skipping the ends of words); plain and
-# --compress go to the validator.
+# and 12 with 5-bit weights (fields skipping the ends of words), and with
+# a width per basis vector (--cpca 6,alloc:24: "bits": 0 and "widths",
+# each level within its own width's range); plain and --compress go to the
+# validator.
 import numpy as np
-cvd = os.path.join(work, "cpca.vdsh")
-run([bake, "builtin:room", "-o", cvd, "-q", "--rays", "64", "--orders", "7,12", "--encoding", "cpca",
-     "--cpca", "6,20,5"])
-cq, cf = os.path.join(work, "cpca.glb"), os.path.join(work, "cpca_decoded.glb")
-run([export, cvd, "-o", cq])
-run([export, cvd, "-o", cf, "--decode-cpca", "--float"])
-run([export, cvd, "-o", os.path.join(work, "cpca_compressed.glb"), "--compress"])
-if not fail:
-    glbs += [cq, cf, os.path.join(work, "cpca_compressed.glb")]
+
+
+def check_cpca(tag, setting):
+    """Bake orders 7, 12 with --cpca setting, export as stored, decoded and
+    compressed; the stored glb decoded by the GLTF.md rule must be the
+    decoded glb, bit for bit."""
+    cvd = os.path.join(work, tag + ".vdsh")
+    run([bake, "builtin:room", "-o", cvd, "-q", "--rays", "64", "--orders", "7,12", "--encoding",
+         "cpca", "--cpca", setting])
+    cq, cf = os.path.join(work, tag + ".glb"), os.path.join(work, tag + "_decoded.glb")
+    run([export, cvd, "-o", cq])
+    run([export, cvd, "-o", cf, "--decode-cpca", "--float"])
+    run([export, cvd, "-o", os.path.join(work, tag + "_compressed.glb"), "--compress"])
+    if fail:
+        return
+    glbs.extend([cq, cf, os.path.join(work, tag + "_compressed.glb")])
     gq, bq = read_glb(cq)
     gf, bf = read_glb(cf)
     aq, af = gq["meshes"][0]["primitives"][0]["attributes"], gf["meshes"][0]["primitives"][0]["attributes"]
     sq = gq["meshes"][0]["extras"]["vdsh"]["streams"]
+    mixed = False
     for st in sq:
         cp, n = st.get("cpca"), st["order"]
         if not cp or st["component"] != "cpca" or st["attributes"] != 0:
-            fail.append("cpca.glb: order %d not exported as cpca: %r" % (n, st))
+            fail.append("%s.glb: order %d not exported as cpca: %r" % (tag, n, st))
             continue
         nc, K, B = n * n, cp["clusters"], cp["basis"]
         view = gq["bufferViews"][cp["model_view"]]
@@ -344,6 +354,15 @@ if not fail:
         cl = np.array(accessor(gq, bq, aq[cp["cluster_attribute"]]))[:, 0]
         lv = np.concatenate([np.array(accessor(gq, bq, aq[cp["weight_prefix"] + str(g)]))
                              for g in range(cp["weight_attributes"])], axis=1)
+        widths = cp.get("widths") if cp["bits"] == 0 else [cp["bits"]] * B
+        if not (isinstance(widths, list) and len(widths) == B and
+                all(isinstance(x, int) and 2 <= x <= 8 for x in widths)):
+            fail.append("%s.glb order %d: bits %d, widths %r" % (tag, n, cp["bits"], cp.get("widths")))
+            continue
+        mixed |= len(set(widths)) > 1
+        L = (1 << (np.array(widths) - 1)) - 1
+        if (np.abs(lv[:, :B]) > L).any():
+            fail.append("%s.glb order %d: a weight level beyond its width's range" % (tag, n))
         w = (lv[:, :B].astype(np.float32) * steps.reshape(K, B)[cl]).astype(np.float32)
         a = means[cl].copy()
         for j in range(B):
@@ -351,13 +370,20 @@ if not fail:
         ref = np.concatenate([np.array(accessor(gf, bf, af["_VDSH%d_%d" % (n, g)]), np.float32)
                               for g in range((nc + 3) // 4)], axis=1)[:, :nc]
         bad = int((a.view(np.uint32) != ref.view(np.uint32)).sum())
-        print("cpca order %d (K %d, B %d, bits %d): %d vertices, %d bytes of attributes per vertex; "
-              "%d coefficients differ from vdsh_stream_decode's" % (n, K, B, cp["bits"], len(cl),
+        print("%s order %d (K %d, B %d, bits %d): %d vertices, %d bytes of attributes per vertex; "
+              "%d coefficients differ from vdsh_stream_decode's" % (tag, n, K, B, cp["bits"], len(cl),
                                                                      4 + 4 * cp["weight_attributes"], bad))
         if bad:
-            fail.append("cpca.glb order %d: %d coefficients decode differently from --decode-cpca" % (n, bad))
+            fail.append("%s.glb order %d: %d coefficients decode differently from --decode-cpca"
+                        % (tag, n, bad))
     if len(sq) != 2:
-        fail.append("cpca.glb: %d streams, not 2" % len(sq))
+        fail.append("%s.glb: %d streams, not 2" % (tag, len(sq)))
+    if tag == "cpcaw" and not mixed:
+        fail.append("cpcaw.glb: every stream's vectors one width (not the mixed case)")
+
+
+check_cpca("cpca", "6,20,5")
+check_cpca("cpcaw", "6,alloc:24")
 
 # The validator comes from npm (gltf_npm_setup); where the registry cannot
 # be reached that fixture skips, and so does this test's validation: every

@@ -8,7 +8,8 @@
  * The files are baked by vdsh-bake itself (so every chunk a real bake
  * writes is there): a small scene of a floor and a box refined to max
  * edge 1 (orders 2,3,5, f16; and orders 1,4, f32, method full, with the
- * timings chunk; order 6 in cpca, 3 clusters of 7 vectors, 5-bit weights), and
+ * timings chunk; order 6 in cpca, 3 clusters of 7 vectors, 5-bit weights;
+ * order 6 in cpca with a width per vector, --cpca 3,alloc:60), and
  * builtin:room at max edge 0 (the room's 261 KB are
  * swept at a stride of 1/1009 of the file and with 1,000 two-byte changes;
  * a full sweep would take minutes). Then:
@@ -203,7 +204,8 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *bake = argv[1], *info = argv[2], *dir = argv[3];
-    char obj[4096], a[4096], b[4096], c[4096], room[4096], var[4096], cp[4096], err_path[4096];
+    char obj[4096], a[4096], b[4096], c[4096], room[4096], var[4096], cp[4096], cw[4096],
+        err_path[4096];
     mkdir(dir, 0755);
     snprintf(obj, sizeof obj, "%s/scene.obj", dir);
     snprintf(a, sizeof a, "%s/scene-f16.vdsh", dir);
@@ -212,6 +214,7 @@ int main(int argc, char **argv)
     snprintf(room, sizeof room, "%s/room.vdsh", dir);
     snprintf(var, sizeof var, "%s/scene-var.vdsh", dir);
     snprintf(cp, sizeof cp, "%s/scene-cpca.vdsh", dir);
+    snprintf(cw, sizeof cw, "%s/scene-cpca-widths.vdsh", dir);
     snprintf(err_path, sizeof err_path, "%s/bake.err", dir);
     if (write_all(obj, (const uint8_t *)scene_obj, sizeof scene_obj - 1) != 0) {
         fprintf(stderr, "cannot write %s\n", obj);
@@ -251,17 +254,23 @@ int main(int argc, char **argv)
     char *bake_cp[] = {(char *)bake,  obj,     "--max-edge", "1",  "--rays",     "64",
                        "--cube-size", "0",     "--orders",   "6",  "--encoding", "cpca",
                        "--cpca",      "3,7,5", "-q",         "-o", cp,           NULL};
+    /* a width per basis vector: the widths table and mixed fields */
+    char *bake_cw[] = {(char *)bake,  obj,          "--max-edge", "1",  "--rays",     "64",
+                       "--cube-size", "0",          "--orders",   "6",  "--encoding", "cpca",
+                       "--cpca",      "3,alloc:60", "-q",         "-o", cw,           NULL};
     int ok = run(bake_a, err_path) == 0 && run(bake_b, err_path) == 0 &&
              run(bake_c, err_path) == 0 && run(bake_room, err_path) == 0 &&
-             run(bake_var, err_path) == 0 && run(bake_cp, err_path) == 0;
+             run(bake_var, err_path) == 0 && run(bake_cp, err_path) == 0 &&
+             run(bake_cw, err_path) == 0;
     CHECK(ok, "vdsh-bake failed (see %s)", err_path);
     if (!ok)
         return test_report("robust_corrupt");
 
-    const char *names[6] = {"scene-f16.vdsh", "scene-f32.vdsh", "scene-s8s6.vdsh",
-                            "room.vdsh",      "scene-var.vdsh", "scene-cpca.vdsh"};
-    const char *paths[6] = {a, b, c, room, var, cp};
-    for (int k = 0; k < 6; k++) {
+    const char *names[7] = {
+        "scene-f16.vdsh", "scene-f32.vdsh",  "scene-s8s6.vdsh",       "room.vdsh",
+        "scene-var.vdsh", "scene-cpca.vdsh", "scene-cpca-widths.vdsh"};
+    const char *paths[7] = {a, b, c, room, var, cp, cw};
+    for (int k = 0; k < 7; k++) {
         size_t size;
         uint8_t *data = test_read_file(paths[k], &size);
         CHECK(data && size > 64, "cannot read %s", paths[k]);

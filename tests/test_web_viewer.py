@@ -47,7 +47,8 @@ A cpca stream (issue 29): the room baked with --encoding cpca at order
 buffer view; plain and --compress), decoded by the page in its vertex
 stage (the default, compressed on the GPU; the page's title says so) and
 at load (cpca=load), against vdsh-view's buf12 (decoded in its vertex
-stage), same tolerance; a cpca glb with 9 bits per weight and an unknown
+stage), same tolerance, and the same with a width per basis vector
+(--cpca 8,alloc:32); a cpca glb with 9 bits per weight and an unknown
 cpca= are refused on the page.
 
 Errors on the page (issue 26: a GLSL error in the tab title was the only
@@ -230,6 +231,16 @@ for query, want in (("", "cpca vertex"), ("&cpca=load", "cpca load")):
     dom = page("glb=cpca.glb&order=12&size=%dx%d%s" % (W, H, query))
     if "<title>ready %dx%d %s</title>" % (W, H, want) not in dom:
         fail.append("cpca.glb%s: the page's title does not say '%s' (a different decode path?)" % (query, want))
+# The same with a width per basis vector (--cpca 8,alloc:32: "bits": 0
+# and "widths"; the page's shader unpacks each field with its own width,
+# vdshCpcaBufferData's BUF_CPCA_UNPACK).
+cpcaw_vd, cpcaw_glb = scene("cpcaw", "builtin:room", ["--max-edge", "0.5", "--rays", "256", "--encoding", "cpca",
+                                                      "--cpca", "8,alloc:32"], [12],
+                            lambda lo, hi: ([7.5, 4.5, 8.0], [-2.0, 1.0, -2.0], [0.5, 1.2, 0.5]),
+                            [("12", "buf12"), ("12", "buf12", "cpca=load")])
+cw = glb_json(cpcaw_glb)["meshes"][0]["extras"]["vdsh"]["streams"][0].get("cpca", {})
+if cw.get("bits") != 0 or len(set(cw.get("widths", []))) < 2:
+    fail.append("cpcaw.glb: not a stream of mixed widths: %r" % {k: cw.get(k) for k in ("bits", "widths")})
 
 # Errors on the page itself.
 bad = os.path.join(work, "bad.glb")

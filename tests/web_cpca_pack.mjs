@@ -9,7 +9,12 @@
 // the load decode within f32 rounding of the other product order
 // (level * (step * basis) there, (level * step) * basis here): a field or
 // texel out of place is off by whole values. Also: a level out of range
-// and a model view too short are refused by both.
+// and a model view too short are refused by both. Streams with a width
+// per basis vector (bits 0 and "widths", formats/GLTF.md) are packed the
+// same way and decoded through the BUF_CPCA_UNPACK macro that
+// vdshCpcaBufferData writes for the shader (its statements executed
+// here); a width out of 2..8 and a level beyond its own width's range
+// are refused.
 // vdsh_core.js is an ES module named .js (browsers do not mind); node 18
 // reads a .js outside a "type": "module" package as CommonJS, so it is
 // imported from a copy named .mjs.
@@ -27,8 +32,9 @@ const rnd = () => (seed = (Math.imul(seed, 1103515245) + 12345) >>> 0) / 4294967
 const fail = (msg) => { console.log('FAIL: ' + msg); process.exitCode = 1; };
 const f16ish = (x) => Math.fround(Math.round(x * 1024) / 1024);
 
-function stream(N, K, B, bits, nv) {
-  const nc = N * N, L = (1 << (bits - 1)) - 1;
+// widths: null (every vector `bits` wide) or a width per vector (bits 0)
+function stream(N, K, B, bits, nv, widths = null) {
+  const nc = N * N, Ls = Array.from({ length: B }, (_, j) => (1 << ((widths ? widths[j] : bits) - 1)) - 1);
   const steps = Array.from({ length: K * B }, () => Math.fround(0.01 + rnd()));  // any f32: products round
   const means = Array.from({ length: K * nc }, () => f16ish(rnd() * 4 - 2));
   const bases = Array.from({ length: K * B * nc }, () => f16ish(rnd() * 2 - 1));
@@ -36,7 +42,7 @@ function stream(N, K, B, bits, nv) {
   const dv = new DataView(bytes.buffer);
   let off = 8;  // not at 0: offsets are honoured
   const put = (a) => { const at = off; a.forEach((x, i) => dv.setFloat32(at + 4 * i, x, true)); off += 4 * a.length; return at; };
-  const st = { order: N, cpca: { clusters: K, basis: B, bits } };
+  const st = { order: N, cpca: widths ? { clusters: K, basis: B, bits: 0, widths } : { clusters: K, basis: B, bits } };
   st.cpca.steps_offset = put(steps);
   st.cpca.means_offset = put(means);
   st.cpca.bases_offset = put(bases);
@@ -45,7 +51,7 @@ function stream(N, K, B, bits, nv) {
   for (let v = 0; v < nv; v++) {
     cluster[4 * v] = Math.floor(rnd() * K);
     for (let j = 0; j < B; j++)
-      levels[j >> 2][4 * v + (j & 3)] = v < 2 ? (v ? -L : L) : Math.floor(rnd() * (2 * L + 1)) - L;
+      levels[j >> 2][4 * v + (j & 3)] = v < 2 ? (v ? -Ls[j] : Ls[j]) : Math.floor(rnd() * (2 * Ls[j] + 1)) - Ls[j];
   }
   return { st, cluster, levels, bytes };
 }
@@ -59,10 +65,23 @@ function shaderDecode(cd, N, nv) {
   for (let v = 0; v < nv; v++) {
     let at = v * cd.stride, w = word(at), shift = 8;
     const texel = (w & 255) * cd.T, wt = [];
-    for (let j = 0; j < B; j++) {
-      if (shift + cd.bits > 32) { w = word(++at); shift = 0; }
-      wt.push(((w << (32 - shift - cd.bits)) | 0) >> (32 - cd.bits));
-      shift += cd.bits;
+    if (cd.bits) {
+      for (let j = 0; j < B; j++) {
+        if (shift + cd.bits > 32) { w = word(++at); shift = 0; }
+        wt.push(((w << (32 - shift - cd.bits)) | 0) >> (32 - cd.bits));
+        shift += cd.bits;
+      }
+    } else {
+      // BUF_CPCA_UNPACK(first), statement by statement
+      const body = cd.unpack.replace(/^#define BUF_CPCA_UNPACK\(f\)/, '').trim();
+      for (const st of body.split(';').map((x) => x.trim()).filter((x) => x)) {
+        let m;
+        if ((m = /^w = BUF_FETCH\(\(f\) \+ (\d+)\)\.r$/.exec(st))) w = word(v * cd.stride + Number(m[1]));
+        else if ((m = /^b_wt\[(\d+)\] = float\(int\(w << (\d+)u\) >> (\d+)\)$/.exec(st)))
+          wt[Number(m[1])] = ((w << Number(m[2])) | 0) >> Number(m[3]);
+        else throw new Error('BUF_CPCA_UNPACK: unknown statement ' + st);
+      }
+      if (wt.length !== B || wt.some((x) => x === undefined)) throw new Error('BUF_CPCA_UNPACK: not every weight');
     }
     for (let p = 0; p < seq.length; p++) {
       const t = (texel + (p >> 2)) * (B + 1);
@@ -95,6 +114,41 @@ for (const [N, K, B, bits, width] of [[1, 1, 1, 2, 4096], [2, 3, 4, 8, 4096], [3
   if (cd.stride !== Math.ceil((8 + B * bits) / 32) && 32 % bits === 0)
     fail(`order ${N} ${K},${B},${bits}: ${cd.stride} words per record`);
   cases++;
+}
+// A width per basis vector (bits 0): mixed widths, fields skipping the
+// ends of words; every vector 8 bits; a single 2-bit vector.
+const mixed = (B, f) => Array.from({ length: B }, (_, j) => f(j));
+for (const [N, K, widths, width] of [[12, 8, mixed(31, (j) => [6, 5, 5, 4, 4, 4][j] || (j < 15 ? 3 : 2)), 4096],
+  [3, 6, mixed(9, () => 8), 16], [1, 1, [2], 4096], [16, 3, mixed(100, (j) => 2 + ((j * 3) % 7)), 300]]) {
+  const B = widths.length, nv = 37, { st, cluster, levels, bytes } = stream(N, K, B, 0, nv, widths);
+  const dec = vdshCpcaDecode(st, nv, cluster, levels, bytes);
+  const cd = vdshCpcaBufferData(st, nv, cluster, levels, bytes, width);
+  const got = shaderDecode(cd, N, nv);
+  let worst = 0;
+  for (let i = 0; i < dec.length; i++)
+    worst = Math.max(worst, Math.abs(got.out[i] - dec[i]) / ((B + 2) * 2 ** -23 * got.mag[i] + 1e-30));
+  let words = 1;
+  for (let j = 0, sh = 8; j < B; sh += widths[j], j++) if (sh + widths[j] > 32) { words++; sh = 0; }
+  console.log(`order ${N}, ${K},${B}, widths ${widths[0]}..${widths[B - 1]}, width ${cd.width}: ${cd.stride} ` +
+    `words per vertex, largest |vertex decode - load decode| ${worst.toFixed(3)} of its rounding bound`);
+  if (!(worst <= 1)) fail(`order ${N} ${K},${B} widths: decodes differ by ${worst} of the rounding bound`);
+  if (cd.stride !== words || cd.bits !== 0) fail(`order ${N} ${K},${B} widths: ${cd.stride} words, not ${words}`);
+  cases++;
+}
+{
+  const widths = [8, 3, 2, 5], { st, cluster, levels, bytes } = stream(4, 2, 4, 0, 5, widths);
+  levels[0][4 * 3 + 2] = -2;  // vertex 3, vector 2: 2 bits, -1..1
+  for (const f of [() => vdshCpcaDecode(st, 5, cluster, levels, bytes), () => vdshCpcaBufferData(st, 5, cluster, levels, bytes, 4096)])
+    try { f(); fail('a weight level of -2 at 2 bits was accepted'); } catch (e) {
+      if (!/weight level -2, not within \+-1/.test(e.message)) fail('wrong message: ' + e.message);
+    }
+  levels[0][4 * 3 + 2] = 0;
+  for (const bad of [[8, 3, 1, 5], [8, 3, 2, 9], [8, 3, 2], undefined]) {
+    st.cpca.widths = bad;
+    try { vdshCpcaBufferData(st, 5, cluster, levels, bytes, 4096); fail('widths ' + bad + ' accepted'); } catch (e) {
+      if (!/without "widths"/.test(e.message)) fail('wrong message: ' + e.message);
+    }
+  }
 }
 // Refused by both: a level beyond +-(2^(bits-1) - 1), a model view cut short.
 const { st, cluster, levels, bytes } = stream(5, 2, 6, 4, 5);

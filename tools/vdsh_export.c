@@ -521,7 +521,8 @@ static cJSON *stream_entry(const vdsh_stream *s, const char *prefix, uint32_t gr
 
 /* A cpca stream as stored (formats/GLTF.md "cpca streams"): per vertex
  * the cluster index (<prefix>C, VEC4 unsigned byte, x) and the weight
- * levels (<prefix>W<k>, VEC4 byte, levels 4k..4k+3, 0 past B); the model
+ * levels (<prefix>W<k>, VEC4 byte, levels 4k..4k+3, 0 past B; with bits 0
+ * each vector's width in "widths"); the model
  * (steps, means, bases as f32) in one buffer view named by the stream's
  * extras. tmp: room for nv * 4 bytes. Returns 0, or -1 out of memory. */
 static int export_cpca(const vdsh_stream *s, uint32_t nv, const char *prefix, view_list *vl,
@@ -536,7 +537,7 @@ static int export_cpca(const vdsh_stream *s, uint32_t nv, const char *prefix, vi
     if (!model)
         return -1;
     for (size_t i = 0; i < K * B; i++)
-        model[i] = vdsh_cpca_step(m->scales[i], m->bits);
+        model[i] = vdsh_cpca_step(m->scales[i], vdsh_cpca_width(m, (uint32_t)(i % B)));
     for (size_t i = 0; i < K * nc; i++)
         model[K * B + i] = vdsh_f32_from_f16(m->means[i]);
     for (size_t i = 0; i < K * B * nc; i++)
@@ -554,6 +555,11 @@ static int export_cpca(const vdsh_stream *s, uint32_t nv, const char *prefix, vi
     cJSON_AddNumberToObject(cp, "clusters", (double)K);
     cJSON_AddNumberToObject(cp, "basis", (double)B);
     cJSON_AddNumberToObject(cp, "bits", m->bits);
+    if (!m->bits) { /* a width per basis vector (formats/GLTF.md) */
+        cJSON *wa = cJSON_AddArrayToObject(cp, "widths");
+        for (uint32_t j = 0; j < m->basis; j++)
+            cJSON_AddItemToArray(wa, cJSON_CreateNumber(m->widths[j]));
+    }
     snprintf(name, sizeof name, "%sC", prefix);
     cJSON_AddStringToObject(cp, "cluster_attribute", name);
     snprintf(name, sizeof name, "%sW", prefix);

@@ -267,10 +267,24 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
             const vdsh_cpca *m = &s->cpca;
             uint32_t rows = vdsh_file_stream_vertices(f);
             vdsh_stream_size z = vdsh_stream_size_of(s, rows);
-            printf("        cpca: %u clusters, %u basis vectors of %u-bit weights; %zu bytes "
+            char wbits[16];
+            snprintf(wbits, sizeof wbits, "%u-bit", m->bits);
+            printf("        cpca: %u clusters, %u basis vectors of %s weights; %zu bytes "
                    "per vertex, %.1f with the model (%llu bytes)\n",
-                   m->clusters, m->basis, m->bits, vdsh_stream_bytes_per_vertex(s), z.mean_bytes,
-                   (unsigned long long)vdsh_cpca_model_bytes(s->order, m->clusters, m->basis));
+                   m->clusters, m->basis, m->bits ? wbits : "per-vector",
+                   vdsh_stream_bytes_per_vertex(s), z.mean_bytes,
+                   (unsigned long long)vdsh_cpca_stream_model_bytes(m, s->order));
+            if (!m->bits) { /* runs, vector 1 first: 7x3 is three vectors of 7 bits */
+                printf("        widths:");
+                for (uint32_t j = 0; j < m->basis;) {
+                    uint32_t e = j;
+                    while (e < m->basis && m->widths[e] == m->widths[j])
+                        e++;
+                    printf("%s%ux%u", j ? "," : " ", m->widths[j], e - j);
+                    j = e;
+                }
+                putchar('\n');
+            }
             printf("        vertices per cluster:");
             for (uint32_t c = 0; c < m->clusters; c++) {
                 uint32_t count = 0;
@@ -311,6 +325,9 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
                vdsh_encoding_name(f->part.encoding));
     if (f->has_part && f->part.encoding == VDSH_ENCODING_CPCA && !f->part.cpca_clusters)
         printf("               cpca auto:%u (fitted at the merge)\n", f->part.cpca_basis);
+    else if (f->has_part && f->part.encoding == VDSH_ENCODING_CPCA && !f->part.cpca_bits)
+        printf("               cpca %u,alloc:%u (fitted at the merge)\n", f->part.cpca_clusters,
+               f->part.cpca_basis);
     else if (f->has_part && f->part.encoding == VDSH_ENCODING_CPCA)
         printf("               cpca %u,%u,%u (fitted at the merge)\n", f->part.cpca_clusters,
                f->part.cpca_basis, f->part.cpca_bits);
@@ -398,8 +415,12 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
             vt_json_u64(&j, cp, "basis", s->cpca.basis);
             vt_json_u64(&j, cp, "bits", s->cpca.bits);
             vt_json_u64(&j, cp, "record_words", s->cpca.record_words);
-            vt_json_u64(&j, cp, "model_bytes",
-                        vdsh_cpca_model_bytes(s->order, s->cpca.clusters, s->cpca.basis));
+            vt_json_u64(&j, cp, "model_bytes", vdsh_cpca_stream_model_bytes(&s->cpca, s->order));
+            if (!s->cpca.bits) {
+                cJSON *wa = vt_json_array(&j, cp, "widths");
+                for (uint32_t q = 0; q < s->cpca.basis; q++)
+                    vt_json_u64(&j, wa, NULL, s->cpca.widths[q]);
+            }
             vt_json_f64(&j, cp, "mean_bytes_per_vertex",
                         vdsh_stream_size_of(s, vdsh_file_stream_vertices(f)).mean_bytes);
         }

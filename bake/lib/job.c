@@ -296,9 +296,10 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         f.part = (vdsh_part){
             .index = d->shard_index, .count = d->shard_count, .encoding = job_encoding(d)};
         if (job_encoding(d) == VDSH_ENCODING_CPCA) {
-            /* auto: 0, budget, 0 (VDSH.md "Parts") */
+            /* auto: 0, budget, 0; K,alloc:BYTES: K, budget, 0 (VDSH.md
+             * "Parts") */
             vdsh_cpca_settings st = job_cpca(d);
-            f.part.cpca_clusters = st.budget ? 0 : st.clusters;
+            f.part.cpca_clusters = st.clusters;
             f.part.cpca_basis = st.budget ? st.budget : st.basis;
             f.part.cpca_bits = st.budget ? 0 : st.bits;
         }

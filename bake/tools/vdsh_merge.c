@@ -444,10 +444,11 @@ static int merge_streams(merge *m)
              * variable-order stream's rows (zeros past each vertex's
              * order) become a fixed stream of its cap, as cpca_variable
              * (bake/lib/job.c) writes it. */
-            const vdsh_part *pt = &m->p0->part; /* auto: 0, budget, 0 */
+            /* auto: 0, budget, 0; K,alloc:BYTES: K, budget, 0 */
+            const vdsh_part *pt = &m->p0->part;
             vdsh_cpca_settings st = {pt->cpca_clusters, pt->cpca_basis, pt->cpca_bits, 0};
-            if (!pt->cpca_clusters)
-                st = (vdsh_cpca_settings){0, 0, 0, pt->cpca_basis};
+            if (!pt->cpca_bits)
+                st = (vdsh_cpca_settings){pt->cpca_clusters, 0, 0, pt->cpca_basis};
             vdsh_stream f32 = m->streams[s];
             f32.encoding = VDSH_ENCODING_F32;
             f32.scale = 1.0f;

@@ -7,7 +7,8 @@
     c = vdsh.coefficients(s)           # V x order^2 float32 (stored x scale;
                                        # s8, s8s6: stored x float32(scale_i / levels_i))
     s["cpca"]                          # a cpca stream (VDSH.md "cpca streams"): dict clusters,
-                                       # basis, bits, record_words, scales (K x B), means
+                                       # basis, bits (0: a width per vector), record_words,
+                                       # widths (B ints), scales (K x B), means
                                        # (K x n^2), bases (K x B x n^2) float32, cluster (V),
                                        # levels (V x B ints); c is decoded as vdsh.c does
     s["variable_order"], s["orders"]   # a variable-order stream (VDSH.md): each vertex's
@@ -251,9 +252,10 @@ def _chunk(f, cid, b, path):
                   % (i, n, rb, re, enc))
         if enc != 4 and (ck or cb or cbits):
             _fail(path, "part: cpca settings with encoding %s (must be 0)" % ENCODINGS[enc])
-        if enc == 4 and ck == 0:  # auto: 0, budget, 0
-            if not (1 <= cb <= 4096 and cbits == 0):
-                _fail(path, "part: cpca auto settings 0,%d,%d out of range" % (cb, cbits))
+        if enc == 4 and (ck == 0 or cbits == 0):  # auto: 0, budget, 0; alloc: K, budget, 0
+            if not (ck <= 256 and 1 <= cb <= 4096 and cbits == 0):
+                _fail(path, "part: cpca %s settings %d,%d,%d out of range"
+                      % ("auto" if ck == 0 else "alloc", ck, cb, cbits))
         elif enc == 4 and not (1 <= ck <= 256 and 1 <= cb <= 256 and 2 <= cbits <= 8):
             _fail(path, "part: cpca settings %d,%d,%d out of range" % (ck, cb, cbits))
         f.part = dict(index=i, count=n, range_begin=rb, range_end=re, encoding=ENCODINGS[enc])
@@ -414,12 +416,17 @@ def _coef(f, b, V, path):
             levels if enc >= 2 else None, variable, orders, path)
 
 
-def _cpca_field(bits, j):
-    """(word, shift) of weight j's field in a cpca record (VDSH.md)."""
-    first, per = (32 - 8) // bits, 32 // bits
-    if j < first:
-        return 0, 8 + j * bits
-    return 1 + (j - first) // per, ((j - first) % per) * bits
+def _cpca_fields(widths):
+    """(word, shift) of each weight's field in a cpca record whose weight
+    j is widths[j] bits wide (VDSH.md): from bit 8 of word 0 upward, a
+    field that does not fit in what is left of a word starting the next."""
+    out, word, shift = [], 0, 8
+    for w in widths:
+        if shift + w > 32:
+            word, shift = word + 1, 0
+        out.append((word, shift))
+        shift += w
+    return out
 
 
 def _cpca(b, order, V, path):
@@ -431,17 +438,28 @@ def _cpca(b, order, V, path):
     if len(b) < 64:
         _fail(path, "COEF: shorter than its cpca header")
     K, B, bits, W = struct.unpack_from("<4I", b, 48)
-    if not (1 <= K <= 256 and 1 <= B <= nc and 2 <= bits <= 8):
+    if not (1 <= K <= 256 and 1 <= B <= nc and (bits == 0 or 2 <= bits <= 8)):
         _fail(path, "COEF: cpca clusters %d, basis %d or bits %d out of range" % (K, B, bits))
-    fields = [_cpca_field(bits, j) for j in range(B)]
+    r16 = lambda n: (n + 15) // 16 * 16  # noqa: E731
+    at = 64
+    if bits:
+        widths = np.full(B, bits, np.int64)
+    else:  # a width per basis vector: u8[B], zero-padded to 16
+        if len(b) < 64 + r16(B):
+            _fail(path, "COEF: shorter than its cpca widths table")
+        widths = np.frombuffer(b, np.uint8, B, 64).astype(np.int64)
+        if ((widths < 2) | (widths > 8)).any():
+            _fail(path, "COEF: a cpca width is out of 2..8")
+        if any(b[64 + B:64 + r16(B)]):
+            _fail(path, "COEF: padding after the cpca widths not zero")
+        at += r16(B)
+    fields = _cpca_fields(int(x) for x in widths)
     if W != (fields[-1][0] + 1):
         _fail(path, "COEF: cpca record_words %d, must be %d" % (W, fields[-1][0] + 1))
-    r16 = lambda n: (n + 15) // 16 * 16  # noqa: E731
     sizes = [4 * K * B, 2 * K * nc, 2 * K * B * nc]
-    model = 64 + sum(r16(x) for x in sizes)
+    model = at + sum(r16(x) for x in sizes)
     if len(b) != model + 4 * W * V:
         _fail(path, "COEF: payload is %d bytes, must be %d" % (len(b), model + 4 * W * V))
-    at = 64
     arrays = []
     for x, dt, shape in zip(sizes, ["<f4", "<f2", "<f2"], [(K, B), (K, nc), (K, B, nc)]):
         if any(b[at + x:at + r16(x)]):
@@ -453,8 +471,8 @@ def _cpca(b, order, V, path):
         _fail(path, "COEF: a cpca scale is not finite and >= 0")
     if not (np.isfinite(means16).all() and np.isfinite(bases16).all()):
         _fail(path, "COEF: a cpca mean or basis value is not finite")
-    L = (1 << (bits - 1)) - 1
-    step = (scales.astype(np.float32) / np.float32(L)).astype(np.float32)
+    L = (1 << (widths - 1)) - 1  # per vector
+    step = (scales.astype(np.float32) / L.astype(np.float32)).astype(np.float32)
     means = means16.astype(np.float32)
     bases = bases16.astype(np.float32)
     bound = (np.abs(means.astype(np.float64)) +
@@ -469,18 +487,22 @@ def _cpca(b, order, V, path):
     used[0] = 0xff
     levels = np.empty((V, B), np.int32)
     for j, (w, sh) in enumerate(fields):
-        used[w] |= np.uint64(((1 << bits) - 1) << sh)
-        u = ((rec[:, w] >> np.uint32(sh)) & np.uint32((1 << bits) - 1)).astype(np.int32)
-        levels[:, j] = u - (u >> (bits - 1)) * (1 << bits)
+        wd = int(widths[j])
+        used[w] |= np.uint64(((1 << wd) - 1) << sh)
+        u = ((rec[:, w] >> np.uint32(sh)) & np.uint32((1 << wd) - 1)).astype(np.int32)
+        levels[:, j] = u - (u >> (wd - 1)) * (1 << wd)
     if (rec.astype(np.uint64) & ~used).any():
         _fail(path, "COEF: unused bits of a cpca record not zero")
-    if (levels < -L).any():
-        _fail(path, "COEF: a cpca weight is below -%d" % L)
+    low = (levels < -L).any(axis=0)
+    if low.any():
+        j = int(np.argmax(low))
+        _fail(path, "COEF: cpca weight %d is below -%d" % (j, L[j]))
     out = means[cluster]
     wts = levels.astype(np.float32) * step[cluster]
     for j in range(B):
         out = out + wts[:, j:j + 1] * bases[cluster, j]
     return out.astype(np.float32), dict(clusters=K, basis=B, bits=bits, record_words=W,
+                                        widths=widths.astype(np.int32),
                                         scales=scales.astype(np.float32), means=means,
                                         bases=bases, cluster=cluster, levels=levels)
 

@@ -43,7 +43,9 @@
  * BUF_KIND 4 (cpca, formats/VDSH.md "cpca streams"): the record is the
  * file's, BUF_STRIDE words (u_coef, uint): cluster c in bits 0-7 of word
  * 0, then BUF_CPCA_BASIS weight levels of BUF_CPCA_BITS bits each, a
- * field that does not fit in what is left of a word starting the next.
+ * field that does not fit in what is left of a word starting the next
+ * (BUF_CPCA_BITS 0: a width per vector, each field's word and shifts
+ * written out by the includer as BUF_CPCA_UNPACK(first), vr_buffer.c).
  * buf_begin unpacks the levels once; buf_next decodes four coefficients
  * (a texel of the f32 record) at a time from the model u_model (f32
  * texels: for cluster c and record texel t, BUF_CPCA_BASIS + 1 texels
@@ -137,6 +139,10 @@ void buf_begin(int first)
     int word = first, shift = 8;
     b_texel = int(w & 255u) * BUF_CPCA_T;
     b_j = 4;
+#if BUF_CPCA_BITS == 0
+    /* a width per vector: the fields' places written out (vr_buffer.c) */
+    BUF_CPCA_UNPACK(first)
+#else
     for (int j = 0; j < BUF_CPCA_BASIS; j++) {
         if (shift + BUF_CPCA_BITS > 32) {
             word++;
@@ -146,6 +152,7 @@ void buf_begin(int first)
         b_wt[j] = float(int(w << uint(32 - shift - BUF_CPCA_BITS)) >> (32 - BUF_CPCA_BITS));
         shift += BUF_CPCA_BITS;
     }
+#endif
 #else
     b_texel = first;
     b_j = 4;

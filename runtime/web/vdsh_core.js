@@ -136,10 +136,16 @@ export function vdshBufferData(get, nv, stream, maxTexture) {
 // (j < 0) or weight level j, checked against the stream's ranges.
 function cpcaModel(stream, cluster, levels, model) {
   const c = stream.cpca, N = stream.order, nc = N * N;
-  const K = c.clusters, B = c.basis, L = (1 << (c.bits - 1)) - 1;
+  const K = c.clusters, B = c.basis;
   const bad = (what) => new Error('cpca stream of order ' + N + ': ' + what);
-  if (!(K >= 1 && K <= 256 && B >= 1 && B <= nc && c.bits >= 2 && c.bits <= 8))
+  if (!(K >= 1 && K <= 256 && B >= 1 && B <= nc && (c.bits === 0 || (c.bits >= 2 && c.bits <= 8))))
     throw bad('clusters ' + K + ', basis ' + B + ', bits ' + c.bits + ' out of range');
+  // bits 0: a width per basis vector (formats/GLTF.md "cpca streams")
+  if (c.bits === 0 && !(Array.isArray(c.widths) && c.widths.length === B &&
+      c.widths.every((x) => Number.isInteger(x) && x >= 2 && x <= 8)))
+    throw bad('bits 0 without "widths", ' + B + ' integers 2..8');
+  const widths = c.bits ? new Array(B).fill(c.bits) : c.widths.slice();
+  const Ls = widths.map((x) => (1 << (x - 1)) - 1);
   if (levels.length !== Math.ceil(B / 4)) throw bad(levels.length + ' weight attributes, not ' + Math.ceil(B / 4));
   const dv = new DataView(model.buffer, model.byteOffset, model.byteLength);
   const floats = (off, n, what) => {
@@ -160,10 +166,11 @@ function cpcaModel(stream, cluster, levels, model) {
       return k;
     }
     const q = levels[j >> 2][4 * v + (j & 3)];
-    if (!(Math.abs(q) <= L && Number.isInteger(q))) throw bad('vertex ' + v + ' has weight level ' + q + ', not within +-' + L);
+    if (!(Math.abs(q) <= Ls[j] && Number.isInteger(q)))
+      throw bad('vertex ' + v + ' has weight level ' + q + ', not within +-' + Ls[j]);
     return q;
   };
-  return { N, nc, K, B, bits: c.bits, at, steps: floats(c.steps_offset, K * B, 'steps'),
+  return { N, nc, K, B, bits: c.bits, widths, at, steps: floats(c.steps_offset, K * B, 'steps'),
     means: floats(c.means_offset, K * nc, 'means'), bases: floats(c.bases_offset, K * B * nc, 'bases') };
 }
 
@@ -194,8 +201,9 @@ export function vdshCpcaDecode(stream, nv, cluster, levels, model) {
 // stage (vdsh_buffer.glsl's BUF_KIND 4, as vdsh-view draws it): each
 // vertex's record as the file stores it (formats/VDSH.md "cpca streams":
 // the cluster in bits 0-7 of word 0, then the weight levels of `bits`
-// bits each, two's complement, a field that does not fit in what is left
-// of a word starting the next), `stride` words from vertex v * stride,
+// bits each, or with bits 0 of widths[j] bits, two's complement, a field
+// that does not fit in what is left of a word starting the next; `unpack`
+// is then the shader's BUF_CPCA_UNPACK), `stride` words from vertex v * stride,
 // one word per texel of an R32UI texture; and the model as RGBA32F
 // texels (runtime/vr_buffer.c's build_model): for cluster c and record
 // texel t (four coefficients in bufferSequence's order), B + 1 texels from
@@ -203,13 +211,17 @@ export function vdshCpcaDecode(stream, nv, cluster, levels, model) {
 // step. Both textures are `width` texels wide. Arguments as
 // vdshCpcaDecode's; maxTexture: the GPU's MAX_TEXTURE_SIZE.
 export function vdshCpcaBufferData(stream, nv, cluster, levels, model, maxTexture) {
-  const m = cpcaModel(stream, cluster, levels, model), { N, nc, K, B, bits } = m;
+  const m = cpcaModel(stream, cluster, levels, model), { N, nc, K, B, bits, widths } = m;
+  // each field's word and shift (weight j widths[j] bits wide)
+  const fields = [];
   let stride = 1;
-  for (let j = 0, shift = 8; j < B; j++, shift += bits)
-    if (shift + bits > 32) {
+  for (let j = 0, shift = 8; j < B; shift += widths[j], j++) {
+    if (shift + widths[j] > 32) {
       stride++;
       shift = 0;
     }
+    fields.push([stride - 1, shift]);
+  }
   const width = Math.min(maxTexture, 4096);
   const seq = bufferSequence(N), T = Math.ceil(seq.length / 4), row = B + 1;
   const rows = (texels, what) => {
@@ -221,15 +233,9 @@ export function vdshCpcaBufferData(stream, nv, cluster, levels, model, maxTextur
   const height = rows(nv * stride, 'records'), modelHeight = rows(K * T * row, 'model');
   const words = new Uint32Array(width * height);
   for (let v = 0; v < nv; v++) {
-    let at = v * stride, shift = 8;
-    words[at] = m.at(v, -1);
-    for (let j = 0; j < B; j++, shift += bits) {
-      if (shift + bits > 32) {
-        at++;
-        shift = 0;
-      }
-      words[at] |= ((m.at(v, j) & ((1 << bits) - 1)) << shift) >>> 0;
-    }
+    words[v * stride] = m.at(v, -1);
+    for (let j = 0; j < B; j++)
+      words[v * stride + fields[j][0]] |= ((m.at(v, j) & ((1 << widths[j]) - 1)) << fields[j][1]) >>> 0;
   }
   const texels = new Float32Array(width * modelHeight * 4);
   for (let c = 0; c < K; c++)
@@ -239,7 +245,21 @@ export function vdshCpcaBufferData(stream, nv, cluster, levels, model, maxTextur
       for (let j = 0; j < B; j++)
         texels[t + 4 * (j + 1)] = Math.fround(m.steps[c * B + j] * m.bases[(c * B + j) * nc + seq[p]]);
     }
-  return { stride, words, width, height, model: texels, modelHeight, basis: B, bits, T };
+  // bits 0: buf_begin's unpacking written out, as runtime/vr_buffer.c's
+  // cpca_unpack_define writes it (the word fetched once, then per field
+  // its shifts as constants)
+  let unpack = '';
+  if (!bits) {
+    unpack = '#define BUF_CPCA_UNPACK(f)';
+    for (let j = 0, last = 0; j < B; j++) {
+      const [wd, sh] = fields[j];
+      if (wd !== last) unpack += ` w = BUF_FETCH((f) + ${wd}).r;`;
+      last = wd;
+      unpack += ` b_wt[${j}] = float(int(w << ${32 - sh - widths[j]}u) >> ${32 - widths[j]});`;
+    }
+    unpack += '\n';
+  }
+  return { stride, words, width, height, model: texels, modelHeight, basis: B, bits, widths, unpack, T };
 }
 
 // The vertex stage's VDSH code for a plan (vdshStreamPlan), after
@@ -260,7 +280,8 @@ export function vdshVertexGlsl(plan, shaders, texWidth, cpca) {
   if (plan.buffer) {
     const ks = ksTable(plan.order);
     const kind = cpca ? `#define BUF_KIND 4\n#define BUF_VARIABLE 0\n#define BUF_STRIDE ${cpca.stride}\n` +
-      `#define BUF_CPCA_BASIS ${cpca.basis}\n#define BUF_CPCA_BITS ${cpca.bits}\n#define BUF_CPCA_T ${cpca.T}\n`
+      `#define BUF_CPCA_BASIS ${cpca.basis}\n#define BUF_CPCA_BITS ${cpca.bits}\n#define BUF_CPCA_T ${cpca.T}\n` +
+      (cpca.unpack || '')
       : '#define BUF_KIND 0\n#define BUF_VARIABLE 1\n#define BUF_STRIDE 0\n';
     decl = `#define BUF_TEXTURE_2D 1\n#define BUF_TEX_WIDTH ${texWidth}\n${kind}#define BUF_ORDER ${plan.order}\n` +
       `#define BUF_RECEIVER vdshP\n#define BUF_LIGHT(i) vdshL[i]\n#define BUF_SCALE vdshScale\n` +

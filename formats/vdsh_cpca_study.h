@@ -1,0 +1,68 @@
+/*
+ * vdsh_cpca_study.h - the cpca encoder with a bit width per basis vector,
+ * for measurement only (issue 29, docs/ACCURACY.md "Bits per vector by its
+ * variance"; not installed, no file format: the decoded coefficients are
+ * returned, to be scored as an ordinary f32 stream).
+ * Purpose: check the numpy study's width allocation (scripts/cpca_study
+ * `K.B.wT`) on the real encoder's fit, refinement included, before the
+ * format change.
+ * Method: vdsh_cpca_encode's k-means, fit and refinement rounds with B
+ * vectors (settings K, B), then every cluster fitted again with
+ * fit_basis (> B) vectors (the first B the same). Per cluster, vector and
+ * width (0, 2..8) the squared quantisation error of its weights with the
+ * encoder's scale choice (1, 0.95, ..., 0.35 x the largest |weight|, the
+ * least error); the errors summed over the clusters (cluster order) give
+ * one width table for the stream. With a budget of T bytes per vertex:
+ * for each record of W 32-bit words, the most vectors m whose model (the
+ * cpca model of m vectors plus a u8 width table padded to 16 bytes) fits
+ * T x rows with the records; 32 W - 8 bits spread over the first m by
+ * greedy marginal allocation (from all 0, repeatedly raise the width,
+ * 0 -> 2 -> 3 ... 8, that lowers the summed error most per bit spent,
+ * the lowest vector on a tie), fewer bits while the fields do not pack
+ * into W words (a field never straddles two words, as the format's);
+ * the W with the least error (unstored vectors counting their whole
+ * variance; the first on a tie) kept. f64, one thread, fixed order.
+ * Does not: write a stream (no format holds the widths yet).
+ * Usage:
+ *     vdsh_cpca_widths_fit wf;
+ *     vdsh_cpca_settings st = {8, 54, 4, 0};
+ *     vdsh_cpca_encode_widths(coefs, normals, rows, 12, &st, 108, 32.0, NULL,
+ *                             decoded, &wf, &err);
+ * Threading: no shared state.
+ */
+#ifndef VDSH_CPCA_STUDY_H
+#define VDSH_CPCA_STUDY_H
+
+#include "vdsh_cpca.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct vdsh_cpca_widths_fit {
+    uint32_t clusters;               /* K used (capped at rows) */
+    uint32_t basis;                  /* vectors stored: the last of width > 0, plus 1 */
+    uint32_t words;                  /* record words (the index and the packed fields) */
+    uint8_t widths[VDSH_MAX_COEFFS]; /* per vector, 0 or 2..8 */
+    double bytes_per_vertex;         /* records and model (width table included) */
+    double rms_error;                /* RMS over rows of |decoded - c| */
+} vdsh_cpca_widths_fit;
+
+/* Fit src (rows x order^2, finite) with settings' K and B (bits ignored;
+ * no auto), refit with fit_basis vectors (B..order^2) and allocate widths:
+ * budget > 0 bytes per vertex as above, else the fixed table `widths`
+ * (fit_basis entries, 0 or 2..8). decoded (rows x order^2) receives
+ * every row as the format's rule decodes it (f32, mean + weight x f16
+ * basis, vectors in order, width-0 vectors skipped). VDSH_ERR_ARGUMENT
+ * for bad arguments or a budget nothing fits; as vdsh_cpca_encode
+ * otherwise. */
+vdsh_result vdsh_cpca_encode_widths(const float *src, const float *normals, uint32_t rows,
+                                    uint32_t order, const vdsh_cpca_settings *settings,
+                                    uint32_t fit_basis, double budget, const uint8_t *widths,
+                                    float *decoded, vdsh_cpca_widths_fit *out, vdsh_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
