@@ -776,6 +776,40 @@ static double quantise(double w, double s, int levels)
     return q > levels ? levels : q < -levels ? -levels : q;
 }
 
+/* Clusters by k-means on the coefficients plus the normals (weighted by
+ * NORMAL_WEIGHT times the coefficients' spread, sqrt of the mean over rows
+ * of |c - mean c|^2), fits every cluster, then up to `rounds` rounds of
+ * reassignment and fitting again (no vertex moved: the fit is the last
+ * one's). mu (n), dist (rows) and cent (k x (n + 3)) are scratch. */
+static vdsh_result cluster_and_fit(fit_ctx *f, refine_ctx *rd, uint32_t rounds, double *mu,
+                                   double *dist, double *cent, vdsh_error *err)
+{
+    const float *src = f->src;
+    const uint32_t n = f->n, rows = f->rows;
+    for (uint32_t i = 0; i < n; i++)
+        mu[i] = 0.0;
+    for (uint32_t v = 0; v < rows; v++)
+        for (uint32_t i = 0; i < n; i++)
+            mu[i] += src[(size_t)v * n + i];
+    for (uint32_t i = 0; i < n; i++)
+        mu[i] /= rows;
+    double spread = 0.0;
+    for (uint32_t v = 0; v < rows; v++)
+        for (uint32_t i = 0; i < n; i++) {
+            double e = src[(size_t)v * n + i] - mu[i];
+            spread += e * e;
+        }
+    spread = sqrt(spread / rows);
+    kmeans(src, f->normals, rows, n, NORMAL_WEIGHT * spread, f->k, f->labels, dist, cent);
+    vdsh_result res = fit_all(f, err);
+    for (uint32_t round = 0; res == VDSH_OK && round < rounds; round++) {
+        if (!reassign(f, rd))
+            break;
+        res = fit_all(f, err);
+    }
+    return res;
+}
+
 /* One fit with fixed settings (checked; the sources finite); *proxy (may
  * be NULL) the stored fit's hemisphere error (stored_error). */
 static vdsh_result encode_fixed(const float *src, const float *normals, uint32_t rows,
@@ -845,29 +879,7 @@ static vdsh_result encode_fixed(const float *src, const float *normals, uint32_t
                   .frac = frac,
                   .idx = idx};
 
-    /* the coefficients' spread: sqrt(mean over rows of |c - mean c|^2) */
-    for (uint32_t i = 0; i < n; i++)
-        mu[i] = 0.0;
-    for (uint32_t v = 0; v < rows; v++)
-        for (uint32_t i = 0; i < n; i++)
-            mu[i] += src[(size_t)v * n + i];
-    for (uint32_t i = 0; i < n; i++)
-        mu[i] /= rows;
-    double spread = 0.0;
-    for (uint32_t v = 0; v < rows; v++)
-        for (uint32_t i = 0; i < n; i++) {
-            double e = src[(size_t)v * n + i] - mu[i];
-            spread += e * e;
-        }
-    spread = sqrt(spread / rows);
-    kmeans(src, normals, rows, n, NORMAL_WEIGHT * spread, k, labels, dist, cent);
-
-    res = fit_all(&fc, err);
-    for (uint32_t round = 0; res == VDSH_OK && round < rounds; round++) {
-        if (!reassign(&fc, &rd))
-            break; /* no vertex moved: the fit is the last one's */
-        res = fit_all(&fc, err);
-    }
+    res = cluster_and_fit(&fc, &rd, rounds, mu, dist, cent, err);
     if (res != VDSH_OK)
         goto done;
 
@@ -1263,27 +1275,7 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
                   .frac = frac,
                   .idx = idx};
     /* k-means, fit and refinement exactly as encode_fixed */
-    for (uint32_t i = 0; i < n; i++)
-        mu[i] = 0.0;
-    for (uint32_t v = 0; v < rows; v++)
-        for (uint32_t i = 0; i < n; i++)
-            mu[i] += src[(size_t)v * n + i];
-    for (uint32_t i = 0; i < n; i++)
-        mu[i] /= rows;
-    double spread = 0.0;
-    for (uint32_t v = 0; v < rows; v++)
-        for (uint32_t i = 0; i < n; i++) {
-            double e = src[(size_t)v * n + i] - mu[i];
-            spread += e * e;
-        }
-    spread = sqrt(spread / rows);
-    kmeans(src, normals, rows, n, NORMAL_WEIGHT * spread, k, labels, dist, cent);
-    res = fit_all(&fc, err);
-    for (uint32_t round = 0; res == VDSH_OK && round < rounds; round++) {
-        if (!reassign(&fc, &rd))
-            break;
-        res = fit_all(&fc, err);
-    }
+    res = cluster_and_fit(&fc, &rd, rounds, mu, dist, cent, err);
     /* the final labels' fit with bf vectors (its first b the same) */
     fc.b = bf;
     if (res == VDSH_OK)
