@@ -776,16 +776,97 @@ static double quantise(double w, double s, int levels)
     return q > levels ? levels : q < -levels ? -levels : q;
 }
 
+/* ---- the scratch both encoders fit with ---- */
+
+/* The fit's context and everything it points at, the metric's and the
+ * refinement's directions, and cluster_and_fit's scratch: one owner, freed
+ * by fit_scratch_free (also half-built). Not moved once allocated (fc
+ * points at md). */
+typedef struct fit_scratch {
+    fit_ctx fc;
+    metric_dirs md;
+    refine_ctx rd; /* allocated only with need_rd */
+    double *mu;    /* n */
+    double *dist;  /* rows */
+    double *cent;  /* k x (n + 3) */
+} fit_scratch;
+
+static void fit_scratch_free(fit_scratch *s)
+{
+    fit_ctx *f = &s->fc;
+    free(f->labels);
+    free(f->means);
+    free(f->bases);
+    free(f->members);
+    free(f->mus);
+    free(f->l);
+    free(f->proj);
+    free(f->g);
+    free(f->sc);
+    free(f->sy);
+    free(f->ev);
+    free(f->tmp);
+    free(f->frac);
+    free(f->idx);
+    metric_free(&s->md);
+    refine_free(&s->rd);
+    free(s->mu);
+    free(s->dist);
+    free(s->cent);
+    memset(s, 0, sizeof *s);
+}
+
+/* Scratch for k clusters of b vectors (fc.b), with room for the bases and
+ * projections of fit_basis >= b vectors; the refinement's directions only
+ * with need_rd. 0 when out of memory: free it with fit_scratch_free. */
+static int fit_scratch_alloc(fit_scratch *s, const float *src, const float *normals, uint32_t rows,
+                             uint32_t order, uint32_t k, uint32_t b, uint32_t fit_basis,
+                             int need_rd)
+{
+    memset(s, 0, sizeof *s);
+    const uint32_t n = order * order, bf = fit_basis;
+    fit_ctx *f = &s->fc;
+    *f = (fit_ctx){.src = src,
+                   .normals = normals,
+                   .rows = rows,
+                   .n = n,
+                   .k = k,
+                   .b = b,
+                   .md = &s->md,
+                   .labels = malloc(sizeof(uint32_t) * rows),
+                   .means = malloc(sizeof(uint16_t) * k * n),
+                   .bases = malloc(sizeof(uint16_t) * k * bf * n),
+                   .members = malloc(sizeof(uint32_t) * k),
+                   .mus = malloc(sizeof(double) * k * n),
+                   .l = malloc(sizeof(double) * n * n),
+                   .proj = malloc(sizeof(double) * k * n * bf),
+                   .g = malloc(sizeof(double) * n * n),
+                   .sc = malloc(sizeof(double) * n * n),
+                   .sy = malloc(sizeof(double) * n * n),
+                   .ev = malloc(sizeof(double) * n * n),
+                   .tmp = malloc(sizeof(double) * n * n),
+                   .frac = malloc(sizeof(double) * 6 * CUBE_N * CUBE_N),
+                   .idx = malloc(sizeof(uint32_t) * n)};
+    s->mu = malloc(sizeof(double) * n);
+    s->dist = malloc(sizeof(double) * rows);
+    s->cent = malloc(sizeof(double) * k * (n + 3));
+    return f->labels && f->means && f->bases && f->members && f->mus && f->l && f->proj && f->g &&
+           f->sc && f->sy && f->ev && f->tmp && f->frac && f->idx && s->mu && s->dist && s->cent &&
+           metric_init(&s->md, order, CUBE_N) &&
+           (!need_rd || refine_init(&s->rd, order, k, b, rows));
+}
+
 /* Clusters by k-means on the coefficients plus the normals (weighted by
  * NORMAL_WEIGHT times the coefficients' spread, sqrt of the mean over rows
  * of |c - mean c|^2), fits every cluster, then up to `rounds` rounds of
  * reassignment and fitting again (no vertex moved: the fit is the last
- * one's). mu (n), dist (rows) and cent (k x (n + 3)) are scratch. */
-static vdsh_result cluster_and_fit(fit_ctx *f, refine_ctx *rd, uint32_t rounds, double *mu,
-                                   double *dist, double *cent, vdsh_error *err)
+ * one's); rounds > 0 needs s's refinement directions. */
+static vdsh_result cluster_and_fit(fit_scratch *s, uint32_t rounds, vdsh_error *err)
 {
+    fit_ctx *f = &s->fc;
     const float *src = f->src;
     const uint32_t n = f->n, rows = f->rows;
+    double *mu = s->mu;
     for (uint32_t i = 0; i < n; i++)
         mu[i] = 0.0;
     for (uint32_t v = 0; v < rows; v++)
@@ -800,10 +881,10 @@ static vdsh_result cluster_and_fit(fit_ctx *f, refine_ctx *rd, uint32_t rounds, 
             spread += e * e;
         }
     spread = sqrt(spread / rows);
-    kmeans(src, f->normals, rows, n, NORMAL_WEIGHT * spread, f->k, f->labels, dist, cent);
+    kmeans(src, f->normals, rows, n, NORMAL_WEIGHT * spread, f->k, f->labels, s->dist, s->cent);
     vdsh_result res = fit_all(f, err);
     for (uint32_t round = 0; res == VDSH_OK && round < rounds; round++) {
-        if (!reassign(f, rd))
+        if (!reassign(f, &s->rd))
             break;
         res = fit_all(f, err);
     }
@@ -829,63 +910,33 @@ static vdsh_result encode_fixed(const float *src, const float *normals, uint32_t
     size_t o_rec = o_bases + (((size_t)k * b * n * 2 + 15) & ~(size_t)15);
     size_t total = o_rec + (size_t)rows * words * 4;
     uint8_t *block = calloc(1, total);
-    uint32_t *labels = malloc(sizeof(uint32_t) * rows);
-    double *dist = malloc(sizeof(double) * rows);
-    double *cent = malloc(sizeof(double) * k * (n + 3));
-    double *g = malloc(sizeof(double) * n * n), *l = malloc(sizeof(double) * n * n);
-    double *sc = malloc(sizeof(double) * n * n), *sy = malloc(sizeof(double) * n * n);
-    double *ev = malloc(sizeof(double) * n * n), *proj = malloc(sizeof(double) * k * n * b);
-    double *tmp = malloc(sizeof(double) * n * n), *mu = malloc(sizeof(double) * n);
-    double *mus = malloc(sizeof(double) * k * n);
-    uint32_t *members = malloc(sizeof(uint32_t) * k);
     double *wmax = malloc(sizeof(double) * b);
     double *cerr = malloc(sizeof(double) * b * SCALE_CANDIDATES);
-    uint32_t *idx = malloc(sizeof(uint32_t) * n);
-    double *frac = malloc(sizeof(double) * 6 * CUBE_N * CUBE_N);
-    metric_dirs md = {0};
-    refine_ctx rd = {0};
+    fit_scratch fs;
     const uint32_t rounds = k > 1 ? REFINE_ROUNDS : 0;
-    const int need_rd = rounds || proxy;
     vdsh_result res = VDSH_OK;
-    if (!block || !labels || !dist || !cent || !g || !l || !sc || !sy || !ev || !proj || !tmp ||
-        !mu || !mus || !members || !wmax || !cerr || !idx || !frac ||
-        !metric_init(&md, order, CUBE_N) || (need_rd && !refine_init(&rd, order, k, b, rows))) {
+    if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, b, rounds || proxy) || !block ||
+        !wmax || !cerr) {
         res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory (%zu bytes)", total);
         goto done;
     }
+    fit_ctx *fc = &fs.fc;
     float *scales = (float *)block;
     uint16_t *means = (uint16_t *)(block + o_means);
     uint16_t *bases = (uint16_t *)(block + o_bases);
     uint32_t *records = (uint32_t *)(block + o_rec);
-    fit_ctx fc = {.src = src,
-                  .normals = normals,
-                  .rows = rows,
-                  .n = n,
-                  .k = k,
-                  .b = b,
-                  .md = &md,
-                  .labels = labels,
-                  .means = means,
-                  .bases = bases,
-                  .members = members,
-                  .mus = mus,
-                  .l = l,
-                  .proj = proj,
-                  .g = g,
-                  .sc = sc,
-                  .sy = sy,
-                  .ev = ev,
-                  .tmp = tmp,
-                  .frac = frac,
-                  .idx = idx};
+    const uint32_t *labels = fc->labels;
+    const double *mus = fc->mus, *proj = fc->proj;
 
-    res = cluster_and_fit(&fc, &rd, rounds, mu, dist, cent, err);
+    res = cluster_and_fit(&fs, rounds, err);
     if (res != VDSH_OK)
         goto done;
+    memcpy(means, fc->means, sizeof(uint16_t) * k * n);
+    memcpy(bases, fc->bases, sizeof(uint16_t) * k * b * n);
 
     const int levels = vdsh_cpca_levels(bits);
     for (uint32_t c = 0; c < k; c++) {
-        if (!fc.members[c])
+        if (!fc->members[c])
             continue; /* mean, basis and scales 0; no vertex refers to it */
         const double *cmu = mus + (size_t)c * n, *cproj = proj + (size_t)c * b * n;
         /* weights, in three passes: the largest |weight| per vector; the
@@ -967,29 +1018,12 @@ static vdsh_result encode_fixed(const float *src, const float *normals, uint32_t
         out->rms_error = sqrt(e2 / rows);
     }
     if (proxy)
-        *proxy = stored_error(&fc, &rd, scales, records, bits, words);
+        *proxy = stored_error(fc, &fs.rd, scales, records, bits, words);
 done:
     free(block);
-    free(labels);
-    free(dist);
-    free(cent);
-    free(g);
-    free(l);
-    free(mus);
-    free(members);
-    free(sc);
-    free(sy);
-    free(ev);
-    free(proj);
-    free(tmp);
-    free(mu);
     free(wmax);
     free(cerr);
-    free(idx);
-    free(frac);
-    metric_free(&md);
-    if (need_rd)
-        refine_free(&rd);
+    fit_scratch_free(&fs);
     return res;
 }
 
@@ -1224,62 +1258,29 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
             return vdsh_failf(err, VDSH_ERR_INVALID,
                               "cpca: vertex %zu coefficient %zu is not finite", x / n, x % n);
     const uint32_t bf = fit_basis;
-    uint16_t *means = malloc(sizeof(uint16_t) * k * n);
-    uint16_t *bases = malloc(sizeof(uint16_t) * k * bf * n);
-    uint32_t *labels = malloc(sizeof(uint32_t) * rows);
-    double *dist = malloc(sizeof(double) * rows);
-    double *cent = malloc(sizeof(double) * k * (n + 3));
-    double *g = malloc(sizeof(double) * n * n), *l = malloc(sizeof(double) * n * n);
-    double *sc = malloc(sizeof(double) * n * n), *sy = malloc(sizeof(double) * n * n);
-    double *ev = malloc(sizeof(double) * n * n), *proj = malloc(sizeof(double) * k * n * bf);
-    double *tmp = malloc(sizeof(double) * n * n), *mu = malloc(sizeof(double) * n);
-    double *mus = malloc(sizeof(double) * k * n);
-    uint32_t *members = malloc(sizeof(uint32_t) * k);
-    uint32_t *idx = malloc(sizeof(uint32_t) * n);
-    double *frac = malloc(sizeof(double) * 6 * CUBE_N * CUBE_N);
     double *wts = malloc(sizeof(double) * rows * bf);          /* each row's weights */
     double *cdist = malloc(sizeof(double) * k * bf * NWIDTHS); /* per cluster */
     float *cscale = malloc(sizeof(float) * k * bf * NWIDTHS);  /* the best scale */
     double *tot = malloc(sizeof(double) * bf * NWIDTHS);       /* over clusters */
     uint32_t *level = malloc(sizeof(uint32_t) * bf), *best_level = malloc(sizeof(uint32_t) * bf);
-    metric_dirs md = {0};
-    refine_ctx rd = {0};
+    fit_scratch fs;
     const uint32_t rounds = k > 1 ? REFINE_ROUNDS : 0;
     vdsh_result res = VDSH_OK;
-    if (!means || !bases || !labels || !dist || !cent || !g || !l || !sc || !sy || !ev || !proj ||
-        !tmp || !mu || !mus || !members || !idx || !frac || !wts || !cdist || !cscale || !tot ||
-        !level || !best_level || !metric_init(&md, order, CUBE_N) ||
-        (rounds && !refine_init(&rd, order, k, b, rows))) {
+    if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, bf, rounds) || !wts || !cdist ||
+        !cscale || !tot || !level || !best_level) {
         res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca widths: out of memory");
         goto done;
     }
-    fit_ctx fc = {.src = src,
-                  .normals = normals,
-                  .rows = rows,
-                  .n = n,
-                  .k = k,
-                  .b = b,
-                  .md = &md,
-                  .labels = labels,
-                  .means = means,
-                  .bases = bases,
-                  .members = members,
-                  .mus = mus,
-                  .l = l,
-                  .proj = proj,
-                  .g = g,
-                  .sc = sc,
-                  .sy = sy,
-                  .ev = ev,
-                  .tmp = tmp,
-                  .frac = frac,
-                  .idx = idx};
+    fit_ctx *fc = &fs.fc;
+    const uint32_t *labels = fc->labels, *members = fc->members;
+    const uint16_t *means = fc->means, *bases = fc->bases;
+    const double *mus = fc->mus, *proj = fc->proj;
     /* k-means, fit and refinement exactly as encode_fixed */
-    res = cluster_and_fit(&fc, &rd, rounds, mu, dist, cent, err);
+    res = cluster_and_fit(&fs, rounds, err);
     /* the final labels' fit with bf vectors (its first b the same) */
-    fc.b = bf;
+    fc->b = bf;
     if (res == VDSH_OK)
-        res = fit_all(&fc, err);
+        res = fit_all(fc, err);
     if (res != VDSH_OK)
         goto done;
 
@@ -1490,31 +1491,12 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
     }
     out->rms_error = sqrt(e2 / rows);
 done:
-    free(means);
-    free(bases);
-    free(labels);
-    free(dist);
-    free(cent);
-    free(g);
-    free(l);
-    free(sc);
-    free(sy);
-    free(ev);
-    free(proj);
-    free(tmp);
-    free(mu);
-    free(mus);
-    free(members);
-    free(idx);
-    free(frac);
     free(wts);
     free(cdist);
     free(cscale);
     free(tot);
     free(level);
     free(best_level);
-    metric_free(&md);
-    if (rounds)
-        refine_free(&rd);
+    fit_scratch_free(&fs);
     return res;
 }
