@@ -57,6 +57,7 @@ file(MAKE_DIRECTORY ${_rt_dir}/room_log)
 
 # Rendering sanity: closed sphere, light behind a wall, modes, passes.
 _runtime_test(test_runtime_render)
+target_link_libraries(test_runtime_render PRIVATE vb_icosphere)
 add_test(NAME runtime_render_shadows_where_expected
          COMMAND test_runtime_render ${_rt_dir}/room/room.vdsh ${_rt_dir}/render)
 _runtime_props(runtime_render_shadows_where_expected FIXTURES_REQUIRED runtime_room)

@@ -18,6 +18,7 @@
  *             the polynomials, else order 3, else 2 (vdsh-view's default
  *             is the same definition: runtime_view_render checks that).
  */
+#include "icosphere.h"
 #include "test_runtime_util.h"
 
 enum { W = 128, H = 96 };
@@ -25,62 +26,8 @@ enum { W = 128, H = 96 };
 /* ------------------------------------------------------------------ */
 /* The sphere                                                            */
 
-enum { SPHERE_LEVELS = 3, MAX_SV = 700, MAX_ST = 1300 };
-
-/* A unit icosphere: the icosahedron, each triangle split in four with the
- * midpoints pushed onto the sphere, shared between neighbours. */
-static void icosphere(float (*pos)[3], uint32_t *nv, uint32_t (*tri)[3], uint32_t *nt)
-{
-    const float t = 1.6180339887f;
-    const float base[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
-                               {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
-                               {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-    static const uint32_t faces[20][3] = {
-        {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-        {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-        {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
-    float len = sqrtf(1.0f + t * t);
-    for (int i = 0; i < 12; i++)
-        for (int k = 0; k < 3; k++)
-            pos[i][k] = base[i][k] / len;
-    *nv = 12;
-    memcpy(tri, faces, sizeof faces);
-    *nt = 20;
-    static uint32_t ea[MAX_ST * 2], eb[MAX_ST * 2], em[MAX_ST * 2], next[MAX_ST][3];
-    for (int level = 0; level < SPHERE_LEVELS; level++) {
-        uint32_t ne = 0, nn = 0;
-        for (uint32_t f = 0; f < *nt; f++) {
-            uint32_t mid[3];
-            for (int e = 0; e < 3; e++) {
-                uint32_t a = tri[f][e], b = tri[f][(e + 1) % 3];
-                uint32_t lo = a < b ? a : b, hi = a < b ? b : a, m = UINT32_MAX;
-                for (uint32_t q = 0; q < ne && m == UINT32_MAX; q++)
-                    if (ea[q] == lo && eb[q] == hi)
-                        m = em[q];
-                if (m == UINT32_MAX) {
-                    float p[3], l = 0.0f;
-                    for (int k = 0; k < 3; k++) {
-                        p[k] = 0.5f * (pos[a][k] + pos[b][k]);
-                        l += p[k] * p[k];
-                    }
-                    for (int k = 0; k < 3; k++)
-                        pos[*nv][k] = p[k] / sqrtf(l);
-                    m = (*nv)++;
-                    ea[ne] = lo, eb[ne] = hi, em[ne++] = m;
-                }
-                mid[e] = m;
-            }
-            uint32_t split[4][3] = {{tri[f][0], mid[0], mid[2]},
-                                    {tri[f][1], mid[1], mid[0]},
-                                    {tri[f][2], mid[2], mid[1]},
-                                    {mid[0], mid[1], mid[2]}};
-            memcpy(next[nn], split, sizeof split);
-            nn += 4;
-        }
-        memcpy(tri, next, nn * sizeof next[0]);
-        *nt = nn;
-    }
-}
+/* bake/lib's icosphere (the built-in scenes' spheres'), a level finer */
+enum { SPHERE_LEVELS = 3 };
 
 /* The inside of a sphere of radius R at the origin, normals inwards, with
  * exact visibility distances: from a point p on it, direction w meets the
@@ -89,10 +36,10 @@ static void icosphere(float (*pos)[3], uint32_t *nv, uint32_t (*tri)[3], uint32_
  * orders 2, 3, 5 numerically (64 x 64 stratified directions). */
 static void sphere_file(rt_file *f, float R)
 {
-    static float pos[MAX_SV][3];
-    static uint32_t tri[MAX_ST][3];
+    static float pos[VB_ICOSPHERE_VERTICES(SPHERE_LEVELS)][3];
+    static uint32_t tri[VB_ICOSPHERE_TRIANGLES(SPHERE_LEVELS)][3];
     uint32_t nv = 0, nt = 0;
-    icosphere(pos, &nv, tri, &nt);
+    vb_icosphere(SPHERE_LEVELS, pos, &nv, tri, &nt);
     rt_file_init(f, nv, nt);
     for (uint32_t i = 0; i < nv; i++)
         for (int k = 0; k < 3; k++) {

@@ -60,6 +60,7 @@
  * constants (no cosf or sinf; this file is built without FMA
  * contraction), so N gives the same bytes on any machine and compiler.
  */
+#include "icosphere.h"
 #include "mesh.h"
 #include "vdsh_det.h"
 
@@ -84,13 +85,7 @@
 
 /* Room for the whole of builtin:room (it has 1,518 vertices and 2,428
  * triangles; test_mesh checks the counts). The variants' arrays grow. */
-enum {
-    MAX_VERTICES = 4096,
-    MAX_TRIANGLES = 4096,
-    MAX_LATTICE = 64,
-    SPHERE_MAX_VERTICES = 162,
-    SPHERE_MAX_TRIANGLES = 320
-};
+enum { MAX_VERTICES = 4096, MAX_TRIANGLES = 4096, MAX_LATTICE = 64 };
 
 typedef struct room_builder {
     vb_mesh *m;
@@ -318,78 +313,14 @@ static void add_box(room_builder *b, float cx, float cz, float y0, float sx, flo
         add_quad(b, p[0], p[1], p[3], p[2]);
 }
 
-/* A unit icosphere: the icosahedron, each triangle split into four with
- * midpoints pushed onto the sphere, SPHERE_LEVELS times. Midpoints are
- * shared between the two triangles of an edge (found by a linear search:
- * a few hundred edges), so the facets meet exactly. */
-static void icosphere(float pos[][3], uint32_t *nv, uint32_t tri[][3], uint32_t *nt)
-{
-    const float t = 1.6180339887f;
-    static const float base[12][3] = {
-        {-1, 1.6180339887f, 0},  {1, 1.6180339887f, 0},   {-1, -1.6180339887f, 0},
-        {1, -1.6180339887f, 0},  {0, -1, 1.6180339887f},  {0, 1, 1.6180339887f},
-        {0, -1, -1.6180339887f}, {0, 1, -1.6180339887f},  {1.6180339887f, 0, -1},
-        {1.6180339887f, 0, 1},   {-1.6180339887f, 0, -1}, {-1.6180339887f, 0, 1}};
-    static const uint32_t faces[20][3] = {
-        {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-        {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-        {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
-    float len = sqrtf(1.0f + t * t);
-    for (int i = 0; i < 12; i++)
-        for (int k = 0; k < 3; k++)
-            pos[i][k] = base[i][k] / len;
-    *nv = 12;
-    memcpy(tri, faces, sizeof faces);
-    *nt = 20;
-    for (int level = 0; level < SPHERE_LEVELS; level++) {
-        uint32_t edge_a[SPHERE_MAX_TRIANGLES * 3 / 2], edge_b[SPHERE_MAX_TRIANGLES * 3 / 2];
-        uint32_t edge_mid[SPHERE_MAX_TRIANGLES * 3 / 2];
-        uint32_t next[SPHERE_MAX_TRIANGLES][3];
-        uint32_t ne = 0, nn = 0;
-        for (uint32_t f = 0; f < *nt; f++) {
-            uint32_t mid[3];
-            for (int e = 0; e < 3; e++) {
-                uint32_t a = tri[f][e], c = tri[f][(e + 1) % 3];
-                uint32_t lo = a < c ? a : c, hi = a < c ? c : a, found = UINT32_MAX;
-                for (uint32_t q = 0; q < ne; q++)
-                    if (edge_a[q] == lo && edge_b[q] == hi)
-                        found = edge_mid[q];
-                if (found == UINT32_MAX) {
-                    float m[3], l = 0.0f;
-                    for (int k = 0; k < 3; k++) {
-                        m[k] = 0.5f * (pos[a][k] + pos[c][k]);
-                        l += m[k] * m[k];
-                    }
-                    l = sqrtf(l);
-                    for (int k = 0; k < 3; k++)
-                        pos[*nv][k] = m[k] / l;
-                    found = (*nv)++;
-                    edge_a[ne] = lo;
-                    edge_b[ne] = hi;
-                    edge_mid[ne++] = found;
-                }
-                mid[e] = found;
-            }
-            const uint32_t split[4][3] = {{tri[f][0], mid[0], mid[2]},
-                                          {tri[f][1], mid[1], mid[0]},
-                                          {tri[f][2], mid[2], mid[1]},
-                                          {mid[0], mid[1], mid[2]}};
-            memcpy(next[nn], split, sizeof split);
-            nn += 4;
-        }
-        memcpy(tri, next, nn * sizeof next[0]);
-        *nt = nn;
-    }
-}
-
 /* The sphere of radius r with its lowest vertex on y = y0: smooth, its
  * triangles sharing vertices, so the computed normals are radial. */
 static void add_sphere(room_builder *b, float cx, float y0, float cz, float r)
 {
-    float pos[SPHERE_MAX_VERTICES][3];
-    uint32_t tri[SPHERE_MAX_TRIANGLES][3];
+    float pos[VB_ICOSPHERE_VERTICES(SPHERE_LEVELS)][3];
+    uint32_t tri[VB_ICOSPHERE_TRIANGLES(SPHERE_LEVELS)][3];
     uint32_t nv = 0, nt = 0;
-    icosphere(pos, &nv, tri, &nt);
+    vb_icosphere(SPHERE_LEVELS, pos, &nv, tri, &nt);
     float lowest = 0.0f;
     for (uint32_t i = 0; i < nv; i++)
         if (pos[i][1] < lowest)
