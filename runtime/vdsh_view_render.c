@@ -95,6 +95,25 @@ static const vv_mode *grid_mode(const vr_scene *s, int c)
     return last;
 }
 
+/* The mode the grid's summary line describes: the order-5 column's; for a
+ * file with no fixed order, its adaptive stream's (the order-5 column is
+ * not in the file), with that stream's method, as bake_label names it. */
+static void summary_mode(const vr_scene *s, char *out, size_t size)
+{
+    vr_scene_info info;
+    vr_scene_get_info(s, &info);
+    int fixed = 0;
+    for (int k = 1; k <= VDSH_MAX_ORDER; k++)
+        fixed |= info.has_order[k];
+    if (fixed || !info.variable_order) {
+        snprintf(out, size, "%s", vr_scene_mode_label(s, grid_mode(s, GRID_ORDER5_COL)->mode));
+        return;
+    }
+    char label[160];
+    vv_mode_label(s, VR_MODE_VDSH_BUFFER, VR_STREAM_VARIABLE, label, sizeof label);
+    snprintf(out, size, "%s, %s", label, vdsh_method_name(info.variable_method));
+}
+
 /* One row of the grid: the panels of one scene into row (cols panels w
  * wide); have[c]: 1 when the scene has column c's mode. */
 static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w, int h, int cols,
@@ -160,10 +179,12 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
             memcpy(row + ((size_t)y * (size_t)cols * (size_t)w + (size_t)m * (size_t)w) * 4,
                    px + (size_t)y * (size_t)w * 4, (size_t)w * 4);
     }
-    if (!rc && !o->quiet)
-        fprintf(stderr, "vdsh-view: %s: %s (%s), %d light%s\n", bake, names,
-                vr_scene_mode_label(scene, grid_mode(scene, GRID_ORDER5_COL)->mode), n,
+    if (!rc && !o->quiet) {
+        char mode[256];
+        summary_mode(scene, mode, sizeof mode);
+        fprintf(stderr, "vdsh-view: %s: %s (%s), %d light%s\n", bake, names, mode, n,
                 n == 1 ? "" : "s");
+    }
     vr_scene_destroy(scene);
     return rc;
 }

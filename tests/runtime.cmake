@@ -440,8 +440,8 @@ expect 2 "positive count" --frames "$d/x" "$room"
 # The buffer modes on the command line: a file with orders 7, 9, 12 and an
 # order per vertex (test_runtime_buffer derive); the grid gains its
 # adaptive-order column (6 panels) and says so; --help names the modes;
-# a file of adaptive order alone draws its buffer and its grid row names
-# its method.
+# a file of adaptive order alone draws its buffer and its grid row and
+# summary line name its method.
 add_test(NAME runtime_view_buffer COMMAND sh -c [=[
 set -e
 v=$1; png=$2; derive=$3; log=$4; d=$5
@@ -473,6 +473,11 @@ grep -q "mode buffer: VDSH adaptive order (up to 9" "$d/default.log"
 "$v" --grid "$d/agrid.png" --size 96x72 "$d/adaptive.vdsh" 2> "$d/agrid.log"
 cat "$d/agrid.log"
 grep -q "adaptive.vdsh: decision bake" "$d/agrid.log"
+# and its summary line describes that stream and its method, not the
+# order-5 column (not in this file)
+grep -q "| adaptive (VDSH adaptive order (up to 9, mean [0-9.]*; per-vertex), decision)" \
+  "$d/agrid.log"
+if grep -q "VDSH order 5" "$d/agrid.log"; then exit 1; fi
 ]=] sh ${_view} ${_png} $<TARGET_FILE:test_runtime_buffer> ${_room_log} ${_rt_dir}/view_buffer
        $<TARGET_FILE:vdsh-bake>)
 
