@@ -891,6 +891,28 @@ static vdsh_result cluster_and_fit(fit_scratch *s, uint32_t rounds, vdsh_error *
     return res;
 }
 
+/* The RMS error of fit's stream against src (rows x order^2), decoded as
+ * every reader decodes. */
+static double decode_rms(const vdsh_cpca_fit *fit, const float *src, uint32_t rows, uint32_t order)
+{
+    const uint32_t n = order * order;
+    vdsh_stream s = {.order = order,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .scale = 1.0f,
+                     .data = fit->records,
+                     .cpca = fit->model};
+    float dec[VDSH_MAX_COEFFS];
+    double e2 = 0.0;
+    for (uint32_t v = 0; v < rows; v++) {
+        vdsh_stream_decode(&s, v, dec);
+        for (uint32_t i = 0; i < n; i++) {
+            double e = (double)dec[i] - src[(size_t)v * n + i];
+            e2 += e * e;
+        }
+    }
+    return sqrt(e2 / rows);
+}
+
 /* One fit with fixed settings (checked; the sources finite); *proxy (may
  * be NULL) the stored fit's hemisphere error (stored_error). */
 static vdsh_result encode_fixed(const float *src, const float *normals, uint32_t rows,
@@ -999,24 +1021,7 @@ static vdsh_result encode_fixed(const float *src, const float *normals, uint32_t
     out->records = records;
     out->storage_ = block;
     block = NULL;
-    {
-        /* the decode error, as every reader decodes */
-        vdsh_stream s = {.order = order,
-                         .encoding = VDSH_ENCODING_CPCA,
-                         .scale = 1.0f,
-                         .data = records,
-                         .cpca = out->model};
-        float dec[VDSH_MAX_COEFFS];
-        double e2 = 0.0;
-        for (uint32_t v = 0; v < rows; v++) {
-            vdsh_stream_decode(&s, v, dec);
-            for (uint32_t i = 0; i < n; i++) {
-                double e = (double)dec[i] - src[(size_t)v * n + i];
-                e2 += e * e;
-            }
-        }
-        out->rms_error = sqrt(e2 / rows);
-    }
+    out->rms_error = decode_rms(out, src, rows, order);
     if (proxy)
         *proxy = stored_error(fc, &fs.rd, scales, records, bits, words);
 done:
@@ -1447,21 +1452,7 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
         }
         fit->records = rec;
         fit->storage_ = block;
-        vdsh_stream s = {.order = order,
-                         .encoding = VDSH_ENCODING_CPCA,
-                         .scale = 1.0f,
-                         .data = rec,
-                         .cpca = fit->model};
-        float dec[VDSH_MAX_COEFFS];
-        double e2 = 0.0;
-        for (uint32_t v = 0; v < rows; v++) {
-            vdsh_stream_decode(&s, v, dec);
-            for (uint32_t i = 0; i < n; i++) {
-                double e = (double)dec[i] - src[(size_t)v * n + i];
-                e2 += e * e;
-            }
-        }
-        fit->rms_error = out->rms_error = sqrt(e2 / rows);
+        fit->rms_error = out->rms_error = decode_rms(fit, src, rows, order);
         goto done;
     }
 
