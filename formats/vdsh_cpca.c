@@ -1039,6 +1039,18 @@ static uint64_t fit_bytes(uint32_t rows, uint32_t order, const vdsh_cpca_setting
            vdsh_cpca_model_bytes(order, s->clusters, s->basis);
 }
 
+/* The largest basis (at most order^2) whose stream of `rows` rows with
+ * s's other settings takes at most limit bytes; 0 when none does. */
+static uint32_t largest_basis(uint32_t rows, uint32_t order, const vdsh_cpca_settings *s,
+                              uint64_t limit)
+{
+    vdsh_cpca_settings t = *s;
+    for (t.basis = order * order; t.basis >= 1; t.basis--)
+        if (fit_bytes(rows, order, &t) <= limit)
+            return t.basis;
+    return 0;
+}
+
 static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t rows,
                                 uint32_t order, const vdsh_cpca_settings *settings,
                                 vdsh_cpca_fit *out, vdsh_error *err);
@@ -1048,7 +1060,7 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
                                uint32_t order, uint32_t budget, vdsh_cpca_fit *out, vdsh_error *err)
 {
     static const uint32_t ks[] = {4, 8, 16};
-    const uint32_t n = order * order, bits = 4;
+    const uint32_t bits = 4;
     const uint64_t limit = (uint64_t)budget * rows;
     double best_e = 0.0;
     uint32_t last_k = 0;
@@ -1058,12 +1070,7 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
         if (st.clusters == last_k)
             continue; /* capped at rows: the same as the last */
         last_k = st.clusters;
-        for (uint32_t b = n; b >= 1 && !st.basis; b--) {
-            vdsh_cpca_settings t = st;
-            t.basis = b;
-            if (fit_bytes(rows, order, &t) <= limit)
-                st.basis = b;
-        }
+        st.basis = largest_basis(rows, order, &st, limit);
         if (!st.basis)
             continue;
         vdsh_cpca_fit fit;
@@ -1214,12 +1221,7 @@ static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t
     const uint32_t n = order * order;
     const uint64_t limit = (uint64_t)settings->budget * rows;
     vdsh_cpca_settings st = {settings->clusters < rows ? settings->clusters : rows, 0, 4, 0};
-    for (uint32_t b = n; b >= 1 && !st.basis; b--) {
-        vdsh_cpca_settings t = st;
-        t.basis = b;
-        if (fit_bytes(rows, order, &t) <= limit)
-            st.basis = b;
-    }
+    st.basis = largest_basis(rows, order, &st, limit);
     if (!st.basis)
         return vdsh_failf(err, VDSH_ERR_ARGUMENT,
                           "cpca: alloc budget %u bytes per vertex too small for %u rows of order "
