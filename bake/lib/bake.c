@@ -1306,10 +1306,10 @@ static vb_result resolve_decision(bake_run *b, vb_error *err)
         d->offset_cap_min = 1;
     if (d->offset_cap && !b->mi->decision)
         return vb_fail(err, VB_ERR_ARGUMENT, "the offset cap is method decision's");
-    if (d->offset_cap && (!(d->offset_cap_tol >= 0.0f && d->offset_cap_tol <= 5.0f) ||
+    if (d->offset_cap && (!(fabsf(d->offset_cap_tol) <= 5.0f) ||
                           !(d->offset_cap_keep > 0.0f && d->offset_cap_keep <= 1.0f)))
         return vb_fail(err, VB_ERR_ARGUMENT,
-                       "the offset cap's tolerance must be in 0..5 and its share in (0, 1]");
+                       "the offset cap's tolerance must be in -5..5 and its share in (0, 1]");
     vb_decision_defaults(&b->dec);
     if (d->decision)
         b->dec = *d->decision;

@@ -146,10 +146,10 @@ typedef struct vb_bake_desc {
     /* Method decision, the per-receiver offset cap (issue 25; 0: off):
      * each receiver's log offset is raised (never above 0) to keep all
      * but 1 - offset_cap_keep of its lit training pairs lit, less
-     * offset_cap_tol ln units, where it has at least offset_cap_min lit
-     * pairs; the calibration measures its held-out lights through the
-     * capped offsets. Fixed orders only (not the adaptive order's
-     * stream). keep 0: 1; min 0: 1. */
+     * offset_cap_tol ln units (negative: lit by that much more), where
+     * it has at least offset_cap_min lit pairs; the calibration measures
+     * its held-out lights through the capped offsets. Fixed orders only
+     * (not the adaptive order's stream). keep 0: 1; min 0: 1. */
     int offset_cap;
     float offset_cap_tol, offset_cap_keep;
     uint32_t offset_cap_min;

@@ -247,7 +247,8 @@ static void usage(FILE *f)
             "                          decision: cap each receiver's log offset (raise it,\n"
             "                          never above 0) so that KEEP of its lit training\n"
             "                          pairs stay lit, less TOL ln units, where it has\n"
-            "                          at least MIN lit pairs (default KEEP 1, MIN 1); the\n"
+            "                          at least MIN lit pairs (default KEEP 1, MIN 1); a\n"
+            "                          negative TOL keeps them lit by -TOL more; the\n"
             "                          calibration runs through the capped offsets.\n"
             "                          Fixed orders only (issue 25, docs/ACCURACY.md)\n"
             "      --decision-lights N decision: training lights per receiver, each\n"
@@ -843,9 +844,9 @@ static int read_choice(int c, const char *arg, options *o)
         unsigned min = 1;
         char tail = 0;
         int n = sscanf(arg, "%f,%f,%u%c", &tol, &keep, &min, &tail);
-        if (n < 1 || n > 3 || !(tol >= 0.0f && tol <= 5.0f) || !(keep > 0.0f && keep <= 1.0f) ||
-            min < 1 || min > VB_DECISION_MAX_PAIRS)
-            return bad_usage("--offset-cap takes TOL[,KEEP[,MIN]]: a tolerance in 0..5 ln "
+        if (n < 1 || n > 3 || !(fabsf(tol) <= 5.0f) || !(keep > 0.0f && keep <= 1.0f) || min < 1 ||
+            min > VB_DECISION_MAX_PAIRS)
+            return bad_usage("--offset-cap takes TOL[,KEEP[,MIN]]: a tolerance in -5..5 ln "
                              "units, the share of lit training pairs kept lit in (0, 1], the "
                              "least lit pairs 1..1024, not '%s'",
                              arg);
