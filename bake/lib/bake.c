@@ -107,6 +107,8 @@ typedef struct job {
      * order slot), and those of the range's samples (per receiver of the
      * range and slot), added with the calibrated offset after the bake. */
     int cap_on;
+    float free_offset[VDSH_ORDER_SLOTS]; /* receivers without a cap: the
+                                          * offset calibrated without caps */
     float cap_tol, cap_keep;
     uint32_t cap_min;
     float *cal_caps, *done_caps;
@@ -416,11 +418,12 @@ static uint32_t dec_pairs(const job *J, uint32_t *at, uint32_t *scanned, const f
     return m;
 }
 
-/* The log offset receiver's fit draws with: the bake's, raised to the
- * receiver's cap (<= 0; -inf: none). */
-static inline float capped_offset(float off, float cap)
+/* The log offset a receiver's fit draws with: the bake's, raised to the
+ * receiver's cap (<= 0); where it has none (-inf), `uncapped` (the offset
+ * calibrated without caps). */
+static inline float capped_offset(float off, float cap, float uncapped)
 {
-    return off < cap ? cap : off;
+    return cap == -INFINITY ? uncapped : off < cap ? cap : off;
 }
 
 static int cmp_margin(const void *a, const void *b)
@@ -529,7 +532,7 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
                 uint32_t lit = 0;
                 cap[o] = dec_cap(J, o, out->coeffs[1][o], m, Y, ys, logd, lab, mg, &lit);
                 if (!out->cal) {
-                    float off = capped_offset(J->log_offset[o], cap[o]);
+                    float off = capped_offset(J->log_offset[o], cap[o], J->free_offset[o]);
                     uint64_t bad = 0;
                     for (uint32_t i = 0; i < lit; i++)
                         bad += mg[i] >= 0.0f && mg[i] + off < -J->cap_tol - 1e-5f;
@@ -864,8 +867,9 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!out->coeffs[1][o])
             continue;
-        float off = out->cal ? J->log_offset[o] : capped_offset(J->log_offset[o], cap[o]);
-        if (!out->cal && off != J->log_offset[o])
+        float off = out->cal ? J->log_offset[o]
+                             : capped_offset(J->log_offset[o], cap[o], J->free_offset[o]);
+        if (!out->cal && cap[o] > J->log_offset[o])
             atomic_fetch_add(&J->cap_bound, 1);
         if (off != 0.0f)
             out->coeffs[1][o][0] += off / 0.28209479177387814f;
@@ -1475,7 +1479,8 @@ static vb_result setup_offsets(bake_run *b, vb_error *err)
     const vb_method_info *mi = b->mi;
     job *J = b->J;
     for (int o = 1; o <= VDSH_MAX_ORDER && mi->param == VB_PARAM_LOG_OFFSET; o++) {
-        J->log_offset[o] = d->log_offsets ? d->log_offsets[o] : mi->default_log_offset[o];
+        J->log_offset[o] = J->free_offset[o] =
+            d->log_offsets ? d->log_offsets[o] : mi->default_log_offset[o];
         if (!isfinite(J->log_offset[o]) || fabsf(J->log_offset[o]) > 5.0f)
             return vb_fail(err, VB_ERR_ARGUMENT, "order %d: log offset %g is not in -5..5", o,
                            (double)J->log_offset[o]);
@@ -1571,20 +1576,23 @@ static vb_result choose_quantities(bake_run *b, vb_error *err)
 
 /* Lit pairs (margins m[i] of receivers with caps cap[i]) drawn in shadow
  * at log offset off: m + max(off, cap) < 0. */
-static uint32_t capped_false(const float *m, const float *cap, uint32_t count, float off)
+static uint32_t capped_false(const float *m, const float *cap, uint32_t count, float off,
+                             float uncapped)
 {
     uint32_t f = 0;
     for (uint32_t i = 0; i < count; i++)
-        f += m[i] + capped_offset(off, cap[i]) < 0.0f;
+        f += m[i] + capped_offset(off, cap[i], uncapped) < 0.0f;
     return f;
 }
 
 /* vb_decision_offset through the receivers' caps: the least offset -m[j]
  * that leaves at most rate * count of the lit pairs in false shadow,
- * each at its receiver's capped offset (without caps, the same offset
- * as vb_decision_offset's). The count falls as the offset rises, so a
- * bisection over the candidates, sorted. */
-static float capped_rate_offset(const float *m, const float *cap, uint32_t count, double rate)
+ * each at its receiver's capped offset (capped_offset; receivers without
+ * a cap at `uncapped`, whatever the offset). The count falls as the offset
+ * rises, so a bisection over the candidates, sorted; the greatest where
+ * none is within the rate. */
+static float capped_rate_offset(const float *m, const float *cap, uint32_t count, double rate,
+                                float uncapped)
 {
     if (count == 0)
         return 0.0f;
@@ -1597,12 +1605,11 @@ static float capped_rate_offset(const float *m, const float *cap, uint32_t count
     uint32_t k = (uint32_t)(rate * count);
     if (k >= count)
         k = count - 1;
-    /* The first candidate whose false count is within k (the last one,
-     * the greatest offset, leaves none). */
+    /* The first candidate whose false count is within k, else the last. */
     uint32_t lo = 0, hi = count - 1;
     while (lo < hi) {
         uint32_t mid = lo + (hi - lo) / 2;
-        if (capped_false(m, cap, count, cand[mid]) <= k)
+        if (capped_false(m, cap, count, cand[mid], uncapped) <= k)
             hi = mid;
         else
             lo = mid + 1;
@@ -1617,7 +1624,7 @@ static float capped_rate_offset(const float *m, const float *cap, uint32_t count
  * cal_count samples gathered into lit, offset for false_rate, within
  * -5..5. */
 static float slot_offset(const job *J, uint32_t cal_count, int slot, float false_rate, float *lit,
-                         float *lit_cap)
+                         float *lit_cap, int capped)
 {
     uint32_t k = 0;
     for (uint32_t i = 0; i < cal_count; i++)
@@ -1629,8 +1636,8 @@ static float slot_offset(const job *J, uint32_t cal_count, int slot, float false
                 lit[k++] = m;
             }
         }
-    float off = J->cap_on && slot ? capped_rate_offset(lit, lit_cap, k, false_rate)
-                                  : vb_decision_offset(lit, k, false_rate);
+    float off = capped ? capped_rate_offset(lit, lit_cap, k, false_rate, J->free_offset[slot])
+                       : vb_decision_offset(lit, k, false_rate);
     return off < -5.0f ? -5.0f : off > 5.0f ? 5.0f : off;
 }
 
@@ -1658,11 +1665,17 @@ static vb_result calibrate_offsets(bake_run *b, vb_error *err)
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
     for (int o = 1; o <= VDSH_MAX_ORDER && r == VB_OK; o++)
         if (b->coeffs[o])
-            J->log_offset[o] = slot_offset(J, cal_count, o, d->false_rate, lit, lit_cap);
+            J->log_offset[o] = J->free_offset[o] =
+                slot_offset(J, cal_count, o, d->false_rate, lit, lit_cap, 0);
+    /* With the cap: that offset stays the uncapped receivers' (free_offset),
+     * and the others' is calibrated again through their caps. */
+    for (int o = 1; o <= VDSH_MAX_ORDER && r == VB_OK && J->cap_on; o++)
+        if (b->coeffs[o])
+            J->log_offset[o] = slot_offset(J, cal_count, o, d->false_rate, lit, lit_cap, 1);
     /* The adaptive order's stream: one offset, from each sample's chosen
      * fit (slot 0), whatever its order. */
     if (J->var_decision && r == VB_OK)
-        J->var_dec_offset = slot_offset(J, cal_count, 0, d->false_rate, lit, lit_cap);
+        J->var_dec_offset = slot_offset(J, cal_count, 0, d->false_rate, lit, lit_cap, 0);
     free(lit);
     free(lit_cap);
     return r;
@@ -1683,8 +1696,8 @@ static vb_result bake_receivers(bake_run *b, vb_error *err)
             for (int o = 1; o <= VDSH_MAX_ORDER; o++)
                 if (b->coeffs[o]) {
                     float cap = J->done_caps[(size_t)(v - lo) * VDSH_ORDER_SLOTS + o];
-                    float off = capped_offset(J->log_offset[o], cap);
-                    atomic_fetch_add(&J->cap_bound, off != J->log_offset[o]);
+                    float off = capped_offset(J->log_offset[o], cap, J->free_offset[o]);
+                    atomic_fetch_add(&J->cap_bound, cap > J->log_offset[o]);
                     b->coeffs[o][(size_t)(v - lo) * o * o] += off / 0.28209479177387814f;
                 }
     /* The adaptive order's decision fits: their offset, now known. */

@@ -148,7 +148,8 @@ typedef struct vb_bake_desc {
      * but 1 - offset_cap_keep of its lit training pairs lit, less
      * offset_cap_tol ln units (negative: lit by that much more), where
      * it has at least offset_cap_min lit pairs; the calibration measures
-     * its held-out lights through the capped offsets. Fixed orders only
+     * its held-out lights through the capped offsets. Receivers without a
+     * cap keep the offset calibrated without caps. Fixed orders only
      * (not the adaptive order's stream). keep 0: 1; min 0: 1. */
     int offset_cap;
     float offset_cap_tol, offset_cap_keep;
