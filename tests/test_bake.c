@@ -914,6 +914,104 @@ static void test_decision_neighbours(void)
     test_mesh_free(&rec);
 }
 
+/* The per-receiver offset cap (issue 25, vb_bake_desc.offset_cap):
+ * receivers on the floor of a room with a pillar, more than the
+ * calibration sample. Without the cap the calibrated offset turns some receivers' lit
+ * training pairs false; with it (strict, and with a tolerance) none
+ * beyond the tolerance, some receivers' offsets raised, and the global
+ * offset recalibrated through the caps no higher than without them;
+ * 1 and 2 threads give the same coefficients; a cap on another method
+ * is refused. */
+static void test_offset_cap(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    test_make_room(&occ, 4, 3, 2.5f);
+    const float w = 0.3f, h = 3.0f; /* a pillar, as above */
+    const float px0[4][3] = {{-w, 0, -w}, {-w, 0, w}, {-w, h, w}, {-w, h, -w}};
+    const float px1[4][3] = {{w, 0, -w}, {w, h, -w}, {w, h, w}, {w, 0, w}};
+    const float pz0[4][3] = {{-w, 0, -w}, {-w, h, -w}, {w, h, -w}, {w, 0, -w}};
+    const float pz1[4][3] = {{-w, 0, w}, {w, 0, w}, {w, h, w}, {-w, h, w}};
+    const float nx[3] = {-1, 0, 0}, pxn[3] = {1, 0, 0}, nz[3] = {0, 0, -1}, pzn[3] = {0, 0, 1};
+    test_add_quad(&occ, px0, nx);
+    test_add_quad(&occ, px1, pxn);
+    test_add_quad(&occ, pz0, nz);
+    test_add_quad(&occ, pz1, pzn);
+    enum { NP = 1200, O = 5 };
+    float *p = malloc(sizeof(float) * 3 * NP), *n = malloc(sizeof(float) * 3 * NP);
+    uint64_t s = 29;
+    for (int i = 0; p && n && i < NP; i++) {
+        float x, z;
+        do {
+            x = (float)(7.0 * test_rand(&s) - 3.5), z = (float)(4.0 * test_rand(&s) - 2.0);
+        } while (fabsf(x) < 0.4f && fabsf(z) < 0.4f);
+        p[3 * i] = x, p[3 * i + 1] = 0.0f, p[3 * i + 2] = z;
+        n[3 * i] = 0.0f, n[3 * i + 1] = 1.0f, n[3 * i + 2] = 0.0f;
+    }
+    CHECK(p && n, "out of memory");
+    if (!p || !n)
+        return;
+    test_make_points(&rec, NP, p, n);
+    vb_error err;
+    vb_scene *sc = NULL;
+    CHECK(vb_scene_create(&occ, NULL, &sc, &err) == VB_OK, "scene: %s", err.msg);
+    /* none, strict, tolerance 0.2, strict on 1 thread */
+    vb_bake_output b[4] = {{0}};
+    const float tol[4] = {0.0f, 0.0f, 0.2f, 0.0f};
+    for (int i = 0; i < 4 && sc; i++) {
+        vb_bake_desc d = {.keep_normals = 1,
+                          .receivers = &rec,
+                          .scene = sc,
+                          .rays = 400,
+                          .seed = 7,
+                          .threads = i == 3 ? 1 : 2,
+                          .order_mask = 1u << O,
+                          .method = VB_METHOD_DECISION,
+                          .offset_cap = i > 0,
+                          .offset_cap_tol = tol[i]};
+        CHECK(vb_bake_run(&d, &b[i], &err) == VB_OK, "bake %d: %s", i, err.msg);
+    }
+    if (b[0].coeffs[O] && b[1].coeffs[O] && b[2].coeffs[O] && b[3].coeffs[O]) {
+        printf("offset cap: offsets %+.3f / %+.3f / %+.3f; lit training pairs turned false "
+               "%llu / %llu / %llu of %llu; offsets raised %llu / %llu\n",
+               (double)b[0].log_offset[O], (double)b[1].log_offset[O], (double)b[2].log_offset[O],
+               (unsigned long long)b[0].lit_training_false,
+               (unsigned long long)b[1].lit_training_false,
+               (unsigned long long)b[2].lit_training_false, (unsigned long long)b[0].lit_training,
+               (unsigned long long)b[1].cap_bound, (unsigned long long)b[2].cap_bound);
+        CHECK(b[0].log_offset[O] < 0.0f && b[0].lit_training > 0 && b[0].lit_training_false > 0 &&
+                  b[0].cap_bound == 0,
+              "without the cap the offset (%g) turns no lit training pair false",
+              (double)b[0].log_offset[O]);
+        for (int i = 1; i <= 2; i++) {
+            CHECK(b[i].lit_training == b[0].lit_training, "cap %d: other training pairs", i);
+            CHECK(b[i].lit_training_false == 0,
+                  "cap %d: %llu lit training pairs in shadow by more than %g", i,
+                  (unsigned long long)b[i].lit_training_false, (double)tol[i]);
+            CHECK(b[i].cap_bound > 0, "cap %d: no receiver's offset raised", i);
+            CHECK(b[i].log_offset[O] <= b[0].log_offset[O],
+                  "cap %d: the recalibrated offset %g is above the uncapped %g", i,
+                  (double)b[i].log_offset[O], (double)b[0].log_offset[O]);
+        }
+        CHECK(memcmp(b[1].coeffs[O], b[3].coeffs[O], sizeof(float) * NP * O * O) == 0 &&
+                  b[1].log_offset[O] == b[3].log_offset[O],
+              "cap: 1 and 2 threads differ");
+        CHECK(memcmp(b[0].coeffs[O], b[1].coeffs[O], sizeof(float) * NP * O * O) != 0,
+              "cap: the coefficients are the uncapped ones");
+    }
+    vb_bake_desc bad = {
+        .receivers = &rec, .scene = sc, .method = VB_METHOD_SHADOW, .offset_cap = 1};
+    vb_bake_output none = {0};
+    CHECK(sc && vb_bake_run(&bad, &none, &err) == VB_ERR_ARGUMENT && strstr(err.msg, "offset cap"),
+          "a cap on method shadow is refused");
+    for (int i = 0; i < 4; i++)
+        vb_bake_output_free(&b[i]);
+    vb_scene_destroy(sc);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+    free(p);
+    free(n);
+}
+
 int main(void)
 {
     test_grid();
@@ -927,5 +1025,6 @@ int main(void)
     test_ranges();
     test_adaptive_order();
     test_decision_neighbours();
+    test_offset_cap();
     return test_report("test_bake");
 }

@@ -156,6 +156,9 @@ expect_exit 2 "--log-offset with lsq" "$bake" builtin:room --method lsq --log-of
 expect_exit 2 "--log-offset out of range" "$bake" builtin:room --log-offset 7 -o "$tmp/x.vdsh"
 expect_exit 2 "--lambda with shadow" "$bake" builtin:room --lambda 1e-3 -o "$tmp/x.vdsh"
 expect_exit 2 "unknown option" "$bake" builtin:room --frobnicate -o "$tmp/x.vdsh"
+expect_exit 2 "--offset-cap with shadow" "$bake" builtin:room --method shadow --offset-cap 0 -o "$tmp/x.vdsh"
+expect_exit 2 "--offset-cap share out of range" "$bake" builtin:room --offset-cap 0,1.5 -o "$tmp/x.vdsh"
+expect_exit 2 "--offset-cap not a number" "$bake" builtin:room --offset-cap x -o "$tmp/x.vdsh"
 expect_exit 2 "--adaptive without --max-edge" "$bake" builtin:room --adaptive 0.1 -o "$tmp/x.vdsh"
 expect_exit 2 "--adaptive with a negative tolerance" "$bake" builtin:room --max-edge 1 --adaptive -1 -o "$tmp/x.vdsh"
 expect_exit 2 "--min-edge without --adaptive" "$bake" builtin:room --max-edge 1 --min-edge 0.1 -o "$tmp/x.vdsh"
@@ -165,6 +168,7 @@ expect_exit 1 "--max-receivers below the start mesh" "$bake" builtin:room --max-
 check "no output after usage errors" test ! -e "$tmp/x.vdsh"
 expect_exit 0 "--help" "$bake" --help
 check "--help shows usage" grep -q "usage: vdsh-bake" "$tmp/out.txt"
+check "--help lists --offset-cap" grep -q -- "--offset-cap TOL" "$tmp/out.txt"
 expect_exit 0 "--version" "$bake" --version
 
 # Data errors exit 1, name the file, and leave no output (nor temp files).

@@ -101,6 +101,18 @@ typedef struct job {
     vb_decision_params dec;
     unsigned char *dec_scratch;
     float *cal_margins;
+    /* The per-receiver offset cap (vb_bake_desc.offset_cap): on, its
+     * tolerance (ln units), share of lit training pairs kept lit and
+     * least lit pairs; the calibration samples' caps (per sample and
+     * order slot), and those of the range's samples (per receiver of the
+     * range and slot), added with the calibrated offset after the bake. */
+    int cap_on;
+    float free_offset[VDSH_ORDER_SLOTS]; /* receivers without a cap: the
+                                          * offset calibrated without caps */
+    float cap_tol, cap_keep;
+    uint32_t cap_min;
+    float *cal_caps, *done_caps;
+    _Atomic uint64_t cap_bound, lit_training, lit_false;
     _Atomic uint32_t dec_fitted, dec_fallbacks;
     _Atomic uint64_t dec_pairs, dec_rays;
     _Atomic uint64_t traced, missed;
@@ -116,6 +128,7 @@ typedef struct vertex_sink {
     unsigned char *dec_scratch; /* decision fit: the worker's */
     float *cal;                 /* decision calibration: margins, VDSH_ORDER_SLOTS x CAL_LIGHTS
                                  * (slot 0: the adaptive order's chosen fit) */
+    float *cal_cap;             /* and its offset caps, per order (-inf: none) */
     float *x, *y, *z, *t;
     uint32_t *n;
 } vertex_sink;
@@ -405,6 +418,48 @@ static uint32_t dec_pairs(const job *J, uint32_t *at, uint32_t *scanned, const f
     return m;
 }
 
+/* The log offset a receiver's fit draws with: the bake's, raised to the
+ * receiver's cap (<= 0); where it has none (-inf), `uncapped` (the offset
+ * calibrated without caps). */
+static inline float capped_offset(float off, float cap, float uncapped)
+{
+    return cap == -INFINITY ? uncapped : off < cap ? cap : off;
+}
+
+static int cmp_margin(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+/* The margins ln D - ln d_L of fit c (order o) at the receiver's lit
+ * training pairs (the first m of Y, logd, lab) into mg; their count into
+ * *lit. Returns its offset cap (vb_bake_desc.offset_cap): the least
+ * offset that keeps the cap's share of them lit, less its tolerance,
+ * at most 0; -inf where the cap is off or too few pairs are lit. mg
+ * comes back sorted when a cap was computed. */
+static float dec_cap(const job *J, int o, const float *c, uint32_t m, const float *Y, uint32_t ys,
+                     const float *logd, const uint8_t *lab, float *mg, uint32_t *lit)
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < m; i++) {
+        if (lab[i])
+            continue;
+        float s = 0.0f;
+        for (int j = 0; j < o * o; j++)
+            s += c[j] * Y[(size_t)j * ys + i];
+        mg[n++] = s - logd[i];
+    }
+    *lit = n;
+    if (!J->cap_on || n == 0 || n < J->cap_min)
+        return -INFINITY;
+    qsort(mg, n, sizeof *mg, cmp_margin);
+    uint32_t q = (uint32_t)((1.0 - (double)J->cap_keep) * n);
+    q = q < n ? q : n - 1;
+    float cap = -mg[q] - J->cap_tol;
+    return cap < 0.0f ? cap : 0.0f;
+}
+
 /* Adaptive order with the decision fit: each candidate order's lsq fit
  * (varc[k], no offset) scored by the decision loss on the receiver's
  * training pairs at the offset that suits it best (vb_decision_score:
@@ -449,7 +504,8 @@ static int choose_decision(const job *J, uint32_t m, const float *Y, uint32_t ys
  * Returns 1 if the receiver had enough pairs to fit, 0 if it keeps its
  * lsq fits. */
 static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3],
-                           const vertex_sink *out, float (*varc)[VDSH_MAX_COEFFS], int *var_k)
+                           const vertex_sink *out, float (*varc)[VDSH_MAX_COEFFS], int *var_k,
+                           float cap[VDSH_ORDER_SLOTS])
 {
     const uint32_t K = VB_DECISION_MAX_PAIRS, top = J->order;
     float *x = (float *)out->dec_scratch, *y = x + K, *z = y + K, *logd = z + K, *Y = logd + K;
@@ -466,8 +522,24 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
         ys = ys < K ? ys : K;
         vdsh_sh_eval_soa((int)top, m, x, y, z, Y, ys);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-            if (out->coeffs[1][o])
+            if (out->coeffs[1][o]) {
                 vb_decision_fit(o, m, Y, ys, logd, lab, &J->dec, out->coeffs[1][o], ds);
+                /* Its cap, and, outside the calibration (whose offset is
+                 * not known yet), its lit training pairs that the offset
+                 * draws in shadow (lit without it; 1e-5: the cap's own
+                 * rounding). */
+                float mg[VB_DECISION_MAX_PAIRS];
+                uint32_t lit = 0;
+                cap[o] = dec_cap(J, o, out->coeffs[1][o], m, Y, ys, logd, lab, mg, &lit);
+                if (!out->cal) {
+                    float off = capped_offset(J->log_offset[o], cap[o], J->free_offset[o]);
+                    uint64_t bad = 0;
+                    for (uint32_t i = 0; i < lit; i++)
+                        bad += mg[i] >= 0.0f && mg[i] + off < -J->cap_tol - 1e-5f;
+                    atomic_fetch_add(&J->lit_training, lit);
+                    atomic_fetch_add(&J->lit_false, bad);
+                }
+            }
         if (varc)
             *var_k = choose_decision(J, m, Y, ys, logd, lab, varc, ds);
         atomic_fetch_add(&J->dec_pairs, m);
@@ -767,8 +839,14 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
         }
     }
     int var_k = 0;
-    const int fitted =
-        J->decision && want[1] ? decision_vertex(J, v, org, n, out, dvar ? varc : NULL, &var_k) : 0;
+    float cap[VDSH_ORDER_SLOTS];
+    for (int o = 0; o <= VDSH_MAX_ORDER; o++)
+        cap[o] = -INFINITY;
+    const int fitted = J->decision && want[1]
+                           ? decision_vertex(J, v, org, n, out, dvar ? varc : NULL, &var_k, cap)
+                           : 0;
+    if (out->cal_cap)
+        memcpy(out->cal_cap, cap, sizeof cap);
     if (var && dvar) {
         uint32_t r = v - J->lo;
         J->var_lsq[r] = !fitted;
@@ -784,10 +862,18 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
         }
     }
     /* Methods shadow and decision: the log offset, through c0 (Y00 is a
-     * constant). */
-    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-        if (out->coeffs[1][o] && J->log_offset[o] != 0.0f)
-            out->coeffs[1][o][0] += J->log_offset[o] / 0.28209479177387814f;
+     * constant), raised to the receiver's cap (outside the calibration:
+     * its samples get theirs after it). */
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
+        if (!out->coeffs[1][o])
+            continue;
+        float off = out->cal ? J->log_offset[o]
+                             : capped_offset(J->log_offset[o], cap[o], J->free_offset[o]);
+        if (!out->cal && cap[o] > J->log_offset[o])
+            atomic_fetch_add(&J->cap_bound, 1);
+        if (off != 0.0f)
+            out->coeffs[1][o][0] += off / 0.28209479177387814f;
+    }
     if (upper > 0 && near_zero >= 0.9 * upper)
         (*degenerate)++;
 }
@@ -1002,7 +1088,8 @@ static void calibrate_block(void *ctx, uint32_t begin, uint32_t end, unsigned wo
         uint32_t v = choose_receiver(i, nrec, J->choose_count);
         float c[VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS];
         vertex_sink out = {.dec_scratch = J->dec_scratch + (size_t)worker * dec_scratch_bytes(J),
-                           .cal = J->cal_margins + (size_t)i * VDSH_ORDER_SLOTS * CAL_LIGHTS};
+                           .cal = J->cal_margins + (size_t)i * VDSH_ORDER_SLOTS * CAL_LIGHTS,
+                           .cal_cap = J->cal_caps + (size_t)i * VDSH_ORDER_SLOTS};
         if (J->var_scratch) /* its adaptive order too: the main pass skips it */
             out.var_scratch = J->var_scratch + (size_t)worker * var_scratch_floats(J);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
@@ -1018,6 +1105,8 @@ static void calibrate_block(void *ctx, uint32_t begin, uint32_t end, unsigned wo
             if (J->coeffs[o])
                 memcpy(J->coeffs[o] + (size_t)(v - J->lo) * o * o, c[o],
                        (size_t)o * o * sizeof(float));
+        memcpy(J->done_caps + (size_t)(v - J->lo) * VDSH_ORDER_SLOTS, out.cal_cap,
+               VDSH_ORDER_SLOTS * sizeof(float));
         J->done[v - J->lo] = 1;
     }
     atomic_fetch_add(&J->traced, traced);
@@ -1215,6 +1304,16 @@ static vb_result resolve_decision(bake_run *b, vb_error *err)
         d->false_rate = VB_DEFAULT_FALSE_RATE;
     if (!(d->false_rate > 0.0f && d->false_rate < 0.5f))
         return vb_fail(err, VB_ERR_ARGUMENT, "the false rate must be in (0, 0.5)");
+    if (d->offset_cap_keep == 0.0f)
+        d->offset_cap_keep = 1.0f;
+    if (d->offset_cap_min == 0)
+        d->offset_cap_min = 1;
+    if (d->offset_cap && !b->mi->decision)
+        return vb_fail(err, VB_ERR_ARGUMENT, "the offset cap is method decision's");
+    if (d->offset_cap && (!(fabsf(d->offset_cap_tol) <= 5.0f) ||
+                          !(d->offset_cap_keep > 0.0f && d->offset_cap_keep <= 1.0f)))
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "the offset cap's tolerance must be in -5..5 and its share in (0, 1]");
     vb_decision_defaults(&b->dec);
     if (d->decision)
         b->dec = *d->decision;
@@ -1380,13 +1479,18 @@ static vb_result setup_offsets(bake_run *b, vb_error *err)
     const vb_method_info *mi = b->mi;
     job *J = b->J;
     for (int o = 1; o <= VDSH_MAX_ORDER && mi->param == VB_PARAM_LOG_OFFSET; o++) {
-        J->log_offset[o] = d->log_offsets ? d->log_offsets[o] : mi->default_log_offset[o];
+        J->log_offset[o] = J->free_offset[o] =
+            d->log_offsets ? d->log_offsets[o] : mi->default_log_offset[o];
         if (!isfinite(J->log_offset[o]) || fabsf(J->log_offset[o]) > 5.0f)
             return vb_fail(err, VB_ERR_ARGUMENT, "order %d: log offset %g is not in -5..5", o,
                            (double)J->log_offset[o]);
     }
     J->dec = b->dec;
     J->dec_lights = d->decision_lights;
+    J->cap_on = d->offset_cap;
+    J->cap_tol = d->offset_cap ? d->offset_cap_tol : 0.0f;
+    J->cap_keep = d->offset_cap_keep;
+    J->cap_min = d->offset_cap_min;
     if (mi->decision && !d->trace_only) {
         J->pool = malloc(DEC_POOL * sizeof *J->pool);
         if (!J->pool)
@@ -1470,21 +1574,70 @@ static vb_result choose_quantities(bake_run *b, vb_error *err)
     return VB_OK;
 }
 
+/* Lit pairs (margins m[i] of receivers with caps cap[i]) drawn in shadow
+ * at log offset off: m + max(off, cap) < 0. */
+static uint32_t capped_false(const float *m, const float *cap, uint32_t count, float off,
+                             float uncapped)
+{
+    uint32_t f = 0;
+    for (uint32_t i = 0; i < count; i++)
+        f += m[i] + capped_offset(off, cap[i], uncapped) < 0.0f;
+    return f;
+}
+
+/* vb_decision_offset through the receivers' caps: the least offset -m[j]
+ * that leaves at most rate * count of the lit pairs in false shadow,
+ * each at its receiver's capped offset (capped_offset; receivers without
+ * a cap at `uncapped`, whatever the offset). The count falls as the offset
+ * rises, so a bisection over the candidates, sorted; the greatest where
+ * none is within the rate. */
+static float capped_rate_offset(const float *m, const float *cap, uint32_t count, double rate,
+                                float uncapped)
+{
+    if (count == 0)
+        return 0.0f;
+    float *cand = malloc((size_t)count * sizeof *cand);
+    if (!cand)
+        return 0.0f;
+    for (uint32_t i = 0; i < count; i++)
+        cand[i] = -m[i];
+    qsort(cand, count, sizeof *cand, cmp_margin);
+    uint32_t k = (uint32_t)(rate * count);
+    if (k >= count)
+        k = count - 1;
+    /* The first candidate whose false count is within k, else the last. */
+    uint32_t lo = 0, hi = count - 1;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (capped_false(m, cap, count, cand[mid], uncapped) <= k)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    float off = cand[lo];
+    free(cand);
+    return off;
+}
+
 /* The calibrated log offset of margin slot `slot` (an order; 0: the
  * adaptive order's chosen fits): the lit held-out margins of the
  * cal_count samples gathered into lit, offset for false_rate, within
  * -5..5. */
-static float slot_offset(const job *J, uint32_t cal_count, int slot, float false_rate, float *lit)
+static float slot_offset(const job *J, uint32_t cal_count, int slot, float false_rate, float *lit,
+                         float *lit_cap, int capped)
 {
     uint32_t k = 0;
     for (uint32_t i = 0; i < cal_count; i++)
         for (uint32_t j = 0; j < CAL_LIGHTS; j++) {
             float m =
                 J->cal_margins[((size_t)i * VDSH_ORDER_SLOTS + (size_t)slot) * CAL_LIGHTS + j];
-            if (!isnan(m))
+            if (!isnan(m)) {
+                lit_cap[k] = J->cal_caps[(size_t)i * VDSH_ORDER_SLOTS + (size_t)slot];
                 lit[k++] = m;
+            }
         }
-    float off = vb_decision_offset(lit, k, false_rate);
+    float off = capped ? capped_rate_offset(lit, lit_cap, k, false_rate, J->free_offset[slot])
+                       : vb_decision_offset(lit, k, false_rate);
     return off < -5.0f ? -5.0f : off > 5.0f ? 5.0f : off;
 }
 
@@ -1501,20 +1654,30 @@ static vb_result calibrate_offsets(bake_run *b, vb_error *err)
         choose_count(d->receivers->vertex_count);
     J->done = calloc((size_t)(b->hi - b->lo), 1);
     J->cal_margins = malloc((size_t)cal_count * VDSH_ORDER_SLOTS * CAL_LIGHTS * sizeof(float));
+    J->cal_caps = malloc((size_t)cal_count * VDSH_ORDER_SLOTS * sizeof(float));
+    J->done_caps = malloc((size_t)(b->hi - b->lo) * VDSH_ORDER_SLOTS * sizeof(float));
     float *lit = malloc((size_t)cal_count * CAL_LIGHTS * sizeof(float) + 1);
+    float *lit_cap = malloc((size_t)cal_count * CAL_LIGHTS * sizeof(float) + 1);
     vb_result r = VB_OK;
-    if (!J->done || !J->cal_margins || !lit)
+    if (!J->done || !J->cal_margins || !J->cal_caps || !J->done_caps || !lit || !lit_cap)
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
     else if (vb_parallel_for(d->threads, cal_count, 4, calibrate_block, J, NULL, NULL) == 0)
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
     for (int o = 1; o <= VDSH_MAX_ORDER && r == VB_OK; o++)
         if (b->coeffs[o])
-            J->log_offset[o] = slot_offset(J, cal_count, o, d->false_rate, lit);
+            J->log_offset[o] = J->free_offset[o] =
+                slot_offset(J, cal_count, o, d->false_rate, lit, lit_cap, 0);
+    /* With the cap: that offset stays the uncapped receivers' (free_offset),
+     * and the others' is calibrated again through their caps. */
+    for (int o = 1; o <= VDSH_MAX_ORDER && r == VB_OK && J->cap_on; o++)
+        if (b->coeffs[o])
+            J->log_offset[o] = slot_offset(J, cal_count, o, d->false_rate, lit, lit_cap, 1);
     /* The adaptive order's stream: one offset, from each sample's chosen
      * fit (slot 0), whatever its order. */
     if (J->var_decision && r == VB_OK)
-        J->var_dec_offset = slot_offset(J, cal_count, 0, d->false_rate, lit);
+        J->var_dec_offset = slot_offset(J, cal_count, 0, d->false_rate, lit, lit_cap, 0);
     free(lit);
+    free(lit_cap);
     return r;
 }
 
@@ -1531,9 +1694,12 @@ static vb_result bake_receivers(bake_run *b, vb_error *err)
     for (uint32_t v = lo; b->cal_count && J->done && v < hi; v++)
         if (J->done[v - lo])
             for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-                if (b->coeffs[o])
-                    b->coeffs[o][(size_t)(v - lo) * o * o] +=
-                        J->log_offset[o] / 0.28209479177387814f;
+                if (b->coeffs[o]) {
+                    float cap = J->done_caps[(size_t)(v - lo) * VDSH_ORDER_SLOTS + o];
+                    float off = capped_offset(J->log_offset[o], cap, J->free_offset[o]);
+                    atomic_fetch_add(&J->cap_bound, cap > J->log_offset[o]);
+                    b->coeffs[o][(size_t)(v - lo) * o * o] += off / 0.28209479177387814f;
+                }
     /* The adaptive order's decision fits: their offset, now known. */
     for (uint32_t v = lo; J->var_decision && v < hi; v++)
         if (!J->var_lsq[v - lo])
@@ -1581,6 +1747,9 @@ static void fill_output(bake_run *b, vb_bake_output *out)
         o.calibration_receivers = b->cal_count;
         o.decision_rays = atomic_load(&J->dec_rays);
         o.false_rate = b->cal_count ? d->false_rate : 0.0f;
+        o.cap_bound = atomic_load(&J->cap_bound);
+        o.lit_training = atomic_load(&J->lit_training);
+        o.lit_training_false = atomic_load(&J->lit_false);
     }
     o.window = d->window;
     o.vertex_count = R->vertex_count;
@@ -1639,6 +1808,8 @@ static void run_free(bake_run *b)
         free(J->pool);
         free(J->dec_scratch);
         free(J->cal_margins);
+        free(J->cal_caps);
+        free(J->done_caps);
     }
     free(J);
     for (int k = 0; k <= VDSH_MAX_ORDER; k++)

@@ -143,6 +143,17 @@ typedef struct vb_bake_desc {
     const vb_decision_params *decision;
     uint32_t decision_lights;
     float false_rate;
+    /* Method decision, the per-receiver offset cap (issue 25; 0: off):
+     * each receiver's log offset is raised (never above 0) to keep all
+     * but 1 - offset_cap_keep of its lit training pairs lit, less
+     * offset_cap_tol ln units (negative: lit by that much more), where
+     * it has at least offset_cap_min lit pairs; the calibration measures
+     * its held-out lights through the capped offsets. Receivers without a
+     * cap keep the offset calibrated without caps. Fixed orders only
+     * (not the adaptive order's stream). keep 0: 1; min 0: 1. */
+    int offset_cap;
+    float offset_cap_tol, offset_cap_keep;
+    uint32_t offset_cap_min;
     int max_order;    /* 0: the highest order in order_mask, or
                                   VB_DEFAULT_ORDER */
     unsigned threads; /* 0: every online core */
@@ -188,6 +199,13 @@ typedef struct vb_bake_output {
     uint64_t decision_rays; /* rays toward the lights (not in rays_traced) */
     double decision_pairs;
     float false_rate;
+    /* The offset cap (vb_bake_desc.offset_cap): (receiver, order) rows
+     * whose offset it raised, and over the fitted receivers outside the
+     * calibration sample, their lit training pairs and those of them
+     * that the log offset turns false: drawn lit without it, in shadow
+     * by more than the cap's tolerance (0 without the cap) with it
+     * (counted with or without the cap). */
+    uint64_t cap_bound, lit_training, lit_training_false;
     vdsh_window window;    /* applied */
     uint32_t vertex_count; /* all receivers */
     /* The receivers baked: vb_bake_desc's range, or 0, vertex_count

@@ -60,6 +60,9 @@ typedef struct options {
     float false_rate;            /* --false-rate; 0: the default */
     vb_decision_params decision; /* --decision-params */
     int have_decision;
+    int offset_cap; /* --offset-cap TOL[,KEEP[,MIN]] */
+    float offset_cap_tol, offset_cap_keep;
+    uint32_t offset_cap_min;
     float log_floor;
     vdsh_window window;
     vdsh_encoding encoding;
@@ -240,6 +243,14 @@ static void usage(FILE *f)
             "      --false-rate R      decision: the share of lit (light, receiver) pairs\n"
             "                          the calibrated offset leaves in false shadow, on\n"
             "                          held-out lights (default %g)\n"
+            "      --offset-cap TOL[,KEEP[,MIN]]\n"
+            "                          decision: cap each receiver's log offset (raise it,\n"
+            "                          never above 0) so that KEEP of its lit training\n"
+            "                          pairs stay lit, less TOL ln units, where it has\n"
+            "                          at least MIN lit pairs (default KEEP 1, MIN 1); a\n"
+            "                          negative TOL keeps them lit by -TOL more; the\n"
+            "                          calibration runs through the capped offsets.\n"
+            "                          Fixed orders only (issue 25, docs/ACCURACY.md)\n"
             "      --decision-lights N decision: training lights per receiver, each\n"
             "                          traced (1..%d, default %d)\n"
             "      --decision-params TAU,LIT,RIDGE,RIDGE0,STEPS\n"
@@ -520,6 +531,9 @@ static int write_report(const char *path, const options *o, const vb_job *job,
         vt_json_f64(&j, dec, "mean_pairs", b->decision_pairs);
         vt_json_u64(&j, dec, "calibration_receivers", b->calibration_receivers);
         vt_json_f32(&j, dec, "false_rate", b->false_rate);
+        vt_json_u64(&j, dec, "offset_cap_bound", b->cap_bound);
+        vt_json_u64(&j, dec, "lit_training_pairs", b->lit_training);
+        vt_json_u64(&j, dec, "lit_training_false", b->lit_training_false);
         cJSON *off = vt_json_object(&j, dec, "log_offsets");
         for (int i = 0; i < o->order_count; i++) {
             char key[8];
@@ -687,6 +701,7 @@ enum {
     O_MAX_ORDER,
     O_DEC_LIGHTS,
     O_FALSE_RATE,
+    O_OFFSET_CAP,
     O_DEC_PARAMS,
     O_SDF,
     O_CPCA
@@ -824,6 +839,23 @@ static int read_choice(int c, const char *arg, options *o)
             !(o->false_rate < 0.5f))
             return bad_usage("--false-rate takes a number in (0, 0.5), not '%s'", arg);
         break;
+    case O_OFFSET_CAP: {
+        float tol = 0.0f, keep = 1.0f;
+        unsigned min = 1;
+        char tail = 0;
+        int n = sscanf(arg, "%f,%f,%u%c", &tol, &keep, &min, &tail);
+        if (n < 1 || n > 3 || !(fabsf(tol) <= 5.0f) || !(keep > 0.0f && keep <= 1.0f) || min < 1 ||
+            min > VB_DECISION_MAX_PAIRS)
+            return bad_usage("--offset-cap takes TOL[,KEEP[,MIN]]: a tolerance in -5..5 ln "
+                             "units, the share of lit training pairs kept lit in (0, 1], the "
+                             "least lit pairs 1..1024, not '%s'",
+                             arg);
+        o->offset_cap = 1;
+        o->offset_cap_tol = tol;
+        o->offset_cap_keep = keep;
+        o->offset_cap_min = min;
+        break;
+    }
     case O_DEC_PARAMS: {
         vb_decision_params *p = &o->decision;
         vb_decision_defaults(p);
@@ -905,9 +937,10 @@ static int check_options(options *o)
         return bad_usage("%s", mi->refused[stored]);
     if (o->have_log_offset && mi->param != VB_PARAM_LOG_OFFSET)
         return bad_usage("%s", "--log-offset is methods decision's and shadow's");
-    if ((o->false_rate != 0.0f || o->decision_lights || o->have_decision) && !mi->decision)
-        return bad_usage("%s", "--false-rate, --decision-lights and --decision-params are "
-                               "method decision's");
+    if ((o->false_rate != 0.0f || o->decision_lights || o->have_decision || o->offset_cap) &&
+        !mi->decision)
+        return bad_usage("%s", "--false-rate, --decision-lights, --decision-params and "
+                               "--offset-cap are method decision's");
     if (o->lambda != 0.0f && mi->lambda_fixed)
         return bad_usage("--lambda is lsq's: method %s uses lsq's default (its method "
                          "parameter is the log offset)",
@@ -970,6 +1003,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"log-offset", required_argument, 0, O_LOG_OFFSET},
         {"decision-lights", required_argument, 0, O_DEC_LIGHTS},
         {"false-rate", required_argument, 0, O_FALSE_RATE},
+        {"offset-cap", required_argument, 0, O_OFFSET_CAP},
         {"decision-params", required_argument, 0, O_DEC_PARAMS},
         {"log-floor", required_argument, 0, O_LOG_FLOOR},
         {"keep-normals", no_argument, 0, O_KEEP_NORMALS},
@@ -1098,6 +1132,10 @@ static vb_job_desc job_desc(const options *o, FILE *log, progress *pr, float *of
                                   .decision = o->have_decision ? &o->decision : NULL,
                                   .decision_lights = o->decision_lights,
                                   .false_rate = o->false_rate,
+                                  .offset_cap = o->offset_cap,
+                                  .offset_cap_tol = o->offset_cap_tol,
+                                  .offset_cap_keep = o->offset_cap_keep,
+                                  .offset_cap_min = o->offset_cap_min,
                                   .window = o->window,
                                   .order_mask = order_mask,
                                   .threads = o->threads,
@@ -1252,6 +1290,13 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
                         (double)bo->variable_param);
             fputc('\n', log);
         }
+        if (o->offset_cap)
+            fprintf(
+                log,
+                "vdsh-bake: offset cap raised %llu (receiver, order) offsets; the offset turns %llu of "
+                "%llu lit training pairs false (by more than %g; calibration sample not counted)\n",
+                (unsigned long long)bo->cap_bound, (unsigned long long)bo->lit_training_false,
+                (unsigned long long)bo->lit_training, (double)o->offset_cap_tol);
     }
     if (bo->auto_receivers > 0) {
         fprintf(log,
