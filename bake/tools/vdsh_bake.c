@@ -840,12 +840,13 @@ static int read_choice(int c, const char *arg, options *o)
             return bad_usage("--false-rate takes a number in (0, 0.5), not '%s'", arg);
         break;
     case O_OFFSET_CAP: {
-        float tol = 0.0f, keep = 1.0f;
-        unsigned min = 1;
-        char tail = 0;
-        int n = sscanf(arg, "%f,%f,%u%c", &tol, &keep, &min, &tail);
-        if (n < 1 || n > 3 || !(fabsf(tol) <= 5.0f) || !(keep > 0.0f && keep <= 1.0f) || min < 1 ||
-            min > VB_DECISION_MAX_PAIRS)
+        float v[3] = {0.0f, 1.0f, 1.0f};
+        int n = vt_parse_floats(arg, v, 1, 3);
+        float tol = v[0], keep = v[1];
+        unsigned min = v[2] >= 1.0f && v[2] <= (float)VB_DECISION_MAX_PAIRS && v[2] == floorf(v[2])
+                           ? (unsigned)v[2]
+                           : 0u;
+        if (!n || !(fabsf(tol) <= 5.0f) || !(keep > 0.0f && keep <= 1.0f) || min < 1)
             return bad_usage("--offset-cap takes TOL[,KEEP[,MIN]]: a tolerance in -5..5 ln "
                              "units, the share of lit training pairs kept lit in (0, 1], the "
                              "least lit pairs 1..1024, not '%s'",
@@ -859,9 +860,11 @@ static int read_choice(int c, const char *arg, options *o)
     case O_DEC_PARAMS: {
         vb_decision_params *p = &o->decision;
         vb_decision_defaults(p);
-        if (sscanf(arg, "%f,%f,%f,%f,%d", &p->tau, &p->lit_weight, &p->ridge, &p->ridge0,
-                   &p->steps) != 5 ||
-            !(p->tau > 0.0f) || !(p->lit_weight > 0.0f) || !(p->ridge >= 0.0f) ||
+        float v[5] = {0.0f, 0.0f, 0.0f, 0.0f, -1.0f};
+        int ok = vt_parse_floats(arg, v, 5, 5) == 5 && v[4] == floorf(v[4]);
+        p->tau = v[0], p->lit_weight = v[1], p->ridge = v[2], p->ridge0 = v[3];
+        p->steps = ok && v[4] >= 0.0f && v[4] <= 64.0f ? (int)v[4] : -1;
+        if (!(p->tau > 0.0f) || !(p->lit_weight > 0.0f) || !(p->ridge >= 0.0f) ||
             !(p->ridge0 > 0.0f) || p->steps < 0 || p->steps > 64)
             return bad_usage("--decision-params takes TAU,LIT_WEIGHT,RIDGE,RIDGE0,STEPS "
                              "(positive; ridge >= 0; steps 0..64), not '%s'",
@@ -1294,7 +1297,7 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
             fprintf(
                 log,
                 "vdsh-bake: offset cap raised %llu (receiver, order) offsets; the offset turns %llu of "
-                "%llu lit training pairs false (by more than %g; calibration sample not counted)\n",
+                "%llu lit training pairs false (margin below %g; calibration sample not counted)\n",
                 (unsigned long long)bo->cap_bound, (unsigned long long)bo->lit_training_false,
                 (unsigned long long)bo->lit_training, (double)o->offset_cap_tol);
     }
