@@ -1032,143 +1032,11 @@ done:
     return res;
 }
 
-/* ---- STUDY ONLY (issue 29, s8 bases; docs/ACCURACY.md "s8 bases"):
- * VDSH_CPCA_S8BASIS=32 rounds the final fit's bases to s8 (one f32 scale
- * per vector, its largest |component|; VDSH_CPCA_S8SCALE=lse: the one
- * of 1, 0.99, ..., 0.80 x that with the least squared error) and counts
- * the model with s8 bases (B x n bytes + a 4-byte scale per vector) for
- * B and the widths; =same rounds them but counts f16 bytes (the record
- * today's); =count counts s8 bytes but keeps f16 bases (the f16 model
- * with the s8 model's record). Unset: main's encoder. To be removed before merging. ---- */
-static int s8_study_mode(void)
-{
-    const char *e = getenv("VDSH_CPCA_S8BASIS");
-    return !e ? 0 : !strcmp(e, "32") ? 1 : !strcmp(e, "same") ? 2 : !strcmp(e, "count") ? 3 : 0;
-}
-
-/* VDSH_CPCA_S8FIRST=N: the first N vectors (of b) stay f16 (default 0). */
-static uint32_t s8_study_first(uint32_t b)
-{
-    const char *e = getenv("VDSH_CPCA_S8FIRST");
-    uint32_t first = e ? (uint32_t)atoi(e) : 0;
-    return first < b ? first : b;
-}
-
-static uint64_t study_model_bytes(uint32_t order, uint32_t k, uint32_t b)
-{
-    uint64_t f16 = vdsh_cpca_model_bytes(order, k, b);
-    if (s8_study_mode() != 1 && s8_study_mode() != 3)
-        return f16;
-    uint64_t n = (uint64_t)order * order, kb = (uint64_t)k * (b - s8_study_first(b));
-    return f16 - ((2 * kb * n + 15) & ~15ull) + ((kb * n + 15) & ~15ull) + ((4 * kb + 15) & ~15ull);
-}
-
-/* Round every basis vector of fc (fc->b vectors) to s8 levels with its
- * scale, stored back as f16(level x scale / 127), and recompute the
- * projections so that the weights are the least-squares ones (in the
- * cluster's metric) on the rounded basis. */
-static vdsh_result s8_round_bases(fit_ctx *f, vdsh_error *err)
-{
-    const uint32_t n = f->n, b = f->b;
-    const char *sm = getenv("VDSH_CPCA_S8SCALE");
-    const int lse = sm && !strcmp(sm, "lse");
-    double *mb = malloc(sizeof(double) * n * b), *gb = malloc(sizeof(double) * b * b),
-           *lb = malloc(sizeof(double) * b * b), *y = malloc(sizeof(double) * b);
-    double bv[VDSH_MAX_COEFFS];
-    vdsh_result res = VDSH_OK;
-    if (!mb || !gb || !lb || !y) {
-        res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca s8 study: out of memory");
-        goto out;
-    }
-    for (uint32_t c = 0; c < f->k; c++) {
-        if (!f->members[c])
-            continue;
-        for (uint32_t j = s8_study_first(b); j < b; j++) {
-            uint16_t *h = f->bases + ((size_t)c * b + j) * n;
-            double amax = 0.0;
-            for (uint32_t a = 0; a < n; a++) {
-                bv[a] = vdsh_f32_from_f16(h[a]);
-                amax = fabs(bv[a]) > amax ? fabs(bv[a]) : amax;
-            }
-            float best_s = (float)amax;
-            if (lse) {
-                double best_e = -1.0;
-                for (uint32_t t = 0; t <= 20; t++) {
-                    float s = (float)(amax * (1.0 - 0.01 * t));
-                    double e = 0.0;
-                    for (uint32_t a = 0; a < n; a++) {
-                        double d = bv[a] - quantise(bv[a], s, 127) * (double)(s / 127.0f);
-                        e += d * d;
-                    }
-                    if (best_e < 0.0 || e < best_e) {
-                        best_e = e;
-                        best_s = s;
-                    }
-                }
-            }
-            float step = best_s / 127.0f;
-            for (uint32_t a = 0; a < n; a++)
-                h[a] = vdsh_f16_from_f32((float)quantise(bv[a], best_s, 127) * step);
-        }
-        /* metric M (g), rounded basis Bt: P = M Bt (Bt^T M Bt)^-1 */
-        metric_gram_members(f->md, f->normals, f->labels, f->rows, c, f->members[c], f->frac, f->g);
-        const double *g = f->g;
-        for (uint32_t a = 0; a < n; a++)
-            for (uint32_t j = 0; j < b; j++) {
-                const uint16_t *h = f->bases + ((size_t)c * b + j) * n;
-                double s = 0.0;
-                for (uint32_t q = 0; q < n; q++)
-                    s += g[(size_t)a * n + q] * vdsh_f32_from_f16(h[q]);
-                mb[(size_t)a * b + j] = s;
-            }
-        for (uint32_t i = 0; i < b; i++)
-            for (uint32_t j = 0; j < b; j++) {
-                const uint16_t *h = f->bases + ((size_t)c * b + i) * n;
-                double s = 0.0;
-                for (uint32_t a = 0; a < n; a++)
-                    s += vdsh_f32_from_f16(h[a]) * mb[(size_t)a * b + j];
-                gb[(size_t)i * b + j] = s;
-            }
-        for (uint32_t i = 0; i < b; i++)
-            for (uint32_t j = 0; j < i; j++)
-                gb[(size_t)j * b + i] = gb[(size_t)i * b + j] =
-                    0.5 * (gb[(size_t)i * b + j] + gb[(size_t)j * b + i]);
-        if (!cholesky(gb, b, lb)) {
-            res = vdsh_failf(err, VDSH_ERR_INVALID, "cpca s8 study: cluster %u: singular basis", c);
-            goto out;
-        }
-        double *proj = f->proj + (size_t)c * b * n;
-        for (uint32_t a = 0; a < n; a++) {
-            const double *r = mb + (size_t)a * b;
-            for (uint32_t i = 0; i < b; i++) { /* L y' = r */
-                double s = r[i];
-                for (uint32_t q = 0; q < i; q++)
-                    s -= lb[(size_t)i * b + q] * y[q];
-                y[i] = s / lb[(size_t)i * b + i];
-            }
-            for (uint32_t i = b; i-- > 0;) { /* L^T y = y' */
-                double s = y[i];
-                for (uint32_t q = i + 1; q < b; q++)
-                    s -= lb[(size_t)q * b + i] * y[q];
-                y[i] = s / lb[(size_t)i * b + i];
-            }
-            for (uint32_t j = 0; j < b; j++)
-                proj[(size_t)j * n + a] = y[j];
-        }
-    }
-out:
-    free(mb);
-    free(gb);
-    free(lb);
-    free(y);
-    return res;
-}
-
 /* Bytes of a stream of `rows` rows with settings s, the model included. */
 static uint64_t fit_bytes(uint32_t rows, uint32_t order, const vdsh_cpca_settings *s)
 {
     return (uint64_t)rows * 4 * vdsh_cpca_record_words(s->basis, s->bits) +
-           study_model_bytes(order, s->clusters, s->basis);
+           vdsh_cpca_model_bytes(order, s->clusters, s->basis);
 }
 
 /* The largest basis (at most order^2) whose stream of `rows` rows with
@@ -1322,7 +1190,7 @@ static void allocate_widths(const double *dist, uint32_t m, uint32_t bits, uint3
 /* Bytes of the model of k clusters and m vectors with a width table. */
 static uint64_t widths_model_bytes(uint32_t order, uint32_t k, uint32_t m)
 {
-    return study_model_bytes(order, k, m) + ((m + 15u) & ~15u);
+    return vdsh_cpca_model_bytes(order, k, m) + ((m + 15u) & ~15u);
 }
 
 static vdsh_result encode_widths(const float *src, const float *normals, uint32_t rows,
@@ -1420,8 +1288,6 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
     fc->b = bf;
     if (res == VDSH_OK)
         res = fit_all(fc, err);
-    if (res == VDSH_OK && (s8_study_mode() == 1 || s8_study_mode() == 2))
-        res = s8_round_bases(fc, err);
     if (res != VDSH_OK)
         goto done;
 
@@ -1483,9 +1349,7 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
         const double limit = budget * rows;
         double best_e = 0.0;
         int have = 0;
-        const char *fw = getenv("VDSH_CPCA_S8WORDS"); /* STUDY ONLY: force W */
-        for (uint32_t words = fw ? (uint32_t)atoi(fw) : 1; words <= (fw ? (uint32_t)atoi(fw) : 64);
-             words++) {
+        for (uint32_t words = 1; words <= 64; words++) {
             uint32_t m = 0;
             while (m < bf &&
                    (double)rows * 4.0 * words + (double)widths_model_bytes(order, k, m + 1) <=
