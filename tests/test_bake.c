@@ -827,6 +827,23 @@ static void test_adaptive_order(void)
     test_mesh_free(&rec);
 }
 
+/* A 4 x 3 x 2.5 room with a 0.6 x 0.6 pillar at its centre, 3 high: four
+ * quads facing out (the decision fit's neighbour and offset-cap tests). */
+static void test_make_pillar_room(vb_mesh *occ)
+{
+    test_make_room(occ, 4, 3, 2.5f);
+    const float w = 0.3f, h = 3.0f;
+    const float px0[4][3] = {{-w, 0, -w}, {-w, 0, w}, {-w, h, w}, {-w, h, -w}};
+    const float px1[4][3] = {{w, 0, -w}, {w, h, -w}, {w, h, w}, {w, 0, w}};
+    const float pz0[4][3] = {{-w, 0, -w}, {-w, h, -w}, {w, h, -w}, {w, 0, -w}};
+    const float pz1[4][3] = {{-w, 0, w}, {w, 0, w}, {w, h, w}, {-w, h, w}};
+    const float nx[3] = {-1, 0, 0}, pxn[3] = {1, 0, 0}, nz[3] = {0, 0, -1}, pzn[3] = {0, 0, 1};
+    test_add_quad(occ, px0, nx);
+    test_add_quad(occ, px1, pxn);
+    test_add_quad(occ, pz0, nz);
+    test_add_quad(occ, pz1, pzn);
+}
+
 /* Method decision: receivers a millimetre apart on a floor, lit by the
  * same free space, get nearly the same fit. The fit of ln D to the shadow
  * decision must not add noise of its own between neighbours beyond the
@@ -837,18 +854,7 @@ static void test_adaptive_order(void)
 static void test_decision_neighbours(void)
 {
     vb_mesh occ = {0}, rec = {0};
-    test_make_room(&occ, 4, 3, 2.5f);
-    /* A pillar: four quads, facing out. */
-    const float w = 0.3f, h = 3.0f;
-    const float px0[4][3] = {{-w, 0, -w}, {-w, 0, w}, {-w, h, w}, {-w, h, -w}};
-    const float px1[4][3] = {{w, 0, -w}, {w, h, -w}, {w, h, w}, {w, 0, w}};
-    const float pz0[4][3] = {{-w, 0, -w}, {-w, h, -w}, {w, h, -w}, {w, 0, -w}};
-    const float pz1[4][3] = {{-w, 0, w}, {w, 0, w}, {w, h, w}, {-w, h, w}};
-    const float nx[3] = {-1, 0, 0}, pxn[3] = {1, 0, 0}, nz[3] = {0, 0, -1}, pzn[3] = {0, 0, 1};
-    test_add_quad(&occ, px0, nx);
-    test_add_quad(&occ, px1, pxn);
-    test_add_quad(&occ, pz0, nz);
-    test_add_quad(&occ, pz1, pzn);
+    test_make_pillar_room(&occ);
     enum { NP = 24, O = 7 };
     float p[3 * 2 * NP], n[3 * 2 * NP];
     uint64_t s = 23;
@@ -925,17 +931,7 @@ static void test_decision_neighbours(void)
 static void test_offset_cap(void)
 {
     vb_mesh occ = {0}, rec = {0};
-    test_make_room(&occ, 4, 3, 2.5f);
-    const float w = 0.3f, h = 3.0f; /* a pillar, as above */
-    const float px0[4][3] = {{-w, 0, -w}, {-w, 0, w}, {-w, h, w}, {-w, h, -w}};
-    const float px1[4][3] = {{w, 0, -w}, {w, h, -w}, {w, h, w}, {w, 0, w}};
-    const float pz0[4][3] = {{-w, 0, -w}, {-w, h, -w}, {w, h, -w}, {w, 0, -w}};
-    const float pz1[4][3] = {{-w, 0, w}, {w, 0, w}, {w, h, w}, {-w, h, w}};
-    const float nx[3] = {-1, 0, 0}, pxn[3] = {1, 0, 0}, nz[3] = {0, 0, -1}, pzn[3] = {0, 0, 1};
-    test_add_quad(&occ, px0, nx);
-    test_add_quad(&occ, px1, pxn);
-    test_add_quad(&occ, pz0, nz);
-    test_add_quad(&occ, pz1, pzn);
+    test_make_pillar_room(&occ);
     enum { NP = 1200, O = 5 };
     float *p = malloc(sizeof(float) * 3 * NP), *n = malloc(sizeof(float) * 3 * NP);
     uint64_t s = 29;
