@@ -159,6 +159,7 @@ expect_exit 2 "unknown option" "$bake" builtin:room --frobnicate -o "$tmp/x.vdsh
 expect_exit 2 "--offset-cap with shadow" "$bake" builtin:room --method shadow --offset-cap 0 -o "$tmp/x.vdsh"
 expect_exit 2 "--offset-cap share out of range" "$bake" builtin:room --offset-cap 0,1.5 -o "$tmp/x.vdsh"
 expect_exit 2 "--offset-cap not a number" "$bake" builtin:room --offset-cap x -o "$tmp/x.vdsh"
+expect_exit 2 "--offset-cap without fixed orders" "$bake" builtin:room --adaptive-order 0.05 --offset-cap 0 -o "$tmp/x.vdsh"
 expect_exit 2 "--offset-cap trailing comma" "$bake" builtin:room --offset-cap 0, -o "$tmp/x.vdsh"
 expect_exit 2 "--offset-cap trailing text" "$bake" builtin:room --offset-cap 0,1,4x -o "$tmp/x.vdsh"
 expect_exit 2 "--offset-cap fractional MIN" "$bake" builtin:room --offset-cap 0,1,2.5 -o "$tmp/x.vdsh"

@@ -959,6 +959,9 @@ static int check_options(options *o)
                          vb_method_name(o->method));
     if (o->order_tolerance > 0.0f && !o->orders_given)
         o->order_count = 0; /* the variable-order stream alone */
+    if (o->offset_cap && o->order_count == 0)
+        return bad_usage("%s", "--offset-cap caps the fixed orders' offsets: this bake writes "
+                               "the adaptive order's stream alone (add --orders)");
 
     return VT_CLI_RUN;
 }
