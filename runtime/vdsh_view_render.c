@@ -58,7 +58,7 @@ static void bake_label(const char *path, const vr_scene *s, char *out, size_t si
     const char *slash = strrchr(path, '/');
     uint32_t method = info.variable_method;
     for (int k = 1; k <= VDSH_MAX_ORDER; k++)
-        if (info.has_order[k])
+        if (info.has_order[k] || info.has_buffer[k])
             method = info.method[k];
     snprintf(out, size, "%s: %s bake, %s", slash ? slash + 1 : path, vdsh_method_name(method),
              vdsh_quantity_name(info.quantity));
@@ -67,7 +67,8 @@ static void bake_label(const char *path, const vr_scene *s, char *out, size_t si
 /* The grid's columns (vv_mode.grid): the paper's row, then adaptive
  * order (kept only when some scene has a stream with an order per
  * vertex), then distance-field shadows (kept only when some scene has a
- * volume). The summary line describes the order-5 column. */
+ * volume). The summary line describes the first VDSH column the file
+ * has (summary_mode). */
 enum { GRID_MAX_COLS = 16, GRID_PAPER_COLS = 5, GRID_ORDER5_COL = 3 };
 
 /* The number of columns: the highest vv_mode.grid. */
@@ -95,23 +96,32 @@ static const vv_mode *grid_mode(const vr_scene *s, int c)
     return last;
 }
 
-/* The mode the grid's summary line describes: the order-5 column's; for a
- * file with no fixed order, its adaptive stream's (the order-5 column is
- * not in the file), with that stream's method, as bake_label names it. */
+/* The mode the grid's summary line describes: the first of the VDSH
+ * columns (orders 5, 3, 2) the file has; else its adaptive stream's, with
+ * that stream's method, as bake_label names it; else its highest fixed
+ * order's (a file with none of the paper's orders). */
 static void summary_mode(const vr_scene *s, char *out, size_t size)
 {
+    for (int c = GRID_ORDER5_COL; c <= GRID_PAPER_COLS; c++) {
+        const vv_mode *m = grid_mode(s, c);
+        if (vv_mode_available(s, m)) {
+            snprintf(out, size, "%s", vr_scene_mode_label(s, m->mode));
+            return;
+        }
+    }
     vr_scene_info info;
     vr_scene_get_info(s, &info);
-    int fixed = 0;
-    for (int k = 1; k <= VDSH_MAX_ORDER; k++)
-        fixed |= info.has_order[k];
-    if (fixed || !info.variable_order) {
-        snprintf(out, size, "%s", vr_scene_mode_label(s, grid_mode(s, GRID_ORDER5_COL)->mode));
+    char label[160];
+    if (info.variable_order) {
+        vv_mode_label(s, VR_MODE_VDSH_BUFFER, VR_STREAM_VARIABLE, label, sizeof label);
+        snprintf(out, size, "%s, %s", label, vdsh_method_name(info.variable_method));
         return;
     }
-    char label[160];
-    vv_mode_label(s, VR_MODE_VDSH_BUFFER, VR_STREAM_VARIABLE, label, sizeof label);
-    snprintf(out, size, "%s, %s", label, vdsh_method_name(info.variable_method));
+    int top = 0;
+    for (int k = 1; k <= VDSH_MAX_ORDER; k++)
+        top = info.has_order[k] || info.has_buffer[k] ? k : top;
+    vv_mode_label(s, VR_MODE_VDSH_BUFFER, top, label, sizeof label);
+    snprintf(out, size, "%s", label);
 }
 
 /* One row of the grid: the panels of one scene into row (cols panels w

@@ -239,7 +239,7 @@ typedef struct vr_scene_info {
     float bounds_max[3];
     int has_order[VDSH_ORDER_SLOTS];          /* has_order[n]: a stream of order n */
     vdsh_encoding encoding[VDSH_ORDER_SLOTS]; /* its encoding */
-    vdsh_method method[VDSH_ORDER_SLOTS];     /* how it was baked */
+    vdsh_method method[VDSH_ORDER_SLOTS];     /* how it was baked (has_order or has_buffer) */
     float scale[VDSH_ORDER_SLOTS];            /* its stream scale */
     int has_cubemaps;                         /* basis cubemaps made */
     int cube_size;                            /* their face size, or 0 */

@@ -333,6 +333,8 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
                                                        st->encoding != VDSH_ENCODING_CPCA)))
             continue;
         r = vr_buffer_upload(s, st, remap, desc->buffer_floats, desc->cpca_decode, name, err);
+        if (!variable && !s->vbo_stream[st->order])
+            s->method[st->order] = st->method;
     }
     if (r != VR_OK)
         goto done;
@@ -403,6 +405,8 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     i.sdf_bytes = s->sdf_bytes;
     i.interior = s->view.interior;
     for (int o = 1; o < VDSH_ORDER_SLOTS; o++) {
+        if (o > 5)
+            i.method[o] = s->method[o];
         i.has_buffer[o] = s->buffer[o].order != 0;
         i.buffer_encoding[o] = s->buffer[o].encoding;
         i.buffer_per_frame[o] = s->buffer[o].decode_prog != 0;

@@ -441,7 +441,8 @@ expect 2 "positive count" --frames "$d/x" "$room"
 # order per vertex (test_runtime_buffer derive); the grid gains its
 # adaptive-order column (6 panels) and says so; --help names the modes;
 # a file of adaptive order alone draws its buffer and its grid row and
-# summary line name its method.
+# summary line name its method; files of fixed orders without order 5
+# name their method and their first order in the summary line.
 add_test(NAME runtime_view_buffer COMMAND sh -c [=[
 set -e
 v=$1; png=$2; derive=$3; log=$4; d=$5
@@ -478,6 +479,18 @@ grep -q "adaptive.vdsh: decision bake" "$d/agrid.log"
 grep -q "| adaptive (VDSH adaptive order (up to 9, mean [0-9.]*; per-vertex), decision)" \
   "$d/agrid.log"
 if grep -q "VDSH order 5" "$d/agrid.log"; then exit 1; fi
+# A file of fixed orders without 5: order 3 alone, whose summary names
+# order 3; order 7 alone (drawn from a buffer), whose row names its
+# method (shadow; it was labelled a paper bake) and summary order 7
+"$6" builtin:room --max-edge 1.0 --rays 256 --orders 3 -q -o "$d/o3.vdsh"
+"$v" --grid "$d/o3grid.png" --size 96x72 "$d/o3.vdsh" 2> "$d/o3grid.log"
+cat "$d/o3grid.log"
+grep -q "vdsh2 (VDSH order 3 (9 coeff" "$d/o3grid.log"
+"$6" builtin:room --max-edge 1.0 --rays 256 --orders 7 --method shadow -q -o "$d/o7.vdsh"
+"$v" --grid "$d/o7grid.png" --size 96x72 "$d/o7.vdsh" 2> "$d/o7grid.log"
+cat "$d/o7grid.log"
+grep -q "o7.vdsh: shadow bake" "$d/o7grid.log"
+grep -q "vdsh2 (VDSH order 7 (49 coeff" "$d/o7grid.log"
 ]=] sh ${_view} ${_png} $<TARGET_FILE:test_runtime_buffer> ${_room_log} ${_rt_dir}/view_buffer
        $<TARGET_FILE:vdsh-bake>)
 
