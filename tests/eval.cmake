@@ -4,7 +4,8 @@
 #                name states what the part checks
 #   eval_cli     vdsh-bake + vdsh-eval end to end: exit codes, messages,
 #                the JSON and the per-vertex file
-#   eval_json    the JSON parses and holds what the sweep reads
+#   eval_json    the JSON parses and holds what the sweep reads, and the
+#                light rule it was scored with
 if(TARGET vb_eval)
   add_executable(test_eval ${CMAKE_CURRENT_LIST_DIR}/test_eval.c)
   target_link_libraries(test_eval PRIVATE vb_eval)
@@ -52,6 +53,17 @@ for k in ('vertices', 'interior'):
     assert 0 < m['shadow_mae'] < 1 and len(m['worst']) == 10
 assert j['truth']['vertices']['receivers'] == 700 and j['truth']['interior']['receivers'] == 500
 assert j['eval']['directions'] == 64
+assert j['eval']['scene_light_rule'] == 'uniform', j['eval']
+# --light-rule: recorded, and the lights where the rule puts them (ceiling:
+# the top fifth of the height)
+r = subprocess.run([ev, f, '--interior', '0', '--points', '300', '--light-rule', 'ceiling',
+                    '--json', f + '.c.json'], check=True, stdout=subprocess.PIPE, text=True)
+assert \"light rule 'ceiling'\" in r.stdout, r.stdout
+j = json.load(open(f + '.c.json'))
+assert j['eval']['scene_light_rule'] == 'ceiling', j['eval']
+lo, hi = j['scene']['bounds_min'][1], j['scene']['bounds_max'][1]
+ys = [p[1] for p in j['eval']['scene_light_positions']]
+assert ys and min(ys) >= lo + 0.8 * (hi - lo) - 1e-4 * (hi - lo), (lo, hi, min(ys))
 print('ok')"
              $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval>)
   endif()

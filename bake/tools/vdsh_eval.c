@@ -419,6 +419,7 @@ static int write_json(const char *out, const context *c, char *msg, size_t cap)
     vt_json_u64(&j, ev, "threads", r->threads);
     vt_json_f64(&j, ev, "seconds", r->seconds);
     vt_json_u64(&j, ev, "scene_lights", r->light_count);
+    vt_json_string(&j, ev, "scene_light_rule", vb_light_rule_name((vb_light_rule)c->d->light_rule));
     vt_json_u64(&j, ev, "scene_light_candidates", r->light_candidates);
     cJSON *lp = vt_json_array(&j, ev, "scene_light_positions");
     for (uint32_t l = 0; l < r->light_count; l++)
@@ -549,11 +550,13 @@ static void print_table(FILE *o, const context *c)
     }
     fprintf(o, "\n  order = n bands, n^2 coefficients (aN: adaptive, each vertex 1..N); B/v = "
                "bytes of coefficients per vertex (adaptive: on average); +- = 95%% interval\n");
+    const vb_light_rule rule = (vb_light_rule)c->d->light_rule;
     fprintf(o,
-            "\n  SCENE LIGHTS (the primary metric): %u point lights placed uniformly in the "
+            "\n  SCENE LIGHTS (the primary metric): %u point lights placed %s%s%s in the "
             "scene's free space, each\n  scored at every receiver it lights; "
             "false = P(s_hat < .5 | d_T >= d_L), recall = P(s_hat < .5 | s_ideal < .5)\n\n",
-            r->light_count);
+            r->light_count, rule ? "by the light rule '" : "uniformly",
+            rule ? vb_light_rule_name(rule) : "", rule ? "'" : "");
     fprintf(o, "  %-8s %5s %6s %3s %3s %-9s | %7s | %-15s %-13s %-12s | %-6s %6s %6s\n", "",
             "order", "offset", "B/v", "enc", "fit", "pairs", "smooth: MAE", "false", "recall",
             "binary", "false", "recall");
