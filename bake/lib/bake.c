@@ -433,7 +433,7 @@ static int cmp_margin(const void *a, const void *b)
 }
 
 /* The margins ln D - ln d_L of fit c (order o) at the receiver's lit
- * training pairs (the first m of Y, logd, lab) into mg; their count into
+ * training pairs (the first m of Y, logd, lab) into mg (room for m); their count into
  * *lit. Returns its offset cap (vb_bake_desc.offset_cap): the least
  * offset that keeps the cap's share of them lit, less its tolerance,
  * at most 0; -inf where the cap is off or too few pairs are lit. mg
@@ -441,15 +441,20 @@ static int cmp_margin(const void *a, const void *b)
 static float dec_cap(const job *J, int o, const float *c, uint32_t m, const float *Y, uint32_t ys,
                      const float *logd, const uint8_t *lab, float *mg, uint32_t *lit)
 {
-    uint32_t n = 0;
-    for (uint32_t i = 0; i < m; i++) {
-        if (lab[i])
-            continue;
-        float s = 0.0f;
-        for (int j = 0; j < o * o; j++)
-            s += c[j] * Y[(size_t)j * ys + i];
-        mg[n++] = s - logd[i];
+    /* ln D at every pair, coefficient by coefficient along Y's rows (each
+     * pair's sum in the order j = 0, 1, ...), then the lit pairs' margins
+     * gathered to the front */
+    for (uint32_t i = 0; i < m; i++)
+        mg[i] = 0.0f;
+    for (int j = 0; j < o * o; j++) {
+        const float cj = c[j], *row = Y + (size_t)j * ys;
+        for (uint32_t i = 0; i < m; i++)
+            mg[i] += cj * row[i];
     }
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < m; i++)
+        if (!lab[i])
+            mg[n++] = mg[i] - logd[i];
     *lit = n;
     if (!J->cap_on || n == 0 || n < J->cap_min)
         return -INFINITY;
