@@ -392,7 +392,6 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     for (int o = 1; o <= 5; o++) {
         i.has_order[o] = s->vbo_stream[o] != 0;
         i.encoding[o] = s->encoding[o];
-        i.method[o] = s->method[o];
         i.scale[o] = s->scale[o];
     }
     i.has_cubemaps = s->basis[0] != 0;
@@ -405,8 +404,7 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
     i.sdf_bytes = s->sdf_bytes;
     i.interior = s->view.interior;
     for (int o = 1; o < VDSH_ORDER_SLOTS; o++) {
-        if (o > 5)
-            i.method[o] = s->method[o];
+        i.method[o] = s->method[o];
         i.has_buffer[o] = s->buffer[o].order != 0;
         i.buffer_encoding[o] = s->buffer[o].encoding;
         i.buffer_per_frame[o] = s->buffer[o].decode_prog != 0;
