@@ -967,6 +967,11 @@ static int check_options(options *o)
         return bad_usage("%s", "--offset-cap with SMOOTH steps averages each receiver's cap with "
                                "its mesh neighbours', which a shard does not bake: bake the "
                                "whole mesh (no --shard), or use SMOOTH 0");
+    if (o->offset_cap && o->offset_cap_smooth && o->adaptive)
+        return bad_usage("%s", "--offset-cap with SMOOTH steps cannot be combined with --adaptive: "
+                               "its rounds bake the new receivers as ranges, without their "
+                               "neighbours (plan the receivers with --adaptive --plan and no cap, "
+                               "then bake the plan with --receivers)");
     if (o->offset_cap && o->order_count == 0)
         return bad_usage("%s", "--offset-cap caps the fixed orders' offsets: this bake writes "
                                "the adaptive order's stream alone (add --orders)");
