@@ -535,7 +535,11 @@ static int write_report(const char *path, const options *o, const vb_job *job,
         vt_json_f32(&j, dec, "false_rate", b->false_rate);
         vt_json_u64(&j, dec, "offset_cap_bound", b->cap_bound);
         vt_json_u64(&j, dec, "lit_training_pairs", b->lit_training);
-        vt_json_u64(&j, dec, "lit_training_false", b->lit_training_false);
+        vt_json_u64(&j, dec, "offset_cap_smooth", o->offset_cap ? o->offset_cap_smooth : 0);
+        if (o->offset_cap && o->offset_cap_smooth) /* not counted: the offset came after */
+            vt_json_null(&j, dec, "lit_training_false");
+        else
+            vt_json_u64(&j, dec, "lit_training_false", b->lit_training_false);
         cJSON *off = vt_json_object(&j, dec, "log_offsets");
         for (int i = 0; i < o->order_count; i++) {
             char key[8];
