@@ -1008,6 +1008,151 @@ static void test_offset_cap(void)
     free(n);
 }
 
+/* The smoothed offset cap (vb_bake_desc.offset_cap_smooth): on a floor
+ * mesh of triangles around the pillar, with the log offset given as -5
+ * (no calibration: each receiver draws at max(-5, its cap)), one step
+ * gives each receiver whose ring all have caps above -5 the mean of its
+ * own and its ring's unsmoothed shifts (the ring found here from the
+ * triangles, apart from the baker's), the shifts stay within the
+ * unsmoothed ones' range, and neighbours' shifts differ less on average;
+ * calibrated, 1 and 2 threads give the same bytes, and a range (a shard)
+ * is refused. */
+static void test_offset_cap_smooth(void)
+{
+    vb_mesh occ = {0}, rec = {0};
+    test_make_pillar_room(&occ);
+    enum { GX = 36, GZ = 20, NV = GX * GZ, NT = 2 * (GX - 1) * (GZ - 1), O = 5 };
+    test_mesh_alloc(&rec, NV, NT);
+    for (int j = 0; j < GZ; j++)
+        for (int i = 0; i < GX; i++) {
+            float *q = rec.positions + 3 * (j * GX + i);
+            q[0] = -3.5f + 7.0f * (float)i / (GX - 1);
+            q[1] = 0.0f;
+            q[2] = -2.0f + 4.0f * (float)j / (GZ - 1);
+            rec.normals[3 * (j * GX + i) + 1] = 1.0f;
+        }
+    uint32_t t = 0;
+    for (int j = 0; j + 1 < GZ; j++)
+        for (int i = 0; i + 1 < GX; i++) {
+            uint32_t a = (uint32_t)(j * GX + i), b = a + 1, c = a + GX + 1, e = a + GX;
+            uint32_t tri[6] = {a, e, c, a, c, b};
+            memcpy(rec.indices + 3 * t, tri, sizeof tri);
+            t += 2;
+        }
+    unsigned char *ring = calloc((size_t)NV * NV, 1);
+    CHECK(ring != NULL, "out of memory");
+    for (uint32_t k = 0; ring && k < (uint32_t)NT; k++)
+        for (int e = 0; e < 3; e++) {
+            uint32_t x = rec.indices[3 * k + e], y = rec.indices[3 * k + (e + 1) % 3];
+            ring[(size_t)x * NV + y] = ring[(size_t)y * NV + x] = 1;
+        }
+    vb_error err;
+    vb_scene *sc = NULL;
+    CHECK(vb_scene_create(&occ, NULL, &sc, &err) == VB_OK, "scene: %s", err.msg);
+    float given[VDSH_ORDER_SLOTS];
+    for (int o = 0; o < VDSH_ORDER_SLOTS; o++)
+        given[o] = -5.0f;
+    /* no cap, per receiver, smoothed one step (offset -5 given); then
+     * smoothed two steps calibrated on 2 and 1 threads */
+    enum { NB = 5 };
+    vb_bake_output b[NB] = {{0}};
+    const int cap[NB] = {0, 1, 1, 1, 1};
+    const uint32_t smooth[NB] = {0, 0, 1, 2, 2};
+    for (int i = 0; i < NB && sc; i++) {
+        vb_bake_desc d = {.keep_normals = 1,
+                          .receivers = &rec,
+                          .scene = sc,
+                          .rays = 400,
+                          .seed = 7,
+                          .threads = i == 4 ? 1 : 2,
+                          .order_mask = 1u << O,
+                          .method = VB_METHOD_DECISION,
+                          .log_offsets = i < 3 ? given : NULL,
+                          .offset_cap = cap[i],
+                          .offset_cap_tol = -0.2f,
+                          .offset_cap_smooth = smooth[i]};
+        CHECK(vb_bake_run(&d, &b[i], &err) == VB_OK, "bake %d: %s", i, err.msg);
+    }
+    if (ring && b[0].coeffs[O] && b[1].coeffs[O] && b[2].coeffs[O] && b[3].coeffs[O] &&
+        b[4].coeffs[O]) {
+        /* each receiver's shift: its offset, max(-5, cap), from c0 */
+        const float y00 = 0.28209479177387814f;
+        float e1[NV], e2[NV];
+        for (int v = 0; v < NV; v++) {
+            float c0 = b[0].coeffs[O][(size_t)v * O * O];
+            e1[v] = -5.0f + (b[1].coeffs[O][(size_t)v * O * O] - c0) * y00;
+            e2[v] = -5.0f + (b[2].coeffs[O][(size_t)v * O * O] - c0) * y00;
+        }
+        int checked = 0, bad = 0;
+        float lo = INFINITY, hi = -INFINITY, worst = 0.0f;
+        double d1 = 0.0, d2 = 0.0;
+        int edges = 0;
+        for (int v = 0; v < NV; v++) {
+            if (e1[v] > -4.99f) {
+                lo = e1[v] < lo ? e1[v] : lo;
+                hi = e1[v] > hi ? e1[v] : hi;
+            }
+            int all = e1[v] > -4.99f, n = 1;
+            double sum = e1[v];
+            for (int u = 0; u < NV; u++)
+                if (ring[(size_t)v * NV + u]) {
+                    all &= e1[u] > -4.99f;
+                    sum += e1[u], n++;
+                    if (u > v && e1[u] > -4.99f && e1[v] > -4.99f) {
+                        d1 += fabsf(e1[u] - e1[v]);
+                        d2 += fabsf(e2[u] - e2[v]);
+                        edges++;
+                    }
+                }
+            if (!all)
+                continue;
+            checked++;
+            float diff = fabsf(e2[v] - (float)(sum / n));
+            worst = diff > worst ? diff : worst;
+            bad += diff > 1e-3f;
+        }
+        int outside = 0;
+        for (int v = 0; v < NV; v++)
+            outside += e1[v] > -4.99f && (e2[v] < lo - 1e-3f || e2[v] > hi + 1e-3f);
+        printf("smoothed offset cap: %d receivers with their whole ring capped, the ring mean "
+               "within %.2g; mean neighbour difference %.4f -> %.4f over %d edges; offsets "
+               "raised %llu / %llu; calibrated offset %+.3f\n",
+               checked, (double)worst, d1 / (edges ? edges : 1), d2 / (edges ? edges : 1), edges,
+               (unsigned long long)b[1].cap_bound, (unsigned long long)b[2].cap_bound,
+               (double)b[3].log_offset[O]);
+        CHECK(checked > NV / 4, "only %d receivers with their whole ring capped", checked);
+        CHECK(bad == 0, "%d receivers' smoothed shift is not their ring's mean (worst %g)", bad,
+              (double)worst);
+        CHECK(outside == 0, "%d smoothed shifts outside the unsmoothed range", outside);
+        CHECK(edges > 0 && d2 < d1, "smoothing did not bring neighbours' shifts closer (%g, %g)",
+              d1, d2);
+        CHECK(b[1].cap_bound > 0 && b[2].cap_bound > 0, "no offset raised");
+        CHECK(memcmp(b[3].coeffs[O], b[4].coeffs[O], sizeof(float) * NV * O * O) == 0 &&
+                  b[3].log_offset[O] == b[4].log_offset[O],
+              "smoothed cap: 1 and 2 threads differ");
+    }
+    vb_bake_desc shard = {.keep_normals = 1,
+                          .receivers = &rec,
+                          .scene = sc,
+                          .rays = 100,
+                          .order_mask = 1u << O,
+                          .method = VB_METHOD_DECISION,
+                          .offset_cap = 1,
+                          .offset_cap_smooth = 1,
+                          .range_begin = 0,
+                          .range_end = NV / 2};
+    vb_bake_output none = {0};
+    CHECK(sc && vb_bake_run(&shard, &none, &err) == VB_ERR_ARGUMENT &&
+              strstr(err.msg, "smoothed offset cap"),
+          "a range with the smoothed cap is refused");
+    for (int i = 0; i < NB; i++)
+        vb_bake_output_free(&b[i]);
+    vb_scene_destroy(sc);
+    test_mesh_free(&occ);
+    test_mesh_free(&rec);
+    free(ring);
+}
+
 int main(void)
 {
     test_grid();
@@ -1022,5 +1167,6 @@ int main(void)
     test_adaptive_order();
     test_decision_neighbours();
     test_offset_cap();
+    test_offset_cap_smooth();
     return test_report("test_bake");
 }
