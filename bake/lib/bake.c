@@ -111,10 +111,6 @@ typedef struct job {
                                           * offset calibrated without caps */
     float cap_tol, cap_keep;
     uint32_t cap_min;
-    /* The caps smoothed over mesh neighbours (vb_bake_desc.offset_cap_smooth:
-     * its steps, 0 off): every receiver's cap goes into done_caps, and
-     * its offset is added after the bake (smooth_caps). */
-    uint32_t cap_smooth;
     float *cal_caps, *done_caps;
     _Atomic uint64_t cap_bound, lit_training, lit_false;
     _Atomic uint32_t dec_fitted, dec_fallbacks;
@@ -540,9 +536,7 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
                 float mg[VB_DECISION_MAX_PAIRS];
                 uint32_t lit = 0;
                 cap[o] = dec_cap(J, o, out->coeffs[1][o], m, Y, ys, logd, lab, mg, &lit);
-                if (!out->cal && J->cap_smooth) {
-                    atomic_fetch_add(&J->lit_training, lit); /* the offset not known yet */
-                } else if (!out->cal) {
+                if (!out->cal) {
                     float off = capped_offset(J->log_offset[o], cap[o], J->free_offset[o]);
                     uint64_t bad = 0;
                     for (uint32_t i = 0; i < lit; i++)
@@ -874,12 +868,8 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
     }
     /* Methods shadow and decision: the log offset, through c0 (Y00 is a
      * constant), raised to the receiver's cap (outside the calibration:
-     * its samples get theirs after it; with the smoothed cap, every
-     * receiver gets its after the bake, smooth_caps). */
-    const int defer = J->cap_smooth && !out->cal && J->done_caps && v >= J->lo && v < J->hi;
-    if (defer)
-        memcpy(J->done_caps + (size_t)(v - J->lo) * VDSH_ORDER_SLOTS, cap, sizeof cap);
-    for (int o = 1; o <= VDSH_MAX_ORDER && !defer; o++) {
+     * its samples get theirs after it). */
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!out->coeffs[1][o])
             continue;
         float off = out->cal ? J->log_offset[o]
@@ -1329,15 +1319,6 @@ static vb_result resolve_decision(bake_run *b, vb_error *err)
                           !(d->offset_cap_keep > 0.0f && d->offset_cap_keep <= 1.0f)))
         return vb_fail(err, VB_ERR_ARGUMENT,
                        "the offset cap's tolerance must be in -5..5 and its share in (0, 1]");
-    if (d->offset_cap && d->offset_cap_smooth > VB_MAX_CAP_SMOOTH)
-        return vb_fail(err, VB_ERR_ARGUMENT, "the offset cap's smoothing steps must be 0..%u",
-                       VB_MAX_CAP_SMOOTH);
-    if (d->offset_cap && d->offset_cap_smooth &&
-        (b->lo != 0 || b->hi != d->receivers->vertex_count))
-        return vb_fail(err, VB_ERR_ARGUMENT,
-                       "the smoothed offset cap averages each receiver's cap with its mesh "
-                       "neighbours', which a range (a shard) does not bake: bake the whole "
-                       "mesh, or use the per-receiver cap (smoothing 0)");
     vb_decision_defaults(&b->dec);
     if (d->decision)
         b->dec = *d->decision;
@@ -1515,14 +1496,6 @@ static vb_result setup_offsets(bake_run *b, vb_error *err)
     J->cap_tol = d->offset_cap ? d->offset_cap_tol : 0.0f;
     J->cap_keep = d->offset_cap_keep;
     J->cap_min = d->offset_cap_min;
-    J->cap_smooth = d->offset_cap && !d->trace_only ? d->offset_cap_smooth : 0;
-    if (J->cap_smooth) {
-        const size_t rows = (size_t)(b->hi - b->lo) * VDSH_ORDER_SLOTS;
-        if (!(J->done_caps = malloc(rows * sizeof *J->done_caps + 1)))
-            return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-        for (size_t i = 0; i < rows; i++)
-            J->done_caps[i] = -INFINITY;
-    }
     if (mi->decision && !d->trace_only) {
         J->pool = malloc(DEC_POOL * sizeof *J->pool);
         if (!J->pool)
@@ -1687,8 +1660,7 @@ static vb_result calibrate_offsets(bake_run *b, vb_error *err)
     J->done = calloc((size_t)(b->hi - b->lo), 1);
     J->cal_margins = malloc((size_t)cal_count * VDSH_ORDER_SLOTS * CAL_LIGHTS * sizeof(float));
     J->cal_caps = malloc((size_t)cal_count * VDSH_ORDER_SLOTS * sizeof(float));
-    if (!J->done_caps)
-        J->done_caps = malloc((size_t)(b->hi - b->lo) * VDSH_ORDER_SLOTS * sizeof(float));
+    J->done_caps = malloc((size_t)(b->hi - b->lo) * VDSH_ORDER_SLOTS * sizeof(float));
     float *lit = malloc((size_t)cal_count * CAL_LIGHTS * sizeof(float) + 1);
     float *lit_cap = malloc((size_t)cal_count * CAL_LIGHTS * sizeof(float) + 1);
     vb_result r = VB_OK;
@@ -1714,127 +1686,6 @@ static vb_result calibrate_offsets(bake_run *b, vb_error *err)
     return r;
 }
 
-/* The receivers' mesh neighbours (vertices sharing a triangle's edge),
- * as CSR: *first (vertex_count + 1 entries) and *adj, ascending and
- * without repeats per vertex. 0 on out of memory. */
-static int receiver_rings(const vb_mesh *R, uint32_t **first, uint32_t **adj)
-{
-    const uint32_t V = R->vertex_count, T = R->triangle_count;
-    uint32_t *f = calloc((size_t)V + 1, sizeof *f), *a = malloc((size_t)6 * T * sizeof *a + 1);
-    if (!f || !a) {
-        free(f);
-        free(a);
-        return 0;
-    }
-    for (uint32_t t = 0; t < T; t++)
-        for (int e = 0; e < 3; e++) {
-            uint32_t i = R->indices[3 * (size_t)t + e], j = R->indices[3 * (size_t)t + (e + 1) % 3];
-            if (i != j)
-                f[i + 1]++, f[j + 1]++;
-        }
-    for (uint32_t v = 0; v < V; v++)
-        f[v + 1] += f[v];
-    uint32_t *at = malloc((size_t)V * sizeof *at + 1);
-    if (!at) {
-        free(f);
-        free(a);
-        return 0;
-    }
-    memcpy(at, f, (size_t)V * sizeof *at);
-    for (uint32_t t = 0; t < T; t++)
-        for (int e = 0; e < 3; e++) {
-            uint32_t i = R->indices[3 * (size_t)t + e], j = R->indices[3 * (size_t)t + (e + 1) % 3];
-            if (i != j)
-                a[at[i]++] = j, a[at[j]++] = i;
-        }
-    /* sorted, repeats dropped, packed */
-    uint32_t n = 0;
-    for (uint32_t v = 0; v < V; v++) {
-        uint32_t b = f[v], e = f[v + 1];
-        for (uint32_t k = b + 1; k < e; k++) /* insertion sort: rings are small */
-            for (uint32_t m = k; m > b && a[m - 1] > a[m]; m--) {
-                uint32_t x = a[m];
-                a[m] = a[m - 1], a[m - 1] = x;
-            }
-        f[v] = n;
-        for (uint32_t k = b; k < e; k++)
-            if (k == b || a[k] != a[k - 1])
-                a[n++] = a[k];
-    }
-    f[V] = n;
-    free(at);
-    *first = f;
-    *adj = a;
-    return 1;
-}
-
-/* The smoothed cap (vb_bake_desc.offset_cap_smooth), after the whole
- * bake: per fixed order, the caps in done_caps smoothed by that many
- * Jacobi steps over the mesh neighbours (a receiver with a cap takes the
- * mean of its own and its neighbours' that have one; without one it
- * keeps none), in vertex order on one thread; the calibration samples'
- * smoothed caps then recalibrate the offset (as calibrate_offsets does
- * with the unsmoothed ones), and every receiver gets its offset,
- * capped_offset of its smoothed cap. The range is the whole mesh
- * (resolve_decision). */
-static vb_result smooth_caps(bake_run *b, vb_error *err)
-{
-    const vb_bake_desc *d = &b->d;
-    job *J = b->J;
-    const vb_mesh *R = d->receivers;
-    const uint32_t V = R->vertex_count;
-    uint32_t *first = NULL, *adj = NULL;
-    float *s = malloc((size_t)V * sizeof *s + 1), *t = malloc((size_t)V * sizeof *t + 1);
-    const uint32_t cal_count = b->cal_count;
-    float *lit = malloc((size_t)cal_count * CAL_LIGHTS * sizeof(float) + 1);
-    float *lit_cap = malloc((size_t)cal_count * CAL_LIGHTS * sizeof(float) + 1);
-    vb_result r = VB_OK;
-    if (!s || !t || !lit || !lit_cap || !receiver_rings(R, &first, &adj))
-        r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the smoothed offset cap");
-    for (int o = 1; o <= VDSH_MAX_ORDER && r == VB_OK; o++) {
-        if (!b->coeffs[o])
-            continue;
-        for (uint32_t v = 0; v < V; v++)
-            s[v] = J->done_caps[(size_t)v * VDSH_ORDER_SLOTS + o];
-        for (uint32_t step = 0; step < J->cap_smooth; step++) {
-            for (uint32_t v = 0; v < V; v++) {
-                if (s[v] == -INFINITY) {
-                    t[v] = -INFINITY;
-                    continue;
-                }
-                double sum = s[v];
-                uint32_t n = 1;
-                for (uint32_t k = first[v]; k < first[v + 1]; k++)
-                    if (s[adj[k]] != -INFINITY)
-                        sum += s[adj[k]], n++;
-                t[v] = (float)(sum / n);
-            }
-            float *x = s;
-            s = t, t = x;
-        }
-        if (b->calibrate && J->decision && cal_count) {
-            for (uint32_t i = 0; i < cal_count; i++)
-                J->cal_caps[(size_t)i * VDSH_ORDER_SLOTS + o] = s[choose_receiver(i, V, cal_count)];
-            J->log_offset[o] = slot_offset(J, cal_count, o, d->false_rate, lit, lit_cap, 1);
-        }
-        uint64_t bound = 0;
-        for (uint32_t v = 0; v < V; v++) {
-            float off = capped_offset(J->log_offset[o], s[v], J->free_offset[o]);
-            bound += s[v] > J->log_offset[o];
-            if (off != 0.0f)
-                b->coeffs[o][(size_t)v * o * o] += off / 0.28209479177387814f;
-        }
-        atomic_fetch_add(&J->cap_bound, bound);
-    }
-    free(first);
-    free(adj);
-    free(s);
-    free(t);
-    free(lit);
-    free(lit_cap);
-    return r;
-}
-
 /* Trace and project every receiver of the range on the workers; the
  * calibration's receivers were baked before their offset, which is added
  * to them here. */
@@ -1845,7 +1696,7 @@ static vb_result bake_receivers(bake_run *b, vb_error *err)
     const uint32_t lo = b->lo, hi = b->hi;
     b->started = vb_parallel_for(d->threads, d->receivers->vertex_count, BLOCK, bake_block, J,
                                  d->progress ? bake_progress : NULL, J);
-    for (uint32_t v = lo; b->cal_count && J->done && !J->cap_smooth && v < hi; v++)
+    for (uint32_t v = lo; b->cal_count && J->done && v < hi; v++)
         if (J->done[v - lo])
             for (int o = 1; o <= VDSH_MAX_ORDER; o++)
                 if (b->coeffs[o]) {
@@ -1861,7 +1712,7 @@ static vb_result bake_receivers(bake_run *b, vb_error *err)
                 J->var_dec_offset / 0.28209479177387814f;
     if (b->started == 0)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
-    return J->cap_smooth ? smooth_caps(b, err) : VB_OK;
+    return VB_OK;
 }
 
 /* The output: the settings as resolved, the counts, and the arrays (moved

@@ -150,16 +150,10 @@ typedef struct vb_bake_desc {
      * it has at least offset_cap_min lit pairs; the calibration measures
      * its held-out lights through the capped offsets. Receivers without a
      * cap keep the offset calibrated without caps. Fixed orders only
-     * (not the adaptive order's stream). keep 0: 1; min 0: 1.
-     * offset_cap_smooth > 0: the caps smoothed over the receivers' mesh
-     * neighbours (their triangles' edges) before the calibration and
-     * the offsets: that many Jacobi steps, each replacing a receiver's
-     * cap by the mean of its own and its neighbours' caps (receivers
-     * without a cap neither take one nor count). Needs the whole
-     * bake (no range: a shard does not bake its neighbours). */
+     * (not the adaptive order's stream). keep 0: 1; min 0: 1. */
     int offset_cap;
     float offset_cap_tol, offset_cap_keep;
-    uint32_t offset_cap_min, offset_cap_smooth;
+    uint32_t offset_cap_min;
     int max_order;    /* 0: the highest order in order_mask, or
                                   VB_DEFAULT_ORDER */
     unsigned threads; /* 0: every online core */
@@ -185,7 +179,6 @@ typedef struct vb_bake_desc {
 #define VB_DEFAULT_RAY_TOLERANCE 0.06f /* validation room: docs/ACCURACY.md */
 #define VB_DEFAULT_DECISION_LIGHTS 256
 #define VB_DEFAULT_FALSE_RATE 0.008f
-#define VB_MAX_CAP_SMOOTH 64 /* vb_bake_desc.offset_cap_smooth's most steps */
 
 typedef struct vb_bake_output {
     int max_order;
@@ -211,8 +204,7 @@ typedef struct vb_bake_output {
      * calibration sample, their lit training pairs and those of them
      * that the log offset turns false: drawn lit without it, in shadow
      * by more than the cap's tolerance (0 without the cap) with it
-     * (counted with or without the cap; not with offset_cap_smooth,
-     * whose offsets are known only after the bake: 0). */
+     * (counted with or without the cap). */
     uint64_t cap_bound, lit_training, lit_training_false;
     vdsh_window window;    /* applied */
     uint32_t vertex_count; /* all receivers */

@@ -60,9 +60,9 @@ typedef struct options {
     float false_rate;            /* --false-rate; 0: the default */
     vb_decision_params decision; /* --decision-params */
     int have_decision;
-    int offset_cap; /* --offset-cap TOL[,KEEP[,MIN[,SMOOTH]]] */
+    int offset_cap; /* --offset-cap TOL[,KEEP[,MIN]] */
     float offset_cap_tol, offset_cap_keep;
-    uint32_t offset_cap_min, offset_cap_smooth;
+    uint32_t offset_cap_min;
     float log_floor;
     vdsh_window window;
     vdsh_encoding encoding;
@@ -243,15 +243,13 @@ static void usage(FILE *f)
             "      --false-rate R      decision: the share of lit (light, receiver) pairs\n"
             "                          the calibrated offset leaves in false shadow, on\n"
             "                          held-out lights (default %g)\n"
-            "      --offset-cap TOL[,KEEP[,MIN[,SMOOTH]]]\n"
+            "      --offset-cap TOL[,KEEP[,MIN]]\n"
             "                          decision: cap each receiver's log offset (raise it,\n"
             "                          never above 0) so that KEEP of its lit training\n"
             "                          pairs stay lit, less TOL ln units, where it has\n"
             "                          at least MIN lit pairs (default KEEP 1, MIN 1); a\n"
-            "                          negative TOL keeps them lit by -TOL more; SMOOTH\n"
-            "                          steps (0..64, default 0) average each cap with its\n"
-            "                          mesh neighbours' (whole bakes only, no --shard);\n"
-            "                          the calibration runs through the capped offsets.\n"
+            "                          negative TOL keeps them lit by -TOL more; the\n"
+            "                          calibration runs through the capped offsets.\n"
             "                          Fixed orders only (issue 25, docs/ACCURACY.md)\n"
             "      --decision-lights N decision: training lights per receiver, each\n"
             "                          traced (1..%d, default %d)\n"
@@ -535,11 +533,7 @@ static int write_report(const char *path, const options *o, const vb_job *job,
         vt_json_f32(&j, dec, "false_rate", b->false_rate);
         vt_json_u64(&j, dec, "offset_cap_bound", b->cap_bound);
         vt_json_u64(&j, dec, "lit_training_pairs", b->lit_training);
-        vt_json_u64(&j, dec, "offset_cap_smooth", o->offset_cap ? o->offset_cap_smooth : 0);
-        if (o->offset_cap && o->offset_cap_smooth) /* not counted: the offset came after */
-            vt_json_null(&j, dec, "lit_training_false");
-        else
-            vt_json_u64(&j, dec, "lit_training_false", b->lit_training_false);
+        vt_json_u64(&j, dec, "lit_training_false", b->lit_training_false);
         cJSON *off = vt_json_object(&j, dec, "log_offsets");
         for (int i = 0; i < o->order_count; i++) {
             char key[8];
@@ -846,19 +840,17 @@ static int read_choice(int c, const char *arg, options *o)
             return bad_usage("--false-rate takes a number in (0, 0.5), not '%s'", arg);
         break;
     case O_OFFSET_CAP: {
-        float v[4] = {0.0f, 1.0f, 1.0f, 0.0f};
-        int n = vt_parse_floats(arg, v, 1, 4);
+        float v[3] = {0.0f, 1.0f, 1.0f};
+        int n = vt_parse_floats(arg, v, 1, 3);
         float tol = v[0], keep = v[1];
         unsigned min = v[2] >= 1.0f && v[2] <= (float)VB_DECISION_MAX_PAIRS && v[2] == floorf(v[2])
                            ? (unsigned)v[2]
                            : 0u;
-        int smooth_ok = v[3] >= 0.0f && v[3] <= (float)VB_MAX_CAP_SMOOTH && v[3] == floorf(v[3]);
-        if (!n || !(fabsf(tol) <= 5.0f) || !(keep > 0.0f && keep <= 1.0f) || min < 1 || !smooth_ok)
-            return bad_usage("--offset-cap takes TOL[,KEEP[,MIN[,SMOOTH]]]: a tolerance in -5..5 "
-                             "ln units, the share of lit training pairs kept lit in (0, 1], the "
-                             "least lit pairs 1..1024, the smoothing steps 0..64, not '%s'",
+        if (!n || !(fabsf(tol) <= 5.0f) || !(keep > 0.0f && keep <= 1.0f) || min < 1)
+            return bad_usage("--offset-cap takes TOL[,KEEP[,MIN]]: a tolerance in -5..5 ln "
+                             "units, the share of lit training pairs kept lit in (0, 1], the "
+                             "least lit pairs 1..1024, not '%s'",
                              arg);
-        o->offset_cap_smooth = (uint32_t)v[3];
         o->offset_cap = 1;
         o->offset_cap_tol = tol;
         o->offset_cap_keep = keep;
@@ -967,15 +959,6 @@ static int check_options(options *o)
                          vb_method_name(o->method));
     if (o->order_tolerance > 0.0f && !o->orders_given)
         o->order_count = 0; /* the variable-order stream alone */
-    if (o->offset_cap && o->offset_cap_smooth && o->shard_count)
-        return bad_usage("%s", "--offset-cap with SMOOTH steps averages each receiver's cap with "
-                               "its mesh neighbours', which a shard does not bake: bake the "
-                               "whole mesh (no --shard), or use SMOOTH 0");
-    if (o->offset_cap && o->offset_cap_smooth && o->adaptive)
-        return bad_usage("%s", "--offset-cap with SMOOTH steps cannot be combined with --adaptive: "
-                               "its rounds bake the new receivers as ranges, without their "
-                               "neighbours (plan the receivers with --adaptive --plan and no cap, "
-                               "then bake the plan with --receivers)");
     if (o->offset_cap && o->order_count == 0)
         return bad_usage("%s", "--offset-cap caps the fixed orders' offsets: this bake writes "
                                "the adaptive order's stream alone (add --orders)");
@@ -1159,7 +1142,6 @@ static vb_job_desc job_desc(const options *o, FILE *log, progress *pr, float *of
                                   .offset_cap_tol = o->offset_cap_tol,
                                   .offset_cap_keep = o->offset_cap_keep,
                                   .offset_cap_min = o->offset_cap_min,
-                                  .offset_cap_smooth = o->offset_cap_smooth,
                                   .window = o->window,
                                   .order_mask = order_mask,
                                   .threads = o->threads,
@@ -1314,14 +1296,7 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
                         (double)bo->variable_param);
             fputc('\n', log);
         }
-        if (o->offset_cap && o->offset_cap_smooth)
-            fprintf(log,
-                    "vdsh-bake: offset cap smoothed over %u step(s) of mesh neighbours raised %llu "
-                    "(receiver, order) offsets; %llu lit training pairs (the offset's false ones "
-                    "not counted with smoothing)\n",
-                    o->offset_cap_smooth, (unsigned long long)bo->cap_bound,
-                    (unsigned long long)bo->lit_training);
-        else if (o->offset_cap)
+        if (o->offset_cap)
             fprintf(
                 log,
                 "vdsh-bake: offset cap raised %llu (receiver, order) offsets; the offset turns %llu of "
