@@ -323,6 +323,17 @@ same_file_case("eval --per-vertex a.vdsh", [ev, sv, "-q", "--per-vertex", sv], s
 same_file_case("info --json a.vdsh", [info, "--json", sv, sv], sv)
 same_file_case("frames views -o a.vdsh", [frames, "views", sv, "-q", "-o", sv], sv)
 same_file_case("view --render a.vdsh", [view, "--render", sv, sv], sv)
+# the sources a .vdsh records are inputs of the programs that read them
+# (vdsh-eval, vdsh-frames views), found as recorded without being named
+mv = os.path.join(sf, b"m.vdsh")
+rc, _, err = run(bake, mesh, "--rays", "16", "--cube-size", "0", "-q", "-o", mv)
+check(rc == 0, "bake m.vdsh: %s" % err)
+same_file_case("eval --per-vertex over the recorded source", [ev, mv, "-q", "--points", "16",
+               "--interior", "16", "--per-vertex", mesh], mesh)
+same_file_case("eval --json over the recorded source", [ev, mv, "-q", "--points", "16",
+               "--interior", "16", "--json", os.path.join(sf, b"hard.obj")], mesh)
+same_file_case("frames views -o the recorded source", [frames, "views", mv, "-q", "-o", mesh],
+               mesh)
 check(not [n for n in os.listdir(sf) if b".tmp" in n], "same-file refusals left temporaries")
 
 # ---- early: a bad output folder, found before the meshes load ------------

@@ -1062,6 +1062,11 @@ static int evaluate(const options *o, const vdsh_file *f, const scored *sc)
     spath = find_sources(o, f);
     if (!spath)
         goto out;
+    { /* the sources found from the file's record are inputs too */
+        const char *outs[] = {o->json, o->per_vertex};
+        if (vt_cli_check_outputs(outs, 2, (const char *const *)spath, (int)f->source_count) != 0)
+            goto out;
+    }
     warnings warned = {.path = o->path};
     vb_eval_scene_desc sd = {.fast = o->fast_truth,
                              .allow_mismatch = o->allow_mismatch,
