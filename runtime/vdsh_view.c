@@ -8,6 +8,7 @@
  *
  * Exit status: 0 success, 1 error (a file, GL), 2 usage error.
  */
+#include "vdsh_camera.h"
 #include "vdsh_view.h"
 #include "vt_cli.h"
 
@@ -281,6 +282,16 @@ static int parse_args(int argc, char **argv, vv_options *o)
         case O_CAMERA:
             if (vt_parse_floats(v, o->camera, 6, 6) != 6)
                 return usage_error("--camera: expected EX,EY,EZ,TX,TY,TZ, got '%s'", v);
+            {
+                vdsh_camera cam = {{o->camera[0], o->camera[1], o->camera[2]},
+                                   {o->camera[3], o->camera[4], o->camera[5]},
+                                   {0.0f, 0.0f, 0.0f},
+                                   0.0f};
+                if (vdsh_camera_degenerate(&cam))
+                    return usage_error("--camera: the eye is at the target or straight above or "
+                                       "below it (up is +y: move it aside a little), got '%s'",
+                                       v);
+            }
             o->have_camera = 1;
             break;
         case O_FIT: o->fit = 1; break;

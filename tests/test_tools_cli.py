@@ -169,7 +169,9 @@ for opt in ("--frames", "--lights", "--shadow-size"):
 for opt in ("--fov", "--ambient"):
     cases += [(view, opt, v, ["--render", os.path.join(W, b"x.png"), seeded]) for v in BAD_REAL]
 for opt, vals in (("--size", ["640", "640x", "0x480", "0x10x0x10", "640x480x1", " 64x48", "1e2x10"]),
-                  ("--camera", ["1,2,3,4,5", "1,2,3,4,5,6,7", "1,2,3,4,5,nan", "1,2,3,4,5,0x1"]),
+                  ("--camera", ["1,2,3,4,5", "1,2,3,4,5,6,7", "1,2,3,4,5,nan", "1,2,3,4,5,0x1",
+                               # no image plane: eye at the target, or straight above it
+                               "1,2,3,1,2,3", "0,5,0,0,0,0", "2,-4,1,2,3,1"]),
                   ("--light", ["1,2", "1,2,3,4", "1,2,inf", "1,,2"]),
                   ("--attenuation", ["1,0", "1,0,-1", "0,0,0", "1,0,1e99"])):
     cases += [(view, opt, v, ["--render", os.path.join(W, b"x.png"), seeded]) for v in vals]
@@ -429,6 +431,19 @@ strict_file("vdsh-frames views", views)
 truth = os.path.join(jd, b"truth")
 rc, _, err = run(frames, "truth", sv, "-q", "--views", views, "-o", truth)
 check(rc == 0, "vdsh-frames truth: %s" % err)
+# a view straight down (along its up vector) has no image plane: refused
+down = os.path.join(jd, b"down.json")
+vs = json.loads(open(views, "rb").read())
+vs["views"] = vs["views"][:1]
+vs["views"][0]["target"] = [vs["views"][0]["eye"][0], 0.0, vs["views"][0]["eye"][2]]
+vs["views"][0]["eye"][1] += 1.0
+open(down, "w").write(json.dumps(vs))
+for args in (["truth", sv, "-q", "--views", down, "-o", os.path.join(jd, b"down")],
+             ["score", sv, "-q", "--views", down, "--truth", truth, "--frames", truth,
+              "--modes", "ideal"]):
+    rc, _, err = run(frames, *args)
+    check(rc == 1 and b"down.json" in err and b"along 'up'" in err,
+          "vdsh-frames %s, a view straight down: exit %d (want 1), %r" % (args[0], rc, err[:200]))
 score = os.path.join(jd, b"score.json")
 rc, _, err = run(frames, "score", sv, "-q", "--views", views, "--truth", truth, "--frames", truth,
                  "--modes", "ideal,hard", "--json", score)
