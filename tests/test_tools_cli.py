@@ -383,6 +383,24 @@ check(not os.path.exists(os.path.join(td, b"r.vdsh")) and temporaries(td) == [],
 rc, _, err = run(bake, *quick, "--cubemap-dir", td, "-o", os.path.join(td, b"r.vdsh"))
 check(rc == 0 and all(open(os.path.join(td, n), "rb").read() != b"old" for n in cube_names),
       "the bake without a limit writes them: %r" % err[:200])
+# vdsh-eval's --json and --per-vertex change together, whichever fails:
+# the room (--points 50: JSON ~15 KB, per-vertex ~95 KB) under a 24 KiB
+# limit, where the JSON was once renamed before the per-vertex file
+# failed; a 4-vertex mesh (per-vertex ~0.2 KB) under 4 KiB, the JSON failing.
+for vd, npts, kib, fails in ((sv, "50", 24, b"e.pv"), (mv, "4", 4, b"e.json")):
+    pj, pp = os.path.join(td, b"e.json"), os.path.join(td, b"e.pv")
+    open(pj, "w").write("old")
+    open(pp, "w").write("old")
+    eargs = [ev, vd, "-q", "--points", npts, "--interior", "0", "--json", pj, "--per-vertex", pp]
+    rc, _, err = run(*eargs, limit_kib=kib)
+    check(rc == 1 and b"File too large" in err and os.path.join(td, fails) in err,
+          "eval under a %d KiB limit: exit %d %r" % (kib, rc, err[:300]))
+    check(open(pp, "rb").read() == b"old" and open(pj, "rb").read() == b"old" and
+          temporaries(td) == [], "a failed eval (%s) replaced an output or left %s" % (
+              fails, os.listdir(td)))
+    rc, _, err = run(*eargs)
+    check(rc == 0 and os.path.getsize(pp) > 3 and strict_json(open(pj, "rb").read()),
+          "eval without a limit writes both: %r" % err[:200])
 
 # ---- orders: vdsh-export takes 1..16 -------------------------------------
 o16 = os.path.join(W, b"o16.vdsh")

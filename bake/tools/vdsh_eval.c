@@ -462,8 +462,11 @@ static void put_u32(unsigned char *p, uint32_t v)
     p[2] = (unsigned char)(v >> 16), p[3] = (unsigned char)(v >> 24);
 }
 
-static int write_per_vertex(const char *out, const vdsh_file *f, const vb_eval_result *r, char *msg,
-                            size_t cap)
+/* Writes the whole file to a temporary and finishes it (on disk, not yet
+ * renamed): the caller commits it once the JSON is written too, or aborts
+ * it, so that a failed run leaves neither. */
+static int write_per_vertex(const char *out, const vdsh_file *f, const vb_eval_result *r,
+                            vdsh_output *po, char *msg, size_t cap)
 {
     vdsh_output o;
     vdsh_error err;
@@ -492,10 +495,11 @@ static int write_per_vertex(const char *out, const vdsh_file *f, const vb_eval_r
      * vdsh_output_commit reports it and removes the file. */
     vdsh_output_put(&o, r->per_vertex,
                     sizeof(float) * (size_t)f->header.vertex_count * r->per_vertex_fields);
-    if (vdsh_output_commit(&o, &err) != VDSH_OK) {
+    if (vdsh_output_finish(&o, &err) != VDSH_OK) {
         snprintf(msg, cap, "%s", err.msg);
         return -1;
     }
+    *po = o;
     return 0;
 }
 
@@ -1032,12 +1036,21 @@ static int report(const options *o, const context *ctx)
         print_table(stdout, ctx);
     fflush(stdout);
     char msg[PATH_MAX + 256];
-    if (o->json && write_json(o->json, ctx, msg, sizeof msg) != 0) {
+    /* both files complete before either is renamed into place */
+    vdsh_output pv = {.fd = -1};
+    if (o->per_vertex &&
+        write_per_vertex(o->per_vertex, ctx->f, ctx->r, &pv, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-eval: %s\n", msg);
         return 1;
     }
-    if (o->per_vertex && write_per_vertex(o->per_vertex, ctx->f, ctx->r, msg, sizeof msg) != 0) {
+    if (o->json && write_json(o->json, ctx, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-eval: %s\n", msg);
+        vdsh_output_abort(&pv);
+        return 1;
+    }
+    vdsh_error err;
+    if (o->per_vertex && vdsh_output_commit(&pv, &err) != VDSH_OK) {
+        fprintf(stderr, "vdsh-eval: %s\n", err.msg);
         return 1;
     }
     return 0;
