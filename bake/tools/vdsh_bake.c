@@ -1090,7 +1090,10 @@ static void say_written(FILE *log, const options *o, const vb_job *job, const vb
         fprintf(log, "%s%d", s ? "," : " ", o->orders[s]);
     if (bo->variable_cap)
         fprintf(log, "%sadaptive 1..%d", o->order_count ? "," : " ", bo->variable_cap);
-    fprintf(log, ", %s)", vdsh_encoding_name(o->encoding));
+    if (o->shard_count) /* a part keeps f32 coefficients: vdsh-merge encodes them */
+        fprintf(log, ", f32 in a part: %s once merged)", vdsh_encoding_name(o->encoding));
+    else
+        fprintf(log, ", %s)", vdsh_encoding_name(o->encoding));
     if (cube_size > 0)
         fprintf(log, " and 4 basis cubemaps %dx%d in %s", cube_size, cube_size,
                 o->cubemap_dir ? o->cubemap_dir : "the output's directory");
