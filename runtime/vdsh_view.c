@@ -475,6 +475,10 @@ static int parse_args(int argc, char **argv, vv_options *o)
         return usage_error("%s", "--fit and --camera both choose the view: give one");
     /* The images it writes: never a scene file, and writable now. */
     const char *outs[] = {o->render_path, o->grid_path, o->screenshot};
+    const char *opts[] = {"--render", "--grid", "--screenshot"};
+    int rc = vt_cli_no_stdout(outs, opts, 3);
+    if (rc)
+        return rc;
     if (vt_cli_check_outputs(outs, 3, (const char *const *)o->files, o->file_count) != 0)
         return 1;
     return 0;

@@ -338,6 +338,32 @@ same_file_case("frames views -o the recorded source", [frames, "views", mv, "-q"
                mesh)
 check(not [n for n in os.listdir(sf) if b".tmp" in n], "same-file refusals left temporaries")
 
+# ---- stdout: '-' is stdout for JSON only; a file output refuses it --------
+# (each wrote a file named '-' in the working folder, exit 0)
+dd = os.path.join(W, b"dash")
+os.makedirs(dd)
+for prog, args, opt in (
+        (bake, [mesh, "--rays", "16", "-q", "-o", "-"], "-o"),
+        (bake, [mesh, "-q", "--export-obj", "-"], "--export-obj"),
+        (bake, [mesh, "--max-edge", "1", "-q", "--plan", "-"], "--plan"),
+        (merge, [part, "-q", "-o", "-"], "-o"),
+        (ev, [sv, "-q", "--points", "16", "--per-vertex", "-"], "--per-vertex"),
+        (export, [sv, "-q", "-o", "-"], "-o"),
+        (view, [sv, "-q", "--render", "-"], "--render"),
+        (view, [sv, "-q", "--grid", "-"], "--grid"),
+        (frames, ["truth", sv, "-q", "--views", os.path.join(W, b"none.json"), "-o", "-"], "-o")):
+    p = subprocess.run([prog, *args], capture_output=True, cwd=dd)
+    name = os.path.basename(prog)
+    check(p.returncode == 2 and (opt + " -").encode() in p.stderr and not os.listdir(dd),
+          "%s %s -: exit %d (want 2), %r, left %s" % (name, opt, p.returncode, p.stderr[:200],
+                                                     os.listdir(dd)))
+    for n in os.listdir(dd):
+        os.remove(os.path.join(dd, n))
+p = subprocess.run([bake, mesh, "--rays", "16", "--cube-size", "0", "-q", "-o",
+                    os.path.join(dd, b"r.vdsh"), "--report", "-"], capture_output=True, cwd=dd)
+check(p.returncode == 0 and strict_json(p.stdout) and sorted(os.listdir(dd)) == [b"r.vdsh"],
+      "bake --report - (stdout): exit %d, left %s" % (p.returncode, os.listdir(dd)))
+
 # ---- early: a bad output folder, found before the meshes load ------------
 ed = os.path.join(W, b"early")
 os.makedirs(ed)

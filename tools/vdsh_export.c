@@ -1103,7 +1103,10 @@ static int write_glb(exporter *e)
 /* Read, build the glTF step by step, write. */
 static int run(const options *o)
 {
-    const char *ins[2] = {o->in, o->source};
+    const char *ins[2] = {o->in, o->source}, *opt = "-o";
+    int usage = vt_cli_no_stdout(&o->out, &opt, 1);
+    if (usage)
+        return usage;
     if (vt_cli_check_outputs(&o->out, 1, ins, o->source ? 2 : 1) != 0)
         return 1;
     vdsh_file *f = vt_read_whole(o->in);

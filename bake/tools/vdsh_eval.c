@@ -1134,6 +1134,11 @@ static int run(const options *o)
 {
     /* 0. Every output can be written, and none is an input. */
     {
+        const char *opt = "--per-vertex";
+        int rc = vt_cli_no_stdout(&o->per_vertex, &opt, 1);
+        if (rc)
+            return rc;
+
         const char *outs[] = {o->json, o->per_vertex};
         const char *ins[VDSH_MAX_SOURCES + 2] = {o->path, o->bake_report};
         int nin = 2;

@@ -419,6 +419,10 @@ static int run_truth(const options *op)
     const char *sdf_arg = op->sdf;
     const uint32_t compare = op->compare;
     const float sdf_k = op->sdf_k;
+    const char *opt = "-o";
+    int rc = vt_cli_no_stdout(&dir, &opt, 1);
+    if (rc)
+        return rc;
     vt_views V = {0};
     if (read_views(views_path, &V))
         return 1;
