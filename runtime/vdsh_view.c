@@ -467,6 +467,10 @@ static int parse_args(int argc, char **argv, vv_options *o)
     }
     if ((o->render_path != NULL) + (o->grid_path != NULL) + o->bench > 1)
         return usage_error("%s", "choose one of --render, --grid and --bench");
+    if ((o->screenshot || o->keys || o->no_overlay) &&
+        (o->render_path || o->grid_path || o->bench || o->views_path))
+        return usage_error("%s", "--screenshot, --keys and --no-overlay are the window's: not "
+                                 "with --render, --grid, --bench or --views");
     if (o->file_count > 1 && !o->bench && !o->grid_path)
         return usage_error("one scene file at a time (several only with --grid and --bench), "
                            "got '%s'",

@@ -164,6 +164,10 @@ expect2 --bench --bench-cube-sizes 1,2,3,4,5,6,7,8,9 "$room"
 expect2 --bench-counts "$room"
 expect2 --bench-modes none "$room"
 expect2 --bench --bench-modes "" "$room"
+# the window's options where no window opens (they were ignored, exit 0)
+expect2 --render a.png --keys abc "$room"
+expect2 --grid a.png --screenshot b.png "$room"
+expect2 --bench --no-overlay "$room"
 exit $fail
 ]=] sh ${_view} ${_room})
 
