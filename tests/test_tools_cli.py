@@ -359,6 +359,10 @@ for prog, args, opt in (
                                                      os.listdir(dd)))
     for n in os.listdir(dd):
         os.remove(os.path.join(dd, n))
+# vdsh-export writes binary glTF: an output named .gltf (JSON text) is refused
+p = subprocess.run([export, sv, "-q", "-o", "x.gltf"], capture_output=True, cwd=dd)
+check(p.returncode == 2 and b"x.gltf" in p.stderr and b".glb" in p.stderr and not os.listdir(dd),
+      "export -o x.gltf: exit %d (want 2), %r" % (p.returncode, p.stderr[:200]))
 p = subprocess.run([bake, mesh, "--rays", "16", "--cube-size", "0", "-q", "-o",
                     os.path.join(dd, b"r.vdsh"), "--report", "-"], capture_output=True, cwd=dd)
 check(p.returncode == 0 and strict_json(p.stdout) and sorted(os.listdir(dd)) == [b"r.vdsh"],

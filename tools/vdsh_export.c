@@ -677,6 +677,12 @@ static int parse_args(int argc, char **argv, options *o)
         return VT_EXIT_USAGE;
     if (!o->out)
         return vt_usage_error("vdsh-export", "%s", "no output: give -o OUT.glb");
+    size_t n = strlen(o->out);
+    if (n >= 5 && strcasecmp(o->out + n - 5, ".gltf") == 0) /* JSON text, not what it writes */
+        return vt_usage_error("vdsh-export",
+                              "-o %s: the file is binary glTF (a .glb); a .gltf is JSON text "
+                              "that glTF readers would refuse: name it .glb",
+                              o->out);
     return -1;
 }
 
