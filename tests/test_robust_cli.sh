@@ -109,6 +109,13 @@ f no-faces.obj "$tri"
 bad_mesh "$in/no-faces.obj" "empty mesh"
 f degenerate.obj "${tri}f 1 1 2\nf 2 3 3\n"
 bad_mesh "$in/degenerate.obj" "empty mesh"
+# triangles with distinct corners but no area: a line, a point (the line
+# baked an empty scene, exit 0; the point said 'scene diagonal 0' without
+# naming the file)
+f collinear.obj 'v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 3 2 1\n'
+bad_mesh "$in/collinear.obj" "no triangle has any area"
+f point.obj 'v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n'
+bad_mesh "$in/point.obj" "no triangle has any area"
 f utf16.obj '\xff\xfev\x00 \x000\x00'
 bad_mesh "$in/utf16.obj" "UTF-16"
 
