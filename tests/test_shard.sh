@@ -179,6 +179,7 @@ expect_exit 2 "--plan with --receivers" "$bake" builtin:room --receivers "$tmp/p
 expect_exit 2 "--receivers with --max-edge" "$bake" builtin:room --receivers "$tmp/plan.obj" --max-edge 1 -o "$out"
 expect_exit 1 "--receivers of a missing file" "$bake" builtin:room --receivers "$tmp/none.obj" -o "$out"
 says "--receivers of a missing file" "none.obj"
+says "--receivers of a missing file: what failed" "reading the receivers (--receivers)"
 check "no output after refusals" test ! -e "$out"
 
 exit $fail

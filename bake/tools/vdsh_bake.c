@@ -1360,7 +1360,9 @@ static int run(const options *o)
 
     /* 2. Receivers: the scene's vertices, refined if asked. */
     if (vb_job_refine(&job, &jd, &err) != VB_OK) {
-        fprintf(stderr, "vdsh-bake: refining receivers: %s\n", err.msg);
+        fprintf(stderr, "vdsh-bake: %s: %s\n",
+                o->receivers ? "reading the receivers (--receivers)" : "refining receivers",
+                err.msg);
         goto out;
     }
     const vb_mesh *rec = &job.receivers;
