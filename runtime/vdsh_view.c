@@ -304,6 +304,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
             int n = vt_parse_floats(v, f, 3, 6);
             if (n != 3 && n != 6)
                 return usage_error("--light: expected X,Y,Z or X,Y,Z,R,G,B, got '%s'", v);
+            if (n == 6 && !(f[3] >= 0.0f && f[4] >= 0.0f && f[5] >= 0.0f))
+                return usage_error("--light: the colour R,G,B must be >= 0, got '%s'", v);
             if (o->light_count == VV_MAX_LIGHTS)
                 return usage_error("--light: at most 64 lights (%s)", v);
             vr_light *l = &o->lights[o->light_count++];

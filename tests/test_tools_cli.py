@@ -172,7 +172,7 @@ for opt, vals in (("--size", ["640", "640x", "0x480", "0x10x0x10", "640x480x1", 
                   ("--camera", ["1,2,3,4,5", "1,2,3,4,5,6,7", "1,2,3,4,5,nan", "1,2,3,4,5,0x1",
                                # no image plane: eye at the target, or straight above it
                                "1,2,3,1,2,3", "0,5,0,0,0,0", "2,-4,1,2,3,1"]),
-                  ("--light", ["1,2", "1,2,3,4", "1,2,inf", "1,,2"]),
+                  ("--light", ["1,2", "1,2,3,4", "1,2,inf", "1,,2", "1,2,3,-1,0,0"]),
                   ("--attenuation", ["1,0", "1,0,-1", "0,0,0", "1,0,1e99"])):
     cases += [(view, opt, v, ["--render", os.path.join(W, b"x.png"), seeded]) for v in vals]
 for prog, opt, value, rest in cases:
