@@ -13,6 +13,22 @@ void vdsh_camera_basis(const vdsh_camera *c, float s[3], float u[3], float f[3])
     vdsh_look_at(c->eye, c->target, up, s, u, f);
 }
 
+int vdsh_camera_degenerate(const vdsh_camera *c)
+{
+    double f[3], u[3] = {c->up[0], c->up[1], c->up[2]};
+    if (!u[0] && !u[1] && !u[2])
+        u[1] = 1.0;
+    for (int i = 0; i < 3; i++)
+        f[i] = (double)c->target[i] - (double)c->eye[i];
+    const double x[3] = {f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2],
+                         f[0] * u[1] - f[1] * u[0]};
+    const double ff = f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
+    const double uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+    const double xx = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+    /* sin of the angle between f and up below 1e-6, or no f at all */
+    return !(ff > 0.0) || !(xx > 1e-12 * ff * uu);
+}
+
 float vdsh_camera_fov(const vdsh_camera *c)
 {
     return c->fov_y > 0.0f ? c->fov_y : 60.0f;

@@ -18,7 +18,8 @@
  *
  * Does not: know about scenes (the runtime's default camera lives in
  * runtime/), trace rays or touch GL.
- * Errors: none (degenerate input gives a finite but meaningless basis).
+ * Errors: none (degenerate input gives a finite but meaningless basis:
+ * vdsh_camera_degenerate tells, for the programs that take a camera).
  * Threading: pure functions.
  */
 #ifndef VDSH_CAMERA_H
@@ -37,6 +38,11 @@ typedef struct vdsh_camera {
 
 /* The basis (s, u, f): right, up and forward unit vectors. */
 void vdsh_camera_basis(const vdsh_camera *c, float s[3], float u[3], float f[3]);
+
+/* 1 when the camera has no basis: eye and target are the same point, or
+ * it looks along its up vector (straight down or up with the default +y),
+ * where f x up vanishes and the frame is meaningless (black); else 0. */
+int vdsh_camera_degenerate(const vdsh_camera *c);
 
 /* The field of view with its default applied, in degrees. */
 float vdsh_camera_fov(const vdsh_camera *c);

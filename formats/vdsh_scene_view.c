@@ -365,6 +365,25 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
             g->lo[k] = fminf(g->lo[k], x);
             g->hi[k] = fmaxf(g->hi[k], x);
         }
+    for (int k = 0; k < 3; k++)
+        if (g->lo[k] < -VDSH_VIEW_MAX_COORD || g->hi[k] > VDSH_VIEW_MAX_COORD) {
+            float far = fmaxf(-g->lo[k], g->hi[k]);
+            vdsh_view_tracer_destroy(g);
+            return vdsh_failf(err, VDSH_ERR_INVALID,
+                              "mesh: a coordinate reaches %g, beyond the %g the view's float "
+                              "arithmetic takes: scale the scene down",
+                              (double)far, (double)VDSH_VIEW_MAX_COORD);
+        }
+    float longest = 0.0f;
+    for (int k = 0; k < 3; k++)
+        longest = fmaxf(longest, g->hi[k] - g->lo[k]);
+    if (m->triangle_count && !(longest >= VDSH_VIEW_MIN_EXTENT)) {
+        vdsh_view_tracer_destroy(g);
+        return vdsh_failf(err, VDSH_ERR_INVALID,
+                          "mesh: the scene is %g across, below the %g the view's float "
+                          "arithmetic takes: scale the scene up",
+                          (double)longest, (double)VDSH_VIEW_MIN_EXTENT);
+    }
     float ext[3], diag = 0.0f;
     for (int k = 0; k < 3; k++) {
         if (!(g->lo[k] <= g->hi[k]))

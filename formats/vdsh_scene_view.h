@@ -40,7 +40,10 @@
  *
  * Errors: vdsh_view_compute and vdsh_view_tracer_create return
  * VDSH_ERR_OUT_OF_MEMORY or VDSH_ERR_INVALID (a triangle index not below
- * vertex_count), message in err, outputs untouched. The rest cannot fail.
+ * vertex_count, a coordinate beyond +-VDSH_VIEW_MAX_COORD or a scene
+ * smaller than VDSH_VIEW_MIN_EXTENT, where the float squares of the view's
+ * distances overflow or underflow), message in err,
+ * outputs untouched. The rest cannot fail.
  * Ownership: the mesh arrays are borrowed; a tracer borrows them for its
  * whole life (keep them until vdsh_view_tracer_destroy, which accepts
  * NULL). vdsh_view holds no pointers.
@@ -162,6 +165,12 @@ typedef struct vdsh_view_hit {
                                     winding normal (v1 - v0) x (v2 - v0)
                                     points along the ray */
 } vdsh_view_hit;
+
+/* The largest |coordinate| the view's float arithmetic takes (extents
+ * and their squares stay finite below it), and the least extent along the
+ * scene's longest axis (squares of its distances stay normal floats). */
+#define VDSH_VIEW_MAX_COORD 1e18f
+#define VDSH_VIEW_MIN_EXTENT 1e-15f
 
 /* A uniform grid of the mesh's triangles (about two cells per triangle). */
 vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **out,

@@ -8,6 +8,7 @@
  *
  * Exit status: 0 success, 1 error (a file, GL), 2 usage error.
  */
+#include "vdsh_camera.h"
 #include "vdsh_view.h"
 #include "vt_cli.h"
 
@@ -281,6 +282,16 @@ static int parse_args(int argc, char **argv, vv_options *o)
         case O_CAMERA:
             if (vt_parse_floats(v, o->camera, 6, 6) != 6)
                 return usage_error("--camera: expected EX,EY,EZ,TX,TY,TZ, got '%s'", v);
+            {
+                vdsh_camera cam = {{o->camera[0], o->camera[1], o->camera[2]},
+                                   {o->camera[3], o->camera[4], o->camera[5]},
+                                   {0.0f, 0.0f, 0.0f},
+                                   0.0f};
+                if (vdsh_camera_degenerate(&cam))
+                    return usage_error("--camera: the eye is at the target or straight above or "
+                                       "below it (up is +y: move it aside a little), got '%s'",
+                                       v);
+            }
             o->have_camera = 1;
             break;
         case O_FIT: o->fit = 1; break;
@@ -293,6 +304,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
             int n = vt_parse_floats(v, f, 3, 6);
             if (n != 3 && n != 6)
                 return usage_error("--light: expected X,Y,Z or X,Y,Z,R,G,B, got '%s'", v);
+            if (n == 6 && !(f[3] >= 0.0f && f[4] >= 0.0f && f[5] >= 0.0f))
+                return usage_error("--light: the colour R,G,B must be >= 0, got '%s'", v);
             if (o->light_count == VV_MAX_LIGHTS)
                 return usage_error("--light: at most 64 lights (%s)", v);
             vr_light *l = &o->lights[o->light_count++];
@@ -456,6 +469,10 @@ static int parse_args(int argc, char **argv, vv_options *o)
     }
     if ((o->render_path != NULL) + (o->grid_path != NULL) + o->bench > 1)
         return usage_error("%s", "choose one of --render, --grid and --bench");
+    if ((o->screenshot || o->keys || o->no_overlay) &&
+        (o->render_path || o->grid_path || o->bench || o->views_path))
+        return usage_error("%s", "--screenshot, --keys and --no-overlay are the window's: not "
+                                 "with --render, --grid, --bench or --views");
     if (o->file_count > 1 && !o->bench && !o->grid_path)
         return usage_error("one scene file at a time (several only with --grid and --bench), "
                            "got '%s'",
@@ -464,6 +481,10 @@ static int parse_args(int argc, char **argv, vv_options *o)
         return usage_error("%s", "--fit and --camera both choose the view: give one");
     /* The images it writes: never a scene file, and writable now. */
     const char *outs[] = {o->render_path, o->grid_path, o->screenshot};
+    const char *opts[] = {"--render", "--grid", "--screenshot"};
+    int rc = vt_cli_no_stdout(outs, opts, 3);
+    if (rc)
+        return rc;
     if (vt_cli_check_outputs(outs, 3, (const char *const *)o->files, o->file_count) != 0)
         return 1;
     return 0;

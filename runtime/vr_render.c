@@ -507,7 +507,12 @@ static void camera_matrix(const vr_renderer *r, const vr_scene *s, const vr_came
         }
         far2 = fmaxf(far2, d2);
     }
-    float far = 1.05f * sqrtf(far2) + 1e-6f;
+    /* the margin 1e-6 (scene units), or a thousandth of the distance in a
+     * scene too small for it (1e-11 units across: every surface nearer
+     * than far / 4000 was clipped, a black frame) */
+    float far = 1.05f * sqrtf(far2) + fminf(1e-6f, 1e-3f * sqrtf(far2));
+    if (!(far > 0.0f))
+        far = 1e-6f;
     float aspect = (float)r->width / (float)r->height;
     /* The view and the perspective are formats/vdsh_camera.h's: the same
      * camera a ray-traced frame of this view uses (vdsh-frames). */

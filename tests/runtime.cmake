@@ -164,6 +164,10 @@ expect2 --bench --bench-cube-sizes 1,2,3,4,5,6,7,8,9 "$room"
 expect2 --bench-counts "$room"
 expect2 --bench-modes none "$room"
 expect2 --bench --bench-modes "" "$room"
+# the window's options where no window opens (they were ignored, exit 0)
+expect2 --render a.png --keys abc "$room"
+expect2 --grid a.png --screenshot b.png "$room"
+expect2 --bench --no-overlay "$room"
 exit $fail
 ]=] sh ${_view} ${_room})
 
@@ -197,6 +201,38 @@ expect1 "order per vertex" --render "$d/x.png" --mode adaptive "$room"
 "$v" -q --render "$d/buf3.png" --size 64x48 --mode buf3 "$4" || { echo "buf3 failed"; fail=1; }
 exit $fail
 ]=] sh ${_view} ${_room} ${_rt_dir}/view_errors ${_room_log})
+
+# Scale: a scene 1e-11 units across draws the same bytes as at unit size
+# (it drew black: every surface was nearer than the near plane); one too
+# small or too large for the view's float arithmetic (1e-16, 1e20 across)
+# is refused, exit 1, naming the file and what to do (1e20 crashed).
+if(TARGET vdsh-bake)
+  add_test(NAME runtime_view_scale COMMAND sh -c [=[
+v=$1; bake=$2; d=$3; fail=0
+rm -rf "$d"; mkdir -p "$d"
+for s in 1 1e-11 1e-16 1e20; do
+  awk -v s=$s 'BEGIN {
+    split("0 0 0 4 0 0 4 0 4 0 0 4 1 1 1 3 1 1 3 1 3 1 1 3", c, " ")
+    for (i = 0; i < 8; i++) printf "v %.9g %.9g %.9g\n", c[3*i+1]*s, c[3*i+2]*s, c[3*i+3]*s
+    print "f 1 3 2"; print "f 1 4 3"; print "f 5 6 7"; print "f 5 7 8"; print "f 5 7 6"; print "f 5 8 7"
+  }' > "$d/s$s.obj"
+  "$bake" "$d/s$s.obj" --rays 16 --cube-size 0 -q -o "$d/s$s.vdsh" || { echo "bake at scale $s failed"; fail=1; }
+done
+"$v" -q --render "$d/s1.png" --size 64x48 --mode none "$d/s1.vdsh" || fail=1
+"$v" -q --render "$d/s1e-11.png" --size 64x48 --mode none "$d/s1e-11.vdsh" || fail=1
+cmp "$d/s1.png" "$d/s1e-11.png" || { echo "a scene 1e-11 across draws differently"; fail=1; }
+for c in "1e-16 scale the scene up" "1e20 scale the scene down"; do
+  s=${c%% *}; want=${c#* }
+  out=$("$v" -q --render "$d/x.png" --size 64x48 "$d/s$s.vdsh" 2>&1); rc=$?
+  echo "$out"
+  [ $rc -eq 1 ] || { echo "scale $s: exit $rc, not 1"; fail=1; }
+  case $out in *"s$s.vdsh"*"$want"*) ;; *) echo "scale $s: message does not say '$want'"; fail=1 ;; esac
+done
+[ ! -e "$d/x.png" ] || { echo "a refused scene left an image"; fail=1; }
+exit $fail
+]=] sh ${_view} $<TARGET_FILE:vdsh-bake> ${_rt_dir}/view_scale)
+  _runtime_props(runtime_view_scale)
+endif()
 
 # Headless images: one render per mode and the comparison row.
 add_test(NAME runtime_view_render COMMAND sh -c [=[

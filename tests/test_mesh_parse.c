@@ -112,6 +112,15 @@ static void test_obj_normals(void)
     const char *vline = "v 0 0 0\nv 1 0 0\n \vv 0 1 0\nf 1 2 3\n";
     expect_refused("vl.obj", VB_MESH_OBJ, vline, strlen(vline),
                    "line 3: a vertex line starting with a vertical tab");
+    /* A UTF-8 byte order mark before the first line is not part of it:
+     * the first vertex is read, not skipped with every index shifted
+     * (this file was the triangle of vertices 2, 3, 4). */
+    const char *bom = "\xef\xbb\xbfv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n";
+    CHECK(parse_text("bom.obj", VB_MESH_OBJ, bom, &raw, &err) == VB_OK && raw.vertex_count == 4 &&
+              raw.triangle_count == 1 && raw.indices[0] == 0 && raw.positions[0] == 0.0f &&
+              raw.positions[3] == 1.0f,
+          "bom.obj: %u vertices, %u triangles, %s", raw.vertex_count, raw.triangle_count, err.msg);
+    vb_mesh_raw_free(&raw);
     /* Text after '#' on a face line that names another vertex. */
     const char *hash = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3 # 4\n";
     expect_refused("h.obj", VB_MESH_OBJ, hash, strlen(hash),

@@ -268,6 +268,26 @@ r = subprocess.run([sys.executable, "-m", "vdsh", "info", "--bogus", missing],
                    capture_output=True, text=True, env=env)
 if r.returncode != 2 or "--help" not in r.stderr:
     fail.append("info --bogus: exit %d, %r" % (r.returncode, r.stderr))
+# --json over an input (or a hard link to it) is refused, the input kept
+if checked and os.path.exists(checked[0]):
+    src = checked[0]
+    link = os.path.join(work, "info-link.vdsh")
+    if os.path.lexists(link):
+        os.unlink(link)
+    os.link(src, link)
+    before = open(src, "rb").read()
+    for target in (src, link):
+        r = subprocess.run([sys.executable, "-m", "vdsh", "info", "--json", target, src],
+                           capture_output=True, text=True, env=env)
+        if r.returncode != 1 or "same file" not in r.stderr or open(src, "rb").read() != before:
+            fail.append("info --json over its input: exit %d, %r, the input %s" % (
+                r.returncode, r.stderr, "kept" if open(src, "rb").read() == before else "CHANGED"))
+            open(src, "wb").write(before)
+    os.unlink(link)
+    r = subprocess.run([sys.executable, "-m", "vdsh", "info", "--json", work, src],
+                       capture_output=True, text=True, env=env)
+    if r.returncode != 1 or "is a directory" not in r.stderr:
+        fail.append("info --json FOLDER: exit %d, %r" % (r.returncode, r.stderr))
 r = subprocess.run([sys.executable, "-m", "vdsh", "--help"], capture_output=True, text=True,
                    env=env)
 if r.returncode or not r.stdout.startswith("usage: "):

@@ -109,6 +109,13 @@ f no-faces.obj "$tri"
 bad_mesh "$in/no-faces.obj" "empty mesh"
 f degenerate.obj "${tri}f 1 1 2\nf 2 3 3\n"
 bad_mesh "$in/degenerate.obj" "empty mesh"
+# triangles with distinct corners but no area: a line, a point (the line
+# baked an empty scene, exit 0; the point said 'scene diagonal 0' without
+# naming the file)
+f collinear.obj 'v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 3 2 1\n'
+bad_mesh "$in/collinear.obj" "no triangle has any area"
+f point.obj 'v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n'
+bad_mesh "$in/point.obj" "no triangle has any area"
 f utf16.obj '\xff\xfev\x00 \x000\x00'
 bad_mesh "$in/utf16.obj" "UTF-16"
 
@@ -142,6 +149,8 @@ f face-flags-first.ply 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float 
 bad_mesh "$in/face-flags-first.ply" "before vertex_indices is not supported"
 f two-face-elements.ply 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nelement face 9\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n'
 bad_mesh "$in/two-face-elements.ply" "second face element"
+f bom.ply "\xef\xbb\xbf$(printf "$ply_head" ascii 3 1)\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
+bad_mesh "$in/bom.ply" "byte order mark"
 f texcoord-list.ply 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nproperty list uchar float texcoord\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 6 0 0 1 0 0 1\n'
 bad_mesh "$in/texcoord-list.ply" "not supported"
 
@@ -168,6 +177,8 @@ f two-vertices.off 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n'
 bad_mesh "$in/two-vertices.off" "needs at least 3"
 f not-off.off 'OOF\n3 1 0\n'
 bad_mesh "$in/not-off.off" "not an OFF file"
+f bom.off '\xef\xbb\xbfOFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n'
+bad_mesh "$in/bom.off" "byte order mark"
 
 # ---- STL --------------------------------------------------------------------
 facet='facet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  vertex 0 1 0\n endloop\nendfacet\n'

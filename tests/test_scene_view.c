@@ -366,6 +366,47 @@ static void test_object(void)
     }
 }
 
+/* A sphere scaled by s: the view of a scene at any scale the view's float
+ * arithmetic takes, a clear error beyond it (a scene 1e19 across crashed
+ * the ray grid; 1e-20 across gave a light with infinite attenuation). */
+static void test_scale(void)
+{
+    const struct {
+        float s;
+        const char *want; /* NULL: computed */
+    } cases[] = {{1e-14f, NULL},
+                 {1e17f, NULL},
+                 {1e-17f, "scale the scene up"},
+                 {1e-30f, "scale the scene up"},
+                 {1e19f, "scale the scene down"},
+                 {1e30f, "scale the scene down"}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        memset(&M, 0, sizeof M);
+        const float c[3] = {3 * cases[i].s, cases[i].s, -2 * cases[i].s};
+        sphere(&M, c, cases[i].s, 8, 12);
+        vdsh_view_mesh m = view_mesh(&M);
+        vdsh_view v;
+        vdsh_error err = {0};
+        vdsh_result r = vdsh_view_compute(&m, &v, &err);
+        if (!cases[i].want) {
+            CHECK(r == VDSH_OK, "a sphere of radius %g: %s", (double)cases[i].s, err.msg);
+            if (r == VDSH_OK) {
+                CHECK(!v.interior && !vdsh_camera_degenerate(&v.camera),
+                      "a sphere of radius %g: interior %d, a degenerate camera", (double)cases[i].s,
+                      v.interior);
+                for (int k = 0; k < v.light_count; k++)
+                    CHECK(isfinite(v.lights[k][0]) && isfinite(v.lights[k][1]) &&
+                              isfinite(v.lights[k][2]),
+                          "a sphere of radius %g: light %d not finite", (double)cases[i].s, k);
+            }
+        } else {
+            CHECK(r == VDSH_ERR_INVALID && strstr(err.msg, cases[i].want),
+                  "a sphere of radius %g: result %d, '%s' (want '%s')", (double)cases[i].s, (int)r,
+                  err.msg, cases[i].want);
+        }
+    }
+}
+
 static void test_none(void)
 {
     /* A solid cube (faces outward by winding) whose normals say "room":
@@ -641,6 +682,7 @@ int main(int argc, char **argv)
     test_space();
     test_room();
     test_object();
+    test_scale();
     test_none();
     test_two_rooms();
     test_blocked_eye();

@@ -19,6 +19,12 @@ make_tmp
 tiny=(builtin:room --max-edge 1.5 --rays 32 --cube-size 8 -q)
 expect_exit 0 "whole bake" "$bake" "${tiny[@]}" -o "$tmp/whole.vdsh"
 expect_exit 0 "whole bake f32" "$bake" "${tiny[@]}" --encoding f32 -o "$tmp/whole32.vdsh"
+# a part's summary says its coefficients are f32 (152 bytes per vertex at
+# orders 2,3,5) and what the merge makes of them (it said s8s6 beside 152)
+loud=("${tiny[@]:0:${#tiny[@]}-1}")
+expect_exit 0 "shard 0/2, not quiet" "$bake" "${loud[@]}" --shard 0/2 -o "$tmp/loud-part.vdsh"
+says "a part's summary" "152.0 bytes of coefficients per vertex for orders 2,3,5, f32 in a part: s8s6 once merged)"
+rm -f "$tmp/loud-part.vdsh"
 
 for n in 1 2 7 64; do
   d=$tmp/n$n; mkdir -p "$d"
@@ -173,6 +179,7 @@ expect_exit 2 "--plan with --receivers" "$bake" builtin:room --receivers "$tmp/p
 expect_exit 2 "--receivers with --max-edge" "$bake" builtin:room --receivers "$tmp/plan.obj" --max-edge 1 -o "$out"
 expect_exit 1 "--receivers of a missing file" "$bake" builtin:room --receivers "$tmp/none.obj" -o "$out"
 says "--receivers of a missing file" "none.obj"
+says "--receivers of a missing file: what failed" "reading the receivers (--receivers)"
 check "no output after refusals" test ! -e "$out"
 
 exit $fail

@@ -169,8 +169,10 @@ for opt in ("--frames", "--lights", "--shadow-size"):
 for opt in ("--fov", "--ambient"):
     cases += [(view, opt, v, ["--render", os.path.join(W, b"x.png"), seeded]) for v in BAD_REAL]
 for opt, vals in (("--size", ["640", "640x", "0x480", "0x10x0x10", "640x480x1", " 64x48", "1e2x10"]),
-                  ("--camera", ["1,2,3,4,5", "1,2,3,4,5,6,7", "1,2,3,4,5,nan", "1,2,3,4,5,0x1"]),
-                  ("--light", ["1,2", "1,2,3,4", "1,2,inf", "1,,2"]),
+                  ("--camera", ["1,2,3,4,5", "1,2,3,4,5,6,7", "1,2,3,4,5,nan", "1,2,3,4,5,0x1",
+                               # no image plane: eye at the target, or straight above it
+                               "1,2,3,1,2,3", "0,5,0,0,0,0", "2,-4,1,2,3,1"]),
+                  ("--light", ["1,2", "1,2,3,4", "1,2,inf", "1,,2", "1,2,3,-1,0,0"]),
                   ("--attenuation", ["1,0", "1,0,-1", "0,0,0", "1,0,1e99"])):
     cases += [(view, opt, v, ["--render", os.path.join(W, b"x.png"), seeded]) for v in vals]
 for prog, opt, value, rest in cases:
@@ -323,7 +325,48 @@ same_file_case("eval --per-vertex a.vdsh", [ev, sv, "-q", "--per-vertex", sv], s
 same_file_case("info --json a.vdsh", [info, "--json", sv, sv], sv)
 same_file_case("frames views -o a.vdsh", [frames, "views", sv, "-q", "-o", sv], sv)
 same_file_case("view --render a.vdsh", [view, "--render", sv, sv], sv)
+# the sources a .vdsh records are inputs of the programs that read them
+# (vdsh-eval, vdsh-frames views), found as recorded without being named
+mv = os.path.join(sf, b"m.vdsh")
+rc, _, err = run(bake, mesh, "--rays", "16", "--cube-size", "0", "-q", "-o", mv)
+check(rc == 0, "bake m.vdsh: %s" % err)
+same_file_case("eval --per-vertex over the recorded source", [ev, mv, "-q", "--points", "16",
+               "--interior", "16", "--per-vertex", mesh], mesh)
+same_file_case("eval --json over the recorded source", [ev, mv, "-q", "--points", "16",
+               "--interior", "16", "--json", os.path.join(sf, b"hard.obj")], mesh)
+same_file_case("frames views -o the recorded source", [frames, "views", mv, "-q", "-o", mesh],
+               mesh)
 check(not [n for n in os.listdir(sf) if b".tmp" in n], "same-file refusals left temporaries")
+
+# ---- stdout: '-' is stdout for JSON only; a file output refuses it --------
+# (each wrote a file named '-' in the working folder, exit 0)
+dd = os.path.join(W, b"dash")
+os.makedirs(dd)
+for prog, args, opt in (
+        (bake, [mesh, "--rays", "16", "-q", "-o", "-"], "-o"),
+        (bake, [mesh, "-q", "--export-obj", "-"], "--export-obj"),
+        (bake, [mesh, "--max-edge", "1", "-q", "--plan", "-"], "--plan"),
+        (merge, [part, "-q", "-o", "-"], "-o"),
+        (ev, [sv, "-q", "--points", "16", "--per-vertex", "-"], "--per-vertex"),
+        (export, [sv, "-q", "-o", "-"], "-o"),
+        (view, [sv, "-q", "--render", "-"], "--render"),
+        (view, [sv, "-q", "--grid", "-"], "--grid"),
+        (frames, ["truth", sv, "-q", "--views", os.path.join(W, b"none.json"), "-o", "-"], "-o")):
+    p = subprocess.run([prog, *args], capture_output=True, cwd=dd)
+    name = os.path.basename(prog)
+    check(p.returncode == 2 and (opt + " -").encode() in p.stderr and not os.listdir(dd),
+          "%s %s -: exit %d (want 2), %r, left %s" % (name, opt, p.returncode, p.stderr[:200],
+                                                     os.listdir(dd)))
+    for n in os.listdir(dd):
+        os.remove(os.path.join(dd, n))
+# vdsh-export writes binary glTF: an output named .gltf (JSON text) is refused
+p = subprocess.run([export, sv, "-q", "-o", "x.gltf"], capture_output=True, cwd=dd)
+check(p.returncode == 2 and b"x.gltf" in p.stderr and b".glb" in p.stderr and not os.listdir(dd),
+      "export -o x.gltf: exit %d (want 2), %r" % (p.returncode, p.stderr[:200]))
+p = subprocess.run([bake, mesh, "--rays", "16", "--cube-size", "0", "-q", "-o",
+                    os.path.join(dd, b"r.vdsh"), "--report", "-"], capture_output=True, cwd=dd)
+check(p.returncode == 0 and strict_json(p.stdout) and sorted(os.listdir(dd)) == [b"r.vdsh"],
+      "bake --report - (stdout): exit %d, left %s" % (p.returncode, os.listdir(dd)))
 
 # ---- early: a bad output folder, found before the meshes load ------------
 ed = os.path.join(W, b"early")
@@ -370,6 +413,24 @@ check(not os.path.exists(os.path.join(td, b"r.vdsh")) and temporaries(td) == [],
 rc, _, err = run(bake, *quick, "--cubemap-dir", td, "-o", os.path.join(td, b"r.vdsh"))
 check(rc == 0 and all(open(os.path.join(td, n), "rb").read() != b"old" for n in cube_names),
       "the bake without a limit writes them: %r" % err[:200])
+# vdsh-eval's --json and --per-vertex change together, whichever fails:
+# the room (--points 50: JSON ~15 KB, per-vertex ~95 KB) under a 24 KiB
+# limit, where the JSON was once renamed before the per-vertex file
+# failed; a 4-vertex mesh (per-vertex ~0.2 KB) under 4 KiB, the JSON failing.
+for vd, npts, kib, fails in ((sv, "50", 24, b"e.pv"), (mv, "4", 4, b"e.json")):
+    pj, pp = os.path.join(td, b"e.json"), os.path.join(td, b"e.pv")
+    open(pj, "w").write("old")
+    open(pp, "w").write("old")
+    eargs = [ev, vd, "-q", "--points", npts, "--interior", "0", "--json", pj, "--per-vertex", pp]
+    rc, _, err = run(*eargs, limit_kib=kib)
+    check(rc == 1 and b"File too large" in err and os.path.join(td, fails) in err,
+          "eval under a %d KiB limit: exit %d %r" % (kib, rc, err[:300]))
+    check(open(pp, "rb").read() == b"old" and open(pj, "rb").read() == b"old" and
+          temporaries(td) == [], "a failed eval (%s) replaced an output or left %s" % (
+              fails, os.listdir(td)))
+    rc, _, err = run(*eargs)
+    check(rc == 0 and os.path.getsize(pp) > 3 and strict_json(open(pj, "rb").read()),
+          "eval without a limit writes both: %r" % err[:200])
 
 # ---- orders: vdsh-export takes 1..16 -------------------------------------
 o16 = os.path.join(W, b"o16.vdsh")
@@ -418,6 +479,19 @@ strict_file("vdsh-frames views", views)
 truth = os.path.join(jd, b"truth")
 rc, _, err = run(frames, "truth", sv, "-q", "--views", views, "-o", truth)
 check(rc == 0, "vdsh-frames truth: %s" % err)
+# a view straight down (along its up vector) has no image plane: refused
+down = os.path.join(jd, b"down.json")
+vs = json.loads(open(views, "rb").read())
+vs["views"] = vs["views"][:1]
+vs["views"][0]["target"] = [vs["views"][0]["eye"][0], 0.0, vs["views"][0]["eye"][2]]
+vs["views"][0]["eye"][1] += 1.0
+open(down, "w").write(json.dumps(vs))
+for args in (["truth", sv, "-q", "--views", down, "-o", os.path.join(jd, b"down")],
+             ["score", sv, "-q", "--views", down, "--truth", truth, "--frames", truth,
+              "--modes", "ideal"]):
+    rc, _, err = run(frames, *args)
+    check(rc == 1 and b"down.json" in err and b"along 'up'" in err,
+          "vdsh-frames %s, a view straight down: exit %d (want 1), %r" % (args[0], rc, err[:200]))
 score = os.path.join(jd, b"score.json")
 rc, _, err = run(frames, "score", sv, "-q", "--views", views, "--truth", truth, "--frames", truth,
                  "--modes", "ideal,hard", "--json", score)

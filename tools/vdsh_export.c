@@ -677,6 +677,12 @@ static int parse_args(int argc, char **argv, options *o)
         return VT_EXIT_USAGE;
     if (!o->out)
         return vt_usage_error("vdsh-export", "%s", "no output: give -o OUT.glb");
+    size_t n = strlen(o->out);
+    if (n >= 5 && strcasecmp(o->out + n - 5, ".gltf") == 0) /* JSON text, not what it writes */
+        return vt_usage_error("vdsh-export",
+                              "-o %s: the file is binary glTF (a .glb); a .gltf is JSON text "
+                              "that glTF readers would refuse: name it .glb",
+                              o->out);
     return -1;
 }
 
@@ -1103,7 +1109,10 @@ static int write_glb(exporter *e)
 /* Read, build the glTF step by step, write. */
 static int run(const options *o)
 {
-    const char *ins[2] = {o->in, o->source};
+    const char *ins[2] = {o->in, o->source}, *opt = "-o";
+    int usage = vt_cli_no_stdout(&o->out, &opt, 1);
+    if (usage)
+        return usage;
     if (vt_cli_check_outputs(&o->out, 1, ins, o->source ? 2 : 1) != 0)
         return 1;
     vdsh_file *f = vt_read_whole(o->in);

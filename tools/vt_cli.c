@@ -261,6 +261,19 @@ static int check_writable(const char *path)
     return 0;
 }
 
+int vt_cli_no_stdout(const char *const *outputs, const char *const *opts, int output_count)
+{
+    for (int i = 0; i < output_count; i++)
+        if (outputs[i] && strcmp(outputs[i], "-") == 0) {
+            fprintf(stderr,
+                    "%s: %s -: this output is not written to standard output: give a file "
+                    "name (or /dev/stdout, for a pipe)\n",
+                    cli_prog, opts[i]);
+            return vt_cli_try_help();
+        }
+    return 0;
+}
+
 int vt_cli_check_outputs(const char *const *outputs, int output_count, const char *const *inputs,
                          int input_count)
 {

@@ -100,6 +100,13 @@ int vt_cli_try_help(void);
 int vt_cli_check_outputs(const char *const *outputs, int output_count, const char *const *inputs,
                          int input_count);
 
+/* Outputs that are files or folders, never standard output: "-" (which
+ * the JSON outputs take for stdout) is refused before any work, naming
+ * the option, rather than written as a file named "-": "PROG: OPT -: ...".
+ * opts[i] names outputs[i] (NULL entries are skipped). Returns 0, or
+ * VT_EXIT_USAGE after the message. */
+int vt_cli_no_stdout(const char *const *outputs, const char *const *opts, int output_count);
+
 /* 1 when a and b name one existing regular file (device and inode). */
 int vt_cli_same_file(const char *a, const char *b);
 

@@ -78,6 +78,10 @@ int vt_views_read(const char *path, vt_views *out, char *msg, size_t cap)
                  x->name);
         if (!memcmp(x->camera.eye, x->camera.target, sizeof x->camera.eye))
             FAIL("%s: view '%s': eye and target are the same point", path, x->name);
+        if (vdsh_camera_degenerate(&x->camera))
+            FAIL("%s: view '%s': the eye looks along 'up' (straight above or below the "
+                 "target with up +y): no image plane",
+                 path, x->name);
         const cJSON *fov = cJSON_GetObjectItemCaseSensitive(o, "fov_y");
         if (fov && (!cJSON_IsNumber(fov) || !(fov->valuedouble > 0 && fov->valuedouble < 180)))
             FAIL("%s: view '%s': fov_y must be in (0, 180) degrees", path, x->name);

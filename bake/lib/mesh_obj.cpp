@@ -126,6 +126,10 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
         ((bytes[0] == 0xfe && bytes[1] == 0xff) || (bytes[0] == 0xff && bytes[1] == 0xfe)))
         return vb_fail(err, VB_ERR_FORMAT,
                        "%s: UTF-16 text is not supported (save as UTF-8 or ASCII)", path);
+    /* A UTF-8 byte order mark is not part of the first line: read as its
+     * keyword, it hid a first "v" line and shifted every index after it. */
+    if (size >= 3 && bytes[0] == 0xef && bytes[1] == 0xbb && bytes[2] == 0xbf)
+        bytes += 3, size -= 3;
 
     /* Positive indices may point forward, so count the "v" lines before
      * checking faces. */

@@ -260,6 +260,11 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
 {
     cursor c(bytes, size);
     token t;
+    if (size >= 3 && bytes[0] == 0xef && bytes[1] == 0xbb && bytes[2] == 0xbf)
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: starts with a UTF-8 byte order mark: save it without one (the "
+                       "first line must be 'ply')",
+                       path);
     if (!c.next_on_line(&t) || !(t.is("ply") || t.is("PLY")) || c.next_on_line(&t))
         return vb_fail(err, VB_ERR_FORMAT, "%s: not a PLY file (first line must be 'ply')", path);
     c.skip_line();

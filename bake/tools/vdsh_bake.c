@@ -638,6 +638,13 @@ static int check_outputs(const options *o, const vb_job_desc *jd, const char *co
     const char *outs[4 + VB_CUBEMAP_BASIS_FILES] = {jd->output, o->report, o->plan, o->export_obj};
     int n = 4;
     vb_error err;
+    {
+        const char *files[] = {jd->output, o->plan, o->export_obj};
+        const char *opts[] = {"-o", "--plan", "--export-obj"};
+        int rc = vt_cli_no_stdout(files, opts, 3);
+        if (rc)
+            return rc;
+    }
     if (jd->output && !jd->shard_count && vb_job_cube_size(jd) > 0)
         for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++) {
             if (vb_output_cubemap_path(jd->output, jd->cubemap_dir, k, cube[k], sizeof cube[k],
@@ -1090,7 +1097,10 @@ static void say_written(FILE *log, const options *o, const vb_job *job, const vb
         fprintf(log, "%s%d", s ? "," : " ", o->orders[s]);
     if (bo->variable_cap)
         fprintf(log, "%sadaptive 1..%d", o->order_count ? "," : " ", bo->variable_cap);
-    fprintf(log, ", %s)", vdsh_encoding_name(o->encoding));
+    if (o->shard_count) /* a part keeps f32 coefficients: vdsh-merge encodes them */
+        fprintf(log, ", f32 in a part: %s once merged)", vdsh_encoding_name(o->encoding));
+    else
+        fprintf(log, ", %s)", vdsh_encoding_name(o->encoding));
     if (cube_size > 0)
         fprintf(log, " and 4 basis cubemaps %dx%d in %s", cube_size, cube_size,
                 o->cubemap_dir ? o->cubemap_dir : "the output's directory");
@@ -1338,8 +1348,9 @@ static int run(const options *o)
     vb_job job = {0};
 
     /* 0. Every output writable and none of them an input, before any work. */
-    if (check_outputs(o, &jd, o->meshes, o->mesh_count) != 0)
-        return 1;
+    int bad = check_outputs(o, &jd, o->meshes, o->mesh_count);
+    if (bad)
+        return bad;
 
     /* 1. Load every mesh into one occluder scene. */
     if (vb_job_load(&job, &jd, &err) != VB_OK) {
@@ -1349,7 +1360,9 @@ static int run(const options *o)
 
     /* 2. Receivers: the scene's vertices, refined if asked. */
     if (vb_job_refine(&job, &jd, &err) != VB_OK) {
-        fprintf(stderr, "vdsh-bake: refining receivers: %s\n", err.msg);
+        fprintf(stderr, "vdsh-bake: %s: %s\n",
+                o->receivers ? "reading the receivers (--receivers)" : "refining receivers",
+                err.msg);
         goto out;
     }
     const vb_mesh *rec = &job.receivers;

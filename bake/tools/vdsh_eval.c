@@ -462,8 +462,11 @@ static void put_u32(unsigned char *p, uint32_t v)
     p[2] = (unsigned char)(v >> 16), p[3] = (unsigned char)(v >> 24);
 }
 
-static int write_per_vertex(const char *out, const vdsh_file *f, const vb_eval_result *r, char *msg,
-                            size_t cap)
+/* Writes the whole file to a temporary and finishes it (on disk, not yet
+ * renamed): the caller commits it once the JSON is written too, or aborts
+ * it, so that a failed run leaves neither. */
+static int write_per_vertex(const char *out, const vdsh_file *f, const vb_eval_result *r,
+                            vdsh_output *po, char *msg, size_t cap)
 {
     vdsh_output o;
     vdsh_error err;
@@ -492,10 +495,11 @@ static int write_per_vertex(const char *out, const vdsh_file *f, const vb_eval_r
      * vdsh_output_commit reports it and removes the file. */
     vdsh_output_put(&o, r->per_vertex,
                     sizeof(float) * (size_t)f->header.vertex_count * r->per_vertex_fields);
-    if (vdsh_output_commit(&o, &err) != VDSH_OK) {
+    if (vdsh_output_finish(&o, &err) != VDSH_OK) {
         snprintf(msg, cap, "%s", err.msg);
         return -1;
     }
+    *po = o;
     return 0;
 }
 
@@ -1032,12 +1036,21 @@ static int report(const options *o, const context *ctx)
         print_table(stdout, ctx);
     fflush(stdout);
     char msg[PATH_MAX + 256];
-    if (o->json && write_json(o->json, ctx, msg, sizeof msg) != 0) {
+    /* both files complete before either is renamed into place */
+    vdsh_output pv = {.fd = -1};
+    if (o->per_vertex &&
+        write_per_vertex(o->per_vertex, ctx->f, ctx->r, &pv, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-eval: %s\n", msg);
         return 1;
     }
-    if (o->per_vertex && write_per_vertex(o->per_vertex, ctx->f, ctx->r, msg, sizeof msg) != 0) {
+    if (o->json && write_json(o->json, ctx, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-eval: %s\n", msg);
+        vdsh_output_abort(&pv);
+        return 1;
+    }
+    vdsh_error err;
+    if (o->per_vertex && vdsh_output_commit(&pv, &err) != VDSH_OK) {
+        fprintf(stderr, "vdsh-eval: %s\n", err.msg);
         return 1;
     }
     return 0;
@@ -1062,6 +1075,11 @@ static int evaluate(const options *o, const vdsh_file *f, const scored *sc)
     spath = find_sources(o, f);
     if (!spath)
         goto out;
+    { /* the sources found from the file's record are inputs too */
+        const char *outs[] = {o->json, o->per_vertex};
+        if (vt_cli_check_outputs(outs, 2, (const char *const *)spath, (int)f->source_count) != 0)
+            goto out;
+    }
     warnings warned = {.path = o->path};
     vb_eval_scene_desc sd = {.fast = o->fast_truth,
                              .allow_mismatch = o->allow_mismatch,
@@ -1116,6 +1134,11 @@ static int run(const options *o)
 {
     /* 0. Every output can be written, and none is an input. */
     {
+        const char *opt = "--per-vertex";
+        int rc = vt_cli_no_stdout(&o->per_vertex, &opt, 1);
+        if (rc)
+            return rc;
+
         const char *outs[] = {o->json, o->per_vertex};
         const char *ins[VDSH_MAX_SOURCES + 2] = {o->path, o->bake_report};
         int nin = 2;

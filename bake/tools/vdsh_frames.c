@@ -184,7 +184,11 @@ static void loaded_free(loaded *l)
     memset(l, 0, sizeof *l);
 }
 
-static int load_scene(const char *path, unsigned threads, int traced, loaded *out)
+/* The scene of `path`; with `traced`, its occluders from the recorded
+ * sources, which must not be `output` (the file the caller will write;
+ * NULL: none): they are inputs too. */
+static int load_scene(const char *path, unsigned threads, int traced, const char *output,
+                      loaded *out)
 {
     loaded l = {0};
     vb_error err;
@@ -211,6 +215,9 @@ static int load_scene(const char *path, unsigned threads, int traced, loaded *ou
             goto done;
         }
     }
+    if (output &&
+        vt_cli_check_outputs(&output, 1, (const char *const *)spath, (int)l.f->source_count) != 0)
+        goto done;
     vb_eval_scene_desc sd = {.threads = threads};
     if (vb_eval_scene_create(l.f, (const char *const *)spath, l.f->source_count, &sd, &l.occ,
                              &err) != VB_OK ||
@@ -252,7 +259,7 @@ static int run_views(const options *op)
     d.threads = op->threads;
 
     loaded L;
-    if (load_scene(path, op->threads, 1, &L))
+    if (load_scene(path, op->threads, 1, out, &L))
         return 1;
     int status = 1;
     vb_frames_view *fv = calloc(1 + (size_t)d.cameras, sizeof *fv);
@@ -412,11 +419,15 @@ static int run_truth(const options *op)
     const char *sdf_arg = op->sdf;
     const uint32_t compare = op->compare;
     const float sdf_k = op->sdf_k;
+    const char *opt = "-o";
+    int rc = vt_cli_no_stdout(&dir, &opt, 1);
+    if (rc)
+        return rc;
     vt_views V = {0};
     if (read_views(views_path, &V))
         return 1;
     loaded L;
-    if (load_scene(path, op->threads, 1, &L)) {
+    if (load_scene(path, op->threads, 1, NULL, &L)) {
         vt_views_free(&V);
         return 1;
     }
@@ -723,7 +734,7 @@ static int run_score(const options *op)
     if (read_views(views_path, &V))
         return 1;
     loaded L = {0};
-    if (load_scene(path, op->threads, 0, &L)) {
+    if (load_scene(path, op->threads, 0, NULL, &L)) {
         vt_views_free(&V);
         return 1;
     }

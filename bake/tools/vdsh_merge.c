@@ -566,6 +566,10 @@ static int check_outputs(const options *o)
     char cube[VB_CUBEMAP_BASIS_FILES][PATH_MAX];
     const char *outs[1 + VB_CUBEMAP_BASIS_FILES] = {o->output};
     vb_error e;
+    const char *opt = "-o";
+    int rc = vt_cli_no_stdout(outs, &opt, 1);
+    if (rc)
+        return rc;
     for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
         if (vb_output_cubemap_path(o->output, NULL, k, cube[k], sizeof cube[k], &e) == VB_OK)
             outs[1 + k] = cube[k];
@@ -577,8 +581,9 @@ static int check_outputs(const options *o)
  * exit status (0 merged, 1 refused or failed: said on stderr). */
 static int run(const options *o)
 {
-    if (check_outputs(o) != 0)
-        return 1;
+    int rc = check_outputs(o);
+    if (rc)
+        return rc;
     merge m = {0};
     int status = 1;
     for (int i = 0; i < o->part_count; i++) {

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import stat
 import sys
 import tempfile
 from typing import Any, Dict, List, Optional
@@ -140,6 +141,15 @@ def _write_atomic(path: str, text: str) -> None:
         raise
 
 
+def _same_file(a: str, b: str) -> bool:
+    """Whether a and b name one existing regular file (device and inode)."""
+    try:
+        sa, sb = os.stat(a), os.stat(b)
+    except OSError:
+        return False
+    return stat.S_ISREG(sa.st_mode) and (sa.st_dev, sa.st_ino) == (sb.st_dev, sb.st_ino)
+
+
 def info(argv: List[str]) -> int:
     """`info [--json OUT] FILE...`; returns the exit status."""
     out: Optional[str] = None
@@ -165,6 +175,17 @@ def info(argv: List[str]) -> int:
         k += 1
     if not files:
         return _usage("no file given")
+    if out is not None and out != "-":
+        # as vdsh-info: never over an input (the same file by device and
+        # inode, whatever the names), never a folder; checked before any work
+        for path in files:
+            if _same_file(out, path):
+                print("%s: %s is the input %s (the same file): not overwriting it"
+                      % (PROG, out, path), file=sys.stderr)
+                return 1
+        if os.path.isdir(out):
+            print("%s: %s: cannot write: is a directory" % (PROG, out), file=sys.stderr)
+            return 1
     docs, status = [], 0
     for path in files:
         try:

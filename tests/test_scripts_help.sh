@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# The README's scripts take --help (exit 0, their usage on stdout, nothing
+# run) and refuse an unknown option (exit 2, the option named, nothing
+# run): `scripts/demo --help` ran the demo with an output folder named
+# --help, `scripts/test -R x` the whole suite. Each script runs from a copy
+# in a scratch tree, so that one that ignored the option would find no
+# sources there instead of building or testing this checkout.
+# Usage: test_scripts_help.sh SOURCE_DIR
+set -u
+src=$1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+mkdir -p "$tmp/scripts"
+fail=0
+for s in demo test setup format_check bake-parallel bake-slurm; do
+  cp "$src/scripts/$s" "$tmp/scripts/$s"
+done
+for s in demo test setup format_check bake-parallel bake-slurm; do
+  out=$(cd "$tmp" && timeout 30 bash "scripts/$s" --help 2>"$tmp/err"); rc=$?
+  if [[ $rc -ne 0 || $out != *"scripts/$s"* || -s $tmp/err ]]; then
+    echo "FAIL: scripts/$s --help: exit $rc, want 0 and its usage; stdout: ${out:0:200}; stderr: $(head -c 300 "$tmp/err")" >&2
+    fail=1
+  fi
+done
+for s in demo test setup format_check; do
+  out=$(cd "$tmp" && timeout 30 bash "scripts/$s" --bogus 2>"$tmp/err"); rc=$?
+  if [[ $rc -ne 2 ]] || ! grep -q -- "--bogus" "$tmp/err"; then
+    echo "FAIL: scripts/$s --bogus: exit $rc, want 2 naming the option; stderr: $(head -c 300 "$tmp/err")" >&2
+    fail=1
+  fi
+done
+leftover=$(cd "$tmp" && ls -A | grep -v '^scripts$' | grep -v '^err$')
+[[ -z $leftover ]] || { echo "FAIL: the scripts left files: $leftover" >&2; fail=1; }
+[[ $fail -eq 0 ]] && echo "scripts: --help and unknown options handled"
+exit $fail
