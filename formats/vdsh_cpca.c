@@ -215,7 +215,6 @@ static void jacobi(double *a, uint32_t n, double *v)
 typedef struct metric_dirs {
     uint32_t count, n;
     double *dir;  /* 3 per direction */
-    double *sw;   /* per direction: sqrt(weight) */
     double *wy;   /* per direction: sqrt(weight) * Y_i, n values */
     double *full; /* n x n: sum over all directions of weight * Y Y^T */
 } metric_dirs;
@@ -226,10 +225,9 @@ static int metric_init(metric_dirs *m, uint32_t order, uint32_t cube_n)
     m->count = count;
     m->n = n;
     m->dir = malloc(sizeof(double) * 3 * count);
-    m->sw = malloc(sizeof(double) * count);
     m->wy = malloc(sizeof(double) * (size_t)n * count);
     m->full = calloc((size_t)n * n, sizeof(double));
-    if (!m->dir || !m->sw || !m->wy || !m->full)
+    if (!m->dir || !m->wy || !m->full)
         return 0;
     float y[VDSH_MAX_COEFFS];
     uint32_t at = 0;
@@ -253,7 +251,6 @@ static int metric_init(metric_dirs *m, uint32_t order, uint32_t cube_n)
                 }
                 vdsh_sh_eval((int)order, df, y);
                 double sw = sqrt(w);
-                m->sw[at] = sw;
                 for (uint32_t k = 0; k < n; k++)
                     m->wy[(size_t)at * n + k] = sw * (double)y[k];
             }
@@ -272,7 +269,6 @@ static int metric_init(metric_dirs *m, uint32_t order, uint32_t cube_n)
 static void metric_free(metric_dirs *m)
 {
     free(m->dir);
-    free(m->sw);
     free(m->wy);
     free(m->full);
 }
@@ -1203,116 +1199,6 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
                                  float *decoded, vdsh_cpca_widths_fit *out, vdsh_cpca_fit *fit,
                                  vdsh_error *err);
 
-/* e^x for |x| <= 700 with only +, -, * and / (ldexp exact): the same
- * double on any CPU, unlike libm's. */
-static double plain_exp(double x)
-{
-    x = x > 700.0 ? 700.0 : x < -700.0 ? -700.0 : x;
-    const double ln2_hi = 6.93147180369123816490e-01, ln2_lo = 1.90821492927058770002e-10;
-    double kf = floor(x / 0.69314718055994530942 + 0.5);
-    double r = (x - kf * ln2_hi) - kf * ln2_lo; /* |r| <= 0.35 */
-    double t = 1.0, p = 1.0;
-    for (int i = 1; i <= 18; i++) {
-        t = t * r / i;
-        p += t;
-    }
-    return ldexp(p, (int)kf);
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-/* The 10th and 90th percentiles of src's ln D over every 8th vertex's
- * hemisphere of rd's directions: the range of light distances the
- * flip metric counts over. */
-static void lnd_range(const fit_ctx *f, refine_ctx *rd, double *lo, double *hi)
-{
-    uint32_t cap = ((f->rows + 7) / 8) * rd->rd.count, nv = 0;
-    double *all = malloc(sizeof(double) * cap);
-    *lo = -1.0;
-    *hi = 1.0;
-    if (!all)
-        return;
-    for (uint32_t v = 0; v < f->rows; v += 8) {
-        uint32_t nh = vertex_hemisphere(f, rd, v);
-        for (uint32_t h = 0; h < nh; h++) {
-            uint32_t d = rd->hemi[h];
-            all[nv++] = rd->xval[d] / rd->rd.sw[d];
-        }
-    }
-    if (nv) {
-        qsort(all, nv, sizeof(double), cmp_double);
-        *lo = all[(size_t)nv / 10];
-        *hi = all[(size_t)nv * 9 / 10];
-    }
-    free(all);
-}
-
-static double clampd(double x, double lo, double hi)
-{
-    return x < lo ? lo : x > hi ? hi : x;
-}
-
-/* The decoded error of ncand width tables (cand: ncand x bf indices into
- * WIDTH_SET), summed over vertices over the vertex's own hemisphere of
- * rd's directions (solid-angle weighted), the decoded ln D against src's:
- * eh the squared error; en the squared error weighted by 1 / D of src
- * (where an occluder is near, a light beyond it is close to the
- * decision's edge); ef |clamp(decoded) - clamp(src)| with ln D clamped
- * to [lo, hi]: the decisions flipped for lights at ln d uniform on
- * [lo, hi]. The weights as encode_widths quantises them (wts, cscale);
- * f->b the bf vectors. */
-static void decoded_errors(const fit_ctx *f, refine_ctx *rd, const double *wts, const float *cscale,
-                           uint32_t bf, const uint32_t *cand, uint32_t ncand, double lo, double hi,
-                           double *eh, double *en, double *ef, double *wq, double *dw)
-{
-    uint32_t kj[VDSH_MAX_COEFFS];
-    const uint32_t count = rd->rd.count;
-    cluster_values(f, rd);
-    for (uint32_t t = 0; t < ncand; t++)
-        eh[t] = en[t] = ef[t] = 0.0;
-    for (uint32_t v = 0; v < f->rows; v++) {
-        const uint32_t c = f->labels[v], nh = vertex_hemisphere(f, rd, v);
-        const double *mv = rd->mval + (size_t)c * count, *bv = rd->bval + (size_t)c * count * bf;
-        for (uint32_t h = 0; h < nh; h++) {
-            uint32_t d = rd->hemi[h];
-            dw[h] = plain_exp(-rd->xval[d] / rd->rd.sw[d]);
-        }
-        for (uint32_t t = 0; t < ncand; t++) {
-            const uint32_t *lv = cand + (size_t)t * bf;
-            uint32_t m = 0;
-            for (uint32_t j = 0; j < bf; j++) {
-                uint32_t i = lv[j];
-                if (!i)
-                    continue;
-                const int levels = (1 << (WIDTH_SET[i] - 1)) - 1;
-                float sc = cscale[((size_t)c * bf + j) * NWIDTHS + i];
-                float step = sc / (float)levels;
-                kj[m] = j;
-                wq[m++] = (double)((float)quantise(wts[(size_t)v * bf + j], sc, levels) * step);
-            }
-            double a = 0.0, b = 0.0, g = 0.0;
-            for (uint32_t h = 0; h < nh; h++) {
-                uint32_t d = rd->hemi[h];
-                double s = rd->xval[d] - mv[d];
-                const double *bd = bv + (size_t)d * bf;
-                for (uint32_t q = 0; q < m; q++)
-                    s -= wq[q] * bd[kj[q]];
-                double sw = rd->rd.sw[d], ref = rd->xval[d] / sw;
-                a += s * s;
-                b += dw[h] * s * s;
-                g += sw * sw * fabs(clampd(ref - s / sw, lo, hi) - clampd(ref, lo, hi));
-            }
-            eh[t] += a;
-            en[t] += b;
-            ef[t] += g;
-        }
-    }
-}
-
 vdsh_result vdsh_cpca_encode_widths(const float *src, const float *normals, uint32_t rows,
                                     uint32_t order, const vdsh_cpca_settings *settings,
                                     uint32_t fit_basis, double budget, const uint8_t *widths,
@@ -1384,12 +1270,11 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
     float *cscale = malloc(sizeof(float) * k * bf * NWIDTHS);  /* the best scale */
     double *tot = malloc(sizeof(double) * bf * NWIDTHS);       /* over clusters */
     uint32_t *level = malloc(sizeof(uint32_t) * bf), *best_level = malloc(sizeof(uint32_t) * bf);
-    uint32_t *cand = malloc(sizeof(uint32_t) * 64 * bf); /* candidate tables */
     fit_scratch fs;
     const uint32_t rounds = k > 1 ? REFINE_ROUNDS : 0;
     vdsh_result res = VDSH_OK;
     if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, bf, rounds) || !wts || !cdist ||
-        !cscale || !tot || !level || !best_level || !cand) {
+        !cscale || !tot || !level || !best_level) {
         res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca widths: out of memory");
         goto done;
     }
@@ -1464,8 +1349,6 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
         const double limit = budget * rows;
         double best_e = 0.0;
         int have = 0;
-        uint32_t ncand = 0, cand_words[64], cand_m[64];
-        double cand_tot[64];
         for (uint32_t words = 1; words <= 64; words++) {
             uint32_t m = 0;
             while (m < bf &&
@@ -1487,12 +1370,6 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
             double e = 0.0;
             for (uint32_t j = 0; j < bf; j++)
                 e += tot[(size_t)j * NWIDTHS + (j < m ? level[j] : 0)];
-            cand_words[ncand] = words;
-            cand_m[ncand] = m;
-            cand_tot[ncand] = e;
-            for (uint32_t j = 0; j < bf; j++)
-                cand[(size_t)ncand * bf + j] = j < m ? level[j] : 0;
-            ncand++;
             if (!have || e < best_e) {
                 best_e = e;
                 have = 1;
@@ -1504,67 +1381,6 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
             res = vdsh_failf(err, VDSH_ERR_ARGUMENT,
                              "cpca widths: %g bytes per vertex: nothing fits", budget);
             goto done;
-        }
-        { /* STUDY: the word count's rule */
-            const char *rule = getenv("VDSH_ALLOC_RULE"), *fw = getenv("VDSH_ALLOC_WORDS"),
-                       *lg = getenv("VDSH_ALLOC_LOG");
-            double *de_h = calloc(ncand, sizeof(double)), *de_n = calloc(ncand, sizeof(double));
-            double *de_f = calloc(ncand, sizeof(double));
-            double *wq = malloc(sizeof(double) * bf),
-                   *dw = malloc(sizeof(double) * 6 * REFINE_CUBE_N * REFINE_CUBE_N);
-            refine_ctx rd2;
-            if (!de_h || !de_n || !de_f || !wq || !dw || !refine_init(&rd2, order, k, bf, rows)) {
-                res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca widths: out of memory");
-                goto done;
-            }
-            double lo, hi;
-            lnd_range(fc, &rd2, &lo, &hi);
-            decoded_errors(fc, &rd2, wts, cscale, bf, cand, ncand, lo, hi, de_h, de_n, de_f, wq,
-                           dw);
-            uint32_t pick = 0, bt = 0, bh = 0, bn = 0, bfl = 0;
-            for (uint32_t t = 1; t < ncand; t++) {
-                if (cand_tot[t] < cand_tot[bt])
-                    bt = t;
-                if (de_h[t] < de_h[bh])
-                    bh = t;
-                if (de_n[t] < de_n[bn])
-                    bn = t;
-                if (de_f[t] < de_f[bfl])
-                    bfl = t;
-            }
-            pick = bt;
-            if (rule && !strcmp(rule, "hemi"))
-                pick = bh;
-            if (rule && !strcmp(rule, "near"))
-                pick = bn;
-            if (rule && !strcmp(rule, "flip"))
-                pick = bfl;
-            if (fw)
-                for (uint32_t t = 0; t < ncand; t++)
-                    if (cand_words[t] == (uint32_t)atoi(fw))
-                        pick = t;
-            if (lg) {
-                FILE *fl = fopen(lg, "a");
-                if (fl) {
-                    fprintf(fl, "rows %u k %u bf %u rule %s words %s pick W=%u lnD %.3f..%.3f\n",
-                            rows, k, bf, rule ? rule : "-", fw ? fw : "-", cand_words[pick], lo,
-                            hi);
-                    for (uint32_t t = 0; t < ncand; t++)
-                        fprintf(fl, "  W=%u m=%u tot=%.6g hemi=%.6g near=%.6g flip=%.6g%s%s%s%s\n",
-                                cand_words[t], cand_m[t], cand_tot[t], de_h[t], de_n[t], de_f[t],
-                                t == bt ? " *tot" : "", t == bh ? " *hemi" : "",
-                                t == bn ? " *near" : "", t == bfl ? " *flip" : "");
-                    fclose(fl);
-                }
-            }
-            for (uint32_t j = 0; j < bf; j++)
-                best_level[j] = cand[(size_t)pick * bf + j];
-            refine_free(&rd2);
-            free(de_h);
-            free(de_n);
-            free(de_f);
-            free(wq);
-            free(dw);
         }
         for (uint32_t j = 0; j < bf; j++)
             out->widths[j] = (uint8_t)WIDTH_SET[best_level[j]];
@@ -1674,7 +1490,6 @@ done:
     free(tot);
     free(level);
     free(best_level);
-    free(cand);
     fit_scratch_free(&fs);
     return res;
 }
