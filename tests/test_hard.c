@@ -272,6 +272,59 @@ static void test_scale_and_offset(void)
     test_mesh_free(&rec);
 }
 
+/* The log distance's fits do not depend on the scene's units: scaled by
+ * a power of two (the same rays, bit for bit), a log stream's c_0 moves
+ * by ln(scale) sqrt(4 pi) and nothing else, within float rounding, for
+ * the least squares (`shadow`) and the decision fit with its calibrated
+ * offsets. (The projection's sampling error used to act on ln d itself,
+ * whose level the units set: Wuson scaled by 1024 drew 12% more shadow
+ * MAE at order 5.) */
+static void test_log_fit_units(void)
+{
+    const vb_method methods[2] = {VB_METHOD_SHADOW, VB_METHOD_DECISION};
+    const float scales[2] = {1.0f / 16384, 1024.0f};
+    for (int mi = 0; mi < 2; mi++) {
+        vb_mesh occ = {0}, rec = {0};
+        refined_room(&occ, &rec, 4.0f, 3.0f, 2.5f);
+        vb_bake_output ref = {0};
+        CHECK(bake_with(&occ, &rec, methods[mi], 256, 1, &ref), "reference bake");
+        for (int si = 0; si < 2 && ref.coeffs[5]; si++) {
+            vb_mesh o2 = {0}, r2 = {0};
+            refined_room(&o2, &r2, 4.0f, 3.0f, 2.5f);
+            const float zero[3] = {0, 0, 0};
+            transform(&o2, scales[si], zero);
+            transform(&r2, scales[si], zero);
+            vb_bake_output b = {0};
+            CHECK(bake_with(&o2, &r2, methods[mi], 256, 1, &b), "bake at scale %g", scales[si]);
+            if (b.coeffs[5]) {
+                const double shift = log((double)scales[si]) * sqrt(4.0 * 3.14159265358979323846);
+                double dc = 0, rest = 0;
+                for (uint32_t v = 0; v < rec.vertex_count; v++)
+                    for (int i = 0; i < 25; i++) {
+                        size_t k = 25 * (size_t)v + i;
+                        double e = b.coeffs[5][k] - ref.coeffs[5][k] - (i ? 0.0 : shift);
+                        if (i)
+                            rest = fmax(rest, fabs(e));
+                        else
+                            dc = fmax(dc, fabs(e));
+                    }
+                CHECK(dc < 1e-3 && rest < 1e-3,
+                      "method %d at scale %g: c_0 off the shift by %g, the rest moved by %g",
+                      (int)methods[mi], scales[si], dc, rest);
+                CHECK(fabsf(b.log_offset[5] - ref.log_offset[5]) < 1e-3f,
+                      "method %d at scale %g: order 5's log offset %g, %g at scale 1",
+                      (int)methods[mi], scales[si], b.log_offset[5], ref.log_offset[5]);
+            }
+            vb_bake_output_free(&b);
+            test_mesh_free(&o2);
+            test_mesh_free(&r2);
+        }
+        vb_bake_output_free(&ref);
+        test_mesh_free(&occ);
+        test_mesh_free(&rec);
+    }
+}
+
 /* f16 streams keep their relative precision at any scale (stored values
  * are coefficients / the largest |coefficient|). */
 static void test_f16_range(void)
@@ -867,6 +920,7 @@ int main(void)
     test_degenerate_triangles();
     test_undefined_normal();
     test_scale_and_offset();
+    test_log_fit_units();
     test_f16_range();
     test_coplanar_receivers();
     test_open_mesh();

@@ -8,7 +8,10 @@
 # facing out through a wall. Their s8s6 scales (vdsh-info --json) must be
 # the room's alone; each scale of the second is the largest |coefficient|
 # over its drawn receivers (its f32 bake), and the buried ones do exceed
-# some scale (so the test can fail). Then the same with shards: 1 and 3
+# some scale (so the test can fail): the clamp distance is set far beyond
+# the room (1000, the log floor kept at 0.01), so the two facing out into
+# the void see ln 1000 everywhere, more than any receiver in the closed
+# room sees. Then the same with shards: 1 and 3
 # parts merged are the whole s8s6 bake byte for byte (the merge finds the
 # drawn receivers from POSN and TRIS), and the room's s8 and s8s6 bakes,
 # which have no such receivers, merge byte for byte too.
@@ -41,7 +44,7 @@ f 20//1 21//1 22//1
 f 23//3 24//3 25//3
 OBJ
 
-opts=(--rays 64 --cube-size 0 --threads 2 --orders 2,3,5 -q)
+opts=(--rays 64 --cube-size 0 --threads 2 --orders 2,3,5 --max-distance 1000 --log-floor 0.01 -q)
 for m in a b; do
   run "bake $m s8s6" "$bake" "$tmp/$m.obj" "${opts[@]}" --encoding s8s6 -o "$tmp/$m.vdsh"
   run "info $m" "$info" --json - "$tmp/$m.vdsh" >"$tmp/$m.json"

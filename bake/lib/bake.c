@@ -299,7 +299,7 @@ static uint32_t slot_of(const job *J, uint32_t v)
 /* Adaptive rays: the highest order's fit of accumulated projection `acc`
  * (a quantity's per-lane sums) over `cells` directions, into c. */
 static void adapt_fit(const job *J, const float n[3], float acc[VDSH_MAX_COEFFS][VB_PACKET],
-                      uint32_t cells, float c[VDSH_MAX_COEFFS])
+                      uint32_t cells, double level, float c[VDSH_MAX_COEFFS])
 {
     double w = (J->grid->hemisphere ? 2.0 : 4.0) * VB_PI / cells;
     int nb = J->order * J->order;
@@ -314,6 +314,8 @@ static void adapt_fit(const job *J, const float n[3], float acc[VDSH_MAX_COEFFS]
     vb_fit_angles angles;
     vb_fit_frame(top, n, &angles);
     vb_fit_unrotate(top, &angles, b, u);
+    if (level != 0.0)
+        vb_fit_add_constant(top, J->grid->hemisphere, level, u);
     vb_fit_finish(top, &angles, u, c);
 }
 
@@ -623,6 +625,17 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
     const int dvar =
         J->var_decision && !d->trace_only && !out->n && (var || (out->cal && out->var_scratch));
     want[1] |= var | dvar;
+    /* The log distance is projected less a level of its own (the mean of
+     * the first traced packets' values), put back exactly after the fit:
+     * the fit then does not depend on the units the scene is in (the
+     * projection's sampling error acts on ln d - level, not on ln d, whose
+     * level is set by the units). */
+    const vb_fit *top = &J->fits[J->order];
+    vb_fit_angles angles;
+    vb_fit_frame(top, n, &angles);
+    const int centre = want[1] && vb_fit_constant_exact(&angles, J->grid->hemisphere);
+    int have_level = 0;
+    float level = 0.0f;
     /* Loop invariants in locals: the lane loops below vectorise. */
     const float inv_scale = J->inv_scale, max_distance = d->max_distance;
     const float degenerate_dist = J->near[slot], log_floor = J->log_floor;
@@ -732,6 +745,24 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
                         float l = fast_log(dist[p][k] > log_floor ? dist[p][k] : log_floor);
                         logd[p][k] = l * (float)(valid[p][k] & 1);
                     }
+            if (want[1] && centre && !have_level) {
+                float sum = 0.0f;
+                uint32_t cnt = 0;
+                for (int p = 0; p < np; p++)
+                    for (int k = 0; k < VB_PACKET; k++)
+                        if (valid[p][k]) {
+                            sum += logd[p][k];
+                            cnt++;
+                        }
+                if (cnt) {
+                    level = sum / (float)cnt;
+                    have_level = 1;
+                }
+            }
+            if (have_level)
+                for (int p = 0; p < np; p++)
+                    for (int k = 0; k < VB_PACKET; k++)
+                        logd[p][k] -= level * (float)(valid[p][k] & 1);
             for (int p = 0; p < np; p++) {
                 const float *dx = rh[p].ray.dir_x, *dy = rh[p].ray.dir_y, *dz = rh[p].ray.dir_z;
                 if (want[0])
@@ -777,7 +808,7 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
         cells_used = pk * VB_PACKET;
         if (round + 1 < rounds && (want[0] || want[1])) {
             float cur[VDSH_MAX_COEFFS];
-            adapt_fit(J, n, acc[aq], cells_used, cur);
+            adapt_fit(J, n, acc[aq], cells_used, aq ? (double)level : 0.0, cur);
             int stop = 0;
             if (round > 0) {
                 double sum = 0.0;
@@ -814,9 +845,6 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
     int nb = J->order * J->order;
     /* The rotation's first half once for every order: the highest
      * order's leading bands are the lower orders' (fit.h). */
-    const vb_fit *top = &J->fits[J->order];
-    vb_fit_angles angles;
-    vb_fit_frame(top, n, &angles);
     double u[VDSH_MAX_COEFFS];
     float varc[VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS];
     for (int q = 0; q < 2; q++) {
@@ -830,6 +858,8 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
             b[i] = s * w;
         }
         vb_fit_unrotate(top, &angles, b, u);
+        if (q == 1 && have_level)
+            vb_fit_add_constant(top, J->grid->hemisphere, level, u);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (out->coeffs[q][o])
                 vb_fit_finish(&J->fits[o], &angles, u, out->coeffs[q][o]);

@@ -198,6 +198,25 @@ static void hemisphere_gram(int order, double lambda, double *G)
     }
 }
 
+/* h_i = integral over z > 0 of Y_i, by hemisphere_gram's quadrature. */
+static void hemisphere_integral(int order, double *h)
+{
+    enum { NZ = 16, NP = 64 };
+    int n = order * order;
+    double zx[NZ], zw[NZ], y[VB_FIT_MAX];
+    gauss01(NZ, zx, zw);
+    memset(h, 0, (size_t)n * sizeof *h);
+    for (int a = 0; a < NZ; a++)
+        for (int b = 0; b < NP; b++) {
+            double r = sqrt(1.0 - zx[a] * zx[a]), phi = 2.0 * PI * (b + 0.5) / NP;
+            double d[3] = {r * vdsh_det_cos(phi), r * vdsh_det_sin(phi), zx[a]};
+            eval_d(order, d, y);
+            double w = zw[a] * 2.0 * PI / NP;
+            for (int i = 0; i < n; i++)
+                h[i] += w * y[i];
+        }
+}
+
 /* Per band l: pinv_l = B_l^T (B_l B_l^T)^-1 of the basis block at the
  * band's samples, over-determined, so each block is close to a multiple
  * of an orthogonal matrix (condition ~1) and evaluation error is not
@@ -265,6 +284,7 @@ vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out, 
     f->lambda = lambda;
     for (int i = 0; i < n; i++)
         f->window[i] = 1.0;
+    hemisphere_integral(order, f->hemi);
 
     int ok = 1;
     switch (base) {
@@ -380,6 +400,11 @@ void vb_sh_rotation(const vb_fit *f, const double R[9], double *out)
     }
 }
 
+int vb_fit_constant_exact(const vb_fit_angles *a, int hemisphere)
+{
+    return !hemisphere || a->rotates;
+}
+
 void vb_fit_frame(const vb_fit *f, const float n[3], vb_fit_angles *a)
 {
     memset(a, 0, sizeof *a);
@@ -470,6 +495,20 @@ VB_CLONES void vb_fit_finish(const vb_fit *f, const vb_fit_angles *a, const doub
     rotate_z(f->order, a->ca, a->sa, 1.0, v);
     for (int i = 0; i < n; i++)
         c[i] = (float)(f->window[i] * v[i]);
+}
+
+void vb_fit_add_constant(const vb_fit *f, int hemisphere, double m, double *u)
+{
+    if (!hemisphere) {
+        u[0] += m * sqrt(4.0 * PI); /* the whole sphere: 1 is sqrt(4 pi) Y_0 */
+        return;
+    }
+    /* u's frame is X^T's image of the local one (N = X M X^T) */
+    double h[VB_FIT_MAX];
+    memcpy(h, f->hemi, (size_t)f->order * f->order * sizeof *h);
+    rotate_x(f, f->order, 0, h);
+    for (int i = 0; i < f->order * f->order; i++)
+        u[i] += m * h[i];
 }
 
 void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c)

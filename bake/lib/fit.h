@@ -55,6 +55,8 @@ typedef struct vb_fit {
     vb_fit_base base;                   /* the map (a method's row, method.h) */
     float lambda;                       /* lsq regularisation */
     double window[VB_FIT_MAX];          /* per coefficient: its band's weight */
+    double hemi[VB_FIT_MAX];            /* integral over z > 0 of Y_i: the local
+                                         * frame's projection of the constant 1 */
     double M[VB_FIT_MAX * VB_FIT_MAX];  /* local-frame map, order^2 square */
     double NT[VB_FIT_MAX * VB_FIT_MAX]; /* N = X M X^T, order^2 square,
                                        * column-major */
@@ -115,6 +117,17 @@ typedef struct vb_fit_angles {
 void vb_fit_frame(const vb_fit *f, const float n[3], vb_fit_angles *a);
 void vb_fit_unrotate(const vb_fit *f, const vb_fit_angles *a, const double *b, double *u);
 void vb_fit_finish(const vb_fit *f, const vb_fit_angles *a, const double *u, float *c);
+
+/* A constant m taken out of the projected values (f - m projected, for a
+ * fit that does not depend on the units f's level is in), put back
+ * exactly: u += m times the exact projection of 1 over the directions
+ * projected (the hemisphere about the normal, or the whole sphere).
+ * vb_fit_constant_exact says whether it can be (a fit that rotates, or a
+ * whole-sphere projection, in which frame the constant is the same);
+ * then a constant in, m sqrt(4 pi) on c_0 out of vb_fit_finish (times
+ * the window's band 0), the other coefficients untouched. */
+int vb_fit_constant_exact(const vb_fit_angles *a, int hemisphere);
+void vb_fit_add_constant(const vb_fit *f, int hemisphere, double m, double *u);
 
 /* SH rotation for bands 0..order-1: out (order^2 x order^2, row-major,
  * block-diagonal) such that if f(w) = sum c_i Y_i(R^T w) then
