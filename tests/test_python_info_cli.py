@@ -48,6 +48,10 @@ for out in (os.path.join(work, "no-such-folder", "x.json"), work):
 if os.path.exists(os.path.join(work, "no-such-folder")):
     fail.append("a missing folder was created")
 
+r = info("--json=", good)
+if r.returncode != 2 or "--json" not in r.stderr:
+    fail.append("--json= (no name): exit %d, %r" % (r.returncode, r.stderr))
+
 link, redirected = os.path.join(work, "stdout-link"), os.path.join(work, "redirected.json")
 os.symlink("/proc/self/fd/1", link)
 with open(redirected, "w") as fh:

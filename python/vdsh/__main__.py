@@ -231,6 +231,8 @@ def info(argv: List[str]) -> int:
                 out = argv[k]
             else:
                 return _usage("%s needs a file name (-: stdout)" % a)
+            if not out:
+                return _usage("--json needs a file name (-: stdout), not ''")
         elif a == "--":
             files += argv[k + 1:]
             break
