@@ -10,7 +10,9 @@ take it (README "Bad input and hard cases", formats/vdsh_output.h):
   link left a link (a rename over it used to replace /dev/stdout itself);
 - a new JSON file has mode 0666 less the umask, no temporary left beside it;
 - inputs that are not regular files (/dev/zero, a FIFO with no writer):
-  exit 1 naming the file, at once (they used to exhaust memory and hang).
+  exit 1 naming the file, at once (they used to exhaust memory and hang);
+- the library's shadows() with lights that are not L x 3 positions: a
+  ValueError saying so.
 """
 import glob
 import json
@@ -87,6 +89,22 @@ for path in ("/dev/zero", fifo):
             fail.append("info %s: exit %d, %r" % (path, r.returncode, r.stderr[-300:]))
     except subprocess.TimeoutExpired:
         fail.append("info %s: still running after 60 s" % path)
+
+# The library: lights that are not positions are named as such (was
+# numpy's "cannot reshape array of size 4 into shape (3)").
+sys.path.insert(0, os.path.join(src, "python"))
+sys.dont_write_bytecode = True
+import vdsh  # noqa: E402
+f = vdsh.read(os.path.join(src, "tests", "corpus", "vdsh", "cube-s8-orders1235.vdsh"))
+for bad in ([[0, 3, 0, 1]], [1, 2], [[[0, 1, 2]]]):
+    try:
+        vdsh.shadows(f, f.streams[0], bad)
+        fail.append("shadows(lights=%r): accepted" % (bad,))
+    except ValueError as e:
+        if "lights: positions" not in str(e):
+            fail.append("shadows(lights=%r): %s" % (bad, e))
+if vdsh.shadows(f, f.streams[0], [0, 1, 2]).shape[1] != 1:
+    fail.append("shadows(lights=[x, y, z]): not one light")
 
 for m in fail:
     print("FAIL:", m)
