@@ -278,6 +278,17 @@ for f, want in errs:
     if not msg or want not in msg:
         fail.append("%s: no visible message naming '%s' on the page (got %r)" % (f, want, msg))
 
+# A module the page cannot fetch (vdsh_core.js not copied beside it, or the
+# page opened from file:// without access to files): said on the page (it
+# stayed blank, "loading").
+core = os.path.join(work, "vdsh_core.js")
+os.rename(core, core + ".off")
+msg = message(page("glb=cpca.glb&size=%dx%d" % (W, H)))
+os.rename(core + ".off", core)
+print("without vdsh_core.js: the page says: %s" % msg)
+if not msg or "cannot load vdsh_web.js and vdsh_core.js" not in msg:
+    fail.append("without vdsh_core.js: no visible message (got %r)" % msg)
+
 # Compressed files: quantised (KHR_mesh_quantization), meshopt.
 if node and modules and os.path.exists(os.path.join(modules, "meshoptimizer", "meshopt_encoder.js")):
     pack = os.path.join(os.path.dirname(os.path.abspath(__file__)), "web_glb_pack.mjs")
