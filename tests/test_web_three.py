@@ -243,7 +243,10 @@ else:
 # default, or as NaN: eye=a,b gave a black frame).
 for q, want in (("eye=1,2", "eye=1,2: expected x,y,z"), ("light=a,b,c", "light=a,b,c: expected x,y,z"),
                 ("output=shade", "give output=shadow"), ("path=buffers", "give path=buffer"),
-                ("size=320", "size=320: expected WxH"), ("fov=0", "fov=0: expected degrees")):
+                ("size=320", "size=320: expected WxH"), ("fov=0", "fov=0: expected degrees"),
+                # three.js not where the page looks: stayed "loading", no message (and
+                # three=DIR without "./" was taken by the import map as a bare name)
+                ("three=nowhere/", "/web/nowhere/ (build/three.module.js")):
     t = title_error("glb=../room.glb&" + q)
     print("three.html?%s: %s" % (q, t))
     if want not in t:
