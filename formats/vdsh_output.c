@@ -6,6 +6,7 @@
 #include "vdsh_failf.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <fcntl.h>
 #include <stdarg.h>
 #include <stdatomic.h>
@@ -43,12 +44,62 @@ static void release(vdsh_output *o)
     o->fd = -1;
 }
 
-/* An existing character device or FIFO: opened in place (a stream). 1 when
- * it is one and opened, 0 when the target is a regular file or absent (the
+/* 1 when path leads through /proc/<pid>/fd (/dev/stdout, /dev/fd/N,
+ * /proc/self/fd/N, or a link to one): a descriptor the process already has
+ * open, whatever it is (a terminal, a pipe, or the regular file a shell
+ * redirected it to). Such a target is written in place: a rename over it
+ * would replace the link itself (/dev/stdout, for root) or fail. */
+static int through_proc_fd(const char *path)
+{
+    char q[PATH_MAX], dir[PATH_MAX], real[PATH_MAX], link[PATH_MAX];
+    if (snprintf(q, sizeof q, "%s", path) >= (int)sizeof q)
+        return 0;
+    for (int depth = 0; depth < 40; depth++) {
+        char *slash = strrchr(q, '/');
+        const char *base = slash ? slash + 1 : q;
+        if (!slash)
+            snprintf(dir, sizeof dir, ".");
+        else if (slash == q)
+            snprintf(dir, sizeof dir, "/");
+        else
+            snprintf(dir, sizeof dir, "%.*s", (int)(slash - q), q);
+        if (!realpath(dir, real))
+            return 0;
+        if (strcmp(real, "/proc") == 0 || strncmp(real, "/proc/", 6) == 0)
+            return 1;
+        char full[PATH_MAX];
+        if (snprintf(full, sizeof full, "%s/%s", strcmp(real, "/") ? real : "", base) >=
+            (int)sizeof full)
+            return 0;
+        ssize_t n = readlink(full, link, sizeof link - 1);
+        if (n < 0)
+            return 0; /* not a link (or absent): the name is final */
+        link[n] = 0;
+        if (link[0] == '/')
+            snprintf(q, sizeof q, "%s", link);
+        else if (snprintf(q, sizeof q, "%s/%s", strcmp(real, "/") ? real : "", link) >=
+                 (int)sizeof q)
+            return 0;
+    }
+    return 0;
+}
+
+/* An existing character device or FIFO, or a path through /proc/<pid>/fd:
+ * opened in place (a stream; appended to, the latter). 1 when it is one
+ * and opened, 0 when the target is a regular file or absent (the
  * temporary-file path follows), -1 on an error (already reported). */
 static int open_stream(const char *path, vdsh_output *o, vdsh_error *err, vdsh_result *res)
 {
     struct stat st;
+    if (stat(path, &st) == 0 && !S_ISDIR(st.st_mode) && through_proc_fd(path)) {
+        int fd = open(path, O_WRONLY | O_APPEND | O_NOCTTY | O_CLOEXEC);
+        if (fd < 0) {
+            *res = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+            return -1;
+        }
+        o->fd = fd;
+        return 1;
+    }
     if (stat(path, &st) != 0 || S_ISREG(st.st_mode))
         return 0;
     if (!S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode)) {

@@ -29,7 +29,11 @@
  * Targets that are not regular files: an existing character device or
  * FIFO (/dev/stdout, /dev/null, a pipe) is written in place as a stream
  * (tmp is NULL; nothing to rename, nothing to fsync), so that
- * "--json /dev/stdout" works and nothing under /dev is ever replaced. An
+ * "--json /dev/stdout" works and nothing under /dev is ever replaced; so is
+ * any path that leads through /proc/<pid>/fd (/dev/stdout, /dev/fd/N, a link
+ * to one), whatever the descriptor is, a regular file the shell redirected
+ * it to included (appended to, O_APPEND: "--json /dev/stdout > out.json"
+ * puts the JSON in out.json and leaves the link /dev/stdout alone). An
  * existing directory, block device or socket is refused. A symbolic link
  * to a regular file is replaced by the new file, as rename does.
  *

@@ -57,4 +57,13 @@ check_recipe_usage() { # check_recipe_usage SCRIPT: scripts/SCRIPT (needs
   fi
   "$scripts/$name" --help 2>/dev/null | grep -q "scripts/$name N OUT.vdsh" ||
     { echo "FAIL: $name --help" >&2; fail=1; }
+  # No '--' (every word went to the scheduler: parallel ran the mesh as a
+  # command, exit 127), or nothing after it: usage errors, before anything runs.
+  local args
+  for args in "2 nodash.vdsh builtin:room --max-edge 1" "2 nodash.vdsh -j 2 --"; do
+    usage=$(cd "${TMPDIR:-/tmp}" && "$scripts/$name" $args 2>&1); rc=$?
+    [[ $rc -eq 2 && $usage == *"'--'"* && $usage == "$name: "* ]] ||
+      { echo "FAIL: $name $args: exit $rc, not 2 naming '--': $usage" >&2; fail=1; }
+  done
+  [[ -e ${TMPDIR:-/tmp}/nodash.vdsh ]] && { echo "FAIL: $name wrote nodash.vdsh" >&2; fail=1; }
 }

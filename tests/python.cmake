@@ -25,3 +25,12 @@ add_test(NAME python_eval_matches_c_library
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info>
                  $<TARGET_FILE:test_python_eval_ref> ${PROJECT_SOURCE_DIR}
                  ${CMAKE_CURRENT_BINARY_DIR}/python_eval)
+
+# python_info_cli  `python -m vdsh info` on a user's mistakes: --json onto
+#                  its own input, into a missing folder, through /dev/stdout
+#                  redirected to a file (never replacing the link); inputs
+#                  that are not regular files (/dev/zero, a FIFO). Imports
+#                  python/ from the checkout; seconds.
+add_test(NAME python_info_cli
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_python_info_cli.py
+                 ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/python_info_cli)

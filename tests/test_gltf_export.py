@@ -402,6 +402,24 @@ p = subprocess.run([export, missing, "-o", out], capture_output=True, text=True)
 if p.returncode != 1 or missing not in p.stderr or os.path.exists(out):
     fail.append("missing input: rc %d, %s" % (p.returncode, p.stderr.strip()))
 
+# --source that cannot be read: exit 1 at once naming it and why (a FIFO,
+# or a .gltf whose buffer is one, used to block vdsh-export forever).
+tiny = os.path.join(work, "tiny.vdsh")
+run([bake, "builtin:room", "--max-edge", "2", "--rays", "16", "--cube-size", "0", "-q", "-o", tiny])
+fifo = os.path.join(work, "fifo.glb")
+if not os.path.exists(fifo):
+    os.mkfifo(fifo)
+with open(os.path.join(work, "fifo-buffer.gltf"), "w") as fh:
+    json.dump({"asset": {"version": "2.0"}, "buffers": [{"uri": "fifo.glb", "byteLength": 12}]}, fh)
+for src, want in ((missing, "No such file"), (fifo, "not a regular file"), (work, "is a directory"),
+                  (os.path.join(work, "fifo-buffer.gltf"), "buffer 0 (fifo.glb) cannot be read: not a regular file")):
+    try:
+        p = subprocess.run([export, tiny, "--source", src, "-o", out], capture_output=True, text=True, timeout=60)
+        if p.returncode != 1 or src not in p.stderr or want not in p.stderr or os.path.exists(out):
+            fail.append("--source %s: rc %d, %s (want '%s')" % (src, p.returncode, p.stderr.strip(), want))
+    except subprocess.TimeoutExpired:
+        fail.append("--source %s: still running after 60 s" % src)
+
 for f in fail:
     print("FAIL:", f)
 if not fail and not validator:

@@ -234,6 +234,32 @@ static void test_streams(void)
     CHECK(read(p[0], got, sizeof got) == 5 && memcmp(got, "piped", 5) == 0, "pipe content");
     close(p[0]);
     close(p[1]);
+
+    /* A link to /proc/self/fd/N whose descriptor is a regular file (what
+     * /dev/stdout is under "> out.json"): written in place, appended after
+     * what the descriptor already wrote, the link left a link (a rename
+     * would have replaced /dev/stdout itself). */
+    const char *redirected = in_work("redirected"), *fdlink = in_work("fdlink");
+    int fd = open(redirected, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    CHECK(fd >= 0 && write(fd, "before,", 7) == 7, "the redirected file");
+    char target[64];
+    snprintf(target, sizeof target, "/proc/self/fd/%d", fd);
+    CHECK(symlink(target, fdlink) == 0, "link to %s", target);
+    vdsh_output ro;
+    CHECK(vdsh_output_open(fdlink, &ro, &err) == VDSH_OK && ro.tmp == NULL,
+          "a link to a descriptor opens in place: %s", err.msg);
+    if (ro.tmp == NULL) {
+        fputs("json", ro.fp);
+        CHECK(vdsh_output_commit(&ro, &err) == VDSH_OK, "a descriptor: %s", err.msg);
+    } else {
+        vdsh_output_abort(&ro);
+    }
+    CHECK(lstat(fdlink, &st) == 0 && S_ISLNK(st.st_mode), "the link is still a link");
+    CHECK(holds(redirected, "before,json"), "the descriptor's file got the text after its own");
+    CHECK(temporaries(work) == 0, "nothing created beside the link");
+    close(fd);
+    unlink(fdlink);
+    unlink(redirected);
 }
 
 /* 6. Many writers to one target at once, threads and processes: every

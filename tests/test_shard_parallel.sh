@@ -20,6 +20,14 @@ if ! command -v parallel >/dev/null; then
 fi
 make_tmp
 tiny=(builtin:room --max-edge 1.5 --rays 32 --cube-size 8)
+# Without GNU parallel on PATH: said, exit 1, nothing baked (was bash's
+# "parallel: command not found", 127).
+mkdir -p "$tmp/bin"
+for t in bash dirname rm; do ln -s "$(command -v $t)" "$tmp/bin/$t"; done
+msg=$(PATH=$tmp/bin VDSH_BAKE=$bake VDSH_MERGE=$merge "$tmp/bin/bash" "$scripts/bake-parallel" 2 "$tmp/nopar.vdsh" -- "${tiny[@]}" 2>&1)
+rc=$?
+[[ $rc -eq 1 && $msg == *"no GNU parallel"* ]] || { echo "FAIL: without parallel: exit $rc: $msg" >&2; fail=1; }
+ls "$tmp"/nopar* >/dev/null 2>&1 && { echo "FAIL: without parallel: files written" >&2; fail=1; }
 "$bake" "${tiny[@]}" -q -o "$tmp/whole.vdsh" || { echo "FAIL: whole bake" >&2; exit 1; }
 export VDSH_BAKE=$bake VDSH_MERGE=$merge
 name="$tmp/it's a \$cene"

@@ -16,6 +16,15 @@ bake=$1 merge=$2 scripts=$3
 . "$(dirname "$0")/lib.sh"
 # The usage text (needs no Slurm).
 check_recipe_usage bake-slurm
+# Without sbatch on PATH: said, exit 1, nothing run (was bash's "sbatch:
+# command not found", 127, after vdsh-bake's check).
+nos=$(mktemp -d /tmp/vdsh-nosbatch.XXXXXX)
+for t in bash dirname; do ln -s "$(command -v $t)" "$nos/$t"; done
+msg=$(cd "$nos" && PATH=$nos VDSH_BAKE=$bake VDSH_MERGE=$merge "$nos/bash" "$scripts/bake-slurm" 2 "$nos/x.vdsh" -- builtin:room 2>&1)
+rc=$?
+[[ $rc -eq 1 && $msg == *"no sbatch"* ]] || { echo "FAIL: without sbatch: exit $rc: $msg" >&2; fail=1; }
+ls "$nos"/x* >/dev/null 2>&1 && { echo "FAIL: without sbatch: files written" >&2; fail=1; }
+rm -rf "$nos"
 skip() { [[ $fail -eq 0 ]] || exit 1; echo "SKIP: $1"; exit 77; }
 [[ $(id -u) -eq 0 ]] || skip "needs root to start slurmctld and slurmd"
 if ! command -v slurmctld >/dev/null || ! command -v slurmd >/dev/null || ! command -v munged >/dev/null; then

@@ -239,6 +239,19 @@ if os.path.exists(engine):
 else:
     print("no %s: the --source part skipped" % engine)
 
+# URL parameters with a typo: said on the page (they were drawn as the
+# default, or as NaN: eye=a,b gave a black frame).
+for q, want in (("eye=1,2", "eye=1,2: expected x,y,z"), ("light=a,b,c", "light=a,b,c: expected x,y,z"),
+                ("output=shade", "give output=shadow"), ("path=buffers", "give path=buffer"),
+                ("size=320", "size=320: expected WxH"), ("fov=0", "fov=0: expected degrees"),
+                # three.js not where the page looks: stayed "loading", no message (and
+                # three=DIR without "./" was taken by the import map as a bare name)
+                ("three=nowhere/", "/web/nowhere/ (build/three.module.js")):
+    t = title_error("glb=../room.glb&" + q)
+    print("three.html?%s: %s" % (q, t))
+    if want not in t:
+        fail.append("three.html?%s: no message naming '%s' (title %r)" % (q, want, t))
+
 # GLSL ES 3.00: the C runtime's programs from the same files.
 import re
 d = dom(base + "es_check.html")

@@ -263,7 +263,11 @@ open(os.path.join(work, "cpca-bad.glb"), "wb").write(
     struct.pack("<III", 0x46546C67, 2, 20 + len(js) + len(d) - 20 - jl) + struct.pack("<II", len(js), 0x4E4F534A) + js +
     d[20 + jl:])
 errs = [("bad.glb", "not a glb"), ("draco.glb", "KHR_draco_mesh_compression"), ("cpca-bad.glb", "bits 9 out of range"),
-        ("cpca.glb&cpca=gpu", "give cpca=vertex or cpca=load")]
+        ("cpca.glb&cpca=gpu", "give cpca=vertex or cpca=load"),
+        # URL parameters with a typo were ignored, the default drawn
+        ("cpca.glb&output=shade", "give output=shadow"), ("cpca.glb&path=buffers", "give path=buffer"),
+        ("cpca.glb&lights=0", "lights=0: expected a whole number"), ("cpca.glb&size=640x", "size=640x: expected WxH"),
+        ("cpca.glb&fov=abc", "fov=abc: expected degrees")]
 plain = os.path.join(models, "glTF2", "2CylinderEngine-glTF-Binary", "2CylinderEngine.glb")
 if os.path.exists(plain):
     shutil.copy(plain, os.path.join(work, "plain.glb"))
@@ -273,6 +277,17 @@ for f, want in errs:
     print("%s: the page says: %s" % (f, msg))
     if not msg or want not in msg:
         fail.append("%s: no visible message naming '%s' on the page (got %r)" % (f, want, msg))
+
+# A module the page cannot fetch (vdsh_core.js not copied beside it, or the
+# page opened from file:// without access to files): said on the page (it
+# stayed blank, "loading").
+core = os.path.join(work, "vdsh_core.js")
+os.rename(core, core + ".off")
+msg = message(page("glb=cpca.glb&size=%dx%d" % (W, H)))
+os.rename(core + ".off", core)
+print("without vdsh_core.js: the page says: %s" % msg)
+if not msg or "cannot load vdsh_web.js and vdsh_core.js" not in msg:
+    fail.append("without vdsh_core.js: no visible message (got %r)" % msg)
 
 # Compressed files: quantised (KHR_mesh_quantization), meshopt.
 if node and modules and os.path.exists(os.path.join(modules, "meshoptimizer", "meshopt_encoder.js")):

@@ -7,11 +7,15 @@
 #include "vdsh_gltf_component.h"
 #include "vdsh_math.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 static int fail(char *msg, size_t cap, const char *fmt, ...)
 {
@@ -22,11 +26,28 @@ static int fail(char *msg, size_t cap, const char *fmt, ...)
     return -1;
 }
 
-static uint8_t *slurp(const char *path, size_t *size)
+/* The whole of a regular file; NULL with *why (errno's text, or "not a
+ * regular file": a FIFO would block, /dev/zero never end) otherwise. */
+static uint8_t *slurp(const char *path, size_t *size, const char **why)
 {
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
+    *why = "cannot read it";
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+    if (fd < 0) {
+        *why = strerror(errno);
         return NULL;
+    }
+    struct stat st = {0};
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        *why = S_ISDIR(st.st_mode) ? "is a directory" : "not a regular file";
+        close(fd);
+        return NULL;
+    }
+    FILE *fp = fdopen(fd, "rb");
+    if (!fp) {
+        *why = strerror(errno);
+        close(fd);
+        return NULL;
+    }
     uint8_t *d = NULL;
     if (fseek(fp, 0, SEEK_END) == 0) {
         long n = ftell(fp);
@@ -104,9 +125,10 @@ int vdsh_src_load(const char *path, vdsh_src *s, char *msg, size_t cap)
 {
     memset(s, 0, sizeof *s);
     size_t size = 0;
-    uint8_t *d = slurp(path, &size);
+    const char *why = NULL;
+    uint8_t *d = slurp(path, &size, &why);
     if (!d)
-        return fail(msg, cap, "%s: cannot read the source glTF", path);
+        return fail(msg, cap, "%s: cannot read the source glTF: %s", path, why);
     const char *slash = strrchr(path, '/');
     s->dir = slash ? strndup(path, (size_t)(slash - path + 1)) : strdup("");
     uint8_t *bin = NULL;
@@ -145,6 +167,7 @@ int vdsh_src_load(const char *path, vdsh_src *s, char *msg, size_t cap)
         cJSON *uri = cJSON_GetObjectItemCaseSensitive(b, "uri");
         double want = cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(b, "byteLength"));
         vdsh_src_buffer *sb = &s->buffers[i];
+        const char *bwhy = "not decoded";
         if (!cJSON_IsString(uri)) {
             if (i != 0 || !bin) {
                 fail(msg, cap, "%s: buffer %d has no uri and is not the glb's BIN chunk", path, i);
@@ -160,13 +183,13 @@ int vdsh_src_load(const char *path, vdsh_src *s, char *msg, size_t cap)
             if (p) {
                 strcpy(p, s->dir);
                 strcat(p, uri->valuestring);
-                sb->data = slurp(p, &sb->size);
+                sb->data = slurp(p, &sb->size, &bwhy);
                 free(p);
             }
         }
         if (!sb->data) {
-            fail(msg, cap, "%s: buffer %d (%s) cannot be read", path, i,
-                 cJSON_IsString(uri) ? uri->valuestring : "BIN chunk");
+            fail(msg, cap, "%s: buffer %d (%s) cannot be read: %s", path, i,
+                 cJSON_IsString(uri) ? uri->valuestring : "BIN chunk", bwhy);
             goto out;
         }
         if (!(want >= 0) || want > (double)sb->size) {

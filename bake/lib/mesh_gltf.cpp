@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include "mesh_read.h"
@@ -352,6 +353,37 @@ bool no_images(tinygltf::Image *, const int, std::string *, std::string *, int, 
     return true;
 }
 
+/* The first extension the file requires, read from its JSON alone (empty
+ * when none, or when the JSON does not parse): tinygltf refuses some such
+ * files before its own list can be checked (EXT_meshopt_compression's
+ * fallback buffer has no data: "Invalid byteLength"), and the extension is
+ * then the reason to give. */
+std::string required_extension(int binary, const uint8_t *bytes, size_t size)
+{
+    const char *j = (const char *)bytes;
+    size_t n = size;
+    if (binary) {
+        uint32_t len = 0;
+        if (size < 20)
+            return std::string();
+        memcpy(&len, bytes + 12, 4);
+        if (len > size - 20)
+            return std::string();
+        j = (const char *)bytes + 20;
+        n = len;
+    }
+    nlohmann::json doc = nlohmann::json::parse(j, j + n, nullptr, false);
+    if (!doc.is_object())
+        return std::string();
+    auto it = doc.find("extensionsRequired");
+    if (it == doc.end() || !it->is_array())
+        return std::string();
+    for (const auto &x : *it)
+        if (x.is_string())
+            return x.get<std::string>();
+    return std::string();
+}
+
 vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, size_t size,
                 vb_mesh_raw *out, vb_error *err)
 {
@@ -368,6 +400,11 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
                      : loader.LoadASCIIFromString(&model, &e, &w, (const char *)bytes,
                                                   (unsigned)size, dir);
     if (!ok) {
+        std::string x = required_extension(binary, bytes, size);
+        if (!x.empty())
+            return vb_fail(err, VB_ERR_FORMAT,
+                           "%s: requires the extension %s, which the baker does not read", name,
+                           x.c_str());
         while (!e.empty() && (e.back() == '\n' || e.back() == ' '))
             e.pop_back();
         for (char &ch : e)

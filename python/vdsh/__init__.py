@@ -38,6 +38,7 @@ Every reading rule of the spec is checked; numpy only.
 from __future__ import annotations
 
 import os
+import stat
 import struct
 import zlib
 from typing import Any, Dict, List, NoReturn, Optional, Union
@@ -106,7 +107,13 @@ def read(path: Union[str, "os.PathLike[str]"]) -> VdshFile:
     Returns a VdshFile. Raises VdshError, whose message names the file and
     what is wrong, for a file that breaks a rule, and OSError when it
     cannot be opened."""
-    with open(path, "rb") as fh:
+    # O_NONBLOCK: a FIFO opens without waiting for a writer, and is refused
+    # below with anything else that is not a regular file (/dev/zero would
+    # never end).
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    with os.fdopen(fd, "rb") as fh:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            _fail(os.fspath(path), "not a regular file")
         data = fh.read()
     return parse(data, path)
 

@@ -2,11 +2,11 @@
 (vdsh-info's main figures, its --json field names), read by this package."""
 from __future__ import annotations
 
+import errno
 import json
 import os
 import stat
 import sys
-import tempfile
 from typing import Any, Dict, List, Optional
 
 import numpy as np
@@ -128,26 +128,92 @@ def _text(d: Dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _is_descriptor(path: str) -> bool:
+    """Whether `path` leads through /proc/<pid>/fd (/dev/stdout, /dev/fd/N,
+    /proc/self/fd/N): a descriptor already open, whatever it is (a terminal,
+    a pipe, or a regular file the shell redirected to), to be written in
+    place and appended to, never replaced by a rename (which would replace
+    the link /dev/stdout itself)."""
+    q = os.path.abspath(path)
+    for _ in range(40):
+        folder = os.path.realpath(os.path.dirname(q))
+        if folder == "/proc" or folder.startswith("/proc/"):
+            return True
+        q = os.path.join(folder, os.path.basename(q))
+        if not os.path.islink(q):
+            return False
+        q = os.path.join(folder, os.readlink(q))
+    return False
+
+
 def _write_atomic(path: str, text: str) -> None:
-    """`text` into `path` through a temporary file beside it and a rename."""
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=os.path.basename(path) + ".tmp.", dir=folder)
+    """`text` into `path` as formats/vdsh_output.h writes files: through a
+    temporary file beside it ("<path>.tmp.<pid>.<n>", created exclusively,
+    mode 0666 less the umask) renamed over it, so that a reader sees the old
+    file or the whole new one; an existing character device or FIFO
+    (/dev/null, a pipe) or a path through /proc/<pid>/fd (/dev/stdout) is
+    written in place, never replaced; a directory
+    or any other kind of file is refused (OSError naming it)."""
+    if _is_descriptor(path):
+        with open(path, "a") as fh:
+            fh.write(text)
+        return
+    try:
+        st = os.stat(path)
+    except OSError:
+        st = None
+    if st is not None and not stat.S_ISREG(st.st_mode):
+        if not (stat.S_ISCHR(st.st_mode) or stat.S_ISFIFO(st.st_mode)):
+            raise OSError(errno.EISDIR if stat.S_ISDIR(st.st_mode) else errno.EINVAL,
+                          "cannot write: %s" % ("is a directory" if stat.S_ISDIR(st.st_mode)
+                                                else "not a regular file"))
+        with open(path, "w") as fh:
+            fh.write(text)
+        return
+    for n in range(1000):
+        tmp = "%s.tmp.%d.%d" % (path, os.getpid(), n)
+        try:
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOCTTY, 0o666)
+            break
+        except FileExistsError:
+            continue
+    else:
+        raise OSError(errno.EEXIST, "cannot create a temporary file beside it: every name taken")
     try:
         with os.fdopen(fd, "w") as fh:
             fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
         os.replace(tmp, path)
     except BaseException:
         os.unlink(tmp)
         raise
 
 
-def _same_file(a: str, b: str) -> bool:
-    """Whether a and b name one existing regular file (device and inode)."""
+def _check_output(out: str, files: List[str]) -> Optional[str]:
+    """Why `out` cannot be written (the same file as an input, a folder that
+    is not there), checked before any file is read; None when it can."""
     try:
-        sa, sb = os.stat(a), os.stat(b)
+        st = os.stat(out)
     except OSError:
-        return False
-    return stat.S_ISREG(sa.st_mode) and (sa.st_dev, sa.st_ino) == (sb.st_dev, sb.st_ino)
+        st = None
+    if st is not None:
+        if stat.S_ISDIR(st.st_mode):
+            return "%s: cannot write: is a directory" % out
+        if stat.S_ISREG(st.st_mode):
+            for f in files:
+                try:
+                    if os.path.samefile(out, f):
+                        return "%s: is the input %s (the same file): refusing to overwrite it" % (out, f)
+                except OSError:
+                    pass
+        return None
+    folder = os.path.dirname(out) or "."
+    if not os.path.isdir(folder):
+        return "%s: cannot write: no folder %s" % (out, folder)
+    if not os.access(folder, os.W_OK | os.X_OK):
+        return "%s: cannot write: folder %s is not writable" % (out, folder)
+    return None
 
 
 def info(argv: List[str]) -> int:
@@ -165,6 +231,8 @@ def info(argv: List[str]) -> int:
                 out = argv[k]
             else:
                 return _usage("%s needs a file name (-: stdout)" % a)
+            if not out:
+                return _usage("--json needs a file name (-: stdout), not ''")
         elif a == "--":
             files += argv[k + 1:]
             break
@@ -175,17 +243,10 @@ def info(argv: List[str]) -> int:
         k += 1
     if not files:
         return _usage("no file given")
-    if out is not None and out != "-":
-        # as vdsh-info: never over an input (the same file by device and
-        # inode, whatever the names), never a folder; checked before any work
-        for path in files:
-            if _same_file(out, path):
-                print("%s: %s is the input %s (the same file): not overwriting it"
-                      % (PROG, out, path), file=sys.stderr)
-                return 1
-        if os.path.isdir(out):
-            print("%s: %s: cannot write: is a directory" % (PROG, out), file=sys.stderr)
-            return 1
+    why = _check_output(out, files) if out not in (None, "-") else None
+    if why:
+        print("%s: %s" % (PROG, why), file=sys.stderr)
+        return 1
     docs, status = [], 0
     for path in files:
         try:

@@ -257,7 +257,11 @@ def distances_toward(f: "VdshFile", stream: Stream, dirs: ArrayLike,
 def _toward_lights(f: "VdshFile", v: np.ndarray, lights: ArrayLike) -> tuple:
     """Unit directions (3 arrays, V x L) and distances (V x L) from the
     vertices to the lights, in float32 as vdsh_shadow.c's toward()."""
-    L = np.asarray(lights, np.float32).reshape(-1, 3)
+    L = np.asarray(lights, np.float32)
+    if L.size % 3 or (L.ndim > 1 and L.shape[-1] != 3) or L.ndim > 2:
+        raise ValueError("lights: positions x, y, z (L x 3), not an array of shape %s"
+                         % (L.shape,))
+    L = L.reshape(-1, 3)
     p = f.positions[v]
     vx = L[None, :, 0] - p[:, 0:1]
     vy = L[None, :, 1] - p[:, 1:2]

@@ -393,6 +393,21 @@ async function main() {
     if (v.length !== 3 || !v.every(Number.isFinite)) throw new Error(name + '=' + s + ': expected x,y,z');
     return v;
   };
+  // The other parameters, checked before the file is read: a typo is said
+  // on the page, not drawn as the default.
+  const oneOf = (name, allowed) => {
+    const v = q.get(name);
+    if (v !== null && !allowed.includes(v))
+      throw new Error(name + '=' + v + ': give ' + allowed.map((a) => name + '=' + a).join(' or ') + ', or leave it out');
+  };
+  oneOf('output', ['shadow']);
+  oneOf('path', ['buffer']);
+  if (q.get('size') !== null && !/^[1-9][0-9]{0,4}x[1-9][0-9]{0,4}$/.test(q.get('size')))
+    throw new Error('size=' + q.get('size') + ': expected WxH, whole numbers of CSS pixels (640x400)');
+  if (q.get('lights') !== null && !/^[1-9][0-9]{0,3}$/.test(q.get('lights')))
+    throw new Error('lights=' + q.get('lights') + ': expected a whole number >= 1');
+  if (q.get('fov') !== null && !(Number(q.get('fov')) > 0 && Number(q.get('fov')) < 180))
+    throw new Error('fov=' + q.get('fov') + ': expected degrees between 0 and 180');
   const url = q.get('glb') || 'scene.glb';
   const { json, bin } = parseGlb(await load(url));
   for (const e of json.extensionsRequired || [])
