@@ -15,9 +15,21 @@
  * scene's sky, and the space around an object, are free.
  *
  * Lights "placed uniformly in free space" are the candidates of a seeded
- * sequence, uniform in the scene's bounding box, that pass the test, in
+ * sequence, uniform in the scene's light region, that pass the test, in
  * sequence order (vdsh_light_candidate): deterministic, the same on every
  * machine.
+ *
+ * The light region (vdsh_light_region) is the scene's bounding box, unless
+ * the box holds too little free space: fewer than VDSH_REGION_MIN_FREE of
+ * the first VDSH_REGION_PROBES candidates of the seed VDSH_REGION_SEED in
+ * the box are free (a closed convex object fills its bounds: a box, a
+ * sphere). Then it is the box grown by VDSH_REGION_GROW of its diagonal on
+ * every side: the object seen from around it. The test stops at the
+ * VDSH_REGION_MIN_FREE-th free candidate, so a scene with room (every
+ * interior, every open scene) pays a handful of probes and keeps its
+ * bounds: its lights are the ones placed before the rule. In a grown
+ * region the placement gives up after VDSH_REGION_TRIES + 4 per light
+ * candidates (most are free there), not the 1000 per light of the box.
  *
  * Does not: cast rays (the caller does, with whatever it has).
  * Errors: none. Threading: pure functions.
@@ -32,6 +44,17 @@ extern "C" {
 #endif
 
 #define VDSH_FREE_PROBES 14
+
+/* The light region's rule (above). */
+#define VDSH_REGION_SEED 0x6f626a6563747321ull /* "object!" */
+#define VDSH_REGION_PROBES 1024u
+#define VDSH_REGION_MIN_FREE 4u
+#define VDSH_REGION_GROW 0.25f
+#define VDSH_REGION_TRIES 4096u
+
+/* The free-space test of a caller (its probes cast with whatever it has):
+ * nonzero for free space at p. */
+typedef int (*vdsh_free_fn)(const void *ctx, const float p[3]);
 
 /* The probe directions (unit vectors). */
 void vdsh_free_probe_dirs(float dirs[VDSH_FREE_PROBES][3]);
@@ -49,6 +72,17 @@ int vdsh_free_space(const float t[VDSH_FREE_PROBES], const int back[VDSH_FREE_PR
  * (a counter-based hash: candidate k does not depend on the others). */
 void vdsh_light_candidate(const float lo[3], const float hi[3], uint64_t seed, uint32_t k,
                           float out[3]);
+
+/* The light region of the scene with bounds lo..hi (above), into
+ * out_lo..out_hi (may alias lo, hi); is_free(ctx, p) the caller's test.
+ * Returns 1 when the region is the grown box, 0 when it is the bounds.
+ * *probes (may be NULL): the candidates tested. */
+int vdsh_light_region(const float lo[3], const float hi[3], vdsh_free_fn is_free, const void *ctx,
+                      float out_lo[3], float out_hi[3], uint32_t *probes);
+
+/* The most candidates a placement of count lights tries: 1000 per light
+ * in the bounds, VDSH_REGION_TRIES + 4 per light in a grown region. */
+uint64_t vdsh_light_tries(uint32_t count, int grown);
 
 #ifdef __cplusplus
 }

@@ -463,9 +463,11 @@ enum { VR_MAX_POOL_LIGHTS = 64 };
 /* Up to max of the light positions placed at load (vr_scene_desc
  * light_pool); returns how many were written (0 without a pool). They are
  * "placed uniformly in free space" as formats/vdsh_light.h defines it:
- * the candidates of vdsh_light_candidate (seed 1) in the bounds that pass
- * vdsh_view_free_space against the drawn mesh, in sequence order, at most
- * 256 tried per position; deterministic. Colours and attenuations are
+ * the candidates of vdsh_light_candidate (seed 1) in the light region
+ * (vdsh_light_region: the bounds, or the bounds grown around a closed
+ * object) that pass vdsh_view_free_space against the drawn mesh, in
+ * sequence order, at most 256 tried per position in the bounds
+ * (vdsh_light_tries in a grown region); deterministic. Colours and attenuations are
  * left zero. */
 int vr_scene_pool_lights(const vr_scene *s, vr_light *out, int max);
 

@@ -56,6 +56,17 @@ int vr_scene_default_lights(const vr_scene *s, vr_light *out, int max)
     return n;
 }
 
+typedef struct pool_free {
+    const vdsh_view_tracer *t;
+    float diag;
+} pool_free;
+
+static int pool_is_free(const void *ctx, const float p[3])
+{
+    const pool_free *c = ctx;
+    return vdsh_view_free_space(c->t, p, c->diag);
+}
+
 /* The light pool: candidates of the seeded uniform sequence in the
  * bounds, kept when in free space (vdsh_light.h), in sequence order. */
 vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count, const char *name,
@@ -72,9 +83,14 @@ vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count, c
     }
     diag = sqrtf(diag);
     s->pool_count = 0;
-    for (uint32_t k = 0; s->pool_count < count && k < 256u * (uint32_t)count; k++) {
+    pool_free c = {t, diag};
+    float lo[3], hi[3];
+    const int grown =
+        vdsh_light_region(s->bounds_min, s->bounds_max, pool_is_free, &c, lo, hi, NULL);
+    const uint64_t limit = grown ? vdsh_light_tries((uint32_t)count, 1) : 256u * (uint64_t)count;
+    for (uint32_t k = 0; s->pool_count < count && k < limit; k++) {
         float p[3];
-        vdsh_light_candidate(s->bounds_min, s->bounds_max, 1, k, p);
+        vdsh_light_candidate(lo, hi, 1, k, p);
         if (vdsh_view_free_space(t, p, diag))
             memcpy(s->pool[s->pool_count++], p, sizeof p);
     }

@@ -12,7 +12,8 @@ if(TARGET vb_eval)
   # test name : test_eval part
   foreach(pair heldout:heldout interpolate:interpolate sources:sources
                sphere_error_matches_analytic:sphere room_error_falls_with_order:room
-               fits_beat_paper_projection:methods oracle_exact_threads_identical:oracle)
+               fits_beat_paper_projection:methods oracle_exact_threads_identical:oracle
+               lights_around_closed_object_same_with_room:lights)
     string(REPLACE ":" ";" pair ${pair})
     list(GET pair 0 name)
     list(GET pair 1 part)
@@ -75,4 +76,13 @@ if(TARGET vdsh-eval AND Python3_Interpreter_FOUND)
   add_test(NAME eval_offsets
            COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_eval_offsets.py
                    $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval> ${CMAKE_CURRENT_BINARY_DIR}/eval_offsets)
+endif()
+
+#   eval_closed_object  a closed cube fills its bounds: the default bake runs
+#                       the decision fit, vdsh-eval places its lights around
+#                       it by every rule (formats/vdsh_light.h's light region)
+if(TARGET vdsh-eval AND Python3_Interpreter_FOUND)
+  add_test(NAME eval_closed_object
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_closed_object.py
+                   $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval> ${CMAKE_CURRENT_BINARY_DIR}/eval_closed_object)
 endif()

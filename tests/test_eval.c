@@ -19,6 +19,15 @@
  *               vertex coefficients (f32 and f16); interior points are inside
  *               their triangles and area-weighted
  *   sources     a source whose hash differs is rejected, naming it
+ *   lights      the light region (vdsh_light.h): a scene with room (the
+ *               built-in room) keeps its bounds, and its lights are the
+ *               candidates in the bounds that pass, as before the region
+ *               (a copy of that loop here), by every rule; a closed box
+ *               fills its bounds: the region is the bounds grown by a
+ *               quarter of the diagonal, every rule places its lights
+ *               there, outside the box, in free space, within a few
+ *               thousand candidates, the same on 1 and 2 threads' bakes;
+ *               the decision fit runs on the box (its lights > 0)
  */
 #include <math.h>
 #include <stdlib.h>
@@ -31,6 +40,7 @@
 #include "scene.h"
 #include "test_util.h"
 #include "vdsh.h"
+#include "vdsh_light.h"
 #include "vdsh_sh.h"
 #include "vdsh_shadow.h"
 
@@ -817,6 +827,129 @@ static void test_sources(void)
     vb_mesh_free(&occ);
 }
 
+/* ---- the light region ---------------------------------------------------- */
+
+/* The unit cube [0,1]^3, its faces wound outward: a closed object. */
+static void make_cube(vb_mesh *m)
+{
+    static const uint32_t tri[36] = {0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
+                                     2, 6, 7, 2, 7, 3, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6};
+    mesh_alloc(m, 8, 12);
+    for (uint32_t i = 0; i < 8; i++)
+        for (int a = 0; a < 3; a++) {
+            m->positions[3 * i + a] = (float)((i >> a) & 1u);
+            m->normals[3 * i + a] = ((i >> a) & 1u ? 1.0f : -1.0f) * 0.57735027f;
+        }
+    memcpy(m->indices, tri, sizeof tri);
+}
+
+/* The placement before the light region: candidates in the bounds, kept
+ * when free, 1000 per light; the ceiling rule lifts them to the top fifth. */
+static uint32_t place_in_bounds(const vb_scene *s, uint64_t seed, uint32_t count, int ceiling,
+                                float (*out)[3])
+{
+    const float *lo = s->bounds_min, *hi = s->bounds_max;
+    uint32_t n = 0, k = 0;
+    while (n < count && k < 1000u * count) {
+        float p[3];
+        vdsh_light_candidate(lo, hi, seed, k++, p);
+        if (ceiling) {
+            float u = hi[1] > lo[1] ? (p[1] - lo[1]) / (hi[1] - lo[1]) : 0.5f;
+            p[1] = lo[1] + (0.8f + 0.2f * u) * (hi[1] - lo[1]);
+        }
+        if (vb_scene_free_space(s, p))
+            memcpy(out[n++], p, sizeof out[0]);
+    }
+    return n;
+}
+
+static void test_lights(void)
+{
+    enum { N = 256 };
+    float(*a)[3] = malloc(N * sizeof *a), (*b)[3] = malloc(N * sizeof *b);
+    vb_mesh occ = {0}, rec = {0}, cube = {0};
+    vb_scene *s = NULL, *c = NULL;
+    vb_error err;
+    uint32_t tried = 0;
+    if (!a || !b || !room_scene(1.0f, &occ, &rec, &s))
+        goto out;
+    float lo[3], hi[3];
+    CHECK(vb_scene_light_region(s, lo, hi) == 0, "the room's region is grown");
+    CHECK(!memcmp(lo, s->bounds_min, sizeof lo) && !memcmp(hi, s->bounds_max, sizeof hi),
+          "the room's region is not its bounds");
+    for (int ceiling = 0; ceiling <= 1; ceiling++) {
+        const uint64_t seed = 0x5eed + (uint64_t)ceiling;
+        CHECK(place_in_bounds(s, seed, N, ceiling, a) == N, "reference placement");
+        CHECK(vb_scene_place_lights_rule(s, seed, N,
+                                         ceiling ? VB_LIGHTS_CEILING : VB_LIGHTS_UNIFORM, b, NULL,
+                                         &err) == VB_OK,
+              "room rule %d: %s", ceiling, err.msg);
+        CHECK(!memcmp(a, b, N * sizeof *a), "room rule %d: other lights than before", ceiling);
+    }
+
+    make_cube(&cube);
+    if (!scene_from(&cube, &c)) {
+        CHECK(0, "cube scene");
+        goto out;
+    }
+    CHECK(place_in_bounds(c, 7, 1, 0, a) == 0, "the cube's bounds hold free space");
+    CHECK(vb_scene_light_region(c, lo, hi) == 1, "the cube's region is its bounds");
+    const float g = VDSH_REGION_GROW * c->diagonal;
+    for (int k = 0; k < 3; k++)
+        CHECK(fabsf(lo[k] - (c->bounds_min[k] - g)) < 1e-5f &&
+                  fabsf(hi[k] - (c->bounds_max[k] + g)) < 1e-5f,
+              "grown region axis %d: %g..%g", k, (double)lo[k], (double)hi[k]);
+    for (int rule = VB_LIGHTS_UNIFORM; rule <= VB_LIGHTS_PATH; rule++) {
+        vb_result r = vb_scene_place_lights_rule(c, 0x11 + (uint64_t)rule, N, (vb_light_rule)rule,
+                                                 b, &tried, &err);
+        CHECK(r == VB_OK, "cube rule %s: %s", vb_light_rule_name((vb_light_rule)rule), err.msg);
+        if (r != VB_OK)
+            continue;
+        CHECK(tried <= vdsh_light_tries(N, 1), "cube rule %d: %u candidates", rule, tried);
+        for (int l = 0; l < N; l++) {
+            int outside = 0, within = 1;
+            for (int k = 0; k < 3; k++) {
+                outside |= b[l][k] < 0.0f || b[l][k] > 1.0f;
+                within &= b[l][k] >= lo[k] && b[l][k] <= hi[k];
+            }
+            CHECK(outside && within && vb_scene_free_space(c, b[l]),
+                  "cube rule %d light %d at (%g, %g, %g)", rule, l, (double)b[l][0],
+                  (double)b[l][1], (double)b[l][2]);
+        }
+    }
+
+    /* The decision fit runs on the closed box, the same on 1 and 2 threads. */
+    vb_bake_output o[2] = {{0}};
+    for (int t = 0; t < 2; t++) {
+        vb_bake_desc d = {.receivers = &cube,
+                          .scene = c,
+                          .rays = 256,
+                          .seed = 3,
+                          .threads = 1 + (uint32_t)t,
+                          .method = VB_METHOD_DECISION,
+                          .order_mask = (1u << 2) | (1u << 3)};
+        vb_result r = vb_bake_run(&d, &o[t], &err);
+        CHECK(r == VB_OK, "decision bake of the cube: %s", err.msg);
+        if (r != VB_OK)
+            goto out;
+        CHECK(o[t].decision_lights > 0 && o[t].decision_fitted == cube.vertex_count,
+              "the cube's decision fit: %u lights, %u of %u fitted", o[t].decision_lights,
+              o[t].decision_fitted, cube.vertex_count);
+    }
+    CHECK(!memcmp(o[0].coeffs[3], o[1].coeffs[3], 9 * cube.vertex_count * sizeof(float)),
+          "1 and 2 threads differ on the cube");
+    for (int t = 0; t < 2; t++)
+        vb_bake_output_free(&o[t]);
+out:
+    free(a);
+    free(b);
+    vb_scene_destroy(s);
+    vb_scene_destroy(c);
+    vb_mesh_free(&occ);
+    vb_mesh_free(&rec);
+    vb_mesh_free(&cube);
+}
+
 int main(int argc, char **argv)
 {
     const char *only = argc > 1 ? argv[1] : NULL;
@@ -830,5 +963,6 @@ int main(int argc, char **argv)
     RUN("room", test_room);
     RUN("methods", test_methods);
     RUN("oracle", test_oracle_and_threads);
+    RUN("lights", test_lights);
     return test_report("test_eval");
 }

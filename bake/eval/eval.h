@@ -250,6 +250,8 @@ typedef struct vb_eval_result {
     uint32_t light_count;                        /* scene lights placed */
     float (*lights)[3];                          /* their positions, scene units */
     uint32_t light_candidates;                   /* candidates tried to place them */
+    int light_region_grown;                      /* 1: placed around a closed object, in the bounds
+                               grown (vdsh_light.h: vb_scene_light_region) */
     vb_eval_truth truth[VB_EVAL_KINDS];
     uint64_t seed;       /* as used */
     uint32_t directions; /* per receiver, as used */

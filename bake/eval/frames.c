@@ -793,10 +793,12 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
     const uint32_t limit = EYE_TRIES_PER_VIEW * d.cameras;
     struct RTCIntersectContext ictx;
     rtcInitIntersectContext(&ictx);
+    float elo[3], ehi[3]; /* eyes go where lights go (vdsh_light.h) */
+    vb_scene_light_region(occ, elo, ehi);
     for (uint32_t k = 0; have < d.cameras && k < limit; k++) {
         st.eyes_tried++;
         float eye[3];
-        vdsh_light_candidate(occ->bounds_min, occ->bounds_max, eye_seed, k, eye);
+        vdsh_light_candidate(elo, ehi, eye_seed, k, eye);
         if (!vb_scene_free_space(occ, eye))
             continue;
         st.eyes_free++;

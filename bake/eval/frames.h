@@ -39,7 +39,8 @@
  *
  * Views (vb_frames_make_views): view 0 is the viewer's default camera for
  * the scene; the others look from eyes in the scene's free space
- * (vdsh_light.h's rule, the one for lights) at surface points they see,
+ * (vdsh_light.h's rule, the one for lights, in the light region: the
+ * bounds, or around a closed object) at surface points they see,
  * kept when a low-resolution frame shows no surface nearer than 5% of the
  * diagonal and, for each light, at least VB_FRAMES_MIN_SHARE of the
  * frame's pixels lit and as many hard-shadowed. Lights come from one pool

@@ -194,6 +194,24 @@ static float probe_nearest(const vb_scene *s, const float p[3])
     return best;
 }
 
+static int free_cb(const void *ctx, const float p[3])
+{
+    return vb_scene_free_space((const vb_scene *)ctx, p);
+}
+
+int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3])
+{
+    return vdsh_light_region(s->bounds_min, s->bounds_max, free_cb, s, lo, hi, NULL);
+}
+
+/* Where the candidates went, for the messages. */
+static const char *region_name(int grown)
+{
+    return grown ? "the scene's bounds grown by a quarter of their diagonal (too little free "
+                   "space inside them)"
+                 : "the scene's bounds";
+}
+
 const char *vb_light_rule_name(vb_light_rule rule)
 {
     static const char *const names[] = {"uniform", "ceiling", "near", "path"};
@@ -208,9 +226,10 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
         return vb_scene_place_lights(s, seed, count, out, tried, err);
     if ((unsigned)rule > VB_LIGHTS_PATH)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown light rule %d", (int)rule);
-    const float *lo = s->bounds_min, *hi = s->bounds_max;
+    float lo[3], hi[3];
+    const int grown = vb_scene_light_region(s, lo, hi);
     uint32_t n = 0, k = 0;
-    const uint64_t limit = 1000ull * (count ? count : 1);
+    const uint64_t limit = vdsh_light_tries(count, grown);
     while (n < count && k < limit) {
         float p[3];
         vdsh_light_candidate(lo, hi, seed, k++, p);
@@ -235,8 +254,8 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
     if (n < count)
         return vb_fail(err, VB_ERR_INVALID,
                        "no room for %u lights by rule %s: %u found in %u "
-                       "candidates",
-                       count, vb_light_rule_name(rule), n, k);
+                       "candidates in %s",
+                       count, vb_light_rule_name(rule), n, k, region_name(grown));
     return VB_OK;
 }
 
@@ -245,11 +264,13 @@ vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count
 {
     /* Give up when a thousand candidates per light find no room: a scene
      * without free space (a solid, or everything closer than clearance). */
+    float lo[3], hi[3];
+    const int grown = vb_scene_light_region(s, lo, hi);
     uint32_t n = 0, k = 0;
-    const uint64_t limit = 1000ull * (count ? count : 1);
+    const uint64_t limit = vdsh_light_tries(count, grown);
     while (n < count && k < limit) {
         float p[3];
-        vdsh_light_candidate(s->bounds_min, s->bounds_max, seed, k++, p);
+        vdsh_light_candidate(lo, hi, seed, k++, p);
         if (vb_scene_free_space(s, p))
             memcpy(out[n++], p, sizeof out[0]);
     }
@@ -257,8 +278,8 @@ vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count
         *tried = k;
     if (n < count)
         return vb_fail(err, VB_ERR_INVALID,
-                       "no free space for lights: %u of %u candidates in the scene's bounds "
+                       "no free space for lights: %u of %u candidates in %s "
                        "were inside solids or nearer than %g to a surface",
-                       k, k, (double)vdsh_free_clearance(s->diagonal));
+                       k - n, k, region_name(grown), (double)vdsh_free_clearance(s->diagonal));
     return VB_OK;
 }

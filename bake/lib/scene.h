@@ -63,16 +63,23 @@ static inline void vb_scene_to_local(const vb_scene *s, const float p[3], float 
 void vb_offset_origin(const float p[3], const float n[3], float out[3]);
 
 /* `count` lights placed uniformly in the free space of scene s
- * (vdsh_light.h): the candidates of the sequence `seed` that pass, in
- * order. *tried (may be NULL) gets how many candidates were drawn. Fails
- * (VB_ERR_INVALID) when 1000 candidates per light are not enough. */
+ * (vdsh_light.h): the candidates of the sequence `seed` in the scene's
+ * light region (vb_scene_light_region) that pass, in order. *tried (may be
+ * NULL) gets how many candidates were drawn. Fails (VB_ERR_INVALID) when
+ * vdsh_light_tries candidates are not enough (1000 per light in the
+ * bounds; a few thousand in a grown region). */
 vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
                                 uint32_t *tried, vb_error *err);
 
+/* The region lights are placed in (vdsh_light_region): the bounds, or,
+ * when they hold too little free space (a closed object), the bounds grown
+ * by a quarter of their diagonal. Returns 1 when grown. */
+int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3]);
+
 /* Other ways to place lights, for reports that a figure does not hang on
  * one light distribution (issue 25): all in free space, from the same
- * seeded candidates: uniform (vb_scene_place_lights), near the ceiling
- * (the top fifth of the bounds' height, +y up), near surfaces (a surface
+ * seeded candidates in the light region: uniform (vb_scene_place_lights),
+ * near the ceiling (the top fifth of the region's height, +y up), near surfaces (a surface
  * within 5% of the diagonal along a probe direction), along a path (a
  * walk along x at two thirds of the height, swinging across z). */
 typedef enum vb_light_rule {

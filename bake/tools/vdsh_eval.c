@@ -421,6 +421,8 @@ static int write_json(const char *out, const context *c, char *msg, size_t cap)
     vt_json_u64(&j, ev, "scene_lights", r->light_count);
     vt_json_string(&j, ev, "scene_light_rule", vb_light_rule_name((vb_light_rule)c->d->light_rule));
     vt_json_u64(&j, ev, "scene_light_candidates", r->light_candidates);
+    if (r->light_region_grown) /* only then: earlier JSONs stay as they were */
+        vt_json_string(&j, ev, "scene_light_region", "grown");
     cJSON *lp = vt_json_array(&j, ev, "scene_light_positions");
     for (uint32_t l = 0; l < r->light_count; l++)
         json_vec(&j, lp, NULL, r->lights[l]);
@@ -561,6 +563,10 @@ static void print_table(FILE *o, const context *c)
             "false = P(s_hat < .5 | d_T >= d_L), recall = P(s_hat < .5 | s_ideal < .5)\n\n",
             r->light_count, rule ? "by the light rule '" : "uniformly",
             rule ? vb_light_rule_name(rule) : "", rule ? "'" : "");
+    if (r->light_region_grown)
+        fprintf(o, "  (the scene's bounds hold too little free space, a closed object: the "
+                   "lights are placed\n  around it, in the bounds grown by a quarter of their "
+                   "diagonal on every side)\n\n");
     fprintf(o, "  %-8s %5s %6s %3s %3s %-9s | %7s | %-15s %-13s %-12s | %-6s %6s %6s\n", "",
             "order", "offset", "B/v", "enc", "fit", "pairs", "smooth: MAE", "false", "recall",
             "binary", "false", "recall");
