@@ -172,49 +172,35 @@ static const double (*rot_set(const vb_fit *f, int l))[3]
     return l < 5 ? (const double(*)[3])f->rot_dirs : (const double(*)[3])f->rot_dirs_high;
 }
 
-/* G_ij = integral over z > 0 of Y_i Y_j, plus lambda (l(l+1))^2 on the
- * diagonal: Gauss-Legendre in z (exact to degree 31) times 64 azimuths
- * (exact for cos/sin of order < 64); the products have degree <= 30. */
-static void hemisphere_gram(int order, double lambda, double *G)
-{
-    enum { NZ = 16, NP = 64 };
-    int n = order * order;
-    double zx[NZ], zw[NZ], y[VB_FIT_MAX];
-    gauss01(NZ, zx, zw);
-    memset(G, 0, (size_t)n * n * sizeof *G);
-    for (int a = 0; a < NZ; a++)
-        for (int b = 0; b < NP; b++) {
-            double r = sqrt(1.0 - zx[a] * zx[a]), phi = 2.0 * PI * (b + 0.5) / NP;
-            double d[3] = {r * vdsh_det_cos(phi), r * vdsh_det_sin(phi), zx[a]};
-            eval_d(order, d, y);
-            double w = zw[a] * 2.0 * PI / NP;
-            for (int i = 0; i < n; i++)
-                for (int j = 0; j < n; j++)
-                    G[i * n + j] += w * y[i] * y[j];
-        }
-    for (int i = 0; i < n; i++) {
-        double l = band_of(i);
-        G[i * n + i] += lambda * (l * (l + 1)) * (l * (l + 1));
-    }
-}
-
-/* h_i = integral over z > 0 of Y_i, by hemisphere_gram's quadrature. */
-static void hemisphere_integral(int order, double *h)
+/* h_i = integral over z > 0 of Y_i, and (G not NULL) G_ij = integral
+ * over z > 0 of Y_i Y_j plus lambda (l(l+1))^2 on the diagonal:
+ * Gauss-Legendre in z (exact to degree 31) times 64 azimuths (exact for
+ * cos/sin of order < 64); the products have degree <= 30. */
+static void hemisphere_moments(int order, double lambda, double *h, double *G)
 {
     enum { NZ = 16, NP = 64 };
     int n = order * order;
     double zx[NZ], zw[NZ], y[VB_FIT_MAX];
     gauss01(NZ, zx, zw);
     memset(h, 0, (size_t)n * sizeof *h);
+    if (G)
+        memset(G, 0, (size_t)n * n * sizeof *G);
     for (int a = 0; a < NZ; a++)
         for (int b = 0; b < NP; b++) {
             double r = sqrt(1.0 - zx[a] * zx[a]), phi = 2.0 * PI * (b + 0.5) / NP;
             double d[3] = {r * vdsh_det_cos(phi), r * vdsh_det_sin(phi), zx[a]};
             eval_d(order, d, y);
             double w = zw[a] * 2.0 * PI / NP;
-            for (int i = 0; i < n; i++)
+            for (int i = 0; i < n; i++) {
                 h[i] += w * y[i];
+                for (int j = 0; G && j < n; j++)
+                    G[i * n + j] += w * y[i] * y[j];
+            }
         }
+    for (int i = 0; G && i < n; i++) {
+        double l = band_of(i);
+        G[i * n + i] += lambda * (l * (l + 1)) * (l * (l + 1));
+    }
 }
 
 /* Per band l: pinv_l = B_l^T (B_l B_l^T)^-1 of the basis block at the
@@ -284,7 +270,7 @@ vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out, 
     f->lambda = lambda;
     for (int i = 0; i < n; i++)
         f->window[i] = 1.0;
-    hemisphere_integral(order, f->hemi);
+    hemisphere_moments(order, lambda, f->hemi, base == VB_FIT_LSQ ? G : NULL);
 
     int ok = 1;
     switch (base) {
@@ -301,7 +287,6 @@ vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out, 
         }
         break;
     case VB_FIT_LSQ:
-        hemisphere_gram(order, lambda, G);
         ok = invert(n, G, f->M);
         if (ok == 0) {
             r = vb_fail(err, VB_ERR_ARGUMENT,
