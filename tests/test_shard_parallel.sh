@@ -28,6 +28,14 @@ msg=$(PATH=$tmp/bin VDSH_BAKE=$bake VDSH_MERGE=$merge "$tmp/bin/bash" "$scripts/
 rc=$?
 [[ $rc -eq 1 && $msg == *"no GNU parallel"* ]] || { echo "FAIL: without parallel: exit $rc: $msg" >&2; fail=1; }
 ls "$tmp"/nopar* >/dev/null 2>&1 && { echo "FAIL: without parallel: files written" >&2; fail=1; }
+# vdsh-bake's own output or shard among its arguments: refused, exit 2,
+# nothing baked (a user's -o was silently overridden by the script's).
+for a in "-o $tmp/y.vdsh" "--output=$tmp/y.vdsh" "--shard 1/2"; do
+  msg=$(VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-parallel" 2 "$tmp/x.vdsh" -- "${tiny[@]}" $a 2>&1)
+  rc=$?
+  [[ $rc -eq 2 && $msg == *"among vdsh-bake's arguments"* ]] || { echo "FAIL: '$a': exit $rc: $msg" >&2; fail=1; }
+done
+ls "$tmp"/[xy].* "$tmp"/x.part-* >/dev/null 2>&1 && { echo "FAIL: -o among the arguments: files written" >&2; fail=1; }
 "$bake" "${tiny[@]}" -q -o "$tmp/whole.vdsh" || { echo "FAIL: whole bake" >&2; exit 1; }
 export VDSH_BAKE=$bake VDSH_MERGE=$merge
 name="$tmp/it's a \$cene"

@@ -24,6 +24,14 @@ msg=$(cd "$nos" && PATH=$nos VDSH_BAKE=$bake VDSH_MERGE=$merge "$nos/bash" "$scr
 rc=$?
 [[ $rc -eq 1 && $msg == *"no sbatch"* ]] || { echo "FAIL: without sbatch: exit $rc: $msg" >&2; fail=1; }
 ls "$nos"/x* >/dev/null 2>&1 && { echo "FAIL: without sbatch: files written" >&2; fail=1; }
+# vdsh-bake's own output or shard among its arguments: refused, exit 2 (a
+# user's -o was silently overridden by the script's).
+for a in "-o $nos/y.vdsh" "--output=$nos/y.vdsh" "-o$nos/y.vdsh" "--shard 1/2"; do
+  msg=$(VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-slurm" 2 "$nos/x.vdsh" -- builtin:room $a 2>&1)
+  rc=$?
+  [[ $rc -eq 2 && $msg == *"among vdsh-bake's arguments"* ]] || { echo "FAIL: '$a': exit $rc: $msg" >&2; fail=1; }
+done
+ls "$nos"/[xy]* >/dev/null 2>&1 && { echo "FAIL: -o among the arguments: files written" >&2; fail=1; }
 rm -rf "$nos"
 skip() { [[ $fail -eq 0 ]] || exit 1; echo "SKIP: $1"; exit 77; }
 [[ $(id -u) -eq 0 ]] || skip "needs root to start slurmctld and slurmd"
