@@ -115,6 +115,7 @@ typedef struct job {
     _Atomic uint64_t cap_bound, lit_training, lit_false;
     _Atomic uint32_t dec_fitted, dec_fallbacks;
     _Atomic uint64_t dec_pairs, dec_rays;
+    _Atomic uint64_t cal_shadowed; /* the calibration's shadowed held-out pairs */
     _Atomic uint64_t traced, missed;
     _Atomic uint32_t degenerate;
 } job;
@@ -568,6 +569,10 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
     atomic_fetch_add(&J->dec_rays, rays);
     if (!h)
         return fitted;
+    uint64_t shadowed = 0;
+    for (uint32_t i = 0; i < h; i++)
+        shadowed += lab[i] != 0;
+    atomic_fetch_add(&J->cal_shadowed, shadowed);
     vdsh_sh_eval_soa((int)top, h, x, y, z, Y, K);
     for (int o = 0; o <= VDSH_MAX_ORDER; o++) {
         const float *c = o ? out->coeffs[1][o] : varc && fitted ? varc[*var_k] : NULL;
@@ -1657,7 +1662,10 @@ static float capped_rate_offset(const float *m, const float *cap, uint32_t count
 /* The calibrated log offset of margin slot `slot` (an order; 0: the
  * adaptive order's chosen fits): the lit held-out margins of the
  * cal_count samples gathered into lit, offset for false_rate, within
- * -5..5. */
+ * -5..5; and not below 0 when no held-out light was shadowed (an offset
+ * below 0 trades false shadows for recall, and there is nothing to
+ * recall: a closed object's corners, which then shortened every
+ * distance by up to e^-2.3). */
 static float slot_offset(const job *J, uint32_t cal_count, int slot, float false_rate, float *lit,
                          float *lit_cap, int capped)
 {
@@ -1673,6 +1681,8 @@ static float slot_offset(const job *J, uint32_t cal_count, int slot, float false
         }
     float off = capped ? capped_rate_offset(lit, lit_cap, k, false_rate, J->free_offset[slot])
                        : vb_decision_offset(lit, k, false_rate);
+    if (atomic_load(&J->cal_shadowed) == 0 && off < 0.0f)
+        off = 0.0f;
     return off < -5.0f ? -5.0f : off > 5.0f ? 5.0f : off;
 }
 
