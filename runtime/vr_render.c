@@ -401,7 +401,9 @@ static vr_result ensure_shadow_tex(vr_renderer *r, int slot, vr_error *err)
 
 /* Near and far planes of a light's face projections: far reaches the
  * farthest corner of the scene; near is a fixed fraction of it (32-bit
- * float depth keeps about far/near * 2^-24 relative precision at far). */
+ * float depth keeps about far/near * 2^-24 relative precision at far).
+ * Both relative to the scene, so a scene 1e-11 across keeps its shadows
+ * (an absolute margin of 1e-6 put it inside the near plane). */
 static void shadow_planes(const vr_scene *s, const float l[3], float nf[2])
 {
     float far2 = 0.0f;
@@ -413,7 +415,9 @@ static void shadow_planes(const vr_scene *s, const float l[3], float nf[2])
         }
         far2 = fmaxf(far2, d2);
     }
-    float far = 1.01f * sqrtf(far2) + 1e-6f;
+    float far = 1.01f * sqrtf(far2);
+    if (!(far > 0.0f))
+        far = 1.0f; /* the light at the only point of the scene */
     nf[0] = far * 1e-3f;
     nf[1] = far;
 }
@@ -428,8 +432,11 @@ static void face_view_proj(int f, const float eye[3], const float nf[2], float o
                                     {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
     static const float up[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1},
                                    {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+    /* The target a step away at the eye's own scale: eye + 1 is the eye
+     * itself in float beyond 2^24 (no view, no shadows). */
+    const float k = 1.0f + fmaxf(fabsf(eye[0]), fmaxf(fabsf(eye[1]), fabsf(eye[2])));
     vdsh_camera c = {{eye[0], eye[1], eye[2]},
-                     {eye[0] + dir[f][0], eye[1] + dir[f][1], eye[2] + dir[f][2]},
+                     {eye[0] + k * dir[f][0], eye[1] + k * dir[f][1], eye[2] + k * dir[f][2]},
                      {up[f][0], up[f][1], up[f][2]},
                      90.0f};
     float view[16], proj[16];

@@ -210,7 +210,7 @@ if(TARGET vdsh-bake)
   add_test(NAME runtime_view_scale COMMAND sh -c [=[
 v=$1; bake=$2; d=$3; fail=0
 rm -rf "$d"; mkdir -p "$d"
-for s in 1 1e-11 1e-16 1e20; do
+for s in 1 1e-11 1e10 1e17 1e-16 1e20; do
   awk -v s=$s 'BEGIN {
     split("0 0 0 4 0 0 4 0 4 0 0 4 1 1 1 3 1 1 3 1 3 1 1 3", c, " ")
     for (i = 0; i < 8; i++) printf "v %.9g %.9g %.9g\n", c[3*i+1]*s, c[3*i+2]*s, c[3*i+3]*s
@@ -221,6 +221,16 @@ done
 "$v" -q --render "$d/s1.png" --size 64x48 --mode none "$d/s1.vdsh" || fail=1
 "$v" -q --render "$d/s1e-11.png" --size 64x48 --mode none "$d/s1e-11.vdsh" || fail=1
 cmp "$d/s1.png" "$d/s1e-11.png" || { echo "a scene 1e-11 across draws differently"; fail=1; }
+# Cube shadow maps at any scale the view takes: the same image, and not
+# the unshadowed one (their near plane had an absolute margin of 1e-6, and
+# the faces' targets eye + 1, which is the eye in float beyond 2^24).
+for s in 1 1e-11 1e10 1e17; do
+  "$v" -q --render "$d/c$s.png" --size 64x48 --mode cube "$d/s$s.vdsh" || fail=1
+done
+! cmp -s "$d/c1.png" "$d/s1.png" || { echo "cube maps draw no shadow at unit size"; fail=1; }
+for s in 1e-11 1e10 1e17; do
+  cmp "$d/c1.png" "$d/c$s.png" || { echo "cube maps at scale $s draw differently"; fail=1; }
+done
 for c in "1e-16 scale the scene up" "1e20 scale the scene down"; do
   s=${c%% *}; want=${c#* }
   out=$("$v" -q --render "$d/x.png" --size 64x48 "$d/s$s.vdsh" 2>&1); rc=$?
