@@ -218,6 +218,17 @@ for s in 1 1e-11 1e10 1e17 1e-16 1e20; do
   }' > "$d/s$s.obj"
   "$bake" "$d/s$s.obj" --rays 16 --cube-size 0 -q -o "$d/s$s.vdsh" || { echo "bake at scale $s failed"; fail=1; }
 done
+# The bake takes every scale but says which ones the views refuse.
+for c in "1e20 down" "1e-16 up" "1 none"; do
+  s=${c%% *}; want=${c#* }
+  out=$("$bake" "$d/s$s.obj" --rays 16 --cube-size 0 -o "$d/w.vdsh" 2>&1)
+  case $want:$out in
+    none:*"warning: the scene"*) echo "scale $s: a warning the views do not need"; fail=1 ;;
+    none:*) ;;
+    *:*"warning: the scene"*"scale the scene $want"*) ;;
+    *) echo "scale $s: no warning to scale the scene $want: $out"; fail=1 ;;
+  esac
+done
 "$v" -q --render "$d/s1.png" --size 64x48 --mode none "$d/s1.vdsh" || fail=1
 "$v" -q --render "$d/s1e-11.png" --size 64x48 --mode none "$d/s1e-11.vdsh" || fail=1
 cmp "$d/s1.png" "$d/s1e-11.png" || { echo "a scene 1e-11 across draws differently"; fail=1; }

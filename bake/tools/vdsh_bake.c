@@ -32,6 +32,7 @@
 #include "vdsh.h"
 #include "vdsh_cpca.h"
 #include "vdsh_output.h"
+#include "vdsh_scene_view.h"
 #include "vt_cli.h"
 #include "vt_json.h"
 
@@ -1208,6 +1209,22 @@ static void say_receivers(FILE *log, const options *o, const vb_job *job, vb_mes
                 100.0 * spacing->long_area, 100.0 * VB_SPACING_WARN_EDGE, (double)spacing->diagonal,
                 (double)spacing->median_edge, (double)spacing->p90_edge,
                 (double)spacing->suggest_edge);
+    /* The bake takes any scale (a normalised frame); the views do not. */
+    if (log && (o->output || o->plan) && rec->vertex_count) {
+        float lo[3], hi[3], far = 0.0f, across = 0.0f;
+        vb_mesh_bounds(rec, lo, hi);
+        for (int k = 0; k < 3; k++) {
+            far = fmaxf(far, fmaxf(fabsf(lo[k]), fabsf(hi[k])));
+            across = fmaxf(across, hi[k] - lo[k]);
+        }
+        if (far > VDSH_VIEW_MAX_COORD || !(across >= VDSH_VIEW_MIN_EXTENT))
+            fprintf(log,
+                    "vdsh-bake: warning: the scene is %g across with coordinates up to %g: "
+                    "vdsh-view, vdsh-frames views and vdsh-export refuse scenes beyond %g or "
+                    "under %g across (float views); scale the scene %s to view the bake\n",
+                    (double)across, (double)far, (double)VDSH_VIEW_MAX_COORD,
+                    (double)VDSH_VIEW_MIN_EXTENT, far > VDSH_VIEW_MAX_COORD ? "down" : "up");
+    }
 }
 
 /* What the bake did: rounds, fits, rays, repairs and warnings. */
