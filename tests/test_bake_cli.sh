@@ -170,6 +170,11 @@ expect_exit 2 "--adaptive with a negative tolerance" "$bake" builtin:room --max-
 expect_exit 2 "--min-edge without --adaptive" "$bake" builtin:room --max-edge 1 --min-edge 0.1 -o "$tmp/x.vdsh"
 expect_exit 2 "--max-receivers without --adaptive" "$bake" builtin:room --max-edge 1 --max-receivers 9 -o "$tmp/x.vdsh"
 expect_exit 2 "--adaptive with --shard" "$bake" builtin:room --max-edge 1 --adaptive 0.1 --shard 0/2 -o "$tmp/x.vdsh"
+expect_exit 2 "the same mesh twice" "$bake" builtin:room builtin:room -o "$tmp/x.vdsh"
+check "the same mesh twice is named" grep -q "builtin:room given twice" "$tmp/err.txt"
+ln -sf room.obj "$tmp/room-link.obj"
+expect_exit 2 "one file under two names" "$bake" "$tmp/room.obj" "$tmp/room-link.obj" -o "$tmp/x.vdsh"
+check "one file under two names is named" grep -q "are the same file" "$tmp/err.txt"
 expect_exit 1 "--max-receivers below the start mesh" "$bake" builtin:room --max-edge 1 --adaptive 0.1 --max-receivers 9 -o "$tmp/x.vdsh"
 check "no output after usage errors" test ! -e "$tmp/x.vdsh"
 expect_exit 0 "--help" "$bake" --help

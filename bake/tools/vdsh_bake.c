@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "bake.h"
@@ -941,6 +942,27 @@ static int check_options(options *o)
         return bad_usage("%s", "no mesh given");
     if (o->mesh_count > VDSH_MAX_SOURCES)
         return bad_usage("%s", "too many meshes (at most 64)");
+    /* The same mesh twice (by name, or the same file by device and inode)
+     * would bake its triangles twice, each over the other. */
+    for (int i = 1; i < o->mesh_count; i++)
+        for (int j = 0; j < i; j++) {
+            struct stat a, b;
+            int same = strcmp(o->meshes[i], o->meshes[j]) == 0 ||
+                       (stat(o->meshes[i], &a) == 0 && stat(o->meshes[j], &b) == 0 &&
+                        S_ISREG(a.st_mode) && a.st_dev == b.st_dev && a.st_ino == b.st_ino);
+            if (same) {
+                char msg[2 * PATH_MAX + 128];
+                if (strcmp(o->meshes[i], o->meshes[j]) == 0)
+                    snprintf(msg, sizeof msg, "%s given twice", o->meshes[i]);
+                else
+                    snprintf(msg, sizeof msg, "%s and %s are the same file", o->meshes[j],
+                             o->meshes[i]);
+                size_t len = strlen(msg);
+                snprintf(msg + len, sizeof msg - len,
+                         ": its triangles would be baked twice, each copy over the other");
+                return bad_usage("%s", msg);
+            }
+        }
     /* What the method's row allows. */
     const vb_method_info *mi = vb_method_get(o->method);
     vdsh_quantity stored = vb_quantity_stored(o->quantity);
