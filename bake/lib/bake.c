@@ -750,7 +750,7 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
                         float l = fast_log(dist[p][k] > log_floor ? dist[p][k] : log_floor);
                         logd[p][k] = l * (float)(valid[p][k] & 1);
                     }
-            if (want[1] && centre && !have_level) {
+            if (centre && !have_level) {
                 float sum = 0.0f;
                 uint32_t cnt = 0;
                 for (int p = 0; p < np; p++)
@@ -813,7 +813,7 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
         cells_used = pk * VB_PACKET;
         if (round + 1 < rounds && (want[0] || want[1])) {
             float cur[VDSH_MAX_COEFFS];
-            adapt_fit(J, n, acc[aq], cells_used, aq ? (double)level : 0.0, cur);
+            adapt_fit(J, n, acc[aq], cells_used, level, cur); /* level: 0 unless aq */
             int stop = 0;
             if (round > 0) {
                 double sum = 0.0;

@@ -249,6 +249,8 @@ float vb_fit_lambda(float lambda, int order)
     return (float)(lambda * s * s);
 }
 
+static inline void rotate_x(const vb_fit *f, int order, int transpose, double *v);
+
 vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out, vb_error *err)
 {
     if (order < 1 || order > VDSH_MAX_ORDER)
@@ -338,6 +340,7 @@ vb_result vb_fit_create(int order, vb_fit_base base, float lambda, vb_fit *out, 
                            f->X[lj][(j - oj) * kj + b];
             f->NT[j * n + i] = sum;
         }
+    rotate_x(f, order, 0, f->hemi); /* into u's frame, once */
     *out = *f;
 done:
     free(G);
@@ -488,12 +491,8 @@ void vb_fit_add_constant(const vb_fit *f, int hemisphere, double m, double *u)
         u[0] += m * sqrt(4.0 * PI); /* the whole sphere: 1 is sqrt(4 pi) Y_0 */
         return;
     }
-    /* u's frame is X^T's image of the local one (N = X M X^T) */
-    double h[VB_FIT_MAX];
-    memcpy(h, f->hemi, (size_t)f->order * f->order * sizeof *h);
-    rotate_x(f, f->order, 0, h);
     for (int i = 0; i < f->order * f->order; i++)
-        u[i] += m * h[i];
+        u[i] += m * f->hemi[i];
 }
 
 void vb_fit_apply(const vb_fit *f, const float n[3], const double *b, float *c)

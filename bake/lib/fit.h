@@ -55,8 +55,9 @@ typedef struct vb_fit {
     vb_fit_base base;                   /* the map (a method's row, method.h) */
     float lambda;                       /* lsq regularisation */
     double window[VB_FIT_MAX];          /* per coefficient: its band's weight */
-    double hemi[VB_FIT_MAX];            /* integral over z > 0 of Y_i: the local
-                                         * frame's projection of the constant 1 */
+    double hemi[VB_FIT_MAX];            /* X times the integral over z > 0 of
+                                         * Y_i: the projection of the constant 1,
+                                         * in u's frame (vb_fit_unrotate) */
     double M[VB_FIT_MAX * VB_FIT_MAX];  /* local-frame map, order^2 square */
     double NT[VB_FIT_MAX * VB_FIT_MAX]; /* N = X M X^T, order^2 square,
                                        * column-major */
