@@ -69,16 +69,8 @@ vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err)
      * rather than as a zero scene diagonal deep in the bake. */
     const vb_mesh *o = &j->occluders;
     int any_area = 0;
-    for (uint32_t t = 0; t < o->triangle_count && !any_area; t++) {
-        const float *a = o->positions + 3 * (size_t)o->indices[3 * (size_t)t],
-                    *b = o->positions + 3 * (size_t)o->indices[3 * (size_t)t + 1],
-                    *c = o->positions + 3 * (size_t)o->indices[3 * (size_t)t + 2];
-        double u[3], v[3];
-        for (int k = 0; k < 3; k++)
-            u[k] = (double)b[k] - a[k], v[k] = (double)c[k] - a[k];
-        any_area = u[1] * v[2] - u[2] * v[1] != 0.0 || u[2] * v[0] - u[0] * v[2] != 0.0 ||
-                   u[0] * v[1] - u[1] * v[0] != 0.0;
-    }
+    for (uint32_t t = 0; t < o->triangle_count && !any_area; t++)
+        any_area = vb_triangle_has_area(o->positions, o->indices + 3 * (size_t)t);
     if (!any_area)
         return vb_fail(err, VB_ERR_INVALID,
                        "%s%s: no triangle has any area (all %u are a line or a point): "

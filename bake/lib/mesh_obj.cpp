@@ -128,7 +128,7 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
                        "%s: UTF-16 text is not supported (save as UTF-8 or ASCII)", path);
     /* A UTF-8 byte order mark is not part of the first line: read as its
      * keyword, it hid a first "v" line and shifted every index after it. */
-    if (size >= 3 && bytes[0] == 0xef && bytes[1] == 0xbb && bytes[2] == 0xbf)
+    if (utf8_bom(bytes, size))
         bytes += 3, size -= 3;
 
     /* Positive indices may point forward, so count the "v" lines before

@@ -45,7 +45,7 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
     if (p < le && (*p == '4' || *p == 'n'))
         return vb_fail(err, VB_ERR_FORMAT,
                        "%s: 4OFF/nOFF (vertex dimension other than 3) is not supported", path);
-    if (size >= 3 && bytes[0] == 0xef && bytes[1] == 0xbb && bytes[2] == 0xbf)
+    if (utf8_bom(bytes, size))
         return vb_fail(err, VB_ERR_FORMAT,
                        "%s: starts with a UTF-8 byte order mark: save it without one (the "
                        "first line must be [ST][C][N]OFF)",

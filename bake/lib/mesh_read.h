@@ -158,6 +158,12 @@ const uint64_t max_count = 0x7fffffffu;
 /* Little binary helpers                                                  */
 /* ====================================================================== */
 
+/* Whether a text file starts with a UTF-8 byte order mark (EF BB BF). */
+inline bool utf8_bom(const uint8_t *bytes, size_t size)
+{
+    return size >= 3 && bytes[0] == 0xef && bytes[1] == 0xbb && bytes[2] == 0xbf;
+}
+
 inline uint32_t load_u32(const uint8_t *p, bool big_endian)
 {
     return big_endian ? (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3]

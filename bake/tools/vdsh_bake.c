@@ -21,7 +21,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include "bake.h"
@@ -946,22 +945,19 @@ static int check_options(options *o)
      * would bake its triangles twice, each over the other. */
     for (int i = 1; i < o->mesh_count; i++)
         for (int j = 0; j < i; j++) {
-            struct stat a, b;
-            int same = strcmp(o->meshes[i], o->meshes[j]) == 0 ||
-                       (stat(o->meshes[i], &a) == 0 && stat(o->meshes[j], &b) == 0 &&
-                        S_ISREG(a.st_mode) && a.st_dev == b.st_dev && a.st_ino == b.st_ino);
-            if (same) {
-                char msg[2 * PATH_MAX + 128];
-                if (strcmp(o->meshes[i], o->meshes[j]) == 0)
-                    snprintf(msg, sizeof msg, "%s given twice", o->meshes[i]);
-                else
-                    snprintf(msg, sizeof msg, "%s and %s are the same file", o->meshes[j],
-                             o->meshes[i]);
-                size_t len = strlen(msg);
-                snprintf(msg + len, sizeof msg - len,
-                         ": its triangles would be baked twice, each copy over the other");
-                return bad_usage("%s", msg);
-            }
+            const int named_twice = strcmp(o->meshes[i], o->meshes[j]) == 0;
+            if (!named_twice && !vt_cli_same_file(o->meshes[j], o->meshes[i]))
+                continue;
+            char msg[2 * PATH_MAX + 128];
+            if (named_twice)
+                snprintf(msg, sizeof msg, "%s given twice", o->meshes[i]);
+            else
+                snprintf(msg, sizeof msg, "%s and %s are the same file", o->meshes[j],
+                         o->meshes[i]);
+            size_t len = strlen(msg);
+            snprintf(msg + len, sizeof msg - len,
+                     ": its triangles would be baked twice, each copy over the other");
+            return bad_usage("%s", msg);
         }
     /* What the method's row allows. */
     const vb_method_info *mi = vb_method_get(o->method);
