@@ -233,10 +233,11 @@ vdsh_result vdsh_sdf_write_memory(const vdsh_sdf *v, void **out, size_t *size, v
     return VDSH_OK;
 }
 
-vdsh_result vdsh_sdf_write(const char *path, const vdsh_sdf *v, vdsh_error *err)
+vdsh_result vdsh_sdf_stage(const char *path, const vdsh_sdf *v, vdsh_output *out, vdsh_error *err)
 {
     void *data;
     size_t size;
+    *out = (vdsh_output){.fd = -1};
     vdsh_result r = vdsh_sdf_write_memory(v, &data, &size, err);
     if (r != VDSH_OK) {
         if (err) {
@@ -246,9 +247,20 @@ vdsh_result vdsh_sdf_write(const char *path, const vdsh_sdf *v, vdsh_error *err)
         }
         return r;
     }
-    r = vdsh_output_write(path, data, size, err);
+    r = vdsh_output_open(path, out, err);
+    if (r == VDSH_OK) {
+        vdsh_output_put(out, data, size);
+        r = vdsh_output_finish(out, err);
+    }
     free(data);
     return r;
+}
+
+vdsh_result vdsh_sdf_write(const char *path, const vdsh_sdf *v, vdsh_error *err)
+{
+    vdsh_output out;
+    vdsh_result r = vdsh_sdf_stage(path, v, &out, err);
+    return r == VDSH_OK ? vdsh_output_commit(&out, err) : r;
 }
 
 void vdsh_sdf_free(vdsh_sdf *v)

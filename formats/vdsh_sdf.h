@@ -81,6 +81,13 @@ vdsh_result vdsh_sdf_read_memory(const void *data, size_t size, const char *name
                                  vdsh_error *err);
 /* Atomically (vdsh_output.h); validates with the reader's rules first. */
 vdsh_result vdsh_sdf_write(const char *path, const vdsh_sdf *v, vdsh_error *err);
+/* The same, staged: written beside `path` and put on disk, not yet
+ * renamed; the caller commits or aborts *out (vdsh_output.h), so that the
+ * volume appears together with its .vdsh file (vdsh-bake --sdf). On
+ * failure *out is released. */
+struct vdsh_output;
+vdsh_result vdsh_sdf_stage(const char *path, const vdsh_sdf *v, struct vdsh_output *out,
+                           vdsh_error *err);
 /* The file's bytes in a malloc'd buffer. */
 vdsh_result vdsh_sdf_write_memory(const vdsh_sdf *v, void **out, size_t *size, vdsh_error *err);
 void vdsh_sdf_free(vdsh_sdf *v);

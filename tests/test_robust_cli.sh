@@ -213,6 +213,55 @@ for k in 09-12 13-16 17-20 21-24; do
   cmp -s "$tmp/keep.sh$k.exr" "$tmp/keep.sh$k.orig" || { echo "FAIL: existing cubemap sh$k changed" >&2; fail=1; }
 done
 
+# ---- Side outputs (--plan, --export-obj, --sdf) appear with the bake ------
+# They are staged when made and renamed only when the whole bake succeeds:
+# a bake that fails or is interrupted after making them leaves none.
+# empty_out WHAT: the output folder must be empty (then emptied).
+empty_out() {
+  if [[ -n $(ls -A "$out") ]]; then
+    echo "FAIL: $1: files left in the output folder: $(ls -A "$out")" >&2; fail=1
+    rm -f "$out"/* "$out"/.[!.]* 2>/dev/null
+  fi
+}
+cases=$((cases + 1))   # the bake fails after the plan and the export are made
+"$bake" "$in/good.obj" --shard 0/5 --rays 16 -q --plan "$out/plan.obj" \
+  --export-obj "$out/export.obj" -o "$out/scene.vdsh" 2>"$tmp/stderr"
+rc=$?
+[[ $rc -eq 1 ]] && grep -qF "shard 0/5" "$tmp/stderr" ||
+  { echo "FAIL: --shard 0/5 of 3 receivers: exit $rc: $(cat "$tmp/stderr")" >&2; fail=1; }
+empty_out "a failed bake's --plan and --export-obj"
+cases=$((cases + 1))   # interrupted while tracing, the plan and the export made
+"$bake" builtin:room --max-edge 0.5 --rays 512 --threads 1 -q --plan "$out/plan.obj" \
+  --export-obj "$out/export.obj" --sdf 8 -o "$out/scene.vdsh" 2>/dev/null &
+pid=$!
+for _ in $(seq 600); do   # until the plan is made (staged, or written by old code)
+  compgen -G "$out/export.obj*" >/dev/null && break
+  sleep 0.05
+done
+sleep 0.2
+kill -TERM $pid 2>/dev/null
+wait $pid
+rc=$?
+if [[ $rc -eq 0 ]]; then
+  echo "note: the bake ended before SIGTERM; the interrupted case not tried"
+  rm -f "$out"/*
+else
+  [[ $rc -eq 143 ]] || { echo "FAIL: SIGTERM while tracing: exit $rc, want 143" >&2; fail=1; }
+  empty_out "an interrupted bake's side outputs"
+fi
+cases=$((cases + 1))   # a bake that succeeds writes them all, and no temporary
+"$bake" "$in/good.obj" --rays 16 -q --plan "$out/plan.ply" --export-obj "$out/export.obj" \
+  --sdf 8 -o "$out/scene.vdsh" ||
+  { echo "FAIL: good.obj with --plan, --export-obj and --sdf does not bake" >&2; fail=1; }
+for k in plan.ply export.obj scene.sdf scene.vdsh; do
+  [[ -s $out/$k ]] || { echo "FAIL: the successful bake did not write $k" >&2; fail=1; }
+done
+[[ -z $(compgen -G "$out/*.tmp.*") ]] || { echo "FAIL: temporaries left: $(ls "$out")" >&2; fail=1; }
+"$bake" "$in/good.obj" --rays 16 -q --plan "$out/only.obj" ||
+  { echo "FAIL: --plan alone does not write the plan" >&2; fail=1; }
+[[ -s $out/only.obj ]] || { echo "FAIL: --plan alone did not write the plan" >&2; fail=1; }
+rm -f "$out"/*
+
 # ---- vdsh-info on damaged .vdsh files -------------------------------------
 good=$tmp/keep.orig
 size=$(stat -c %s "$good")

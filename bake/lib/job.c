@@ -347,7 +347,8 @@ vb_result vb_output_cubemap_path(const char *output, const char *cubemap_dir, in
 }
 
 vb_result vb_write_outputs(const vdsh_file *f, const char *output, const char *cubemap_dir,
-                           const vb_cubemap_basis *b, uint64_t *bytes, vb_error *err)
+                           const vb_cubemap_basis *b, vdsh_output *also, int also_count,
+                           uint64_t *bytes, vb_error *err)
 {
     if (!output)
         return vb_fail(err, VB_ERR_ARGUMENT, "no output file");
@@ -376,8 +377,17 @@ vb_result vb_write_outputs(const vdsh_file *f, const char *output, const char *c
     /* 2. The cubemaps, staged too. */
     if (r == VB_OK && b)
         r = vb_cubemap_basis_stage(b, cubemap_dir ? cubemap_dir : dir, stem, cubes, err);
-    /* 3. All complete: rename, the .vdsh file last. */
-    int renamed = 0;
+    /* 3. All complete: rename, the caller's staged files, then the
+     * cubemaps, then the .vdsh file last. */
+    int renamed = 0, renamed_also = 0;
+    for (int k = 0; r == VB_OK && k < also_count; k++) {
+        if (!also[k].path) /* none staged there */
+            continue;
+        if (vdsh_output_commit(&also[k], &verr) != VDSH_OK)
+            r = vb_fail(err, VB_ERR_IO, "%s", verr.msg);
+        else
+            renamed_also++;
+    }
     for (int k = 0; r == VB_OK && b && k < VB_CUBEMAP_BASIS_FILES; k++) {
         if (vdsh_output_commit(&cubes[k], &verr) != VDSH_OK)
             r = vb_fail(err, VB_ERR_IO, "%s", verr.msg);
@@ -386,17 +396,22 @@ vb_result vb_write_outputs(const vdsh_file *f, const char *output, const char *c
     }
     if (r == VB_OK && vdsh_output_commit(&file, &verr) != VDSH_OK)
         r = vb_fail(err, VB_ERR_IO, "%s", verr.msg);
+    if (r != VB_OK && renamed_also > 0)
+        vb_append(err, " (%d side files were already replaced)", renamed_also);
     if (r != VB_OK && renamed > 0)
         vb_append(err, " (%d basis cubemaps were already replaced)", renamed);
     for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
         vdsh_output_abort(&cubes[k]);
+    for (int k = 0; k < also_count; k++)
+        vdsh_output_abort(&also[k]);
     vdsh_output_abort(&file);
     if (r == VB_OK && bytes)
         *bytes = size;
     return r;
 }
 
-vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vb_error *err)
+vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vdsh_output *also, int also_count,
+                       vb_error *err)
 {
     if (!d->output)
         return vb_fail(err, VB_ERR_ARGUMENT, "no output file");
@@ -413,7 +428,7 @@ vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vb_error *err)
         }
     }
     return vb_write_outputs(&j->file, d->output, d->cubemap_dir, cube_size > 0 ? &j->basis : NULL,
-                            &j->file_bytes, err);
+                            also, also_count, &j->file_bytes, err);
 }
 
 void vb_shard_range(uint32_t v, uint32_t i, uint32_t n, uint32_t *begin, uint32_t *end)

@@ -10,7 +10,7 @@
  *     vb_job_desc d = {.paths = paths, .path_count = n, .output = "room.vdsh"};
  *     ok = vb_job_load(&j, &d, &err) == VB_OK && vb_job_refine(&j, &d, &err) == VB_OK &&
  *          vb_job_bake(&j, &d, &err) == VB_OK && vb_bake_fill_file(&j, &d, &err) == VB_OK &&
- *          vb_job_write(&j, &d, &err) == VB_OK;
+ *          vb_job_write(&j, &d, NULL, 0, &err) == VB_OK;
  *     vb_job_free(&j);
  *
  * A zero vb_job_desc (apart from paths and output) is vdsh-bake's defaults
@@ -37,6 +37,7 @@
 #include "mesh.h"
 #include "scene.h"
 #include "vb.h"
+#include "vdsh_output.h"
 #include "vdsh.h"
 #include "vdsh_cpca.h"
 
@@ -130,9 +131,11 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err);
  * if asked, timings. */
 vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err);
 
-/* Write the basis cubemaps (if any) and the .vdsh file together
- * (vb_write_outputs); j->file_bytes receives the file's size. */
-vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vb_error *err);
+/* Write the basis cubemaps (if any) and the .vdsh file together, with
+ * the caller's staged side files `also` (vb_write_outputs);
+ * j->file_bytes receives the file's size. */
+vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vdsh_output *also, int also_count,
+                       vb_error *err);
 
 /* The path of basis cubemap k (0..3) that goes with the .vdsh `output`:
  * in cubemap_dir, or beside output when it is NULL; the stem is output's
@@ -141,16 +144,20 @@ vb_result vb_output_cubemap_path(const char *output, const char *cubemap_dir, in
                                  size_t cap, vb_error *err);
 
 /* A bake's outputs, all or none: the .vdsh file f to `output` and, when b
- * is not NULL, its basis cubemaps (cubemap_dir, NULL: beside output).
- * Every file is first written to a temporary beside its target and put on
- * disk; only when all five are complete are they renamed over their
- * targets (the cubemaps, then the .vdsh file, last). A failure before
- * that leaves every target as it was and no temporary behind; only a
- * failing rename, which the message then says, can leave a mix. *bytes
- * (may be NULL) receives the .vdsh file's size. The encoded file is held
- * in memory while staged. */
+ * is not NULL, its basis cubemaps (cubemap_dir, NULL: beside output),
+ * and the also_count files `also` the caller has staged (finished, not
+ * committed: vdsh_output.h; entries without a path are skipped), such as
+ * vdsh-bake's plan, OBJ export and distance volume. Every file is first
+ * written to a temporary beside its target and put on disk; only when all
+ * are complete are they renamed over their targets (the caller's, the
+ * cubemaps, then the .vdsh file, last). A failure before that leaves
+ * every target as it was and no temporary behind (the caller's staged
+ * files are removed too); only a failing rename, which the message then
+ * says, can leave a mix. *bytes (may be NULL) receives the .vdsh file's
+ * size. The encoded file is held in memory while staged. */
 vb_result vb_write_outputs(const vdsh_file *f, const char *output, const char *cubemap_dir,
-                           const vb_cubemap_basis *b, uint64_t *bytes, vb_error *err);
+                           const vb_cubemap_basis *b, vdsh_output *also, int also_count,
+                           uint64_t *bytes, vb_error *err);
 
 void vb_job_free(vb_job *j);
 

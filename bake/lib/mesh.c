@@ -618,6 +618,7 @@ vb_result vb_mesh_append(vb_mesh *dst, const vb_mesh *src, vb_error *err)
 static vb_result write_begin(const vb_mesh *m, const char *path, const char *what, int need_normals,
                              vdsh_output *out, vb_error *err)
 {
+    *out = (vdsh_output){.fd = -1};
     if (!m || !path || !path[0] || (m->vertex_count && !m->positions) ||
         (m->vertex_count && need_normals && !m->normals) || (m->triangle_count && !m->indices))
         return vb_fail(err, VB_ERR_ARGUMENT, "%s: invalid argument", what);
@@ -635,10 +636,22 @@ static vb_result write_begin(const vb_mesh *m, const char *path, const char *wha
     return VB_OK;
 }
 
-/* Close what write_begin opened: renamed into place, or removed. */
+/* Finish what write_begin opened: complete and on disk, not yet renamed
+ * (or removed, on failure). */
 static vb_result write_end(vdsh_output *out, vb_error *err)
 {
     vdsh_error ve;
+    if (vdsh_output_finish(out, &ve) != VDSH_OK)
+        return vb_fail(err, VB_ERR_IO, "%s", ve.msg);
+    return VB_OK;
+}
+
+/* A staged file renamed into place (or removed, on failure). */
+static vb_result commit_staged(vb_result staged, vdsh_output *out, vb_error *err)
+{
+    vdsh_error ve;
+    if (staged != VB_OK)
+        return staged;
     if (vdsh_output_commit(out, &ve) != VDSH_OK)
         return vb_fail(err, VB_ERR_IO, "%s", ve.msg);
     return VB_OK;
@@ -647,10 +660,21 @@ static vb_result write_end(vdsh_output *out, vb_error *err)
 vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path, vb_error *err)
 {
     vdsh_output out;
-    vb_result r = write_begin(m, path, "write_obj", 0, &out, err);
+    return commit_staged(vb_mesh_stage_obj(m, path, &out, err), &out, err);
+}
+
+vb_result vb_mesh_write_ply(const vb_mesh *m, const char *path, vb_error *err)
+{
+    vdsh_output out;
+    return commit_staged(vb_mesh_stage_ply(m, path, &out, err), &out, err);
+}
+
+vb_result vb_mesh_stage_obj(const vb_mesh *m, const char *path, vdsh_output *out, vb_error *err)
+{
+    vb_result r = write_begin(m, path, "write_obj", 0, out, err);
     if (r != VB_OK)
         return r;
-    FILE *f = out.fp;
+    FILE *f = out->fp;
 
     /* %.9g: 9 significant digits read back as the same float. */
     fprintf(f, "# vdsh mesh: %u vertices, %u triangles\n", m->vertex_count, m->triangle_count);
@@ -671,7 +695,7 @@ vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path, vb_error *err)
         else
             fprintf(f, "f %u %u %u\n", tri[0] + 1, tri[1] + 1, tri[2] + 1);
     }
-    return write_end(&out, err);
+    return write_end(out, err);
 }
 
 /* vb_mesh_write_ply's header for v vertices and t triangles (the plan
@@ -690,13 +714,12 @@ static int ply_header(char *buf, size_t cap, uint32_t v, uint32_t t)
 #define PLY_VERTEX_BYTES 24 /* x y z nx ny nz, f32 */
 #define PLY_FACE_BYTES 13   /* uchar 3, 3 x u32 */
 
-vb_result vb_mesh_write_ply(const vb_mesh *m, const char *path, vb_error *err)
+vb_result vb_mesh_stage_ply(const vb_mesh *m, const char *path, vdsh_output *out, vb_error *err)
 {
-    vdsh_output out;
-    vb_result r = write_begin(m, path, "write_ply", 1, &out, err);
+    vb_result r = write_begin(m, path, "write_ply", 1, out, err);
     if (r != VB_OK)
         return r;
-    FILE *f = out.fp;
+    FILE *f = out->fp;
     char header[PLY_HEADER_MAX];
     ply_header(header, sizeof header, m->vertex_count, m->triangle_count);
     fputs(header, f);
@@ -710,7 +733,7 @@ vb_result vb_mesh_write_ply(const vb_mesh *m, const char *path, vb_error *err)
         fwrite(&three, 1, 1, f);
         fwrite(m->indices + 3 * (size_t)t, sizeof(uint32_t), 3, f);
     }
-    return write_end(&out, err);
+    return write_end(out, err);
 }
 
 /* ---------------------------------------------------------------------- */

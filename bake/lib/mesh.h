@@ -346,6 +346,18 @@ vb_result vb_mesh_write_obj(const vb_mesh *m, const char *path, vb_error *err);
  * atomically, as vb_mesh_write_obj. Needs normals. */
 vb_result vb_mesh_write_ply(const vb_mesh *m, const char *path, vb_error *err);
 
+/* The same two, staged (formats/vdsh_output.h): the file is written to a
+ * temporary beside `path` and put on disk, not yet renamed, so that it
+ * appears together with the files it goes with (vdsh-bake's --plan and
+ * --export-obj with its .vdsh file): the caller then commits *out
+ * (vdsh_output_commit) or removes it (vdsh_output_abort). On failure *out
+ * is released (nothing left behind; abort accepts it). */
+struct vdsh_output;
+vb_result vb_mesh_stage_obj(const vb_mesh *m, const char *path, struct vdsh_output *out,
+                            vb_error *err);
+vb_result vb_mesh_stage_ply(const vb_mesh *m, const char *path, struct vdsh_output *out,
+                            vb_error *err);
+
 /* How far apart a mesh's vertices are, as receivers, relative to a
  * scene's size: each triangle's longest edge, weighted by the triangle's
  * area (a viewer sees surface, not triangle counts). VDSH interpolates the

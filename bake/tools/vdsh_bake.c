@@ -412,6 +412,15 @@ static pthread_mutex_t output_lock = PTHREAD_MUTEX_INITIALIZER;
 static sigset_t interrupt_signals;
 static atomic_int interrupted;
 
+/* The side outputs (--plan, --export-obj, --sdf): each staged beside its
+ * target when made (vb_mesh_stage_obj, vdsh_sdf_stage) and renamed only
+ * with the bake's other outputs, when everything has succeeded (with the
+ * .vdsh file, before it: vb_job_write); a failed or interrupted bake
+ * removes them, so it leaves none behind. Used under output_lock. */
+enum { SIDE_PLAN, SIDE_EXPORT, SIDE_SDF, SIDE_COUNT };
+static vdsh_output side[SIDE_COUNT];
+static char side_note[SIDE_COUNT][PATH_MAX + 160]; /* said once renamed */
+
 static void *interrupt_thread(void *unused)
 {
     (void)unused;
@@ -420,6 +429,8 @@ static void *interrupt_thread(void *unused)
         return NULL;
     atomic_store(&interrupted, sig);
     pthread_mutex_lock(&output_lock);
+    for (int k = 0; k < SIDE_COUNT; k++)
+        vdsh_output_abort(&side[k]); /* staged side outputs: removed */
     sigset_t one;
     sigemptyset(&one);
     sigaddset(&one, sig);
@@ -609,25 +620,55 @@ static void on_mesh(void *user, const char *path, const vb_mesh *m, const vb_sou
 
 /* ---- main ---------------------------------------------------------------- */
 
-/* Write the receivers as a plan for shards (--plan): binary PLY when the
- * name ends in .ply, else OBJ; exact floats either way. Nonzero on error
- * (said on stderr). */
-static int write_plan(const vb_mesh *m, const char *path, FILE *log)
+/* Stage the receivers as a plan for shards (--plan; side[SIDE_PLAN]):
+ * binary PLY when the name ends in .ply, else OBJ; exact floats either
+ * way. Nonzero on error (said on stderr). */
+static int write_plan(const vb_mesh *m, const char *path)
 {
     vb_error err;
     size_t n = strlen(path);
+    vdsh_output *out = &side[SIDE_PLAN];
     pthread_mutex_lock(&output_lock);
-    vb_result r = n > 4 && strcasecmp(path + n - 4, ".ply") == 0 ? vb_mesh_write_ply(m, path, &err)
-                                                                 : vb_mesh_write_obj(m, path, &err);
+    vb_result r = n > 4 && strcasecmp(path + n - 4, ".ply") == 0
+                      ? vb_mesh_stage_ply(m, path, out, &err)
+                      : vb_mesh_stage_obj(m, path, out, &err);
     pthread_mutex_unlock(&output_lock);
     if (r != VB_OK) {
         fprintf(stderr, "vdsh-bake: %s\n", err.msg);
         return 1;
     }
-    if (log)
-        fprintf(log, "vdsh-bake: wrote the plan %s (%u receivers, %u triangles)\n", path,
-                m->vertex_count, m->triangle_count);
+    snprintf(side_note[SIDE_PLAN], sizeof side_note[SIDE_PLAN],
+             "wrote the plan %s (%u receivers, %u triangles)", path, m->vertex_count,
+             m->triangle_count);
     return 0;
+}
+
+/* Say the side outputs that are now in place (their notes, once). */
+static void say_sides(FILE *log)
+{
+    for (int k = 0; k < SIDE_COUNT; k++) {
+        if (log && side_note[k][0] && !side[k].path)
+            fprintf(log, "vdsh-bake: %s\n", side_note[k]);
+        if (!side[k].path)
+            side_note[k][0] = '\0';
+    }
+}
+
+/* Rename the staged side outputs into place (the bake succeeded without
+ * a .vdsh file to write them with). Nonzero on error (said). Under
+ * output_lock. */
+static int commit_sides(FILE *log)
+{
+    int bad = 0;
+    for (int k = 0; k < SIDE_COUNT; k++) {
+        vdsh_error verr;
+        if (side[k].path && vdsh_output_commit(&side[k], &verr) != VDSH_OK) {
+            fprintf(stderr, "vdsh-bake: %s\n", verr.msg);
+            bad = 1;
+        }
+    }
+    say_sides(log);
+    return bad;
 }
 
 /* Every file the bake will write (vt_cli_check_outputs): the .vdsh file
@@ -1403,7 +1444,7 @@ static int run(const options *o)
     const vb_mesh *rec = &job.receivers;
     say_receivers(log, o, &job, &spacing);
     if (o->plan && !o->adaptive) { /* uniform: the refined receivers, before any bake */
-        if (write_plan(rec, o->plan, log) != 0)
+        if (write_plan(rec, o->plan) != 0)
             goto out;
         if (!o->output && !o->export_obj && !o->trace_only) {
             status = 0;
@@ -1412,14 +1453,13 @@ static int run(const options *o)
     }
     if (o->export_obj) {
         pthread_mutex_lock(&output_lock);
-        vb_result written = vb_mesh_write_obj(rec, o->export_obj, &err);
+        vb_result written = vb_mesh_stage_obj(rec, o->export_obj, &side[SIDE_EXPORT], &err);
         pthread_mutex_unlock(&output_lock);
         if (written != VB_OK) {
             fprintf(stderr, "vdsh-bake: %s\n", err.msg);
             goto out;
         }
-        if (log)
-            fprintf(log, "vdsh-bake: wrote %s\n", o->export_obj);
+        snprintf(side_note[SIDE_EXPORT], sizeof side_note[SIDE_EXPORT], "wrote %s", o->export_obj);
         if (!o->output && !o->trace_only) {
             status = 0;
             goto out;
@@ -1443,7 +1483,7 @@ static int run(const options *o)
         vb_mesh planned = job.receivers;
         if (bo->normals)
             planned.normals = bo->normals;
-        if (write_plan(&planned, o->plan, log) != 0)
+        if (write_plan(&planned, o->plan) != 0)
             goto out;
         if (!o->output) {
             status = 0;
@@ -1478,29 +1518,28 @@ static int run(const options *o)
     if (o->sdf && bake_sdf(o, &job, sdf_path, sizeof sdf_path, &vol, &sdf_seconds) != 0)
         goto out;
 
-    /* 6. Write: the basis cubemaps and the distance volume, then the .vdsh
-     * file, last. */
+    /* 6. Write: the distance volume staged, then the side outputs, the
+     * basis cubemaps and the .vdsh file, last, renamed together. */
     pthread_mutex_lock(&output_lock);
     writing = 1;
     if (o->sdf) {
         vdsh_error verr;
-        vdsh_result vr = vdsh_sdf_write(sdf_path, &vol, &verr);
+        vdsh_result vr = vdsh_sdf_stage(sdf_path, &vol, &side[SIDE_SDF], &verr);
         vdsh_sdf_free(&vol);
         if (vr != VDSH_OK) {
             fprintf(stderr, "vdsh-bake: %s\n", verr.msg);
             goto out;
         }
-        if (log)
-            fprintf(log,
-                    "vdsh-bake: distance volume %u x %u x %u (spacing %g) baked in %.2f s, "
-                    "wrote %s (%.2f MB)\n",
-                    vol.dim[0], vol.dim[1], vol.dim[2], (double)vol.cell, sdf_seconds, sdf_path,
-                    vdsh_sdf_file_size(&vol) / 1e6);
+        snprintf(side_note[SIDE_SDF], sizeof side_note[SIDE_SDF],
+                 "distance volume %u x %u x %u (spacing %g) baked in %.2f s, wrote %s (%.2f MB)",
+                 vol.dim[0], vol.dim[1], vol.dim[2], (double)vol.cell, sdf_seconds, sdf_path,
+                 vdsh_sdf_file_size(&vol) / 1e6);
     }
-    if (vb_job_write(&job, &jd, &err) != VB_OK) {
+    if (vb_job_write(&job, &jd, side, SIDE_COUNT, &err) != VB_OK) {
         fprintf(stderr, "vdsh-bake: %s\n", err.msg);
         goto out;
     }
+    say_sides(log);
     double write_seconds = vb_now() - t;
     if (log)
         say_written(log, o, &job, &jd, write_seconds);
@@ -1512,11 +1551,17 @@ static int run(const options *o)
     status = 0;
 
 out:
-    if (writing) {
-        pthread_mutex_unlock(&output_lock);
-        while (atomic_load(&interrupted))
-            pause(); /* the interrupt thread ends the process */
-    }
+    /* The side outputs: renamed into place when the bake succeeded
+     * (without -o; with it vb_job_write did), else removed. */
+    if (!writing)
+        pthread_mutex_lock(&output_lock);
+    if (status == 0 && commit_sides(log) != 0)
+        status = 1;
+    for (int k = 0; k < SIDE_COUNT; k++)
+        vdsh_output_abort(&side[k]);
+    pthread_mutex_unlock(&output_lock);
+    while (atomic_load(&interrupted))
+        pause(); /* the interrupt thread ends the process */
     vb_job_free(&job);
     return status;
 }

@@ -532,8 +532,8 @@ static int merge_write(merge *m, const options *o)
         return 1;
     }
     uint64_t bytes = 0;
-    if (vb_write_outputs(&m->f, o->output, NULL, m->f.header.cube_size > 0 ? &m->basis : NULL,
-                         &bytes, &err) != VB_OK) {
+    if (vb_write_outputs(&m->f, o->output, NULL, m->f.header.cube_size > 0 ? &m->basis : NULL, NULL,
+                         0, &bytes, &err) != VB_OK) {
         fprintf(stderr, "vdsh-merge: %s\n", err.msg);
         return 1;
     }
