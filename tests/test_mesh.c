@@ -449,8 +449,8 @@ static void test_load_obj(void)
     expect_load_free(
         text_fixture(
             "clean.obj",
-            "# comment\nv 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\nv 0 1 0\nv 9 9 9\n"
-            "o thing\ng group\ns 1\nf 1 2 3 4 5\nf 1 1 2\nf 2/7/1 3//2 4 # inline comment\n"),
+            "# comment\nv 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\nv 0 1 0\nv 9 9 9\nvt 0 0\n"
+            "o thing\ng group\ns 1\nf 1 2 3 4 5\nf 1 1 2\nf 2/1/1 3//2 4 # inline comment\n"),
         5, 4);
 
     /* file normals (vn) are used, normalised; a zero one is replaced by
@@ -512,8 +512,31 @@ static void test_load_obj(void)
         {"points.obj", "v 0 0 0\nv 1 0 0\np 1 2\n", VB_ERR_INVALID, "empty mesh"},
         {"degenerate.obj", "v 0 0 0\nv 1 0 0\nf 1 2 2\nf 1 1 1\n", VB_ERR_INVALID, "empty mesh"},
         {"truncated.obj", "v 0 0 0\nv 1 0 0\nv 0 1", VB_ERR_FORMAT, "line 3"},
+        /* texture coordinate indices are checked as vertex indices are */
+        {"range_vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n", VB_ERR_INVALID,
+         "line 5: face corner '2/2': texture coordinate index 2 out of range"},
+        {"range_vt_neg.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/-1 2 3\nvt 0 0\n", VB_ERR_INVALID,
+         "line 4: face corner '1/-1': texture coordinate index -1 out of range"},
+        {"zero_vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/0/ 2 3\n", VB_ERR_INVALID,
+         "texture coordinate index 0 out of range"},
     };
     expect_bad_files("", bad, sizeof bad / sizeof bad[0]);
+    /* texture coordinates in range (one pointing forward), or none */
+    expect_load_free(text_fixture("vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\n"
+                                            "f 1/1 2/-1/ 3/2\nvt 1 1\nf 1//1 2/ 3\n"),
+                     3, 1);
+    /* a NUL byte in a number or a face corner: said as such, with the line
+     * (a message quoting the token stops at the NUL) */
+    {
+        static const char nul_v[] = "v 0 0 0\nv 1.\0"
+                                    "5 0 0\nv 0 1 0\nf 1 2 3\n";
+        static const char nul_f[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\0"
+                                    "3 3\n";
+        expect_fail_free(fixture("nul_v.obj", nul_v, sizeof nul_v - 1), VB_ERR_FORMAT,
+                         "nul_v.obj: line 2: vertex 2: coordinate '1.' contains a NUL byte");
+        expect_fail_free(fixture("nul_f.obj", nul_f, sizeof nul_f - 1), VB_ERR_FORMAT,
+                         "nul_f.obj: line 4: face corner '2' contains a NUL byte");
+    }
     const uint8_t utf16[] = {0xfe, 0xff, 0, 'v', 0, ' ', 0, '1'};
     expect_fail_free(fixture("utf16.obj", utf16, sizeof utf16), VB_ERR_FORMAT, "UTF-16");
 }
@@ -564,8 +587,48 @@ static void test_load_ply_off_stl(void)
          "vertex index 3 out of range (3 vertices)"},
         {"trunc.ply", "0 0 0\n1 0 0\n0 1", VB_ERR_FORMAT, "truncated"},
         {"twoface.ply", "0 0 0\n1 0 0\n0 1 0\n2 0 1\n", VB_ERR_FORMAT, "face 0 has 2 vertices"},
+        {"trailing.ply", "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n", VB_ERR_FORMAT,
+         "line 14: data after the last element ('face'): '3'"},
     };
     expect_bad_files(ply_head, bad, sizeof bad / sizeof bad[0]);
+    /* blanks after the last element are no data */
+    {
+        char text[512];
+        snprintf(text, sizeof text, "%s0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n \r\n\n", ply_head);
+        expect_load_free(text_fixture("blank_tail.ply", text), 3, 1);
+    }
+    /* binary: bytes after the last element */
+    {
+        uint8_t buf[512];
+        static const char head[] = "ply\nformat binary_little_endian 1.0\nelement vertex 3\n"
+                                   "property float x\nproperty float y\nproperty float z\n"
+                                   "element face 1\nproperty list uchar int vertex_indices\n"
+                                   "end_header\n";
+        size_t n = sizeof head - 1;
+        memcpy(buf, head, n);
+        const float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+        for (int k = 0; k < 9; k++, n += 4)
+            put_f32(buf + n, v[k], 0);
+        buf[n++] = 3;
+        for (uint32_t k = 0; k < 3; k++, n += 4)
+            put_u32(buf + n, k, 0);
+        expect_load_free(fixture("exact_bin.ply", buf, n), 3, 1);
+        memcpy(buf + n, "junk", 4);
+        expect_fail_free(fixture("trailing_bin.ply", buf, n + 4), VB_ERR_FORMAT,
+                         "trailing_bin.ply: 4 bytes of data after the last element ('face')");
+    }
+    /* PLY has one version, 1.0 */
+    expect_load_free(text_fixture("v1.ply",
+                                  "ply\nformat ascii 1\nelement vertex 3\nproperty float "
+                                  "x\nproperty float y\nproperty float z\nelement face "
+                                  "1\nproperty list uchar int vertex_indices\nend_header\n"
+                                  "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
+                     3, 1);
+    expect_fail_free(text_fixture("v2.ply",
+                                  "ply\nformat ascii 2.0\nelement vertex 3\nproperty "
+                                  "float x\nproperty float y\nproperty float z\nend_header"
+                                  "\n0 0 0\n1 0 0\n0 1 0\n"),
+                     VB_ERR_FORMAT, "v2.ply: line 2: unknown PLY version '2.0'");
     expect_fail_free(
         text_fixture("vlist.ply",
                      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"

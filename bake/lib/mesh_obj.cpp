@@ -109,8 +109,10 @@ void remove_repeated(std::vector<int64_t> &v)
  * corners whose index (before the first '/') is a whole non-zero integer
  * in range; positive indices may point forward. Faces with fewer than
  * three distinct vertices add nothing (their triangles are counted as
- * dropped). Texture coordinates, materials and every other keyword are
- * ignored.
+ * dropped). A corner's texture coordinate index, when a whole number,
+ * must name a "vt" line (the same rules); the coordinates themselves,
+ * materials and every other keyword are ignored. A NUL byte in a number
+ * or corner is refused as such.
  *
  * Where OpenMesh's reader read a line otherwise than these checks, the
  * reading follows OpenMesh, and the file is refused when the counts then
@@ -133,11 +135,13 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
 
     /* Positive indices may point forward, so count the "v" lines before
      * checking faces. */
-    uint64_t total = 0;
+    uint64_t total = 0, total_vt = 0;
     for (cursor c(bytes, size); !c.at_end(); c.skip_line()) {
         token kw;
         if (c.next_on_line(&kw) && kw.is("v"))
             total++;
+        else if (kw.is("vt"))
+            total_vt++;
     }
 
     /* Faces are built after all normals are known (a face may name a
@@ -153,8 +157,8 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
     out.positions.reserve(3 * (size_t)std::min<uint64_t>(total, 1u << 24));
 
     cursor c(bytes, size);
-    uint64_t nv = 0, nn = 0;         /* "v", "vn" lines so far */
-    int64_t read_v = 0, read_vn = 0; /* of those, the lines not skipped */
+    uint64_t nv = 0, nn = 0, nvt = 0; /* "v", "vn", "vt" lines so far */
+    int64_t read_v = 0, read_vn = 0;  /* of those, the lines not skipped */
     std::vector<long long> corners;
     std::string &hint = ex->hint;
     while (!c.at_end()) {
@@ -184,10 +188,9 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
                                    what, (unsigned long long)number);
                 num_status s = parse_float(t, &xyz[i]);
                 if (s != NUM_OK)
-                    return vb_fail(err, s == NUM_BAD ? VB_ERR_FORMAT : VB_ERR_INVALID,
-                                   "%s: line %lu: %s %llu: coordinate '%.*s' %s", path, c.line,
-                                   what, (unsigned long long)number, t.show_len(), t.b,
-                                   num_problem(s));
+                    return vb_fail(err, num_error(s), "%s: line %lu: %s %llu: coordinate '%.*s' %s",
+                                   path, c.line, what, (unsigned long long)number, t.show_len(),
+                                   t.b, num_problem(s));
             }
             if (is_v) {
                 nv++;
@@ -214,6 +217,11 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
             token t;
             const char *rest = c.p;
             while (c.next_on_line(&t) && t.b[0] != '#') {
+                if (memchr(t.b, '\0', t.size()))
+                    return vb_fail(err, VB_ERR_FORMAT,
+                                   "%s: line %lu: face corner '%.*s' contains a NUL byte "
+                                   "(binary data in a text file?)",
+                                   path, c.line, t.show_len(), t.b);
                 const char *slash = (const char *)memchr(t.b, '/', t.size());
                 token idx{t.b, slash ? slash : t.e};
                 long long v = 0;
@@ -234,6 +242,21 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
                                    path, c.line, v, (unsigned long long)total);
                 }
                 corners.push_back(v);
+                /* The texture coordinate (v/VT/...), when given as a
+                 * number: it must name a "vt" line, as the vertex a "v". */
+                long long vt = 0;
+                const char *vt_end =
+                    slash ? (const char *)memchr(slash + 1, '/', (size_t)(t.e - slash - 1))
+                          : nullptr;
+                token vt_idx{slash ? slash + 1 : t.e, vt_end ? vt_end : t.e};
+                if (vt_idx.size() && parse_int(vt_idx, &vt) &&
+                    (vt == 0 || (vt < 0 && vt < -(long long)nvt) ||
+                     (vt > 0 && (unsigned long long)vt > total_vt)))
+                    return vb_fail(err, VB_ERR_INVALID,
+                                   "%s: line %lu: face corner '%.*s': texture coordinate index "
+                                   "%lld out of range (\"vt\" lines%s: %llu)",
+                                   path, c.line, t.show_len(), t.b, vt, vt < 0 ? " so far" : "",
+                                   (unsigned long long)(vt < 0 ? nvt : total_vt));
             }
             if (corners.size() < 3)
                 return vb_fail(err, VB_ERR_FORMAT,
@@ -274,8 +297,9 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
                     hint = "line " + std::to_string(line_no) +
                            ": the text after '#' reads as further face corners";
             }
-        }
-        /* "vt", "mtllib", "usemtl", groups, ...: not used */
+        } else if (kw.is("vt"))
+            nvt++; /* counted for the faces' checks; not used */
+        /* "mtllib", "usemtl", groups, ...: not used */
         c.skip_line();
     }
     if (ex->triangles > max_count)

@@ -176,10 +176,10 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
                                (unsigned long long)i, (unsigned long long)nv);
             num_status s = parse_float(t, &v[k]);
             if (s != NUM_OK)
-                return vb_fail(err, s == NUM_BAD ? VB_ERR_FORMAT : VB_ERR_INVALID,
-                               "%s: line %lu: vertex %llu: %s '%.*s' %s", path, c.line,
-                               (unsigned long long)i, k < 3 ? "coordinate" : "normal component",
-                               t.show_len(), t.b, num_problem(s));
+                return vb_fail(err, num_error(s), "%s: line %lu: vertex %llu: %s '%.*s' %s", path,
+                               c.line, (unsigned long long)i,
+                               k < 3 ? "coordinate" : "normal component", t.show_len(), t.b,
+                               num_problem(s));
         }
         out.add_vertex(v[0], v[1], v[2]);
         if (normal)

@@ -66,6 +66,8 @@ static const char *after_plus(const token &t)
 
 num_status parse_float(const token &t, float *out)
 {
+    if (memchr(t.b, '\0', t.size()))
+        return NUM_NUL;
     const char *b = after_plus(t);
     if (!b)
         return NUM_BAD;
@@ -137,6 +139,7 @@ const char *num_problem(num_status s)
     case NUM_BAD: return "is not a number";
     case NUM_RANGE: return "is out of float range";
     case NUM_NONFINITE: return "is not finite";
+    case NUM_NUL: return "contains a NUL byte (binary data in a text file?)";
     }
     return "is not a number";
 }

@@ -242,7 +242,8 @@ vb_result ply_binary_read(const char *path, const std::vector<ply_element> &elem
  * never read); "vertex" must come before "face" and have x, y, z; the
  * only list property is the face's vertex_indices (or vertex_index), with
  * a uint8/uchar/uint16/int count and integer entries; one "face" element
- * and nothing before vertex_indices in it. Every value of the elements
+ * and nothing before vertex_indices in it. Version 1.0 only (the only one there
+ * is); no data after the last element when every element is read. Every value of the elements
  * read is checked (ascii: a whole number of the property's kind; both:
  * sizes, face indices in range, finite x, y, z) before it is used.
  *
@@ -306,6 +307,13 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
             else
                 return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: unknown PLY format '%.*s'", path,
                                line, args[0].show_len(), args[0].b);
+            /* The version: PLY has one, 1.0 (written "1.0", also read as
+             * "1" or "1."); another is a format this reader does not know. */
+            float version = 0.0f;
+            if (parse_float(args[1], &version) != NUM_OK || version != 1.0f)
+                return vb_fail(err, VB_ERR_FORMAT,
+                               "%s: line %lu: unknown PLY version '%.*s' (the only one is 1.0)",
+                               path, line, args[1].show_len(), args[1].b);
         } else if (kw.is("element")) {
             long long n = 0;
             if (args.size() != 2 || !parse_int(args[1], &n) || n < 0)
@@ -574,7 +582,7 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                         if (p.type->is_float) {
                             num_status s = parse_float(t, &f);
                             if (s != NUM_OK)
-                                return vb_fail(err, s == NUM_BAD ? VB_ERR_FORMAT : VB_ERR_INVALID,
+                                return vb_fail(err, num_error(s),
                                                "%s: line %lu: %s %llu: %s '%.*s' %s", path, c.line,
                                                e.name.c_str(), (unsigned long long)n,
                                                p.name.c_str(), t.show_len(), t.b, num_problem(s));
@@ -630,6 +638,18 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
             }
         }
     }
+    /* Nothing follows the last element (checked when every element was
+     * read): trailing data is a wrong element count, or two files in one. */
+    if (last == elems.size() && format != 0 && left > 0)
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: %zu bytes of data after the last element ('%s'): a wrong element "
+                       "count?",
+                       path, left, elems.back().name.c_str());
+    if (last == elems.size() && format == 0 && c.next(&t))
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: line %lu: data after the last element ('%s'): '%.*s' (a wrong "
+                       "element count?)",
+                       path, c.line, elems.back().name.c_str(), t.show_len(), t.b);
     ex->vertices = nv;
     if (differs.msg[0]) {
         if (err)

@@ -129,13 +129,14 @@ struct cursor {
     }
 };
 
-enum num_status { NUM_OK, NUM_BAD, NUM_RANGE, NUM_NONFINITE };
+enum num_status { NUM_OK, NUM_BAD, NUM_RANGE, NUM_NONFINITE, NUM_NUL };
 
 /* A whole token as a float, the way std::istream reads one (strtof): an
  * optional sign, decimal digits, optional exponent; underflow is fine
  * (the float strtof gives, down to a signed zero), overflow is an error.
  * "nan" and "inf" parse here (and are reported as such) although
- * std::istream refuses them. */
+ * std::istream refuses them. A NUL byte in the token is NUM_NUL (a
+ * message showing the token would end at it). */
 num_status parse_float(const token &t, float *out);
 
 /* A whole token as a decimal integer with an optional sign. */
@@ -149,6 +150,12 @@ bool stream_int(const char *b, const char *e, int *out);
 
 /* For messages: "is not a number", "is out of float range", ... */
 const char *num_problem(num_status s);
+/* The error code for a status other than NUM_OK: VB_ERR_FORMAT for text
+ * that is no number, VB_ERR_INVALID for a number out of range. */
+inline vb_result num_error(num_status s)
+{
+    return s == NUM_BAD || s == NUM_NUL ? VB_ERR_FORMAT : VB_ERR_INVALID;
+}
 
 /* The largest counts accepted from a file: vertex indices are uint32_t,
  * and the readers this one replaces kept handles in an int. */

@@ -169,9 +169,8 @@ vb_result read_stl(const char *path, const uint8_t *bytes, size_t size, builder 
                                    path, c.line);
                 num_status s = parse_float(t, &v[3 * i + k]);
                 if (s != NUM_OK)
-                    return vb_fail(err, s == NUM_BAD ? VB_ERR_FORMAT : VB_ERR_INVALID,
-                                   "%s: line %lu: vertex coordinate '%.*s' %s", path, c.line,
-                                   t.show_len(), t.b, num_problem(s));
+                    return vb_fail(err, num_error(s), "%s: line %lu: vertex coordinate '%.*s' %s",
+                                   path, c.line, t.show_len(), t.b, num_problem(s));
             }
             c.skip_line();
         }
