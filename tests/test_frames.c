@@ -856,6 +856,18 @@ static int part_errors(void)
               test_file_contains(err_path, "a-s1-l1-c-vdsh3.png") &&
               test_file_contains(err_path, "32 x 24") && !exists(json),
           "a frame of another size is named");
+    /* An RGBA picture where a frame should be: refused, not read as grey
+     * (its alpha composited onto black, its samples decoded as sRGB). */
+    {
+        static uint8_t rgba[64 * 48 * 4];
+        memset(rgba, 200, sizeof rgba);
+        CHECK(vt_png_rgba_write(other, 64, 48, rgba, msg, sizeof msg) == 0, "%s", msg);
+        CHECK(run((char *[]){fr, "score", vdsh, "--views", views, "--truth", truth, "--frames",
+                             truth, "--modes", "c-vdsh3", "--json", json, NULL}) == 1 &&
+                  test_file_contains(err_path, "a-s1-l1-c-vdsh3.png: an RGBA PNG, not a frame") &&
+                  !exists(json),
+              "an RGBA frame is refused, named");
+    }
     char mask[4096];
     vt_frame_path(mask, sizeof mask, truth, "a", 0, 0, "mask");
     f = fopen(mask, "w");

@@ -15,6 +15,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <png.h>
 #include <stdint.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -325,6 +326,38 @@ static void test_frames(void)
             worst = fmaxf(worst, fabsf(back[i] - v[i]));
         CHECK(worst <= 0.5f / 65535.0f + 1e-7f, "16-bit round trip: off by %g", worst);
         free(back);
+    }
+    /* 8-bit grey: the samples as values (/ 255), not decoded as sRGB; a
+     * PNG with colour or alpha is no frame: refused, saying which. */
+    {
+        png_image im;
+        memset(&im, 0, sizeof im);
+        im.version = PNG_IMAGE_VERSION, im.width = 3, im.height = 1, im.format = PNG_FORMAT_GRAY;
+        const uint8_t grey[3] = {0, 128, 255};
+        snprintf(path, sizeof path, "%s/grey8.png", work);
+        CHECK(png_image_write_to_file(&im, path, 0, grey, 0, NULL), "write %s", path);
+        back = NULL;
+        CHECK(vt_png16_read(path, &w, &h, &back, msg, sizeof msg) == 0 && w == 3 && h == 1, "%s",
+              msg);
+        if (back) {
+            CHECK(back[0] == 0.0f && fabsf(back[1] - 128.0f / 255.0f) < 1e-6f && back[2] == 1.0f,
+                  "8-bit grey 0, 128, 255 read as %g, %g, %g", back[0], back[1], back[2]);
+            free(back);
+        }
+        const uint8_t rgba[3 * 4] = {128, 128, 128, 255, 0, 0, 0, 255, 255, 255, 255, 128};
+        snprintf(path, sizeof path, "%s/rgba.png", work);
+        CHECK(vt_png_rgba_write(path, 3, 1, rgba, msg, sizeof msg) == 0, "%s", msg);
+        back = NULL;
+        CHECK(vt_png16_read(path, &w, &h, &back, msg, sizeof msg) == -1 && !back &&
+                  strstr(msg, "rgba.png: an RGBA PNG, not a frame"),
+              "an RGBA PNG read as a frame: %s", msg);
+        im.format = PNG_FORMAT_RGB;
+        const uint8_t rgb[9] = {10, 20, 30, 0, 0, 0, 255, 255, 255};
+        snprintf(path, sizeof path, "%s/rgb.png", work);
+        CHECK(png_image_write_to_file(&im, path, 0, rgb, 0, NULL), "write %s", path);
+        CHECK(vt_png16_read(path, &w, &h, &back, msg, sizeof msg) == -1 &&
+                  strstr(msg, "rgb.png: an RGB PNG, not a frame"),
+              "an RGB PNG read as a frame: %s", msg);
     }
     snprintf(path, sizeof path, "%s/views.json", work);
     vt_view one = {.name = "a-1",

@@ -110,8 +110,27 @@ int vt_png16_read(const char *path, int *width, int *height, float **out, char *
         snprintf(msg, cap, "%s: not a readable PNG: %s", path, img.message);
         return -1;
     }
-    /* Linear 16-bit grey: libpng's simplified API reads any PNG as it. */
-    img.format = PNG_FORMAT_LINEAR_Y;
+    /* Frames hold values, not colours: grey without alpha only. libpng's
+     * simplified API would read any PNG as grey, but not as values: it
+     * takes the luminance of colour, composites alpha onto black and
+     * decodes 8-bit samples as sRGB (128 read as 0.22, not 0.50). */
+    if (img.format & (PNG_FORMAT_FLAG_COLOR | PNG_FORMAT_FLAG_ALPHA | PNG_FORMAT_FLAG_COLORMAP)) {
+        const png_uint_32 f = img.format;
+        const char *kind = f & PNG_FORMAT_FLAG_COLORMAP ? "a palette"
+                           : f & PNG_FORMAT_FLAG_COLOR
+                               ? (f & PNG_FORMAT_FLAG_ALPHA ? "an RGBA" : "an RGB")
+                               : "a grey and alpha";
+        snprintf(msg, cap,
+                 "%s: %s PNG, not a frame: frames are greyscale values without alpha "
+                 "(16-bit grey, as vdsh-view and vdsh-frames truth write them)",
+                 path, kind);
+        png_image_free(&img);
+        return -1;
+    }
+    /* 16-bit: linear (as written, gAMA 1.0), read as it is; 8-bit: the
+     * samples as they are (sRGB in, sRGB out: no conversion), / 255. */
+    const int wide = (img.format & PNG_FORMAT_FLAG_LINEAR) != 0;
+    img.format = wide ? PNG_FORMAT_LINEAR_Y : PNG_FORMAT_GRAY;
     size_t n = (size_t)img.width * img.height;
     uint16_t *px = malloc(PNG_IMAGE_SIZE(img));
     float *v = malloc((n ? n : 1) * sizeof *v);
@@ -122,8 +141,9 @@ int vt_png16_read(const char *path, int *width, int *height, float **out, char *
         free(v);
         return -1;
     }
+    const uint8_t *px8 = (const uint8_t *)px;
     for (size_t i = 0; i < n; i++)
-        v[i] = (float)px[i] / 65535.0f;
+        v[i] = wide ? (float)px[i] / 65535.0f : (float)px8[i] / 255.0f;
     free(px);
     *width = (int)img.width;
     *height = (int)img.height;

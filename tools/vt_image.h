@@ -23,7 +23,11 @@ extern "C" {
 int vt_png16_write(const char *path, int width, int height, const float *values, char *msg,
                    size_t cap);
 
-/* A 16-bit (or 8-bit) greyscale PNG as floats in [0, 1]. */
+/* A 16-bit (or 8-bit) greyscale PNG as floats in [0, 1]: each sample / 65535
+ * (or / 255), no gamma conversion. A PNG with colour, alpha or a palette is
+ * refused (-1, the message says which): no frame is written so, and reading
+ * it as grey would weigh colours, composite alpha onto black or decode
+ * sRGB. */
 int vt_png16_read(const char *path, int *width, int *height, float **out, char *msg, size_t cap);
 
 /* 8-bit RGBA, row 0 at the top. */
