@@ -25,6 +25,8 @@
   early     a bad output folder (of the .vdsh or of the cubemaps) is found
             before the meshes load, and the message names that path
   together  a bake that fails while writing leaves the old basis cubemaps
+  twice     -o given twice is a usage error (vdsh-bake, -merge, -export,
+            -frames)
   orders    vdsh-export takes orders 1..16
   strict    every JSON document any program writes parses with a strict
             parser that also refuses duplicate keys (vdsh-frames views and
@@ -357,6 +359,18 @@ for prog, args, opt in (
     check(p.returncode == 2 and (opt + " -").encode() in p.stderr and not os.listdir(dd),
           "%s %s -: exit %d (want 2), %r, left %s" % (name, opt, p.returncode, p.stderr[:200],
                                                      os.listdir(dd)))
+    for n in os.listdir(dd):
+        os.remove(os.path.join(dd, n))
+# ---- -o given twice: a usage error in every program that takes it ---------
+# (the last one silently won: a typo in a script wrote somewhere unexpected)
+for prog, args in ((bake, [mesh, "--rays", "16", "-q"]), (merge, [part, "-q"]),
+                   (export, [sv, "-q"]), (frames, ["views", sv, "-q"])):
+    p = subprocess.run([prog, *args, "-o", "a.out", "--output=b.out"], capture_output=True, cwd=dd)
+    name = os.path.basename(prog)
+    check(p.returncode == 2 and b"-o given twice ('a.out', then 'b.out')" in p.stderr and
+          not os.listdir(dd),
+          "%s -o a.out -o b.out: exit %d (want 2), %r, left %s" % (name, p.returncode,
+                                                                   p.stderr[:200], os.listdir(dd)))
     for n in os.listdir(dd):
         os.remove(os.path.join(dd, n))
 # vdsh-export writes binary glTF: an output named .gltf (JSON text) is refused

@@ -651,7 +651,10 @@ static int parse_args(int argc, char **argv, options *o)
     int opt, set[VDSH_ORDER_SLOTS];
     while ((opt = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
         switch (opt) {
-        case 'o': o->out = optarg; break;
+        case 'o':
+            if (!vt_opt_once("-o", optarg, &o->out))
+                return VT_EXIT_USAGE;
+            break;
         case 'O':
             if (!vt_parse_orders(optarg, 0, VDSH_MAX_ORDER, set))
                 return vt_usage_error("vdsh-export",

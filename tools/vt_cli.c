@@ -368,6 +368,17 @@ int vt_opt_int(const char *option, const char *what, const char *arg, int lo, in
     return refuse_range(option, what, arg, l, h);
 }
 
+int vt_opt_once(const char *option, const char *arg, const char **slot)
+{
+    if (*slot) {
+        vt_usage_error(cli_prog, "%s given twice ('%s', then '%s'): give it once", option, *slot,
+                       arg);
+        return 0;
+    }
+    *slot = arg;
+    return 1;
+}
+
 int vt_opt_positive(const char *option, const char *arg, float *out)
 {
     float v;

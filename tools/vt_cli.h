@@ -152,6 +152,11 @@ int vt_opt_u32(const char *option, const char *what, const char *arg, uint32_t l
                uint32_t *out);
 int vt_opt_int(const char *option, const char *what, const char *arg, int lo, int hi, int *out);
 
+/* An option that names one thing (-o FILE): *slot = arg the first time;
+ * given again, "OPTION given twice ('A', then 'B'): give it once", even
+ * with the same value (before, the last silently won). */
+int vt_opt_once(const char *option, const char *arg, const char **slot);
+
 /* A real number > 0 ("takes a positive number") or >= 0 ("takes a number
  * >= 0"); -0 counts as 0. */
 int vt_opt_positive(const char *option, const char *arg, float *out);

@@ -1100,7 +1100,10 @@ static int parse_args(int argc, char **argv, options *o)
         if (r == OPT_TAKEN)
             continue;
         switch (c) {
-        case 'o': o->output = optarg; break;
+        case 'o':
+            if (!vt_opt_once("-o", optarg, &o->output))
+                return VT_EXIT_USAGE;
+            break;
         case O_WELD: o->weld = 1; break;
         case O_CUBEDIR: o->cubemap_dir = optarg; break;
         case O_ROBUST: o->robust = 1; break;

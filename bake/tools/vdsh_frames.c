@@ -927,7 +927,7 @@ static int take_option(int c, options *o)
 {
     uint64_t u;
     switch (c) {
-    case 'o': o->output = optarg; return 1;
+    case 'o': return vt_opt_once("-o", optarg, &o->output);
     case O_VIEWS: o->views_path = optarg; return 1;
     case O_SDF: o->sdf = optarg; return 1;
     case O_TRUTH: o->truth = optarg; return 1;

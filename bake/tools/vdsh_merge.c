@@ -262,7 +262,10 @@ static int parse_args(int argc, char **argv, options *o)
     int c;
     while ((c = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
         switch (c) {
-        case 'o': o->output = optarg; break;
+        case 'o':
+            if (!vt_opt_once("-o", optarg, &o->output))
+                return VT_EXIT_USAGE;
+            break;
         case 'q': o->quiet = 1; break;
         default: return vt_cli_common_option(c, usage, NULL);
         }
