@@ -248,4 +248,16 @@ expect_exit 2 "adaptive order with paper" "$bake" builtin:room --adaptive-order 
   --method paper -o "$tmp/y.vdsh"
 check "no output after refused adaptive orders" test ! -e "$tmp/y.vdsh"
 
+# Plurals in the progress and summary lines: one triangle, one thread, one
+# degenerate receiver are said in the singular ("1 triangles" before).
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$tmp/one.obj"
+"$bake" "$tmp/one.obj" --rays 16 --threads 1 -o "$tmp/one.vdsh" 2>"$tmp/one.txt"
+check "one triangle: said in the singular" grep -q "one.obj: 3 vertices, 1 triangle (" "$tmp/one.txt"
+check "one thread: said in the singular" grep -q "on 1 thread)" "$tmp/one.txt"
+check "no '1 <plural>' in the bake's lines" \
+  bash -c '! grep -E "(^|[^0-9.])1 (triangles|threads|receivers|rays|vertices|ray origins)\b" "$1"' _ "$tmp/one.txt"
+"$bake" builtin:room --max-edge 1.5 --rays 64 --threads 1 -o "$tmp/room1.vdsh" 2>"$tmp/room1.txt"
+check "the room's one degenerate receiver and repair: singular" \
+  bash -c '! grep -E "(^|[^0-9.])1 (receivers|ray origins|degenerate receivers|threads)\b" "$1"' _ "$tmp/room1.txt"
+
 exit $fail

@@ -385,8 +385,8 @@ static void on_progress(void *user, uint32_t done, uint32_t total, uint64_t trac
     else if (rate > 0.0)
         snprintf(eta, sizeof eta, "ETA %.1f s", (total - done) * per_receiver / rate);
     double t = now - p->t0;
-    fprintf(stderr, "%svdsh-bake: %5.1f%%  %u/%u receivers  %.1f Mrays/s  %s%s",
-            p->terminal ? "\r" : "", 100.0 * frac, done, total,
+    fprintf(stderr, "%svdsh-bake: %5.1f%%  %u/%u receiver%s  %.1f Mrays/s  %s%s",
+            p->terminal ? "\r" : "", 100.0 * frac, done, total, vt_s(total),
             rate > 0.0 ? rate * 1e-6 : (t > 0 ? traced / t * 1e-6 : 0.0), eta,
             p->terminal ? "   " : "\n");
     if (p->terminal && last)
@@ -613,8 +613,9 @@ static void on_mesh(void *user, const char *path, const vb_mesh *m, const vb_sou
                     double seconds)
 {
     FILE *log = user;
-    fprintf(log, "vdsh-bake: %s: %u vertices, %u triangles (%.2f s)\n", path, m->vertex_count,
-            m->triangle_count, seconds);
+    fprintf(log, "vdsh-bake: %s: %u %s, %u triangle%s (%.2f s)\n", path, m->vertex_count,
+            vt_plural(m->vertex_count, "vertex", "vertices"), m->triangle_count,
+            vt_s(m->triangle_count), seconds);
     vb_mesh_report_print(log, "vdsh-bake", path, &info->report);
 }
 
@@ -638,8 +639,8 @@ static int write_plan(const vb_mesh *m, const char *path)
         return 1;
     }
     snprintf(side_note[SIDE_PLAN], sizeof side_note[SIDE_PLAN],
-             "wrote the plan %s (%u receivers, %u triangles)", path, m->vertex_count,
-             m->triangle_count);
+             "wrote the plan %s (%u receiver%s, %u triangle%s)", path, m->vertex_count,
+             vt_s(m->vertex_count), m->triangle_count, vt_s(m->triangle_count));
     return 0;
 }
 
@@ -1243,10 +1244,11 @@ static void say_receivers(FILE *log, const options *o, const vb_job *job, vb_mes
     const vb_mesh *rec = &job->receivers;
     if (log && o->max_edge > 0.0f)
         fprintf(log,
-                "vdsh-bake: receivers refined to max edge %g: %u vertices, "
-                "%u triangles, worst aspect ratio %.1f (%.2f s)\n",
-                (double)o->max_edge, rec->vertex_count, rec->triangle_count,
-                vb_mesh_worst_aspect(rec, NULL), job->timings.refine);
+                "vdsh-bake: receivers refined to max edge %g: %u %s, "
+                "%u triangle%s, worst aspect ratio %.1f (%.2f s)\n",
+                (double)o->max_edge, rec->vertex_count,
+                vt_plural(rec->vertex_count, "vertex", "vertices"), rec->triangle_count,
+                vt_s(rec->triangle_count), vb_mesh_worst_aspect(rec, NULL), job->timings.refine);
     /* Receivers far apart against the scene draw false shadows inside their
      * triangles: say so when nothing chose them (no --max-edge, --adaptive
      * or --receivers) and a bake or plan follows. */
@@ -1298,12 +1300,13 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
         return;
     if (o->adaptive)
         fprintf(log,
-                "vdsh-bake: adaptive receivers: %u from %u in %u rounds (%u midpoints "
-                "baked, tolerance %g + noise floor %.3g from %u receivers baked twice, min "
+                "vdsh-bake: adaptive receivers: %u from %u in %u round%s (%u midpoint%s "
+                "baked, tolerance %g + noise floor %.3g from %u receiver%s baked twice, min "
                 "edge %g%s)\n",
                 job->receivers.vertex_count, job->adaptive.start_receivers, job->adaptive.rounds,
-                job->adaptive.candidates, (double)o->adaptive_tol, job->adaptive.noise_floor,
-                job->adaptive.noise_sample, (double)o->min_edge,
+                vt_s(job->adaptive.rounds), job->adaptive.candidates,
+                vt_s(job->adaptive.candidates), (double)o->adaptive_tol, job->adaptive.noise_floor,
+                job->adaptive.noise_sample, vt_s(job->adaptive.noise_sample), (double)o->min_edge,
                 job->adaptive.budget_reached    ? ", the budget stopped it"
                 : job->adaptive.uniform_reached ? ", stopped at the uniform bake's count at 2 x "
                                                   "the min edge"
@@ -1311,22 +1314,25 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
     if (o->adaptive && job->adaptive.rounds_reached)
         fprintf(log,
                 "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
-                "while still splitting (%u edges split in the last round, %u edges not "
+                "while still splitting (%u edge%s split in the last round, %u edge%s not "
                 "yet judged): raise --max-rounds\n",
-                job->adaptive.max_rounds, job->adaptive.last_split, job->adaptive.pending);
+                job->adaptive.max_rounds, job->adaptive.last_split, vt_s(job->adaptive.last_split),
+                job->adaptive.pending, vt_s(job->adaptive.pending));
     if (bo->flipped_normals)
         fprintf(log,
-                "vdsh-bake: %u receiver normals pointed into geometry and were "
+                "vdsh-bake: %u receiver normal%s pointed into geometry and %s "
                 "flipped (--keep-normals keeps them)\n",
-                bo->flipped_normals);
+                bo->flipped_normals, vt_s(bo->flipped_normals),
+                vt_plural(bo->flipped_normals, "was", "were"));
     fprintf(log,
             "vdsh-bake: traced %.1f M rays in %.2f s (%.1f Mrays/s on %u "
-            "threads), %.2f%% missed, %u ray origins moved off other geometry, "
-            "%u degenerate receivers (max distance %g)\n",
+            "thread%s), %.2f%% missed, %u ray origin%s moved off other geometry, "
+            "%u degenerate receiver%s (max distance %g)\n",
             bo->rays_traced * 1e-6, bo->seconds,
             bo->seconds > 0 ? bo->rays_traced / bo->seconds * 1e-6 : 0.0, bo->threads,
-            bo->rays_traced ? 100.0 * bo->rays_missed / bo->rays_traced : 0.0, bo->moved_origins,
-            bo->degenerate_receivers, (double)bo->max_distance);
+            vt_s(bo->threads), bo->rays_traced ? 100.0 * bo->rays_missed / bo->rays_traced : 0.0,
+            bo->moved_origins, vt_s(bo->moved_origins), bo->degenerate_receivers,
+            vt_s(bo->degenerate_receivers), (double)bo->max_distance);
     if (bo->variable_orders) {
         uint32_t hist[VDSH_ORDER_SLOTS] = {0};
         uint32_t rows = bo->range_end - bo->range_begin;
@@ -1351,32 +1357,35 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
                 bo->vertex_count ? (double)bo->rays_traced / bo->vertex_count : 0.0, bo->rays,
                 (double)bo->ray_tolerance);
     fprintf(log,
-            "vdsh-bake: ray origins checked in %.2f s: %llu probe rays (%.1f%% of the "
-            "traced rays), %u receivers repaired, %u moved\n",
+            "vdsh-bake: ray origins checked in %.2f s: %llu probe ray%s (%.1f%% of the "
+            "traced rays), %u receiver%s repaired, %u moved\n",
             bo->origins.seconds, (unsigned long long)bo->origins.probe_rays,
+            vt_s(bo->origins.probe_rays),
             bo->rays_traced ? 100.0 * bo->origins.probe_rays / bo->rays_traced : 0.0,
-            bo->origins.flagged, bo->origins.moved);
+            bo->origins.flagged, vt_s(bo->origins.flagged), bo->origins.moved);
     if (bo->origins.skipped_zero_area)
         fprintf(log,
                 "vdsh-bake: %u receiver%s on zero-area triangles only (drawn nowhere): "
                 "origin%s not probed\n",
-                bo->origins.skipped_zero_area, bo->origins.skipped_zero_area == 1 ? "" : "s",
-                bo->origins.skipped_zero_area == 1 ? "" : "s");
+                bo->origins.skipped_zero_area, vt_s(bo->origins.skipped_zero_area),
+                vt_s(bo->origins.skipped_zero_area));
     if (bo->method == VDSH_METHOD_DECISION) {
         if (!bo->decision_lights)
             fprintf(log, "vdsh-bake: warning: no free space for lights in this scene: every "
                          "receiver keeps its least-squares fit\n");
         else
             fprintf(log,
-                    "vdsh-bake: decision fit: %u receivers fitted on %.0f traced lights "
-                    "each on average, %u with fewer than 16 lights above their horizon "
+                    "vdsh-bake: decision fit: %u receiver%s fitted on %.0f traced lights "
+                    "each on average, %u with fewer than 16 lights above %s horizon "
                     "kept the least-squares fit\n",
-                    bo->decision_fitted, bo->decision_pairs, bo->decision_fallbacks);
+                    bo->decision_fitted, vt_s(bo->decision_fitted), bo->decision_pairs,
+                    bo->decision_fallbacks, vt_plural(bo->decision_fallbacks, "its", "their"));
         if (bo->calibration_receivers) {
             fprintf(log,
-                    "vdsh-bake: log offsets calibrated on %u receivers for %.1f%% false "
+                    "vdsh-bake: log offsets calibrated on %u receiver%s for %.1f%% false "
                     "shadow on held-out lights:",
-                    bo->calibration_receivers, 100.0 * bo->false_rate);
+                    bo->calibration_receivers, vt_s(bo->calibration_receivers),
+                    100.0 * bo->false_rate);
             for (int s = 0; s < o->order_count; s++)
                 fprintf(log, "%s order %d %+.3f", s ? "," : "", o->orders[s],
                         (double)bo->log_offset[o->orders[s]]);
@@ -1395,9 +1404,9 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
     }
     if (bo->auto_receivers > 0) {
         fprintf(log,
-                "vdsh-bake: quantity chosen on %u sampled receivers (expected shadow "
+                "vdsh-bake: quantity chosen on %u sampled receiver%s (expected shadow "
                 "error, distance / log):",
-                bo->auto_receivers);
+                bo->auto_receivers, vt_s(bo->auto_receivers));
         for (int s = 0; s < o->order_count; s++) {
             int k = o->orders[s];
             fprintf(log, "%s order %d %s (%.4f / %.4f)", s ? "," : "", k,
@@ -1408,10 +1417,13 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
     }
     if (bo->degenerate_receivers > 0)
         fprintf(log,
-                "vdsh-bake: warning: %u receivers (%.2f%%) see distance ~0 in almost "
-                "every direction above their horizon: receivers inside or flush "
+                "vdsh-bake: warning: %u receiver%s (%.2f%%) %s distance ~0 in almost "
+                "every direction above %s horizon: receivers inside or flush "
                 "against other geometry, or inverted normals\n",
-                bo->degenerate_receivers, 100.0 * bo->degenerate_receivers / rec->vertex_count);
+                bo->degenerate_receivers, vt_s(bo->degenerate_receivers),
+                100.0 * bo->degenerate_receivers / rec->vertex_count,
+                vt_plural(bo->degenerate_receivers, "sees", "see"),
+                vt_plural(bo->degenerate_receivers, "its", "their"));
 }
 
 static int run(const options *o)
@@ -1472,9 +1484,10 @@ static int run(const options *o)
     /* 3. The occluders' BVH, then orient, trace and project. */
     if (log)
         fprintf(log,
-                "vdsh-bake: tracing %u rays x %u receivers against %u triangles "
+                "vdsh-bake: tracing %u ray%s x %u receiver%s against %u triangle%s "
                 "(method %s)\n",
-                o->rays, rec->vertex_count, job.occluders.triangle_count,
+                o->rays, vt_s(o->rays), rec->vertex_count, vt_s(rec->vertex_count),
+                job.occluders.triangle_count, vt_s(job.occluders.triangle_count),
                 vb_method_name(o->method));
     pr.t0 = vb_now();
     if (vb_job_bake(&job, &jd, &err) != VB_OK) {

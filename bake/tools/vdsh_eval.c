@@ -167,7 +167,8 @@ static void on_progress(void *user, uint32_t done, uint32_t total)
     double t = vb_now() - p->t0;
     double frac = total ? (double)done / total : 1.0;
     double eta = frac > 0.0 ? t * (1.0 - frac) / frac : 0.0;
-    fprintf(stderr, "\r  %5.1f%%  %u/%u receivers  ETA %.1f s   ", 100.0 * frac, done, total, eta);
+    fprintf(stderr, "\r  %5.1f%%  %u/%u receiver%s  ETA %.1f s   ", 100.0 * frac, done, total,
+            vt_s(total), eta);
     if (done == total)
         fputs("\r                                                        \r", stderr);
     fflush(stderr);
@@ -535,18 +536,21 @@ static void print_table(FILE *o, const context *c)
         fprintf(o, "; time not recorded (bake with --record-timings or pass --bake-report)\n");
     if (f->has_stats)
         fprintf(o,
-                "            bake's own rays: %.4f%% missed, %u degenerate receivers, "
-                "%u undefined normals\n",
+                "            bake's own rays: %.4f%% missed, %u degenerate receiver%s, "
+                "%u undefined normal%s\n",
                 f->stats.rays_traced ? 100.0 * f->stats.rays_missed / f->stats.rays_traced : 0.0,
-                f->stats.degenerate_receivers, f->stats.undefined_normals);
+                f->stats.degenerate_receivers, vt_s(f->stats.degenerate_receivers),
+                f->stats.undefined_normals, vt_s(f->stats.undefined_normals));
     fprintf(o,
             "  eval      seed %llu, %u held-out directions/receiver (one light each), "
-            "%s truth traversal%s; %.2f s on %u threads\n",
+            "%s truth traversal%s; %.2f s on %u thread%s\n",
             (unsigned long long)r->seed, r->directions, c->fast_truth ? "default" : "robust",
-            r->oracle ? ", ORACLE (truth scored against itself)" : "", r->seconds, r->threads);
+            r->oracle ? ", ORACLE (truth scored against itself)" : "", r->seconds, r->threads,
+            vt_s(r->threads));
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         const vb_eval_truth *t = &r->truth[k];
-        fprintf(o, "  truth     %-8s %u receivers", kind_name(k), t->receivers);
+        fprintf(o, "  truth     %-8s %u receiver%s", kind_name(k), t->receivers,
+                vt_s(t->receivers));
         if (t->skipped)
             fprintf(o, " (+%u skipped: undefined normal)", t->skipped);
         fprintf(o, ", %llu rays, %.4f%% escaped, %.3f%% at ~0 distance, %u degenerate",

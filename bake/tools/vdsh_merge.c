@@ -541,8 +541,8 @@ static int merge_write(merge *m, const options *o)
         return 1;
     }
     if (!o->quiet)
-        fprintf(stderr, "vdsh-merge: wrote %s (%u shards, %u receivers, %.2f MB)\n", o->output,
-                m->count, m->V, bytes / 1e6);
+        fprintf(stderr, "vdsh-merge: wrote %s (%u shard%s, %u receiver%s, %.2f MB)\n", o->output,
+                m->count, vt_s(m->count), m->V, vt_s(m->V), bytes / 1e6);
     return 0;
 }
 
