@@ -40,6 +40,20 @@ static int bake(const vb_mesh *occ, const vb_mesh *rec, vb_method method, uint32
     return bake_with(occ, rec, method, rays, 0, out);
 }
 
+/* The end of a case: its bake output and scene (NULL: none) and the
+ * two meshes it made (occluders and receivers; NULL: none) freed. */
+static void case_free(vb_bake_output *out, vb_scene *s, vb_mesh *occ, vb_mesh *rec)
+{
+    if (out)
+        vb_bake_output_free(out);
+    if (s)
+        vb_scene_destroy(s);
+    if (occ)
+        test_mesh_free(occ);
+    if (rec)
+        test_mesh_free(rec);
+}
+
 static int all_finite(const vb_bake_output *b)
 {
     size_t n = (size_t)b->vertex_count * b->max_order * b->max_order;
@@ -107,9 +121,7 @@ static void test_corners(void)
     CHECK(corners == 4, "found %d floor corners", corners);
 done:
     vb_bake_output_free(&out);
-    vb_bake_output_free(&fast);
-    test_mesh_free(&occ);
-    test_mesh_free(&rec);
+    case_free(&fast, NULL, &occ, &rec);
 }
 
 /* Zero-area triangles (collinear corners, repeated corners) hit nothing:
@@ -170,11 +182,9 @@ static void test_degenerate_triangles(void)
     CHECK(bake(&nee, &rec, VB_METHOD_FULL, 400, &a), "bake with needles and slivers");
     if (a.coeffs[5])
         CHECK(all_finite(&a), "needles or slivers made a non-finite coefficient");
-    vb_bake_output_free(&a);
     test_mesh_free(&nee);
     test_mesh_free(&junk);
-    test_mesh_free(&occ);
-    test_mesh_free(&rec);
+    case_free(&a, NULL, &occ, &rec);
 }
 
 /* A receiver whose normal is undefined (0,0,0: only zero-area faces) has
@@ -195,9 +205,7 @@ static void test_undefined_normal(void)
         CHECK(a.undefined_normals == 2, "undefined normals counted: %u", a.undefined_normals);
     }
     vb_bake_output_free(&a);
-    vb_bake_output_free(&b);
-    test_mesh_free(&occ);
-    test_mesh_free(&rec);
+    case_free(&b, NULL, &occ, &rec);
 }
 
 static void transform(vb_mesh *m, float scale, const float offset[3])
@@ -263,13 +271,9 @@ static void test_scale_and_offset(void)
                       cases[c].what, moved, rec.vertex_count);
             }
         }
-        vb_bake_output_free(&b);
-        test_mesh_free(&o2);
-        test_mesh_free(&r2);
+        case_free(&b, NULL, &o2, &r2);
     }
-    vb_bake_output_free(&ref);
-    test_mesh_free(&occ);
-    test_mesh_free(&rec);
+    case_free(&ref, NULL, &occ, &rec);
 }
 
 /* The log distance's fits do not depend on the scene's units: scaled by
@@ -315,13 +319,9 @@ static void test_log_fit_units(void)
                       "method %d at scale %g: order 5's log offset %g, %g at scale 1",
                       (int)methods[mi], scales[si], b.log_offset[5], ref.log_offset[5]);
             }
-            vb_bake_output_free(&b);
-            test_mesh_free(&o2);
-            test_mesh_free(&r2);
+            case_free(&b, NULL, &o2, &r2);
         }
-        vb_bake_output_free(&ref);
-        test_mesh_free(&occ);
-        test_mesh_free(&rec);
+        case_free(&ref, NULL, &occ, &rec);
     }
 }
 
@@ -389,9 +389,7 @@ static void test_f16_range(void)
                       vdsh_encoding_name(quant[e]), zeroed ? " (all zero)" : "", bad);
                 free(mem);
             }
-        vb_bake_output_free(&b);
-        test_mesh_free(&occ);
-        test_mesh_free(&rec);
+        case_free(&b, NULL, &occ, &rec);
     }
 }
 
@@ -433,9 +431,7 @@ static void test_coplanar_receivers(void)
     CHECK(floor_edge >= 5 && pillar_foot >= 2, "found %d floor-edge and %d pillar-foot vertices",
           floor_edge, pillar_foot);
 done:
-    vb_bake_output_free(&b);
-    test_mesh_free(&occ);
-    test_mesh_free(&rec);
+    case_free(&b, NULL, &occ, &rec);
 }
 
 /* An open mesh: every ray from a lone floor escapes and gets the clamp
@@ -459,9 +455,7 @@ static void test_open_mesh(void)
             CHECK(fabs(b.coeffs[5][25 * (size_t)v] - want) < 0.03 * want, "c0 %g, want %g",
                   b.coeffs[5][25 * (size_t)v], want);
     }
-    vb_bake_output_free(&b);
-    test_mesh_free(&occ);
-    test_mesh_free(&rec);
+    case_free(&b, NULL, &occ, &rec);
 }
 
 /* A closed solid box [x0,x1] x [y0,y1] x [z0,z1]: six unwelded quads with
@@ -523,9 +517,7 @@ static void test_inverted_normals(void)
           rec.vertex_count, flipped);
     CHECK(flipped == box, "flipped %u, the inverted box has %u receivers", flipped, box);
     free(before);
-    vb_scene_destroy(s);
-    test_mesh_free(&m);
-    test_mesh_free(&rec);
+    case_free(NULL, s, &m, &rec);
 }
 
 /* The bake orients its receivers itself unless told to keep their normals
@@ -577,10 +569,7 @@ static void test_orient_in_bake(void)
           vdsh_quantity_name(oz.quantity[5]), oz.flipped_normals);
     vb_bake_output_free(&oz);
     vb_bake_output_free(&oa);
-    vb_bake_output_free(&ob);
-    vb_scene_destroy(s);
-    test_mesh_free(&m);
-    test_mesh_free(&rec);
+    case_free(&ob, s, &m, &rec);
     test_mesh_free(&mine);
 }
 
@@ -620,9 +609,7 @@ static void test_contact_and_embedded(void)
               "%u degenerate receivers, %u pressed against the floor or ceiling",
               b.degenerate_receivers, pressed);
     }
-    vb_bake_output_free(&b);
-    test_mesh_free(&m);
-    test_mesh_free(&rec);
+    case_free(&b, NULL, &m, &rec);
 }
 
 /* Upper-hemisphere rays from each origin (traced frame) that hit nothing:
@@ -706,9 +693,7 @@ static void test_coincident_faces(void)
     CHECK(st.moved == bottoms, "%u origins moved, %u box-bottom receivers", st.moved, bottoms);
     free(org);
     free(before);
-    vb_scene_destroy(s);
-    test_mesh_free(&m);
-    test_mesh_free(&rec);
+    case_free(NULL, s, &m, &rec);
 }
 
 /* Repair cost and "near" at the scale of the parts (issue 12): a hall of
@@ -753,9 +738,7 @@ static void test_small_parts(void)
           "%u receivers sent to the repair, %u moved", b.origins.flagged, b.origins.moved);
     CHECK(b.origins.probe_rays <= b.rays_traced / 8, "the probes traced %llu rays, the bake %llu",
           (unsigned long long)b.origins.probe_rays, (unsigned long long)b.rays_traced);
-    vb_bake_output_free(&b);
-    vb_scene_destroy(s);
-    test_mesh_free(&m);
+    case_free(&b, s, &m, NULL);
 }
 
 /* The default fit (shadow: lsq of the log distance, offset) and lsq with the
@@ -822,10 +805,7 @@ static void test_default_fit(vb_method method)
           vb_method_name(method), bad, checked);
     printf("%s: %ld of %ld reconstructions would exceed the max distance %g unclamped\n",
            vb_method_name(method), runaway, checked, (double)b.max_distance);
-    vb_bake_output_free(&b);
-    vb_scene_destroy(s);
-    test_mesh_free(&m);
-    test_mesh_free(&rec);
+    case_free(&b, s, &m, &rec);
 }
 
 /* Walls that nothing stands in front of are lit by a light in the middle
@@ -884,9 +864,7 @@ static void test_lit_walls(void)
         CHECK(dark <= share[o] * walls && worst >= lowest[o],
               "order %d: %d of %d wall receivers shadowed, lowest s %g", o, dark, walls, worst);
     }
-    vb_bake_output_free(&out);
-    test_mesh_free(&occ);
-    test_mesh_free(&rec);
+    case_free(&out, NULL, &occ, &rec);
 }
 
 /* Non-finite or out-of-range input through the API is rejected with a
@@ -909,9 +887,7 @@ static void test_bad_api_input(void)
     vb_bake_desc d = {.keep_normals = 1, .receivers = &rec, .scene = s, .rays = 64};
     vb_bake_output out = {0};
     CHECK(vb_bake_run(&d, &out, &err) == VB_ERR_INVALID && !out.coeffs[5], "Inf normal accepted");
-    vb_scene_destroy(s);
-    test_mesh_free(&occ);
-    test_mesh_free(&rec);
+    case_free(NULL, s, &occ, &rec);
 }
 
 int main(void)
