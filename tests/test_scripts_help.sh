@@ -12,7 +12,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 mkdir -p "$tmp/scripts"
 fail=0
-for s in demo test setup format_check bake-parallel bake-slurm; do
+for s in demo test setup format_check bake-parallel bake-slurm shard_args.sh; do
   cp "$src/scripts/$s" "$tmp/scripts/$s"
 done
 for s in demo test setup format_check bake-parallel bake-slurm; do

@@ -1,0 +1,35 @@
+# scripts/shard_args.sh - sourced by scripts/bake-parallel and
+# scripts/bake-slurm (not run): the checks of their command line that both
+# make, in the same words.
+#
+#   shard_count PROG N           N is a whole number >= 1, else exit 2
+#   shard_bake_args PROG USAGE ARGS...
+#                                ARGS (what follows the scheduler's options)
+#                                start with '--' and hold vdsh-bake's
+#                                arguments, none of them -o, --output or
+#                                --shard (the script sets those), else exit 2;
+#                                the caller then drops the '--' (shift)
+
+shard_count() {
+  [[ $2 =~ ^[1-9][0-9]*$ ]] || { echo "$1: N is a whole number >= 1, not '$2'" >&2; exit 2; }
+}
+
+shard_bake_args() {
+  local prog=$1 synopsis=$2 a
+  shift 2
+  # Without '--' every word would go to the scheduler (the mesh as its option or command).
+  if [[ $# -eq 0 ]]; then
+    echo "$prog: no '--' before vdsh-bake's arguments: $synopsis" >&2
+    exit 2
+  fi
+  shift
+  if [[ $# -eq 0 ]]; then
+    echo "$prog: no vdsh-bake arguments after '--' (the meshes and options every shard bakes)" >&2
+    exit 2
+  fi
+  for a in "$@"; do # the script writes OUT and the shards: none of vdsh-bake's own
+    [[ $a =~ ^(-o|--output|--shard)(=.*)?$ || $a =~ ^-o.+ ]] &&
+      { echo "$prog: '$a' among vdsh-bake's arguments: the output is OUT (the second argument) and the script sets --shard" >&2; exit 2; }
+  done
+  return 0
+}
