@@ -7,6 +7,7 @@
 #include "fit.h" /* vb_gauss_legendre */
 #include "test_util.h"
 #include "vdsh.h"
+#include "vdsh_light.h"
 #include "vdsh_sh.h"
 #include "vdsh_shadow.h"
 
@@ -520,6 +521,64 @@ static void test_clamp_never_exceeds(void)
           "coverage: %ld of %ld clamped", clamped, checked);
 }
 
+static int never_free(const void *ctx, const float p[3])
+{
+    (void)ctx, (void)p;
+    return 0;
+}
+
+/* Lights beyond the clamp (docs/DESIGN.md, "Lights beyond the clamp"):
+ * a stored distance is at most the clamp D, so an unoccluded light at
+ * d_L is drawn ramp(D / d_L): lit up to D, below 0.5 past 1.5 D, 0 from
+ * 3 D on (binary: blocked past D) - by design. With the default clamp
+ * (the bounds' diagonal) a closed object's grown light region stays
+ * within 1.433 D of every point of the bounds, so none of its lights is
+ * drawn shadowed unoccluded: for boxes of every shape (flat, thin, a cube),
+ * the farthest corner pair is within that, and the ramp there >= 0.5. */
+static void test_lights_beyond_clamp(void)
+{
+    const float D = 2.0f;
+    CHECK(vdsh_shadow_compare(D, D, VDSH_COMPARE_SMOOTH) == 1.0f &&
+              vdsh_shadow_compare(D, 1.5f * D * 1.001f, VDSH_COMPARE_SMOOTH) < 0.5f &&
+              vdsh_shadow_compare(D, 3.0f * D, VDSH_COMPARE_SMOOTH) == 0.0f &&
+              vdsh_shadow_compare(D, D * 1.001f, VDSH_COMPARE_BINARY) == 0.0f,
+          "a light past the clamp: smooth at D, 1.5 D, 3 D and binary past D");
+    uint64_t s = 5;
+    double worst = 0.0;
+    for (int trial = 0; trial < 500; trial++) {
+        float lo[3], hi[3], glo[3], ghi[3];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = (float)(10.0 * test_rand(&s) - 5.0);
+            double e = trial == 0 ? 1.0 : test_rand(&s); /* trial 0: a cube */
+            if (trial % 5 == 1 && a == 1)
+                e = 0.0; /* flat */
+            hi[a] = lo[a] + (float)(e * (trial % 7 == 2 && a == 0 ? 100.0 : 3.0));
+        }
+        CHECK(vdsh_light_region(lo, hi, never_free, NULL, glo, ghi, NULL) == 1,
+              "trial %d: no free space: the grown region", trial);
+        double diag = 0.0;
+        for (int a = 0; a < 3; a++)
+            diag += ((double)hi[a] - lo[a]) * ((double)hi[a] - lo[a]);
+        diag = sqrt(diag);
+        double far = 0.0; /* the farthest pair: a corner of each box */
+        for (int c = 0; c < 8; c++)
+            for (int g = 0; g < 8; g++) {
+                double d2 = 0.0;
+                for (int a = 0; a < 3; a++) {
+                    double x = c >> a & 1 ? hi[a] : lo[a], y = g >> a & 1 ? ghi[a] : glo[a];
+                    d2 += (x - y) * (x - y);
+                }
+                far = fmax(far, sqrt(d2));
+            }
+        worst = fmax(worst, far / diag);
+        CHECK(far <= 1.434 * diag &&
+                  vdsh_shadow_compare((float)diag, (float)far, VDSH_COMPARE_SMOOTH) >= 0.5f,
+              "trial %d: a light of the grown region %g from the bounds, %g x the clamp", trial,
+              far, far / diag);
+    }
+    CHECK(worst > 1.43, "the cube reaches the bound: %g", worst);
+}
+
 /* vdsh_shadow.c's table of comparisons: names round-trip, each row
  * compares (a light just past the stored distance is blocked, one well
  * before it lit), unknown names are refused. */
@@ -541,6 +600,7 @@ int main(void)
 {
     test_shadow();
     test_compare_table();
+    test_lights_beyond_clamp();
     test_interior();
     test_clamp_horizon();
     test_clamp_never_exceeds();
