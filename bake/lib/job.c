@@ -402,8 +402,6 @@ vb_result vb_write_outputs(const vdsh_file *f, const char *output, const char *c
         vb_append(err, " (%d basis cubemaps were already replaced)", renamed);
     for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
         vdsh_output_abort(&cubes[k]);
-    for (int k = 0; k < also_count; k++)
-        vdsh_output_abort(&also[k]);
     vdsh_output_abort(&file);
     if (r == VB_OK && bytes)
         *bytes = size;

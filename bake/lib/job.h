@@ -151,9 +151,10 @@ vb_result vb_output_cubemap_path(const char *output, const char *cubemap_dir, in
  * written to a temporary beside its target and put on disk; only when all
  * are complete are they renamed over their targets (the caller's, the
  * cubemaps, then the .vdsh file, last). A failure before that leaves
- * every target as it was and no temporary behind (the caller's staged
- * files are removed too); only a failing rename, which the message then
- * says, can leave a mix. *bytes (may be NULL) receives the .vdsh file's
+ * every target as it was and no temporary of this function's behind (the
+ * caller's staged files stay the caller's: it removes them with
+ * vdsh_output_abort, a no-op for those already renamed); only a failing
+ * rename, which the message then says, can leave a mix. *bytes (may be NULL) receives the .vdsh file's
  * size. The encoded file is held in memory while staged. */
 vb_result vb_write_outputs(const vdsh_file *f, const char *output, const char *cubemap_dir,
                            const vb_cubemap_basis *b, vdsh_output *also, int also_count,
