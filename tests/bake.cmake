@@ -125,3 +125,8 @@ add_test(NAME bake_quant_drawn
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
                  ${PROJECT_SOURCE_DIR}/python)
 set_tests_properties(bake_quant_drawn PROPERTIES TIMEOUT 60)
+
+# The light placement's decisions (vdsh_light.h) printed for comparison
+# across Embree's kernel sets (test_isa_agree.sh).
+add_executable(light_region_probe light_region_probe.c)
+target_link_libraries(light_region_probe PRIVATE vb_core)

@@ -199,9 +199,9 @@ static int free_cb(const void *ctx, const float p[3])
     return vb_scene_free_space((const vb_scene *)ctx, p);
 }
 
-int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3])
+int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3], uint32_t *probes)
 {
-    return vdsh_light_region(s->bounds_min, s->bounds_max, free_cb, s, lo, hi, NULL);
+    return vdsh_light_region(s->bounds_min, s->bounds_max, free_cb, s, lo, hi, probes);
 }
 
 /* Where the candidates went, for the messages. */
@@ -227,7 +227,7 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
     if ((unsigned)rule > VB_LIGHTS_PATH)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown light rule %d", (int)rule);
     float lo[3], hi[3];
-    const int grown = vb_scene_light_region(s, lo, hi);
+    const int grown = vb_scene_light_region(s, lo, hi, NULL);
     uint32_t n = 0, k = 0;
     const uint64_t limit = vdsh_light_tries(count, grown);
     while (n < count && k < limit) {
@@ -265,7 +265,7 @@ vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count
     /* Give up when a thousand candidates per light find no room: a scene
      * without free space (a solid, or everything closer than clearance). */
     float lo[3], hi[3];
-    const int grown = vb_scene_light_region(s, lo, hi);
+    const int grown = vb_scene_light_region(s, lo, hi, NULL);
     uint32_t n = 0, k = 0;
     const uint64_t limit = vdsh_light_tries(count, grown);
     while (n < count && k < limit) {
