@@ -42,6 +42,10 @@ typedef struct vb_scene {
     float bounds_min[3], bounds_max[3]; /* occluders, scene units */
     float diagonal;                     /* of the bounds, scene units */
     uint32_t vertex_count, triangle_count;
+    /* The traced triangles (local frame), Embree's buffers, alive with the
+     * scene: the free-space test measures its probes' hits on them itself. */
+    const float *local_vertices;
+    const unsigned *local_indices;
     char embree_error[256]; /* last Embree error reported on this device */
 } vb_scene;
 
