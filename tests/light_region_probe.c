@@ -10,7 +10,9 @@
  *     hash of their coordinates' bits
  * and, on stderr, the smallest relative gap |t - clearance| / clearance of
  * any probe ray of those candidates to the clearance: how near a probe
- * came to flipping its candidate (Embree's kernels differ by a few ulps).
+ * came to flipping its candidate, and a hash of Embree's own distances for
+ * those probes (Embree's kernels differ by a few ulps; the free-space test
+ * measures its hits itself: bake/lib/scene.c probe_hit).
  * Exit 1 on a load or scene error.
  */
 #include <math.h>
@@ -32,8 +34,10 @@ static uint64_t fnv(uint64_t h, const void *p, size_t n)
     return h;
 }
 
-/* The smallest |t - c| / c of the 14 probes from p (scene units). */
-static double probe_gap(const vb_scene *s, const float p[3])
+/* The smallest |t - c| / c of the 14 probes from p (scene units), with
+ * Embree's own distances; *h: their bits hashed (they differ between
+ * kernel sets, the free-space test's own measure does not). */
+static double probe_gap(const vb_scene *s, const float p[3], uint64_t *h)
 {
     float dirs[VDSH_FREE_PROBES][3], o[3];
     vdsh_free_probe_dirs(dirs);
@@ -55,6 +59,7 @@ static double probe_gap(const vb_scene *s, const float p[3])
         rtcIntersect1(s->scene, &ctx, &rh);
         if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
             continue;
+        *h = fnv(*h, &rh.ray.tfar, sizeof rh.ray.tfar);
         double g = fabs(rh.ray.tfar / s->scale - c) / c;
         gap = g < gap ? g : gap;
     }
@@ -88,6 +93,7 @@ int main(int argc, char **argv)
     printf("region %s probes %u\n", grown ? "grown" : "bounds", probes);
     printf("candidates:");
     double gap = INFINITY;
+    uint64_t th = 0xcbf29ce484222325ull;
     uint32_t free_count = 0;
     for (uint32_t k = 0; k < VDSH_REGION_PROBES; k++) {
         float p[3];
@@ -96,7 +102,7 @@ int main(int argc, char **argv)
             printf(" %u", k);
             free_count++;
         }
-        double g = probe_gap(s, p);
+        double g = probe_gap(s, p, &th);
         gap = g < gap ? g : gap;
     }
     printf(" (%u free)\n", free_count);
@@ -107,8 +113,10 @@ int main(int argc, char **argv)
                (unsigned long long)fnv(0xcbf29ce484222325ull, pool, POOL * sizeof *pool));
     else
         printf("pool: none (%s)\n", pool ? err.msg : "out of memory");
-    fprintf(stderr, "light_region_probe: %s: nearest probe to the clearance: %.3g of it\n", argv[1],
-            gap);
+    fprintf(stderr,
+            "light_region_probe: %s: nearest probe to the clearance: %.3g of it; Embree's "
+            "distances hash %016llx\n",
+            argv[1], gap, (unsigned long long)th);
     free(pool);
     vb_scene_destroy(s);
     vb_mesh_free(&m);
