@@ -134,6 +134,13 @@ add_test(NAME bake_quant_drawn
                  ${PROJECT_SOURCE_DIR}/python)
 set_tests_properties(bake_quant_drawn PROPERTIES TIMEOUT 60)
 
+# No FMA instruction in the programs (tests/test_no_fma.sh).
+add_test(NAME build_no_fma
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_no_fma.sh $<TARGET_FILE:vdsh-bake>
+                 $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-eval> $<TARGET_FILE:vdsh-frames>
+                 $<TARGET_FILE:vdsh-info>)
+set_tests_properties(build_no_fma PROPERTIES SKIP_RETURN_CODE 77)
+
 # The light placement's decisions (vdsh_light.h) printed for comparison
 # across Embree's kernel sets (test_isa_decisions.sh).
 add_executable(light_region_probe light_region_probe.c)
