@@ -217,10 +217,13 @@ static float probe_nearest(const vb_scene *s, const float p[3])
                                    .mask = 0xffffffffu};
         struct RTCRay r = ray;
         rtcOccluded1(s->scene, &ctx, &r);
-        if (r.tfar < 0.0f) { /* met something: find how far */
+        if (r.tfar < 0.0f) { /* met something: find how far (probe_hit) */
             struct RTCRayHit rh = {.ray = ray, .hit = {.geomID = RTC_INVALID_GEOMETRY_ID}};
             rtcIntersect1(s->scene, &ctx, &rh);
-            float d = rh.ray.tfar / s->scale;
+            float d = INFINITY;
+            int back = 0;
+            if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+                probe_hit(s, o, dirs[i], rh.hit.primID, rh.ray.tfar, &d, &back);
             best = d < best ? d : best;
         }
     }

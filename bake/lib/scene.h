@@ -101,7 +101,10 @@ const char *vb_light_rule_name(vb_light_rule rule);
 
 /* Whether p (scene units) is in the free space of scene s: vdsh_light.h's
  * rule, its probes cast with Embree. The test vb_scene_place_lights applies
- * to every candidate (vdsh-frames applies it to eyes too). */
+ * to every candidate (vdsh-frames applies it to eyes too). Each probe's
+ * distance and side are measured on the triangle Embree found, in double
+ * arithmetic: the same under every Embree kernel set (docs/DESIGN.md,
+ * "Across CPUs, decision by decision"). */
 int vb_scene_free_space(const vb_scene *s, const float p[3]);
 
 #ifdef __cplusplus
