@@ -19,7 +19,7 @@
 # The decision fit (issue 25): the same, with at most 0.1% of the vertices
 # beyond 1e-3 (its labels are Embree's occlusion rays, its arithmetic
 # plain float with no libm and no FMA); its calibrated per-order log
-# offsets (vdsh-info's method_param) within 1e-3 of the native ones
+# offsets (vdsh-info's method_param) within 1e-4 of the native ones
 # (measured: 4.5e-7; an offset is one held-out pair's margin, and the
 # margins differ by the coefficients' spread).
 # The bake's discrete decisions (light region, calibration guard, cpca):
@@ -75,7 +75,7 @@ if [[ ${ISA_ONE:-} == 1 ]]; then
     -q -o "$REF/decision-$isa.vdsh" || exit 1
   "$compare" "$REF/decision.vdsh" "$REF/decision-$isa.vdsh" 1e-3 0.001 ||
     { echo "FAIL: $isa: room, decision fit" >&2; fail=1; }
-  near "$(offsets "$REF/decision.vdsh")" "$(offsets "$REF/decision-$isa.vdsh")" 1e-3 ||
+  near "$(offsets "$REF/decision.vdsh")" "$(offsets "$REF/decision-$isa.vdsh")" 1e-4 ||
     { echo "FAIL: $isa: room, calibrated log offsets $(offsets "$REF/decision-$isa.vdsh"), natively" \
       "$(offsets "$REF/decision.vdsh")" >&2; fail=1; }
   if [[ -f $REF/sponza.vdsh ]]; then
