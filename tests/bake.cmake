@@ -43,6 +43,14 @@ if(NOT VDSH_SANITIZE)
            COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_isa_agree.sh $<TARGET_FILE:vdsh-bake>
                    $<TARGET_FILE:vdsh-info> $<TARGET_FILE:vdsh_compare>
                    ${CMAKE_CURRENT_SOURCE_DIR}/with_each_isa.sh ${VDSH_SHARED_SCENES})
+  # The bake's discrete decisions across kernel sets: the light region of
+  # closed objects either side of its rule, the calibration's guard, cpca
+  # streams and the encoder's bytes (test_isa_decisions.sh).
+  add_test(NAME bake_isa_decisions
+           COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_isa_decisions.sh $<TARGET_FILE:vdsh-bake>
+                   $<TARGET_FILE:vdsh-info> $<TARGET_FILE:vdsh_compare> $<TARGET_FILE:vdsh-merge>
+                   $<TARGET_FILE:light_region_probe> ${CMAKE_CURRENT_SOURCE_DIR}/with_each_isa.sh
+                   ${VDSH_SHARED_SCENES})
 endif()
 
 # The same bytes on any x86-64 CPU: glibc's libm paths of a CPU without
@@ -125,3 +133,15 @@ add_test(NAME bake_quant_drawn
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
                  ${PROJECT_SOURCE_DIR}/python)
 set_tests_properties(bake_quant_drawn PROPERTIES TIMEOUT 60)
+
+# No FMA instruction in the programs (tests/test_no_fma.sh).
+add_test(NAME build_no_fma
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_no_fma.sh $<TARGET_FILE:vdsh-bake>
+                 $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-eval> $<TARGET_FILE:vdsh-frames>
+                 $<TARGET_FILE:vdsh-info>)
+set_tests_properties(build_no_fma PROPERTIES SKIP_RETURN_CODE 77)
+
+# The light placement's decisions (vdsh_light.h) printed for comparison
+# across Embree's kernel sets (test_isa_decisions.sh).
+add_executable(light_region_probe light_region_probe.c)
+target_link_libraries(light_region_probe PRIVATE vb_core)

@@ -874,7 +874,7 @@ static void test_lights(void)
     if (!a || !b || !room_scene(1.0f, &occ, &rec, &s))
         goto out;
     float lo[3], hi[3];
-    CHECK(vb_scene_light_region(s, lo, hi) == 0, "the room's region is grown");
+    CHECK(vb_scene_light_region(s, lo, hi, NULL) == 0, "the room's region is grown");
     CHECK(!memcmp(lo, s->bounds_min, sizeof lo) && !memcmp(hi, s->bounds_max, sizeof hi),
           "the room's region is not its bounds");
     for (int ceiling = 0; ceiling <= 1; ceiling++) {
@@ -893,7 +893,7 @@ static void test_lights(void)
         goto out;
     }
     CHECK(place_in_bounds(c, 7, 1, 0, a) == 0, "the cube's bounds hold free space");
-    CHECK(vb_scene_light_region(c, lo, hi) == 1, "the cube's region is its bounds");
+    CHECK(vb_scene_light_region(c, lo, hi, NULL) == 1, "the cube's region is its bounds");
     const float g = VDSH_REGION_GROW * c->diagonal;
     for (int k = 0; k < 3; k++)
         CHECK(fabsf(lo[k] - (c->bounds_min[k] - g)) < 1e-5f &&

@@ -1,12 +1,16 @@
 /*
- * vdsh_compare A.vdsh B.vdsh [TOL [SHARE]]: how far apart two bakes of the same
+ * vdsh_compare A.vdsh B.vdsh [TOL [SHARE [LIMIT]]]: how far apart two bakes of the same
  * scene are. The geometry (positions, normals, indices) and the stream
  * list must match exactly; per stream it prints the vertices whose
  * coefficients differ and the largest difference in units of the stream's
  * largest |coefficient| (its f16 scale). Exit 0 when every difference is
  * at most TOL (default 0: identical) and at most a SHARE of the vertices
- * (default 1) differ by more than 1e-3 (beyond the f16 rounding of a
- * stream whose scale moved); 1 otherwise; 2 on usage or read errors. Used by the cross-ISA tests (tests/bake.cmake).
+ * (default 1) differ by more than LIMIT (default 1e-3: beyond the f16
+ * rounding of a stream whose scale moved), all in units of the first
+ * file's largest |coefficient|; 1 otherwise; 2 on usage or read errors.
+ * It prints the median and 99th percentile of the vertices' differences
+ * too (cpca streams: the encoder's discrete choices spread them).
+ * Used by the cross-ISA tests (tests/bake.cmake).
  * A variable-order stream's vertices whose orders differ count among
  * those beyond 1e-3 (and are printed); the others are compared as above.
  */
@@ -17,14 +21,21 @@
 
 #include "vdsh.h"
 
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
 int main(int argc, char **argv)
 {
-    if (argc < 3 || argc > 5) {
-        fprintf(stderr, "usage: vdsh_compare A.vdsh B.vdsh [TOL [SHARE]]\n");
+    if (argc < 3 || argc > 6) {
+        fprintf(stderr, "usage: vdsh_compare A.vdsh B.vdsh [TOL [SHARE [LIMIT]]]\n");
         return 2;
     }
     double tol = argc >= 4 ? strtod(argv[3], NULL) : 0.0;
     double share = argc >= 5 ? strtod(argv[4], NULL) : 1.0;
+    double limit = argc >= 6 ? strtod(argv[5], NULL) : 1e-3;
     vdsh_file *a = NULL, *b = NULL;
     vdsh_error err;
     if (vdsh_read(argv[1], &a, &err) != VDSH_OK || vdsh_read(argv[2], &b, &err) != VDSH_OK) {
@@ -33,6 +44,7 @@ int main(int argc, char **argv)
         return 2;
     }
     int status = 0;
+    double *diffs = NULL;
     if (a->has_part || b->has_part) { /* streams of one range: compare merged files */
         fprintf(stderr, "vdsh_compare: a part of a sharded bake: merge it first\n");
         vdsh_free(a);
@@ -56,7 +68,13 @@ int main(int argc, char **argv)
             status = 1;
             continue;
         }
-        uint32_t nc = x->order * x->order, differ = 0, above = 0, worst = 0, reordered = 0;
+        uint32_t nc = x->order * x->order, differ = 0, above = 0, worst = 0, reordered = 0, nd = 0;
+        free(diffs);
+        if (!(diffs = malloc(((size_t)V + 1) * sizeof *diffs))) {
+            fprintf(stderr, "vdsh_compare: out of memory\n");
+            status = 2;
+            goto out;
+        }
         float cx[VDSH_MAX_COEFFS], cy[VDSH_MAX_COEFFS];
         double maxc = 0.0, maxd = 0.0;
         for (uint32_t v = 0; v < V; v++) {
@@ -75,14 +93,17 @@ int main(int argc, char **argv)
             for (uint32_t i = 0; i < nc; i++)
                 dv = fmax(dv, fabs((double)cx[i] - cy[i]));
             differ += dv > 0.0;
-            above += dv > 1e-3 * maxc; /* beyond the f16 rounding of a rescaled stream */
+            above += dv > limit * maxc; /* beyond the f16 rounding of a rescaled stream */
+            diffs[nd++] = maxc > 0.0 ? dv / maxc : dv;
             if (dv > maxd)
                 maxd = dv, worst = v;
         }
         double rel = maxc > 0.0 ? maxd / maxc : maxd;
-        printf("order %u %s: %u of %u vertices differ (%u by more than 1e-3), largest "
-               "difference %.3g of the largest |coefficient|",
-               x->order, vdsh_quantity_name(x->quantity), differ, V, above, rel);
+        qsort(diffs, nd, sizeof *diffs, cmp_double);
+        printf("order %u %s: %u of %u vertices differ (%u by more than %g), largest "
+               "difference %.3g of the largest |coefficient|, median %.3g, 99th percentile %.3g",
+               x->order, vdsh_quantity_name(x->quantity), differ, V, above, limit, rel,
+               nd ? diffs[nd / 2] : 0.0, nd ? diffs[(size_t)(0.99 * (nd - 1))] : 0.0);
         if (differ)
             printf(" (vertex %u at %g %g %g)", worst, (double)a->positions[3 * (size_t)worst],
                    (double)a->positions[3 * (size_t)worst + 1],
@@ -94,6 +115,7 @@ int main(int argc, char **argv)
             status = 1;
     }
 out:
+    free(diffs);
     vdsh_free(a);
     vdsh_free(b);
     return status;

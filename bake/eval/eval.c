@@ -1056,7 +1056,7 @@ static vb_result place_scene_lights(eval_run *e, vb_error *err)
     if (r != VB_OK)
         return r;
     float lo[3], hi[3];
-    o->light_region_grown = vb_scene_light_region(d->scene, lo, hi);
+    o->light_region_grown = vb_scene_light_region(d->scene, lo, hi, NULL);
     o->light_count = nl;
     for (uint32_t l = 0; l < nl; l++)
         vb_scene_to_local(d->scene, o->lights[l], e->lights_local[l]);

@@ -794,7 +794,7 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
     struct RTCIntersectContext ictx;
     rtcInitIntersectContext(&ictx);
     float elo[3], ehi[3]; /* eyes go where lights go (vdsh_light.h) */
-    vb_scene_light_region(occ, elo, ehi);
+    vb_scene_light_region(occ, elo, ehi, NULL);
     for (uint32_t k = 0; have < d.cameras && k < limit; k++) {
         st.eyes_tried++;
         float eye[3];

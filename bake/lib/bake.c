@@ -1795,6 +1795,11 @@ static void fill_output(bake_run *b, vb_bake_output *out)
         o.cap_bound = atomic_load(&J->cap_bound);
         o.lit_training = atomic_load(&J->lit_training);
         o.lit_training_false = atomic_load(&J->lit_false);
+        o.calibration_shadowed = atomic_load(&J->cal_shadowed);
+        if (J->decision) {
+            float lo[3], hi[3];
+            o.light_region_grown = vb_scene_light_region(d->scene, lo, hi, &o.light_region_probes);
+        }
     }
     o.window = d->window;
     o.vertex_count = R->vertex_count;

@@ -206,6 +206,13 @@ typedef struct vb_bake_output {
      * by more than the cap's tolerance (0 without the cap) with it
      * (counted with or without the cap). */
     uint64_t cap_bound, lit_training, lit_training_false;
+    /* Method decision with lights: the light region of the training pool
+     * (vb_scene_light_region: 1 grown around a closed object, 0 the
+     * bounds) and the candidates its rule tested; the calibration's
+     * held-out pairs that were shadowed (0: its offsets are kept >= 0). */
+    int light_region_grown;
+    uint32_t light_region_probes;
+    uint64_t calibration_shadowed;
     vdsh_window window;    /* applied */
     uint32_t vertex_count; /* all receivers */
     /* The receivers baked: vb_bake_desc's range, or 0, vertex_count

@@ -100,6 +100,8 @@ vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc, vb_scen
     for (uint32_t i = 0; i < occ->vertex_count; i++)
         vb_scene_to_local(s, occ->positions + 3 * i, v + 3 * i);
     memcpy(ix, occ->indices, (size_t)occ->triangle_count * 3 * sizeof *ix);
+    s->local_vertices = v;
+    s->local_indices = ix;
     rtcCommitGeometry(geom);
     rtcAttachGeometry(s->scene, geom);
     rtcReleaseGeometry(geom);
@@ -136,6 +138,39 @@ void vb_offset_origin(const float p[3], const float n[3], float out[3])
 
 /* ---- lights in free space (vdsh_light.h) ---- */
 
+/* A probe's hit, measured on the triangle Embree found (primID) in plain
+ * double arithmetic: its distance (scene units) and side do not depend on
+ * the kernel set that found it. Embree's kernels round t and Ng each their
+ * own way (FMA or not, lane order): a free-space decision - a probe at the
+ * clearance, a grazing face's side - would hinge on those last bits.
+ * Only which triangle a probe meets is Embree's. A hit the plane measure
+ * cannot place (the ray along the plane) keeps Embree's t and side. */
+static void probe_hit(const vb_scene *s, const float o[3], const float d[3], unsigned prim,
+                      float tfar, float *t, int *back)
+{
+    const unsigned *ix = s->local_indices + 3 * (size_t)prim;
+    const float *a = s->local_vertices + 3 * (size_t)ix[0];
+    const float *b = s->local_vertices + 3 * (size_t)ix[1];
+    const float *c = s->local_vertices + 3 * (size_t)ix[2];
+    double e1[3], e2[3], n[3];
+    for (int k = 0; k < 3; k++)
+        e1[k] = (double)b[k] - a[k], e2[k] = (double)c[k] - a[k];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    const double den = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+    const double num =
+        n[0] * ((double)a[0] - o[0]) + n[1] * ((double)a[1] - o[1]) + n[2] * ((double)a[2] - o[2]);
+    const double tt = den != 0.0 ? num / den : -1.0;
+    if (!(tt >= 0.0) || !isfinite(tt)) { /* along the plane: Embree's word */
+        *t = tfar / s->scale;
+        *back = 0;
+        return;
+    }
+    *t = (float)(tt / s->scale);
+    *back = den > 0.0;
+}
+
 int vb_scene_free_space(const vb_scene *s, const float p[3])
 {
     float dirs[VDSH_FREE_PROBES][3], t[VDSH_FREE_PROBES];
@@ -154,11 +189,9 @@ int vb_scene_free_space(const vb_scene *s, const float p[3])
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(s->scene, &ctx, &rh);
-        int hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-        t[i] = hit ? rh.ray.tfar / s->scale : INFINITY;
-        back[i] =
-            hit &&
-            rh.hit.Ng_x * dirs[i][0] + rh.hit.Ng_y * dirs[i][1] + rh.hit.Ng_z * dirs[i][2] > 0.0f;
+        t[i] = INFINITY, back[i] = 0;
+        if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+            probe_hit(s, o, dirs[i], rh.hit.primID, rh.ray.tfar, &t[i], &back[i]);
     }
     return vdsh_free_space(t, back, vdsh_free_clearance(s->diagonal));
 }
@@ -184,10 +217,13 @@ static float probe_nearest(const vb_scene *s, const float p[3])
                                    .mask = 0xffffffffu};
         struct RTCRay r = ray;
         rtcOccluded1(s->scene, &ctx, &r);
-        if (r.tfar < 0.0f) { /* met something: find how far */
+        if (r.tfar < 0.0f) { /* met something: find how far (probe_hit) */
             struct RTCRayHit rh = {.ray = ray, .hit = {.geomID = RTC_INVALID_GEOMETRY_ID}};
             rtcIntersect1(s->scene, &ctx, &rh);
-            float d = rh.ray.tfar / s->scale;
+            float d = INFINITY;
+            int back = 0;
+            if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+                probe_hit(s, o, dirs[i], rh.hit.primID, rh.ray.tfar, &d, &back);
             best = d < best ? d : best;
         }
     }
@@ -199,9 +235,9 @@ static int free_cb(const void *ctx, const float p[3])
     return vb_scene_free_space((const vb_scene *)ctx, p);
 }
 
-int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3])
+int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3], uint32_t *probes)
 {
-    return vdsh_light_region(s->bounds_min, s->bounds_max, free_cb, s, lo, hi, NULL);
+    return vdsh_light_region(s->bounds_min, s->bounds_max, free_cb, s, lo, hi, probes);
 }
 
 /* Where the candidates went, for the messages. */
@@ -227,7 +263,7 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
     if ((unsigned)rule > VB_LIGHTS_PATH)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown light rule %d", (int)rule);
     float lo[3], hi[3];
-    const int grown = vb_scene_light_region(s, lo, hi);
+    const int grown = vb_scene_light_region(s, lo, hi, NULL);
     uint32_t n = 0, k = 0;
     const uint64_t limit = vdsh_light_tries(count, grown);
     while (n < count && k < limit) {
@@ -265,7 +301,7 @@ vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count
     /* Give up when a thousand candidates per light find no room: a scene
      * without free space (a solid, or everything closer than clearance). */
     float lo[3], hi[3];
-    const int grown = vb_scene_light_region(s, lo, hi);
+    const int grown = vb_scene_light_region(s, lo, hi, NULL);
     uint32_t n = 0, k = 0;
     const uint64_t limit = vdsh_light_tries(count, grown);
     while (n < count && k < limit) {

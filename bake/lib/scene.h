@@ -42,6 +42,10 @@ typedef struct vb_scene {
     float bounds_min[3], bounds_max[3]; /* occluders, scene units */
     float diagonal;                     /* of the bounds, scene units */
     uint32_t vertex_count, triangle_count;
+    /* The traced triangles (local frame), Embree's buffers, alive with the
+     * scene: the free-space test measures its probes' hits on them itself. */
+    const float *local_vertices;
+    const unsigned *local_indices;
     char embree_error[256]; /* last Embree error reported on this device */
 } vb_scene;
 
@@ -73,8 +77,9 @@ vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count
 
 /* The region lights are placed in (vdsh_light_region): the bounds, or,
  * when they hold too little free space (a closed object), the bounds grown
- * by a quarter of their diagonal. Returns 1 when grown. */
-int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3]);
+ * by a quarter of their diagonal. Returns 1 when grown. *probes (may be
+ * NULL): the candidates the rule tested. */
+int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3], uint32_t *probes);
 
 /* Other ways to place lights, for reports that a figure does not hang on
  * one light distribution (issue 25): all in free space, from the same
@@ -96,7 +101,10 @@ const char *vb_light_rule_name(vb_light_rule rule);
 
 /* Whether p (scene units) is in the free space of scene s: vdsh_light.h's
  * rule, its probes cast with Embree. The test vb_scene_place_lights applies
- * to every candidate (vdsh-frames applies it to eyes too). */
+ * to every candidate (vdsh-frames applies it to eyes too). Each probe's
+ * distance and side are measured on the triangle Embree found, in double
+ * arithmetic: the same under every Embree kernel set (docs/DESIGN.md,
+ * "Across CPUs, decision by decision"). */
 int vb_scene_free_space(const vb_scene *s, const float p[3]);
 
 #ifdef __cplusplus

@@ -546,6 +546,12 @@ static int write_report(const char *path, const options *o, const vb_job *job,
         vt_json_u64(&j, dec, "offset_cap_bound", b->cap_bound);
         vt_json_u64(&j, dec, "lit_training_pairs", b->lit_training);
         vt_json_u64(&j, dec, "lit_training_false", b->lit_training_false);
+        if (b->decision_lights) {
+            vt_json_string(&j, dec, "light_region", b->light_region_grown ? "grown" : "bounds");
+            vt_json_u64(&j, dec, "light_region_probes", b->light_region_probes);
+        }
+        if (b->calibration_receivers)
+            vt_json_u64(&j, dec, "held_out_shadowed", b->calibration_shadowed);
         cJSON *off = vt_json_object(&j, dec, "log_offsets");
         for (int i = 0; i < o->order_count; i++) {
             char key[8];
