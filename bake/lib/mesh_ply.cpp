@@ -3,7 +3,8 @@
  * OpenMesh 9's reading rules where they decide the result: elements are
  * read in order up to and including "face"; x, y, z, nx, ny, nz as floats;
  * the face's vertex_indices list; binary data as OpenMesh's reader
- * consumed it.
+ * consumed it. The elements after "face" are not used but walked, to find
+ * a truncated file or trailing data.
  */
 #include "mesh_read.h"
 
