@@ -276,8 +276,14 @@ static int parse_args(int argc, char **argv, vv_options *o)
         case 'h': fputs(usage_text, stdout); return -1;
         case 'V': vt_cli_version(NULL); return -1;
         case 'q': o->quiet = 1; break;
-        case O_RENDER: o->render_path = v; break;
-        case O_GRID: o->grid_path = v; break;
+        case O_RENDER:
+            if (!vt_opt_once("--render", v, &o->render_path))
+                return VT_EXIT_USAGE;
+            break;
+        case O_GRID:
+            if (!vt_opt_once("--grid", v, &o->grid_path))
+                return VT_EXIT_USAGE;
+            break;
         case O_BENCH: o->bench = 1; break;
         case O_CAMERA:
             if (vt_parse_floats(v, o->camera, 6, 6) != 6)
@@ -354,7 +360,10 @@ static int parse_args(int argc, char **argv, vv_options *o)
             o->compare = which ? VDSH_COMPARE_BINARY : VDSH_COMPARE_SMOOTH;
             break;
         case O_PCF: o->pcf = 1; break;
-        case O_SDF: o->sdf_path = v; break;
+        case O_SDF:
+            if (!vt_opt_once("--sdf", v, &o->sdf_path))
+                return VT_EXIT_USAGE;
+            break;
         case O_SDF_K:
             if (!vt_parse_float(v, &o->sdf_k) || !(o->sdf_k > 0.0f && o->sdf_k <= 1000.0f))
                 return usage_error("--sdf-k: expected a number > 0 and <= 1000, got '%s'", v);
@@ -374,8 +383,14 @@ static int parse_args(int argc, char **argv, vv_options *o)
                 return rc;
             o->egl = which ? VR_EGL_SURFACELESS : VR_EGL_DEVICE;
             break;
-        case O_FRAMES: o->frames_arg = v; break;
-        case O_VIEWS: o->views_path = v; break;
+        case O_FRAMES:
+            if (!vt_opt_once("--frames", v, &o->frames_arg))
+                return VT_EXIT_USAGE;
+            break;
+        case O_VIEWS:
+            if (!vt_opt_once("--views", v, &o->views_path))
+                return VT_EXIT_USAGE;
+            break;
         case O_MODES:
             if (parse_modes(v, o))
                 return usage_error("--modes: expected a comma-separated list of cube, cube-pcf, "
@@ -383,7 +398,10 @@ static int parse_args(int argc, char **argv, vv_options *o)
                                    "and adaptive, got '%s'",
                                    v);
             break;
-        case O_SCREENSHOT: o->screenshot = v; break;
+        case O_SCREENSHOT:
+            if (!vt_opt_once("--screenshot", v, &o->screenshot))
+                return VT_EXIT_USAGE;
+            break;
         case O_NO_OVERLAY: o->no_overlay = 1; break;
         case O_KEYS:
             for (const char *k = v; *k; k++)

@@ -256,6 +256,17 @@ check "one triangle: said in the singular" grep -q "one.obj: 3 vertices, 1 trian
 check "one thread: said in the singular" grep -q "on 1 thread)" "$tmp/one.txt"
 check "no '1 <plural>' in the bake's lines" \
   bash -c '! grep -E "(^|[^0-9.])1 (triangles|threads|receivers|rays|vertices|ray origins)\b" "$1"' _ "$tmp/one.txt"
+# vdsh-info's listing the same ("1 triangles", "(1 coefficients)" before;
+# scripts/pareto reads both forms)
+"$bake" "$tmp/one.obj" --rays 16 --threads 1 --orders 1 --record-timings --cube-size 0 -q \
+  -o "$tmp/one1.vdsh"
+"$info" "$tmp/one1.vdsh" >"$tmp/one1.info.txt"
+check "info: one triangle, receivers and occluders" \
+  bash -c '[ "$(grep -cE "^  (receivers|occluders)    3 vertices, 1 triangle$" "$1")" = 2 ]' _ "$tmp/one1.info.txt"
+check "info: order 1 has 1 coefficient" grep -q "order 1 (1 coefficient)," "$tmp/one1.info.txt"
+check "info: 1 thread" grep -q ", 1 thread$" "$tmp/one1.info.txt"
+check "no '1 <plural>' in vdsh-info's listing" \
+  bash -c '! grep -E "(^|[^0-9.])1 (triangles|vertices|coefficients|threads|bytes|clusters|basis vectors|lights|receivers|rounds|midpoints)\b" "$1"' _ "$tmp/one1.info.txt"
 "$bake" builtin:room --max-edge 1.5 --rays 64 --threads 1 -o "$tmp/room1.vdsh" 2>"$tmp/room1.txt"
 check "the room's one degenerate receiver and repair: singular" \
   bash -c '! grep -E "(^|[^0-9.])1 (receivers|ray origins|degenerate receivers|threads)\b" "$1"' _ "$tmp/room1.txt"

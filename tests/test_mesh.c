@@ -450,7 +450,7 @@ static void test_load_obj(void)
         text_fixture(
             "clean.obj",
             "# comment\nv 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\nv 0 1 0\nv 9 9 9\nvt 0 0\n"
-            "o thing\ng group\ns 1\nf 1 2 3 4 5\nf 1 1 2\nf 2/1/1 3//2 4 # inline comment\n"),
+            "vn 0 0 1\nvn 0 0 1\no thing\ng group\ns 1\nf 1 2 3 4 5\nf 1 1 2\nf 2/1/1 3//2 4 # inline comment\n"),
         5, 4);
 
     /* file normals (vn) are used, normalised; a zero one is replaced by
@@ -519,11 +519,31 @@ static void test_load_obj(void)
          "line 4: face corner '1/-1': texture coordinate index -1 out of range"},
         {"zero_vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/0/ 2 3\n", VB_ERR_INVALID,
          "texture coordinate index 0 out of range"},
+        /* a texture index that is no number, and normal indices, the same
+         * (before: ignored, the corner's normal silently not given) */
+        {"word_vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/x/1 2 3\n", VB_ERR_FORMAT,
+         "word_vt.obj: line 6: face corner '1/x/1': texture coordinate index 'x' is not a number"},
+        {"range_vn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//3 3//2\nvn 0 0 1\n",
+         VB_ERR_INVALID,
+         "range_vn.obj: line 5: face corner '2//3': normal index 3 out of range (\"vn\" lines: 2)"},
+        {"range_vn_far.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//3\n",
+         VB_ERR_INVALID,
+         "line 5: face corner '3//3': normal index 3 out of range (\"vn\" lines: 1)"},
+        {"range_vn_neg.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//-1 2 3\nvn 0 0 1\n", VB_ERR_INVALID,
+         "line 4: face corner '1//-1': normal index -1 out of range (\"vn\" lines so far: 0)"},
+        {"zero_vn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1/ 2//0 3\n", VB_ERR_INVALID,
+         "face corner '2//0': normal index 0 out of range"},
+        {"word_vn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//n 2 3\n", VB_ERR_FORMAT,
+         "face corner '1//n': normal index 'n' is not a number"},
     };
     expect_bad_files("", bad, sizeof bad / sizeof bad[0]);
     /* texture coordinates in range (one pointing forward), or none */
-    expect_load_free(text_fixture("vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\n"
+    expect_load_free(text_fixture("vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n"
                                             "f 1/1 2/-1/ 3/2\nvt 1 1\nf 1//1 2/ 3\n"),
+                     3, 1);
+    /* normal indices in range: forward, backward, with texture indices */
+    expect_load_free(text_fixture("vn_ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n"
+                                               "f 1/1/2 2//-1 3/1/1\nvn 0 0 1\n"),
                      3, 1);
     /* a NUL byte in a number or a face corner: said as such, with the line
      * (a message quoting the token stops at the NUL) */
@@ -617,6 +637,76 @@ static void test_load_ply_off_stl(void)
         expect_fail_free(fixture("trailing_bin.ply", buf, n + 4), VB_ERR_FORMAT,
                          "trailing_bin.ply: 4 bytes of data after the last element ('face')");
     }
+    /* elements after "face" are never used, but PLY's data holds every
+     * element declared: they are walked by their layout, so a file ending
+     * in them is truncated and data after them is trailing (before: never
+     * looked at, both accepted) */
+    {
+        static const char head[] =
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+            "element edge 2\nproperty int vertex1\nproperty uint8 vertex2\n"
+            "element material 1\nproperty list uchar float weights\nproperty float shine\n"
+            "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+        static const bad_file after[] = {
+            {"after_trunc.ply", "0 1\n1 2\n2 0.5 0.5\n", VB_ERR_FORMAT,
+             "after_trunc.ply: truncated: file ends in material 0 of 1"},
+            {"after_trunc_edge.ply", "0 1\n", VB_ERR_FORMAT,
+             "after_trunc_edge.ply: truncated: file ends in edge 1 of 2"},
+            {"after_trailing.ply", "0 1\n1 2\n2 0.5 0.5 8\n7\n", VB_ERR_FORMAT,
+             "after_trailing.ply: line 23: data after the last element ('material'): '7'"},
+            {"after_word.ply", "0 1\n1 x\n2 0.5 0.5 8\n", VB_ERR_FORMAT,
+             "after_word.ply: line 21: edge 1: vertex2 'x' is not an integer"},
+            {"after_size.ply", "0 1\n1 2\n-2 0.5 0.5 8\n", VB_ERR_FORMAT,
+             "after_size.ply: line 22: material 0: bad list size '-2'"},
+            {"after_float.ply", "0 1\n1 2\n2 0.5 0.5 bright\n", VB_ERR_FORMAT,
+             "after_float.ply: line 22: material 0: shine 'bright' is not a number"},
+        };
+        expect_bad_files(head, after, sizeof after / sizeof after[0]);
+        char text[1024];
+        snprintf(text, sizeof text, "%s0 1\n1 2\n2 0.5 0.5 8\n\n", head);
+        expect_load_free(text_fixture("after_whole.ply", text), 3, 1);
+    }
+    {
+        uint8_t buf[512];
+        static const char head[] = "ply\nformat binary_big_endian 1.0\nelement vertex 3\n"
+                                   "property float x\nproperty float y\nproperty float z\n"
+                                   "element face 1\nproperty list uchar int vertex_indices\n"
+                                   "element material 2\nproperty list int uint16 ids\n"
+                                   "property double shine\nend_header\n";
+        size_t n = sizeof head - 1;
+        memcpy(buf, head, n);
+        const float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+        for (int k = 0; k < 9; k++, n += 4)
+            put_f32(buf + n, v[k], 1);
+        buf[n++] = 3;
+        for (uint32_t k = 0; k < 3; k++, n += 4)
+            put_u32(buf + n, k, 1);
+        const size_t faces_end = n;
+        /* material 0: two ids; material 1: none */
+        put_u32(buf + n, 2, 1);
+        n += 4;
+        memcpy(buf + n, "\0\1\0\2", 4);
+        n += 4;
+        memset(buf + n, 0, 8);
+        n += 8;
+        put_u32(buf + n, 0, 1);
+        n += 4;
+        memset(buf + n, 0, 8);
+        n += 8;
+        expect_load_free(fixture("after_whole_bin.ply", buf, n), 3, 1);
+        expect_fail_free(fixture("after_trunc_bin.ply", buf, n - 1), VB_ERR_FORMAT,
+                         "after_trunc_bin.ply: truncated in material 1 of 2");
+        expect_fail_free(fixture("after_none_bin.ply", buf, faces_end), VB_ERR_FORMAT,
+                         "after_none_bin.ply: truncated in material 0 of 2");
+        buf[n] = 0;
+        expect_fail_free(fixture("after_trailing_bin.ply", buf, n + 1), VB_ERR_FORMAT,
+                         "after_trailing_bin.ply: 1 bytes of data after the last element "
+                         "('material')");
+        put_u32(buf + faces_end, 0x80000000u, 1);
+        expect_fail_free(fixture("after_neg_bin.ply", buf, n), VB_ERR_FORMAT,
+                         "after_neg_bin.ply: material 0: negative list size");
+    }
     /* PLY has one version, 1.0 */
     expect_load_free(text_fixture("v1.ply",
                                   "ply\nformat ascii 1\nelement vertex 3\nproperty float "
@@ -671,6 +761,50 @@ static void test_load_ply_off_stl(void)
         {"4off.off", "4OFF\n1 0 0\n0 0 0 0\n", VB_ERR_FORMAT, "4OFF"},
     };
     expect_bad_files("", bad_off, sizeof bad_off / sizeof bad_off[0]);
+
+    /* a NUL byte in an integer field (a count, a list size, an index) is
+     * said as such with the line, as in a float field (the message quoting
+     * the token stops at the NUL: "bad list size '3'" before) */
+    {
+        static const struct {
+            const char *name;
+            const char *text;
+            size_t size;
+            const char *want;
+        } nul[] = {
+#define NUL_CASE(name, text, want) {name, text, sizeof text - 1, want}
+            NUL_CASE("nul_count.off", "OFF\n3 1\0 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+                     "nul_count.off: line 2: count '1' contains a NUL byte"),
+            NUL_CASE("nul_size.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3\0 0 1 2\n",
+                     "nul_size.off: line 6: face 0: vertex count '3' contains a NUL byte"),
+            NUL_CASE("nul_index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\0 2\n",
+                     "nul_index.off: line 6: face 0: vertex index '1' contains a NUL byte"),
+            NUL_CASE("nul_size.ply",
+                     "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty "
+                     "float y\nproperty float z\nelement face 1\nproperty list uchar int "
+                     "vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3\0 0 1 2\n",
+                     "nul_size.ply: line 13: face 0: list size '3' contains a NUL byte"),
+            NUL_CASE("nul_index.ply",
+                     "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty "
+                     "float y\nproperty float z\nelement face 1\nproperty list uchar int "
+                     "vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1\0 2\n",
+                     "nul_index.ply: line 13: face 0: vertex_indices '1' contains a NUL byte"),
+            NUL_CASE("nul_int.ply",
+                     "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty "
+                     "float y\nproperty float z\nproperty uchar red\nelement face 1\nproperty "
+                     "list uchar int vertex_indices\nend_header\n0 0 0 7\n1 0 0 7\0\n0 1 0 "
+                     "7\n3 0 1 2\n",
+                     "nul_int.ply: line 12: vertex 1: red '7' contains a NUL byte"),
+            NUL_CASE("nul_elem.ply",
+                     "ply\nformat ascii 1.0\nelement vertex 3\0\nproperty float x\nproperty "
+                     "float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n",
+                     "nul_elem.ply: line 3: element count '3' contains a NUL byte"),
+#undef NUL_CASE
+        };
+        for (size_t i = 0; i < sizeof nul / sizeof nul[0]; i++)
+            expect_fail_free(fixture(nul[i].name, nul[i].text, nul[i].size), VB_ERR_FORMAT,
+                             nul[i].want);
+    }
 
     /* STL: ascii (vertices merged by OpenMesh's reader), a degenerate facet
      * dropped; binary */

@@ -71,35 +71,48 @@ static void test_numbers(void)
     expect_refused("x.obj", VB_MESH_OBJ, hex, strlen(hex), "'0x10' is not a number");
 }
 
-/* OBJ normals: named per corner, forward or backward (negative), "//0"
- * and a number past the normals name none; a vertex given two normals
- * keeps one per corner and their average per vertex. */
+/* OBJ normals: named per corner, forward or backward (negative); a
+ * vertex given two normals keeps one per corner and their average per
+ * vertex. "//0", a number past the "vn" lines and a negative one past those
+ * so far are refused (before: they named no normal, silently). */
 static void test_obj_normals(void)
 {
     vb_mesh_raw raw;
     vb_error err;
-    const char *obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
-                      "f 1//1 2//-1 3//0\n" /* -1: the last normal so far, none yet: no normal */
-                      "vn 0 0 1\nvn 1 0 0\n"
-                      "f 2//2 4//9 3//-2\n"; /* 9: past the normals (2): none */
+    const char *obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 0 0 1\n"
+                      "f 1//2 2//-1 3\n" /* 2: forward; -1: the last so far (1) */
+                      "vn 1 0 0\n"
+                      "f 2//2 4 3//-2\n"; /* -2: normal 1 */
     CHECK(parse_text("c.obj", VB_MESH_OBJ, obj, &raw, &err) == VB_OK, "%s", err.msg);
     if (raw.triangle_count == 2 && raw.corner_given && raw.has_normal) {
-        static const uint8_t given[6] = {1, 0, 0, 1, 0, 1};
+        static const uint8_t given[6] = {1, 1, 0, 1, 0, 1};
         for (int c = 0; c < 6; c++)
             CHECK(raw.corner_given[c] == given[c], "c.obj: corner %d given %u", c,
                   raw.corner_given[c]);
-        CHECK(raw.corner_normals[2] == 1.0f, "c.obj: corner 0 takes normal 1 (forward)");
-        CHECK(raw.corner_normals[9] == 1.0f && raw.corner_normals[17] == 1.0f,
-              "c.obj: corner 3 normal 2, corner 5 normal -2 = 1");
-        /* vertex 2 (index 1): given normal 1 nowhere, normal 2 once */
+        CHECK(raw.corner_normals[0] == 1.0f, "c.obj: corner 0 takes normal 2 (forward)");
+        CHECK(raw.corner_normals[5] == 1.0f && raw.corner_normals[9] == 1.0f &&
+                  raw.corner_normals[17] == 1.0f,
+              "c.obj: corner 1 normal -1 = 1, corner 3 normal 2, corner 5 normal -2 = 1");
+        /* vertex 2 (index 1): normal 1 and normal 2, averaged */
         CHECK(raw.has_normal[0] && raw.has_normal[1] && raw.has_normal[2] && !raw.has_normal[3],
               "c.obj: has_normal %u %u %u %u", raw.has_normal[0], raw.has_normal[1],
               raw.has_normal[2], raw.has_normal[3]);
-        CHECK(raw.normals[3] == 1.0f && raw.normals[8] == 1.0f, "c.obj: per-vertex normals");
+        CHECK(raw.normals[0] == 1.0f && raw.normals[8] == 1.0f && raw.normals[3] > 0.7f &&
+                  raw.normals[3] == raw.normals[5],
+              "c.obj: per-vertex normals");
     } else {
         CHECK(0, "c.obj: %u triangles, corner normals %p", raw.triangle_count,
               (void *)raw.corner_given);
     }
+    vb_mesh_raw_free(&raw);
+    static const char zero[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//0 3\n";
+    static const char past[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2 3//9\n";
+    static const char back[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//-1 2 3\nvn 0 0 1\n";
+    expect_refused("z.obj", VB_MESH_OBJ, zero, strlen(zero), "normal index 0 out of range");
+    expect_refused("p.obj", VB_MESH_OBJ, past, strlen(past),
+                   "line 5: face corner '3//9': normal index 9 out of range");
+    expect_refused("b.obj", VB_MESH_OBJ, back, strlen(back),
+                   "line 4: face corner '1//-1': normal index -1 out of range");
     vb_mesh_raw_free(&raw);
 
     /* A line that starts with a vertical tab (after blanks) is skipped; a

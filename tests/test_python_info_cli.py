@@ -38,6 +38,11 @@ good = os.path.join(work, "cube.vdsh")
 shutil.copy(os.path.join(src, "tests", "corpus", "vdsh", "cube-s8-orders1235.vdsh"), good)
 before = open(good, "rb").read()
 
+# the listing's plurals, as vdsh-info's: order 1 has "1 coefficient"
+r = info(good)
+if r.returncode or "order 1 (1 coefficient)," not in r.stdout or "(1 coefficients)" in r.stdout:
+    fail.append("info cube.vdsh: order 1's count not in the singular: %r" % r.stdout[:600])
+
 r = info("--json", good, good)
 if r.returncode != 1 or good not in r.stderr or open(good, "rb").read() != before:
     fail.append("--json onto its input: exit %d, %r, input %s" % (

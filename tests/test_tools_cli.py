@@ -26,7 +26,9 @@
             before the meshes load, and the message names that path
   together  a bake that fails while writing leaves the old basis cubemaps
   twice     -o given twice is a usage error (vdsh-bake, -merge, -export,
-            -frames)
+            -frames), and so is every other option naming one file or folder
+            (--plan, --report, --json, --views, --render, ...) in every
+            program
   orders    vdsh-export takes orders 1..16
   strict    every JSON document any program writes parses with a strict
             parser that also refuses duplicate keys (vdsh-frames views and
@@ -371,6 +373,26 @@ for prog, args in ((bake, [mesh, "--rays", "16", "-q"]), (merge, [part, "-q"]),
           not os.listdir(dd),
           "%s -o a.out -o b.out: exit %d (want 2), %r, left %s" % (name, p.returncode,
                                                                    p.stderr[:200], os.listdir(dd)))
+    for n in os.listdir(dd):
+        os.remove(os.path.join(dd, n))
+# ... and so is every other option that names one file or folder, in every
+# program (--plan, --report, --json, ...: the last one silently won)
+twice = [(bake, [mesh, "--rays", "16", "-q", "-o", "x.vdsh"], o)
+         for o in ("--report", "--export-obj", "--plan", "--receivers", "--cubemap-dir")]
+twice += [(ev, [sv, "-q"], o) for o in ("--json", "--per-vertex", "--bake-report")]
+twice += [(frames, ["truth", sv, "-q", "-o", "t"], o) for o in ("--views", "--sdf")]
+twice += [(frames, ["score", sv, "-q"], o) for o in ("--views", "--truth", "--frames", "--json")]
+twice += [(export, [sv, "-q"], "--source"), (info, [sv], "--json")]
+twice += [(view, [sv, "-q"], o)
+          for o in ("--render", "--grid", "--sdf", "--screenshot", "--views", "--frames")]
+for prog, args, opt in twice:
+    p = subprocess.run([prog, *args, opt, "a.out", opt + "=b.out"], capture_output=True, cwd=dd)
+    name = os.path.basename(prog)
+    check(p.returncode == 2 and
+          ("%s given twice ('a.out', then 'b.out')" % opt).encode() in p.stderr and
+          not os.listdir(dd),
+          "%s %s a.out %s b.out: exit %d (want 2), %r, left %s" % (
+              name, opt, opt, p.returncode, p.stderr[:200], os.listdir(dd)))
     for n in os.listdir(dd):
         os.remove(os.path.join(dd, n))
 # vdsh-export writes binary glTF: an output named .gltf (JSON text) is refused

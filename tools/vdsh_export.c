@@ -668,7 +668,10 @@ static int parse_args(int argc, char **argv, options *o)
         case 'F': o->use_float = 1; break;
         case 'C': o->compress = 1; break;
         case 'D': o->decode_cpca = 1; break;
-        case 'S': o->source = optarg; break;
+        case 'S':
+            if (!vt_opt_once("--source", optarg, &o->source))
+                return VT_EXIT_USAGE;
+            break;
         case 'q': o->quiet = 1; break;
         case 'h': usage(stdout); return 0;
         case 'V': return vt_cli_version(NULL);

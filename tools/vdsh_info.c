@@ -205,12 +205,15 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
     receiver_bounds(f, lo, hi);
 
     printf("%s\n", path);
-    printf("  receivers    %u vertices, %u triangles\n", h->vertex_count, h->triangle_count);
+    printf("  receivers    %u %s, %u triangle%s\n", h->vertex_count,
+           vt_plural(h->vertex_count, "vertex", "vertices"), h->triangle_count,
+           vt_s(h->triangle_count));
     printf("               bounds (%g, %g, %g) .. (%g, %g, %g), diagonal "
            "%g\n",
            lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], diagonal(lo, hi));
-    printf("  occluders    %u vertices, %u triangles\n", h->occluder_vertex_count,
-           h->occluder_triangle_count);
+    printf("  occluders    %u %s, %u triangle%s\n", h->occluder_vertex_count,
+           vt_plural(h->occluder_vertex_count, "vertex", "vertices"), h->occluder_triangle_count,
+           vt_s(h->occluder_triangle_count));
     printf("               bounds (%g, %g, %g) .. (%g, %g, %g), diagonal "
            "%g\n",
            h->bounds_min[0], h->bounds_min[1], h->bounds_min[2], h->bounds_max[0], h->bounds_max[1],
@@ -232,18 +235,18 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
     for (uint32_t i = 0; i < f->source_count; i++) {
         char hex[65];
         sha_hex(f->sources[i].sha256, hex);
-        printf("    [%u] %s\n        %llu bytes, sha256 %s\n", i, f->sources[i].name,
-               (unsigned long long)f->sources[i].size, hex);
+        printf("    [%u] %s\n        %llu byte%s, sha256 %s\n", i, f->sources[i].name,
+               (unsigned long long)f->sources[i].size, vt_s(f->sources[i].size), hex);
     }
 
     printf("  streams      %u\n", f->stream_count);
     for (uint32_t i = 0; i < f->stream_count; i++) {
         const vdsh_stream *s = &f->streams[i];
         coef0_stats st = stream_coef0(f, s);
-        printf("    [%u] order %s%u (%u coefficients%s), %s, method %s", i,
+        printf("    [%u] order %s%u (%u coefficient%s%s), %s, method %s", i,
                s->flags & VDSH_STREAM_VARIABLE ? "1.." : "", s->order, s->order * s->order,
-               s->flags & VDSH_STREAM_VARIABLE ? " at most" : "", vdsh_encoding_name(s->encoding),
-               or_unknown(vdsh_method_name(s->method)));
+               vt_s(s->order * s->order), s->flags & VDSH_STREAM_VARIABLE ? " at most" : "",
+               vdsh_encoding_name(s->encoding), or_unknown(vdsh_method_name(s->method)));
         if (strcmp(vdsh_method_name(s->method), "?") == 0)
             printf(" (%u)", s->method);
         printf(", quantity %s", vdsh_quantity_name(s->quantity));
@@ -269,11 +272,14 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
             vdsh_stream_size z = vdsh_stream_size_of(s, rows);
             char wbits[16];
             snprintf(wbits, sizeof wbits, "%u-bit", m->bits);
-            printf("        cpca: %u clusters, %u basis vectors of %s weights; %zu bytes "
-                   "per vertex, %.1f with the model (%llu bytes)\n",
-                   m->clusters, m->basis, m->bits ? wbits : "per-vector",
-                   vdsh_stream_bytes_per_vertex(s), z.mean_bytes,
-                   (unsigned long long)vdsh_cpca_stream_model_bytes(m, s->order));
+            size_t bpv = vdsh_stream_bytes_per_vertex(s);
+            unsigned long long model =
+                (unsigned long long)vdsh_cpca_stream_model_bytes(m, s->order);
+            printf("        cpca: %u cluster%s, %u basis vector%s of %s weights; %zu byte%s "
+                   "per vertex, %.1f with the model (%llu byte%s)\n",
+                   m->clusters, vt_s(m->clusters), m->basis, vt_s(m->basis),
+                   m->bits ? wbits : "per-vector", bpv, vt_s(bpv), z.mean_bytes, model,
+                   vt_s(model));
             if (!m->bits) { /* runs, vector 1 first: 7x3 is three vectors of 7 bits */
                 printf("        widths:");
                 for (uint32_t j = 0; j < m->basis;) {
@@ -303,7 +309,8 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
                     printf(" %u: %u", k, z.rows_per_order[k]);
             putchar('\n');
         } else {
-            printf("        %zu bytes per vertex\n", vdsh_stream_bytes_per_vertex(s));
+            size_t bpv = vdsh_stream_bytes_per_vertex(s);
+            printf("        %zu byte%s per vertex\n", bpv, vt_s(bpv));
         }
         printf("        coefficient 0: min %g, max %g, mean %g\n", st.min, st.max, st.mean);
     }
@@ -333,17 +340,18 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
                f->part.cpca_basis, f->part.cpca_bits);
     if (f->has_adaptive) {
         const vdsh_adaptive *a = &f->adaptive;
-        printf("  adaptive     tolerance %g, min edge %g, budget %u (0: none), %u lights\n"
-               "               %u receivers from %u in %u of at most %u rounds, %u midpoints "
+        printf("  adaptive     tolerance %g, min edge %g, budget %u (0: none), %u light%s\n"
+               "               %u receiver%s from %u in %u of at most %u round%s, %u midpoint%s "
                "baked\n",
-               a->tolerance, a->min_edge, a->max_receivers, a->lights, f->header.vertex_count,
-               a->start_receivers, a->rounds, a->max_rounds, a->candidates);
+               a->tolerance, a->min_edge, a->max_receivers, a->lights, vt_s(a->lights),
+               f->header.vertex_count, vt_s(f->header.vertex_count), a->start_receivers, a->rounds,
+               a->max_rounds, vt_s(a->max_rounds), a->candidates, vt_s(a->candidates));
     }
     if (f->has_timings) {
         const vdsh_timings *t = &f->timings;
         printf("  timings      load %.3f s, refine %.3f s, build %.3f s, "
-               "trace %.3f s\n               total %.3f s, %u threads\n",
-               t->load, t->refine, t->build, t->trace, t->total, t->threads);
+               "trace %.3f s\n               total %.3f s, %u thread%s\n",
+               t->load, t->refine, t->build, t->trace, t->total, t->threads, vt_s(t->threads));
     }
     printf("  size         %llu bytes, %.2f bytes per vertex\n", (unsigned long long)size,
            (double)size / h->vertex_count);
@@ -601,7 +609,7 @@ static int verify(const char *path, int json)
         if (!json_emit(&j, path))
             bad_chunks = -1; /* not printed: json_emit said why */
     } else {
-        printf("%s: %zu bytes\n", path, size);
+        printf("%s: %zu byte%s\n", path, size, vt_s(size));
         if (r == VDSH_OK)
             printf("  chunk  id        offset          size  crc\n");
         for (uint32_t i = 0; r == VDSH_OK && i < count; i++) {
@@ -623,7 +631,8 @@ static int verify(const char *path, int json)
     if (valid != VDSH_OK)
         fprintf(stderr, "%s: %s\n", prog, err.msg);
     else if (bad_chunks > 0) /* cannot happen for a file the reader accepts */
-        fprintf(stderr, "%s: %s: %d chunks fail their CRC\n", prog, path, bad_chunks);
+        fprintf(stderr, "%s: %s: %d %s\n", prog, path, bad_chunks,
+                bad_chunks == 1 ? "chunk fails its CRC" : "chunks fail their CRC");
     free(chunks);
     free(data);
     return valid == VDSH_OK && bad_chunks == 0;
@@ -681,7 +690,10 @@ static int parse_args(int argc, char **argv, options *o)
     int opt;
     while ((opt = getopt_long(argc, argv, "j:hV", longopts, NULL)) != -1) {
         switch (opt) {
-        case 'j': o->json_out = optarg; break;
+        case 'j':
+            if (!vt_opt_once("--json", optarg, &o->json_out))
+                return VT_EXIT_USAGE;
+            break;
         case 'c': o->check = 1; break;
         case 'h': usage(stdout); return 0;
         case 'V': return vt_cli_version(NULL);

@@ -109,9 +109,10 @@ void remove_repeated(std::vector<int64_t> &v)
  * corners whose index (before the first '/') is a whole non-zero integer
  * in range; positive indices may point forward. Faces with fewer than
  * three distinct vertices add nothing (their triangles are counted as
- * dropped). A corner's texture coordinate index, when a whole number,
- * must name a "vt" line (the same rules); the coordinates themselves,
- * materials and every other keyword are ignored. A NUL byte in a number
+ * dropped). A corner's texture coordinate and normal indices, when
+ * given, must be whole numbers naming a "vt" and a "vn" line (the same
+ * rules); the texture coordinates themselves, materials and every other
+ * keyword are ignored. A NUL byte in a number
  * or corner is refused as such.
  *
  * Where OpenMesh's reader read a line otherwise than these checks, the
@@ -135,13 +136,15 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
 
     /* Positive indices may point forward, so count the "v" lines before
      * checking faces. */
-    uint64_t total = 0, total_vt = 0;
+    uint64_t total = 0, total_vt = 0, total_vn = 0;
     for (cursor c(bytes, size); !c.at_end(); c.skip_line()) {
         token kw;
         if (c.next_on_line(&kw) && kw.is("v"))
             total++;
         else if (kw.is("vt"))
             total_vt++;
+        else if (kw.is("vn"))
+            total_vn++;
     }
 
     /* Faces are built after all normals are known (a face may name a
@@ -242,21 +245,36 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
                                    path, c.line, v, (unsigned long long)total);
                 }
                 corners.push_back(v);
-                /* The texture coordinate (v/VT/...), when given as a
-                 * number: it must name a "vt" line, as the vertex a "v". */
-                long long vt = 0;
+                /* The texture coordinate and the normal (v/VT/VN), when
+                 * given: a whole number naming a "vt" (a "vn") line, as the
+                 * vertex a "v"; positive ones may point forward. */
                 const char *vt_end =
                     slash ? (const char *)memchr(slash + 1, '/', (size_t)(t.e - slash - 1))
                           : nullptr;
-                token vt_idx{slash ? slash + 1 : t.e, vt_end ? vt_end : t.e};
-                if (vt_idx.size() && parse_int(vt_idx, &vt) &&
-                    (vt == 0 || (vt < 0 && vt < -(long long)nvt) ||
-                     (vt > 0 && (unsigned long long)vt > total_vt)))
-                    return vb_fail(err, VB_ERR_INVALID,
-                                   "%s: line %lu: face corner '%.*s': texture coordinate index "
-                                   "%lld out of range (\"vt\" lines%s: %llu)",
-                                   path, c.line, t.show_len(), t.b, vt, vt < 0 ? " so far" : "",
-                                   (unsigned long long)(vt < 0 ? nvt : total_vt));
+                const token sub[2] = {{slash ? slash + 1 : t.e, vt_end ? vt_end : t.e},
+                                      {vt_end ? vt_end + 1 : t.e, t.e}};
+                static const char *const sub_what[2] = {"texture coordinate", "normal"};
+                static const char *const sub_kw[2] = {"vt", "vn"};
+                const uint64_t so_far[2] = {nvt, nn}, all[2] = {total_vt, total_vn};
+                for (int k = 0; k < 2; k++) {
+                    long long i = 0;
+                    if (!sub[k].size())
+                        continue;
+                    if (!parse_int(sub[k], &i))
+                        return vb_fail(err, VB_ERR_FORMAT,
+                                       "%s: line %lu: face corner '%.*s': %s index '%.*s' is not "
+                                       "a number",
+                                       path, c.line, t.show_len(), t.b, sub_what[k],
+                                       sub[k].show_len(), sub[k].b);
+                    if (i == 0 || (i < 0 && i < -(long long)so_far[k]) ||
+                        (i > 0 && (unsigned long long)i > all[k]))
+                        return vb_fail(err, VB_ERR_INVALID,
+                                       "%s: line %lu: face corner '%.*s': %s index %lld out of "
+                                       "range (\"%s\" lines%s: %llu)",
+                                       path, c.line, t.show_len(), t.b, sub_what[k], i, sub_kw[k],
+                                       i < 0 ? " so far" : "",
+                                       (unsigned long long)(i < 0 ? so_far[k] : all[k]));
+                }
             }
             if (corners.size() < 3)
                 return vb_fail(err, VB_ERR_FORMAT,

@@ -143,7 +143,11 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
     long long counts[3];
     for (int i = 0; i < 3; i++) {
         token t;
-        if (!c.next(&t) || !parse_int(t, &counts[i]) || counts[i] < 0)
+        bool got = c.next(&t);
+        if (got && has_nul(t))
+            return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: count '%.*s' %s", path, c.line,
+                           t.show_len(), t.b, num_problem(NUM_NUL));
+        if (!got || !parse_int(t, &counts[i]) || counts[i] < 0)
             return vb_fail(
                 err, VB_ERR_FORMAT,
                 "%s: line %lu: expected three counts (vertices faces edges) after the OFF line",
@@ -193,9 +197,9 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
             return vb_fail(err, VB_ERR_FORMAT, "%s: truncated: file ends before face %llu of %llu",
                            path, (unsigned long long)f, (unsigned long long)nf);
         if (!parse_int(t, &n) || n < 0)
-            return vb_fail(err, VB_ERR_FORMAT,
-                           "%s: line %lu: face %llu: vertex count '%.*s' is not a number", path,
-                           c.line, (unsigned long long)f, t.show_len(), t.b);
+            return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: face %llu: vertex count '%.*s' %s",
+                           path, c.line, (unsigned long long)f, t.show_len(), t.b,
+                           int_problem(t, "is not a number"));
         if (n < 3)
             return vb_fail(err, VB_ERR_FORMAT,
                            "%s: line %lu: face %llu has %lld vertices (needs at least 3)", path,
@@ -211,8 +215,9 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
                                (unsigned long long)f);
             if (!parse_int(t, &idx))
                 return vb_fail(err, VB_ERR_FORMAT,
-                               "%s: line %lu: face %llu: vertex index '%.*s' is not a number", path,
-                               c.line, (unsigned long long)f, t.show_len(), t.b);
+                               "%s: line %lu: face %llu: vertex index '%.*s' %s", path, c.line,
+                               (unsigned long long)f, t.show_len(), t.b,
+                               int_problem(t, "is not a number"));
             if (idx < 0 || (uint64_t)idx >= nv)
                 return vb_fail(
                     err, VB_ERR_INVALID,

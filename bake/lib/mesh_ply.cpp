@@ -3,7 +3,8 @@
  * OpenMesh 9's reading rules where they decide the result: elements are
  * read in order up to and including "face"; x, y, z, nx, ny, nz as floats;
  * the face's vertex_indices list; binary data as OpenMesh's reader
- * consumed it.
+ * consumed it. The elements after "face" are not used but walked, to find
+ * a truncated file or trailing data.
  */
 #include "mesh_read.h"
 
@@ -236,6 +237,101 @@ vb_result ply_binary_read(const char *path, const std::vector<ply_element> &elem
     return VB_OK;
 }
 
+/* The elements after "face", never used: walked by the layout the header
+ * declares, since PLY's data holds every element declared, in order, and
+ * only then is a truncated file or trailing data found. Ascii values must
+ * be numbers of their property's kind (a whole number for an integer
+ * type; the value itself is not used, so nan or 1e99 in a float property
+ * pass) and list sizes whole numbers >= 0; binary values are not looked
+ * at. The cursor (ascii) or b and left (binary) move past them. */
+vb_result ply_walk_unused(const char *path, const std::vector<ply_element> &elems, size_t first,
+                          int format, size_t size, cursor &c, const uint8_t *&b, size_t &left,
+                          vb_error *err)
+{
+    const bool big = format == 2;
+    token t;
+    for (size_t i = first; i < elems.size(); i++) {
+        const ply_element &e = elems[i];
+        if (e.props.empty()) /* no data: nothing to walk, however many */
+            continue;
+        for (uint64_t n = 0; n < e.count; n++)
+            for (const ply_property &p : e.props) {
+                uint64_t items = 1;
+                if (format != 0) {
+                    if (p.count_type) {
+                        const size_t cs = (size_t)p.count_type->size;
+                        if (left < cs)
+                            return vb_fail(err, VB_ERR_FORMAT, "%s: truncated in %s %llu of %llu",
+                                           path, e.name.c_str(), (unsigned long long)n,
+                                           (unsigned long long)e.count);
+                        if (cs == 1)
+                            items = b[0];
+                        else if (cs == 2)
+                            items =
+                                big ? (uint64_t)(b[0] << 8 | b[1]) : (uint64_t)(b[1] << 8 | b[0]);
+                        else {
+                            uint32_t u = load_u32(b, big);
+                            if (p.count_type->is_signed && (int32_t)u < 0)
+                                return vb_fail(err, VB_ERR_FORMAT,
+                                               "%s: %s %llu: negative list size", path,
+                                               e.name.c_str(), (unsigned long long)n);
+                            items = u;
+                        }
+                        b += cs;
+                        left -= cs;
+                    }
+                    const size_t ts = (size_t)p.type->size;
+                    if (items > left / ts)
+                        return vb_fail(err, VB_ERR_FORMAT, "%s: truncated in %s %llu of %llu", path,
+                                       e.name.c_str(), (unsigned long long)n,
+                                       (unsigned long long)e.count);
+                    b += items * ts;
+                    left -= items * ts;
+                    continue;
+                }
+                if (p.count_type) {
+                    long long cnt = 0;
+                    if (!c.next(&t))
+                        return vb_fail(
+                            err, VB_ERR_FORMAT, "%s: truncated: file ends in %s %llu of %llu", path,
+                            e.name.c_str(), (unsigned long long)n, (unsigned long long)e.count);
+                    if (has_nul(t))
+                        return vb_fail(err, VB_ERR_FORMAT,
+                                       "%s: line %lu: %s %llu: list size '%.*s' %s", path, c.line,
+                                       e.name.c_str(), (unsigned long long)n, t.show_len(), t.b,
+                                       num_problem(NUM_NUL));
+                    if (!parse_int(t, &cnt) || cnt < 0 || (uint64_t)cnt > size)
+                        return vb_fail(err, VB_ERR_FORMAT,
+                                       "%s: line %lu: %s %llu: bad list size '%.*s'", path, c.line,
+                                       e.name.c_str(), (unsigned long long)n, t.show_len(), t.b);
+                    items = (uint64_t)cnt;
+                }
+                for (uint64_t q = 0; q < items; q++) {
+                    if (!c.next(&t))
+                        return vb_fail(
+                            err, VB_ERR_FORMAT, "%s: truncated: file ends in %s %llu of %llu", path,
+                            e.name.c_str(), (unsigned long long)n, (unsigned long long)e.count);
+                    long long iv = 0;
+                    float f = 0.0f;
+                    if (p.type->is_float) {
+                        num_status st = parse_float(t, &f);
+                        if (st == NUM_BAD || st == NUM_NUL)
+                            return vb_fail(err, VB_ERR_FORMAT,
+                                           "%s: line %lu: %s %llu: %s '%.*s' %s", path, c.line,
+                                           e.name.c_str(), (unsigned long long)n, p.name.c_str(),
+                                           t.show_len(), t.b, num_problem(st));
+                    } else if (!parse_int(t, &iv)) {
+                        return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: %s %llu: %s '%.*s' %s",
+                                       path, c.line, e.name.c_str(), (unsigned long long)n,
+                                       p.name.c_str(), t.show_len(), t.b,
+                                       int_problem(t, "is not an integer"));
+                    }
+                }
+            }
+    }
+    return VB_OK;
+}
+
 } // namespace
 
 /* Elements are read in order up to and including "face" (later ones are
@@ -243,7 +339,9 @@ vb_result ply_binary_read(const char *path, const std::vector<ply_element> &elem
  * only list property is the face's vertex_indices (or vertex_index), with
  * a uint8/uchar/uint16/int count and integer entries; one "face" element
  * and nothing before vertex_indices in it. Version 1.0 only (the only one there
- * is); no data after the last element when every element is read. Every value of the elements
+ * is). The elements after "face" are walked by their declared layout
+ * (ply_walk_unused): a file that ends in them is truncated, and data after
+ * the last element of all is refused. Every value of the elements
  * read is checked (ascii: a whole number of the property's kind; both:
  * sizes, face indices in range, finite x, y, z) before it is used.
  *
@@ -316,6 +414,9 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                                path, line, args[1].show_len(), args[1].b);
         } else if (kw.is("element")) {
             long long n = 0;
+            if (args.size() == 2 && has_nul(args[1]))
+                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: element count '%.*s' %s", path,
+                               line, args[1].show_len(), args[1].b, num_problem(NUM_NUL));
             if (args.size() != 2 || !parse_int(args[1], &n) || n < 0)
                 return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: bad element line", path, line);
             if ((uint64_t)n > max_count)
@@ -559,6 +660,11 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                                            "%s: truncated: file ends in %s %llu of %llu", path,
                                            e.name.c_str(), (unsigned long long)n,
                                            (unsigned long long)e.count);
+                        if (has_nul(t))
+                            return vb_fail(err, VB_ERR_FORMAT,
+                                           "%s: line %lu: %s %llu: list size '%.*s' %s", path,
+                                           c.line, e.name.c_str(), (unsigned long long)n,
+                                           t.show_len(), t.b, num_problem(NUM_NUL));
                         if (!parse_int(t, &cnt) || cnt < 0 || (uint64_t)cnt > size)
                             return vb_fail(err, VB_ERR_FORMAT,
                                            "%s: line %lu: %s %llu: bad list size '%.*s'", path,
@@ -588,10 +694,10 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                                                p.name.c_str(), t.show_len(), t.b, num_problem(s));
                         } else {
                             if (!parse_int(t, &iv))
-                                return vb_fail(err, VB_ERR_FORMAT,
-                                               "%s: line %lu: %s %llu: %s '%.*s' is not an integer",
-                                               path, c.line, e.name.c_str(), (unsigned long long)n,
-                                               p.name.c_str(), t.show_len(), t.b);
+                                return vb_fail(
+                                    err, VB_ERR_FORMAT, "%s: line %lu: %s %llu: %s '%.*s' %s", path,
+                                    c.line, e.name.c_str(), (unsigned long long)n, p.name.c_str(),
+                                    t.show_len(), t.b, int_problem(t, "is not an integer"));
                             if (is_indices && (iv < 0 || (uint64_t)iv >= nv))
                                 return vb_fail(
                                     err, VB_ERR_INVALID,
@@ -638,14 +744,18 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
             }
         }
     }
-    /* Nothing follows the last element (checked when every element was
-     * read): trailing data is a wrong element count, or two files in one. */
-    if (last == elems.size() && format != 0 && left > 0)
+    /* The elements after "face": there, whole, and nothing after them. */
+    vb_result walked = ply_walk_unused(path, elems, last, format, size, c, b, left, err);
+    if (walked != VB_OK)
+        return walked;
+    /* Nothing follows the last element: trailing data is a wrong element
+     * count, or two files in one. */
+    if (format != 0 && left > 0)
         return vb_fail(err, VB_ERR_FORMAT,
                        "%s: %zu bytes of data after the last element ('%s'): a wrong element "
                        "count?",
                        path, left, elems.back().name.c_str());
-    if (last == elems.size() && format == 0 && c.next(&t))
+    if (format == 0 && c.next(&t))
         return vb_fail(err, VB_ERR_FORMAT,
                        "%s: line %lu: data after the last element ('%s'): '%.*s' (a wrong "
                        "element count?)",

@@ -150,6 +150,20 @@ bool stream_int(const char *b, const char *e, int *out);
 
 /* For messages: "is not a number", "is out of float range", ... */
 const char *num_problem(num_status s);
+/* Whether a token holds a NUL byte (binary data in a text file). A
+ * message quoting the token stops at the NUL, so an integer field that
+ * holds one is said as such (int_problem), as parse_float's NUM_NUL is. */
+inline bool has_nul(const token &t)
+{
+    return memchr(t.b, '\0', t.size()) != nullptr;
+}
+/* For an integer token that did not parse (or was refused): the problem
+ * for a message "... '%.*s' %s": num_problem(NUM_NUL) when the token
+ * holds a NUL byte, else `otherwise` ("is not a number", ...). */
+inline const char *int_problem(const token &t, const char *otherwise)
+{
+    return has_nul(t) ? num_problem(NUM_NUL) : otherwise;
+}
 /* The error code for a status other than NUM_OK: VB_ERR_FORMAT for text
  * that is no number, VB_ERR_INVALID for a number out of range. */
 inline vb_result num_error(num_status s)

@@ -1112,14 +1112,29 @@ static int parse_args(int argc, char **argv, options *o)
                 return VT_EXIT_USAGE;
             break;
         case O_WELD: o->weld = 1; break;
-        case O_CUBEDIR: o->cubemap_dir = optarg; break;
+        case O_CUBEDIR:
+            if (!vt_opt_once("--cubemap-dir", optarg, &o->cubemap_dir))
+                return VT_EXIT_USAGE;
+            break;
         case O_ROBUST: o->robust = 1; break;
         case O_NO_ROBUST: o->robust = 0; break;
-        case O_REPORT: o->report = optarg; break;
+        case O_REPORT:
+            if (!vt_opt_once("--report", optarg, &o->report))
+                return VT_EXIT_USAGE;
+            break;
         case O_TIMINGS: o->record_timings = 1; break;
-        case O_EXPORT: o->export_obj = optarg; break;
-        case O_PLAN: o->plan = optarg; break;
-        case O_RECEIVERS: o->receivers = optarg; break;
+        case O_EXPORT:
+            if (!vt_opt_once("--export-obj", optarg, &o->export_obj))
+                return VT_EXIT_USAGE;
+            break;
+        case O_PLAN:
+            if (!vt_opt_once("--plan", optarg, &o->plan))
+                return VT_EXIT_USAGE;
+            break;
+        case O_RECEIVERS:
+            if (!vt_opt_once("--receivers", optarg, &o->receivers))
+                return VT_EXIT_USAGE;
+            break;
         case O_TRACE_ONLY: o->trace_only = 1; break;
         case O_LOG: o->quantity = VB_QUANTITY_LOG; break;
         case O_KEEP_NORMALS: o->keep_normals = 1; break;

@@ -850,9 +850,9 @@ static int parse_args(int argc, char **argv, options *o)
         case O_ORACLE: d->oracle = 1; break;
         case O_FAST: o->fast_truth = 1; break;
         case O_ALLOW: o->allow_mismatch = 1; break;
-        case O_JSON: o->json = optarg; break;
-        case O_PV: o->per_vertex = optarg; break;
-        case O_BAKE_REPORT: o->bake_report = optarg; break;
+        case O_JSON: ok = vt_opt_once("--json", optarg, &o->json); break;
+        case O_PV: ok = vt_opt_once("--per-vertex", optarg, &o->per_vertex); break;
+        case O_BAKE_REPORT: ok = vt_opt_once("--bake-report", optarg, &o->bake_report); break;
         case 'q': o->quiet = 1; break;
         case 'h': usage(stdout); return 0;
         case 'V': return vt_cli_version("Embree " RTC_VERSION_STRING);

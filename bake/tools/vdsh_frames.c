@@ -930,11 +930,11 @@ static int take_option(int c, options *o)
     uint64_t u;
     switch (c) {
     case 'o': return vt_opt_once("-o", optarg, &o->output);
-    case O_VIEWS: o->views_path = optarg; return 1;
-    case O_SDF: o->sdf = optarg; return 1;
-    case O_TRUTH: o->truth = optarg; return 1;
-    case O_FRAMES: o->frames = optarg; return 1;
-    case O_JSON: o->json = optarg; return 1;
+    case O_VIEWS: return vt_opt_once("--views", optarg, &o->views_path);
+    case O_SDF: return vt_opt_once("--sdf", optarg, &o->sdf);
+    case O_TRUTH: return vt_opt_once("--truth", optarg, &o->truth);
+    case O_FRAMES: return vt_opt_once("--frames", optarg, &o->frames);
+    case O_JSON: return vt_opt_once("--json", optarg, &o->json);
     case 'q': o->quiet = 1; return 1;
     case O_THREADS: return vt_opt_u32("--threads", NULL, optarg, 1, 256, &o->threads);
     case O_CAMERAS:

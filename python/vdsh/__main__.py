@@ -88,27 +88,35 @@ def summary(f: VdshFile, path: str) -> Dict[str, Any]:
         **{k: v for k, v in (("part", f.part), ("adaptive", f.adaptive)) if v is not None})
 
 
+def _n(n: int, one: str, many: str = "") -> str:
+    """'1 triangle', '2 triangles' (vdsh-info's plurals)."""
+    return "%d %s" % (n, one if n == 1 else (many or one + "s"))
+
+
 def _text(d: Dict[str, Any]) -> str:
     b = d["bake"]
 
     def vec(v: List[float]) -> str:
         return "(%s)" % ", ".join("%g" % x for x in v)
     lines = [d["file"],
-             "  receivers    %d vertices, %d triangles" % (d["vertex_count"], d["triangle_count"]),
+             "  receivers    %s, %s" % (_n(d["vertex_count"], "vertex", "vertices"),
+                                       _n(d["triangle_count"], "triangle")),
              "               bounds %s .. %s" % (vec(d["receiver_bounds"]["min"]),
                                                  vec(d["receiver_bounds"]["max"])),
-             "  occluders    %d vertices, %d triangles" % (b["occluder_vertex_count"],
-                                                           b["occluder_triangle_count"]),
+             "  occluders    %s, %s" % (_n(b["occluder_vertex_count"], "vertex", "vertices"),
+                                       _n(b["occluder_triangle_count"], "triangle")),
              "  bake         rays %d per receiver, sampling %s, seed %d"
              % (b["rays"], b["sampling"], b["seed"]),
              "               max_distance %g, max_edge %g" % (b["max_distance"], b["max_edge"]),
              "  sources      %d" % len(d["sources"])]
-    lines += ["    [%d] %s (%d bytes)" % (i, s["name"], s["size"]) for i, s in enumerate(d["sources"])]
+    lines += ["    [%d] %s (%s)" % (i, s["name"], _n(s["size"], "byte"))
+              for i, s in enumerate(d["sources"])]
     lines.append("  streams      %d" % len(d["streams"]))
     for i, s in enumerate(d["streams"]):
-        lines.append("    [%d] order %d%s (%d coefficients), %s, method %s, quantity %s"
+        lines.append("    [%d] order %d%s (%s), %s, method %s, quantity %s"
                      % (i, s["order"], " (variable)" if s["variable_order"] else "",
-                        s["coefficients"], s["encoding"], s["method"], s["quantity"]))
+                        _n(s["coefficients"], "coefficient"), s["encoding"], s["method"],
+                        s["quantity"]))
         if s["variable_order"]:
             lines.append("        vertices per order 1..%d: %s" % (
                 s["order"], " ".join(str(n) for n in s["vertices_per_order"])))
