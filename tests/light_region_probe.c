@@ -2,7 +2,9 @@
  * light_region_probe SCENE [SEED]: what the light placement of a bake
  * decides for SCENE (vdsh_light.h), printed so that runs under different
  * Embree kernel sets (tests/with_each_isa.sh) can be compared line by line:
- *   region grown|bounds probes N       vb_scene_light_region's decision
+ *   region grown|bounds probes N box LO HI   vb_scene_light_region's
+ *     decision, the region's corners as hexadecimal floats (how far it
+ *     grew: vdsh_light_growth of the free count below)
  *   candidates: the free ones among the first 1024 region candidates
  *     of the bounds (their indices, whether or not the rule stopped early)
  *   pool: the decision fit's 256 training lights (seed SEED, default 1, as
@@ -90,7 +92,12 @@ int main(int argc, char **argv)
     float lo[3], hi[3];
     uint32_t probes = 0;
     const int grown = vb_scene_light_region(s, lo, hi, &probes);
-    printf("region %s probes %u\n", grown ? "grown" : "bounds", probes);
+    printf("region %s probes %u box", grown ? "grown" : "bounds", probes);
+    for (int a = 0; a < 3; a++)
+        printf(" %a", (double)lo[a]);
+    for (int a = 0; a < 3; a++)
+        printf(" %a", (double)hi[a]);
+    printf("\n");
     printf("candidates:");
     double gap = INFINITY;
     uint64_t th = 0xcbf29ce484222325ull;
