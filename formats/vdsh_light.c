@@ -54,23 +54,34 @@ void vdsh_light_candidate(const float lo[3], const float hi[3], uint64_t seed, u
         out[a] = (float)((double)lo[a] + unit(seed, k, (uint32_t)a) * ((double)hi[a] - lo[a]));
 }
 
+double vdsh_light_growth(uint32_t free_count)
+{
+    if (free_count <= VDSH_REGION_FULL)
+        return (double)VDSH_REGION_GROW;
+    if (free_count >= VDSH_REGION_ROOM)
+        return 0.0;
+    return (double)VDSH_REGION_GROW * (double)(VDSH_REGION_ROOM - free_count) /
+           (double)(VDSH_REGION_ROOM - VDSH_REGION_FULL);
+}
+
 int vdsh_light_region(const float lo[3], const float hi[3], vdsh_free_fn is_free, const void *ctx,
                       float out_lo[3], float out_hi[3], uint32_t *probes)
 {
     float l[3] = {lo[0], lo[1], lo[2]}, h[3] = {hi[0], hi[1], hi[2]};
     uint32_t found = 0, k = 0;
-    while (found < VDSH_REGION_MIN_FREE && k < VDSH_REGION_PROBES) {
+    while (found < VDSH_REGION_ROOM && k < VDSH_REGION_PROBES) {
         float p[3];
         vdsh_light_candidate(l, h, VDSH_REGION_SEED, k++, p);
         found += is_free(ctx, p) != 0;
     }
     if (probes)
         *probes = k;
-    int grown = found < VDSH_REGION_MIN_FREE;
+    const double share = vdsh_light_growth(found);
+    const int grown = share > 0.0;
     double diag = 0.0;
     for (int a = 0; a < 3; a++)
         diag += ((double)h[a] - l[a]) * ((double)h[a] - l[a]);
-    const double g = grown ? (double)VDSH_REGION_GROW * sqrt(diag) : 0.0;
+    const double g = share * sqrt(diag);
     for (int a = 0; a < 3; a++) {
         out_lo[a] = grown ? (float)((double)l[a] - g) : l[a];
         out_hi[a] = grown ? (float)((double)h[a] + g) : h[a];
@@ -80,5 +91,6 @@ int vdsh_light_region(const float lo[3], const float hi[3], vdsh_free_fn is_free
 
 uint64_t vdsh_light_tries(uint32_t count, int grown)
 {
-    return grown ? VDSH_REGION_TRIES + 4ull * count : 1000ull * (count ? count : 1);
+    const uint64_t per_light = 1000ull * (count ? count : 1);
+    return grown ? VDSH_REGION_TRIES + per_light : per_light;
 }

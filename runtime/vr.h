@@ -465,7 +465,7 @@ enum { VR_MAX_POOL_LIGHTS = 64 };
  * "placed uniformly in free space" as formats/vdsh_light.h defines it:
  * the candidates of vdsh_light_candidate (seed 1) in the light region
  * (vdsh_light_region: the bounds, or the bounds grown around a closed
- * object) that pass vdsh_view_free_space against the drawn mesh, in
+ * or nearly closed object) that pass vdsh_view_free_space against the drawn mesh, in
  * sequence order, at most 256 tried per position in the bounds
  * (vdsh_light_tries in a grown region); deterministic. Colours and attenuations are
  * left zero. */

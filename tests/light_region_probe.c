@@ -2,7 +2,9 @@
  * light_region_probe SCENE [SEED]: what the light placement of a bake
  * decides for SCENE (vdsh_light.h), printed so that runs under different
  * Embree kernel sets (tests/with_each_isa.sh) can be compared line by line:
- *   region grown|bounds probes N       vb_scene_light_region's decision
+ *   region grown|bounds probes N box LO HI   vb_scene_light_region's
+ *     decision, the region's corners as hexadecimal floats (how far it
+ *     grew: vdsh_light_growth of the free count below)
  *   candidates: the free ones among the first 1024 region candidates
  *     of the bounds (their indices, whether or not the rule stopped early)
  *   pool: the decision fit's 256 training lights (seed SEED, default 1, as
@@ -12,7 +14,9 @@
  * any probe ray of those candidates to the clearance: how near a probe
  * came to flipping its candidate, and a hash of Embree's own distances for
  * those probes (Embree's kernels differ by a few ulps; the free-space test
- * measures its hits itself: bake/lib/scene.c probe_hit).
+ * measures its hits itself: bake/lib/scene.c probe_hit), and the share of
+ * the free candidates' probe rays that meet nothing (open space: an
+ * object's surroundings; a closed room's free space sees walls).
  * Exit 1 on a load or scene error.
  */
 #include <math.h>
@@ -37,7 +41,7 @@ static uint64_t fnv(uint64_t h, const void *p, size_t n)
 /* The smallest |t - c| / c of the 14 probes from p (scene units), with
  * Embree's own distances; *h: their bits hashed (they differ between
  * kernel sets, the free-space test's own measure does not). */
-static double probe_gap(const vb_scene *s, const float p[3], uint64_t *h)
+static double probe_gap(const vb_scene *s, const float p[3], uint64_t *h, uint32_t *misses)
 {
     float dirs[VDSH_FREE_PROBES][3], o[3];
     vdsh_free_probe_dirs(dirs);
@@ -57,8 +61,10 @@ static double probe_gap(const vb_scene *s, const float p[3], uint64_t *h)
                                        .mask = 0xffffffffu},
                                .hit = {.geomID = RTC_INVALID_GEOMETRY_ID}};
         rtcIntersect1(s->scene, &ctx, &rh);
-        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+            ++*misses;
             continue;
+        }
         *h = fnv(*h, &rh.ray.tfar, sizeof rh.ray.tfar);
         double g = fabs(rh.ray.tfar / s->scale - c) / c;
         gap = g < gap ? g : gap;
@@ -90,19 +96,27 @@ int main(int argc, char **argv)
     float lo[3], hi[3];
     uint32_t probes = 0;
     const int grown = vb_scene_light_region(s, lo, hi, &probes);
-    printf("region %s probes %u\n", grown ? "grown" : "bounds", probes);
+    printf("region %s probes %u box", grown ? "grown" : "bounds", probes);
+    for (int a = 0; a < 3; a++)
+        printf(" %a", (double)lo[a]);
+    for (int a = 0; a < 3; a++)
+        printf(" %a", (double)hi[a]);
+    printf("\n");
     printf("candidates:");
     double gap = INFINITY;
     uint64_t th = 0xcbf29ce484222325ull;
-    uint32_t free_count = 0;
+    uint32_t free_count = 0, escaped = 0;
     for (uint32_t k = 0; k < VDSH_REGION_PROBES; k++) {
         float p[3];
         vdsh_light_candidate(s->bounds_min, s->bounds_max, VDSH_REGION_SEED, k, p);
-        if (vb_scene_free_space(s, p)) {
+        const int is_free = vb_scene_free_space(s, p);
+        if (is_free) {
             printf(" %u", k);
             free_count++;
         }
-        double g = probe_gap(s, p, &th);
+        uint32_t misses = 0;
+        double g = probe_gap(s, p, &th, &misses);
+        escaped += is_free ? misses : 0;
         gap = g < gap ? g : gap;
     }
     printf(" (%u free)\n", free_count);
@@ -115,8 +129,9 @@ int main(int argc, char **argv)
         printf("pool: none (%s)\n", pool ? err.msg : "out of memory");
     fprintf(stderr,
             "light_region_probe: %s: nearest probe to the clearance: %.3g of it; Embree's "
-            "distances hash %016llx\n",
-            argv[1], gap, (unsigned long long)th);
+            "distances hash %016llx; free candidates' probes that meet nothing: %.1f%%\n",
+            argv[1], gap, (unsigned long long)th,
+            free_count ? 100.0 * escaped / (free_count * (double)VDSH_FREE_PROBES) : 0.0);
     free(pool);
     vb_scene_destroy(s);
     vb_mesh_free(&m);

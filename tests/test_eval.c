@@ -905,7 +905,7 @@ static void test_lights(void)
         CHECK(r == VB_OK, "cube rule %s: %s", vb_light_rule_name((vb_light_rule)rule), err.msg);
         if (r != VB_OK)
             continue;
-        CHECK(tried <= vdsh_light_tries(N, 1), "cube rule %d: %u candidates", rule, tried);
+        CHECK(tried <= VDSH_REGION_TRIES + 4u * N, "cube rule %d: %u candidates", rule, tried);
         for (int l = 0; l < N; l++) {
             int outside = 0, within = 1;
             for (int k = 0; k < 3; k++) {

@@ -3,15 +3,17 @@
 # the CPU has (tests/with_each_isa.sh), or, where they are not, what
 # follows from them agrees (docs/DESIGN.md, "Across CPUs"):
 #   - the light region (formats/vdsh_light.h): a closed cube, a cube less
-#     a corner notch just too small for the rule (2 of 1024 candidates
-#     free: grown) and just large enough (4 free, the 4th at candidate 824:
-#     its bounds, one flipped candidate from the other decision), a cube
-#     turned by 0.02 rad (5 free, in slivers next to its faces), the room
-#     and Sponza (when ../shared/scenes has it): light_region_probe's
-#     decision, every free candidate of the 1024 and the decision fit's
-#     256 training lights, bit for bit; and the bakes of the cube and the
-#     two notches report the same region (vdsh-bake --report:
-#     decision.light_region, light_region_probes);
+#     a corner notch with 2 and with 4 of 1024 candidates free (the old
+#     rule's threshold: now both fully grown, the cube's region), a cube
+#     turned by 0.02 rad (5 free, in slivers next to its faces: fully
+#     grown), a cube turned by 10 degrees (~200 free: grown by a part of
+#     the quarter diagonal, which moves with every free candidate), the
+#     room and Sponza (when ../shared/scenes has it: their bounds):
+#     light_region_probe's decision and region (hexadecimal floats), every
+#     free candidate of the 1024 and the decision fit's 256 training
+#     lights, bit for bit; and the bakes of the cube and the two notches
+#     report the same region (vdsh-bake --report: decision.light_region,
+#     light_region_probes);
 #   - the calibration's guard on the cube: no held-out light shadowed
 #     (held_out_shadowed 0) and every log offset 0 with every ISA;
 #   - cpca streams (8,alloc:32 on order 5, auto on order 3) of the room:
@@ -62,7 +64,7 @@ auto=(--orders 3 --encoding cpca --cpca auto)
 if [[ ${ISA_ONE:-} == 1 ]]; then
   isa=${VDSH_EMBREE_CONFIG#isa=}
   fail=0
-  scene_list=("$REF/cube.obj" "$REF/notch-low.obj" "$REF/notch-high.obj" "$REF/turned.obj" builtin:room)
+  scene_list=("$REF/cube.obj" "$REF/notch-low.obj" "$REF/notch-high.obj" "$REF/turned.obj" "$REF/turned10.obj" builtin:room)
   [[ -n $SPONZA ]] && scene_list+=("$SPONZA")
   for s in "${scene_list[@]}"; do
     name=${s##*/}
@@ -104,8 +106,8 @@ trap 'rm -rf "$tmp"' EXIT
 fail=0
 # The closed objects: the unit cube (faces wound outward), the cube less
 # the corner [0,a]^3 (the faces between filled and empty cells of a 2x2x2
-# grid split at a), and the cube turned by 0.02 rad about y and 0.014
-# about x.
+# grid split at a), the cube turned by 0.02 rad about y and 0.014
+# about x, and the cube turned by 10 degrees about y.
 "$py" - "$tmp" <<'EOF' || exit 1
 import math, os, sys
 d = sys.argv[1]
@@ -150,23 +152,40 @@ for x, y, z in vs:
     y, z = math.cos(u) * y - math.sin(u) * z, math.sin(u) * y + math.cos(u) * z
     out.append((x, y, z))
 write("turned.obj", out, fs)
+t = math.radians(10.0)
+out = []
+for x, y, z in vs:
+    x, y, z = x - 0.5, y - 0.5, z - 0.5
+    out.append((math.cos(t) * x - math.sin(t) * z, y, math.sin(t) * x + math.cos(t) * z))
+write("turned10.obj", out, fs)
 EOF
-scene_list=("$tmp/cube.obj" "$tmp/notch-low.obj" "$tmp/notch-high.obj" "$tmp/turned.obj" builtin:room)
+scene_list=("$tmp/cube.obj" "$tmp/notch-low.obj" "$tmp/notch-high.obj" "$tmp/turned.obj" "$tmp/turned10.obj" builtin:room)
 SPONZA=$scenes/sponza_dabrovic/sponza.obj
 if [[ -f $SPONZA ]]; then scene_list+=("$SPONZA"); else
   echo "no Sponza at $SPONZA: its light placement is not compared"; SPONZA=; fi
 for s in "${scene_list[@]}"; do
   "$probe" "$s" >"$tmp/probe-${s##*/}.txt" 2>/dev/null || { echo "FAIL: probe $s" >&2; exit 1; }
 done
-# The objects are what the test says: the notches either side of the rule.
+# The objects are what the test says (formats/vdsh_light.h: fully grown
+# at <= 64 of 1024 free, the bounds at >= 256, linear between).
 free_of() { sed -n 's/.*(\([0-9]*\) free).*/\1/p' "$tmp/probe-$1.txt"; }
 region_of() { sed -n 's/^region \([a-z]*\) .*/\1/p' "$tmp/probe-$1.txt"; }
+box_of() { sed -n 's/^region .* box \(.*\)/\1/p' "$tmp/probe-$1.txt"; }
 [[ $(region_of cube.obj) == grown && $(free_of cube.obj) == 0 ]] ||
   { echo "FAIL: the cube: region $(region_of cube.obj), $(free_of cube.obj) free" >&2; fail=1; }
-[[ $(region_of notch-low.obj) == grown && $(free_of notch-low.obj) -ge 1 ]] ||
-  { echo "FAIL: the small notch: region $(region_of notch-low.obj), $(free_of notch-low.obj) free: not just below the rule" >&2; fail=1; }
-[[ $(region_of notch-high.obj) == bounds && $(free_of notch-high.obj) -le 5 ]] ||
-  { echo "FAIL: the large notch: region $(region_of notch-high.obj), $(free_of notch-high.obj) free: not just above the rule" >&2; fail=1; }
+for o in notch-low.obj notch-high.obj turned.obj; do
+  [[ $(region_of $o) == grown && $(free_of $o) -ge 1 && $(free_of $o) -le 64 ]] ||
+    { echo "FAIL: $o: region $(region_of $o), $(free_of $o) free: not fully grown with a few free" >&2; fail=1; }
+done
+for o in notch-low.obj notch-high.obj; do # the cube's bounds, the cube's region
+  [[ $(box_of $o) == "$(box_of cube.obj)" ]] ||
+    { echo "FAIL: $o: region $(box_of $o), the cube's $(box_of cube.obj)" >&2; fail=1; }
+done
+[[ $(region_of turned10.obj) == grown && $(free_of turned10.obj) -gt 64 && $(free_of turned10.obj) -lt 256 ]] ||
+  { echo "FAIL: turned10.obj: region $(region_of turned10.obj), $(free_of turned10.obj) free: not partly grown" >&2; fail=1; }
+for o in builtin:room ${SPONZA:+${SPONZA##*/}}; do # interiors keep their bounds
+  [[ $(region_of $o) == bounds ]] || { echo "FAIL: $o: region $(region_of $o), want its bounds" >&2; fail=1; }
+done
 for o in cube notch-low notch-high; do
   "$bake" "$tmp/$o.obj" --cube-size 0 --rays 256 -q --report "$tmp/$o.json" -o "$tmp/$o.vdsh" || exit 1
 done

@@ -579,6 +579,59 @@ static void test_lights_beyond_clamp(void)
     CHECK(worst > 1.43, "the cube reaches the bound: %g", worst);
 }
 
+/* A scene whose box holds a fraction *ctx of free space: the points
+ * with x below lo + fraction * (hi - lo) of the unit box are free. */
+static int free_below(const void *ctx, const float p[3])
+{
+    return p[0] < *(const float *)ctx;
+}
+
+/* The light region's rule (formats/vdsh_light.h) is continuous: as the
+ * free space in the bounds grows from none to all, the growth never
+ * jumps (a step of 1 of 1024 free moves the region by at most the
+ * quarter diagonal / 192), it is the full quarter diagonal up to 64 of
+ * 1024 free, and the bounds exactly from 256 free: the region of every
+ * interior measured (>= 48% free). */
+static void test_light_region_continuous(void)
+{
+    const float lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    const double diag = sqrt(3.0), step = VDSH_REGION_GROW * diag / 192.0;
+    double prev = (double)VDSH_REGION_GROW * diag;
+    int bounds = 0, full = 0;
+    for (int i = 0; i <= 100; i++) {
+        float f = (float)i / 100.0f, glo[3], ghi[3];
+        uint32_t probes = 0, n = 0;
+        const int grown = vdsh_light_region(lo, hi, free_below, &f, glo, ghi, &probes);
+        for (uint32_t k = 0; k < probes; k++) {
+            float p[3];
+            vdsh_light_candidate(lo, hi, VDSH_REGION_SEED, k, p);
+            n += free_below(&f, p);
+        }
+        const double g = -(double)glo[0];
+        CHECK(fabs(g - vdsh_light_growth(n) * diag) < 1e-6 &&
+                  fabs((double)ghi[0] - 1.0 - g) < 1e-6 && grown == (g > 0.0),
+              "%.2f free (%u): the region grown by %g, the rule's %g", f, n, g,
+              vdsh_light_growth(n) * diag);
+        CHECK(g <= prev + 1e-9, "%.2f free: the growth %g rose from %g", f, g, prev);
+        CHECK(n <= 64 || n >= VDSH_REGION_ROOM || probes == VDSH_REGION_PROBES,
+              "%.2f free: the rule stopped early at %u free", f, n);
+        bounds += !grown && n >= VDSH_REGION_ROOM && probes < VDSH_REGION_PROBES;
+        full += n <= 64 && fabs(g - VDSH_REGION_GROW * diag) < 1e-6;
+        prev = g;
+    }
+    CHECK(bounds > 60 && full >= 5, "%d fractions keep their bounds, %d fully grown", bounds, full);
+    for (uint32_t n = 0; n < VDSH_REGION_PROBES; n++)
+        CHECK(vdsh_light_growth(n) >= vdsh_light_growth(n + 1) &&
+                  vdsh_light_growth(n) - vdsh_light_growth(n + 1) <= step / diag + 1e-12,
+              "growth %u to %u free: %g to %g", n, n + 1, vdsh_light_growth(n),
+              vdsh_light_growth(n + 1));
+    CHECK(vdsh_light_growth(0) == VDSH_REGION_GROW &&
+              vdsh_light_growth(VDSH_REGION_FULL) == VDSH_REGION_GROW &&
+              vdsh_light_growth(VDSH_REGION_ROOM) == 0.0 &&
+              vdsh_light_growth(VDSH_REGION_ROOM - 1) > 0.0,
+          "the rule's ends");
+}
+
 /* vdsh_shadow.c's table of comparisons: names round-trip, each row
  * compares (a light just past the stored distance is blocked, one well
  * before it lit), unknown names are refused. */
@@ -601,6 +654,7 @@ int main(void)
     test_shadow();
     test_compare_table();
     test_lights_beyond_clamp();
+    test_light_region_continuous();
     test_interior();
     test_clamp_horizon();
     test_clamp_never_exceeds();

@@ -243,8 +243,8 @@ int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3], uint32_t 
 /* Where the candidates went, for the messages. */
 static const char *region_name(int grown)
 {
-    return grown ? "the scene's bounds grown by a quarter of their diagonal (too little free "
-                   "space inside them)"
+    return grown ? "the scene's bounds grown by up to a quarter of their diagonal (too little "
+                   "free space inside them)"
                  : "the scene's bounds";
 }
 

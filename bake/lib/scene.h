@@ -77,7 +77,8 @@ vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count
 
 /* The region lights are placed in (vdsh_light_region): the bounds, or,
  * when they hold too little free space (a closed object), the bounds grown
- * by a quarter of their diagonal. Returns 1 when grown. *probes (may be
+ * by up to a quarter of their diagonal, the less free space the more.
+ * Returns 1 when grown. *probes (may be
  * NULL): the candidates the rule tested. */
 int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3], uint32_t *probes);
 

@@ -570,9 +570,10 @@ static void print_table(FILE *o, const context *c)
             r->light_count, rule ? "by the light rule '" : "uniformly",
             rule ? vb_light_rule_name(rule) : "", rule ? "'" : "");
     if (r->light_region_grown)
-        fprintf(o, "  (the scene's bounds hold too little free space, a closed object: the "
-                   "lights are placed\n  around it, in the bounds grown by a quarter of their "
-                   "diagonal on every side)\n\n");
+        fprintf(o,
+                "  (the scene's bounds hold too little free space, a closed object: the "
+                "lights are placed\n  around it, in the bounds grown by up to a quarter of their "
+                "diagonal on every side)\n\n");
     fprintf(o, "  %-8s %5s %6s %3s %3s %-9s | %7s | %-15s %-13s %-12s | %-6s %6s %6s\n", "",
             "order", "offset", "B/v", "enc", "fit", "pairs", "smooth: MAE", "false", "recall",
             "binary", "false", "recall");
