@@ -420,6 +420,33 @@ for src, want in ((missing, "No such file"), (fifo, "not a regular file"), (work
     except subprocess.TimeoutExpired:
         fail.append("--source %s: still running after 60 s" % src)
 
+# --source whose URIs are percent-encoded (glTF URIs are RFC 3986: a file
+# "Box Textured0.bin" is written "Box%20Textured0.bin"), as the baker
+# (tinygltf) decodes them: the buffer is read and the image embedded, not
+# refused or left as a URI that names no file.
+box = os.path.join(models, "glTF2", "BoxTextured-glTF")
+if os.path.isdir(box):
+    pct = os.path.join(work, "pct")
+    os.makedirs(pct, exist_ok=True)
+    with open(os.path.join(box, "BoxTextured0.bin"), "rb") as fi, \
+            open(os.path.join(pct, "Box Textured0.bin"), "wb") as fo:
+        fo.write(fi.read())
+    with open(os.path.join(box, "CesiumLogoFlat.png"), "rb") as fi, \
+            open(os.path.join(pct, "Cesium Logo+1.png"), "wb") as fo:
+        fo.write(fi.read())
+    g0 = json.load(open(os.path.join(box, "BoxTextured.gltf")))
+    g0["buffers"][0]["uri"] = "Box%20Textured0.bin"
+    g0["images"][0]["uri"] = "Cesium%20Logo%2B1.png"
+    src = os.path.join(pct, "box.gltf")
+    json.dump(g0, open(src, "w"))
+    vd, out = os.path.join(pct, "box.vdsh"), os.path.join(pct, "box.glb")
+    run([bake, src, "-o", vd, "-q", "--rays", "16", "--orders", "2"])
+    p = run([export, vd, "--source", src, "-o", out, "-q"])
+    if p.returncode == 0:
+        g, bn = read_glb(out)
+        if any("uri" in i for i in g.get("images", [])) or "cannot be read" in p.stderr:
+            fail.append("%s: percent-encoded image URI not embedded: %s" % (out, p.stderr.strip()))
+
 for f in fail:
     print("FAIL:", f)
 if not fail and not validator:

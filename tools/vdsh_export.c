@@ -336,11 +336,9 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
                            : !strcasecmp(dot, ".png")                                ? "image/png"
                            : (!strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg")) ? "image/jpeg"
                                                                                      : NULL;
-        char *p = malloc(strlen(src.dir) + strlen(uri->valuestring) + 1);
+        char *p = vdsh_src_file(&src, uri->valuestring);
         if (!p)
             goto oom;
-        strcpy(p, src.dir);
-        strcat(p, uri->valuestring);
         FILE *fp = fopen(p, "rb");
         free(p);
         if (!fp || !mime) {

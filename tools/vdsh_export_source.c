@@ -80,6 +80,17 @@ static int b64(int c)
     return -1;
 }
 
+static int hex(int c)
+{
+    if (c >= '0' && c <= '9')
+        return c - '0';
+    if (c >= 'a' && c <= 'f')
+        return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F')
+        return c - 'A' + 10;
+    return -1;
+}
+
 /* A data: URI's base64 payload; NULL when it is not base64. */
 static uint8_t *data_uri(const char *uri, size_t *size)
 {
@@ -109,6 +120,27 @@ static uint8_t *data_uri(const char *uri, size_t *size)
     }
     *size = o;
     return d;
+}
+
+char *vdsh_src_file(const vdsh_src *s, const char *uri)
+{
+    size_t n = strlen(uri), d = strlen(s->dir);
+    char *p = malloc(d + n + 1);
+    if (!p)
+        return NULL;
+    memcpy(p, s->dir, d);
+    char *o = p + d;
+    for (size_t i = 0; i < n; i++) {
+        int hi = i + 2 < n ? hex(uri[i + 1]) : -1, lo = i + 2 < n ? hex(uri[i + 2]) : -1;
+        if (uri[i] == '%' && hi >= 0 && lo >= 0 && (hi | lo)) {
+            *o++ = (char)(hi << 4 | lo);
+            i += 2;
+        } else {
+            *o++ = uri[i];
+        }
+    }
+    *o = 0;
+    return p;
 }
 
 void vdsh_src_free(vdsh_src *s)
@@ -179,10 +211,8 @@ int vdsh_src_load(const char *path, vdsh_src *s, char *msg, size_t cap)
         } else if (strncmp(uri->valuestring, "data:", 5) == 0) {
             sb->data = data_uri(uri->valuestring, &sb->size);
         } else {
-            char *p = malloc(strlen(s->dir) + strlen(uri->valuestring) + 1);
+            char *p = vdsh_src_file(s, uri->valuestring);
             if (p) {
-                strcpy(p, s->dir);
-                strcat(p, uri->valuestring);
                 sb->data = slurp(p, &sb->size, &bwhy);
                 free(p);
             }
