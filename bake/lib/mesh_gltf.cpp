@@ -13,7 +13,9 @@
  * LINE* primitives, primitives with morph targets, meshes of skinned
  * nodes. Refused with the file and reason: unparsable JSON, buffers out of
  * range, an accessor of the wrong type, node cycles, no scene, extensions
- * the file requires (e.g. Draco compression), images are never decoded.
+ * the file requires (e.g. Draco compression) but KHR_mesh_quantization and
+ * those of textures and materials (neutral_extension); images are never
+ * decoded.
  *
  * External buffers (.gltf) resolve relative to `name`'s directory; a glTF
  * loaded from memory under a name without a directory resolves them in
@@ -353,6 +355,21 @@ bool no_images(tinygltf::Image *, const int, std::string *, std::string *, int, 
     return true;
 }
 
+/* A required extension that leaves the triangles as they are, so the
+ * baker reads the file: KHR_mesh_quantization (integer positions and
+ * normals, which read_accessor reads; the dequantisation is the node's
+ * transform), and extensions of textures and materials alone. */
+bool neutral_extension(const std::string &x)
+{
+    static const char *const names[] = {"KHR_mesh_quantization", "KHR_texture_transform",
+                                        "KHR_texture_basisu", "EXT_texture_webp",
+                                        "EXT_texture_avif"};
+    for (const char *n : names)
+        if (x == n)
+            return true;
+    return x.rfind("KHR_materials_", 0) == 0;
+}
+
 /* The first extension the file requires, read from its JSON alone (empty
  * when none, or when the JSON does not parse): tinygltf refuses some such
  * files before its own list can be checked (EXT_meshopt_compression's
@@ -379,7 +396,7 @@ std::string required_extension(int binary, const uint8_t *bytes, size_t size)
     if (it == doc.end() || !it->is_array())
         return std::string();
     for (const auto &x : *it)
-        if (x.is_string())
+        if (x.is_string() && !neutral_extension(x.get<std::string>()))
             return x.get<std::string>();
     return std::string();
 }
@@ -414,9 +431,10 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
                        e.empty() ? "(no reason given)" : e.c_str());
     }
     for (const std::string &x : model.extensionsRequired)
-        return vb_fail(err, VB_ERR_FORMAT,
-                       "%s: requires the extension %s, which the baker does not read", name,
-                       x.c_str());
+        if (!neutral_extension(x))
+            return vb_fail(err, VB_ERR_FORMAT,
+                           "%s: requires the extension %s, which the baker does not read", name,
+                           x.c_str());
     if (model.scenes.empty())
         return vb_fail(err, VB_ERR_FORMAT, "%s: no scene", name);
     int s = scene >= 0 ? scene : (model.defaultScene >= 0 ? model.defaultScene : 0);
