@@ -120,6 +120,17 @@ if os.path.isdir(g2):
         path = os.path.join(g2, rel)
         tris, p = load(path)
         refused(path, p)
+    # glTF 1.0 (assimp-testmodels' glTF folder): refused as such, not as
+    # "no scene" or "Invalid glTF binary".
+    g1 = os.path.join(models, "glTF")
+    for rel in ["BoxTextured-glTF/BoxTextured.gltf", "BoxTextured-glTF-Binary/BoxTextured.glb",
+                "CesiumMilkTruck/CesiumMilkTruck.gltf"]:
+        path = os.path.join(g1, rel)
+        if os.path.exists(path):
+            tris, p = load(path)
+            refused(path, p)
+            if "glTF 1.0" not in p.stderr:
+                failures.append("%s: not said to be glTF 1.0: %s" % (path, p.stderr.strip()))
 else:
     print("no %s: assimp-testmodels part skipped" % g2)
 

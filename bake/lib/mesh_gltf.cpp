@@ -375,21 +375,54 @@ bool neutral_extension(const std::string &x)
  * files before its own list can be checked (EXT_meshopt_compression's
  * fallback buffer has no data: "Invalid byteLength"), and the extension is
  * then the reason to give. */
-std::string required_extension(int binary, const uint8_t *bytes, size_t size)
+nlohmann::json file_json(int binary, const uint8_t *bytes, size_t size)
 {
     const char *j = (const char *)bytes;
     size_t n = size;
     if (binary) {
         uint32_t len = 0;
         if (size < 20)
-            return std::string();
+            return nlohmann::json();
         memcpy(&len, bytes + 12, 4);
         if (len > size - 20)
-            return std::string();
+            return nlohmann::json();
         j = (const char *)bytes + 20;
         n = len;
     }
-    nlohmann::json doc = nlohmann::json::parse(j, j + n, nullptr, false);
+    return nlohmann::json::parse(j, j + n, nullptr, false);
+}
+
+/* Whether the file is glTF 1.0 (tinygltf then says "no scene", "Invalid
+ * glTF binary" or that "asset" is missing): a binary of container version
+ * 1, an asset.version 1.x, or objects where 2.0 has arrays (1.0's
+ * dictionaries of accessors, meshes, nodes). */
+bool gltf_1(int binary, const uint8_t *bytes, size_t size)
+{
+    uint32_t v = 0;
+    if (binary && size >= 8)
+        memcpy(&v, bytes + 4, 4);
+    if (v == 1)
+        return true;
+    nlohmann::json doc = file_json(binary, bytes, size);
+    if (!doc.is_object())
+        return false;
+    auto a = doc.find("asset");
+    if (a != doc.end() && a->is_object()) {
+        auto ver = a->find("version");
+        if (ver != a->end() && ver->is_string() && ver->get<std::string>().rfind("1", 0) == 0)
+            return true;
+    }
+    for (const char *k : {"accessors", "meshes", "nodes"}) {
+        auto it = doc.find(k);
+        if (it != doc.end() && it->is_object())
+            return true;
+    }
+    return false;
+}
+
+std::string required_extension(int binary, const uint8_t *bytes, size_t size)
+{
+    nlohmann::json doc = file_json(binary, bytes, size);
     if (!doc.is_object())
         return std::string();
     auto it = doc.find("extensionsRequired");
@@ -416,6 +449,11 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     bool ok = binary ? loader.LoadBinaryFromMemory(&model, &e, &w, bytes, (unsigned)size, dir)
                      : loader.LoadASCIIFromString(&model, &e, &w, (const char *)bytes,
                                                   (unsigned)size, dir);
+    if ((!ok || model.asset.version.rfind("1", 0) == 0) && gltf_1(binary, bytes, size))
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: a glTF 1.0 file: only glTF 2.0 is read (convert it, e.g. with "
+                       "Khronos' gltf-pipeline)",
+                       name);
     if (!ok) {
         std::string x = required_extension(binary, bytes, size);
         if (!x.empty())
