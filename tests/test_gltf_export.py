@@ -447,6 +447,26 @@ if os.path.isdir(box):
         if any("uri" in i for i in g.get("images", [])) or "cannot be read" in p.stderr:
             fail.append("%s: percent-encoded image URI not embedded: %s" % (out, p.stderr.strip()))
 
+# --source whose positions are a sparse accessor (the baker applies it;
+# tests/gltf_fixtures.py's sparse_zero and sparse_nodes, a node tree):
+# every vertex the bake has is matched, as .gltf and .glb.
+sys.path.insert(0, here)
+import gltf_fixtures  # noqa: E402
+for name, g0, bin0, _ in gltf_fixtures.fixtures():
+    if not name.startswith("sparse"):
+        continue
+    for ext, data in (("gltf", gltf_fixtures.as_gltf(g0, bin0)), ("glb", gltf_fixtures.as_glb(g0, bin0))):
+        src = os.path.join(work, "src-%s.%s" % (name, ext))
+        open(src, "wb").write(data)
+        vd, out = os.path.join(work, "src-%s.vdsh" % name), os.path.join(work, "src-%s-%s.glb" % (name, ext))
+        run([bake, src, "-o", vd, "-q", "--rays", "16", "--orders", "2", "--cube-size", "0"])
+        p = run([export, vd, "--source", src, "-o", out, "-q"])
+        if p.returncode == 0:
+            x = read_glb(out)[0]["extensions"]["VDSH_visibility_distance"]
+            if x["source_vertices_matched"] != 3:
+                fail.append("%s: %s of %s vertices matched, want 3" % (out, x["source_vertices_matched"],
+                                                                      x["source_vertices"]))
+
 for f in fail:
     print("FAIL:", f)
 if not fail and not validator:
