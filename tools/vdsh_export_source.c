@@ -474,6 +474,14 @@ static int visit(walk *w, int node, const double *parent, uint8_t *on_path, int 
     node_matrix(n, local);
     vdsh_mat4d_mul(parent, local, m);
     int mesh = (int)num(n, "mesh", -1);
+    if (mesh >= 0 &&
+        cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(n, "extensions"),
+                                         "EXT_mesh_gpu_instancing"))
+        return fail(w->msg, w->cap_msg,
+                    "%s: node %d draws its mesh as instances (EXT_mesh_gpu_instancing), which "
+                    "share their VDSH attributes: --source cannot give each its own shadows "
+                    "(export without --source)",
+                    w->path, node);
     if (mesh >= 0 && cJSON_GetObjectItemCaseSensitive(n, "skin") == NULL) {
         cJSON *me =
             cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(w->s->json, "meshes"), mesh);

@@ -6,16 +6,16 @@
  *
  * What is read: every mesh primitive reachable from the default scene (or
  * scene `scene` when >= 0), each node's matrix or TRS applied (normals by
- * the inverse transpose; a mirroring transform flips the winding), modes
+ * the inverse transpose; a mirroring transform flips the winding), once per
+ * instance of EXT_mesh_gpu_instancing (its TRS inside the node's), modes
  * TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN, indexed or not, float or
  * normalised integer POSITION/NORMAL, sparse accessors. What is skipped and
  * counted (vb_mesh_raw.gltf_*, printed by vb_mesh_report_print): POINTS and
  * LINE* primitives, primitives with morph targets, meshes of skinned
  * nodes. Refused with the file and reason: unparsable JSON, buffers out of
  * range, an accessor of the wrong type, node cycles, no scene, extensions
- * the file requires (e.g. Draco compression) but KHR_mesh_quantization and
- * those of textures and materials (neutral_extension); images are never
- * decoded.
+ * the file requires (e.g. Draco compression) but those read_extension
+ * lists; images are never decoded.
  *
  * External buffers (.gltf) resolve relative to `name`'s directory; a glTF
  * loaded from memory under a name without a directory resolves them in
@@ -301,6 +301,59 @@ vb_result add_primitive(const reader &rd, const tinygltf::Primitive &p, const ma
     return VB_OK;
 }
 
+/* The world matrices a node's mesh is drawn with: `w`, or with
+ * EXT_mesh_gpu_instancing (used or required) w times each instance's TRS
+ * (TRANSLATION, ROTATION, SCALE accessors of one count). */
+vb_result instances(const reader &rd, int node, const tinygltf::Node &n, const mat4 &w,
+                    std::vector<mat4> &ws)
+{
+    auto ext = n.extensions.find("EXT_mesh_gpu_instancing");
+    if (ext == n.extensions.end()) {
+        ws.assign(1, w);
+        return VB_OK;
+    }
+    const tinygltf::Value &at = ext->second.Get("attributes");
+    static const char *const names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+    std::vector<double> v[3];
+    size_t count = 0, got[3] = {0, 0, 0};
+    bool any = false;
+    for (int k = 0; k < 3; k++) {
+        if (!at.IsObject() || !at.Has(names[k]))
+            continue;
+        const tinygltf::Value &a = at.Get(names[k]);
+        vb_result r = read_accessor(rd, a.IsNumber() ? a.GetNumberAsInt() : -1,
+                                    k == 1 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3, false,
+                                    names[k], v[k], &got[k]);
+        if (r != VB_OK)
+            return r;
+        if (any && got[k] != count)
+            return vb_fail(rd.err, VB_ERR_FORMAT,
+                           "%s: node %d: EXT_mesh_gpu_instancing attributes of different counts",
+                           rd.name, node);
+        count = got[k];
+        any = true;
+    }
+    if (!any)
+        return vb_fail(rd.err, VB_ERR_FORMAT,
+                       "%s: node %d: EXT_mesh_gpu_instancing without TRANSLATION, ROTATION or "
+                       "SCALE",
+                       rd.name, node);
+    ws.resize(count);
+    for (size_t i = 0; i < count; i++) {
+        mat4 t;
+        vdsh_mat4d_trs(got[0] ? &v[0][3 * i] : nullptr, got[1] ? &v[1][4 * i] : nullptr,
+                       got[2] ? &v[2][3 * i] : nullptr, t.data());
+        ws[i] = mul(w, t);
+        for (double x : ws[i])
+            if (!std::isfinite(x))
+                return vb_fail(rd.err, VB_ERR_INVALID,
+                               "%s: node %d: instance %zu: non-finite "
+                               "transform",
+                               rd.name, node, i);
+    }
+    return VB_OK;
+}
+
 vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint8_t> &on_path,
                 int depth, out_mesh &o)
 {
@@ -321,24 +374,30 @@ vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint
         if ((size_t)n.mesh >= m.meshes.size())
             return vb_fail(rd.err, VB_ERR_FORMAT, "%s: node %d: mesh %d does not exist", rd.name,
                            node, n.mesh);
-        for (const tinygltf::Primitive &p : m.meshes[(size_t)n.mesh].primitives) {
-            if (n.skin >= 0) {
-                o.skipped_skin++;
-                continue;
+        std::vector<mat4> ws;
+        vb_result r = instances(rd, node, n, w, ws);
+        if (r != VB_OK)
+            return r;
+        for (const mat4 &wi : ws)
+            for (const tinygltf::Primitive &p : m.meshes[(size_t)n.mesh].primitives) {
+                if (n.skin >= 0) {
+                    o.skipped_skin++;
+                    continue;
+                }
+                if (!p.targets.empty()) {
+                    o.skipped_morph++;
+                    continue;
+                }
+                if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES &&
+                    p.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+                    p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+                    o.skipped_modes++;
+                    continue;
+                }
+                r = add_primitive(rd, p, wi, o);
+                if (r != VB_OK)
+                    return r;
             }
-            if (!p.targets.empty()) {
-                o.skipped_morph++;
-                continue;
-            }
-            if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES &&
-                p.mode != TINYGLTF_MODE_TRIANGLE_STRIP && p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
-                o.skipped_modes++;
-                continue;
-            }
-            vb_result r = add_primitive(rd, p, w, o);
-            if (r != VB_OK)
-                return r;
-        }
     }
     for (int c : n.children) {
         vb_result r = visit(rd, c, w, on_path, depth + 1, o);
@@ -355,15 +414,16 @@ bool no_images(tinygltf::Image *, const int, std::string *, std::string *, int, 
     return true;
 }
 
-/* A required extension that leaves the triangles as they are, so the
- * baker reads the file: KHR_mesh_quantization (integer positions and
- * normals, which read_accessor reads; the dequantisation is the node's
- * transform), and extensions of textures and materials alone. */
-bool neutral_extension(const std::string &x)
+/* A required extension the baker reads: KHR_mesh_quantization (integer
+ * positions and normals, which read_accessor reads; the dequantisation is
+ * the node's transform), EXT_mesh_gpu_instancing (instances()), and
+ * extensions of textures and materials alone (the triangles are the
+ * same). */
+bool read_extension(const std::string &x)
 {
-    static const char *const names[] = {"KHR_mesh_quantization", "KHR_texture_transform",
-                                        "KHR_texture_basisu", "EXT_texture_webp",
-                                        "EXT_texture_avif"};
+    static const char *const names[] = {"KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
+                                        "KHR_texture_transform", "KHR_texture_basisu",
+                                        "EXT_texture_webp",      "EXT_texture_avif"};
     for (const char *n : names)
         if (x == n)
             return true;
@@ -429,7 +489,7 @@ std::string required_extension(int binary, const uint8_t *bytes, size_t size)
     if (it == doc.end() || !it->is_array())
         return std::string();
     for (const auto &x : *it)
-        if (x.is_string() && !neutral_extension(x.get<std::string>()))
+        if (x.is_string() && !read_extension(x.get<std::string>()))
             return x.get<std::string>();
     return std::string();
 }
@@ -469,7 +529,7 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
                        e.empty() ? "(no reason given)" : e.c_str());
     }
     for (const std::string &x : model.extensionsRequired)
-        if (!neutral_extension(x))
+        if (!read_extension(x))
             return vb_fail(err, VB_ERR_FORMAT,
                            "%s: requires the extension %s, which the baker does not read", name,
                            x.c_str());
