@@ -73,6 +73,17 @@ for name, g, binary, expected in gltf_fixtures.fixtures():
         if name == "points_lines" and "2 glTF primitives of points or lines skipped" not in p.stderr:
             failures.append("%s: skipped primitives not reported: %s" % (path, p.stderr.strip()))
 
+# The container is known by its bytes, not the name: a .glb named .gltf
+# and a .gltf named .glb load (was a JSON parse error, "Invalid magic"),
+# as vdsh-export --source reads them.
+name, g, binary, expected = gltf_fixtures.fixtures()[0]
+for ext, data in (("gltf", gltf_fixtures.as_glb(g, binary)), ("glb", gltf_fixtures.as_gltf(g, binary))):
+    path = os.path.join(work, "swapped.%s" % ext)
+    open(path, "wb").write(data)
+    tris, p = load(path)
+    if tris is None or len(tris) != len(expected):
+        failures.append("%s: %s" % (path, p.stderr.strip()))
+
 # A file that requires an extension tinygltf refuses before its own list
 # can be checked (vdsh-export --compress: EXT_meshopt_compression's fallback
 # buffer has no data): the extension is named, not "Invalid byteLength".

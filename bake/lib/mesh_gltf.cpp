@@ -497,6 +497,9 @@ std::string required_extension(int binary, const uint8_t *bytes, size_t size)
 vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, size_t size,
                 vb_mesh_raw *out, vb_error *err)
 {
+    /* The container by its bytes, as vdsh-export --source reads it: a .glb
+     * named .gltf, or the other way round, is still the file it is. */
+    binary = size >= 4 && memcmp(bytes, "glTF", 4) == 0;
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(no_images, nullptr);
     tinygltf::Model model;
