@@ -437,6 +437,7 @@ if os.path.isdir(box):
     g0 = json.load(open(os.path.join(box, "BoxTextured.gltf")))
     g0["buffers"][0]["uri"] = "Box%20Textured0.bin"
     g0["images"][0]["uri"] = "Cesium%20Logo%2B1.png"
+    g0["images"][0]["mimeType"] = "image/png"  # with a uri too: not written twice
     src = os.path.join(pct, "box.gltf")
     json.dump(g0, open(src, "w"))
     vd, out = os.path.join(pct, "box.vdsh"), os.path.join(pct, "box.glb")
@@ -446,6 +447,13 @@ if os.path.isdir(box):
         g, bn = read_glb(out)
         if any("uri" in i for i in g.get("images", [])) or "cannot be read" in p.stderr:
             fail.append("%s: percent-encoded image URI not embedded: %s" % (out, p.stderr.strip()))
+        d = open(out, "rb").read()
+        dup = []
+        json.loads(d[20:20 + struct.unpack_from("<I", d, 12)[0]],
+                   object_pairs_hook=lambda kv: dup.extend(k for i, (k, _) in enumerate(kv)
+                                                           if k in [k2 for k2, _ in kv[:i]]) or dict(kv))
+        if dup:
+            fail.append("%s: keys written twice in one object: %s" % (out, sorted(set(dup))))
 
 # --source whose positions are a sparse accessor (the baker applies it;
 # tests/gltf_fixtures.py's sparse_zero and sparse_nodes, a node tree):

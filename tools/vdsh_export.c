@@ -366,6 +366,7 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         cJSON_AddNumberToObject(nv, "byteLength", (double)(b->size - start));
         cJSON_AddItemToArray(views, nv);
         cJSON_DeleteItemFromObjectCaseSensitive(img, "uri");
+        cJSON_DeleteItemFromObjectCaseSensitive(img, "mimeType"); /* a uri's may have one */
         cJSON_AddNumberToObject(img, "bufferView", cJSON_GetArraySize(views) - 1);
         cJSON_AddStringToObject(img, "mimeType", mime);
     }
