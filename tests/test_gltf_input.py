@@ -10,6 +10,7 @@ files: the valid ones load with their triangle counts (primitive modes
 4-6, strips and fans, give the quad of mode 4), the malformed ones are
 refused with the file named.
 """
+import json
 import os
 import subprocess
 import sys
@@ -83,6 +84,18 @@ for ext, data in (("gltf", gltf_fixtures.as_glb(g, binary)), ("glb", gltf_fixtur
     tris, p = load(path)
     if tris is None or len(tris) != len(expected):
         failures.append("%s: %s" % (path, p.stderr.strip()))
+
+# A node chain deeper than the reader goes (1000) is refused as such, not
+# as "a cycle in the node tree" (it has none).
+name, g, binary, expected = gltf_fixtures.fixtures()[0]
+g = json.loads(json.dumps(g))
+g["nodes"] = [{"children": [i + 1]} for i in range(1100)] + [{"mesh": 0}]
+path = os.path.join(work, "deep.glb")
+open(path, "wb").write(gltf_fixtures.as_glb(g, binary))
+tris, p = load(path)
+refused(path, p)
+if "cycle" in p.stderr or "deeper" not in p.stderr:
+    failures.append("%s: %s" % (path, p.stderr.strip()))
 
 # A file that requires an extension tinygltf refuses before its own list
 # can be checked (vdsh-export --compress: EXT_meshopt_compression's fallback

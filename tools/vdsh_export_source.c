@@ -467,8 +467,11 @@ static int visit(walk *w, int node, const double *parent, uint8_t *on_path, int 
     cJSON *n = cJSON_GetArrayItem(nodes, node);
     if (!n || node < 0)
         return fail(w->msg, w->cap_msg, "%s: node %d does not exist", w->path, node);
-    if (on_path[node] || depth > 1000)
+    if (on_path[node])
         return fail(w->msg, w->cap_msg, "%s: node %d is its own ancestor", w->path, node);
+    if (depth > 1000)
+        return fail(w->msg, w->cap_msg, "%s: node %d: the node tree is deeper than 1000 levels",
+                    w->path, node);
     on_path[node] = 1;
     double local[16], m[16];
     node_matrix(n, local);

@@ -360,9 +360,14 @@ vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint
     const tinygltf::Model &m = rd.m;
     if (node < 0 || (size_t)node >= m.nodes.size())
         return vb_fail(rd.err, VB_ERR_FORMAT, "%s: node %d does not exist", rd.name, node);
-    if (on_path[(size_t)node] || depth > 1000)
+    if (on_path[(size_t)node])
         return vb_fail(rd.err, VB_ERR_FORMAT,
                        "%s: node %d is its own ancestor (a cycle in the node tree)", rd.name, node);
+    if (depth > 1000)
+        return vb_fail(rd.err, VB_ERR_FORMAT,
+                       "%s: node %d: the node tree is deeper than 1000 levels, which the reader "
+                       "does not go",
+                       rd.name, node);
     on_path[(size_t)node] = 1;
     const tinygltf::Node &n = m.nodes[(size_t)node];
     mat4 w = mul(parent, node_matrix(n));
