@@ -97,6 +97,34 @@ refused(path, p)
 if "cycle" in p.stderr or "deeper" not in p.stderr:
     failures.append("%s: %s" % (path, p.stderr.strip()))
 
+# External buffers are read beside the .gltf only, and only regular files:
+# a buffer missing there is refused even when the current directory has
+# one of that name (tinygltf looked there too and loaded it), a FIFO is
+# refused at once (it waited for a writer forever), a directory as such
+# (was "out of memory while reading").
+name, g, binary, expected = gltf_fixtures.fixtures()[0]
+ext_dir = os.path.join(work, "external")
+os.makedirs(os.path.join(ext_dir, "models"), exist_ok=True)
+g = json.loads(json.dumps(g))
+for case, what in (("elsewhere", "File not found"), ("fifo", "not a regular file"), ("dir", "not a regular file")):
+    g["buffers"][0]["uri"] = case + ".bin"
+    path = os.path.join(ext_dir, "models", case + ".gltf")
+    open(path, "w").write(json.dumps(g))
+    target = os.path.join(ext_dir, "models", case + ".bin")
+    if case == "elsewhere":
+        open(os.path.join(ext_dir, case + ".bin"), "wb").write(bytes(binary))
+    elif case == "fifo" and not os.path.exists(target):
+        os.mkfifo(target)
+    elif case == "dir":
+        os.makedirs(target, exist_ok=True)
+    try:
+        p = subprocess.run([bake, os.path.join("models", case + ".gltf"), "--export-obj", "out.obj"], cwd=ext_dir,
+                           capture_output=True, text=True, timeout=30)
+        if p.returncode == 0 or what not in p.stderr:
+            failures.append("%s: rc %d, %s (want '%s')" % (path, p.returncode, p.stderr.strip(), what))
+    except subprocess.TimeoutExpired:
+        failures.append("%s: still running after 30 s" % path)
+
 # A file that requires an extension tinygltf refuses before its own list
 # can be checked (vdsh-export --compress: EXT_meshopt_compression's fallback
 # buffer has no data): the extension is named, not "Invalid byteLength".

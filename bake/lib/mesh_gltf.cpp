@@ -24,6 +24,8 @@
  * Errors: vb_result; no C++ exception leaves this file.
  * Threading: no shared state; concurrent calls are fine.
  */
+#include <sys/stat.h>
+
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -413,6 +415,39 @@ vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint
     return VB_OK;
 }
 
+/* External files (buffers): beside the glTF only (tinygltf also looked
+ * in the current directory, and read a same-named file there), regular
+ * files only (vb_mesh_read_file: a FIFO would block). `dir` is the base
+ * directory tinygltf joins URIs to. */
+struct files {
+    std::string dir;
+};
+
+bool file_exists(const std::string &path, void *user)
+{
+    const std::string &dir = ((const files *)user)->dir;
+    const std::string base = !dir.empty() && dir.back() == '/' ? dir : dir + "/";
+    struct stat st;
+    return path.compare(0, base.size(), base) == 0 && stat(path.c_str(), &st) == 0;
+}
+
+bool read_whole_file(std::vector<unsigned char> *out, std::string *err, const std::string &path,
+                     void *)
+{
+    uint8_t *bytes = nullptr;
+    size_t size = 0;
+    vb_error e;
+    memset(&e, 0, sizeof e);
+    if (vb_mesh_read_file(path.c_str(), &bytes, &size, &e) != VB_OK) {
+        if (err)
+            *err = e.msg;
+        return false;
+    }
+    out->assign(bytes, bytes + size);
+    free(bytes);
+    return true;
+}
+
 bool no_images(tinygltf::Image *, const int, std::string *, std::string *, int, int,
                const unsigned char *, int, void *)
 {
@@ -511,7 +546,12 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     std::string e, w;
     std::string path(name);
     size_t slash = path.rfind('/');
-    std::string dir = slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+    std::string dir = slash == std::string::npos ? std::string(".")
+                      : slash == 0               ? std::string("/")
+                                                 : path.substr(0, slash);
+    files fs_dir{dir};
+    loader.SetFsCallbacks({&file_exists, &tinygltf::ExpandFilePath, &read_whole_file,
+                           &tinygltf::WriteWholeFile, &fs_dir});
     if (size > 0xffffffffu)
         return vb_fail(err, VB_ERR_FORMAT, "%s: file too large", name);
     bool ok = binary ? loader.LoadBinaryFromMemory(&model, &e, &w, bytes, (unsigned)size, dir)
