@@ -385,26 +385,26 @@ vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint
         vb_result r = instances(rd, node, n, w, ws);
         if (r != VB_OK)
             return r;
-        for (const mat4 &wi : ws)
-            for (const tinygltf::Primitive &p : m.meshes[(size_t)n.mesh].primitives) {
-                if (n.skin >= 0) {
-                    o.skipped_skin++;
-                    continue;
-                }
-                if (!p.targets.empty()) {
-                    o.skipped_morph++;
-                    continue;
-                }
-                if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES &&
-                    p.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
-                    p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
-                    o.skipped_modes++;
-                    continue;
-                }
+        for (const tinygltf::Primitive &p : m.meshes[(size_t)n.mesh].primitives) {
+            if (n.skin >= 0) {
+                o.skipped_skin++;
+                continue;
+            }
+            if (!p.targets.empty()) {
+                o.skipped_morph++;
+                continue;
+            }
+            if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES &&
+                p.mode != TINYGLTF_MODE_TRIANGLE_STRIP && p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+                o.skipped_modes++;
+                continue;
+            }
+            for (const mat4 &wi : ws) {
                 r = add_primitive(rd, p, wi, o);
                 if (r != VB_OK)
                     return r;
             }
+        }
     }
     for (int c : n.children) {
         vb_result r = visit(rd, c, w, on_path, depth + 1, o);
