@@ -455,6 +455,19 @@ if os.path.isdir(box):
         if dup:
             fail.append("%s: keys written twice in one object: %s" % (out, sorted(set(dup))))
 
+# --source of a bake of several meshes: the glb holds that glTF's scene
+# alone, said on stderr (the other meshes' receivers were dropped without
+# a word).
+box_glb = os.path.join(models, "glTF2", "BoxTextured-glTF-Binary", "BoxTextured.glb")
+if os.path.exists(box_glb):
+    vd, out = os.path.join(work, "two-src.vdsh"), os.path.join(work, "two-src.glb")
+    floor = os.path.join(work, "floor.obj")
+    open(floor, "w").write("v -3 -1 -3\nv 3 -1 -3\nv 3 -1 3\nv -3 -1 3\nf 1 3 2\nf 1 4 3\n")
+    run([bake, box_glb, floor, "-o", vd, "-q", "--rays", "16", "--orders", "2", "--cube-size", "0"])
+    p = run([export, vd, "--source", box_glb, "-o", out])
+    if p.returncode == 0 and "2 meshes" not in p.stderr:
+        fail.append("--source of a 2-mesh bake: nothing said: %s" % p.stderr.strip())
+
 # --source whose positions are a sparse accessor (the baker applies it;
 # tests/gltf_fixtures.py's sparse_zero and sparse_nodes, a node tree):
 # every vertex the bake has is matched, as .gltf and .glb.

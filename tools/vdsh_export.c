@@ -472,6 +472,11 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         cJSON_DeleteItemFromObjectCaseSensitive(asset, "generator");
         cJSON_AddStringToObject(asset, "generator", "vdsh-export --source (formats/GLTF.md)");
     }
+    if (f->source_count > 1)
+        fprintf(stderr,
+                "vdsh-export: %s: baked from %u meshes; the glb holds %s's scene only (the "
+                "other meshes' receivers are not in it)\n",
+                in, f->source_count, path);
     if (matched < vertices)
         fprintf(stderr,
                 "vdsh-export: %s: %llu of %llu source vertices have no receiver at their position "
