@@ -157,6 +157,12 @@ const char *vdsh_window_name(uint32_t window);
 const char *vdsh_sampling_name(uint32_t sampling);
 const char *vdsh_offset_rule_name(uint32_t rule);
 
+/* 1 when `name` can name a source in SRCS (1..VDSH_MAX_NAME bytes of
+ * valid UTF-8, no NUL: the rule the writer and reader apply); else 0 with
+ * the reason ("is not valid UTF-8 (byte 3)") in why[0..n) when why is
+ * not NULL. For a program to refuse a mesh path before baking it. */
+int vdsh_source_name_ok(const char *name, char *why, size_t n);
+
 /* The encodings, one row each, in the order command lines list them: the
  * one table that names, sizes and describes them (vdsh_encoding_name,
  * vdsh_encoding_bytes, vdsh_encoding_from_name, vdsh_encoding_names and

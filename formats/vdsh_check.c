@@ -175,6 +175,18 @@ int vdsh_check_name(const uint8_t *name, size_t len, uint32_t i, why *w)
     return 1;
 }
 
+int vdsh_source_name_ok(const char *name, char *why_out, size_t n)
+{
+    why w = {{0}};
+    if (vdsh_check_name((const uint8_t *)name, strlen(name), 0, &w))
+        return 1;
+    /* "SRCS: source 0: name is not ..." as "is not ..." */
+    const char *m = strstr(w.msg, "name ");
+    if (why_out && n)
+        snprintf(why_out, n, "%s", m ? m + 5 : w.msg);
+    return 0;
+}
+
 /* One fixed-order stream per (order, quantity), one variable-order
  * stream per quantity. */
 int vdsh_same_slot(const vdsh_stream *a, const vdsh_stream *b)

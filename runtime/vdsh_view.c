@@ -162,7 +162,7 @@ static int pick(const char *opt, const char *v, const char *a, const char *b, in
     return vt_usage_error("vdsh-view", "%s: expected %s or %s, got '%s'", opt, a, b, v);
 }
 
-/* A buffer mode asks for its stream; orders 1-5 are buffered on request. */
+/* A buffer mode asks for its stream; orders 2, 3, 5 are buffered on request (1 and 4 always are). */
 static void note_buffer(vv_options *o, const vv_mode *m)
 {
     if (m->mode == VR_MODE_VDSH_BUFFER && m->stream >= 1 && m->stream <= 5)

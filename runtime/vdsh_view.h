@@ -74,7 +74,7 @@ typedef struct vv_options {
     const char *frames_dir;
     int frame_modes[VV_MAX_MODES]; /* --modes: indices into vv_modes[] */
     int frame_mode_count;
-    int buffers; /* load orders 1-5 as buffers too (a bufN mode
+    int buffers; /* load orders 2, 3, 5 as buffers too (a bufN mode
                                   of such an order, or --bench) */
 } vv_options;
 

@@ -76,7 +76,7 @@
  *                       k^2 basis functions by the associated-Legendre
  *                       recurrence of formats/vdsh_sh.c (bands 0..k-1, the
  *                       same convention), each coefficient fetched once for
- *                       all lights of a pass. Streams of orders 1-5 are
+ *                       all lights of a pass. Streams of orders 2, 3, 5 are
  *                       buffered only with vr_scene_desc.buffers. A cpca
  *                       stream (vdsh-bake --encoding cpca, any order: never
  *                       on attributes) keeps its records as R32UI words and
@@ -185,10 +185,10 @@ typedef struct vr_scene_desc {
      * of the triangles and 14 rays per position tried. */
     int light_pool;
     /* Streams for VR_MODE_VDSH_BUFFER. 0 (default): those no attribute
-     * path can draw go up as buffer textures (orders above 5, streams
-     * with an order per vertex, cpca streams); orders 1-5 only as
-     * attributes. 1: orders
-     * 1-5 as buffers too (more GPU memory: both copies). */
+     * path can draw go up as buffer textures (orders 1, 4 and above 5,
+     * streams with an order per vertex, cpca streams); orders 2, 3 and 5
+     * only as attributes. 1: orders
+     * 2, 3 and 5 as buffers too (more GPU memory: both copies). */
     int buffers;
     /* 0 (default): buffers hold the file's encoding as stored. 1: decoded
      * f32 coefficients instead (vdsh_stream_decode; 2x the bytes of f16,
@@ -343,8 +343,8 @@ const char *vr_mode_label(vr_mode m);
  * default that vdsh-view (no --mode) uses too: order 5 the paper's way
  * (VR_MODE_VDSH5) where the scene supports it, else order 5 with the
  * polynomials, else the highest of orders 3 and 2 the file has, else
- * VR_MODE_VDSH_BUFFER when it has a buffer stream (a bake of orders above 5
- * or of adaptive order only; vr_draw_desc.stream 0 then draws its
+ * VR_MODE_VDSH_BUFFER when it has a buffer stream (a bake of orders 1, 4,
+ * above 5 or of adaptive order only; vr_draw_desc.stream 0 then draws its
  * default). A scene with none of these streams gets VR_MODE_VDSH5, which
  * vr_draw refuses with VR_ERR_MISSING naming the stream. Never
  * VR_MODE_DEFAULT. */

@@ -581,7 +581,7 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
         if (!buf && d.stream == 0)
             return vr_fail(err, VR_ERR_MISSING,
                            "mode buffer: the scene has no %s stream in a "
-                           "buffer (orders above 5, an order per vertex; orders 1-5 with "
+                           "buffer (orders 1, 4, above 5, an order per vertex; 2, 3, 5 with "
                            "vr_scene_desc.buffers)",
                            vdsh_quantity_name(s->quantity));
         if (!buf)
@@ -589,7 +589,7 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                            "mode buffer: the scene has no order-%d %s stream in a buffer%s",
                            d.stream, vdsh_quantity_name(s->quantity),
                            d.stream >= 1 && d.stream <= 5 && s->vbo_stream[d.stream]
-                               ? " (orders 1-5 are buffered with vr_scene_desc.buffers)"
+                               ? " (orders 2, 3, 5 are buffered with vr_scene_desc.buffers)"
                                : "");
     } else if (!vr_scene_supports(s, mode)) {
         if (mode == VR_MODE_SDF)

@@ -321,16 +321,18 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
         r = upload_stream(s, st, nv, remap, name, err);
     }
     /* Buffer textures (VR_MODE_VDSH_BUFFER): what attributes cannot
-     * hold (orders above 5, the stream with an order per vertex, cpca
-     * streams of any order: decoded in the vertex stage), and
-     * with desc->buffers orders 1-5 too; the first stream of each. */
+     * hold or no attribute mode draws (orders 1, 4 and above 5, the
+     * stream with an order per vertex, cpca streams of any order:
+     * decoded in the vertex stage), and with desc->buffers orders 2, 3
+     * and 5 too; the first stream of each. */
     for (uint32_t i = 0; i < f->stream_count && r == VR_OK; i++) {
         const vdsh_stream *st = &f->streams[i];
         int variable = (st->flags & VDSH_STREAM_VARIABLE) != 0;
         if (st->quantity != quantity || st->order < 1 || st->order > VDSH_MAX_ORDER ||
             (variable ? s->variable.order != 0
-                      : s->buffer[st->order].order || (st->order <= 5 && !desc->buffers &&
-                                                       st->encoding != VDSH_ENCODING_CPCA)))
+                      : s->buffer[st->order].order ||
+                            ((st->order == 2 || st->order == 3 || st->order == 5) &&
+                             !desc->buffers && st->encoding != VDSH_ENCODING_CPCA)))
             continue;
         r = vr_buffer_upload(s, st, remap, desc->buffer_floats, desc->cpca_decode, name, err);
         if (!variable && !s->vbo_stream[st->order])

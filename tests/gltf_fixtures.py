@@ -112,6 +112,27 @@ def fixtures():
                                 {"attributes": {"POSITION": pos}, "mode": 1},
                                 {"attributes": {"POSITION": pos}, "mode": 4}]}], [{"mesh": 0}], [0])
     out.append(("points_lines", g, b.bin, [(v(QUAD, 0), v(QUAD, 1), v(QUAD, 2))]))
+    # Extensions that leave the triangles as they are, required: read.
+    # KHR_mesh_quantization (gltfpack's default): integer positions, not
+    # normalised, scaled by the node; texture and material extensions.
+    b = Builder()
+    pos = b.acc([0, 0, 0, 2, 0, 0, 0, 2, 0], USHORT)
+    g = b.gltf([{"primitives": [{"attributes": {"POSITION": pos}}]}], [{"mesh": 0, "scale": [0.5, 0.5, 0.5]}], [0],
+               {"extensionsUsed": ["KHR_mesh_quantization", "KHR_texture_transform", "KHR_materials_emissive_strength"],
+                "extensionsRequired": ["KHR_mesh_quantization", "KHR_texture_transform",
+                                       "KHR_materials_emissive_strength"]})
+    out.append(("quantized", g, b.bin, [((0, 0, 0), (1, 0, 0), (0, 1, 0))]))
+    # EXT_mesh_gpu_instancing (used, not required): every instance baked,
+    # each instance's TRS inside the node's transform.
+    b = Builder()
+    pos = b.acc(QUAD[:9])
+    tr = b.acc([0, 0, 0, 5, 0, 0])
+    sc = b.acc([1, 1, 1, 2, 2, 2])
+    g = b.gltf([{"primitives": [{"attributes": {"POSITION": pos}}]}],
+               [{"mesh": 0, "translation": [0, 0, 1],
+                 "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": tr, "SCALE": sc}}}}], [0],
+               {"extensionsUsed": ["EXT_mesh_gpu_instancing"]})
+    out.append(("instanced", g, b.bin, [((0, 0, 1), (1, 0, 1), (1, 1, 1)), ((5, 0, 1), (7, 0, 1), (7, 2, 1))]))
     # Refused: index out of range, stride/overrun, cycle, only points.
     b = Builder()
     pos = b.acc(QUAD[:9])

@@ -420,6 +420,87 @@ for src, want in ((missing, "No such file"), (fifo, "not a regular file"), (work
     except subprocess.TimeoutExpired:
         fail.append("--source %s: still running after 60 s" % src)
 
+# --source whose URIs are percent-encoded (glTF URIs are RFC 3986: a file
+# "Box Textured0.bin" is written "Box%20Textured0.bin"), as the baker
+# (tinygltf) decodes them: the buffer is read and the image embedded, not
+# refused or left as a URI that names no file.
+box = os.path.join(models, "glTF2", "BoxTextured-glTF")
+if os.path.isdir(box):
+    pct = os.path.join(work, "pct")
+    os.makedirs(pct, exist_ok=True)
+    with open(os.path.join(box, "BoxTextured0.bin"), "rb") as fi, \
+            open(os.path.join(pct, "Box Textured0.bin"), "wb") as fo:
+        fo.write(fi.read())
+    with open(os.path.join(box, "CesiumLogoFlat.png"), "rb") as fi, \
+            open(os.path.join(pct, "Cesium Logo+1.png"), "wb") as fo:
+        fo.write(fi.read())
+    g0 = json.load(open(os.path.join(box, "BoxTextured.gltf")))
+    g0["buffers"][0]["uri"] = "Box%20Textured0.bin"
+    g0["images"][0]["uri"] = "Cesium%20Logo%2B1.png"
+    g0["images"][0]["mimeType"] = "image/png"  # with a uri too: not written twice
+    src = os.path.join(pct, "box.gltf")
+    json.dump(g0, open(src, "w"))
+    vd, out = os.path.join(pct, "box.vdsh"), os.path.join(pct, "box.glb")
+    run([bake, src, "-o", vd, "-q", "--rays", "16", "--orders", "2"])
+    p = run([export, vd, "--source", src, "-o", out, "-q"])
+    if p.returncode == 0:
+        g, bn = read_glb(out)
+        if any("uri" in i for i in g.get("images", [])) or "cannot be read" in p.stderr:
+            fail.append("%s: percent-encoded image URI not embedded: %s" % (out, p.stderr.strip()))
+        d = open(out, "rb").read()
+        dup = []
+        json.loads(d[20:20 + struct.unpack_from("<I", d, 12)[0]],
+                   object_pairs_hook=lambda kv: dup.extend(k for i, (k, _) in enumerate(kv)
+                                                           if k in [k2 for k2, _ in kv[:i]]) or dict(kv))
+        if dup:
+            fail.append("%s: keys written twice in one object: %s" % (out, sorted(set(dup))))
+
+# --source of a bake of several meshes: the glb holds that glTF's scene
+# alone, said on stderr (the other meshes' receivers were dropped without
+# a word).
+box_glb = os.path.join(models, "glTF2", "BoxTextured-glTF-Binary", "BoxTextured.glb")
+if os.path.exists(box_glb):
+    vd, out = os.path.join(work, "two-src.vdsh"), os.path.join(work, "two-src.glb")
+    floor = os.path.join(work, "floor.obj")
+    open(floor, "w").write("v -3 -1 -3\nv 3 -1 -3\nv 3 -1 3\nv -3 -1 3\nf 1 3 2\nf 1 4 3\n")
+    run([bake, box_glb, floor, "-o", vd, "-q", "--rays", "16", "--orders", "2", "--cube-size", "0"])
+    p = run([export, vd, "--source", box_glb, "-o", out])
+    if p.returncode == 0 and "2 meshes" not in p.stderr:
+        fail.append("--source of a 2-mesh bake: nothing said: %s" % p.stderr.strip())
+
+# --source whose positions are a sparse accessor (the baker applies it;
+# tests/gltf_fixtures.py's sparse_zero and sparse_nodes, a node tree):
+# every vertex the bake has is matched, as .gltf and .glb.
+sys.path.insert(0, here)
+import gltf_fixtures  # noqa: E402
+for name, g0, bin0, _ in gltf_fixtures.fixtures():
+    if name == "instanced":
+        # EXT_mesh_gpu_instancing: the instances share their primitives, so
+        # --source cannot give each its own shadows: refused, naming it
+        # (it wrote instance 0's attributes for all of them).
+        src = os.path.join(work, "src-instanced.glb")
+        open(src, "wb").write(gltf_fixtures.as_glb(g0, bin0))
+        vd, out = os.path.join(work, "src-instanced.vdsh"), os.path.join(work, "src-instanced-out.glb")
+        run([bake, src, "-o", vd, "-q", "--rays", "16", "--orders", "2", "--cube-size", "0"])
+        if os.path.exists(out):
+            os.remove(out)
+        p = subprocess.run([export, vd, "--source", src, "-o", out, "-q"], capture_output=True, text=True)
+        if p.returncode != 1 or "EXT_mesh_gpu_instancing" not in p.stderr or os.path.exists(out):
+            fail.append("--source %s: rc %d, %s" % (src, p.returncode, p.stderr.strip()))
+    if not name.startswith("sparse"):
+        continue
+    for ext, data in (("gltf", gltf_fixtures.as_gltf(g0, bin0)), ("glb", gltf_fixtures.as_glb(g0, bin0))):
+        src = os.path.join(work, "src-%s.%s" % (name, ext))
+        open(src, "wb").write(data)
+        vd, out = os.path.join(work, "src-%s.vdsh" % name), os.path.join(work, "src-%s-%s.glb" % (name, ext))
+        run([bake, src, "-o", vd, "-q", "--rays", "16", "--orders", "2", "--cube-size", "0"])
+        p = run([export, vd, "--source", src, "-o", out, "-q"])
+        if p.returncode == 0:
+            x = read_glb(out)[0]["extensions"]["VDSH_visibility_distance"]
+            if x["source_vertices_matched"] != 3:
+                fail.append("%s: %s of %s vertices matched, want 3" % (out, x["source_vertices_matched"],
+                                                                      x["source_vertices"]))
+
 for f in fail:
     print("FAIL:", f)
 if not fail and not validator:

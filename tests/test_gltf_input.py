@@ -10,6 +10,7 @@ files: the valid ones load with their triangle counts (primitive modes
 4-6, strips and fans, give the quad of mode 4), the malformed ones are
 refused with the file named.
 """
+import json
 import os
 import subprocess
 import sys
@@ -73,6 +74,57 @@ for name, g, binary, expected in gltf_fixtures.fixtures():
         if name == "points_lines" and "2 glTF primitives of points or lines skipped" not in p.stderr:
             failures.append("%s: skipped primitives not reported: %s" % (path, p.stderr.strip()))
 
+# The container is known by its bytes, not the name: a .glb named .gltf
+# and a .gltf named .glb load (was a JSON parse error, "Invalid magic"),
+# as vdsh-export --source reads them.
+name, g, binary, expected = gltf_fixtures.fixtures()[0]
+for ext, data in (("gltf", gltf_fixtures.as_glb(g, binary)), ("glb", gltf_fixtures.as_gltf(g, binary))):
+    path = os.path.join(work, "swapped.%s" % ext)
+    open(path, "wb").write(data)
+    tris, p = load(path)
+    if tris is None or len(tris) != len(expected):
+        failures.append("%s: %s" % (path, p.stderr.strip()))
+
+# A node chain deeper than the reader goes (1000) is refused as such, not
+# as "a cycle in the node tree" (it has none).
+name, g, binary, expected = gltf_fixtures.fixtures()[0]
+g = json.loads(json.dumps(g))
+g["nodes"] = [{"children": [i + 1]} for i in range(1100)] + [{"mesh": 0}]
+path = os.path.join(work, "deep.glb")
+open(path, "wb").write(gltf_fixtures.as_glb(g, binary))
+tris, p = load(path)
+refused(path, p)
+if "cycle" in p.stderr or "deeper" not in p.stderr:
+    failures.append("%s: %s" % (path, p.stderr.strip()))
+
+# External buffers are read beside the .gltf only, and only regular files:
+# a buffer missing there is refused even when the current directory has
+# one of that name (tinygltf looked there too and loaded it), a FIFO is
+# refused at once (it waited for a writer forever), a directory as such
+# (was "out of memory while reading").
+name, g, binary, expected = gltf_fixtures.fixtures()[0]
+ext_dir = os.path.join(work, "external")
+os.makedirs(os.path.join(ext_dir, "models"), exist_ok=True)
+g = json.loads(json.dumps(g))
+for case, what in (("elsewhere", "File not found"), ("fifo", "not a regular file"), ("dir", "not a regular file")):
+    g["buffers"][0]["uri"] = case + ".bin"
+    path = os.path.join(ext_dir, "models", case + ".gltf")
+    open(path, "w").write(json.dumps(g))
+    target = os.path.join(ext_dir, "models", case + ".bin")
+    if case == "elsewhere":
+        open(os.path.join(ext_dir, case + ".bin"), "wb").write(bytes(binary))
+    elif case == "fifo" and not os.path.exists(target):
+        os.mkfifo(target)
+    elif case == "dir":
+        os.makedirs(target, exist_ok=True)
+    try:
+        p = subprocess.run([bake, os.path.join("models", case + ".gltf"), "--export-obj", "out.obj"], cwd=ext_dir,
+                           capture_output=True, text=True, timeout=30)
+        if p.returncode == 0 or what not in p.stderr:
+            failures.append("%s: rc %d, %s (want '%s')" % (path, p.returncode, p.stderr.strip(), what))
+    except subprocess.TimeoutExpired:
+        failures.append("%s: still running after 30 s" % path)
+
 # A file that requires an extension tinygltf refuses before its own list
 # can be checked (vdsh-export --compress: EXT_meshopt_compression's fallback
 # buffer has no data): the extension is named, not "Invalid byteLength".
@@ -120,6 +172,17 @@ if os.path.isdir(g2):
         path = os.path.join(g2, rel)
         tris, p = load(path)
         refused(path, p)
+    # glTF 1.0 (assimp-testmodels' glTF folder): refused as such, not as
+    # "no scene" or "Invalid glTF binary".
+    g1 = os.path.join(models, "glTF")
+    for rel in ["BoxTextured-glTF/BoxTextured.gltf", "BoxTextured-glTF-Binary/BoxTextured.glb",
+                "CesiumMilkTruck/CesiumMilkTruck.gltf"]:
+        path = os.path.join(g1, rel)
+        if os.path.exists(path):
+            tris, p = load(path)
+            refused(path, p)
+            if "glTF 1.0" not in p.stderr:
+                failures.append("%s: not said to be glTF 1.0: %s" % (path, p.stderr.strip()))
 else:
     print("no %s: assimp-testmodels part skipped" % g2)
 

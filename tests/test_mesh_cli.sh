@@ -171,5 +171,22 @@ else
   echo "FAIL: bake of scan.ply failed:" >&2; cat "$tmp/err" >&2; fail=1
 fi
 
+# A mesh whose file name is not UTF-8 (a Latin-1 name) cannot be recorded
+# in the .vdsh (VDSH.md: SRCS names are UTF-8): refused before the bake,
+# naming the mesh, nothing written (it was refused after the whole bake,
+# naming the output).
+latin=$tmp/$'mod\xe8le.obj'
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$latin"
+if "$bake" "$latin" --rays 16 --cube-size 0 -o "$tmp/latin.vdsh" 2>"$tmp/err"; then
+  echo "FAIL: a mesh named in Latin-1 was baked into a .vdsh" >&2; fail=1
+else
+  has "$tmp/err" "$latin: its name is not valid UTF-8"
+  if grep -q "tracing" "$tmp/err" || [[ -e $tmp/latin.vdsh ]]; then
+    echo "FAIL: the Latin-1 name was refused after the bake:" >&2; cat "$tmp/err" >&2; fail=1
+  fi
+fi
+"$bake" "$latin" --export-obj "$tmp/latin-out.obj" -q 2>"$tmp/err" ||
+  { echo "FAIL: --export-obj refused a Latin-1 name:" >&2; cat "$tmp/err" >&2; fail=1; }
+
 [[ $fail -eq 0 ]] && echo "mesh report cli: all checks passed"
 exit $fail

@@ -312,6 +312,20 @@ static void test_off(void)
                      &raw, &err) == VB_OK,
           "ok.off: %s", err.msg);
     vb_mesh_raw_free(&raw);
+    /* Counts on the OFF line itself ("OFF 3 1 0", ModelNet40's "OFF3 1 0"):
+     * read there (the first vertex was taken for the counts: "empty
+     * mesh"); "OFF BINARY" stays binary. */
+    static const char *const one_line[] = {"OFF 3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+                                           "OFF3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+                                           "COFF 3 1 0 \r\n0 0 0 1 1 1 1\n1 0 0 1 1 1 1\n"
+                                           "0 1 0 1 1 1 1\n3 0 1 2\n"};
+    for (int i = 0; i < 3; i++) {
+        vb_result r = parse_text("line.off", VB_MESH_OFF, one_line[i], &raw, &err);
+        CHECK(r == VB_OK && raw.vertex_count == 3 && raw.triangle_count == 1,
+              "counts on the OFF line %d: %s", i, r == VB_OK ? "wrong mesh" : err.msg);
+        if (r == VB_OK)
+            vb_mesh_raw_free(&raw);
+    }
 }
 
 static void test_arguments(void)

@@ -95,6 +95,21 @@ for path in ("/dev/zero", fifo):
     except subprocess.TimeoutExpired:
         fail.append("info %s: still running after 60 s" % path)
 
+# A file cut short (a download stopped) is "truncated" with its size, as
+# vdsh-info says, also within the 32-byte header (was "not a .vdsh file
+# (magic)"); a damaged magic is not called truncated.
+for cut in (0, 5, 8, 20, 31, 32, 100, len(before) - 1):
+    path = os.path.join(work, "cut-%d.vdsh" % cut)
+    open(path, "wb").write(before[:cut])
+    r = info(path)
+    if r.returncode != 1 or "truncated: %d bytes" % cut not in r.stderr or path not in r.stderr:
+        fail.append("info %s (%d bytes): exit %d, %r" % (path, cut, r.returncode, r.stderr[-300:]))
+path = os.path.join(work, "not-vdsh.vdsh")
+open(path, "wb").write(b"VDSX" + before[4:20])
+r = info(path)
+if r.returncode != 1 or "truncated" in r.stderr or "not a .vdsh file" not in r.stderr:
+    fail.append("info %s: exit %d, %r" % (path, r.returncode, r.stderr[-300:]))
+
 # The library: lights that are not positions are named as such (was
 # numpy's "cannot reshape array of size 4 into shape (3)").
 sys.path.insert(0, os.path.join(src, "python"))

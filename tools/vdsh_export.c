@@ -336,11 +336,9 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
                            : !strcasecmp(dot, ".png")                                ? "image/png"
                            : (!strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg")) ? "image/jpeg"
                                                                                      : NULL;
-        char *p = malloc(strlen(src.dir) + strlen(uri->valuestring) + 1);
+        char *p = vdsh_src_file(&src, uri->valuestring);
         if (!p)
             goto oom;
-        strcpy(p, src.dir);
-        strcat(p, uri->valuestring);
         FILE *fp = fopen(p, "rb");
         free(p);
         if (!fp || !mime) {
@@ -368,6 +366,7 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         cJSON_AddNumberToObject(nv, "byteLength", (double)(b->size - start));
         cJSON_AddItemToArray(views, nv);
         cJSON_DeleteItemFromObjectCaseSensitive(img, "uri");
+        cJSON_DeleteItemFromObjectCaseSensitive(img, "mimeType"); /* a uri's may have one */
         cJSON_AddNumberToObject(img, "bufferView", cJSON_GetArraySize(views) - 1);
         cJSON_AddStringToObject(img, "mimeType", mime);
     }
@@ -473,6 +472,11 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         cJSON_DeleteItemFromObjectCaseSensitive(asset, "generator");
         cJSON_AddStringToObject(asset, "generator", "vdsh-export --source (formats/GLTF.md)");
     }
+    if (f->source_count > 1)
+        fprintf(stderr,
+                "vdsh-export: %s: baked from %u meshes; the glb holds %s's scene only (the "
+                "other meshes' receivers are not in it)\n",
+                in, f->source_count, path);
     if (matched < vertices)
         fprintf(stderr,
                 "vdsh-export: %s: %llu of %llu source vertices have no receiver at their position "

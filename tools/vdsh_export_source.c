@@ -80,6 +80,17 @@ static int b64(int c)
     return -1;
 }
 
+static int hex(int c)
+{
+    if (c >= '0' && c <= '9')
+        return c - '0';
+    if (c >= 'a' && c <= 'f')
+        return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F')
+        return c - 'A' + 10;
+    return -1;
+}
+
 /* A data: URI's base64 payload; NULL when it is not base64. */
 static uint8_t *data_uri(const char *uri, size_t *size)
 {
@@ -109,6 +120,27 @@ static uint8_t *data_uri(const char *uri, size_t *size)
     }
     *size = o;
     return d;
+}
+
+char *vdsh_src_file(const vdsh_src *s, const char *uri)
+{
+    size_t n = strlen(uri), d = strlen(s->dir);
+    char *p = malloc(d + n + 1);
+    if (!p)
+        return NULL;
+    memcpy(p, s->dir, d);
+    char *o = p + d;
+    for (size_t i = 0; i < n; i++) {
+        int hi = i + 2 < n ? hex(uri[i + 1]) : -1, lo = i + 2 < n ? hex(uri[i + 2]) : -1;
+        if (uri[i] == '%' && hi >= 0 && lo >= 0 && (hi | lo)) {
+            *o++ = (char)(hi << 4 | lo);
+            i += 2;
+        } else {
+            *o++ = uri[i];
+        }
+    }
+    *o = 0;
+    return p;
 }
 
 void vdsh_src_free(vdsh_src *s)
@@ -179,10 +211,8 @@ int vdsh_src_load(const char *path, vdsh_src *s, char *msg, size_t cap)
         } else if (strncmp(uri->valuestring, "data:", 5) == 0) {
             sb->data = data_uri(uri->valuestring, &sb->size);
         } else {
-            char *p = malloc(strlen(s->dir) + strlen(uri->valuestring) + 1);
+            char *p = vdsh_src_file(s, uri->valuestring);
             if (p) {
-                strcpy(p, s->dir);
-                strcat(p, uri->valuestring);
                 sb->data = slurp(p, &sb->size, &bwhy);
                 free(p);
             }
@@ -212,8 +242,23 @@ static double num(const cJSON *o, const char *k, double dflt)
     return cJSON_IsNumber(v) ? v->valuedouble : dflt;
 }
 
-/* A VEC3 accessor as 3 * count doubles (as mesh_gltf.cpp reads it; sparse
- * accessors are refused here). */
+/* Bytes [offset, offset + (count - 1) * stride + elem) of buffer view
+ * `bv`, checked against the view and its buffer; NULL when they overrun. */
+static const uint8_t *view_bytes(const vdsh_src *s, int bv, double offset, size_t count,
+                                 size_t elem, size_t stride)
+{
+    cJSON *v = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(s->json, "bufferViews"), bv);
+    int b = (int)num(v, "buffer", -1);
+    double vo = num(v, "byteOffset", 0), len = num(v, "byteLength", 0);
+    if (!v || bv < 0 || b < 0 || b >= s->buffer_count || !(vo >= 0) || !(len >= 0) ||
+        !(offset >= 0) || vo + len > (double)s->buffers[b].size ||
+        offset + (double)(count - 1) * (double)stride + (double)elem > len)
+        return NULL;
+    return s->buffers[b].data + (size_t)vo + (size_t)offset;
+}
+
+/* A VEC3 accessor as 3 * count doubles, its sparse values applied (as
+ * mesh_gltf.cpp reads it). */
 static double *read_vec3(const char *path, const vdsh_src *s, int ai, size_t *count, char *msg,
                          size_t cap)
 {
@@ -229,35 +274,59 @@ static double *read_vec3(const char *path, const vdsh_src *s, int ai, size_t *co
         fail(msg, cap, "%s: accessor %d is not a VEC3 of a known component type", path, ai);
         return NULL;
     }
-    if (cJSON_GetObjectItemCaseSensitive(a, "sparse")) {
-        fail(msg, cap, "%s: accessor %d is sparse, which --source does not read", path, ai);
-        return NULL;
-    }
     int normalized = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(a, "normalized"));
     double *out = calloc(3 * n + 1, sizeof *out);
     if (!out) {
         fail(msg, cap, "%s: out of memory", path);
         return NULL;
     }
+    const size_t elem = 3 * cs;
     if (bv >= 0 && n) {
         cJSON *v = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(s->json, "bufferViews"), bv);
-        int b = (int)num(v, "buffer", -1);
-        size_t stride = (size_t)num(v, "byteStride", 0), elem = 3 * cs;
-        size_t off = (size_t)num(v, "byteOffset", 0) + (size_t)num(a, "byteOffset", 0);
-        size_t len = (size_t)num(v, "byteLength", 0);
+        size_t stride = (size_t)num(v, "byteStride", 0);
         if (!stride)
             stride = elem;
-        if (!v || b < 0 || b >= s->buffer_count ||
-            (size_t)num(v, "byteOffset", 0) + len > s->buffers[b].size ||
-            (size_t)num(a, "byteOffset", 0) + (n - 1) * stride + elem > len) {
+        const uint8_t *p = view_bytes(s, bv, num(a, "byteOffset", 0), n, elem, stride);
+        if (!p) {
             free(out);
             fail(msg, cap, "%s: accessor %d overruns its buffer view", path, ai);
             return NULL;
         }
-        const uint8_t *p = s->buffers[b].data + off;
         for (size_t i = 0; i < n; i++)
             for (size_t c = 0; c < 3; c++)
                 out[3 * i + c] = vdsh_gltf_component(p + i * stride + c * cs, ct, normalized);
+    }
+    const cJSON *sp = cJSON_GetObjectItemCaseSensitive(a, "sparse");
+    if (sp) {
+        const cJSON *si = cJSON_GetObjectItemCaseSensitive(sp, "indices");
+        const cJSON *sv = cJSON_GetObjectItemCaseSensitive(sp, "values");
+        size_t sc = (size_t)num(sp, "count", 0);
+        int ict = (int)num(si, "componentType", 0);
+        size_t ics = vdsh_gltf_component_size(ict);
+        const uint8_t *pi = NULL, *pv = NULL;
+        if (sc >= 1 && sc <= n && (ict == 5121 || ict == 5123 || ict == 5125)) {
+            pi = view_bytes(s, (int)num(si, "bufferView", -1), num(si, "byteOffset", 0), sc, ics,
+                            ics);
+            pv = view_bytes(s, (int)num(sv, "bufferView", -1), num(sv, "byteOffset", 0), sc, elem,
+                            elem);
+        }
+        if (!pi || !pv) {
+            free(out);
+            fail(msg, cap, "%s: accessor %d: bad sparse indices or values", path, ai);
+            return NULL;
+        }
+        for (size_t k = 0; k < sc; k++) {
+            double di = vdsh_gltf_component(pi + k * ics, ict, 0);
+            if (!(di < (double)n)) {
+                free(out);
+                fail(msg, cap, "%s: accessor %d: sparse index %.0f out of range (%zu)", path, ai,
+                     di, n);
+                return NULL;
+            }
+            for (size_t c = 0; c < 3; c++)
+                out[3 * (size_t)di + c] =
+                    vdsh_gltf_component(pv + k * elem + c * cs, ct, normalized);
+        }
     }
     *count = n;
     return out;
@@ -398,13 +467,24 @@ static int visit(walk *w, int node, const double *parent, uint8_t *on_path, int 
     cJSON *n = cJSON_GetArrayItem(nodes, node);
     if (!n || node < 0)
         return fail(w->msg, w->cap_msg, "%s: node %d does not exist", w->path, node);
-    if (on_path[node] || depth > 1000)
+    if (on_path[node])
         return fail(w->msg, w->cap_msg, "%s: node %d is its own ancestor", w->path, node);
+    if (depth > 1000)
+        return fail(w->msg, w->cap_msg, "%s: node %d: the node tree is deeper than 1000 levels",
+                    w->path, node);
     on_path[node] = 1;
     double local[16], m[16];
     node_matrix(n, local);
     vdsh_mat4d_mul(parent, local, m);
     int mesh = (int)num(n, "mesh", -1);
+    if (mesh >= 0 &&
+        cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(n, "extensions"),
+                                         "EXT_mesh_gpu_instancing"))
+        return fail(w->msg, w->cap_msg,
+                    "%s: node %d draws its mesh as instances (EXT_mesh_gpu_instancing), which "
+                    "share their VDSH attributes: --source cannot give each its own shadows "
+                    "(export without --source)",
+                    w->path, node);
     if (mesh >= 0 && cJSON_GetObjectItemCaseSensitive(n, "skin") == NULL) {
         cJSON *me =
             cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(w->s->json, "meshes"), mesh);

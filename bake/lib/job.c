@@ -33,6 +33,16 @@ vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err)
     if (d->path_count < 1 || d->path_count > VDSH_MAX_SOURCES)
         return vb_fail(err, VB_ERR_ARGUMENT, "%u meshes: 1..%d make a scene", d->path_count,
                        VDSH_MAX_SOURCES);
+    /* A name the .vdsh cannot record (SRCS: UTF-8) is refused before the
+     * bake, not by the writer after it. */
+    for (uint32_t i = 0; i < d->path_count && d->output; i++) {
+        char why[200];
+        if (!vdsh_source_name_ok(d->paths[i], why, sizeof why))
+            return vb_fail(err, VB_ERR_ARGUMENT,
+                           "%s: its name %s, which a .vdsh cannot record as its source: "
+                           "rename the file",
+                           d->paths[i], why);
+    }
     j->t_start = vb_now();
     j->sources = calloc(d->path_count, sizeof *j->sources);
     if (!j->sources)

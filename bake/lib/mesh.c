@@ -740,7 +740,7 @@ vb_result vb_mesh_stage_ply(const vb_mesh *m, const char *path, vdsh_output *out
 /* Loading                                                                */
 /* ---------------------------------------------------------------------- */
 
-static vb_result read_file(const char *path, uint8_t **bytes, size_t *size, vb_error *err)
+vb_result vb_mesh_read_file(const char *path, uint8_t **bytes, size_t *size, vb_error *err)
 {
     /* O_NONBLOCK: opening a FIFO must not wait for a writer (it is refused
      * below, as anything but a regular file); regular files ignore it. */
@@ -1445,7 +1445,7 @@ vb_result vb_mesh_load(const char *path, const vb_load_desc *desc, vb_mesh *out,
             return r;
         uint8_t *bytes = NULL;
         size_t size = 0;
-        r = read_file(path, &bytes, &size, err);
+        r = vb_mesh_read_file(path, &bytes, &size, err);
         if (r != VB_OK)
             return r;
         r = load_bytes(path, format, desc ? desc->gltf_scene : 0, bytes, size, &m, &si, err);

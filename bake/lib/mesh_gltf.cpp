@@ -6,14 +6,16 @@
  *
  * What is read: every mesh primitive reachable from the default scene (or
  * scene `scene` when >= 0), each node's matrix or TRS applied (normals by
- * the inverse transpose; a mirroring transform flips the winding), modes
+ * the inverse transpose; a mirroring transform flips the winding), once per
+ * instance of EXT_mesh_gpu_instancing (its TRS inside the node's), modes
  * TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN, indexed or not, float or
  * normalised integer POSITION/NORMAL, sparse accessors. What is skipped and
  * counted (vb_mesh_raw.gltf_*, printed by vb_mesh_report_print): POINTS and
  * LINE* primitives, primitives with morph targets, meshes of skinned
  * nodes. Refused with the file and reason: unparsable JSON, buffers out of
  * range, an accessor of the wrong type, node cycles, no scene, extensions
- * the file requires (e.g. Draco compression), images are never decoded.
+ * the file requires (e.g. Draco compression) but those read_extension
+ * lists; images are never decoded.
  *
  * External buffers (.gltf) resolve relative to `name`'s directory; a glTF
  * loaded from memory under a name without a directory resolves them in
@@ -22,6 +24,8 @@
  * Errors: vb_result; no C++ exception leaves this file.
  * Threading: no shared state; concurrent calls are fine.
  */
+#include <sys/stat.h>
+
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -299,15 +303,73 @@ vb_result add_primitive(const reader &rd, const tinygltf::Primitive &p, const ma
     return VB_OK;
 }
 
+/* The world matrices a node's mesh is drawn with: `w`, or with
+ * EXT_mesh_gpu_instancing (used or required) w times each instance's TRS
+ * (TRANSLATION, ROTATION, SCALE accessors of one count). */
+vb_result instances(const reader &rd, int node, const tinygltf::Node &n, const mat4 &w,
+                    std::vector<mat4> &ws)
+{
+    auto ext = n.extensions.find("EXT_mesh_gpu_instancing");
+    if (ext == n.extensions.end()) {
+        ws.assign(1, w);
+        return VB_OK;
+    }
+    const tinygltf::Value &at = ext->second.Get("attributes");
+    static const char *const names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+    std::vector<double> v[3];
+    size_t count = 0, got[3] = {0, 0, 0};
+    bool any = false;
+    for (int k = 0; k < 3; k++) {
+        if (!at.IsObject() || !at.Has(names[k]))
+            continue;
+        const tinygltf::Value &a = at.Get(names[k]);
+        vb_result r = read_accessor(rd, a.IsNumber() ? a.GetNumberAsInt() : -1,
+                                    k == 1 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3, false,
+                                    names[k], v[k], &got[k]);
+        if (r != VB_OK)
+            return r;
+        if (any && got[k] != count)
+            return vb_fail(rd.err, VB_ERR_FORMAT,
+                           "%s: node %d: EXT_mesh_gpu_instancing attributes of different counts",
+                           rd.name, node);
+        count = got[k];
+        any = true;
+    }
+    if (!any)
+        return vb_fail(rd.err, VB_ERR_FORMAT,
+                       "%s: node %d: EXT_mesh_gpu_instancing without TRANSLATION, ROTATION or "
+                       "SCALE",
+                       rd.name, node);
+    ws.resize(count);
+    for (size_t i = 0; i < count; i++) {
+        mat4 t;
+        vdsh_mat4d_trs(got[0] ? &v[0][3 * i] : nullptr, got[1] ? &v[1][4 * i] : nullptr,
+                       got[2] ? &v[2][3 * i] : nullptr, t.data());
+        ws[i] = mul(w, t);
+        for (double x : ws[i])
+            if (!std::isfinite(x))
+                return vb_fail(rd.err, VB_ERR_INVALID,
+                               "%s: node %d: instance %zu: non-finite "
+                               "transform",
+                               rd.name, node, i);
+    }
+    return VB_OK;
+}
+
 vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint8_t> &on_path,
                 int depth, out_mesh &o)
 {
     const tinygltf::Model &m = rd.m;
     if (node < 0 || (size_t)node >= m.nodes.size())
         return vb_fail(rd.err, VB_ERR_FORMAT, "%s: node %d does not exist", rd.name, node);
-    if (on_path[(size_t)node] || depth > 1000)
+    if (on_path[(size_t)node])
         return vb_fail(rd.err, VB_ERR_FORMAT,
                        "%s: node %d is its own ancestor (a cycle in the node tree)", rd.name, node);
+    if (depth > 1000)
+        return vb_fail(rd.err, VB_ERR_FORMAT,
+                       "%s: node %d: the node tree is deeper than 1000 levels, which the reader "
+                       "does not go",
+                       rd.name, node);
     on_path[(size_t)node] = 1;
     const tinygltf::Node &n = m.nodes[(size_t)node];
     mat4 w = mul(parent, node_matrix(n));
@@ -319,6 +381,10 @@ vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint
         if ((size_t)n.mesh >= m.meshes.size())
             return vb_fail(rd.err, VB_ERR_FORMAT, "%s: node %d: mesh %d does not exist", rd.name,
                            node, n.mesh);
+        std::vector<mat4> ws;
+        vb_result r = instances(rd, node, n, w, ws);
+        if (r != VB_OK)
+            return r;
         for (const tinygltf::Primitive &p : m.meshes[(size_t)n.mesh].primitives) {
             if (n.skin >= 0) {
                 o.skipped_skin++;
@@ -333,9 +399,11 @@ vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint
                 o.skipped_modes++;
                 continue;
             }
-            vb_result r = add_primitive(rd, p, w, o);
-            if (r != VB_OK)
-                return r;
+            for (const mat4 &wi : ws) {
+                r = add_primitive(rd, p, wi, o);
+                if (r != VB_OK)
+                    return r;
+            }
         }
     }
     for (int c : n.children) {
@@ -347,10 +415,59 @@ vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint
     return VB_OK;
 }
 
+/* External files (buffers): beside the glTF only (tinygltf also looked
+ * in the current directory, and read a same-named file there), regular
+ * files only (vb_mesh_read_file: a FIFO would block). `dir` is the base
+ * directory tinygltf joins URIs to. */
+struct files {
+    std::string dir;
+};
+
+bool file_exists(const std::string &path, void *user)
+{
+    const std::string &dir = ((const files *)user)->dir;
+    const std::string base = !dir.empty() && dir.back() == '/' ? dir : dir + "/";
+    struct stat st;
+    return path.compare(0, base.size(), base) == 0 && stat(path.c_str(), &st) == 0;
+}
+
+bool read_whole_file(std::vector<unsigned char> *out, std::string *err, const std::string &path,
+                     void *)
+{
+    uint8_t *bytes = nullptr;
+    size_t size = 0;
+    vb_error e;
+    memset(&e, 0, sizeof e);
+    if (vb_mesh_read_file(path.c_str(), &bytes, &size, &e) != VB_OK) {
+        if (err)
+            *err = e.msg;
+        return false;
+    }
+    out->assign(bytes, bytes + size);
+    free(bytes);
+    return true;
+}
+
 bool no_images(tinygltf::Image *, const int, std::string *, std::string *, int, int,
                const unsigned char *, int, void *)
 {
     return true;
+}
+
+/* A required extension the baker reads: KHR_mesh_quantization (integer
+ * positions and normals, which read_accessor reads; the dequantisation is
+ * the node's transform), EXT_mesh_gpu_instancing (instances()), and
+ * extensions of textures and materials alone (the triangles are the
+ * same). */
+bool read_extension(const std::string &x)
+{
+    static const char *const names[] = {"KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
+                                        "KHR_texture_transform", "KHR_texture_basisu",
+                                        "EXT_texture_webp",      "EXT_texture_avif"};
+    for (const char *n : names)
+        if (x == n)
+            return true;
+    return x.rfind("KHR_materials_", 0) == 0;
 }
 
 /* The first extension the file requires, read from its JSON alone (empty
@@ -358,28 +475,61 @@ bool no_images(tinygltf::Image *, const int, std::string *, std::string *, int, 
  * files before its own list can be checked (EXT_meshopt_compression's
  * fallback buffer has no data: "Invalid byteLength"), and the extension is
  * then the reason to give. */
-std::string required_extension(int binary, const uint8_t *bytes, size_t size)
+nlohmann::json file_json(int binary, const uint8_t *bytes, size_t size)
 {
     const char *j = (const char *)bytes;
     size_t n = size;
     if (binary) {
         uint32_t len = 0;
         if (size < 20)
-            return std::string();
+            return nlohmann::json();
         memcpy(&len, bytes + 12, 4);
         if (len > size - 20)
-            return std::string();
+            return nlohmann::json();
         j = (const char *)bytes + 20;
         n = len;
     }
-    nlohmann::json doc = nlohmann::json::parse(j, j + n, nullptr, false);
+    return nlohmann::json::parse(j, j + n, nullptr, false);
+}
+
+/* Whether the file is glTF 1.0 (tinygltf then says "no scene", "Invalid
+ * glTF binary" or that "asset" is missing): a binary of container version
+ * 1, an asset.version 1.x, or objects where 2.0 has arrays (1.0's
+ * dictionaries of accessors, meshes, nodes). */
+bool gltf_1(int binary, const uint8_t *bytes, size_t size)
+{
+    uint32_t v = 0;
+    if (binary && size >= 8)
+        memcpy(&v, bytes + 4, 4);
+    if (v == 1)
+        return true;
+    nlohmann::json doc = file_json(binary, bytes, size);
+    if (!doc.is_object())
+        return false;
+    auto a = doc.find("asset");
+    if (a != doc.end() && a->is_object()) {
+        auto ver = a->find("version");
+        if (ver != a->end() && ver->is_string() && ver->get<std::string>().rfind("1", 0) == 0)
+            return true;
+    }
+    for (const char *k : {"accessors", "meshes", "nodes"}) {
+        auto it = doc.find(k);
+        if (it != doc.end() && it->is_object())
+            return true;
+    }
+    return false;
+}
+
+std::string required_extension(int binary, const uint8_t *bytes, size_t size)
+{
+    nlohmann::json doc = file_json(binary, bytes, size);
     if (!doc.is_object())
         return std::string();
     auto it = doc.find("extensionsRequired");
     if (it == doc.end() || !it->is_array())
         return std::string();
     for (const auto &x : *it)
-        if (x.is_string())
+        if (x.is_string() && !read_extension(x.get<std::string>()))
             return x.get<std::string>();
     return std::string();
 }
@@ -387,18 +537,31 @@ std::string required_extension(int binary, const uint8_t *bytes, size_t size)
 vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, size_t size,
                 vb_mesh_raw *out, vb_error *err)
 {
+    /* The container by its bytes, as vdsh-export --source reads it: a .glb
+     * named .gltf, or the other way round, is still the file it is. */
+    binary = size >= 4 && memcmp(bytes, "glTF", 4) == 0;
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(no_images, nullptr);
     tinygltf::Model model;
     std::string e, w;
     std::string path(name);
     size_t slash = path.rfind('/');
-    std::string dir = slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+    std::string dir = slash == std::string::npos ? std::string(".")
+                      : slash == 0               ? std::string("/")
+                                                 : path.substr(0, slash);
+    files fs_dir{dir};
+    loader.SetFsCallbacks({&file_exists, &tinygltf::ExpandFilePath, &read_whole_file,
+                           &tinygltf::WriteWholeFile, &fs_dir});
     if (size > 0xffffffffu)
         return vb_fail(err, VB_ERR_FORMAT, "%s: file too large", name);
     bool ok = binary ? loader.LoadBinaryFromMemory(&model, &e, &w, bytes, (unsigned)size, dir)
                      : loader.LoadASCIIFromString(&model, &e, &w, (const char *)bytes,
                                                   (unsigned)size, dir);
+    if ((!ok || model.asset.version.rfind("1", 0) == 0) && gltf_1(binary, bytes, size))
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: a glTF 1.0 file: only glTF 2.0 is read (convert it, e.g. with "
+                       "Khronos' gltf-pipeline)",
+                       name);
     if (!ok) {
         std::string x = required_extension(binary, bytes, size);
         if (!x.empty())
@@ -414,9 +577,10 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
                        e.empty() ? "(no reason given)" : e.c_str());
     }
     for (const std::string &x : model.extensionsRequired)
-        return vb_fail(err, VB_ERR_FORMAT,
-                       "%s: requires the extension %s, which the baker does not read", name,
-                       x.c_str());
+        if (!read_extension(x))
+            return vb_fail(err, VB_ERR_FORMAT,
+                           "%s: requires the extension %s, which the baker does not read", name,
+                           x.c_str());
     if (model.scenes.empty())
         return vb_fail(err, VB_ERR_FORMAT, "%s: no scene", name);
     int s = scene >= 0 ? scene : (model.defaultScene >= 0 ? model.defaultScene : 0);

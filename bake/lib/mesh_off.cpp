@@ -16,7 +16,7 @@ namespace vb_read
 
 /* Header line [ST][C][N]OFF [BINARY] ("4OFF"/"nOFF" unsupported; BINARY
  * exactly one character after OFF, as OpenMesh's reader decided); counts
- * nV nF nE as tokens; each vertex is 3 numbers (+3 for a normal with N),
+ * nV nF nE as tokens (on the OFF line itself when it holds just them); each vertex is 3 numbers (+3 for a normal with N),
  * then the rest of its line (colours, texture coordinates: not used); each
  * face is a count and that many indices as tokens, then (only with C) the
  * rest of its line. Binary: little-endian uint32 counts, float32
@@ -57,6 +57,7 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
      * "OFFxBINARY" is binary and "OFF  BINARY" is not (OpenMesh's rule,
      * kept: files were baked by it). */
     p += 3;
+    const char *after_off = p; /* the counts, when the OFF line has them */
     if (p < le)
         p++;
     if (le - p >= 6 && memcmp(p, "BINARY", 6) == 0)
@@ -139,9 +140,26 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
         return VB_OK;
     }
 
-    /* ascii */
+    /* ascii. The counts on the OFF line itself when it holds exactly three
+     * ("OFF 8 6 0", ModelNet40's "OFF8 6 0"; OpenMesh took the first
+     * vertex for them), else on the lines after it. */
     long long counts[3];
-    for (int i = 0; i < 3; i++) {
+    int on_line = 0;
+    for (const char *q = after_off; on_line >= 0;) {
+        while (q < le && (*q == ' ' || *q == '\t' || *q == '\r'))
+            q++;
+        if (q == le)
+            break;
+        token t{q, q};
+        while (q < le && *q != ' ' && *q != '\t' && *q != '\r')
+            q++;
+        t.e = q;
+        if (on_line == 3 || !parse_int(t, &counts[on_line]) || counts[on_line] < 0)
+            on_line = -1;
+        else
+            on_line++;
+    }
+    for (int i = on_line == 3 ? 3 : 0; i < 3; i++) {
         token t;
         bool got = c.next(&t);
         if (got && has_nul(t))

@@ -84,6 +84,12 @@ vb_result vb_mesh_parse(const char *name, vb_mesh_format format, const uint8_t *
 
 void vb_mesh_raw_free(vb_mesh_raw *raw);
 
+/* The whole of a regular file into *bytes (malloc'ed, *size bytes): a
+ * FIFO, a directory or a device is refused ("not a regular file") without
+ * waiting for a writer. mesh.c's, for the meshes and the glTF reader's
+ * external buffers. */
+vb_result vb_mesh_read_file(const char *path, uint8_t **bytes, size_t *size, vb_error *err);
+
 /* glTF 2.0 (binary = 0: .gltf JSON, 1: .glb) from mesh_gltf.cpp: scene
  * `scene`, or the default scene when < 0; see that file's top comment. */
 vb_result vb_mesh_parse_gltf(const char *name, int binary, int scene, const uint8_t *bytes,

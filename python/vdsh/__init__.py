@@ -121,13 +121,17 @@ def read(path: Union[str, "os.PathLike[str]"]) -> VdshFile:
 def parse(data: bytes, path: str = "memory") -> VdshFile:
     """As `read`, from the file's bytes; `path` names it in messages."""
     n = len(data)
-    if n < 32 or data[:8] != MAGIC:
+    if data[:8] != MAGIC[:n]:
         _fail(path, "not a .vdsh file (magic)")
+    if n < 32:  # a file cut short, as vdsh-info says it
+        _fail(path, "truncated: %d bytes, shorter than the 32-byte header" % n)
     version, count, size, flags, crc = struct.unpack_from("<IIQII", data, 8)
     if zlib.crc32(data[:28]) != crc:
         _fail(path, "header CRC mismatch")
     if version != 1:
         _fail(path, "version %d unsupported" % version)
+    if size > n:
+        _fail(path, "truncated: %d bytes, the header says %d" % (n, size))
     if size != n:
         _fail(path, "file_size %d but the file has %d bytes" % (size, n))
     if not 1 <= count <= 64 or flags != 0:
