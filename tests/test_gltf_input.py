@@ -2,7 +2,8 @@
 
 The hand-written fixtures (gltf_fixtures.py: lists, strips, fans, sparse
 accessors, node matrices and TRS, a mirroring scale, points and lines
-skipped; refused files) loaded as .gltf and .glb through
+skipped, morph targets (base pose) and skins (bind pose) baked; refused
+files) loaded as .gltf and .glb through
 `vdsh-bake FILE --export-obj OUT`: the triangles written must be the
 expected ones (positions, winding); refused files fail with a message
 naming the file, never by a signal. Then Debian's assimp-testmodels glTF2
@@ -73,6 +74,10 @@ for name, g, binary, expected in gltf_fixtures.fixtures():
             failures.append("%s: triangles %s, expected %s" % (path, tris, expected))
         if name == "points_lines" and "2 glTF primitives of points or lines skipped" not in p.stderr:
             failures.append("%s: skipped primitives not reported: %s" % (path, p.stderr.strip()))
+        if name == "morph" and "1 glTF primitive with morph targets baked in the base pose" not in p.stderr:
+            failures.append("%s: ignored morph targets not reported: %s" % (path, p.stderr.strip()))
+        if name == "skinned" and "1 glTF primitive of skinned nodes baked in the bind pose" not in p.stderr:
+            failures.append("%s: bind pose not reported: %s" % (path, p.stderr.strip()))
 
 # The container is known by its bytes, not the name: a .glb named .gltf
 # and a .gltf named .glb load (was a JSON parse error, "Invalid magic"),
@@ -151,6 +156,10 @@ if os.path.isdir(g2):
     good[os.path.join(g2, "BoxTextured-glTF-Embedded", "BoxTextured.gltf")] = 12
     good[os.path.join(g2, "BoxTextured-glTF", "BoxTextured.gltf")] = 12
     good[os.path.join(g2, "cameras", "Cameras.gltf")] = 2
+    # morph targets: the base pose; skinned: the bind pose (were skipped,
+    # then refused as empty)
+    good[os.path.join(g2, "glTF-Sample-Models", "AnimatedMorphCube-glTF", "AnimatedMorphCube.gltf")] = 12
+    good[os.path.join(g2, "simple_skin", "simple_skin.gltf")] = 8
     quad = None
     for path, n in sorted(good.items()):
         tris, p = load(path)
@@ -166,8 +175,7 @@ if os.path.isdir(g2):
     bad = ["IndexOutOfRange/IndexOutOfRange.gltf", "IndexOutOfRange/AllIndicesOutOfRange.gltf",
            "MissingBin/BoxTextured.gltf", "RecursiveNodes/RecursiveNodes.gltf", "TestNoRootNode/NoScene.gltf",
            "BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb", "draco/2CylinderEngine.gltf",
-           "glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_00.gltf",
-           "glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf", "simple_skin/simple_skin.gltf"]
+           "glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_00.gltf"]
     for rel in bad:
         path = os.path.join(g2, rel)
         tris, p = load(path)

@@ -226,11 +226,15 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
         fprintf(fp, "%s%s%s: %u glTF primitive%s of points or lines skipped (no surface)\n", tool,
                 sep, path, r->gltf_skipped_modes, plural(r->gltf_skipped_modes));
     if (r->gltf_skipped_morph)
-        fprintf(fp, "%s%s%s: %u glTF primitive%s with morph targets skipped (not baked)\n", tool,
-                sep, path, r->gltf_skipped_morph, plural(r->gltf_skipped_morph));
+        fprintf(fp,
+                "%s%s%s: %u glTF primitive%s with morph targets baked in the base pose (targets "
+                "ignored)\n",
+                tool, sep, path, r->gltf_skipped_morph, plural(r->gltf_skipped_morph));
     if (r->gltf_skipped_skin)
-        fprintf(fp, "%s%s%s: %u glTF primitive%s of skinned nodes skipped (not baked)\n", tool, sep,
-                path, r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
+        fprintf(fp,
+                "%s%s%s: %u glTF primitive%s of skinned nodes baked in the bind pose (skin and "
+                "node transform ignored)\n",
+                tool, sep, path, r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
     /* the zero file normals left undefined were said above */
     uint32_t undefined =
         r->undefined_normals -

@@ -174,11 +174,11 @@ typedef struct vb_mesh_report {
                                     their triangles have no area (those
                                     with a zero file normal included) */
     uint32_t gltf_skipped_modes;  /* glTF: point and line primitives skipped */
-    uint32_t gltf_skipped_morph;  /* glTF: primitives with morph targets
-                                    skipped (their base shape is not what
-                                    the file shows once animated) */
-    uint32_t gltf_skipped_skin;   /* glTF: primitives of skinned nodes
-                                    skipped */
+    uint32_t gltf_skipped_morph;  /* glTF: primitives with morph targets,
+                                    baked in their base pose (targets
+                                    ignored; not skipped, despite the name) */
+    uint32_t gltf_skipped_skin;   /* glTF: primitives of skinned nodes,
+                                    baked in their bind pose (not skipped) */
 } vb_mesh_report;
 
 /* What a loaded source was: size and hash for the .vdsh SRCS chunk, and

@@ -9,10 +9,12 @@
  * the inverse transpose; a mirroring transform flips the winding), once per
  * instance of EXT_mesh_gpu_instancing (its TRS inside the node's), modes
  * TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN, indexed or not, float or
- * normalised integer POSITION/NORMAL, sparse accessors. What is skipped and
- * counted (vb_mesh_raw.gltf_*, printed by vb_mesh_report_print): POINTS and
- * LINE* primitives, primitives with morph targets, meshes of skinned
- * nodes. Refused with the file and reason: unparsable JSON, buffers out of
+ * normalised integer POSITION/NORMAL, sparse accessors; primitives with
+ * morph targets in their base pose (targets ignored), meshes of skinned
+ * nodes in their bind pose (POSITION as stored, the node's transform
+ * ignored as the spec says), both counted. What is skipped and counted
+ * (vb_mesh_raw.gltf_*, printed by vb_mesh_report_print): POINTS and LINE*
+ * primitives. Refused with the file and reason: unparsable JSON, buffers out of
  * range, an accessor of the wrong type, node cycles, no scene, extensions
  * the file requires (e.g. Draco compression) but those read_extension
  * lists; images are never decoded.
@@ -385,20 +387,26 @@ vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint
         vb_result r = instances(rd, node, n, w, ws);
         if (r != VB_OK)
             return r;
+        /* A skinned node's mesh in its bind pose: the glTF spec ignores
+         * the node's own transform (the joints place the mesh), and at
+         * the bind pose every joint's world matrix times its inverse bind
+         * matrix is the identity, so POSITION is already in scene
+         * coordinates. */
+        const mat4 id{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        if (n.skin >= 0)
+            ws.assign(1, id);
         for (const tinygltf::Primitive &p : m.meshes[(size_t)n.mesh].primitives) {
-            if (n.skin >= 0) {
-                o.skipped_skin++;
-                continue;
-            }
-            if (!p.targets.empty()) {
-                o.skipped_morph++;
-                continue;
-            }
             if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES &&
                 p.mode != TINYGLTF_MODE_TRIANGLE_STRIP && p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
                 o.skipped_modes++;
                 continue;
             }
+            /* morph targets ignored: the base pose (the primitive's own
+             * POSITION and NORMAL) is baked */
+            if (!p.targets.empty())
+                o.skipped_morph++;
+            if (n.skin >= 0)
+                o.skipped_skin++;
             for (const mat4 &wi : ws) {
                 r = add_primitive(rd, p, wi, o);
                 if (r != VB_OK)
@@ -599,11 +607,11 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     for (float v : o.pos)
         if (!std::isfinite(v))
             return vb_fail(err, VB_ERR_INVALID, "%s: a vertex has a non-finite coordinate", name);
-    if (o.idx.empty() && o.skipped_modes + o.skipped_morph + o.skipped_skin)
+    if (o.idx.empty() && o.skipped_modes)
         return vb_fail(err, VB_ERR_INVALID,
-                       "%s: empty mesh: no triangles left after skipping %u point/line, %u "
-                       "morph-target and %u skinned primitives",
-                       name, o.skipped_modes, o.skipped_morph, o.skipped_skin);
+                       "%s: empty mesh: no triangles left after skipping %u point/line "
+                       "primitives",
+                       name, o.skipped_modes);
     vb_mesh_raw raw;
     memset(&raw, 0, sizeof raw);
     raw.vertex_count = (uint32_t)(o.pos.size() / 3);
