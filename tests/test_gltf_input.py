@@ -79,6 +79,39 @@ for name, g, binary, expected in gltf_fixtures.fixtures():
         if name == "skinned" and "1 glTF primitive of skinned nodes baked in the bind pose" not in p.stderr:
             failures.append("%s: bind pose not reported: %s" % (path, p.stderr.strip()))
 
+# External images are never read (the baker does not use them): a .gltf
+# naming a 256 MiB image file (sparse) beside its external buffer loads
+# with a peak RSS far below the image's size (tinygltf read every image
+# file into memory before the no-op image loader saw it: ~800 MB peak).
+name, g, binary, expected = gltf_fixtures.fixtures()[0]
+d = os.path.join(work, "bigimage")
+os.makedirs(d, exist_ok=True)
+gi = json.loads(json.dumps(g))
+gi["buffers"][0]["uri"] = "quad.bin"
+gi["images"] = [{"uri": "big%20texture.png"}]
+gi["textures"] = [{"source": 0}]
+gi["materials"] = [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]
+gi["meshes"][0]["primitives"][0]["material"] = 0
+open(os.path.join(d, "quad.bin"), "wb").write(binary)
+with open(os.path.join(d, "big texture.png"), "wb") as f:
+    f.truncate(256 << 20)
+path = os.path.join(d, "bigimage.gltf")
+open(path, "w").write(json.dumps(gi))
+out = os.path.join(work, "out.obj")
+proc = subprocess.Popen([bake, path, "--export-obj", out], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+_, status, usage = os.wait4(proc.pid, 0)
+proc.returncode = os.waitstatus_to_exitcode(status)
+err = proc.stderr.read().decode()
+if proc.returncode != 0:
+    failures.append("%s: rc %d: %s" % (path, proc.returncode, err.strip()))
+elif usage.ru_maxrss > 128 * 1024:
+    failures.append("%s: peak RSS %d KiB: the 256 MiB image file was read" % (path, usage.ru_maxrss))
+else:
+    tris, p = load(path)
+    if tris is None or len(tris) != len(expected) or not all(same(t, e) for t, e in zip(tris, expected)):
+        failures.append("%s: triangles %s, expected %s" % (path, tris, expected))
+os.remove(os.path.join(d, "big texture.png"))
+
 # The container is known by its bytes, not the name: a .glb named .gltf
 # and a .gltf named .glb load (was a JSON parse error, "Invalid magic"),
 # as vdsh-export --source reads them.

@@ -429,14 +429,47 @@ vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint
  * directory tinygltf joins URIs to. */
 struct files {
     std::string dir;
+    /* the external images' paths, as tinygltf forms them: said not to
+     * exist, so that tinygltf keeps the URI and reads nothing (the baker
+     * never uses images; a no-op image loader alone still had every
+     * image file read into memory first) */
+    std::vector<std::string> images;
 };
 
 bool file_exists(const std::string &path, void *user)
 {
-    const std::string &dir = ((const files *)user)->dir;
+    const files *fs = (const files *)user;
+    const std::string &dir = fs->dir;
     const std::string base = !dir.empty() && dir.back() == '/' ? dir : dir + "/";
+    for (const std::string &im : fs->images)
+        if (path == im)
+            return false;
     struct stat st;
     return path.compare(0, base.size(), base) == 0 && stat(path.c_str(), &st) == 0;
+}
+
+/* tinygltf's dlib::urldecode, which it applies to a URI before joining it
+ * to the base directory */
+std::string url_decode(const std::string &u)
+{
+    auto hex = [](char c) -> int {
+        return c >= '0' && c <= '9'   ? c - '0'
+               : c >= 'a' && c <= 'f' ? c - 'a' + 10
+               : c >= 'A' && c <= 'F' ? c - 'A' + 10
+                                      : 0;
+    };
+    std::string r;
+    for (size_t i = 0; i < u.size(); i++) {
+        if (u[i] == '+') {
+            r += ' ';
+        } else if (u[i] == '%' && u.size() > i + 2) {
+            r += (char)((hex(u[i + 1]) << 4) | hex(u[i + 2]));
+            i += 2;
+        } else {
+            r += u[i];
+        }
+    }
+    return r;
 }
 
 bool read_whole_file(std::vector<unsigned char> *out, std::string *err, const std::string &path,
@@ -542,6 +575,40 @@ std::string required_extension(int binary, const uint8_t *bytes, size_t size)
     return std::string();
 }
 
+/* The paths tinygltf would read the file's external images from (the
+ * base directory joined to each decoded URI, as its LoadExternalFile
+ * does), leaving out any a buffer also names. Only when the JSON has an
+ * "images" member at all (the JSON is parsed a second time then). */
+void external_images(int binary, const uint8_t *bytes, size_t size, const std::string &dir,
+                     std::vector<std::string> &out)
+{
+    static const char key[] = "\"images\"";
+    if (!memmem(bytes, size, key, sizeof key - 1))
+        return;
+    nlohmann::json doc = file_json(binary, bytes, size);
+    if (!doc.is_object())
+        return;
+    auto uris = [&](const char *k) {
+        std::vector<std::string> u;
+        auto it = doc.find(k);
+        if (it != doc.end() && it->is_array())
+            for (const auto &x : *it)
+                if (x.is_object() && x.contains("uri") && x["uri"].is_string())
+                    u.push_back(url_decode(x["uri"].get<std::string>()));
+        return u;
+    };
+    std::vector<std::string> bufs = uris("buffers");
+    for (const std::string &u : uris("images")) {
+        if (u.rfind("data:", 0) == 0 || u.empty())
+            continue;
+        bool buffer = false;
+        for (const std::string &b : bufs)
+            buffer = buffer || b == u;
+        if (!buffer)
+            out.push_back(dir.back() == '/' ? dir + u : dir + "/" + u);
+    }
+}
+
 vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, size_t size,
                 vb_mesh_raw *out, vb_error *err)
 {
@@ -557,7 +624,8 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     std::string dir = slash == std::string::npos ? std::string(".")
                       : slash == 0               ? std::string("/")
                                                  : path.substr(0, slash);
-    files fs_dir{dir};
+    files fs_dir{dir, {}};
+    external_images(binary, bytes, size, dir, fs_dir.images);
     loader.SetFsCallbacks({&file_exists, &tinygltf::ExpandFilePath, &read_whole_file,
                            &tinygltf::WriteWholeFile, &fs_dir});
     if (size > 0xffffffffu)
