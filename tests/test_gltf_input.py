@@ -1,4 +1,4 @@
-"""test_gltf_input.py VDSH_BAKE WORKDIR ASSIMP_MODELS - glTF 2.0 input.
+"""test_gltf_input.py VDSH_BAKE WORKDIR ASSIMP_MODELS [VDSH_EVAL VDSH_INFO] - glTF 2.0 input.
 
 The hand-written fixtures (gltf_fixtures.py: lists, strips, fans, sparse
 accessors, node matrices and TRS, a mirroring scale, points and lines
@@ -13,6 +13,7 @@ refused with the file named.
 """
 import json
 import os
+import struct
 import subprocess
 import sys
 
@@ -20,6 +21,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gltf_fixtures  # noqa: E402
 
 bake, work, models = sys.argv[1], sys.argv[2], sys.argv[3]
+evaluate, info = (sys.argv[4], sys.argv[5]) if len(sys.argv) > 5 else (None, None)
 os.makedirs(work, exist_ok=True)
 failures = []
 
@@ -111,6 +113,43 @@ else:
     if tris is None or len(tris) != len(expected) or not all(same(t, e) for t, e in zip(tris, expected)):
         failures.append("%s: triangles %s, expected %s" % (path, tris, expected))
 os.remove(os.path.join(d, "big texture.png"))
+
+# A .gltf source's recorded SHA-256 and size cover its external buffers
+# (formats/VDSH.md, SRCS: the file's bytes, then each external buffer's):
+# vdsh-eval refuses the source once its .bin changed, even when the counts
+# are the same (the hash was the .gltf's alone: a moved vertex passed).
+if evaluate:
+    import hashlib
+    d = os.path.join(work, "hashbin")
+    os.makedirs(d, exist_ok=True)
+    gi = json.loads(json.dumps(g))
+    gi["buffers"][0]["uri"] = "quad.bin"
+    path, vd = os.path.join(d, "quad.gltf"), os.path.join(d, "quad.vdsh")
+    text = json.dumps(gi).encode()
+    open(path, "wb").write(text)
+    open(os.path.join(d, "quad.bin"), "wb").write(binary)
+    p = subprocess.run([bake, path, "-o", vd, "-q", "--rays", "16", "--orders", "2", "--cube-size", "0"],
+                       capture_output=True, text=True)
+    if p.returncode != 0:
+        failures.append("%s: bake rc %d: %s" % (path, p.returncode, p.stderr.strip()))
+    else:
+        q = subprocess.run([info, "--json", "-", vd], capture_output=True, text=True)
+        srcs = json.loads(q.stdout)["sources"] if q.returncode == 0 else []
+        want = hashlib.sha256(text + bytes(binary)).hexdigest()
+        if len(srcs) != 1 or srcs[0]["sha256"] != want or srcs[0]["size"] != len(text) + len(binary):
+            failures.append("%s: recorded %s, want size %d, sha256 %s (JSON then .bin)"
+                            % (vd, srcs, len(text) + len(binary), want))
+        ev = [evaluate, vd, path, "-q", "--points", "4", "--interior", "0", "--lights", "2",
+              "--directions", "2", "--threads", "1"]
+        p = subprocess.run(ev, capture_output=True, text=True)
+        if p.returncode != 0:
+            failures.append("%s: vdsh-eval of the unchanged source: rc %d: %s" % (vd, p.returncode, p.stderr.strip()))
+        moved = bytearray(binary)
+        moved[0:4] = struct.pack("<f", 0.5)  # vertex 0's x: same counts, same bounds
+        open(os.path.join(d, "quad.bin"), "wb").write(moved)
+        p = subprocess.run(ev, capture_output=True, text=True)
+        if p.returncode == 0 or "is not the mesh the bake used" not in p.stderr:
+            failures.append("%s: vdsh-eval with a changed .bin: rc %d: %s" % (vd, p.returncode, p.stderr.strip()))
 
 # The container is known by its bytes, not the name: a .glb named .gltf
 # and a .gltf named .glb load (was a JSON parse error, "Invalid magic"),

@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include <nettle/sha2.h>
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
@@ -687,6 +688,25 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     raw.gltf_skipped_modes = o.skipped_modes;
     raw.gltf_skipped_morph = o.skipped_morph;
     raw.gltf_skipped_skin = o.skipped_skin;
+    /* The source's hash covers its external buffers too (formats/VDSH.md,
+     * SRCS): the file's bytes, then each external buffer's, in order. */
+    bool external = false;
+    for (const tinygltf::Buffer &b : model.buffers)
+        external = external || (!b.uri.empty() && b.uri.rfind("data:", 0) != 0);
+    if (external) {
+        struct sha256_ctx c;
+        sha256_init(&c);
+        sha256_update(&c, size, bytes);
+        uint64_t total = size;
+        for (const tinygltf::Buffer &b : model.buffers)
+            if (!b.uri.empty() && b.uri.rfind("data:", 0) != 0) {
+                sha256_update(&c, b.data.size(), b.data.data());
+                total += b.data.size();
+            }
+        sha256_digest(&c, SHA256_DIGEST_SIZE, raw.gltf_sha256);
+        raw.gltf_size = total;
+        raw.gltf_hashed = 1;
+    }
     try {
         raw.positions = vb_read::malloc_copy(o.pos);
         raw.indices = vb_read::malloc_copy(o.idx);
