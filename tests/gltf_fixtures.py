@@ -118,9 +118,10 @@ def fixtures():
     b = Builder()
     pos = b.acc([0, 0, 0, 2, 0, 0, 0, 2, 0], USHORT)
     g = b.gltf([{"primitives": [{"attributes": {"POSITION": pos}}]}], [{"mesh": 0, "scale": [0.5, 0.5, 0.5]}], [0],
-               {"extensionsUsed": ["KHR_mesh_quantization", "KHR_texture_transform", "KHR_materials_emissive_strength"],
+               {"extensionsUsed": ["KHR_mesh_quantization", "KHR_texture_transform", "KHR_materials_emissive_strength",
+                                   "KHR_technique_webgl"],
                 "extensionsRequired": ["KHR_mesh_quantization", "KHR_texture_transform",
-                                       "KHR_materials_emissive_strength"]})
+                                       "KHR_materials_emissive_strength", "KHR_technique_webgl"]})
     out.append(("quantized", g, b.bin, [((0, 0, 0), (1, 0, 0), (0, 1, 0))]))
     # EXT_mesh_gpu_instancing (used, not required): every instance baked,
     # each instance's TRS inside the node's transform.

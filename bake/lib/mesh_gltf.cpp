@@ -500,12 +500,13 @@ bool no_images(tinygltf::Image *, const int, std::string *, std::string *, int, 
  * positions and normals, which read_accessor reads; the dequantisation is
  * the node's transform), EXT_mesh_gpu_instancing (instances()), and
  * extensions of textures and materials alone (the triangles are the
- * same). */
+ * same; KHR_technique_webgl, shaders for materials, among them). */
 bool read_extension(const std::string &x)
 {
     static const char *const names[] = {"KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
                                         "KHR_texture_transform", "KHR_texture_basisu",
-                                        "EXT_texture_webp",      "EXT_texture_avif"};
+                                        "EXT_texture_webp",      "EXT_texture_avif",
+                                        "KHR_technique_webgl"};
     for (const char *n : names)
         if (x == n)
             return true;
