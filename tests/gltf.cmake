@@ -8,7 +8,8 @@
 #                     tests/gltf_fixtures.py)
 add_test(NAME gltf_input
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_gltf_input.py
-                 $<TARGET_FILE:vdsh-bake> ${CMAKE_CURRENT_BINARY_DIR}/gltf_input ${VDSH_ASSIMP_MODELS})
+                 $<TARGET_FILE:vdsh-bake> ${CMAKE_CURRENT_BINARY_DIR}/gltf_input ${VDSH_ASSIMP_MODELS}
+                 $<TARGET_FILE:vdsh-eval> $<TARGET_FILE:vdsh-info>)
 
 foreach(ext gltf glb)
   _robust_fuzz_target(mesh_${ext} SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_fuzz_mesh.c

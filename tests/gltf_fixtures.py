@@ -30,7 +30,7 @@ class Builder:
         return len(self.views) - 1
 
     def acc(self, values, ctype=FLOAT, kind="VEC3", sparse=None, no_view=False):
-        n = {"SCALAR": 1, "VEC3": 3}[kind]
+        n = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[kind]
         fmt = {FLOAT: "f", USHORT: "H", UBYTE: "B", UINT: "I"}[ctype]
         a = {"componentType": ctype, "count": len(values) // n, "type": kind}
         if not no_view:
@@ -118,9 +118,10 @@ def fixtures():
     b = Builder()
     pos = b.acc([0, 0, 0, 2, 0, 0, 0, 2, 0], USHORT)
     g = b.gltf([{"primitives": [{"attributes": {"POSITION": pos}}]}], [{"mesh": 0, "scale": [0.5, 0.5, 0.5]}], [0],
-               {"extensionsUsed": ["KHR_mesh_quantization", "KHR_texture_transform", "KHR_materials_emissive_strength"],
+               {"extensionsUsed": ["KHR_mesh_quantization", "KHR_texture_transform", "KHR_materials_emissive_strength",
+                                   "KHR_technique_webgl"],
                 "extensionsRequired": ["KHR_mesh_quantization", "KHR_texture_transform",
-                                       "KHR_materials_emissive_strength"]})
+                                       "KHR_materials_emissive_strength", "KHR_technique_webgl"]})
     out.append(("quantized", g, b.bin, [((0, 0, 0), (1, 0, 0), (0, 1, 0))]))
     # EXT_mesh_gpu_instancing (used, not required): every instance baked,
     # each instance's TRS inside the node's transform.
@@ -133,6 +134,25 @@ def fixtures():
                  "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": tr, "SCALE": sc}}}}], [0],
                {"extensionsUsed": ["EXT_mesh_gpu_instancing"]})
     out.append(("instanced", g, b.bin, [((0, 0, 1), (1, 0, 1), (1, 1, 1)), ((5, 0, 1), (7, 0, 1), (7, 2, 1))]))
+    # Morph targets: the base pose (the primitive's own POSITION) is baked,
+    # the target (which would move vertex 2) ignored; the node's transform
+    # applies as for any mesh.
+    b = Builder()
+    pos = b.acc(QUAD[:9])
+    tgt = b.acc([0, 0, 0, 0, 0, 0, 0, 0, 4])
+    g = b.gltf([{"primitives": [{"attributes": {"POSITION": pos}, "targets": [{"POSITION": tgt}]}],
+                "weights": [1.0]}], [{"mesh": 0, "translation": [0, 0, 3]}], [0])
+    out.append(("morph", g, b.bin, [((0, 0, 3), (1, 0, 3), (1, 1, 3))]))
+    # Skinned node: the bind pose, POSITION as stored; the skinned node's
+    # own translation is ignored (glTF spec), the joint node draws nothing.
+    b = Builder()
+    pos = b.acc(QUAD[:9])
+    joints = b.acc([0, 0, 0, 0] * 3, USHORT, "VEC4")
+    weights = b.acc([1.0, 0, 0, 0] * 3, FLOAT, "VEC4")
+    g = b.gltf([{"primitives": [{"attributes": {"POSITION": pos, "JOINTS_0": joints, "WEIGHTS_0": weights}}]}],
+               [{"mesh": 0, "skin": 0, "translation": [0, 0, 7]}, {"translation": [0, 0, 0]}], [0, 1],
+               {"skins": [{"joints": [1]}]})
+    out.append(("skinned", g, b.bin, [(v(QUAD, 0), v(QUAD, 1), v(QUAD, 2))]))
     # Refused: index out of range, stride/overrun, cycle, only points.
     b = Builder()
     pos = b.acc(QUAD[:9])

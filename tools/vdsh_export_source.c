@@ -485,7 +485,12 @@ static int visit(walk *w, int node, const double *parent, uint8_t *on_path, int 
                     "share their VDSH attributes: --source cannot give each its own shadows "
                     "(export without --source)",
                     w->path, node);
-    if (mesh >= 0 && cJSON_GetObjectItemCaseSensitive(n, "skin") == NULL) {
+    if (mesh >= 0) {
+        /* a skinned node's mesh in its bind pose, as the baker reads it
+         * (bake/lib/mesh_gltf.cpp): POSITION as stored, the node's own
+         * transform ignored (glTF spec) */
+        static const double bind[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        const double *pm = cJSON_GetObjectItemCaseSensitive(n, "skin") ? bind : m;
         cJSON *me =
             cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(w->s->json, "meshes"), mesh);
         if (!me)
@@ -495,10 +500,9 @@ static int visit(walk *w, int node, const double *parent, uint8_t *on_path, int 
         for (int pi = 0; pi < cJSON_GetArraySize(prims); pi++) {
             cJSON *p = cJSON_GetArrayItem(prims, pi);
             int mode = (int)num(p, "mode", 4);
-            if (cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(p, "targets")) > 0 ||
-                mode < 4 || mode > 6)
-                continue; /* skipped by the baker too */
-            if (map_prim(w, node, mesh, pi, p, m))
+            if (mode < 4 || mode > 6)
+                continue; /* skipped by the baker too; morph targets: the base pose */
+            if (map_prim(w, node, mesh, pi, p, pm))
                 return -1;
         }
     }

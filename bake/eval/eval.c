@@ -1269,7 +1269,22 @@ vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths, uin
         if (r != VB_OK)
             goto fail;
         const vdsh_source *src = &f->sources[i];
-        if (info.size != src->size || memcmp(info.sha256, src->sha256, 32) != 0) {
+        /* a bake before 2026-11-30 recorded a .gltf's hash without its
+         * external buffers (formats/VDSH.md, SRCS): still accepted, with a
+         * warning that the buffers could not be checked */
+        int file_only =
+            (info.file_size != info.size || memcmp(info.file_sha256, info.sha256, 32) != 0) &&
+            info.file_size == src->size && memcmp(info.file_sha256, src->sha256, 32) == 0;
+        if (file_only && d.warn) {
+            char msg[768];
+            snprintf(msg, sizeof msg,
+                     "source %u of %u, '%s': the bake recorded the hash of the .gltf alone "
+                     "(a bake before 2026-11-30): its external buffers were not checked, only "
+                     "the counts and bounds",
+                     i + 1, count, paths[i]);
+            d.warn(d.warn_user, msg);
+        }
+        if (!file_only && (info.size != src->size || memcmp(info.sha256, src->sha256, 32) != 0)) {
             char now[65], then[65], msg[768];
             hex(info.sha256, 32, now);
             hex(src->sha256, 32, then);

@@ -226,11 +226,15 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
         fprintf(fp, "%s%s%s: %u glTF primitive%s of points or lines skipped (no surface)\n", tool,
                 sep, path, r->gltf_skipped_modes, plural(r->gltf_skipped_modes));
     if (r->gltf_skipped_morph)
-        fprintf(fp, "%s%s%s: %u glTF primitive%s with morph targets skipped (not baked)\n", tool,
-                sep, path, r->gltf_skipped_morph, plural(r->gltf_skipped_morph));
+        fprintf(fp,
+                "%s%s%s: %u glTF primitive%s with morph targets baked in the base pose (targets "
+                "ignored)\n",
+                tool, sep, path, r->gltf_skipped_morph, plural(r->gltf_skipped_morph));
     if (r->gltf_skipped_skin)
-        fprintf(fp, "%s%s%s: %u glTF primitive%s of skinned nodes skipped (not baked)\n", tool, sep,
-                path, r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
+        fprintf(fp,
+                "%s%s%s: %u glTF primitive%s of skinned nodes baked in the bind pose (skin and "
+                "node transform ignored)\n",
+                tool, sep, path, r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
     /* the zero file normals left undefined were said above */
     uint32_t undefined =
         r->undefined_normals -
@@ -1344,6 +1348,8 @@ static vb_result builtin_info(const vb_mesh *m, vb_source_info *info, vb_error *
             buf[4 * w + (size_t)b] = (uint8_t)(m->indices[j] >> (8 * b));
     info->size = (uint64_t)words * 4;
     vb_sha256(buf, words * 4, info->sha256);
+    info->file_size = info->size;
+    memcpy(info->file_sha256, info->sha256, 32);
     free(buf);
     return VB_OK;
 }
@@ -1387,12 +1393,18 @@ static vb_result load_bytes(const char *name, vb_mesh_format format, int gltf_sc
         return vb_fail(err, VB_ERR_FORMAT, "%s: empty file", name);
     si->size = size;
     vb_sha256(bytes, size, si->sha256);
+    si->file_size = si->size;
+    memcpy(si->file_sha256, si->sha256, 32);
     vb_mesh_raw raw;
     memset(&raw, 0, sizeof raw);
     vb_result r = format == VB_MESH_GLTF || format == VB_MESH_GLB
                       ? vb_mesh_parse_gltf(name, format == VB_MESH_GLB, gltf_scene - 1, bytes, size,
                                            &raw, err)
                       : vb_mesh_parse(name, format, bytes, size, &raw, err);
+    if (r == VB_OK && raw.gltf_hashed) {
+        si->size = raw.gltf_size;
+        memcpy(si->sha256, raw.gltf_sha256, 32);
+    }
     if (r == VB_OK)
         r = clean_raw(name, format, &raw, m, &si->report, err);
     vb_mesh_raw_free(&raw);

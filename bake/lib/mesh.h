@@ -174,18 +174,23 @@ typedef struct vb_mesh_report {
                                     their triangles have no area (those
                                     with a zero file normal included) */
     uint32_t gltf_skipped_modes;  /* glTF: point and line primitives skipped */
-    uint32_t gltf_skipped_morph;  /* glTF: primitives with morph targets
-                                    skipped (their base shape is not what
-                                    the file shows once animated) */
-    uint32_t gltf_skipped_skin;   /* glTF: primitives of skinned nodes
-                                    skipped */
+    uint32_t gltf_skipped_morph;  /* glTF: primitives with morph targets,
+                                    baked in their base pose (targets
+                                    ignored; not skipped, despite the name) */
+    uint32_t gltf_skipped_skin;   /* glTF: primitives of skinned nodes,
+                                    baked in their bind pose (not skipped) */
 } vb_mesh_report;
 
 /* What a loaded source was: size and hash for the .vdsh SRCS chunk, and
  * what loading found. */
 typedef struct vb_source_info {
-    uint64_t size; /* bytes of the file (or of the built-in arrays) */
-    uint8_t sha256[32];
+    uint64_t size;           /* bytes of the file (or of the built-in arrays); for a
+                      glTF with external buffers, the file's plus theirs */
+    uint8_t sha256[32];      /* of those bytes in that order (formats/VDSH.md) */
+    uint64_t file_size;      /* the file's bytes alone, and their SHA-256: */
+    uint8_t file_sha256[32]; /* what bakes before 2026-11-30 recorded for a
+                                glTF with external buffers (= size, sha256
+                                for every other source) */
     vb_mesh_report report;
 } vb_source_info;
 

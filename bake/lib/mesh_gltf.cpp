@@ -9,10 +9,12 @@
  * the inverse transpose; a mirroring transform flips the winding), once per
  * instance of EXT_mesh_gpu_instancing (its TRS inside the node's), modes
  * TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN, indexed or not, float or
- * normalised integer POSITION/NORMAL, sparse accessors. What is skipped and
- * counted (vb_mesh_raw.gltf_*, printed by vb_mesh_report_print): POINTS and
- * LINE* primitives, primitives with morph targets, meshes of skinned
- * nodes. Refused with the file and reason: unparsable JSON, buffers out of
+ * normalised integer POSITION/NORMAL, sparse accessors; primitives with
+ * morph targets in their base pose (targets ignored), meshes of skinned
+ * nodes in their bind pose (POSITION as stored, the node's transform
+ * ignored as the spec says), both counted. What is skipped and counted
+ * (vb_mesh_raw.gltf_*, printed by vb_mesh_report_print): POINTS and LINE*
+ * primitives. Refused with the file and reason: unparsable JSON, buffers out of
  * range, an accessor of the wrong type, node cycles, no scene, extensions
  * the file requires (e.g. Draco compression) but those read_extension
  * lists; images are never decoded.
@@ -32,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include <nettle/sha2.h>
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
@@ -385,20 +388,26 @@ vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint
         vb_result r = instances(rd, node, n, w, ws);
         if (r != VB_OK)
             return r;
+        /* A skinned node's mesh in its bind pose: the glTF spec ignores
+         * the node's own transform (the joints place the mesh), and at
+         * the bind pose every joint's world matrix times its inverse bind
+         * matrix is the identity, so POSITION is already in scene
+         * coordinates. */
+        const mat4 id{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        if (n.skin >= 0)
+            ws.assign(1, id);
         for (const tinygltf::Primitive &p : m.meshes[(size_t)n.mesh].primitives) {
-            if (n.skin >= 0) {
-                o.skipped_skin++;
-                continue;
-            }
-            if (!p.targets.empty()) {
-                o.skipped_morph++;
-                continue;
-            }
             if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES &&
                 p.mode != TINYGLTF_MODE_TRIANGLE_STRIP && p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
                 o.skipped_modes++;
                 continue;
             }
+            /* morph targets ignored: the base pose (the primitive's own
+             * POSITION and NORMAL) is baked */
+            if (!p.targets.empty())
+                o.skipped_morph++;
+            if (n.skin >= 0)
+                o.skipped_skin++;
             for (const mat4 &wi : ws) {
                 r = add_primitive(rd, p, wi, o);
                 if (r != VB_OK)
@@ -421,14 +430,47 @@ vb_result visit(const reader &rd, int node, const mat4 &parent, std::vector<uint
  * directory tinygltf joins URIs to. */
 struct files {
     std::string dir;
+    /* the external images' paths, as tinygltf forms them: said not to
+     * exist, so that tinygltf keeps the URI and reads nothing (the baker
+     * never uses images; a no-op image loader alone still had every
+     * image file read into memory first) */
+    std::vector<std::string> images;
 };
 
 bool file_exists(const std::string &path, void *user)
 {
-    const std::string &dir = ((const files *)user)->dir;
+    const files *fs = (const files *)user;
+    const std::string &dir = fs->dir;
     const std::string base = !dir.empty() && dir.back() == '/' ? dir : dir + "/";
+    for (const std::string &im : fs->images)
+        if (path == im)
+            return false;
     struct stat st;
     return path.compare(0, base.size(), base) == 0 && stat(path.c_str(), &st) == 0;
+}
+
+/* tinygltf's dlib::urldecode, which it applies to a URI before joining it
+ * to the base directory */
+std::string url_decode(const std::string &u)
+{
+    auto hex = [](char c) -> int {
+        return c >= '0' && c <= '9'   ? c - '0'
+               : c >= 'a' && c <= 'f' ? c - 'a' + 10
+               : c >= 'A' && c <= 'F' ? c - 'A' + 10
+                                      : 0;
+    };
+    std::string r;
+    for (size_t i = 0; i < u.size(); i++) {
+        if (u[i] == '+') {
+            r += ' ';
+        } else if (u[i] == '%' && u.size() > i + 2) {
+            r += (char)((hex(u[i + 1]) << 4) | hex(u[i + 2]));
+            i += 2;
+        } else {
+            r += u[i];
+        }
+    }
+    return r;
 }
 
 bool read_whole_file(std::vector<unsigned char> *out, std::string *err, const std::string &path,
@@ -458,12 +500,13 @@ bool no_images(tinygltf::Image *, const int, std::string *, std::string *, int, 
  * positions and normals, which read_accessor reads; the dequantisation is
  * the node's transform), EXT_mesh_gpu_instancing (instances()), and
  * extensions of textures and materials alone (the triangles are the
- * same). */
+ * same; KHR_technique_webgl, shaders for materials, among them). */
 bool read_extension(const std::string &x)
 {
     static const char *const names[] = {"KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
                                         "KHR_texture_transform", "KHR_texture_basisu",
-                                        "EXT_texture_webp",      "EXT_texture_avif"};
+                                        "EXT_texture_webp",      "EXT_texture_avif",
+                                        "KHR_technique_webgl"};
     for (const char *n : names)
         if (x == n)
             return true;
@@ -534,6 +577,40 @@ std::string required_extension(int binary, const uint8_t *bytes, size_t size)
     return std::string();
 }
 
+/* The paths tinygltf would read the file's external images from (the
+ * base directory joined to each decoded URI, as its LoadExternalFile
+ * does), leaving out any a buffer also names. Only when the JSON has an
+ * "images" member at all (the JSON is parsed a second time then). */
+void external_images(int binary, const uint8_t *bytes, size_t size, const std::string &dir,
+                     std::vector<std::string> &out)
+{
+    static const char key[] = "\"images\"";
+    if (!memmem(bytes, size, key, sizeof key - 1))
+        return;
+    nlohmann::json doc = file_json(binary, bytes, size);
+    if (!doc.is_object())
+        return;
+    auto uris = [&](const char *k) {
+        std::vector<std::string> u;
+        auto it = doc.find(k);
+        if (it != doc.end() && it->is_array())
+            for (const auto &x : *it)
+                if (x.is_object() && x.contains("uri") && x["uri"].is_string())
+                    u.push_back(url_decode(x["uri"].get<std::string>()));
+        return u;
+    };
+    std::vector<std::string> bufs = uris("buffers");
+    for (const std::string &u : uris("images")) {
+        if (u.rfind("data:", 0) == 0 || u.empty())
+            continue;
+        bool buffer = false;
+        for (const std::string &b : bufs)
+            buffer = buffer || b == u;
+        if (!buffer)
+            out.push_back(dir.back() == '/' ? dir + u : dir + "/" + u);
+    }
+}
+
 vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, size_t size,
                 vb_mesh_raw *out, vb_error *err)
 {
@@ -549,7 +626,8 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     std::string dir = slash == std::string::npos ? std::string(".")
                       : slash == 0               ? std::string("/")
                                                  : path.substr(0, slash);
-    files fs_dir{dir};
+    files fs_dir{dir, {}};
+    external_images(binary, bytes, size, dir, fs_dir.images);
     loader.SetFsCallbacks({&file_exists, &tinygltf::ExpandFilePath, &read_whole_file,
                            &tinygltf::WriteWholeFile, &fs_dir});
     if (size > 0xffffffffu)
@@ -599,11 +677,11 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     for (float v : o.pos)
         if (!std::isfinite(v))
             return vb_fail(err, VB_ERR_INVALID, "%s: a vertex has a non-finite coordinate", name);
-    if (o.idx.empty() && o.skipped_modes + o.skipped_morph + o.skipped_skin)
+    if (o.idx.empty() && o.skipped_modes)
         return vb_fail(err, VB_ERR_INVALID,
-                       "%s: empty mesh: no triangles left after skipping %u point/line, %u "
-                       "morph-target and %u skinned primitives",
-                       name, o.skipped_modes, o.skipped_morph, o.skipped_skin);
+                       "%s: empty mesh: no triangles left after skipping %u point/line "
+                       "primitives",
+                       name, o.skipped_modes);
     vb_mesh_raw raw;
     memset(&raw, 0, sizeof raw);
     raw.vertex_count = (uint32_t)(o.pos.size() / 3);
@@ -611,6 +689,25 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     raw.gltf_skipped_modes = o.skipped_modes;
     raw.gltf_skipped_morph = o.skipped_morph;
     raw.gltf_skipped_skin = o.skipped_skin;
+    /* The source's hash covers its external buffers too (formats/VDSH.md,
+     * SRCS): the file's bytes, then each external buffer's, in order. */
+    bool external = false;
+    for (const tinygltf::Buffer &b : model.buffers)
+        external = external || (!b.uri.empty() && b.uri.rfind("data:", 0) != 0);
+    if (external) {
+        struct sha256_ctx c;
+        sha256_init(&c);
+        sha256_update(&c, size, bytes);
+        uint64_t total = size;
+        for (const tinygltf::Buffer &b : model.buffers)
+            if (!b.uri.empty() && b.uri.rfind("data:", 0) != 0) {
+                sha256_update(&c, b.data.size(), b.data.data());
+                total += b.data.size();
+            }
+        sha256_digest(&c, SHA256_DIGEST_SIZE, raw.gltf_sha256);
+        raw.gltf_size = total;
+        raw.gltf_hashed = 1;
+    }
     try {
         raw.positions = vb_read::malloc_copy(o.pos);
         raw.indices = vb_read::malloc_copy(o.idx);

@@ -74,8 +74,13 @@ typedef struct vb_mesh_raw {
     uint32_t dropped_triangles;  /* OBJ faces dropped for fewer than 3
                                    distinct vertices (see vb_mesh_report) */
     uint32_t gltf_skipped_modes; /* glTF primitives skipped: points, lines */
-    uint32_t gltf_skipped_morph; /* glTF primitives skipped: morph targets */
-    uint32_t gltf_skipped_skin;  /* glTF primitives skipped: skinned node */
+    uint32_t gltf_skipped_morph; /* glTF primitives with morph targets: base pose baked */
+    uint32_t gltf_skipped_skin;  /* glTF primitives of skinned nodes: bind pose baked */
+    int gltf_hashed;             /* glTF with external buffers: the source's
+                                   hash and size are these, not the file's */
+    uint64_t gltf_size;          /* the file's bytes plus its external buffers' */
+    uint8_t gltf_sha256[32];     /* SHA-256 of the file's bytes, then of each
+                                   external buffer's in `buffers` order */
 } vb_mesh_raw;
 
 /* Read `size` bytes (the whole file) of `format`; `name` is for messages. */
