@@ -237,6 +237,32 @@ vb_result ply_binary_read(const char *path, const std::vector<ply_element> &elem
     return VB_OK;
 }
 
+/* A binary list's size (p.count_type at b, moved past): the element's
+ * n-th item, for messages; a truncated file or a negative size refused. */
+static vb_result binary_list_size(const char *path, const ply_element &e, uint64_t n,
+                                  const ply_property &p, bool big, const uint8_t *&b, size_t &left,
+                                  uint64_t &items, vb_error *err)
+{
+    const size_t cs = (size_t)p.count_type->size;
+    if (left < cs)
+        return vb_fail(err, VB_ERR_FORMAT, "%s: truncated in %s %llu of %llu", path, e.name.c_str(),
+                       (unsigned long long)n, (unsigned long long)e.count);
+    if (cs == 1)
+        items = b[0];
+    else if (cs == 2)
+        items = big ? (uint64_t)(b[0] << 8 | b[1]) : (uint64_t)(b[1] << 8 | b[0]);
+    else {
+        uint32_t u = load_u32(b, big);
+        if (p.count_type->is_signed && (int32_t)u < 0)
+            return vb_fail(err, VB_ERR_FORMAT, "%s: %s %llu: negative list size", path,
+                           e.name.c_str(), (unsigned long long)n);
+        items = u;
+    }
+    b += cs;
+    left -= cs;
+    return VB_OK;
+}
+
 /* The elements after "face", never used: walked by the layout the header
  * declares, since PLY's data holds every element declared, in order, and
  * only then is a truncated file or trailing data found. Ascii values must
@@ -259,26 +285,9 @@ vb_result ply_walk_unused(const char *path, const std::vector<ply_element> &elem
                 uint64_t items = 1;
                 if (format != 0) {
                     if (p.count_type) {
-                        const size_t cs = (size_t)p.count_type->size;
-                        if (left < cs)
-                            return vb_fail(err, VB_ERR_FORMAT, "%s: truncated in %s %llu of %llu",
-                                           path, e.name.c_str(), (unsigned long long)n,
-                                           (unsigned long long)e.count);
-                        if (cs == 1)
-                            items = b[0];
-                        else if (cs == 2)
-                            items =
-                                big ? (uint64_t)(b[0] << 8 | b[1]) : (uint64_t)(b[1] << 8 | b[0]);
-                        else {
-                            uint32_t u = load_u32(b, big);
-                            if (p.count_type->is_signed && (int32_t)u < 0)
-                                return vb_fail(err, VB_ERR_FORMAT,
-                                               "%s: %s %llu: negative list size", path,
-                                               e.name.c_str(), (unsigned long long)n);
-                            items = u;
-                        }
-                        b += cs;
-                        left -= cs;
+                        vb_result r = binary_list_size(path, e, n, p, big, b, left, items, err);
+                        if (r != VB_OK)
+                            return r;
                     }
                     const size_t ts = (size_t)p.type->size;
                     if (items > left / ts)
@@ -576,27 +585,10 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                     polygon.clear();
                 if (format != 0) {
                     if (p.count_type) {
-                        int cs = p.count_type->size;
-                        if (left < (size_t)cs)
-                            return vb_fail(err, VB_ERR_FORMAT, "%s: truncated in %s %llu of %llu",
-                                           path, e.name.c_str(), (unsigned long long)n,
-                                           (unsigned long long)e.count);
-                        uint64_t cnt = 0;
-                        if (cs == 1)
-                            cnt = b[0];
-                        else if (cs == 2)
-                            cnt = big ? (uint64_t)(b[0] << 8 | b[1]) : (uint64_t)(b[1] << 8 | b[0]);
-                        else {
-                            uint32_t u = load_u32(b, big);
-                            if (p.count_type->is_signed && (int32_t)u < 0)
-                                return vb_fail(err, VB_ERR_FORMAT,
-                                               "%s: %s %llu: negative list size", path,
-                                               e.name.c_str(), (unsigned long long)n);
-                            cnt = u;
-                        }
-                        b += cs;
-                        left -= (size_t)cs;
-                        items = cnt;
+                        vb_result r = binary_list_size(path, e, n, p, big, b, left, items, err);
+                        if (r != VB_OK)
+                            return r;
+                        const uint64_t cnt = items;
                         if (is_indices && cnt < 3)
                             return vb_fail(err, VB_ERR_FORMAT,
                                            "%s: face %llu has %llu vertices (needs at least 3)",
