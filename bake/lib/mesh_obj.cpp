@@ -220,7 +220,7 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
             token t;
             const char *rest = c.p;
             while (c.next_on_line(&t) && t.b[0] != '#') {
-                if (memchr(t.b, '\0', t.size()))
+                if (has_nul(t))
                     return vb_fail(err, VB_ERR_FORMAT,
                                    "%s: line %lu: face corner '%.*s' contains a NUL byte "
                                    "(binary data in a text file?)",

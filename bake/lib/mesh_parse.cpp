@@ -66,7 +66,7 @@ static const char *after_plus(const token &t)
 
 num_status parse_float(const token &t, float *out)
 {
-    if (memchr(t.b, '\0', t.size()))
+    if (has_nul(t))
         return NUM_NUL;
     const char *b = after_plus(t);
     if (!b)

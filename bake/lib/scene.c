@@ -171,10 +171,12 @@ static void probe_hit(const vb_scene *s, const float o[3], const float d[3], uns
     *back = den > 0.0;
 }
 
-int vb_scene_free_space(const vb_scene *s, const float p[3])
+/* The 14 probes from p (vdsh_free_probe_dirs): each one's hit distance
+ * (scene units, INFINITY when it meets nothing) and side, by probe_hit. */
+static void cast_probes(const vb_scene *s, const float p[3], float t[VDSH_FREE_PROBES],
+                        int back[VDSH_FREE_PROBES])
 {
-    float dirs[VDSH_FREE_PROBES][3], t[VDSH_FREE_PROBES];
-    int back[VDSH_FREE_PROBES];
+    float dirs[VDSH_FREE_PROBES][3];
     vdsh_free_probe_dirs(dirs);
     float o[3];
     vb_scene_to_local(s, p, o);
@@ -193,6 +195,13 @@ int vb_scene_free_space(const vb_scene *s, const float p[3])
         if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
             probe_hit(s, o, dirs[i], rh.hit.primID, rh.ray.tfar, &t[i], &back[i]);
     }
+}
+
+int vb_scene_free_space(const vb_scene *s, const float p[3])
+{
+    float t[VDSH_FREE_PROBES];
+    int back[VDSH_FREE_PROBES];
+    cast_probes(s, p, t, back);
     return vdsh_free_space(t, back, vdsh_free_clearance(s->diagonal));
 }
 
@@ -200,33 +209,11 @@ int vb_scene_free_space(const vb_scene *s, const float p[3])
  * INFINITY when none is met. */
 static float probe_nearest(const vb_scene *s, const float p[3])
 {
-    float dirs[VDSH_FREE_PROBES][3], o[3], best = INFINITY;
-    vdsh_free_probe_dirs(dirs);
-    vb_scene_to_local(s, p, o);
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    for (int i = 0; i < VDSH_FREE_PROBES; i++) {
-        const struct RTCRay ray = {.org_x = o[0],
-                                   .org_y = o[1],
-                                   .org_z = o[2],
-                                   .dir_x = dirs[i][0],
-                                   .dir_y = dirs[i][1],
-                                   .dir_z = dirs[i][2],
-                                   .tnear = 0.0f,
-                                   .tfar = INFINITY,
-                                   .mask = 0xffffffffu};
-        struct RTCRay r = ray;
-        rtcOccluded1(s->scene, &ctx, &r);
-        if (r.tfar < 0.0f) { /* met something: find how far (probe_hit) */
-            struct RTCRayHit rh = {.ray = ray, .hit = {.geomID = RTC_INVALID_GEOMETRY_ID}};
-            rtcIntersect1(s->scene, &ctx, &rh);
-            float d = INFINITY;
-            int back = 0;
-            if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
-                probe_hit(s, o, dirs[i], rh.hit.primID, rh.ray.tfar, &d, &back);
-            best = d < best ? d : best;
-        }
-    }
+    float t[VDSH_FREE_PROBES], best = INFINITY;
+    int back[VDSH_FREE_PROBES];
+    cast_probes(s, p, t, back);
+    for (int i = 0; i < VDSH_FREE_PROBES; i++)
+        best = t[i] < best ? t[i] : best;
     return best;
 }
 
