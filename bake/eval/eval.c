@@ -189,15 +189,49 @@ static inline int mae_part(int vis, int occ, float s_hat)
     return VB_EVAL_PART_PENUMBRA;
 }
 
+/* A receiver's streams, ready to evaluate: each stream's coefficients at
+ * the receiver and, at an interior point, its triangle's corners with how
+ * the runtime interpolates between them. */
+typedef struct rstreams {
+    float coef[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS];
+    float vc[VDSH_MAX_STREAMS][3][VDSH_MAX_COEFFS];
+    const float *pv[3];
+    uint32_t interp[VDSH_MAX_STREAMS];
+    int corners;
+} rstreams;
+
+/* What stream s draws at receiver r for a light at lp, in direction w and
+ * at distance dl from the point (the truth dt under --oracle): the
+ * distance it compares in *D, the smooth shadow in *s_hat and, if b_hat is
+ * not NULL, the binary one. */
+static void stream_shadow(const job *J, const rstreams *R, const receiver *r, uint32_t s,
+                          const float w[3], const float lp[3], float dl, float dt, float *D,
+                          float *s_hat, float *b_hat)
+{
+    const vdsh_stream *st = &J->f->streams[s];
+    if (J->d->oracle || !R->corners) {
+        *D = J->d->oracle
+                 ? dt
+                 : vdsh_stream_distance(st->order, st->quantity, J->max_distance, R->coef[s], w);
+        *s_hat = vdsh_shadow_compare(*D, dl, VDSH_COMPARE_SMOOTH);
+        if (b_hat)
+            *b_hat = vdsh_shadow_compare(*D, dl, VDSH_COMPARE_BINARY);
+        return;
+    }
+    const float *cv[3] = {R->vc[s][0], R->vc[s][1], R->vc[s][2]};
+    *s_hat = vdsh_shadow_interior(st->order, st->quantity, J->max_distance, R->interp[s], cv, R->pv,
+                                  r->bary, lp, VDSH_COMPARE_SMOOTH, D);
+    if (b_hat)
+        *b_hat = vdsh_shadow_interior(st->order, st->quantity, J->max_distance, R->interp[s], cv,
+                                      R->pv, r->bary, lp, VDSH_COMPARE_BINARY, NULL);
+}
+
 /* The scene lights at one receiver: every light above its horizon, the
  * truth traced from the receiver's origin toward it (16 at a time), the
  * streams evaluated toward it on the path the runtime draws them. */
-static void eval_scene_lights(job *J, uint32_t ri, const float coef[][VDSH_MAX_COEFFS],
-                              const float vc[][3][VDSH_MAX_COEFFS], const float *const pv[3],
-                              const uint32_t *interp, int corners)
+static void eval_scene_lights(job *J, uint32_t ri, const rstreams *R)
 {
     const receiver *r = J->rec + ri;
-    const vdsh_file *f = J->f;
     const uint32_t S = J->streams;
     sacc *acc = J->sacc + (size_t)ri * S;
     const float scale = J->scene->scale;
@@ -254,21 +288,8 @@ static void eval_scene_lights(job *J, uint32_t ri, const float coef[][VDSH_MAX_C
             const int vis = dt >= L0, occ = s_ideal < 0.5f, occ_bin = dt < L0;
             const float *L = J->lights[first + (uint32_t)k];
             for (uint32_t s = 0; s < S; s++) {
-                const vdsh_stream *st = &f->streams[s];
                 float D, s_hat;
-                if (J->d->oracle) {
-                    D = dt;
-                    s_hat = vdsh_shadow_compare(D, L0, VDSH_COMPARE_SMOOTH);
-                } else if (!corners) {
-                    D = vdsh_stream_distance(st->order, st->quantity, J->max_distance, coef[s],
-                                             w[k]);
-                    s_hat = vdsh_shadow_compare(D, L0, VDSH_COMPARE_SMOOTH);
-                } else {
-                    const float *cv[3] = {vc[s][0], vc[s][1], vc[s][2]};
-                    s_hat =
-                        vdsh_shadow_interior(st->order, st->quantity, J->max_distance, interp[s],
-                                             cv, pv, r->bary, L, VDSH_COMPARE_SMOOTH, &D);
-                }
+                stream_shadow(J, R, r, s, w[k], L, L0, dt, &D, &s_hat, NULL);
                 const int b_dark = D < L0;
                 sacc *a = acc + s;
                 const float err_ = fabsf(s_hat - s_ideal);
@@ -294,24 +315,22 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
     const receiver *r = J->rec + ri;
     const vdsh_file *f = J->f;
     const uint32_t S = J->streams;
-    float coef[VDSH_MAX_STREAMS][VDSH_MAX_COEFFS];
+    rstreams R;
     for (uint32_t s = 0; s < S; s++)
-        receiver_coeffs(f, &f->streams[s], r, coef[s]);
+        receiver_coeffs(f, &f->streams[s], r, R.coef[s]);
     /* Interior points: their triangle's corners, for the per-vertex
      * interpolation modes. */
-    const int corners = r->kind == VB_EVAL_INTERIOR;
-    float vc[VDSH_MAX_STREAMS][3][VDSH_MAX_COEFFS];
-    const float *pv[3] = {NULL, NULL, NULL};
-    uint32_t interp[VDSH_MAX_STREAMS];
-    for (uint32_t s = 0; s < S && corners; s++) {
+    R.corners = r->kind == VB_EVAL_INTERIOR;
+    R.pv[0] = R.pv[1] = R.pv[2] = NULL;
+    for (uint32_t s = 0; s < S && R.corners; s++) {
         const uint32_t *t = f->indices + 3 * (size_t)r->triangle;
         for (int k = 0; k < 3; k++) {
-            vdsh_stream_decode(&f->streams[s], t[k], vc[s][k]);
-            pv[k] = f->positions + 3 * (size_t)t[k];
+            vdsh_stream_decode(&f->streams[s], t[k], R.vc[s][k]);
+            R.pv[k] = f->positions + 3 * (size_t)t[k];
         }
-        interp[s] = J->d->interp == VB_EVAL_INTERP_RUNTIME
-                        ? vdsh_runtime_interp(f->streams[s].order, f->streams[s].quantity)
-                        : J->d->interp - 1;
+        R.interp[s] = J->d->interp == VB_EVAL_INTERP_RUNTIME
+                          ? vdsh_runtime_interp(f->streams[s].order, f->streams[s].quantity)
+                          : J->d->interp - 1;
     }
     racc *acc = J->acc + (size_t)ri * S;
     rtruth *tr = J->truth + ri;
@@ -366,23 +385,8 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
             const float lp[3] = {r->position[0] + w[0] * dl, r->position[1] + w[1] * dl,
                                  r->position[2] + w[2] * dl};
             for (uint32_t s = 0; s < S; s++) {
-                const vdsh_stream *st = &f->streams[s];
                 float D, s_hat, b_hat;
-                if (J->d->oracle || !corners) {
-                    D = J->d->oracle ? dt
-                                     : vdsh_stream_distance(st->order, st->quantity,
-                                                            J->max_distance, coef[s], w);
-                    s_hat = vdsh_shadow_compare(D, dl, VDSH_COMPARE_SMOOTH);
-                    b_hat = vdsh_shadow_compare(D, dl, VDSH_COMPARE_BINARY);
-                } else {
-                    const float *cv[3] = {vc[s][0], vc[s][1], vc[s][2]};
-                    s_hat =
-                        vdsh_shadow_interior(st->order, st->quantity, J->max_distance, interp[s],
-                                             cv, pv, r->bary, lp, VDSH_COMPARE_SMOOTH, &D);
-                    b_hat =
-                        vdsh_shadow_interior(st->order, st->quantity, J->max_distance, interp[s],
-                                             cv, pv, r->bary, lp, VDSH_COMPARE_BINARY, NULL);
-                }
+                stream_shadow(J, &R, r, s, w, lp, dl, dt, &D, &s_hat, &b_hat);
                 const float e = fabsf(D - dt) / floor_;
                 racc *a = acc + s;
                 a->n++;
@@ -403,8 +407,7 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
         }
     }
     if (J->light_count)
-        eval_scene_lights(J, ri, (const float(*)[VDSH_MAX_COEFFS])coef,
-                          (const float(*)[3][VDSH_MAX_COEFFS])vc, pv, interp, corners);
+        eval_scene_lights(J, ri, &R);
 }
 
 static void eval_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
