@@ -17,6 +17,12 @@ add_test(NAME gltf_input
 add_test(NAME gltf_uri
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_gltf_uri.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-export> ${CMAKE_CURRENT_BINARY_DIR}/gltf_uri)
+#   gltf_uri_rule     formats/vdsh_gltf_uri.h byte for byte against
+#                     tinygltf's own dlib::urldecode (hand-picked and
+#                     random URIs)
+add_executable(test_gltf_uri_rule ${CMAKE_CURRENT_SOURCE_DIR}/test_gltf_uri_rule.cpp)
+target_link_libraries(test_gltf_uri_rule PRIVATE vdsh_format)
+add_test(NAME gltf_uri_rule COMMAND test_gltf_uri_rule)
 
 foreach(ext gltf glb)
   _robust_fuzz_target(mesh_${ext} SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_fuzz_mesh.c
