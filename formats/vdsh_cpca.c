@@ -1094,9 +1094,10 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
     if (!have) {
         vdsh_cpca_settings least = {1, 1, bits, 0};
         return vdsh_failf(err, VDSH_ERR_ARGUMENT,
-                          "cpca: auto budget %u bytes per vertex too small for %u rows of order "
+                          "cpca: auto budget %u byte%s per vertex too small for %u row%s of order "
                           "%u (the least model, 1,1,%u, takes %.1f)",
-                          budget, rows, order, bits, (double)fit_bytes(rows, order, &least) / rows);
+                          budget, vdsh_s(budget), rows, vdsh_s(rows), order, bits,
+                          (double)fit_bytes(rows, order, &least) / rows);
     }
     return VDSH_OK;
 }
@@ -1224,9 +1225,10 @@ static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t
     st.basis = largest_basis(rows, order, &st, limit);
     if (!st.basis)
         return vdsh_failf(err, VDSH_ERR_ARGUMENT,
-                          "cpca: alloc budget %u bytes per vertex too small for %u rows of order "
-                          "%u at %u clusters",
-                          settings->budget, rows, order, st.clusters);
+                          "cpca: alloc budget %u byte%s per vertex too small for %u row%s of order "
+                          "%u at %u cluster%s",
+                          settings->budget, vdsh_s(settings->budget), rows, vdsh_s(rows), order,
+                          st.clusters, vdsh_s(st.clusters));
     uint32_t fb = 2 * st.basis < n ? 2 * st.basis : n;
     vdsh_cpca_widths_fit wf;
     return encode_widths(src, normals, rows, order, &st, fb, (double)settings->budget, NULL, NULL,

@@ -83,7 +83,21 @@ static void place(const float c[3], const float u[3][3], float s, float a, float
         out[k] = c[k] + s * (a * u[0][k] + b * u[1][k] + d * u[2][k]);
 }
 
-void vdsh_view_fit_camera(const float lo[3], const float hi[3], vdsh_camera *out)
+/* The fit camera's direction from the centre to the eye: from the side
+ * of the room's eye, from above (unit). */
+static void fit_direction(const float lo[3], const float hi[3], float w[3])
+{
+    float c[3], u[3][3];
+    frame(lo, hi, c, u);
+    place((float[3]){0, 0, 0}, u, 1.0f, 0.8f, 0.45f, 0.4f, w);
+    float n = sqrtf(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    for (int k = 0; k < 3; k++)
+        w[k] /= n;
+}
+
+/* The fit camera looking at the bounds' centre from direction w (unit,
+ * not vertical). */
+static void fit_along(const float lo[3], const float hi[3], const float w[3], vdsh_camera *out)
 {
     float c[3], u[3][3];
     float r = frame(lo, hi, c, u);
@@ -92,15 +106,11 @@ void vdsh_view_fit_camera(const float lo[3], const float hi[3], vdsh_camera *out
     cam.fov_y = 60.0f;
     cam.up[1] = 1.0f;
     memcpy(cam.target, c, sizeof cam.target);
-    /* Seen from the side of the room's eye, from above: w points from the
-     * centre to the eye, s to the right of the image, v up in it. */
-    float w[3], s[3], v[3];
-    place((float[3]){0, 0, 0}, u, 1.0f, 0.8f, 0.45f, 0.4f, w);
-    float n = sqrtf(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    for (int k = 0; k < 3; k++)
-        w[k] /= n;
+    /* w points from the centre to the eye, s to the right of the image, v
+     * up in it. */
+    float s[3], v[3];
     s[0] = w[2], s[1] = 0.0f, s[2] = -w[0]; /* up x w */
-    n = sqrtf(s[0] * s[0] + s[2] * s[2]);
+    float n = sqrtf(s[0] * s[0] + s[2] * s[2]);
     s[0] /= n, s[2] /= n;
     v[0] = w[1] * s[2] - w[2] * s[1];
     v[1] = w[2] * s[0] - w[0] * s[2];
@@ -124,6 +134,13 @@ void vdsh_view_fit_camera(const float lo[3], const float hi[3], vdsh_camera *out
     for (int k = 0; k < 3; k++)
         cam.eye[k] = c[k] + dist * w[k];
     *out = cam;
+}
+
+void vdsh_view_fit_camera(const float lo[3], const float hi[3], vdsh_camera *out)
+{
+    float w[3];
+    fit_direction(lo, hi, w);
+    fit_along(lo, hi, w, out);
 }
 
 int vdsh_view_preferred_lights(const float lo[3], const float hi[3], int interior, float (*out)[3],
@@ -866,6 +883,76 @@ static vdsh_result choose_lights(const vdsh_view_tracer *t, const vdsh_view_mesh
     return VDSH_OK;
 }
 
+/* Whether every vertex lies on one plane (a single triangle, a quad, a
+ * flat panel), within a millionth of the diagonal; then *n is its unit
+ * normal toward the front: the side the vertex normals face on the whole
+ * (the winding normals where those cancel). 0 also when no triangle has
+ * an area or the sides cancel. */
+static int flat_front(const vdsh_view_mesh *m, float diag, float n[3])
+{
+    /* the plane of the triangle of largest area */
+    double best = 0.0, pn[3] = {0, 0, 0};
+    const float *p0 = NULL;
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const float *a = m->positions + 3 * (size_t)m->indices[3 * (size_t)t];
+        const float *b = m->positions + 3 * (size_t)m->indices[3 * (size_t)t + 1];
+        const float *c = m->positions + 3 * (size_t)m->indices[3 * (size_t)t + 2];
+        double e1[3], e2[3], x[3];
+        for (int k = 0; k < 3; k++)
+            e1[k] = (double)b[k] - a[k], e2[k] = (double)c[k] - a[k];
+        x[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        x[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        x[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        double l = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        if (l > best) {
+            best = l;
+            for (int k = 0; k < 3; k++)
+                pn[k] = x[k] / l;
+            p0 = a;
+        }
+    }
+    if (!p0)
+        return 0;
+    double side = 0.0, wind = 0.0;
+    for (uint32_t i = 0; i < m->vertex_count; i++) {
+        const float *q = m->positions + 3 * (size_t)i;
+        double d = 0.0;
+        for (int k = 0; k < 3; k++)
+            d += ((double)q[k] - p0[k]) * pn[k];
+        if (fabs(d) > 1e-6 * diag)
+            return 0;
+        if (m->normals)
+            for (int k = 0; k < 3; k++)
+                side += (double)m->normals[3 * (size_t)i + (size_t)k] * pn[k];
+    }
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        const float *a = m->positions + 3 * (size_t)m->indices[3 * (size_t)t];
+        const float *b = m->positions + 3 * (size_t)m->indices[3 * (size_t)t + 1];
+        const float *c = m->positions + 3 * (size_t)m->indices[3 * (size_t)t + 2];
+        double e1[3], e2[3];
+        for (int k = 0; k < 3; k++)
+            e1[k] = (double)b[k] - a[k], e2[k] = (double)c[k] - a[k];
+        wind += (e1[1] * e2[2] - e1[2] * e2[1]) * pn[0] + (e1[2] * e2[0] - e1[0] * e2[2]) * pn[1] +
+                (e1[0] * e2[1] - e1[1] * e2[0]) * pn[2];
+    }
+    double sign = side != 0.0 ? side : wind;
+    if (sign == 0.0)
+        return 0;
+    for (int k = 0; k < 3; k++)
+        n[k] = (float)(sign > 0.0 ? pn[k] : -pn[k]);
+    return 1;
+}
+
+/* x mirrored through the plane through c with unit normal n. */
+static void mirror(float x[3], const float c[3], const float n[3])
+{
+    float d = 0.0f;
+    for (int k = 0; k < 3; k++)
+        d += (x[k] - c[k]) * n[k];
+    for (int k = 0; k < 3; k++)
+        x[k] -= 2.0f * d * n[k];
+}
+
 vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_error *err)
 {
     vdsh_view_tracer *t = NULL;
@@ -878,17 +965,34 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
     const float *lo = v.bounds_min, *hi = v.bounds_max;
     v.front_share = vdsh_view_front_share(t, m, lo, hi);
     v.interior = v.front_share >= VDSH_VIEW_INTERIOR_SHARE;
-    if (v.interior)
-        vdsh_view_room_camera_free(t, lo, hi, &v.camera);
-    else
-        vdsh_view_fit_camera(lo, hi, &v.camera);
-
     float diag = 0.0f;
     for (int k = 0; k < 3; k++)
         diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
     diag = sqrtf(diag) > 0.0f ? sqrtf(diag) : 1.0f;
+    /* A flat object's fit camera on its back side (a triangle facing away
+     * from the fixed direction): the view mirrored through the plane, eye
+     * and lights alike, so that it sees the front lit as the fit view
+     * would. Nearly vertical once mirrored: the eye along the normal. */
+    float fn[3], w[3], c[3];
+    int flip = 0;
+    if (!v.interior) {
+        fit_direction(lo, hi, w);
+        if (flat_front(m, diag, fn) && w[0] * fn[0] + w[1] * fn[1] + w[2] * fn[2] < 0.0f) {
+            flip = 1;
+            mirror(w, (float[3]){0, 0, 0}, fn);
+            if (w[0] * w[0] + w[2] * w[2] < 0.01f)
+                memcpy(w, fn, sizeof w);
+        }
+        fit_along(lo, hi, w, &v.camera);
+    } else {
+        vdsh_view_room_camera_free(t, lo, hi, &v.camera);
+    }
     v.light_count =
         vdsh_view_preferred_lights(lo, hi, v.interior, v.preferred, VDSH_VIEW_MAX_LIGHTS);
+    for (int k = 0; k < 3; k++)
+        c[k] = 0.5f * (lo[k] + hi[k]);
+    for (int i = 0; flip && i < v.light_count; i++)
+        mirror(v.preferred[i], c, fn);
     for (int i = 0; i < v.light_count; i++) {
         v.light_free[i] =
             find_free(t, v.preferred[i], lo, hi, v.interior, diag, &v.light_trials, v.lights[i]);

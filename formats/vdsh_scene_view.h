@@ -16,7 +16,10 @@
  * triangles (vdsh_view_front_share): the scene is an interior when at
  * least VDSH_VIEW_INTERIOR_SHARE of them first meet the front of a
  * surface, the side its vertex normals face. Anything else is framed from
- * outside (vdsh_view_fit_camera).
+ * outside (vdsh_view_fit_camera); a flat object (every vertex on one
+ * plane: a single triangle, a panel) from the side its normals face, the
+ * fit view mirrored through its plane, lights too, where the fit
+ * direction meets its back.
  *
  * Default lights: preferred positions from the bounds alone
  * (vdsh_view_preferred_lights: a room's spread through it, an object's
@@ -115,7 +118,13 @@ typedef struct vdsh_view {
 } vdsh_view;
 
 /* Everything above from the mesh: bounds, the interior test, the default
- * camera, the default lights. A preferred light position in free space is
+ * camera, the default lights. A flat object (all vertices within a
+ * millionth of the diagonal of the plane of its largest triangle) whose
+ * front (the side the summed vertex normals face; the winding's where
+ * they cancel) faces away from the fit camera's direction w: the camera
+ * is fitted along w mirrored through the plane (along the plane's normal
+ * where that is within about 6 degrees of vertical), and the preferred
+ * lights are mirrored through the plane through the bounds' centre. A preferred light position in free space is
  * kept. Otherwise the candidates p + k h d are tried, rings k = 1, 2, ...
  * of step h = half the clearance (vdsh_free_clearance of the bounds'
  * diagonal), up to half the diagonal, d each of the 26 directions toward

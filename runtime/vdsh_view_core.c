@@ -40,7 +40,7 @@ const vv_mode vv_modes[] = {
     {"vdsh3", "vdsh3", VR_MODE_VDSH3, 0, 0, OPT | FRM | DEF | BEN, 4, '4'},
     {"vdsh5", "vdsh5", VR_MODE_VDSH5, 0, 0, OPT | FRM | DEF | BEN, 3, '5'},
     {"vdsh5poly", "vdsh5poly", VR_MODE_VDSH5_POLY, 0, 0, OPT | FRM | DEF | BEN, 3, '6'},
-    {"sdf", "sdf", VR_MODE_SDF, 0, 0, OPT | FRM | BEN, 7, 0},
+    {"sdf", "sdf", VR_MODE_SDF, 0, 0, OPT | FRM | BEN, 8, 0},
     BUF(1, 0),
     BUF(2, 0),
     BUF(3, 0),
@@ -57,8 +57,9 @@ const vv_mode vv_modes[] = {
     BUF(14, LOG),
     BUF(15, LOG),
     BUF(16, LOG),
-    {"adaptive", "adaptive", VR_MODE_VDSH_BUFFER, 0, VR_STREAM_VARIABLE, OPT | FRM | LOG, 6, 0},
-    {"buffer", "buffer", VR_MODE_VDSH_BUFFER, 0, 0, OPT, 0, '7'},
+    {"adaptive", "adaptive", VR_MODE_VDSH_BUFFER, 0, VR_STREAM_VARIABLE, OPT | FRM | LOG, 7, 0},
+    /* its grid column: the highest fixed stream no other column draws */
+    {"buffer", "buffer", VR_MODE_VDSH_BUFFER, 0, 0, OPT, 6, '7'},
     {NULL, NULL, VR_MODE_DEFAULT, 0, 0, 0, 0, 0}};
 #undef BUF
 

@@ -64,12 +64,15 @@ static void bake_label(const char *path, const vr_scene *s, char *out, size_t si
              vdsh_quantity_name(info.quantity));
 }
 
-/* The grid's columns (vv_mode.grid): the paper's row, then adaptive
- * order (kept only when some scene has a stream with an order per
- * vertex), then distance-field shadows (kept only when some scene has a
- * volume). The summary line describes the first VDSH column the file
- * has (summary_mode). */
-enum { GRID_MAX_COLS = 16, GRID_PAPER_COLS = 5, GRID_ORDER5_COL = 3 };
+/* The grid's columns (vv_mode.grid): the paper's row (an order the file
+ * holds only as a buffer, a cpca stream, drawn from it), then the file's
+ * highest fixed stream of another order (1, 4, above 5: drawn from its
+ * buffer), adaptive order (kept only when some scene has a stream with an
+ * order per vertex), then distance-field shadows (kept only when some
+ * scene has a volume); the buffer column is kept only when some scene
+ * has such a stream. The summary line describes the first VDSH column
+ * the file has (summary_mode). */
+enum { GRID_MAX_COLS = 16, GRID_PAPER_COLS = 5, GRID_ORDER5_COL = 3, GRID_BUFFER_COL = 6 };
 
 /* The number of columns: the highest vv_mode.grid. */
 static int grid_columns(void)
@@ -80,48 +83,73 @@ static int grid_columns(void)
     return n < GRID_MAX_COLS ? n : GRID_MAX_COLS;
 }
 
+/* The bufK mode (the order-K stream from its buffer); NULL if none. */
+static const vv_mode *buf_mode(int k)
+{
+    for (int i = 0; vv_modes[i].name; i++)
+        if (vv_modes[i].mode == VR_MODE_VDSH_BUFFER && vv_modes[i].stream == k)
+            return &vv_modes[i];
+    return NULL;
+}
+
+/* Whether the scene has the grid mode m: the buffer column's own entry
+ * ("buffer", stream 0: any stream) stands for none. */
+static int grid_has(const vr_scene *s, const vv_mode *m)
+{
+    return !(m->mode == VR_MODE_VDSH_BUFFER && m->stream == 0) && vv_mode_available(s, m);
+}
+
 /* The mode of column c (1..) for this scene: the first of its rows the
- * scene has, else the last. Order 5 the paper's way when the cubemaps
- * are there, else with the polynomials (the same image to f16
- * precision); a log-distance scene draws both per vertex. */
+ * scene has; else, in a VDSH order column, that order's buffer (a cpca
+ * stream); in the buffer column, the highest fixed order that neither
+ * the paper's columns (2, 3, 5) draw; else the last row. Order 5 the
+ * paper's way when the cubemaps are there, else with the polynomials (the
+ * same image to f16 precision); a log-distance scene draws both per
+ * vertex. */
 static const vv_mode *grid_mode(const vr_scene *s, int c)
 {
     const vv_mode *last = NULL;
     for (int i = 0; vv_modes[i].name; i++)
         if (vv_modes[i].grid == c) {
-            if (vv_mode_available(s, &vv_modes[i]))
+            if (grid_has(s, &vv_modes[i]))
                 return &vv_modes[i];
             last = &vv_modes[i];
         }
+    if (!last)
+        return NULL;
+    int order = last->mode == VR_MODE_VDSH2                                       ? 2
+                : last->mode == VR_MODE_VDSH3                                     ? 3
+                : last->mode == VR_MODE_VDSH5 || last->mode == VR_MODE_VDSH5_POLY ? 5
+                                                                                  : 0;
+    const vv_mode *b = order ? buf_mode(order) : NULL;
+    if (b && grid_has(s, b))
+        return b;
+    for (int k = VDSH_MAX_ORDER; c == GRID_BUFFER_COL && k >= 1; k--)
+        if (k != 2 && k != 3 && k != 5 && (b = buf_mode(k)) && grid_has(s, b))
+            return b;
     return last;
 }
 
 /* The mode the grid's summary line describes: the first of the VDSH
- * columns (orders 5, 3, 2) the file has; else its adaptive stream's, with
- * that stream's method, as bake_label names it; else its highest fixed
- * order's (a file with none of the paper's orders). */
+ * columns (orders 5, 3, 2, the buffer column) the file has; else its
+ * adaptive stream's, with that stream's method, as bake_label names it. */
 static void summary_mode(const vr_scene *s, char *out, size_t size)
 {
-    for (int c = GRID_ORDER5_COL; c <= GRID_PAPER_COLS; c++) {
+    for (int c = GRID_ORDER5_COL; c <= GRID_BUFFER_COL; c++) {
         const vv_mode *m = grid_mode(s, c);
-        if (vv_mode_available(s, m)) {
-            snprintf(out, size, "%s", vr_scene_mode_label(s, m->mode));
+        if (grid_has(s, m)) {
+            vv_mode_label(s, m->mode, m->stream, out, size);
             return;
         }
     }
     vr_scene_info info;
     vr_scene_get_info(s, &info);
     char label[160];
-    if (info.variable_order) {
-        vv_mode_label(s, VR_MODE_VDSH_BUFFER, VR_STREAM_VARIABLE, label, sizeof label);
+    vv_mode_label(s, VR_MODE_VDSH_BUFFER, VR_STREAM_VARIABLE, label, sizeof label);
+    if (info.variable_order)
         snprintf(out, size, "%s, %s", label, vdsh_method_name(info.variable_method));
-        return;
-    }
-    int top = 0;
-    for (int k = 1; k <= VDSH_MAX_ORDER; k++)
-        top = info.has_order[k] || info.has_buffer[k] ? k : top;
-    vv_mode_label(s, VR_MODE_VDSH_BUFFER, top, label, sizeof label);
-    snprintf(out, size, "%s", label);
+    else
+        snprintf(out, size, "no VDSH stream");
 }
 
 /* One row of the grid: the panels of one scene into row (cols panels w
@@ -147,7 +175,7 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
         vv_scene_camera(scene, o, &d.camera);
         char label[320];
         int shadow = o->shadow_size ? o->shadow_size : VR_DEFAULT_SHADOW_MAP_SIZE;
-        have[m] = vv_mode_available(scene, e);
+        have[m] = grid_has(scene, e);
         if (m < GRID_PAPER_COLS || have[m])
             snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", m ? " | " : "",
                      e->name);
@@ -155,7 +183,9 @@ static int grid_row(const vv_options *o, const char *path, vr_renderer *r, int w
             snprintf(label, sizeof label, "cube shadow map (%d^2 x 6, %s)", shadow,
                      o->pcf ? "PCF" : "1 tap");
         else if (e->mode == VR_MODE_VDSH_BUFFER && !have[m])
-            snprintf(label, sizeof label, "VDSH adaptive order");
+            snprintf(label, sizeof label, "%s",
+                     e->stream == VR_STREAM_VARIABLE ? "VDSH adaptive order"
+                                                     : "VDSH order 1, 4 or above 5");
         else if (e->mode == VR_MODE_SDF)
             snprintf(label, sizeof label, "%s, k %g", vr_mode_label(VR_MODE_SDF),
                      (double)(o->sdf_k > 0.0f ? o->sdf_k : VDSH_SDF_DEFAULT_K));

@@ -1,3 +1,4 @@
+#!/usr/bin/python3
 """obj_to_glb.py IN.obj OUT.glb - the OBJ that vdsh-bake --export-obj writes
 (v, vn, f v//vn triangles, one normal per vertex) as a .glb with the same
 vertices, normals and triangles (for scripts/bench_gltf_load)."""

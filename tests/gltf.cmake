@@ -11,6 +11,19 @@ add_test(NAME gltf_input
                  $<TARGET_FILE:vdsh-bake> ${CMAKE_CURRENT_BINARY_DIR}/gltf_input ${VDSH_ASSIMP_MODELS}
                  $<TARGET_FILE:vdsh-eval> $<TARGET_FILE:vdsh-info>)
 
+#   gltf_uri          a buffer URI with %20 and '+' names the same file in
+#                     vdsh-bake and vdsh-export --source (tinygltf's rule,
+#                     formats/vdsh_gltf_uri.h); missing or "%00": refused
+add_test(NAME gltf_uri
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_gltf_uri.py
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-export> ${CMAKE_CURRENT_BINARY_DIR}/gltf_uri)
+#   gltf_uri_rule     formats/vdsh_gltf_uri.h byte for byte against
+#                     tinygltf's own dlib::urldecode (hand-picked and
+#                     random URIs)
+add_executable(test_gltf_uri_rule ${CMAKE_CURRENT_SOURCE_DIR}/test_gltf_uri_rule.cpp)
+target_link_libraries(test_gltf_uri_rule PRIVATE vdsh_format)
+add_test(NAME gltf_uri_rule COMMAND test_gltf_uri_rule)
+
 foreach(ext gltf glb)
   _robust_fuzz_target(mesh_${ext} SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/test_fuzz_mesh.c
                       LIBS vb_mesh m DEFS VDSH_FUZZ_EXT="${ext}")

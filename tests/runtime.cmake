@@ -497,10 +497,12 @@ expect 2 "positive count" --frames "$d/x" "$room"
 
 # The buffer modes on the command line: a file with orders 7, 9, 12 and an
 # order per vertex (test_runtime_buffer derive); the grid gains its
-# adaptive-order column (6 panels) and says so; --help names the modes;
-# a file of adaptive order alone draws its buffer and its grid row and
+# buffer column (| buf12) and adaptive-order column (7 panels) and says
+# so; --help names the modes; a file of adaptive order alone draws its buffer and its grid row and
 # summary line name its method; files of fixed orders without order 5
-# name their method and their first order in the summary line.
+# name their method and their first order in the summary line; an order
+# other than 2, 3, 5 gets the buffer column (| bufN), a cpca order 5 the
+# order-5 column.
 add_test(NAME runtime_view_buffer COMMAND sh -c [=[
 set -e
 v=$1; png=$2; derive=$3; log=$4; d=$5
@@ -515,12 +517,13 @@ cat "$d/render.log"
 grep -q "VDSH adaptive order (up to 11, mean 6.0" "$d/render.log"
 "$v" --grid "$d/grid.png" --size 96x72 "$d/high.vdsh" "$log" 2> "$d/grid.log"
 cat "$d/grid.log"
-"$png" info "$d/grid.png" 576 144
-grep -q "| adaptive" "$d/grid.log"
+"$png" info "$d/grid.png" 672 144
+grep -q "| buf12 | adaptive" "$d/grid.log"
 "$v" --grid "$d/grid5.png" --size 96x72 "$log" 2> /dev/null
 "$png" info "$d/grid5.png" 480 72
 "$v" --help | grep -q "bufN the stream of order N"
 "$v" --help | grep -q "adaptive-order column\|| adaptive order"
+"$v" --help | grep -q "| bufN when a SCENE has a fixed order"
 # A bake of adaptive order alone: the default mode is the buffer's
 "$6" builtin:room --max-edge 1.0 --rays 256 --adaptive-order 0.05 --max-order 9 -q \
   -o "$d/adaptive.vdsh"
@@ -548,7 +551,18 @@ grep -q "vdsh2 (VDSH order 3 (9 coeff" "$d/o3grid.log"
 "$v" --grid "$d/o7grid.png" --size 96x72 "$d/o7.vdsh" 2> "$d/o7grid.log"
 cat "$d/o7grid.log"
 grep -q "o7.vdsh: shadow bake" "$d/o7grid.log"
-grep -q "vdsh2 (VDSH order 7 (49 coeff" "$d/o7grid.log"
+# drawn in a column of its own, the summary line describing that column
+# (before: no panel drew order 7)
+grep -q "vdsh2 | buf7 (VDSH order 7 (49 coeff" "$d/o7grid.log"
+"$png" info "$d/o7grid.png" 576 72
+# cpca order 5 alone (a buffer): drawn in the order-5 column, not "not in
+# this file" beside a summary that names order 5
+"$6" builtin:room --max-edge 1.0 --rays 256 --orders 5 --encoding cpca --cpca auto -q \
+  -o "$d/c5.vdsh"
+"$v" --grid "$d/c5grid.png" --size 96x72 "$d/c5.vdsh" 2> "$d/c5grid.log"
+cat "$d/c5grid.log"
+grep -q "none | cube | buf5 | vdsh3 | vdsh2 (VDSH order 5 (25 coeff" "$d/c5grid.log"
+"$png" info "$d/c5grid.png" 480 72
 ]=] sh ${_view} ${_png} $<TARGET_FILE:test_runtime_buffer> ${_room_log} ${_rt_dir}/view_buffer
        $<TARGET_FILE:vdsh-bake>)
 

@@ -63,7 +63,7 @@ for bad in auto:0 auto:x auto: auto:4097 auto:-3 autox; do
   says_any "--cpca $bad" "or auto or auto:BYTES"
 done
 expect_exit 1 "a budget nothing fits" "$bake" "${tiny[@]}" --encoding cpca --cpca auto:1 -o "$out"
-says_any "auto:1 refused" "auto budget 1 bytes per vertex too small"
+says_any "auto:1 refused" "auto budget 1 byte per vertex too small"
 expect_exit 1 "merge refuses parts of two budgets" "$merge" -q "$d/p0.vdsh" "$d/p1.vdsh" \
   "$tmp/a32-2.vdsh" -o "$out"
 says_any "merge of two budgets" "another --cpca"

@@ -412,7 +412,8 @@ if not os.path.exists(fifo):
 with open(os.path.join(work, "fifo-buffer.gltf"), "w") as fh:
     json.dump({"asset": {"version": "2.0"}, "buffers": [{"uri": "fifo.glb", "byteLength": 12}]}, fh)
 for src, want in ((missing, "No such file"), (fifo, "not a regular file"), (work, "is a directory"),
-                  (os.path.join(work, "fifo-buffer.gltf"), "buffer 0 (fifo.glb) cannot be read: not a regular file")):
+                  (os.path.join(work, "fifo-buffer.gltf"),
+                   "buffer 0 (fifo.glb) cannot be read: %s: not a regular file" % os.path.join(work, "fifo.glb"))):
     try:
         p = subprocess.run([export, tiny, "--source", src, "-o", out], capture_output=True, text=True, timeout=60)
         if p.returncode != 1 or src not in p.stderr or want not in p.stderr or os.path.exists(out):

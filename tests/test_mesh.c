@@ -535,6 +535,14 @@ static void test_load_obj(void)
          "face corner '2//0': normal index 0 out of range"},
         {"word_vn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//n 2 3\n", VB_ERR_FORMAT,
          "face corner '1//n': normal index 'n' is not a number"},
+        /* a fourth '/' field: said as such (before: "normal index '1/1' is
+         * not a number") */
+        {"four_fields.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/1/1 2 3\n",
+         VB_ERR_FORMAT,
+         "four_fields.obj: line 6: face corner '1/1/1/1' has too many '/' fields (4; at most 3: "
+         "v/vt/vn)"},
+        {"trailing_field.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1 2//1/ 3\n", VB_ERR_FORMAT,
+         "line 5: face corner '2//1/' has too many '/' fields (4;"},
     };
     expect_bad_files("", bad, sizeof bad / sizeof bad[0]);
     /* texture coordinates in range (one pointing forward), or none */

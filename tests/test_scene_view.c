@@ -12,6 +12,8 @@
  *              preferred light inside a pillar moves into free space
  *              nearby, the others stay where they were
  *     object   a sphere is framed from outside, lit from outside it
+ *     flat     a single triangle facing any way (and a flat quad): the
+ *              default camera sees its front, all of it, a light there
  *     none     a scene with no free space keeps the preferred lights and
  *              says they are not free
  *     two-rooms  an internal wall with a door, the camera in one room:
@@ -366,6 +368,97 @@ static void test_object(void)
     }
 }
 
+/* A point seen by camera c: in front of it and within 30 degrees of its
+ * axis up, down and to the sides (fov_y 60, an image at least square). */
+static int in_view(const vdsh_camera *c, const float p[3])
+{
+    float s[3], u[3], f[3], d[3];
+    vdsh_camera_basis(c, s, u, f);
+    for (int k = 0; k < 3; k++)
+        d[k] = p[k] - c->eye[k];
+    float z = d[0] * f[0] + d[1] * f[1] + d[2] * f[2];
+    float x = d[0] * s[0] + d[1] * s[1] + d[2] * s[2];
+    float y = d[0] * u[0] + d[1] * u[1] + d[2] * u[2];
+    float t = tanf(30.0f * 3.14159265f / 180.0f) * 1.0001f;
+    return z > 0.0f && fabsf(x) <= t * z && fabsf(y) <= t * z;
+}
+
+static float side_of(const float p[3], const float o[3], const float n[3])
+{
+    return (p[0] - o[0]) * n[0] + (p[1] - o[1]) * n[1] + (p[2] - o[2]) * n[2];
+}
+
+/* A flat object, one triangle facing any way (axis-aligned both ways,
+ * tilted both ways) or a quad whose second triangle is wound the other
+ * way (its normals still say the front): the default camera sees the
+ * side the normals face, the whole object in view, and a light on that
+ * side. (The fit camera's fixed direction saw a triangle facing away
+ * from it from behind.) */
+static void test_flat(void)
+{
+    static const float dirs[][3] = {{0, 0, 1},  {0, 0, -1}, {1, 0, 0},    {-1, 0, 0},  {0, 1, 0},
+                                    {0, -1, 0}, {1, 2, 3},  {-1, -2, -3}, {-3, 1, -2}, {3, -1, 2}};
+    const float o[3] = {3, 1, -2};
+    for (size_t i = 0; i < sizeof dirs / sizeof dirs[0] + 1; i++) {
+        int is_quad = i == sizeof dirs / sizeof dirs[0];
+        float n[3], t1[3], t2[3];
+        memcpy(n, dirs[is_quad ? 1 : i], sizeof n);
+        float l = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int k = 0; k < 3; k++)
+            n[k] /= l;
+        /* t1 across n, t2 = n x t1: a t1 t2 counter-clockwise seen from n */
+        float a[3] = {fabsf(n[0]) < 0.9f ? 1.0f : 0.0f, fabsf(n[0]) < 0.9f ? 0.0f : 1.0f, 0};
+        t1[0] = a[1] * n[2] - a[2] * n[1];
+        t1[1] = a[2] * n[0] - a[0] * n[2];
+        t1[2] = a[0] * n[1] - a[1] * n[0];
+        l = sqrtf(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]);
+        for (int k = 0; k < 3; k++)
+            t1[k] /= l;
+        t2[0] = n[1] * t1[2] - n[2] * t1[1];
+        t2[1] = n[2] * t1[0] - n[0] * t1[2];
+        t2[2] = n[0] * t1[1] - n[1] * t1[0];
+        memset(&M, 0, sizeof M);
+        float p[4][3];
+        for (int k = 0; k < 3; k++) {
+            p[0][k] = o[k];
+            p[1][k] = o[k] + 2.0f * t1[k];
+            p[2][k] = o[k] + 2.0f * t1[k] + t2[k];
+            p[3][k] = o[k] + t2[k];
+        }
+        if (is_quad) {
+            quad(&M, p[0], p[1], p[2], p[3]);
+            uint32_t swap = M.idx[1][1];
+            M.idx[1][1] = M.idx[1][2];
+            M.idx[1][2] = swap;
+        } else {
+            static const int corner[3] = {0, 1, 3};
+            for (int v = 0; v < 3; v++) {
+                memcpy(M.pos[v], p[corner[v]], sizeof p[0]);
+                memcpy(M.nrm[v], n, sizeof n);
+                M.idx[0][v] = (uint32_t)v;
+            }
+            M.nv = 3, M.nt = 1;
+        }
+        vdsh_view_mesh m = view_mesh(&M);
+        vdsh_view v;
+        vdsh_error err;
+        CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
+        CHECK(!v.interior, "flat %zu: an interior", i);
+        CHECK(side_of(v.camera.eye, o, n) > 0.0f,
+              "flat %zu (normal %g %g %g): the camera sees the back (eye %g %g %g)", i,
+              (double)n[0], (double)n[1], (double)n[2], (double)v.camera.eye[0],
+              (double)v.camera.eye[1], (double)v.camera.eye[2]);
+        CHECK(!vdsh_camera_degenerate(&v.camera), "flat %zu: a degenerate camera", i);
+        for (int k = 0; k < 4; k++)
+            CHECK(k == 2 && !is_quad ? 1 : in_view(&v.camera, p[k]),
+                  "flat %zu: corner %d out of view", i, k);
+        int front = 0;
+        for (int k = 0; k < v.light_count; k++)
+            front += side_of(v.lights[k], o, n) > 0.0f;
+        CHECK(front > 0, "flat %zu: no light on the front side", i);
+    }
+}
+
 /* A sphere scaled by s: the view of a scene at any scale the view's float
  * arithmetic takes, a clear error beyond it (a scene 1e19 across crashed
  * the ray grid; 1e-20 across gave a light with infinite attenuation). */
@@ -682,6 +775,7 @@ int main(int argc, char **argv)
     test_space();
     test_room();
     test_object();
+    test_flat();
     test_scale();
     test_none();
     test_two_rooms();

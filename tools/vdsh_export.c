@@ -336,16 +336,17 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
                            : !strcasecmp(dot, ".png")                                ? "image/png"
                            : (!strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg")) ? "image/jpeg"
                                                                                      : NULL;
-        char *p = vdsh_src_file(&src, uri->valuestring);
-        if (!p)
+        const char *why = "cannot be read";
+        char *p = vdsh_src_file(&src, uri->valuestring, &why);
+        if (!p && strcmp(why, "out of memory") == 0)
             goto oom;
-        FILE *fp = fopen(p, "rb");
+        FILE *fp = p ? fopen(p, "rb") : NULL;
         free(p);
         if (!fp || !mime) {
             if (fp)
                 fclose(fp);
             fprintf(stderr, "vdsh-export: %s: image %s %s: kept as a URI relative to the output\n",
-                    path, uri->valuestring, fp ? "is neither PNG nor JPEG" : "cannot be read");
+                    path, uri->valuestring, fp ? "is neither PNG nor JPEG" : why);
             continue;
         }
         if (blob_align4(b)) {

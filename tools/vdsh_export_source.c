@@ -5,6 +5,7 @@
  */
 #include "vdsh_export_source.h"
 #include "vdsh_gltf_component.h"
+#include "vdsh_gltf_uri.h"
 #include "vdsh_math.h"
 
 #include <errno.h>
@@ -80,17 +81,6 @@ static int b64(int c)
     return -1;
 }
 
-static int hex(int c)
-{
-    if (c >= '0' && c <= '9')
-        return c - '0';
-    if (c >= 'a' && c <= 'f')
-        return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F')
-        return c - 'A' + 10;
-    return -1;
-}
-
 /* A data: URI's base64 payload; NULL when it is not base64. */
 static uint8_t *data_uri(const char *uri, size_t *size)
 {
@@ -122,24 +112,20 @@ static uint8_t *data_uri(const char *uri, size_t *size)
     return d;
 }
 
-char *vdsh_src_file(const vdsh_src *s, const char *uri)
+char *vdsh_src_file(const vdsh_src *s, const char *uri, const char **why)
 {
     size_t n = strlen(uri), d = strlen(s->dir);
     char *p = malloc(d + n + 1);
-    if (!p)
+    if (!p) {
+        *why = "out of memory";
         return NULL;
-    memcpy(p, s->dir, d);
-    char *o = p + d;
-    for (size_t i = 0; i < n; i++) {
-        int hi = i + 2 < n ? hex(uri[i + 1]) : -1, lo = i + 2 < n ? hex(uri[i + 2]) : -1;
-        if (uri[i] == '%' && hi >= 0 && lo >= 0 && (hi | lo)) {
-            *o++ = (char)(hi << 4 | lo);
-            i += 2;
-        } else {
-            *o++ = uri[i];
-        }
     }
-    *o = 0;
+    memcpy(p, s->dir, d);
+    if (vdsh_gltf_uri_decode(uri, n, p + d) != strlen(p + d)) {
+        *why = "its uri decodes to a NUL byte, which no file name holds";
+        free(p);
+        return NULL;
+    }
     return p;
 }
 
@@ -200,6 +186,7 @@ int vdsh_src_load(const char *path, vdsh_src *s, char *msg, size_t cap)
         double want = cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(b, "byteLength"));
         vdsh_src_buffer *sb = &s->buffers[i];
         const char *bwhy = "not decoded";
+        char *file = NULL;
         if (!cJSON_IsString(uri)) {
             if (i != 0 || !bin) {
                 fail(msg, cap, "%s: buffer %d has no uri and is not the glb's BIN chunk", path, i);
@@ -211,17 +198,23 @@ int vdsh_src_load(const char *path, vdsh_src *s, char *msg, size_t cap)
         } else if (strncmp(uri->valuestring, "data:", 5) == 0) {
             sb->data = data_uri(uri->valuestring, &sb->size);
         } else {
-            char *p = vdsh_src_file(s, uri->valuestring);
-            if (p) {
-                sb->data = slurp(p, &sb->size, &bwhy);
-                free(p);
-            }
+            file = vdsh_src_file(s, uri->valuestring, &bwhy);
+            if (file)
+                sb->data = slurp(file, &sb->size, &bwhy);
         }
         if (!sb->data) {
-            fail(msg, cap, "%s: buffer %d (%s) cannot be read: %s", path, i,
-                 cJSON_IsString(uri) ? uri->valuestring : "BIN chunk", bwhy);
+            /* the file too, as the URI decodes to it ("a%20b+c.bin" is
+             * "a b c.bin", tinygltf's rule) */
+            if (file)
+                fail(msg, cap, "%s: buffer %d (%s) cannot be read: %s: %s", path, i,
+                     uri->valuestring, file, bwhy);
+            else
+                fail(msg, cap, "%s: buffer %d (%s) cannot be read: %s", path, i,
+                     cJSON_IsString(uri) ? uri->valuestring : "BIN chunk", bwhy);
+            free(file);
             goto out;
         }
+        free(file);
         if (!(want >= 0) || want > (double)sb->size) {
             fail(msg, cap, "%s: buffer %d is %zu bytes, shorter than its byteLength %.0f", path, i,
                  sb->size, want);

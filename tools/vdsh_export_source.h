@@ -46,9 +46,10 @@ typedef struct vdsh_src_prim {
 } vdsh_src_prim;
 
 /* The file a relative URI of the source names: its directory plus the URI
- * percent-decoded (RFC 3986, as glTF URIs are written: "a%20b.bin" is
- * "a b.bin"; %00 is kept as it is); malloc'ed, NULL when out of memory. */
-char *vdsh_src_file(const vdsh_src *s, const char *uri);
+ * decoded as the baker (tinygltf) decodes it, formats/vdsh_gltf_uri.h:
+ * "a%20b+c.bin" is "a b c.bin". Malloc'ed; NULL with *why when out of
+ * memory or when the URI decodes to a NUL byte ("%00"). */
+char *vdsh_src_file(const vdsh_src *s, const char *uri, const char **why);
 
 int vdsh_src_load(const char *path, vdsh_src *s, char *msg, size_t cap);
 void vdsh_src_free(vdsh_src *s);

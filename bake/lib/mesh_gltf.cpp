@@ -40,6 +40,7 @@
 
 #include "mesh_read.h"
 #include "vdsh_gltf_component.h"
+#include "vdsh_gltf_uri.h"
 #include "vdsh_math.h"
 
 namespace
@@ -435,42 +436,34 @@ struct files {
      * never uses images; a no-op image loader alone still had every
      * image file read into memory first) */
     std::vector<std::string> images;
+    /* a path held a NUL byte (a URI's "%00"): refused, not read as the
+     * file its bytes before the NUL name */
+    bool nul;
 };
 
 bool file_exists(const std::string &path, void *user)
 {
-    const files *fs = (const files *)user;
+    files *fs = (files *)user;
     const std::string &dir = fs->dir;
     const std::string base = !dir.empty() && dir.back() == '/' ? dir : dir + "/";
     for (const std::string &im : fs->images)
         if (path == im)
             return false;
+    if (path.find('\0') != std::string::npos) {
+        fs->nul = true;
+        return false;
+    }
     struct stat st;
     return path.compare(0, base.size(), base) == 0 && stat(path.c_str(), &st) == 0;
 }
 
-/* tinygltf's dlib::urldecode, which it applies to a URI before joining it
- * to the base directory */
+/* The file name a URI names, as tinygltf decodes it before joining it to
+ * the base directory (formats/vdsh_gltf_uri.h, which vdsh-export --source
+ * uses too); any NUL byte kept, as in tinygltf's path. */
 std::string url_decode(const std::string &u)
 {
-    auto hex = [](char c) -> int {
-        return c >= '0' && c <= '9'   ? c - '0'
-               : c >= 'a' && c <= 'f' ? c - 'a' + 10
-               : c >= 'A' && c <= 'F' ? c - 'A' + 10
-                                      : 0;
-    };
-    std::string r;
-    for (size_t i = 0; i < u.size(); i++) {
-        if (u[i] == '+') {
-            r += ' ';
-        } else if (u[i] == '%' && u.size() > i + 2) {
-            r += (char)((hex(u[i + 1]) << 4) | hex(u[i + 2]));
-            i += 2;
-        } else {
-            r += u[i];
-        }
-    }
-    return r;
+    std::vector<char> r(u.size() + 1);
+    return std::string(r.data(), vdsh_gltf_uri_decode(u.data(), u.size(), r.data()));
 }
 
 bool read_whole_file(std::vector<unsigned char> *out, std::string *err, const std::string &path,
@@ -533,6 +526,23 @@ nlohmann::json file_json(int binary, const uint8_t *bytes, size_t size)
         n = len;
     }
     return nlohmann::json::parse(j, j + n, nullptr, false);
+}
+
+/* The first buffer URI that decodes to a NUL byte ("%00"; empty when
+ * none): tinygltf would read the file named by the bytes before it. */
+std::string nul_buffer_uri(int binary, const uint8_t *bytes, size_t size)
+{
+    nlohmann::json doc = file_json(binary, bytes, size);
+    auto it = doc.is_object() ? doc.find("buffers") : doc.end();
+    if (it == doc.end() || !it->is_array())
+        return std::string();
+    for (const auto &x : *it)
+        if (x.is_object() && x.contains("uri") && x["uri"].is_string()) {
+            std::string u = x["uri"].get<std::string>();
+            if (u.rfind("data:", 0) != 0 && url_decode(u).find('\0') != std::string::npos)
+                return u;
+        }
+    return std::string();
 }
 
 /* Whether the file is glTF 1.0 (tinygltf then says "no scene", "Invalid
@@ -626,7 +636,7 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     std::string dir = slash == std::string::npos ? std::string(".")
                       : slash == 0               ? std::string("/")
                                                  : path.substr(0, slash);
-    files fs_dir{dir, {}};
+    files fs_dir{dir, {}, false};
     external_images(binary, bytes, size, dir, fs_dir.images);
     loader.SetFsCallbacks({&file_exists, &tinygltf::ExpandFilePath, &read_whole_file,
                            &tinygltf::WriteWholeFile, &fs_dir});
@@ -641,6 +651,11 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
                        "Khronos' gltf-pipeline)",
                        name);
     if (!ok) {
+        std::string u = fs_dir.nul ? nul_buffer_uri(binary, bytes, size) : std::string();
+        if (!u.empty())
+            return vb_fail(err, VB_ERR_FORMAT,
+                           "%s: buffer uri \"%s\" decodes to a NUL byte, which no file name holds",
+                           name, u.c_str());
         std::string x = required_extension(binary, bytes, size);
         if (!x.empty())
             return vb_fail(err, VB_ERR_FORMAT,

@@ -111,8 +111,9 @@ void remove_repeated(std::vector<int64_t> &v)
  * three distinct vertices add nothing (their triangles are counted as
  * dropped). A corner's texture coordinate and normal indices, when
  * given, must be whole numbers naming a "vt" and a "vn" line (the same
- * rules); the texture coordinates themselves, materials and every other
- * keyword are ignored. A NUL byte in a number
+ * rules); a corner has at most three '/' fields (v/vt/vn). The texture
+ * coordinates themselves, materials and every other keyword are ignored.
+ * A NUL byte in a number
  * or corner is refused as such.
  *
  * Where OpenMesh's reader read a line otherwise than these checks, the
@@ -225,6 +226,16 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
                                    "%s: line %lu: face corner '%.*s' contains a NUL byte "
                                    "(binary data in a text file?)",
                                    path, c.line, t.show_len(), t.b);
+                /* v, v/vt, v//vn or v/vt/vn: a fourth field would be
+                 * read into the normal index ("'1/1' is not a number") */
+                size_t fields = 1;
+                for (const char *q = t.b; q < t.e; q++)
+                    fields += *q == '/';
+                if (fields > 3)
+                    return vb_fail(err, VB_ERR_FORMAT,
+                                   "%s: line %lu: face corner '%.*s' has too many '/' fields "
+                                   "(%zu; at most 3: v/vt/vn)",
+                                   path, c.line, t.show_len(), t.b, fields);
                 const char *slash = (const char *)memchr(t.b, '/', t.size());
                 token idx{t.b, slash ? slash : t.e};
                 long long v = 0;

@@ -126,10 +126,15 @@ def parse(data: bytes, path: str = "memory") -> VdshFile:
     if n < 32:  # a file cut short, as vdsh-info says it
         _fail(path, "truncated: %d bytes, shorter than the 32-byte header" % n)
     version, count, size, flags, crc = struct.unpack_from("<IIQII", data, 8)
-    if zlib.crc32(data[:28]) != crc:
-        _fail(path, "header CRC mismatch")
+    # The version before the header CRC, as formats/vdsh_read.c: a later
+    # version may lay its header out otherwise, and "version N" is then
+    # the useful message.
+    crc_ok = zlib.crc32(data[:28]) == crc
     if version != 1:
-        _fail(path, "version %d unsupported" % version)
+        _fail(path, "format version %d, this reader reads version 1%s" % (
+            version, "" if crc_ok else " (and the header CRC fails: the file may be damaged)"))
+    if not crc_ok:
+        _fail(path, "header CRC mismatch (stored 0x%08x, computed 0x%08x)" % (crc, zlib.crc32(data[:28])))
     if size > n:
         _fail(path, "truncated: %d bytes, the header says %d" % (n, size))
     if size != n:
