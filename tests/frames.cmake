@@ -210,6 +210,15 @@ if(Python3_Interpreter_FOUND AND TARGET vb_frames)
                    ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR})
 endif()
 
+# scripts/speed_vs_error at its smallest (test_speed_vs_error.py): --resume
+# reuses only evaluations of the same arguments; no scene to sweep is an
+# error that leaves --doc as it was.
+if(Python3_EXECUTABLE AND TARGET vb_frames)
+  add_test(NAME speed_vs_error_script
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_speed_vs_error.py
+                   ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR})
+endif()
+
 # scripts/pareto --quick: the speed-against-error report at its smallest
 # (the room at --max-edge 1, the 3-view test set, a few modes, 1 and 3
 # lights): its CSV and JSON rows complete and finite, the GL counts of
