@@ -6,11 +6,14 @@
 #include <errno.h>
 #include <float.h>
 #include <math.h>
+#include <pthread.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "vdsh_output.h"
 
@@ -217,6 +220,45 @@ void vt_cli_begin(const char *prog, char **argv)
 const char *vt_cli_prog(void)
 {
     return cli_prog;
+}
+
+static sigset_t clean_exit_signals;
+
+static void *clean_exit_thread(void *unused)
+{
+    (void)unused;
+    int sig;
+    if (sigwait(&clean_exit_signals, &sig) != 0)
+        return NULL;
+    vdsh_output_remove_temporaries();
+    sigset_t one;
+    sigemptyset(&one);
+    sigaddset(&one, sig);
+    signal(sig, SIG_DFL);
+    pthread_sigmask(SIG_UNBLOCK, &one, NULL);
+    raise(sig); /* the default action: the process ends with this signal */
+    _exit(128 + sig);
+}
+
+void vt_cli_clean_exit_on_signals(void)
+{
+    static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+    int count = 0;
+    sigemptyset(&clean_exit_signals);
+    for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
+        struct sigaction sa;
+        if (sigaction(sigs[i], NULL, &sa) == 0 && sa.sa_handler != SIG_IGN) {
+            sigaddset(&clean_exit_signals, sigs[i]);
+            count++;
+        }
+    }
+    pthread_t t;
+    if (count == 0 || pthread_sigmask(SIG_BLOCK, &clean_exit_signals, NULL) != 0)
+        return;
+    if (pthread_create(&t, NULL, clean_exit_thread, NULL) != 0)
+        pthread_sigmask(SIG_UNBLOCK, &clean_exit_signals, NULL); /* plain signals then */
+    else
+        pthread_detach(t);
 }
 
 int vt_cli_version(const char *detail)

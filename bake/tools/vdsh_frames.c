@@ -1056,6 +1056,7 @@ static int parse_args(int argc, char **argv, options *o)
 int main(int argc, char **argv)
 {
     vt_cli_begin(PROG, argv);
+    vt_cli_clean_exit_on_signals(); /* no temporary file left by a signal */
     options o;
     int status = parse_args(argc, argv, &o);
     return status >= 0 ? status : o.run(&o);

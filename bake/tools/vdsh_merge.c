@@ -613,6 +613,7 @@ out:
 int main(int argc, char **argv)
 {
     vt_cli_begin("vdsh-merge", argv);
+    vt_cli_clean_exit_on_signals(); /* no temporary file left by a signal */
     options o;
     int status = parse_args(argc, argv, &o);
     return status == VT_CLI_RUN ? run(&o) : status;
