@@ -139,7 +139,8 @@ add_test(NAME robust_load
          COMMAND test_robust_load ${CMAKE_CURRENT_BINARY_DIR}/robust_load_tmp ${_load_inputs})
 
 # SIGTERM while a program writes leaves no temporary file (vdsh-merge,
-# vdsh-frames truth, vdsh-eval, vdsh-export, vdsh-info --json): an
+# vdsh-frames truth, vdsh-eval, vdsh-export, vdsh-info --json, vdsh-view
+# --render): an
 # LD_PRELOAD shim sends it at a chosen rename, deterministically. Not in a
 # sanitizer build (its runtime must come first among preloaded libraries).
 if(NOT VDSH_SANITIZE AND TARGET vdsh-frames AND TARGET vdsh-export)
@@ -149,5 +150,6 @@ if(NOT VDSH_SANITIZE AND TARGET vdsh-frames AND TARGET vdsh-export)
            COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/test_signal_temporaries.sh
                    $<TARGET_FILE:kill_at_rename> $<TARGET_FILE:vdsh-bake>
                    $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-frames>
-                   $<TARGET_FILE:vdsh-eval> $<TARGET_FILE:vdsh-export> $<TARGET_FILE:vdsh-info>)
+                   $<TARGET_FILE:vdsh-eval> $<TARGET_FILE:vdsh-export> $<TARGET_FILE:vdsh-info>
+                   $<$<TARGET_EXISTS:vdsh-view>:$<TARGET_FILE:vdsh-view>>)
 endif()

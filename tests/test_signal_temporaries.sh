@@ -7,9 +7,10 @@
 # first rename of a chosen output, when its temporary (and others') is
 # written and not yet renamed. Each program must still end by the signal
 # (exit 143); whatever it renamed is whole.
-# Usage: test_signal_temporaries.sh SHIM.so VDSH_BAKE VDSH_MERGE VDSH_FRAMES VDSH_EVAL VDSH_EXPORT VDSH_INFO
+# vdsh-view --render too, when it can render (GL).
+# Usage: test_signal_temporaries.sh SHIM.so VDSH_BAKE VDSH_MERGE VDSH_FRAMES VDSH_EVAL VDSH_EXPORT VDSH_INFO [VDSH_VIEW]
 set -u
-shim=$1 bake=$2 merge=$3 frames=$4 evaluate=$5 export=$6 info=$7
+shim=$1 bake=$2 merge=$3 frames=$4 evaluate=$5 export=$6 info=$7 view=${8:-}
 . "$(dirname "$0")/lib.sh"
 make_tmp
 d=$tmp/o
@@ -38,5 +39,10 @@ killed "vdsh-eval" e.json "$evaluate" "$tmp/scene.vdsh" -q --points 50 --interio
   --per-vertex "$d/e.pv"
 killed "vdsh-export" x.glb "$export" -q "$tmp/scene.vdsh" -o "$d/x.glb"
 killed "vdsh-info --json" i.json "$info" --json "$d/i.json" "$tmp/scene.vdsh"
+if [[ -n $view ]] && "$view" "$tmp/scene.vdsh" --render "$tmp/probe.png" --size 64x48 -q >/dev/null 2>&1; then
+  killed "vdsh-view --render" r.png "$view" "$tmp/scene.vdsh" --render "$d/r.png" --size 64x48 -q
+else
+  echo "vdsh-view: not checked (no GL render)"
+fi
 [[ $fail -eq 0 ]] && echo "no temporary file left by SIGTERM"
 exit $fail
