@@ -5,7 +5,8 @@
 # already there bakes only the others. The usage text is the header comment
 # only (issue 26: it ended with the script's `set -euo pipefail`). Installs
 # Debian's parallel when root and it is missing; skips (77) when it cannot
-# be had. Each shard's progress is in the output.
+# be had. Each shard's progress is in the output. OUT in a missing folder
+# is refused before any shard runs.
 # Usage: test_shard_parallel.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
@@ -36,6 +37,11 @@ for a in "-o $tmp/y.vdsh" "--output=$tmp/y.vdsh" "--shard 1/2"; do
   [[ $rc -eq 2 && $msg == *"among vdsh-bake's arguments"* ]] || { echo "FAIL: '$a': exit $rc: $msg" >&2; fail=1; }
 done
 ls "$tmp"/[xy].* "$tmp"/x.part-* >/dev/null 2>&1 && { echo "FAIL: -o among the arguments: files written" >&2; fail=1; }
+# OUT in a folder that does not exist: said before any shard runs, exit 1.
+msg=$(VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-parallel" 2 "$tmp/nodir/x.vdsh" -- "${tiny[@]}" 2>&1)
+rc=$?
+[[ $rc -eq 1 && $msg == *"no folder '$tmp/nodir'"* && $msg != *vdsh-bake* ]] ||
+  { echo "FAIL: OUT in a missing folder: exit $rc: $msg" >&2; fail=1; }
 "$bake" "${tiny[@]}" -q -o "$tmp/whole.vdsh" || { echo "FAIL: whole bake" >&2; exit 1; }
 export VDSH_BAKE=$bake VDSH_MERGE=$merge
 name="$tmp/it's a \$cene"

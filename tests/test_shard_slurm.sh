@@ -9,8 +9,8 @@
 # bake arguments are refused before anything is submitted (vdsh-bake's
 # message, its exit status, no job queued); a shard that fails after
 # submission gets the merge job cancelled, not left pending forever; the
-# output's name has a space and a quote; more shards than receivers are
-# refused before anything is submitted.
+# output's name has a space and a quote; more shards than receivers and
+# OUT in a missing folder are refused before anything is submitted.
 # Usage: test_shard_slurm.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
@@ -43,6 +43,13 @@ msg=$(PATH=$nos:$PATH VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-slurm" 10
 rc=$?
 [[ $rc -ne 0 && $msg == *"needs shard < count <= the"* && ! -e $nos/sbatch.calls ]] ||
   { echo "FAIL: 100000 shards of a small bake: exit $rc, sbatch called: $(cat "$nos/sbatch.calls" 2>/dev/null | head -c 200): $msg" >&2; fail=1; }
+# OUT in a folder that does not exist: refused, nothing submitted (its
+# absolute path was made as "/x.vdsh", the parts and the merge queued to
+# write in the root folder, exit 0).
+msg=$(PATH=$nos:$PATH VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-slurm" 2 "$nos/nodir/x.vdsh" -- builtin:room --max-edge 1.5 2>&1)
+rc=$?
+[[ $rc -eq 1 && $msg == *"no folder '$nos/nodir'"* && ! -e $nos/sbatch.calls ]] ||
+  { echo "FAIL: OUT in a missing folder: exit $rc, sbatch called: $(cat "$nos/sbatch.calls" 2>/dev/null | head -c 300): $msg" >&2; fail=1; }
 rm -rf "$nos"
 skip() { [[ $fail -eq 0 ]] || exit 1; echo "SKIP: $1"; exit 77; }
 [[ $(id -u) -eq 0 ]] || skip "needs root to start slurmctld and slurmd"
