@@ -4,7 +4,8 @@ order, f16, 200 evaluation points): --resume reuses an evaluation only
 when the same arguments made it (a rerun with --orders 3 reused the order-2
 evaluations and reported order 2, exit 0), and a run with no scene to sweep
 (its meshes missing) fails and leaves --doc's section as it was (it wrote
-an empty table there, exit 0).
+an empty table there, exit 0); --rays and --orders that are not whole
+numbers are usage errors (they were tracebacks).
 
 Usage: test_speed_vs_error.py SCRIPTS_DIR BUILD_DIR
 """
@@ -47,6 +48,14 @@ with tempfile.TemporaryDirectory() as tmp:
     r = sweep(out, "3", "--resume")
     check(r.returncode == 0 and "not reused" not in r.stdout and orders_in(out) == ["3"],
           "the same arguments again: reused (%r)" % r.stdout[-300:])
+
+    # --rays and --orders that are not whole numbers: usage errors naming
+    # the option (a ValueError traceback).
+    for opt, val in (("--rays", "64,abc"), ("--orders", "2,,3"), ("--orders", "0")):
+        r = subprocess.run([script, "--build", build, opt, val, "--out", os.path.join(tmp, "bad")],
+                           capture_output=True, text=True)
+        check(r.returncode == 2 and opt in r.stderr and "Traceback" not in r.stderr,
+              "%s %s: exit %d, %r" % (opt, val, r.returncode, r.stderr[-300:]))
 
     # No scene: a copy of the script finds no ../shared/scenes beside it.
     tree = os.path.join(tmp, "tree", "scripts")
