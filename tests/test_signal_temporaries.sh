@@ -34,6 +34,10 @@ killed() { # killed WHAT AT COMMAND...: SIGTERM at the first rename to AT
   [[ -z $left ]] || { echo "FAIL: $what: temporary files left: $left" >&2; fail=1; }
 }
 killed "vdsh-merge" m.sh09 "$merge" -q "$tmp/part-0.vdsh" "$tmp/part-1.vdsh" -o "$d/m.vdsh"
+# ... and its outputs change together: the signal at the first cubemap's
+# rename waits for the rest (it left new cubemaps beside no .vdsh).
+n=$(ls "$d"/m.vdsh "$d"/m.sh*.exr 2>/dev/null | wc -l)
+[[ $n -eq 5 ]] || { echo "FAIL: vdsh-merge: $n of its 5 outputs written: $(ls "$d")" >&2; fail=1; }
 killed "vdsh-frames truth" c-vdsh2 "$frames" truth "$tmp/scene.vdsh" --views "$tmp/v.json" -o "$d/f" -q
 killed "vdsh-eval" e.json "$evaluate" "$tmp/scene.vdsh" -q --points 50 --interior 50 --json "$d/e.json" \
   --per-vertex "$d/e.pv"

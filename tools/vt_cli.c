@@ -9,6 +9,7 @@
 #include <pthread.h>
 #include <signal.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -223,6 +224,29 @@ const char *vt_cli_prog(void)
 }
 
 static sigset_t clean_exit_signals;
+static pthread_mutex_t defer_lock = PTHREAD_MUTEX_INITIALIZER;
+
+void vt_cli_defer_signals(void)
+{
+    pthread_mutex_lock(&defer_lock);
+}
+
+static atomic_int clean_exit_taken; /* the signal thread has a signal */
+
+void vt_cli_undefer_signals(void)
+{
+    pthread_mutex_unlock(&defer_lock);
+    /* A signal that came meanwhile ends the process now, with its status,
+     * even though the outputs are complete (as vdsh-bake's): the program
+     * does not go on (and exit 0) while the signal thread takes the lock. */
+    sigset_t pending;
+    int waiting = atomic_load(&clean_exit_taken);
+    if (!waiting && sigpending(&pending) == 0)
+        for (int sig = 1; sig < NSIG && !waiting; sig++)
+            waiting = sigismember(&clean_exit_signals, sig) == 1 && sigismember(&pending, sig) == 1;
+    while (waiting)
+        pause();
+}
 
 static void *clean_exit_thread(void *unused)
 {
@@ -230,6 +254,8 @@ static void *clean_exit_thread(void *unused)
     int sig;
     if (sigwait(&clean_exit_signals, &sig) != 0)
         return NULL;
+    atomic_store(&clean_exit_taken, 1);
+    pthread_mutex_lock(&defer_lock); /* a group of outputs being written: after it */
     vdsh_output_remove_temporaries();
     sigset_t one;
     sigemptyset(&one);

@@ -87,6 +87,13 @@ const char *vt_cli_prog(void); /* "vdsh" before vt_cli_begin */
  * vdsh-bake has its own (it also defers the signal while it writes). */
 void vt_cli_clean_exit_on_signals(void);
 
+/* Outputs that change together (a .vdsh and its basis cubemaps): between
+ * vt_cli_defer_signals and vt_cli_undefer_signals such a signal waits, so
+ * that the program ends with all of them written or none (their
+ * temporaries removed), never some renamed and the others not. */
+void vt_cli_defer_signals(void);
+void vt_cli_undefer_signals(void);
+
 /* --version: "PROG VERSION (.vdsh format N[, detail])" on stdout.
  * Returns 0, the exit status. */
 int vt_cli_version(const char *detail);
