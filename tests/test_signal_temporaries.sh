@@ -41,6 +41,8 @@ n=$(ls "$d"/m.vdsh "$d"/m.sh*.exr 2>/dev/null | wc -l)
 killed "vdsh-frames truth" c-vdsh2 "$frames" truth "$tmp/scene.vdsh" --views "$tmp/v.json" -o "$d/f" -q
 killed "vdsh-eval" e.json "$evaluate" "$tmp/scene.vdsh" -q --points 50 --interior 50 --json "$d/e.json" \
   --per-vertex "$d/e.pv"
+n=$(ls "$d"/e.json "$d"/e.pv 2>/dev/null | wc -l)
+[[ $n -eq 2 ]] || { echo "FAIL: vdsh-eval: $n of its 2 outputs (--json, --per-vertex) written: $(ls "$d")" >&2; fail=1; }
 killed "vdsh-export" x.glb "$export" -q "$tmp/scene.vdsh" -o "$d/x.glb"
 killed "vdsh-info --json" i.json "$info" --json "$d/i.json" "$tmp/scene.vdsh"
 if [[ -n $view ]] && "$view" "$tmp/scene.vdsh" --render "$tmp/probe.png" --size 64x48 -q >/dev/null 2>&1; then

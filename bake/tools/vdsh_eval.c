@@ -1049,24 +1049,30 @@ static int report(const options *o, const context *ctx)
         print_table(stdout, ctx);
     fflush(stdout);
     char msg[PATH_MAX + 256];
-    /* both files complete before either is renamed into place */
+    /* both files complete before either is renamed into place, and a
+     * signal meanwhile waits for both (vt_cli_defer_signals) */
+    vt_cli_defer_signals();
     vdsh_output pv = {.fd = -1};
+    int status = 1;
     if (o->per_vertex &&
         write_per_vertex(o->per_vertex, ctx->f, ctx->r, &pv, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-eval: %s\n", msg);
-        return 1;
+        goto out;
     }
     if (o->json && write_json(o->json, ctx, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-eval: %s\n", msg);
         vdsh_output_abort(&pv);
-        return 1;
+        goto out;
     }
     vdsh_error err;
     if (o->per_vertex && vdsh_output_commit(&pv, &err) != VDSH_OK) {
         fprintf(stderr, "vdsh-eval: %s\n", err.msg);
-        return 1;
+        goto out;
     }
-    return 0;
+    status = 0;
+out:
+    vt_cli_undefer_signals();
+    return status;
 }
 
 /* Steps 2 to 5 of run: the bake time, the occluders, the evaluation, the
