@@ -34,6 +34,21 @@ def clean_exit_on_signals():
 # Every script that imports this list is one of the measuring scripts.
 clean_exit_on_signals()
 
+
+def check_output_files(ap, *options):
+    """(option, path) pairs of files a script writes at its end (--json,
+    --plot): each path's folder must exist, checked before the run (a
+    missing one was a FileNotFoundError after all the work). ap.error
+    (exit 2) naming the option and the folder; None paths are skipped."""
+    for opt, path in options:
+        if path is None or path == "-":
+            continue
+        folder = os.path.dirname(os.path.abspath(path))
+        if os.path.isdir(path):
+            ap.error("%s %s: a folder, not a file" % (opt, path))
+        if not os.path.isdir(folder):
+            ap.error("%s %s: no folder %s (create it first)" % (opt, path, folder))
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHARED = os.path.join(ROOT, "..", "shared", "scenes")
 ASSIMP = "/usr/share/assimp/models"
