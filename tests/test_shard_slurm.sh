@@ -9,7 +9,7 @@
 # bake arguments are refused before anything is submitted (vdsh-bake's
 # message, its exit status, no job queued); a shard that fails after
 # submission gets the merge job cancelled, not left pending forever; the
-# output's name has a space and a quote; more shards than receivers and
+# output's name has a space, a quote and a '%' (the logs beside it); more shards than receivers and
 # OUT in a missing folder are refused before anything is submitted.
 # Usage: test_shard_slurm.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
@@ -146,7 +146,7 @@ final_state() {
 }
 queued() { squeue -h -o %i 2>/dev/null | wc -l; }
 # A name with a space and a quote.
-name="$tmp/it's a scene"
+name="$tmp/it's a 100%x scene" # '%x' is a pattern of sbatch --output: the logs went elsewhere
 job=$("$scripts/bake-slurm" 4 "$name.vdsh" --cpus-per-task=1 -- "${tiny[@]}" --threads 1) ||
   { echo "FAIL: bake-slurm" >&2; dump; exit 1; }
 state=$(final_state "$job")
