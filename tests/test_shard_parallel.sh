@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # scripts/bake-parallel with real GNU parallel: 5 shards on local job slots
 # merge to the whole bake's file byte for byte, into an output whose name
-# has a space, a quote and a dollar sign (issue 26); a rerun with a part
+# has a space, a quote, a dollar sign (issue 26) and braces; a rerun with a part
 # already there bakes only the others. The usage text is the header comment
 # only (issue 26: it ended with the script's `set -euo pipefail`). Installs
 # Debian's parallel when root and it is missing; skips (77) when it cannot
@@ -52,7 +52,7 @@ rc=$?
   { echo "FAIL: OUT in a missing folder: exit $rc: $msg" >&2; fail=1; }
 "$bake" "${tiny[@]}" -q -o "$tmp/whole.vdsh" || { echo "FAIL: whole bake" >&2; exit 1; }
 export VDSH_BAKE=$bake VDSH_MERGE=$merge
-name="$tmp/it's a \$cene"
+name="$tmp/it's a \$cene {} {1}" # '{}' and '{1}': parallel's replacement strings (they became the shard)
 if ! "$scripts/bake-parallel" 5 "$name.vdsh" -j 2 -- "${tiny[@]}" 2>"$tmp/err.txt"; then
   echo "FAIL: bake-parallel:" >&2; cat "$tmp/err.txt" >&2; fail=1
 fi
