@@ -8,6 +8,7 @@
 #include <errno.h>
 #include <limits.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -30,14 +31,58 @@ vdsh_result vdsh_failf(vdsh_error *err, vdsh_result r, const char *fmt, ...)
     return r;
 }
 
+/* The temporary files that exist now (every open output's), for
+ * vdsh_output_remove_temporaries: a growing array under one lock. The
+ * lock is held while a temporary is created and listed, renamed or
+ * removed and struck off, so that the list is always what is on disk. */
+static pthread_mutex_t live_lock = PTHREAD_MUTEX_INITIALIZER;
+static char **live;
+static size_t live_count, live_cap;
+
+static int live_add(char *tmp) /* under live_lock; 0, or -1 out of memory */
+{
+    if (live_count == live_cap) {
+        size_t cap = live_cap ? 2 * live_cap : 16;
+        char **grown = realloc(live, cap * sizeof *grown);
+        if (!grown)
+            return -1;
+        live = grown, live_cap = cap;
+    }
+    live[live_count++] = tmp;
+    return 0;
+}
+
+static void live_remove(const char *tmp) /* under live_lock */
+{
+    for (size_t i = 0; i < live_count; i++)
+        if (live[i] == tmp) {
+            live[i] = live[--live_count];
+            return;
+        }
+}
+
+void vdsh_output_remove_temporaries(void)
+{
+    pthread_mutex_lock(&live_lock);
+    for (size_t i = 0; i < live_count; i++)
+        unlink(live[i]);
+    live_count = 0;
+    /* The lock stays held: the caller ends the process, and no output may
+     * create, rename or remove a temporary meanwhile. */
+}
+
 static void release(vdsh_output *o)
 {
     if (o->fp)
         fclose(o->fp);
     else if (o->fd >= 0)
         close(o->fd);
-    if (o->tmp)
+    if (o->tmp) {
+        pthread_mutex_lock(&live_lock);
         unlink(o->tmp);
+        live_remove(o->tmp);
+        pthread_mutex_unlock(&live_lock);
+    }
     free(o->tmp);
     free(o->path);
     memset(o, 0, sizeof *o);
@@ -154,6 +199,7 @@ vdsh_result vdsh_output_open(const char *path, vdsh_output *out, vdsh_error *err
             return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
         }
         int e = 0;
+        pthread_mutex_lock(&live_lock);
         for (int attempt = 0; attempt < MAX_ATTEMPTS; attempt++) {
             snprintf(o.tmp, cap, "%s.tmp.%ld.%u", path, (long)getpid(),
                      atomic_fetch_add(&counter, 1u));
@@ -162,6 +208,13 @@ vdsh_result vdsh_output_open(const char *path, vdsh_output *out, vdsh_error *err
             if (o.fd >= 0 || e != EEXIST)
                 break;
         }
+        if (o.fd >= 0 && live_add(o.tmp) != 0) {
+            unlink(o.tmp);
+            close(o.fd);
+            o.fd = -1;
+            e = ENOMEM;
+        }
+        pthread_mutex_unlock(&live_lock);
         if (o.fd < 0) {
             res = vdsh_failf(err, VDSH_ERR_IO,
                              "%s: cannot create a temporary file beside it "
@@ -269,13 +322,17 @@ vdsh_result vdsh_output_commit(vdsh_output *o, vdsh_error *err)
     if (r != VDSH_OK)
         return r;
     if (o->tmp) {
+        pthread_mutex_lock(&live_lock);
         if (rename(o->tmp, o->path) != 0) {
             int e = errno;
+            pthread_mutex_unlock(&live_lock);
             r = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot rename %s to it: %s", o->path, o->tmp,
                            strerror(e));
             release(o);
             return r;
         }
+        live_remove(o->tmp);
+        pthread_mutex_unlock(&live_lock);
         sync_parent_dir(o->path);
         free(o->tmp);
         o->tmp = NULL;

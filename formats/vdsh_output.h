@@ -24,7 +24,8 @@
  * directory; the data is safe by then). Several files that must change
  * together (the four basis cubemaps) are all finished before the first is
  * committed. A SIGKILL can leave a temporary file behind, never a partial
- * target.
+ * target; a program that ends on SIGINT or SIGTERM removes them first
+ * with vdsh_output_remove_temporaries.
  *
  * Targets that are not regular files: an existing character device or
  * FIFO (/dev/stdout, /dev/null, a pipe) is written in place as a stream
@@ -106,6 +107,15 @@ void vdsh_output_abort(vdsh_output *o);
 
 /* The whole file from memory: open, write `size` bytes, commit. */
 vdsh_result vdsh_output_write(const char *path, const void *data, size_t size, vdsh_error *err);
+
+/* Remove every temporary file of every output now open, in any thread,
+ * and keep any output from creating, renaming or removing one after:
+ * for a program that is about to end on a signal (SIGINT, SIGTERM), so
+ * that it leaves no "<path>.tmp..." behind; each target stays as it was
+ * or is whole. Not async-signal-safe: call it from a thread that took the
+ * signal with sigwait() (tools/vt_cli.h: vt_cli_clean_exit_on_signals),
+ * then end the process. */
+void vdsh_output_remove_temporaries(void);
 
 #ifdef __cplusplus
 }

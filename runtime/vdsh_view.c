@@ -514,6 +514,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
 int main(int argc, char **argv)
 {
     vt_cli_begin("vdsh-view", argv);
+    vt_cli_clean_exit_on_signals(); /* no temporary file left by a signal */
     vv_options o;
     int rc = parse_args(argc, argv, &o);
     if (rc)

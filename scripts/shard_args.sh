@@ -9,6 +9,9 @@
 #                                arguments, none of them -o, --output or
 #                                --shard (the script sets those), else exit 2;
 #                                the caller then drops the '--' (shift)
+#   shard_out_dir PROG OUT       OUT's folder exists and is writable, else
+#                                exit 1 naming it (bake-slurm made an absolute
+#                                path of a missing folder as "/OUT": the root)
 
 shard_count() {
   [[ $2 =~ ^[1-9][0-9]*$ ]] || { echo "$1: N is a whole number >= 1, not '$2'" >&2; exit 2; }
@@ -31,5 +34,19 @@ shard_bake_args() {
     [[ $a =~ ^(-o|--output|--shard)(=.*)?$ || $a =~ ^-o.+ ]] &&
       { echo "$prog: '$a' among vdsh-bake's arguments: the output is OUT (the second argument) and the script sets --shard" >&2; exit 2; }
   done
+  return 0
+}
+
+shard_out_dir() {
+  local dir
+  dir=$(dirname -- "$2")
+  if [[ ! -d $dir ]]; then
+    echo "$1: no folder '$dir' for $2 (and its parts): create it first; nothing run" >&2
+    exit 1
+  fi
+  if [[ ! -w $dir ]]; then
+    echo "$1: the folder '$dir' of $2 is not writable: nothing run" >&2
+    exit 1
+  fi
   return 0
 }

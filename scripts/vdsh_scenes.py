@@ -13,6 +13,41 @@ Third-party meshes live outside the repository (../shared/scenes, Debian's
 assimp-testmodels); scripts skip or refuse those that are absent.
 """
 import os
+import signal
+import sys
+
+
+def clean_exit_on_signals():
+    """SIGTERM and SIGHUP end a script as Ctrl-C does, through Python's
+    exception handling: the program it is running is killed
+    (subprocess.run does that on any exception) and its temporary folders
+    removed (tempfile.TemporaryDirectory). By default they ended Python at
+    once, leaving the child running and the folder, gigabytes of frames
+    for Sponza, in /tmp. A signal ignored at start (nohup) stays ignored."""
+    def leave(sig, _frame):
+        sys.exit(128 + sig)
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        if signal.getsignal(sig) is not signal.SIG_IGN:
+            signal.signal(sig, leave)
+
+
+# Every script that imports this list is one of the measuring scripts.
+clean_exit_on_signals()
+
+
+def check_output_files(ap, *options):
+    """(option, path) pairs of files a script writes at its end (--json,
+    --plot): each path's folder must exist, checked before the run (a
+    missing one was a FileNotFoundError after all the work). ap.error
+    (exit 2) naming the option and the folder; None paths are skipped."""
+    for opt, path in options:
+        if path is None or path == "-":
+            continue
+        folder = os.path.dirname(os.path.abspath(path))
+        if os.path.isdir(path):
+            ap.error("%s %s: a folder, not a file" % (opt, path))
+        if not os.path.isdir(folder):
+            ap.error("%s %s: no folder %s (create it first)" % (opt, path, folder))
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHARED = os.path.join(ROOT, "..", "shared", "scenes")

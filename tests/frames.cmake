@@ -201,11 +201,21 @@ endif()
 # and cpca 4,12,4, and an adaptive order (cap 7) in each, C frames at 128
 # x 96: a row per order and encoding with frame scores; bytes per vertex
 # are the spec's records (cpca: plus its model over the receivers; its
-# adaptive order a fixed stream of the cap); an unknown encoding is an
-# error. No GL.
+# adaptive order a fixed stream of the cap); an unknown encoding, a
+# --scenes word that is no scene and a run with every mesh missing are
+# errors; --frames on an unlisted scene makes its view set. No GL.
 if(Python3_Interpreter_FOUND AND TARGET vb_frames)
   add_test(NAME order_curve_script
            COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_order_curve.py
+                   ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR})
+endif()
+
+# scripts/speed_vs_error at its smallest (test_speed_vs_error.py): --resume
+# reuses only evaluations of the same arguments; no scene to sweep is an
+# error that leaves --doc as it was.
+if(Python3_EXECUTABLE AND TARGET vb_frames)
+  add_test(NAME speed_vs_error_script
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_speed_vs_error.py
                    ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR})
 endif()
 

@@ -137,3 +137,19 @@ add_executable(test_robust_load ${_robust_dir}/test_robust_load.c)
 target_link_libraries(test_robust_load PRIVATE vb_mesh)
 add_test(NAME robust_load
          COMMAND test_robust_load ${CMAKE_CURRENT_BINARY_DIR}/robust_load_tmp ${_load_inputs})
+
+# SIGTERM while a program writes leaves no temporary file (vdsh-merge,
+# vdsh-frames truth, vdsh-eval, vdsh-export, vdsh-info --json, vdsh-view
+# --render): an
+# LD_PRELOAD shim sends it at a chosen rename, deterministically. Not in a
+# sanitizer build (its runtime must come first among preloaded libraries).
+if(NOT VDSH_SANITIZE AND TARGET vdsh-frames AND TARGET vdsh-export)
+  add_library(kill_at_rename MODULE ${CMAKE_CURRENT_LIST_DIR}/kill_at_rename.c)
+  target_link_libraries(kill_at_rename PRIVATE ${CMAKE_DL_LIBS})
+  add_test(NAME robust_signal_leaves_no_temporary
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/test_signal_temporaries.sh
+                   $<TARGET_FILE:kill_at_rename> $<TARGET_FILE:vdsh-bake>
+                   $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-frames>
+                   $<TARGET_FILE:vdsh-eval> $<TARGET_FILE:vdsh-export> $<TARGET_FILE:vdsh-info>
+                   $<$<TARGET_EXISTS:vdsh-view>:$<TARGET_FILE:vdsh-view>>)
+endif()

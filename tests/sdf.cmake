@@ -26,3 +26,20 @@ set -e
 bash "$each" "$bake" bash -c '"$0" builtin:room --max-edge 2 --rays 16 --orders 2 --cube-size 0 --sdf 48 -q --threads 2 -o "$1/isa.vdsh" && cmp "$1/t1.sdf" "$1/isa.sdf"' "$bake" "$d"
 ]=] sh $<TARGET_FILE:vdsh-bake> ${CMAKE_CURRENT_LIST_DIR}/with_each_isa.sh
      ${CMAKE_CURRENT_BINARY_DIR}/sdf_bake)
+
+# vdsh-frames truth --sdf-k on a scene without a distance volume: an error
+# naming the file it looked for, no frames (it made no c-sdf frame and
+# exited 0, the option silently ignored); with the volume beside it, the
+# c-sdf frames.
+add_test(NAME sdf_frames_sdf_k_needs_volume COMMAND bash -c [=[
+bake=$1; frames=$2; d=$3
+rm -rf "$d"; mkdir -p "$d"
+run() { "$bake" builtin:room:3 --max-edge 1.5 --rays 16 --orders 2 --cube-size 0 -q "$@"; }
+run -o "$d/plain.vdsh" && run --sdf 16 -o "$d/vol.vdsh" || exit 1
+"$frames" views "$d/vol.vdsh" -q --cameras 1 --size 32x24 -o "$d/v.json" || exit 1
+msg=$("$frames" truth "$d/plain.vdsh" --views "$d/v.json" -o "$d/f0" --sdf-k 3 -q 2>&1); rc=$?
+[[ $rc -eq 2 && $msg == *plain.sdf* && ! -e $d/f0 ]] ||
+  { echo "FAIL: --sdf-k without a volume: exit $rc, $msg; $(ls "$d/f0" 2>/dev/null | head -3)"; exit 1; }
+"$frames" truth "$d/vol.vdsh" --views "$d/v.json" -o "$d/f1" --sdf-k 3 -q || exit 1
+[[ -e $d/f1/default-s0-l0-c-sdf.png ]] || { echo "FAIL: no c-sdf frame with the volume"; exit 1; }
+]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames> ${CMAKE_CURRENT_BINARY_DIR}/sdf_k_volume)

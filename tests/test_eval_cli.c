@@ -242,6 +242,16 @@ int main(int argc, char **argv)
     CHECK(rc == 0 && test_file_contains(out_path, "(bake report)") &&
               !test_file_contains(out_path, "order 2 "),
           "--bake-report, --orders");
+    /* A report of another bake: refused, naming it (its time was given as
+     * this file's, exit 0). */
+    char other[4096]; /* not path_in: its 8 buffers are in use */
+    snprintf(other, sizeof other, "%s/other.bake.json", work);
+    FILE *of = fopen(other, "w");
+    fprintf(of, "{\"sources\": [\"other.obj\"], \"receivers\": 3, \"seconds\": {\"total\": 7}}\n");
+    fclose(of);
+    rc = run((char *[]){ev, vdsh, "--bake-report", other, "--interior", "0", NULL});
+    CHECK(rc == 1 && test_file_contains(err_path, "the report of another bake"),
+          "--bake-report of another bake refused: exit %d", rc);
 
     /* The mesh changes: named; --allow-mismatch goes on with a warning; the
      * original content under another name is accepted. */

@@ -3,7 +3,8 @@
 (exit non-zero, naming it; it printed empty tables and exited 0), and a
 scene may be the path of a mesh file (baked, its view set made by
 vdsh-frames views, scored: a table row of its name and a --json document
-that parses strictly). Skips (77) when vdsh-view cannot render (no GL).
+that parses strictly), also when its file is named like a listed scene
+(room.obj: its own view set, not docs/views/room's). Skips (77) when vdsh-view cannot render (no GL).
 
 Usage: test_frames_script.py SCRIPTS_DIR BUILD_DIR WORK_DIR
 """
@@ -59,6 +60,25 @@ if gl:
         check(d["floorbox"]["default"]["vdsh5"]["0"]["frames"] > 0, "its scores in --json")
     except (OSError, ValueError, KeyError) as e:
         check(False, "--json: %s" % e)
+    # The same mesh in a file named like a listed scene (room.obj): its own
+    # view set, made with --cameras and --size, not docs/views/room's (which
+    # it took, with --cameras and --size ignored, scoring the built-in room's
+    # cameras on another mesh).
+    os.makedirs(os.path.join(work, "named"), exist_ok=True)
+    room = os.path.join(work, "named", "room.obj")
+    shutil.copyfile(mesh, room)
+    js2 = os.path.join(work, "named.json")
+    r = subprocess.run([frames, "--build", build, "--scenes", room, "--max-edge", "1",
+                        "--cameras", "1", "--size", "128x96", "--json", js2],
+                       capture_output=True, text=True)
+    try:
+        d2 = json.load(open(js2), object_pairs_hook=no_duplicates)
+        for k in ("0", "1"):
+            got, want = (x["default"]["vdsh5"][k]["frames"] for x in (d2["room"], d["floorbox"]))
+            check(got == want, "room.obj, light set %s: %d frames scored, %d for the same mesh "
+                  "as floorbox.obj (a listed scene's view set?)" % (k, got, want))
+    except (OSError, ValueError, KeyError, NameError) as e:
+        check(False, "room.obj: exit %d, %s %r" % (r.returncode, e, r.stderr[-300:]))
 if fails:
     sys.exit(1)
 print("ok" if gl else "skipped the mesh path: no GL")

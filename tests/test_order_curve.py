@@ -14,7 +14,9 @@ cpca (4,12,4), C frames at 128 x 96. Checks:
   differ);
 - the adaptive-order rows: s8s6's variable-order stream (records of
   orders 1..7, padded to words), cpca's a fixed cpca stream of the cap (order 7's records);
-- an unknown encoding is an error naming it.
+- an unknown encoding is an error naming it; so is a --scenes word that
+  is no scene; a run that scores no scene fails; --frames on a scene
+  without a listed view set scores frames of a view set made for it.
 
 Usage: test_order_curve.py SCRIPTS_DIR BUILD_DIR
 """
@@ -56,6 +58,33 @@ r = subprocess.run([script, "--build", build, "--encodings", "s8s6,nosuch"],
                    capture_output=True, text=True)
 check(r.returncode != 0 and "nosuch" in r.stderr and "|" not in r.stdout,
       "an unknown encoding: exit %d, stderr %r" % (r.returncode, r.stderr[-300:]))
+
+# --scenes: a word that is no scene (no '=') is a usage error naming it
+# (it was a Python traceback); a run whose meshes are all missing is an
+# error (it printed an empty table and exited 0).
+r = subprocess.run([script, "--build", build, "--scenes", "room3"], capture_output=True,
+                   text=True)
+check(r.returncode == 2 and "'room3'" in r.stderr and "Traceback" not in r.stderr and
+      "|" not in r.stdout, "--scenes room3: exit %d, stderr %r" % (r.returncode, r.stderr[-300:]))
+r = subprocess.run([script, "--build", build, "--scenes", "x=/nonexistent/x.obj:0.5"],
+                   capture_output=True, text=True)
+check(r.returncode not in (0, 2) and "no scene scored" in r.stderr and "|" not in r.stdout,
+      "every mesh missing: exit %d, stderr %r" % (r.returncode, r.stderr[-300:]))
+# --frames on a scene without docs/views/NAME.views.json: a view set made
+# for it, and frame scores (--frames did nothing there).
+with tempfile.TemporaryDirectory() as tmp:
+    js = os.path.join(tmp, "tiny.json")
+    r = subprocess.run([script, "--build", build, "--scenes", "tiny=builtin:room:3:1.5",
+                        "--rays", "16", "--orders", "2", "--tolerances", "none", "--frames",
+                        "--size", "32x24", "--points", "100", "--interior", "200", "--json", js],
+                       capture_output=True, text=True)
+    try:
+        f = json.load(open(js))["tiny"][0]["frames"]
+        check(f is not None and f["frames"] > 0 and 0.0 < f["rmse_ideal"] < 1.0,
+              "--frames on an unlisted scene: frame scores %s" % f)
+    except (OSError, ValueError, KeyError, IndexError) as e:
+        check(False, "--frames on an unlisted scene: exit %d, %s %r"
+              % (r.returncode, e, r.stderr[-500:]))
 
 K, B, BITS = 4, 12, 4
 with tempfile.TemporaryDirectory() as tmp:

@@ -128,6 +128,15 @@ expect_exit 2 "--shard 7/7 is a usage error" "$bake" "${tiny[@]}" --shard 7/7 -o
 expect_exit 2 "--shard x is a usage error" "$bake" "${tiny[@]}" --shard 1/x -o "$out"
 expect_exit 1 "more shards than receivers" "$bake" builtin:room --rays 8 -q --shard 0/1000000 -o "$out"
 check "no output after bad shards" test ! -e "$out"
+# ... also where the run stops before the bake (--export-obj: bake-slurm's
+# check before it submits; --plan): it exited 0 and wrote them.
+expect_exit 1 "more shards than receivers, --export-obj" "$bake" builtin:room --max-edge 1.5 -q \
+  --shard 0/1000000 --export-obj "$tmp/shard-check.obj"
+says "more shards than receivers, --export-obj" "needs shard < count <= the"
+check "no --export-obj after bad shards" test ! -e "$tmp/shard-check.obj"
+expect_exit 1 "more shards than receivers, --plan" "$bake" builtin:room --max-edge 1.5 -q \
+  --shard 0/1000000 --plan "$tmp/shard-check.ply"
+check "no --plan after bad shards" test ! -e "$tmp/shard-check.ply"
 
 # A shard killed mid-bake leaves no part; rerunning it alone completes the set.
 k=$tmp/killed; mkdir -p "$k"

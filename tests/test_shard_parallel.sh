@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # scripts/bake-parallel with real GNU parallel: 5 shards on local job slots
 # merge to the whole bake's file byte for byte, into an output whose name
-# has a space, a quote and a dollar sign (issue 26); a rerun with a part
+# has a space, a quote, a dollar sign (issue 26) and braces; a rerun with a part
 # already there bakes only the others. The usage text is the header comment
 # only (issue 26: it ended with the script's `set -euo pipefail`). Installs
 # Debian's parallel when root and it is missing; skips (77) when it cannot
-# be had. Each shard's progress is in the output.
+# be had. Each shard's progress is in the output. OUT in a missing folder
+# is refused before any shard runs, and so is a parallel that is not GNU's.
 # Usage: test_shard_parallel.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
@@ -36,9 +37,22 @@ for a in "-o $tmp/y.vdsh" "--output=$tmp/y.vdsh" "--shard 1/2"; do
   [[ $rc -eq 2 && $msg == *"among vdsh-bake's arguments"* ]] || { echo "FAIL: '$a': exit $rc: $msg" >&2; fail=1; }
 done
 ls "$tmp"/[xy].* "$tmp"/x.part-* >/dev/null 2>&1 && { echo "FAIL: -o among the arguments: files written" >&2; fail=1; }
+# moreutils' parallel (same name, other options) first on PATH: said, exit 1
+# (the run failed with that program's usage line).
+mkdir -p "$tmp/mu"
+printf '#!/bin/sh\necho "parallel [OPTIONS] command -- arguments" >&2\nexit 1\n' >"$tmp/mu/parallel"
+chmod +x "$tmp/mu/parallel"
+msg=$(PATH=$tmp/mu:$PATH VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-parallel" 2 "$tmp/mu.vdsh" -- "${tiny[@]}" 2>&1)
+rc=$?
+[[ $rc -eq 1 && $msg == *"is not GNU parallel"* ]] || { echo "FAIL: moreutils' parallel: exit $rc: $msg" >&2; fail=1; }
+# OUT in a folder that does not exist: said before any shard runs, exit 1.
+msg=$(VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-parallel" 2 "$tmp/nodir/x.vdsh" -- "${tiny[@]}" 2>&1)
+rc=$?
+[[ $rc -eq 1 && $msg == *"no folder '$tmp/nodir'"* && $msg != *vdsh-bake* ]] ||
+  { echo "FAIL: OUT in a missing folder: exit $rc: $msg" >&2; fail=1; }
 "$bake" "${tiny[@]}" -q -o "$tmp/whole.vdsh" || { echo "FAIL: whole bake" >&2; exit 1; }
 export VDSH_BAKE=$bake VDSH_MERGE=$merge
-name="$tmp/it's a \$cene"
+name="$tmp/it's a \$cene {} {1}" # '{}' and '{1}': parallel's replacement strings (they became the shard)
 if ! "$scripts/bake-parallel" 5 "$name.vdsh" -j 2 -- "${tiny[@]}" 2>"$tmp/err.txt"; then
   echo "FAIL: bake-parallel:" >&2; cat "$tmp/err.txt" >&2; fail=1
 fi

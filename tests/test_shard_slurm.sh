@@ -9,7 +9,8 @@
 # bake arguments are refused before anything is submitted (vdsh-bake's
 # message, its exit status, no job queued); a shard that fails after
 # submission gets the merge job cancelled, not left pending forever; the
-# output's name has a space and a quote.
+# output's name has a space, a quote and a '%' (the logs beside it); more shards than receivers and
+# OUT in a missing folder are refused before anything is submitted.
 # Usage: test_shard_slurm.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
@@ -32,6 +33,23 @@ for a in "-o $nos/y.vdsh" "--output=$nos/y.vdsh" "-o$nos/y.vdsh" "--shard 1/2"; 
   [[ $rc -eq 2 && $msg == *"among vdsh-bake's arguments"* ]] || { echo "FAIL: '$a': exit $rc: $msg" >&2; fail=1; }
 done
 ls "$nos"/[xy]* >/dev/null 2>&1 && { echo "FAIL: -o among the arguments: files written" >&2; fail=1; }
+# More shards than receivers: refused by the check, nothing submitted (an
+# sbatch of our own records any call). vdsh-bake --export-obj exited 0
+# before the shard was checked against the receivers, so every shard
+# failed on the cluster.
+printf '#!/bin/sh\necho "$@" >> "%s/sbatch.calls"\necho 1\n' "$nos" > "$nos/sbatch"
+chmod +x "$nos/sbatch"
+msg=$(PATH=$nos:$PATH VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-slurm" 100000 "$nos/x.vdsh" -- builtin:room --max-edge 1.5 2>&1)
+rc=$?
+[[ $rc -ne 0 && $msg == *"needs shard < count <= the"* && ! -e $nos/sbatch.calls ]] ||
+  { echo "FAIL: 100000 shards of a small bake: exit $rc, sbatch called: $(cat "$nos/sbatch.calls" 2>/dev/null | head -c 200): $msg" >&2; fail=1; }
+# OUT in a folder that does not exist: refused, nothing submitted (its
+# absolute path was made as "/x.vdsh", the parts and the merge queued to
+# write in the root folder, exit 0).
+msg=$(PATH=$nos:$PATH VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-slurm" 2 "$nos/nodir/x.vdsh" -- builtin:room --max-edge 1.5 2>&1)
+rc=$?
+[[ $rc -eq 1 && $msg == *"no folder '$nos/nodir'"* && ! -e $nos/sbatch.calls ]] ||
+  { echo "FAIL: OUT in a missing folder: exit $rc, sbatch called: $(cat "$nos/sbatch.calls" 2>/dev/null | head -c 300): $msg" >&2; fail=1; }
 rm -rf "$nos"
 skip() { [[ $fail -eq 0 ]] || exit 1; echo "SKIP: $1"; exit 77; }
 [[ $(id -u) -eq 0 ]] || skip "needs root to start slurmctld and slurmd"
@@ -128,7 +146,7 @@ final_state() {
 }
 queued() { squeue -h -o %i 2>/dev/null | wc -l; }
 # A name with a space and a quote.
-name="$tmp/it's a scene"
+name="$tmp/it's a 100%x scene" # '%x' is a pattern of sbatch --output: the logs went elsewhere
 job=$("$scripts/bake-slurm" 4 "$name.vdsh" --cpus-per-task=1 -- "${tiny[@]}" --threads 1) ||
   { echo "FAIL: bake-slurm" >&2; dump; exit 1; }
 state=$(final_state "$job")

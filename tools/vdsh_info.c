@@ -742,6 +742,7 @@ static int run(const options *o)
 int main(int argc, char **argv)
 {
     vt_cli_begin(prog, argv);
+    vt_cli_clean_exit_on_signals(); /* no temporary file left by a signal */
     options o;
     int status = parse_args(argc, argv, &o);
     return status >= 0 ? status : run(&o);

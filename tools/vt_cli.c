@@ -6,11 +6,15 @@
 #include <errno.h>
 #include <float.h>
 #include <math.h>
+#include <pthread.h>
+#include <signal.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "vdsh_output.h"
 
@@ -217,6 +221,70 @@ void vt_cli_begin(const char *prog, char **argv)
 const char *vt_cli_prog(void)
 {
     return cli_prog;
+}
+
+static sigset_t clean_exit_signals;
+static pthread_mutex_t defer_lock = PTHREAD_MUTEX_INITIALIZER;
+
+void vt_cli_defer_signals(void)
+{
+    pthread_mutex_lock(&defer_lock);
+}
+
+static atomic_int clean_exit_taken; /* the signal thread has a signal */
+
+void vt_cli_undefer_signals(void)
+{
+    pthread_mutex_unlock(&defer_lock);
+    /* A signal that came meanwhile ends the process now, with its status,
+     * even though the outputs are complete (as vdsh-bake's): the program
+     * does not go on (and exit 0) while the signal thread takes the lock. */
+    sigset_t pending;
+    int waiting = atomic_load(&clean_exit_taken);
+    if (!waiting && sigpending(&pending) == 0)
+        for (int sig = 1; sig < NSIG && !waiting; sig++)
+            waiting = sigismember(&clean_exit_signals, sig) == 1 && sigismember(&pending, sig) == 1;
+    while (waiting)
+        pause();
+}
+
+static void *clean_exit_thread(void *unused)
+{
+    (void)unused;
+    int sig;
+    if (sigwait(&clean_exit_signals, &sig) != 0)
+        return NULL;
+    atomic_store(&clean_exit_taken, 1);
+    pthread_mutex_lock(&defer_lock); /* a group of outputs being written: after it */
+    vdsh_output_remove_temporaries();
+    sigset_t one;
+    sigemptyset(&one);
+    sigaddset(&one, sig);
+    signal(sig, SIG_DFL);
+    pthread_sigmask(SIG_UNBLOCK, &one, NULL);
+    raise(sig); /* the default action: the process ends with this signal */
+    _exit(128 + sig);
+}
+
+void vt_cli_clean_exit_on_signals(void)
+{
+    static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+    int count = 0;
+    sigemptyset(&clean_exit_signals);
+    for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
+        struct sigaction sa;
+        if (sigaction(sigs[i], NULL, &sa) == 0 && sa.sa_handler != SIG_IGN) {
+            sigaddset(&clean_exit_signals, sigs[i]);
+            count++;
+        }
+    }
+    pthread_t t;
+    if (count == 0 || pthread_sigmask(SIG_BLOCK, &clean_exit_signals, NULL) != 0)
+        return;
+    if (pthread_create(&t, NULL, clean_exit_thread, NULL) != 0)
+        pthread_sigmask(SIG_UNBLOCK, &clean_exit_signals, NULL); /* plain signals then */
+    else
+        pthread_detach(t);
 }
 
 int vt_cli_version(const char *detail)

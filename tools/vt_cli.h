@@ -77,6 +77,23 @@ int vt_parse_size(const char *s, int lo, int hi, int *w, int *h);
 void vt_cli_begin(const char *prog, char **argv);
 const char *vt_cli_prog(void); /* "vdsh" before vt_cli_begin */
 
+/* SIGINT, SIGTERM and SIGHUP end the program as before (the signal's own
+ * exit status), but first remove the temporary files of the outputs being
+ * written (vdsh_output_remove_temporaries): an interrupted program leaves
+ * no "<path>.tmp..." beside its outputs, each target as it was or whole.
+ * Blocks the signals and takes them in a thread of its own (sigwait), so
+ * call it before the program starts any thread (every thread inherits the
+ * mask). Signals ignored at start (nohup, a background job) stay ignored.
+ * vdsh-bake has its own (it also defers the signal while it writes). */
+void vt_cli_clean_exit_on_signals(void);
+
+/* Outputs that change together (a .vdsh and its basis cubemaps): between
+ * vt_cli_defer_signals and vt_cli_undefer_signals such a signal waits, so
+ * that the program ends with all of them written or none (their
+ * temporaries removed), never some renamed and the others not. */
+void vt_cli_defer_signals(void);
+void vt_cli_undefer_signals(void);
+
 /* --version: "PROG VERSION (.vdsh format N[, detail])" on stdout.
  * Returns 0, the exit status. */
 int vt_cli_version(const char *detail);

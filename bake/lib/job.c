@@ -103,8 +103,20 @@ vb_result vb_job_refine(vb_job *j, const vb_job_desc *d, vb_error *err)
     return r;
 }
 
+vb_result vb_job_check_shard(const vb_job *j, const vb_job_desc *d, vb_error *err)
+{
+    if (d->shard_count &&
+        (d->shard_index >= d->shard_count || d->shard_count > j->receivers.vertex_count))
+        return vb_fail(err, VB_ERR_ARGUMENT, "shard %u/%u: needs shard < count <= the %u receivers",
+                       d->shard_index, d->shard_count, j->receivers.vertex_count);
+    return VB_OK;
+}
+
 vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
 {
+    vb_result sr = vb_job_check_shard(j, d, err);
+    if (sr != VB_OK)
+        return sr;
     double t = vb_now();
     vb_scene_desc sd = {.robust = !d->fast_traversal, .threads = d->bake.threads};
     vb_result r = vb_scene_create(&j->occluders, &sd, &j->scene, err);
@@ -113,10 +125,6 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
     j->timings.build = vb_now() - t;
     vb_bake_desc bd = d->bake;
     if (d->shard_count) {
-        if (d->shard_index >= d->shard_count || d->shard_count > j->receivers.vertex_count)
-            return vb_fail(err, VB_ERR_ARGUMENT,
-                           "shard %u/%u: needs shard < count <= the %u receivers", d->shard_index,
-                           d->shard_count, j->receivers.vertex_count);
         vb_shard_range(j->receivers.vertex_count, d->shard_index, d->shard_count, &bd.range_begin,
                        &bd.range_end);
     }

@@ -122,6 +122,12 @@ vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err);
  * mesh at receivers_path as it is. */
 vb_result vb_job_refine(vb_job *j, const vb_job_desc *d, vb_error *err);
 
+/* The shard (d->shard_index of d->shard_count) fits the receivers
+ * vb_job_refine made: index < count <= receivers; VB_OK when not sharded.
+ * vb_job_bake checks it too; a caller that stops before baking (vdsh-bake
+ * --export-obj, bake-slurm's check of a sharded bake) calls it itself. */
+vb_result vb_job_check_shard(const vb_job *j, const vb_job_desc *d, vb_error *err);
+
 /* Build the BVH and bake (bake.h); timings recorded. */
 vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err);
 

@@ -1481,6 +1481,13 @@ static int run(const options *o)
     }
     const vb_mesh *rec = &job.receivers;
     say_receivers(log, o, &job, &spacing);
+    /* The shard against the receivers before any output: --export-obj
+     * (bake-slurm's check before it submits) and --plan exit before the
+     * bake, where a shard count above the receivers was found. */
+    if (vb_job_check_shard(&job, &jd, &err) != VB_OK) {
+        fprintf(stderr, "vdsh-bake: %s\n", err.msg);
+        goto out;
+    }
     if (o->plan && !o->adaptive) { /* uniform: the refined receivers, before any bake */
         if (write_plan(rec, o->plan) != 0)
             goto out;

@@ -112,7 +112,9 @@ static void usage(FILE *f)
             "                          -: on stdout, instead of the table)\n"
             "      --per-vertex FILE   per-vertex errors for a heat map (layout below)\n"
             "      --bake-report FILE  take the bake time from vdsh-bake --report JSON\n"
-            "                          (default: the file's time chunk, if recorded)\n"
+            "                          of this file's bake (its receivers and sources\n"
+            "                          must match; default: the file's time chunk, if\n"
+            "                          recorded)\n"
             "      --worst N           worst receivers listed (default 10, at most 64)\n"
             "      --threads N         worker threads (default: all cores)\n"
             "  -q, --quiet             no progress on stderr\n"
@@ -196,7 +198,33 @@ typedef struct bake_time {
 
 /* vdsh-bake --report: "seconds": {..., "trace": T, ..., "total": T} and
  * "threads": N, read with the JSON parser every tool shares (vt_json.h). */
-static int read_bake_report(const char *path, bake_time *bt, char *msg, size_t cap)
+/* 1 when the report's receivers and sources are the file's (a report of
+ * another bake gave its time as this file's, exit 0); else 0 with msg. */
+static int report_is_of(const cJSON *root, const char *path, const vdsh_file *f,
+                        const char *vdsh_path, char *msg, size_t cap)
+{
+    double receivers = vt_json_number(root, "receivers");
+    const cJSON *src = cJSON_GetObjectItemCaseSensitive(root, "sources");
+    int same = receivers == (double)f->header.vertex_count && cJSON_IsArray(src) &&
+               cJSON_GetArraySize(src) == (int)f->source_count;
+    for (uint32_t i = 0; same && i < f->source_count; i++) {
+        const cJSON *n = cJSON_GetArrayItem(src, (int)i);
+        same = cJSON_IsString(n) && strcmp(n->valuestring, f->sources[i].name) == 0;
+    }
+    if (!same)
+        snprintf(msg, cap,
+                 "%s: the report of another bake (%.0f receivers, first source '%s'), not "
+                 "of %s (%u receivers, first source '%s')",
+                 path, receivers >= 0.0 ? receivers : -1.0,
+                 cJSON_IsArray(src) && cJSON_IsString(cJSON_GetArrayItem(src, 0))
+                     ? cJSON_GetArrayItem(src, 0)->valuestring
+                     : "?",
+                 vdsh_path, f->header.vertex_count, f->source_count ? f->sources[0].name : "?");
+    return same;
+}
+
+static int read_bake_report(const char *path, const vdsh_file *f, const char *vdsh_path,
+                            bake_time *bt, char *msg, size_t cap)
 {
     cJSON *root = vt_json_read_file(path, msg, cap);
     if (!root)
@@ -206,6 +234,10 @@ static int read_bake_report(const char *path, bake_time *bt, char *msg, size_t c
     if (!cJSON_IsObject(root) || !cJSON_IsObject(sec) || !(total >= 0.0)) {
         snprintf(msg, cap, "%s: no \"seconds\": {\"total\": ...} (not a vdsh-bake --report?)",
                  path);
+        cJSON_Delete(root);
+        return 0;
+    }
+    if (!report_is_of(root, path, f, vdsh_path, msg, cap)) {
         cJSON_Delete(root);
         return 0;
     }
@@ -996,7 +1028,7 @@ static int bake_time_of(const options *o, const vdsh_file *f, bake_time *bt)
     memset(bt, 0, sizeof *bt);
     if (o->bake_report) {
         char msg[PATH_MAX + 128];
-        if (!read_bake_report(o->bake_report, bt, msg, sizeof msg)) {
+        if (!read_bake_report(o->bake_report, f, o->path, bt, msg, sizeof msg)) {
             fprintf(stderr, "vdsh-eval: %s\n", msg);
             return 1;
         }
@@ -1049,24 +1081,30 @@ static int report(const options *o, const context *ctx)
         print_table(stdout, ctx);
     fflush(stdout);
     char msg[PATH_MAX + 256];
-    /* both files complete before either is renamed into place */
+    /* both files complete before either is renamed into place, and a
+     * signal meanwhile waits for both (vt_cli_defer_signals) */
+    vt_cli_defer_signals();
     vdsh_output pv = {.fd = -1};
+    int status = 1;
     if (o->per_vertex &&
         write_per_vertex(o->per_vertex, ctx->f, ctx->r, &pv, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-eval: %s\n", msg);
-        return 1;
+        goto out;
     }
     if (o->json && write_json(o->json, ctx, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-eval: %s\n", msg);
         vdsh_output_abort(&pv);
-        return 1;
+        goto out;
     }
     vdsh_error err;
     if (o->per_vertex && vdsh_output_commit(&pv, &err) != VDSH_OK) {
         fprintf(stderr, "vdsh-eval: %s\n", err.msg);
-        return 1;
+        goto out;
     }
-    return 0;
+    status = 0;
+out:
+    vt_cli_undefer_signals();
+    return status;
 }
 
 /* Steps 2 to 5 of run: the bake time, the occluders, the evaluation, the
@@ -1188,6 +1226,7 @@ static int run(const options *o)
 int main(int argc, char **argv)
 {
     vt_cli_begin("vdsh-eval", argv);
+    vt_cli_clean_exit_on_signals(); /* no temporary file left by a signal */
     options o;
     int status = parse_args(argc, argv, &o);
     return status >= 0 ? status : run(&o);

@@ -105,7 +105,8 @@ static void usage(FILE *f)
             "                          for ideal and the c-vdshN frames\n"
             "      --sdf FILE          the distance volume for c-sdf (default SCENE.sdf,\n"
             "                          when it exists)\n"
-            "      --sdf-k K           c-sdf's softness (default 400, as vdsh-view's)\n"
+            "      --sdf-k K           c-sdf's softness (default 400, as vdsh-view's);\n"
+            "                          an error when the scene has no volume\n"
             "\n"
             "score: reads the truth (hard, ideal, mask from --truth DIR) and the frames\n"
             "  of each mode in LIST (comma-separated: vdsh-view's modes cube, cube-pcf,\n"
@@ -165,6 +166,7 @@ typedef struct options {
     uint32_t compare;                  /* truth: --compare */
     const char *sdf;                   /* truth: --sdf */
     float sdf_k;                       /* truth: --sdf-k */
+    int sdf_k_given;                   /* --sdf-k on the command line */
     const char *truth, *frames, *json; /* score */
     char modes[MAX_MODES][64];         /* score: --modes */
     int mode_count;
@@ -454,6 +456,14 @@ static int run_truth(const options *op)
                 return 1;
             }
             have_sdf = 1;
+        } else if (op->sdf_k_given) { /* it made no c-sdf frame, exit 0 */
+            fprintf(stderr,
+                    PROG ": --sdf-k: %s has no distance volume (no %s; bake one with "
+                         "vdsh-bake --sdf N, or give --sdf FILE)\n",
+                    path, vdsh_sdf_path(path, sp, sizeof sp) == 0 ? sp : "SCENE.sdf");
+            loaded_free(&L);
+            vt_views_free(&V);
+            return 2;
         }
     }
     const size_t n = (size_t)w * (size_t)h;
@@ -953,6 +963,7 @@ static int take_option(int c, options *o)
     case O_SDF_K:
         if (!vt_parse_float(optarg, &o->sdf_k) || !(o->sdf_k > 0.0f && o->sdf_k <= 1000.0f))
             return !bad_usage("--sdf-k takes a number > 0 and <= 1000, not '%s'", optarg);
+        o->sdf_k_given = 1;
         return 1;
     case O_COMPARE:
         o->compare = vdsh_compare_by_name(optarg);
@@ -1045,6 +1056,7 @@ static int parse_args(int argc, char **argv, options *o)
 int main(int argc, char **argv)
 {
     vt_cli_begin(PROG, argv);
+    vt_cli_clean_exit_on_signals(); /* no temporary file left by a signal */
     options o;
     int status = parse_args(argc, argv, &o);
     return status >= 0 ? status : o.run(&o);

@@ -535,8 +535,12 @@ static int merge_write(merge *m, const options *o)
         return 1;
     }
     uint64_t bytes = 0;
-    if (vb_write_outputs(&m->f, o->output, NULL, m->f.header.cube_size > 0 ? &m->basis : NULL, NULL,
-                         0, &bytes, &err) != VB_OK) {
+    vt_cli_defer_signals(); /* all of them, or none: not cubemaps beside an old file */
+    vb_result r =
+        vb_write_outputs(&m->f, o->output, NULL, m->f.header.cube_size > 0 ? &m->basis : NULL, NULL,
+                         0, &bytes, &err);
+    vt_cli_undefer_signals();
+    if (r != VB_OK) {
         fprintf(stderr, "vdsh-merge: %s\n", err.msg);
         return 1;
     }
@@ -613,6 +617,7 @@ out:
 int main(int argc, char **argv)
 {
     vt_cli_begin("vdsh-merge", argv);
+    vt_cli_clean_exit_on_signals(); /* no temporary file left by a signal */
     options o;
     int status = parse_args(argc, argv, &o);
     return status == VT_CLI_RUN ? run(&o) : status;
