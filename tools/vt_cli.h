@@ -83,8 +83,7 @@ const char *vt_cli_prog(void); /* "vdsh" before vt_cli_begin */
  * no "<path>.tmp..." beside its outputs, each target as it was or whole.
  * Blocks the signals and takes them in a thread of its own (sigwait), so
  * call it before the program starts any thread (every thread inherits the
- * mask). Signals ignored at start (nohup, a background job) stay ignored.
- * vdsh-bake has its own (it also defers the signal while it writes). */
+ * mask). Signals ignored at start (nohup, a background job) stay ignored. */
 void vt_cli_clean_exit_on_signals(void);
 
 /* Outputs that change together (a .vdsh and its basis cubemaps): between

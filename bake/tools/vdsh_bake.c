@@ -14,9 +14,6 @@
 #include <libgen.h>
 #include <limits.h>
 #include <math.h>
-#include <pthread.h>
-#include <signal.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -398,70 +395,22 @@ static void on_progress(void *user, uint32_t done, uint32_t total, uint64_t trac
 
 /* ---- interrupts ---------------------------------------------------------- */
 
-/* SIGINT, SIGTERM and SIGHUP end a bake at once, except while it writes
- * its outputs: then the signal waits until the last file is in place, so
- * an interrupted bake never leaves a temporary file behind (SIGKILL
- * cannot wait: each output is still replaced atomically, but its
- * temporary file stays, named "<output>.tmp...").
- *
- * No asynchronous handler: the signals are blocked before any thread
- * exists (every thread inherits that) and one thread takes them with
- * sigwait(); it needs output_lock, which main holds while writing, before
- * it lets the signal end the process (also when the bake has just
- * succeeded: the exit status says it was interrupted, whatever the race).
- * Signals ignored at start (nohup, background jobs) stay ignored. */
-static pthread_mutex_t output_lock = PTHREAD_MUTEX_INITIALIZER;
-static sigset_t interrupt_signals;
-static atomic_int interrupted;
+/* SIGINT, SIGTERM and SIGHUP end a bake at once, removing the temporary
+ * files of whatever it is writing (vt_cli_clean_exit_on_signals), except
+ * while it writes its outputs (between vt_cli_defer_signals and
+ * vt_cli_undefer_signals): then the signal waits until the last file is
+ * in place, and the exit status still says the bake was interrupted.
+ * SIGKILL cannot wait: each output is still replaced atomically, but its
+ * temporary file stays, named "<output>.tmp...". */
 
 /* The side outputs (--plan, --export-obj, --sdf): each staged beside its
  * target when made (vb_mesh_stage_obj, vdsh_sdf_stage) and renamed only
  * with the bake's other outputs, when everything has succeeded (with the
  * .vdsh file, before it: vb_job_write); a failed or interrupted bake
- * removes them, so it leaves none behind. Used under output_lock. */
+ * removes them, so it leaves none behind. Used with signals deferred. */
 enum { SIDE_PLAN, SIDE_EXPORT, SIDE_SDF, SIDE_COUNT };
 static vdsh_output side[SIDE_COUNT];
 static char side_note[SIDE_COUNT][PATH_MAX + 160]; /* said once renamed */
-
-static void *interrupt_thread(void *unused)
-{
-    (void)unused;
-    int sig;
-    if (sigwait(&interrupt_signals, &sig) != 0)
-        return NULL;
-    atomic_store(&interrupted, sig);
-    pthread_mutex_lock(&output_lock);
-    for (int k = 0; k < SIDE_COUNT; k++)
-        vdsh_output_abort(&side[k]); /* staged side outputs: removed */
-    sigset_t one;
-    sigemptyset(&one);
-    sigaddset(&one, sig);
-    signal(sig, SIG_DFL);
-    pthread_sigmask(SIG_UNBLOCK, &one, NULL);
-    raise(sig); /* the default action: the process ends with this signal */
-    _exit(128 + sig);
-}
-
-static void defer_interrupts_while_writing(void)
-{
-    static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
-    int count = 0;
-    sigemptyset(&interrupt_signals);
-    for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
-        struct sigaction sa;
-        if (sigaction(sigs[i], NULL, &sa) == 0 && sa.sa_handler != SIG_IGN) {
-            sigaddset(&interrupt_signals, sigs[i]);
-            count++;
-        }
-    }
-    pthread_t t;
-    if (count == 0 || pthread_sigmask(SIG_BLOCK, &interrupt_signals, NULL) != 0)
-        return;
-    if (pthread_create(&t, NULL, interrupt_thread, NULL) != 0)
-        pthread_sigmask(SIG_UNBLOCK, &interrupt_signals, NULL); /* plain signals then */
-    else
-        pthread_detach(t);
-}
 
 /* ---- output -------------------------------------------------------------- */
 
@@ -637,11 +586,11 @@ static int write_plan(const vb_mesh *m, const char *path)
     vb_error err;
     size_t n = strlen(path);
     vdsh_output *out = &side[SIDE_PLAN];
-    pthread_mutex_lock(&output_lock);
+    vt_cli_defer_signals();
     vb_result r = n > 4 && strcasecmp(path + n - 4, ".ply") == 0
                       ? vb_mesh_stage_ply(m, path, out, &err)
                       : vb_mesh_stage_obj(m, path, out, &err);
-    pthread_mutex_unlock(&output_lock);
+    vt_cli_undefer_signals();
     if (r != VB_OK) {
         fprintf(stderr, "vdsh-bake: %s\n", err.msg);
         return 1;
@@ -665,7 +614,7 @@ static void say_sides(FILE *log)
 
 /* Rename the staged side outputs into place (the bake succeeded without
  * a .vdsh file to write them with). Nonzero on error (said). Under
- * output_lock. */
+ * deferred signals. */
 static int commit_sides(FILE *log)
 {
     int bad = 0;
@@ -711,10 +660,10 @@ static int check_outputs(const options *o, const vb_job_desc *jd, const char *co
         ins[nin++] = meshes[i];
     ins[nin++] = o->receivers;
     /* The checks make and remove a temporary beside each output: an
-     * interrupt waits for them as for the writes (output_lock). */
-    pthread_mutex_lock(&output_lock);
+     * interrupt waits for them as for the writes. */
+    vt_cli_defer_signals();
     int bad = vt_cli_check_outputs(outs, n, ins, nin);
-    pthread_mutex_unlock(&output_lock);
+    vt_cli_undefer_signals();
     return bad;
 }
 
@@ -1456,7 +1405,7 @@ static int run(const options *o)
     float offsets[VDSH_ORDER_SLOTS];
     const vb_job_desc jd = job_desc(o, log, &pr, offsets);
     int status = 1;
-    int writing = 0; /* output_lock held: outputs are being written */
+    int writing = 0; /* signals deferred: outputs are being written */
     vb_mesh_spacing spacing = {0};
     vb_error err;
     vb_job job = {0};
@@ -1497,9 +1446,9 @@ static int run(const options *o)
         }
     }
     if (o->export_obj) {
-        pthread_mutex_lock(&output_lock);
+        vt_cli_defer_signals();
         vb_result written = vb_mesh_stage_obj(rec, o->export_obj, &side[SIDE_EXPORT], &err);
-        pthread_mutex_unlock(&output_lock);
+        vt_cli_undefer_signals();
         if (written != VB_OK) {
             fprintf(stderr, "vdsh-bake: %s\n", err.msg);
             goto out;
@@ -1539,7 +1488,7 @@ static int run(const options *o)
     say_bake(log, o, &job);
     char msg[PATH_MAX + 256];
     if (o->trace_only) {
-        pthread_mutex_lock(&output_lock);
+        vt_cli_defer_signals();
         writing = 1;
         if (o->report && write_bare_report(o->report, bo, &job.timings, msg, sizeof msg) != 0) {
             fprintf(stderr, "vdsh-bake: %s (the report)\n", msg);
@@ -1566,7 +1515,7 @@ static int run(const options *o)
 
     /* 6. Write: the distance volume staged, then the side outputs, the
      * basis cubemaps and the .vdsh file, last, renamed together. */
-    pthread_mutex_lock(&output_lock);
+    vt_cli_defer_signals();
     writing = 1;
     if (o->sdf) {
         vdsh_error verr;
@@ -1600,14 +1549,12 @@ out:
     /* The side outputs: renamed into place when the bake succeeded
      * (without -o; with it vb_job_write did), else removed. */
     if (!writing)
-        pthread_mutex_lock(&output_lock);
+        vt_cli_defer_signals();
     if (status == 0 && commit_sides(log) != 0)
         status = 1;
     for (int k = 0; k < SIDE_COUNT; k++)
         vdsh_output_abort(&side[k]);
-    pthread_mutex_unlock(&output_lock);
-    while (atomic_load(&interrupted))
-        pause(); /* the interrupt thread ends the process */
+    vt_cli_undefer_signals(); /* an interrupt that came meanwhile ends it here */
     vb_job_free(&job);
     return status;
 }
@@ -1615,7 +1562,7 @@ out:
 int main(int argc, char **argv)
 {
     vt_cli_begin("vdsh-bake", argv);
-    defer_interrupts_while_writing(); /* first: before any thread starts */
+    vt_cli_clean_exit_on_signals(); /* first: before any thread starts */
     options o;
     int status = parse_args(argc, argv, &o);
     return status == VT_CLI_RUN ? run(&o) : status;
