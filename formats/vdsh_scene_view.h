@@ -97,9 +97,13 @@ typedef struct vdsh_view_mesh {
 typedef struct vdsh_view {
     float bounds_min[3]; /* of all vertices (vdsh_view_bounds) */
     float bounds_max[3];
-    float front_share;                     /* vdsh_view_front_share, 0..1 */
-    int interior;                          /* front_share >= VDSH_VIEW_INTERIOR_SHARE */
-    vdsh_camera camera;                    /* the default camera: room or fit */
+    float front_share;  /* vdsh_view_front_share, 0..1 */
+    int interior;       /* front_share >= VDSH_VIEW_INTERIOR_SHARE */
+    vdsh_camera camera; /* the default camera: room or fit */
+    /* The fit camera, whatever the scene (vdsh-view --fit): a flat
+     * object's seen from its front, as vdsh_view_compute says; an
+     * object's default camera. */
+    vdsh_camera fit;
     int light_count;                       /* VDSH_VIEW_MAX_LIGHTS */
     float lights[VDSH_VIEW_MAX_LIGHTS][3]; /* default light positions */
     /* before any move (a light the frame rule took from the seeded
@@ -121,8 +125,8 @@ typedef struct vdsh_view {
  * camera, the default lights. A flat object (all vertices within a
  * millionth of the diagonal of the plane of its largest triangle) whose
  * front (the side the summed vertex normals face; the winding's where
- * they cancel) faces away from the fit camera's direction w: the camera
- * is fitted along w mirrored through the plane (along the plane's normal
+ * they cancel) faces away from the fit camera's direction w: the fit
+ * camera (fit; an object's camera) is fitted along w mirrored through the plane (along the plane's normal
  * where that is within about 6 degrees of vertical), and the preferred
  * lights are mirrored through the plane through the bounds' centre. A preferred light position in free space is
  * kept. Otherwise the candidates p + k h d are tried, rings k = 1, 2, ...
