@@ -72,6 +72,13 @@ add_test(NAME bake_shard
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
                  $<TARGET_FILE:vdsh-eval>)
+# Parts of one .gltf bake whose SRCS record the source with and without
+# its external buffers (a baker before 2026-11-30): merged when both match
+# the file, into the whole bake's bytes; refused when they do not.
+add_test(NAME bake_merge_source_record
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_merge_source_record.py
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge>
+                 ${CMAKE_CURRENT_BINARY_DIR}/merge_source_record)
 # vdsh-bake --encoding cpca (issue 29): 1 and 2 threads, 1, 3 and 7 shards
 # merged give the same bytes; decode error against the f32 bake bounded;
 # bad --cpca settings and mixed parts refused.
