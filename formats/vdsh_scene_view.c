@@ -364,8 +364,8 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
     for (size_t i = 0; i < 3 * (size_t)m->triangle_count; i++)
         if (m->indices[i] >= m->vertex_count)
             return vdsh_failf(err, VDSH_ERR_INVALID,
-                              "mesh: triangle %zu: vertex index %u not below the %u vertices",
-                              i / 3, m->indices[i], m->vertex_count);
+                              "mesh: triangle %zu: vertex index %u not below the %u vert%s", i / 3,
+                              m->indices[i], m->vertex_count, m->vertex_count == 1 ? "ex" : "ices");
     vdsh_view_tracer *g = calloc(1, sizeof *g);
     if (!g)
         return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "mesh: out of memory (ray grid)");
