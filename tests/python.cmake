@@ -42,4 +42,4 @@ add_test(NAME python_info_cli
 add_test(NAME format_plurals
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_plurals.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info> ${PROJECT_SOURCE_DIR}
-                 ${CMAKE_CURRENT_BINARY_DIR}/plurals)
+                 ${CMAKE_CURRENT_BINARY_DIR}/plurals $<TARGET_FILE:vdsh-eval>)

@@ -3,7 +3,7 @@
 (vdsh-info), the Python reader (python/vdsh), the mesh readers (vdsh-bake)
 and the bake's light placement; counts other than 1 keep the plural.
 
-Usage: test_plurals.py VDSH_BAKE VDSH_INFO SOURCE_DIR WORKDIR
+Usage: test_plurals.py VDSH_BAKE VDSH_INFO SOURCE_DIR WORKDIR [VDSH_EVAL]
 """
 import os
 import re
@@ -14,6 +14,7 @@ import sys
 import zlib
 
 bake, info, src, work = sys.argv[1:5]
+evaluate = sys.argv[5] if len(sys.argv) > 5 else None
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
 sys.path.insert(0, os.path.join(src, "python"))
@@ -92,6 +93,14 @@ for name, text, want in (
     if q.returncode == 0:
         failures.append("%s: baked" % name)
     expect(name, q.stderr.strip(), want)
+
+# vdsh-eval's summary of a one-triangle bake.
+if evaluate:
+    q = subprocess.run([evaluate, good, one_obj, "--points", "4", "--lights", "2", "--directions", "2",
+                        "--threads", "1"], capture_output=True, text=True)
+    line = [x for x in q.stdout.splitlines() if "receiver" in x and "occluder" in x]
+    expect("vdsh-eval summary", line[0] if line else q.stdout + q.stderr,
+           "3 receiver vertices, 1 triangle; 1 occluder triangle;")
 
 if failures:
     print("\n".join(failures))
