@@ -97,13 +97,9 @@ typedef struct vdsh_view_mesh {
 typedef struct vdsh_view {
     float bounds_min[3]; /* of all vertices (vdsh_view_bounds) */
     float bounds_max[3];
-    float front_share;  /* vdsh_view_front_share, 0..1 */
-    int interior;       /* front_share >= VDSH_VIEW_INTERIOR_SHARE */
-    vdsh_camera camera; /* the default camera: room or fit */
-    /* The fit camera, whatever the scene (vdsh-view --fit): a flat
-     * object's seen from its front, as vdsh_view_compute says; an
-     * object's default camera. */
-    vdsh_camera fit;
+    float front_share;                     /* vdsh_view_front_share, 0..1 */
+    int interior;                          /* front_share >= VDSH_VIEW_INTERIOR_SHARE */
+    vdsh_camera camera;                    /* the default camera: room or fit */
     int light_count;                       /* VDSH_VIEW_MAX_LIGHTS */
     float lights[VDSH_VIEW_MAX_LIGHTS][3]; /* default light positions */
     /* before any move (a light the frame rule took from the seeded
@@ -119,6 +115,10 @@ typedef struct vdsh_view {
     float light_lit[VDSH_VIEW_MAX_LIGHTS];
     float light_shadowed[VDSH_VIEW_MAX_LIGHTS];
     uint32_t pool_tried; /* seeded candidates the frame rule tried */
+    /* The fit camera, whatever the scene (vdsh-view --fit): a flat
+     * object's seen from its front, as vdsh_view_compute says; an
+     * object's default camera. */
+    vdsh_camera fit;
 } vdsh_view;
 
 /* Everything above from the mesh: bounds, the interior test, the default
