@@ -121,9 +121,9 @@ int vdsh_check_indices(const uint32_t *idx, uint32_t t, uint32_t v, why *w)
         while (idx[i] < v)
             i++;
         return vdsh_bad(w,
-                        "TRIS: index %u out of range (%u vertices) in "
+                        "TRIS: index %u out of range (%u vert%s) in "
                         "triangle %zu",
-                        idx[i], v, i / 3);
+                        idx[i], v, v == 1 ? "ex" : "ices", i / 3);
     }
     return 1;
 }

@@ -1381,7 +1381,8 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
         }
         if (!have) {
             res = vdsh_failf(err, VDSH_ERR_ARGUMENT,
-                             "cpca widths: %g bytes per vertex: nothing fits", budget);
+                             "cpca widths: %g byte%s per vertex: nothing fits", budget,
+                             budget == 1.0 ? "" : "s");
             goto done;
         }
         for (uint32_t j = 0; j < bf; j++)

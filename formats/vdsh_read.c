@@ -125,8 +125,8 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks, uint32_t *
             return vdsh_failf_at(r->err, VDSH_ERR_NOT_VDSH, r->name,
                                  "not a .vdsh file (wrong magic)");
         return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
-                             "truncated: %zu bytes, shorter than the %d-byte header", size,
-                             FILE_HEADER_SIZE);
+                             "truncated: %zu byte%s, shorter than the %d-byte header", size,
+                             vdsh_s(size), FILE_HEADER_SIZE);
     }
     if (memcmp(d, vdsh_magic, sizeof vdsh_magic) != 0) {
         if (memcmp(d, vdsh_magic, 4) == 0)
@@ -137,8 +137,8 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks, uint32_t *
     }
     if (size < FILE_HEADER_SIZE)
         return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
-                             "truncated: %zu bytes, shorter than the %d-byte header", size,
-                             FILE_HEADER_SIZE);
+                             "truncated: %zu byte%s, shorter than the %d-byte header", size,
+                             vdsh_s(size), FILE_HEADER_SIZE);
 
     /* The version comes before the header CRC: a later version may lay its
      * header out differently, and "unsupported version" is then the useful
@@ -163,13 +163,13 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks, uint32_t *
     uint32_t flags = get_u32(d + 24);
     if ((uint64_t)size < file_size)
         return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
-                             "truncated: %zu bytes, the header says %llu", size,
+                             "truncated: %zu byte%s, the header says %llu", size, vdsh_s(size),
                              (unsigned long long)file_size);
     if ((uint64_t)size > file_size)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                             "%zu bytes, but the header says %llu (data after the "
+                             "%zu byte%s, but the header says %llu (data after the "
                              "end)",
-                             size, (unsigned long long)file_size);
+                             size, vdsh_s(size), (unsigned long long)file_size);
     if (flags != 0)
         return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name, "header flags 0x%x, must be 0",
                              flags);
@@ -186,14 +186,15 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks, uint32_t *
         if (w == WALK_NO_HEADER)
             return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
                                  "chunk %u at offset %llu: header runs past the end "
-                                 "of the file (%u chunks announced)",
-                                 i, (unsigned long long)off, chunk_count);
+                                 "of the file (%u chunk%s announced)",
+                                 i, (unsigned long long)off, chunk_count, vdsh_s(chunk_count));
         printable_id(d + off, pid);
         if (w == WALK_PAST_END)
             return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
-                                 "chunk %u '%s' at offset %llu: payload of %llu bytes "
+                                 "chunk %u '%s' at offset %llu: payload of %llu byte%s "
                                  "runs past the end of the file",
-                                 i, pid, (unsigned long long)off, (unsigned long long)c->size);
+                                 i, pid, (unsigned long long)off, (unsigned long long)c->size,
+                                 vdsh_s(c->size));
         if (cs != cc)
             return vdsh_failf_at(r->err, VDSH_ERR_CRC, r->name,
                                  "chunk %u '%s' at offset %llu: CRC mismatch (stored "
@@ -215,9 +216,9 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks, uint32_t *
         off = payload + c->size + pad16(c->size);
     }
     if (off != size)
-        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                             "%llu bytes after the last of %u chunks",
-                             (unsigned long long)(size - off), chunk_count);
+        return vdsh_failf_at(
+            r->err, VDSH_ERR_CHUNK, r->name, "%llu byte%s after the last of %u chunk%s",
+            (unsigned long long)(size - off), vdsh_s(size - off), chunk_count, vdsh_s(chunk_count));
     *count = chunk_count;
     return VDSH_OK;
 }
@@ -229,8 +230,8 @@ static vdsh_result read_head(const reader *r, const chunk_ref *c, layout *L)
     why w;
     if (c->size != HEAD_SIZE)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                             "HEAD: payload is %llu bytes, must be %d", (unsigned long long)c->size,
-                             HEAD_SIZE);
+                             "HEAD: payload is %llu byte%s, must be %d",
+                             (unsigned long long)c->size, vdsh_s(c->size), HEAD_SIZE);
     vdsh_fields_get(&vdsh_head_chunk, p, h);
     if (!all_zero(p + 80, 48))
         return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
@@ -247,7 +248,8 @@ static vdsh_result read_srcs(const reader *r, const chunk_ref *c, layout *L)
     why w;
     if (n < 4)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                             "SRCS: payload of %llu bytes has no count", (unsigned long long)n);
+                             "SRCS: payload of %llu byte%s has no count", (unsigned long long)n,
+                             vdsh_s(n));
     uint32_t count = get_u32(p);
     if (count > VDSH_MAX_SOURCES)
         return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name, "SRCS: count %u out of range 0..%d",
@@ -283,19 +285,21 @@ static vdsh_result read_srcs(const reader *r, const chunk_ref *c, layout *L)
     }
     if (off != n)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                             "SRCS: %llu bytes after the last source",
-                             (unsigned long long)(n - off));
+                             "SRCS: %llu byte%s after the last source",
+                             (unsigned long long)(n - off), vdsh_s(n - off));
     L->source_count = count;
     return VDSH_OK;
 }
 
 /* POSN, NORM and TRIS: 12 bytes per vertex or triangle. */
-static vdsh_result read_array(const reader *r, const chunk_ref *c, uint32_t count, const char *what)
+static vdsh_result read_array(const reader *r, const chunk_ref *c, uint32_t count, const char *one,
+                              const char *many)
 {
     if (c->size != (uint64_t)count * 12)
         return vdsh_failf_at(
-            r->err, VDSH_ERR_CHUNK, r->name, "%s: payload is %llu bytes, %u %s need %llu", c->id,
-            (unsigned long long)c->size, count, what, (unsigned long long)count * 12);
+            r->err, VDSH_ERR_CHUNK, r->name, "%s: payload is %llu byte%s, %u %s need%s %llu", c->id,
+            (unsigned long long)c->size, vdsh_s(c->size), count, count == 1 ? one : many,
+            count == 1 ? "s" : "", (unsigned long long)count * 12);
     return VDSH_OK;
 }
 
@@ -312,9 +316,9 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
                              VDSH_MAX_STREAMS);
     if (c->size < STREAM_HEADER_SIZE)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                             "COEF stream %u: payload of %llu bytes is shorter than "
+                             "COEF stream %u: payload of %llu byte%s is shorter than "
                              "the %d-byte stream header",
-                             i, (unsigned long long)c->size, STREAM_HEADER_SIZE);
+                             i, (unsigned long long)c->size, vdsh_s(c->size), STREAM_HEADER_SIZE);
     vdsh_fields_get(&vdsh_stream_header, p, s);
     s->data = NULL;
     s->orders = NULL;
@@ -327,9 +331,9 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
     if (s->encoding == VDSH_ENCODING_CPCA) {
         if (c->size - STREAM_HEADER_SIZE < CPCA_HEADER_SIZE)
             return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                                 "%s: %llu bytes of data, shorter than the %d-byte cpca header", l,
+                                 "%s: %llu byte%s of data, shorter than the %d-byte cpca header", l,
                                  (unsigned long long)(c->size - STREAM_HEADER_SIZE),
-                                 CPCA_HEADER_SIZE);
+                                 vdsh_s(c->size - STREAM_HEADER_SIZE), CPCA_HEADER_SIZE);
         s->cpca.clusters = get_u32(p + STREAM_HEADER_SIZE);
         s->cpca.basis = get_u32(p + STREAM_HEADER_SIZE + 4);
         s->cpca.bits = get_u32(p + STREAM_HEADER_SIZE + 8);
@@ -340,8 +344,9 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
         if (!s->cpca.bits && b >= 1 && b <= VDSH_MAX_COEFFS) {
             if (c->size - STREAM_HEADER_SIZE - CPCA_HEADER_SIZE < ((b + 15) & ~15ull))
                 return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                                     "%s: %llu bytes of data, shorter than the cpca widths table",
-                                     l, (unsigned long long)(c->size - STREAM_HEADER_SIZE));
+                                     "%s: %llu byte%s of data, shorter than the cpca widths table",
+                                     l, (unsigned long long)(c->size - STREAM_HEADER_SIZE),
+                                     vdsh_s(c->size - STREAM_HEADER_SIZE));
             s->cpca.widths = p + STREAM_HEADER_SIZE + CPCA_HEADER_SIZE;
         }
     }
@@ -352,9 +357,9 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
                          : vdsh_stream_table_bytes(s->encoding, s->order);
     if (c->size - STREAM_HEADER_SIZE < table)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                             "%s: %llu bytes of data, shorter than its %llu-byte scale table", l,
+                             "%s: %llu byte%s of data, shorter than its %llu-byte scale table", l,
                              (unsigned long long)(c->size - STREAM_HEADER_SIZE),
-                             (unsigned long long)table);
+                             vdsh_s(c->size - STREAM_HEADER_SIZE), (unsigned long long)table);
     if (table && s->encoding == VDSH_ENCODING_CPCA) {
         uint64_t n = (uint64_t)s->order * s->order, k = s->cpca.clusters, b = s->cpca.basis;
         uint64_t sizes[4] = {s->cpca.bits ? 0 : b, 4 * k * b, 2 * k * n, 2 * k * b * n};
@@ -405,9 +410,10 @@ static vdsh_result check_coef_sizes(const reader *r, layout *L)
             orders = round16(rows);
             if (L->stream_bytes[i] < table + orders)
                 return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                                     "%s: %llu bytes of data, shorter than its scale and order "
+                                     "%s: %llu byte%s of data, shorter than its scale and order "
                                      "tables (%llu bytes)",
                                      l, (unsigned long long)L->stream_bytes[i],
+                                     vdsh_s(L->stream_bytes[i]),
                                      (unsigned long long)(table + orders));
             s->orders = r->d + L->stream_data[i];
             if (!all_zero(s->orders + rows, orders - rows))
@@ -422,9 +428,11 @@ static vdsh_result check_coef_sizes(const reader *r, layout *L)
         uint64_t need = table + vdsh_stream_data_bytes(s, rows);
         if (L->stream_bytes[i] != need)
             return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                                 "%s: %llu bytes of data, %u vertices of %s need %llu%s", l,
-                                 (unsigned long long)L->stream_bytes[i], rows,
-                                 vdsh_encoding_name(s->encoding), (unsigned long long)need,
+                                 "%s: %llu byte%s of data, %u %s of %s need%s %llu%s", l,
+                                 (unsigned long long)L->stream_bytes[i], vdsh_s(L->stream_bytes[i]),
+                                 rows, rows == 1 ? "vertex" : "vertices",
+                                 vdsh_encoding_name(s->encoding), rows == 1 ? "s" : "",
+                                 (unsigned long long)need,
                                  L->has_part ? " (a part: its range's receivers)" : "");
         s->coef_scales = table && !cpca ? (const float *)(r->d + L->stream_table[i]) : NULL;
         if (cpca)
@@ -461,8 +469,8 @@ static vdsh_result read_fixed(const reader *r, const chunk_ref *c, uint32_t i, i
                              (unsigned long long)c->offset, k->id);
     if (c->size != k->size)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
-                             "%s: payload is %llu bytes, must be %d", k->id,
-                             (unsigned long long)c->size, (int)k->size);
+                             "%s: payload is %llu byte%s, must be %d", k->id,
+                             (unsigned long long)c->size, vdsh_s(c->size), (int)k->size);
     if (!all_zero(p + k->reserved, k->reserved_size))
         return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
                              "%s: reserved bytes %u..%u not zero", k->id, (unsigned)k->reserved,
@@ -515,12 +523,12 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks, uint3
         } else if (req == 1 || req == 2) { /* POSN, NORM */
             int (*check)(const float *, uint32_t, why *) =
                 req == 1 ? vdsh_check_positions : vdsh_check_normals;
-            if ((res = read_array(r, c, h->vertex_count, "vertices")) == VDSH_OK &&
+            if ((res = read_array(r, c, h->vertex_count, "vertex", "vertices")) == VDSH_OK &&
                 !check((const float *)p, h->vertex_count, &w))
                 res = invalid(r, &w);
             *(req == 1 ? &L->posn : &L->norm) = c->offset + CHUNK_HEADER_SIZE;
         } else if (req == 3) {
-            if ((res = read_array(r, c, h->triangle_count, "triangles")) == VDSH_OK &&
+            if ((res = read_array(r, c, h->triangle_count, "triangle", "triangles")) == VDSH_OK &&
                 !vdsh_check_indices((const uint32_t *)p, h->triangle_count, h->vertex_count, &w))
                 res = invalid(r, &w);
             L->tris = c->offset + CHUNK_HEADER_SIZE;
@@ -744,8 +752,8 @@ vdsh_result vdsh_scan_chunks(const void *data, size_t size, const char *name, vd
         return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, nm, "not a .vdsh file (wrong magic)");
     if (size < FILE_HEADER_SIZE)
         return vdsh_failf_at(err, VDSH_ERR_TRUNCATED, nm,
-                             "truncated: %zu bytes, shorter than the %d-byte header", size,
-                             FILE_HEADER_SIZE);
+                             "truncated: %zu byte%s, shorter than the %d-byte header", size,
+                             vdsh_s(size), FILE_HEADER_SIZE);
     uint64_t off = FILE_HEADER_SIZE;
     uint32_t n = 0;
     while (off < size && n < UINT32_MAX) {

@@ -364,8 +364,8 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
     for (size_t i = 0; i < 3 * (size_t)m->triangle_count; i++)
         if (m->indices[i] >= m->vertex_count)
             return vdsh_failf(err, VDSH_ERR_INVALID,
-                              "mesh: triangle %zu: vertex index %u not below the %u vertices",
-                              i / 3, m->indices[i], m->vertex_count);
+                              "mesh: triangle %zu: vertex index %u not below the %u vert%s", i / 3,
+                              m->indices[i], m->vertex_count, m->vertex_count == 1 ? "ex" : "ices");
     vdsh_view_tracer *g = calloc(1, sizeof *g);
     if (!g)
         return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "mesh: out of memory (ray grid)");
@@ -975,18 +975,19 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
      * would. Nearly vertical once mirrored: the eye along the normal. */
     float fn[3], w[3], c[3];
     int flip = 0;
-    if (!v.interior) {
-        fit_direction(lo, hi, w);
-        if (flat_front(m, diag, fn) && w[0] * fn[0] + w[1] * fn[1] + w[2] * fn[2] < 0.0f) {
-            flip = 1;
-            mirror(w, (float[3]){0, 0, 0}, fn);
-            if (w[0] * w[0] + w[2] * w[2] < 0.01f)
-                memcpy(w, fn, sizeof w);
-        }
-        fit_along(lo, hi, w, &v.camera);
-    } else {
-        vdsh_view_room_camera_free(t, lo, hi, &v.camera);
+    fit_direction(lo, hi, w);
+    if (flat_front(m, diag, fn) && w[0] * fn[0] + w[1] * fn[1] + w[2] * fn[2] < 0.0f) {
+        flip = 1;
+        mirror(w, (float[3]){0, 0, 0}, fn);
+        if (w[0] * w[0] + w[2] * w[2] < 0.01f)
+            memcpy(w, fn, sizeof w);
     }
+    fit_along(lo, hi, w, &v.fit);
+    if (!v.interior)
+        v.camera = v.fit;
+    else
+        vdsh_view_room_camera_free(t, lo, hi, &v.camera);
+    flip = flip && !v.interior;
     v.light_count =
         vdsh_view_preferred_lights(lo, hi, v.interior, v.preferred, VDSH_VIEW_MAX_LIGHTS);
     for (int k = 0; k < 3; k++)

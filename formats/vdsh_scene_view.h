@@ -115,14 +115,18 @@ typedef struct vdsh_view {
     float light_lit[VDSH_VIEW_MAX_LIGHTS];
     float light_shadowed[VDSH_VIEW_MAX_LIGHTS];
     uint32_t pool_tried; /* seeded candidates the frame rule tried */
+    /* The fit camera, whatever the scene (vdsh-view --fit): a flat
+     * object's seen from its front, as vdsh_view_compute says; an
+     * object's default camera. */
+    vdsh_camera fit;
 } vdsh_view;
 
 /* Everything above from the mesh: bounds, the interior test, the default
  * camera, the default lights. A flat object (all vertices within a
  * millionth of the diagonal of the plane of its largest triangle) whose
  * front (the side the summed vertex normals face; the winding's where
- * they cancel) faces away from the fit camera's direction w: the camera
- * is fitted along w mirrored through the plane (along the plane's normal
+ * they cancel) faces away from the fit camera's direction w: the fit
+ * camera (fit; an object's camera) is fitted along w mirrored through the plane (along the plane's normal
  * where that is within about 6 degrees of vertical), and the preferred
  * lights are mirrored through the plane through the bounds' centre. A preferred light position in free space is
  * kept. Otherwise the candidates p + k h d are tried, rings k = 1, 2, ...

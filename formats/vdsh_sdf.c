@@ -117,7 +117,7 @@ vdsh_result vdsh_sdf_read_memory(const void *data, size_t size, const char *name
     if (size < VDSH_SDF_HEADER_SIZE)
         return vdsh_failf_at(
             err, size >= 8 && memcmp(d, MAGIC, 8) == 0 ? VDSH_ERR_TRUNCATED : VDSH_ERR_NOT_VDSH,
-            name, "%zu bytes: shorter than the %d-byte distance volume header", size,
+            name, "%zu byte%s: shorter than the %d-byte distance volume header", size, vdsh_s(size),
             VDSH_SDF_HEADER_SIZE);
     if (memcmp(d, MAGIC, 8) != 0)
         return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, name,
@@ -147,9 +147,10 @@ vdsh_result vdsh_sdf_read_memory(const void *data, size_t size, const char *name
     size_t n = sample_count(&v);
     if (n > (size - VDSH_SDF_HEADER_SIZE) / 2)
         return vdsh_failf_at(err, VDSH_ERR_TRUNCATED, name,
-                             "distance volume: %zu bytes of samples, "
+                             "distance volume: %zu byte%s of samples, "
                              "%u x %u x %u need %zu",
-                             size - VDSH_SDF_HEADER_SIZE, v.dim[0], v.dim[1], v.dim[2], 2 * n);
+                             size - VDSH_SDF_HEADER_SIZE, vdsh_s(size - VDSH_SDF_HEADER_SIZE),
+                             v.dim[0], v.dim[1], v.dim[2], 2 * n);
     if (size - VDSH_SDF_HEADER_SIZE != 2 * n)
         return vdsh_failf_at(err, VDSH_ERR_INVALID, name,
                              "distance volume: %zu bytes after the "

@@ -445,7 +445,9 @@ void vr_scene_default_camera(const vr_scene *s, vr_camera *out);
  * to the side of the bounds' centre, looking at it, just far enough that
  * every corner of the bounds is within a 60-degree field of view (fov_y
  * 60) vertically and horizontally (an image at least as wide as it is
- * tall shows all of it; a wider fov too). */
+ * tall shows all of it; a wider fov too). A flat object (one triangle,
+ * a panel) is seen from the side its normals face: the view mirrored
+ * through its plane (vdsh_view.fit, formats/vdsh_scene_view.h). */
 void vr_scene_fit_camera(const vr_scene *s, vr_camera *out);
 
 /* Up to max (at most 4) default light positions; returns how many were

@@ -20,6 +20,12 @@ __attribute__((format(printf, 3, 4)))
 vr_result
 vr_fail(vr_error *err, vr_result r, const char *fmt, ...);
 
+/* Plurals in messages: vr_plural(n, "vertex", "vertices"). */
+static inline const char *vr_plural(unsigned long long n, const char *one, const char *many)
+{
+    return n == 1 ? one : many;
+}
+
 /* VR_OK when glGetError reports nothing; else VR_ERR_GL naming `what`.
  * Drains every pending error so that the next check starts clean. */
 vr_result vr_check_gl(vr_error *err, const char *what);

@@ -41,9 +41,7 @@ void vr_scene_default_camera(const vr_scene *s, vr_camera *out)
 
 void vr_scene_fit_camera(const vr_scene *s, vr_camera *out)
 {
-    vdsh_camera c;
-    vdsh_view_fit_camera(s->bounds_min, s->bounds_max, &c);
-    from_vdsh(&c, out);
+    from_vdsh(&s->view.fit, out);
 }
 
 int vr_scene_default_lights(const vr_scene *s, vr_light *out, int max)

@@ -72,6 +72,13 @@ add_test(NAME bake_shard
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_shard.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
                  $<TARGET_FILE:vdsh-eval>)
+# Parts of one .gltf bake whose SRCS record the source with and without
+# its external buffers (a baker before 2026-11-30): merged when both match
+# the file, into the whole bake's bytes; refused when they do not.
+add_test(NAME bake_merge_source_record
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_merge_source_record.py
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge>
+                 ${CMAKE_CURRENT_BINARY_DIR}/merge_source_record)
 # vdsh-bake --encoding cpca (issue 29): 1 and 2 threads, 1, 3 and 7 shards
 # merged give the same bytes; decode error against the f32 bake bounded;
 # bad --cpca settings and mixed parts refused.
@@ -145,3 +152,22 @@ set_tests_properties(build_no_fma PROPERTIES SKIP_RETURN_CODE 77)
 # across Embree's kernel sets (test_isa_decisions.sh).
 add_executable(light_region_probe light_region_probe.c)
 target_link_libraries(light_region_probe PRIVATE vb_core)
+# vdsh-view's light pool (vr_scene_place_pool: the grid tracer's
+# vdsh_view_free_space) and the bake side's placement (vb_scene_place_lights:
+# Embree's probes, measured in double) with the same seed, one rule
+# (formats/vdsh_light.c): 64 positions equal bit for bit, in a room (the
+# bounds) and around a closed cube (the grown region).
+add_executable(light_pool_agree light_pool_agree.c)
+target_link_libraries(light_pool_agree PRIVATE vb_core vdsh_format m)
+add_test(NAME bake_light_pool_agree COMMAND sh -c [=[
+bake=$1; probe=$2; data=$3; d=$4; fail=0
+rm -rf "$d"; mkdir -p "$d"
+printf 'v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 3 4 8 7\nf 2 3 7 6\nf 1 5 8 4\n' > "$d/cube.obj"
+for s in "$d/cube.obj" "$data/room_box.obj"; do
+  n=$(basename "$s" .obj)
+  "$bake" "$s" --rays 16 --cube-size 0 -q -o "$d/$n.vdsh" || exit 1
+  "$probe" "$d/$n.vdsh" 64 || fail=1
+done
+exit $fail
+]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:light_pool_agree> ${CMAKE_CURRENT_SOURCE_DIR}/data
+    ${CMAKE_CURRENT_BINARY_DIR}/light_pool_agree_tmp)

@@ -49,6 +49,15 @@ if(VDSH_NODE)
   add_test(NAME web_cpca_pack
            COMMAND ${VDSH_NODE} ${CMAKE_CURRENT_SOURCE_DIR}/web_cpca_pack.mjs
                    ${PROJECT_SOURCE_DIR}/runtime/web/vdsh_core.js)
+  # web_fallback_view   runtime/web/vdsh_core.js's vdshFallbackView (the
+  #                     page's view of a glb without extras.vdsh.view): a
+  #                     flat object (a triangle facing each way, a quad)
+  #                     seen from its front, as vdsh-view sees it (the
+  #                     view vdsh-export writes), a solid from the bounds
+  add_test(NAME web_fallback_view
+           COMMAND ${VDSH_NODE} ${CMAKE_CURRENT_SOURCE_DIR}/web_fallback_view.mjs
+                   ${PROJECT_SOURCE_DIR}/runtime/web/vdsh_core.js $<TARGET_FILE:vdsh-bake>
+                   $<TARGET_FILE:vdsh-export> ${CMAKE_CURRENT_BINARY_DIR}/web_fallback_view)
 endif()
 
 #   gltf_web_viewer   runtime/web in headless chromium against vdsh-view's

@@ -34,3 +34,12 @@ add_test(NAME python_eval_matches_c_library
 add_test(NAME python_info_cli
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_python_info_cli.py
                  ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/python_info_cli)
+
+# format_plurals    a count of 1 said in the singular ("truncated: 1 byte",
+#                   "1 chunk announced", "(1 vertex)", "its 1 triangle"):
+#                   the C reader (vdsh-info), the Python reader, the mesh
+#                   readers (vdsh-bake); other counts keep the plural
+add_test(NAME format_plurals
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_plurals.py
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info> ${PROJECT_SOURCE_DIR}
+                 ${CMAKE_CURRENT_BINARY_DIR}/plurals $<TARGET_FILE:vdsh-eval>)

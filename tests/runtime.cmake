@@ -254,6 +254,24 @@ done
 exit $fail
 ]=] sh ${_view} $<TARGET_FILE:vdsh-bake> ${_rt_dir}/view_scale ${_png})
   _runtime_props(runtime_view_scale)
+  # --fit on a flat object (one triangle) facing away from the fit
+  # direction: seen from its front, as the default view sees it (the
+  # default camera of an object is the fit camera; --fit framed the
+  # triangle's back from the bounds alone).
+  add_test(NAME runtime_view_fit_flat COMMAND sh -c [=[
+v=$1; bake=$2; d=$3; fail=0
+rm -rf "$d"; mkdir -p "$d"
+for c in "away 1 2 3" "toward 1 3 2"; do
+  set -- $c
+  printf 'v 0 0 0\nv 1 0 0\nv 0 0 1\nf %s %s %s\n' $2 $3 $4 > "$d/$1.obj"
+  "$bake" "$d/$1.obj" --rays 16 --cube-size 0 -q -o "$d/$1.vdsh" || exit 1
+  "$v" -q --render "$d/$1-default.png" --size 64x48 --mode none "$d/$1.vdsh" || exit 1
+  "$v" -q --render "$d/$1-fit.png" --size 64x48 --mode none --fit "$d/$1.vdsh" || exit 1
+  cmp -s "$d/$1-default.png" "$d/$1-fit.png" || { echo "triangle facing $1: --fit draws another view than the default"; fail=1; }
+done
+exit $fail
+]=] sh ${_view} $<TARGET_FILE:vdsh-bake> ${_rt_dir}/view_fit_flat)
+  _runtime_props(runtime_view_fit_flat)
 endif()
 
 # Headless images: one render per mode and the comparison row.

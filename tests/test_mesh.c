@@ -709,7 +709,7 @@ static void test_load_ply_off_stl(void)
                          "after_none_bin.ply: truncated in material 0 of 2");
         buf[n] = 0;
         expect_fail_free(fixture("after_trailing_bin.ply", buf, n + 1), VB_ERR_FORMAT,
-                         "after_trailing_bin.ply: 1 bytes of data after the last element "
+                         "after_trailing_bin.ply: 1 byte of data after the last element "
                          "('material')");
         put_u32(buf + faces_end, 0x80000000u, 1);
         expect_fail_free(fixture("after_neg_bin.ply", buf, n), VB_ERR_FORMAT,

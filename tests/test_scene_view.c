@@ -449,6 +449,8 @@ static void test_flat(void)
               (double)n[0], (double)n[1], (double)n[2], (double)v.camera.eye[0],
               (double)v.camera.eye[1], (double)v.camera.eye[2]);
         CHECK(!vdsh_camera_degenerate(&v.camera), "flat %zu: a degenerate camera", i);
+        CHECK(same_camera(&v.fit, &v.camera), "flat %zu: the fit camera (--fit) is not the view's",
+              i);
         for (int k = 0; k < 4; k++)
             CHECK(k == 2 && !is_quad ? 1 : in_view(&v.camera, p[k]),
                   "flat %zu: corner %d out of view", i, k);

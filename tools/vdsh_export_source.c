@@ -216,8 +216,8 @@ int vdsh_src_load(const char *path, vdsh_src *s, char *msg, size_t cap)
         }
         free(file);
         if (!(want >= 0) || want > (double)sb->size) {
-            fail(msg, cap, "%s: buffer %d is %zu bytes, shorter than its byteLength %.0f", path, i,
-                 sb->size, want);
+            fail(msg, cap, "%s: buffer %d is %zu byte%s, shorter than its byteLength %.0f", path, i,
+                 sb->size, sb->size == 1 ? "" : "s", want);
             goto out;
         }
     }

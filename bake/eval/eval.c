@@ -1313,9 +1313,10 @@ vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths, uin
     if (!d.allow_mismatch && (occ.vertex_count != f->header.occluder_vertex_count ||
                               occ.triangle_count != f->header.occluder_triangle_count)) {
         r = vb_fail(err, VB_ERR_INVALID,
-                    "the sources load as %u vertices and %u triangles, but the bake traced "
+                    "the sources load as %u %s and %u triangle%s, but the bake traced "
                     "%u and %u (the mesh loader changed since the bake?)",
-                    occ.vertex_count, occ.triangle_count, f->header.occluder_vertex_count,
+                    occ.vertex_count, vb_plural(occ.vertex_count, "vertex", "vertices"),
+                    occ.triangle_count, vb_s(occ.triangle_count), f->header.occluder_vertex_count,
                     f->header.occluder_triangle_count);
         goto fail;
     }

@@ -628,9 +628,9 @@ static vb_result write_begin(const vb_mesh *m, const char *path, const char *wha
         return vb_fail(err, VB_ERR_ARGUMENT, "%s: invalid argument", what);
     for (size_t j = 0; j < 3 * (size_t)m->triangle_count; j++)
         if (m->indices[j] >= m->vertex_count)
-            return vb_fail(err, VB_ERR_INVALID,
-                           "%s: triangle %zu: index %u out of range (%u vertices)", path, j / 3,
-                           m->indices[j], m->vertex_count);
+            return vb_fail(err, VB_ERR_INVALID, "%s: triangle %zu: index %u out of range (%u %s)",
+                           path, j / 3, m->indices[j], m->vertex_count,
+                           vb_plural(m->vertex_count, "vertex", "vertices"));
     vdsh_error ve;
     vdsh_result vr = vdsh_output_open(path, out, &ve);
     if (vr != VDSH_OK)
@@ -1186,9 +1186,9 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
         if (v < 0 || v >= (int64_t)raw->vertex_count) {
             free(idx);
             return vb_fail(err, VB_ERR_INVALID,
-                           "%s: face %llu: vertex index %lld out of range (%u vertices)", path,
+                           "%s: face %llu: vertex index %lld out of range (%u %s)", path,
                            (unsigned long long)raw->faces[j / 3] + base, (long long)v + base,
-                           raw->vertex_count);
+                           raw->vertex_count, vb_plural(raw->vertex_count, "vertex", "vertices"));
         }
         idx[j] = (uint32_t)v;
     }
@@ -1232,8 +1232,9 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
         split_free(&sv);
         vb_mesh_free(&m);
         if (degenerate)
-            return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh (all %u triangles repeat a vertex)",
-                           path, degenerate);
+            return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh (%s %u %s a vertex)", path,
+                           degenerate == 1 ? "its" : "all", degenerate,
+                           degenerate == 1 ? "triangle repeats" : "triangles repeat");
         return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh (no faces)", path);
     }
     vb_mesh_report rp;

@@ -123,9 +123,9 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
                 uint64_t idx = load_u32(b + 4 * k, false);
                 if (idx >= nv)
                     return vb_fail(err, VB_ERR_INVALID,
-                                   "%s: face %llu: vertex index %llu out of range (%llu vertices)",
-                                   path, (unsigned long long)f, (unsigned long long)idx,
-                                   (unsigned long long)nv);
+                                   "%s: face %llu: vertex index %llu out of range (%llu %s)", path,
+                                   (unsigned long long)f, (unsigned long long)idx,
+                                   (unsigned long long)nv, vb_plural(nv, "vertex", "vertices"));
                 polygon.push_back((int64_t)idx);
             }
             b += 4 * n;
@@ -237,10 +237,10 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
                                (unsigned long long)f, t.show_len(), t.b,
                                int_problem(t, "is not a number"));
             if (idx < 0 || (uint64_t)idx >= nv)
-                return vb_fail(
-                    err, VB_ERR_INVALID,
-                    "%s: line %lu: face %llu: vertex index %lld out of range (%llu vertices)", path,
-                    c.line, (unsigned long long)f, idx, (unsigned long long)nv);
+                return vb_fail(err, VB_ERR_INVALID,
+                               "%s: line %lu: face %llu: vertex index %lld out of range (%llu %s)",
+                               path, c.line, (unsigned long long)f, idx, (unsigned long long)nv,
+                               vb_plural(nv, "vertex", "vertices"));
             polygon.push_back((int64_t)idx);
         }
         if (color)

@@ -314,10 +314,10 @@ vb_result parse(const char *name, vb_mesh_format format, const uint8_t *bytes, s
     for (size_t j = 0; j < b.indices.size(); j++) {
         int64_t v = b.indices[j];
         if (v < 0 || (uint64_t)v >= nv)
-            return vb_fail(err, VB_ERR_INVALID,
-                           "%s: face %llu: vertex index %lld out of range (%u vertices)", name,
-                           (unsigned long long)b.tri_face[j / 3] + base,
-                           (long long)v + (long long)base, (unsigned)nv);
+            return vb_fail(
+                err, VB_ERR_INVALID, "%s: face %llu: vertex index %lld out of range (%u %s)", name,
+                (unsigned long long)b.tri_face[j / 3] + base, (long long)v + (long long)base,
+                (unsigned)nv, vb_plural(nv, "vertex", "vertices"));
     }
     b.finish(ex.dropped, out);
     return VB_OK;

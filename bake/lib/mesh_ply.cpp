@@ -591,8 +591,9 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                         const uint64_t cnt = items;
                         if (is_indices && cnt < 3)
                             return vb_fail(err, VB_ERR_FORMAT,
-                                           "%s: face %llu has %llu vertices (needs at least 3)",
-                                           path, (unsigned long long)n, (unsigned long long)cnt);
+                                           "%s: face %llu has %llu %s (needs at least 3)", path,
+                                           (unsigned long long)n, (unsigned long long)cnt,
+                                           vb_plural(cnt, "vertex", "vertices"));
                     }
                     int ts = p.type->size;
                     if (items > left / (size_t)ts)
@@ -637,8 +638,9 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                             if (idx < 0 || (uint64_t)idx >= nv)
                                 return vb_fail(
                                     err, VB_ERR_INVALID,
-                                    "%s: face %llu: vertex index %lld out of range (%llu vertices)",
-                                    path, (unsigned long long)n, idx, (unsigned long long)nv);
+                                    "%s: face %llu: vertex index %lld out of range (%llu %s)", path,
+                                    (unsigned long long)n, idx, (unsigned long long)nv,
+                                    vb_plural(nv, "vertex", "vertices"));
                             polygon.push_back(idx);
                         }
                     }
@@ -693,9 +695,9 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                             if (is_indices && (iv < 0 || (uint64_t)iv >= nv))
                                 return vb_fail(
                                     err, VB_ERR_INVALID,
-                                    "%s: line %lu: face %llu: vertex index %lld out of range (%llu vertices)",
-                                    path, c.line, (unsigned long long)n, iv,
-                                    (unsigned long long)nv);
+                                    "%s: line %lu: face %llu: vertex index %lld out of range (%llu %s)",
+                                    path, c.line, (unsigned long long)n, iv, (unsigned long long)nv,
+                                    vb_plural(nv, "vertex", "vertices"));
                         }
                         /* Colours not of type float were read as an int:
                          * anything else would shift (or stop) the rest,
@@ -744,9 +746,9 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
      * count, or two files in one. */
     if (format != 0 && left > 0)
         return vb_fail(err, VB_ERR_FORMAT,
-                       "%s: %zu bytes of data after the last element ('%s'): a wrong element "
+                       "%s: %zu byte%s of data after the last element ('%s'): a wrong element "
                        "count?",
-                       path, left, elems.back().name.c_str());
+                       path, left, vb_s(left), elems.back().name.c_str());
     if (format == 0 && c.next(&t))
         return vb_fail(err, VB_ERR_FORMAT,
                        "%s: line %lu: data after the last element ('%s'): '%.*s' (a wrong "

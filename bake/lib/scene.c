@@ -276,9 +276,10 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
         *tried = k;
     if (n < count)
         return vb_fail(err, VB_ERR_INVALID,
-                       "no room for %u lights by rule %s: %u found in %u "
-                       "candidates in %s",
-                       count, vb_light_rule_name(rule), n, k, region_name(grown));
+                       "no room for %u light%s by rule %s: %u found in %u "
+                       "candidate%s in %s",
+                       count, vb_s(count), vb_light_rule_name(rule), n, k, vb_s(k),
+                       region_name(grown));
     return VB_OK;
 }
 
@@ -301,8 +302,9 @@ vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count
         *tried = k;
     if (n < count)
         return vb_fail(err, VB_ERR_INVALID,
-                       "no free space for lights: %u of %u candidates in %s "
-                       "were inside solids or nearer than %g to a surface",
-                       k - n, k, region_name(grown), (double)vdsh_free_clearance(s->diagonal));
+                       "no free space for lights: %u of %u candidate%s in %s "
+                       "%s inside solids or nearer than %g to a surface",
+                       k - n, k, vb_s(k), region_name(grown), k - n == 1 ? "was" : "were",
+                       (double)vdsh_free_clearance(s->diagonal));
     return VB_OK;
 }

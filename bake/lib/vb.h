@@ -34,6 +34,17 @@ typedef struct vb_error {
     char msg[512];
 } vb_error;
 
+/* Plurals in messages, as tools/vt_cli.h's: "%u byte%s", n, vb_s(n)
+ * says "1 byte", "2 bytes"; vb_plural(n, "vertex", "vertices"). */
+static inline const char *vb_s(unsigned long long n)
+{
+    return n == 1 ? "" : "s";
+}
+static inline const char *vb_plural(unsigned long long n, const char *one, const char *many)
+{
+    return n == 1 ? one : many;
+}
+
 /* Format a message into err (if not NULL) and return r. */
 #if defined(__GNUC__)
 __attribute__((format(printf, 3, 4)))

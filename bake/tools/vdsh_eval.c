@@ -556,9 +556,11 @@ static void print_table(FILE *o, const context *c)
     else
         fprintf(o, " (SHA-256 verified)\n");
     fprintf(o,
-            "            %u receiver vertices, %u triangles; %u occluder triangles; "
+            "            %u receiver %s, %u triangle%s; %u occluder triangle%s; "
             "diagonal %.4g\n",
-            h->vertex_count, h->triangle_count, h->occluder_triangle_count, (double)r->diagonal);
+            h->vertex_count, vt_plural(h->vertex_count, "vertex", "vertices"), h->triangle_count,
+            vt_s(h->triangle_count), h->occluder_triangle_count, vt_s(h->occluder_triangle_count),
+            (double)r->diagonal);
     fprintf(o, "  bake      %u rays/receiver (%s), seed %llu, max distance %.4g, max edge %g",
             h->rays, vdsh_sampling_name(h->sampling), (unsigned long long)h->seed,
             (double)h->max_distance, (double)h->max_edge);

@@ -5,7 +5,9 @@
  *     vdsh-merge part-0.vdsh part-1.vdsh ... -o scene.vdsh
  *
  * Every part is read and checked against the first: same inputs (SRCS:
- * names, sizes, SHA-256), same options (HEAD and every stream header),
+ * names, sizes, SHA-256; a .gltf recorded without its external buffers,
+ * by a bake before 2026-11-30, and with them, when both records match
+ * the file its name finds), same options (HEAD and every stream header),
  * same receivers (positions, oriented normals, triangles), same shard
  * count and merged encoding; each shard exactly once, with the receiver
  * range vb_shard_range gives it. A refusal names the part (and, for
@@ -45,6 +47,7 @@
 
 #include "cubemap.h"
 #include "job.h"
+#include "mesh.h"
 #include "vdsh.h"
 #include "vdsh_cpca.h"
 #include "vt_cli.h"
@@ -79,15 +82,111 @@ static int same_header(const vdsh_header *a, const vdsh_header *b)
            memcmp(a->bounds_max, b->bounds_max, sizeof a->bounds_max) == 0;
 }
 
-static int same_sources(const vdsh_file *a, const vdsh_file *b)
+/* A glTF source's two records (formats/VDSH.md, SRCS): bakes before
+ * 2026-11-30 hashed the .gltf alone, later ones the file and its external
+ * buffers. Parts of one bake from both kinds of baker differ there only;
+ * they belong together when both records verify against the same file
+ * (found by its recorded name, as given, else beside the part), which is
+ * read once per source. The merged file records the file with its
+ * buffers, as the whole bake now writes it. */
+typedef struct source_check {
+    int done;  /* looked for and hashed */
+    int found; /* the file was found and read: info holds both records */
+    vb_source_info info;
+    char path[PATH_MAX];
+} source_check;
+
+static source_check checks[VDSH_MAX_SOURCES];
+static int quiet_merge;
+
+static int record_is(const vdsh_source *r, uint64_t size, const uint8_t sha[32])
 {
+    return r->size == size && memcmp(r->sha256, sha, 32) == 0;
+}
+
+/* Source i's file: its name as given, else beside the part at `part`. */
+static void check_source(uint32_t i, const char *name, const char *part)
+{
+    source_check *c = &checks[i];
+    if (c->done)
+        return;
+    c->done = 1;
+    char tmp[PATH_MAX];
+    snprintf(tmp, sizeof tmp, "%s", part);
+    const char *cands[2] = {name, NULL};
+    char beside[PATH_MAX];
+    if (name[0] != '/' &&
+        snprintf(beside, sizeof beside, "%s/%s", dirname(tmp), name) < (int)sizeof beside)
+        cands[1] = beside;
+    for (int k = 0; k < 2 && !c->found; k++) {
+        if (!cands[k] || access(cands[k], R_OK) != 0)
+            continue;
+        vb_mesh m = {0};
+        vb_error err;
+        if (vb_mesh_load(cands[k], &(vb_load_desc){0}, &m, &c->info, &err) == VB_OK) {
+            c->found = 1;
+            snprintf(c->path, sizeof c->path, "%s", cands[k]);
+        }
+        vb_mesh_free(&m);
+    }
+}
+
+/* Whether b's sources are a's (a: the first part, whose record of a
+ * source is upgraded to the file with its buffers when b recorded it so
+ * and both verify); else *why says what differs. */
+static int same_sources(vdsh_file *a, const char *a_path, const vdsh_file *b, const char *b_path,
+                        char *why, size_t why_size)
+{
+    snprintf(why, why_size, "%s", "other inputs (SRCS: names, sizes or SHA-256 differ)");
     if (a->source_count != b->source_count)
         return 0;
     for (uint32_t i = 0; i < a->source_count; i++)
-        if (memcmp(a->sources[i].sha256, b->sources[i].sha256, 32) != 0 ||
-            a->sources[i].size != b->sources[i].size ||
-            strcmp(a->sources[i].name, b->sources[i].name) != 0)
+        if (strcmp(a->sources[i].name, b->sources[i].name) != 0)
             return 0;
+    for (uint32_t i = 0; i < a->source_count; i++) {
+        vdsh_source *ra = &a->sources[i];
+        const vdsh_source *rb = &b->sources[i];
+        if (record_is(ra, rb->size, rb->sha256))
+            continue;
+        /* the file alone is the shorter record (formats/VDSH.md) */
+        if (ra->size == rb->size)
+            return 0;
+        check_source(i, ra->name, b_path);
+        if (!checks[i].found)
+            check_source(i, ra->name, a_path);
+        const source_check *c = &checks[i];
+        if (!c->found) {
+            snprintf(why, why_size,
+                     "source %u, '%s', recorded with and without its external buffers (a bake "
+                     "before 2026-11-30 hashed the .gltf alone), and the file is not found to "
+                     "check both against (give the parts where its name, as recorded, finds it)",
+                     i + 1, ra->name);
+            return 0;
+        }
+        const vb_source_info *f = &c->info;
+        const int a_full = record_is(ra, f->size, f->sha256),
+                  a_alone = record_is(ra, f->file_size, f->file_sha256);
+        const int b_full = record_is(rb, f->size, f->sha256),
+                  b_alone = record_is(rb, f->file_size, f->file_sha256);
+        if (!((a_full && b_alone) || (a_alone && b_full))) {
+            snprintf(why, why_size,
+                     "other inputs (SRCS: source %u, '%s', recorded as %llu and %llu bytes: "
+                     "%s is not the file both parts baked)",
+                     i + 1, ra->name, (unsigned long long)ra->size, (unsigned long long)rb->size,
+                     c->path);
+            return 0;
+        }
+        if (!quiet_merge)
+            fprintf(stderr,
+                    "vdsh-merge: %s: source %u, '%s', recorded without its external buffers "
+                    "(a bake before 2026-11-30); both records match %s: the merged file "
+                    "records it with them\n",
+                    a_alone ? a_path : b_path, i + 1, ra->name, c->path);
+        if (a_alone) {
+            ra->size = f->size;
+            memcpy(ra->sha256, f->sha256, 32);
+        }
+    }
     return 1;
 }
 
@@ -102,10 +201,12 @@ static int same_stream(const vdsh_stream *a, const vdsh_stream *b)
 }
 
 /* Why part b does not belong with part a (the first), or NULL. */
-static const char *mismatch(const vdsh_file *a, const vdsh_file *b)
+static const char *mismatch(vdsh_file *a, const char *a_path, const vdsh_file *b,
+                            const char *b_path)
 {
-    if (!same_sources(a, b))
-        return "other inputs (SRCS: names, sizes or SHA-256 differ)";
+    static char why[PATH_MAX + 512];
+    if (!same_sources(a, a_path, b, b_path, why, sizeof why))
+        return why;
     if (!same_header(&a->header, &b->header))
         return "other options or receivers (HEAD differs)";
     if (a->stream_count != b->stream_count)
@@ -133,8 +234,7 @@ static const char *mismatch(const vdsh_file *a, const vdsh_file *b)
 /* Read part `path` and check it: a part, belonging with `first` (at
  * first_path; NULL: it is the first), f32 streams. 0, or 1 after saying why (*out then
  * NULL). */
-static int read_part(const char *path, const vdsh_file *first, const char *first_path,
-                     vdsh_file **out)
+static int read_part(const char *path, vdsh_file *first, const char *first_path, vdsh_file **out)
 {
     vdsh_error verr;
     vdsh_file *p = NULL;
@@ -151,7 +251,7 @@ static int read_part(const char *path, const vdsh_file *first, const char *first
         vdsh_free(p);
         return 1;
     }
-    const char *why = first ? mismatch(first, p) : NULL;
+    const char *why = first ? mismatch(first, first_path, p, path) : NULL;
     if (why) {
         fprintf(stderr, "vdsh-merge: %s: does not belong with %s: %s\n", path, first_path, why);
         vdsh_free(p);
@@ -593,6 +693,7 @@ static int run(const options *o)
         return rc;
     merge m = {0};
     int status = 1;
+    quiet_merge = o->quiet;
     for (int i = 0; i < o->part_count; i++) {
         vdsh_file *p = NULL;
         if (read_part(o->parts[i], i ? m.p0 : NULL, o->parts[0], &p) != 0)

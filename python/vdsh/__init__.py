@@ -93,6 +93,11 @@ class VdshFile:
         self.positions = self.normals = self.triangles = None
 
 
+def _s(n: int) -> str:
+    """Plurals in messages: "%d byte%s" % (n, _s(n)) says "1 byte", "2 bytes"."""
+    return "" if n == 1 else "s"
+
+
 def _fail(path: str, msg: str) -> NoReturn:
     raise VdshError("%s: %s" % (path, msg))
 
@@ -124,7 +129,7 @@ def parse(data: bytes, path: str = "memory") -> VdshFile:
     if data[:8] != MAGIC[:n]:
         _fail(path, "not a .vdsh file (magic)")
     if n < 32:  # a file cut short, as vdsh-info says it
-        _fail(path, "truncated: %d bytes, shorter than the 32-byte header" % n)
+        _fail(path, "truncated: %d byte%s, shorter than the 32-byte header" % (n, _s(n)))
     version, count, size, flags, crc = struct.unpack_from("<IIQII", data, 8)
     # The version before the header CRC, as formats/vdsh_read.c: a later
     # version may lay its header out otherwise, and "version N" is then
@@ -136,9 +141,9 @@ def parse(data: bytes, path: str = "memory") -> VdshFile:
     if not crc_ok:
         _fail(path, "header CRC mismatch (stored 0x%08x, computed 0x%08x)" % (crc, zlib.crc32(data[:28])))
     if size > n:
-        _fail(path, "truncated: %d bytes, the header says %d" % (n, size))
+        _fail(path, "truncated: %d byte%s, the header says %d" % (n, _s(n), size))
     if size != n:
-        _fail(path, "file_size %d but the file has %d bytes" % (size, n))
+        _fail(path, "file_size %d but the file has %d byte%s" % (size, n, _s(n)))
     if not 1 <= count <= 64 or flags != 0:
         _fail(path, "chunk_count %d or flags %d out of range" % (count, flags))
     f, off, seen = VdshFile(), 32, []
@@ -190,7 +195,7 @@ def _chunk(f, cid, b, path):
     h = f.header
     if cid == b"HEAD":
         if len(b) != 128:
-            _fail(path, "HEAD is %d bytes, must be 128" % len(b))
+            _fail(path, "HEAD is %d byte%s, must be 128" % (len(b), _s(len(b))))
         (V, T, rays, sampling, seed, maxd, maxe, rule, lflags, cube, ov, ot, tflags) = \
             struct.unpack_from("<IIIIQffIIIIII", b, 0)
         bmin = struct.unpack_from("<3f", b, 56)
@@ -238,7 +243,7 @@ def _chunk(f, cid, b, path):
             _fail(path, "SRCS: payload does not end after the last name")
     elif cid in (b"POSN", b"NORM"):
         if len(b) != 12 * V:
-            _fail(path, "%s is %d bytes, must be %d" % (cid.decode(), len(b), 12 * V))
+            _fail(path, "%s is %d byte%s, must be %d" % (cid.decode(), len(b), _s(len(b)), 12 * V))
         a = np.frombuffer(b, "<f4").reshape(V, 3)
         if not np.isfinite(a).all():
             _fail(path, "%s: a value is not finite" % cid.decode())
@@ -252,7 +257,7 @@ def _chunk(f, cid, b, path):
             f.positions = a
     elif cid == b"TRIS":
         if len(b) != 12 * T:
-            _fail(path, "TRIS is %d bytes, must be %d" % (len(b), 12 * T))
+            _fail(path, "TRIS is %d byte%s, must be %d" % (len(b), _s(len(b)), 12 * T))
         t = np.frombuffer(b, "<u4").reshape(T, 3)
         if T and t.max() >= V:
             _fail(path, "TRIS: an index is out of range")
@@ -261,7 +266,7 @@ def _chunk(f, cid, b, path):
         f._coef.append(b)
     elif cid == b"part":
         if len(b) != 32:
-            _fail(path, "part is %d bytes, must be 32" % len(b))
+            _fail(path, "part is %d byte%s, must be 32" % (len(b), _s(len(b))))
         i, n, rb, re, enc, ck, cb, cbits = struct.unpack_from("<8I", b, 0)
         if not (n >= 1 and i < n and rb < re <= h["vertex_count"] and enc <= 4):
             _fail(path, "part: shard %d of %d, receivers %d..%d or encoding %d out of range"
@@ -279,7 +284,7 @@ def _chunk(f, cid, b, path):
             f.part.update(cpca_clusters=ck, cpca_basis=cb, cpca_bits=cbits)
     elif cid == b"adpt":
         if len(b) != 32:
-            _fail(path, "adpt is %d bytes, must be 32" % len(b))
+            _fail(path, "adpt is %d byte%s, must be 32" % (len(b), _s(len(b))))
         tol, me = struct.unpack_from("<2f", b, 0)
         mr, nl, mx, st, rd, cd = struct.unpack_from("<6I", b, 8)
         V = h["vertex_count"]
@@ -290,13 +295,13 @@ def _chunk(f, cid, b, path):
                           start_receivers=st, rounds=rd, candidates=cd)
     elif cid == b"stat":
         if len(b) != 32:
-            _fail(path, "stat is %d bytes, must be 32" % len(b))
+            _fail(path, "stat is %d byte%s, must be 32" % (len(b), _s(len(b))))
         v = struct.unpack("<QQIIII", b)
         f.stats = dict(zip(["rays_traced", "rays_missed", "degenerate_receivers",
                             "undefined_normals", "moved_origins", "flipped_normals"], v))
     elif cid == b"time":
         if len(b) != 64:
-            _fail(path, "time is %d bytes, must be 64" % len(b))
+            _fail(path, "time is %d byte%s, must be 64" % (len(b), _s(len(b))))
         v = struct.unpack_from("<5d", b, 0)
         if not all(np.isfinite(x) and x >= 0 for x in v):
             _fail(path, "time: a value is not finite or negative")
@@ -408,7 +413,7 @@ def _coef(f, b, V, path):
         rec = np.array([(_bpv(enc, k * k) + 3) // 4 * 4 for k in range(order + 1)])
         start = data + otab + np.concatenate(([0], np.cumsum(rec[orders])))
         if len(b) != start[-1]:
-            _fail(path, "COEF: payload is %d bytes, must be %d" % (len(b), start[-1]))
+            _fail(path, "COEF: payload is %d byte%s, must be %d" % (len(b), _s(len(b)), start[-1]))
         buf = np.frombuffer(b, np.uint8)
         stored = np.zeros((V, nc), np.float32 if enc < 2 else np.int32)
         for k in np.unique(orders):
@@ -421,7 +426,7 @@ def _coef(f, b, V, path):
     else:
         bpv = _bpv(enc, nc)
         if len(b) != data + V * bpv:
-            _fail(path, "COEF: payload is %d bytes, must be %d" % (len(b), data + V * bpv))
+            _fail(path, "COEF: payload is %d byte%s, must be %d" % (len(b), _s(len(b)), data + V * bpv))
         raw = np.frombuffer(b, np.uint8, V * bpv, data).reshape(V, bpv)
         stored = _records(raw, nc, enc, levels, path)
     big = float(np.abs(stored.astype(np.float32)).max()) if stored.size else 0.0
@@ -475,7 +480,7 @@ def _cpca(b, order, V, path):
     sizes = [4 * K * B, 2 * K * nc, 2 * K * B * nc]
     model = at + sum(r16(x) for x in sizes)
     if len(b) != model + 4 * W * V:
-        _fail(path, "COEF: payload is %d bytes, must be %d" % (len(b), model + 4 * W * V))
+        _fail(path, "COEF: payload is %d byte%s, must be %d" % (len(b), _s(len(b)), model + 4 * W * V))
     arrays = []
     for x, dt, shape in zip(sizes, ["<f4", "<f2", "<f2"], [(K, B), (K, nc), (K, B, nc)]):
         if any(b[at + x:at + r16(x)]):

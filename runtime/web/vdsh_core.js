@@ -328,3 +328,95 @@ export function vdshVertexGlsl(plan, shaders, texWidth, cpca) {
 `;
   return { defines, decl };
 }
+
+// The default view of a file without extras.vdsh.view (an older export),
+// formats/vdsh_scene_view.c's for an object: the outside camera
+// (vdsh_view_fit_camera) and an object's preferred lights, outside its
+// bounding sphere (so in free space). lo, hi: the bounds; pos, nrm
+// (vertex_count x 3) and indices (triangle_count x 3), when given, decide
+// whether the object is flat (every vertex within a millionth of the
+// diagonal of the plane of its largest triangle: one triangle, a panel);
+// a flat object whose front (the side its summed vertex normals face; the
+// winding's where they cancel) faces away from the fit direction w is
+// seen along w mirrored through its plane (along its normal where that is
+// within about 6 degrees of vertical), its lights mirrored through the
+// plane through the bounds' centre: vdsh_view_compute's rule (flat_front,
+// mirror), so that the camera sees the side the normals face.
+export function vdshFallbackView(lo, hi, pos, nrm, indices) {
+  const f = Math.fround;
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const norm = (a) => { const l = Math.hypot(a[0], a[1], a[2]); return [a[0] / l, a[1] / l, a[2] / l]; };
+  const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+  const c = [0, 1, 2].map((k) => f(0.5 * (lo[k] + hi[k])));
+  const r = Math.sqrt([0, 1, 2].reduce((a, k) => a + 0.25 * (hi[k] - lo[k]) ** 2, 0)) || 1;
+  const diag = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
+  const ax = hi[0] - lo[0] >= hi[2] - lo[2] ? 0 : 2, other = 2 - ax;
+  const u = [[0, 0, 0], [0, 1, 0], [0, 0, 0]];
+  u[0][ax] = 1;
+  u[2][other] = 1;
+  const place = (cc, s, a, b, d) => [0, 1, 2].map((k) => cc[k] + s * (a * u[0][k] + b * u[1][k] + d * u[2][k]));
+  let w = norm(place([0, 0, 0], 1, 0.8, 0.45, 0.4));
+  const fn = pos && indices ? flatFront(pos, nrm, indices, diag) : null;
+  const flip = fn !== null && dot(w, fn) < 0;
+  // x mirrored through the plane through cc with unit normal fn
+  const mirror = (x, cc) => {
+    const d = dot([0, 1, 2].map((k) => x[k] - cc[k]), fn);
+    return x.map((v, k) => v - 2 * d * fn[k]);
+  };
+  if (flip) {
+    w = mirror(w, [0, 0, 0]);
+    if (w[0] * w[0] + w[2] * w[2] < 0.01) w = fn.slice();
+  }
+  const s = norm([w[2], 0, -w[0]]);
+  const v = cross(w, s);
+  const t = Math.tan(0.5 * 60 * Math.PI / 180);
+  let dist = 0;
+  for (let corner = 0; corner < 8; corner++) {
+    const p = [0, 1, 2].map((k) => ((corner >> k) & 1 ? hi[k] : lo[k]) - c[k]);
+    dist = Math.max(dist, dot(p, w) + Math.max(Math.abs(dot(p, s)), Math.abs(dot(p, v))) / t);
+  }
+  dist = 1.05 * (dist > 0 ? dist : r);
+  const around = [[1.5, 1.5, -0.4], [-1.3, 1.2, 1.4], [0.5, 2.1, 1.5], [1.6, 0.5, 1.2]];
+  const lights = around.map((a) => place(c, r, a[0], a[1], a[2]));
+  return {
+    interior: false, eye: c.map((x, k) => x + dist * w[k]), target: c, up: [0, 1, 0], fov_y: 60,
+    lights: flip ? lights.map((l) => mirror(l, c)) : lights, fallback: true,
+  };
+}
+
+// formats/vdsh_scene_view.c's flat_front: the unit normal toward a flat
+// object's front, or null (not flat, no triangle with an area, or the
+// sides cancel).
+function flatFront(pos, nrm, indices, diag) {
+  let best = 0, pn = null, p0 = null;
+  const at = (i) => [pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]];
+  const crossOf = (t) => {
+    const a = at(indices[3 * t]), b = at(indices[3 * t + 1]), c = at(indices[3 * t + 2]);
+    const e1 = [0, 1, 2].map((k) => b[k] - a[k]), e2 = [0, 1, 2].map((k) => c[k] - a[k]);
+    return { a, x: [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]] };
+  };
+  const nt = Math.floor(indices.length / 3), nv = Math.floor(pos.length / 3);
+  for (let t = 0; t < nt; t++) {
+    const { a, x } = crossOf(t);
+    const l = Math.hypot(x[0], x[1], x[2]);
+    if (l > best) {
+      best = l;
+      pn = x.map((e) => e / l);
+      p0 = a;
+    }
+  }
+  if (!pn) return null;
+  let side = 0, wind = 0;
+  for (let i = 0; i < nv; i++) {
+    const q = at(i);
+    if (Math.abs((q[0] - p0[0]) * pn[0] + (q[1] - p0[1]) * pn[1] + (q[2] - p0[2]) * pn[2]) > 1e-6 * diag) return null;
+    if (nrm) side += nrm[3 * i] * pn[0] + nrm[3 * i + 1] * pn[1] + nrm[3 * i + 2] * pn[2];
+  }
+  for (let t = 0; t < nt; t++) {
+    const { x } = crossOf(t);
+    wind += x[0] * pn[0] + x[1] * pn[1] + x[2] * pn[2];
+  }
+  const sign = side !== 0 ? side : wind;
+  if (sign === 0) return null;
+  return pn.map((e) => (sign > 0 ? e : -e));
+}

@@ -39,8 +39,9 @@
 // meshes[0].extras.vdsh.view (formats/vdsh_scene_view.h: a room seen from
 // inside, an object framed from outside, lights moved into free space).
 // A file without it (an older export) is framed from outside, lit from
-// outside its bounding sphere (vdsh_view_fit_camera and an object's
-// preferred lights), as vdsh-view frames an object.
+// outside its bounding sphere (vdsh_core.js's vdshFallbackView:
+// vdsh_view_fit_camera and an object's preferred lights), as vdsh-view
+// frames an object; a flat one (a triangle, a panel) from its front.
 //
 // Files: glTF 2.0 binary; attributes of any component type, normalised or
 // not, interleaved or not, and the node's transform (KHR_mesh_quantization,
@@ -67,7 +68,7 @@
 // failure the message is shown on the page (#msg), in document.title
 // ("error: ...") and in window.vdshError.
 import { VDSH_EXT, vdshChooseStream, vdshStreamPlan, vdshBufferData, vdshVertexGlsl, vdshCpcaDecode,
-  vdshCpcaBufferData } from './vdsh_core.js';
+  vdshCpcaBufferData, vdshFallbackView } from './vdsh_core.js';
 
 // The program: vdsh_core.js's vertex stage (the VDSH value per light,
 // interpolated), then vdsh-view's shading per fragment.
@@ -326,35 +327,6 @@ function viewProj(cam, aspect, zn, zf) {
   return { m: new Float32Array(mul4(p, v)), s, u, f };
 }
 
-// formats/vdsh_scene_view.c for a file without extras.vdsh.view: the
-// outside camera (vdsh_view_fit_camera) and an object's preferred lights,
-// outside its bounding sphere (so in free space).
-function fallbackView(lo, hi) {
-  const f = Math.fround;
-  const c = [0, 1, 2].map((k) => f(0.5 * (lo[k] + hi[k])));
-  const r = Math.sqrt([0, 1, 2].reduce((a, k) => a + 0.25 * (hi[k] - lo[k]) ** 2, 0)) || 1;
-  const ax = hi[0] - lo[0] >= hi[2] - lo[2] ? 0 : 2, other = 2 - ax;
-  const u = [[0, 0, 0], [0, 1, 0], [0, 0, 0]];
-  u[0][ax] = 1;
-  u[2][other] = 1;
-  const place = (cc, s, a, b, d) => [0, 1, 2].map((k) => cc[k] + s * (a * u[0][k] + b * u[1][k] + d * u[2][k]));
-  let w = norm(place([0, 0, 0], 1, 0.8, 0.45, 0.4));
-  let s = norm([w[2], 0, -w[0]]);
-  const v = cross(w, s);
-  const t = Math.tan(0.5 * 60 * Math.PI / 180);
-  let dist = 0;
-  for (let corner = 0; corner < 8; corner++) {
-    const p = [0, 1, 2].map((k) => ((corner >> k) & 1 ? hi[k] : lo[k]) - c[k]);
-    dist = Math.max(dist, dot(p, w) + Math.max(Math.abs(dot(p, s)), Math.abs(dot(p, v))) / t);
-  }
-  dist = 1.05 * (dist > 0 ? dist : r);
-  const around = [[1.5, 1.5, -0.4], [-1.3, 1.2, 1.4], [0.5, 2.1, 1.5], [1.6, 0.5, 1.2]];
-  return {
-    interior: false, eye: c.map((x, k) => x + dist * w[k]), target: c, up: [0, 1, 0], fov_y: 60,
-    lights: around.map((a) => place(c, r, a[0], a[1], a[2])), fallback: true,
-  };
-}
-
 // ---- the page ------------------------------------------------------------
 
 function load(url) {
@@ -476,7 +448,7 @@ async function main() {
   // The view: URL, else vdsh-view's default (extras.vdsh.view), else from
   // outside.
   const dv = vx.view && Array.isArray(vx.view.eye) && Array.isArray(vx.view.lights) && vx.view.lights.length
-    ? vx.view : fallbackView(lo, hi);
+    ? vx.view : vdshFallbackView(lo, hi, pos, nrm, indices);
   const cam = {
     eye: q.get('eye') ? vec('eye', q.get('eye')) : dv.eye.slice(),
     target: q.get('target') ? vec('target', q.get('target')) : dv.target.slice(),
