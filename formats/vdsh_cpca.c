@@ -297,6 +297,8 @@ typedef struct lightmix {
     uint32_t nl, rows;
     float *lights, *pos; /* nl x 3, rows x 3 */
     uint32_t *tex;       /* nl: scratch */
+    double *lw;          /* nl: scratch */
+    double rel;          /* VDSH_CPCA_LIGHTREL's h, or 0: no relevance weight */
 } lightmix;
 
 static float *read_f32s(const char *path, size_t *count)
@@ -323,6 +325,7 @@ static void lightmix_free(lightmix *lm)
     free(lm->lights);
     free(lm->pos);
     free(lm->tex);
+    free(lm->lw);
     memset(lm, 0, sizeof *lm);
 }
 
@@ -343,8 +346,12 @@ static int lightmix_load(lightmix *lm, uint32_t rows)
     lm->nl = (uint32_t)(nl / 3);
     lm->rows = rows;
     lm->tex = lm->nl ? malloc(sizeof(uint32_t) * lm->nl) : NULL;
+    lm->lw = lm->nl ? malloc(sizeof(double) * lm->nl) : NULL;
+    const char *rel = getenv("VDSH_CPCA_LIGHTREL");
+    char *rend = NULL;
+    lm->rel = rel && *rel ? strtod(rel, &rend) : 0.0;
     if (*end || !(a >= 0.0 && a <= 1.0) || !lm->lights || !lm->pos || np != 3 * (size_t)rows ||
-        !lm->tex) {
+        !lm->tex || !lm->lw || (rend && *rend) || !(lm->rel >= 0.0)) {
         fprintf(stderr,
                 "cpca: VDSH_CPCA_LIGHTMIX=%s needs 0 <= a <= 1, VDSH_CPCA_LIGHTS (f32 x, y, z "
                 "per light) and VDSH_CPCA_POSITIONS (%u rows of f32 x, y, z)\n",
@@ -369,20 +376,41 @@ static uint32_t cube_texel(const double d[3], uint32_t cube_n)
     return (face * cube_n + j) * cube_n + i;
 }
 
-/* The texels (cube of cube_n) of the pool's lights above vertex v's
- * horizon, in lm->tex: their count. */
-static uint32_t light_texels(lightmix *lm, uint32_t v, const float *nv, uint32_t cube_n)
+/* The texels of m of the pool's lights above vertex v's horizon, in
+ * lm->tex, and their weights in lm->lw: their count in *t, the weights'
+ * sum returned. A weight is 1, or with VDSH_CPCA_LIGHTREL=h (lm->rel) the
+ * light's relevance to the shadow decision: 1 / (1 + ((q - 0.55) / h)^2),
+ * q = ln d_L - ln D (D the vertex's own function x at the light's texel):
+ * lights far nearer than D (lit whatever a small error does) or far beyond
+ * it (shadowed) count less than those near the ramp, q in 0 .. ln 3. */
+static double light_texels(lightmix *lm, uint32_t v, const float *nv, const metric_dirs *m,
+                           const float *x, uint32_t *t)
 {
     const float *p = lm->pos + 3 * (size_t)v;
-    uint32_t t = 0;
+    const uint32_t n = m->n;
+    double sum = 0.0;
+    *t = 0;
     for (uint32_t l = 0; l < lm->nl; l++) {
         const float *q = lm->lights + 3 * (size_t)l;
         double d[3] = {(double)q[0] - p[0], (double)q[1] - p[1], (double)q[2] - p[2]};
         if (!(d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0))
             continue;
-        lm->tex[t++] = cube_texel(d, cube_n);
+        uint32_t at = cube_texel(d, m->cube_n);
+        double wt = 1.0;
+        if (lm->rel > 0.0) {
+            const double *y = m->wy + (size_t)at * n;
+            double s = 0.0;
+            for (uint32_t k = 0; k < n; k++)
+                s += y[k] * (double)x[k];
+            s /= sqrt(m->w[at]);
+            double z = (0.5 * log(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - s - 0.55) / lm->rel;
+            wt = 1.0 / (1.0 + z * z);
+        }
+        lm->tex[*t] = at;
+        lm->lw[(*t)++] = wt;
+        sum += wt;
     }
-    return t;
+    return sum;
 }
 
 #define TWO_PI 6.283185307179586
@@ -395,7 +423,7 @@ static uint32_t light_texels(lightmix *lm, uint32_t v, const float *nv, uint32_t
  * members each keep weight on their own horizon. */
 static void metric_gram_members(const metric_dirs *m, const float *normals, const uint32_t *labels,
                                 uint32_t rows, uint32_t c, uint32_t members, double *frac,
-                                double *g, lightmix *lm)
+                                double *g, lightmix *lm, const float *src)
 {
     uint32_t n = m->n;
     for (uint32_t d = 0; d < m->count; d++)
@@ -406,11 +434,12 @@ static void metric_gram_members(const metric_dirs *m, const float *normals, cons
         const float *nv = normals + 3 * (size_t)v;
         double a = nv[0], b = nv[1], e = nv[2], u = 1.0;
         if (lm) { /* the study hook: (1 - a) uniform + a light density */
-            uint32_t t = light_texels(lm, v, nv, m->cube_n);
-            if (t) {
+            uint32_t t;
+            double sum = light_texels(lm, v, nv, m, src + (size_t)v * n, &t);
+            if (t && sum > 0.0) {
                 u = 1.0 - lm->a;
                 for (uint32_t i = 0; i < t; i++)
-                    frac[lm->tex[i]] += lm->a * TWO_PI / (t * m->w[lm->tex[i]]);
+                    frac[lm->tex[i]] += lm->a * TWO_PI * lm->lw[i] / (sum * m->w[lm->tex[i]]);
             }
         }
         for (uint32_t d = 0; d < m->count; d++) {
@@ -630,7 +659,7 @@ static vdsh_result fit_cluster(fit_ctx *f, uint32_t c, vdsh_error *err)
         f->means[(size_t)c * n + i] = h;
         mu[i] = vdsh_f32_from_f16(h);
     }
-    metric_gram_members(f->md, normals, labels, rows, c, members, frac, g, f->lm);
+    metric_gram_members(f->md, normals, labels, rows, c, members, frac, g, f->lm, src);
     if (!cholesky(g, n, l)) {
         return vdsh_failf(err, VDSH_ERR_INVALID, "cpca: cluster %u: metric not positive definite",
                           c);
@@ -833,13 +862,16 @@ static uint32_t vertex_hemisphere(const fit_ctx *f, refine_ctx *r, uint32_t v)
     }
     if (r->dw) { /* the study hook: (1 - a) uniform + a light density */
         lightmix *lm = f->lm;
-        uint32_t t = light_texels(lm, v, nv, r->rd.cube_n);
+        uint32_t t;
+        double sum = light_texels(lm, v, nv, &r->rd, x, &t);
+        if (!(sum > 0.0))
+            t = 0;
         for (uint32_t h = 0; h < nh; h++)
             r->dw[r->hemi[h]] = t ? 1.0 - lm->a : 1.0;
         for (uint32_t i = 0; i < t; i++) {
             const double *dd = r->rd.dir + 3 * (size_t)lm->tex[i];
             if (dd[0] * nv[0] + dd[1] * nv[1] + dd[2] * nv[2] > 0.0)
-                r->dw[lm->tex[i]] += lm->a * TWO_PI / (t * r->rd.w[lm->tex[i]]);
+                r->dw[lm->tex[i]] += lm->a * TWO_PI * lm->lw[i] / (sum * r->rd.w[lm->tex[i]]);
         }
     }
     return nh;
