@@ -382,7 +382,9 @@ static uint32_t cube_texel(const double d[3], uint32_t cube_n)
  * light's relevance to the shadow decision: 1 / (1 + ((q - 0.55) / h)^2),
  * q = ln d_L - ln D (D the vertex's own function x at the light's texel):
  * lights far nearer than D (lit whatever a small error does) or far beyond
- * it (shadowed) count less than those near the ramp, q in 0 .. ln 3. */
+ * it (shadowed) count less than those near the ramp, q in 0 .. ln 3. The
+ * relevance calls libm's log, which this file otherwise avoids (its
+ * results may depend on the CPU's code path): measurement only. */
 static double light_texels(lightmix *lm, uint32_t v, const float *nv, const metric_dirs *m,
                            const float *x, uint32_t *t)
 {
