@@ -213,8 +213,9 @@ static void jacobi(double *a, uint32_t n, double *v)
 /* ---- the metric: the SH's Gram matrix over cube texel directions ---- */
 
 typedef struct metric_dirs {
-    uint32_t count, n;
+    uint32_t count, n, cube_n;
     double *dir;  /* 3 per direction */
+    double *w;    /* per direction: its texel's solid angle */
     double *wy;   /* per direction: sqrt(weight) * Y_i, n values */
     double *full; /* n x n: sum over all directions of weight * Y Y^T */
 } metric_dirs;
@@ -224,10 +225,12 @@ static int metric_init(metric_dirs *m, uint32_t order, uint32_t cube_n)
     uint32_t n = order * order, count = 6 * cube_n * cube_n;
     m->count = count;
     m->n = n;
+    m->cube_n = cube_n;
     m->dir = malloc(sizeof(double) * 3 * count);
+    m->w = malloc(sizeof(double) * count);
     m->wy = malloc(sizeof(double) * (size_t)n * count);
     m->full = calloc((size_t)n * n, sizeof(double));
-    if (!m->dir || !m->wy || !m->full)
+    if (!m->dir || !m->w || !m->wy || !m->full)
         return 0;
     float y[VDSH_MAX_COEFFS];
     uint32_t at = 0;
@@ -244,6 +247,7 @@ static int metric_init(metric_dirs *m, uint32_t order, uint32_t cube_n)
                 double r2 = 1.0 + u * u + v * v, r = sqrt(r2);
                 /* solid angle of the texel, to first order */
                 double w = 4.0 / ((double)cube_n * cube_n) / (r2 * r);
+                m->w[at] = w;
                 float df[3];
                 for (int k = 0; k < 3; k++) {
                     m->dir[3 * at + k] = d[k] / r;
@@ -269,9 +273,149 @@ static int metric_init(metric_dirs *m, uint32_t order, uint32_t cube_n)
 static void metric_free(metric_dirs *m)
 {
     free(m->dir);
+    free(m->w);
     free(m->wy);
     free(m->full);
 }
+
+/* ---- study hook: the light-density metric (docs/ACCURACY.md, "A
+ * light-density metric") ----
+ *
+ * Measurement only, off unless the environment says: with
+ * VDSH_CPCA_LIGHTMIX=a (0 <= a <= 1), VDSH_CPCA_LIGHTS=FILE (f32 x, y, z
+ * per light: a pool placed by the scene's light rule) and
+ * VDSH_CPCA_POSITIONS=FILE (f32 x, y, z per row, the rows' receiver
+ * positions) every vertex's hemisphere weight of a direction becomes
+ * (1 - a) + a * rho, rho the share of the pool's lights above the vertex's
+ * horizon whose direction from the vertex falls in that direction's cube
+ * texel, over the texel's share of the hemisphere's solid angle (2 pi): the
+ * density of possible lights seen from the vertex, with the uniform
+ * weight's integral. A vertex with no light above its horizon keeps the
+ * uniform weight. Unset: the default metric, the same bytes. */
+typedef struct lightmix {
+    double a;
+    uint32_t nl, rows;
+    float *lights, *pos; /* nl x 3, rows x 3 */
+    uint32_t *tex;       /* nl: scratch */
+    double *lw;          /* nl: scratch */
+    double rel;          /* VDSH_CPCA_LIGHTREL's h, or 0: no relevance weight */
+} lightmix;
+
+static float *read_f32s(const char *path, size_t *count)
+{
+    FILE *fp = path ? fopen(path, "rb") : NULL;
+    if (!fp)
+        return NULL;
+    float *out = NULL;
+    long size = fseek(fp, 0, SEEK_END) == 0 ? ftell(fp) : -1;
+    if (size > 0 && size % 12 == 0 && fseek(fp, 0, SEEK_SET) == 0) {
+        out = malloc((size_t)size);
+        if (out && fread(out, 1, (size_t)size, fp) != (size_t)size) {
+            free(out);
+            out = NULL;
+        }
+        *count = (size_t)size / 4;
+    }
+    fclose(fp);
+    return out;
+}
+
+static void lightmix_free(lightmix *lm)
+{
+    free(lm->lights);
+    free(lm->pos);
+    free(lm->tex);
+    free(lm->lw);
+    memset(lm, 0, sizeof *lm);
+}
+
+/* lm from the environment: 1 when on, 0 when off (lm zeroed), -1 (and a
+ * message) when set but unusable. */
+static int lightmix_load(lightmix *lm, uint32_t rows)
+{
+    memset(lm, 0, sizeof *lm);
+    const char *mix = getenv("VDSH_CPCA_LIGHTMIX");
+    if (!mix || !*mix)
+        return 0;
+    char *end = NULL;
+    double a = strtod(mix, &end);
+    size_t nl = 0, np = 0;
+    lm->a = a;
+    lm->lights = read_f32s(getenv("VDSH_CPCA_LIGHTS"), &nl);
+    lm->pos = read_f32s(getenv("VDSH_CPCA_POSITIONS"), &np);
+    lm->nl = (uint32_t)(nl / 3);
+    lm->rows = rows;
+    lm->tex = lm->nl ? malloc(sizeof(uint32_t) * lm->nl) : NULL;
+    lm->lw = lm->nl ? malloc(sizeof(double) * lm->nl) : NULL;
+    const char *rel = getenv("VDSH_CPCA_LIGHTREL");
+    char *rend = NULL;
+    lm->rel = rel && *rel ? strtod(rel, &rend) : 0.0;
+    if (*end || !(a >= 0.0 && a <= 1.0) || !lm->lights || !lm->pos || np != 3 * (size_t)rows ||
+        !lm->tex || !lm->lw || (rend && *rend) || !(lm->rel >= 0.0)) {
+        fprintf(stderr,
+                "cpca: VDSH_CPCA_LIGHTMIX=%s needs 0 <= a <= 1, VDSH_CPCA_LIGHTS (f32 x, y, z "
+                "per light) and VDSH_CPCA_POSITIONS (%u rows of f32 x, y, z)\n",
+                mix, rows);
+        lightmix_free(lm);
+        return -1;
+    }
+    return 1;
+}
+
+/* The texel of direction d on a cube of cube_n (metric_init's layout). */
+static uint32_t cube_texel(const double d[3], uint32_t cube_n)
+{
+    double ax = fabs(d[0]), ay = fabs(d[1]), az = fabs(d[2]);
+    uint32_t axis = ax >= ay && ax >= az ? 0u : ay >= az ? 1u : 2u;
+    double m = fabs(d[axis]);
+    uint32_t face = axis * 2u + (d[axis] < 0.0);
+    double u = d[(axis + 1) % 3] / m, v = d[(axis + 2) % 3] / m;
+    double fi = (u + 1.0) * 0.5 * cube_n, fj = (v + 1.0) * 0.5 * cube_n;
+    uint32_t i = fi <= 0.0 ? 0u : fi >= cube_n ? cube_n - 1u : (uint32_t)fi;
+    uint32_t j = fj <= 0.0 ? 0u : fj >= cube_n ? cube_n - 1u : (uint32_t)fj;
+    return (face * cube_n + j) * cube_n + i;
+}
+
+/* The texels of m of the pool's lights above vertex v's horizon, in
+ * lm->tex, and their weights in lm->lw: their count in *t, the weights'
+ * sum returned. A weight is 1, or with VDSH_CPCA_LIGHTREL=h (lm->rel) the
+ * light's relevance to the shadow decision: 1 / (1 + ((q - 0.55) / h)^2),
+ * q = ln d_L - ln D (D the vertex's own function x at the light's texel):
+ * lights far nearer than D (lit whatever a small error does) or far beyond
+ * it (shadowed) count less than those near the ramp, q in 0 .. ln 3. The
+ * relevance calls libm's log, which this file otherwise avoids (its
+ * results may depend on the CPU's code path): measurement only. */
+static double light_texels(lightmix *lm, uint32_t v, const float *nv, const metric_dirs *m,
+                           const float *x, uint32_t *t)
+{
+    const float *p = lm->pos + 3 * (size_t)v;
+    const uint32_t n = m->n;
+    double sum = 0.0;
+    *t = 0;
+    for (uint32_t l = 0; l < lm->nl; l++) {
+        const float *q = lm->lights + 3 * (size_t)l;
+        double d[3] = {(double)q[0] - p[0], (double)q[1] - p[1], (double)q[2] - p[2]};
+        if (!(d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0))
+            continue;
+        uint32_t at = cube_texel(d, m->cube_n);
+        double wt = 1.0;
+        if (lm->rel > 0.0) {
+            const double *y = m->wy + (size_t)at * n;
+            double s = 0.0;
+            for (uint32_t k = 0; k < n; k++)
+                s += y[k] * (double)x[k];
+            s /= sqrt(m->w[at]);
+            double z = (0.5 * log(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - s - 0.55) / lm->rel;
+            wt = 1.0 / (1.0 + z * z);
+        }
+        lm->tex[*t] = at;
+        lm->lw[(*t)++] = wt;
+        sum += wt;
+    }
+    return sum;
+}
+
+#define TWO_PI 6.283185307179586
 
 /* g = sum over directions of weight * (the fraction of the cluster's
  * members whose hemisphere holds the direction) * Y Y^T, plus SPHERE_EPS
@@ -281,7 +425,7 @@ static void metric_free(metric_dirs *m)
  * members each keep weight on their own horizon. */
 static void metric_gram_members(const metric_dirs *m, const float *normals, const uint32_t *labels,
                                 uint32_t rows, uint32_t c, uint32_t members, double *frac,
-                                double *g)
+                                double *g, lightmix *lm, const float *src)
 {
     uint32_t n = m->n;
     for (uint32_t d = 0; d < m->count; d++)
@@ -290,11 +434,20 @@ static void metric_gram_members(const metric_dirs *m, const float *normals, cons
         if (labels[v] != c)
             continue;
         const float *nv = normals + 3 * (size_t)v;
-        double a = nv[0], b = nv[1], e = nv[2];
+        double a = nv[0], b = nv[1], e = nv[2], u = 1.0;
+        if (lm) { /* the study hook: (1 - a) uniform + a light density */
+            uint32_t t;
+            double sum = light_texels(lm, v, nv, m, src + (size_t)v * n, &t);
+            if (t && sum > 0.0) {
+                u = 1.0 - lm->a;
+                for (uint32_t i = 0; i < t; i++)
+                    frac[lm->tex[i]] += lm->a * TWO_PI * lm->lw[i] / (sum * m->w[lm->tex[i]]);
+            }
+        }
         for (uint32_t d = 0; d < m->count; d++) {
             const double *dd = m->dir + 3 * (size_t)d;
             if (dd[0] * a + dd[1] * b + dd[2] * e > 0.0)
-                frac[d] += 1.0;
+                frac[d] += u;
         }
     }
     for (size_t k = 0; k < (size_t)n * n; k++)
@@ -464,6 +617,7 @@ typedef struct fit_ctx {
     double *proj;                          /* k x b x n: the weights' projections */
     double *g, *sc, *sy, *ev, *tmp, *frac; /* scratch */
     uint32_t *idx;
+    lightmix *lm; /* the study hook's, or NULL */
 } fit_ctx;
 
 /* Cluster c's mean and basis from its members (labels): the mean stored
@@ -507,7 +661,7 @@ static vdsh_result fit_cluster(fit_ctx *f, uint32_t c, vdsh_error *err)
         f->means[(size_t)c * n + i] = h;
         mu[i] = vdsh_f32_from_f16(h);
     }
-    metric_gram_members(f->md, normals, labels, rows, c, members, frac, g);
+    metric_gram_members(f->md, normals, labels, rows, c, members, frac, g, f->lm, src);
     if (!cholesky(g, n, l)) {
         return vdsh_failf(err, VDSH_ERR_INVALID, "cpca: cluster %u: metric not positive definite",
                           c);
@@ -605,6 +759,7 @@ typedef struct refine_ctx {
     double *w;      /* b */
     uint32_t *hemi; /* count: the directions in the vertex's hemisphere */
     uint32_t *next; /* rows: the new labels */
+    double *dw;     /* count: the study hook's weights of the vertex's directions, or NULL */
 } refine_ctx;
 
 static int refine_init(refine_ctx *r, uint32_t order, uint32_t k, uint32_t b, uint32_t rows)
@@ -631,6 +786,7 @@ static void refine_free(refine_ctx *r)
     free(r->w);
     free(r->hemi);
     free(r->next);
+    free(r->dw);
 }
 
 /* The squared error of a vertex's reconstruction by cluster c with the
@@ -647,7 +803,7 @@ static double hemi_error(const fit_ctx *f, const refine_ctx *r, uint32_t c, uint
         const double *bd = bv + (size_t)d * b;
         for (uint32_t j = 0; j < b; j++)
             s -= r->w[j] * bd[j];
-        e += s * s;
+        e += r->dw ? r->dw[d] * s * s : s * s;
     }
     return e;
 }
@@ -705,6 +861,20 @@ static uint32_t vertex_hemisphere(const fit_ctx *f, refine_ctx *r, uint32_t v)
         for (uint32_t a = 0; a < n; a++)
             s += y[a] * (double)x[a];
         r->xval[d] = s;
+    }
+    if (r->dw) { /* the study hook: (1 - a) uniform + a light density */
+        lightmix *lm = f->lm;
+        uint32_t t;
+        double sum = light_texels(lm, v, nv, &r->rd, x, &t);
+        if (!(sum > 0.0))
+            t = 0;
+        for (uint32_t h = 0; h < nh; h++)
+            r->dw[r->hemi[h]] = t ? 1.0 - lm->a : 1.0;
+        for (uint32_t i = 0; i < t; i++) {
+            const double *dd = r->rd.dir + 3 * (size_t)lm->tex[i];
+            if (dd[0] * nv[0] + dd[1] * nv[1] + dd[2] * nv[2] > 0.0)
+                r->dw[lm->tex[i]] += lm->a * TWO_PI * lm->lw[i] / (sum * r->rd.w[lm->tex[i]]);
+        }
     }
     return nh;
 }
@@ -784,6 +954,7 @@ static double quantise(double w, double s, int levels)
  * points at md). */
 typedef struct fit_scratch {
     fit_ctx fc;
+    lightmix lm; /* the study hook's */
     metric_dirs md;
     refine_ctx rd; /* allocated only with need_rd */
     double *mu;    /* n */
@@ -813,6 +984,7 @@ static void fit_scratch_free(fit_scratch *s)
     free(s->mu);
     free(s->dist);
     free(s->cent);
+    lightmix_free(&s->lm);
     memset(s, 0, sizeof *s);
 }
 
@@ -850,6 +1022,18 @@ static int fit_scratch_alloc(fit_scratch *s, const float *src, const float *norm
     s->mu = malloc(sizeof(double) * n);
     s->dist = malloc(sizeof(double) * rows);
     s->cent = malloc(sizeof(double) * k * (n + 3));
+    const int lm = lightmix_load(&s->lm, rows);
+    if (lm < 0)
+        return 0;
+    f->lm = lm ? &s->lm : NULL;
+    if (lm && need_rd) {
+        if (!refine_init(&s->rd, order, k, b, rows))
+            return 0;
+        s->rd.dw = malloc(sizeof(double) * s->rd.rd.count);
+        if (!s->rd.dw)
+            return 0;
+        need_rd = 0; /* done */
+    }
     return f->labels && f->means && f->bases && f->members && f->mus && f->l && f->proj && f->g &&
            f->sc && f->sy && f->ev && f->tmp && f->frac && f->idx && s->mu && s->dist && s->cent &&
            metric_init(&s->md, order, CUBE_N) &&

@@ -171,3 +171,14 @@ done
 exit $fail
 ]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:light_pool_agree> ${CMAKE_CURRENT_SOURCE_DIR}/data
     ${CMAKE_CURRENT_BINARY_DIR}/light_pool_agree_tmp)
+
+# A light pool placed by the project's rule, written as f32 (the cpca
+# encoder's light-density study hook; scripts/cpca_study `l` settings).
+add_executable(light_pool_tool light_pool_tool.c)
+target_link_libraries(light_pool_tool PRIVATE vb_core)
+# The cpca encoder's light-density study hook: off unless set, a = 0
+# today's bytes, a = 1 a valid other fit, unusable settings refused.
+add_test(NAME bake_cpca_lightmix
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_cpca_lightmix.py
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:light_pool_tool> ${PROJECT_SOURCE_DIR}
+                 ${CMAKE_CURRENT_BINARY_DIR}/bake_cpca_lightmix)
