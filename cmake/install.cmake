@@ -1,6 +1,8 @@
 # The installed package: `cmake --install BUILD [--prefix DIR]` puts the
 # formats and runtime libraries (static, or shared with
-# -DBUILD_SHARED_LIBS=ON), their public headers (include/vdsh/), the
+# -DBUILD_SHARED_LIBS=ON), their public headers (include/vdsh/: both
+# include/vdsh and include are include paths, so <vdsh/vdsh.h>, the
+# documented form, and <vdsh.h> both work), the
 # programs, a CMake config package and pkg-config files in place:
 #   find_package(vdsh CONFIG REQUIRED)
 #   target_link_libraries(app PRIVATE vdsh::formats)   # .vdsh reader/writer
@@ -31,7 +33,7 @@ install(FILES ${PROJECT_SOURCE_DIR}/runtime/web/index.html ${PROJECT_SOURCE_DIR}
         DESTINATION ${CMAKE_INSTALL_DATADIR}/vdsh/web)
 
 # What the package config looks up for its consumers: the public link
-# dependencies always; the private ones (zlib, meshoptimizer, GLFW) only
+# dependencies always; the private ones (zlib, Threads, meshoptimizer, GLFW) only
 # for static libraries, whose link interface names them. VDSH_HAVE_GLFW
 # comes from runtime/CMakeLists.txt; both are TRUE or FALSE, never empty.
 if(VDSH_HAVE_GLFW)

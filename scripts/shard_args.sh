@@ -8,7 +8,12 @@
 #                                start with '--' and hold vdsh-bake's
 #                                arguments, none of them -o, --output or
 #                                --shard (the script sets those), else exit 2;
-#                                the caller then drops the '--' (shift)
+#                                sets shard_args to those arguments less
+#                                any --report FILE, and shard_report to
+#                                FILE (else empty): every shard writing
+#                                FILE, the last one won; the caller gives
+#                                each shard its own: FILE less .json, then
+#                                .part-I.json, beside FILE (like the parts)
 #   shard_out_dir PROG OUT       OUT's folder exists and is writable, else
 #                                exit 1 naming it (bake-slurm made an absolute
 #                                path of a missing folder as "/OUT": the root)
@@ -30,10 +35,30 @@ shard_bake_args() {
     echo "$prog: no vdsh-bake arguments after '--' (the meshes and options every shard bakes)" >&2
     exit 2
   fi
-  for a in "$@"; do # the script writes OUT and the shards: none of vdsh-bake's own
+  shard_args=() shard_report=""
+  while [[ $# -gt 0 ]]; do # the script writes OUT and the shards: none of vdsh-bake's own
+    a=$1
+    shift
     [[ $a =~ ^(-o|--output|--shard)(=.*)?$ || $a =~ ^-o.+ ]] &&
       { echo "$prog: '$a' among vdsh-bake's arguments: the output is OUT (the second argument) and the script sets --shard" >&2; exit 2; }
+    # --report and its abbreviations (getopt_long takes --rep, --repo ...).
+    if [[ $a =~ ^--rep(o|or|ort)?(=.*)?$ ]]; then
+      if [[ $a == *=* ]]; then
+        shard_report=${a#*=}
+      elif [[ $# -gt 0 ]]; then
+        shard_report=$1
+        shift
+      else
+        echo "$prog: '$a' without a FILE among vdsh-bake's arguments" >&2
+        exit 2
+      fi
+      [[ -n $shard_report ]] || { echo "$prog: '$a' with an empty FILE among vdsh-bake's arguments" >&2; exit 2; }
+      continue
+    fi
+    shard_args+=("$a")
   done
+  [[ ${#shard_args[@]} -gt 0 ]] ||
+    { echo "$prog: no vdsh-bake arguments after '--' (the meshes and options every shard bakes)" >&2; exit 2; }
   return 0
 }
 

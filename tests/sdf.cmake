@@ -43,3 +43,13 @@ msg=$("$frames" truth "$d/plain.vdsh" --views "$d/v.json" -o "$d/f0" --sdf-k 3 -
 "$frames" truth "$d/vol.vdsh" --views "$d/v.json" -o "$d/f1" --sdf-k 3 -q || exit 1
 [[ -e $d/f1/default-s0-l0-c-sdf.png ]] || { echo "FAIL: no c-sdf frame with the volume"; exit 1; }
 ]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames> ${CMAKE_CURRENT_BINARY_DIR}/sdf_k_volume)
+
+# scripts/sdf_frames' steps without GL (tests/test_sdf_frames_script.py):
+# the volume's figures from vdsh-bake --report's "sdf", a clear message
+# when no pixel counts, sizes in kB below 1 MB.
+if(Python3_EXECUTABLE)
+  add_test(NAME sdf_frames_script_report
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_sdf_frames_script.py
+                   ${PROJECT_SOURCE_DIR}/scripts $<TARGET_FILE:vdsh-bake>
+                   ${CMAKE_CURRENT_BINARY_DIR}/sdf_frames_script)
+endif()

@@ -102,6 +102,14 @@ int main(int argc, char **argv)
     CHECK(run((char *[]){ev, "--no-such-option", "x.vdsh", NULL}) == 2, "bad option");
     CHECK(run((char *[]){ev, "--points", "0", "x.vdsh", NULL}) == 2, "--points 0");
     CHECK(run((char *[]){ev, "--orders", "2,17", "x.vdsh", NULL}) == 2, "--orders 2,17");
+    /* Options that would do nothing are usage errors (they were accepted and
+     * ignored): --interp with no interior points, --offsets with --oracle. */
+    CHECK(run((char *[]){ev, "--interior", "0", "--interp", "distance", "x.vdsh", NULL}) == 2 &&
+              test_file_contains(err_path, "--interior 0"),
+          "--interp with --interior 0 refused");
+    CHECK(run((char *[]){ev, "--oracle", "--offsets", "0.2", "x.vdsh", NULL}) == 2 &&
+              test_file_contains(err_path, "--oracle"),
+          "--offsets with --oracle refused");
     char *missing = path_in("no-such.vdsh");
     CHECK(run((char *[]){ev, missing, NULL}) == 1 && test_file_contains(err_path, "no-such.vdsh"),
           "a missing file is named");
@@ -141,6 +149,27 @@ int main(int argc, char **argv)
         CHECK(j && cJSON_GetArraySize(streams) == 3, "JSON: %s", j ? "streams" : msg);
         CHECK(vt_json_number(cJSON_GetArrayItem(streams, 2), "bytes_per_vertex") == 24.0,
               "JSON: order 5 in the default encoding (s8s6) is 24 bytes per vertex");
+        /* The table's scene-light pair counts: whole below 10,000 (88 pairs
+         * were printed as "8.8e-05M"), else k or M. */
+        const cJSON *sl =
+            cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(streams, 0), "scene_lights");
+        const char *kinds[] = {"vertices", "interior"};
+        for (int k = 0; k < 2; k++) {
+            double pairs = vt_json_number(cJSON_GetObjectItemCaseSensitive(sl, kinds[k]), "pairs");
+            char want[64];
+            if (pairs < 10000)
+                snprintf(want, sizeof want, "| %7.0f |", pairs);
+            else {
+                double v = pairs < 1e6 ? pairs / 1e3 : pairs / 1e6; /* three figures */
+                snprintf(want, sizeof want, "| %6.*f%c |",
+                         v < 9.995   ? 2
+                         : v < 99.95 ? 1
+                                     : 0,
+                         v, pairs < 1e6 ? 'k' : 'M');
+            }
+            CHECK(pairs > 0 && test_file_contains(out_path, want),
+                  "the table shows %s's %.0f scene-light pairs as '%s'", kinds[k], pairs, want);
+        }
         cJSON_Delete(j);
     }
     size_t size = 0;

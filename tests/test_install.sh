@@ -11,6 +11,10 @@
 # also when the prefix is moved; the CMake package has no empty if() and
 # finds GLFW for vdsh::context (a static consumer links the imported glfw,
 # not a bare -lglfw); vdsh-context.pc builds a consumer of vr_context.h.
+# The headers work as <vdsh/vdsh.h> (documented; consumer.c) and as
+# <vr_context.h> (context_consumer.c), through both the CMake package and
+# pkg-config. Static: libvdsh-formats' pthread is declared (.pc -pthread,
+# find_dependency(Threads)) and a -static program links with the .pc flags.
 # Usage: test_install.sh CMAKE SOURCE_DIR WORK_DIR C_COMPILER
 set -u
 cmake=$1 src=$2 work=$3 cc=$4
@@ -105,6 +109,23 @@ for kind in shared static; do
     fi
     LD_LIBRARY_PATH="$p/lib" "$work/$kind/pc-context" | grep -q "context: linked" ||
       { echo "FAIL: $kind: pkg-config context consumer run"; fail=1; }
+    if [ $kind = static ]; then
+      # libvdsh-formats uses pthread (vdsh_output.c): its static link
+      # interface says so (the .pc file and the CMake package did not), and
+      # a fully static program links with the .pc file's flags alone.
+      flags=$(PKG_CONFIG_PATH="$p/lib/pkgconfig" pkg-config --cflags --libs --static vdsh-formats)
+      [[ " $flags " == *" -pthread "* ]] ||
+        { echo "FAIL: static: pkg-config --static vdsh-formats lacks -pthread: $flags"; fail=1; }
+      grep -q 'find_dependency(Threads)' "$p/lib/cmake/vdsh/vdshConfig.cmake" ||
+        { echo "FAIL: static: vdshConfig.cmake does not find_dependency(Threads)"; fail=1; }
+      if ! "$cc" -static -o "$work/$kind/pc-formats" "$src/tests/install_consumer/formats_consumer.c" \
+           $flags > "$work/$kind.pc-formats.log" 2>&1; then
+        cat "$work/$kind.pc-formats.log"; echo "FAIL: static: -static formats consumer with pkg-config ($flags)"; fail=1
+      else
+        "$work/$kind/pc-formats" "$work/$kind/f.txt" | grep -q "^formats .*: wrote" && [ -s "$work/$kind/f.txt" ] ||
+          { echo "FAIL: static: -static formats consumer run"; fail=1; }
+      fi
+    fi
     echo "$kind, pkg-config: builds and runs (runtime, context)"
   fi
 done

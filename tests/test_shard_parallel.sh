@@ -7,6 +7,7 @@
 # Debian's parallel when root and it is missing; skips (77) when it cannot
 # be had. Each shard's progress is in the output. OUT in a missing folder
 # is refused before any shard runs, and so is a parallel that is not GNU's.
+# --report R.json among the bake's arguments: each shard writes R.part-I.json.
 # Usage: test_shard_parallel.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
@@ -80,4 +81,20 @@ if "$scripts/bake-parallel" 3 "$tmp/bad.vdsh" -- "${tiny[@]}" --rays 0 2>/dev/nu
   echo "FAIL: a failing shard did not fail the run" >&2; fail=1
 fi
 [[ -e $tmp/bad.vdsh ]] && { echo "FAIL: merged despite a failed shard" >&2; fail=1; }
+# --report among vdsh-bake's arguments: each shard writes its own report,
+# named like its part (every shard wrote the same file, the last one won).
+for form in "--report $tmp/rep.json" "--report=$tmp/rep.json" "--repo $tmp/rep.json"; do
+  rm -f "$tmp"/rep*.json "$tmp/rep.vdsh"
+  "$scripts/bake-parallel" 3 "$tmp/rep.vdsh" -j 2 -- "${tiny[@]}" $form 2>/dev/null ||
+    { echo "FAIL: bake-parallel with '$form'" >&2; fail=1; }
+  cmp -s "$tmp/rep.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: '$form': merge differs" >&2; fail=1; }
+  [[ -e $tmp/rep.json ]] && { echo "FAIL: '$form': every shard wrote rep.json" >&2; fail=1; }
+  for i in 0 1 2; do
+    grep -q '"seconds"' "$tmp/rep.part-$i.json" 2>/dev/null ||
+      { echo "FAIL: '$form': no report rep.part-$i.json for shard $i" >&2; fail=1; }
+  done
+done
+msg=$("$scripts/bake-parallel" 2 "$tmp/rep2.vdsh" -- "${tiny[@]}" --report 2>&1)
+rc=$?
+[[ $rc -eq 2 && $msg == *"without a FILE"* ]] || { echo "FAIL: --report without FILE: exit $rc: $msg" >&2; fail=1; }
 exit $fail

@@ -10,7 +10,8 @@
 # message, its exit status, no job queued); a shard that fails after
 # submission gets the merge job cancelled, not left pending forever; the
 # output's name has a space, a quote and a '%' (the logs beside it); more shards than receivers and
-# OUT in a missing folder are refused before anything is submitted.
+# OUT in a missing folder are refused before anything is submitted;
+# --report R.json among the bake's arguments: each shard writes R.part-I.json.
 # Usage: test_shard_slurm.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
@@ -50,6 +51,22 @@ msg=$(PATH=$nos:$PATH VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-slurm" 2 
 rc=$?
 [[ $rc -eq 1 && $msg == *"no folder '$nos/nodir'"* && ! -e $nos/sbatch.calls ]] ||
   { echo "FAIL: OUT in a missing folder: exit $rc, sbatch called: $(cat "$nos/sbatch.calls" 2>/dev/null | head -c 300): $msg" >&2; fail=1; }
+# --report among vdsh-bake's arguments: each shard writes its own report,
+# named like its part (every shard wrote the same file, the last one won;
+# the check before submitting wrote it too). An sbatch of our own keeps the
+# shard array's command, run here as shard 1.
+mkdir -p "$nos/rep"
+printf '#!/bin/sh\nwhile [ $# -gt 0 ]; do [ "$1" = --wrap ] && printf "%%s\\n" "$2" >> "%s/wraps"; shift; done\necho 7\n' \
+  "$nos/rep" > "$nos/rep/sbatch"
+chmod +x "$nos/rep/sbatch"
+(cd "$nos/rep" && PATH=$nos/rep:$PATH VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-slurm" 2 r.vdsh -- \
+  builtin:room --max-edge 1.5 --rays 32 --cube-size 8 --report r.json >/dev/null 2>&1) ||
+  { echo "FAIL: bake-slurm with --report" >&2; fail=1; }
+[[ -e $nos/rep/r.json ]] && { echo "FAIL: --report: r.json written before any shard ran" >&2; fail=1; }
+(cd / && SLURM_ARRAY_TASK_ID=1 sh -c "$(head -n 1 "$nos/rep/wraps" 2>/dev/null)" >/dev/null 2>&1) ||
+  { echo "FAIL: --report: shard 1's command failed: $(head -n 1 "$nos/rep/wraps" 2>/dev/null)" >&2; fail=1; }
+[[ -e $nos/rep/r.part-1.vdsh && ! -e $nos/rep/r.json ]] && grep -q '"seconds"' "$nos/rep/r.part-1.json" 2>/dev/null ||
+  { echo "FAIL: --report: shard 1 wrote no r.part-1.json (or wrote r.json): $(ls "$nos/rep")" >&2; fail=1; }
 rm -rf "$nos"
 skip() { [[ $fail -eq 0 ]] || exit 1; echo "SKIP: $1"; exit 77; }
 [[ $(id -u) -eq 0 ]] || skip "needs root to start slurmctld and slurmd"

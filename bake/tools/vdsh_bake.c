@@ -426,7 +426,8 @@ static void report_seconds(vt_json *j, cJSON *root, const vdsh_timings *t)
 }
 
 static int write_report(const char *path, const options *o, const vb_job *job,
-                        const vb_mesh_spacing *sp, double write_seconds, char *msg, size_t cap)
+                        const vb_mesh_spacing *sp, const vdsh_sdf *vol, double sdf_seconds,
+                        double write_seconds, char *msg, size_t cap)
 {
     const vdsh_file *f = &job->file;
     const vb_bake_output *b = &job->bake;
@@ -541,6 +542,20 @@ static int write_report(const char *path, const options *o, const vb_job *job,
                                              : 0.0);
     vt_json_u64(&j, root, "coefficient_bytes_per_vertex", coef_bytes);
     vt_json_i64(&j, root, "file_bytes", file_size);
+    if (vol) { /* --sdf: the distance volume beside the output */
+        cJSON *sdf = vt_json_object(&j, root, "sdf");
+        char sdf_path[PATH_MAX];
+        if (vdsh_sdf_path(o->output, sdf_path, sizeof sdf_path) == 0)
+            vt_json_string(&j, sdf, "path", sdf_path);
+        cJSON *dim = vt_json_array(&j, sdf, "dims");
+        for (int i = 0; i < 3; i++)
+            vt_json_u64(&j, dim, NULL, vol->dim[i]);
+        vt_json_f64(&j, sdf, "spacing", vol->cell);
+        vt_json_f64(&j, sdf, "seconds", sdf_seconds);
+        vt_json_u64(&j, sdf, "bytes", vdsh_sdf_file_size(vol));
+    } else {
+        vt_json_null(&j, root, "sdf");
+    }
     int r = vt_json_write_file(&j, path, msg, cap);
     vt_json_free(&j);
     return r;
@@ -1538,8 +1553,8 @@ static int run(const options *o)
     double write_seconds = vb_now() - t;
     if (log)
         say_written(log, o, &job, &jd, write_seconds);
-    if (o->report &&
-        write_report(o->report, o, &job, &spacing, write_seconds, msg, sizeof msg) != 0) {
+    if (o->report && write_report(o->report, o, &job, &spacing, o->sdf ? &vol : NULL, sdf_seconds,
+                                  write_seconds, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-bake: %s (the report)\n", msg);
         goto out;
     }

@@ -98,11 +98,13 @@ static void usage(FILE *f)
             "                          times e^offset), e.g. -0.2,0.2,0.4 (at most %d\n"
             "                          streams in all: pick orders with --orders)\n"
             "      --oracle            score the ray-cast truth instead of the streams:\n"
-            "                          every error must come out exactly 0\n"
+            "                          every error must come out exactly 0 (not with\n"
+            "                          --offsets)\n"
             "      --interp M          how interior points get a stream's value from the\n"
             "                          triangle's vertices: runtime (default: the path\n"
             "                          vdsh-view draws the stream with), coefficients,\n"
-            "                          distance, visibility or split (vdsh_shadow.h)\n"
+            "                          distance, visibility or split (vdsh_shadow.h;\n"
+            "                          not with --interior 0)\n"
             "      --fast-truth        Embree's default traversal for the truth (default:\n"
             "                          robust, so truth rays do not leak through edges)\n"
             "      --allow-mismatch    use sources whose SHA-256 differs (with a warning)\n"
@@ -320,6 +322,24 @@ static void json_metrics(vt_json *j, cJSON *o, const vb_eval_metrics *m, int kin
     cJSON *worst = vt_json_array(j, o, "worst");
     for (uint32_t i = 0; i < m->worst_count; i++)
         json_receiver(j, worst, &m->worst[i], kind);
+}
+
+/* A count for the table, readably: whole below 10,000, else k, M or G with
+ * three figures (88, 9999, 12.3k, 456k, 1.23M; was "8.8e-05M"). */
+static const char *count_label(uint64_t n, char *buf, size_t size)
+{
+    static const char unit[] = "kMGT";
+    if (n < 10000) {
+        snprintf(buf, size, "%llu", (unsigned long long)n);
+        return buf;
+    }
+    double v = (double)n;
+    int u = -1;
+    do {
+        v /= 1000.0, u++;
+    } while (v >= 999.5 && u < 3);
+    snprintf(buf, size, v < 9.995 ? "%.2f%c" : v < 99.95 ? "%.1f%c" : "%.0f%c", v, unit[u]);
+    return buf;
 }
 
 static void json_scene(vt_json *j, cJSON *o, const vb_eval_scene_metrics *m)
@@ -626,15 +646,15 @@ static void print_table(FILE *o, const context *c)
             snprintf(fa, sizeof fa, "%.2f+-%.2f%%", 100.0 * m->false_shadow,
                      196.0 * m->false_shadow_se);
             snprintf(rc, sizeof rc, "%.1f+-%.1f%%", 100.0 * m->recall, 196.0 * m->recall_se);
-            char ol[16];
+            char ol[16], pairs[32];
             fprintf(o,
-                    "  %-8s %5s %+6.2f %3.0f %3s %-9s | %7.2gM | %-15s %-13s %-12s | %6.4f "
+                    "  %-8s %5s %+6.2f %3.0f %3s %-9s | %7s | %-15s %-13s %-12s | %6.4f "
                     "%5.2f%% %5.1f%%\n",
                     kind_name(k), order_label(st, ol, sizeof ol), (double)c->offset[s],
                     vdsh_stream_size_of(stored(c, s), vdsh_file_stream_vertices(f)).mean_bytes,
-                    vdsh_encoding_name(stored(c, s)->encoding), fit, (double)m->pairs * 1e-6, mae,
-                    fa, rc, m->binary_mae, 100.0 * m->binary_false_shadow,
-                    100.0 * m->binary_recall);
+                    vdsh_encoding_name(stored(c, s)->encoding), fit,
+                    count_label(m->pairs, pairs, sizeof pairs), mae, fa, rc, m->binary_mae,
+                    100.0 * m->binary_false_shadow, 100.0 * m->binary_recall);
         }
     }
     fprintf(o, "\n  RELATIVE LIGHTS (secondary, as in earlier figures): one light per held-out "
@@ -838,7 +858,7 @@ static int parse_args(int argc, char **argv, options *o)
     memset(o, 0, sizeof *o);
     o->d.interior = 65536;
     vb_eval_desc *d = &o->d;
-    int c, ok = 1;
+    int c, ok = 1, interp_given = 0;
     while (ok && (c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
         switch (c) {
         case O_POINTS:
@@ -869,6 +889,7 @@ static int parse_args(int argc, char **argv, options *o)
                 return bad_usage("--interp takes runtime, coefficients, distance, "
                                  "visibility or split, not '%s'",
                                  optarg);
+            interp_given = 1;
             break;
         case O_LIGHT_RULE:
             if (!parse_light_rule(optarg, &d->light_rule))
@@ -896,6 +917,14 @@ static int parse_args(int argc, char **argv, options *o)
     }
     if (!ok)
         return VT_EXIT_USAGE;
+    /* Options that would do nothing: said, not silently ignored. */
+    if (interp_given && d->interior == 0)
+        return bad_usage("%s", "--interp chooses how interior points are scored, and "
+                               "--interior 0 scores none: drop one of them");
+    if (o->noffsets && d->oracle)
+        return bad_usage("%s", "--offsets scores the streams with offsets added, and "
+                               "--oracle scores the ray-cast truth instead of the streams: "
+                               "drop one of them");
     o->path = vt_arg_vdsh(argc, argv, optind, NULL, 1);
     if (!o->path)
         return VT_EXIT_USAGE;

@@ -1,12 +1,13 @@
 /* consumer.c - built against an installed vdsh (tests/test_install.sh):
  * writes a one-triangle .vdsh with the formats library, reads it back,
  * checks every field it wrote and evaluates its stream; links the runtime
- * (vr.h) to show its symbols resolve. Prints the library version. */
+ * (vr.h) to show its symbols resolve. Prints the library version. Includes
+ * the headers as <vdsh/X.h>; context_consumer.c as <X.h>: both work. */
 #include <stdio.h>
 #include <string.h>
-#include <vdsh.h>
-#include <vdsh_shadow.h>
-#include <vr.h>
+#include <vdsh/vdsh.h> /* the documented form (README "Using the library") */
+#include <vdsh/vdsh_shadow.h>
+#include <vdsh/vr.h>
 
 int main(int argc, char **argv)
 {
