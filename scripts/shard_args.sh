@@ -7,7 +7,9 @@
 #                                ARGS (what follows the scheduler's options)
 #                                start with '--' and hold vdsh-bake's
 #                                arguments, none of them -o, --output or
-#                                --shard (the script sets those), else exit 2;
+#                                --shard, nor an abbreviation getopt_long
+#                                takes for them (the script sets those), else
+#                                exit 2;
 #                                sets shard_args to those arguments less
 #                                any --report FILE, and shard_report to
 #                                FILE (else empty): every shard writing
@@ -39,7 +41,9 @@ shard_bake_args() {
   while [[ $# -gt 0 ]]; do # the script writes OUT and the shards: none of vdsh-bake's own
     a=$1
     shift
-    [[ $a =~ ^(-o|--output|--shard)(=.*)?$ || $a =~ ^-o.+ ]] &&
+    # getopt_long takes any unique prefix of a long option: --ou, --sh ...
+    local name=${a%%=*}
+    [[ $a =~ ^-o || ( $name == --??* && ( "--output" == "$name"* || "--shard" == "$name"* ) ) ]] &&
       { echo "$prog: '$a' among vdsh-bake's arguments: the output is OUT (the second argument) and the script sets --shard" >&2; exit 2; }
     # --report and its abbreviations (getopt_long takes --rep, --repo ...).
     if [[ $a =~ ^--rep(o|or|ort)?(=.*)?$ ]]; then

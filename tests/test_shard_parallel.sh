@@ -32,7 +32,7 @@ rc=$?
 ls "$tmp"/nopar* >/dev/null 2>&1 && { echo "FAIL: without parallel: files written" >&2; fail=1; }
 # vdsh-bake's own output or shard among its arguments: refused, exit 2,
 # nothing baked (a user's -o was silently overridden by the script's).
-for a in "-o $tmp/y.vdsh" "--output=$tmp/y.vdsh" "--shard 1/2"; do
+for a in "-o $tmp/y.vdsh" "--output=$tmp/y.vdsh" "--shard 1/2" "--out $tmp/y.vdsh" "--outp=$tmp/y.vdsh" "--sha 1/2" "--sh=1/2"; do
   msg=$(VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-parallel" 2 "$tmp/x.vdsh" -- "${tiny[@]}" $a 2>&1)
   rc=$?
   [[ $rc -eq 2 && $msg == *"among vdsh-bake's arguments"* ]] || { echo "FAIL: '$a': exit $rc: $msg" >&2; fail=1; }

@@ -28,7 +28,7 @@ rc=$?
 ls "$nos"/x* >/dev/null 2>&1 && { echo "FAIL: without sbatch: files written" >&2; fail=1; }
 # vdsh-bake's own output or shard among its arguments: refused, exit 2 (a
 # user's -o was silently overridden by the script's).
-for a in "-o $nos/y.vdsh" "--output=$nos/y.vdsh" "-o$nos/y.vdsh" "--shard 1/2"; do
+for a in "-o $nos/y.vdsh" "--output=$nos/y.vdsh" "-o$nos/y.vdsh" "--shard 1/2" "--out $nos/y.vdsh" "--sha 1/2"; do
   msg=$(VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-slurm" 2 "$nos/x.vdsh" -- builtin:room $a 2>&1)
   rc=$?
   [[ $rc -eq 2 && $msg == *"among vdsh-bake's arguments"* ]] || { echo "FAIL: '$a': exit $rc: $msg" >&2; fail=1; }
