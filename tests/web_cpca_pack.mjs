@@ -15,17 +15,8 @@
 // vdshCpcaBufferData writes for the shader (its statements executed
 // here); a width out of 2..8 and a level beyond its own width's range
 // are refused.
-// vdsh_core.js is an ES module named .js (browsers do not mind); node 18
-// reads a .js outside a "type": "module" package as CommonJS, so it is
-// imported from a copy named .mjs.
-import { copyFileSync, mkdtempSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { pathToFileURL } from 'node:url';
-const dir = mkdtempSync(join(tmpdir(), 'vdsh-core-'));
-copyFileSync(process.argv[2], join(dir, 'vdsh_core.mjs'));
-const { vdshCpcaDecode, vdshCpcaBufferData, bufferSequence } = await import(pathToFileURL(join(dir, 'vdsh_core.mjs')).href);
-rmSync(dir, { recursive: true });
+import { importCore } from './web_core.mjs';
+const { vdshCpcaDecode, vdshCpcaBufferData, bufferSequence } = await importCore(process.argv[2]);
 
 let seed = 12345;
 const rnd = () => (seed = (Math.imul(seed, 1103515245) + 12345) >>> 0) / 4294967296;

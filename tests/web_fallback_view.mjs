@@ -7,12 +7,12 @@
 // With BAKE and EXPORT: each triangle baked and exported, and the page's
 // view against the one vdsh-export wrote (vdsh-view's, in C): eye and
 // target to 1e-4 of the diagonal, each light on the same side. Exit 0 or 1 with the failures.
-import { pathToFileURL } from 'node:url';
+import { importCore } from './web_core.mjs';
 import { execFileSync } from 'node:child_process';
 import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 
 const [core, bake, exporter, dir] = process.argv.slice(2);
-const { vdshFallbackView } = await import(pathToFileURL(core).href);
+const { vdshFallbackView } = await importCore(core);
 const fail = [];
 const check = (ok, msg) => { if (!ok) fail.push(msg); };
 const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
