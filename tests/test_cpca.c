@@ -191,7 +191,7 @@ static void curved_cluster(void)
         }
         memcpy(nrm + 3 * v, faces[g], sizeof faces[g]);
     }
-    vdsh_cpca_settings st = {1, 1, 8, 0};
+    vdsh_cpca_settings st = {.clusters = 1, .basis = 1, .bits = 8, .budget = 0};
     vdsh_cpca_fit fit;
     vdsh_error err = {{0}};
     CHECK(vdsh_cpca_encode(c, nrm, CURVED_ROWS, CURVED_ORDER, &st, &fit, &err) == VDSH_OK,
@@ -250,7 +250,7 @@ static void line_and_blob(void)
         for (int i = 0; i < LINE_NC; i++)
             spread += (c[v * LINE_NC + i] - mean[i]) * (c[v * LINE_NC + i] - mean[i]) / LINE_ROWS;
     spread = sqrt(spread);
-    vdsh_cpca_settings st = {2, 1, 8, 0};
+    vdsh_cpca_settings st = {.clusters = 2, .basis = 1, .bits = 8, .budget = 0};
     vdsh_cpca_fit fit;
     vdsh_error err = {{0}};
     CHECK(vdsh_cpca_encode(c, nrm, LINE_ROWS, LINE_ORDER, &st, &fit, &err) == VDSH_OK,
@@ -286,7 +286,7 @@ static void auto_settings(void)
     vdsh_error err = {{0}};
     static const uint32_t budgets[] = {12, 20, 32};
     for (size_t i = 0; i < sizeof budgets / sizeof *budgets; i++) {
-        vdsh_cpca_settings st = {0, 0, 0, budgets[i]};
+        vdsh_cpca_settings st = {.clusters = 0, .basis = 0, .bits = 0, .budget = budgets[i]};
         vdsh_cpca_fit a, b;
         CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &a, &err) == VDSH_OK, "auto:%u: %s",
               budgets[i], err.msg);
@@ -312,7 +312,7 @@ static void auto_settings(void)
         vdsh_cpca_fit_free(&a);
         vdsh_cpca_fit_free(&b);
     }
-    vdsh_cpca_settings tiny = {0, 0, 0, 1};
+    vdsh_cpca_settings tiny = {.clusters = 0, .basis = 0, .bits = 0, .budget = 1};
     vdsh_cpca_fit f;
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &tiny, &f, &err) == VDSH_ERR_ARGUMENT &&
               strstr(err.msg, "budget") && !f.storage_,
@@ -326,7 +326,7 @@ static void auto_settings(void)
 static void widths_study(void)
 {
     vdsh_error err = {{0}};
-    vdsh_cpca_settings st = {K, B, BITS, 0};
+    vdsh_cpca_settings st = {.clusters = K, .basis = B, .bits = BITS, .budget = 0};
     vdsh_cpca_fit fit;
     static float dec[ROWS * NC], dec2[ROWS * NC];
     vdsh_cpca_widths_fit wf, wf2;
@@ -592,7 +592,7 @@ static void alloc_settings(void)
     free(mem);
     vdsh_cpca_fit_free(&a);
     vdsh_cpca_fit_free(&b);
-    vdsh_cpca_settings tiny = {3, 0, 0, 1};
+    vdsh_cpca_settings tiny = {.clusters = 3, .basis = 0, .bits = 0, .budget = 1};
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &tiny, &a, &err) == VDSH_ERR_ARGUMENT &&
               strstr(err.msg, "budget") && !a.storage_,
           "alloc:1 not refused (%s)", err.msg);
@@ -606,7 +606,7 @@ static void alloc_settings(void)
 int main(int argc, char **argv)
 {
     make_data();
-    vdsh_cpca_settings st = {K, B, BITS, 0};
+    vdsh_cpca_settings st = {.clusters = K, .basis = B, .bits = BITS, .budget = 0};
     vdsh_cpca_fit fit, again, one;
     vdsh_error err;
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &fit, &err) == VDSH_OK, "encode: %s",
@@ -670,7 +670,7 @@ int main(int argc, char **argv)
     double e = rms_vs(&s, src);
     CHECK(fabs(e - fit.rms_error) <= 1e-9 * (1 + e), "rms_error %g, decode %g", fit.rms_error, e);
     CHECK(e < 0.1 * spread, "error %g not below a tenth of the spread %g", e, spread);
-    vdsh_cpca_settings small = {1, 1, 4, 0};
+    vdsh_cpca_settings small = {.clusters = 1, .basis = 1, .bits = 4, .budget = 0};
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &small, &one, &err) == VDSH_OK, "K=1");
     CHECK(one.rms_error > 2.0 * e, "one vector %g, not worse than %g", one.rms_error, e);
     printf("format_cpca: error %.4g, spread %.4g, one vector %.4g\n", e, spread, one.rms_error);
