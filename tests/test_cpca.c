@@ -44,6 +44,10 @@
  *                  field's -L - 1 refused
  *   alloc          --cpca K,alloc:BYTES: widths 2..8 within the budget,
  *                  the same bytes twice, read back, too small refused
+ *   light metric   the light-density metric: mix 0, no pool or no light
+ *                  above any horizon give the uniform metric's bytes, a
+ *                  pool another fit (the same twice), bad mixes and pools
+ *                  refused; parse's ,light:A
  *   settings       vdsh_cpca_parse accepts K,B,BITS, auto and auto:BYTES
  *                  and refuses the rest
  */
@@ -603,6 +607,120 @@ static void alloc_settings(void)
           "bad alloc settings accepted");
 }
 
+/* Whether two fits of K, B, BITS are the same bytes (model and records). */
+static int same_fit(const vdsh_cpca_fit *a, const vdsh_cpca_fit *b)
+{
+    size_t mb = (size_t)vdsh_cpca_model_bytes(ORDER, K, B) - 16;
+    return a->model.record_words == b->model.record_words &&
+           memcmp(a->storage_, b->storage_, mb) == 0 &&
+           memcmp(a->records, b->records, (size_t)ROWS * 4 * a->model.record_words) == 0;
+}
+
+/* The light-density metric (settings light_mix and the pool): a mix of 0,
+ * no pool, or a pool no vertex sees above its horizon (every light at
+ * every vertex's position) give the uniform metric's bytes; a pool around
+ * the vertices another fit, valid, the same twice; bad light settings
+ * refused; vdsh_cpca_parse's ,light:A. */
+static void light_metric(void)
+{
+    enum { NL = 64 };
+    static float pool[NL * 3], origin[ROWS * 3], at_origin[NL * 3];
+    for (int l = 0; l < NL; l++) { /* around the vertices (x 0..599, y = z = 0) */
+        pool[3 * l] = (float)(l * 10 % ROWS);
+        pool[3 * l + 1] = (float)(l % 7) - 3.0f;
+        pool[3 * l + 2] = (float)(l % 5) - 2.0f;
+    }
+    vdsh_cpca_settings st = {.clusters = K, .basis = B, .bits = BITS, .budget = 0};
+    vdsh_cpca_fit u, f, g;
+    vdsh_error err;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &u, &err) == VDSH_OK, "uniform: %s",
+          err.msg);
+    const struct {
+        const char *what;
+        float mix;
+        uint32_t count;
+        const float *lights, *pos;
+    } same[] = {{"mix 0 with a pool", 0.0f, NL, pool, positions},
+                {"mix 1 without lights", 1.0f, 0, NULL, NULL},
+                {"mix 1, no light above a horizon", 1.0f, NL, at_origin, origin}};
+    for (size_t k = 0; k < sizeof same / sizeof *same; k++) {
+        vdsh_cpca_settings l = st;
+        l.light_mix = same[k].mix;
+        l.light_count = same[k].count;
+        l.lights = same[k].lights;
+        l.positions = same[k].pos;
+        CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &l, &f, &err) == VDSH_OK, "%s: %s",
+              same[k].what, err.msg);
+        CHECK(same_fit(&u, &f), "%s: not the uniform metric's bytes", same[k].what);
+        vdsh_cpca_fit_free(&f);
+    }
+    vdsh_cpca_settings l = st;
+    l.light_mix = 1.0f;
+    l.light_count = NL;
+    l.lights = pool;
+    l.positions = positions;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &l, &f, &err) == VDSH_OK, "mix 1: %s",
+          err.msg);
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &l, &g, &err) == VDSH_OK, "mix 1 again");
+    CHECK(!same_fit(&u, &f), "mix 1 with a pool: the uniform metric's bytes");
+    CHECK(same_fit(&f, &g), "mix 1: two encodings differ");
+    CHECK(isfinite(f.rms_error) && f.rms_error < 4.0 * u.rms_error, "mix 1: error %g, uniform %g",
+          f.rms_error, u.rms_error);
+    printf("format_cpca: light mix 1: error %.4g, uniform %.4g\n", f.rms_error, u.rms_error);
+    vdsh_cpca_fit_free(&f);
+    vdsh_cpca_fit_free(&g);
+    vdsh_cpca_fit_free(&u);
+    /* refused */
+    static float inf_pool[NL * 3];
+    memcpy(inf_pool, pool, sizeof pool);
+    inf_pool[7] = INFINITY;
+    const struct {
+        const char *what;
+        float mix;
+        uint32_t count;
+        const float *lights, *pos;
+    } bad[] = {{"mix 1.5", 1.5f, NL, pool, positions},
+               {"mix -0.5", -0.5f, NL, pool, positions},
+               {"mix nan", NAN, NL, pool, positions},
+               {"lights NULL", 1.0f, NL, NULL, positions},
+               {"positions NULL", 1.0f, NL, pool, NULL},
+               {"a light not finite", 1.0f, NL, inf_pool, positions}};
+    for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
+        vdsh_cpca_settings b = st;
+        b.light_mix = bad[k].mix;
+        b.light_count = bad[k].count;
+        b.lights = bad[k].lights;
+        b.positions = bad[k].pos;
+        CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &b, &f, &err) == VDSH_ERR_ARGUMENT &&
+                  strstr(err.msg, "light"),
+              "%s accepted or not said: %s", bad[k].what, err.msg);
+    }
+    /* the grammar */
+    vdsh_cpca_settings p, d = vdsh_cpca_settings_default();
+    CHECK(vdsh_cpca_parse("3,alloc:16,light:0.5", &p, &err) == VDSH_OK && p.clusters == 3 &&
+              p.budget == 16 && p.light_mix == 0.5f,
+          "3,alloc:16,light:0.5");
+    CHECK(vdsh_cpca_parse("light:1", &p, &err) == VDSH_OK && p.clusters == d.clusters &&
+              p.basis == d.basis && p.bits == d.bits && p.budget == 0 && p.light_mix == 1.0f,
+          "light:1 alone");
+    CHECK(vdsh_cpca_parse("auto,light:0", &p, &err) == VDSH_OK && p.budget == 32 &&
+              p.light_mix == 0.0f,
+          "auto,light:0");
+    CHECK(vdsh_cpca_parse("8,52,4,light:.25", &p, &err) == VDSH_OK && p.light_mix == 0.25f,
+          "8,52,4,light:.25");
+    CHECK(vdsh_cpca_parse("8,52,4", &p, &err) == VDSH_OK &&
+              p.light_mix == VDSH_CPCA_DEFAULT_LIGHT_MIX && d.light_mix == p.light_mix &&
+              !p.light_count && !p.lights && !p.positions,
+          "the default light mix");
+    static const char *const refuse[] = {
+        "light:2",       "light:",           "light:-0",          "light:1e0",
+        "light:inf",     "light:1,8,52,4",   "8,52,4,light:x",    "8,52,4,light:1,",
+        "8,52,4light:1", "auto,light:0.5.1", "3,alloc:0,light:1", "8,52,4,light:1,light:0"};
+    for (size_t k = 0; k < sizeof refuse / sizeof *refuse; k++)
+        CHECK(vdsh_cpca_parse(refuse[k], &p, &err) == VDSH_ERR_ARGUMENT, "'%s' accepted",
+              refuse[k]);
+}
+
 int main(int argc, char **argv)
 {
     make_data();
@@ -780,6 +898,7 @@ int main(int argc, char **argv)
     auto_settings();
     widths_study();
     alloc_settings();
+    light_metric();
 
     /* settings */
     vdsh_cpca_settings p;
