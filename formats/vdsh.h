@@ -322,6 +322,17 @@ typedef struct vdsh_adaptive {
     uint32_t candidates;      /* midpoints baked, split or not */
 } vdsh_adaptive;
 
+/* A part's cpca light pool (`lpol` chunk, VDSH.md "Parts"): the light mix
+ * and the pool of the cpca encoder's light-density metric (vdsh_cpca.h),
+ * which vdsh-merge passes to the encoder. Only in parts whose `part`
+ * encoding is cpca, and only with a mix > 0. */
+#define VDSH_MAX_POOL_LIGHTS 65536
+typedef struct vdsh_light_pool {
+    float mix;           /* 0 < mix <= 1 */
+    uint32_t count;      /* 1..VDSH_MAX_POOL_LIGHTS */
+    const float *lights; /* 3 * count, finite */
+} vdsh_light_pool;
+
 typedef struct vdsh_file {
     vdsh_header header;
     uint32_t source_count;
@@ -339,6 +350,8 @@ typedef struct vdsh_file {
     vdsh_part part;
     int has_adaptive; /* `adpt` chunk present: adaptive receivers */
     vdsh_adaptive adaptive;
+    int has_light_pool; /* `lpol` chunk present: a cpca part's light pool */
+    vdsh_light_pool light_pool;
     void *storage_; /* owned memory; do not touch */
 } vdsh_file;
 

@@ -533,6 +533,23 @@ int vdsh_check_part(const vdsh_part *t, uint32_t vertex_count, why *w)
     return 1;
 }
 
+int vdsh_check_light_pool(const vdsh_light_pool *l, int has_part, const vdsh_part *part, why *w)
+{
+    if (!has_part || part->encoding != VDSH_ENCODING_CPCA)
+        return vdsh_bad(w, "lpol: a light pool outside a cpca part (only parts of --encoding "
+                           "cpca bakes carry one)");
+    if (!(l->mix > 0.0f && l->mix <= 1.0f))
+        return vdsh_bad(w, "lpol: light mix %g out of range (0, 1]", (double)l->mix);
+    if (l->count < 1 || l->count > VDSH_MAX_POOL_LIGHTS)
+        return vdsh_bad(w, "lpol: %u lights, out of range 1..%d", l->count, VDSH_MAX_POOL_LIGHTS);
+    if (!l->lights)
+        return vdsh_bad(w, "lpol: lights is NULL");
+    for (size_t x = 0; x < 3 * (size_t)l->count; x++)
+        if (!isfinite(l->lights[x]))
+            return vdsh_bad(w, "lpol: light %zu is not finite", x / 3);
+    return 1;
+}
+
 int vdsh_check_adaptive(const vdsh_adaptive *a, uint32_t vertex_count, why *w)
 {
     if (!(a->tolerance >= 0.0f))

@@ -33,13 +33,41 @@ enum {
 
 vdsh_cpca_settings vdsh_cpca_settings_default(void)
 {
-    vdsh_cpca_settings s = {VDSH_CPCA_DEFAULT_CLUSTERS, VDSH_CPCA_DEFAULT_BASIS,
-                            VDSH_CPCA_DEFAULT_BITS, 0};
+    vdsh_cpca_settings s = {VDSH_CPCA_DEFAULT_CLUSTERS,
+                            VDSH_CPCA_DEFAULT_BASIS,
+                            VDSH_CPCA_DEFAULT_BITS,
+                            0,
+                            VDSH_CPCA_DEFAULT_LIGHT_MIX,
+                            0,
+                            NULL,
+                            NULL};
     return s;
+}
+
+static int check_light(const vdsh_cpca_settings *s, vdsh_error *err)
+{
+    if (!(s->light_mix >= 0.0f && s->light_mix <= 1.0f)) {
+        vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: light mix %g out of range 0..1",
+                   (double)s->light_mix);
+        return 0;
+    }
+    if (s->light_count && (!s->lights || !s->positions)) {
+        vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: %u light%s without %s", s->light_count,
+                   vdsh_s(s->light_count), !s->lights ? "the lights" : "the receiver positions");
+        return 0;
+    }
+    for (size_t x = 0; x < 3 * (size_t)s->light_count; x++)
+        if (!isfinite(s->lights[x])) {
+            vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: light %zu is not finite", x / 3);
+            return 0;
+        }
+    return 1;
 }
 
 static int check_settings(const vdsh_cpca_settings *s, vdsh_error *err)
 {
+    if (!check_light(s, err))
+        return 0;
     if (s->budget) {
         if (s->budget > VDSH_CPCA_MAX_BUDGET) {
             vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: auto budget %u out of range 1..%d", s->budget,
@@ -71,7 +99,63 @@ static int check_settings(const vdsh_cpca_settings *s, vdsh_error *err)
     return 1;
 }
 
+static vdsh_result parse_base(const char *text, vdsh_cpca_settings *out, vdsh_error *err);
+
+/* "light:A", A a decimal in 0..1 (digits and one point only: no sign,
+ * exponent, inf or nan); 0 when malformed. */
+static int parse_light(const char *p, float *mix)
+{
+    if (strncmp(p, "light:", 6) != 0)
+        return 0;
+    p += 6;
+    const char *q = p;
+    int digits = 0, points = 0;
+    for (; *q; q++) {
+        if (*q >= '0' && *q <= '9')
+            digits++;
+        else if (*q == '.' && !points++)
+            continue;
+        else
+            return 0;
+    }
+    if (!digits || q - p > 16)
+        return 0;
+    char *end;
+    double a = strtod(p, &end);
+    if (*end || !(a >= 0.0 && a <= 1.0))
+        return 0;
+    *mix = (float)a;
+    return 1;
+}
+
 vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_error *err)
+{
+    const char *p = text ? text : "";
+    const char *l = strncmp(p, "light:", 6) == 0 ? p : strstr(p, ",light:");
+    float mix = VDSH_CPCA_DEFAULT_LIGHT_MIX;
+    if (l && !parse_light(l + (*l == ','), &mix))
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                          "cpca settings '%s': expected light:A at the end, A the light mix "
+                          "0..1 (for example 8,alloc:32,light:1)",
+                          p);
+    vdsh_cpca_settings s = vdsh_cpca_settings_default();
+    if (l != p) {
+        char base[64];
+        size_t len = l ? (size_t)(l - p) : strlen(p);
+        if (len >= sizeof base)
+            return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca settings '%s': too long", p);
+        memcpy(base, p, len);
+        base[len] = 0;
+        vdsh_result r = parse_base(base, &s, err);
+        if (r != VDSH_OK)
+            return r;
+    }
+    s.light_mix = mix;
+    *out = s;
+    return VDSH_OK;
+}
+
+static vdsh_result parse_base(const char *text, vdsh_cpca_settings *out, vdsh_error *err)
 {
     unsigned long v[3];
     const char *p = text ? text : "";
@@ -89,7 +173,8 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
             return vdsh_failf(err, VDSH_ERR_ARGUMENT,
                               "cpca settings '%s': expected auto or auto:BYTES", text);
         }
-        vdsh_cpca_settings s = {0, 0, 0, (uint32_t)budget};
+        vdsh_cpca_settings s = {0};
+        s.budget = (uint32_t)budget;
         *out = s;
         return VDSH_OK;
     }
@@ -107,7 +192,9 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
                                   "cpca settings '%s': expected K,alloc:BYTES, K 1..%d, bytes "
                                   "per vertex 1..%d (for example 8,alloc:32)",
                                   text, VDSH_CPCA_MAX_CLUSTERS, VDSH_CPCA_MAX_BUDGET);
-            vdsh_cpca_settings s = {(uint32_t)k, 0, 0, (uint32_t)budget};
+            vdsh_cpca_settings s = {0};
+            s.clusters = (uint32_t)k;
+            s.budget = (uint32_t)budget;
             *out = s;
             return VDSH_OK;
         }
@@ -124,7 +211,10 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
                               "cpca settings '%s': expected K,B,BITS (for example 8,54,4)", text);
         p = end + (k < 2);
     }
-    vdsh_cpca_settings s = {(uint32_t)v[0], (uint32_t)v[1], (uint32_t)v[2], 0};
+    vdsh_cpca_settings s = {0};
+    s.clusters = (uint32_t)v[0];
+    s.basis = (uint32_t)v[1];
+    s.bits = (uint32_t)v[2];
     if (!check_settings(&s, err))
         return VDSH_ERR_ARGUMENT;
     *out = s;
@@ -278,88 +368,43 @@ static void metric_free(metric_dirs *m)
     free(m->full);
 }
 
-/* ---- study hook: the light-density metric (docs/ACCURACY.md, "A
- * light-density metric") ----
+/* ---- the light-density metric (vdsh_cpca.h, settings light_mix; docs/
+ * ACCURACY.md "A light-density metric") ----
  *
- * Measurement only, off unless the environment says: with
- * VDSH_CPCA_LIGHTMIX=a (0 <= a <= 1), VDSH_CPCA_LIGHTS=FILE (f32 x, y, z
- * per light: a pool placed by the scene's light rule) and
- * VDSH_CPCA_POSITIONS=FILE (f32 x, y, z per row, the rows' receiver
- * positions) every vertex's hemisphere weight of a direction becomes
- * (1 - a) + a * rho, rho the share of the pool's lights above the vertex's
- * horizon whose direction from the vertex falls in that direction's cube
- * texel, over the texel's share of the hemisphere's solid angle (2 pi): the
- * density of possible lights seen from the vertex, with the uniform
- * weight's integral. A vertex with no light above its horizon keeps the
- * uniform weight. Unset: the default metric, the same bytes. */
+ * Every vertex's hemisphere weight of a direction is (1 - a) + a * rho,
+ * rho the share of the pool's lights above the vertex's horizon whose
+ * direction from the vertex falls in that direction's cube texel, over the
+ * texel's share of the hemisphere's solid angle (2 pi): the density of
+ * possible lights seen from the vertex, with the uniform weight's
+ * integral. A vertex with no light above its horizon keeps the uniform
+ * weight. +, -, x, / and comparisons only (no libm): the same bytes on any
+ * CPU. */
 typedef struct lightmix {
     double a;
-    uint32_t nl, rows;
-    float *lights, *pos; /* nl x 3, rows x 3 */
-    uint32_t *tex;       /* nl: scratch */
-    double *lw;          /* nl: scratch */
-    double rel;          /* VDSH_CPCA_LIGHTREL's h, or 0: no relevance weight */
+    uint32_t nl;
+    const float *lights, *pos; /* nl x 3, rows x 3 */
+    uint32_t *tex;             /* nl: scratch */
 } lightmix;
-
-static float *read_f32s(const char *path, size_t *count)
-{
-    FILE *fp = path ? fopen(path, "rb") : NULL;
-    if (!fp)
-        return NULL;
-    float *out = NULL;
-    long size = fseek(fp, 0, SEEK_END) == 0 ? ftell(fp) : -1;
-    if (size > 0 && size % 12 == 0 && fseek(fp, 0, SEEK_SET) == 0) {
-        out = malloc((size_t)size);
-        if (out && fread(out, 1, (size_t)size, fp) != (size_t)size) {
-            free(out);
-            out = NULL;
-        }
-        *count = (size_t)size / 4;
-    }
-    fclose(fp);
-    return out;
-}
 
 static void lightmix_free(lightmix *lm)
 {
-    free(lm->lights);
-    free(lm->pos);
     free(lm->tex);
-    free(lm->lw);
     memset(lm, 0, sizeof *lm);
 }
 
-/* lm from the environment: 1 when on, 0 when off (lm zeroed), -1 (and a
- * message) when set but unusable. */
-static int lightmix_load(lightmix *lm, uint32_t rows)
+/* lm from the settings: 1 when on, 0 when off (lm zeroed), -1 out of
+ * memory. */
+static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st)
 {
     memset(lm, 0, sizeof *lm);
-    const char *mix = getenv("VDSH_CPCA_LIGHTMIX");
-    if (!mix || !*mix)
+    if (!st || !(st->light_mix > 0.0f) || !st->light_count || !st->lights || !st->positions)
         return 0;
-    char *end = NULL;
-    double a = strtod(mix, &end);
-    size_t nl = 0, np = 0;
-    lm->a = a;
-    lm->lights = read_f32s(getenv("VDSH_CPCA_LIGHTS"), &nl);
-    lm->pos = read_f32s(getenv("VDSH_CPCA_POSITIONS"), &np);
-    lm->nl = (uint32_t)(nl / 3);
-    lm->rows = rows;
-    lm->tex = lm->nl ? malloc(sizeof(uint32_t) * lm->nl) : NULL;
-    lm->lw = lm->nl ? malloc(sizeof(double) * lm->nl) : NULL;
-    const char *rel = getenv("VDSH_CPCA_LIGHTREL");
-    char *rend = NULL;
-    lm->rel = rel && *rel ? strtod(rel, &rend) : 0.0;
-    if (*end || !(a >= 0.0 && a <= 1.0) || !lm->lights || !lm->pos || np != 3 * (size_t)rows ||
-        !lm->tex || !lm->lw || (rend && *rend) || !(lm->rel >= 0.0)) {
-        fprintf(stderr,
-                "cpca: VDSH_CPCA_LIGHTMIX=%s needs 0 <= a <= 1, VDSH_CPCA_LIGHTS (f32 x, y, z "
-                "per light) and VDSH_CPCA_POSITIONS (%u rows of f32 x, y, z)\n",
-                mix, rows);
-        lightmix_free(lm);
-        return -1;
-    }
-    return 1;
+    lm->a = (double)st->light_mix;
+    lm->nl = st->light_count;
+    lm->lights = st->lights;
+    lm->pos = st->positions;
+    lm->tex = malloc(sizeof(uint32_t) * lm->nl);
+    return lm->tex ? 1 : -1;
 }
 
 /* The texel of direction d on a cube of cube_n (metric_init's layout). */
@@ -376,43 +421,20 @@ static uint32_t cube_texel(const double d[3], uint32_t cube_n)
     return (face * cube_n + j) * cube_n + i;
 }
 
-/* The texels of m of the pool's lights above vertex v's horizon, in
- * lm->tex, and their weights in lm->lw: their count in *t, the weights'
- * sum returned. A weight is 1, or with VDSH_CPCA_LIGHTREL=h (lm->rel) the
- * light's relevance to the shadow decision: 1 / (1 + ((q - 0.55) / h)^2),
- * q = ln d_L - ln D (D the vertex's own function x at the light's texel):
- * lights far nearer than D (lit whatever a small error does) or far beyond
- * it (shadowed) count less than those near the ramp, q in 0 .. ln 3. The
- * relevance calls libm's log, which this file otherwise avoids (its
- * results may depend on the CPU's code path): measurement only. */
-static double light_texels(lightmix *lm, uint32_t v, const float *nv, const metric_dirs *m,
-                           const float *x, uint32_t *t)
+/* The texels of m of the pool's lights above vertex v's horizon (normal
+ * nv), in lm->tex; their count returned. */
+static uint32_t light_texels(lightmix *lm, uint32_t v, const float *nv, const metric_dirs *m)
 {
     const float *p = lm->pos + 3 * (size_t)v;
-    const uint32_t n = m->n;
-    double sum = 0.0;
-    *t = 0;
+    uint32_t t = 0;
     for (uint32_t l = 0; l < lm->nl; l++) {
         const float *q = lm->lights + 3 * (size_t)l;
         double d[3] = {(double)q[0] - p[0], (double)q[1] - p[1], (double)q[2] - p[2]};
         if (!(d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0))
             continue;
-        uint32_t at = cube_texel(d, m->cube_n);
-        double wt = 1.0;
-        if (lm->rel > 0.0) {
-            const double *y = m->wy + (size_t)at * n;
-            double s = 0.0;
-            for (uint32_t k = 0; k < n; k++)
-                s += y[k] * (double)x[k];
-            s /= sqrt(m->w[at]);
-            double z = (0.5 * log(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - s - 0.55) / lm->rel;
-            wt = 1.0 / (1.0 + z * z);
-        }
-        lm->tex[*t] = at;
-        lm->lw[(*t)++] = wt;
-        sum += wt;
+        lm->tex[t++] = cube_texel(d, m->cube_n);
     }
-    return sum;
+    return t;
 }
 
 #define TWO_PI 6.283185307179586
@@ -425,7 +447,7 @@ static double light_texels(lightmix *lm, uint32_t v, const float *nv, const metr
  * members each keep weight on their own horizon. */
 static void metric_gram_members(const metric_dirs *m, const float *normals, const uint32_t *labels,
                                 uint32_t rows, uint32_t c, uint32_t members, double *frac,
-                                double *g, lightmix *lm, const float *src)
+                                double *g, lightmix *lm)
 {
     uint32_t n = m->n;
     for (uint32_t d = 0; d < m->count; d++)
@@ -435,13 +457,13 @@ static void metric_gram_members(const metric_dirs *m, const float *normals, cons
             continue;
         const float *nv = normals + 3 * (size_t)v;
         double a = nv[0], b = nv[1], e = nv[2], u = 1.0;
-        if (lm) { /* the study hook: (1 - a) uniform + a light density */
-            uint32_t t;
-            double sum = light_texels(lm, v, nv, m, src + (size_t)v * n, &t);
-            if (t && sum > 0.0) {
+        if (lm) { /* (1 - a) uniform + a light density */
+            const uint32_t t = light_texels(lm, v, nv, m);
+            if (t) {
+                const double sum = (double)t;
                 u = 1.0 - lm->a;
                 for (uint32_t i = 0; i < t; i++)
-                    frac[lm->tex[i]] += lm->a * TWO_PI * lm->lw[i] / (sum * m->w[lm->tex[i]]);
+                    frac[lm->tex[i]] += lm->a * TWO_PI / (sum * m->w[lm->tex[i]]);
             }
         }
         for (uint32_t d = 0; d < m->count; d++) {
@@ -617,7 +639,7 @@ typedef struct fit_ctx {
     double *proj;                          /* k x b x n: the weights' projections */
     double *g, *sc, *sy, *ev, *tmp, *frac; /* scratch */
     uint32_t *idx;
-    lightmix *lm; /* the study hook's, or NULL */
+    lightmix *lm; /* the light-density metric's, or NULL */
 } fit_ctx;
 
 /* Cluster c's mean and basis from its members (labels): the mean stored
@@ -661,7 +683,7 @@ static vdsh_result fit_cluster(fit_ctx *f, uint32_t c, vdsh_error *err)
         f->means[(size_t)c * n + i] = h;
         mu[i] = vdsh_f32_from_f16(h);
     }
-    metric_gram_members(f->md, normals, labels, rows, c, members, frac, g, f->lm, src);
+    metric_gram_members(f->md, normals, labels, rows, c, members, frac, g, f->lm);
     if (!cholesky(g, n, l)) {
         return vdsh_failf(err, VDSH_ERR_INVALID, "cpca: cluster %u: metric not positive definite",
                           c);
@@ -759,7 +781,7 @@ typedef struct refine_ctx {
     double *w;      /* b */
     uint32_t *hemi; /* count: the directions in the vertex's hemisphere */
     uint32_t *next; /* rows: the new labels */
-    double *dw;     /* count: the study hook's weights of the vertex's directions, or NULL */
+    double *dw;     /* count: the light-density weights of the vertex's directions, or NULL */
 } refine_ctx;
 
 static int refine_init(refine_ctx *r, uint32_t order, uint32_t k, uint32_t b, uint32_t rows)
@@ -862,18 +884,16 @@ static uint32_t vertex_hemisphere(const fit_ctx *f, refine_ctx *r, uint32_t v)
             s += y[a] * (double)x[a];
         r->xval[d] = s;
     }
-    if (r->dw) { /* the study hook: (1 - a) uniform + a light density */
+    if (r->dw) { /* (1 - a) uniform + a light density */
         lightmix *lm = f->lm;
-        uint32_t t;
-        double sum = light_texels(lm, v, nv, &r->rd, x, &t);
-        if (!(sum > 0.0))
-            t = 0;
+        const uint32_t t = light_texels(lm, v, nv, &r->rd);
+        const double sum = (double)t;
         for (uint32_t h = 0; h < nh; h++)
             r->dw[r->hemi[h]] = t ? 1.0 - lm->a : 1.0;
         for (uint32_t i = 0; i < t; i++) {
             const double *dd = r->rd.dir + 3 * (size_t)lm->tex[i];
             if (dd[0] * nv[0] + dd[1] * nv[1] + dd[2] * nv[2] > 0.0)
-                r->dw[lm->tex[i]] += lm->a * TWO_PI * lm->lw[i] / (sum * r->rd.w[lm->tex[i]]);
+                r->dw[lm->tex[i]] += lm->a * TWO_PI / (sum * r->rd.w[lm->tex[i]]);
         }
     }
     return nh;
@@ -954,7 +974,7 @@ static double quantise(double w, double s, int levels)
  * points at md). */
 typedef struct fit_scratch {
     fit_ctx fc;
-    lightmix lm; /* the study hook's */
+    lightmix lm; /* the light-density metric's */
     metric_dirs md;
     refine_ctx rd; /* allocated only with need_rd */
     double *mu;    /* n */
@@ -993,7 +1013,7 @@ static void fit_scratch_free(fit_scratch *s)
  * with need_rd. 0 when out of memory: free it with fit_scratch_free. */
 static int fit_scratch_alloc(fit_scratch *s, const float *src, const float *normals, uint32_t rows,
                              uint32_t order, uint32_t k, uint32_t b, uint32_t fit_basis,
-                             int need_rd)
+                             int need_rd, const vdsh_cpca_settings *light)
 {
     memset(s, 0, sizeof *s);
     const uint32_t n = order * order, bf = fit_basis;
@@ -1022,7 +1042,7 @@ static int fit_scratch_alloc(fit_scratch *s, const float *src, const float *norm
     s->mu = malloc(sizeof(double) * n);
     s->dist = malloc(sizeof(double) * rows);
     s->cent = malloc(sizeof(double) * k * (n + 3));
-    const int lm = lightmix_load(&s->lm, rows);
+    const int lm = lightmix_load(&s->lm, light);
     if (lm < 0)
         return 0;
     f->lm = lm ? &s->lm : NULL;
@@ -1121,8 +1141,8 @@ static vdsh_result encode_fixed(const float *src, const float *normals, uint32_t
     fit_scratch fs;
     const uint32_t rounds = k > 1 ? REFINE_ROUNDS : 0;
     vdsh_result res = VDSH_OK;
-    if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, b, rounds || proxy) || !block ||
-        !wmax || !cerr) {
+    if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, b, rounds || proxy, settings) ||
+        !block || !wmax || !cerr) {
         res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory (%zu bytes)", total);
         goto done;
     }
@@ -1241,8 +1261,10 @@ static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t
 
 /* auto: the candidates vdsh_cpca.h names, the least stored_error kept. */
 static vdsh_result encode_auto(const float *src, const float *normals, uint32_t rows,
-                               uint32_t order, uint32_t budget, vdsh_cpca_fit *out, vdsh_error *err)
+                               uint32_t order, const vdsh_cpca_settings *settings,
+                               vdsh_cpca_fit *out, vdsh_error *err)
 {
+    const uint32_t budget = settings->budget;
     static const uint32_t ks[] = {4, 8, 16};
     const uint32_t bits = 4;
     const uint64_t limit = (uint64_t)budget * rows;
@@ -1250,7 +1272,11 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
     uint32_t last_k = 0;
     int have = 0;
     for (size_t i = 0; i < sizeof ks / sizeof ks[0]; i++) {
-        vdsh_cpca_settings st = {ks[i] < rows ? ks[i] : rows, 0, bits, 0};
+        vdsh_cpca_settings st = *settings;
+        st.clusters = ks[i] < rows ? ks[i] : rows;
+        st.basis = 0;
+        st.bits = bits;
+        st.budget = 0;
         if (st.clusters == last_k)
             continue; /* capped at rows: the same as the last */
         last_k = st.clusters;
@@ -1276,7 +1302,7 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
         }
     }
     if (!have) {
-        vdsh_cpca_settings least = {1, 1, bits, 0};
+        vdsh_cpca_settings least = {.clusters = 1, .basis = 1, .bits = bits, .budget = 0};
         return vdsh_failf(err, VDSH_ERR_ARGUMENT,
                           "cpca: auto budget %u byte%s per vertex too small for %u row%s of order "
                           "%u (the least model, 1,1,%u, takes %.1f)",
@@ -1305,7 +1331,7 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
     if (settings->budget && settings->clusters)
         return encode_alloc(src, normals, rows, order, settings, out, err);
     if (settings->budget)
-        return encode_auto(src, normals, rows, order, settings->budget, out, err);
+        return encode_auto(src, normals, rows, order, settings, out, err);
     return encode_fixed(src, normals, rows, order, settings, out, NULL, err);
 }
 
@@ -1405,7 +1431,11 @@ static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t
 {
     const uint32_t n = order * order;
     const uint64_t limit = (uint64_t)settings->budget * rows;
-    vdsh_cpca_settings st = {settings->clusters < rows ? settings->clusters : rows, 0, 4, 0};
+    vdsh_cpca_settings st = *settings;
+    st.clusters = settings->clusters < rows ? settings->clusters : rows;
+    st.basis = 0;
+    st.bits = 4;
+    st.budget = 0;
     st.basis = largest_basis(rows, order, &st, limit);
     if (!st.basis)
         return vdsh_failf(err, VDSH_ERR_ARGUMENT,
@@ -1459,8 +1489,8 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
     fit_scratch fs;
     const uint32_t rounds = k > 1 ? REFINE_ROUNDS : 0;
     vdsh_result res = VDSH_OK;
-    if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, bf, rounds) || !wts || !cdist ||
-        !cscale || !tot || !level || !best_level) {
+    if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, bf, rounds, settings) || !wts ||
+        !cdist || !cscale || !tot || !level || !best_level) {
         res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca widths: out of memory");
         goto done;
     }

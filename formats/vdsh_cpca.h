@@ -11,7 +11,9 @@
  * seeding from a fixed seed, Lloyd rounds until no vertex moves (at most
  * 25); per cluster the mean (f16) and the B leading principal directions
  * of the deviations in the mean of the members' own upper-hemisphere
- * metrics plus 0.01 of the whole sphere; then 3 rounds of CPCA refinement
+ * metrics plus 0.01 of the whole sphere (each member's hemisphere weighted
+ * by the light density of a pool when settings say: light_mix); then 3
+ * rounds of CPCA refinement
  * (each vertex to the cluster whose mean and basis reconstruct it with the
  * least error over its own hemisphere, then every cluster fitted again,
  * stopping early when no vertex moves); weights quantised
@@ -52,14 +54,39 @@ typedef struct vdsh_cpca_settings {
      * (--cpca K,alloc:BYTES): a width per basis vector within the budget
      * (bits 0 in the stream). 0: the fixed K, B, bits. */
     uint32_t budget;
+    /* The light-density metric (docs/ACCURACY.md "A light-density metric";
+     * VDSH.md "cpca streams"): vertex v's weight of cube direction w is
+     * (1 - light_mix) + light_mix * rho_v(w), rho_v the share of the pool's
+     * lights above v's horizon whose direction from v falls in w's texel,
+     * over the texel's share of the hemisphere (a vertex that sees no light
+     * above its horizon keeps the uniform weight). light_mix 0..1
+     * (vdsh-bake --cpca ...,light:A); 0, light_count 0 or NULL lights: the
+     * uniform metric, the bytes of the encoder without it. The pool is an
+     * input (vdsh-bake places it by the scene's light rule, a part carries
+     * it for vdsh-merge: VDSH.md `lpol`); positions are the rows' receiver
+     * positions, 3 per row, in the pool's space. */
+    float light_mix;
+    uint32_t light_count;
+    const float *lights;    /* 3 per light, finite */
+    const float *positions; /* 3 per row */
 } vdsh_cpca_settings;
 
-/* K = 8, B = 54, 4 bits (docs/ACCURACY.md "Compressed high orders"). */
+/* The light mix vdsh_cpca_parse gives when the text does not say: the
+ * light density alone (docs/ACCURACY.md "A light-density metric": mean
+ * over ten validation bakes +4.40% -> +2.47% over uncompressed order 12).
+ * vdsh_cpca_encode needs the pool too: without one the metric is uniform. */
+#define VDSH_CPCA_DEFAULT_LIGHT_MIX 1.0f
+
+/* K = 8, B = 54, 4 bits, VDSH_CPCA_DEFAULT_LIGHT_MIX, no pool
+ * (docs/ACCURACY.md "Compressed high orders"). */
 vdsh_cpca_settings vdsh_cpca_settings_default(void);
 
 /* Parse "K,B,BITS" (for example "8,54,4"), "auto" (budget 32),
- * "auto:BYTES" (1..VDSH_CPCA_MAX_BUDGET) or "K,alloc:BYTES" into *out; VDSH_ERR_ARGUMENT with
- * a message for a malformed string or a value out of range. */
+ * "auto:BYTES" (1..VDSH_CPCA_MAX_BUDGET) or "K,alloc:BYTES", each with an
+ * optional ",light:A" (A in 0..1, the light mix; else
+ * VDSH_CPCA_DEFAULT_LIGHT_MIX), or "light:A" alone (the default K, B, bits
+ * with that mix) into *out (no pool: the caller sets it); VDSH_ERR_ARGUMENT
+ * with a message for a malformed string or a value out of range. */
 vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_error *err);
 
 /* A fitted stream: model (its pointers into storage_) and records

@@ -25,7 +25,7 @@
  * Does not: write a stream (no format holds the widths yet).
  * Usage:
  *     vdsh_cpca_widths_fit wf;
- *     vdsh_cpca_settings st = {8, 54, 4, 0};
+ *     vdsh_cpca_settings st = {.clusters = 8, .basis = 54, .bits = 4, .budget = 0};
  *     vdsh_cpca_encode_widths(coefs, normals, rows, 12, &st, 108, 32.0, NULL,
  *                             decoded, &wf, &err);
  * Threading: no shared state.

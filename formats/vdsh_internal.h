@@ -226,6 +226,8 @@ int vdsh_check_stats(const vdsh_stats *t, uint32_t vertex_count, why *w);
 
 int vdsh_check_part(const vdsh_part *t, uint32_t vertex_count, why *w);
 
+/* An `lpol` chunk's contents; with has_part (else 0) the part it is in. */
+int vdsh_check_light_pool(const vdsh_light_pool *l, int has_part, const vdsh_part *part, why *w);
 int vdsh_check_adaptive(const vdsh_adaptive *a, uint32_t vertex_count, why *w);
 
 int vdsh_check_timings(const vdsh_timings *t, why *w);

@@ -100,6 +100,9 @@ typedef struct layout {
     vdsh_part part;
     int has_adaptive;
     vdsh_adaptive adaptive;
+    int has_light_pool;
+    vdsh_light_pool light_pool; /* lights: set by load_owned */
+    uint64_t lpol;              /* offset of the lights */
 } layout;
 
 typedef struct reader {
@@ -486,6 +489,32 @@ static vdsh_result read_fixed(const reader *r, const chunk_ref *c, uint32_t i, i
     return VDSH_OK;
 }
 
+/* lpol (VDSH.md "Parts"): 16 bytes (u32 count, f32 mix, 8 zero bytes),
+ * then count lights of 3 f32; checked against the part chunk once every
+ * chunk is read. */
+static vdsh_result read_lpol(const reader *r, const chunk_ref *c, uint32_t i, layout *L)
+{
+    const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
+    if (L->has_light_pool)
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
+                             "chunk %u at offset %llu: a second lpol chunk", i,
+                             (unsigned long long)c->offset);
+    uint32_t count = c->size >= 16 ? get_u32(p) : 0;
+    if (c->size < 16 || c->size != 16 + 12 * (uint64_t)count)
+        return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
+                             "lpol: payload is %llu byte%s, must be 16 + 12 x its %u light%s",
+                             (unsigned long long)c->size, vdsh_s(c->size), count, vdsh_s(count));
+    if (!all_zero(p + 8, 8))
+        return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
+                             "lpol: reserved bytes 8..15 not zero");
+    L->light_pool.count = count;
+    L->light_pool.mix = get_f32(p + 4);
+    L->light_pool.lights = (const float *)(p + 16);
+    L->lpol = c->offset + CHUNK_HEADER_SIZE + 16;
+    L->has_light_pool = 1;
+    return VDSH_OK;
+}
+
 /* Pass 2: which chunks, in which numbers, with which contents. */
 static vdsh_result read_contents(const reader *r, const chunk_ref *chunks, uint32_t count,
                                  layout *L)
@@ -536,6 +565,8 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks, uint3
             res = read_coef(r, c, L);
         } else if ((fixed = vdsh_fixed_kind(c->id)) >= 0) {
             res = read_fixed(r, c, i, fixed, L);
+        } else if (memcmp(c->id, "lpol", 4) == 0) {
+            res = read_lpol(r, c, i, L);
         } else if (c->id[0] >= 'A' && c->id[0] <= 'Z') {
             res = vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                                 "chunk %u '%s' at offset %llu: unknown critical chunk "
@@ -552,6 +583,8 @@ static vdsh_result read_contents(const reader *r, const chunk_ref *chunks, uint3
             return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name, "no %s chunk", required[k]);
     if (L->stream_count == 0)
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name, "no COEF chunk");
+    if (L->has_light_pool && !vdsh_check_light_pool(&L->light_pool, L->has_part, &L->part, &w))
+        return invalid(r, &w);
     return check_coef_sizes(r, L);
 }
 
@@ -642,6 +675,10 @@ static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name, vdsh_
     f->part = L.part;
     f->has_adaptive = L.has_adaptive;
     f->adaptive = L.adaptive;
+    f->has_light_pool = L.has_light_pool;
+    f->light_pool = L.light_pool;
+    if (L.has_light_pool)
+        f->light_pool.lights = (const float *)(buf + L.lpol);
     *out = f;
     return VDSH_OK;
 }

@@ -37,6 +37,7 @@ typedef struct plan {
     /* each stream's header, then an s8 stream's scale table and padding */
     uint8_t stream_header[VDSH_MAX_STREAMS][STREAM_HEADER_SIZE + S8_TABLE_MAX];
     uint8_t fixed[VDSH_FIXED_COUNT][TIME_SIZE]; /* stat, time, part, adpt */
+    uint8_t lpol[16];                           /* the lpol chunk's head */
     uint8_t *srcs;                              /* malloc'd SRCS payload */
     uint8_t *model[VDSH_MAX_STREAMS];           /* malloc'd cpca models, padded */
     out_chunk chunks[MAX_CHUNKS];
@@ -126,6 +127,8 @@ static vdsh_result check_file(const vdsh_file *f, const char *name, vdsh_error *
     if (f->has_timings && !vdsh_check_timings(&f->timings, &w))
         return argument(err, name, &w);
     if (f->has_adaptive && !vdsh_check_adaptive(&f->adaptive, h->vertex_count, &w))
+        return argument(err, name, &w);
+    if (f->has_light_pool && !vdsh_check_light_pool(&f->light_pool, f->has_part, &f->part, &w))
         return argument(err, name, &w);
     return VDSH_OK;
 }
@@ -246,6 +249,12 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name, vds
             vdsh_fields_put(x, P->fixed[k], fixed[k]);
             add_chunk(P, x->id, P->fixed[k], x->size, NULL, 0);
         }
+    if (f->has_light_pool) { /* a cpca part's light pool (VDSH.md "Parts") */
+        put_u32(P->lpol, f->light_pool.count);
+        put_f32(P->lpol + 4, f->light_pool.mix);
+        add_chunk(P, "lpol", P->lpol, sizeof P->lpol, f->light_pool.lights,
+                  12 * (uint64_t)f->light_pool.count);
+    }
 
     /* Sizes are bounded by the checks above (2^28 vertices, 16 streams of
      * at most 100 bytes per vertex): well inside 64 bits. */

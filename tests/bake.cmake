@@ -172,13 +172,15 @@ exit $fail
 ]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:light_pool_agree> ${CMAKE_CURRENT_SOURCE_DIR}/data
     ${CMAKE_CURRENT_BINARY_DIR}/light_pool_agree_tmp)
 
-# A light pool placed by the project's rule, written as f32 (the cpca
-# encoder's light-density study hook; scripts/cpca_study `l` settings).
+# A light pool placed by the project's rule, written as f32 (the pool of
+# vdsh-bake --cpca ...,light:A, for scripts/cpca_study's `l` settings).
 add_executable(light_pool_tool light_pool_tool.c)
 target_link_libraries(light_pool_tool PRIVATE vb_core)
-# The cpca encoder's light-density study hook: off unless set, a = 0
-# today's bytes, a = 1 a valid other fit, unusable settings refused.
+# The cpca encoder's light-density metric (--cpca ...,light:A): light:0
+# the uniform metric, light:1 and 0.5 valid other fits, the default's
+# bytes, bad values refused; parts carry the pool (lpol), mismatched or
+# damaged pools refused by the merge and the readers.
 add_test(NAME bake_cpca_lightmix
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_cpca_lightmix.py
-                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:light_pool_tool> ${PROJECT_SOURCE_DIR}
-                 ${CMAKE_CURRENT_BINARY_DIR}/bake_cpca_lightmix)
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
+                 ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/bake_cpca_lightmix)

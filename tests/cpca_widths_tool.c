@@ -30,7 +30,10 @@ int main(int argc, char **argv)
         return 2;
     }
     unsigned order = (unsigned)atoi(argv[2]);
-    vdsh_cpca_settings st = {(uint32_t)atoi(argv[3]), (uint32_t)atoi(argv[4]), 4, 0};
+    vdsh_cpca_settings st = {.clusters = (uint32_t)atoi(argv[3]),
+                             .basis = (uint32_t)atoi(argv[4]),
+                             .bits = 4,
+                             .budget = 0};
     uint32_t fit_basis = (uint32_t)atoi(argv[5]);
     vdsh_error err;
     vdsh_file *f;

@@ -3,9 +3,10 @@
  * SCENE's free space by the project's rule (vb_scene_place_lights: seeded
  * candidates, uniform in the light region, that pass the free-space test;
  * vdsh_light.h), written to OUT as little-endian f32 x, y, z per light,
- * and the region on stdout. Measurement only: the light pool of the cpca
- * encoder's light-density study hook (formats/vdsh_cpca.c,
- * VDSH_CPCA_LIGHTS; docs/ACCURACY.md, "A light-density metric").
+ * and the region on stdout. Measurement only: with COUNT 2048 and SEED
+ * (bake seed) ^ 0xdec15105 the pool vdsh-bake --cpca ...,light:A places
+ * (bake/lib/job.c); scripts/cpca_study passes it to vdsh-merge in a part's
+ * lpol chunk (docs/ACCURACY.md, "A light-density metric").
  * With `box`: the first COUNT candidates in the light region, no
  * free-space test (a pool a merge could draw from the region alone).
  * Exit 1 on a load, scene or placement error, 2 on bad usage.

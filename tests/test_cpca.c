@@ -44,6 +44,10 @@
  *                  field's -L - 1 refused
  *   alloc          --cpca K,alloc:BYTES: widths 2..8 within the budget,
  *                  the same bytes twice, read back, too small refused
+ *   light metric   the light-density metric: mix 0, no pool or no light
+ *                  above any horizon give the uniform metric's bytes, a
+ *                  pool another fit (the same twice), bad mixes and pools
+ *                  refused; parse's ,light:A
  *   settings       vdsh_cpca_parse accepts K,B,BITS, auto and auto:BYTES
  *                  and refuses the rest
  */
@@ -191,7 +195,7 @@ static void curved_cluster(void)
         }
         memcpy(nrm + 3 * v, faces[g], sizeof faces[g]);
     }
-    vdsh_cpca_settings st = {1, 1, 8, 0};
+    vdsh_cpca_settings st = {.clusters = 1, .basis = 1, .bits = 8, .budget = 0};
     vdsh_cpca_fit fit;
     vdsh_error err = {{0}};
     CHECK(vdsh_cpca_encode(c, nrm, CURVED_ROWS, CURVED_ORDER, &st, &fit, &err) == VDSH_OK,
@@ -250,7 +254,7 @@ static void line_and_blob(void)
         for (int i = 0; i < LINE_NC; i++)
             spread += (c[v * LINE_NC + i] - mean[i]) * (c[v * LINE_NC + i] - mean[i]) / LINE_ROWS;
     spread = sqrt(spread);
-    vdsh_cpca_settings st = {2, 1, 8, 0};
+    vdsh_cpca_settings st = {.clusters = 2, .basis = 1, .bits = 8, .budget = 0};
     vdsh_cpca_fit fit;
     vdsh_error err = {{0}};
     CHECK(vdsh_cpca_encode(c, nrm, LINE_ROWS, LINE_ORDER, &st, &fit, &err) == VDSH_OK,
@@ -286,7 +290,7 @@ static void auto_settings(void)
     vdsh_error err = {{0}};
     static const uint32_t budgets[] = {12, 20, 32};
     for (size_t i = 0; i < sizeof budgets / sizeof *budgets; i++) {
-        vdsh_cpca_settings st = {0, 0, 0, budgets[i]};
+        vdsh_cpca_settings st = {.clusters = 0, .basis = 0, .bits = 0, .budget = budgets[i]};
         vdsh_cpca_fit a, b;
         CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &a, &err) == VDSH_OK, "auto:%u: %s",
               budgets[i], err.msg);
@@ -312,7 +316,7 @@ static void auto_settings(void)
         vdsh_cpca_fit_free(&a);
         vdsh_cpca_fit_free(&b);
     }
-    vdsh_cpca_settings tiny = {0, 0, 0, 1};
+    vdsh_cpca_settings tiny = {.clusters = 0, .basis = 0, .bits = 0, .budget = 1};
     vdsh_cpca_fit f;
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &tiny, &f, &err) == VDSH_ERR_ARGUMENT &&
               strstr(err.msg, "budget") && !f.storage_,
@@ -326,7 +330,7 @@ static void auto_settings(void)
 static void widths_study(void)
 {
     vdsh_error err = {{0}};
-    vdsh_cpca_settings st = {K, B, BITS, 0};
+    vdsh_cpca_settings st = {.clusters = K, .basis = B, .bits = BITS, .budget = 0};
     vdsh_cpca_fit fit;
     static float dec[ROWS * NC], dec2[ROWS * NC];
     vdsh_cpca_widths_fit wf, wf2;
@@ -592,7 +596,7 @@ static void alloc_settings(void)
     free(mem);
     vdsh_cpca_fit_free(&a);
     vdsh_cpca_fit_free(&b);
-    vdsh_cpca_settings tiny = {3, 0, 0, 1};
+    vdsh_cpca_settings tiny = {.clusters = 3, .basis = 0, .bits = 0, .budget = 1};
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &tiny, &a, &err) == VDSH_ERR_ARGUMENT &&
               strstr(err.msg, "budget") && !a.storage_,
           "alloc:1 not refused (%s)", err.msg);
@@ -603,10 +607,124 @@ static void alloc_settings(void)
           "bad alloc settings accepted");
 }
 
+/* Whether two fits of K, B, BITS are the same bytes (model and records). */
+static int same_fit(const vdsh_cpca_fit *a, const vdsh_cpca_fit *b)
+{
+    size_t mb = (size_t)vdsh_cpca_model_bytes(ORDER, K, B) - 16;
+    return a->model.record_words == b->model.record_words &&
+           memcmp(a->storage_, b->storage_, mb) == 0 &&
+           memcmp(a->records, b->records, (size_t)ROWS * 4 * a->model.record_words) == 0;
+}
+
+/* The light-density metric (settings light_mix and the pool): a mix of 0,
+ * no pool, or a pool no vertex sees above its horizon (every light at
+ * every vertex's position) give the uniform metric's bytes; a pool around
+ * the vertices another fit, valid, the same twice; bad light settings
+ * refused; vdsh_cpca_parse's ,light:A. */
+static void light_metric(void)
+{
+    enum { NL = 64 };
+    static float pool[NL * 3], origin[ROWS * 3], at_origin[NL * 3];
+    for (int l = 0; l < NL; l++) { /* around the vertices (x 0..599, y = z = 0) */
+        pool[3 * l] = (float)(l * 10 % ROWS);
+        pool[3 * l + 1] = (float)(l % 7) - 3.0f;
+        pool[3 * l + 2] = (float)(l % 5) - 2.0f;
+    }
+    vdsh_cpca_settings st = {.clusters = K, .basis = B, .bits = BITS, .budget = 0};
+    vdsh_cpca_fit u, f, g;
+    vdsh_error err;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &u, &err) == VDSH_OK, "uniform: %s",
+          err.msg);
+    const struct {
+        const char *what;
+        float mix;
+        uint32_t count;
+        const float *lights, *pos;
+    } same[] = {{"mix 0 with a pool", 0.0f, NL, pool, positions},
+                {"mix 1 without lights", 1.0f, 0, NULL, NULL},
+                {"mix 1, no light above a horizon", 1.0f, NL, at_origin, origin}};
+    for (size_t k = 0; k < sizeof same / sizeof *same; k++) {
+        vdsh_cpca_settings l = st;
+        l.light_mix = same[k].mix;
+        l.light_count = same[k].count;
+        l.lights = same[k].lights;
+        l.positions = same[k].pos;
+        CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &l, &f, &err) == VDSH_OK, "%s: %s",
+              same[k].what, err.msg);
+        CHECK(same_fit(&u, &f), "%s: not the uniform metric's bytes", same[k].what);
+        vdsh_cpca_fit_free(&f);
+    }
+    vdsh_cpca_settings l = st;
+    l.light_mix = 1.0f;
+    l.light_count = NL;
+    l.lights = pool;
+    l.positions = positions;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &l, &f, &err) == VDSH_OK, "mix 1: %s",
+          err.msg);
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &l, &g, &err) == VDSH_OK, "mix 1 again");
+    CHECK(!same_fit(&u, &f), "mix 1 with a pool: the uniform metric's bytes");
+    CHECK(same_fit(&f, &g), "mix 1: two encodings differ");
+    CHECK(isfinite(f.rms_error) && f.rms_error < 4.0 * u.rms_error, "mix 1: error %g, uniform %g",
+          f.rms_error, u.rms_error);
+    printf("format_cpca: light mix 1: error %.4g, uniform %.4g\n", f.rms_error, u.rms_error);
+    vdsh_cpca_fit_free(&f);
+    vdsh_cpca_fit_free(&g);
+    vdsh_cpca_fit_free(&u);
+    /* refused */
+    static float inf_pool[NL * 3];
+    memcpy(inf_pool, pool, sizeof pool);
+    inf_pool[7] = INFINITY;
+    const struct {
+        const char *what;
+        float mix;
+        uint32_t count;
+        const float *lights, *pos;
+    } bad[] = {{"mix 1.5", 1.5f, NL, pool, positions},
+               {"mix -0.5", -0.5f, NL, pool, positions},
+               {"mix nan", NAN, NL, pool, positions},
+               {"lights NULL", 1.0f, NL, NULL, positions},
+               {"positions NULL", 1.0f, NL, pool, NULL},
+               {"a light not finite", 1.0f, NL, inf_pool, positions}};
+    for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
+        vdsh_cpca_settings b = st;
+        b.light_mix = bad[k].mix;
+        b.light_count = bad[k].count;
+        b.lights = bad[k].lights;
+        b.positions = bad[k].pos;
+        CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &b, &f, &err) == VDSH_ERR_ARGUMENT &&
+                  strstr(err.msg, "light"),
+              "%s accepted or not said: %s", bad[k].what, err.msg);
+    }
+    /* the grammar */
+    vdsh_cpca_settings p, d = vdsh_cpca_settings_default();
+    CHECK(vdsh_cpca_parse("3,alloc:16,light:0.5", &p, &err) == VDSH_OK && p.clusters == 3 &&
+              p.budget == 16 && p.light_mix == 0.5f,
+          "3,alloc:16,light:0.5");
+    CHECK(vdsh_cpca_parse("light:1", &p, &err) == VDSH_OK && p.clusters == d.clusters &&
+              p.basis == d.basis && p.bits == d.bits && p.budget == 0 && p.light_mix == 1.0f,
+          "light:1 alone");
+    CHECK(vdsh_cpca_parse("auto,light:0", &p, &err) == VDSH_OK && p.budget == 32 &&
+              p.light_mix == 0.0f,
+          "auto,light:0");
+    CHECK(vdsh_cpca_parse("8,52,4,light:.25", &p, &err) == VDSH_OK && p.light_mix == 0.25f,
+          "8,52,4,light:.25");
+    CHECK(vdsh_cpca_parse("8,52,4", &p, &err) == VDSH_OK &&
+              p.light_mix == VDSH_CPCA_DEFAULT_LIGHT_MIX && d.light_mix == p.light_mix &&
+              !p.light_count && !p.lights && !p.positions,
+          "the default light mix");
+    static const char *const refuse[] = {
+        "light:2",       "light:",           "light:-0",          "light:1e0",
+        "light:inf",     "light:1,8,52,4",   "8,52,4,light:x",    "8,52,4,light:1,",
+        "8,52,4light:1", "auto,light:0.5.1", "3,alloc:0,light:1", "8,52,4,light:1,light:0"};
+    for (size_t k = 0; k < sizeof refuse / sizeof *refuse; k++)
+        CHECK(vdsh_cpca_parse(refuse[k], &p, &err) == VDSH_ERR_ARGUMENT, "'%s' accepted",
+              refuse[k]);
+}
+
 int main(int argc, char **argv)
 {
     make_data();
-    vdsh_cpca_settings st = {K, B, BITS, 0};
+    vdsh_cpca_settings st = {.clusters = K, .basis = B, .bits = BITS, .budget = 0};
     vdsh_cpca_fit fit, again, one;
     vdsh_error err;
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &fit, &err) == VDSH_OK, "encode: %s",
@@ -670,7 +788,7 @@ int main(int argc, char **argv)
     double e = rms_vs(&s, src);
     CHECK(fabs(e - fit.rms_error) <= 1e-9 * (1 + e), "rms_error %g, decode %g", fit.rms_error, e);
     CHECK(e < 0.1 * spread, "error %g not below a tenth of the spread %g", e, spread);
-    vdsh_cpca_settings small = {1, 1, 4, 0};
+    vdsh_cpca_settings small = {.clusters = 1, .basis = 1, .bits = 4, .budget = 0};
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &small, &one, &err) == VDSH_OK, "K=1");
     CHECK(one.rms_error > 2.0 * e, "one vector %g, not worse than %g", one.rms_error, e);
     printf("format_cpca: error %.4g, spread %.4g, one vector %.4g\n", e, spread, one.rms_error);
@@ -780,6 +898,7 @@ int main(int argc, char **argv)
     auto_settings();
     widths_study();
     alloc_settings();
+    light_metric();
 
     /* settings */
     vdsh_cpca_settings p;

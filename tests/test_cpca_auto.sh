@@ -41,7 +41,7 @@ done
 expect_exit 0 "auto:12 merge" "$merge" -q "$d"/p*.vdsh -o "$d/m.vdsh"
 check "auto:12: 3 shards merged identical to the whole bake" cmp "$d/m.vdsh" "$d/w1.vdsh"
 expect_exit 0 "vdsh-info on an auto part" "$info" "$d/p1.vdsh"
-says_any "vdsh-info shows the part's budget" "cpca auto:12 (fitted at the merge)"
+says_any "vdsh-info shows the part's budget" "cpca auto:12,light:"
 check "the Python reader reads an auto part" /usr/bin/python3 -c '
 import sys
 sys.path.insert(0, sys.argv[1])

@@ -30,7 +30,7 @@ done
 expect_exit 0 "vdsh-info" "$info" "$tmp/w1.vdsh"
 says_any "vdsh-info shows the model" "cpca: 4 clusters, 20 basis vectors of 4-bit weights"
 expect_exit 0 "vdsh-info on a part" "$info" "$tmp/n3/p1.vdsh"
-says_any "vdsh-info shows a part's settings" "cpca 4,20,4 (fitted at the merge)"
+says_any "vdsh-info shows a part's settings" "cpca 4,20,4,light:"
 
 # A width per basis vector (--cpca K,alloc:BYTES): whole bake = 2 threads
 # = 3 shards merged, byte for byte; vdsh-info shows the widths and a
@@ -50,7 +50,7 @@ expect_exit 0 "vdsh-info, alloc" "$info" "$tmp/c1.vdsh"
 says_any "vdsh-info shows per-vector weights" "basis vectors of per-vector weights"
 says_any "vdsh-info shows the widths" "widths: "
 expect_exit 0 "vdsh-info on an alloc part" "$info" "$tmp/c3/p1.vdsh"
-says_any "vdsh-info shows an alloc part's settings" "cpca 4,alloc:40 (fitted at the merge)"
+says_any "vdsh-info shows an alloc part's settings" "cpca 4,alloc:40,light:"
 check "the Python reader reads an alloc part and the merged widths" /usr/bin/python3 -c '
 import sys
 sys.path.insert(0, sys.argv[1])

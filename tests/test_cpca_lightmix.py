@@ -1,54 +1,46 @@
 #!/usr/bin/python3
-"""The cpca encoder's light-density study hook (formats/vdsh_cpca.c,
-VDSH_CPCA_LIGHTMIX; docs/ACCURACY.md, "A light-density metric"): off by
-default; on with a = 0 it writes today's bytes; with a = 1 another fit,
-still a valid file that decodes near the f32 bake; an unusable setting
-(positions of the wrong length, a outside 0..1) is an error naming the
-variables, the bake exits non-zero and writes no file.
+"""The cpca encoder's light-density metric (vdsh-bake --cpca ...,light:A;
+formats/vdsh_cpca.h; docs/ACCURACY.md, "A light-density metric"):
 
-Usage: test_cpca_lightmix.py VDSH_BAKE LIGHT_POOL_TOOL SOURCE_DIR WORK_DIR
+- light:0 is the uniform metric: the same bytes whether or not a pool
+  exists (the default K, B, bits with `light:0` alone, and a part merged);
+- light:1 and light:0.5 are other fits, valid files that decode near the
+  f32 bake; the default (no light:) is VDSH_CPCA_DEFAULT_LIGHT_MIX's;
+- bad values are refused with a message naming light:A, exit 2, no file;
+- a part carries the pool (`lpol`), vdsh-info shows the mix; vdsh-merge
+  refuses parts whose pools differ, naming the part, and a part whose
+  lpol is damaged (CRC, a mix out of range) or an lpol in a whole file is
+  refused by the C and Python readers;
+- a one-shard part's merge equals the whole bake at light:1 (bake_cpca
+  checks 2 shards and threads with the default).
+
+Usage: test_cpca_lightmix.py VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR WORK_DIR
 """
 import os
+import struct
 import subprocess
 import sys
+import zlib
 
 import numpy as np
 
-bake, pool_tool, src, work = sys.argv[1:5]
+bake, merge, info, src, work = sys.argv[1:6]
 sys.path.insert(0, os.path.join(src, "python"))
 import vdsh  # noqa: E402
 
 os.makedirs(work, exist_ok=True)
 TINY = ["builtin:room", "--max-edge", "1.0", "--rays", "64", "--cube-size", "0", "-q",
         "--orders", "7"]
-CPCA = ["--encoding", "cpca", "--cpca", "4,alloc:40"]
-HOOK = ("VDSH_CPCA_LIGHTMIX", "VDSH_CPCA_LIGHTS", "VDSH_CPCA_POSITIONS")
 fail = []
-
-
-def run_bake(out, extra, env=None):
-    e = {k: v for k, v in os.environ.items() if k not in HOOK}
-    e.update(env or {})
-    return subprocess.run([bake] + TINY + extra + ["-o", out], env=e, capture_output=True,
-                          text=True)
 
 
 def path(name):
     return os.path.join(work, name)
 
 
-r = run_bake(path("f32.vdsh"), ["--encoding", "f32"])
-r2 = run_bake(path("plain.vdsh"), CPCA)
-if r.returncode or r2.returncode:
-    sys.exit("bake failed: %s %s" % (r.stderr, r2.stderr))
-ref = vdsh.read(path("f32.vdsh"))
-np.asarray(ref.positions, "<f4").tofile(path("pos.f32"))
-subprocess.run([pool_tool, "builtin:room", "256", "7", path("pool.f32")], check=True,
-               stdout=subprocess.DEVNULL)
-lights = np.fromfile(path("pool.f32"), "<f4").reshape(-1, 3)
-if len(lights) != 256 or not np.isfinite(lights).all():
-    fail.append("light_pool_tool: %d lights" % len(lights))
-hook = dict(VDSH_CPCA_LIGHTS=path("pool.f32"), VDSH_CPCA_POSITIONS=path("pos.f32"))
+def run_bake(out, extra):
+    return subprocess.run([bake] + TINY + extra + ["-o", path(out)], capture_output=True,
+                          text=True)
 
 
 def blob(name):
@@ -56,35 +48,134 @@ def blob(name):
         return f.read()
 
 
+def must(r, what):
+    if r.returncode:
+        sys.exit("%s failed: %s" % (what, r.stderr))
+
+
+must(run_bake("f32.vdsh", ["--encoding", "f32"]), "f32 bake")
+ref = vdsh.read(path("f32.vdsh"))
 x = vdsh.coefficients(ref.streams[0]).astype(np.float64)
 spread = np.sqrt(((x - x.mean(0)) ** 2).sum(1).mean())
-for a in ("0", "1"):
-    name = "mix%s.vdsh" % a
-    r = run_bake(path(name), CPCA, dict(hook, VDSH_CPCA_LIGHTMIX=a))
-    if r.returncode:
-        fail.append("a = %s: bake failed: %s" % (a, r.stderr))
-        continue
-    same = blob(name) == blob("plain.vdsh")
-    if same != (a == "0"):
-        fail.append("a = %s: bytes %s today's" % (a, "equal" if same else "differ from"))
-    got = vdsh.coefficients(vdsh.read(path(name)).streams[0]).astype(np.float64)
-    err = np.sqrt(((got - x) ** 2).sum(1).mean()) / spread
-    if not err < 0.5:
-        fail.append("a = %s: decoded error %.3f of the spread" % (a, err))
-    print("a = %s: %s today's bytes, decoded error %.4f of the spread" % (
-        a, "same as" if same else "not", err))
 
-np.asarray(ref.positions, "<f4")[:-1].tofile(path("short.f32"))
-for what, env in (("short positions", dict(hook, VDSH_CPCA_LIGHTMIX="0.5",
-                                           VDSH_CPCA_POSITIONS=path("short.f32"))),
-                  ("a = 2", dict(hook, VDSH_CPCA_LIGHTMIX="2")),
-                  ("no pool", dict(VDSH_CPCA_LIGHTMIX="0.5",
-                                   VDSH_CPCA_POSITIONS=path("pos.f32")))):
-    out = path("bad.vdsh")
-    r = run_bake(out, CPCA, env)
-    if r.returncode == 0 or "VDSH_CPCA_POSITIONS" not in r.stderr or os.path.exists(out):
-        fail.append("%s: exit %d, file %s, stderr %r" % (what, r.returncode,
-                                                         os.path.exists(out), r.stderr))
+CPCA = ["--encoding", "cpca", "--cpca"]
+for name, setting in (("l0", "4,alloc:40,light:0"), ("l05", "4,alloc:40,light:0.5"),
+                      ("l1", "4,alloc:40,light:1"), ("def", "4,alloc:40"),
+                      ("l0alone", "light:0"), ("l0full", "8,54,4,light:0")):
+    must(run_bake(name + ".vdsh", CPCA + [setting]), setting)
+    got = vdsh.coefficients(vdsh.read(path(name + ".vdsh")).streams[0]).astype(np.float64)
+    err = np.sqrt(((got - x) ** 2).sum(1).mean()) / spread
+    print("%s: decoded error %.4f of the spread" % (setting, err))
+    if not err < 0.5:
+        fail.append("%s: decoded error %.3f of the spread" % (setting, err))
+
+if blob("l0.vdsh") in (blob("l1.vdsh"), blob("l05.vdsh")) or blob("l1.vdsh") == blob("l05.vdsh"):
+    fail.append("light:0, 0.5 and 1 are not three fits")
+if blob("l0alone.vdsh") != blob("l0full.vdsh"):
+    fail.append("light:0 alone is not the default K, B, bits with light:0")
+# the default mix, as vdsh-bake --help says it
+helptext = subprocess.run([bake, "--help"], capture_output=True, text=True).stdout
+default = helptext.split("A in 0..1, default ")[1].split(";")[0]
+want = {"0": "l0", "1": "l1"}.get(default)
+if want is None or blob("def.vdsh") != blob(want + ".vdsh"):
+    fail.append("the default light mix (--help: %r) does not give its bytes" % default)
+
+for bad in ("4,alloc:40,light:2", "4,alloc:40,light:-1", "4,alloc:40,light:", "light:abc",
+            "4,alloc:40,light:1,2", "light:0.5x", "4,alloc:40,light:nan", "4,alloc:40,light:1e0"):
+    r = run_bake("bad.vdsh", CPCA + [bad])
+    if r.returncode != 2 or "light:A" not in r.stderr or os.path.exists(path("bad.vdsh")):
+        fail.append("--cpca %s: exit %d, file %s, stderr %r" % (
+            bad, r.returncode, os.path.exists(path("bad.vdsh")), r.stderr))
+
+# Parts: the pool in `lpol`, shown by vdsh-info; one shard merged is the
+# whole bake.
+for name, setting in (("p1", "4,alloc:40,light:1"), ("p05", "4,alloc:40,light:0.5"),
+                      ("p0", "4,alloc:40,light:0")):
+    must(run_bake(name + ".vdsh", CPCA + [setting, "--shard", "0/1"]), setting + " part")
+p1 = vdsh.read(path("p1.vdsh"))
+if p1.light_pool is None or len(p1.light_pool["lights"]) != 2048 or p1.light_pool["mix"] != 1:
+    fail.append("the light:1 part's lpol: %r" % (p1.light_pool and {
+        k: (len(v) if k == "lights" else v) for k, v in p1.light_pool.items()}))
+if vdsh.read(path("p0.vdsh")).light_pool is not None:
+    fail.append("a light:0 part carries a pool")
+for whole in ("l1.vdsh", "def.vdsh"):
+    if vdsh.read(path(whole)).light_pool is not None or b"lpol" in blob(whole):
+        fail.append("%s (a whole file) carries lpol" % whole)
+txt = subprocess.run([info, path("p1.vdsh")], capture_output=True, text=True).stdout
+if "cpca 4,alloc:40,light:1 (fitted at the merge; light pool of 2048 lights)" not in txt:
+    fail.append("vdsh-info does not show the part's light mix: %r" % txt)
+for name, want in (("p1", "l1"), ("p0", "l0")):
+    r = subprocess.run([merge, "-q", path(name + ".vdsh"), "-o", path(name + "-m.vdsh")],
+                       capture_output=True, text=True)
+    if r.returncode or blob(name + "-m.vdsh") != blob(want + ".vdsh"):
+        fail.append("%s merged is not the whole %s bake: %s" % (name, want, r.stderr))
+
+# Two shards whose pools differ: refused, naming the part.
+for i, setting in ((0, "4,alloc:40,light:1"), (1, "4,alloc:40,light:0.5")):
+    must(run_bake("s%d.vdsh" % i, CPCA + [setting, "--shard", "%d/2" % i]), "shard %d" % i)
+r = subprocess.run([merge, "-q", path("s0.vdsh"), path("s1.vdsh"), "-o", path("mix.vdsh")],
+                   capture_output=True, text=True)
+if r.returncode == 0 or "s1.vdsh" not in r.stderr or "light pool" not in r.stderr or \
+        os.path.exists(path("mix.vdsh")):
+    fail.append("parts with other pools: exit %d, stderr %r" % (r.returncode, r.stderr))
+
+
+def chunks(d):
+    """(offset, id, size) of every chunk of file bytes d."""
+    out, off = [], 32
+    while off + 16 <= len(d):
+        cid, size = d[off:off + 4], struct.unpack_from("<Q", d, off + 8)[0]
+        out.append((off, cid, size))
+        off += 16 + size + (-size % 16)
+    return out
+
+
+def fix_crc(d, off, size):
+    pay = bytes(d[off + 16:off + 16 + size + (-size % 16)])
+    crc = zlib.crc32(pay, zlib.crc32(bytes(d[off + 8:off + 16]), zlib.crc32(bytes(d[off:off + 4]))))
+    struct.pack_into("<I", d, off + 4, crc)
+
+
+def refused(name, data, words):
+    """The C reader (via vdsh-info and vdsh-merge) and the Python reader
+    refuse data, saying each of words."""
+    with open(path(name), "wb") as f:
+        f.write(data)
+    for cmd in ([info, path(name)], [merge, "-q", path(name), "-o", path(name + "-m")]):
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode == 0 or name not in r.stderr or not all(w in r.stderr for w in words) or \
+                os.path.exists(path(name + "-m")):
+            fail.append("%s: %s: exit %d, stderr %r" % (name, os.path.basename(cmd[0]),
+                                                        r.returncode, r.stderr))
+    try:
+        vdsh.read(path(name))
+        fail.append("%s: the Python reader accepts it" % name)
+    except vdsh.VdshError as e:
+        if not all(w in str(e) for w in words if w != "CRC"):
+            fail.append("%s: the Python reader says %r" % (name, str(e)))
+
+
+d = bytearray(blob("p1.vdsh"))
+off, _, size = next(c for c in chunks(d) if c[1] == b"lpol")
+bad = bytearray(d)
+bad[off + 16 + 16 + 5] ^= 0x40  # a light's byte, the CRC left
+refused("lpol-crc.vdsh", bad, ["CRC"])
+bad = bytearray(d)
+struct.pack_into("<f", bad, off + 16 + 4, 0.0)  # mix 0, the CRC fixed
+fix_crc(bad, off, size)
+refused("lpol-mix0.vdsh", bad, ["lpol", "light mix"])
+bad = bytearray(d)
+struct.pack_into("<I", bad, off + 16, 2047)  # a count the size does not hold
+fix_crc(bad, off, size)
+refused("lpol-count.vdsh", bad, ["lpol"])
+# an lpol in a whole file: the part chunk removed (its id turned into an
+# unknown ancillary one is still skipped, so lpol is then outside a part)
+bad = bytearray(d)
+poff, _, psize = next(c for c in chunks(d) if c[1] == b"part")
+bad[poff:poff + 4] = b"xprt"
+fix_crc(bad, poff, psize)
+refused("lpol-whole.vdsh", bad, ["lpol", "outside a cpca part"])
+
 if fail:
     sys.exit("FAIL:\n  " + "\n  ".join(fail))
 print("ok")

@@ -16,13 +16,19 @@
 #     light_region_probes);
 #   - the calibration's guard on the cube: no held-out light shadowed
 #     (held_out_shadowed 0) and every log offset 0 with every ISA;
-#   - cpca streams (8,alloc:32 on order 5, auto on order 3) of the room:
+#   - cpca streams (8,alloc:32 on order 5, auto on order 3) of the room,
+#     with the uniform metric (light:0: alloc0, auto0) and the default
+#     light-density metric (alloc, auto; its pool is the same on every ISA:
+#     the light placement's decisions above):
 #     k-means, refinement and the widths are discrete choices over
 #     coefficients that differ by ~1e-5 across ISAs, so the streams are
 #     not the same bytes. Each is valid, auto picks the same settings, and
 #     in units of E, the native stream's largest decode error against the
-#     native f32 bake: its own decode error within 1.25 E (no ISA's stream
-#     is worse), every vertex within 2.2 E of the native stream's decode
+#     native f32 bake: its own decode error within 1.25 E with light:0 (no
+#     ISA's stream is worse) and within 2 E with the light density (its
+#     metric leaves the directions no light reaches loosely fitted, so the
+#     worst vertex's coefficient error moves more with the fit: measured
+#     <= 1.54 E), every vertex within 2.2 E of the native stream's decode
 #     (two encodings each within E of nearly the same coefficients; measured
 #     <= 1.72 E) and at most 1% beyond 1.5 E; the streams' calibrated log
 #     offsets within 1e-4 of the native ones (measured <= 2.1e-6);
@@ -60,6 +66,19 @@ times() { "$py" -c "print(float('$1') * $2)"; }
 room=(builtin:room --rays 64 --cube-size 0 -q)
 alloc=(--orders 5 --encoding cpca --cpca 8,alloc:32)
 auto=(--orders 3 --encoding cpca --cpca auto)
+alloc0=(--orders 5 --encoding cpca --cpca 8,alloc:32,light:0)
+auto0=(--orders 3 --encoding cpca --cpca auto,light:0)
+KINDS="alloc auto alloc0 auto0"
+# kind_opts KIND: opts=(its options), f32 (its f32 bake's name), own (the
+# bound on its own decode error, in E).
+kind_opts() {
+  case $1 in
+    alloc) opts=("${alloc[@]}") f32=f5 own=2 ;;
+    auto) opts=("${auto[@]}") f32=f3 own=2 ;;
+    alloc0) opts=("${alloc0[@]}") f32=f5 own=1.25 ;;
+    auto0) opts=("${auto0[@]}") f32=f3 own=1.25 ;;
+  esac
+}
 
 if [[ ${ISA_ONE:-} == 1 ]]; then
   isa=${VDSH_EMBREE_CONFIG#isa=}
@@ -83,21 +102,24 @@ if [[ ${ISA_ONE:-} == 1 ]]; then
   done
   guard=$(report "$REF/cube-$isa.json" "d['decision']['held_out_shadowed'], sorted(set(d['decision']['log_offsets'].values()))")
   [[ $guard == "0 [0]" ]] || { echo "FAIL: $isa: cube: held-out shadowed, offsets: $guard, want 0 [0]" >&2; fail=1; }
-  for k in alloc auto; do
-    if [[ $k == alloc ]]; then opts=("${alloc[@]}") f32=$REF/f5.vdsh; else opts=("${auto[@]}") f32=$REF/f3.vdsh; fi
+  for k in $KINDS; do
+    kind_opts "$k"
+    f32=$REF/$f32.vdsh
     "$bake" "${room[@]}" "${opts[@]}" -o "$REF/$k-$isa.vdsh" || exit 1
     "$info" --verify "$REF/$k-$isa.vdsh" >/dev/null 2>&1 || { echo "FAIL: $isa: $k: not a valid file" >&2; fail=1; }
     e=$(cat "$REF/e-$k.txt")
-    own=$(largest "$f32" "$REF/$k-$isa.vdsh")
-    "$py" -c "import sys; sys.exit(0 if float('$own') <= 1.25 * float('$e') else 1)" ||
-      { echo "FAIL: $isa: $k: decode error $own, natively $e" >&2; fail=1; }
+    ownerr=$(largest "$f32" "$REF/$k-$isa.vdsh")
+    "$py" -c "import sys; sys.exit(0 if float('$ownerr') <= $own * float('$e') else 1)" ||
+      { echo "FAIL: $isa: $k: decode error $ownerr, natively $e (bound $own E)" >&2; fail=1; }
     "$compare" "$REF/$k.vdsh" "$REF/$k-$isa.vdsh" "$(times "$e" 2.2)" 0.01 "$(times "$e" 1.5)" >"$REF/cmp.txt" ||
       { echo "FAIL: $isa: $k: decoded coefficients against the native stream (E = $e):" >&2; cat "$REF/cmp.txt" >&2; fail=1; }
     near "$(offsets "$REF/$k.vdsh")" "$(offsets "$REF/$k-$isa.vdsh")" 1e-4 ||
       { echo "FAIL: $isa: $k: log offsets $(offsets "$REF/$k-$isa.vdsh"), natively $(offsets "$REF/$k.vdsh")" >&2; fail=1; }
   done
-  [[ $(cpca_settings "$REF/auto-$isa.vdsh") == "$(cpca_settings "$REF/auto.vdsh")" ]] ||
-    { echo "FAIL: $isa: auto chose $(cpca_settings "$REF/auto-$isa.vdsh"), natively $(cpca_settings "$REF/auto.vdsh")" >&2; fail=1; }
+  for k in auto auto0; do
+    [[ $(cpca_settings "$REF/$k-$isa.vdsh") == "$(cpca_settings "$REF/$k.vdsh")" ]] ||
+      { echo "FAIL: $isa: $k chose $(cpca_settings "$REF/$k-$isa.vdsh"), natively $(cpca_settings "$REF/$k.vdsh")" >&2; fail=1; }
+  done
   exit $fail
 fi
 
@@ -191,17 +213,18 @@ for o in cube notch-low notch-high; do
 done
 # cpca: the native streams, the f32 bakes they are measured against, and
 # E, each stream's largest decode error.
-"$bake" "${room[@]}" "${alloc[@]}" -o "$tmp/alloc.vdsh" || exit 1
-"$bake" "${room[@]}" "${auto[@]}" -o "$tmp/auto.vdsh" || exit 1
 "$bake" "${room[@]}" --orders 5 --encoding f32 -o "$tmp/f5.vdsh" || exit 1
 "$bake" "${room[@]}" --orders 3 --encoding f32 -o "$tmp/f3.vdsh" || exit 1
-largest "$tmp/f5.vdsh" "$tmp/alloc.vdsh" >"$tmp/e-alloc.txt"
-largest "$tmp/f3.vdsh" "$tmp/auto.vdsh" >"$tmp/e-auto.txt"
-echo "cpca decode error E natively: alloc $(cat "$tmp/e-alloc.txt"), auto $(cat "$tmp/e-auto.txt")"
+for k in $KINDS; do
+  kind_opts "$k"
+  "$bake" "${room[@]}" "${opts[@]}" -o "$tmp/$k.vdsh" || exit 1
+  largest "$tmp/$f32.vdsh" "$tmp/$k.vdsh" >"$tmp/e-$k.txt"
+  echo "cpca decode error E natively: $k $(cat "$tmp/e-$k.txt")"
+done
 # The encoder alone: the same f32 parts, merged with glibc's baseline libm
 # paths (a CPU without AVX2 and FMA) and the narrowest Embree kernels.
-for k in alloc auto; do
-  if [[ $k == alloc ]]; then opts=("${alloc[@]}"); else opts=("${auto[@]}"); fi
+for k in $KINDS; do
+  kind_opts "$k"
   for i in 0 1; do
     "$bake" "${room[@]}" "${opts[@]}" --shard "$i/2" -o "$tmp/$k-p$i.vdsh" || exit 1
   done

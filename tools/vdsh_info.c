@@ -330,14 +330,21 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
                "as %s\n",
                f->part.index, f->part.count, f->part.range_begin, f->part.range_end,
                vdsh_encoding_name(f->part.encoding));
-    if (f->has_part && f->part.encoding == VDSH_ENCODING_CPCA && !f->part.cpca_clusters)
-        printf("               cpca auto:%u (fitted at the merge)\n", f->part.cpca_basis);
-    else if (f->has_part && f->part.encoding == VDSH_ENCODING_CPCA && !f->part.cpca_bits)
-        printf("               cpca %u,alloc:%u (fitted at the merge)\n", f->part.cpca_clusters,
-               f->part.cpca_basis);
-    else if (f->has_part && f->part.encoding == VDSH_ENCODING_CPCA)
-        printf("               cpca %u,%u,%u (fitted at the merge)\n", f->part.cpca_clusters,
-               f->part.cpca_basis, f->part.cpca_bits);
+    if (f->has_part && f->part.encoding == VDSH_ENCODING_CPCA) {
+        /* the light mix and its pool: the lpol chunk's (none: light:0) */
+        const double mix = f->has_light_pool ? (double)f->light_pool.mix : 0.0;
+        if (!f->part.cpca_clusters)
+            printf("               cpca auto:%u", f->part.cpca_basis);
+        else if (!f->part.cpca_bits)
+            printf("               cpca %u,alloc:%u", f->part.cpca_clusters, f->part.cpca_basis);
+        else
+            printf("               cpca %u,%u,%u", f->part.cpca_clusters, f->part.cpca_basis,
+                   f->part.cpca_bits);
+        printf(",light:%g (fitted at the merge", mix);
+        if (f->has_light_pool)
+            printf("; light pool of %u light%s", f->light_pool.count, vt_s(f->light_pool.count));
+        printf(")\n");
+    }
     if (f->has_adaptive) {
         const vdsh_adaptive *a = &f->adaptive;
         printf("  adaptive     tolerance %g, min edge %g, budget %u (0: none), %u light%s\n"
@@ -460,6 +467,9 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
             vt_json_u64(&j, pt, "cpca_clusters", f->part.cpca_clusters);
             vt_json_u64(&j, pt, "cpca_basis", f->part.cpca_basis);
             vt_json_u64(&j, pt, "cpca_bits", f->part.cpca_bits);
+            vt_json_f64(&j, pt, "cpca_light_mix",
+                        f->has_light_pool ? (double)f->light_pool.mix : 0.0);
+            vt_json_u64(&j, pt, "cpca_light_pool", f->has_light_pool ? f->light_pool.count : 0);
         }
     }
     if (f->has_adaptive) {

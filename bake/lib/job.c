@@ -164,9 +164,49 @@ static vdsh_encoding job_encoding(const vb_job_desc *d)
     return d->encoding_given ? d->encoding : VB_DEFAULT_ENCODING;
 }
 
-static vdsh_cpca_settings job_cpca(const vb_job_desc *d)
+static vdsh_cpca_settings job_cpca_asked(const vb_job_desc *d)
 {
     return d->cpca.clusters || d->cpca.budget ? d->cpca : vdsh_cpca_settings_default();
+}
+
+/* The cpca light-density metric's pool (docs/ACCURACY.md "A light-density
+ * metric"): VB_CPCA_POOL lights placed by the scene's light rule
+ * (vb_scene_place_lights: the light region, the free-space test) with the
+ * decision fit's training-pool seed, in scene (world) space like the
+ * receivers' positions; placed once, for whole bakes and parts alike.
+ * A scene where the rule places no lights keeps the uniform metric (as the
+ * decision fit does without its pool): the same in every shard. */
+#define VB_CPCA_POOL 2048u
+static vb_result job_cpca_pool(vb_job *j, const vb_job_desc *d, vb_error *err)
+{
+    if (j->cpca_pool_tried || !(job_cpca_asked(d).light_mix > 0.0f))
+        return VB_OK;
+    j->cpca_pool_tried = 1;
+    float(*pool)[3] = malloc(VB_CPCA_POOL * sizeof *pool);
+    if (!pool)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the cpca light pool");
+    vb_error perr;
+    if (vb_scene_place_lights(j->scene, d->bake.seed ^ 0xdec15105ull, VB_CPCA_POOL, pool, NULL,
+                              &perr) != VB_OK) {
+        free(pool);
+        return VB_OK;
+    }
+    j->cpca_pool = pool;
+    j->cpca_pool_count = VB_CPCA_POOL;
+    return VB_OK;
+}
+
+/* The encoder's settings: what was asked for, with the job's pool and
+ * receivers when the light mix is > 0 (job_cpca_pool first). */
+static vdsh_cpca_settings job_cpca(const vb_job *j, const vb_job_desc *d)
+{
+    vdsh_cpca_settings st = job_cpca_asked(d);
+    if (st.light_mix > 0.0f && j->cpca_pool) {
+        st.light_count = j->cpca_pool_count;
+        st.lights = &j->cpca_pool[0][0];
+        st.positions = j->receivers.positions;
+    }
+    return st;
 }
 
 /* --encoding cpca with --adaptive-order: the variable-order stream (f32, in
@@ -190,7 +230,7 @@ static vb_result cpca_variable(vb_job *j, const vb_job_desc *d, uint32_t s, vb_e
     f32.offsets = NULL;
     f32.coef_scales = NULL;
     f32.data = rows;
-    vdsh_cpca_settings st = job_cpca(d);
+    vdsh_cpca_settings st = job_cpca(j, d);
     vdsh_error e;
     void *storage = NULL;
     const float *nrm = j->bake.normals ? j->bake.normals : j->receivers.normals;
@@ -225,6 +265,11 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
                            j->receivers.triangle_count, j->drawn);
         j->bake.drawn = j->drawn;
     }
+    if (job_encoding(d) == VDSH_ENCODING_CPCA) {
+        vb_result r = job_cpca_pool(j, d, err);
+        if (r != VB_OK)
+            return r;
+    }
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!b->coeffs[o])
             continue;
@@ -242,7 +287,7 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         if (cpca) {
             /* The global step over every receiver (vdsh-merge does the
              * same over the joined parts), with the file's normals. */
-            vdsh_cpca_settings st = job_cpca(d);
+            vdsh_cpca_settings st = job_cpca(j, d);
             vdsh_error e;
             void *storage = NULL;
             vdsh_stream f32 = j->streams[count];
@@ -329,10 +374,16 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         if (job_encoding(d) == VDSH_ENCODING_CPCA) {
             /* auto: 0, budget, 0; K,alloc:BYTES: K, budget, 0 (VDSH.md
              * "Parts") */
-            vdsh_cpca_settings st = job_cpca(d);
+            vdsh_cpca_settings st = job_cpca(j, d);
             f.part.cpca_clusters = st.clusters;
             f.part.cpca_basis = st.budget ? st.budget : st.basis;
             f.part.cpca_bits = st.budget ? 0 : st.bits;
+            if (st.light_mix > 0.0f &&
+                st.light_count) { /* the pool for the merge (VDSH.md `lpol`) */
+                f.has_light_pool = 1;
+                f.light_pool = (vdsh_light_pool){
+                    .mix = st.light_mix, .count = st.light_count, .lights = st.lights};
+            }
         }
         vb_shard_range(h->vertex_count, d->shard_index, d->shard_count, &f.part.range_begin,
                        &f.part.range_end);
@@ -460,6 +511,7 @@ void vb_job_free(vb_job *j)
     if (j->basis_running)
         pthread_join(j->basis_thread, NULL);
     vb_cubemap_basis_free(&j->basis);
+    free(j->cpca_pool);
     for (int s = 0; s < VDSH_MAX_STREAMS; s++)
         free(j->stream_data[s]);
     vb_bake_output_free(&j->bake);

@@ -185,7 +185,13 @@ static void usage(FILE *f)
             "                          (2..8 bits) within BYTES per vertex (1..4096, the\n"
             "                          model included; docs/ACCURACY.md \"C encoder, with\n"
             "                          refinement\": teapot +2.2%% at 30.3 B, default +3.8%%\n"
-            "                          at 34.0 B)\n"
+            "                          at 34.0 B); each may end in ,light:A (or light:A\n"
+            "                          alone: the default K, B, BITS): the fit's metric\n"
+            "                          weights each receiver's hemisphere by\n"
+            "                          (1 - A) + A x the density of 2048 lights placed by\n"
+            "                          the scene's light rule (A in 0..1, default %g;\n"
+            "                          light:0 the uniform hemisphere; docs/ACCURACY.md\n"
+            "                          \"A light-density metric\")\n"
             "      --shard I/N         bake shard I (0-based) of N only and write a part\n"
             "                          file; vdsh-merge joins the N parts into the file\n"
             "                          the whole bake writes, byte for byte\n"
@@ -307,9 +313,9 @@ static void usage(FILE *f)
             "Exit status: 0 success, 1 error, 2 usage error.\n"
             "Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n",
             VB_DEFAULT_CUBE_SIZE, VB_SDF_MIN_RESOLUTION, VB_SDF_MAX_RESOLUTION, VDSH_MAX_ORDER,
-            VB_DEFAULT_RAYS, rays_side, rays_side, VB_DEFAULT_RAYS,
-            (double)VB_DEFAULT_RAY_TOLERANCE, VDSH_MAX_ORDER, VB_DEFAULT_ORDER_CAP, methods_help(),
-            (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
+            (double)VDSH_CPCA_DEFAULT_LIGHT_MIX, VB_DEFAULT_RAYS, rays_side, rays_side,
+            VB_DEFAULT_RAYS, (double)VB_DEFAULT_RAY_TOLERANCE, VDSH_MAX_ORDER, VB_DEFAULT_ORDER_CAP,
+            methods_help(), (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
             (double)vb_shadow_log_offset(3), (double)vb_shadow_log_offset(5),
             (double)VB_DEFAULT_FALSE_RATE, VB_DECISION_MAX_PAIRS, VB_DEFAULT_DECISION_LIGHTS,
             VB_ADAPTIVE_ROUNDS, VB_DEFAULT_SEED);
@@ -847,7 +853,8 @@ static int read_choice(int c, const char *arg, options *o)
             return bad_usage("--cpca takes K,B,BITS: clusters 1..256, basis vectors "
                              "1..256, bits 2..8 (default 8,54,4), or auto or auto:BYTES, or "
                              "K,alloc:BYTES (a width per basis vector), bytes per vertex "
-                             "1..4096, not '%s'",
+                             "1..4096, each optionally ending in ,light:A (or light:A alone), "
+                             "the light mix A in 0..1; not '%s'",
                              arg);
         o->have_cpca = 1;
         break;

@@ -221,6 +221,11 @@ static const char *mismatch(vdsh_file *a, const char *a_path, const vdsh_file *b
     if (a->part.cpca_clusters != b->part.cpca_clusters ||
         a->part.cpca_basis != b->part.cpca_basis || a->part.cpca_bits != b->part.cpca_bits)
         return "another --cpca";
+    const vdsh_light_pool *la = &a->light_pool, *lb = &b->light_pool;
+    if (a->has_light_pool != b->has_light_pool ||
+        (a->has_light_pool && (memcmp(&la->mix, &lb->mix, 4) != 0 || la->count != lb->count ||
+                               memcmp(la->lights, lb->lights, (size_t)la->count * 12) != 0)))
+        return "another cpca light pool (lpol chunk differs: another --cpca light:A, seed or scene)";
     uint64_t v = a->header.vertex_count, t = a->header.triangle_count;
     if (memcmp(a->positions, b->positions, v * 12) != 0 ||
         memcmp(a->indices, b->indices, t * 12) != 0)
@@ -413,6 +418,7 @@ static int merge_begin(merge *m, const char *output)
     m->target = m->p0->part.encoding;
     m->f = *m->p0;
     m->f.has_part = 0;
+    m->f.has_light_pool = 0; /* parts only */
     m->f.has_timings = 0;
     m->f.storage_ = NULL;
     m->f.streams = m->streams;
@@ -549,9 +555,19 @@ static int merge_streams(merge *m)
              * (bake/lib/job.c) writes it. */
             /* auto: 0, budget, 0; K,alloc:BYTES: K, budget, 0 */
             const vdsh_part *pt = &m->p0->part;
-            vdsh_cpca_settings st = {pt->cpca_clusters, pt->cpca_basis, pt->cpca_bits, 0};
+            vdsh_cpca_settings st = {.clusters = pt->cpca_clusters,
+                                     .basis = pt->cpca_basis,
+                                     .bits = pt->cpca_bits,
+                                     .budget = 0};
             if (!pt->cpca_bits)
-                st = (vdsh_cpca_settings){pt->cpca_clusters, 0, 0, pt->cpca_basis};
+                st = (vdsh_cpca_settings){
+                    .clusters = pt->cpca_clusters, .basis = 0, .bits = 0, .budget = pt->cpca_basis};
+            if (m->p0->has_light_pool) { /* the light-density metric, as the bake's */
+                st.light_mix = m->p0->light_pool.mix;
+                st.light_count = m->p0->light_pool.count;
+                st.lights = m->p0->light_pool.lights;
+                st.positions = m->p0->positions;
+            }
             vdsh_stream f32 = m->streams[s];
             f32.encoding = VDSH_ENCODING_F32;
             f32.scale = 1.0f;

@@ -20,6 +20,8 @@
     f.adaptive                         # None, or what refined adaptive receivers (`adpt`):
                                        # dict tolerance, min_edge, max_receivers, lights,
                                        # max_rounds, start_receivers, rounds, candidates
+    f.light_pool                       # None, or a cpca part's light pool (`lpol`): dict
+                                       # mix (the light mix, 0 < mix <= 1), lights (L x 3)
 
 Evaluation, vectorised over vertices and lights (vdsh.evaluate; float32,
 the C library's numbers to the bit):
@@ -58,7 +60,9 @@ ENCODINGS = ["f32", "f16", "s8", "s8s6", "cpca"]
 QUANTITIES = ["distance", "distance2", "log-distance"]
 MAX_ORDER = 16
 WINDOWS = ["none", "hann", "lanczos"]
-KNOWN = {b"HEAD", b"SRCS", b"POSN", b"NORM", b"TRIS", b"COEF", b"stat", b"time", b"part", b"adpt"}
+KNOWN = {b"HEAD", b"SRCS", b"POSN", b"NORM", b"TRIS", b"COEF", b"stat", b"time", b"part", b"adpt",
+         b"lpol"}
+MAX_POOL_LIGHTS = 65536
 LOG_SUM_MAX = 80.0
 
 
@@ -73,7 +77,8 @@ class VdshFile:
     window_param, method_param, scale, quantity_param, stored, coef_scales,
     levels, variable_order, orders), `positions`, `normals` (V x 3 float32),
     `triangles` (T x 3 uint32), and the ancillary `stats`, `timings`,
-    `part`, `adaptive` (dicts, or None when the chunk is absent)."""
+    `part`, `adaptive`, `light_pool` (dicts, or None when the chunk is
+    absent)."""
 
     header: Dict[str, Any]
     sources: List[Dict[str, Any]]
@@ -82,13 +87,14 @@ class VdshFile:
     timings: Optional[Dict[str, float]]
     part: Optional[Dict[str, Any]]
     adaptive: Optional[Dict[str, Any]]
+    light_pool: Optional[Dict[str, Any]]
     positions: np.ndarray
     normals: np.ndarray
     triangles: np.ndarray
 
     def __init__(self) -> None:
         self.header, self.sources, self.streams = {}, [], []
-        self.stats = self.timings = self.part = self.adaptive = None
+        self.stats = self.timings = self.part = self.adaptive = self.light_pool = None
         self._coef = []  # COEF payloads, read once every chunk is (a part's size them)
         self.positions = self.normals = self.triangles = None
 
@@ -188,6 +194,8 @@ def parse(data: bytes, path: str = "memory") -> VdshFile:
         _fail(path, "no COEF chunk")
     if f.stats and f.stats["rays_missed"] > f.stats["rays_traced"]:
         _fail(path, "stat: rays_missed > rays_traced")
+    if f.light_pool is not None and (not f.part or f.part["encoding"] != "cpca"):
+        _fail(path, "lpol: a light pool outside a cpca part")
     return f
 
 
@@ -282,6 +290,20 @@ def _chunk(f, cid, b, path):
         f.part = dict(index=i, count=n, range_begin=rb, range_end=re, encoding=ENCODINGS[enc])
         if enc == 4:
             f.part.update(cpca_clusters=ck, cpca_basis=cb, cpca_bits=cbits)
+    elif cid == b"lpol":  # a cpca part's light pool (VDSH.md "Parts")
+        cnt = struct.unpack_from("<I", b, 0)[0] if len(b) >= 16 else 0
+        if len(b) < 16 or len(b) != 16 + 12 * cnt:
+            _fail(path, "lpol is %d byte%s, must be 16 + 12 x its %d light%s"
+                  % (len(b), _s(len(b)), cnt, _s(cnt)))
+        mix = struct.unpack_from("<f", b, 4)[0]
+        if any(b[8:16]):
+            _fail(path, "lpol: reserved bytes 8..15 not zero")
+        if not (0 < mix <= 1) or not 1 <= cnt <= MAX_POOL_LIGHTS:
+            _fail(path, "lpol: light mix %g or %d light%s out of range" % (mix, cnt, _s(cnt)))
+        lights = np.frombuffer(b, "<f4", 3 * cnt, 16).reshape(cnt, 3)
+        if not np.isfinite(lights).all():
+            _fail(path, "lpol: a light is not finite")
+        f.light_pool = dict(mix=mix, lights=lights)
     elif cid == b"adpt":
         if len(b) != 32:
             _fail(path, "adpt is %d byte%s, must be 32" % (len(b), _s(len(b))))

@@ -85,7 +85,17 @@ def summary(f: VdshFile, path: str) -> Dict[str, Any]:
                   occluder_bounds=dict(min=[float(x) for x in h["bounds_min"]],
                                        max=[float(x) for x in h["bounds_max"]])),
         sources=f.sources, streams=streams, stats=f.stats, timings=f.timings,
-        **{k: v for k, v in (("part", f.part), ("adaptive", f.adaptive)) if v is not None})
+        **{k: v for k, v in (("part", _part(f)), ("adaptive", f.adaptive)) if v is not None})
+
+
+def _part(f: Any) -> Any:
+    """The part's dict; a cpca part's with its light mix and pool size
+    (`lpol`; none: light mix 0), as vdsh-info's."""
+    if not f.part or f.part.get("encoding") != "cpca":
+        return f.part
+    lp = f.light_pool
+    return dict(f.part, cpca_light_mix=float(lp["mix"]) if lp else 0.0,
+                cpca_light_pool=len(lp["lights"]) if lp else 0)
 
 
 def _n(n: int, one: str, many: str = "") -> str:
