@@ -37,7 +37,7 @@ vdsh_cpca_settings vdsh_cpca_settings_default(void)
                             VDSH_CPCA_DEFAULT_BASIS,
                             VDSH_CPCA_DEFAULT_BITS,
                             0,
-                            VDSH_CPCA_DEFAULT_LIGHT_MIX,
+                            0.0f,
                             0,
                             NULL,
                             NULL};
@@ -132,7 +132,7 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
 {
     const char *p = text ? text : "";
     const char *l = strncmp(p, "light:", 6) == 0 ? p : strstr(p, ",light:");
-    float mix = VDSH_CPCA_DEFAULT_LIGHT_MIX;
+    float mix = -1.0f; /* not said */
     if (l && !parse_light(l + (*l == ','), &mix))
         return vdsh_failf(err, VDSH_ERR_ARGUMENT,
                           "cpca settings '%s': expected light:A at the end, A the light mix "
@@ -150,7 +150,9 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
         if (r != VDSH_OK)
             return r;
     }
-    s.light_mix = mix;
+    /* Not said: the light density for the byte-budget forms, the uniform
+     * hemisphere for fixed widths (vdsh_cpca.h). */
+    s.light_mix = mix >= 0.0f ? mix : s.budget ? VDSH_CPCA_DEFAULT_LIGHT_MIX : 0.0f;
     *out = s;
     return VDSH_OK;
 }

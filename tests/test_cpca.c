@@ -708,10 +708,15 @@ static void light_metric(void)
           "auto,light:0");
     CHECK(vdsh_cpca_parse("8,52,4,light:.25", &p, &err) == VDSH_OK && p.light_mix == 0.25f,
           "8,52,4,light:.25");
-    CHECK(vdsh_cpca_parse("8,52,4", &p, &err) == VDSH_OK &&
-              p.light_mix == VDSH_CPCA_DEFAULT_LIGHT_MIX && d.light_mix == p.light_mix &&
-              !p.light_count && !p.lights && !p.positions,
-          "the default light mix");
+    CHECK(vdsh_cpca_parse("8,52,4", &p, &err) == VDSH_OK && p.light_mix == 0.0f &&
+              d.light_mix == p.light_mix && !p.light_count && !p.lights && !p.positions,
+          "fixed widths: the uniform metric unless said");
+    CHECK(vdsh_cpca_parse("8,alloc:32", &p, &err) == VDSH_OK &&
+              p.light_mix == VDSH_CPCA_DEFAULT_LIGHT_MIX && !p.light_count,
+          "alloc: the default light mix");
+    CHECK(vdsh_cpca_parse("auto", &p, &err) == VDSH_OK &&
+              p.light_mix == VDSH_CPCA_DEFAULT_LIGHT_MIX,
+          "auto: the default light mix");
     static const char *const refuse[] = {
         "light:2",       "light:",           "light:-0",          "light:1e0",
         "light:inf",     "light:1,8,52,4",   "8,52,4,light:x",    "8,52,4,light:1,",

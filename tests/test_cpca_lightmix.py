@@ -5,7 +5,8 @@ formats/vdsh_cpca.h; docs/ACCURACY.md, "A light-density metric"):
 - light:0 is the uniform metric: the same bytes whether or not a pool
   exists (the default K, B, bits with `light:0` alone, and a part merged);
 - light:1 and light:0.5 are other fits, valid files that decode near the
-  f32 bake; the default (no light:) is VDSH_CPCA_DEFAULT_LIGHT_MIX's;
+  f32 bake; the default (no light:) is VDSH_CPCA_DEFAULT_LIGHT_MIX's for
+  alloc, light:0's for fixed widths (8,54,4);
 - bad values are refused with a message naming light:A, exit 2, no file;
 - a part carries the pool (`lpol`), vdsh-info shows the mix; vdsh-merge
   refuses parts whose pools differ, naming the part, and a part whose
@@ -61,7 +62,8 @@ spread = np.sqrt(((x - x.mean(0)) ** 2).sum(1).mean())
 CPCA = ["--encoding", "cpca", "--cpca"]
 for name, setting in (("l0", "4,alloc:40,light:0"), ("l05", "4,alloc:40,light:0.5"),
                       ("l1", "4,alloc:40,light:1"), ("def", "4,alloc:40"),
-                      ("l0alone", "light:0"), ("l0full", "8,54,4,light:0")):
+                      ("l0alone", "light:0"), ("l0full", "8,54,4,light:0"),
+                      ("fixed", "8,54,4")):
     must(run_bake(name + ".vdsh", CPCA + [setting]), setting)
     got = vdsh.coefficients(vdsh.read(path(name + ".vdsh")).streams[0]).astype(np.float64)
     err = np.sqrt(((got - x) ** 2).sum(1).mean()) / spread
@@ -75,10 +77,13 @@ if blob("l0alone.vdsh") != blob("l0full.vdsh"):
     fail.append("light:0 alone is not the default K, B, bits with light:0")
 # the default mix, as vdsh-bake --help says it
 helptext = subprocess.run([bake, "--help"], capture_output=True, text=True).stdout
-default = helptext.split("A in 0..1, default ")[1].split(";")[0]
+default = helptext.split("A in 0..1, default ")[1].split()[0]
 want = {"0": "l0", "1": "l1"}.get(default)
 if want is None or blob("def.vdsh") != blob(want + ".vdsh"):
     fail.append("the default light mix (--help: %r) does not give its bytes" % default)
+# fixed widths keep the uniform metric unless told (it lost there)
+if blob("fixed.vdsh") != blob("l0full.vdsh"):
+    fail.append("8,54,4 without light: is not the uniform metric")
 
 for bad in ("4,alloc:40,light:2", "4,alloc:40,light:-1", "4,alloc:40,light:", "light:abc",
             "4,alloc:40,light:1,2", "light:0.5x", "4,alloc:40,light:nan", "4,alloc:40,light:1e0"):
