@@ -86,6 +86,14 @@ const char *vt_cli_prog(void); /* "vdsh" before vt_cli_begin */
  * mask). Signals ignored at start (nohup, a background job) stay ignored. */
 void vt_cli_clean_exit_on_signals(void);
 
+/* A folder of temporary outputs (vdsh-frames truth's, moved into place once
+ * whole): a signal that ends the program (vt_cli_clean_exit_on_signals)
+ * removes every file in it and the folder too. One at a time; NULL: none. */
+void vt_cli_remove_dir_on_signal(const char *dir);
+
+/* Every file in `dir` (not recursing), then `dir` itself: best effort. */
+void vt_cli_remove_dir(const char *dir);
+
 /* Outputs that change together (a .vdsh and its basis cubemaps): between
  * vt_cli_defer_signals and vt_cli_undefer_signals such a signal waits, so
  * that the program ends with all of them written or none (their
