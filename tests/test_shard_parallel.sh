@@ -7,7 +7,9 @@
 # Debian's parallel when root and it is missing; skips (77) when it cannot
 # be had. Each shard's progress is in the output. OUT in a missing folder
 # is refused before any shard runs, and so is a parallel that is not GNU's.
-# --report R.json among the bake's arguments: each shard writes R.part-I.json.
+# --report R.json among the bake's arguments: each shard writes R.part-I.json;
+# a rerun with fewer shards removes the extra shards' reports and refuses
+# their parts.
 # Usage: test_shard_parallel.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
@@ -94,6 +96,31 @@ for form in "--report $tmp/rep.json" "--report=$tmp/rep.json" "--repo $tmp/rep.j
       { echo "FAIL: '$form': no report rep.part-$i.json for shard $i" >&2; fail=1; }
   done
 done
+# A rerun with fewer shards: the reports of the earlier run's extra shards
+# are removed (rep.part-3.json and -4 stayed beside the new 0-2), and a
+# part of it with an index the rerun does not have is refused, naming it.
+rm -f "$tmp"/rep*.json "$tmp/rep.vdsh"
+"$scripts/bake-parallel" 5 "$tmp/rep.vdsh" -j 2 -- "${tiny[@]}" --report "$tmp/rep.json" 2>/dev/null ||
+  { echo "FAIL: bake-parallel 5 shards with --report" >&2; fail=1; }
+[[ -e $tmp/rep.part-4.json ]] || { echo "FAIL: 5 shards wrote no rep.part-4.json" >&2; fail=1; }
+"$scripts/bake-parallel" 3 "$tmp/rep.vdsh" -j 2 -- "${tiny[@]}" --report "$tmp/rep.json" 2>"$tmp/err.txt" ||
+  { echo "FAIL: bake-parallel 3 shards after 5:" >&2; cat "$tmp/err.txt" >&2; fail=1; }
+cmp -s "$tmp/rep.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: 3 shards after 5: merge differs" >&2; fail=1; }
+for i in 3 4; do
+  [[ -e $tmp/rep.part-$i.json ]] && { echo "FAIL: the stale report rep.part-$i.json kept" >&2; fail=1; }
+done
+grep -q "removed '$tmp/rep.part-4.json'" "$tmp/err.txt" || { echo "FAIL: the removal not said:" >&2; cat "$tmp/err.txt" >&2; fail=1; }
+for i in 0 1 2; do
+  grep -q '"seconds"' "$tmp/rep.part-$i.json" 2>/dev/null || { echo "FAIL: 3 shards after 5: no rep.part-$i.json" >&2; fail=1; }
+done
+"$bake" "${tiny[@]}" -q --shard 4/5 -o "$tmp/stale.part-4.vdsh" || { echo "FAIL: shard 4/5" >&2; fail=1; }
+printf '#!/bin/sh\necho ran >> %q\nexec %q "$@"\n' "$tmp/stale.log" "$bake" > "$tmp/stale-bake"
+chmod +x "$tmp/stale-bake"
+msg=$(VDSH_BAKE=$tmp/stale-bake "$scripts/bake-parallel" 3 "$tmp/stale.vdsh" -- "${tiny[@]}" 2>&1)
+rc=$?
+[[ $rc -eq 1 && $msg == *"'$tmp/stale.part-4.vdsh' is a part of a bake with more than 3 shards"* ]] ||
+  { echo "FAIL: a part of a run with more shards: exit $rc: $msg" >&2; fail=1; }
+[[ -e $tmp/stale.log || -e $tmp/stale.vdsh ]] && { echo "FAIL: a part of a run with more shards: shards baked" >&2; fail=1; }
 msg=$("$scripts/bake-parallel" 2 "$tmp/rep2.vdsh" -- "${tiny[@]}" --report 2>&1)
 rc=$?
 [[ $rc -eq 2 && $msg == *"without a FILE"* ]] || { echo "FAIL: --report without FILE: exit $rc: $msg" >&2; fail=1; }
