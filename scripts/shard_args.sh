@@ -16,6 +16,10 @@
 #                                FILE, the last one won; the caller gives
 #                                each shard its own: FILE less .json, then
 #                                .part-I.json, beside FILE (like the parts)
+#   shard_sh_quote ARGS...       ARGS as words any POSIX sh reads back
+#                                (eval "set -- $(shard_sh_quote ...)"): each
+#                                in single quotes, a ' as '\'' (bash's %q
+#                                writes $'...' for a newline: not sh's)
 #   shard_out_dir PROG OUT       OUT's folder exists and is writable, else
 #                                exit 1 naming it (bake-slurm made an absolute
 #                                path of a missing folder as "/OUT": the root)
@@ -120,4 +124,10 @@ shard_stale_reports() { # shard_stale_reports PROG N STEM REPORT_STEM
     fi
   done
   return 0
+}
+
+shard_sh_quote() {
+  local a q=\' out=""
+  for a in "$@"; do out+="'${a//$q/$q\\$q$q}' "; done
+  printf '%s' "$out"
 }

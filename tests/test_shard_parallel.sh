@@ -7,6 +7,7 @@
 # Debian's parallel when root and it is missing; skips (77) when it cannot
 # be had. Each shard's progress is in the output. OUT in a missing folder
 # is refused before any shard runs, and so is a parallel that is not GNU's.
+# --sshlogin hosts need no bash (a POSIX sh runs the shards).
 # --report R.json among the bake's arguments: each shard writes R.part-I.json;
 # a rerun with fewer shards removes the extra shards' reports and refuses
 # their parts.
@@ -78,6 +79,21 @@ VDSH_BAKE=$tmp/logging-bake "$scripts/bake-parallel" 5 "$tmp/again.vdsh" -j 2 --
 ran=$(sort "$tmp/shards.log" 2>/dev/null | tr '\n' ' ')
 [[ $ran == "0/5 1/5 3/5 4/5 " ]] || { echo "FAIL: the rerun baked shards '$ran', not 0 1 3 4" >&2; fail=1; }
 cmp "$tmp/again.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: rerun merge differs" >&2; fail=1; }
+# --sshlogin with hosts that have no bash, only a POSIX sh (dash) and what
+# GNU parallel needs there (perl, rm): an ssh of our own (PARALLEL_SSH)
+# runs the host's command line with sh and a PATH of those only (the shard
+# ran as "bash -c ...": "bash: not found").
+mkdir -p "$tmp/nobash"
+for t in perl sh rm; do ln -s "$(command -v $t)" "$tmp/nobash/$t"; done
+cat >"$tmp/fakessh" <<SSH
+#!/bin/sh
+while [ \$# -gt 0 ]; do case \$1 in -o|-l|-p) shift 2;; --) shift; break;; -*) shift;; *) shift; [ "\${1:-}" = -- ] && shift; break;; esac; done
+SHELL=/bin/sh PATH=$tmp/nobash exec /bin/sh -c "\$*"
+SSH
+chmod +x "$tmp/fakessh"
+PARALLEL_SSH=$tmp/fakessh "$scripts/bake-parallel" 3 "$tmp/ssh it's.vdsh" --sshlogin 2/nobashhost -- "${tiny[@]}" 2>"$tmp/err.txt" ||
+  { echo "FAIL: bake-parallel --sshlogin to a host without bash:" >&2; tail -5 "$tmp/err.txt" >&2; fail=1; }
+cmp -s "$tmp/ssh it's.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: --sshlogin without bash: merge differs" >&2; fail=1; }
 # A failing shard fails the run and writes no merged file.
 if "$scripts/bake-parallel" 3 "$tmp/bad.vdsh" -- "${tiny[@]}" --rays 0 2>/dev/null; then
   echo "FAIL: a failing shard did not fail the run" >&2; fail=1
