@@ -127,7 +127,10 @@ shard_stale_reports() { # shard_stale_reports PROG N STEM REPORT_STEM
 }
 
 shard_sh_quote() {
-  local a q=\' out=""
-  for a in "$@"; do out+="'${a//$q/$q\\$q$q}' "; done
+  local a q=\' out="" sep=""
+  for a in "$@"; do
+    out+="$sep'${a//$q/$q\\$q$q}'"
+    sep=" "
+  done
   printf '%s' "$out"
 }

@@ -12,7 +12,8 @@
 # output's name has a space, a quote and a '%' (the logs beside it); more shards than receivers and
 # OUT in a missing folder are refused before anything is submitted;
 # --report R.json among the bake's arguments: each shard writes R.part-I.json;
-# stale reports (more shards, parts baked again) removed, stale parts refused.
+# stale reports (more shards, parts baked again) removed, stale parts refused;
+# a relative mesh and VDSH_BAKE work when the job starts elsewhere (--chdir).
 # Usage: test_shard_slurm.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
@@ -88,6 +89,22 @@ mv "$nos/rep/wraps.keep" "$nos/rep/wraps"
   { echo "FAIL: --report: shard 1's command failed: $(head -n 1 "$nos/rep/wraps" 2>/dev/null)" >&2; fail=1; }
 [[ -e $nos/rep/r.part-1.vdsh && ! -e $nos/rep/r.json ]] && grep -q '"seconds"' "$nos/rep/r.part-1.json" 2>/dev/null ||
   { echo "FAIL: --report: shard 1 wrote no r.part-1.json (or wrote r.json): $(ls "$nos/rep")" >&2; fail=1; }
+# Relative paths (a mesh, VDSH_BAKE) given from the caller's folder: the
+# shard's command runs them from there wherever the job starts (sbatch
+# --chdir=/ among the options; the job run here from /): they were looked
+# up in the job's folder ("no such file").
+mkdir -p "$nos/rel/bin"
+cp "$(dirname "$0")/data/room_box.obj" "$nos/rel/m.obj"
+ln -s "$bake" "$nos/rel/bin/vdsh-bake"
+printf '#!/bin/sh\nwhile [ $# -gt 0 ]; do [ "$1" = --wrap ] && printf "%%s\\n" "$2" >> "%s/wraps"; shift; done\necho 8\n' \
+  "$nos/rel" > "$nos/rel/sbatch"
+chmod +x "$nos/rel/sbatch"
+(cd "$nos/rel" && PATH=$nos/rel:$PATH VDSH_BAKE=bin/vdsh-bake VDSH_MERGE=$merge "$scripts/bake-slurm" 2 r.vdsh --chdir=/ -- \
+  m.obj --max-edge 1.5 --rays 32 --cube-size 8 >/dev/null 2>&1) ||
+  { echo "FAIL: bake-slurm with a relative mesh and VDSH_BAKE" >&2; fail=1; }
+(cd / && SLURM_ARRAY_TASK_ID=0 sh -c "$(head -n 1 "$nos/rel/wraps" 2>/dev/null)" >"$nos/rel/out.txt" 2>&1) ||
+  { echo "FAIL: relative paths: shard 0's command failed from /: $(head -c 300 "$nos/rel/out.txt")" >&2; fail=1; }
+[[ -e $nos/rel/r.part-0.vdsh ]] || { echo "FAIL: relative paths: no r.part-0.vdsh" >&2; fail=1; }
 rm -rf "$nos"
 skip() { [[ $fail -eq 0 ]] || exit 1; echo "SKIP: $1"; exit 77; }
 [[ $(id -u) -eq 0 ]] || skip "needs root to start slurmctld and slurmd"
