@@ -290,14 +290,8 @@ vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count
      * without free space (a solid, or everything closer than clearance). */
     float lo[3], hi[3];
     const int grown = vb_scene_light_region(s, lo, hi, NULL);
-    uint32_t n = 0, k = 0;
-    const uint64_t limit = vdsh_light_tries(count, grown);
-    while (n < count && k < limit) {
-        float p[3];
-        vdsh_light_candidate(lo, hi, seed, k++, p);
-        if (vb_scene_free_space(s, p))
-            memcpy(out[n++], p, sizeof out[0]);
-    }
+    uint32_t k = 0;
+    const uint32_t n = vdsh_light_place(lo, hi, grown, seed, count, free_cb, s, out, NULL, &k);
     if (tried)
         *tried = k;
     if (n < count)
