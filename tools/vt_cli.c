@@ -472,16 +472,6 @@ int vt_opt_int(const char *option, const char *what, const char *arg, int lo, in
     return refuse_range(option, what, arg, l, h);
 }
 
-const char *vt_s(unsigned long long n)
-{
-    return n == 1 ? "" : "s";
-}
-
-const char *vt_plural(unsigned long long n, const char *one, const char *many)
-{
-    return n == 1 ? one : many;
-}
-
 int vt_opt_once(const char *option, const char *arg, const char **slot)
 {
     if (*slot) {

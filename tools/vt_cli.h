@@ -47,6 +47,7 @@
 
 #include <stdint.h>
 #include <stdio.h>
+#include "vdsh_plural.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -176,10 +177,7 @@ int vt_opt_u32(const char *option, const char *what, const char *arg, uint32_t l
                uint32_t *out);
 int vt_opt_int(const char *option, const char *what, const char *arg, int lo, int hi, int *out);
 
-/* Plurals in messages: "%u receiver%s", n, vt_s(n) says "1 receiver",
- * "2 receivers"; vt_plural(n, "vertex", "vertices") the irregular ones. */
-const char *vt_s(unsigned long long n);
-const char *vt_plural(unsigned long long n, const char *one, const char *many);
+/* Plurals in messages: formats/vdsh_plural.h (vdsh_s, vdsh_plural). */
 
 /* An option that names one thing (-o FILE): *slot = arg the first time;
  * given again, "OPTION given twice ('A', then 'B'): give it once", even

@@ -278,7 +278,7 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
         return vb_fail(err, VB_ERR_INVALID,
                        "no room for %u light%s by rule %s: %u found in %u "
                        "candidate%s in %s",
-                       count, vb_s(count), vb_light_rule_name(rule), n, k, vb_s(k),
+                       count, vdsh_s(count), vb_light_rule_name(rule), n, k, vdsh_s(k),
                        region_name(grown));
     return VB_OK;
 }
@@ -298,7 +298,7 @@ vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count
         return vb_fail(err, VB_ERR_INVALID,
                        "no free space for lights: %u of %u candidate%s in %s "
                        "%s inside solids or nearer than %g to a surface",
-                       k - n, k, vb_s(k), region_name(grown), k - n == 1 ? "was" : "were",
+                       k - n, k, vdsh_s(k), region_name(grown), k - n == 1 ? "was" : "were",
                        (double)vdsh_free_clearance(s->diagonal));
     return VB_OK;
 }

@@ -306,8 +306,8 @@ static int run_views(const options *op)
     if (!op->quiet) {
         printf(PROG " views: %s -> %s: %d view%s, %d x %d, seed %llu; %u candidate eye%s "
                     "(%u in free space), %.2f s\n",
-               path, out, set.count, vt_s((unsigned)set.count), d.width, d.height,
-               (unsigned long long)d.seed, st.eyes_tried, vt_s(st.eyes_tried), st.eyes_free,
+               path, out, set.count, vdsh_s((unsigned)set.count), d.width, d.height,
+               (unsigned long long)d.seed, st.eyes_tried, vdsh_s(st.eyes_tried), st.eyes_free,
                vb_now() - t0);
         if (st.default_lights_ok < VB_FRAMES_VIEW_LIGHTS)
             printf("  note: only %u of the default view's 4 lights light and shadow %.0f%% "
@@ -597,7 +597,7 @@ static int run_truth(const options *op)
     int light_frames = 0, stream_frames = 0;
     if (!op->quiet)
         printf(PROG " truth: %s, %d view%s from %s, %d x %d, %s comparison -> %s\n", path, V.count,
-               vt_s((unsigned)V.count), views_path, w, h, vdsh_compare_name(compare), dir);
+               vdsh_s((unsigned)V.count), views_path, w, h, vdsh_compare_name(compare), dir);
     for (int vi = 0; vi < V.count; vi++) {
         const vt_view *v = V.views + vi;
         double t = vb_now();
@@ -701,7 +701,7 @@ static int run_truth(const options *op)
         if (!op->quiet)
             printf("  %-10s primary %6.1f ms; %d light%s: shadow %6.1f ms per light, C streams "
                    "%6.1f ms per light\n",
-                   v->name, 1e3 * tp, view_lights, vt_s((unsigned)view_lights),
+                   v->name, 1e3 * tp, view_lights, vdsh_s((unsigned)view_lights),
                    1e3 * ts / (view_lights ? view_lights : 1),
                    1e3 * tc / (view_lights ? view_lights : 1));
     }
@@ -714,7 +714,7 @@ static int run_truth(const options *op)
         printf("  a frame's truth (%d x %d, primary + shadow ray per pixel): %.1f ms "
                "(primary %.1f + shadow %.1f) on %u thread%s\n",
                w, h, 1e3 * (per_view + per_light), 1e3 * per_view, 1e3 * per_light,
-               vb_parallel_threads(op->threads), vt_s(vb_parallel_threads(op->threads)));
+               vb_parallel_threads(op->threads), vdsh_s(vb_parallel_threads(op->threads)));
         printf("  C streams: %.1f ms per stream per frame; %d + %d frames written (%.2f s) in "
                "%.2f s in all\n",
                stream_frames ? 1e3 * t_streams / stream_frames : 0.0, 3 * light_frames,
@@ -912,7 +912,7 @@ static int run_score(const options *op)
     cJSON *jm = vt_json_array(&j, root, "modes");
     if (!op->quiet)
         printf(PROG " score: %s, %d view%s from %s, %d x %d; truth %s, frames %s\n", path, V.count,
-               vt_s((unsigned)V.count), views_path, V.width, V.height, truth, frames);
+               vdsh_s((unsigned)V.count), views_path, V.width, V.height, truth, frames);
     for (int m = 0; m < mode_count; m++) {
         const vb_frames_tally *T = tally + (size_t)m * frame_count;
         vb_frames_tally scene = {0};
