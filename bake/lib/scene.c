@@ -278,7 +278,7 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
         return vb_fail(err, VB_ERR_INVALID,
                        "no room for %u light%s by rule %s: %u found in %u "
                        "candidate%s in %s",
-                       count, vb_s(count), vb_light_rule_name(rule), n, k, vb_s(k),
+                       count, vdsh_s(count), vb_light_rule_name(rule), n, k, vdsh_s(k),
                        region_name(grown));
     return VB_OK;
 }
@@ -290,21 +290,15 @@ vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count
      * without free space (a solid, or everything closer than clearance). */
     float lo[3], hi[3];
     const int grown = vb_scene_light_region(s, lo, hi, NULL);
-    uint32_t n = 0, k = 0;
-    const uint64_t limit = vdsh_light_tries(count, grown);
-    while (n < count && k < limit) {
-        float p[3];
-        vdsh_light_candidate(lo, hi, seed, k++, p);
-        if (vb_scene_free_space(s, p))
-            memcpy(out[n++], p, sizeof out[0]);
-    }
+    uint32_t k = 0;
+    const uint32_t n = vdsh_light_place(lo, hi, grown, seed, count, free_cb, s, out, NULL, &k);
     if (tried)
         *tried = k;
     if (n < count)
         return vb_fail(err, VB_ERR_INVALID,
                        "no free space for lights: %u of %u candidate%s in %s "
                        "%s inside solids or nearer than %g to a surface",
-                       k - n, k, vb_s(k), region_name(grown), k - n == 1 ? "was" : "were",
+                       k - n, k, vdsh_s(k), region_name(grown), k - n == 1 ? "was" : "were",
                        (double)vdsh_free_clearance(s->diagonal));
     return VB_OK;
 }
