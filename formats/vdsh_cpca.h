@@ -96,8 +96,8 @@ vdsh_cpca_settings vdsh_cpca_settings_default(void);
  * "auto:BYTES" (1..VDSH_CPCA_MAX_BUDGET) or "K,alloc:BYTES", each with an
  * optional ",light:A" (A in 0..1, the light mix; else
  * VDSH_CPCA_DEFAULT_LIGHT_MIX for auto and alloc, 0 for K,B,BITS), or
- * "light:A" alone (the default K, B, bits
- * with that mix) into *out (no pool: the caller sets it); VDSH_ERR_ARGUMENT
+ * "light:A" alone (the default settings, vdsh_cpca_settings_default's
+ * K and budget, with that mix) into *out (no pool: the caller sets it); VDSH_ERR_ARGUMENT
  * with a message for a malformed string or a value out of range. */
 vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_error *err);
 
