@@ -162,5 +162,14 @@ expect_exit 0 "a part of other settings" "$bake" "${tiny[@]}" --encoding cpca --
 expect_exit 1 "merge refuses other settings" "$merge" -q "$tmp"/n3/p0.vdsh "$tmp"/n3/p1.vdsh \
   "$tmp/other-2.vdsh" -o "$out"
 says_any "merge of other settings" "another --cpca"
+# The default (16,alloc:32) on a mesh too small for its model within 32
+# bytes per vertex (48 receivers): an error that names the way out, and
+# fixed settings bake it.
+expect_exit 1 "the default on a 48-vertex mesh" "$bake" "$src/tests/data/room_box.obj" --max-edge 0 \
+  --rays 16 --cube-size 0 --orders 12 --encoding cpca -q -o "$out"
+says_any "too small for the default" "too small for 48 rows"
+says_any "the way out named" "fixed K,B,BITS: --cpca 8,54,4"
+expect_exit 0 "8,54,4 on the 48-vertex mesh" "$bake" "$src/tests/data/room_box.obj" --max-edge 0 \
+  --rays 16 --cube-size 0 --orders 12 --encoding cpca --cpca 8,54,4 -q -o "$tmp/box.vdsh"
 check "nothing written after refusals" test ! -e "$out"
 exit $fail
