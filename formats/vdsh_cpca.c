@@ -33,14 +33,8 @@ enum {
 
 vdsh_cpca_settings vdsh_cpca_settings_default(void)
 {
-    vdsh_cpca_settings s = {VDSH_CPCA_DEFAULT_CLUSTERS,
-                            VDSH_CPCA_DEFAULT_BASIS,
-                            VDSH_CPCA_DEFAULT_BITS,
-                            0,
-                            0.0f,
-                            0,
-                            NULL,
-                            NULL};
+    vdsh_cpca_settings s = {VDSH_CPCA_DEFAULT_CLUSTERS,  0, 0,    VDSH_CPCA_DEFAULT_BUDGET,
+                            VDSH_CPCA_DEFAULT_LIGHT_MIX, 0, NULL, NULL};
     return s;
 }
 
@@ -1442,7 +1436,8 @@ static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t
     if (!st.basis)
         return vdsh_failf(err, VDSH_ERR_ARGUMENT,
                           "cpca: alloc budget %u byte%s per vertex too small for %u row%s of order "
-                          "%u at %u cluster%s",
+                          "%u at %u cluster%s (give fewer clusters, more bytes or fixed "
+                          "K,B,BITS: --cpca 8,54,4)",
                           settings->budget, vdsh_s(settings->budget), rows, vdsh_s(rows), order,
                           st.clusters, vdsh_s(st.clusters));
     uint32_t fb = 2 * st.basis < n ? 2 * st.basis : n;
