@@ -120,7 +120,8 @@ typedef struct vdsh_cpca_fit {
  * vertex's own hemisphere (the refinement's error; first in that order on
  * a tie). VDSH_ERR_ARGUMENT when none fits the budget. With K and a
  * budget (alloc): K, B refined as above with the largest B whose 4-bit
- * records and model fit, then a width per vector over min(2B, n) vectors
+ * records and model fit (K halved while no B fits; VDSH_ERR_ARGUMENT when
+ * none fits at K = 1), then a width per vector over min(2B, n) vectors
  * (vdsh_cpca_study.h's allocation; VDSH.md "cpca streams"), vectors of
  * width 0 dropped: model.bits 0 and model.widths set.
  * VDSH_ERR_ARGUMENT for bad settings, order or rows; VDSH_ERR_INVALID for

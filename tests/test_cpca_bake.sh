@@ -162,14 +162,29 @@ expect_exit 0 "a part of other settings" "$bake" "${tiny[@]}" --encoding cpca --
 expect_exit 1 "merge refuses other settings" "$merge" -q "$tmp"/n3/p0.vdsh "$tmp"/n3/p1.vdsh \
   "$tmp/other-2.vdsh" -o "$out"
 says_any "merge of other settings" "another --cpca"
-# The default (16,alloc:32) on a mesh too small for its model within 32
-# bytes per vertex (48 receivers): an error that names the way out, and
-# fixed settings bake it.
-expect_exit 1 "the default on a 48-vertex mesh" "$bake" "$src/tests/data/room_box.obj" --max-edge 0 \
+# The default (16,alloc:32) on a mesh too small for 16 clusters' model
+# within 32 bytes per vertex (48 receivers): K is halved until a model
+# fits, within the budget. One triangle (3 receivers) fits at no K: an
+# error that names the way out, and fixed settings bake it.
+expect_exit 0 "the default on a 48-vertex mesh" "$bake" "$src/tests/data/room_box.obj" --max-edge 0 \
+  --rays 16 --cube-size 0 --orders 12 --encoding cpca -q -o "$tmp/box.vdsh"
+check "the default on 48 vertices: fewer clusters" /usr/bin/python3 -c '
+import os, sys
+sys.path.insert(0, sys.argv[1])
+import vdsh
+c = vdsh.read(sys.argv[2]).streams[0]["cpca"]
+assert 1 <= c["clusters"] < 16, c["clusters"]
+assert os.path.getsize(sys.argv[2]) > 0
+' "$src/python" "$tmp/box.vdsh"
+check "the default on 48 vertices: within 32 B/vertex with the model" sh -c \
+  "'$info' '$tmp/box.vdsh' | sed -n 's/.*bytes per vertex, \\([0-9.]*\\) with the model.*/\\1/p' |
+   awk '{ ok = \$1 > 0 && \$1 <= 32 } END { exit !(NR == 1 && ok) }'"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$tmp/tri.obj"
+expect_exit 1 "the default on one triangle" "$bake" "$tmp/tri.obj" --max-edge 0 \
   --rays 16 --cube-size 0 --orders 12 --encoding cpca -q -o "$out"
-says_any "too small for the default" "too small for 48 rows"
+says_any "too small even at one cluster" "too small for 3 rows of order 12, even at 1 cluster"
 says_any "the way out named" "fixed K,B,BITS: --cpca 8,54,4"
-expect_exit 0 "8,54,4 on the 48-vertex mesh" "$bake" "$src/tests/data/room_box.obj" --max-edge 0 \
-  --rays 16 --cube-size 0 --orders 12 --encoding cpca --cpca 8,54,4 -q -o "$tmp/box.vdsh"
+expect_exit 0 "8,54,4 on one triangle" "$bake" "$tmp/tri.obj" --max-edge 0 \
+  --rays 16 --cube-size 0 --orders 12 --encoding cpca --cpca 8,54,4 -q -o "$tmp/tri.vdsh"
 check "nothing written after refusals" test ! -e "$out"
 exit $fail
