@@ -238,16 +238,14 @@ static void eval_scene_lights(job *J, uint32_t ri, const rstreams *R)
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     for (uint32_t first = 0; first < J->light_count; first += VB_PACKET) {
-        struct RTCRay16 ray __attribute__((aligned(64)));
+        struct RTCRayHit16 rh __attribute__((aligned(64)));
         int valid[VB_PACKET] __attribute__((aligned(64)));
         float dl[VB_PACKET], w[VB_PACKET][3];
         for (int k = 0; k < VB_PACKET; k++) {
             uint32_t l = first + (uint32_t)k;
             valid[k] = 0;
-            ray.tnear[k] = 0.0f, ray.tfar[k] = 0.0f, ray.time[k] = 0.0f;
-            ray.mask[k] = 0xffffffffu, ray.id[k] = (unsigned)k, ray.flags[k] = 0;
-            ray.org_x[k] = r->origin[0], ray.org_y[k] = r->origin[1], ray.org_z[k] = r->origin[2];
-            ray.dir_x[k] = 0.0f, ray.dir_y[k] = 0.0f, ray.dir_z[k] = 1.0f;
+            vb_ray16_init(&rh, k, r->origin, 0.0f);
+            rh.ray.dir_x[k] = 0.0f, rh.ray.dir_y[k] = 0.0f, rh.ray.dir_z[k] = 1.0f;
             dl[k] = 0.0f;
             if (l >= J->light_count)
                 continue;
@@ -264,17 +262,11 @@ static void eval_scene_lights(job *J, uint32_t ri, const rstreams *R)
             float dlocal = sqrtf(o2l[0] * o2l[0] + o2l[1] * o2l[1] + o2l[2] * o2l[2]);
             if (!(dlocal > 0.0f))
                 continue;
-            ray.dir_x[k] = o2l[0] / dlocal, ray.dir_y[k] = o2l[1] / dlocal;
-            ray.dir_z[k] = o2l[2] / dlocal;
-            ray.tfar[k] = dlocal;
+            rh.ray.dir_x[k] = o2l[0] / dlocal, rh.ray.dir_y[k] = o2l[1] / dlocal;
+            rh.ray.dir_z[k] = o2l[2] / dlocal;
+            rh.ray.tfar[k] = dlocal;
             dl[k] = d;
             valid[k] = -1;
-        }
-        struct RTCRayHit16 rh __attribute__((aligned(64)));
-        rh.ray = ray;
-        for (int k = 0; k < VB_PACKET; k++) {
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
         }
         rtcIntersect16(valid, J->scene->scene, &ctx, &rh);
         for (int k = 0; k < VB_PACKET; k++) {
@@ -345,19 +337,8 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
         int valid[VB_PACKET] __attribute__((aligned(64)));
         heldout_packet(J->grid, pk, J->dir_seed, r->id, r->normal, rh.ray.dir_x, rh.ray.dir_y,
                        rh.ray.dir_z, valid);
-        for (int k = 0; k < VB_PACKET; k++) {
-            rh.ray.org_x[k] = r->origin[0];
-            rh.ray.org_y[k] = r->origin[1];
-            rh.ray.org_z[k] = r->origin[2];
-            rh.ray.tnear[k] = 0.0f;
-            rh.ray.tfar[k] = J->max_local;
-            rh.ray.time[k] = 0.0f;
-            rh.ray.mask[k] = 0xffffffffu;
-            rh.ray.id[k] = (unsigned)k;
-            rh.ray.flags[k] = 0;
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-        }
+        for (int k = 0; k < VB_PACKET; k++)
+            vb_ray16_init(&rh, k, r->origin, J->max_local);
         rtcIntersect16(valid, J->scene->scene, &ctx, &rh);
 
         for (int k = 0; k < VB_PACKET; k++) {
