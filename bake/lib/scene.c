@@ -240,8 +240,6 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
                                      vb_light_rule rule, float (*out)[3], uint32_t *tried,
                                      vb_error *err)
 {
-    if (rule == VB_LIGHTS_UNIFORM)
-        return vb_scene_place_lights(s, seed, count, out, tried, err);
     if ((unsigned)rule > VB_LIGHTS_PATH)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown light rule %d", (int)rule);
     float lo[3], hi[3];
@@ -269,6 +267,15 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
     }
     if (tried)
         *tried = k;
+    /* Uniform lights give up when a thousand candidates per light find no
+     * room: a scene without free space (a solid, or everything closer than
+     * clearance). */
+    if (n < count && rule == VB_LIGHTS_UNIFORM)
+        return vb_fail(err, VB_ERR_INVALID,
+                       "no free space for lights: %u of %u candidate%s in %s "
+                       "%s inside solids or nearer than %g to a surface",
+                       k - n, k, vb_s(k), region_name(grown), k - n == 1 ? "was" : "were",
+                       (double)vdsh_free_clearance(s->diagonal));
     if (n < count)
         return vb_fail(err, VB_ERR_INVALID,
                        "no room for %u light%s by rule %s: %u found in %u "
@@ -281,25 +288,5 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
 vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
                                 uint32_t *tried, vb_error *err)
 {
-    /* Give up when a thousand candidates per light find no room: a scene
-     * without free space (a solid, or everything closer than clearance). */
-    float lo[3], hi[3];
-    const int grown = vb_scene_light_region(s, lo, hi, NULL);
-    uint32_t n = 0, k = 0;
-    const uint64_t limit = vdsh_light_tries(count, grown);
-    while (n < count && k < limit) {
-        float p[3];
-        vdsh_light_candidate(lo, hi, seed, k++, p);
-        if (vb_scene_free_space(s, p))
-            memcpy(out[n++], p, sizeof out[0]);
-    }
-    if (tried)
-        *tried = k;
-    if (n < count)
-        return vb_fail(err, VB_ERR_INVALID,
-                       "no free space for lights: %u of %u candidate%s in %s "
-                       "%s inside solids or nearer than %g to a surface",
-                       k - n, k, vb_s(k), region_name(grown), k - n == 1 ? "was" : "were",
-                       (double)vdsh_free_clearance(s->diagonal));
-    return VB_OK;
+    return vb_scene_place_lights_rule(s, seed, count, VB_LIGHTS_UNIFORM, out, tried, err);
 }
