@@ -631,38 +631,33 @@ static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind, 
         ratio sq = {0}, ab = {0}, mae_r = {0}, mb = {0}, fa = {0}, le = {0}, fb = {0}, lb = {0};
         uint32_t n_used = 0, nm = 0;
         uint64_t ringing = 0;
+        /* Pass 0 sums the ratios; pass 1, with the sums known, their
+         * residuals (ratio_se). */
         for (int pass = 0; pass < 2; pass++) {
             for (uint32_t i = first; i < first + count; i++) {
                 const racc *a = J->acc + (size_t)i * S + s;
                 if (a->n == 0)
                     continue;
-                if (pass == 0) {
-                    n_used++;
-                    ratio_add(&sq, a->sq, a->n);
-                    ratio_add(&ab, a->abs, a->n);
-                    ratio_add(&mae_r, a->mae, a->n);
-                    ratio_add(&mb, a->mae_bin, a->n);
-                    ratio_add(&fa, a->fals, a->vis);
-                    ratio_add(&le, a->leak, a->occ);
-                    ratio_add(&fb, a->fals_bin, a->vis);
-                    ratio_add(&lb, a->leak_bin, a->occ_bin);
-                    o->visible += a->vis;
-                    o->occluded += a->occ;
-                    o->occluded_binary += a->occ_bin;
-                    ringing += a->ringing;
-                    mae[nm] = a->mae / a->n;
-                    items[nm].key = mae[nm];
-                    items[nm].index = i;
-                    nm++;
-                } else {
-                    ratio_res(&sq, a->sq, a->n);
-                    ratio_res(&mae_r, a->mae, a->n);
-                    ratio_res(&mb, a->mae_bin, a->n);
-                    ratio_res(&fa, a->fals, a->vis);
-                    ratio_res(&le, a->leak, a->occ);
-                    ratio_res(&fb, a->fals_bin, a->vis);
-                    ratio_res(&lb, a->leak_bin, a->occ_bin);
-                }
+                void (*f)(ratio *, double, double) = pass ? ratio_res : ratio_add;
+                f(&sq, a->sq, a->n);
+                f(&ab, a->abs, a->n);
+                f(&mae_r, a->mae, a->n);
+                f(&mb, a->mae_bin, a->n);
+                f(&fa, a->fals, a->vis);
+                f(&le, a->leak, a->occ);
+                f(&fb, a->fals_bin, a->vis);
+                f(&lb, a->leak_bin, a->occ_bin);
+                if (pass)
+                    continue;
+                n_used++;
+                o->visible += a->vis;
+                o->occluded += a->occ;
+                o->occluded_binary += a->occ_bin;
+                ringing += a->ringing;
+                mae[nm] = a->mae / a->n;
+                items[nm].key = mae[nm];
+                items[nm].index = i;
+                nm++;
             }
         }
         o->samples = (uint64_t)sq.b;
