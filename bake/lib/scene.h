@@ -29,18 +29,22 @@
 extern "C" {
 #endif
 
+/* robust 1: RTC_SCENE_FLAG_ROBUST (default 0); threads: Embree's build
+ * threads (0: all cores). */
 typedef struct vb_scene_desc {
-    int robust;       /* 1: RTC_SCENE_FLAG_ROBUST (default 0) */
-    unsigned threads; /* Embree build threads; 0 = all cores */
+    int robust;
+    unsigned threads;
 } vb_scene_desc;
 
+/* The traced frame is (p - centre) * scale, scale a power of two; the
+ * bounds and their diagonal are the occluders', in scene units. */
 typedef struct vb_scene {
     RTCDevice device;
     RTCScene scene;
-    float centre[3];                    /* subtracted before scaling */
-    float scale;                        /* power of two */
-    float bounds_min[3], bounds_max[3]; /* occluders, scene units */
-    float diagonal;                     /* of the bounds, scene units */
+    float centre[3];
+    float scale;
+    float bounds_min[3], bounds_max[3];
+    float diagonal;
     uint32_t vertex_count, triangle_count;
     /* The traced triangles (local frame), Embree's buffers, alive with the
      * scene: the free-space test measures its probes' hits on them itself. */
