@@ -143,42 +143,37 @@ int vt_parse_float(const char *s, float *out)
     return s && float_n(s, strlen(s), out);
 }
 
+/* The length of the comma-separated item at p; *next gets the item after
+ * it, NULL after the last. */
+static size_t list_item(const char *p, const char **next)
+{
+    const char *comma = strchr(p, ',');
+    *next = comma ? comma + 1 : NULL;
+    return comma ? (size_t)(comma - p) : strlen(p);
+}
+
 int vt_parse_floats(const char *s, float *out, int min, int max)
 {
-    if (!s)
-        return 0;
     int n = 0;
-    const char *p = s;
-    for (;;) {
-        const char *comma = strchr(p, ',');
-        size_t len = comma ? (size_t)(comma - p) : strlen(p);
+    for (const char *p = s, *next; p; p = next) {
+        size_t len = list_item(p, &next);
         float v;
         if (n == max || !float_n(p, len, &v))
             return 0;
         out[n++] = v;
-        if (!comma)
-            break;
-        p = comma + 1;
     }
     return n >= min ? n : 0;
 }
 
 int vt_parse_u64_list(const char *s, uint64_t lo, uint64_t hi, uint64_t *out, int min, int max)
 {
-    if (!s)
-        return 0;
     int n = 0;
-    const char *p = s;
-    for (;;) {
-        const char *comma = strchr(p, ',');
-        size_t len = comma ? (size_t)(comma - p) : strlen(p);
+    for (const char *p = s, *next; p; p = next) {
+        size_t len = list_item(p, &next);
         uint64_t v;
         if (n == max || !digits_u64(p, len, &v) || v < lo || v > hi)
             return 0;
         out[n++] = v;
-        if (!comma)
-            break;
-        p = comma + 1;
     }
     return n >= min ? n : 0;
 }

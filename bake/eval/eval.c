@@ -238,16 +238,14 @@ static void eval_scene_lights(job *J, uint32_t ri, const rstreams *R)
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     for (uint32_t first = 0; first < J->light_count; first += VB_PACKET) {
-        struct RTCRay16 ray __attribute__((aligned(64)));
+        struct RTCRayHit16 rh __attribute__((aligned(64)));
         int valid[VB_PACKET] __attribute__((aligned(64)));
         float dl[VB_PACKET], w[VB_PACKET][3];
         for (int k = 0; k < VB_PACKET; k++) {
             uint32_t l = first + (uint32_t)k;
             valid[k] = 0;
-            ray.tnear[k] = 0.0f, ray.tfar[k] = 0.0f, ray.time[k] = 0.0f;
-            ray.mask[k] = 0xffffffffu, ray.id[k] = (unsigned)k, ray.flags[k] = 0;
-            ray.org_x[k] = r->origin[0], ray.org_y[k] = r->origin[1], ray.org_z[k] = r->origin[2];
-            ray.dir_x[k] = 0.0f, ray.dir_y[k] = 0.0f, ray.dir_z[k] = 1.0f;
+            vb_ray16_init(&rh, k, r->origin, 0.0f);
+            rh.ray.dir_x[k] = 0.0f, rh.ray.dir_y[k] = 0.0f, rh.ray.dir_z[k] = 1.0f;
             dl[k] = 0.0f;
             if (l >= J->light_count)
                 continue;
@@ -264,17 +262,11 @@ static void eval_scene_lights(job *J, uint32_t ri, const rstreams *R)
             float dlocal = sqrtf(o2l[0] * o2l[0] + o2l[1] * o2l[1] + o2l[2] * o2l[2]);
             if (!(dlocal > 0.0f))
                 continue;
-            ray.dir_x[k] = o2l[0] / dlocal, ray.dir_y[k] = o2l[1] / dlocal;
-            ray.dir_z[k] = o2l[2] / dlocal;
-            ray.tfar[k] = dlocal;
+            rh.ray.dir_x[k] = o2l[0] / dlocal, rh.ray.dir_y[k] = o2l[1] / dlocal;
+            rh.ray.dir_z[k] = o2l[2] / dlocal;
+            rh.ray.tfar[k] = dlocal;
             dl[k] = d;
             valid[k] = -1;
-        }
-        struct RTCRayHit16 rh __attribute__((aligned(64)));
-        rh.ray = ray;
-        for (int k = 0; k < VB_PACKET; k++) {
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
         }
         rtcIntersect16(valid, J->scene->scene, &ctx, &rh);
         for (int k = 0; k < VB_PACKET; k++) {
@@ -345,19 +337,8 @@ static void eval_receiver(job *J, uint32_t ri, uint64_t *hist)
         int valid[VB_PACKET] __attribute__((aligned(64)));
         heldout_packet(J->grid, pk, J->dir_seed, r->id, r->normal, rh.ray.dir_x, rh.ray.dir_y,
                        rh.ray.dir_z, valid);
-        for (int k = 0; k < VB_PACKET; k++) {
-            rh.ray.org_x[k] = r->origin[0];
-            rh.ray.org_y[k] = r->origin[1];
-            rh.ray.org_z[k] = r->origin[2];
-            rh.ray.tnear[k] = 0.0f;
-            rh.ray.tfar[k] = J->max_local;
-            rh.ray.time[k] = 0.0f;
-            rh.ray.mask[k] = 0xffffffffu;
-            rh.ray.id[k] = (unsigned)k;
-            rh.ray.flags[k] = 0;
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-        }
+        for (int k = 0; k < VB_PACKET; k++)
+            vb_ray16_init(&rh, k, r->origin, J->max_local);
         rtcIntersect16(valid, J->scene->scene, &ctx, &rh);
 
         for (int k = 0; k < VB_PACKET; k++) {
@@ -650,38 +631,33 @@ static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind, 
         ratio sq = {0}, ab = {0}, mae_r = {0}, mb = {0}, fa = {0}, le = {0}, fb = {0}, lb = {0};
         uint32_t n_used = 0, nm = 0;
         uint64_t ringing = 0;
+        /* Pass 0 sums the ratios; pass 1, with the sums known, their
+         * residuals (ratio_se). */
         for (int pass = 0; pass < 2; pass++) {
             for (uint32_t i = first; i < first + count; i++) {
                 const racc *a = J->acc + (size_t)i * S + s;
                 if (a->n == 0)
                     continue;
-                if (pass == 0) {
-                    n_used++;
-                    ratio_add(&sq, a->sq, a->n);
-                    ratio_add(&ab, a->abs, a->n);
-                    ratio_add(&mae_r, a->mae, a->n);
-                    ratio_add(&mb, a->mae_bin, a->n);
-                    ratio_add(&fa, a->fals, a->vis);
-                    ratio_add(&le, a->leak, a->occ);
-                    ratio_add(&fb, a->fals_bin, a->vis);
-                    ratio_add(&lb, a->leak_bin, a->occ_bin);
-                    o->visible += a->vis;
-                    o->occluded += a->occ;
-                    o->occluded_binary += a->occ_bin;
-                    ringing += a->ringing;
-                    mae[nm] = a->mae / a->n;
-                    items[nm].key = mae[nm];
-                    items[nm].index = i;
-                    nm++;
-                } else {
-                    ratio_res(&sq, a->sq, a->n);
-                    ratio_res(&mae_r, a->mae, a->n);
-                    ratio_res(&mb, a->mae_bin, a->n);
-                    ratio_res(&fa, a->fals, a->vis);
-                    ratio_res(&le, a->leak, a->occ);
-                    ratio_res(&fb, a->fals_bin, a->vis);
-                    ratio_res(&lb, a->leak_bin, a->occ_bin);
-                }
+                void (*f)(ratio *, double, double) = pass ? ratio_res : ratio_add;
+                f(&sq, a->sq, a->n);
+                f(&ab, a->abs, a->n);
+                f(&mae_r, a->mae, a->n);
+                f(&mb, a->mae_bin, a->n);
+                f(&fa, a->fals, a->vis);
+                f(&le, a->leak, a->occ);
+                f(&fb, a->fals_bin, a->vis);
+                f(&lb, a->leak_bin, a->occ_bin);
+                if (pass)
+                    continue;
+                n_used++;
+                o->visible += a->vis;
+                o->occluded += a->occ;
+                o->occluded_binary += a->occ_bin;
+                ringing += a->ringing;
+                mae[nm] = a->mae / a->n;
+                items[nm].key = mae[nm];
+                items[nm].index = i;
+                nm++;
             }
         }
         o->samples = (uint64_t)sq.b;

@@ -121,12 +121,9 @@ static int tile_pixel(const pass *P, int width, int height, uint32_t t, int k, i
 
 static void ray_reset(struct RTCRayHit16 *rh, int k)
 {
-    rh->ray.org_x[k] = rh->ray.org_y[k] = rh->ray.org_z[k] = 0.0f;
+    static const float zero[3] = {0.0f, 0.0f, 0.0f};
+    vb_ray16_init(rh, k, zero, 0.0f);
     rh->ray.dir_x[k] = 0.0f, rh->ray.dir_y[k] = 0.0f, rh->ray.dir_z[k] = 1.0f;
-    rh->ray.tnear[k] = 0.0f, rh->ray.tfar[k] = 0.0f, rh->ray.time[k] = 0.0f;
-    rh->ray.mask[k] = 0xffffffffu, rh->ray.id[k] = (unsigned)k, rh->ray.flags[k] = 0;
-    rh->hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-    rh->hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
 }
 
 static void primary_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
@@ -810,12 +807,7 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
         float o[3];
         vb_scene_to_local(rs, eye, o);
         struct RTCRayHit rh;
-        rh.ray.org_x = o[0], rh.ray.org_y = o[1], rh.ray.org_z = o[2];
-        rh.ray.dir_x = dir[0], rh.ray.dir_y = dir[1], rh.ray.dir_z = dir[2];
-        rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.time = 0.0f;
-        rh.ray.mask = 0xffffffffu, rh.ray.id = 0, rh.ray.flags = 0;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        vb_ray_init(&rh, o, dir, INFINITY, 0);
         rtcIntersect1(rs->scene, &ictx, &rh);
         if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
             continue;

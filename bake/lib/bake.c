@@ -693,17 +693,7 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
                             ok[k] = 0;
                     }
                     any |= ok[k];
-                    r->ray.org_x[k] = org[0];
-                    r->ray.org_y[k] = org[1];
-                    r->ray.org_z[k] = org[2];
-                    r->ray.tnear[k] = 0.0f;
-                    r->ray.tfar[k] = J->max_local;
-                    r->ray.time[k] = 0.0f;
-                    r->ray.mask[k] = 0xffffffffu;
-                    r->ray.id[k] = (unsigned)k;
-                    r->ray.flags[k] = 0;
-                    r->hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-                    r->hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+                    vb_ray16_init(r, k, org, J->max_local);
                 }
                 if (!any)
                     continue;

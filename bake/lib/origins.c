@@ -330,11 +330,7 @@ static void probe_packet(const prober *J, const float o[3], const float n[3], fl
         rh->ray.dir_x[k] = l[0] * t[0] + l[1] * b[0] + sz * l[2] * n[0];
         rh->ray.dir_y[k] = l[0] * t[1] + l[1] * b[1] + sz * l[2] * n[1];
         rh->ray.dir_z[k] = l[0] * t[2] + l[1] * b[2] + sz * l[2] * n[2];
-        rh->ray.org_x[k] = o[0], rh->ray.org_y[k] = o[1], rh->ray.org_z[k] = o[2];
-        rh->ray.tnear[k] = 0.0f, rh->ray.tfar[k] = tfar, rh->ray.time[k] = 0.0f;
-        rh->ray.mask[k] = 0xffffffffu, rh->ray.id[k] = (unsigned)k, rh->ray.flags[k] = 0;
-        rh->hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-        rh->hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        vb_ray16_init(rh, k, o, tfar);
         valid[k] = -1;
     }
 }
@@ -365,14 +361,9 @@ static short_result short_probe(const prober *J, const float o[3], const float n
         collect_init(&C);
         probe_packet(J, o, n, side ? -1.0f : 1.0f, near, &rh, valid);
         for (int k = 0; k < PROBES; k++) {
+            const float d[3] = {rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]};
             struct RTCRayHit r1;
-            r1.ray.org_x = o[0], r1.ray.org_y = o[1], r1.ray.org_z = o[2];
-            r1.ray.dir_x = rh.ray.dir_x[k], r1.ray.dir_y = rh.ray.dir_y[k];
-            r1.ray.dir_z = rh.ray.dir_z[k];
-            r1.ray.tnear = 0.0f, r1.ray.tfar = near, r1.ray.time = 0.0f;
-            r1.ray.mask = 0xffffffffu, r1.ray.id = (unsigned)k, r1.ray.flags = 0;
-            r1.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            r1.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            vb_ray_init(&r1, o, d, near, (unsigned)k);
             rtcIntersect1(J->s->scene, &C.ctx, &r1);
             (*rays)++;
             int c = classify(C.tf[k], C.tb[k]);
@@ -824,12 +815,7 @@ static int first_face(const prober *J, const float o[3], const float d[3], uint6
 {
     (*rays)++;
     struct RTCRayHit rh;
-    rh.ray.dir_x = d[0], rh.ray.dir_y = d[1], rh.ray.dir_z = d[2];
-    rh.ray.org_x = o[0], rh.ray.org_y = o[1], rh.ray.org_z = o[2];
-    rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.time = 0.0f;
-    rh.ray.mask = 0xffffffffu, rh.ray.id = 0, rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    vb_ray_init(&rh, o, d, INFINITY, 0);
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     rtcIntersect1(J->s->scene, &ctx, &rh);

@@ -184,12 +184,7 @@ static void cast_probes(const vb_scene *s, const float p[3], float t[VDSH_FREE_P
     rtcInitIntersectContext(&ctx);
     for (int i = 0; i < VDSH_FREE_PROBES; i++) {
         struct RTCRayHit rh;
-        rh.ray.org_x = o[0], rh.ray.org_y = o[1], rh.ray.org_z = o[2];
-        rh.ray.dir_x = dirs[i][0], rh.ray.dir_y = dirs[i][1], rh.ray.dir_z = dirs[i][2];
-        rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.time = 0.0f;
-        rh.ray.mask = 0xffffffffu, rh.ray.id = 0, rh.ray.flags = 0;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        vb_ray_init(&rh, o, dirs[i], INFINITY, 0);
         rtcIntersect1(s->scene, &ctx, &rh);
         t[i] = INFINITY, back[i] = 0;
         if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
@@ -245,10 +240,10 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
                                      vb_light_rule rule, float (*out)[3], uint32_t *tried,
                                      vb_error *err)
 {
-    if (rule == VB_LIGHTS_UNIFORM)
-        return vb_scene_place_lights(s, seed, count, out, tried, err);
     if ((unsigned)rule > VB_LIGHTS_PATH)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown light rule %d", (int)rule);
+    if (rule == VB_LIGHTS_UNIFORM) /* the runtime's placement too */
+        return vb_scene_place_lights(s, seed, count, out, tried, err);
     float lo[3], hi[3];
     const int grown = vb_scene_light_region(s, lo, hi, NULL);
     uint32_t n = 0, k = 0;

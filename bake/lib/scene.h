@@ -29,18 +29,22 @@
 extern "C" {
 #endif
 
+/* robust 1: RTC_SCENE_FLAG_ROBUST (default 0); threads: Embree's build
+ * threads (0: all cores). */
 typedef struct vb_scene_desc {
-    int robust;       /* 1: RTC_SCENE_FLAG_ROBUST (default 0) */
-    unsigned threads; /* Embree build threads; 0 = all cores */
+    int robust;
+    unsigned threads;
 } vb_scene_desc;
 
+/* The traced frame is (p - centre) * scale, scale a power of two; the
+ * bounds and their diagonal are the occluders', in scene units. */
 typedef struct vb_scene {
     RTCDevice device;
     RTCScene scene;
-    float centre[3];                    /* subtracted before scaling */
-    float scale;                        /* power of two */
-    float bounds_min[3], bounds_max[3]; /* occluders, scene units */
-    float diagonal;                     /* of the bounds, scene units */
+    float centre[3];
+    float scale;
+    float bounds_min[3], bounds_max[3];
+    float diagonal;
     uint32_t vertex_count, triangle_count;
     /* The traced triangles (local frame), Embree's buffers, alive with the
      * scene: the free-space test measures its probes' hits on them itself. */
@@ -58,6 +62,30 @@ static inline void vb_scene_to_local(const vb_scene *s, const float p[3], float 
 {
     for (int i = 0; i < 3; i++)
         out[i] = (p[i] - s->centre[i]) * s->scale;
+}
+
+/* A ray from o along d over [0, tfar] (traced frame), with no hit yet:
+ * every field Embree reads is set. */
+static inline void vb_ray_init(struct RTCRayHit *rh, const float o[3], const float d[3], float tfar,
+                               unsigned id)
+{
+    rh->ray.org_x = o[0], rh->ray.org_y = o[1], rh->ray.org_z = o[2];
+    rh->ray.dir_x = d[0], rh->ray.dir_y = d[1], rh->ray.dir_z = d[2];
+    rh->ray.tnear = 0.0f, rh->ray.tfar = tfar, rh->ray.time = 0.0f;
+    rh->ray.mask = 0xffffffffu, rh->ray.id = id, rh->ray.flags = 0;
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
+/* Ray k of a packet from o over [0, tfar] (traced frame), id k, with no
+ * hit yet; its direction is the caller's to set. */
+static inline void vb_ray16_init(struct RTCRayHit16 *rh, int k, const float o[3], float tfar)
+{
+    rh->ray.org_x[k] = o[0], rh->ray.org_y[k] = o[1], rh->ray.org_z[k] = o[2];
+    rh->ray.tnear[k] = 0.0f, rh->ray.tfar[k] = tfar, rh->ray.time[k] = 0.0f;
+    rh->ray.mask[k] = 0xffffffffu, rh->ray.id[k] = (unsigned)k, rh->ray.flags[k] = 0;
+    rh->hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
 }
 
 /* A ray origin just off the surface at local point p along unit normal n

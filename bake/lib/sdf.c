@@ -135,12 +135,7 @@ static float sample_at(const job *J, uint32_t i, uint32_t j, uint32_t k)
     rtcInitIntersectContext(&ic);
     for (int r = 0; r < VDSH_FREE_PROBES; r++) {
         struct RTCRayHit rh;
-        memset(&rh, 0, sizeof rh);
-        rh.ray.org_x = o[0], rh.ray.org_y = o[1], rh.ray.org_z = o[2];
-        rh.ray.dir_x = J->dirs[r][0], rh.ray.dir_y = J->dirs[r][1], rh.ray.dir_z = J->dirs[r][2];
-        rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.mask = 0xffffffffu;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        vb_ray_init(&rh, o, J->dirs[r], INFINITY, 0);
         rtcIntersect1(J->s->scene, &ic, &rh);
         if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
             continue;
