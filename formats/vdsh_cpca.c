@@ -385,18 +385,80 @@ typedef struct lightmix {
     double a;
     uint32_t nl;
     const float *lights, *pos; /* nl x 3, rows x 3 */
-    uint32_t *tex;             /* nl: scratch */
+    /* Every row's texels of its lights above its horizon, in pool order,
+     * on the fit's cube (fit) and the refinement's (ref), found once by
+     * lightmix_load: row v's at at[v]..at[v + 1], for the rows v < cached
+     * (the first that fit in LIGHT_CACHE texels); the later rows' are
+     * found again at every use, into the scratch at at[cached]. */
+    uint32_t cached;
+    size_t *at;
+    uint16_t *fit, *ref;
 } lightmix;
+
+/* The most texels lightmix_load keeps (x 4 bytes): 256 MiB, the rows of
+ * about 2^16 receivers with half a 2048-light pool above each horizon. */
+#define LIGHT_CACHE ((size_t)1 << 26)
 
 static void lightmix_free(lightmix *lm)
 {
-    free(lm->tex);
+    free(lm->at);
+    free(lm->fit);
+    free(lm->ref);
     memset(lm, 0, sizeof *lm);
 }
 
-/* lm from the settings: 1 when on, 0 when off (lm zeroed), -1 out of
- * memory. */
-static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st)
+/* The face of direction d (not 0) on metric_init's cube and the texel's
+ * coordinates on that face, u, v in -1..1. */
+static uint32_t cube_face(const double d[3], double *u, double *v)
+{
+    double ax = fabs(d[0]), ay = fabs(d[1]), az = fabs(d[2]);
+    uint32_t axis = ax >= ay && ax >= az ? 0u : ay >= az ? 1u : 2u;
+    double m = fabs(d[axis]);
+    *u = d[(axis + 1) % 3] / m;
+    *v = d[(axis + 2) % 3] / m;
+    return axis * 2u + (d[axis] < 0.0);
+}
+
+/* The texel at u, v of a face of a cube of cube_n (metric_init's layout). */
+static uint16_t cube_texel(uint32_t face, double u, double v, uint32_t cube_n)
+{
+    double fi = (u + 1.0) * 0.5 * cube_n, fj = (v + 1.0) * 0.5 * cube_n;
+    uint32_t i = fi <= 0.0 ? 0u : fi >= cube_n ? cube_n - 1u : (uint32_t)fi;
+    uint32_t j = fj <= 0.0 ? 0u : fj >= cube_n ? cube_n - 1u : (uint32_t)fj;
+    return (uint16_t)((face * cube_n + j) * cube_n + i);
+}
+
+/* Whether light l is above the horizon of the vertex at p with normal nv;
+ * d its direction from p. */
+static int light_above(const lightmix *lm, uint32_t l, const float *p, const float *nv, double d[3])
+{
+    const float *q = lm->lights + 3 * (size_t)l;
+    for (int i = 0; i < 3; i++)
+        d[i] = (double)q[i] - p[i];
+    return d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0;
+}
+
+/* Row v's texels (normal nv) into fit and ref from slot at: their count. */
+static uint32_t row_texels(const lightmix *lm, uint32_t v, const float *nv, size_t at)
+{
+    const float *p = lm->pos + 3 * (size_t)v;
+    uint32_t t = 0;
+    for (uint32_t l = 0; l < lm->nl; l++) {
+        double d[3], u, w;
+        if (!light_above(lm, l, p, nv, d))
+            continue;
+        uint32_t face = cube_face(d, &u, &w);
+        lm->fit[at + t] = cube_texel(face, u, w, CUBE_N);
+        lm->ref[at + t] = cube_texel(face, u, w, REFINE_CUBE_N);
+        t++;
+    }
+    return t;
+}
+
+/* lm from the settings, the rows' texels found (normals, rows x 3): 1 when
+ * on, 0 when off (lm zeroed), -1 out of memory. */
+static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float *normals,
+                         uint32_t rows)
 {
     memset(lm, 0, sizeof *lm);
     if (!st || !(st->light_mix > 0.0f) || !st->light_count || !st->lights || !st->positions)
@@ -405,37 +467,39 @@ static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st)
     lm->nl = st->light_count;
     lm->lights = st->lights;
     lm->pos = st->positions;
-    lm->tex = malloc(sizeof(uint32_t) * lm->nl);
-    return lm->tex ? 1 : -1;
-}
-
-/* The texel of direction d on a cube of cube_n (metric_init's layout). */
-static uint32_t cube_texel(const double d[3], uint32_t cube_n)
-{
-    double ax = fabs(d[0]), ay = fabs(d[1]), az = fabs(d[2]);
-    uint32_t axis = ax >= ay && ax >= az ? 0u : ay >= az ? 1u : 2u;
-    double m = fabs(d[axis]);
-    uint32_t face = axis * 2u + (d[axis] < 0.0);
-    double u = d[(axis + 1) % 3] / m, v = d[(axis + 2) % 3] / m;
-    double fi = (u + 1.0) * 0.5 * cube_n, fj = (v + 1.0) * 0.5 * cube_n;
-    uint32_t i = fi <= 0.0 ? 0u : fi >= cube_n ? cube_n - 1u : (uint32_t)fi;
-    uint32_t j = fj <= 0.0 ? 0u : fj >= cube_n ? cube_n - 1u : (uint32_t)fj;
-    return (face * cube_n + j) * cube_n + i;
-}
-
-/* The texels of m of the pool's lights above vertex v's horizon (normal
- * nv), in lm->tex; their count returned. */
-static uint32_t light_texels(lightmix *lm, uint32_t v, const float *nv, const metric_dirs *m)
-{
-    const float *p = lm->pos + 3 * (size_t)v;
-    uint32_t t = 0;
-    for (uint32_t l = 0; l < lm->nl; l++) {
-        const float *q = lm->lights + 3 * (size_t)l;
-        double d[3] = {(double)q[0] - p[0], (double)q[1] - p[1], (double)q[2] - p[2]};
-        if (!(d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0))
-            continue;
-        lm->tex[t++] = cube_texel(d, m->cube_n);
+    if (!(lm->at = malloc(sizeof(size_t) * ((size_t)rows + 1))))
+        return -1;
+    lm->at[0] = 0;
+    for (; lm->cached < rows; lm->cached++) { /* the rows kept, and where */
+        const uint32_t v = lm->cached;
+        const float *p = lm->pos + 3 * (size_t)v, *nv = normals + 3 * (size_t)v;
+        uint32_t t = 0;
+        for (uint32_t l = 0; l < lm->nl; l++) {
+            double d[3];
+            t += (uint32_t)light_above(lm, l, p, nv, d);
+        }
+        if (lm->at[v] + t > LIGHT_CACHE)
+            break;
+        lm->at[v + 1] = lm->at[v] + t;
     }
+    const size_t size = lm->at[lm->cached] + (lm->cached < rows ? lm->nl : 0);
+    lm->fit = malloc(sizeof(uint16_t) * size + 1);
+    lm->ref = malloc(sizeof(uint16_t) * size + 1);
+    if (!lm->fit || !lm->ref)
+        return -1;
+    for (uint32_t v = 0; v < lm->cached; v++)
+        row_texels(lm, v, normals + 3 * (size_t)v, lm->at[v]);
+    return 1;
+}
+
+/* Row v's texels on the fit's cube (ref 0) or the refinement's (1) in
+ * *tex; their count returned. */
+static uint32_t light_texels(const lightmix *lm, uint32_t v, const float *nv, int ref,
+                             const uint16_t **tex)
+{
+    size_t at = lm->at[v < lm->cached ? v : lm->cached];
+    uint32_t t = v < lm->cached ? (uint32_t)(lm->at[v + 1] - at) : row_texels(lm, v, nv, at);
+    *tex = (ref ? lm->ref : lm->fit) + at;
     return t;
 }
 
@@ -460,12 +524,13 @@ static void metric_gram_members(const metric_dirs *m, const float *normals, cons
         const float *nv = normals + 3 * (size_t)v;
         double a = nv[0], b = nv[1], e = nv[2], u = 1.0;
         if (lm) { /* (1 - a) uniform + a light density */
-            const uint32_t t = light_texels(lm, v, nv, m);
+            const uint16_t *tex;
+            const uint32_t t = light_texels(lm, v, nv, 0, &tex);
             if (t) {
                 const double sum = (double)t;
                 u = 1.0 - lm->a;
                 for (uint32_t i = 0; i < t; i++)
-                    frac[lm->tex[i]] += lm->a * TWO_PI / (sum * m->w[lm->tex[i]]);
+                    frac[tex[i]] += lm->a * TWO_PI / (sum * m->w[tex[i]]);
             }
         }
         for (uint32_t d = 0; d < m->count; d++) {
@@ -887,15 +952,16 @@ static uint32_t vertex_hemisphere(const fit_ctx *f, refine_ctx *r, uint32_t v)
         r->xval[d] = s;
     }
     if (r->dw) { /* (1 - a) uniform + a light density */
-        lightmix *lm = f->lm;
-        const uint32_t t = light_texels(lm, v, nv, &r->rd);
+        const lightmix *lm = f->lm;
+        const uint16_t *tex;
+        const uint32_t t = light_texels(lm, v, nv, 1, &tex);
         const double sum = (double)t;
         for (uint32_t h = 0; h < nh; h++)
             r->dw[r->hemi[h]] = t ? 1.0 - lm->a : 1.0;
         for (uint32_t i = 0; i < t; i++) {
-            const double *dd = r->rd.dir + 3 * (size_t)lm->tex[i];
+            const double *dd = r->rd.dir + 3 * (size_t)tex[i];
             if (dd[0] * nv[0] + dd[1] * nv[1] + dd[2] * nv[2] > 0.0)
-                r->dw[lm->tex[i]] += lm->a * TWO_PI / (sum * r->rd.w[lm->tex[i]]);
+                r->dw[tex[i]] += lm->a * TWO_PI / (sum * r->rd.w[tex[i]]);
         }
     }
     return nh;
@@ -1044,7 +1110,7 @@ static int fit_scratch_alloc(fit_scratch *s, const float *src, const float *norm
     s->mu = malloc(sizeof(double) * n);
     s->dist = malloc(sizeof(double) * rows);
     s->cent = malloc(sizeof(double) * k * (n + 3));
-    const int lm = lightmix_load(&s->lm, light);
+    const int lm = lightmix_load(&s->lm, light, normals, rows);
     if (lm < 0)
         return 0;
     f->lm = lm ? &s->lm : NULL;
