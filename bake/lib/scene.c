@@ -283,8 +283,8 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
     return VB_OK;
 }
 
-vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
-                                uint32_t *tried, vb_error *err)
+static vb_result place_uniform(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
+                               uint32_t *tried, uint32_t first, int *first_ok, vb_error *err)
 {
     /* Give up when a thousand candidates per light find no room: a scene
      * without free space (a solid, or everything closer than clearance). */
@@ -292,11 +292,17 @@ vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count
     const int grown = vb_scene_light_region(s, lo, hi, NULL);
     uint32_t n = 0, k = 0;
     const uint64_t limit = vdsh_light_tries(count, grown);
+    const uint64_t first_limit = vdsh_light_tries(first, grown);
+    if (first_ok)
+        *first_ok = 0;
     while (n < count && k < limit) {
         float p[3];
         vdsh_light_candidate(lo, hi, seed, k++, p);
-        if (vb_scene_free_space(s, p))
+        if (vb_scene_free_space(s, p)) {
             memcpy(out[n++], p, sizeof out[0]);
+            if (n == first && first_ok) /* placing `first` would stop here */
+                *first_ok = k <= first_limit;
+        }
     }
     if (tried)
         *tried = k;
@@ -307,4 +313,16 @@ vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count
                        k - n, k, vb_s(k), region_name(grown), k - n == 1 ? "was" : "were",
                        (double)vdsh_free_clearance(s->diagonal));
     return VB_OK;
+}
+
+vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
+                                uint32_t *tried, vb_error *err)
+{
+    return place_uniform(s, seed, count, out, tried, 0, NULL, err);
+}
+
+vb_result vb_scene_place_pool(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
+                              uint32_t first, int *first_ok, vb_error *err)
+{
+    return place_uniform(s, seed, count, out, NULL, first, first_ok, err);
 }
