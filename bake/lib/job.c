@@ -367,19 +367,9 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         f.has_part = 1;
         f.part = (vdsh_part){
             .index = d->shard_index, .count = d->shard_count, .encoding = job_encoding(d)};
-        if (job_encoding(d) == VDSH_ENCODING_CPCA) {
-            /* auto: 0, budget, 0; K,alloc:BYTES: K, budget, 0 (VDSH.md
-             * "Parts") */
+        if (job_encoding(d) == VDSH_ENCODING_CPCA) { /* the pool for the merge */
             vdsh_cpca_settings st = job_cpca(j, d);
-            f.part.cpca_clusters = st.clusters;
-            f.part.cpca_basis = st.budget ? st.budget : st.basis;
-            f.part.cpca_bits = st.budget ? 0 : st.bits;
-            if (st.light_mix > 0.0f &&
-                st.light_count) { /* the pool for the merge (VDSH.md `lpol`) */
-                f.has_light_pool = 1;
-                f.light_pool = (vdsh_light_pool){
-                    .mix = st.light_mix, .count = st.light_count, .lights = st.lights};
-            }
+            vdsh_cpca_part_record(&st, &f);
         }
         vb_shard_range(h->vertex_count, d->shard_index, d->shard_count, &f.part.range_begin,
                        &f.part.range_end);
