@@ -117,8 +117,8 @@ typedef struct vdsh_cpca_fit {
  * (vdsh_cpca_study.h's allocation; VDSH.md "cpca streams"), vectors of
  * width 0 dropped: model.bits 0 and model.widths set.
  * With the light-density metric, each row's texels of the pool's lights
- * above its horizon are found once and kept for the whole encode (4 bytes
- * per light; at most 256 MiB, the rows past that found again at every
+ * above its horizon are found once and kept for the whole encode (2 bytes
+ * per light; at most 128 MiB, the rows past that found again at every
  * pass): docs/BENCHMARKS.md "cpca light-density metric: encode time".
  * VDSH_ERR_ARGUMENT for bad settings, order or rows; VDSH_ERR_INVALID for
  * a value that is not finite or a model that does not fit f16;
