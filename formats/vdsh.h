@@ -239,11 +239,12 @@ typedef struct vdsh_cpca {
 #define VDSH_CPCA_MIN_BITS 2
 #define VDSH_CPCA_MAX_BITS 8
 #define VDSH_CPCA_INDEX_BITS 8
-/* The baker's defaults (vdsh-bake --cpca K,B,BITS): docs/ACCURACY.md. */
-#define VDSH_CPCA_DEFAULT_CLUSTERS 8
-#define VDSH_CPCA_DEFAULT_BASIS 54
-#define VDSH_CPCA_DEFAULT_BITS 4
-/* --cpca auto[:BYTES]: bytes per vertex, the model included */
+/* The baker's default (vdsh-bake --encoding cpca without --cpca):
+ * K,alloc:BYTES with K = VDSH_CPCA_DEFAULT_CLUSTERS and BYTES =
+ * VDSH_CPCA_DEFAULT_BUDGET, 16,alloc:32 (docs/ACCURACY.md "The default
+ * of --encoding cpca"); before, the fixed 8,54,4. */
+#define VDSH_CPCA_DEFAULT_CLUSTERS 16
+/* --cpca auto[:BYTES] and the default: bytes per vertex, the model included */
 #define VDSH_CPCA_DEFAULT_BUDGET 32
 #define VDSH_CPCA_MAX_BUDGET 4096
 

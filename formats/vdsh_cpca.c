@@ -33,14 +33,8 @@ enum {
 
 vdsh_cpca_settings vdsh_cpca_settings_default(void)
 {
-    vdsh_cpca_settings s = {VDSH_CPCA_DEFAULT_CLUSTERS,
-                            VDSH_CPCA_DEFAULT_BASIS,
-                            VDSH_CPCA_DEFAULT_BITS,
-                            0,
-                            0.0f,
-                            0,
-                            NULL,
-                            NULL};
+    vdsh_cpca_settings s = {VDSH_CPCA_DEFAULT_CLUSTERS,  0, 0,    VDSH_CPCA_DEFAULT_BUDGET,
+                            VDSH_CPCA_DEFAULT_LIGHT_MIX, 0, NULL, NULL};
     return s;
 }
 
@@ -1563,13 +1557,16 @@ static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t
     st.basis = 0;
     st.bits = 4;
     st.budget = 0;
-    st.basis = largest_basis(rows, order, &st, limit);
+    /* K is a most: a model too large for the budget halves it (16, 8, ...,
+     * 1), so a small mesh still fits; only one no single cluster fits fails. */
+    while (!(st.basis = largest_basis(rows, order, &st, limit)) && st.clusters > 1)
+        st.clusters /= 2;
     if (!st.basis)
         return vdsh_failf(err, VDSH_ERR_ARGUMENT,
                           "cpca: alloc budget %u byte%s per vertex too small for %u row%s of order "
-                          "%u at %u cluster%s",
-                          settings->budget, vdsh_s(settings->budget), rows, vdsh_s(rows), order,
-                          st.clusters, vdsh_s(st.clusters));
+                          "%u, even at 1 cluster (give more bytes or fixed K,B,BITS: --cpca "
+                          "8,54,4)",
+                          settings->budget, vdsh_s(settings->budget), rows, vdsh_s(rows), order);
     uint32_t fb = 2 * st.basis < n ? 2 * st.basis : n;
     vdsh_cpca_widths_fit wf;
     return encode_widths(src, normals, rows, order, &st, fb, (double)settings->budget, NULL, NULL,

@@ -72,25 +72,32 @@ typedef struct vdsh_cpca_settings {
 } vdsh_cpca_settings;
 
 /* The light mix vdsh_cpca_parse gives when the text does not say, for
- * the byte-budget settings (K,alloc:BYTES and auto): the light density
- * alone (docs/ACCURACY.md "A light-density metric": `8,alloc:32` over ten
- * validation bakes +4.40% -> +2.47% over uncompressed order 12). The
- * fixed K,B,BITS settings (the default 8,54,4 among them) keep the
- * uniform hemisphere, 0: with fixed widths the metric lost 0.3 points on
- * the mean of eight validation bakes (fandisk -4.7, the teapot -3.5).
- * vdsh_cpca_encode needs the pool too: without one the metric is uniform. */
+ * the byte-budget settings (K,alloc:BYTES and auto, the default among
+ * them): the light density alone (docs/ACCURACY.md "A light-density
+ * metric": `8,alloc:32` over ten validation bakes +4.40% -> +2.47% over
+ * uncompressed order 12). The fixed K,B,BITS settings (8,54,4, the
+ * default before, among them) keep the uniform hemisphere, 0: with fixed
+ * widths the metric lost 0.3 points on the mean of eight validation bakes
+ * (fandisk -4.7, the teapot -3.5). vdsh_cpca_encode needs the pool too:
+ * without one the metric is uniform. */
 #define VDSH_CPCA_DEFAULT_LIGHT_MIX 1.0f
 
-/* K = 8, B = 54, 4 bits, light mix 0, no pool
- * (docs/ACCURACY.md "Compressed high orders"). */
+/* K,alloc:BYTES with K = VDSH_CPCA_DEFAULT_CLUSTERS (16) and BYTES =
+ * VDSH_CPCA_DEFAULT_BUDGET (32), light mix VDSH_CPCA_DEFAULT_LIGHT_MIX,
+ * no pool (docs/ACCURACY.md "The default of --encoding cpca": over sixteen
+ * validation bakes +1.68% over uncompressed order 12, within 3% on 14,
+ * against 8,alloc:32's +2.05% and 11; 8,54,4, the default before, passed
+ * 32 bytes per vertex below about 32,000 receivers). A mesh too small for
+ * the model within 32 bytes per vertex (a few hundred receivers at order
+ * 12) is refused by vdsh_cpca_encode: give fixed K,B,BITS there. */
 vdsh_cpca_settings vdsh_cpca_settings_default(void);
 
 /* Parse "K,B,BITS" (for example "8,54,4"), "auto" (budget 32),
  * "auto:BYTES" (1..VDSH_CPCA_MAX_BUDGET) or "K,alloc:BYTES", each with an
  * optional ",light:A" (A in 0..1, the light mix; else
  * VDSH_CPCA_DEFAULT_LIGHT_MIX for auto and alloc, 0 for K,B,BITS), or
- * "light:A" alone (the default K, B, bits
- * with that mix) into *out (no pool: the caller sets it); VDSH_ERR_ARGUMENT
+ * "light:A" alone (the default settings, vdsh_cpca_settings_default's
+ * K and budget, with that mix) into *out (no pool: the caller sets it); VDSH_ERR_ARGUMENT
  * with a message for a malformed string or a value out of range. */
 vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_error *err);
 
@@ -113,7 +120,8 @@ typedef struct vdsh_cpca_fit {
  * vertex's own hemisphere (the refinement's error; first in that order on
  * a tie). VDSH_ERR_ARGUMENT when none fits the budget. With K and a
  * budget (alloc): K, B refined as above with the largest B whose 4-bit
- * records and model fit, then a width per vector over min(2B, n) vectors
+ * records and model fit (K halved while no B fits; VDSH_ERR_ARGUMENT when
+ * none fits at K = 1), then a width per vector over min(2B, n) vectors
  * (vdsh_cpca_study.h's allocation; VDSH.md "cpca streams"), vectors of
  * width 0 dropped: model.bits 0 and model.widths set.
  * With the light-density metric, each row's texels of the pool's lights

@@ -2,12 +2,13 @@
  * vdsh_failf.h - internal to the formats library (not installed): write a
  * printf-style message into err (when not NULL) and return r. The one
  * message helper of the library (vdsh_output.c and vdsh.c hold them), and
- * vdsh_s for plurals.
+ * vdsh_plural.h for plurals.
  */
 #ifndef VDSH_FAILF_H
 #define VDSH_FAILF_H
 
 #include "vdsh.h"
+#include "vdsh_plural.h"
 
 #if defined(__GNUC__)
 __attribute__((format(printf, 3, 4)))
@@ -23,11 +24,6 @@ __attribute__((format(printf, 4, 5)))
 vdsh_result
 vdsh_failf_at(vdsh_error *err, vdsh_result r, const char *name, const char *fmt, ...);
 
-/* Plurals in messages, as tools/vt_cli.h's vt_s: "%u byte%s", n,
- * vdsh_s(n) says "1 byte", "2 bytes". */
-static inline const char *vdsh_s(unsigned long long n)
-{
-    return n == 1 ? "" : "s";
-}
+/* Plurals in messages: vdsh_plural.h (vdsh_s, vdsh_plural). */
 
 #endif

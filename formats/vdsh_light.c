@@ -2,6 +2,7 @@
 #include "vdsh_light.h"
 
 #include <math.h>
+#include <string.h>
 
 void vdsh_free_probe_dirs(float dirs[VDSH_FREE_PROBES][3])
 {
@@ -93,4 +94,25 @@ uint64_t vdsh_light_tries(uint32_t count, int grown)
 {
     const uint64_t per_light = 1000ull * (count ? count : 1);
     return grown ? VDSH_REGION_TRIES + per_light : per_light;
+}
+
+uint32_t vdsh_light_place(const float lo[3], const float hi[3], int grown, uint64_t seed,
+                          uint32_t count, vdsh_free_fn is_free, const void *ctx, float (*out)[3],
+                          uint32_t *out_k, uint32_t *tried)
+{
+    const uint64_t limit = vdsh_light_tries(count, grown);
+    uint32_t n = 0, k = 0;
+    while (n < count && k < limit) {
+        float p[3];
+        vdsh_light_candidate(lo, hi, seed, k, p);
+        if (is_free(ctx, p)) {
+            if (out_k)
+                out_k[n] = k;
+            memcpy(out[n++], p, sizeof p);
+        }
+        k++;
+    }
+    if (tried)
+        *tried = k;
+    return n;
 }

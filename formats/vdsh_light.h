@@ -36,7 +36,7 @@
  * keeps its bounds: its lights are the ones placed before the rule. n is
  * a count of free-space decisions, the same under every Embree kernel set
  * (docs/DESIGN.md, "Across CPUs"), and the share a function of it alone.
- * Placement gives up after 1000 candidates per light (and
+ * Placement (vdsh_light_place) gives up after 1000 candidates per light (and
  * VDSH_REGION_TRIES more in a grown region): a scene whose own free space
  * is small and enclosed (an inside-out object, a crowded interior, under
  * 25% of its box free) may be grown, and its lights are still found only
@@ -101,6 +101,18 @@ int vdsh_light_region(const float lo[3], const float hi[3], vdsh_free_fn is_free
 /* The most candidates a placement of count lights tries: 1000 per light
  * in the bounds, VDSH_REGION_TRIES more in a grown region. */
 uint64_t vdsh_light_tries(uint32_t count, int grown);
+
+/* Lights placed uniformly in free space: candidates k = 0, 1, ... of seed
+ * (vdsh_light_candidate in the region lo..hi) that pass is_free(ctx, p),
+ * in sequence order, into out[0..count), until count are found or
+ * vdsh_light_tries(count, grown) were tried. The one placement of the
+ * bake side (bake/lib/scene.c) and of the runtime's light pool
+ * (runtime/vr_view.c: it gave up at 256 candidates per light where the
+ * baker tried 1000). Returns how many were placed; *tried (may be NULL)
+ * the candidates tried; out_k (may be NULL) each one's candidate index. */
+uint32_t vdsh_light_place(const float lo[3], const float hi[3], int grown, uint64_t seed,
+                          uint32_t count, vdsh_free_fn is_free, const void *ctx, float (*out)[3],
+                          uint32_t *out_k, uint32_t *tried);
 
 #ifdef __cplusplus
 }

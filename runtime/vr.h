@@ -468,8 +468,8 @@ enum { VR_MAX_POOL_LIGHTS = 64 };
  * the candidates of vdsh_light_candidate (seed 1) in the light region
  * (vdsh_light_region: the bounds, or the bounds grown around a closed
  * or nearly closed object) that pass vdsh_view_free_space against the drawn mesh, in
- * sequence order, at most 256 tried per position in the bounds
- * (vdsh_light_tries in a grown region); deterministic. Colours and attenuations are
+ * sequence order (vdsh_light_place, the bake side's placement: at most
+ * vdsh_light_tries candidates, 1000 per position in the bounds); deterministic. Colours and attenuations are
  * left zero. */
 int vr_scene_pool_lights(const vr_scene *s, vr_light *out, int max);
 

@@ -11,6 +11,7 @@
 
 #include "vdsh_scene_view.h"
 #include "vdsh_sdf.h"
+#include "vdsh_plural.h"
 #include "vr.h"
 
 /* Format a message into err (if not NULL) and return r. */
@@ -20,11 +21,7 @@ __attribute__((format(printf, 3, 4)))
 vr_result
 vr_fail(vr_error *err, vr_result r, const char *fmt, ...);
 
-/* Plurals in messages: vr_plural(n, "vertex", "vertices"). */
-static inline const char *vr_plural(unsigned long long n, const char *one, const char *many)
-{
-    return n == 1 ? one : many;
-}
+/* Plurals in messages: formats/vdsh_plural.h (vdsh_s, vdsh_plural). */
 
 /* VR_OK when glGetError reports nothing; else VR_ERR_GL naming `what`.
  * Drains every pending error so that the next check starts clean. */

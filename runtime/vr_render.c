@@ -565,7 +565,7 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                        (double)d.sdf_k);
     if (d.light_count < 0 || (d.light_count > 0 && !d.lights))
         return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: %d light%s but no array", d.light_count,
-                       vr_plural((unsigned long long)d.light_count, "", "s"));
+                       vdsh_plural((unsigned long long)d.light_count, "", "s"));
     for (int i = 0; i < d.light_count; i++)
         if (!finite3(d.lights[i].position) || !finite3(d.lights[i].color) ||
             !finite3(d.lights[i].attenuation))

@@ -33,8 +33,8 @@ vr_result vr_sdf_load(vr_scene *s, const vr_scene_desc *desc, uint32_t vertex_co
         return vr_fail(err, VR_ERR_FORMAT,
                        "%s: the distance volume was baked beside a scene "
                        "of %u %s and %u %s, not this one (%u, %u): bake it again",
-                       path, v.vertex_count, vr_plural(v.vertex_count, "vertex", "vertices"),
-                       v.triangle_count, vr_plural(v.triangle_count, "triangle", "triangles"),
+                       path, v.vertex_count, vdsh_plural(v.vertex_count, "vertex", "vertices"),
+                       v.triangle_count, vdsh_plural(v.triangle_count, "triangle", "triangles"),
                        vertex_count, triangle_count);
     }
     GLint max3d = 0;

@@ -85,13 +85,10 @@ vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count, c
     float lo[3], hi[3];
     const int grown =
         vdsh_light_region(s->bounds_min, s->bounds_max, pool_is_free, &c, lo, hi, NULL);
-    const uint64_t limit = grown ? vdsh_light_tries((uint32_t)count, 1) : 256u * (uint64_t)count;
-    for (uint32_t k = 0; s->pool_count < count && k < limit; k++) {
-        float p[3];
-        vdsh_light_candidate(lo, hi, 1, k, p);
-        if (vdsh_view_free_space(t, p, diag))
-            memcpy(s->pool[s->pool_count++], p, sizeof p);
-    }
+    /* The bake side's placement, limit included (vdsh_light_tries: it
+     * gave up here at 256 candidates per light, the baker at 1000). */
+    s->pool_count = (int)vdsh_light_place(lo, hi, grown, 1, (uint32_t)count, pool_is_free, &c,
+                                          s->pool, NULL, NULL);
     vdsh_view_tracer_destroy(t);
     return VR_OK;
 }

@@ -16,9 +16,23 @@
 #                                FILE, the last one won; the caller gives
 #                                each shard its own: FILE less .json, then
 #                                .part-I.json, beside FILE (like the parts)
+#   shard_sh_quote ARGS...       ARGS as words any POSIX sh reads back
+#                                (eval "set -- $(shard_sh_quote ...)"): each
+#                                in single quotes, a ' as '\'' (bash's %q
+#                                writes $'...' for a newline: not sh's)
 #   shard_out_dir PROG OUT       OUT's folder exists and is writable, else
 #                                exit 1 naming it (bake-slurm made an absolute
 #                                path of a missing folder as "/OUT": the root)
+#   shard_stale_parts PROG N STEM
+#                                a part STEM.part-I.vdsh with I >= N (an
+#                                earlier run with more shards) is refused:
+#                                exit 1 naming it
+#   shard_stale_reports PROG N STEM REPORT_STEM
+#                                a report REPORT_STEM.part-I.json (empty
+#                                REPORT_STEM: none) with I >= N, or whose part
+#                                STEM.part-I.vdsh is not there (its shard
+#                                bakes again), is removed: a rerun with fewer
+#                                shards kept the extra ones beside the new
 
 shard_count() {
   [[ $2 =~ ^[1-9][0-9]*$ ]] || { echo "$1: N is a whole number >= 1, not '$2'" >&2; exit 2; }
@@ -78,4 +92,45 @@ shard_out_dir() {
     exit 1
   fi
   return 0
+}
+
+shard_stale_parts() { # shard_stale_parts PROG N STEM
+  local prog=$1 n=$2 stem=$3 f i
+  for f in "$stem".part-*.vdsh; do
+    [[ -e $f ]] || continue
+    i=${f#"$stem".part-}
+    i=${i%.vdsh}
+    if [[ $i =~ ^(0|[1-9][0-9]*)$ ]] && ((i >= n)); then
+      echo "$prog: '$f' is a part of a bake with more than $n shards: remove it (or rerun with that count); nothing run" >&2
+      exit 1
+    fi
+  done
+  return 0
+}
+
+shard_stale_reports() { # shard_stale_reports PROG N STEM REPORT_STEM
+  local prog=$1 n=$2 stem=$3 rstem=$4 f i
+  [[ -n $rstem ]] || return 0
+  for f in "$rstem".part-*.json; do
+    [[ -e $f ]] || continue
+    i=${f#"$rstem".part-}
+    i=${i%.json}
+    [[ $i =~ ^(0|[1-9][0-9]*)$ ]] || continue # not one of ours
+    if ((i >= n)) || [[ ! -e $stem.part-$i.vdsh ]]; then
+      rm -f -- "$f" || { echo "$prog: cannot remove the stale report '$f': nothing run" >&2; exit 1; }
+      if ((i >= n)); then
+        echo "$prog: removed '$f', the report of a shard of an earlier bake with more shards" >&2
+      fi
+    fi
+  done
+  return 0
+}
+
+shard_sh_quote() {
+  local a q=\' out="" sep=""
+  for a in "$@"; do
+    out+="$sep'${a//$q/$q\\$q$q}'"
+    sep=" "
+  done
+  printf '%s' "$out"
 }

@@ -82,13 +82,14 @@ done
 "$view" "$d/baked.vdsh" --views "$views" --frames "$d/baked-gl" --modes buf7,buf9,buf12,adaptive -q
 "$cmp" "$views" "$d/baked-c" "$d/baked-gl" 0.002 0.005 \
   buf7=c-vdsh7 buf9=c-vdsh9 buf12=c-vdsh12 adaptive=c-vdsh-var
-# cpca streams (issue 29), decoded in the vertex stage: order 12 at the
-# baker's default settings (4-bit weights, no bits skipped), and orders 3
+# cpca streams (issue 29), decoded in the vertex stage: order 12 at
+# 8,54,4 (4-bit weights, no bits skipped; the default before 16,alloc:32,
+# whose widths frames_gl_cpca_widths draws), and orders 3
 # and 7 with 5-bit weights (fields skip the ends of words; order 3 is drawn
 # from a buffer too: cpca never goes to attributes). The C frames decode
 # through vdsh_stream_decode.
 "$bake" builtin:room --max-edge 0.5 --rays 400 --cube-size 0 --orders 12 --encoding cpca \
-  -q -o "$d/cpca.vdsh"
+  --cpca 8,54,4 -q -o "$d/cpca.vdsh"
 "$bake" builtin:room --max-edge 0.5 --rays 400 --cube-size 0 --orders 3,7 --encoding cpca \
   --cpca 6,20,5 -q -o "$d/cpca5.vdsh"
 for f in cpca cpca5; do

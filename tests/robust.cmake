@@ -152,4 +152,10 @@ if(NOT VDSH_SANITIZE AND TARGET vdsh-frames AND TARGET vdsh-export)
                    $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-frames>
                    $<TARGET_FILE:vdsh-eval> $<TARGET_FILE:vdsh-export> $<TARGET_FILE:vdsh-info>
                    $<$<TARGET_EXISTS:vdsh-view>:$<TARGET_FILE:vdsh-view>>)
+  # vdsh-frames truth's folder whole or not at all: killed (the shim) or
+  # failed part-way, no partial truth in DIR; an earlier truth kept.
+  add_test(NAME robust_truth_whole_or_none
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/test_truth_whole.sh
+                   $<TARGET_FILE:kill_at_rename> $<TARGET_FILE:vdsh-bake>
+                   $<TARGET_FILE:vdsh-frames>)
 endif()

@@ -594,8 +594,8 @@ add_test(NAME runtime_view_cpca_frame COMMAND sh -c [=[
 v=$1; png=$2; bake=$3; log=$4; d=$5
 rm -rf "$d"; mkdir -p "$d"
 set -e
-"$bake" builtin:room --max-edge 1.0 --rays 256 --cube-size 0 --orders 12 --encoding cpca -q \
-  -o "$d/c.vdsh"
+"$bake" builtin:room --max-edge 1.0 --rays 256 --cube-size 0 --orders 12 --encoding cpca \
+  --cpca 8,54,4 -q -o "$d/c.vdsh"
 set +e
 "$v" -q --render "$d/pass.png" --size 96x72 --mode buf12 --lights 16 "$d/c.vdsh"
 rc=$?

@@ -700,16 +700,31 @@ static void light_metric(void)
     CHECK(vdsh_cpca_parse("3,alloc:16,light:0.5", &p, &err) == VDSH_OK && p.clusters == 3 &&
               p.budget == 16 && p.light_mix == 0.5f,
           "3,alloc:16,light:0.5");
-    CHECK(vdsh_cpca_parse("light:1", &p, &err) == VDSH_OK && p.clusters == d.clusters &&
-              p.basis == d.basis && p.bits == d.bits && p.budget == 0 && p.light_mix == 1.0f,
-          "light:1 alone");
+    CHECK(vdsh_cpca_parse("light:0", &p, &err) == VDSH_OK && p.clusters == d.clusters &&
+              p.basis == d.basis && p.bits == d.bits && p.budget == d.budget && p.light_mix == 0.0f,
+          "light:0 alone");
+    /* the default: K,alloc:BYTES (16,alloc:32) with the default light mix,
+     * what the text "16,alloc:32" gives (docs/ACCURACY.md "The default of
+     * --encoding cpca") */
+    CHECK(d.clusters == VDSH_CPCA_DEFAULT_CLUSTERS && d.budget == VDSH_CPCA_DEFAULT_BUDGET &&
+              d.basis == 0 && d.bits == 0 && d.light_mix == VDSH_CPCA_DEFAULT_LIGHT_MIX &&
+              !d.light_count && !d.lights && !d.positions,
+          "the default settings: K,alloc:BYTES with the default light mix");
+    {
+        char text[32];
+        snprintf(text, sizeof text, "%u,alloc:%u", (unsigned)d.clusters, (unsigned)d.budget);
+        CHECK(vdsh_cpca_parse(text, &p, &err) == VDSH_OK && p.clusters == d.clusters &&
+                  p.basis == d.basis && p.bits == d.bits && p.budget == d.budget &&
+                  p.light_mix == d.light_mix && !p.light_count,
+              "the default settings are %s's", text);
+    }
     CHECK(vdsh_cpca_parse("auto,light:0", &p, &err) == VDSH_OK && p.budget == 32 &&
               p.light_mix == 0.0f,
           "auto,light:0");
     CHECK(vdsh_cpca_parse("8,52,4,light:.25", &p, &err) == VDSH_OK && p.light_mix == 0.25f,
           "8,52,4,light:.25");
-    CHECK(vdsh_cpca_parse("8,52,4", &p, &err) == VDSH_OK && p.light_mix == 0.0f &&
-              d.light_mix == p.light_mix && !p.light_count && !p.lights && !p.positions,
+    CHECK(vdsh_cpca_parse("8,52,4", &p, &err) == VDSH_OK && p.light_mix == 0.0f && !p.light_count &&
+              !p.lights && !p.positions,
           "fixed widths: the uniform metric unless said");
     CHECK(vdsh_cpca_parse("8,alloc:32", &p, &err) == VDSH_OK &&
               p.light_mix == VDSH_CPCA_DEFAULT_LIGHT_MIX && !p.light_count,

@@ -6,8 +6,8 @@
 # within f16 and quantisation rounding; with the default-like settings
 # well below the coefficients' spread); --adaptive-order's stream, as a
 # fixed cpca stream of its cap, is alike (threads, shards, decode error);
-# bad settings are usage errors and parts of other settings are refused by
-# the merge.
+# the default settings (16,alloc:32, light:1) alike; bad settings are
+# usage errors and parts of other settings are refused by the merge.
 # Usage: test_cpca_bake.sh VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR
 set -u
 bake=$1 merge=$2 info=$3 src=$4
@@ -60,6 +60,22 @@ assert (p["cpca_clusters"], p["cpca_basis"], p["cpca_bits"]) == (4, 40, 0), p
 c = vdsh.read(sys.argv[3]).streams[0]["cpca"]
 assert c["bits"] == 0 and len(c["widths"]) == c["basis"] and 2 <= min(c["widths"]), c["widths"]
 ' "$src/python" "$tmp/c3/p1.vdsh" "$tmp/c1.vdsh"
+
+# The default (--encoding cpca without --cpca: 16,alloc:32 with the light
+# pool, which parts carry in lpol): whole bake = 2 threads = 3 shards
+# merged, byte for byte; a part names the default's settings.
+expect_exit 0 "default cpca, 1 thread" "$bake" "${tiny[@]}" --encoding cpca --threads 1 -o "$tmp/d1.vdsh"
+expect_exit 0 "default cpca, 2 threads" "$bake" "${tiny[@]}" --encoding cpca --threads 2 -o "$tmp/d2.vdsh"
+check "default cpca, 1 and 2 threads: identical" cmp "$tmp/d1.vdsh" "$tmp/d2.vdsh"
+mkdir -p "$tmp/d3"
+for i in 0 1 2; do
+  expect_exit 0 "default cpca shard $i/3" "$bake" "${tiny[@]}" --encoding cpca --shard "$i/3" \
+    -o "$tmp/d3/p$i.vdsh"
+done
+expect_exit 0 "default cpca merge" "$merge" -q "$tmp"/d3/p*.vdsh -o "$tmp/d3/scene.vdsh"
+check "default cpca, 3 shards: identical to the whole bake" cmp "$tmp/d3/scene.vdsh" "$tmp/d1.vdsh"
+expect_exit 0 "vdsh-info on a default part" "$info" "$tmp/d3/p1.vdsh"
+says_any "a default part's settings" "cpca 16,alloc:32,light:1"
 
 # Against the f32 bake of the same options.
 expect_exit 0 "f32 bake" "$bake" "${tiny[@]}" --encoding f32 -o "$tmp/f32.vdsh"
@@ -146,5 +162,29 @@ expect_exit 0 "a part of other settings" "$bake" "${tiny[@]}" --encoding cpca --
 expect_exit 1 "merge refuses other settings" "$merge" -q "$tmp"/n3/p0.vdsh "$tmp"/n3/p1.vdsh \
   "$tmp/other-2.vdsh" -o "$out"
 says_any "merge of other settings" "another --cpca"
+# The default (16,alloc:32) on a mesh too small for 16 clusters' model
+# within 32 bytes per vertex (48 receivers): K is halved until a model
+# fits, within the budget. One triangle (3 receivers) fits at no K: an
+# error that names the way out, and fixed settings bake it.
+expect_exit 0 "the default on a 48-vertex mesh" "$bake" "$src/tests/data/room_box.obj" --max-edge 0 \
+  --rays 16 --cube-size 0 --orders 12 --encoding cpca -q -o "$tmp/box.vdsh"
+check "the default on 48 vertices: fewer clusters" /usr/bin/python3 -c '
+import os, sys
+sys.path.insert(0, sys.argv[1])
+import vdsh
+c = vdsh.read(sys.argv[2]).streams[0]["cpca"]
+assert 1 <= c["clusters"] < 16, c["clusters"]
+assert os.path.getsize(sys.argv[2]) > 0
+' "$src/python" "$tmp/box.vdsh"
+check "the default on 48 vertices: within 32 B/vertex with the model" sh -c \
+  "'$info' '$tmp/box.vdsh' | sed -n 's/.*bytes per vertex, \\([0-9.]*\\) with the model.*/\\1/p' |
+   awk '{ ok = \$1 > 0 && \$1 <= 32 } END { exit !(NR == 1 && ok) }'"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$tmp/tri.obj"
+expect_exit 1 "the default on one triangle" "$bake" "$tmp/tri.obj" --max-edge 0 \
+  --rays 16 --cube-size 0 --orders 12 --encoding cpca -q -o "$out"
+says_any "too small even at one cluster" "too small for 3 rows of order 12, even at 1 cluster"
+says_any "the way out named" "fixed K,B,BITS: --cpca 8,54,4"
+expect_exit 0 "8,54,4 on one triangle" "$bake" "$tmp/tri.obj" --max-edge 0 \
+  --rays 16 --cube-size 0 --orders 12 --encoding cpca --cpca 8,54,4 -q -o "$tmp/tri.vdsh"
 check "nothing written after refusals" test ! -e "$out"
 exit $fail

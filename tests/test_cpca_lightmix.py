@@ -6,7 +6,8 @@ formats/vdsh_cpca.h; docs/ACCURACY.md, "A light-density metric"):
   exists (the default K, B, bits with `light:0` alone, and a part merged);
 - light:1 and light:0.5 are other fits, valid files that decode near the
   f32 bake; the default (no light:) is VDSH_CPCA_DEFAULT_LIGHT_MIX's for
-  alloc, light:0's for fixed widths (8,54,4);
+  alloc, light:0's for fixed widths (8,54,4); the plain --encoding cpca is
+  --help's default settings (16,alloc:32) with light:1;
 - bad values are refused with a message naming light:A, exit 2, no file;
 - a part carries the pool (`lpol`), vdsh-info shows the mix; vdsh-merge
   refuses parts whose pools differ, naming the part, and a part whose
@@ -60,11 +61,17 @@ x = vdsh.coefficients(ref.streams[0]).astype(np.float64)
 spread = np.sqrt(((x - x.mean(0)) ** 2).sum(1).mean())
 
 CPCA = ["--encoding", "cpca", "--cpca"]
+# the default settings, as vdsh-bake --help says them (16,alloc:32)
+helptext = subprocess.run([bake, "--help"], capture_output=True, text=True).stdout
+DEFAULT = helptext.split("model included); default ")[1].split()[0]
+if ",alloc:" not in DEFAULT:
+    fail.append("--help's default settings %r are not K,alloc:BYTES" % DEFAULT)
 for name, setting in (("l0", "4,alloc:40,light:0"), ("l05", "4,alloc:40,light:0.5"),
                       ("l1", "4,alloc:40,light:1"), ("def", "4,alloc:40"),
-                      ("l0alone", "light:0"), ("l0full", "8,54,4,light:0"),
-                      ("fixed", "8,54,4")):
-    must(run_bake(name + ".vdsh", CPCA + [setting]), setting)
+                      ("l0alone", "light:0"), ("l0full", DEFAULT + ",light:0"),
+                      ("l1full", DEFAULT + ",light:1"), ("plain", None),
+                      ("fixed", "8,54,4"), ("fixed0", "8,54,4,light:0")):
+    must(run_bake(name + ".vdsh", CPCA + [setting] if setting else CPCA[:2]), str(setting))
     got = vdsh.coefficients(vdsh.read(path(name + ".vdsh")).streams[0]).astype(np.float64)
     err = np.sqrt(((got - x) ** 2).sum(1).mean()) / spread
     print("%s: decoded error %.4f of the spread" % (setting, err))
@@ -74,15 +81,17 @@ for name, setting in (("l0", "4,alloc:40,light:0"), ("l05", "4,alloc:40,light:0.
 if blob("l0.vdsh") in (blob("l1.vdsh"), blob("l05.vdsh")) or blob("l1.vdsh") == blob("l05.vdsh"):
     fail.append("light:0, 0.5 and 1 are not three fits")
 if blob("l0alone.vdsh") != blob("l0full.vdsh"):
-    fail.append("light:0 alone is not the default K, B, bits with light:0")
+    fail.append("light:0 alone is not the default K and budget with light:0")
+# the plain --encoding cpca is the default settings with their (alloc) mix
+if blob("plain.vdsh") != blob("l1full.vdsh"):
+    fail.append("--encoding cpca without --cpca is not --cpca %s,light:1" % DEFAULT)
 # the default mix, as vdsh-bake --help says it
-helptext = subprocess.run([bake, "--help"], capture_output=True, text=True).stdout
 default = helptext.split("A in 0..1, default ")[1].split()[0]
 want = {"0": "l0", "1": "l1"}.get(default)
 if want is None or blob("def.vdsh") != blob(want + ".vdsh"):
     fail.append("the default light mix (--help: %r) does not give its bytes" % default)
 # fixed widths keep the uniform metric unless told (it lost there)
-if blob("fixed.vdsh") != blob("l0full.vdsh"):
+if blob("fixed.vdsh") != blob("fixed0.vdsh"):
     fail.append("8,54,4 without light: is not the uniform metric")
 
 for bad in ("4,alloc:40,light:2", "4,alloc:40,light:-1", "4,alloc:40,light:", "light:abc",

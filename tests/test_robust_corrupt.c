@@ -9,7 +9,9 @@
  * writes is there): a small scene of a floor and a box refined to max
  * edge 1 (orders 2,3,5, f16; and orders 1,4, f32, method full, with the
  * timings chunk; order 6 in cpca, 3 clusters of 7 vectors, 5-bit weights;
- * order 6 in cpca with a width per vector, --cpca 3,alloc:60), and
+ * order 6 in cpca with a width per vector, --cpca 3,alloc:60; shard 0 of 2
+ * of that bake, a part with its part and lpol chunks, the latter 24 KB of
+ * light pool), and
  * builtin:room at max edge 0 (the room's 261 KB are
  * swept at a stride of 1/1009 of the file and with 1,000 two-byte changes;
  * a full sweep would take minutes). Then:
@@ -204,7 +206,7 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *bake = argv[1], *info = argv[2], *dir = argv[3];
-    char obj[4096], a[4096], b[4096], c[4096], room[4096], var[4096], cp[4096], cw[4096],
+    char obj[4096], a[4096], b[4096], c[4096], room[4096], var[4096], cp[4096], cw[4096], pt[4096],
         err_path[4096];
     mkdir(dir, 0755);
     snprintf(obj, sizeof obj, "%s/scene.obj", dir);
@@ -215,6 +217,7 @@ int main(int argc, char **argv)
     snprintf(var, sizeof var, "%s/scene-var.vdsh", dir);
     snprintf(cp, sizeof cp, "%s/scene-cpca.vdsh", dir);
     snprintf(cw, sizeof cw, "%s/scene-cpca-widths.vdsh", dir);
+    snprintf(pt, sizeof pt, "%s/scene-cpca-part.vdsh", dir);
     snprintf(err_path, sizeof err_path, "%s/bake.err", dir);
     if (write_all(obj, (const uint8_t *)scene_obj, sizeof scene_obj - 1) != 0) {
         fprintf(stderr, "cannot write %s\n", obj);
@@ -258,24 +261,42 @@ int main(int argc, char **argv)
     char *bake_cw[] = {(char *)bake,  obj,          "--max-edge", "1",  "--rays",     "64",
                        "--cube-size", "0",          "--orders",   "6",  "--encoding", "cpca",
                        "--cpca",      "3,alloc:60", "-q",         "-o", cw,           NULL};
+    /* a part of a sharded cpca bake: the part chunk, and lpol (the light
+     * pool of the byte-budget settings' light-density metric) */
+    char *bake_pt[] = {(char *)bake, obj,           "--max-edge", "1",          "--rays",
+                       "64",         "--cube-size", "0",          "--orders",   "6",
+                       "--encoding", "cpca",        "--cpca",     "3,alloc:60", "--shard",
+                       "0/2",        "-q",          "-o",         pt,           NULL};
     int ok = run(bake_a, err_path) == 0 && run(bake_b, err_path) == 0 &&
              run(bake_c, err_path) == 0 && run(bake_room, err_path) == 0 &&
              run(bake_var, err_path) == 0 && run(bake_cp, err_path) == 0 &&
-             run(bake_cw, err_path) == 0;
+             run(bake_cw, err_path) == 0 && run(bake_pt, err_path) == 0;
     CHECK(ok, "vdsh-bake failed (see %s)", err_path);
     if (!ok)
         return test_report("robust_corrupt");
 
-    const char *names[7] = {
-        "scene-f16.vdsh", "scene-f32.vdsh",  "scene-s8s6.vdsh",       "room.vdsh",
-        "scene-var.vdsh", "scene-cpca.vdsh", "scene-cpca-widths.vdsh"};
-    const char *paths[7] = {a, b, c, room, var, cp, cw};
-    for (int k = 0; k < 7; k++) {
+    const char *names[8] = {
+        "scene-f16.vdsh", "scene-f32.vdsh",  "scene-s8s6.vdsh",        "room.vdsh",
+        "scene-var.vdsh", "scene-cpca.vdsh", "scene-cpca-widths.vdsh", "scene-cpca-part.vdsh"};
+    const char *paths[8] = {a, b, c, room, var, cp, cw, pt};
+    for (int k = 0; k < 8; k++) {
         size_t size;
         uint8_t *data = test_read_file(paths[k], &size);
         CHECK(data && size > 64, "cannot read %s", paths[k]);
         if (!data)
             continue;
+        if (paths[k] == pt) { /* the sweep covers both chunks of a part */
+            vdsh_chunk_info chunks[32];
+            uint32_t count = 0;
+            vdsh_error err;
+            int part = 0, lpol = 0;
+            if (vdsh_scan_chunks(data, size, pt, chunks, 32, &count, &err) == VDSH_OK)
+                for (uint32_t i = 0; i < count; i++) {
+                    part |= strcmp(chunks[i].id, "part") == 0;
+                    lpol |= strcmp(chunks[i].id, "lpol") == 0;
+                }
+            CHECK(part && lpol, "%s: no part chunk (%d) or no lpol chunk (%d)", pt, part, lpol);
+        }
         /* The small files: every byte; the room: about 1,000 positions. */
         int large = size > 65536;
         sweep(names[k], data, size, large ? size / 1009 : 1, large ? 1000 : 4000, info, dir);

@@ -7,7 +7,10 @@
 # Debian's parallel when root and it is missing; skips (77) when it cannot
 # be had. Each shard's progress is in the output. OUT in a missing folder
 # is refused before any shard runs, and so is a parallel that is not GNU's.
-# --report R.json among the bake's arguments: each shard writes R.part-I.json.
+# --sshlogin hosts need no bash (a POSIX sh runs the shards).
+# --report R.json among the bake's arguments: each shard writes R.part-I.json;
+# a rerun with fewer shards removes the extra shards' reports and refuses
+# their parts.
 # Usage: test_shard_parallel.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
@@ -76,6 +79,21 @@ VDSH_BAKE=$tmp/logging-bake "$scripts/bake-parallel" 5 "$tmp/again.vdsh" -j 2 --
 ran=$(sort "$tmp/shards.log" 2>/dev/null | tr '\n' ' ')
 [[ $ran == "0/5 1/5 3/5 4/5 " ]] || { echo "FAIL: the rerun baked shards '$ran', not 0 1 3 4" >&2; fail=1; }
 cmp "$tmp/again.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: rerun merge differs" >&2; fail=1; }
+# --sshlogin with hosts that have no bash, only a POSIX sh (dash) and what
+# GNU parallel needs there (perl, rm): an ssh of our own (PARALLEL_SSH)
+# runs the host's command line with sh and a PATH of those only (the shard
+# ran as "bash -c ...": "bash: not found").
+mkdir -p "$tmp/nobash"
+for t in perl sh rm; do ln -s "$(command -v $t)" "$tmp/nobash/$t"; done
+cat >"$tmp/fakessh" <<SSH
+#!/bin/sh
+while [ \$# -gt 0 ]; do case \$1 in -o|-l|-p) shift 2;; --) shift; break;; -*) shift;; *) shift; [ "\${1:-}" = -- ] && shift; break;; esac; done
+SHELL=/bin/sh PATH=$tmp/nobash exec /bin/sh -c "\$*"
+SSH
+chmod +x "$tmp/fakessh"
+PARALLEL_SSH=$tmp/fakessh "$scripts/bake-parallel" 3 "$tmp/ssh it's.vdsh" --sshlogin 2/nobashhost -- "${tiny[@]}" 2>"$tmp/err.txt" ||
+  { echo "FAIL: bake-parallel --sshlogin to a host without bash:" >&2; tail -5 "$tmp/err.txt" >&2; fail=1; }
+cmp -s "$tmp/ssh it's.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: --sshlogin without bash: merge differs" >&2; fail=1; }
 # A failing shard fails the run and writes no merged file.
 if "$scripts/bake-parallel" 3 "$tmp/bad.vdsh" -- "${tiny[@]}" --rays 0 2>/dev/null; then
   echo "FAIL: a failing shard did not fail the run" >&2; fail=1
@@ -94,6 +112,31 @@ for form in "--report $tmp/rep.json" "--report=$tmp/rep.json" "--repo $tmp/rep.j
       { echo "FAIL: '$form': no report rep.part-$i.json for shard $i" >&2; fail=1; }
   done
 done
+# A rerun with fewer shards: the reports of the earlier run's extra shards
+# are removed (rep.part-3.json and -4 stayed beside the new 0-2), and a
+# part of it with an index the rerun does not have is refused, naming it.
+rm -f "$tmp"/rep*.json "$tmp/rep.vdsh"
+"$scripts/bake-parallel" 5 "$tmp/rep.vdsh" -j 2 -- "${tiny[@]}" --report "$tmp/rep.json" 2>/dev/null ||
+  { echo "FAIL: bake-parallel 5 shards with --report" >&2; fail=1; }
+[[ -e $tmp/rep.part-4.json ]] || { echo "FAIL: 5 shards wrote no rep.part-4.json" >&2; fail=1; }
+"$scripts/bake-parallel" 3 "$tmp/rep.vdsh" -j 2 -- "${tiny[@]}" --report "$tmp/rep.json" 2>"$tmp/err.txt" ||
+  { echo "FAIL: bake-parallel 3 shards after 5:" >&2; cat "$tmp/err.txt" >&2; fail=1; }
+cmp -s "$tmp/rep.vdsh" "$tmp/whole.vdsh" || { echo "FAIL: 3 shards after 5: merge differs" >&2; fail=1; }
+for i in 3 4; do
+  [[ -e $tmp/rep.part-$i.json ]] && { echo "FAIL: the stale report rep.part-$i.json kept" >&2; fail=1; }
+done
+grep -q "removed '$tmp/rep.part-4.json'" "$tmp/err.txt" || { echo "FAIL: the removal not said:" >&2; cat "$tmp/err.txt" >&2; fail=1; }
+for i in 0 1 2; do
+  grep -q '"seconds"' "$tmp/rep.part-$i.json" 2>/dev/null || { echo "FAIL: 3 shards after 5: no rep.part-$i.json" >&2; fail=1; }
+done
+"$bake" "${tiny[@]}" -q --shard 4/5 -o "$tmp/stale.part-4.vdsh" || { echo "FAIL: shard 4/5" >&2; fail=1; }
+printf '#!/bin/sh\necho ran >> %q\nexec %q "$@"\n' "$tmp/stale.log" "$bake" > "$tmp/stale-bake"
+chmod +x "$tmp/stale-bake"
+msg=$(VDSH_BAKE=$tmp/stale-bake "$scripts/bake-parallel" 3 "$tmp/stale.vdsh" -- "${tiny[@]}" 2>&1)
+rc=$?
+[[ $rc -eq 1 && $msg == *"'$tmp/stale.part-4.vdsh' is a part of a bake with more than 3 shards"* ]] ||
+  { echo "FAIL: a part of a run with more shards: exit $rc: $msg" >&2; fail=1; }
+[[ -e $tmp/stale.log || -e $tmp/stale.vdsh ]] && { echo "FAIL: a part of a run with more shards: shards baked" >&2; fail=1; }
 msg=$("$scripts/bake-parallel" 2 "$tmp/rep2.vdsh" -- "${tiny[@]}" --report 2>&1)
 rc=$?
 [[ $rc -eq 2 && $msg == *"without a FILE"* ]] || { echo "FAIL: --report without FILE: exit $rc: $msg" >&2; fail=1; }

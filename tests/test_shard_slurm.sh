@@ -11,7 +11,9 @@
 # submission gets the merge job cancelled, not left pending forever; the
 # output's name has a space, a quote and a '%' (the logs beside it); more shards than receivers and
 # OUT in a missing folder are refused before anything is submitted;
-# --report R.json among the bake's arguments: each shard writes R.part-I.json.
+# --report R.json among the bake's arguments: each shard writes R.part-I.json;
+# stale reports (more shards, parts baked again) removed, stale parts refused;
+# a relative mesh and VDSH_BAKE work when the job starts elsewhere (--chdir).
 # Usage: test_shard_slurm.sh VDSH_BAKE VDSH_MERGE SCRIPTS_DIR
 set -u
 bake=$1 merge=$2 scripts=$3
@@ -59,14 +61,50 @@ mkdir -p "$nos/rep"
 printf '#!/bin/sh\nwhile [ $# -gt 0 ]; do [ "$1" = --wrap ] && printf "%%s\\n" "$2" >> "%s/wraps"; shift; done\necho 7\n' \
   "$nos/rep" > "$nos/rep/sbatch"
 chmod +x "$nos/rep/sbatch"
+# Reports left by an earlier run with more shards (r.part-2.json, -5) and
+# one of a part that is not there (r.part-0.json: shard 0 bakes again)
+# are removed at submission; r.part-1.json, whose part is there, is kept.
+for i in 0 1 2 5; do echo "{\"stale\": $i}" >"$nos/rep/r.part-$i.json"; done
+: >"$nos/rep/r.part-1.vdsh"
 (cd "$nos/rep" && PATH=$nos/rep:$PATH VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-slurm" 2 r.vdsh -- \
   builtin:room --max-edge 1.5 --rays 32 --cube-size 8 --report r.json >/dev/null 2>&1) ||
   { echo "FAIL: bake-slurm with --report" >&2; fail=1; }
 [[ -e $nos/rep/r.json ]] && { echo "FAIL: --report: r.json written before any shard ran" >&2; fail=1; }
+for i in 0 2 5; do
+  [[ -e $nos/rep/r.part-$i.json ]] && { echo "FAIL: --report: the stale r.part-$i.json kept" >&2; fail=1; }
+done
+[[ -e $nos/rep/r.part-1.json ]] || { echo "FAIL: --report: r.part-1.json of a part there removed" >&2; fail=1; }
+rm -f "$nos/rep/r.part-1.vdsh" "$nos/rep/r.part-1.json"
+# A part of an earlier run with more shards: refused, naming it, nothing
+# submitted (merged parts 0-1 and left part 2 behind for ever).
+: >"$nos/rep/s.part-2.vdsh"
+mv "$nos/rep/wraps" "$nos/rep/wraps.keep"
+msg=$(cd "$nos/rep" && PATH=$nos/rep:$PATH VDSH_BAKE=$bake VDSH_MERGE=$merge "$scripts/bake-slurm" 2 s.vdsh -- \
+  builtin:room --max-edge 1.5 --rays 32 --cube-size 8 2>&1)
+rc=$?
+[[ $rc -eq 1 && $msg == *"s.part-2.vdsh' is a part of a bake with more than 2 shards"* && ! -e $nos/rep/wraps ]] ||
+  { echo "FAIL: a part of a run with more shards: exit $rc, submitted: $(cat "$nos/rep/wraps" 2>/dev/null): $msg" >&2; fail=1; }
+mv "$nos/rep/wraps.keep" "$nos/rep/wraps"
 (cd / && SLURM_ARRAY_TASK_ID=1 sh -c "$(head -n 1 "$nos/rep/wraps" 2>/dev/null)" >/dev/null 2>&1) ||
   { echo "FAIL: --report: shard 1's command failed: $(head -n 1 "$nos/rep/wraps" 2>/dev/null)" >&2; fail=1; }
 [[ -e $nos/rep/r.part-1.vdsh && ! -e $nos/rep/r.json ]] && grep -q '"seconds"' "$nos/rep/r.part-1.json" 2>/dev/null ||
   { echo "FAIL: --report: shard 1 wrote no r.part-1.json (or wrote r.json): $(ls "$nos/rep")" >&2; fail=1; }
+# Relative paths (a mesh, VDSH_BAKE) given from the caller's folder: the
+# shard's command runs them from there wherever the job starts (sbatch
+# --chdir=/ among the options; the job run here from /): they were looked
+# up in the job's folder ("no such file").
+mkdir -p "$nos/rel/bin"
+cp "$(dirname "$0")/data/room_box.obj" "$nos/rel/m.obj"
+ln -s "$bake" "$nos/rel/bin/vdsh-bake"
+printf '#!/bin/sh\nwhile [ $# -gt 0 ]; do [ "$1" = --wrap ] && printf "%%s\\n" "$2" >> "%s/wraps"; shift; done\necho 8\n' \
+  "$nos/rel" > "$nos/rel/sbatch"
+chmod +x "$nos/rel/sbatch"
+(cd "$nos/rel" && PATH=$nos/rel:$PATH VDSH_BAKE=bin/vdsh-bake VDSH_MERGE=$merge "$scripts/bake-slurm" 2 r.vdsh --chdir=/ -- \
+  m.obj --max-edge 1.5 --rays 32 --cube-size 8 >/dev/null 2>&1) ||
+  { echo "FAIL: bake-slurm with a relative mesh and VDSH_BAKE" >&2; fail=1; }
+(cd / && SLURM_ARRAY_TASK_ID=0 sh -c "$(head -n 1 "$nos/rel/wraps" 2>/dev/null)" >"$nos/rel/out.txt" 2>&1) ||
+  { echo "FAIL: relative paths: shard 0's command failed from /: $(head -c 300 "$nos/rel/out.txt")" >&2; fail=1; }
+[[ -e $nos/rel/r.part-0.vdsh ]] || { echo "FAIL: relative paths: no r.part-0.vdsh" >&2; fail=1; }
 rm -rf "$nos"
 skip() { [[ $fail -eq 0 ]] || exit 1; echo "SKIP: $1"; exit 77; }
 [[ $(id -u) -eq 0 ]] || skip "needs root to start slurmctld and slurmd"

@@ -24,7 +24,8 @@ shadow cannot pass). Also:
     extension VDSH_visibility_distance, attributes on every primitive),
     plain and --compress, drawn with vdshApply and the source's own
     materials, against vdsh-view's frame of the same bake;
-  - a cpca stream (issue 29: --encoding cpca, order 12), exported as
+  - a cpca stream (issue 29: --encoding cpca, order 12; the default
+    16,alloc:32, a width per basis vector), exported as
     stored, kept compressed by vdshLoadCpca and decoded in the vertex
     stage (plain and --compress, 1 and 3 lights) or decoded at load
     (cpca=load), against vdsh-view's buf12 (decoded in its vertex stage),

@@ -222,7 +222,8 @@ default_view("room", room_vd, room_glb)
 # decoded at load by vdshCpcaDecode (cpca=load), each against vdsh-view's
 # buf12 (decoded in its vertex stage), same tolerance; the page's title
 # names the path it took.
-cpca_vd, cpca_glb = scene("cpca", "builtin:room", ["--max-edge", "0.5", "--rays", "256", "--encoding", "cpca"], [12],
+cpca_vd, cpca_glb = scene("cpca", "builtin:room", ["--max-edge", "0.5", "--rays", "256", "--encoding", "cpca",
+                                                    "--cpca", "8,54,4"], [12],
                           lambda lo, hi: ([7.5, 4.5, 8.0], [-2.0, 1.0, -2.0], [0.5, 1.2, 0.5]),
                           [("12", "buf12"), ("12", "buf12", "cpca=load")])
 if "cpca" not in glb_json(cpca_glb)["meshes"][0]["extras"]["vdsh"]["streams"][0]:

@@ -206,14 +206,14 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
 
     printf("%s\n", path);
     printf("  receivers    %u %s, %u triangle%s\n", h->vertex_count,
-           vt_plural(h->vertex_count, "vertex", "vertices"), h->triangle_count,
-           vt_s(h->triangle_count));
+           vdsh_plural(h->vertex_count, "vertex", "vertices"), h->triangle_count,
+           vdsh_s(h->triangle_count));
     printf("               bounds (%g, %g, %g) .. (%g, %g, %g), diagonal "
            "%g\n",
            lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], diagonal(lo, hi));
     printf("  occluders    %u %s, %u triangle%s\n", h->occluder_vertex_count,
-           vt_plural(h->occluder_vertex_count, "vertex", "vertices"), h->occluder_triangle_count,
-           vt_s(h->occluder_triangle_count));
+           vdsh_plural(h->occluder_vertex_count, "vertex", "vertices"), h->occluder_triangle_count,
+           vdsh_s(h->occluder_triangle_count));
     printf("               bounds (%g, %g, %g) .. (%g, %g, %g), diagonal "
            "%g\n",
            h->bounds_min[0], h->bounds_min[1], h->bounds_min[2], h->bounds_max[0], h->bounds_max[1],
@@ -236,7 +236,7 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
         char hex[65];
         sha_hex(f->sources[i].sha256, hex);
         printf("    [%u] %s\n        %llu byte%s, sha256 %s\n", i, f->sources[i].name,
-               (unsigned long long)f->sources[i].size, vt_s(f->sources[i].size), hex);
+               (unsigned long long)f->sources[i].size, vdsh_s(f->sources[i].size), hex);
     }
 
     printf("  streams      %u\n", f->stream_count);
@@ -245,7 +245,7 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
         coef0_stats st = stream_coef0(f, s);
         printf("    [%u] order %s%u (%u coefficient%s%s), %s, method %s", i,
                s->flags & VDSH_STREAM_VARIABLE ? "1.." : "", s->order, s->order * s->order,
-               vt_s(s->order * s->order), s->flags & VDSH_STREAM_VARIABLE ? " at most" : "",
+               vdsh_s(s->order * s->order), s->flags & VDSH_STREAM_VARIABLE ? " at most" : "",
                vdsh_encoding_name(s->encoding), or_unknown(vdsh_method_name(s->method)));
         if (strcmp(vdsh_method_name(s->method), "?") == 0)
             printf(" (%u)", s->method);
@@ -277,9 +277,9 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
                 (unsigned long long)vdsh_cpca_stream_model_bytes(m, s->order);
             printf("        cpca: %u cluster%s, %u basis vector%s of %s weights; %zu byte%s "
                    "per vertex, %.1f with the model (%llu byte%s)\n",
-                   m->clusters, vt_s(m->clusters), m->basis, vt_s(m->basis),
-                   m->bits ? wbits : "per-vector", bpv, vt_s(bpv), z.mean_bytes, model,
-                   vt_s(model));
+                   m->clusters, vdsh_s(m->clusters), m->basis, vdsh_s(m->basis),
+                   m->bits ? wbits : "per-vector", bpv, vdsh_s(bpv), z.mean_bytes, model,
+                   vdsh_s(model));
             if (!m->bits) { /* runs, vector 1 first: 7x3 is three vectors of 7 bits */
                 printf("        widths:");
                 for (uint32_t j = 0; j < m->basis;) {
@@ -310,7 +310,7 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
             putchar('\n');
         } else {
             size_t bpv = vdsh_stream_bytes_per_vertex(s);
-            printf("        %zu byte%s per vertex\n", bpv, vt_s(bpv));
+            printf("        %zu byte%s per vertex\n", bpv, vdsh_s(bpv));
         }
         printf("        coefficient 0: min %g, max %g, mean %g\n", st.min, st.max, st.mean);
     }
@@ -342,7 +342,7 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
                    f->part.cpca_bits);
         printf(",light:%g (fitted at the merge", mix);
         if (f->has_light_pool)
-            printf("; light pool of %u light%s", f->light_pool.count, vt_s(f->light_pool.count));
+            printf("; light pool of %u light%s", f->light_pool.count, vdsh_s(f->light_pool.count));
         printf(")\n");
     }
     if (f->has_adaptive) {
@@ -350,15 +350,16 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
         printf("  adaptive     tolerance %g, min edge %g, budget %u (0: none), %u light%s\n"
                "               %u receiver%s from %u in %u of at most %u round%s, %u midpoint%s "
                "baked\n",
-               a->tolerance, a->min_edge, a->max_receivers, a->lights, vt_s(a->lights),
-               f->header.vertex_count, vt_s(f->header.vertex_count), a->start_receivers, a->rounds,
-               a->max_rounds, vt_s(a->max_rounds), a->candidates, vt_s(a->candidates));
+               a->tolerance, a->min_edge, a->max_receivers, a->lights, vdsh_s(a->lights),
+               f->header.vertex_count, vdsh_s(f->header.vertex_count), a->start_receivers,
+               a->rounds, a->max_rounds, vdsh_s(a->max_rounds), a->candidates,
+               vdsh_s(a->candidates));
     }
     if (f->has_timings) {
         const vdsh_timings *t = &f->timings;
         printf("  timings      load %.3f s, refine %.3f s, build %.3f s, "
                "trace %.3f s\n               total %.3f s, %u thread%s\n",
-               t->load, t->refine, t->build, t->trace, t->total, t->threads, vt_s(t->threads));
+               t->load, t->refine, t->build, t->trace, t->total, t->threads, vdsh_s(t->threads));
     }
     printf("  size         %llu bytes, %.2f bytes per vertex\n", (unsigned long long)size,
            (double)size / h->vertex_count);
@@ -619,7 +620,7 @@ static int verify(const char *path, int json)
         if (!json_emit(&j, path))
             bad_chunks = -1; /* not printed: json_emit said why */
     } else {
-        printf("%s: %zu byte%s\n", path, size, vt_s(size));
+        printf("%s: %zu byte%s\n", path, size, vdsh_s(size));
         if (r == VDSH_OK)
             printf("  chunk  id        offset          size  crc\n");
         for (uint32_t i = 0; r == VDSH_OK && i < count; i++) {

@@ -3,7 +3,9 @@
  */
 #include "vt_cli.h"
 
+#include <dirent.h>
 #include <errno.h>
+#include <limits.h>
 #include <float.h>
 #include <math.h>
 #include <pthread.h>
@@ -248,6 +250,37 @@ void vt_cli_undefer_signals(void)
         pause();
 }
 
+static pthread_mutex_t signal_dir_lock = PTHREAD_MUTEX_INITIALIZER;
+static char signal_dir[PATH_MAX]; /* under signal_dir_lock */
+
+void vt_cli_remove_dir(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (d) {
+        struct dirent *e;
+        char p[PATH_MAX];
+        while ((e = readdir(d)) != NULL) {
+            if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+                continue;
+            int len = snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
+            if (len > 0 && (size_t)len < sizeof p)
+                unlink(p);
+        }
+        closedir(d);
+    }
+    rmdir(dir);
+}
+
+void vt_cli_remove_dir_on_signal(const char *dir)
+{
+    pthread_mutex_lock(&signal_dir_lock);
+    if (dir && strlen(dir) < sizeof signal_dir)
+        memcpy(signal_dir, dir, strlen(dir) + 1);
+    else
+        signal_dir[0] = '\0';
+    pthread_mutex_unlock(&signal_dir_lock);
+}
+
 static void *clean_exit_thread(void *unused)
 {
     (void)unused;
@@ -257,6 +290,9 @@ static void *clean_exit_thread(void *unused)
     atomic_store(&clean_exit_taken, 1);
     pthread_mutex_lock(&defer_lock); /* a group of outputs being written: after it */
     vdsh_output_remove_temporaries();
+    pthread_mutex_lock(&signal_dir_lock); /* kept: the process ends */
+    if (signal_dir[0])
+        vt_cli_remove_dir(signal_dir);
     sigset_t one;
     sigemptyset(&one);
     sigaddset(&one, sig);
@@ -434,16 +470,6 @@ int vt_opt_int(const char *option, const char *what, const char *arg, int lo, in
     snprintf(l, sizeof l, "%d", lo);
     snprintf(h, sizeof h, "%d", hi);
     return refuse_range(option, what, arg, l, h);
-}
-
-const char *vt_s(unsigned long long n)
-{
-    return n == 1 ? "" : "s";
-}
-
-const char *vt_plural(unsigned long long n, const char *one, const char *many)
-{
-    return n == 1 ? one : many;
 }
 
 int vt_opt_once(const char *option, const char *arg, const char **slot)

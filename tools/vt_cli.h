@@ -47,6 +47,7 @@
 
 #include <stdint.h>
 #include <stdio.h>
+#include "vdsh_plural.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -85,6 +86,14 @@ const char *vt_cli_prog(void); /* "vdsh" before vt_cli_begin */
  * call it before the program starts any thread (every thread inherits the
  * mask). Signals ignored at start (nohup, a background job) stay ignored. */
 void vt_cli_clean_exit_on_signals(void);
+
+/* A folder of temporary outputs (vdsh-frames truth's, moved into place once
+ * whole): a signal that ends the program (vt_cli_clean_exit_on_signals)
+ * removes every file in it and the folder too. One at a time; NULL: none. */
+void vt_cli_remove_dir_on_signal(const char *dir);
+
+/* Every file in `dir` (not recursing), then `dir` itself: best effort. */
+void vt_cli_remove_dir(const char *dir);
 
 /* Outputs that change together (a .vdsh and its basis cubemaps): between
  * vt_cli_defer_signals and vt_cli_undefer_signals such a signal waits, so
@@ -168,10 +177,7 @@ int vt_opt_u32(const char *option, const char *what, const char *arg, uint32_t l
                uint32_t *out);
 int vt_opt_int(const char *option, const char *what, const char *arg, int lo, int hi, int *out);
 
-/* Plurals in messages: "%u receiver%s", n, vt_s(n) says "1 receiver",
- * "2 receivers"; vt_plural(n, "vertex", "vertices") the irregular ones. */
-const char *vt_s(unsigned long long n);
-const char *vt_plural(unsigned long long n, const char *one, const char *many);
+/* Plurals in messages: formats/vdsh_plural.h (vdsh_s, vdsh_plural). */
 
 /* An option that names one thing (-o FILE): *slot = arg the first time;
  * given again, "OPTION given twice ('A', then 'B'): give it once", even

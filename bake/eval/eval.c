@@ -1315,8 +1315,8 @@ vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths, uin
         r = vb_fail(err, VB_ERR_INVALID,
                     "the sources load as %u %s and %u triangle%s, but the bake traced "
                     "%u and %u (the mesh loader changed since the bake?)",
-                    occ.vertex_count, vb_plural(occ.vertex_count, "vertex", "vertices"),
-                    occ.triangle_count, vb_s(occ.triangle_count), f->header.occluder_vertex_count,
+                    occ.vertex_count, vdsh_plural(occ.vertex_count, "vertex", "vertices"),
+                    occ.triangle_count, vdsh_s(occ.triangle_count), f->header.occluder_vertex_count,
                     f->header.occluder_triangle_count);
         goto fail;
     }

@@ -630,7 +630,7 @@ static vb_result write_begin(const vb_mesh *m, const char *path, const char *wha
         if (m->indices[j] >= m->vertex_count)
             return vb_fail(err, VB_ERR_INVALID, "%s: triangle %zu: index %u out of range (%u %s)",
                            path, j / 3, m->indices[j], m->vertex_count,
-                           vb_plural(m->vertex_count, "vertex", "vertices"));
+                           vdsh_plural(m->vertex_count, "vertex", "vertices"));
     vdsh_error ve;
     vdsh_result vr = vdsh_output_open(path, out, &ve);
     if (vr != VDSH_OK)
@@ -1188,7 +1188,7 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
             return vb_fail(err, VB_ERR_INVALID,
                            "%s: face %llu: vertex index %lld out of range (%u %s)", path,
                            (unsigned long long)raw->faces[j / 3] + base, (long long)v + base,
-                           raw->vertex_count, vb_plural(raw->vertex_count, "vertex", "vertices"));
+                           raw->vertex_count, vdsh_plural(raw->vertex_count, "vertex", "vertices"));
         }
         idx[j] = (uint32_t)v;
     }

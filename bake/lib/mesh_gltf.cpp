@@ -253,7 +253,7 @@ vb_result add_primitive(const reader &rd, const tinygltf::Primitive &p, const ma
     for (size_t i = 0; i < ni; i++)
         if (ind[i] >= (double)nv)
             return vb_fail(rd.err, VB_ERR_INVALID, "%s: index %.0f out of range (%zu %s)", rd.name,
-                           ind[i], nv, vb_plural(nv, "vertex", "vertices"));
+                           ind[i], nv, vdsh_plural(nv, "vertex", "vertices"));
     if (o.pos.size() / 3 + nv > max_vertices)
         return vb_fail(rd.err, VB_ERR_FORMAT, "%s: too many vertices", rd.name);
     /* Normal matrix: inverse transpose of the upper 3x3 (cofactors). */

@@ -248,13 +248,14 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
                         return vb_fail(
                             err, VB_ERR_INVALID,
                             "%s: line %lu: face index %lld out of range (%llu %s so far)", path,
-                            c.line, v, (unsigned long long)nv, vb_plural(nv, "vertex", "vertices"));
+                            c.line, v, (unsigned long long)nv,
+                            vdsh_plural(nv, "vertex", "vertices"));
                     v = (long long)nv + v + 1;
                 } else if ((unsigned long long)v > total) {
                     return vb_fail(err, VB_ERR_INVALID,
                                    "%s: line %lu: face index %lld out of range (%llu %s)", path,
                                    c.line, v, (unsigned long long)total,
-                                   vb_plural(total, "vertex", "vertices"));
+                                   vdsh_plural(total, "vertex", "vertices"));
                 }
                 corners.push_back(v);
                 /* The texture coordinate and the normal (v/VT/VN), when
@@ -291,7 +292,7 @@ vb_result read_obj(const char *path, const uint8_t *bytes, size_t size, builder 
             if (corners.size() < 3)
                 return vb_fail(err, VB_ERR_FORMAT,
                                "%s: line %lu: face has %zu %s (needs at least 3)", path, c.line,
-                               corners.size(), vb_plural(corners.size(), "vertex", "vertices"));
+                               corners.size(), vdsh_plural(corners.size(), "vertex", "vertices"));
             std::sort(corners.begin(), corners.end());
             size_t distinct =
                 (size_t)(std::unique(corners.begin(), corners.end()) - corners.begin());

@@ -125,7 +125,7 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
                     return vb_fail(err, VB_ERR_INVALID,
                                    "%s: face %llu: vertex index %llu out of range (%llu %s)", path,
                                    (unsigned long long)f, (unsigned long long)idx,
-                                   (unsigned long long)nv, vb_plural(nv, "vertex", "vertices"));
+                                   (unsigned long long)nv, vdsh_plural(nv, "vertex", "vertices"));
                 polygon.push_back((int64_t)idx);
             }
             b += 4 * n;
@@ -240,7 +240,7 @@ vb_result read_off(const char *path, const uint8_t *bytes, size_t size, builder 
                 return vb_fail(err, VB_ERR_INVALID,
                                "%s: line %lu: face %llu: vertex index %lld out of range (%llu %s)",
                                path, c.line, (unsigned long long)f, idx, (unsigned long long)nv,
-                               vb_plural(nv, "vertex", "vertices"));
+                               vdsh_plural(nv, "vertex", "vertices"));
             polygon.push_back((int64_t)idx);
         }
         if (color)

@@ -317,7 +317,7 @@ vb_result parse(const char *name, vb_mesh_format format, const uint8_t *bytes, s
             return vb_fail(
                 err, VB_ERR_INVALID, "%s: face %llu: vertex index %lld out of range (%u %s)", name,
                 (unsigned long long)b.tri_face[j / 3] + base, (long long)v + (long long)base,
-                (unsigned)nv, vb_plural(nv, "vertex", "vertices"));
+                (unsigned)nv, vdsh_plural(nv, "vertex", "vertices"));
     }
     b.finish(ex.dropped, out);
     return VB_OK;

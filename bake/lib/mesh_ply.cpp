@@ -593,7 +593,7 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                             return vb_fail(err, VB_ERR_FORMAT,
                                            "%s: face %llu has %llu %s (needs at least 3)", path,
                                            (unsigned long long)n, (unsigned long long)cnt,
-                                           vb_plural(cnt, "vertex", "vertices"));
+                                           vdsh_plural(cnt, "vertex", "vertices"));
                     }
                     int ts = p.type->size;
                     if (items > left / (size_t)ts)
@@ -640,7 +640,7 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                                     err, VB_ERR_INVALID,
                                     "%s: face %llu: vertex index %lld out of range (%llu %s)", path,
                                     (unsigned long long)n, idx, (unsigned long long)nv,
-                                    vb_plural(nv, "vertex", "vertices"));
+                                    vdsh_plural(nv, "vertex", "vertices"));
                             polygon.push_back(idx);
                         }
                     }
@@ -697,7 +697,7 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                                     err, VB_ERR_INVALID,
                                     "%s: line %lu: face %llu: vertex index %lld out of range (%llu %s)",
                                     path, c.line, (unsigned long long)n, iv, (unsigned long long)nv,
-                                    vb_plural(nv, "vertex", "vertices"));
+                                    vdsh_plural(nv, "vertex", "vertices"));
                         }
                         /* Colours not of type float were read as an int:
                          * anything else would shift (or stop) the rest,
@@ -748,7 +748,7 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
         return vb_fail(err, VB_ERR_FORMAT,
                        "%s: %zu byte%s of data after the last element ('%s'): a wrong element "
                        "count?",
-                       path, left, vb_s(left), elems.back().name.c_str());
+                       path, left, vdsh_s(left), elems.back().name.c_str());
     if (format == 0 && c.next(&t))
         return vb_fail(err, VB_ERR_FORMAT,
                        "%s: line %lu: data after the last element ('%s'): '%.*s' (a wrong "

@@ -278,7 +278,7 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
         return vb_fail(err, VB_ERR_INVALID,
                        "no room for %u light%s by rule %s: %u found in %u "
                        "candidate%s in %s",
-                       count, vb_s(count), vb_light_rule_name(rule), n, k, vb_s(k),
+                       count, vdsh_s(count), vb_light_rule_name(rule), n, k, vdsh_s(k),
                        region_name(grown));
     return VB_OK;
 }
@@ -290,27 +290,20 @@ static vb_result place_uniform(const vb_scene *s, uint64_t seed, uint32_t count,
      * without free space (a solid, or everything closer than clearance). */
     float lo[3], hi[3];
     const int grown = vb_scene_light_region(s, lo, hi, NULL);
-    uint32_t n = 0, k = 0;
-    const uint64_t limit = vdsh_light_tries(count, grown);
-    const uint64_t first_limit = vdsh_light_tries(first, grown);
-    if (first_ok)
-        *first_ok = 0;
-    while (n < count && k < limit) {
-        float p[3];
-        vdsh_light_candidate(lo, hi, seed, k++, p);
-        if (vb_scene_free_space(s, p)) {
-            memcpy(out[n++], p, sizeof out[0]);
-            if (n == first && first_ok) /* placing `first` would stop here */
-                *first_ok = k <= first_limit;
-        }
-    }
+    uint32_t k = 0, *at = NULL; /* with first_ok: each light's candidate */
+    if (first_ok && !(at = malloc(sizeof *at * (size_t)count + 1)))
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u lights", count);
+    const uint32_t n = vdsh_light_place(lo, hi, grown, seed, count, free_cb, s, out, at, &k);
+    if (first_ok) /* placing `first` stops at its last light, if in time */
+        *first_ok = first >= 1 && n >= first && at[first - 1] < vdsh_light_tries(first, grown);
+    free(at);
     if (tried)
         *tried = k;
     if (n < count)
         return vb_fail(err, VB_ERR_INVALID,
                        "no free space for lights: %u of %u candidate%s in %s "
                        "%s inside solids or nearer than %g to a surface",
-                       k - n, k, vb_s(k), region_name(grown), k - n == 1 ? "was" : "were",
+                       k - n, k, vdsh_s(k), region_name(grown), k - n == 1 ? "was" : "were",
                        (double)vdsh_free_clearance(s->diagonal));
     return VB_OK;
 }

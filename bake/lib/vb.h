@@ -13,6 +13,7 @@
 
 #include <stdarg.h>
 #include <stdint.h>
+#include "vdsh_plural.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -34,16 +35,7 @@ typedef struct vb_error {
     char msg[512];
 } vb_error;
 
-/* Plurals in messages, as tools/vt_cli.h's: "%u byte%s", n, vb_s(n)
- * says "1 byte", "2 bytes"; vb_plural(n, "vertex", "vertices"). */
-static inline const char *vb_s(unsigned long long n)
-{
-    return n == 1 ? "" : "s";
-}
-static inline const char *vb_plural(unsigned long long n, const char *one, const char *many)
-{
-    return n == 1 ? one : many;
-}
+/* Plurals in messages: formats/vdsh_plural.h (vdsh_s, vdsh_plural). */
 
 /* Format a message into err (if not NULL) and return r. */
 #if defined(__GNUC__)

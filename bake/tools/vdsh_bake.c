@@ -176,17 +176,22 @@ static void usage(FILE *f)
             "                          each vertex's order)\n"
             "      --cpca K,B,BITS     cpca settings: clusters (1..256), basis vectors per\n"
             "                          cluster (capped at order^2), bits per weight (2..8);\n"
-            "                          default 8,54,4; or auto[:BYTES]: per stream, of\n"
+            "                          or auto[:BYTES]: per stream, of\n"
             "                          K = 4, 8, 16 at 4 bits with the largest B within\n"
             "                          BYTES per vertex (1..4096, default 32; the model\n"
             "                          included), the one with the least fit error\n"
             "                          (2-4x the encode time of one setting); or\n"
             "                          K,alloc:BYTES: K clusters, a width per basis vector\n"
             "                          (2..8 bits) within BYTES per vertex (1..4096, the\n"
-            "                          model included; docs/ACCURACY.md \"C encoder, with\n"
-            "                          refinement\": teapot +2.2%% at 30.3 B, default +3.8%%\n"
-            "                          at 34.0 B); each may end in ,light:A (or light:A\n"
-            "                          alone: the default K, B, BITS): the fit's metric\n"
+            "                          model included); default %u,alloc:%u (order 12\n"
+            "                          within 3%% of uncompressed on 14 of 16 validation\n"
+            "                          bakes, mean +1.7%%; 8,alloc:32 11 of 16, +2.1%%,\n"
+            "                          at 0.7x the encode time; 8,54,4, the default\n"
+            "                          before, passes 32 B below ~32k receivers:\n"
+            "                          docs/ACCURACY.md \"The default of --encoding\n"
+            "                          cpca\"; K is a most: a model over the budget\n"
+            "                          halves it); each may end in ,light:A (or light:A\n"
+            "                          alone: the default K and budget): the fit's metric\n"
             "                          weights each receiver's hemisphere by\n"
             "                          (1 - A) + A x the density of 2048 lights placed by\n"
             "                          the scene's light rule (A in 0..1, default %g for\n"
@@ -314,6 +319,7 @@ static void usage(FILE *f)
             "Exit status: 0 success, 1 error, 2 usage error.\n"
             "Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n",
             VB_DEFAULT_CUBE_SIZE, VB_SDF_MIN_RESOLUTION, VB_SDF_MAX_RESOLUTION, VDSH_MAX_ORDER,
+            VDSH_CPCA_DEFAULT_CLUSTERS, VDSH_CPCA_DEFAULT_BUDGET,
             (double)VDSH_CPCA_DEFAULT_LIGHT_MIX, VB_DEFAULT_RAYS, rays_side, rays_side,
             VB_DEFAULT_RAYS, (double)VB_DEFAULT_RAY_TOLERANCE, VDSH_MAX_ORDER, VB_DEFAULT_ORDER_CAP,
             methods_help(), (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
@@ -392,7 +398,7 @@ static void on_progress(void *user, uint32_t done, uint32_t total, uint64_t trac
         snprintf(eta, sizeof eta, "ETA %.1f s", (total - done) * per_receiver / rate);
     double t = now - p->t0;
     fprintf(stderr, "%svdsh-bake: %5.1f%%  %u/%u receiver%s  %.1f Mrays/s  %s%s",
-            p->terminal ? "\r" : "", 100.0 * frac, done, total, vt_s(total),
+            p->terminal ? "\r" : "", 100.0 * frac, done, total, vdsh_s(total),
             rate > 0.0 ? rate * 1e-6 : (t > 0 ? traced / t * 1e-6 : 0.0), eta,
             p->terminal ? "   " : "\n");
     if (p->terminal && last)
@@ -593,8 +599,8 @@ static void on_mesh(void *user, const char *path, const vb_mesh *m, const vb_sou
 {
     FILE *log = user;
     fprintf(log, "vdsh-bake: %s: %u %s, %u triangle%s (%.2f s)\n", path, m->vertex_count,
-            vt_plural(m->vertex_count, "vertex", "vertices"), m->triangle_count,
-            vt_s(m->triangle_count), seconds);
+            vdsh_plural(m->vertex_count, "vertex", "vertices"), m->triangle_count,
+            vdsh_s(m->triangle_count), seconds);
     vb_mesh_report_print(log, "vdsh-bake", path, &info->report);
 }
 
@@ -619,7 +625,7 @@ static int write_plan(const vb_mesh *m, const char *path)
     }
     snprintf(side_note[SIDE_PLAN], sizeof side_note[SIDE_PLAN],
              "wrote the plan %s (%u receiver%s, %u triangle%s)", path, m->vertex_count,
-             vt_s(m->vertex_count), m->triangle_count, vt_s(m->triangle_count));
+             vdsh_s(m->vertex_count), m->triangle_count, vdsh_s(m->triangle_count));
     return 0;
 }
 
@@ -851,12 +857,13 @@ static int read_choice(int c, const char *arg, options *o)
     }
     case O_CPCA:
         if (vdsh_cpca_parse(arg, &o->cpca, NULL) != VDSH_OK)
-            return bad_usage("--cpca takes K,B,BITS: clusters 1..256, basis vectors "
-                             "1..256, bits 2..8 (default 8,54,4), or auto or auto:BYTES, or "
-                             "K,alloc:BYTES (a width per basis vector), bytes per vertex "
-                             "1..4096, each optionally ending in ,light:A (or light:A alone), "
-                             "the light mix A in 0..1; not '%s'",
-                             arg);
+            return bad_usage(
+                "--cpca takes K,B,BITS: clusters 1..256, basis vectors "
+                "1..256, bits 2..8, or auto or auto:BYTES, or "
+                "K,alloc:BYTES (a width per basis vector), bytes per vertex "
+                "1..4096 (default 16,alloc:32), each optionally ending in ,light:A (or light:A alone), "
+                "the light mix A in 0..1; not '%s'",
+                arg);
         o->have_cpca = 1;
         break;
     case O_LOG_OFFSET:
@@ -1242,8 +1249,8 @@ static void say_receivers(FILE *log, const options *o, const vb_job *job, vb_mes
                 "vdsh-bake: receivers refined to max edge %g: %u %s, "
                 "%u triangle%s, worst aspect ratio %.1f (%.2f s)\n",
                 (double)o->max_edge, rec->vertex_count,
-                vt_plural(rec->vertex_count, "vertex", "vertices"), rec->triangle_count,
-                vt_s(rec->triangle_count), vb_mesh_worst_aspect(rec, NULL), job->timings.refine);
+                vdsh_plural(rec->vertex_count, "vertex", "vertices"), rec->triangle_count,
+                vdsh_s(rec->triangle_count), vb_mesh_worst_aspect(rec, NULL), job->timings.refine);
     /* Receivers far apart against the scene draw false shadows inside their
      * triangles: say so when nothing chose them (no --max-edge, --adaptive
      * or --receivers) and a bake or plan follows. */
@@ -1299,9 +1306,10 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
                 "baked, tolerance %g + noise floor %.3g from %u receiver%s baked twice, min "
                 "edge %g%s)\n",
                 job->receivers.vertex_count, job->adaptive.start_receivers, job->adaptive.rounds,
-                vt_s(job->adaptive.rounds), job->adaptive.candidates,
-                vt_s(job->adaptive.candidates), (double)o->adaptive_tol, job->adaptive.noise_floor,
-                job->adaptive.noise_sample, vt_s(job->adaptive.noise_sample), (double)o->min_edge,
+                vdsh_s(job->adaptive.rounds), job->adaptive.candidates,
+                vdsh_s(job->adaptive.candidates), (double)o->adaptive_tol,
+                job->adaptive.noise_floor, job->adaptive.noise_sample,
+                vdsh_s(job->adaptive.noise_sample), (double)o->min_edge,
                 job->adaptive.budget_reached    ? ", the budget stopped it"
                 : job->adaptive.uniform_reached ? ", stopped at the uniform bake's count at 2 x "
                                                   "the min edge"
@@ -1311,23 +1319,24 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
                 "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
                 "while still splitting (%u edge%s split in the last round, %u edge%s not "
                 "yet judged): raise --max-rounds\n",
-                job->adaptive.max_rounds, job->adaptive.last_split, vt_s(job->adaptive.last_split),
-                job->adaptive.pending, vt_s(job->adaptive.pending));
+                job->adaptive.max_rounds, job->adaptive.last_split,
+                vdsh_s(job->adaptive.last_split), job->adaptive.pending,
+                vdsh_s(job->adaptive.pending));
     if (bo->flipped_normals)
         fprintf(log,
                 "vdsh-bake: %u receiver normal%s pointed into geometry and %s "
                 "flipped (--keep-normals keeps them)\n",
-                bo->flipped_normals, vt_s(bo->flipped_normals),
-                vt_plural(bo->flipped_normals, "was", "were"));
+                bo->flipped_normals, vdsh_s(bo->flipped_normals),
+                vdsh_plural(bo->flipped_normals, "was", "were"));
     fprintf(log,
             "vdsh-bake: traced %.1f M rays in %.2f s (%.1f Mrays/s on %u "
             "thread%s), %.2f%% missed, %u ray origin%s moved off other geometry, "
             "%u degenerate receiver%s (max distance %g)\n",
             bo->rays_traced * 1e-6, bo->seconds,
             bo->seconds > 0 ? bo->rays_traced / bo->seconds * 1e-6 : 0.0, bo->threads,
-            vt_s(bo->threads), bo->rays_traced ? 100.0 * bo->rays_missed / bo->rays_traced : 0.0,
-            bo->moved_origins, vt_s(bo->moved_origins), bo->degenerate_receivers,
-            vt_s(bo->degenerate_receivers), (double)bo->max_distance);
+            vdsh_s(bo->threads), bo->rays_traced ? 100.0 * bo->rays_missed / bo->rays_traced : 0.0,
+            bo->moved_origins, vdsh_s(bo->moved_origins), bo->degenerate_receivers,
+            vdsh_s(bo->degenerate_receivers), (double)bo->max_distance);
     if (bo->variable_orders) {
         uint32_t hist[VDSH_ORDER_SLOTS] = {0};
         uint32_t rows = bo->range_end - bo->range_begin;
@@ -1355,15 +1364,15 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
             "vdsh-bake: ray origins checked in %.2f s: %llu probe ray%s (%.1f%% of the "
             "traced rays), %u receiver%s repaired, %u moved\n",
             bo->origins.seconds, (unsigned long long)bo->origins.probe_rays,
-            vt_s(bo->origins.probe_rays),
+            vdsh_s(bo->origins.probe_rays),
             bo->rays_traced ? 100.0 * bo->origins.probe_rays / bo->rays_traced : 0.0,
-            bo->origins.flagged, vt_s(bo->origins.flagged), bo->origins.moved);
+            bo->origins.flagged, vdsh_s(bo->origins.flagged), bo->origins.moved);
     if (bo->origins.skipped_zero_area)
         fprintf(log,
                 "vdsh-bake: %u receiver%s on zero-area triangles only (drawn nowhere): "
                 "origin%s not probed\n",
-                bo->origins.skipped_zero_area, vt_s(bo->origins.skipped_zero_area),
-                vt_s(bo->origins.skipped_zero_area));
+                bo->origins.skipped_zero_area, vdsh_s(bo->origins.skipped_zero_area),
+                vdsh_s(bo->origins.skipped_zero_area));
     if (bo->method == VDSH_METHOD_DECISION) {
         if (!bo->decision_lights)
             fprintf(log, "vdsh-bake: warning: no free space for lights in this scene: every "
@@ -1373,13 +1382,13 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
                     "vdsh-bake: decision fit: %u receiver%s fitted on %.0f traced lights "
                     "each on average, %u with fewer than 16 lights above %s horizon "
                     "kept the least-squares fit\n",
-                    bo->decision_fitted, vt_s(bo->decision_fitted), bo->decision_pairs,
-                    bo->decision_fallbacks, vt_plural(bo->decision_fallbacks, "its", "their"));
+                    bo->decision_fitted, vdsh_s(bo->decision_fitted), bo->decision_pairs,
+                    bo->decision_fallbacks, vdsh_plural(bo->decision_fallbacks, "its", "their"));
         if (bo->calibration_receivers) {
             fprintf(log,
                     "vdsh-bake: log offsets calibrated on %u receiver%s for %.1f%% false "
                     "shadow on held-out lights:",
-                    bo->calibration_receivers, vt_s(bo->calibration_receivers),
+                    bo->calibration_receivers, vdsh_s(bo->calibration_receivers),
                     100.0 * bo->false_rate);
             for (int s = 0; s < o->order_count; s++)
                 fprintf(log, "%s order %d %+.3f", s ? "," : "", o->orders[s],
@@ -1401,7 +1410,7 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
         fprintf(log,
                 "vdsh-bake: quantity chosen on %u sampled receiver%s (expected shadow "
                 "error, distance / log):",
-                bo->auto_receivers, vt_s(bo->auto_receivers));
+                bo->auto_receivers, vdsh_s(bo->auto_receivers));
         for (int s = 0; s < o->order_count; s++) {
             int k = o->orders[s];
             fprintf(log, "%s order %d %s (%.4f / %.4f)", s ? "," : "", k,
@@ -1415,10 +1424,10 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
                 "vdsh-bake: warning: %u receiver%s (%.2f%%) %s distance ~0 in almost "
                 "every direction above %s horizon: receivers inside or flush "
                 "against other geometry, or inverted normals\n",
-                bo->degenerate_receivers, vt_s(bo->degenerate_receivers),
+                bo->degenerate_receivers, vdsh_s(bo->degenerate_receivers),
                 100.0 * bo->degenerate_receivers / rec->vertex_count,
-                vt_plural(bo->degenerate_receivers, "sees", "see"),
-                vt_plural(bo->degenerate_receivers, "its", "their"));
+                vdsh_plural(bo->degenerate_receivers, "sees", "see"),
+                vdsh_plural(bo->degenerate_receivers, "its", "their"));
 }
 
 static int run(const options *o)
@@ -1488,8 +1497,8 @@ static int run(const options *o)
         fprintf(log,
                 "vdsh-bake: tracing %u ray%s x %u receiver%s against %u triangle%s "
                 "(method %s)\n",
-                o->rays, vt_s(o->rays), rec->vertex_count, vt_s(rec->vertex_count),
-                job.occluders.triangle_count, vt_s(job.occluders.triangle_count),
+                o->rays, vdsh_s(o->rays), rec->vertex_count, vdsh_s(rec->vertex_count),
+                job.occluders.triangle_count, vdsh_s(job.occluders.triangle_count),
                 vb_method_name(o->method));
     pr.t0 = vb_now();
     if (vb_job_bake(&job, &jd, &err) != VB_OK) {

@@ -172,7 +172,7 @@ static void on_progress(void *user, uint32_t done, uint32_t total)
     double frac = total ? (double)done / total : 1.0;
     double eta = frac > 0.0 ? t * (1.0 - frac) / frac : 0.0;
     fprintf(stderr, "\r  %5.1f%%  %u/%u receiver%s  ETA %.1f s   ", 100.0 * frac, done, total,
-            vt_s(total), eta);
+            vdsh_s(total), eta);
     if (done == total)
         fputs("\r                                                        \r", stderr);
     fflush(stderr);
@@ -578,9 +578,9 @@ static void print_table(FILE *o, const context *c)
     fprintf(o,
             "            %u receiver %s, %u triangle%s; %u occluder triangle%s; "
             "diagonal %.4g\n",
-            h->vertex_count, vt_plural(h->vertex_count, "vertex", "vertices"), h->triangle_count,
-            vt_s(h->triangle_count), h->occluder_triangle_count, vt_s(h->occluder_triangle_count),
-            (double)r->diagonal);
+            h->vertex_count, vdsh_plural(h->vertex_count, "vertex", "vertices"), h->triangle_count,
+            vdsh_s(h->triangle_count), h->occluder_triangle_count,
+            vdsh_s(h->occluder_triangle_count), (double)r->diagonal);
     fprintf(o, "  bake      %u rays/receiver (%s), seed %llu, max distance %.4g, max edge %g",
             h->rays, vdsh_sampling_name(h->sampling), (unsigned long long)h->seed,
             (double)h->max_distance, (double)h->max_edge);
@@ -593,18 +593,18 @@ static void print_table(FILE *o, const context *c)
                 "            bake's own rays: %.4f%% missed, %u degenerate receiver%s, "
                 "%u undefined normal%s\n",
                 f->stats.rays_traced ? 100.0 * f->stats.rays_missed / f->stats.rays_traced : 0.0,
-                f->stats.degenerate_receivers, vt_s(f->stats.degenerate_receivers),
-                f->stats.undefined_normals, vt_s(f->stats.undefined_normals));
+                f->stats.degenerate_receivers, vdsh_s(f->stats.degenerate_receivers),
+                f->stats.undefined_normals, vdsh_s(f->stats.undefined_normals));
     fprintf(o,
             "  eval      seed %llu, %u held-out directions/receiver (one light each), "
             "%s truth traversal%s; %.2f s on %u thread%s\n",
             (unsigned long long)r->seed, r->directions, c->fast_truth ? "default" : "robust",
             r->oracle ? ", ORACLE (truth scored against itself)" : "", r->seconds, r->threads,
-            vt_s(r->threads));
+            vdsh_s(r->threads));
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         const vb_eval_truth *t = &r->truth[k];
         fprintf(o, "  truth     %-8s %u receiver%s", kind_name(k), t->receivers,
-                vt_s(t->receivers));
+                vdsh_s(t->receivers));
         if (t->skipped)
             fprintf(o, " (+%u skipped: undefined normal)", t->skipped);
         fprintf(o, ", %llu rays, %.4f%% escaped, %.3f%% at ~0 distance, %u degenerate",

@@ -16,6 +16,7 @@
  * The story of each is its cmd_ function: read, compute with the core
  * (bake/frames.h), write atomically, print.
  */
+#include <dirent.h>
 #include <errno.h>
 #include <getopt.h>
 #include <limits.h>
@@ -24,6 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "bake.h"
 #include "eval.h"
@@ -98,7 +100,10 @@ static void usage(FILE *f)
             "  (ambient 0.03 + sum of 1.6 / (1 + 0.6 (n - 1)) x max(N . l, 0) /\n"
             "  (1 + d^2 / r^2) x shadow), r = 0.3 x the scene's diagonal, n lights.\n"
             "  Prints the time of each pass; a frame's truth is the primary pass plus\n"
-            "  one light's shadow pass.\n"
+            "  one light's shadow pass. DIR gets the whole truth or none of it: the\n"
+            "  frames are written into DIR.tmp.XXXXXX beside it (removed on failure\n"
+            "  or SIGINT/SIGTERM/SIGHUP; only a SIGKILL leaves it), then that folder\n"
+            "  becomes DIR, or its frames replace their namesakes in DIR.\n"
             "      --views FILE        the view set\n"
             "  -o, --output DIR        where the frames go (created if missing)\n"
             "      --compare C         smooth (default, the paper's ramp) or binary,\n"
@@ -301,8 +306,8 @@ static int run_views(const options *op)
     if (!op->quiet) {
         printf(PROG " views: %s -> %s: %d view%s, %d x %d, seed %llu; %u candidate eye%s "
                     "(%u in free space), %.2f s\n",
-               path, out, set.count, vt_s((unsigned)set.count), d.width, d.height,
-               (unsigned long long)d.seed, st.eyes_tried, vt_s(st.eyes_tried), st.eyes_free,
+               path, out, set.count, vdsh_s((unsigned)set.count), d.width, d.height,
+               (unsigned long long)d.seed, st.eyes_tried, vdsh_s(st.eyes_tried), st.eyes_free,
                vb_now() - t0);
         if (st.default_lights_ok < VB_FRAMES_VIEW_LIGHTS)
             printf("  note: only %u of the default view's 4 lights light and shadow %.0f%% "
@@ -339,16 +344,102 @@ static void stream_mode(const vdsh_stream *st, char *name, size_t cap)
         snprintf(name, cap, "c-vdsh%u", st->order);
 }
 
-static int make_dir(const char *dir)
+/* The truth appears whole or not at all (a folder left by a failed or
+ * killed run was read as a whole truth): it is written into a new folder
+ * beside DIR, "DIR.tmp.XXXXXX" (beside the folder a link DIR leads to),
+ * removed on any failure or SIGINT/SIGTERM/SIGHUP, then renamed to DIR when
+ * DIR is not there or empty, else its frames moved into DIR, each replacing
+ * its namesake (signals wait meanwhile). Only a SIGKILL can leave the
+ * temporary folder behind, never a part of a truth in DIR. */
+static int truth_begin(const char *dir, char *tmp, size_t cap)
 {
     struct stat st;
-    if (mkdir(dir, 0777) == 0)
-        return 0;
-    if (errno == EEXIST && stat(dir, &st) == 0 && S_ISDIR(st.st_mode))
-        return 0;
-    fprintf(stderr, PROG ": %s: cannot create the folder: %s\n", dir,
-            errno == EEXIST ? "a file of that name is there" : strerror(errno));
-    return -1;
+    char real[PATH_MAX];
+    const char *base = dir;
+    if (stat(dir, &st) == 0) {
+        if (!S_ISDIR(st.st_mode)) {
+            fprintf(stderr, PROG ": %s: cannot create the folder: a file of that name is there\n",
+                    dir);
+            return -1;
+        }
+        if (!realpath(dir, real)) {
+            fprintf(stderr, PROG ": %s: %s\n", dir, strerror(errno));
+            return -1;
+        }
+        base = real;
+    }
+    size_t len = strlen(base);
+    while (len > 1 && base[len - 1] == '/')
+        len--;
+    static const char suffix[] = ".tmp.XXXXXX";
+    if (len + sizeof suffix > cap) {
+        fprintf(stderr, PROG ": %s: path too long\n", dir);
+        return -1;
+    }
+    memcpy(tmp, base, len);
+    memcpy(tmp + len, suffix, sizeof suffix);
+    if (!mkdtemp(tmp)) {
+        fprintf(stderr, PROG ": %s: cannot create the folder %s: %s\n", dir, tmp, strerror(errno));
+        return -1;
+    }
+    vt_cli_remove_dir_on_signal(tmp);
+    mode_t mask = umask(0); /* mkdtemp makes it 0700: a new folder's mode */
+    umask(mask);
+    chmod(tmp, 0777 & ~mask);
+    return 0;
+}
+
+/* Each of tmp's files to dir/NAME (pass 0: only checks that no NAME there
+ * is a folder, so that no move fails half-way). */
+static int truth_move(const char *dir, const char *tmp, int pass)
+{
+    DIR *d = opendir(tmp);
+    if (!d) {
+        fprintf(stderr, PROG ": %s: %s\n", tmp, strerror(errno));
+        return -1;
+    }
+    int rc = 0;
+    struct dirent *e;
+    while (rc == 0 && (e = readdir(d)) != NULL) {
+        if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+            continue;
+        char from[PATH_MAX], to[PATH_MAX];
+        struct stat st;
+        int a = snprintf(from, sizeof from, "%s/%s", tmp, e->d_name);
+        int b = snprintf(to, sizeof to, "%s/%s", dir, e->d_name);
+        if (a < 0 || b < 0 || (size_t)a >= sizeof from || (size_t)b >= sizeof to) {
+            fprintf(stderr, PROG ": %s: path too long\n", dir);
+            rc = -1;
+        } else if (pass == 0 && lstat(to, &st) == 0 && S_ISDIR(st.st_mode)) {
+            fprintf(stderr, PROG ": %s: a folder of that name is there: no frame written\n", to);
+            rc = -1;
+        } else if (pass == 1 && rename(from, to) != 0) {
+            fprintf(stderr, PROG ": %s: %s\n", to, strerror(errno));
+            rc = -1;
+        }
+    }
+    closedir(d);
+    return rc;
+}
+
+static int truth_commit(const char *dir, const char *tmp)
+{
+    int rc = 0;
+    vt_cli_defer_signals();
+    if (rename(tmp, dir) != 0) {
+        if (errno != ENOTEMPTY && errno != EEXIST && errno != ENOTDIR) {
+            fprintf(stderr, PROG ": %s: cannot rename %s to it: %s\n", dir, tmp, strerror(errno));
+            rc = -1;
+        } else if (truth_move(dir, tmp, 0) || truth_move(dir, tmp, 1)) {
+            rc = -1;
+        } else {
+            rmdir(tmp);
+        }
+    }
+    if (rc == 0)
+        vt_cli_remove_dir_on_signal(NULL);
+    vt_cli_undefer_signals();
+    return rc;
 }
 
 /* The frames of one light, written on the workers: PNG encoding is most
@@ -435,7 +526,8 @@ static int run_truth(const options *op)
         vt_views_free(&V);
         return 1;
     }
-    int status = 1;
+    int status = 1, have_tmp = 0;
+    char tmp_dir[PATH_MAX];
     const vdsh_file *f = L.f;
     const int w = V.width, h = V.height;
     /* The distance volume: --sdf, else the companion file when it exists. */
@@ -497,14 +589,15 @@ static int run_truth(const options *op)
         fprintf(stderr, PROG ": out of memory for %d x %d frames\n", w, h);
         goto done;
     }
-    if (make_dir(dir))
+    if (truth_begin(dir, tmp_dir, sizeof tmp_dir))
         goto done;
+    have_tmp = 1;
 
     double t_primary = 0.0, t_shadow = 0.0, t_streams = 0.0, t_write = 0.0, t0 = vb_now();
     int light_frames = 0, stream_frames = 0;
     if (!op->quiet)
         printf(PROG " truth: %s, %d view%s from %s, %d x %d, %s comparison -> %s\n", path, V.count,
-               vt_s((unsigned)V.count), views_path, w, h, vdsh_compare_name(compare), dir);
+               vdsh_s((unsigned)V.count), views_path, w, h, vdsh_compare_name(compare), dir);
     for (int vi = 0; vi < V.count; vi++) {
         const vt_view *v = V.views + vi;
         double t = vb_now();
@@ -530,7 +623,7 @@ static int run_truth(const options *op)
                 view_lights++;
                 vis_hard[j] = lights[j].hard;
                 vis_ideal[j] = lights[j].ideal;
-                frame_batch fb = {.dir = dir,
+                frame_batch fb = {.dir = tmp_dir,
                                   .view = v->name,
                                   .set = k,
                                   .light = j,
@@ -586,7 +679,7 @@ static int run_truth(const options *op)
             vb_frames_shading_default(L.fs, v->light_count[k], &sh);
             for (int pass = 0; pass < 2; pass++) {
                 char p[PATH_MAX], msg[PATH_MAX + 256];
-                int len = snprintf(p, sizeof p, "%s/%s-s%d-shaded-%s.png", dir, v->name, k,
+                int len = snprintf(p, sizeof p, "%s/%s-s%d-shaded-%s.png", tmp_dir, v->name, k,
                                    pass ? "ideal" : "hard");
                 if (len < 0 || (size_t)len >= sizeof p) {
                     fprintf(stderr, PROG ": %s: path too long\n", dir);
@@ -608,17 +701,20 @@ static int run_truth(const options *op)
         if (!op->quiet)
             printf("  %-10s primary %6.1f ms; %d light%s: shadow %6.1f ms per light, C streams "
                    "%6.1f ms per light\n",
-                   v->name, 1e3 * tp, view_lights, vt_s((unsigned)view_lights),
+                   v->name, 1e3 * tp, view_lights, vdsh_s((unsigned)view_lights),
                    1e3 * ts / (view_lights ? view_lights : 1),
                    1e3 * tc / (view_lights ? view_lights : 1));
     }
+    if (truth_commit(dir, tmp_dir))
+        goto done;
+    have_tmp = 0;
     if (!op->quiet) {
         double per_view = t_primary / V.count;
         double per_light = light_frames ? t_shadow / light_frames : 0.0;
         printf("  a frame's truth (%d x %d, primary + shadow ray per pixel): %.1f ms "
                "(primary %.1f + shadow %.1f) on %u thread%s\n",
                w, h, 1e3 * (per_view + per_light), 1e3 * per_view, 1e3 * per_light,
-               vb_parallel_threads(op->threads), vt_s(vb_parallel_threads(op->threads)));
+               vb_parallel_threads(op->threads), vdsh_s(vb_parallel_threads(op->threads)));
         printf("  C streams: %.1f ms per stream per frame; %d + %d frames written (%.2f s) in "
                "%.2f s in all\n",
                stream_frames ? 1e3 * t_streams / stream_frames : 0.0, 3 * light_frames,
@@ -626,6 +722,10 @@ static int run_truth(const options *op)
     }
     status = 0;
 done:
+    if (have_tmp) { /* a failure: none of the truth */
+        vt_cli_remove_dir(tmp_dir);
+        vt_cli_remove_dir_on_signal(NULL);
+    }
     for (int j = 0; j < VT_VIEWS_MAX_LIGHTS; j++)
         vb_frames_light_free(&lights[j]);
     vb_frames_hits_free(&hits);
@@ -812,7 +912,7 @@ static int run_score(const options *op)
     cJSON *jm = vt_json_array(&j, root, "modes");
     if (!op->quiet)
         printf(PROG " score: %s, %d view%s from %s, %d x %d; truth %s, frames %s\n", path, V.count,
-               vt_s((unsigned)V.count), views_path, V.width, V.height, truth, frames);
+               vdsh_s((unsigned)V.count), views_path, V.width, V.height, truth, frames);
     for (int m = 0; m < mode_count; m++) {
         const vb_frames_tally *T = tally + (size_t)m * frame_count;
         vb_frames_tally scene = {0};

@@ -649,7 +649,7 @@ static int merge_write(merge *m, const options *o)
     }
     if (!o->quiet)
         fprintf(stderr, "vdsh-merge: wrote %s (%u shard%s, %u receiver%s, %.2f MB)\n", o->output,
-                m->count, vt_s(m->count), m->V, vt_s(m->V), bytes / 1e6);
+                m->count, vdsh_s(m->count), m->V, vdsh_s(m->V), bytes / 1e6);
     return 0;
 }
 
