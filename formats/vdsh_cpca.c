@@ -379,18 +379,94 @@ typedef struct lightmix {
     double a;
     uint32_t nl;
     const float *lights, *pos; /* nl x 3, rows x 3 */
-    uint32_t *tex;             /* nl: scratch */
+    /* Every row's texels of its lights above its horizon, in pool order
+     * (packed: light_texel), found once by lightmix_load: row v's at
+     * tex[at[v]..at[v + 1]), for the rows v < cached (the first that fit
+     * in LIGHT_CACHE texels); the later rows' are found again at every
+     * use, into the scratch at at[cached]. */
+    uint32_t cached;
+    size_t *at;
+    uint16_t *tex;
+    uint16_t ref[6 * CUBE_N * CUBE_N]; /* refine_texel's of each fit texel */
 } lightmix;
+
+/* The most texels lightmix_load keeps (x 2 bytes): 128 MiB, the rows of
+ * about 2^16 receivers with half a 2048-light pool above each horizon. */
+#define LIGHT_CACHE ((size_t)1 << 26)
 
 static void lightmix_free(lightmix *lm)
 {
+    free(lm->at);
     free(lm->tex);
     memset(lm, 0, sizeof *lm);
 }
 
-/* lm from the settings: 1 when on, 0 when off (lm zeroed), -1 out of
- * memory. */
-static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st)
+/* The index along a side of cube_n texels of face coordinate u (-1..1). */
+static uint32_t cube_index(double u, uint32_t cube_n)
+{
+    double f = (u + 1.0) * 0.5 * cube_n;
+    return f <= 0.0 ? 0u : f >= cube_n ? cube_n - 1u : (uint32_t)f;
+}
+
+/* The texel of direction d (not 0) on the fit's cube (CUBE_N) and on the
+ * refinement's (REFINE_CUBE_N), metric_init's layout, in 16 bits: the
+ * fit's texel (bits 0-13: 6 x 37^2 = 8214 texels) and the refinement's as
+ * 0 or 1 more than the refinement's index holding the fit texel's first
+ * corner along i (bit 14) and j (bit 15): with i = floor(37 x), x =
+ * (u + 1) / 2, floor(12 x) is floor(12 i / 37) or one more (12/37 < 1),
+ * also as rounded, since 12 i / 37 (i = 1..36) is never within rounding
+ * of an integer. +, -, x, / and comparisons only (no libm). */
+#define FIT_TEXEL 0x3fffu
+static uint16_t light_texel(const double d[3])
+{
+    double ax = fabs(d[0]), ay = fabs(d[1]), az = fabs(d[2]);
+    uint32_t axis = ax >= ay && ax >= az ? 0u : ay >= az ? 1u : 2u;
+    double m = fabs(d[axis]);
+    double u = d[(axis + 1) % 3] / m, v = d[(axis + 2) % 3] / m;
+    uint32_t face = axis * 2u + (d[axis] < 0.0);
+    uint32_t i = cube_index(u, CUBE_N), j = cube_index(v, CUBE_N);
+    uint32_t di = cube_index(u, REFINE_CUBE_N) - i * REFINE_CUBE_N / CUBE_N;
+    uint32_t dj = cube_index(v, REFINE_CUBE_N) - j * REFINE_CUBE_N / CUBE_N;
+    return (uint16_t)(((face * CUBE_N + j) * CUBE_N + i) | di << 14 | dj << 15);
+}
+
+/* The refinement cube's texel of a packed light_texel (bits 14, 15 0:
+ * the one holding the fit texel's first corner). */
+static uint32_t refine_texel(uint32_t t)
+{
+    const uint32_t fit = t & FIT_TEXEL, face = fit / (CUBE_N * CUBE_N);
+    const uint32_t j = fit / CUBE_N % CUBE_N, i = fit % CUBE_N;
+    return (face * REFINE_CUBE_N + j * REFINE_CUBE_N / CUBE_N + (t >> 15 & 1u)) * REFINE_CUBE_N +
+           i * REFINE_CUBE_N / CUBE_N + (t >> 14 & 1u);
+}
+
+/* Whether light l is above the horizon of the vertex at p with normal nv;
+ * d its direction from p. */
+static int light_above(const lightmix *lm, uint32_t l, const float *p, const float *nv, double d[3])
+{
+    const float *q = lm->lights + 3 * (size_t)l;
+    for (int i = 0; i < 3; i++)
+        d[i] = (double)q[i] - p[i];
+    return d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0;
+}
+
+/* Row v's texels (normal nv) into tex from slot at: their count. */
+static uint32_t row_texels(const lightmix *lm, uint32_t v, const float *nv, size_t at)
+{
+    const float *p = lm->pos + 3 * (size_t)v;
+    uint32_t t = 0;
+    for (uint32_t l = 0; l < lm->nl; l++) {
+        double d[3];
+        if (light_above(lm, l, p, nv, d))
+            lm->tex[at + t++] = light_texel(d);
+    }
+    return t;
+}
+
+/* lm from the settings, the rows' texels found (normals, rows x 3): 1 when
+ * on, 0 when off (lm zeroed), -1 out of memory. */
+static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float *normals,
+                         uint32_t rows)
 {
     memset(lm, 0, sizeof *lm);
     if (!st || !(st->light_mix > 0.0f) || !st->light_count || !st->lights || !st->positions)
@@ -399,37 +475,37 @@ static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st)
     lm->nl = st->light_count;
     lm->lights = st->lights;
     lm->pos = st->positions;
-    lm->tex = malloc(sizeof(uint32_t) * lm->nl);
-    return lm->tex ? 1 : -1;
-}
-
-/* The texel of direction d on a cube of cube_n (metric_init's layout). */
-static uint32_t cube_texel(const double d[3], uint32_t cube_n)
-{
-    double ax = fabs(d[0]), ay = fabs(d[1]), az = fabs(d[2]);
-    uint32_t axis = ax >= ay && ax >= az ? 0u : ay >= az ? 1u : 2u;
-    double m = fabs(d[axis]);
-    uint32_t face = axis * 2u + (d[axis] < 0.0);
-    double u = d[(axis + 1) % 3] / m, v = d[(axis + 2) % 3] / m;
-    double fi = (u + 1.0) * 0.5 * cube_n, fj = (v + 1.0) * 0.5 * cube_n;
-    uint32_t i = fi <= 0.0 ? 0u : fi >= cube_n ? cube_n - 1u : (uint32_t)fi;
-    uint32_t j = fj <= 0.0 ? 0u : fj >= cube_n ? cube_n - 1u : (uint32_t)fj;
-    return (face * cube_n + j) * cube_n + i;
-}
-
-/* The texels of m of the pool's lights above vertex v's horizon (normal
- * nv), in lm->tex; their count returned. */
-static uint32_t light_texels(lightmix *lm, uint32_t v, const float *nv, const metric_dirs *m)
-{
-    const float *p = lm->pos + 3 * (size_t)v;
-    uint32_t t = 0;
-    for (uint32_t l = 0; l < lm->nl; l++) {
-        const float *q = lm->lights + 3 * (size_t)l;
-        double d[3] = {(double)q[0] - p[0], (double)q[1] - p[1], (double)q[2] - p[2]};
-        if (!(d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0))
-            continue;
-        lm->tex[t++] = cube_texel(d, m->cube_n);
+    for (uint32_t t = 0; t < 6 * CUBE_N * CUBE_N; t++)
+        lm->ref[t] = (uint16_t)refine_texel(t);
+    if (!(lm->at = malloc(sizeof(size_t) * ((size_t)rows + 1))))
+        return -1;
+    lm->at[0] = 0;
+    for (; lm->cached < rows; lm->cached++) { /* the rows kept, and where */
+        const uint32_t v = lm->cached;
+        const float *p = lm->pos + 3 * (size_t)v, *nv = normals + 3 * (size_t)v;
+        uint32_t t = 0;
+        for (uint32_t l = 0; l < lm->nl; l++) {
+            double d[3];
+            t += (uint32_t)light_above(lm, l, p, nv, d);
+        }
+        if (lm->at[v] + t > LIGHT_CACHE)
+            break;
+        lm->at[v + 1] = lm->at[v] + t;
     }
+    const size_t size = lm->at[lm->cached] + (lm->cached < rows ? lm->nl : 0);
+    if (!(lm->tex = malloc(sizeof(uint16_t) * size + 1)))
+        return -1;
+    for (uint32_t v = 0; v < lm->cached; v++)
+        row_texels(lm, v, normals + 3 * (size_t)v, lm->at[v]);
+    return 1;
+}
+
+/* Row v's packed texels (light_texel) in *tex; their count returned. */
+static uint32_t light_texels(const lightmix *lm, uint32_t v, const float *nv, const uint16_t **tex)
+{
+    size_t at = lm->at[v < lm->cached ? v : lm->cached];
+    uint32_t t = v < lm->cached ? (uint32_t)(lm->at[v + 1] - at) : row_texels(lm, v, nv, at);
+    *tex = lm->tex + at;
     return t;
 }
 
@@ -443,7 +519,7 @@ static uint32_t light_texels(lightmix *lm, uint32_t v, const float *nv, const me
  * members each keep weight on their own horizon. */
 static void metric_gram_members(const metric_dirs *m, const float *normals, const uint32_t *labels,
                                 uint32_t rows, uint32_t c, uint32_t members, double *frac,
-                                double *g, lightmix *lm)
+                                double *g, const lightmix *lm)
 {
     uint32_t n = m->n;
     for (uint32_t d = 0; d < m->count; d++)
@@ -454,12 +530,15 @@ static void metric_gram_members(const metric_dirs *m, const float *normals, cons
         const float *nv = normals + 3 * (size_t)v;
         double a = nv[0], b = nv[1], e = nv[2], u = 1.0;
         if (lm) { /* (1 - a) uniform + a light density */
-            const uint32_t t = light_texels(lm, v, nv, m);
+            const uint16_t *tex;
+            const uint32_t t = light_texels(lm, v, nv, &tex);
             if (t) {
                 const double sum = (double)t;
                 u = 1.0 - lm->a;
-                for (uint32_t i = 0; i < t; i++)
-                    frac[lm->tex[i]] += lm->a * TWO_PI / (sum * m->w[lm->tex[i]]);
+                for (uint32_t i = 0; i < t; i++) {
+                    const uint32_t x = tex[i] & FIT_TEXEL;
+                    frac[x] += lm->a * TWO_PI / (sum * m->w[x]);
+                }
             }
         }
         for (uint32_t d = 0; d < m->count; d++) {
@@ -635,7 +714,7 @@ typedef struct fit_ctx {
     double *proj;                          /* k x b x n: the weights' projections */
     double *g, *sc, *sy, *ev, *tmp, *frac; /* scratch */
     uint32_t *idx;
-    lightmix *lm; /* the light-density metric's, or NULL */
+    const lightmix *lm; /* the light-density metric's, or NULL */
 } fit_ctx;
 
 /* Cluster c's mean and basis from its members (labels): the mean stored
@@ -881,15 +960,18 @@ static uint32_t vertex_hemisphere(const fit_ctx *f, refine_ctx *r, uint32_t v)
         r->xval[d] = s;
     }
     if (r->dw) { /* (1 - a) uniform + a light density */
-        lightmix *lm = f->lm;
-        const uint32_t t = light_texels(lm, v, nv, &r->rd);
+        const lightmix *lm = f->lm;
+        const uint16_t *tex;
+        const uint32_t t = light_texels(lm, v, nv, &tex);
         const double sum = (double)t;
         for (uint32_t h = 0; h < nh; h++)
             r->dw[r->hemi[h]] = t ? 1.0 - lm->a : 1.0;
         for (uint32_t i = 0; i < t; i++) {
-            const double *dd = r->rd.dir + 3 * (size_t)lm->tex[i];
+            const uint32_t d =
+                lm->ref[tex[i] & FIT_TEXEL] + (tex[i] >> 15) * REFINE_CUBE_N + (tex[i] >> 14 & 1u);
+            const double *dd = r->rd.dir + 3 * (size_t)d;
             if (dd[0] * nv[0] + dd[1] * nv[1] + dd[2] * nv[2] > 0.0)
-                r->dw[lm->tex[i]] += lm->a * TWO_PI / (sum * r->rd.w[lm->tex[i]]);
+                r->dw[d] += lm->a * TWO_PI / (sum * r->rd.w[d]);
         }
     }
     return nh;
@@ -1006,10 +1088,12 @@ static void fit_scratch_free(fit_scratch *s)
 
 /* Scratch for k clusters of b vectors (fc.b), with room for the bases and
  * projections of fit_basis >= b vectors; the refinement's directions only
- * with need_rd. 0 when out of memory: free it with fit_scratch_free. */
+ * with need_rd; the light-density metric's rows found for it, or the
+ * caller's (shared: encode_auto's candidates share one). 0 when out of
+ * memory: free it with fit_scratch_free. */
 static int fit_scratch_alloc(fit_scratch *s, const float *src, const float *normals, uint32_t rows,
                              uint32_t order, uint32_t k, uint32_t b, uint32_t fit_basis,
-                             int need_rd, const vdsh_cpca_settings *light)
+                             int need_rd, const vdsh_cpca_settings *light, const lightmix *shared)
 {
     memset(s, 0, sizeof *s);
     const uint32_t n = order * order, bf = fit_basis;
@@ -1038,10 +1122,10 @@ static int fit_scratch_alloc(fit_scratch *s, const float *src, const float *norm
     s->mu = malloc(sizeof(double) * n);
     s->dist = malloc(sizeof(double) * rows);
     s->cent = malloc(sizeof(double) * k * (n + 3));
-    const int lm = lightmix_load(&s->lm, light);
+    const int lm = shared ? 1 : lightmix_load(&s->lm, light, normals, rows);
     if (lm < 0)
         return 0;
-    f->lm = lm ? &s->lm : NULL;
+    f->lm = shared ? shared : lm ? &s->lm : NULL;
     if (lm && need_rd) {
         if (!refine_init(&s->rd, order, k, b, rows))
             return 0;
@@ -1117,7 +1201,8 @@ static double decode_rms(const vdsh_cpca_fit *fit, const float *src, uint32_t ro
  * be NULL) the stored fit's hemisphere error (stored_error). */
 static vdsh_result encode_fixed(const float *src, const float *normals, uint32_t rows,
                                 uint32_t order, const vdsh_cpca_settings *settings,
-                                vdsh_cpca_fit *out, double *proxy, vdsh_error *err)
+                                const lightmix *shared, vdsh_cpca_fit *out, double *proxy,
+                                vdsh_error *err)
 {
     memset(out, 0, sizeof *out);
     const uint32_t n = order * order;
@@ -1137,7 +1222,8 @@ static vdsh_result encode_fixed(const float *src, const float *normals, uint32_t
     fit_scratch fs;
     const uint32_t rounds = k > 1 ? REFINE_ROUNDS : 0;
     vdsh_result res = VDSH_OK;
-    if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, b, rounds || proxy, settings) ||
+    if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, b, rounds || proxy, settings,
+                           shared) ||
         !block || !wmax || !cerr) {
         res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory (%zu bytes)", total);
         goto done;
@@ -1267,6 +1353,12 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
     double best_e = 0.0;
     uint32_t last_k = 0;
     int have = 0;
+    lightmix shared; /* every candidate's: the rows' light texels found once */
+    const int lm = lightmix_load(&shared, settings, normals, rows);
+    if (lm < 0) {
+        lightmix_free(&shared);
+        return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory for the light texels");
+    }
     for (size_t i = 0; i < sizeof ks / sizeof ks[0]; i++) {
         vdsh_cpca_settings st = *settings;
         st.clusters = ks[i] < rows ? ks[i] : rows;
@@ -1281,10 +1373,12 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
             continue;
         vdsh_cpca_fit fit;
         double e;
-        vdsh_result r = encode_fixed(src, normals, rows, order, &st, &fit, &e, err);
+        vdsh_result r =
+            encode_fixed(src, normals, rows, order, &st, lm ? &shared : NULL, &fit, &e, err);
         if (r != VDSH_OK) {
             if (have)
                 vdsh_cpca_fit_free(out);
+            lightmix_free(&shared);
             return r;
         }
         if (!have || e < best_e) {
@@ -1297,6 +1391,7 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
             vdsh_cpca_fit_free(&fit);
         }
     }
+    lightmix_free(&shared);
     if (!have) {
         vdsh_cpca_settings least = {.clusters = 1, .basis = 1, .bits = bits, .budget = 0};
         return vdsh_failf(err, VDSH_ERR_ARGUMENT,
@@ -1328,7 +1423,7 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
         return encode_alloc(src, normals, rows, order, settings, out, err);
     if (settings->budget)
         return encode_auto(src, normals, rows, order, settings, out, err);
-    return encode_fixed(src, normals, rows, order, settings, out, NULL, err);
+    return encode_fixed(src, normals, rows, order, settings, NULL, out, NULL, err);
 }
 
 vdsh_result vdsh_cpca_encode_stream(const vdsh_stream *src, uint32_t rows, const float *normals,
@@ -1356,6 +1451,36 @@ vdsh_result vdsh_cpca_encode_stream(const vdsh_stream *src, uint32_t rows, const
     if (rms_error)
         *rms_error = fit.rms_error;
     return VDSH_OK;
+}
+
+void vdsh_cpca_part_record(const vdsh_cpca_settings *st, vdsh_file *f)
+{
+    f->part.cpca_clusters = st->clusters;
+    f->part.cpca_basis = st->budget ? st->budget : st->basis;
+    f->part.cpca_bits = st->budget ? 0 : st->bits;
+    f->has_light_pool = st->light_mix > 0.0f && st->light_count && st->lights;
+    if (f->has_light_pool)
+        f->light_pool =
+            (vdsh_light_pool){.mix = st->light_mix, .count = st->light_count, .lights = st->lights};
+}
+
+vdsh_cpca_settings vdsh_cpca_part_settings(const vdsh_file *f)
+{
+    const vdsh_part *pt = &f->part;
+    vdsh_cpca_settings st = {.clusters = pt->cpca_clusters};
+    if (pt->cpca_bits) {
+        st.basis = pt->cpca_basis;
+        st.bits = pt->cpca_bits;
+    } else {
+        st.budget = pt->cpca_basis;
+    }
+    if (f->has_light_pool) {
+        st.light_mix = f->light_pool.mix;
+        st.light_count = f->light_pool.count;
+        st.lights = f->light_pool.lights;
+        st.positions = f->positions;
+    }
+    return st;
 }
 
 /* ---- a width per basis vector (measurement only: vdsh_cpca_study.h) ---- */
@@ -1488,8 +1613,8 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
     fit_scratch fs;
     const uint32_t rounds = k > 1 ? REFINE_ROUNDS : 0;
     vdsh_result res = VDSH_OK;
-    if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, bf, rounds, settings) || !wts ||
-        !cdist || !cscale || !tot || !level || !best_level) {
+    if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, bf, rounds, settings, NULL) ||
+        !wts || !cdist || !cscale || !tot || !level || !best_level) {
         res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca widths: out of memory");
         goto done;
     }

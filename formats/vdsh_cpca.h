@@ -124,6 +124,10 @@ typedef struct vdsh_cpca_fit {
  * none fits at K = 1), then a width per vector over min(2B, n) vectors
  * (vdsh_cpca_study.h's allocation; VDSH.md "cpca streams"), vectors of
  * width 0 dropped: model.bits 0 and model.widths set.
+ * With the light-density metric, each row's texels of the pool's lights
+ * above its horizon are found once and kept for the whole encode (2 bytes
+ * per light; at most 128 MiB, the rows past that found again at every
+ * pass): docs/BENCHMARKS.md "cpca light-density metric: encode time".
  * VDSH_ERR_ARGUMENT for bad settings, order or rows; VDSH_ERR_INVALID for
  * a value that is not finite or a model that does not fit f16;
  * VDSH_ERR_OUT_OF_MEMORY. On failure *out is zeroed. */
@@ -132,6 +136,17 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
                              vdsh_error *err);
 
 void vdsh_cpca_fit_free(vdsh_cpca_fit *fit);
+
+/* A cpca part's record of its settings (VDSH.md "Parts"), into f:
+ * part.cpca_clusters, cpca_basis, cpca_bits (K,B,BITS: K, B, BITS; auto:
+ * 0, budget, 0; K,alloc:BYTES: K, budget, 0) and, with a light mix > 0 and
+ * a pool, the `lpol` chunk's light_pool (borrowing st->lights). */
+void vdsh_cpca_part_record(const vdsh_cpca_settings *st, vdsh_file *f);
+
+/* The settings cpca part f records, as vdsh_cpca_part_record wrote them,
+ * for the merge: with its pool and f's receiver positions when it has
+ * one (every part has the same). */
+vdsh_cpca_settings vdsh_cpca_part_settings(const vdsh_file *f);
 
 /* The same for a whole stream: `src` a fixed-order f32 stream of `rows`
  * rows with scale 1 (a bake's or a merge's), *out its header with

@@ -739,6 +739,26 @@ static void light_metric(void)
     for (size_t k = 0; k < sizeof refuse / sizeof *refuse; k++)
         CHECK(vdsh_cpca_parse(refuse[k], &p, &err) == VDSH_ERR_ARGUMENT, "'%s' accepted",
               refuse[k]);
+    /* a part's record of the settings and back (VDSH.md "Parts": the
+     * bake writes it, vdsh-merge encodes with what it reads) */
+    static const char *const kinds[] = {"8,52,4",          "light:1",    "auto:24",
+                                        "auto:24,light:1", "3,alloc:16", "3,alloc:16,light:0.5"};
+    for (size_t k = 0; k < sizeof kinds / sizeof *kinds; k++) {
+        CHECK(vdsh_cpca_parse(kinds[k], &p, &err) == VDSH_OK, "'%s' refused", kinds[k]);
+        if (p.light_mix > 0.0f) {
+            p.light_count = NL;
+            p.lights = pool;
+            p.positions = positions;
+        }
+        vdsh_file part = {.has_part = 1, .positions = positions};
+        vdsh_cpca_part_record(&p, &part);
+        vdsh_cpca_settings q = vdsh_cpca_part_settings(&part);
+        CHECK(part.has_light_pool == (p.light_mix > 0.0f) && q.clusters == p.clusters &&
+                  q.budget == p.budget && (p.budget || (q.basis == p.basis && q.bits == p.bits)) &&
+                  q.light_mix == p.light_mix && q.light_count == p.light_count &&
+                  q.lights == p.lights && q.positions == p.positions,
+              "'%s': the part's record reads back as other settings", kinds[k]);
+    }
 }
 
 int main(int argc, char **argv)

@@ -886,6 +886,46 @@ static void test_lights(void)
               "room rule %d: %s", ceiling, err.msg);
         CHECK(!memcmp(a, b, N * sizeof *a), "room rule %d: other lights than before", ceiling);
     }
+    /* A pool's first lights are a smaller pool's (vb_scene_place_pool:
+     * the decision fit's and the cpca metric's one placement). */
+    float(*big)[3] = malloc(2 * N * sizeof *big);
+    int first_ok = 0;
+    CHECK(big && vb_scene_place_pool(s, 0x77, 2 * N, big, N, &first_ok, &err) == VB_OK && first_ok,
+          "room pool of %d: %s", 2 * N, err.msg);
+    CHECK(big && vb_scene_place_lights(s, 0x77, N, a, NULL, &err) == VB_OK &&
+              !memcmp(a, big, N * sizeof *a),
+          "the pool's first %d lights are not a pool of %d", N, N);
+    free(big);
+    /* The decision fit's pool placed by the bake, or given (bake desc
+     * pool, as vdsh-bake's job places it once): the same fit; another
+     * seed's pool given: another fit (the pool is used). */
+    float(*pool)[3] = malloc(VB_DECISION_POOL * sizeof *pool);
+    vb_bake_output fit[3] = {{0}};
+    for (int i = 0; i < 3 && pool; i++) {
+        vb_bake_desc d = {.receivers = &rec,
+                          .scene = s,
+                          .rays = 64,
+                          .seed = 3,
+                          .threads = 1,
+                          .method = VB_METHOD_DECISION,
+                          .order_mask = 1u << 3};
+        if (i) {
+            CHECK(vb_scene_place_pool(s, (i == 1 ? 3 : 4) ^ VB_POOL_SEED, VB_DECISION_POOL, pool, 1,
+                                      NULL, &err) == VB_OK,
+                  "room pool: %s", err.msg);
+            d.pool = &pool[0][0];
+            d.pool_count = VB_DECISION_POOL;
+        }
+        CHECK(vb_bake_run(&d, &fit[i], &err) == VB_OK && fit[i].coeffs[3], "room bake %d: %s", i,
+              err.msg);
+    }
+    const size_t fit_bytes = 9 * (size_t)rec.vertex_count * sizeof(float);
+    CHECK(pool && fit[2].coeffs[3] && !memcmp(fit[0].coeffs[3], fit[1].coeffs[3], fit_bytes) &&
+              memcmp(fit[0].coeffs[3], fit[2].coeffs[3], fit_bytes),
+          "the decision fit with its pool given differs, or another pool changes nothing");
+    for (int i = 0; i < 3; i++)
+        vb_bake_output_free(&fit[i]);
+    free(pool);
 
     make_cube(&cube);
     if (!scene_from(&cube, &c)) {

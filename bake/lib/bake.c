@@ -326,7 +326,6 @@ static void adapt_fit(const job *J, const float n[3], float acc[VDSH_MAX_COEFFS]
  * needs for its own decision fit (fewer: it keeps its lsq fit). */
 #define CAL_LIGHTS 64
 #define DEC_MIN_PAIRS 16
-#define DEC_POOL 4096
 #define DEC_BOUNDARY -0.40546511f /* ln(2/3) */
 
 /* A worker's decision scratch: the pairs (x, y, z, ln d: K floats each),
@@ -1522,15 +1521,16 @@ static vb_result setup_offsets(bake_run *b, vb_error *err)
     J->cap_keep = d->offset_cap_keep;
     J->cap_min = d->offset_cap_min;
     if (mi->decision && !d->trace_only) {
-        J->pool = malloc(DEC_POOL * sizeof *J->pool);
+        J->pool = malloc(VB_DECISION_POOL * sizeof *J->pool);
         if (!J->pool)
             return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         vb_error perr;
-        if (vb_scene_place_lights(d->scene, d->seed ^ 0xdec15105ull, DEC_POOL, J->pool, NULL,
-                                  &perr) == VB_OK) {
-            for (uint32_t k = 0; k < DEC_POOL; k++)
-                vb_scene_to_local(d->scene, J->pool[k], J->pool[k]);
-            J->pool_count = DEC_POOL;
+        if (d->pool ? d->pool_count == VB_DECISION_POOL
+                    : vb_scene_place_pool(d->scene, d->seed ^ VB_POOL_SEED, VB_DECISION_POOL,
+                                          J->pool, 0, NULL, &perr) == VB_OK) {
+            for (uint32_t k = 0; k < VB_DECISION_POOL; k++)
+                vb_scene_to_local(d->scene, d->pool ? d->pool + 3 * k : J->pool[k], J->pool[k]);
+            J->pool_count = VB_DECISION_POOL;
             J->decision = 1;
             size_t bytes = dec_scratch_bytes(J) * d->threads;
             if (!(J->dec_scratch = aligned_alloc(64, (bytes + 63) & ~(size_t)63)))

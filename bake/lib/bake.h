@@ -97,6 +97,14 @@ extern "C" {
  * coefficients of the last, so that testing them all costs little. */
 int vb_order_candidate(int k, int cap);
 
+/* The pool of lights of the decision fit (its training lights: all
+ * VB_DECISION_POOL) and of the cpca light-density metric (its first
+ * VB_CPCA_POOL; bake/lib/job.c), placed once per bake by the scene's rule
+ * (vb_scene_place_pool) with the bake's seed ^ VB_POOL_SEED. */
+#define VB_POOL_SEED 0xdec15105ull
+#define VB_DECISION_POOL 4096u
+#define VB_CPCA_POOL 2048u
+
 typedef struct vb_bake_desc {
     const vb_mesh *receivers; /* positions and normals (borrowed) */
     const vb_scene *scene;    /* the occluders (borrowed) */
@@ -143,6 +151,12 @@ typedef struct vb_bake_desc {
     const vb_decision_params *decision;
     uint32_t decision_lights;
     float false_rate;
+    /* Method decision, its training pool as placed (VB_DECISION_POOL
+     * above; 3 floats per light, scene units, borrowed): pool_count
+     * VB_DECISION_POOL, or 0 where there was no room (the lsq fits are
+     * kept). NULL: the bake places it. */
+    const float *pool;
+    uint32_t pool_count;
     /* Method decision, the per-receiver offset cap (issue 25; 0: off):
      * each receiver's log offset is raised (never above 0) to keep all
      * but 1 - offset_cap_keep of its lit training pairs lit, less

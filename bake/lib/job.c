@@ -112,6 +112,43 @@ vb_result vb_job_check_shard(const vb_job *j, const vb_job_desc *d, vb_error *er
     return VB_OK;
 }
 
+/* The encoding of the whole bake's streams (a part's are f32 whatever it is). */
+static vdsh_encoding job_encoding(const vb_job_desc *d)
+{
+    return d->encoding_given ? d->encoding : VB_DEFAULT_ENCODING;
+}
+
+static vdsh_cpca_settings job_cpca_asked(const vb_job_desc *d)
+{
+    return d->cpca.clusters || d->cpca.budget ? d->cpca : vdsh_cpca_settings_default();
+}
+
+/* The light pool (bake.h, VB_POOL_SEED), placed once for the bake's
+ * decision fit (all VB_DECISION_POOL lights, in every adaptive round) and
+ * the cpca light-density metric (docs/ACCURACY.md "A light-density
+ * metric": the first VB_CPCA_POOL, in scene units like the receivers'
+ * positions, where a placement of that many alone finds room), whole bakes
+ * and parts alike. A scene where the rule places no lights keeps the lsq
+ * fits and the uniform metric: the same in every shard. */
+static vb_result job_pool(vb_job *j, const vb_job_desc *d, vb_error *err)
+{
+    const int decision = vb_method_get(d->bake.method)->decision && !d->bake.trace_only;
+    const int cpca = job_encoding(d) == VDSH_ENCODING_CPCA && !d->bake.trace_only &&
+                     job_cpca_asked(d).light_mix > 0.0f;
+    const uint32_t count = decision ? VB_DECISION_POOL : cpca ? VB_CPCA_POOL : 0;
+    if (!count)
+        return VB_OK;
+    if (!(j->pool = malloc(count * sizeof *j->pool)))
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the light pool");
+    vb_error perr;
+    int first_ok;
+    vb_result r = vb_scene_place_pool(j->scene, d->bake.seed ^ VB_POOL_SEED, count, j->pool,
+                                      VB_CPCA_POOL, &first_ok, &perr);
+    j->pool_count = r == VB_OK ? count : 0;
+    j->cpca_lights = cpca && first_ok ? VB_CPCA_POOL : 0;
+    return VB_OK;
+}
+
 vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
 {
     vb_result sr = vb_job_check_shard(j, d, err);
@@ -130,6 +167,12 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
     }
     bd.receivers = &j->receivers;
     bd.scene = j->scene;
+    if ((r = job_pool(j, d, err)) != VB_OK)
+        return r;
+    if (j->pool && vb_method_get(bd.method)->decision) {
+        bd.pool = &j->pool[0][0];
+        bd.pool_count = j->pool_count;
+    }
     if (d->adaptive) {
         if (d->shard_count)
             return vb_fail(err, VB_ERR_ARGUMENT,
@@ -158,55 +201,41 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
     return VB_OK;
 }
 
-/* The encoding of the whole bake's streams (a part's are f32 whatever it is). */
-static vdsh_encoding job_encoding(const vb_job_desc *d)
-{
-    return d->encoding_given ? d->encoding : VB_DEFAULT_ENCODING;
-}
-
-static vdsh_cpca_settings job_cpca_asked(const vb_job_desc *d)
-{
-    return d->cpca.clusters || d->cpca.budget ? d->cpca : vdsh_cpca_settings_default();
-}
-
-/* The cpca light-density metric's pool (docs/ACCURACY.md "A light-density
- * metric"): VB_CPCA_POOL lights placed by the scene's light rule
- * (vb_scene_place_lights: the light region, the free-space test) with the
- * decision fit's training-pool seed, in scene (world) space like the
- * receivers' positions; placed once, for whole bakes and parts alike.
- * A scene where the rule places no lights keeps the uniform metric (as the
- * decision fit does without its pool): the same in every shard. */
-#define VB_CPCA_POOL 2048u
-static vb_result job_cpca_pool(vb_job *j, const vb_job_desc *d, vb_error *err)
-{
-    if (j->cpca_pool_tried || !(job_cpca_asked(d).light_mix > 0.0f))
-        return VB_OK;
-    j->cpca_pool_tried = 1;
-    float(*pool)[3] = malloc(VB_CPCA_POOL * sizeof *pool);
-    if (!pool)
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the cpca light pool");
-    vb_error perr;
-    if (vb_scene_place_lights(j->scene, d->bake.seed ^ 0xdec15105ull, VB_CPCA_POOL, pool, NULL,
-                              &perr) != VB_OK) {
-        free(pool);
-        return VB_OK;
-    }
-    j->cpca_pool = pool;
-    j->cpca_pool_count = VB_CPCA_POOL;
-    return VB_OK;
-}
-
 /* The encoder's settings: what was asked for, with the job's pool and
- * receivers when the light mix is > 0 (job_cpca_pool first). */
+ * receivers when the light mix is > 0 (job_pool placed it). */
 static vdsh_cpca_settings job_cpca(const vb_job *j, const vb_job_desc *d)
 {
     vdsh_cpca_settings st = job_cpca_asked(d);
-    if (st.light_mix > 0.0f && j->cpca_pool) {
-        st.light_count = j->cpca_pool_count;
-        st.lights = &j->cpca_pool[0][0];
+    if (st.light_mix > 0.0f && j->cpca_lights) {
+        st.light_count = j->cpca_lights;
+        st.lights = &j->pool[0][0];
         st.positions = j->receivers.positions;
     }
     return st;
+}
+
+/* Stream s cpca-encoded from f32 (rows of every receiver) by the global
+ * step, with the file's normals: the encoder's block replaces
+ * j->stream_data[s] (f32's data, when it is there, is freed); on failure
+ * the stream keeps f32's header without data. */
+static vb_result job_cpca_encode(vb_job *j, const vb_job_desc *d, uint32_t s, vdsh_stream f32,
+                                 const char *what, vb_error *err)
+{
+    vdsh_cpca_settings st = job_cpca(j, d);
+    vdsh_error e;
+    void *storage = NULL;
+    const float *nrm = j->bake.normals ? j->bake.normals : j->receivers.normals;
+    vdsh_result er = vdsh_cpca_encode_stream(&f32, j->receivers.vertex_count, nrm, &st,
+                                             &j->streams[s], &storage, NULL, &e);
+    free(j->stream_data[s]);
+    j->stream_data[s] = storage;
+    if (er != VDSH_OK) {
+        j->streams[s] = f32; /* its block is freed: nothing of it stays */
+        j->streams[s].data = NULL;
+        return vb_fail(err, er == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_INVALID,
+                       "%s stream: %s", what, e.msg);
+    }
+    return VB_OK;
 }
 
 /* --encoding cpca with --adaptive-order: the variable-order stream (f32, in
@@ -230,23 +259,9 @@ static vb_result cpca_variable(vb_job *j, const vb_job_desc *d, uint32_t s, vb_e
     f32.offsets = NULL;
     f32.coef_scales = NULL;
     f32.data = rows;
-    vdsh_cpca_settings st = job_cpca(j, d);
-    vdsh_error e;
-    void *storage = NULL;
-    const float *nrm = j->bake.normals ? j->bake.normals : j->receivers.normals;
-    vdsh_result er = vdsh_cpca_encode_stream(&f32, V, nrm, &st, &j->streams[s], &storage, NULL, &e);
+    vb_result r = job_cpca_encode(j, d, s, f32, "adaptive-order", err);
     free(rows);
-    free(j->stream_data[s]);
-    j->stream_data[s] = storage;
-    if (er != VDSH_OK) {
-        j->streams[s] = var; /* its block is freed: nothing of it stays */
-        j->streams[s].data = NULL;
-        j->streams[s].orders = NULL;
-        j->streams[s].offsets = NULL;
-        return vb_fail(err, er == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_INVALID,
-                       "adaptive-order stream: %s", e.msg);
-    }
-    return VB_OK;
+    return r;
 }
 
 vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
@@ -265,11 +280,6 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
                            j->receivers.triangle_count, j->drawn);
         j->bake.drawn = j->drawn;
     }
-    if (job_encoding(d) == VDSH_ENCODING_CPCA) {
-        vb_result r = job_cpca_pool(j, d, err);
-        if (r != VB_OK)
-            return r;
-    }
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!b->coeffs[o])
             continue;
@@ -284,25 +294,11 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
             &j->streams[count], &j->stream_data[count], err);
         if (r != VB_OK)
             return r;
-        if (cpca) {
-            /* The global step over every receiver (vdsh-merge does the
-             * same over the joined parts), with the file's normals. */
-            vdsh_cpca_settings st = job_cpca(j, d);
-            vdsh_error e;
-            void *storage = NULL;
-            vdsh_stream f32 = j->streams[count];
-            const float *nrm = b->normals ? b->normals : j->receivers.normals;
-            vdsh_result er = vdsh_cpca_encode_stream(&f32, j->receivers.vertex_count, nrm, &st,
-                                                     &j->streams[count], &storage, NULL, &e);
-            free(j->stream_data[count]);
-            j->stream_data[count] = storage;
-            if (er != VDSH_OK) {
-                j->streams[count] = f32;
-                j->streams[count].data = NULL;
-                return vb_fail(err,
-                               er == VDSH_ERR_OUT_OF_MEMORY ? VB_ERR_OUT_OF_MEMORY : VB_ERR_INVALID,
-                               "order %d stream: %s", o, e.msg);
-            }
+        if (cpca) { /* as vdsh-merge over the joined parts */
+            char what[32];
+            snprintf(what, sizeof what, "order %d", o);
+            if ((r = job_cpca_encode(j, d, count, j->streams[count], what, err)) != VB_OK)
+                return r;
         }
         j->coefficient_bytes += vdsh_stream_bytes_per_vertex(&j->streams[count]);
         count++;
@@ -371,19 +367,9 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         f.has_part = 1;
         f.part = (vdsh_part){
             .index = d->shard_index, .count = d->shard_count, .encoding = job_encoding(d)};
-        if (job_encoding(d) == VDSH_ENCODING_CPCA) {
-            /* auto: 0, budget, 0; K,alloc:BYTES: K, budget, 0 (VDSH.md
-             * "Parts") */
+        if (job_encoding(d) == VDSH_ENCODING_CPCA) { /* the pool for the merge */
             vdsh_cpca_settings st = job_cpca(j, d);
-            f.part.cpca_clusters = st.clusters;
-            f.part.cpca_basis = st.budget ? st.budget : st.basis;
-            f.part.cpca_bits = st.budget ? 0 : st.bits;
-            if (st.light_mix > 0.0f &&
-                st.light_count) { /* the pool for the merge (VDSH.md `lpol`) */
-                f.has_light_pool = 1;
-                f.light_pool = (vdsh_light_pool){
-                    .mix = st.light_mix, .count = st.light_count, .lights = st.lights};
-            }
+            vdsh_cpca_part_record(&st, &f);
         }
         vb_shard_range(h->vertex_count, d->shard_index, d->shard_count, &f.part.range_begin,
                        &f.part.range_end);
@@ -511,7 +497,7 @@ void vb_job_free(vb_job *j)
     if (j->basis_running)
         pthread_join(j->basis_thread, NULL);
     vb_cubemap_basis_free(&j->basis);
-    free(j->cpca_pool);
+    free(j->pool);
     for (int s = 0; s < VDSH_MAX_STREAMS; s++)
         free(j->stream_data[s]);
     vb_bake_output_free(&j->bake);

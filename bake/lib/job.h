@@ -100,11 +100,13 @@ typedef struct vb_job {
     vdsh_file file;           /* filled by vb_bake_fill_file (borrows the above) */
     uint64_t file_bytes;      /* the written file's size (vb_job_write) */
     vdsh_timings timings;
-    /* encoding cpca with a light mix > 0: the light-density metric's pool
-     * (vb_job_cpca_pool), which a part carries for the merge (`lpol`). */
-    float (*cpca_pool)[3];
-    uint32_t cpca_pool_count;
-    int cpca_pool_tried;
+    /* The light pool (job.c: job_pool; bake.h, VB_POOL_SEED), scene
+     * units: the decision fit's (pool_count VB_DECISION_POOL; 0 where it
+     * found no room) and, with encoding cpca and a light mix > 0, the
+     * light-density metric's first cpca_lights (VB_CPCA_POOL; 0: none),
+     * which a part carries for the merge (`lpol`). */
+    float (*pool)[3];
+    uint32_t pool_count, cpca_lights;
     vb_adaptive_stats adaptive; /* with d->adaptive */
     double t_start;
     /* The basis cubemaps' helper thread. */

@@ -278,15 +278,20 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
     return VB_OK;
 }
 
-vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
-                                uint32_t *tried, vb_error *err)
+static vb_result place_uniform(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
+                               uint32_t *tried, uint32_t first, int *first_ok, vb_error *err)
 {
     /* Give up when a thousand candidates per light find no room: a scene
      * without free space (a solid, or everything closer than clearance). */
     float lo[3], hi[3];
     const int grown = vb_scene_light_region(s, lo, hi, NULL);
-    uint32_t k = 0;
-    const uint32_t n = vdsh_light_place(lo, hi, grown, seed, count, free_cb, s, out, NULL, &k);
+    uint32_t k = 0, *at = NULL; /* with first_ok: each light's candidate */
+    if (first_ok && !(at = malloc(sizeof *at * (size_t)count + 1)))
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for %u lights", count);
+    const uint32_t n = vdsh_light_place(lo, hi, grown, seed, count, free_cb, s, out, at, &k);
+    if (first_ok) /* placing `first` stops at its last light, if in time */
+        *first_ok = first >= 1 && n >= first && at[first - 1] < vdsh_light_tries(first, grown);
+    free(at);
     if (tried)
         *tried = k;
     if (n < count)
@@ -296,4 +301,16 @@ vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count
                        k - n, k, vdsh_s(k), region_name(grown), k - n == 1 ? "was" : "were",
                        (double)vdsh_free_clearance(s->diagonal));
     return VB_OK;
+}
+
+vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
+                                uint32_t *tried, vb_error *err)
+{
+    return place_uniform(s, seed, count, out, tried, 0, NULL, err);
+}
+
+vb_result vb_scene_place_pool(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
+                              uint32_t first, int *first_ok, vb_error *err)
+{
+    return place_uniform(s, seed, count, out, NULL, first, first_ok, err);
 }

@@ -103,6 +103,14 @@ void vb_offset_origin(const float p[3], const float n[3], float out[3]);
 vb_result vb_scene_place_lights(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
                                 uint32_t *tried, vb_error *err);
 
+/* vb_scene_place_lights (no *tried), and whether its first `first` lights
+ * (1 <= first <= count; out[0..first-1] whenever *first_ok) are those of
+ * a placement of `first` lights with this seed that succeeds (*first_ok
+ * 1): the candidates are one sequence, so a pool's first lights are a
+ * smaller pool's, but the smaller one gives up sooner (vdsh_light_tries). */
+vb_result vb_scene_place_pool(const vb_scene *s, uint64_t seed, uint32_t count, float (*out)[3],
+                              uint32_t first, int *first_ok, vb_error *err);
+
 /* The region lights are placed in (vdsh_light_region): the bounds, or,
  * when they hold too little free space (a closed object), the bounds grown
  * by up to a quarter of their diagonal, the less free space the more.

@@ -553,21 +553,8 @@ static int merge_streams(merge *m)
              * variable-order stream's rows (zeros past each vertex's
              * order) become a fixed stream of its cap, as cpca_variable
              * (bake/lib/job.c) writes it. */
-            /* auto: 0, budget, 0; K,alloc:BYTES: K, budget, 0 */
-            const vdsh_part *pt = &m->p0->part;
-            vdsh_cpca_settings st = {.clusters = pt->cpca_clusters,
-                                     .basis = pt->cpca_basis,
-                                     .bits = pt->cpca_bits,
-                                     .budget = 0};
-            if (!pt->cpca_bits)
-                st = (vdsh_cpca_settings){
-                    .clusters = pt->cpca_clusters, .basis = 0, .bits = 0, .budget = pt->cpca_basis};
-            if (m->p0->has_light_pool) { /* the light-density metric, as the bake's */
-                st.light_mix = m->p0->light_pool.mix;
-                st.light_count = m->p0->light_pool.count;
-                st.lights = m->p0->light_pool.lights;
-                st.positions = m->p0->positions;
-            }
+            /* as the bake's, with the pool it placed (lpol) */
+            vdsh_cpca_settings st = vdsh_cpca_part_settings(m->p0);
             vdsh_stream f32 = m->streams[s];
             f32.encoding = VDSH_ENCODING_F32;
             f32.scale = 1.0f;
