@@ -594,7 +594,8 @@ float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m, 
     return (float)front / (float)VDSH_VIEW_RAYS;
 }
 
-int vdsh_view_free_space(const vdsh_view_tracer *t, const float p[3], float diagonal)
+/* vdsh_light.h's rule at this clearance. */
+static int free_at(const vdsh_view_tracer *t, const float p[3], float clearance)
 {
     float dirs[VDSH_FREE_PROBES][3], dist[VDSH_FREE_PROBES];
     int back[VDSH_FREE_PROBES];
@@ -605,7 +606,12 @@ int vdsh_view_free_space(const vdsh_view_tracer *t, const float p[3], float diag
         dist[i] = hit ? h.t : INFINITY;
         back[i] = hit && h.back;
     }
-    return vdsh_free_space(dist, back, vdsh_free_clearance(diagonal));
+    return vdsh_free_space(dist, back, clearance);
+}
+
+int vdsh_view_free_space(const vdsh_view_tracer *t, const float p[3], float diagonal)
+{
+    return free_at(t, p, vdsh_free_clearance(diagonal));
 }
 
 /* ---- what a light lights in the default frame ------------------------- */
@@ -746,7 +752,13 @@ static int cmp_cand(const void *a, const void *b)
 
 enum { FALLBACK_CANDIDATES = 4096 };
 
-/* A position in free space near p0, into out; 1, or 0 when none found. */
+/* A position in free space near p0, into out; 1, or 0 when none found.
+ * p0 itself when it is free; else, on rings of 26 directions around it,
+ * the nearest position VDSH_VIEW_LIGHT_MARGIN clearances from every
+ * surface within VDSH_VIEW_MARGIN_REACH clearances of p0, else the
+ * nearest free one (a light moved just out of a solid lands one
+ * clearance from its face: the hard case of every precomputed shadow,
+ * which the default frame should not show). */
 static int find_free(const vdsh_view_tracer *t, const float p0[3], const float lo[3],
                      const float hi[3], int interior, float diagonal, uint32_t *trials,
                      float out[3])
@@ -758,21 +770,25 @@ static int find_free(const vdsh_view_tracer *t, const float p0[3], const float l
     }
     float dirs[26][3];
     int nd = nudge_dirs(dirs);
-    float h = 0.5f * vdsh_free_clearance(diagonal);
-    int rings = (int)ceilf(0.5f * diagonal / h);
-    for (int k = 1; k <= rings; k++)
-        for (int j = 0; j < nd; j++) {
-            float p[3];
-            for (int a = 0; a < 3; a++)
-                p[a] = p0[a] + (float)k * h * dirs[j][a];
-            if (interior && !inside(p, lo, hi))
-                continue;
-            (*trials)++;
-            if (vdsh_view_free_space(t, p, diagonal)) {
-                memcpy(out, p, sizeof p);
-                return 1;
+    const float clearance = vdsh_free_clearance(diagonal), h = 0.5f * clearance;
+    const int rings = (int)ceilf(0.5f * diagonal / h);
+    for (int pass = 0; pass < 2; pass++) {
+        const float need = pass ? clearance : VDSH_VIEW_LIGHT_MARGIN * clearance;
+        const int last = pass ? rings : (int)(VDSH_VIEW_MARGIN_REACH / 0.5f);
+        for (int k = 1; k <= last; k++)
+            for (int j = 0; j < nd; j++) {
+                float p[3];
+                for (int a = 0; a < 3; a++)
+                    p[a] = p0[a] + (float)k * h * dirs[j][a];
+                if (interior && !inside(p, lo, hi))
+                    continue;
+                (*trials)++;
+                if (free_at(t, p, need)) {
+                    memcpy(out, p, sizeof p);
+                    return 1;
+                }
             }
-        }
+    }
     /* Nothing near: the seeded candidates in the bounds, nearest first. */
     cand *c = malloc(FALLBACK_CANDIDATES * sizeof *c);
     if (!c)

@@ -76,6 +76,11 @@ extern "C" {
 #define VDSH_VIEW_RAYS 128
 #define VDSH_VIEW_INTERIOR_SHARE 0.6f
 #define VDSH_VIEW_MAX_LIGHTS 4
+/* A default light whose preferred place is not free moves to the nearest
+ * place this many clearances (vdsh_free_clearance) from every surface,
+ * within VDSH_VIEW_MARGIN_REACH clearances; else to the nearest free one. */
+#define VDSH_VIEW_LIGHT_MARGIN 8.0f
+#define VDSH_VIEW_MARGIN_REACH 16.0f
 /* The frame rule for an interior's default lights (vdsh-frames' view-set
  * rule, bake/eval/frames.h): each lights at least this share of a
  * VDSH_VIEW_CHECK_W x VDSH_VIEW_CHECK_H frame of the default camera and

@@ -455,8 +455,9 @@ void vr_scene_fit_camera(const vr_scene *s, vr_camera *out);
  * the middle, a little above the floor); an object's stand outside its
  * bounding sphere, light 0 above it and to the side of the default eye.
  * Each is in free space (formats/vdsh_light.h: not inside a solid, not on
- * a surface), moved at load to the nearest such position when its place
- * is not (vdsh_view_compute says how). Colours and attenuations are left
+ * a surface), moved at load when its place is not: to the nearest place
+ * VDSH_VIEW_LIGHT_MARGIN clearances from every surface, else the nearest
+ * free one (vdsh_view_compute, formats/vdsh_scene_view.h, says how). Colours and attenuations are left
  * to the caller. */
 int vr_scene_default_lights(const vr_scene *s, vr_light *out, int max);
 

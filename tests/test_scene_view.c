@@ -137,8 +137,9 @@ static float diagonal_of(const float lo[3], const float hi[3])
     return sqrtf(d);
 }
 
-/* vdsh_light.h's rule, probes cast at every triangle (no grid). */
-static int free_all(const vdsh_view_mesh *m, const float p[3], float diagonal)
+/* vdsh_light.h's rule at this clearance, probes cast at every triangle
+ * (no grid). */
+static int free_all_at(const vdsh_view_mesh *m, const float p[3], float clearance)
 {
     float dirs[VDSH_FREE_PROBES][3], t[VDSH_FREE_PROBES];
     int back[VDSH_FREE_PROBES];
@@ -149,7 +150,12 @@ static int free_all(const vdsh_view_mesh *m, const float p[3], float diagonal)
         t[i] = hit ? h.t : INFINITY;
         back[i] = hit && h.back;
     }
-    return vdsh_free_space(t, back, vdsh_free_clearance(diagonal));
+    return vdsh_free_space(t, back, clearance);
+}
+
+static int free_all(const vdsh_view_mesh *m, const float p[3], float diagonal)
+{
+    return free_all_at(m, p, vdsh_free_clearance(diagonal));
 }
 
 static float dist3(const float a[3], const float b[3])
@@ -326,10 +332,16 @@ static void test_room(void)
               v.lights[i][2]);
         if (i == 2) {
             CHECK(!was_free, "light 2's preferred position is free: the pillar misses it");
+            /* Out of the pillar to a place VDSH_VIEW_LIGHT_MARGIN
+             * clearances from every surface (not one clearance from the
+             * pillar's face), within VDSH_VIEW_MARGIN_REACH of it. */
+            const float cl = vdsh_free_clearance(diag);
             float moved = dist3(v.lights[i], v.preferred[i]);
-            CHECK(moved > 0.0f && moved < 4.0f * vdsh_free_clearance(diag),
-                  "light 2 moved %g from the pillar (clearance %g)", (double)moved,
-                  (double)vdsh_free_clearance(diag));
+            CHECK(moved > 0.0f && moved <= (VDSH_VIEW_MARGIN_REACH + 0.5f) * cl,
+                  "light 2 moved %g from the pillar (clearance %g)", (double)moved, (double)cl);
+            CHECK(free_all_at(&m, v.lights[i], VDSH_VIEW_LIGHT_MARGIN * cl),
+                  "light 2 at (%g, %g, %g) is within %g clearances of a surface", v.lights[i][0],
+                  v.lights[i][1], v.lights[i][2], (double)VDSH_VIEW_LIGHT_MARGIN);
             int in_pillar = 1;
             for (int k = 0; k < 3; k++)
                 in_pillar &= v.lights[i][k] >= plo[k] && v.lights[i][k] <= phi[k];
@@ -755,7 +767,13 @@ static int test_builtin_room(const char *path)
                   i);
             CHECK(in_solid(v.preferred[i], 0.01f, what, sizeof what),
                   "light %d's preferred position is not at a pillar", i);
-            CHECK(moved > 0.0f && moved < 1.0f, "light %d moved %g", i, (double)moved);
+            /* out of the pillar to a place VDSH_VIEW_LIGHT_MARGIN
+             * clearances from every surface, within the reach */
+            CHECK(moved > 0.0f && moved <= (VDSH_VIEW_MARGIN_REACH + 0.5f) * clear,
+                  "light %d moved %g", i, (double)moved);
+            CHECK(free_all_at(&m, v.lights[i], VDSH_VIEW_LIGHT_MARGIN * clear),
+                  "light %d is within %g clearances of a surface", i,
+                  (double)VDSH_VIEW_LIGHT_MARGIN);
         } else {
             CHECK(pref_free && moved == 0.0f, "light %d: free %d, moved %g", i, pref_free,
                   (double)moved);
