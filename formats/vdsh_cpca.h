@@ -87,9 +87,10 @@ typedef struct vdsh_cpca_settings {
  * no pool (docs/ACCURACY.md "The default of --encoding cpca": over sixteen
  * validation bakes +1.68% over uncompressed order 12, within 3% on 14,
  * against 8,alloc:32's +2.05% and 11; 8,54,4, the default before, passed
- * 32 bytes per vertex below about 32,000 receivers). A mesh too small for
- * the model within 32 bytes per vertex (a few hundred receivers at order
- * 12) is refused by vdsh_cpca_encode: give fixed K,B,BITS there. */
+ * 32 bytes per vertex below about 32,000 receivers). K is a most: on a
+ * mesh too small for 16 clusters' model within 32 bytes per vertex (a few
+ * hundred receivers at order 12) vdsh_cpca_encode halves it until one
+ * fits; only a mesh no single cluster fits is refused. */
 vdsh_cpca_settings vdsh_cpca_settings_default(void);
 
 /* Parse "K,B,BITS" (for example "8,54,4"), "auto" (budget 32),
