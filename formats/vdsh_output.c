@@ -170,6 +170,14 @@ static int open_stream(const char *path, vdsh_output *o, vdsh_error *err, vdsh_r
     return 1;
 }
 
+int vdsh_output_is_stream(const char *path)
+{
+    struct stat st;
+    if (!path || !*path || stat(path, &st) != 0 || S_ISDIR(st.st_mode))
+        return 0;
+    return S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode) || through_proc_fd(path);
+}
+
 vdsh_result vdsh_output_open(const char *path, vdsh_output *out, vdsh_error *err)
 {
     static atomic_uint counter;

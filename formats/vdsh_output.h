@@ -88,6 +88,12 @@ typedef struct vdsh_output {
  * A directory, block device or socket at `path` is VDSH_ERR_IO. */
 vdsh_result vdsh_output_open(const char *path, vdsh_output *out, vdsh_error *err);
 
+/* 1 when vdsh_output_open would write `path` in place, as a stream (an
+ * existing character device or FIFO such as /dev/null, or a path through
+ * /proc/<pid>/fd such as /dev/stdout), else 0. Files named after such a
+ * target ("OUT.sh09-12.exr" beside it) would land in /dev or /proc. */
+int vdsh_output_is_stream(const char *path);
+
 /* fwrite to fp, remembering why the first failed write failed (the
  * commit reports it: a stream's error flag alone does not say why).
  * Returns the count written, as fwrite. */

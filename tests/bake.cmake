@@ -192,3 +192,11 @@ add_test(NAME bake_cpca_lightmix
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_cpca_lightmix.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
                  ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/bake_cpca_lightmix)
+
+# -o /dev/null, /dev/stdout or a FIFO: the file in place, byte for byte,
+# and no basis cubemaps beside it (they went into /dev), unless
+# --cubemap-dir; --sdf with such an OUT refused; vdsh-merge the same.
+add_test(NAME bake_stream_output
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_bake_stream_output.sh
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge>)
+set_tests_properties(bake_stream_output PROPERTIES TIMEOUT 60)

@@ -401,12 +401,19 @@ vb_result vb_output_cubemap_path(const char *output, const char *cubemap_dir, in
     return vb_cubemap_basis_path(cubemap_dir ? cubemap_dir : dir, stem, k, buf, cap, err);
 }
 
+int vb_output_has_cubemaps(const char *output, const char *cubemap_dir)
+{
+    return cubemap_dir != NULL || (output && !vdsh_output_is_stream(output));
+}
+
 vb_result vb_write_outputs(const vdsh_file *f, const char *output, const char *cubemap_dir,
                            const vb_cubemap_basis *b, vdsh_output *also, int also_count,
                            uint64_t *bytes, vb_error *err)
 {
     if (!output)
         return vb_fail(err, VB_ERR_ARGUMENT, "no output file");
+    if (!vb_output_has_cubemaps(output, cubemap_dir))
+        b = NULL; /* not beside /dev/null or /dev/stdout */
     char dir[PATH_MAX], stem[PATH_MAX];
     split_output(output, dir, stem, sizeof dir);
     vdsh_output cubes[VB_CUBEMAP_BASIS_FILES], file = {.fd = -1};

@@ -156,6 +156,13 @@ vb_result vb_job_write(vb_job *j, const vb_job_desc *d, vdsh_output *also, int a
 vb_result vb_output_cubemap_path(const char *output, const char *cubemap_dir, int k, char *buf,
                                  size_t cap, vb_error *err);
 
+/* 1 when a bake's basis cubemaps go with the .vdsh `output`: written to
+ * cubemap_dir when it is not NULL, else beside output unless output is
+ * written in place (a device or pipe such as /dev/null or /dev/stdout:
+ * vdsh_output_is_stream), where they would land in /dev; 0 then, and
+ * vb_write_outputs leaves them out. */
+int vb_output_has_cubemaps(const char *output, const char *cubemap_dir);
+
 /* A bake's outputs, all or none: the .vdsh file f to `output` and, when b
  * is not NULL, its basis cubemaps (cubemap_dir, NULL: beside output),
  * and the also_count files `also` the caller has staged (finished, not

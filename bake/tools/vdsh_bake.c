@@ -673,7 +673,8 @@ static int check_outputs(const options *o, const vb_job_desc *jd, const char *co
         if (rc)
             return rc;
     }
-    if (jd->output && !jd->shard_count && vb_job_cube_size(jd) > 0)
+    if (jd->output && !jd->shard_count && vb_job_cube_size(jd) > 0 &&
+        vb_output_has_cubemaps(jd->output, jd->cubemap_dir))
         for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++) {
             if (vb_output_cubemap_path(jd->output, jd->cubemap_dir, k, cube[k], sizeof cube[k],
                                        &err) != VB_OK) {
@@ -961,6 +962,10 @@ static int check_options(options *o)
     if (o->sdf && (o->shard_count || !o->output || o->trace_only))
         return bad_usage("%s", "--sdf writes beside the output file: it needs -o OUT.vdsh, "
                                "and neither --shard nor --trace-only");
+    if (o->sdf && vdsh_output_is_stream(o->output))
+        return bad_usage("--sdf writes OUT's companion file beside it: not with -o %s, "
+                         "a device or pipe",
+                         o->output);
     if (o->plan && o->receivers)
         return bad_usage("%s", "--plan writes the receivers --receivers reads: not both");
     if (o->receivers && (o->adaptive || o->max_edge > 0.0f || o->weld))
@@ -1167,9 +1172,14 @@ static void say_written(FILE *log, const options *o, const vb_job *job, const vb
         fprintf(log, ", f32 in a part: %s once merged)", vdsh_encoding_name(o->encoding));
     else
         fprintf(log, ", %s)", vdsh_encoding_name(o->encoding));
-    if (cube_size > 0)
+    if (cube_size > 0 && vb_output_has_cubemaps(o->output, o->cubemap_dir))
         fprintf(log, " and 4 basis cubemaps %dx%d in %s", cube_size, cube_size,
                 o->cubemap_dir ? o->cubemap_dir : "the output's directory");
+    else if (cube_size > 0) /* not beside /dev/null or /dev/stdout */
+        fprintf(log,
+                ", without its basis cubemaps: %s is a device or pipe "
+                "(--cubemap-dir DIR writes them)",
+                o->output);
     fprintf(log, "\nvdsh-bake: done in %.2f s\n", job->timings.total + write_seconds);
 }
 

@@ -632,24 +632,27 @@ static int merge_spilled(merge *m, const char *output)
 static int merge_write(merge *m, const options *o)
 {
     vb_error err;
-    if (m->f.header.cube_size > 0 &&
-        vb_cubemap_basis_encode((int)m->f.header.cube_size, &m->basis, &err) != VB_OK) {
+    /* None beside a device or pipe (-o /dev/null): they would land in /dev. */
+    const int cubes = m->f.header.cube_size > 0 && vb_output_has_cubemaps(o->output, NULL);
+    if (cubes && vb_cubemap_basis_encode((int)m->f.header.cube_size, &m->basis, &err) != VB_OK) {
         fprintf(stderr, "vdsh-merge: %s\n", err.msg);
         return 1;
     }
     uint64_t bytes = 0;
     vt_cli_defer_signals(); /* all of them, or none: not cubemaps beside an old file */
     vb_result r =
-        vb_write_outputs(&m->f, o->output, NULL, m->f.header.cube_size > 0 ? &m->basis : NULL, NULL,
-                         0, &bytes, &err);
+        vb_write_outputs(&m->f, o->output, NULL, cubes ? &m->basis : NULL, NULL, 0, &bytes, &err);
     vt_cli_undefer_signals();
     if (r != VB_OK) {
         fprintf(stderr, "vdsh-merge: %s\n", err.msg);
         return 1;
     }
     if (!o->quiet)
-        fprintf(stderr, "vdsh-merge: wrote %s (%u shard%s, %u receiver%s, %.2f MB)\n", o->output,
-                m->count, vdsh_s(m->count), m->V, vdsh_s(m->V), bytes / 1e6);
+        fprintf(stderr, "vdsh-merge: wrote %s (%u shard%s, %u receiver%s, %.2f MB)%s\n", o->output,
+                m->count, vdsh_s(m->count), m->V, vdsh_s(m->V), bytes / 1e6,
+                m->f.header.cube_size > 0 && !cubes
+                    ? ", without its basis cubemaps: a device or pipe"
+                    : "");
     return 0;
 }
 
@@ -680,11 +683,12 @@ static int check_outputs(const options *o)
     int rc = vt_cli_no_stdout(outs, &opt, 1);
     if (rc)
         return rc;
-    for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
-        if (vb_output_cubemap_path(o->output, NULL, k, cube[k], sizeof cube[k], &e) == VB_OK)
-            outs[1 + k] = cube[k];
-    return vt_cli_check_outputs(outs, 1 + VB_CUBEMAP_BASIS_FILES, (const char *const *)o->parts,
-                                o->part_count) != 0;
+    int n = 1;
+    if (vb_output_has_cubemaps(o->output, NULL)) /* not beside /dev/null */
+        for (int k = 0; k < VB_CUBEMAP_BASIS_FILES; k++)
+            if (vb_output_cubemap_path(o->output, NULL, k, cube[k], sizeof cube[k], &e) == VB_OK)
+                outs[n++] = cube[k];
+    return vt_cli_check_outputs(outs, n, (const char *const *)o->parts, o->part_count) != 0;
 }
 
 /* Pass 1, one part at a time, then the streams, pass 2 and the files: the
