@@ -8,6 +8,13 @@ import sys
 
 import numpy as np
 
+if len(sys.argv) == 2 and sys.argv[1] in ("-h", "--help"):
+    print(__doc__)
+    sys.exit(0)
+if len(sys.argv) != 3 or any(a.startswith("-") for a in sys.argv[1:]):
+    print("usage: scripts/obj_to_glb.py IN.obj OUT.glb", file=sys.stderr)
+    sys.exit(2)
+
 v, n, f = [], [], []
 for line in open(sys.argv[1]):
     p = line.split()

@@ -29,6 +29,29 @@ for s in demo test setup format_check; do
     fail=1
   fi
 done
+# The measuring and helper scripts: --help exits 0 with the usage on
+# stdout, an unknown option exits 2 (npm_gltf_tools --help ran
+# `mkdir --help` and npm with a folder named --help; bench_gltf_load
+# --help baked with an argument '--help'; obj_to_glb.py gave a traceback;
+# bench_shard, fuzz and reference_set --help exited 2, bench_gltf_libs 1
+# without libassimp-dev). Python ones through /usr/bin/python3 (Debian's,
+# as their #! says).
+for s in bench_gltf_libs bench_gltf_load bench_shard fuzz npm_gltf_tools obj_to_glb.py plot_shard_rss \
+         reference_set; do
+  cp "$src/scripts/$s" "$tmp/scripts/$s"
+  case $s in *.py | plot_shard_rss) run=(/usr/bin/python3) ;; *) run=(bash) ;; esac
+  out=$(cd "$tmp" && timeout 30 "${run[@]}" "scripts/$s" --help 2>"$tmp/err"); rc=$?
+  if [[ $rc -ne 0 || -z $out || -s $tmp/err ]]; then
+    echo "FAIL: scripts/$s --help: exit $rc, want 0 and its usage on stdout; stdout: ${out:0:200}; stderr: $(head -c 300 "$tmp/err")" >&2
+    fail=1
+  fi
+  out=$(cd "$tmp" && timeout 30 "${run[@]}" "scripts/$s" --bogus 2>"$tmp/err"); rc=$?
+  if [[ $rc -ne 2 ]] || grep -q Traceback "$tmp/err"; then
+    echo "FAIL: scripts/$s --bogus: exit $rc, want 2; stderr: $(head -c 300 "$tmp/err")" >&2
+    fail=1
+  fi
+done
+rm -f "$tmp/err"
 leftover=$(cd "$tmp" && ls -A | grep -v '^scripts$' | grep -v '^err$')
 [[ -z $leftover ]] || { echo "FAIL: the scripts left files: $leftover" >&2; fail=1; }
 [[ $fail -eq 0 ]] && echo "scripts: --help and unknown options handled"
