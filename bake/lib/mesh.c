@@ -235,6 +235,11 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
                 "%s%s%s: %u glTF primitive%s of skinned nodes baked in the bind pose (skin and "
                 "node transform ignored)\n",
                 tool, sep, path, r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
+    if (r->gltf_ragged)
+        fprintf(fp,
+                "%s%s%s: %u glTF triangle list%s with a count not a multiple of 3 (invalid "
+                "glTF): the last 1 or 2 indices ignored\n",
+                tool, sep, path, r->gltf_ragged, r->gltf_ragged == 1 ? "" : "s");
     /* the zero file normals left undefined were said above */
     uint32_t undefined =
         r->undefined_normals -
@@ -1244,6 +1249,7 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
     rp.gltf_skipped_modes = raw->gltf_skipped_modes;
     rp.gltf_skipped_morph = raw->gltf_skipped_morph;
     rp.gltf_skipped_skin = raw->gltf_skipped_skin;
+    rp.gltf_ragged = raw->gltf_ragged;
     rp.split_vertices = sv.split;
     rp.split_added = sv.added;
     rp.removed_vertices = vertex_count - m.vertex_count;

@@ -179,6 +179,9 @@ typedef struct vb_mesh_report {
                                     ignored; not skipped, despite the name) */
     uint32_t gltf_skipped_skin;   /* glTF: primitives of skinned nodes,
                                     baked in their bind pose (not skipped) */
+    uint32_t gltf_ragged;         /* glTF: TRIANGLES primitives whose index
+                                    (or vertex) count is not a multiple of
+                                    3, the last 1 or 2 ignored */
 } vb_mesh_report;
 
 /* What a loaded source was: size and hash for the .vdsh SRCS chunk, and

@@ -218,7 +218,7 @@ struct out_mesh {
     std::vector<float> pos, nrm;
     std::vector<uint8_t> has_n;
     std::vector<int64_t> idx;
-    uint32_t skipped_modes = 0, skipped_morph = 0, skipped_skin = 0;
+    uint32_t skipped_modes = 0, skipped_morph = 0, skipped_skin = 0, ragged = 0;
 };
 
 vb_result add_primitive(const reader &rd, const tinygltf::Primitive &p, const mat4 &w, out_mesh &o)
@@ -292,6 +292,8 @@ vb_result add_primitive(const reader &rd, const tinygltf::Primitive &p, const ma
         o.idx.insert(o.idx.end(), {v0, v1, v2});
     };
     if (p.mode == TINYGLTF_MODE_TRIANGLES || p.mode == -1) {
+        if (ni % 3) /* invalid glTF; other readers drop the rest too: said */
+            o.ragged++;
         for (size_t i = 0; i + 2 < ni; i += 3)
             tri(i, i + 1, i + 2);
     } else if (p.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
@@ -704,6 +706,7 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     raw.gltf_skipped_modes = o.skipped_modes;
     raw.gltf_skipped_morph = o.skipped_morph;
     raw.gltf_skipped_skin = o.skipped_skin;
+    raw.gltf_ragged = o.ragged;
     /* The source's hash covers its external buffers too (formats/VDSH.md,
      * SRCS): the file's bytes, then each external buffer's, in order. */
     bool external = false;

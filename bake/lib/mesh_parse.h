@@ -76,6 +76,8 @@ typedef struct vb_mesh_raw {
     uint32_t gltf_skipped_modes; /* glTF primitives skipped: points, lines */
     uint32_t gltf_skipped_morph; /* glTF primitives with morph targets: base pose baked */
     uint32_t gltf_skipped_skin;  /* glTF primitives of skinned nodes: bind pose baked */
+    uint32_t gltf_ragged;        /* glTF triangle lists whose count is not a
+                                   multiple of 3: the last 1 or 2 ignored */
     int gltf_hashed;             /* glTF with external buffers: the source's
                                    hash and size are these, not the file's */
     uint64_t gltf_size;          /* the file's bytes plus its external buffers' */
