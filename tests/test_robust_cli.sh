@@ -84,6 +84,19 @@ bad_mesh "$in/missing.obj" "cannot open"
 f scene.xyz 'v 0 0 0\n'
 bad_mesh "$in/scene.xyz" "unsupported file type"
 bad_mesh "builtin:nowhere" "unknown built-in scene"
+# Coordinates near FLT_MAX: a box on a floor 4e38 wide (its extent inf in
+# float) aborted in Embree (SIGABRT on infinite rays); these failed deep in
+# the bake on an inf diagonal, without the file's name. Refused at load,
+# named; 1.4e36 across still bakes.
+f huge38.obj 'v -2e38 0 -2e38\nv -2e38 0 2e38\nv 2e38 0 2e38\nv 0 1e38 0\nf 1 2 3\nf 1 3 4\nf 2 4 3\n'
+bad_mesh "$in/huge38.obj" "scale it down"
+f huge37.obj 'v -1.6e38 0 -1.6e38\nv -1.6e38 0 1.6e38\nv 1.6e38 0 1.6e38\nv 0 1e38 0\nf 1 2 3\nf 1 3 4\nf 2 4 3\n'
+bad_mesh "$in/huge37.obj" "scale it down"
+f big36.obj 'v -5e35 0 -5e35\nv -5e35 0 5e35\nv 5e35 0 5e35\nv 0 2e35 0\nf 1 2 3\nf 1 3 4\nf 2 4 3\n'
+cases=$((cases + 1))
+if ! timeout 60 "$bake" "$in/big36.obj" --rays 16 -q -o "$tmp/big36.vdsh" 2>"$tmp/stderr"; then
+  echo "FAIL: big36.obj (1.4e36 across) did not bake: $(cat "$tmp/stderr")" >&2; fail=1
+fi
 
 # ---- OBJ ------------------------------------------------------------------
 tri='v 0 0 0\nv 1 0 0\nv 0 1 0\n'

@@ -3,6 +3,7 @@
 
 #include <libgen.h>
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -87,6 +88,24 @@ vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err)
                        "nothing casts or receives a shadow",
                        d->paths[0], d->path_count > 1 ? " and the other meshes" : "",
                        o->triangle_count);
+    /* Too large for single precision (coordinates near FLT_MAX): said here,
+     * rather than as an infinite diagonal, or Embree's abort on rays of
+     * infinite length, deep in the bake. */
+    float lo[3], hi[3];
+    vb_mesh_bounds(o, lo, hi);
+    double diag2 = 0.0, far = 0.0;
+    for (int k = 0; k < 3; k++) {
+        const double e = (double)hi[k] - (double)lo[k];
+        diag2 += e * e;
+        far = fmax(far, fmax(fabs((double)lo[k]), fabs((double)hi[k])));
+    }
+    if (!(sqrt(diag2) <= VB_MAX_DIAGONAL))
+        return vb_fail(err, VB_ERR_INVALID,
+                       "%s%s: the scene is %.3g across (coordinates up to %.3g): more than the "
+                       "bake takes, %g (its frame and distances are single precision); scale "
+                       "it down",
+                       d->paths[0], d->path_count > 1 ? " and the other meshes" : "", sqrt(diag2),
+                       far, VB_MAX_DIAGONAL);
     return VB_OK;
 }
 

@@ -48,6 +48,13 @@ extern "C" {
 /* vdsh-bake's coefficient encoding when none is asked for. */
 #define VB_DEFAULT_ENCODING VDSH_ENCODING_S8S6
 
+/* The largest scene a bake takes: a bounding-box diagonal up to this many
+ * units. The bake's frame, light region and distances are single
+ * precision: a scene near FLT_MAX across (3.4e38) has a diagonal, or a
+ * light region, of inf (vb_job_load refuses it, naming the files, where
+ * Embree aborted on the infinite rays). */
+#define VB_MAX_DIAGONAL 1e37
+
 typedef struct vb_job_desc {
     const char *const *paths;   /* meshes (mesh.h names), borrowed */
     uint32_t path_count;        /* 1..VDSH_MAX_SOURCES */
