@@ -8,6 +8,13 @@
 
 #include "vt_json.h"
 
+/* A number that is finite as a float too (1e39 is a finite double but
+ * inf as the float the views hold: Embree aborted on the rays toward it). */
+static int finite_number(const cJSON *x)
+{
+    return cJSON_IsNumber(x) && isfinite(x->valuedouble) && isfinite((float)x->valuedouble);
+}
+
 static int vec3(const cJSON *o, const char *key, float out[3], int optional)
 {
     const cJSON *a = cJSON_GetObjectItemCaseSensitive(o, key);
@@ -17,7 +24,7 @@ static int vec3(const cJSON *o, const char *key, float out[3], int optional)
         return -1;
     for (int i = 0; i < 3; i++) {
         const cJSON *x = cJSON_GetArrayItem(a, i);
-        if (!cJSON_IsNumber(x) || !isfinite(x->valuedouble))
+        if (!finite_number(x))
             return -1;
         out[i] = (float)x->valuedouble;
     }
@@ -74,8 +81,9 @@ int vt_views_read(const char *path, vt_views *out, char *msg, size_t cap)
                 FAIL("%s: view %d: name '%s' used twice", path, i, x->name);
         if (vec3(o, "eye", x->camera.eye, 0) || vec3(o, "target", x->camera.target, 0) ||
             vec3(o, "up", x->camera.up, 1))
-            FAIL("%s: view '%s': 'eye', 'target' (and 'up') must be 3 finite numbers", path,
-                 x->name);
+            FAIL("%s: view '%s': 'eye', 'target' (and 'up') must be 3 finite numbers "
+                 "(single precision: |x| < 3.4e38)",
+                 path, x->name);
         if (!memcmp(x->camera.eye, x->camera.target, sizeof x->camera.eye))
             FAIL("%s: view '%s': eye and target are the same point", path, x->name);
         if (vdsh_camera_degenerate(&x->camera))
@@ -104,13 +112,14 @@ int vt_views_read(const char *path, vt_views *out, char *msg, size_t cap)
                 int bad = !cJSON_IsArray(p) || cJSON_GetArraySize(p) != 3;
                 for (int a = 0; a < 3 && !bad; a++) {
                     const cJSON *c = cJSON_GetArrayItem(p, a);
-                    bad = !cJSON_IsNumber(c) || !isfinite(c->valuedouble);
+                    bad = !finite_number(c);
                     if (!bad)
                         x->lights[k][l][a] = (float)c->valuedouble;
                 }
                 if (bad)
-                    FAIL("%s: view '%s': light %d of set %d must be 3 finite numbers", path,
-                         x->name, l, k);
+                    FAIL("%s: view '%s': light %d of set %d must be 3 finite numbers "
+                         "(single precision: |x| < 3.4e38)",
+                         path, x->name, l, k);
             }
         }
     }
