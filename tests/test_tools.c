@@ -382,11 +382,12 @@ static void test_frames(void)
         "\"target\": [1,0,0], \"light_sets\": [[]]}]}",
         "{\"width\": 0.5, \"height\": 10, \"views\": [{\"name\": \"a\", \"eye\": [0,0,0], "
         "\"target\": [1,0,0], \"light_sets\": [[[0,1,0]]]}]}",
-        /* finite doubles, inf as floats: vdsh-frames truth aborted in Embree
-         * (SIGABRT) on a light at 1e39, leaving its DIR.tmp.* folder */
+        /* beyond +-1e18 (VDSH_VIEW_MAX_COORD): vdsh-frames truth aborted in
+         * Embree (SIGABRT) on a light at 1e39 (inf as a float) or an eye at
+         * 3e38, leaving its DIR.tmp.* folder */
         "{\"width\": 10, \"height\": 10, \"views\": [{\"name\": \"a\", \"eye\": [0,0,0], "
         "\"target\": [1,0,0], \"light_sets\": [[[1e39,1,0]]]}]}",
-        "{\"width\": 10, \"height\": 10, \"views\": [{\"name\": \"a\", \"eye\": [0,-1e39,0], "
+        "{\"width\": 10, \"height\": 10, \"views\": [{\"name\": \"a\", \"eye\": [0,-3e38,0], "
         "\"target\": [1,0,0], \"light_sets\": [[[0,1,0]]]}]}"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         FILE *f = fopen(path, "wb");

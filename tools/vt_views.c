@@ -6,13 +6,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vdsh_scene_view.h"
 #include "vt_json.h"
 
-/* A number that is finite as a float too (1e39 is a finite double but
- * inf as the float the views hold: Embree aborted on the rays toward it). */
+/* A coordinate within +-VDSH_VIEW_MAX_COORD, the views' bound on a scene
+ * (1e39 is a finite double but inf as the float the views hold, and an eye
+ * at 3e38 overflows the ray arithmetic: Embree aborted on either). */
 static int finite_number(const cJSON *x)
 {
-    return cJSON_IsNumber(x) && isfinite(x->valuedouble) && isfinite((float)x->valuedouble);
+    return cJSON_IsNumber(x) && fabs(x->valuedouble) <= (double)VDSH_VIEW_MAX_COORD;
 }
 
 static int vec3(const cJSON *o, const char *key, float out[3], int optional)
@@ -82,7 +84,7 @@ int vt_views_read(const char *path, vt_views *out, char *msg, size_t cap)
         if (vec3(o, "eye", x->camera.eye, 0) || vec3(o, "target", x->camera.target, 0) ||
             vec3(o, "up", x->camera.up, 1))
             FAIL("%s: view '%s': 'eye', 'target' (and 'up') must be 3 finite numbers "
-                 "(single precision: |x| < 3.4e38)",
+                 "within +-1e18",
                  path, x->name);
         if (!memcmp(x->camera.eye, x->camera.target, sizeof x->camera.eye))
             FAIL("%s: view '%s': eye and target are the same point", path, x->name);
@@ -118,7 +120,7 @@ int vt_views_read(const char *path, vt_views *out, char *msg, size_t cap)
                 }
                 if (bad)
                     FAIL("%s: view '%s': light %d of set %d must be 3 finite numbers "
-                         "(single precision: |x| < 3.4e38)",
+                         "within +-1e18",
                          path, x->name, l, k);
             }
         }
