@@ -235,6 +235,15 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
                 "%s%s%s: %u glTF primitive%s of skinned nodes baked in the bind pose (skin and "
                 "node transform ignored)\n",
                 tool, sep, path, r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
+    if (r->nonconvex_polygons)
+        fprintf(fp,
+                "%s%s%s: warning: %u polygon%s of 4 or more vertices not convex (or far from "
+                "flat): fanned from the first vertex, the triangles cover %.3gx the area %s, "
+                "part of it outside the face; triangulate %s in the exporter\n",
+                tool, sep, path, r->nonconvex_polygons, plural(r->nonconvex_polygons),
+                1.0 + r->nonconvex_excess,
+                r->nonconvex_polygons == 1 ? "it encloses" : "they enclose",
+                r->nonconvex_polygons == 1 ? "it" : "them");
     if (r->gltf_ragged)
         fprintf(fp,
                 "%s%s%s: %u glTF triangle list%s with a count not a multiple of 3 (invalid "
@@ -1170,6 +1179,47 @@ static int drop_duplicates(const float *positions, uint32_t *idx, uint32_t *coun
     return 1;
 }
 
+/* Polygons of 4+ vertices (consecutive triangles of one file face, fanned
+ * from its first vertex) whose fan covers more than 1% beyond the area the
+ * polygon encloses (the length of its vector area, which the fan's vector
+ * areas sum to): concave faces, whose fan reaches outside them and
+ * overlaps itself, or faces far from flat. Another reader (assimp's ear
+ * clipping) takes them differently: counted and said, not refused. */
+static void nonconvex_polygons(const vb_mesh_raw *raw, uint32_t *count, double *excess)
+{
+    double fan_sum = 0.0, own_sum = 0.0;
+    *count = 0;
+    for (uint32_t t = 0; raw->faces && t < raw->triangle_count;) {
+        uint32_t e = t + 1;
+        while (e < raw->triangle_count && raw->faces[e] == raw->faces[t])
+            e++;
+        if (e - t >= 2) {
+            double fan = 0.0, vec[3] = {0.0, 0.0, 0.0};
+            for (uint32_t k = t; k < e; k++) {
+                const int64_t *ix = raw->indices + 3 * (size_t)k;
+                const float *a = raw->positions + 3 * ix[0], *b = raw->positions + 3 * ix[1],
+                            *c = raw->positions + 3 * ix[2];
+                double u[3], v[3], x[3];
+                for (int d = 0; d < 3; d++)
+                    u[d] = (double)b[d] - a[d], v[d] = (double)c[d] - a[d];
+                x[0] = u[1] * v[2] - u[2] * v[1];
+                x[1] = u[2] * v[0] - u[0] * v[2];
+                x[2] = u[0] * v[1] - u[1] * v[0];
+                fan += sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+                for (int d = 0; d < 3; d++)
+                    vec[d] += x[d];
+            }
+            const double own = sqrt(vec[0] * vec[0] + vec[1] * vec[1] + vec[2] * vec[2]);
+            if (fan > 1.01 * own) {
+                (*count)++;
+                fan_sum += fan, own_sum += own;
+            }
+        }
+        t = e;
+    }
+    *excess = *count ? (own_sum > 0.0 ? fan_sum / own_sum - 1.0 : INFINITY) : 0.0;
+}
+
 /* Raw file mesh -> clean vb_mesh (see mesh.h for what clean means). */
 static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mesh_raw *raw,
                            vb_mesh *out, vb_mesh_report *rep, vb_error *err)
@@ -1252,6 +1302,7 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
     rp.gltf_ragged = raw->gltf_ragged;
     rp.split_vertices = sv.split;
     rp.split_added = sv.added;
+    nonconvex_polygons(raw, &rp.nonconvex_polygons, &rp.nonconvex_excess);
     rp.removed_vertices = vertex_count - m.vertex_count;
 
     /* File normals only when every vertex kept has one: a mix of given and

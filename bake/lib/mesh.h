@@ -182,6 +182,11 @@ typedef struct vb_mesh_report {
     uint32_t gltf_ragged;         /* glTF: TRIANGLES primitives whose index
                                     (or vertex) count is not a multiple of
                                     3, the last 1 or 2 ignored */
+    uint32_t nonconvex_polygons;  /* faces of 4+ vertices whose fan
+                                    triangles cover more than they enclose
+                                    (concave, or far from flat): baked as
+                                    fanned, area outside the face included */
+    double nonconvex_excess;      /* their fan area over their own, less 1 */
 } vb_mesh_report;
 
 /* What a loaded source was: size and hash for the .vdsh SRCS chunk, and
