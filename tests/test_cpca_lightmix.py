@@ -13,11 +13,14 @@ formats/vdsh_cpca.h; docs/ACCURACY.md, "A light-density metric"):
   refuses parts whose pools differ, naming the part, and a part whose
   lpol is damaged (CRC, a mix out of range) or an lpol in a whole file is
   refused by the C and Python readers;
+- a whole bake's --report says the mix and pool it fitted with (the
+  file does not record them), vdsh-info says so;
 - a one-shard part's merge equals the whole bake at light:1 (bake_cpca
   checks 2 shards and threads with the default).
 
 Usage: test_cpca_lightmix.py VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR WORK_DIR
 """
+import json
 import os
 import struct
 import subprocess
@@ -123,6 +126,27 @@ for name, want in (("p1", "l1"), ("p0", "l0")):
                        capture_output=True, text=True)
     if r.returncode or blob(name + "-m.vdsh") != blob(want + ".vdsh"):
         fail.append("%s merged is not the whole %s bake: %s" % (name, want, r.stderr))
+
+# A whole file does not record the mix or the pool (VDSH.md "cpca
+# streams"): the bake's --report says them, vdsh-info says where to look.
+for name, setting, mix, pool in (("r05", "4,alloc:40,light:0.5", 0.5, 2048),
+                                 ("r0", "4,alloc:40,light:0", 0.0, 0),
+                                 ("rfix", "8,54,4", 0.0, 0)):
+    must(run_bake(name + ".vdsh", CPCA + [setting, "--report", path(name + ".json")]), setting)
+    with open(path(name + ".json")) as f:
+        cp = json.load(f).get("cpca")
+    k = int(setting.split(",")[0])
+    if not cp or cp.get("light_mix") != mix or cp.get("light_pool") != pool or \
+            cp.get("clusters") != k:
+        fail.append("--cpca %s: the report's cpca %r (want light_mix %g, light_pool %d)" % (
+            setting, cp, mix, pool))
+    txt = subprocess.run([info, path(name + ".vdsh")], capture_output=True, text=True).stdout
+    if "light mix and pool not recorded in a whole file (vdsh-bake --report" not in txt:
+        fail.append("vdsh-info of a whole cpca file does not say where the mix is: %r" % txt)
+must(run_bake("rs8.vdsh", ["--report", path("rs8.json")]), "s8s6 bake")
+with open(path("rs8.json")) as f:
+    if json.load(f).get("cpca", 0) is not None:
+        fail.append("an s8s6 bake's report has a cpca object")
 
 # Two shards whose pools differ: refused, naming the part.
 for i, setting in ((0, "4,alloc:40,light:1"), (1, "4,alloc:40,light:0.5")):

@@ -201,9 +201,9 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
     return VB_OK;
 }
 
-/* The encoder's settings: what was asked for, with the job's pool and
+/* job.h. The encoder's settings: what was asked for, with the job's pool and
  * receivers when the light mix is > 0 (job_pool placed it). */
-static vdsh_cpca_settings job_cpca(const vb_job *j, const vb_job_desc *d)
+vdsh_cpca_settings vb_job_cpca_settings(const vb_job *j, const vb_job_desc *d)
 {
     vdsh_cpca_settings st = job_cpca_asked(d);
     if (st.light_mix > 0.0f && j->cpca_lights) {
@@ -221,7 +221,7 @@ static vdsh_cpca_settings job_cpca(const vb_job *j, const vb_job_desc *d)
 static vb_result job_cpca_encode(vb_job *j, const vb_job_desc *d, uint32_t s, vdsh_stream f32,
                                  const char *what, vb_error *err)
 {
-    vdsh_cpca_settings st = job_cpca(j, d);
+    vdsh_cpca_settings st = vb_job_cpca_settings(j, d);
     vdsh_error e;
     void *storage = NULL;
     const float *nrm = j->bake.normals ? j->bake.normals : j->receivers.normals;
@@ -368,7 +368,7 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         f.part = (vdsh_part){
             .index = d->shard_index, .count = d->shard_count, .encoding = job_encoding(d)};
         if (job_encoding(d) == VDSH_ENCODING_CPCA) { /* the pool for the merge */
-            vdsh_cpca_settings st = job_cpca(j, d);
+            vdsh_cpca_settings st = vb_job_cpca_settings(j, d);
             vdsh_cpca_part_record(&st, &f);
         }
         vb_shard_range(h->vertex_count, d->shard_index, d->shard_count, &f.part.range_begin,

@@ -144,6 +144,13 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err);
  * if asked, timings. */
 vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err);
 
+/* The cpca settings the job encodes with (after vb_job_bake): what was
+ * asked (d->cpca, or vdsh_cpca_settings_default()) with the light pool it
+ * placed, light_count 0 where the mix is 0 or the rule found no room (the
+ * uniform metric). A whole file does not record them (formats/VDSH.md,
+ * "cpca streams"): vdsh-bake's --report says them. Borrows j's pool. */
+vdsh_cpca_settings vb_job_cpca_settings(const vb_job *j, const vb_job_desc *d);
+
 /* Write the basis cubemaps (if any) and the .vdsh file together, with
  * the caller's staged side files `also` (vb_write_outputs);
  * j->file_bytes receives the file's size. */
