@@ -140,12 +140,14 @@ static vb_result job_pool(vb_job *j, const vb_job_desc *d, vb_error *err)
         return VB_OK;
     if (!(j->pool = malloc(count * sizeof *j->pool)))
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the light pool");
+    const double t = vb_now();
     vb_error perr;
     int first_ok;
     vb_result r = vb_scene_place_pool(j->scene, d->bake.seed ^ VB_POOL_SEED, count, j->pool,
                                       VB_CPCA_POOL, &first_ok, &perr);
     j->pool_count = r == VB_OK ? count : 0;
     j->cpca_lights = cpca && first_ok ? VB_CPCA_POOL : 0;
+    j->pool_seconds = vb_now() - t;
     return VB_OK;
 }
 

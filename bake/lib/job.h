@@ -107,6 +107,10 @@ typedef struct vb_job {
      * which a part carries for the merge (`lpol`). */
     float (*pool)[3];
     uint32_t pool_count, cpca_lights;
+    /* Its placement's seconds (0: none placed), between the BVH build
+     * and the trace: in timings.total, not in the `time` chunk's parts
+     * (vdsh-bake --report: seconds.pool). */
+    double pool_seconds;
     vb_adaptive_stats adaptive; /* with d->adaptive */
     double t_start;
     /* The basis cubemaps' helper thread. */

@@ -561,6 +561,7 @@ static int write_report(const char *path, const options *o, const vb_job_desc *j
     vt_json_u64(&j, org, "skipped_zero_area", b->origins.skipped_zero_area);
     report_seconds(&j, root, t);
     cJSON *sec = cJSON_GetObjectItemCaseSensitive(root, "seconds");
+    vt_json_f64(&j, sec, "pool", job->pool_seconds);
     vt_json_f64(&j, sec, "origins", b->origins.seconds);
     vt_json_f64(&j, sec, "write", write_seconds);
     vt_json_f64(&j, sec, "total", t->total + write_seconds);
@@ -1376,6 +1377,10 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
                 "(cap %u, tolerance %g)\n",
                 bo->vertex_count ? (double)bo->rays_traced / bo->vertex_count : 0.0, bo->rays,
                 (double)bo->ray_tolerance);
+    if (job->pool)
+        fprintf(log, "vdsh-bake: light pool placed in %.2f s: %u light%s%s\n", job->pool_seconds,
+                job->pool_count, vdsh_s(job->pool_count),
+                job->pool_count ? "" : " (no room in free space: none used)");
     fprintf(log,
             "vdsh-bake: ray origins checked in %.2f s: %llu probe ray%s (%.1f%% of the "
             "traced rays), %u receiver%s repaired, %u moved\n",
