@@ -187,8 +187,10 @@ target_link_libraries(light_pool_tool PRIVATE vb_core)
 # The cpca encoder's light-density metric (--cpca ...,light:A): light:0
 # the uniform metric, light:1 and 0.5 valid other fits, the default's
 # bytes, bad values refused; parts carry the pool (lpol), mismatched or
-# damaged pools refused by the merge and the readers.
+# damaged pools refused by the merge and the readers; light_pool_tool's
+# bake:1 is the part's pool.
 add_test(NAME bake_cpca_lightmix
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_cpca_lightmix.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
-                 ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/bake_cpca_lightmix)
+                 ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/bake_cpca_lightmix
+                 $<TARGET_FILE:light_pool_tool>)

@@ -15,10 +15,12 @@ formats/vdsh_cpca.h; docs/ACCURACY.md, "A light-density metric"):
   refused by the C and Python readers;
 - a whole bake's --report says the mix and pool it fitted with (the
   file does not record them), vdsh-info says so;
+- tests/light_pool_tool's seed bake:1 is the pool a bake of seed 1 places
+  (bake.h VB_POOL_SEED, one definition: scripts/cpca_study draws with it);
 - a one-shard part's merge equals the whole bake at light:1 (bake_cpca
   checks 2 shards and threads with the default).
 
-Usage: test_cpca_lightmix.py VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR WORK_DIR
+Usage: test_cpca_lightmix.py VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR WORK_DIR LIGHT_POOL_TOOL
 """
 import json
 import os
@@ -29,7 +31,7 @@ import zlib
 
 import numpy as np
 
-bake, merge, info, src, work = sys.argv[1:6]
+bake, merge, info, src, work, pool_tool = sys.argv[1:7]
 sys.path.insert(0, os.path.join(src, "python"))
 import vdsh  # noqa: E402
 
@@ -113,6 +115,10 @@ p1 = vdsh.read(path("p1.vdsh"))
 if p1.light_pool is None or len(p1.light_pool["lights"]) != 2048 or p1.light_pool["mix"] != 1:
     fail.append("the light:1 part's lpol: %r" % (p1.light_pool and {
         k: (len(v) if k == "lights" else v) for k, v in p1.light_pool.items()}))
+r = subprocess.run([pool_tool, "builtin:room", "2048", "bake:1", path("pool.f32")],
+                   capture_output=True, text=True)
+if r.returncode or np.asarray(p1.light_pool["lights"], dtype="<f4").tobytes() != blob("pool.f32"):
+    fail.append("light_pool_tool bake:1 is not the part's pool: %s" % r.stderr)
 if vdsh.read(path("p0.vdsh")).light_pool is not None:
     fail.append("a light:0 part carries a pool")
 for whole in ("l1.vdsh", "def.vdsh"):
