@@ -862,19 +862,26 @@ static vdsh_result choose_lights(const vdsh_view_tracer *t, const vdsh_view_mesh
         shares_of(t, &f, c[n].p, diag, &c[n].lit, &c[n].sh);
         good += tier(&c[n]) == 0;
     }
-    /* Too few light the frame: seeded candidates in free space, until enough do. */
-    for (uint32_t k = 0; good < v->light_count && k < VDSH_VIEW_LIGHT_POOL; k++) {
-        float p[3];
-        vdsh_light_candidate(v->bounds_min, v->bounds_max, 2, k, p);
-        v->pool_tried++;
-        if (!vdsh_view_free_space(t, p, diag))
-            continue;
-        memcpy(c[n].p, p, sizeof p);
-        c[n].free = 1, c[n].pref = -1;
-        shares_of(t, &f, p, diag, &c[n].lit, &c[n].sh);
-        good += tier(&c[n]) == 1;
-        n++;
-    }
+    /* Too few light the frame: seeded candidates, until enough do; first
+     * those VDSH_VIEW_LIGHT_MARGIN clearances from every surface, as
+     * find_free moves a light (one clearance from a wall is the hard case
+     * of every precomputed shadow, which the default frame should not
+     * show), then the others in free space. */
+    const float margin = VDSH_VIEW_LIGHT_MARGIN * vdsh_free_clearance(diag);
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t k = 0; good < v->light_count && k < VDSH_VIEW_LIGHT_POOL; k++) {
+            float p[3];
+            vdsh_light_candidate(v->bounds_min, v->bounds_max, 2, k, p);
+            v->pool_tried++;
+            const int far = free_at(t, p, margin);
+            if (pass ? far || !vdsh_view_free_space(t, p, diag) : !far)
+                continue;
+            memcpy(c[n].p, p, sizeof p);
+            c[n].free = 1, c[n].pref = -1;
+            shares_of(t, &f, p, diag, &c[n].lit, &c[n].sh);
+            good += tier(&c[n]) == 1;
+            n++;
+        }
     frame_free(&f);
     /* Tiers in candidate order; the last by the share lit (a stable
      * selection: ties keep the earlier). */

@@ -84,8 +84,10 @@ extern "C" {
 /* The frame rule for an interior's default lights (vdsh-frames' view-set
  * rule, bake/eval/frames.h): each lights at least this share of a
  * VDSH_VIEW_CHECK_W x VDSH_VIEW_CHECK_H frame of the default camera and
- * shadows as many; up to VDSH_VIEW_LIGHT_POOL seeded candidates in free
- * space are tried when the preferred lights do not. */
+ * shadows as many; up to VDSH_VIEW_LIGHT_POOL seeded candidates are tried
+ * when the preferred lights do not, those in free space
+ * VDSH_VIEW_LIGHT_MARGIN clearances from every surface taken (as a moved
+ * light: the margin). */
 #define VDSH_VIEW_MIN_SHARE 0.05f
 #define VDSH_VIEW_CHECK_W 64
 #define VDSH_VIEW_CHECK_H 48
