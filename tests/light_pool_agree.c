@@ -11,6 +11,12 @@
  * bit, and the first that differs with its candidates' probe distances
  * against the clearance. Exit 0 when every position is the same, 1 when
  * one differs (or the runtime places fewer), 2 on an error.
+ * They agree on every scene tried but one kind: coincident faces of
+ * opposite sides (a concave polygon fanned into overlapping triangles):
+ * which of two faces at the same distance a probe meets is each tracer's
+ * own tie, and the two see a front or a back there. A point on a face (a
+ * flat scene's candidates) is on it for both (bake/lib/scene.c,
+ * PROBE_BACK).
  * light_pool_agree --pockets OUT.obj H: writes the pocket scene below.
  */
 #include <math.h>
