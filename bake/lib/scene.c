@@ -49,14 +49,13 @@ vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc, vb_scen
     s->vertex_count = occ->vertex_count;
     s->triangle_count = occ->triangle_count;
     vb_mesh_bounds(occ, s->bounds_min, s->bounds_max);
-    double diag2 = 0.0, extent = 0.0;
+    double extent = 0.0;
     for (int i = 0; i < 3; i++) {
         double e = (double)s->bounds_max[i] - s->bounds_min[i];
-        diag2 += e * e;
         extent = fmax(extent, e);
         s->centre[i] = (float)(0.5 * ((double)s->bounds_min[i] + s->bounds_max[i]));
     }
-    s->diagonal = (float)sqrt(diag2);
+    s->diagonal = vdsh_free_diagonal(s->bounds_min, s->bounds_max); /* the runtime's too */
     /* Largest power of two with extent * scale <= 2: local coordinates in
      * [-1, 1]. A zero extent (all points equal) keeps scale 1. */
     s->scale = 1.0f;
