@@ -33,8 +33,9 @@ enum {
 
 vdsh_cpca_settings vdsh_cpca_settings_default(void)
 {
-    vdsh_cpca_settings s = {VDSH_CPCA_DEFAULT_CLUSTERS,  0, 0,    VDSH_CPCA_DEFAULT_BUDGET,
-                            VDSH_CPCA_DEFAULT_LIGHT_MIX, 0, NULL, NULL};
+    vdsh_cpca_settings s = {.clusters = VDSH_CPCA_DEFAULT_CLUSTERS,
+                            .budget = VDSH_CPCA_DEFAULT_BUDGET,
+                            .light_mix = VDSH_CPCA_DEFAULT_LIGHT_MIX};
     return s;
 }
 
@@ -390,8 +391,9 @@ typedef struct lightmix {
     uint16_t ref[6 * CUBE_N * CUBE_N]; /* refine_texel's of each fit texel */
 } lightmix;
 
-/* The most texels lightmix_load keeps (x 2 bytes): 128 MiB, the rows of
- * about 2^16 receivers with half a 2048-light pool above each horizon. */
+/* The most texels lightmix_load keeps (x 2 bytes) unless the settings
+ * say (light_cache): 128 MiB, the rows of about 2^16 receivers with half a
+ * 2048-light pool above each horizon. */
 #define LIGHT_CACHE ((size_t)1 << 26)
 
 static void lightmix_free(lightmix *lm)
@@ -479,24 +481,26 @@ static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float
         lm->ref[t] = (uint16_t)refine_texel(t);
     if (!(lm->at = malloc(sizeof(size_t) * ((size_t)rows + 1))))
         return -1;
+    /* One walk: each row's texels written where it would be kept, until
+     * the next would pass the cap; room for every row's (or the cap's)
+     * and one more row's, the scratch of the rows past the cap, then
+     * shrunk to what is kept (pages never written are never touched). */
+    const size_t cap = st->light_cache ? st->light_cache : LIGHT_CACHE;
+    const size_t most = (size_t)rows * lm->nl;
+    if (!(lm->tex = malloc(sizeof(uint16_t) * ((most < cap ? most : cap) + lm->nl) + 1)))
+        return -1;
     lm->at[0] = 0;
-    for (; lm->cached < rows; lm->cached++) { /* the rows kept, and where */
+    for (; lm->cached < rows; lm->cached++) {
         const uint32_t v = lm->cached;
-        const float *p = lm->pos + 3 * (size_t)v, *nv = normals + 3 * (size_t)v;
-        uint32_t t = 0;
-        for (uint32_t l = 0; l < lm->nl; l++) {
-            double d[3];
-            t += (uint32_t)light_above(lm, l, p, nv, d);
-        }
-        if (lm->at[v] + t > LIGHT_CACHE)
+        const uint32_t t = row_texels(lm, v, normals + 3 * (size_t)v, lm->at[v]);
+        if (lm->at[v] + t > cap)
             break;
         lm->at[v + 1] = lm->at[v] + t;
     }
     const size_t size = lm->at[lm->cached] + (lm->cached < rows ? lm->nl : 0);
-    if (!(lm->tex = malloc(sizeof(uint16_t) * size + 1)))
-        return -1;
-    for (uint32_t v = 0; v < lm->cached; v++)
-        row_texels(lm, v, normals + 3 * (size_t)v, lm->at[v]);
+    uint16_t *shrunk = realloc(lm->tex, sizeof(uint16_t) * size + 1);
+    if (shrunk)
+        lm->tex = shrunk;
     return 1;
 }
 

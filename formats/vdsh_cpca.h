@@ -69,6 +69,11 @@ typedef struct vdsh_cpca_settings {
     uint32_t light_count;
     const float *lights;    /* 3 per light, finite */
     const float *positions; /* 3 per row */
+    /* The most light texels the metric keeps between passes (2 bytes
+     * each; 0: 2^26, 128 MiB): the rows past it are found again at every
+     * pass, the same bytes more slowly (vdsh_cpca_encode). A memory cap
+     * only; the tests lower it to check that the output does not move. */
+    size_t light_cache;
 } vdsh_cpca_settings;
 
 /* The light mix vdsh_cpca_parse gives when the text does not say, for
@@ -128,7 +133,8 @@ typedef struct vdsh_cpca_fit {
  * With the light-density metric, each row's texels of the pool's lights
  * above its horizon are found once and kept for the whole encode (2 bytes
  * per light; at most 128 MiB, the rows past that found again at every
- * pass): docs/BENCHMARKS.md "cpca light-density metric: encode time".
+ * pass; settings->light_cache lowers that cap): docs/BENCHMARKS.md "cpca
+ * light-density metric: encode time".
  * VDSH_ERR_ARGUMENT for bad settings, order or rows; VDSH_ERR_INVALID for
  * a value that is not finite or a model that does not fit f16;
  * VDSH_ERR_OUT_OF_MEMORY. On failure *out is zeroed. */

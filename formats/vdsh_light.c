@@ -25,6 +25,16 @@ float vdsh_free_clearance(float diagonal)
     return 0.01f * diagonal;
 }
 
+float vdsh_free_diagonal(const float lo[3], const float hi[3])
+{
+    double d2 = 0.0;
+    for (int a = 0; a < 3; a++) {
+        const double e = (double)hi[a] - lo[a];
+        d2 += e * e;
+    }
+    return (float)sqrt(d2);
+}
+
 int vdsh_free_space(const float t[VDSH_FREE_PROBES], const int back[VDSH_FREE_PROBES],
                     float clearance)
 {

@@ -74,6 +74,12 @@ void vdsh_free_probe_dirs(float dirs[VDSH_FREE_PROBES][3]);
 /* The clearance for a scene whose bounding box has this diagonal. */
 float vdsh_free_clearance(float diagonal);
 
+/* The diagonal of the box lo..hi as both sides take it (summed in double,
+ * then rounded to float once): the bake's scene (bake/lib/scene.c) and the
+ * runtime's light pool (runtime/vr_view.c) the same bits, so the same
+ * clearance (a float sum was an ulp off on some scenes). */
+float vdsh_free_diagonal(const float lo[3], const float hi[3]);
+
 /* The decision from the probes' first hits: t[i] the distance (INFINITY:
  * nothing), back[i] nonzero when the face was met from behind (its normal
  * along the ray). Returns 1 for free space. */

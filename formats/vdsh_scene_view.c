@@ -595,18 +595,30 @@ float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m, 
 }
 
 /* vdsh_light.h's rule at this clearance. */
-static int free_at(const vdsh_view_tracer *t, const float p[3], float clearance)
-{
-    float dirs[VDSH_FREE_PROBES][3], dist[VDSH_FREE_PROBES];
+/* The free-space probes from p (vdsh_light.h): each one's first hit and
+ * side, for vdsh_free_space at one clearance or several. */
+typedef struct probes {
+    float dist[VDSH_FREE_PROBES];
     int back[VDSH_FREE_PROBES];
+} probes;
+
+static void probe(const vdsh_view_tracer *t, const float p[3], probes *out)
+{
+    float dirs[VDSH_FREE_PROBES][3];
     vdsh_free_probe_dirs(dirs);
     for (int i = 0; i < VDSH_FREE_PROBES; i++) {
         vdsh_view_hit h;
         int hit = vdsh_view_trace(t, p, dirs[i], 0.0f, &h);
-        dist[i] = hit ? h.t : INFINITY;
-        back[i] = hit && h.back;
+        out->dist[i] = hit ? h.t : INFINITY;
+        out->back[i] = hit && h.back;
     }
-    return vdsh_free_space(dist, back, clearance);
+}
+
+static int free_at(const vdsh_view_tracer *t, const float p[3], float clearance)
+{
+    probes pr;
+    probe(t, p, &pr);
+    return vdsh_free_space(pr.dist, pr.back, clearance);
 }
 
 int vdsh_view_free_space(const vdsh_view_tracer *t, const float p[3], float diagonal)
@@ -772,9 +784,13 @@ static int find_free(const vdsh_view_tracer *t, const float p0[3], const float l
     int nd = nudge_dirs(dirs);
     const float clearance = vdsh_free_clearance(diagonal), h = 0.5f * clearance;
     const int rings = (int)ceilf(0.5f * diagonal / h);
+    const int reach = (int)(VDSH_VIEW_MARGIN_REACH / 0.5f);
+    /* The first pass's positions free at one clearance (1 no, 2 yes, 0
+     * not probed), for the second: each position probed once. Without
+     * memory for it, probed again. */
+    uint8_t *seen = calloc((size_t)reach * (size_t)nd + 1, 1);
     for (int pass = 0; pass < 2; pass++) {
-        const float need = pass ? clearance : VDSH_VIEW_LIGHT_MARGIN * clearance;
-        const int last = pass ? rings : (int)(VDSH_VIEW_MARGIN_REACH / 0.5f);
+        const int last = pass ? rings : reach;
         for (int k = 1; k <= last; k++)
             for (int j = 0; j < nd; j++) {
                 float p[3];
@@ -783,12 +799,26 @@ static int find_free(const vdsh_view_tracer *t, const float p0[3], const float l
                 if (interior && !inside(p, lo, hi))
                     continue;
                 (*trials)++;
-                if (free_at(t, p, need)) {
+                uint8_t *at = seen && k <= reach ? &seen[(size_t)(k - 1) * nd + (size_t)j] : NULL;
+                int ok;
+                if (pass && at && *at) {
+                    ok = *at == 2;
+                } else {
+                    probes pr;
+                    probe(t, p, &pr);
+                    ok = vdsh_free_space(pr.dist, pr.back,
+                                         pass ? clearance : VDSH_VIEW_LIGHT_MARGIN * clearance);
+                    if (!pass && at)
+                        *at = (uint8_t)(1 + vdsh_free_space(pr.dist, pr.back, clearance));
+                }
+                if (ok) {
+                    free(seen);
                     memcpy(out, p, sizeof p);
                     return 1;
                 }
             }
     }
+    free(seen);
     /* Nothing near: the seeded candidates in the bounds, nearest first. */
     cand *c = malloc(FALLBACK_CANDIDATES * sizeof *c);
     if (!c)
@@ -862,19 +892,34 @@ static vdsh_result choose_lights(const vdsh_view_tracer *t, const vdsh_view_mesh
         shares_of(t, &f, c[n].p, diag, &c[n].lit, &c[n].sh);
         good += tier(&c[n]) == 0;
     }
-    /* Too few light the frame: seeded candidates in free space, until enough do. */
-    for (uint32_t k = 0; good < v->light_count && k < VDSH_VIEW_LIGHT_POOL; k++) {
-        float p[3];
-        vdsh_light_candidate(v->bounds_min, v->bounds_max, 2, k, p);
-        v->pool_tried++;
-        if (!vdsh_view_free_space(t, p, diag))
-            continue;
-        memcpy(c[n].p, p, sizeof p);
-        c[n].free = 1, c[n].pref = -1;
-        shares_of(t, &f, p, diag, &c[n].lit, &c[n].sh);
-        good += tier(&c[n]) == 1;
-        n++;
-    }
+    /* Too few light the frame: seeded candidates, until enough do; first
+     * those VDSH_VIEW_LIGHT_MARGIN clearances from every surface, as
+     * find_free moves a light (one clearance from a wall is the hard case
+     * of every precomputed shadow, which the default frame should not
+     * show), then the others in free space. */
+    const float clearance = vdsh_free_clearance(diag);
+    const float margin = VDSH_VIEW_LIGHT_MARGIN * clearance;
+    uint8_t room[VDSH_VIEW_LIGHT_POOL]; /* the first pass's: 2 at the margin, 1 free, 0 not */
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t k = 0; good < v->light_count && k < VDSH_VIEW_LIGHT_POOL; k++) {
+            float p[3];
+            vdsh_light_candidate(v->bounds_min, v->bounds_max, 2, k, p);
+            v->pool_tried++;
+            if (!pass) { /* the second runs only once the first tried all */
+                probes pr;
+                probe(t, p, &pr);
+                room[k] = vdsh_free_space(pr.dist, pr.back, margin)      ? 2
+                          : vdsh_free_space(pr.dist, pr.back, clearance) ? 1
+                                                                         : 0;
+            }
+            if (room[k] != 2 - pass)
+                continue;
+            memcpy(c[n].p, p, sizeof p);
+            c[n].free = 1, c[n].pref = -1;
+            shares_of(t, &f, p, diag, &c[n].lit, &c[n].sh);
+            good += tier(&c[n]) == 1;
+            n++;
+        }
     frame_free(&f);
     /* Tiers in candidate order; the last by the share lit (a stable
      * selection: ties keep the earlier). */

@@ -84,8 +84,11 @@ extern "C" {
 /* The frame rule for an interior's default lights (vdsh-frames' view-set
  * rule, bake/eval/frames.h): each lights at least this share of a
  * VDSH_VIEW_CHECK_W x VDSH_VIEW_CHECK_H frame of the default camera and
- * shadows as many; up to VDSH_VIEW_LIGHT_POOL seeded candidates in free
- * space are tried when the preferred lights do not. */
+ * shadows as many; when the preferred lights do not, up to
+ * VDSH_VIEW_LIGHT_POOL seeded candidates are tried: first those
+ * VDSH_VIEW_LIGHT_MARGIN clearances from every surface (the margin of a
+ * moved light), then, while too few light the frame, the others in free
+ * space. */
 #define VDSH_VIEW_MIN_SHARE 0.05f
 #define VDSH_VIEW_CHECK_W 64
 #define VDSH_VIEW_CHECK_H 48
@@ -119,7 +122,7 @@ typedef struct vdsh_view {
      * shares of its pixels lit and shadowed; 0 for an object's. */
     float light_lit[VDSH_VIEW_MAX_LIGHTS];
     float light_shadowed[VDSH_VIEW_MAX_LIGHTS];
-    uint32_t pool_tried; /* seeded candidates the frame rule tried */
+    uint32_t pool_tried; /* seeded candidate tests of the frame rule (both passes) */
     /* The fit camera, whatever the scene (vdsh-view --fit): a flat
      * object's seen from its front, as vdsh_view_compute says; an
      * object's default camera. */

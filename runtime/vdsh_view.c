@@ -177,9 +177,8 @@ static void note_buffer(vv_options *o, const vv_mode *m)
 static int parse_modes(const char *list, vv_options *o)
 {
     o->frame_mode_count = 0;
-    const char *p = list;
-    for (;;) {
-        size_t len = strcspn(p, ",");
+    for (const char *p = list, *next; p; p = next) {
+        size_t len = vt_list_item(p, &next);
         int found = vv_mode_find(p, len, VV_MODE_FRAMES);
         if (found < 0)
             return -1;
@@ -190,10 +189,8 @@ static int parse_modes(const char *list, vv_options *o)
             o->frame_modes[o->frame_mode_count++] = found;
             note_buffer(o, &vv_modes[found]);
         }
-        if (!p[len])
-            return 0;
-        p += len + 1;
     }
+    return 0;
 }
 
 /* Returns 0, or an exit status (help/version: -1 meaning exit 0). */

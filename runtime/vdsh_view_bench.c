@@ -9,6 +9,7 @@
  */
 #include "vdsh_view.h"
 
+#include "vt_cli.h"
 #include "vt_json.h"
 
 #include <stdio.h>
@@ -97,14 +98,12 @@ static int bench_keeps(const vv_options *o, const char *name)
     if (!o->bench_modes)
         return 1;
     size_t len = strlen(name);
-    for (const char *p = o->bench_modes;;) {
-        size_t n = strcspn(p, ",");
+    for (const char *p = o->bench_modes, *next; p; p = next) {
+        size_t n = vt_list_item(p, &next);
         if (n == len && !strncmp(p, name, len))
             return 1;
-        if (!p[n])
-            return 0;
-        p += n + 1;
     }
+    return 0;
 }
 
 /* Keep only the modes --bench-modes names. */

@@ -74,12 +74,7 @@ vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count, c
     vdsh_error ve;
     if (vdsh_view_tracer_create(m, &t, &ve) != VDSH_OK)
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: light pool: %s", name, ve.msg);
-    float diag = 0.0f;
-    for (int a = 0; a < 3; a++) {
-        float e = s->bounds_max[a] - s->bounds_min[a];
-        diag += e * e;
-    }
-    diag = sqrtf(diag);
+    const float diag = vdsh_free_diagonal(s->bounds_min, s->bounds_max); /* the bake's */
     s->pool_count = 0;
     pool_free c = {t, diag};
     float lo[3], hi[3];

@@ -156,8 +156,9 @@ target_link_libraries(light_region_probe PRIVATE vb_core)
 # vdsh_view_free_space) and the bake side's placement (vb_scene_place_lights:
 # Embree's probes, measured in double) with the same seed, one rule
 # (formats/vdsh_light.c vdsh_light_place, limit included): 64 positions
-# equal bit for bit, in a room (the bounds) and around a closed cube (the
-# grown region); 32 in a scene whose free space is small pockets.
+# equal bit for bit, in a room (the bounds), around a closed cube and over
+# a flat quad (the grown region); 32 in a scene whose free space is small
+# pockets.
 add_executable(light_pool_agree light_pool_agree.c)
 target_include_directories(light_pool_agree PRIVATE ${PROJECT_SOURCE_DIR}/runtime)
 target_link_libraries(light_pool_agree PRIVATE vb_core vr vdsh_format m)
@@ -170,6 +171,13 @@ for s in "$d/cube.obj" "$data/room_box.obj"; do
   "$bake" "$s" --rays 16 --cube-size 0 -q -o "$d/$n.vdsh" || exit 1
   "$probe" "$d/$n.vdsh" 64 || fail=1
 done
+# A flat quad: every candidate of its bounds lies on its plane; the
+# bake's probes (Embree, no hit promised at the ray's start) saw no face
+# there and placed all 64 lights on the quad, where the runtime's found
+# them not free and grew the region (0 of 64 equal).
+printf 'v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nf 1 4 3\nf 1 3 2\n' > "$d/quad.obj"
+"$bake" "$d/quad.obj" --method lsq --rays 16 --cube-size 0 -q -o "$d/quad.vdsh" || exit 1
+"$probe" "$d/quad.vdsh" 64 || fail=1
 # Free space in small pockets (about 1 candidate in 900 free, the region
 # the bounds): the runtime gave up at 256 candidates per light and placed
 # 9 of 32 where the bake placed 32.
@@ -187,11 +195,13 @@ target_link_libraries(light_pool_tool PRIVATE vb_core)
 # The cpca encoder's light-density metric (--cpca ...,light:A): light:0
 # the uniform metric, light:1 and 0.5 valid other fits, the default's
 # bytes, bad values refused; parts carry the pool (lpol), mismatched or
-# damaged pools refused by the merge and the readers.
+# damaged pools refused by the merge and the readers; light_pool_tool's
+# bake:1 is the part's pool.
 add_test(NAME bake_cpca_lightmix
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_cpca_lightmix.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
-                 ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/bake_cpca_lightmix)
+                 ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/bake_cpca_lightmix
+                 $<TARGET_FILE:light_pool_tool>)
 
 # -o /dev/null, /dev/stdout or a FIFO: the file in place, byte for byte,
 # and no basis cubemaps beside it (they went into /dev), unless

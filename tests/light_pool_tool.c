@@ -3,10 +3,12 @@
  * SCENE's free space by the project's rule (vb_scene_place_lights: seeded
  * candidates, uniform in the light region, that pass the free-space test;
  * vdsh_light.h), written to OUT as little-endian f32 x, y, z per light,
- * and the region on stdout. Measurement only: with COUNT 2048 and SEED
- * (bake seed) ^ 0xdec15105 the pool vdsh-bake --cpca ...,light:A places
- * (bake/lib/job.c); scripts/cpca_study passes it to vdsh-merge in a part's
- * lpol chunk (docs/ACCURACY.md, "A light-density metric").
+ * and the region on stdout. SEED is a number, or bake:N for the seed of
+ * the pool a bake of seed N places, N ^ VB_POOL_SEED (bake.h).
+ * Measurement only: with COUNT 2048 and SEED bake:N the pool vdsh-bake
+ * --seed N --cpca ...,light:A places (bake/lib/job.c); scripts/cpca_study
+ * passes it to vdsh-merge in a part's lpol chunk (docs/ACCURACY.md, "A
+ * light-density metric").
  * With `box`: the first COUNT candidates in the light region, no
  * free-space test (a pool a merge could draw from the region alone).
  * Exit 1 on a load, scene or placement error, 2 on bad usage.
@@ -15,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake.h"
 #include "mesh.h"
 #include "scene.h"
 #include "vdsh_light.h"
@@ -27,7 +30,8 @@ int main(int argc, char **argv)
     }
     const int box = argc == 6;
     const unsigned long count = strtoul(argv[2], NULL, 0);
-    const uint64_t seed = strtoull(argv[3], NULL, 0);
+    const int bake = strncmp(argv[3], "bake:", 5) == 0;
+    const uint64_t seed = strtoull(argv[3] + (bake ? 5 : 0), NULL, 0) ^ (bake ? VB_POOL_SEED : 0);
     if (count < 1 || count > 1000000) {
         fprintf(stderr, "light_pool_tool: COUNT must be 1..1000000, not '%s'\n", argv[2]);
         return 2;

@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake.h"
 #include "mesh.h"
 #include "scene.h"
 #include "vdsh_light.h"
@@ -122,7 +123,7 @@ int main(int argc, char **argv)
     printf(" (%u free)\n", free_count);
     float(*pool)[3] = malloc(POOL * sizeof *pool);
     uint32_t tried = 0;
-    if (pool && vb_scene_place_lights(s, seed ^ 0xdec15105ull, POOL, pool, &tried, &err) == VB_OK)
+    if (pool && vb_scene_place_lights(s, seed ^ VB_POOL_SEED, POOL, pool, &tried, &err) == VB_OK)
         printf("pool %u lights from %u candidates, hash %016llx\n", POOL, tried,
                (unsigned long long)fnv(0xcbf29ce484222325ull, pool, POOL * sizeof *pool));
     else

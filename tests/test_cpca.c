@@ -664,6 +664,36 @@ static void light_metric(void)
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &l, &g, &err) == VDSH_OK, "mix 1 again");
     CHECK(!same_fit(&u, &f), "mix 1 with a pool: the uniform metric's bytes");
     CHECK(same_fit(&f, &g), "mix 1: two encodings differ");
+    /* The texel cache's cap hit (light_cache: no row kept, or some of
+     * them; the pool puts thousands of texels above the rows' horizons):
+     * the rows past it found again at every pass, the same bytes, for the
+     * fixed settings and for a budget's candidates (one cache shared). */
+    vdsh_cpca_settings alloc = l;
+    alloc.bits = 0;
+    alloc.budget = 48;
+    vdsh_cpca_fit fa;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &alloc, &fa, &err) == VDSH_OK,
+          "mix 1, alloc:48: %s", err.msg);
+    for (size_t cap = 1; cap <= 4096; cap *= 4096) {
+        vdsh_cpca_settings c = l, ca = alloc;
+        c.light_cache = ca.light_cache = cap;
+        vdsh_cpca_fit h, ha;
+        CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &c, &h, &err) == VDSH_OK &&
+                  same_fit(&f, &h),
+              "mix 1, a cache of %zu texels: not the uncapped bytes (%s)", cap, err.msg);
+        CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &ca, &ha, &err) == VDSH_OK &&
+                  ha.model.clusters == fa.model.clusters && ha.model.basis == fa.model.basis &&
+                  ha.model.record_words == fa.model.record_words &&
+                  ha.model.bits == fa.model.bits &&
+                  (fa.model.bits || !memcmp(ha.model.widths, fa.model.widths, fa.model.basis)) &&
+                  !memcmp(ha.records, fa.records, (size_t)ROWS * 4 * fa.model.record_words) &&
+                  !memcmp(ha.storage_, fa.storage_,
+                          (size_t)vdsh_cpca_stream_model_bytes(&fa.model, ORDER) - 16),
+              "mix 1, alloc:48, a cache of %zu texels: not the uncapped bytes (%s)", cap, err.msg);
+        vdsh_cpca_fit_free(&h);
+        vdsh_cpca_fit_free(&ha);
+    }
+    vdsh_cpca_fit_free(&fa);
     CHECK(isfinite(f.rms_error) && f.rms_error < 4.0 * u.rms_error, "mix 1: error %g, uniform %g",
           f.rms_error, u.rms_error);
     printf("format_cpca: light mix 1: error %.4g, uniform %.4g\n", f.rms_error, u.rms_error);

@@ -13,11 +13,16 @@ formats/vdsh_cpca.h; docs/ACCURACY.md, "A light-density metric"):
   refuses parts whose pools differ, naming the part, and a part whose
   lpol is damaged (CRC, a mix out of range) or an lpol in a whole file is
   refused by the C and Python readers;
+- a whole bake's --report says the mix and pool it fitted with (the
+  file does not record them), vdsh-info says so;
+- tests/light_pool_tool's seed bake:1 is the pool a bake of seed 1 places
+  (bake.h VB_POOL_SEED, one definition: scripts/cpca_study draws with it);
 - a one-shard part's merge equals the whole bake at light:1 (bake_cpca
   checks 2 shards and threads with the default).
 
-Usage: test_cpca_lightmix.py VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR WORK_DIR
+Usage: test_cpca_lightmix.py VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR WORK_DIR LIGHT_POOL_TOOL
 """
+import json
 import os
 import struct
 import subprocess
@@ -26,7 +31,7 @@ import zlib
 
 import numpy as np
 
-bake, merge, info, src, work = sys.argv[1:6]
+bake, merge, info, src, work, pool_tool = sys.argv[1:7]
 sys.path.insert(0, os.path.join(src, "python"))
 import vdsh  # noqa: E402
 
@@ -110,6 +115,10 @@ p1 = vdsh.read(path("p1.vdsh"))
 if p1.light_pool is None or len(p1.light_pool["lights"]) != 2048 or p1.light_pool["mix"] != 1:
     fail.append("the light:1 part's lpol: %r" % (p1.light_pool and {
         k: (len(v) if k == "lights" else v) for k, v in p1.light_pool.items()}))
+r = subprocess.run([pool_tool, "builtin:room", "2048", "bake:1", path("pool.f32")],
+                   capture_output=True, text=True)
+if r.returncode or np.asarray(p1.light_pool["lights"], dtype="<f4").tobytes() != blob("pool.f32"):
+    fail.append("light_pool_tool bake:1 is not the part's pool: %s" % r.stderr)
 if vdsh.read(path("p0.vdsh")).light_pool is not None:
     fail.append("a light:0 part carries a pool")
 for whole in ("l1.vdsh", "def.vdsh"):
@@ -123,6 +132,27 @@ for name, want in (("p1", "l1"), ("p0", "l0")):
                        capture_output=True, text=True)
     if r.returncode or blob(name + "-m.vdsh") != blob(want + ".vdsh"):
         fail.append("%s merged is not the whole %s bake: %s" % (name, want, r.stderr))
+
+# A whole file does not record the mix or the pool (VDSH.md "cpca
+# streams"): the bake's --report says them, vdsh-info says where to look.
+for name, setting, mix, pool in (("r05", "4,alloc:40,light:0.5", 0.5, 2048),
+                                 ("r0", "4,alloc:40,light:0", 0.0, 0),
+                                 ("rfix", "8,54,4", 0.0, 0)):
+    must(run_bake(name + ".vdsh", CPCA + [setting, "--report", path(name + ".json")]), setting)
+    with open(path(name + ".json")) as f:
+        cp = json.load(f).get("cpca")
+    k = int(setting.split(",")[0])
+    if not cp or cp.get("light_mix") != mix or cp.get("light_pool") != pool or \
+            cp.get("clusters") != k:
+        fail.append("--cpca %s: the report's cpca %r (want light_mix %g, light_pool %d)" % (
+            setting, cp, mix, pool))
+    txt = subprocess.run([info, path(name + ".vdsh")], capture_output=True, text=True).stdout
+    if "light mix and pool not recorded in a whole file (vdsh-bake --report" not in txt:
+        fail.append("vdsh-info of a whole cpca file does not say where the mix is: %r" % txt)
+must(run_bake("rs8.vdsh", ["--report", path("rs8.json")]), "s8s6 bake")
+with open(path("rs8.json")) as f:
+    if json.load(f).get("cpca", 0) is not None:
+        fail.append("an s8s6 bake's report has a cpca object")
 
 # Two shards whose pools differ: refused, naming the part.
 for i, setting in ((0, "4,alloc:40,light:1"), (1, "4,alloc:40,light:0.5")):

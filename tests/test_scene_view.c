@@ -783,6 +783,47 @@ static int test_builtin_room(const char *path)
     return test_report("scene_view room");
 }
 
+/* The two rooms 6 high, the crate at x 17: the preferred lights 0 and 1
+ * do not light the frame, and the frame rule takes two seeded
+ * candidates. Those VDSH_VIEW_LIGHT_MARGIN clearances from every surface
+ * come first, as a moved light keeps the margin (both were taken 1-3
+ * clearances from a wall or the floor, the hard case of every precomputed
+ * shadow, where candidates at the margin also light the frame). */
+static void test_seeded_margin(void)
+{
+    memset(&M, 0, sizeof M);
+    box(&M, (float[3]){0, 0, 0}, (float[3]){20, 6, 8}, 1);
+    box(&M, (float[3]){11.8f, 0, 0}, (float[3]){12.2f, 6, 0.4f}, 0);
+    box(&M, (float[3]){11.8f, 0, 1.4f}, (float[3]){12.2f, 6, 8}, 0);
+    box(&M, (float[3]){11.8f, 2.2f, 0.4f}, (float[3]){12.2f, 6, 1.4f}, 0);
+    box(&M, (float[3]){17, 0, 2}, (float[3]){18, 1, 3}, 0);
+    vdsh_view_mesh m = view_mesh(&M);
+    vdsh_view v;
+    vdsh_error err;
+    CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
+    const float margin =
+        VDSH_VIEW_LIGHT_MARGIN * vdsh_free_clearance(diagonal_of(v.bounds_min, v.bounds_max));
+    float pref[VDSH_VIEW_MAX_LIGHTS][3];
+    vdsh_view_preferred_lights(v.bounds_min, v.bounds_max, 1, pref, VDSH_VIEW_MAX_LIGHTS);
+    int seeded = 0;
+    for (int i = 0; i < v.light_count; i++) {
+        int own = 0; /* a seeded light's preferred place is its own */
+        for (int q = 0; q < VDSH_VIEW_MAX_LIGHTS; q++)
+            own |= !memcmp(v.preferred[i], pref[q], sizeof pref[q]);
+        if (own)
+            continue;
+        seeded++;
+        printf("seeded margin: light %d (%g, %g, %g) lights %.1f%%\n", i, v.lights[i][0],
+               v.lights[i][1], v.lights[i][2], 100.0 * v.light_lit[i]);
+        CHECK(free_all_at(&m, v.lights[i], margin) && v.light_lit[i] >= VDSH_VIEW_MIN_SHARE,
+              "seeded light %d (%g, %g, %g) nearer than %g clearances to a surface, or lights "
+              "%g of the frame",
+              i, (double)v.lights[i][0], (double)v.lights[i][1], (double)v.lights[i][2],
+              (double)VDSH_VIEW_LIGHT_MARGIN, (double)v.light_lit[i]);
+    }
+    CHECK(seeded == 2, "the test has lost its case: %d seeded lights, not 2", seeded);
+}
+
 int main(int argc, char **argv)
 {
     if (argc == 3 && !strcmp(argv[1], "room"))
@@ -799,6 +840,7 @@ int main(int argc, char **argv)
     test_scale();
     test_none();
     test_two_rooms();
+    test_seeded_margin();
     test_blocked_eye();
     test_errors();
     return test_report("scene_view");

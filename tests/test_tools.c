@@ -119,6 +119,27 @@ static cJSON *round_trip(vt_json *j)
     return back;
 }
 
+/* vt_list_item, the one splitter of every comma list (vt_parse_floats,
+ * vdsh-view --frame-modes and --bench-modes, vdsh-frames --modes): each
+ * item, empty ones too, for the caller to refuse. */
+static void test_list_items(void)
+{
+    const struct {
+        const char *s, *want;
+    } cases[] = {{"a", "a|"},       {"", "|"},     {"ab,c", "ab|c|"},
+                 {"a,,b", "a||b|"}, {"a,", "a||"}, {",", "||"}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char got[64] = "";
+        for (const char *p = cases[i].s, *next; p; p = next) {
+            size_t len = vt_list_item(p, &next);
+            strncat(got, p, len);
+            strcat(got, "|");
+        }
+        CHECK(strcmp(got, cases[i].want) == 0, "'%s' split as %s, not %s", cases[i].s, got,
+              cases[i].want);
+    }
+}
+
 static void test_json_strings(void)
 {
     static const char *const s[] = {"plain",
@@ -469,6 +490,7 @@ int main(int argc, char **argv)
     mkdir(work, 0755);
     test_integers();
     test_reals();
+    test_list_items();
     test_json_strings();
     test_json_numbers();
     test_json_files();

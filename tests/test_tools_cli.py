@@ -111,6 +111,20 @@ try:
           "report: values")
 except (ValueError, KeyError, OSError) as e:
     check(False, "bake --report does not parse: %s" % e)
+# The light pool's placement (method decision: between the BVH build and
+# the trace) has its own seconds, within the total; none for paper.
+pool_report = os.path.join(W, b"pool.json")
+rc, out, err = run(bake, *[a if a != "paper" else "decision" for a in quick], "-o",
+                   os.path.join(W, b"pool.vdsh"), "--report", pool_report)
+check(rc == 0, "bake, method decision: exit %d %s" % (rc, err))
+try:
+    sec = strict_json(open(pool_report, "rb").read())["seconds"]
+    parts = sum(sec[k] for k in ("load", "refine", "build", "pool", "trace"))
+    check(sec["pool"] > 0 and parts <= sec["total"],
+          "report, method decision: seconds %r (pool > 0, the parts within total)" % sec)
+    check(rep["seconds"]["pool"] == 0, "report, method paper: pool seconds %r" % rep["seconds"])
+except (ValueError, KeyError, OSError) as e:
+    check(False, "bake --report (decision): %s" % e)
 
 for args in (["--json", "-"], ["--json", "-", "--verify"]):
     rc, out, err = run(info, *args, odd)

@@ -345,6 +345,12 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
             printf("; light pool of %u light%s", f->light_pool.count, vdsh_s(f->light_pool.count));
         printf(")\n");
     }
+    int whole_cpca = 0;
+    for (uint32_t i = 0; i < f->stream_count && !f->has_part; i++)
+        whole_cpca |= f->streams[i].encoding == VDSH_ENCODING_CPCA;
+    if (whole_cpca) /* VDSH.md "cpca streams": only a part's lpol records A */
+        printf("  cpca         light mix and pool not recorded in a whole file (vdsh-bake "
+               "--report: cpca.light_mix, cpca.light_pool)\n");
     if (f->has_adaptive) {
         const vdsh_adaptive *a = &f->adaptive;
         printf("  adaptive     tolerance %g, min edge %g, budget %u (0: none), %u light%s\n"

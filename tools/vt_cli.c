@@ -143,9 +143,7 @@ int vt_parse_float(const char *s, float *out)
     return s && float_n(s, strlen(s), out);
 }
 
-/* The length of the comma-separated item at p; *next gets the item after
- * it, NULL after the last. */
-static size_t list_item(const char *p, const char **next)
+size_t vt_list_item(const char *p, const char **next)
 {
     const char *comma = strchr(p, ',');
     *next = comma ? comma + 1 : NULL;
@@ -156,7 +154,7 @@ int vt_parse_floats(const char *s, float *out, int min, int max)
 {
     int n = 0;
     for (const char *p = s, *next; p; p = next) {
-        size_t len = list_item(p, &next);
+        size_t len = vt_list_item(p, &next);
         float v;
         if (n == max || !float_n(p, len, &v))
             return 0;
@@ -169,7 +167,7 @@ int vt_parse_u64_list(const char *s, uint64_t lo, uint64_t hi, uint64_t *out, in
 {
     int n = 0;
     for (const char *p = s, *next; p; p = next) {
-        size_t len = list_item(p, &next);
+        size_t len = vt_list_item(p, &next);
         uint64_t v;
         if (n == max || !digits_u64(p, len, &v) || v < lo || v > hi)
             return 0;

@@ -63,6 +63,13 @@ int vt_parse_int(const char *s, int lo, int hi, int *out);
 /* A finite real number (range checks are the caller's: > 0, >= 0, ...). */
 int vt_parse_float(const char *s, float *out);
 
+/* The length of the comma-separated item at p; *next gets the item after
+ * it, NULL after the last: the one splitter of every list (an empty item
+ * has length 0, for the caller to refuse). Usage:
+ *     for (const char *p = s, *next; p; p = next) {
+ *         size_t len = vt_list_item(p, &next); ... } */
+size_t vt_list_item(const char *p, const char **next);
+
 /* min..max comma-separated reals into out; returns the count, 0 if not
  * such a list (then out may be partly written). */
 int vt_parse_floats(const char *s, float *out, int min, int max);

@@ -631,8 +631,9 @@ static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind, 
         ratio sq = {0}, ab = {0}, mae_r = {0}, mb = {0}, fa = {0}, le = {0}, fb = {0}, lb = {0};
         uint32_t n_used = 0, nm = 0;
         uint64_t ringing = 0;
-        /* Pass 0 sums the ratios; pass 1, with the sums known, their
-         * residuals (ratio_se). */
+        /* Pass 0 sums the ratios; pass 1, with the sums known, the
+         * residuals of those with a standard error (ratio_se: not the
+         * mean distance, ab). */
         for (int pass = 0; pass < 2; pass++) {
             for (uint32_t i = first; i < first + count; i++) {
                 const racc *a = J->acc + (size_t)i * S + s;
@@ -640,7 +641,8 @@ static vb_result reduce(const job *J, uint32_t first, uint32_t count, int kind, 
                     continue;
                 void (*f)(ratio *, double, double) = pass ? ratio_res : ratio_add;
                 f(&sq, a->sq, a->n);
-                f(&ab, a->abs, a->n);
+                if (!pass)
+                    ratio_add(&ab, a->abs, a->n);
                 f(&mae_r, a->mae, a->n);
                 f(&mb, a->mae_bin, a->n);
                 f(&fa, a->fals, a->vis);

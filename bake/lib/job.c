@@ -159,12 +159,14 @@ static vb_result job_pool(vb_job *j, const vb_job_desc *d, vb_error *err)
         return VB_OK;
     if (!(j->pool = malloc(count * sizeof *j->pool)))
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for the light pool");
+    const double t = vb_now();
     vb_error perr;
     int first_ok;
     vb_result r = vb_scene_place_pool(j->scene, d->bake.seed ^ VB_POOL_SEED, count, j->pool,
                                       VB_CPCA_POOL, &first_ok, &perr);
     j->pool_count = r == VB_OK ? count : 0;
     j->cpca_lights = cpca && first_ok ? VB_CPCA_POOL : 0;
+    j->pool_seconds = vb_now() - t;
     return VB_OK;
 }
 
@@ -220,9 +222,9 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
     return VB_OK;
 }
 
-/* The encoder's settings: what was asked for, with the job's pool and
+/* job.h. The encoder's settings: what was asked for, with the job's pool and
  * receivers when the light mix is > 0 (job_pool placed it). */
-static vdsh_cpca_settings job_cpca(const vb_job *j, const vb_job_desc *d)
+vdsh_cpca_settings vb_job_cpca_settings(const vb_job *j, const vb_job_desc *d)
 {
     vdsh_cpca_settings st = job_cpca_asked(d);
     if (st.light_mix > 0.0f && j->cpca_lights) {
@@ -240,7 +242,7 @@ static vdsh_cpca_settings job_cpca(const vb_job *j, const vb_job_desc *d)
 static vb_result job_cpca_encode(vb_job *j, const vb_job_desc *d, uint32_t s, vdsh_stream f32,
                                  const char *what, vb_error *err)
 {
-    vdsh_cpca_settings st = job_cpca(j, d);
+    vdsh_cpca_settings st = vb_job_cpca_settings(j, d);
     vdsh_error e;
     void *storage = NULL;
     const float *nrm = j->bake.normals ? j->bake.normals : j->receivers.normals;
@@ -387,7 +389,7 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         f.part = (vdsh_part){
             .index = d->shard_index, .count = d->shard_count, .encoding = job_encoding(d)};
         if (job_encoding(d) == VDSH_ENCODING_CPCA) { /* the pool for the merge */
-            vdsh_cpca_settings st = job_cpca(j, d);
+            vdsh_cpca_settings st = vb_job_cpca_settings(j, d);
             vdsh_cpca_part_record(&st, &f);
         }
         vb_shard_range(h->vertex_count, d->shard_index, d->shard_count, &f.part.range_begin,

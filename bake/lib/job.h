@@ -114,6 +114,10 @@ typedef struct vb_job {
      * which a part carries for the merge (`lpol`). */
     float (*pool)[3];
     uint32_t pool_count, cpca_lights;
+    /* Its placement's seconds (0: none placed), between the BVH build
+     * and the trace: in timings.total, not in the `time` chunk's parts
+     * (vdsh-bake --report: seconds.pool). */
+    double pool_seconds;
     vb_adaptive_stats adaptive; /* with d->adaptive */
     double t_start;
     /* The basis cubemaps' helper thread. */
@@ -150,6 +154,13 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err);
  * receivers (with the bake's oriented normals), streams, statistics and,
  * if asked, timings. */
 vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err);
+
+/* The cpca settings the job encodes with (after vb_job_bake): what was
+ * asked (d->cpca, or vdsh_cpca_settings_default()) with the light pool it
+ * placed, light_count 0 where the mix is 0 or the rule found no room (the
+ * uniform metric). A whole file does not record them (formats/VDSH.md,
+ * "cpca streams"): vdsh-bake's --report says them. Borrows j's pool. */
+vdsh_cpca_settings vb_job_cpca_settings(const vb_job *j, const vb_job_desc *d);
 
 /* Write the basis cubemaps (if any) and the .vdsh file together, with
  * the caller's staged side files `also` (vb_write_outputs);

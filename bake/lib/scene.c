@@ -49,14 +49,13 @@ vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc, vb_scen
     s->vertex_count = occ->vertex_count;
     s->triangle_count = occ->triangle_count;
     vb_mesh_bounds(occ, s->bounds_min, s->bounds_max);
-    double diag2 = 0.0, extent = 0.0;
+    double extent = 0.0;
     for (int i = 0; i < 3; i++) {
         double e = (double)s->bounds_max[i] - s->bounds_min[i];
-        diag2 += e * e;
         extent = fmax(extent, e);
         s->centre[i] = (float)(0.5 * ((double)s->bounds_min[i] + s->bounds_max[i]));
     }
-    s->diagonal = (float)sqrt(diag2);
+    s->diagonal = vdsh_free_diagonal(s->bounds_min, s->bounds_max); /* the runtime's too */
     /* Largest power of two with extent * scale <= 2: local coordinates in
      * [-1, 1]. A zero extent (all points equal) keeps scale 1. */
     s->scale = 1.0f;
@@ -138,6 +137,16 @@ void vb_offset_origin(const float p[3], const float n[3], float out[3])
 
 /* ---- lights in free space (vdsh_light.h) ---- */
 
+/* Embree promises nothing of a hit at the ray's start (rtcIntersect1: at
+ * tnear it may be hit or missed; 3.13 misses it): a point on a face, as
+ * every candidate of a flat scene's bounds is (a single quad, a flat
+ * panel), saw none of it and was free, where the runtime's tracer
+ * (vdsh_view_trace, t >= 0) meets it at 0: the two placed other lights
+ * (tests/light_pool_agree). Each probe starts this far (local units, the
+ * scene within [-1, 1]) behind the point; a face met before the point is
+ * at distance 0, nearer than any clearance. */
+#define PROBE_BACK 0x1p-16f
+
 /* A probe's hit, measured on the triangle Embree found (primID) in plain
  * double arithmetic: its distance (scene units) and side do not depend on
  * the kernel set that found it. Embree's kernels round t and Ng each their
@@ -161,13 +170,13 @@ static void probe_hit(const vb_scene *s, const float o[3], const float d[3], uns
     const double den = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
     const double num =
         n[0] * ((double)a[0] - o[0]) + n[1] * ((double)a[1] - o[1]) + n[2] * ((double)a[2] - o[2]);
-    const double tt = den != 0.0 ? num / den : -1.0;
-    if (!(tt >= 0.0) || !isfinite(tt)) { /* along the plane: Embree's word */
-        *t = tfar / s->scale;
+    const double tt = den != 0.0 ? num / den : NAN;
+    if (!isfinite(tt)) { /* along the plane: Embree's word, from the probe's start */
+        *t = tfar > PROBE_BACK ? (tfar - PROBE_BACK) / s->scale : 0.0f;
         *back = 0;
         return;
     }
-    *t = (float)(tt / s->scale);
+    *t = tt > 0.0 ? (float)(tt / s->scale) : 0.0f; /* met before o: o is on it */
     *back = den > 0.0;
 }
 
@@ -184,7 +193,10 @@ static void cast_probes(const vb_scene *s, const float p[3], float t[VDSH_FREE_P
     rtcInitIntersectContext(&ctx);
     for (int i = 0; i < VDSH_FREE_PROBES; i++) {
         struct RTCRayHit rh;
-        vb_ray_init(&rh, o, dirs[i], INFINITY, 0);
+        float start[3];
+        for (int a = 0; a < 3; a++)
+            start[a] = o[a] - PROBE_BACK * dirs[i][a];
+        vb_ray_init(&rh, start, dirs[i], INFINITY, 0);
         rtcIntersect1(s->scene, &ctx, &rh);
         t[i] = INFINITY, back[i] = 0;
         if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)

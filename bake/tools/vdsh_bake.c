@@ -439,9 +439,9 @@ static void report_seconds(vt_json *j, cJSON *root, const vdsh_timings *t)
     vt_json_f64(j, sec, "trace", t->trace);
 }
 
-static int write_report(const char *path, const options *o, const vb_job *job,
-                        const vb_mesh_spacing *sp, const vdsh_sdf *vol, double sdf_seconds,
-                        double write_seconds, char *msg, size_t cap)
+static int write_report(const char *path, const options *o, const vb_job_desc *jd,
+                        const vb_job *job, const vb_mesh_spacing *sp, const vdsh_sdf *vol,
+                        double sdf_seconds, double write_seconds, char *msg, size_t cap)
 {
     const vdsh_file *f = &job->file;
     const vb_bake_output *b = &job->bake;
@@ -468,6 +468,22 @@ static int write_report(const char *path, const options *o, const vb_job *job,
     for (int i = 0; i < o->order_count; i++)
         vt_json_u64(&j, orders, NULL, (uint64_t)o->orders[i]);
     vt_json_string(&j, root, "encoding", vdsh_encoding_name(o->encoding));
+    if (o->encoding == VDSH_ENCODING_CPCA) {
+        /* The settings the streams were fitted with, light mix and pool
+         * included: a whole file does not record them (VDSH.md "cpca
+         * streams"), a part's `part` and `lpol` chunks do. light_pool 0:
+         * the uniform metric (a mix of 0, or no room for the pool). */
+        const vdsh_cpca_settings st = vb_job_cpca_settings(job, jd);
+        cJSON *cp = vt_json_object(&j, root, "cpca");
+        vt_json_u64(&j, cp, "clusters", st.clusters);
+        vt_json_u64(&j, cp, "basis", st.budget ? 0 : st.basis);
+        vt_json_u64(&j, cp, "bits", st.budget ? 0 : st.bits);
+        vt_json_u64(&j, cp, "budget", st.budget);
+        vt_json_f32(&j, cp, "light_mix", st.light_mix);
+        vt_json_u64(&j, cp, "light_pool", st.light_count);
+    } else {
+        vt_json_null(&j, root, "cpca");
+    }
     vt_json_f32(&j, root, "max_distance", b->max_distance);
     vt_json_f32(&j, root, "max_edge", o->max_edge);
     /* The receivers' spacing before any bake (vb_mesh_spacing_of). */
@@ -546,6 +562,7 @@ static int write_report(const char *path, const options *o, const vb_job *job,
     vt_json_u64(&j, org, "skipped_zero_area", b->origins.skipped_zero_area);
     report_seconds(&j, root, t);
     cJSON *sec = cJSON_GetObjectItemCaseSensitive(root, "seconds");
+    vt_json_f64(&j, sec, "pool", job->pool_seconds);
     vt_json_f64(&j, sec, "origins", b->origins.seconds);
     vt_json_f64(&j, sec, "write", write_seconds);
     vt_json_f64(&j, sec, "total", t->total + write_seconds);
@@ -1371,6 +1388,10 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
                 "(cap %u, tolerance %g)\n",
                 bo->vertex_count ? (double)bo->rays_traced / bo->vertex_count : 0.0, bo->rays,
                 (double)bo->ray_tolerance);
+    if (job->pool)
+        fprintf(log, "vdsh-bake: light pool placed in %.2f s: %u light%s%s\n", job->pool_seconds,
+                job->pool_count, vdsh_s(job->pool_count),
+                job->pool_count ? "" : " (no room in free space: none used)");
     fprintf(log,
             "vdsh-bake: ray origins checked in %.2f s: %llu probe ray%s (%.1f%% of the "
             "traced rays), %u receiver%s repaired, %u moved\n",
@@ -1581,8 +1602,8 @@ static int run(const options *o)
     double write_seconds = vb_now() - t;
     if (log)
         say_written(log, o, &job, &jd, write_seconds);
-    if (o->report && write_report(o->report, o, &job, &spacing, o->sdf ? &vol : NULL, sdf_seconds,
-                                  write_seconds, msg, sizeof msg) != 0) {
+    if (o->report && write_report(o->report, o, &jd, &job, &spacing, o->sdf ? &vol : NULL,
+                                  sdf_seconds, write_seconds, msg, sizeof msg) != 0) {
         fprintf(stderr, "vdsh-bake: %s (the report)\n", msg);
         goto out;
     }

@@ -755,21 +755,18 @@ static int good_mode(const char *s, size_t n)
 static int parse_modes(const char *s, char modes[MAX_MODES][64])
 {
     int n = 0;
-    for (;;) {
-        const char *e = strchr(s, ',');
-        size_t len = e ? (size_t)(e - s) : strlen(s);
-        if (!good_mode(s, len) || n == MAX_MODES)
+    for (const char *p = s, *next; p; p = next) {
+        size_t len = vt_list_item(p, &next);
+        if (!good_mode(p, len) || n == MAX_MODES)
             return 0;
-        memcpy(modes[n], s, len);
+        memcpy(modes[n], p, len);
         modes[n][len] = '\0';
         for (int i = 0; i < n; i++)
             if (strcmp(modes[i], modes[n]) == 0)
                 return 0;
         n++;
-        if (!e)
-            return n;
-        s = e + 1;
     }
+    return n;
 }
 
 /* A frame of the view set's size, or -1 with the file named. */
