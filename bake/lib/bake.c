@@ -97,7 +97,6 @@ typedef struct job {
      * order and held-out light: lit pairs' margins, NAN otherwise). */
     int decision;
     float (*pool)[3];
-    float (*cal_pool)[3]; /* STUDY: the calibration's pool (NULL: pool) */
     uint32_t pool_count, dec_lights;
     vb_decision_params dec;
     unsigned char *dec_scratch;
@@ -377,9 +376,9 @@ static uint32_t dec_skip(const job *J, uint32_t v, uint32_t scanned)
  * (its label: shadowed when anything is in the way). x, y, z: the unit
  * direction; logd: ln of the light's distance (scene units, the fits'
  * floor); lab: 1 shadowed. *at moves past the lights read. */
-static uint32_t dec_pairs(const job *J, float (*pool)[3], uint32_t *at, uint32_t *scanned,
-                          const float *org, const float n[3], uint32_t want, float *x, float *y,
-                          float *z, float *logd, uint8_t *lab, uint64_t *traced)
+static uint32_t dec_pairs(const job *J, uint32_t *at, uint32_t *scanned, const float *org,
+                          const float n[3], uint32_t want, float *x, float *y, float *z,
+                          float *logd, uint8_t *lab, uint64_t *traced)
 {
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -388,7 +387,7 @@ static uint32_t dec_pairs(const job *J, float (*pool)[3], uint32_t *at, uint32_t
      * a 16-wide packet would walk the union of their paths (measured: the
      * same labels, about a third less time). */
     while (m < want && *scanned < J->pool_count) {
-        const float *L = pool[*at];
+        const float *L = J->pool[*at];
         *at = *at + 1 == J->pool_count ? 0 : *at + 1;
         ++*scanned;
         float dx = L[0] - org[0], dy = L[1] - org[1], dz = L[2] - org[2];
@@ -521,8 +520,7 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
     double *ds = (double *)(out->dec_scratch + dec_doubles_at(J));
     uint32_t at = dec_start(J), scanned = 0;
     uint64_t rays = 0;
-    uint32_t m =
-        dec_pairs(J, J->pool, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab, &rays);
+    uint32_t m = dec_pairs(J, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab, &rays);
     if (m >= DEC_MIN_PAIRS) {
         /* The basis's rows m (rounded up) + 16 floats apart, not K: rows
          * 4 KiB apart share the L1's sets, and the fit reads them all on
@@ -566,8 +564,7 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
     uint32_t skip = dec_skip(J, v, scanned);
     at = (uint32_t)(((uint64_t)at + skip) % J->pool_count);
     scanned += skip;
-    uint32_t h = dec_pairs(J, J->cal_pool ? J->cal_pool : J->pool, &at, &scanned, org, n,
-                           CAL_LIGHTS, x, y, z, logd, lab, &rays);
+    uint32_t h = dec_pairs(J, &at, &scanned, org, n, CAL_LIGHTS, x, y, z, logd, lab, &rays);
     atomic_fetch_add(&J->dec_rays, rays);
     if (!h)
         return fitted;
@@ -1501,38 +1498,6 @@ static vb_result setup_job(bake_run *b, vb_error *err)
     return VB_OK;
 }
 
-/* STUDY: every VDSH_POOL_NEAR-th slot of the decision pool replaced by a
- * light placed by the near rule. */
-static void mix_near(const vb_bake_desc *d, job *J)
-{
-    const char *e = getenv("VDSH_POOL_NEAR");
-    int every = e ? atoi(e) : 0;
-    if (every <= 0)
-        return;
-    /* STUDY: VDSH_POOL_NEAR_WHERE fit (training only), cal (calibration
-     * only) or both (default) */
-    const char *w = getenv("VDSH_POOL_NEAR_WHERE");
-    float(*pool)[3] = J->pool;
-    if (w && strcmp(w, "both") != 0) {
-        float(*copy)[3] = malloc(VB_DECISION_POOL * sizeof *copy);
-        memcpy(copy, J->pool, VB_DECISION_POOL * sizeof *copy);
-        if (strcmp(w, "fit") == 0) {
-            J->cal_pool = copy; /* uniform */
-        } else {
-            J->cal_pool = copy; /* mixed below */
-            pool = copy;
-        }
-    }
-    uint32_t n = VB_DECISION_POOL / (uint32_t)every;
-    float(*near)[3] = malloc((size_t)n * sizeof *near + 1);
-    vb_error e2;
-    if (near && vb_scene_place_lights_rule(d->scene, d->seed ^ VB_POOL_SEED ^ 0x6e656172ull, n,
-                                           VB_LIGHTS_NEAR, near, NULL, &e2) == VB_OK)
-        for (uint32_t i = 0; i < n; i++)
-            vb_scene_to_local(d->scene, near[i], pool[(size_t)i * every + every - 1]);
-    free(near);
-}
-
 /* The per-order log offsets, for the methods that have them; method
  * decision: the pool of lights in free space (traced frame) and the
  * workers' scratch (no free space: the lsq fits are kept); adaptive
@@ -1565,7 +1530,6 @@ static vb_result setup_offsets(bake_run *b, vb_error *err)
                                           J->pool, 0, NULL, &perr) == VB_OK) {
             for (uint32_t k = 0; k < VB_DECISION_POOL; k++)
                 vb_scene_to_local(d->scene, d->pool ? d->pool + 3 * k : J->pool[k], J->pool[k]);
-            mix_near(d, J);
             J->pool_count = VB_DECISION_POOL;
             J->decision = 1;
             size_t bytes = dec_scratch_bytes(J) * d->threads;
@@ -1882,7 +1846,6 @@ static void run_free(bake_run *b)
         free(J->var_scratch);
         free(J->var_lsq);
         free(J->pool);
-        free(J->cal_pool);
         free(J->dec_scratch);
         free(J->cal_margins);
         free(J->cal_caps);
