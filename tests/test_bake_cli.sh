@@ -271,4 +271,29 @@ check "no '1 <plural>' in vdsh-info's listing" \
 check "the room's one degenerate receiver and repair: singular" \
   bash -c '! grep -E "(^|[^0-9.])1 (receivers|ray origins|degenerate receivers|threads)\b" "$1"' _ "$tmp/room1.txt"
 
+# Near training lights (--decision-near K, default 2): the report counts
+# them, 0 turns them off (the uniform pool: another file), both bakes are
+# the same on 1 and 2 threads, and only method decision takes the option.
+near=(builtin:room --max-edge 1.5 --rays 64 --cube-size 0 -q)
+expect_exit 0 "near: default, 1 thread" "$bake" "${near[@]}" --threads 1 -o "$tmp/n1.vdsh" \
+  --report "$tmp/n1.json"
+expect_exit 0 "near: default, 2 threads" "$bake" "${near[@]}" --threads 2 -o "$tmp/n2.vdsh"
+expect_exit 0 "near: none" "$bake" "${near[@]}" --decision-near 0 --threads 2 -o "$tmp/n0.vdsh" \
+  --report "$tmp/n0.json"
+expect_exit 0 "near: none, 1 thread" "$bake" "${near[@]}" --decision-near 0 --threads 1 \
+  -o "$tmp/n01.vdsh"
+check "near: 1 and 2 threads give identical files" cmp -s "$tmp/n1.vdsh" "$tmp/n2.vdsh"
+check "near: none, 1 and 2 threads give identical files" cmp -s "$tmp/n0.vdsh" "$tmp/n01.vdsh"
+check "near: the default places near training lights" \
+  json "$tmp/n1.json" 'd["decision"]["near_pool_lights"] > 0'
+check "near: --decision-near 0 places none" \
+  json "$tmp/n0.json" 'd["decision"]["near_pool_lights"] == 0'
+check "near: the training lights change the fit" bash -c '! cmp -s "$1" "$2"' _ "$tmp/n1.vdsh" \
+  "$tmp/n0.vdsh"
+expect_exit 2 "near: only method decision" "$bake" "${near[@]}" --method shadow --decision-near 2 \
+  -o "$tmp/nx.vdsh"
+check "near: the refusal names the option" grep -q -- "--decision-near" "$tmp/err.txt"
+expect_exit 2 "near: not negative" "$bake" "${near[@]}" --decision-near -1 -o "$tmp/nx.vdsh"
+check "near: nothing written on a refusal" test ! -e "$tmp/nx.vdsh"
+
 exit $fail

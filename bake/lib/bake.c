@@ -96,7 +96,8 @@ typedef struct job {
      * (dec_scratch_bytes); the calibration's held-out margins (per sample,
      * order and held-out light: lit pairs' margins, NAN otherwise). */
     int decision;
-    float (*pool)[3];
+    float (*pool)[3];     /* the training lights (mix_near) */
+    float (*cal_pool)[3]; /* the calibration's: the pool before mix_near */
     uint32_t pool_count, dec_lights;
     vb_decision_params dec;
     unsigned char *dec_scratch;
@@ -376,9 +377,9 @@ static uint32_t dec_skip(const job *J, uint32_t v, uint32_t scanned)
  * (its label: shadowed when anything is in the way). x, y, z: the unit
  * direction; logd: ln of the light's distance (scene units, the fits'
  * floor); lab: 1 shadowed. *at moves past the lights read. */
-static uint32_t dec_pairs(const job *J, uint32_t *at, uint32_t *scanned, const float *org,
-                          const float n[3], uint32_t want, float *x, float *y, float *z,
-                          float *logd, uint8_t *lab, uint64_t *traced)
+static uint32_t dec_pairs(const job *J, float (*pool)[3], uint32_t *at, uint32_t *scanned,
+                          const float *org, const float n[3], uint32_t want, float *x, float *y,
+                          float *z, float *logd, uint8_t *lab, uint64_t *traced)
 {
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -387,7 +388,7 @@ static uint32_t dec_pairs(const job *J, uint32_t *at, uint32_t *scanned, const f
      * a 16-wide packet would walk the union of their paths (measured: the
      * same labels, about a third less time). */
     while (m < want && *scanned < J->pool_count) {
-        const float *L = J->pool[*at];
+        const float *L = pool[*at];
         *at = *at + 1 == J->pool_count ? 0 : *at + 1;
         ++*scanned;
         float dx = L[0] - org[0], dy = L[1] - org[1], dz = L[2] - org[2];
@@ -520,7 +521,8 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
     double *ds = (double *)(out->dec_scratch + dec_doubles_at(J));
     uint32_t at = dec_start(J), scanned = 0;
     uint64_t rays = 0;
-    uint32_t m = dec_pairs(J, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab, &rays);
+    uint32_t m =
+        dec_pairs(J, J->pool, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab, &rays);
     if (m >= DEC_MIN_PAIRS) {
         /* The basis's rows m (rounded up) + 16 floats apart, not K: rows
          * 4 KiB apart share the L1's sets, and the fit reads them all on
@@ -564,7 +566,8 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
     uint32_t skip = dec_skip(J, v, scanned);
     at = (uint32_t)(((uint64_t)at + skip) % J->pool_count);
     scanned += skip;
-    uint32_t h = dec_pairs(J, &at, &scanned, org, n, CAL_LIGHTS, x, y, z, logd, lab, &rays);
+    uint32_t h =
+        dec_pairs(J, J->cal_pool, &at, &scanned, org, n, CAL_LIGHTS, x, y, z, logd, lab, &rays);
     atomic_fetch_add(&J->dec_rays, rays);
     if (!h)
         return fitted;
@@ -1187,7 +1190,8 @@ typedef struct bake_run {
     double t0; /* when the tracing began */
     double auto_error[VDSH_ORDER_SLOTS][2];
     uint32_t auto_receivers, cal_count;
-    unsigned started; /* the workers of the bake */
+    uint32_t near_lights; /* the decision pool's lights placed by the near rule */
+    unsigned started;     /* the workers of the bake */
 } bake_run;
 
 typedef vb_result (*bake_step)(bake_run *b, vb_error *err);
@@ -1331,6 +1335,11 @@ static vb_result resolve_decision(bake_run *b, vb_error *err)
                        VB_DECISION_MAX_PAIRS, d->decision_lights);
     if (d->false_rate == 0.0f)
         d->false_rate = VB_DEFAULT_FALSE_RATE;
+    if (d->decision_near == 0)
+        d->decision_near = VB_DEFAULT_DECISION_NEAR;
+    if (d->decision_near > (int)VB_DECISION_POOL)
+        return vb_fail(err, VB_ERR_ARGUMENT, "decision near share must be 1 in 1..%u, not 1 in %d",
+                       VB_DECISION_POOL, d->decision_near);
     if (!(d->false_rate > 0.0f && d->false_rate < 0.5f))
         return vb_fail(err, VB_ERR_ARGUMENT, "the false rate must be in (0, 0.5)");
     if (d->offset_cap_keep == 0.0f)
@@ -1498,6 +1507,29 @@ static vb_result setup_job(bake_run *b, vb_error *err)
     return VB_OK;
 }
 
+/* The training pool: the pool with one in d->decision_near of its slots
+ * (K-1, 2K-1, ...) replaced by a light placed by the near rule (bake.h,
+ * VB_DEFAULT_DECISION_NEAR), in the traced frame; the calibration keeps
+ * the pool as placed. Where the near rule finds no room for them all,
+ * the training pool is the pool. Returns the lights placed. */
+static uint32_t mix_near(const vb_bake_desc *d, float (*pool)[3])
+{
+    if (d->decision_near <= 0)
+        return 0;
+    const uint32_t every = (uint32_t)d->decision_near, n = VB_DECISION_POOL / every;
+    float(*near)[3] = malloc((size_t)n * sizeof *near + 1);
+    vb_error ignored;
+    if (!near || vb_scene_place_lights_rule(d->scene, d->seed ^ VB_POOL_SEED ^ VB_NEAR_SEED, n,
+                                            VB_LIGHTS_NEAR, near, NULL, &ignored) != VB_OK) {
+        free(near);
+        return 0;
+    }
+    for (uint32_t i = 0; i < n; i++)
+        vb_scene_to_local(d->scene, near[i], pool[(size_t)i * every + every - 1]);
+    free(near);
+    return n;
+}
+
 /* The per-order log offsets, for the methods that have them; method
  * decision: the pool of lights in free space (traced frame) and the
  * workers' scratch (no free space: the lsq fits are kept); adaptive
@@ -1530,6 +1562,13 @@ static vb_result setup_offsets(bake_run *b, vb_error *err)
                                           J->pool, 0, NULL, &perr) == VB_OK) {
             for (uint32_t k = 0; k < VB_DECISION_POOL; k++)
                 vb_scene_to_local(d->scene, d->pool ? d->pool + 3 * k : J->pool[k], J->pool[k]);
+            J->cal_pool = J->pool;
+            if (d->decision_near > 0) {
+                if (!(J->pool = malloc(VB_DECISION_POOL * sizeof *J->pool)))
+                    return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+                memcpy(J->pool, J->cal_pool, VB_DECISION_POOL * sizeof *J->pool);
+                b->near_lights = mix_near(d, J->pool);
+            }
             J->pool_count = VB_DECISION_POOL;
             J->decision = 1;
             size_t bytes = dec_scratch_bytes(J) * d->threads;
@@ -1775,6 +1814,7 @@ static void fill_output(bake_run *b, vb_bake_output *out)
     o.log_floor = any_log ? d->log_floor : 0.0f;
     if (mi->decision) {
         o.decision_lights = J->decision ? d->decision_lights : 0;
+        o.decision_near_lights = J->decision ? b->near_lights : 0;
         o.decision_fitted = atomic_load(&J->dec_fitted);
         o.decision_fallbacks = atomic_load(&J->dec_fallbacks);
         o.decision_pairs =
@@ -1845,6 +1885,8 @@ static void run_free(bake_run *b)
         free(J->done);
         free(J->var_scratch);
         free(J->var_lsq);
+        if (J->pool != J->cal_pool)
+            free(J->cal_pool);
         free(J->pool);
         free(J->dec_scratch);
         free(J->cal_margins);

@@ -103,6 +103,18 @@ int vb_order_candidate(int k, int cap);
  * (vb_scene_place_pool) with the bake's seed ^ VB_POOL_SEED. */
 #define VB_POOL_SEED 0xdec15105ull
 #define VB_DECISION_POOL 4096u
+/* Method decision: for the training lights, one in
+ * VB_DEFAULT_DECISION_NEAR of the decision pool's lights (slots K-1,
+ * 2K-1, ...) is placed by the near rule instead (free space with a
+ * surface nearer than 5% of the diagonal along a probe: scene.h,
+ * VB_LIGHTS_NEAR, vdsh-eval's --light-rule near), seed bake seed ^
+ * VB_POOL_SEED ^ VB_NEAR_SEED, so that the fit sees lights where they
+ * often go: beside walls and furniture. The calibration's held-out
+ * lights stay uniform in free space (the same slots of the pool as
+ * placed), and so does the cpca metric's pool (docs/ACCURACY.md, "Lights
+ * near surfaces in the decision pool"). */
+#define VB_DEFAULT_DECISION_NEAR 2
+#define VB_NEAR_SEED 0x6e656172ull /* "near" */
 #define VB_CPCA_POOL 2048u
 
 typedef struct vb_bake_desc {
@@ -151,6 +163,10 @@ typedef struct vb_bake_desc {
     const vb_decision_params *decision;
     uint32_t decision_lights;
     float false_rate;
+    /* Method decision: one in decision_near of the training pool's
+     * lights placed by the near rule (VB_DEFAULT_DECISION_NEAR above); 0:
+     * the default; < 0: none (uniform in free space, as before). */
+    int decision_near;
     /* Method decision, its training pool as placed (VB_DECISION_POOL
      * above; 3 floats per light, scene units, borrowed): pool_count
      * VB_DECISION_POOL, or 0 where there was no room (the lsq fits are
@@ -211,6 +227,9 @@ typedef struct vb_bake_output {
      * lights, every receiver kept its lsq fit. */
     uint32_t decision_fitted, decision_fallbacks, decision_lights, calibration_receivers;
     uint64_t decision_rays; /* rays toward the lights (not in rays_traced) */
+    /* Method decision: the pool's lights placed by the near rule (0: none,
+     * or no room for them: the pool is uniform). */
+    uint32_t decision_near_lights;
     double decision_pairs;
     float false_rate;
     /* The offset cap (vb_bake_desc.offset_cap): (receiver, order) rows

@@ -55,6 +55,7 @@ typedef struct options {
     float log_offset;
     int have_log_offset;
     uint32_t decision_lights;    /* --decision-lights; 0: the default */
+    int decision_near;           /* --decision-near as vb_bake_desc's; 0: the default */
     float false_rate;            /* --false-rate; 0: the default */
     vb_decision_params decision; /* --decision-params */
     int have_decision;
@@ -266,6 +267,11 @@ static void usage(FILE *f)
             "                          Fixed orders only (issue 25, docs/ACCURACY.md)\n"
             "      --decision-lights N decision: training lights per receiver, each\n"
             "                          traced (1..%d, default %d)\n"
+            "      --decision-near K   decision: one in K of the training lights placed\n"
+            "                          near a surface (in free space, a surface within\n"
+            "                          5%% of the diagonal: vdsh-eval's --light-rule\n"
+            "                          near), the rest and the calibration's lights\n"
+            "                          uniform in free space (0: none; default %d)\n"
             "      --decision-params TAU,LIT,RIDGE,RIDGE0,STEPS\n"
             "                          decision: the loss's temperature (ln units), the\n"
             "                          weight of lit pairs, the ridge per (l(l+1))^2 and\n"
@@ -326,7 +332,7 @@ static void usage(FILE *f)
             methods_help(), (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
             (double)vb_shadow_log_offset(3), (double)vb_shadow_log_offset(5),
             (double)VB_DEFAULT_FALSE_RATE, VB_DECISION_MAX_PAIRS, VB_DEFAULT_DECISION_LIGHTS,
-            VB_ADAPTIVE_ROUNDS, VB_DEFAULT_SEED);
+            VB_DEFAULT_DECISION_NEAR, VB_ADAPTIVE_ROUNDS, VB_DEFAULT_SEED);
 }
 
 static int bad_usage(const char *fmt, const char *arg)
@@ -520,6 +526,7 @@ static int write_report(const char *path, const options *o, const vb_job_desc *j
     if (b->method == VDSH_METHOD_DECISION) {
         cJSON *dec = vt_json_object(&j, root, "decision");
         vt_json_u64(&j, dec, "lights", b->decision_lights);
+        vt_json_u64(&j, dec, "near_pool_lights", b->decision_near_lights);
         vt_json_u64(&j, dec, "fitted", b->decision_fitted);
         vt_json_u64(&j, dec, "kept_lsq", b->decision_fallbacks);
         vt_json_f64(&j, dec, "mean_pairs", b->decision_pairs);
@@ -754,6 +761,7 @@ enum {
     O_ADAPTIVE_ORDER,
     O_MAX_ORDER,
     O_DEC_LIGHTS,
+    O_DEC_NEAR,
     O_FALSE_RATE,
     O_OFFSET_CAP,
     O_DEC_PARAMS,
@@ -842,6 +850,10 @@ static int read_value(int c, const char *arg, options *o)
     case O_DEC_LIGHTS:
         ok =
             vt_opt_u32("--decision-lights", "", arg, 1, VB_DECISION_MAX_PAIRS, &o->decision_lights);
+        break;
+    case O_DEC_NEAR:
+        ok = vt_opt_int("--decision-near", "", arg, 0, (int)VB_DECISION_POOL, &o->decision_near);
+        o->decision_near = o->decision_near ? o->decision_near : -1; /* 0: none */
         break;
     case O_ENCODING:
         ok = vt_opt_choice("--encoding", arg, encodings(), &v);
@@ -1018,10 +1030,11 @@ static int check_options(options *o)
         return bad_usage("%s", mi->refused[stored]);
     if (o->have_log_offset && mi->param != VB_PARAM_LOG_OFFSET)
         return bad_usage("%s", "--log-offset is methods decision's and shadow's");
-    if ((o->false_rate != 0.0f || o->decision_lights || o->have_decision || o->offset_cap) &&
+    if ((o->false_rate != 0.0f || o->decision_lights || o->decision_near || o->have_decision ||
+         o->offset_cap) &&
         !mi->decision)
-        return bad_usage("%s", "--false-rate, --decision-lights, --decision-params and "
-                               "--offset-cap are method decision's");
+        return bad_usage("%s", "--false-rate, --decision-lights, --decision-near, "
+                               "--decision-params and --offset-cap are method decision's");
     if (o->lambda != 0.0f && mi->lambda_fixed)
         return bad_usage("--lambda is lsq's: method %s uses lsq's default (its method "
                          "parameter is the log offset)",
@@ -1086,6 +1099,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"lambda", required_argument, 0, O_LAMBDA},
         {"log-offset", required_argument, 0, O_LOG_OFFSET},
         {"decision-lights", required_argument, 0, O_DEC_LIGHTS},
+        {"decision-near", required_argument, 0, O_DEC_NEAR},
         {"false-rate", required_argument, 0, O_FALSE_RATE},
         {"offset-cap", required_argument, 0, O_OFFSET_CAP},
         {"decision-params", required_argument, 0, O_DEC_PARAMS},
@@ -1241,6 +1255,7 @@ static vb_job_desc job_desc(const options *o, FILE *log, progress *pr, float *of
                                   .log_offsets = o->have_log_offset ? offsets : NULL,
                                   .decision = o->have_decision ? &o->decision : NULL,
                                   .decision_lights = o->decision_lights,
+                                  .decision_near = o->decision_near,
                                   .false_rate = o->false_rate,
                                   .offset_cap = o->offset_cap,
                                   .offset_cap_tol = o->offset_cap_tol,
