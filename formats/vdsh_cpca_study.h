@@ -23,6 +23,9 @@
  * the W with the least error (unstored vectors counting their whole
  * variance; the first on a tie) kept. f64, one thread, fixed order.
  * Does not: write a stream (no format holds the widths yet).
+ * Also here: vdsh_cpca_pool_score, a fitted stream's error over its light
+ * pool (docs/ACCURACY.md "Choosing K per stream at encode time": no
+ * criterion measured there chose K well enough to be the encoder's).
  * Usage:
  *     vdsh_cpca_widths_fit wf;
  *     vdsh_cpca_settings st = {.clusters = 8, .basis = 54, .bits = 4, .budget = 0};
