@@ -1838,3 +1838,69 @@ done:
     fit_scratch_free(&fs);
     return res;
 }
+
+/* ---- the pool score of a fitted stream (vdsh_cpca_study.h) ---- */
+
+/* ln x for x > 0 finite: frexp (exact) and the atanh series, +, -, x, /
+ * only (no libm transcendental): the same bits on any CPU. */
+static double det_ln(double x)
+{
+    int e;
+    double m = frexp(x, &e); /* x = m 2^e, m in [0.5, 1) */
+    if (m < 0.70710678118654752) {
+        m *= 2.0;
+        e--;
+    }
+    const double s = (m - 1.0) / (m + 1.0), s2 = s * s; /* |s| < 0.172 */
+    double t = s, sum = 0.0;
+    for (int k = 1; k <= 25; k += 2) {
+        sum += t / k;
+        t *= s2;
+    }
+    return 2.0 * sum + e * 0.69314718055994530942;
+}
+
+vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_t rows,
+                                 uint32_t order, const vdsh_cpca_settings *settings,
+                                 const vdsh_cpca_fit *fit, vdsh_cpca_pool_scores *out,
+                                 vdsh_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!src || !normals || !settings || !fit || !settings->light_count || !settings->lights ||
+        !settings->positions || order < 1 || order > VDSH_MAX_ORDER)
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca pool score: bad arguments");
+    const uint32_t n = order * order;
+    vdsh_stream s = {.order = order,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .scale = 1.0f,
+                     .data = fit->records,
+                     .cpca = fit->model};
+    float dec[VDSH_MAX_COEFFS], y[VDSH_MAX_COEFFS];
+    for (uint32_t v = 0; v < rows; v++) {
+        vdsh_stream_decode(&s, v, dec);
+        const float *x = src + (size_t)v * n, *p = settings->positions + 3 * (size_t)v;
+        const float *nv = normals + 3 * (size_t)v;
+        for (uint32_t l = 0; l < settings->light_count; l++) {
+            const float *q = settings->lights + 3 * (size_t)l;
+            double d[3];
+            for (int i = 0; i < 3; i++)
+                d[i] = (double)q[i] - p[i];
+            if (!(d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0))
+                continue;
+            const double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            float df[3] = {(float)(d[0] / r), (float)(d[1] / r), (float)(d[2] / r)};
+            vdsh_sh_eval((int)order, df, y);
+            double a = 0.0, b = 0.0;
+            for (uint32_t i = 0; i < n; i++) {
+                a += (double)x[i] * y[i];
+                b += (double)dec[i] * y[i];
+            }
+            const double t = det_ln(r);
+            out->pairs++;
+            out->disagree += (a >= t) != (b >= t);
+            out->missed += (a >= t) && !(b >= t);
+            out->squared += (b - a) * (b - a);
+        }
+    }
+    return VDSH_OK;
+}

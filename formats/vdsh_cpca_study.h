@@ -23,6 +23,9 @@
  * the W with the least error (unstored vectors counting their whole
  * variance; the first on a tie) kept. f64, one thread, fixed order.
  * Does not: write a stream (no format holds the widths yet).
+ * Also here: vdsh_cpca_pool_score, a fitted stream's error over its light
+ * pool (docs/ACCURACY.md "Choosing K per stream at encode time": no
+ * criterion measured there chose K well enough to be the encoder's).
  * Usage:
  *     vdsh_cpca_widths_fit wf;
  *     vdsh_cpca_settings st = {.clusters = 8, .basis = 54, .bits = 4, .budget = 0};
@@ -60,6 +63,26 @@ vdsh_result vdsh_cpca_encode_widths(const float *src, const float *normals, uint
                                     uint32_t order, const vdsh_cpca_settings *settings,
                                     uint32_t fit_basis, double budget, const uint8_t *widths,
                                     float *decoded, vdsh_cpca_widths_fit *out, vdsh_error *err);
+
+/* The pool score of a fitted stream against its source (issue 29, the
+ * choice of K): over every vertex v and every light of settings' pool
+ * above v's horizon (settings->positions the rows' positions), ln D at
+ * the light's direction from the source's coefficients and from the
+ * decoded stream's, each compared with ln of the light's distance (lit
+ * when not below it, the binary comparison). pairs: the pairs counted;
+ * disagree: the pairs whose decisions differ; missed: of those, lit by
+ * the source and shadowed by the stream; squared: the sum over the pairs
+ * of the squared difference of the two ln D. f64 (the SH basis f32, as
+ * the encoder's metric), +, -, x, /, sqrt only: the same on any CPU. */
+typedef struct vdsh_cpca_pool_score {
+    uint64_t pairs, disagree, missed;
+    double squared;
+} vdsh_cpca_pool_scores;
+
+vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_t rows,
+                                 uint32_t order, const vdsh_cpca_settings *settings,
+                                 const vdsh_cpca_fit *fit, vdsh_cpca_pool_scores *out,
+                                 vdsh_error *err);
 
 #ifdef __cplusplus
 }

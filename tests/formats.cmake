@@ -150,3 +150,8 @@ add_test(NAME format_cpca_python
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_cpca_python.py
                  $<TARGET_FILE:test_cpca> ${PROJECT_SOURCE_DIR}
                  ${CMAKE_CURRENT_BINARY_DIR}/format_cpca_python)
+
+# cpca_kchoice_tool: the K,alloc:BYTES fit at several K with each one's
+# pool score (issue 29, the choice of K; measurement only).
+add_executable(cpca_kchoice_tool ${CMAKE_CURRENT_LIST_DIR}/cpca_kchoice_tool.c)
+target_link_libraries(cpca_kchoice_tool PRIVATE vdsh_format m)

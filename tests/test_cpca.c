@@ -50,6 +50,10 @@
  *                  refused; parse's ,light:A
  *   settings       vdsh_cpca_parse accepts K,B,BITS, auto and auto:BYTES
  *                  and refuses the rest
+ *   pool score     vdsh_cpca_pool_score (vdsh_cpca_study.h) of a
+ *                  lossy fit: its pairs, differing decisions and squared
+ *                  ln D error the same as summed here with libm's log;
+ *                  the same twice; refused without a pool
  */
 #include "vdsh.h"
 #include "vdsh_cpca.h"
@@ -791,6 +795,89 @@ static void light_metric(void)
     }
 }
 
+/* vdsh_cpca_pool_score against the same sums done here with libm's log:
+ * the pairs (vertex, light above its horizon), the decisions that differ
+ * (lit when ln D is not below ln of the distance), those lit by the
+ * source, and the squared ln D difference; the same twice; refused
+ * without a pool. */
+static void pool_score(void)
+{
+    enum { NL = 64 };
+    static float pool[NL * 3];
+    for (int l = 0; l < NL; l++) { /* around the vertices (x 0..599, y = z = 0) */
+        pool[3 * l] = (float)(l * 10 % ROWS) + 0.5f;
+        pool[3 * l + 1] = (float)(l % 7) - 3.0f;
+        pool[3 * l + 2] = (float)(l % 5) - 2.0f;
+    }
+    vdsh_cpca_settings st = {.clusters = K, /* lossy: one vector of 2 bits */
+                             .basis = 1,
+                             .bits = 2,
+                             .light_mix = 1.0f,
+                             .light_count = NL,
+                             .lights = pool,
+                             .positions = positions};
+    vdsh_cpca_fit f;
+    vdsh_error err;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &f, &err) == VDSH_OK, "pool score: %s",
+          err.msg);
+    vdsh_cpca_pool_scores a, b;
+    CHECK(vdsh_cpca_pool_score(src, normals, ROWS, ORDER, &st, &f, &a, &err) == VDSH_OK,
+          "pool score: %s", err.msg);
+    CHECK(vdsh_cpca_pool_score(src, normals, ROWS, ORDER, &st, &f, &b, &err) == VDSH_OK &&
+              memcmp(&a, &b, sizeof a) == 0,
+          "pool score: not the same twice");
+    vdsh_stream s = {.order = ORDER,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .scale = 1.0f,
+                     .data = f.records,
+                     .cpca = f.model};
+    uint64_t pairs = 0, differ = 0, missed = 0;
+    double sq = 0.0;
+    float dec[VDSH_MAX_COEFFS], y[VDSH_MAX_COEFFS];
+    for (uint32_t v = 0; v < ROWS; v++) {
+        vdsh_stream_decode(&s, v, dec);
+        for (int l = 0; l < NL; l++) {
+            double d[3], r2 = 0.0, up = 0.0;
+            for (int i = 0; i < 3; i++) {
+                d[i] = (double)pool[3 * l + i] - positions[3 * v + i];
+                r2 += d[i] * d[i];
+                up += d[i] * normals[3 * v + i];
+            }
+            if (!(up > 0.0))
+                continue;
+            const double r = sqrt(r2), t = log(r);
+            float df[3] = {(float)(d[0] / r), (float)(d[1] / r), (float)(d[2] / r)};
+            vdsh_sh_eval(ORDER, df, y);
+            double x0 = 0.0, x1 = 0.0;
+            for (int i = 0; i < NC; i++) {
+                x0 += (double)src[v * NC + i] * y[i];
+                x1 += (double)dec[i] * y[i];
+            }
+            pairs++;
+            differ += (x0 >= t) != (x1 >= t);
+            missed += (x0 >= t) && !(x1 >= t);
+            sq += (x1 - x0) * (x1 - x0);
+        }
+    }
+    CHECK(pairs > 0 && a.pairs == pairs && a.disagree == differ && a.missed == missed &&
+              fabs(a.squared - sq) <= 1e-9 * sq,
+          "pool score: pairs %llu (%llu), differing %llu (%llu), lit by the source %llu (%llu), "
+          "squared %g (%g)",
+          (unsigned long long)a.pairs, (unsigned long long)pairs, (unsigned long long)a.disagree,
+          (unsigned long long)differ, (unsigned long long)a.missed, (unsigned long long)missed,
+          a.squared, sq);
+    CHECK(a.disagree > 0 && a.disagree < a.pairs && a.squared > 0.0,
+          "pool score: a lossy fit with no decision differing (%llu of %llu)",
+          (unsigned long long)a.disagree, (unsigned long long)a.pairs);
+    printf("format_cpca: pool score: %llu pairs, %llu decisions differ, squared %.4g\n",
+           (unsigned long long)a.pairs, (unsigned long long)a.disagree, a.squared);
+    vdsh_cpca_settings none = st;
+    none.light_count = 0;
+    CHECK(vdsh_cpca_pool_score(src, normals, ROWS, ORDER, &none, &f, &a, &err) == VDSH_ERR_ARGUMENT,
+          "pool score without a pool not refused");
+    vdsh_cpca_fit_free(&f);
+}
+
 int main(int argc, char **argv)
 {
     make_data();
@@ -969,6 +1056,7 @@ int main(int argc, char **argv)
     widths_study();
     alloc_settings();
     light_metric();
+    pool_score();
 
     /* settings */
     vdsh_cpca_settings p;
