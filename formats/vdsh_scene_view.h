@@ -111,8 +111,9 @@ typedef struct vdsh_view {
     vdsh_camera camera;                    /* the default camera: room or fit */
     int light_count;                       /* VDSH_VIEW_MAX_LIGHTS */
     float lights[VDSH_VIEW_MAX_LIGHTS][3]; /* default light positions */
-    /* before any move (a light the frame rule took from the seeded
-     * candidates: that candidate) */
+    /* before any move into free space (a light the frame rule took from
+     * the seeded candidates: that candidate; an object's: already pulled
+     * into its light region) */
     float preferred[VDSH_VIEW_MAX_LIGHTS][3];
     /* 1: lights[i] is in free space (moved there when preferred[i] was
      * not); 0: no position searched was (a scene without free space), and
