@@ -1108,8 +1108,11 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
      * the same clearance): an object's lights inside it, where the bake's
      * fit was made for them. */
     region_free rc = {t, vdsh_free_diagonal(lo, hi)};
-    v.region_grown =
-        vdsh_light_region(lo, hi, region_is_free, &rc, v.region_min, v.region_max, NULL);
+    memcpy(v.region_min, lo, sizeof v.region_min);
+    memcpy(v.region_max, hi, sizeof v.region_max);
+    if (!v.interior) /* a room's lights stay in its bounds: no probes spent */
+        v.region_grown =
+            vdsh_light_region(lo, hi, region_is_free, &rc, v.region_min, v.region_max, NULL);
     float blo[3], bhi[3];
     light_box(v.region_min, v.region_max, lo, hi, rc.diag, flat, blo, bhi);
     const float *slo = v.interior ? lo : blo, *shi = v.interior ? hi : bhi;

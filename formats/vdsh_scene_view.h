@@ -120,12 +120,13 @@ typedef struct vdsh_view {
      * lights[i] is preferred[i]. */
     int light_free[VDSH_VIEW_MAX_LIGHTS];
     uint32_t light_trials; /* positions tested for free space */
-    /* The light region the bake trained on (vdsh_light_region of the
-     * bounds with vdsh_view_free_space: the bounds, or the bounds grown
-     * around a closed object) and whether it is grown. An object's
-     * lights lie in it (vdsh_view_compute: but a flat one's, and along an
-     * axis thinner than the clearance), an interior's in its bounds,
-     * which it holds. */
+    /* An object's light region, the one the bake trained on
+     * (vdsh_light_region of the bounds with vdsh_view_free_space: the
+     * bounds, or the bounds grown around a closed object), and whether it
+     * is grown; its lights lie in it (vdsh_view_compute: but a flat
+     * one's, and along an axis thinner than the clearance). An
+     * interior's: its bounds, not grown (not probed; its lights stay in
+     * its bounds, which its region holds). */
     float region_min[3];
     float region_max[3];
     int region_grown;
