@@ -765,15 +765,15 @@ static int cmp_cand(const void *a, const void *b)
 enum { FALLBACK_CANDIDATES = 4096 };
 
 /* A position in free space near p0, into out; 1, or 0 when none found.
- * p0 itself when it is free; else, on rings of 26 directions around it,
+ * p0 itself when it is free; else, inside lo..hi (an interior's bounds,
+ * an object's light region), on rings of 26 directions around it,
  * the nearest position VDSH_VIEW_LIGHT_MARGIN clearances from every
  * surface within VDSH_VIEW_MARGIN_REACH clearances of p0, else the
  * nearest free one (a light moved just out of a solid lands one
  * clearance from its face: the hard case of every precomputed shadow,
  * which the default frame should not show). */
 static int find_free(const vdsh_view_tracer *t, const float p0[3], const float lo[3],
-                     const float hi[3], int interior, float diagonal, uint32_t *trials,
-                     float out[3])
+                     const float hi[3], float diagonal, uint32_t *trials, float out[3])
 {
     (*trials)++;
     if (vdsh_view_free_space(t, p0, diagonal)) {
@@ -796,7 +796,7 @@ static int find_free(const vdsh_view_tracer *t, const float p0[3], const float l
                 float p[3];
                 for (int a = 0; a < 3; a++)
                     p[a] = p0[a] + (float)k * h * dirs[j][a];
-                if (interior && !inside(p, lo, hi))
+                if (!inside(p, lo, hi))
                     continue;
                 (*trials)++;
                 uint8_t *at = seen && k <= reach ? &seen[(size_t)(k - 1) * nd + (size_t)j] : NULL;
@@ -844,6 +844,54 @@ static int find_free(const vdsh_view_tracer *t, const float p0[3], const float l
     }
     free(c);
     return found;
+}
+
+typedef struct region_free {
+    const vdsh_view_tracer *t;
+    float diag;
+} region_free;
+
+static int region_is_free(const void *ctx, const float p[3])
+{
+    const region_free *c = ctx;
+    return vdsh_view_free_space(c->t, p, c->diag);
+}
+
+/* An object's box for its lights (vdsh_view_compute): the light region
+ * rlo..rhi, but along an axis where it is thinner than the clearance (no
+ * room for a light) the bounds grown there by VDSH_REGION_GROW of the
+ * diagonal, as around a closed object; a flat object's (flat: its
+ * free-space probes pass through it and leave its region its bounds,
+ * where a light can stand behind it) those grown bounds on every axis. */
+static void light_box(const float rlo[3], const float rhi[3], const float lo[3], const float hi[3],
+                      float diag, int flat, float blo[3], float bhi[3])
+{
+    const float g = VDSH_REGION_GROW * diag;
+    for (int k = 0; k < 3; k++) {
+        const int grow = flat || rhi[k] - rlo[k] < vdsh_free_clearance(diag);
+        blo[k] = grow ? lo[k] - g : rlo[k];
+        bhi[k] = grow ? hi[k] + g : rhi[k];
+    }
+}
+
+/* p pulled into lo..hi, VDSH_VIEW_REGION_INSET of the extent inside each
+ * face: per axis, or with c (the box's centre: a flat object's) along the
+ * line to c, so that it stays on its side of any plane through c. */
+static void into_region(float p[3], const float lo[3], const float hi[3], const float *c)
+{
+    float s = 1.0f;
+    for (int k = 0; k < 3; k++) {
+        const float in = VDSH_VIEW_REGION_INSET * (hi[k] - lo[k]);
+        if (!c) {
+            p[k] = fminf(fmaxf(p[k], lo[k] + in), hi[k] - in);
+            continue;
+        }
+        const float d = p[k] - c[k], room = d > 0.0f ? hi[k] - in - c[k] : c[k] - (lo[k] + in);
+        if (fabsf(d) > room)
+            s = fminf(s, room / fabsf(d));
+    }
+    for (int k = 0; c && k < 3; k++)
+        p[k] = c[k] + s * (p[k] - c[k]);
 }
 
 /* The frame rule (vdsh_view_compute): an interior's lights, found in
@@ -1037,7 +1085,8 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
     float fn[3], w[3], c[3];
     int flip = 0;
     fit_direction(lo, hi, w);
-    if (flat_front(m, diag, fn) && w[0] * fn[0] + w[1] * fn[1] + w[2] * fn[2] < 0.0f) {
+    const int flat = flat_front(m, diag, fn);
+    if (flat && w[0] * fn[0] + w[1] * fn[1] + w[2] * fn[2] < 0.0f) {
         flip = 1;
         mirror(w, (float[3]){0, 0, 0}, fn);
         if (w[0] * w[0] + w[2] * w[2] < 0.01f)
@@ -1055,9 +1104,23 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
         c[k] = 0.5f * (lo[k] + hi[k]);
     for (int i = 0; flip && i < v.light_count; i++)
         mirror(v.preferred[i], c, fn);
+    /* The light region as the bake computes it (the bake's diagonal, so
+     * the same clearance): an object's lights inside it, where the bake's
+     * fit was made for them. */
+    region_free rc = {t, vdsh_free_diagonal(lo, hi)};
+    memcpy(v.region_min, lo, sizeof v.region_min);
+    memcpy(v.region_max, hi, sizeof v.region_max);
+    if (!v.interior) /* a room's lights stay in its bounds: no probes spent */
+        v.region_grown =
+            vdsh_light_region(lo, hi, region_is_free, &rc, v.region_min, v.region_max, NULL);
+    float blo[3], bhi[3];
+    light_box(v.region_min, v.region_max, lo, hi, rc.diag, flat, blo, bhi);
+    const float *slo = v.interior ? lo : blo, *shi = v.interior ? hi : bhi;
+    for (int i = 0; !v.interior && i < v.light_count; i++)
+        into_region(v.preferred[i], slo, shi, flat ? c : NULL);
     for (int i = 0; i < v.light_count; i++) {
         v.light_free[i] =
-            find_free(t, v.preferred[i], lo, hi, v.interior, diag, &v.light_trials, v.lights[i]);
+            find_free(t, v.preferred[i], slo, shi, diag, &v.light_trials, v.lights[i]);
         if (!v.light_free[i])
             memcpy(v.lights[i], v.preferred[i], sizeof v.lights[i]);
     }

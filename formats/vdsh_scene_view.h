@@ -23,7 +23,8 @@
  *
  * Default lights: preferred positions from the bounds alone
  * (vdsh_view_preferred_lights: a room's spread through it, an object's
- * outside its bounding sphere); each that is not in free space (inside a
+ * outside its bounding sphere, then pulled into the light region the bake
+ * trained on, vdsh_light.h); each that is not in free space (inside a
  * pillar, on a wall) is moved to the nearest position that is, searched
  * deterministically (vdsh_view_compute says how).
  *
@@ -110,14 +111,25 @@ typedef struct vdsh_view {
     vdsh_camera camera;                    /* the default camera: room or fit */
     int light_count;                       /* VDSH_VIEW_MAX_LIGHTS */
     float lights[VDSH_VIEW_MAX_LIGHTS][3]; /* default light positions */
-    /* before any move (a light the frame rule took from the seeded
-     * candidates: that candidate) */
+    /* before any move into free space (a light the frame rule took from
+     * the seeded candidates: that candidate; an object's: already pulled
+     * into its light region) */
     float preferred[VDSH_VIEW_MAX_LIGHTS][3];
     /* 1: lights[i] is in free space (moved there when preferred[i] was
      * not); 0: no position searched was (a scene without free space), and
      * lights[i] is preferred[i]. */
     int light_free[VDSH_VIEW_MAX_LIGHTS];
     uint32_t light_trials; /* positions tested for free space */
+    /* An object's light region, the one the bake trained on
+     * (vdsh_light_region of the bounds with vdsh_view_free_space: the
+     * bounds, or the bounds grown around a closed object), and whether it
+     * is grown; its lights lie in it (vdsh_view_compute: but a flat
+     * one's, and along an axis thinner than the clearance). An
+     * interior's: its bounds, not grown (not probed; its lights stay in
+     * its bounds, which its region holds). */
+    float region_min[3];
+    float region_max[3];
+    int region_grown;
     /* An interior's lights in the check frame (vdsh_view_light_shares):
      * shares of its pixels lit and shadowed; 0 for an object's. */
     float light_lit[VDSH_VIEW_MAX_LIGHTS];
@@ -136,12 +148,24 @@ typedef struct vdsh_view {
  * they cancel) faces away from the fit camera's direction w: the fit
  * camera (fit; an object's camera) is fitted along w mirrored through the plane (along the plane's normal
  * where that is within about 6 degrees of vertical), and the preferred
- * lights are mirrored through the plane through the bounds' centre. A preferred light position in free space is
+ * lights are mirrored through the plane through the bounds' centre. An
+ * object's preferred lights are then pulled into the light region
+ * (region_min..region_max; along an axis where it is thinner than the
+ * clearance the bounds grown by VDSH_REGION_GROW of the diagonal there)
+ * per axis, VDSH_VIEW_REGION_INSET of its extent inside each face; a flat
+ * object's (whose region, its bounds, has room behind it) into its bounds
+ * grown so on every axis, along the line to the centre (so each stays on
+ * its side of the plane): the bake's decision fit and its calibration saw
+ * lights there only, and a light beyond 1.5 clamp distances (the
+ * diagonal) shadows every receiver (docs/DESIGN.md, "Lights beyond the
+ * clamp"; the lights outside the bounding sphere that were the rule drew
+ * false blotches on an object's floor). A preferred light position in free space is
  * kept. Otherwise the candidates p + k h d are tried, rings k = 1, 2, ...
  * of step h = half the clearance (vdsh_free_clearance of the bounds'
  * diagonal), up to half the diagonal, d each of the 26 directions toward
  * a cube's faces, edges and corners in a fixed order; an interior's
- * candidates must lie inside its bounds. The first in free space is the
+ * candidates must lie inside its bounds, an object's inside its light
+ * region. The first in free space is the
  * light. If none is, the first 4096 candidates of vdsh_light_candidate
  * (seed 1) are tried, nearest first.
  * Then an interior's lights must light what the camera sees (a room
@@ -168,6 +192,10 @@ void vdsh_view_bounds(const float *positions, uint32_t vertex_count, float lo[3]
  * (for an image at least as wide as it is tall) horizontally. */
 void vdsh_view_room_camera(const float lo[3], const float hi[3], vdsh_camera *out);
 void vdsh_view_fit_camera(const float lo[3], const float hi[3], vdsh_camera *out);
+
+/* The share of the light region's extent an object's preferred light is
+ * kept inside each of its faces (vdsh_view_compute). */
+#define VDSH_VIEW_REGION_INSET 0.05f
 
 /* Up to max (at most VDSH_VIEW_MAX_LIGHTS) preferred light positions from
  * the bounds only; returns how many. Not checked for free space. */

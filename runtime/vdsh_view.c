@@ -82,7 +82,7 @@ static const char usage_text[] =
     "                        one of the first six that the scene has)\n"
     "\n"
     "View (defaults come from the scene's bounds, y up: a room is seen from\n"
-    "inside, an object framed from outside, lit from outside):\n"
+    "inside, an object framed from outside, lit in its light region):\n"
     "      --camera EX,EY,EZ,TX,TY,TZ   eye and target point\n"
     "      --fit             frame the whole scene from outside, also a room\n"
     "      --fov DEG         vertical field of view (default 60)\n"

@@ -452,8 +452,9 @@ void vr_scene_fit_camera(const vr_scene *s, vr_camera *out);
 
 /* Up to max (at most 4) default light positions; returns how many were
  * written. An interior's are spread through its bounds (light 0 roughly in
- * the middle, a little above the floor); an object's stand outside its
- * bounding sphere, light 0 above it and to the side of the default eye.
+ * the middle, a little above the floor); an object's in the light region
+ * the bake trained on (vdsh_light_region), light 0 toward the top of it
+ * and to the side of the default eye.
  * Each is in free space (formats/vdsh_light.h: not inside a solid, not on
  * a surface), moved at load when its place is not: to the nearest place
  * VDSH_VIEW_LIGHT_MARGIN clearances from every surface, else the nearest

@@ -65,6 +65,22 @@ assert j['eval']['scene_light_rule'] == 'ceiling', j['eval']
 lo, hi = j['scene']['bounds_min'][1], j['scene']['bounds_max'][1]
 ys = [p[1] for p in j['eval']['scene_light_positions']]
 assert ys and min(ys) >= lo + 0.8 * (hi - lo) - 1e-4 * (hi - lo), (lo, hi, min(ys))
+# grown: in the bounds grown by a quarter of the diagonal; around: in them
+# grown by a diagonal, outside the bounds (the room is open above)
+for rule, share in (('grown', 0.25), ('around', 1.0)):
+    subprocess.run([ev, f, '-q', '--interior', '0', '--points', '300', '--light-rule', rule,
+                    '--json', f + '.g.json'], check=True, stdout=subprocess.DEVNULL)
+    j = json.load(open(f + '.g.json'))
+    assert j['eval']['scene_light_rule'] == rule, j['eval']
+    blo, bhi = j['scene']['bounds_min'], j['scene']['bounds_max']
+    g = share * sum((b - a) ** 2 for a, b in zip(blo, bhi)) ** 0.5
+    ps = j['eval']['scene_light_positions']
+    assert len(ps) == 32
+    for p in ps:
+        assert all(blo[k] - g <= p[k] <= bhi[k] + g for k in range(3)), (rule, p)
+        inside = all(blo[k] <= p[k] <= bhi[k] for k in range(3))
+        assert rule == 'grown' or not inside, p
+    assert any(not all(blo[k] <= p[k] <= bhi[k] for k in range(3)) for p in ps), rule
 print('ok')"
              $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval>)
   endif()

@@ -235,11 +235,16 @@ done
 "$png" same "$d/s1.png" "$d/s1e-11.png" 2 || { echo "a scene 1e-11 across draws differently"; fail=1; }
 # Cube shadow maps at any scale the view takes: the same image, and not
 # the unshadowed one (their near plane had an absolute margin of 1e-6, and
-# the faces' targets eye + 1, which is the eye in float beyond 2^24).
+# the faces' targets eye + 1, which is the eye in float beyond 2^24). The
+# light above the raised quad, scaled with the scene: the default lights
+# lie in the light region, here the bounds, below the quad, where it
+# shadows nothing.
 for s in 1 1e-11 1e10 1e17; do
-  "$v" -q --render "$d/c$s.png" --size 64x48 --mode cube "$d/s$s.vdsh" || fail=1
+  l=$(awk -v s=$s 'BEGIN { printf "%.9g,%.9g,%.9g", 2 * s, 3 * s, 2 * s }')
+  "$v" -q --render "$d/c$s.png" --size 64x48 --mode cube --light "$l" "$d/s$s.vdsh" || fail=1
 done
-! "$png" same "$d/c1.png" "$d/s1.png" 2 2>/dev/null || { echo "cube maps draw no shadow at unit size"; fail=1; }
+"$v" -q --render "$d/n1.png" --size 64x48 --mode none --light 2,3,2 "$d/s1.vdsh" || fail=1
+! "$png" same "$d/c1.png" "$d/n1.png" 2 2>/dev/null || { echo "cube maps draw no shadow at unit size"; fail=1; }
 for s in 1e-11 1e10 1e17; do
   "$png" same "$d/c1.png" "$d/c$s.png" 2 || { echo "cube maps at scale $s draw differently"; fail=1; }
 done

@@ -12,6 +12,9 @@
  *              preferred light inside a pillar moves into free space
  *              nearby, the others stay where they were
  *     object   a sphere is framed from outside, lit from outside it
+ *     object-on-floor  a cube on a floor quad: every default light in the
+ *              light region the bake trains on (vdsh_light_region, here
+ *              the bounds), free, within a diagonal of the bounds
  *     flat     a single triangle facing any way (and a flat quad): the
  *              default camera sees its front, all of it, a light there
  *     none     a scene with no free space keeps the preferred lights and
@@ -377,6 +380,61 @@ static void test_object(void)
         CHECK(r > 1.0f + vdsh_free_clearance(diag), "light %d is %g from the centre", i, (double)r);
         CHECK(v.light_free[i] && free_all(&m, v.lights[i], diag), "light %d is not free", i);
         CHECK(!memcmp(v.lights[i], v.preferred[i], sizeof v.lights[i]), "light %d moved", i);
+    }
+}
+
+typedef struct plain_ctx {
+    const vdsh_view_mesh *m;
+    float diag;
+} plain_ctx;
+
+static int plain_free(const void *ctx, const float p[3])
+{
+    const plain_ctx *c = ctx;
+    return free_all(c->m, p, c->diag);
+}
+
+/* An object on a floor (a unit cube on a 4 x 4 quad, seen from outside):
+ * its light region is its bounds (the box is mostly free), the one the
+ * bake trains its fit on, and every default light lies in it, free, within
+ * a diagonal (the default clamp) of every corner of the bounds. The
+ * lights outside the bounding sphere that were the rule stood beyond the
+ * region, up to 1.48 diagonals from the floor's far corner, and drew
+ * false blotches on the open floor. */
+static void test_object_on_floor(void)
+{
+    memset(&M, 0, sizeof M);
+    quad(&M, (float[3]){-2, 0, -2}, (float[3]){-2, 0, 2}, (float[3]){2, 0, 2},
+         (float[3]){2, 0, -2});
+    box(&M, (float[3]){-0.5f, 0, -0.5f}, (float[3]){0.5f, 1, 0.5f}, 0);
+    vdsh_view_mesh m = view_mesh(&M);
+    vdsh_view v;
+    vdsh_error err;
+    CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
+    CHECK(!v.interior, "a cube on a floor: an interior");
+    const float diag = vdsh_free_diagonal(v.bounds_min, v.bounds_max);
+    plain_ctx pc = {&m, diag};
+    float lo[3], hi[3];
+    int grown = vdsh_light_region(v.bounds_min, v.bounds_max, plain_free, &pc, lo, hi, NULL);
+    CHECK(!grown && v.region_grown == grown, "a cube on a floor: region grown %d (plain %d)",
+          v.region_grown, grown);
+    CHECK(!memcmp(lo, v.region_min, sizeof lo) && !memcmp(hi, v.region_max, sizeof hi),
+          "the view's light region is not vdsh_light_region's");
+    for (int i = 0; i < v.light_count; i++) {
+        const float *p = v.lights[i];
+        int in = 1;
+        for (int k = 0; k < 3; k++)
+            in = in && p[k] >= lo[k] && p[k] <= hi[k];
+        CHECK(in, "light %d (%g %g %g) outside the light region", i, (double)p[0], (double)p[1],
+              (double)p[2]);
+        CHECK(v.light_free[i] && free_all(&m, p, diag), "light %d is not free", i);
+        for (int corner = 0; corner < 8; corner++) {
+            float q[3];
+            for (int k = 0; k < 3; k++)
+                q[k] = (corner >> k) & 1 ? v.bounds_max[k] : v.bounds_min[k];
+            CHECK(dist3(p, q) <= diag, "light %d is %g diagonals from corner %d", i,
+                  (double)(dist3(p, q) / diag), corner);
+        }
     }
 }
 
@@ -836,6 +894,7 @@ int main(int argc, char **argv)
     test_space();
     test_room();
     test_object();
+    test_object_on_floor();
     test_flat();
     test_scale();
     test_none();

@@ -3,7 +3,8 @@
 // extras.vdsh.view, on flat objects (formats/vdsh_scene_view.c's rule):
 // a triangle facing each axis both ways, a tilted one, a quad wound both
 // ways: the eye and a light on the side the normals face, every corner
-// of the bounds in view; a solid (a tetrahedron): the bounds-only view.
+// of the bounds in view; a solid (a tetrahedron): the bounds-only view,
+// its lights in its bounds.
 // With BAKE and EXPORT: each triangle baked and exported, and the page's
 // view against the one vdsh-export wrote (vdsh-view's, in C): eye and
 // target to 1e-4 of the diagonal, each light on the same side. Exit 0 or 1 with the failures.
@@ -82,6 +83,10 @@ check(away >= 4, 'only ' + away + ' cases face away from the bounds-only view: t
   const [lo, hi] = bounds(t.pos);
   check(JSON.stringify(vdshFallbackView(lo, hi, t.pos, t.nrm, t.indices)) === JSON.stringify(vdshFallbackView(lo, hi)),
     'a tetrahedron is not framed from the bounds alone');
+  // its lights in its bounds, which the bake's light region holds (they
+  // stood outside the bounding sphere, where the fit was never trained)
+  for (const l of vdshFallbackView(lo, hi).lights)
+    check(l.every((x, k) => x >= lo[k] && x <= hi[k]), 'a tetrahedron\'s light ' + l + ' outside its bounds');
 }
 
 // Against vdsh-view's own default view (vdsh-export's extras.vdsh.view).

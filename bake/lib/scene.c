@@ -244,7 +244,7 @@ static const char *region_name(int grown)
 
 const char *vb_light_rule_name(vb_light_rule rule)
 {
-    static const char *const names[] = {"uniform", "ceiling", "near", "path"};
+    static const char *const names[] = {"uniform", "ceiling", "near", "path", "grown", "around"};
     return (unsigned)rule < sizeof names / sizeof names[0] ? names[rule] : "?";
 }
 
@@ -252,12 +252,21 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
                                      vb_light_rule rule, float (*out)[3], uint32_t *tried,
                                      vb_error *err)
 {
-    if ((unsigned)rule > VB_LIGHTS_PATH)
+    if ((unsigned)rule > VB_LIGHTS_AROUND)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown light rule %d", (int)rule);
     if (rule == VB_LIGHTS_UNIFORM) /* the runtime's placement too */
         return vb_scene_place_lights(s, seed, count, out, tried, err);
     float lo[3], hi[3];
-    const int grown = vb_scene_light_region(s, lo, hi, NULL);
+    int grown = vb_scene_light_region(s, lo, hi, NULL);
+    if (rule == VB_LIGHTS_GROWN || rule == VB_LIGHTS_AROUND) {
+        const double g =
+            (rule == VB_LIGHTS_GROWN ? (double)VDSH_REGION_GROW : 1.0) * (double)s->diagonal;
+        for (int a = 0; a < 3; a++) {
+            lo[a] = (float)((double)s->bounds_min[a] - g);
+            hi[a] = (float)((double)s->bounds_max[a] + g);
+        }
+        grown = 1;
+    }
     uint32_t n = 0, k = 0;
     const uint64_t limit = vdsh_light_tries(count, grown);
     while (n < count && k < limit) {
@@ -273,6 +282,10 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
             p[2] = 0.5f * (lo[2] + hi[2]) +
                    0.3f * (hi[2] - lo[2]) * (float)vdsh_det_sin(6.2831853f * t);
         }
+        if (rule == VB_LIGHTS_AROUND && p[0] >= s->bounds_min[0] && p[0] <= s->bounds_max[0] &&
+            p[1] >= s->bounds_min[1] && p[1] <= s->bounds_max[1] && p[2] >= s->bounds_min[2] &&
+            p[2] <= s->bounds_max[2])
+            continue;
         if (!vb_scene_free_space(s, p))
             continue;
         if (rule == VB_LIGHTS_NEAR && !(probe_nearest(s, p) < 0.05f * s->diagonal))
@@ -286,7 +299,8 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
                        "no room for %u light%s by rule %s: %u found in %u "
                        "candidate%s in %s",
                        count, vdsh_s(count), vb_light_rule_name(rule), n, k, vdsh_s(k),
-                       region_name(grown));
+                       rule >= VB_LIGHTS_GROWN ? "the bounds grown for the rule"
+                                               : region_name(grown));
     return VB_OK;
 }
 

@@ -123,12 +123,20 @@ int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3], uint32_t 
  * seeded candidates in the light region: uniform (vb_scene_place_lights),
  * near the ceiling (the top fifth of the region's height, +y up), near surfaces (a surface
  * within 5% of the diagonal along a probe direction), along a path (a
- * walk along x at two thirds of the height, swinging across z). */
+ * walk along x at two thirds of the height, swinging across z); and,
+ * for lights around an object as a viewer puts them, outside the light
+ * region: grown (uniform in the bounds grown by VDSH_REGION_GROW of
+ * their diagonal, the bounds' inside too) and around (uniform in the
+ * bounds grown by a whole diagonal, outside the bounds only: where
+ * vdsh-view's default lights for an object stood, about 1.08 diagonals
+ * from its centre). */
 typedef enum vb_light_rule {
     VB_LIGHTS_UNIFORM = 0,
     VB_LIGHTS_CEILING,
     VB_LIGHTS_NEAR,
-    VB_LIGHTS_PATH
+    VB_LIGHTS_PATH,
+    VB_LIGHTS_GROWN,
+    VB_LIGHTS_AROUND
 } vb_light_rule;
 
 vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t count,

@@ -90,7 +90,11 @@ static void usage(FILE *f)
             "                          (a surface within 5%% of the diagonal) or path (a\n"
             "                          walk along x at 2/3 of the height, swinging in z);\n"
             "                          heights of the light region: the bounds, or around a\n"
-            "                          closed object the bounds grown (formats/vdsh_light.h)\n"
+            "                          closed object the bounds grown (formats/vdsh_light.h);\n"
+            "                          grown (the bounds grown by a quarter of their\n"
+            "                          diagonal) or around (grown by a diagonal, outside\n"
+            "                          the bounds: where a viewer puts lights around an\n"
+            "                          object)\n"
             "      --orders LIST       only these orders, e.g. 3,5 (default: every stream)\n"
             "      --offsets LIST      the trade between recall and false shadows as a\n"
             "                          curve: each stream is also scored with each\n"
@@ -794,7 +798,7 @@ static int parse_interp(const char *s, uint32_t *out)
 
 static int parse_light_rule(const char *s, int *out)
 {
-    for (int k = VB_LIGHTS_UNIFORM; k <= VB_LIGHTS_PATH; k++)
+    for (int k = VB_LIGHTS_UNIFORM; k <= VB_LIGHTS_AROUND; k++)
         if (!strcmp(s, vb_light_rule_name((vb_light_rule)k))) {
             *out = k;
             return 1;
@@ -893,8 +897,9 @@ static int parse_args(int argc, char **argv, options *o)
             break;
         case O_LIGHT_RULE:
             if (!parse_light_rule(optarg, &d->light_rule))
-                return bad_usage("--light-rule takes uniform, ceiling, near or path, not '%s'",
-                                 optarg);
+                return bad_usage(
+                    "--light-rule takes uniform, ceiling, near, path, grown or around, not '%s'",
+                    optarg);
             break;
         case O_OFFSETS:
             o->noffsets = parse_offsets(optarg, o->offsets);

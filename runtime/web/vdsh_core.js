@@ -332,7 +332,7 @@ export function vdshVertexGlsl(plan, shaders, texWidth, cpca) {
 // The default view of a file without extras.vdsh.view (an older export),
 // formats/vdsh_scene_view.c's for an object: the outside camera
 // (vdsh_view_fit_camera) and an object's preferred lights, outside its
-// bounding sphere (so in free space). lo, hi: the bounds; pos, nrm
+// bounding sphere, pulled into its bounds (below). lo, hi: the bounds; pos, nrm
 // (vertex_count x 3) and indices (triangle_count x 3), when given, decide
 // whether the object is flat (every vertex within a millionth of the
 // diagonal of the plane of its largest triangle: one triangle, a panel);
@@ -377,10 +377,31 @@ export function vdshFallbackView(lo, hi, pos, nrm, indices) {
   }
   dist = 1.05 * (dist > 0 ? dist : r);
   const around = [[1.5, 1.5, -0.4], [-1.3, 1.2, 1.4], [0.5, 2.1, 1.5], [1.6, 0.5, 1.2]];
-  const lights = around.map((a) => place(c, r, a[0], a[1], a[2]));
+  let lights = around.map((a) => place(c, r, a[0], a[1], a[2]));
+  if (flip) lights = lights.map((l) => mirror(l, c));
+  // Pulled into the bounds, 5% of each extent inside every face
+  // (VDSH_VIEW_REGION_INSET), as vdsh_view_compute pulls them into the
+  // light region the bake trained on, which holds the bounds (this page
+  // has no free-space test to grow it around a closed object); along an
+  // axis thinner than the clearance (1% of the diagonal) the bounds grown
+  // by a quarter of the diagonal there, a flat object's on every axis and
+  // along the line to the centre, so each stays on its side of the plane.
+  const g = 0.25 * diag, flat = fn !== null;
+  const blo = lo.map((x, k) => (flat || hi[k] - lo[k] < 0.01 * diag ? x - g : x));
+  const bhi = hi.map((x, k) => (flat || hi[k] - lo[k] < 0.01 * diag ? x + g : x));
+  const inset = (k) => 0.05 * (bhi[k] - blo[k]);
+  lights = lights.map((p) => {
+    if (!flat) return p.map((x, k) => Math.min(Math.max(x, blo[k] + inset(k)), bhi[k] - inset(k)));
+    let sc = 1;
+    for (let k = 0; k < 3; k++) {
+      const d = p[k] - c[k], room = d > 0 ? bhi[k] - inset(k) - c[k] : c[k] - (blo[k] + inset(k));
+      if (Math.abs(d) > room) sc = Math.min(sc, room / Math.abs(d));
+    }
+    return p.map((x, k) => c[k] + sc * (x - c[k]));
+  });
   return {
     interior: false, eye: c.map((x, k) => x + dist * w[k]), target: c, up: [0, 1, 0], fov_y: 60,
-    lights: flip ? lights.map((l) => mirror(l, c)) : lights, fallback: true,
+    lights, fallback: true,
   };
 }
 

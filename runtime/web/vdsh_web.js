@@ -39,7 +39,7 @@
 // meshes[0].extras.vdsh.view (formats/vdsh_scene_view.h: a room seen from
 // inside, an object framed from outside, lights moved into free space).
 // A file without it (an older export) is framed from outside, lit from
-// outside its bounding sphere (vdsh_core.js's vdshFallbackView:
+// within its bounds (vdsh_core.js's vdshFallbackView:
 // vdsh_view_fit_camera and an object's preferred lights), as vdsh-view
 // frames an object; a flat one (a triangle, a panel) from its front.
 //
