@@ -1179,16 +1179,22 @@ static vdsh_result cluster_and_fit(fit_scratch *s, uint32_t rounds, vdsh_error *
     return res;
 }
 
+/* fit as a stream of `order`, for vdsh_stream_decode. */
+static vdsh_stream fit_stream(const vdsh_cpca_fit *fit, uint32_t order)
+{
+    return (vdsh_stream){.order = order,
+                         .encoding = VDSH_ENCODING_CPCA,
+                         .scale = 1.0f,
+                         .data = fit->records,
+                         .cpca = fit->model};
+}
+
 /* The RMS error of fit's stream against src (rows x order^2), decoded as
  * every reader decodes. */
 static double decode_rms(const vdsh_cpca_fit *fit, const float *src, uint32_t rows, uint32_t order)
 {
     const uint32_t n = order * order;
-    vdsh_stream s = {.order = order,
-                     .encoding = VDSH_ENCODING_CPCA,
-                     .scale = 1.0f,
-                     .data = fit->records,
-                     .cpca = fit->model};
+    const vdsh_stream s = fit_stream(fit, order);
     float dec[VDSH_MAX_COEFFS];
     double e2 = 0.0;
     for (uint32_t v = 0; v < rows; v++) {
@@ -1870,11 +1876,7 @@ vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_
         !settings->positions || order < 1 || order > VDSH_MAX_ORDER)
         return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca pool score: bad arguments");
     const uint32_t n = order * order;
-    vdsh_stream s = {.order = order,
-                     .encoding = VDSH_ENCODING_CPCA,
-                     .scale = 1.0f,
-                     .data = fit->records,
-                     .cpca = fit->model};
+    const vdsh_stream s = fit_stream(fit, order);
     float dec[VDSH_MAX_COEFFS], y[VDSH_MAX_COEFFS];
     for (uint32_t v = 0; v < rows; v++) {
         vdsh_stream_decode(&s, v, dec);

@@ -846,15 +846,10 @@ static int find_free(const vdsh_view_tracer *t, const float p0[3], const float l
     return found;
 }
 
-typedef struct region_free {
-    const vdsh_view_tracer *t;
-    float diag;
-} region_free;
-
-static int region_is_free(const void *ctx, const float p[3])
+int vdsh_view_is_free(const void *ctx, const float p[3])
 {
-    const region_free *c = ctx;
-    return vdsh_view_free_space(c->t, p, c->diag);
+    const vdsh_view_free_ctx *c = ctx;
+    return vdsh_view_free_space(c->t, p, c->diagonal);
 }
 
 /* An object's box for its lights (vdsh_view_compute): the light region
@@ -1107,14 +1102,14 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
     /* The light region as the bake computes it (the bake's diagonal, so
      * the same clearance): an object's lights inside it, where the bake's
      * fit was made for them. */
-    region_free rc = {t, vdsh_free_diagonal(lo, hi)};
+    vdsh_view_free_ctx rc = {t, vdsh_free_diagonal(lo, hi)};
     memcpy(v.region_min, lo, sizeof v.region_min);
     memcpy(v.region_max, hi, sizeof v.region_max);
     if (!v.interior) /* a room's lights stay in its bounds: no probes spent */
         v.region_grown =
-            vdsh_light_region(lo, hi, region_is_free, &rc, v.region_min, v.region_max, NULL);
+            vdsh_light_region(lo, hi, vdsh_view_is_free, &rc, v.region_min, v.region_max, NULL);
     float blo[3], bhi[3];
-    light_box(v.region_min, v.region_max, lo, hi, rc.diag, flat, blo, bhi);
+    light_box(v.region_min, v.region_max, lo, hi, rc.diagonal, flat, blo, bhi);
     const float *slo = v.interior ? lo : blo, *shi = v.interior ? hi : bhi;
     for (int i = 0; !v.interior && i < v.light_count; i++)
         into_region(v.preferred[i], slo, shi, flat ? c : NULL);

@@ -259,6 +259,14 @@ float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m, 
  * clearance from `diagonal`; back faces by winding. */
 int vdsh_view_free_space(const vdsh_view_tracer *t, const float p[3], float diagonal);
 
+/* vdsh_view_free_space as a vdsh_free_fn (vdsh_light.h), for
+ * vdsh_light_region and vdsh_light_place: ctx a vdsh_view_free_ctx. */
+typedef struct vdsh_view_free_ctx {
+    const vdsh_view_tracer *t;
+    float diagonal;
+} vdsh_view_free_ctx;
+int vdsh_view_is_free(const void *ctx, const float p[3]);
+
 /* The shares of a width x height frame of camera c whose pixels a point
  * light at `light` lights and shadows: a pixel's first hit, its
  * interpolated normal turned toward the eye, faces the light (N . (L - p)

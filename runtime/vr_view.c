@@ -54,17 +54,6 @@ int vr_scene_default_lights(const vr_scene *s, vr_light *out, int max)
     return n;
 }
 
-typedef struct pool_free {
-    const vdsh_view_tracer *t;
-    float diag;
-} pool_free;
-
-static int pool_is_free(const void *ctx, const float p[3])
-{
-    const pool_free *c = ctx;
-    return vdsh_view_free_space(c->t, p, c->diag);
-}
-
 /* The light pool: candidates of the seeded uniform sequence in the
  * bounds, kept when in free space (vdsh_light.h), in sequence order. */
 vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count, const char *name,
@@ -76,13 +65,13 @@ vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count, c
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: light pool: %s", name, ve.msg);
     const float diag = vdsh_free_diagonal(s->bounds_min, s->bounds_max); /* the bake's */
     s->pool_count = 0;
-    pool_free c = {t, diag};
+    vdsh_view_free_ctx c = {t, diag};
     float lo[3], hi[3];
     const int grown =
-        vdsh_light_region(s->bounds_min, s->bounds_max, pool_is_free, &c, lo, hi, NULL);
+        vdsh_light_region(s->bounds_min, s->bounds_max, vdsh_view_is_free, &c, lo, hi, NULL);
     /* The bake side's placement, limit included (vdsh_light_tries: it
      * gave up here at 256 candidates per light, the baker at 1000). */
-    s->pool_count = (int)vdsh_light_place(lo, hi, grown, 1, (uint32_t)count, pool_is_free, &c,
+    s->pool_count = (int)vdsh_light_place(lo, hi, grown, 1, (uint32_t)count, vdsh_view_is_free, &c,
                                           s->pool, NULL, NULL);
     vdsh_view_tracer_destroy(t);
     return VR_OK;

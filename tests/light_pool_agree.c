@@ -32,17 +32,6 @@
 #include "vdsh_scene_view.h"
 #include "vr_internal.h"
 
-typedef struct view_free {
-    const vdsh_view_tracer *t;
-    float diag;
-} view_free;
-
-static int is_free_view(const void *ctx, const float p[3])
-{
-    const view_free *c = ctx;
-    return vdsh_view_free_space(c->t, p, c->diag);
-}
-
 /* A scene whose free space is small pockets (inward-facing boxes of half
  * size h, in a solid unit cube) around the first VDSH_REGION_PROBES
  * candidates of the region test: the region stays the bounds (most of
@@ -115,12 +104,13 @@ int main(int argc, char **argv)
     vdsh_view_tracer *t = NULL;
     if (vdsh_view_tracer_create(&vm, &t, &ve) != VDSH_OK)
         return fprintf(stderr, "%s\n", ve.msg), 2;
-    view_free vf = {t, diag};
+    vdsh_view_free_ctx vf = {t, diag};
     float rlo[3], rhi[3];
-    const int grown = vdsh_light_region(lo, hi, is_free_view, &vf, rlo, rhi, NULL);
+    const int grown = vdsh_light_region(lo, hi, vdsh_view_is_free, &vf, rlo, rhi, NULL);
     float(*rt)[3] = calloc(count, sizeof *rt);
     uint32_t *rt_k = calloc(count, sizeof *rt_k);
-    uint32_t n = vdsh_light_place(rlo, rhi, grown, 1, count, is_free_view, &vf, rt, rt_k, NULL);
+    uint32_t n =
+        vdsh_light_place(rlo, rhi, grown, 1, count, vdsh_view_is_free, &vf, rt, rt_k, NULL);
     /* ... and the runtime's own (vr_scene_place_pool, what vdsh-view's
      * --light-pool draws) on the same bounds: the same positions. */
     if (count > VR_MAX_POOL_LIGHTS)
