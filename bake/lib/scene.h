@@ -136,7 +136,8 @@ typedef enum vb_light_rule {
     VB_LIGHTS_NEAR,
     VB_LIGHTS_PATH,
     VB_LIGHTS_GROWN,
-    VB_LIGHTS_AROUND
+    VB_LIGHTS_AROUND,
+    VB_LIGHTS_SHELL
 } vb_light_rule;
 
 vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t count,

@@ -798,7 +798,7 @@ static int parse_interp(const char *s, uint32_t *out)
 
 static int parse_light_rule(const char *s, int *out)
 {
-    for (int k = VB_LIGHTS_UNIFORM; k <= VB_LIGHTS_AROUND; k++)
+    for (int k = VB_LIGHTS_UNIFORM; k <= VB_LIGHTS_SHELL; k++)
         if (!strcmp(s, vb_light_rule_name((vb_light_rule)k))) {
             *out = k;
             return 1;
