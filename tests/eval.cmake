@@ -66,8 +66,9 @@ lo, hi = j['scene']['bounds_min'][1], j['scene']['bounds_max'][1]
 ys = [p[1] for p in j['eval']['scene_light_positions']]
 assert ys and min(ys) >= lo + 0.8 * (hi - lo) - 1e-4 * (hi - lo), (lo, hi, min(ys))
 # grown: in the bounds grown by a quarter of the diagonal; around: in them
-# grown by a diagonal, outside the bounds (the room is open above)
-for rule, share in (('grown', 0.25), ('around', 1.0)):
+# grown by a diagonal, outside the bounds (the room is open above); shell:
+# grown by a quarter, outside the bounds (vdsh-bake --decision-shell)
+for rule, share in (('grown', 0.25), ('around', 1.0), ('shell', 0.25)):
     subprocess.run([ev, f, '-q', '--interior', '0', '--points', '300', '--light-rule', rule,
                     '--json', f + '.g.json'], check=True, stdout=subprocess.DEVNULL)
     j = json.load(open(f + '.g.json'))
