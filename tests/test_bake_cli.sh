@@ -296,4 +296,52 @@ check "near: the refusal names the option" grep -q -- "--decision-near" "$tmp/er
 expect_exit 2 "near: not negative" "$bake" "${near[@]}" --decision-near -1 -o "$tmp/nx.vdsh"
 check "near: nothing written on a refusal" test ! -e "$tmp/nx.vdsh"
 
+# Shell training lights (--decision-shell K, default none): on an object
+# (a unit cube on a 4 x 4 floor) the report counts them, the bake is the
+# same on 1 and 2 threads and differs from the default's; the default
+# places none; only method decision takes the option.
+cat > "$tmp/cube_floor.obj" <<'OBJ'
+v -2 0 -2
+v -2 0 2
+v 2 0 2
+v 2 0 -2
+v -0.5 0 -0.5
+v 0.5 0 -0.5
+v 0.5 0 0.5
+v -0.5 0 0.5
+v -0.5 1 -0.5
+v 0.5 1 -0.5
+v 0.5 1 0.5
+v -0.5 1 0.5
+f 1 2 3
+f 1 3 4
+f 5 9 10
+f 5 10 6
+f 6 10 11
+f 6 11 7
+f 7 11 12
+f 7 12 8
+f 8 12 9
+f 8 9 5
+f 9 12 11
+f 9 11 10
+OBJ
+shell=("$tmp/cube_floor.obj" --max-edge 0.25 --rays 64 --cube-size 0 -q)
+expect_exit 0 "shell: 4, 1 thread" "$bake" "${shell[@]}" --decision-shell 4 --threads 1 \
+  -o "$tmp/s1.vdsh" --report "$tmp/s1.json"
+expect_exit 0 "shell: 4, 2 threads" "$bake" "${shell[@]}" --decision-shell 4 --threads 2 \
+  -o "$tmp/s2.vdsh"
+expect_exit 0 "shell: default" "$bake" "${shell[@]}" --threads 2 -o "$tmp/s0.vdsh" \
+  --report "$tmp/s0.json"
+check "shell: 1 and 2 threads give identical files" cmp -s "$tmp/s1.vdsh" "$tmp/s2.vdsh"
+check "shell: a quarter of the pool placed in the shell" \
+  json "$tmp/s1.json" 'd["decision"]["shell_pool_lights"] == 1024'
+check "shell: the default places none" json "$tmp/s0.json" 'd["decision"]["shell_pool_lights"] == 0'
+check "shell: the training lights change the fit" bash -c '! cmp -s "$1" "$2"' _ "$tmp/s1.vdsh" \
+  "$tmp/s0.vdsh"
+expect_exit 2 "shell: only method decision" "$bake" "${shell[@]}" --method shadow \
+  --decision-shell 2 -o "$tmp/sx.vdsh"
+check "shell: the refusal names the option" grep -q -- "--decision-shell" "$tmp/err.txt"
+expect_exit 2 "shell: not negative" "$bake" "${shell[@]}" --decision-shell -1 -o "$tmp/sx.vdsh"
+
 exit $fail

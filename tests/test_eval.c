@@ -886,6 +886,23 @@ static void test_lights(void)
               "room rule %d: %s", ceiling, err.msg);
         CHECK(!memcmp(a, b, N * sizeof *a), "room rule %d: other lights than before", ceiling);
     }
+    /* The shell rule around the room: outside its bounds, within them grown
+     * by VDSH_REGION_GROW of the diagonal, in free space. */
+    vb_result shell_r = vb_scene_place_lights_rule(s, 0x5e11, N, VB_LIGHTS_SHELL, b, NULL, &err);
+    CHECK(shell_r == VB_OK, "room shell: %s", err.msg);
+    if (shell_r == VB_OK) {
+        const float gr = VDSH_REGION_GROW * s->diagonal;
+        for (int l = 0; l < N; l++) {
+            int outside = 0, within = 1;
+            for (int k = 0; k < 3; k++) {
+                outside |= b[l][k] < s->bounds_min[k] || b[l][k] > s->bounds_max[k];
+                within &= b[l][k] >= s->bounds_min[k] - gr && b[l][k] <= s->bounds_max[k] + gr;
+            }
+            CHECK(outside && within && vb_scene_free_space(s, b[l]),
+                  "room shell light %d at (%g, %g, %g)", l, (double)b[l][0], (double)b[l][1],
+                  (double)b[l][2]);
+        }
+    }
     /* A pool's first lights are a smaller pool's (vb_scene_place_pool:
      * the decision fit's and the cpca metric's one placement). */
     float(*big)[3] = malloc(2 * N * sizeof *big);
@@ -939,7 +956,11 @@ static void test_lights(void)
         CHECK(fabsf(lo[k] - (c->bounds_min[k] - g)) < 1e-5f &&
                   fabsf(hi[k] - (c->bounds_max[k] + g)) < 1e-5f,
               "grown region axis %d: %g..%g", k, (double)lo[k], (double)hi[k]);
-    for (int rule = VB_LIGHTS_UNIFORM; rule <= VB_LIGHTS_PATH; rule++) {
+    /* ... and the shell (the bounds grown by VDSH_REGION_GROW, outside
+     * them): the same box here, the rule's own bounds test. */
+    for (int rule = VB_LIGHTS_UNIFORM; rule <= VB_LIGHTS_SHELL; rule++) {
+        if (rule > VB_LIGHTS_PATH && rule != VB_LIGHTS_SHELL)
+            continue;
         vb_result r = vb_scene_place_lights_rule(c, 0x11 + (uint64_t)rule, N, (vb_light_rule)rule,
                                                  b, &tried, &err);
         CHECK(r == VB_OK, "cube rule %s: %s", vb_light_rule_name((vb_light_rule)rule), err.msg);

@@ -1190,8 +1190,9 @@ typedef struct bake_run {
     double t0; /* when the tracing began */
     double auto_error[VDSH_ORDER_SLOTS][2];
     uint32_t auto_receivers, cal_count;
-    uint32_t near_lights; /* the decision pool's lights placed by the near rule */
-    unsigned started;     /* the workers of the bake */
+    uint32_t near_lights;  /* the decision pool's lights placed by the near rule */
+    uint32_t shell_lights; /* ... and in the shell (vb_bake_desc.decision_shell) */
+    unsigned started;      /* the workers of the bake */
 } bake_run;
 
 typedef vb_result (*bake_step)(bake_run *b, vb_error *err);
@@ -1340,6 +1341,10 @@ static vb_result resolve_decision(bake_run *b, vb_error *err)
     if (d->decision_near > (int)VB_DECISION_POOL)
         return vb_fail(err, VB_ERR_ARGUMENT, "decision near share must be 1 in 1..%u, not 1 in %d",
                        VB_DECISION_POOL, d->decision_near);
+    if (d->decision_shell < 0 || d->decision_shell > (int)VB_DECISION_POOL)
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "decision shell share must be 1 in 1..%u (0: none), not 1 in %d",
+                       VB_DECISION_POOL, d->decision_shell);
     if (!(d->false_rate > 0.0f && d->false_rate < 0.5f))
         return vb_fail(err, VB_ERR_ARGUMENT, "the false rate must be in (0, 0.5)");
     if (d->offset_cap_keep == 0.0f)
@@ -1530,6 +1535,30 @@ static uint32_t mix_near(const vb_bake_desc *d, float (*pool)[3])
     return n;
 }
 
+/* Slots 0, K, 2K, ... of the training pool (K = d->decision_shell)
+ * replaced by lights in the shell around the bounds (bake.h,
+ * vb_bake_desc.decision_shell), in the traced frame. Returns the lights
+ * placed; no room is an error. */
+static vb_result mix_shell(const vb_bake_desc *d, float (*pool)[3], uint32_t *placed, vb_error *err)
+{
+    const uint32_t every = (uint32_t)d->decision_shell, n = VB_DECISION_POOL / every;
+    float(*sh)[3] = malloc((size_t)n * sizeof *sh + 1);
+    if (!sh)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    vb_result r = vb_scene_place_lights_rule(d->scene, d->seed ^ VB_POOL_SEED ^ VB_SHELL_SEED, n,
+                                             VB_LIGHTS_SHELL, sh, NULL, err);
+    if (r == VB_OK) {
+        for (uint32_t i = 0; i < n; i++)
+            vb_scene_to_local(d->scene, sh[i], pool[(size_t)i * every]);
+        *placed = n;
+    } else {
+        vb_fail(err, r,
+                "decision shell: no room for %u lights in the shell around the scene's bounds", n);
+    }
+    free(sh);
+    return r;
+}
+
 /* The per-order log offsets, for the methods that have them; method
  * decision: the pool of lights in free space (traced frame) and the
  * workers' scratch (no free space: the lsq fits are kept); adaptive
@@ -1563,11 +1592,16 @@ static vb_result setup_offsets(bake_run *b, vb_error *err)
             for (uint32_t k = 0; k < VB_DECISION_POOL; k++)
                 vb_scene_to_local(d->scene, d->pool ? d->pool + 3 * k : J->pool[k], J->pool[k]);
             J->cal_pool = J->pool;
-            if (d->decision_near > 0) {
+            if (d->decision_near > 0 || d->decision_shell > 0) {
                 if (!(J->pool = malloc(VB_DECISION_POOL * sizeof *J->pool)))
                     return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
                 memcpy(J->pool, J->cal_pool, VB_DECISION_POOL * sizeof *J->pool);
                 b->near_lights = mix_near(d, J->pool);
+                if (d->decision_shell > 0) {
+                    vb_result r = mix_shell(d, J->pool, &b->shell_lights, err);
+                    if (r != VB_OK)
+                        return r;
+                }
             }
             J->pool_count = VB_DECISION_POOL;
             J->decision = 1;
@@ -1815,6 +1849,7 @@ static void fill_output(bake_run *b, vb_bake_output *out)
     if (mi->decision) {
         o.decision_lights = J->decision ? d->decision_lights : 0;
         o.decision_near_lights = J->decision ? b->near_lights : 0;
+        o.decision_shell_lights = J->decision ? b->shell_lights : 0;
         o.decision_fitted = atomic_load(&J->dec_fitted);
         o.decision_fallbacks = atomic_load(&J->dec_fallbacks);
         o.decision_pairs =

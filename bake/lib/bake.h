@@ -114,7 +114,8 @@ int vb_order_candidate(int k, int cap);
  * placed), and so does the cpca metric's pool (docs/ACCURACY.md, "Lights
  * near surfaces in the decision pool"). */
 #define VB_DEFAULT_DECISION_NEAR 2
-#define VB_NEAR_SEED 0x6e656172ull /* "near" */
+#define VB_NEAR_SEED 0x6e656172ull  /* "near" */
+#define VB_SHELL_SEED 0x7368656cull /* "shel": vb_bake_desc.decision_shell */
 #define VB_CPCA_POOL 2048u
 
 typedef struct vb_bake_desc {
@@ -167,6 +168,16 @@ typedef struct vb_bake_desc {
      * lights placed by the near rule (VB_DEFAULT_DECISION_NEAR above); 0:
      * the default; < 0: none (uniform in free space, as before). */
     int decision_near;
+    /* Method decision: one in decision_shell of the training pool's
+     * lights (slots 0, K, 2K, ...; after the near rule's, so they win
+     * where the slots meet) placed in the shell around the bounds
+     * (VB_LIGHTS_SHELL: outside them, inside them grown by
+     * VDSH_REGION_GROW of the diagonal), seed bake seed ^ VB_POOL_SEED ^
+     * VB_SHELL_SEED: for an object lit from around it. The calibration's
+     * held-out lights stay in the light region. 0: none (the default;
+     * docs/ACCURACY.md, "A mixed pool for objects"). No room in the shell
+     * is an error. */
+    int decision_shell;
     /* Method decision, its training pool as placed (VB_DECISION_POOL
      * above; 3 floats per light, scene units, borrowed): pool_count
      * VB_DECISION_POOL, or 0 where there was no room (the lsq fits are
@@ -230,6 +241,9 @@ typedef struct vb_bake_output {
     /* Method decision: the pool's lights placed by the near rule (0: none,
      * or no room for them: the pool is uniform). */
     uint32_t decision_near_lights;
+    /* Method decision: the pool's lights placed in the shell
+     * (vb_bake_desc.decision_shell; 0: none). */
+    uint32_t decision_shell_lights;
     double decision_pairs;
     float false_rate;
     /* The offset cap (vb_bake_desc.offset_cap): (receiver, order) rows

@@ -244,7 +244,8 @@ static const char *region_name(int grown)
 
 const char *vb_light_rule_name(vb_light_rule rule)
 {
-    static const char *const names[] = {"uniform", "ceiling", "near", "path", "grown", "around"};
+    static const char *const names[] = {"uniform", "ceiling", "near", "path",
+                                        "grown",   "around",  "shell"};
     return (unsigned)rule < sizeof names / sizeof names[0] ? names[rule] : "?";
 }
 
@@ -252,15 +253,15 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
                                      vb_light_rule rule, float (*out)[3], uint32_t *tried,
                                      vb_error *err)
 {
-    if ((unsigned)rule > VB_LIGHTS_AROUND)
+    if ((unsigned)rule > VB_LIGHTS_SHELL)
         return vb_fail(err, VB_ERR_ARGUMENT, "unknown light rule %d", (int)rule);
     if (rule == VB_LIGHTS_UNIFORM) /* the runtime's placement too */
         return vb_scene_place_lights(s, seed, count, out, tried, err);
     float lo[3], hi[3];
     int grown = vb_scene_light_region(s, lo, hi, NULL);
-    if (rule == VB_LIGHTS_GROWN || rule == VB_LIGHTS_AROUND) {
+    if (rule == VB_LIGHTS_GROWN || rule == VB_LIGHTS_AROUND || rule == VB_LIGHTS_SHELL) {
         const double g =
-            (rule == VB_LIGHTS_GROWN ? (double)VDSH_REGION_GROW : 1.0) * (double)s->diagonal;
+            (rule == VB_LIGHTS_AROUND ? 1.0 : (double)VDSH_REGION_GROW) * (double)s->diagonal;
         for (int a = 0; a < 3; a++) {
             lo[a] = (float)((double)s->bounds_min[a] - g);
             hi[a] = (float)((double)s->bounds_max[a] + g);
@@ -282,9 +283,9 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
             p[2] = 0.5f * (lo[2] + hi[2]) +
                    0.3f * (hi[2] - lo[2]) * (float)vdsh_det_sin(6.2831853f * t);
         }
-        if (rule == VB_LIGHTS_AROUND && p[0] >= s->bounds_min[0] && p[0] <= s->bounds_max[0] &&
-            p[1] >= s->bounds_min[1] && p[1] <= s->bounds_max[1] && p[2] >= s->bounds_min[2] &&
-            p[2] <= s->bounds_max[2])
+        if ((rule == VB_LIGHTS_AROUND || rule == VB_LIGHTS_SHELL) && p[0] >= s->bounds_min[0] &&
+            p[0] <= s->bounds_max[0] && p[1] >= s->bounds_min[1] && p[1] <= s->bounds_max[1] &&
+            p[2] >= s->bounds_min[2] && p[2] <= s->bounds_max[2])
             continue;
         if (!vb_scene_free_space(s, p))
             continue;

@@ -129,14 +129,17 @@ int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3], uint32_t 
  * their diagonal, the bounds' inside too) and around (uniform in the
  * bounds grown by a whole diagonal, outside the bounds only: where
  * vdsh-view's default lights for an object stood, about 1.08 diagonals
- * from its centre). */
+ * from its centre) and shell (the bounds grown by VDSH_REGION_GROW of
+ * their diagonal, outside the bounds only: vb_bake_desc.decision_shell's
+ * training lights). */
 typedef enum vb_light_rule {
     VB_LIGHTS_UNIFORM = 0,
     VB_LIGHTS_CEILING,
     VB_LIGHTS_NEAR,
     VB_LIGHTS_PATH,
     VB_LIGHTS_GROWN,
-    VB_LIGHTS_AROUND
+    VB_LIGHTS_AROUND,
+    VB_LIGHTS_SHELL
 } vb_light_rule;
 
 vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t count,

@@ -56,6 +56,7 @@ typedef struct options {
     int have_log_offset;
     uint32_t decision_lights;    /* --decision-lights; 0: the default */
     int decision_near;           /* --decision-near as vb_bake_desc's; 0: the default */
+    int decision_shell;          /* --decision-shell; 0: none */
     float false_rate;            /* --false-rate; 0: the default */
     vb_decision_params decision; /* --decision-params */
     int have_decision;
@@ -272,6 +273,11 @@ static void usage(FILE *f)
             "                          5%% of the diagonal: vdsh-eval's --light-rule\n"
             "                          near), the rest and the calibration's lights\n"
             "                          uniform in free space (0: none; default %d)\n"
+            "      --decision-shell K  decision: one in K of the training lights placed\n"
+            "                          around an object (outside its bounds, inside them\n"
+            "                          grown by a quarter diagonal: vdsh-eval's\n"
+            "                          --light-rule shell); the calibration's stay in the\n"
+            "                          light region (0: none, the default; objects only)\n"
             "      --decision-params TAU,LIT,RIDGE,RIDGE0,STEPS\n"
             "                          decision: the loss's temperature (ln units), the\n"
             "                          weight of lit pairs, the ridge per (l(l+1))^2 and\n"
@@ -527,6 +533,7 @@ static int write_report(const char *path, const options *o, const vb_job_desc *j
         cJSON *dec = vt_json_object(&j, root, "decision");
         vt_json_u64(&j, dec, "lights", b->decision_lights);
         vt_json_u64(&j, dec, "near_pool_lights", b->decision_near_lights);
+        vt_json_u64(&j, dec, "shell_pool_lights", b->decision_shell_lights);
         vt_json_u64(&j, dec, "fitted", b->decision_fitted);
         vt_json_u64(&j, dec, "kept_lsq", b->decision_fallbacks);
         vt_json_f64(&j, dec, "mean_pairs", b->decision_pairs);
@@ -762,6 +769,7 @@ enum {
     O_MAX_ORDER,
     O_DEC_LIGHTS,
     O_DEC_NEAR,
+    O_DEC_SHELL,
     O_FALSE_RATE,
     O_OFFSET_CAP,
     O_DEC_PARAMS,
@@ -854,6 +862,9 @@ static int read_value(int c, const char *arg, options *o)
     case O_DEC_NEAR:
         ok = vt_opt_int("--decision-near", "", arg, 0, (int)VB_DECISION_POOL, &o->decision_near);
         o->decision_near = o->decision_near ? o->decision_near : -1; /* 0: none */
+        break;
+    case O_DEC_SHELL:
+        ok = vt_opt_int("--decision-shell", "", arg, 0, (int)VB_DECISION_POOL, &o->decision_shell);
         break;
     case O_ENCODING:
         ok = vt_opt_choice("--encoding", arg, encodings(), &v);
@@ -1030,11 +1041,12 @@ static int check_options(options *o)
         return bad_usage("%s", mi->refused[stored]);
     if (o->have_log_offset && mi->param != VB_PARAM_LOG_OFFSET)
         return bad_usage("%s", "--log-offset is methods decision's and shadow's");
-    if ((o->false_rate != 0.0f || o->decision_lights || o->decision_near || o->have_decision ||
-         o->offset_cap) &&
+    if ((o->false_rate != 0.0f || o->decision_lights || o->decision_near || o->decision_shell ||
+         o->have_decision || o->offset_cap) &&
         !mi->decision)
-        return bad_usage("%s", "--false-rate, --decision-lights, --decision-near, "
-                               "--decision-params and --offset-cap are method decision's");
+        return bad_usage("%s",
+                         "--false-rate, --decision-lights, --decision-near, --decision-shell, "
+                         "--decision-params and --offset-cap are method decision's");
     if (o->lambda != 0.0f && mi->lambda_fixed)
         return bad_usage("--lambda is lsq's: method %s uses lsq's default (its method "
                          "parameter is the log offset)",
@@ -1100,6 +1112,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"log-offset", required_argument, 0, O_LOG_OFFSET},
         {"decision-lights", required_argument, 0, O_DEC_LIGHTS},
         {"decision-near", required_argument, 0, O_DEC_NEAR},
+        {"decision-shell", required_argument, 0, O_DEC_SHELL},
         {"false-rate", required_argument, 0, O_FALSE_RATE},
         {"offset-cap", required_argument, 0, O_OFFSET_CAP},
         {"decision-params", required_argument, 0, O_DEC_PARAMS},
@@ -1256,6 +1269,7 @@ static vb_job_desc job_desc(const options *o, FILE *log, progress *pr, float *of
                                   .decision = o->have_decision ? &o->decision : NULL,
                                   .decision_lights = o->decision_lights,
                                   .decision_near = o->decision_near,
+                                  .decision_shell = o->decision_shell,
                                   .false_rate = o->false_rate,
                                   .offset_cap = o->offset_cap,
                                   .offset_cap_tol = o->offset_cap_tol,

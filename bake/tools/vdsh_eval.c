@@ -94,7 +94,8 @@ static void usage(FILE *f)
             "                          grown (the bounds grown by a quarter of their\n"
             "                          diagonal) or around (grown by a diagonal, outside\n"
             "                          the bounds: where a viewer puts lights around an\n"
-            "                          object)\n"
+            "                          object) or shell (grown by a quarter diagonal,\n"
+            "                          outside the bounds: vdsh-bake's --decision-shell)\n"
             "      --orders LIST       only these orders, e.g. 3,5 (default: every stream)\n"
             "      --offsets LIST      the trade between recall and false shadows as a\n"
             "                          curve: each stream is also scored with each\n"
@@ -798,7 +799,7 @@ static int parse_interp(const char *s, uint32_t *out)
 
 static int parse_light_rule(const char *s, int *out)
 {
-    for (int k = VB_LIGHTS_UNIFORM; k <= VB_LIGHTS_AROUND; k++)
+    for (int k = VB_LIGHTS_UNIFORM; k <= VB_LIGHTS_SHELL; k++)
         if (!strcmp(s, vb_light_rule_name((vb_light_rule)k))) {
             *out = k;
             return 1;
@@ -898,7 +899,7 @@ static int parse_args(int argc, char **argv, options *o)
         case O_LIGHT_RULE:
             if (!parse_light_rule(optarg, &d->light_rule))
                 return bad_usage(
-                    "--light-rule takes uniform, ceiling, near, path, grown or around, not '%s'",
+                    "--light-rule takes uniform, ceiling, near, path, grown, around or shell, not '%s'",
                     optarg);
             break;
         case O_OFFSETS:
