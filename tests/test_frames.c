@@ -810,6 +810,20 @@ static int part_errors(void)
         CHECK(0, "bake");
         return test_report("frames_errors");
     }
+    /* A lone quad casts no shadow: no view is found, and the message
+     * says a seed would not help (it advised one). */
+    char *qobj = path_in("quad.obj"), *qvdsh = path_in("quad.vdsh");
+    FILE *qf = fopen(qobj, "w");
+    fprintf(qf, "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 2 3\nf 1 3 4\n");
+    fclose(qf);
+    CHECK(bake_to((char *[]){qobj, NULL}, qvdsh, "0.2") == 0 &&
+              run((char *[]){fr, "views", qvdsh, "-o", path_in("q.json"), "--cameras", "2",
+                             NULL}) == 1 &&
+              test_file_contains(err_path, "found 0 of 2") &&
+              test_file_contains(err_path, "no seed changes") &&
+              !test_file_contains(err_path, "try another seed"),
+          "a scene with no shadow: no seed advised");
+
     char *missing = path_in("no-such.vdsh"), *nov = path_in("no-such.views.json"),
          *bad = path_in("bad.views.json"), *views = path_in("ok.views.json"),
          *truth = path_in("truth"), *json = path_in("score.json");

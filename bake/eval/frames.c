@@ -842,9 +842,12 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
                     "found %u of %u views (%u candidate eyes, %u in free space): too few "
                     "views show at least %.0f%% of their pixels lit and as many "
                     "hard-shadowed by one light with no surface nearer than %.0f%% of the "
-                    "diagonal; ask for fewer cameras or try another seed",
+                    "diagonal; %s",
                     have, d.cameras, st.eyes_tried, st.eyes_free, 100.0 * VB_FRAMES_MIN_SHARE,
-                    100.0 * NEAREST_SHARE);
+                    100.0 * NEAREST_SHARE,
+                    have ? "ask for fewer cameras or try another seed"
+                         : "none did: the scene may cast no shadow one light shows (a lone "
+                           "plane or convex object), which no seed changes");
         goto done;
     }
     memcpy(out, views, (1 + (size_t)d.cameras) * sizeof *views);
