@@ -236,15 +236,15 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
                 "node transform ignored)\n",
                 tool, sep, path, r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
     if (r->nonconvex_polygons)
-        fprintf(fp,
-                "%s%s%s: warning: %u polygon%s of 4 or more vertices not simple (or far from "
-                "flat), so not ear-clipped: fanned from the first vertex, the triangles cover "
-                "%.3gx the area %s, part of it outside the face; triangulate %s in the "
-                "exporter\n",
-                tool, sep, path, r->nonconvex_polygons, plural(r->nonconvex_polygons),
-                1.0 + r->nonconvex_excess,
-                r->nonconvex_polygons == 1 ? "it encloses" : "they enclose",
-                r->nonconvex_polygons == 1 ? "it" : "them");
+        fprintf(
+            fp,
+            "%s%s%s: warning: %u polygon%s of 4 or more vertices not simple (or far from "
+            "flat, or too large to clip), so not ear-clipped: fanned from the first vertex, the triangles cover "
+            "%.3gx the area %s, part of it outside the face; triangulate %s in the "
+            "exporter\n",
+            tool, sep, path, r->nonconvex_polygons, plural(r->nonconvex_polygons),
+            1.0 + r->nonconvex_excess, r->nonconvex_polygons == 1 ? "it encloses" : "they enclose",
+            r->nonconvex_polygons == 1 ? "it" : "them");
     if (r->gltf_ragged)
         fprintf(fp,
                 "%s%s%s: %u glTF triangle list%s with a count not a multiple of 3 (invalid "
