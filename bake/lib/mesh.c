@@ -1186,9 +1186,9 @@ static int drop_duplicates(const float *positions, uint32_t *idx, uint32_t *coun
  * The readers ear-clip concave polygons (mesh_read.h,
  * triangulate_polygon), whose triangles then cover the face exactly; what
  * is left here is what they fanned from the first vertex instead: polygons
- * that are not simple (crossing or touching themselves, no area), or far
- * from flat. Another reader may take them differently: counted and said,
- * not refused. */
+ * that are not simple (crossing themselves, no area), far from flat, or
+ * past the file's ear clipping time bound. Another reader may take them
+ * differently: counted and said, not refused. */
 static void nonconvex_polygons(const vb_mesh_raw *raw, uint32_t *count, double *excess)
 {
     double fan_sum = 0.0, own_sum = 0.0;
