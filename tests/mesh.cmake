@@ -24,7 +24,7 @@ set_tests_properties(mesh_shared_scenes_load_expected_counts mesh_assimp_models_
 # on, and the files OpenMesh's readers misread that are now refused.
 add_executable(test_mesh_parse ${CMAKE_CURRENT_LIST_DIR}/test_mesh_parse.c)
 target_link_libraries(test_mesh_parse PRIVATE vb_mesh m)
-add_test(NAME mesh_parse COMMAND test_mesh_parse)
+add_test(NAME mesh_parse COMMAND test_mesh_parse ${VDSH_ASSIMP_MODELS})
 
 # What loading found, on vdsh-bake's stderr (and -q, and vdsh-eval quiet).
 add_test(NAME mesh_report_cli

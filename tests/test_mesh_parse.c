@@ -7,13 +7,16 @@
  * copy of the previous one, binary PLY coordinates read shifted) and now
  * refuses.
  *
- * Usage: test_mesh_parse   (no data needed)
+ * Usage: test_mesh_parse [ASSIMP_MODELS]  (no data needed; with assimp's
+ * test models, their concave polygon is checked too)
  */
 #include "mesh.h"
 #include "mesh_parse.h"
 #include "test_util.h"
 
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static vb_result parse(const char *name, vb_mesh_format f, const void *bytes, size_t size,
@@ -328,6 +331,215 @@ static void test_off(void)
     }
 }
 
+/* ====================================================================== */
+/* Polygons: the fan where it lies inside, ear clipping where it does not  */
+/* ====================================================================== */
+
+/* Twice the vector area of raw's triangle t (its corners' cross product). */
+static void raw_cross(const vb_mesh_raw *raw, uint32_t t, double x[3])
+{
+    const float *a = raw->positions + 3 * raw->indices[3 * (size_t)t],
+                *b = raw->positions + 3 * raw->indices[3 * (size_t)t + 1],
+                *c = raw->positions + 3 * raw->indices[3 * (size_t)t + 2];
+    double u[3], v[3];
+    for (int d = 0; d < 3; d++)
+        u[d] = (double)b[d] - a[d], v[d] = (double)c[d] - a[d];
+    x[0] = u[1] * v[2] - u[2] * v[1];
+    x[1] = u[2] * v[0] - u[0] * v[2];
+    x[2] = u[0] * v[1] - u[1] * v[0];
+}
+
+/* Over every polygon of raw (a run of triangles of one file face): the
+ * largest ratio of its triangles' total area to the area it encloses (the
+ * length of their summed vector areas, the same for any triangulation of
+ * the polygon: 1 when the triangles tile it, more when part lies outside
+ * and overlaps). *total: all triangles' area. */
+static double worst_cover(const vb_mesh_raw *raw, double *total)
+{
+    double worst = 1.0;
+    *total = 0.0;
+    for (uint32_t t = 0; t < raw->triangle_count;) {
+        uint32_t e = t;
+        double sum = 0.0, vec[3] = {0.0, 0.0, 0.0};
+        for (; e < raw->triangle_count && raw->faces[e] == raw->faces[t]; e++) {
+            double x[3];
+            raw_cross(raw, e, x);
+            sum += sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+            for (int d = 0; d < 3; d++)
+                vec[d] += x[d];
+        }
+        const double own = sqrt(vec[0] * vec[0] + vec[1] * vec[1] + vec[2] * vec[2]);
+        if (sum > worst * own)
+            worst = own > 0.0 ? sum / own : INFINITY;
+        *total += 0.5 * sum;
+        t = e;
+    }
+    return worst;
+}
+
+/* Whether raw's triangles are polygon v[0..n-1] fanned from v[0]. */
+static int is_fan(const vb_mesh_raw *raw, const int64_t *v, uint32_t n)
+{
+    if (raw->triangle_count != n - 2)
+        return 0;
+    for (uint32_t i = 1; i + 1 < n; i++) {
+        const int64_t *t = raw->indices + 3 * (size_t)(i - 1);
+        if (t[0] != v[0] || t[1] != v[i] || t[2] != v[i + 1])
+            return 0;
+    }
+    return 1;
+}
+
+/* An L of area 3 listed from a corner that does not see all of it: its
+ * fan covered 4 (a triangle outside the face, overlapping another). Every
+ * reader that takes polygons ear-clips it: 4 triangles tiling the L, in
+ * its winding (+z). The same L listed from its inner corner, which sees
+ * all of it, keeps the fan, as do a convex quad and pentagon (one with a
+ * corner on an edge: its degenerate triangle included). */
+static void test_concave(void)
+{
+    static const char obj[] = "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\n"
+                              "f 3 4 5 6 1 2\n";
+    static const char off[] = "OFF\n6 1 0\n0 0 0\n2 0 0\n2 1 0\n1 1 0\n1 2 0\n0 2 0\n"
+                              "6 2 3 4 5 0 1\n";
+    static const char ply[] = "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\n"
+                              "property float y\nproperty float z\nelement face 1\n"
+                              "property list uchar int vertex_indices\nend_header\n"
+                              "0 0 0\n2 0 0\n2 1 0\n1 1 0\n1 2 0\n0 2 0\n6 2 3 4 5 0 1\n";
+    const struct {
+        const char *name;
+        vb_mesh_format f;
+        const char *text;
+    } ells[] = {{"ell.obj", VB_MESH_OBJ, obj},
+                {"ell.off", VB_MESH_OFF, off},
+                {"ell.ply", VB_MESH_PLY, ply}};
+    static const int64_t ell[6] = {2, 3, 4, 5, 0, 1};
+    for (size_t i = 0; i < sizeof ells / sizeof ells[0]; i++) {
+        vb_mesh_raw raw;
+        vb_error err;
+        vb_result r = parse_text(ells[i].name, ells[i].f, ells[i].text, &raw, &err);
+        CHECK(r == VB_OK && raw.triangle_count == 4, "%s: %s, %u triangles", ells[i].name,
+              r == VB_OK ? "read" : err.msg, raw.triangle_count);
+        if (r != VB_OK)
+            continue;
+        double total = 0.0;
+        const double worst = worst_cover(&raw, &total);
+        CHECK(worst <= 1.0 + 1e-12 && fabs(total - 3.0) <= 1e-12,
+              "%s: triangles cover %.6gx the L, area %.9g (its own: 3)", ells[i].name, worst,
+              total);
+        CHECK(!is_fan(&raw, ell, 6), "%s: still fanned", ells[i].name);
+        for (uint32_t t = 0; t < raw.triangle_count; t++) {
+            double x[3];
+            raw_cross(&raw, t, x);
+            CHECK(x[2] > 0.0, "%s: triangle %u not in the L's winding (%g)", ells[i].name, t, x[2]);
+            CHECK(raw.faces[t] == 0, "%s: triangle %u of face %u", ells[i].name, t, raw.faces[t]);
+        }
+        vb_mesh_raw_free(&raw);
+    }
+
+    /* Fans kept, index for index. */
+    const struct {
+        const char *text;
+        int64_t v[6];
+        uint32_t n;
+    } fans[] = {
+        {"v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nf 4 5 6 1 2 3\n",
+         {3, 4, 5, 0, 1, 2},
+         6},
+        {"v 0 0 0\nv 2 0 0\nv 2 1 0.01\nv 0 1 0\nf 1 2 3 4\n", {0, 1, 2, 3}, 4},
+        {"v 0 0 0\nv 1 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nf 2 3 4 5 1\n", {1, 2, 3, 4, 0}, 5},
+        {"v 0 0 0\nv 2 0 0\nv 3 1 1\nv 1 2 2\nv -1 1 1\nf 1 2 3 4 5\n", {0, 1, 2, 3, 4}, 5},
+    };
+    for (size_t i = 0; i < sizeof fans / sizeof fans[0]; i++) {
+        vb_mesh_raw raw;
+        vb_error err;
+        vb_result r = parse_text("fan.obj", VB_MESH_OBJ, fans[i].text, &raw, &err);
+        CHECK(r == VB_OK && is_fan(&raw, fans[i].v, fans[i].n), "fan %zu: %s", i,
+              r == VB_OK ? "not the fan" : err.msg);
+        if (r == VB_OK)
+            vb_mesh_raw_free(&raw);
+    }
+
+    /* Not simple (a crossing: no ear; the fan covers more than the
+     * vector area) or far from flat (the L's inner corner raised 3 above
+     * it: clipped triangles would cover far more than it encloses): fanned
+     * as before (mesh.c warns). */
+    static const char *const fallback[] = {
+        "v 0 0 0\nv 3 0 0\nv 3 2 0\nv 1 -1 0\nv 1 2 0\nv 0 2 0\nf 1 2 3 4 5 6\n",
+        "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 3\nv 1 2 0\nv 0 2 0\nf 3 4 5 6 1 2\n",
+    };
+    for (size_t i = 0; i < sizeof fallback / sizeof fallback[0]; i++) {
+        vb_mesh_raw raw;
+        vb_error err;
+        vb_result r = parse_text("odd.obj", VB_MESH_OBJ, fallback[i], &raw, &err);
+        const int64_t v0[6] = {0, 1, 2, 3, 4, 5}, v1[6] = {2, 3, 4, 5, 0, 1};
+        double total = 0.0;
+        CHECK(r == VB_OK && is_fan(&raw, i == 0 ? v0 : v1, 6) && worst_cover(&raw, &total) > 1.01,
+              "fallback %zu: %s", i, r == VB_OK ? "not the fan, or no excess" : err.msg);
+        if (r == VB_OK)
+            vb_mesh_raw_free(&raw);
+    }
+}
+
+/* OBJ corner normals follow the corners into the clipped triangles: each
+ * corner of each triangle keeps the normal its vertex was given there. */
+static void test_concave_normals(void)
+{
+    static const char obj[] = "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\n"
+                              "vn 1 0 0\nvn 0 1 0\nvn 0 0 1\nvn -1 0 0\nvn 0 -1 0\n"
+                              "f 3//3 4//4 5 6//1 1//5 2//2\n";
+    vb_mesh_raw raw;
+    vb_error err;
+    vb_result r = parse_text("ell_n.obj", VB_MESH_OBJ, obj, &raw, &err);
+    CHECK(r == VB_OK && raw.triangle_count == 4 && raw.corner_given && raw.corner_normals,
+          "ell_n.obj: %s", r == VB_OK ? "no corner normals" : err.msg);
+    if (r != VB_OK)
+        return;
+    /* vertex (0-based) -> normal number (1-based), 0: none */
+    static const int given[6] = {5, 2, 3, 4, 0, 1};
+    static const float vn[5][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, {0, -1, 0}};
+    for (uint32_t c = 0; raw.corner_given && c < 3 * raw.triangle_count; c++) {
+        const int g = given[raw.indices[c]];
+        CHECK(raw.corner_given[c] == (g != 0), "ell_n.obj: corner %u (vertex %lld) given %u", c,
+              (long long)raw.indices[c], raw.corner_given[c]);
+        if (g)
+            CHECK(memcmp(raw.corner_normals + 3 * c, vn[g - 1], sizeof vn[0]) == 0,
+                  "ell_n.obj: corner %u (vertex %lld) has another vertex's normal", c,
+                  (long long)raw.indices[c]);
+    }
+    double total = 0.0;
+    CHECK(worst_cover(&raw, &total) <= 1.0 + 1e-12, "ell_n.obj: not clipped");
+    vb_mesh_raw_free(&raw);
+}
+
+/* assimp's concave_polygon.obj: one flat polygon of 64 vertices, which
+ * the fan covered 13.5x over; clipped, its triangles tile it. */
+static void test_assimp_concave(const char *models)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/OBJ/concave_polygon.obj", models);
+    uint8_t *bytes = NULL;
+    size_t size = 0;
+    vb_error err;
+    if (vb_mesh_read_file(path, &bytes, &size, &err) != VB_OK) {
+        printf("skipped: %s\n", err.msg);
+        return;
+    }
+    vb_mesh_raw raw;
+    vb_result r = parse(path, VB_MESH_OBJ, bytes, size, &raw, &err);
+    free(bytes);
+    CHECK(r == VB_OK, "%s", err.msg);
+    if (r != VB_OK)
+        return;
+    double total = 0.0;
+    const double worst = worst_cover(&raw, &total);
+    printf("concave_polygon.obj: %u triangles cover %.9gx the area the polygon encloses\n",
+           raw.triangle_count, worst);
+    CHECK(raw.triangle_count > 2 && worst <= 1.0 + 1e-9, "%s: triangles cover %.6gx its area", path,
+          worst);
+    vb_mesh_raw_free(&raw);
+}
+
 static void test_arguments(void)
 {
     vb_mesh_raw raw;
@@ -344,7 +556,7 @@ static void test_arguments(void)
     vb_mesh_raw_free(NULL);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     test_numbers();
     test_obj_normals();
@@ -353,5 +565,9 @@ int main(void)
     test_ply_colours();
     test_off();
     test_arguments();
+    test_concave();
+    test_concave_normals();
+    if (argc > 1)
+        test_assimp_concave(argv[1]);
     return test_report("mesh_parse");
 }

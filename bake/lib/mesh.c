@@ -236,14 +236,15 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
                 "node transform ignored)\n",
                 tool, sep, path, r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
     if (r->nonconvex_polygons)
-        fprintf(fp,
-                "%s%s%s: warning: %u polygon%s of 4 or more vertices not convex (or far from "
-                "flat): fanned from the first vertex, the triangles cover %.3gx the area %s, "
-                "part of it outside the face; triangulate %s in the exporter\n",
-                tool, sep, path, r->nonconvex_polygons, plural(r->nonconvex_polygons),
-                1.0 + r->nonconvex_excess,
-                r->nonconvex_polygons == 1 ? "it encloses" : "they enclose",
-                r->nonconvex_polygons == 1 ? "it" : "them");
+        fprintf(
+            fp,
+            "%s%s%s: warning: %u polygon%s of 4 or more vertices not simple (or far from "
+            "flat, or too large to clip), so not ear-clipped: fanned from the first vertex, the triangles cover "
+            "%.3gx the area %s, part of it outside the face; triangulate %s in the "
+            "exporter\n",
+            tool, sep, path, r->nonconvex_polygons, plural(r->nonconvex_polygons),
+            1.0 + r->nonconvex_excess, r->nonconvex_polygons == 1 ? "it encloses" : "they enclose",
+            r->nonconvex_polygons == 1 ? "it" : "them");
     if (r->gltf_ragged)
         fprintf(fp,
                 "%s%s%s: %u glTF triangle list%s with a count not a multiple of 3 (invalid "
@@ -1179,12 +1180,15 @@ static int drop_duplicates(const float *positions, uint32_t *idx, uint32_t *coun
     return 1;
 }
 
-/* Polygons of 4+ vertices (consecutive triangles of one file face, fanned
- * from its first vertex) whose fan covers more than 1% beyond the area the
- * polygon encloses (the length of its vector area, which the fan's vector
- * areas sum to): concave faces, whose fan reaches outside them and
- * overlaps itself, or faces far from flat. Another reader (assimp's ear
- * clipping) takes them differently: counted and said, not refused. */
+/* Polygons of 4+ vertices (consecutive triangles of one file face) whose
+ * triangles cover more than 1% beyond the area the polygon encloses (the
+ * length of its vector area, which the triangles' vector areas sum to).
+ * The readers ear-clip concave polygons (mesh_read.h,
+ * triangulate_polygon), whose triangles then cover the face exactly; what
+ * is left here is what they fanned from the first vertex instead: polygons
+ * that are not simple (crossing themselves, no area), far from flat, or
+ * past the file's ear clipping time bound. Another reader may take them
+ * differently: counted and said, not refused. */
 static void nonconvex_polygons(const vb_mesh_raw *raw, uint32_t *count, double *excess)
 {
     double fan_sum = 0.0, own_sum = 0.0;

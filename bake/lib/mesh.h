@@ -32,7 +32,9 @@
  * receivers. Any other "builtin:" name fails with VB_ERR_ARGUMENT and a
  * message listing these.
  *
- * Loaded meshes are clean: triangles only (polygons fan-triangulated),
+ * Loaded meshes are clean: triangles only (polygons fanned from their
+ * first vertex where that fan lies inside them, every convex one; other
+ * flat, simple polygons ear-clipped: mesh_read.h triangulate_polygon),
  * every index < vertex_count, no unreferenced vertices, every coordinate
  * finite, normals unit length or (0,0,0) where undefined (a vertex whose
  * faces all have zero area). Vertex normals come from the file when it has
@@ -182,10 +184,11 @@ typedef struct vb_mesh_report {
     uint32_t gltf_ragged;         /* glTF: TRIANGLES primitives whose index
                                     (or vertex) count is not a multiple of
                                     3, the last 1 or 2 ignored */
-    uint32_t nonconvex_polygons;  /* faces of 4+ vertices whose fan
-                                    triangles cover more than they enclose
-                                    (concave, or far from flat): baked as
-                                    fanned, area outside the face included */
+    uint32_t nonconvex_polygons;  /* faces of 4+ vertices whose triangles
+                                    cover more than they enclose: not
+                                    simple or far from flat, so fanned, not
+                                    ear-clipped; baked as fanned, area
+                                    outside the face included */
     double nonconvex_excess;      /* their fan area over their own, less 1 */
 } vb_mesh_report;
 

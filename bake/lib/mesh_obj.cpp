@@ -5,7 +5,7 @@
  * after blanks is '#' is a comment; faces take each corner's index before
  * the first '/', resolve negative indices against the "v" lines so far,
  * give the corner's vertex the normal the corner names, drop repeated
- * vertices (first occurrence kept) and fan-triangulate what is left (fewer
+ * vertices (first occurrence kept) and triangulate what is left (fewer
  * than three: no face). Each corner keeps the last normal its line gave
  * its vertex.
  */

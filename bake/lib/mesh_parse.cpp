@@ -19,6 +19,13 @@
  * its format's rules): numbers are read as std::istream reads them
  * (correctly rounded, the same floats as strtof), and must be whole tokens.
  *
+ * One departure from OpenMesh: it fanned every polygon from its first
+ * vertex, which puts part of a concave polygon's triangles outside it
+ * (phantom occluders: Sponza's arches, fanned up to 3x their area). A
+ * polygon whose fan reaches outside it is ear-clipped instead
+ * (triangulate_polygon, builder::triangulate, after every reader); any
+ * other, every convex polygon included, keeps the fan bit for bit.
+ *
  * Normals given for a vertex more than once are averaged as mesh_parse.h
  * says; per face corner (OBJ) each corner keeps the last normal its line
  * gave its vertex.
@@ -255,6 +262,195 @@ void builder::add_corner_normals(const int64_t *v, size_t n)
     pending.clear();
 }
 
+/* ====================================================================== */
+/* Polygons: fan or ear clipping                                          */
+/* ====================================================================== */
+
+namespace
+{
+
+/* Twice the signed area of 2D triangle (a, b, c). */
+inline double cross2(const double *a, const double *b, const double *c)
+{
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+/* Twice the area of 3D triangle (a, b, c), float corners, in double. */
+double area3(const float *a, const float *b, const float *c)
+{
+    double u[3], w[3];
+    for (int d = 0; d < 3; d++)
+        u[d] = (double)b[d] - a[d], w[d] = (double)c[d] - a[d];
+    const double x = u[1] * w[2] - u[2] * w[1], y = u[2] * w[0] - u[0] * w[2],
+                 z = u[0] * w[1] - u[1] * w[0];
+    return std::sqrt(x * x + y * y + z * z);
+}
+
+} // namespace
+
+bool triangulate_polygon(const float *positions, const int64_t *v, size_t n,
+                         std::vector<uint32_t> &tris, uint64_t *budget)
+{
+    const size_t first = tris.size();
+    auto fan = [&] {
+        tris.resize(first);
+        for (size_t i = 1; i + 1 < n; i++) {
+            tris.push_back(0);
+            tris.push_back((uint32_t)i);
+            tris.push_back((uint32_t)(i + 1));
+        }
+        return false;
+    };
+    if (n < 4)
+        return fan();
+    auto pos = [&](size_t c) { return positions + 3 * (size_t)v[c]; };
+
+    /* Newell normal (twice the vector area), corners relative to corner 0. */
+    std::vector<double> q(3 * n);
+    for (size_t c = 0; c < n; c++)
+        for (int d = 0; d < 3; d++)
+            q[3 * c + (size_t)d] = (double)pos(c)[d] - (double)pos(0)[d];
+    double nrm[3] = {0.0, 0.0, 0.0};
+    for (size_t c = 1; c + 1 < n; c++) {
+        const double *a = &q[3 * c], *b = &q[3 * c + 3];
+        nrm[0] += a[1] * b[2] - a[2] * b[1];
+        nrm[1] += a[2] * b[0] - a[0] * b[2];
+        nrm[2] += a[0] * b[1] - a[1] * b[0];
+    }
+    const double own = std::sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    if (!(own > 0.0) || !std::isfinite(own))
+        return fan();
+
+    /* Drop the dominant axis; (x, y) cyclic after it, so that the 2D
+     * winding is the normal's sign along it, made positive. */
+    int k = 0;
+    for (int d = 1; d < 3; d++)
+        if (std::fabs(nrm[d]) > std::fabs(nrm[k]))
+            k = d;
+    const int ax = (k + 1) % 3, ay = (k + 2) % 3;
+    const double flip = nrm[k] < 0.0 ? -1.0 : 1.0;
+    std::vector<double> p(2 * n);
+    for (size_t c = 0; c < n; c++) {
+        p[2 * c] = q[3 * c + (size_t)ax];
+        p[2 * c + 1] = flip * q[3 * c + (size_t)ay];
+    }
+    auto pt = [&](size_t c) { return &p[2 * c]; };
+
+    /* The fan, where none of its triangles is negative. The tolerance
+     * (relative to the polygon's own projected area) only keeps rounding
+     * in nearly collinear corners from sending a convex polygon on. */
+    double total = 0.0, most_negative = 0.0;
+    for (size_t i = 1; i + 1 < n; i++) {
+        const double a = cross2(pt(0), pt(i), pt(i + 1));
+        total += a;
+        most_negative = std::min(most_negative, a);
+    }
+    if (!(total > 0.0) || most_negative >= -1e-9 * total)
+        return fan();
+
+    /* Ear clipping over a ring of the corners left. */
+    std::vector<size_t> prev(n), next(n);
+    for (size_t c = 0; c < n; c++) {
+        prev[c] = (c + n - 1) % n;
+        next[c] = (c + 1) % n;
+    }
+    size_t left = n, cur = 1, misses = 0;
+    while (left > 3) {
+        const size_t a = prev[cur], c = next[cur];
+        const double *pa = pt(a), *pb = pt(cur), *pc = pt(c);
+        bool ear = cross2(pa, pb, pc) > 0.0;
+        for (size_t r = next[c]; ear && r != a; r = next[r]) {
+            if (*budget == 0)
+                return fan();
+            (*budget)--;
+            const double *pr = pt(r);
+            /* A corner at one of the ear's own positions (a polygon that
+             * touches itself there) does not block it. */
+            if ((pr[0] == pa[0] && pr[1] == pa[1]) || (pr[0] == pb[0] && pr[1] == pb[1]) ||
+                (pr[0] == pc[0] && pr[1] == pc[1]))
+                continue;
+            if (cross2(pa, pb, pr) >= 0.0 && cross2(pb, pc, pr) >= 0.0 && cross2(pc, pa, pr) >= 0.0)
+                ear = false;
+        }
+        if (ear) {
+            tris.push_back((uint32_t)a);
+            tris.push_back((uint32_t)cur);
+            tris.push_back((uint32_t)c);
+            next[a] = c;
+            prev[c] = a;
+            left--;
+            cur = c;
+            misses = 0;
+        } else {
+            cur = next[cur];
+            if (++misses >= left)
+                return fan(); /* no ear: not a simple polygon */
+        }
+    }
+    if (!(cross2(pt(prev[cur]), pt(cur), pt(next[cur])) >= 0.0))
+        return fan();
+    tris.push_back((uint32_t)prev[cur]);
+    tris.push_back((uint32_t)cur);
+    tris.push_back((uint32_t)next[cur]);
+
+    /* Far from flat: the triangles' own area more than 1% over the
+     * polygon's vector area (equal for a flat polygon). */
+    double area = 0.0;
+    for (size_t t = first; t < tris.size(); t += 3)
+        area += area3(pos(tris[t]), pos(tris[t + 1]), pos(tris[t + 2]));
+    if (!(area <= 1.01 * own))
+        return fan();
+    return true;
+}
+
+void builder::triangulate()
+{
+    std::vector<int64_t> poly;
+    std::vector<uint32_t> tris;
+    std::vector<float> normals;
+    std::vector<uint8_t> given;
+    const size_t nt = tri_face.size();
+    const bool corners = !corner_normals.empty();
+    for (size_t t = 0; t < nt;) {
+        size_t e = t + 1;
+        while (e < nt && tri_face[e] == tri_face[t])
+            e++;
+        const size_t n = e - t + 2;
+        if (n >= 4) {
+            /* The polygon's corners from its fan: {0,i,i+1} for i = 1..n-2. */
+            auto fan_slot = [&](size_t c) {
+                return c == 0 ? 3 * t : c + 1 < n ? 3 * (t + c - 1) + 1 : 3 * (t + n - 3) + 2;
+            };
+            poly.resize(n);
+            for (size_t c = 0; c < n; c++)
+                poly[c] = indices[fan_slot(c)];
+            tris.clear();
+            if (triangulate_polygon(positions.data(), poly.data(), n, tris, &clip_budget)) {
+                if (corners) {
+                    normals.resize(3 * n);
+                    given.resize(n);
+                    for (size_t c = 0; c < n; c++) {
+                        const size_t s = fan_slot(c);
+                        given[c] = corner_given[s];
+                        for (int d = 0; d < 3; d++)
+                            normals[3 * c + (size_t)d] = corner_normals[3 * s + (size_t)d];
+                    }
+                }
+                for (size_t j = 0; j < tris.size(); j++) {
+                    const size_t s = 3 * t + j, c = tris[j];
+                    indices[s] = poly[c];
+                    if (corners) {
+                        corner_given[s] = given[c];
+                        for (int d = 0; d < 3; d++)
+                            corner_normals[3 * s + (size_t)d] = normals[3 * c + (size_t)d];
+                    }
+                }
+            }
+        }
+        t = e;
+    }
+}
+
 } // namespace vb_read
 
 namespace
@@ -319,6 +515,7 @@ vb_result parse(const char *name, vb_mesh_format format, const uint8_t *bytes, s
                 (unsigned long long)b.tri_face[j / 3] + base, (long long)v + (long long)base,
                 (unsigned)nv, vdsh_plural(nv, "vertex", "vertices"));
     }
+    b.triangulate();
     b.finish(ex.dropped, out);
     return VB_OK;
 }

@@ -1,14 +1,15 @@
 /*
  * mesh_parse.h - the strict readers behind vb_mesh_load: the bytes of an
  * OBJ, PLY, OFF or STL file in, the file's own arrays out (positions, file
- * normals per vertex and per face corner, fan-triangulated faces), before
+ * normals per vertex and per face corner, triangulated faces), before
  * any cleaning. Internal to bake/ (mesh.c and the tests); tools use mesh.h.
  *
  * Does not: open files, hash, split creases, compute normals or compact
  * (mesh.c does all that), nor use OpenMesh. The readers read exactly what OpenMesh 9's readers read from the
  * same bytes (the baker used those until issue 13, and every recorded bake
  * depends on it: the same positions, the same vertex numbering, the same
- * normals), and refuse what those readers would have read wrongly or
+ * normals; one exception: concave polygons are ear-clipped, not fanned
+ * across their outside), and refuse what those readers would have read wrongly or
  * without a word: numbers that do not parse or are NaN/Inf, faces with fewer
  * than 3 vertices, out-of-range indices, truncated files, counts that do
  * not fit the file, properties and lines the readers would have misread
@@ -56,8 +57,10 @@ typedef enum vb_mesh_format {
     VB_MESH_GLB
 } vb_mesh_format;
 
-/* A file as read, before cleaning: polygons fan-triangulated (triangles
- * that repeat a vertex included), every index in range, positions finite,
+/* A file as read, before cleaning: polygons triangulated (fanned from
+ * their first vertex where that fan lies inside them, as OpenMesh did,
+ * else ear-clipped: mesh_read.h triangulate_polygon; each polygon's n - 2
+ * triangles consecutive, triangles that repeat a vertex included), every index in range, positions finite,
  * file normals per vertex (one given normal as is, several: their unit
  * average; (0,0,0) where none was given) and, for OBJ, per triangle corner
  * (as given, finite). */

@@ -8,7 +8,7 @@
  * Here: a cursor over the bytes that counts lines and reads tokens as
  * std::istream does, numbers as OpenMesh 9's readers read them, the arrays
  * being built (builder: positions, normals averaged as mesh_parse.h says,
- * fan-triangulated faces, OBJ corner normals), what the checks counted
+ * triangulated faces, OBJ corner normals), what the checks counted
  * (expectation, compared with what was built by vb_mesh_parse), and
  * little-endian/big-endian loads for the binary formats.
  *
@@ -230,7 +230,7 @@ class builder
     std::vector<float> positions;
     std::vector<float> normal_sums; /* empty until the first normal */
     std::vector<uint8_t> has_normal;
-    std::vector<int64_t> indices; /* fan-triangulated */
+    std::vector<int64_t> indices; /* fanned; triangulate() re-cuts */
     std::vector<uint32_t> tri_face;
     uint64_t polygons = 0;
 
@@ -262,7 +262,8 @@ class builder
         positions.push_back(z);
     }
 
-    /* A polygon of n >= 3 vertices, fanned from its first. */
+    /* A polygon of n >= 3 vertices, fanned from its first (triangulate
+     * later replaces the fans that reach outside their polygon). */
     void add_face(const int64_t *v, size_t n)
     {
         for (size_t i = 1; i + 1 < n; i++) {
@@ -285,8 +286,20 @@ class builder
      * Non-finite normals and vertices that do not exist are ignored. */
     void set_normal(int64_t v, const float n[3]);
 
+    /* Re-triangulate, once every position and index is known and checked
+     * (vb_mesh_parse, before finish), each polygon of 4+ vertices whose
+     * fan from its first vertex does not lie inside it: ear clipping
+     * (triangulate_polygon), its corner normals following its corners.
+     * Polygons whose fan does (every convex one) keep it exactly. */
+    void triangulate();
+
     /* Hand over malloc'ed arrays (mesh.c frees them with free()). */
     void finish(uint64_t dropped, vb_mesh_raw *out);
+
+    /* Point-in-triangle tests left to ear clipping in this file (a bound
+     * on the time a file of huge concave polygons can take: past it, the
+     * rest are fanned, deterministically). */
+    uint64_t clip_budget = 200000000;
 
   private:
     /* The corners of the polygon just fanned: its vertices' pending
@@ -294,12 +307,35 @@ class builder
     void add_corner_normals(const int64_t *v, size_t n);
 };
 
+/* The triangulation of polygon v[0..n-1] (n >= 4; indices into
+ * `positions`, 3 floats each, all in range and finite) into n - 2
+ * triangles, appended to `tris` as corner numbers 0..n-1 of the polygon,
+ * 3 per triangle, in the polygon's winding. The one place the readers
+ * triangulate polygons (builder::triangulate calls it for every reader).
+ *
+ * The polygon is projected onto the plane of its Newell normal (its
+ * dominant axis dropped, so that the projection keeps its orientation).
+ * When every fan triangle from corner 0 has no negative area there (all
+ * convex polygons, and those corner 0 sees whole), the result is that fan,
+ * exactly as the readers always fanned: {0,1,2}, {0,2,3}, ... Otherwise
+ * the polygon is cut by ear clipping (from corner 1 on; the first ear
+ * found is clipped, and the search goes on from the ear's next corner).
+ * Falls back to the fan, returning false, for polygons with no area
+ * (a zero Newell normal), without an ear (not simple), whose clipped
+ * triangles cover more than 1% above the area the polygon encloses (the
+ * Newell normal's length: far from flat; the fan's excess is what mesh.c
+ * reports), or when *budget point-in-triangle tests run out. Returns true
+ * when the result is not the fan. Deterministic: the same floats give
+ * the same triangles on any machine (IEEE double, no library calls). */
+bool triangulate_polygon(const float *positions, const int64_t *v, size_t n,
+                         std::vector<uint32_t> &tris, uint64_t *budget);
+
 /* What the checks counted: the file must deliver exactly this. */
 struct expectation {
     uint64_t vertices = 0;
     bool vertices_known = true; /* STL: merged, count not known ahead */
     uint64_t faces = 0;         /* polygons with >= 3 vertices */
-    uint64_t triangles = 0;     /* after fan triangulation */
+    uint64_t triangles = 0;     /* n - 2 per polygon of n */
     uint64_t dropped = 0;       /* OBJ: triangles of faces with < 3 distinct */
     std::string hint;           /* why the two might differ: the first line
                                      OpenMesh's reader read otherwise */
