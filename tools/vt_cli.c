@@ -221,19 +221,21 @@ const char *vt_cli_prog(void)
 static sigset_t clean_exit_signals;
 static pthread_mutex_t defer_lock = PTHREAD_MUTEX_INITIALIZER;
 
+static atomic_int defer_held; /* between vt_cli_defer_signals and undefer */
+
 void vt_cli_defer_signals(void)
 {
     pthread_mutex_lock(&defer_lock);
+    atomic_store(&defer_held, 1);
 }
 
 static atomic_int clean_exit_taken; /* the signal thread has a signal */
 
-void vt_cli_undefer_signals(void)
+/* A signal that came (pending, or taken by the signal thread) ends the
+ * process now, with its status: the program does not go on, or exit 0,
+ * while the signal thread waits for a lock or for the scheduler. */
+static void wait_for_signal_thread(void)
 {
-    pthread_mutex_unlock(&defer_lock);
-    /* A signal that came meanwhile ends the process now, with its status,
-     * even though the outputs are complete (as vdsh-bake's): the program
-     * does not go on (and exit 0) while the signal thread takes the lock. */
     sigset_t pending;
     int waiting = atomic_load(&clean_exit_taken);
     if (!waiting && sigpending(&pending) == 0)
@@ -241,6 +243,23 @@ void vt_cli_undefer_signals(void)
             waiting = sigismember(&clean_exit_signals, sig) == 1 && sigismember(&pending, sig) == 1;
     while (waiting)
         pause();
+}
+
+void vt_cli_undefer_signals(void)
+{
+    atomic_store(&defer_held, 0);
+    pthread_mutex_unlock(&defer_lock);
+    wait_for_signal_thread(); /* even though the outputs are complete */
+}
+
+/* At exit: an exit while deferred (an error between defer and undefer)
+ * lets the signal thread go first, then waits for it as undefer does. */
+static void exit_by_pending_signal(void)
+{
+    if (atomic_load(&defer_held))
+        vt_cli_undefer_signals();
+    else
+        wait_for_signal_thread();
 }
 
 static pthread_mutex_t signal_dir_lock = PTHREAD_MUTEX_INITIALIZER;
@@ -310,10 +329,15 @@ void vt_cli_clean_exit_on_signals(void)
     pthread_t t;
     if (count == 0 || pthread_sigmask(SIG_BLOCK, &clean_exit_signals, NULL) != 0)
         return;
-    if (pthread_create(&t, NULL, clean_exit_thread, NULL) != 0)
+    if (pthread_create(&t, NULL, clean_exit_thread, NULL) != 0) {
         pthread_sigmask(SIG_UNBLOCK, &clean_exit_signals, NULL); /* plain signals then */
-    else
-        pthread_detach(t);
+        return;
+    }
+    pthread_detach(t);
+    /* A signal that came before the program returns from main ends it by
+     * the signal, not with status 0 (on a loaded machine the signal thread
+     * may not have run yet: robust_signal_leaves_no_temporary). */
+    atexit(exit_by_pending_signal);
 }
 
 int vt_cli_version(const char *detail)

@@ -91,7 +91,9 @@ const char *vt_cli_prog(void); /* "vdsh" before vt_cli_begin */
  * no "<path>.tmp..." beside its outputs, each target as it was or whole.
  * Blocks the signals and takes them in a thread of its own (sigwait), so
  * call it before the program starts any thread (every thread inherits the
- * mask). Signals ignored at start (nohup, a background job) stay ignored. */
+ * mask). Signals ignored at start (nohup, a background job) stay ignored.
+ * A signal that comes before the program exits ends it by that signal
+ * (exit waits for the signal thread), never with the program's status. */
 void vt_cli_clean_exit_on_signals(void);
 
 /* A folder of temporary outputs (vdsh-frames truth's, moved into place once
