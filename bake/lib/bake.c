@@ -105,7 +105,7 @@ typedef struct job {
      * (d 0) to 0 at graze_cos (graze_d, world units); lit pairs only
      * when graze_lit. Off when graze_w == 1. */
     float graze_w, graze_cos, graze_d;
-    int graze_lit;
+    int graze_lit, graze_raw;
     unsigned char *dec_scratch;
     float *cal_margins;
     /* The per-receiver offset cap (vb_bake_desc.offset_cap): on, its
@@ -545,6 +545,7 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
             pscale[i] = 1.0f + (J->graze_w - 1.0f) * f;
         }
         dp.pair_scale = pscale;
+        dp.scale_raw = J->graze_raw;
     }
     if (m >= DEC_MIN_PAIRS) {
         /* The basis's rows m (rounded up) + 16 floats apart, not K: rows
@@ -1526,6 +1527,7 @@ static vb_result setup_job(bake_run *b, vb_error *err)
         J->graze_cos = (e = getenv("VDSH_GRAZE_COS")) ? strtof(e, NULL) : 0.3f;
         J->graze_d = ((e = getenv("VDSH_GRAZE_D")) ? strtof(e, NULL) : 0.05f) * d->max_distance;
         J->graze_lit = (e = getenv("VDSH_GRAZE_LIT")) ? atoi(e) : 0;
+        J->graze_raw = (e = getenv("VDSH_GRAZE_RAW")) ? atoi(e) : 0;
     }
     J->horizon = mi->horizon;
     J->adaptive = d->adaptive_rays != 0;

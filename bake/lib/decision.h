@@ -46,6 +46,7 @@ typedef struct vb_decision_params {
     int hessians;            /* steps with a fresh Hessian (0: every step); later
                        * steps keep the last one's factor */
     const float *pair_scale; /* NULL, or one factor per pair on a_i */
+    int scale_raw;           /* 1: a_i normalised without pair_scale */
 } vb_decision_params;
 
 /* The defaults: chosen on the validation scenes. */
