@@ -104,7 +104,7 @@ typedef struct job {
      * up: factor 1 + (w - 1) ramp(cos) ramp(d), ramps from 1 at cos 0
      * (d 0) to 0 at graze_cos (graze_d, world units); lit pairs only
      * when graze_lit. Off when graze_w == 1. */
-    float graze_w, graze_cos, graze_d;
+    float graze_w, graze_cos, graze_d, diag;
     int graze_lit, graze_raw;
     unsigned char *dec_scratch;
     float *cal_margins;
@@ -530,6 +530,30 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
     uint64_t rays = 0;
     uint32_t m =
         dec_pairs(J, J->pool, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab, &rays);
+    static _Atomic uint64_t gz_stat[6];
+    if (getenv("VDSH_GRAZE_STATS") && m >= DEC_MIN_PAIRS) {
+        /* study only: pairs; cos < .3 and d < .05 diag; cos < .5 and d < .15 diag; receivers with one of each */
+        uint64_t a = 0, b = 0;
+        for (uint32_t i = 0; i < m; i++) {
+            float c = x[i] * n[0] + y[i] * n[1] + z[i] * n[2];
+            float dd = expf(logd[i] - DEC_BOUNDARY) / J->diag;
+            a += c < 0.3f && dd < 0.05f;
+            b += c < 0.5f && dd < 0.15f;
+        }
+        atomic_fetch_add(&gz_stat[0], m);
+        atomic_fetch_add(&gz_stat[1], a);
+        atomic_fetch_add(&gz_stat[2], b);
+        atomic_fetch_add(&gz_stat[3], a > 0);
+        atomic_fetch_add(&gz_stat[4], b > 0);
+        uint64_t k = atomic_fetch_add(&gz_stat[5], 1) + 1;
+        if (k % 20000 == 0)
+            fprintf(
+                stderr,
+                "graze stats after %llu receivers: pairs %llu, short grazing (.3,.05) %llu, (.5,.15) %llu; receivers with any: %llu, %llu\n",
+                (unsigned long long)k, (unsigned long long)gz_stat[0],
+                (unsigned long long)gz_stat[1], (unsigned long long)gz_stat[2],
+                (unsigned long long)gz_stat[3], (unsigned long long)gz_stat[4]);
+    }
     vb_decision_params dp = J->dec;
     float pscale[VB_DECISION_MAX_PAIRS];
     if (m >= DEC_MIN_PAIRS && J->graze_w != 1.0f) {
@@ -1528,6 +1552,7 @@ static vb_result setup_job(bake_run *b, vb_error *err)
         J->graze_d = ((e = getenv("VDSH_GRAZE_D")) ? strtof(e, NULL) : 0.05f) * d->max_distance;
         J->graze_lit = (e = getenv("VDSH_GRAZE_LIT")) ? atoi(e) : 0;
         J->graze_raw = (e = getenv("VDSH_GRAZE_RAW")) ? atoi(e) : 0;
+        J->diag = d->max_distance;
     }
     J->horizon = mi->horizon;
     J->adaptive = d->adaptive_rays != 0;
