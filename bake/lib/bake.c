@@ -100,12 +100,6 @@ typedef struct job {
     float (*cal_pool)[3]; /* the calibration's: the pool before mix_near */
     uint32_t pool_count, dec_lights;
     vb_decision_params dec;
-    /* Prototype (VDSH_GRAZE_*): short, grazing training pairs weighted
-     * up: factor 1 + (w - 1) ramp(cos) ramp(d), ramps from 1 at cos 0
-     * (d 0) to 0 at graze_cos (graze_d, world units); lit pairs only
-     * when graze_lit. Off when graze_w == 1. */
-    float graze_w, graze_cos, graze_d, diag;
-    int graze_lit, graze_raw;
     unsigned char *dec_scratch;
     float *cal_margins;
     /* The per-receiver offset cap (vb_bake_desc.offset_cap): on, its
@@ -483,8 +477,7 @@ static float dec_cap(const job *J, int o, const float *c, uint32_t m, const floa
  * Hessian), into varc[k]. Returns k. Deterministic as the decision fit
  * is (decision.h). */
 static int choose_decision(const job *J, uint32_t m, const float *Y, uint32_t ys, const float *logd,
-                           const uint8_t *lab, float (*varc)[VDSH_MAX_COEFFS], double *ds,
-                           const vb_decision_params *dp)
+                           const uint8_t *lab, float (*varc)[VDSH_MAX_COEFFS], double *ds)
 {
     const int cap = J->var_cap;
     float err[VDSH_ORDER_SLOTS], least = INFINITY;
@@ -492,7 +485,7 @@ static int choose_decision(const job *J, uint32_t m, const float *Y, uint32_t ys
         if (!vb_order_candidate(k, cap))
             continue;
         float b;
-        err[k] = vb_decision_score(k, m, Y, ys, logd, lab, dp, varc[k], &b, ds);
+        err[k] = vb_decision_score(k, m, Y, ys, logd, lab, &J->dec, varc[k], &b, ds);
         least = err[k] < least ? err[k] : least;
     }
     int best_k = cap;
@@ -503,7 +496,7 @@ static int choose_decision(const job *J, uint32_t m, const float *Y, uint32_t ys
      * good per sample as a fresh one at every step on the validation
      * rooms, for a third of the Hessians (docs/ACCURACY.md, "Adaptive
      * order by the decision loss"). */
-    vb_decision_params p = *dp;
+    vb_decision_params p = J->dec;
     p.hessians = 1;
     vb_decision_fit(best_k, m, Y, ys, logd, lab, &p, varc[best_k], ds);
     return best_k;
@@ -530,47 +523,6 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
     uint64_t rays = 0;
     uint32_t m =
         dec_pairs(J, J->pool, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab, &rays);
-    static _Atomic uint64_t gz_stat[6];
-    if (getenv("VDSH_GRAZE_STATS") && m >= DEC_MIN_PAIRS) {
-        /* study only: pairs; cos < .3 and d < .05 diag; cos < .5 and d < .15 diag; receivers with one of each */
-        uint64_t a = 0, b = 0;
-        for (uint32_t i = 0; i < m; i++) {
-            float c = x[i] * n[0] + y[i] * n[1] + z[i] * n[2];
-            float dd = expf(logd[i] - DEC_BOUNDARY) / J->diag;
-            a += c < 0.3f && dd < 0.05f;
-            b += c < 0.5f && dd < 0.15f;
-        }
-        atomic_fetch_add(&gz_stat[0], m);
-        atomic_fetch_add(&gz_stat[1], a);
-        atomic_fetch_add(&gz_stat[2], b);
-        atomic_fetch_add(&gz_stat[3], a > 0);
-        atomic_fetch_add(&gz_stat[4], b > 0);
-        uint64_t k = atomic_fetch_add(&gz_stat[5], 1) + 1;
-        if (k % 20000 == 0)
-            fprintf(
-                stderr,
-                "graze stats after %llu receivers: pairs %llu, short grazing (.3,.05) %llu, (.5,.15) %llu; receivers with any: %llu, %llu\n",
-                (unsigned long long)k, (unsigned long long)gz_stat[0],
-                (unsigned long long)gz_stat[1], (unsigned long long)gz_stat[2],
-                (unsigned long long)gz_stat[3], (unsigned long long)gz_stat[4]);
-    }
-    vb_decision_params dp = J->dec;
-    float pscale[VB_DECISION_MAX_PAIRS];
-    if (m >= DEC_MIN_PAIRS && J->graze_w != 1.0f) {
-        for (uint32_t i = 0; i < m; i++) {
-            float c = x[i] * n[0] + y[i] * n[1] + z[i] * n[2];
-            float rc = 1.0f - c / J->graze_cos;
-            /* logd = ln d + DEC_BOUNDARY; d from it (exact enough for a ramp) */
-            float dd = expf(logd[i] - DEC_BOUNDARY);
-            float rd = 1.0f - dd / J->graze_d;
-            float f = rc > 0.0f && rd > 0.0f ? rc * rd : 0.0f;
-            if (J->graze_lit && lab[i])
-                f = 0.0f;
-            pscale[i] = 1.0f + (J->graze_w - 1.0f) * f;
-        }
-        dp.pair_scale = pscale;
-        dp.scale_raw = J->graze_raw;
-    }
     if (m >= DEC_MIN_PAIRS) {
         /* The basis's rows m (rounded up) + 16 floats apart, not K: rows
          * 4 KiB apart share the L1's sets, and the fit reads them all on
@@ -580,7 +532,7 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
         vdsh_sh_eval_soa((int)top, m, x, y, z, Y, ys);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (out->coeffs[1][o]) {
-                vb_decision_fit(o, m, Y, ys, logd, lab, &dp, out->coeffs[1][o], ds);
+                vb_decision_fit(o, m, Y, ys, logd, lab, &J->dec, out->coeffs[1][o], ds);
                 /* Its cap, and, outside the calibration (whose offset is
                  * not known yet), its lit training pairs that the offset
                  * draws in shadow (lit without it; 1e-5: the cap's own
@@ -598,7 +550,7 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
                 }
             }
         if (varc)
-            *var_k = choose_decision(J, m, Y, ys, logd, lab, varc, ds, &dp);
+            *var_k = choose_decision(J, m, Y, ys, logd, lab, varc, ds);
         atomic_fetch_add(&J->dec_pairs, m);
         atomic_fetch_add(&J->dec_fitted, 1);
     } else {
@@ -1545,15 +1497,6 @@ static vb_result setup_job(bake_run *b, vb_error *err)
     J->log_floor = d->log_floor;
     J->max_local = d->max_distance * d->scene->scale;
     J->inv_scale = 1.0f / d->scene->scale;
-    {
-        const char *e;
-        J->graze_w = (e = getenv("VDSH_GRAZE_W")) ? strtof(e, NULL) : 1.0f;
-        J->graze_cos = (e = getenv("VDSH_GRAZE_COS")) ? strtof(e, NULL) : 0.3f;
-        J->graze_d = ((e = getenv("VDSH_GRAZE_D")) ? strtof(e, NULL) : 0.05f) * d->max_distance;
-        J->graze_lit = (e = getenv("VDSH_GRAZE_LIT")) ? atoi(e) : 0;
-        J->graze_raw = (e = getenv("VDSH_GRAZE_RAW")) ? atoi(e) : 0;
-        J->diag = d->max_distance;
-    }
     J->horizon = mi->horizon;
     J->adaptive = d->adaptive_rays != 0;
     J->ray_tol = d->ray_tolerance;

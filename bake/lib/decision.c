@@ -12,8 +12,6 @@ void vb_decision_defaults(vb_decision_params *p)
     p->ridge0 = 1e-4f;
     p->steps = 3;
     p->hessians = 0;
-    p->pair_scale = NULL;
-    p->scale_raw = 0;
 }
 
 /* ---- e^x and ln x, eight at a time --------------------------------------- */
@@ -218,19 +216,16 @@ static inline __attribute__((always_inline)) double sum_lanes(uint32_t m, const 
  * m8, and the margins t and tt cleared. */
 static inline __attribute__((always_inline)) void pair_setup(uint32_t m, uint32_t m8,
                                                              const uint8_t *shadowed,
-                                                             float lit_weight, const float *ps,
-                                                             int raw, float *sgn, float *wt,
-                                                             float *t, float *tt)
+                                                             float lit_weight, float *sgn,
+                                                             float *wt, float *t, float *tt)
 {
     double a = 0.0;
     for (uint32_t i = 0; i < m; i++)
-        a += (shadowed[i] ? 1.0 : lit_weight) * (ps && !raw ? ps[i] : 1.0f);
+        a += shadowed[i] ? 1.0 : lit_weight;
     const float w_shadowed = (float)(1.0 / a), w_lit = (float)(lit_weight / a);
     for (uint32_t i = 0; i < m8; i++) {
         sgn[i] = i >= m ? 0.0f : shadowed[i] ? 1.0f : -1.0f;
         wt[i] = i >= m ? 0.0f : shadowed[i] ? w_shadowed : w_lit;
-        if (ps && i < m)
-            wt[i] *= ps[i];
         t[i] = tt[i] = 0.0f;
     }
 }
@@ -417,7 +412,7 @@ int vb_decision_fit(int order, uint32_t m, const float *Y, uint32_t stride,
           *wt = sgn + K, *sh = wt + K, *ex = sh + K, *Z = ex + K;
     const uint32_t m8 = (m + 7) & ~7u;
     const float inv_tau = 1.0f / p->tau;
-    pair_setup(m, m8, shadowed, p->lit_weight, p->pair_scale, p->scale_raw, sgn, wt, t, tt);
+    pair_setup(m, m8, shadowed, p->lit_weight, sgn, wt, t, tt);
     for (int j = 0; j < n; j++) {
         int l = 0;
         while ((l + 1) * (l + 1) <= j)
@@ -529,7 +524,7 @@ float vb_decision_score(int order, uint32_t m, const float *Y, uint32_t stride, 
           *sgn = sp + K, *wt = sgn + K, *ex = wt + K;
     const uint32_t m8 = (m + 7) & ~7u;
     const float inv_tau = 1.0f / p->tau;
-    pair_setup(m, m8, shadowed, p->lit_weight, p->pair_scale, p->scale_raw, sgn, wt, t, tt);
+    pair_setup(m, m8, shadowed, p->lit_weight, sgn, wt, t, tt);
     for (int j = 0; j < n; j++)
         c[j] = cf[j];
     margins(n, m, Y, stride, logd, c, t);

@@ -38,15 +38,13 @@ extern "C" {
 
 /* The settings (docs/ACCURACY.md, "The decision fit: settings"). */
 typedef struct vb_decision_params {
-    float tau;               /* softplus temperature, ln units */
-    float lit_weight;        /* a_i of lit pairs (shadowed: 1) */
-    float ridge;             /* times (l(l+1))^2, toward the lsq fit */
-    float ridge0;            /* on every coefficient, toward the lsq fit */
-    int steps;               /* Newton steps at most */
-    int hessians;            /* steps with a fresh Hessian (0: every step); later
+    float tau;        /* softplus temperature, ln units */
+    float lit_weight; /* a_i of lit pairs (shadowed: 1) */
+    float ridge;      /* times (l(l+1))^2, toward the lsq fit */
+    float ridge0;     /* on every coefficient, toward the lsq fit */
+    int steps;        /* Newton steps at most */
+    int hessians;     /* steps with a fresh Hessian (0: every step); later
                        * steps keep the last one's factor */
-    const float *pair_scale; /* NULL, or one factor per pair on a_i */
-    int scale_raw;           /* 1: a_i normalised without pair_scale */
 } vb_decision_params;
 
 /* The defaults: chosen on the validation scenes. */
