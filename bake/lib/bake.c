@@ -103,7 +103,7 @@ typedef struct job {
     /* Prototype (VDSH_TSHELL_*): shell_n more training lights per
      * receiver over its own tangent plane, r up to shell_r and height
      * up to shell_h (world units), the same offsets for every receiver. */
-    int shell_n;
+    int shell_n, shell_mino;
     float shell_r, shell_h, shell_s;
     unsigned char *dec_scratch;
     float *cal_margins;
@@ -528,6 +528,7 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
     uint64_t rays = 0;
     uint32_t m =
         dec_pairs(J, J->pool, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab, &rays);
+    const uint32_t m0 = m;
     if (J->shell_n > 0) {
         float a[3] = {1.0f, 0.0f, 0.0f};
         if (fabsf(n[0]) > 0.6f)
@@ -581,14 +582,15 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
         vdsh_sh_eval_soa((int)top, m, x, y, z, Y, ys);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (out->coeffs[1][o]) {
-                vb_decision_fit(o, m, Y, ys, logd, lab, &J->dec, out->coeffs[1][o], ds);
+                const uint32_t mo = o < J->shell_mino ? m0 : m;
+                vb_decision_fit(o, mo, Y, ys, logd, lab, &J->dec, out->coeffs[1][o], ds);
                 /* Its cap, and, outside the calibration (whose offset is
                  * not known yet), its lit training pairs that the offset
                  * draws in shadow (lit without it; 1e-5: the cap's own
                  * rounding). */
                 float mg[VB_DECISION_MAX_PAIRS];
                 uint32_t lit = 0;
-                cap[o] = dec_cap(J, o, out->coeffs[1][o], m, Y, ys, logd, lab, mg, &lit);
+                cap[o] = dec_cap(J, o, out->coeffs[1][o], mo, Y, ys, logd, lab, mg, &lit);
                 if (!out->cal) {
                     float off = capped_offset(J->log_offset[o], cap[o], J->free_offset[o]);
                     uint64_t bad = 0;
@@ -599,7 +601,7 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
                 }
             }
         if (varc)
-            *var_k = choose_decision(J, m, Y, ys, logd, lab, varc, ds);
+            *var_k = choose_decision(J, J->shell_mino ? m0 : m, Y, ys, logd, lab, varc, ds);
         atomic_fetch_add(&J->dec_pairs, m);
         atomic_fetch_add(&J->dec_fitted, 1);
     } else {
@@ -1552,6 +1554,7 @@ static vb_result setup_job(bake_run *b, vb_error *err)
         J->shell_r = ((e = getenv("VDSH_TSHELL_R")) ? strtof(e, NULL) : 0.1f) * d->max_distance;
         J->shell_h = ((e = getenv("VDSH_TSHELL_H")) ? strtof(e, NULL) : 0.04f) * d->max_distance;
         J->shell_s = d->scene->scale;
+        J->shell_mino = (e = getenv("VDSH_TSHELL_MINO")) ? atoi(e) : 0;
     }
     J->horizon = mi->horizon;
     J->adaptive = d->adaptive_rays != 0;
