@@ -100,11 +100,6 @@ typedef struct job {
     float (*cal_pool)[3]; /* the calibration's: the pool before mix_near */
     uint32_t pool_count, dec_lights;
     vb_decision_params dec;
-    /* Prototype (VDSH_TSHELL_*): shell_n more training lights per
-     * receiver over its own tangent plane, r up to shell_r and height
-     * up to shell_h (world units), the same offsets for every receiver. */
-    int shell_n, shell_mino, shell_free;
-    float shell_r, shell_h, shell_s;
     unsigned char *dec_scratch;
     float *cal_margins;
     /* The per-receiver offset cap (vb_bake_desc.offset_cap): on, its
@@ -528,92 +523,6 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
     uint64_t rays = 0;
     uint32_t m =
         dec_pairs(J, J->pool, &at, &scanned, org, n, J->dec_lights, x, y, z, logd, lab, &rays);
-    const uint32_t m0 = m;
-    if (J->shell_n > 0) {
-        float a[3] = {1.0f, 0.0f, 0.0f};
-        if (fabsf(n[0]) > 0.6f)
-            a[0] = 0.0f, a[1] = 1.0f;
-        float t1[3] = {n[1] * a[2] - n[2] * a[1], n[2] * a[0] - n[0] * a[2],
-                       n[0] * a[1] - n[1] * a[0]};
-        float il = 1.0f / sqrtf(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]);
-        t1[0] *= il, t1[1] *= il, t1[2] *= il;
-        float t2[3] = {n[1] * t1[2] - n[2] * t1[1], n[2] * t1[0] - n[0] * t1[2],
-                       n[0] * t1[1] - n[1] * t1[0]};
-        const float lo = 0.01f * J->log_floor / 0.01f; /* 1% of the diagonal */
-        for (int k = 0; k < J->shell_n && m < K; k++) {
-            uint64_t hk = dec_hash(J, 0x5eedull * 1000003ull + (uint64_t)k);
-            float u1 = (float)(hk & 0xffffff) / 16777216.0f;
-            float u2 = (float)((hk >> 24) & 0xffffff) / 16777216.0f;
-            float u3 = (float)((hk >> 48) & 0xffff) / 65536.0f;
-            float r = (lo + (J->shell_r - lo) * u1) * J->shell_s;
-            float hh = (lo + (J->shell_h - lo) * u3) * J->shell_s;
-            float cp = cosf(6.2831853f * u2), sp = sinf(6.2831853f * u2);
-            float L[3];
-            for (int c = 0; c < 3; c++)
-                L[c] = org[c] + r * (cp * t1[c] + sp * t2[c]) + hh * n[c];
-            float dx = L[0] - org[0], dy = L[1] - org[1], dz = L[2] - org[2];
-            float len = sqrtf(dx * dx + dy * dy + dz * dz), inv = 1.0f / len;
-            struct RTCIntersectContext ctx;
-            rtcInitIntersectContext(&ctx);
-            struct RTCRay ry = {.org_x = org[0],
-                                .org_y = org[1],
-                                .org_z = org[2],
-                                .dir_x = dx * inv,
-                                .dir_y = dy * inv,
-                                .dir_z = dz * inv,
-                                .tnear = 0.0f,
-                                .tfar = len,
-                                .mask = 0xffffffffu};
-            if (J->shell_free) {
-                /* free space: no surface within 1% of the diagonal along the axes */
-                int bad = 0;
-                for (int ax = 0; ax < 6 && !bad; ax++) {
-                    float dd[3] = {0.0f, 0.0f, 0.0f};
-                    dd[ax >> 1] = ax & 1 ? -1.0f : 1.0f;
-                    struct RTCRay pr = {.org_x = L[0],
-                                        .org_y = L[1],
-                                        .org_z = L[2],
-                                        .dir_x = dd[0],
-                                        .dir_y = dd[1],
-                                        .dir_z = dd[2],
-                                        .tnear = 0.0f,
-                                        .tfar = lo * J->shell_s,
-                                        .mask = 0xffffffffu};
-                    rtcOccluded1(J->d->scene->scene, &ctx, &pr);
-                    ++rays;
-                    bad = pr.tfar < 0.0f;
-                }
-                if (!bad) {
-                    /* inside a solid: the first surface from L toward the
-                     * receiver is seen from its back */
-                    struct RTCRayHit rh;
-                    memset(&rh, 0, sizeof rh);
-                    rh.ray.org_x = L[0], rh.ray.org_y = L[1], rh.ray.org_z = L[2];
-                    rh.ray.dir_x = -dx * inv, rh.ray.dir_y = -dy * inv, rh.ray.dir_z = -dz * inv;
-                    rh.ray.tnear = 0.0f;
-                    rh.ray.tfar = len * 0.999f;
-                    rh.ray.mask = 0xffffffffu;
-                    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-                    rtcIntersect1(J->d->scene->scene, &ctx, &rh);
-                    ++rays;
-                    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID &&
-                        rh.hit.Ng_x * rh.ray.dir_x + rh.hit.Ng_y * rh.ray.dir_y +
-                                rh.hit.Ng_z * rh.ray.dir_z >
-                            0.0f)
-                        bad = 1;
-                }
-                if (bad)
-                    continue;
-            }
-            rtcOccluded1(J->d->scene->scene, &ctx, &ry);
-            ++rays;
-            x[m] = ry.dir_x, y[m] = ry.dir_y, z[m] = ry.dir_z;
-            float dw = len * J->inv_scale;
-            logd[m] = fast_log(dw > J->log_floor ? dw : J->log_floor) + DEC_BOUNDARY;
-            lab[m] = ry.tfar < 0.0f;
-            m++;
-        }
-    }
     if (m >= DEC_MIN_PAIRS) {
         /* The basis's rows m (rounded up) + 16 floats apart, not K: rows
          * 4 KiB apart share the L1's sets, and the fit reads them all on
@@ -623,15 +532,14 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
         vdsh_sh_eval_soa((int)top, m, x, y, z, Y, ys);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (out->coeffs[1][o]) {
-                const uint32_t mo = o < J->shell_mino ? m0 : m;
-                vb_decision_fit(o, mo, Y, ys, logd, lab, &J->dec, out->coeffs[1][o], ds);
+                vb_decision_fit(o, m, Y, ys, logd, lab, &J->dec, out->coeffs[1][o], ds);
                 /* Its cap, and, outside the calibration (whose offset is
                  * not known yet), its lit training pairs that the offset
                  * draws in shadow (lit without it; 1e-5: the cap's own
                  * rounding). */
                 float mg[VB_DECISION_MAX_PAIRS];
                 uint32_t lit = 0;
-                cap[o] = dec_cap(J, o, out->coeffs[1][o], mo, Y, ys, logd, lab, mg, &lit);
+                cap[o] = dec_cap(J, o, out->coeffs[1][o], m, Y, ys, logd, lab, mg, &lit);
                 if (!out->cal) {
                     float off = capped_offset(J->log_offset[o], cap[o], J->free_offset[o]);
                     uint64_t bad = 0;
@@ -642,7 +550,7 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
                 }
             }
         if (varc)
-            *var_k = choose_decision(J, J->shell_mino ? m0 : m, Y, ys, logd, lab, varc, ds);
+            *var_k = choose_decision(J, m, Y, ys, logd, lab, varc, ds);
         atomic_fetch_add(&J->dec_pairs, m);
         atomic_fetch_add(&J->dec_fitted, 1);
     } else {
@@ -1589,15 +1497,6 @@ static vb_result setup_job(bake_run *b, vb_error *err)
     J->log_floor = d->log_floor;
     J->max_local = d->max_distance * d->scene->scale;
     J->inv_scale = 1.0f / d->scene->scale;
-    {
-        const char *e;
-        J->shell_n = (e = getenv("VDSH_TSHELL_N")) ? atoi(e) : 0;
-        J->shell_r = ((e = getenv("VDSH_TSHELL_R")) ? strtof(e, NULL) : 0.1f) * d->max_distance;
-        J->shell_h = ((e = getenv("VDSH_TSHELL_H")) ? strtof(e, NULL) : 0.04f) * d->max_distance;
-        J->shell_s = d->scene->scale;
-        J->shell_mino = (e = getenv("VDSH_TSHELL_MINO")) ? atoi(e) : 0;
-        J->shell_free = (e = getenv("VDSH_TSHELL_FREE")) ? atoi(e) : 0;
-    }
     J->horizon = mi->horizon;
     J->adaptive = d->adaptive_rays != 0;
     J->ray_tol = d->ray_tolerance;
