@@ -300,32 +300,7 @@ check "near: nothing written on a refusal" test ! -e "$tmp/nx.vdsh"
 # (a unit cube on a 4 x 4 floor) the report counts them, the bake is the
 # same on 1 and 2 threads and differs from the default's; the default
 # places none; only method decision takes the option.
-cat > "$tmp/cube_floor.obj" <<'OBJ'
-v -2 0 -2
-v -2 0 2
-v 2 0 2
-v 2 0 -2
-v -0.5 0 -0.5
-v 0.5 0 -0.5
-v 0.5 0 0.5
-v -0.5 0 0.5
-v -0.5 1 -0.5
-v 0.5 1 -0.5
-v 0.5 1 0.5
-v -0.5 1 0.5
-f 1 2 3
-f 1 3 4
-f 5 9 10
-f 5 10 6
-f 6 10 11
-f 6 11 7
-f 7 11 12
-f 7 12 8
-f 8 12 9
-f 8 9 5
-f 9 12 11
-f 9 11 10
-OBJ
+cp "$(dirname "$0")/data/cube_floor.obj" "$tmp/cube_floor.obj"
 shell=("$tmp/cube_floor.obj" --max-edge 0.25 --rays 64 --cube-size 0 -q)
 expect_exit 0 "shell: 4, 1 thread" "$bake" "${shell[@]}" --decision-shell 4 --threads 1 \
   -o "$tmp/s1.vdsh" --report "$tmp/s1.json"

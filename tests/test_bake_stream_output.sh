@@ -13,32 +13,7 @@ trap 'rm -rf "$tmp"' EXIT
 fail=0
 no() { echo "FAIL: $*" >&2; fail=1; }
 # a floor and a box on it
-cat > "$tmp/m.obj" <<'OBJ'
-v -2 0 -2
-v -2 0 2
-v 2 0 2
-v 2 0 -2
-v -0.5 0 -0.5
-v 0.5 0 -0.5
-v 0.5 0 0.5
-v -0.5 0 0.5
-v -0.5 1 -0.5
-v 0.5 1 -0.5
-v 0.5 1 0.5
-v -0.5 1 0.5
-f 1 2 3
-f 1 3 4
-f 5 10 6
-f 5 9 10
-f 6 11 7
-f 6 10 11
-f 7 12 8
-f 7 11 12
-f 8 9 5
-f 8 12 9
-f 9 12 11
-f 9 11 10
-OBJ
+cp "$(dirname "$0")/data/cube_floor.obj" "$tmp/m.obj"
 opts=(--rays 64 -q)
 cd "$tmp" || exit 1
 "$bake" m.obj "${opts[@]}" -o ref.vdsh || { echo "FAIL: the regular bake" >&2; exit 1; }
