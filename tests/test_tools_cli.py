@@ -123,6 +123,9 @@ try:
     check(sec["pool"] > 0 and parts <= sec["total"],
           "report, method decision: seconds %r (pool > 0, the parts within total)" % sec)
     check(rep["seconds"]["pool"] == 0, "report, method paper: pool seconds %r" % rep["seconds"])
+    # The streams' encoding (cpca's fit among it) has its own seconds, within write.
+    check(0 <= sec["encode"] <= sec["write"],
+          "report: encode seconds %r (within write)" % sec)
 except (ValueError, KeyError, OSError) as e:
     check(False, "bake --report (decision): %s" % e)
 
