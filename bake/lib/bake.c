@@ -1512,50 +1512,57 @@ static vb_result setup_job(bake_run *b, vb_error *err)
     return VB_OK;
 }
 
+/* Slots first, first + every, ... of the training pool (traced frame)
+ * replaced by VB_DECISION_POOL / every lights placed by `rule` with
+ * `seed`; *placed their count (0 on failure, the pool unchanged). */
+static vb_result mix_rule(const vb_bake_desc *d, float (*pool)[3], vb_light_rule rule,
+                          uint64_t seed, uint32_t every, uint32_t first, uint32_t *placed,
+                          vb_error *err)
+{
+    const uint32_t n = VB_DECISION_POOL / every;
+    *placed = 0;
+    float(*lights)[3] = malloc((size_t)n * sizeof *lights + 1);
+    if (!lights)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    vb_result r = vb_scene_place_lights_rule(d->scene, seed, n, rule, lights, NULL, err);
+    if (r == VB_OK) {
+        for (uint32_t i = 0; i < n; i++)
+            vb_scene_to_local(d->scene, lights[i], pool[(size_t)i * every + first]);
+        *placed = n;
+    }
+    free(lights);
+    return r;
+}
+
 /* The training pool: the pool with one in d->decision_near of its slots
  * (K-1, 2K-1, ...) replaced by a light placed by the near rule (bake.h,
- * VB_DEFAULT_DECISION_NEAR), in the traced frame; the calibration keeps
- * the pool as placed. Where the near rule finds no room for them all,
- * the training pool is the pool. Returns the lights placed. */
+ * VB_DEFAULT_DECISION_NEAR); the calibration keeps the pool as placed.
+ * Where the near rule finds no room for them all (or no memory), the
+ * training pool is the pool. Returns the lights placed. */
 static uint32_t mix_near(const vb_bake_desc *d, float (*pool)[3])
 {
-    if (d->decision_near <= 0)
-        return 0;
-    const uint32_t every = (uint32_t)d->decision_near, n = VB_DECISION_POOL / every;
-    float(*near)[3] = malloc((size_t)n * sizeof *near + 1);
+    uint32_t placed = 0;
     vb_error ignored;
-    if (!near || vb_scene_place_lights_rule(d->scene, d->seed ^ VB_POOL_SEED ^ VB_NEAR_SEED, n,
-                                            VB_LIGHTS_NEAR, near, NULL, &ignored) != VB_OK) {
-        free(near);
-        return 0;
+    if (d->decision_near > 0) {
+        const uint32_t every = (uint32_t)d->decision_near;
+        mix_rule(d, pool, VB_LIGHTS_NEAR, d->seed ^ VB_POOL_SEED ^ VB_NEAR_SEED, every, every - 1,
+                 &placed, &ignored);
     }
-    for (uint32_t i = 0; i < n; i++)
-        vb_scene_to_local(d->scene, near[i], pool[(size_t)i * every + every - 1]);
-    free(near);
-    return n;
+    return placed;
 }
 
 /* Slots 0, K, 2K, ... of the training pool (K = d->decision_shell)
  * replaced by lights in the shell around the bounds (bake.h,
- * vb_bake_desc.decision_shell), in the traced frame. Returns the lights
- * placed; no room is an error. */
+ * vb_bake_desc.decision_shell). No room is an error. */
 static vb_result mix_shell(const vb_bake_desc *d, float (*pool)[3], uint32_t *placed, vb_error *err)
 {
-    const uint32_t every = (uint32_t)d->decision_shell, n = VB_DECISION_POOL / every;
-    float(*sh)[3] = malloc((size_t)n * sizeof *sh + 1);
-    if (!sh)
-        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-    vb_result r = vb_scene_place_lights_rule(d->scene, d->seed ^ VB_POOL_SEED ^ VB_SHELL_SEED, n,
-                                             VB_LIGHTS_SHELL, sh, NULL, err);
-    if (r == VB_OK) {
-        for (uint32_t i = 0; i < n; i++)
-            vb_scene_to_local(d->scene, sh[i], pool[(size_t)i * every]);
-        *placed = n;
-    } else {
+    const uint32_t every = (uint32_t)d->decision_shell;
+    vb_result r = mix_rule(d, pool, VB_LIGHTS_SHELL, d->seed ^ VB_POOL_SEED ^ VB_SHELL_SEED, every,
+                           0, placed, err);
+    if (r != VB_OK && r != VB_ERR_OUT_OF_MEMORY)
         vb_fail(err, r,
-                "decision shell: no room for %u lights in the shell around the scene's bounds", n);
-    }
-    free(sh);
+                "decision shell: no room for %u lights in the shell around the scene's bounds",
+                VB_DECISION_POOL / every);
     return r;
 }
 
