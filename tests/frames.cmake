@@ -7,7 +7,8 @@
 #   frames_box_shadow_matches_geometry
 #                  a floor, a box and a light: the shadow's pixel count
 #                  against geometry; byte-identical across thread counts
-#   frames_views   views: valid, in free space, lit and shadowed, seeded
+#   frames_views   views: valid, in free space, lit and shadowed, seeded;
+#                  --light-rule near puts every light near a surface
 #   frames_orders  order 7 and variable-order streams (c-vdsh7, c-vdsh-var)
 #   frames_errors  bad input: exit 1 naming the file, usage errors exit 2
 if(TARGET vb_frames)

@@ -16,7 +16,9 @@
  *            default view first, every eye and light in free space, every
  *            view's lights light and shadow a share of it, no surface
  *            nearer than 5% of the diagonal; the same file for the same
- *            seed (on 1 thread and on 2), another for another seed
+ *            seed (on 1 thread and on 2), another for another seed;
+ *            --light-rule near: every light within 5% of the diagonal of
+ *            a surface (uniform, the default: not every one)
  *   orders   orders above 5 and variable-order streams: a stream whose
  *            every vertex has order 7 scores and draws exactly as the
  *            fixed order-7 stream (c-vdsh-var = c-vdsh7); with orders 3
@@ -415,16 +417,34 @@ static int part_box(void)
 
 /* ---- the built-in room: views and the oracle --------------------------------------------- */
 
-static int room_views(const char *vdsh, const char *views, const char *seed, const char *threads)
+/* vdsh-frames views of the room: 3 cameras, 160 x 120; rule NULL: no
+ * --light-rule. */
+static int room_views_rule(const char *vdsh, const char *views, const char *seed,
+                           const char *threads, const char *rule)
 {
     if (!exists(vdsh) && bake_to((char *[]){"builtin:room", NULL}, vdsh, "1") != 0)
         return -1;
     int rc = run((char *[]){(char *)frames, "views", (char *)vdsh, "-o", (char *)views, "--cameras",
                             "3", "--size", "160x120", "--seed", (char *)seed, "--threads",
-                            (char *)threads, NULL});
+                            (char *)threads, rule ? "--light-rule" : NULL, (char *)rule, NULL});
     if (rc != 0)
         show_stderr();
     return rc;
+}
+
+static int room_views(const char *vdsh, const char *views, const char *seed, const char *threads)
+{
+    return room_views_rule(vdsh, views, seed, threads, NULL);
+}
+
+static int same_file(const char *a, const char *b)
+{
+    size_t na = 0, nb = 0;
+    unsigned char *x = test_read_file(a, &na), *y = test_read_file(b, &nb);
+    int same = x && y && na == nb && memcmp(x, y, na) == 0;
+    free(x);
+    free(y);
+    return same;
 }
 
 static int part_views(void)
@@ -444,11 +464,36 @@ static int part_views(void)
     free(b);
     free(c);
 
-    vt_views V = {0};
+    /* --light-rule: uniform is the default; near puts every light of
+     * every view within 5% of the diagonal of a surface (the rule's own
+     * measure, vb_scene_probe_nearest), which uniform's lights are not. */
+    char *vu = path_in("uniform.views.json"), *vn = path_in("near.views.json");
+    CHECK(room_views_rule(vdsh, vu, "5", "2", "uniform") == 0, "views, --light-rule uniform");
+    CHECK(same_file(v1, vu), "--light-rule uniform gives the default's file");
+    CHECK(room_views_rule(vdsh, vn, "5", "2", "near") == 0, "views, --light-rule near");
+    CHECK(!same_file(v1, vn), "--light-rule near gives another file");
+
+    vt_views V = {0}, N = {0};
     char msg[4300];
     CHECK(vt_views_read(v1, &V, msg, sizeof msg) == 0, "%s", msg);
+    CHECK(vt_views_read(vn, &N, msg, sizeof msg) == 0, "%s", msg);
     scene3 s;
-    if (V.count && scene_load(vdsh, "builtin:room", &s) == 0) {
+    if (V.count && N.count && scene_load(vdsh, "builtin:room", &s) == 0) {
+        const float within = 0.05f * s.occ->diagonal;
+        int far_uniform = 0;
+        CHECK(N.count == V.count, "near: %d views", N.count);
+        for (int i = 0; i < N.count && i < V.count; i++)
+            for (int k = 0; k < N.views[i].set_count; k++)
+                for (int l = 0; l < N.views[i].light_count[k]; l++) {
+                    const float *p = N.views[i].lights[k][l];
+                    float t = vb_scene_probe_nearest(s.occ, p);
+                    CHECK(vb_scene_free_space(s.occ, p) && t < within,
+                          "near: view %s, set %d, light %d: a surface %g away (%g is near)",
+                          N.views[i].name, k, l, (double)t, (double)within);
+                    far_uniform +=
+                        !(vb_scene_probe_nearest(s.occ, V.views[i].lights[k][l]) < within);
+                }
+        CHECK(far_uniform > 0, "uniform: %d lights farther than 5%% of the diagonal", far_uniform);
         CHECK(V.count == 4 && V.width == 160 && V.height == 120, "4 views of 160 x 120");
         CHECK(strcmp(V.views[0].name, "default") == 0, "the default view first");
         /* The viewer's default camera for a room: from inside, along x. */
@@ -506,6 +551,7 @@ static int part_views(void)
         CHECK(0, "read the views and the scene");
     }
     vt_views_free(&V);
+    vt_views_free(&N);
     return test_report("frames_views");
 }
 
@@ -801,6 +847,11 @@ static int part_errors(void)
     CHECK(run((char *[]){fr, "score", "x.vdsh", "--views", "v", "--truth", "t", "--frames", "f",
                          NULL}) == 2,
           "no modes");
+    CHECK(run((char *[]){fr, "views", "x.vdsh", "-o", "v.json", "--light-rule", "nearby", NULL}) ==
+                  2 &&
+              test_file_contains(err_path, "--light-rule") &&
+              test_file_contains(err_path, "nearby"),
+          "views --light-rule nearby");
     CHECK(run((char *[]){fr, "views", "x.vdsh", "-o", "v.json", "--bogus", NULL}) == 2,
           "an unknown option");
 

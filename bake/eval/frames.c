@@ -756,8 +756,8 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
-    r = vb_scene_place_lights(occ, vb_eval_purpose_seed(d.seed, PURPOSE_LIGHTS), LIGHT_POOL, pool,
-                              NULL, err);
+    r = vb_scene_place_lights_rule(occ, vb_eval_purpose_seed(d.seed, PURPOSE_LIGHTS), LIGHT_POOL,
+                                   (vb_light_rule)d.light_rule, pool, NULL, err);
     if (r != VB_OK)
         goto done;
     V.pool = (const float(*)[3])pool;

@@ -44,7 +44,8 @@
  * kept when a low-resolution frame shows no surface nearer than 5% of the
  * diagonal and, for each light, at least VB_FRAMES_MIN_SHARE of the
  * frame's pixels lit and as many hard-shadowed. Lights come from one pool
- * placed in free space (vb_scene_place_lights). Everything is a function of
+ * placed in free space (vb_scene_place_lights, or another rule of
+ * vb_scene_place_lights_rule: light_rule). Everything is a function of
  * the seed.
  *
  * Does not: read or write files (vdsh-frames does, with tools/), know GL.
@@ -208,6 +209,8 @@ typedef struct vb_frames_views_desc {
     int width, height; /* the frames' size (only the aspect
                                     matters here); 0: 512 x 384 */
     unsigned threads;
+    int light_rule; /* where the pool of lights goes (vb_light_rule, scene.h;
+                       the eyes stay uniform); 0: uniform */
 } vb_frames_views_desc;
 
 typedef struct vb_frames_views_stats {

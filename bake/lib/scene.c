@@ -212,9 +212,7 @@ int vb_scene_free_space(const vb_scene *s, const float p[3])
     return vdsh_free_space(t, back, vdsh_free_clearance(s->diagonal));
 }
 
-/* The nearest surface along the 14 probe directions from p (scene units),
- * INFINITY when none is met. */
-static float probe_nearest(const vb_scene *s, const float p[3])
+float vb_scene_probe_nearest(const vb_scene *s, const float p[3])
 {
     float t[VDSH_FREE_PROBES], best = INFINITY;
     int back[VDSH_FREE_PROBES];
@@ -289,7 +287,7 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
             continue;
         if (!vb_scene_free_space(s, p))
             continue;
-        if (rule == VB_LIGHTS_NEAR && !(probe_nearest(s, p) < 0.05f * s->diagonal))
+        if (rule == VB_LIGHTS_NEAR && !(vb_scene_probe_nearest(s, p) < 0.05f * s->diagonal))
             continue;
         memcpy(out[n++], p, sizeof out[0]);
     }

@@ -147,6 +147,11 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
                                      vb_error *err);
 const char *vb_light_rule_name(vb_light_rule rule);
 
+/* The nearest surface from p (scene units) along the VDSH_FREE_PROBES
+ * probe directions of the free-space rule, INFINITY when none is met:
+ * VB_LIGHTS_NEAR keeps a light when it is under 5% of the diagonal. */
+float vb_scene_probe_nearest(const vb_scene *s, const float p[3]);
+
 /* Whether p (scene units) is in the free space of scene s: vdsh_light.h's
  * rule, its probes cast with Embree. The test vb_scene_place_lights applies
  * to every candidate (vdsh-frames applies it to eyes too). Each probe's

@@ -66,12 +66,21 @@ static void usage(FILE *f)
             "  surface nearer than 5%% of the diagonal and each of its lights lights\n"
             "  at least 5%% of the frame's pixels and hard-shadows as many. Every view\n"
             "  gets light set 0 (one light) and set 1 (three), drawn from 128 lights\n"
-            "  placed in free space (vdsh-eval's rule); the default view takes the\n"
-            "  best it can get. Deterministic for a seed.\n"
+            "  placed in free space (vdsh-eval's rule; --light-rule); the default view\n"
+            "  takes the best it can get. Deterministic for a seed.\n"
             "  -o, --output FILE       the view set to write\n"
             "      --cameras N         views besides the default (default 6)\n"
             "      --seed N            seed of the eyes, directions and lights (default 1)\n"
             "      --size WxH          frame size recorded in the set (default 512x384)\n"
+            "      --light-rule R      where the 128 lights go, all in free space (vdsh-eval's\n"
+            "                          --light-rule; the eyes stay where they were):\n"
+            "                          uniform (default), ceiling (the top fifth of the\n"
+            "                          height, +y up), near (a surface within 5%% of the\n"
+            "                          diagonal), path (a walk along x at 2/3 of the\n"
+            "                          height), grown (the bounds grown by a quarter of\n"
+            "                          their diagonal), around (grown by a diagonal,\n"
+            "                          outside the bounds) or shell (grown by a quarter\n"
+            "                          diagonal, outside the bounds)\n"
             "\n"
             "truth: for every view, light set K and light J, frames DIR/NAME-sK-lJ-MODE.png\n"
             "  (16-bit grey, value round(v * 65535)), MODE:\n"
@@ -166,7 +175,7 @@ typedef struct options {
     unsigned threads;                   /* --threads; 0: every core */
     int quiet;
     const char *output;                /* -o: views' VIEWS.json, truth's DIR */
-    vb_frames_views_desc views;        /* views: --cameras, --seed, --size */
+    vb_frames_views_desc views;        /* views: --cameras, --seed, --size, --light-rule */
     const char *views_path;            /* truth, score: --views */
     uint32_t compare;                  /* truth: --compare */
     const char *sdf;                   /* truth: --sdf */
@@ -304,11 +313,12 @@ static int run_views(const options *op)
         goto done;
     }
     if (!op->quiet) {
-        printf(PROG " views: %s -> %s: %d view%s, %d x %d, seed %llu; %u candidate eye%s "
+        printf(PROG " views: %s -> %s: %d view%s, %d x %d, seed %llu%s%s; %u candidate eye%s "
                     "(%u in free space), %.2f s\n",
                path, out, set.count, vdsh_s((unsigned)set.count), d.width, d.height,
-               (unsigned long long)d.seed, st.eyes_tried, vdsh_s(st.eyes_tried), st.eyes_free,
-               vb_now() - t0);
+               (unsigned long long)d.seed, d.light_rule ? ", lights by rule " : "",
+               d.light_rule ? vb_light_rule_name((vb_light_rule)d.light_rule) : "", st.eyes_tried,
+               vdsh_s(st.eyes_tried), st.eyes_free, vb_now() - t0);
         if (st.default_lights_ok < VB_FRAMES_VIEW_LIGHTS)
             printf("  note: only %u of the default view's 4 lights light and shadow %.0f%% "
                    "of it each; the best others fill in\n",
@@ -980,6 +990,7 @@ enum {
     O_THREADS = 256,
     O_CAMERAS,
     O_SEED,
+    O_LIGHT_RULE,
     O_SIZE,
     O_VIEWS,
     O_COMPARE,
@@ -1002,6 +1013,7 @@ static const struct option views_options[] = {{"output", required_argument, 0, '
                                               {"cameras", required_argument, 0, O_CAMERAS},
                                               {"seed", required_argument, 0, O_SEED},
                                               {"size", required_argument, 0, O_SIZE},
+                                              {"light-rule", required_argument, 0, O_LIGHT_RULE},
                                               COMMON_OPTIONS,
                                               {0, 0, 0, 0}};
 static const struct option truth_options[] = {{"output", required_argument, 0, 'o'},
@@ -1053,6 +1065,15 @@ static int take_option(int c, options *o)
         if (!vt_parse_u64(optarg, 1, UINT64_MAX, &o->views.seed))
             return !bad_usage("--seed takes a whole number >= 1, not '%s'", optarg);
         return 1;
+    case O_LIGHT_RULE:
+        for (int k = VB_LIGHTS_UNIFORM; k <= VB_LIGHTS_SHELL; k++)
+            if (strcmp(optarg, vb_light_rule_name((vb_light_rule)k)) == 0) {
+                o->views.light_rule = k;
+                return 1;
+            }
+        return !bad_usage("--light-rule takes uniform, ceiling, near, path, grown, around or "
+                          "shell, not '%s'",
+                          optarg);
     case O_SIZE:
         if (!vt_parse_size(optarg, 16, 16384, &o->views.width, &o->views.height))
             return !bad_usage("--size takes WxH, each 16..16384, not '%s'", optarg);
