@@ -319,4 +319,19 @@ expect_exit 2 "shell: only method decision" "$bake" "${shell[@]}" --method shado
 check "shell: the refusal names the option" grep -q -- "--decision-shell" "$tmp/err.txt"
 expect_exit 2 "shell: not negative" "$bake" "${shell[@]}" --decision-shell -1 -o "$tmp/sx.vdsh"
 
+# No room in the shell: a closed cube room, faces inward, has free space
+# inside (its pool is placed) but none around it (every point in the
+# shell sees the back of a wall): an error that says so, exit 1, nothing
+# written; without --decision-shell the room bakes.
+cp "$(dirname "$0")/data/cube_room.obj" "$tmp/cube_room.obj"
+room=("$tmp/cube_room.obj" --max-edge 1 --rays 16 --cube-size 0 -q)
+expect_exit 1 "shell: no room around a closed room" "$bake" "${room[@]}" --decision-shell 4 \
+  -o "$tmp/sr.vdsh" --report "$tmp/sr.json"
+check "shell: the error names the shell" grep -q "decision shell.*no room for 1024 lights" \
+  "$tmp/err.txt"
+check "shell: the error says why" grep -q "closed room" "$tmp/err.txt"
+check "shell: no file written on no room" test ! -e "$tmp/sr.vdsh"
+check "shell: no report written on no room" test ! -e "$tmp/sr.json"
+expect_exit 0 "shell: the same room without the shell bakes" "$bake" "${room[@]}" -o "$tmp/sr0.vdsh"
+
 exit $fail

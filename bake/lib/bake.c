@@ -1553,16 +1553,23 @@ static uint32_t mix_near(const vb_bake_desc *d, float (*pool)[3])
 
 /* Slots 0, K, 2K, ... of the training pool (K = d->decision_shell)
  * replaced by lights in the shell around the bounds (bake.h,
- * vb_bake_desc.decision_shell). No room is an error. */
+ * vb_bake_desc.decision_shell). No room is an error: a closed room (faces
+ * inward) whose bounds are about as deep as they are wide, seen from
+ * anywhere in the shell, shows some probe the back of a wall
+ * (tests/data/cube_room.obj). */
 static vb_result mix_shell(const vb_bake_desc *d, float (*pool)[3], uint32_t *placed, vb_error *err)
 {
     const uint32_t every = (uint32_t)d->decision_shell;
     vb_result r = mix_rule(d, pool, VB_LIGHTS_SHELL, d->seed ^ VB_POOL_SEED ^ VB_SHELL_SEED, every,
                            0, placed, err);
-    if (r != VB_OK && r != VB_ERR_OUT_OF_MEMORY)
+    if (r != VB_OK && r != VB_ERR_OUT_OF_MEMORY) {
+        vb_error why = *err;
         vb_fail(err, r,
-                "decision shell: no room for %u lights in the shell around the scene's bounds",
-                VB_DECISION_POOL / every);
+                "decision shell (one in %u training lights): no room for %u light%s in the shell "
+                "around the scene's bounds (%s); outside a closed room every point sees the "
+                "backs of its walls, so the shell is for objects",
+                every, VB_DECISION_POOL / every, vdsh_s(VB_DECISION_POOL / every), why.msg);
+    }
     return r;
 }
 
