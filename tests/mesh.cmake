@@ -30,3 +30,12 @@ add_test(NAME mesh_parse COMMAND test_mesh_parse ${VDSH_ASSIMP_MODELS})
 add_test(NAME mesh_report_cli
          COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/test_mesh_cli.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval>)
+
+# The ear clipping's time bound (bake/lib/mesh_read.h triangulate_polygon):
+# past it a polygon falls back to its fan, valid triangles (in range,
+# distinct corners) partly outside a concave face; every shorter budget
+# gives exactly the fan, and a file whose first polygon spends a file's
+# budget fans the next too (see the test's header).
+add_executable(test_triangulate ${CMAKE_CURRENT_LIST_DIR}/test_triangulate.cpp)
+target_link_libraries(test_triangulate PRIVATE vb_mesh m)
+add_test(NAME mesh_triangulate_time_bound COMMAND test_triangulate)
