@@ -17,6 +17,14 @@ add_test(NAME gltf_input
 add_test(NAME gltf_uri
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_gltf_uri.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-export> ${CMAKE_CURRENT_BINARY_DIR}/gltf_uri)
+#   gltf_source_match vdsh-export --source takes the glTF the bake recorded
+#                     (size and SHA-256, external buffers included): an edited
+#                     copy (one vertex moved), another quad and a changed .bin
+#                     refused, nothing written; --allow-mismatch exports
+add_test(NAME gltf_source_match
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_gltf_source_match.py
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-export>
+                 ${CMAKE_CURRENT_BINARY_DIR}/gltf_source_match)
 #   gltf_uri_rule     formats/vdsh_gltf_uri.h byte for byte against
 #                     tinygltf's own dlib::urldecode (hand-picked and
 #                     random URIs)

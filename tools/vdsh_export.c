@@ -265,8 +265,26 @@ static int exact_numbers(cJSON *n)
     }
     return 0;
 }
+/* Whether source file `src` is one the bake recorded (formats/VDSH.md,
+ * SRCS: size and SHA-256, the file's external buffers included; or the
+ * file's bytes alone, as bakes before 2026-11-30 recorded a glTF with
+ * external buffers). Matching vertices by position alone took an edited
+ * copy of the model (one vertex moved) with a warning that blamed the
+ * bake ("unreferenced, or dropped by the bake") and exit 0. */
+static int source_recorded(const vdsh_file *f, const vdsh_src *src)
+{
+    for (uint32_t i = 0; i < f->source_count; i++) {
+        const vdsh_source *r = &f->sources[i];
+        if ((r->size == src->size && memcmp(r->sha256, src->sha256, 32) == 0) ||
+            (r->size == src->file_size && memcmp(r->sha256, src->file_sha256, 32) == 0))
+            return 1;
+    }
+    return 0;
+}
+
 static int with_source(const char *in, const char *path, const vdsh_file *f, cJSON *root,
-                       view_list *vl, cJSON *attrs, cJSON **vx, blob *b, int compress)
+                       view_list *vl, cJSON *attrs, cJSON **vx, blob *b, int compress,
+                       int allow_mismatch)
 {
     char msg[1024];
     vdsh_src src;
@@ -293,6 +311,38 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
             "from\n",
             in, path);
         goto out;
+    }
+    /* A file the bake did not record: fine when its geometry is the
+     * bake's (materials edited since: every vertex at a receiver), else
+     * an edited model (a vertex moved or added) whose vertices would
+     * silently get no shadows: refused unless --allow-mismatch. */
+    const int recorded = source_recorded(f, &src);
+    if (!recorded) {
+        char names[512] = "";
+        for (uint32_t i = 0, at = 0; i < f->source_count && at < sizeof names; i++)
+            at += (uint32_t)snprintf(names + at, sizeof names - at, "%s%s (%llu bytes)",
+                                     i ? ", " : "", f->sources[i].name,
+                                     (unsigned long long)f->sources[i].size);
+        if (matched == vertices)
+            fprintf(stderr,
+                    "vdsh-export: %s: note: not the file %s recorded (%s; this one %llu bytes, "
+                    "its SHA-256 other), but every vertex is at a receiver: its geometry is the "
+                    "bake's\n",
+                    path, in, names, (unsigned long long)src.size);
+        else {
+            fprintf(stderr,
+                    "vdsh-export: %s: %s: not the file %s was baked from (%s; this one %llu "
+                    "bytes, its SHA-256 other) and %llu of its %llu vertices are at no receiver: "
+                    "its geometry was edited; %s\n",
+                    path, allow_mismatch ? "warning" : "error", in, names,
+                    (unsigned long long)src.size, (unsigned long long)(vertices - matched),
+                    (unsigned long long)vertices,
+                    allow_mismatch ? "exported anyway (--allow-mismatch), their VDSH attributes 0"
+                                   : "give the glTF it was baked from (--allow-mismatch exports it "
+                                     "anyway, those vertices' VDSH attributes 0)");
+            if (!allow_mismatch)
+                goto out;
+        }
     }
     /* one BIN buffer: the source's buffers one after the other */
     size_t *base = calloc((size_t)src.buffer_count + 1, sizeof *base);
@@ -478,7 +528,7 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
                 "vdsh-export: %s: baked from %u meshes; the glb holds %s's scene only (the "
                 "other meshes' receivers are not in it)\n",
                 in, f->source_count, path);
-    if (matched < vertices)
+    if (matched < vertices && recorded)
         fprintf(stderr,
                 "vdsh-export: %s: %llu of %llu source vertices have no receiver at their position "
                 "(unreferenced, or dropped by the bake): their VDSH attributes are 0\n",
@@ -625,7 +675,12 @@ static void usage(FILE *fp)
             "                     data kept as it is\n"
             "      --source FILE  the glTF the .vdsh was baked from: write its own scene (nodes,\n"
             "                     meshes, materials, textures, UVs...) with the VDSH attributes\n"
-            "                     added to each primitive (formats/GLTF.md)\n"
+            "                     added to each primitive (formats/GLTF.md); a file other\n"
+            "                     than the one the bake recorded (size and SHA-256) is taken\n"
+            "                     when every vertex is at a receiver (edited materials),\n"
+            "                     else refused (edited geometry)\n"
+            "      --allow-mismatch  --source: export edited geometry anyway (with a\n"
+            "                     warning), vertices at no receiver getting 0\n"
             "  -q, --quiet        no summary on stderr\n"
             "  -h, --help         this text\n"
             "  -V, --version      version\n"
@@ -640,18 +695,22 @@ static void usage(FILE *fp)
 typedef struct options {
     const char *in, *out, *source;
     int want[VDSH_ORDER_SLOTS], any_order; /* --orders, each time adding to the set */
-    int use_float, quiet, compress, decode_cpca;
+    int use_float, quiet, compress, decode_cpca, allow_mismatch;
 } options;
 
 /* -1 with *o ready to run, else the exit status (help, version, a usage
  * error: said). */
 static int parse_args(int argc, char **argv, options *o)
 {
-    static const struct option longopts[] = {
-        {"output", required_argument, 0, 'o'}, {"orders", required_argument, 0, 'O'},
-        {"float", no_argument, 0, 'F'},        {"compress", no_argument, 0, 'C'},
-        {"decode-cpca", no_argument, 0, 'D'},  {"source", required_argument, 0, 'S'},
-        {"quiet", no_argument, 0, 'q'},        VT_CLI_LONGOPTS_END};
+    static const struct option longopts[] = {{"output", required_argument, 0, 'o'},
+                                             {"orders", required_argument, 0, 'O'},
+                                             {"float", no_argument, 0, 'F'},
+                                             {"compress", no_argument, 0, 'C'},
+                                             {"decode-cpca", no_argument, 0, 'D'},
+                                             {"source", required_argument, 0, 'S'},
+                                             {"allow-mismatch", no_argument, 0, 'M'},
+                                             {"quiet", no_argument, 0, 'q'},
+                                             VT_CLI_LONGOPTS_END};
     memset(o, 0, sizeof *o);
     int opt, set[VDSH_ORDER_SLOTS];
     while ((opt = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
@@ -673,6 +732,7 @@ static int parse_args(int argc, char **argv, options *o)
         case 'F': o->use_float = 1; break;
         case 'C': o->compress = 1; break;
         case 'D': o->decode_cpca = 1; break;
+        case 'M': o->allow_mismatch = 1; break;
         case 'S':
             if (!vt_opt_once("--source", optarg, &o->source))
                 return VT_EXIT_USAGE;
@@ -1142,8 +1202,8 @@ static int run(const options *o)
     if (!rc)
         rc = put_streams(&e);
     if (!rc && o->source)
-        rc =
-            with_source(o->in, o->source, f, e.root, &e.vl, e.attrs, &e.vx, &e.b, o->compress) != 0;
+        rc = with_source(o->in, o->source, f, e.root, &e.vl, e.attrs, &e.vx, &e.b, o->compress,
+                         o->allow_mismatch) != 0;
     else if (!rc)
         rc = assemble(&e);
     if (!rc)

@@ -34,6 +34,11 @@ typedef struct vdsh_src {
     vdsh_src_buffer *buffers; /* its buffers' bytes, one per buffers[] */
     int buffer_count;
     char *dir; /* the source's directory, for relative URIs */
+    /* What a bake records of it (formats/VDSH.md, SRCS): the file's bytes
+     * followed by each external buffer's (no external buffer: the file's
+     * alone), and the file's alone (what bakes before 2026-11-30 recorded). */
+    uint8_t sha256[32], file_sha256[32];
+    uint64_t size, file_size;
 } vdsh_src;
 
 /* One primitive instance reached by the walk: node, its mesh, primitive
@@ -51,6 +56,8 @@ typedef struct vdsh_src_prim {
  * memory or when the URI decodes to a NUL byte ("%00"). */
 char *vdsh_src_file(const vdsh_src *s, const char *uri, const char **why);
 
+/* Read the source (its JSON, every buffer) and hash it as the baker does
+ * (sha256, size above). */
 int vdsh_src_load(const char *path, vdsh_src *s, char *msg, size_t cap);
 void vdsh_src_free(vdsh_src *s);
 
