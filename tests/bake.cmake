@@ -203,6 +203,15 @@ add_test(NAME bake_cpca_lightmix
                  ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/bake_cpca_lightmix
                  $<TARGET_FILE:light_pool_tool>)
 
+# scripts/cpca_study's cache in --work (tests/test_cpca_study_cache.py):
+# bakes, truth and light pools named by what made them (mesh and its
+# bytes, edge, method, --rays; the view set's bytes; --light-pool,
+# --light-seed), not by scene and fit alone: a rerun with other settings
+# reused the first run's bakes.
+add_test(NAME scripts_cpca_study_cache
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_cpca_study_cache.py
+                 ${PROJECT_SOURCE_DIR}/scripts ${CMAKE_CURRENT_BINARY_DIR}/scripts_cpca_study_cache)
+
 # -o /dev/null, /dev/stdout or a FIFO: the file in place, byte for byte,
 # and no basis cubemaps beside it (they went into /dev), unless
 # --cubemap-dir; --sdf with such an OUT refused; vdsh-merge the same.

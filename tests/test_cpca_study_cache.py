@@ -1,0 +1,70 @@
+"""scripts/cpca_study's cache (--work): each cached file is named by what
+made it, so a rerun with other settings makes its own instead of reusing
+stale results (it named the bakes and the truth by scene and fit only: a
+rerun with another --rays, edge or mesh scored the first run's bakes).
+
+cache_paths, the names scene() uses: the same settings give the same
+names (a rerun reuses them); another --rays, edge, method, mesh file
+content or built-in scene gives other bakes (and truth); another view
+set's bytes another truth (the same bakes); another --light-pool or
+--light-seed or mesh another light pool (the same bakes).
+
+Usage: test_cpca_study_cache.py SCRIPTS_DIR WORK_DIR
+"""
+import argparse
+import importlib.machinery
+import importlib.util
+import os
+import sys
+
+scripts, work = sys.argv[1:3]
+os.makedirs(work, exist_ok=True)
+loader = importlib.machinery.SourceFileLoader("cpca_study", os.path.join(scripts, "cpca_study"))
+spec = importlib.util.spec_from_loader("cpca_study", loader)
+cs = importlib.util.module_from_spec(spec)
+loader.exec_module(cs)
+fail = 0
+
+
+def check(ok, what):
+    global fail
+    if not ok:
+        print("FAIL:", what, file=sys.stderr)
+        fail = 1
+
+
+mesh, views = os.path.join(work, "m.obj"), os.path.join(work, "v.views.json")
+open(mesh, "w").write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+open(views, "w").write('{"width": 64, "height": 48, "views": []}\n')
+
+
+def paths(rays=625, pool=2048, seed=1, m=mesh, edge="0.25", method="decision"):
+    a = argparse.Namespace(work=work, rays=rays, light_pool=pool, light_seed=seed)
+    p = cs.cache_paths(a, "s", m, edge, method, views)
+    return dict(ref=p["ref"], o5=p["o5"], truth=p["truth"], pool=p["pool"](False),
+                box=p["pool"](True))
+
+
+base = paths()
+check(paths() == base, "the same settings: the same names (a rerun reuses them)")
+check(all(os.path.dirname(v) == work for v in base.values()), "all in --work")
+check(len(set(base.values())) == len(base), "one name each")
+for what, other in (("--rays 64", paths(rays=64)), ("edge 0.5", paths(edge="0.5")),
+                    ("method shadow", paths(method="shadow"))):
+    check(other["ref"] != base["ref"] and other["o5"] != base["o5"] and other["truth"] != base["truth"],
+          "%s: other bakes and truth" % what)
+    if what != "method shadow":  # a pool is the scene's and fit's (its name's), not the bake's
+        check(other["pool"] == base["pool"], "%s: the same light pool" % what)
+check(paths(m="builtin:room")["ref"] != paths(m="builtin:room:1")["ref"], "builtin scenes: their own bakes")
+for what, other in (("--light-pool 512", paths(pool=512)), ("--light-seed 2", paths(seed=2))):
+    check(other["pool"] != base["pool"] and other["box"] != base["box"], "%s: another pool" % what)
+    check(other["ref"] == base["ref"] and other["truth"] == base["truth"], "%s: the same bakes" % what)
+
+# The files' bytes, not their names: an edited mesh or view set.
+open(views, "w").write('{"width": 64, "height": 48, "views": [], "note": 1}\n')
+v2 = paths()
+check(v2["truth"] != base["truth"] and v2["ref"] == base["ref"], "another view set: another truth only")
+open(mesh, "w").write("v 0 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\n")
+m2 = paths()
+check(m2["ref"] != base["ref"] and m2["pool"] != base["pool"], "an edited mesh: other bakes and pool")
+sys.exit(fail)
