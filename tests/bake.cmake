@@ -6,6 +6,14 @@ add_test(NAME bake_cli_deterministic_no_partial_output
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_bake_cli.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info> ${VDSH_SHARED_SCENES})
 
+# No receiver ray starts on a surface (Embree promises nothing at t = 0):
+# vb_ray_origins' origins in an unwelded L corner, a panel on a floor, a
+# flat quad and a cube on a floor; the control (normal offset only) does
+# start rays on the adjacent faces.
+add_executable(test_origins_on_surface test_origins_on_surface.c)
+target_link_libraries(test_origins_on_surface PRIVATE vb_core m)
+add_test(NAME bake_origins_off_surfaces COMMAND test_origins_on_surface)
+
 add_executable(test_hard test_hard.c)
 target_link_libraries(test_hard PRIVATE vb_core)
 add_test(NAME bake_hard_cases COMMAND test_hard)
