@@ -1037,8 +1037,12 @@ static vb_result place_scene_lights(eval_run *e, vb_error *err)
     if (r != VB_OK)
         return r;
     float lo[3], hi[3];
-    o->light_region_grown = vb_scene_light_region(d->scene, lo, hi, NULL);
-    o->light_region_given = d->scene->region_given;
+    const int grown = vb_scene_light_region(d->scene, lo, hi, NULL);
+    /* a given region (the file's lreg, --light-region) is reported where
+     * the rule places in the region (not grown, around, shell: their own
+     * boxes) and is not "grown around a closed object" */
+    o->light_region_given = d->scene->region_given && d->light_rule < VB_LIGHTS_GROWN;
+    o->light_region_grown = grown && !d->scene->region_given;
     memcpy(o->light_region_min, lo, sizeof lo);
     memcpy(o->light_region_max, hi, sizeof hi);
     o->light_count = nl;
