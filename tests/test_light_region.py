@@ -9,6 +9,8 @@ ACCURACY.md "Where your lights go"), on a unit cube on a 4 x 4 floor
 - `grown` and a box are recorded in an `lreg` chunk that the C reader
   (vdsh-info, text and --json) and the Python reader give back: grown
   is the bounds grown by a quarter of their diagonal, a box as given;
+- a box beyond 1.5 x the clamp from the bounds is baked with a warning
+  naming --max-distance (grown never is);
 - the same bytes on 1 and 2 threads; two shards merged are the whole
   bake's bytes; parts with other regions are refused by vdsh-merge;
 - a damaged lreg (rule 3, min >= max, reserved byte) is refused by the C
@@ -129,6 +131,17 @@ must(run_bake("box.vdsh", ["--light-region", BOX]), "box bake")
 lr = vdsh.read(path("box.vdsh")).light_region
 if not lr or lr["rule"] != "box" or lr["min"] != [-1.5, 0, -1.5] or lr["max"] != [1.5, 2.5, 1.5]:
     fail.append("box: the Python reader's light region %r" % lr)
+
+# a box out of the clamp's reach is baked, with a warning naming
+# --max-distance; grown never is (at most 1.43 diagonals from the bounds)
+for spec, warned in (("5,5,5,6,6,6", True), ("grown", False)):
+    r = subprocess.run([bake] + [a for a in BASE if a != "-q"] +
+                       ["--light-region", spec, "-o", path("far.vdsh")], capture_output=True,
+                       text=True)
+    said = "warning" in r.stderr and "--max-distance" in r.stderr
+    if r.returncode or said != warned:
+        fail.append("--light-region %s: exit %d, warned %s: %r" % (spec, r.returncode, said,
+                                                                  r.stderr))
 
 # 4. Shards: merged, the whole bake's bytes; other regions refused.
 for i in (0, 1):

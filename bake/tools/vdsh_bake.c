@@ -1459,6 +1459,27 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
                 "origin%s not probed\n",
                 bo->origins.skipped_zero_area, vdsh_s(bo->origins.skipped_zero_area),
                 vdsh_s(bo->origins.skipped_zero_area));
+    if (job->light_region.rule) { /* --light-region: where, and whether in reach */
+        const vdsh_light_box *b = &job->light_region;
+        const float *lo = job->scene->bounds_min, *hi = job->scene->bounds_max;
+        double far = 0.0; /* the farthest light from the farthest occluder corner */
+        for (int a = 0; a < 3; a++) {
+            const double d = fmax(fabs((double)b->max[a] - lo[a]), fabs((double)hi[a] - b->min[a]));
+            far += d * d;
+        }
+        far = sqrt(far);
+        fprintf(log, "vdsh-bake: lights in %s %g %g %g .. %g %g %g\n",
+                b->rule == VDSH_LIGHT_REGION_GROWN ? "the bounds grown:" : "the box",
+                (double)b->min[0], (double)b->min[1], (double)b->min[2], (double)b->max[0],
+                (double)b->max[1], (double)b->max[2]);
+        if (far > 1.5 * (double)bo->max_distance)
+            fprintf(log,
+                    "vdsh-bake: warning: lights in this region may stand up to %g from a "
+                    "receiver, beyond 1.5 x the max distance %g, where every stream reads "
+                    "shadow: give --max-distance %g or more (docs/DESIGN.md, \"Lights beyond "
+                    "the clamp\")\n",
+                    far, (double)bo->max_distance, far / 1.5);
+    }
     if (bo->method == VDSH_METHOD_DECISION) {
         if (!bo->decision_lights)
             fprintf(log, "vdsh-bake: warning: no free space for lights in this scene: every "
