@@ -215,6 +215,11 @@ static const vdsh_field adpt_fields[] = {
     FIELD(16, vdsh_adaptive, max_rounds),   FIELD(20, vdsh_adaptive, start_receivers),
     FIELD(24, vdsh_adaptive, rounds),       FIELD(28, vdsh_adaptive, candidates),
 };
+static const vdsh_field lreg_fields[] = {
+    FIELD(0, vdsh_light_box, rule),
+    FIELD(4, vdsh_light_box, min),
+    FIELD(16, vdsh_light_box, max),
+};
 static const vdsh_field head_fields[] = {
     FIELD(0, vdsh_header, vertex_count),
     FIELD(4, vdsh_header, triangle_count),
@@ -250,6 +255,7 @@ const vdsh_fixed_chunk vdsh_fixed_chunks[VDSH_FIXED_COUNT] = {
     [VDSH_FIXED_TIME] = {"time", TIME_SIZE, 44, 20, FIELDS(time_fields)},
     [VDSH_FIXED_PART] = {"part", PART_SIZE, 0, 0, FIELDS(part_fields)},
     [VDSH_FIXED_ADPT] = {"adpt", ADPT_SIZE, 0, 0, FIELDS(adpt_fields)},
+    [VDSH_FIXED_LREG] = {"lreg", LREG_SIZE, 28, 4, FIELDS(lreg_fields)},
 };
 
 int vdsh_fixed_kind(const char *id)

@@ -323,6 +323,19 @@ typedef struct vdsh_adaptive {
     uint32_t candidates;      /* midpoints baked, split or not */
 } vdsh_adaptive;
 
+/* Where the lights go (`lreg` chunk, VDSH.md), when the bake was told
+ * (vdsh-bake --light-region grown or a box): the decision fit trained, and
+ * its offsets were calibrated, on lights in this box (in free space), and
+ * readers place their default lights there. Absent: the scene's own rule
+ * (vdsh_light.h, vdsh_light_region). */
+enum { VDSH_LIGHT_REGION_GROWN = 1, VDSH_LIGHT_REGION_BOX = 2 };
+typedef struct vdsh_light_box {
+    uint32_t rule; /* VDSH_LIGHT_REGION_GROWN (the bounds grown by
+                        * VDSH_REGION_GROW of their diagonal) or _BOX (given) */
+    float min[3];  /* scene units (the space of POSN), finite */
+    float max[3];  /* finite, > min on every axis */
+} vdsh_light_box;
+
 /* A part's cpca light pool (`lpol` chunk, VDSH.md "Parts"): the light mix
  * and the pool of the cpca encoder's light-density metric (vdsh_cpca.h),
  * which vdsh-merge passes to the encoder. Only in parts whose `part`
@@ -353,6 +366,8 @@ typedef struct vdsh_file {
     vdsh_adaptive adaptive;
     int has_light_pool; /* `lpol` chunk present: a cpca part's light pool */
     vdsh_light_pool light_pool;
+    int has_light_box; /* `lreg` chunk present: where the bake's lights went */
+    vdsh_light_box light_box;
     void *storage_; /* owned memory; do not touch */
 } vdsh_file;
 

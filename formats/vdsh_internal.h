@@ -45,6 +45,7 @@ enum {
     TIME_SIZE = 64,
     PART_SIZE = 32,
     ADPT_SIZE = 32,
+    LREG_SIZE = 32,
     SOURCE_FIXED_SIZE = 44, /* sha256, size, name_length */
     MAX_CHUNKS = 64,
     CPCA_HEADER_SIZE = 16 /* clusters, basis, bits, record_words */
@@ -145,7 +146,14 @@ static inline int all_zero(const uint8_t *p, size_t n)
 /* The optional fixed-size chunks: one list of each one's fields, which
  * the reader decodes (vdsh_fields_get) and the writer encodes
  * (vdsh_fields_put); in the order the writer emits them. */
-enum { VDSH_FIXED_STAT, VDSH_FIXED_TIME, VDSH_FIXED_PART, VDSH_FIXED_ADPT, VDSH_FIXED_COUNT };
+enum {
+    VDSH_FIXED_STAT,
+    VDSH_FIXED_TIME,
+    VDSH_FIXED_PART,
+    VDSH_FIXED_ADPT,
+    VDSH_FIXED_LREG,
+    VDSH_FIXED_COUNT
+};
 typedef struct vdsh_field {
     uint8_t offset; /* in the payload */
     uint8_t size;   /* bytes: 4 (u32, f32) or 8 (u64, f64) */
@@ -229,6 +237,7 @@ int vdsh_check_part(const vdsh_part *t, uint32_t vertex_count, why *w);
 /* An `lpol` chunk's contents; with has_part (else 0) the part it is in. */
 int vdsh_check_light_pool(const vdsh_light_pool *l, int has_part, const vdsh_part *part, why *w);
 int vdsh_check_adaptive(const vdsh_adaptive *a, uint32_t vertex_count, why *w);
+int vdsh_check_light_box(const vdsh_light_box *b, why *w);
 
 int vdsh_check_timings(const vdsh_timings *t, why *w);
 

@@ -100,6 +100,8 @@ typedef struct layout {
     vdsh_part part;
     int has_adaptive;
     vdsh_adaptive adaptive;
+    int has_light_box;
+    vdsh_light_box light_box;
     int has_light_pool;
     vdsh_light_pool light_pool; /* lights: set by load_owned */
     uint64_t lpol;              /* offset of the lights */
@@ -456,13 +458,14 @@ static vdsh_result check_coef_sizes(const reader *r, layout *L)
     return VDSH_OK;
 }
 
-/* stat, time, part, adpt: at most one each, of a fixed size, decoded by
+/* stat, time, part, adpt, lreg: at most one each, of a fixed size, decoded by
  * the table the writer encodes with, then checked as the writer checks. */
 static vdsh_result read_fixed(const reader *r, const chunk_ref *c, uint32_t i, int kind, layout *L)
 {
     const vdsh_fixed_chunk *k = &vdsh_fixed_chunks[kind];
-    int *has[VDSH_FIXED_COUNT] = {&L->has_stats, &L->has_timings, &L->has_part, &L->has_adaptive};
-    void *out[VDSH_FIXED_COUNT] = {&L->stats, &L->timings, &L->part, &L->adaptive};
+    int *has[VDSH_FIXED_COUNT] = {&L->has_stats, &L->has_timings, &L->has_part, &L->has_adaptive,
+                                  &L->has_light_box};
+    void *out[VDSH_FIXED_COUNT] = {&L->stats, &L->timings, &L->part, &L->adaptive, &L->light_box};
     const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
     uint32_t vc = L->header.vertex_count;
     why w;
@@ -482,7 +485,8 @@ static vdsh_result read_fixed(const reader *r, const chunk_ref *c, uint32_t i, i
     int ok = kind == VDSH_FIXED_STAT   ? vdsh_check_stats(&L->stats, vc, &w)
              : kind == VDSH_FIXED_TIME ? vdsh_check_timings(&L->timings, &w)
              : kind == VDSH_FIXED_PART ? vdsh_check_part(&L->part, vc, &w)
-                                       : vdsh_check_adaptive(&L->adaptive, vc, &w);
+             : kind == VDSH_FIXED_ADPT ? vdsh_check_adaptive(&L->adaptive, vc, &w)
+                                       : vdsh_check_light_box(&L->light_box, &w);
     if (!ok)
         return invalid(r, &w);
     *has[kind] = 1;
@@ -675,6 +679,8 @@ static vdsh_result load_owned(uint8_t *buf, size_t size, const char *name, vdsh_
     f->part = L.part;
     f->has_adaptive = L.has_adaptive;
     f->adaptive = L.adaptive;
+    f->has_light_box = L.has_light_box;
+    f->light_box = L.light_box;
     f->has_light_pool = L.has_light_pool;
     f->light_pool = L.light_pool;
     if (L.has_light_pool)

@@ -1105,11 +1105,16 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
     vdsh_view_free_ctx rc = {t, vdsh_free_diagonal(lo, hi)};
     memcpy(v.region_min, lo, sizeof v.region_min);
     memcpy(v.region_max, hi, sizeof v.region_max);
-    if (!v.interior) /* a room's lights stay in its bounds: no probes spent */
+    v.region_given = m->light_region && !v.interior;
+    if (v.region_given) { /* the user's (the file's lreg): as given */
+        memcpy(v.region_min, m->light_region, sizeof v.region_min);
+        memcpy(v.region_max, m->light_region + 3, sizeof v.region_max);
+        v.region_grown = 1;
+    } else if (!v.interior) /* a room's lights stay in its bounds: no probes spent */
         v.region_grown =
             vdsh_light_region(lo, hi, vdsh_view_is_free, &rc, v.region_min, v.region_max, NULL);
     float blo[3], bhi[3];
-    light_box(v.region_min, v.region_max, lo, hi, rc.diagonal, flat, blo, bhi);
+    light_box(v.region_min, v.region_max, lo, hi, rc.diagonal, flat && !v.region_given, blo, bhi);
     const float *slo = v.interior ? lo : blo, *shi = v.interior ? hi : bhi;
     for (int i = 0; !v.interior && i < v.light_count; i++)
         into_region(v.preferred[i], slo, shi, flat ? c : NULL);

@@ -101,6 +101,11 @@ typedef struct vdsh_view_mesh {
     const uint32_t *indices; /* triangle_count x 3 */
     uint32_t vertex_count;
     uint32_t triangle_count;
+    /* NULL, or where the bake's lights went (the file's `lreg` chunk,
+     * vdsh-bake --light-region): min x,y,z, max x,y,z. An object's default
+     * lights go there instead of the rule's region (an interior's stay in
+     * its bounds, as its lights' frame rule places them). */
+    const float *light_region;
 } vdsh_view_mesh;
 
 typedef struct vdsh_view {
@@ -130,6 +135,7 @@ typedef struct vdsh_view {
     float region_min[3];
     float region_max[3];
     int region_grown;
+    int region_given; /* 1: the mesh's light_region, as given (an object's) */
     /* An interior's lights in the check frame (vdsh_view_light_shares):
      * shares of its pixels lit and shadowed; 0 for an object's. */
     float light_lit[VDSH_VIEW_MAX_LIGHTS];

@@ -36,7 +36,7 @@ typedef struct plan {
     uint8_t head[HEAD_SIZE];
     /* each stream's header, then an s8 stream's scale table and padding */
     uint8_t stream_header[VDSH_MAX_STREAMS][STREAM_HEADER_SIZE + S8_TABLE_MAX];
-    uint8_t fixed[VDSH_FIXED_COUNT][TIME_SIZE]; /* stat, time, part, adpt */
+    uint8_t fixed[VDSH_FIXED_COUNT][TIME_SIZE]; /* stat, time, part, adpt, lreg */
     uint8_t lpol[16];                           /* the lpol chunk's head */
     uint8_t *srcs;                              /* malloc'd SRCS payload */
     uint8_t *model[VDSH_MAX_STREAMS];           /* malloc'd cpca models, padded */
@@ -129,6 +129,8 @@ static vdsh_result check_file(const vdsh_file *f, const char *name, vdsh_error *
     if (f->has_adaptive && !vdsh_check_adaptive(&f->adaptive, h->vertex_count, &w))
         return argument(err, name, &w);
     if (f->has_light_pool && !vdsh_check_light_pool(&f->light_pool, f->has_part, &f->part, &w))
+        return argument(err, name, &w);
+    if (f->has_light_box && !vdsh_check_light_box(&f->light_box, &w))
         return argument(err, name, &w);
     return VDSH_OK;
 }
@@ -242,7 +244,8 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name, vds
     const void *fixed[VDSH_FIXED_COUNT] = {f->has_stats ? (const void *)&f->stats : NULL,
                                            f->has_timings ? (const void *)&f->timings : NULL,
                                            f->has_part ? (const void *)&f->part : NULL,
-                                           f->has_adaptive ? (const void *)&f->adaptive : NULL};
+                                           f->has_adaptive ? (const void *)&f->adaptive : NULL,
+                                           f->has_light_box ? (const void *)&f->light_box : NULL};
     for (int k = 0; k < VDSH_FIXED_COUNT; k++)
         if (fixed[k]) {
             const vdsh_fixed_chunk *x = &vdsh_fixed_chunks[k];

@@ -453,7 +453,8 @@ void vr_scene_fit_camera(const vr_scene *s, vr_camera *out);
 /* Up to max (at most 4) default light positions; returns how many were
  * written. An interior's are spread through its bounds (light 0 roughly in
  * the middle, a little above the floor); an object's in the light region
- * the bake trained on (vdsh_light_region), light 0 toward the top of it
+ * the bake trained on (vdsh_light_region, or the box the file's `lreg`
+ * chunk records: vdsh-bake --light-region), light 0 toward the top of it
  * and to the side of the default eye.
  * Each is in free space (formats/vdsh_light.h: not inside a solid, not on
  * a surface), moved at load when its place is not: to the nearest place
@@ -468,7 +469,8 @@ enum { VR_MAX_POOL_LIGHTS = 64 };
  * light_pool); returns how many were written (0 without a pool). They are
  * "placed uniformly in free space" as formats/vdsh_light.h defines it:
  * the candidates of vdsh_light_candidate (seed 1) in the light region
- * (vdsh_light_region: the bounds, or the bounds grown around a closed
+ * (the file's `lreg` box when it has one, else vdsh_light_region: the
+ * bounds, or the bounds grown around a closed
  * or nearly closed object) that pass vdsh_view_free_space against the drawn mesh, in
  * sequence order (vdsh_light_place, the bake side's placement: at most
  * vdsh_light_tries candidates, 1000 per position in the bounds); deterministic. Colours and attenuations are

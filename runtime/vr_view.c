@@ -67,8 +67,14 @@ vr_result vr_scene_place_pool(vr_scene *s, const vdsh_view_mesh *m, int count, c
     s->pool_count = 0;
     vdsh_view_free_ctx c = {t, diag};
     float lo[3], hi[3];
-    const int grown =
-        vdsh_light_region(s->bounds_min, s->bounds_max, vdsh_view_is_free, &c, lo, hi, NULL);
+    int grown = 1;
+    if (m->light_region) { /* the file's (lreg): where the bake's lights went */
+        memcpy(lo, m->light_region, sizeof lo);
+        memcpy(hi, m->light_region + 3, sizeof hi);
+    } else {
+        grown =
+            vdsh_light_region(s->bounds_min, s->bounds_max, vdsh_view_is_free, &c, lo, hi, NULL);
+    }
     /* The bake side's placement, limit included (vdsh_light_tries: it
      * gave up here at 256 candidates per light, the baker at 1000). */
     s->pool_count = (int)vdsh_light_place(lo, hi, grown, 1, (uint32_t)count, vdsh_view_is_free, &c,

@@ -136,3 +136,17 @@ for o in (3, 5):
 print('ok', false)"
              $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval>)
 endif()
+
+#   light_region  vdsh-bake --light-region (auto, grown, a box): refused
+#                 values, the default's bytes, the lreg chunk in both
+#                 readers, threads and shards, vdsh-eval's lights where
+#                 the file says, and under lights around an object fewer
+#                 false shadows than the default's (docs/ACCURACY.md,
+#                 "Where your lights go")
+if(TARGET vdsh-eval AND Python3_Interpreter_FOUND)
+  add_test(NAME light_region
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_light_region.py
+                   $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval> $<TARGET_FILE:vdsh-merge>
+                   $<TARGET_FILE:vdsh-info> ${PROJECT_SOURCE_DIR}
+                   ${CMAKE_CURRENT_BINARY_DIR}/light_region)
+endif()

@@ -419,6 +419,10 @@ static void sample_init(sample *s, int kind, uint32_t v)
                                         .start_receivers = 1,
                                         .rounds = 8,
                                         .candidates = 100000};
+        s->f.has_light_box = kind == 1; /* vdsh-bake --light-region */
+        s->f.light_box = (vdsh_light_box){.rule = VDSH_LIGHT_REGION_BOX,
+                                          .min = {-1.5f, 0.0f, -2.25f},
+                                          .max = {1.5f, 3.0e5f, 0.125f}};
     }
 }
 
@@ -520,6 +524,9 @@ static void check_same_file(const vdsh_file *got, const vdsh_file *want)
     CHECK(!!got->has_adaptive == !!want->has_adaptive);
     if (want->has_adaptive)
         CHECK(memcmp(&got->adaptive, &want->adaptive, sizeof got->adaptive) == 0);
+    CHECK(!!got->has_light_box == !!want->has_light_box);
+    if (want->has_light_box)
+        CHECK(memcmp(&got->light_box, &want->light_box, sizeof got->light_box) == 0);
 }
 
 /* ------------------------------------------------------------------ */
@@ -1908,6 +1915,15 @@ static void test_writer_checks(void)
     REJECT("rounds", s_.f.has_adaptive = 1, s_.f.adaptive.rounds = 9);
     REJECT("lights", s_.f.has_adaptive = 1, s_.f.adaptive.lights = 0);
     REJECT("midpoints", s_.f.has_adaptive = 1, s_.f.adaptive.candidates = 0);
+#define LBOX(...)                                                                                  \
+    s_.f.has_light_box = 1,                                                                        \
+    s_.f.light_box = (vdsh_light_box){.rule = 2, .min = {0, 0, 0}, .max = {1, 1, 1}}, __VA_ARGS__
+    REJECT("lreg: rule", LBOX(s_.f.light_box.rule = 0));
+    REJECT("lreg: rule", LBOX(s_.f.light_box.rule = 3));
+    REJECT("lreg: axis 0", LBOX(s_.f.light_box.min[0] = NAN));
+    REJECT("lreg: axis 1", LBOX(s_.f.light_box.max[1] = 0.0f));
+    REJECT("lreg: axis 2", LBOX(s_.f.light_box.max[2] = INFINITY));
+#undef LBOX
     REJECT("triangle_count", s_.f.header.triangle_count = (1u << 28) + 1);
     REJECT("rays", s_.f.header.rays = 0);
     REJECT("sampling", s_.f.header.sampling = 2);

@@ -12,7 +12,8 @@
  * Property checked beyond "no crash": whatever the reader accepts, the
  * writer accepts too and writes back to bytes that read the same; a
  * part's `part` and `lpol` chunks read back as they were (the corpus has
- * parts: box-s8s6-part1of2.vdsh, box-cpca-part0of2-lpol6.vdsh).
+ * parts: box-s8s6-part1of2.vdsh, box-cpca-part0of2-lpol6.vdsh), and an
+ * lreg chunk the same (cubefloor-f16-lreg-grown.vdsh).
  *
  * Random bytes almost never pass the CRCs, so the value rules behind them
  * are reached by a second pass over a copy whose CRCs have been recomputed
@@ -93,6 +94,12 @@ static void one_input(const uint8_t *data, size_t size)
           memcmp(f->light_pool.lights, g->light_pool.lights,
                  3 * sizeof(float) * f->light_pool.count) != 0))) {
         fprintf(stderr, "a part's part or lpol chunk does not survive a rewrite\n");
+        abort();
+    }
+    /* The light region (`lreg`, vdsh-bake --light-region) too, bit for bit. */
+    if (g->has_light_box != f->has_light_box ||
+        (f->has_light_box && memcmp(&f->light_box, &g->light_box, sizeof f->light_box) != 0)) {
+        fprintf(stderr, "an lreg chunk does not survive a rewrite\n");
         abort();
     }
     free(mem);

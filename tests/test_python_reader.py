@@ -176,6 +176,11 @@ def compare(path):
             ca[k] != pa[k] for k in ("max_receivers", "lights", "max_rounds", "start_receivers",
                                      "rounds", "candidates"))):
         fail.append("%s: adaptive: C %s, Python %s" % (path, ca, pa))
+    # the light region (lreg, vdsh-bake --light-region): rule and box
+    cl, pl = c.get("light_region"), p.light_region
+    if (cl is None) != (pl is None) or (cl and (cl["rule"] != pl["rule"] or any(
+            not close(a, b) for k in ("min", "max") for a, b in zip(cl[k], pl[k])))):
+        fail.append("%s: light region: C %s, Python %s" % (path, cl, pl))
     return p
 
 
@@ -191,6 +196,7 @@ for name, args in (("default", []), ("paper-f32", ["--method", "paper", "--encod
                    ("s8s6", ["--encoding", "s8s6"]),
                    ("s8s6-small", ["--encoding", "s8s6", "--orders", "3,5"]),
                    ("adaptive", ["--adaptive", "0.05"]),
+                   ("light-region", ["--light-region", "-1,0.5,-2,9,2.5,7"]),
                    ("order12", ["--orders", "7,12", "--encoding", "f16"]),
                    ("cpca-small", ["--orders", "7", "--encoding", "cpca", "--cpca", "3,9,4"]),
                    ("adaptive-order", ["--adaptive-order", "0.02", "--max-order", "9",

@@ -10,8 +10,8 @@
  * edge 1 (orders 2,3,5, f16; and orders 1,4, f32, method full, with the
  * timings chunk; order 6 in cpca, 3 clusters of 7 vectors, 5-bit weights;
  * order 6 in cpca with a width per vector, --cpca 3,alloc:60; shard 0 of 2
- * of that bake, a part with its part and lpol chunks, the latter 24 KB of
- * light pool), and
+ * of that bake with --light-region grown, a part with its part, lpol and
+ * lreg chunks, lpol 24 KB of light pool), and
  * builtin:room at max edge 0 (the room's 261 KB are
  * swept at a stride of 1/1009 of the file and with 1,000 two-byte changes;
  * a full sweep would take minutes). Then:
@@ -261,12 +261,13 @@ int main(int argc, char **argv)
     char *bake_cw[] = {(char *)bake,  obj,          "--max-edge", "1",  "--rays",     "64",
                        "--cube-size", "0",          "--orders",   "6",  "--encoding", "cpca",
                        "--cpca",      "3,alloc:60", "-q",         "-o", cw,           NULL};
-    /* a part of a sharded cpca bake: the part chunk, and lpol (the light
-     * pool of the byte-budget settings' light-density metric) */
-    char *bake_pt[] = {(char *)bake, obj,           "--max-edge", "1",          "--rays",
-                       "64",         "--cube-size", "0",          "--orders",   "6",
-                       "--encoding", "cpca",        "--cpca",     "3,alloc:60", "--shard",
-                       "0/2",        "-q",          "-o",         pt,           NULL};
+    /* a part of a sharded cpca bake: the part chunk, lpol (the light
+     * pool of the byte-budget settings' light-density metric) and lreg
+     * (--light-region grown: the pool placed around the scene) */
+    char *bake_pt[] = {(char *)bake,  obj,          "--max-edge", "1",   "--rays",         "64",
+                       "--cube-size", "0",          "--orders",   "6",   "--encoding",     "cpca",
+                       "--cpca",      "3,alloc:60", "--shard",    "0/2", "--light-region", "grown",
+                       "-q",          "-o",         pt,           NULL};
     int ok = run(bake_a, err_path) == 0 && run(bake_b, err_path) == 0 &&
              run(bake_c, err_path) == 0 && run(bake_room, err_path) == 0 &&
              run(bake_var, err_path) == 0 && run(bake_cp, err_path) == 0 &&
@@ -289,13 +290,15 @@ int main(int argc, char **argv)
             vdsh_chunk_info chunks[32];
             uint32_t count = 0;
             vdsh_error err;
-            int part = 0, lpol = 0;
+            int part = 0, lpol = 0, lreg = 0;
             if (vdsh_scan_chunks(data, size, pt, chunks, 32, &count, &err) == VDSH_OK)
                 for (uint32_t i = 0; i < count; i++) {
                     part |= strcmp(chunks[i].id, "part") == 0;
                     lpol |= strcmp(chunks[i].id, "lpol") == 0;
+                    lreg |= strcmp(chunks[i].id, "lreg") == 0;
                 }
-            CHECK(part && lpol, "%s: no part chunk (%d) or no lpol chunk (%d)", pt, part, lpol);
+            CHECK(part && lpol && lreg, "%s: no part (%d), lpol (%d) or lreg chunk (%d)", pt, part,
+                  lpol, lreg);
         }
         /* The small files: every byte; the room: about 1,000 positions. */
         int large = size > 65536;

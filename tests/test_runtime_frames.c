@@ -270,8 +270,9 @@ static int check_empty(char **argv)
 
     /* The pixels whose primary ray meets nothing in the mesh, away from
      * its silhouette (every ray of the 3 x 3 block around misses). */
-    vdsh_view_mesh mesh = {f->positions, f->normals, f->indices, f->header.vertex_count,
-                           f->header.triangle_count};
+    vdsh_view_mesh mesh = {
+        f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
+        NULL};
     vdsh_view_tracer *tr = NULL;
     CHECK(vdsh_view_tracer_create(&mesh, &tr, &err) == VDSH_OK, "%s", err.msg);
     unsigned char *miss = calloc((size_t)w * (size_t)h, 1),
@@ -387,8 +388,9 @@ static void check_pool(const char *path, const vdsh_file *f, const vr_scene *pla
         CHECK(0, "%s", err.msg);
         return;
     }
-    vdsh_view_mesh m = {f->positions, f->normals, f->indices, f->header.vertex_count,
-                        f->header.triangle_count};
+    vdsh_view_mesh m = {
+        f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
+        NULL};
     vdsh_view_tracer *t = NULL;
     vdsh_error verr;
     CHECK(vdsh_view_tracer_create(&m, &t, &verr) == VDSH_OK, "%s", verr.msg);
@@ -435,8 +437,9 @@ static int check_lights(const char *path)
     CHECK(ok, "%s", err.msg);
     CHECK(vdsh_read(path, &f, &verr) == VDSH_OK, "%s", verr.msg);
     if (ok && f) {
-        vdsh_view_mesh m = {f->positions, f->normals, f->indices, f->header.vertex_count,
-                            f->header.triangle_count};
+        vdsh_view_mesh m = {
+            f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
+            NULL};
         CHECK(vdsh_view_compute(&m, &v, &verr) == VDSH_OK, "%s", verr.msg);
         vr_camera c;
         vr_scene_default_camera(s, &c);

@@ -55,7 +55,7 @@ typedef struct mesh {
 
 static vdsh_view_mesh view_mesh(const mesh *m)
 {
-    vdsh_view_mesh v = {&m->pos[0][0], &m->nrm[0][0], &m->idx[0][0], m->nv, m->nt};
+    vdsh_view_mesh v = {&m->pos[0][0], &m->nrm[0][0], &m->idx[0][0], m->nv, m->nt, NULL};
     return v;
 }
 
@@ -786,8 +786,9 @@ static int test_builtin_room(const char *path)
         fprintf(stderr, "%s\n", err.msg);
         return 1;
     }
-    vdsh_view_mesh m = {f->positions, f->normals, f->indices, f->header.vertex_count,
-                        f->header.triangle_count};
+    vdsh_view_mesh m = {
+        f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
+        NULL};
     vdsh_view v;
     CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
     CHECK(v.interior, "%s: not an interior (front share %g)", path, (double)v.front_share);

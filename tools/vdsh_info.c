@@ -361,6 +361,13 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
                a->rounds, a->max_rounds, vdsh_s(a->max_rounds), a->candidates,
                vdsh_s(a->candidates));
     }
+    if (f->has_light_box) {
+        const vdsh_light_box *b = &f->light_box;
+        printf("  lights       region %s: %g %g %g .. %g %g %g (vdsh-bake --light-region)\n",
+               b->rule == VDSH_LIGHT_REGION_GROWN ? "grown" : "box", (double)b->min[0],
+               (double)b->min[1], (double)b->min[2], (double)b->max[0], (double)b->max[1],
+               (double)b->max[2]);
+    }
     if (f->has_timings) {
         const vdsh_timings *t = &f->timings;
         printf("  timings      load %.3f s, refine %.3f s, build %.3f s, "
@@ -495,6 +502,16 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
         vt_json_f32(&j, ad, "min_edge", a->min_edge);
         for (size_t i = 0; i < sizeof count / sizeof count[0]; i++)
             vt_json_u64(&j, ad, count[i].key, count[i].v);
+    }
+    if (f->has_light_box) {
+        const vdsh_light_box *b = &f->light_box;
+        cJSON *lr = vt_json_object(&j, root, "light_region");
+        vt_json_string(&j, lr, "rule", b->rule == VDSH_LIGHT_REGION_GROWN ? "grown" : "box");
+        cJSON *mn = vt_json_array(&j, lr, "min"), *mx = vt_json_array(&j, lr, "max");
+        for (int a = 0; a < 3; a++) {
+            vt_json_f32(&j, mn, NULL, b->min[a]);
+            vt_json_f32(&j, mx, NULL, b->max[a]);
+        }
     }
     vt_record_timings(&j, root, f);
     return json_emit(&j, path);

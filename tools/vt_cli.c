@@ -511,6 +511,34 @@ int vt_opt_positive(const char *option, const char *arg, float *out)
     return 0;
 }
 
+int vt_opt_light_region(const char *option, const char *arg, int file_ok, int *rule, float box[6])
+{
+    const char *names = file_ok ? "auto, grown, file" : "auto, grown";
+    if (strcmp(arg, "auto") == 0 || strcmp(arg, "grown") == 0 ||
+        (file_ok && strcmp(arg, "file") == 0)) {
+        *rule = arg[0] == 'a' ? 0 : arg[0] == 'g' ? 1 : 3;
+        return 1;
+    }
+    float v[6];
+    if (vt_parse_floats(arg, v, 6, 6) != 6) {
+        vt_usage_error(cli_prog,
+                       "%s takes %s or a box XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (six numbers, scene "
+                       "units), not '%s'",
+                       option, names, arg);
+        return 0;
+    }
+    for (int a = 0; a < 3; a++)
+        if (!(v[a] < v[a + 3])) {
+            vt_usage_error(cli_prog,
+                           "%s '%s': the box's %c runs %g..%g: each min must be below its max",
+                           option, arg, "xyz"[a], (double)v[a], (double)v[a + 3]);
+            return 0;
+        }
+    memcpy(box, v, sizeof v);
+    *rule = 2;
+    return 1;
+}
+
 int vt_opt_nonnegative(const char *option, const char *arg, float *out)
 {
     float v;

@@ -205,6 +205,12 @@ int vt_opt_nonnegative(const char *option, const char *arg, float *out);
 int vt_opt_tolerance(const char *option, const char *noun, const char *arg, int zero_ok,
                      double *out);
 
+/* Where the lights go (vdsh-bake, vdsh-eval --light-region SPEC): `auto`
+ * (*rule 0), `grown` (1), XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (2: box[0..5],
+ * finite, each min below its max) or, when file_ok, `file` (3). Says what
+ * is wrong, naming the option. */
+int vt_opt_light_region(const char *option, const char *arg, int file_ok, int *rule, float box[6]);
+
 /* One of a list of names, each standing for a value; the list ends with
  * {NULL, 0}. Says "takes A, B or C". */
 typedef struct vt_choice {

@@ -1037,7 +1037,14 @@ static vb_result place_scene_lights(eval_run *e, vb_error *err)
     if (r != VB_OK)
         return r;
     float lo[3], hi[3];
-    o->light_region_grown = vb_scene_light_region(d->scene, lo, hi, NULL);
+    const int grown = vb_scene_light_region(d->scene, lo, hi, NULL);
+    /* a given region (the file's lreg, --light-region) is reported where
+     * the rule places in the region (not grown, around, shell: their own
+     * boxes) and is not "grown around a closed object" */
+    o->light_region_given = d->scene->region_given && d->light_rule < VB_LIGHTS_GROWN;
+    o->light_region_grown = grown && !d->scene->region_given;
+    memcpy(o->light_region_min, lo, sizeof lo);
+    memcpy(o->light_region_max, hi, sizeof hi);
     o->light_count = nl;
     for (uint32_t l = 0; l < nl; l++)
         vb_scene_to_local(d->scene, o->lights[l], e->lights_local[l]);
@@ -1310,6 +1317,12 @@ vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths, uin
     }
     vb_scene_desc sd = {.robust = !d.fast, .threads = d.threads};
     r = vb_scene_create(&occ, &sd, out, err);
+    if (r == VB_OK && f->has_light_box && /* where the bake's lights went (lreg) */
+        (r = vb_scene_set_light_region(*out, f->light_box.min, f->light_box.max,
+                                       "the file's light region (lreg)", err)) != VB_OK) {
+        vb_scene_destroy(*out);
+        *out = NULL;
+    }
 fail:
     vb_mesh_free(&occ);
     return r;

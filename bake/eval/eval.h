@@ -252,6 +252,9 @@ typedef struct vb_eval_result {
     uint32_t light_candidates;                   /* candidates tried to place them */
     int light_region_grown;                      /* 1: placed around a closed object, in the bounds
                                grown (vdsh_light.h: vb_scene_light_region) */
+    int light_region_given;                      /* 1: the region was given (the file's lreg, or
+                             * vdsh-eval --light-region): light_region_min..max */
+    float light_region_min[3], light_region_max[3]; /* the region placed in */
     vb_eval_truth truth[VB_EVAL_KINDS];
     uint64_t seed;       /* as used */
     uint32_t directions; /* per receiver, as used */
@@ -289,7 +292,9 @@ typedef struct vb_eval_scene_desc {
  * file (the error names the source, its number and both hashes) and the
  * totals against the file's occluder counts and bounds, then build the
  * scene. `desc` may be NULL (defaults). count must equal the file's
- * source_count. */
+ * source_count. A file with an `lreg` chunk (vdsh-bake --light-region)
+ * gives the scene its light region (vb_scene_set_light_region): lights
+ * placed on it go where the bake's went. */
 vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths, uint32_t count,
                                const vb_eval_scene_desc *desc, vb_scene **out, vb_error *err);
 

@@ -1878,6 +1878,7 @@ static void fill_output(bake_run *b, vb_bake_output *out)
         if (J->decision) {
             float lo[3], hi[3];
             o.light_region_grown = vb_scene_light_region(d->scene, lo, hi, &o.light_region_probes);
+            o.light_region_given = d->scene->region_given;
         }
     }
     o.window = d->window;

@@ -258,6 +258,7 @@ typedef struct vb_bake_output {
      * bounds) and the candidates its rule tested; the calibration's
      * held-out pairs that were shadowed (0: its offsets are kept >= 0). */
     int light_region_grown;
+    int light_region_given; /* the region given (vb_scene_set_light_region) */
     uint32_t light_region_probes;
     uint64_t calibration_shadowed;
     vdsh_window window;    /* applied */

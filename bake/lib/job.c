@@ -181,6 +181,15 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
     if (r != VB_OK)
         return r;
     j->timings.build = vb_now() - t;
+    if (d->light_region.rule) {
+        vdsh_light_box *box = &j->light_region;
+        *box = d->light_region;
+        if (box->rule == VDSH_LIGHT_REGION_GROWN)
+            vb_scene_grown_box(j->scene, box->min, box->max);
+        if ((r = vb_scene_set_light_region(j->scene, box->min, box->max, "--light-region", err)) !=
+            VB_OK)
+            return r;
+    }
     vb_bake_desc bd = d->bake;
     if (d->shard_count) {
         vb_shard_range(j->receivers.vertex_count, d->shard_index, d->shard_count, &bd.range_begin,
@@ -360,6 +369,10 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
                                      .start_receivers = j->adaptive.start_receivers,
                                      .rounds = j->adaptive.rounds,
                                      .candidates = j->adaptive.candidates};
+    }
+    if (d->light_region.rule) {
+        f.has_light_box = 1;
+        f.light_box = j->light_region;
     }
     h->load_flags = d->weld ? VDSH_LOAD_WELD : 0;
     h->cube_size = (uint32_t)vb_job_cube_size(d);

@@ -68,6 +68,13 @@ typedef struct vb_job_desc {
     int adaptive;               /* 1: adaptive receivers (adaptive.h) from there */
     vb_adaptive_desc adapt;
     int fast_traversal; /* 0: Embree's robust traversal (default) */
+    /* Where the lights go (vdsh-bake --light-region): rule 0, the scene's
+     * rule (vdsh_light_region; no `lreg` chunk); VDSH_LIGHT_REGION_GROWN,
+     * the bounds grown by VDSH_REGION_GROW of their diagonal (min, max
+     * unused); VDSH_LIGHT_REGION_BOX, min..max. Every placement of the
+     * bake uses it (vb_scene_set_light_region), and the file records it
+     * (`lreg`). */
+    vdsh_light_box light_region;
     /* The bake (receivers and scene are the job's). Its orders give the
      * streams, in increasing order. */
     vb_bake_desc bake;
@@ -118,7 +125,8 @@ typedef struct vb_job {
      * and the trace: in timings.total, not in the `time` chunk's parts
      * (vdsh-bake --report: seconds.pool). */
     double pool_seconds;
-    vb_adaptive_stats adaptive; /* with d->adaptive */
+    vb_adaptive_stats adaptive;  /* with d->adaptive */
+    vdsh_light_box light_region; /* the desc's, its box filled in (rule 0: none) */
     double t_start;
     /* The basis cubemaps' helper thread. */
     pthread_t basis_thread;

@@ -229,12 +229,58 @@ static int free_cb(const void *ctx, const float p[3])
 
 int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3], uint32_t *probes)
 {
+    if (s->region_given) {
+        memcpy(lo, s->region_min, sizeof s->region_min);
+        memcpy(hi, s->region_max, sizeof s->region_max);
+        if (probes)
+            *probes = 0;
+        return 1;
+    }
     return vdsh_light_region(s->bounds_min, s->bounds_max, free_cb, s, lo, hi, probes);
 }
 
-/* Where the candidates went, for the messages. */
-static const char *region_name(int grown)
+void vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3])
 {
+    const double g = (double)VDSH_REGION_GROW * (double)s->diagonal;
+    for (int a = 0; a < 3; a++) {
+        lo[a] = (float)((double)s->bounds_min[a] - g);
+        hi[a] = (float)((double)s->bounds_max[a] + g);
+    }
+}
+
+vb_result vb_scene_set_light_region(vb_scene *s, const float lo[3], const float hi[3],
+                                    const char *what, vb_error *err)
+{
+    for (int a = 0; a < 3; a++)
+        if (!isfinite(lo[a]) || !isfinite(hi[a]) || !(lo[a] < hi[a]))
+            return vb_fail(err, VB_ERR_ARGUMENT,
+                           "%s: the box's %c is %g..%g: it must be finite, min below max", what,
+                           "xyz"[a], (double)lo[a], (double)hi[a]);
+    uint32_t k = 0;
+    for (; k < VDSH_REGION_PROBES; k++) {
+        float p[3];
+        vdsh_light_candidate(lo, hi, VDSH_REGION_SEED, k, p);
+        if (vb_scene_free_space(s, p))
+            break;
+    }
+    if (k == VDSH_REGION_PROBES)
+        return vb_fail(err, VB_ERR_INVALID,
+                       "%s: no free space for lights in %g %g %g .. %g %g %g: none of %u points "
+                       "tested there is outside the solids and %g or more from a surface",
+                       what, (double)lo[0], (double)lo[1], (double)lo[2], (double)hi[0],
+                       (double)hi[1], (double)hi[2], VDSH_REGION_PROBES,
+                       (double)vdsh_free_clearance(s->diagonal));
+    memcpy(s->region_min, lo, sizeof s->region_min);
+    memcpy(s->region_max, hi, sizeof s->region_max);
+    s->region_given = 1;
+    return VB_OK;
+}
+
+/* Where the candidates went, for the messages. */
+static const char *region_name(const vb_scene *s, int grown)
+{
+    if (s->region_given)
+        return "the light region given (--light-region)";
     return grown ? "the scene's bounds grown by up to a quarter of their diagonal (too little "
                    "free space inside them)"
                  : "the scene's bounds";
@@ -257,9 +303,11 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
         return vb_scene_place_lights(s, seed, count, out, tried, err);
     float lo[3], hi[3];
     int grown = vb_scene_light_region(s, lo, hi, NULL);
-    if (rule == VB_LIGHTS_GROWN || rule == VB_LIGHTS_AROUND || rule == VB_LIGHTS_SHELL) {
-        const double g =
-            (rule == VB_LIGHTS_AROUND ? 1.0 : (double)VDSH_REGION_GROW) * (double)s->diagonal;
+    if (rule == VB_LIGHTS_GROWN || rule == VB_LIGHTS_SHELL) {
+        vb_scene_grown_box(s, lo, hi);
+        grown = 1;
+    } else if (rule == VB_LIGHTS_AROUND) {
+        const double g = (double)s->diagonal;
         for (int a = 0; a < 3; a++) {
             lo[a] = (float)((double)s->bounds_min[a] - g);
             hi[a] = (float)((double)s->bounds_max[a] + g);
@@ -299,7 +347,7 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
                        "candidate%s in %s",
                        count, vdsh_s(count), vb_light_rule_name(rule), n, k, vdsh_s(k),
                        rule >= VB_LIGHTS_GROWN ? "the bounds grown for the rule"
-                                               : region_name(grown));
+                                               : region_name(s, grown));
     return VB_OK;
 }
 
@@ -323,7 +371,7 @@ static vb_result place_uniform(const vb_scene *s, uint64_t seed, uint32_t count,
         return vb_fail(err, VB_ERR_INVALID,
                        "no free space for lights: %u of %u candidate%s in %s "
                        "%s inside solids or nearer than %g to a surface",
-                       k - n, k, vdsh_s(k), region_name(grown), k - n == 1 ? "was" : "were",
+                       k - n, k, vdsh_s(k), region_name(s, grown), k - n == 1 ? "was" : "were",
                        (double)vdsh_free_clearance(s->diagonal));
     return VB_OK;
 }

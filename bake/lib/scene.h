@@ -50,6 +50,10 @@ typedef struct vb_scene {
      * scene: the free-space test measures its probes' hits on them itself. */
     const float *local_vertices;
     const unsigned *local_indices;
+    /* A light region given by the user (vb_scene_set_light_region):
+     * region_given 1, the box region_min..region_max; 0: the rule's. */
+    int region_given;
+    float region_min[3], region_max[3];
     char embree_error[256]; /* last Embree error reported on this device */
 } vb_scene;
 
@@ -113,10 +117,28 @@ vb_result vb_scene_place_pool(const vb_scene *s, uint64_t seed, uint32_t count, 
 
 /* The region lights are placed in (vdsh_light_region): the bounds, or,
  * when they hold too little free space (a closed object), the bounds grown
- * by up to a quarter of their diagonal, the less free space the more.
- * Returns 1 when grown. *probes (may be
- * NULL): the candidates the rule tested. */
+ * by up to a quarter of their diagonal, the less free space the more; or
+ * the region given (vb_scene_set_light_region). Returns 1 when grown or
+ * given (placements then try vdsh_light_tries(count, 1) candidates).
+ * *probes (may be NULL): the candidates the rule tested (0 when given). */
 int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3], uint32_t *probes);
+
+/* Where the user says the lights go (vdsh-bake --light-region, or a file's
+ * `lreg` chunk): every placement on s (the decision fit's pool and its
+ * near lights, the calibration's, the cpca metric's, vdsh-eval's uniform
+ * and near rules, vdsh-frames' lights and eyes) uses the box lo..hi
+ * instead of the rule's region, still in free space. The box must be
+ * finite with lo < hi on every axis (VB_ERR_ARGUMENT), and hold free
+ * space: one of its first VDSH_REGION_PROBES candidates (seed
+ * VDSH_REGION_SEED) at least (VB_ERR_INVALID). `what` names the box in
+ * messages ("--light-region"). */
+vb_result vb_scene_set_light_region(vb_scene *s, const float lo[3], const float hi[3],
+                                    const char *what, vb_error *err);
+
+/* The bounds of s grown on every side by VDSH_REGION_GROW of its
+ * diagonal (in double, rounded once): the `grown` light rule's box, and
+ * vdsh-bake --light-region grown's. */
+void vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3]);
 
 /* Other ways to place lights, for reports that a figure does not hang on
  * one light distribution (issue 25): all in free space, from the same

@@ -57,6 +57,8 @@ typedef struct options {
     uint32_t decision_lights;    /* --decision-lights; 0: the default */
     int decision_near;           /* --decision-near as vb_bake_desc's; 0: the default */
     int decision_shell;          /* --decision-shell; 0: none */
+    int light_region;            /* --light-region: 0 auto, 1 grown, 2 the box */
+    float light_box[6];          /* --light-region's box: min x,y,z, max x,y,z */
     float false_rate;            /* --false-rate; 0: the default */
     vb_decision_params decision; /* --decision-params */
     int have_decision;
@@ -278,6 +280,15 @@ static void usage(FILE *f)
             "                          grown by a quarter diagonal: vdsh-eval's\n"
             "                          --light-rule shell); the calibration's stay in the\n"
             "                          light region (0: none, the default; objects only)\n"
+            "      --light-region SPEC where your lights go: every light the bake places\n"
+            "                          (the decision fit's training and calibration\n"
+            "                          lights, the cpca metric's pool) goes there, in\n"
+            "                          free space, and readers (vdsh-view, vdsh-eval,\n"
+            "                          vdsh-frames) put their lights there too: auto (the\n"
+            "                          scene's rule, default), grown (the bounds grown by a\n"
+            "                          quarter of their diagonal on every side: lights\n"
+            "                          around and above an object) or a box\n"
+            "                          XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX in scene units\n"
             "      --decision-params TAU,LIT,RIDGE,RIDGE0,STEPS\n"
             "                          decision: the loss's temperature (ln units), the\n"
             "                          weight of lit pairs, the ridge per (l(l+1))^2 and\n"
@@ -544,7 +555,10 @@ static int write_report(const char *path, const options *o, const vb_job_desc *j
         vt_json_u64(&j, dec, "lit_training_pairs", b->lit_training);
         vt_json_u64(&j, dec, "lit_training_false", b->lit_training_false);
         if (b->decision_lights) {
-            vt_json_string(&j, dec, "light_region", b->light_region_grown ? "grown" : "bounds");
+            vt_json_string(&j, dec, "light_region",
+                           b->light_region_given   ? "given"
+                           : b->light_region_grown ? "grown"
+                                                   : "bounds");
             vt_json_u64(&j, dec, "light_region_probes", b->light_region_probes);
         }
         if (b->calibration_receivers)
@@ -772,6 +786,7 @@ enum {
     O_DEC_LIGHTS,
     O_DEC_NEAR,
     O_DEC_SHELL,
+    O_LIGHT_REGION,
     O_FALSE_RATE,
     O_OFFSET_CAP,
     O_DEC_PARAMS,
@@ -867,6 +882,9 @@ static int read_value(int c, const char *arg, options *o)
         break;
     case O_DEC_SHELL:
         ok = vt_opt_int("--decision-shell", "", arg, 0, (int)VB_DECISION_POOL, &o->decision_shell);
+        break;
+    case O_LIGHT_REGION:
+        ok = vt_opt_light_region("--light-region", arg, 0, &o->light_region, o->light_box);
         break;
     case O_ENCODING:
         ok = vt_opt_choice("--encoding", arg, encodings(), &v);
@@ -1115,6 +1133,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"decision-lights", required_argument, 0, O_DEC_LIGHTS},
         {"decision-near", required_argument, 0, O_DEC_NEAR},
         {"decision-shell", required_argument, 0, O_DEC_SHELL},
+        {"light-region", required_argument, 0, O_LIGHT_REGION},
         {"false-rate", required_argument, 0, O_FALSE_RATE},
         {"offset-cap", required_argument, 0, O_OFFSET_CAP},
         {"decision-params", required_argument, 0, O_DEC_PARAMS},
@@ -1243,58 +1262,62 @@ static vb_job_desc job_desc(const options *o, FILE *log, progress *pr, float *of
         order_mask |= 1u << o->orders[s];
     for (int k = 0; k <= VDSH_MAX_ORDER; k++)
         offsets[k] = o->log_offset;
-    return (vb_job_desc){.paths = o->meshes,
-                         .path_count = (uint32_t)o->mesh_count,
-                         .output = o->trace_only ? NULL : o->output,
-                         .cubemap_dir = o->cubemap_dir,
-                         .weld = o->weld,
-                         .max_edge = o->max_edge,
-                         .fast_traversal = !o->robust,
-                         .adaptive = o->adaptive,
-                         .receivers_path = o->receivers,
-                         .adapt = {.tolerance = o->adaptive_tol,
-                                   .min_edge = o->min_edge,
-                                   .max_receivers = o->max_receivers,
-                                   .max_rounds = o->max_rounds ? o->max_rounds : VB_ADAPTIVE_ROUNDS,
-                                   .on_round = log ? on_round : NULL,
-                                   .user = log},
-                         .bake = {.rays = o->rays,
-                                  .adaptive_rays = o->adaptive_rays,
-                                  .ray_tolerance = o->ray_tolerance,
-                                  .seed = o->seed,
-                                  .max_distance = o->max_distance,
-                                  .method = o->method,
-                                  .quantity = o->quantity,
-                                  .lambda = o->lambda,
-                                  .log_floor = o->log_floor,
-                                  .log_offsets = o->have_log_offset ? offsets : NULL,
-                                  .decision = o->have_decision ? &o->decision : NULL,
-                                  .decision_lights = o->decision_lights,
-                                  .decision_near = o->decision_near,
-                                  .decision_shell = o->decision_shell,
-                                  .false_rate = o->false_rate,
-                                  .offset_cap = o->offset_cap,
-                                  .offset_cap_tol = o->offset_cap_tol,
-                                  .offset_cap_keep = o->offset_cap_keep,
-                                  .offset_cap_min = o->offset_cap_min,
-                                  .window = o->window,
-                                  .order_mask = order_mask,
-                                  .threads = o->threads,
-                                  .order_tolerance = o->order_tolerance,
-                                  .variable_cap = o->max_order,
-                                  .keep_normals = o->keep_normals,
-                                  .trace_only = o->trace_only,
-                                  .progress = on_progress,
-                                  .progress_user = pr},
-                         .encoding_given = 1,
-                         .encoding = o->encoding,
-                         .cpca = o->cpca,
-                         .cube_size = o->cube_size > 0 ? o->cube_size : -1,
-                         .record_timings = o->record_timings,
-                         .shard_index = o->shard_index,
-                         .shard_count = o->shard_count,
-                         .on_mesh = log ? on_mesh : NULL,
-                         .user = log};
+    return (vb_job_desc){
+        .paths = o->meshes,
+        .path_count = (uint32_t)o->mesh_count,
+        .output = o->trace_only ? NULL : o->output,
+        .cubemap_dir = o->cubemap_dir,
+        .weld = o->weld,
+        .max_edge = o->max_edge,
+        .fast_traversal = !o->robust,
+        .light_region = {.rule = (uint32_t)o->light_region,
+                         .min = {o->light_box[0], o->light_box[1], o->light_box[2]},
+                         .max = {o->light_box[3], o->light_box[4], o->light_box[5]}},
+        .adaptive = o->adaptive,
+        .receivers_path = o->receivers,
+        .adapt = {.tolerance = o->adaptive_tol,
+                  .min_edge = o->min_edge,
+                  .max_receivers = o->max_receivers,
+                  .max_rounds = o->max_rounds ? o->max_rounds : VB_ADAPTIVE_ROUNDS,
+                  .on_round = log ? on_round : NULL,
+                  .user = log},
+        .bake = {.rays = o->rays,
+                 .adaptive_rays = o->adaptive_rays,
+                 .ray_tolerance = o->ray_tolerance,
+                 .seed = o->seed,
+                 .max_distance = o->max_distance,
+                 .method = o->method,
+                 .quantity = o->quantity,
+                 .lambda = o->lambda,
+                 .log_floor = o->log_floor,
+                 .log_offsets = o->have_log_offset ? offsets : NULL,
+                 .decision = o->have_decision ? &o->decision : NULL,
+                 .decision_lights = o->decision_lights,
+                 .decision_near = o->decision_near,
+                 .decision_shell = o->decision_shell,
+                 .false_rate = o->false_rate,
+                 .offset_cap = o->offset_cap,
+                 .offset_cap_tol = o->offset_cap_tol,
+                 .offset_cap_keep = o->offset_cap_keep,
+                 .offset_cap_min = o->offset_cap_min,
+                 .window = o->window,
+                 .order_mask = order_mask,
+                 .threads = o->threads,
+                 .order_tolerance = o->order_tolerance,
+                 .variable_cap = o->max_order,
+                 .keep_normals = o->keep_normals,
+                 .trace_only = o->trace_only,
+                 .progress = on_progress,
+                 .progress_user = pr},
+        .encoding_given = 1,
+        .encoding = o->encoding,
+        .cpca = o->cpca,
+        .cube_size = o->cube_size > 0 ? o->cube_size : -1,
+        .record_timings = o->record_timings,
+        .shard_index = o->shard_index,
+        .shard_count = o->shard_count,
+        .on_mesh = log ? on_mesh : NULL,
+        .user = log};
 }
 
 /* What the receivers are, and a warning when they are far apart against
@@ -1436,6 +1459,27 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
                 "origin%s not probed\n",
                 bo->origins.skipped_zero_area, vdsh_s(bo->origins.skipped_zero_area),
                 vdsh_s(bo->origins.skipped_zero_area));
+    if (job->light_region.rule) { /* --light-region: where, and whether in reach */
+        const vdsh_light_box *b = &job->light_region;
+        const float *lo = job->scene->bounds_min, *hi = job->scene->bounds_max;
+        double far = 0.0; /* the farthest light from the farthest occluder corner */
+        for (int a = 0; a < 3; a++) {
+            const double d = fmax(fabs((double)b->max[a] - lo[a]), fabs((double)hi[a] - b->min[a]));
+            far += d * d;
+        }
+        far = sqrt(far);
+        fprintf(log, "vdsh-bake: lights in %s %g %g %g .. %g %g %g\n",
+                b->rule == VDSH_LIGHT_REGION_GROWN ? "the bounds grown:" : "the box",
+                (double)b->min[0], (double)b->min[1], (double)b->min[2], (double)b->max[0],
+                (double)b->max[1], (double)b->max[2]);
+        if (far > 1.5 * (double)bo->max_distance)
+            fprintf(log,
+                    "vdsh-bake: warning: lights in this region may stand up to %g from a "
+                    "receiver, beyond 1.5 x the max distance %g, where every stream reads "
+                    "shadow: give --max-distance %g or more (docs/DESIGN.md, \"Lights beyond "
+                    "the clamp\")\n",
+                    far, (double)bo->max_distance, far / 1.5);
+    }
     if (bo->method == VDSH_METHOD_DECISION) {
         if (!bo->decision_lights)
             fprintf(log, "vdsh-bake: warning: no free space for lights in this scene: every "

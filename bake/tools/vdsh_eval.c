@@ -96,6 +96,11 @@ static void usage(FILE *f)
             "                          the bounds: where a viewer puts lights around an\n"
             "                          object) or shell (grown by a quarter diagonal,\n"
             "                          outside the bounds: vdsh-bake's --decision-shell)\n"
+            "      --light-region SPEC the light region of uniform, ceiling, near and path:\n"
+            "                          file (default: the bake's --light-region, recorded\n"
+            "                          in the file, else auto), auto (the scene's rule),\n"
+            "                          grown (the bounds grown by a quarter diagonal) or\n"
+            "                          a box XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX\n"
             "      --orders LIST       only these orders, e.g. 3,5 (default: every stream)\n"
             "      --offsets LIST      the trade between recall and false shadows as a\n"
             "                          curve: each stream is also scored with each\n"
@@ -481,7 +486,12 @@ static int write_json(const char *out, const context *c, char *msg, size_t cap)
     vt_json_u64(&j, ev, "scene_lights", r->light_count);
     vt_json_string(&j, ev, "scene_light_rule", vb_light_rule_name((vb_light_rule)c->d->light_rule));
     vt_json_u64(&j, ev, "scene_light_candidates", r->light_candidates);
-    if (r->light_region_grown) /* only then: earlier JSONs stay as they were */
+    if (r->light_region_given) { /* the file's lreg, or --light-region */
+        vt_json_string(&j, ev, "scene_light_region", "given");
+        cJSON *box = vt_json_array(&j, ev, "scene_light_region_box");
+        for (int a = 0; a < 6; a++)
+            vt_json_f32(&j, box, NULL, a < 3 ? r->light_region_min[a] : r->light_region_max[a - 3]);
+    } else if (r->light_region_grown) /* only then: earlier JSONs stay as they were */
         vt_json_string(&j, ev, "scene_light_region", "grown");
     cJSON *lp = vt_json_array(&j, ev, "scene_light_positions");
     for (uint32_t l = 0; l < r->light_count; l++)
@@ -628,7 +638,14 @@ static void print_table(FILE *o, const context *c)
             "false = P(s_hat < .5 | d_T >= d_L), recall = P(s_hat < .5 | s_ideal < .5)\n\n",
             r->light_count, rule ? "by the light rule '" : "uniformly",
             rule ? vb_light_rule_name(rule) : "", rule ? "'" : "");
-    if (r->light_region_grown)
+    if (r->light_region_given)
+        fprintf(o,
+                "  (the light region given: %g %g %g .. %g %g %g, the file's (vdsh-bake "
+                "--light-region) or\n  vdsh-eval --light-region's)\n\n",
+                (double)r->light_region_min[0], (double)r->light_region_min[1],
+                (double)r->light_region_min[2], (double)r->light_region_max[0],
+                (double)r->light_region_max[1], (double)r->light_region_max[2]);
+    else if (r->light_region_grown)
         fprintf(o,
                 "  (the scene's bounds hold too little free space, a closed object: the "
                 "lights are placed\n  around it, in the bounds grown by up to a quarter of their "
@@ -782,6 +799,8 @@ typedef struct options {
     float offsets[VDSH_MAX_STREAMS];          /* --offsets */
     int noffsets;
     int quiet, fast_truth, allow_mismatch;
+    int light_region;   /* --light-region: 0 auto, 1 grown, 2 the box, 3 the file's (default) */
+    float light_box[6]; /* its box: min x,y,z, max x,y,z */
 } options;
 
 /* --interp: runtime, or a path of vdsh_shadow.h (1 + its number). */
@@ -839,7 +858,8 @@ static int parse_args(int argc, char **argv, options *o)
         O_THREADS,
         O_LIGHTS,
         O_OFFSETS,
-        O_LIGHT_RULE
+        O_LIGHT_RULE,
+        O_LIGHT_REGION
     };
     static const struct option longopts[] = {{"points", required_argument, 0, O_POINTS},
                                              {"interior", required_argument, 0, O_INTERIOR},
@@ -857,11 +877,13 @@ static int parse_args(int argc, char **argv, options *o)
                                              {"threads", required_argument, 0, O_THREADS},
                                              {"lights", required_argument, 0, O_LIGHTS},
                                              {"light-rule", required_argument, 0, O_LIGHT_RULE},
+                                             {"light-region", required_argument, 0, O_LIGHT_REGION},
                                              {"offsets", required_argument, 0, O_OFFSETS},
                                              {"quiet", no_argument, 0, 'q'},
                                              VT_CLI_LONGOPTS_END};
     memset(o, 0, sizeof *o);
     o->d.interior = 65536;
+    o->light_region = 3;
     vb_eval_desc *d = &o->d;
     int c, ok = 1, interp_given = 0;
     while (ok && (c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
@@ -901,6 +923,9 @@ static int parse_args(int argc, char **argv, options *o)
                 return bad_usage(
                     "--light-rule takes uniform, ceiling, near, path, grown, around or shell, not '%s'",
                     optarg);
+            break;
+        case O_LIGHT_REGION:
+            ok = vt_opt_light_region("--light-region", optarg, 1, &o->light_region, o->light_box);
             break;
         case O_OFFSETS:
             o->noffsets = parse_offsets(optarg, o->offsets);
@@ -1178,6 +1203,19 @@ static int evaluate(const options *o, const vdsh_file *f, const scored *sc)
         VB_OK) {
         fprintf(stderr, "vdsh-eval: %s: %s\n", o->path, err.msg);
         goto out;
+    }
+    if (o->light_region == 0) { /* auto: the scene's rule, whatever the file says */
+        scene->region_given = 0;
+    } else if (o->light_region == 1 || o->light_region == 2) {
+        float lo[3], hi[3];
+        if (o->light_region == 1)
+            vb_scene_grown_box(scene, lo, hi);
+        for (int a = 0; a < 3 && o->light_region == 2; a++)
+            lo[a] = o->light_box[a], hi[a] = o->light_box[a + 3];
+        if (vb_scene_set_light_region(scene, lo, hi, "--light-region", &err) != VB_OK) {
+            fprintf(stderr, "vdsh-eval: %s: %s\n", o->path, err.msg);
+            goto out;
+        }
     }
 
     /* 4. Evaluate. */

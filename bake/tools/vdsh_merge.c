@@ -209,6 +209,10 @@ static const char *mismatch(vdsh_file *a, const char *a_path, const vdsh_file *b
         return why;
     if (!same_header(&a->header, &b->header))
         return "other options or receivers (HEAD differs)";
+    /* before the streams: another region calibrates other log offsets */
+    if (a->has_light_box != b->has_light_box ||
+        (a->has_light_box && memcmp(&a->light_box, &b->light_box, sizeof a->light_box) != 0))
+        return "another --light-region (lreg chunk differs)";
     if (a->stream_count != b->stream_count)
         return "other orders (stream count differs)";
     for (uint32_t s = 0; s < a->stream_count; s++)

@@ -22,6 +22,9 @@
                                        # max_rounds, start_receivers, rounds, candidates
     f.light_pool                       # None, or a cpca part's light pool (`lpol`): dict
                                        # mix (the light mix, 0 < mix <= 1), lights (L x 3)
+    f.light_region                     # None, or where the bake's lights went (`lreg`,
+                                       # vdsh-bake --light-region): dict rule ("grown" or
+                                       # "box"), min, max (3 floats each, scene units)
 
 Evaluation, vectorised over vertices and lights (vdsh.evaluate; float32,
 the C library's numbers to the bit):
@@ -61,7 +64,7 @@ QUANTITIES = ["distance", "distance2", "log-distance"]
 MAX_ORDER = 16
 WINDOWS = ["none", "hann", "lanczos"]
 KNOWN = {b"HEAD", b"SRCS", b"POSN", b"NORM", b"TRIS", b"COEF", b"stat", b"time", b"part", b"adpt",
-         b"lpol"}
+         b"lpol", b"lreg"}
 MAX_POOL_LIGHTS = 65536
 LOG_SUM_MAX = 80.0
 
@@ -88,6 +91,7 @@ class VdshFile:
     part: Optional[Dict[str, Any]]
     adaptive: Optional[Dict[str, Any]]
     light_pool: Optional[Dict[str, Any]]
+    light_region: Optional[Dict[str, Any]]
     positions: np.ndarray
     normals: np.ndarray
     triangles: np.ndarray
@@ -95,6 +99,7 @@ class VdshFile:
     def __init__(self) -> None:
         self.header, self.sources, self.streams = {}, [], []
         self.stats = self.timings = self.part = self.adaptive = self.light_pool = None
+        self.light_region = None
         self._coef = []  # COEF payloads, read once every chunk is (a part's size them)
         self.positions = self.normals = self.triangles = None
 
@@ -304,6 +309,19 @@ def _chunk(f, cid, b, path):
         if not np.isfinite(lights).all():
             _fail(path, "lpol: a light is not finite")
         f.light_pool = dict(mix=mix, lights=lights)
+    elif cid == b"lreg":  # where the bake's lights went (VDSH.md `lreg`)
+        if len(b) != 32:
+            _fail(path, "lreg is %d byte%s, must be 32" % (len(b), _s(len(b))))
+        rule = struct.unpack_from("<I", b, 0)[0]
+        lo = struct.unpack_from("<3f", b, 4)
+        hi = struct.unpack_from("<3f", b, 16)
+        if any(b[28:32]):
+            _fail(path, "lreg: reserved bytes 28..31 not zero")
+        if rule not in (1, 2):
+            _fail(path, "lreg: rule %d out of range (1 grown, 2 box)" % rule)
+        if not all(np.isfinite(a) and np.isfinite(c) and a < c for a, c in zip(lo, hi)):
+            _fail(path, "lreg: the box is not finite with min < max")
+        f.light_region = dict(rule="grown" if rule == 1 else "box", min=list(lo), max=list(hi))
     elif cid == b"adpt":
         if len(b) != 32:
             _fail(path, "adpt is %d byte%s, must be 32" % (len(b), _s(len(b))))

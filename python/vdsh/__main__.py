@@ -85,7 +85,8 @@ def summary(f: VdshFile, path: str) -> Dict[str, Any]:
                   occluder_bounds=dict(min=[float(x) for x in h["bounds_min"]],
                                        max=[float(x) for x in h["bounds_max"]])),
         sources=f.sources, streams=streams, stats=f.stats, timings=f.timings,
-        **{k: v for k, v in (("part", _part(f)), ("adaptive", f.adaptive)) if v is not None})
+        **{k: v for k, v in (("part", _part(f)), ("adaptive", f.adaptive),
+                             ("light_region", f.light_region)) if v is not None})
 
 
 def _part(f: Any) -> Any:
@@ -141,6 +142,11 @@ def _text(d: Dict[str, Any]) -> str:
         pt = d["part"]
         lines.append("  part         %d of %d, receivers %d..%d" % (
             pt["index"], pt["count"], pt["range_begin"], pt["range_end"]))
+    if d.get("light_region"):
+        lr = d["light_region"]
+        lines.append("  lights       region %s: %s .. %s (vdsh-bake --light-region)" % (
+            lr["rule"], " ".join("%g" % x for x in lr["min"]),
+            " ".join("%g" % x for x in lr["max"])))
     lines.append("  size         %d bytes, %.2f bytes per vertex" % (d["file_size"],
                                                                     d["bytes_per_vertex"]))
     return "\n".join(lines) + "\n"
