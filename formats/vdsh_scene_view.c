@@ -26,6 +26,19 @@ void vdsh_view_bounds(const float *positions, uint32_t vertex_count, float lo[3]
         }
 }
 
+/* The bounds' diagonal in float (1 when it is 0): the view's scale for
+ * its ray offsets, open rays and free-space clearance. Not
+ * vdsh_free_diagonal, the bake's, summed in double: the two can differ
+ * in the last bit, and the default view has been computed with this one;
+ * only the light region (vdsh_view_compute) uses the bake's. */
+static float diagonal_of(const float lo[3], const float hi[3])
+{
+    float diag2 = 0.0f;
+    for (int k = 0; k < 3; k++)
+        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    return sqrtf(diag2) > 0.0f ? sqrtf(diag2) : 1.0f;
+}
+
 /* The longest horizontal axis (x or z) and the other one. */
 static void axes(const float lo[3], const float hi[3], int *ax, int *other)
 {
@@ -401,14 +414,10 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
                           "arithmetic takes: scale the scene up",
                           (double)longest, (double)VDSH_VIEW_MIN_EXTENT);
     }
-    float ext[3], diag = 0.0f;
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < 3; k++)
         if (!(g->lo[k] <= g->hi[k]))
             g->lo[k] = g->hi[k] = 0.0f;
-        ext[k] = g->hi[k] - g->lo[k];
-        diag += ext[k] * ext[k];
-    }
-    diag = sqrtf(diag) > 0.0f ? sqrtf(diag) : 1.0f;
+    float ext[3], diag = diagonal_of(g->lo, g->hi);
     for (int k = 0; k < 3; k++) {
         float pad = 1e-4f * diag;
         g->lo[k] -= pad;
@@ -512,14 +521,6 @@ int vdsh_view_trace(const vdsh_view_tracer *g, const float org[3], const float d
 
 /* ---- the interior test and free space -------------------------------- */
 
-static float diagonal_of(const float lo[3], const float hi[3])
-{
-    float diag2 = 0.0f;
-    for (int k = 0; k < 3; k++)
-        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    return sqrtf(diag2) > 0.0f ? sqrtf(diag2) : 1.0f;
-}
-
 /* Of a 9 x 7 grid of the camera's rays, how many travel farther than a
  * tenth of the diagonal before they meet a surface (or meet none). */
 static int open_rays(const vdsh_view_tracer *t, const vdsh_camera *c, float diag)
@@ -566,12 +567,9 @@ float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m, 
 {
     vdsh_camera room;
     vdsh_view_room_camera_free(t, lo, hi, &room);
-    float diag2 = 0.0f;
-    for (int k = 0; k < 3; k++)
-        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
     /* Hits up to this close are the surface the eye stands on (a flat
      * scene) or rounding; they do not count. */
-    float tmin = nextafterf(1e-5f * sqrtf(diag2), INFINITY);
+    float tmin = nextafterf(1e-5f * diagonal_of(lo, hi), INFINITY);
     int front = 0;
     for (int i = 0; i < VDSH_VIEW_RAYS; i++) {
         /* A Fibonacci sphere: nearly uniform directions, the same every
@@ -1069,10 +1067,7 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
     const float *lo = v.bounds_min, *hi = v.bounds_max;
     v.front_share = vdsh_view_front_share(t, m, lo, hi);
     v.interior = v.front_share >= VDSH_VIEW_INTERIOR_SHARE;
-    float diag = 0.0f;
-    for (int k = 0; k < 3; k++)
-        diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    diag = sqrtf(diag) > 0.0f ? sqrtf(diag) : 1.0f;
+    const float diag = diagonal_of(lo, hi);
     /* A flat object's fit camera on its back side (a triangle facing away
      * from the fixed direction): the view mirrored through the plane, eye
      * and lights alike, so that it sees the front lit as the fit view
