@@ -521,6 +521,38 @@ int vdsh_view_trace(const vdsh_view_tracer *g, const float org[3], const float d
 
 /* ---- the interior test and free space -------------------------------- */
 
+/* The free-space probes from p (vdsh_light.h): each one's first hit and
+ * side, for vdsh_free_space at one clearance or several. */
+typedef struct probes {
+    float dist[VDSH_FREE_PROBES];
+    int back[VDSH_FREE_PROBES];
+} probes;
+
+static void probe(const vdsh_view_tracer *t, const float p[3], probes *out)
+{
+    float dirs[VDSH_FREE_PROBES][3];
+    vdsh_free_probe_dirs(dirs);
+    for (int i = 0; i < VDSH_FREE_PROBES; i++) {
+        vdsh_view_hit h;
+        int hit = vdsh_view_trace(t, p, dirs[i], 0.0f, &h);
+        out->dist[i] = hit ? h.t : INFINITY;
+        out->back[i] = hit && h.back;
+    }
+}
+
+/* vdsh_light.h's rule at this clearance. */
+static int free_at(const vdsh_view_tracer *t, const float p[3], float clearance)
+{
+    probes pr;
+    probe(t, p, &pr);
+    return vdsh_free_space(pr.dist, pr.back, clearance);
+}
+
+int vdsh_view_free_space(const vdsh_view_tracer *t, const float p[3], float diagonal)
+{
+    return free_at(t, p, vdsh_free_clearance(diagonal));
+}
+
 /* Of a 9 x 7 grid of the camera's rays, how many travel farther than a
  * tenth of the diagonal before they meet a surface (or meet none). */
 static int open_rays(const vdsh_view_tracer *t, const vdsh_camera *c, float diag)
@@ -543,22 +575,28 @@ int vdsh_view_room_camera_free(const vdsh_view_tracer *t, const float lo[3], con
     float diag = diagonal_of(lo, hi);
     /* The standard eye, then higher (over a block on the floor, the
      * Cornell box's), then across the room at the same heights; the
-     * target stays. */
+     * target stays. A moved eye first VDSH_VIEW_EYE_MARGIN clearances from
+     * every surface (the first free one stood 0.25 units from a sphere of
+     * the Cornell box, a third of the frame), then, where none is, one
+     * clearance, as the standard eye. */
     static const float up[5] = {0.28f, 0.4f, 0.55f, 0.7f, 0.85f};
     static const float across[3] = {0.0f, -0.3f, 0.3f};
     int ax = hi[0] - lo[0] >= hi[2] - lo[2] ? 0 : 2, other = 2 - ax;
     float e1 = hi[1] - lo[1], eo = hi[other] - lo[other], co = 0.5f * (lo[other] + hi[other]);
-    for (int j = 0; j < 3; j++)
-        for (int i = 0; i < 5; i++) {
-            vdsh_camera c = *out;
-            c.eye[1] = lo[1] + up[i] * e1;
-            c.eye[other] = co + (0.05f + across[j]) * eo;
-            if (vdsh_view_free_space(t, c.eye, diag) && open_rays(t, &c, diag) >= 48) {
+    const float clearance = vdsh_free_clearance(diag);
+    for (int pass = 0; pass < 2; pass++)
+        for (int j = 0; j < 3; j++)
+            for (int i = pass && !j; i < 5; i++) {
                 int moved = i || j;
-                *out = c;
-                return moved;
+                vdsh_camera c = *out;
+                c.eye[1] = lo[1] + up[i] * e1;
+                c.eye[other] = co + (0.05f + across[j]) * eo;
+                float need = moved && !pass ? VDSH_VIEW_EYE_MARGIN * clearance : clearance;
+                if (free_at(t, c.eye, need) && open_rays(t, &c, diag) >= 48) {
+                    *out = c;
+                    return moved;
+                }
             }
-        }
     return 0;
 }
 
@@ -590,38 +628,6 @@ float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m, 
         front += n[0] * d[0] + n[1] * d[1] + n[2] * d[2] < 0.0f;
     }
     return (float)front / (float)VDSH_VIEW_RAYS;
-}
-
-/* vdsh_light.h's rule at this clearance. */
-/* The free-space probes from p (vdsh_light.h): each one's first hit and
- * side, for vdsh_free_space at one clearance or several. */
-typedef struct probes {
-    float dist[VDSH_FREE_PROBES];
-    int back[VDSH_FREE_PROBES];
-} probes;
-
-static void probe(const vdsh_view_tracer *t, const float p[3], probes *out)
-{
-    float dirs[VDSH_FREE_PROBES][3];
-    vdsh_free_probe_dirs(dirs);
-    for (int i = 0; i < VDSH_FREE_PROBES; i++) {
-        vdsh_view_hit h;
-        int hit = vdsh_view_trace(t, p, dirs[i], 0.0f, &h);
-        out->dist[i] = hit ? h.t : INFINITY;
-        out->back[i] = hit && h.back;
-    }
-}
-
-static int free_at(const vdsh_view_tracer *t, const float p[3], float clearance)
-{
-    probes pr;
-    probe(t, p, &pr);
-    return vdsh_free_space(pr.dist, pr.back, clearance);
-}
-
-int vdsh_view_free_space(const vdsh_view_tracer *t, const float p[3], float diagonal)
-{
-    return free_at(t, p, vdsh_free_clearance(diagonal));
 }
 
 /* ---- what a light lights in the default frame ------------------------- */
