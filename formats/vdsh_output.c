@@ -129,36 +129,46 @@ static int through_proc_fd(const char *path)
     return 0;
 }
 
-/* An existing character device or FIFO, or a path through /proc/<pid>/fd:
- * opened in place (a stream; appended to, the latter). 1 when it is one
- * and opened, 0 when the target is a regular file or absent (the
- * temporary-file path follows), -1 on an error (already reported). */
+/* What vdsh_output_open makes of a target (stat into *st): TARGET_FILE, a
+ * regular file or none (the temporary-file path); TARGET_PROC_FD, a path
+ * through /proc/<pid>/fd, whatever it leads to (written in place,
+ * appended to); TARGET_DEVICE, a character device or FIFO (written in
+ * place); TARGET_REFUSED, a directory, block device or socket. */
+enum { TARGET_REFUSED = -1, TARGET_FILE, TARGET_PROC_FD, TARGET_DEVICE };
+
+static int target_kind(const char *path, struct stat *st)
+{
+    if (stat(path, st) != 0)
+        return TARGET_FILE;
+    if (!S_ISDIR(st->st_mode) && through_proc_fd(path))
+        return TARGET_PROC_FD;
+    if (S_ISREG(st->st_mode))
+        return TARGET_FILE;
+    return S_ISCHR(st->st_mode) || S_ISFIFO(st->st_mode) ? TARGET_DEVICE : TARGET_REFUSED;
+}
+
+/* A stream target (target_kind) opened in place: 1 when it is one and
+ * opened, 0 when the temporary-file path follows, -1 on an error (already
+ * reported). */
 static int open_stream(const char *path, vdsh_output *o, vdsh_error *err, vdsh_result *res)
 {
     struct stat st;
-    if (stat(path, &st) == 0 && !S_ISDIR(st.st_mode) && through_proc_fd(path)) {
-        int fd = open(path, O_WRONLY | O_APPEND | O_NOCTTY | O_CLOEXEC);
-        if (fd < 0) {
-            *res = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-            return -1;
-        }
-        o->fd = fd;
-        return 1;
-    }
-    if (stat(path, &st) != 0 || S_ISREG(st.st_mode))
+    const int kind = target_kind(path, &st);
+    if (kind == TARGET_FILE)
         return 0;
-    if (!S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode)) {
+    if (kind == TARGET_REFUSED) {
         *res = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot write: %s", path,
                           S_ISDIR(st.st_mode) ? "is a directory" : "not a regular file");
         return -1;
     }
-    int fd = open(path, O_WRONLY | O_NOCTTY | O_CLOEXEC);
+    int fd = open(path, O_WRONLY | O_NOCTTY | O_CLOEXEC | (kind == TARGET_PROC_FD ? O_APPEND : 0));
     if (fd < 0) {
         *res = vdsh_failf(err, VDSH_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
         return -1;
     }
     /* What was opened, not what stat saw a moment ago, decides. */
-    if (fstat(fd, &st) != 0 || (!S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode))) {
+    if (kind == TARGET_DEVICE &&
+        (fstat(fd, &st) != 0 || (!S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode)))) {
         close(fd);
         *res = vdsh_failf(err, VDSH_ERR_IO,
                           "%s: cannot write: not a regular file "
@@ -173,9 +183,7 @@ static int open_stream(const char *path, vdsh_output *o, vdsh_error *err, vdsh_r
 int vdsh_output_is_stream(const char *path)
 {
     struct stat st;
-    if (!path || !*path || stat(path, &st) != 0 || S_ISDIR(st.st_mode))
-        return 0;
-    return S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode) || through_proc_fd(path);
+    return path && *path && target_kind(path, &st) > TARGET_FILE;
 }
 
 vdsh_result vdsh_output_open(const char *path, vdsh_output *out, vdsh_error *err)

@@ -26,6 +26,19 @@ void vdsh_view_bounds(const float *positions, uint32_t vertex_count, float lo[3]
         }
 }
 
+/* The bounds' diagonal in float (1 when it is 0): the view's scale for
+ * its ray offsets, open rays and free-space clearance. Not
+ * vdsh_free_diagonal, the bake's, summed in double: the two can differ
+ * in the last bit, and the default view has been computed with this one;
+ * only the light region (vdsh_view_compute) uses the bake's. */
+static float diagonal_of(const float lo[3], const float hi[3])
+{
+    float diag2 = 0.0f;
+    for (int k = 0; k < 3; k++)
+        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    return sqrtf(diag2) > 0.0f ? sqrtf(diag2) : 1.0f;
+}
+
 /* The longest horizontal axis (x or z) and the other one. */
 static void axes(const float lo[3], const float hi[3], int *ax, int *other)
 {
@@ -401,14 +414,10 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
                           "arithmetic takes: scale the scene up",
                           (double)longest, (double)VDSH_VIEW_MIN_EXTENT);
     }
-    float ext[3], diag = 0.0f;
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < 3; k++)
         if (!(g->lo[k] <= g->hi[k]))
             g->lo[k] = g->hi[k] = 0.0f;
-        ext[k] = g->hi[k] - g->lo[k];
-        diag += ext[k] * ext[k];
-    }
-    diag = sqrtf(diag) > 0.0f ? sqrtf(diag) : 1.0f;
+    float ext[3], diag = diagonal_of(g->lo, g->hi);
     for (int k = 0; k < 3; k++) {
         float pad = 1e-4f * diag;
         g->lo[k] -= pad;
@@ -512,12 +521,36 @@ int vdsh_view_trace(const vdsh_view_tracer *g, const float org[3], const float d
 
 /* ---- the interior test and free space -------------------------------- */
 
-static float diagonal_of(const float lo[3], const float hi[3])
+/* The free-space probes from p (vdsh_light.h): each one's first hit and
+ * side, for vdsh_free_space at one clearance or several. */
+typedef struct probes {
+    float dist[VDSH_FREE_PROBES];
+    int back[VDSH_FREE_PROBES];
+} probes;
+
+static void probe(const vdsh_view_tracer *t, const float p[3], probes *out)
 {
-    float diag2 = 0.0f;
-    for (int k = 0; k < 3; k++)
-        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    return sqrtf(diag2) > 0.0f ? sqrtf(diag2) : 1.0f;
+    float dirs[VDSH_FREE_PROBES][3];
+    vdsh_free_probe_dirs(dirs);
+    for (int i = 0; i < VDSH_FREE_PROBES; i++) {
+        vdsh_view_hit h;
+        int hit = vdsh_view_trace(t, p, dirs[i], 0.0f, &h);
+        out->dist[i] = hit ? h.t : INFINITY;
+        out->back[i] = hit && h.back;
+    }
+}
+
+/* vdsh_light.h's rule at this clearance. */
+static int free_at(const vdsh_view_tracer *t, const float p[3], float clearance)
+{
+    probes pr;
+    probe(t, p, &pr);
+    return vdsh_free_space(pr.dist, pr.back, clearance);
+}
+
+int vdsh_view_free_space(const vdsh_view_tracer *t, const float p[3], float diagonal)
+{
+    return free_at(t, p, vdsh_free_clearance(diagonal));
 }
 
 /* Of a 9 x 7 grid of the camera's rays, how many travel farther than a
@@ -542,22 +575,28 @@ int vdsh_view_room_camera_free(const vdsh_view_tracer *t, const float lo[3], con
     float diag = diagonal_of(lo, hi);
     /* The standard eye, then higher (over a block on the floor, the
      * Cornell box's), then across the room at the same heights; the
-     * target stays. */
+     * target stays. A moved eye first VDSH_VIEW_EYE_MARGIN clearances from
+     * every surface (the first free one stood 0.25 units from a sphere of
+     * the Cornell box, a third of the frame), then, where none is, one
+     * clearance, as the standard eye. */
     static const float up[5] = {0.28f, 0.4f, 0.55f, 0.7f, 0.85f};
     static const float across[3] = {0.0f, -0.3f, 0.3f};
     int ax = hi[0] - lo[0] >= hi[2] - lo[2] ? 0 : 2, other = 2 - ax;
     float e1 = hi[1] - lo[1], eo = hi[other] - lo[other], co = 0.5f * (lo[other] + hi[other]);
-    for (int j = 0; j < 3; j++)
-        for (int i = 0; i < 5; i++) {
-            vdsh_camera c = *out;
-            c.eye[1] = lo[1] + up[i] * e1;
-            c.eye[other] = co + (0.05f + across[j]) * eo;
-            if (vdsh_view_free_space(t, c.eye, diag) && open_rays(t, &c, diag) >= 48) {
+    const float clearance = vdsh_free_clearance(diag);
+    for (int pass = 0; pass < 2; pass++)
+        for (int j = 0; j < 3; j++)
+            for (int i = pass && !j; i < 5; i++) {
                 int moved = i || j;
-                *out = c;
-                return moved;
+                vdsh_camera c = *out;
+                c.eye[1] = lo[1] + up[i] * e1;
+                c.eye[other] = co + (0.05f + across[j]) * eo;
+                float need = moved && !pass ? VDSH_VIEW_EYE_MARGIN * clearance : clearance;
+                if (free_at(t, c.eye, need) && open_rays(t, &c, diag) >= 48) {
+                    *out = c;
+                    return moved;
+                }
             }
-        }
     return 0;
 }
 
@@ -566,12 +605,9 @@ float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m, 
 {
     vdsh_camera room;
     vdsh_view_room_camera_free(t, lo, hi, &room);
-    float diag2 = 0.0f;
-    for (int k = 0; k < 3; k++)
-        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
     /* Hits up to this close are the surface the eye stands on (a flat
      * scene) or rounding; they do not count. */
-    float tmin = nextafterf(1e-5f * sqrtf(diag2), INFINITY);
+    float tmin = nextafterf(1e-5f * diagonal_of(lo, hi), INFINITY);
     int front = 0;
     for (int i = 0; i < VDSH_VIEW_RAYS; i++) {
         /* A Fibonacci sphere: nearly uniform directions, the same every
@@ -592,38 +628,6 @@ float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m, 
         front += n[0] * d[0] + n[1] * d[1] + n[2] * d[2] < 0.0f;
     }
     return (float)front / (float)VDSH_VIEW_RAYS;
-}
-
-/* vdsh_light.h's rule at this clearance. */
-/* The free-space probes from p (vdsh_light.h): each one's first hit and
- * side, for vdsh_free_space at one clearance or several. */
-typedef struct probes {
-    float dist[VDSH_FREE_PROBES];
-    int back[VDSH_FREE_PROBES];
-} probes;
-
-static void probe(const vdsh_view_tracer *t, const float p[3], probes *out)
-{
-    float dirs[VDSH_FREE_PROBES][3];
-    vdsh_free_probe_dirs(dirs);
-    for (int i = 0; i < VDSH_FREE_PROBES; i++) {
-        vdsh_view_hit h;
-        int hit = vdsh_view_trace(t, p, dirs[i], 0.0f, &h);
-        out->dist[i] = hit ? h.t : INFINITY;
-        out->back[i] = hit && h.back;
-    }
-}
-
-static int free_at(const vdsh_view_tracer *t, const float p[3], float clearance)
-{
-    probes pr;
-    probe(t, p, &pr);
-    return vdsh_free_space(pr.dist, pr.back, clearance);
-}
-
-int vdsh_view_free_space(const vdsh_view_tracer *t, const float p[3], float diagonal)
-{
-    return free_at(t, p, vdsh_free_clearance(diagonal));
 }
 
 /* ---- what a light lights in the default frame ------------------------- */
@@ -1069,10 +1073,7 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
     const float *lo = v.bounds_min, *hi = v.bounds_max;
     v.front_share = vdsh_view_front_share(t, m, lo, hi);
     v.interior = v.front_share >= VDSH_VIEW_INTERIOR_SHARE;
-    float diag = 0.0f;
-    for (int k = 0; k < 3; k++)
-        diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    diag = sqrtf(diag) > 0.0f ? sqrtf(diag) : 1.0f;
+    const float diag = diagonal_of(lo, hi);
     /* A flat object's fit camera on its back side (a triangle facing away
      * from the fixed direction): the view mirrored through the plane, eye
      * and lights alike, so that it sees the front lit as the fit view

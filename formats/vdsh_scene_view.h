@@ -246,10 +246,14 @@ int vdsh_view_trace_all(const vdsh_view_mesh *m, const float org[3], const float
 /* The room camera, its eye moved when it is not in free space or stands
  * against a surface (fewer than 48 of a 9 x 7 grid of its rays travel a
  * tenth of the diagonal: in front of the Cornell box's short block) to the
- * first position of a fixed list that is free and open: higher (0.4,
- * 0.55, 0.7, 0.85 of the height), then across the room (0.3 of its width
- * to either side); the target stays. Returns 1 when the eye moved (0: the
- * eye of vdsh_view_room_camera, also when no position of the list is). */
+ * first position of a fixed list that is open and VDSH_VIEW_EYE_MARGIN
+ * clearances (a tenth of the diagonal) from every surface by the
+ * free-space probes (vdsh_light.h), else the first that is open and free:
+ * higher (0.4, 0.55, 0.7, 0.85 of the height), then across the room (0.3
+ * of its width to either side); the target stays. Returns 1 when the eye
+ * moved (0: the eye of vdsh_view_room_camera, also when no position of the
+ * list is). */
+#define VDSH_VIEW_EYE_MARGIN 10.0f
 int vdsh_view_room_camera_free(const vdsh_view_tracer *t, const float lo[3], const float hi[3],
                                vdsh_camera *out);
 

@@ -244,12 +244,12 @@ typedef struct vr_scene_info {
     int has_cubemaps;                         /* basis cubemaps made */
     int cube_size;                            /* their face size, or 0 */
     vdsh_quantity quantity;                   /* the quantity drawn */
-    float max_distance;                       /* the file's: no reconstructed distance
-                                     exceeds it (vdsh_shadow.h) */
-    size_t gpu_bytes;                         /* buffers and textures uploaded */
-    int interior;                             /* 1: a room, seen from inside by default;
-                                     0: an object, framed from outside (see
-                                     vr_scene_default_camera) */
+    /* the file's: no reconstructed distance exceeds it (vdsh_shadow.h) */
+    float max_distance;
+    size_t gpu_bytes; /* buffers and textures uploaded */
+    /* 1: a room, seen from inside by default; 0: an object, framed from
+     * outside (see vr_scene_default_camera) */
+    int interior;
     /* VR_MODE_VDSH_BUFFER's streams: has_buffer[n], a fixed stream of
      * order n; variable_order, the cap of the stream with an order per
      * vertex (0: none), variable_mean_order its vertices' mean order and
@@ -290,9 +290,9 @@ typedef enum vr_color_format {
 typedef struct vr_renderer_desc {
     int width, height;            /* 0: VR_DEFAULT_WIDTH x _HEIGHT, 1024 x 768 */
     vr_color_format color_format; /* 0: RGBA8 */
-    int shadow_map_size;          /* cube shadow map face size; 0:
-                                   VR_DEFAULT_SHADOW_MAP_SIZE, 512 */
-    int max_lights_per_pass;      /* 1..VR_MAX_LIGHTS_PER_PASS; 0: 8 */
+    /* cube shadow map face size; 0: VR_DEFAULT_SHADOW_MAP_SIZE, 512 */
+    int shadow_map_size;
+    int max_lights_per_pass; /* 1..VR_MAX_LIGHTS_PER_PASS; 0: 8 */
 } vr_renderer_desc;
 
 /* Create the offscreen framebuffer (colour texture + 32-bit float depth)
@@ -376,8 +376,9 @@ typedef struct vr_light {
 
 typedef struct vr_camera {
     float eye[3];
-    float target[3];    /* eye == target (e.g. both zero): the scene's
-                                default view (vr_scene_default_camera) */
+    /* eye == target (e.g. both zero): the scene's default view
+     * (vr_scene_default_camera) */
+    float target[3];
     float up[3];        /* zero: (0, 1, 0) */
     float fov_y;        /* degrees; 0: 60 */
     float znear, zfar;  /* 0: from the scene bounds */
@@ -385,20 +386,16 @@ typedef struct vr_camera {
 } vr_camera;
 
 typedef enum vr_output {
-    VR_OUTPUT_COLOR = 0,   /* albedo * (ambient + sum lambert * shadow) */
-    VR_OUTPUT_SHADOW = 1,  /* light 0: (s, d_V, d_L, 1): s the shadow
-                                factor alone (0 shadowed .. 1 lit; no
-                                Lambert term, no attenuation, also where
-                                the surface faces away from the light:
-                                whatever the mode's test gives there, the
-                                cube map's depth test or the SH distance
-                                below the horizon), and the distances
-                                compared (on the visibility path, the
-                                vertices' values interpolated, as
-                                vdsh_shadow_interior's d_vis); d_V is -1
-                                in modes none and cube. Alpha 1 where a
-                                surface was drawn: the clear colour's
-                                alpha elsewhere */
+    VR_OUTPUT_COLOR = 0, /* albedo * (ambient + sum lambert * shadow) */
+    /* light 0: (s, d_V, d_L, 1): s the shadow factor alone (0 shadowed .. 1
+     * lit; no Lambert term, no attenuation, also where the surface faces
+     * away from the light: whatever the mode's test gives there, the cube
+     * map's depth test or the SH distance below the horizon), and the
+     * distances compared (on the visibility path, the vertices' values
+     * interpolated, as vdsh_shadow_interior's d_vis); d_V is -1 in modes
+     * none and cube. Alpha 1 where a surface was drawn: the clear colour's
+     * alpha elsewhere */
+    VR_OUTPUT_SHADOW = 1,
     VR_OUTPUT_POSITION = 2 /* (world x, y, z, 1) */
 } vr_output;
 
@@ -413,14 +410,14 @@ typedef struct vr_draw_desc {
     float albedo[3];      /* all zero: 0.8 grey */
     float clear_color[4]; /* zero: black, alpha 0 */
     vr_output output;     /* 0: colour */
-    int points;           /* 1: draw the vertices as 1-pixel points, not
-                                triangles (a test aid: each pixel then holds
-                                one vertex's unclipped, uninterpolated value) */
-    int stream;           /* VR_MODE_VDSH_BUFFER: the stream drawn,
-                                vr_scene_buffer_stream's argument (0: the
-                                scene's default); ignored by other modes */
-    float sdf_k;          /* VR_MODE_SDF: the softness k of
-                                vdsh_sdf_shadow; 0: VDSH_SDF_DEFAULT_K */
+    /* 1: draw the vertices as 1-pixel points, not triangles (a test aid:
+     * each pixel then holds one vertex's unclipped, uninterpolated value) */
+    int points;
+    /* VR_MODE_VDSH_BUFFER: the stream drawn, vr_scene_buffer_stream's
+     * argument (0: the scene's default); ignored by other modes */
+    int stream;
+    /* VR_MODE_SDF: the softness k of vdsh_sdf_shadow; 0: VDSH_SDF_DEFAULT_K */
+    float sdf_k;
 } vr_draw_desc;
 
 /* Draw one frame into the renderer's framebuffer: for each group of up to

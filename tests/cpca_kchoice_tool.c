@@ -13,6 +13,7 @@
  * pairs, disagree, missed, squared, seconds (the fit's, then the score's).
  * Exit 1 for a bad file or fit, 2 for bad usage.
  */
+#include "cpca_tool.h"
 #include "vdsh.h"
 #include "vdsh_cpca_study.h"
 
@@ -41,18 +42,14 @@ int main(int argc, char **argv)
         fprintf(stderr, "cpca_kchoice_tool: %s\n", err.msg);
         return 1;
     }
-    const vdsh_stream *s = NULL;
-    for (uint32_t i = 0; i < f->stream_count; i++)
-        if (f->streams[i].order == order && !(f->streams[i].flags & VDSH_STREAM_VARIABLE) &&
-            f->streams[i].encoding == VDSH_ENCODING_F32 && f->streams[i].scale == 1.0f)
-            s = &f->streams[i];
+    const vdsh_stream *s = cpca_tool_stream(f, order);
     const uint32_t rows = vdsh_file_stream_vertices(f);
     FILE *pf = fopen(argv[2], "rb");
     float *pool = malloc(sizeof(float) * 3 * 65536);
     size_t nl = pf && pool ? fread(pool, sizeof(float) * 3, 65536, pf) : 0;
     if (pf)
         fclose(pf);
-    if (!s || f->has_part || !nl) {
+    if (!s || !nl) {
         fprintf(stderr, "cpca_kchoice_tool: %s: no f32 stream of order 12, or no pool in %s\n",
                 argv[1], argv[2]);
         vdsh_free(f);

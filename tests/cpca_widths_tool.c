@@ -15,6 +15,7 @@
  * bytes_per_vertex, rms_error, widths. Exit 1 for a bad file or fit, 2
  * for bad usage.
  */
+#include "cpca_tool.h"
 #include "vdsh.h"
 #include "vdsh_cpca_study.h"
 
@@ -41,13 +42,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "cpca_widths_tool: %s\n", err.msg);
         return 1;
     }
-    const vdsh_stream *s = NULL;
-    for (uint32_t i = 0; i < f->stream_count; i++)
-        if (f->streams[i].order == order && !(f->streams[i].flags & VDSH_STREAM_VARIABLE) &&
-            f->streams[i].encoding == VDSH_ENCODING_F32 && f->streams[i].scale == 1.0f)
-            s = &f->streams[i];
+    const vdsh_stream *s = cpca_tool_stream(f, order);
     uint32_t rows = vdsh_file_stream_vertices(f), n = order * order;
-    if (!s || f->has_part) {
+    if (!s) {
         fprintf(stderr, "cpca_widths_tool: %s: no f32 stream of order %u (or a part)\n", argv[1],
                 order);
         vdsh_free(f);

@@ -728,6 +728,39 @@ static void test_blocked_eye(void)
            open_std, open_new);
 }
 
+/* A room twice as long as test_blocked_eye's (its end wall beyond the
+ * margin) and a post the standard eye stands in, its top 0.15 below the
+ * first higher eye (0.4 of the height): that eye is free (one clearance)
+ * and open, but within VDSH_VIEW_EYE_MARGIN clearances of the post (as the
+ * Cornell box's stood 0.25 units from a sphere). The eye moves on to a
+ * place the margin from every surface. */
+static void test_eye_margin(void)
+{
+    memset(&M, 0, sizeof M);
+    const float lo[3] = {-2, 0, -1}, hi[3] = {2, 2, 1};
+    box(&M, lo, hi, 1);
+    vdsh_camera room;
+    vdsh_view_room_camera(lo, hi, &room);
+    const float *e = room.eye, up = lo[1] + 0.4f * (hi[1] - lo[1]);
+    box(&M, (float[3]){e[0] - 0.1f, 0.0f, e[2] - 0.1f},
+        (float[3]){e[0] + 0.1f, up - 0.15f, e[2] + 0.1f}, 0);
+    vdsh_view_mesh m = view_mesh(&M);
+    vdsh_view v;
+    vdsh_error err;
+    CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
+    CHECK(v.interior, "the room is not an interior (front share %g)", (double)v.front_share);
+    const float clear = vdsh_free_clearance(vdsh_free_diagonal(v.bounds_min, v.bounds_max));
+    const float first[3] = {e[0], up, e[2]};
+    CHECK(free_all_at(&m, first, clear) && !free_all_at(&m, first, VDSH_VIEW_EYE_MARGIN * clear),
+          "the test is wrong: the first higher eye is not free within the margin");
+    CHECK(v.camera.eye[1] > up, "the eye at height %g, not above %g", (double)v.camera.eye[1],
+          (double)up);
+    CHECK(free_all_at(&m, v.camera.eye, VDSH_VIEW_EYE_MARGIN * clear),
+          "the moved eye (%g %g %g) is within %g clearances of a surface", (double)v.camera.eye[0],
+          (double)v.camera.eye[1], (double)v.camera.eye[2], (double)VDSH_VIEW_EYE_MARGIN);
+    printf("eye margin: moved to height %.2f\n", (double)v.camera.eye[1]);
+}
+
 static void test_errors(void)
 {
     memset(&M, 0, sizeof M);
@@ -902,6 +935,7 @@ int main(int argc, char **argv)
     test_two_rooms();
     test_seeded_margin();
     test_blocked_eye();
+    test_eye_margin();
     test_errors();
     return test_report("scene_view");
 }

@@ -847,15 +847,11 @@ typedef struct eval_run {
     vb_eval_result o;
 } eval_run;
 
-/* The diagonal of the file's bounds; the scene's when they are empty. */
+/* The diagonal of the file's bounds (the bake's, vdsh_light.h); the
+ * scene's when they are empty. */
 static float file_diagonal(const vdsh_file *f, const vb_scene *scene)
 {
-    double d2 = 0.0;
-    for (int i = 0; i < 3; i++) {
-        double e = (double)f->header.bounds_max[i] - f->header.bounds_min[i];
-        d2 += e * e;
-    }
-    float diag = (float)sqrt(d2);
+    float diag = vdsh_free_diagonal(f->header.bounds_min, f->header.bounds_max);
     return diag > 0.0f ? diag : scene->diagonal;
 }
 

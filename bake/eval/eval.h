@@ -106,24 +106,27 @@ enum { VB_EVAL_INTERP_RUNTIME = 0 };
 typedef struct vb_eval_desc {
     const vdsh_file *file; /* receivers and streams (borrowed) */
     const vb_scene *scene; /* occluders as the bake traced them (borrowed) */
-    uint64_t seed;         /* 0: VB_EVAL_DEFAULT_SEED. Mixed with a
-                                  per-purpose constant, so even the bake's
-                                  seed gives other directions */
-    uint32_t points;       /* vertices evaluated: a deterministic sample
-                                  of this many; 0 or >= vertex_count: all */
-    uint32_t interior;     /* random interior points; 0: none */
-    uint32_t directions;   /* held-out directions per receiver, each with
-                                  one light; 0: 64 (an 8 x 8 grid). Like the
-                                  bake's --rays, rounded down to a grid */
-    uint32_t lights;       /* scene lights (VB_EVAL_SCENE_LIGHTS): how many
-                                  are placed in free space; 0: 32 */
-    int light_rule;        /* where (vb_light_rule, scene.h); 0: uniform */
-    uint32_t worst;        /* worst receivers kept per (kind, stream);
-                                  0: 10; at most VB_EVAL_MAX_WORST */
-    int oracle;            /* 1: score the truth itself (D := d_T) instead
-                                  of the streams: every error must be exactly
-                                  0 (tests the scoring and the sampling) */
-    int per_vertex;        /* 1: fill result.per_vertex */
+    /* 0: VB_EVAL_DEFAULT_SEED. Mixed with a per-purpose constant, so even
+     * the bake's seed gives other directions */
+    uint64_t seed;
+    /* vertices evaluated: a deterministic sample of this many; 0 or >=
+     * vertex_count: all */
+    uint32_t points;
+    uint32_t interior; /* random interior points; 0: none */
+    /* held-out directions per receiver, each with one light; 0: 64 (an 8 x 8
+     * grid). Like the bake's --rays, rounded down to a grid */
+    uint32_t directions;
+    /* scene lights (VB_EVAL_SCENE_LIGHTS): how many are placed in free
+     * space; 0: 32 */
+    uint32_t lights;
+    int light_rule; /* where (vb_light_rule, scene.h); 0: uniform */
+    /* worst receivers kept per (kind, stream); 0: 10; at most
+     * VB_EVAL_MAX_WORST */
+    uint32_t worst;
+    /* 1: score the truth itself (D := d_T) instead of the streams: every
+     * error must be exactly 0 (tests the scoring and the sampling) */
+    int oracle;
+    int per_vertex; /* 1: fill result.per_vertex */
     /* How interior points get a stream's value from their triangle's
      * vertices (vdsh_shadow.h): VB_EVAL_INTERP_RUNTIME (0, the default) is
      * the path runtime/ draws that stream with (vdsh_runtime_interp), what a
@@ -138,10 +141,11 @@ typedef struct vb_eval_desc {
 
 /* A receiver worth a look: where it is and how bad. */
 typedef struct vb_eval_receiver {
-    uint32_t index;               /* vertex index, or interior point number */
-    uint32_t triangle;            /* interior: its triangle; vertex: UINT32_MAX */
-    float bary[3];                /* interior: barycentrics of the triangle's
-                                  vertices a, b, c; vertex: 1, 0, 0 */
+    uint32_t index;    /* vertex index, or interior point number */
+    uint32_t triangle; /* interior: its triangle; vertex: UINT32_MAX */
+    /* interior: barycentrics of the triangle's vertices a, b, c; vertex: 1,
+     * 0, 0 */
+    float bary[3];
     float position[3], normal[3]; /* scene units; interpolated normal */
     double shadow_mae;            /* smooth, over its directions */
     double distance_rms;
@@ -163,11 +167,12 @@ typedef struct vb_eval_metrics {
     double binary_mae, binary_mae_se;
     double binary_false_shadow, binary_false_shadow_se;
     double binary_light_leak, binary_light_leak_se; /* given d_T < d_L */
-    double ringing;                                 /* fraction of samples whose SH sum was <= 0
-                                  (negative ringing, read as distance 0) */
-    uint64_t visible;                               /* samples with d_T >= d_L */
-    uint64_t occluded;                              /* samples with s_ideal < 0.5 */
-    uint64_t occluded_binary;                       /* samples with d_T < d_L */
+    /* fraction of samples whose SH sum was <= 0 (negative ringing, read as
+     * distance 0) */
+    double ringing;
+    uint64_t visible;         /* samples with d_T >= d_L */
+    uint64_t occluded;        /* samples with s_ideal < 0.5 */
+    uint64_t occluded_binary; /* samples with d_T < d_L */
     /* Per-receiver smooth shadow MAE: percentiles over receivers. */
     double receiver_mae_p50, receiver_mae_p90, receiver_mae_p99;
     uint32_t worst_count;
@@ -193,9 +198,9 @@ typedef struct vb_eval_scene_metrics {
     uint64_t pairs;                       /* (receiver, light) pairs scored */
     double shadow_mae, shadow_mae_se;     /* |s_hat - s_ideal|, smooth */
     double false_shadow, false_shadow_se; /* P(s_hat < .5 | d_T >= d_L) */
-    double recall, recall_se;             /* P(s_hat < .5 | s_ideal < .5):
-                                               the shadows drawn */
-    double light_leak, light_leak_se;     /* P(s_hat > .5 | s_ideal < .5) */
+    /* P(s_hat < .5 | s_ideal < .5): the shadows drawn */
+    double recall, recall_se;
+    double light_leak, light_leak_se; /* P(s_hat > .5 | s_ideal < .5) */
     double binary_mae;
     double binary_false_shadow; /* P(D < d_L | d_T >= d_L) */
     double binary_recall;       /* P(D < d_L | d_T < d_L) */
@@ -241,19 +246,21 @@ enum {
 };
 
 typedef struct vb_eval_result {
-    uint32_t stream_count;                       /* = the file's; metrics[k][i] is stream i */
-    vb_eval_metrics *metrics[VB_EVAL_KINDS];     /* stream_count each: lights
-                                  relative to each direction's truth
-                                  (d_L = 2u d_T), the secondary metric */
-    vb_eval_scene_metrics *scene[VB_EVAL_KINDS]; /* stream_count each: scene
-                                  lights, the primary metric */
-    uint32_t light_count;                        /* scene lights placed */
-    float (*lights)[3];                          /* their positions, scene units */
-    uint32_t light_candidates;                   /* candidates tried to place them */
-    int light_region_grown;                      /* 1: placed around a closed object, in the bounds
-                               grown (vdsh_light.h: vb_scene_light_region) */
-    int light_region_given;                      /* 1: the region was given (the file's lreg, or
-                             * vdsh-eval --light-region): light_region_min..max */
+    uint32_t stream_count; /* = the file's; metrics[k][i] is stream i */
+    /* stream_count each: lights relative to each direction's truth (d_L = 2u
+     * d_T), the secondary metric */
+    vb_eval_metrics *metrics[VB_EVAL_KINDS];
+    /* stream_count each: scene lights, the primary metric */
+    vb_eval_scene_metrics *scene[VB_EVAL_KINDS];
+    uint32_t light_count;      /* scene lights placed */
+    float (*lights)[3];        /* their positions, scene units */
+    uint32_t light_candidates; /* candidates tried to place them */
+    /* 1: placed around a closed object, in the bounds grown (vdsh_light.h:
+     * vb_scene_light_region) */
+    int light_region_grown;
+    /* 1: the region was given (the file's lreg, or vdsh-eval
+     * --light-region): light_region_min..max */
+    int light_region_given;
     float light_region_min[3], light_region_max[3]; /* the region placed in */
     vb_eval_truth truth[VB_EVAL_KINDS];
     uint64_t seed;       /* as used */
@@ -275,12 +282,13 @@ void vb_eval_result_free(vb_eval_result *r);
 /* ---- scene reconstruction --------------------------------------------- */
 
 typedef struct vb_eval_scene_desc {
-    int fast;           /* 1: Embree's default traversal; 0 (default):
-                                  RTC_SCENE_FLAG_ROBUST, so the truth does not
-                                  leak through shared edges */
-    int allow_mismatch; /* 1: a source whose SHA-256 or size differs
-                                  from the file's is used anyway */
-    unsigned threads;   /* Embree build threads; 0 = all cores */
+    /* 1: Embree's default traversal; 0 (default): RTC_SCENE_FLAG_ROBUST, so
+     * the truth does not leak through shared edges */
+    int fast;
+    /* 1: a source whose SHA-256 or size differs from the file's is used
+     * anyway */
+    int allow_mismatch;
+    unsigned threads; /* Embree build threads; 0 = all cores */
     /* With allow_mismatch, called once per mismatching source. May be NULL. */
     void (*warn)(void *user, const char *message);
     void *warn_user;

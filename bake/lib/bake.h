@@ -121,8 +121,8 @@ int vb_order_candidate(int k, int cap);
 typedef struct vb_bake_desc {
     const vb_mesh *receivers; /* positions and normals (borrowed) */
     const vb_scene *scene;    /* the occluders (borrowed) */
-    uint32_t rays;            /* directions per receiver; 0: 2500. With
-                                * adaptive_rays: the cap */
+    /* directions per receiver; 0: 2500. With adaptive_rays: the cap */
+    uint32_t rays;
     /* Adaptive rays (--rays auto): 1 traces nested stratified rounds
      * (vb_dirgrid_create_nested: 1/16, 1/8, ... of the cap's power-of-two
      * grid) and stops a receiver once a round changed its fit of the
@@ -131,8 +131,9 @@ typedef struct vb_bake_desc {
      * the new fit's distance over the last one's: the quantity choice's
      * score below). The decision reads the receiver's own rays only. */
     int adaptive_rays;
-    float ray_tolerance;  /* 0: VB_DEFAULT_RAY_TOLERANCE; < 0: tolerance 0
-                                * (every round); inf: stop at the first check */
+    /* 0: VB_DEFAULT_RAY_TOLERANCE; < 0: tolerance 0 (every round); inf: stop
+     * at the first check */
+    float ray_tolerance;
     uint64_t seed;        /* 0 is a valid seed */
     float max_distance;   /* clamp; 0: the occluders' bbox diagonal */
     vb_method method;     /* method.h; 0: shadow (the default) */
@@ -141,13 +142,15 @@ typedef struct vb_bake_desc {
      * `quantity` (adaptive receivers bake later rounds with the first
      * round's choice); NULL: as `quantity` says. */
     const vdsh_quantity *order_quantity;
-    float lambda;             /* lsq and shadow regularisation; 0: 1e-4 */
-    const float *log_offsets; /* method shadow: per order (index 1..VDSH_MAX_ORDER), added
-                                * to the fitted ln d; NULL: vb_shadow_log_offset */
-    float log_floor;          /* log-distance floor; 0: 1% of max_distance */
-    vdsh_window window;       /* on each order's bands; 0: none */
-    uint32_t order_mask;      /* bit n: produce order n; 0: max_order only
-                                * (none with a variable order and no mask) */
+    float lambda; /* lsq and shadow regularisation; 0: 1e-4 */
+    /* method shadow: per order (index 1..VDSH_MAX_ORDER), added to the
+     * fitted ln d; NULL: vb_shadow_log_offset */
+    const float *log_offsets;
+    float log_floor;    /* log-distance floor; 0: 1% of max_distance */
+    vdsh_window window; /* on each order's bands; 0: none */
+    /* bit n: produce order n; 0: max_order only (none with a variable order
+     * and no mask) */
+    uint32_t order_mask;
     /* Adaptive order (issue 16): > 0 adds a variable-order stream of the
      * quantity of order `variable_cap`: each receiver gets the lowest
      * order 1..variable_cap whose expected shadow error on its own traced
@@ -195,8 +198,8 @@ typedef struct vb_bake_desc {
     int offset_cap;
     float offset_cap_tol, offset_cap_keep;
     uint32_t offset_cap_min;
-    int max_order;    /* 0: the highest order in order_mask, or
-                                  VB_DEFAULT_ORDER */
+    /* 0: the highest order in order_mask, or VB_DEFAULT_ORDER */
+    int max_order;
     unsigned threads; /* 0: every online core */
     /* 0 (the tools' default): receivers whose normals point into geometry
      * are turned toward free space first (vb_orient_receivers, on a copy:
@@ -226,11 +229,11 @@ typedef struct vb_bake_output {
     vdsh_method method;                       /* the method as stored */
     vdsh_quantity quantity[VDSH_ORDER_SLOTS]; /* per order: the quantity stored */
     uint32_t auto_receivers;                  /* VB_QUANTITY_AUTO: receivers sampled (else 0) */
-    double auto_error[VDSH_ORDER_SLOTS][2];   /* their expected shadow error
-                                * per order, distance [0] and log [1] */
-    float lambda;                             /* lsq or shadow regularisation used (0 otherwise) */
-    float log_offset[VDSH_ORDER_SLOTS];       /* method shadow: per order, as used */
-    float log_floor;                          /* log-distance floor used (0 otherwise) */
+    /* their expected shadow error per order, distance [0] and log [1] */
+    double auto_error[VDSH_ORDER_SLOTS][2];
+    float lambda;                       /* lsq or shadow regularisation used (0 otherwise) */
+    float log_offset[VDSH_ORDER_SLOTS]; /* method shadow: per order, as used */
+    float log_floor;                    /* log-distance floor used (0 otherwise) */
     /* Method decision: receivers fitted (the others, with fewer than 16
      * lights above their horizon, keep the lsq fit), their mean training
      * pairs, the calibration's target false rate and its receivers (0:
@@ -288,8 +291,8 @@ typedef struct vb_bake_output {
      * not refitted; docs/ACCURACY.md). */
     vdsh_method variable_method;
     float variable_param;
-    uint32_t rays;       /* directions per receiver actually used (the
-                                * cap with adaptive rays) */
+    /* directions per receiver actually used (the cap with adaptive rays) */
+    uint32_t rays;
     float ray_tolerance; /* adaptive rays: the tolerance used, else 0 */
     int hemisphere;      /* sampling domain: 0 sphere, 1 hemisphere */
     float max_distance;  /* the clamp used, scene units */
@@ -305,8 +308,9 @@ typedef struct vb_bake_output {
     uint32_t flipped_normals; /* receivers whose normal was turned */
     uint32_t moved_origins;   /* receivers whose origin the repair moved */
     vb_origins_stats origins; /* the ray origins' repair: what it did and cost */
-    double seconds;           /* wall time of the trace-and-project loop
-                                * (the origins' time is origins.seconds) */
+    /* wall time of the trace-and-project loop (the origins' time is
+     * origins.seconds) */
+    double seconds;
 } vb_bake_output;
 
 vb_result vb_bake_run(const vb_bake_desc *desc, vb_bake_output *out, vb_error *err);

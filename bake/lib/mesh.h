@@ -130,78 +130,77 @@ typedef struct vb_mesh {
 } vb_mesh;
 
 typedef struct vb_load_desc {
-    int weld;       /* 1: merge vertices with bit-identical positions
-                              (-0 and +0 count as equal; normals then
-                              recomputed); 0 (default): keep the file's
-                              vertices */
-    int gltf_scene; /* glTF: 0 (default) = the file's default scene
-                              (or its first); N + 1 = scene N */
+    /* 1: merge vertices with bit-identical positions (-0 and +0 count as
+     * equal; normals then recomputed); 0 (default): keep the file's vertices */
+    int weld;
+    /* glTF: 0 (default) = the file's default scene (or its first); N + 1 =
+     * scene N */
+    int gltf_scene;
 } vb_load_desc;
 
 /* What loading found in a file and did about it, as counts (all zero for
  * the built-in scene and for a file with nothing to say). Counts of
  * vertices are of the file's vertices unless said otherwise. */
 typedef struct vb_mesh_report {
-    uint32_t dropped_triangles;   /* repeated a vertex index (no area),
-                                    dropped; OBJ faces with fewer than 3
-                                    distinct vertices count as their
-                                    corners - 2 */
-    uint32_t duplicate_triangles; /* the same three positions as an earlier
-                                    triangle (any corner order, either
-                                    winding), dropped; a reversed copy with
-                                    vertices of its own (a two-sided sheet's
-                                    back) is kept */
-    uint32_t removed_vertices;    /* used by no remaining triangle */
-    uint32_t split_vertices;      /* split at creases (corner normals) */
-    uint32_t split_added;         /* vertices those splits added */
-    uint32_t missing_normals;     /* used vertices with no file normal while
-                                    others have one: all normals computed */
-    uint32_t zero_normals;        /* loaded vertices whose file normal is
-                                    zero (or whose given normals cancel) */
-    uint32_t zero_repaired;       /* of those, given their own triangles'
-                                    normal */
-    uint32_t zero_cancelled;      /* of those, whose triangles' normals
-                                    cancel (two-sided): given their largest
-                                    triangle's normal */
-    uint32_t zero_undefined;      /* of those, left (0,0,0): their
-                                    triangles have no area (zero_repaired +
-                                    zero_cancelled + zero_undefined =
-                                    zero_normals) */
-    uint32_t cancelled_normals;   /* loaded vertices without a file normal
-                                    whose computed normal cancelled
-                                    (two-sided triangles): given their
-                                    largest triangle's normal */
-    uint32_t welded;              /* vertices merged by weld */
-    uint32_t undefined_normals;   /* loaded vertices left (0,0,0) at the end:
-                                    their triangles have no area (those
-                                    with a zero file normal included) */
-    uint32_t gltf_skipped_modes;  /* glTF: point and line primitives skipped */
-    uint32_t gltf_skipped_morph;  /* glTF: primitives with morph targets,
-                                    baked in their base pose (targets
-                                    ignored; not skipped, despite the name) */
-    uint32_t gltf_skipped_skin;   /* glTF: primitives of skinned nodes,
-                                    baked in their bind pose (not skipped) */
-    uint32_t gltf_ragged;         /* glTF: TRIANGLES primitives whose index
-                                    (or vertex) count is not a multiple of
-                                    3, the last 1 or 2 ignored */
-    uint32_t nonconvex_polygons;  /* faces of 4+ vertices whose triangles
-                                    cover more than they enclose: not
-                                    simple or far from flat, so fanned, not
-                                    ear-clipped; baked as fanned, area
-                                    outside the face included */
-    double nonconvex_excess;      /* their fan area over their own, less 1 */
+    /* repeated a vertex index (no area), dropped; OBJ faces with fewer than
+     * 3 distinct vertices count as their corners - 2 */
+    uint32_t dropped_triangles;
+    /* the same three positions as an earlier triangle (any corner order,
+     * either winding), dropped; a reversed copy with vertices of its own (a
+     * two-sided sheet's back) is kept */
+    uint32_t duplicate_triangles;
+    uint32_t removed_vertices; /* used by no remaining triangle */
+    uint32_t split_vertices;   /* split at creases (corner normals) */
+    uint32_t split_added;      /* vertices those splits added */
+    /* used vertices with no file normal while others have one: all normals
+     * computed */
+    uint32_t missing_normals;
+    /* loaded vertices whose file normal is zero (or whose given normals
+     * cancel) */
+    uint32_t zero_normals;
+    /* of those, given their own triangles' normal */
+    uint32_t zero_repaired;
+    /* of those, whose triangles' normals cancel (two-sided): given their
+     * largest triangle's normal */
+    uint32_t zero_cancelled;
+    /* of those, left (0,0,0): their triangles have no area (zero_repaired +
+     * zero_cancelled + zero_undefined = zero_normals) */
+    uint32_t zero_undefined;
+    /* loaded vertices without a file normal whose computed normal cancelled
+     * (two-sided triangles): given their largest triangle's normal */
+    uint32_t cancelled_normals;
+    uint32_t welded; /* vertices merged by weld */
+    /* loaded vertices left (0,0,0) at the end: their triangles have no area
+     * (those with a zero file normal included) */
+    uint32_t undefined_normals;
+    uint32_t gltf_skipped_modes; /* glTF: point and line primitives skipped */
+    /* glTF: primitives with morph targets, baked in their base pose (targets
+     * ignored; not skipped, despite the name) */
+    uint32_t gltf_skipped_morph;
+    /* glTF: primitives of skinned nodes, baked in their bind pose (not
+     * skipped) */
+    uint32_t gltf_skipped_skin;
+    /* glTF: TRIANGLES primitives whose index (or vertex) count is not a
+     * multiple of 3, the last 1 or 2 ignored */
+    uint32_t gltf_ragged;
+    /* faces of 4+ vertices whose triangles cover more than they enclose: not
+     * simple or far from flat, so fanned, not ear-clipped; baked as fanned,
+     * area outside the face included */
+    uint32_t nonconvex_polygons;
+    double nonconvex_excess; /* their fan area over their own, less 1 */
 } vb_mesh_report;
 
 /* What a loaded source was: size and hash for the .vdsh SRCS chunk, and
  * what loading found. */
 typedef struct vb_source_info {
-    uint64_t size;           /* bytes of the file (or of the built-in arrays); for a
-                      glTF with external buffers, the file's plus theirs */
-    uint8_t sha256[32];      /* of those bytes in that order (formats/VDSH.md) */
-    uint64_t file_size;      /* the file's bytes alone, and their SHA-256: */
-    uint8_t file_sha256[32]; /* what bakes before 2026-11-30 recorded for a
-                                glTF with external buffers (= size, sha256
-                                for every other source) */
+    /* bytes of the file (or of the built-in arrays); for a glTF with
+     * external buffers, the file's plus theirs */
+    uint64_t size;
+    uint8_t sha256[32]; /* of those bytes in that order (formats/VDSH.md) */
+    uint64_t file_size; /* the file's bytes alone, and their SHA-256: */
+    /* what bakes before 2026-11-30 recorded for a glTF with external buffers
+     * (= size, sha256 for every other source) */
+    uint8_t file_sha256[32];
     vb_mesh_report report;
 } vb_source_info;
 
@@ -394,18 +393,19 @@ vb_result vb_mesh_stage_ply(const vb_mesh *m, const char *path, struct vdsh_outp
 #define VB_SPACING_SUGGEST 0.01f
 
 typedef struct vb_mesh_spacing {
-    float diagonal;     /* the scene diagonal the fractions are of */
-    double area;        /* total triangle area */
-    float median_edge;  /* area-weighted median of the triangles' longest
-                            * edges (within 2% of the exact quantile) */
-    float p90_edge;     /* its 90th percentile (likewise) */
-    float max_edge;     /* the longest edge */
-    double long_area;   /* share of the area (0..1) in triangles whose
-                            * longest edge exceeds VB_SPACING_WARN_EDGE x
-                            * diagonal */
-    int far_apart;      /* long_area > VB_SPACING_WARN_AREA */
-    float suggest_edge; /* VB_SPACING_SUGGEST x diagonal, to 2 significant
-                            * digits */
+    float diagonal; /* the scene diagonal the fractions are of */
+    double area;    /* total triangle area */
+    /* area-weighted median of the triangles' longest edges (within 2% of the
+     * exact quantile) */
+    float median_edge;
+    float p90_edge; /* its 90th percentile (likewise) */
+    float max_edge; /* the longest edge */
+    /* share of the area (0..1) in triangles whose longest edge exceeds
+     * VB_SPACING_WARN_EDGE x diagonal */
+    double long_area;
+    int far_apart; /* long_area > VB_SPACING_WARN_AREA */
+    /* VB_SPACING_SUGGEST x diagonal, to 2 significant digits */
+    float suggest_edge;
 } vb_mesh_spacing;
 
 /* The spacing of m's vertices against `diagonal` (<= 0: m's own bounds'
