@@ -42,6 +42,14 @@ _runtime_test(test_runtime_shaders)
 target_include_directories(test_runtime_shaders PRIVATE ${PROJECT_BINARY_DIR}/runtime)
 add_test(NAME runtime_shaders_embedded_byte_for_byte COMMAND test_runtime_shaders ${PROJECT_SOURCE_DIR}/runtime/shaders)
 
+# The shader files as another engine includes them (shaders/README.md's
+# recipes, compiled and linked from the files with only the #defines it
+# lists), and a buffer path missing a #define fails naming it.
+_runtime_test(test_runtime_shaders_standalone)
+add_test(NAME runtime_shaders_standalone
+         COMMAND test_runtime_shaders_standalone ${PROJECT_SOURCE_DIR}/runtime/shaders)
+_runtime_props(runtime_shaders_standalone)
+
 # A small bake of the built-in room for the tests below (0.2 s).
 add_test(NAME runtime_fixture_room
          COMMAND vdsh-bake builtin:room --max-edge 0.5 --rays 400 --method paper -q
