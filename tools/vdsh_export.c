@@ -1021,7 +1021,16 @@ static int put_streams(exporter *e)
         e->exported++;
     }
     if (o->any_order && !e->exported) {
-        fprintf(stderr, "vdsh-export: %s: no stream of the orders asked for\n", o->in);
+        char have[128] = "";
+        size_t n = 0;
+        for (uint32_t si = 0; si < f->stream_count && n < sizeof have; si++)
+            n += (size_t)snprintf(
+                have + n, sizeof have - n, "%s%u%s", si ? ", " : "", f->streams[si].order,
+                f->streams[si].flags & VDSH_STREAM_VARIABLE ? " (adaptive order)" : "");
+        fprintf(stderr,
+                "vdsh-export: %s: no stream of the orders asked for (--orders); the file has "
+                "order%s %s\n",
+                o->in, f->stream_count == 1 ? "" : "s", have);
         return 1;
     }
     return 0;
