@@ -313,10 +313,32 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
     if (!views)
         views = cJSON_AddArrayToObject(g, "bufferViews");
     cJSON *v;
+    int view_index = 0;
     cJSON_ArrayForEach(v, views)
     {
         int bi = (int)cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(v, "buffer"));
         cJSON *off = cJSON_GetObjectItemCaseSensitive(v, "byteOffset");
+        /* A view past its buffer's end (one no primitive uses, which the
+         * bake never read) would read the next buffer, or the VDSH
+         * attributes, once the buffers are one: refused, as invalid. */
+        double vo = cJSON_IsNumber(off) ? off->valuedouble : 0;
+        double vl_len = cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(v, "byteLength"));
+        if (bi < 0 || bi >= src.buffer_count || !(vo >= 0) || !(vl_len >= 0) ||
+            vo + vl_len > (double)src.buffers[bi].size) {
+            if (bi < 0 || bi >= src.buffer_count)
+                fprintf(stderr,
+                        "vdsh-export: %s: bufferView %d names buffer %d, which does not exist: "
+                        "not a valid glTF (--source copies every view)\n",
+                        path, view_index, bi);
+            else
+                fprintf(stderr,
+                        "vdsh-export: %s: bufferView %d (bytes %.0f..%.0f) does not fit buffer %d "
+                        "(%zu bytes): not a valid glTF (--source copies every view)\n",
+                        path, view_index, vo, vo + vl_len, bi, src.buffers[bi].size);
+            free(base);
+            goto out;
+        }
+        view_index++;
         double o = (cJSON_IsNumber(off) ? off->valuedouble : 0) +
                    (double)base[bi >= 0 && bi < src.buffer_count ? bi : 0];
         cJSON_DeleteItemFromObjectCaseSensitive(v, "byteOffset");
