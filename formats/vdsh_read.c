@@ -119,6 +119,38 @@ static vdsh_result invalid(const reader *r, const why *w)
     return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name, "%s", w->msg);
 }
 
+/* What a file that is not a .vdsh is, when its first bytes say so: the
+ * files the tools write beside a bake and the meshes a bake reads, handed
+ * to a .vdsh reader by mistake (the distance volume's magic begins with
+ * "VDSH", and was called a .vdsh damaged in transfer). NULL: unknown. */
+static const char *other_format(const uint8_t *d, size_t size)
+{
+    static const struct {
+        const char *magic;
+        size_t len;
+        const char *what;
+    } known[] = {
+        {"VDSHSDF\0", 8, "a VDSH distance volume (vdsh-bake --sdf; vdsh-view --sdf reads it)"},
+        {"glTF", 4, "a binary glTF (.glb: vdsh-export writes it, vdsh-bake reads it as a mesh)"},
+        {"\x76\x2f\x31\x01", 4, "an OpenEXR image (the bake's basis cubemaps)"},
+        {"ply\n", 4, "a PLY mesh (vdsh-bake reads it)"},
+        {"\x89PNG", 4, "a PNG image"},
+    };
+    for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
+        if (size >= known[i].len && memcmp(d, known[i].magic, known[i].len) == 0)
+            return known[i].what;
+    return NULL;
+}
+
+/* "not a .vdsh file", and what it is where its first bytes say so. */
+static vdsh_result not_vdsh(vdsh_error *err, const char *name, const uint8_t *d, size_t size)
+{
+    const char *what = other_format(d, size);
+    if (what)
+        return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, name, "not a .vdsh file: %s", what);
+    return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, name, "not a .vdsh file (wrong magic)");
+}
+
 /* Pass 1: file header, chunk walk, every CRC and padding. */
 static vdsh_result read_structure(const reader *r, chunk_ref *chunks, uint32_t *count)
 {
@@ -127,18 +159,19 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks, uint32_t *
 
     if (size < sizeof vdsh_magic) {
         if (memcmp(d, vdsh_magic, size) != 0)
-            return vdsh_failf_at(r->err, VDSH_ERR_NOT_VDSH, r->name,
-                                 "not a .vdsh file (wrong magic)");
+            return not_vdsh(r->err, r->name, d, size);
         return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
                              "truncated: %zu byte%s, shorter than the %d-byte header", size,
                              vdsh_s(size), FILE_HEADER_SIZE);
     }
     if (memcmp(d, vdsh_magic, sizeof vdsh_magic) != 0) {
+        if (other_format(d, size))
+            return not_vdsh(r->err, r->name, d, size);
         if (memcmp(d, vdsh_magic, 4) == 0)
             return vdsh_failf_at(r->err, VDSH_ERR_NOT_VDSH, r->name,
                                  "not a .vdsh file: magic bytes 4..7 damaged (a "
                                  "text-mode transfer changes CR, LF and ^Z)");
-        return vdsh_failf_at(r->err, VDSH_ERR_NOT_VDSH, r->name, "not a .vdsh file (wrong magic)");
+        return not_vdsh(r->err, r->name, d, size);
     }
     if (size < FILE_HEADER_SIZE)
         return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
@@ -792,7 +825,7 @@ vdsh_result vdsh_scan_chunks(const void *data, size_t size, const char *name, vd
                              "vdsh_scan_chunks: NULL "
                              "argument");
     if (size && memcmp(d, vdsh_magic, size < sizeof vdsh_magic ? size : sizeof vdsh_magic))
-        return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, nm, "not a .vdsh file (wrong magic)");
+        return not_vdsh(err, nm, d, size);
     if (size < FILE_HEADER_SIZE)
         return vdsh_failf_at(err, VDSH_ERR_TRUNCATED, nm,
                              "truncated: %zu byte%s, shorter than the %d-byte header", size,

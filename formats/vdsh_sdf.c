@@ -120,8 +120,11 @@ vdsh_result vdsh_sdf_read_memory(const void *data, size_t size, const char *name
             name, "%zu byte%s: shorter than the %d-byte distance volume header", size, vdsh_s(size),
             VDSH_SDF_HEADER_SIZE);
     if (memcmp(d, MAGIC, 8) != 0)
-        return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, name,
-                             "not a VDSH distance volume (wrong magic)");
+        return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, name, "not a VDSH distance volume (%s)",
+                             memcmp(d, "VDSH\r\n\x1a\n", 8) == 0
+                                 ? "a .vdsh file: vdsh-bake --sdf writes the volume beside it, "
+                                   "as a .sdf"
+                                 : "wrong magic");
     if (get_u32(d + 60) != vdsh_crc32(0, d, 60))
         return vdsh_failf_at(err, VDSH_ERR_CRC, name, "distance volume header: CRC mismatch");
     if (get_u32(d + 8) != SDF_VERSION)

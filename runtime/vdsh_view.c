@@ -48,6 +48,7 @@ static const char usage_text[] =
     "                        all in this process, each round timing\n"
     "                        every mode of every SCENE once (wall time and\n"
     "                        process CPU time per frame); JSON on stdout\n"
+    "  -j, --json FILE       with --bench: the JSON to FILE instead (-: stdout)\n"
     "      --bench-lights L  with --bench: only these of 1,3,16,64 lights\n"
     "      --bench-cube-sizes LIST  with --bench: time the cube shadow map\n"
     "                        (1 tap and PCF) at each of these face sizes, as\n"
@@ -249,6 +250,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
         {"pcf", no_argument, 0, O_PCF},
         {"sdf", required_argument, 0, O_SDF},
         {"sdf-k", required_argument, 0, O_SDF_K},
+        {"json", required_argument, 0, 'j'},
         {"shadow-size", required_argument, 0, O_SHADOW_SIZE},
         {"size", required_argument, 0, O_SIZE},
         {"no-cubemaps", no_argument, 0, O_NO_CUBEMAPS},
@@ -269,7 +271,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
         {"quiet", no_argument, 0, 'q'},
         VT_CLI_LONGOPTS_END};
     int c;
-    while ((c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "qhVj:", longopts, NULL)) != -1) {
         const char *v = optarg;
         int which, rc;
         switch (c) {
@@ -450,6 +452,10 @@ static int parse_args(int argc, char **argv, vv_options *o)
             o->bench_modes = v;
             break;
         case O_BENCH_COUNTS: o->bench_counts = 1; break;
+        case 'j':
+            if (!vt_opt_once("--json", v, &o->json_path))
+                return 2;
+            break;
         default: /* getopt_long said what is wrong */ vt_cli_try_help(); return VT_EXIT_USAGE;
         }
     }
@@ -478,10 +484,10 @@ static int parse_args(int argc, char **argv, vv_options *o)
         if (o->frame_mode_count)
             return usage_error("%s", "--modes: only with --views");
         if ((o->buffer_floats || o->bench_sets || o->bench_cube_count || o->bench_modes ||
-             o->bench_counts) &&
+             o->bench_counts || o->json_path) &&
             !o->bench)
             return usage_error("%s", "--buffer-floats, --bench-lights, --bench-cube-sizes, "
-                                     "--bench-modes, --bench-counts: only with --bench");
+                                     "--bench-modes, --bench-counts, --json: only with --bench");
         if (o->frames_arg && !vt_parse_int(o->frames_arg, 1, 1000000, &o->frames))
             return usage_error("--frames: expected a positive count, got '%s'", o->frames_arg);
     }
@@ -497,13 +503,15 @@ static int parse_args(int argc, char **argv, vv_options *o)
                            o->files[1]);
     if (o->fit && o->have_camera)
         return usage_error("%s", "--fit and --camera both choose the view: give one");
-    /* The images it writes: never a scene file, and writable now. */
-    const char *outs[] = {o->render_path, o->grid_path, o->screenshot};
-    const char *opts[] = {"--render", "--grid", "--screenshot"};
+    /* The images it writes: never a scene file, and writable now; the
+     * same for --json's file ("-": stdout, not checked). */
+    const char *outs[] = {o->render_path, o->grid_path, o->screenshot,
+                          o->json_path && strcmp(o->json_path, "-") ? o->json_path : NULL};
+    const char *opts[] = {"--render", "--grid", "--screenshot", "--json"};
     int rc = vt_cli_no_stdout(outs, opts, 3);
     if (rc)
         return rc;
-    if (vt_cli_check_outputs(outs, 3, (const char *const *)o->files, o->file_count) != 0)
+    if (vt_cli_check_outputs(outs, 4, (const char *const *)o->files, o->file_count) != 0)
         return 1;
     return 0;
 }

@@ -65,6 +65,7 @@ typedef struct vv_options {
     int bench_cube_count;
     const char *bench_modes; /* --bench-modes: only these names; NULL: all */
     int bench_counts;        /* --bench-counts: GL counts of each mode */
+    const char *json_path;   /* --json FILE: --bench's JSON ("-", NULL: stdout) */
     int quiet;
     const char *screenshot;
     int no_overlay;

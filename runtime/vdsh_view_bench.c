@@ -458,7 +458,8 @@ int vv_run_bench(const vv_options *o)
     for (int i = 0; i < o->file_count && !rc; i++)
         bench_print(o, &b[i], rounds, &j, list);
     char msg[256];
-    if (!rc && vt_json_write_stream(&j, stdout, "stdout", msg, sizeof msg) != 0) {
+    if (!rc && (o->json_path ? vt_json_write_file(&j, o->json_path, msg, sizeof msg)
+                             : vt_json_write_stream(&j, stdout, "stdout", msg, sizeof msg)) != 0) {
         fprintf(stderr, "vdsh-view: --bench: %s\n", msg);
         rc = 1;
     }

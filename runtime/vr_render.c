@@ -593,6 +593,9 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                                ? " (orders 2, 3, 5 are buffered with vr_scene_desc.buffers)"
                                : "");
     } else if (!vr_scene_supports(s, mode)) {
+        if (mode == VR_MODE_SDF && s->sdf_stale[0])
+            return vr_fail(err, VR_ERR_MISSING, "mode sdf needs the scene's distance volume: %s",
+                           s->sdf_stale);
         if (mode == VR_MODE_SDF)
             return vr_fail(err, VR_ERR_MISSING,
                            "mode sdf needs the scene's distance volume: "

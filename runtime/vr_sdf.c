@@ -30,6 +30,19 @@ vr_result vr_sdf_load(vr_scene *s, const vr_scene_desc *desc, uint32_t vertex_co
     if ((v.vertex_count || v.triangle_count) &&
         (v.vertex_count != vertex_count || v.triangle_count != triangle_count)) {
         vdsh_sdf_free(&v);
+        /* The companion, found by name: left by an earlier bake of the same
+         * output with --sdf (a bake without --sdf leaves it). It is not
+         * this scene's, but it must not stop the modes that do not use it:
+         * skipped, and mode sdf says why. One named with sdf_path fails. */
+        if (!desc->sdf_path) {
+            snprintf(s->sdf_stale, sizeof s->sdf_stale,
+                     "%s beside it was baked beside another bake (%u %s and %u %s, not "
+                     "%u and %u): not loaded; bake again with vdsh-bake --sdf N",
+                     path, v.vertex_count, vdsh_plural(v.vertex_count, "vertex", "vertices"),
+                     v.triangle_count, vdsh_plural(v.triangle_count, "triangle", "triangles"),
+                     vertex_count, triangle_count);
+            return VR_OK;
+        }
         return vr_fail(err, VR_ERR_FORMAT,
                        "%s: the distance volume was baked beside a scene "
                        "of %u %s and %u %s, not this one (%u, %u): bake it again",

@@ -70,6 +70,16 @@ _format_tool_test(format_info_truncated 1
 _format_tool_test(format_info_not_vdsh 1
   --err "text.vdsh: not a .vdsh file"
   -- ${_info} ${_fx}/text.vdsh)
+# A file the tools write that is not a .vdsh is named for what it is: the
+# distance volume (its magic begins "VDSH": it was called a .vdsh damaged
+# in a text-mode transfer) and a glb.
+_format_tool_test(format_info_names_other_files 1
+  --err "volume.sdf: not a .vdsh file: a VDSH distance volume"
+  --err "scene.glb: not a .vdsh file: a binary glTF"
+  -- ${_info} ${_fx}/volume.sdf ${_fx}/scene.glb)
+_format_tool_test(format_info_verify_names_other_files 1
+  --err "volume.sdf: not a .vdsh file: a VDSH distance volume"
+  -- ${_info} --verify ${_fx}/volume.sdf)
 _format_tool_test(format_info_missing 1
   --err "no-such-file.vdsh: cannot open"
   -- ${_info} ${_fx}/no-such-file.vdsh)

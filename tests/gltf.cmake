@@ -37,6 +37,14 @@ foreach(ext gltf glb)
                       LIBS vb_mesh m DEFS VDSH_FUZZ_EXT="${ext}")
 endforeach()
 
+# gltf_source_views  vdsh-export --source refuses a source buffer view that
+#                    does not fit its buffer (it read the VDSH attributes
+#                    once the buffers were one), naming it; seconds.
+add_test(NAME gltf_source_views
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_gltf_source_views.py
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-export>
+                 ${CMAKE_CURRENT_BINARY_DIR}/gltf_source_views)
+
 # npm packages (gltf-validator) into the build dir, once: a fixture.
 #   gltf_export       bake -> vdsh-export -> the Khronos glTF Validator
 find_program(VDSH_NODE node)

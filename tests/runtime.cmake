@@ -42,6 +42,14 @@ _runtime_test(test_runtime_shaders)
 target_include_directories(test_runtime_shaders PRIVATE ${PROJECT_BINARY_DIR}/runtime)
 add_test(NAME runtime_shaders_embedded_byte_for_byte COMMAND test_runtime_shaders ${PROJECT_SOURCE_DIR}/runtime/shaders)
 
+# The shader files as another engine includes them (shaders/README.md's
+# recipes, compiled and linked from the files with only the #defines it
+# lists), and a buffer path missing a #define fails naming it.
+_runtime_test(test_runtime_shaders_standalone)
+add_test(NAME runtime_shaders_standalone
+         COMMAND test_runtime_shaders_standalone ${PROJECT_SOURCE_DIR}/runtime/shaders)
+_runtime_props(runtime_shaders_standalone)
+
 # A small bake of the built-in room for the tests below (0.2 s).
 add_test(NAME runtime_fixture_room
          COMMAND vdsh-bake builtin:room --max-edge 0.5 --rays 400 --method paper -q
@@ -168,8 +176,30 @@ expect2 --bench --bench-modes "" "$room"
 expect2 --render a.png --keys abc "$room"
 expect2 --grid a.png --screenshot b.png "$room"
 expect2 --bench --no-overlay "$room"
+# --json is --bench's; given twice, a usage error
+expect2 --json a.json "$room"
+expect2 --bench --json a.json --json b.json "$room"
 exit $fail
 ]=] sh ${_view} ${_room})
+
+# vdsh-view --bench --json FILE (README: every program writes its JSON
+# with --json FILE, '-' stdout; --bench wrote only to stdout): the JSON in
+# FILE, nothing on stdout; --json - is stdout; a scene file as FILE is
+# refused (exit 1) and left as it was.
+add_test(NAME runtime_view_bench_json COMMAND sh -c [=[
+v=$1; room=$2; d=$3
+rm -rf "$d"; mkdir -p "$d"
+b() { "$v" --bench --bench-lights 1 --bench-modes vdsh3 --frames 1 --size 32x24 -q "$@"; }
+b --json "$d/b.json" "$room" > "$d/stdout"; rc=$?
+[ $rc -eq 77 ] && exit 77
+[ $rc -eq 0 ] && [ ! -s "$d/stdout" ] && grep -q '"scenes"' "$d/b.json" ||
+  { echo "FAIL: --json FILE: exit $rc, stdout $(wc -c < "$d/stdout") bytes"; exit 1; }
+b --json - "$room" > "$d/stdout2" && grep -q '"scenes"' "$d/stdout2" || { echo "FAIL: --json -"; exit 1; }
+cp "$room" "$d/copy.vdsh"
+b --json "$d/copy.vdsh" "$d/copy.vdsh" 2> "$d/err"; rc=$?
+[ $rc -eq 1 ] && cmp -s "$room" "$d/copy.vdsh" || { echo "FAIL: --json over the scene: exit $rc"; cat "$d/err"; exit 1; }
+echo ok
+]=] sh ${_view} ${_room} ${_rt_dir}/view_bench_json)
 
 # Data errors exit 1 and name the file; nothing crashes.
 add_test(NAME runtime_view_errors COMMAND sh -c [=[
@@ -632,7 +662,7 @@ if "$png" same "$d/wpass.png" "$d/pass.png" 0; then echo "control: widths as uni
 _runtime_props(runtime_view_cpca_frame FIXTURES_REQUIRED runtime_room)
 endif()
 
-foreach(t runtime_view_usage runtime_view_errors runtime_view_render runtime_view_bench
+foreach(t runtime_view_usage runtime_view_bench_json runtime_view_errors runtime_view_render runtime_view_bench
           runtime_view_frame runtime_view_window runtime_view_frames runtime_view_buffer)
   if(TEST ${t})
     _runtime_props(${t} FIXTURES_REQUIRED runtime_room)

@@ -44,6 +44,27 @@ msg=$("$frames" truth "$d/plain.vdsh" --views "$d/v.json" -o "$d/f0" --sdf-k 3 -
 [[ -e $d/f1/default-s0-l0-c-sdf.png ]] || { echo "FAIL: no c-sdf frame with the volume"; exit 1; }
 ]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames> ${CMAKE_CURRENT_BINARY_DIR}/sdf_k_volume)
 
+# A companion volume left by an earlier bake of the same output (the next
+# bake had no --sdf, other receivers): vdsh-frames truth skips it, saying
+# so, and writes no c-sdf frames (it wrote c-sdf frames from it, where
+# vdsh-view refused to load the scene at all); named with --sdf, it is an
+# error (exit 1, no frames), as the runtime's rule (vr.h, sdf_path).
+add_test(NAME sdf_frames_stale_companion COMMAND bash -c [=[
+bake=$1; frames=$2; d=$3
+rm -rf "$d"; mkdir -p "$d"
+"$bake" builtin:room:3 --max-edge 2 --rays 16 --orders 2 --cube-size 0 --sdf 16 -q -o "$d/s.vdsh" &&
+"$bake" builtin:room:3 --max-edge 1.5 --rays 16 --orders 2 --cube-size 0 -q -o "$d/s.vdsh" || exit 1
+[[ -e $d/s.sdf ]] || { echo "FAIL: no s.sdf left by the first bake"; exit 1; }
+"$frames" views "$d/s.vdsh" -q --cameras 1 --size 32x24 -o "$d/v.json" || exit 1
+msg=$("$frames" truth "$d/s.vdsh" --views "$d/v.json" -o "$d/f0" -q 2>&1); rc=$?
+[[ $rc -eq 0 && $msg == *s.sdf*"another bake"* && -e $d/f0/default-s0-l0-c-vdsh2.png && ! -e $d/f0/default-s0-l0-c-sdf.png ]] ||
+  { echo "FAIL: stale companion: exit $rc, $msg; $(ls "$d/f0" 2>/dev/null | grep -c sdf) c-sdf frames"; exit 1; }
+msg=$("$frames" truth "$d/s.vdsh" --views "$d/v.json" -o "$d/f1" --sdf "$d/s.sdf" -q 2>&1); rc=$?
+[[ $rc -eq 1 && $msg == *s.sdf*"another bake"* && ! -e $d/f1 ]] ||
+  { echo "FAIL: stale volume named with --sdf: exit $rc, $msg"; exit 1; }
+echo "ok: $msg"
+]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames> ${CMAKE_CURRENT_BINARY_DIR}/sdf_stale)
+
 # scripts/sdf_frames' steps without GL (tests/test_sdf_frames_script.py):
 # the volume's figures from vdsh-bake --report's "sdf", a clear message
 # when no pixel counts, sizes in kB below 1 MB.

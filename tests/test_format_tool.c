@@ -4,7 +4,9 @@
  *   test_format_tool make DIR
  *       write the fixtures: good.vdsh (two sources, order 5 f16, order 3
  *       f32, stat and time chunks), corrupt.vdsh (one payload byte changed),
- *       truncated.vdsh (cut in a chunk), text.vdsh (not a .vdsh at all)
+ *       truncated.vdsh (cut in a chunk), text.vdsh (not a .vdsh at all),
+ *       volume.sdf and scene.glb (the first bytes of a distance volume and
+ *       of a binary glTF: files the tools write, not .vdsh files)
  *   test_format_tool clean DIR
  *       remove what `make` wrote
  *   test_format_tool expect CODE [--out TEXT]... [--err TEXT]... -- PROG ARG...
@@ -151,14 +153,34 @@ static int write_fixtures(const char *dir)
         fclose(fp);
     }
     free(mem);
+    /* The distance volume's magic begins with "VDSH" (was called a .vdsh
+     * damaged in a text-mode transfer). */
+    static const struct {
+        const char *name;
+        char bytes[16];
+    } other[2] = {{"volume.sdf", "VDSHSDF\0\1\0\0\0\23\0\0"},
+                  {"scene.glb", "glTF\2\0\0\0\100\0\0"}};
+    for (int i = 0; i < 2; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, other[i].name);
+        FILE *fp = fopen(path, "wb");
+        if (!fp) {
+            perror(path);
+            return 1;
+        }
+        uint8_t zeros[64] = {0};
+        fwrite(other[i].bytes, 1, 12, fp);
+        fwrite(zeros, 1, sizeof zeros, fp);
+        fclose(fp);
+    }
     return 0;
 }
 
 static int clean_fixtures(const char *dir)
 {
-    static const char *const names[] = {"good.vdsh", "corrupt.vdsh", "truncated.vdsh", "text.vdsh"};
+    static const char *const names[] = {"good.vdsh", "corrupt.vdsh", "truncated.vdsh",
+                                        "text.vdsh", "volume.sdf",   "scene.glb"};
     char path[4096];
-    for (int i = 0; i < 4; i++) {
+    for (int i = 0; i < 6; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, names[i]);
         unlink(path);
     }

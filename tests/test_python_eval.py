@@ -244,7 +244,15 @@ r = subprocess.run([bake, "builtin:room", "--max-edge", "2", "--rays", "64", "-q
                    capture_output=True, text=True)
 if r.returncode:
     fail.append("bake cpca: %s" % r.stderr.strip())
-checked = [p for p, _ in files[:3]] + [os.path.join(work, "adaptive-order.vdsh"), part, cpca]
+# A width per basis vector (cpca bits 0): its "widths" in "cpca".
+cpca_w = os.path.join(work, "cpca-widths.vdsh")
+r = subprocess.run([bake, "builtin:room", "--max-edge", "2", "--rays", "64", "-q", "--cube-size",
+                    "0", "--orders", "7", "--encoding", "cpca", "--cpca", "2,alloc:24", "-o",
+                    cpca_w], capture_output=True, text=True)
+if r.returncode:
+    fail.append("bake cpca widths: %s" % r.stderr.strip())
+checked = [p for p, _ in files[:3]] + [os.path.join(work, "adaptive-order.vdsh"), part, cpca,
+                                       cpca_w]
 for path in checked:
     if not os.path.exists(path):
         continue
@@ -255,6 +263,10 @@ for path in checked:
         fail.append("info %s: exit %d, vdsh-info %d" % (path, py.returncode, c.returncode))
         continue
     same(json.loads(py.stdout), json.loads(c.stdout), os.path.basename(path))
+    # A cpca stream's model, as vdsh-info writes it (it was left out).
+    for i, st in enumerate(json.loads(py.stdout)["streams"]):
+        if st["encoding"] == "cpca" and "cpca" not in st:
+            fail.append("info %s: stream %d (cpca) has no \"cpca\" object" % (path, i))
     t = subprocess.run([sys.executable, "-m", "vdsh", "info", path], capture_output=True,
                        text=True, env=env)
     if t.returncode or "%d vertices" % vdsh.read(path).header["vertex_count"] not in t.stdout:

@@ -110,6 +110,16 @@ r = info(path)
 if r.returncode != 1 or "truncated" in r.stderr or "not a .vdsh file" not in r.stderr:
     fail.append("info %s: exit %d, %r" % (path, r.returncode, r.stderr[-300:]))
 
+# A distance volume (its magic begins "VDSH") and a glb are named for what
+# they are, as vdsh-info names them.
+for name, head, what in (("volume.sdf", b"VDSHSDF\0", "a VDSH distance volume"),
+                         ("scene.glb", b"glTF\2\0\0\0", "a binary glTF")):
+    path = os.path.join(work, name)
+    open(path, "wb").write(head + bytes(64))
+    r = info(path)
+    if r.returncode != 1 or "not a .vdsh file: " + what not in r.stderr or path not in r.stderr:
+        fail.append("info %s: exit %d, %r" % (path, r.returncode, r.stderr[-300:]))
+
 # The library: lights that are not positions are named as such (was
 # numpy's "cannot reshape array of size 4 into shape (3)").
 sys.path.insert(0, os.path.join(src, "python"))

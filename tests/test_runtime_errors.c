@@ -8,6 +8,7 @@
  * that).
  */
 #include "test_runtime_util.h"
+#include "vdsh_sdf.h"
 
 #include <unistd.h>
 
@@ -178,6 +179,49 @@ static void test_files(const char *dir)
         CHECK(!info.has_cubemaps && info.cube_size == 0, "skipped cubemaps reported");
         vr_renderer_destroy(r);
         vr_scene_destroy(s);
+    }
+    /* A companion distance volume (good.sdf beside good.vdsh) baked beside
+     * another bake, as an earlier `vdsh-bake --sdf` of the same output
+     * leaves it when the next bake has no --sdf: the scene loads (it
+     * failed, and vdsh-view drew nothing in any mode), mode sdf says why;
+     * the same file named with sdf_path fails the load. */
+    {
+        char sdf[600];
+        snprintf(sdf, sizeof sdf, "%s/good.sdf", dir);
+        uint16_t samples[8] = {40000, 40000, 40000, 40000, 40000, 40000, 40000, 40000};
+        vdsh_sdf v = {.dim = {2, 2, 2},
+                      .origin = {-1, -1, -1},
+                      .cell = 2,
+                      .max_distance = 4,
+                      .vertex_count = 9999,
+                      .triangle_count = 1,
+                      .samples = samples};
+        vdsh_error ve;
+        CHECK(vdsh_sdf_write(sdf, &v, &ve) == VDSH_OK, "write %s: %s", sdf, ve.msg);
+        sd.path = path;
+        s = NULL;
+        CHECK(vr_scene_create(&sd, &s, &err) == VR_OK, "stale companion volume: %s", err.msg);
+        if (s) {
+            CHECK(!vr_scene_supports(s, VR_MODE_SDF), "stale companion volume loaded");
+            vr_renderer *r = NULL;
+            vr_renderer_desc rd = {.width = 8, .height = 8};
+            CHECK(vr_renderer_create(&rd, &r, &err) == VR_OK, "%s", err.msg);
+            vr_light light = {.position = {0, 0, 1}};
+            vr_draw_desc d = {.mode = VR_MODE_SDF, .lights = &light, .light_count = 1};
+            vr_result res = r ? vr_draw(r, s, &d, &err) : VR_ERR_GL;
+            CHECK(res == VR_ERR_MISSING && strstr(err.msg, "good.sdf") &&
+                      strstr(err.msg, "another bake"),
+                  "mode sdf with a stale companion: %s", err.msg);
+            printf("%-28s -> %s: %s\n", "stale companion volume", vr_result_str(res), err.msg);
+            d.mode = VR_MODE_VDSH3;
+            CHECK(r && vr_draw(r, s, &d, &err) == VR_OK, "vdsh3 beside a stale volume: %s",
+                  err.msg);
+            vr_renderer_destroy(r);
+            vr_scene_destroy(s);
+        }
+        vr_scene_desc named = {.path = path, .sdf_path = sdf};
+        expect_fail("stale volume named", &named, VR_ERR_FORMAT, "good.sdf");
+        unlink(sdf);
     }
     /* A cube_size no GL can hold is refused by name before anything is
      * allocated for it; cube_size 0 means none (vdsh5 unavailable). */

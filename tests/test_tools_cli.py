@@ -495,6 +495,11 @@ check(rc == 0 and os.path.getsize(os.path.join(W, b"o16.glb")) > 0,
       "vdsh-export --orders 16: exit %d %r" % (rc, err))
 rc, _, err = run(export, o16, "--orders", "17", "-o", os.path.join(W, b"o17.glb"))
 check(rc == 2 and b"1..16" in err, "vdsh-export --orders 17: exit %d %r" % (rc, err))
+# An order the file does not have: exit 1, naming the orders it has, and
+# no output.
+rc, _, err = run(export, o16, "--orders", "5", "-o", os.path.join(W, b"o5.glb"))
+check(rc == 1 and b"the file has orders 2, 16" in err and not os.path.exists(os.path.join(W, b"o5.glb")),
+      "vdsh-export --orders 5 of orders 2, 16: exit %d %r" % (rc, err))
 
 # ---- strict: every JSON document the programs write ----------------------
 jd = os.path.join(W, b"json")

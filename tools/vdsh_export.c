@@ -363,10 +363,32 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
     if (!views)
         views = cJSON_AddArrayToObject(g, "bufferViews");
     cJSON *v;
+    int view_index = 0;
     cJSON_ArrayForEach(v, views)
     {
         int bi = (int)cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(v, "buffer"));
         cJSON *off = cJSON_GetObjectItemCaseSensitive(v, "byteOffset");
+        /* A view past its buffer's end (one no primitive uses, which the
+         * bake never read) would read the next buffer, or the VDSH
+         * attributes, once the buffers are one: refused, as invalid. */
+        double vo = cJSON_IsNumber(off) ? off->valuedouble : 0;
+        double vl_len = cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(v, "byteLength"));
+        if (bi < 0 || bi >= src.buffer_count || !(vo >= 0) || !(vl_len >= 0) ||
+            vo + vl_len > (double)src.buffers[bi].size) {
+            if (bi < 0 || bi >= src.buffer_count)
+                fprintf(stderr,
+                        "vdsh-export: %s: bufferView %d names buffer %d, which does not exist: "
+                        "not a valid glTF (--source copies every view)\n",
+                        path, view_index, bi);
+            else
+                fprintf(stderr,
+                        "vdsh-export: %s: bufferView %d (bytes %.0f..%.0f) does not fit buffer %d "
+                        "(%zu bytes): not a valid glTF (--source copies every view)\n",
+                        path, view_index, vo, vo + vl_len, bi, src.buffers[bi].size);
+            free(base);
+            goto out;
+        }
+        view_index++;
         double o = (cJSON_IsNumber(off) ? off->valuedouble : 0) +
                    (double)base[bi >= 0 && bi < src.buffer_count ? bi : 0];
         cJSON_DeleteItemFromObjectCaseSensitive(v, "byteOffset");
@@ -1084,7 +1106,16 @@ static int put_streams(exporter *e)
         e->exported++;
     }
     if (o->any_order && !e->exported) {
-        fprintf(stderr, "vdsh-export: %s: no stream of the orders asked for\n", o->in);
+        char have[128] = "";
+        size_t n = 0;
+        for (uint32_t si = 0; si < f->stream_count && n < sizeof have; si++)
+            n += (size_t)snprintf(
+                have + n, sizeof have - n, "%s%u%s", si ? ", " : "", f->streams[si].order,
+                f->streams[si].flags & VDSH_STREAM_VARIABLE ? " (adaptive order)" : "");
+        fprintf(stderr,
+                "vdsh-export: %s: no stream of the orders asked for (--orders); the file has "
+                "order%s %s\n",
+                o->in, f->stream_count == 1 ? "" : "s", have);
         return 1;
     }
     return 0;

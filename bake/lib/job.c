@@ -13,8 +13,13 @@
 
 int vb_job_cube_size(const vb_job_desc *d)
 {
-    /* The cubemaps serve orders 4 and 5 (functions 9..24; vdsh_cube.h). */
+    /* The cubemaps serve orders 4 and 5 (functions 9..24; vdsh_cube.h).
+     * No fixed order with an adaptive order: its stream alone, drawn from
+     * buffers (bake.c resolve_orders), which the cubemaps do not serve
+     * (they were written, and recorded in the header, for such a file). */
     uint32_t mask = d->bake.order_mask;
+    if (mask == 0 && d->bake.order_tolerance > 0.0f)
+        return 0;
     if (mask == 0)
         mask = 1u << (d->bake.max_order ? d->bake.max_order : VB_DEFAULT_ORDER); /* bake.h */
     if (!(mask & (1u << 4 | 1u << 5)) || d->cube_size < 0)

@@ -558,7 +558,30 @@ static int run_truth(const options *op)
                 return 1;
             }
             have_sdf = 1;
-        } else if (op->sdf_k_given) { /* it made no c-sdf frame, exit 0 */
+            /* The runtime's rule (vr.h, sdf_path): a volume baked beside
+             * other vertex or triangle counts is refused when named, and
+             * skipped when it is the companion (left by an earlier bake of
+             * the same name), so c-sdf is what vdsh-view's mode sdf draws. */
+            if ((vol.vertex_count || vol.triangle_count) &&
+                (vol.vertex_count != f->header.vertex_count ||
+                 vol.triangle_count != f->header.triangle_count)) {
+                fprintf(stderr,
+                        PROG ": %s%s was baked beside another bake (%u vertices and %u "
+                             "triangles, not %u and %u)%s\n",
+                        p, sdf_arg ? "" : " beside it", vol.vertex_count, vol.triangle_count,
+                        f->header.vertex_count, f->header.triangle_count,
+                        sdf_arg ? ": bake it again (vdsh-bake --sdf N)"
+                                : ": skipped, no c-sdf frames (bake again with vdsh-bake --sdf N)");
+                vdsh_sdf_free(&vol);
+                have_sdf = 0;
+                if (sdf_arg) {
+                    loaded_free(&L);
+                    vt_views_free(&V);
+                    return 1;
+                }
+            }
+        }
+        if (!have_sdf && op->sdf_k_given) { /* it made no c-sdf frame, exit 0 */
             fprintf(stderr,
                     PROG ": --sdf-k: %s has no distance volume (no %s; bake one with "
                          "vdsh-bake --sdf N, or give --sdf FILE)\n",

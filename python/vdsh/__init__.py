@@ -134,10 +134,25 @@ def read(path: Union[str, "os.PathLike[str]"]) -> VdshFile:
     return parse(data, path)
 
 
+_OTHER_FORMATS = (
+    (b"VDSHSDF\0", "a VDSH distance volume (vdsh-bake --sdf; vdsh-view --sdf reads it)"),
+    (b"glTF", "a binary glTF (.glb: vdsh-export writes it, vdsh-bake reads it as a mesh)"),
+    (b"\x76\x2f\x31\x01", "an OpenEXR image (the bake's basis cubemaps)"),
+    (b"ply\n", "a PLY mesh (vdsh-bake reads it)"),
+    (b"\x89PNG", "a PNG image"),
+)
+
+
 def parse(data: bytes, path: str = "memory") -> VdshFile:
     """As `read`, from the file's bytes; `path` names it in messages."""
     n = len(data)
     if data[:8] != MAGIC[:n]:
+        # Files the tools write beside a bake, or meshes, named for what
+        # they are, as formats/vdsh_read.c does (the distance volume's
+        # magic begins with "VDSH").
+        for magic, what in _OTHER_FORMATS:
+            if data[:len(magic)] == magic:
+                _fail(path, "not a .vdsh file: " + what)
         _fail(path, "not a .vdsh file (magic)")
     if n < 32:  # a file cut short, as vdsh-info says it
         _fail(path, "truncated: %d byte%s, shorter than the 32-byte header" % (n, _s(n)))

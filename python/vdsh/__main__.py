@@ -38,6 +38,23 @@ def _bytes_per_vertex(s: Dict[str, Any]) -> int:
     return {"f32": 4 * nc, "f16": 2 * nc, "s8": nc, "s8s6": min(nc, 4) + 4 * words}[s["encoding"]]
 
 
+def _cpca(s: Dict[str, Any], rows: int) -> Dict[str, Any]:
+    """vdsh-info --json's "cpca" of a cpca stream: the model (its bytes as
+    formats/vdsh_encode.c's vdsh_cpca_stream_model_bytes: the 16-byte
+    header, the scales, means and bases each padded to 16 bytes, the widths
+    table when bits is 0) and the bytes per vertex with it."""
+    c = s["cpca"]
+    r16 = lambda x: (x + 15) // 16 * 16  # noqa: E731
+    k, b, n = c["clusters"], c["basis"], s["order"] ** 2
+    model = 16 + r16(4 * k * b) + r16(2 * k * n) + r16(2 * k * b * n) + (0 if c["bits"] else r16(b))
+    o: Dict[str, Any] = dict(clusters=k, basis=b, bits=c["bits"], record_words=c["record_words"],
+                             model_bytes=model)
+    if not c["bits"]:
+        o["widths"] = [int(w) for w in c["widths"]]
+    o["mean_bytes_per_vertex"] = 4 * c["record_words"] + (model / rows if rows else 0.0)
+    return o
+
+
 def summary(f: VdshFile, path: str) -> Dict[str, Any]:
     """The figures of vdsh-info --json this package knows, under its names."""
     h = f.header
@@ -56,6 +73,8 @@ def summary(f: VdshFile, path: str) -> Dict[str, Any]:
                               mean=float(c0.astype(np.float64).mean())))
         if s["coef_scales"] is not None:
             o["coef_scales"] = [float(x) for x in s["coef_scales"]]
+        if s["encoding"] == "cpca":
+            o["cpca"] = _cpca(s, len(s["cpca"]["cluster"]))
         if s["variable_order"]:
             # as vdsh_stream_size_of: records padded to 4 bytes, after the
             # order table (rows padded to 16)

@@ -66,6 +66,14 @@
  * the frame at 16 lights (docs/BENCHMARKS.md "Decoding once per frame").
  */
 #if BUFFER
+/* What the includer must define (README.md here): a shader that leaves
+ * one out fails here, naming it, not at the first line that uses it (no
+ * quotes in the messages: GLSL ES has no such characters). */
+#if !defined(NUM_LIGHTS) || !defined(BUF_ORDER) || !defined(BUF_KIND) || !defined(BUF_VARIABLE)
+#error vdsh_buffer.glsl: define NUM_LIGHTS, BUF_ORDER, BUF_KIND and BUF_VARIABLE before it
+#elif BUF_VARIABLE == 0 && !defined(BUF_STRIDE)
+#error vdsh_buffer.glsl: BUF_VARIABLE 0 needs BUF_STRIDE, the texels (words for BUF_KIND 3 and 4) of one vertex record
+#endif
 #ifndef BUF_TEXTURE_2D
 #define BUF_TEXTURE_2D 0
 #endif
