@@ -227,3 +227,5 @@ add_test(NAME bake_stream_output
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_bake_stream_output.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge>)
 set_tests_properties(bake_stream_output PROPERTIES TIMEOUT 60)
+add_executable(object_rule_probe object_rule_probe.c)
+target_link_libraries(object_rule_probe PRIVATE vb_core)
