@@ -160,6 +160,10 @@ set_tests_properties(build_no_fma PROPERTIES SKIP_RETURN_CODE 77)
 # across Embree's kernel sets (test_isa_decisions.sh).
 add_executable(light_region_probe light_region_probe.c)
 target_link_libraries(light_region_probe PRIVATE vb_core)
+# Counts for telling objects from rooms (docs/ACCURACY.md, "Objects or
+# rooms"): a measuring tool, no test.
+add_executable(object_rule_probe object_rule_probe.c)
+target_link_libraries(object_rule_probe PRIVATE vb_core)
 # vdsh-view's light pool (vr_scene_place_pool: the grid tracer's
 # vdsh_view_free_space) and the bake side's placement (vb_scene_place_lights:
 # Embree's probes, measured in double) with the same seed, one rule
@@ -227,5 +231,3 @@ add_test(NAME bake_stream_output
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_bake_stream_output.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge>)
 set_tests_properties(bake_stream_output PROPERTIES TIMEOUT 60)
-add_executable(object_rule_probe object_rule_probe.c)
-target_link_libraries(object_rule_probe PRIVATE vb_core)
