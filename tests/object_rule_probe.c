@@ -1,7 +1,7 @@
 /*
  * object_rule_probe SCENE: statistics for telling an object (seen from
  * outside) from a room or interior (issue 25; docs/ACCURACY.md, "Objects
- * or rooms: no rule for auto"), each a count of free-space decisions or
+ * or rooms: a rule for auto, not adopted"), each a count of free-space decisions or
  * of probe rays that meet nothing (vdsh_light.h, the same probes as the
  * free-space test), so the same on every kernel set and thread count:
  *   line 1: in N      free of the first VDSH_REGION_PROBES candidates in
