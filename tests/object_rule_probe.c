@@ -1,9 +1,10 @@
 /*
  * object_rule_probe SCENE: statistics for telling an object (seen from
  * outside) from a room or interior (issue 25; docs/ACCURACY.md, "Objects
- * or rooms: a rule for auto, not adopted"), each a count of free-space decisions or
- * of probe rays that meet nothing (vdsh_light.h, the same probes as the
- * free-space test), so the same on every kernel set and thread count:
+ * or rooms: a rule for auto, not adopted"), each a count of free-space
+ * decisions or of probe rays that meet nothing (vdsh_light.h, the same
+ * probes as the free-space test; the same output under the four Embree
+ * kernel sets on the scenes measured there; one thread):
  *   line 1: in N      free of the first VDSH_REGION_PROBES candidates in
  *                     the bounds (vdsh_light_region's count, not stopped
  *                     early)
