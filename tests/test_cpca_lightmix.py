@@ -27,13 +27,13 @@ import os
 import struct
 import subprocess
 import sys
-import zlib
 
 import numpy as np
 
 bake, merge, info, src, work, pool_tool = sys.argv[1:7]
 sys.path.insert(0, os.path.join(src, "python"))
 import vdsh  # noqa: E402
+from testlib import chunks, fix_crc  # noqa: E402
 
 os.makedirs(work, exist_ok=True)
 TINY = ["builtin:room", "--max-edge", "1.0", "--rays", "64", "--cube-size", "0", "-q",
@@ -162,22 +162,6 @@ r = subprocess.run([merge, "-q", path("s0.vdsh"), path("s1.vdsh"), "-o", path("m
 if r.returncode == 0 or "s1.vdsh" not in r.stderr or "light pool" not in r.stderr or \
         os.path.exists(path("mix.vdsh")):
     fail.append("parts with other pools: exit %d, stderr %r" % (r.returncode, r.stderr))
-
-
-def chunks(d):
-    """(offset, id, size) of every chunk of file bytes d."""
-    out, off = [], 32
-    while off + 16 <= len(d):
-        cid, size = d[off:off + 4], struct.unpack_from("<Q", d, off + 8)[0]
-        out.append((off, cid, size))
-        off += 16 + size + (-size % 16)
-    return out
-
-
-def fix_crc(d, off, size):
-    pay = bytes(d[off + 16:off + 16 + size + (-size % 16)])
-    crc = zlib.crc32(pay, zlib.crc32(bytes(d[off + 8:off + 16]), zlib.crc32(bytes(d[off:off + 4]))))
-    struct.pack_into("<I", d, off + 4, crc)
 
 
 def refused(name, data, words):

@@ -17,6 +17,7 @@ import numpy as np
 test_cpca, src, work = sys.argv[1:4]
 sys.path.insert(0, os.path.join(src, "python"))
 import vdsh  # noqa: E402
+from testlib import chunks, fix_crc  # noqa: E402
 
 os.makedirs(work, exist_ok=True)
 subprocess.run([test_cpca, work], check=True, stdout=subprocess.DEVNULL)
@@ -31,38 +32,15 @@ if not np.array_equal(got.view(np.uint32), want.view(np.uint32)):
     fail.append("decode differs from C at %d of %d values" % ((got != want).sum(), got.size))
 # a changed cluster index (CRCs fixed) is refused by Python as by C
 d = bytearray(open(os.path.join(work, "cpca.vdsh"), "rb").read())
-off = 32
-while off + 16 <= len(d):
-    n = int.from_bytes(d[off + 8:off + 16], "little")
-    if d[off:off + 4] == b"COEF":
-        d[off + 16 + 4352] = 3
-        import zlib
-        pad = (n + 15) // 16 * 16
-        crc = zlib.crc32(d[off + 8:off + 16], zlib.crc32(d[off:off + 4]))
-        d[off + 4:off + 8] = zlib.crc32(d[off + 16:off + 16 + pad], crc).to_bytes(4, "little")
-    off += 16 + (n + 15) // 16 * 16
+off, _, n = next(c for c in chunks(d) if c[1] == b"COEF")
+d[off + 16 + 4352] = 3
+fix_crc(d, off, n)
 try:
     vdsh.parse(bytes(d), "bad.vdsh")
     fail.append("a cluster index >= K accepted")
 except vdsh.VdshError as e:
     if "cluster" not in str(e):
         fail.append("refused for another reason: %s" % e)
-
-
-def chunks(d):
-    """(offset, id, size) of each chunk of file bytes d."""
-    off = 32
-    while off + 16 <= len(d):
-        n = int.from_bytes(d[off + 8:off + 16], "little")
-        yield off, bytes(d[off:off + 4]), n
-        off += 16 + (n + 15) // 16 * 16
-
-
-def fix_crc(d, off, n):
-    import zlib
-    pad = (n + 15) // 16 * 16
-    crc = zlib.crc32(d[off + 8:off + 16], zlib.crc32(d[off:off + 4]))
-    d[off + 4:off + 8] = zlib.crc32(d[off + 16:off + 16 + pad], crc).to_bytes(4, "little")
 
 
 def refused(d, what, name):

@@ -29,11 +29,11 @@ import os
 import struct
 import subprocess
 import sys
-import zlib
 
 bake, ev, merge, info, src, work = sys.argv[1:7]
 sys.path.insert(0, os.path.join(src, "python"))
 import vdsh  # noqa: E402
+from testlib import chunks, fix_crc  # noqa: E402
 
 os.makedirs(work, exist_ok=True)
 OBJ = os.path.join(src, "tests", "data", "cube_floor.obj")
@@ -61,22 +61,6 @@ def must(r, what):
 def blob(name):
     with open(path(name), "rb") as f:
         return f.read()
-
-
-def chunks(d):
-    """(offset, id, size) of every chunk of file bytes d."""
-    out, off = [], 32
-    while off + 16 <= len(d):
-        cid, size = d[off:off + 4], struct.unpack_from("<Q", d, off + 8)[0]
-        out.append((off, cid, size))
-        off += 16 + size + (-size % 16)
-    return out
-
-
-def fix_crc(d, off, size):
-    pay = bytes(d[off + 16:off + 16 + size + (-size % 16)])
-    crc = zlib.crc32(pay, zlib.crc32(bytes(d[off + 8:off + 16]), zlib.crc32(bytes(d[off:off + 4]))))
-    struct.pack_into("<I", d, off + 4, crc)
 
 
 # 1. Bad values: exit 2, the message names the option, no file.

@@ -50,3 +50,24 @@ def view_frames(view, views, frames, modes, vd):
             sys.exit(77)
         print("FAIL: vdsh-view: " + p.stderr)
         sys.exit(1)
+
+
+def chunks(d):
+    """(offset, id, size) of every chunk of .vdsh file bytes d (past the
+    32-byte header; formats/VDSH.md: 16-byte chunk headers, payloads padded
+    to 16)."""
+    out, off = [], 32
+    while off + 16 <= len(d):
+        size = int.from_bytes(d[off + 8:off + 16], "little")
+        out.append((off, bytes(d[off:off + 4]), size))
+        off += 16 + size + (-size % 16)
+    return out
+
+
+def fix_crc(d, off, size):
+    """Rewrite the CRC of the chunk at `off` of bytearray d (id, size and
+    padded payload), so that a reader gets past it to the damage a test made."""
+    import zlib
+    crc = zlib.crc32(bytes(d[off + 8:off + 16]), zlib.crc32(bytes(d[off:off + 4])))
+    crc = zlib.crc32(bytes(d[off + 16:off + 16 + size + (-size % 16)]), crc)
+    d[off + 4:off + 8] = crc.to_bytes(4, "little")
