@@ -67,13 +67,18 @@ typedef enum vb_mesh_format {
 typedef struct vb_mesh_raw {
     uint32_t vertex_count;
     uint32_t triangle_count;
-    float *positions;            /* 3 * vertex_count */
-    float *normals;              /* 3 * vertex_count or NULL (file has none) */
-    uint8_t *has_normal;         /* vertex_count or NULL: file gave a normal */
-    int64_t *indices;            /* 3 * triangle_count */
-    uint32_t *faces;             /* triangle_count: 0-based polygon in the file */
-    float *corner_normals;       /* 9 * triangle_count or NULL (none given) */
-    uint8_t *corner_given;       /* 3 * triangle_count or NULL: corner has one */
+    float *positions;      /* 3 * vertex_count */
+    float *normals;        /* 3 * vertex_count or NULL (file has none) */
+    uint8_t *has_normal;   /* vertex_count or NULL: file gave a normal */
+    int64_t *indices;      /* 3 * triangle_count */
+    uint32_t *faces;       /* triangle_count: 0-based polygon in the file */
+    float *corner_normals; /* 9 * triangle_count or NULL (none given) */
+    uint8_t *corner_given; /* 3 * triangle_count or NULL: corner has one */
+    /* unclipped_count polygons (file numbers as in `faces`, ascending)
+     * fanned because the ear clipping's time bound ran out, not tried (NULL
+     * when none) */
+    uint32_t *unclipped_faces;
+    uint32_t unclipped_count;
     uint32_t dropped_triangles;  /* OBJ faces dropped for fewer than 3
                                    distinct vertices (see vb_mesh_report) */
     uint32_t gltf_skipped_modes; /* glTF primitives skipped: points, lines */
