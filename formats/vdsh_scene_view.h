@@ -217,9 +217,9 @@ typedef struct vdsh_view_hit {
     float t;    /* distance along the unit direction */
     float u, v; /* barycentrics of vertices 1 and 2 */
     uint32_t triangle;
-    int back; /* the ray met the face from behind: its
-                                    winding normal (v1 - v0) x (v2 - v0)
-                                    points along the ray */
+    /* the ray met the face from behind: its winding normal (v1 - v0) x (v2 -
+     * v0) points along the ray */
+    int back;
 } vdsh_view_hit;
 
 /* The largest |coordinate| the view's float arithmetic takes (extents

@@ -79,18 +79,22 @@ typedef struct vb_mesh_raw {
      * when none) */
     uint32_t *unclipped_faces;
     uint32_t unclipped_count;
-    uint32_t dropped_triangles;  /* OBJ faces dropped for fewer than 3
-                                   distinct vertices (see vb_mesh_report) */
+    /* OBJ faces dropped for fewer than 3 distinct vertices (see
+     * vb_mesh_report) */
+    uint32_t dropped_triangles;
     uint32_t gltf_skipped_modes; /* glTF primitives skipped: points, lines */
     uint32_t gltf_skipped_morph; /* glTF primitives with morph targets: base pose baked */
     uint32_t gltf_skipped_skin;  /* glTF primitives of skinned nodes: bind pose baked */
-    uint32_t gltf_ragged;        /* glTF triangle lists whose count is not a
-                                   multiple of 3: the last 1 or 2 ignored */
-    int gltf_hashed;             /* glTF with external buffers: the source's
-                                   hash and size are these, not the file's */
-    uint64_t gltf_size;          /* the file's bytes plus its external buffers' */
-    uint8_t gltf_sha256[32];     /* SHA-256 of the file's bytes, then of each
-                                   external buffer's in `buffers` order */
+    /* glTF triangle lists whose count is not a multiple of 3: the last 1 or 2
+     * ignored */
+    uint32_t gltf_ragged;
+    /* glTF with external buffers: the source's hash and size are these, not
+     * the file's */
+    int gltf_hashed;
+    uint64_t gltf_size; /* the file's bytes plus its external buffers' */
+    /* SHA-256 of the file's bytes, then of each external buffer's in `buffers`
+     * order */
+    uint8_t gltf_sha256[32];
 } vb_mesh_raw;
 
 /* Read `size` bytes (the whole file) of `format`; `name` is for messages. */
