@@ -185,8 +185,18 @@ typedef struct vdsh_view {
  * and shadow that share each; the lights are, in this order: the kept
  * ones, the candidates that light the frame and shadow the share, those
  * that light it, then the rest by the share they light (ties: the earlier). Where
- * every preferred light lights the frame, nothing changes. Deterministic: the same mesh
- * gives the same view on every machine. */
+ * every preferred light lights the frame, nothing changes. An object's
+ * lights, where its light region is its bounds (not given, not grown),
+ * must light what the camera sees of it likewise: a light that lights
+ * less than VDSH_VIEW_MIN_SHARE of the check frame's pixels that see the
+ * object, or less than it shadows (pulled into the bounds, it can stand
+ * behind the object's end faces: the 2CylinderEngine's light 0, inside
+ * its end cap), tries its preferred position pulled into the bounds
+ * grown by VDSH_REGION_GROW of the diagonal on every axis instead, found
+ * free as above, and takes it when that one lights the object so; the
+ * lights that light it stay (the default views of the teapot, bunny,
+ * fandisk, rocker arm and a cube on a floor: light 0 as it was).
+ * Deterministic: the same mesh gives the same view on every machine. */
 vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_error *err);
 
 /* The bounding box of positions (vertex_count x 3), fminf / fmaxf per
