@@ -84,10 +84,11 @@ typedef enum vdsh_result {
     VDSH_ERR_VERSION,   /* a version this reader does not support */
     VDSH_ERR_TRUNCATED, /* shorter than its header or a chunk says */
     VDSH_ERR_CRC,       /* header or chunk CRC mismatch */
-    VDSH_ERR_CHUNK,     /* chunk structure: unknown critical id, missing,
-                               repeated or misplaced chunk, bad size, padding */
-    VDSH_ERR_INVALID,   /* a value out of range: count, enum, index, NaN */
-    VDSH_ERR_ARGUMENT   /* the caller passed an inconsistent vdsh_file */
+    /* chunk structure: unknown critical id, missing, repeated or misplaced
+     * chunk, bad size, padding */
+    VDSH_ERR_CHUNK,
+    VDSH_ERR_INVALID, /* a value out of range: count, enum, index, NaN */
+    VDSH_ERR_ARGUMENT /* the caller passed an inconsistent vdsh_file */
 } vdsh_result;
 
 /* A static string such as "CRC mismatch"; never NULL. */
@@ -112,12 +113,13 @@ enum { VDSH_TRACE_ROBUST = 1u };
 typedef enum vdsh_encoding {
     VDSH_ENCODING_F32 = 0,
     VDSH_ENCODING_F16 = 1,
-    VDSH_ENCODING_S8 = 2,   /* signed 8-bit, a scale per coefficient index */
-    VDSH_ENCODING_S8S6 = 3, /* bands 0-1 as s8, bands 2+ signed 6-bit, packed
-                                five to a u32 word; scales as s8 */
-    VDSH_ENCODING_CPCA = 4  /* clustered PCA (issue 29): per cluster a mean
-                                and basis vectors (f16), per vertex a cluster
-                                index and packed weights (vdsh_cpca below) */
+    VDSH_ENCODING_S8 = 2, /* signed 8-bit, a scale per coefficient index */
+    /* bands 0-1 as s8, bands 2+ signed 6-bit, packed five to a u32 word;
+     * scales as s8 */
+    VDSH_ENCODING_S8S6 = 3,
+    /* clustered PCA (issue 29): per cluster a mean and basis vectors (f16),
+     * per vertex a cluster index and packed weights (vdsh_cpca below) */
+    VDSH_ENCODING_CPCA = 4
 } vdsh_encoding;
 /* The largest encoding value this version reads and writes. */
 #define VDSH_ENCODING_LAST VDSH_ENCODING_CPCA
@@ -232,8 +234,8 @@ typedef struct vdsh_cpca {
     const uint8_t *widths; /* bits 0: B widths, each 2..8; else NULL */
     const float *scales;   /* K * B: vector j of cluster c at c * B + j */
     const uint16_t *means; /* f16, K * order^2: cluster c's at c * order^2 */
-    const uint16_t *bases; /* f16, K * B * order^2: vector j of cluster c
-                                 at (c * B + j) * order^2 */
+    /* f16, K * B * order^2: vector j of cluster c at (c * B + j) * order^2 */
+    const uint16_t *bases;
 } vdsh_cpca;
 #define VDSH_CPCA_MAX_CLUSTERS 256
 #define VDSH_CPCA_MIN_BITS 2
@@ -256,10 +258,12 @@ typedef struct vdsh_stream {
     uint32_t window;   /* vdsh_window */
     float window_param;
     float method_param;
-    float scale;              /* coefficient = stored value * scale (f32, f16);
-                              s8: 1, the table below scales */
-    float quantity_param;     /* log-distance: the floor (distances below it
-                              were clamped to it before the log); else 0 */
+    /* coefficient = stored value * scale (f32, f16); s8: 1, the table below
+     * scales */
+    float scale;
+    /* log-distance: the floor (distances below it were clamped to it before
+     * the log); else 0 */
+    float quantity_param;
     const void *data;         /* vertex_count * order^2 values of `encoding` */
     const float *coef_scales; /* s8, s8s6 only (else NULL): order^2 scales,
                                  one per coefficient index, each finite and
@@ -330,10 +334,11 @@ typedef struct vdsh_adaptive {
  * (vdsh_light.h, vdsh_light_region). */
 enum { VDSH_LIGHT_REGION_GROWN = 1, VDSH_LIGHT_REGION_BOX = 2 };
 typedef struct vdsh_light_box {
-    uint32_t rule; /* VDSH_LIGHT_REGION_GROWN (the bounds grown by
-                        * VDSH_REGION_GROW of their diagonal) or _BOX (given) */
-    float min[3];  /* scene units (the space of POSN), finite */
-    float max[3];  /* finite, > min on every axis */
+    /* VDSH_LIGHT_REGION_GROWN (the bounds grown by VDSH_REGION_GROW of their
+     * diagonal) or _BOX (given) */
+    uint32_t rule;
+    float min[3]; /* scene units (the space of POSN), finite */
+    float max[3]; /* finite, > min on every axis */
 } vdsh_light_box;
 
 /* A part's cpca light pool (`lpol` chunk, VDSH.md "Parts"): the light mix
@@ -590,9 +595,10 @@ uint32_t vdsh_crc32(uint32_t crc, const void *data, size_t size);
 /* One chunk as it lies in a file image, for tools that list and check
  * chunks (vdsh-info --verify). */
 typedef struct vdsh_chunk_info {
-    char id[5];      /* the 4 id bytes + NUL; non-letters read as '?' */
-    int complete;    /* payload and padding lie inside the data; if 0,
-                              crc_computed is 0 and this is the last entry */
+    char id[5]; /* the 4 id bytes + NUL; non-letters read as '?' */
+    /* payload and padding lie inside the data; if 0, crc_computed is 0 and
+     * this is the last entry */
+    int complete;
     uint64_t offset; /* of the 16-byte chunk header */
     uint64_t size;   /* payload bytes the header states (no padding) */
     uint32_t crc_stored;

@@ -687,8 +687,10 @@ static void frame_free(frame_pts *f)
     f->p = f->nrm = NULL;
 }
 
+/* per_hit: shares of the pixels that see a surface (an object's, which
+ * fills part of its frame), else of the whole frame (an interior's). */
 static void shares_of(const vdsh_view_tracer *t, const frame_pts *f, const float L[3],
-                      float diagonal, float *lit, float *shadowed)
+                      float diagonal, int per_hit, float *lit, float *shadowed)
 {
     const float eps = 1e-4f * diagonal;
     uint32_t a = 0, b = 0;
@@ -710,8 +712,9 @@ static void shares_of(const vdsh_view_tracer *t, const frame_pts *f, const float
         else
             a++;
     }
-    *lit = f->pixels ? (float)a / (float)f->pixels : 0.0f;
-    *shadowed = f->pixels ? (float)b / (float)f->pixels : 0.0f;
+    const uint32_t of = per_hit ? f->n : f->pixels;
+    *lit = of ? (float)a / (float)of : 0.0f;
+    *shadowed = of ? (float)b / (float)of : 0.0f;
 }
 
 void vdsh_view_light_shares(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
@@ -722,7 +725,7 @@ void vdsh_view_light_shares(const vdsh_view_tracer *t, const vdsh_view_mesh *m,
     *lit = *shadowed = 0.0f;
     if (width <= 0 || height <= 0 || !frame_points(t, m, c, width, height, &f))
         return;
-    shares_of(t, &f, light, diagonal, lit, shadowed);
+    shares_of(t, &f, light, diagonal, 0, lit, shadowed);
     frame_free(&f);
 }
 
@@ -936,7 +939,7 @@ static vdsh_result choose_lights(const vdsh_view_tracer *t, const vdsh_view_mesh
     for (int i = 0; i < v->light_count; i++, n++) {
         memcpy(c[n].p, v->lights[i], sizeof c[n].p);
         c[n].free = v->light_free[i], c[n].pref = i;
-        shares_of(t, &f, c[n].p, diag, &c[n].lit, &c[n].sh);
+        shares_of(t, &f, c[n].p, diag, 0, &c[n].lit, &c[n].sh);
         good += tier(&c[n]) == 0;
     }
     /* Too few light the frame: seeded candidates, until enough do; first
@@ -963,7 +966,7 @@ static vdsh_result choose_lights(const vdsh_view_tracer *t, const vdsh_view_mesh
                 continue;
             memcpy(c[n].p, p, sizeof p);
             c[n].free = 1, c[n].pref = -1;
-            shares_of(t, &f, p, diag, &c[n].lit, &c[n].sh);
+            shares_of(t, &f, p, diag, 0, &c[n].lit, &c[n].sh);
             good += tier(&c[n]) == 1;
             n++;
         }
@@ -988,6 +991,48 @@ static vdsh_result choose_lights(const vdsh_view_tracer *t, const vdsh_view_mesh
         take_light(&out, k, &c[best], v);
     }
     *v = out;
+    return VDSH_OK;
+}
+
+/* An object's lights pulled into a light region of its bounds (not
+ * grown: bounds that hold free space) can stand behind its end faces:
+ * the 2CylinderEngine's light 0, clamped per axis to the bounds' far
+ * corner, stood inside its end cap, on the side away from the eye, and
+ * lit 7% of what the camera sees of it and shadowed 27%. A light that
+ * lights less than VDSH_VIEW_MIN_SHARE of the pixels that see the object,
+ * or less than it shadows, tries its preferred position raw[i] pulled
+ * into the bounds grown as around a closed object (light_box, every axis)
+ * instead, and takes it when that one lights the frame so; the others are
+ * left as they were. */
+static vdsh_result object_lights(const vdsh_view_tracer *t, const vdsh_view_mesh *m, vdsh_view *v,
+                                 float diag, float region_diag, int flat, const float *c,
+                                 const float (*raw)[3])
+{
+    frame_pts f;
+    if (!frame_points(t, m, &v->camera, VDSH_VIEW_CHECK_W, VDSH_VIEW_CHECK_H, &f))
+        return VDSH_ERR_OUT_OF_MEMORY;
+    float glo[3], ghi[3];
+    light_box(v->region_min, v->region_max, v->bounds_min, v->bounds_max, region_diag, 1, glo, ghi);
+    for (int i = 0; i < v->light_count; i++) {
+        scored a = {{0}, 0, 0, 0, i};
+        shares_of(t, &f, v->lights[i], diag, 1, &a.lit, &a.sh);
+        if (tier(&a) == 0)
+            continue;
+        scored b = {{0}, 0, 0, 0, i};
+        float q[3];
+        memcpy(q, raw[i], sizeof q);
+        into_region(q, glo, ghi, flat ? c : NULL);
+        b.free = find_free(t, q, glo, ghi, diag, &v->light_trials, b.p);
+        if (!b.free)
+            memcpy(b.p, q, sizeof q);
+        shares_of(t, &f, b.p, diag, 1, &b.lit, &b.sh);
+        if (tier(&b) != 0)
+            continue;
+        memcpy(v->lights[i], b.p, sizeof b.p);
+        memcpy(v->preferred[i], q, sizeof q);
+        v->light_free[i] = b.free;
+    }
+    frame_free(&f);
     return VDSH_OK;
 }
 
@@ -1117,6 +1162,8 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
     float blo[3], bhi[3];
     light_box(v.region_min, v.region_max, lo, hi, rc.diagonal, flat && !v.region_given, blo, bhi);
     const float *slo = v.interior ? lo : blo, *shi = v.interior ? hi : bhi;
+    float raw[VDSH_VIEW_MAX_LIGHTS][3];
+    memcpy(raw, v.preferred, sizeof raw);
     for (int i = 0; !v.interior && i < v.light_count; i++)
         into_region(v.preferred[i], slo, shi, flat ? c : NULL);
     for (int i = 0; i < v.light_count; i++) {
@@ -1125,7 +1172,9 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
         if (!v.light_free[i])
             memcpy(v.lights[i], v.preferred[i], sizeof v.lights[i]);
     }
-    if (v.interior && choose_lights(t, m, &v, diag) != VDSH_OK) {
+    if ((v.interior && choose_lights(t, m, &v, diag) != VDSH_OK) ||
+        (!v.interior && !v.region_given && !v.region_grown &&
+         object_lights(t, m, &v, diag, rc.diagonal, flat, c, (const float(*)[3])raw) != VDSH_OK)) {
         vdsh_view_tracer_destroy(t);
         return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "out of memory for the default lights");
     }

@@ -68,10 +68,11 @@ extern "C" {
 
 /* Rays from the room's eye, and the share of them that must meet the
  * front of a surface for the scene to count as an interior. Measured
- * (vdsh_view_front_share, default bakes): the built-in room 1.0, Lost
- * Empire 1.0, Sponza 0.99, the Cornell boxes (one wall open) 0.64-0.70; a
- * floor with a box on it 0.48 (the floor below, the sky above), fandisk
- * 0.40, the rocker arm 0.36, the teapot 0.27 (an eye beside the object
+ * (vdsh_view_front_share, default bakes): the built-in room 1.0, Sponza
+ * 0.99, the Cornell boxes (one wall open) 0.64-0.70; a floor with a box
+ * on it 0.48 (the floor below, the sky above), fandisk 0.40, the rocker
+ * arm 0.36, Lost Empire 0.33 (a terrain open to the sky: framed from
+ * outside, as an object), the teapot 0.27 (an eye beside the object
  * inside its bounds), the bunnies 0 (an eye inside the mesh sees the backs
  * of its faces). */
 #define VDSH_VIEW_RAYS 128
@@ -184,8 +185,18 @@ typedef struct vdsh_view {
  * and shadow that share each; the lights are, in this order: the kept
  * ones, the candidates that light the frame and shadow the share, those
  * that light it, then the rest by the share they light (ties: the earlier). Where
- * every preferred light lights the frame, nothing changes. Deterministic: the same mesh
- * gives the same view on every machine. */
+ * every preferred light lights the frame, nothing changes. An object's
+ * lights, where its light region is its bounds (not given, not grown),
+ * must light what the camera sees of it likewise: a light that lights
+ * less than VDSH_VIEW_MIN_SHARE of the check frame's pixels that see the
+ * object, or less than it shadows (pulled into the bounds, it can stand
+ * behind the object's end faces: the 2CylinderEngine's light 0, inside
+ * its end cap), tries its preferred position pulled into the bounds
+ * grown by VDSH_REGION_GROW of the diagonal on every axis instead, found
+ * free as above, and takes it when that one lights the object so; the
+ * lights that light it stay (the default views of the teapot, bunny,
+ * fandisk, rocker arm and a cube on a floor: light 0 as it was).
+ * Deterministic: the same mesh gives the same view on every machine. */
 vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_error *err);
 
 /* The bounding box of positions (vertex_count x 3), fminf / fmaxf per
@@ -216,9 +227,9 @@ typedef struct vdsh_view_hit {
     float t;    /* distance along the unit direction */
     float u, v; /* barycentrics of vertices 1 and 2 */
     uint32_t triangle;
-    int back; /* the ray met the face from behind: its
-                                    winding normal (v1 - v0) x (v2 - v0)
-                                    points along the ray */
+    /* the ray met the face from behind: its winding normal (v1 - v0) x (v2 -
+     * v0) points along the ray */
+    int back;
 } vdsh_view_hit;
 
 /* The largest |coordinate| the view's float arithmetic takes (extents

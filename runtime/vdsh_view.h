@@ -56,12 +56,13 @@ typedef struct vv_options {
     vr_egl_platform egl;
     int frames;
     int no_mallopt;
-    int buffer_floats;       /* --bench: also time buffers of decoded f32 */
-    int cpca_frame;          /* cpca decoded once per frame (--cpca-frame) */
-    int bench_sets;          /* --bench-lights: bit i, light set i of
-                                  1, 3, 16, 64; 0: all */
-    int bench_cube_sizes[8]; /* --bench-cube-sizes: cube and cube_pcf
-                                  timed at each face size (cubeN, cube_pcfN) */
+    int buffer_floats; /* --bench: also time buffers of decoded f32 */
+    int cpca_frame;    /* cpca decoded once per frame (--cpca-frame) */
+    /* --bench-lights: bit i, light set i of 1, 3, 16, 64; 0: all */
+    int bench_sets;
+    /* --bench-cube-sizes: cube and cube_pcf timed at each face size (cubeN,
+     * cube_pcfN) */
+    int bench_cube_sizes[8];
     int bench_cube_count;
     const char *bench_modes; /* --bench-modes: only these names; NULL: all */
     int bench_counts;        /* --bench-counts: GL counts of each mode */
@@ -75,8 +76,9 @@ typedef struct vv_options {
     const char *frames_dir;
     int frame_modes[VV_MAX_MODES]; /* --modes: indices into vv_modes[] */
     int frame_mode_count;
-    int buffers; /* load orders 2, 3, 5 as buffers too (a bufN mode
-                                  of such an order, or --bench) */
+    /* load orders 2, 3, 5 as buffers too (a bufN mode of such an order, or
+     * --bench) */
+    int buffers;
 } vv_options;
 
 /* The viewer's render modes: the one list that --mode, --modes, the frame
@@ -100,10 +102,10 @@ typedef struct vv_mode {
     int pcf;
     int stream;     /* VR_MODE_VDSH_BUFFER: vr_draw_desc.stream */
     unsigned flags; /* VV_MODE_* below */
-    int grid;       /* --grid: its column, 1..; 0 none. Several
-                                  rows in a column: the first the scene
-                                  has, else the last */
-    char key;       /* the window: its digit key, 0 none */
+    /* --grid: its column, 1..; 0 none. Several rows in a column: the first the
+     * scene has, else the last */
+    int grid;
+    char key; /* the window: its digit key, 0 none */
 } vv_mode;
 
 enum {

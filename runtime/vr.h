@@ -209,7 +209,7 @@ typedef struct vr_scene_desc {
      * as a 3D texture. NULL (default): the .vdsh's companion file
      * (vdsh_sdf_path: room.vdsh -> room.sdf) when desc->path is set and
      * that file exists, else none (VR_MODE_SDF then fails with
-     * VR_ERR_MISSING). A volume that cannot be read fails the load, as
+     * VR_ERR_MISSING, naming that file). A volume that cannot be read fails the load, as
      * does one named here that was baked beside a scene of other vertex
      * or triangle counts; such a companion (left by an earlier bake of
      * the same name) is skipped, and VR_MODE_SDF's VR_ERR_MISSING says

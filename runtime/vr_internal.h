@@ -151,10 +151,12 @@ struct vr_scene {
     GLuint sdf_tex;                     /* mode sdf: the distance volume (0: none) */
     vdsh_sdf sdf;                       /* its header (samples NULL) */
     size_t sdf_bytes;
-    /* The companion volume found beside the .vdsh but baked beside
-     * another bake (left by an earlier vdsh-bake --sdf of the same name):
-     * not loaded, and why, for mode sdf's message ("": none skipped). */
-    char sdf_stale[4608];
+    /* Why mode sdf has no volume, for its message: the companion volume
+     * found beside the .vdsh but baked beside another bake (left by an
+     * earlier vdsh-bake --sdf of the same name), not loaded; or the
+     * companion's name, this scene's own, when there is none ("": the
+     * scene has no path, or a volume was loaded). */
+    char sdf_why[4608];
 };
 
 /* Mode sdf (vr_sdf.c): load desc->sdf_path, or the .vdsh's companion when

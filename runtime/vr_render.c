@@ -593,14 +593,14 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
                                ? " (orders 2, 3, 5 are buffered with vr_scene_desc.buffers)"
                                : "");
     } else if (!vr_scene_supports(s, mode)) {
-        if (mode == VR_MODE_SDF && s->sdf_stale[0])
+        if (mode == VR_MODE_SDF && s->sdf_why[0])
             return vr_fail(err, VR_ERR_MISSING, "mode sdf needs the scene's distance volume: %s",
-                           s->sdf_stale);
+                           s->sdf_why);
         if (mode == VR_MODE_SDF)
             return vr_fail(err, VR_ERR_MISSING,
                            "mode sdf needs the scene's distance volume: "
                            "none was loaded (bake it with vdsh-bake --sdf N, which writes "
-                           "room.sdf beside room.vdsh)");
+                           "SCENE.sdf beside SCENE.vdsh)");
         if (mode == VR_MODE_VDSH5 && s->vbo_stream[5])
             return vr_fail(err, VR_ERR_MISSING,
                            "mode %s needs the basis cubemaps, which this scene has not "

@@ -17,9 +17,16 @@ vr_result vr_sdf_load(vr_scene *s, const vr_scene_desc *desc, uint32_t vertex_co
     const char *path = desc->sdf_path;
     if (!path) {
         struct stat st;
-        if (!desc->path || desc->file || vdsh_sdf_path(desc->path, companion, sizeof companion) ||
-            stat(companion, &st) != 0)
+        if (!desc->path || desc->file || vdsh_sdf_path(desc->path, companion, sizeof companion))
             return VR_OK; /* no volume: mode sdf is unsupported */
+        if (stat(companion, &st) != 0) {
+            /* Mode sdf names the file it looked for, this scene's own. */
+            snprintf(s->sdf_why, sizeof s->sdf_why,
+                     "none was loaded: no %s (bake it with vdsh-bake --sdf N, which writes it "
+                     "beside %s)",
+                     companion, desc->path);
+            return VR_OK;
+        }
         path = companion;
     }
     vdsh_sdf v;
@@ -35,7 +42,7 @@ vr_result vr_sdf_load(vr_scene *s, const vr_scene_desc *desc, uint32_t vertex_co
          * this scene's, but it must not stop the modes that do not use it:
          * skipped, and mode sdf says why. One named with sdf_path fails. */
         if (!desc->sdf_path) {
-            snprintf(s->sdf_stale, sizeof s->sdf_stale,
+            snprintf(s->sdf_why, sizeof s->sdf_why,
                      "%s beside it was baked beside another bake (%u %s and %u %s, not "
                      "%u and %u): not loaded; bake again with vdsh-bake --sdf N",
                      path, v.vertex_count, vdsh_plural(v.vertex_count, "vertex", "vertices"),

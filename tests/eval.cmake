@@ -26,6 +26,27 @@ if(TARGET vb_eval)
            COMMAND test_eval_cli $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval>
                    ${CMAKE_CURRENT_BINARY_DIR}/eval_cli)
 
+  # The table's columns line up with its header: the default bake's
+  # streams (s8s6, decision+log: 4 and 12 characters where the columns were
+  # 3 and 9 wide) pushed every column after them out of line; and a paper
+  # f32 stream of the usual widths keeps the old bytes (columns 3 and 9).
+  add_test(NAME eval_table_columns COMMAND bash -c [=[
+bake=$1; ev=$2; d=$3
+rm -rf "$d"; mkdir -p "$d"
+for m in decision paper; do
+  "$bake" builtin:room --max-edge 2 --rays 16 --cube-size 0 --orders 2 --method $m \
+    $([ $m = paper ] && echo --encoding f32) -q -o "$d/$m.vdsh" || exit 1
+  "$ev" "$d/$m.vdsh" -q --points 100 --interior 0 --directions 16 --lights 2 > "$d/$m.txt" || exit 1
+  # every line of the two tables: its first '|' where the header has it
+  awk '/ order offset B\/v/ { bar = index($0, "|"); n++; next }
+       bar && /^  vertices .*[|]/ { if (index($0, "|") != bar) { print "FAIL: " $0; bad = 1 }; rows++ }
+       /^$/ { bar = 0 }
+       END { if (n != 2 || rows < 2) { print "FAIL: " n " tables, " rows " rows"; bad = 1 }; exit bad }' \
+    "$d/$m.txt" || { cat "$d/$m.txt"; exit 1; }
+done
+grep -q " 16 f32 paper     | " "$d/paper.txt" || { echo "FAIL: paper f32 not in columns 3 and 9"; cat "$d/paper.txt"; exit 1; }
+]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval> ${CMAKE_CURRENT_BINARY_DIR}/eval_table_columns)
+
   find_package(Python3 COMPONENTS Interpreter QUIET)
   if(Python3_Interpreter_FOUND)
     add_test(NAME eval_json

@@ -134,6 +134,19 @@ set_tests_properties(${_format_tool_tests} PROPERTIES
 add_executable(test_scene_view ${CMAKE_CURRENT_LIST_DIR}/test_scene_view.c)
 target_link_libraries(test_scene_view PRIVATE vdsh_format m)
 add_test(NAME format_scene_view COMMAND test_scene_view unit)
+# The 2CylinderEngine (Debian's assimp-testmodels; skipped without it),
+# baked coarse: every default light lights what the camera sees of it
+# (light 0 stood inside its end cap, the view mostly dark).
+if(TARGET vdsh-bake)
+  add_test(NAME format_scene_view_engine_lights COMMAND bash -c [=[
+glb=/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb
+[ -e "$glb" ] || { echo "no $glb: skipped"; exit 77; }
+rm -rf "$3"; mkdir -p "$3"
+"$1" "$glb" --max-edge 1000 --rays 1 --orders 1 --cube-size 0 -q -o "$3/engine.vdsh" || exit 1
+"$2" object-lights "$3/engine.vdsh"
+]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:test_scene_view> ${CMAKE_CURRENT_BINARY_DIR}/scene_view_engine)
+  set_tests_properties(format_scene_view_engine_lights PROPERTIES SKIP_RETURN_CODE 77)
+endif()
 
 # format_det_math   formats/vdsh_det.h (the bake's sin, cos, exp, log, atan2,
 #                   acos, the same bits on every CPU) within 1-4 ulp of libm

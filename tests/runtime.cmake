@@ -222,6 +222,9 @@ cp "$room" "$d/alone.vdsh"
 "$v" -q --render "$d/beside.png" --size 64x48 --mode vdsh5 "$room" || fail=1
 cmp "$d/alone.png" "$d/beside.png" || { echo "the .vdsh alone renders differently"; fail=1; }
 expect1 "x/y/z.png" --render "$d/x/y/z.png" "$room"
+# mode sdf without a volume names the file it looked for, this scene's own
+# (it cited a sample room.sdf)
+expect1 "no $d/alone.sdf" --render "$d/x.png" --mode sdf "$d/alone.vdsh"
 "$v" -q --render "$d/ok.png" --size 64x48 --no-cubemaps --mode vdsh5poly "$d/alone.vdsh" || { echo "--no-cubemaps failed"; fail=1; }
 # a log-distance bake needs no cubemaps in any mode
 "$v" -q --render "$d/log.png" --size 64x48 --mode vdsh5 "$4" || { echo "log-distance vdsh5 failed"; fail=1; }

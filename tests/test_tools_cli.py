@@ -307,6 +307,13 @@ for name, prog in PROGRAMS.items():
           "%s without arguments: exit %d, stderr %r" % (name, rc, err[:200]))
 rc, out, _ = run(bake, "--help")
 check(b"glTF" in out and b".glb" in out, "vdsh-bake --help names glTF input")
+# vdsh-export -q drops the summary and keeps its notes and warnings
+# (test_gltf_source_match.py checks them under -q): its help says so (it
+# said only "no summary", and the notes read as -q not honoured)
+rc, out, _ = run(export, "--help")
+q = [l for l in out.split(b"\n") if b"--quiet" in l]
+check(rc == 0 and q and b"warnings" in out.split(b"--quiet")[1].split(b"\n  -")[0],
+      "vdsh-export --help: -q does not say that notes and warnings stay: %r" % q)
 
 # ---- same file: an output that is an input is refused --------------------
 sf = os.path.join(W, b"same")

@@ -76,25 +76,26 @@ typedef struct vb_adaptive_desc {
 } vb_adaptive_desc;
 
 typedef struct vb_adaptive_stats {
-    uint32_t start_receivers;   /* the start mesh's vertices */
-    uint32_t rounds;            /* rounds that baked midpoints */
-    uint32_t candidates;        /* midpoints baked (split or not) */
-    uint32_t lights;            /* lights the error was scored with */
-    uint32_t max_rounds;        /* the round limit used */
-    int budget_reached;         /* the receiver budget stopped it */
-    int rounds_reached;         /* the round limit stopped it while its last round
-                                * still split edges */
-    uint32_t last_split;        /* edges the last round split */
-    uint32_t pending;           /* with rounds_reached: edges not yet judged, long
-                                * enough to split (the next round's midpoints) */
+    uint32_t start_receivers; /* the start mesh's vertices */
+    uint32_t rounds;          /* rounds that baked midpoints */
+    uint32_t candidates;      /* midpoints baked (split or not) */
+    uint32_t lights;          /* lights the error was scored with */
+    uint32_t max_rounds;      /* the round limit used */
+    int budget_reached;       /* the receiver budget stopped it */
+    /* the round limit stopped it while its last round still split edges */
+    int rounds_reached;
+    uint32_t last_split; /* edges the last round split */
+    /* with rounds_reached: edges not yet judged, long enough to split (the
+     * next round's midpoints) */
+    uint32_t pending;
     uint32_t uniform_receivers; /* the uniform refinement of the start mesh to
                                  * 2 min_edge: the cap on every vertex baked
                                  * (0: over vb_mesh_refine's limit, no cap) */
     int uniform_reached;        /* that cap stopped it */
     uint32_t noise_sample;      /* start receivers baked twice for the noise floor */
     double noise_floor;         /* their two bakes' spread (quantile) */
-    double threshold;           /* what an edge's error had to pass: tolerance +
-                                * noise floor */
+    /* what an edge's error had to pass: tolerance + noise floor */
+    double threshold;
 } vb_adaptive_stats;
 
 /* Bake `start` with `bake` (its receivers and range are ignored), then

@@ -56,16 +56,18 @@ extern "C" {
 #define VB_MAX_DIAGONAL 1e37
 
 typedef struct vb_job_desc {
-    const char *const *paths;   /* meshes (mesh.h names), borrowed */
-    uint32_t path_count;        /* 1..VDSH_MAX_SOURCES */
-    const char *output;         /* the .vdsh file; NULL: none (vb_job_write refuses) */
-    const char *cubemap_dir;    /* NULL: beside output */
-    int weld;                   /* vb_load_desc.weld */
-    float max_edge;             /* receivers refined to it; 0: the vertices as they are.
-                                * With adaptive: where the refinement starts */
-    const char *receivers_path; /* receivers read from this mesh as they are (a plan:
-                                * vdsh-bake --receivers); NULL: the occluders, refined */
-    int adaptive;               /* 1: adaptive receivers (adaptive.h) from there */
+    const char *const *paths; /* meshes (mesh.h names), borrowed */
+    uint32_t path_count;      /* 1..VDSH_MAX_SOURCES */
+    const char *output;       /* the .vdsh file; NULL: none (vb_job_write refuses) */
+    const char *cubemap_dir;  /* NULL: beside output */
+    int weld;                 /* vb_load_desc.weld */
+    /* receivers refined to it; 0: the vertices as they are. With adaptive:
+     * where the refinement starts */
+    float max_edge;
+    /* receivers read from this mesh as they are (a plan: vdsh-bake
+     * --receivers); NULL: the occluders, refined */
+    const char *receivers_path;
+    int adaptive; /* 1: adaptive receivers (adaptive.h) from there */
     vb_adaptive_desc adapt;
     int fast_traversal; /* 0: Embree's robust traversal (default) */
     /* Where the lights go (vdsh-bake --light-region): rule 0, the scene's
@@ -109,10 +111,11 @@ typedef struct vb_job {
     vdsh_stream streams[VDSH_MAX_STREAMS];
     void *stream_data[VDSH_MAX_STREAMS];
     size_t coefficient_bytes; /* per vertex, all fixed-order streams */
-    double variable_bytes;    /* per vertex on average, the variable-order
-                                * stream's (order table included; 0: none) */
-    vdsh_file file;           /* filled by vb_bake_fill_file (borrows the above) */
-    uint64_t file_bytes;      /* the written file's size (vb_job_write) */
+    /* per vertex on average, the variable-order stream's (order table
+     * included; 0: none) */
+    double variable_bytes;
+    vdsh_file file;      /* filled by vb_bake_fill_file (borrows the above) */
+    uint64_t file_bytes; /* the written file's size (vb_job_write) */
     vdsh_timings timings;
     /* The light pool (job.c: job_pool; bake.h, VB_POOL_SEED), scene
      * units: the decision fit's (pool_count VB_DECISION_POOL; 0 where it

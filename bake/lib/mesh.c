@@ -236,15 +236,26 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
                 "node transform ignored)\n",
                 tool, sep, path, r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
     if (r->nonconvex_polygons)
-        fprintf(
-            fp,
-            "%s%s%s: warning: %u polygon%s of 4 or more vertices not simple (or far from "
-            "flat, or too large to clip), so not ear-clipped: fanned from the first vertex, the triangles cover "
-            "%.3gx the area %s, part of it outside the face; triangulate %s in the "
-            "exporter\n",
-            tool, sep, path, r->nonconvex_polygons, plural(r->nonconvex_polygons),
-            1.0 + r->nonconvex_excess, r->nonconvex_polygons == 1 ? "it encloses" : "they enclose",
-            r->nonconvex_polygons == 1 ? "it" : "them");
+        fprintf(fp,
+                "%s%s%s: warning: %u polygon%s of 4 or more vertices not simple (or far from "
+                "flat), so not ear-clipped: fanned from the first vertex, the triangles cover "
+                "%.3gx the area %s, part of it outside the face; triangulate %s in the "
+                "exporter\n",
+                tool, sep, path, r->nonconvex_polygons, plural(r->nonconvex_polygons),
+                1.0 + r->nonconvex_excess,
+                r->nonconvex_polygons == 1 ? "it encloses" : "they enclose",
+                r->nonconvex_polygons == 1 ? "it" : "them");
+    if (r->unclipped_polygons)
+        fprintf(fp,
+                "%s%s%s: warning: %u polygon%s of 4 or more vertices too large to clip (past "
+                "the ear clipping's time bound), so not ear-clipped: fanned from the first "
+                "vertex, the triangles "
+                "cover %.3gx the area %s, part of it outside the face; triangulate %s in the "
+                "exporter\n",
+                tool, sep, path, r->unclipped_polygons, plural(r->unclipped_polygons),
+                1.0 + r->unclipped_excess,
+                r->unclipped_polygons == 1 ? "it encloses" : "they enclose",
+                r->unclipped_polygons == 1 ? "it" : "them");
     if (r->gltf_ragged)
         fprintf(fp,
                 "%s%s%s: %u glTF triangle list%s with a count not a multiple of 3 (invalid "
@@ -1186,13 +1197,14 @@ static int drop_duplicates(const float *positions, uint32_t *idx, uint32_t *coun
  * The readers ear-clip concave polygons (mesh_read.h,
  * triangulate_polygon), whose triangles then cover the face exactly; what
  * is left here is what they fanned from the first vertex instead: polygons
- * that are not simple (crossing themselves, no area), far from flat, or
- * past the file's ear clipping time bound. Another reader may take them
+ * that are not simple (crossing themselves, no area) or far from flat,
+ * and, counted apart (raw->unclipped_faces), those past the file's ear
+ * clipping time bound, not tried. Another reader may take them
  * differently: counted and said, not refused. */
-static void nonconvex_polygons(const vb_mesh_raw *raw, uint32_t *count, double *excess)
+static void nonconvex_polygons(const vb_mesh_raw *raw, vb_mesh_report *rp)
 {
-    double fan_sum = 0.0, own_sum = 0.0;
-    *count = 0;
+    double fan_sum[2] = {0.0, 0.0}, own_sum[2] = {0.0, 0.0};
+    uint32_t count[2] = {0, 0}, next_unclipped = 0;
     for (uint32_t t = 0; raw->faces && t < raw->triangle_count;) {
         uint32_t e = t + 1;
         while (e < raw->triangle_count && raw->faces[e] == raw->faces[t])
@@ -1215,13 +1227,23 @@ static void nonconvex_polygons(const vb_mesh_raw *raw, uint32_t *count, double *
             }
             const double own = sqrt(vec[0] * vec[0] + vec[1] * vec[1] + vec[2] * vec[2]);
             if (fan > 1.01 * own) {
-                (*count)++;
-                fan_sum += fan, own_sum += own;
+                /* unclipped_faces ascends, as the faces do */
+                while (next_unclipped < raw->unclipped_count &&
+                       raw->unclipped_faces[next_unclipped] < raw->faces[t])
+                    next_unclipped++;
+                const int timed_out = next_unclipped < raw->unclipped_count &&
+                                      raw->unclipped_faces[next_unclipped] == raw->faces[t];
+                count[timed_out]++;
+                fan_sum[timed_out] += fan, own_sum[timed_out] += own;
             }
         }
         t = e;
     }
-    *excess = *count ? (own_sum > 0.0 ? fan_sum / own_sum - 1.0 : INFINITY) : 0.0;
+    double excess[2];
+    for (int k = 0; k < 2; k++)
+        excess[k] = count[k] ? (own_sum[k] > 0.0 ? fan_sum[k] / own_sum[k] - 1.0 : INFINITY) : 0.0;
+    rp->nonconvex_polygons = count[0], rp->nonconvex_excess = excess[0];
+    rp->unclipped_polygons = count[1], rp->unclipped_excess = excess[1];
 }
 
 /* Raw file mesh -> clean vb_mesh (see mesh.h for what clean means). */
@@ -1306,7 +1328,7 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
     rp.gltf_ragged = raw->gltf_ragged;
     rp.split_vertices = sv.split;
     rp.split_added = sv.added;
-    nonconvex_polygons(raw, &rp.nonconvex_polygons, &rp.nonconvex_excess);
+    nonconvex_polygons(raw, &rp);
     rp.removed_vertices = vertex_count - m.vertex_count;
 
     /* File normals only when every vertex kept has one: a mix of given and

@@ -188,6 +188,10 @@ typedef struct vb_mesh_report {
      * area outside the face included */
     uint32_t nonconvex_polygons;
     double nonconvex_excess; /* their fan area over their own, less 1 */
+    /* the same, but fanned because the ear clipping's time bound ran out
+     * (the file's other polygons spent it), not tried: not counted above */
+    uint32_t unclipped_polygons;
+    double unclipped_excess; /* their fan area over their own, less 1 */
 } vb_mesh_report;
 
 /* What a loaded source was: size and hash for the .vdsh SRCS chunk, and

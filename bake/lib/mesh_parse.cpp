@@ -212,6 +212,10 @@ void builder::finish(uint64_t dropped, vb_mesh_raw *out)
             raw.corner_given = malloc_copy(corner_given);
         }
         raw.dropped_triangles = (uint32_t)std::min<uint64_t>(dropped, UINT32_MAX);
+        if (!unclipped.empty()) {
+            raw.unclipped_faces = malloc_copy(unclipped);
+            raw.unclipped_count = (uint32_t)unclipped.size();
+        }
     } catch (...) {
         vb_mesh_raw_free(&raw);
         throw;
@@ -289,7 +293,7 @@ double area3(const float *a, const float *b, const float *c)
 } // namespace
 
 bool triangulate_polygon(const float *positions, const int64_t *v, size_t n,
-                         std::vector<uint32_t> &tris, uint64_t *budget)
+                         std::vector<uint32_t> &tris, uint64_t *budget, bool *timed_out)
 {
     const size_t first = tris.size();
     auto fan = [&] {
@@ -360,8 +364,11 @@ bool triangulate_polygon(const float *positions, const int64_t *v, size_t n,
         const double *pa = pt(a), *pb = pt(cur), *pc = pt(c);
         bool ear = cross2(pa, pb, pc) > 0.0;
         for (size_t r = next[c]; ear && r != a; r = next[r]) {
-            if (*budget == 0)
+            if (*budget == 0) {
+                if (timed_out)
+                    *timed_out = true;
                 return fan();
+            }
             (*budget)--;
             const double *pr = pt(r);
             /* A corner at one of the ear's own positions (a polygon that
@@ -425,7 +432,12 @@ void builder::triangulate()
             for (size_t c = 0; c < n; c++)
                 poly[c] = indices[fan_slot(c)];
             tris.clear();
-            if (triangulate_polygon(positions.data(), poly.data(), n, tris, &clip_budget)) {
+            bool timed_out = false;
+            const bool clipped = triangulate_polygon(positions.data(), poly.data(), n, tris,
+                                                     &clip_budget, &timed_out);
+            if (timed_out)
+                unclipped.push_back(tri_face[t]);
+            if (clipped) {
                 if (corners) {
                     normals.resize(3 * n);
                     given.resize(n);
@@ -554,5 +566,6 @@ extern "C" void vb_mesh_raw_free(vb_mesh_raw *raw)
     free(raw->corner_given);
     free(raw->indices);
     free(raw->faces);
+    free(raw->unclipped_faces);
     memset(raw, 0, sizeof *raw);
 }

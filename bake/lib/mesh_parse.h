@@ -67,25 +67,34 @@ typedef enum vb_mesh_format {
 typedef struct vb_mesh_raw {
     uint32_t vertex_count;
     uint32_t triangle_count;
-    float *positions;            /* 3 * vertex_count */
-    float *normals;              /* 3 * vertex_count or NULL (file has none) */
-    uint8_t *has_normal;         /* vertex_count or NULL: file gave a normal */
-    int64_t *indices;            /* 3 * triangle_count */
-    uint32_t *faces;             /* triangle_count: 0-based polygon in the file */
-    float *corner_normals;       /* 9 * triangle_count or NULL (none given) */
-    uint8_t *corner_given;       /* 3 * triangle_count or NULL: corner has one */
-    uint32_t dropped_triangles;  /* OBJ faces dropped for fewer than 3
-                                   distinct vertices (see vb_mesh_report) */
+    float *positions;      /* 3 * vertex_count */
+    float *normals;        /* 3 * vertex_count or NULL (file has none) */
+    uint8_t *has_normal;   /* vertex_count or NULL: file gave a normal */
+    int64_t *indices;      /* 3 * triangle_count */
+    uint32_t *faces;       /* triangle_count: 0-based polygon in the file */
+    float *corner_normals; /* 9 * triangle_count or NULL (none given) */
+    uint8_t *corner_given; /* 3 * triangle_count or NULL: corner has one */
+    /* unclipped_count polygons (file numbers as in `faces`, ascending)
+     * fanned because the ear clipping's time bound ran out, not tried (NULL
+     * when none) */
+    uint32_t *unclipped_faces;
+    uint32_t unclipped_count;
+    /* OBJ faces dropped for fewer than 3 distinct vertices (see
+     * vb_mesh_report) */
+    uint32_t dropped_triangles;
     uint32_t gltf_skipped_modes; /* glTF primitives skipped: points, lines */
     uint32_t gltf_skipped_morph; /* glTF primitives with morph targets: base pose baked */
     uint32_t gltf_skipped_skin;  /* glTF primitives of skinned nodes: bind pose baked */
-    uint32_t gltf_ragged;        /* glTF triangle lists whose count is not a
-                                   multiple of 3: the last 1 or 2 ignored */
-    int gltf_hashed;             /* glTF with external buffers: the source's
-                                   hash and size are these, not the file's */
-    uint64_t gltf_size;          /* the file's bytes plus its external buffers' */
-    uint8_t gltf_sha256[32];     /* SHA-256 of the file's bytes, then of each
-                                   external buffer's in `buffers` order */
+    /* glTF triangle lists whose count is not a multiple of 3: the last 1 or 2
+     * ignored */
+    uint32_t gltf_ragged;
+    /* glTF with external buffers: the source's hash and size are these, not
+     * the file's */
+    int gltf_hashed;
+    uint64_t gltf_size; /* the file's bytes plus its external buffers' */
+    /* SHA-256 of the file's bytes, then of each external buffer's in `buffers`
+     * order */
+    uint8_t gltf_sha256[32];
 } vb_mesh_raw;
 
 /* Read `size` bytes (the whole file) of `format`; `name` is for messages. */

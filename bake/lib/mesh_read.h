@@ -300,6 +300,9 @@ class builder
      * on the time a file of huge concave polygons can take: past it, the
      * rest are fanned, deterministically). */
     uint64_t clip_budget = 200000000;
+    /* The polygons (file numbers, ascending) fanned because clip_budget
+     * ran out, not because they are not simple (for mesh.c's warnings). */
+    std::vector<uint32_t> unclipped;
 
   private:
     /* The corners of the polygon just fanned: its vertices' pending
@@ -324,11 +327,12 @@ class builder
  * (a zero Newell normal), without an ear (not simple), whose clipped
  * triangles cover more than 1% above the area the polygon encloses (the
  * Newell normal's length: far from flat; the fan's excess is what mesh.c
- * reports), or when *budget point-in-triangle tests run out. Returns true
+ * reports), or when *budget point-in-triangle tests run out (then, and
+ * only then, *timed_out is set true when given). Returns true
  * when the result is not the fan. Deterministic: the same floats give
  * the same triangles on any machine (IEEE double, no library calls). */
 bool triangulate_polygon(const float *positions, const int64_t *v, size_t n,
-                         std::vector<uint32_t> &tris, uint64_t *budget);
+                         std::vector<uint32_t> &tris, uint64_t *budget, bool *timed_out = nullptr);
 
 /* What the checks counted: the file must deliver exactly this. */
 struct expectation {

@@ -577,6 +577,33 @@ static int write_per_vertex(const char *out, const vdsh_file *f, const vb_eval_r
 
 /* ---- the table ---------------------------------------------------------------- */
 
+/* A stream's fit in the tables: its method, and the quantity when not
+ * distance ("decision+log"). */
+static const char *fit_label(const vdsh_stream *st, char *buf, size_t cap)
+{
+    snprintf(buf, cap, "%s%s", vdsh_method_name(st->method),
+             st->quantity == VDSH_QUANTITY_LOG_DISTANCE ? "+log"
+             : st->quantity == VDSH_QUANTITY_DISTANCE2  ? "+d2"
+                                                        : "");
+    return buf;
+}
+
+/* The widths of the tables' enc and fit columns: at least the usual 3 and
+ * 9, else the longest of the file's streams ("cpca", "decision+log"), so
+ * the columns after them stay in line with the header. */
+static void enc_fit_widths(const context *c, int *enc_w, int *fit_w)
+{
+    *enc_w = 3;
+    *fit_w = 9;
+    for (uint32_t s = 0; s < c->r->stream_count; s++) {
+        char fit[32];
+        int e = (int)strlen(vdsh_encoding_name(stored(c, s)->encoding));
+        int m = (int)strlen(fit_label(&c->f->streams[s], fit, sizeof fit));
+        *enc_w = e > *enc_w ? e : *enc_w;
+        *fit_w = m > *fit_w ? m : *fit_w;
+    }
+}
+
 static void print_table(FILE *o, const context *c)
 {
     const vdsh_file *f = c->f;
@@ -650,9 +677,11 @@ static void print_table(FILE *o, const context *c)
                 "  (the scene's bounds hold too little free space, a closed object: the "
                 "lights are placed\n  around it, in the bounds grown by up to a quarter of their "
                 "diagonal on every side)\n\n");
-    fprintf(o, "  %-8s %5s %6s %3s %3s %-9s | %7s | %-15s %-13s %-12s | %-6s %6s %6s\n", "",
-            "order", "offset", "B/v", "enc", "fit", "pairs", "smooth: MAE", "false", "recall",
-            "binary", "false", "recall");
+    int ew, fw;
+    enc_fit_widths(c, &ew, &fw);
+    fprintf(o, "  %-8s %5s %6s %3s %*s %-*s | %7s | %-15s %-13s %-12s | %-6s %6s %6s\n", "",
+            "order", "offset", "B/v", ew, "enc", fw, "fit", "pairs", "smooth: MAE", "false",
+            "recall", "binary", "false", "recall");
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         if (r->truth[k].receivers == 0)
             continue;
@@ -660,21 +689,18 @@ static void print_table(FILE *o, const context *c)
             const vdsh_stream *st = &f->streams[s];
             const vb_eval_scene_metrics *m = &r->scene[k][s];
             char mae[32], fa[32], rc[32], fit[32];
-            snprintf(fit, sizeof fit, "%s%s", vdsh_method_name(st->method),
-                     st->quantity == VDSH_QUANTITY_LOG_DISTANCE ? "+log"
-                     : st->quantity == VDSH_QUANTITY_DISTANCE2  ? "+d2"
-                                                                : "");
+            fit_label(st, fit, sizeof fit);
             snprintf(mae, sizeof mae, "%.4f+-%.4f", m->shadow_mae, 1.96 * m->shadow_mae_se);
             snprintf(fa, sizeof fa, "%.2f+-%.2f%%", 100.0 * m->false_shadow,
                      196.0 * m->false_shadow_se);
             snprintf(rc, sizeof rc, "%.1f+-%.1f%%", 100.0 * m->recall, 196.0 * m->recall_se);
             char ol[16], pairs[32];
             fprintf(o,
-                    "  %-8s %5s %+6.2f %3.0f %3s %-9s | %7s | %-15s %-13s %-12s | %6.4f "
+                    "  %-8s %5s %+6.2f %3.0f %*s %-*s | %7s | %-15s %-13s %-12s | %6.4f "
                     "%5.2f%% %5.1f%%\n",
                     kind_name(k), order_label(st, ol, sizeof ol), (double)c->offset[s],
-                    vdsh_stream_size_of(stored(c, s), vdsh_file_stream_vertices(f)).mean_bytes,
-                    vdsh_encoding_name(stored(c, s)->encoding), fit,
+                    vdsh_stream_size_of(stored(c, s), vdsh_file_stream_vertices(f)).mean_bytes, ew,
+                    vdsh_encoding_name(stored(c, s)->encoding), fw, fit,
                     count_label(m->pairs, pairs, sizeof pairs), mae, fa, rc, m->binary_mae,
                     100.0 * m->binary_false_shadow, 100.0 * m->binary_recall);
         }
@@ -684,8 +710,8 @@ static void print_table(FILE *o, const context *c)
     fprintf(o, "  distance = |D - d_T| / max(d_T, 0.01 diag); false = P(s_hat < .5 | d_T >= d_L), "
                "leak = P(s_hat > .5 | s_ideal < .5)\n\n");
     fprintf(o,
-            "  %-8s %5s %6s %3s %3s %-9s | %-14s %6s %6s %6s | %-15s %-13s %-13s | %-6s %6s %6s\n",
-            "", "order", "offset", "B/v", "enc", "fit", "distance RMS", "p50", "p90", "p99",
+            "  %-8s %5s %6s %3s %*s %-*s | %-14s %6s %6s %6s | %-15s %-13s %-13s | %-6s %6s %6s\n",
+            "", "order", "offset", "B/v", ew, "enc", fw, "fit", "distance RMS", "p50", "p90", "p99",
             "smooth: MAE", "false", "leak", "binary", "false", "leak");
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         if (r->truth[k].receivers == 0)
@@ -694,10 +720,7 @@ static void print_table(FILE *o, const context *c)
             const vdsh_stream *st = &f->streams[s];
             const vb_eval_metrics *m = &r->metrics[k][s];
             char rms[32], mae[32], fa[32], le[32], fit[32];
-            snprintf(fit, sizeof fit, "%s%s", vdsh_method_name(st->method),
-                     st->quantity == VDSH_QUANTITY_LOG_DISTANCE ? "+log"
-                     : st->quantity == VDSH_QUANTITY_DISTANCE2  ? "+d2"
-                                                                : "");
+            fit_label(st, fit, sizeof fit);
             snprintf(rms, sizeof rms, "%.3f+-%.3f", m->distance_rms, 1.96 * m->distance_rms_se);
             snprintf(mae, sizeof mae, "%.4f+-%.4f", m->shadow_mae, 1.96 * m->shadow_mae_se);
             snprintf(fa, sizeof fa, "%.2f+-%.2f%%", 100.0 * m->false_shadow,
@@ -706,11 +729,11 @@ static void print_table(FILE *o, const context *c)
                      196.0 * m->light_leak_se);
             char ol[16];
             fprintf(o,
-                    "  %-8s %5s %+6.2f %3.0f %3s %-9s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s "
+                    "  %-8s %5s %+6.2f %3.0f %*s %-*s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s "
                     "%-13s | %6.4f %5.2f%% %5.2f%%\n",
                     kind_name(k), order_label(st, ol, sizeof ol), (double)c->offset[s],
-                    vdsh_stream_size_of(stored(c, s), vdsh_file_stream_vertices(f)).mean_bytes,
-                    vdsh_encoding_name(stored(c, s)->encoding), fit, rms, m->distance_p50,
+                    vdsh_stream_size_of(stored(c, s), vdsh_file_stream_vertices(f)).mean_bytes, ew,
+                    vdsh_encoding_name(stored(c, s)->encoding), fw, fit, rms, m->distance_p50,
                     m->distance_p90, m->distance_p99, mae, fa, le, m->binary_mae,
                     100.0 * m->binary_false_shadow, 100.0 * m->binary_light_leak);
         }
