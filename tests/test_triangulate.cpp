@@ -310,12 +310,43 @@ static void file_past_the_bound()
         vb_mesh_raw_free(&raw);
 }
 
+/* A bowtie encloses no area, so the warning cannot give the fans' area as
+ * a multiple of it (it printed "infx"). */
+static void bowtie_warning()
+{
+    const std::string text = obj_of({bowtie()});
+    vb_mesh m;
+    vb_source_info info;
+    vb_error err;
+    std::memset(&m, 0, sizeof m);
+    std::memset(&info, 0, sizeof info);
+    vb_result r =
+        vb_mesh_load_memory(text.data(), text.size(), "bowtie.obj", nullptr, &m, &info, &err);
+    if (r != VB_OK) {
+        CHECK(false, "bowtie.obj: %s", err.msg);
+        return;
+    }
+    vb_mesh_free(&m);
+    char *buf = nullptr;
+    size_t size = 0;
+    FILE *fp = open_memstream(&buf, &size);
+    vb_mesh_report_print(fp, "test", "bowtie.obj", &info.report);
+    std::fclose(fp);
+    const std::string said(buf ? buf : "");
+    std::free(buf);
+    CHECK(info.report.nonconvex_polygons == 1 && said.find("encloses none") != std::string::npos &&
+              said.find("inf") == std::string::npos && said.find("nan") == std::string::npos,
+          "bowtie.obj: %u not simple (want 1), warning: %s", info.report.nonconvex_polygons,
+          said.c_str());
+}
+
 int main()
 {
     budget_sweep("L", ell());
     budget_sweep("comb of 16 teeth", comb(16));
     budget_sweep("comb of 16 teeth, tilted", tilted(comb(16)));
     file_past_the_bound();
+    bowtie_warning();
     if (failures)
         std::fprintf(stderr, "test_triangulate: %d failure%s\n", failures,
                      failures == 1 ? "" : "s");

@@ -161,6 +161,27 @@ static const char *plural(uint32_t n)
     return n == 1 ? "" : "s";
 }
 
+/* The warning for n polygons fanned instead of ear-clipped, and why; the
+ * fans cover 1 + excess times the area the polygons enclose (infinite when
+ * they enclose none: a bowtie). */
+static void warn_fanned(FILE *fp, const char *tool, const char *sep, const char *path, uint32_t n,
+                        double excess, const char *why)
+{
+    if (!n)
+        return;
+    fprintf(fp,
+            "%s%s%s: warning: %u polygon%s of 4 or more vertices %s, so not ear-clipped: fanned "
+            "from the first vertex, ",
+            tool, sep, path, n, plural(n), why);
+    if (isfinite(excess))
+        fprintf(fp, "the triangles cover %.3gx the area %s, part of it outside the face",
+                1.0 + excess, n == 1 ? "it encloses" : "they enclose");
+    else
+        fprintf(fp, "the triangles cover area where %s none",
+                n == 1 ? "it encloses" : "they enclose");
+    fprintf(fp, "; triangulate %s in the exporter\n", n == 1 ? "it" : "them");
+}
+
 void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb_mesh_report *r)
 {
     if (!fp || !r)
@@ -235,27 +256,10 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
                 "%s%s%s: %u glTF primitive%s of skinned nodes baked in the bind pose (skin and "
                 "node transform ignored)\n",
                 tool, sep, path, r->gltf_skipped_skin, plural(r->gltf_skipped_skin));
-    if (r->nonconvex_polygons)
-        fprintf(fp,
-                "%s%s%s: warning: %u polygon%s of 4 or more vertices not simple (or far from "
-                "flat), so not ear-clipped: fanned from the first vertex, the triangles cover "
-                "%.3gx the area %s, part of it outside the face; triangulate %s in the "
-                "exporter\n",
-                tool, sep, path, r->nonconvex_polygons, plural(r->nonconvex_polygons),
-                1.0 + r->nonconvex_excess,
-                r->nonconvex_polygons == 1 ? "it encloses" : "they enclose",
-                r->nonconvex_polygons == 1 ? "it" : "them");
-    if (r->unclipped_polygons)
-        fprintf(fp,
-                "%s%s%s: warning: %u polygon%s of 4 or more vertices too large to clip (past "
-                "the ear clipping's time bound), so not ear-clipped: fanned from the first "
-                "vertex, the triangles "
-                "cover %.3gx the area %s, part of it outside the face; triangulate %s in the "
-                "exporter\n",
-                tool, sep, path, r->unclipped_polygons, plural(r->unclipped_polygons),
-                1.0 + r->unclipped_excess,
-                r->unclipped_polygons == 1 ? "it encloses" : "they enclose",
-                r->unclipped_polygons == 1 ? "it" : "them");
+    warn_fanned(fp, tool, sep, path, r->nonconvex_polygons, r->nonconvex_excess,
+                "not simple (or far from flat)");
+    warn_fanned(fp, tool, sep, path, r->unclipped_polygons, r->unclipped_excess,
+                "too large to clip (past the ear clipping's time bound)");
     if (r->gltf_ragged)
         fprintf(fp,
                 "%s%s%s: %u glTF triangle list%s with a count not a multiple of 3 (invalid "
