@@ -175,6 +175,18 @@ if(Python3_Interpreter_FOUND AND TARGET vb_frames)
                    ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR})
 endif()
 
+# scripts/score_bootstrap (test_score_bootstrap.py): on made-up score
+# files, the ratio of two vdsh-frames scores is the pooled one, its
+# bootstrap interval over views holds it (0 and [0, 0] for a file against
+# itself); files of other views, truth or masks, a scene row the views do
+# not pool to, no score JSON or a missing file refused with the file
+# named. No bake.
+if(Python3_Interpreter_FOUND)
+  add_test(NAME scripts_score_bootstrap
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_score_bootstrap.py
+                   ${PROJECT_SOURCE_DIR}/scripts ${CMAKE_CURRENT_BINARY_DIR}/scripts_score_bootstrap)
+endif()
+
 # scripts/false_probe at its smallest (test_false_probe.py): on
 # frames_gap --keep's run of validation room 3 (--max-edge 1, 64 x 48,
 # order 2), a default frame with false shadow is probed; its numpy path
