@@ -12,17 +12,14 @@ set's bytes another truth (the same bakes); another --light-pool or
 Usage: test_cpca_study_cache.py SCRIPTS_DIR WORK_DIR
 """
 import argparse
-import importlib.machinery
-import importlib.util
 import os
 import sys
 
+from testlib import load_script
+
 scripts, work = sys.argv[1:3]
 os.makedirs(work, exist_ok=True)
-loader = importlib.machinery.SourceFileLoader("cpca_study", os.path.join(scripts, "cpca_study"))
-spec = importlib.util.spec_from_loader("cpca_study", loader)
-cs = importlib.util.module_from_spec(spec)
-loader.exec_module(cs)
+cs = load_script(os.path.join(scripts, "cpca_study"))
 fail = 0
 
 

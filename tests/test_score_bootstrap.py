@@ -12,21 +12,18 @@ refused with the file named and a non-zero exit.
 
 Usage: test_score_bootstrap.py SCRIPTS_DIR WORK_DIR
 """
-import importlib.machinery
-import importlib.util
 import json
 import math
 import os
 import subprocess
 import sys
 
+from testlib import load_script
+
 scripts, work = sys.argv[1:3]
 os.makedirs(work, exist_ok=True)
 tool = os.path.join(scripts, "score_bootstrap")
-loader = importlib.machinery.SourceFileLoader("score_bootstrap", tool)
-spec = importlib.util.spec_from_loader("score_bootstrap", loader)
-sb = importlib.util.module_from_spec(spec)
-loader.exec_module(sb)
+sb = load_script(tool)
 failed = 0
 
 

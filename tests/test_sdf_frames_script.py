@@ -6,19 +6,16 @@ volume was "0.01 MB").
 
 Usage: test_sdf_frames_script.py SCRIPTS_DIR VDSH_BAKE WORK_DIR
 """
-import importlib.machinery
-import importlib.util
 import json
 import os
 import shutil
 import sys
 
+from testlib import load_script
+
 scripts, bake, work = sys.argv[1:4]
 sys.path.insert(0, scripts)
-loader = importlib.machinery.SourceFileLoader("sdf_frames", os.path.join(scripts, "sdf_frames"))
-spec = importlib.util.spec_from_loader("sdf_frames", loader)
-sf = importlib.util.module_from_spec(spec)
-loader.exec_module(sf)
+sf = load_script(os.path.join(scripts, "sdf_frames"))
 fail = 0
 
 

@@ -71,3 +71,15 @@ def fix_crc(d, off, size):
     crc = zlib.crc32(bytes(d[off + 8:off + 16]), zlib.crc32(bytes(d[off:off + 4])))
     crc = zlib.crc32(bytes(d[off + 16:off + 16 + size + (-size % 16)]), crc)
     d[off + 4:off + 8] = crc.to_bytes(4, "little")
+
+
+def load_script(path):
+    """The script at `path` (a file without .py, like scripts/cpca_study)
+    imported as a module, its main() not run (scripts guard it)."""
+    import importlib.machinery
+    import importlib.util
+    name = os.path.basename(path).replace("-", "_")
+    loader = importlib.machinery.SourceFileLoader(name, path)
+    module = importlib.util.module_from_spec(importlib.util.spec_from_loader(name, loader))
+    loader.exec_module(module)
+    return module
