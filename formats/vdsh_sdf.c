@@ -275,6 +275,12 @@ void vdsh_sdf_free(vdsh_sdf *v)
     }
 }
 
+int vdsh_sdf_other_scene(const vdsh_sdf *v, uint32_t vertex_count, uint32_t triangle_count)
+{
+    return (v->vertex_count || v->triangle_count) &&
+           (v->vertex_count != vertex_count || v->triangle_count != triangle_count);
+}
+
 /* ---- the trace: runtime/vr_glsl_sdf.c repeats it operation for operation ---- */
 
 float vdsh_sdf_sample(const vdsh_sdf *v, const float p[3])

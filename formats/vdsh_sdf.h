@@ -92,6 +92,12 @@ vdsh_result vdsh_sdf_stage(const char *path, const vdsh_sdf *v, struct vdsh_outp
 vdsh_result vdsh_sdf_write_memory(const vdsh_sdf *v, void **out, size_t *size, vdsh_error *err);
 void vdsh_sdf_free(vdsh_sdf *v);
 
+/* 1 when v was baked beside another scene: it records the counts of the
+ * .vdsh it was baked beside, and they are not these (0: the same, or not
+ * recorded). vdsh-view refuses such a volume when named and skips it as a
+ * companion; vdsh-frames truth does the same. */
+int vdsh_sdf_other_scene(const vdsh_sdf *v, uint32_t vertex_count, uint32_t triangle_count);
+
 /* The volume's bytes on disk (header and samples). */
 size_t vdsh_sdf_file_size(const vdsh_sdf *v);
 

@@ -34,8 +34,7 @@ vr_result vr_sdf_load(vr_scene *s, const vr_scene_desc *desc, uint32_t vertex_co
     vdsh_result vr = vdsh_sdf_read(path, &v, &ve);
     if (vr != VDSH_OK)
         return vr_fail(err, vr == VDSH_ERR_IO ? VR_ERR_IO : VR_ERR_FORMAT, "%s", ve.msg);
-    if ((v.vertex_count || v.triangle_count) &&
-        (v.vertex_count != vertex_count || v.triangle_count != triangle_count)) {
+    if (vdsh_sdf_other_scene(&v, vertex_count, triangle_count)) {
         vdsh_sdf_free(&v);
         /* The companion, found by name: left by an earlier bake of the same
          * output with --sdf (a bake without --sdf leaves it). It is not

@@ -239,13 +239,19 @@ int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3], uint32_t 
     return vdsh_light_region(s->bounds_min, s->bounds_max, free_cb, s, lo, hi, probes);
 }
 
-void vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3])
+/* The bounds of s grown on every side by `share` of its diagonal. */
+static void grow_bounds(const vb_scene *s, double share, float lo[3], float hi[3])
 {
-    const double g = (double)VDSH_REGION_GROW * (double)s->diagonal;
+    const double g = share * (double)s->diagonal;
     for (int a = 0; a < 3; a++) {
         lo[a] = (float)((double)s->bounds_min[a] - g);
         hi[a] = (float)((double)s->bounds_max[a] + g);
     }
+}
+
+void vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3])
+{
+    grow_bounds(s, (double)VDSH_REGION_GROW, lo, hi);
 }
 
 vb_result vb_scene_set_light_region(vb_scene *s, const float lo[3], const float hi[3],
@@ -293,6 +299,14 @@ const char *vb_light_rule_name(vb_light_rule rule)
     return (unsigned)rule < sizeof names / sizeof names[0] ? names[rule] : "?";
 }
 
+int vb_light_rule_by_name(const char *name)
+{
+    for (int k = VB_LIGHTS_UNIFORM; k <= VB_LIGHTS_SHELL; k++)
+        if (strcmp(name, vb_light_rule_name((vb_light_rule)k)) == 0)
+            return k;
+    return -1;
+}
+
 vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t count,
                                      vb_light_rule rule, float (*out)[3], uint32_t *tried,
                                      vb_error *err)
@@ -303,15 +317,8 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
         return vb_scene_place_lights(s, seed, count, out, tried, err);
     float lo[3], hi[3];
     int grown = vb_scene_light_region(s, lo, hi, NULL);
-    if (rule == VB_LIGHTS_GROWN || rule == VB_LIGHTS_SHELL) {
-        vb_scene_grown_box(s, lo, hi);
-        grown = 1;
-    } else if (rule == VB_LIGHTS_AROUND) {
-        const double g = (double)s->diagonal;
-        for (int a = 0; a < 3; a++) {
-            lo[a] = (float)((double)s->bounds_min[a] - g);
-            hi[a] = (float)((double)s->bounds_max[a] + g);
-        }
+    if (rule == VB_LIGHTS_GROWN || rule == VB_LIGHTS_AROUND || rule == VB_LIGHTS_SHELL) {
+        grow_bounds(s, rule == VB_LIGHTS_AROUND ? 1.0 : (double)VDSH_REGION_GROW, lo, hi);
         grown = 1;
     }
     uint32_t n = 0, k = 0;

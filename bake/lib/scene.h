@@ -168,6 +168,8 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
                                      vb_light_rule rule, float (*out)[3], uint32_t *tried,
                                      vb_error *err);
 const char *vb_light_rule_name(vb_light_rule rule);
+/* The rule of that name (vb_light_rule_name's), -1 when none is. */
+int vb_light_rule_by_name(const char *name);
 
 /* The nearest surface from p (scene units) along the VDSH_FREE_PROBES
  * probe directions of the free-space rule, INFINITY when none is met:

@@ -839,16 +839,6 @@ static int parse_interp(const char *s, uint32_t *out)
     return interp != UINT32_MAX;
 }
 
-static int parse_light_rule(const char *s, int *out)
-{
-    for (int k = VB_LIGHTS_UNIFORM; k <= VB_LIGHTS_SHELL; k++)
-        if (!strcmp(s, vb_light_rule_name((vb_light_rule)k))) {
-            *out = k;
-            return 1;
-        }
-    return 0;
-}
-
 /* 1..VDSH_MAX_STREAMS - 1 offsets in -5..5 (the copies and the streams
  * themselves must fit in VDSH_MAX_STREAMS). */
 static int parse_offsets(const char *s, float *out)
@@ -942,7 +932,7 @@ static int parse_args(int argc, char **argv, options *o)
             interp_given = 1;
             break;
         case O_LIGHT_RULE:
-            if (!parse_light_rule(optarg, &d->light_rule))
+            if ((d->light_rule = vb_light_rule_by_name(optarg)) < 0)
                 return bad_usage(
                     "--light-rule takes uniform, ceiling, near, path, grown, around or shell, not '%s'",
                     optarg);

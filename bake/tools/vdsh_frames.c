@@ -562,9 +562,7 @@ static int run_truth(const options *op)
              * other vertex or triangle counts is refused when named, and
              * skipped when it is the companion (left by an earlier bake of
              * the same name), so c-sdf is what vdsh-view's mode sdf draws. */
-            if ((vol.vertex_count || vol.triangle_count) &&
-                (vol.vertex_count != f->header.vertex_count ||
-                 vol.triangle_count != f->header.triangle_count)) {
+            if (vdsh_sdf_other_scene(&vol, f->header.vertex_count, f->header.triangle_count)) {
                 fprintf(stderr,
                         PROG ": %s%s was baked beside another bake (%u vertices and %u "
                              "triangles, not %u and %u)%s\n",
@@ -1089,11 +1087,8 @@ static int take_option(int c, options *o)
             return !bad_usage("--seed takes a whole number >= 1, not '%s'", optarg);
         return 1;
     case O_LIGHT_RULE:
-        for (int k = VB_LIGHTS_UNIFORM; k <= VB_LIGHTS_SHELL; k++)
-            if (strcmp(optarg, vb_light_rule_name((vb_light_rule)k)) == 0) {
-                o->views.light_rule = k;
-                return 1;
-            }
+        if ((o->views.light_rule = vb_light_rule_by_name(optarg)) >= 0)
+            return 1;
         return !bad_usage("--light-rule takes uniform, ceiling, near, path, grown, around or "
                           "shell, not '%s'",
                           optarg);
