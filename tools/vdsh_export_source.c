@@ -222,27 +222,24 @@ int vdsh_src_load(const char *path, vdsh_src *s, char *msg, size_t cap)
             goto out;
         }
     }
-    /* The baker's hash (bake/lib/mesh_gltf.cpp): the file's bytes, then
-     * each external buffer's (not data: URIs, not the BIN chunk), in order. */
-    struct sha256_ctx c;
-    sha256_init(&c);
-    sha256_update(&c, size, d);
-    sha256_digest(&c, SHA256_DIGEST_SIZE, s->file_sha256);
+    /* The baker's hashes (bake/lib/mesh_gltf.cpp): the file's bytes alone,
+     * and the file's bytes then each external buffer's (not data: URIs,
+     * not the BIN chunk), in order; the two are one without an external
+     * buffer. */
+    struct sha256_ctx file, all;
+    sha256_init(&file);
+    sha256_update(&file, size, d);
+    all = file;
+    sha256_digest(&file, SHA256_DIGEST_SIZE, s->file_sha256);
     s->file_size = s->size = size;
-    memcpy(s->sha256, s->file_sha256, sizeof s->sha256);
-    int external = 0;
     for (int i = 0; i < s->buffer_count; i++) {
         const cJSON *uri = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(bufs, i), "uri");
         if (cJSON_IsString(uri) && strncmp(uri->valuestring, "data:", 5) != 0) {
-            if (!external)
-                sha256_update(&c, size, d);
-            external = 1;
-            sha256_update(&c, s->buffers[i].size, s->buffers[i].data);
+            sha256_update(&all, s->buffers[i].size, s->buffers[i].data);
             s->size += s->buffers[i].size;
         }
     }
-    if (external)
-        sha256_digest(&c, SHA256_DIGEST_SIZE, s->sha256);
+    sha256_digest(&all, SHA256_DIGEST_SIZE, s->sha256);
     rc = 0;
 out:
     free(d);
