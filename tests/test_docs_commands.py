@@ -8,13 +8,14 @@ docs mention exists. Options get renamed and removed, and the docs then go
 stale without anyone noticing.
 
 Commands are taken from code blocks (indented or fenced) and from inline
-code spans that start with a program. Line continuations (backslash), pipes,
+code spans (`vdsh-bake --light-region grown`). Line continuations (backslash), pipes,
 &&, ;, comments, env assignments (NAME=value), wrappers (nice, timeout,
 env, time), placeholders (SCENE, FILE, K, ...: values are never checked)
 and optional parts in brackets ([--seed N]) are handled. Arguments after
 bake-parallel's and bake-slurm's `--` are vdsh-bake's; the strings given to
-a script's --extra, --eval-args, ... (BAKE_ARGS below) are checked against
-the program they go to.
+a script's --extra, --variant, --eval-args, ... (NESTED below) are checked
+against the program they go to. Options are those a help defines (opening
+a line, or in its usage), not any it mentions.
 
 Usage: test_docs_commands.py SOURCE_DIR BUILD_DIR [PROG=PATH ...] [--list]
   PROG=PATH: where the build's programs are (vdsh-bake=build/bake/vdsh-bake);
@@ -58,8 +59,9 @@ NESTED = {
     ("pareto", "--bake-args"): ("vdsh-bake", "ARGS"),
     ("speed_vs_error", "--eval-args"): ("vdsh-eval", "ARGS"),
 }
-WRAPPERS = {"nice": {"-n": 1}, "timeout": {}, "env": {}, "time": {}, "/usr/bin/time": {"-o": 1, "-f": 1},
-            "exec": {}, "sudo": {}, "xvfb-run": {}}
+# Commands that run another: the options of theirs that take a value.
+WRAPPERS = {"nice": {"-n": 1}, "timeout": {}, "env": {}, "time": {}, "exec": {}, "sudo": {},
+            "/usr/bin/time": {"-o": 1, "-f": 1}, "xvfb-run": {}}
 SEPARATORS = {"|", "||", "&&", ";", "&", "(", ")", "$(", "`", "{", "}", "do", "then", "else",
               "!", ";;"}
 OPTION = re.compile(r"(?<![\w-])(--?[A-Za-z0-9][\w-]*)")
@@ -187,7 +189,8 @@ def segments(words):
     """The simple commands of a word list, split at operators."""
     seg = []
     for w in words:
-        if w in SEPARATORS or (w and set(w) <= set("|&;()<>") and w not in ("<", ">", ">>", ">&", "<&")):
+        redirect = w in ("<", ">", ">>", ">&", "<&")
+        if w in SEPARATORS or (w and set(w) <= set("|&;()<>") and not redirect):
             if seg:
                 yield seg
             seg = []
@@ -371,7 +374,8 @@ def check_docs(src, build, progs, helps, docs, listing=False):
         sub = None
         opts, after = options_of(words)
         first = next((w for w in words if not w.startswith("-")), None)
-        if first and first in helps.subcommands(prog) and (not opts or words.index(first) < opts[0][1]):
+        if first and first in helps.subcommands(prog) and \
+                (not opts or words.index(first) < opts[0][1]):
             sub = first
         if not words and prog.startswith("scripts/"):
             if not os.path.isfile(os.path.join(src, prog)):
@@ -386,7 +390,8 @@ def check_docs(src, build, progs, helps, docs, listing=False):
                 skipped += 1
             return
         if not helps.text(prog, sub):
-            fails.append(f"{doc}:{ln}: `{name} --help` failed, {helps.errors.get((prog, sub))} (for: {cmd})")
+            why = helps.errors.get((prog, sub))
+            fails.append(f"{doc}:{ln}: `{name} --help` failed, {why} (for: {cmd})")
             return
         checked += 1
         bad = []
@@ -463,7 +468,7 @@ def main():
     args = [a for a in sys.argv[1:] if a != "--list"]
     listing = "--list" in sys.argv
     src, build = args[0], args[1]
-    progs = dict(a.split("=", 1) for a in args[2:])
+    progs = {p: os.path.abspath(path) for p, path in (a.split("=", 1) for a in args[2:])}
     helps = Helps(src, progs)
     docs = []
     for doc in doc_files(src):
