@@ -4,7 +4,9 @@ that runs one of our programs (vdsh-bake, vdsh-merge, vdsh-info, vdsh-eval,
 vdsh-frames, vdsh-view, vdsh-export, scripts/NAME, python3 -m vdsh) uses
 only options that program's --help (or its subcommand's) names, and a
 build/DIR/PROG path is where the build puts PROG; every scripts/NAME the
-docs mention exists. Options get renamed and removed, and the docs then go
+docs mention exists; and every long option the docs name anywhere, prose
+and tables included, is some program's or script's (or another tool's,
+FOREIGN below). Options get renamed and removed, and the docs then go
 stale without anyone noticing.
 
 Commands are taken from code blocks (indented or fenced) and from inline
@@ -44,6 +46,20 @@ HISTORICAL = {
     ("docs/ACCURACY.md", "vdsh-bake", "--decision-fit-pairs"):
         "lights' unmerged option, commit 97a1f2f",
 }
+
+# Long options the docs name anywhere (prose, tables, commands) must be
+# some program's or script's, or one of these other tools' (so that a
+# renamed option is caught also where no command shows it).
+FOREIGN = {
+    "chromium": ("--headless", "--no-sandbox", "--use-angle", "--enable-unsafe-swiftshader",
+                 "--allow-file-access-from-files", "--window-size", "--virtual-time-budget"),
+    "cmake, ctest": ("--install", "--prefix", "--test-dir", "--output-on-failure"),
+    "pip, venv": ("--no-build-isolation", "--no-deps", "--target", "--system-site-packages"),
+    "pkg-config": ("--cflags", "--libs", "--static"),
+    "sbatch": ("--dependency", "--cpus-per-task", "--chdir", "--kill-on-invalid-dep"),
+    "perf, heaptrack_print": ("--sort", "--print-peaks"),
+}
+LONG = re.compile(r"(?<![\w-])(--[A-Za-z0-9][\w-]*)")
 
 PROGRAMS = ("vdsh-bake", "vdsh-merge", "vdsh-info", "vdsh-eval", "vdsh-frames", "vdsh-view",
             "vdsh-export")
@@ -430,6 +446,27 @@ def check_docs(src, build, progs, helps, docs, listing=False):
             if written[len("build/"):] != where[prog]:
                 fails.append(f"{doc}:{ln}: {written}: the build puts {prog} at build/{where[prog]}")
 
+    # Every long option named anywhere: some program's, script's or tool's
+    # (with every program built: a build without the bake cannot tell).
+    if all(p in progs for p in PROGRAMS):
+        known = set(o for opts in FOREIGN.values() for o in opts)
+        every = [(p, None) for p in PROGRAMS] + [("python -m vdsh", "info")]
+        for name in sorted(os.listdir(os.path.join(src, "scripts"))):
+            path = os.path.join(src, "scripts", name)
+            if os.path.isfile(path) and os.access(path, os.X_OK):
+                every.append(("scripts/" + name, None))
+        with concurrent.futures.ThreadPoolExecutor(8) as pool:
+            list(pool.map(lambda k: helps.text(*k), every))
+        for prog, sub in every:
+            known |= helps.options(prog, sub) or set()
+        for doc, text in docs:
+            for n, line in enumerate(text.split("\n"), 1):
+                for opt in LONG.findall(line):
+                    if opt not in known and not any(d == doc and o == opt
+                                                     for d, _, o in HISTORICAL):
+                        fails.append(f"{doc}:{n}: {opt} is no program's, script's or listed "
+                                     f"tool's option: {line.strip()[:120]}")
+                        known.add(opt)  # once per option
     return fails, (len(commands), checked, skipped, len(script_mentions))
 
 
@@ -452,6 +489,9 @@ def self_test(src, build, progs, helps):
     want = {"--no-such-option", "scripts/no_such_script", "--bogus-two", "-Z"}
     if "vdsh-bake" in progs:
         want.add("--bogus-bake")
+    if all(p in progs for p in PROGRAMS):
+        want |= {"--no-such-option anywhere", "--bogus-two anywhere", "--bogus-bake anywhere",
+                 "--not-an-option anywhere"}
     got = set()
     for f in fails:
         m = re.search(r"not in its --help: (.*?)   \(in:", f)
@@ -459,6 +499,8 @@ def self_test(src, build, progs, helps):
             got |= set(m.group(1).split())
         elif "does not exist" in f:
             got.add(f.split(": ")[1].split()[0])
+        elif "is no program's" in f:
+            got.add(f.split(": ")[1].split()[0] + " anywhere")
         else:
             got.add(f)
     return [] if got == want else [f"self-test: flagged {sorted(got)}, want {sorted(want)}"]
