@@ -24,6 +24,7 @@ Usage: test_docs_commands.py SOURCE_DIR BUILD_DIR [PROG=PATH ...] [--list]
   a command of a program not given is counted as skipped (a build without
   the bake). --list prints every command found and what it was checked as.
 """
+import ast
 import concurrent.futures
 import glob
 import os
@@ -272,8 +273,29 @@ def options_of(words):
     return opts, None
 
 
+def python_options(path):
+    """The options a Python script's --help lists, read from its source
+    without running it (importing numpy and matplotlib for each script
+    took most of this test's time): the option strings of its argparse
+    add_argument calls (argparse's -h, --help added), or, in a script
+    that parses sys.argv itself, every option-like string in it."""
+    with open(path, encoding="utf-8") as f:
+        tree = ast.parse(f.read(), path)
+    strings = []
+    argparse_opts = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str):
+            strings.append(node.value)
+        if isinstance(node, ast.Call) and getattr(node.func, "attr", "") == "add_argument":
+            argparse_opts += [a.value for a in node.args
+                              if isinstance(a, ast.Constant) and isinstance(a.value, str)]
+    found = argparse_opts + ["-h", "--help"] if argparse_opts else strings
+    return sorted(o for o in found if re.match(r"^--?[A-Za-z0-9][\w-]*$", o))
+
+
 class Helps:
-    """--help of each program (and subcommand), fetched once."""
+    """--help of each program (and subcommand), fetched once; a Python
+    script's options from its source (python_options)."""
 
     def __init__(self, src, progs):
         self.src = src
@@ -301,6 +323,12 @@ class Helps:
             argv = self.argv(prog)
             if argv is None:
                 self.cache[key] = None
+            elif argv[0] == sys.executable and prog.startswith("scripts/"):
+                try:
+                    self.cache[key] = "".join("  %s\n" % o for o in python_options(argv[1]))
+                except (SyntaxError, ValueError) as e:
+                    self.cache[key] = ""
+                    self.errors[key] = f"does not parse: {e}"
             else:
                 env = dict(os.environ, PYTHONPATH=os.path.join(self.src, "python"))
                 p = subprocess.run(argv + ([sub] if sub else []) + ["--help"], capture_output=True,
