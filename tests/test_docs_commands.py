@@ -394,7 +394,7 @@ def check_docs(src, build, progs, helps, docs, listing=False):
         if not os.path.exists(os.path.join(src, "scripts", name)):
             fails.append(f"{doc}:{n}: scripts/{name} does not exist")
 
-    # Fetch the helps in parallel (the scripts start Python each).
+    # Fetch the helps in parallel (each program and bash script runs once).
     wanted = set()
     for doc, ln, cmd, prog, words, written in commands:
         if words or not prog.startswith("scripts/"):
