@@ -340,7 +340,7 @@ class Helps:
 
     def subcommands(self, prog):
         """Words the program's --help shows as `PROG WORD`: its subcommands.
-        Not asked of scripts: `scripts/bench_shard rss --help` runs rss."""
+        Not asked of scripts: a script need not read --help after a subcommand."""
         if prog.startswith("scripts/"):
             return set()
         t = self.text(prog) or ""

@@ -51,6 +51,13 @@ for s in bench_gltf_libs bench_gltf_load bench_shard fuzz npm_gltf_tools obj_to_
     fail=1
   fi
 done
+# A measurement's name then --help prints the usage and measures
+# nothing (bench_shard rss --help ran rss).
+out=$(cd "$tmp" && BUILD=$tmp/none timeout 30 bash scripts/bench_shard rss --help 2>"$tmp/err"); rc=$?
+if [[ $rc -ne 0 || $out != *"scripts/bench_shard rss"* || -s $tmp/err ]]; then
+  echo "FAIL: scripts/bench_shard rss --help: exit $rc, want 0 and the usage; stderr: $(head -c 300 "$tmp/err")" >&2
+  fail=1
+fi
 rm -f "$tmp/err"
 leftover=$(cd "$tmp" && ls -A | grep -v '^scripts$' | grep -v '^err$')
 [[ -z $leftover ]] || { echo "FAIL: the scripts left files: $leftover" >&2; fail=1; }
