@@ -280,10 +280,9 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     /* The default view (room or object, camera, lights in free space),
      * from the mesh as the file has it (formats/vdsh_scene_view.h). */
     {
-        const float region[6] = {f->light_box.min[0], f->light_box.min[1], f->light_box.min[2],
-                                 f->light_box.max[0], f->light_box.max[1], f->light_box.max[2]};
-        vdsh_view_mesh vm = {f->positions,    f->normals,        f->indices,
-                             h->vertex_count, h->triangle_count, f->has_light_box ? region : NULL};
+        float region[6];
+        vdsh_view_mesh vm;
+        vdsh_view_file_mesh(f, region, &vm);
         vdsh_error ve;
         vdsh_result vr = vdsh_view_compute(&vm, &s->view, &ve);
         if (vr != VDSH_OK) {

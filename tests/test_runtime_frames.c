@@ -27,8 +27,9 @@
  *                      not 1 and not a Lambert term)
  *   lights SCENE       the runtime's default camera and four default
  *                      lights (vr_scene_default_camera / _lights) are
- *                      vdsh_view_compute's of the same file; its light
- *                      pool (vr_scene_pool_lights) holds 64 distinct
+ *                      vdsh_view_compute's of the same file
+ *                      (vdsh_view_file_mesh); its light pool
+ *                      (vr_scene_pool_lights) holds 64 distinct
  *                      positions in free space (vdsh_view_free_space with
  *                      a tracer of the file's mesh), inside the bounds,
  *                      the first free candidates of vdsh_light_candidate
@@ -437,9 +438,9 @@ static int check_lights(const char *path)
     CHECK(ok, "%s", err.msg);
     CHECK(vdsh_read(path, &f, &verr) == VDSH_OK, "%s", verr.msg);
     if (ok && f) {
-        vdsh_view_mesh m = {
-            f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
-            NULL};
+        float region[6];
+        vdsh_view_mesh m;
+        vdsh_view_file_mesh(f, region, &m);
         CHECK(vdsh_view_compute(&m, &v, &verr) == VDSH_OK, "%s", verr.msg);
         vr_camera c;
         vr_scene_default_camera(s, &c);

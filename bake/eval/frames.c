@@ -636,10 +636,9 @@ void vb_frames_scores_get(const vb_frames_tally *t, vb_frames_scores *out)
 
 static vb_result default_camera(const vb_frames_scene *s, vdsh_camera *out, vb_error *err)
 {
-    const vdsh_file *f = s->file;
-    vdsh_view_mesh m = {
-        f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
-        NULL};
+    float region[6];
+    vdsh_view_mesh m;
+    vdsh_view_file_mesh(s->file, region, &m);
     vdsh_view v;
     vdsh_error ve;
     if (vdsh_view_compute(&m, &v, &ve) != VDSH_OK)
