@@ -811,9 +811,9 @@ static int test_builtin_room(const char *path)
         fprintf(stderr, "%s\n", err.msg);
         return 1;
     }
-    vdsh_view_mesh m = {
-        f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
-        NULL};
+    float region[6];
+    vdsh_view_mesh m;
+    vdsh_view_file_mesh(f, region, &m);
     vdsh_view v;
     CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
     CHECK(v.interior, "%s: not an interior (front share %g)", path, (double)v.front_share);
@@ -921,9 +921,9 @@ static int test_object_lights(const char *path)
         fprintf(stderr, "%s\n", err.msg);
         return 1;
     }
-    vdsh_view_mesh m = {
-        f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
-        NULL};
+    float region[6];
+    vdsh_view_mesh m;
+    vdsh_view_file_mesh(f, region, &m);
     vdsh_view v;
     CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
     CHECK(!v.interior && !v.region_grown,
