@@ -1338,11 +1338,7 @@ static void say_receivers(FILE *log, const options *o, const vb_job *job, vb_mes
     if ((log && !chosen && (o->output || o->plan)) || o->report) {
         float lo[3], hi[3];
         vb_mesh_bounds(&job->occluders, lo, hi);
-        vb_mesh_spacing_of(rec,
-                           sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) +
-                                 (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                 (hi[2] - lo[2]) * (hi[2] - lo[2])),
-                           spacing);
+        vb_mesh_spacing_of(rec, vdsh_view_diagonal(lo, hi), spacing);
     }
     if (log && !chosen && (o->output || o->plan) && spacing->far_apart)
         fprintf(log,
