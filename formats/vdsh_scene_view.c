@@ -26,12 +26,7 @@ void vdsh_view_bounds(const float *positions, uint32_t vertex_count, float lo[3]
         }
 }
 
-/* The bounds' diagonal in float (1 when it is 0): the view's scale for
- * its ray offsets, open rays and free-space clearance. Not
- * vdsh_free_diagonal, the bake's, summed in double: the two can differ
- * in the last bit, and the default view has been computed with this one;
- * only the light region (vdsh_view_compute) uses the bake's. */
-static float diagonal_of(const float lo[3], const float hi[3])
+float vdsh_view_diagonal(const float lo[3], const float hi[3])
 {
     float diag2 = 0.0f;
     for (int k = 0; k < 3; k++)
@@ -417,7 +412,7 @@ vdsh_result vdsh_view_tracer_create(const vdsh_view_mesh *m, vdsh_view_tracer **
     for (int k = 0; k < 3; k++)
         if (!(g->lo[k] <= g->hi[k]))
             g->lo[k] = g->hi[k] = 0.0f;
-    float ext[3], diag = diagonal_of(g->lo, g->hi);
+    float ext[3], diag = vdsh_view_diagonal(g->lo, g->hi);
     for (int k = 0; k < 3; k++) {
         float pad = 1e-4f * diag;
         g->lo[k] -= pad;
@@ -572,7 +567,7 @@ int vdsh_view_room_camera_free(const vdsh_view_tracer *t, const float lo[3], con
                                vdsh_camera *out)
 {
     vdsh_view_room_camera(lo, hi, out);
-    float diag = diagonal_of(lo, hi);
+    float diag = vdsh_view_diagonal(lo, hi);
     /* The standard eye, then higher (over a block on the floor, the
      * Cornell box's), then across the room at the same heights; the
      * target stays. A moved eye first VDSH_VIEW_EYE_MARGIN clearances from
@@ -607,7 +602,7 @@ float vdsh_view_front_share(const vdsh_view_tracer *t, const vdsh_view_mesh *m, 
     vdsh_view_room_camera_free(t, lo, hi, &room);
     /* Hits up to this close are the surface the eye stands on (a flat
      * scene) or rounding; they do not count. */
-    float tmin = nextafterf(1e-5f * diagonal_of(lo, hi), INFINITY);
+    float tmin = nextafterf(1e-5f * vdsh_view_diagonal(lo, hi), INFINITY);
     int front = 0;
     for (int i = 0; i < VDSH_VIEW_RAYS; i++) {
         /* A Fibonacci sphere: nearly uniform directions, the same every
@@ -1118,7 +1113,7 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
     const float *lo = v.bounds_min, *hi = v.bounds_max;
     v.front_share = vdsh_view_front_share(t, m, lo, hi);
     v.interior = v.front_share >= VDSH_VIEW_INTERIOR_SHARE;
-    const float diag = diagonal_of(lo, hi);
+    const float diag = vdsh_view_diagonal(lo, hi);
     /* A flat object's fit camera on its back side (a triangle facing away
      * from the fixed direction): the view mirrored through the plane, eye
      * and lights alike, so that it sees the front lit as the fit view
@@ -1181,4 +1176,16 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
     vdsh_view_tracer_destroy(t);
     *out = v;
     return VDSH_OK;
+}
+
+void vdsh_view_file_mesh(const vdsh_file *f, float region[6], vdsh_view_mesh *out)
+{
+    memcpy(region, f->light_box.min, 3 * sizeof *region);
+    memcpy(region + 3, f->light_box.max, 3 * sizeof *region);
+    *out = (vdsh_view_mesh){f->positions,
+                            f->normals,
+                            f->indices,
+                            f->header.vertex_count,
+                            f->header.triangle_count,
+                            f->has_light_box ? region : NULL};
 }

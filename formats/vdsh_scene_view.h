@@ -199,9 +199,23 @@ typedef struct vdsh_view {
  * Deterministic: the same mesh gives the same view on every machine. */
 vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_error *err);
 
+/* The mesh of a file, as vdsh-view, vdsh-export and vdsh-frames give it to
+ * vdsh_view_compute: *out borrows f's arrays, and its light_region is
+ * region, filled with f's `lreg` box, when f has one (else NULL); f and
+ * region must outlive *out. */
+void vdsh_view_file_mesh(const vdsh_file *f, float region[6], vdsh_view_mesh *out);
+
 /* The bounding box of positions (vertex_count x 3), fminf / fmaxf per
  * axis; with no vertices lo = +INFINITY, hi = -INFINITY. */
 void vdsh_view_bounds(const float *positions, uint32_t vertex_count, float lo[3], float hi[3]);
+
+/* The bounds' diagonal in float (1 when it is 0): the view's scale for
+ * its ray offsets, open rays and free-space clearance, and vdsh-view's
+ * for its lights' fall-off. Not vdsh_free_diagonal, the bake's, summed in
+ * double: the two can differ in the last bit, and the default view has
+ * been computed with this one; only the light region (vdsh_view_compute)
+ * uses the bake's. */
+float vdsh_view_diagonal(const float lo[3], const float hi[3]);
 
 /* The cameras (fov_y 60, up +y), from the bounds only. Fit: the eye up and
  * to the side of the bounds' centre, looking at it, just far enough that

@@ -127,7 +127,7 @@ int vv_mode_available(const vr_scene *s, const vv_mode *m);
  * mode its order (cap and mean order of an adaptive stream). */
 void vv_mode_label(const vr_scene *s, vr_mode mode, int stream, char *out, size_t size);
 
-/* The scene's bounds' diagonal (1 for an empty box). */
+/* The scene's bounds' diagonal, the default view's (vdsh_view_diagonal). */
 float vv_scene_diagonal(const vr_scene *s);
 /* n default lights of the scene: positions from vr_scene_default_lights,
  * the viewer's colours and fall-off (or --attenuation). */

@@ -6,6 +6,7 @@
 #include "vdsh_view.h"
 
 #include "vdsh_output.h"
+#include "vdsh_scene_view.h"
 
 #include <stb/stb_image_write.h>
 
@@ -105,10 +106,7 @@ float vv_scene_diagonal(const vr_scene *s)
 {
     vr_scene_info info;
     vr_scene_get_info(s, &info);
-    float d2 = 0.0f;
-    for (int k = 0; k < 3; k++)
-        d2 += (info.bounds_max[k] - info.bounds_min[k]) * (info.bounds_max[k] - info.bounds_min[k]);
-    return sqrtf(d2) > 0.0f ? sqrtf(d2) : 1.0f;
+    return vdsh_view_diagonal(info.bounds_min, info.bounds_max);
 }
 
 /* n default lights of the scene: positions from vr_scene_default_lights,

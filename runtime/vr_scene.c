@@ -189,6 +189,24 @@ static vr_result upload_stream(vr_scene *s, const vdsh_stream *st, size_t vertic
     return VR_OK;
 }
 
+/* The default view (room or object, camera, lights in free space), from
+ * the mesh as the file has it (formats/vdsh_scene_view.h), and the light
+ * pool's `pool` lights (none when 0). */
+static vr_result default_view(vr_scene *s, const vdsh_file *f, int pool, const char *name,
+                              vr_error *err)
+{
+    float region[6];
+    vdsh_view_mesh vm;
+    vdsh_view_file_mesh(f, region, &vm);
+    vdsh_error ve;
+    vdsh_result vr = vdsh_view_compute(&vm, &s->view, &ve);
+    if (vr != VDSH_OK)
+        return vr_fail(err, map_vdsh_result(vr), "%s: %s", name, ve.msg);
+    memcpy(s->bounds_min, s->view.bounds_min, sizeof s->bounds_min);
+    memcpy(s->bounds_max, s->view.bounds_max, sizeof s->bounds_max);
+    return pool > 0 ? vr_scene_place_pool(s, &vm, pool, name, err) : VR_OK;
+}
+
 vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *err)
 {
     if (!desc || !out || (!desc->path && !desc->file))
@@ -277,26 +295,8 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
                            err);
     if (r != VR_OK)
         goto done;
-    /* The default view (room or object, camera, lights in free space),
-     * from the mesh as the file has it (formats/vdsh_scene_view.h). */
-    {
-        const float region[6] = {f->light_box.min[0], f->light_box.min[1], f->light_box.min[2],
-                                 f->light_box.max[0], f->light_box.max[1], f->light_box.max[2]};
-        vdsh_view_mesh vm = {f->positions,    f->normals,        f->indices,
-                             h->vertex_count, h->triangle_count, f->has_light_box ? region : NULL};
-        vdsh_error ve;
-        vdsh_result vr = vdsh_view_compute(&vm, &s->view, &ve);
-        if (vr != VDSH_OK) {
-            r = vr_fail(err, map_vdsh_result(vr), "%s: %s", name, ve.msg);
-            goto done;
-        }
-        memcpy(s->bounds_min, s->view.bounds_min, sizeof s->bounds_min);
-        memcpy(s->bounds_max, s->view.bounds_max, sizeof s->bounds_max);
-        if (desc->light_pool > 0)
-            r = vr_scene_place_pool(s, &vm, desc->light_pool, name, err);
-        if (r != VR_OK)
-            goto done;
-    }
+    if ((r = default_view(s, f, desc->light_pool, name, err)) != VR_OK)
+        goto done;
     glGenBuffers(1, &s->vbo_position);
     glGenBuffers(1, &s->vbo_normal);
     if (upload_permuted(s->vbo_position, f->positions, nv, 12, remap) ||

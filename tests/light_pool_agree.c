@@ -97,8 +97,9 @@ int main(int argc, char **argv)
         return fprintf(stderr, "%s\n", ve.msg), 2;
     const vdsh_header *h = &f->header;
     /* the runtime's pool */
-    vdsh_view_mesh vm = {f->positions,    f->normals,        f->indices,
-                         h->vertex_count, h->triangle_count, NULL};
+    float region[6];
+    vdsh_view_mesh vm;
+    vdsh_view_file_mesh(f, region, &vm);
     float lo[3], hi[3];
     vdsh_view_bounds(f->positions, h->vertex_count, lo, hi);
     const float diag = vdsh_free_diagonal(lo, hi);

@@ -25,9 +25,7 @@
 #include <string.h>
 
 #include "bake.h"
-#include "mesh.h"
-#include "scene.h"
-#include "vdsh_light.h"
+#include "probe_scene.h"
 
 #define POOL 256u
 
@@ -44,30 +42,17 @@ static uint64_t fnv(uint64_t h, const void *p, size_t n)
  * kernel sets, the free-space test's own measure does not). */
 static double probe_gap(const vb_scene *s, const float p[3], uint64_t *h, uint32_t *misses)
 {
-    float dirs[VDSH_FREE_PROBES][3], o[3];
-    vdsh_free_probe_dirs(dirs);
-    vb_scene_to_local(s, p, o);
+    float t[VDSH_FREE_PROBES];
+    probe_embree_t(s, p, t);
     const double c = vdsh_free_clearance(s->diagonal);
     double gap = INFINITY;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
     for (int i = 0; i < VDSH_FREE_PROBES; i++) {
-        struct RTCRayHit rh = {.ray = {.org_x = o[0],
-                                       .org_y = o[1],
-                                       .org_z = o[2],
-                                       .dir_x = dirs[i][0],
-                                       .dir_y = dirs[i][1],
-                                       .dir_z = dirs[i][2],
-                                       .tfar = INFINITY,
-                                       .mask = 0xffffffffu},
-                               .hit = {.geomID = RTC_INVALID_GEOMETRY_ID}};
-        rtcIntersect1(s->scene, &ctx, &rh);
-        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        if (t[i] == INFINITY) {
             ++*misses;
             continue;
         }
-        *h = fnv(*h, &rh.ray.tfar, sizeof rh.ray.tfar);
-        double g = fabs(rh.ray.tfar / s->scale - c) / c;
+        *h = fnv(*h, &t[i], sizeof t[i]);
+        double g = fabs(t[i] / s->scale - c) / c;
         gap = g < gap ? g : gap;
     }
     return gap;
@@ -80,20 +65,10 @@ int main(int argc, char **argv)
         return 2;
     }
     const uint64_t seed = argc > 2 ? strtoull(argv[2], NULL, 0) : 1u;
-    vb_error err;
     vb_mesh m = {0};
-    vb_load_desc ld = {0};
-    if (vb_mesh_load(argv[1], &ld, &m, NULL, &err) != VB_OK) {
-        fprintf(stderr, "light_region_probe: %s\n", err.msg);
+    vb_scene *s = probe_scene("light_region_probe", argv[1], &m);
+    if (!s)
         return 1;
-    }
-    vb_scene *s = NULL;
-    vb_scene_desc sd = {.robust = 1}; /* vdsh-bake's default */
-    if (vb_scene_create(&m, &sd, &s, &err) != VB_OK) {
-        fprintf(stderr, "light_region_probe: %s\n", err.msg);
-        vb_mesh_free(&m);
-        return 1;
-    }
     float lo[3], hi[3];
     uint32_t probes = 0;
     const int grown = vb_scene_light_region(s, lo, hi, &probes);
@@ -123,6 +98,7 @@ int main(int argc, char **argv)
     printf(" (%u free)\n", free_count);
     float(*pool)[3] = malloc(POOL * sizeof *pool);
     uint32_t tried = 0;
+    vb_error err;
     if (pool && vb_scene_place_lights(s, seed ^ VB_POOL_SEED, POOL, pool, &tried, &err) == VB_OK)
         printf("pool %u lights from %u candidates, hash %016llx\n", POOL, tried,
                (unsigned long long)fnv(0xcbf29ce484222325ull, pool, POOL * sizeof *pool));

@@ -26,33 +26,18 @@
 #include <stdlib.h>
 
 #include "bake.h"
-#include "mesh.h"
-#include "scene.h"
-#include "vdsh_light.h"
+#include "probe_scene.h"
 
 static uint32_t dir_esc[VDSH_FREE_PROBES], hist[VDSH_FREE_PROBES + 1];
 
 static uint32_t misses_from(const vb_scene *s, const float p[3])
 {
-    float dirs[VDSH_FREE_PROBES][3], o[3];
-    vdsh_free_probe_dirs(dirs);
-    vb_scene_to_local(s, p, o);
+    float t[VDSH_FREE_PROBES];
+    probe_embree_t(s, p, t);
     uint32_t n = 0;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
     for (int i = 0; i < VDSH_FREE_PROBES; i++) {
-        struct RTCRayHit rh = {.ray = {.org_x = o[0],
-                                       .org_y = o[1],
-                                       .org_z = o[2],
-                                       .dir_x = dirs[i][0],
-                                       .dir_y = dirs[i][1],
-                                       .dir_z = dirs[i][2],
-                                       .tfar = INFINITY,
-                                       .mask = 0xffffffffu},
-                               .hit = {.geomID = RTC_INVALID_GEOMETRY_ID}};
-        rtcIntersect1(s->scene, &ctx, &rh);
-        n += rh.hit.geomID == RTC_INVALID_GEOMETRY_ID;
-        dir_esc[i] += rh.hit.geomID == RTC_INVALID_GEOMETRY_ID;
+        n += t[i] == INFINITY;
+        dir_esc[i] += t[i] == INFINITY;
     }
     return n;
 }
@@ -63,20 +48,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: object_rule_probe SCENE\n");
         return 2;
     }
-    vb_error err;
     vb_mesh m = {0};
-    vb_load_desc ld = {0};
-    if (vb_mesh_load(argv[1], &ld, &m, NULL, &err) != VB_OK) {
-        fprintf(stderr, "object_rule_probe: %s\n", err.msg);
+    vb_scene *s = probe_scene("object_rule_probe", argv[1], &m);
+    if (!s)
         return 1;
-    }
-    vb_scene *s = NULL;
-    vb_scene_desc sd = {.robust = 1};
-    if (vb_scene_create(&m, &sd, &s, &err) != VB_OK) {
-        fprintf(stderr, "object_rule_probe: %s\n", err.msg);
-        vb_mesh_free(&m);
-        return 1;
-    }
     const float *lo = s->bounds_min, *hi = s->bounds_max;
     uint32_t in = 0, esc = 0, open = 0;
     for (uint32_t k = 0; k < VDSH_REGION_PROBES; k++) {

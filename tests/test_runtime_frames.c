@@ -27,8 +27,9 @@
  *                      not 1 and not a Lambert term)
  *   lights SCENE       the runtime's default camera and four default
  *                      lights (vr_scene_default_camera / _lights) are
- *                      vdsh_view_compute's of the same file; its light
- *                      pool (vr_scene_pool_lights) holds 64 distinct
+ *                      vdsh_view_compute's of the same file
+ *                      (vdsh_view_file_mesh); its light pool
+ *                      (vr_scene_pool_lights) holds 64 distinct
  *                      positions in free space (vdsh_view_free_space with
  *                      a tracer of the file's mesh), inside the bounds,
  *                      the first free candidates of vdsh_light_candidate
@@ -270,9 +271,9 @@ static int check_empty(char **argv)
 
     /* The pixels whose primary ray meets nothing in the mesh, away from
      * its silhouette (every ray of the 3 x 3 block around misses). */
-    vdsh_view_mesh mesh = {
-        f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
-        NULL};
+    float region[6];
+    vdsh_view_mesh mesh;
+    vdsh_view_file_mesh(f, region, &mesh);
     vdsh_view_tracer *tr = NULL;
     CHECK(vdsh_view_tracer_create(&mesh, &tr, &err) == VDSH_OK, "%s", err.msg);
     unsigned char *miss = calloc((size_t)w * (size_t)h, 1),
@@ -388,19 +389,15 @@ static void check_pool(const char *path, const vdsh_file *f, const vr_scene *pla
         CHECK(0, "%s", err.msg);
         return;
     }
-    vdsh_view_mesh m = {
-        f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
-        NULL};
+    float region[6];
+    vdsh_view_mesh m;
+    vdsh_view_file_mesh(f, region, &m);
     vdsh_view_tracer *t = NULL;
     vdsh_error verr;
     CHECK(vdsh_view_tracer_create(&m, &t, &verr) == VDSH_OK, "%s", verr.msg);
     vr_scene_info info;
     vr_scene_get_info(s, &info);
-    float diag = 0.0f;
-    for (int a = 0; a < 3; a++)
-        diag +=
-            (info.bounds_max[a] - info.bounds_min[a]) * (info.bounds_max[a] - info.bounds_min[a]);
-    diag = sqrtf(diag);
+    const float diag = vdsh_view_diagonal(info.bounds_min, info.bounds_max);
     vr_light l[VR_MAX_POOL_LIGHTS];
     int n = vr_scene_pool_lights(s, l, VR_MAX_POOL_LIGHTS);
     CHECK(n == VR_MAX_POOL_LIGHTS, "%d pool lights, not %d", n, VR_MAX_POOL_LIGHTS);
@@ -437,9 +434,9 @@ static int check_lights(const char *path)
     CHECK(ok, "%s", err.msg);
     CHECK(vdsh_read(path, &f, &verr) == VDSH_OK, "%s", verr.msg);
     if (ok && f) {
-        vdsh_view_mesh m = {
-            f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
-            NULL};
+        float region[6];
+        vdsh_view_mesh m;
+        vdsh_view_file_mesh(f, region, &m);
         CHECK(vdsh_view_compute(&m, &v, &verr) == VDSH_OK, "%s", verr.msg);
         vr_camera c;
         vr_scene_default_camera(s, &c);

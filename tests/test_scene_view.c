@@ -132,14 +132,6 @@ static void sphere(mesh *m, const float c[3], float r, int stacks, int slices)
 
 /* ---- free space by the plain loop -------------------------------------- */
 
-static float diagonal_of(const float lo[3], const float hi[3])
-{
-    float d = 0.0f;
-    for (int k = 0; k < 3; k++)
-        d += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    return sqrtf(d);
-}
-
 /* vdsh_light.h's rule at this clearance, probes cast at every triangle
  * (no grid). */
 static int free_all_at(const vdsh_view_mesh *m, const float p[3], float clearance)
@@ -287,7 +279,7 @@ static void test_space(void)
     CHECK(vdsh_view_tracer_create(&m, &t, &err) == VDSH_OK, "%s", err.msg);
     if (!t)
         return;
-    float diag = diagonal_of((float[3]){-10, 0, -10}, (float[3]){10, 6, 10});
+    float diag = vdsh_view_diagonal((float[3]){-10, 0, -10}, (float[3]){10, 6, 10});
     float c = vdsh_free_clearance(diag);
     struct {
         float p[3];
@@ -326,7 +318,7 @@ static void test_room(void)
     vdsh_camera room;
     vdsh_view_room_camera(v.bounds_min, v.bounds_max, &room);
     CHECK(same_camera(&v.camera, &room), "a room is not seen by the room camera");
-    float diag = diagonal_of(v.bounds_min, v.bounds_max);
+    float diag = vdsh_view_diagonal(v.bounds_min, v.bounds_max);
     CHECK(v.light_count == VDSH_VIEW_MAX_LIGHTS, "%d lights", v.light_count);
     for (int i = 0; i < v.light_count; i++) {
         int was_free = free_all(&m, v.preferred[i], diag);
@@ -374,7 +366,7 @@ static void test_object(void)
     vdsh_camera fit;
     vdsh_view_fit_camera(v.bounds_min, v.bounds_max, &fit);
     CHECK(same_camera(&v.camera, &fit), "an object is not framed by the fit camera");
-    float diag = diagonal_of(v.bounds_min, v.bounds_max);
+    float diag = vdsh_view_diagonal(v.bounds_min, v.bounds_max);
     for (int i = 0; i < v.light_count; i++) {
         float r = dist3(v.lights[i], c);
         CHECK(r > 1.0f + vdsh_free_clearance(diag), "light %d is %g from the centre", i, (double)r);
@@ -657,7 +649,7 @@ static void test_two_rooms(void)
     CHECK(v.interior, "two rooms: not an interior (front share %g)", (double)v.front_share);
     CHECK(v.camera.eye[0] > 12.2f, "the camera is not in the second room (x %g)",
           (double)v.camera.eye[0]);
-    float diag = diagonal_of(v.bounds_min, v.bounds_max);
+    float diag = vdsh_view_diagonal(v.bounds_min, v.bounds_max);
     /* the case: the preferred light 0 is free, behind the wall */
     float pref[VDSH_VIEW_MAX_LIGHTS][3], lit, sh;
     vdsh_view_preferred_lights(v.bounds_min, v.bounds_max, 1, pref, VDSH_VIEW_MAX_LIGHTS);
@@ -705,7 +697,7 @@ static void test_blocked_eye(void)
     CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
     CHECK(v.interior, "the blocked room is not an interior (front share %g)",
           (double)v.front_share);
-    float diag = diagonal_of(v.bounds_min, v.bounds_max);
+    float diag = vdsh_view_diagonal(v.bounds_min, v.bounds_max);
     CHECK(free_all(&m, room.eye, diag), "the test is wrong: the standard eye is not free");
     CHECK(v.camera.eye[1] > bhi[1], "the eye at height %g, not above the block (%g)",
           (double)v.camera.eye[1], (double)bhi[1]);
@@ -819,9 +811,9 @@ static int test_builtin_room(const char *path)
         fprintf(stderr, "%s\n", err.msg);
         return 1;
     }
-    vdsh_view_mesh m = {
-        f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
-        NULL};
+    float region[6];
+    vdsh_view_mesh m;
+    vdsh_view_file_mesh(f, region, &m);
     vdsh_view v;
     CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
     CHECK(v.interior, "%s: not an interior (front share %g)", path, (double)v.front_share);
@@ -836,7 +828,7 @@ static int test_builtin_room(const char *path)
                      {0, 1, 0},
                      60.0f};
     CHECK(same_camera(&v.camera, &c), "%s: the default camera is not the room camera", path);
-    float diag = diagonal_of(lo, hi), clear = vdsh_free_clearance(diag);
+    float diag = vdsh_view_diagonal(lo, hi), clear = vdsh_free_clearance(diag);
     for (int i = 0; i < v.light_count; i++) {
         char what[64];
         int pref_free = free_all(&m, v.preferred[i], diag);
@@ -893,8 +885,8 @@ static void test_seeded_margin(void)
     vdsh_view v;
     vdsh_error err;
     CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
-    const float margin =
-        VDSH_VIEW_LIGHT_MARGIN * vdsh_free_clearance(diagonal_of(v.bounds_min, v.bounds_max));
+    const float margin = VDSH_VIEW_LIGHT_MARGIN *
+                         vdsh_free_clearance(vdsh_view_diagonal(v.bounds_min, v.bounds_max));
     float pref[VDSH_VIEW_MAX_LIGHTS][3];
     vdsh_view_preferred_lights(v.bounds_min, v.bounds_max, 1, pref, VDSH_VIEW_MAX_LIGHTS);
     int seeded = 0;
@@ -929,9 +921,9 @@ static int test_object_lights(const char *path)
         fprintf(stderr, "%s\n", err.msg);
         return 1;
     }
-    vdsh_view_mesh m = {
-        f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
-        NULL};
+    float region[6];
+    vdsh_view_mesh m;
+    vdsh_view_file_mesh(f, region, &m);
     vdsh_view v;
     CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
     CHECK(!v.interior && !v.region_grown,
@@ -940,7 +932,7 @@ static int test_object_lights(const char *path)
           path, v.interior, v.region_grown);
     vdsh_view_tracer *t = NULL;
     CHECK(vdsh_view_tracer_create(&m, &t, &err) == VDSH_OK, "%s", err.msg);
-    const float diag = diagonal_of(v.bounds_min, v.bounds_max);
+    const float diag = vdsh_view_diagonal(v.bounds_min, v.bounds_max);
     for (int i = 0; t && i < v.light_count; i++) {
         float lit, sh;
         vdsh_view_light_shares(t, &m, &v.camera, VDSH_VIEW_CHECK_W, VDSH_VIEW_CHECK_H, v.lights[i],

@@ -981,10 +981,9 @@ static int describe_bake(exporter *e)
     /* The default view: vdsh-view's camera and lights (one definition,
      * formats/vdsh_scene_view.h), from the same mesh. */
     {
-        const float region[6] = {f->light_box.min[0], f->light_box.min[1], f->light_box.min[2],
-                                 f->light_box.max[0], f->light_box.max[1], f->light_box.max[2]};
-        vdsh_view_mesh vm = {f->positions, f->normals, f->indices,
-                             e->nv,        e->nt,      f->has_light_box ? region : NULL};
+        float region[6];
+        vdsh_view_mesh vm;
+        vdsh_view_file_mesh(f, region, &vm);
         vdsh_view view;
         vdsh_error ve;
         if (vdsh_view_compute(&vm, &view, &ve) != VDSH_OK) {

@@ -511,12 +511,14 @@ int vt_opt_positive(const char *option, const char *arg, float *out)
     return 0;
 }
 
-int vt_opt_light_region(const char *option, const char *arg, int file_ok, int *rule, float box[6])
+int vt_opt_light_region(const char *option, const char *arg, int file_ok, vdsh_light_box *out)
 {
     const char *names = file_ok ? "auto, grown, file" : "auto, grown";
     if (strcmp(arg, "auto") == 0 || strcmp(arg, "grown") == 0 ||
         (file_ok && strcmp(arg, "file") == 0)) {
-        *rule = arg[0] == 'a' ? 0 : arg[0] == 'g' ? 1 : 3;
+        out->rule = arg[0] == 'a'   ? 0
+                    : arg[0] == 'g' ? VDSH_LIGHT_REGION_GROWN
+                                    : VT_LIGHT_REGION_FILE;
         return 1;
     }
     float v[6];
@@ -534,8 +536,9 @@ int vt_opt_light_region(const char *option, const char *arg, int file_ok, int *r
                            option, arg, "xyz"[a], (double)v[a], (double)v[a + 3]);
             return 0;
         }
-    memcpy(box, v, sizeof v);
-    *rule = 2;
+    out->rule = VDSH_LIGHT_REGION_BOX;
+    memcpy(out->min, v, sizeof out->min);
+    memcpy(out->max, v + 3, sizeof out->max);
     return 1;
 }
 

@@ -47,6 +47,7 @@
 
 #include <stdint.h>
 #include <stdio.h>
+#include "vdsh.h"
 #include "vdsh_plural.h"
 
 #ifdef __cplusplus
@@ -206,10 +207,12 @@ int vt_opt_tolerance(const char *option, const char *noun, const char *arg, int 
                      double *out);
 
 /* Where the lights go (vdsh-bake, vdsh-eval --light-region SPEC): `auto`
- * (*rule 0), `grown` (1), XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (2: box[0..5],
- * finite, each min below its max) or, when file_ok, `file` (3). Says what
- * is wrong, naming the option. */
-int vt_opt_light_region(const char *option, const char *arg, int file_ok, int *rule, float box[6]);
+ * (out->rule 0), `grown` (VDSH_LIGHT_REGION_GROWN, its box left to the
+ * scene: vb_scene_use_light_box), XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX
+ * (VDSH_LIGHT_REGION_BOX, finite, each min below its max) or, when file_ok,
+ * `file` (VT_LIGHT_REGION_FILE). Says what is wrong, naming the option. */
+enum { VT_LIGHT_REGION_FILE = 3 };
+int vt_opt_light_region(const char *option, const char *arg, int file_ok, vdsh_light_box *out);
 
 /* One of a list of names, each standing for a value; the list ends with
  * {NULL, 0}. Says "takes A, B or C". */

@@ -53,19 +53,9 @@ vb_result vb_frames_scene_create(const vdsh_file *f, const vb_scene *occluders, 
     s->file = f;
     s->occluders = occluders;
     /* The bounds the runtime frames its default view with: every vertex. */
-    for (int k = 0; k < 3; k++)
-        s->bounds_min[k] = INFINITY, s->bounds_max[k] = -INFINITY;
-    for (uint32_t v = 0; v < h->vertex_count; v++)
-        for (int k = 0; k < 3; k++) {
-            float x = f->positions[3 * (size_t)v + (size_t)k];
-            s->bounds_min[k] = fminf(s->bounds_min[k], x);
-            s->bounds_max[k] = fmaxf(s->bounds_max[k], x);
-        }
-    double d2 = 0.0;
-    for (int k = 0; k < 3; k++)
-        d2 += ((double)s->bounds_max[k] - s->bounds_min[k]) *
-              ((double)s->bounds_max[k] - s->bounds_min[k]);
-    s->diagonal = d2 > 0.0 ? (float)sqrt(d2) : 1.0f;
+    vdsh_view_bounds(f->positions, h->vertex_count, s->bounds_min, s->bounds_max);
+    const float diag = vdsh_free_diagonal(s->bounds_min, s->bounds_max);
+    s->diagonal = diag > 0.0f ? diag : 1.0f;
     /* The scene only reads the arrays (vb_scene_create copies them). The
      * robust traversal, as a rasteriser's coverage rules: no primary ray
      * slips between two triangles that share an edge. */
@@ -636,10 +626,9 @@ void vb_frames_scores_get(const vb_frames_tally *t, vb_frames_scores *out)
 
 static vb_result default_camera(const vb_frames_scene *s, vdsh_camera *out, vb_error *err)
 {
-    const vdsh_file *f = s->file;
-    vdsh_view_mesh m = {
-        f->positions, f->normals, f->indices, f->header.vertex_count, f->header.triangle_count,
-        NULL};
+    float region[6];
+    vdsh_view_mesh m;
+    vdsh_view_file_mesh(s->file, region, &m);
     vdsh_view v;
     vdsh_error ve;
     if (vdsh_view_compute(&m, &v, &ve) != VDSH_OK)

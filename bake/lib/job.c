@@ -187,11 +187,8 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
         return r;
     j->timings.build = vb_now() - t;
     if (d->light_region.rule) {
-        vdsh_light_box *box = &j->light_region;
-        *box = d->light_region;
-        if (box->rule == VDSH_LIGHT_REGION_GROWN)
-            vb_scene_grown_box(j->scene, box->min, box->max);
-        if ((r = vb_scene_set_light_region(j->scene, box->min, box->max, "--light-region", err)) !=
+        j->light_region = d->light_region;
+        if ((r = vb_scene_use_light_box(j->scene, &j->light_region, "--light-region", err)) !=
             VB_OK)
             return r;
     }

@@ -254,6 +254,17 @@ void vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3])
     grow_bounds(s, (double)VDSH_REGION_GROW, lo, hi);
 }
 
+vb_result vb_scene_use_light_box(vb_scene *s, vdsh_light_box *box, const char *what, vb_error *err)
+{
+    vdsh_light_box b = *box;
+    if (b.rule == VDSH_LIGHT_REGION_GROWN)
+        vb_scene_grown_box(s, b.min, b.max);
+    vb_result r = vb_scene_set_light_region(s, b.min, b.max, what, err);
+    if (r == VB_OK)
+        *box = b;
+    return r;
+}
+
 vb_result vb_scene_set_light_region(vb_scene *s, const float lo[3], const float hi[3],
                                     const char *what, vb_error *err)
 {

@@ -24,6 +24,7 @@
 
 #include "mesh.h"
 #include "vb.h"
+#include "vdsh.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -139,6 +140,12 @@ vb_result vb_scene_set_light_region(vb_scene *s, const float lo[3], const float 
  * diagonal (in double, rounded once): the `grown` light rule's box, and
  * vdsh-bake --light-region grown's. */
 void vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3]);
+
+/* vb_scene_set_light_region by a --light-region rule (vdsh-bake's and
+ * vdsh-eval's): VDSH_LIGHT_REGION_GROWN, s's grown box (vb_scene_grown_box),
+ * written into box on success (box untouched on failure);
+ * VDSH_LIGHT_REGION_BOX, box as given. */
+vb_result vb_scene_use_light_box(vb_scene *s, vdsh_light_box *box, const char *what, vb_error *err);
 
 /* Other ways to place lights, for reports that a figure does not hang on
  * one light distribution (issue 25): all in free space, from the same

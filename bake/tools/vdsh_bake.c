@@ -57,8 +57,7 @@ typedef struct options {
     uint32_t decision_lights;    /* --decision-lights; 0: the default */
     int decision_near;           /* --decision-near as vb_bake_desc's; 0: the default */
     int decision_shell;          /* --decision-shell; 0: none */
-    int light_region;            /* --light-region: 0 auto, 1 grown, 2 the box */
-    float light_box[6];          /* --light-region's box: min x,y,z, max x,y,z */
+    vdsh_light_box light_region; /* --light-region: rule 0 auto, grown, or the box */
     float false_rate;            /* --false-rate; 0: the default */
     vb_decision_params decision; /* --decision-params */
     int have_decision;
@@ -884,7 +883,7 @@ static int read_value(int c, const char *arg, options *o)
         ok = vt_opt_int("--decision-shell", "", arg, 0, (int)VB_DECISION_POOL, &o->decision_shell);
         break;
     case O_LIGHT_REGION:
-        ok = vt_opt_light_region("--light-region", arg, 0, &o->light_region, o->light_box);
+        ok = vt_opt_light_region("--light-region", arg, 0, &o->light_region);
         break;
     case O_ENCODING:
         ok = vt_opt_choice("--encoding", arg, encodings(), &v);
@@ -1270,9 +1269,7 @@ static vb_job_desc job_desc(const options *o, FILE *log, progress *pr, float *of
         .weld = o->weld,
         .max_edge = o->max_edge,
         .fast_traversal = !o->robust,
-        .light_region = {.rule = (uint32_t)o->light_region,
-                         .min = {o->light_box[0], o->light_box[1], o->light_box[2]},
-                         .max = {o->light_box[3], o->light_box[4], o->light_box[5]}},
+        .light_region = o->light_region,
         .adaptive = o->adaptive,
         .receivers_path = o->receivers,
         .adapt = {.tolerance = o->adaptive_tol,
@@ -1317,7 +1314,8 @@ static vb_job_desc job_desc(const options *o, FILE *log, progress *pr, float *of
         .shard_index = o->shard_index,
         .shard_count = o->shard_count,
         .on_mesh = log ? on_mesh : NULL,
-        .user = log};
+        .user = log,
+    };
 }
 
 /* What the receivers are, and a warning when they are far apart against
@@ -1340,11 +1338,7 @@ static void say_receivers(FILE *log, const options *o, const vb_job *job, vb_mes
     if ((log && !chosen && (o->output || o->plan)) || o->report) {
         float lo[3], hi[3];
         vb_mesh_bounds(&job->occluders, lo, hi);
-        vb_mesh_spacing_of(rec,
-                           sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) +
-                                 (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                 (hi[2] - lo[2]) * (hi[2] - lo[2])),
-                           spacing);
+        vb_mesh_spacing_of(rec, vdsh_view_diagonal(lo, hi), spacing);
     }
     if (log && !chosen && (o->output || o->plan) && spacing->far_apart)
         fprintf(log,

@@ -822,8 +822,9 @@ typedef struct options {
     float offsets[VDSH_MAX_STREAMS];          /* --offsets */
     int noffsets;
     int quiet, fast_truth, allow_mismatch;
-    int light_region;   /* --light-region: 0 auto, 1 grown, 2 the box, 3 the file's (default) */
-    float light_box[6]; /* its box: min x,y,z, max x,y,z */
+    /* --light-region: rule 0 auto, grown, the box, or VT_LIGHT_REGION_FILE
+     * (the file's, the default) */
+    vdsh_light_box light_region;
 } options;
 
 /* --interp: runtime, or a path of vdsh_shadow.h (1 + its number). */
@@ -896,7 +897,7 @@ static int parse_args(int argc, char **argv, options *o)
                                              VT_CLI_LONGOPTS_END};
     memset(o, 0, sizeof *o);
     o->d.interior = 65536;
-    o->light_region = 3;
+    o->light_region.rule = VT_LIGHT_REGION_FILE;
     vb_eval_desc *d = &o->d;
     int c, ok = 1, interp_given = 0;
     while (ok && (c = getopt_long(argc, argv, "qhV", longopts, NULL)) != -1) {
@@ -938,7 +939,7 @@ static int parse_args(int argc, char **argv, options *o)
                     optarg);
             break;
         case O_LIGHT_REGION:
-            ok = vt_opt_light_region("--light-region", optarg, 1, &o->light_region, o->light_box);
+            ok = vt_opt_light_region("--light-region", optarg, 1, &o->light_region);
             break;
         case O_OFFSETS:
             o->noffsets = parse_offsets(optarg, o->offsets);
@@ -1217,18 +1218,13 @@ static int evaluate(const options *o, const vdsh_file *f, const scored *sc)
         fprintf(stderr, "vdsh-eval: %s: %s\n", o->path, err.msg);
         goto out;
     }
-    if (o->light_region == 0) { /* auto: the scene's rule, whatever the file says */
+    vdsh_light_box region = o->light_region;
+    if (region.rule == 0) { /* auto: the scene's rule, whatever the file says */
         scene->region_given = 0;
-    } else if (o->light_region == 1 || o->light_region == 2) {
-        float lo[3], hi[3];
-        if (o->light_region == 1)
-            vb_scene_grown_box(scene, lo, hi);
-        for (int a = 0; a < 3 && o->light_region == 2; a++)
-            lo[a] = o->light_box[a], hi[a] = o->light_box[a + 3];
-        if (vb_scene_set_light_region(scene, lo, hi, "--light-region", &err) != VB_OK) {
-            fprintf(stderr, "vdsh-eval: %s: %s\n", o->path, err.msg);
-            goto out;
-        }
+    } else if (region.rule != VT_LIGHT_REGION_FILE &&
+               vb_scene_use_light_box(scene, &region, "--light-region", &err) != VB_OK) {
+        fprintf(stderr, "vdsh-eval: %s: %s\n", o->path, err.msg);
+        goto out;
     }
 
     /* 4. Evaluate. */
