@@ -143,7 +143,7 @@ static const char usage_text[] =
     "      --no-mallopt      keep glibc's default malloc trimming (by default\n"
     "                        the viewer raises M_TRIM_THRESHOLD and\n"
     "                        M_MMAP_THRESHOLD: see docs/BENCHMARKS.md)\n"
-    "  -q, --quiet           no summary on stderr\n"
+    "  -q, --quiet           nothing on stderr but errors (no summary or progress)\n"
     "  -h, --help            this text (the window's keys: press h in it)\n"
     "  -V, --version         version\n"
     "\n"

@@ -129,7 +129,8 @@ static void usage(FILE *f)
             "                          recorded)\n"
             "      --worst N           worst receivers listed (default 10, at most 64)\n"
             "      --threads N         worker threads (default: all cores)\n"
-            "  -q, --quiet             no progress on stderr\n"
+            "  -q, --quiet             nothing on stderr but errors (no progress or\n"
+            "                          warnings; the results still go to stdout)\n"
             "  -h, --help              this text\n"
             "  -V, --version           version\n"
             "\n"
@@ -191,13 +192,15 @@ static void on_progress(void *user, uint32_t done, uint32_t total)
 typedef struct warnings {
     const char *path;
     int count;
+    int quiet; /* -q: counted, not said */
 } warnings;
 
 static void on_warn(void *user, const char *msg)
 {
     warnings *w = user;
     w->count++;
-    fprintf(stderr, "vdsh-eval: %s: warning: %s\n", w->path, msg);
+    if (!w->quiet)
+        fprintf(stderr, "vdsh-eval: %s: warning: %s\n", w->path, msg);
 }
 
 /* ---- bake time ------------------------------------------------------------- */
@@ -1206,7 +1209,7 @@ static int evaluate(const options *o, const vdsh_file *f, const scored *sc)
         if (vt_cli_check_outputs(outs, 2, (const char *const *)spath, (int)f->source_count) != 0)
             goto out;
     }
-    warnings warned = {.path = o->path};
+    warnings warned = {.path = o->path, .quiet = o->quiet};
     vb_eval_scene_desc sd = {.fast = o->fast_truth,
                              .allow_mismatch = o->allow_mismatch,
                              .threads = o->d.threads,

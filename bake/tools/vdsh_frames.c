@@ -148,7 +148,8 @@ static void usage(FILE *f)
             "Common options:\n"
             "      --threads N         worker threads (default: all cores); the output\n"
             "                          does not depend on it\n"
-            "  -q, --quiet             print nothing but errors\n"
+            "  -q, --quiet             nothing on stderr but errors, and no table on\n"
+            "                          stdout\n"
             "  -h, --help              this text\n"
             "  -V, --version           version\n"
             "\n"
@@ -563,12 +564,14 @@ static int run_truth(const options *op)
              * skipped when it is the companion (left by an earlier bake of
              * the same name), so c-sdf is what vdsh-view's mode sdf draws. */
             if (vdsh_sdf_other_scene(&vol, f->header.vertex_count, f->header.triangle_count)) {
-                fprintf(stderr,
-                        PROG ": %s%s was baked beside another bake (%u vertices and %u "
-                             "triangles, not %u and %u)%s\n",
-                        p, sdf_arg ? "" : " beside it", vol.vertex_count, vol.triangle_count,
-                        f->header.vertex_count, f->header.triangle_count,
-                        sdf_arg ? ": bake it again (vdsh-bake --sdf N)"
+                if (sdf_arg || !op->quiet) /* the companion skipped: a note */
+                    fprintf(stderr,
+                            PROG ": %s%s was baked beside another bake (%u vertices and %u "
+                                 "triangles, not %u and %u)%s\n",
+                            p, sdf_arg ? "" : " beside it", vol.vertex_count, vol.triangle_count,
+                            f->header.vertex_count, f->header.triangle_count,
+                            sdf_arg
+                                ? ": bake it again (vdsh-bake --sdf N)"
                                 : ": skipped, no c-sdf frames (bake again with vdsh-bake --sdf N)");
                 vdsh_sdf_free(&vol);
                 have_sdf = 0;
