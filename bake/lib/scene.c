@@ -249,9 +249,9 @@ static void grow_bounds(const vb_scene *s, double share, float lo[3], float hi[3
     }
 }
 
-void vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3])
+int vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3])
 {
-    grow_bounds(s, (double)VDSH_REGION_GROW, lo, hi);
+    return vdsh_light_grown_box(s->bounds_min, s->bounds_max, free_cb, s, lo, hi);
 }
 
 vb_result vb_scene_set_light_region(vb_scene *s, const float lo[3], const float hi[3],
@@ -317,10 +317,11 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
         return vb_scene_place_lights(s, seed, count, out, tried, err);
     float lo[3], hi[3];
     int grown = vb_scene_light_region(s, lo, hi, NULL);
-    if (rule == VB_LIGHTS_GROWN || rule == VB_LIGHTS_AROUND || rule == VB_LIGHTS_SHELL) {
+    if (rule == VB_LIGHTS_GROWN)
+        vb_scene_grown_box(s, lo, hi);
+    else if (rule == VB_LIGHTS_AROUND || rule == VB_LIGHTS_SHELL)
         grow_bounds(s, rule == VB_LIGHTS_AROUND ? 1.0 : (double)VDSH_REGION_GROW, lo, hi);
-        grown = 1;
-    }
+    grown |= rule >= VB_LIGHTS_GROWN;
     uint32_t n = 0, k = 0;
     const uint64_t limit = vdsh_light_tries(count, grown);
     while (n < count && k < limit) {

@@ -136,9 +136,12 @@ vb_result vb_scene_set_light_region(vb_scene *s, const float lo[3], const float 
                                     const char *what, vb_error *err);
 
 /* The bounds of s grown on every side by VDSH_REGION_GROW of its
- * diagonal (in double, rounded once): the `grown` light rule's box, and
- * vdsh-bake --light-region grown's. */
-void vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3]);
+ * diagonal (in double, rounded once), but not on a side a one-sided
+ * surface closes (below an open floor that spans the bounds:
+ * vdsh_light_grown_box, its probes cast with Embree): the `grown` light
+ * rule's box, and vdsh-bake --light-region grown's. Returns the mask of
+ * closed sides. */
+int vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3]);
 
 /* Other ways to place lights, for reports that a figure does not hang on
  * one light distribution (issue 25): all in free space, from the same
