@@ -282,6 +282,22 @@ vb_result vb_scene_set_light_region(vb_scene *s, const float lo[3], const float 
     return VB_OK;
 }
 
+vb_result vb_scene_apply_light_region(vb_scene *s, int rule, const float box[6], const char *what,
+                                      vb_error *err)
+{
+    if (rule == VB_REGION_AUTO) /* the scene's rule, whatever the file says */
+        s->region_given = 0;
+    if (rule != VB_REGION_GROWN && rule != VB_REGION_BOX)
+        return VB_OK;
+    float lo[3], hi[3];
+    if (rule == VB_REGION_GROWN)
+        vb_scene_grown_box(s, lo, hi);
+    else
+        for (int a = 0; a < 3; a++)
+            lo[a] = box[a], hi[a] = box[a + 3];
+    return vb_scene_set_light_region(s, lo, hi, what, err);
+}
+
 /* Where the candidates went, for the messages. */
 static const char *region_name(const vb_scene *s, int grown)
 {

@@ -135,6 +135,16 @@ int vb_scene_light_region(const vb_scene *s, float lo[3], float hi[3], uint32_t 
 vb_result vb_scene_set_light_region(vb_scene *s, const float lo[3], const float hi[3],
                                     const char *what, vb_error *err);
 
+/* A reader's --light-region (vdsh-eval, vdsh-frames views; the values of
+ * tools/vt_cli.h's vt_opt_light_region): VB_REGION_FILE keeps the region
+ * the scene has (the file's `lreg`, vb_eval_scene_create), VB_REGION_AUTO
+ * drops it for the scene's rule, VB_REGION_GROWN sets vb_scene_grown_box,
+ * VB_REGION_BOX box[0..5] (min x,y,z, max x,y,z), both through
+ * vb_scene_set_light_region (its errors, `what` naming the option). */
+enum { VB_REGION_AUTO = 0, VB_REGION_GROWN = 1, VB_REGION_BOX = 2, VB_REGION_FILE = 3 };
+vb_result vb_scene_apply_light_region(vb_scene *s, int rule, const float box[6], const char *what,
+                                      vb_error *err);
+
 /* The bounds of s grown on every side by VDSH_REGION_GROW of its
  * diagonal (in double, rounded once), but not on a side a one-sided
  * surface closes (below an open floor that spans the bounds:

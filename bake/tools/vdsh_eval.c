@@ -1222,18 +1222,10 @@ static int evaluate(const options *o, const vdsh_file *f, const scored *sc)
         fprintf(stderr, "vdsh-eval: %s: %s\n", o->path, err.msg);
         goto out;
     }
-    if (o->light_region == 0) { /* auto: the scene's rule, whatever the file says */
-        scene->region_given = 0;
-    } else if (o->light_region == 1 || o->light_region == 2) {
-        float lo[3], hi[3];
-        if (o->light_region == 1)
-            vb_scene_grown_box(scene, lo, hi);
-        for (int a = 0; a < 3 && o->light_region == 2; a++)
-            lo[a] = o->light_box[a], hi[a] = o->light_box[a + 3];
-        if (vb_scene_set_light_region(scene, lo, hi, "--light-region", &err) != VB_OK) {
-            fprintf(stderr, "vdsh-eval: %s: %s\n", o->path, err.msg);
-            goto out;
-        }
+    if (vb_scene_apply_light_region(scene, o->light_region, o->light_box, "--light-region", &err) !=
+        VB_OK) {
+        fprintf(stderr, "vdsh-eval: %s: %s\n", o->path, err.msg);
+        goto out;
     }
 
     /* 4. Evaluate. */

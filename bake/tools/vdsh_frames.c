@@ -81,6 +81,13 @@ static void usage(FILE *f)
             "                          their diagonal), around (grown by a diagonal,\n"
             "                          outside the bounds) or shell (grown by a quarter\n"
             "                          diagonal, outside the bounds)\n"
+            "      --light-region SPEC the light region of the eyes and of uniform,\n"
+            "                          ceiling, near and path (vdsh-eval's): file\n"
+            "                          (default: the bake's --light-region, recorded in\n"
+            "                          the file, else auto), auto (the scene's rule),\n"
+            "                          grown (vdsh-bake's) or a box\n"
+            "                          XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (truth and score\n"
+            "                          take none: the view set holds the lights)\n"
             "\n"
             "truth: for every view, light set K and light J, frames DIR/NAME-sK-lJ-MODE.png\n"
             "  (16-bit grey, value round(v * 65535)), MODE:\n"
@@ -182,6 +189,8 @@ typedef struct options {
     const char *sdf;                   /* truth: --sdf */
     float sdf_k;                       /* truth: --sdf-k */
     int sdf_k_given;                   /* --sdf-k on the command line */
+    int light_region;                  /* views: --light-region (vb_scene_apply_light_region) */
+    float light_box[6];                /* its box */
     const char *truth, *frames, *json; /* score */
     char modes[MAX_MODES][64];         /* score: --modes */
     int mode_count;
@@ -279,6 +288,13 @@ static int run_views(const options *op)
     loaded L;
     if (load_scene(path, op->threads, 1, out, &L))
         return 1;
+    vb_error rerr;
+    if (vb_scene_apply_light_region(L.occ, op->light_region, op->light_box, "--light-region",
+                                    &rerr) != VB_OK) {
+        fprintf(stderr, PROG ": %s: %s\n", path, rerr.msg);
+        loaded_free(&L);
+        return 1;
+    }
     int status = 1;
     vb_frames_view *fv = calloc(1 + (size_t)d.cameras, sizeof *fv);
     vt_views set = {.width = d.width, .height = d.height, .count = 1 + (int)d.cameras};
@@ -1015,6 +1031,7 @@ enum {
     O_CAMERAS,
     O_SEED,
     O_LIGHT_RULE,
+    O_LIGHT_REGION,
     O_SIZE,
     O_VIEWS,
     O_COMPARE,
@@ -1033,13 +1050,15 @@ enum {
         "version", no_argument, 0, 'V'                                                             \
     }
 
-static const struct option views_options[] = {{"output", required_argument, 0, 'o'},
-                                              {"cameras", required_argument, 0, O_CAMERAS},
-                                              {"seed", required_argument, 0, O_SEED},
-                                              {"size", required_argument, 0, O_SIZE},
-                                              {"light-rule", required_argument, 0, O_LIGHT_RULE},
-                                              COMMON_OPTIONS,
-                                              {0, 0, 0, 0}};
+static const struct option views_options[] = {
+    {"output", required_argument, 0, 'o'},
+    {"cameras", required_argument, 0, O_CAMERAS},
+    {"seed", required_argument, 0, O_SEED},
+    {"size", required_argument, 0, O_SIZE},
+    {"light-rule", required_argument, 0, O_LIGHT_RULE},
+    {"light-region", required_argument, 0, O_LIGHT_REGION},
+    COMMON_OPTIONS,
+    {0, 0, 0, 0}};
 static const struct option truth_options[] = {{"output", required_argument, 0, 'o'},
                                               {"views", required_argument, 0, O_VIEWS},
                                               {"compare", required_argument, 0, O_COMPARE},
@@ -1095,6 +1114,8 @@ static int take_option(int c, options *o)
         return !bad_usage("--light-rule takes uniform, ceiling, near, path, grown, around or "
                           "shell, not '%s'",
                           optarg);
+    case O_LIGHT_REGION:
+        return vt_opt_light_region("--light-region", optarg, 1, &o->light_region, o->light_box);
     case O_SIZE:
         if (!vt_parse_size(optarg, 16, 16384, &o->views.width, &o->views.height))
             return !bad_usage("--size takes WxH, each 16..16384, not '%s'", optarg);
@@ -1150,6 +1171,7 @@ static int parse_args(int argc, char **argv, options *o)
     o->views = (vb_frames_views_desc){.cameras = 6, .seed = 1, .width = 512, .height = 384};
     o->compare = VDSH_COMPARE_SMOOTH;
     o->sdf_k = VDSH_SDF_DEFAULT_K;
+    o->light_region = VB_REGION_FILE;
     if (argc < 2)
         return bad_usage("%s", "no subcommand given (views, truth or score)");
     const char *name = argv[1];
