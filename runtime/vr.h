@@ -464,7 +464,8 @@ void vr_scene_fit_camera(const vr_scene *s, vr_camera *out);
 
 /* Up to max (at most 4) default light positions; returns how many were
  * written. An interior's are spread through its bounds (light 0 roughly in
- * the middle, a little above the floor); an object's in the light region
+ * the middle, a little above the floor), pulled into the box the file's
+ * `lreg` chunk records when it has one; an object's in the light region
  * the bake trained on (vdsh_light_region, or the box the file's `lreg`
  * chunk records: vdsh-bake --light-region), light 0 toward the top of it
  * and to the side of the default eye.
