@@ -100,6 +100,37 @@ int vdsh_light_region(const float lo[3], const float hi[3], vdsh_free_fn is_free
     return grown;
 }
 
+int vdsh_light_grown_box(const float lo[3], const float hi[3], vdsh_free_fn is_free,
+                         const void *ctx, float out_lo[3], float out_hi[3])
+{
+    const float diag = vdsh_free_diagonal(lo, hi);
+    const double g = (double)VDSH_REGION_GROW * (double)diag;
+    const double out = 2.0 * (double)vdsh_free_clearance(diag);
+    int closed = 0;
+    for (int a = 0; a < 3; a++)
+        for (int side = 0; side < 2; side++) {
+            const int b = (a + 1) % 3, c = (a + 2) % 3;
+            int any = 0;
+            for (int i = 0; i < VDSH_SIDE_GRID && !any; i++)
+                for (int j = 0; j < VDSH_SIDE_GRID && !any; j++) {
+                    float p[3];
+                    p[a] = side ? (float)((double)hi[a] + out) : (float)((double)lo[a] - out);
+                    p[b] = (float)((double)lo[b] +
+                                   ((double)hi[b] - lo[b]) * (i + 0.5) / VDSH_SIDE_GRID);
+                    p[c] = (float)((double)lo[c] +
+                                   ((double)hi[c] - lo[c]) * (j + 0.5) / VDSH_SIDE_GRID);
+                    any = is_free(ctx, p) != 0;
+                }
+            closed |= !any << (2 * a + side);
+        }
+    for (int a = 0; a < 3; a++) {
+        const float l = lo[a], h = hi[a]; /* out may alias lo, hi */
+        out_lo[a] = closed >> (2 * a) & 1 ? l : (float)((double)l - g);
+        out_hi[a] = closed >> (2 * a + 1) & 1 ? h : (float)((double)h + g);
+    }
+    return closed;
+}
+
 uint64_t vdsh_light_tries(uint32_t count, int grown)
 {
     const uint64_t per_light = 1000ull * (count ? count : 1);

@@ -104,6 +104,24 @@ double vdsh_light_growth(uint32_t free_count);
 int vdsh_light_region(const float lo[3], const float hi[3], vdsh_free_fn is_free, const void *ctx,
                       float out_lo[3], float out_hi[3], uint32_t *probes);
 
+/* The bounds lo..hi grown on every side by VDSH_REGION_GROW of their
+ * diagonal (vdsh_free_diagonal; in double, rounded once): the box of
+ * vdsh-bake --light-region grown and of the `grown` light rule; but not
+ * on a side closed by a one-sided surface, where none of a
+ * VDSH_SIDE_GRID x VDSH_SIDE_GRID grid of points two clearances outside
+ * that face of the bounds (cell centres) is free (is_free(ctx, p)): below
+ * an open floor that spans the bounds (its probes see the floor's back
+ * and nothing's front), behind a room's walls. Lights there light none of
+ * the surfaces (they face away) and shadow the rest behind the floor:
+ * about one in six of the cube-on-a-floor's grown region's lights stood
+ * below its floor (docs/ACCURACY.md, "Where your lights go"). A closed
+ * object's sides are open (its faces' fronts are seen from outside).
+ * Returns a mask of the closed sides: bit 2a for the min side of axis a,
+ * 2a + 1 for the max side. */
+#define VDSH_SIDE_GRID 5
+int vdsh_light_grown_box(const float lo[3], const float hi[3], vdsh_free_fn is_free,
+                         const void *ctx, float out_lo[3], float out_hi[3]);
+
 /* The most candidates a placement of count lights tries: 1000 per light
  * in the bounds, VDSH_REGION_TRIES more in a grown region. */
 uint64_t vdsh_light_tries(uint32_t count, int grown);

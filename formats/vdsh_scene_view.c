@@ -948,7 +948,7 @@ static vdsh_result choose_lights(const vdsh_view_tracer *t, const vdsh_view_mesh
     for (int pass = 0; pass < 2; pass++)
         for (uint32_t k = 0; good < v->light_count && k < VDSH_VIEW_LIGHT_POOL; k++) {
             float p[3];
-            vdsh_light_candidate(v->bounds_min, v->bounds_max, 2, k, p);
+            vdsh_light_candidate(v->region_min, v->region_max, 2, k, p);
             v->pool_tried++;
             if (!pass) { /* the second runs only once the first tried all */
                 probes pr;
@@ -1146,8 +1146,8 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
     vdsh_view_free_ctx rc = {t, vdsh_free_diagonal(lo, hi)};
     memcpy(v.region_min, lo, sizeof v.region_min);
     memcpy(v.region_max, hi, sizeof v.region_max);
-    v.region_given = m->light_region && !v.interior;
-    if (v.region_given) { /* the user's (the file's lreg): as given */
+    v.region_given = m->light_region != NULL;
+    if (v.region_given) { /* the user's (the file's lreg): as given, a room's too */
         memcpy(v.region_min, m->light_region, sizeof v.region_min);
         memcpy(v.region_max, m->light_region + 3, sizeof v.region_max);
         v.region_grown = 1;
@@ -1156,11 +1156,13 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
             vdsh_light_region(lo, hi, vdsh_view_is_free, &rc, v.region_min, v.region_max, NULL);
     float blo[3], bhi[3];
     light_box(v.region_min, v.region_max, lo, hi, rc.diagonal, flat && !v.region_given, blo, bhi);
-    const float *slo = v.interior ? lo : blo, *shi = v.interior ? hi : bhi;
+    /* a room's lights in its bounds, or in the region given (the frame
+     * rule's seeded candidates too: choose_lights) */
+    const float *slo = v.interior ? v.region_min : blo, *shi = v.interior ? v.region_max : bhi;
     float raw[VDSH_VIEW_MAX_LIGHTS][3];
     memcpy(raw, v.preferred, sizeof raw);
-    for (int i = 0; !v.interior && i < v.light_count; i++)
-        into_region(v.preferred[i], slo, shi, flat ? c : NULL);
+    for (int i = 0; (!v.interior || v.region_given) && i < v.light_count; i++)
+        into_region(v.preferred[i], slo, shi, flat && !v.interior ? c : NULL);
     for (int i = 0; i < v.light_count; i++) {
         v.light_free[i] =
             find_free(t, v.preferred[i], slo, shi, diag, &v.light_trials, v.lights[i]);

@@ -103,9 +103,11 @@ typedef struct vdsh_view_mesh {
     uint32_t vertex_count;
     uint32_t triangle_count;
     /* NULL, or where the bake's lights went (the file's `lreg` chunk,
-     * vdsh-bake --light-region): min x,y,z, max x,y,z. An object's default
-     * lights go there instead of the rule's region (an interior's stay in
-     * its bounds, as its lights' frame rule places them). */
+     * vdsh-bake --light-region): min x,y,z, max x,y,z. The default
+     * lights go there instead of the rule's region: an object's, and an
+     * interior's (its preferred lights pulled into it, the frame rule's
+     * candidates drawn in it; they stayed in its bounds, where the bake
+     * trained on none of them when the region was elsewhere). */
     const float *light_region;
 } vdsh_view_mesh;
 
@@ -132,11 +134,11 @@ typedef struct vdsh_view {
      * is grown; its lights lie in it (vdsh_view_compute: but a flat
      * one's, and along an axis thinner than the clearance). An
      * interior's: its bounds, not grown (not probed; its lights stay in
-     * its bounds, which its region holds). */
+     * its bounds, which its region holds), or the region given. */
     float region_min[3];
     float region_max[3];
     int region_grown;
-    int region_given; /* 1: the mesh's light_region, as given (an object's) */
+    int region_given; /* 1: the mesh's light_region, as given */
     /* An interior's lights in the check frame (vdsh_view_light_shares):
      * shares of its pixels lit and shadowed; 0 for an object's. */
     float light_lit[VDSH_VIEW_MAX_LIGHTS];
@@ -166,13 +168,14 @@ typedef struct vdsh_view {
  * lights there only, and a light beyond 1.5 clamp distances (the
  * diagonal) shadows every receiver (docs/DESIGN.md, "Lights beyond the
  * clamp"; the lights outside the bounding sphere that were the rule drew
- * false blotches on an object's floor). A preferred light position in free space is
- * kept. Otherwise the candidates p + k h d are tried, rings k = 1, 2, ...
+ * false blotches on an object's floor). An interior's are pulled so into
+ * the region given (vdsh_view_mesh.light_region), when there is one. A
+ * preferred light position in free space is kept. Otherwise the candidates p + k h d are tried, rings k = 1, 2, ...
  * of step h = half the clearance (vdsh_free_clearance of the bounds'
  * diagonal), up to half the diagonal, d each of the 26 directions toward
  * a cube's faces, edges and corners in a fixed order; an interior's
- * candidates must lie inside its bounds, an object's inside its light
- * region. The first in free space is the
+ * candidates must lie inside its bounds (the region given, if any), an
+ * object's inside its light region. The first in free space is the
  * light. If none is, the first 4096 candidates of vdsh_light_candidate
  * (seed 1) are tried, nearest first.
  * Then an interior's lights must light what the camera sees (a room
@@ -180,7 +183,8 @@ typedef struct vdsh_view {
  * scored in the check frame (vdsh_view_light_shares) and kept when it
  * lights it: at least VDSH_VIEW_MIN_SHARE of it, and more than it
  * shadows (a light behind a wall seen through a door shadows most). When fewer are kept, the candidates
- * of vdsh_light_candidate (seed 2) in the bounds that are in free space
+ * of vdsh_light_candidate (seed 2) in the bounds (the region given, if
+ * any) that are in free space
  * are scored, up to VDSH_VIEW_LIGHT_POOL of them or until enough light
  * and shadow that share each; the lights are, in this order: the kept
  * ones, the candidates that light the frame and shadow the share, those

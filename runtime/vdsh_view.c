@@ -90,6 +90,11 @@ static const char usage_text[] =
     "      --light X,Y,Z[,R,G,B]  a point light (repeatable)\n"
     "      --lights N        use N default lights, 1..64 (default 1; beyond\n"
     "                        four, positions placed uniformly in free space)\n"
+    "      --light-region SPEC  where the default lights (and those beyond four)\n"
+    "                        go, as vdsh-eval's: file (default: the bake's\n"
+    "                        --light-region, recorded in the file, else auto),\n"
+    "                        auto (the scene's rule), grown (vdsh-bake's) or a\n"
+    "                        box XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX\n"
     "      --attenuation A0,A1,A2  for every light: 1/(A0 + A1 d + A2 d^2)\n"
     "                        (default 1, 0, 1/(0.3 * diagonal)^2)\n"
     "      --ambient V       ambient light (default 0.03)\n"
@@ -143,7 +148,7 @@ static const char usage_text[] =
     "      --no-mallopt      keep glibc's default malloc trimming (by default\n"
     "                        the viewer raises M_TRIM_THRESHOLD and\n"
     "                        M_MMAP_THRESHOLD: see docs/BENCHMARKS.md)\n"
-    "  -q, --quiet           no summary on stderr\n"
+    "  -q, --quiet           nothing on stderr but errors (no summary or progress)\n"
     "  -h, --help            this text (the window's keys: press h in it)\n"
     "  -V, --version         version\n"
     "\n"
@@ -232,7 +237,8 @@ static int parse_args(int argc, char **argv, vv_options *o)
         O_BENCH_MODES,
         O_BENCH_COUNTS,
         O_SDF,
-        O_SDF_K
+        O_SDF_K,
+        O_LIGHT_REGION
     };
     static const struct option longopts[] = {
         {"render", required_argument, 0, O_RENDER},
@@ -266,6 +272,7 @@ static int parse_args(int argc, char **argv, vv_options *o)
         {"bench-cube-sizes", required_argument, 0, O_BENCH_CUBE_SIZES},
         {"bench-modes", required_argument, 0, O_BENCH_MODES},
         {"bench-counts", no_argument, 0, O_BENCH_COUNTS},
+        {"light-region", required_argument, 0, O_LIGHT_REGION},
         {"views", required_argument, 0, O_VIEWS},
         {"modes", required_argument, 0, O_MODES},
         {"quiet", no_argument, 0, 'q'},
@@ -452,6 +459,18 @@ static int parse_args(int argc, char **argv, vv_options *o)
             o->bench_modes = v;
             break;
         case O_BENCH_COUNTS: o->bench_counts = 1; break;
+        case O_LIGHT_REGION: {
+            /* vt_opt_light_region's auto, grown, box, file */
+            static const int to_vr[4] = {VR_LIGHT_REGION_AUTO, VR_LIGHT_REGION_GROWN,
+                                         VR_LIGHT_REGION_BOX, VR_LIGHT_REGION_FILE};
+            vdsh_light_box b;
+            if (!vt_opt_light_region("--light-region", v, 1, &b))
+                return VT_EXIT_USAGE;
+            o->light_region = to_vr[b.rule];
+            memcpy(o->light_box, b.min, sizeof b.min);
+            memcpy(o->light_box + 3, b.max, sizeof b.max);
+            break;
+        }
         case 'j':
             if (!vt_opt_once("--json", v, &o->json_path))
                 return 2;

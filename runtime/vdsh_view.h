@@ -68,6 +68,8 @@ typedef struct vv_options {
     int bench_counts;        /* --bench-counts: GL counts of each mode */
     const char *json_path;   /* --json FILE: --bench's JSON ("-", NULL: stdout) */
     int quiet;
+    int light_region;   /* --light-region: vr_scene_desc.light_region (0: the file's) */
+    float light_box[6]; /* its box */
     const char *screenshot;
     int no_overlay;
     const char *keys;

@@ -262,7 +262,9 @@ int vv_open_scene(const vv_options *o, const char *path, vr_scene **out)
                         .buffers = o->buffers,
                         .cpca_decode =
                             o->cpca_frame && !o->bench ? VR_CPCA_PER_FRAME : VR_CPCA_PER_PASS,
-                        .sdf_path = o->sdf_path};
+                        .sdf_path = o->sdf_path,
+                        .light_region = o->light_region};
+    memcpy(sd.light_box, o->light_box, sizeof sd.light_box);
     if (vr_scene_create(&sd, out, &err) != VR_OK) {
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
         return 1;

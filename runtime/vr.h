@@ -215,7 +215,19 @@ typedef struct vr_scene_desc {
      * the same name) is skipped, and VR_MODE_SDF's VR_ERR_MISSING says
      * so. */
     const char *sdf_path;
+    /* Where the default lights (vr_scene_default_lights) and the light
+     * pool go (vdsh-view --light-region): VR_LIGHT_REGION_FILE (0,
+     * default) the box the file's `lreg` chunk records (vdsh-bake
+     * --light-region), else the scene's rule; VR_LIGHT_REGION_AUTO the
+     * scene's rule, whatever the file says; VR_LIGHT_REGION_GROWN the
+     * bounds grown as vdsh-bake --light-region grown grows them
+     * (vdsh_light_grown_box); VR_LIGHT_REGION_BOX light_box (min x,y,z,
+     * max x,y,z; each min below its max, else VR_ERR_ARGUMENT). */
+    int light_region;
+    float light_box[6];
 } vr_scene_desc;
+
+enum { VR_LIGHT_REGION_FILE = 0, VR_LIGHT_REGION_AUTO, VR_LIGHT_REGION_GROWN, VR_LIGHT_REGION_BOX };
 
 /* Load (when desc->path is set and desc->file is not), validate, upload
  * positions, normals, indices, every stream of the chosen quantity (orders
@@ -452,7 +464,8 @@ void vr_scene_fit_camera(const vr_scene *s, vr_camera *out);
 
 /* Up to max (at most 4) default light positions; returns how many were
  * written. An interior's are spread through its bounds (light 0 roughly in
- * the middle, a little above the floor); an object's in the light region
+ * the middle, a little above the floor), pulled into the box the file's
+ * `lreg` chunk records when it has one; an object's in the light region
  * the bake trained on (vdsh_light_region, or the box the file's `lreg`
  * chunk records: vdsh-bake --light-region), light 0 toward the top of it
  * and to the side of the default eye.

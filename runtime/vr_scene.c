@@ -21,6 +21,7 @@
 #include "vr_internal.h"
 
 #include "vdsh_cube.h"
+#include "vdsh_light.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -189,22 +190,65 @@ static vr_result upload_stream(vr_scene *s, const vdsh_stream *st, size_t vertic
     return VR_OK;
 }
 
+/* desc->light_region into m->light_region (region: its storage). */
+static vr_result light_region_of(const vr_scene_desc *desc, vdsh_view_mesh *m, float region[6],
+                                 const char *name, vr_error *err)
+{
+    switch (desc->light_region) {
+    case VR_LIGHT_REGION_FILE: return VR_OK;
+    case VR_LIGHT_REGION_AUTO: m->light_region = NULL; return VR_OK;
+    case VR_LIGHT_REGION_BOX:
+        for (int a = 0; a < 3; a++)
+            if (!isfinite(desc->light_box[a]) || !isfinite(desc->light_box[a + 3]) ||
+                !(desc->light_box[a] < desc->light_box[a + 3]))
+                return vr_fail(err, VR_ERR_ARGUMENT,
+                               "%s: the light region's %c is %g..%g: it must be finite, min "
+                               "below max",
+                               name, "xyz"[a], (double)(desc->light_box[a]),
+                               (double)(desc->light_box[a + 3]));
+        memcpy(region, desc->light_box, 6 * sizeof(float));
+        m->light_region = region;
+        return VR_OK;
+    case VR_LIGHT_REGION_GROWN: {
+        /* vdsh-bake --light-region grown's box, its probes against the
+         * drawn mesh */
+        vdsh_view_tracer *t = NULL;
+        vdsh_error ve;
+        if (vdsh_view_tracer_create(m, &t, &ve) != VDSH_OK)
+            return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: light region: %s", name, ve.msg);
+        float lo[3], hi[3];
+        vdsh_view_bounds(m->positions, m->vertex_count, lo, hi);
+        vdsh_view_free_ctx c = {t, vdsh_free_diagonal(lo, hi)};
+        vdsh_light_grown_box(lo, hi, vdsh_view_is_free, &c, region, region + 3);
+        vdsh_view_tracer_destroy(t);
+        m->light_region = region;
+        return VR_OK;
+    }
+    default:
+        return vr_fail(err, VR_ERR_ARGUMENT, "%s: unknown light region rule %d", name,
+                       desc->light_region);
+    }
+}
+
 /* The default view (room or object, camera, lights in free space), from
- * the mesh as the file has it (formats/vdsh_scene_view.h), and the light
- * pool's `pool` lights (none when 0). */
-static vr_result default_view(vr_scene *s, const vdsh_file *f, int pool, const char *name,
-                              vr_error *err)
+ * the mesh as the file has it (formats/vdsh_scene_view.h) in desc's light
+ * region, and the light pool's desc->light_pool lights (none when 0). */
+static vr_result default_view(vr_scene *s, const vdsh_file *f, const vr_scene_desc *desc,
+                              const char *name, vr_error *err)
 {
     float region[6];
     vdsh_view_mesh vm;
     vdsh_view_file_mesh(f, region, &vm);
+    vr_result r = light_region_of(desc, &vm, region, name, err);
+    if (r != VR_OK)
+        return r;
     vdsh_error ve;
     vdsh_result vr = vdsh_view_compute(&vm, &s->view, &ve);
     if (vr != VDSH_OK)
         return vr_fail(err, map_vdsh_result(vr), "%s: %s", name, ve.msg);
     memcpy(s->bounds_min, s->view.bounds_min, sizeof s->bounds_min);
     memcpy(s->bounds_max, s->view.bounds_max, sizeof s->bounds_max);
-    return pool > 0 ? vr_scene_place_pool(s, &vm, pool, name, err) : VR_OK;
+    return desc->light_pool > 0 ? vr_scene_place_pool(s, &vm, desc->light_pool, name, err) : VR_OK;
 }
 
 vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *err)
@@ -295,7 +339,7 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
                            err);
     if (r != VR_OK)
         goto done;
-    if ((r = default_view(s, f, desc->light_pool, name, err)) != VR_OK)
+    if ((r = default_view(s, f, desc, name, err)) != VR_OK)
         goto done;
     glGenBuffers(1, &s->vbo_position);
     glGenBuffers(1, &s->vbo_normal);

@@ -164,6 +164,17 @@ if(Python3_Interpreter_FOUND AND TARGET vb_frames AND TARGET vdsh-view)
   set_tests_properties(frames_script PROPERTIES SKIP_RETURN_CODE 77)
 endif()
 
+# The readers' --light-region (test_light_region_readers.py): vdsh-frames
+# views' eyes and lights in the file's region, the bounds (auto) or a box;
+# truth and score refuse it; vdsh-view's default lights by the image they
+# draw (file = grown = the recorded box, auto another; skipped without GL).
+if(Python3_Interpreter_FOUND AND TARGET vb_frames AND TARGET vdsh-view)
+  add_test(NAME light_region_readers
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_light_region_readers.py
+                   $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames> $<TARGET_FILE:vdsh-view>
+                   ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/light_region_readers)
+endif()
+
 # scripts/frames_gap at its smallest (test_frames_gap.py): validation room
 # 3 at --max-edge 1, 64 x 48 C frames, order 2, with a shadow variant; the
 # squared error's split by pixel class adds up, and matches vdsh-frames

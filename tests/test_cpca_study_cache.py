@@ -7,7 +7,11 @@ cache_paths, the names scene() uses: the same settings give the same
 names (a rerun reuses them); another --rays, edge, method, mesh file
 content or built-in scene gives other bakes (and truth); another view
 set's bytes another truth (the same bakes); another --light-pool or
---light-seed or mesh another light pool (the same bakes).
+--light-seed or mesh another light pool (the same bakes); a rebuilt
+vdsh-bake that writes other bytes other bakes (and truth), a rebuilt
+vdsh-frames another truth, a rebuilt light_pool_tool another pool (the
+key held none of the tools: a rebuilt baker's run scored the old one's
+bakes); a tool rebuilt to the same bytes the same names.
 
 Usage: test_cpca_study_cache.py SCRIPTS_DIR WORK_DIR
 """
@@ -33,10 +37,24 @@ def check(ok, what):
 mesh, views = os.path.join(work, "m.obj"), os.path.join(work, "v.views.json")
 open(mesh, "w").write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
 open(views, "w").write('{"width": 64, "height": 48, "views": []}\n')
+build = os.path.join(work, "build")
+TOOLS = {"bake": os.path.join(build, "bake", "vdsh-bake"),
+         "frames": os.path.join(build, "bake", "vdsh-frames"),
+         "pool": os.path.join(build, "tests", "light_pool_tool")}
+
+
+def tool(which, text):
+    os.makedirs(os.path.dirname(TOOLS[which]), exist_ok=True)
+    with open(TOOLS[which], "w") as f:
+        f.write(text)
+
+
+for which in TOOLS:
+    tool(which, "#!/bin/sh\n# %s 1\n" % which)
 
 
 def paths(rays=625, pool=2048, seed=1, m=mesh, edge="0.25", method="decision"):
-    a = argparse.Namespace(work=work, rays=rays, light_pool=pool, light_seed=seed)
+    a = argparse.Namespace(work=work, build=build, rays=rays, light_pool=pool, light_seed=seed)
     p = cs.cache_paths(a, "s", m, edge, method, views)
     return dict(ref=p["ref"], o5=p["o5"], truth=p["truth"], pool=p["pool"](False),
                 box=p["pool"](True))
@@ -56,6 +74,18 @@ check(paths(m="builtin:room")["ref"] != paths(m="builtin:room:1")["ref"], "built
 for what, other in (("--light-pool 512", paths(pool=512)), ("--light-seed 2", paths(seed=2))):
     check(other["pool"] != base["pool"] and other["box"] != base["box"], "%s: another pool" % what)
     check(other["ref"] == base["ref"] and other["truth"] == base["truth"], "%s: the same bakes" % what)
+
+# The tools that made them: a rebuilt tool with other bytes (the same
+# bytes again, e.g. a relink: the same names).
+for which, changes in (("bake", ("ref", "o5", "truth")), ("frames", ("truth",)),
+                       ("pool", ("pool", "box"))):
+    tool(which, "#!/bin/sh\n# %s 2\n" % which)
+    other = paths()
+    for k in base:
+        check((other[k] != base[k]) == (k in changes),
+              "a rebuilt %s: %s %s" % (which, k, "kept" if k in changes else "changed"))
+    tool(which, "#!/bin/sh\n# %s 1\n" % which)
+    check(paths() == base, "%s rebuilt to the same bytes: the same names" % which)
 
 # The files' bytes, not their names: an edited mesh or view set.
 open(views, "w").write('{"width": 64, "height": 48, "views": [], "note": 1}\n')

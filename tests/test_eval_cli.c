@@ -299,6 +299,10 @@ int main(int argc, char **argv)
           "a changed source is named (exit %d)", rc);
     rc = run((char *[]){ev, vdsh, "--allow-mismatch", "--interior", "100", NULL});
     CHECK(rc == 0 && test_file_contains(err_path, "warning"), "--allow-mismatch (exit %d)", rc);
+    /* -q: nothing on stderr but errors, in every program (the warning was
+     * said under -q too) */
+    rc = run((char *[]){ev, vdsh, "--allow-mismatch", "--interior", "100", "-q", NULL});
+    CHECK(rc == 0 && !test_file_contains(err_path, "warning"), "--allow-mismatch -q (exit %d)", rc);
     rc = run((char *[]){ev, vdsh, moved, moved, NULL});
     CHECK(rc == 2 && test_file_contains(err_path, "2 mesh(es) given"), "two meshes for one source");
 

@@ -94,14 +94,20 @@ for src in (moved, other):
             or os.path.exists(o)):
         fail.append("--source %s (not the bake's): rc %d, %s, output %s" %
                     (os.path.basename(src), p.returncode, p.stderr.strip(), os.path.exists(o)))
-o = out_of("named")
-p = run([export, vd, "--source", named, "-o", o, "-q"])
-if p.returncode != 0 or "note" not in p.stderr or not os.path.exists(o):
-    fail.append("--source named.glb (a material added): rc %d, %s" % (p.returncode, p.stderr.strip()))
-o = out_of("moved-allowed")
-p = run([export, vd, "--source", moved, "--allow-mismatch", "-o", o, "-q"])
-if p.returncode != 0 or "warning" not in p.stderr or not os.path.exists(o):
-    fail.append("--source moved.glb --allow-mismatch: rc %d, %s" % (p.returncode, p.stderr.strip()))
+# the note and the warning are said without -q; -q says nothing but errors
+# (as every program's -q: vdsh-export's kept its notes and warnings)
+for quiet in ([], ["-q"]):
+    o = out_of("named")
+    p = run([export, vd, "--source", named, "-o", o] + quiet)
+    if p.returncode != 0 or ("note" in p.stderr) == bool(quiet) or not os.path.exists(o):
+        fail.append("--source named.glb (a material added) %s: rc %d, %r" %
+                    (quiet, p.returncode, p.stderr.strip()))
+    o = out_of("moved-allowed")
+    p = run([export, vd, "--source", moved, "--allow-mismatch", "-o", o] + quiet)
+    if p.returncode != 0 or ("warning" in p.stderr) == bool(quiet) or not os.path.exists(o) or \
+            (quiet and p.stderr):
+        fail.append("--source moved.glb --allow-mismatch %s: rc %d, %r" %
+                    (quiet, p.returncode, p.stderr.strip()))
 
 # A .gltf with an external buffer: the buffer's bytes are part of the record.
 g, qbin = os.path.join(work, "q.gltf"), os.path.join(work, "q.bin")

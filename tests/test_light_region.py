@@ -96,8 +96,11 @@ f = vdsh.read(path("grown.vdsh"))
 lo, hi = f.header["bounds_min"], f.header["bounds_max"]
 g = 0.25 * sum((b - a) ** 2 for a, b in zip(lo, hi)) ** 0.5
 lr = f.light_region
+# grown on every side but the floor's: below the open floor (one-sided,
+# spanning the bounds) lights light nothing (vdsh_light_grown_box)
+want_lo = [lo[0] - g, lo[1], lo[2] - g]
 if not lr or lr["rule"] != "grown" or \
-        any(abs(lr["min"][k] - (lo[k] - g)) > 1e-5 or abs(lr["max"][k] - (hi[k] + g)) > 1e-5
+        any(abs(lr["min"][k] - want_lo[k]) > 1e-5 or abs(lr["max"][k] - (hi[k] + g)) > 1e-5
             for k in range(3)):
     fail.append("grown: the Python reader's light region %r (bounds %r..%r)" % (lr, lo, hi))
 r = must(subprocess.run([info, path("grown.vdsh")], capture_output=True, text=True), "info")
@@ -181,10 +184,18 @@ def evaluate(name, extra):
 j = evaluate("grown.vdsh", [])
 ps = j["eval"]["scene_light_positions"]
 if j["eval"].get("scene_light_region") != "given" or \
-        any(not all(lo[k] - g - 1e-5 <= p[k] <= hi[k] + g + 1e-5 for k in range(3)) for p in ps) \
+        any(not all(want_lo[k] - 1e-5 <= p[k] <= hi[k] + g + 1e-5 for k in range(3)) for p in ps) \
         or not any(p[1] > hi[1] for p in ps):
     fail.append("eval of the grown bake: lights %r, region %r" %
                 (ps[:4], j["eval"].get("scene_light_region")))
+# none below the open floor (one in six stood there: they lit nothing),
+# under vdsh-eval's own --light-region grown and its --light-rule grown too
+for extra in (["--light-region", "grown"], ["--light-rule", "grown"]):
+    below = [p for p in evaluate("grown.vdsh", extra)["eval"]["scene_light_positions"]
+             if p[1] < lo[1]]
+    if below:
+        fail.append("eval %s: %d lights below the open floor, e.g. %r" % (extra, len(below),
+                                                                        below[0]))
 j = evaluate("grown.vdsh", ["--light-region", "auto"])
 ps = j["eval"]["scene_light_positions"]
 if "scene_light_region" in j["eval"] or \

@@ -386,6 +386,54 @@ static int plain_free(const void *ctx, const float p[3])
     return free_all(c->m, p, c->diag);
 }
 
+/* A room with a light region recorded (the file's lreg, vdsh-bake
+ * --light-region): its default lights go there, as an object's do (they
+ * stayed in the bounds, lights the bake trained on none of); a region
+ * reaching outside the room (the bounds grown) keeps them inside it, free;
+ * the frame rule's candidates come from the region too. */
+static void test_room_region(void)
+{
+    float plo[3], phi[3];
+    unit_room(&M, plo, phi);
+    vdsh_view_mesh m = view_mesh(&M);
+    vdsh_view plain, v;
+    vdsh_error err;
+    CHECK(vdsh_view_compute(&m, &plain, &err) == VDSH_OK, "%s", err.msg);
+    /* the half of the room toward -x, below 4 m */
+    static const float half[6] = {-9.5f, 0.5f, -9.5f, -1.0f, 4.0f, 9.5f};
+    int outside = 0;
+    for (int i = 0; i < plain.light_count; i++)
+        outside += plain.lights[i][0] > half[3];
+    CHECK(outside > 0, "no default light of the room outside the test's box: it proves nothing");
+    m.light_region = half;
+    CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
+    const float diag = vdsh_view_diagonal(v.bounds_min, v.bounds_max);
+    CHECK(v.interior && v.region_given, "room with a region: interior %d, region given %d",
+          v.interior, v.region_given);
+    CHECK(!memcmp(&v.camera, &plain.camera, sizeof v.camera), "the region moved the camera");
+    for (int i = 0; i < v.light_count; i++) {
+        int in = 1;
+        for (int k = 0; k < 3; k++)
+            in = in && v.lights[i][k] >= half[k] && v.lights[i][k] <= half[k + 3];
+        CHECK(in && v.light_free[i] && free_all(&m, v.lights[i], diag),
+              "room light %d (%g %g %g) outside the region given, or not free", i,
+              (double)v.lights[i][0], (double)v.lights[i][1], (double)v.lights[i][2]);
+    }
+    /* the bounds grown by a quarter diagonal: outside the room is not
+     * free, so every light stays inside it */
+    const float g = 0.25f * diag;
+    const float grown[6] = {-10 - g, -g, -10 - g, 10 + g, 6 + g, 10 + g};
+    m.light_region = grown;
+    CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
+    for (int i = 0; i < v.light_count; i++) {
+        int in = 1;
+        for (int k = 0; k < 3; k++)
+            in = in && v.lights[i][k] > v.bounds_min[k] && v.lights[i][k] < v.bounds_max[k];
+        CHECK(in && v.light_free[i], "grown region: room light %d (%g %g %g) outside the room", i,
+              (double)v.lights[i][0], (double)v.lights[i][1], (double)v.lights[i][2]);
+    }
+}
+
 /* An object on a floor (a unit cube on a 4 x 4 quad, seen from outside):
  * its light region is its bounds (the box is mostly free), the one the
  * bake trains its fit on, and every default light lies in it, free, within
@@ -961,6 +1009,7 @@ int main(int argc, char **argv)
     test_rays();
     test_space();
     test_room();
+    test_room_region();
     test_object();
     test_object_on_floor();
     test_flat();

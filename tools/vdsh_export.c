@@ -284,7 +284,7 @@ static int source_recorded(const vdsh_file *f, const vdsh_src *src)
 
 static int with_source(const char *in, const char *path, const vdsh_file *f, cJSON *root,
                        view_list *vl, cJSON *attrs, cJSON **vx, blob *b, int compress,
-                       int allow_mismatch)
+                       int allow_mismatch, int quiet)
 {
     char msg[1024];
     vdsh_src src;
@@ -323,13 +323,15 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
             at += (uint32_t)snprintf(names + at, sizeof names - at, "%s%s (%llu bytes)",
                                      i ? ", " : "", f->sources[i].name,
                                      (unsigned long long)f->sources[i].size);
-        if (matched == vertices)
-            fprintf(stderr,
+        if (matched == vertices) {
+            if (!quiet)
+                fprintf(
+                    stderr,
                     "vdsh-export: %s: note: not the file %s recorded (%s; this one %llu bytes, "
                     "its SHA-256 other), but every vertex is at a receiver: its geometry is the "
                     "bake's\n",
                     path, in, names, (unsigned long long)src.size);
-        else {
+        } else if (!allow_mismatch || !quiet) {
             fprintf(stderr,
                     "vdsh-export: %s: %s: not the file %s was baked from (%s; this one %llu "
                     "bytes, its SHA-256 other) and %llu of its %llu vertices are at no receiver: "
@@ -417,8 +419,10 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         if (!fp || !mime) {
             if (fp)
                 fclose(fp);
-            fprintf(stderr, "vdsh-export: %s: image %s %s: kept as a URI relative to the output\n",
-                    path, uri->valuestring, fp ? "is neither PNG nor JPEG" : why);
+            if (!quiet)
+                fprintf(stderr,
+                        "vdsh-export: %s: image %s %s: kept as a URI relative to the output\n",
+                        path, uri->valuestring, fp ? "is neither PNG nor JPEG" : why);
             continue;
         }
         if (blob_align4(b)) {
@@ -545,12 +549,12 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         cJSON_DeleteItemFromObjectCaseSensitive(asset, "generator");
         cJSON_AddStringToObject(asset, "generator", "vdsh-export --source (formats/GLTF.md)");
     }
-    if (f->source_count > 1)
+    if (f->source_count > 1 && !quiet)
         fprintf(stderr,
                 "vdsh-export: %s: baked from %u meshes; the glb holds %s's scene only (the "
                 "other meshes' receivers are not in it)\n",
                 in, f->source_count, path);
-    if (matched < vertices && recorded)
+    if (matched < vertices && recorded && !quiet)
         fprintf(stderr,
                 "vdsh-export: %s: %llu of %llu source vertices have no receiver at their position "
                 "(unreferenced, or dropped by the bake): their VDSH attributes are 0\n",
@@ -703,8 +707,8 @@ static void usage(FILE *fp)
             "                     else refused (edited geometry)\n"
             "      --allow-mismatch  --source: export edited geometry anyway (with a\n"
             "                     warning), vertices at no receiver getting 0\n"
-            "  -q, --quiet        no summary on stderr (notes and warnings, as --source's\n"
-            "                     on another file than the bake's, are still said)\n"
+            "  -q, --quiet        nothing on stderr but errors (no summary, notes or\n"
+            "                     warnings)\n"
             "  -h, --help         this text\n"
             "  -V, --version      version\n"
             "\n"
@@ -1237,7 +1241,7 @@ static int run(const options *o)
         rc = put_streams(&e);
     if (!rc && o->source)
         rc = with_source(o->in, o->source, f, e.root, &e.vl, e.attrs, &e.vx, &e.b, o->compress,
-                         o->allow_mismatch) != 0;
+                         o->allow_mismatch, o->quiet) != 0;
     else if (!rc)
         rc = assemble(&e);
     if (!rc)

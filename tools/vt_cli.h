@@ -206,9 +206,10 @@ int vt_opt_nonnegative(const char *option, const char *arg, float *out);
 int vt_opt_tolerance(const char *option, const char *noun, const char *arg, int zero_ok,
                      double *out);
 
-/* Where the lights go (vdsh-bake, vdsh-eval --light-region SPEC): `auto`
- * (out->rule 0), `grown` (VDSH_LIGHT_REGION_GROWN, its box left to the
- * scene: vb_scene_use_light_box), XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX
+/* Where the lights go (--light-region SPEC of vdsh-bake, vdsh-eval,
+ * vdsh-frames views, vdsh-view): `auto` (out->rule 0), `grown`
+ * (VDSH_LIGHT_REGION_GROWN, its box left to the scene:
+ * vb_scene_use_light_box), XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX
  * (VDSH_LIGHT_REGION_BOX, finite, each min below its max) or, when file_ok,
  * `file` (VT_LIGHT_REGION_FILE). Says what is wrong, naming the option. */
 enum { VT_LIGHT_REGION_FILE = 3 };

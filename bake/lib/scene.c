@@ -249,13 +249,19 @@ static void grow_bounds(const vb_scene *s, double share, float lo[3], float hi[3
     }
 }
 
-void vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3])
+int vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3])
 {
-    grow_bounds(s, (double)VDSH_REGION_GROW, lo, hi);
+    return vdsh_light_grown_box(s->bounds_min, s->bounds_max, free_cb, s, lo, hi);
 }
 
 vb_result vb_scene_use_light_box(vb_scene *s, vdsh_light_box *box, const char *what, vb_error *err)
 {
+    if (box->rule == 0) { /* auto: the scene's rule, whatever the file says */
+        s->region_given = 0;
+        return VB_OK;
+    }
+    if (box->rule != VDSH_LIGHT_REGION_GROWN && box->rule != VDSH_LIGHT_REGION_BOX)
+        return VB_OK; /* a reader's `file`: the region the scene has */
     vdsh_light_box b = *box;
     if (b.rule == VDSH_LIGHT_REGION_GROWN)
         vb_scene_grown_box(s, b.min, b.max);
@@ -328,10 +334,11 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
         return vb_scene_place_lights(s, seed, count, out, tried, err);
     float lo[3], hi[3];
     int grown = vb_scene_light_region(s, lo, hi, NULL);
-    if (rule == VB_LIGHTS_GROWN || rule == VB_LIGHTS_AROUND || rule == VB_LIGHTS_SHELL) {
+    if (rule == VB_LIGHTS_GROWN)
+        vb_scene_grown_box(s, lo, hi);
+    else if (rule == VB_LIGHTS_AROUND || rule == VB_LIGHTS_SHELL)
         grow_bounds(s, rule == VB_LIGHTS_AROUND ? 1.0 : (double)VDSH_REGION_GROW, lo, hi);
-        grown = 1;
-    }
+    grown |= rule >= VB_LIGHTS_GROWN;
     uint32_t n = 0, k = 0;
     const uint64_t limit = vdsh_light_tries(count, grown);
     while (n < count && k < limit) {

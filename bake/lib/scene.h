@@ -137,14 +137,21 @@ vb_result vb_scene_set_light_region(vb_scene *s, const float lo[3], const float 
                                     const char *what, vb_error *err);
 
 /* The bounds of s grown on every side by VDSH_REGION_GROW of its
- * diagonal (in double, rounded once): the `grown` light rule's box, and
- * vdsh-bake --light-region grown's. */
-void vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3]);
+ * diagonal (in double, rounded once), but not on a side a one-sided
+ * surface closes (below an open floor that spans the bounds:
+ * vdsh_light_grown_box, its probes cast with Embree): the `grown` light
+ * rule's box, and vdsh-bake --light-region grown's. Returns the mask of
+ * closed sides. */
+int vb_scene_grown_box(const vb_scene *s, float lo[3], float hi[3]);
 
-/* vb_scene_set_light_region by a --light-region rule (vdsh-bake's and
- * vdsh-eval's): VDSH_LIGHT_REGION_GROWN, s's grown box (vb_scene_grown_box),
- * written into box on success (box untouched on failure);
- * VDSH_LIGHT_REGION_BOX, box as given. */
+/* A --light-region rule (tools/vt_cli.h's vt_opt_light_region: vdsh-bake,
+ * vdsh-eval, vdsh-frames views) applied to s: rule 0 (auto) drops any region
+ * for the scene's rule, whatever the file says; VDSH_LIGHT_REGION_GROWN sets
+ * s's grown box (vb_scene_grown_box) and VDSH_LIGHT_REGION_BOX the box as
+ * given, both through vb_scene_set_light_region (its errors, `what` naming
+ * the option), the box set written into box on success (untouched on
+ * failure); any other rule (a reader's `file`) keeps the region s has (the
+ * file's `lreg`, vb_eval_scene_create). */
 vb_result vb_scene_use_light_box(vb_scene *s, vdsh_light_box *box, const char *what, vb_error *err);
 
 /* Other ways to place lights, for reports that a figure does not hang on

@@ -92,15 +92,17 @@ static void usage(FILE *f)
             "                          heights of the light region: the bounds, or around a\n"
             "                          closed object the bounds grown (formats/vdsh_light.h);\n"
             "                          grown (the bounds grown by a quarter of their\n"
-            "                          diagonal) or around (grown by a diagonal, outside\n"
+            "                          diagonal, not below an open floor) or around\n"
+            "                          (grown by a diagonal, outside\n"
             "                          the bounds: where a viewer puts lights around an\n"
             "                          object) or shell (grown by a quarter diagonal,\n"
             "                          outside the bounds: vdsh-bake's --decision-shell)\n"
             "      --light-region SPEC the light region of uniform, ceiling, near and path:\n"
             "                          file (default: the bake's --light-region, recorded\n"
             "                          in the file, else auto), auto (the scene's rule),\n"
-            "                          grown (the bounds grown by a quarter diagonal) or\n"
-            "                          a box XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX\n"
+            "                          grown (the bounds grown by a quarter diagonal, not\n"
+            "                          below an open floor: vdsh-bake's) or a box\n"
+            "                          XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX\n"
             "      --orders LIST       only these orders, e.g. 3,5 (default: every stream)\n"
             "      --offsets LIST      the trade between recall and false shadows as a\n"
             "                          curve: each stream is also scored with each\n"
@@ -129,7 +131,8 @@ static void usage(FILE *f)
             "                          recorded)\n"
             "      --worst N           worst receivers listed (default 10, at most 64)\n"
             "      --threads N         worker threads (default: all cores)\n"
-            "  -q, --quiet             no progress on stderr\n"
+            "  -q, --quiet             nothing on stderr but errors (no progress or\n"
+            "                          warnings; the results still go to stdout)\n"
             "  -h, --help              this text\n"
             "  -V, --version           version\n"
             "\n"
@@ -191,13 +194,15 @@ static void on_progress(void *user, uint32_t done, uint32_t total)
 typedef struct warnings {
     const char *path;
     int count;
+    int quiet; /* -q: counted, not said */
 } warnings;
 
 static void on_warn(void *user, const char *msg)
 {
     warnings *w = user;
     w->count++;
-    fprintf(stderr, "vdsh-eval: %s: warning: %s\n", w->path, msg);
+    if (!w->quiet)
+        fprintf(stderr, "vdsh-eval: %s: warning: %s\n", w->path, msg);
 }
 
 /* ---- bake time ------------------------------------------------------------- */
@@ -1207,7 +1212,7 @@ static int evaluate(const options *o, const vdsh_file *f, const scored *sc)
         if (vt_cli_check_outputs(outs, 2, (const char *const *)spath, (int)f->source_count) != 0)
             goto out;
     }
-    warnings warned = {.path = o->path};
+    warnings warned = {.path = o->path, .quiet = o->quiet};
     vb_eval_scene_desc sd = {.fast = o->fast_truth,
                              .allow_mismatch = o->allow_mismatch,
                              .threads = o->d.threads,
@@ -1219,10 +1224,7 @@ static int evaluate(const options *o, const vdsh_file *f, const scored *sc)
         goto out;
     }
     vdsh_light_box region = o->light_region;
-    if (region.rule == 0) { /* auto: the scene's rule, whatever the file says */
-        scene->region_given = 0;
-    } else if (region.rule != VT_LIGHT_REGION_FILE &&
-               vb_scene_use_light_box(scene, &region, "--light-region", &err) != VB_OK) {
+    if (vb_scene_use_light_box(scene, &region, "--light-region", &err) != VB_OK) {
         fprintf(stderr, "vdsh-eval: %s: %s\n", o->path, err.msg);
         goto out;
     }

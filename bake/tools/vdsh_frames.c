@@ -81,6 +81,13 @@ static void usage(FILE *f)
             "                          their diagonal), around (grown by a diagonal,\n"
             "                          outside the bounds) or shell (grown by a quarter\n"
             "                          diagonal, outside the bounds)\n"
+            "      --light-region SPEC the light region of the eyes and of uniform,\n"
+            "                          ceiling, near and path (vdsh-eval's): file\n"
+            "                          (default: the bake's --light-region, recorded in\n"
+            "                          the file, else auto), auto (the scene's rule),\n"
+            "                          grown (vdsh-bake's) or a box\n"
+            "                          XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (truth and score\n"
+            "                          take none: the view set holds the lights)\n"
             "\n"
             "truth: for every view, light set K and light J, frames DIR/NAME-sK-lJ-MODE.png\n"
             "  (16-bit grey, value round(v * 65535)), MODE:\n"
@@ -148,7 +155,8 @@ static void usage(FILE *f)
             "Common options:\n"
             "      --threads N         worker threads (default: all cores); the output\n"
             "                          does not depend on it\n"
-            "  -q, --quiet             print nothing but errors\n"
+            "  -q, --quiet             nothing on stderr but errors, and no table on\n"
+            "                          stdout\n"
             "  -h, --help              this text\n"
             "  -V, --version           version\n"
             "\n"
@@ -181,6 +189,7 @@ typedef struct options {
     const char *sdf;                   /* truth: --sdf */
     float sdf_k;                       /* truth: --sdf-k */
     int sdf_k_given;                   /* --sdf-k on the command line */
+    vdsh_light_box light_region;       /* views: --light-region (vb_scene_use_light_box) */
     const char *truth, *frames, *json; /* score */
     char modes[MAX_MODES][64];         /* score: --modes */
     int mode_count;
@@ -278,6 +287,13 @@ static int run_views(const options *op)
     loaded L;
     if (load_scene(path, op->threads, 1, out, &L))
         return 1;
+    vb_error rerr;
+    vdsh_light_box region = op->light_region;
+    if (vb_scene_use_light_box(L.occ, &region, "--light-region", &rerr) != VB_OK) {
+        fprintf(stderr, PROG ": %s: %s\n", path, rerr.msg);
+        loaded_free(&L);
+        return 1;
+    }
     int status = 1;
     vb_frames_view *fv = calloc(1 + (size_t)d.cameras, sizeof *fv);
     vt_views set = {.width = d.width, .height = d.height, .count = 1 + (int)d.cameras};
@@ -563,12 +579,14 @@ static int run_truth(const options *op)
              * skipped when it is the companion (left by an earlier bake of
              * the same name), so c-sdf is what vdsh-view's mode sdf draws. */
             if (vdsh_sdf_other_scene(&vol, f->header.vertex_count, f->header.triangle_count)) {
-                fprintf(stderr,
-                        PROG ": %s%s was baked beside another bake (%u vertices and %u "
-                             "triangles, not %u and %u)%s\n",
-                        p, sdf_arg ? "" : " beside it", vol.vertex_count, vol.triangle_count,
-                        f->header.vertex_count, f->header.triangle_count,
-                        sdf_arg ? ": bake it again (vdsh-bake --sdf N)"
+                if (sdf_arg || !op->quiet) /* the companion skipped: a note */
+                    fprintf(stderr,
+                            PROG ": %s%s was baked beside another bake (%u vertices and %u "
+                                 "triangles, not %u and %u)%s\n",
+                            p, sdf_arg ? "" : " beside it", vol.vertex_count, vol.triangle_count,
+                            f->header.vertex_count, f->header.triangle_count,
+                            sdf_arg
+                                ? ": bake it again (vdsh-bake --sdf N)"
                                 : ": skipped, no c-sdf frames (bake again with vdsh-bake --sdf N)");
                 vdsh_sdf_free(&vol);
                 have_sdf = 0;
@@ -1012,6 +1030,7 @@ enum {
     O_CAMERAS,
     O_SEED,
     O_LIGHT_RULE,
+    O_LIGHT_REGION,
     O_SIZE,
     O_VIEWS,
     O_COMPARE,
@@ -1030,13 +1049,15 @@ enum {
         "version", no_argument, 0, 'V'                                                             \
     }
 
-static const struct option views_options[] = {{"output", required_argument, 0, 'o'},
-                                              {"cameras", required_argument, 0, O_CAMERAS},
-                                              {"seed", required_argument, 0, O_SEED},
-                                              {"size", required_argument, 0, O_SIZE},
-                                              {"light-rule", required_argument, 0, O_LIGHT_RULE},
-                                              COMMON_OPTIONS,
-                                              {0, 0, 0, 0}};
+static const struct option views_options[] = {
+    {"output", required_argument, 0, 'o'},
+    {"cameras", required_argument, 0, O_CAMERAS},
+    {"seed", required_argument, 0, O_SEED},
+    {"size", required_argument, 0, O_SIZE},
+    {"light-rule", required_argument, 0, O_LIGHT_RULE},
+    {"light-region", required_argument, 0, O_LIGHT_REGION},
+    COMMON_OPTIONS,
+    {0, 0, 0, 0}};
 static const struct option truth_options[] = {{"output", required_argument, 0, 'o'},
                                               {"views", required_argument, 0, O_VIEWS},
                                               {"compare", required_argument, 0, O_COMPARE},
@@ -1092,6 +1113,7 @@ static int take_option(int c, options *o)
         return !bad_usage("--light-rule takes uniform, ceiling, near, path, grown, around or "
                           "shell, not '%s'",
                           optarg);
+    case O_LIGHT_REGION: return vt_opt_light_region("--light-region", optarg, 1, &o->light_region);
     case O_SIZE:
         if (!vt_parse_size(optarg, 16, 16384, &o->views.width, &o->views.height))
             return !bad_usage("--size takes WxH, each 16..16384, not '%s'", optarg);
@@ -1147,6 +1169,7 @@ static int parse_args(int argc, char **argv, options *o)
     o->views = (vb_frames_views_desc){.cameras = 6, .seed = 1, .width = 512, .height = 384};
     o->compare = VDSH_COMPARE_SMOOTH;
     o->sdf_k = VDSH_SDF_DEFAULT_K;
+    o->light_region.rule = VT_LIGHT_REGION_FILE;
     if (argc < 2)
         return bad_usage("%s", "no subcommand given (views, truth or score)");
     const char *name = argv[1];

@@ -60,7 +60,7 @@ static void usage(FILE *f)
           "its SH basis cubemaps beside it.\n"
           "\n"
           "  -o, --output FILE   the merged .vdsh (written atomically)\n"
-          "  -q, --quiet         no progress on stderr\n"
+          "  -q, --quiet         nothing on stderr but errors (no summary or notes)\n"
           "  -h, --help          this help\n"
           "  -V, --version       version\n"
           "\n"

@@ -329,10 +329,204 @@ export function vdshVertexGlsl(plan, shaders, texWidth, cpca) {
   return { defines, decl };
 }
 
+// ---- free space (formats/vdsh_light.h, formats/vdsh_scene_view.c) ----
+// The rule vdsh-view places its default lights by, in double arithmetic
+// (the C is float: a decision at a clearance's edge may differ): a point
+// is free when none of 14 probes (the axes, the cube diagonals) meets a
+// surface nearer than the clearance (1% of the diagonal), and none meets
+// the back of a face first, or more meet fronts than backs.
+
+const FREE_DIRS = (() => {
+  const d = [];
+  for (let a = 0; a < 3; a++)
+    for (const s of [-1, 1]) { const v = [0, 0, 0]; v[a] = s; d.push(v); }
+  const q = 0.57735026918962576;
+  for (let k = 0; k < 8; k++) d.push([k & 1 ? q : -q, k & 2 ? q : -q, k & 4 ? q : -q]);
+  return d;
+})();
+
+// vdsh_free_diagonal: the bounds' diagonal, the clearance's scale.
+function freeDiagonal(lo, hi) {
+  return Math.fround(Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2])) || 1;
+}
+
+// vdsh_free_space: the decision from the probes' first hits.
+function freeSpace(hits, clearance) {
+  let backs = 0, fronts = 0;
+  for (const h of hits) {
+    if (!h) continue;
+    if (h.t < clearance) return false;
+    if (h.back) backs++; else fronts++;
+  }
+  return backs === 0 || fronts > backs;
+}
+
+// A uniform grid of the triangles (about two cells per triangle, at most
+// 128 a side) and the first hit along a ray (Moller-Trumbore, edges
+// included; back: the winding normal along the ray), as vdsh_view_trace.
+export function vdshViewTracer(pos, indices) {
+  const nt = Math.floor(indices.length / 3);
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < 3 * nt; i++)
+    for (let k = 0; k < 3; k++) {
+      const x = pos[3 * indices[i] + k];
+      lo[k] = Math.min(lo[k], x);
+      hi[k] = Math.max(hi[k], x);
+    }
+  const diag = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
+  const ext = [0, 0, 0], n = [1, 1, 1], cell = [0, 0, 0];
+  for (let k = 0; k < 3; k++) {
+    lo[k] -= 1e-4 * diag;
+    ext[k] = Math.max(hi[k] + 1e-4 * diag - lo[k], 1e-3 * diag);
+  }
+  const h = Math.cbrt(ext[0] * ext[1] * ext[2] / (2 * Math.max(nt, 1)));
+  for (let k = 0; k < 3; k++) {
+    n[k] = Math.min(128, Math.max(1, Math.ceil(ext[k] / h)));
+    cell[k] = ext[k] / n[k];
+  }
+  const cellOf = (k, x) => Math.min(n[k] - 1, Math.max(0, Math.floor((x - lo[k]) / cell[k])));
+  const vert = (t, j) => 3 * indices[3 * t + j];
+  const lists = new Map();
+  for (let t = 0; t < nt; t++) {
+    const c0 = [0, 0, 0], c1 = [0, 0, 0];
+    for (let k = 0; k < 3; k++) {
+      const xs = [0, 1, 2].map((j) => pos[vert(t, j) + k]);
+      const a = Math.min(...xs), b = Math.max(...xs), pad = 1e-3 * diag + 1e-3 * cell[k];
+      c0[k] = cellOf(k, a - pad);
+      c1[k] = cellOf(k, b + pad);
+    }
+    for (let z = c0[2]; z <= c1[2]; z++)
+      for (let y = c0[1]; y <= c1[1]; y++)
+        for (let x = c0[0]; x <= c1[0]; x++) {
+          const id = (z * n[1] + y) * n[0] + x;
+          if (!lists.has(id)) lists.set(id, []);
+          lists.get(id).push(t);
+        }
+  }
+  function hitTri(t, o, d, tmin, best) {
+    const a = vert(t, 0), b = vert(t, 1), c = vert(t, 2);
+    const e1 = [0, 1, 2].map((k) => pos[b + k] - pos[a + k]), e2 = [0, 1, 2].map((k) => pos[c + k] - pos[a + k]);
+    const s = [0, 1, 2].map((k) => o[k] - pos[a + k]);
+    const p = [d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]];
+    const det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
+    if (det === 0) return;
+    const u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) / det;
+    if (!(u >= 0 && u <= 1)) return;
+    const q = [s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2], s[0] * e1[1] - s[1] * e1[0]];
+    const v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
+    if (!(v >= 0 && u + v <= 1)) return;
+    const dist = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det;
+    if (!(dist >= tmin) || !(dist < best.t || (dist === best.t && t < best.tri))) return;
+    best.t = dist;
+    best.tri = t;
+    best.back = det < 0;
+  }
+  function trace(o, d, tmin = 0) {
+    let t0 = Math.max(tmin, 0), t1 = Infinity;
+    for (let k = 0; k < 3; k++) {
+      if (d[k] === 0) {
+        if (o[k] < lo[k] || o[k] > lo[k] + ext[k]) return null;
+        continue;
+      }
+      const a = (lo[k] - o[k]) / d[k], b = (lo[k] + ext[k] - o[k]) / d[k];
+      t0 = Math.max(t0, Math.min(a, b));
+      t1 = Math.min(t1, Math.max(a, b));
+    }
+    if (!(t0 <= t1)) return null;
+    const c = [0, 1, 2].map((k) => cellOf(k, o[k] + t0 * d[k]));
+    const step = d.map((x) => (x > 0 ? 1 : x < 0 ? -1 : 0));
+    const best = { t: Infinity, tri: -1, back: false };
+    for (;;) {
+      const list = lists.get((c[2] * n[1] + c[1]) * n[0] + c[0]);
+      if (list) for (const t of list) hitTri(t, o, d, tmin, best);
+      let axis = 0;
+      const next = [0, 1, 2].map((k) => (step[k] ? (lo[k] + (c[k] + (step[k] > 0)) * cell[k] - o[k]) / d[k] : Infinity));
+      for (let k = 1; k < 3; k++) if (next[k] < next[axis]) axis = k;
+      if (best.t <= next[axis] || next[axis] > t1) break;
+      c[axis] += step[axis];
+      if (c[axis] < 0 || c[axis] >= n[axis]) break;
+    }
+    return best.tri < 0 ? null : best;
+  }
+  const probes = (p) => FREE_DIRS.map((d) => trace(p, d));
+  return {
+    trace, probes,
+    // vdsh_view_free_space at `clearance` (default: 1% of the diagonal given)
+    free: (p, diagonal, clearance = 0.01 * diagonal) => freeSpace(probes(p), clearance),
+  };
+}
+
+// vdsh_light_candidate: candidate k of the seeded sequence, uniform in
+// lo..hi (SplitMix64 on seed, k, axis: the C's bits, as BigInt).
+export function vdshLightCandidate(lo, hi, seed, k) {
+  const M = (x) => BigInt.asUintN(64, x);
+  return [0, 1, 2].map((a) => {
+    let z = M(BigInt(seed) + 0x9e3779b97f4a7c15n * BigInt(k * 4 + a + 1));
+    z = M((z ^ (z >> 30n)) * 0xbf58476d1ce4e5b9n);
+    z = M((z ^ (z >> 27n)) * 0x94d049bb133111ebn);
+    z ^= z >> 31n;
+    const u = Number(z >> 11n) / 9007199254740992;
+    return Math.fround(lo[a] + u * (hi[a] - lo[a]));
+  });
+}
+
+// vdsh_light_region: the bounds, or grown by up to a quarter of their
+// diagonal when few of 1024 seeded candidates in them are free (a closed
+// object fills its bounds): VDSH_REGION_GROW at 64 or fewer free, 0 at
+// 256 or more, linear between.
+export function vdshLightRegion(lo, hi, isFree) {
+  const seed = 0x6f626a6563747321n;
+  let found = 0;
+  for (let k = 0; found < 256 && k < 1024; k++) found += isFree(vdshLightCandidate(lo, hi, seed, k)) ? 1 : 0;
+  const share = found <= 64 ? 0.25 : found >= 256 ? 0 : 0.25 * (256 - found) / (256 - 64);
+  const g = share * Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  return share > 0 ? [lo.map((x) => Math.fround(x - g)), hi.map((x) => Math.fround(x + g))] : [lo.slice(), hi.slice()];
+}
+
+// find_free (vdsh_scene_view.c): p0 when free; else, inside lo..hi, on
+// rings k = 1, 2, ... of 26 directions (faces, edges, corners) at steps
+// of half the clearance, the nearest position 8 clearances from every
+// surface within 16 clearances (VDSH_VIEW_LIGHT_MARGIN, _MARGIN_REACH),
+// else the nearest free one up to half the diagonal; else the seeded
+// candidates (seed 1) in lo..hi, nearest first, the first 4096. null
+// when none is free.
+export function vdshFindFree(tracer, p0, lo, hi, diagonal) {
+  const clear = 0.01 * diagonal, h = 0.5 * clear;
+  if (tracer.free(p0, diagonal)) return p0.slice();
+  const dirs = [];
+  for (let ones = 1; ones <= 3; ones++)
+    for (let z = -1; z <= 1; z++)
+      for (let y = -1; y <= 1; y++)
+        for (let x = -1; x <= 1; x++)
+          if (Math.abs(x) + Math.abs(y) + Math.abs(z) === ones) {
+            const l = Math.sqrt(ones);
+            dirs.push([x / l, y / l, z / l]);
+          }
+  const inside = (p) => p.every((x, k) => x > lo[k] && x < hi[k]);
+  const rings = Math.ceil(0.5 * diagonal / h), reach = 32;
+  for (let pass = 0; pass < 2; pass++)
+    for (let k = 1; k <= (pass ? rings : reach); k++)
+      for (const d of dirs) {
+        const p = p0.map((x, a) => Math.fround(x + k * h * d[a]));
+        if (inside(p) && freeSpace(tracer.probes(p), pass ? clear : 8 * clear)) return p;
+      }
+  const cand = [];
+  for (let k = 0; k < 4096; k++) {
+    const p = vdshLightCandidate(lo, hi, 1, k);
+    cand.push({ p, d2: (p[0] - p0[0]) ** 2 + (p[1] - p0[1]) ** 2 + (p[2] - p0[2]) ** 2, k });
+  }
+  cand.sort((a, b) => a.d2 - b.d2 || a.k - b.k);
+  for (const c of cand) if (tracer.free(c.p, diagonal)) return c.p;
+  return null;
+}
+
 // The default view of a file without extras.vdsh.view (an older export),
 // formats/vdsh_scene_view.c's for an object: the outside camera
 // (vdsh_view_fit_camera) and an object's preferred lights, outside its
-// bounding sphere, pulled into its bounds (below). lo, hi: the bounds; pos, nrm
+// bounding sphere, pulled into its light region (below) and, with the
+// mesh, each moved into free space as vdsh-view moves it (find_free):
+// pulled into the bounds, a light could stand inside the object. lo, hi:
+// the bounds; pos, nrm
 // (vertex_count x 3) and indices (triangle_count x 3), when given, decide
 // whether the object is flat (every vertex within a millionth of the
 // diagonal of the plane of its largest triangle: one triangle, a panel);
@@ -379,16 +573,23 @@ export function vdshFallbackView(lo, hi, pos, nrm, indices) {
   const around = [[1.5, 1.5, -0.4], [-1.3, 1.2, 1.4], [0.5, 2.1, 1.5], [1.6, 0.5, 1.2]];
   let lights = around.map((a) => place(c, r, a[0], a[1], a[2]));
   if (flip) lights = lights.map((l) => mirror(l, c));
-  // Pulled into the bounds, 5% of each extent inside every face
+  // Pulled into the light region, 5% of each extent inside every face
   // (VDSH_VIEW_REGION_INSET), as vdsh_view_compute pulls them into the
-  // light region the bake trained on, which holds the bounds (this page
-  // has no free-space test to grow it around a closed object); along an
-  // axis thinner than the clearance (1% of the diagonal) the bounds grown
-  // by a quarter of the diagonal there, a flat object's on every axis and
-  // along the line to the centre, so each stays on its side of the plane.
-  const g = 0.25 * diag, flat = fn !== null;
-  const blo = lo.map((x, k) => (flat || hi[k] - lo[k] < 0.01 * diag ? x - g : x));
-  const bhi = hi.map((x, k) => (flat || hi[k] - lo[k] < 0.01 * diag ? x + g : x));
+  // light region the bake trained on: with the mesh, vdsh_light_region's
+  // (the bounds, or around a closed object the bounds grown; without it,
+  // the bounds, which the region holds); along an axis thinner than the
+  // clearance (1% of the diagonal) the bounds grown by a quarter of the
+  // diagonal there, a flat object's on every axis and along the line to
+  // the centre, so each stays on its side of the plane. Then, with the
+  // mesh, each into free space (vdshFindFree, vdsh_view_compute's rule).
+  const flat = fn !== null;
+  const tracer = pos && indices && indices.length >= 3 ? vdshViewTracer(pos, indices) : null;
+  let rlo = lo, rhi = hi;
+  if (tracer && !flat) [rlo, rhi] = vdshLightRegion(lo, hi, (p) => tracer.free(p, freeDiagonal(lo, hi)));
+  const g = 0.25 * freeDiagonal(lo, hi), clear = 0.01 * freeDiagonal(lo, hi);
+  const grow = (k) => flat || rhi[k] - rlo[k] < clear;
+  const blo = rlo.map((x, k) => (grow(k) ? lo[k] - g : x));
+  const bhi = rhi.map((x, k) => (grow(k) ? hi[k] + g : x));
   const inset = (k) => 0.05 * (bhi[k] - blo[k]);
   lights = lights.map((p) => {
     if (!flat) return p.map((x, k) => Math.min(Math.max(x, blo[k] + inset(k)), bhi[k] - inset(k)));
@@ -399,6 +600,7 @@ export function vdshFallbackView(lo, hi, pos, nrm, indices) {
     }
     return p.map((x, k) => c[k] + sc * (x - c[k]));
   });
+  if (tracer) lights = lights.map((p) => vdshFindFree(tracer, p, blo, bhi, diag) || p);
   return {
     interior: false, eye: c.map((x, k) => x + dist * w[k]), target: c, up: [0, 1, 0], fov_y: 60,
     lights, fallback: true,

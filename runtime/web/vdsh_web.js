@@ -39,9 +39,10 @@
 // meshes[0].extras.vdsh.view (formats/vdsh_scene_view.h: a room seen from
 // inside, an object framed from outside, lights moved into free space).
 // A file without it (an older export) is framed from outside, lit from
-// within its bounds (vdsh_core.js's vdshFallbackView:
-// vdsh_view_fit_camera and an object's preferred lights), as vdsh-view
-// frames an object; a flat one (a triangle, a panel) from its front.
+// in its light region (vdsh_core.js's vdshFallbackView:
+// vdsh_view_fit_camera and an object's preferred lights, moved into free
+// space by vdsh-view's rule), as vdsh-view frames an object; a flat one (a
+// triangle, a panel) from its front.
 //
 // Files: glTF 2.0 binary; attributes of any component type, normalised or
 // not, interleaved or not, and the node's transform (KHR_mesh_quantization,
