@@ -1145,6 +1145,23 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
         c[k] = 0.5f * (lo[k] + hi[k]);
     for (int i = 0; flip && i < v.light_count; i++)
         mirror(v.preferred[i], c, fn);
+    /* A flat object's lights on its front, the side the camera sees, and
+     * a quarter of the diagonal off its plane at least: the places around
+     * the bounds put light 0 (vdsh-view's one light) behind a panel facing
+     * across the longest horizontal axis (a triangle in z = 0 facing +z:
+     * the default frame black), mirrored or not, and a tilted one's light
+     * so near the plane that the search for free space (find_free) took
+     * one behind it. */
+    for (int i = 0; flat && !v.interior && i < v.light_count; i++) {
+        float d = 0.0f;
+        for (int k = 0; k < 3; k++)
+            d += (v.preferred[i][k] - c[k]) * fn[k];
+        if (d < 0.0f)
+            mirror(v.preferred[i], c, fn), d = -d;
+        const float off = 0.25f * diag;
+        for (int k = 0; d < off && k < 3; k++)
+            v.preferred[i][k] += (off - d) * fn[k];
+    }
     /* The light region as the bake computes it (the bake's diagonal, so
      * the same clearance): an object's lights inside it, where the bake's
      * fit was made for them. */

@@ -155,7 +155,13 @@ typedef struct vdsh_view {
  * they cancel) faces away from the fit camera's direction w: the fit
  * camera (fit; an object's camera) is fitted along w mirrored through the plane (along the plane's normal
  * where that is within about 6 degrees of vertical), and the preferred
- * lights are mirrored through the plane through the bounds' centre. An
+ * lights are mirrored through the plane through the bounds' centre. Then
+ * every preferred light of a flat object (facing either way) that lies
+ * behind that plane is mirrored through it, and one nearer the plane than
+ * a quarter of the diagonal moved along its normal to that distance: all
+ * its lights light the front the camera sees (light 0 stood behind a
+ * panel facing across the longest horizontal axis, and the default frame
+ * was black). An
  * object's preferred lights are then pulled into the light region
  * (region_min..region_max; along an axis where it is thinner than the
  * clearance the bounds grown by VDSH_REGION_GROW of the diagonal there)
