@@ -340,8 +340,10 @@ export function vdshVertexGlsl(plan, shaders, texWidth, cpca) {
 // winding's where they cancel) faces away from the fit direction w is
 // seen along w mirrored through its plane (along its normal where that is
 // within about 6 degrees of vertical), its lights mirrored through the
-// plane through the bounds' centre: vdsh_view_compute's rule (flat_front,
-// mirror), so that the camera sees the side the normals face.
+// plane through the bounds' centre, then each behind the plane mirrored to
+// its front and moved a quarter diagonal off it: vdsh_view_compute's rule
+// (flat_front, mirror), so that the camera sees the side the normals face,
+// lit.
 export function vdshFallbackView(lo, hi, pos, nrm, indices) {
   const f = Math.fround;
   const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -379,6 +381,17 @@ export function vdshFallbackView(lo, hi, pos, nrm, indices) {
   const around = [[1.5, 1.5, -0.4], [-1.3, 1.2, 1.4], [0.5, 2.1, 1.5], [1.6, 0.5, 1.2]];
   let lights = around.map((a) => place(c, r, a[0], a[1], a[2]));
   if (flip) lights = lights.map((l) => mirror(l, c));
+  // A flat object's lights on its front and a quarter of the diagonal off
+  // its plane at least, as vdsh_view_compute puts them (light 0 stood
+  // behind a panel facing across the longest horizontal axis).
+  if (fn !== null) {
+    lights = lights.map((l) => {
+      let d = dot([0, 1, 2].map((k) => l[k] - c[k]), fn);
+      if (d < 0) { l = mirror(l, c); d = -d; }
+      const off = f(0.25 * diag);
+      return d < off ? l.map((x, k) => x + (off - d) * fn[k]) : l;
+    });
+  }
   // Pulled into the bounds, 5% of each extent inside every face
   // (VDSH_VIEW_REGION_INSET), as vdsh_view_compute pulls them into the
   // light region the bake trained on, which holds the bounds (this page
