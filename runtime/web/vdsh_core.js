@@ -334,8 +334,9 @@ export function vdshVertexGlsl(plan, shaders, texWidth, cpca) {
 // (vdsh_view_fit_camera) and an object's preferred lights, outside its
 // bounding sphere, pulled into its bounds (below). lo, hi: the bounds; pos, nrm
 // (vertex_count x 3) and indices (triangle_count x 3), when given, decide
-// whether the object is flat (every vertex within a millionth of the
-// diagonal of the plane of its largest triangle: one triangle, a panel);
+// whether the object is flat (every vertex within a hundredth of the
+// diagonal of the plane of its largest triangle, VDSH_VIEW_FLAT_SHARE: one
+// triangle, a panel);
 // a flat object whose front (the side its summed vertex normals face; the
 // winding's where they cancel) faces away from the fit direction w is
 // seen along w mirrored through its plane (along its normal where that is
@@ -368,6 +369,16 @@ export function vdshFallbackView(lo, hi, pos, nrm, indices) {
   if (flip) {
     w = mirror(w, [0, 0, 0]);
     if (w[0] * w[0] + w[2] * w[2] < 0.01) w = fn.slice();
+  }
+  // ... and at most 45 degrees off its normal (VDSH_VIEW_FLAT_ANGLE), turned
+  // toward it, its azimuth about the normal kept.
+  if (fn !== null) {
+    const cw = dot(w, fn), cmax = f(Math.cos(45 * Math.PI / 180));
+    if (cw < cmax) {
+      const tn = norm(w.map((x, k) => x - cw * fn[k])), smax = Math.sqrt(1 - cmax * cmax);
+      w = fn.map((x, k) => cmax * x + smax * tn[k]);
+      if (w[0] * w[0] + w[2] * w[2] < 0.01) w = fn.slice();
+    }
   }
   const s = norm([w[2], 0, -w[0]]);
   const v = cross(w, s);
@@ -443,7 +454,7 @@ function flatFront(pos, nrm, indices, diag) {
   let side = 0, wind = 0;
   for (let i = 0; i < nv; i++) {
     const q = at(i);
-    if (Math.abs((q[0] - p0[0]) * pn[0] + (q[1] - p0[1]) * pn[1] + (q[2] - p0[2]) * pn[2]) > 1e-6 * diag) return null;
+    if (Math.abs((q[0] - p0[0]) * pn[0] + (q[1] - p0[1]) * pn[1] + (q[2] - p0[2]) * pn[2]) > 0.01 * diag) return null;
     if (nrm) side += nrm[3 * i] * pn[0] + nrm[3 * i + 1] * pn[1] + nrm[3 * i + 2] * pn[2];
   }
   for (let t = 0; t < nt; t++) {
