@@ -1032,7 +1032,7 @@ static vdsh_result object_lights(const vdsh_view_tracer *t, const vdsh_view_mesh
 }
 
 /* Whether every vertex lies on one plane (a single triangle, a quad, a
- * flat panel), within a millionth of the diagonal; then *n is its unit
+ * flat panel), within VDSH_VIEW_FLAT_SHARE of the diagonal; then *n is its unit
  * normal toward the front: the side the vertex normals face on the whole
  * (the winding normals where those cancel). 0 also when no triangle has
  * an area or the sides cancel. */
@@ -1067,7 +1067,7 @@ static int flat_front(const vdsh_view_mesh *m, float diag, float n[3])
         double d = 0.0;
         for (int k = 0; k < 3; k++)
             d += ((double)q[k] - p0[k]) * pn[k];
-        if (fabs(d) > 1e-6 * diag)
+        if (fabs(d) > VDSH_VIEW_FLAT_SHARE * diag)
             return 0;
         if (m->normals)
             for (int k = 0; k < 3; k++)
@@ -1118,13 +1118,30 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
      * from the fixed direction): the view mirrored through the plane, eye
      * and lights alike, so that it sees the front lit as the fit view
      * would. Nearly vertical once mirrored: the eye along the normal. */
-    float fn[3], w[3], c[3];
+    float fn[3] = {0, 0, 0}, w[3], c[3];
     int flip = 0;
     fit_direction(lo, hi, w);
     const int flat = flat_front(m, diag, fn);
     if (flat && w[0] * fn[0] + w[1] * fn[1] + w[2] * fn[2] < 0.0f) {
         flip = 1;
         mirror(w, (float[3]){0, 0, 0}, fn);
+        if (w[0] * w[0] + w[2] * w[2] < 0.01f)
+            memcpy(w, fn, sizeof w);
+    }
+    /* ... and at most VDSH_VIEW_FLAT_ANGLE from its normal: the fixed
+     * direction saw a panel facing across the longest horizontal axis 66
+     * degrees off its normal, and a tilted quad nearly edge-on (a line);
+     * turned toward the normal in the plane of the two, its azimuth kept. */
+    const float cw = w[0] * fn[0] + w[1] * fn[1] + w[2] * fn[2];
+    const float cmax = cosf(VDSH_VIEW_FLAT_ANGLE * 3.14159265358979f / 180.0f);
+    if (flat && cw < cmax) {
+        float tn[3], tl = 0.0f;
+        for (int k = 0; k < 3; k++)
+            tn[k] = w[k] - cw * fn[k], tl += tn[k] * tn[k];
+        tl = sqrtf(tl);
+        const float smax = sqrtf(1.0f - cmax * cmax);
+        for (int k = 0; k < 3; k++)
+            w[k] = cmax * fn[k] + smax * tn[k] / tl;
         if (w[0] * w[0] + w[2] * w[2] < 0.01f)
             memcpy(w, fn, sizeof w);
     }
@@ -1140,6 +1157,23 @@ vdsh_result vdsh_view_compute(const vdsh_view_mesh *m, vdsh_view *out, vdsh_erro
         c[k] = 0.5f * (lo[k] + hi[k]);
     for (int i = 0; flip && i < v.light_count; i++)
         mirror(v.preferred[i], c, fn);
+    /* A flat object's lights on its front, the side the camera sees, and
+     * a quarter of the diagonal off its plane at least: the places around
+     * the bounds put light 0 (vdsh-view's one light) behind a panel facing
+     * across the longest horizontal axis (a triangle in z = 0 facing +z:
+     * the default frame black), mirrored or not, and a tilted one's light
+     * so near the plane that the search for free space (find_free) took
+     * one behind it. */
+    for (int i = 0; flat && !v.interior && i < v.light_count; i++) {
+        float d = 0.0f;
+        for (int k = 0; k < 3; k++)
+            d += (v.preferred[i][k] - c[k]) * fn[k];
+        if (d < 0.0f)
+            mirror(v.preferred[i], c, fn), d = -d;
+        const float off = 0.25f * diag;
+        for (int k = 0; d < off && k < 3; k++)
+            v.preferred[i][k] += (off - d) * fn[k];
+    }
     /* The light region as the bake computes it (the bake's diagonal, so
      * the same clearance): an object's lights inside it, where the bake's
      * fit was made for them. */

@@ -151,13 +151,24 @@ typedef struct vdsh_view {
 } vdsh_view;
 
 /* Everything above from the mesh: bounds, the interior test, the default
- * camera, the default lights. A flat object (all vertices within a
- * millionth of the diagonal of the plane of its largest triangle) whose
+ * camera, the default lights. A flat object (all vertices within
+ * VDSH_VIEW_FLAT_SHARE of the diagonal of the plane of its largest
+ * triangle) whose
  * front (the side the summed vertex normals face; the winding's where
  * they cancel) faces away from the fit camera's direction w: the fit
  * camera (fit; an object's camera) is fitted along w mirrored through the plane (along the plane's normal
  * where that is within about 6 degrees of vertical), and the preferred
- * lights are mirrored through the plane through the bounds' centre. An
+ * lights are mirrored through the plane through the bounds' centre. A flat
+ * object's camera direction more than VDSH_VIEW_FLAT_ANGLE from its
+ * normal is then turned toward the normal to that angle, its azimuth
+ * about the normal kept (a panel facing across the longest horizontal
+ * axis was seen 66 degrees off its normal, a tilted quad edge-on). Then
+ * every preferred light of a flat object (facing either way) that lies
+ * behind that plane is mirrored through it, and one nearer the plane than
+ * a quarter of the diagonal moved along its normal to that distance: all
+ * its lights light the front the camera sees (light 0 stood behind a
+ * panel facing across the longest horizontal axis, and the default frame
+ * was black). An
  * object's preferred lights are then pulled into the light region
  * (region_min..region_max; along an axis where it is thinner than the
  * clearance the bounds grown by VDSH_REGION_GROW of the diagonal there)
@@ -227,6 +238,14 @@ float vdsh_view_diagonal(const float lo[3], const float hi[3]);
  * (for an image at least as wide as it is tall) horizontally. */
 void vdsh_view_room_camera(const float lo[3], const float hi[3], vdsh_camera *out);
 void vdsh_view_fit_camera(const float lo[3], const float hi[3], vdsh_camera *out);
+
+/* A flat object: every vertex within this share of the diagonal of the
+ * plane of its largest triangle (the clearance, vdsh_free_clearance: a
+ * millionth took a quad whose fourth corner stood a thousandth off the
+ * plane for a solid, framed edge-on). Its camera is at most
+ * VDSH_VIEW_FLAT_ANGLE degrees from its normal (vdsh_view_compute). */
+#define VDSH_VIEW_FLAT_SHARE 0.01f
+#define VDSH_VIEW_FLAT_ANGLE 45.0f
 
 /* The share of the light region's extent an object's preferred light is
  * kept inside each of its faces (vdsh_view_compute). */

@@ -979,6 +979,33 @@ static void test_lights(void)
         }
     }
 
+    /* A lone triangle (in z = 0, over half its bounds): its region is its
+     * plane, where no point is near it along a probe (the probes in the
+     * plane pass it edge-on), and the near rule gives up after the first
+     * light's candidates find none, not a thousand per light (the bake's
+     * 2048 near lights spent 2M candidates, seconds, on one triangle). */
+    {
+        vb_mesh tri = {0};
+        vb_scene *ts = NULL;
+        mesh_alloc(&tri, 3, 1);
+        static const float tp[9] = {0, 0, 0, 1, 0, 0, 1, 1, 0};
+        memcpy(tri.positions, tp, sizeof tp);
+        for (int i = 0; i < 3; i++)
+            tri.normals[3 * i + 2] = 1.0f, tri.indices[i] = (uint32_t)i;
+        if (scene_from(&tri, &ts)) {
+            const int grown = vb_scene_light_region(ts, lo, hi, NULL);
+            vb_result r = vb_scene_place_lights_rule(ts, 0x3ea, N, VB_LIGHTS_NEAR, b, &tried, &err);
+            CHECK(r == VB_ERR_INVALID && strstr(err.msg, "no room"),
+                  "lone triangle, near rule: %d %s", (int)r, err.msg);
+            CHECK(tried == vdsh_light_tries(1, grown),
+                  "lone triangle, near rule: %u candidates tried, not the first light's %llu",
+                  tried, (unsigned long long)vdsh_light_tries(1, grown));
+        } else
+            CHECK(0, "triangle scene");
+        vb_scene_destroy(ts);
+        vb_mesh_free(&tri);
+    }
+
     /* The decision fit runs on the closed box, the same on 1 and 2 threads. */
     vb_bake_output o[2] = {{0}};
     for (int t = 0; t < 2; t++) {

@@ -9,7 +9,8 @@ expected ones (positions, winding); refused files fail with a message
 naming the file, never by a signal. Then Debian's assimp-testmodels glTF2
 files: the valid ones load with their triangle counts (primitive modes
 4-6, strips and fans, give the quad of mode 4), the malformed ones are
-refused with the file named.
+refused with the file named (a mesh whose primitives is not an array and
+a scene without nodes with that reason, not "empty mesh (no faces)").
 """
 import json
 import os
@@ -275,6 +276,16 @@ if os.path.isdir(g2):
         path = os.path.join(g2, rel)
         tris, p = load(path)
         refused(path, p)
+    # No triangles, and the JSON says why (the bake said only "empty mesh
+    # (no faces)"): a mesh whose primitives is not an array, a scene
+    # without nodes.
+    for rel, why in [("wrongTypes/badArray.gltf", '"primitives" is missing or not an array'),
+                     ("TestNoRootNode/SceneWithoutNodes.gltf", "scene 0 has no nodes")]:
+        path = os.path.join(g2, rel)
+        tris, p = load(path)
+        refused(path, p)
+        if why not in p.stderr:
+            failures.append("%s: the reason (%s) not given: %s" % (path, why, p.stderr.strip()))
     # glTF 1.0 (assimp-testmodels' glTF folder): refused as such, not as
     # "no scene" or "Invalid glTF binary".
     g1 = os.path.join(models, "glTF")

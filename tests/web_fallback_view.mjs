@@ -2,7 +2,7 @@
 // vdshFallbackView, the web viewer's default view of a glb without
 // extras.vdsh.view, on flat objects (formats/vdsh_scene_view.c's rule):
 // a triangle facing each axis both ways, a tilted one, a quad wound both
-// ways: the eye and a light on the side the normals face, every corner
+// ways: the eye and every light on the side the normals face, every corner
 // of the bounds in view; a solid (a tetrahedron): the bounds-only camera,
 // its lights in its bounds without the mesh; solids with the mesh (a box,
 // a flatter one, a cube on a floor): every light in free space (vdsh-view's
@@ -68,7 +68,7 @@ for (const { name, m } of cases) {
   const plain = vdshFallbackView(lo, hi);
   away += dot(sub(plain.eye, a), n) < 0;
   check(dot(sub(v.eye, a), n) > 0, name + ': the eye ' + v.eye + ' sees the back');
-  check(v.lights.some((l) => dot(sub(l, a), n) > 0), name + ': no light on the front side');
+  v.lights.forEach((l, i) => check(dot(sub(l, a), n) > 0, name + ': light ' + i + ' behind the front'));
   // every corner of the bounds in the view (fov_y 60, a square image)
   const f = sub(v.target, v.eye), s = cross(f, v.up), u = cross(s, f), t = Math.tan(Math.PI / 6);
   for (let k = 0; k < 8; k++) {

@@ -203,7 +203,7 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
     if (r->split_vertices)
         fprintf(fp,
                 "%s%s%s: %u vert%s split at creases (their face corners give normals more than %g "
-                "degrees apart): %u vert%s added\n",
+                "degrees apart): %u vert%s added (in the count above)\n",
                 tool, sep, path, r->split_vertices, r->split_vertices == 1 ? "ex" : "ices",
                 VB_MESH_NORMAL_AGREE_DEG, r->split_added, r->split_added == 1 ? "ex" : "ices");
     if (r->missing_normals)

@@ -589,6 +589,33 @@ std::string required_extension(int binary, const uint8_t *bytes, size_t size)
     return std::string();
 }
 
+/* Why scene s gave no triangle, where the JSON says (empty when it does
+ * not): tinygltf takes a mesh whose "primitives" is not an array for a
+ * mesh without primitives, and a scene without nodes for an empty one,
+ * and the bake then said only "empty mesh (no faces)". */
+std::string no_triangles_reason(int binary, const uint8_t *bytes, size_t size, int s)
+{
+    nlohmann::json doc = file_json(binary, bytes, size);
+    if (!doc.is_object())
+        return std::string();
+    auto meshes = doc.find("meshes");
+    if (meshes != doc.end() && meshes->is_array())
+        for (size_t i = 0; i < meshes->size(); i++) {
+            const nlohmann::json &m = (*meshes)[i];
+            if (m.is_object() && (!m.contains("primitives") || !m["primitives"].is_array()))
+                return "mesh " + std::to_string(i) +
+                       ": \"primitives\" is missing or not an array (not valid glTF 2.0)";
+        }
+    auto scenes = doc.find("scenes");
+    if (scenes != doc.end() && scenes->is_array() && (size_t)s < scenes->size()) {
+        const nlohmann::json &sc = (*scenes)[(size_t)s];
+        if (sc.is_object() &&
+            (!sc.contains("nodes") || !sc["nodes"].is_array() || sc["nodes"].empty()))
+            return "scene " + std::to_string(s) + " has no nodes: nothing to bake";
+    }
+    return std::string();
+}
+
 /* The paths tinygltf would read the file's external images from (the
  * base directory joined to each decoded URI, as its LoadExternalFile
  * does), leaving out any a buffer also names. Only when the JSON has an
@@ -694,6 +721,11 @@ vb_result parse(const char *name, int binary, int scene, const uint8_t *bytes, s
     for (float v : o.pos)
         if (!std::isfinite(v))
             return vb_fail(err, VB_ERR_INVALID, "%s: a vertex has a non-finite coordinate", name);
+    if (o.idx.empty() && !o.skipped_modes) {
+        std::string why = no_triangles_reason(binary, bytes, size, s);
+        if (!why.empty())
+            return vb_fail(err, VB_ERR_INVALID, "%s: empty mesh: %s", name, why.c_str());
+    }
     if (o.idx.empty() && o.skipped_modes)
         return vb_fail(err, VB_ERR_INVALID,
                        "%s: empty mesh: no triangles left after skipping %u point/line "

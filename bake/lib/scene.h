@@ -167,7 +167,10 @@ vb_result vb_scene_use_light_box(vb_scene *s, vdsh_light_box *box, const char *w
  * vdsh-view's default lights for an object stood, about 1.08 diagonals
  * from its centre) and shell (the bounds grown by VDSH_REGION_GROW of
  * their diagonal, outside the bounds only: vb_bake_desc.decision_shell's
- * training lights). */
+ * training lights). Candidates tried, by every rule but uniform
+ * (vdsh_light_place's): vdsh_light_tries(count, grown) at
+ * most, and only the first vdsh_light_tries(1, grown) when those hold no
+ * light at all (a rule that finds no room gives up early). */
 typedef enum vb_light_rule {
     VB_LIGHTS_UNIFORM = 0,
     VB_LIGHTS_CEILING,

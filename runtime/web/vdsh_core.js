@@ -528,14 +528,17 @@ export function vdshFindFree(tracer, p0, lo, hi, diagonal) {
 // pulled into the bounds, a light could stand inside the object. lo, hi:
 // the bounds; pos, nrm
 // (vertex_count x 3) and indices (triangle_count x 3), when given, decide
-// whether the object is flat (every vertex within a millionth of the
-// diagonal of the plane of its largest triangle: one triangle, a panel);
+// whether the object is flat (every vertex within a hundredth of the
+// diagonal of the plane of its largest triangle, VDSH_VIEW_FLAT_SHARE: one
+// triangle, a panel);
 // a flat object whose front (the side its summed vertex normals face; the
 // winding's where they cancel) faces away from the fit direction w is
 // seen along w mirrored through its plane (along its normal where that is
 // within about 6 degrees of vertical), its lights mirrored through the
-// plane through the bounds' centre: vdsh_view_compute's rule (flat_front,
-// mirror), so that the camera sees the side the normals face.
+// plane through the bounds' centre, then each behind the plane mirrored to
+// its front and moved a quarter diagonal off it: vdsh_view_compute's rule
+// (flat_front, mirror), so that the camera sees the side the normals face,
+// lit.
 export function vdshFallbackView(lo, hi, pos, nrm, indices) {
   const f = Math.fround;
   const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -561,6 +564,16 @@ export function vdshFallbackView(lo, hi, pos, nrm, indices) {
     w = mirror(w, [0, 0, 0]);
     if (w[0] * w[0] + w[2] * w[2] < 0.01) w = fn.slice();
   }
+  // ... and at most 45 degrees off its normal (VDSH_VIEW_FLAT_ANGLE), turned
+  // toward it, its azimuth about the normal kept.
+  if (fn !== null) {
+    const cw = dot(w, fn), cmax = f(Math.cos(45 * Math.PI / 180));
+    if (cw < cmax) {
+      const tn = norm(w.map((x, k) => x - cw * fn[k])), smax = Math.sqrt(1 - cmax * cmax);
+      w = fn.map((x, k) => cmax * x + smax * tn[k]);
+      if (w[0] * w[0] + w[2] * w[2] < 0.01) w = fn.slice();
+    }
+  }
   const s = norm([w[2], 0, -w[0]]);
   const v = cross(w, s);
   const t = Math.tan(0.5 * 60 * Math.PI / 180);
@@ -573,6 +586,17 @@ export function vdshFallbackView(lo, hi, pos, nrm, indices) {
   const around = [[1.5, 1.5, -0.4], [-1.3, 1.2, 1.4], [0.5, 2.1, 1.5], [1.6, 0.5, 1.2]];
   let lights = around.map((a) => place(c, r, a[0], a[1], a[2]));
   if (flip) lights = lights.map((l) => mirror(l, c));
+  // A flat object's lights on its front and a quarter of the diagonal off
+  // its plane at least, as vdsh_view_compute puts them (light 0 stood
+  // behind a panel facing across the longest horizontal axis).
+  if (fn !== null) {
+    lights = lights.map((l) => {
+      let d = dot([0, 1, 2].map((k) => l[k] - c[k]), fn);
+      if (d < 0) { l = mirror(l, c); d = -d; }
+      const off = f(0.25 * diag);
+      return d < off ? l.map((x, k) => x + (off - d) * fn[k]) : l;
+    });
+  }
   // Pulled into the light region, 5% of each extent inside every face
   // (VDSH_VIEW_REGION_INSET), as vdsh_view_compute pulls them into the
   // light region the bake trained on: with the mesh, vdsh_light_region's
@@ -632,7 +656,7 @@ function flatFront(pos, nrm, indices, diag) {
   let side = 0, wind = 0;
   for (let i = 0; i < nv; i++) {
     const q = at(i);
-    if (Math.abs((q[0] - p0[0]) * pn[0] + (q[1] - p0[1]) * pn[1] + (q[2] - p0[2]) * pn[2]) > 1e-6 * diag) return null;
+    if (Math.abs((q[0] - p0[0]) * pn[0] + (q[1] - p0[1]) * pn[1] + (q[2] - p0[2]) * pn[2]) > 0.01 * diag) return null;
     if (nrm) side += nrm[3 * i] * pn[0] + nrm[3 * i + 1] * pn[1] + nrm[3 * i + 2] * pn[2];
   }
   for (let t = 0; t < nt; t++) {
