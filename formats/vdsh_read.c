@@ -119,11 +119,30 @@ static vdsh_result invalid(const reader *r, const why *w)
     return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name, "%s", w->msg);
 }
 
-/* What a file that is not a .vdsh is, when its first bytes say so: the
- * files the tools write beside a bake and the meshes a bake reads, handed
- * to a .vdsh reader by mistake (the distance volume's magic begins with
- * "VDSH", and was called a .vdsh damaged in transfer). NULL: unknown. */
-static const char *other_format(const uint8_t *d, size_t size)
+/* The hint after a mesh's name: the tools that read a .vdsh read a bake. */
+#define BAKE_IT_FIRST "; bake it first: vdsh-bake MODEL -o MODEL.vdsh"
+
+/* 1 when NAME's last extension is EXT (lower case), in any case. */
+static int has_extension(const char *name, const char *ext)
+{
+    const char *dot = strrchr(name, '.');
+    const char *slash = strrchr(name, '/');
+    if (!dot || (slash && dot < slash))
+        return 0;
+    for (dot++; *dot && *ext; dot++, ext++)
+        if ((*dot >= 'A' && *dot <= 'Z' ? *dot - 'A' + 'a' : *dot) != *ext)
+            return 0;
+    return *dot == 0 && *ext == 0;
+}
+
+/* What a file that is not a .vdsh is: the files the tools write beside a
+ * bake by their first bytes (the distance volume's magic begins with
+ * "VDSH", and was called a .vdsh damaged in transfer), and every mesh
+ * format vdsh-bake reads by the same rule (python/vdsh/__init__.py says
+ * the same): by its magic where it has one (PLY, glb), else by the name's
+ * extension, as vdsh-bake picks the reader (.obj, .off, .stl, .gltf).
+ * NULL: unknown. */
+static const char *other_format(const char *name, const uint8_t *d, size_t size)
 {
     static const struct {
         const char *magic;
@@ -131,21 +150,43 @@ static const char *other_format(const uint8_t *d, size_t size)
         const char *what;
     } known[] = {
         {"VDSHSDF\0", 8, "a VDSH distance volume (vdsh-bake --sdf; vdsh-view --sdf reads it)"},
-        {"glTF", 4, "a binary glTF (.glb: vdsh-export writes it, vdsh-bake reads it as a mesh)"},
+        {"glTF", 4, "a binary glTF mesh (.glb, as vdsh-export writes)" BAKE_IT_FIRST},
         {"\x76\x2f\x31\x01", 4, "an OpenEXR image (the bake's basis cubemaps)"},
-        {"ply\n", 4, "a PLY mesh (vdsh-bake reads it)"},
+        {"ply\n", 4, "a PLY mesh" BAKE_IT_FIRST},
+        {"ply\r", 4, "a PLY mesh" BAKE_IT_FIRST},
         {"\x89PNG", 4, "a PNG image"},
+    };
+    static const struct {
+        const char *ext;
+        const char *what;
+    } meshes[] = {
+        {"obj", "a Wavefront OBJ mesh" BAKE_IT_FIRST},
+        {"ply", "a PLY mesh" BAKE_IT_FIRST},
+        {"off", "an OFF mesh" BAKE_IT_FIRST},
+        {"stl", "an STL mesh" BAKE_IT_FIRST},
+        {"gltf", "a glTF mesh" BAKE_IT_FIRST},
+        {"glb", "a binary glTF mesh (.glb, as vdsh-export writes)" BAKE_IT_FIRST},
     };
     for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
         if (size >= known[i].len && memcmp(d, known[i].magic, known[i].len) == 0)
             return known[i].what;
+    for (size_t i = 0; name && i < sizeof meshes / sizeof meshes[0]; i++)
+        if (has_extension(name, meshes[i].ext))
+            return meshes[i].what;
     return NULL;
 }
 
-/* "not a .vdsh file", and what it is where its first bytes say so. */
+/* "not a .vdsh file", and what it is where its first bytes say so, then
+ * a .vdsh's magic damaged in transfer, then a mesh by its name. */
 static vdsh_result not_vdsh(vdsh_error *err, const char *name, const uint8_t *d, size_t size)
 {
-    const char *what = other_format(d, size);
+    const char *what = other_format(NULL, d, size);
+    if (!what && size >= sizeof vdsh_magic && memcmp(d, vdsh_magic, 4) == 0)
+        return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, name,
+                             "not a .vdsh file: magic bytes 4..7 damaged (a "
+                             "text-mode transfer changes CR, LF and ^Z)");
+    if (!what)
+        what = other_format(name, d, size);
     if (what)
         return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, name, "not a .vdsh file: %s", what);
     return vdsh_failf_at(err, VDSH_ERR_NOT_VDSH, name, "not a .vdsh file (wrong magic)");
@@ -164,15 +205,8 @@ static vdsh_result read_structure(const reader *r, chunk_ref *chunks, uint32_t *
                              "truncated: %zu byte%s, shorter than the %d-byte header", size,
                              vdsh_s(size), FILE_HEADER_SIZE);
     }
-    if (memcmp(d, vdsh_magic, sizeof vdsh_magic) != 0) {
-        if (other_format(d, size))
-            return not_vdsh(r->err, r->name, d, size);
-        if (memcmp(d, vdsh_magic, 4) == 0)
-            return vdsh_failf_at(r->err, VDSH_ERR_NOT_VDSH, r->name,
-                                 "not a .vdsh file: magic bytes 4..7 damaged (a "
-                                 "text-mode transfer changes CR, LF and ^Z)");
+    if (memcmp(d, vdsh_magic, sizeof vdsh_magic) != 0)
         return not_vdsh(r->err, r->name, d, size);
-    }
     if (size < FILE_HEADER_SIZE)
         return vdsh_failf_at(r->err, VDSH_ERR_TRUNCATED, r->name,
                              "truncated: %zu byte%s, shorter than the %d-byte header", size,

@@ -43,3 +43,20 @@ add_test(NAME format_plurals
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_plurals.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info> ${PROJECT_SOURCE_DIR}
                  ${CMAKE_CURRENT_BINARY_DIR}/plurals $<TARGET_FILE:vdsh-eval>)
+
+# format_mesh_not_vdsh
+#                   a mesh of every format vdsh-bake reads, handed to each
+#                   program that reads a .vdsh (vdsh-info, --verify,
+#                   vdsh-eval, vdsh-frames, vdsh-export, vdsh-merge,
+#                   vdsh-view where built, python -m vdsh info): exit 1 and
+#                   one message, "not a .vdsh file: a PLY mesh; bake it
+#                   first: vdsh-bake MODEL -o MODEL.vdsh"
+set(_mesh_not_vdsh_programs $<TARGET_FILE:vdsh-info> $<TARGET_FILE:vdsh-eval>
+    $<TARGET_FILE:vdsh-frames> $<TARGET_FILE:vdsh-export> $<TARGET_FILE:vdsh-merge>)
+if(TARGET vdsh-view)
+  list(APPEND _mesh_not_vdsh_programs $<TARGET_FILE:vdsh-view>)
+endif()
+add_test(NAME format_mesh_not_vdsh
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_mesh_not_vdsh.py
+                 ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/mesh_not_vdsh
+                 ${_mesh_not_vdsh_programs})

@@ -2393,6 +2393,61 @@ static void test_variable_streams(void)
     free(src);
 }
 
+/* A mesh handed to a .vdsh reader (vdsh-view model.obj) is named for what
+ * it is, with the bake that makes a .vdsh of it, for every format vdsh-bake
+ * reads: by the first bytes where the format has a magic (PLY, glb), else
+ * by the name's extension in any case (was "wrong magic" for .obj, .off,
+ * .stl and .gltf). vdsh_scan_chunks (vdsh-info --verify) says the same. */
+static void test_mesh_named(void)
+{
+    static const struct {
+        const char *name, *bytes, *what;
+    } cases[] = {
+        {"model.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "a Wavefront OBJ mesh"},
+        {"MODEL.OBJ", "# exported\nv 0 0 0\n", "a Wavefront OBJ mesh"},
+        {"model.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "an OFF mesh"},
+        {"3DSMaxExport.STL", "solid 3DSMaxExport\n  facet normal 0 0 1\n", "an STL mesh"},
+        {"model.stl", "binary STL header, eighty bytes of anything at all", "an STL mesh"},
+        {"dir.v/model.gltf", "{\"asset\": {\"version\": \"2.0\"}}\n", "a glTF mesh"},
+        {"model.ply", "ply\nformat ascii 1.0\n", "a PLY mesh"},
+        {"a.vdsh", "ply\r\nformat binary_little_endian 1.0\r\n", "a PLY mesh"},
+        {"model.ply", "not a ply header but named one\n", "a PLY mesh"},
+        {"model.vdsh", "glTF\2\0\0\0\100\0\0\0\0\0\0\0\0\0\0", "a binary glTF mesh"},
+        {"model.glb", "glTF", "a binary glTF mesh"},
+        {"ob", "v", NULL},
+        {"model.objx", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", NULL},
+        {"obj/model", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", NULL},
+        {"model.obj", "VDSH\r\n\x1a\r damaged by a transfer, not a mesh", "text-mode"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const uint8_t *d = (const uint8_t *)cases[i].bytes;
+        size_t n = i == 9 ? 16 : strlen(cases[i].bytes);
+        vdsh_file *f = NULL;
+        vdsh_error err;
+        char want[256];
+        snprintf(want, sizeof want, "%s: not a .vdsh file%s%s", cases[i].name,
+                 cases[i].what ? ": " : " (wrong magic)", cases[i].what ? cases[i].what : "");
+        vdsh_result r = vdsh_read_memory(d, n, cases[i].name, &f, &err);
+        int ok = r == VDSH_ERR_NOT_VDSH && !f;
+        if (cases[i].what && !strcmp(cases[i].what, "text-mode"))
+            ok = ok && strstr(err.msg, "magic bytes 4..7 damaged");
+        else
+            ok = ok && strstr(err.msg, want) &&
+                 !!strstr(err.msg, "; bake it first: vdsh-bake MODEL -o MODEL.vdsh") ==
+                     (cases[i].what != NULL);
+        if (!ok)
+            fprintf(stderr, "%s: got %d '%s', want '%s'\n", cases[i].name, (int)r, err.msg, want);
+        CHECK(ok);
+        vdsh_free(f);
+        uint32_t count = 0;
+        r = vdsh_scan_chunks(d, n, cases[i].name, NULL, 0, &count, &err);
+        CHECK(r == VDSH_ERR_NOT_VDSH &&
+              strstr(err.msg, !cases[i].what                        ? "wrong magic"
+                              : !strcmp(cases[i].what, "text-mode") ? "magic bytes 4..7 damaged"
+                                                                    : cases[i].what));
+    }
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && !strcmp(argv[1], "--exhaustive-f16"))
@@ -2415,6 +2470,7 @@ int main(int argc, char **argv)
     test_truncation();
     test_byte_changes();
     test_rules();
+    test_mesh_named();
     test_parts();
     test_variable_streams();
     test_mutations();

@@ -134,26 +134,46 @@ def read(path: Union[str, "os.PathLike[str]"]) -> VdshFile:
     return parse(data, path)
 
 
+_BAKE_IT_FIRST = "; bake it first: vdsh-bake MODEL -o MODEL.vdsh"
 _OTHER_FORMATS = (
     (b"VDSHSDF\0", "a VDSH distance volume (vdsh-bake --sdf; vdsh-view --sdf reads it)"),
-    (b"glTF", "a binary glTF (.glb: vdsh-export writes it, vdsh-bake reads it as a mesh)"),
+    (b"glTF", "a binary glTF mesh (.glb, as vdsh-export writes)" + _BAKE_IT_FIRST),
     (b"\x76\x2f\x31\x01", "an OpenEXR image (the bake's basis cubemaps)"),
-    (b"ply\n", "a PLY mesh (vdsh-bake reads it)"),
+    (b"ply\n", "a PLY mesh" + _BAKE_IT_FIRST),
+    (b"ply\r", "a PLY mesh" + _BAKE_IT_FIRST),
     (b"\x89PNG", "a PNG image"),
 )
+# The mesh formats vdsh-bake reads, by the name's extension (as vdsh-bake
+# picks the reader) where the first bytes do not say.
+_MESHES = {
+    ".obj": "a Wavefront OBJ mesh" + _BAKE_IT_FIRST,
+    ".ply": "a PLY mesh" + _BAKE_IT_FIRST,
+    ".off": "an OFF mesh" + _BAKE_IT_FIRST,
+    ".stl": "an STL mesh" + _BAKE_IT_FIRST,
+    ".gltf": "a glTF mesh" + _BAKE_IT_FIRST,
+    ".glb": "a binary glTF mesh (.glb, as vdsh-export writes)" + _BAKE_IT_FIRST,
+}
 
 
 def parse(data: bytes, path: str = "memory") -> VdshFile:
     """As `read`, from the file's bytes; `path` names it in messages."""
     n = len(data)
     if data[:8] != MAGIC[:n]:
-        # Files the tools write beside a bake, or meshes, named for what
-        # they are, as formats/vdsh_read.c does (the distance volume's
-        # magic begins with "VDSH").
+        # Files the tools write beside a bake, and meshes, named for what
+        # they are by the rule of formats/vdsh_read.c: the first bytes,
+        # then (for a file that is not a damaged .vdsh) the mesh
+        # extensions vdsh-bake reads (the distance volume's magic begins
+        # with "VDSH").
         for magic, what in _OTHER_FORMATS:
             if data[:len(magic)] == magic:
                 _fail(path, "not a .vdsh file: " + what)
-        _fail(path, "not a .vdsh file (magic)")
+        if n >= 8 and data[:4] == MAGIC[:4]:
+            _fail(path, "not a .vdsh file: magic bytes 4..7 damaged (a text-mode "
+                  "transfer changes CR, LF and ^Z)")
+        what = _MESHES.get(os.path.splitext(os.fspath(path))[1].lower())
+        if what:
+            _fail(path, "not a .vdsh file: " + what)
+        _fail(path, "not a .vdsh file (wrong magic)")
     if n < 32:  # a file cut short, as vdsh-info says it
         _fail(path, "truncated: %d byte%s, shorter than the 32-byte header" % (n, _s(n)))
     version, count, size, flags, crc = struct.unpack_from("<IIQII", data, 8)
