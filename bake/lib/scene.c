@@ -336,8 +336,20 @@ vb_result vb_scene_place_lights_rule(const vb_scene *s, uint64_t seed, uint32_t 
     int grown = vb_scene_light_region(s, lo, hi, NULL);
     if (rule == VB_LIGHTS_GROWN)
         vb_scene_grown_box(s, lo, hi);
-    else if (rule == VB_LIGHTS_AROUND || rule == VB_LIGHTS_SHELL)
+    else if (rule == VB_LIGHTS_AROUND || rule == VB_LIGHTS_SHELL) {
+        /* Outside the bounds, but not beyond a side a one-sided surface
+         * closes (vdsh_light_grown_box's rule: below an open floor, lights
+         * light none of what a viewer sees and shadow everything). */
+        float glo[3], ghi[3];
+        const int closed = vb_scene_grown_box(s, glo, ghi);
         grow_bounds(s, rule == VB_LIGHTS_AROUND ? 1.0 : (double)VDSH_REGION_GROW, lo, hi);
+        for (int a = 0; a < 3; a++) {
+            if (closed >> (2 * a) & 1)
+                lo[a] = s->bounds_min[a];
+            if (closed >> (2 * a + 1) & 1)
+                hi[a] = s->bounds_max[a];
+        }
+    }
     grown |= rule >= VB_LIGHTS_GROWN;
     uint32_t n = 0, k = 0;
     const uint64_t limit = vdsh_light_tries(count, grown);
