@@ -46,6 +46,12 @@ const char *vdsh_library_version(void)
     return VDSH_VERSION_STRING;
 }
 
+const char *vdsh_up_axis_name(uint32_t code)
+{
+    static const char *const names[VDSH_UP_AXES] = {"y", "z", "-z", "x", "-x", "-y"};
+    return code < VDSH_UP_AXES ? names[code] : NULL;
+}
+
 const char *vdsh_result_str(vdsh_result r)
 {
     switch (r) {

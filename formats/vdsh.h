@@ -107,7 +107,14 @@ typedef enum vdsh_sampling { VDSH_SAMPLING_SPHERE = 0, VDSH_SAMPLING_HEMISPHERE 
 
 typedef enum vdsh_offset_rule { VDSH_OFFSET_NONE = 0, VDSH_OFFSET_WB_AVG = 1 } vdsh_offset_rule;
 
-enum { VDSH_LOAD_WELD = 1u };
+/* HEAD load_flags: bit 0 welded; bits 1..3 the sources' up axis, which
+ * the baker turned into +y before anything else (vdsh-bake --up-axis;
+ * readers that rebuild the scene from the sources turn them the same way):
+ * 0 y (none: the default), 1 z, 2 -z, 3 x, 4 -x, 5 -y (vdsh_up_axis_name). */
+enum { VDSH_LOAD_WELD = 1u, VDSH_LOAD_UP_SHIFT = 1, VDSH_LOAD_UP_MASK = 7u << 1, VDSH_UP_AXES = 6 };
+
+/* "y", "z", "-z", "x", "-x", "-y" for up axis code 0..5; NULL otherwise. */
+const char *vdsh_up_axis_name(uint32_t code);
 enum { VDSH_TRACE_ROBUST = 1u };
 
 typedef enum vdsh_encoding {

@@ -231,3 +231,12 @@ add_test(NAME bake_stream_output
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/test_bake_stream_output.sh
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge>)
 set_tests_properties(bake_stream_output PROPERTIES TIMEOUT 60)
+# vdsh-bake --up-axis: the cube on its floor written z-up (and -z, x, -x,
+# -y up) bakes to the y-up bake's receivers and coefficients; the file
+# records the axis (vdsh-info, python -m vdsh info); vdsh-eval turns the
+# sources the same way (the y-up figures); --up-axis y: the same bytes.
+add_test(NAME bake_up_axis
+         COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_up_axis.py
+                 $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-info> $<TARGET_FILE:vdsh-eval>
+                 $<TARGET_FILE:vdsh-frames> ${PROJECT_SOURCE_DIR}
+                 ${CMAKE_CURRENT_BINARY_DIR}/up_axis)

@@ -1548,7 +1548,9 @@ static void test_rules(void)
     PATCHF(head + 24, INFINITY, VDSH_ERR_INVALID, "max_distance");
     PATCHF(head + 28, -1.0f, VDSH_ERR_INVALID, "max_edge");
     PATCH32(head + 32, 2, 1, VDSH_ERR_INVALID, "offset_rule 2");
-    PATCH32(head + 36, 2, 1, VDSH_ERR_INVALID, "load_flags");
+    PATCH32(head + 36, 16, 1, VDSH_ERR_INVALID, "load_flags");
+    PATCH32(head + 36, 6u << 1, 1, VDSH_ERR_INVALID, "up axis 6 unknown");
+    PATCH32(head + 36, 1u | 5u << 1, 1, VDSH_OK, NULL); /* welded, -y up */
     PATCH32(head + 52, 0x80000000u, 1, VDSH_ERR_INVALID, "trace_flags");
     PATCHF(head + 60, NAN, VDSH_ERR_INVALID, "bounds");
     PATCHF(head + 68, -100.0f, VDSH_ERR_INVALID, "bounds_min[0]");
@@ -1931,7 +1933,8 @@ static void test_writer_checks(void)
     REJECT("max_distance", s_.f.header.max_distance = NAN);
     REJECT("max_edge", s_.f.header.max_edge = -1);
     REJECT("offset_rule", s_.f.header.offset_rule = 9);
-    REJECT("load_flags", s_.f.header.load_flags = 2);
+    REJECT("load_flags", s_.f.header.load_flags = 16);
+    REJECT("up axis 7", s_.f.header.load_flags = 7u << 1);
     REJECT("trace_flags", s_.f.header.trace_flags = 3);
     REJECT("bounds", s_.f.header.bounds_min[2] = INFINITY);
     REJECT("bounds_min[1]", s_.f.header.bounds_min[1] = 7);

@@ -1499,11 +1499,33 @@ static vb_result load_bytes(const char *name, vb_mesh_format format, int gltf_sc
     return r;
 }
 
-/* The common tail of both loaders: weld if asked, count what is left
- * without a normal, then hand over. */
-static vb_result finish_load(vb_result r, vb_mesh *m, vb_source_info *si, int weld, vb_mesh *out,
-                             vb_source_info *info, vb_error *err)
+/* v (x, y, z) turned so that the up axis `up` (vb_load_desc.up_axis)
+ * becomes +y: a proper rotation (determinant 1, windings kept), exact. */
+static void turn_up(int up, float *v)
 {
+    const float x = v[0], y = v[1], z = v[2];
+    switch (up) {
+    case 1: v[0] = x, v[1] = z, v[2] = -y; break;  /* z up: -90 degrees about x */
+    case 2: v[0] = x, v[1] = -z, v[2] = y; break;  /* -z up: +90 degrees about x */
+    case 3: v[0] = -y, v[1] = x, v[2] = z; break;  /* x up: +90 degrees about z */
+    case 4: v[0] = y, v[1] = -x, v[2] = z; break;  /* -x up: -90 degrees about z */
+    case 5: v[0] = x, v[1] = -y, v[2] = -z; break; /* -y up: 180 degrees about x */
+    default: break;
+    }
+}
+
+/* The common tail of both loaders: turn the up axis into +y, weld if
+ * asked, count what is left without a normal, then hand over. */
+static vb_result finish_load(vb_result r, vb_mesh *m, vb_source_info *si, const vb_load_desc *desc,
+                             vb_mesh *out, vb_source_info *info, vb_error *err)
+{
+    const int weld = desc ? desc->weld : 0, up = desc ? desc->up_axis : 0;
+    if (r == VB_OK && (up < 0 || up >= VDSH_UP_AXES))
+        r = vb_fail(err, VB_ERR_ARGUMENT, "load: up axis %d unknown (0..%d)", up, VDSH_UP_AXES - 1);
+    for (uint32_t i = 0; r == VB_OK && up && i < m->vertex_count; i++) {
+        turn_up(up, m->positions + 3 * (size_t)i);
+        turn_up(up, m->normals + 3 * (size_t)i);
+    }
     uint32_t before = m->vertex_count;
     if (r == VB_OK && weld) {
         r = vb_mesh_weld(m, err);
@@ -1551,7 +1573,7 @@ vb_result vb_mesh_load(const char *path, const vb_load_desc *desc, vb_mesh *out,
         r = load_bytes(path, format, desc ? desc->gltf_scene : 0, bytes, size, &m, &si, err);
         free(bytes);
     }
-    return finish_load(r, &m, &si, desc ? desc->weld : 0, out, info, err);
+    return finish_load(r, &m, &si, desc, out, info, err);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -1664,5 +1686,5 @@ vb_result vb_mesh_load_memory(const void *data, size_t size, const char *name,
     memset(&si, 0, sizeof si);
     r = load_bytes(name, format, desc ? desc->gltf_scene : 0, (const uint8_t *)data, size, &m, &si,
                    err);
-    return finish_load(r, &m, &si, desc ? desc->weld : 0, out, info, err);
+    return finish_load(r, &m, &si, desc, out, info, err);
 }

@@ -136,6 +136,11 @@ typedef struct vb_load_desc {
     /* glTF: 0 (default) = the file's default scene (or its first); N + 1 =
      * scene N */
     int gltf_scene;
+    /* the file's up axis, turned into +y first (every position and normal,
+     * by an exact rotation: coordinates swapped and negated): 0 y (none,
+     * the default), 1 z, 2 -z, 3 x, 4 -x, 5 -y (formats/vdsh.h,
+     * VDSH_LOAD_UP_MASK; vdsh-bake --up-axis) */
+    int up_axis;
 } vb_load_desc;
 
 /* What loading found in a file and did about it, as counts (all zero for

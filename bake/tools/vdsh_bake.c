@@ -77,6 +77,7 @@ typedef struct options {
     uint32_t max_receivers; /* --max-receivers; 0: none */
     uint32_t max_rounds;    /* --max-rounds; 0: none given (VB_ADAPTIVE_ROUNDS) */
     int weld;
+    int up_axis; /* --up-axis: vb_load_desc.up_axis; 0: y */
     uint64_t seed;
     uint32_t threads;
     int cube_size;
@@ -324,6 +325,12 @@ static void usage(FILE *f)
             "      --receivers FILE    bake these receivers (a mesh file, e.g. a plan)\n"
             "                          as they are, instead of the scene's vertices\n"
             "      --weld              merge vertices with identical positions\n"
+            "      --up-axis A         the meshes' up axis: y (default), z (most CAD\n"
+            "                          and 3ds Max exports, STL), -z, x, -x or -y; the\n"
+            "                          meshes are turned so that it points along +y\n"
+            "                          (scenes are y-up) before anything else, and the\n"
+            "                          file records it: vdsh-eval and vdsh-frames turn\n"
+            "                          the sources the same way\n"
             "      --keep-normals      keep normals that point into geometry (default:\n"
             "                          a receiver blocked at ~0 on its own side and open\n"
             "                          on the other gets its normal flipped)\n"
@@ -756,6 +763,7 @@ enum {
     O_MAXDIST,
     O_MAXEDGE,
     O_WELD,
+    O_UP_AXIS,
     O_SEED,
     O_THREADS,
     O_CUBESIZE,
@@ -1115,6 +1123,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"max-distance", required_argument, 0, O_MAXDIST},
         {"max-edge", required_argument, 0, O_MAXEDGE},
         {"weld", no_argument, 0, O_WELD},
+        {"up-axis", required_argument, 0, O_UP_AXIS},
         {"seed", required_argument, 0, O_SEED},
         {"threads", required_argument, 0, O_THREADS},
         {"cube-size", required_argument, 0, O_CUBESIZE},
@@ -1164,6 +1173,13 @@ static int parse_args(int argc, char **argv, options *o)
                 return VT_EXIT_USAGE;
             break;
         case O_WELD: o->weld = 1; break;
+        case O_UP_AXIS:
+            for (o->up_axis = 0; o->up_axis < VDSH_UP_AXES; o->up_axis++)
+                if (strcmp(optarg, vdsh_up_axis_name((uint32_t)o->up_axis)) == 0)
+                    break;
+            if (o->up_axis == VDSH_UP_AXES)
+                return bad_usage("--up-axis takes y, z, -z, x, -x or -y, not '%s'", optarg);
+            break;
         case O_CUBEDIR:
             if (!vt_opt_once("--cubemap-dir", optarg, &o->cubemap_dir))
                 return VT_EXIT_USAGE;
@@ -1268,6 +1284,7 @@ static vb_job_desc job_desc(const options *o, FILE *log, progress *pr, float *of
         .output = o->trace_only ? NULL : o->output,
         .cubemap_dir = o->cubemap_dir,
         .weld = o->weld,
+        .up_axis = o->up_axis,
         .max_edge = o->max_edge,
         .fast_traversal = !o->robust,
         .light_region = o->light_region,

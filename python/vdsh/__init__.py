@@ -134,6 +134,10 @@ def read(path: Union[str, "os.PathLike[str]"]) -> VdshFile:
     return parse(data, path)
 
 
+# HEAD load_flags bits 1..3: the sources' up axis, turned into +y by the
+# bake (vdsh-bake --up-axis; formats/vdsh.h, VDSH_LOAD_UP_MASK).
+UP_AXES = ("y", "z", "-z", "x", "-x", "-y")
+
 _BAKE_IT_FIRST = "; bake it first: vdsh-bake MODEL -o MODEL.vdsh"
 _OTHER_FORMATS = (
     (b"VDSHSDF\0", "a VDSH distance volume (vdsh-bake --sdf; vdsh-view --sdf reads it)"),
@@ -252,7 +256,8 @@ def _chunk(f, cid, b, path):
             _fail(path, "HEAD: a count or sampling out of range")
         if not (_finite(maxd) and maxd > 0 and _finite(maxe) and maxe >= 0):
             _fail(path, "HEAD: max_distance or max_edge out of range")
-        if rule > 1 or lflags & ~1 or tflags & ~1:
+        # load_flags: bit 0 welded, bits 1..3 the up axis (UP_AXES)
+        if rule > 1 or lflags & ~15 or lflags >> 1 >= len(UP_AXES) or tflags & ~1:
             _fail(path, "HEAD: offset_rule or flags out of range")
         if not _finite(*bmin, *bmax) or any(a > c for a, c in zip(bmin, bmax)):
             _fail(path, "HEAD: bounds not finite or min > max")

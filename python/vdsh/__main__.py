@@ -11,7 +11,7 @@ from typing import Any, Dict, List, Optional
 
 import numpy as np
 
-from . import VdshError, VdshFile, __version__, coefficients, read
+from . import UP_AXES, VdshError, VdshFile, __version__, coefficients, read
 
 PROG = "python -m vdsh"
 USAGE = """usage: %s info [--json OUT.json] FILE.vdsh...
@@ -97,7 +97,8 @@ def summary(f: VdshFile, path: str) -> Dict[str, Any]:
         bake=dict(rays=h["rays"], sampling=h["sampling"], seed=h["seed"],
                   max_distance=float(h["max_distance"]), max_edge=float(h["max_edge"]),
                   offset_rule=["none", "wb-avg"][h["offset_rule"]], load_flags=h["load_flags"],
-                  welded=bool(h["load_flags"] & 1), trace_flags=h["trace_flags"],
+                  welded=bool(h["load_flags"] & 1),
+                  up_axis=UP_AXES[h["load_flags"] >> 1], trace_flags=h["trace_flags"],
                   robust=bool(h["trace_flags"] & 1), cube_size=h["cube_size"],
                   occluder_vertex_count=h["occluder_vertex_count"],
                   occluder_triangle_count=h["occluder_triangle_count"],
