@@ -123,6 +123,8 @@ figs = []
 for name in ("y.vdsh", "upz.vdsh"):
     must([ev, path(name)] + EVAL + ["--json", path(name + ".json")])
     e = json.load(open(path(name + ".json")))
+    if e["bake"].get("up_axis") != ("y" if name == "y.vdsh" else "z"):
+        fail.append("vdsh-eval --json %s: up_axis %r" % (name, e["bake"].get("up_axis")))
     figs.append([(s["order"], s["scene_lights"]["interior"]["shadow_mae"],
                   s["scene_lights"]["interior"]["false_shadow"]) for s in e["streams"]] +
                 [e["eval"]["scene_light_positions"]])
