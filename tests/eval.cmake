@@ -89,22 +89,24 @@ assert ys and min(ys) >= lo + 0.8 * (hi - lo) - 1e-4 * (hi - lo), (lo, hi, min(y
 # grown: in the bounds grown by a quarter of the diagonal, but not beyond
 # a side a one-sided surface closes: the room's inward shell closes all
 # six, so its grown lights stay in the bounds (9 of 32 stood outside its
-# walls, lighting nothing in it); around: in them grown by a diagonal,
-# outside the bounds; shell: grown by a quarter, outside the bounds
-# (vdsh-bake --decision-shell)
-for rule, share in (('grown', 0.25), ('around', 1.0), ('shell', 0.25)):
-    subprocess.run([ev, f, '-q', '--interior', '0', '--points', '300', '--light-rule', rule,
-                    '--json', f + '.g.json'], check=True, stdout=subprocess.DEVNULL)
-    j = json.load(open(f + '.g.json'))
-    assert j['eval']['scene_light_rule'] == rule, j['eval']
-    blo, bhi = j['scene']['bounds_min'], j['scene']['bounds_max']
-    g = share * sum((b - a) ** 2 for a, b in zip(blo, bhi)) ** 0.5
-    ps = j['eval']['scene_light_positions']
-    assert len(ps) == 32
-    for p in ps:
-        assert all(blo[k] - g <= p[k] <= bhi[k] + g for k in range(3)), (rule, p)
-        inside = all(blo[k] <= p[k] <= bhi[k] for k in range(3))
-        assert inside if rule == 'grown' else not inside, (rule, p)
+# walls, lighting nothing in it); around and shell (outside the bounds,
+# grown by a diagonal and a quarter) stop at the same closed sides, so a
+# closed room has no room for them: said, exit 1
+subprocess.run([ev, f, '-q', '--interior', '0', '--points', '300', '--light-rule', 'grown',
+                '--json', f + '.g.json'], check=True, stdout=subprocess.DEVNULL)
+j = json.load(open(f + '.g.json'))
+assert j['eval']['scene_light_rule'] == 'grown', j['eval']
+blo, bhi = j['scene']['bounds_min'], j['scene']['bounds_max']
+ps = j['eval']['scene_light_positions']
+assert len(ps) == 32
+for p in ps:
+    assert all(blo[k] <= p[k] <= bhi[k] for k in range(3)), p
+for rule in ('around', 'shell'):
+    r = subprocess.run([ev, f, '-q', '--interior', '0', '--points', '300', '--light-rule', rule,
+                        '--json', f + '.s.json'], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                       text=True)
+    assert r.returncode == 1 and 'no room for' in r.stderr and rule in r.stderr, (rule, r)
+    assert not os.path.exists(f + '.s.json'), rule
 print('ok')"
              $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-eval>)
   endif()
