@@ -219,7 +219,9 @@ add_test(NAME bake_cpca_lightmix
 # bakes, truth and light pools named by what made them (mesh and its
 # bytes, edge, method, --rays; the view set's bytes; --light-pool,
 # --light-seed), not by scene and fit alone: a rerun with other settings
-# reused the first run's bakes.
+# reused the first run's bakes. The streams' frame scores named by the
+# view set too; --views-dir DIR (DIR/NAME.views.json) in --help, a
+# missing folder or view set refused before any bake.
 add_test(NAME scripts_cpca_study_cache
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_cpca_study_cache.py
                  ${PROJECT_SOURCE_DIR}/scripts ${CMAKE_CURRENT_BINARY_DIR}/scripts_cpca_study_cache)

@@ -6,17 +6,22 @@ rerun with another --rays, edge or mesh scored the first run's bakes).
 cache_paths, the names scene() uses: the same settings give the same
 names (a rerun reuses them); another --rays, edge, method, mesh file
 content or built-in scene gives other bakes (and truth); another view
-set's bytes another truth (the same bakes); another --light-pool or
+set's bytes another truth (the same bakes) and other score names for
+the order-5 and compressed streams' frames; another --light-pool or
 --light-seed or mesh another light pool (the same bakes); a rebuilt
 vdsh-bake that writes other bytes other bakes (and truth), a rebuilt
 vdsh-frames another truth, a rebuilt light_pool_tool another pool (the
 key held none of the tools: a rebuilt baker's run scored the old one's
-bakes); a tool rebuilt to the same bytes the same names.
+bakes); a tool rebuilt to the same bytes the same names. --views-dir
+DIR: scene NAME's view set is DIR/NAME.views.json; --help names the
+option, and a folder or view set that is not there is refused, named,
+before anything is baked.
 
 Usage: test_cpca_study_cache.py SCRIPTS_DIR WORK_DIR
 """
 import argparse
 import os
+import subprocess
 import sys
 
 from testlib import load_script
@@ -57,7 +62,8 @@ def paths(rays=625, pool=2048, seed=1, m=mesh, edge="0.25", method="decision"):
     a = argparse.Namespace(work=work, build=build, rays=rays, light_pool=pool, light_seed=seed)
     p = cs.cache_paths(a, "s", m, edge, method, views)
     return dict(ref=p["ref"], o5=p["o5"], truth=p["truth"], pool=p["pool"](False),
-                box=p["pool"](True))
+                box=p["pool"](True), o5_frames=p["frames"](p["o5"]),
+                cpca_frames=p["frames"](p["ref"] + ".cpca"))
 
 
 base = paths()
@@ -77,7 +83,8 @@ for what, other in (("--light-pool 512", paths(pool=512)), ("--light-seed 2", pa
 
 # The tools that made them: a rebuilt tool with other bytes (the same
 # bytes again, e.g. a relink: the same names).
-for which, changes in (("bake", ("ref", "o5", "truth")), ("frames", ("truth",)),
+frames = ("o5_frames", "cpca_frames")  # the streams' scores: named by the bake and the truth
+for which, changes in (("bake", ("ref", "o5", "truth") + frames), ("frames", ("truth",) + frames),
                        ("pool", ("pool", "box"))):
     tool(which, "#!/bin/sh\n# %s 2\n" % which)
     other = paths()
@@ -90,8 +97,25 @@ for which, changes in (("bake", ("ref", "o5", "truth")), ("frames", ("truth",)),
 # The files' bytes, not their names: an edited mesh or view set.
 open(views, "w").write('{"width": 64, "height": 48, "views": [], "note": 1}\n')
 v2 = paths()
-check(v2["truth"] != base["truth"] and v2["ref"] == base["ref"], "another view set: another truth only")
+check(v2["truth"] != base["truth"] and v2["ref"] == base["ref"], "another view set: another truth")
+check(v2["o5_frames"] != base["o5_frames"] and v2["cpca_frames"] != base["cpca_frames"],
+      "another view set: other frames and scores of the streams (not over the first set's)")
 open(mesh, "w").write("v 0 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\n")
 m2 = paths()
 check(m2["ref"] != base["ref"] and m2["pool"] != base["pool"], "an edited mesh: other bakes and pool")
+
+# --views-dir: DIR/NAME.views.json; refused when not there, before any bake.
+check(cs.views_path("/some/dir", "val-x") == "/some/dir/val-x.views.json", "views_path: DIR/NAME.views.json")
+script = os.path.join(scripts, "cpca_study")
+r = subprocess.run([sys.executable, script, "--help"], capture_output=True, text=True)
+check(r.returncode == 0 and "--views-dir" in r.stdout, "--help names --views-dir")
+run_work = os.path.join(work, "run")
+for vdir, want in ((os.path.join(work, "nowhere"), "--views-dir %s: no such folder" % os.path.join(work, "nowhere")),
+                   (work, "no view set %s" % os.path.join(work, "s.views.json"))):
+    r = subprocess.run([sys.executable, script, "--work", run_work, "--views-dir", vdir,
+                        "--build", os.path.join(work, "nobuild"), "--scenes", "s=%s:0.25" % mesh,
+                        "--methods", "decision", "--settings", "1.8.8"], capture_output=True, text=True)
+    check(r.returncode != 0 and want in r.stderr,
+          "--views-dir %s: refused naming %s (%s)" % (vdir, want, r.stderr.strip()[:200]))
+    check(not os.path.isdir(run_work) or not os.listdir(run_work), "--views-dir %s: nothing baked" % vdir)
 sys.exit(fail)
