@@ -56,7 +56,8 @@ rm -rf "$d"; mkdir -p "$d"
 "$bake" builtin:room:3 --max-edge 1.5 --rays 16 --orders 2 --cube-size 0 -q -o "$d/s.vdsh" || exit 1
 [[ -e $d/s.sdf ]] || { echo "FAIL: no s.sdf left by the first bake"; exit 1; }
 "$frames" views "$d/s.vdsh" -q --cameras 1 --size 32x24 -o "$d/v.json" || exit 1
-msg=$("$frames" truth "$d/s.vdsh" --views "$d/v.json" -o "$d/f0" -q 2>&1); rc=$?
+# the note is said without -q (with -q only errors: tools_cli)
+msg=$("$frames" truth "$d/s.vdsh" --views "$d/v.json" -o "$d/f0" 2>&1); rc=$?
 [[ $rc -eq 0 && $msg == *s.sdf*"another bake"* && -e $d/f0/default-s0-l0-c-vdsh2.png && ! -e $d/f0/default-s0-l0-c-sdf.png ]] ||
   { echo "FAIL: stale companion: exit $rc, $msg; $(ls "$d/f0" 2>/dev/null | grep -c sdf) c-sdf frames"; exit 1; }
 msg=$("$frames" truth "$d/s.vdsh" --views "$d/v.json" -o "$d/f1" --sdf "$d/s.sdf" -q 2>&1); rc=$?
