@@ -108,6 +108,10 @@ typedef enum vdsh_sampling { VDSH_SAMPLING_SPHERE = 0, VDSH_SAMPLING_HEMISPHERE 
 typedef enum vdsh_offset_rule { VDSH_OFFSET_NONE = 0, VDSH_OFFSET_WB_AVG = 1 } vdsh_offset_rule;
 
 enum { VDSH_LOAD_WELD = 1u };
+/* load_flags bits 8..15: the crease angle of the computed normals, whole
+ * degrees 1..179 (vb_load_desc.crease); 0: none */
+enum { VDSH_LOAD_CREASE_SHIFT = 8, VDSH_LOAD_CREASE_MASK = 0xffu << 8 };
+#define VDSH_LOAD_CREASE(flags) (((flags)&VDSH_LOAD_CREASE_MASK) >> VDSH_LOAD_CREASE_SHIFT)
 enum { VDSH_TRACE_ROBUST = 1u };
 
 typedef enum vdsh_encoding {

@@ -226,6 +226,9 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
            or_unknown(vdsh_offset_rule_name(h->offset_rule)),
            (h->load_flags & VDSH_LOAD_WELD) ? "yes" : "no",
            (h->trace_flags & VDSH_TRACE_ROBUST) ? "yes" : "no");
+    if (VDSH_LOAD_CREASE(h->load_flags))
+        printf("               crease %u degrees (computed normals split at sharper edges)\n",
+               VDSH_LOAD_CREASE(h->load_flags));
     if (h->cube_size)
         printf("               basis cubemaps %u x %u per face\n", h->cube_size, h->cube_size);
     else
@@ -399,6 +402,8 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
     vt_record_params(&j, bake, h);
     vt_json_u64(&j, bake, "load_flags", h->load_flags);
     vt_json_bool(&j, bake, "welded", h->load_flags & VDSH_LOAD_WELD);
+    if (VDSH_LOAD_CREASE(h->load_flags))
+        vt_json_u64(&j, bake, "crease", VDSH_LOAD_CREASE(h->load_flags));
     vt_json_u64(&j, bake, "trace_flags", h->trace_flags);
     vt_json_bool(&j, bake, "robust", h->trace_flags & VDSH_TRACE_ROBUST);
     vt_json_u64(&j, bake, "cube_size", h->cube_size);

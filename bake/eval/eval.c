@@ -1243,7 +1243,8 @@ vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths, uin
     if (count == 0)
         return vb_fail(err, VB_ERR_INVALID,
                        "the file records no source meshes: give the bake's meshes");
-    vb_load_desc ld = {.weld = (f->header.load_flags & VDSH_LOAD_WELD) != 0};
+    vb_load_desc ld = {.weld = (f->header.load_flags & VDSH_LOAD_WELD) != 0,
+                       .crease = (int)VDSH_LOAD_CREASE(f->header.load_flags)};
     vb_mesh occ = {0};
     vb_result r = VB_OK;
     for (uint32_t i = 0; i < count; i++) {

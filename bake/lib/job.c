@@ -58,7 +58,7 @@ vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err)
     j->basis_size = cube_size;
     j->basis_running = cube_size > 0 && d->output && !d->bake.trace_only && !d->shard_count &&
                        pthread_create(&j->basis_thread, NULL, encode_basis, j) == 0;
-    vb_load_desc ld = {.weld = d->weld};
+    vb_load_desc ld = {.weld = d->weld, .crease = d->crease > 0 && d->crease < 180 ? d->crease : 0};
     for (uint32_t i = 0; i < d->path_count; i++) {
         const char *path = d->paths[i];
         vb_mesh m = {0};
@@ -376,7 +376,9 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         f.has_light_box = 1;
         f.light_box = j->light_region;
     }
-    h->load_flags = d->weld ? VDSH_LOAD_WELD : 0;
+    h->load_flags =
+        (d->weld ? VDSH_LOAD_WELD : 0) |
+        (d->crease > 0 && d->crease < 180 ? (uint32_t)d->crease << VDSH_LOAD_CREASE_SHIFT : 0);
     h->cube_size = (uint32_t)vb_job_cube_size(d);
     h->occluder_vertex_count = j->occluders.vertex_count;
     h->occluder_triangle_count = j->occluders.triangle_count;

@@ -61,6 +61,7 @@ typedef struct vb_job_desc {
     const char *output;       /* the .vdsh file; NULL: none (vb_job_write refuses) */
     const char *cubemap_dir;  /* NULL: beside output */
     int weld;                 /* vb_load_desc.weld */
+    int crease;               /* vb_load_desc.crease: 0 or 180+ = off */
     /* receivers refined to it; 0: the vertices as they are. With adaptive:
      * where the refinement starts */
     float max_edge;

@@ -136,6 +136,16 @@ typedef struct vb_load_desc {
     /* glTF: 0 (default) = the file's default scene (or its first); N + 1 =
      * scene N */
     int gltf_scene;
+    /* Crease angle for computed normals, in whole degrees: 0 (default) or
+     * 180 and above = off. When the normals are computed (the file gives
+     * none for some used vertex, or weld recomputed them), a vertex whose
+     * triangles meet at an edge through it with face normals more than this
+     * many degrees apart is split: one vertex per smooth fan (triangles
+     * joined across its edges whose face normals are at most this far
+     * apart), each with the normal of its own fan's triangles (so a cube's
+     * 8 shared corners become 24 vertices with face normals at 60 degrees,
+     * a sphere stays smooth). File normals are never changed. */
+    int crease;
 } vb_load_desc;
 
 /* What loading found in a file and did about it, as counts (all zero for
@@ -170,6 +180,13 @@ typedef struct vb_mesh_report {
      * (two-sided triangles): given their largest triangle's normal */
     uint32_t cancelled_normals;
     uint32_t welded; /* vertices merged by weld */
+    /* 1 when the normals were computed from the faces (no file normals, or
+     * weld), so vb_load_desc.crease applies */
+    uint32_t normals_computed;
+    /* vb_load_desc.crease: vertices split at creases of the computed
+     * normals, and the vertices those splits added */
+    uint32_t crease_vertices;
+    uint32_t crease_added;
     /* loaded vertices left (0,0,0) at the end: their triangles have no area
      * (those with a zero file normal included) */
     uint32_t undefined_normals;

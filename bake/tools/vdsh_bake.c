@@ -77,6 +77,7 @@ typedef struct options {
     uint32_t max_receivers; /* --max-receivers; 0: none */
     uint32_t max_rounds;    /* --max-rounds; 0: none given (VB_ADAPTIVE_ROUNDS) */
     int weld;
+    int crease; /* --crease DEG; 0: off */
     uint64_t seed;
     uint32_t threads;
     int cube_size;
@@ -324,6 +325,11 @@ static void usage(FILE *f)
             "      --receivers FILE    bake these receivers (a mesh file, e.g. a plan)\n"
             "                          as they are, instead of the scene's vertices\n"
             "      --weld              merge vertices with identical positions\n"
+            "      --crease DEG        computed normals (a mesh without normals, or\n"
+            "                          --weld): split vertices where faces meet at more\n"
+            "                          than DEG degrees, each side its own normal\n"
+            "                          (0..180; default 0 = off, 180 = off); file\n"
+            "                          normals are kept as they are\n"
             "      --keep-normals      keep normals that point into geometry (default:\n"
             "                          a receiver blocked at ~0 on its own side and open\n"
             "                          on the other gets its normal flipped)\n"
@@ -756,6 +762,7 @@ enum {
     O_MAXDIST,
     O_MAXEDGE,
     O_WELD,
+    O_CREASE,
     O_SEED,
     O_THREADS,
     O_CUBESIZE,
@@ -866,6 +873,7 @@ static int read_value(int c, const char *arg, options *o)
     case O_MAX_ROUNDS: ok = vt_opt_u32("--max-rounds", NULL, arg, 1, 1000, &o->max_rounds); break;
     case O_SEED: ok = vt_opt_u64("--seed", NULL, arg, 0, UINT64_MAX, &o->seed); break;
     case O_THREADS: ok = vt_opt_u32("--threads", NULL, arg, 1, 256, &o->threads); break;
+    case O_CREASE: ok = vt_opt_int("--crease", NULL, arg, 0, 180, &o->crease); break;
     case O_CUBESIZE: ok = vt_opt_int("--cube-size", NULL, arg, 0, 4096, &o->cube_size); break;
     case O_SDF:
         ok = vt_opt_int("--sdf", NULL, arg, VB_SDF_MIN_RESOLUTION, VB_SDF_MAX_RESOLUTION, &o->sdf);
@@ -1032,6 +1040,8 @@ static int check_options(options *o)
     if (o->receivers && (o->adaptive || o->max_edge > 0.0f || o->weld))
         return bad_usage("%s", "--receivers takes the receivers as they are: not with "
                                "--adaptive, --max-edge or --weld");
+    if (o->crease >= 180)
+        o->crease = 0; /* 180: no crease is sharper */
     if (o->mesh_count < 1)
         return bad_usage("%s", "no mesh given");
     if (o->mesh_count > VDSH_MAX_SOURCES)
@@ -1115,6 +1125,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"max-distance", required_argument, 0, O_MAXDIST},
         {"max-edge", required_argument, 0, O_MAXEDGE},
         {"weld", no_argument, 0, O_WELD},
+        {"crease", required_argument, 0, O_CREASE},
         {"seed", required_argument, 0, O_SEED},
         {"threads", required_argument, 0, O_THREADS},
         {"cube-size", required_argument, 0, O_CUBESIZE},
@@ -1268,6 +1279,7 @@ static vb_job_desc job_desc(const options *o, FILE *log, progress *pr, float *of
         .output = o->trace_only ? NULL : o->output,
         .cubemap_dir = o->cubemap_dir,
         .weld = o->weld,
+        .crease = o->crease,
         .max_edge = o->max_edge,
         .fast_traversal = !o->robust,
         .light_region = o->light_region,

@@ -470,6 +470,8 @@ static int write_json(const char *out, const context *c, char *msg, size_t cap)
     cJSON *bake = vt_json_object(&j, root, "bake");
     vt_record_params(&j, bake, h);
     vt_json_bool(&j, bake, "welded", h->load_flags & VDSH_LOAD_WELD);
+    if (VDSH_LOAD_CREASE(h->load_flags))
+        vt_json_u64(&j, bake, "crease", VDSH_LOAD_CREASE(h->load_flags));
     vt_json_bool(&j, bake, "robust", h->trace_flags & VDSH_TRACE_ROBUST);
     vt_json_u64(&j, bake, "cube_size", h->cube_size);
     vt_record_stats(&j, bake, f, 0);

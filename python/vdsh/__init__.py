@@ -232,7 +232,7 @@ def _chunk(f, cid, b, path):
             _fail(path, "HEAD: a count or sampling out of range")
         if not (_finite(maxd) and maxd > 0 and _finite(maxe) and maxe >= 0):
             _fail(path, "HEAD: max_distance or max_edge out of range")
-        if rule > 1 or lflags & ~1 or tflags & ~1:
+        if rule > 1 or lflags & ~0xff01 or (lflags >> 8) & 0xff >= 180 or tflags & ~1:
             _fail(path, "HEAD: offset_rule or flags out of range")
         if not _finite(*bmin, *bmax) or any(a > c for a, c in zip(bmin, bmax)):
             _fail(path, "HEAD: bounds not finite or min > max")
