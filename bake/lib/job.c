@@ -75,6 +75,7 @@ vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err)
         j->sources[i].size = info.size;
         memcpy(j->sources[i].sha256, info.sha256, 32);
         j->source_count = i + 1;
+        j->creased |= info.report.crease_vertices > 0;
         if (d->on_mesh)
             d->on_mesh(d->user, path, &m, &info, vb_now() - t);
         vb_mesh_free(&m);
@@ -376,9 +377,8 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         f.has_light_box = 1;
         f.light_box = j->light_region;
     }
-    h->load_flags =
-        (d->weld ? VDSH_LOAD_WELD : 0) |
-        (d->crease > 0 && d->crease < 180 ? (uint32_t)d->crease << VDSH_LOAD_CREASE_SHIFT : 0);
+    h->load_flags = (d->weld ? VDSH_LOAD_WELD : 0) |
+                    (j->creased ? (uint32_t)d->crease << VDSH_LOAD_CREASE_SHIFT : 0);
     h->cube_size = (uint32_t)vb_job_cube_size(d);
     h->occluder_vertex_count = j->occluders.vertex_count;
     h->occluder_triangle_count = j->occluders.triangle_count;

@@ -131,6 +131,10 @@ typedef struct vb_job {
     double pool_seconds;
     vb_adaptive_stats adaptive;  /* with d->adaptive */
     vdsh_light_box light_region; /* the desc's, its box filled in (rule 0: none) */
+    /* 1 when the crease angle split a vertex of some source: only then is it
+     * recorded (HEAD load_flags), so that bakes it left alone keep their
+     * bytes */
+    int creased;
     double t_start;
     /* The basis cubemaps' helper thread. */
     pthread_t basis_thread;

@@ -40,7 +40,8 @@
  * faces all have zero area). Vertex normals come from the file when it has
  * them for every vertex (a zero one is replaced by the computed normal of
  * the vertex's own triangles), else are computed (angle-weighted face
- * normals over the vertex's own faces, so unwelded hard edges stay hard).
+ * normals over the vertex's own faces, so unwelded hard edges stay hard;
+ * with vb_load_desc.crease, shared vertices split at sharp edges too).
  * Triangles with a repeated index are dropped (they have no area and no
  * effect on rays); zero-area triangles with distinct indices are kept.
  * Duplicate triangles are dropped: one with the same three positions as

@@ -328,8 +328,8 @@ static void usage(FILE *f)
             "      --crease DEG        computed normals (a mesh without normals, or\n"
             "                          --weld): split vertices where faces meet at more\n"
             "                          than DEG degrees, each side its own normal\n"
-            "                          (0..180; default 0 = off, 180 = off); file\n"
-            "                          normals are kept as they are\n"
+            "                          (0..180, default %d; 0 or 180: off, smooth\n"
+            "                          across every edge); file normals are kept\n"
             "      --keep-normals      keep normals that point into geometry (default:\n"
             "                          a receiver blocked at ~0 on its own side and open\n"
             "                          on the other gets its normal flipped)\n"
@@ -355,7 +355,7 @@ static void usage(FILE *f)
             methods_help(), (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
             (double)vb_shadow_log_offset(3), (double)vb_shadow_log_offset(5),
             (double)VB_DEFAULT_FALSE_RATE, VB_DECISION_MAX_PAIRS, VB_DEFAULT_DECISION_LIGHTS,
-            VB_DEFAULT_DECISION_NEAR, VB_ADAPTIVE_ROUNDS, VB_DEFAULT_SEED);
+            VB_DEFAULT_DECISION_NEAR, VB_ADAPTIVE_ROUNDS, VB_DEFAULT_CREASE, VB_DEFAULT_SEED);
 }
 
 static int bad_usage(const char *fmt, const char *arg)
@@ -1111,6 +1111,7 @@ static int parse_args(int argc, char **argv, options *o)
     o->seed = VB_DEFAULT_SEED;
     o->robust = 1;
     o->cube_size = VB_DEFAULT_CUBE_SIZE;
+    o->crease = VB_DEFAULT_CREASE;
 
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
