@@ -115,6 +115,10 @@ enum { VDSH_LOAD_WELD = 1u, VDSH_LOAD_UP_SHIFT = 1, VDSH_LOAD_UP_MASK = 7u << 1,
 
 /* "y", "z", "-z", "x", "-x", "-y" for up axis code 0..5; NULL otherwise. */
 const char *vdsh_up_axis_name(uint32_t code);
+/* load_flags bits 8..15: the crease angle of the computed normals, whole
+ * degrees 1..179 (vb_load_desc.crease); 0: none */
+enum { VDSH_LOAD_CREASE_SHIFT = 8, VDSH_LOAD_CREASE_MASK = 0xffu << 8 };
+#define VDSH_LOAD_CREASE(flags) (((flags)&VDSH_LOAD_CREASE_MASK) >> VDSH_LOAD_CREASE_SHIFT)
 enum { VDSH_TRACE_ROBUST = 1u };
 
 typedef enum vdsh_encoding {

@@ -35,12 +35,15 @@ int vdsh_check_header(const vdsh_header *h, why *w)
         return vdsh_bad(w, "HEAD: max_edge %g must be finite and >= 0", (double)h->max_edge);
     if (h->offset_rule > VDSH_OFFSET_WB_AVG)
         return vdsh_bad(w, "HEAD: offset_rule %u unknown (0 none, 1 wb-avg)", h->offset_rule);
-    if (h->load_flags & ~(uint32_t)(VDSH_LOAD_WELD | VDSH_LOAD_UP_MASK))
+    if (h->load_flags & ~(uint32_t)(VDSH_LOAD_WELD | VDSH_LOAD_UP_MASK | VDSH_LOAD_CREASE_MASK))
         return vdsh_bad(w, "HEAD: load_flags 0x%x has unknown bits", h->load_flags);
     if ((h->load_flags & VDSH_LOAD_UP_MASK) >> VDSH_LOAD_UP_SHIFT >= VDSH_UP_AXES)
         return vdsh_bad(w, "HEAD: load_flags 0x%x: up axis %u unknown (0..%d)", h->load_flags,
                         (h->load_flags & VDSH_LOAD_UP_MASK) >> VDSH_LOAD_UP_SHIFT,
                         VDSH_UP_AXES - 1);
+    if (VDSH_LOAD_CREASE(h->load_flags) >= 180)
+        return vdsh_bad(w, "HEAD: load_flags 0x%x: crease angle %u degrees (1..179, or 0)",
+                        h->load_flags, VDSH_LOAD_CREASE(h->load_flags));
     if (h->trace_flags & ~(uint32_t)VDSH_TRACE_ROBUST)
         return vdsh_bad(w, "HEAD: trace_flags 0x%x has unknown bits", h->trace_flags);
     for (int k = 0; k < 3; k++) {

@@ -337,4 +337,26 @@ check "shell: no file written on no room" test ! -e "$tmp/sr.vdsh"
 check "shell: no report written on no room" test ! -e "$tmp/sr.json"
 expect_exit 0 "shell: the same room without the shell bakes" "$bake" "${room[@]}" -o "$tmp/sr0.vdsh"
 
+# --crease (default 60): a cube without normals splits into 24 vertices
+# (face normals) and the file records the angle, which vdsh-info shows;
+# --crease 0 keeps the 8 smooth corners and records nothing, as does a
+# mesh the angle splits nowhere (a corner tetrahedron's face normals meet
+# at 90 and 125.3 degrees: split at 60, not at 130): its file is the
+# --crease 0 one byte for byte.
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n' >"$tmp/crease_cube.obj"
+cube=("$tmp/crease_cube.obj" --rays 16 --cube-size 0 -q)
+expect_exit 0 "crease: default bake of a cube" "$bake" "${cube[@]}" -o "$tmp/c60.vdsh"
+expect_exit 0 "crease: --crease 0" "$bake" "${cube[@]}" --crease 0 -o "$tmp/c0.vdsh"
+"$info" --json - "$tmp/c60.vdsh" >"$tmp/c60.json" 2>/dev/null
+"$info" --json - "$tmp/c0.vdsh" >"$tmp/c0.json" 2>/dev/null
+check "crease: 24 receivers at the default" json "$tmp/c60.json" "d['vertex_count'] == 24 and d['bake']['occluder_vertex_count'] == 24 and d['bake']['crease'] == 60"
+check "crease: 8 receivers and no crease recorded at 0" json "$tmp/c0.json" "d['vertex_count'] == 8 and 'crease' not in d['bake']"
+expect_exit 0 "crease: --crease 180" "$bake" "${cube[@]}" --crease 180 -o "$tmp/c180.vdsh"
+check "crease: 180 is off" cmp -s "$tmp/c0.vdsh" "$tmp/c180.vdsh"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n' >"$tmp/tet.obj"
+expect_exit 0 "crease: tetrahedron at 130" "$bake" "$tmp/tet.obj" --rays 16 --cube-size 0 -q --crease 130 -o "$tmp/t130.vdsh"
+expect_exit 0 "crease: tetrahedron off" "$bake" "$tmp/tet.obj" --rays 16 --cube-size 0 -q --crease 0 -o "$tmp/t0.vdsh"
+check "crease: an angle that splits nothing is not recorded" cmp -s "$tmp/t0.vdsh" "$tmp/t130.vdsh"
+expect_exit 2 "crease: out of range" "$bake" "${cube[@]}" --crease 181 -o "$tmp/cbad.vdsh"
+
 exit $fail

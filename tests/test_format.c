@@ -306,7 +306,7 @@ static void sample_init(sample *s, int kind, uint32_t v)
     h->max_distance = 15.0f;
     h->max_edge = 0.2f;
     h->offset_rule = VDSH_OFFSET_WB_AVG;
-    h->load_flags = VDSH_LOAD_WELD;
+    h->load_flags = VDSH_LOAD_WELD | 60u << VDSH_LOAD_CREASE_SHIFT;
     h->cube_size = 64;
     h->occluder_vertex_count = 1200;
     h->occluder_triangle_count = 2400;
@@ -1935,6 +1935,8 @@ static void test_writer_checks(void)
     REJECT("offset_rule", s_.f.header.offset_rule = 9);
     REJECT("load_flags", s_.f.header.load_flags = 16);
     REJECT("up axis 7", s_.f.header.load_flags = 7u << 1);
+    REJECT("crease angle 180", s_.f.header.load_flags = 180u << VDSH_LOAD_CREASE_SHIFT);
+    REJECT("unknown bits", s_.f.header.load_flags = 1u << 16);
     REJECT("trace_flags", s_.f.header.trace_flags = 3);
     REJECT("bounds", s_.f.header.bounds_min[2] = INFINITY);
     REJECT("bounds_min[1]", s_.f.header.bounds_min[1] = 7);

@@ -1165,6 +1165,136 @@ static const char report_ply[] =
     "3 0 0 0 0 0\n4 0 0 0 0 0\n5 0 0 0 0 0\n"
     "3 0 1 2\n3 1 3 2\n3 1 1 2\n3 6 6 6\n3 7 8 9\n";
 
+/* vb_load_desc.crease: computed normals split where faces meet at more
+ * than the crease angle; smooth meshes and file normals stay as they
+ * are. */
+static void test_crease(void)
+{
+    static const char cube[] = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                               "v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                               "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\n"
+                               "f 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+    char *p = text_fixture("crease_cube.obj", cube);
+    vb_error err;
+    vb_source_info info;
+    vb_mesh plain = {0}, m = {0};
+    CHECK(vb_mesh_load(p, NULL, &plain, &info, &err) == VB_OK, "%s: %s", p, err.msg);
+    CHECK(plain.vertex_count == 8 && info.report.crease_vertices == 0,
+          "cube without crease: %u vertices, %u split (want 8, 0)", plain.vertex_count,
+          info.report.crease_vertices);
+    /* 60 degrees: every corner splits into its 3 faces, each vertex with
+     * its face's normal exactly */
+    for (int weld = 0; weld < 2; weld++) {
+        vb_load_desc d = {.weld = weld, .crease = 60};
+        CHECK(vb_mesh_load(p, &d, &m, &info, &err) == VB_OK, "%s: %s", p, err.msg);
+        CHECK(m.vertex_count == 24 && m.triangle_count == 12 && info.report.crease_vertices == 8 &&
+                  info.report.crease_added == 16,
+              "cube at 60 degrees (weld %d): %u vertices, %u triangles, %u split, %u added "
+              "(want 24, 12, 8, 16)",
+              weld, m.vertex_count, m.triangle_count, info.report.crease_vertices,
+              info.report.crease_added);
+        check_clean(&m, "crease cube");
+        uint32_t off = 0;
+        for (uint32_t t = 0; t < m.triangle_count; t++) {
+            const uint32_t *tri = m.indices + 3 * (size_t)t;
+            const float *a = m.positions + 3 * (size_t)tri[0],
+                        *b = m.positions + 3 * (size_t)tri[1],
+                        *c = m.positions + 3 * (size_t)tri[2];
+            float u[3], v[3], fnrm[3];
+            for (int k = 0; k < 3; k++)
+                u[k] = b[k] - a[k], v[k] = c[k] - a[k];
+            fnrm[0] = u[1] * v[2] - u[2] * v[1];
+            fnrm[1] = u[2] * v[0] - u[0] * v[2];
+            fnrm[2] = u[0] * v[1] - u[1] * v[0];
+            for (int k = 0; k < 3; k++)
+                fnrm[k] = fnrm[k] > 0.0f ? 1.0f : fnrm[k] < 0.0f ? -1.0f : 0.0f;
+            for (int c2 = 0; c2 < 3; c2++)
+                off += memcmp(m.normals + 3 * (size_t)tri[c2], fnrm, sizeof fnrm) != 0;
+        }
+        CHECK(off == 0, "cube at 60 degrees: %u corners without their face's normal", off);
+        vb_mesh_free(&m);
+    }
+    /* 180 (off) and 0: as without */
+    for (int deg = 0; deg <= 180; deg += 180) {
+        vb_load_desc d = {.crease = deg};
+        CHECK(vb_mesh_load(p, &d, &m, &info, &err) == VB_OK, "%s: %s", p, err.msg);
+        CHECK(m.vertex_count == 8 && memcmp(m.normals, plain.normals, 3 * sizeof(float) * 8) == 0 &&
+                  memcmp(m.indices, plain.indices, 3 * sizeof(uint32_t) * 12) == 0,
+              "cube at %d degrees: not the mesh without crease", deg);
+        vb_mesh_free(&m);
+    }
+    vb_mesh_free(&plain);
+    free(p);
+
+    /* File normals are kept: the same cube with one normal per vertex
+     * (pointing out of the corner) loads the same at 60 degrees. */
+    {
+        char text[1024];
+        size_t len = strlen(cube) - strlen(strstr(cube, "f "));
+        memcpy(text, cube, len);
+        text[len] = '\0';
+        for (int i = 0; i < 8; i++)
+            len += (size_t)snprintf(text + len, sizeof text - len, "vn %d %d %d\n",
+                                    i == 1 || i == 2 || i == 5 || i == 6 ? 1 : -1,
+                                    i == 2 || i == 3 || i == 6 || i == 7 ? 1 : -1, i >= 4 ? 1 : -1);
+        len += (size_t)snprintf(text + len, sizeof text - len,
+                                "f 1//1 4//4 3//3 2//2\nf 5//5 6//6 7//7 8//8\n"
+                                "f 1//1 2//2 6//6 5//5\nf 2//2 3//3 7//7 6//6\n"
+                                "f 3//3 4//4 8//8 7//7\nf 4//4 1//1 5//5 8//8\n");
+        char *q = text_fixture("crease_cube_vn.obj", text);
+        vb_mesh a = {0}, b = {0};
+        vb_load_desc d = {.crease = 60};
+        CHECK(vb_mesh_load(q, NULL, &a, NULL, &err) == VB_OK, "%s: %s", q, err.msg);
+        CHECK(vb_mesh_load(q, &d, &b, &info, &err) == VB_OK, "%s: %s", q, err.msg);
+        CHECK(a.vertex_count == 8 && b.vertex_count == 8 && info.report.crease_vertices == 0 &&
+                  info.report.normals_computed == 0 &&
+                  memcmp(a.normals, b.normals, 3 * sizeof(float) * 8) == 0 &&
+                  memcmp(a.indices, b.indices, 3 * sizeof(uint32_t) * 12) == 0,
+              "cube with file normals: changed by the crease (%u, %u vertices)", a.vertex_count,
+              b.vertex_count);
+        vb_mesh_free(&a);
+        vb_mesh_free(&b);
+        free(q);
+    }
+
+    /* A sphere stays smooth: the icosahedron's faces meet at 41.8 degrees
+     * between normals, so 60 leaves its 12 vertices (bit for bit the
+     * normals without crease) and 30 splits each into its 5 faces. */
+    {
+        vb_mesh ico = make_icosphere(1.0f);
+        char text[4096];
+        size_t len = 0;
+        for (uint32_t i = 0; i < ico.vertex_count; i++)
+            len += (size_t)snprintf(text + len, sizeof text - len, "v %.9g %.9g %.9g\n",
+                                    ico.positions[3 * i], ico.positions[3 * i + 1],
+                                    ico.positions[3 * i + 2]);
+        for (uint32_t t = 0; t < ico.triangle_count; t++)
+            len += (size_t)snprintf(text + len, sizeof text - len, "f %u %u %u\n",
+                                    ico.indices[3 * t] + 1, ico.indices[3 * t + 1] + 1,
+                                    ico.indices[3 * t + 2] + 1);
+        CHECK(len < sizeof text, "icosahedron text too long");
+        char *q = text_fixture("crease_ico.obj", text);
+        vb_mesh a = {0}, b = {0};
+        vb_load_desc d60 = {.crease = 60}, d30 = {.crease = 30};
+        CHECK(vb_mesh_load(q, NULL, &a, NULL, &err) == VB_OK, "%s: %s", q, err.msg);
+        CHECK(vb_mesh_load(q, &d60, &b, &info, &err) == VB_OK, "%s: %s", q, err.msg);
+        CHECK(a.vertex_count == 12 && b.vertex_count == 12 && info.report.crease_vertices == 0 &&
+                  memcmp(a.normals, b.normals, 3 * sizeof(float) * 12) == 0,
+              "icosahedron at 60 degrees: %u vertices, %u split (want 12, 0, same normals)",
+              b.vertex_count, info.report.crease_vertices);
+        vb_mesh_free(&b);
+        CHECK(vb_mesh_load(q, &d30, &b, &info, &err) == VB_OK, "%s: %s", q, err.msg);
+        CHECK(b.vertex_count == 60 && info.report.crease_vertices == 12 &&
+                  info.report.crease_added == 48,
+              "icosahedron at 30 degrees: %u vertices, %u split, %u added (want 60, 12, 48)",
+              b.vertex_count, info.report.crease_vertices, info.report.crease_added);
+        vb_mesh_free(&a);
+        vb_mesh_free(&b);
+        vb_mesh_free(&ico);
+        free(q);
+    }
+}
+
 static void test_load_report(void)
 {
     char *p = text_fixture("report.ply", report_ply);
@@ -2210,6 +2340,7 @@ static int run_unit(const char *tmp_parent)
     test_corruption();
     test_normals_weld_append();
     test_corner_normals();
+    test_crease();
     test_load_report();
     test_spacing();
     test_room();

@@ -95,7 +95,7 @@ for axis in WRITE:
     if len(srcs) != 1 or srcs[0]["name"] != obj or srcs[0]["size"] != len(data) or \
             srcs[0]["sha256"] != hashlib.sha256(data).hexdigest():
         fail.append("%s up: sources %r are not the file" % (axis, srcs))
-    want = (h["load_flags"] >> 1) == vdsh.UP_AXES.index(axis)
+    want = (h["load_flags"] >> 1) & 7 == vdsh.UP_AXES.index(axis)
     r = run([info, out])
     if not want or "up axis %s (" % axis not in r.stdout:
         fail.append("%s up: load_flags %d, vdsh-info %r" % (axis, h["load_flags"], r.stdout[:600]))

@@ -230,6 +230,9 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
         printf("               up axis %s (the sources turned into +y: vdsh-bake --up-axis)\n",
                or_unknown(
                    vdsh_up_axis_name((h->load_flags & VDSH_LOAD_UP_MASK) >> VDSH_LOAD_UP_SHIFT)));
+    if (VDSH_LOAD_CREASE(h->load_flags))
+        printf("               crease %u degrees (computed normals split at sharper edges)\n",
+               VDSH_LOAD_CREASE(h->load_flags));
     if (h->cube_size)
         printf("               basis cubemaps %u x %u per face\n", h->cube_size, h->cube_size);
     else
@@ -406,6 +409,8 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
     vt_json_string(
         &j, bake, "up_axis",
         or_unknown(vdsh_up_axis_name((h->load_flags & VDSH_LOAD_UP_MASK) >> VDSH_LOAD_UP_SHIFT)));
+    if (VDSH_LOAD_CREASE(h->load_flags))
+        vt_json_u64(&j, bake, "crease", VDSH_LOAD_CREASE(h->load_flags));
     vt_json_u64(&j, bake, "trace_flags", h->trace_flags);
     vt_json_bool(&j, bake, "robust", h->trace_flags & VDSH_TRACE_ROBUST);
     vt_json_u64(&j, bake, "cube_size", h->cube_size);

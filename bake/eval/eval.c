@@ -1243,11 +1243,12 @@ vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths, uin
     if (count == 0)
         return vb_fail(err, VB_ERR_INVALID,
                        "the file records no source meshes: give the bake's meshes");
-    /* the sources loaded as the bake loaded them: welded, and turned from
-     * their up axis into +y (HEAD load_flags) */
+    /* the sources loaded as the bake loaded them: welded, turned from
+     * their up axis into +y and split at creases (HEAD load_flags) */
     vb_load_desc ld = {.weld = (f->header.load_flags & VDSH_LOAD_WELD) != 0,
                        .up_axis =
-                           (int)((f->header.load_flags & VDSH_LOAD_UP_MASK) >> VDSH_LOAD_UP_SHIFT)};
+                           (int)((f->header.load_flags & VDSH_LOAD_UP_MASK) >> VDSH_LOAD_UP_SHIFT),
+                       .crease = (int)VDSH_LOAD_CREASE(f->header.load_flags)};
     vb_mesh occ = {0};
     vb_result r = VB_OK;
     for (uint32_t i = 0; i < count; i++) {

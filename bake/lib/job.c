@@ -58,7 +58,9 @@ vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err)
     j->basis_size = cube_size;
     j->basis_running = cube_size > 0 && d->output && !d->bake.trace_only && !d->shard_count &&
                        pthread_create(&j->basis_thread, NULL, encode_basis, j) == 0;
-    vb_load_desc ld = {.weld = d->weld, .up_axis = d->up_axis};
+    vb_load_desc ld = {.weld = d->weld,
+                       .up_axis = d->up_axis,
+                       .crease = d->crease > 0 && d->crease < 180 ? d->crease : 0};
     for (uint32_t i = 0; i < d->path_count; i++) {
         const char *path = d->paths[i];
         vb_mesh m = {0};
@@ -75,6 +77,7 @@ vb_result vb_job_load(vb_job *j, const vb_job_desc *d, vb_error *err)
         j->sources[i].size = info.size;
         memcpy(j->sources[i].sha256, info.sha256, 32);
         j->source_count = i + 1;
+        j->creased |= info.report.crease_vertices > 0;
         if (d->on_mesh)
             d->on_mesh(d->user, path, &m, &info, vb_now() - t);
         vb_mesh_free(&m);
@@ -376,7 +379,8 @@ vb_result vb_bake_fill_file(vb_job *j, const vb_job_desc *d, vb_error *err)
         f.has_light_box = 1;
         f.light_box = j->light_region;
     }
-    h->load_flags = (d->weld ? VDSH_LOAD_WELD : 0) | (uint32_t)d->up_axis << VDSH_LOAD_UP_SHIFT;
+    h->load_flags = (d->weld ? VDSH_LOAD_WELD : 0) | (uint32_t)d->up_axis << VDSH_LOAD_UP_SHIFT |
+                    (j->creased ? (uint32_t)d->crease << VDSH_LOAD_CREASE_SHIFT : 0);
     h->cube_size = (uint32_t)vb_job_cube_size(d);
     h->occluder_vertex_count = j->occluders.vertex_count;
     h->occluder_triangle_count = j->occluders.triangle_count;

@@ -62,6 +62,7 @@ typedef struct vb_job_desc {
     const char *cubemap_dir;  /* NULL: beside output */
     int weld;                 /* vb_load_desc.weld */
     int up_axis;              /* vb_load_desc.up_axis, recorded in HEAD load_flags */
+    int crease;               /* vb_load_desc.crease: 0 or 180+ = off */
     /* receivers refined to it; 0: the vertices as they are. With adaptive:
      * where the refinement starts */
     float max_edge;
@@ -131,6 +132,10 @@ typedef struct vb_job {
     double pool_seconds;
     vb_adaptive_stats adaptive;  /* with d->adaptive */
     vdsh_light_box light_region; /* the desc's, its box filled in (rule 0: none) */
+    /* 1 when the crease angle split a vertex of some source: only then is it
+     * recorded (HEAD load_flags), so that bakes it left alone keep their
+     * bytes */
+    int creased;
     double t_start;
     /* The basis cubemaps' helper thread. */
     pthread_t basis_thread;

@@ -243,6 +243,12 @@ void vb_mesh_report_print(FILE *fp, const char *tool, const char *path, const vb
     if (r->welded)
         fprintf(fp, "%s%s%s: %u vert%s merged by welding (normals then computed from the faces)\n",
                 tool, sep, path, r->welded, r->welded == 1 ? "ex" : "ices");
+    if (r->crease_vertices)
+        fprintf(fp,
+                "%s%s%s: %u vert%s split at creases of the computed normals (the crease "
+                "angle): %u vert%s added\n",
+                tool, sep, path, r->crease_vertices, r->crease_vertices == 1 ? "ex" : "ices",
+                r->crease_added, r->crease_added == 1 ? "ex" : "ices");
     if (r->gltf_skipped_modes)
         fprintf(fp, "%s%s%s: %u glTF primitive%s of points or lines skipped (no surface)\n", tool,
                 sep, path, r->gltf_skipped_modes, plural(r->gltf_skipped_modes));
@@ -450,6 +456,203 @@ static void compute_normals(vb_mesh *m, uint8_t *cancelled)
 void vb_mesh_compute_normals(vb_mesh *m)
 {
     compute_normals(m, NULL);
+}
+
+/* ---------------------------------------------------------------------- */
+/* Creases of computed normals (vb_load_desc.crease)                      */
+/* ---------------------------------------------------------------------- */
+
+static uint32_t uf_find(uint32_t *parent, uint32_t i)
+{
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+/* The lower root wins, so a fan's root is its first triangle in order. */
+static void uf_join(uint32_t *parent, uint32_t a, uint32_t b)
+{
+    a = uf_find(parent, a), b = uf_find(parent, b);
+    if (a < b)
+        parent[b] = a;
+    else if (b < a)
+        parent[a] = b;
+}
+
+/* (other vertex, slot) of one triangle around a vertex, sorted by other
+ * vertex so that triangles sharing an edge through the vertex neighbour. */
+typedef struct crease_edge {
+    uint32_t other, slot;
+} crease_edge;
+
+static int crease_edge_cmp(const void *pa, const void *pb)
+{
+    const crease_edge *a = pa, *b = pb;
+    if (a->other != b->other)
+        return a->other < b->other ? -1 : 1;
+    return a->slot < b->slot ? -1 : a->slot > b->slot;
+}
+
+/* Splits m's vertices at creases sharper than crease_deg (mesh.h,
+ * vb_load_desc.crease) and recomputes its normals. Each vertex's triangles
+ * (in triangle order) are joined across the edges through it whose two
+ * face normals are at most crease_deg apart; triangles without area join
+ * the vertex's first fan. A vertex with one fan keeps its place; one with
+ * k fans becomes k vertices in a row, in the order of each fan's first
+ * triangle. *split, *added: vertices split, vertices added. Nothing
+ * changes when no vertex splits (the normals then are recomputed as they
+ * were). */
+static vb_result crease_split(vb_mesh *m, int crease_deg, uint8_t **cancelled, uint32_t *split,
+                              uint32_t *added)
+{
+    *split = *added = 0;
+    const uint32_t nv = m->vertex_count, nt = m->triangle_count;
+    const size_t corners = 3 * (size_t)nt;
+    const double agree = vdsh_det_cos(crease_deg * 3.14159265358979323846 / 180.0);
+    double *fn = alloc_array(3 * (size_t)(nt ? nt : 1), sizeof *fn);
+    uint8_t *area = calloc(nt ? nt : 1, 1);
+    size_t *start = calloc((size_t)nv + 1, sizeof *start);
+    size_t *list = alloc_array(corners ? corners : 1, sizeof *list);
+    uint32_t *slot_group = alloc_array(corners ? corners : 1, sizeof *slot_group);
+    uint32_t *groups = alloc_array(nv ? nv : 1, sizeof *groups);
+    uint32_t *parent = NULL, *label = NULL;
+    crease_edge *edges = NULL;
+    size_t cap = 0;
+    vb_result r = VB_ERR_OUT_OF_MEMORY;
+    if (!fn || !area || !start || !list || !slot_group || !groups)
+        goto done;
+    for (uint32_t t = 0; t < nt; t++) {
+        double p[3][3];
+        area[t] = triangle_normal(m, t, p, fn + 3 * (size_t)t) != 0.0;
+    }
+    for (size_t c = 0; c < corners; c++)
+        start[m->indices[c] + 1]++;
+    for (uint32_t v = 0; v < nv; v++)
+        start[v + 1] += start[v];
+    {
+        size_t *fill = alloc_array(nv ? nv : 1, sizeof *fill);
+        if (!fill)
+            goto done;
+        memcpy(fill, start, nv * sizeof *fill);
+        for (size_t c = 0; c < corners; c++)
+            list[fill[m->indices[c]]++] = c;
+        free(fill);
+    }
+    uint64_t total = 0;
+    for (uint32_t v = 0; v < nv; v++) {
+        const size_t s0 = start[v];
+        const uint32_t k = (uint32_t)(start[v + 1] - s0);
+        if (k > cap) {
+            size_t nc = k > 2 * cap ? k : 2 * cap;
+            uint32_t *np = realloc(parent, nc * sizeof *np), *nl = NULL;
+            if (np)
+                parent = np;
+            nl = np ? realloc(label, nc * sizeof *nl) : NULL;
+            if (nl)
+                label = nl;
+            crease_edge *ne = nl ? realloc(edges, 2 * nc * sizeof *ne) : NULL;
+            if (!ne)
+                goto done;
+            edges = ne;
+            cap = nc;
+        }
+        for (uint32_t i = 0; i < k; i++) {
+            const size_t c = list[s0 + i];
+            const uint32_t *tri = m->indices + c / 3 * 3;
+            parent[i] = i;
+            edges[2 * i] = (crease_edge){tri[(c + 1) % 3], i};
+            edges[2 * i + 1] = (crease_edge){tri[(c + 2) % 3], i};
+        }
+        if (k > 1)
+            qsort(edges, 2 * (size_t)k, sizeof *edges, crease_edge_cmp);
+        for (size_t a = 0; a < 2 * (size_t)k;) {
+            size_t b = a + 1;
+            while (b < 2 * (size_t)k && edges[b].other == edges[a].other)
+                b++;
+            for (size_t i = a; i < b; i++)
+                for (size_t j = i + 1; j < b; j++) {
+                    const size_t ti = list[s0 + edges[i].slot] / 3,
+                                 tj = list[s0 + edges[j].slot] / 3;
+                    if (!area[ti] || !area[tj])
+                        continue;
+                    const double *x = fn + 3 * ti, *y = fn + 3 * tj;
+                    if (x[0] * y[0] + x[1] * y[1] + x[2] * y[2] >= agree)
+                        uf_join(parent, edges[i].slot, edges[j].slot);
+                }
+            a = b;
+        }
+        /* Triangles without area join the first fan (with area, if any). */
+        uint32_t first = 0;
+        while (first < k && !area[list[s0 + first] / 3])
+            first++;
+        if (first == k)
+            first = 0;
+        for (uint32_t i = 0; i < k; i++)
+            if (!area[list[s0 + i] / 3])
+                uf_join(parent, i, first);
+        uint32_t ng = 0;
+        for (uint32_t i = 0; i < k; i++) {
+            uint32_t root = uf_find(parent, i);
+            if (root == i)
+                label[i] = ng++;
+            slot_group[s0 + i] = label[root];
+        }
+        groups[v] = ng ? ng : 1;
+        total += groups[v];
+    }
+    r = VB_OK;
+    if (total == nv) {
+        compute_normals(m, *cancelled);
+        goto done;
+    }
+    if (total > 0x7fffffffu) {
+        r = VB_ERR_INVALID;
+        goto done;
+    }
+    {
+        const uint32_t nn = (uint32_t)total;
+        float *pos = alloc_array(3 * (size_t)nn, sizeof(float));
+        float *nrm = alloc_array(3 * (size_t)nn, sizeof(float));
+        uint8_t *canc = calloc(nn, 1);
+        if (!pos || !nrm || !canc) {
+            free(pos);
+            free(nrm);
+            free(canc);
+            r = VB_ERR_OUT_OF_MEMORY;
+            goto done;
+        }
+        uint32_t next = 0;
+        for (uint32_t v = 0; v < nv; v++) {
+            for (uint32_t g = 0; g < groups[v]; g++)
+                memcpy(pos + 3 * (size_t)(next + g), m->positions + 3 * (size_t)v,
+                       3 * sizeof(float));
+            if (groups[v] > 1)
+                (*split)++, *added += groups[v] - 1;
+            for (size_t j = start[v]; j < start[v + 1]; j++)
+                m->indices[list[j]] = next + slot_group[j];
+            next += groups[v];
+        }
+        free(m->positions);
+        free(m->normals);
+        free(*cancelled);
+        m->positions = pos, m->normals = nrm, *cancelled = canc;
+        m->vertex_count = nn;
+        compute_normals(m, *cancelled);
+    }
+
+done:
+    free(fn);
+    free(area);
+    free(start);
+    free(list);
+    free(slot_group);
+    free(groups);
+    free(parent);
+    free(label);
+    free(edges);
+    return r;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -1371,6 +1574,7 @@ static vb_result clean_raw(const char *path, vb_mesh_format format, const vb_mes
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
     }
     if (!use_file) {
+        rp.normals_computed = 1;
         compute_normals(&m, cancelled);
         for (uint32_t i = 0; i < m.vertex_count; i++)
             rp.cancelled_normals += cancelled[i];
@@ -1515,11 +1719,13 @@ static void turn_up(int up, float *v)
 }
 
 /* The common tail of both loaders: turn the up axis into +y, weld if
- * asked, count what is left without a normal, then hand over. */
+ * asked, split computed normals at creases, count what is left without a
+ * normal, then hand over. */
 static vb_result finish_load(vb_result r, vb_mesh *m, vb_source_info *si, const vb_load_desc *desc,
-                             vb_mesh *out, vb_source_info *info, vb_error *err)
+                             const char *path, vb_mesh *out, vb_source_info *info, vb_error *err)
 {
     const int weld = desc ? desc->weld : 0, up = desc ? desc->up_axis : 0;
+    const int crease = desc ? desc->crease : 0;
     if (r == VB_OK && (up < 0 || up >= VDSH_UP_AXES))
         r = vb_fail(err, VB_ERR_ARGUMENT, "load: up axis %d unknown (0..%d)", up, VDSH_UP_AXES - 1);
     for (uint32_t i = 0; r == VB_OK && up && i < m->vertex_count; i++) {
@@ -1530,6 +1736,23 @@ static vb_result finish_load(vb_result r, vb_mesh *m, vb_source_info *si, const 
     if (r == VB_OK && weld) {
         r = vb_mesh_weld(m, err);
         si->report.welded = before - m->vertex_count;
+        si->report.normals_computed = 1;
+    }
+    if (r == VB_OK && crease > 0 && crease < 180 && si->report.normals_computed) {
+        uint8_t *cancelled = calloc(m->vertex_count ? m->vertex_count : 1, 1);
+        r = cancelled ? crease_split(m, crease, &cancelled, &si->report.crease_vertices,
+                                     &si->report.crease_added)
+                      : VB_ERR_OUT_OF_MEMORY;
+        if (r == VB_OK) {
+            si->report.cancelled_normals = 0;
+            for (uint32_t i = 0; i < m->vertex_count; i++)
+                si->report.cancelled_normals += cancelled[i];
+        } else {
+            r = r == VB_ERR_OUT_OF_MEMORY
+                    ? vb_fail(err, r, "%s: out of memory", path)
+                    : vb_fail(err, r, "%s: too many vertices after splitting at creases", path);
+        }
+        free(cancelled);
     }
     if (r != VB_OK) {
         vb_mesh_free(m);
@@ -1573,7 +1796,7 @@ vb_result vb_mesh_load(const char *path, const vb_load_desc *desc, vb_mesh *out,
         r = load_bytes(path, format, desc ? desc->gltf_scene : 0, bytes, size, &m, &si, err);
         free(bytes);
     }
-    return finish_load(r, &m, &si, desc, out, info, err);
+    return finish_load(r, &m, &si, desc, path, out, info, err);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -1686,5 +1909,5 @@ vb_result vb_mesh_load_memory(const void *data, size_t size, const char *name,
     memset(&si, 0, sizeof si);
     r = load_bytes(name, format, desc ? desc->gltf_scene : 0, (const uint8_t *)data, size, &m, &si,
                    err);
-    return finish_load(r, &m, &si, desc, out, info, err);
+    return finish_load(r, &m, &si, desc, name, out, info, err);
 }

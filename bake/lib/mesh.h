@@ -40,7 +40,8 @@
  * faces all have zero area). Vertex normals come from the file when it has
  * them for every vertex (a zero one is replaced by the computed normal of
  * the vertex's own triangles), else are computed (angle-weighted face
- * normals over the vertex's own faces, so unwelded hard edges stay hard).
+ * normals over the vertex's own faces, so unwelded hard edges stay hard;
+ * with vb_load_desc.crease, shared vertices split at sharp edges too).
  * Triangles with a repeated index are dropped (they have no area and no
  * effect on rays); zero-area triangles with distinct indices are kept.
  * Duplicate triangles are dropped: one with the same three positions as
@@ -141,6 +142,16 @@ typedef struct vb_load_desc {
      * the default), 1 z, 2 -z, 3 x, 4 -x, 5 -y (formats/vdsh.h,
      * VDSH_LOAD_UP_MASK; vdsh-bake --up-axis) */
     int up_axis;
+    /* Crease angle for computed normals, in whole degrees: 0 (default) or
+     * 180 and above = off. When the normals are computed (the file gives
+     * none for some used vertex, or weld recomputed them), a vertex whose
+     * triangles meet at an edge through it with face normals more than this
+     * many degrees apart is split: one vertex per smooth fan (triangles
+     * joined across its edges whose face normals are at most this far
+     * apart), each with the normal of its own fan's triangles (so a cube's
+     * 8 shared corners become 24 vertices with face normals at 60 degrees,
+     * a sphere stays smooth). File normals are never changed. */
+    int crease;
 } vb_load_desc;
 
 /* What loading found in a file and did about it, as counts (all zero for
@@ -175,6 +186,13 @@ typedef struct vb_mesh_report {
      * (two-sided triangles): given their largest triangle's normal */
     uint32_t cancelled_normals;
     uint32_t welded; /* vertices merged by weld */
+    /* 1 when the normals were computed from the faces (no file normals, or
+     * weld), so vb_load_desc.crease applies */
+    uint32_t normals_computed;
+    /* vb_load_desc.crease: vertices split at creases of the computed
+     * normals, and the vertices those splits added */
+    uint32_t crease_vertices;
+    uint32_t crease_added;
     /* loaded vertices left (0,0,0) at the end: their triangles have no area
      * (those with a zero file normal included) */
     uint32_t undefined_normals;

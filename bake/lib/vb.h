@@ -68,6 +68,9 @@ double vb_now(void);
 #define VB_DEFAULT_RAYS 2500u   /* directions per receiver, a 50 x 50 grid */
 #define VB_DEFAULT_CUBE_SIZE 64 /* basis cubemap face, texels */
 #define VB_DEFAULT_SEED 1u      /* vdsh-bake --seed */
+/* vdsh-bake --crease: computed normals split where faces meet at more than
+ * this many degrees (docs/ACCURACY.md, "Creases of computed normals") */
+#define VB_DEFAULT_CREASE 60
 
 #ifdef __cplusplus
 }

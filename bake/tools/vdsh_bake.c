@@ -78,6 +78,7 @@ typedef struct options {
     uint32_t max_rounds;    /* --max-rounds; 0: none given (VB_ADAPTIVE_ROUNDS) */
     int weld;
     int up_axis; /* --up-axis: vb_load_desc.up_axis; 0: y */
+    int crease;  /* --crease DEG; 0: off */
     uint64_t seed;
     uint32_t threads;
     int cube_size;
@@ -331,6 +332,11 @@ static void usage(FILE *f)
             "                          (scenes are y-up) before anything else, and the\n"
             "                          file records it: vdsh-eval and vdsh-frames turn\n"
             "                          the sources the same way\n"
+            "      --crease DEG        computed normals (a mesh without normals, or\n"
+            "                          --weld): split vertices where faces meet at more\n"
+            "                          than DEG degrees, each side its own normal\n"
+            "                          (0..180, default %d; 0 or 180: off, smooth\n"
+            "                          across every edge); file normals are kept\n"
             "      --keep-normals      keep normals that point into geometry (default:\n"
             "                          a receiver blocked at ~0 on its own side and open\n"
             "                          on the other gets its normal flipped)\n"
@@ -356,7 +362,7 @@ static void usage(FILE *f)
             methods_help(), (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
             (double)vb_shadow_log_offset(3), (double)vb_shadow_log_offset(5),
             (double)VB_DEFAULT_FALSE_RATE, VB_DECISION_MAX_PAIRS, VB_DEFAULT_DECISION_LIGHTS,
-            VB_DEFAULT_DECISION_NEAR, VB_ADAPTIVE_ROUNDS, VB_DEFAULT_SEED);
+            VB_DEFAULT_DECISION_NEAR, VB_ADAPTIVE_ROUNDS, VB_DEFAULT_CREASE, VB_DEFAULT_SEED);
 }
 
 static int bad_usage(const char *fmt, const char *arg)
@@ -764,6 +770,7 @@ enum {
     O_MAXEDGE,
     O_WELD,
     O_UP_AXIS,
+    O_CREASE,
     O_SEED,
     O_THREADS,
     O_CUBESIZE,
@@ -874,6 +881,7 @@ static int read_value(int c, const char *arg, options *o)
     case O_MAX_ROUNDS: ok = vt_opt_u32("--max-rounds", NULL, arg, 1, 1000, &o->max_rounds); break;
     case O_SEED: ok = vt_opt_u64("--seed", NULL, arg, 0, UINT64_MAX, &o->seed); break;
     case O_THREADS: ok = vt_opt_u32("--threads", NULL, arg, 1, 256, &o->threads); break;
+    case O_CREASE: ok = vt_opt_int("--crease", NULL, arg, 0, 180, &o->crease); break;
     case O_CUBESIZE: ok = vt_opt_int("--cube-size", NULL, arg, 0, 4096, &o->cube_size); break;
     case O_SDF:
         ok = vt_opt_int("--sdf", NULL, arg, VB_SDF_MIN_RESOLUTION, VB_SDF_MAX_RESOLUTION, &o->sdf);
@@ -1040,6 +1048,8 @@ static int check_options(options *o)
     if (o->receivers && (o->adaptive || o->max_edge > 0.0f || o->weld))
         return bad_usage("%s", "--receivers takes the receivers as they are: not with "
                                "--adaptive, --max-edge or --weld");
+    if (o->crease >= 180)
+        o->crease = 0; /* 180: no crease is sharper */
     if (o->mesh_count < 1)
         return bad_usage("%s", "no mesh given");
     if (o->mesh_count > VDSH_MAX_SOURCES)
@@ -1109,6 +1119,7 @@ static int parse_args(int argc, char **argv, options *o)
     o->seed = VB_DEFAULT_SEED;
     o->robust = 1;
     o->cube_size = VB_DEFAULT_CUBE_SIZE;
+    o->crease = VB_DEFAULT_CREASE;
 
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
@@ -1124,6 +1135,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"max-edge", required_argument, 0, O_MAXEDGE},
         {"weld", no_argument, 0, O_WELD},
         {"up-axis", required_argument, 0, O_UP_AXIS},
+        {"crease", required_argument, 0, O_CREASE},
         {"seed", required_argument, 0, O_SEED},
         {"threads", required_argument, 0, O_THREADS},
         {"cube-size", required_argument, 0, O_CUBESIZE},
@@ -1285,6 +1297,7 @@ static vb_job_desc job_desc(const options *o, FILE *log, progress *pr, float *of
         .cubemap_dir = o->cubemap_dir,
         .weld = o->weld,
         .up_axis = o->up_axis,
+        .crease = o->crease,
         .max_edge = o->max_edge,
         .fast_traversal = !o->robust,
         .light_region = o->light_region,

@@ -474,6 +474,8 @@ static int write_json(const char *out, const context *c, char *msg, size_t cap)
     vt_json_bool(&j, bake, "welded", h->load_flags & VDSH_LOAD_WELD);
     const char *up = vdsh_up_axis_name((h->load_flags & VDSH_LOAD_UP_MASK) >> VDSH_LOAD_UP_SHIFT);
     vt_json_string(&j, bake, "up_axis", up ? up : "?");
+    if (VDSH_LOAD_CREASE(h->load_flags))
+        vt_json_u64(&j, bake, "crease", VDSH_LOAD_CREASE(h->load_flags));
     vt_json_bool(&j, bake, "robust", h->trace_flags & VDSH_TRACE_ROBUST);
     vt_json_u64(&j, bake, "cube_size", h->cube_size);
     vt_record_stats(&j, bake, f, 0);

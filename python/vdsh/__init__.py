@@ -256,8 +256,10 @@ def _chunk(f, cid, b, path):
             _fail(path, "HEAD: a count or sampling out of range")
         if not (_finite(maxd) and maxd > 0 and _finite(maxe) and maxe >= 0):
             _fail(path, "HEAD: max_distance or max_edge out of range")
-        # load_flags: bit 0 welded, bits 1..3 the up axis (UP_AXES)
-        if rule > 1 or lflags & ~15 or lflags >> 1 >= len(UP_AXES) or tflags & ~1:
+        # load_flags: bit 0 welded, bits 1..3 the up axis (UP_AXES), bits
+        # 8..15 the crease angle (0 or 1..179)
+        if (rule > 1 or lflags & ~0xff0f or (lflags >> 1) & 7 >= len(UP_AXES)
+                or (lflags >> 8) & 0xff >= 180 or tflags & ~1):
             _fail(path, "HEAD: offset_rule or flags out of range")
         if not _finite(*bmin, *bmax) or any(a > c for a, c in zip(bmin, bmax)):
             _fail(path, "HEAD: bounds not finite or min > max")

@@ -89,21 +89,25 @@ def summary(f: VdshFile, path: str) -> Dict[str, Any]:
             o["vertices_per_order"] = [int(x) for x in per[1:]]
         streams.append(o)
     p = f.positions
+    bake = dict(rays=h["rays"], sampling=h["sampling"], seed=h["seed"],
+                max_distance=float(h["max_distance"]), max_edge=float(h["max_edge"]),
+                offset_rule=["none", "wb-avg"][h["offset_rule"]], load_flags=h["load_flags"],
+                welded=bool(h["load_flags"] & 1),
+                up_axis=UP_AXES[(h["load_flags"] >> 1) & 7])
+    if (h["load_flags"] >> 8) & 0xff:  # as vdsh-info: only when the bake split at creases
+        bake["crease"] = (h["load_flags"] >> 8) & 0xff
+    bake.update(trace_flags=h["trace_flags"],
+                robust=bool(h["trace_flags"] & 1), cube_size=h["cube_size"],
+                occluder_vertex_count=h["occluder_vertex_count"],
+                occluder_triangle_count=h["occluder_triangle_count"],
+                occluder_bounds=dict(min=[float(x) for x in h["bounds_min"]],
+                                     max=[float(x) for x in h["bounds_max"]]))
     return dict(
         file=path, valid=True, file_size=size, bytes_per_vertex=size / h["vertex_count"],
         format_version=1, vertex_count=h["vertex_count"], triangle_count=h["triangle_count"],
         receiver_bounds=dict(min=[float(x) for x in p.min(axis=0)],
                              max=[float(x) for x in p.max(axis=0)]),
-        bake=dict(rays=h["rays"], sampling=h["sampling"], seed=h["seed"],
-                  max_distance=float(h["max_distance"]), max_edge=float(h["max_edge"]),
-                  offset_rule=["none", "wb-avg"][h["offset_rule"]], load_flags=h["load_flags"],
-                  welded=bool(h["load_flags"] & 1),
-                  up_axis=UP_AXES[h["load_flags"] >> 1], trace_flags=h["trace_flags"],
-                  robust=bool(h["trace_flags"] & 1), cube_size=h["cube_size"],
-                  occluder_vertex_count=h["occluder_vertex_count"],
-                  occluder_triangle_count=h["occluder_triangle_count"],
-                  occluder_bounds=dict(min=[float(x) for x in h["bounds_min"]],
-                                       max=[float(x) for x in h["bounds_max"]])),
+        bake=bake,
         sources=f.sources, streams=streams, stats=f.stats, timings=f.timings,
         **{k: v for k, v in (("part", _part(f)), ("adaptive", f.adaptive),
                              ("light_region", f.light_region)) if v is not None})
