@@ -1413,6 +1413,148 @@ static void say_receivers(FILE *log, const options *o, const vb_job *job, vb_mes
     }
 }
 
+/* The adaptive receivers: how many from how many, and whether the round
+ * cap stopped them while still splitting. */
+static void say_adaptive_receivers(FILE *log, const options *o, const vb_job *job)
+{
+    fprintf(log,
+            "vdsh-bake: adaptive receivers: %u from %u in %u round%s (%u midpoint%s "
+            "baked, tolerance %g + noise floor %.3g from %u receiver%s baked twice, min "
+            "edge %g%s)\n",
+            job->receivers.vertex_count, job->adaptive.start_receivers, job->adaptive.rounds,
+            vdsh_s(job->adaptive.rounds), job->adaptive.candidates,
+            vdsh_s(job->adaptive.candidates), (double)o->adaptive_tol, job->adaptive.noise_floor,
+            job->adaptive.noise_sample, vdsh_s(job->adaptive.noise_sample), (double)o->min_edge,
+            job->adaptive.budget_reached    ? ", the budget stopped it"
+            : job->adaptive.uniform_reached ? ", stopped at the uniform bake's count at 2 x "
+                                              "the min edge"
+                                            : "");
+    if (job->adaptive.rounds_reached)
+        fprintf(log,
+                "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
+                "while still splitting (%u edge%s split in the last round, %u edge%s not "
+                "yet judged): raise --max-rounds\n",
+                job->adaptive.max_rounds, job->adaptive.last_split,
+                vdsh_s(job->adaptive.last_split), job->adaptive.pending,
+                vdsh_s(job->adaptive.pending));
+}
+
+/* The adaptive order's receivers per order. */
+static void say_adaptive_order(FILE *log, const vb_bake_output *bo)
+{
+    uint32_t hist[VDSH_ORDER_SLOTS] = {0};
+    uint32_t rows = bo->range_end - bo->range_begin;
+    double coeffs = 0.0;
+    for (uint32_t v = 0; v < rows; v++) {
+        hist[bo->variable_orders[v]]++;
+        coeffs += (double)bo->variable_orders[v] * bo->variable_orders[v];
+    }
+    fprintf(log,
+            "vdsh-bake: adaptive order (tolerance %g, cap %d): %.1f coefficients per "
+            "receiver on average; receivers per order:",
+            (double)bo->order_tolerance, bo->variable_cap, rows ? coeffs / rows : 0.0);
+    for (int k = 1; k <= bo->variable_cap; k++)
+        if (hist[k])
+            fprintf(log, " %d: %u (%.1f%%)", k, hist[k], 100.0 * hist[k] / rows);
+    fputc('\n', log);
+}
+
+/* The ray origins' check: probe rays, receivers repaired and moved,
+ * those on zero-area triangles only. */
+static void say_origins(FILE *log, const vb_bake_output *bo)
+{
+    fprintf(log,
+            "vdsh-bake: ray origins checked in %.2f s: %llu probe ray%s (%.1f%% of the "
+            "traced rays), %u receiver%s repaired, %u moved\n",
+            bo->origins.seconds, (unsigned long long)bo->origins.probe_rays,
+            vdsh_s(bo->origins.probe_rays),
+            bo->rays_traced ? 100.0 * bo->origins.probe_rays / bo->rays_traced : 0.0,
+            bo->origins.flagged, vdsh_s(bo->origins.flagged), bo->origins.moved);
+    if (bo->origins.skipped_zero_area)
+        fprintf(log,
+                "vdsh-bake: %u receiver%s on zero-area triangles only (drawn nowhere): "
+                "origin%s not probed\n",
+                bo->origins.skipped_zero_area, vdsh_s(bo->origins.skipped_zero_area),
+                vdsh_s(bo->origins.skipped_zero_area));
+}
+
+/* --light-region: where, and whether in reach. */
+static void say_light_region(FILE *log, const vb_job *job)
+{
+    const vdsh_light_box *b = &job->light_region;
+    const float *lo = job->scene->bounds_min, *hi = job->scene->bounds_max;
+    double far = 0.0; /* the farthest light from the farthest occluder corner */
+    for (int a = 0; a < 3; a++) {
+        const double d = fmax(fabs((double)b->max[a] - lo[a]), fabs((double)hi[a] - b->min[a]));
+        far += d * d;
+    }
+    far = sqrt(far);
+    fprintf(log, "vdsh-bake: lights in %s %g %g %g .. %g %g %g\n",
+            b->rule == VDSH_LIGHT_REGION_GROWN ? "the bounds grown:" : "the box", (double)b->min[0],
+            (double)b->min[1], (double)b->min[2], (double)b->max[0], (double)b->max[1],
+            (double)b->max[2]);
+    if (far > 1.5 * (double)job->bake.max_distance)
+        fprintf(log,
+                "vdsh-bake: warning: lights in this region may stand up to %g from a "
+                "receiver, beyond 1.5 x the max distance %g, where every stream reads "
+                "shadow: give --max-distance %g or more (docs/DESIGN.md, \"Lights beyond "
+                "the clamp\")\n",
+                far, (double)job->bake.max_distance, far / 1.5);
+}
+
+/* The decision fit: receivers fitted, the calibrated log offsets and the
+ * offset cap's effect. */
+static void say_decision(FILE *log, const options *o, const vb_bake_output *bo)
+{
+    if (!bo->decision_lights)
+        fprintf(log, "vdsh-bake: warning: no free space for lights in this scene: every "
+                     "receiver keeps its least-squares fit\n");
+    else
+        fprintf(log,
+                "vdsh-bake: decision fit: %u receiver%s fitted on %.0f traced lights "
+                "each on average, %u with fewer than 16 lights above %s horizon "
+                "kept the least-squares fit\n",
+                bo->decision_fitted, vdsh_s(bo->decision_fitted), bo->decision_pairs,
+                bo->decision_fallbacks, vdsh_plural(bo->decision_fallbacks, "its", "their"));
+    if (bo->calibration_receivers) {
+        fprintf(log,
+                "vdsh-bake: log offsets calibrated on %u receiver%s for %.1f%% false "
+                "shadow on held-out lights:",
+                bo->calibration_receivers, vdsh_s(bo->calibration_receivers),
+                100.0 * bo->false_rate);
+        for (int s = 0; s < o->order_count; s++)
+            fprintf(log, "%s order %d %+.3f", s ? "," : "", o->orders[s],
+                    (double)bo->log_offset[o->orders[s]]);
+        if (bo->variable_cap && bo->variable_method == VDSH_METHOD_DECISION)
+            fprintf(log, "%s adaptive order %+.3f", o->order_count ? "," : "",
+                    (double)bo->variable_param);
+        fputc('\n', log);
+    }
+    if (o->offset_cap)
+        fprintf(
+            log,
+            "vdsh-bake: offset cap raised %llu (receiver, order) offsets; the offset turns %llu of "
+            "%llu lit training pairs false (margin below %g; calibration sample not counted)\n",
+            (unsigned long long)bo->cap_bound, (unsigned long long)bo->lit_training_false,
+            (unsigned long long)bo->lit_training, (double)o->offset_cap_tol);
+}
+
+/* --quantity auto: each order's choice and the errors it was made on. */
+static void say_quantity_choice(FILE *log, const options *o, const vb_bake_output *bo)
+{
+    fprintf(log,
+            "vdsh-bake: quantity chosen on %u sampled receiver%s (expected shadow "
+            "error, distance / log):",
+            bo->auto_receivers, vdsh_s(bo->auto_receivers));
+    for (int s = 0; s < o->order_count; s++) {
+        int k = o->orders[s];
+        fprintf(log, "%s order %d %s (%.4f / %.4f)", s ? "," : "", k,
+                bo->quantity[k] == VDSH_QUANTITY_LOG_DISTANCE ? "log" : "distance",
+                bo->auto_error[k][0], bo->auto_error[k][1]);
+    }
+    fputc('\n', log);
+}
+
 /* What the bake did: rounds, fits, rays, repairs and warnings. */
 static void say_bake(FILE *log, const options *o, const vb_job *job)
 {
@@ -1421,27 +1563,7 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
     if (!log)
         return;
     if (o->adaptive)
-        fprintf(log,
-                "vdsh-bake: adaptive receivers: %u from %u in %u round%s (%u midpoint%s "
-                "baked, tolerance %g + noise floor %.3g from %u receiver%s baked twice, min "
-                "edge %g%s)\n",
-                job->receivers.vertex_count, job->adaptive.start_receivers, job->adaptive.rounds,
-                vdsh_s(job->adaptive.rounds), job->adaptive.candidates,
-                vdsh_s(job->adaptive.candidates), (double)o->adaptive_tol,
-                job->adaptive.noise_floor, job->adaptive.noise_sample,
-                vdsh_s(job->adaptive.noise_sample), (double)o->min_edge,
-                job->adaptive.budget_reached    ? ", the budget stopped it"
-                : job->adaptive.uniform_reached ? ", stopped at the uniform bake's count at 2 x "
-                                                  "the min edge"
-                                                : "");
-    if (o->adaptive && job->adaptive.rounds_reached)
-        fprintf(log,
-                "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
-                "while still splitting (%u edge%s split in the last round, %u edge%s not "
-                "yet judged): raise --max-rounds\n",
-                job->adaptive.max_rounds, job->adaptive.last_split,
-                vdsh_s(job->adaptive.last_split), job->adaptive.pending,
-                vdsh_s(job->adaptive.pending));
+        say_adaptive_receivers(log, o, job);
     if (bo->flipped_normals)
         fprintf(log,
                 "vdsh-bake: %u receiver normal%s pointed into geometry and %s "
@@ -1457,23 +1579,8 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
             vdsh_s(bo->threads), bo->rays_traced ? 100.0 * bo->rays_missed / bo->rays_traced : 0.0,
             bo->moved_origins, vdsh_s(bo->moved_origins), bo->degenerate_receivers,
             vdsh_s(bo->degenerate_receivers), (double)bo->max_distance);
-    if (bo->variable_orders) {
-        uint32_t hist[VDSH_ORDER_SLOTS] = {0};
-        uint32_t rows = bo->range_end - bo->range_begin;
-        double coeffs = 0.0;
-        for (uint32_t v = 0; v < rows; v++) {
-            hist[bo->variable_orders[v]]++;
-            coeffs += (double)bo->variable_orders[v] * bo->variable_orders[v];
-        }
-        fprintf(log,
-                "vdsh-bake: adaptive order (tolerance %g, cap %d): %.1f coefficients per "
-                "receiver on average; receivers per order:",
-                (double)bo->order_tolerance, bo->variable_cap, rows ? coeffs / rows : 0.0);
-        for (int k = 1; k <= bo->variable_cap; k++)
-            if (hist[k])
-                fprintf(log, " %d: %u (%.1f%%)", k, hist[k], 100.0 * hist[k] / rows);
-        fputc('\n', log);
-    }
+    if (bo->variable_orders)
+        say_adaptive_order(log, bo);
     if (o->adaptive_rays)
         fprintf(log,
                 "vdsh-bake: adaptive rays: %.1f traced per receiver on average "
@@ -1484,86 +1591,13 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
         fprintf(log, "vdsh-bake: light pool placed in %.2f s: %u light%s%s\n", job->pool_seconds,
                 job->pool_count, vdsh_s(job->pool_count),
                 job->pool_count ? "" : " (no room in free space: none used)");
-    fprintf(log,
-            "vdsh-bake: ray origins checked in %.2f s: %llu probe ray%s (%.1f%% of the "
-            "traced rays), %u receiver%s repaired, %u moved\n",
-            bo->origins.seconds, (unsigned long long)bo->origins.probe_rays,
-            vdsh_s(bo->origins.probe_rays),
-            bo->rays_traced ? 100.0 * bo->origins.probe_rays / bo->rays_traced : 0.0,
-            bo->origins.flagged, vdsh_s(bo->origins.flagged), bo->origins.moved);
-    if (bo->origins.skipped_zero_area)
-        fprintf(log,
-                "vdsh-bake: %u receiver%s on zero-area triangles only (drawn nowhere): "
-                "origin%s not probed\n",
-                bo->origins.skipped_zero_area, vdsh_s(bo->origins.skipped_zero_area),
-                vdsh_s(bo->origins.skipped_zero_area));
-    if (job->light_region.rule) { /* --light-region: where, and whether in reach */
-        const vdsh_light_box *b = &job->light_region;
-        const float *lo = job->scene->bounds_min, *hi = job->scene->bounds_max;
-        double far = 0.0; /* the farthest light from the farthest occluder corner */
-        for (int a = 0; a < 3; a++) {
-            const double d = fmax(fabs((double)b->max[a] - lo[a]), fabs((double)hi[a] - b->min[a]));
-            far += d * d;
-        }
-        far = sqrt(far);
-        fprintf(log, "vdsh-bake: lights in %s %g %g %g .. %g %g %g\n",
-                b->rule == VDSH_LIGHT_REGION_GROWN ? "the bounds grown:" : "the box",
-                (double)b->min[0], (double)b->min[1], (double)b->min[2], (double)b->max[0],
-                (double)b->max[1], (double)b->max[2]);
-        if (far > 1.5 * (double)bo->max_distance)
-            fprintf(log,
-                    "vdsh-bake: warning: lights in this region may stand up to %g from a "
-                    "receiver, beyond 1.5 x the max distance %g, where every stream reads "
-                    "shadow: give --max-distance %g or more (docs/DESIGN.md, \"Lights beyond "
-                    "the clamp\")\n",
-                    far, (double)bo->max_distance, far / 1.5);
-    }
-    if (bo->method == VDSH_METHOD_DECISION) {
-        if (!bo->decision_lights)
-            fprintf(log, "vdsh-bake: warning: no free space for lights in this scene: every "
-                         "receiver keeps its least-squares fit\n");
-        else
-            fprintf(log,
-                    "vdsh-bake: decision fit: %u receiver%s fitted on %.0f traced lights "
-                    "each on average, %u with fewer than 16 lights above %s horizon "
-                    "kept the least-squares fit\n",
-                    bo->decision_fitted, vdsh_s(bo->decision_fitted), bo->decision_pairs,
-                    bo->decision_fallbacks, vdsh_plural(bo->decision_fallbacks, "its", "their"));
-        if (bo->calibration_receivers) {
-            fprintf(log,
-                    "vdsh-bake: log offsets calibrated on %u receiver%s for %.1f%% false "
-                    "shadow on held-out lights:",
-                    bo->calibration_receivers, vdsh_s(bo->calibration_receivers),
-                    100.0 * bo->false_rate);
-            for (int s = 0; s < o->order_count; s++)
-                fprintf(log, "%s order %d %+.3f", s ? "," : "", o->orders[s],
-                        (double)bo->log_offset[o->orders[s]]);
-            if (bo->variable_cap && bo->variable_method == VDSH_METHOD_DECISION)
-                fprintf(log, "%s adaptive order %+.3f", o->order_count ? "," : "",
-                        (double)bo->variable_param);
-            fputc('\n', log);
-        }
-        if (o->offset_cap)
-            fprintf(
-                log,
-                "vdsh-bake: offset cap raised %llu (receiver, order) offsets; the offset turns %llu of "
-                "%llu lit training pairs false (margin below %g; calibration sample not counted)\n",
-                (unsigned long long)bo->cap_bound, (unsigned long long)bo->lit_training_false,
-                (unsigned long long)bo->lit_training, (double)o->offset_cap_tol);
-    }
-    if (bo->auto_receivers > 0) {
-        fprintf(log,
-                "vdsh-bake: quantity chosen on %u sampled receiver%s (expected shadow "
-                "error, distance / log):",
-                bo->auto_receivers, vdsh_s(bo->auto_receivers));
-        for (int s = 0; s < o->order_count; s++) {
-            int k = o->orders[s];
-            fprintf(log, "%s order %d %s (%.4f / %.4f)", s ? "," : "", k,
-                    bo->quantity[k] == VDSH_QUANTITY_LOG_DISTANCE ? "log" : "distance",
-                    bo->auto_error[k][0], bo->auto_error[k][1]);
-        }
-        fputc('\n', log);
-    }
+    say_origins(log, bo);
+    if (job->light_region.rule)
+        say_light_region(log, job);
+    if (bo->method == VDSH_METHOD_DECISION)
+        say_decision(log, o, bo);
+    if (bo->auto_receivers > 0)
+        say_quantity_choice(log, o, bo);
     if (bo->degenerate_receivers > 0)
         fprintf(log,
                 "vdsh-bake: warning: %u receiver%s (%.2f%%) %s distance ~0 in almost "
