@@ -951,12 +951,117 @@ static void print_row(const char *view, const char *set, int lights, const vb_fr
            100.0 * s.blotch_area);
 }
 
+/* The frames of a view set: one per (view, set, light). */
+static size_t frame_count_of(const vt_views *V)
+{
+    size_t n = 0;
+    for (int vi = 0; vi < V->count; vi++)
+        for (int k = 0; k < V->views[vi].set_count; k++)
+            n += (size_t)V->views[vi].light_count[k];
+    return n;
+}
+
+/* Every frame of every mode scored against the truth: tally[m *
+ * frame_count + fi] for mode m and frame fi, frames in view, set and
+ * light order. Returns 0, or -1 with the message printed. */
+static int score_frames(const options *op, const vt_views *V, size_t frame_count,
+                        vb_frames_tally *tally)
+{
+    const char *views_path = op->views_path;
+    float *hard = NULL, *ideal = NULL, *mask = NULL, *s = NULL;
+    vb_error err;
+    char p[PATH_MAX];
+    int rc = -1;
+    size_t fi = 0;
+    for (int vi = 0; vi < V->count; vi++) {
+        const vt_view *v = V->views + vi;
+        for (int k = 0; k < v->set_count; k++)
+            for (int l = 0; l < v->light_count[k]; l++, fi++) {
+                if (read_frame(op->truth, V, views_path, v->name, k, l, "hard", &hard, p,
+                               sizeof p) ||
+                    read_frame(op->truth, V, views_path, v->name, k, l, "ideal", &ideal, p,
+                               sizeof p) ||
+                    read_frame(op->truth, V, views_path, v->name, k, l, "mask", &mask, p, sizeof p))
+                    goto done;
+                for (int m = 0; m < op->mode_count; m++) {
+                    if (read_frame(op->frames, V, views_path, v->name, k, l, op->modes[m], &s, p,
+                                   sizeof p))
+                        goto done;
+                    if (vb_frames_score_frame(s, hard, ideal, mask, V->width, V->height,
+                                              &tally[(size_t)m * frame_count + fi],
+                                              &err) != VB_OK) {
+                        fprintf(stderr, PROG ": %s: %s\n", p, err.msg);
+                        goto done;
+                    }
+                    free(s);
+                    s = NULL;
+                }
+                free(hard);
+                free(ideal);
+                free(mask);
+                hard = ideal = mask = NULL;
+            }
+    }
+    rc = 0;
+done:
+    free(hard);
+    free(ideal);
+    free(mask);
+    free(s);
+    return rc;
+}
+
+/* Mode m's scores (T: its frames' tallies): per frame and set in the
+ * JSON (under jm), per set and for the scene in the table. */
+static void report_mode(const options *op, const vt_views *V, int m, const vb_frames_tally *T,
+                        vt_json *j, cJSON *jm)
+{
+    const char *mode = op->modes[m];
+    vb_frames_tally scene = {0};
+    char p[PATH_MAX];
+    cJSON *mo = vt_json_object(j, jm, NULL);
+    vt_json_string(j, mo, "mode", mode);
+    cJSON *sets = vt_json_array(j, mo, "sets");
+    if (!op->quiet)
+        printf("\n  mode %s\n  %-10s %-3s %6s %9s  %8s %6s  %8s %6s  %7s %7s  %s\n", mode, "view",
+               "set", "lights", "counted", "RMSE/id", "PSNR", "RMSE/hd", "PSNR", "recall", "false",
+               "blotches");
+    size_t fi = 0;
+    for (int vi = 0; vi < V->count; vi++) {
+        const vt_view *v = V->views + vi;
+        for (int k = 0; k < v->set_count; k++) {
+            vb_frames_tally set = {0};
+            cJSON *so = vt_json_object(j, sets, NULL);
+            vt_json_string(j, so, "view", v->name);
+            vt_json_i64(j, so, "set", k);
+            /* each frame's scores; "frames" (json_scores) is their count */
+            cJSON *fr = vt_json_array(j, so, "per_frame");
+            for (int l = 0; l < v->light_count[k]; l++, fi++) {
+                vb_frames_tally_add(&set, &T[fi]);
+                cJSON *o = vt_json_object(j, fr, NULL);
+                vt_json_i64(j, o, "light", l);
+                vt_frame_path(p, sizeof p, op->frames, v->name, k, l, mode);
+                vt_json_string(j, o, "file", p);
+                json_scores(j, o, &T[fi]);
+            }
+            json_scores(j, so, &set);
+            vb_frames_tally_add(&scene, &set);
+            if (!op->quiet) {
+                char sk[16];
+                snprintf(sk, sizeof sk, "%d", k);
+                print_row(v->name, sk, v->light_count[k], &set);
+            }
+        }
+    }
+    json_scores(j, vt_json_object(j, mo, "scene"), &scene);
+    if (!op->quiet)
+        print_row("scene", "", (int)scene.frames, &scene);
+}
+
 static int run_score(const options *op)
 {
     const char *path = op->path, *views_path = op->views_path, *truth = op->truth;
     const char *frames = op->frames, *json = op->json;
-    const char(*modes)[64] = op->modes;
-    const int mode_count = op->mode_count;
     {
         const char *ins[] = {path, views_path};
         if (vt_cli_check_outputs(&json, 1, ins, 2) != 0)
@@ -974,48 +1079,15 @@ static int run_score(const options *op)
     int status = 1;
     /* Tallies: per mode, per (view, set, light) frame; sets and the scene
      * are sums of those, in order. */
-    size_t frame_count = 0;
-    for (int vi = 0; vi < V.count; vi++)
-        for (int k = 0; k < V.views[vi].set_count; k++)
-            frame_count += (size_t)V.views[vi].light_count[k];
-    vb_frames_tally *tally = calloc((size_t)mode_count * frame_count, sizeof *tally);
-    float *hard = NULL, *ideal = NULL, *mask = NULL, *s = NULL;
+    const size_t frame_count = frame_count_of(&V);
+    vb_frames_tally *tally = calloc((size_t)op->mode_count * frame_count, sizeof *tally);
     vt_json j = {0};
-    vb_error err;
-    char p[PATH_MAX];
     if (!tally) {
         fprintf(stderr, PROG ": out of memory\n");
         goto done;
     }
-    size_t fi = 0;
-    for (int vi = 0; vi < V.count; vi++) {
-        const vt_view *v = V.views + vi;
-        for (int k = 0; k < v->set_count; k++)
-            for (int l = 0; l < v->light_count[k]; l++, fi++) {
-                if (read_frame(truth, &V, views_path, v->name, k, l, "hard", &hard, p, sizeof p) ||
-                    read_frame(truth, &V, views_path, v->name, k, l, "ideal", &ideal, p,
-                               sizeof p) ||
-                    read_frame(truth, &V, views_path, v->name, k, l, "mask", &mask, p, sizeof p))
-                    goto done;
-                for (int m = 0; m < mode_count; m++) {
-                    if (read_frame(frames, &V, views_path, v->name, k, l, modes[m], &s, p,
-                                   sizeof p))
-                        goto done;
-                    if (vb_frames_score_frame(s, hard, ideal, mask, V.width, V.height,
-                                              &tally[(size_t)m * frame_count + fi],
-                                              &err) != VB_OK) {
-                        fprintf(stderr, PROG ": %s: %s\n", p, err.msg);
-                        goto done;
-                    }
-                    free(s);
-                    s = NULL;
-                }
-                free(hard);
-                free(ideal);
-                free(mask);
-                hard = ideal = mask = NULL;
-            }
-    }
+    if (score_frames(op, &V, frame_count, tally))
+        goto done;
 
     /* Report: the table, then the JSON. */
     cJSON *root = vt_json_object(&j, NULL, NULL);
@@ -1033,47 +1105,8 @@ static int run_score(const options *op)
     if (!op->quiet)
         printf(PROG " score: %s, %d view%s from %s, %d x %d; truth %s, frames %s\n", path, V.count,
                vdsh_s((unsigned)V.count), views_path, V.width, V.height, truth, frames);
-    for (int m = 0; m < mode_count; m++) {
-        const vb_frames_tally *T = tally + (size_t)m * frame_count;
-        vb_frames_tally scene = {0};
-        cJSON *mo = vt_json_object(&j, jm, NULL);
-        vt_json_string(&j, mo, "mode", modes[m]);
-        cJSON *sets = vt_json_array(&j, mo, "sets");
-        if (!op->quiet)
-            printf("\n  mode %s\n  %-10s %-3s %6s %9s  %8s %6s  %8s %6s  %7s %7s  %s\n", modes[m],
-                   "view", "set", "lights", "counted", "RMSE/id", "PSNR", "RMSE/hd", "PSNR",
-                   "recall", "false", "blotches");
-        fi = 0;
-        for (int vi = 0; vi < V.count; vi++) {
-            const vt_view *v = V.views + vi;
-            for (int k = 0; k < v->set_count; k++) {
-                vb_frames_tally set = {0};
-                cJSON *so = vt_json_object(&j, sets, NULL);
-                vt_json_string(&j, so, "view", v->name);
-                vt_json_i64(&j, so, "set", k);
-                /* each frame's scores; "frames" (json_scores) is their count */
-                cJSON *fr = vt_json_array(&j, so, "per_frame");
-                for (int l = 0; l < v->light_count[k]; l++, fi++) {
-                    vb_frames_tally_add(&set, &T[fi]);
-                    cJSON *o = vt_json_object(&j, fr, NULL);
-                    vt_json_i64(&j, o, "light", l);
-                    vt_frame_path(p, sizeof p, frames, v->name, k, l, modes[m]);
-                    vt_json_string(&j, o, "file", p);
-                    json_scores(&j, o, &T[fi]);
-                }
-                json_scores(&j, so, &set);
-                vb_frames_tally_add(&scene, &set);
-                if (!op->quiet) {
-                    char sk[16];
-                    snprintf(sk, sizeof sk, "%d", k);
-                    print_row(v->name, sk, v->light_count[k], &set);
-                }
-            }
-        }
-        json_scores(&j, vt_json_object(&j, mo, "scene"), &scene);
-        if (!op->quiet)
-            print_row("scene", "", (int)scene.frames, &scene);
-    }
+    for (int m = 0; m < op->mode_count; m++)
+        report_mode(op, &V, m, tally + (size_t)m * frame_count, &j, jm);
     if (!op->quiet)
         printf("\n  (over mask pixels; recall: of hard = 0 and ideal < .5, drawn < .5; false: "
                "of hard = 1, drawn < .5;\n   blotches: false-shadow regions above %.2f%% of a "
@@ -1088,10 +1121,6 @@ static int run_score(const options *op)
 done:
     vt_json_free(&j);
     free(tally);
-    free(hard);
-    free(ideal);
-    free(mask);
-    free(s);
     loaded_free(&L);
     vt_views_free(&V);
     return status;
