@@ -105,6 +105,147 @@ static vr_result shaded_frame(vr_renderer *r, const vr_scene *scene, const vv_op
     return res;
 }
 
+/* The modes: those asked for (each must be in the scene), else every
+ * shadow mode the scene has. Returns 0, or 1 with the message printed. */
+static int choose_modes(const vv_options *o, const vr_scene *scene, int modes[VV_MAX_MODES],
+                        int *nm)
+{
+    int rc = 0;
+    *nm = 0;
+    if (o->frame_mode_count) {
+        for (int i = 0; i < o->frame_mode_count && !rc; i++) {
+            const vv_mode *m = &vv_modes[o->frame_modes[i]];
+            if (!vv_mode_available(scene, m)) {
+                fprintf(stderr, "vdsh-view: %s: mode %s is not available in this file%s\n",
+                        o->files[0], m->name,
+                        m->mode == VR_MODE_VDSH5 ? " (order 5 with its basis cubemaps)" : "");
+                rc = 1;
+            }
+            modes[(*nm)++] = o->frame_modes[i];
+        }
+    } else {
+        for (int i = 0; vv_modes[i].name; i++)
+            if ((vv_modes[i].flags & VV_MODE_FRAMES_DEFAULT) &&
+                vv_mode_available(scene, &vv_modes[i]))
+                modes[(*nm)++] = i;
+    }
+    return rc;
+}
+
+/* What every frame of the run shares. */
+typedef struct frames_run {
+    const vv_options *o;
+    const vt_views *vs;
+    const vv_session *s;
+    /* The shadow frames' target (RGBA32F); shaded pictures use s->r. */
+    vr_renderer *rf;
+    int w, h;
+    size_t n;
+    /* A shadow frame read back and its grey values; a shaded picture. */
+    float *rgba, *grey;
+    unsigned char *px;
+    /* Frames in all and written so far, for the progress lines. */
+    int total, done;
+} frames_run;
+
+/* One mode's times: the first frame's (it compiles the program), the
+ * others' draw and read-back, and the PNGs'. */
+typedef struct mode_times {
+    double first_ms, mode_ms, png_ms;
+    int frames;
+} mode_times;
+
+/* The shadow frame of light j of set k, written as a 16-bit grey PNG. */
+static int write_shadow_frame(frames_run *F, const vv_mode *m, const vt_view *view,
+                              const vr_camera *cam, int k, int j, mode_times *t)
+{
+    const vv_options *o = F->o;
+    char path[4096], msg[1024];
+    vr_error err;
+    if (vt_frame_path(path, sizeof path, o->frames_dir, view->name, k, j, m->name)) {
+        fprintf(stderr, "vdsh-view: %s: frame path too long\n", o->frames_dir);
+        return 1;
+    }
+    double t0 = vv_now_ms();
+    if (shadow_frame(F->rf, F->s->scene, o, m, cam, view->lights[k][j], F->rgba, F->grey, F->n,
+                     &err) != VR_OK) {
+        fprintf(stderr, "vdsh-view: %s: %s: %s\n", o->files[0], path, err.msg);
+        return 1;
+    }
+    double ms = vv_now_ms() - t0;
+    if (t->frames++ == 0)
+        t->first_ms = ms;
+    else
+        t->mode_ms += ms;
+    F->done++;
+    double t1 = vv_now_ms();
+    if (vt_png16_write(path, F->w, F->h, F->grey, msg, sizeof msg) != 0) {
+        fprintf(stderr, "vdsh-view: %s\n", msg);
+        return 1;
+    }
+    double wms = vv_now_ms() - t1;
+    t->png_ms += wms;
+    if (!o->quiet)
+        fprintf(stderr, "vdsh-view: [%d/%d] %s  %.1f ms (PNG %.1f ms)\n", F->done, F->total, path,
+                ms, wms);
+    return 0;
+}
+
+/* The shaded picture of set k, written as an RGBA PNG. */
+static int write_shaded_frame(frames_run *F, const vv_mode *m, const vt_view *view,
+                              const vr_camera *cam, int k)
+{
+    const vv_options *o = F->o;
+    char path[4096], msg[1024];
+    vr_error err;
+    if (vt_shaded_path(path, sizeof path, o->frames_dir, view->name, k, m->name)) {
+        fprintf(stderr, "vdsh-view: %s: frame path too long\n", o->frames_dir);
+        return 1;
+    }
+    if (shaded_frame(F->s->r, F->s->scene, o, m, cam, view, k, F->px, F->n, &err) != VR_OK) {
+        fprintf(stderr, "vdsh-view: %s: %s: %s\n", o->files[0], path, err.msg);
+        return 1;
+    }
+    if (vt_png_rgba_write(path, F->w, F->h, F->px, msg, sizeof msg) != 0) {
+        fprintf(stderr, "vdsh-view: %s\n", msg);
+        return 1;
+    }
+    return 0;
+}
+
+/* Every frame of mode m (one program, its shadow maps re-rendered per
+ * frame), then a line with its times: a frame's is its draw and
+ * read-back, without the PNG. */
+static int render_mode(frames_run *F, const vv_mode *m)
+{
+    const vv_options *o = F->o;
+    mode_times t = {0};
+    for (int v = 0; v < F->vs->count; v++) {
+        const vt_view *view = &F->vs->views[v];
+        vr_camera cam;
+        view_camera(view, &cam);
+        for (int k = 0; k < view->set_count; k++) {
+            for (int j = 0; j < view->light_count[k]; j++)
+                if (write_shadow_frame(F, m, view, &cam, k, j, &t))
+                    return 1;
+            if (write_shaded_frame(F, m, view, &cam, k))
+                return 1;
+        }
+    }
+    /* The first frame of a mode compiles its program. */
+    if (!o->quiet && t.frames > 1)
+        fprintf(stderr,
+                "vdsh-view: mode %s: %d frames of %dx%d, %.1f ms per frame after "
+                "the first (%.1f ms: compiling), draw and read-back; PNG %.1f ms per "
+                "frame\n",
+                m->name, t.frames, F->w, F->h, t.mode_ms / (t.frames - 1), t.first_ms,
+                t.png_ms / t.frames);
+    else if (!o->quiet && t.frames == 1)
+        fprintf(stderr, "vdsh-view: mode %s: 1 frame of %dx%d, %.1f ms (with compiling)\n", m->name,
+                F->w, F->h, t.first_ms);
+    return 0;
+}
+
 int vv_run_frames(const vv_options *o)
 {
     char msg[1024];
@@ -136,119 +277,33 @@ int vv_run_frames(const vv_options *o)
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
         rc = 1;
     }
-
-    /* The modes: those asked for (each must be in the scene), else every
-     * shadow mode the scene has. */
     int modes[VV_MAX_MODES], nm = 0;
-    if (!rc && o->frame_mode_count) {
-        for (int i = 0; i < o->frame_mode_count && !rc; i++) {
-            const vv_mode *m = &vv_modes[o->frame_modes[i]];
-            if (!vv_mode_available(s.scene, m)) {
-                fprintf(stderr, "vdsh-view: %s: mode %s is not available in this file%s\n",
-                        o->files[0], m->name,
-                        m->mode == VR_MODE_VDSH5 ? " (order 5 with its basis cubemaps)" : "");
-                rc = 1;
-            }
-            modes[nm++] = o->frame_modes[i];
-        }
-    } else if (!rc) {
-        for (int i = 0; vv_modes[i].name; i++)
-            if ((vv_modes[i].flags & VV_MODE_FRAMES_DEFAULT) &&
-                vv_mode_available(s.scene, &vv_modes[i]))
-                modes[nm++] = i;
-    }
+    if (!rc)
+        rc = choose_modes(o, s.scene, modes, &nm);
 
-    float *rgba = malloc(n * 4 * sizeof(float)), *grey = malloc(n * sizeof(float));
-    unsigned char *px = malloc(n * 4);
-    if (!rc && (!rgba || !grey || !px)) {
+    frames_run F = {.o = o, .vs = &vs, .s = &s, .rf = rf, .w = w, .h = h, .n = n};
+    F.rgba = malloc(n * 4 * sizeof(float));
+    F.grey = malloc(n * sizeof(float));
+    F.px = malloc(n * 4);
+    if (!rc && (!F.rgba || !F.grey || !F.px)) {
         fprintf(stderr, "vdsh-view: out of memory (%dx%d frames)\n", w, h);
         rc = 1;
     }
-    int total = 0, done = 0;
     for (int v = 0; v < vs.count; v++)
         for (int k = 0; k < vs.views[v].set_count; k++)
-            total += vs.views[v].light_count[k];
-    total *= nm;
+            F.total += vs.views[v].light_count[k];
+    F.total *= nm;
     if (!rc && !o->quiet)
         fprintf(stderr,
                 "vdsh-view: %s: %d view%s of %s, %d shadow frames of %dx%d in %d "
                 "mode%s, into %s (%s)\n",
-                o->files[0], vs.count, vs.count == 1 ? "" : "s", o->views_path, total, w, h, nm,
+                o->files[0], vs.count, vs.count == 1 ? "" : "s", o->views_path, F.total, w, h, nm,
                 nm == 1 ? "" : "s", o->frames_dir, vr_gl_renderer());
-
-    /* Mode by mode (one program, its shadow maps re-rendered per frame);
-     * the time of a frame is its draw and read-back, without the PNG. */
-    for (int mi = 0; mi < nm && !rc; mi++) {
-        const vv_mode *m = &vv_modes[modes[mi]];
-        double mode_ms = 0.0, first_ms = 0.0, png_ms = 0.0;
-        int mode_frames = 0;
-        for (int v = 0; v < vs.count && !rc; v++) {
-            const vt_view *view = &vs.views[v];
-            vr_camera cam;
-            view_camera(view, &cam);
-            for (int k = 0; k < view->set_count && !rc; k++) {
-                char path[4096];
-                for (int j = 0; j < view->light_count[k] && !rc; j++) {
-                    if (vt_frame_path(path, sizeof path, o->frames_dir, view->name, k, j,
-                                      m->name)) {
-                        fprintf(stderr, "vdsh-view: %s: frame path too long\n", o->frames_dir);
-                        rc = 1;
-                        break;
-                    }
-                    double t0 = vv_now_ms();
-                    if (shadow_frame(rf, s.scene, o, m, &cam, view->lights[k][j], rgba, grey, n,
-                                     &err) != VR_OK) {
-                        fprintf(stderr, "vdsh-view: %s: %s: %s\n", o->files[0], path, err.msg);
-                        rc = 1;
-                        break;
-                    }
-                    double ms = vv_now_ms() - t0;
-                    if (mode_frames++ == 0)
-                        first_ms = ms;
-                    else
-                        mode_ms += ms;
-                    done++;
-                    double t1 = vv_now_ms();
-                    if (vt_png16_write(path, w, h, grey, msg, sizeof msg) != 0) {
-                        fprintf(stderr, "vdsh-view: %s\n", msg);
-                        rc = 1;
-                        break;
-                    }
-                    double wms = vv_now_ms() - t1;
-                    png_ms += wms;
-                    if (!o->quiet)
-                        fprintf(stderr, "vdsh-view: [%d/%d] %s  %.1f ms (PNG %.1f ms)\n", done,
-                                total, path, ms, wms);
-                }
-                if (rc)
-                    break;
-                if (vt_shaded_path(path, sizeof path, o->frames_dir, view->name, k, m->name)) {
-                    fprintf(stderr, "vdsh-view: %s: frame path too long\n", o->frames_dir);
-                    rc = 1;
-                } else if (shaded_frame(s.r, s.scene, o, m, &cam, view, k, px, n, &err) != VR_OK) {
-                    fprintf(stderr, "vdsh-view: %s: %s: %s\n", o->files[0], path, err.msg);
-                    rc = 1;
-                } else if (vt_png_rgba_write(path, w, h, px, msg, sizeof msg) != 0) {
-                    fprintf(stderr, "vdsh-view: %s\n", msg);
-                    rc = 1;
-                }
-            }
-        }
-        /* The first frame of a mode compiles its program. */
-        if (!rc && !o->quiet && mode_frames > 1)
-            fprintf(stderr,
-                    "vdsh-view: mode %s: %d frames of %dx%d, %.1f ms per frame after "
-                    "the first (%.1f ms: compiling), draw and read-back; PNG %.1f ms per "
-                    "frame\n",
-                    m->name, mode_frames, w, h, mode_ms / (mode_frames - 1), first_ms,
-                    png_ms / mode_frames);
-        else if (!rc && !o->quiet && mode_frames == 1)
-            fprintf(stderr, "vdsh-view: mode %s: 1 frame of %dx%d, %.1f ms (with compiling)\n",
-                    m->name, w, h, first_ms);
-    }
-    free(rgba);
-    free(grey);
-    free(px);
+    for (int mi = 0; mi < nm && !rc; mi++)
+        rc = render_mode(&F, &vv_modes[modes[mi]]);
+    free(F.rgba);
+    free(F.grey);
+    free(F.px);
     vr_renderer_destroy(rf);
     vv_session_close(&s);
     vt_views_free(&vs);

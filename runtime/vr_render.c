@@ -541,55 +541,65 @@ static void camera_matrix(const vr_renderer *r, const vr_scene *s, const vr_came
     vr_mat4_mul(vp, proj, view);
 }
 
-vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, vr_error *err)
+/* The descriptor's defaults, in one place. */
+static void draw_defaults(const vr_scene *s, vr_draw_desc *d)
 {
-    if (!r || !s || !desc)
-        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: NULL renderer, scene or descriptor");
-    vr_draw_desc d = *desc;
-    /* Defaults, in one place. */
-    if (d.mode == VR_MODE_DEFAULT)
-        d.mode = vr_scene_default_mode(s);
-    if (!d.albedo[0] && !d.albedo[1] && !d.albedo[2])
-        d.albedo[0] = d.albedo[1] = d.albedo[2] = 0.8f;
+    if (d->mode == VR_MODE_DEFAULT)
+        d->mode = vr_scene_default_mode(s);
+    if (!d->albedo[0] && !d->albedo[1] && !d->albedo[2])
+        d->albedo[0] = d->albedo[1] = d->albedo[2] = 0.8f;
+    if (d->sdf_k == 0.0f)
+        d->sdf_k = VDSH_SDF_DEFAULT_K;
+}
 
-    if ((unsigned)d.mode >= VR_MODE_COUNT_)
-        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown mode %u", (unsigned)d.mode);
-    if ((unsigned)d.compare > VDSH_COMPARE_BINARY)
-        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown comparison %u", (unsigned)d.compare);
-    if ((unsigned)d.output > VR_OUTPUT_POSITION)
-        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown output %u", (unsigned)d.output);
-    if (d.sdf_k == 0.0f)
-        d.sdf_k = VDSH_SDF_DEFAULT_K;
-    if (!(d.sdf_k > 0.0f && d.sdf_k < 1e6f))
+/* The descriptor's values, its defaults filled in. */
+static vr_result check_draw_desc(const vr_draw_desc *d, vr_error *err)
+{
+    if ((unsigned)d->mode >= VR_MODE_COUNT_)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown mode %u", (unsigned)d->mode);
+    if ((unsigned)d->compare > VDSH_COMPARE_BINARY)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown comparison %u",
+                       (unsigned)d->compare);
+    if ((unsigned)d->output > VR_OUTPUT_POSITION)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: unknown output %u", (unsigned)d->output);
+    if (!(d->sdf_k > 0.0f && d->sdf_k < 1e6f))
         return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: sdf_k %g is not a number > 0",
-                       (double)d.sdf_k);
-    if (d.light_count < 0 || (d.light_count > 0 && !d.lights))
-        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: %d light%s but no array", d.light_count,
-                       vdsh_plural((unsigned long long)d.light_count, "", "s"));
-    for (int i = 0; i < d.light_count; i++)
-        if (!finite3(d.lights[i].position) || !finite3(d.lights[i].color) ||
-            !finite3(d.lights[i].attenuation))
+                       (double)d->sdf_k);
+    if (d->light_count < 0 || (d->light_count > 0 && !d->lights))
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: %d light%s but no array", d->light_count,
+                       vdsh_plural((unsigned long long)d->light_count, "", "s"));
+    for (int i = 0; i < d->light_count; i++)
+        if (!finite3(d->lights[i].position) || !finite3(d->lights[i].color) ||
+            !finite3(d->lights[i].attenuation))
             return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: light %d is not finite", i);
-    vr_mode mode = d.mode;
-    const vr_buffer *buf = NULL;
+    return VR_OK;
+}
+
+/* Whether the scene has what d->mode draws, with a message that says what
+ * is missing and how to get it; for mode buffer, *buf: the stream drawn. */
+static vr_result check_mode(const vr_scene *s, const vr_draw_desc *d, const vr_buffer **buf,
+                            vr_error *err)
+{
+    vr_mode mode = d->mode;
+    *buf = NULL;
     if (mode == VR_MODE_VDSH_BUFFER) {
-        buf = vr_scene_buffer(s, d.stream);
-        if (!buf && d.stream == VR_STREAM_VARIABLE)
+        *buf = vr_scene_buffer(s, d->stream);
+        if (!*buf && d->stream == VR_STREAM_VARIABLE)
             return vr_fail(err, VR_ERR_MISSING,
                            "mode buffer: the scene has no %s stream with "
                            "an order per vertex",
                            vdsh_quantity_name(s->quantity));
-        if (!buf && d.stream == 0)
+        if (!*buf && d->stream == 0)
             return vr_fail(err, VR_ERR_MISSING,
                            "mode buffer: the scene has no %s stream in a "
                            "buffer (orders 1, 4, above 5, an order per vertex; 2, 3, 5 with "
                            "vr_scene_desc.buffers)",
                            vdsh_quantity_name(s->quantity));
-        if (!buf)
+        if (!*buf)
             return vr_fail(err, VR_ERR_MISSING,
                            "mode buffer: the scene has no order-%d %s stream in a buffer%s",
-                           d.stream, vdsh_quantity_name(s->quantity),
-                           d.stream >= 1 && d.stream <= 5 && s->vbo_stream[d.stream]
+                           d->stream, vdsh_quantity_name(s->quantity),
+                           d->stream >= 1 && d->stream <= 5 && s->vbo_stream[d->stream]
                                ? " (orders 2, 3, 5 are buffered with vr_scene_desc.buffers)"
                                : "");
     } else if (!vr_scene_supports(s, mode)) {
@@ -610,9 +620,13 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
         return vr_fail(err, VR_ERR_MISSING, "mode %s: the scene has no order-%d %s stream",
                        vr_mode_name(mode), vr_mode_order(mode), vdsh_quantity_name(s->quantity));
     }
-    int order = vr_mode_order(mode);
+    return VR_OK;
+}
 
-    /* Timing slot of this frame. */
+/* The timing slot of a new frame, its finished predecessors' timings
+ * collected first. */
+static frame_slot *begin_frame(vr_renderer *r)
+{
     uint64_t frame = ++r->frame;
     frame_slot *slot = &r->slots[frame % FRAMES_IN_FLIGHT];
     for (int i = 0; i < FRAMES_IN_FLIGHT; i++)
@@ -622,155 +636,210 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
     slot->count = 0;
     slot->pending = 1;
     slot->cpu_start = now_seconds();
+    return slot;
+}
 
-    float vp[16];
-    camera_matrix(r, s, &d.camera, vp);
-
-    int per = r->per_pass;
-    int groups = d.light_count > 0 ? (d.light_count + per - 1) / per : 1;
-    if (d.output != VR_OUTPUT_COLOR)
-        groups = 1;
-    slot->groups = groups;
-
+/* The frame's target cleared, and the state every pass starts from. */
+static void clear_target(const vr_renderer *r, const vr_draw_desc *d)
+{
     glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
     glViewport(0, 0, r->width, r->height);
     glDepthMask(GL_TRUE);
-    glClearColor(d.clear_color[0], d.clear_color[1], d.clear_color[2], d.clear_color[3]);
+    glClearColor(d->clear_color[0], d->clear_color[1], d->clear_color[2], d->clear_color[3]);
     glClearDepth(1.0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glDisable(GL_CULL_FACE);
     glDisable(GL_BLEND);
     glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+}
 
-    /* A cpca stream decoded once per frame: into its scratch, which
-     * the passes read as f32 records (vr_buffer_decode). */
-    int scratch = buf && buf->decode_prog;
-    if (scratch)
-        vr_buffer_decode(s, buf);
+/* What every pass of one frame shares. */
+typedef struct draw_frame {
+    vr_renderer *r;
+    const vr_scene *s;
+    const vr_draw_desc *d;
+    /* The stream's order in the attribute modes (0: none). */
+    int order;
+    /* Mode buffer: the stream drawn, and whether it was decoded into its
+     * f32 scratch this frame (a cpca stream: vr_buffer_decode). */
+    const vr_buffer *buf;
+    int scratch;
+    float vp[16];
+    frame_slot *slot;
+} draw_frame;
 
-    vr_result res = VR_OK;
-    for (int g = 0; g < groups && res == VR_OK; g++) {
-        const vr_light *group = d.lights ? d.lights + g * per : NULL;
-        int n = d.light_count - g * per;
-        if (n > per)
-            n = per;
-        if (n < 0)
-            n = 0;
+/* The program of a pass of n lights: everything that changes its source. */
+static void program_key(const draw_frame *F, int n, vr_program_key *key)
+{
+    const vr_draw_desc *d = F->d;
+    const vr_buffer *buf = F->buf;
+    memset(key, 0, sizeof *key);
+    key->mode = (uint8_t)d->mode;
+    key->compare = (uint8_t)d->compare;
+    key->quantity = (uint8_t)F->s->quantity;
+    key->output = (uint8_t)d->output;
+    key->pcf = (uint8_t)(d->pcf && d->mode == VR_MODE_CUBE);
+    key->lights = (uint8_t)n;
+    key->packed = F->order && F->s->encoding[F->order] == VDSH_ENCODING_S8S6;
+    if (buf) {
+        key->buf_order = (uint8_t)buf->order;
+        key->buf_kind = (uint8_t)(F->scratch ? VR_BUF_F32 : buf->kind);
+        key->buf_variable = (uint8_t)buf->variable;
+        key->ks_hash = buf->ks_hash;
+        key->cpca_basis = (uint16_t)(F->scratch ? 0 : buf->cpca_basis);
+        key->cpca_bits = (uint8_t)(F->scratch ? 0 : buf->cpca_bits);
+        key->cpca_words = (uint8_t)(F->scratch || buf->kind != VR_BUF_CPCA ? 0 : buf->stride);
+    }
+}
 
-        float nf[VR_MAX_LIGHTS_PER_PASS][2];
-        if (mode == VR_MODE_CUBE && n > 0) {
-            int t = timer_begin(r, slot, 0, g);
-            res = render_shadow_maps(r, s, group, n, nf, err);
-            timer_end(t);
-            if (res != VR_OK)
-                break;
-        }
+/* Depth and blending of pass g: the first writes depth, the others add
+ * their lights onto it where the depth is equal. */
+static void pass_state(const vr_renderer *r, int g)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
+    glViewport(0, 0, r->width, r->height);
+    glEnable(GL_DEPTH_TEST);
+    if (g == 0) {
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_TRUE);
+        glDisable(GL_BLEND);
+    } else {
+        glDepthFunc(GL_LEQUAL);
+        glDepthMask(GL_FALSE);
+        glEnable(GL_BLEND);
+        glBlendFunc(GL_ONE, GL_ONE);
+    }
+}
 
-        vr_program_key key;
-        memset(&key, 0, sizeof key);
-        key.mode = (uint8_t)mode;
-        key.compare = (uint8_t)d.compare;
-        key.quantity = (uint8_t)s->quantity;
-        key.output = (uint8_t)d.output;
-        key.pcf = (uint8_t)(d.pcf && mode == VR_MODE_CUBE);
-        key.lights = (uint8_t)n;
-        key.packed = order && s->encoding[order] == VDSH_ENCODING_S8S6;
-        if (buf) {
-            key.buf_order = (uint8_t)buf->order;
-            key.buf_kind = (uint8_t)(scratch ? VR_BUF_F32 : buf->kind);
-            key.buf_variable = (uint8_t)buf->variable;
-            key.ks_hash = buf->ks_hash;
-            key.cpca_basis = (uint16_t)(scratch ? 0 : buf->cpca_basis);
-            key.cpca_bits = (uint8_t)(scratch ? 0 : buf->cpca_bits);
-            key.cpca_words = (uint8_t)(scratch || buf->kind != VR_BUF_CPCA ? 0 : buf->stride);
+/* The uniforms of pass g: camera, the stream's scale and steps, the
+ * ambient term (first pass only) and the group's n lights. */
+static void set_uniforms(const draw_frame *F, const vr_program *p, int g, const vr_light *group,
+                         int n)
+{
+    const vr_scene *s = F->s;
+    const vr_draw_desc *d = F->d;
+    int order = F->order;
+    glUseProgram(p->prog);
+    glUniformMatrix4fv(p->u_view_proj, 1, GL_FALSE, F->vp);
+    glUniform1f(p->u_scale, F->buf ? F->buf->scale : order ? s->scale[order] : 1.0f);
+    if (order)
+        glUniform4fv(p->u_coef_step, VR_COEF_ATTRIBS, s->coef_step[order]);
+    glUniform1f(p->u_max_distance, s->max_distance);
+    /* The albedo multiplies the ambient term and the light colours
+     * here, once, rather than every fragment. */
+    float ambient[3];
+    for (int k = 0; k < 3; k++)
+        ambient[k] = g == 0 ? d->albedo[k] * d->ambient[k] : 0.0f;
+    glUniform3fv(p->u_ambient, 1, ambient);
+    if (n > 0) {
+        float pos[VR_MAX_LIGHTS_PER_PASS][3], col[VR_MAX_LIGHTS_PER_PASS][3];
+        float att[VR_MAX_LIGHTS_PER_PASS][3];
+        for (int i = 0; i < n; i++) {
+            const vr_light *L = &group[i];
+            memcpy(pos[i], L->position, sizeof pos[i]);
+            int black = !L->color[0] && !L->color[1] && !L->color[2];
+            for (int k = 0; k < 3; k++)
+                col[i][k] = d->albedo[k] * (black ? 1.0f : L->color[k]);
+            int none = !L->attenuation[0] && !L->attenuation[1] && !L->attenuation[2];
+            for (int k = 0; k < 3; k++)
+                att[i][k] = none ? (k == 0 ? 1.0f : 0.0f) : L->attenuation[k];
         }
-        const vr_program *p = NULL;
-        res = get_program(r, &key, buf ? buf->ks : NULL,
-                          buf && !scratch && buf->kind == VR_BUF_CPCA ? buf->cpca_unpack : NULL, &p,
-                          err);
-        if (res != VR_OK)
-            break;
+        glUniform3fv(p->u_light_pos, n, &pos[0][0]);
+        glUniform3fv(p->u_light_color, n, &col[0][0]);
+        glUniform3fv(p->u_light_att, n, &att[0][0]);
+    }
+}
 
-        int t = timer_begin(r, slot, 1, g);
-        glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
-        glViewport(0, 0, r->width, r->height);
-        glEnable(GL_DEPTH_TEST);
-        if (g == 0) {
-            glDepthFunc(GL_LESS);
-            glDepthMask(GL_TRUE);
-            glDisable(GL_BLEND);
-        } else {
-            glDepthFunc(GL_LEQUAL);
-            glDepthMask(GL_FALSE);
-            glEnable(GL_BLEND);
-            glBlendFunc(GL_ONE, GL_ONE);
+/* The textures the mode reads: the group's shadow maps (nf: their near
+ * and far planes), the basis cubemaps, the distance volume or the
+ * buffer stream; unit 0 active after. */
+static void bind_textures(const draw_frame *F, const vr_program *p, const vr_program_key *key,
+                          int n, const float nf[][2])
+{
+    const vr_renderer *r = F->r;
+    const vr_scene *s = F->s;
+    const vr_buffer *buf = F->buf;
+    vr_mode mode = F->d->mode;
+    if (mode == VR_MODE_CUBE && n > 0) {
+        glUniform2fv(p->u_shadow_nf, n, &nf[0][0]);
+        glUniform1f(p->u_shadow_texel, 2.0f / (float)r->shadow_size);
+        for (int i = 0; i < n; i++) {
+            glActiveTexture(GL_TEXTURE0 + VR_UNIT_SHADOW + (GLenum)i);
+            glBindTexture(GL_TEXTURE_CUBE_MAP, r->shadow_tex[i]);
+            glBindSampler(VR_UNIT_SHADOW + (GLuint)i,
+                          key->pcf ? r->sampler_linear : r->sampler_nearest);
         }
-        glUseProgram(p->prog);
-        glUniformMatrix4fv(p->u_view_proj, 1, GL_FALSE, vp);
-        glUniform1f(p->u_scale, buf ? buf->scale : order ? s->scale[order] : 1.0f);
-        if (order)
-            glUniform4fv(p->u_coef_step, VR_COEF_ATTRIBS, s->coef_step[order]);
-        glUniform1f(p->u_max_distance, s->max_distance);
-        /* The albedo multiplies the ambient term and the light colours
-         * here, once, rather than every fragment. */
-        float ambient[3];
-        for (int k = 0; k < 3; k++)
-            ambient[k] = g == 0 ? d.albedo[k] * d.ambient[k] : 0.0f;
-        glUniform3fv(p->u_ambient, 1, ambient);
-        if (n > 0) {
-            float pos[VR_MAX_LIGHTS_PER_PASS][3], col[VR_MAX_LIGHTS_PER_PASS][3];
-            float att[VR_MAX_LIGHTS_PER_PASS][3];
-            for (int i = 0; i < n; i++) {
-                const vr_light *L = &group[i];
-                memcpy(pos[i], L->position, sizeof pos[i]);
-                int black = !L->color[0] && !L->color[1] && !L->color[2];
-                for (int k = 0; k < 3; k++)
-                    col[i][k] = d.albedo[k] * (black ? 1.0f : L->color[k]);
-                int none = !L->attenuation[0] && !L->attenuation[1] && !L->attenuation[2];
-                for (int k = 0; k < 3; k++)
-                    att[i][k] = none ? (k == 0 ? 1.0f : 0.0f) : L->attenuation[k];
-            }
-            glUniform3fv(p->u_light_pos, n, &pos[0][0]);
-            glUniform3fv(p->u_light_color, n, &col[0][0]);
-            glUniform3fv(p->u_light_att, n, &att[0][0]);
+    }
+    if (mode == VR_MODE_VDSH5 && vr_mode_interp(mode, s->quantity) == VDSH_INTERP_SPLIT) {
+        for (int k = 0; k < 4; k++) {
+            glActiveTexture(GL_TEXTURE0 + VR_UNIT_BASIS + (GLenum)k);
+            glBindTexture(GL_TEXTURE_CUBE_MAP, s->basis[k]);
         }
-        if (mode == VR_MODE_CUBE && n > 0) {
-            glUniform2fv(p->u_shadow_nf, n, &nf[0][0]);
-            glUniform1f(p->u_shadow_texel, 2.0f / (float)r->shadow_size);
-            for (int i = 0; i < n; i++) {
-                glActiveTexture(GL_TEXTURE0 + VR_UNIT_SHADOW + (GLenum)i);
-                glBindTexture(GL_TEXTURE_CUBE_MAP, r->shadow_tex[i]);
-                glBindSampler(VR_UNIT_SHADOW + (GLuint)i,
-                              key.pcf ? r->sampler_linear : r->sampler_nearest);
-            }
+    }
+    if (mode == VR_MODE_SDF)
+        vr_sdf_bind(s, p->prog, F->d->sdf_k);
+    if (buf) {
+        glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
+        glBindTexture(GL_TEXTURE_BUFFER, F->scratch ? buf->scratch_tex : buf->tex);
+        if (buf->model_tex && !F->scratch) {
+            glActiveTexture(GL_TEXTURE0 + VR_UNIT_MODEL);
+            glBindTexture(GL_TEXTURE_BUFFER, buf->model_tex);
         }
-        if (mode == VR_MODE_VDSH5 && vr_mode_interp(mode, s->quantity) == VDSH_INTERP_SPLIT) {
-            for (int k = 0; k < 4; k++) {
-                glActiveTexture(GL_TEXTURE0 + VR_UNIT_BASIS + (GLenum)k);
-                glBindTexture(GL_TEXTURE_CUBE_MAP, s->basis[k]);
-            }
-        }
-        if (mode == VR_MODE_SDF)
-            vr_sdf_bind(s, p->prog, d.sdf_k);
-        if (buf) {
-            glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
-            glBindTexture(GL_TEXTURE_BUFFER, scratch ? buf->scratch_tex : buf->tex);
-            if (buf->model_tex && !scratch) {
-                glActiveTexture(GL_TEXTURE0 + VR_UNIT_MODEL);
-                glBindTexture(GL_TEXTURE_BUFFER, buf->model_tex);
-            }
-        }
-        glActiveTexture(GL_TEXTURE0);
-        glBindVertexArray(buf ? buf->vao : s->vao[order]);
-        if (d.points)
-            glDrawArrays(GL_POINTS, 0, (GLsizei)s->vertex_count);
-        else
-            glDrawElements(GL_TRIANGLES, (GLsizei)(3 * s->triangle_count), GL_UNSIGNED_INT, NULL);
+    }
+    glActiveTexture(GL_TEXTURE0);
+}
+
+/* Pass g: lights g * per .. of the frame's, their shadow maps first in
+ * mode cube, then the scene drawn with them. */
+static vr_result draw_pass(const draw_frame *F, int g, vr_error *err)
+{
+    vr_renderer *r = F->r;
+    const vr_scene *s = F->s;
+    const vr_draw_desc *d = F->d;
+    int per = r->per_pass;
+    const vr_light *group = d->lights ? d->lights + g * per : NULL;
+    int n = d->light_count - g * per;
+    if (n > per)
+        n = per;
+    if (n < 0)
+        n = 0;
+
+    float nf[VR_MAX_LIGHTS_PER_PASS][2];
+    if (d->mode == VR_MODE_CUBE && n > 0) {
+        int t = timer_begin(r, F->slot, 0, g);
+        vr_result res = render_shadow_maps(r, s, group, n, nf, err);
         timer_end(t);
+        if (res != VR_OK)
+            return res;
     }
 
-    /* Leave the state as the next user expects it. */
-    for (int i = 0; i < per; i++)
+    vr_program_key key;
+    program_key(F, n, &key);
+    const vr_buffer *buf = F->buf;
+    const vr_program *p = NULL;
+    vr_result res = get_program(
+        r, &key, buf ? buf->ks : NULL,
+        buf && !F->scratch && buf->kind == VR_BUF_CPCA ? buf->cpca_unpack : NULL, &p, err);
+    if (res != VR_OK)
+        return res;
+
+    int t = timer_begin(r, F->slot, 1, g);
+    pass_state(r, g);
+    set_uniforms(F, p, g, group, n);
+    bind_textures(F, p, &key, n, (const float(*)[2])nf);
+    glBindVertexArray(buf ? buf->vao : s->vao[F->order]);
+    if (d->points)
+        glDrawArrays(GL_POINTS, 0, (GLsizei)s->vertex_count);
+    else
+        glDrawElements(GL_TRIANGLES, (GLsizei)(3 * s->triangle_count), GL_UNSIGNED_INT, NULL);
+    timer_end(t);
+    return VR_OK;
+}
+
+/* Leave the state as the next user expects it. */
+static void restore_state(const vr_renderer *r)
+{
+    for (int i = 0; i < r->per_pass; i++)
         glBindSampler(VR_UNIT_SHADOW + (GLuint)i, 0);
     glBindVertexArray(0);
     glUseProgram(0);
@@ -778,6 +847,40 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
     glDepthFunc(GL_LESS);
     glDisable(GL_BLEND);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, vr_error *err)
+{
+    if (!r || !s || !desc)
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_draw: NULL renderer, scene or descriptor");
+    vr_draw_desc d = *desc;
+    draw_defaults(s, &d);
+    draw_frame F = {.r = r, .s = s, .d = &d};
+    vr_result res = check_draw_desc(&d, err);
+    if (res == VR_OK)
+        res = check_mode(s, &d, &F.buf, err);
+    if (res != VR_OK)
+        return res;
+    F.order = vr_mode_order(d.mode);
+    F.slot = begin_frame(r);
+    camera_matrix(r, s, &d.camera, F.vp);
+
+    int per = r->per_pass;
+    int groups = d.light_count > 0 ? (d.light_count + per - 1) / per : 1;
+    if (d.output != VR_OUTPUT_COLOR)
+        groups = 1;
+    F.slot->groups = groups;
+    clear_target(r, &d);
+
+    /* A cpca stream decoded once per frame: into its scratch, which
+     * the passes read as f32 records (vr_buffer_decode). */
+    F.scratch = F.buf && F.buf->decode_prog;
+    if (F.scratch)
+        vr_buffer_decode(s, F.buf);
+
+    for (int g = 0; g < groups && res == VR_OK; g++)
+        res = draw_pass(&F, g, err);
+    restore_state(r);
     if (res == VR_OK)
         res = vr_check_gl(err, "vr_draw");
     return res;

@@ -251,11 +251,9 @@ static vr_result default_view(vr_scene *s, const vdsh_file *f, const vr_scene_de
     return desc->light_pool > 0 ? vr_scene_place_pool(s, &vm, desc->light_pool, name, err) : VR_OK;
 }
 
-vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *err)
+/* The descriptor's own checks, before a file is read. */
+static vr_result check_desc(const vr_scene_desc *desc, const char *name, vr_error *err)
 {
-    if (!desc || !out || (!desc->path && !desc->file))
-        return vr_fail(err, VR_ERR_ARGUMENT, "vr_scene_create: no path or file given");
-    const char *name = desc->path ? desc->path : "(memory)";
     if ((unsigned)desc->quantity > VDSH_QUANTITY_LOG_DISTANCE)
         return vr_fail(err, VR_ERR_ARGUMENT, "%s: unknown quantity %u", name,
                        (unsigned)desc->quantity);
@@ -264,6 +262,142 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
                        desc->light_pool, VR_MAX_POOL_LIGHTS);
     if (!glGetString(GL_VERSION))
         return vr_fail(err, VR_ERR_GL, "%s: no current GL context", name);
+    return VR_OK;
+}
+
+/* What a valid file must also be to be drawn: triangles, a whole bake
+ * rather than one shard's part, a usable max_distance. */
+static vr_result check_drawable(const vdsh_file *f, const char *name, vr_error *err)
+{
+    const vdsh_header *h = &f->header;
+    if (h->vertex_count == 0 || h->triangle_count == 0)
+        return vr_fail(err, VR_ERR_FORMAT, "%s: no triangles to draw", name);
+    if (f->has_part) /* its streams hold one range's receivers */
+        return vr_fail(err, VR_ERR_FORMAT,
+                       "%s: a part of a sharded bake (shard %u of %u): "
+                       "join the parts with vdsh-merge first",
+                       name, f->part.index, f->part.count);
+    /* Checked by the reader for a file, not for one from memory: every
+     * reconstructed distance is clamped to it. */
+    if (!isfinite(h->max_distance) || !(h->max_distance > 0.0f))
+        return vr_fail(err, VR_ERR_FORMAT, "%s: max_distance %g must be finite and > 0", name,
+                       (double)h->max_distance);
+    return VR_OK;
+}
+
+/* The quantity to draw: the one asked for, else the file's own (a file
+ * baked with --log has only log-distance streams). */
+static vdsh_quantity drawn_quantity(const vdsh_file *f, vdsh_quantity asked)
+{
+    if (!has_quantity(f, asked))
+        for (uint32_t i = 0; i < f->stream_count; i++)
+            if (f->streams[i].order >= 1 && f->streams[i].order <= VDSH_MAX_ORDER)
+                return f->streams[i].quantity;
+    return asked;
+}
+
+/* Everything per vertex goes up in the order of vr_order_triangles (the
+ * same vertices and triangles, arranged for the vertex cache): the GPU's
+ * indices and remap, a file vertex's place on the GPU. Both allocated
+ * here, freed by the caller, also on failure. */
+static vr_result order_vertices(const vdsh_file *f, uint32_t **gpu_indices, uint32_t **remap,
+                                const char *name, vr_error *err)
+{
+    const vdsh_header *h = &f->header;
+    *gpu_indices = malloc(3 * (size_t)h->triangle_count * sizeof **gpu_indices);
+    *remap = malloc((size_t)h->vertex_count * sizeof **remap);
+    if (!*gpu_indices || !*remap)
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+    return vr_order_triangles(f->indices, h->triangle_count, h->vertex_count, *gpu_indices, *remap,
+                              name, err);
+}
+
+/* Positions, normals and indices in the GPU's order (order_vertices),
+ * and vao[0] over them. */
+static vr_result upload_geometry(vr_scene *s, const vdsh_file *f, const uint32_t *gpu_indices,
+                                 const uint32_t *remap, const char *name, vr_error *err)
+{
+    size_t nv = f->header.vertex_count, ni = 3 * (size_t)f->header.triangle_count;
+    glGenBuffers(1, &s->vbo_position);
+    glGenBuffers(1, &s->vbo_normal);
+    if (upload_permuted(s->vbo_position, f->positions, nv, 12, remap) ||
+        upload_permuted(s->vbo_normal, f->normals, nv, 12, remap))
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+    glGenVertexArrays(1, &s->vao[0]);
+    glBindVertexArray(s->vao[0]);
+    glGenBuffers(1, &s->ibo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, s->ibo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(ni * sizeof *gpu_indices), gpu_indices,
+                 GL_STATIC_DRAW);
+    vr_scene_base_attribs(s);
+    glBindVertexArray(0);
+    s->gpu_bytes = nv * 24 + (size_t)f->header.triangle_count * 12;
+    return VR_OK;
+}
+
+/* Vertex attributes: the first fixed-order stream of each order 1..5 in
+ * the drawn quantity (not cpca, decoded only from buffer textures). */
+static vr_result upload_attribute_streams(vr_scene *s, const vdsh_file *f, const uint32_t *remap,
+                                          const char *name, vr_error *err)
+{
+    vr_result r = VR_OK;
+    for (uint32_t i = 0; i < f->stream_count && r == VR_OK; i++) {
+        const vdsh_stream *st = &f->streams[i];
+        if (st->quantity != s->quantity || st->order < 1 || st->order > 5 ||
+            (st->flags & VDSH_STREAM_VARIABLE) || s->vbo_stream[st->order] ||
+            st->encoding == VDSH_ENCODING_CPCA)
+            continue;
+        r = upload_stream(s, st, f->header.vertex_count, remap, name, err);
+    }
+    return r;
+}
+
+/* Buffer textures (VR_MODE_VDSH_BUFFER): what attributes cannot hold or
+ * no attribute mode draws (orders 1, 4 and above 5, the stream with an
+ * order per vertex, cpca streams of any order: decoded in the vertex
+ * stage), and with desc->buffers orders 2, 3 and 5 too; the first stream
+ * of each. */
+static vr_result upload_buffer_streams(vr_scene *s, const vdsh_file *f, const vr_scene_desc *desc,
+                                       const uint32_t *remap, const char *name, vr_error *err)
+{
+    vr_result r = VR_OK;
+    for (uint32_t i = 0; i < f->stream_count && r == VR_OK; i++) {
+        const vdsh_stream *st = &f->streams[i];
+        int variable = (st->flags & VDSH_STREAM_VARIABLE) != 0;
+        if (st->quantity != s->quantity || st->order < 1 || st->order > VDSH_MAX_ORDER ||
+            (variable ? s->variable.order != 0
+                      : s->buffer[st->order].order ||
+                            ((st->order == 2 || st->order == 3 || st->order == 5) &&
+                             !desc->buffers && st->encoding != VDSH_ENCODING_CPCA)))
+            continue;
+        r = vr_buffer_upload(s, st, remap, desc->buffer_floats, desc->cpca_decode, name, err);
+        if (!variable && !s->vbo_stream[st->order])
+            s->method[st->order] = st->method;
+    }
+    return r;
+}
+
+/* The basis cubemaps of order 5's split path, at the face size the bake
+ * chose. */
+static vr_result upload_basis(vr_scene *s, uint32_t cube_size, const char *name, vr_error *err)
+{
+    glGenTextures(4, s->basis);
+    vr_result r = make_basis(s->basis, cube_size, name, err);
+    if (r != VR_OK)
+        return r;
+    s->cube_size = (int)cube_size;
+    s->gpu_bytes += 4 * 6 * (size_t)s->cube_size * (size_t)s->cube_size * 8;
+    return VR_OK;
+}
+
+vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *err)
+{
+    if (!desc || !out || (!desc->path && !desc->file))
+        return vr_fail(err, VR_ERR_ARGUMENT, "vr_scene_create: no path or file given");
+    const char *name = desc->path ? desc->path : "(memory)";
+    vr_result r = check_desc(desc, name, err);
+    if (r != VR_OK)
+        return r;
 
     /* 1. The file: read and validated by formats/ (every CRC and range). */
     vdsh_file *owned = NULL;
@@ -276,37 +410,13 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
         f = owned;
     }
     const vdsh_header *h = &f->header;
-    vr_result r = VR_OK;
     vr_scene *s = NULL;
     uint32_t *gpu_indices = NULL, *remap = NULL;
-    if (h->vertex_count == 0 || h->triangle_count == 0) {
-        r = vr_fail(err, VR_ERR_FORMAT, "%s: no triangles to draw", name);
+    if ((r = check_drawable(f, name, err)) != VR_OK)
         goto done;
-    }
-    if (f->has_part) { /* its streams hold one range's receivers */
-        r = vr_fail(err, VR_ERR_FORMAT,
-                    "%s: a part of a sharded bake (shard %u of %u): "
-                    "join the parts with vdsh-merge first",
-                    name, f->part.index, f->part.count);
-        goto done;
-    }
-    /* Checked by the reader for a file, not for one from memory: every
-     * reconstructed distance is clamped to it. */
-    if (!isfinite(h->max_distance) || !(h->max_distance > 0.0f)) {
-        r = vr_fail(err, VR_ERR_FORMAT, "%s: max_distance %g must be finite and > 0", name,
-                    (double)h->max_distance);
-        goto done;
-    }
 
-    /* 2. The quantity to draw: the one asked for, else the file's own
-     * (a file baked with --log has only log-distance streams). */
-    vdsh_quantity quantity = desc->quantity;
-    if (!has_quantity(f, quantity))
-        for (uint32_t i = 0; i < f->stream_count; i++)
-            if (f->streams[i].order >= 1 && f->streams[i].order <= VDSH_MAX_ORDER) {
-                quantity = f->streams[i].quantity;
-                break;
-            }
+    /* 2. The quantity to draw. */
+    vdsh_quantity quantity = drawn_quantity(f, desc->quantity);
 
     /* 3. The basis cubemaps, when order 5 is drawn with them (the paper's
      * split path; a log-distance stream is summed whole per vertex), at
@@ -315,7 +425,8 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
                      vdsh_runtime_interp(5, quantity) == VDSH_INTERP_SPLIT && h->cube_size > 0 &&
                      !desc->skip_cubemaps;
 
-    /* 4. Upload. */
+    /* 4. The scene: its vertices ordered for the vertex cache, its default
+     * view, then everything uploaded. */
     s = calloc(1, sizeof *s);
     if (!s) {
         r = vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
@@ -326,78 +437,21 @@ vr_result vr_scene_create(const vr_scene_desc *desc, vr_scene **out, vr_error *e
     s->quantity = quantity;
     s->max_distance = h->max_distance;
 
-    /* Everything per vertex goes up in the order of vr_order_triangles
-     * (the same vertices and triangles, arranged for the vertex cache). */
-    size_t nv = h->vertex_count, ni = 3 * (size_t)h->triangle_count;
-    gpu_indices = malloc(ni * sizeof *gpu_indices);
-    remap = malloc(nv * sizeof *remap);
-    if (!gpu_indices || !remap) {
-        r = vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
-        goto done;
-    }
-    r = vr_order_triangles(f->indices, h->triangle_count, h->vertex_count, gpu_indices, remap, name,
-                           err);
-    if (r != VR_OK)
-        goto done;
-    if ((r = default_view(s, f, desc, name, err)) != VR_OK)
-        goto done;
-    glGenBuffers(1, &s->vbo_position);
-    glGenBuffers(1, &s->vbo_normal);
-    if (upload_permuted(s->vbo_position, f->positions, nv, 12, remap) ||
-        upload_permuted(s->vbo_normal, f->normals, nv, 12, remap)) {
-        r = vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
-        goto done;
-    }
-    glGenVertexArrays(1, &s->vao[0]);
-    glBindVertexArray(s->vao[0]);
-    glGenBuffers(1, &s->ibo);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, s->ibo);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(ni * sizeof *gpu_indices), gpu_indices,
-                 GL_STATIC_DRAW);
-    vr_scene_base_attribs(s);
-    glBindVertexArray(0);
-    s->gpu_bytes = nv * 24 + (size_t)h->triangle_count * 12;
-
-    for (uint32_t i = 0; i < f->stream_count && r == VR_OK; i++) {
-        const vdsh_stream *st = &f->streams[i];
-        if (st->quantity != quantity || st->order < 1 || st->order > 5 ||
-            (st->flags & VDSH_STREAM_VARIABLE) || s->vbo_stream[st->order] ||
-            st->encoding == VDSH_ENCODING_CPCA)
-            continue;
-        r = upload_stream(s, st, nv, remap, name, err);
-    }
-    /* Buffer textures (VR_MODE_VDSH_BUFFER): what attributes cannot
-     * hold or no attribute mode draws (orders 1, 4 and above 5, the
-     * stream with an order per vertex, cpca streams of any order:
-     * decoded in the vertex stage), and with desc->buffers orders 2, 3
-     * and 5 too; the first stream of each. */
-    for (uint32_t i = 0; i < f->stream_count && r == VR_OK; i++) {
-        const vdsh_stream *st = &f->streams[i];
-        int variable = (st->flags & VDSH_STREAM_VARIABLE) != 0;
-        if (st->quantity != quantity || st->order < 1 || st->order > VDSH_MAX_ORDER ||
-            (variable ? s->variable.order != 0
-                      : s->buffer[st->order].order ||
-                            ((st->order == 2 || st->order == 3 || st->order == 5) &&
-                             !desc->buffers && st->encoding != VDSH_ENCODING_CPCA)))
-            continue;
-        r = vr_buffer_upload(s, st, remap, desc->buffer_floats, desc->cpca_decode, name, err);
-        if (!variable && !s->vbo_stream[st->order])
-            s->method[st->order] = st->method;
-    }
-    if (r != VR_OK)
-        goto done;
-    if (want_basis) {
-        glGenTextures(4, s->basis);
-        r = make_basis(s->basis, h->cube_size, name, err);
-        if (r != VR_OK)
-            goto done;
-        s->cube_size = (int)h->cube_size;
-        s->gpu_bytes += 4 * 6 * (size_t)s->cube_size * (size_t)s->cube_size * 8;
-    }
-    r = vr_sdf_load(s, desc, h->vertex_count, h->triangle_count, err);
-    if (r != VR_OK)
-        goto done;
-    r = vr_check_gl(err, name);
+    r = order_vertices(f, &gpu_indices, &remap, name, err);
+    if (r == VR_OK)
+        r = default_view(s, f, desc, name, err);
+    if (r == VR_OK)
+        r = upload_geometry(s, f, gpu_indices, remap, name, err);
+    if (r == VR_OK)
+        r = upload_attribute_streams(s, f, remap, name, err);
+    if (r == VR_OK)
+        r = upload_buffer_streams(s, f, desc, remap, name, err);
+    if (r == VR_OK && want_basis)
+        r = upload_basis(s, h->cube_size, name, err);
+    if (r == VR_OK)
+        r = vr_sdf_load(s, desc, h->vertex_count, h->triangle_count, err);
+    if (r == VR_OK)
+        r = vr_check_gl(err, name);
 
 done:
     free(gpu_indices);

@@ -198,13 +198,12 @@ static uint64_t file_size_of(const char *path)
 /* Summary                                                             */
 /* ------------------------------------------------------------------ */
 
-static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
+/* The receivers and the occluders: counts, bounds and diagonals. */
+static void print_meshes(const vdsh_file *f)
 {
     const vdsh_header *h = &f->header;
     float lo[3], hi[3];
     receiver_bounds(f, lo, hi);
-
-    printf("%s\n", path);
     printf("  receivers    %u %s, %u triangle%s\n", h->vertex_count,
            vdsh_plural(h->vertex_count, "vertex", "vertices"), h->triangle_count,
            vdsh_s(h->triangle_count));
@@ -218,6 +217,11 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
            "%g\n",
            h->bounds_min[0], h->bounds_min[1], h->bounds_min[2], h->bounds_max[0], h->bounds_max[1],
            h->bounds_max[2], diagonal(h->bounds_min, h->bounds_max));
+}
+
+/* The bake's parameters the header records. */
+static void print_bake(const vdsh_header *h)
+{
     printf("  bake         rays %u per receiver, sampling %s, seed %llu\n", h->rays,
            or_unknown(vdsh_sampling_name(h->sampling)), (unsigned long long)h->seed);
     printf("               max_distance %g, max_edge %g%s\n", h->max_distance, h->max_edge,
@@ -237,7 +241,10 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
         printf("               basis cubemaps %u x %u per face\n", h->cube_size, h->cube_size);
     else
         printf("               basis cubemaps none\n");
+}
 
+static void print_sources(const vdsh_file *f)
+{
     printf("  sources      %u\n", f->source_count);
     for (uint32_t i = 0; i < f->source_count; i++) {
         char hex[65];
@@ -245,144 +252,195 @@ static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
         printf("    [%u] %s\n        %llu byte%s, sha256 %s\n", i, f->sources[i].name,
                (unsigned long long)f->sources[i].size, vdsh_s(f->sources[i].size), hex);
     }
+}
 
-    printf("  streams      %u\n", f->stream_count);
-    for (uint32_t i = 0; i < f->stream_count; i++) {
-        const vdsh_stream *s = &f->streams[i];
-        coef0_stats st = stream_coef0(f, s);
-        printf("    [%u] order %s%u (%u coefficient%s%s), %s, method %s", i,
-               s->flags & VDSH_STREAM_VARIABLE ? "1.." : "", s->order, s->order * s->order,
-               vdsh_s(s->order * s->order), s->flags & VDSH_STREAM_VARIABLE ? " at most" : "",
-               vdsh_encoding_name(s->encoding), or_unknown(vdsh_method_name(s->method)));
-        if (strcmp(vdsh_method_name(s->method), "?") == 0)
-            printf(" (%u)", s->method);
-        printf(", quantity %s", vdsh_quantity_name(s->quantity));
-        if (s->quantity == VDSH_QUANTITY_LOG_DISTANCE)
-            printf(" (floor %g)", s->quantity_param);
+/* A quantised stream's per-index table: coefficient i = stored * scale_i
+ * / levels_i. */
+static void print_coef_scales(const vdsh_stream *s)
+{
+    uint32_t nc = s->order * s->order;
+    printf("        %s scales (largest |coefficient| per index):", vdsh_encoding_name(s->encoding));
+    for (uint32_t k = 0; k < nc; k++)
+        printf("%s%g", k % 9 == 0 && k ? "\n          " : " ", s->coef_scales[k]);
+    putchar('\n');
+}
+
+/* A cpca stream: clusters, basis, weights, bytes with and without the
+ * model, the weights' widths and the vertices in each cluster. */
+static void print_cpca(const vdsh_file *f, const vdsh_stream *s)
+{
+    const vdsh_cpca *m = &s->cpca;
+    uint32_t rows = vdsh_file_stream_vertices(f);
+    vdsh_stream_size z = vdsh_stream_size_of(s, rows);
+    char wbits[16];
+    snprintf(wbits, sizeof wbits, "%u-bit", m->bits);
+    size_t bpv = vdsh_stream_bytes_per_vertex(s);
+    unsigned long long model = (unsigned long long)vdsh_cpca_stream_model_bytes(m, s->order);
+    printf("        cpca: %u cluster%s, %u basis vector%s of %s weights; %zu byte%s "
+           "per vertex, %.1f with the model (%llu byte%s)\n",
+           m->clusters, vdsh_s(m->clusters), m->basis, vdsh_s(m->basis),
+           m->bits ? wbits : "per-vector", bpv, vdsh_s(bpv), z.mean_bytes, model, vdsh_s(model));
+    if (!m->bits) { /* runs, vector 1 first: 7x3 is three vectors of 7 bits */
+        printf("        widths:");
+        for (uint32_t j = 0; j < m->basis;) {
+            uint32_t e = j;
+            while (e < m->basis && m->widths[e] == m->widths[j])
+                e++;
+            printf("%s%ux%u", j ? "," : " ", m->widths[j], e - j);
+            j = e;
+        }
         putchar('\n');
-        printf("        window %s", vdsh_window_name(s->window));
-        if (s->window != VDSH_WINDOW_NONE)
-            printf(" (param %g)", s->window_param);
-        printf(", method_param %g, scale %g\n", s->method_param, s->scale);
-        if (vdsh_encoding_quantised(s->encoding) && s->coef_scales) {
-            /* the per-index table: coefficient i = stored * scale_i / levels_i */
-            uint32_t nc = s->order * s->order;
-            printf("        %s scales (largest |coefficient| per index):",
-                   vdsh_encoding_name(s->encoding));
-            for (uint32_t k = 0; k < nc; k++)
-                printf("%s%g", k % 9 == 0 && k ? "\n          " : " ", s->coef_scales[k]);
-            putchar('\n');
-        }
-        if (s->encoding == VDSH_ENCODING_CPCA) {
-            const vdsh_cpca *m = &s->cpca;
-            uint32_t rows = vdsh_file_stream_vertices(f);
-            vdsh_stream_size z = vdsh_stream_size_of(s, rows);
-            char wbits[16];
-            snprintf(wbits, sizeof wbits, "%u-bit", m->bits);
-            size_t bpv = vdsh_stream_bytes_per_vertex(s);
-            unsigned long long model =
-                (unsigned long long)vdsh_cpca_stream_model_bytes(m, s->order);
-            printf("        cpca: %u cluster%s, %u basis vector%s of %s weights; %zu byte%s "
-                   "per vertex, %.1f with the model (%llu byte%s)\n",
-                   m->clusters, vdsh_s(m->clusters), m->basis, vdsh_s(m->basis),
-                   m->bits ? wbits : "per-vector", bpv, vdsh_s(bpv), z.mean_bytes, model,
-                   vdsh_s(model));
-            if (!m->bits) { /* runs, vector 1 first: 7x3 is three vectors of 7 bits */
-                printf("        widths:");
-                for (uint32_t j = 0; j < m->basis;) {
-                    uint32_t e = j;
-                    while (e < m->basis && m->widths[e] == m->widths[j])
-                        e++;
-                    printf("%s%ux%u", j ? "," : " ", m->widths[j], e - j);
-                    j = e;
-                }
-                putchar('\n');
-            }
-            printf("        vertices per cluster:");
-            for (uint32_t c = 0; c < m->clusters; c++) {
-                uint32_t count = 0;
-                for (uint32_t v = 0; v < rows; v++)
-                    count += vdsh_cpca_cluster(s, v) == c;
-                printf(" %u", count);
-            }
-            putchar('\n');
-        } else if (s->flags & VDSH_STREAM_VARIABLE) {
-            vdsh_stream_size z = vdsh_stream_size_of(s, vdsh_file_stream_vertices(f));
-            printf("        variable order: %.1f bytes per vertex on average, %u at most; "
-                   "vertices per order:",
-                   z.mean_bytes, z.max_bytes);
-            for (uint32_t k = 1; k <= s->order; k++)
-                if (z.rows_per_order[k])
-                    printf(" %u: %u", k, z.rows_per_order[k]);
-            putchar('\n');
-        } else {
-            size_t bpv = vdsh_stream_bytes_per_vertex(s);
-            printf("        %zu byte%s per vertex\n", bpv, vdsh_s(bpv));
-        }
-        printf("        coefficient 0: min %g, max %g, mean %g\n", st.min, st.max, st.mean);
     }
+    printf("        vertices per cluster:");
+    for (uint32_t c = 0; c < m->clusters; c++) {
+        uint32_t count = 0;
+        for (uint32_t v = 0; v < rows; v++)
+            count += vdsh_cpca_cluster(s, v) == c;
+        printf(" %u", count);
+    }
+    putchar('\n');
+}
 
-    if (f->has_stats) {
-        const vdsh_stats *t = &f->stats;
-        printf("  stats        rays traced %llu, missed %llu", (unsigned long long)t->rays_traced,
-               (unsigned long long)t->rays_missed);
-        if (t->rays_traced)
-            printf(" (%.2f%%)", 100.0 * (double)t->rays_missed / (double)t->rays_traced);
-        printf("\n               degenerate receivers %u, undefined normals %u, "
-               "origins moved %u, normals flipped %u\n",
-               t->degenerate_receivers, t->undefined_normals, t->moved_origins, t->flipped_normals);
+/* A variable-order stream: its bytes per vertex and vertices per order. */
+static void print_variable(const vdsh_file *f, const vdsh_stream *s)
+{
+    vdsh_stream_size z = vdsh_stream_size_of(s, vdsh_file_stream_vertices(f));
+    printf("        variable order: %.1f bytes per vertex on average, %u at most; "
+           "vertices per order:",
+           z.mean_bytes, z.max_bytes);
+    for (uint32_t k = 1; k <= s->order; k++)
+        if (z.rows_per_order[k])
+            printf(" %u: %u", k, z.rows_per_order[k]);
+    putchar('\n');
+}
+
+/* Stream i: its order, encoding, fit and quantity, window and scale,
+ * its encoding's own figures, and coefficient 0's range. */
+static void print_stream(const vdsh_file *f, uint32_t i)
+{
+    const vdsh_stream *s = &f->streams[i];
+    coef0_stats st = stream_coef0(f, s);
+    printf("    [%u] order %s%u (%u coefficient%s%s), %s, method %s", i,
+           s->flags & VDSH_STREAM_VARIABLE ? "1.." : "", s->order, s->order * s->order,
+           vdsh_s(s->order * s->order), s->flags & VDSH_STREAM_VARIABLE ? " at most" : "",
+           vdsh_encoding_name(s->encoding), or_unknown(vdsh_method_name(s->method)));
+    if (strcmp(vdsh_method_name(s->method), "?") == 0)
+        printf(" (%u)", s->method);
+    printf(", quantity %s", vdsh_quantity_name(s->quantity));
+    if (s->quantity == VDSH_QUANTITY_LOG_DISTANCE)
+        printf(" (floor %g)", s->quantity_param);
+    putchar('\n');
+    printf("        window %s", vdsh_window_name(s->window));
+    if (s->window != VDSH_WINDOW_NONE)
+        printf(" (param %g)", s->window_param);
+    printf(", method_param %g, scale %g\n", s->method_param, s->scale);
+    if (vdsh_encoding_quantised(s->encoding) && s->coef_scales)
+        print_coef_scales(s);
+    if (s->encoding == VDSH_ENCODING_CPCA) {
+        print_cpca(f, s);
+    } else if (s->flags & VDSH_STREAM_VARIABLE) {
+        print_variable(f, s);
+    } else {
+        size_t bpv = vdsh_stream_bytes_per_vertex(s);
+        printf("        %zu byte%s per vertex\n", bpv, vdsh_s(bpv));
     }
+    printf("        coefficient 0: min %g, max %g, mean %g\n", st.min, st.max, st.mean);
+}
+
+/* The bake's own ray statistics (the stat chunk). */
+static void print_stats(const vdsh_stats *t)
+{
+    printf("  stats        rays traced %llu, missed %llu", (unsigned long long)t->rays_traced,
+           (unsigned long long)t->rays_missed);
+    if (t->rays_traced)
+        printf(" (%.2f%%)", 100.0 * (double)t->rays_missed / (double)t->rays_traced);
+    printf("\n               degenerate receivers %u, undefined normals %u, "
+           "origins moved %u, normals flipped %u\n",
+           t->degenerate_receivers, t->undefined_normals, t->moved_origins, t->flipped_normals);
+}
+
+/* A shard's part: its range, how it is merged, and for cpca the
+ * settings and the light mix the merge fits with. */
+static void print_part(const vdsh_file *f)
+{
+    printf("  part         shard %u of %u: receivers %u..%u (its streams' rows), merged "
+           "as %s\n",
+           f->part.index, f->part.count, f->part.range_begin, f->part.range_end,
+           vdsh_encoding_name(f->part.encoding));
+    if (f->part.encoding != VDSH_ENCODING_CPCA)
+        return;
+    /* the light mix and its pool: the lpol chunk's (none: light:0) */
+    const double mix = f->has_light_pool ? (double)f->light_pool.mix : 0.0;
+    if (!f->part.cpca_clusters)
+        printf("               cpca auto:%u", f->part.cpca_basis);
+    else if (!f->part.cpca_bits)
+        printf("               cpca %u,alloc:%u", f->part.cpca_clusters, f->part.cpca_basis);
+    else
+        printf("               cpca %u,%u,%u", f->part.cpca_clusters, f->part.cpca_basis,
+               f->part.cpca_bits);
+    printf(",light:%g (fitted at the merge", mix);
+    if (f->has_light_pool)
+        printf("; light pool of %u light%s", f->light_pool.count, vdsh_s(f->light_pool.count));
+    printf(")\n");
+}
+
+/* The adaptive receivers' parameters and rounds (the adpt chunk). */
+static void print_adaptive(const vdsh_file *f)
+{
+    const vdsh_adaptive *a = &f->adaptive;
+    printf("  adaptive     tolerance %g, min edge %g, budget %u (0: none), %u light%s\n"
+           "               %u receiver%s from %u in %u of at most %u round%s, %u midpoint%s "
+           "baked\n",
+           a->tolerance, a->min_edge, a->max_receivers, a->lights, vdsh_s(a->lights),
+           f->header.vertex_count, vdsh_s(f->header.vertex_count), a->start_receivers, a->rounds,
+           a->max_rounds, vdsh_s(a->max_rounds), a->candidates, vdsh_s(a->candidates));
+}
+
+/* The light region vdsh-bake --light-region recorded. */
+static void print_light_box(const vdsh_light_box *b)
+{
+    printf("  lights       region %s: %g %g %g .. %g %g %g (vdsh-bake --light-region)\n",
+           b->rule == VDSH_LIGHT_REGION_GROWN ? "grown" : "box", (double)b->min[0],
+           (double)b->min[1], (double)b->min[2], (double)b->max[0], (double)b->max[1],
+           (double)b->max[2]);
+}
+
+static void print_timings(const vdsh_timings *t)
+{
+    printf("  timings      load %.3f s, refine %.3f s, build %.3f s, "
+           "trace %.3f s\n               total %.3f s, %u thread%s\n",
+           t->load, t->refine, t->build, t->trace, t->total, t->threads, vdsh_s(t->threads));
+}
+
+/* The summary of one file: meshes, bake, sources, streams, then the
+ * optional chunks it has, and its size. */
+static void print_summary(const char *path, const vdsh_file *f, uint64_t size)
+{
+    printf("%s\n", path);
+    print_meshes(f);
+    print_bake(&f->header);
+    print_sources(f);
+    printf("  streams      %u\n", f->stream_count);
+    for (uint32_t i = 0; i < f->stream_count; i++)
+        print_stream(f, i);
+    if (f->has_stats)
+        print_stats(&f->stats);
     if (f->has_part)
-        printf("  part         shard %u of %u: receivers %u..%u (its streams' rows), merged "
-               "as %s\n",
-               f->part.index, f->part.count, f->part.range_begin, f->part.range_end,
-               vdsh_encoding_name(f->part.encoding));
-    if (f->has_part && f->part.encoding == VDSH_ENCODING_CPCA) {
-        /* the light mix and its pool: the lpol chunk's (none: light:0) */
-        const double mix = f->has_light_pool ? (double)f->light_pool.mix : 0.0;
-        if (!f->part.cpca_clusters)
-            printf("               cpca auto:%u", f->part.cpca_basis);
-        else if (!f->part.cpca_bits)
-            printf("               cpca %u,alloc:%u", f->part.cpca_clusters, f->part.cpca_basis);
-        else
-            printf("               cpca %u,%u,%u", f->part.cpca_clusters, f->part.cpca_basis,
-                   f->part.cpca_bits);
-        printf(",light:%g (fitted at the merge", mix);
-        if (f->has_light_pool)
-            printf("; light pool of %u light%s", f->light_pool.count, vdsh_s(f->light_pool.count));
-        printf(")\n");
-    }
+        print_part(f);
     int whole_cpca = 0;
     for (uint32_t i = 0; i < f->stream_count && !f->has_part; i++)
         whole_cpca |= f->streams[i].encoding == VDSH_ENCODING_CPCA;
     if (whole_cpca) /* VDSH.md "cpca streams": only a part's lpol records A */
         printf("  cpca         light mix and pool not recorded in a whole file (vdsh-bake "
                "--report: cpca.light_mix, cpca.light_pool)\n");
-    if (f->has_adaptive) {
-        const vdsh_adaptive *a = &f->adaptive;
-        printf("  adaptive     tolerance %g, min edge %g, budget %u (0: none), %u light%s\n"
-               "               %u receiver%s from %u in %u of at most %u round%s, %u midpoint%s "
-               "baked\n",
-               a->tolerance, a->min_edge, a->max_receivers, a->lights, vdsh_s(a->lights),
-               f->header.vertex_count, vdsh_s(f->header.vertex_count), a->start_receivers,
-               a->rounds, a->max_rounds, vdsh_s(a->max_rounds), a->candidates,
-               vdsh_s(a->candidates));
-    }
-    if (f->has_light_box) {
-        const vdsh_light_box *b = &f->light_box;
-        printf("  lights       region %s: %g %g %g .. %g %g %g (vdsh-bake --light-region)\n",
-               b->rule == VDSH_LIGHT_REGION_GROWN ? "grown" : "box", (double)b->min[0],
-               (double)b->min[1], (double)b->min[2], (double)b->max[0], (double)b->max[1],
-               (double)b->max[2]);
-    }
-    if (f->has_timings) {
-        const vdsh_timings *t = &f->timings;
-        printf("  timings      load %.3f s, refine %.3f s, build %.3f s, "
-               "trace %.3f s\n               total %.3f s, %u thread%s\n",
-               t->load, t->refine, t->build, t->trace, t->total, t->threads, vdsh_s(t->threads));
-    }
+    if (f->has_adaptive)
+        print_adaptive(f);
+    if (f->has_light_box)
+        print_light_box(&f->light_box);
+    if (f->has_timings)
+        print_timings(&f->timings);
     printf("  size         %llu bytes, %.2f bytes per vertex\n", (unsigned long long)size,
-           (double)size / h->vertex_count);
+           (double)size / f->header.vertex_count);
 }
 
 static int print_json(const char *path, const vdsh_file *f, uint64_t size)

@@ -715,6 +715,144 @@ static vb_result pick_lights(const view_check *V, const vb_frames_hits *h, uint3
     return VB_OK;
 }
 
+/* The check frame: CHECK_SIZE pixels on the longer side, the view set's
+ * aspect, at least 4 a side. */
+static void check_frame_size(const vb_frames_views_desc *d, int *width, int *height)
+{
+    if (d->width >= d->height) {
+        *width = CHECK_SIZE;
+        *height = (int)lround((double)CHECK_SIZE * d->height / d->width);
+    } else {
+        *height = CHECK_SIZE;
+        *width = (int)lround((double)CHECK_SIZE * d->width / d->height);
+    }
+    *width = *width < 4 ? 4 : *width;
+    *height = *height < 4 ? 4 : *height;
+}
+
+/* View 0: the viewer's own camera; its lights are the best there are
+ * (*found: how many of them light and shadow enough of it). */
+static vb_result make_default_view(const view_check *V, vb_frames_view *v, uint32_t *found,
+                                   vb_error *err)
+{
+    vb_frames_hits h = {0};
+    vb_result r = default_camera(V->s, &v->camera, err);
+    if (r == VB_OK)
+        r = vb_frames_trace_primary(V->s, &v->camera, V->width, V->height, V->threads, &h, err);
+    if (r == VB_OK) {
+        int ok;
+        r = pick_lights(V, &h, 0, 0, v, found, &ok, err);
+    }
+    vb_frames_hits_free(&h);
+    return r;
+}
+
+/* What the search for the other views' eyes shares between candidates. */
+typedef struct eye_search {
+    const view_check *V;
+    uint64_t eye_seed, look_seed, order_seed;
+    /* Eyes go where lights go (vdsh_light.h): the light region. */
+    float lo[3], hi[3];
+    /* No surface nearer to the eye: NEAREST_SHARE of the diagonal. */
+    float nearest;
+    struct RTCIntersectContext ictx;
+} eye_search;
+
+static void eye_search_init(eye_search *E, const view_check *V, uint64_t seed)
+{
+    E->V = V;
+    E->eye_seed = vb_eval_purpose_seed(seed, PURPOSE_EYES);
+    E->look_seed = vb_eval_purpose_seed(seed, PURPOSE_LOOK);
+    E->order_seed = vb_eval_purpose_seed(seed, PURPOSE_ORDER);
+    vb_scene_light_region(V->s->occluders, E->lo, E->hi, NULL);
+    E->nearest = NEAREST_SHARE * V->s->diagonal;
+    rtcInitIntersectContext(&E->ictx);
+}
+
+/* Candidate eye k, when in free space, looking at the surface point it
+ * sees in a direction between 53 degrees below the horizon and 12 above
+ * (as a visitor looks: along and down, where shadows fall); 0 when it is
+ * not in free space or sees no surface at least E->nearest away. */
+static int aim_eye(eye_search *E, uint32_t k, vdsh_camera *cam, vb_frames_views_stats *st)
+{
+    const vb_frames_scene *s = E->V->s;
+    st->eyes_tried++;
+    float eye[3];
+    vdsh_light_candidate(E->lo, E->hi, E->eye_seed, k, eye);
+    if (!vb_scene_free_space(s->occluders, eye))
+        return 0;
+    st->eyes_free++;
+    float u1, u2;
+    vb_hash2(E->look_seed, k, 0, &u1, &u2);
+    float y = -0.8f + 1.0f * u1, rho = sqrtf(1.0f - y * y);
+    float dir[3] = {rho * cosf(6.28318531f * u2), y, rho * sinf(6.28318531f * u2)};
+    const vb_scene *rs = s->receivers;
+    float o[3];
+    vb_scene_to_local(rs, eye, o);
+    struct RTCRayHit rh;
+    vb_ray_init(&rh, o, dir, INFINITY, 0);
+    rtcIntersect1(rs->scene, &E->ictx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+        return 0;
+    float t = rh.ray.tfar / rs->scale;
+    if (t < E->nearest)
+        return 0;
+    memcpy(cam->eye, eye, sizeof eye);
+    for (int q = 0; q < 3; q++)
+        cam->target[q] = eye[q] + t * dir[q];
+    cam->fov_y = 60.0f;
+    return 1;
+}
+
+/* The nearest surface a check frame shows (its smallest depth). */
+static float nearest_depth(const view_check *V, const vb_frames_hits *h)
+{
+    float near = INFINITY;
+    for (size_t i = 0; i < (size_t)V->width * (size_t)V->height; i++)
+        near = fminf(near, h->depth[i]);
+    return near;
+}
+
+/* View v from candidate eye k: *ok when the eye is aimed, its check frame
+ * shows no surface nearer than E->nearest and four of the pool's lights,
+ * from a start of its own, light and shadow enough of it. */
+static vb_result try_eye(eye_search *E, uint32_t k, vb_frames_view *v, int *ok,
+                         vb_frames_views_stats *st, vb_error *err)
+{
+    const view_check *V = E->V;
+    *ok = 0;
+    vdsh_camera cam = {0};
+    if (!aim_eye(E, k, &cam, st))
+        return VB_OK;
+    memset(v, 0, sizeof *v);
+    v->camera = cam;
+    vb_frames_hits h = {0};
+    vb_result r =
+        vb_frames_trace_primary(V->s, &v->camera, V->width, V->height, V->threads, &h, err);
+    if (r == VB_OK && nearest_depth(V, &h) >= E->nearest) {
+        uint32_t found;
+        uint32_t start = (uint32_t)(vb_eval_purpose_seed(E->order_seed, k) % LIGHT_POOL);
+        r = pick_lights(V, &h, start, 1, v, &found, ok, err);
+    }
+    vb_frames_hits_free(&h);
+    return r;
+}
+
+static vb_result too_few_views(uint32_t have, uint32_t cameras, const vb_frames_views_stats *st,
+                               vb_error *err)
+{
+    return vb_fail(err, VB_ERR_INVALID,
+                   "found %u of %u views (%u candidate eyes, %u in free space): too few "
+                   "views show at least %.0f%% of their pixels lit and as many "
+                   "hard-shadowed by one light with no surface nearer than %.0f%% of the "
+                   "diagonal; %s",
+                   have, cameras, st->eyes_tried, st->eyes_free, 100.0 * VB_FRAMES_MIN_SHARE,
+                   100.0 * NEAREST_SHARE,
+                   have ? "ask for fewer cameras or try another seed"
+                        : "none did: the scene may cast no shadow one light shows (a lone "
+                          "plane or convex object), which no seed changes");
+}
+
 vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_desc *desc,
                                vb_frames_view *out, vb_frames_views_stats *stats, vb_error *err)
 {
@@ -727,124 +865,46 @@ vb_result vb_frames_make_views(const vb_frames_scene *s, const vb_frames_views_d
         d.width = 512, d.height = 384;
     vb_frames_views_stats st = {0};
     view_check V = {.s = s, .threads = d.threads};
-    if (d.width >= d.height) {
-        V.width = CHECK_SIZE;
-        V.height = (int)lround((double)CHECK_SIZE * d.height / d.width);
-    } else {
-        V.height = CHECK_SIZE;
-        V.width = (int)lround((double)CHECK_SIZE * d.width / d.height);
-    }
-    V.width = V.width < 4 ? 4 : V.width;
-    V.height = V.height < 4 ? 4 : V.height;
+    check_frame_size(&d, &V.width, &V.height);
 
-    const vb_scene *occ = s->occluders;
+    /* The pool the views' lights are drawn from, placed as vdsh-eval's. */
     float(*pool)[3] = malloc(LIGHT_POOL * sizeof *pool);
     vb_frames_view *views = calloc(1 + (size_t)d.cameras, sizeof *views);
-    vb_frames_hits h = {0};
     vb_result r = VB_OK;
     if (!pool || !views) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
-    r = vb_scene_place_lights_rule(occ, vb_eval_purpose_seed(d.seed, PURPOSE_LIGHTS), LIGHT_POOL,
-                                   (vb_light_rule)d.light_rule, pool, NULL, err);
+    r = vb_scene_place_lights_rule(s->occluders, vb_eval_purpose_seed(d.seed, PURPOSE_LIGHTS),
+                                   LIGHT_POOL, (vb_light_rule)d.light_rule, pool, NULL, err);
     if (r != VB_OK)
         goto done;
     V.pool = (const float(*)[3])pool;
-    const uint64_t order_seed = vb_eval_purpose_seed(d.seed, PURPOSE_ORDER);
 
-    /* View 0: the viewer's own camera; its lights are the best there are. */
-    {
-        vb_frames_view *v = &views[0];
-        r = default_camera(s, &v->camera, err);
-        if (r == VB_OK)
-            r = vb_frames_trace_primary(s, &v->camera, V.width, V.height, d.threads, &h, err);
-        if (r != VB_OK)
-            goto done;
-        uint32_t found;
-        int ok;
-        r = pick_lights(&V, &h, 0, 0, v, &found, &ok, err);
-        vb_frames_hits_free(&h);
-        if (r != VB_OK)
-            goto done;
-        st.default_lights_ok = found;
-    }
+    r = make_default_view(&V, &views[0], &st.default_lights_ok, err);
+    if (r != VB_OK)
+        goto done;
 
-    /* The others: eyes in free space, each looking at a surface point it
-     * sees, in a direction between 53 degrees below the horizon and 12
-     * above (as a visitor looks: along and down, where shadows fall). */
-    const uint64_t eye_seed = vb_eval_purpose_seed(d.seed, PURPOSE_EYES);
-    const uint64_t look_seed = vb_eval_purpose_seed(d.seed, PURPOSE_LOOK);
-    const float nearest = NEAREST_SHARE * s->diagonal;
+    /* The others: candidate eyes in order, until enough views are kept. */
+    eye_search E;
+    eye_search_init(&E, &V, d.seed);
     uint32_t have = 0;
     const uint32_t limit = EYE_TRIES_PER_VIEW * d.cameras;
-    struct RTCIntersectContext ictx;
-    rtcInitIntersectContext(&ictx);
-    float elo[3], ehi[3]; /* eyes go where lights go (vdsh_light.h) */
-    vb_scene_light_region(occ, elo, ehi, NULL);
     for (uint32_t k = 0; have < d.cameras && k < limit; k++) {
-        st.eyes_tried++;
-        float eye[3];
-        vdsh_light_candidate(elo, ehi, eye_seed, k, eye);
-        if (!vb_scene_free_space(occ, eye))
-            continue;
-        st.eyes_free++;
-        float u1, u2;
-        vb_hash2(look_seed, k, 0, &u1, &u2);
-        float y = -0.8f + 1.0f * u1, rho = sqrtf(1.0f - y * y);
-        float dir[3] = {rho * cosf(6.28318531f * u2), y, rho * sinf(6.28318531f * u2)};
-        const vb_scene *rs = s->receivers;
-        float o[3];
-        vb_scene_to_local(rs, eye, o);
-        struct RTCRayHit rh;
-        vb_ray_init(&rh, o, dir, INFINITY, 0);
-        rtcIntersect1(rs->scene, &ictx, &rh);
-        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
-            continue;
-        float t = rh.ray.tfar / rs->scale;
-        if (t < nearest)
-            continue;
-        vb_frames_view *v = &views[1 + have];
-        memset(v, 0, sizeof *v);
-        memcpy(v->camera.eye, eye, sizeof eye);
-        for (int q = 0; q < 3; q++)
-            v->camera.target[q] = eye[q] + t * dir[q];
-        v->camera.fov_y = 60.0f;
-        r = vb_frames_trace_primary(s, &v->camera, V.width, V.height, d.threads, &h, err);
-        if (r != VB_OK)
-            goto done;
-        float near = INFINITY;
-        for (size_t i = 0; i < (size_t)V.width * (size_t)V.height; i++)
-            near = fminf(near, h.depth[i]);
-        int ok = 0;
-        if (near >= nearest) {
-            uint32_t found;
-            uint32_t start = (uint32_t)(vb_eval_purpose_seed(order_seed, k) % LIGHT_POOL);
-            r = pick_lights(&V, &h, start, 1, v, &found, &ok, err);
-        }
-        vb_frames_hits_free(&h);
+        int ok;
+        r = try_eye(&E, k, &views[1 + have], &ok, &st, err);
         if (r != VB_OK)
             goto done;
         have += ok;
     }
     if (have < d.cameras) {
-        r = vb_fail(err, VB_ERR_INVALID,
-                    "found %u of %u views (%u candidate eyes, %u in free space): too few "
-                    "views show at least %.0f%% of their pixels lit and as many "
-                    "hard-shadowed by one light with no surface nearer than %.0f%% of the "
-                    "diagonal; %s",
-                    have, d.cameras, st.eyes_tried, st.eyes_free, 100.0 * VB_FRAMES_MIN_SHARE,
-                    100.0 * NEAREST_SHARE,
-                    have ? "ask for fewer cameras or try another seed"
-                         : "none did: the scene may cast no shadow one light shows (a lone "
-                           "plane or convex object), which no seed changes");
+        r = too_few_views(have, d.cameras, &st, err);
         goto done;
     }
     memcpy(out, views, (1 + (size_t)d.cameras) * sizeof *views);
     if (stats)
         *stats = st;
 done:
-    vb_frames_hits_free(&h);
     free(pool);
     free(views);
     return r;

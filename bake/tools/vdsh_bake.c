@@ -475,6 +475,160 @@ static void report_seconds(vt_json *j, cJSON *root, const vdsh_timings *t)
     vt_json_f64(j, sec, "trace", t->trace);
 }
 
+/* The report's "cpca": the settings the streams were fitted with, light
+ * mix and pool included: a whole file does not record them (VDSH.md
+ * "cpca streams"), a part's `part` and `lpol` chunks do. light_pool 0:
+ * the uniform metric (a mix of 0, or no room for the pool). */
+static void report_cpca(vt_json *j, cJSON *root, const options *o, const vb_job *job,
+                        const vb_job_desc *jd)
+{
+    if (o->encoding != VDSH_ENCODING_CPCA) {
+        vt_json_null(j, root, "cpca");
+        return;
+    }
+    const vdsh_cpca_settings st = vb_job_cpca_settings(job, jd);
+    cJSON *cp = vt_json_object(j, root, "cpca");
+    vt_json_u64(j, cp, "clusters", st.clusters);
+    vt_json_u64(j, cp, "basis", st.budget ? 0 : st.basis);
+    vt_json_u64(j, cp, "bits", st.budget ? 0 : st.bits);
+    vt_json_u64(j, cp, "budget", st.budget);
+    vt_json_f32(j, cp, "light_mix", st.light_mix);
+    vt_json_u64(j, cp, "light_pool", st.light_count);
+}
+
+/* The receivers' spacing before any bake (vb_mesh_spacing_of). */
+static void report_spacing(vt_json *j, cJSON *root, const vb_mesh_spacing *sp)
+{
+    cJSON *spc = vt_json_object(j, root, "receiver_spacing");
+    vt_json_f32(j, spc, "scene_diagonal", sp->diagonal);
+    vt_json_f32(j, spc, "median_longest_edge", sp->median_edge);
+    vt_json_f32(j, spc, "p90_longest_edge", sp->p90_edge);
+    vt_json_f32(j, spc, "max_longest_edge", sp->max_edge);
+    vt_json_f64(j, spc, "long_area_share", sp->long_area);
+    vt_json_bool(j, spc, "far_apart", sp->far_apart);
+}
+
+/* The adaptive receivers' parameters and how their rounds ended. */
+static void report_adaptive(vt_json *j, cJSON *root, const options *o, const vb_job *job)
+{
+    if (!o->adaptive) {
+        vt_json_null(j, root, "adaptive");
+        return;
+    }
+    cJSON *ad = vt_json_object(j, root, "adaptive");
+    vt_json_f32(j, ad, "tolerance", o->adaptive_tol);
+    vt_json_f32(j, ad, "min_edge", o->min_edge);
+    vt_json_u64(j, ad, "max_receivers", o->max_receivers);
+    vt_json_u64(j, ad, "start_receivers", job->adaptive.start_receivers);
+    vt_json_u64(j, ad, "rounds", job->adaptive.rounds);
+    vt_json_u64(j, ad, "midpoints_baked", job->adaptive.candidates);
+    vt_json_bool(j, ad, "budget_reached", job->adaptive.budget_reached);
+    vt_json_u64(j, ad, "max_rounds", job->adaptive.max_rounds);
+    vt_json_bool(j, ad, "rounds_reached", job->adaptive.rounds_reached);
+    vt_json_u64(j, ad, "edges_pending", job->adaptive.pending);
+    vt_json_u64(j, ad, "uniform_receivers", job->adaptive.uniform_receivers);
+    vt_json_bool(j, ad, "uniform_reached", job->adaptive.uniform_reached);
+    vt_json_u64(j, ad, "noise_sample", job->adaptive.noise_sample);
+    vt_json_f64(j, ad, "noise_floor", job->adaptive.noise_floor);
+    vt_json_f64(j, ad, "threshold", job->adaptive.threshold);
+}
+
+/* The decision fit: its lights and pools, fits, calibration and the log
+ * offsets per order. */
+static void report_decision(vt_json *j, cJSON *root, const options *o, const vb_bake_output *b)
+{
+    if (b->method != VDSH_METHOD_DECISION) {
+        vt_json_null(j, root, "decision");
+        return;
+    }
+    cJSON *dec = vt_json_object(j, root, "decision");
+    vt_json_u64(j, dec, "lights", b->decision_lights);
+    vt_json_u64(j, dec, "near_pool_lights", b->decision_near_lights);
+    vt_json_u64(j, dec, "shell_pool_lights", b->decision_shell_lights);
+    vt_json_u64(j, dec, "fitted", b->decision_fitted);
+    vt_json_u64(j, dec, "kept_lsq", b->decision_fallbacks);
+    vt_json_f64(j, dec, "mean_pairs", b->decision_pairs);
+    vt_json_u64(j, dec, "calibration_receivers", b->calibration_receivers);
+    vt_json_f32(j, dec, "false_rate", b->false_rate);
+    vt_json_u64(j, dec, "offset_cap_bound", b->cap_bound);
+    vt_json_u64(j, dec, "lit_training_pairs", b->lit_training);
+    vt_json_u64(j, dec, "lit_training_false", b->lit_training_false);
+    if (b->decision_lights) {
+        vt_json_string(j, dec, "light_region",
+                       b->light_region_given   ? "given"
+                       : b->light_region_grown ? "grown"
+                                               : "bounds");
+        vt_json_u64(j, dec, "light_region_probes", b->light_region_probes);
+    }
+    if (b->calibration_receivers)
+        vt_json_u64(j, dec, "held_out_shadowed", b->calibration_shadowed);
+    cJSON *off = vt_json_object(j, dec, "log_offsets");
+    for (int i = 0; i < o->order_count; i++) {
+        char key[8];
+        snprintf(key, sizeof key, "%d", o->orders[i]);
+        vt_json_f32(j, off, key, b->log_offset[o->orders[i]]);
+    }
+    if (b->variable_cap && b->variable_method == VDSH_METHOD_DECISION)
+        vt_json_f32(j, off, "adaptive", b->variable_param);
+}
+
+/* The bake's rays: counts, receivers repaired, and the origins' probes. */
+static void report_rays(vt_json *j, cJSON *root, const vb_bake_output *b)
+{
+    vt_json_u64(j, root, "rays_traced", b->rays_traced);
+    vt_json_u64(j, root, "rays_missed", b->rays_missed);
+    vt_json_u64(j, root, "degenerate_receivers", b->degenerate_receivers);
+    vt_json_u64(j, root, "undefined_normals", b->undefined_normals);
+    vt_json_u64(j, root, "moved_origins", b->moved_origins);
+    vt_json_u64(j, root, "flipped_normals", b->flipped_normals);
+    cJSON *org = vt_json_object(j, root, "origins");
+    vt_json_u64(j, org, "probe_rays", b->origins.probe_rays);
+    vt_json_u64(j, org, "repaired", b->origins.flagged);
+    vt_json_u64(j, org, "moved", b->origins.moved);
+    vt_json_u64(j, org, "coincident_faces", b->origins.ties);
+    vt_json_u64(j, org, "skipped_zero_area", b->origins.skipped_zero_area);
+}
+
+/* The times of every step, the write's included, and the ray rates. */
+static void report_times(vt_json *j, cJSON *root, const vb_job *job, double encode_seconds,
+                         double write_seconds)
+{
+    const vb_bake_output *b = &job->bake;
+    const vdsh_timings *t = &job->timings;
+    report_seconds(j, root, t);
+    cJSON *sec = cJSON_GetObjectItemCaseSensitive(root, "seconds");
+    vt_json_f64(j, sec, "pool", job->pool_seconds);
+    vt_json_f64(j, sec, "origins", b->origins.seconds);
+    vt_json_f64(j, sec, "encode", encode_seconds); /* of write: the streams filled (cpca's fit) */
+    vt_json_f64(j, sec, "write", write_seconds);
+    vt_json_f64(j, sec, "total", t->total + write_seconds);
+    vt_json_f64(j, root, "mrays_per_second_trace",
+                t->trace > 0 ? b->rays_traced / t->trace * 1e-6 : 0.0);
+    vt_json_f64(j, root, "mrays_per_second_total",
+                t->total + write_seconds > 0 ? b->rays_traced / (t->total + write_seconds) * 1e-6
+                                             : 0.0);
+}
+
+/* --sdf: the distance volume beside the output. */
+static void report_sdf(vt_json *j, cJSON *root, const options *o, const vdsh_sdf *vol,
+                       double sdf_seconds)
+{
+    if (!vol) {
+        vt_json_null(j, root, "sdf");
+        return;
+    }
+    cJSON *sdf = vt_json_object(j, root, "sdf");
+    char sdf_path[PATH_MAX];
+    if (vdsh_sdf_path(o->output, sdf_path, sizeof sdf_path) == 0)
+        vt_json_string(j, sdf, "path", sdf_path);
+    cJSON *dim = vt_json_array(j, sdf, "dims");
+    for (int i = 0; i < 3; i++)
+        vt_json_u64(j, dim, NULL, vol->dim[i]);
+    vt_json_f64(j, sdf, "spacing", vol->cell);
+    vt_json_f64(j, sdf, "seconds", sdf_seconds);
+    vt_json_u64(j, sdf, "bytes", vdsh_sdf_file_size(vol));
+}
+
 static int write_report(const char *path, const options *o, const vb_job_desc *jd,
                         const vb_job *job, const vb_mesh_spacing *sp, const vdsh_sdf *vol,
                         double sdf_seconds, double encode_seconds, double write_seconds, char *msg,
@@ -482,9 +636,6 @@ static int write_report(const char *path, const options *o, const vb_job_desc *j
 {
     const vdsh_file *f = &job->file;
     const vb_bake_output *b = &job->bake;
-    const vdsh_timings *t = &job->timings;
-    size_t coef_bytes = job->coefficient_bytes;
-    long long file_size = (long long)job->file_bytes;
     vt_json j = {0};
     cJSON *root = vt_json_object(&j, NULL, NULL);
     vt_json_string(&j, root, "output", o->output);
@@ -505,131 +656,23 @@ static int write_report(const char *path, const options *o, const vb_job_desc *j
     for (int i = 0; i < o->order_count; i++)
         vt_json_u64(&j, orders, NULL, (uint64_t)o->orders[i]);
     vt_json_string(&j, root, "encoding", vdsh_encoding_name(o->encoding));
-    if (o->encoding == VDSH_ENCODING_CPCA) {
-        /* The settings the streams were fitted with, light mix and pool
-         * included: a whole file does not record them (VDSH.md "cpca
-         * streams"), a part's `part` and `lpol` chunks do. light_pool 0:
-         * the uniform metric (a mix of 0, or no room for the pool). */
-        const vdsh_cpca_settings st = vb_job_cpca_settings(job, jd);
-        cJSON *cp = vt_json_object(&j, root, "cpca");
-        vt_json_u64(&j, cp, "clusters", st.clusters);
-        vt_json_u64(&j, cp, "basis", st.budget ? 0 : st.basis);
-        vt_json_u64(&j, cp, "bits", st.budget ? 0 : st.bits);
-        vt_json_u64(&j, cp, "budget", st.budget);
-        vt_json_f32(&j, cp, "light_mix", st.light_mix);
-        vt_json_u64(&j, cp, "light_pool", st.light_count);
-    } else {
-        vt_json_null(&j, root, "cpca");
-    }
+    report_cpca(&j, root, o, job, jd);
     vt_json_f32(&j, root, "max_distance", b->max_distance);
     vt_json_f32(&j, root, "max_edge", o->max_edge);
-    /* The receivers' spacing before any bake (vb_mesh_spacing_of). */
-    cJSON *spc = vt_json_object(&j, root, "receiver_spacing");
-    vt_json_f32(&j, spc, "scene_diagonal", sp->diagonal);
-    vt_json_f32(&j, spc, "median_longest_edge", sp->median_edge);
-    vt_json_f32(&j, spc, "p90_longest_edge", sp->p90_edge);
-    vt_json_f32(&j, spc, "max_longest_edge", sp->max_edge);
-    vt_json_f64(&j, spc, "long_area_share", sp->long_area);
-    vt_json_bool(&j, spc, "far_apart", sp->far_apart);
+    report_spacing(&j, root, sp);
     /* The receivers as baked: their worst triangle (vb_mesh_worst_aspect:
      * 1 equilateral, 1.73 right isosceles). */
     vt_json_f64(&j, root, "worst_aspect", vb_mesh_worst_aspect(&job->receivers, NULL));
-    if (o->adaptive) {
-        cJSON *ad = vt_json_object(&j, root, "adaptive");
-        vt_json_f32(&j, ad, "tolerance", o->adaptive_tol);
-        vt_json_f32(&j, ad, "min_edge", o->min_edge);
-        vt_json_u64(&j, ad, "max_receivers", o->max_receivers);
-        vt_json_u64(&j, ad, "start_receivers", job->adaptive.start_receivers);
-        vt_json_u64(&j, ad, "rounds", job->adaptive.rounds);
-        vt_json_u64(&j, ad, "midpoints_baked", job->adaptive.candidates);
-        vt_json_bool(&j, ad, "budget_reached", job->adaptive.budget_reached);
-        vt_json_u64(&j, ad, "max_rounds", job->adaptive.max_rounds);
-        vt_json_bool(&j, ad, "rounds_reached", job->adaptive.rounds_reached);
-        vt_json_u64(&j, ad, "edges_pending", job->adaptive.pending);
-        vt_json_u64(&j, ad, "uniform_receivers", job->adaptive.uniform_receivers);
-        vt_json_bool(&j, ad, "uniform_reached", job->adaptive.uniform_reached);
-        vt_json_u64(&j, ad, "noise_sample", job->adaptive.noise_sample);
-        vt_json_f64(&j, ad, "noise_floor", job->adaptive.noise_floor);
-        vt_json_f64(&j, ad, "threshold", job->adaptive.threshold);
-    } else {
-        vt_json_null(&j, root, "adaptive");
-    }
-    if (b->method == VDSH_METHOD_DECISION) {
-        cJSON *dec = vt_json_object(&j, root, "decision");
-        vt_json_u64(&j, dec, "lights", b->decision_lights);
-        vt_json_u64(&j, dec, "near_pool_lights", b->decision_near_lights);
-        vt_json_u64(&j, dec, "shell_pool_lights", b->decision_shell_lights);
-        vt_json_u64(&j, dec, "fitted", b->decision_fitted);
-        vt_json_u64(&j, dec, "kept_lsq", b->decision_fallbacks);
-        vt_json_f64(&j, dec, "mean_pairs", b->decision_pairs);
-        vt_json_u64(&j, dec, "calibration_receivers", b->calibration_receivers);
-        vt_json_f32(&j, dec, "false_rate", b->false_rate);
-        vt_json_u64(&j, dec, "offset_cap_bound", b->cap_bound);
-        vt_json_u64(&j, dec, "lit_training_pairs", b->lit_training);
-        vt_json_u64(&j, dec, "lit_training_false", b->lit_training_false);
-        if (b->decision_lights) {
-            vt_json_string(&j, dec, "light_region",
-                           b->light_region_given   ? "given"
-                           : b->light_region_grown ? "grown"
-                                                   : "bounds");
-            vt_json_u64(&j, dec, "light_region_probes", b->light_region_probes);
-        }
-        if (b->calibration_receivers)
-            vt_json_u64(&j, dec, "held_out_shadowed", b->calibration_shadowed);
-        cJSON *off = vt_json_object(&j, dec, "log_offsets");
-        for (int i = 0; i < o->order_count; i++) {
-            char key[8];
-            snprintf(key, sizeof key, "%d", o->orders[i]);
-            vt_json_f32(&j, off, key, b->log_offset[o->orders[i]]);
-        }
-        if (b->variable_cap && b->variable_method == VDSH_METHOD_DECISION)
-            vt_json_f32(&j, off, "adaptive", b->variable_param);
-    } else {
-        vt_json_null(&j, root, "decision");
-    }
+    report_adaptive(&j, root, o, job);
+    report_decision(&j, root, o, b);
     vt_json_u64(&j, root, "seed", o->seed);
     vt_json_u64(&j, root, "threads", b->threads);
     vt_json_bool(&j, root, "robust", o->robust);
-    vt_json_u64(&j, root, "rays_traced", b->rays_traced);
-    vt_json_u64(&j, root, "rays_missed", b->rays_missed);
-    vt_json_u64(&j, root, "degenerate_receivers", b->degenerate_receivers);
-    vt_json_u64(&j, root, "undefined_normals", b->undefined_normals);
-    vt_json_u64(&j, root, "moved_origins", b->moved_origins);
-    vt_json_u64(&j, root, "flipped_normals", b->flipped_normals);
-    cJSON *org = vt_json_object(&j, root, "origins");
-    vt_json_u64(&j, org, "probe_rays", b->origins.probe_rays);
-    vt_json_u64(&j, org, "repaired", b->origins.flagged);
-    vt_json_u64(&j, org, "moved", b->origins.moved);
-    vt_json_u64(&j, org, "coincident_faces", b->origins.ties);
-    vt_json_u64(&j, org, "skipped_zero_area", b->origins.skipped_zero_area);
-    report_seconds(&j, root, t);
-    cJSON *sec = cJSON_GetObjectItemCaseSensitive(root, "seconds");
-    vt_json_f64(&j, sec, "pool", job->pool_seconds);
-    vt_json_f64(&j, sec, "origins", b->origins.seconds);
-    vt_json_f64(&j, sec, "encode", encode_seconds); /* of write: the streams filled (cpca's fit) */
-    vt_json_f64(&j, sec, "write", write_seconds);
-    vt_json_f64(&j, sec, "total", t->total + write_seconds);
-    vt_json_f64(&j, root, "mrays_per_second_trace",
-                t->trace > 0 ? b->rays_traced / t->trace * 1e-6 : 0.0);
-    vt_json_f64(&j, root, "mrays_per_second_total",
-                t->total + write_seconds > 0 ? b->rays_traced / (t->total + write_seconds) * 1e-6
-                                             : 0.0);
-    vt_json_u64(&j, root, "coefficient_bytes_per_vertex", coef_bytes);
-    vt_json_i64(&j, root, "file_bytes", file_size);
-    if (vol) { /* --sdf: the distance volume beside the output */
-        cJSON *sdf = vt_json_object(&j, root, "sdf");
-        char sdf_path[PATH_MAX];
-        if (vdsh_sdf_path(o->output, sdf_path, sizeof sdf_path) == 0)
-            vt_json_string(&j, sdf, "path", sdf_path);
-        cJSON *dim = vt_json_array(&j, sdf, "dims");
-        for (int i = 0; i < 3; i++)
-            vt_json_u64(&j, dim, NULL, vol->dim[i]);
-        vt_json_f64(&j, sdf, "spacing", vol->cell);
-        vt_json_f64(&j, sdf, "seconds", sdf_seconds);
-        vt_json_u64(&j, sdf, "bytes", vdsh_sdf_file_size(vol));
-    } else {
-        vt_json_null(&j, root, "sdf");
-    }
+    report_rays(&j, root, b);
+    report_times(&j, root, job, encode_seconds, write_seconds);
+    vt_json_u64(&j, root, "coefficient_bytes_per_vertex", job->coefficient_bytes);
+    vt_json_i64(&j, root, "file_bytes", (long long)job->file_bytes);
+    report_sdf(&j, root, o, vol, sdf_seconds);
     int r = vt_json_write_file(&j, path, msg, cap);
     vt_json_free(&j);
     return r;
@@ -1400,6 +1443,148 @@ static void say_receivers(FILE *log, const options *o, const vb_job *job, vb_mes
     }
 }
 
+/* The adaptive receivers: how many from how many, and whether the round
+ * cap stopped them while still splitting. */
+static void say_adaptive_receivers(FILE *log, const options *o, const vb_job *job)
+{
+    fprintf(log,
+            "vdsh-bake: adaptive receivers: %u from %u in %u round%s (%u midpoint%s "
+            "baked, tolerance %g + noise floor %.3g from %u receiver%s baked twice, min "
+            "edge %g%s)\n",
+            job->receivers.vertex_count, job->adaptive.start_receivers, job->adaptive.rounds,
+            vdsh_s(job->adaptive.rounds), job->adaptive.candidates,
+            vdsh_s(job->adaptive.candidates), (double)o->adaptive_tol, job->adaptive.noise_floor,
+            job->adaptive.noise_sample, vdsh_s(job->adaptive.noise_sample), (double)o->min_edge,
+            job->adaptive.budget_reached    ? ", the budget stopped it"
+            : job->adaptive.uniform_reached ? ", stopped at the uniform bake's count at 2 x "
+                                              "the min edge"
+                                            : "");
+    if (job->adaptive.rounds_reached)
+        fprintf(log,
+                "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
+                "while still splitting (%u edge%s split in the last round, %u edge%s not "
+                "yet judged): raise --max-rounds\n",
+                job->adaptive.max_rounds, job->adaptive.last_split,
+                vdsh_s(job->adaptive.last_split), job->adaptive.pending,
+                vdsh_s(job->adaptive.pending));
+}
+
+/* The adaptive order's receivers per order. */
+static void say_adaptive_order(FILE *log, const vb_bake_output *bo)
+{
+    uint32_t hist[VDSH_ORDER_SLOTS] = {0};
+    uint32_t rows = bo->range_end - bo->range_begin;
+    double coeffs = 0.0;
+    for (uint32_t v = 0; v < rows; v++) {
+        hist[bo->variable_orders[v]]++;
+        coeffs += (double)bo->variable_orders[v] * bo->variable_orders[v];
+    }
+    fprintf(log,
+            "vdsh-bake: adaptive order (tolerance %g, cap %d): %.1f coefficients per "
+            "receiver on average; receivers per order:",
+            (double)bo->order_tolerance, bo->variable_cap, rows ? coeffs / rows : 0.0);
+    for (int k = 1; k <= bo->variable_cap; k++)
+        if (hist[k])
+            fprintf(log, " %d: %u (%.1f%%)", k, hist[k], 100.0 * hist[k] / rows);
+    fputc('\n', log);
+}
+
+/* The ray origins' check: probe rays, receivers repaired and moved,
+ * those on zero-area triangles only. */
+static void say_origins(FILE *log, const vb_bake_output *bo)
+{
+    fprintf(log,
+            "vdsh-bake: ray origins checked in %.2f s: %llu probe ray%s (%.1f%% of the "
+            "traced rays), %u receiver%s repaired, %u moved\n",
+            bo->origins.seconds, (unsigned long long)bo->origins.probe_rays,
+            vdsh_s(bo->origins.probe_rays),
+            bo->rays_traced ? 100.0 * bo->origins.probe_rays / bo->rays_traced : 0.0,
+            bo->origins.flagged, vdsh_s(bo->origins.flagged), bo->origins.moved);
+    if (bo->origins.skipped_zero_area)
+        fprintf(log,
+                "vdsh-bake: %u receiver%s on zero-area triangles only (drawn nowhere): "
+                "origin%s not probed\n",
+                bo->origins.skipped_zero_area, vdsh_s(bo->origins.skipped_zero_area),
+                vdsh_s(bo->origins.skipped_zero_area));
+}
+
+/* --light-region: where, and whether in reach. */
+static void say_light_region(FILE *log, const vb_job *job)
+{
+    const vdsh_light_box *b = &job->light_region;
+    const float *lo = job->scene->bounds_min, *hi = job->scene->bounds_max;
+    double far = 0.0; /* the farthest light from the farthest occluder corner */
+    for (int a = 0; a < 3; a++) {
+        const double d = fmax(fabs((double)b->max[a] - lo[a]), fabs((double)hi[a] - b->min[a]));
+        far += d * d;
+    }
+    far = sqrt(far);
+    fprintf(log, "vdsh-bake: lights in %s %g %g %g .. %g %g %g\n",
+            b->rule == VDSH_LIGHT_REGION_GROWN ? "the bounds grown:" : "the box", (double)b->min[0],
+            (double)b->min[1], (double)b->min[2], (double)b->max[0], (double)b->max[1],
+            (double)b->max[2]);
+    if (far > 1.5 * (double)job->bake.max_distance)
+        fprintf(log,
+                "vdsh-bake: warning: lights in this region may stand up to %g from a "
+                "receiver, beyond 1.5 x the max distance %g, where every stream reads "
+                "shadow: give --max-distance %g or more (docs/DESIGN.md, \"Lights beyond "
+                "the clamp\")\n",
+                far, (double)job->bake.max_distance, far / 1.5);
+}
+
+/* The decision fit: receivers fitted, the calibrated log offsets and the
+ * offset cap's effect. */
+static void say_decision(FILE *log, const options *o, const vb_bake_output *bo)
+{
+    if (!bo->decision_lights)
+        fprintf(log, "vdsh-bake: warning: no free space for lights in this scene: every "
+                     "receiver keeps its least-squares fit\n");
+    else
+        fprintf(log,
+                "vdsh-bake: decision fit: %u receiver%s fitted on %.0f traced lights "
+                "each on average, %u with fewer than 16 lights above %s horizon "
+                "kept the least-squares fit\n",
+                bo->decision_fitted, vdsh_s(bo->decision_fitted), bo->decision_pairs,
+                bo->decision_fallbacks, vdsh_plural(bo->decision_fallbacks, "its", "their"));
+    if (bo->calibration_receivers) {
+        fprintf(log,
+                "vdsh-bake: log offsets calibrated on %u receiver%s for %.1f%% false "
+                "shadow on held-out lights:",
+                bo->calibration_receivers, vdsh_s(bo->calibration_receivers),
+                100.0 * bo->false_rate);
+        for (int s = 0; s < o->order_count; s++)
+            fprintf(log, "%s order %d %+.3f", s ? "," : "", o->orders[s],
+                    (double)bo->log_offset[o->orders[s]]);
+        if (bo->variable_cap && bo->variable_method == VDSH_METHOD_DECISION)
+            fprintf(log, "%s adaptive order %+.3f", o->order_count ? "," : "",
+                    (double)bo->variable_param);
+        fputc('\n', log);
+    }
+    if (o->offset_cap)
+        fprintf(
+            log,
+            "vdsh-bake: offset cap raised %llu (receiver, order) offsets; the offset turns %llu of "
+            "%llu lit training pairs false (margin below %g; calibration sample not counted)\n",
+            (unsigned long long)bo->cap_bound, (unsigned long long)bo->lit_training_false,
+            (unsigned long long)bo->lit_training, (double)o->offset_cap_tol);
+}
+
+/* --quantity auto: each order's choice and the errors it was made on. */
+static void say_quantity_choice(FILE *log, const options *o, const vb_bake_output *bo)
+{
+    fprintf(log,
+            "vdsh-bake: quantity chosen on %u sampled receiver%s (expected shadow "
+            "error, distance / log):",
+            bo->auto_receivers, vdsh_s(bo->auto_receivers));
+    for (int s = 0; s < o->order_count; s++) {
+        int k = o->orders[s];
+        fprintf(log, "%s order %d %s (%.4f / %.4f)", s ? "," : "", k,
+                bo->quantity[k] == VDSH_QUANTITY_LOG_DISTANCE ? "log" : "distance",
+                bo->auto_error[k][0], bo->auto_error[k][1]);
+    }
+    fputc('\n', log);
+}
+
 /* What the bake did: rounds, fits, rays, repairs and warnings. */
 static void say_bake(FILE *log, const options *o, const vb_job *job)
 {
@@ -1408,27 +1593,7 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
     if (!log)
         return;
     if (o->adaptive)
-        fprintf(log,
-                "vdsh-bake: adaptive receivers: %u from %u in %u round%s (%u midpoint%s "
-                "baked, tolerance %g + noise floor %.3g from %u receiver%s baked twice, min "
-                "edge %g%s)\n",
-                job->receivers.vertex_count, job->adaptive.start_receivers, job->adaptive.rounds,
-                vdsh_s(job->adaptive.rounds), job->adaptive.candidates,
-                vdsh_s(job->adaptive.candidates), (double)o->adaptive_tol,
-                job->adaptive.noise_floor, job->adaptive.noise_sample,
-                vdsh_s(job->adaptive.noise_sample), (double)o->min_edge,
-                job->adaptive.budget_reached    ? ", the budget stopped it"
-                : job->adaptive.uniform_reached ? ", stopped at the uniform bake's count at 2 x "
-                                                  "the min edge"
-                                                : "");
-    if (o->adaptive && job->adaptive.rounds_reached)
-        fprintf(log,
-                "vdsh-bake: warning: adaptive refinement stopped at the round cap (%u) "
-                "while still splitting (%u edge%s split in the last round, %u edge%s not "
-                "yet judged): raise --max-rounds\n",
-                job->adaptive.max_rounds, job->adaptive.last_split,
-                vdsh_s(job->adaptive.last_split), job->adaptive.pending,
-                vdsh_s(job->adaptive.pending));
+        say_adaptive_receivers(log, o, job);
     if (bo->flipped_normals)
         fprintf(log,
                 "vdsh-bake: %u receiver normal%s pointed into geometry and %s "
@@ -1444,23 +1609,8 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
             vdsh_s(bo->threads), bo->rays_traced ? 100.0 * bo->rays_missed / bo->rays_traced : 0.0,
             bo->moved_origins, vdsh_s(bo->moved_origins), bo->degenerate_receivers,
             vdsh_s(bo->degenerate_receivers), (double)bo->max_distance);
-    if (bo->variable_orders) {
-        uint32_t hist[VDSH_ORDER_SLOTS] = {0};
-        uint32_t rows = bo->range_end - bo->range_begin;
-        double coeffs = 0.0;
-        for (uint32_t v = 0; v < rows; v++) {
-            hist[bo->variable_orders[v]]++;
-            coeffs += (double)bo->variable_orders[v] * bo->variable_orders[v];
-        }
-        fprintf(log,
-                "vdsh-bake: adaptive order (tolerance %g, cap %d): %.1f coefficients per "
-                "receiver on average; receivers per order:",
-                (double)bo->order_tolerance, bo->variable_cap, rows ? coeffs / rows : 0.0);
-        for (int k = 1; k <= bo->variable_cap; k++)
-            if (hist[k])
-                fprintf(log, " %d: %u (%.1f%%)", k, hist[k], 100.0 * hist[k] / rows);
-        fputc('\n', log);
-    }
+    if (bo->variable_orders)
+        say_adaptive_order(log, bo);
     if (o->adaptive_rays)
         fprintf(log,
                 "vdsh-bake: adaptive rays: %.1f traced per receiver on average "
@@ -1471,86 +1621,13 @@ static void say_bake(FILE *log, const options *o, const vb_job *job)
         fprintf(log, "vdsh-bake: light pool placed in %.2f s: %u light%s%s\n", job->pool_seconds,
                 job->pool_count, vdsh_s(job->pool_count),
                 job->pool_count ? "" : " (no room in free space: none used)");
-    fprintf(log,
-            "vdsh-bake: ray origins checked in %.2f s: %llu probe ray%s (%.1f%% of the "
-            "traced rays), %u receiver%s repaired, %u moved\n",
-            bo->origins.seconds, (unsigned long long)bo->origins.probe_rays,
-            vdsh_s(bo->origins.probe_rays),
-            bo->rays_traced ? 100.0 * bo->origins.probe_rays / bo->rays_traced : 0.0,
-            bo->origins.flagged, vdsh_s(bo->origins.flagged), bo->origins.moved);
-    if (bo->origins.skipped_zero_area)
-        fprintf(log,
-                "vdsh-bake: %u receiver%s on zero-area triangles only (drawn nowhere): "
-                "origin%s not probed\n",
-                bo->origins.skipped_zero_area, vdsh_s(bo->origins.skipped_zero_area),
-                vdsh_s(bo->origins.skipped_zero_area));
-    if (job->light_region.rule) { /* --light-region: where, and whether in reach */
-        const vdsh_light_box *b = &job->light_region;
-        const float *lo = job->scene->bounds_min, *hi = job->scene->bounds_max;
-        double far = 0.0; /* the farthest light from the farthest occluder corner */
-        for (int a = 0; a < 3; a++) {
-            const double d = fmax(fabs((double)b->max[a] - lo[a]), fabs((double)hi[a] - b->min[a]));
-            far += d * d;
-        }
-        far = sqrt(far);
-        fprintf(log, "vdsh-bake: lights in %s %g %g %g .. %g %g %g\n",
-                b->rule == VDSH_LIGHT_REGION_GROWN ? "the bounds grown:" : "the box",
-                (double)b->min[0], (double)b->min[1], (double)b->min[2], (double)b->max[0],
-                (double)b->max[1], (double)b->max[2]);
-        if (far > 1.5 * (double)bo->max_distance)
-            fprintf(log,
-                    "vdsh-bake: warning: lights in this region may stand up to %g from a "
-                    "receiver, beyond 1.5 x the max distance %g, where every stream reads "
-                    "shadow: give --max-distance %g or more (docs/DESIGN.md, \"Lights beyond "
-                    "the clamp\")\n",
-                    far, (double)bo->max_distance, far / 1.5);
-    }
-    if (bo->method == VDSH_METHOD_DECISION) {
-        if (!bo->decision_lights)
-            fprintf(log, "vdsh-bake: warning: no free space for lights in this scene: every "
-                         "receiver keeps its least-squares fit\n");
-        else
-            fprintf(log,
-                    "vdsh-bake: decision fit: %u receiver%s fitted on %.0f traced lights "
-                    "each on average, %u with fewer than 16 lights above %s horizon "
-                    "kept the least-squares fit\n",
-                    bo->decision_fitted, vdsh_s(bo->decision_fitted), bo->decision_pairs,
-                    bo->decision_fallbacks, vdsh_plural(bo->decision_fallbacks, "its", "their"));
-        if (bo->calibration_receivers) {
-            fprintf(log,
-                    "vdsh-bake: log offsets calibrated on %u receiver%s for %.1f%% false "
-                    "shadow on held-out lights:",
-                    bo->calibration_receivers, vdsh_s(bo->calibration_receivers),
-                    100.0 * bo->false_rate);
-            for (int s = 0; s < o->order_count; s++)
-                fprintf(log, "%s order %d %+.3f", s ? "," : "", o->orders[s],
-                        (double)bo->log_offset[o->orders[s]]);
-            if (bo->variable_cap && bo->variable_method == VDSH_METHOD_DECISION)
-                fprintf(log, "%s adaptive order %+.3f", o->order_count ? "," : "",
-                        (double)bo->variable_param);
-            fputc('\n', log);
-        }
-        if (o->offset_cap)
-            fprintf(
-                log,
-                "vdsh-bake: offset cap raised %llu (receiver, order) offsets; the offset turns %llu of "
-                "%llu lit training pairs false (margin below %g; calibration sample not counted)\n",
-                (unsigned long long)bo->cap_bound, (unsigned long long)bo->lit_training_false,
-                (unsigned long long)bo->lit_training, (double)o->offset_cap_tol);
-    }
-    if (bo->auto_receivers > 0) {
-        fprintf(log,
-                "vdsh-bake: quantity chosen on %u sampled receiver%s (expected shadow "
-                "error, distance / log):",
-                bo->auto_receivers, vdsh_s(bo->auto_receivers));
-        for (int s = 0; s < o->order_count; s++) {
-            int k = o->orders[s];
-            fprintf(log, "%s order %d %s (%.4f / %.4f)", s ? "," : "", k,
-                    bo->quantity[k] == VDSH_QUANTITY_LOG_DISTANCE ? "log" : "distance",
-                    bo->auto_error[k][0], bo->auto_error[k][1]);
-        }
-        fputc('\n', log);
-    }
+    say_origins(log, bo);
+    if (job->light_region.rule)
+        say_light_region(log, job);
+    if (bo->method == VDSH_METHOD_DECISION)
+        say_decision(log, o, bo);
+    if (bo->auto_receivers > 0)
+        say_quantity_choice(log, o, bo);
     if (bo->degenerate_receivers > 0)
         fprintf(log,
                 "vdsh-bake: warning: %u receiver%s (%.2f%%) %s distance ~0 in almost "

@@ -615,7 +615,9 @@ static void enc_fit_widths(const context *c, int *enc_w, int *fit_w)
     }
 }
 
-static void print_table(FILE *o, const context *c)
+/* The table's opening lines: the scene, the bake's parameters and its own
+ * ray counts, the evaluator's parameters. */
+static void print_run(FILE *o, const context *c)
 {
     const vdsh_file *f = c->f;
     const vdsh_header *h = &f->header;
@@ -654,6 +656,12 @@ static void print_table(FILE *o, const context *c)
             (unsigned long long)r->seed, r->directions, c->fast_truth ? "default" : "robust",
             r->oracle ? ", ORACLE (truth scored against itself)" : "", r->seconds, r->threads,
             vdsh_s(r->threads));
+}
+
+/* One line per kind of receiver: the truth's rays, how many escaped or
+ * hit at ~0 distance, and the degenerate receivers. */
+static void print_truth(FILE *o, const vb_eval_result *r)
+{
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         const vb_eval_truth *t = &r->truth[k];
         fprintf(o, "  truth     %-8s %u receiver%s", kind_name(k), t->receivers,
@@ -667,8 +675,26 @@ static void print_table(FILE *o, const context *c)
             fprintf(o, " (%.2f%%)", 100.0 * t->degenerate / t->receivers);
         fputc('\n', o);
     }
-    fprintf(o, "\n  order = n bands, n^2 coefficients (aN: adaptive, each vertex 1..N); B/v = "
-               "bytes of coefficients per vertex (adaptive: on average); +- = 95%% interval\n");
+}
+
+/* The columns both tables open a stream's row with: kind, order, offset,
+ * bytes per vertex, encoding and fit (ew, fw: enc_fit_widths). */
+static void print_stream_columns(FILE *o, const context *c, int k, uint32_t s, int ew, int fw)
+{
+    const vdsh_stream *st = &c->f->streams[s];
+    char ol[16], fit[32];
+    fprintf(o, "  %-8s %5s %+6.2f %3.0f %*s %-*s", kind_name(k), order_label(st, ol, sizeof ol),
+            (double)c->offset[s],
+            vdsh_stream_size_of(stored(c, s), vdsh_file_stream_vertices(c->f)).mean_bytes, ew,
+            vdsh_encoding_name(stored(c, s)->encoding), fw, fit_label(st, fit, sizeof fit));
+}
+
+/* The primary table: point lights in the scene's free space, where they
+ * were placed, and per kind and stream the pairs scored, the smooth and
+ * binary errors. */
+static void print_scene_lights(FILE *o, const context *c)
+{
+    const vb_eval_result *r = c->r;
     const vb_light_rule rule = (vb_light_rule)c->d->light_rule;
     fprintf(o,
             "\n  SCENE LIGHTS (the primary metric): %u point lights placed %s%s%s in the "
@@ -697,29 +723,31 @@ static void print_table(FILE *o, const context *c)
         if (r->truth[k].receivers == 0)
             continue;
         for (uint32_t s = 0; s < r->stream_count; s++) {
-            const vdsh_stream *st = &f->streams[s];
             const vb_eval_scene_metrics *m = &r->scene[k][s];
-            char mae[32], fa[32], rc[32], fit[32];
-            fit_label(st, fit, sizeof fit);
+            char mae[32], fa[32], rc[32], pairs[32];
             snprintf(mae, sizeof mae, "%.4f+-%.4f", m->shadow_mae, 1.96 * m->shadow_mae_se);
             snprintf(fa, sizeof fa, "%.2f+-%.2f%%", 100.0 * m->false_shadow,
                      196.0 * m->false_shadow_se);
             snprintf(rc, sizeof rc, "%.1f+-%.1f%%", 100.0 * m->recall, 196.0 * m->recall_se);
-            char ol[16], pairs[32];
-            fprintf(o,
-                    "  %-8s %5s %+6.2f %3.0f %*s %-*s | %7s | %-15s %-13s %-12s | %6.4f "
-                    "%5.2f%% %5.1f%%\n",
-                    kind_name(k), order_label(st, ol, sizeof ol), (double)c->offset[s],
-                    vdsh_stream_size_of(stored(c, s), vdsh_file_stream_vertices(f)).mean_bytes, ew,
-                    vdsh_encoding_name(stored(c, s)->encoding), fw, fit,
+            print_stream_columns(o, c, k, s, ew, fw);
+            fprintf(o, " | %7s | %-15s %-13s %-12s | %6.4f %5.2f%% %5.1f%%\n",
                     count_label(m->pairs, pairs, sizeof pairs), mae, fa, rc, m->binary_mae,
                     100.0 * m->binary_false_shadow, 100.0 * m->binary_recall);
         }
     }
+}
+
+/* The secondary table: one light per held-out direction at a distance
+ * relative to the truth's; the distance error and the shadow errors. */
+static void print_relative_lights(FILE *o, const context *c)
+{
+    const vb_eval_result *r = c->r;
     fprintf(o, "\n  RELATIVE LIGHTS (secondary, as in earlier figures): one light per held-out "
                "direction at d_L = 2u d_T,\n  u uniform in (0.05, 1]\n");
     fprintf(o, "  distance = |D - d_T| / max(d_T, 0.01 diag); false = P(s_hat < .5 | d_T >= d_L), "
                "leak = P(s_hat > .5 | s_ideal < .5)\n\n");
+    int ew, fw;
+    enc_fit_widths(c, &ew, &fw);
     fprintf(o,
             "  %-8s %5s %6s %3s %*s %-*s | %-14s %6s %6s %6s | %-15s %-13s %-13s | %-6s %6s %6s\n",
             "", "order", "offset", "B/v", ew, "enc", fw, "fit", "distance RMS", "p50", "p90", "p99",
@@ -728,37 +756,43 @@ static void print_table(FILE *o, const context *c)
         if (r->truth[k].receivers == 0)
             continue;
         for (uint32_t s = 0; s < r->stream_count; s++) {
-            const vdsh_stream *st = &f->streams[s];
             const vb_eval_metrics *m = &r->metrics[k][s];
-            char rms[32], mae[32], fa[32], le[32], fit[32];
-            fit_label(st, fit, sizeof fit);
+            char rms[32], mae[32], fa[32], le[32];
             snprintf(rms, sizeof rms, "%.3f+-%.3f", m->distance_rms, 1.96 * m->distance_rms_se);
             snprintf(mae, sizeof mae, "%.4f+-%.4f", m->shadow_mae, 1.96 * m->shadow_mae_se);
             snprintf(fa, sizeof fa, "%.2f+-%.2f%%", 100.0 * m->false_shadow,
                      196.0 * m->false_shadow_se);
             snprintf(le, sizeof le, "%.2f+-%.2f%%", 100.0 * m->light_leak,
                      196.0 * m->light_leak_se);
-            char ol[16];
-            fprintf(o,
-                    "  %-8s %5s %+6.2f %3.0f %*s %-*s | %-14s %6.3f %6.3f %6.3f | %-15s %-13s "
-                    "%-13s | %6.4f %5.2f%% %5.2f%%\n",
-                    kind_name(k), order_label(st, ol, sizeof ol), (double)c->offset[s],
-                    vdsh_stream_size_of(stored(c, s), vdsh_file_stream_vertices(f)).mean_bytes, ew,
-                    vdsh_encoding_name(stored(c, s)->encoding), fw, fit, rms, m->distance_p50,
-                    m->distance_p90, m->distance_p99, mae, fa, le, m->binary_mae,
-                    100.0 * m->binary_false_shadow, 100.0 * m->binary_light_leak);
+            print_stream_columns(o, c, k, s, ew, fw);
+            fprintf(o, " | %-14s %6.3f %6.3f %6.3f | %-15s %-13s %-13s | %6.4f %5.2f%% %5.2f%%\n",
+                    rms, m->distance_p50, m->distance_p90, m->distance_p99, mae, fa, le,
+                    m->binary_mae, 100.0 * m->binary_false_shadow, 100.0 * m->binary_light_leak);
         }
     }
+}
+
+/* Per kind, the share of samples whose SH sum ranged <= 0 (read as
+ * distance 0) in each stream; not for the oracle, which has no sums. */
+static void print_ringing(FILE *o, const context *c)
+{
+    const vb_eval_result *r = c->r;
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         if (r->truth[k].receivers == 0 || r->oracle)
             continue;
         fprintf(o, "  %-8s SH sum range <= 0 (read as distance 0) on", kind_name(k));
         for (uint32_t s = 0; s < r->stream_count; s++)
-            fprintf(o, "%s order %u %.3f%%", s ? "," : "", f->streams[s].order,
+            fprintf(o, "%s order %u %.3f%%", s ? "," : "", c->f->streams[s].order,
                     100.0 * r->metrics[k][s].ringing);
         fprintf(o, " of samples\n");
     }
-    /* Where to look: the worst receivers of the highest order, both kinds. */
+}
+
+/* Where to look: the worst receivers of the highest order, both kinds. */
+static void print_worst(FILE *o, const context *c)
+{
+    const vdsh_file *f = c->f;
+    const vb_eval_result *r = c->r;
     uint32_t best = 0;
     for (uint32_t s = 1; s < r->stream_count; s++)
         if (f->streams[s].order > f->streams[best].order)
@@ -787,6 +821,12 @@ static void print_table(FILE *o, const context *c)
                     w->distance_rms, 100.0 * w->near_zero);
         }
     }
+}
+
+/* The first five receivers of each kind whose truth rays mostly escape
+ * (a leak if the scene is closed). */
+static void print_escaping(FILE *o, const vb_eval_result *r)
+{
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         const vb_eval_truth *t = &r->truth[k];
         if (t->escaping_listed == 0 || t->escaping_list[0].escaped < 0.5)
@@ -803,6 +843,12 @@ static void print_table(FILE *o, const context *c)
                     (double)w->normal[1], (double)w->normal[2], 100.0 * w->escaped);
         }
     }
+}
+
+/* The first five degenerate receivers of each kind (truth almost all at
+ * ~0 distance: a bake defect). */
+static void print_degenerate(FILE *o, const vb_eval_result *r)
+{
     for (int k = 0; k < VB_EVAL_KINDS; k++) {
         const vb_eval_truth *t = &r->truth[k];
         if (t->degenerate_listed == 0)
@@ -819,6 +865,22 @@ static void print_table(FILE *o, const context *c)
                     (double)w->normal[1], (double)w->normal[2]);
         }
     }
+}
+
+/* The text report: the run, the truth, the two tables, then where to
+ * look (ringing, worst, escaping and degenerate receivers). */
+static void print_table(FILE *o, const context *c)
+{
+    print_run(o, c);
+    print_truth(o, c->r);
+    fprintf(o, "\n  order = n bands, n^2 coefficients (aN: adaptive, each vertex 1..N); B/v = "
+               "bytes of coefficients per vertex (adaptive: on average); +- = 95%% interval\n");
+    print_scene_lights(o, c);
+    print_relative_lights(o, c);
+    print_ringing(o, c);
+    print_worst(o, c);
+    print_escaping(o, c->r);
+    print_degenerate(o, c->r);
 }
 
 /* ---- the command line ------------------------------------------------------------ */

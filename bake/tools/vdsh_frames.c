@@ -536,90 +536,60 @@ static void sdf_block(void *ctx, uint32_t begin, uint32_t end, unsigned worker)
                                           P->hits->normal + 3 * (size_t)i, P->light, P->k);
 }
 
-static int run_truth(const options *op)
+/* The distance volume of c-sdf: --sdf, else the companion file when it
+ * exists (*have: one was read and fits the scene). Returns 0, 1 on an
+ * error (the message printed) or 2 for --sdf-k with no volume. */
+static int open_volume(const options *op, const vdsh_file *f, vdsh_sdf *vol, int *have)
 {
-    const char *path = op->path, *views_path = op->views_path, *dir = op->output;
-    const char *sdf_arg = op->sdf;
-    const uint32_t compare = op->compare;
-    const float sdf_k = op->sdf_k;
-    const char *opt = "-o";
-    int rc = vt_cli_no_stdout(&dir, &opt, 1);
-    if (rc)
-        return rc;
-    vt_views V = {0};
-    if (read_views(views_path, &V))
-        return 1;
-    loaded L;
-    if (load_scene(path, op->threads, 1, NULL, &L)) {
-        vt_views_free(&V);
-        return 1;
-    }
-    int status = 1, have_tmp = 0;
-    char tmp_dir[PATH_MAX];
-    const vdsh_file *f = L.f;
-    const int w = V.width, h = V.height;
-    /* The distance volume: --sdf, else the companion file when it exists. */
-    vdsh_sdf vol = {0};
-    int have_sdf = 0;
-    {
-        char sp[PATH_MAX];
-        struct stat sst;
-        const char *p = sdf_arg;
-        if (!p && vdsh_sdf_path(path, sp, sizeof sp) == 0 && stat(sp, &sst) == 0)
-            p = sp;
-        if (p) {
-            vdsh_error ve;
-            if (vdsh_sdf_read(p, &vol, &ve) != VDSH_OK) {
-                fprintf(stderr, PROG ": %s\n", ve.msg);
-                loaded_free(&L);
-                vt_views_free(&V);
-                return 1;
-            }
-            have_sdf = 1;
-            /* The runtime's rule (vr.h, sdf_path): a volume baked beside
-             * other vertex or triangle counts is refused when named, and
-             * skipped when it is the companion (left by an earlier bake of
-             * the same name), so c-sdf is what vdsh-view's mode sdf draws. */
-            if (vdsh_sdf_other_scene(&vol, f->header.vertex_count, f->header.triangle_count)) {
-                if (sdf_arg || !op->quiet) /* the companion skipped: a note */
-                    fprintf(stderr,
-                            PROG ": %s%s was baked beside another bake (%u vertices and %u "
-                                 "triangles, not %u and %u)%s\n",
-                            p, sdf_arg ? "" : " beside it", vol.vertex_count, vol.triangle_count,
-                            f->header.vertex_count, f->header.triangle_count,
-                            sdf_arg
-                                ? ": bake it again (vdsh-bake --sdf N)"
+    const char *path = op->path, *sdf_arg = op->sdf;
+    char sp[PATH_MAX];
+    struct stat sst;
+    const char *p = sdf_arg;
+    *have = 0;
+    if (!p && vdsh_sdf_path(path, sp, sizeof sp) == 0 && stat(sp, &sst) == 0)
+        p = sp;
+    if (p) {
+        vdsh_error ve;
+        if (vdsh_sdf_read(p, vol, &ve) != VDSH_OK) {
+            fprintf(stderr, PROG ": %s\n", ve.msg);
+            return 1;
+        }
+        *have = 1;
+        /* The runtime's rule (vr.h, sdf_path): a volume baked beside
+         * other vertex or triangle counts is refused when named, and
+         * skipped when it is the companion (left by an earlier bake of
+         * the same name), so c-sdf is what vdsh-view's mode sdf draws. */
+        if (vdsh_sdf_other_scene(vol, f->header.vertex_count, f->header.triangle_count)) {
+            if (sdf_arg || !op->quiet) /* the companion skipped: a note */
+                fprintf(stderr,
+                        PROG ": %s%s was baked beside another bake (%u vertices and %u "
+                             "triangles, not %u and %u)%s\n",
+                        p, sdf_arg ? "" : " beside it", vol->vertex_count, vol->triangle_count,
+                        f->header.vertex_count, f->header.triangle_count,
+                        sdf_arg ? ": bake it again (vdsh-bake --sdf N)"
                                 : ": skipped, no c-sdf frames (bake again with vdsh-bake --sdf N)");
-                vdsh_sdf_free(&vol);
-                have_sdf = 0;
-                if (sdf_arg) {
-                    loaded_free(&L);
-                    vt_views_free(&V);
-                    return 1;
-                }
-            }
-        }
-        if (!have_sdf && op->sdf_k_given) { /* it made no c-sdf frame, exit 0 */
-            fprintf(stderr,
-                    PROG ": --sdf-k: %s has no distance volume (no %s; bake one with "
-                         "vdsh-bake --sdf N, or give --sdf FILE)\n",
-                    path, vdsh_sdf_path(path, sp, sizeof sp) == 0 ? sp : "SCENE.sdf");
-            loaded_free(&L);
-            vt_views_free(&V);
-            return 2;
+            vdsh_sdf_free(vol);
+            *have = 0;
+            if (sdf_arg)
+                return 1;
         }
     }
-    const size_t n = (size_t)w * (size_t)h;
-    vb_frames_hits hits = {0};
-    vb_frames_light lights[VT_VIEWS_MAX_LIGHTS];
-    memset(lights, 0, sizeof lights);
-    float *streams = malloc(((size_t)f->stream_count + 2) * n * sizeof *streams);
-    frame_item *items = calloc(4 + (size_t)f->stream_count, sizeof *items);
-    uint8_t *rgba = malloc(4 * n);
-    vb_error err;
-    /* One c-vdshN per order, the first fixed-order stream of each, and one
-     * c-vdsh-var, the first variable-order stream (slot 0 of seen). */
-    int use[VDSH_MAX_STREAMS] = {0}, seen[VDSH_ORDER_SLOTS] = {0};
+    if (!*have && op->sdf_k_given) { /* it made no c-sdf frame, exit 0 */
+        fprintf(stderr,
+                PROG ": --sdf-k: %s has no distance volume (no %s; bake one with "
+                     "vdsh-bake --sdf N, or give --sdf FILE)\n",
+                path, vdsh_sdf_path(path, sp, sizeof sp) == 0 ? sp : "SCENE.sdf");
+        return 2;
+    }
+    return 0;
+}
+
+/* The streams drawn (use[s]): one c-vdshN per order, the first
+ * fixed-order stream of each, and one c-vdsh-var, the first
+ * variable-order stream (slot 0 of seen); a note for each other. */
+static void choose_streams(const options *op, const vdsh_file *f, int use[VDSH_MAX_STREAMS])
+{
+    int seen[VDSH_ORDER_SLOTS] = {0};
     for (uint32_t s = 0; s < f->stream_count; s++) {
         const vdsh_stream *st = &f->streams[s];
         uint32_t o = st->flags & VDSH_STREAM_VARIABLE ? 0 : st->order;
@@ -630,160 +600,264 @@ static int run_truth(const options *op)
         } else if (!op->quiet) {
             char name[32];
             stream_mode(st, name, sizeof name);
-            fprintf(stderr, PROG ": %s: stream %u (%s): %s\n", path, s, name,
+            fprintf(stderr, PROG ": %s: stream %u (%s): %s\n", op->path, s, name,
                     seen[o] ? "a mode of that name is drawn already: only the first is"
                             : "a variable-order stream is drawn only per vertex distance "
                               "(log distance): skipped");
         }
     }
-    if (!streams || !items || !rgba) {
-        fprintf(stderr, PROG ": out of memory for %d x %d frames\n", w, h);
+}
+
+/* What the truth of every view shares. */
+typedef struct truth_run {
+    const options *op;
+    const vt_views *V;
+    const loaded *L;
+    /* The output folder, and the one the frames go to until the commit. */
+    const char *dir;
+    char tmp_dir[PATH_MAX];
+    int w, h;
+    size_t n;
+    /* Per stream: drawn as a c-vdsh frame (choose_streams). */
+    int use[VDSH_MAX_STREAMS];
+    /* The distance volume of c-sdf, when have_sdf (open_volume). */
+    vdsh_sdf vol;
+    int have_sdf;
+    /* Scratch: a view's primary hits, its set's lights, a light's C
+     * frames (stream s at s * n, c-sdf at (stream_count + 1) * n), the
+     * frames to write and a shaded picture. */
+    vb_frames_hits hits;
+    vb_frames_light lights[VT_VIEWS_MAX_LIGHTS];
+    float *streams;
+    frame_item *items;
+    uint8_t *rgba;
+    /* For the summary: seconds of each pass, and frames made. */
+    double t_primary, t_shadow, t_streams, t_write;
+    int light_frames, stream_frames;
+} truth_run;
+
+/* One view's times, for its line. */
+typedef struct view_times {
+    double primary, shadow, streams;
+    int lights;
+} view_times;
+
+/* Light j of set k of view v: its shadow pass, then its frames written:
+ * hard, ideal and mask, each stream drawn, and c-sdf. */
+static int truth_light(truth_run *T, const vt_view *v, int k, int j, view_times *vt)
+{
+    const options *op = T->op;
+    const vdsh_file *f = T->L->f;
+    const float *L0 = v->lights[k][j];
+    vb_frames_light *lt = &T->lights[j];
+    vb_error err;
+    double t = vb_now();
+    if (vb_frames_trace_light(T->L->fs, &T->hits, L0, op->compare, op->threads, lt, &err) !=
+        VB_OK) {
+        fprintf(stderr, PROG ": view '%s': %s\n", v->name, err.msg);
+        return -1;
+    }
+    vt->shadow += vb_now() - t;
+    T->light_frames++;
+    vt->lights++;
+    frame_item *items = T->items;
+    frame_batch fb = {.dir = T->tmp_dir,
+                      .view = v->name,
+                      .set = k,
+                      .light = j,
+                      .w = T->w,
+                      .h = T->h,
+                      .items = items};
+    uint32_t count = 0;
+    const char *truth_modes[3] = {"hard", "ideal", "mask"};
+    const float *truth_values[3] = {lt->hard, lt->ideal, lt->mask};
+    for (int m = 0; m < 3; m++, count++) {
+        memset(&items[count], 0, sizeof items[count]);
+        snprintf(items[count].mode, sizeof items[count].mode, "%s", truth_modes[m]);
+        items[count].values = truth_values[m];
+    }
+    for (uint32_t s = 0; s < f->stream_count; s++) {
+        if (!T->use[s])
+            continue;
+        float *out = T->streams + (size_t)s * T->n;
+        t = vb_now();
+        if (vb_frames_eval_stream(T->L->fs, &T->hits, s, L0, op->compare, op->threads, out, &err) !=
+            VB_OK) {
+            fprintf(stderr, PROG ": %s: %s\n", op->path, err.msg);
+            return -1;
+        }
+        vt->streams += vb_now() - t;
+        T->stream_frames++;
+        memset(&items[count], 0, sizeof items[count]);
+        stream_mode(&f->streams[s], items[count].mode, sizeof items[count].mode);
+        items[count++].values = out;
+    }
+    if (T->have_sdf) {
+        float *out = T->streams + (size_t)(f->stream_count + 1) * T->n;
+        t = vb_now();
+        sdf_pass sp = {.v = &T->vol, .hits = &T->hits, .light = L0, .k = op->sdf_k, .out = out};
+        if (!vb_parallel_for(op->threads, (uint32_t)T->n, 1024, sdf_block, &sp, NULL, NULL)) {
+            fprintf(stderr, PROG ": cannot start worker threads\n");
+            return -1;
+        }
+        vt->streams += vb_now() - t;
+        T->stream_frames++;
+        memset(&items[count], 0, sizeof items[count]);
+        snprintf(items[count].mode, sizeof items[count].mode, "c-sdf");
+        items[count++].values = out;
+    }
+    t = vb_now();
+    if (write_frames(&fb, count, op->threads))
+        return -1;
+    T->t_write += vb_now() - t;
+    return 0;
+}
+
+/* The pictures of set k: shaded with its lights' hard and ideal shadows. */
+static int truth_shaded(truth_run *T, const vt_view *v, int k, const float *const *vis_hard,
+                        const float *const *vis_ideal)
+{
+    vb_frames_shading sh;
+    vb_frames_shading_default(T->L->fs, v->light_count[k], &sh);
+    for (int pass = 0; pass < 2; pass++) {
+        char p[PATH_MAX], msg[PATH_MAX + 256];
+        int len = snprintf(p, sizeof p, "%s/%s-s%d-shaded-%s.png", T->tmp_dir, v->name, k,
+                           pass ? "ideal" : "hard");
+        if (len < 0 || (size_t)len >= sizeof p) {
+            fprintf(stderr, PROG ": %s: path too long\n", T->dir);
+            return -1;
+        }
+        vb_frames_shade(&T->hits, (const float(*)[3])v->lights[k], v->light_count[k],
+                        pass ? vis_ideal : vis_hard, &sh, T->rgba);
+        if (vt_png_rgba_write(p, T->w, T->h, T->rgba, msg, sizeof msg) != 0) {
+            fprintf(stderr, PROG ": %s\n", msg);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* View vi: its primary pass, then every light of every set, and the
+ * set's pictures; a line with its times. */
+static int truth_view(truth_run *T, int vi)
+{
+    const options *op = T->op;
+    const vt_view *v = T->V->views + vi;
+    view_times vt = {0};
+    vb_error err;
+    double t = vb_now();
+    if (vb_frames_trace_primary(T->L->fs, &v->camera, T->w, T->h, op->threads, &T->hits, &err) !=
+        VB_OK) {
+        fprintf(stderr, PROG ": %s: view '%s': %s\n", op->views_path, v->name, err.msg);
+        return -1;
+    }
+    vt.primary = vb_now() - t;
+    T->t_primary += vt.primary;
+    for (int k = 0; k < v->set_count; k++) {
+        const float *vis_hard[VT_VIEWS_MAX_LIGHTS], *vis_ideal[VT_VIEWS_MAX_LIGHTS];
+        for (int j = 0; j < v->light_count[k]; j++) {
+            if (truth_light(T, v, k, j, &vt))
+                return -1;
+            vis_hard[j] = T->lights[j].hard;
+            vis_ideal[j] = T->lights[j].ideal;
+        }
+        if (truth_shaded(T, v, k, vis_hard, vis_ideal))
+            return -1;
+        for (int j = 0; j < v->light_count[k]; j++)
+            vb_frames_light_free(&T->lights[j]);
+    }
+    vb_frames_hits_free(&T->hits);
+    T->t_shadow += vt.shadow;
+    T->t_streams += vt.streams;
+    if (!op->quiet)
+        printf("  %-10s primary %6.1f ms; %d light%s: shadow %6.1f ms per light, C streams "
+               "%6.1f ms per light\n",
+               v->name, 1e3 * vt.primary, vt.lights, vdsh_s((unsigned)vt.lights),
+               1e3 * vt.shadow / (vt.lights ? vt.lights : 1),
+               1e3 * vt.streams / (vt.lights ? vt.lights : 1));
+    return 0;
+}
+
+/* The summary: a frame's truth, the C streams, the frames written. */
+static void print_truth_times(const truth_run *T, double t0)
+{
+    const options *op = T->op;
+    double per_view = T->t_primary / T->V->count;
+    double per_light = T->light_frames ? T->t_shadow / T->light_frames : 0.0;
+    printf("  a frame's truth (%d x %d, primary + shadow ray per pixel): %.1f ms "
+           "(primary %.1f + shadow %.1f) on %u thread%s\n",
+           T->w, T->h, 1e3 * (per_view + per_light), 1e3 * per_view, 1e3 * per_light,
+           vb_parallel_threads(op->threads), vdsh_s(vb_parallel_threads(op->threads)));
+    printf("  C streams: %.1f ms per stream per frame; %d + %d frames written (%.2f s) in "
+           "%.2f s in all\n",
+           T->stream_frames ? 1e3 * T->t_streams / T->stream_frames : 0.0, 3 * T->light_frames,
+           T->stream_frames, T->t_write, vb_now() - t0);
+}
+
+static int run_truth(const options *op)
+{
+    const char *dir = op->output;
+    const char *opt = "-o";
+    int rc = vt_cli_no_stdout(&dir, &opt, 1);
+    if (rc)
+        return rc;
+    vt_views V = {0};
+    if (read_views(op->views_path, &V))
+        return 1;
+    loaded L;
+    if (load_scene(op->path, op->threads, 1, NULL, &L)) {
+        vt_views_free(&V);
+        return 1;
+    }
+    truth_run T = {.op = op, .V = &V, .L = &L, .dir = dir, .w = V.width, .h = V.height};
+    rc = open_volume(op, L.f, &T.vol, &T.have_sdf);
+    if (rc) {
+        vdsh_sdf_free(&T.vol);
+        loaded_free(&L);
+        vt_views_free(&V);
+        return rc;
+    }
+    int status = 1, have_tmp = 0;
+    const vdsh_file *f = L.f;
+    T.n = (size_t)T.w * (size_t)T.h;
+    T.streams = malloc(((size_t)f->stream_count + 2) * T.n * sizeof *T.streams);
+    T.items = calloc(4 + (size_t)f->stream_count, sizeof *T.items);
+    T.rgba = malloc(4 * T.n);
+    choose_streams(op, f, T.use);
+    if (!T.streams || !T.items || !T.rgba) {
+        fprintf(stderr, PROG ": out of memory for %d x %d frames\n", T.w, T.h);
         goto done;
     }
-    if (truth_begin(dir, tmp_dir, sizeof tmp_dir))
+    if (truth_begin(dir, T.tmp_dir, sizeof T.tmp_dir))
         goto done;
     have_tmp = 1;
 
-    double t_primary = 0.0, t_shadow = 0.0, t_streams = 0.0, t_write = 0.0, t0 = vb_now();
-    int light_frames = 0, stream_frames = 0;
+    double t0 = vb_now();
     if (!op->quiet)
-        printf(PROG " truth: %s, %d view%s from %s, %d x %d, %s comparison -> %s\n", path, V.count,
-               vdsh_s((unsigned)V.count), views_path, w, h, vdsh_compare_name(compare), dir);
-    for (int vi = 0; vi < V.count; vi++) {
-        const vt_view *v = V.views + vi;
-        double t = vb_now();
-        if (vb_frames_trace_primary(L.fs, &v->camera, w, h, op->threads, &hits, &err) != VB_OK) {
-            fprintf(stderr, PROG ": %s: view '%s': %s\n", views_path, v->name, err.msg);
+        printf(PROG " truth: %s, %d view%s from %s, %d x %d, %s comparison -> %s\n", op->path,
+               V.count, vdsh_s((unsigned)V.count), op->views_path, T.w, T.h,
+               vdsh_compare_name(op->compare), dir);
+    for (int vi = 0; vi < V.count; vi++)
+        if (truth_view(&T, vi))
             goto done;
-        }
-        double tp = vb_now() - t, ts = 0.0, tc = 0.0;
-        t_primary += tp;
-        int view_lights = 0;
-        for (int k = 0; k < v->set_count; k++) {
-            const float *vis_hard[VT_VIEWS_MAX_LIGHTS], *vis_ideal[VT_VIEWS_MAX_LIGHTS];
-            for (int j = 0; j < v->light_count[k]; j++) {
-                const float *L0 = v->lights[k][j];
-                t = vb_now();
-                if (vb_frames_trace_light(L.fs, &hits, L0, compare, op->threads, &lights[j],
-                                          &err) != VB_OK) {
-                    fprintf(stderr, PROG ": view '%s': %s\n", v->name, err.msg);
-                    goto done;
-                }
-                ts += vb_now() - t;
-                light_frames++;
-                view_lights++;
-                vis_hard[j] = lights[j].hard;
-                vis_ideal[j] = lights[j].ideal;
-                frame_batch fb = {.dir = tmp_dir,
-                                  .view = v->name,
-                                  .set = k,
-                                  .light = j,
-                                  .w = w,
-                                  .h = h,
-                                  .items = items};
-                uint32_t count = 0;
-                const char *truth_modes[3] = {"hard", "ideal", "mask"};
-                const float *truth_values[3] = {lights[j].hard, lights[j].ideal, lights[j].mask};
-                for (int m = 0; m < 3; m++, count++) {
-                    memset(&items[count], 0, sizeof items[count]);
-                    snprintf(items[count].mode, sizeof items[count].mode, "%s", truth_modes[m]);
-                    items[count].values = truth_values[m];
-                }
-                for (uint32_t s = 0; s < f->stream_count; s++) {
-                    if (!use[s])
-                        continue;
-                    float *out = streams + (size_t)s * n;
-                    t = vb_now();
-                    if (vb_frames_eval_stream(L.fs, &hits, s, L0, compare, op->threads, out,
-                                              &err) != VB_OK) {
-                        fprintf(stderr, PROG ": %s: %s\n", path, err.msg);
-                        goto done;
-                    }
-                    tc += vb_now() - t;
-                    stream_frames++;
-                    memset(&items[count], 0, sizeof items[count]);
-                    stream_mode(&f->streams[s], items[count].mode, sizeof items[count].mode);
-                    items[count++].values = out;
-                }
-                if (have_sdf) {
-                    float *out = streams + (size_t)(f->stream_count + 1) * n;
-                    t = vb_now();
-                    sdf_pass sp = {.v = &vol, .hits = &hits, .light = L0, .k = sdf_k, .out = out};
-                    if (!vb_parallel_for(op->threads, (uint32_t)n, 1024, sdf_block, &sp, NULL,
-                                         NULL)) {
-                        fprintf(stderr, PROG ": cannot start worker threads\n");
-                        goto done;
-                    }
-                    tc += vb_now() - t;
-                    stream_frames++;
-                    memset(&items[count], 0, sizeof items[count]);
-                    snprintf(items[count].mode, sizeof items[count].mode, "c-sdf");
-                    items[count++].values = out;
-                }
-                t = vb_now();
-                if (write_frames(&fb, count, op->threads))
-                    goto done;
-                t_write += vb_now() - t;
-            }
-            /* The pictures of the set. */
-            vb_frames_shading sh;
-            vb_frames_shading_default(L.fs, v->light_count[k], &sh);
-            for (int pass = 0; pass < 2; pass++) {
-                char p[PATH_MAX], msg[PATH_MAX + 256];
-                int len = snprintf(p, sizeof p, "%s/%s-s%d-shaded-%s.png", tmp_dir, v->name, k,
-                                   pass ? "ideal" : "hard");
-                if (len < 0 || (size_t)len >= sizeof p) {
-                    fprintf(stderr, PROG ": %s: path too long\n", dir);
-                    goto done;
-                }
-                vb_frames_shade(&hits, (const float(*)[3])v->lights[k], v->light_count[k],
-                                pass ? vis_ideal : vis_hard, &sh, rgba);
-                if (vt_png_rgba_write(p, w, h, rgba, msg, sizeof msg) != 0) {
-                    fprintf(stderr, PROG ": %s\n", msg);
-                    goto done;
-                }
-            }
-            for (int j = 0; j < v->light_count[k]; j++)
-                vb_frames_light_free(&lights[j]);
-        }
-        vb_frames_hits_free(&hits);
-        t_shadow += ts;
-        t_streams += tc;
-        if (!op->quiet)
-            printf("  %-10s primary %6.1f ms; %d light%s: shadow %6.1f ms per light, C streams "
-                   "%6.1f ms per light\n",
-                   v->name, 1e3 * tp, view_lights, vdsh_s((unsigned)view_lights),
-                   1e3 * ts / (view_lights ? view_lights : 1),
-                   1e3 * tc / (view_lights ? view_lights : 1));
-    }
-    if (truth_commit(dir, tmp_dir))
+    if (truth_commit(dir, T.tmp_dir))
         goto done;
     have_tmp = 0;
-    if (!op->quiet) {
-        double per_view = t_primary / V.count;
-        double per_light = light_frames ? t_shadow / light_frames : 0.0;
-        printf("  a frame's truth (%d x %d, primary + shadow ray per pixel): %.1f ms "
-               "(primary %.1f + shadow %.1f) on %u thread%s\n",
-               w, h, 1e3 * (per_view + per_light), 1e3 * per_view, 1e3 * per_light,
-               vb_parallel_threads(op->threads), vdsh_s(vb_parallel_threads(op->threads)));
-        printf("  C streams: %.1f ms per stream per frame; %d + %d frames written (%.2f s) in "
-               "%.2f s in all\n",
-               stream_frames ? 1e3 * t_streams / stream_frames : 0.0, 3 * light_frames,
-               stream_frames, t_write, vb_now() - t0);
-    }
+    if (!op->quiet)
+        print_truth_times(&T, t0);
     status = 0;
 done:
     if (have_tmp) { /* a failure: none of the truth */
-        vt_cli_remove_dir(tmp_dir);
+        vt_cli_remove_dir(T.tmp_dir);
         vt_cli_remove_dir_on_signal(NULL);
     }
     for (int j = 0; j < VT_VIEWS_MAX_LIGHTS; j++)
-        vb_frames_light_free(&lights[j]);
-    vb_frames_hits_free(&hits);
-    free(streams);
-    free(items);
-    free(rgba);
-    vdsh_sdf_free(&vol);
+        vb_frames_light_free(&T.lights[j]);
+    vb_frames_hits_free(&T.hits);
+    free(T.streams);
+    free(T.items);
+    free(T.rgba);
+    vdsh_sdf_free(&T.vol);
     loaded_free(&L);
     vt_views_free(&V);
     return status;
@@ -879,12 +953,117 @@ static void print_row(const char *view, const char *set, int lights, const vb_fr
            100.0 * s.blotch_area);
 }
 
+/* The frames of a view set: one per (view, set, light). */
+static size_t frame_count_of(const vt_views *V)
+{
+    size_t n = 0;
+    for (int vi = 0; vi < V->count; vi++)
+        for (int k = 0; k < V->views[vi].set_count; k++)
+            n += (size_t)V->views[vi].light_count[k];
+    return n;
+}
+
+/* Every frame of every mode scored against the truth: tally[m *
+ * frame_count + fi] for mode m and frame fi, frames in view, set and
+ * light order. Returns 0, or -1 with the message printed. */
+static int score_frames(const options *op, const vt_views *V, size_t frame_count,
+                        vb_frames_tally *tally)
+{
+    const char *views_path = op->views_path;
+    float *hard = NULL, *ideal = NULL, *mask = NULL, *s = NULL;
+    vb_error err;
+    char p[PATH_MAX];
+    int rc = -1;
+    size_t fi = 0;
+    for (int vi = 0; vi < V->count; vi++) {
+        const vt_view *v = V->views + vi;
+        for (int k = 0; k < v->set_count; k++)
+            for (int l = 0; l < v->light_count[k]; l++, fi++) {
+                if (read_frame(op->truth, V, views_path, v->name, k, l, "hard", &hard, p,
+                               sizeof p) ||
+                    read_frame(op->truth, V, views_path, v->name, k, l, "ideal", &ideal, p,
+                               sizeof p) ||
+                    read_frame(op->truth, V, views_path, v->name, k, l, "mask", &mask, p, sizeof p))
+                    goto done;
+                for (int m = 0; m < op->mode_count; m++) {
+                    if (read_frame(op->frames, V, views_path, v->name, k, l, op->modes[m], &s, p,
+                                   sizeof p))
+                        goto done;
+                    if (vb_frames_score_frame(s, hard, ideal, mask, V->width, V->height,
+                                              &tally[(size_t)m * frame_count + fi],
+                                              &err) != VB_OK) {
+                        fprintf(stderr, PROG ": %s: %s\n", p, err.msg);
+                        goto done;
+                    }
+                    free(s);
+                    s = NULL;
+                }
+                free(hard);
+                free(ideal);
+                free(mask);
+                hard = ideal = mask = NULL;
+            }
+    }
+    rc = 0;
+done:
+    free(hard);
+    free(ideal);
+    free(mask);
+    free(s);
+    return rc;
+}
+
+/* Mode m's scores (T: its frames' tallies): per frame and set in the
+ * JSON (under jm), per set and for the scene in the table. */
+static void report_mode(const options *op, const vt_views *V, int m, const vb_frames_tally *T,
+                        vt_json *j, cJSON *jm)
+{
+    const char *mode = op->modes[m];
+    vb_frames_tally scene = {0};
+    char p[PATH_MAX];
+    cJSON *mo = vt_json_object(j, jm, NULL);
+    vt_json_string(j, mo, "mode", mode);
+    cJSON *sets = vt_json_array(j, mo, "sets");
+    if (!op->quiet)
+        printf("\n  mode %s\n  %-10s %-3s %6s %9s  %8s %6s  %8s %6s  %7s %7s  %s\n", mode, "view",
+               "set", "lights", "counted", "RMSE/id", "PSNR", "RMSE/hd", "PSNR", "recall", "false",
+               "blotches");
+    size_t fi = 0;
+    for (int vi = 0; vi < V->count; vi++) {
+        const vt_view *v = V->views + vi;
+        for (int k = 0; k < v->set_count; k++) {
+            vb_frames_tally set = {0};
+            cJSON *so = vt_json_object(j, sets, NULL);
+            vt_json_string(j, so, "view", v->name);
+            vt_json_i64(j, so, "set", k);
+            /* each frame's scores; "frames" (json_scores) is their count */
+            cJSON *fr = vt_json_array(j, so, "per_frame");
+            for (int l = 0; l < v->light_count[k]; l++, fi++) {
+                vb_frames_tally_add(&set, &T[fi]);
+                cJSON *o = vt_json_object(j, fr, NULL);
+                vt_json_i64(j, o, "light", l);
+                vt_frame_path(p, sizeof p, op->frames, v->name, k, l, mode);
+                vt_json_string(j, o, "file", p);
+                json_scores(j, o, &T[fi]);
+            }
+            json_scores(j, so, &set);
+            vb_frames_tally_add(&scene, &set);
+            if (!op->quiet) {
+                char sk[16];
+                snprintf(sk, sizeof sk, "%d", k);
+                print_row(v->name, sk, v->light_count[k], &set);
+            }
+        }
+    }
+    json_scores(j, vt_json_object(j, mo, "scene"), &scene);
+    if (!op->quiet)
+        print_row("scene", "", (int)scene.frames, &scene);
+}
+
 static int run_score(const options *op)
 {
     const char *path = op->path, *views_path = op->views_path, *truth = op->truth;
     const char *frames = op->frames, *json = op->json;
-    const char(*modes)[64] = op->modes;
-    const int mode_count = op->mode_count;
     {
         const char *ins[] = {path, views_path};
         if (vt_cli_check_outputs(&json, 1, ins, 2) != 0)
@@ -902,48 +1081,15 @@ static int run_score(const options *op)
     int status = 1;
     /* Tallies: per mode, per (view, set, light) frame; sets and the scene
      * are sums of those, in order. */
-    size_t frame_count = 0;
-    for (int vi = 0; vi < V.count; vi++)
-        for (int k = 0; k < V.views[vi].set_count; k++)
-            frame_count += (size_t)V.views[vi].light_count[k];
-    vb_frames_tally *tally = calloc((size_t)mode_count * frame_count, sizeof *tally);
-    float *hard = NULL, *ideal = NULL, *mask = NULL, *s = NULL;
+    const size_t frame_count = frame_count_of(&V);
+    vb_frames_tally *tally = calloc((size_t)op->mode_count * frame_count, sizeof *tally);
     vt_json j = {0};
-    vb_error err;
-    char p[PATH_MAX];
     if (!tally) {
         fprintf(stderr, PROG ": out of memory\n");
         goto done;
     }
-    size_t fi = 0;
-    for (int vi = 0; vi < V.count; vi++) {
-        const vt_view *v = V.views + vi;
-        for (int k = 0; k < v->set_count; k++)
-            for (int l = 0; l < v->light_count[k]; l++, fi++) {
-                if (read_frame(truth, &V, views_path, v->name, k, l, "hard", &hard, p, sizeof p) ||
-                    read_frame(truth, &V, views_path, v->name, k, l, "ideal", &ideal, p,
-                               sizeof p) ||
-                    read_frame(truth, &V, views_path, v->name, k, l, "mask", &mask, p, sizeof p))
-                    goto done;
-                for (int m = 0; m < mode_count; m++) {
-                    if (read_frame(frames, &V, views_path, v->name, k, l, modes[m], &s, p,
-                                   sizeof p))
-                        goto done;
-                    if (vb_frames_score_frame(s, hard, ideal, mask, V.width, V.height,
-                                              &tally[(size_t)m * frame_count + fi],
-                                              &err) != VB_OK) {
-                        fprintf(stderr, PROG ": %s: %s\n", p, err.msg);
-                        goto done;
-                    }
-                    free(s);
-                    s = NULL;
-                }
-                free(hard);
-                free(ideal);
-                free(mask);
-                hard = ideal = mask = NULL;
-            }
-    }
+    if (score_frames(op, &V, frame_count, tally))
+        goto done;
 
     /* Report: the table, then the JSON. */
     cJSON *root = vt_json_object(&j, NULL, NULL);
@@ -961,47 +1107,8 @@ static int run_score(const options *op)
     if (!op->quiet)
         printf(PROG " score: %s, %d view%s from %s, %d x %d; truth %s, frames %s\n", path, V.count,
                vdsh_s((unsigned)V.count), views_path, V.width, V.height, truth, frames);
-    for (int m = 0; m < mode_count; m++) {
-        const vb_frames_tally *T = tally + (size_t)m * frame_count;
-        vb_frames_tally scene = {0};
-        cJSON *mo = vt_json_object(&j, jm, NULL);
-        vt_json_string(&j, mo, "mode", modes[m]);
-        cJSON *sets = vt_json_array(&j, mo, "sets");
-        if (!op->quiet)
-            printf("\n  mode %s\n  %-10s %-3s %6s %9s  %8s %6s  %8s %6s  %7s %7s  %s\n", modes[m],
-                   "view", "set", "lights", "counted", "RMSE/id", "PSNR", "RMSE/hd", "PSNR",
-                   "recall", "false", "blotches");
-        fi = 0;
-        for (int vi = 0; vi < V.count; vi++) {
-            const vt_view *v = V.views + vi;
-            for (int k = 0; k < v->set_count; k++) {
-                vb_frames_tally set = {0};
-                cJSON *so = vt_json_object(&j, sets, NULL);
-                vt_json_string(&j, so, "view", v->name);
-                vt_json_i64(&j, so, "set", k);
-                /* each frame's scores; "frames" (json_scores) is their count */
-                cJSON *fr = vt_json_array(&j, so, "per_frame");
-                for (int l = 0; l < v->light_count[k]; l++, fi++) {
-                    vb_frames_tally_add(&set, &T[fi]);
-                    cJSON *o = vt_json_object(&j, fr, NULL);
-                    vt_json_i64(&j, o, "light", l);
-                    vt_frame_path(p, sizeof p, frames, v->name, k, l, modes[m]);
-                    vt_json_string(&j, o, "file", p);
-                    json_scores(&j, o, &T[fi]);
-                }
-                json_scores(&j, so, &set);
-                vb_frames_tally_add(&scene, &set);
-                if (!op->quiet) {
-                    char sk[16];
-                    snprintf(sk, sizeof sk, "%d", k);
-                    print_row(v->name, sk, v->light_count[k], &set);
-                }
-            }
-        }
-        json_scores(&j, vt_json_object(&j, mo, "scene"), &scene);
-        if (!op->quiet)
-            print_row("scene", "", (int)scene.frames, &scene);
-    }
+    for (int m = 0; m < op->mode_count; m++)
+        report_mode(op, &V, m, tally + (size_t)m * frame_count, &j, jm);
     if (!op->quiet)
         printf("\n  (over mask pixels; recall: of hard = 0 and ideal < .5, drawn < .5; false: "
                "of hard = 1, drawn < .5;\n   blotches: false-shadow regions above %.2f%% of a "
@@ -1016,10 +1123,6 @@ static int run_score(const options *op)
 done:
     vt_json_free(&j);
     free(tally);
-    free(hard);
-    free(ideal);
-    free(mask);
-    free(s);
     loaded_free(&L);
     vt_views_free(&V);
     return status;
