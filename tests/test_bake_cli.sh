@@ -337,7 +337,7 @@ check "shell: no file written on no room" test ! -e "$tmp/sr.vdsh"
 check "shell: no report written on no room" test ! -e "$tmp/sr.json"
 expect_exit 0 "shell: the same room without the shell bakes" "$bake" "${room[@]}" -o "$tmp/sr0.vdsh"
 
-# --crease (default 60): a cube without normals splits into 24 vertices
+# --crease 60 (the default is off): a cube without normals splits into 24 vertices
 # (face normals) and the file records the angle, which vdsh-info shows;
 # --crease 0 keeps the 8 smooth corners and records nothing, as does a
 # mesh the angle splits nowhere (a corner tetrahedron's face normals meet
@@ -345,11 +345,13 @@ expect_exit 0 "shell: the same room without the shell bakes" "$bake" "${room[@]}
 # --crease 0 one byte for byte.
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n' >"$tmp/crease_cube.obj"
 cube=("$tmp/crease_cube.obj" --rays 16 --cube-size 0 -q)
-expect_exit 0 "crease: default bake of a cube" "$bake" "${cube[@]}" -o "$tmp/c60.vdsh"
+expect_exit 0 "crease: --crease 60" "$bake" "${cube[@]}" --crease 60 -o "$tmp/c60.vdsh"
 expect_exit 0 "crease: --crease 0" "$bake" "${cube[@]}" --crease 0 -o "$tmp/c0.vdsh"
+expect_exit 0 "crease: default bake of a cube" "$bake" "${cube[@]}" -o "$tmp/cdef.vdsh"
+check "crease: off by default" cmp -s "$tmp/c0.vdsh" "$tmp/cdef.vdsh"
 "$info" --json - "$tmp/c60.vdsh" >"$tmp/c60.json" 2>/dev/null
 "$info" --json - "$tmp/c0.vdsh" >"$tmp/c0.json" 2>/dev/null
-check "crease: 24 receivers at the default" json "$tmp/c60.json" "d['vertex_count'] == 24 and d['bake']['occluder_vertex_count'] == 24 and d['bake']['crease'] == 60"
+check "crease: 24 receivers at 60" json "$tmp/c60.json" "d['vertex_count'] == 24 and d['bake']['occluder_vertex_count'] == 24 and d['bake']['crease'] == 60"
 check "crease: 8 receivers and no crease recorded at 0" json "$tmp/c0.json" "d['vertex_count'] == 8 and 'crease' not in d['bake']"
 expect_exit 0 "crease: --crease 180" "$bake" "${cube[@]}" --crease 180 -o "$tmp/c180.vdsh"
 check "crease: 180 is off" cmp -s "$tmp/c0.vdsh" "$tmp/c180.vdsh"

@@ -69,8 +69,11 @@ double vb_now(void);
 #define VB_DEFAULT_CUBE_SIZE 64 /* basis cubemap face, texels */
 #define VB_DEFAULT_SEED 1u      /* vdsh-bake --seed */
 /* vdsh-bake --crease: computed normals split where faces meet at more than
- * this many degrees (docs/ACCURACY.md, "Creases of computed normals") */
-#define VB_DEFAULT_CREASE 60
+ * this many degrees; 0: off. 60 measured best on the validation meshes but
+ * is not the default: with it Sponza's bakes differ between Embree's kernel
+ * sets beyond bake_isa_agree's bounds (docs/ACCURACY.md, "Creases of
+ * computed normals") */
+#define VB_DEFAULT_CREASE 0
 
 #ifdef __cplusplus
 }
