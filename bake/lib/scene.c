@@ -47,6 +47,7 @@ vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc, vb_scen
     if (!s)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
     s->vertex_count = occ->vertex_count;
+    s->corner_lift = d.corner_lift != 0;
     s->triangle_count = occ->triangle_count;
     vb_mesh_bounds(occ, s->bounds_min, s->bounds_max);
     double extent = 0.0;
