@@ -273,6 +273,7 @@ static const struct option longopts[] = {
     {"modes", required_argument, 0, O_MODES},
     {"quiet", no_argument, 0, 'q'},
     VT_CLI_LONGOPTS_END};
+
 /* --camera EX,EY,EZ,TX,TY,TZ: 0, or the usage error. */
 static int parse_camera(const char *v, vv_options *o)
 {
