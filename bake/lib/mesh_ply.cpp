@@ -237,6 +237,19 @@ vb_result ply_binary_read(const char *path, const std::vector<ply_element> &elem
     return VB_OK;
 }
 
+/* A binary integer of type t (1, 2 or 4 bytes) at q, with its sign. */
+static long long binary_integer(const ply_type *t, const uint8_t *q, bool big)
+{
+    if (t->size == 1)
+        return t->is_signed ? (long long)(int8_t)q[0] : (long long)q[0];
+    if (t->size == 2) {
+        uint16_t u = big ? (uint16_t)(q[0] << 8 | q[1]) : (uint16_t)(q[1] << 8 | q[0]);
+        return t->is_signed ? (long long)(int16_t)u : (long long)u;
+    }
+    uint32_t u = load_u32(q, big);
+    return t->is_signed ? (long long)(int32_t)u : (long long)u;
+}
+
 /* A binary list's size (p.count_type at b, moved past): the element's
  * n-th item, for messages; a truncated file or a negative size refused. */
 static vb_result binary_list_size(const char *path, const ply_element &e, uint64_t n,
@@ -682,19 +695,9 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                                        e.name.c_str(), (unsigned long long)n,
                                        (unsigned long long)e.count);
                     if (into) {
-                        double d = 0.0;
-                        if (p.type->is_float)
-                            d = ts == 4 ? (double)load_f32(b, big) : load_f64(b, big);
-                        else if (ts == 1)
-                            d = p.type->is_signed ? (double)(int8_t)b[0] : (double)b[0];
-                        else if (ts == 2) {
-                            uint16_t u =
-                                big ? (uint16_t)(b[0] << 8 | b[1]) : (uint16_t)(b[1] << 8 | b[0]);
-                            d = p.type->is_signed ? (double)(int16_t)u : (double)u;
-                        } else {
-                            uint32_t u = load_u32(b, big);
-                            d = p.type->is_signed ? (double)(int32_t)u : (double)u;
-                        }
+                        double d = !p.type->is_float ? (double)binary_integer(p.type, b, big)
+                                   : ts == 4         ? (double)load_f32(b, big)
+                                                     : load_f64(b, big);
                         if (is_xyz && (!std::isfinite(d) || std::fabs(d) > (double)FLT_MAX))
                             return vb_fail(err, VB_ERR_INVALID,
                                            "%s: vertex %llu has a non-finite coordinate", path,
@@ -703,19 +706,7 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                     }
                     if (is_indices) {
                         for (uint64_t q = 0; q < items; q++) {
-                            const uint8_t *ip = b + q * (size_t)ts;
-                            long long idx = 0;
-                            if (ts == 1)
-                                idx =
-                                    p.type->is_signed ? (long long)(int8_t)ip[0] : (long long)ip[0];
-                            else if (ts == 2) {
-                                uint16_t u = big ? (uint16_t)(ip[0] << 8 | ip[1])
-                                                 : (uint16_t)(ip[1] << 8 | ip[0]);
-                                idx = p.type->is_signed ? (long long)(int16_t)u : (long long)u;
-                            } else {
-                                uint32_t u = load_u32(ip, big);
-                                idx = p.type->is_signed ? (long long)(int32_t)u : (long long)u;
-                            }
+                            long long idx = binary_integer(p.type, b + q * (size_t)ts, big);
                             if (idx < 0 || (uint64_t)idx >= nv)
                                 return vb_fail(
                                     err, VB_ERR_INVALID,
