@@ -42,27 +42,29 @@ static double now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
+/* Exit 1 with the log when the shader or program did not build. */
+static void built(GLuint obj, int is_program)
+{
+    GLint ok = 0;
+    char log[4096];
+    (is_program ? glGetProgramiv
+                : glGetShaderiv)(obj, is_program ? GL_LINK_STATUS : GL_COMPILE_STATUS, &ok);
+    if (ok)
+        return;
+    (is_program ? glGetProgramInfoLog : glGetShaderInfoLog)(obj, sizeof log, NULL, log);
+    fprintf(stderr, "compute_probe: %s: %s\n", is_program ? "link" : "compile", log);
+    exit(1);
+}
+
 static GLuint program(const char *src)
 {
     GLuint s = glCreateShader(GL_COMPUTE_SHADER), p = glCreateProgram();
-    GLint ok = 0;
-    char log[4096];
     glShaderSource(s, 1, &src, NULL);
     glCompileShader(s);
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        glGetShaderInfoLog(s, sizeof log, NULL, log);
-        fprintf(stderr, "compute_probe: compile: %s\n", log);
-        exit(1);
-    }
+    built(s, 0);
     glAttachShader(p, s);
     glLinkProgram(p);
-    glGetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        glGetProgramInfoLog(p, sizeof log, NULL, log);
-        fprintf(stderr, "compute_probe: link: %s\n", log);
-        exit(1);
-    }
+    built(p, 1);
     glDeleteShader(s);
     return p;
 }
