@@ -352,6 +352,13 @@ typedef struct vdsh_light_box {
     float max[3]; /* finite, > min on every axis */
 } vdsh_light_box;
 
+/* The first axis (0 x, 1 y, 2 z) on which min..max is not a light box's
+ * (both finite, min below max), else -1: the `lreg` chunk's rule, which
+ * the reader and writer apply, and every light box given (vdsh-bake,
+ * vdsh-eval, vdsh-frames and vdsh-view --light-region; the runtime's
+ * vr_scene_desc.light_box). */
+int vdsh_light_box_bad_axis(const float min[3], const float max[3]);
+
 /* A part's cpca light pool (`lpol` chunk, VDSH.md "Parts"): the light mix
  * and the pool of the cpca encoder's light-density metric (vdsh_cpca.h),
  * which vdsh-merge passes to the encoder. Only in parts whose `part`

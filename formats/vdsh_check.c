@@ -578,14 +578,22 @@ int vdsh_check_adaptive(const vdsh_adaptive *a, uint32_t vertex_count, why *w)
     return 1;
 }
 
+int vdsh_light_box_bad_axis(const float min[3], const float max[3])
+{
+    for (int a = 0; a < 3; a++)
+        if (!isfinite(min[a]) || !isfinite(max[a]) || !(min[a] < max[a]))
+            return a;
+    return -1;
+}
+
 int vdsh_check_light_box(const vdsh_light_box *b, why *w)
 {
     if (b->rule != VDSH_LIGHT_REGION_GROWN && b->rule != VDSH_LIGHT_REGION_BOX)
         return vdsh_bad(w, "lreg: rule %u out of range (1 grown, 2 box)", b->rule);
-    for (int a = 0; a < 3; a++)
-        if (!isfinite(b->min[a]) || !isfinite(b->max[a]) || !(b->min[a] < b->max[a]))
-            return vdsh_bad(w, "lreg: axis %d is %g..%g, not finite with min < max", a,
-                            (double)b->min[a], (double)b->max[a]);
+    int a = vdsh_light_box_bad_axis(b->min, b->max);
+    if (a >= 0)
+        return vdsh_bad(w, "lreg: axis %d is %g..%g, not finite with min < max", a,
+                        (double)b->min[a], (double)b->max[a]);
     return 1;
 }
 

@@ -92,6 +92,10 @@ extern "C" {
  * moved light), then, while too few light the frame, the others in free
  * space. */
 #define VDSH_VIEW_MIN_SHARE 0.05f
+/* An object's camera turns about the vertical until its light 0 faces at
+ * least this share of the pixels that see the object, or as much as a
+ * turn allows (vdsh_view_compute). */
+#define VDSH_VIEW_KEY_FACING 0.5f
 #define VDSH_VIEW_CHECK_W 64
 #define VDSH_VIEW_CHECK_H 48
 #define VDSH_VIEW_LIGHT_POOL 64
@@ -189,6 +193,12 @@ typedef struct vdsh_view {
  * object's inside its light region. The first in free space is the
  * light. If none is, the first 4096 candidates of vdsh_light_candidate
  * (seed 1) are tried, nearest first.
+ * Then an object's camera (not a flat one's) turns toward light 0: when
+ * light 0 faces less than VDSH_VIEW_KEY_FACING of the check frame's pixels
+ * that see the object, the fit camera along the fit direction turned
+ * about the vertical by 45, -45, 90, -90, 135, -135, 180 degrees, the
+ * first whose frame light 0 faces so, else the one it faces most (fit is
+ * that camera too).
  * Then an interior's lights must light what the camera sees (a room
  * behind an internal wall is free space too): each light so found is
  * scored in the check frame (vdsh_view_light_shares) and kept when it

@@ -199,293 +199,294 @@ static int parse_modes(const char *list, vv_options *o)
     return 0;
 }
 
-/* Returns 0, or an exit status (help/version: -1 meaning exit 0). */
-static int parse_args(int argc, char **argv, vv_options *o)
+/* vdsh-view's options beyond -q, -h, -V and -j. */
+enum {
+    O_RENDER = 256,
+    O_GRID,
+    O_BENCH,
+    O_CAMERA,
+    O_FIT,
+    O_FOV,
+    O_LIGHT,
+    O_LIGHTS,
+    O_ATT,
+    O_AMBIENT,
+    O_MODE,
+    O_COMPARE,
+    O_PCF,
+    O_SHADOW_SIZE,
+    O_SIZE,
+    O_NO_CUBEMAPS,
+    O_EGL,
+    O_FRAMES,
+    O_SCREENSHOT,
+    O_NO_OVERLAY,
+    O_KEYS,
+    O_NO_MALLOPT,
+    O_VIEWS,
+    O_MODES,
+    O_BUFFER_FLOATS,
+    O_CPCA_FRAME,
+    O_BENCH_LIGHTS,
+    O_BENCH_CUBE_SIZES,
+    O_BENCH_MODES,
+    O_BENCH_COUNTS,
+    O_SDF,
+    O_SDF_K,
+    O_LIGHT_REGION
+};
+
+static const struct option longopts[] = {
+    {"render", required_argument, 0, O_RENDER},
+    {"grid", required_argument, 0, O_GRID},
+    {"bench", no_argument, 0, O_BENCH},
+    {"camera", required_argument, 0, O_CAMERA},
+    {"fit", no_argument, 0, O_FIT},
+    {"fov", required_argument, 0, O_FOV},
+    {"light", required_argument, 0, O_LIGHT},
+    {"lights", required_argument, 0, O_LIGHTS},
+    {"attenuation", required_argument, 0, O_ATT},
+    {"ambient", required_argument, 0, O_AMBIENT},
+    {"mode", required_argument, 0, O_MODE},
+    {"compare", required_argument, 0, O_COMPARE},
+    {"pcf", no_argument, 0, O_PCF},
+    {"sdf", required_argument, 0, O_SDF},
+    {"sdf-k", required_argument, 0, O_SDF_K},
+    {"json", required_argument, 0, 'j'},
+    {"shadow-size", required_argument, 0, O_SHADOW_SIZE},
+    {"size", required_argument, 0, O_SIZE},
+    {"no-cubemaps", no_argument, 0, O_NO_CUBEMAPS},
+    {"egl", required_argument, 0, O_EGL},
+    {"frames", required_argument, 0, O_FRAMES},
+    {"screenshot", required_argument, 0, O_SCREENSHOT},
+    {"no-overlay", no_argument, 0, O_NO_OVERLAY},
+    {"keys", required_argument, 0, O_KEYS},
+    {"no-mallopt", no_argument, 0, O_NO_MALLOPT},
+    {"buffer-floats", no_argument, 0, O_BUFFER_FLOATS},
+    {"cpca-frame", no_argument, 0, O_CPCA_FRAME},
+    {"bench-lights", required_argument, 0, O_BENCH_LIGHTS},
+    {"bench-cube-sizes", required_argument, 0, O_BENCH_CUBE_SIZES},
+    {"bench-modes", required_argument, 0, O_BENCH_MODES},
+    {"bench-counts", no_argument, 0, O_BENCH_COUNTS},
+    {"light-region", required_argument, 0, O_LIGHT_REGION},
+    {"views", required_argument, 0, O_VIEWS},
+    {"modes", required_argument, 0, O_MODES},
+    {"quiet", no_argument, 0, 'q'},
+    VT_CLI_LONGOPTS_END};
+
+/* --camera EX,EY,EZ,TX,TY,TZ: 0, or the usage error. */
+static int parse_camera(const char *v, vv_options *o)
 {
-    memset(o, 0, sizeof *o);
-    o->mode = VR_MODE_DEFAULT; /* the runtime's, vr_scene_default_mode */
-    o->egl = VR_EGL_AUTO;
-    enum {
-        O_RENDER = 256,
-        O_GRID,
-        O_BENCH,
-        O_CAMERA,
-        O_FIT,
-        O_FOV,
-        O_LIGHT,
-        O_LIGHTS,
-        O_ATT,
-        O_AMBIENT,
-        O_MODE,
-        O_COMPARE,
-        O_PCF,
-        O_SHADOW_SIZE,
-        O_SIZE,
-        O_NO_CUBEMAPS,
-        O_EGL,
-        O_FRAMES,
-        O_SCREENSHOT,
-        O_NO_OVERLAY,
-        O_KEYS,
-        O_NO_MALLOPT,
-        O_VIEWS,
-        O_MODES,
-        O_BUFFER_FLOATS,
-        O_CPCA_FRAME,
-        O_BENCH_LIGHTS,
-        O_BENCH_CUBE_SIZES,
-        O_BENCH_MODES,
-        O_BENCH_COUNTS,
-        O_SDF,
-        O_SDF_K,
-        O_LIGHT_REGION
-    };
-    static const struct option longopts[] = {
-        {"render", required_argument, 0, O_RENDER},
-        {"grid", required_argument, 0, O_GRID},
-        {"bench", no_argument, 0, O_BENCH},
-        {"camera", required_argument, 0, O_CAMERA},
-        {"fit", no_argument, 0, O_FIT},
-        {"fov", required_argument, 0, O_FOV},
-        {"light", required_argument, 0, O_LIGHT},
-        {"lights", required_argument, 0, O_LIGHTS},
-        {"attenuation", required_argument, 0, O_ATT},
-        {"ambient", required_argument, 0, O_AMBIENT},
-        {"mode", required_argument, 0, O_MODE},
-        {"compare", required_argument, 0, O_COMPARE},
-        {"pcf", no_argument, 0, O_PCF},
-        {"sdf", required_argument, 0, O_SDF},
-        {"sdf-k", required_argument, 0, O_SDF_K},
-        {"json", required_argument, 0, 'j'},
-        {"shadow-size", required_argument, 0, O_SHADOW_SIZE},
-        {"size", required_argument, 0, O_SIZE},
-        {"no-cubemaps", no_argument, 0, O_NO_CUBEMAPS},
-        {"egl", required_argument, 0, O_EGL},
-        {"frames", required_argument, 0, O_FRAMES},
-        {"screenshot", required_argument, 0, O_SCREENSHOT},
-        {"no-overlay", no_argument, 0, O_NO_OVERLAY},
-        {"keys", required_argument, 0, O_KEYS},
-        {"no-mallopt", no_argument, 0, O_NO_MALLOPT},
-        {"buffer-floats", no_argument, 0, O_BUFFER_FLOATS},
-        {"cpca-frame", no_argument, 0, O_CPCA_FRAME},
-        {"bench-lights", required_argument, 0, O_BENCH_LIGHTS},
-        {"bench-cube-sizes", required_argument, 0, O_BENCH_CUBE_SIZES},
-        {"bench-modes", required_argument, 0, O_BENCH_MODES},
-        {"bench-counts", no_argument, 0, O_BENCH_COUNTS},
-        {"light-region", required_argument, 0, O_LIGHT_REGION},
-        {"views", required_argument, 0, O_VIEWS},
-        {"modes", required_argument, 0, O_MODES},
-        {"quiet", no_argument, 0, 'q'},
-        VT_CLI_LONGOPTS_END};
-    int c;
-    while ((c = getopt_long(argc, argv, "qhVj:", longopts, NULL)) != -1) {
-        const char *v = optarg;
-        int which, rc;
-        switch (c) {
-        case 'h': fputs(usage_text, stdout); return -1;
-        case 'V': vt_cli_version(NULL); return -1;
-        case 'q': o->quiet = 1; break;
-        case O_RENDER:
-            if (!vt_opt_once("--render", v, &o->render_path))
-                return VT_EXIT_USAGE;
-            break;
-        case O_GRID:
-            if (!vt_opt_once("--grid", v, &o->grid_path))
-                return VT_EXIT_USAGE;
-            break;
-        case O_BENCH: o->bench = 1; break;
-        case O_CAMERA:
-            if (vt_parse_floats(v, o->camera, 6, 6) != 6)
-                return usage_error("--camera: expected EX,EY,EZ,TX,TY,TZ, got '%s'", v);
-            {
-                vdsh_camera cam = {{o->camera[0], o->camera[1], o->camera[2]},
-                                   {o->camera[3], o->camera[4], o->camera[5]},
-                                   {0.0f, 0.0f, 0.0f},
-                                   0.0f};
-                if (vdsh_camera_degenerate(&cam))
-                    return usage_error("--camera: the eye is at the target or straight above or "
-                                       "below it (up is +y: move it aside a little), got '%s'",
-                                       v);
-            }
-            o->have_camera = 1;
-            break;
-        case O_FIT: o->fit = 1; break;
-        case O_FOV:
-            if (!vt_parse_float(v, &o->fov) || !(o->fov > 1.0f && o->fov < 179.0f))
-                return usage_error("--fov: expected degrees in (1, 179), got '%s'", v);
-            break;
-        case O_LIGHT: {
-            float f[6];
-            int n = vt_parse_floats(v, f, 3, 6);
-            if (n != 3 && n != 6)
-                return usage_error("--light: expected X,Y,Z or X,Y,Z,R,G,B, got '%s'", v);
-            if (n == 6 && !(f[3] >= 0.0f && f[4] >= 0.0f && f[5] >= 0.0f))
-                return usage_error("--light: the colour R,G,B must be >= 0, got '%s'", v);
-            if (o->light_count == VV_MAX_LIGHTS)
-                return usage_error("--light: at most 64 lights (%s)", v);
-            vr_light *l = &o->lights[o->light_count++];
-            memset(l, 0, sizeof *l);
-            memcpy(l->position, f, sizeof l->position);
-            if (n == 6) {
-                memcpy(l->color, f + 3, sizeof l->color);
-                /* all-zero means white in vr_light: keep a black light black */
-                if (!f[3] && !f[4] && !f[5])
-                    l->color[0] = 1e-30f;
-            }
-            break;
-        }
-        case O_LIGHTS:
-            if (!vt_parse_int(v, 1, VV_MAX_LIGHTS, &o->default_lights))
-                return usage_error("--lights: expected 1..64, got '%s'", v);
-            break;
-        case O_ATT:
-            if (vt_parse_floats(v, o->att, 3, 3) != 3 || o->att[0] < 0 || o->att[1] < 0 ||
-                o->att[2] < 0 || !(o->att[0] + o->att[1] + o->att[2] > 0))
-                return usage_error("--attenuation: expected A0,A1,A2 >= 0, not all 0, got '%s'", v);
-            o->have_att = 1;
-            break;
-        case O_AMBIENT:
-            if (!vt_parse_float(v, &o->ambient) || o->ambient < 0)
-                return usage_error("--ambient: expected a value >= 0, got '%s'", v);
-            o->have_ambient = 1;
-            break;
-        case O_MODE: {
-            int i = vv_mode_find(v, strlen(v), VV_MODE_OPTION);
-            if (i < 0)
-                return usage_error("--mode: expected none, cube, vdsh2, vdsh3, vdsh5, "
-                                   "vdsh5poly, buffer, bufN (N = 1..16) or adaptive, "
-                                   "got '%s'",
-                                   v);
-            o->mode = vv_modes[i].mode;
-            if (vv_modes[i].stream) /* the others keep a stream given before */
-                o->stream = vv_modes[i].stream;
-            note_buffer(o, &vv_modes[i]);
-            o->have_mode = 1;
-            break;
-        }
-        case O_COMPARE:
-            if ((rc = pick("--compare", v, "smooth", "binary", &which)) != 0)
-                return rc;
-            o->compare = which ? VDSH_COMPARE_BINARY : VDSH_COMPARE_SMOOTH;
-            break;
-        case O_PCF: o->pcf = 1; break;
-        case O_SDF:
-            if (!vt_opt_once("--sdf", v, &o->sdf_path))
-                return VT_EXIT_USAGE;
-            break;
-        case O_SDF_K:
-            if (!vt_parse_float(v, &o->sdf_k) || !(o->sdf_k > 0.0f && o->sdf_k <= 1000.0f))
-                return usage_error("--sdf-k: expected a number > 0 and <= 1000, got '%s'", v);
-            break;
-        case O_SHADOW_SIZE:
-            if (!vt_parse_int(v, 1, 8192, &o->shadow_size))
-                return usage_error("--shadow-size: expected 1..8192, got '%s'", v);
-            break;
-        case O_SIZE:
-            if (!vt_parse_size(v, 1, 16384, &o->width, &o->height))
-                return usage_error("--size: expected WxH (1..16384), got '%s'", v);
-            o->have_size = 1;
-            break;
-        case O_NO_CUBEMAPS: o->no_cubemaps = 1; break;
-        case O_EGL:
-            if ((rc = pick("--egl", v, "device", "surfaceless", &which)) != 0)
-                return rc;
-            o->egl = which ? VR_EGL_SURFACELESS : VR_EGL_DEVICE;
-            break;
-        case O_FRAMES:
-            if (!vt_opt_once("--frames", v, &o->frames_arg))
-                return VT_EXIT_USAGE;
-            break;
-        case O_VIEWS:
-            if (!vt_opt_once("--views", v, &o->views_path))
-                return VT_EXIT_USAGE;
-            break;
-        case O_MODES:
-            if (parse_modes(v, o))
-                return usage_error("--modes: expected a comma-separated list of cube, cube-pcf, "
-                                   "vdsh2, vdsh3, vdsh5, vdsh5poly, none, bufN (N = 1..16) "
-                                   "and adaptive, got '%s'",
-                                   v);
-            break;
-        case O_SCREENSHOT:
-            if (!vt_opt_once("--screenshot", v, &o->screenshot))
-                return VT_EXIT_USAGE;
-            break;
-        case O_NO_OVERLAY: o->no_overlay = 1; break;
-        case O_KEYS:
-            for (const char *k = v; *k; k++)
-                if (!strchr("abcdefghijklmnopqrstuvwxyz0123456789 <>", *k))
-                    return usage_error("--keys: letters, digits, space, '<' and '>' only, "
-                                       "got '%s'",
-                                       v);
-            o->keys = v;
-            break;
-        case O_NO_MALLOPT: o->no_mallopt = 1; break;
-        case O_BUFFER_FLOATS: o->buffer_floats = 1; break;
-        case O_CPCA_FRAME: o->cpca_frame = 1; break;
-        case O_BENCH_LIGHTS: {
-            float n[4];
-            int k = vt_parse_floats(v, n, 1, 4);
-            o->bench_sets = 0;
-            for (int i = 0; i < k; i++)
-                o->bench_sets |= n[i] == 1    ? 1
-                                 : n[i] == 3  ? 2
-                                 : n[i] == 16 ? 4
-                                 : n[i] == 64 ? 8
-                                              : 16;
-            if (k < 1 || o->bench_sets >= 16)
-                return usage_error("--bench-lights: expected some of 1,3,16,64, got '%s'", v);
-            break;
-        }
-        case O_BENCH_CUBE_SIZES: {
-            float n[8];
-            int k = vt_parse_floats(v, n, 1, 8);
-            o->bench_cube_count = k > 0 ? k : 0;
-            for (int i = 0; i < k; i++) {
-                if (!(n[i] >= 1 && n[i] <= 8192 && n[i] == (float)(int)n[i]))
-                    k = 0;
-                else
-                    o->bench_cube_sizes[i] = (int)n[i];
-            }
-            if (k < 1)
-                return usage_error("--bench-cube-sizes: expected 1 to 8 face sizes of 1..8192, "
-                                   "got '%s'",
-                                   v);
-            break;
-        }
-        case O_BENCH_MODES:
-            if (!*v)
-                return usage_error("%s", "--bench-modes: expected mode names");
-            o->bench_modes = v;
-            break;
-        case O_BENCH_COUNTS: o->bench_counts = 1; break;
-        case O_LIGHT_REGION: {
-            /* vt_opt_light_region's auto, grown, box, file */
-            static const int to_vr[4] = {VR_LIGHT_REGION_AUTO, VR_LIGHT_REGION_GROWN,
-                                         VR_LIGHT_REGION_BOX, VR_LIGHT_REGION_FILE};
-            vdsh_light_box b;
-            if (!vt_opt_light_region("--light-region", v, 1, &b))
-                return VT_EXIT_USAGE;
-            o->light_region = to_vr[b.rule];
-            memcpy(o->light_box, b.min, sizeof b.min);
-            memcpy(o->light_box + 3, b.max, sizeof b.max);
-            break;
-        }
-        case 'j':
-            if (!vt_opt_once("--json", v, &o->json_path))
-                return 2;
-            break;
-        default: /* getopt_long said what is wrong */ vt_cli_try_help(); return VT_EXIT_USAGE;
-        }
+    if (vt_parse_floats(v, o->camera, 6, 6) != 6)
+        return usage_error("--camera: expected EX,EY,EZ,TX,TY,TZ, got '%s'", v);
+    vdsh_camera cam = {{o->camera[0], o->camera[1], o->camera[2]},
+                       {o->camera[3], o->camera[4], o->camera[5]},
+                       {0.0f, 0.0f, 0.0f},
+                       0.0f};
+    if (vdsh_camera_degenerate(&cam))
+        return usage_error("--camera: the eye is at the target or straight above or "
+                           "below it (up is +y: move it aside a little), got '%s'",
+                           v);
+    o->have_camera = 1;
+    return 0;
+}
+
+/* --light X,Y,Z or X,Y,Z,R,G,B, one more light: 0, or the usage error. */
+static int parse_light(const char *v, vv_options *o)
+{
+    float f[6];
+    int n = vt_parse_floats(v, f, 3, 6);
+    if (n != 3 && n != 6)
+        return usage_error("--light: expected X,Y,Z or X,Y,Z,R,G,B, got '%s'", v);
+    if (n == 6 && !(f[3] >= 0.0f && f[4] >= 0.0f && f[5] >= 0.0f))
+        return usage_error("--light: the colour R,G,B must be >= 0, got '%s'", v);
+    if (o->light_count == VV_MAX_LIGHTS)
+        return usage_error("--light: at most 64 lights (%s)", v);
+    vr_light *l = &o->lights[o->light_count++];
+    memset(l, 0, sizeof *l);
+    memcpy(l->position, f, sizeof l->position);
+    if (n == 6) {
+        memcpy(l->color, f + 3, sizeof l->color);
+        /* all-zero means white in vr_light: keep a black light black */
+        if (!f[3] && !f[4] && !f[5])
+            l->color[0] = 1e-30f;
     }
-    for (int i = optind; i < argc; i++) {
-        if (o->file_count == VV_MAX_FILES)
-            return usage_error("too many scene files (%s)", argv[i]);
-        o->files[o->file_count++] = argv[i];
+    return 0;
+}
+
+/* --mode NAME: 0, or the usage error. */
+static int parse_mode(const char *v, vv_options *o)
+{
+    int i = vv_mode_find(v, strlen(v), VV_MODE_OPTION);
+    if (i < 0)
+        return usage_error("--mode: expected none, cube, vdsh2, vdsh3, vdsh5, "
+                           "vdsh5poly, buffer, bufN (N = 1..16) or adaptive, "
+                           "got '%s'",
+                           v);
+    o->mode = vv_modes[i].mode;
+    if (vv_modes[i].stream) /* the others keep a stream given before */
+        o->stream = vv_modes[i].stream;
+    note_buffer(o, &vv_modes[i]);
+    o->have_mode = 1;
+    return 0;
+}
+
+/* --keys: letters, digits, space, '<' and '>': 0, or the usage error. */
+static int parse_keys(const char *v, vv_options *o)
+{
+    for (const char *k = v; *k; k++)
+        if (!strchr("abcdefghijklmnopqrstuvwxyz0123456789 <>", *k))
+            return usage_error("--keys: letters, digits, space, '<' and '>' only, "
+                               "got '%s'",
+                               v);
+    o->keys = v;
+    return 0;
+}
+
+/* --bench-lights: some of 1,3,16,64 as bits 1, 2, 4, 8 of o->bench_sets:
+ * 0, or the usage error. */
+static int parse_bench_lights(const char *v, vv_options *o)
+{
+    float n[4];
+    int k = vt_parse_floats(v, n, 1, 4);
+    o->bench_sets = 0;
+    for (int i = 0; i < k; i++)
+        o->bench_sets |= n[i] == 1 ? 1 : n[i] == 3 ? 2 : n[i] == 16 ? 4 : n[i] == 64 ? 8 : 16;
+    if (k < 1 || o->bench_sets >= 16)
+        return usage_error("--bench-lights: expected some of 1,3,16,64, got '%s'", v);
+    return 0;
+}
+
+/* --bench-cube-sizes: 1 to 8 face sizes: 0, or the usage error. */
+static int parse_bench_cube_sizes(const char *v, vv_options *o)
+{
+    float n[8];
+    int k = vt_parse_floats(v, n, 1, 8);
+    o->bench_cube_count = k > 0 ? k : 0;
+    for (int i = 0; i < k; i++) {
+        if (!(n[i] >= 1 && n[i] <= 8192 && n[i] == (float)(int)n[i]))
+            k = 0;
+        else
+            o->bench_cube_sizes[i] = (int)n[i];
     }
-    if (o->file_count == 0)
-        return usage_error("%s", "no scene file given");
-    /* --frames: a folder with --views, else a count. */
+    if (k < 1)
+        return usage_error("--bench-cube-sizes: expected 1 to 8 face sizes of 1..8192, "
+                           "got '%s'",
+                           v);
+    return 0;
+}
+
+/* --light-region: vt_opt_light_region's rule as the runtime's: 0, or the
+ * usage error (vt_opt_light_region said what is wrong). */
+static int parse_light_region(const char *v, vv_options *o)
+{
+    /* vt_opt_light_region's auto, grown, box, file */
+    static const int to_vr[4] = {VR_LIGHT_REGION_AUTO, VR_LIGHT_REGION_GROWN, VR_LIGHT_REGION_BOX,
+                                 VR_LIGHT_REGION_FILE};
+    vdsh_light_box b;
+    if (!vt_opt_light_region("--light-region", v, 1, &b))
+        return VT_EXIT_USAGE;
+    o->light_region = to_vr[b.rule];
+    memcpy(o->light_box, b.min, sizeof b.min);
+    memcpy(o->light_box + 3, b.max, sizeof b.max);
+    return 0;
+}
+
+/* getopt_long's option c with value v into o: 0, or an exit status
+ * (help/version: -1 meaning exit 0). */
+static int parse_option(int c, const char *v, vv_options *o)
+{
+    int which, rc;
+    switch (c) {
+    case 'h': fputs(usage_text, stdout); return -1;
+    case 'V': vt_cli_version(NULL); return -1;
+    case 'q': o->quiet = 1; return 0;
+    case O_RENDER: return vt_opt_once("--render", v, &o->render_path) ? 0 : VT_EXIT_USAGE;
+    case O_GRID: return vt_opt_once("--grid", v, &o->grid_path) ? 0 : VT_EXIT_USAGE;
+    case O_BENCH: o->bench = 1; return 0;
+    case O_CAMERA: return parse_camera(v, o);
+    case O_FIT: o->fit = 1; return 0;
+    case O_FOV:
+        if (!vt_parse_float(v, &o->fov) || !(o->fov > 1.0f && o->fov < 179.0f))
+            return usage_error("--fov: expected degrees in (1, 179), got '%s'", v);
+        return 0;
+    case O_LIGHT: return parse_light(v, o);
+    case O_LIGHTS:
+        if (!vt_parse_int(v, 1, VV_MAX_LIGHTS, &o->default_lights))
+            return usage_error("--lights: expected 1..64, got '%s'", v);
+        return 0;
+    case O_ATT:
+        if (vt_parse_floats(v, o->att, 3, 3) != 3 || o->att[0] < 0 || o->att[1] < 0 ||
+            o->att[2] < 0 || !(o->att[0] + o->att[1] + o->att[2] > 0))
+            return usage_error("--attenuation: expected A0,A1,A2 >= 0, not all 0, got '%s'", v);
+        o->have_att = 1;
+        return 0;
+    case O_AMBIENT:
+        if (!vt_parse_float(v, &o->ambient) || o->ambient < 0)
+            return usage_error("--ambient: expected a value >= 0, got '%s'", v);
+        o->have_ambient = 1;
+        return 0;
+    case O_MODE: return parse_mode(v, o);
+    case O_COMPARE:
+        if ((rc = pick("--compare", v, "smooth", "binary", &which)) != 0)
+            return rc;
+        o->compare = which ? VDSH_COMPARE_BINARY : VDSH_COMPARE_SMOOTH;
+        return 0;
+    case O_PCF: o->pcf = 1; return 0;
+    case O_SDF: return vt_opt_once("--sdf", v, &o->sdf_path) ? 0 : VT_EXIT_USAGE;
+    case O_SDF_K:
+        if (!vt_parse_float(v, &o->sdf_k) || !(o->sdf_k > 0.0f && o->sdf_k <= 1000.0f))
+            return usage_error("--sdf-k: expected a number > 0 and <= 1000, got '%s'", v);
+        return 0;
+    case O_SHADOW_SIZE:
+        if (!vt_parse_int(v, 1, 8192, &o->shadow_size))
+            return usage_error("--shadow-size: expected 1..8192, got '%s'", v);
+        return 0;
+    case O_SIZE:
+        if (!vt_parse_size(v, 1, 16384, &o->width, &o->height))
+            return usage_error("--size: expected WxH (1..16384), got '%s'", v);
+        o->have_size = 1;
+        return 0;
+    case O_NO_CUBEMAPS: o->no_cubemaps = 1; return 0;
+    case O_EGL:
+        if ((rc = pick("--egl", v, "device", "surfaceless", &which)) != 0)
+            return rc;
+        o->egl = which ? VR_EGL_SURFACELESS : VR_EGL_DEVICE;
+        return 0;
+    case O_FRAMES: return vt_opt_once("--frames", v, &o->frames_arg) ? 0 : VT_EXIT_USAGE;
+    case O_VIEWS: return vt_opt_once("--views", v, &o->views_path) ? 0 : VT_EXIT_USAGE;
+    case O_MODES:
+        if (parse_modes(v, o))
+            return usage_error("--modes: expected a comma-separated list of cube, cube-pcf, "
+                               "vdsh2, vdsh3, vdsh5, vdsh5poly, none, bufN (N = 1..16) "
+                               "and adaptive, got '%s'",
+                               v);
+        return 0;
+    case O_SCREENSHOT: return vt_opt_once("--screenshot", v, &o->screenshot) ? 0 : VT_EXIT_USAGE;
+    case O_NO_OVERLAY: o->no_overlay = 1; return 0;
+    case O_KEYS: return parse_keys(v, o);
+    case O_NO_MALLOPT: o->no_mallopt = 1; return 0;
+    case O_BUFFER_FLOATS: o->buffer_floats = 1; return 0;
+    case O_CPCA_FRAME: o->cpca_frame = 1; return 0;
+    case O_BENCH_LIGHTS: return parse_bench_lights(v, o);
+    case O_BENCH_CUBE_SIZES: return parse_bench_cube_sizes(v, o);
+    case O_BENCH_MODES:
+        if (!*v)
+            return usage_error("%s", "--bench-modes: expected mode names");
+        o->bench_modes = v;
+        return 0;
+    case O_BENCH_COUNTS: o->bench_counts = 1; return 0;
+    case O_LIGHT_REGION: return parse_light_region(v, o);
+    case 'j': return vt_opt_once("--json", v, &o->json_path) ? 0 : 2;
+    default: /* getopt_long said what is wrong */ vt_cli_try_help(); return VT_EXIT_USAGE;
+    }
+}
+
+/* --views: the folder for the frames in --frames, and none of the
+ * options it gives itself; else --frames is a count and --modes is not
+ * given. 0, or the usage error. */
+static int check_views(vv_options *o)
+{
     if (o->views_path) {
         if (!o->frames_arg || !*o->frames_arg)
             return usage_error("%s", "--views: give the folder for the frames with --frames DIR");
@@ -499,17 +500,24 @@ static int parse_args(int argc, char **argv, vv_options *o)
         if (o->have_mode || o->pcf)
             return usage_error("%s", "--views renders the modes of --modes (cube-pcf: the cube "
                                      "map with PCF): not with --mode or --pcf");
-    } else {
-        if (o->frame_mode_count)
-            return usage_error("%s", "--modes: only with --views");
-        if ((o->buffer_floats || o->bench_sets || o->bench_cube_count || o->bench_modes ||
-             o->bench_counts || o->json_path) &&
-            !o->bench)
-            return usage_error("%s", "--buffer-floats, --bench-lights, --bench-cube-sizes, "
-                                     "--bench-modes, --bench-counts, --json: only with --bench");
-        if (o->frames_arg && !vt_parse_int(o->frames_arg, 1, 1000000, &o->frames))
-            return usage_error("--frames: expected a positive count, got '%s'", o->frames_arg);
+        return 0;
     }
+    if (o->frame_mode_count)
+        return usage_error("%s", "--modes: only with --views");
+    if ((o->buffer_floats || o->bench_sets || o->bench_cube_count || o->bench_modes ||
+         o->bench_counts || o->json_path) &&
+        !o->bench)
+        return usage_error("%s", "--buffer-floats, --bench-lights, --bench-cube-sizes, "
+                                 "--bench-modes, --bench-counts, --json: only with --bench");
+    if (o->frames_arg && !vt_parse_int(o->frames_arg, 1, 1000000, &o->frames))
+        return usage_error("--frames: expected a positive count, got '%s'", o->frames_arg);
+    return 0;
+}
+
+/* One way to run, one scene file unless --grid or --bench, one view
+ * choice: 0, or the usage error. */
+static int check_run(const vv_options *o)
+{
     if ((o->render_path != NULL) + (o->grid_path != NULL) + o->bench > 1)
         return usage_error("%s", "choose one of --render, --grid and --bench");
     if ((o->screenshot || o->keys || o->no_overlay) &&
@@ -522,8 +530,13 @@ static int parse_args(int argc, char **argv, vv_options *o)
                            o->files[1]);
     if (o->fit && o->have_camera)
         return usage_error("%s", "--fit and --camera both choose the view: give one");
-    /* The images it writes: never a scene file, and writable now; the
-     * same for --json's file ("-": stdout, not checked). */
+    return 0;
+}
+
+/* The images it writes: never a scene file, and writable now; the same
+ * for --json's file ("-": stdout, not checked). 0, or an exit status. */
+static int check_outputs(const vv_options *o)
+{
     const char *outs[] = {o->render_path, o->grid_path, o->screenshot,
                           o->json_path && strcmp(o->json_path, "-") ? o->json_path : NULL};
     const char *opts[] = {"--render", "--grid", "--screenshot", "--json"};
@@ -533,6 +546,28 @@ static int parse_args(int argc, char **argv, vv_options *o)
     if (vt_cli_check_outputs(outs, 4, (const char *const *)o->files, o->file_count) != 0)
         return 1;
     return 0;
+}
+
+/* Returns 0, or an exit status (help/version: -1 meaning exit 0). */
+static int parse_args(int argc, char **argv, vv_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->mode = VR_MODE_DEFAULT; /* the runtime's, vr_scene_default_mode */
+    o->egl = VR_EGL_AUTO;
+    int c, rc;
+    while ((c = getopt_long(argc, argv, "qhVj:", longopts, NULL)) != -1)
+        if ((rc = parse_option(c, optarg, o)) != 0)
+            return rc;
+    for (int i = optind; i < argc; i++) {
+        if (o->file_count == VV_MAX_FILES)
+            return usage_error("too many scene files (%s)", argv[i]);
+        o->files[o->file_count++] = argv[i];
+    }
+    if (o->file_count == 0)
+        return usage_error("%s", "no scene file given");
+    if ((rc = check_views(o)) != 0 || (rc = check_run(o)) != 0)
+        return rc;
+    return check_outputs(o);
 }
 
 int main(int argc, char **argv)

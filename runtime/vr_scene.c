@@ -197,18 +197,19 @@ static vr_result light_region_of(const vr_scene_desc *desc, vdsh_view_mesh *m, f
     switch (desc->light_region) {
     case VR_LIGHT_REGION_FILE: return VR_OK;
     case VR_LIGHT_REGION_AUTO: m->light_region = NULL; return VR_OK;
-    case VR_LIGHT_REGION_BOX:
-        for (int a = 0; a < 3; a++)
-            if (!isfinite(desc->light_box[a]) || !isfinite(desc->light_box[a + 3]) ||
-                !(desc->light_box[a] < desc->light_box[a + 3]))
-                return vr_fail(err, VR_ERR_ARGUMENT,
-                               "%s: the light region's %c is %g..%g: it must be finite, min "
-                               "below max",
-                               name, "xyz"[a], (double)(desc->light_box[a]),
-                               (double)(desc->light_box[a + 3]));
+    case VR_LIGHT_REGION_BOX: {
+        /* from the caller, not a file: the reader's check has not seen it */
+        int a = vdsh_light_box_bad_axis(desc->light_box, desc->light_box + 3);
+        if (a >= 0)
+            return vr_fail(err, VR_ERR_ARGUMENT,
+                           "%s: the light region's %c is %g..%g: it must be finite, min "
+                           "below max",
+                           name, "xyz"[a], (double)(desc->light_box[a]),
+                           (double)(desc->light_box[a + 3]));
         memcpy(region, desc->light_box, 6 * sizeof(float));
         m->light_region = region;
         return VR_OK;
+    }
     case VR_LIGHT_REGION_GROWN: {
         /* vdsh-bake --light-region grown's box, its probes against the
          * drawn mesh */

@@ -146,6 +146,18 @@ rm -rf "$3"; mkdir -p "$3"
 "$2" object-lights "$3/engine.vdsh"
 ]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:test_scene_view> ${CMAKE_CURRENT_BINARY_DIR}/scene_view_engine)
   set_tests_properties(format_scene_view_engine_lights PROPERTIES SKIP_RETURN_CODE 77)
+  # The fandisk (../shared/scenes; skipped without it): light 0, in its
+  # bounds, faced 23% of what the fit camera sees of it (the default frame
+  # dark but a notch); the camera turns toward it (vdsh_view_compute).
+  add_test(NAME format_scene_view_fandisk_key COMMAND bash -c [=[
+obj=$4/fandisk/fandisk.obj
+[ -e "$obj" ] || { echo "no $obj: skipped"; exit 77; }
+rm -rf "$3"; mkdir -p "$3"
+"$1" "$obj" --rays 1 --orders 1 --cube-size 0 -q -o "$3/fandisk.vdsh" || exit 1
+"$2" object-lights "$3/fandisk.vdsh"
+]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:test_scene_view> ${CMAKE_CURRENT_BINARY_DIR}/scene_view_fandisk
+           ${VDSH_SHARED_SCENES})
+  set_tests_properties(format_scene_view_fandisk_key PROPERTIES SKIP_RETURN_CODE 77)
 endif()
 
 # format_det_math   formats/vdsh_det.h (the bake's sin, cos, exp, log, atan2,

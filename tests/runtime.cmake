@@ -681,3 +681,21 @@ add_test(NAME runtime_standalone
          COMMAND ${CMAKE_CURRENT_LIST_DIR}/test_runtime_standalone.sh ${CMAKE_COMMAND}
                  ${PROJECT_SOURCE_DIR} ${_rt_dir}/standalone ${CMAKE_C_COMPILER}
                  ${CMAKE_CXX_COMPILER})
+
+# compute_probe   issue 29's order-12 work in compute shaders (GL 4.3):
+#                 sums per (vertex, light) of a bake's order-12 stream
+#                 checked against vdsh_sh_eval, a cpca-shaped decode per
+#                 (vertex, texel) checked against C; times printed for
+#                 docs/BENCHMARKS.md "On a GPU: NVIDIA H200" (measurement:
+#                 the times are not asserted). Skips (77) without a GL 4.3
+#                 context.
+add_executable(compute_probe ${CMAKE_CURRENT_LIST_DIR}/compute_probe.c)
+target_link_libraries(compute_probe PRIVATE vr_context vdsh_format m)
+if(TARGET vdsh-bake)
+  add_test(NAME runtime_compute_probe COMMAND sh -c [=[
+rm -rf "$3"; mkdir -p "$3"
+"$1" builtin:room --max-edge 1 --rays 16 --cube-size 0 --orders 12 --encoding cpca -q -o "$3/room12.vdsh" || exit 1
+"$2" "$3/room12.vdsh" 3
+]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:compute_probe> ${_rt_dir}/compute_probe)
+  _runtime_props(runtime_compute_probe)
+endif()

@@ -1926,6 +1926,17 @@ static void test_writer_checks(void)
     REJECT("lreg: axis 1", LBOX(s_.f.light_box.max[1] = 0.0f));
     REJECT("lreg: axis 2", LBOX(s_.f.light_box.max[2] = INFINITY));
 #undef LBOX
+    /* The same rule as the readers of --light-region and the runtime
+     * apply it to a box they are given: the first axis that fails. */
+    {
+        const float lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, flat[3] = {1, 0, 1};
+        const float nan_y[3] = {1, NAN, 1}, inf_z[3] = {1, 1, INFINITY};
+        CHECK(vdsh_light_box_bad_axis(lo, hi) == -1);
+        CHECK(vdsh_light_box_bad_axis(hi, lo) == 0);
+        CHECK(vdsh_light_box_bad_axis(lo, flat) == 1);
+        CHECK(vdsh_light_box_bad_axis(lo, nan_y) == 1);
+        CHECK(vdsh_light_box_bad_axis(lo, inf_z) == 2);
+    }
     REJECT("triangle_count", s_.f.header.triangle_count = (1u << 28) + 1);
     REJECT("rays", s_.f.header.rays = 0);
     REJECT("sampling", s_.f.header.sampling = 2);

@@ -20,7 +20,10 @@
  * and the floor's planes in the L corner, the T junction and at the
  * cube's foot, where robust traversal meets the face at t ~ 0 (a shadow
  * at distance 0 above the horizon) and fast traversal misses it (measured
- * on Embree 3.13): the test sees the case it guards against.
+ * on Embree 3.13): the test sees the case it guards against. With a
+ * creased bake's corner lift (scene.h corner_lift) the same holds, the L
+ * corner's corner receivers are offset at least 8 times as far and every
+ * other origin keeps its bits.
  */
 #include <math.h>
 #include <stdio.h>
@@ -86,6 +89,58 @@ typedef struct scene_case {
     int control_on_face; /* the normal-only offset puts origins on faces */
 } scene_case;
 
+/* A creased bake's corners (scene.h corner_lift, origins.h "Corners"):
+ * with the flag, no origin on a face either; a corner receiver (another
+ * normal at its position) is offset at least 8 times as far from its
+ * position as without it (VB_CORNER_LIFT: 16), every other one's origin is
+ * the same bits. org, nrm: the origins and normals without the flag. */
+static void corner_lift(const scene_case *sc, const vb_mesh *m, int robust, const float *org,
+                        const float *nrm)
+{
+    const uint32_t n = m->vertex_count;
+    vb_scene *s = NULL;
+    vb_error err;
+    vb_scene_desc sd = {.robust = robust, .threads = 1, .corner_lift = 1};
+    float *lo = malloc(12 * (size_t)n + 4), *ln = malloc(12 * (size_t)n + 4);
+    if (!lo || !ln || vb_scene_create(m, &sd, &s, &err) != VB_OK ||
+        vb_receivers_prepare(m, s, 1, NULL, 0, 0, n, ln, NULL, lo, NULL, NULL, &err) != VB_OK) {
+        CHECK(0, "%s, corner lift: %s", sc->name, s ? err.msg : "scene or memory");
+    } else {
+        const counts c = probe(s, n, lo, ln);
+        CHECK(c.at_face == 0, "%s, corner lift: %ld receivers' origins on a face", sc->name,
+              c.at_face);
+        long corners = 0, short_lift = 0, moved_other = 0;
+        for (uint32_t v = 0; v < n; v++) {
+            int corner = 0;
+            for (uint32_t u = 0; u < n && !corner; u++)
+                corner = !memcmp(m->positions + 3 * (size_t)u, m->positions + 3 * (size_t)v, 12) &&
+                         memcmp(nrm + 3 * (size_t)u, nrm + 3 * (size_t)v, 12);
+            float p[3];
+            vb_scene_to_local(s, m->positions + 3 * (size_t)v, p);
+            double d0 = 0.0, d1 = 0.0;
+            for (int i = 0; i < 3; i++) {
+                d0 += ((double)org[3 * (size_t)v + i] - p[i]) * (org[3 * (size_t)v + i] - p[i]);
+                d1 += ((double)lo[3 * (size_t)v + i] - p[i]) * (lo[3 * (size_t)v + i] - p[i]);
+            }
+            if (corner) {
+                corners++;
+                short_lift += !(d1 >= 64.0 * d0 && d0 > 0.0);
+            } else {
+                moved_other += memcmp(org + 3 * (size_t)v, lo + 3 * (size_t)v, 12) != 0;
+            }
+        }
+        CHECK(short_lift == 0 && moved_other == 0,
+              "%s, corner lift: %ld of %ld corners lifted less than 8 times as far; %ld other "
+              "receivers moved",
+              sc->name, short_lift, corners, moved_other);
+        printf("%s, corner lift: %ld corners, origins on a face %ld\n", sc->name, corners,
+               c.at_face);
+    }
+    vb_scene_destroy(s);
+    free(lo);
+    free(ln);
+}
+
 static void run_case(const scene_case *sc, int robust)
 {
     vb_mesh m;
@@ -123,6 +178,7 @@ static void run_case(const scene_case *sc, int robust)
                "normal offset only: %ld (%ld rays met it at ~0, %ld missed it)\n",
                sc->name, robust ? "robust" : "fast", bake.receivers, bake.rays, bake.at_face,
                ctl.at_face, ctl.self_hits, ctl.misses);
+        corner_lift(sc, &m, robust, org, nrm);
     }
     vb_scene_destroy(s);
     vb_mesh_free(&m);

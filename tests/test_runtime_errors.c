@@ -223,6 +223,16 @@ static void test_files(const char *dir)
         expect_fail("stale volume named", &named, VR_ERR_FORMAT, "good.sdf");
         unlink(sdf);
     }
+    /* A light box from the caller, which no reader has checked, is
+     * refused by the first axis that is not finite with min below max. */
+    {
+        vr_scene_desc lb = {
+            .path = path, .light_region = VR_LIGHT_REGION_BOX, .light_box = {0, 0, 0, 1, NAN, 1}};
+        expect_fail("light box y not finite", &lb, VR_ERR_ARGUMENT, "light region's y");
+        lb.light_box[4] = 1;
+        lb.light_box[2] = 2;
+        expect_fail("light box z min above max", &lb, VR_ERR_ARGUMENT, "light region's z");
+    }
     /* A cube_size no GL can hold is refused by name before anything is
      * allocated for it; cube_size 0 means none (vdsh5 unavailable). */
     {

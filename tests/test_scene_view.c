@@ -170,6 +170,63 @@ static int same_camera(const vdsh_camera *a, const vdsh_camera *b)
            a->fov_y == b->fov_y;
 }
 
+/* The share of camera c's check-frame pixels that see the mesh whose
+ * surface faces light L (lit or shadowed: vdsh_view_light_shares). */
+static float key_facing(const vdsh_view_tracer *t, const vdsh_view_mesh *m, const vdsh_camera *c,
+                        const float L[3], float diag)
+{
+    const int w = VDSH_VIEW_CHECK_W, h = VDSH_VIEW_CHECK_H;
+    int hits = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            float o[3], d[3];
+            vdsh_view_hit hit;
+            vdsh_camera_ray(c, w, h, x, y, o, d);
+            hits += vdsh_view_trace(t, o, d, 0.0f, &hit);
+        }
+    float lit, sh;
+    vdsh_view_light_shares(t, m, c, w, h, L, diag, &lit, &sh);
+    return hits ? (lit + sh) * (float)(w * h) / (float)hits : 0.0f;
+}
+
+/* An object's default camera (vdsh_view_compute): the fit camera where
+ * light 0 faces VDSH_VIEW_KEY_FACING of what it sees, else the fit camera
+ * turned about the vertical by a multiple of 45 degrees, looking at the
+ * same point, whose frame light 0 faces more. */
+static void check_key_camera(const vdsh_view_mesh *m, const vdsh_view *v, const char *name)
+{
+    vdsh_view_tracer *t = NULL;
+    vdsh_error err;
+    CHECK(vdsh_view_tracer_create(m, &t, &err) == VDSH_OK, "%s: %s", name, err.msg);
+    if (!t)
+        return;
+    const float diag = vdsh_view_diagonal(v->bounds_min, v->bounds_max);
+    vdsh_camera fit;
+    vdsh_view_fit_camera(v->bounds_min, v->bounds_max, &fit);
+    const float f0 = key_facing(t, m, &fit, v->lights[0], diag);
+    const float f1 = key_facing(t, m, &v->camera, v->lights[0], diag);
+    printf("%s: light 0 faces %.1f%% of the fit camera's object pixels, %.1f%% of the view's\n",
+           name, 100.0 * f0, 100.0 * f1);
+    CHECK(same_camera(&v->fit, &v->camera), "%s: the fit camera (--fit) is not the view's", name);
+    if (same_camera(&v->camera, &fit)) {
+        CHECK(f0 >= VDSH_VIEW_KEY_FACING, "%s: light 0 faces %g of the view, not turned", name,
+              (double)f0);
+    } else {
+        CHECK(!memcmp(v->camera.target, fit.target, sizeof fit.target) &&
+                  v->camera.fov_y == fit.fov_y,
+              "%s: the turned camera looks elsewhere", name);
+        float a[2] = {fit.eye[0] - fit.target[0], fit.eye[2] - fit.target[2]};
+        float b[2] = {v->camera.eye[0] - fit.target[0], v->camera.eye[2] - fit.target[2]};
+        float ang =
+            atan2f(a[0] * b[1] - a[1] * b[0], a[0] * b[0] + a[1] * b[1]) * 4.0f / 3.14159265f;
+        CHECK(fabsf(ang - roundf(ang)) < 1e-3f, "%s: turned by %g x 45 degrees", name, (double)ang);
+        CHECK(f0 < VDSH_VIEW_KEY_FACING && f1 > f0,
+              "%s: turned with light 0 facing %g of the fit view, %g of the turned", name,
+              (double)f0, (double)f1);
+    }
+    vdsh_view_tracer_destroy(t);
+}
+
 /* ---- unit tests --------------------------------------------------------- */
 
 static mesh M;
@@ -365,9 +422,9 @@ static void test_object(void)
     CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
     CHECK(!v.interior && v.front_share == 0.0f, "a sphere: interior %d, front share %g", v.interior,
           (double)v.front_share);
-    vdsh_camera fit;
-    vdsh_view_fit_camera(v.bounds_min, v.bounds_max, &fit);
-    CHECK(same_camera(&v.camera, &fit), "an object is not framed by the fit camera");
+    /* light 0 in a corner of the bounds faces 40% of the sphere seen
+     * from the fit direction: the camera turns toward it */
+    check_key_camera(&m, &v, "sphere");
     float diag = vdsh_view_diagonal(v.bounds_min, v.bounds_max);
     for (int i = 0; i < v.light_count; i++) {
         float r = dist3(v.lights[i], c);
@@ -1036,6 +1093,7 @@ static int test_object_lights(const char *path)
           "%s: interior %d, region grown %d (want an object whose "
           "region is its bounds)",
           path, v.interior, v.region_grown);
+    check_key_camera(&m, &v, path);
     vdsh_view_tracer *t = NULL;
     CHECK(vdsh_view_tracer_create(&m, &t, &err) == VDSH_OK, "%s", err.msg);
     const float diag = vdsh_view_diagonal(v.bounds_min, v.bounds_max);

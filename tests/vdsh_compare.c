@@ -13,6 +13,8 @@
  * Used by the cross-ISA tests (tests/bake.cmake).
  * A variable-order stream's vertices whose orders differ count among
  * those beyond 1e-3 (and are printed); the others are compared as above.
+ * With VDSH_COMPARE_LIST=1 in the environment it lists every vertex beyond
+ * LIMIT too (index, position, difference): where two bakes part.
  */
 #include <math.h>
 #include <stdio.h>
@@ -45,6 +47,8 @@ int main(int argc, char **argv)
     }
     int status = 0;
     double *diffs = NULL;
+    const char *list_env = getenv("VDSH_COMPARE_LIST");
+    const int list = list_env && strcmp(list_env, "1") == 0;
     if (a->has_part || b->has_part) { /* streams of one range: compare merged files */
         fprintf(stderr, "vdsh_compare: a part of a sharded bake: merge it first\n");
         vdsh_free(a);
@@ -94,6 +98,10 @@ int main(int argc, char **argv)
                 dv = fmax(dv, fabs((double)cx[i] - cy[i]));
             differ += dv > 0.0;
             above += dv > limit * maxc; /* beyond the f16 rounding of a rescaled stream */
+            if (list && dv > limit * maxc)
+                printf("  order %u vertex %u at %g %g %g: %.3g\n", x->order, v,
+                       (double)a->positions[3 * (size_t)v], (double)a->positions[3 * (size_t)v + 1],
+                       (double)a->positions[3 * (size_t)v + 2], maxc > 0.0 ? dv / maxc : dv);
             diffs[nd++] = maxc > 0.0 ? dv / maxc : dv;
             if (dv > maxd)
                 maxd = dv, worst = v;

@@ -282,88 +282,65 @@ static int source_recorded(const vdsh_file *f, const vdsh_src *src)
     return 0;
 }
 
-static int with_source(const char *in, const char *path, const vdsh_file *f, cJSON *root,
-                       view_list *vl, cJSON *attrs, cJSON **vx, blob *b, int compress,
-                       int allow_mismatch, int quiet)
+/* Whether the source may be exported against f: one the bake recorded,
+ * or one whose geometry is the bake's (materials edited since: every
+ * vertex at a receiver); else an edited model (a vertex moved or added)
+ * whose vertices would silently get no shadows: refused unless
+ * allow_mismatch. Returns -1 (refused, after a message), else whether the
+ * bake recorded it. */
+static int source_accepted(const char *in, const char *path, const vdsh_file *f,
+                           const vdsh_src *src, uint64_t vertices, uint64_t matched,
+                           int allow_mismatch, int quiet)
 {
-    char msg[1024];
-    vdsh_src src;
-    vdsh_src_prim *prims = NULL;
-    int np = 0, rc = 1;
-    int *node_mesh = NULL, *mesh_node = NULL;
-    cJSON **orig = NULL;
-    int orig_n = 0;
-    view_list nl = {0};
-    if (vdsh_src_load(path, &src, msg, sizeof msg) ||
-        vdsh_src_map(path, &src, f->positions, f->normals, f->header.vertex_count, &prims, &np, msg,
-                     sizeof msg)) {
-        fprintf(stderr, "vdsh-export: %s\n", msg);
+    if (source_recorded(f, src))
         return 1;
-    }
-    cJSON *g = src.json;
-    uint64_t vertices = 0, matched = 0;
-    for (int i = 0; i < np; i++)
-        vertices += prims[i].vertex_count, matched += prims[i].matched;
-    if (np == 0 || matched == 0) {
-        fprintf(
-            stderr,
-            "vdsh-export: %s: no vertex of %s is at a receiver of the bake: not the glTF it was baked "
-            "from\n",
-            in, path);
-        goto out;
-    }
-    /* A file the bake did not record: fine when its geometry is the
-     * bake's (materials edited since: every vertex at a receiver), else
-     * an edited model (a vertex moved or added) whose vertices would
-     * silently get no shadows: refused unless --allow-mismatch. */
-    const int recorded = source_recorded(f, &src);
-    if (!recorded) {
-        char names[512] = "";
-        for (uint32_t i = 0, at = 0; i < f->source_count && at < sizeof names; i++)
-            at += (uint32_t)snprintf(names + at, sizeof names - at, "%s%s (%llu bytes)",
-                                     i ? ", " : "", f->sources[i].name,
-                                     (unsigned long long)f->sources[i].size);
-        if (matched == vertices) {
-            if (!quiet)
-                fprintf(
-                    stderr,
+    char names[512] = "";
+    for (uint32_t i = 0, at = 0; i < f->source_count && at < sizeof names; i++)
+        at += (uint32_t)snprintf(names + at, sizeof names - at, "%s%s (%llu bytes)", i ? ", " : "",
+                                 f->sources[i].name, (unsigned long long)f->sources[i].size);
+    if (matched == vertices) {
+        if (!quiet)
+            fprintf(stderr,
                     "vdsh-export: %s: note: not the file %s recorded (%s; this one %llu bytes, "
                     "its SHA-256 other), but every vertex is at a receiver: its geometry is the "
                     "bake's\n",
-                    path, in, names, (unsigned long long)src.size);
-        } else if (!allow_mismatch || !quiet) {
-            fprintf(stderr,
-                    "vdsh-export: %s: %s: not the file %s was baked from (%s; this one %llu "
-                    "bytes, its SHA-256 other) and %llu of its %llu vertices are at no receiver: "
-                    "its geometry was edited; %s\n",
-                    path, allow_mismatch ? "warning" : "error", in, names,
-                    (unsigned long long)src.size, (unsigned long long)(vertices - matched),
-                    (unsigned long long)vertices,
-                    allow_mismatch ? "exported anyway (--allow-mismatch), their VDSH attributes 0"
-                                   : "give the glTF it was baked from (--allow-mismatch exports it "
-                                     "anyway, those vertices' VDSH attributes 0)");
-            if (!allow_mismatch)
-                goto out;
-        }
+                    path, in, names, (unsigned long long)src->size);
+    } else if (!allow_mismatch || !quiet) {
+        fprintf(stderr,
+                "vdsh-export: %s: %s: not the file %s was baked from (%s; this one %llu "
+                "bytes, its SHA-256 other) and %llu of its %llu vertices are at no receiver: "
+                "its geometry was edited; %s\n",
+                path, allow_mismatch ? "warning" : "error", in, names,
+                (unsigned long long)src->size, (unsigned long long)(vertices - matched),
+                (unsigned long long)vertices,
+                allow_mismatch ? "exported anyway (--allow-mismatch), their VDSH attributes 0"
+                               : "give the glTF it was baked from (--allow-mismatch exports it "
+                                 "anyway, those vertices' VDSH attributes 0)");
+        if (!allow_mismatch)
+            return -1;
     }
-    /* one BIN buffer: the source's buffers one after the other */
-    size_t *base = calloc((size_t)src.buffer_count + 1, sizeof *base);
+    return 0;
+}
+
+/* One BIN buffer: the source's buffers one after the other in b, each
+ * of its views moved onto it. Returns 0, 1 after a message (a view past
+ * its buffer's end) or -1 (out of memory). */
+static int join_buffers(const char *path, const vdsh_src *src, blob *b, cJSON *views)
+{
+    size_t *base = calloc((size_t)src->buffer_count + 1, sizeof *base);
     if (!base)
-        goto oom;
-    for (int i = 0; i < src.buffer_count; i++) {
+        return -1;
+    for (int i = 0; i < src->buffer_count; i++) {
         if (blob_align4(b)) {
             free(base);
-            goto oom;
+            return -1;
         }
         base[i] = b->size;
-        if (blob_put(b, src.buffers[i].data, src.buffers[i].size)) {
+        if (blob_put(b, src->buffers[i].data, src->buffers[i].size)) {
             free(base);
-            goto oom;
+            return -1;
         }
     }
-    cJSON *views = cJSON_GetObjectItemCaseSensitive(g, "bufferViews");
-    if (!views)
-        views = cJSON_AddArrayToObject(g, "bufferViews");
     cJSON *v;
     int view_index = 0;
     cJSON_ArrayForEach(v, views)
@@ -375,9 +352,9 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
          * attributes, once the buffers are one: refused, as invalid. */
         double vo = cJSON_IsNumber(off) ? off->valuedouble : 0;
         double vl_len = cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(v, "byteLength"));
-        if (bi < 0 || bi >= src.buffer_count || !(vo >= 0) || !(vl_len >= 0) ||
-            vo + vl_len > (double)src.buffers[bi].size) {
-            if (bi < 0 || bi >= src.buffer_count)
+        if (bi < 0 || bi >= src->buffer_count || !(vo >= 0) || !(vl_len >= 0) ||
+            vo + vl_len > (double)src->buffers[bi].size) {
+            if (bi < 0 || bi >= src->buffer_count)
                 fprintf(stderr,
                         "vdsh-export: %s: bufferView %d names buffer %d, which does not exist: "
                         "not a valid glTF (--source copies every view)\n",
@@ -386,19 +363,27 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
                 fprintf(stderr,
                         "vdsh-export: %s: bufferView %d (bytes %.0f..%.0f) does not fit buffer %d "
                         "(%zu bytes): not a valid glTF (--source copies every view)\n",
-                        path, view_index, vo, vo + vl_len, bi, src.buffers[bi].size);
+                        path, view_index, vo, vo + vl_len, bi, src->buffers[bi].size);
             free(base);
-            goto out;
+            return 1;
         }
         view_index++;
         double o = (cJSON_IsNumber(off) ? off->valuedouble : 0) +
-                   (double)base[bi >= 0 && bi < src.buffer_count ? bi : 0];
+                   (double)base[bi >= 0 && bi < src->buffer_count ? bi : 0];
         cJSON_DeleteItemFromObjectCaseSensitive(v, "byteOffset");
         cJSON_AddNumberToObject(v, "byteOffset", o);
         cJSON_ReplaceItemInObjectCaseSensitive(v, "buffer", cJSON_CreateNumber(0));
     }
     free(base);
-    /* images named by file: into the BIN (the glb is written elsewhere) */
+    return 0;
+}
+
+/* Images named by file: into the BIN (the glb is written elsewhere), each
+ * by a new view; one that is not PNG or JPEG, or cannot be read, stays a
+ * URI (a note). Returns 0, or -1 (out of memory). */
+static int embed_images(const char *path, const vdsh_src *src, cJSON *g, blob *b, cJSON *views,
+                        int quiet)
+{
     cJSON *img;
     cJSON_ArrayForEach(img, cJSON_GetObjectItemCaseSensitive(g, "images"))
     {
@@ -411,9 +396,9 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
                            : (!strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg")) ? "image/jpeg"
                                                                                      : NULL;
         const char *why = "cannot be read";
-        char *p = vdsh_src_file(&src, uri->valuestring, &why);
+        char *p = vdsh_src_file(src, uri->valuestring, &why);
         if (!p && strcmp(why, "out of memory") == 0)
-            goto oom;
+            return -1;
         FILE *fp = p ? fopen(p, "rb") : NULL;
         free(p);
         if (!fp || !mime) {
@@ -427,14 +412,14 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         }
         if (blob_align4(b)) {
             fclose(fp);
-            goto oom;
+            return -1;
         }
         size_t start = b->size, got;
         uint8_t chunk[65536];
         while ((got = fread(chunk, 1, sizeof chunk, fp)) > 0)
             if (blob_put(b, chunk, got)) {
                 fclose(fp);
-                goto oom;
+                return -1;
             }
         fclose(fp);
         cJSON *nv = cJSON_CreateObject();
@@ -447,18 +432,74 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         cJSON_AddNumberToObject(img, "bufferView", cJSON_GetArraySize(views) - 1);
         cJSON_AddStringToObject(img, "mimeType", mime);
     }
-    /* the VDSH attributes per primitive instance; a mesh a second node
-     * uses is copied (each instance has its own receivers) */
+    return 0;
+}
+
+/* Primitive sp's VDSH attributes (those of attrs, from the per-receiver
+ * views in vl): for each of its vertices its receiver's values, a view in
+ * nl (numbered after the source's view_base views) and an accessor in
+ * the source's accs; its extension says how many vertices matched.
+ * Returns 0, or -1 (out of memory). */
+static int prim_attributes(const vdsh_src_prim *sp, cJSON *prim, cJSON *accs, const cJSON *my_accs,
+                           const view_list *vl, const cJSON *attrs, int view_base, view_list *nl)
+{
+    cJSON *pattrs = cJSON_GetObjectItemCaseSensitive(prim, "attributes");
+    cJSON *a;
+    cJSON_ArrayForEach(a, attrs)
+    {
+        if (strncmp(a->string, "_VDSH", 5) != 0)
+            continue;
+        cJSON *acc = cJSON_GetArrayItem(my_accs, (int)a->valuedouble);
+        const pending_view *pv =
+            &vl->v[(int)cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(acc, "bufferView"))];
+        uint8_t *d = calloc((size_t)sp->vertex_count + 1, pv->stride);
+        if (!d)
+            return -1;
+        for (uint32_t k = 0; k < sp->vertex_count; k++)
+            if (sp->map[k] != UINT32_MAX)
+                memcpy(d + (size_t)k * pv->stride, pv->data + (size_t)sp->map[k] * pv->stride,
+                       pv->stride);
+        int vi = add_view(nl, d, (size_t)sp->vertex_count * pv->stride, pv->stride, 34962);
+        free(d);
+        if (vi < 0)
+            return -1;
+        cJSON *na = cJSON_Duplicate(acc, 1);
+        cJSON_ReplaceItemInObjectCaseSensitive(na, "bufferView",
+                                               cJSON_CreateNumber(view_base + vi));
+        cJSON_ReplaceItemInObjectCaseSensitive(na, "count", cJSON_CreateNumber(sp->vertex_count));
+        cJSON_AddItemToArray(accs, na);
+        cJSON_DeleteItemFromObjectCaseSensitive(pattrs, a->string);
+        cJSON_AddNumberToObject(pattrs, a->string, cJSON_GetArraySize(accs) - 1);
+    }
+    cJSON *ext = cJSON_GetObjectItemCaseSensitive(prim, "extensions");
+    if (!ext)
+        ext = cJSON_AddObjectToObject(prim, "extensions");
+    cJSON_DeleteItemFromObjectCaseSensitive(ext, VDSH_EXT);
+    cJSON *pe = cJSON_AddObjectToObject(ext, VDSH_EXT);
+    cJSON_AddNumberToObject(pe, "vertices", sp->vertex_count);
+    cJSON_AddNumberToObject(pe, "matched", sp->matched);
+    return 0;
+}
+
+/* The VDSH attributes per primitive instance (prim_attributes); a mesh a
+ * second node uses is copied (each instance has its own receivers).
+ * Returns 0, or -1 (out of memory). */
+static int add_vdsh_attributes(cJSON *g, const cJSON *root, const vdsh_src_prim *prims, int np,
+                               const view_list *vl, const cJSON *attrs, const cJSON *views,
+                               view_list *nl)
+{
     cJSON *meshes = cJSON_GetObjectItemCaseSensitive(g, "meshes");
     cJSON *nodes = cJSON_GetObjectItemCaseSensitive(g, "nodes");
     cJSON *accs = cJSON_GetObjectItemCaseSensitive(g, "accessors");
-    cJSON *my_accs = cJSON_GetObjectItemCaseSensitive(root, "accessors");
+    const cJSON *my_accs = cJSON_GetObjectItemCaseSensitive(root, "accessors");
     const int nm = cJSON_GetArraySize(meshes), nn = cJSON_GetArraySize(nodes);
-    node_mesh = malloc(((size_t)nn + 1) * sizeof *node_mesh);
-    mesh_node = malloc(((size_t)nm + 1) * sizeof *mesh_node);
-    orig = calloc((size_t)nm + 1, sizeof *orig);
+    int rc = -1;
+    int *node_mesh = malloc(((size_t)nn + 1) * sizeof *node_mesh);
+    int *mesh_node = malloc(((size_t)nm + 1) * sizeof *mesh_node);
+    cJSON **orig = calloc((size_t)nm + 1, sizeof *orig);
+    int orig_n = 0;
     if (!node_mesh || !mesh_node || !orig)
-        goto oom;
+        goto out;
     for (int i = 0; i < nn; i++)
         node_mesh[i] = -1;
     for (int i = 0; i < nm; i++) {
@@ -485,53 +526,34 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         cJSON *prim = cJSON_GetArrayItem(
             cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(meshes, mi), "primitives"),
             sp->prim);
-        cJSON *pattrs = cJSON_GetObjectItemCaseSensitive(prim, "attributes");
-        cJSON *a;
-        cJSON_ArrayForEach(a, attrs)
-        {
-            if (strncmp(a->string, "_VDSH", 5) != 0)
-                continue;
-            cJSON *acc = cJSON_GetArrayItem(my_accs, (int)a->valuedouble);
-            const pending_view *pv = &vl->v[(int)cJSON_GetNumberValue(
-                cJSON_GetObjectItemCaseSensitive(acc, "bufferView"))];
-            uint8_t *d = calloc((size_t)sp->vertex_count + 1, pv->stride);
-            if (!d)
-                goto oom;
-            for (uint32_t k = 0; k < sp->vertex_count; k++)
-                if (sp->map[k] != UINT32_MAX)
-                    memcpy(d + (size_t)k * pv->stride, pv->data + (size_t)sp->map[k] * pv->stride,
-                           pv->stride);
-            int vi = add_view(&nl, d, (size_t)sp->vertex_count * pv->stride, pv->stride, 34962);
-            free(d);
-            if (vi < 0)
-                goto oom;
-            cJSON *na = cJSON_Duplicate(acc, 1);
-            cJSON_ReplaceItemInObjectCaseSensitive(na, "bufferView",
-                                                   cJSON_CreateNumber(view_base + vi));
-            cJSON_ReplaceItemInObjectCaseSensitive(na, "count",
-                                                   cJSON_CreateNumber(sp->vertex_count));
-            cJSON_AddItemToArray(accs, na);
-            cJSON_DeleteItemFromObjectCaseSensitive(pattrs, a->string);
-            cJSON_AddNumberToObject(pattrs, a->string, cJSON_GetArraySize(accs) - 1);
-        }
-        cJSON *ext = cJSON_GetObjectItemCaseSensitive(prim, "extensions");
-        if (!ext)
-            ext = cJSON_AddObjectToObject(prim, "extensions");
-        cJSON_DeleteItemFromObjectCaseSensitive(ext, VDSH_EXT);
-        cJSON *pe = cJSON_AddObjectToObject(ext, VDSH_EXT);
-        cJSON_AddNumberToObject(pe, "vertices", sp->vertex_count);
-        cJSON_AddNumberToObject(pe, "matched", sp->matched);
+        if (prim_attributes(sp, prim, accs, my_accs, vl, attrs, view_base, nl))
+            goto out;
     }
-    /* --compress: the VDSH views meshopt-compressed (lossless), living in
-     * a fallback buffer 1 without bytes; the source's own views, images
-     * and geometry stay as they are (no quantisation: the source's
-     * positions are kept bit for bit). */
+    rc = 0;
+out:
+    for (int i = 0; i < orig_n; i++)
+        cJSON_Delete(orig[i]);
+    free(orig);
+    free(node_mesh);
+    free(mesh_node);
+    return rc;
+}
+
+/* The new views after the source's in b (--compress: meshopt-compressed,
+ * lossless, living in a fallback buffer 1 without bytes; the source's own
+ * views, images and geometry stay as they are: no quantisation, the
+ * source's positions are kept bit for bit), the buffers, the metadata *vx
+ * (taken) with the vertex counts as the root's extension, the
+ * generator. Returns 0, or -1 (out of memory). */
+static int finish_source(cJSON *g, blob *b, const view_list *nl, cJSON *views, int compress,
+                         cJSON **vx, uint64_t vertices, uint64_t matched)
+{
     size_t raw = 0;
-    if (write_views(&nl, compress, b, views, &raw) || blob_align4(b))
-        goto oom;
+    if (write_views(nl, compress, b, views, &raw) || blob_align4(b))
+        return -1;
     cJSON_DeleteItemFromObjectCaseSensitive(g, "buffers");
-    add_buffers(g, b->size, compress && nl.n > 0, raw);
-    if (compress && nl.n > 0) {
+    add_buffers(g, b->size, compress && nl->n > 0, raw);
+    if (compress && nl->n > 0) {
         list_extension(g, "extensionsUsed", "EXT_meshopt_compression");
         list_extension(g, "extensionsRequired", "EXT_meshopt_compression");
     }
@@ -549,6 +571,49 @@ static int with_source(const char *in, const char *path, const vdsh_file *f, cJS
         cJSON_DeleteItemFromObjectCaseSensitive(asset, "generator");
         cJSON_AddStringToObject(asset, "generator", "vdsh-export --source (formats/GLTF.md)");
     }
+    return 0;
+}
+
+static int with_source(const char *in, const char *path, const vdsh_file *f, cJSON *root,
+                       view_list *vl, cJSON *attrs, cJSON **vx, blob *b, int compress,
+                       int allow_mismatch, int quiet)
+{
+    char msg[1024];
+    vdsh_src src;
+    vdsh_src_prim *prims = NULL;
+    int np = 0, rc = 1, r;
+    view_list nl = {0};
+    if (vdsh_src_load(path, &src, msg, sizeof msg) ||
+        vdsh_src_map(path, &src, f->positions, f->normals, f->header.vertex_count, &prims, &np, msg,
+                     sizeof msg)) {
+        fprintf(stderr, "vdsh-export: %s\n", msg);
+        return 1;
+    }
+    cJSON *g = src.json;
+    uint64_t vertices = 0, matched = 0;
+    for (int i = 0; i < np; i++)
+        vertices += prims[i].vertex_count, matched += prims[i].matched;
+    if (np == 0 || matched == 0) {
+        fprintf(
+            stderr,
+            "vdsh-export: %s: no vertex of %s is at a receiver of the bake: not the glTF it was baked "
+            "from\n",
+            in, path);
+        goto out;
+    }
+    const int recorded =
+        source_accepted(in, path, f, &src, vertices, matched, allow_mismatch, quiet);
+    if (recorded < 0)
+        goto out;
+    cJSON *views = cJSON_GetObjectItemCaseSensitive(g, "bufferViews");
+    if (!views)
+        views = cJSON_AddArrayToObject(g, "bufferViews");
+    if ((r = join_buffers(path, &src, b, views)) > 0)
+        goto out;
+    if (r < 0 || embed_images(path, &src, g, b, views, quiet) ||
+        add_vdsh_attributes(g, root, prims, np, vl, attrs, views, &nl) ||
+        finish_source(g, b, &nl, views, compress, vx, vertices, matched))
+        goto oom;
     if (f->source_count > 1 && !quiet)
         fprintf(stderr,
                 "vdsh-export: %s: baked from %u meshes; the glb holds %s's scene only (the "
@@ -573,11 +638,6 @@ out:
     for (int i = 0; i < np; i++)
         free(prims[i].map);
     free(prims);
-    for (int i = 0; i < orig_n; i++)
-        cJSON_Delete(orig[i]);
-    free(orig);
-    free(node_mesh);
-    free(mesh_node);
     view_list_free(&nl);
     vdsh_src_free(&src);
     return rc;

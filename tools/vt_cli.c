@@ -529,13 +529,13 @@ int vt_opt_light_region(const char *option, const char *arg, int file_ok, vdsh_l
                        option, names, arg);
         return 0;
     }
-    for (int a = 0; a < 3; a++)
-        if (!(v[a] < v[a + 3])) {
-            vt_usage_error(cli_prog,
-                           "%s '%s': the box's %c runs %g..%g: each min must be below its max",
-                           option, arg, "xyz"[a], (double)v[a], (double)v[a + 3]);
-            return 0;
-        }
+    int a = vdsh_light_box_bad_axis(v, v + 3); /* v is finite: min below max */
+    if (a >= 0) {
+        vt_usage_error(cli_prog,
+                       "%s '%s': the box's %c runs %g..%g: each min must be below its max", option,
+                       arg, "xyz"[a], (double)v[a], (double)v[a + 3]);
+        return 0;
+    }
     out->rule = VDSH_LIGHT_REGION_BOX;
     memcpy(out->min, v, sizeof out->min);
     memcpy(out->max, v + 3, sizeof out->max);

@@ -1316,7 +1316,11 @@ vb_result vb_eval_scene_create(const vdsh_file *f, const char *const *paths, uin
                     (double)hi[2]);
         goto fail;
     }
-    vb_scene_desc sd = {.robust = !d.fast, .threads = d.threads};
+    /* The bake's corner origins (scene.h corner_lift): its load flags
+     * record a crease only when one split a vertex. */
+    vb_scene_desc sd = {.robust = !d.fast,
+                        .threads = d.threads,
+                        .corner_lift = VDSH_LOAD_CREASE(f->header.load_flags) > 0};
     r = vb_scene_create(&occ, &sd, out, err);
     if (r == VB_OK && f->has_light_box && /* where the bake's lights went (lreg) */
         (r = vb_scene_set_light_region(*out, f->light_box.min, f->light_box.max,

@@ -310,9 +310,53 @@ done:
     return r;
 }
 
-vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
-                           const vb_adaptive_desc *ad, vb_mesh *receivers, vb_bake_output *out,
-                           vb_adaptive_stats *stats, vb_error *err)
+/* What every round of vb_bake_adaptive shares. */
+typedef struct refinement {
+    const vb_adaptive_desc *ad;
+    /* the bake's description, its receivers and range set per bake */
+    vb_bake_desc bd;
+    /* the receivers so far (M), a round's tentative mesh (T: every
+     * candidate split) and its next receivers (N: the chosen splits) */
+    vb_mesh M, T, N;
+    /* M's bake (B), a round's midpoints' (R) */
+    vb_bake_output B, R;
+    /* the edges judged for good (sorted), a round's candidates (in key
+     * order) */
+    uint64_t *judged, *cand;
+    size_t judged_n, cand_n;
+    /* per candidate: its score, its rank */
+    double *error;
+    vb_ranked *rank;
+    /* per round: the chosen midpoints' rows of T; the candidates' ends */
+    uint32_t *rows, *pairs;
+    /* the lights the scores are taken under */
+    float (*lights)[3];
+    /* B's quantity per order, held for the rounds' bakes */
+    vdsh_quantity quantity[VDSH_ORDER_SLOTS];
+    int order;
+    uint32_t interp;
+    double threshold, t_start;
+    vb_adaptive_stats st;
+} refinement;
+
+static void refinement_free(refinement *x)
+{
+    vb_mesh_free(&x->M);
+    vb_mesh_free(&x->T);
+    vb_mesh_free(&x->N);
+    vb_bake_output_free(&x->B);
+    vb_bake_output_free(&x->R);
+    free(x->judged);
+    free(x->cand);
+    free(x->error);
+    free(x->rank);
+    free(x->rows);
+    free(x->pairs);
+    free(x->lights);
+}
+
+static vb_result check_adaptive_desc(const vb_adaptive_desc *ad, const vb_mesh *start,
+                                     vb_error *err)
 {
     if (!(ad->tolerance >= 0.0f))
         return vb_fail(err, VB_ERR_ARGUMENT, "adaptive: the tolerance must be a number >= 0");
@@ -323,266 +367,306 @@ vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
                        "adaptive: the budget of %u receivers is below the %u the refinement "
                        "starts from (raise --max-receivers or --max-edge)",
                        ad->max_receivers, start->vertex_count);
-    vb_adaptive_stats st = {.start_receivers = start->vertex_count};
-    vb_mesh M = {0}, T = {0}, N = {0};
-    vb_bake_output B = {0}, R = {0};
-    uint64_t *judged = NULL, *cand = NULL;
-    size_t judged_n = 0, cand_n = 0;
-    double *error = NULL;
-    vb_ranked *rank = NULL;
-    uint32_t *rows = NULL, *pairs = NULL; /* per round: new rows; the candidates' ends */
-    float(*lights)[3] = NULL;
-    const double t_start = vb_now();
-    vb_result r = vb_mesh_refine(start, 0.0f, &M, err); /* a copy */
+    return VB_OK;
+}
+
+/* The cap: the receivers of the uniform refinement to 2 min_edge
+ * (adaptive.h), the finest mesh the splits can reach (an edge of at most
+ * 2 min_edge is never split); 0 when it cannot be made. At min_edge
+ * itself it cost 4x the vertices to count: 13.6 M on 2CylinderEngine.glb
+ * from --max-edge 8.4, minutes of the bake's time, for a cap that never
+ * binds there. */
+static uint32_t uniform_receivers(const vb_mesh *start, float min_edge)
+{
+    uint32_t n = 0;
+    vb_mesh U = {0};
+    vb_error uerr;
+    if (vb_mesh_refine(start, 2.0f * min_edge, &U, &uerr) == VB_OK)
+        n = U.vertex_count;
+    vb_mesh_free(&U);
+    return n;
+}
+
+/* Bake no more than the uniform bake would: the `room` longest
+ * candidates that fit, in key order. */
+static vb_result keep_longest(refinement *x, uint64_t room, vb_error *err)
+{
+    free(x->rank);
+    if (!(x->rank = malloc(x->cand_n * sizeof *x->rank + 1)))
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    for (size_t i = 0; i < x->cand_n; i++)
+        x->rank[i] = (vb_ranked){edge_len2(&x->M, x->cand[i]), (uint32_t)i};
+    qsort(x->rank, x->cand_n, sizeof *x->rank, vb_ranked_cmp);
+    uint8_t *keep = calloc(x->cand_n + 1, 1);
+    if (!keep)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    for (uint64_t k = 0; k < room; k++)
+        keep[x->rank[k].index] = 1;
+    size_t u = 0;
+    for (size_t i = 0; i < x->cand_n; i++)
+        if (keep[i])
+            x->cand[u++] = x->cand[i];
+    free(keep);
+    x->cand_n = u;
+    return VB_OK;
+}
+
+/* R's counts added to B's. */
+static void add_counts(vb_bake_output *B, const vb_bake_output *R)
+{
+    B->rays_traced += R->rays_traced;
+    B->rays_missed += R->rays_missed;
+    B->degenerate_receivers += R->degenerate_receivers;
+    B->flipped_normals += R->flipped_normals;
+    B->moved_origins += R->moved_origins;
+    B->origins.moved += R->origins.moved;
+    B->origins.flagged += R->origins.flagged;
+    B->origins.ties += R->origins.ties;
+    B->origins.skipped_zero_area += R->origins.skipped_zero_area;
+    B->origins.probe_rays += R->origins.probe_rays;
+    B->origins.seconds += R->origins.seconds;
+    B->seconds += R->seconds;
+}
+
+/* The tentative mesh T: every candidate split (pairs: their ends), and
+ * the bake of its midpoints, the rows from V, in R. */
+static vb_result bake_midpoints(refinement *x, uint32_t V, vb_error *err)
+{
+    free(x->pairs);
+    if (!(x->pairs = malloc(x->cand_n * 2 * sizeof *x->pairs + 1)))
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    for (size_t i = 0; i < x->cand_n; i++)
+        x->pairs[2 * i] = (uint32_t)(x->cand[i] >> 32), x->pairs[2 * i + 1] = (uint32_t)x->cand[i];
+    vb_mesh_free(&x->T);
+    vb_result r = vb_mesh_split_edges(&x->M, x->pairs, (uint32_t)x->cand_n, &x->T, err);
     if (r != VB_OK)
         return r;
+    vb_bake_output_free(&x->R);
+    x->bd.receivers = &x->T;
+    x->bd.range_begin = V;
+    x->bd.range_end = x->T.vertex_count;
+    if ((r = vb_bake_run(&x->bd, &x->R, err)) != VB_OK)
+        return r;
+    x->st.rounds++;
+    x->st.candidates += (uint32_t)x->cand_n;
+    add_counts(&x->B, &x->R);
+    return VB_OK;
+}
 
-    vb_bake_desc bd = *bake;
-    bd.receivers = &M;
-    bd.range_begin = bd.range_end = 0;
-    if ((r = vb_bake_run(&bd, &B, err)) != VB_OK)
+/* Every candidate's score (score_block) into x->error. */
+static vb_result score_candidates(refinement *x, uint32_t V, vb_error *err)
+{
+    free(x->error);
+    free(x->rank);
+    x->error = malloc(x->cand_n * sizeof *x->error + 1);
+    x->rank = malloc(x->cand_n * sizeof *x->rank + 1);
+    if (!x->error || !x->rank)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    score_job sj = {.fine = &x->T,
+                    .base = V,
+                    .edges = x->cand,
+                    .b = &x->R,
+                    .coarse_c = x->B.coeffs[x->order],
+                    .order = x->order,
+                    .quantity = x->quantity[x->order],
+                    .interp = x->interp,
+                    .lights = (const float(*)[3])x->lights,
+                    .light_count = x->st.lights,
+                    .error = x->error};
+    if (vb_parallel_for(x->B.threads, (uint32_t)x->cand_n, 64, score_block, &sj, NULL, NULL) == 0)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
+    return VB_OK;
+}
+
+/* Split those above the tolerance, largest first within the budget; the
+ * others are judged for good. *s: how many, their ends the first of
+ * x->pairs, their rows of T in x->rows (in key order: the new vertices'
+ * order). */
+static vb_result choose_splits(refinement *x, uint32_t V, uint32_t *s, vb_error *err)
+{
+    const vb_adaptive_desc *ad = x->ad;
+    uint32_t over = 0;
+    for (size_t i = 0; i < x->cand_n; i++)
+        if (x->error[i] > x->threshold)
+            x->rank[over++] = (vb_ranked){x->error[i], (uint32_t)i};
+    qsort(x->rank, over, sizeof *x->rank, vb_ranked_cmp);
+    uint32_t take = over;
+    if (ad->max_receivers && take > ad->max_receivers - V) {
+        take = ad->max_receivers - V;
+        x->st.budget_reached = 1;
+    }
+    uint8_t *chosen = calloc(x->cand_n + 1, 1);
+    uint64_t *nj = realloc(x->judged, (x->judged_n + x->cand_n) * sizeof *x->judged + 1);
+    free(x->rows);
+    x->rows = malloc((size_t)take * sizeof *x->rows + 1);
+    if (!chosen || !nj || !x->rows) {
+        free(chosen);
+        if (nj)
+            x->judged = nj;
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    }
+    x->judged = nj;
+    for (uint32_t k = 0; k < take; k++)
+        chosen[x->rank[k].index] = 1;
+    uint32_t n = 0;
+    for (size_t i = 0; i < x->cand_n; i++) {
+        if (chosen[i]) {
+            x->pairs[2 * n] = x->pairs[2 * i], x->pairs[2 * n + 1] = x->pairs[2 * i + 1];
+            x->rows[n++] = V + (uint32_t)i;
+        } else if (x->error[i] <= x->threshold) {
+            x->judged[x->judged_n++] = x->cand[i];
+        }
+    }
+    free(chosen);
+    qsort(x->judged, x->judged_n, sizeof *x->judged, cmp_u64);
+    *s = n;
+    return VB_OK;
+}
+
+/* The s chosen splits made: M becomes N, whose new vertices keep their
+ * midpoint bakes (and oriented normals). */
+static vb_result keep_midpoints(refinement *x, uint32_t V, uint32_t s, vb_error *err)
+{
+    vb_mesh_free(&x->N);
+    vb_result r = vb_mesh_split_edges(&x->M, x->pairs, s, &x->N, err);
+    if (r != VB_OK)
+        return r;
+    vb_bake_output *B = &x->B;
+    const vb_bake_output *R = &x->R;
+    int ok = 1;
+    for (int o = 1; o <= VDSH_MAX_ORDER; o++)
+        if (B->coeffs[o])
+            ok &= append_rows(&B->coeffs[o], V, R->coeffs[o], R->range_begin, (size_t)o * o,
+                              x->rows, s); /* R holds the midpoints' rows only */
+    if (B->normals)
+        ok &= append_rows(&B->normals, V, R->normals, R->range_begin, 3, x->rows, s);
+    if (!ok)
+        return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
+    for (uint32_t k = 0; k < s; k++)
+        memcpy(x->N.normals + 3 * ((size_t)V + k),
+               R->normals ? R->normals + 3 * (size_t)(x->rows[k] - R->range_begin)
+                          : x->T.normals + 3 * (size_t)x->rows[k],
+               3 * sizeof(float));
+    vb_mesh_free(&x->M);
+    x->M = x->N;
+    memset(&x->N, 0, sizeof x->N);
+    B->vertex_count = B->range_end = x->M.vertex_count;
+    return VB_OK;
+}
+
+/* One round: the candidates (within the budget and the uniform cap),
+ * their midpoints baked and scored, the chosen ones split. *more: whether
+ * another round may split more. */
+static vb_result refine_round(refinement *x, int *more, vb_error *err)
+{
+    const vb_adaptive_desc *ad = x->ad;
+    vb_adaptive_stats *st = &x->st;
+    const uint32_t V = x->M.vertex_count;
+    *more = 0;
+    if (ad->max_receivers && V >= ad->max_receivers) {
+        st->budget_reached = 1;
+        return VB_OK;
+    }
+    free(x->cand);
+    x->cand = NULL;
+    vb_result r = candidate_edges(&x->M, 2.0f * ad->min_edge, x->judged, x->judged_n, &x->cand,
+                                  &x->cand_n, err);
+    if (r != VB_OK || x->cand_n == 0)
+        return r;
+    const uint64_t baked = (uint64_t)st->start_receivers + st->candidates;
+    if (st->uniform_receivers && baked + x->cand_n > st->uniform_receivers) {
+        uint64_t room = st->uniform_receivers > baked ? st->uniform_receivers - baked : 0;
+        st->uniform_reached = 1;
+        if (room == 0)
+            return VB_OK;
+        if ((r = keep_longest(x, room, err)) != VB_OK)
+            return r;
+    }
+    uint32_t s = 0;
+    if ((r = bake_midpoints(x, V, err)) != VB_OK || (r = score_candidates(x, V, err)) != VB_OK ||
+        (r = choose_splits(x, V, &s, err)) != VB_OK)
+        return r;
+    st->last_split = s;
+    if (ad->on_round)
+        ad->on_round(ad->user, st->rounds, V + s, (uint32_t)x->cand_n, s, vb_now() - x->t_start);
+    if (s == 0)
+        return VB_OK;
+    if ((r = keep_midpoints(x, V, s, err)) != VB_OK)
+        return r;
+    *more = !(st->budget_reached || st->uniform_reached);
+    return VB_OK;
+}
+
+vb_result vb_bake_adaptive(const vb_bake_desc *bake, const vb_mesh *start,
+                           const vb_adaptive_desc *ad, vb_mesh *receivers, vb_bake_output *out,
+                           vb_adaptive_stats *stats, vb_error *err)
+{
+    vb_result r = check_adaptive_desc(ad, start, err);
+    if (r != VB_OK)
+        return r;
+    refinement x = {.ad = ad, .st = {.start_receivers = start->vertex_count}};
+    vb_adaptive_stats *st = &x.st;
+    x.t_start = vb_now();
+    if ((r = vb_mesh_refine(start, 0.0f, &x.M, err)) != VB_OK) /* a copy */
+        return r;
+
+    x.bd = *bake;
+    x.bd.receivers = &x.M;
+    x.bd.range_begin = x.bd.range_end = 0;
+    if ((r = vb_bake_run(&x.bd, &x.B, err)) != VB_OK)
         goto done;
-    if (B.normals) /* the oriented normals: midpoints interpolate them */
-        memcpy(M.normals, B.normals, (size_t)M.vertex_count * 3 * sizeof *M.normals);
-    const int order = B.max_order;
-    vdsh_quantity quantity[VDSH_ORDER_SLOTS];
-    memcpy(quantity, B.quantity, sizeof quantity);
-    bd.order_quantity = quantity;
-    const uint32_t interp = vdsh_runtime_interp((uint32_t)order, quantity[order]);
+    if (x.B.normals) /* the oriented normals: midpoints interpolate them */
+        memcpy(x.M.normals, x.B.normals, (size_t)x.M.vertex_count * 3 * sizeof *x.M.normals);
+    x.order = x.B.max_order;
+    memcpy(x.quantity, x.B.quantity, sizeof x.quantity);
+    x.bd.order_quantity = x.quantity;
+    x.interp = vdsh_runtime_interp((uint32_t)x.order, x.quantity[x.order]);
 
-    st.lights = ad->lights ? ad->lights : VB_ADAPTIVE_LIGHTS;
-    if (!(lights = malloc((size_t)st.lights * sizeof *lights))) {
+    st->lights = ad->lights ? ad->lights : VB_ADAPTIVE_LIGHTS;
+    if (!(x.lights = malloc((size_t)st->lights * sizeof *x.lights))) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
-    if ((r = vb_scene_place_lights(bake->scene, ADAPTIVE_LIGHT_SEED, st.lights, lights, NULL,
+    if ((r = vb_scene_place_lights(bake->scene, ADAPTIVE_LIGHT_SEED, st->lights, x.lights, NULL,
                                    err)) != VB_OK)
         goto done;
-
-    /* The cap: the uniform refinement to 2 min_edge (adaptive.h), the
-     * finest mesh the splits can reach (an edge of at most 2 min_edge is
-     * never split). At min_edge itself it cost 4x the vertices to count:
-     * 13.6 M on 2CylinderEngine.glb from --max-edge 8.4, minutes of the
-     * bake's time, for a cap that never binds there. */
-    {
-        vb_mesh U = {0};
-        vb_error uerr;
-        if (vb_mesh_refine(start, 2.0f * ad->min_edge, &U, &uerr) == VB_OK)
-            st.uniform_receivers = U.vertex_count;
-        vb_mesh_free(&U);
-    }
+    st->uniform_receivers = uniform_receivers(start, ad->min_edge);
     /* The split threshold: the tolerance above the fits' noise floor
      * (tolerance 0 asks for every split: no floor). */
-    double threshold = ad->tolerance;
+    x.threshold = ad->tolerance;
     if (isfinite(ad->tolerance) && ad->tolerance > 0.0f) {
-        if ((r = noise_floor(&bd, &M, &B, order, (const float(*)[3])lights, st.lights,
-                             &st.noise_floor, &st.noise_sample, &B, err)) != VB_OK)
+        if ((r = noise_floor(&x.bd, &x.M, &x.B, x.order, (const float(*)[3])x.lights, st->lights,
+                             &st->noise_floor, &st->noise_sample, &x.B, err)) != VB_OK)
             goto done;
-        threshold += st.noise_floor;
+        x.threshold += st->noise_floor;
     }
-    st.threshold = threshold;
-    const uint32_t max_rounds = st.max_rounds =
+    st->threshold = x.threshold;
+    const uint32_t max_rounds = st->max_rounds =
         ad->max_rounds ? ad->max_rounds : VB_ADAPTIVE_ROUNDS;
-    while (isfinite(ad->tolerance) && st.rounds < max_rounds) {
-        const uint32_t V = M.vertex_count;
-        if (ad->max_receivers && V >= ad->max_receivers) {
-            st.budget_reached = 1;
-            break;
-        }
-        free(cand);
-        cand = NULL;
-        if ((r = candidate_edges(&M, 2.0f * ad->min_edge, judged, judged_n, &cand, &cand_n, err)) !=
-            VB_OK)
+    for (int more = 1; more && isfinite(ad->tolerance) && st->rounds < max_rounds;)
+        if ((r = refine_round(&x, &more, err)) != VB_OK)
             goto done;
-        if (cand_n == 0)
-            break;
-        const uint64_t baked = (uint64_t)st.start_receivers + st.candidates;
-        if (st.uniform_receivers && baked + cand_n > st.uniform_receivers) {
-            /* Bake no more than the uniform bake would: the longest
-             * candidates that fit, in key order. */
-            uint64_t room = st.uniform_receivers > baked ? st.uniform_receivers - baked : 0;
-            st.uniform_reached = 1;
-            if (room == 0)
-                break;
-            free(rank);
-            if (!(rank = malloc(cand_n * sizeof *rank + 1))) {
-                r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-                goto done;
-            }
-            for (size_t i = 0; i < cand_n; i++)
-                rank[i] = (vb_ranked){edge_len2(&M, cand[i]), (uint32_t)i};
-            qsort(rank, cand_n, sizeof *rank, vb_ranked_cmp);
-            uint8_t *keep = calloc(cand_n + 1, 1);
-            if (!keep) {
-                r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-                goto done;
-            }
-            for (uint64_t k = 0; k < room; k++)
-                keep[rank[k].index] = 1;
-            size_t u = 0;
-            for (size_t i = 0; i < cand_n; i++)
-                if (keep[i])
-                    cand[u++] = cand[i];
-            free(keep);
-            cand_n = u;
-        }
-        /* The tentative mesh: every candidate split; bake the midpoints. */
-        free(pairs);
-        if (!(pairs = malloc(cand_n * 2 * sizeof *pairs + 1))) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-            goto done;
-        }
-        for (size_t i = 0; i < cand_n; i++)
-            pairs[2 * i] = (uint32_t)(cand[i] >> 32), pairs[2 * i + 1] = (uint32_t)cand[i];
-        vb_mesh_free(&T);
-        if ((r = vb_mesh_split_edges(&M, pairs, (uint32_t)cand_n, &T, err)) != VB_OK)
-            goto done;
-        vb_bake_output_free(&R);
-        bd.receivers = &T;
-        bd.range_begin = V;
-        bd.range_end = T.vertex_count;
-        if ((r = vb_bake_run(&bd, &R, err)) != VB_OK)
-            goto done;
-        st.rounds++;
-        st.candidates += (uint32_t)cand_n;
-        B.rays_traced += R.rays_traced;
-        B.rays_missed += R.rays_missed;
-        B.degenerate_receivers += R.degenerate_receivers;
-        B.flipped_normals += R.flipped_normals;
-        B.moved_origins += R.moved_origins;
-        B.origins.moved += R.origins.moved;
-        B.origins.flagged += R.origins.flagged;
-        B.origins.ties += R.origins.ties;
-        B.origins.skipped_zero_area += R.origins.skipped_zero_area;
-        B.origins.probe_rays += R.origins.probe_rays;
-        B.origins.seconds += R.origins.seconds;
-        B.seconds += R.seconds;
-
-        /* Score every candidate. */
-        free(error);
-        free(rank);
-        error = malloc(cand_n * sizeof *error + 1);
-        rank = malloc(cand_n * sizeof *rank + 1);
-        if (!error || !rank) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-            goto done;
-        }
-        score_job sj = {.fine = &T,
-                        .base = V,
-                        .edges = cand,
-                        .b = &R,
-                        .coarse_c = B.coeffs[order],
-                        .order = order,
-                        .quantity = quantity[order],
-                        .interp = interp,
-                        .lights = (const float(*)[3])lights,
-                        .light_count = st.lights,
-                        .error = error};
-        if (vb_parallel_for(B.threads, (uint32_t)cand_n, 64, score_block, &sj, NULL, NULL) == 0) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "cannot start worker threads");
-            goto done;
-        }
-        /* Split those above the tolerance, largest first within the budget;
-         * the others are judged for good. */
-        uint32_t over = 0;
-        for (size_t i = 0; i < cand_n; i++)
-            if (error[i] > threshold)
-                rank[over++] = (vb_ranked){error[i], (uint32_t)i};
-        qsort(rank, over, sizeof *rank, vb_ranked_cmp);
-        uint32_t take = over;
-        if (ad->max_receivers && take > ad->max_receivers - V) {
-            take = ad->max_receivers - V;
-            st.budget_reached = 1;
-        }
-        uint8_t *chosen = calloc(cand_n + 1, 1);
-        uint64_t *nj = realloc(judged, (judged_n + cand_n) * sizeof *judged + 1);
-        free(rows);
-        rows = malloc((size_t)take * sizeof *rows + 1);
-        if (!chosen || !nj || !rows) {
-            free(chosen);
-            if (nj)
-                judged = nj;
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-            goto done;
-        }
-        judged = nj;
-        for (uint32_t k = 0; k < take; k++)
-            chosen[rank[k].index] = 1;
-        uint32_t s = 0;
-        for (size_t i = 0; i < cand_n; i++) {
-            if (chosen[i]) { /* in key order: the new vertices' order */
-                pairs[2 * s] = pairs[2 * i], pairs[2 * s + 1] = pairs[2 * i + 1];
-                rows[s++] = V + (uint32_t)i;
-            } else if (error[i] <= threshold) {
-                judged[judged_n++] = cand[i];
-            }
-        }
-        free(chosen);
-        qsort(judged, judged_n, sizeof *judged, cmp_u64);
-        st.last_split = s;
-        if (ad->on_round)
-            ad->on_round(ad->user, st.rounds, V + s, (uint32_t)cand_n, s, vb_now() - t_start);
-        if (s == 0)
-            break;
-        vb_mesh_free(&N);
-        if ((r = vb_mesh_split_edges(&M, pairs, s, &N, err)) != VB_OK)
-            goto done;
-        /* The new vertices keep their midpoint bakes (and oriented normals). */
-        int ok = 1;
-        for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-            if (B.coeffs[o])
-                ok &= append_rows(&B.coeffs[o], V, R.coeffs[o], R.range_begin, (size_t)o * o, rows,
-                                  s); /* R holds the midpoints' rows only */
-        if (B.normals)
-            ok &= append_rows(&B.normals, V, R.normals, R.range_begin, 3, rows, s);
-        if (!ok) {
-            r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
-            goto done;
-        }
-        for (uint32_t k = 0; k < s; k++)
-            memcpy(N.normals + 3 * ((size_t)V + k),
-                   R.normals ? R.normals + 3 * (size_t)(rows[k] - R.range_begin)
-                             : T.normals + 3 * (size_t)rows[k],
-                   3 * sizeof(float));
-        vb_mesh_free(&M);
-        M = N;
-        memset(&N, 0, sizeof N);
-        B.vertex_count = B.range_end = M.vertex_count;
-        if (st.budget_reached || st.uniform_reached)
-            break;
-    }
-    if (isfinite(ad->tolerance) && st.rounds == max_rounds && st.last_split > 0 &&
-        !st.budget_reached && !st.uniform_reached) {
+    if (isfinite(ad->tolerance) && st->rounds == max_rounds && st->last_split > 0 &&
+        !st->budget_reached && !st->uniform_reached) {
         /* The round limit stopped a refinement still splitting: how many
          * edges the next round would have judged. */
-        free(cand);
-        cand = NULL;
-        if ((r = candidate_edges(&M, 2.0f * ad->min_edge, judged, judged_n, &cand, &cand_n, err)) !=
-            VB_OK)
+        free(x.cand);
+        x.cand = NULL;
+        if ((r = candidate_edges(&x.M, 2.0f * ad->min_edge, x.judged, x.judged_n, &x.cand,
+                                 &x.cand_n, err)) != VB_OK)
             goto done;
-        st.pending = (uint32_t)cand_n;
-        st.rounds_reached = cand_n > 0;
+        st->pending = (uint32_t)x.cand_n;
+        st->rounds_reached = x.cand_n > 0;
     }
-    B.vertex_count = B.range_end = M.vertex_count;
-    *receivers = M;
-    memset(&M, 0, sizeof M);
-    *out = B;
-    memset(&B, 0, sizeof B);
+    x.B.vertex_count = x.B.range_end = x.M.vertex_count;
+    *receivers = x.M;
+    memset(&x.M, 0, sizeof x.M);
+    *out = x.B;
+    memset(&x.B, 0, sizeof x.B);
     if (stats)
-        *stats = st;
+        *stats = *st;
     r = VB_OK;
 done:
-    vb_mesh_free(&M);
-    vb_mesh_free(&T);
-    vb_mesh_free(&N);
-    vb_bake_output_free(&B);
-    vb_bake_output_free(&R);
-    free(judged);
-    free(cand);
-    free(error);
-    free(rank);
-    free(rows);
-    free(pairs);
-    free(lights);
+    refinement_free(&x);
     return r;
 }

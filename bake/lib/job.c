@@ -184,7 +184,8 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
     if (sr != VB_OK)
         return sr;
     double t = vb_now();
-    vb_scene_desc sd = {.robust = !d->fast_traversal, .threads = d->bake.threads};
+    vb_scene_desc sd = {
+        .robust = !d->fast_traversal, .threads = d->bake.threads, .corner_lift = j->creased};
     vb_result r = vb_scene_create(&j->occluders, &sd, &j->scene, err);
     if (r != VB_OK)
         return r;

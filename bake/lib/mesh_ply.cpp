@@ -237,6 +237,19 @@ vb_result ply_binary_read(const char *path, const std::vector<ply_element> &elem
     return VB_OK;
 }
 
+/* A binary integer of type t (1, 2 or 4 bytes) at q, with its sign. */
+static long long binary_integer(const ply_type *t, const uint8_t *q, bool big)
+{
+    if (t->size == 1)
+        return t->is_signed ? (long long)(int8_t)q[0] : (long long)q[0];
+    if (t->size == 2) {
+        uint16_t u = big ? (uint16_t)(q[0] << 8 | q[1]) : (uint16_t)(q[1] << 8 | q[0]);
+        return t->is_signed ? (long long)(int16_t)u : (long long)u;
+    }
+    uint32_t u = load_u32(q, big);
+    return t->is_signed ? (long long)(int32_t)u : (long long)u;
+}
+
 /* A binary list's size (p.count_type at b, moved past): the element's
  * n-th item, for messages; a truncated file or a negative size refused. */
 static vb_result binary_list_size(const char *path, const ply_element &e, uint64_t n,
@@ -341,44 +354,13 @@ vb_result ply_walk_unused(const char *path, const std::vector<ply_element> &elem
     return VB_OK;
 }
 
-} // namespace
-
-/* Elements are read in order up to and including "face" (later ones are
- * never read); "vertex" must come before "face" and have x, y, z; the
- * only list property is the face's vertex_indices (or vertex_index), with
- * a uint8/uchar/uint16/int count and integer entries; one "face" element
- * and nothing before vertex_indices in it. Version 1.0 only (the only one there
- * is). The elements after "face" are walked by their declared layout
- * (ply_walk_unused): a file that ends in them is truncated, and data after
- * the last element of all is refused. Every value of the elements
- * read is checked (ascii: a whole number of the property's kind; both:
- * sizes, face indices in range, finite x, y, z) before it is used.
- *
- * Refused because OpenMesh's reader read them otherwise than declared
- * (the baker refused such files before, or read garbage from them): binary
- * x, y, z, normals or texture coordinates of an integer type (read as 0,
- * consuming nothing), binary colours of type double (the same) and binary
- * properties named after another type of another size ("property double
- * float32"), unless what OpenMesh read (ply_binary_read) is still what the
- * file declares; ascii colours that are not whole numbers of int range
- * unless their type is float (read as integers: the rest failed or shifted
- * into the next value), unless nothing used follows (the last face). */
-vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder &out,
-                   expectation *ex, vb_error *err)
+/* read_ply's header, from the line after "ply" to end_header: the data's
+ * format (0 ascii, 1 binary little endian, 2 binary big endian) and the
+ * elements declared, with their properties. c is left at the data. */
+vb_result read_ply_header(const char *path, cursor &c, int &format, std::vector<ply_element> &elems,
+                          vb_error *err)
 {
-    cursor c(bytes, size);
     token t;
-    if (utf8_bom(bytes, size))
-        return vb_fail(err, VB_ERR_FORMAT,
-                       "%s: starts with a UTF-8 byte order mark: save it without one (the "
-                       "first line must be 'ply')",
-                       path);
-    if (!c.next_on_line(&t) || !(t.is("ply") || t.is("PLY")) || c.next_on_line(&t))
-        return vb_fail(err, VB_ERR_FORMAT, "%s: not a PLY file (first line must be 'ply')", path);
-    c.skip_line();
-
-    int format = -1; /* 0 ascii, 1 binary little endian, 2 binary big endian */
-    std::vector<ply_element> elems;
     bool ended = false;
     while (!c.at_end()) {
         token kw;
@@ -477,8 +459,24 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
         return vb_fail(err, VB_ERR_FORMAT, "%s: PLY header has no end_header (truncated?)", path);
     if (format < 0)
         return vb_fail(err, VB_ERR_FORMAT, "%s: PLY header has no format line", path);
+    return VB_OK;
+}
 
-    /* Which elements are read, and the structure that can be read. */
+/* Which elements read_ply reads and where their values are: the
+ * structure it can read (the rules above read_ply). */
+struct ply_layout {
+    /* the elements read: those before the face element's end */
+    size_t last = 0;
+    int vertex_elem = -1, face_elem = -1;
+    /* the vertex element's x, y, z; the face's vertex_indices */
+    int xyz[3] = {-1, -1, -1};
+    int indices_prop = -1;
+    bool has_normals = false;
+};
+
+vb_result ply_layout_of(const char *path, std::vector<ply_element> &elems, ply_layout &L,
+                        vb_error *err)
+{
     size_t last = elems.size();
     int vertex_elem = -1, face_elem = -1;
     for (size_t i = 0; i < elems.size(); i++) {
@@ -543,6 +541,102 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
             "%s: face property '%s' before vertex_indices is not supported (the faces would be "
             "misread)",
             path, elems[(size_t)face_elem].props[0].name.c_str());
+    L.last = last;
+    L.vertex_elem = vertex_elem;
+    L.face_elem = face_elem;
+    std::copy(xyz, xyz + 3, L.xyz);
+    L.indices_prop = indices_prop;
+    L.has_normals = has_normals;
+    return VB_OK;
+}
+
+/* Binary properties OpenMesh's reader read otherwise than declared
+ * (ply_binary_read): what it read must be what the file says (out, as
+ * read_ply read it from the data at c), or the file is refused. */
+vb_result ply_check_as_read(const char *path, const std::vector<ply_element> &elems,
+                            const ply_layout &L, int format, const cursor &c, const builder &out,
+                            vb_error *err)
+{
+    const size_t last = L.last;
+    const int vertex_elem = L.vertex_elem, face_elem = L.face_elem;
+    const bool has_normals = L.has_normals, big = format == 2;
+    const ply_property *odd = nullptr;
+    const ply_element *odd_elem = nullptr;
+    for (size_t i = 0; i < last && format != 0 && !odd; i++)
+        for (const ply_property &p : elems[i].props)
+            if (!p.count_type &&
+                ply_read_size(p, (int)i == vertex_elem, (int)i == face_elem) != p.type->size) {
+                odd = &p;
+                odd_elem = &elems[i];
+                break;
+            }
+    if (odd) {
+        builder as_read;
+        vb_error why;
+        if (ply_binary_read(path, elems, last, vertex_elem, face_elem, has_normals, big,
+                            (const uint8_t *)c.p, (size_t)(c.end - c.p), as_read, &why) != VB_OK ||
+            as_read.positions != out.positions || as_read.normal_sums != out.normal_sums ||
+            as_read.has_normal != out.has_normal || as_read.indices != out.indices)
+            return vb_fail(
+                err, VB_ERR_FORMAT,
+                "%s: binary property '%s' of type %s in element '%s' is not supported (x, y, z, "
+                "normals and texture coordinates must be float or double, colours float or an integer "
+                "type, and a property must not be named after another type)",
+                path, odd->name.c_str(), odd->type->name, odd_elem->name.c_str());
+    }
+    return VB_OK;
+}
+
+} // namespace
+
+/* Elements are read in order up to and including "face" (later ones are
+ * never read); "vertex" must come before "face" and have x, y, z; the
+ * only list property is the face's vertex_indices (or vertex_index), with
+ * a uint8/uchar/uint16/int count and integer entries; one "face" element
+ * and nothing before vertex_indices in it. Version 1.0 only (the only one there
+ * is). The elements after "face" are walked by their declared layout
+ * (ply_walk_unused): a file that ends in them is truncated, and data after
+ * the last element of all is refused. Every value of the elements
+ * read is checked (ascii: a whole number of the property's kind; both:
+ * sizes, face indices in range, finite x, y, z) before it is used.
+ *
+ * Refused because OpenMesh's reader read them otherwise than declared
+ * (the baker refused such files before, or read garbage from them): binary
+ * x, y, z, normals or texture coordinates of an integer type (read as 0,
+ * consuming nothing), binary colours of type double (the same) and binary
+ * properties named after another type of another size ("property double
+ * float32"), unless what OpenMesh read (ply_binary_read) is still what the
+ * file declares; ascii colours that are not whole numbers of int range
+ * unless their type is float (read as integers: the rest failed or shifted
+ * into the next value), unless nothing used follows (the last face). */
+vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder &out,
+                   expectation *ex, vb_error *err)
+{
+    cursor c(bytes, size);
+    token t;
+    if (utf8_bom(bytes, size))
+        return vb_fail(err, VB_ERR_FORMAT,
+                       "%s: starts with a UTF-8 byte order mark: save it without one (the "
+                       "first line must be 'ply')",
+                       path);
+    if (!c.next_on_line(&t) || !(t.is("ply") || t.is("PLY")) || c.next_on_line(&t))
+        return vb_fail(err, VB_ERR_FORMAT, "%s: not a PLY file (first line must be 'ply')", path);
+    c.skip_line();
+
+    int format = -1; /* 0 ascii, 1 binary little endian, 2 binary big endian */
+    std::vector<ply_element> elems;
+    ply_layout L;
+    vb_result head = read_ply_header(path, c, format, elems, err);
+    if (head != VB_OK)
+        return head;
+    vb_result lay = ply_layout_of(path, elems, L, err);
+    if (lay != VB_OK)
+        return lay;
+    const size_t last = L.last;
+    const int vertex_elem = L.vertex_elem, face_elem = L.face_elem;
+    const int *xyz = L.xyz;
+    const int indices_prop = L.indices_prop;
+    const bool has_normals = L.has_normals;
     /* ascii: a value OpenMesh's reader would have read otherwise than the
      * checks below is refused once they have passed (before, the file
      * failed after them, or was read as garbage). */
@@ -601,19 +695,9 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                                        e.name.c_str(), (unsigned long long)n,
                                        (unsigned long long)e.count);
                     if (into) {
-                        double d = 0.0;
-                        if (p.type->is_float)
-                            d = ts == 4 ? (double)load_f32(b, big) : load_f64(b, big);
-                        else if (ts == 1)
-                            d = p.type->is_signed ? (double)(int8_t)b[0] : (double)b[0];
-                        else if (ts == 2) {
-                            uint16_t u =
-                                big ? (uint16_t)(b[0] << 8 | b[1]) : (uint16_t)(b[1] << 8 | b[0]);
-                            d = p.type->is_signed ? (double)(int16_t)u : (double)u;
-                        } else {
-                            uint32_t u = load_u32(b, big);
-                            d = p.type->is_signed ? (double)(int32_t)u : (double)u;
-                        }
+                        double d = !p.type->is_float ? (double)binary_integer(p.type, b, big)
+                                   : ts == 4         ? (double)load_f32(b, big)
+                                                     : load_f64(b, big);
                         if (is_xyz && (!std::isfinite(d) || std::fabs(d) > (double)FLT_MAX))
                             return vb_fail(err, VB_ERR_INVALID,
                                            "%s: vertex %llu has a non-finite coordinate", path,
@@ -622,19 +706,7 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                     }
                     if (is_indices) {
                         for (uint64_t q = 0; q < items; q++) {
-                            const uint8_t *ip = b + q * (size_t)ts;
-                            long long idx = 0;
-                            if (ts == 1)
-                                idx =
-                                    p.type->is_signed ? (long long)(int8_t)ip[0] : (long long)ip[0];
-                            else if (ts == 2) {
-                                uint16_t u = big ? (uint16_t)(ip[0] << 8 | ip[1])
-                                                 : (uint16_t)(ip[1] << 8 | ip[0]);
-                                idx = p.type->is_signed ? (long long)(int16_t)u : (long long)u;
-                            } else {
-                                uint32_t u = load_u32(ip, big);
-                                idx = p.type->is_signed ? (long long)(int32_t)u : (long long)u;
-                            }
+                            long long idx = binary_integer(p.type, b + q * (size_t)ts, big);
                             if (idx < 0 || (uint64_t)idx >= nv)
                                 return vb_fail(
                                     err, VB_ERR_INVALID,
@@ -760,34 +832,7 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
             *err = differs;
         return VB_ERR_FORMAT;
     }
-    /* Binary properties OpenMesh's reader read otherwise than declared
-     * (ply_binary_read): what it read must be what the file says, or the
-     * file is refused. */
-    const ply_property *odd = nullptr;
-    const ply_element *odd_elem = nullptr;
-    for (size_t i = 0; i < last && format != 0 && !odd; i++)
-        for (const ply_property &p : elems[i].props)
-            if (!p.count_type &&
-                ply_read_size(p, (int)i == vertex_elem, (int)i == face_elem) != p.type->size) {
-                odd = &p;
-                odd_elem = &elems[i];
-                break;
-            }
-    if (odd) {
-        builder as_read;
-        vb_error why;
-        if (ply_binary_read(path, elems, last, vertex_elem, face_elem, has_normals, big,
-                            (const uint8_t *)c.p, (size_t)(c.end - c.p), as_read, &why) != VB_OK ||
-            as_read.positions != out.positions || as_read.normal_sums != out.normal_sums ||
-            as_read.has_normal != out.has_normal || as_read.indices != out.indices)
-            return vb_fail(
-                err, VB_ERR_FORMAT,
-                "%s: binary property '%s' of type %s in element '%s' is not supported (x, y, z, "
-                "normals and texture coordinates must be float or double, colours float or an integer "
-                "type, and a property must not be named after another type)",
-                path, odd->name.c_str(), odd->type->name, odd_elem->name.c_str());
-    }
-    return VB_OK;
+    return ply_check_as_read(path, elems, L, format, c, out, err);
 }
 
 } // namespace vb_read

@@ -184,7 +184,7 @@ static uint32_t group_end(const pos_key *key, uint32_t n, uint32_t a)
 /* vb_offset_normals for the receivers of E (closed under coincidence):
  * normals and out per slot. */
 static vb_result offset_normals_in(const vb_mesh *m, const subset *E, const float *normals,
-                                   float *out)
+                                   float *out, uint8_t *corner)
 {
     uint32_t n = E->count;
     pos_key *key = sorted_positions(m, E);
@@ -211,6 +211,13 @@ static vb_result offset_normals_in(const vb_mesh *m, const subset *E, const floa
             double len = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
             for (int c = 0; c < 3; c++)
                 out[3 * (size_t)key[k].index + c] = len > 1e-12 ? (float)(s[c] / len) : 0.0f;
+            /* A corner: another normal at its position (its bits differ). */
+            if (corner) {
+                uint8_t any = 0;
+                for (uint32_t j = a; j < b && !any; j++)
+                    any = memcmp(normals + 3 * (size_t)key[j].index, nk, 3 * sizeof *nk) != 0;
+                corner[key[k].index] = any;
+            }
         }
         a = b;
     }
@@ -221,7 +228,7 @@ static vb_result offset_normals_in(const vb_mesh *m, const subset *E, const floa
 vb_result vb_offset_normals(const vb_mesh *m, float *out, vb_error *err)
 {
     subset all = {.count = m->vertex_count};
-    if (offset_normals_in(m, &all, m->normals, out) != VB_OK)
+    if (offset_normals_in(m, &all, m->normals, out, NULL) != VB_OK)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
     return VB_OK;
 }
@@ -410,6 +417,7 @@ typedef struct frames {
     uint32_t *adj_start, *adj; /* slot -> its triangles, in triangle order */
     double *pull;              /* 4 per slot: the centroids' pull x, y, z, weight */
     uint8_t *area;             /* per slot: 1 when one of its triangles has area */
+    uint8_t *corner;           /* per slot: 1 for a corner (origins.h, "Corners") */
 } frames;
 
 static void frames_free(frames *f)
@@ -422,6 +430,7 @@ static void frames_free(frames *f)
     free(f->adj);
     free(f->pull);
     free(f->area);
+    free(f->corner);
     memset(f, 0, sizeof *f);
 }
 
@@ -429,7 +438,7 @@ static void frames_free(frames *f)
  * inset (the centroids' pull in the tangent plane of the averaged normal). */
 static vb_result frames_normals(const vb_mesh *m, frames *f, vb_error *err)
 {
-    if (offset_normals_in(m, f->E, f->normals, f->navg) != VB_OK)
+    if (offset_normals_in(m, f->E, f->normals, f->navg, f->corner) != VB_OK)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
     for (uint32_t k = 0; k < f->E->count; k++) {
         const float *nv = f->navg + 3 * (size_t)k;
@@ -463,12 +472,13 @@ static vb_result frames_create(const vb_mesh *m, const vb_scene *s, const subset
     f->near = malloc((size_t)n * sizeof *f->near + 1);
     f->adj_start = calloc((size_t)n + 1, sizeof *f->adj_start);
     f->area = calloc((size_t)n + 1, 1);
+    f->corner = calloc((size_t)n + 1, 1);
     double *acc = f->pull = calloc((size_t)n * 4 + 1, sizeof *acc); /* x, y, z, weight */
     uint32_t *count = calloc((size_t)n + 1, sizeof *count);
     double *sum = calloc((size_t)n + 1, sizeof *sum);
     vb_result r = VB_OK;
-    if (!f->normals || !f->navg || !f->inset || !f->near || !f->adj_start || !f->area || !acc ||
-        !count || !sum) {
+    if (!f->normals || !f->navg || !f->inset || !f->near || !f->adj_start || !f->area ||
+        !f->corner || !acc || !count || !sum) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for ray origins");
         goto done;
     }
@@ -545,11 +555,13 @@ done:
 static void standard_origin(const vb_scene *s, const vb_mesh *m, const frames *f, uint32_t v,
                             uint32_t k, float sign, float out[3])
 {
-    const float *nv = f->navg + 3 * (size_t)k;
-    float p[3], o[3], ns[3] = {sign * nv[0], sign * nv[1], sign * nv[2]};
+    const float *nv = f->navg + 3 * (size_t)k, *in = f->inset + 3 * (size_t)k;
+    const float lift = s->corner_lift && f->corner[k] ? VB_CORNER_LIFT : 1.0f;
+    float p[3], o[3], ns[3] = {lift * sign * nv[0], lift * sign * nv[1], lift * sign * nv[2]};
+    float is[3] = {lift * in[0], lift * in[1], lift * in[2]};
     vb_scene_to_local(s, m->positions + 3 * (size_t)v, p);
     vb_offset_origin(p, ns, o);
-    vb_offset_origin(o, f->inset + 3 * (size_t)k, out);
+    vb_offset_origin(o, is, out);
 }
 
 /* What the first probe says of an origin. */

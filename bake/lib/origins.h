@@ -34,6 +34,20 @@
  * a floor) is repaired only if its full-length upper probes all escape:
  * the box bottom looks through the floor into the void, a sheet does not.
  *
+ * Corners (vb_scene.corner_lift: bakes whose computed normals split at
+ * creases). A receiver with another normal at its position (a split
+ * vertex's fans, an unwelded box corner) faces its own triangles only, so
+ * its hemisphere holds rays toward the faces beside it, which pass their
+ * shared edges within the offset (~2^-17 of the frame) of the origin:
+ * whether such a ray hits a face beside it at distance ~0 or slips past
+ * its edge is Embree's rounding, and each kernel set (SSE4.2 to AVX-512)
+ * answers differently for some ray (Sponza with --crease 60: one ray of
+ * 256 at 3 receivers, moving their fits by up to 0.28 of the largest
+ * coefficient). The share of such rays falls with the origin's distance
+ * from those edges, so a corner's standard origin is offset VB_CORNER_LIFT
+ * times as far (still ~1e-4 of the frame, under its near distance).
+ * Without creases (the flag 0) origins are as before, bit for bit.
+ *
  * A receiver whose triangles all have no area (cross product exactly 0,
  * the loader's test; its normal came from the file) is drawn nowhere: it
  * keeps the standard origin and is not probed (stats: skipped_zero_area).
@@ -63,6 +77,10 @@ extern "C" {
 #endif
 
 #define VB_REPAIR_CANDIDATES 24
+
+/* How many times further a corner's standard origin is offset when the
+ * scene asks (vb_scene.corner_lift; "Corners" above). */
+#define VB_CORNER_LIFT 16.0f
 
 typedef struct vb_origins_stats {
     uint32_t moved;             /* receivers whose origin the repair moved */

@@ -47,6 +47,7 @@ vb_result vb_scene_create(const vb_mesh *occ, const vb_scene_desc *desc, vb_scen
     if (!s)
         return vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory");
     s->vertex_count = occ->vertex_count;
+    s->corner_lift = d.corner_lift != 0;
     s->triangle_count = occ->triangle_count;
     vb_mesh_bounds(occ, s->bounds_min, s->bounds_max);
     double extent = 0.0;
@@ -274,11 +275,11 @@ vb_result vb_scene_use_light_box(vb_scene *s, vdsh_light_box *box, const char *w
 vb_result vb_scene_set_light_region(vb_scene *s, const float lo[3], const float hi[3],
                                     const char *what, vb_error *err)
 {
-    for (int a = 0; a < 3; a++)
-        if (!isfinite(lo[a]) || !isfinite(hi[a]) || !(lo[a] < hi[a]))
-            return vb_fail(err, VB_ERR_ARGUMENT,
-                           "%s: the box's %c is %g..%g: it must be finite, min below max", what,
-                           "xyz"[a], (double)lo[a], (double)hi[a]);
+    int a = vdsh_light_box_bad_axis(lo, hi);
+    if (a >= 0)
+        return vb_fail(err, VB_ERR_ARGUMENT,
+                       "%s: the box's %c is %g..%g: it must be finite, min below max", what,
+                       "xyz"[a], (double)lo[a], (double)hi[a]);
     uint32_t k = 0;
     for (; k < VDSH_REGION_PROBES; k++) {
         float p[3];

@@ -35,6 +35,8 @@ extern "C" {
 typedef struct vb_scene_desc {
     int robust;
     unsigned threads;
+    /* 1: ray origins of corner receivers lifted further (vb_scene.corner_lift) */
+    int corner_lift;
 } vb_scene_desc;
 
 /* The traced frame is (p - centre) * scale, scale a power of two; the
@@ -56,6 +58,11 @@ typedef struct vb_scene {
     int region_given;
     float region_min[3], region_max[3];
     char embree_error[256]; /* last Embree error reported on this device */
+    /* 1 (a bake whose computed normals split at creases: vb_scene_desc):
+     * the standard origin of a corner receiver - one with a receiver at
+     * its bit-identical position whose normal differs - is offset
+     * VB_CORNER_LIFT times as far (origins.h, "Corners"); 0: as any. */
+    int corner_lift;
 } vb_scene;
 
 vb_result vb_scene_create(const vb_mesh *occluders, const vb_scene_desc *desc, vb_scene **out,
