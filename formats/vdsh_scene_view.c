@@ -1034,7 +1034,7 @@ static vdsh_result object_lights(const vdsh_view_tracer *t, const vdsh_view_mesh
 /* An object's light 0 (vdsh-view's one light) stays in the light region
  * the bake trained on, and there it can face little of what the fit
  * camera sees: the fandisk's region is its bounds, thin across the face in
- * view, and the light found free behind it faced 24% of the object's
+ * view, and the light found free behind it faced 23% of the object's
  * pixels (the default frame dark but a notch); Wuson's 7% (black). When
  * light 0 faces less than VDSH_VIEW_KEY_FACING of the pixels that see the
  * object (lit or shadowed: N . (L - p) > 0), the camera is fitted along w
@@ -1042,7 +1042,7 @@ static vdsh_result object_lights(const vdsh_view_tracer *t, const vdsh_view_mesh
  * degrees in turn, and the first turn whose frame light 0 faces so is
  * kept (the nearest to the fixed direction); when none does, the one it
  * faces most (the first on a tie; none when no turn beats w). The lights
- * stay; object_lights then checks them in the camera kept. Returns
+ * stay; object_lights, where it runs, checks them in the camera kept. Returns
  * VDSH_ERR_OUT_OF_MEMORY or VDSH_OK. */
 static vdsh_result face_key_light(const vdsh_view_tracer *t, const vdsh_view_mesh *m, vdsh_view *v,
                                   float diag, const float w[3])

@@ -422,7 +422,7 @@ static void test_object(void)
     CHECK(vdsh_view_compute(&m, &v, &err) == VDSH_OK, "%s", err.msg);
     CHECK(!v.interior && v.front_share == 0.0f, "a sphere: interior %d, front share %g", v.interior,
           (double)v.front_share);
-    /* light 0 in a corner of the bounds faces 40% of the sphere seen
+    /* light 0 in a corner of the bounds faces 32% of the sphere seen
      * from the fit direction: the camera turns toward it */
     check_key_camera(&m, &v, "sphere");
     float diag = vdsh_view_diagonal(v.bounds_min, v.bounds_max);

@@ -417,7 +417,8 @@ typedef struct frames {
     uint32_t *adj_start, *adj; /* slot -> its triangles, in triangle order */
     double *pull;              /* 4 per slot: the centroids' pull x, y, z, weight */
     uint8_t *area;             /* per slot: 1 when one of its triangles has area */
-    uint8_t *corner;           /* per slot: 1 for a corner (origins.h, "Corners") */
+    uint8_t *corner;           /* per slot: 1 for a corner (origins.h, "Corners"); only with
+                        vb_scene.corner_lift, else NULL */
 } frames;
 
 static void frames_free(frames *f)
@@ -472,13 +473,13 @@ static vb_result frames_create(const vb_mesh *m, const vb_scene *s, const subset
     f->near = malloc((size_t)n * sizeof *f->near + 1);
     f->adj_start = calloc((size_t)n + 1, sizeof *f->adj_start);
     f->area = calloc((size_t)n + 1, 1);
-    f->corner = calloc((size_t)n + 1, 1);
+    f->corner = s->corner_lift ? calloc((size_t)n + 1, 1) : NULL;
     double *acc = f->pull = calloc((size_t)n * 4 + 1, sizeof *acc); /* x, y, z, weight */
     uint32_t *count = calloc((size_t)n + 1, sizeof *count);
     double *sum = calloc((size_t)n + 1, sizeof *sum);
     vb_result r = VB_OK;
     if (!f->normals || !f->navg || !f->inset || !f->near || !f->adj_start || !f->area ||
-        !f->corner || !acc || !count || !sum) {
+        (s->corner_lift && !f->corner) || !acc || !count || !sum) {
         r = vb_fail(err, VB_ERR_OUT_OF_MEMORY, "out of memory for ray origins");
         goto done;
     }
