@@ -68,6 +68,12 @@ static const char usage_text[] =
     "                        12; GL 4.3) instead of in every pass of 8 lights;\n"
     "                        with --bench: time its buffer modes both ways\n"
     "                        (MODE-frame)\n"
+    "      --compute         compute a buffer stream's sums once per frame in a\n"
+    "                        compute shader, per vertex and light (a cpca\n"
+    "                        stream decoded once per frame first; GL 4.3),\n"
+    "                        instead of in the vertex stage of every pass;\n"
+    "                        with --bench: time its buffer modes both ways\n"
+    "                        (MODE-compute)\n"
     "      --views FILE      with --frames DIR: for every view, light set and\n"
     "                        light of the view set FILE (vdsh-frames writes\n"
     "                        one), the shadow of that one light alone as a\n"
@@ -227,6 +233,7 @@ enum {
     O_MODES,
     O_BUFFER_FLOATS,
     O_CPCA_FRAME,
+    O_COMPUTE,
     O_BENCH_LIGHTS,
     O_BENCH_CUBE_SIZES,
     O_BENCH_MODES,
@@ -264,6 +271,7 @@ static const struct option longopts[] = {
     {"no-mallopt", no_argument, 0, O_NO_MALLOPT},
     {"buffer-floats", no_argument, 0, O_BUFFER_FLOATS},
     {"cpca-frame", no_argument, 0, O_CPCA_FRAME},
+    {"compute", no_argument, 0, O_COMPUTE},
     {"bench-lights", required_argument, 0, O_BENCH_LIGHTS},
     {"bench-cube-sizes", required_argument, 0, O_BENCH_CUBE_SIZES},
     {"bench-modes", required_argument, 0, O_BENCH_MODES},
@@ -468,6 +476,7 @@ static int parse_option(int c, const char *v, vv_options *o)
     case O_NO_MALLOPT: o->no_mallopt = 1; return 0;
     case O_BUFFER_FLOATS: o->buffer_floats = 1; return 0;
     case O_CPCA_FRAME: o->cpca_frame = 1; return 0;
+    case O_COMPUTE: o->compute = 1; return 0;
     case O_BENCH_LIGHTS: return parse_bench_lights(v, o);
     case O_BENCH_CUBE_SIZES: return parse_bench_cube_sizes(v, o);
     case O_BENCH_MODES:

@@ -26,8 +26,9 @@ typedef struct bench_mode {
     int pcf;
     const char *name;
     int stream;    /* VR_MODE_VDSH_BUFFER's */
-    int floats;    /* drawn from a copy of the scene: 1 decoded-f32,
-                                2 cpca decoded once per frame */
+    int from_copy; /* drawn from a copy of the scene (bench_scene.copy):
+                                1 decoded-f32, 2 cpca decoded once per frame,
+                                3 sums in a compute shader */
     int renderer;  /* index into the renderers: 0, or 1 + the
                                 --bench-cube-sizes entry of a sized cube */
     int cube_size; /* VR_MODE_CUBE: its face size */
@@ -78,8 +79,10 @@ static double process_cpu_ms(void)
 typedef struct bench_scene {
     const char *path;
     vr_scene *scene;
-    vr_scene *floats; /* --buffer-floats: buffers as decoded f32 */
-    vr_scene *frame;  /* --cpca-frame: cpca decoded once per frame */
+    /* copies of the scene for the buffer modes: [0] --buffer-floats
+     * (buffers as decoded f32), [1] --cpca-frame (cpca decoded once per
+     * frame), [2] --compute (sums in a compute shader) */
+    vr_scene *copy[3];
     bench_mode modes[BENCH_MODES];
     int nm;
     vr_light lights[BENCH_SETS][VR_MAX_POOL_LIGHTS];
@@ -157,15 +160,18 @@ static void add_buffer_modes(bench_scene *b)
  * scene whose buffers hold decoded f32 ("buf12-f32"): the same images,
  * 2-4x the bytes, no unpacking in the shader. --cpca-frame (copy 2): each
  * buffer mode of a cpca stream again, from a copy that decodes it once
- * per frame into a scratch (vr_scene_desc.cpca_decode, "buf12-frame"). */
+ * per frame into a scratch (vr_scene_desc.cpca_decode, "buf12-frame").
+ * --compute (copy 3): each buffer mode again, from a copy whose sums are
+ * computed in a compute shader (vr_scene_desc.sums, "buf12-compute"). */
 static int add_copy_modes(bench_scene *b, int copy)
 {
-    static char names[2][VV_MAX_MODES][32];
+    static const char *suffix[3] = {"f32", "frame", "compute"};
+    static char names[3][VV_MAX_MODES][32];
     int n = b->nm, any = 0;
     vr_scene_info info;
     vr_scene_get_info(b->scene, &info);
     for (int m = 0; m < n; m++)
-        any |= b->modes[m].mode == VR_MODE_VDSH_BUFFER && !b->modes[m].floats;
+        any |= b->modes[m].mode == VR_MODE_VDSH_BUFFER && !b->modes[m].from_copy;
     if (!any)
         return 0;
     vr_error err;
@@ -173,23 +179,24 @@ static int add_copy_modes(bench_scene *b, int copy)
                         .skip_cubemaps = 1,
                         .buffers = 1,
                         .buffer_floats = copy == 1,
-                        .cpca_decode = copy == 2 ? VR_CPCA_PER_FRAME : VR_CPCA_PER_PASS};
-    if (vr_scene_create(&sd, copy == 1 ? &b->floats : &b->frame, &err) != VR_OK) {
+                        .cpca_decode = copy == 2 ? VR_CPCA_PER_FRAME : VR_CPCA_PER_PASS,
+                        .sums = copy == 3 ? VR_SUMS_COMPUTE : VR_SUMS_VERTEX};
+    if (vr_scene_create(&sd, &b->copy[copy - 1], &err) != VR_OK) {
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
         return 1;
     }
     for (int m = 0; m < n && b->nm < BENCH_MODES; m++) {
         int k = vv_mode_find(b->modes[m].name, strlen(b->modes[m].name), VV_MODE_BENCH_LOG);
         int st = b->modes[m].stream;
-        if (b->modes[m].mode != VR_MODE_VDSH_BUFFER || b->modes[m].floats || k < 0 ||
+        if (b->modes[m].mode != VR_MODE_VDSH_BUFFER || b->modes[m].from_copy || k < 0 ||
             (copy == 2 &&
              (st < 1 || st >= VDSH_ORDER_SLOTS || info.buffer_encoding[st] != VDSH_ENCODING_CPCA)))
             continue;
         snprintf(names[copy - 1][k], sizeof names[copy - 1][k], "%s-%s", vv_modes[k].json,
-                 copy == 1 ? "f32" : "frame");
+                 suffix[copy - 1]);
         bench_mode f = b->modes[m];
         f.name = names[copy - 1][k];
-        f.floats = copy;
+        f.from_copy = copy;
         b->modes[b->nm++] = f;
     }
     return 0;
@@ -223,6 +230,8 @@ static int bench_open(const vv_options *o, const char *path, bench_scene *b)
         return 1;
     if (o->cpca_frame && add_copy_modes(b, 2))
         return 1;
+    if (o->compute && add_copy_modes(b, 3))
+        return 1;
     bench_filter(o, b);
     if (!b->nm) {
         fprintf(stderr, "vdsh-view: %s: no mode of --bench-modes %s in this file\n", path,
@@ -240,6 +249,12 @@ static int bench_open(const vv_options *o, const char *path, bench_scene *b)
     return 0;
 }
 
+/* The scene mode m of bs draws: the scene, or one of its copies. */
+static const vr_scene *mode_scene(const bench_scene *bs, int m)
+{
+    return bs->modes[m].from_copy ? bs->copy[bs->modes[m].from_copy - 1] : bs->scene;
+}
+
 /* Mode m of scene bs at light set ls: the draw's description (*d) and the
  * scene it draws (the float-coefficient copy for the buffer modes that
  * read floats). */
@@ -251,7 +266,7 @@ static const vr_scene *mode_desc(const vv_options *o, const bench_scene *bs, int
     d->pcf = bs->modes[m].pcf;
     d->stream = bs->modes[m].stream;
     vv_scene_camera(bs->scene, o, &d->camera);
-    return bs->modes[m].floats == 2 ? bs->frame : bs->modes[m].floats ? bs->floats : bs->scene;
+    return mode_scene(bs, m);
 }
 
 /* Time every mode of every scene, with 1 light, then 3, 16 and 64.
@@ -396,10 +411,7 @@ static void bench_print(const vv_options *o, const bench_scene *b, int all_round
             }
             if (b->modes[m].mode == VR_MODE_VDSH_BUFFER)
                 vt_json_u64(j, r, "buffer_bytes",
-                            vr_scene_buffer_bytes(b->modes[m].floats == 2 ? b->frame
-                                                  : b->modes[m].floats    ? b->floats
-                                                                          : b->scene,
-                                                  b->modes[m].stream));
+                            vr_scene_buffer_bytes(mode_scene(b, m), b->modes[m].stream));
             json_series(j, r, "cpu_ms", b->cpu[ls][m], rounds);
             json_series(j, r, "process_cpu_ms", b->proc[ls][m], rounds);
             json_series(j, r, "gpu_ms", b->gpu[ls][m], rounds);
@@ -466,8 +478,8 @@ int vv_run_bench(const vv_options *o)
     vt_json_free(&j);
     for (int i = 0; b && i < o->file_count; i++) {
         vr_scene_destroy(b[i].scene);
-        vr_scene_destroy(b[i].floats);
-        vr_scene_destroy(b[i].frame);
+        for (int c = 0; c < 3; c++)
+            vr_scene_destroy(b[i].copy[c]);
     }
     free(b);
     for (int i = 0; i < 9; i++)

@@ -262,6 +262,7 @@ int vv_open_scene(const vv_options *o, const char *path, vr_scene **out)
                         .buffers = o->buffers,
                         .cpca_decode =
                             o->cpca_frame && !o->bench ? VR_CPCA_PER_FRAME : VR_CPCA_PER_PASS,
+                        .sums = o->compute && !o->bench ? VR_SUMS_COMPUTE : VR_SUMS_VERTEX,
                         .sdf_path = o->sdf_path,
                         .light_region = o->light_region};
     memcpy(sd.light_box, o->light_box, sizeof sd.light_box);

@@ -159,6 +159,7 @@ typedef struct vr_error {
 typedef struct vr_scene vr_scene;
 
 enum { VR_CPCA_PER_PASS = 0, VR_CPCA_PER_FRAME = 1 };
+enum { VR_SUMS_VERTEX = 0, VR_SUMS_COMPUTE = 1 };
 
 typedef struct vr_scene_desc {
     /* The .vdsh file to load. Either path or file must be set. */
@@ -205,6 +206,20 @@ typedef struct vr_scene_desc {
      * vertex stage, GL 4.3 or GL_ARB_shader_storage_buffer_object, else
      * the load fails with VR_ERR_GL). docs/BENCHMARKS.md has both. */
     int cpca_decode;
+    /* Where a buffer stream's SH sums (VR_MODE_VDSH_BUFFER, a stream of
+     * one order) are computed. VR_SUMS_VERTEX (0, default): in the vertex
+     * stage of every pass, toward the pass's lights. VR_SUMS_COMPUTE:
+     * once per vr_draw in a compute shader, one invocation per (vertex,
+     * light), into a storage buffer of 4 bytes per vertex and light of
+     * the frame that the passes read, one value per light, as order 5's
+     * attributes are read; a cpca stream is then decoded once per frame
+     * (VR_CPCA_PER_FRAME; cpca_decode is not read). The high orders' path
+     * on a GPU (docs/BENCHMARKS.md "Sums in a compute shader"). Needs
+     * compute shaders and storage buffers (GL 4.3, or
+     * GL_ARB_compute_shader and GL_ARB_shader_storage_buffer_object), else
+     * the load fails with VR_ERR_GL. A stream with an order per vertex
+     * keeps the vertex stage's sums. */
+    int sums;
     /* VR_MODE_SDF's signed distance volume (formats/vdsh_sdf.h), uploaded
      * as a 3D texture. NULL (default): the .vdsh's companion file
      * (vdsh_sdf_path: room.vdsh -> room.sdf) when desc->path is set and

@@ -116,6 +116,8 @@ void vr_buffer_destroy(vr_buffer *b)
     glDeleteBuffers(5, bufs);
     if (b->decode_prog)
         glDeleteProgram(b->decode_prog);
+    if (b->sums_prog)
+        glDeleteProgram(b->sums_prog);
     free(b->ks);
     free(b->cpca_unpack);
     memset(b, 0, sizeof *b);
@@ -402,36 +404,63 @@ static char *cpca_dot_define(int basis)
     return d;
 }
 
-/* VR_CPCA_PER_FRAME: the decode program and the scratch of b (see
- * vr.h, shaders/vdsh_cpca_decode.glsl). VR_ERR_GL where the vertex stage
- * has no shader storage buffers or the scratch is over this GL's limits,
- * VR_ERR_SHADER, VR_ERR_OUT_OF_MEMORY. */
-static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const char *name, vr_error *err)
+int vr_has_compute(void)
 {
-    GLint major = 0, minor = 0, blocks = 0, max_texels = 0, ext = 0;
-    GLint64 max_block = 0;
+    GLint major = 0, minor = 0, n = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &major);
     glGetIntegerv(GL_MINOR_VERSION, &minor);
-    /* GL 4.3 has storage buffers in core; before it, only the extension. */
-    const int core = major > 4 || (major == 4 && minor >= 3);
-    int ssbo = core;
-    glGetIntegerv(GL_NUM_EXTENSIONS, &ext);
-    for (GLint i = 0; i < ext && !ssbo; i++)
-        ssbo = !strcmp((const char *)glGetStringi(GL_EXTENSIONS, (GLuint)i),
-                       "GL_ARB_shader_storage_buffer_object");
-    if (ssbo) {
-        glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &blocks);
-        glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+    if (major > 4 || (major == 4 && minor >= 3))
+        return 1;
+    int compute = 0, storage = 0;
+    glGetIntegerv(GL_NUM_EXTENSIONS, &n);
+    for (GLint i = 0; i < n; i++) {
+        const char *e = (const char *)glGetStringi(GL_EXTENSIONS, (GLuint)i);
+        compute |= e && !strcmp(e, "GL_ARB_compute_shader");
+        storage |= e && !strcmp(e, "GL_ARB_shader_storage_buffer_object");
     }
+    return compute && storage;
+}
+
+/* The first lines of a compute shader: its version, or GL 3.3 with the
+ * extensions (NVIDIA's core context is 3.3 with both). */
+static const char *compute_version(void)
+{
+    GLint major = 0, minor = 0;
+    glGetIntegerv(GL_MAJOR_VERSION, &major);
+    glGetIntegerv(GL_MINOR_VERSION, &minor);
+    return major > 4 || (major == 4 && minor >= 3)
+               ? "#version 430 core\n"
+               : "#version 330 core\n#extension GL_ARB_compute_shader : require\n"
+                 "#extension GL_ARB_shader_storage_buffer_object : require\n";
+}
+
+/* Dispatch invocations of a compute shader of 64 per group, in rows of at
+ * most 65535 groups (the shaders number them row by row). */
+static void dispatch(size_t invocations)
+{
+    size_t groups = (invocations + 63) / 64, x = groups < 65535 ? groups : 65535;
+    if (groups)
+        glDispatchCompute((GLuint)x, (GLuint)((groups + x - 1) / x), 1);
+}
+
+/* The decode program and the scratch of b (VR_CPCA_PER_FRAME, or a cpca
+ * stream's VR_SUMS_COMPUTE; vr.h, shaders/vdsh_cpca_decode.glsl).
+ * VR_ERR_GL where this GL has no compute shaders or the scratch is over
+ * its limits, VR_ERR_SHADER, VR_ERR_OUT_OF_MEMORY. */
+static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const char *name, vr_error *err)
+{
+    GLint max_texels = 0;
+    GLint64 max_block = 0;
+    if (!vr_has_compute())
+        return vr_fail(err, VR_ERR_GL,
+                       "%s: order %d cpca stream: decoding once per frame needs compute shaders "
+                       "and shader storage buffers (GL 4.3), which this GL has not",
+                       name, b->order);
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
     glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
     glGetError();
     b->scratch_stride = vr_buffer_stride(b->order, VR_BUF_F32);
     size_t texels = (size_t)s->vertex_count * (size_t)b->scratch_stride;
-    if (!ssbo || blocks < 1)
-        return vr_fail(err, VR_ERR_GL,
-                       "%s: order %d cpca stream: decoding once per frame needs shader storage "
-                       "buffers in the vertex stage (GL 4.3), which this GL has not",
-                       name, b->order);
     if (texels > (size_t)max_texels || (double)texels * 16.0 > (double)max_block)
         return vr_fail(err, VR_ERR_GL,
                        "%s: order %d cpca stream: a scratch of %zu texels is above this GL's "
@@ -446,30 +475,29 @@ static vr_result make_decoder(const vr_scene *s, vr_buffer *b, const char *name,
              "#define BUF_VARIABLE 0\n#define BUF_STRIDE %d\n#define BUF_CPCA_BASIS %d\n"
              "#define BUF_CPCA_BITS %d\n#define BUF_CPCA_T %d\n"
              "const float KS[1] = float[1](1.0);\n",
-             core ? "#version 430 core\n"
-                  : "#version 330 core\n#extension GL_ARB_shader_storage_buffer_object : require\n",
-             b->order, b->stride, b->cpca_basis, b->cpca_bits, b->scratch_stride);
+             compute_version(), b->order, b->stride, b->cpca_basis, b->cpca_bits,
+             b->scratch_stride);
     size_t size = strlen(defines) + (dot ? strlen(dot) : 0) +
                   (b->cpca_unpack ? strlen(b->cpca_unpack) : 0) + vr_buffer_glsl_size +
                   vr_cpca_decode_glsl_size + 1;
-    char *vs = dot ? malloc(size) : NULL;
-    if (!vs) {
+    char *cs = dot ? malloc(size) : NULL;
+    if (!cs) {
         free(dot);
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
     }
-    snprintf(vs, size, "%s%s%s%s%s", defines, dot, b->cpca_unpack ? b->cpca_unpack : "",
+    snprintf(cs, size, "%s%s%s%s%s", defines, dot, b->cpca_unpack ? b->cpca_unpack : "",
              vr_buffer_glsl, vr_cpca_decode_glsl);
     free(dot);
-    static const char fs[] = "#version 330 core\nout vec4 o;\nvoid main() { o = vec4(0.0); }\n";
     char what[256];
     snprintf(what, sizeof what, "%s: cpca decode program", name);
-    vr_result r = vr_link(what, vs, fs, &b->decode_prog, err);
-    free(vs);
+    vr_result r = vr_link_compute(what, cs, &b->decode_prog, err);
+    free(cs);
     if (r != VR_OK)
         return r;
     glUseProgram(b->decode_prog);
     glUniform1i(glGetUniformLocation(b->decode_prog, "u_coef"), VR_UNIT_COEF);
     glUniform1i(glGetUniformLocation(b->decode_prog, "u_model"), VR_UNIT_MODEL);
+    glUniform1i(glGetUniformLocation(b->decode_prog, "u_vertices"), (GLint)s->vertex_count);
     glUseProgram(0);
     glGenBuffers(1, &b->scratch_buf);
     glBindBuffer(GL_TEXTURE_BUFFER, b->scratch_buf);
@@ -492,17 +520,80 @@ void vr_buffer_decode(const vr_scene *s, const vr_buffer *b)
     glBindTexture(GL_TEXTURE_BUFFER, b->model_tex);
     glActiveTexture(GL_TEXTURE0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, b->scratch_buf);
-    glBindVertexArray(b->vao);
-    glEnable(GL_RASTERIZER_DISCARD);
-    glDrawArrays(GL_POINTS, 0, (GLsizei)s->vertex_count);
-    glDisable(GL_RASTERIZER_DISCARD);
+    dispatch((size_t)s->vertex_count * (size_t)b->scratch_stride);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
-    /* the passes read the scratch as a buffer texture */
+    /* the sums or the passes read the scratch as a buffer texture */
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+}
+
+/* VR_SUMS_COMPUTE: the sums program of fixed-order stream b
+ * (shaders/vr_sums.glsl), reading its records as stored or, for a cpca
+ * stream, its scratch (make_decoder first). VR_ERR_GL without compute
+ * shaders, VR_ERR_SHADER, VR_ERR_OUT_OF_MEMORY. */
+static vr_result make_summer(const vr_scene *s, vr_buffer *b, const char *name, vr_error *err)
+{
+    if (!vr_has_compute())
+        return vr_fail(err, VR_ERR_GL,
+                       "%s: order %d stream: sums in a compute shader need compute shaders and "
+                       "shader storage buffers (GL 4.3), which this GL has not",
+                       name, b->order);
+    int scratch = b->decode_prog != 0;
+    vr_buf_kind kind = scratch ? VR_BUF_F32 : b->kind;
+    char defines[256];
+    snprintf(defines, sizeof defines,
+             "%s#define BUFFER 1\n#define NUM_LIGHTS 1\n#define BUF_ORDER %d\n#define BUF_KIND %d\n"
+             "#define BUF_VARIABLE 0\n#define BUF_STRIDE %d\n",
+             compute_version(), b->order, (int)kind, scratch ? b->scratch_stride : b->stride);
+    char *table = vr_ks_table(b->ks, b->order * b->order);
+    size_t size = strlen(defines) + (table ? strlen(table) : 0) + vr_sums_glsl_size +
+                  vr_buffer_glsl_size + vr_sums_main_glsl_size + 1;
+    char *cs = table ? malloc(size) : NULL;
+    if (!cs) {
+        free(table);
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+    }
+    snprintf(cs, size, "%s%s%s%s%s", defines, table, vr_sums_glsl, vr_buffer_glsl,
+             vr_sums_main_glsl);
+    free(table);
+    char what[256];
+    snprintf(what, sizeof what, "%s: order %d sums program", name, b->order);
+    vr_result r = vr_link_compute(what, cs, &b->sums_prog, err);
+    free(cs);
+    if (r != VR_OK)
+        return r;
+    glUseProgram(b->sums_prog);
+    glUniform1i(glGetUniformLocation(b->sums_prog, "u_coef"), VR_UNIT_COEF);
+    glUniform1i(glGetUniformLocation(b->sums_prog, "u_vertices"), (GLint)s->vertex_count);
+    glUniform1f(glGetUniformLocation(b->sums_prog, "u_scale"), b->scale);
+    b->sums_u_lights = glGetUniformLocation(b->sums_prog, "u_lights");
+    glUseProgram(0);
+    return vr_check_gl(err, name);
+}
+
+void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint sums,
+                    const float (*pos)[4], int n)
+{
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, lights);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((size_t)n * sizeof *pos), pos,
+                 GL_STREAM_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    glUseProgram(b->sums_prog);
+    glUniform1i(b->sums_u_lights, n);
+    glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
+    glBindTexture(GL_TEXTURE_BUFFER, b->decode_prog ? b->scratch_tex : b->tex);
+    glActiveTexture(GL_TEXTURE0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s->vbo_position);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, lights);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, sums);
+    dispatch((size_t)s->vertex_count * (size_t)n);
+    for (GLuint i = 0; i < 3; i++)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, 0);
+    /* the passes read the sums as a buffer texture */
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
 }
 
 vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *remap, int floats,
-                           int cpca_decode, const char *name, vr_error *err)
+                           int cpca_decode, int sums, const char *name, vr_error *err)
 {
     int order = (int)st->order;
     int cpca = st->encoding == VDSH_ENCODING_CPCA;
@@ -609,8 +700,11 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
             b.bytes += model_bytes;
         }
         r = vr_check_gl(err, name);
-        if (r == VR_OK && model && cpca_decode == VR_CPCA_PER_FRAME)
+        int summed = sums == VR_SUMS_COMPUTE && !b.variable;
+        if (r == VR_OK && model && (cpca_decode == VR_CPCA_PER_FRAME || summed))
             r = make_decoder(s, &b, name, err);
+        if (r == VR_OK && summed)
+            r = make_summer(s, &b, name, err);
     }
     free(model);
     free(rec);

@@ -142,7 +142,7 @@ static void key_defines(const vr_program_key *k, int flat, char *buf, size_t siz
                      "#define BUF_KIND %u\n#define BUF_VARIABLE %u\n#define BUF_STRIDE %d\n"
                      "#define SHADOW_SDF %d\n"
                      "#define BUF_CPCA_BASIS %u\n#define BUF_CPCA_BITS %u\n"
-                     "#define BUF_CPCA_T %d\n"
+                     "#define BUF_CPCA_T %d\n#define BUF_SUMS %u\n"
                      "#define FOR_EACH_LIGHT",
                      order, visibility, split, distance, cubemap, cube, k->quantity, k->compare,
                      k->output, k->pcf, k->lights, flat, k->packed && order >= 3, buffer,
@@ -152,7 +152,7 @@ static void key_defines(const vr_program_key *k, int flat, char *buf, size_t siz
                          ? (int)k->cpca_words
                          : vr_buffer_stride(k->buf_order, (vr_buf_kind)k->buf_kind),
                      k->mode == VR_MODE_SDF, k->cpca_basis, k->cpca_bits,
-                     vr_buffer_stride(k->buf_order, VR_BUF_F32));
+                     vr_buffer_stride(k->buf_order, VR_BUF_F32), k->buf_sums);
     for (unsigned i = 0; i < k->lights && n > 0 && (size_t)n < size; i++)
         n += snprintf(buf + n, size - (size_t)n, " LIGHT(%u)", i);
     if (n > 0 && (size_t)n < size)
@@ -192,7 +192,10 @@ static vr_result compile(const char *name, GLenum stage, const char *src, GLuint
     char log[768];
     if (failed(sh, 1, log, sizeof log))
         return vr_fail(err, VR_ERR_SHADER, "%s: %s shader: %s", name,
-                       stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
+                       stage == GL_VERTEX_SHADER    ? "vertex"
+                       : stage == GL_COMPUTE_SHADER ? "compute"
+                                                    : "fragment",
+                       log);
     *out = sh;
     return VR_OK;
 }
@@ -222,8 +225,25 @@ vr_result vr_link(const char *name, const char *vs, const char *fs, GLuint *out,
     return VR_OK;
 }
 
+vr_result vr_link_compute(const char *name, const char *src, GLuint *out, vr_error *err)
+{
+    GLuint c = 0;
+    vr_result r = compile(name, GL_COMPUTE_SHADER, src, &c, err);
+    if (r != VR_OK)
+        return r;
+    GLuint p = glCreateProgram();
+    glAttachShader(p, c);
+    glLinkProgram(p);
+    glDeleteShader(c);
+    char log[768];
+    if (failed(p, 0, log, sizeof log))
+        return vr_fail(err, VR_ERR_SHADER, "%s: link: %s", name, log);
+    *out = p;
+    return VR_OK;
+}
+
 /* The buffer path's factor table as GLSL: "const float KS[n] = ...". */
-static char *ks_table(const float *ks, int n)
+char *vr_ks_table(const float *ks, int n)
 {
     size_t size = 64 + 18 * (size_t)n;
     char *t = malloc(size);
@@ -262,15 +282,17 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, const cha
     int flat = varying_components(key, 1) <= max_varying;
 
     /* The buffer path's code goes between the vertex stage's
-     * declarations and its main(). */
-    char *table = buffer ? ks_table(ks, key->buf_order * key->buf_order) : NULL;
+     * declarations and its main(), unless the stage reads sums that a
+     * compute shader made (BUF_SUMS, vr_buffer_sums). */
+    int coefs = buffer && !key->buf_sums;
+    char *table = coefs ? vr_ks_table(ks, key->buf_order * key->buf_order) : NULL;
     size_t vs_size = sizeof defines + vr_glsl_common_size + vr_glsl_vertex_size +
                      (table ? strlen(table) : 0) + strlen(cpca_unpack) + vr_buffer_glsl_size +
                      vr_glsl_vertex_main_size;
     size_t fs_size =
         sizeof defines + vr_glsl_common_size + vr_sdf_glsl_size + vr_glsl_fragment_size;
     char *vs = malloc(vs_size), *fs = malloc(fs_size);
-    if (!vs || !fs || (buffer && !table)) {
+    if (!vs || !fs || (coefs && !table)) {
         free(vs);
         free(fs);
         free(table);
@@ -283,8 +305,7 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, const cha
     for (;; flat = 0) {
         key_defines(key, flat, defines, sizeof defines);
         snprintf(vs, vs_size, "%s%s%s%s%s%s%s", defines, vr_glsl_common, vr_glsl_vertex,
-                 buffer ? table : "", cpca_unpack, buffer ? vr_buffer_glsl : "",
-                 vr_glsl_vertex_main);
+                 coefs ? table : "", cpca_unpack, coefs ? vr_buffer_glsl : "", vr_glsl_vertex_main);
         snprintf(fs, fs_size, "%s%s%s%s", defines, vr_glsl_common,
                  key->mode == VR_MODE_SDF ? vr_sdf_glsl : "", vr_glsl_fragment);
         r = vr_link(name, vs, fs, &prog, err);
@@ -308,6 +329,8 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, const cha
     p.u_ambient = glGetUniformLocation(prog, "u_ambient");
     p.u_shadow_nf = glGetUniformLocation(prog, "u_shadow_nf");
     p.u_shadow_texel = glGetUniformLocation(prog, "u_shadow_texel");
+    p.u_sums_stride = glGetUniformLocation(prog, "u_sums_stride");
+    p.u_sums_first = glGetUniformLocation(prog, "u_sums_first");
 
     /* Samplers never change unit: set them once. */
     glUseProgram(prog);
@@ -323,6 +346,9 @@ vr_result vr_program_build(const vr_program_key *key, const float *ks, const cha
     GLint model = glGetUniformLocation(prog, "u_model");
     if (model >= 0)
         glUniform1i(model, VR_UNIT_MODEL);
+    GLint sums = glGetUniformLocation(prog, "u_sums");
+    if (sums >= 0)
+        glUniform1i(sums, VR_UNIT_SUMS);
     GLint shadow = glGetUniformLocation(prog, "u_shadow");
     if (shadow >= 0) {
         GLint units[VR_MAX_LIGHTS_PER_PASS];

@@ -61,7 +61,8 @@ enum {
     VR_UNIT_SHADOW = 4,
     VR_UNIT_COEF = VR_UNIT_SHADOW + VR_MAX_LIGHTS_PER_PASS,
     VR_UNIT_SDF = VR_UNIT_COEF + 1,
-    VR_UNIT_MODEL = VR_UNIT_SDF + 1 /* a cpca buffer stream's model */
+    VR_UNIT_MODEL = VR_UNIT_SDF + 1, /* a cpca buffer stream's model */
+    VR_UNIT_SUMS = VR_UNIT_MODEL + 1 /* the frame's sums (VR_SUMS_COMPUTE) */
 };
 
 /* A buffer stream's vertex attributes (VR_MODE_VDSH_BUFFER, variable
@@ -104,22 +105,36 @@ typedef struct vr_buffer {
      * unpacking written out, "#define BUF_CPCA_UNPACK(f) ...\n"
      * (vr_buffer_cpca_unpack), malloc'd and in ks_hash; else NULL */
     char *cpca_unpack;
-    /* VR_CPCA_PER_FRAME (vr_scene_desc.cpca_decode): the decode program
-     * (shaders/vdsh_cpca_decode.glsl) and the scratch it writes once per
-     * frame, f32 records of stride scratch_stride texels that the light
-     * passes read as VR_BUF_F32 (vr_render.c); 0: decoded per pass */
+    /* VR_CPCA_PER_FRAME (vr_scene_desc.cpca_decode) or VR_SUMS_COMPUTE:
+     * the decode program (a compute shader, shaders/vdsh_cpca_decode.glsl)
+     * and the scratch it writes once per frame, f32 records of stride
+     * scratch_stride texels that the sums or the light passes read as
+     * VR_BUF_F32 (vr_render.c); 0: decoded per pass */
     GLuint decode_prog, scratch_buf, scratch_tex;
     int scratch_stride;
+    /* VR_SUMS_COMPUTE (vr_scene_desc.sums): the sums program
+     * (shaders/vr_sums.glsl), which reads the records, or the scratch */
+    GLuint sums_prog;
+    GLint sums_u_lights;
 } vr_buffer;
 
 /* Upload stream st (its quantity drawn) as a buffer stream of s, in the
  * GPU vertex order (remap[file vertex] = GPU vertex); floats: decoded f32.
  * VR_ERR_FORMAT, VR_ERR_OUT_OF_MEMORY, VR_ERR_GL naming `name`. */
 vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *remap, int floats,
-                           int cpca_decode, const char *name, vr_error *err);
-/* VR_CPCA_PER_FRAME: decode b's records into its scratch (a draw of
- * points, the rasteriser off), before the frame's light passes. */
+                           int cpca_decode, int sums, const char *name, vr_error *err);
+/* Whether this GL has compute shaders and shader storage buffers (GL
+ * 4.3, or the ARB extensions of both). */
+int vr_has_compute(void);
+/* A cpca stream decoded once per frame: b's records into its scratch (a
+ * compute dispatch), before the frame's sums or light passes. */
 void vr_buffer_decode(const vr_scene *s, const vr_buffer *b);
+/* VR_SUMS_COMPUTE: the SH sums of b toward each of the n lights at
+ * positions pos (xyz, w unused), per vertex and light, into sums
+ * (vertex-major: vertex v's at v * n); lights: a storage buffer of n
+ * vec4 that this fills. After vr_buffer_decode for a cpca stream. */
+void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint sums,
+                    const float (*pos)[4], int n);
 void vr_buffer_destroy(vr_buffer *b);
 /* The positions and normals (and indices) of s into the bound VAO. */
 void vr_scene_base_attribs(const vr_scene *s);
@@ -192,6 +207,8 @@ typedef struct vr_program_key {
                              vector (vr_buffer.cpca_unpack, in ks_hash) */
     uint8_t cpca_words;   /* VR_BUF_CPCA: u32 words per record */
     uint16_t cpca_basis;  /* VR_BUF_CPCA: basis vectors per cluster */
+    uint8_t buf_sums;     /* 1: the vertex stage reads sums a compute
+                             shader made (VR_SUMS_COMPUTE), no record */
 } vr_program_key;
 
 /* Texels of a record of this order and kind. */
@@ -211,6 +228,7 @@ typedef struct vr_program {
     GLint u_view_proj, u_scale, u_coef_step, u_max_distance, u_light_pos, u_light_color,
         u_light_att;
     GLint u_ambient, u_shadow_nf, u_shadow_texel;
+    GLint u_sums_stride, u_sums_first; /* buf_sums */
 } vr_program;
 
 /* Compile and link the lighting program for `key` (ks: the buffer
@@ -227,6 +245,11 @@ vr_result vr_program_build_depth(GLuint *out, vr_error *err);
 
 /* Compile and link vertex + fragment source; `name` for messages. */
 vr_result vr_link(const char *name, const char *vs, const char *fs, GLuint *out, vr_error *err);
+/* The same for one compute shader. */
+vr_result vr_link_compute(const char *name, const char *src, GLuint *out, vr_error *err);
+/* The buffer path's factor table as GLSL, "const float KS[n] = ...;\n";
+ * malloc'd, NULL when out of memory. */
+char *vr_ks_table(const float *ks, int n);
 
 /* Column-major 4x4 matrices. */
 void vr_mat4_mul(float out[16], const float a[16], const float b[16]);

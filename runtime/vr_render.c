@@ -54,6 +54,11 @@ struct vr_renderer {
     uint64_t frame;
     vr_timings last;
     vr_text_state text;
+    /* VR_SUMS_COMPUTE: the frame's light positions and sums (a storage
+     * buffer read by the passes as an R32F buffer texture), grown to the
+     * largest frame drawn */
+    GLuint sums_lights, sums_buf, sums_tex;
+    size_t sums_cap; /* floats */
 };
 
 static double now_seconds(void)
@@ -230,6 +235,9 @@ void vr_renderer_destroy(vr_renderer *r)
         free(s->group);
     }
     vr_text_destroy(&r->text);
+    GLuint bufs[2] = {r->sums_lights, r->sums_buf};
+    glDeleteBuffers(2, bufs);
+    glDeleteTextures(1, &r->sums_tex);
     free(r);
 }
 
@@ -660,10 +668,11 @@ typedef struct draw_frame {
     const vr_draw_desc *d;
     /* The stream's order in the attribute modes (0: none). */
     int order;
-    /* Mode buffer: the stream drawn, and whether it was decoded into its
-     * f32 scratch this frame (a cpca stream: vr_buffer_decode). */
+    /* Mode buffer: the stream drawn, whether it was decoded into its
+     * f32 scratch this frame (a cpca stream: vr_buffer_decode), and
+     * whether its sums were computed (VR_SUMS_COMPUTE: frame_sums). */
     const vr_buffer *buf;
-    int scratch;
+    int scratch, summed;
     float vp[16];
     frame_slot *slot;
 } draw_frame;
@@ -689,6 +698,11 @@ static void program_key(const draw_frame *F, int n, vr_program_key *key)
         key->cpca_basis = (uint16_t)(F->scratch ? 0 : buf->cpca_basis);
         key->cpca_bits = (uint8_t)(F->scratch ? 0 : buf->cpca_bits);
         key->cpca_words = (uint8_t)(F->scratch || buf->kind != VR_BUF_CPCA ? 0 : buf->stride);
+        if (F->summed) { /* no record read: one program for every stream */
+            key->buf_kind = VR_BUF_F32;
+            key->ks_hash = 0;
+            key->buf_sums = 1;
+        }
     }
 }
 
@@ -747,6 +761,10 @@ static void set_uniforms(const draw_frame *F, const vr_program *p, int g, const 
         glUniform3fv(p->u_light_pos, n, &pos[0][0]);
         glUniform3fv(p->u_light_color, n, &col[0][0]);
         glUniform3fv(p->u_light_att, n, &att[0][0]);
+        if (F->summed) {
+            glUniform1i(p->u_sums_stride, d->light_count);
+            glUniform1i(p->u_sums_first, g * F->r->per_pass);
+        }
     }
 }
 
@@ -778,7 +796,10 @@ static void bind_textures(const draw_frame *F, const vr_program *p, const vr_pro
     }
     if (mode == VR_MODE_SDF)
         vr_sdf_bind(s, p->prog, F->d->sdf_k);
-    if (buf) {
+    if (F->summed) {
+        glActiveTexture(GL_TEXTURE0 + VR_UNIT_SUMS);
+        glBindTexture(GL_TEXTURE_BUFFER, r->sums_tex);
+    } else if (buf) {
         glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
         glBindTexture(GL_TEXTURE_BUFFER, F->scratch ? buf->scratch_tex : buf->tex);
         if (buf->model_tex && !F->scratch) {
@@ -819,7 +840,8 @@ static vr_result draw_pass(const draw_frame *F, int g, vr_error *err)
     const vr_program *p = NULL;
     vr_result res = get_program(
         r, &key, buf ? buf->ks : NULL,
-        buf && !F->scratch && buf->kind == VR_BUF_CPCA ? buf->cpca_unpack : NULL, &p, err);
+        buf && !F->scratch && !F->summed && buf->kind == VR_BUF_CPCA ? buf->cpca_unpack : NULL, &p,
+        err);
     if (res != VR_OK)
         return res;
 
@@ -833,6 +855,48 @@ static vr_result draw_pass(const draw_frame *F, int g, vr_error *err)
     else
         glDrawElements(GL_TRIANGLES, (GLsizei)(3 * s->triangle_count), GL_UNSIGNED_INT, NULL);
     timer_end(t);
+    return VR_OK;
+}
+
+/* VR_SUMS_COMPUTE: the frame's sums toward all its lights
+ * (vr_buffer_sums), into the renderer's storage, grown as needed. */
+static vr_result frame_sums(vr_renderer *r, const vr_scene *s, const vr_buffer *b,
+                            const vr_draw_desc *d, vr_error *err)
+{
+    size_t need = (size_t)s->vertex_count * (size_t)d->light_count;
+    if (need > r->sums_cap) {
+        GLint max_texels = 0;
+        glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+        if (need > (size_t)max_texels)
+            return vr_fail(err, VR_ERR_GL,
+                           "vr_draw: sums of %u vertices toward %d lights: %zu texels, above "
+                           "this GL's GL_MAX_TEXTURE_BUFFER_SIZE (%d); draw fewer lights",
+                           s->vertex_count, d->light_count, need, (int)max_texels);
+        if (!r->sums_buf) {
+            glGenBuffers(1, &r->sums_lights);
+            glGenBuffers(1, &r->sums_buf);
+            glGenTextures(1, &r->sums_tex);
+        }
+        glBindBuffer(GL_TEXTURE_BUFFER, r->sums_buf);
+        glBufferData(GL_TEXTURE_BUFFER, (GLsizeiptr)(need * sizeof(float)), NULL, GL_DYNAMIC_COPY);
+        glBindTexture(GL_TEXTURE_BUFFER, r->sums_tex);
+        glTexBuffer(GL_TEXTURE_BUFFER, GL_R32F, r->sums_buf);
+        glBindTexture(GL_TEXTURE_BUFFER, 0);
+        glBindBuffer(GL_TEXTURE_BUFFER, 0);
+        vr_result res = vr_check_gl(err, "vr_draw: the sums' storage");
+        if (res != VR_OK)
+            return res;
+        r->sums_cap = need;
+    }
+    float(*pos)[4] = malloc((size_t)d->light_count * sizeof *pos);
+    if (!pos)
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "vr_draw: out of memory");
+    for (int i = 0; i < d->light_count; i++) {
+        memcpy(pos[i], d->lights[i].position, sizeof d->lights[i].position);
+        pos[i][3] = 1.0f;
+    }
+    vr_buffer_sums(s, b, r->sums_lights, r->sums_buf, (const float(*)[4])pos, d->light_count);
+    free(pos);
     return VR_OK;
 }
 
@@ -873,10 +937,14 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
     clear_target(r, &d);
 
     /* A cpca stream decoded once per frame: into its scratch, which
-     * the passes read as f32 records (vr_buffer_decode). */
+     * the sums or the passes read as f32 records (vr_buffer_decode). */
     F.scratch = F.buf && F.buf->decode_prog;
     if (F.scratch)
         vr_buffer_decode(s, F.buf);
+    /* Sums in a compute shader: once for all the frame's lights. */
+    F.summed = F.buf && F.buf->sums_prog && d.light_count > 0;
+    if (F.summed)
+        res = frame_sums(r, s, F.buf, &d, err);
 
     for (int g = 0; g < groups && res == VR_OK; g++)
         res = draw_pass(&F, g, err);

@@ -258,6 +258,14 @@ static vr_result check_desc(const vr_scene_desc *desc, const char *name, vr_erro
     if ((unsigned)desc->quantity > VDSH_QUANTITY_LOG_DISTANCE)
         return vr_fail(err, VR_ERR_ARGUMENT, "%s: unknown quantity %u", name,
                        (unsigned)desc->quantity);
+    if (desc->cpca_decode != VR_CPCA_PER_PASS && desc->cpca_decode != VR_CPCA_PER_FRAME)
+        return vr_fail(err, VR_ERR_ARGUMENT,
+                       "%s: cpca_decode %d is neither VR_CPCA_PER_PASS nor VR_CPCA_PER_FRAME", name,
+                       desc->cpca_decode);
+    if (desc->sums != VR_SUMS_VERTEX && desc->sums != VR_SUMS_COMPUTE)
+        return vr_fail(err, VR_ERR_ARGUMENT,
+                       "%s: sums %d is neither VR_SUMS_VERTEX nor VR_SUMS_COMPUTE", name,
+                       desc->sums);
     if (desc->light_pool < 0 || desc->light_pool > VR_MAX_POOL_LIGHTS)
         return vr_fail(err, VR_ERR_ARGUMENT, "%s: light_pool %d not in 0..%d", name,
                        desc->light_pool, VR_MAX_POOL_LIGHTS);
@@ -371,7 +379,8 @@ static vr_result upload_buffer_streams(vr_scene *s, const vdsh_file *f, const vr
                             ((st->order == 2 || st->order == 3 || st->order == 5) &&
                              !desc->buffers && st->encoding != VDSH_ENCODING_CPCA)))
             continue;
-        r = vr_buffer_upload(s, st, remap, desc->buffer_floats, desc->cpca_decode, name, err);
+        r = vr_buffer_upload(s, st, remap, desc->buffer_floats, desc->cpca_decode, desc->sums, name,
+                             err);
         if (!variable && !s->vbo_stream[st->order])
             s->method[st->order] = st->method;
     }

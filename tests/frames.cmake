@@ -111,6 +111,22 @@ if "$view" "$d/cpca.vdsh" --cpca-frame --views "$views" --frames "$d/cpcaf-gl" -
 else
   grep -q "shader storage" "$d/cpcaf.err" || { cat "$d/cpcaf.err"; exit 1; }
 fi
+# Sums in a compute shader (--compute, vr_scene_desc.sums): the cpca
+# streams (decoded once per frame first) and the fixed orders of baked
+# (the adaptive stream keeps the vertex stage's sums); skipped where the
+# GL has no compute shaders.
+if "$view" "$d/cpca.vdsh" --compute --views "$views" --frames "$d/cpcax-gl" --modes buf12 -q \
+    2> "$d/cpcax.err"; then
+  "$view" "$d/cpca5.vdsh" --compute --views "$views" --frames "$d/cpca5x-gl" --modes buf3,buf7 -q
+  "$view" "$d/baked.vdsh" --compute --views "$views" --frames "$d/bakedx-gl" \
+    --modes buf7,buf9,buf12,adaptive -q
+  "$cmp" "$views" "$d/cpca-c" "$d/cpcax-gl" 0.002 0.005 buf12=c-vdsh12
+  "$cmp" "$views" "$d/cpca5-c" "$d/cpca5x-gl" 0.002 0.005 buf3=c-vdsh3 buf7=c-vdsh7
+  "$cmp" "$views" "$d/baked-c" "$d/bakedx-gl" 0.002 0.005 \
+    buf7=c-vdsh7 buf9=c-vdsh9 buf12=c-vdsh12 adaptive=c-vdsh-var
+else
+  grep -q "compute shaders" "$d/cpcax.err" || { cat "$d/cpcax.err"; exit 1; }
+fi
 ]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames> $<TARGET_FILE:vdsh-view>
        $<TARGET_FILE:test_frames_gl> ${CMAKE_CURRENT_BINARY_DIR}/frames_gl
        ${CMAKE_CURRENT_LIST_DIR}/data/frames_gl.views.json $<TARGET_FILE:test_runtime_buffer>)

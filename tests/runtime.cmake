@@ -665,6 +665,51 @@ if "$png" same "$d/wpass.png" "$d/pass.png" 0; then echo "control: widths as uni
 _runtime_props(runtime_view_cpca_frame FIXTURES_REQUIRED runtime_room)
 endif()
 
+# Sums in a compute shader (--compute, vr_scene_desc.sums, issue 29): the
+# order-12 cpca stream (decoded once per frame, then summed per vertex
+# and light) and an s8s6 one (summed from its records) draw the frame the
+# vertex stage draws, at 16 lights (two passes reading the frame's sums
+# at their offsets) and 64 (eight); 3 lights is the control. Skips (77)
+# where the GL has no compute shaders, which vdsh-view reports as a
+# failed load.
+if(TARGET vdsh-bake)
+add_test(NAME runtime_view_compute COMMAND sh -c [=[
+v=$1; png=$2; bake=$3; d=$4
+rm -rf "$d"; mkdir -p "$d"
+set -e
+"$bake" builtin:room --max-edge 1.0 --rays 256 --cube-size 0 --orders 12 --encoding cpca \
+  -q -o "$d/c.vdsh"
+"$bake" builtin:room --max-edge 1.0 --rays 256 --cube-size 0 --orders 5,12 -q -o "$d/s.vdsh"
+set +e
+"$v" -q --render "$d/c16.png" --size 96x72 --mode buf12 --lights 16 "$d/c.vdsh"
+rc=$?
+[ $rc -eq 77 ] && exit 77
+[ $rc -eq 0 ] || exit 1
+if ! "$v" -q --render "$d/c16x.png" --size 96x72 --mode buf12 --lights 16 --compute \
+    "$d/c.vdsh" 2> "$d/compute.err"; then
+  cat "$d/compute.err"
+  grep -q "compute shaders" "$d/compute.err" && exit 77
+  exit 1
+fi
+set -e
+for f in c s; do
+  for n in 3 16 64; do
+    [ -f "$d/$f$n.png" ] || "$v" -q --render "$d/$f$n.png" --size 96x72 --mode buf12 --lights $n "$d/$f.vdsh"
+    [ -f "$d/$f${n}x.png" ] || "$v" -q --render "$d/$f${n}x.png" --size 96x72 --mode buf12 \
+      --lights $n --compute "$d/$f.vdsh"
+    "$png" info "$d/$f${n}x.png" 96 72
+    "$png" same "$d/$f$n.png" "$d/$f${n}x.png" 2
+  done
+  if "$png" same "$d/${f}16x.png" "$d/${f}3x.png" 2; then echo "control: 3 and 16 lights"; exit 1; fi
+done
+# the attribute modes ignore it
+"$v" -q --render "$d/v5.png" --size 96x72 --mode vdsh5 --lights 16 "$d/s.vdsh"
+"$v" -q --render "$d/v5x.png" --size 96x72 --mode vdsh5 --lights 16 --compute "$d/s.vdsh"
+"$png" same "$d/v5.png" "$d/v5x.png" 0
+]=] sh ${_view} ${_png} $<TARGET_FILE:vdsh-bake> ${_rt_dir}/view_compute)
+_runtime_props(runtime_view_compute)
+endif()
+
 foreach(t runtime_view_usage runtime_view_bench_json runtime_view_errors runtime_view_render runtime_view_bench
           runtime_view_frame runtime_view_window runtime_view_frames runtime_view_buffer)
   if(TEST ${t})

@@ -233,6 +233,14 @@ static void test_files(const char *dir)
         lb.light_box[2] = 2;
         expect_fail("light box z min above max", &lb, VR_ERR_ARGUMENT, "light region's z");
     }
+    /* Where to decode and sum: an unknown choice is refused by name. */
+    {
+        vr_scene_desc w = {.path = path, .sums = 2};
+        expect_fail("sums 2", &w, VR_ERR_ARGUMENT, "sums 2");
+        w.sums = VR_SUMS_VERTEX;
+        w.cpca_decode = -1;
+        expect_fail("cpca_decode -1", &w, VR_ERR_ARGUMENT, "cpca_decode -1");
+    }
     /* A cube_size no GL can hold is refused by name before anything is
      * allocated for it; cube_size 0 means none (vdsh5 unavailable). */
     {

@@ -81,6 +81,10 @@ int main(int argc, char **argv)
     check_embed(dir, "vr_fragment.glsl", vr_glsl_fragment, vr_glsl_fragment_size);
     check_embed(dir, "vr_depth.vert.glsl", vr_glsl_depth_vs, vr_glsl_depth_vs_size);
     check_embed(dir, "vr_depth.frag.glsl", vr_glsl_depth_fs, vr_glsl_depth_fs_size);
+    check_embed(dir, "vr_sdf.glsl", vr_sdf_glsl, vr_sdf_glsl_size);
+    check_embed(dir, "vdsh_cpca_decode.glsl", vr_cpca_decode_glsl, vr_cpca_decode_glsl_size);
+    check_embed(dir, "vr_sums.glsl", vr_sums_glsl, vr_sums_glsl_size);
+    check_embed(dir, "vr_sums_main.glsl", vr_sums_main_glsl, vr_sums_main_glsl_size);
 
     /* The C definition's numbers, as the headers write them. */
     static const char *const consts[][2] = {
@@ -115,6 +119,6 @@ int main(int argc, char **argv)
     if (test_failures)
         fprintf(stderr, "%d checks failed\n", test_failures);
     else
-        printf("runtime shaders: 7 files embedded as they are, the C constants, the interface\n");
+        printf("runtime shaders: 11 files embedded as they are, the C constants, the interface\n");
     return test_failures ? 1 : 0;
 }

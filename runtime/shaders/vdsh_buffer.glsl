@@ -15,8 +15,9 @@
  * order BUF_ORDER), BUF_TEXTURE_2D (1: a 2D texture BUF_TEX_WIDTH texels
  * wide, for GLSL ES; 0: a buffer texture), a table
  * const float KS[BUF_ORDER * BUF_ORDER] (the K_l^m, times an s8 stream's
- * steps) written before it, and BUF_RECEIVER, BUF_LIGHT(i), BUF_SCALE
- * (default a_position, u_light_pos[i], u_scale).
+ * steps) written before it, and BUF_VERTEX, BUF_RECEIVER, BUF_LIGHT(i),
+ * BUF_SCALE (default gl_VertexID, a_position, u_light_pos[i], u_scale;
+ * the C runtime's compute shaders, vr_sums.glsl, set their own).
  *
  * The recurrence is formats/vdsh_sh.c's eval_high_bands, step for step
  * (the same convention as the closed forms of bands 0-4: Condon-Shortley
@@ -107,8 +108,11 @@ uniform samplerBuffer u_model;
 #endif
 #endif
 /* What buffer_sums reads, unless the includer says otherwise: the
- * receiver's position, light i's position (the bake's frame) and the
+ * vertex (a fixed order's record), the receiver's position, light i's position (the bake's frame) and the
  * stream's scale. */
+#ifndef BUF_VERTEX
+#define BUF_VERTEX gl_VertexID
+#endif
 #ifndef BUF_RECEIVER
 #define BUF_RECEIVER a_position
 #endif
@@ -213,7 +217,7 @@ void buffer_sums(out float sums[NUM_LIGHTS])
     buf_begin(int(a_record));
 #else
     int k = BUF_ORDER;
-    buf_begin(gl_VertexID * BUF_STRIDE);
+    buf_begin(BUF_VERTEX * BUF_STRIDE);
 #endif
     vec3 d[NUM_LIGHTS];
     float cs[NUM_LIGHTS], sn[NUM_LIGHTS], pmm[NUM_LIGHTS], p0[NUM_LIGHTS], p1[NUM_LIGHTS];

@@ -57,6 +57,13 @@ uniform float u_max_distance; /* the clamp of every reconstructed distance */
 #if NUM_LIGHTS > 0
 uniform vec3 u_light_pos[NUM_LIGHTS];
 #endif
+#if BUF_SUMS && NUM_LIGHTS > 0
+/* The frame's SH sums from a compute shader (vr_sums.glsl): vertex v's
+ * toward the frame's light j at v * u_sums_stride + j; this pass's first
+ * light is the frame's u_sums_first. */
+uniform samplerBuffer u_sums;
+uniform int u_sums_stride, u_sums_first;
+#endif
 #if FLAT_LIGHTS
 /* handed on to the fragment stage (see the top of vr_glsl.c) */
 uniform vec3 u_ambient;

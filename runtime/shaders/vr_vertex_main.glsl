@@ -49,7 +49,12 @@ void main()
 #endif
 #if BUFFER && NUM_LIGHTS > 0
     float b_sum[NUM_LIGHTS];
+#if BUF_SUMS
+    for (int i = 0; i < NUM_LIGHTS; i++)
+        b_sum[i] = texelFetch(u_sums, gl_VertexID * u_sums_stride + u_sums_first + i).r;
+#else
     buffer_sums(b_sum);
+#endif
 #endif
 #if (VDSH_VISIBILITY || VDSH_DISTANCE || VDSH_SPLIT) && NUM_LIGHTS > 0
     for (int i = 0; i < NUM_LIGHTS; i++) {

@@ -1,0 +1,29 @@
+/*
+ * vr_sums.glsl - the C runtime's sums in a compute shader
+ * (vr_scene_desc.sums = VR_SUMS_COMPUTE, runtime/vr_buffer.c): one
+ * invocation per (vertex, light) of the frame computes the stream's SH
+ * sum toward its light with vdsh_buffer.glsl's buffer_sums, one light at
+ * a time (NUM_LIGHTS 1), and stores it at vertex * u_lights + light; the
+ * light passes' vertex stage then reads one value per light
+ * (vr_vertex_main.glsl, BUF_SUMS) where it would have summed the record.
+ * This part goes before vdsh_buffer.glsl (the vertex, receiver and light
+ * it reads are these), vr_sums_main.glsl after it. The record is read as
+ * stored, or a cpca stream's decoded scratch (BUF_KIND 0,
+ * vdsh_cpca_decode.glsl). Why per (vertex, light) rather than per vertex
+ * as the vertex stage does: on a GPU the 144 coefficients of order 12
+ * are read from its caches once per light at no cost that shows, while a
+ * vertex's whole set of lights in one invocation holds 16-64 recurrence
+ * states (docs/BENCHMARKS.md "Sums in a compute shader").
+ */
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) readonly buffer vr_positions { float s_position[]; };
+layout(std430, binding = 1) readonly buffer vr_lights { vec4 s_light[]; };
+layout(std430, binding = 2) writeonly buffer vr_sums { float s_sum[]; };
+uniform int u_vertices;   /* vertices of the scene */
+uniform int u_lights;     /* lights of the frame */
+uniform float u_scale;    /* as the vertex stage's */
+int g_vertex, g_light;    /* this invocation's */
+#define BUF_VERTEX g_vertex
+#define BUF_RECEIVER \
+    vec3(s_position[3 * g_vertex], s_position[3 * g_vertex + 1], s_position[3 * g_vertex + 2])
+#define BUF_LIGHT(i) s_light[g_light].xyz
