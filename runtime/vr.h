@@ -209,11 +209,13 @@ typedef struct vr_scene_desc {
     /* Where a buffer stream's SH sums (VR_MODE_VDSH_BUFFER, a stream of
      * one order) are computed. VR_SUMS_VERTEX (0, default): in the vertex
      * stage of every pass, toward the pass's lights. VR_SUMS_COMPUTE:
-     * once per vr_draw in a compute shader, one invocation per (vertex,
-     * light), into a storage buffer of 4 bytes per vertex and light of
-     * the frame that the passes read, one value per light, as order 5's
-     * attributes are read; a cpca stream is then decoded once per frame
-     * (VR_CPCA_PER_FRAME; cpca_decode is not read). The high orders' path
+     * once per vr_draw in a compute shader, one invocation per vertex and
+     * up to 8 lights, into a storage buffer of 4 bytes per vertex and
+     * light of the frame that the passes read, one value per light, as
+     * order 5's attributes are read. A cpca stream is then decoded once,
+     * at load, on the GPU into f32 records that the sums read (576 more
+     * GPU bytes per vertex at order 12; cpca_decode is not read). The
+     * high orders' path
      * on a GPU (docs/BENCHMARKS.md "Sums in a compute shader"). Needs
      * compute shaders and storage buffers (GL 4.3, or
      * GL_ARB_compute_shader and GL_ARB_shader_storage_buffer_object), else

@@ -526,6 +526,14 @@ void vr_buffer_decode(const vr_scene *s, const vr_buffer *b)
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
 }
 
+/* Lights per invocation of the sums (shaders/vr_sums.glsl): each
+ * coefficient is fetched once for that many lights. On llvmpipe, at 16
+ * lights in the built-in room at order 12 (s8s6), the frame took 388 ms
+ * of CPU with 1, 200 with 4, 164 with 8 and 155 with 16, against the
+ * vertex stage's 178 (docs/BENCHMARKS.md "Sums in a compute shader");
+ * 8 is the vertex stage's own group, whose state every GL here holds. */
+enum { SUMS_LIGHTS = VR_MAX_LIGHTS_PER_PASS };
+
 /* VR_SUMS_COMPUTE: the sums program of fixed-order stream b
  * (shaders/vr_sums.glsl), reading its records as stored or, for a cpca
  * stream, its scratch (make_decoder first). VR_ERR_GL without compute
@@ -540,10 +548,12 @@ static vr_result make_summer(const vr_scene *s, vr_buffer *b, const char *name, 
     int scratch = b->decode_prog != 0;
     vr_buf_kind kind = scratch ? VR_BUF_F32 : b->kind;
     char defines[256];
-    snprintf(defines, sizeof defines,
-             "%s#define BUFFER 1\n#define NUM_LIGHTS 1\n#define BUF_ORDER %d\n#define BUF_KIND %d\n"
-             "#define BUF_VARIABLE 0\n#define BUF_STRIDE %d\n",
-             compute_version(), b->order, (int)kind, scratch ? b->scratch_stride : b->stride);
+    snprintf(
+        defines, sizeof defines,
+        "%s#define BUFFER 1\n#define NUM_LIGHTS %d\n#define BUF_ORDER %d\n#define BUF_KIND %d\n"
+        "#define BUF_VARIABLE 0\n#define BUF_STRIDE %d\n",
+        compute_version(), (int)SUMS_LIGHTS, b->order, (int)kind,
+        scratch ? b->scratch_stride : b->stride);
     char *table = vr_ks_table(b->ks, b->order * b->order);
     size_t size = strlen(defines) + (table ? strlen(table) : 0) + vr_sums_glsl_size +
                   vr_buffer_glsl_size + vr_sums_main_glsl_size + 1;
@@ -585,7 +595,7 @@ void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s->vbo_position);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, lights);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, sums);
-    dispatch((size_t)s->vertex_count * (size_t)n);
+    dispatch((size_t)s->vertex_count * (size_t)((n + SUMS_LIGHTS - 1) / SUMS_LIGHTS));
     for (GLuint i = 0; i < 3; i++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, 0);
     /* the passes read the sums as a buffer texture */
@@ -703,6 +713,12 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
         int summed = sums == VR_SUMS_COMPUTE && !b.variable;
         if (r == VR_OK && model && (cpca_decode == VR_CPCA_PER_FRAME || summed))
             r = make_decoder(s, &b, name, err);
+        /* summed in a compute shader, a cpca stream is decoded here,
+         * once: its scratch then holds the same texels every frame */
+        if (r == VR_OK && summed && b.decode_prog) {
+            vr_buffer_decode(s, &b);
+            r = vr_check_gl(err, name);
+        }
         if (r == VR_OK && summed)
             r = make_summer(s, &b, name, err);
     }

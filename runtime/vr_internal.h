@@ -107,7 +107,8 @@ typedef struct vr_buffer {
     char *cpca_unpack;
     /* VR_CPCA_PER_FRAME (vr_scene_desc.cpca_decode) or VR_SUMS_COMPUTE:
      * the decode program (a compute shader, shaders/vdsh_cpca_decode.glsl)
-     * and the scratch it writes once per frame, f32 records of stride
+     * and the scratch it writes once per frame (VR_SUMS_COMPUTE: once, at
+     * load, sums_prog set), f32 records of stride
      * scratch_stride texels that the sums or the light passes read as
      * VR_BUF_F32 (vr_render.c); 0: decoded per pass */
     GLuint decode_prog, scratch_buf, scratch_tex;
@@ -126,8 +127,8 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
 /* Whether this GL has compute shaders and shader storage buffers (GL
  * 4.3, or the ARB extensions of both). */
 int vr_has_compute(void);
-/* A cpca stream decoded once per frame: b's records into its scratch (a
- * compute dispatch), before the frame's sums or light passes. */
+/* A cpca stream decoded: b's records into its scratch (a compute
+ * dispatch), before the frame's light passes, or at load before any sums. */
 void vr_buffer_decode(const vr_scene *s, const vr_buffer *b);
 /* VR_SUMS_COMPUTE: the SH sums of b toward each of the n lights at
  * positions pos (xyz, w unused), per vertex and light, into sums

@@ -936,10 +936,11 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
     F.slot->groups = groups;
     clear_target(r, &d);
 
-    /* A cpca stream decoded once per frame: into its scratch, which
-     * the sums or the passes read as f32 records (vr_buffer_decode). */
+    /* A cpca stream decoded into its scratch, which the sums or the
+     * passes read as f32 records: once per frame (vr_buffer_decode), or
+     * once at load where the sums are computed (vr_buffer_upload). */
     F.scratch = F.buf && F.buf->decode_prog;
-    if (F.scratch)
+    if (F.scratch && !F.buf->sums_prog)
         vr_buffer_decode(s, F.buf);
     /* Sums in a compute shader: once for all the frame's lights. */
     F.summed = F.buf && F.buf->sums_prog && d.light_count > 0;

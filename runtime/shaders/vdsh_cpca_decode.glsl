@@ -1,12 +1,12 @@
 /*
- * vdsh_cpca_decode.glsl - a cpca stream's decode once per frame
- * (vr_scene_desc.cpca_decode = VR_CPCA_PER_FRAME, and every cpca stream
- * whose sums are computed, vr_scene_desc.sums = VR_SUMS_COMPUTE;
- * vr_buffer.c): a compute shader, one invocation per (vertex, texel of
- * four coefficients), that writes each vertex's coefficients as f32
+ * vdsh_cpca_decode.glsl - a cpca stream's decode on the GPU, once per
+ * frame (vr_scene_desc.cpca_decode = VR_CPCA_PER_FRAME) or once at load
+ * (a stream whose sums are computed, vr_scene_desc.sums =
+ * VR_SUMS_COMPUTE; vr_buffer.c): a compute shader, one invocation per
+ * (vertex, texel of four coefficients), that writes each vertex's coefficients as f32
  * texels (the buffer path's BUF_KIND 0 record: BUF_CPCA_T texels in
  * vr_buffer_sequence's order) into a shader storage buffer, the scratch
- * that the frame's sums or light passes then read. It follows
+ * that the light passes or the sums then read. It follows
  * vdsh_buffer.glsl (included before it, BUF_KIND 4, NUM_LIGHTS 0):
  * buf_begin unpacks the weight levels, and the texel is
  * mean + sum_j level_j * texel_j in the same order of operations as

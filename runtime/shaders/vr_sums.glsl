@@ -1,19 +1,18 @@
 /*
  * vr_sums.glsl - the C runtime's sums in a compute shader
  * (vr_scene_desc.sums = VR_SUMS_COMPUTE, runtime/vr_buffer.c): one
- * invocation per (vertex, light) of the frame computes the stream's SH
- * sum toward its light with vdsh_buffer.glsl's buffer_sums, one light at
- * a time (NUM_LIGHTS 1), and stores it at vertex * u_lights + light; the
+ * invocation per vertex and group of NUM_LIGHTS lights of the frame (8;
+ * the last group's missing lights repeat the frame's last) computes the
+ * stream's SH sums toward them with vdsh_buffer.glsl's buffer_sums, and
+ * stores light j's at vertex * u_lights + j; the
  * light passes' vertex stage then reads one value per light
  * (vr_vertex_main.glsl, BUF_SUMS) where it would have summed the record.
  * This part goes before vdsh_buffer.glsl (the vertex, receiver and light
  * it reads are these), vr_sums_main.glsl after it. The record is read as
  * stored, or a cpca stream's decoded scratch (BUF_KIND 0,
- * vdsh_cpca_decode.glsl). Why per (vertex, light) rather than per vertex
- * as the vertex stage does: on a GPU the 144 coefficients of order 12
- * are read from its caches once per light at no cost that shows, while a
- * vertex's whole set of lights in one invocation holds 16-64 recurrence
- * states (docs/BENCHMARKS.md "Sums in a compute shader").
+ * vdsh_cpca_decode.glsl). A group of lights per invocation rather than
+ * one: each coefficient is fetched (and unpacked) once per group, as in
+ * the vertex stage (docs/BENCHMARKS.md "Sums in a compute shader").
  */
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer vr_positions { float s_position[]; };
@@ -26,4 +25,4 @@ int g_vertex, g_light;    /* this invocation's */
 #define BUF_VERTEX g_vertex
 #define BUF_RECEIVER \
     vec3(s_position[3 * g_vertex], s_position[3 * g_vertex + 1], s_position[3 * g_vertex + 2])
-#define BUF_LIGHT(i) s_light[g_light].xyz
+#define BUF_LIGHT(i) s_light[min(g_light + (i), u_lights - 1)].xyz

@@ -7,11 +7,13 @@ void main()
     /* rows of at most 65535 groups (vr_dispatch) */
     int id = int(gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x +
                  gl_GlobalInvocationID.x);
-    g_vertex = id / u_lights;
-    g_light = id - g_vertex * u_lights;
+    int per = (u_lights + NUM_LIGHTS - 1) / NUM_LIGHTS;
+    g_vertex = id / per;
+    g_light = (id - g_vertex * per) * NUM_LIGHTS;
     if (g_vertex >= u_vertices)
         return;
-    float sum[1];
+    float sum[NUM_LIGHTS];
     buffer_sums(sum);
-    s_sum[id] = sum[0];
+    for (int i = 0; i < NUM_LIGHTS && g_light + i < u_lights; i++)
+        s_sum[g_vertex * u_lights + g_light + i] = sum[i];
 }
