@@ -536,7 +536,8 @@ typedef struct vr_timings {
     int groups;     /* light groups (passes) drawn */
     /* GPU time (GL_TIME_ELAPSED), milliseconds. Per group g: the cube
      * shadow maps of its lights and its lighting pass (groups beyond the
-     * last slot add into the last). */
+     * last slot add into the last); group 0's lighting also holds the
+     * frame's decode and sums in compute shaders (vr_scene_desc). */
     double shadow_ms[VR_TIMING_MAX_GROUPS];
     double lighting_ms[VR_TIMING_MAX_GROUPS];
     double shadow_total_ms, lighting_total_ms;
