@@ -526,13 +526,25 @@ void vr_buffer_decode(const vr_scene *s, const vr_buffer *b)
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
 }
 
-/* Lights per invocation of the sums (shaders/vr_sums.glsl): each
- * coefficient is fetched once for that many lights. On llvmpipe, at 16
- * lights in the built-in room at order 12 (s8s6), the frame took 388 ms
- * of CPU with 1, 200 with 4, 164 with 8 and 155 with 16, against the
- * vertex stage's 178 (docs/BENCHMARKS.md "Sums in a compute shader");
- * 8 is the vertex stage's own group, whose state every GL here holds. */
-enum { SUMS_LIGHTS = VR_MAX_LIGHTS_PER_PASS };
+/* Lights per invocation of the sums (shaders/vr_sums.glsl), by what was
+ * measured (docs/BENCHMARKS.md "Sums in a compute shader"). On llvmpipe
+ * a group fetches each coefficient once for its lights: at 16 lights in
+ * the built-in room at order 12 (s8s6) the frame took 388 ms of CPU with
+ * 1, 200 with 4, 164 with 8 and 155 with 16, against the vertex stage's
+ * 178; 8 is the vertex stage's own group. On a GPU one light per
+ * invocation was measured (tests/compute_probe on an NVIDIA H200: 0.13
+ * ms at 16 lights, 28-45x under the vertex stage, whose per-light arrays
+ * a GPU compiler may keep in memory), and a group was not. The
+ * environment's VR_SUMS_GROUP (1..8) overrides it, for the tests (which
+ * draw both on llvmpipe) and for measuring another GL. */
+static int sums_group(void)
+{
+    const char *e = getenv("VR_SUMS_GROUP");
+    if (e && e[0] >= '1' && e[0] <= '0' + VR_MAX_LIGHTS_PER_PASS && !e[1])
+        return e[0] - '0';
+    const char *r = (const char *)glGetString(GL_RENDERER);
+    return r && strstr(r, "llvmpipe") ? VR_MAX_LIGHTS_PER_PASS : 1;
+}
 
 /* VR_SUMS_COMPUTE: the sums program of fixed-order stream b
  * (shaders/vr_sums.glsl), reading its records as stored or, for a cpca
@@ -547,12 +559,13 @@ static vr_result make_summer(const vr_scene *s, vr_buffer *b, const char *name, 
                        name, b->order);
     int scratch = b->decode_prog != 0;
     vr_buf_kind kind = scratch ? VR_BUF_F32 : b->kind;
+    b->sums_group = sums_group();
     char defines[256];
     snprintf(
         defines, sizeof defines,
         "%s#define BUFFER 1\n#define NUM_LIGHTS %d\n#define BUF_ORDER %d\n#define BUF_KIND %d\n"
         "#define BUF_VARIABLE 0\n#define BUF_STRIDE %d\n",
-        compute_version(), (int)SUMS_LIGHTS, b->order, (int)kind,
+        compute_version(), b->sums_group, b->order, (int)kind,
         scratch ? b->scratch_stride : b->stride);
     char *table = vr_ks_table(b->ks, b->order * b->order);
     size_t size = strlen(defines) + (table ? strlen(table) : 0) + vr_sums_glsl_size +
@@ -595,7 +608,7 @@ void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s->vbo_position);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, lights);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, sums);
-    dispatch((size_t)s->vertex_count * (size_t)((n + SUMS_LIGHTS - 1) / SUMS_LIGHTS));
+    dispatch((size_t)s->vertex_count * (size_t)((n + b->sums_group - 1) / b->sums_group));
     for (GLuint i = 0; i < 3; i++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, 0);
     /* the passes read the sums as a buffer texture */

@@ -117,6 +117,7 @@ typedef struct vr_buffer {
      * (shaders/vr_sums.glsl), which reads the records, or the scratch */
     GLuint sums_prog;
     GLint sums_u_lights;
+    int sums_group; /* lights per invocation */
 } vr_buffer;
 
 /* Upload stream st (its quantity drawn) as a buffer stream of s, in the

@@ -669,7 +669,8 @@ endif()
 # order-12 cpca stream (decoded once per frame, then summed per vertex
 # and light) and an s8s6 one (summed from its records) draw the frame the
 # vertex stage draws, at 16 lights (two passes reading the frame's sums
-# at their offsets) and 64 (eight); 3 lights is the control. Skips (77)
+# at their offsets) and 64 (eight), with 8, 3 and 1 lights per
+# invocation (VR_SUMS_GROUP); 3 lights is the control. Skips (77)
 # where the GL has no compute shaders, which vdsh-view reports as a
 # failed load.
 if(TARGET vdsh-bake)
@@ -699,6 +700,13 @@ for f in c s; do
       --lights $n --compute "$d/$f.vdsh"
     "$png" info "$d/$f${n}x.png" 96 72
     "$png" same "$d/$f$n.png" "$d/$f${n}x.png" 2
+  done
+  # one light per invocation (GPUs' default) and 3 (a last group short of
+  # lights) where llvmpipe takes 8
+  for g in 1 3; do
+    VR_SUMS_GROUP=$g "$v" -q --render "$d/${f}g$g.png" --size 96x72 --mode buf12 --lights 16 \
+      --compute "$d/$f.vdsh"
+    "$png" same "$d/${f}16.png" "$d/${f}g$g.png" 2
   done
   if "$png" same "$d/${f}16x.png" "$d/${f}3x.png" 2; then echo "control: 3 and 16 lights"; exit 1; fi
 done

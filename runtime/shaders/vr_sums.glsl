@@ -1,8 +1,9 @@
 /*
  * vr_sums.glsl - the C runtime's sums in a compute shader
  * (vr_scene_desc.sums = VR_SUMS_COMPUTE, runtime/vr_buffer.c): one
- * invocation per vertex and group of NUM_LIGHTS lights of the frame (8;
- * the last group's missing lights repeat the frame's last) computes the
+ * invocation per vertex and group of NUM_LIGHTS lights of the frame (8
+ * on llvmpipe, 1 elsewhere: vr_buffer.c sums_group; the last group's
+ * missing lights repeat the frame's last) computes the
  * stream's SH sums toward them with vdsh_buffer.glsl's buffer_sums, and
  * stores light j's at vertex * u_lights + j; the
  * light passes' vertex stage then reads one value per light
@@ -10,9 +11,9 @@
  * This part goes before vdsh_buffer.glsl (the vertex, receiver and light
  * it reads are these), vr_sums_main.glsl after it. The record is read as
  * stored, or a cpca stream's decoded scratch (BUF_KIND 0,
- * vdsh_cpca_decode.glsl). A group of lights per invocation rather than
- * one: each coefficient is fetched (and unpacked) once per group, as in
- * the vertex stage (docs/BENCHMARKS.md "Sums in a compute shader").
+ * vdsh_cpca_decode.glsl). A group of lights per invocation fetches (and
+ * unpacks) each coefficient once for the group, as the vertex stage
+ * does (docs/BENCHMARKS.md "Sums in a compute shader").
  */
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer vr_positions { float s_position[]; };
