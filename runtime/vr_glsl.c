@@ -200,24 +200,27 @@ static vr_result compile(const char *name, GLenum stage, const char *src, GLuint
     return VR_OK;
 }
 
-vr_result vr_link(const char *name, const char *vs, const char *fs, GLuint *out, vr_error *err)
+/* Compile the n stages and link them into *out. */
+static vr_result link_stages(const char *name, int n, const GLenum *stages, const char *const *srcs,
+                             GLuint *out, vr_error *err)
 {
-    GLuint v = 0, f = 0;
-    vr_result r = compile(name, GL_VERTEX_SHADER, vs, &v, err);
-    if (r == VR_OK)
-        r = compile(name, GL_FRAGMENT_SHADER, fs, &f, err);
+    GLuint sh[2] = {0, 0};
+    vr_result r = VR_OK;
+    for (int i = 0; i < n && r == VR_OK; i++)
+        r = compile(name, stages[i], srcs[i], &sh[i], err);
     if (r != VR_OK) {
-        if (v)
-            glDeleteShader(v);
+        for (int i = 0; i < n; i++)
+            if (sh[i])
+                glDeleteShader(sh[i]);
         return r;
     }
     GLuint p = glCreateProgram();
-    glAttachShader(p, v);
-    glAttachShader(p, f);
+    for (int i = 0; i < n; i++)
+        glAttachShader(p, sh[i]);
     glLinkProgram(p);
     /* The program keeps what it needs; the shaders can go now. */
-    glDeleteShader(v);
-    glDeleteShader(f);
+    for (int i = 0; i < n; i++)
+        glDeleteShader(sh[i]);
     char log[768];
     if (failed(p, 0, log, sizeof log))
         return vr_fail(err, VR_ERR_SHADER, "%s: link: %s", name, log);
@@ -225,21 +228,17 @@ vr_result vr_link(const char *name, const char *vs, const char *fs, GLuint *out,
     return VR_OK;
 }
 
+vr_result vr_link(const char *name, const char *vs, const char *fs, GLuint *out, vr_error *err)
+{
+    const GLenum stages[2] = {GL_VERTEX_SHADER, GL_FRAGMENT_SHADER};
+    const char *srcs[2] = {vs, fs};
+    return link_stages(name, 2, stages, srcs, out, err);
+}
+
 vr_result vr_link_compute(const char *name, const char *src, GLuint *out, vr_error *err)
 {
-    GLuint c = 0;
-    vr_result r = compile(name, GL_COMPUTE_SHADER, src, &c, err);
-    if (r != VR_OK)
-        return r;
-    GLuint p = glCreateProgram();
-    glAttachShader(p, c);
-    glLinkProgram(p);
-    glDeleteShader(c);
-    char log[768];
-    if (failed(p, 0, log, sizeof log))
-        return vr_fail(err, VR_ERR_SHADER, "%s: link: %s", name, log);
-    *out = p;
-    return VR_OK;
+    const GLenum stage = GL_COMPUTE_SHADER;
+    return link_stages(name, 1, &stage, &src, out, err);
 }
 
 /* The buffer path's factor table as GLSL: "const float KS[n] = ...". */
