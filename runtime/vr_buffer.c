@@ -421,14 +421,16 @@ int vr_has_compute(void)
     return compute && storage;
 }
 
-/* The first lines of a compute shader: its version, or GL 3.3 with the
- * extensions (NVIDIA's core context is 3.3 with both). */
+/* The first lines of a compute shader: GLSL 4.30 where the GL compiles
+ * it (GL 4.3, and NVIDIA's 3.3 core context, whose GLSL is 4.60:
+ * compute_probe ran as 4.30 there), else 3.30 with the extensions. */
 static const char *compute_version(void)
 {
-    GLint major = 0, minor = 0;
-    glGetIntegerv(GL_MAJOR_VERSION, &major);
-    glGetIntegerv(GL_MINOR_VERSION, &minor);
-    return major > 4 || (major == 4 && minor >= 3)
+    const char *v = (const char *)glGetString(GL_SHADING_LANGUAGE_VERSION);
+    int major = 0, minor = 0;
+    if (!v || sscanf(v, "%d.%d", &major, &minor) != 2)
+        major = minor = 0;
+    return major > 4 || (major == 4 && minor >= 30)
                ? "#version 430 core\n"
                : "#version 330 core\n#extension GL_ARB_compute_shader : require\n"
                  "#extension GL_ARB_shader_storage_buffer_object : require\n";
