@@ -593,309 +593,444 @@ static int decision_vertex(job *J, uint32_t v, const float *org, const float n[3
     return fitted;
 }
 
-/* An AVX2 clone where the CPU has it, for the lane loops (the log's
- * division above all): no FMA, so the same bits either way. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) &&                             \
-    !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-static void
-bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64_t *missed,
-            uint32_t *degenerate)
+/* ---- one receiver: bake_vertex and its steps ------------------------------ */
+
+/* Every step below is inlined into bake_vertex, and so into each of its
+ * target clones: a step left out of line would be compiled once, for the
+ * baseline ISA, and the lane loops would lose the AVX2 clone. */
+#define VERTEX_STEP static inline __attribute__((always_inline))
+
+/* One receiver's bake in progress: what it asks for, its frame, and the
+ * sums and counts its traced packets add to. */
+typedef struct vertex_state {
+    job *J;
+    uint32_t v, slot;
+    const vertex_sink *out;
+    const float *n, *org; /* oriented normal (or the pole), ray origin */
+    /* Per quantity (0 distance, 1 log distance): projected or not. */
+    int want[2];
+    /* Adaptive order: the log distance's fits, chosen on the traced
+     * directions above the horizon (var_buf: x, y, z, t, then scratch);
+     * dvar: chosen by the decision fit instead. */
+    int var, dvar;
+    float *var_buf;
+    uint32_t var_n;
+    /* The log distance's level (vertex_begin): projected less it, put
+     * back after the fit. */
+    const vb_fit *top;
+    vb_fit_angles angles;
+    int centre, have_level;
+    float level;
+    float acc[2][VDSH_MAX_COEFFS][VB_PACKET]; /* per quantity: per-lane sums */
+    uint32_t near_zero, upper;                /* for the degenerate count */
+    /* Adaptive rays: directions used, this round's directions above the
+     * horizon (ax..az from adapt_from), the last round's fit. */
+    uint32_t cells_used, adapt_from, adapt_n;
+    float adapt_prev[VDSH_MAX_COEFFS];
+    float *ax, *ay, *az;
+    float adapt_buf[3 * 4096];
+} vertex_state;
+
+/* GROUP packets traced together (trace_group). */
+typedef struct packet_group {
+    struct RTCRayHit16 rh[GROUP] __attribute__((aligned(64)));
+    int valid[GROUP][VB_PACKET] __attribute__((aligned(64)));
+    int np;
+} packet_group;
+
+/* A group's values per lane (lane_distances, lane_log_distances): apart
+ * from the packets, so that GCC sees the lane loops' stores cannot alias
+ * their loads, and vectorises them with no run-time checks. */
+typedef struct group_lanes {
+    float dist[GROUP][VB_PACKET], logd[GROUP][VB_PACKET];
+    int up_lane[GROUP][VB_PACKET];
+} group_lanes;
+
+/* Receiver v's state before its first ray: its frame, what `out` and the
+ * job ask of it, and the sums at zero. */
+VERTEX_STEP void vertex_begin(vertex_state *s, job *J, uint32_t v, const vertex_sink *out)
 {
     const vb_bake_desc *d = J->d;
-    const vb_scene *S = d->scene;
-    const uint32_t slot = slot_of(J, v);
-    const float *n =
-        J->normals ? J->normals + 3 * (size_t)slot : d->receivers->normals + 3 * (size_t)v;
-    const float *org = J->origins + 3 * (size_t)slot;
+    s->J = J;
+    s->v = v;
+    s->out = out;
+    s->slot = slot_of(J, v);
+    s->n = J->normals ? J->normals + 3 * (size_t)s->slot : d->receivers->normals + 3 * (size_t)v;
+    s->org = J->origins + 3 * (size_t)s->slot;
     static const float pole[3] = {0.0f, 0.0f, 1.0f};
-    if (J->grid->hemisphere && n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f)
-        n = pole; /* no surface: a hemisphere about +z, fitted as such */
+    if (J->grid->hemisphere && s->n[0] == 0.0f && s->n[1] == 0.0f && s->n[2] == 0.0f)
+        s->n = pole; /* no surface: a hemisphere about +z, fitted as such */
 
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-
-    int want[2] = {0, 0};
-    for (int q = 0; q < 2; q++)
+    for (int q = 0; q < 2; q++) {
+        s->want[q] = 0;
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
-            want[q] |= out->coeffs[q][o] != NULL;
-    /* Adaptive order: the log distance's fits, chosen on the traced
-     * directions above the horizon (var_buf: x, y, z, t, then scratch). */
-    const int var = J->var_cap && v >= J->lo && v < J->hi && !d->trace_only && !out->n;
-    float *var_buf = var ? out->var_scratch : NULL;
-    uint32_t var_n = 0;
+            s->want[q] |= out->coeffs[q][o] != NULL;
+    }
+    s->var = J->var_cap && v >= J->lo && v < J->hi && !d->trace_only && !out->n;
+    s->var_buf = s->var ? out->var_scratch : NULL;
+    s->var_n = 0;
     /* With the decision fit, the choice is made on the training pairs
      * (choose_decision), also for a calibration sample outside the range
      * (its held-out margins count toward the stream's offset). */
-    const int dvar =
-        J->var_decision && !d->trace_only && !out->n && (var || (out->cal && out->var_scratch));
-    want[1] |= var | dvar;
+    s->dvar =
+        J->var_decision && !d->trace_only && !out->n && (s->var || (out->cal && out->var_scratch));
+    s->want[1] |= s->var | s->dvar;
     /* The log distance is projected less a level of its own (the mean of
      * the first traced packets' values), put back exactly after the fit:
      * the fit then does not depend on the units the scene is in (the
      * projection's sampling error acts on ln d - level, not on ln d, whose
      * level is set by the units). */
-    const vb_fit *top = &J->fits[J->order];
-    vb_fit_angles angles;
-    vb_fit_frame(top, n, &angles);
-    const int centre = want[1] && vb_fit_constant_exact(&angles, J->grid->hemisphere);
-    int have_level = 0;
-    float level = 0.0f;
-    /* Loop invariants in locals: the lane loops below vectorise. */
-    const float inv_scale = J->inv_scale, max_distance = d->max_distance;
-    const float degenerate_dist = J->near[slot], log_floor = J->log_floor;
-    const float nx = n[0], ny = n[1], nz = n[2];
-    float acc[2][VDSH_MAX_COEFFS][VB_PACKET];
+    s->top = &J->fits[J->order];
+    vb_fit_frame(s->top, s->n, &s->angles);
+    s->centre = s->want[1] && vb_fit_constant_exact(&s->angles, J->grid->hemisphere);
+    s->have_level = 0;
+    s->level = 0.0f;
     for (int q = 0; q < 2; q++)
-        memset(acc[q], 0, (size_t)J->order * J->order * sizeof acc[q][0]);
-    uint32_t near_zero = 0, upper = 0;
+        memset(s->acc[q], 0, (size_t)J->order * J->order * sizeof s->acc[q][0]);
+    s->near_zero = 0;
+    s->upper = 0;
 
+    s->cells_used = J->grid->count;
+    s->adapt_from = 0;
+    s->adapt_n = 0;
+    s->ax = s->ay = s->az = NULL;
+    if (J->adaptive) {
+        s->ax = s->adapt_buf;
+        s->ay = s->ax + J->grid->count;
+        s->az = s->ay + J->grid->count;
+    }
+}
+
+/* Traces up to GROUP packets from pk (before pk_end) into g, skipping
+ * those with no ray above the horizon. Returns the packet after the last
+ * one looked at. */
+VERTEX_STEP uint32_t trace_group(const vertex_state *s, struct RTCIntersectContext *ctx,
+                                 uint32_t pk, uint32_t pk_end, packet_group *g, uint64_t *traced)
+{
+    const job *J = s->J;
+    const vb_bake_desc *d = J->d;
+    /* Loop invariants in locals (org's values too: read through the
+     * pointer, the packet's stores would need too many alias checks), so
+     * that the lane loop vectorises. */
+    const float *n = s->n;
+    const float org[3] = {s->org[0], s->org[1], s->org[2]}, nx = n[0], ny = n[1], nz = n[2];
+    const int horizon = J->horizon;
+    const float max_local = J->max_local;
+    int np = 0;
+    for (; pk < pk_end && np < GROUP; pk++) {
+        if (horizon && !J->adaptive && vb_dirgrid_packet_below(J->grid, pk, n))
+            continue;
+        struct RTCRayHit16 *r = &g->rh[np];
+        int *ok = g->valid[np];
+        if (J->adaptive)
+            vb_dirgrid_packet_nested(J->grid, pk, d->seed, s->v, n, r->ray.dir_x, r->ray.dir_y,
+                                     r->ray.dir_z, ok);
+        else
+            vb_dirgrid_packet(J->grid, pk, d->seed, s->v, n, r->ray.dir_x, r->ray.dir_y,
+                              r->ray.dir_z, ok);
+        int any = 0;
+        for (int k = 0; k < VB_PACKET; k++) {
+            if (horizon && ok[k]) {
+                float c = r->ray.dir_x[k] * nx + r->ray.dir_y[k] * ny + r->ray.dir_z[k] * nz;
+                if (c < 0.0f)
+                    ok[k] = 0;
+            }
+            any |= ok[k];
+            vb_ray16_init(r, k, org, max_local);
+        }
+        if (!any)
+            continue;
+        rtcIntersect16(ok, d->scene->scene, ctx, r);
+        for (int k = 0; k < VB_PACKET; k++)
+            *traced += ok[k] != 0;
+        np++;
+    }
+    g->np = np;
+    return pk;
+}
+
+/* The group's distance per lane (scene units; a miss: max_distance),
+ * which lanes are above the horizon, and the counts of misses, lanes
+ * above the horizon and those of them near zero. Branch-free over the
+ * lanes, so it vectorises; lanes not traced (empty, or below the
+ * horizon) count as distance 0. */
+VERTEX_STEP void lane_distances(vertex_state *s, const packet_group *g, group_lanes *l,
+                                uint64_t *missed)
+{
+    /* Loop invariants in locals: the lane loop vectorises. */
+    const float inv_scale = s->J->inv_scale, max_distance = s->J->d->max_distance;
+    const float degenerate_dist = s->J->near[s->slot];
+    const float nx = s->n[0], ny = s->n[1], nz = s->n[2];
+    for (int p = 0; p < g->np; p++) {
+        int miss = 0, upper_pk = 0, near_pk = 0;
+        const int *ok = g->valid[p];
+        const uint32_t *gid = g->rh[p].hit.geomID;
+        const float *tfar = g->rh[p].ray.tfar, *dx = g->rh[p].ray.dir_x, *dy = g->rh[p].ray.dir_y,
+                    *dz = g->rh[p].ray.dir_z;
+        for (int k = 0; k < VB_PACKET; k++) {
+            /* Selects as arithmetic (exact for these finite values), in
+             * int: GCC if-converts and vectorises this loop only so. */
+            int live = ok[k] & 1; /* valid: 0 or -1 */
+            int hit = gid[k] != RTC_INVALID_GEOMETRY_ID;
+            float fh = (float)hit, fl = (float)live;
+            float t = tfar[k] * inv_scale * fh + max_distance * (1.0f - fh);
+            float c = dx[k] * nx + dy[k] * ny + dz[k] * nz;
+            int up = live & (c > 0.0f);
+            l->dist[p][k] = t * fl;
+            l->up_lane[p][k] = up;
+            miss += live & (hit ^ 1);
+            upper_pk += up;
+            near_pk += up & (t < degenerate_dist);
+        }
+        s->upper += (uint32_t)upper_pk;
+        s->near_zero += (uint32_t)near_pk;
+        *missed += (uint64_t)miss;
+    }
+}
+
+/* The group's log distance per lane (0 where not traced), less the
+ * receiver's level: with `centre`, the first group with a traced lane
+ * sets it to the mean of its values. */
+VERTEX_STEP void lane_log_distances(vertex_state *s, const packet_group *g, group_lanes *l)
+{
+    const float log_floor = s->J->log_floor;
+    const int np = g->np;
+    for (int p = 0; p < np; p++)
+        for (int k = 0; k < VB_PACKET; k++) {
+            float ln = fast_log(l->dist[p][k] > log_floor ? l->dist[p][k] : log_floor);
+            l->logd[p][k] = ln * (float)(g->valid[p][k] & 1);
+        }
+    if (s->centre && !s->have_level) {
+        float sum = 0.0f;
+        uint32_t cnt = 0;
+        for (int p = 0; p < np; p++)
+            for (int k = 0; k < VB_PACKET; k++)
+                if (g->valid[p][k]) {
+                    sum += l->logd[p][k];
+                    cnt++;
+                }
+        if (cnt) {
+            s->level = sum / (float)cnt;
+            s->have_level = 1;
+        }
+    }
+    if (s->have_level) {
+        const float level = s->level;
+        for (int p = 0; p < np; p++)
+            for (int k = 0; k < VB_PACKET; k++)
+                l->logd[p][k] -= level * (float)(g->valid[p][k] & 1);
+    }
+}
+
+/* The group's packets, in order, into the projections' sums, and their
+ * lanes above the horizon into the per-ray outputs: the sink's rays
+ * (out->n), the adaptive order's directions (var_buf), the adaptive rays'
+ * directions (ax..az). */
+VERTEX_STEP void accumulate_group(vertex_state *s, const packet_group *g, const group_lanes *l)
+{
+    const job *J = s->J;
+    const vertex_sink *out = s->out;
+    for (int p = 0; p < g->np; p++) {
+        const float *dx = g->rh[p].ray.dir_x, *dy = g->rh[p].ray.dir_y, *dz = g->rh[p].ray.dir_z;
+        const int *up_lane = l->up_lane[p];
+        const float *dist = l->dist[p];
+        if (s->want[0])
+            vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, dist, &s->acc[0][0][0], VB_PACKET);
+        if (s->want[1])
+            vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, l->logd[p], &s->acc[1][0][0],
+                                VB_PACKET);
+        if (out->n)
+            for (int k = 0; k < VB_PACKET; k++)
+                if (up_lane[k]) {
+                    uint32_t i = (*out->n)++;
+                    out->x[i] = dx[k];
+                    out->y[i] = dy[k];
+                    out->z[i] = dz[k];
+                    out->t[i] = dist[k];
+                }
+        if (s->var_buf)
+            for (int k = 0; k < VB_PACKET; k++)
+                if (up_lane[k]) {
+                    uint32_t c = J->grid->count;
+                    s->var_buf[s->var_n] = dx[k];
+                    s->var_buf[c + s->var_n] = dy[k];
+                    s->var_buf[2 * c + s->var_n] = dz[k];
+                    s->var_buf[3 * c + s->var_n] = dist[k];
+                    s->var_n++;
+                }
+        if (J->adaptive)
+            for (int k = 0; k < VB_PACKET; k++)
+                if (up_lane[k]) {
+                    s->ax[s->adapt_n] = dx[k];
+                    s->ay[s->adapt_n] = dy[k];
+                    s->az[s->adapt_n] = dz[k];
+                    s->adapt_n++;
+                }
+    }
+}
+
+/* Adaptive rays, after round `round` (not the last): the round's fit of
+ * the highest order, and, from the second round, the expected shadow
+ * error between it and the last round's on this round's directions.
+ * Returns 1 when that is below the tolerance: the receiver stops. */
+VERTEX_STEP int adapt_round_stops(vertex_state *s, uint32_t round)
+{
+    const job *J = s->J;
+    const int aq = s->want[1]; /* the quantity the stopping rule reads */
+    float cur[VDSH_MAX_COEFFS];
+    /* s->level is 0 unless aq: only the log distance is centred. */
+    adapt_fit(J, s->n, s->acc[aq], s->cells_used, s->level, cur);
+    int stop = 0;
+    if (round > 0) {
+        double sum = 0.0;
+        for (uint32_t i = s->adapt_from; i < s->adapt_n; i++) {
+            float dir[3] = {s->ax[i], s->ay[i], s->az[i]}, y[VDSH_MAX_COEFFS];
+            vdsh_sh_eval(J->order, dir, y);
+            double s1 = 0.0, s0 = 0.0;
+            for (int j = 0; j < J->order * J->order; j++)
+                s1 += (double)cur[j] * y[j], s0 += (double)s->adapt_prev[j] * y[j];
+            double ratio;
+            if (aq)
+                ratio = vdsh_det_exp(s1 - s0);
+            else {
+                double tmin = 1e-4 * J->d->max_distance;
+                ratio = (s1 > tmin ? s1 : tmin) / (s0 > tmin ? s0 : tmin);
+            }
+            sum += expected_error(J->error_table, ratio);
+        }
+        uint32_t m = s->adapt_n - s->adapt_from;
+        stop = m == 0 || sum / m < J->ray_tol;
+    }
+    memcpy(s->adapt_prev, cur, sizeof cur);
+    s->adapt_from = s->adapt_n;
+    return stop;
+}
+
+/* Traces the receiver's directions, round by round with adaptive rays
+ * (a round's fit from the second on decides whether to go on), and,
+ * unless trace_only, projects them into s->acc. */
+VERTEX_STEP void trace_vertex(vertex_state *s, uint64_t *traced, uint64_t *missed)
+{
+    const job *J = s->J;
+    const int trace_only = J->d->trace_only;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     /* Packets are traced GROUP at a time, then their lanes are processed
      * together: the log's division and series are a long dependency
      * chain, which independent packets side by side keep the core busy
      * through. Every sum still runs in packet order. */
-    /* Adaptive rays: the nested grid's rounds, a fit after each from the
-     * second on, compared with the last (adapt_* below). */
     const uint32_t rounds = J->adaptive ? J->grid->rounds : 1;
-    const int aq = want[1]; /* the quantity the stopping rule reads */
-    uint32_t cells_used = J->grid->count, adapt_from = 0, adapt_n = 0;
-    float adapt_prev[VDSH_MAX_COEFFS];
-    float *ax = NULL, *ay = NULL, *az = NULL; /* directions above the horizon */
-    float adapt_buf[3 * 4096];
-    if (J->adaptive) {
-        ax = adapt_buf;
-        ay = ax + J->grid->count;
-        az = ay + J->grid->count;
-    }
     for (uint32_t round = 0, pk = 0; round < rounds; round++) {
         const uint32_t pk_end = J->adaptive ? J->grid->round_end[round] : J->grid->packet_count;
-        for (; pk < pk_end;) {
-            struct RTCRayHit16 rh[GROUP] __attribute__((aligned(64)));
-            int valid[GROUP][VB_PACKET] __attribute__((aligned(64)));
-            int np = 0;
-            for (; pk < pk_end && np < GROUP; pk++) {
-                if (J->horizon && !J->adaptive && vb_dirgrid_packet_below(J->grid, pk, n))
-                    continue;
-                struct RTCRayHit16 *r = &rh[np];
-                int *ok = valid[np];
-                if (J->adaptive)
-                    vb_dirgrid_packet_nested(J->grid, pk, d->seed, v, n, r->ray.dir_x, r->ray.dir_y,
-                                             r->ray.dir_z, ok);
-                else
-                    vb_dirgrid_packet(J->grid, pk, d->seed, v, n, r->ray.dir_x, r->ray.dir_y,
-                                      r->ray.dir_z, ok);
-                int any = 0;
-                for (int k = 0; k < VB_PACKET; k++) {
-                    if (J->horizon && ok[k]) {
-                        float c = r->ray.dir_x[k] * n[0] + r->ray.dir_y[k] * n[1] +
-                                  r->ray.dir_z[k] * n[2];
-                        if (c < 0.0f)
-                            ok[k] = 0;
-                    }
-                    any |= ok[k];
-                    vb_ray16_init(r, k, org, J->max_local);
-                }
-                if (!any)
-                    continue;
-                rtcIntersect16(ok, S->scene, &ctx, r);
-                for (int k = 0; k < VB_PACKET; k++)
-                    *traced += ok[k] != 0;
-                np++;
-            }
-            if (d->trace_only)
+        while (pk < pk_end) {
+            packet_group g;
+            pk = trace_group(s, &ctx, pk, pk_end, &g, traced);
+            if (trace_only)
                 continue;
-
-            /* Branch-free over the lanes, so it vectorises. Lanes not traced
-         * (empty, or below the horizon) count as distance 0. */
-            float dist[GROUP][VB_PACKET], logd[GROUP][VB_PACKET];
-            int up_lane[GROUP][VB_PACKET];
-            for (int p = 0; p < np; p++) {
-                int miss = 0, upper_pk = 0, near_pk = 0;
-                const int *ok = valid[p];
-                const uint32_t *gid = rh[p].hit.geomID;
-                const float *tfar = rh[p].ray.tfar, *dx = rh[p].ray.dir_x, *dy = rh[p].ray.dir_y,
-                            *dz = rh[p].ray.dir_z;
-                for (int k = 0; k < VB_PACKET; k++) {
-                    /* Selects as arithmetic (exact for these finite values), in
-                 * int: GCC if-converts and vectorises this loop only so. */
-                    int live = ok[k] & 1; /* valid: 0 or -1 */
-                    int hit = gid[k] != RTC_INVALID_GEOMETRY_ID;
-                    float fh = (float)hit, fl = (float)live;
-                    float t = tfar[k] * inv_scale * fh + max_distance * (1.0f - fh);
-                    float c = dx[k] * nx + dy[k] * ny + dz[k] * nz;
-                    int up = live & (c > 0.0f);
-                    dist[p][k] = t * fl;
-                    up_lane[p][k] = up;
-                    miss += live & (hit ^ 1);
-                    upper_pk += up;
-                    near_pk += up & (t < degenerate_dist);
-                }
-                upper += (uint32_t)upper_pk;
-                near_zero += (uint32_t)near_pk;
-                *missed += (uint64_t)miss;
-            }
-            if (want[1])
-                for (int p = 0; p < np; p++)
-                    for (int k = 0; k < VB_PACKET; k++) {
-                        float l = fast_log(dist[p][k] > log_floor ? dist[p][k] : log_floor);
-                        logd[p][k] = l * (float)(valid[p][k] & 1);
-                    }
-            if (centre && !have_level) {
-                float sum = 0.0f;
-                uint32_t cnt = 0;
-                for (int p = 0; p < np; p++)
-                    for (int k = 0; k < VB_PACKET; k++)
-                        if (valid[p][k]) {
-                            sum += logd[p][k];
-                            cnt++;
-                        }
-                if (cnt) {
-                    level = sum / (float)cnt;
-                    have_level = 1;
-                }
-            }
-            if (have_level)
-                for (int p = 0; p < np; p++)
-                    for (int k = 0; k < VB_PACKET; k++)
-                        logd[p][k] -= level * (float)(valid[p][k] & 1);
-            for (int p = 0; p < np; p++) {
-                const float *dx = rh[p].ray.dir_x, *dy = rh[p].ray.dir_y, *dz = rh[p].ray.dir_z;
-                if (want[0])
-                    vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, dist[p], &acc[0][0][0],
-                                        VB_PACKET);
-                if (want[1])
-                    vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, logd[p], &acc[1][0][0],
-                                        VB_PACKET);
-                if (out->n)
-                    for (int k = 0; k < VB_PACKET; k++)
-                        if (up_lane[p][k]) {
-                            uint32_t i = (*out->n)++;
-                            out->x[i] = dx[k];
-                            out->y[i] = dy[k];
-                            out->z[i] = dz[k];
-                            out->t[i] = dist[p][k];
-                        }
-                if (var_buf)
-                    for (int k = 0; k < VB_PACKET; k++)
-                        if (up_lane[p][k]) {
-                            uint32_t c = J->grid->count;
-                            var_buf[var_n] = dx[k];
-                            var_buf[c + var_n] = dy[k];
-                            var_buf[2 * c + var_n] = dz[k];
-                            var_buf[3 * c + var_n] = dist[p][k];
-                            var_n++;
-                        }
-                if (J->adaptive)
-                    for (int k = 0; k < VB_PACKET; k++)
-                        if (up_lane[p][k]) {
-                            ax[adapt_n] = dx[k];
-                            ay[adapt_n] = dy[k];
-                            az[adapt_n] = dz[k];
-                            adapt_n++;
-                        }
-            }
+            group_lanes l;
+            lane_distances(s, &g, &l, missed);
+            if (s->want[1])
+                lane_log_distances(s, &g, &l);
+            accumulate_group(s, &g, &l);
         }
-        if (!J->adaptive || d->trace_only)
+        if (!J->adaptive || trace_only)
             continue;
-        /* The round's fit of the highest order, and, from the second round,
-     * the expected shadow error between it and the last round's on this
-     * round's directions: below the tolerance, the receiver stops. */
-        cells_used = pk * VB_PACKET;
-        if (round + 1 < rounds && (want[0] || want[1])) {
-            float cur[VDSH_MAX_COEFFS];
-            adapt_fit(J, n, acc[aq], cells_used, level, cur); /* level: 0 unless aq */
-            int stop = 0;
-            if (round > 0) {
-                double sum = 0.0;
-                for (uint32_t i = adapt_from; i < adapt_n; i++) {
-                    float dir[3] = {ax[i], ay[i], az[i]}, y[VDSH_MAX_COEFFS];
-                    vdsh_sh_eval(J->order, dir, y);
-                    double s1 = 0.0, s0 = 0.0;
-                    for (int j = 0; j < J->order * J->order; j++)
-                        s1 += (double)cur[j] * y[j], s0 += (double)adapt_prev[j] * y[j];
-                    double ratio;
-                    if (aq)
-                        ratio = vdsh_det_exp(s1 - s0);
-                    else {
-                        double tmin = 1e-4 * d->max_distance;
-                        ratio = (s1 > tmin ? s1 : tmin) / (s0 > tmin ? s0 : tmin);
-                    }
-                    sum += expected_error(J->error_table, ratio);
-                }
-                uint32_t m = adapt_n - adapt_from;
-                stop = m == 0 || sum / m < J->ray_tol;
-            }
-            memcpy(adapt_prev, cur, sizeof cur);
-            adapt_from = adapt_n;
-            if (stop)
-                break;
-        }
+        s->cells_used = pk * VB_PACKET;
+        if (round + 1 < rounds && (s->want[0] || s->want[1]) && adapt_round_stops(s, round))
+            break;
     }
-    if (d->trace_only)
-        return;
+}
 
-    /* b = the projection (in double: it sums over thousands of rays); each
-     * order's coefficients are its fit's map of b (fit.h). */
-    double w = (J->grid->hemisphere ? 2.0 : 4.0) * VB_PI / cells_used;
+/* The adaptive order's lsq choice (choose_order) on the receiver's
+ * traced directions above its horizon. */
+VERTEX_STEP void choose_var_order(const vertex_state *s, const double *u)
+{
+    uint32_t c = s->J->grid->count;
+    float *b = s->var_buf;
+    choose_order(s->J, s->v, &s->angles, u, b, b + c, b + 2 * c, b + 3 * c, s->var_n,
+                 b + 4 * (size_t)c);
+}
+
+/* Each asked order's fit of each projected quantity into the sink, from
+ * the projection b (in double: it sums over thousands of rays) through
+ * the rotation's first half, done once for every order (the highest
+ * order's leading bands are the lower orders'; fit.h). With the adaptive
+ * order, the candidates' log fits into varc (decision), or the lsq choice
+ * made (choose_order). u: the log distance's unrotated projection. */
+VERTEX_STEP void fit_vertex(vertex_state *s, double u[VDSH_MAX_COEFFS],
+                            float varc[VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS])
+{
+    job *J = s->J;
+    const vertex_sink *out = s->out;
+    double w = (J->grid->hemisphere ? 2.0 : 4.0) * VB_PI / s->cells_used;
     int nb = J->order * J->order;
-    /* The rotation's first half once for every order: the highest
-     * order's leading bands are the lower orders' (fit.h). */
-    double u[VDSH_MAX_COEFFS];
-    float varc[VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS];
     for (int q = 0; q < 2; q++) {
-        if (!want[q])
+        if (!s->want[q])
             continue;
         double b[VDSH_MAX_COEFFS];
         for (int i = 0; i < nb; i++) {
-            double s = 0.0;
+            double sum = 0.0;
             for (int k = 0; k < VB_PACKET; k++)
-                s += acc[q][i][k];
-            b[i] = s * w;
+                sum += s->acc[q][i][k];
+            b[i] = sum * w;
         }
-        vb_fit_unrotate(top, &angles, b, u);
-        if (q == 1 && have_level)
-            vb_fit_add_constant(top, J->grid->hemisphere, level, u);
+        vb_fit_unrotate(s->top, &s->angles, b, u);
+        if (q == 1 && s->have_level)
+            vb_fit_add_constant(s->top, J->grid->hemisphere, s->level, u);
         for (int o = 1; o <= VDSH_MAX_ORDER; o++)
             if (out->coeffs[q][o])
-                vb_fit_finish(&J->fits[o], &angles, u, out->coeffs[q][o]);
-        if (q == 1 && dvar)
+                vb_fit_finish(&J->fits[o], &s->angles, u, out->coeffs[q][o]);
+        if (q == 1 && s->dvar)
             for (int k = 1; k <= J->var_cap; k++)
                 if (vb_order_candidate(k, J->var_cap))
-                    vb_fit_finish(&J->fits[k], &angles, u, varc[k]);
-        if (q == 1 && var_buf && !dvar) {
-            uint32_t c = J->grid->count;
-            choose_order(J, v, &angles, u, var_buf, var_buf + c, var_buf + 2 * c, var_buf + 3 * c,
-                         var_n, var_buf + 4 * (size_t)c);
-        }
+                    vb_fit_finish(&J->fits[k], &s->angles, u, varc[k]);
+        if (q == 1 && s->var_buf && !s->dvar)
+            choose_var_order(s, u);
     }
+}
+
+/* The decision fit (method decision) and the adaptive order's outcome:
+ * each order's offset cap into cap (-inf: none; also to out->cal_cap),
+ * and, for a receiver of the range choosing its order by the decision
+ * fit, that order and fit, or, with too few training pairs, the lsq
+ * choice. */
+VERTEX_STEP void decide_vertex(vertex_state *s, const double *u,
+                               float varc[VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS],
+                               float cap[VDSH_ORDER_SLOTS])
+{
+    job *J = s->J;
+    const vertex_sink *out = s->out;
     int var_k = 0;
-    float cap[VDSH_ORDER_SLOTS];
     for (int o = 0; o <= VDSH_MAX_ORDER; o++)
         cap[o] = -INFINITY;
-    const int fitted = J->decision && want[1]
-                           ? decision_vertex(J, v, org, n, out, dvar ? varc : NULL, &var_k, cap)
-                           : 0;
+    const int fitted =
+        J->decision && s->want[1]
+            ? decision_vertex(J, s->v, s->org, s->n, out, s->dvar ? varc : NULL, &var_k, cap)
+            : 0;
     if (out->cal_cap)
-        memcpy(out->cal_cap, cap, sizeof cap);
-    if (var && dvar) {
-        uint32_t r = v - J->lo;
-        J->var_lsq[r] = !fitted;
-        if (fitted) { /* the decision's choice; its offset added after the bake */
-            J->var_orders[r] = (uint8_t)var_k;
-            float *dst = J->var_coeffs + (size_t)r * J->var_cap * J->var_cap;
-            memset(dst, 0, (size_t)J->var_cap * J->var_cap * sizeof *dst);
-            memcpy(dst, varc[var_k], (size_t)var_k * var_k * sizeof *dst);
-        } else { /* too few training pairs: the lsq choice, shadow's offsets */
-            uint32_t c = J->grid->count;
-            choose_order(J, v, &angles, u, var_buf, var_buf + c, var_buf + 2 * c, var_buf + 3 * c,
-                         var_n, var_buf + 4 * (size_t)c);
-        }
+        memcpy(out->cal_cap, cap, VDSH_ORDER_SLOTS * sizeof *cap);
+    if (!(s->var && s->dvar))
+        return;
+    uint32_t r = s->v - J->lo;
+    J->var_lsq[r] = !fitted;
+    if (fitted) { /* the decision's choice; its offset added after the bake */
+        J->var_orders[r] = (uint8_t)var_k;
+        float *dst = J->var_coeffs + (size_t)r * J->var_cap * J->var_cap;
+        memset(dst, 0, (size_t)J->var_cap * J->var_cap * sizeof *dst);
+        memcpy(dst, varc[var_k], (size_t)var_k * var_k * sizeof *dst);
+    } else { /* too few training pairs: the lsq choice, shadow's offsets */
+        choose_var_order(s, u);
     }
-    /* Methods shadow and decision: the log offset, through c0 (Y00 is a
-     * constant), raised to the receiver's cap (outside the calibration:
-     * its samples get theirs after it). */
+}
+
+/* Methods shadow and decision: the log offset, through c0 (Y00 is a
+ * constant), raised to the receiver's cap (outside the calibration: its
+ * samples get theirs after it). */
+VERTEX_STEP void add_log_offsets(const vertex_state *s, const float cap[VDSH_ORDER_SLOTS])
+{
+    job *J = s->J;
+    const vertex_sink *out = s->out;
     for (int o = 1; o <= VDSH_MAX_ORDER; o++) {
         if (!out->coeffs[1][o])
             continue;
@@ -906,7 +1041,34 @@ bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64
         if (off != 0.0f)
             out->coeffs[1][o][0] += off / 0.28209479177387814f;
     }
-    if (upper > 0 && near_zero >= 0.9 * upper)
+}
+
+/* Receiver v: trace its directions, project them, fit each asked order
+ * into `out`; its traced and missed rays added to *traced and *missed,
+ * and *degenerate counted up if nearly all its rays above the horizon
+ * end at about zero distance. An AVX2 clone where the CPU has it, for
+ * the lane loops (the log's division above all): no FMA, so the same
+ * bits either way. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) &&                             \
+    !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+static void
+bake_vertex(job *J, uint32_t v, const vertex_sink *out, uint64_t *traced, uint64_t *missed,
+            uint32_t *degenerate)
+{
+    vertex_state s;
+    vertex_begin(&s, J, v, out);
+    trace_vertex(&s, traced, missed);
+    if (J->d->trace_only)
+        return;
+    double u[VDSH_MAX_COEFFS];
+    float varc[VDSH_ORDER_SLOTS][VDSH_MAX_COEFFS];
+    fit_vertex(&s, u, varc);
+    float cap[VDSH_ORDER_SLOTS];
+    decide_vertex(&s, u, varc, cap);
+    add_log_offsets(&s, cap);
+    if (s.upper > 0 && s.near_zero >= 0.9 * s.upper)
         (*degenerate)++;
 }
 
