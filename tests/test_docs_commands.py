@@ -76,6 +76,7 @@ NESTED = {
     ("pareto", "--bake-args"): ("vdsh-bake", "ARGS"),
     ("speed_vs_error", "--eval-args"): ("vdsh-eval", "ARGS"),
     ("view_pools", "--variant"): ("vdsh-bake", "NAME=ARGS"),
+    ("view_pools", "--base"): ("vdsh-bake", "ARGS"),
 }
 # Commands that run another: the options of theirs that take a value.
 WRAPPERS = {"nice": {"-n": 1}, "timeout": {}, "env": {}, "time": {}, "exec": {}, "sudo": {},
