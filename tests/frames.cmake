@@ -202,6 +202,17 @@ if(Python3_Interpreter_FOUND AND TARGET vb_frames)
                    ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR})
 endif()
 
+# scripts/view_pools at its smallest (test_view_pools.py): validation room
+# 3 at --max-edge 1, 64 x 48 C frames, order 2, two pools of two views; the
+# default's bake again differs by 0 with the interval [0, 0], --method
+# shadow's differences and t interval over pools are recomputed from the
+# JSON; bad arguments are errors naming them. No GL.
+if(Python3_Interpreter_FOUND AND TARGET vb_frames)
+  add_test(NAME view_pools_script
+           COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_LIST_DIR}/test_view_pools.py
+                   ${PROJECT_SOURCE_DIR}/scripts ${PROJECT_BINARY_DIR})
+endif()
+
 # scripts/score_bootstrap (test_score_bootstrap.py): on made-up score
 # files, the ratio of two vdsh-frames scores is the pooled one, its
 # bootstrap interval over views holds it (0 and [0, 0] for a file against

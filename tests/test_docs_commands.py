@@ -75,6 +75,8 @@ NESTED = {
     ("mottling", "--variant"): ("vdsh-bake", "NAME=ARGS"),
     ("pareto", "--bake-args"): ("vdsh-bake", "ARGS"),
     ("speed_vs_error", "--eval-args"): ("vdsh-eval", "ARGS"),
+    ("view_pools", "--variant"): ("vdsh-bake", "NAME=ARGS"),
+    ("view_pools", "--base"): ("vdsh-bake", "ARGS"),
 }
 # Commands that run another: the options of theirs that take a value.
 WRAPPERS = {"nice": {"-n": 1}, "timeout": {}, "env": {}, "time": {}, "exec": {}, "sudo": {},
