@@ -406,19 +406,9 @@ static char *cpca_dot_define(int basis)
 
 int vr_has_compute(void)
 {
-    GLint major = 0, minor = 0, n = 0;
-    glGetIntegerv(GL_MAJOR_VERSION, &major);
-    glGetIntegerv(GL_MINOR_VERSION, &minor);
-    if (major > 4 || (major == 4 && minor >= 3))
-        return 1;
-    int compute = 0, storage = 0;
-    glGetIntegerv(GL_NUM_EXTENSIONS, &n);
-    for (GLint i = 0; i < n; i++) {
-        const char *e = (const char *)glGetStringi(GL_EXTENSIONS, (GLuint)i);
-        compute |= e && !strcmp(e, "GL_ARB_compute_shader");
-        storage |= e && !strcmp(e, "GL_ARB_shader_storage_buffer_object");
-    }
-    return compute && storage;
+    static const char *const ext[2] = {"GL_ARB_compute_shader",
+                                       "GL_ARB_shader_storage_buffer_object"};
+    return vr_gl_has(4, 3, ext, 2);
 }
 
 /* The first lines of a compute shader: GLSL 4.30 where the GL compiles

@@ -26,6 +26,9 @@ vr_fail(vr_error *err, vr_result r, const char *fmt, ...);
 /* VR_OK when glGetError reports nothing; else VR_ERR_GL naming `what`.
  * Drains every pending error so that the next check starts clean. */
 vr_result vr_check_gl(vr_error *err, const char *what);
+/* Whether the context is GL major.minor or later, or has every one of
+ * the n extensions exts (what that version brings in core). */
+int vr_gl_has(int major, int minor, const char *const *exts, int n);
 
 /* The SH order a mode draws (2, 3, 5), 0 for modes none and cube. */
 int vr_mode_order(vr_mode m);

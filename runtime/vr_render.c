@@ -962,18 +962,8 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
  * ARB_pipeline_statistics_query. */
 static int has_pipeline_statistics(void)
 {
-    GLint major = 0, minor = 0, n = 0;
-    glGetIntegerv(GL_MAJOR_VERSION, &major);
-    glGetIntegerv(GL_MINOR_VERSION, &minor);
-    if (major > 4 || (major == 4 && minor >= 6))
-        return 1;
-    glGetIntegerv(GL_NUM_EXTENSIONS, &n);
-    for (GLint i = 0; i < n; i++) {
-        const char *e = (const char *)glGetStringi(GL_EXTENSIONS, (GLuint)i);
-        if (e && !strcmp(e, "GL_ARB_pipeline_statistics_query"))
-            return 1;
-    }
-    return 0;
+    static const char *const ext[1] = {"GL_ARB_pipeline_statistics_query"};
+    return vr_gl_has(4, 6, ext, 1);
 }
 
 vr_result vr_draw_counted(vr_renderer *r, const vr_scene *s, const vr_draw_desc *d, vr_counts *out,

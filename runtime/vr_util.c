@@ -59,6 +59,26 @@ vr_result vr_check_gl(vr_error *err, const char *what)
                    "%s: %s (0x%04x)", what, gl_error_name(first), (unsigned)first);
 }
 
+int vr_gl_has(int major, int minor, const char *const *exts, int n)
+{
+    GLint ma = 0, mi = 0, count = 0;
+    glGetIntegerv(GL_MAJOR_VERSION, &ma);
+    glGetIntegerv(GL_MINOR_VERSION, &mi);
+    if (ma > major || (ma == major && mi >= minor))
+        return 1;
+    glGetIntegerv(GL_NUM_EXTENSIONS, &count);
+    int found = 0;
+    for (int k = 0; k < n; k++)
+        for (GLint i = 0; i < count; i++) {
+            const char *e = (const char *)glGetStringi(GL_EXTENSIONS, (GLuint)i);
+            if (e && !strcmp(e, exts[k])) {
+                found++;
+                break;
+            }
+        }
+    return found == n;
+}
+
 const char *vr_gl_renderer(void)
 {
     const GLubyte *s = glGetString(GL_RENDERER);
