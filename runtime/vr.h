@@ -215,8 +215,8 @@ typedef struct vr_scene_desc {
      * order 5's attributes are read. A cpca stream is then decoded once,
      * at load, on the GPU into f32 records that the sums read (576 more
      * GPU bytes per vertex at order 12; cpca_decode is not read). The
-     * high orders' path
-     * on a GPU (docs/BENCHMARKS.md "Sums in a compute shader"). Needs
+     * high orders' path on a GPU (docs/BENCHMARKS.md "Sums in a compute
+     * shader"). Needs
      * compute shaders and storage buffers (GL 4.3, or
      * GL_ARB_compute_shader and GL_ARB_shader_storage_buffer_object), else
      * the load fails with VR_ERR_GL. A stream with an order per vertex

@@ -108,8 +108,8 @@ uniform samplerBuffer u_model;
 #endif
 #endif
 /* What buffer_sums reads, unless the includer says otherwise: the
- * vertex (a fixed order's record), the receiver's position, light i's position (the bake's frame) and the
- * stream's scale. */
+ * vertex (a fixed order's record), the receiver's position, light i's
+ * position (the bake's frame) and the stream's scale. */
 #ifndef BUF_VERTEX
 #define BUF_VERTEX gl_VertexID
 #endif

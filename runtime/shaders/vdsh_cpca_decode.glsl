@@ -3,8 +3,8 @@
  * frame (vr_scene_desc.cpca_decode = VR_CPCA_PER_FRAME) or once at load
  * (a stream whose sums are computed, vr_scene_desc.sums =
  * VR_SUMS_COMPUTE; vr_buffer.c): a compute shader, one invocation per
- * (vertex, texel of four coefficients), that writes each vertex's coefficients as f32
- * texels (the buffer path's BUF_KIND 0 record: BUF_CPCA_T texels in
+ * (vertex, texel of four coefficients), that writes each vertex's
+ * coefficients as f32 texels (the buffer path's BUF_KIND 0 record: BUF_CPCA_T texels in
  * vr_buffer_sequence's order) into a shader storage buffer, the scratch
  * that the light passes or the sums then read. It follows
  * vdsh_buffer.glsl (included before it, BUF_KIND 4, NUM_LIGHTS 0):
@@ -24,7 +24,7 @@ uniform int u_vertices;
 
 void main()
 {
-    /* rows of at most 65535 groups (vr_dispatch) */
+    /* rows of at most 65535 groups (vr_buffer.c's dispatch) */
     int id = int(gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x +
                  gl_GlobalInvocationID.x);
     int v = id / BUF_CPCA_T;

@@ -4,7 +4,7 @@
  */
 void main()
 {
-    /* rows of at most 65535 groups (vr_dispatch) */
+    /* rows of at most 65535 groups (vr_buffer.c's dispatch) */
     int id = int(gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x +
                  gl_GlobalInvocationID.x);
     int per = (u_lights + NUM_LIGHTS - 1) / NUM_LIGHTS;
