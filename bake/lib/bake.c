@@ -822,6 +822,23 @@ VERTEX_STEP void lane_log_distances(vertex_state *s, const packet_group *g, grou
     }
 }
 
+/* The directions of a packet's lanes above the horizon (up), and their
+ * distances where t is not NULL, appended at x[*n], y[*n], ... */
+VERTEX_STEP void append_up_lanes(const int *up, const float *dx, const float *dy, const float *dz,
+                                 const float *dist, float *x, float *y, float *z, float *t,
+                                 uint32_t *n)
+{
+    for (int k = 0; k < VB_PACKET; k++)
+        if (up[k]) {
+            uint32_t i = (*n)++;
+            x[i] = dx[k];
+            y[i] = dy[k];
+            z[i] = dz[k];
+            if (t)
+                t[i] = dist[k];
+        }
+}
+
 /* The group's packets, in order, into the projections' sums, and their
  * lanes above the horizon into the per-ray outputs: the sink's rays
  * (out->n), the adaptive order's directions (var_buf), the adaptive rays'
@@ -830,6 +847,7 @@ VERTEX_STEP void accumulate_group(vertex_state *s, const packet_group *g, const 
 {
     const job *J = s->J;
     const vertex_sink *out = s->out;
+    const uint32_t c = J->grid->count; /* var_buf's column stride */
     for (int p = 0; p < g->np; p++) {
         const float *dx = g->rh[p].ray.dir_x, *dy = g->rh[p].ray.dir_y, *dz = g->rh[p].ray.dir_z;
         const int *up_lane = l->up_lane[p];
@@ -840,32 +858,12 @@ VERTEX_STEP void accumulate_group(vertex_state *s, const packet_group *g, const 
             vdsh_sh_project_soa(J->order, VB_PACKET, dx, dy, dz, l->logd[p], &s->acc[1][0][0],
                                 VB_PACKET);
         if (out->n)
-            for (int k = 0; k < VB_PACKET; k++)
-                if (up_lane[k]) {
-                    uint32_t i = (*out->n)++;
-                    out->x[i] = dx[k];
-                    out->y[i] = dy[k];
-                    out->z[i] = dz[k];
-                    out->t[i] = dist[k];
-                }
+            append_up_lanes(up_lane, dx, dy, dz, dist, out->x, out->y, out->z, out->t, out->n);
         if (s->var_buf)
-            for (int k = 0; k < VB_PACKET; k++)
-                if (up_lane[k]) {
-                    uint32_t c = J->grid->count;
-                    s->var_buf[s->var_n] = dx[k];
-                    s->var_buf[c + s->var_n] = dy[k];
-                    s->var_buf[2 * c + s->var_n] = dz[k];
-                    s->var_buf[3 * c + s->var_n] = dist[k];
-                    s->var_n++;
-                }
+            append_up_lanes(up_lane, dx, dy, dz, dist, s->var_buf, s->var_buf + c,
+                            s->var_buf + 2 * c, s->var_buf + 3 * c, &s->var_n);
         if (J->adaptive)
-            for (int k = 0; k < VB_PACKET; k++)
-                if (up_lane[k]) {
-                    s->ax[s->adapt_n] = dx[k];
-                    s->ay[s->adapt_n] = dy[k];
-                    s->az[s->adapt_n] = dz[k];
-                    s->adapt_n++;
-                }
+            append_up_lanes(up_lane, dx, dy, dz, dist, s->ax, s->ay, s->az, NULL, &s->adapt_n);
     }
 }
 
