@@ -17,6 +17,24 @@ import signal
 import sys
 
 
+def pool_frames(sets, which):
+    """A frames cell: vdsh-frames' per-(view, light set) scores of the sets
+    with index `which`, pooled over the views (frames_gap, view_pools):
+    image RMSE over the counted pixels, recall over the shadowed, false
+    area over the lit; nan where there are none."""
+    rows = [s for s in sets if s["set"] == which and s["counted"]]
+    n = sum(s["counted"] for s in rows)
+    sh = sum(s["shadowed"] for s in rows)
+    lit = sum(s["lit"] for s in rows)
+    nan = float("nan")
+    return dict(rmse=(sum(s["rmse_ideal"] ** 2 * s["counted"] for s in rows) / n) ** 0.5
+                if n else nan,
+                recall=sum(s["recall"] * s["shadowed"] for s in rows if s["shadowed"]) / sh
+                if sh else nan,
+                false=sum(s["false_area"] * s["lit"] for s in rows if s["lit"]) / lit
+                if lit else nan)
+
+
 def clean_exit_on_signals():
     """SIGTERM and SIGHUP end a script as Ctrl-C does, through Python's
     exception handling: the program it is running is killed
