@@ -538,6 +538,17 @@ static int sums_group(void)
     return r && strstr(r, "llvmpipe") ? VR_MAX_LIGHTS_PER_PASS : 1;
 }
 
+/* A cpca stream decoded at load for the sums (VR_SUMS_COMPUTE): its
+ * records, model and decode program deleted; the scratch stays. */
+static void release_decoded(vr_buffer *b)
+{
+    GLuint texs[2] = {b->tex, b->model_tex}, bufs[2] = {b->buf, b->model_buf};
+    glDeleteTextures(2, texs);
+    glDeleteBuffers(2, bufs);
+    glDeleteProgram(b->decode_prog);
+    b->tex = b->model_tex = b->buf = b->model_buf = b->decode_prog = 0;
+}
+
 /* VR_SUMS_COMPUTE: the sums program of fixed-order stream b
  * (shaders/vr_sums.glsl), reading its records as stored or, for a cpca
  * stream, its scratch (make_decoder first). VR_ERR_GL without compute
@@ -549,7 +560,7 @@ static vr_result make_summer(const vr_scene *s, vr_buffer *b, const char *name, 
                        "%s: order %d stream: sums in a compute shader need compute shaders and "
                        "shader storage buffers (GL 4.3), which this GL has not",
                        name, b->order);
-    int scratch = b->decode_prog != 0;
+    int scratch = b->scratch_tex != 0;
     vr_buf_kind kind = scratch ? VR_BUF_F32 : b->kind;
     b->sums_group = sums_group();
     char defines[256];
@@ -595,7 +606,7 @@ void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint
     glUseProgram(b->sums_prog);
     glUniform1i(b->sums_u_lights, n);
     glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
-    glBindTexture(GL_TEXTURE_BUFFER, b->decode_prog ? b->scratch_tex : b->tex);
+    glBindTexture(GL_TEXTURE_BUFFER, b->scratch_tex ? b->scratch_tex : b->tex);
     glActiveTexture(GL_TEXTURE0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s->vbo_position);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, lights);
@@ -726,6 +737,13 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
         }
         if (r == VR_OK && summed)
             r = make_summer(s, &b, name, err);
+        /* the sums read the scratch only: the records, the model and the
+         * decode program are not needed again (36 B per vertex in the
+         * room at the default --cpca) */
+        if (r == VR_OK && summed && b.decode_prog) {
+            release_decoded(&b);
+            b.bytes -= bytes + model_bytes;
+        }
     }
     free(model);
     free(rec);

@@ -109,11 +109,13 @@ typedef struct vr_buffer {
      * (vr_buffer_cpca_unpack), malloc'd and in ks_hash; else NULL */
     char *cpca_unpack;
     /* VR_CPCA_PER_FRAME (vr_scene_desc.cpca_decode) or VR_SUMS_COMPUTE:
-     * the decode program (a compute shader, shaders/vdsh_cpca_decode.glsl)
-     * and the scratch it writes once per frame (VR_SUMS_COMPUTE: once, at
-     * load, sums_prog set), f32 records of stride
-     * scratch_stride texels that the sums or the light passes read as
-     * VR_BUF_F32 (vr_render.c); 0: decoded per pass */
+     * the scratch (scratch_tex 0: decoded per pass), f32 records of
+     * stride scratch_stride texels that the sums or the light passes read
+     * as VR_BUF_F32 (vr_render.c), and the decode program that writes it
+     * (a compute shader, shaders/vdsh_cpca_decode.glsl) once per frame.
+     * VR_SUMS_COMPUTE decodes once, at load, and then deletes the
+     * program, the records and the model (decode_prog, buf, tex, model_*
+     * 0; release_decoded) */
     GLuint decode_prog, scratch_buf, scratch_tex;
     int scratch_stride;
     /* VR_SUMS_COMPUTE (vr_scene_desc.sums): the sums program

@@ -939,12 +939,12 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
     /* A cpca stream decoded into its scratch, which the sums or the
      * passes read as f32 records: once per frame (vr_buffer_decode), or
      * once at load where the sums are computed (vr_buffer_upload). */
-    F.scratch = F.buf && F.buf->decode_prog;
+    F.scratch = F.buf && F.buf->scratch_tex;
     /* Sums in a compute shader: once for all the frame's lights. */
     F.summed = F.buf && F.buf->sums_prog && d.light_count > 0;
     /* both counted as the first group's lighting in the timings */
     int t = F.scratch || F.summed ? timer_begin(r, F.slot, 1, 0) : 0;
-    if (F.scratch && !F.buf->sums_prog)
+    if (F.scratch && F.buf->decode_prog)
         vr_buffer_decode(s, F.buf);
     if (F.summed)
         res = frame_sums(r, s, F.buf, &d, err);

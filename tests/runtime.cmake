@@ -715,6 +715,21 @@ done
 MESA_GL_VERSION_OVERRIDE=3.3 MESA_GLSL_VERSION_OVERRIDE=330 "$v" -q --render "$d/c16e.png" \
   --size 96x72 --mode buf12 --lights 16 --compute "$d/c.vdsh"
 "$png" same "$d/c16.png" "$d/c16e.png" 2
+# GPU memory: summed in compute, the cpca stream keeps only its f32
+# scratch (576 B per vertex at order 12), the records and model freed
+# after the decode at load; once per frame it keeps both
+"$v" -q --bench --bench-modes buf12,buf12-frame,buf12-compute --bench-lights 1 --frames 1 \
+  --size 32x24 --cpca-frame --compute -j "$d/bytes.json" "$d/c.vdsh"
+/usr/bin/python3 - "$d/bytes.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))["scenes"][0]
+b = {r["mode"]: r["buffer_bytes"] for r in s["results"]}
+scratch = s["vertices"] * 576
+print("buffer bytes", b, "scratch", scratch)
+assert b["buf12-compute"] == scratch, "compute keeps more than the scratch"
+assert b["buf12-frame"] == b["buf12"] + scratch, "per frame: records, model and scratch"
+assert 0 < b["buf12"] < scratch
+PY
 # the attribute modes ignore it
 "$v" -q --render "$d/v5.png" --size 96x72 --mode vdsh5 --lights 16 "$d/s.vdsh"
 "$v" -q --render "$d/v5x.png" --size 96x72 --mode vdsh5 --lights 16 --compute "$d/s.vdsh"
