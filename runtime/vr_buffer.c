@@ -596,13 +596,8 @@ static vr_result make_summer(const vr_scene *s, vr_buffer *b, const char *name, 
     return vr_check_gl(err, name);
 }
 
-void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint sums,
-                    const float (*pos)[4], int n)
+void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint sums, int n)
 {
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, lights);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((size_t)n * sizeof *pos), pos,
-                 GL_STREAM_DRAW);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     glUseProgram(b->sums_prog);
     glUniform1i(b->sums_u_lights, n);
     glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);

@@ -136,12 +136,10 @@ int vr_has_compute(void);
 /* A cpca stream decoded: b's records into its scratch (a compute
  * dispatch), before the frame's light passes, or at load before any sums. */
 void vr_buffer_decode(const vr_scene *s, const vr_buffer *b);
-/* VR_SUMS_COMPUTE: the SH sums of b toward each of the n lights at
- * positions pos (xyz, w unused), per vertex and light, into sums
- * (vertex-major: vertex v's at v * n); lights: a storage buffer of n
- * vec4 that this fills. After vr_buffer_decode for a cpca stream. */
-void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint sums,
-                    const float (*pos)[4], int n);
+/* VR_SUMS_COMPUTE: the SH sums of b toward each of the n lights whose
+ * positions storage buffer `lights` holds (n vec4, xyz; w unused), per
+ * vertex and light, into sums (vertex-major: vertex v's at v * n). */
+void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint sums, int n);
 void vr_buffer_destroy(vr_buffer *b);
 /* The positions and normals (and indices) of s into the bound VAO. */
 void vr_scene_base_attribs(const vr_scene *s);

@@ -58,7 +58,9 @@ struct vr_renderer {
      * buffer read by the passes as an R32F buffer texture), grown to the
      * largest frame drawn */
     GLuint sums_lights, sums_buf, sums_tex;
-    size_t sums_cap; /* floats */
+    size_t sums_cap;      /* floats */
+    float (*sums_pos)[4]; /* the lights' positions, as uploaded */
+    int sums_pos_cap;     /* lights */
 };
 
 static double now_seconds(void)
@@ -238,6 +240,7 @@ void vr_renderer_destroy(vr_renderer *r)
     GLuint bufs[2] = {r->sums_lights, r->sums_buf};
     glDeleteBuffers(2, bufs);
     glDeleteTextures(1, &r->sums_tex);
+    free(r->sums_pos);
     free(r);
 }
 
@@ -888,15 +891,27 @@ static vr_result frame_sums(vr_renderer *r, const vr_scene *s, const vr_buffer *
             return res;
         r->sums_cap = need;
     }
-    float(*pos)[4] = malloc((size_t)d->light_count * sizeof *pos);
-    if (!pos)
-        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "vr_draw: out of memory");
-    for (int i = 0; i < d->light_count; i++) {
-        memcpy(pos[i], d->lights[i].position, sizeof d->lights[i].position);
-        pos[i][3] = 1.0f;
+    /* the positions: the storage and its copy grown, then rewritten */
+    int n = d->light_count;
+    size_t pos_bytes = (size_t)n * sizeof *r->sums_pos;
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, r->sums_lights);
+    if (n > r->sums_pos_cap) {
+        float(*pos)[4] = realloc(r->sums_pos, pos_bytes);
+        if (!pos) {
+            glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+            return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "vr_draw: out of memory");
+        }
+        r->sums_pos = pos;
+        r->sums_pos_cap = n;
+        glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)pos_bytes, NULL, GL_DYNAMIC_DRAW);
     }
-    vr_buffer_sums(s, b, r->sums_lights, r->sums_buf, (const float(*)[4])pos, d->light_count);
-    free(pos);
+    for (int i = 0; i < n; i++) {
+        memcpy(r->sums_pos[i], d->lights[i].position, sizeof d->lights[i].position);
+        r->sums_pos[i][3] = 1.0f;
+    }
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)pos_bytes, r->sums_pos);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    vr_buffer_sums(s, b, r->sums_lights, r->sums_buf, n);
     return VR_OK;
 }
 
