@@ -50,7 +50,6 @@ import shutil
 import subprocess
 import sys
 import threading
-import urllib.parse
 
 import numpy as np
 from PIL import Image
@@ -99,31 +98,46 @@ def dom(url):
     return subprocess.run(CHROME + ["--dump-dom", url], capture_output=True, text=True, timeout=300).stdout
 
 
-def shot(query, out):
-    if os.path.exists(out):
-        os.remove(out)
-    subprocess.run(CHROME + ["--screenshot=" + out, base + "three.html?" + query], capture_output=True,
-                   text=True, timeout=300)
-    return os.path.exists(out)
-
-
-def title_error(query):
+def title_of(d):
     import re
-    m = re.search(r"<title>(.*?)</title>", dom(base + "three.html?" + query), re.S)
+    m = re.search(r"<title>(.*?)</title>", d, re.S)
     return m.group(1) if m else "(no title)"
 
 
+def shot(query, out):
+    """The page's screenshot into out and its title, in one launch."""
+    if os.path.exists(out):
+        os.remove(out)
+    d = dom_shot(base + "three.html?" + query, out)
+    return os.path.exists(out), title_of(d)
+
+
+def dom_shot(url, out):
+    return subprocess.run(CHROME + ["--screenshot=" + out, "--dump-dom", url], capture_output=True, text=True,
+                          timeout=300).stdout
+
+
+def title_error(query):
+    return title_of(dom(base + "three.html?" + query))
+
+
 def compare(label, png, ref, min_dark):
+    """(lines, fails) of the page's frame against the C frame."""
     a = np.asarray(Image.open(png).convert("L"), float)[:H, :W] / 255
     b = np.asarray(Image.open(ref)).astype(float) / 65535
     diff = np.abs(a - b).mean() * 255
     dark = (1 - b).mean()
-    print("%s: mean |three.js - C| = %.4f/255; mean shadow C %.2f%%, three.js %.2f%%"
-          % (label, diff, 100 * dark, 100 * (1 - a).mean()))
+    lines = ["%s: mean |three.js - C| = %.4f/255; mean shadow C %.2f%%, three.js %.2f%%"
+             % (label, diff, 100 * dark, 100 * (1 - a).mean())]
+    fails = []
     if dark < min_dark:
-        fail.append("%s: the C frame has too little shadow to compare" % label)
+        fails.append("%s: the C frame has too little shadow to compare" % label)
     if not diff < 2.0:
-        fail.append("%s: mean abs difference %.3f/255 >= 2/255" % (label, diff))
+        fails.append("%s: mean abs difference %.3f/255 >= 2/255" % (label, diff))
+    return lines, fails
+
+
+pages = testlib.Pages(fail)
 
 
 def frames(name, vd, eye, target, light_set, modes):
@@ -137,16 +151,18 @@ def check(label, glb, order, eye, target, lights, ref, min_dark, extra="", path=
     q = ("glb=../%s&order=%s&output=shadow&size=%dx%d&eye=%s&target=%s&up=0,1,0&fov=60%s%s"
          % (glb, order, W, H, csv(eye), csv(target), "".join("&light=" + csv(l) for l in lights), extra))
     png = os.path.join(work, "three-%s.png" % label.replace(" ", "-"))
-    if not shot(q, png):
-        fail.append("%s: no screenshot" % label)
-        return
-    t = title_error(q)
-    if not t.startswith("ready"):
-        fail.append("%s: the page says %r" % (label, t))
-        return
-    if path and t.split()[-1] != path:
-        fail.append("%s: drawn on the path %r, not %r" % (label, t.split()[-1], path))
-    compare(label, png, ref, min_dark)
+
+    def job():
+        ok, t = shot(q, png)
+        if not ok:
+            return [], ["%s: no screenshot" % label]
+        if not t.startswith("ready"):
+            return [], ["%s: the page says %r" % (label, t)]
+        lines, fails = compare(label, png, ref, min_dark)
+        if path and t.split()[-1] != path:
+            fails.append("%s: drawn on the path %r, not %r" % (label, t.split()[-1], path))
+        return lines, fails
+    pages.submit(job)
 
 
 eye, target, light = [7.5, 4.5, 8.0], [-2.0, 1.0, -2.0], [0.5, 1.2, 0.5]
@@ -172,8 +188,9 @@ for order, mode in (("5", "vdsh5"), ("12", "buf12")):
 # (three.html's default), plain and --compress, and decoded at load
 # (cpca=load), against vdsh-view's buf12 (decoded in its vertex stage), 1
 # and 3 lights; the page's title names the path taken.
+# (At edge 1.0, 3,755 receivers: the encode takes seconds.)
 cvd = os.path.join(work, "cpca.vdsh")
-run([bake, "builtin:room", "-o", cvd, "-q", "--orders", "12", "--max-edge", "0.5", "--rays", "256",
+run([bake, "builtin:room", "-o", cvd, "-q", "--orders", "12", "--max-edge", "1.0", "--rays", "256",
      "--encoding", "cpca"])
 run([export, cvd, "-o", os.path.join(work, "cpca.glb")])
 run([export, cvd, "-o", os.path.join(work, "cpca-compress.glb"), "--compress", "-q"])
@@ -248,20 +265,24 @@ for q, want in (("eye=1,2", "eye=1,2: expected x,y,z"), ("light=a,b,c", "light=a
                 # three.js not where the page looks: stayed "loading", no message (and
                 # three=DIR without "./" was taken by the import map as a bare name)
                 ("three=nowhere/", "/web/nowhere/ (build/three.module.js")):
-    t = title_error("glb=../room.glb&" + q)
-    print("three.html?%s: %s" % (q, t))
-    if want not in t:
-        fail.append("three.html?%s: no message naming '%s' (title %r)" % (q, want, t))
+    def typo(q=q, want=want):
+        t = title_error("glb=../room.glb&" + q)
+        return (["three.html?%s: %s" % (q, t)],
+                [] if want in t else ["three.html?%s: no message naming '%s' (title %r)" % (q, want, t)])
+    pages.submit(typo)
+
 
 # GLSL ES 3.00: the C runtime's programs from the same files.
-import re
-d = dom(base + "es_check.html")
-m = re.search(r'<pre id="out">(.*?)</pre>', d, re.S)
-out = m.group(1).strip() if m else ""
-print("es_check: " + (out.splitlines()[-1] if out else "(no output)"))
-if not out.endswith("ok") or "FAIL" in out:
-    fail.append("GLSL ES 3.00 check: %s" % out[-3000:])
+def es_check():
+    import re
+    m = re.search(r'<pre id="out">(.*?)</pre>', dom(base + "es_check.html"), re.S)
+    out = m.group(1).strip() if m else ""
+    return (["es_check: " + (out.splitlines()[-1] if out else "(no output)")],
+            [] if out.endswith("ok") and "FAIL" not in out else ["GLSL ES 3.00 check: %s" % out[-3000:]])
 
+
+pages.submit(es_check)
+pages.close()
 server.shutdown()
 for f in fail:
     print("FAIL:", f)

@@ -83,3 +83,34 @@ def load_script(path):
     module = importlib.util.module_from_spec(importlib.util.spec_from_loader(name, loader))
     loader.exec_module(module)
     return module
+
+
+class Pages:
+    """Headless-browser pages run a few at a time: each launch mostly waits
+    (about 2 s of start-up for 0.5 s of CPU), so the web tests start up to
+    `workers` at once. submit(fn, *args) runs fn in a worker; fn returns
+    (lines, fails). drain() waits for every job submitted so far, prints
+    their lines and extends `fails` in submission order, so the output
+    reads as if run one by one; call it before changing a file the pages
+    read."""
+
+    def __init__(self, fails, workers=3):
+        import concurrent.futures
+        self.fails, self.jobs = fails, []
+        self.pool = concurrent.futures.ThreadPoolExecutor(max_workers=workers)
+
+    def submit(self, fn, *args):
+        self.jobs.append(self.pool.submit(fn, *args))
+
+    def drain(self):
+        jobs, self.jobs = self.jobs, []
+        for j in jobs:
+            lines, fails = j.result()
+            for line in lines:
+                print(line)
+            self.fails.extend(fails)
+        sys.stdout.flush()
+
+    def close(self):
+        self.drain()
+        self.pool.shutdown()
