@@ -592,22 +592,54 @@ static vr_result make_summer(const vr_scene *s, vr_buffer *b, const char *name, 
     glUniform1i(glGetUniformLocation(b->sums_prog, "u_vertices"), (GLint)s->vertex_count);
     glUniform1f(glGetUniformLocation(b->sums_prog, "u_scale"), b->scale);
     b->sums_u_lights = glGetUniformLocation(b->sums_prog, "u_lights");
+    b->sums_u_frame = glGetUniformLocation(b->sums_prog, "u_frame");
     glUseProgram(0);
     return vr_check_gl(err, name);
 }
 
-void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint sums, int n)
+vr_result vr_cull_make(GLuint *prog, vr_error *err)
+{
+    const char *version = compute_version();
+    size_t size = strlen(version) + vr_cull_glsl_size + 1;
+    char *cs = malloc(size);
+    if (!cs)
+        return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "vr_draw: out of memory");
+    snprintf(cs, size, "%s%s", version, vr_cull_glsl);
+    vr_result r = vr_link_compute("vr_draw: the sums' cull program", cs, prog, err);
+    free(cs);
+    return r;
+}
+
+void vr_cull(const vr_scene *s, GLuint prog, GLuint seen, const float vp[16], uint32_t frame)
+{
+    glUseProgram(prog);
+    glUniformMatrix4fv(glGetUniformLocation(prog, "u_view_proj"), 1, GL_FALSE, vp);
+    glUniform1i(glGetUniformLocation(prog, "u_triangles"), (GLint)s->triangle_count);
+    glUniform1ui(glGetUniformLocation(prog, "u_frame"), frame);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s->vbo_position);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->ibo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, seen);
+    dispatch(s->triangle_count);
+    for (GLuint i = 0; i < 3; i++)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, 0);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
+void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint sums, int n,
+                    GLuint seen, uint32_t frame)
 {
     glUseProgram(b->sums_prog);
     glUniform1i(b->sums_u_lights, n);
+    glUniform1ui(b->sums_u_frame, frame);
     glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
     glBindTexture(GL_TEXTURE_BUFFER, b->scratch_tex ? b->scratch_tex : b->tex);
     glActiveTexture(GL_TEXTURE0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s->vbo_position);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, lights);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, sums);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, seen);
     dispatch((size_t)s->vertex_count * (size_t)((n + b->sums_group - 1) / b->sums_group));
-    for (GLuint i = 0; i < 3; i++)
+    for (GLuint i = 0; i < 4; i++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, 0);
     /* the passes read the sums as a buffer texture */
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);

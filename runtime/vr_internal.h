@@ -121,7 +121,7 @@ typedef struct vr_buffer {
     /* VR_SUMS_COMPUTE (vr_scene_desc.sums): the sums program
      * (shaders/vr_sums.glsl), which reads the records, or the scratch */
     GLuint sums_prog;
-    GLint sums_u_lights;
+    GLint sums_u_lights, sums_u_frame;
     int sums_group; /* lights per invocation */
 } vr_buffer;
 
@@ -138,8 +138,16 @@ int vr_has_compute(void);
 void vr_buffer_decode(const vr_scene *s, const vr_buffer *b);
 /* VR_SUMS_COMPUTE: the SH sums of b toward each of the n lights whose
  * positions storage buffer `lights` holds (n vec4, xyz; w unused), per
- * vertex and light, into sums (vertex-major: vertex v's at v * n). */
-void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint sums, int n);
+ * vertex and light, into sums (vertex-major: vertex v's at v * n), of the
+ * vertices whose u32 in `seen` is `frame` (vr_cull). */
+void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint sums, int n,
+                    GLuint seen, uint32_t frame);
+/* The cull program (shaders/vr_cull.glsl) into *prog. VR_ERR_SHADER. */
+vr_result vr_cull_make(GLuint *prog, vr_error *err);
+/* Set seen[v] = frame for every vertex v of s that a triangle the view
+ * vp (column-major, as the passes') does not clip away wholly uses;
+ * seen: a storage buffer of a u32 per vertex. */
+void vr_cull(const vr_scene *s, GLuint prog, GLuint seen, const float vp[16], uint32_t frame);
 void vr_buffer_destroy(vr_buffer *b);
 /* The positions and normals (and indices) of s into the bound VAO. */
 void vr_scene_base_attribs(const vr_scene *s);

@@ -61,6 +61,10 @@ struct vr_renderer {
     size_t sums_cap;      /* floats */
     float (*sums_pos)[4]; /* the lights' positions, as uploaded */
     int sums_pos_cap;     /* lights */
+    /* which vertices the frame's view uses (vr_cull): the program, a u32
+     * per vertex (seen_cap of them) and the frame's mark, never 0 */
+    GLuint cull_prog, seen_buf;
+    uint32_t seen_cap, seen_frame;
 };
 
 static double now_seconds(void)
@@ -237,8 +241,10 @@ void vr_renderer_destroy(vr_renderer *r)
         free(s->group);
     }
     vr_text_destroy(&r->text);
-    GLuint bufs[2] = {r->sums_lights, r->sums_buf};
-    glDeleteBuffers(2, bufs);
+    GLuint bufs[3] = {r->sums_lights, r->sums_buf, r->seen_buf};
+    glDeleteBuffers(3, bufs);
+    if (r->cull_prog)
+        glDeleteProgram(r->cull_prog);
     glDeleteTextures(1, &r->sums_tex);
     free(r->sums_pos);
     free(r);
@@ -861,10 +867,46 @@ static vr_result draw_pass(const draw_frame *F, int g, vr_error *err)
     return VR_OK;
 }
 
+/* VR_SUMS_COMPUTE: mark the vertices view vp uses (vr_cull) in the
+ * renderer's seen buffer, grown to the scene (zeros) as needed; *frame:
+ * the mark. */
+static vr_result frame_cull(vr_renderer *r, const vr_scene *s, const float vp[16], uint32_t *frame,
+                            vr_error *err)
+{
+    if (!r->cull_prog) {
+        vr_result res = vr_cull_make(&r->cull_prog, err);
+        if (res != VR_OK)
+            return res;
+    }
+    /* grown, or the mark about to wrap to 0: every mark zero again */
+    if (s->vertex_count > r->seen_cap || r->seen_frame == UINT32_MAX) {
+        uint32_t n = s->vertex_count > r->seen_cap ? s->vertex_count : r->seen_cap;
+        uint32_t *zero = calloc(n, sizeof *zero);
+        if (!zero)
+            return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "vr_draw: out of memory");
+        if (!r->seen_buf)
+            glGenBuffers(1, &r->seen_buf);
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, r->seen_buf);
+        glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((size_t)n * sizeof *zero), zero,
+                     GL_DYNAMIC_COPY);
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+        free(zero);
+        vr_result res = vr_check_gl(err, "vr_draw: the sums' cull storage");
+        if (res != VR_OK)
+            return res;
+        r->seen_cap = n;
+        r->seen_frame = 0;
+    }
+    *frame = ++r->seen_frame;
+    vr_cull(s, r->cull_prog, r->seen_buf, vp, *frame);
+    return VR_OK;
+}
+
 /* VR_SUMS_COMPUTE: the frame's sums toward all its lights
- * (vr_buffer_sums), into the renderer's storage, grown as needed. */
+ * (vr_buffer_sums) at the vertices view vp uses (frame_cull), into the
+ * renderer's storage, grown as needed. */
 static vr_result frame_sums(vr_renderer *r, const vr_scene *s, const vr_buffer *b,
-                            const vr_draw_desc *d, vr_error *err)
+                            const vr_draw_desc *d, const float vp[16], vr_error *err)
 {
     size_t need = (size_t)s->vertex_count * (size_t)d->light_count;
     if (need > r->sums_cap) {
@@ -911,8 +953,11 @@ static vr_result frame_sums(vr_renderer *r, const vr_scene *s, const vr_buffer *
     }
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)pos_bytes, r->sums_pos);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
-    vr_buffer_sums(s, b, r->sums_lights, r->sums_buf, n);
-    return VR_OK;
+    uint32_t frame = 0;
+    vr_result res = frame_cull(r, s, vp, &frame, err);
+    if (res == VR_OK)
+        vr_buffer_sums(s, b, r->sums_lights, r->sums_buf, n, r->seen_buf, frame);
+    return res;
 }
 
 /* Leave the state as the next user expects it. */
@@ -962,7 +1007,7 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
     if (F.scratch && F.buf->decode_prog)
         vr_buffer_decode(s, F.buf);
     if (F.summed)
-        res = frame_sums(r, s, F.buf, &d, err);
+        res = frame_sums(r, s, F.buf, &d, F.vp, err);
     timer_end(t);
 
     for (int g = 0; g < groups && res == VR_OK; g++)

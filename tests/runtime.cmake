@@ -710,6 +710,21 @@ for f in c s; do
   done
   if "$png" same "$d/${f}16x.png" "$d/${f}3x.png" 2; then echo "control: 3 and 16 lights"; exit 1; fi
 done
+# close up, most triangles out of view and many across its edges (a
+# corner, the sphere, the floor under a box): the sums skip the vertices
+# no triangle in view uses (vr_cull.glsl), and the frame is still the
+# vertex stage's
+i=0
+for cam in "0,1.5,0,-9,1,-9" "5,2,5,-3,0.5,-1" "-1,1.2,2.5,-3,0.5,-1"; do
+  i=$((i+1))
+  for f in c s; do
+    "$v" -q --render "$d/${f}near$i.png" --size 96x72 --mode buf12 --lights 16 --camera "$cam" \
+      --fov 25 "$d/$f.vdsh"
+    "$v" -q --render "$d/${f}near${i}x.png" --size 96x72 --mode buf12 --lights 16 --camera "$cam" \
+      --fov 25 --compute "$d/$f.vdsh"
+    "$png" same "$d/${f}near$i.png" "$d/${f}near${i}x.png" 0
+  done
+done
 # GLSL 3.30 with the compute and storage-buffer extensions (Mesa told
 # so; other GLs ignore the variables): the same frame
 MESA_GL_VERSION_OVERRIDE=3.3 MESA_GLSL_VERSION_OVERRIDE=330 "$v" -q --render "$d/c16e.png" \

@@ -85,6 +85,7 @@ int main(int argc, char **argv)
     check_embed(dir, "vdsh_cpca_decode.glsl", vr_cpca_decode_glsl, vr_cpca_decode_glsl_size);
     check_embed(dir, "vr_sums.glsl", vr_sums_glsl, vr_sums_glsl_size);
     check_embed(dir, "vr_sums_main.glsl", vr_sums_main_glsl, vr_sums_main_glsl_size);
+    check_embed(dir, "vr_cull.glsl", vr_cull_glsl, vr_cull_glsl_size);
 
     /* The C definition's numbers, as the headers write them. */
     static const char *const consts[][2] = {

@@ -13,15 +13,18 @@
  * stored, or a cpca stream's decoded scratch (BUF_KIND 0,
  * vdsh_cpca_decode.glsl). A group of lights per invocation fetches (and
  * unpacks) each coefficient once for the group, as the vertex stage
- * does (docs/BENCHMARKS.md "Sums in a compute shader").
+ * does (docs/BENCHMARKS.md "Sums in a compute shader"). Vertices that
+ * no triangle in view uses are skipped (vr_cull.glsl marks the others).
  */
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer vr_positions { float s_position[]; };
 layout(std430, binding = 1) readonly buffer vr_lights { vec4 s_light[]; };
 layout(std430, binding = 2) writeonly buffer vr_sums { float s_sum[]; };
+layout(std430, binding = 3) readonly buffer vr_seen { uint s_seen[]; };
 uniform int u_vertices;   /* vertices of the scene */
 uniform int u_lights;     /* lights of the frame */
 uniform float u_scale;    /* as the vertex stage's */
+uniform uint u_frame;     /* the vertices to sum: s_seen[v] == u_frame */
 int g_vertex, g_light;    /* this invocation's */
 #define BUF_VERTEX g_vertex
 #define BUF_RECEIVER \

@@ -10,7 +10,8 @@ void main()
     int per = (u_lights + NUM_LIGHTS - 1) / NUM_LIGHTS;
     g_vertex = id / per;
     g_light = (id - g_vertex * per) * NUM_LIGHTS;
-    if (g_vertex >= u_vertices)
+    /* a vertex no triangle of the frame's view uses (vr_cull.glsl) */
+    if (g_vertex >= u_vertices || s_seen[g_vertex] != u_frame)
         return;
     float sum[NUM_LIGHTS];
     buffer_sums(sum);
