@@ -787,3 +787,44 @@ rm -rf "$3"; mkdir -p "$3"
 ]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:compute_probe> ${_rt_dir}/compute_probe)
   _runtime_props(runtime_compute_probe)
 endif()
+
+# scripts/gpu_bundle (the GPU frame-time measurement of issue 29 as a
+# folder that needs nothing installed): a one-scene bundle's run.sh,
+# here on any GL (--any-gl), writes a bench JSON per lights-per-invocation
+# group with every mode it names, from the bundle's own copies of
+# vdsh-view and the bakes; without --any-gl it refuses a GL that is
+# not NVIDIA's (exit 3). Skips (77) without a GL context.
+if(TARGET vdsh-bake)
+add_test(NAME runtime_gpu_bundle COMMAND sh -c [=[
+src=$1; build=$2; d=$3
+rm -rf "$d"; mkdir -p "$d"
+set -e
+"$src/scripts/gpu_bundle" "$d/b" --build "$build" --scenes room=builtin:room:1.5
+set +e
+OUT="$d/o" FRAMES=1 "$d/b/run.sh" --any-gl > "$d/run.txt" 2>&1
+rc=$?
+cat "$d/run.txt"
+if [ $rc -ne 0 ]; then
+  grep -q "could not draw" "$d/run.txt" && grep -qi "context\|EGL" "$d/o/smoke.txt" && exit 77
+  exit 1
+fi
+set -e
+for g in 1 8; do
+  /usr/bin/python3 - "$d/o/bench-room-group$g.json" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+got = {(r["mode"], r["lights"]) for s in j["scenes"] for r in s["results"]}
+want = {(m, n) for m in ("buf12", "buf12-frame", "buf12-compute") for n in (1, 16, 64)}
+want |= {("vdsh5", n) for n in (1, 16, 64)}
+assert want <= got, "missing %s" % sorted(want - got)
+assert "/b/s/room-c.vdsh" in json.dumps(j), "not the bundle's bakes"
+PY
+done
+set +e
+OUT="$d/o2" "$d/b/run.sh" > "$d/run2.txt" 2>&1
+rc=$?
+if grep -qi nvidia "$d/o2/smoke.txt"; then exit 0; fi
+[ $rc -eq 3 ] && grep -q "not an NVIDIA GL" "$d/run2.txt"
+]=] sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR} ${_rt_dir}/gpu_bundle)
+_runtime_props(runtime_gpu_bundle)
+endif()

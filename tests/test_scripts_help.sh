@@ -36,7 +36,7 @@ done
 # bench_shard, fuzz and reference_set --help exited 2, bench_gltf_libs 1
 # without libassimp-dev). Python ones through /usr/bin/python3 (Debian's,
 # as their #! says).
-for s in bench_gltf_libs bench_gltf_load bench_shard fuzz npm_gltf_tools obj_to_glb.py plot_shard_rss \
+for s in bench_gltf_libs bench_gltf_load bench_shard fuzz gpu_bundle npm_gltf_tools obj_to_glb.py plot_shard_rss \
          reference_set; do
   cp "$src/scripts/$s" "$tmp/scripts/$s"
   case $s in *.py | plot_shard_rss) run=(/usr/bin/python3) ;; *) run=(bash) ;; esac
