@@ -609,6 +609,141 @@ vb_result ply_check_as_read(const char *path, const std::vector<ply_element> &el
  * file declares; ascii colours that are not whole numbers of int range
  * unless their type is float (read as integers: the rest failed or shifted
  * into the next value), unless nothing used follows (the last face). */
+/* Item n of element e as read_ply walks it: its face's indices go to
+ * *polygon; nv: the vertices, for the indices' range. */
+struct ply_item {
+    const char *path;
+    const ply_element *e;
+    uint64_t n, nv;
+    bool is_face;
+    std::vector<int64_t> *polygon;
+};
+
+/* Binary: property p of item `it` at b (left bytes, moved past it): its
+ * value into *into (a coordinate or normal; is_xyz: a coordinate, which
+ * must be finite), or (is_indices) the face's vertex indices; items: its
+ * values (a list's size, else 1). */
+static vb_result binary_property(const ply_item &it, const ply_property &p, bool big, bool is_xyz,
+                                 bool is_indices, float *into, const uint8_t *&b, size_t &left,
+                                 uint64_t &items, vb_error *err)
+{
+    const char *path = it.path;
+    const ply_element &e = *it.e;
+    const uint64_t n = it.n, nv = it.nv;
+    if (p.count_type) {
+        vb_result r = binary_list_size(path, e, n, p, big, b, left, items, err);
+        if (r != VB_OK)
+            return r;
+        const uint64_t cnt = items;
+        if (is_indices && cnt < 3)
+            return vb_fail(err, VB_ERR_FORMAT, "%s: face %llu has %llu %s (needs at least 3)", path,
+                           (unsigned long long)n, (unsigned long long)cnt,
+                           vdsh_plural(cnt, "vertex", "vertices"));
+    }
+    int ts = p.type->size;
+    if (items > left / (size_t)ts)
+        return vb_fail(err, VB_ERR_FORMAT, "%s: truncated in %s %llu of %llu", path, e.name.c_str(),
+                       (unsigned long long)n, (unsigned long long)e.count);
+    if (into) {
+        double d = !p.type->is_float ? (double)binary_integer(p.type, b, big)
+                   : ts == 4         ? (double)load_f32(b, big)
+                                     : load_f64(b, big);
+        if (is_xyz && (!std::isfinite(d) || std::fabs(d) > (double)FLT_MAX))
+            return vb_fail(err, VB_ERR_INVALID, "%s: vertex %llu has a non-finite coordinate", path,
+                           (unsigned long long)n);
+        *into = ts == 4 && p.type->is_float ? load_f32(b, big) : (float)d;
+    }
+    if (is_indices) {
+        for (uint64_t q = 0; q < items; q++) {
+            long long idx = binary_integer(p.type, b + q * (size_t)ts, big);
+            if (idx < 0 || (uint64_t)idx >= nv)
+                return vb_fail(err, VB_ERR_INVALID,
+                               "%s: face %llu: vertex index %lld out of range (%llu %s)", path,
+                               (unsigned long long)n, idx, (unsigned long long)nv,
+                               vdsh_plural(nv, "vertex", "vertices"));
+            it.polygon->push_back(idx);
+        }
+    }
+    b += items * (size_t)ts;
+    left -= items * (size_t)ts;
+    return VB_OK;
+}
+
+/* ASCII: property p of item `it` from c (size: the file's bytes, a bound
+ * on a list's size), as binary_property; a colour OpenMesh would read
+ * otherwise than these checks is said in *differs (the first only). */
+static vb_result ascii_property(const ply_item &it, const ply_property &p, cursor &c, size_t size,
+                                bool is_indices, float *into, vb_error *differs, uint64_t &items,
+                                vb_error *err)
+{
+    const char *path = it.path;
+    const ply_element &e = *it.e;
+    const uint64_t n = it.n, nv = it.nv;
+    token t;
+    if (p.count_type) {
+        long long cnt = 0;
+        if (!c.next(&t))
+            return vb_fail(err, VB_ERR_FORMAT, "%s: truncated: file ends in %s %llu of %llu", path,
+                           e.name.c_str(), (unsigned long long)n, (unsigned long long)e.count);
+        if (has_nul(t))
+            return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: %s %llu: list size '%.*s' %s", path,
+                           c.line, e.name.c_str(), (unsigned long long)n, t.show_len(), t.b,
+                           num_problem(NUM_NUL));
+        if (!parse_int(t, &cnt) || cnt < 0 || (uint64_t)cnt > size)
+            return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: %s %llu: bad list size '%.*s'", path,
+                           c.line, e.name.c_str(), (unsigned long long)n, t.show_len(), t.b);
+        if (is_indices && cnt < 3)
+            return vb_fail(err, VB_ERR_FORMAT,
+                           "%s: line %lu: face %llu has %lld vertices (needs at least 3)", path,
+                           c.line, (unsigned long long)n, cnt);
+        items = (uint64_t)cnt;
+    }
+    for (uint64_t q = 0; q < items; q++) {
+        if (!c.next(&t))
+            return vb_fail(err, VB_ERR_FORMAT, "%s: truncated: file ends in %s %llu of %llu", path,
+                           e.name.c_str(), (unsigned long long)n, (unsigned long long)e.count);
+        long long iv = 0;
+        float f = 0.0f;
+        if (p.type->is_float) {
+            num_status s = parse_float(t, &f);
+            if (s != NUM_OK)
+                return vb_fail(err, num_error(s), "%s: line %lu: %s %llu: %s '%.*s' %s", path,
+                               c.line, e.name.c_str(), (unsigned long long)n, p.name.c_str(),
+                               t.show_len(), t.b, num_problem(s));
+        } else {
+            if (!parse_int(t, &iv))
+                return vb_fail(err, VB_ERR_FORMAT, "%s: line %lu: %s %llu: %s '%.*s' %s", path,
+                               c.line, e.name.c_str(), (unsigned long long)n, p.name.c_str(),
+                               t.show_len(), t.b, int_problem(t, "is not an integer"));
+            if (is_indices && (iv < 0 || (uint64_t)iv >= nv))
+                return vb_fail(err, VB_ERR_INVALID,
+                               "%s: line %lu: face %llu: vertex index %lld out of range (%llu %s)",
+                               path, c.line, (unsigned long long)n, iv, (unsigned long long)nv,
+                               vdsh_plural(nv, "vertex", "vertices"));
+        }
+        /* Colours not of type float were read as an int: anything else
+         * would shift (or stop) the rest, unless nothing used is read
+         * after it (in the last face, after its vertex_indices). */
+        long long cv = 0;
+        bool last_read = it.is_face && n + 1 == e.count;
+        if (p.role == PLY_COLOR && !(p.read_type->is_float && p.read_type->size == 4) &&
+            !last_read && !differs->msg[0] && (!parse_int(t, &cv) || cv < INT_MIN || cv > INT_MAX))
+            vb_fail(differs, VB_ERR_FORMAT,
+                    "%s: line %lu: %s %llu: %s '%.*s': a colour of type %s must be a whole number "
+                    "of int range",
+                    path, c.line, e.name.c_str(), (unsigned long long)n, p.name.c_str(),
+                    t.show_len(), t.b, p.type->name);
+        if (into) {
+            if (!p.type->is_float)
+                parse_float(t, &f); /* an integer, checked above */
+            *into = f;
+        }
+        if (is_indices)
+            it.polygon->push_back(iv);
+    }
+    return VB_OK;
+}
+
 vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder &out,
                    expectation *ex, vb_error *err)
 {
@@ -665,6 +800,7 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
             out.positions.reserve(3 * (size_t)std::min<uint64_t>(e.count, 1u << 24));
         for (uint64_t n = 0; n < e.count; n++) {
             float v[3] = {0.0f, 0.0f, 0.0f}, nrm[3] = {0.0f, 0.0f, 0.0f};
+            const ply_item it = {path, &e, n, nv, is_face, &polygon};
             for (size_t k = 0; k < e.props.size(); k++) {
                 const ply_property &p = e.props[k];
                 bool is_xyz =
@@ -677,124 +813,12 @@ vb_result read_ply(const char *path, const uint8_t *bytes, size_t size, builder 
                 uint64_t items = 1;
                 if (is_indices)
                     polygon.clear();
-                if (format != 0) {
-                    if (p.count_type) {
-                        vb_result r = binary_list_size(path, e, n, p, big, b, left, items, err);
-                        if (r != VB_OK)
-                            return r;
-                        const uint64_t cnt = items;
-                        if (is_indices && cnt < 3)
-                            return vb_fail(err, VB_ERR_FORMAT,
-                                           "%s: face %llu has %llu %s (needs at least 3)", path,
-                                           (unsigned long long)n, (unsigned long long)cnt,
-                                           vdsh_plural(cnt, "vertex", "vertices"));
-                    }
-                    int ts = p.type->size;
-                    if (items > left / (size_t)ts)
-                        return vb_fail(err, VB_ERR_FORMAT, "%s: truncated in %s %llu of %llu", path,
-                                       e.name.c_str(), (unsigned long long)n,
-                                       (unsigned long long)e.count);
-                    if (into) {
-                        double d = !p.type->is_float ? (double)binary_integer(p.type, b, big)
-                                   : ts == 4         ? (double)load_f32(b, big)
-                                                     : load_f64(b, big);
-                        if (is_xyz && (!std::isfinite(d) || std::fabs(d) > (double)FLT_MAX))
-                            return vb_fail(err, VB_ERR_INVALID,
-                                           "%s: vertex %llu has a non-finite coordinate", path,
-                                           (unsigned long long)n);
-                        *into = ts == 4 && p.type->is_float ? load_f32(b, big) : (float)d;
-                    }
-                    if (is_indices) {
-                        for (uint64_t q = 0; q < items; q++) {
-                            long long idx = binary_integer(p.type, b + q * (size_t)ts, big);
-                            if (idx < 0 || (uint64_t)idx >= nv)
-                                return vb_fail(
-                                    err, VB_ERR_INVALID,
-                                    "%s: face %llu: vertex index %lld out of range (%llu %s)", path,
-                                    (unsigned long long)n, idx, (unsigned long long)nv,
-                                    vdsh_plural(nv, "vertex", "vertices"));
-                            polygon.push_back(idx);
-                        }
-                    }
-                    b += items * (size_t)ts;
-                    left -= items * (size_t)ts;
-                } else {
-                    if (p.count_type) {
-                        long long cnt = 0;
-                        if (!c.next(&t))
-                            return vb_fail(err, VB_ERR_FORMAT,
-                                           "%s: truncated: file ends in %s %llu of %llu", path,
-                                           e.name.c_str(), (unsigned long long)n,
-                                           (unsigned long long)e.count);
-                        if (has_nul(t))
-                            return vb_fail(err, VB_ERR_FORMAT,
-                                           "%s: line %lu: %s %llu: list size '%.*s' %s", path,
-                                           c.line, e.name.c_str(), (unsigned long long)n,
-                                           t.show_len(), t.b, num_problem(NUM_NUL));
-                        if (!parse_int(t, &cnt) || cnt < 0 || (uint64_t)cnt > size)
-                            return vb_fail(err, VB_ERR_FORMAT,
-                                           "%s: line %lu: %s %llu: bad list size '%.*s'", path,
-                                           c.line, e.name.c_str(), (unsigned long long)n,
-                                           t.show_len(), t.b);
-                        if (is_indices && cnt < 3)
-                            return vb_fail(
-                                err, VB_ERR_FORMAT,
-                                "%s: line %lu: face %llu has %lld vertices (needs at least 3)",
-                                path, c.line, (unsigned long long)n, cnt);
-                        items = (uint64_t)cnt;
-                    }
-                    for (uint64_t q = 0; q < items; q++) {
-                        if (!c.next(&t))
-                            return vb_fail(err, VB_ERR_FORMAT,
-                                           "%s: truncated: file ends in %s %llu of %llu", path,
-                                           e.name.c_str(), (unsigned long long)n,
-                                           (unsigned long long)e.count);
-                        long long iv = 0;
-                        float f = 0.0f;
-                        if (p.type->is_float) {
-                            num_status s = parse_float(t, &f);
-                            if (s != NUM_OK)
-                                return vb_fail(err, num_error(s),
-                                               "%s: line %lu: %s %llu: %s '%.*s' %s", path, c.line,
-                                               e.name.c_str(), (unsigned long long)n,
-                                               p.name.c_str(), t.show_len(), t.b, num_problem(s));
-                        } else {
-                            if (!parse_int(t, &iv))
-                                return vb_fail(
-                                    err, VB_ERR_FORMAT, "%s: line %lu: %s %llu: %s '%.*s' %s", path,
-                                    c.line, e.name.c_str(), (unsigned long long)n, p.name.c_str(),
-                                    t.show_len(), t.b, int_problem(t, "is not an integer"));
-                            if (is_indices && (iv < 0 || (uint64_t)iv >= nv))
-                                return vb_fail(
-                                    err, VB_ERR_INVALID,
-                                    "%s: line %lu: face %llu: vertex index %lld out of range (%llu %s)",
-                                    path, c.line, (unsigned long long)n, iv, (unsigned long long)nv,
-                                    vdsh_plural(nv, "vertex", "vertices"));
-                        }
-                        /* Colours not of type float were read as an int:
-                         * anything else would shift (or stop) the rest,
-                         * unless nothing used is read after it (in the
-                         * last face, after its vertex_indices). */
-                        long long cv = 0;
-                        bool last_read = is_face && n + 1 == e.count;
-                        if (p.role == PLY_COLOR &&
-                            !(p.read_type->is_float && p.read_type->size == 4) && !last_read &&
-                            !differs.msg[0] && (!parse_int(t, &cv) || cv < INT_MIN || cv > INT_MAX))
-                            vb_fail(
-                                &differs, VB_ERR_FORMAT,
-                                "%s: line %lu: %s %llu: %s '%.*s': a colour of type %s must be a whole number "
-                                "of int range",
-                                path, c.line, e.name.c_str(), (unsigned long long)n, p.name.c_str(),
-                                t.show_len(), t.b, p.type->name);
-                        if (into) {
-                            if (!p.type->is_float)
-                                parse_float(t, &f); /* an integer, checked above */
-                            *into = f;
-                        }
-                        if (is_indices)
-                            polygon.push_back(iv);
-                    }
-                }
+                vb_result r =
+                    format != 0
+                        ? binary_property(it, p, big, is_xyz, is_indices, into, b, left, items, err)
+                        : ascii_property(it, p, c, size, is_indices, into, &differs, items, err);
+                if (r != VB_OK)
+                    return r;
                 if (is_indices) {
                     ex->faces++;
                     ex->triangles += items - 2;
