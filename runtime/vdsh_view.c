@@ -69,12 +69,15 @@ static const char usage_text[] =
     "                        with --bench: time its buffer modes both ways\n"
     "                        (MODE-frame)\n"
     "      --compute         compute a buffer stream's sums once per frame in a\n"
-    "                        compute shader, per vertex and light (a cpca\n"
-    "                        stream decoded to f32 once, at load: 576 GPU\n"
-    "                        bytes per vertex at order 12; GL 4.3), instead\n"
-    "                        of in the vertex stage of every pass;\n"
-    "                        with --bench: time its buffer modes both ways\n"
-    "                        (MODE-compute)\n"
+    "                        compute shader, per vertex in view and light (a\n"
+    "                        cpca stream decoded there, from its records;\n"
+    "                        GL 4.3), instead of in the vertex stage of every\n"
+    "                        pass; with --bench: time its buffer modes both\n"
+    "                        ways (MODE-compute), and a cpca stream's also\n"
+    "                        decoded at load (MODE-compute-load)\n"
+    "      --cpca-load       decode a cpca stream to f32 once, at load, on the\n"
+    "                        GPU (576 GPU bytes per vertex at order 12, the\n"
+    "                        records freed; GL 4.3)\n"
     "      --views FILE      with --frames DIR: for every view, light set and\n"
     "                        light of the view set FILE (vdsh-frames writes\n"
     "                        one), the shadow of that one light alone as a\n"
@@ -235,6 +238,7 @@ enum {
     O_BUFFER_FLOATS,
     O_CPCA_FRAME,
     O_COMPUTE,
+    O_CPCA_LOAD,
     O_BENCH_LIGHTS,
     O_BENCH_CUBE_SIZES,
     O_BENCH_MODES,
@@ -273,6 +277,7 @@ static const struct option longopts[] = {
     {"buffer-floats", no_argument, 0, O_BUFFER_FLOATS},
     {"cpca-frame", no_argument, 0, O_CPCA_FRAME},
     {"compute", no_argument, 0, O_COMPUTE},
+    {"cpca-load", no_argument, 0, O_CPCA_LOAD},
     {"bench-lights", required_argument, 0, O_BENCH_LIGHTS},
     {"bench-cube-sizes", required_argument, 0, O_BENCH_CUBE_SIZES},
     {"bench-modes", required_argument, 0, O_BENCH_MODES},
@@ -478,6 +483,7 @@ static int parse_option(int c, const char *v, vv_options *o)
     case O_BUFFER_FLOATS: o->buffer_floats = 1; return 0;
     case O_CPCA_FRAME: o->cpca_frame = 1; return 0;
     case O_COMPUTE: o->compute = 1; return 0;
+    case O_CPCA_LOAD: o->cpca_load = 1; return 0;
     case O_BENCH_LIGHTS: return parse_bench_lights(v, o);
     case O_BENCH_CUBE_SIZES: return parse_bench_cube_sizes(v, o);
     case O_BENCH_MODES:
@@ -519,6 +525,12 @@ static int check_views(vv_options *o)
         !o->bench)
         return usage_error("%s", "--buffer-floats, --bench-lights, --bench-cube-sizes, "
                                  "--bench-modes, --bench-counts, --json: only with --bench");
+    if (o->cpca_load && o->cpca_frame)
+        return usage_error("%s", "--cpca-load and --cpca-frame: decode once at load or once "
+                                 "per frame, not both");
+    if (o->cpca_load && o->bench)
+        return usage_error("%s", "--cpca-load: not with --bench (--compute times "
+                                 "MODE-compute-load)");
     if (o->frames_arg && !vt_parse_int(o->frames_arg, 1, 1000000, &o->frames))
         return usage_error("--frames: expected a positive count, got '%s'", o->frames_arg);
     return 0;

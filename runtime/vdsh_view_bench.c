@@ -28,7 +28,8 @@ typedef struct bench_mode {
     int stream;    /* VR_MODE_VDSH_BUFFER's */
     int from_copy; /* drawn from a copy of the scene (bench_scene.copy):
                                 1 decoded-f32, 2 cpca decoded once per frame,
-                                3 sums in a compute shader */
+                                3 sums in a compute shader, 4 the same
+                                decoded at load */
     int renderer;  /* index into the renderers: 0, or 1 + the
                                 --bench-cube-sizes entry of a sized cube */
     int cube_size; /* VR_MODE_CUBE: its face size */
@@ -81,8 +82,9 @@ typedef struct bench_scene {
     vr_scene *scene;
     /* copies of the scene for the buffer modes: [0] --buffer-floats
      * (buffers as decoded f32), [1] --cpca-frame (cpca decoded once per
-     * frame), [2] --compute (sums in a compute shader) */
-    vr_scene *copy[3];
+     * frame), [2] --compute (sums in a compute shader), [3] the same with
+     * a cpca stream decoded at load */
+    vr_scene *copy[4];
     bench_mode modes[BENCH_MODES];
     int nm;
     vr_light lights[BENCH_SETS][VR_MAX_POOL_LIGHTS];
@@ -162,16 +164,23 @@ static void add_buffer_modes(bench_scene *b)
  * buffer mode of a cpca stream again, from a copy that decodes it once
  * per frame into a scratch (vr_scene_desc.cpca_decode, "buf12-frame").
  * --compute (copy 3): each buffer mode again, from a copy whose sums are
- * computed in a compute shader (vr_scene_desc.sums, "buf12-compute"). */
+ * computed in a compute shader (vr_scene_desc.sums, "buf12-compute"; a
+ * cpca stream decoded in the sums), and (copy 4) each cpca one again with
+ * the stream decoded at load ("buf12-compute-load"). */
 static int add_copy_modes(bench_scene *b, int copy)
 {
-    static const char *suffix[3] = {"f32", "frame", "compute"};
-    static char names[3][VV_MAX_MODES][32];
+    static const char *suffix[4] = {"f32", "frame", "compute", "compute-load"};
+    static char names[4][VV_MAX_MODES][32];
     int n = b->nm, any = 0;
     vr_scene_info info;
     vr_scene_get_info(b->scene, &info);
-    for (int m = 0; m < n; m++)
-        any |= b->modes[m].mode == VR_MODE_VDSH_BUFFER && !b->modes[m].from_copy;
+    for (int m = 0; m < n; m++) {
+        int st = b->modes[m].stream;
+        /* copies 2 and 4 differ from the scene in their cpca streams only */
+        any |= b->modes[m].mode == VR_MODE_VDSH_BUFFER && !b->modes[m].from_copy &&
+               ((copy != 2 && copy != 4) || (st >= 1 && st < VDSH_ORDER_SLOTS &&
+                                             info.buffer_encoding[st] == VDSH_ENCODING_CPCA));
+    }
     if (!any)
         return 0;
     vr_error err;
@@ -179,8 +188,10 @@ static int add_copy_modes(bench_scene *b, int copy)
                         .skip_cubemaps = 1,
                         .buffers = 1,
                         .buffer_floats = copy == 1,
-                        .cpca_decode = copy == 2 ? VR_CPCA_PER_FRAME : VR_CPCA_PER_PASS,
-                        .sums = copy == 3 ? VR_SUMS_COMPUTE : VR_SUMS_VERTEX};
+                        .cpca_decode = copy == 2   ? VR_CPCA_PER_FRAME
+                                       : copy == 4 ? VR_CPCA_AT_LOAD
+                                                   : VR_CPCA_PER_PASS,
+                        .sums = copy >= 3 ? VR_SUMS_COMPUTE : VR_SUMS_VERTEX};
     if (vr_scene_create(&sd, &b->copy[copy - 1], &err) != VR_OK) {
         fprintf(stderr, "vdsh-view: %s\n", err.msg);
         return 1;
@@ -189,7 +200,7 @@ static int add_copy_modes(bench_scene *b, int copy)
         int k = vv_mode_find(b->modes[m].name, strlen(b->modes[m].name), VV_MODE_BENCH_LOG);
         int st = b->modes[m].stream;
         if (b->modes[m].mode != VR_MODE_VDSH_BUFFER || b->modes[m].from_copy || k < 0 ||
-            (copy == 2 &&
+            ((copy == 2 || copy == 4) &&
              (st < 1 || st >= VDSH_ORDER_SLOTS || info.buffer_encoding[st] != VDSH_ENCODING_CPCA)))
             continue;
         snprintf(names[copy - 1][k], sizeof names[copy - 1][k], "%s-%s", vv_modes[k].json,
@@ -230,7 +241,7 @@ static int bench_open(const vv_options *o, const char *path, bench_scene *b)
         return 1;
     if (o->cpca_frame && add_copy_modes(b, 2))
         return 1;
-    if (o->compute && add_copy_modes(b, 3))
+    if (o->compute && (add_copy_modes(b, 3) || add_copy_modes(b, 4)))
         return 1;
     bench_filter(o, b);
     if (!b->nm) {
@@ -478,7 +489,7 @@ int vv_run_bench(const vv_options *o)
     vt_json_free(&j);
     for (int i = 0; b && i < o->file_count; i++) {
         vr_scene_destroy(b[i].scene);
-        for (int c = 0; c < 3; c++)
+        for (int c = 0; c < 4; c++)
             vr_scene_destroy(b[i].copy[c]);
     }
     free(b);

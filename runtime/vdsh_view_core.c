@@ -260,8 +260,10 @@ int vv_open_scene(const vv_options *o, const char *path, vr_scene **out)
                         .skip_cubemaps = o->no_cubemaps,
                         .light_pool = pool,
                         .buffers = o->buffers,
-                        .cpca_decode =
-                            o->cpca_frame && !o->bench ? VR_CPCA_PER_FRAME : VR_CPCA_PER_PASS,
+                        .cpca_decode = o->bench        ? VR_CPCA_PER_PASS
+                                       : o->cpca_frame ? VR_CPCA_PER_FRAME
+                                       : o->cpca_load  ? VR_CPCA_AT_LOAD
+                                                       : VR_CPCA_PER_PASS,
                         .sums = o->compute && !o->bench ? VR_SUMS_COMPUTE : VR_SUMS_VERTEX,
                         .sdf_path = o->sdf_path,
                         .light_region = o->light_region};

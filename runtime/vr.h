@@ -158,7 +158,7 @@ typedef struct vr_error {
 
 typedef struct vr_scene vr_scene;
 
-enum { VR_CPCA_PER_PASS = 0, VR_CPCA_PER_FRAME = 1 };
+enum { VR_CPCA_PER_PASS = 0, VR_CPCA_PER_FRAME = 1, VR_CPCA_AT_LOAD = 2 };
 enum { VR_SUMS_VERTEX = 0, VR_SUMS_COMPUTE = 1 };
 
 typedef struct vr_scene_desc {
@@ -196,15 +196,19 @@ typedef struct vr_scene_desc {
      * 4x s8; a cpca stream decoded at load), no unpacking in the shader:
      * for comparisons. */
     int buffer_floats;
-    /* Where a cpca stream is decoded. VR_CPCA_PER_PASS (0, default): in
-     * the vertex stage of every pass of up to VR_MAX_LIGHTS_PER_PASS
-     * lights, from the records as stored (their bytes and the model's
-     * only). VR_CPCA_PER_FRAME: once per vr_draw, by a draw of points
-     * that writes every vertex's f32 coefficients into a scratch buffer
-     * that all the passes then read (16 bytes per 4 coefficients per
-     * vertex more: 576 at order 12; needs shader storage buffers in the
-     * vertex stage, GL 4.3 or GL_ARB_shader_storage_buffer_object, else
-     * the load fails with VR_ERR_GL). docs/BENCHMARKS.md has both. */
+    /* Where a cpca stream is decoded. VR_CPCA_PER_PASS (0, default):
+     * where its sums are computed, from the records as stored (their
+     * bytes and the model's only): in the vertex stage of every pass of up
+     * to VR_MAX_LIGHTS_PER_PASS lights, or (VR_SUMS_COMPUTE) in the
+     * compute sums, once per vertex for up to 16 of the frame's lights.
+     * VR_CPCA_PER_FRAME: once per vr_draw, by a compute shader that writes
+     * every vertex's f32 coefficients into a scratch buffer that the sums
+     * then read (16 bytes per 4 coefficients per vertex more: 576 at order
+     * 12). VR_CPCA_AT_LOAD: the same once, at load, the records and the
+     * model then freed (576 bytes per vertex in all at order 12). Both
+     * need compute shaders and shader storage buffers (GL 4.3, or
+     * GL_ARB_compute_shader and GL_ARB_shader_storage_buffer_object), else
+     * the load fails with VR_ERR_GL. docs/BENCHMARKS.md has each. */
     int cpca_decode;
     /* Where a buffer stream's SH sums (VR_MODE_VDSH_BUFFER, a stream of
      * one order) are computed. VR_SUMS_VERTEX (0, default): in the vertex
@@ -212,11 +216,10 @@ typedef struct vr_scene_desc {
      * once per vr_draw in a compute shader, one invocation per vertex and
      * up to 8 lights, into a storage buffer of 4 bytes per vertex and
      * light of the frame that the passes read, one value per light, as
-     * order 5's attributes are read. A cpca stream is then decoded once,
-     * at load, on the GPU into f32 records that the sums read (576 more
-     * GPU bytes per vertex at order 12; cpca_decode is not read). The
-     * high orders' path on a GPU (docs/BENCHMARKS.md "Sums in a compute
-     * shader"). Needs
+     * order 5's attributes are read; only the vertices of triangles in
+     * view. A cpca stream is decoded as cpca_decode says (the default: in
+     * the sums). The high orders' path on a GPU (docs/BENCHMARKS.md "Sums
+     * in a compute shader"). Needs
      * compute shaders and storage buffers (GL 4.3, or
      * GL_ARB_compute_shader and GL_ARB_shader_storage_buffer_object), else
      * the load fails with VR_ERR_GL. A stream with an order per vertex

@@ -116,8 +116,9 @@ void vr_buffer_destroy(vr_buffer *b)
     glDeleteBuffers(5, bufs);
     if (b->decode_prog)
         glDeleteProgram(b->decode_prog);
-    if (b->sums_prog)
-        glDeleteProgram(b->sums_prog);
+    for (int g = 0; g <= VR_SUMS_MAX_GROUP; g++)
+        if (b->sums_prog[g])
+            glDeleteProgram(b->sums_prog[g]);
     free(b->ks);
     free(b->cpca_unpack);
     memset(b, 0, sizeof *b);
@@ -526,20 +527,28 @@ void vr_buffer_decode(const vr_scene *s, const vr_buffer *b)
  * 178; 8 is the vertex stage's own group. On a GPU one light per
  * invocation was measured (tests/compute_probe on an NVIDIA H200: 0.13
  * ms at 16 lights, 28-45x under the vertex stage, whose per-light arrays
- * a GPU compiler may keep in memory), and a group was not. The
- * environment's VR_SUMS_GROUP (1..8) overrides it, for the tests (which
- * draw both on llvmpipe) and for measuring another GL. */
-static int sums_group(void)
+ * a GPU compiler may keep in memory), and a group was not. A cpca
+ * stream decoded in the sums (in_sums) takes all the frame's lights, up to
+ * VR_SUMS_MAX_GROUP, in one invocation, which then decodes each
+ * coefficient once for them: 0, the frame's (at 16 lights in the room,
+ * 211 ms of CPU with 16, 293 with 8). The environment's VR_SUMS_GROUP
+ * (1..16) overrides it, for the tests (which draw both on llvmpipe) and
+ * for measuring another GL. */
+static int sums_group(int in_sums)
 {
     const char *e = getenv("VR_SUMS_GROUP");
-    if (e && e[0] >= '1' && e[0] <= '0' + VR_MAX_LIGHTS_PER_PASS && !e[1])
-        return e[0] - '0';
+    char *end = NULL;
+    long g = e ? strtol(e, &end, 10) : 0;
+    if (e && end != e && !*end && g >= 1 && g <= VR_SUMS_MAX_GROUP)
+        return (int)g;
+    if (in_sums)
+        return 0;
     const char *r = (const char *)glGetString(GL_RENDERER);
     return r && strstr(r, "llvmpipe") ? VR_MAX_LIGHTS_PER_PASS : 1;
 }
 
-/* A cpca stream decoded at load for the sums (VR_SUMS_COMPUTE): its
- * records, model and decode program deleted; the scratch stays. */
+/* A cpca stream decoded at load (VR_CPCA_AT_LOAD): its records, model
+ * and decode program deleted; the scratch stays. */
 static void release_decoded(vr_buffer *b)
 {
     GLuint texs[2] = {b->tex, b->model_tex}, bufs[2] = {b->buf, b->model_buf};
@@ -549,11 +558,13 @@ static void release_decoded(vr_buffer *b)
     b->tex = b->model_tex = b->buf = b->model_buf = b->decode_prog = 0;
 }
 
-/* VR_SUMS_COMPUTE: the sums program of fixed-order stream b
- * (shaders/vr_sums.glsl), reading its records as stored or, for a cpca
- * stream, its scratch (make_decoder first). VR_ERR_GL without compute
- * shaders, VR_ERR_SHADER, VR_ERR_OUT_OF_MEMORY. */
-static vr_result make_summer(const vr_scene *s, vr_buffer *b, const char *name, vr_error *err)
+/* VR_SUMS_COMPUTE: the sums program of fixed-order stream b for `group`
+ * lights per invocation (shaders/vr_sums.glsl), b->sums_prog[group],
+ * reading its scratch where it has one, else its records as stored (a
+ * cpca stream's decoded as they are read, from the model). VR_ERR_GL
+ * without compute shaders, VR_ERR_SHADER, VR_ERR_OUT_OF_MEMORY. */
+static vr_result make_summer(const vr_scene *s, vr_buffer *b, int group, const char *name,
+                             vr_error *err)
 {
     if (!vr_has_compute())
         return vr_fail(err, VR_ERR_GL,
@@ -562,37 +573,41 @@ static vr_result make_summer(const vr_scene *s, vr_buffer *b, const char *name, 
                        name, b->order);
     int scratch = b->scratch_tex != 0;
     vr_buf_kind kind = scratch ? VR_BUF_F32 : b->kind;
-    b->sums_group = sums_group();
-    char defines[256];
-    snprintf(
-        defines, sizeof defines,
-        "%s#define BUFFER 1\n#define NUM_LIGHTS %d\n#define BUF_ORDER %d\n#define BUF_KIND %d\n"
-        "#define BUF_VARIABLE 0\n#define BUF_STRIDE %d\n",
-        compute_version(), b->sums_group, b->order, (int)kind,
-        scratch ? b->scratch_stride : b->stride);
+    const char *unpack = !scratch && b->cpca_unpack ? b->cpca_unpack : "";
+    char defines[512];
+    snprintf(defines, sizeof defines,
+             "%s#define BUFFER 1\n#define NUM_LIGHTS %d\n#define BUF_ORDER %d\n"
+             "#define BUF_KIND %d\n#define BUF_VARIABLE 0\n#define BUF_STRIDE %d\n"
+             "#define BUF_CPCA_BASIS %d\n#define BUF_CPCA_BITS %d\n#define BUF_CPCA_T %d\n",
+             compute_version(), group, b->order, (int)kind, scratch ? b->scratch_stride : b->stride,
+             b->cpca_basis, b->cpca_bits, vr_buffer_stride(b->order, VR_BUF_F32));
     char *table = vr_ks_table(b->ks, b->order * b->order);
-    size_t size = strlen(defines) + (table ? strlen(table) : 0) + vr_sums_glsl_size +
-                  vr_buffer_glsl_size + vr_sums_main_glsl_size + 1;
+    size_t size = strlen(defines) + strlen(unpack) + (table ? strlen(table) : 0) +
+                  vr_sums_glsl_size + vr_buffer_glsl_size + vr_sums_main_glsl_size + 1;
     char *cs = table ? malloc(size) : NULL;
     if (!cs) {
         free(table);
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
     }
-    snprintf(cs, size, "%s%s%s%s%s", defines, table, vr_sums_glsl, vr_buffer_glsl,
+    snprintf(cs, size, "%s%s%s%s%s%s", defines, unpack, table, vr_sums_glsl, vr_buffer_glsl,
              vr_sums_main_glsl);
     free(table);
     char what[256];
-    snprintf(what, sizeof what, "%s: order %d sums program", name, b->order);
-    vr_result r = vr_link_compute(what, cs, &b->sums_prog, err);
+    snprintf(what, sizeof what, "%s: order %d sums program (%d light%s per invocation)", name,
+             b->order, group, group == 1 ? "" : "s");
+    GLuint prog = 0;
+    vr_result r = vr_link_compute(what, cs, &prog, err);
     free(cs);
     if (r != VR_OK)
         return r;
-    glUseProgram(b->sums_prog);
-    glUniform1i(glGetUniformLocation(b->sums_prog, "u_coef"), VR_UNIT_COEF);
-    glUniform1i(glGetUniformLocation(b->sums_prog, "u_vertices"), (GLint)s->vertex_count);
-    glUniform1f(glGetUniformLocation(b->sums_prog, "u_scale"), b->scale);
-    b->sums_u_lights = glGetUniformLocation(b->sums_prog, "u_lights");
-    b->sums_u_frame = glGetUniformLocation(b->sums_prog, "u_frame");
+    glUseProgram(prog);
+    glUniform1i(glGetUniformLocation(prog, "u_coef"), VR_UNIT_COEF);
+    glUniform1i(glGetUniformLocation(prog, "u_model"), VR_UNIT_MODEL);
+    glUniform1i(glGetUniformLocation(prog, "u_vertices"), (GLint)s->vertex_count);
+    glUniform1f(glGetUniformLocation(prog, "u_scale"), b->scale);
+    b->sums_prog[group] = prog;
+    b->sums_u_lights[group] = glGetUniformLocation(prog, "u_lights");
+    b->sums_u_frame[group] = glGetUniformLocation(prog, "u_frame");
     glUseProgram(0);
     return vr_check_gl(err, name);
 }
@@ -625,24 +640,33 @@ void vr_cull(const vr_scene *s, GLuint prog, GLuint seen, const float vp[16], ui
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
-void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint sums, int n,
-                    GLuint seen, uint32_t frame)
+vr_result vr_buffer_sums(const vr_scene *s, vr_buffer *b, GLuint lights, GLuint sums, int n,
+                         GLuint seen, uint32_t frame, vr_error *err)
 {
-    glUseProgram(b->sums_prog);
-    glUniform1i(b->sums_u_lights, n);
-    glUniform1ui(b->sums_u_frame, frame);
+    int group = b->sums_group ? b->sums_group : n < VR_SUMS_MAX_GROUP ? n : VR_SUMS_MAX_GROUP;
+    if (!b->sums_prog[group]) {
+        vr_result r = make_summer(s, b, group, "vr_draw", err);
+        if (r != VR_OK)
+            return r;
+    }
+    glUseProgram(b->sums_prog[group]);
+    glUniform1i(b->sums_u_lights[group], n);
+    glUniform1ui(b->sums_u_frame[group], frame);
     glActiveTexture(GL_TEXTURE0 + VR_UNIT_COEF);
     glBindTexture(GL_TEXTURE_BUFFER, b->scratch_tex ? b->scratch_tex : b->tex);
+    glActiveTexture(GL_TEXTURE0 + VR_UNIT_MODEL);
+    glBindTexture(GL_TEXTURE_BUFFER, b->scratch_tex ? 0 : b->model_tex);
     glActiveTexture(GL_TEXTURE0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s->vbo_position);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, lights);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, sums);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, seen);
-    dispatch((size_t)s->vertex_count * (size_t)((n + b->sums_group - 1) / b->sums_group));
+    dispatch((size_t)s->vertex_count * (size_t)((n + group - 1) / group));
     for (GLuint i = 0; i < 4; i++)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, 0);
     /* the passes read the sums as a buffer texture */
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    return VR_OK;
 }
 
 vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *remap, int floats,
@@ -753,24 +777,25 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
             b.bytes += model_bytes;
         }
         r = vr_check_gl(err, name);
-        int summed = sums == VR_SUMS_COMPUTE && !b.variable;
-        if (r == VR_OK && model && (cpca_decode == VR_CPCA_PER_FRAME || summed))
+        int at_load = model && cpca_decode == VR_CPCA_AT_LOAD;
+        if (r == VR_OK && model && (cpca_decode == VR_CPCA_PER_FRAME || at_load))
             r = make_decoder(s, &b, name, err);
-        /* summed in a compute shader, a cpca stream is decoded here,
-         * once: its scratch then holds the same texels every frame */
-        if (r == VR_OK && summed && b.decode_prog) {
+        /* decoded here, once: the scratch then holds the same texels every
+         * frame, and the records, the model and the decode program are
+         * not needed again (36 B per vertex in the room at the default
+         * --cpca) */
+        if (r == VR_OK && at_load) {
             vr_buffer_decode(s, &b);
             r = vr_check_gl(err, name);
-        }
-        if (r == VR_OK && summed)
-            r = make_summer(s, &b, name, err);
-        /* the sums read the scratch only: the records, the model and the
-         * decode program are not needed again (36 B per vertex in the
-         * room at the default --cpca) */
-        if (r == VR_OK && summed && b.decode_prog) {
             release_decoded(&b);
             b.bytes -= bytes + model_bytes;
         }
+        b.summed = sums == VR_SUMS_COMPUTE && !b.variable;
+        b.sums_group = b.summed ? sums_group(model && !b.scratch_tex) : 0;
+        /* the first frame's program now, so that a GL that cannot build
+         * it fails the load */
+        if (r == VR_OK && b.summed)
+            r = make_summer(s, &b, b.sums_group ? b.sums_group : VR_SUMS_MAX_GROUP, name, err);
     }
     free(model);
     free(rec);

@@ -84,6 +84,9 @@ typedef enum vr_buf_kind {
 } vr_buf_kind;
 
 /* A stream drawn from buffer textures (VR_MODE_VDSH_BUFFER). */
+/* The most lights one invocation of the compute sums takes. */
+enum { VR_SUMS_MAX_GROUP = 16 };
+
 typedef struct vr_buffer {
     int order;          /* fixed: its order; variable: the cap; 0: none */
     int variable;       /* 1: an order per vertex */
@@ -118,11 +121,17 @@ typedef struct vr_buffer {
      * 0; release_decoded) */
     GLuint decode_prog, scratch_buf, scratch_tex;
     int scratch_stride;
-    /* VR_SUMS_COMPUTE (vr_scene_desc.sums): the sums program
-     * (shaders/vr_sums.glsl), which reads the records, or the scratch */
-    GLuint sums_prog;
-    GLint sums_u_lights, sums_u_frame;
-    int sums_group; /* lights per invocation */
+    /* VR_SUMS_COMPUTE (vr_scene_desc.sums; summed set): the sums
+     * programs (shaders/vr_sums.glsl) by lights per invocation, each
+     * built when first needed (0: not yet), reading the records (a cpca
+     * stream's decoded as they are read: "in the sums") or the scratch;
+     * sums_group: the lights per invocation, or 0: the frame's lights, up
+     * to VR_SUMS_MAX_GROUP (a cpca stream decoded in the sums, whose
+     * decode a group shares) */
+    int summed;
+    GLuint sums_prog[VR_SUMS_MAX_GROUP + 1];
+    GLint sums_u_lights[VR_SUMS_MAX_GROUP + 1], sums_u_frame[VR_SUMS_MAX_GROUP + 1];
+    int sums_group;
 } vr_buffer;
 
 /* Upload stream st (its quantity drawn) as a buffer stream of s, in the
@@ -140,8 +149,8 @@ void vr_buffer_decode(const vr_scene *s, const vr_buffer *b);
  * positions storage buffer `lights` holds (n vec4, xyz; w unused), per
  * vertex and light, into sums (vertex-major: vertex v's at v * n), of the
  * vertices whose u32 in `seen` is `frame` (vr_cull). */
-void vr_buffer_sums(const vr_scene *s, const vr_buffer *b, GLuint lights, GLuint sums, int n,
-                    GLuint seen, uint32_t frame);
+vr_result vr_buffer_sums(const vr_scene *s, vr_buffer *b, GLuint lights, GLuint sums, int n,
+                         GLuint seen, uint32_t frame, vr_error *err);
 /* The cull program (shaders/vr_cull.glsl) into *prog. VR_ERR_SHADER. */
 vr_result vr_cull_make(GLuint *prog, vr_error *err);
 /* Set seen[v] = frame for every vertex v of s that a triangle the view

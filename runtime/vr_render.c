@@ -905,8 +905,8 @@ static vr_result frame_cull(vr_renderer *r, const vr_scene *s, const float vp[16
 /* VR_SUMS_COMPUTE: the frame's sums toward all its lights
  * (vr_buffer_sums) at the vertices view vp uses (frame_cull), into the
  * renderer's storage, grown as needed. */
-static vr_result frame_sums(vr_renderer *r, const vr_scene *s, const vr_buffer *b,
-                            const vr_draw_desc *d, const float vp[16], vr_error *err)
+static vr_result frame_sums(vr_renderer *r, const vr_scene *s, vr_buffer *b, const vr_draw_desc *d,
+                            const float vp[16], vr_error *err)
 {
     size_t need = (size_t)s->vertex_count * (size_t)d->light_count;
     if (need > r->sums_cap) {
@@ -956,7 +956,7 @@ static vr_result frame_sums(vr_renderer *r, const vr_scene *s, const vr_buffer *
     uint32_t frame = 0;
     vr_result res = frame_cull(r, s, vp, &frame, err);
     if (res == VR_OK)
-        vr_buffer_sums(s, b, r->sums_lights, r->sums_buf, n, r->seen_buf, frame);
+        res = vr_buffer_sums(s, b, r->sums_lights, r->sums_buf, n, r->seen_buf, frame, err);
     return res;
 }
 
@@ -1001,13 +1001,15 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
      * once at load where the sums are computed (vr_buffer_upload). */
     F.scratch = F.buf && F.buf->scratch_tex;
     /* Sums in a compute shader: once for all the frame's lights. */
-    F.summed = F.buf && F.buf->sums_prog && d.light_count > 0;
+    F.summed = F.buf && F.buf->summed && d.light_count > 0;
     /* both counted as the first group's lighting in the timings */
     int t = F.scratch || F.summed ? timer_begin(r, F.slot, 1, 0) : 0;
     if (F.scratch && F.buf->decode_prog)
         vr_buffer_decode(s, F.buf);
     if (F.summed)
-        res = frame_sums(r, s, F.buf, &d, F.vp, err);
+        /* the sums programs are built as the frames need them: a cache
+         * in the scene's buffer, not a change to what it draws */
+        res = frame_sums(r, s, (vr_buffer *)F.buf, &d, F.vp, err);
     timer_end(t);
 
     for (int g = 0; g < groups && res == VR_OK; g++)

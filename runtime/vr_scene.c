@@ -258,10 +258,12 @@ static vr_result check_desc(const vr_scene_desc *desc, const char *name, vr_erro
     if ((unsigned)desc->quantity > VDSH_QUANTITY_LOG_DISTANCE)
         return vr_fail(err, VR_ERR_ARGUMENT, "%s: unknown quantity %u", name,
                        (unsigned)desc->quantity);
-    if (desc->cpca_decode != VR_CPCA_PER_PASS && desc->cpca_decode != VR_CPCA_PER_FRAME)
-        return vr_fail(err, VR_ERR_ARGUMENT,
-                       "%s: cpca_decode %d is neither VR_CPCA_PER_PASS nor VR_CPCA_PER_FRAME", name,
-                       desc->cpca_decode);
+    if (desc->cpca_decode != VR_CPCA_PER_PASS && desc->cpca_decode != VR_CPCA_PER_FRAME &&
+        desc->cpca_decode != VR_CPCA_AT_LOAD)
+        return vr_fail(
+            err, VR_ERR_ARGUMENT,
+            "%s: cpca_decode %d is not VR_CPCA_PER_PASS, VR_CPCA_PER_FRAME or VR_CPCA_AT_LOAD",
+            name, desc->cpca_decode);
     if (desc->sums != VR_SUMS_VERTEX && desc->sums != VR_SUMS_COMPUTE)
         return vr_fail(err, VR_ERR_ARGUMENT,
                        "%s: sums %d is neither VR_SUMS_VERTEX nor VR_SUMS_COMPUTE", name,

@@ -172,6 +172,9 @@ expect2 --bench --bench-cube-sizes 1,2,3,4,5,6,7,8,9 "$room"
 expect2 --bench-counts "$room"
 expect2 --bench-modes none "$room"
 expect2 --bench --bench-modes "" "$room"
+# a cpca stream decoded at load and per frame, or at load in --bench
+expect2 --render a.png --cpca-load --cpca-frame "$room"
+expect2 --bench --cpca-load "$room"
 # the window's options where no window opens (they were ignored, exit 0)
 expect2 --render a.png --keys abc "$room"
 expect2 --grid a.png --screenshot b.png "$room"
@@ -666,11 +669,12 @@ _runtime_props(runtime_view_cpca_frame FIXTURES_REQUIRED runtime_room)
 endif()
 
 # Sums in a compute shader (--compute, vr_scene_desc.sums, issue 29): the
-# order-12 cpca stream (decoded once per frame, then summed per vertex
-# and light) and an s8s6 one (summed from its records) draw the frame the
-# vertex stage draws, at 16 lights (two passes reading the frame's sums
-# at their offsets) and 64 (eight), with 8, 3 and 1 lights per
-# invocation (VR_SUMS_GROUP); 3 lights is the control. Skips (77)
+# order-12 cpca stream (decoded in the sums, per vertex for up to 16
+# lights; or at load, --cpca-load) and an s8s6 one (summed from its
+# records) draw the frame the vertex stage draws, at 16 lights (two
+# passes reading the frame's sums at their offsets) and 64 (eight), with
+# the default lights per invocation (16 for the cpca stream, 8 for s8s6 on
+# llvmpipe), 3 and 1 (VR_SUMS_GROUP); 3 lights is the control. Skips (77)
 # where the GL has no compute shaders, which vdsh-view reports as a
 # failed load.
 if(TARGET vdsh-bake)
@@ -730,18 +734,29 @@ done
 MESA_GL_VERSION_OVERRIDE=3.3 MESA_GLSL_VERSION_OVERRIDE=330 "$v" -q --render "$d/c16e.png" \
   --size 96x72 --mode buf12 --lights 16 --compute "$d/c.vdsh"
 "$png" same "$d/c16.png" "$d/c16e.png" 2
-# GPU memory: summed in compute, the cpca stream keeps only its f32
-# scratch (576 B per vertex at order 12), the records and model freed
-# after the decode at load; once per frame it keeps both
-"$v" -q --bench --bench-modes buf12,buf12-frame,buf12-compute --bench-lights 1 --frames 1 \
-  --size 32x24 --cpca-frame --compute -j "$d/bytes.json" "$d/c.vdsh"
+# a cpca stream decoded at load (--cpca-load, VR_CPCA_AT_LOAD), summed in
+# compute or in the vertex stage: the same frame
+for n in 3 16; do
+  "$v" -q --render "$d/c${n}l.png" --size 96x72 --mode buf12 --lights $n --cpca-load "$d/c.vdsh"
+  "$v" -q --render "$d/c${n}lx.png" --size 96x72 --mode buf12 --lights $n --cpca-load --compute \
+    "$d/c.vdsh"
+  "$png" same "$d/c$n.png" "$d/c${n}l.png" 2
+  "$png" same "$d/c$n.png" "$d/c${n}lx.png" 2
+done
+# GPU memory: decoded in the compute sums, the cpca stream keeps its
+# records and model only, as per pass; decoded at load, only its f32
+# scratch (576 B per vertex at order 12), the records and model freed;
+# once per frame both
+"$v" -q --bench --bench-modes buf12,buf12-frame,buf12-compute,buf12-compute-load --bench-lights 1 \
+  --frames 1 --size 32x24 --cpca-frame --compute -j "$d/bytes.json" "$d/c.vdsh"
 /usr/bin/python3 - "$d/bytes.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))["scenes"][0]
 b = {r["mode"]: r["buffer_bytes"] for r in s["results"]}
 scratch = s["vertices"] * 576
 print("buffer bytes", b, "scratch", scratch)
-assert b["buf12-compute"] == scratch, "compute keeps more than the scratch"
+assert b["buf12-compute"] == b["buf12"], "decoded in the sums: the records and model only"
+assert b["buf12-compute-load"] == scratch, "decoded at load: more than the scratch"
 assert b["buf12-frame"] == b["buf12"] + scratch, "per frame: records, model and scratch"
 assert 0 < b["buf12"] < scratch
 PY
@@ -809,12 +824,13 @@ if [ $rc -ne 0 ]; then
   exit 1
 fi
 set -e
-for g in 1 8; do
+for g in default 1 8; do
   /usr/bin/python3 - "$d/o/bench-room-group$g.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
 got = {(r["mode"], r["lights"]) for s in j["scenes"] for r in s["results"]}
-want = {(m, n) for m in ("buf12", "buf12-frame", "buf12-compute") for n in (1, 16, 64)}
+want = {(m, n) for m in ("buf12", "buf12-frame", "buf12-compute", "buf12-compute-load")
+        for n in (1, 16, 64)}
 want |= {("vdsh5", n) for n in (1, 16, 64)}
 assert want <= got, "missing %s" % sorted(want - got)
 assert "/b/s/room-c.vdsh" in json.dumps(j), "not the bundle's bakes"
