@@ -75,6 +75,10 @@ static const char usage_text[] =
     "                        pass; with --bench: time its buffer modes both\n"
     "                        ways (MODE-compute), and a cpca stream's also\n"
     "                        decoded at load (MODE-compute-load)\n"
+    "      --vertex-sums     sum every buffer stream in the vertex stage of each\n"
+    "                        pass (a cpca stream's too, decoded there), where\n"
+    "                        by default a cpca stream's are summed in compute\n"
+    "                        as with --compute when the GL has compute shaders\n"
     "      --cpca-load       decode a cpca stream to f32 once, at load, on the\n"
     "                        GPU (576 GPU bytes per vertex at order 12, the\n"
     "                        records freed; GL 4.3)\n"
@@ -239,6 +243,7 @@ enum {
     O_CPCA_FRAME,
     O_COMPUTE,
     O_CPCA_LOAD,
+    O_VERTEX_SUMS,
     O_BENCH_LIGHTS,
     O_BENCH_CUBE_SIZES,
     O_BENCH_MODES,
@@ -278,6 +283,7 @@ static const struct option longopts[] = {
     {"cpca-frame", no_argument, 0, O_CPCA_FRAME},
     {"compute", no_argument, 0, O_COMPUTE},
     {"cpca-load", no_argument, 0, O_CPCA_LOAD},
+    {"vertex-sums", no_argument, 0, O_VERTEX_SUMS},
     {"bench-lights", required_argument, 0, O_BENCH_LIGHTS},
     {"bench-cube-sizes", required_argument, 0, O_BENCH_CUBE_SIZES},
     {"bench-modes", required_argument, 0, O_BENCH_MODES},
@@ -484,6 +490,7 @@ static int parse_option(int c, const char *v, vv_options *o)
     case O_CPCA_FRAME: o->cpca_frame = 1; return 0;
     case O_COMPUTE: o->compute = 1; return 0;
     case O_CPCA_LOAD: o->cpca_load = 1; return 0;
+    case O_VERTEX_SUMS: o->vertex_sums = 1; return 0;
     case O_BENCH_LIGHTS: return parse_bench_lights(v, o);
     case O_BENCH_CUBE_SIZES: return parse_bench_cube_sizes(v, o);
     case O_BENCH_MODES:
@@ -528,6 +535,11 @@ static int check_views(vv_options *o)
     if (o->cpca_load && o->cpca_frame)
         return usage_error("%s", "--cpca-load and --cpca-frame: decode once at load or once "
                                  "per frame, not both");
+    if (o->vertex_sums && o->compute)
+        return usage_error("%s", "--vertex-sums and --compute: the sums in one place, not both");
+    if (o->vertex_sums && o->bench)
+        return usage_error("%s", "--vertex-sums: not with --bench (its buffer modes are the "
+                                 "vertex stage's; --compute adds MODE-compute)");
     if (o->cpca_load && o->bench)
         return usage_error("%s", "--cpca-load: not with --bench (--compute times "
                                  "MODE-compute-load)");

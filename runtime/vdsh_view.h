@@ -60,6 +60,7 @@ typedef struct vv_options {
     int cpca_frame;    /* cpca decoded once per frame (--cpca-frame) */
     int compute;       /* sums in a compute shader (--compute) */
     int cpca_load;     /* cpca decoded once at load (--cpca-load) */
+    int vertex_sums;   /* every buffer stream summed per pass (--vertex-sums) */
     /* --bench-lights: bit i, light set i of 1, 3, 16, 64; 0: all */
     int bench_sets;
     /* --bench-cube-sizes: cube and cube_pcf timed at each face size (cubeN,

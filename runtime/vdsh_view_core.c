@@ -97,7 +97,8 @@ void vv_mode_label(const vr_scene *s, vr_mode mode, int stream, char *out, size_
         snprintf(out, size, "VDSH adaptive order (up to %d, mean %.1f; per-vertex)",
                  info.variable_order, (double)info.variable_mean_order);
     else if (k > 0)
-        snprintf(out, size, "VDSH order %d (%d coeff., buffer, per-vertex)", k, k * k);
+        snprintf(out, size, "VDSH order %d (%d coeff., buffer, per-vertex%s)", k, k * k,
+                 info.buffer_compute[k] ? ", summed in compute" : "");
     else
         snprintf(out, size, "VDSH from a buffer");
 }
@@ -264,7 +265,12 @@ int vv_open_scene(const vv_options *o, const char *path, vr_scene **out)
                                        : o->cpca_frame ? VR_CPCA_PER_FRAME
                                        : o->cpca_load  ? VR_CPCA_AT_LOAD
                                                        : VR_CPCA_PER_PASS,
-                        .sums = o->compute && !o->bench ? VR_SUMS_COMPUTE : VR_SUMS_VERTEX,
+                        /* --bench: its buffer modes are the vertex
+                         * stage's, the copies the others */
+                        .sums = o->bench         ? VR_SUMS_VERTEX
+                                : o->compute     ? VR_SUMS_COMPUTE
+                                : o->vertex_sums ? VR_SUMS_VERTEX
+                                                 : VR_SUMS_AUTO,
                         .sdf_path = o->sdf_path,
                         .light_region = o->light_region};
     memcpy(sd.light_box, o->light_box, sizeof sd.light_box);

@@ -159,7 +159,7 @@ typedef struct vr_error {
 typedef struct vr_scene vr_scene;
 
 enum { VR_CPCA_PER_PASS = 0, VR_CPCA_PER_FRAME = 1, VR_CPCA_AT_LOAD = 2 };
-enum { VR_SUMS_VERTEX = 0, VR_SUMS_COMPUTE = 1 };
+enum { VR_SUMS_AUTO = 0, VR_SUMS_VERTEX = 1, VR_SUMS_COMPUTE = 2 };
 
 typedef struct vr_scene_desc {
     /* The .vdsh file to load. Either path or file must be set. */
@@ -211,7 +211,11 @@ typedef struct vr_scene_desc {
      * the load fails with VR_ERR_GL. docs/BENCHMARKS.md has each. */
     int cpca_decode;
     /* Where a buffer stream's SH sums (VR_MODE_VDSH_BUFFER, a stream of
-     * one order) are computed. VR_SUMS_VERTEX (0, default): in the vertex
+     * one order) are computed. VR_SUMS_AUTO (0, default): a cpca stream's
+     * as VR_SUMS_COMPUTE where the GL has compute shaders (faster at every
+     * light count measured, the same bytes: docs/BENCHMARKS.md "A cpca
+     * stream decoded in the compute sums"), every other stream's as
+     * VR_SUMS_VERTEX. VR_SUMS_VERTEX: in the vertex
      * stage of every pass, toward the pass's lights. VR_SUMS_COMPUTE:
      * once per vr_draw in a compute shader, one invocation per vertex and
      * up to 8 lights, into a storage buffer of 4 bytes per vertex and
@@ -295,6 +299,9 @@ typedef struct vr_scene_info {
     int has_buffer[VDSH_ORDER_SLOTS];
     vdsh_encoding buffer_encoding[VDSH_ORDER_SLOTS];
     int buffer_per_frame[VDSH_ORDER_SLOTS];
+    /* 1: the fixed stream of order n is summed in a compute shader
+     * (vr_scene_desc.sums) */
+    int buffer_compute[VDSH_ORDER_SLOTS];
     int variable_order;
     float variable_mean_order;
     vdsh_method variable_method;

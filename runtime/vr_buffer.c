@@ -790,7 +790,9 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
             release_decoded(&b);
             b.bytes -= bytes + model_bytes;
         }
-        b.summed = sums == VR_SUMS_COMPUTE && !b.variable;
+        b.summed =
+            (sums == VR_SUMS_COMPUTE || (sums == VR_SUMS_AUTO && model && vr_has_compute())) &&
+            !b.variable;
         b.sums_group = b.summed ? sums_group(model && !b.scratch_tex) : 0;
         /* the first frame's program now, so that a GL that cannot build
          * it fails the load */

@@ -264,9 +264,9 @@ static vr_result check_desc(const vr_scene_desc *desc, const char *name, vr_erro
             err, VR_ERR_ARGUMENT,
             "%s: cpca_decode %d is not VR_CPCA_PER_PASS, VR_CPCA_PER_FRAME or VR_CPCA_AT_LOAD",
             name, desc->cpca_decode);
-    if (desc->sums != VR_SUMS_VERTEX && desc->sums != VR_SUMS_COMPUTE)
+    if (desc->sums != VR_SUMS_AUTO && desc->sums != VR_SUMS_VERTEX && desc->sums != VR_SUMS_COMPUTE)
         return vr_fail(err, VR_ERR_ARGUMENT,
-                       "%s: sums %d is neither VR_SUMS_VERTEX nor VR_SUMS_COMPUTE", name,
+                       "%s: sums %d is not VR_SUMS_AUTO, VR_SUMS_VERTEX or VR_SUMS_COMPUTE", name,
                        desc->sums);
     if (desc->light_pool < 0 || desc->light_pool > VR_MAX_POOL_LIGHTS)
         return vr_fail(err, VR_ERR_ARGUMENT, "%s: light_pool %d not in 0..%d", name,
@@ -522,6 +522,7 @@ void vr_scene_get_info(const vr_scene *s, vr_scene_info *out)
         i.has_buffer[o] = s->buffer[o].order != 0;
         i.buffer_encoding[o] = s->buffer[o].encoding;
         i.buffer_per_frame[o] = s->buffer[o].decode_prog != 0;
+        i.buffer_compute[o] = s->buffer[o].summed;
         i.buffer_bytes += s->buffer[o].bytes;
     }
     i.variable_order = s->variable.order;

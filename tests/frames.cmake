@@ -96,16 +96,17 @@ done
 for f in cpca cpca5; do
   "$frames" truth "$d/$f.vdsh" --views "$views" -o "$d/$f-c" > /dev/null
 done
-"$view" "$d/cpca.vdsh" --views "$views" --frames "$d/cpca-gl" --modes buf12 -q
-"$view" "$d/cpca5.vdsh" --views "$views" --frames "$d/cpca5-gl" --modes buf3,buf7 -q
+"$view" "$d/cpca.vdsh" --vertex-sums --views "$views" --frames "$d/cpca-gl" --modes buf12 -q
+"$view" "$d/cpca5.vdsh" --vertex-sums --views "$views" --frames "$d/cpca5-gl" --modes buf3,buf7 -q
 "$cmp" "$views" "$d/cpca-c" "$d/cpca-gl" 0.002 0.005 buf12=c-vdsh12
 "$cmp" "$views" "$d/cpca5-c" "$d/cpca5-gl" 0.002 0.005 buf3=c-vdsh3 buf7=c-vdsh7
 # The same streams decoded once per frame into a scratch (--cpca-frame,
 # vr_scene_desc.cpca_decode; skipped where the GL has no shader storage
 # buffers in the vertex stage, which vdsh-view reports as a failed load).
-if "$view" "$d/cpca.vdsh" --cpca-frame --views "$views" --frames "$d/cpcaf-gl" --modes buf12 -q \
-    2> "$d/cpcaf.err"; then
-  "$view" "$d/cpca5.vdsh" --cpca-frame --views "$views" --frames "$d/cpca5f-gl" --modes buf3,buf7 -q
+if "$view" "$d/cpca.vdsh" --cpca-frame --vertex-sums --views "$views" --frames "$d/cpcaf-gl" \
+    --modes buf12 -q 2> "$d/cpcaf.err"; then
+  "$view" "$d/cpca5.vdsh" --cpca-frame --vertex-sums --views "$views" --frames "$d/cpca5f-gl" \
+    --modes buf3,buf7 -q
   "$cmp" "$views" "$d/cpca-c" "$d/cpcaf-gl" 0.002 0.005 buf12=c-vdsh12
   "$cmp" "$views" "$d/cpca5-c" "$d/cpca5f-gl" 0.002 0.005 buf3=c-vdsh3 buf7=c-vdsh7
 else

@@ -638,29 +638,29 @@ set -e
 "$bake" builtin:room --max-edge 1.0 --rays 256 --cube-size 0 --orders 12 --encoding cpca \
   --cpca 8,54,4 -q -o "$d/c.vdsh"
 set +e
-"$v" -q --render "$d/pass.png" --size 96x72 --mode buf12 --lights 16 "$d/c.vdsh"
+"$v" -q --vertex-sums --render "$d/pass.png" --size 96x72 --mode buf12 --lights 16 "$d/c.vdsh"
 rc=$?
 [ $rc -eq 77 ] && exit 77
 [ $rc -eq 0 ] || exit 1
-if ! "$v" -q --render "$d/frame.png" --size 96x72 --mode buf12 --lights 16 --cpca-frame \
+if ! "$v" -q --vertex-sums --render "$d/frame.png" --size 96x72 --mode buf12 --lights 16 --cpca-frame \
     "$d/c.vdsh" 2> "$d/frame.err"; then
   cat "$d/frame.err"
   grep -q "shader storage" "$d/frame.err" && exit 77
   exit 1
 fi
 set -e
-"$v" -q --render "$d/frame3.png" --size 96x72 --mode buf12 --lights 3 --cpca-frame "$d/c.vdsh"
+"$v" -q --vertex-sums --render "$d/frame3.png" --size 96x72 --mode buf12 --lights 3 --cpca-frame "$d/c.vdsh"
 "$png" info "$d/pass.png" 96 72
 "$png" same "$d/pass.png" "$d/frame.png" 2
 if "$png" same "$d/pass.png" "$d/frame3.png" 2; then echo "control: 3 and 16 lights the same"; exit 1; fi
-"$v" -q --render "$d/log.png" --size 96x72 --mode vdsh5 --cpca-frame "$log"
+"$v" -q --vertex-sums --render "$d/log.png" --size 96x72 --mode vdsh5 --cpca-frame "$log"
 "$png" info "$d/log.png" 96 72
 # A width per basis vector (--cpca K,alloc:BYTES, bits 0): the same, and
 # its frame is not the uniform stream's (the control)
 "$bake" builtin:room --max-edge 1.0 --rays 256 --cube-size 0 --orders 12 --encoding cpca \
   --cpca 8,alloc:32 -q -o "$d/w.vdsh"
-"$v" -q --render "$d/wpass.png" --size 96x72 --mode buf12 --lights 16 "$d/w.vdsh"
-"$v" -q --render "$d/wframe.png" --size 96x72 --mode buf12 --lights 16 --cpca-frame "$d/w.vdsh"
+"$v" -q --vertex-sums --render "$d/wpass.png" --size 96x72 --mode buf12 --lights 16 "$d/w.vdsh"
+"$v" -q --vertex-sums --render "$d/wframe.png" --size 96x72 --mode buf12 --lights 16 --cpca-frame "$d/w.vdsh"
 "$png" info "$d/wpass.png" 96 72
 "$png" same "$d/wpass.png" "$d/wframe.png" 2
 if "$png" same "$d/wpass.png" "$d/pass.png" 0; then echo "control: widths as uniform"; exit 1; fi
@@ -686,7 +686,7 @@ set -e
   -q -o "$d/c.vdsh"
 "$bake" builtin:room --max-edge 1.0 --rays 256 --cube-size 0 --orders 5,12 -q -o "$d/s.vdsh"
 set +e
-"$v" -q --render "$d/c16.png" --size 96x72 --mode buf12 --lights 16 "$d/c.vdsh"
+"$v" -q --vertex-sums --render "$d/c16.png" --size 96x72 --mode buf12 --lights 16 "$d/c.vdsh"
 rc=$?
 [ $rc -eq 77 ] && exit 77
 [ $rc -eq 0 ] || exit 1
@@ -699,7 +699,7 @@ fi
 set -e
 for f in c s; do
   for n in 3 16 64; do
-    [ -f "$d/$f$n.png" ] || "$v" -q --render "$d/$f$n.png" --size 96x72 --mode buf12 --lights $n "$d/$f.vdsh"
+    [ -f "$d/$f$n.png" ] || "$v" -q --vertex-sums --render "$d/$f$n.png" --size 96x72 --mode buf12 --lights $n "$d/$f.vdsh"
     [ -f "$d/$f${n}x.png" ] || "$v" -q --render "$d/$f${n}x.png" --size 96x72 --mode buf12 \
       --lights $n --compute "$d/$f.vdsh"
     "$png" info "$d/$f${n}x.png" 96 72
@@ -722,7 +722,7 @@ i=0
 for cam in "0,1.5,0,-9,1,-9" "5,2,5,-3,0.5,-1" "-1,1.2,2.5,-3,0.5,-1"; do
   i=$((i+1))
   for f in c s; do
-    "$v" -q --render "$d/${f}near$i.png" --size 96x72 --mode buf12 --lights 16 --camera "$cam" \
+    "$v" -q --vertex-sums --render "$d/${f}near$i.png" --size 96x72 --mode buf12 --lights 16 --camera "$cam" \
       --fov 25 "$d/$f.vdsh"
     "$v" -q --render "$d/${f}near${i}x.png" --size 96x72 --mode buf12 --lights 16 --camera "$cam" \
       --fov 25 --compute "$d/$f.vdsh"
@@ -737,7 +737,8 @@ MESA_GL_VERSION_OVERRIDE=3.3 MESA_GLSL_VERSION_OVERRIDE=330 "$v" -q --render "$d
 # a cpca stream decoded at load (--cpca-load, VR_CPCA_AT_LOAD), summed in
 # compute or in the vertex stage: the same frame
 for n in 3 16; do
-  "$v" -q --render "$d/c${n}l.png" --size 96x72 --mode buf12 --lights $n --cpca-load "$d/c.vdsh"
+  "$v" -q --vertex-sums --render "$d/c${n}l.png" --size 96x72 --mode buf12 --lights $n --cpca-load \
+    "$d/c.vdsh"
   "$v" -q --render "$d/c${n}lx.png" --size 96x72 --mode buf12 --lights $n --cpca-load --compute \
     "$d/c.vdsh"
   "$png" same "$d/c$n.png" "$d/c${n}l.png" 2
@@ -760,8 +761,16 @@ assert b["buf12-compute-load"] == scratch, "decoded at load: more than the scrat
 assert b["buf12-frame"] == b["buf12"] + scratch, "per frame: records, model and scratch"
 assert 0 < b["buf12"] < scratch
 PY
+# a cpca stream's sums are computed in compute by default (the GL has
+# compute shaders here), an s8s6 stream's and --vertex-sums' per pass
+"$v" --render "$d/dc.png" --size 32x24 --mode buf12 "$d/c.vdsh" 2>&1 | grep "summed in compute"
+"$v" --render "$d/ds.png" --size 32x24 --mode buf12 "$d/s.vdsh" 2>&1 | grep "per-vertex)"
+"$v" --render "$d/dv.png" --size 32x24 --mode buf12 --vertex-sums "$d/c.vdsh" 2>&1 |
+  grep "per-vertex)"
+"$v" --render "$d/dx.png" --size 32x24 --mode buf12 --compute "$d/s.vdsh" 2>&1 |
+  grep "summed in compute"
 # the attribute modes ignore it
-"$v" -q --render "$d/v5.png" --size 96x72 --mode vdsh5 --lights 16 "$d/s.vdsh"
+"$v" -q --vertex-sums --render "$d/v5.png" --size 96x72 --mode vdsh5 --lights 16 "$d/s.vdsh"
 "$v" -q --render "$d/v5x.png" --size 96x72 --mode vdsh5 --lights 16 --compute "$d/s.vdsh"
 "$png" same "$d/v5.png" "$d/v5x.png" 0
 ]=] sh ${_view} ${_png} $<TARGET_FILE:vdsh-bake> ${_rt_dir}/view_compute)

@@ -235,8 +235,8 @@ static void test_files(const char *dir)
     }
     /* Where to decode and sum: an unknown choice is refused by name. */
     {
-        vr_scene_desc w = {.path = path, .sums = 2};
-        expect_fail("sums 2", &w, VR_ERR_ARGUMENT, "sums 2");
+        vr_scene_desc w = {.path = path, .sums = 3};
+        expect_fail("sums 3", &w, VR_ERR_ARGUMENT, "sums 3");
         w.sums = VR_SUMS_VERTEX;
         w.cpca_decode = -1;
         expect_fail("cpca_decode -1", &w, VR_ERR_ARGUMENT, "cpca_decode -1");
