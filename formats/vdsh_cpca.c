@@ -1350,7 +1350,6 @@ static uint32_t largest_basis(uint32_t rows, uint32_t order, const vdsh_cpca_set
 static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t rows,
                                 uint32_t order, const vdsh_cpca_settings *settings, uint32_t refit,
                                 vdsh_cpca_refit_report *rep, vdsh_cpca_fit *out, vdsh_error *err);
-static uint32_t refit_rounds(void);
 
 /* auto: the candidates vdsh_cpca.h names, the least stored_error kept. */
 static vdsh_result encode_auto(const float *src, const float *normals, uint32_t rows,
@@ -1431,7 +1430,8 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
             return vdsh_failf(err, VDSH_ERR_INVALID,
                               "cpca: vertex %zu coefficient %zu is not finite", x / n, x % n);
     if (settings->budget && settings->clusters)
-        return encode_alloc(src, normals, rows, order, settings, refit_rounds(), NULL, out, err);
+        return encode_alloc(src, normals, rows, order, settings, VDSH_CPCA_REFIT_ROUNDS, NULL, out,
+                            err);
     if (settings->budget)
         return encode_auto(src, normals, rows, order, settings, out, err);
     return encode_fixed(src, normals, rows, order, settings, NULL, out, NULL, err);
@@ -1614,12 +1614,6 @@ static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t
  * when the cluster's error in its metric, decoded as every reader
  * decodes, falls. f64, one thread, members in row order. */
 
-static uint32_t refit_rounds(void)
-{
-    const char *e = getenv("VDSH_CPCA_REFIT"); /* STUDY: rounds */
-    return e ? (uint32_t)atoi(e) : VDSH_CPCA_REFIT_ROUNDS;
-}
-
 typedef struct refit_ctx {
     const fit_ctx *f;
     uint32_t kb;
@@ -1636,7 +1630,7 @@ typedef struct refit_ctx {
     double *nw;              /* rows x kb: the candidate weights */
     uint16_t *nmean, *nbase; /* n, kb x n: the candidate, stored */
     float *nscale;           /* kb */
-    double *r, *gr;          /* n */
+    double *r;               /* n */
 } refit_ctx;
 
 /* The dequantised weight of w (scale s, width bits), as decoders have it. */
@@ -1853,10 +1847,9 @@ static int refit_model(const fit_ctx *f, uint32_t kb, const uint8_t *wd, uint32_
     rc.nbase = malloc(sizeof(uint16_t) * kb * n);
     rc.nscale = malloc(sizeof(float) * kb);
     rc.r = malloc(sizeof(double) * n);
-    rc.gr = malloc(sizeof(double) * n);
     double *frac = malloc(sizeof(double) * f->md->count);
     int ok = rc.mem && rc.g && rc.a && rc.la && rc.cx && rc.mb && rc.p && rc.gb && rc.lb && rc.bd &&
-             rc.md && rc.nw && rc.nmean && rc.nbase && rc.nscale && rc.r && rc.gr && frac;
+             rc.md && rc.nw && rc.nmean && rc.nbase && rc.nscale && rc.r && frac;
     double e0 = 0.0, e1 = 0.0;
     uint32_t nk = 0;
     for (uint32_t c = 0; ok && c < f->k; c++) {
@@ -1910,7 +1903,6 @@ static int refit_model(const fit_ctx *f, uint32_t kb, const uint8_t *wd, uint32_
     free(rc.nbase);
     free(rc.nscale);
     free(rc.r);
-    free(rc.gr);
     free(frac);
     return ok;
 }
@@ -2148,15 +2140,6 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
             if (rep)
                 *rep = (vdsh_cpca_refit_report){
                     .rounds = refit, .kept = nk, .metric_before = e0, .metric_after = e1};
-            const char *lp = getenv("VDSH_CPCA_REFIT_LOG"); /* STUDY */
-            FILE *lf = lp ? fopen(lp, "a") : NULL;
-            if (lf) {
-                fprintf(lf,
-                        "{\"rounds\": %u, \"kept\": %u, \"metric_before\": %.9g, "
-                        "\"metric_after\": %.9g}\n",
-                        refit, nk, e0, e1);
-                fclose(lf);
-            }
         }
         for (uint32_t v = 0; v < rows; v++) {
             uint32_t *r = rec + (size_t)v * words, c = labels[v];

@@ -92,7 +92,7 @@ vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_
  * their metrics (each cluster's metric_gram_members Gram, the records
  * decoded as every reader decodes) before the refit and after. */
 /* The refit rounds vdsh_cpca_encode runs for K,alloc:BYTES. */
-#define VDSH_CPCA_REFIT_ROUNDS 0
+#define VDSH_CPCA_REFIT_ROUNDS 2
 
 typedef struct vdsh_cpca_refit_report {
     uint32_t rounds, kept;
