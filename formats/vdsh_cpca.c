@@ -1348,8 +1348,8 @@ static uint32_t largest_basis(uint32_t rows, uint32_t order, const vdsh_cpca_set
 }
 
 static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t rows,
-                                uint32_t order, const vdsh_cpca_settings *settings,
-                                vdsh_cpca_fit *out, vdsh_error *err);
+                                uint32_t order, const vdsh_cpca_settings *settings, uint32_t refit,
+                                vdsh_cpca_refit_report *rep, vdsh_cpca_fit *out, vdsh_error *err);
 
 /* auto: the candidates vdsh_cpca.h names, the least stored_error kept. */
 static vdsh_result encode_auto(const float *src, const float *normals, uint32_t rows,
@@ -1430,7 +1430,8 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
             return vdsh_failf(err, VDSH_ERR_INVALID,
                               "cpca: vertex %zu coefficient %zu is not finite", x / n, x % n);
     if (settings->budget && settings->clusters)
-        return encode_alloc(src, normals, rows, order, settings, out, err);
+        return encode_alloc(src, normals, rows, order, settings, VDSH_CPCA_REFIT_ROUNDS, NULL, out,
+                            err);
     if (settings->budget)
         return encode_auto(src, normals, rows, order, settings, out, err);
     return encode_fixed(src, normals, rows, order, settings, NULL, out, NULL, err);
@@ -1539,7 +1540,7 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
                                  uint32_t order, const vdsh_cpca_settings *settings,
                                  uint32_t fit_basis, double budget, const uint8_t *widths,
                                  float *decoded, vdsh_cpca_widths_fit *out, vdsh_cpca_fit *fit,
-                                 vdsh_error *err);
+                                 uint32_t refit, vdsh_cpca_refit_report *rep, vdsh_error *err);
 
 vdsh_result vdsh_cpca_encode_widths(const float *src, const float *normals, uint32_t rows,
                                     uint32_t order, const vdsh_cpca_settings *settings,
@@ -1550,15 +1551,32 @@ vdsh_result vdsh_cpca_encode_widths(const float *src, const float *normals, uint
     if (!decoded || !settings || settings->budget)
         return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca widths: bad arguments");
     return encode_widths(src, normals, rows, order, settings, fit_basis, budget, widths, decoded,
-                         out, NULL, err);
+                         out, NULL, 0, NULL, err);
+}
+
+vdsh_result vdsh_cpca_encode_refit(const float *src, const float *normals, uint32_t rows,
+                                   uint32_t order, const vdsh_cpca_settings *settings,
+                                   uint32_t rounds, vdsh_cpca_fit *out,
+                                   vdsh_cpca_refit_report *report, vdsh_error *err)
+{
+    if (out)
+        memset(out, 0, sizeof *out);
+    if (report)
+        memset(report, 0, sizeof *report);
+    if (!src || !normals || !settings || !out || !settings->budget || !settings->clusters ||
+        rows < 1 || rows > VDSH_MAX_VERTICES || order < 1 || order > VDSH_MAX_ORDER)
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca refit: bad arguments");
+    if (!check_settings(settings, err))
+        return VDSH_ERR_ARGUMENT;
+    return encode_alloc(src, normals, rows, order, settings, rounds, report, out, err);
 }
 
 /* --cpca K,alloc:BYTES (settings K and budget): refined with the largest
  * B whose 4-bit records and model fit the budget, widths allocated over
  * min(2B, n) vectors; *out the stream (bits 0, the widths table). */
 static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t rows,
-                                uint32_t order, const vdsh_cpca_settings *settings,
-                                vdsh_cpca_fit *out, vdsh_error *err)
+                                uint32_t order, const vdsh_cpca_settings *settings, uint32_t refit,
+                                vdsh_cpca_refit_report *rep, vdsh_cpca_fit *out, vdsh_error *err)
 {
     const uint32_t n = order * order;
     const uint64_t limit = (uint64_t)settings->budget * rows;
@@ -1580,14 +1598,320 @@ static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t
     uint32_t fb = 2 * st.basis < n ? 2 * st.basis : n;
     vdsh_cpca_widths_fit wf;
     return encode_widths(src, normals, rows, order, &st, fb, (double)settings->budget, NULL, NULL,
-                         &wf, out, err);
+                         &wf, out, refit, rep, err);
+}
+
+/* ---- the quantisation-aware refit (issue 29; docs/ACCURACY.md
+ * "Quantisation-aware refit of the model") ----
+ *
+ * After the widths and scales are chosen, a cluster's stored mean m and
+ * kept basis B are fitted again to its members' dequantised weights q_v
+ * (least squares, [m B] = X Q^T (Q Q^T)^-1, Q's columns [1; q_v]: the
+ * least error in any metric the members share, so in the cluster's
+ * metric_gram_members Gram too), rounded to f16; the weights are then
+ * the metric projections onto the new (not orthonormal) basis, the
+ * scales chosen again, the weights quantised again. A round is kept only
+ * when the cluster's error in its metric, decoded as every reader
+ * decodes, falls. f64, one thread, members in row order. */
+
+typedef struct refit_ctx {
+    const fit_ctx *f;
+    uint32_t kb;
+    const uint8_t *wd;       /* kb widths */
+    uint32_t *mem;           /* rows: the cluster's members */
+    uint32_t count;          /* members */
+    double *g;               /* n x n: the cluster's metric */
+    double *a, *la;          /* (kb + 1)^2 */
+    double *cx;              /* n x (kb + 1) */
+    double *mb, *p;          /* kb x n */
+    double *gb, *lb;         /* kb x kb */
+    double *bd;              /* kb x n: the candidate basis, decoded */
+    double *md;              /* n: the candidate mean, decoded */
+    double *nw;              /* rows x kb: the candidate weights */
+    uint16_t *nmean, *nbase; /* n, kb x n: the candidate, stored */
+    float *nscale;           /* kb */
+    double *r;               /* n */
+} refit_ctx;
+
+/* The dequantised weight of w (scale s, width bits), as decoders have it. */
+static float dequantised(double w, float s, uint32_t bits)
+{
+    const int levels = vdsh_cpca_levels(bits);
+    return (float)quantise(w, (double)s, levels) * vdsh_cpca_step(s, bits);
+}
+
+/* The cluster's error in its metric: the sum over its members of r^T G r,
+ * r the source less the decoding of (mean, basis, scales, weights w, kb
+ * per row). */
+static double refit_error(refit_ctx *rc, const uint16_t *mean, const uint16_t *basis,
+                          const float *scales, const double *w)
+{
+    const fit_ctx *f = rc->f;
+    const uint32_t n = f->n, kb = rc->kb;
+    float o[VDSH_MAX_COEFFS], wq[VDSH_MAX_COEFFS];
+    double e = 0.0;
+    for (uint32_t i = 0; i < rc->count; i++) {
+        const uint32_t v = rc->mem[i];
+        for (uint32_t a = 0; a < n; a++)
+            o[a] = vdsh_f32_from_f16(mean[a]);
+        for (uint32_t q = 0; q < kb; q++)
+            wq[q] = dequantised(w[(size_t)v * kb + q], scales[q], rc->wd[q]);
+        for (uint32_t q = 0; q < kb; q++) {
+            const uint16_t *bq = basis + (size_t)q * n;
+            for (uint32_t a = 0; a < n; a++)
+                o[a] = o[a] + wq[q] * vdsh_f32_from_f16(bq[a]);
+        }
+        const float *x = f->src + (size_t)v * n;
+        for (uint32_t a = 0; a < n; a++)
+            rc->r[a] = (double)x[a] - (double)o[a];
+        for (uint32_t a = 0; a < n; a++) {
+            const double *ga = rc->g + (size_t)a * n;
+            double s = 0.0;
+            for (uint32_t b = 0; b < n; b++)
+                s += ga[b] * rc->r[b];
+            e += rc->r[a] * s;
+        }
+    }
+    return e;
+}
+
+/* Solve L L^T z = y in place (L lower, m x m). */
+static void chol_solve(const double *l, uint32_t m, double *y)
+{
+    for (uint32_t i = 0; i < m; i++) {
+        double s = y[i];
+        for (uint32_t q = 0; q < i; q++)
+            s -= l[(size_t)i * m + q] * y[q];
+        y[i] = s / l[(size_t)i * m + i];
+    }
+    for (uint32_t i = m; i-- > 0;) {
+        double s = y[i];
+        for (uint32_t q = i + 1; q < m; q++)
+            s -= l[(size_t)q * m + i] * y[q];
+        y[i] = s / l[(size_t)i * m + i];
+    }
+}
+
+/* One round for the cluster whose model is (mean, basis, scales) and
+ * weights w: the candidate in rc->nmean, nbase, nscale, nw; 0 when none
+ * (a singular system, or a value that does not fit f16). */
+static int refit_round(refit_ctx *rc, const uint16_t *mean, const uint16_t *basis,
+                       const float *scales, const double *w)
+{
+    const fit_ctx *f = rc->f;
+    const uint32_t n = f->n, kb = rc->kb, m = kb + 1;
+    double qt[VDSH_MAX_COEFFS + 1];
+    /* the normal equations: A = sum qt qt^T, C = sum x qt^T */
+    memset(rc->a, 0, sizeof(double) * m * m);
+    memset(rc->cx, 0, sizeof(double) * n * m);
+    for (uint32_t i = 0; i < rc->count; i++) {
+        const uint32_t v = rc->mem[i];
+        qt[0] = 1.0;
+        for (uint32_t q = 0; q < kb; q++)
+            qt[q + 1] = (double)dequantised(w[(size_t)v * kb + q], scales[q], rc->wd[q]);
+        for (uint32_t j = 0; j < m; j++) {
+            double *aj = rc->a + (size_t)j * m;
+            for (uint32_t q = 0; q <= j; q++)
+                aj[q] += qt[j] * qt[q];
+        }
+        const float *x = f->src + (size_t)v * n;
+        for (uint32_t a = 0; a < n; a++) {
+            double *ca = rc->cx + (size_t)a * m;
+            const double xa = x[a];
+            for (uint32_t j = 0; j < m; j++)
+                ca[j] += xa * qt[j];
+        }
+    }
+    /* a vector no member uses (every level 0) keeps its basis vector and
+     * leaves the system (its row and column the identity's) */
+    int unused[VDSH_MAX_COEFFS + 1] = {0};
+    for (uint32_t j = 1; j < m; j++)
+        if (!(rc->a[(size_t)j * m + j] > 0.0)) {
+            unused[j] = 1;
+            for (uint32_t q = 0; q < m; q++)
+                rc->a[(size_t)j * m + q] = rc->a[(size_t)q * m + j] = 0.0;
+            rc->a[(size_t)j * m + j] = 1.0;
+        }
+    for (uint32_t j = 0; j < m; j++)
+        for (uint32_t q = 0; q < j; q++)
+            rc->a[(size_t)q * m + j] = rc->a[(size_t)j * m + q];
+    if (!cholesky(rc->a, m, rc->la))
+        return 0;
+    for (uint32_t a = 0; a < n; a++) {
+        double *z = rc->cx + (size_t)a * m; /* row a of [m B] */
+        for (uint32_t j = 1; j < m; j++)
+            if (unused[j])
+                z[j] = 0.0;
+        chol_solve(rc->la, m, z);
+    }
+    for (uint32_t a = 0; a < n; a++) {
+        uint16_t h = vdsh_f16_from_f32((float)rc->cx[(size_t)a * m]);
+        if ((h & 0x7c00u) == 0x7c00u)
+            return 0;
+        rc->nmean[a] = h;
+        rc->md[a] = vdsh_f32_from_f16(h);
+    }
+    for (uint32_t q = 0; q < kb; q++)
+        for (uint32_t a = 0; a < n; a++) {
+            uint16_t h = unused[q + 1] ? basis[(size_t)q * n + a]
+                                       : vdsh_f16_from_f32((float)rc->cx[(size_t)a * m + q + 1]);
+            if ((h & 0x7c00u) == 0x7c00u)
+                return 0;
+            rc->nbase[(size_t)q * n + a] = h;
+            rc->bd[(size_t)q * n + a] = vdsh_f32_from_f16(h);
+        }
+    /* the metric projection: w = (B G B^T)^-1 B G (x - m) */
+    for (uint32_t q = 0; q < kb; q++) /* mb = B G */
+        for (uint32_t a = 0; a < n; a++) {
+            const double *bq = rc->bd + (size_t)q * n;
+            double s = 0.0;
+            for (uint32_t e = 0; e < n; e++)
+                s += bq[e] * rc->g[(size_t)e * n + a];
+            rc->mb[(size_t)q * n + a] = s;
+        }
+    for (uint32_t q = 0; q < kb; q++) /* gb = mb B^T (lower half, mirrored) */
+        for (uint32_t j = 0; j <= q; j++) {
+            double s = 0.0;
+            for (uint32_t a = 0; a < n; a++)
+                s += rc->mb[(size_t)q * n + a] * rc->bd[(size_t)j * n + a];
+            rc->gb[(size_t)q * kb + j] = rc->gb[(size_t)j * kb + q] = s;
+        }
+    if (!cholesky(rc->gb, kb, rc->lb))
+        return 0;
+    double col[VDSH_MAX_COEFFS];
+    for (uint32_t a = 0; a < n; a++) { /* p = gb^-1 mb, column by column */
+        for (uint32_t q = 0; q < kb; q++)
+            col[q] = rc->mb[(size_t)q * n + a];
+        chol_solve(rc->lb, kb, col);
+        for (uint32_t q = 0; q < kb; q++)
+            rc->p[(size_t)q * n + a] = col[q];
+    }
+    for (uint32_t i = 0; i < rc->count; i++) {
+        const uint32_t v = rc->mem[i];
+        const float *x = f->src + (size_t)v * n;
+        for (uint32_t q = 0; q < kb; q++)
+            rc->nw[(size_t)v * kb + q] = weight_of(x, rc->md, rc->p + (size_t)q * n, n);
+    }
+    /* the scales again: per vector the least squared weight error over
+     * the candidates, as encode_widths chooses them */
+    for (uint32_t q = 0; q < kb; q++) {
+        const int levels = vdsh_cpca_levels(rc->wd[q]);
+        double wmax = 0.0, best = 0.0;
+        for (uint32_t i = 0; i < rc->count; i++) {
+            double x = fabs(rc->nw[(size_t)rc->mem[i] * kb + q]);
+            wmax = x > wmax ? x : wmax;
+        }
+        rc->nscale[q] = 0.0f;
+        for (uint32_t t = 0; t < SCALE_CANDIDATES; t++) {
+            double s = candidate_scale(wmax, t), e = 0.0;
+            if (!(s > 0.0))
+                break;
+            double step = (double)((float)s / (float)levels);
+            for (uint32_t i = 0; i < rc->count; i++) {
+                double x = rc->nw[(size_t)rc->mem[i] * kb + q];
+                double d = x - quantise(x, s, levels) * step;
+                e += d * d;
+            }
+            if (t == 0 || e < best) {
+                best = e;
+                rc->nscale[q] = (float)s;
+            }
+        }
+    }
+    return 1;
+}
+
+/* Up to `rounds` refit rounds of every cluster of the stream's model
+ * (means k x n, bases k x kb x n, scales k x kb, as stored) and the rows'
+ * weights w (rows x kb), in place; *before and *after (may be NULL) the
+ * clusters' summed metric error before and after. 0 when out of memory. */
+static int refit_model(const fit_ctx *f, uint32_t kb, const uint8_t *wd, uint32_t rounds,
+                       uint16_t *means, uint16_t *bases, float *scales, double *w, double *before,
+                       double *after, uint32_t *kept)
+{
+    const uint32_t n = f->n, m = kb + 1, rows = f->rows;
+    refit_ctx rc = {.f = f, .kb = kb, .wd = wd};
+    rc.mem = malloc(sizeof(uint32_t) * rows);
+    rc.g = malloc(sizeof(double) * n * n);
+    rc.a = malloc(sizeof(double) * m * m);
+    rc.la = malloc(sizeof(double) * m * m);
+    rc.cx = malloc(sizeof(double) * n * m);
+    rc.mb = malloc(sizeof(double) * kb * n);
+    rc.p = malloc(sizeof(double) * kb * n);
+    rc.gb = malloc(sizeof(double) * kb * kb);
+    rc.lb = malloc(sizeof(double) * kb * kb);
+    rc.bd = malloc(sizeof(double) * kb * n);
+    rc.md = malloc(sizeof(double) * n);
+    rc.nw = malloc(sizeof(double) * rows * kb);
+    rc.nmean = malloc(sizeof(uint16_t) * n);
+    rc.nbase = malloc(sizeof(uint16_t) * kb * n);
+    rc.nscale = malloc(sizeof(float) * kb);
+    rc.r = malloc(sizeof(double) * n);
+    double *frac = malloc(sizeof(double) * f->md->count);
+    int ok = rc.mem && rc.g && rc.a && rc.la && rc.cx && rc.mb && rc.p && rc.gb && rc.lb && rc.bd &&
+             rc.md && rc.nw && rc.nmean && rc.nbase && rc.nscale && rc.r && frac;
+    double e0 = 0.0, e1 = 0.0;
+    uint32_t nk = 0;
+    for (uint32_t c = 0; ok && c < f->k; c++) {
+        if (!f->members[c])
+            continue;
+        rc.count = 0;
+        for (uint32_t v = 0; v < rows; v++)
+            if (f->labels[v] == c)
+                rc.mem[rc.count++] = v;
+        metric_gram_members(f->md, f->normals, f->labels, rows, c, rc.count, frac, rc.g, f->lm);
+        uint16_t *mc = means + (size_t)c * n, *bc = bases + (size_t)c * kb * n;
+        float *sc = scales + (size_t)c * kb;
+        double e = refit_error(&rc, mc, bc, sc, w);
+        e0 += e;
+        for (uint32_t round = 0; round < rounds; round++) {
+            if (!refit_round(&rc, mc, bc, sc, w))
+                break;
+            double en = refit_error(&rc, rc.nmean, rc.nbase, rc.nscale, rc.nw);
+            if (!(en < e))
+                break;
+            e = en;
+            nk++;
+            memcpy(mc, rc.nmean, sizeof(uint16_t) * n);
+            memcpy(bc, rc.nbase, sizeof(uint16_t) * kb * n);
+            memcpy(sc, rc.nscale, sizeof(float) * kb);
+            for (uint32_t i = 0; i < rc.count; i++)
+                memcpy(w + (size_t)rc.mem[i] * kb, rc.nw + (size_t)rc.mem[i] * kb,
+                       sizeof(double) * kb);
+        }
+        e1 += e;
+    }
+    if (before)
+        *before = e0;
+    if (after)
+        *after = e1;
+    if (kept)
+        *kept = nk;
+    free(rc.mem);
+    free(rc.g);
+    free(rc.a);
+    free(rc.la);
+    free(rc.cx);
+    free(rc.mb);
+    free(rc.p);
+    free(rc.gb);
+    free(rc.lb);
+    free(rc.bd);
+    free(rc.md);
+    free(rc.nw);
+    free(rc.nmean);
+    free(rc.nbase);
+    free(rc.nscale);
+    free(rc.r);
+    free(frac);
+    return ok;
 }
 
 static vdsh_result encode_widths(const float *src, const float *normals, uint32_t rows,
                                  uint32_t order, const vdsh_cpca_settings *settings,
                                  uint32_t fit_basis, double budget, const uint8_t *widths,
                                  float *decoded, vdsh_cpca_widths_fit *out, vdsh_cpca_fit *fit,
-                                 vdsh_error *err)
+                                 uint32_t refit, vdsh_cpca_refit_report *rep, vdsh_error *err)
 {
     memset(out, 0, sizeof *out);
     if (fit)
@@ -1792,17 +2116,43 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
                                  .scales = sc_out,
                                  .means = me_out,
                                  .bases = ba_out};
+        /* the rows' weights on the kept vectors */
+        double *kw = malloc(sizeof(double) * rows * kb + 1);
+        if (!kw) {
+            free(block);
+            res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory");
+            goto done;
+        }
+        for (uint32_t v = 0; v < rows; v++)
+            for (uint32_t q = 0; q < kb; q++)
+                kw[(size_t)v * kb + q] = wts[(size_t)v * bf + keep[q]];
+        if (rep)
+            memset(rep, 0, sizeof *rep);
+        if (refit) {
+            double e0, e1;
+            uint32_t nk;
+            if (!refit_model(fc, kb, wd, refit, me_out, ba_out, sc_out, kw, &e0, &e1, &nk)) {
+                free(kw);
+                free(block);
+                res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory");
+                goto done;
+            }
+            if (rep)
+                *rep = (vdsh_cpca_refit_report){
+                    .rounds = refit, .kept = nk, .metric_before = e0, .metric_after = e1};
+        }
         for (uint32_t v = 0; v < rows; v++) {
             uint32_t *r = rec + (size_t)v * words, c = labels[v];
             r[0] = c;
             for (uint32_t q = 0; q < kb; q++) {
-                uint32_t j = keep[q], word, shift;
+                uint32_t word, shift;
                 const int levels = vdsh_cpca_levels(wd[q]);
-                double lq = quantise(wts[(size_t)v * bf + j], sc_out[(size_t)c * kb + q], levels);
+                double lq = quantise(kw[(size_t)v * kb + q], sc_out[(size_t)c * kb + q], levels);
                 vdsh_cpca_model_field(&fit->model, q, &word, &shift);
                 r[word] |= ((uint32_t)(int32_t)lq & ((1u << wd[q]) - 1u)) << shift;
             }
         }
+        free(kw);
         fit->records = rec;
         fit->storage_ = block;
         fit->rms_error = out->rms_error = decode_rms(fit, src, rows, order);

@@ -84,6 +84,26 @@ vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_
                                  const vdsh_cpca_fit *fit, vdsh_cpca_pool_scores *out,
                                  vdsh_error *err);
 
+/* The quantisation-aware refit (issue 29, docs/ACCURACY.md
+ * "Quantisation-aware refit of the model"): vdsh_cpca_encode of settings
+ * K,alloc:BYTES (clusters and budget set) with `rounds` refit rounds
+ * instead of the encoder's own (0: none). report (may be NULL): the
+ * rounds asked, the cluster rounds kept, and the clusters' summed error in
+ * their metrics (each cluster's metric_gram_members Gram, the records
+ * decoded as every reader decodes) before the refit and after. */
+/* The refit rounds vdsh_cpca_encode runs for K,alloc:BYTES. */
+#define VDSH_CPCA_REFIT_ROUNDS 2
+
+typedef struct vdsh_cpca_refit_report {
+    uint32_t rounds, kept;
+    double metric_before, metric_after;
+} vdsh_cpca_refit_report;
+
+vdsh_result vdsh_cpca_encode_refit(const float *src, const float *normals, uint32_t rows,
+                                   uint32_t order, const vdsh_cpca_settings *settings,
+                                   uint32_t rounds, vdsh_cpca_fit *out,
+                                   vdsh_cpca_refit_report *report, vdsh_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -186,6 +186,17 @@ add_test(NAME format_cpca_python
                  $<TARGET_FILE:test_cpca> ${PROJECT_SOURCE_DIR}
                  ${CMAKE_CURRENT_BINARY_DIR}/format_cpca_python)
 
+# format_cpca_refit  the cpca encoder's quantisation-aware refit (issue 29)
+#                   on a real order-12 bake (builtin room, uniform metric
+#                   and a light pool): never raises the clusters' metric
+#                   error, lowers it here, the format unchanged, records
+#                   decode to the reported error, vdsh_cpca_encode the
+#                   default rounds' stream
+add_executable(test_cpca_refit ${CMAKE_CURRENT_LIST_DIR}/test_cpca_refit.c)
+target_link_libraries(test_cpca_refit PRIVATE vdsh_format m)
+add_test(NAME format_cpca_refit
+         COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/test_cpca_refit.sh $<TARGET_FILE:vdsh-bake>
+                 $<TARGET_FILE:test_cpca_refit> $<TARGET_FILE:light_pool_tool>)
 # cpca_kchoice_tool: the K,alloc:BYTES fit at several K with each one's
 # pool score (issue 29, the choice of K; measurement only).
 add_executable(cpca_kchoice_tool ${CMAKE_CURRENT_LIST_DIR}/cpca_kchoice_tool.c)
