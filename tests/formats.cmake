@@ -186,7 +186,7 @@ add_test(NAME format_cpca_python
                  $<TARGET_FILE:test_cpca> ${PROJECT_SOURCE_DIR}
                  ${CMAKE_CURRENT_BINARY_DIR}/format_cpca_python)
 
-# format_cpca_refit  the cpca encoder's quantisation-aware refit (issue 29)
+# format_cpca_refit_uniform, _lights  the cpca encoder's quantisation-aware refit (issue 29)
 #                   on a real order-12 bake (builtin room, uniform metric
 #                   and a light pool): never raises the clusters' metric
 #                   error, lowers it here, the format unchanged, records
@@ -194,9 +194,11 @@ add_test(NAME format_cpca_python
 #                   default rounds' stream
 add_executable(test_cpca_refit ${CMAKE_CURRENT_LIST_DIR}/test_cpca_refit.c)
 target_link_libraries(test_cpca_refit PRIVATE vdsh_format m)
-add_test(NAME format_cpca_refit
-         COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/test_cpca_refit.sh $<TARGET_FILE:vdsh-bake>
-                 $<TARGET_FILE:test_cpca_refit> $<TARGET_FILE:light_pool_tool>)
+foreach(_metric uniform lights)
+  add_test(NAME format_cpca_refit_${_metric}
+           COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/test_cpca_refit.sh $<TARGET_FILE:vdsh-bake>
+                   $<TARGET_FILE:test_cpca_refit> $<TARGET_FILE:light_pool_tool> ${_metric})
+endforeach()
 # cpca_kchoice_tool: the K,alloc:BYTES fit at several K with each one's
 # pool score (issue 29, the choice of K; measurement only).
 add_executable(cpca_kchoice_tool ${CMAKE_CURRENT_LIST_DIR}/cpca_kchoice_tool.c)

@@ -123,12 +123,15 @@ int main(int argc, char **argv)
         st.lights = pool;
         st.positions = f->positions;
     }
-    enum { R = 3 };
+    /* no refit, and the default's rounds (each round's own test, that it
+     * lowers its clusters' error or is not kept, is inside the refit) */
+    enum { R = 2 };
+    static const uint32_t rounds[R] = {0, VDSH_CPCA_REFIT_ROUNDS};
     vdsh_cpca_fit fit[R];
     vdsh_cpca_refit_report rep[R];
     for (uint32_t r = 0; r < R; r++) {
-        vdsh_result res =
-            vdsh_cpca_encode_refit(src, f->normals, rows, order, &st, r, &fit[r], &rep[r], &err);
+        vdsh_result res = vdsh_cpca_encode_refit(src, f->normals, rows, order, &st, rounds[r],
+                                                 &fit[r], &rep[r], &err);
         CHECK(res == VDSH_OK, "refit %u rounds: %s", r, res == VDSH_OK ? "" : err.msg);
         if (res != VDSH_OK) {
             printf("%d of %d checks failed\n", failures, checks);
@@ -137,11 +140,11 @@ int main(int argc, char **argv)
         const double d = decoded_rms(&fit[r], src, rows, order);
         printf("test_cpca_refit: %u rows, %u round%s: metric error %.6g -> %.6g (%u cluster "
                "rounds kept), coefficient RMS error %.6g, %zu bytes\n",
-               rows, r, r == 1 ? "" : "s", rep[r].metric_before, rep[r].metric_after, rep[r].kept,
-               fit[r].rms_error, fit_size(&fit[r], rows, order));
-        CHECK(d == fit[r].rms_error, "%u rounds: the records decode to RMS %.9g, reported %.9g", r,
-              d, fit[r].rms_error);
-        CHECK(rep[r].rounds == r, "%u rounds: report says %u", r, rep[r].rounds);
+               rows, rounds[r], rounds[r] == 1 ? "" : "s", rep[r].metric_before,
+               rep[r].metric_after, rep[r].kept, fit[r].rms_error, fit_size(&fit[r], rows, order));
+        CHECK(d == fit[r].rms_error, "%u rounds: the records decode to RMS %.9g, reported %.9g",
+              rounds[r], d, fit[r].rms_error);
+        CHECK(rep[r].rounds == rounds[r], "%u rounds: report says %u", rounds[r], rep[r].rounds);
     }
     CHECK(rep[0].kept == 0 && rep[0].metric_before == 0.0 && rep[0].metric_after == 0.0,
           "no refit: nothing reported");
@@ -152,12 +155,6 @@ int main(int argc, char **argv)
               rep[r].metric_after);
         CHECK(rep[r].metric_after < rep[r].metric_before && rep[r].kept > 0,
               "%u rounds: the refit did not lower the metric error on this stream", r);
-        CHECK(rep[r].metric_before == rep[1].metric_before,
-              "%u rounds: starts from %.9g, 1 round from %.9g", r, rep[r].metric_before,
-              rep[1].metric_before);
-        CHECK(rep[r].metric_after <= rep[r - 1].metric_after || r == 1,
-              "%u rounds: %.9g, more than %u rounds' %.9g", r, rep[r].metric_after, r - 1,
-              rep[r - 1].metric_after);
         /* the format unchanged: clusters per row, vectors, widths, words */
         const vdsh_cpca *a = &fit[0].model, *b = &fit[r].model;
         int same = a->clusters == b->clusters && a->basis == b->basis && a->bits == b->bits &&
@@ -170,21 +167,15 @@ int main(int argc, char **argv)
               "%u rounds: %zu bytes, no refit %zu", r, fit_size(&fit[r], rows, order),
               fit_size(&fit[0], rows, order));
     }
-    /* the encoder's own behaviour: its default rounds, the same twice */
-    vdsh_cpca_fit d1, d2;
-    CHECK(vdsh_cpca_encode(src, f->normals, rows, order, &st, &d1, &err) == VDSH_OK &&
-              vdsh_cpca_encode(src, f->normals, rows, order, &st, &d2, &err) == VDSH_OK,
+    /* the encoder's own behaviour: its default rounds (the same bytes on
+     * every run and CPU: bake_cpca, bake_same_bytes_any_cpu) */
+    vdsh_cpca_fit d1;
+    CHECK(vdsh_cpca_encode(src, f->normals, rows, order, &st, &d1, &err) == VDSH_OK,
           "vdsh_cpca_encode: %s", err.msg);
-    CHECK(same_stream(&d1, &d2, rows, order), "vdsh_cpca_encode: not the same twice");
-    int which = -1;
-    for (uint32_t r = 0; r < R && which < 0; r++)
-        if (same_stream(&d1, &fit[r], rows, order))
-            which = (int)r;
-    CHECK(which == VDSH_CPCA_REFIT_ROUNDS,
-          "vdsh_cpca_encode is the stream of %d refit rounds, not the default's %d", which,
+    CHECK(same_stream(&d1, &fit[1], rows, order) && !same_stream(&d1, &fit[0], rows, order),
+          "vdsh_cpca_encode is not the stream of the default's %d refit rounds",
           VDSH_CPCA_REFIT_ROUNDS);
     vdsh_cpca_fit_free(&d1);
-    vdsh_cpca_fit_free(&d2);
     for (uint32_t r = 0; r < R; r++)
         vdsh_cpca_fit_free(&fit[r]);
     free(pool);
