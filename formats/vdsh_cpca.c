@@ -1048,6 +1048,33 @@ static double quantise(double w, double s, int levels)
     return q > levels ? levels : q < -levels ? -levels : q;
 }
 
+/* The scale, of candidate_scale's for wmax (the weights' largest |w|),
+ * whose quantisation at `levels` leaves the least squared error over the
+ * count weights w[idx[i] * stride], the first of equals; *err that error.
+ * Where no candidate is > 0: 0, and *err = none. */
+static float least_error_scale(const double *w, size_t stride, const uint32_t *idx, uint32_t count,
+                               double wmax, int levels, double none, double *err)
+{
+    float best = 0.0f;
+    *err = none;
+    for (uint32_t t = 0; t < SCALE_CANDIDATES; t++) {
+        double sc = candidate_scale(wmax, t), e = 0.0;
+        if (!(sc > 0.0))
+            break;
+        double step = (double)((float)sc / (float)levels);
+        for (uint32_t i = 0; i < count; i++) {
+            double x = w[(size_t)idx[i] * stride];
+            double d = x - quantise(x, sc, levels) * step;
+            e += d * d;
+        }
+        if (t == 0 || e < *err) {
+            *err = e;
+            best = (float)sc;
+        }
+    }
+    return best;
+}
+
 /* ---- the scratch both encoders fit with ---- */
 
 /* The fit's context and everything it points at, the metric's and the
@@ -1792,31 +1819,15 @@ static int refit_round(refit_ctx *rc, const uint16_t *mean, const uint16_t *basi
         for (uint32_t q = 0; q < kb; q++)
             rc->nw[(size_t)v * kb + q] = weight_of(x, rc->md, rc->p + (size_t)q * n, n);
     }
-    /* the scales again: per vector the least squared weight error over
-     * the candidates, as encode_widths chooses them */
+    /* the scales again, as encode_widths chooses them */
     for (uint32_t q = 0; q < kb; q++) {
-        const int levels = vdsh_cpca_levels(rc->wd[q]);
-        double wmax = 0.0, best = 0.0;
+        double wmax = 0.0, e;
         for (uint32_t i = 0; i < rc->count; i++) {
             double x = fabs(rc->nw[(size_t)rc->mem[i] * kb + q]);
             wmax = x > wmax ? x : wmax;
         }
-        rc->nscale[q] = 0.0f;
-        for (uint32_t t = 0; t < SCALE_CANDIDATES; t++) {
-            double s = candidate_scale(wmax, t), e = 0.0;
-            if (!(s > 0.0))
-                break;
-            double step = (double)((float)s / (float)levels);
-            for (uint32_t i = 0; i < rc->count; i++) {
-                double x = rc->nw[(size_t)rc->mem[i] * kb + q];
-                double d = x - quantise(x, s, levels) * step;
-                e += d * d;
-            }
-            if (t == 0 || e < best) {
-                best = e;
-                rc->nscale[q] = (float)s;
-            }
-        }
+        rc->nscale[q] = least_error_scale(rc->nw + q, kb, rc->mem, rc->count, wmax,
+                                          vdsh_cpca_levels(rc->wd[q]), 0.0, &e);
     }
     return 1;
 }
@@ -1944,11 +1955,12 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
     float *cscale = malloc(sizeof(float) * k * bf * NWIDTHS);  /* the best scale */
     double *tot = malloc(sizeof(double) * bf * NWIDTHS);       /* over clusters */
     uint32_t *level = malloc(sizeof(uint32_t) * bf), *best_level = malloc(sizeof(uint32_t) * bf);
+    uint32_t *mem = malloc(sizeof(uint32_t) * rows); /* one cluster's rows */
     fit_scratch fs;
     const uint32_t rounds = k > 1 ? REFINE_ROUNDS : 0;
     vdsh_result res = VDSH_OK;
     if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, bf, rounds, settings, NULL) ||
-        !wts || !cdist || !cscale || !tot || !level || !best_level) {
+        !wts || !cdist || !cscale || !tot || !level || !best_level || !mem) {
         res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca widths: out of memory");
         goto done;
     }
@@ -1978,37 +1990,23 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
     for (uint32_t c = 0; c < k; c++) {
         if (!members[c])
             continue;
+        uint32_t count = 0;
+        for (uint32_t v = 0; v < rows; v++)
+            if (labels[v] == c)
+                mem[count++] = v;
         for (uint32_t j = 0; j < bf; j++) {
             double wmax = 0.0, e0 = 0.0;
-            for (uint32_t v = 0; v < rows; v++)
-                if (labels[v] == c) {
-                    double w = wts[(size_t)v * bf + j];
-                    wmax = fabs(w) > wmax ? fabs(w) : wmax;
-                    e0 += w * w;
-                }
+            for (uint32_t i = 0; i < count; i++) {
+                double w = wts[(size_t)mem[i] * bf + j];
+                wmax = fabs(w) > wmax ? fabs(w) : wmax;
+                e0 += w * w;
+            }
             double *cd = cdist + ((size_t)c * bf + j) * NWIDTHS;
             float *cs = cscale + ((size_t)c * bf + j) * NWIDTHS;
             cd[0] = e0;
-            for (uint32_t i = 1; i < NWIDTHS; i++) {
-                const int levels = (1 << (WIDTH_SET[i] - 1)) - 1;
-                cd[i] = e0;
-                for (uint32_t t = 0; t < SCALE_CANDIDATES; t++) {
-                    double s = candidate_scale(wmax, t), e = 0.0;
-                    if (!(s > 0.0))
-                        break;
-                    double step = (double)((float)s / (float)levels);
-                    for (uint32_t v = 0; v < rows; v++)
-                        if (labels[v] == c) {
-                            double w = wts[(size_t)v * bf + j];
-                            double d = w - quantise(w, s, levels) * step;
-                            e += d * d;
-                        }
-                    if (t == 0 || e < cd[i]) {
-                        cd[i] = e;
-                        cs[i] = (float)s;
-                    }
-                }
-            }
+            for (uint32_t i = 1; i < NWIDTHS; i++)
+                cs[i] = least_error_scale(wts + j, bf, mem, count, wmax,
+                                          (1 << (WIDTH_SET[i] - 1)) - 1, e0, &cd[i]);
         }
     }
     for (uint32_t x = 0; x < bf * NWIDTHS; x++) {
@@ -2191,6 +2189,7 @@ done:
     free(tot);
     free(level);
     free(best_level);
+    free(mem);
     fit_scratch_free(&fs);
     return res;
 }
