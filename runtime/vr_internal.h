@@ -83,10 +83,10 @@ typedef enum vr_buf_kind {
                                 from the model texture (vr_buffer.model) */
 } vr_buf_kind;
 
-/* A stream drawn from buffer textures (VR_MODE_VDSH_BUFFER). */
 /* The most lights one invocation of the compute sums takes. */
 enum { VR_SUMS_MAX_GROUP = 16 };
 
+/* A stream drawn from buffer textures (VR_MODE_VDSH_BUFFER). */
 typedef struct vr_buffer {
     int order;          /* fixed: its order; variable: the cap; 0: none */
     int variable;       /* 1: an order per vertex */
@@ -111,14 +111,14 @@ typedef struct vr_buffer {
      * unpacking written out, "#define BUF_CPCA_UNPACK(f) ...\n"
      * (vr_buffer_cpca_unpack), malloc'd and in ks_hash; else NULL */
     char *cpca_unpack;
-    /* VR_CPCA_PER_FRAME (vr_scene_desc.cpca_decode) or VR_SUMS_COMPUTE:
-     * the scratch (scratch_tex 0: decoded per pass), f32 records of
-     * stride scratch_stride texels that the sums or the light passes read
-     * as VR_BUF_F32 (vr_render.c), and the decode program that writes it
-     * (a compute shader, shaders/vdsh_cpca_decode.glsl) once per frame.
-     * VR_SUMS_COMPUTE decodes once, at load, and then deletes the
-     * program, the records and the model (decode_prog, buf, tex, model_*
-     * 0; release_decoded) */
+    /* VR_CPCA_PER_FRAME or VR_CPCA_AT_LOAD (vr_scene_desc.cpca_decode):
+     * the scratch (scratch_tex 0: decoded where the sums are), f32
+     * records of stride scratch_stride texels that the sums or the light
+     * passes read as VR_BUF_F32 (vr_render.c), and the decode program
+     * that writes it (a compute shader, shaders/vdsh_cpca_decode.glsl)
+     * once per frame. VR_CPCA_AT_LOAD decodes once, at load, and then
+     * deletes the program, the records and the model (decode_prog, buf,
+     * tex, model_* 0; release_decoded) */
     GLuint decode_prog, scratch_buf, scratch_tex;
     int scratch_stride;
     /* VR_SUMS_COMPUTE (vr_scene_desc.sums; summed set): the sums

@@ -998,7 +998,7 @@ vr_result vr_draw(vr_renderer *r, const vr_scene *s, const vr_draw_desc *desc, v
 
     /* A cpca stream decoded into its scratch, which the sums or the
      * passes read as f32 records: once per frame (vr_buffer_decode), or
-     * once at load where the sums are computed (vr_buffer_upload). */
+     * once at load (VR_CPCA_AT_LOAD, vr_buffer_upload). */
     F.scratch = F.buf && F.buf->scratch_tex;
     /* Sums in a compute shader: once for all the frame's lights. */
     F.summed = F.buf && F.buf->summed && d.light_count > 0;

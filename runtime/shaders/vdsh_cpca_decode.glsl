@@ -1,8 +1,7 @@
 /*
  * vdsh_cpca_decode.glsl - a cpca stream's decode on the GPU, once per
  * frame (vr_scene_desc.cpca_decode = VR_CPCA_PER_FRAME) or once at load
- * (a stream whose sums are computed, vr_scene_desc.sums =
- * VR_SUMS_COMPUTE; vr_buffer.c): a compute shader, one invocation per
+ * (VR_CPCA_AT_LOAD; vr_buffer.c): a compute shader, one invocation per
  * (vertex, texel of four coefficients), that writes each vertex's
  * coefficients as f32 texels (the buffer path's BUF_KIND 0 record: BUF_CPCA_T texels in
  * vr_buffer_sequence's order) into a shader storage buffer, the scratch

@@ -1,8 +1,9 @@
 /*
  * vr_sums.glsl - the C runtime's sums in a compute shader
  * (vr_scene_desc.sums = VR_SUMS_COMPUTE, runtime/vr_buffer.c): one
- * invocation per vertex and group of NUM_LIGHTS lights of the frame (8
- * on llvmpipe, 1 elsewhere: vr_buffer.c sums_group; the last group's
+ * invocation per vertex and group of NUM_LIGHTS lights of the frame (a
+ * cpca stream read from its records: the frame's lights, up to 16; else
+ * 8 on llvmpipe, 1 elsewhere: vr_buffer.c sums_group; the last group's
  * missing lights repeat the frame's last) computes the
  * stream's SH sums toward them with vdsh_buffer.glsl's buffer_sums, and
  * stores light j's at vertex * u_lights + j; the
@@ -10,9 +11,10 @@
  * (vr_vertex_main.glsl, BUF_SUMS) where it would have summed the record.
  * This part goes before vdsh_buffer.glsl (the vertex, receiver and light
  * it reads are these), vr_sums_main.glsl after it. The record is read as
- * stored, or a cpca stream's decoded scratch (BUF_KIND 0,
- * vdsh_cpca_decode.glsl). A group of lights per invocation fetches (and
- * unpacks) each coefficient once for the group, as the vertex stage
+ * stored (a cpca stream's decoded as it is read, BUF_KIND 4), or a cpca
+ * stream's decoded scratch (BUF_KIND 0, vdsh_cpca_decode.glsl). A group
+ * of lights per invocation fetches (and unpacks, and decodes) each
+ * coefficient once for the group, as the vertex stage
  * does (docs/BENCHMARKS.md "Sums in a compute shader"). Vertices that
  * no triangle in view uses are skipped (vr_cull.glsl marks the others).
  */
