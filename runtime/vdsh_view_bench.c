@@ -167,6 +167,12 @@ static void add_buffer_modes(bench_scene *b)
  * computed in a compute shader (vr_scene_desc.sums, "buf12-compute"; a
  * cpca stream decoded in the sums), and (copy 4) each cpca one again with
  * the stream decoded at load ("buf12-compute-load"). */
+/* Whether buffer stream st of a scene with info is a cpca stream. */
+static int cpca_stream(const vr_scene_info *info, int st)
+{
+    return st >= 1 && st < VDSH_ORDER_SLOTS && info->buffer_encoding[st] == VDSH_ENCODING_CPCA;
+}
+
 static int add_copy_modes(bench_scene *b, int copy)
 {
     static const char *suffix[4] = {"f32", "frame", "compute", "compute-load"};
@@ -174,13 +180,11 @@ static int add_copy_modes(bench_scene *b, int copy)
     int n = b->nm, any = 0;
     vr_scene_info info;
     vr_scene_get_info(b->scene, &info);
-    for (int m = 0; m < n; m++) {
-        int st = b->modes[m].stream;
-        /* copies 2 and 4 differ from the scene in their cpca streams only */
+    /* copies 2 and 4 differ from the scene in their cpca streams only */
+    const int cpca_only = copy == 2 || copy == 4;
+    for (int m = 0; m < n; m++)
         any |= b->modes[m].mode == VR_MODE_VDSH_BUFFER && !b->modes[m].from_copy &&
-               ((copy != 2 && copy != 4) || (st >= 1 && st < VDSH_ORDER_SLOTS &&
-                                             info.buffer_encoding[st] == VDSH_ENCODING_CPCA));
-    }
+               (!cpca_only || cpca_stream(&info, b->modes[m].stream));
     if (!any)
         return 0;
     vr_error err;
@@ -198,10 +202,8 @@ static int add_copy_modes(bench_scene *b, int copy)
     }
     for (int m = 0; m < n && b->nm < BENCH_MODES; m++) {
         int k = vv_mode_find(b->modes[m].name, strlen(b->modes[m].name), VV_MODE_BENCH_LOG);
-        int st = b->modes[m].stream;
         if (b->modes[m].mode != VR_MODE_VDSH_BUFFER || b->modes[m].from_copy || k < 0 ||
-            ((copy == 2 || copy == 4) &&
-             (st < 1 || st >= VDSH_ORDER_SLOTS || info.buffer_encoding[st] != VDSH_ENCODING_CPCA)))
+            (cpca_only && !cpca_stream(&info, b->modes[m].stream)))
             continue;
         snprintf(names[copy - 1][k], sizeof names[copy - 1][k], "%s-%s", vv_modes[k].json,
                  suffix[copy - 1]);
