@@ -612,7 +612,7 @@ static vr_result make_summer(const vr_scene *s, vr_buffer *b, int group, const c
     return vr_check_gl(err, name);
 }
 
-vr_result vr_cull_make(GLuint *prog, vr_error *err)
+vr_result vr_cull_make(vr_cull_prog *c, vr_error *err)
 {
     const char *version = compute_version();
     size_t size = strlen(version) + vr_cull_glsl_size + 1;
@@ -620,17 +620,23 @@ vr_result vr_cull_make(GLuint *prog, vr_error *err)
     if (!cs)
         return vr_fail(err, VR_ERR_OUT_OF_MEMORY, "vr_draw: out of memory");
     snprintf(cs, size, "%s%s", version, vr_cull_glsl);
-    vr_result r = vr_link_compute("vr_draw: the sums' cull program", cs, prog, err);
+    vr_result r = vr_link_compute("vr_draw: the sums' cull program", cs, &c->prog, err);
     free(cs);
-    return r;
+    if (r != VR_OK)
+        return r;
+    c->u_view_proj = glGetUniformLocation(c->prog, "u_view_proj");
+    c->u_triangles = glGetUniformLocation(c->prog, "u_triangles");
+    c->u_frame = glGetUniformLocation(c->prog, "u_frame");
+    return VR_OK;
 }
 
-void vr_cull(const vr_scene *s, GLuint prog, GLuint seen, const float vp[16], uint32_t frame)
+void vr_cull(const vr_scene *s, const vr_cull_prog *c, GLuint seen, const float vp[16],
+             uint32_t frame)
 {
-    glUseProgram(prog);
-    glUniformMatrix4fv(glGetUniformLocation(prog, "u_view_proj"), 1, GL_FALSE, vp);
-    glUniform1i(glGetUniformLocation(prog, "u_triangles"), (GLint)s->triangle_count);
-    glUniform1ui(glGetUniformLocation(prog, "u_frame"), frame);
+    glUseProgram(c->prog);
+    glUniformMatrix4fv(c->u_view_proj, 1, GL_FALSE, vp);
+    glUniform1i(c->u_triangles, (GLint)s->triangle_count);
+    glUniform1ui(c->u_frame, frame);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s->vbo_position);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->ibo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, seen);

@@ -151,12 +151,18 @@ void vr_buffer_decode(const vr_scene *s, const vr_buffer *b);
  * vertices whose u32 in `seen` is `frame` (vr_cull). */
 vr_result vr_buffer_sums(const vr_scene *s, vr_buffer *b, GLuint lights, GLuint sums, int n,
                          GLuint seen, uint32_t frame, vr_error *err);
-/* The cull program (shaders/vr_cull.glsl) into *prog. VR_ERR_SHADER. */
-vr_result vr_cull_make(GLuint *prog, vr_error *err);
+/* The cull program (shaders/vr_cull.glsl) and its uniforms' locations. */
+typedef struct vr_cull_prog {
+    GLuint prog;
+    GLint u_view_proj, u_triangles, u_frame;
+} vr_cull_prog;
+/* Build the cull program into *c. VR_ERR_SHADER, VR_ERR_OUT_OF_MEMORY. */
+vr_result vr_cull_make(vr_cull_prog *c, vr_error *err);
 /* Set seen[v] = frame for every vertex v of s that a triangle the view
  * vp (column-major, as the passes') does not clip away wholly uses;
  * seen: a storage buffer of a u32 per vertex. */
-void vr_cull(const vr_scene *s, GLuint prog, GLuint seen, const float vp[16], uint32_t frame);
+void vr_cull(const vr_scene *s, const vr_cull_prog *c, GLuint seen, const float vp[16],
+             uint32_t frame);
 void vr_buffer_destroy(vr_buffer *b);
 /* The positions and normals (and indices) of s into the bound VAO. */
 void vr_scene_base_attribs(const vr_scene *s);

@@ -63,7 +63,8 @@ struct vr_renderer {
     int sums_pos_cap;     /* lights */
     /* which vertices the frame's view uses (vr_cull): the program, a u32
      * per vertex (seen_cap of them) and the frame's mark, never 0 */
-    GLuint cull_prog, seen_buf;
+    vr_cull_prog cull;
+    GLuint seen_buf;
     uint32_t seen_cap, seen_frame;
 };
 
@@ -243,8 +244,8 @@ void vr_renderer_destroy(vr_renderer *r)
     vr_text_destroy(&r->text);
     GLuint bufs[3] = {r->sums_lights, r->sums_buf, r->seen_buf};
     glDeleteBuffers(3, bufs);
-    if (r->cull_prog)
-        glDeleteProgram(r->cull_prog);
+    if (r->cull.prog)
+        glDeleteProgram(r->cull.prog);
     glDeleteTextures(1, &r->sums_tex);
     free(r->sums_pos);
     free(r);
@@ -873,8 +874,8 @@ static vr_result draw_pass(const draw_frame *F, int g, vr_error *err)
 static vr_result frame_cull(vr_renderer *r, const vr_scene *s, const float vp[16], uint32_t *frame,
                             vr_error *err)
 {
-    if (!r->cull_prog) {
-        vr_result res = vr_cull_make(&r->cull_prog, err);
+    if (!r->cull.prog) {
+        vr_result res = vr_cull_make(&r->cull, err);
         if (res != VR_OK)
             return res;
     }
@@ -898,7 +899,7 @@ static vr_result frame_cull(vr_renderer *r, const vr_scene *s, const float vp[16
         r->seen_frame = 0;
     }
     *frame = ++r->seen_frame;
-    vr_cull(s, r->cull_prog, r->seen_buf, vp, *frame);
+    vr_cull(s, &r->cull, r->seen_buf, vp, *frame);
     return VR_OK;
 }
 
