@@ -297,6 +297,23 @@ static void jacobi(double *a, uint32_t n, double *v)
     }
 }
 
+/* A study knob (vdsh_cpca_study.h): the number in environment variable
+ * `name`, 0 (off: the encoder's own bytes) when unset or empty; one that is
+ * not a number in (0, most] is ignored, with a message. Read at every use:
+ * no state kept. */
+static double study_knob(const char *name, double most)
+{
+    const char *e = getenv(name);
+    if (!e || !*e)
+        return 0.0;
+    char *end;
+    const double s = strtod(e, &end);
+    if (*end == '\0' && s > 0.0 && s <= most)
+        return s;
+    fprintf(stderr, "cpca: %s='%s' is not a number in (0, %g]: ignored\n", name, e, most);
+    return 0.0;
+}
+
 /* ---- the metric: the SH's Gram matrix over cube texel directions ---- */
 
 typedef struct metric_dirs {
@@ -376,10 +393,36 @@ static void metric_free(metric_dirs *m)
  * integral. A vertex with no light above its horizon keeps the uniform
  * weight. +, -, x, / and comparisons only (no libm): the same bytes on any
  * CPU. */
+/* ln x for x > 0 finite: frexp (exact) and the atanh series, +, -, x, /
+ * only (no libm transcendental): the same bits on any CPU. */
+static double det_ln(double x)
+{
+    int e;
+    double m = frexp(x, &e); /* x = m 2^e, m in [0.5, 1) */
+    if (m < 0.70710678118654752) {
+        m *= 2.0;
+        e--;
+    }
+    const double s = (m - 1.0) / (m + 1.0), s2 = s * s; /* |s| < 0.172 */
+    double t = s, sum = 0.0;
+    for (int k = 1; k <= 25; k += 2) {
+        sum += t / k;
+        t *= s2;
+    }
+    return 2.0 * sum + e * 0.69314718055994530942;
+}
+
 typedef struct lightmix {
     double a;
     uint32_t nl;
     const float *lights, *pos; /* nl x 3, rows x 3 */
+    /* The margin study (VDSH_CPCA_MARGIN, vdsh_cpca_study.h): when wt is
+     * set, each light's weight 1 / (1 + m^2 inv_sigma2), m its margin from
+     * the source's coefficients src (order^2 per row), parallel to tex. */
+    const float *src;
+    uint32_t order;
+    double inv_sigma2;
+    float *wt;
     /* Every row's texels of its lights above its horizon, in pool order
      * (packed: light_texel), found once by lightmix_load: row v's at
      * tex[at[v]..at[v + 1]), for the rows v < cached (the first that fit
@@ -400,6 +443,7 @@ static void lightmix_free(lightmix *lm)
 {
     free(lm->at);
     free(lm->tex);
+    free(lm->wt);
     memset(lm, 0, sizeof *lm);
 }
 
@@ -452,23 +496,45 @@ static int light_above(const lightmix *lm, uint32_t l, const float *p, const flo
     return d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0;
 }
 
-/* Row v's texels (normal nv) into tex from slot at: their count. */
+/* The margin study's weight of the light in direction d (length r) from
+ * row v: 1 / (1 + m^2 / sigma^2), m = ln D of the row's coefficients at d
+ * less ln r (the decision's margin). +, -, x, /, sqrt and det_ln only. */
+static float margin_weight(const lightmix *lm, uint32_t v, const double d[3])
+{
+    const uint32_t n = lm->order * lm->order;
+    const double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    const float df[3] = {(float)(d[0] / r), (float)(d[1] / r), (float)(d[2] / r)};
+    float y[VDSH_MAX_COEFFS];
+    vdsh_sh_eval((int)lm->order, df, y);
+    const float *x = lm->src + (size_t)v * n;
+    double a = 0.0;
+    for (uint32_t i = 0; i < n; i++)
+        a += (double)x[i] * y[i];
+    const double m = a - det_ln(r);
+    return (float)(1.0 / (1.0 + m * m * lm->inv_sigma2));
+}
+
+/* Row v's texels (normal nv) into tex from slot at (and their margin
+ * weights into wt, when the study asks): their count. */
 static uint32_t row_texels(const lightmix *lm, uint32_t v, const float *nv, size_t at)
 {
     const float *p = lm->pos + 3 * (size_t)v;
     uint32_t t = 0;
     for (uint32_t l = 0; l < lm->nl; l++) {
         double d[3];
-        if (light_above(lm, l, p, nv, d))
-            lm->tex[at + t++] = light_texel(d);
+        if (!light_above(lm, l, p, nv, d))
+            continue;
+        if (lm->wt)
+            lm->wt[at + t] = margin_weight(lm, v, d);
+        lm->tex[at + t++] = light_texel(d);
     }
     return t;
 }
 
 /* lm from the settings, the rows' texels found (normals, rows x 3): 1 when
  * on, 0 when off (lm zeroed), -1 out of memory. */
-static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float *normals,
-                         uint32_t rows)
+static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float *src,
+                         uint32_t order, const float *normals, uint32_t rows)
 {
     memset(lm, 0, sizeof *lm);
     if (!st || !(st->light_mix > 0.0f) || !st->light_count || !st->lights || !st->positions)
@@ -489,6 +555,14 @@ static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float
     const size_t most = (size_t)rows * lm->nl;
     if (!(lm->tex = malloc(sizeof(uint16_t) * ((most < cap ? most : cap) + lm->nl) + 1)))
         return -1;
+    const double sigma = study_knob("VDSH_CPCA_MARGIN", 1e6);
+    if (sigma > 0.0) {
+        lm->src = src;
+        lm->order = order;
+        lm->inv_sigma2 = 1.0 / (sigma * sigma);
+        if (!(lm->wt = malloc(sizeof(float) * ((most < cap ? most : cap) + lm->nl) + 1)))
+            return -1;
+    }
     lm->at[0] = 0;
     for (; lm->cached < rows; lm->cached++) {
         const uint32_t v = lm->cached;
@@ -501,15 +575,28 @@ static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float
     uint16_t *shrunk = realloc(lm->tex, sizeof(uint16_t) * size + 1);
     if (shrunk)
         lm->tex = shrunk;
+    if (lm->wt) {
+        float *w = realloc(lm->wt, sizeof(float) * size + 1);
+        if (w)
+            lm->wt = w;
+    }
     return 1;
 }
 
-/* Row v's packed texels (light_texel) in *tex; their count returned. */
-static uint32_t light_texels(const lightmix *lm, uint32_t v, const float *nv, const uint16_t **tex)
+/* Row v's packed texels (light_texel) in *tex, their weights in *wt (NULL:
+ * each 1) and the weights' sum in *sum; their count returned. */
+static uint32_t light_texels(const lightmix *lm, uint32_t v, const float *nv, const uint16_t **tex,
+                             const float **wt, double *sum)
 {
     size_t at = lm->at[v < lm->cached ? v : lm->cached];
     uint32_t t = v < lm->cached ? (uint32_t)(lm->at[v + 1] - at) : row_texels(lm, v, nv, at);
     *tex = lm->tex + at;
+    *wt = lm->wt ? lm->wt + at : NULL;
+    double s = 0.0;
+    if (lm->wt)
+        for (uint32_t i = 0; i < t; i++)
+            s += lm->wt[at + i];
+    *sum = lm->wt ? s : (double)t;
     return t;
 }
 
@@ -535,13 +622,15 @@ static void metric_gram_members(const metric_dirs *m, const float *normals, cons
         double a = nv[0], b = nv[1], e = nv[2], u = 1.0;
         if (lm) { /* (1 - a) uniform + a light density */
             const uint16_t *tex;
-            const uint32_t t = light_texels(lm, v, nv, &tex);
-            if (t) {
-                const double sum = (double)t;
+            const float *wt;
+            double sum;
+            const uint32_t t = light_texels(lm, v, nv, &tex, &wt, &sum);
+            if (t && sum > 0.0) {
                 u = 1.0 - lm->a;
                 for (uint32_t i = 0; i < t; i++) {
                     const uint32_t x = tex[i] & FIT_TEXEL;
-                    frac[x] += lm->a * TWO_PI / (sum * m->w[x]);
+                    const double wi = wt ? (double)wt[i] : 1.0;
+                    frac[x] += lm->a * TWO_PI * wi / (sum * m->w[x]);
                 }
             }
         }
@@ -608,7 +697,9 @@ static void kmeans(const float *src, const float *normals, uint32_t rows, uint32
                    uint32_t k, uint32_t *labels, double *dist, double *cent)
 {
     const uint32_t dim = n + 3;
-    uint64_t seed = KMEANS_SEED;
+    /* the seed study (VDSH_CPCA_KMEANS_SEED=N, vdsh_cpca_study.h) */
+    uint64_t seed =
+        KMEANS_SEED ^ (uint64_t)study_knob("VDSH_CPCA_KMEANS_SEED", 65535) * 0x9e3779b97f4a7c15ull;
     /* k-means++ seeding */
     uint32_t first = (uint32_t)(splitmix(&seed) % rows);
     set_centre(src + (size_t)first * n, normals + 3 * (size_t)first, n, ns, cent);
@@ -966,16 +1057,20 @@ static uint32_t vertex_hemisphere(const fit_ctx *f, refine_ctx *r, uint32_t v)
     if (r->dw) { /* (1 - a) uniform + a light density */
         const lightmix *lm = f->lm;
         const uint16_t *tex;
-        const uint32_t t = light_texels(lm, v, nv, &tex);
-        const double sum = (double)t;
+        const float *wt;
+        double sum;
+        uint32_t t = light_texels(lm, v, nv, &tex, &wt, &sum);
+        if (!(sum > 0.0))
+            t = 0;
         for (uint32_t h = 0; h < nh; h++)
             r->dw[r->hemi[h]] = t ? 1.0 - lm->a : 1.0;
         for (uint32_t i = 0; i < t; i++) {
             const uint32_t d =
                 lm->ref[tex[i] & FIT_TEXEL] + (tex[i] >> 15) * REFINE_CUBE_N + (tex[i] >> 14 & 1u);
             const double *dd = r->rd.dir + 3 * (size_t)d;
+            const double wi = wt ? (double)wt[i] : 1.0;
             if (dd[0] * nv[0] + dd[1] * nv[1] + dd[2] * nv[2] > 0.0)
-                r->dw[d] += lm->a * TWO_PI / (sum * r->rd.w[d]);
+                r->dw[d] += lm->a * TWO_PI * wi / (sum * r->rd.w[d]);
         }
     }
     return nh;
@@ -1153,7 +1248,7 @@ static int fit_scratch_alloc(fit_scratch *s, const float *src, const float *norm
     s->mu = malloc(sizeof(double) * n);
     s->dist = malloc(sizeof(double) * rows);
     s->cent = malloc(sizeof(double) * k * (n + 3));
-    const int lm = shared ? 1 : lightmix_load(&s->lm, light, normals, rows);
+    const int lm = shared ? 1 : lightmix_load(&s->lm, light, src, order, normals, rows);
     if (lm < 0)
         return 0;
     f->lm = shared ? shared : lm ? &s->lm : NULL;
@@ -1391,7 +1486,7 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
     uint32_t last_k = 0;
     int have = 0;
     lightmix shared; /* every candidate's: the rows' light texels found once */
-    const int lm = lightmix_load(&shared, settings, normals, rows);
+    const int lm = lightmix_load(&shared, settings, src, order, normals, rows);
     if (lm < 0) {
         lightmix_free(&shared);
         return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory for the light texels");
@@ -1456,9 +1551,12 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
         if (!isfinite(src[x]))
             return vdsh_failf(err, VDSH_ERR_INVALID,
                               "cpca: vertex %zu coefficient %zu is not finite", x / n, x % n);
-    if (settings->budget && settings->clusters)
-        return encode_alloc(src, normals, rows, order, settings, VDSH_CPCA_REFIT_ROUNDS, NULL, out,
-                            err);
+    if (settings->budget && settings->clusters) {
+        /* the rounds study (VDSH_CPCA_REFIT_ROUNDS=R, vdsh_cpca_study.h) */
+        const uint32_t r = (uint32_t)study_knob("VDSH_CPCA_REFIT_ROUNDS", 16);
+        return encode_alloc(src, normals, rows, order, settings, r ? r : VDSH_CPCA_REFIT_ROUNDS,
+                            NULL, out, err);
+    }
     if (settings->budget)
         return encode_auto(src, normals, rows, order, settings, out, err);
     return encode_fixed(src, normals, rows, order, settings, NULL, out, NULL, err);
@@ -2195,25 +2293,6 @@ done:
 }
 
 /* ---- the pool score of a fitted stream (vdsh_cpca_study.h) ---- */
-
-/* ln x for x > 0 finite: frexp (exact) and the atanh series, +, -, x, /
- * only (no libm transcendental): the same bits on any CPU. */
-static double det_ln(double x)
-{
-    int e;
-    double m = frexp(x, &e); /* x = m 2^e, m in [0.5, 1) */
-    if (m < 0.70710678118654752) {
-        m *= 2.0;
-        e--;
-    }
-    const double s = (m - 1.0) / (m + 1.0), s2 = s * s; /* |s| < 0.172 */
-    double t = s, sum = 0.0;
-    for (int k = 1; k <= 25; k += 2) {
-        sum += t / k;
-        t *= s2;
-    }
-    return 2.0 * sum + e * 0.69314718055994530942;
-}
 
 vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_t rows,
                                  uint32_t order, const vdsh_cpca_settings *settings,

@@ -91,6 +91,22 @@ vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_
  * rounds asked, the cluster rounds kept, and the clusters' summed error in
  * their metrics (each cluster's metric_gram_members Gram, the records
  * decoded as every reader decodes) before the refit and after. */
+/* The margin study (issue 29, docs/ACCURACY.md "Weighting the light
+ * metric by the decision margin"): with VDSH_CPCA_MARGIN=SIGMA (a number
+ * > 0) in the environment, every encoder with the light-density metric
+ * weights each pool light of a row by 1 / (1 + (m / SIGMA)^2), m the
+ * light's decision margin: ln D of the row's own coefficients at the
+ * light's direction less ln of its distance; the weights normalised per
+ * row (their sum in place of the count), in the clusters' Grams and the
+ * refinement's weights alike. Unset (or empty): the encoder's own bytes.
+ * Deterministic as the rest (+, -, x, /, sqrt, the f32 SH basis and a
+ * series ln). Not a default: measured, not adopted.
+ * Two more knobs, for the same section: VDSH_CPCA_KMEANS_SEED=N (an
+ * integer 1..65535) draws the k-means++ seeding from another seed (the
+ * fit's own scatter); VDSH_CPCA_REFIT_ROUNDS=R (1..16) runs R refit rounds
+ * for K,alloc:BYTES instead of VDSH_CPCA_REFIT_ROUNDS below. A value out of
+ * range is ignored with a message on stderr. */
+
 /* The refit rounds vdsh_cpca_encode runs for K,alloc:BYTES. */
 #define VDSH_CPCA_REFIT_ROUNDS 2
 

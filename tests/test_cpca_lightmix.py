@@ -18,12 +18,20 @@ formats/vdsh_cpca.h; docs/ACCURACY.md, "A light-density metric"):
 - tests/light_pool_tool's seed bake:1 is the pool a bake of seed 1 places
   (bake.h VB_POOL_SEED, one definition: scripts/cpca_study draws with it);
 - a one-shard part's merge equals the whole bake at light:1 (bake_cpca
-  checks 2 shards and threads with the default).
+  checks 2 shards and threads with the default);
+- the study knobs (formats/vdsh_cpca_study.h; docs/ACCURACY.md "Weighting
+  the light metric by the decision margin"): VDSH_CPCA_MARGIN=1e6 (every
+  light's weight rounds to 1) and VDSH_CPCA_REFIT_ROUNDS=2 (the default's
+  rounds) give light:1's bytes, a value out of range is ignored with a
+  message naming the variable; VDSH_CPCA_MARGIN=0.25 and
+  VDSH_CPCA_KMEANS_SEED=1 are other fits, valid, at the same bytes per
+  vertex budget.
 
 Usage: test_cpca_lightmix.py VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR WORK_DIR LIGHT_POOL_TOOL
 """
 import json
 import os
+import re
 import struct
 import subprocess
 import sys
@@ -132,6 +140,38 @@ for name, want in (("p1", "l1"), ("p0", "l0")):
                        capture_output=True, text=True)
     if r.returncode or blob(name + "-m.vdsh") != blob(want + ".vdsh"):
         fail.append("%s merged is not the whole %s bake: %s" % (name, want, r.stderr))
+
+# The study knobs, in the environment of the bake (its encoder).
+def knob_bake(name, env):
+    r = subprocess.run([bake] + TINY + CPCA + ["4,alloc:40,light:1", "-o", path(name)],
+                       capture_output=True, text=True, env=dict(os.environ, **env))
+    must(r, "%s bake" % env)
+    return r.stderr
+
+
+for name, env in (("k-wide.vdsh", {"VDSH_CPCA_MARGIN": "1e6"}),
+                  ("k-r2.vdsh", {"VDSH_CPCA_REFIT_ROUNDS": "2"})):
+    knob_bake(name, env)
+    if blob(name) != blob("l1.vdsh"):
+        fail.append("%s does not give light:1's bytes" % env)
+for var, val in (("VDSH_CPCA_MARGIN", "abc"), ("VDSH_CPCA_KMEANS_SEED", "70000"),
+                 ("VDSH_CPCA_REFIT_ROUNDS", "-1")):
+    err = knob_bake("k-bad.vdsh", {var: val})
+    if blob("k-bad.vdsh") != blob("l1.vdsh") or var not in err or "ignored" not in err:
+        fail.append("%s=%s: not ignored with a message (stderr %r)" % (var, val, err))
+for name, env in (("k-m.vdsh", {"VDSH_CPCA_MARGIN": "0.25"}),
+                  ("k-seed.vdsh", {"VDSH_CPCA_KMEANS_SEED": "1"})):
+    knob_bake(name, env)
+    st = vdsh.read(path(name)).streams[0]
+    got = vdsh.coefficients(st).astype(np.float64)
+    err = np.sqrt(((got - x) ** 2).sum(1).mean()) / spread
+    print("%s: decoded error %.4f of the spread" % (env, err))
+    if blob(name) == blob("l1.vdsh") or not err < 0.5:
+        fail.append("%s: not another valid fit (decoded error %.3f)" % (env, err))
+    txt = subprocess.run([info, path(name)], capture_output=True, text=True).stdout
+    per = re.search(r"([0-9.]+) with the model", txt)
+    if not per or not float(per.group(1)) <= 40.0:
+        fail.append("%s: not within the 40-byte budget: %r" % (env, txt))
 
 # A whole file does not record the mix or the pool (VDSH.md "cpca
 # streams"): the bake's --report says them, vdsh-info says where to look.
