@@ -314,6 +314,25 @@ static double study_knob(const char *name, double most)
     return 0.0;
 }
 
+/* ln x for x > 0 finite: frexp (exact) and the atanh series, +, -, x, /
+ * only (no libm transcendental): the same bits on any CPU. */
+static double det_ln(double x)
+{
+    int e;
+    double m = frexp(x, &e); /* x = m 2^e, m in [0.5, 1) */
+    if (m < 0.70710678118654752) {
+        m *= 2.0;
+        e--;
+    }
+    const double s = (m - 1.0) / (m + 1.0), s2 = s * s; /* |s| < 0.172 */
+    double t = s, sum = 0.0;
+    for (int k = 1; k <= 25; k += 2) {
+        sum += t / k;
+        t *= s2;
+    }
+    return 2.0 * sum + e * 0.69314718055994530942;
+}
+
 /* ---- the metric: the SH's Gram matrix over cube texel directions ---- */
 
 typedef struct metric_dirs {
@@ -393,25 +412,6 @@ static void metric_free(metric_dirs *m)
  * integral. A vertex with no light above its horizon keeps the uniform
  * weight. +, -, x, / and comparisons only (no libm): the same bytes on any
  * CPU. */
-/* ln x for x > 0 finite: frexp (exact) and the atanh series, +, -, x, /
- * only (no libm transcendental): the same bits on any CPU. */
-static double det_ln(double x)
-{
-    int e;
-    double m = frexp(x, &e); /* x = m 2^e, m in [0.5, 1) */
-    if (m < 0.70710678118654752) {
-        m *= 2.0;
-        e--;
-    }
-    const double s = (m - 1.0) / (m + 1.0), s2 = s * s; /* |s| < 0.172 */
-    double t = s, sum = 0.0;
-    for (int k = 1; k <= 25; k += 2) {
-        sum += t / k;
-        t *= s2;
-    }
-    return 2.0 * sum + e * 0.69314718055994530942;
-}
-
 typedef struct lightmix {
     double a;
     uint32_t nl;

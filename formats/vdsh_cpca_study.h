@@ -84,13 +84,6 @@ vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_
                                  const vdsh_cpca_fit *fit, vdsh_cpca_pool_scores *out,
                                  vdsh_error *err);
 
-/* The quantisation-aware refit (issue 29, docs/ACCURACY.md
- * "Quantisation-aware refit of the model"): vdsh_cpca_encode of settings
- * K,alloc:BYTES (clusters and budget set) with `rounds` refit rounds
- * instead of the encoder's own (0: none). report (may be NULL): the
- * rounds asked, the cluster rounds kept, and the clusters' summed error in
- * their metrics (each cluster's metric_gram_members Gram, the records
- * decoded as every reader decodes) before the refit and after. */
 /* The margin study (issue 29, docs/ACCURACY.md "Weighting the light
  * metric by the decision margin"): with VDSH_CPCA_MARGIN=SIGMA (a number
  * > 0) in the environment, every encoder with the light-density metric
@@ -107,6 +100,13 @@ vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_
  * for K,alloc:BYTES instead of VDSH_CPCA_REFIT_ROUNDS below. A value out of
  * range is ignored with a message on stderr. */
 
+/* The quantisation-aware refit (issue 29, docs/ACCURACY.md
+ * "Quantisation-aware refit of the model"): vdsh_cpca_encode of settings
+ * K,alloc:BYTES (clusters and budget set) with `rounds` refit rounds
+ * instead of the encoder's own (0: none). report (may be NULL): the
+ * rounds asked, the cluster rounds kept, and the clusters' summed error in
+ * their metrics (each cluster's metric_gram_members Gram, the records
+ * decoded as every reader decodes) before the refit and after. */
 /* The refit rounds vdsh_cpca_encode runs for K,alloc:BYTES. */
 #define VDSH_CPCA_REFIT_ROUNDS 2
 
