@@ -694,12 +694,12 @@ static void set_centre(const float *c, const float *nrm, uint32_t n, double ns, 
 
 /* labels[rows] in 0..k-1; scratch `dist` (rows) and centres k * (n + 3). */
 static void kmeans(const float *src, const float *normals, uint32_t rows, uint32_t n, double ns,
-                   uint32_t k, uint32_t *labels, double *dist, double *cent)
+                   uint32_t k, uint32_t start, uint32_t *labels, double *dist, double *cent)
 {
     const uint32_t dim = n + 3;
-    /* the seed study (VDSH_CPCA_KMEANS_SEED=N, vdsh_cpca_study.h) */
-    uint64_t seed =
-        KMEANS_SEED ^ (uint64_t)study_knob("VDSH_CPCA_KMEANS_SEED", 65535) * 0x9e3779b97f4a7c15ull;
+    /* the seed study (VDSH_CPCA_KMEANS_SEED=N, VDSH_CPCA_STARTS: vdsh_cpca_study.h) */
+    uint64_t seed = KMEANS_SEED ^ ((uint64_t)study_knob("VDSH_CPCA_KMEANS_SEED", 65535) + start) *
+                                      0x9e3779b97f4a7c15ull;
     /* k-means++ seeding */
     uint32_t first = (uint32_t)(splitmix(&seed) % rows);
     set_centre(src + (size_t)first * n, normals + 3 * (size_t)first, n, ns, cent);
@@ -1180,10 +1180,11 @@ typedef struct fit_scratch {
     fit_ctx fc;
     lightmix lm; /* the light-density metric's */
     metric_dirs md;
-    refine_ctx rd; /* allocated only with need_rd */
-    double *mu;    /* n */
-    double *dist;  /* rows */
-    double *cent;  /* k x (n + 3) */
+    refine_ctx rd;  /* allocated only with need_rd */
+    double *mu;     /* n */
+    double *dist;   /* rows */
+    double *cent;   /* k x (n + 3) */
+    uint32_t start; /* the settings' k-means start */
 } fit_scratch;
 
 static void fit_scratch_free(fit_scratch *s)
@@ -1223,6 +1224,7 @@ static int fit_scratch_alloc(fit_scratch *s, const float *src, const float *norm
 {
     memset(s, 0, sizeof *s);
     const uint32_t n = order * order, bf = fit_basis;
+    s->start = light ? light->start : 0;
     fit_ctx *f = &s->fc;
     *f = (fit_ctx){.src = src,
                    .normals = normals,
@@ -1291,7 +1293,8 @@ static vdsh_result cluster_and_fit(fit_scratch *s, uint32_t rounds, vdsh_error *
             spread += e * e;
         }
     spread = sqrt(spread / rows);
-    kmeans(src, f->normals, rows, n, NORMAL_WEIGHT * spread, f->k, f->labels, s->dist, s->cent);
+    kmeans(src, f->normals, rows, n, NORMAL_WEIGHT * spread, f->k, s->start, f->labels, s->dist,
+           s->cent);
     vdsh_result res = fit_all(f, err);
     for (uint32_t round = 0; res == VDSH_OK && round < rounds; round++) {
         if (!reassign(f, &s->rd))
@@ -1535,6 +1538,39 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
     return VDSH_OK;
 }
 
+/* The starts study (VDSH_CPCA_STARTS=N, vdsh_cpca_study.h): K,alloc:BYTES
+ * fitted from the k-means starts 0..N-1 in turn, each scored over the
+ * settings' pool (vdsh_cpca_pool_score), the fit with the fewest decisions
+ * differing from src's kept (the first on a tie). */
+static vdsh_result encode_starts(const float *src, const float *normals, uint32_t rows,
+                                 uint32_t order, const vdsh_cpca_settings *settings, uint32_t refit,
+                                 uint32_t starts, vdsh_cpca_fit *out, vdsh_error *err)
+{
+    uint64_t best = UINT64_MAX;
+    for (uint32_t i = 0; i < starts; i++) {
+        vdsh_cpca_settings st = *settings;
+        st.start = settings->start + i;
+        vdsh_cpca_fit fit = {0};
+        vdsh_cpca_pool_scores sc;
+        vdsh_result res = encode_alloc(src, normals, rows, order, &st, refit, NULL, &fit, err);
+        if (res == VDSH_OK)
+            res = vdsh_cpca_pool_score(src, normals, rows, order, &st, &fit, &sc, err);
+        if (res != VDSH_OK) {
+            vdsh_cpca_fit_free(&fit);
+            vdsh_cpca_fit_free(out);
+            return res;
+        }
+        if (sc.disagree < best) {
+            best = sc.disagree;
+            vdsh_cpca_fit_free(out);
+            *out = fit;
+        } else {
+            vdsh_cpca_fit_free(&fit);
+        }
+    }
+    return VDSH_OK;
+}
+
 vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t rows, uint32_t order,
                              const vdsh_cpca_settings *settings, vdsh_cpca_fit *out,
                              vdsh_error *err)
@@ -1554,8 +1590,14 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
     if (settings->budget && settings->clusters) {
         /* the rounds study (VDSH_CPCA_REFIT_ROUNDS=R, vdsh_cpca_study.h) */
         const uint32_t r = (uint32_t)study_knob("VDSH_CPCA_REFIT_ROUNDS", 16);
-        return encode_alloc(src, normals, rows, order, settings, r ? r : VDSH_CPCA_REFIT_ROUNDS,
-                            NULL, out, err);
+        const uint32_t starts = settings->light_count && settings->lights && settings->positions
+                                    ? (uint32_t)study_knob("VDSH_CPCA_STARTS", 16)
+                                    : 0;
+        if (starts < 2)
+            return encode_alloc(src, normals, rows, order, settings, r ? r : VDSH_CPCA_REFIT_ROUNDS,
+                                NULL, out, err);
+        return encode_starts(src, normals, rows, order, settings, r ? r : VDSH_CPCA_REFIT_ROUNDS,
+                             starts, out, err);
     }
     if (settings->budget)
         return encode_auto(src, normals, rows, order, settings, out, err);
@@ -2300,14 +2342,25 @@ vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_
                                  vdsh_error *err)
 {
     memset(out, 0, sizeof *out);
-    if (!src || !normals || !settings || !fit || !settings->light_count || !settings->lights ||
-        !settings->positions || order < 1 || order > VDSH_MAX_ORDER)
+    if (!fit || order < 1 || order > VDSH_MAX_ORDER)
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca pool score: bad arguments");
+    const vdsh_stream s = fit_stream(fit, order);
+    return vdsh_cpca_pool_score_stream(src, normals, rows, order, settings, &s, out, err);
+}
+
+vdsh_result vdsh_cpca_pool_score_stream(const float *src, const float *normals, uint32_t rows,
+                                        uint32_t order, const vdsh_cpca_settings *settings,
+                                        const vdsh_stream *s, vdsh_cpca_pool_scores *out,
+                                        vdsh_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!src || !normals || !settings || !s || !settings->light_count || !settings->lights ||
+        !settings->positions || order < 1 || order > VDSH_MAX_ORDER || s->order != order)
         return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca pool score: bad arguments");
     const uint32_t n = order * order;
-    const vdsh_stream s = fit_stream(fit, order);
     float dec[VDSH_MAX_COEFFS], y[VDSH_MAX_COEFFS];
     for (uint32_t v = 0; v < rows; v++) {
-        vdsh_stream_decode(&s, v, dec);
+        vdsh_stream_decode(s, v, dec);
         const float *x = src + (size_t)v * n, *p = settings->positions + 3 * (size_t)v;
         const float *nv = normals + 3 * (size_t)v;
         for (uint32_t l = 0; l < settings->light_count; l++) {

@@ -74,6 +74,10 @@ typedef struct vdsh_cpca_settings {
      * pass, the same bytes more slowly (vdsh_cpca_encode). A memory cap
      * only; the tests lower it to check that the output does not move. */
     size_t light_cache;
+    /* The k-means start (the seeding's draw): 0, the encoder's own. Study
+     * only (vdsh_cpca_study.h, VDSH_CPCA_STARTS): start i draws as
+     * VDSH_CPCA_KMEANS_SEED=i would. */
+    uint32_t start;
 } vdsh_cpca_settings;
 
 /* The light mix vdsh_cpca_parse gives when the text does not say, for

@@ -84,6 +84,13 @@ vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_
                                  const vdsh_cpca_fit *fit, vdsh_cpca_pool_scores *out,
                                  vdsh_error *err);
 
+/* The same score of any stream of `order` with `rows` vertices (a cpca
+ * stream read from a file, say: tests/cpca_kchoice_tool --score). */
+vdsh_result vdsh_cpca_pool_score_stream(const float *src, const float *normals, uint32_t rows,
+                                        uint32_t order, const vdsh_cpca_settings *settings,
+                                        const vdsh_stream *s, vdsh_cpca_pool_scores *out,
+                                        vdsh_error *err);
+
 /* The margin study (issue 29, docs/ACCURACY.md "Weighting the light
  * metric by the decision margin"): with VDSH_CPCA_MARGIN=SIGMA (a number
  * > 0) in the environment, every encoder with the light-density metric
@@ -98,7 +105,14 @@ vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_
  * integer 1..65535) draws the k-means++ seeding from another seed (the
  * fit's own scatter); VDSH_CPCA_REFIT_ROUNDS=R (1..16) runs R refit rounds
  * for K,alloc:BYTES instead of VDSH_CPCA_REFIT_ROUNDS below. A value out of
- * range is ignored with a message on stderr. */
+ * range is ignored with a message on stderr.
+ * The starts study (docs/ACCURACY.md "Keeping the best of several k-means
+ * starts"): VDSH_CPCA_STARTS=N (2..16) fits K,alloc:BYTES from N k-means
+ * starts (the seeds VDSH_CPCA_KMEANS_SEED=0..N-1 give, or S..S+N-1 with
+ * that knob at S), scores each over the settings' light pool as
+ * vdsh_cpca_pool_score does, and keeps the one whose shadow decisions
+ * differ from the uncompressed coefficients' at the fewest pairs (the
+ * first on a tie): N fits and N scores. Without a pool: one fit. */
 
 /* The quantisation-aware refit (issue 29, docs/ACCURACY.md
  * "Quantisation-aware refit of the model"): vdsh_cpca_encode of settings

@@ -217,12 +217,13 @@ target_link_libraries(light_pool_tool PRIVATE vb_core)
 # the uniform metric, light:1 and 0.5 valid other fits, the default's
 # bytes, bad values refused; parts carry the pool (lpol), mismatched or
 # damaged pools refused by the merge and the readers; light_pool_tool's
-# bake:1 is the part's pool.
+# bake:1 is the part's pool; the study knobs (VDSH_CPCA_STARTS keeps the
+# start with the fewest pool decisions differing: cpca_kchoice_tool --score).
 add_test(NAME bake_cpca_lightmix
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_cpca_lightmix.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>
                  ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/bake_cpca_lightmix
-                 $<TARGET_FILE:light_pool_tool>)
+                 $<TARGET_FILE:light_pool_tool> $<TARGET_FILE:cpca_kchoice_tool>)
 
 # scripts/cpca_study's cache in --work (tests/test_cpca_study_cache.py):
 # bakes, truth and light pools named by what made them (mesh and its

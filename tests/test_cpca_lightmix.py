@@ -25,9 +25,14 @@ formats/vdsh_cpca.h; docs/ACCURACY.md, "A light-density metric"):
   rounds) give light:1's bytes, a value out of range is ignored with a
   message naming the variable; VDSH_CPCA_MARGIN=0.25 and
   VDSH_CPCA_KMEANS_SEED=1 are other fits, valid, at the same bytes per
-  vertex budget.
+  vertex budget; VDSH_CPCA_STARTS=2 keeps whichever of the default's and
+  VDSH_CPCA_KMEANS_SEED=1's bytes has the fewer pool decisions differing
+  (tests/cpca_kchoice_tool --score, the pool the bake fitted with),
+  STARTS=3 with KMEANS_SEED=1 the fewest of seeds 1, 2, 3, STARTS=1 is
+  the default's bytes and STARTS=17 is ignored with a message.
 
 Usage: test_cpca_lightmix.py VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR WORK_DIR LIGHT_POOL_TOOL
+                             KCHOICE_TOOL
 """
 import json
 import os
@@ -38,7 +43,7 @@ import sys
 
 import numpy as np
 
-bake, merge, info, src, work, pool_tool = sys.argv[1:7]
+bake, merge, info, src, work, pool_tool, kchoice = sys.argv[1:8]
 sys.path.insert(0, os.path.join(src, "python"))
 import vdsh  # noqa: E402
 from testlib import chunks, fix_crc  # noqa: E402
@@ -150,12 +155,13 @@ def knob_bake(name, env):
 
 
 for name, env in (("k-wide.vdsh", {"VDSH_CPCA_MARGIN": "1e6"}),
-                  ("k-r2.vdsh", {"VDSH_CPCA_REFIT_ROUNDS": "2"})):
+                  ("k-r2.vdsh", {"VDSH_CPCA_REFIT_ROUNDS": "2"}),
+                  ("k-st1.vdsh", {"VDSH_CPCA_STARTS": "1"})):
     knob_bake(name, env)
     if blob(name) != blob("l1.vdsh"):
         fail.append("%s does not give light:1's bytes" % env)
 for var, val in (("VDSH_CPCA_MARGIN", "abc"), ("VDSH_CPCA_KMEANS_SEED", "70000"),
-                 ("VDSH_CPCA_REFIT_ROUNDS", "-1")):
+                 ("VDSH_CPCA_REFIT_ROUNDS", "-1"), ("VDSH_CPCA_STARTS", "17")):
     err = knob_bake("k-bad.vdsh", {var: val})
     if blob("k-bad.vdsh") != blob("l1.vdsh") or var not in err or "ignored" not in err:
         fail.append("%s=%s: not ignored with a message (stderr %r)" % (var, val, err))
@@ -172,6 +178,29 @@ for name, env in (("k-m.vdsh", {"VDSH_CPCA_MARGIN": "0.25"}),
     per = re.search(r"([0-9.]+) with the model", txt)
     if not per or not float(per.group(1)) <= 40.0:
         fail.append("%s: not within the 40-byte budget: %r" % (env, txt))
+
+
+# VDSH_CPCA_STARTS=N: the start whose decisions over the bake's pool
+# (pool.f32, bake:1) differ from the f32 stream's at the fewest pairs.
+def disagree(names):
+    r = subprocess.run([kchoice, "--score", path("f32.vdsh"), path("pool.f32")] +
+                       [path(n) for n in names], capture_output=True, text=True)
+    must(r, "cpca_kchoice_tool --score")
+    return [json.loads(line)["disagree"] for line in r.stdout.splitlines()]
+
+
+for seed in ("2", "3"):
+    knob_bake("k-seed%s.vdsh" % seed, {"VDSH_CPCA_KMEANS_SEED": seed})
+for name, env, cands in (("k-st2.vdsh", {"VDSH_CPCA_STARTS": "2"}, ["l1.vdsh", "k-seed.vdsh"]),
+                         ("k-st3.vdsh", {"VDSH_CPCA_STARTS": "3", "VDSH_CPCA_KMEANS_SEED": "1"},
+                          ["k-seed.vdsh", "k-seed2.vdsh", "k-seed3.vdsh"])):
+    knob_bake(name, env)
+    d = disagree(cands)
+    keep = cands[d.index(min(d))]
+    print("%s: decisions differing %s, keeps %s" % (env, d, keep))
+    if len(set(blob(c) for c in cands)) != len(cands) or blob(name) != blob(keep):
+        fail.append("%s: not the bytes of %s (fewest decisions differing of %s: %s)" % (
+            env, keep, cands, d))
 
 # A whole file does not record the mix or the pool (VDSH.md "cpca
 # streams"): the bake's --report says them, vdsh-info says where to look.
