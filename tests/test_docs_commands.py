@@ -59,6 +59,7 @@ FOREIGN = {
     "pkg-config": ("--cflags", "--libs", "--static"),
     "sbatch": ("--dependency", "--cpus-per-task", "--chdir", "--kill-on-invalid-dep"),
     "perf, heaptrack_print": ("--sort", "--print-peaks"),
+    "tests/cpca_kchoice_tool (a measurement tool, no --help)": ("--score",),
 }
 LONG = re.compile(r"(?<![\w-])(--[A-Za-z0-9][\w-]*)")
 
