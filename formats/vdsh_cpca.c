@@ -1590,14 +1590,13 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
     if (settings->budget && settings->clusters) {
         /* the rounds study (VDSH_CPCA_REFIT_ROUNDS=R, vdsh_cpca_study.h) */
         const uint32_t r = (uint32_t)study_knob("VDSH_CPCA_REFIT_ROUNDS", 16);
+        const uint32_t rounds = r ? r : VDSH_CPCA_REFIT_ROUNDS;
         const uint32_t starts = settings->light_count && settings->lights && settings->positions
                                     ? (uint32_t)study_knob("VDSH_CPCA_STARTS", 16)
                                     : 0;
         if (starts < 2)
-            return encode_alloc(src, normals, rows, order, settings, r ? r : VDSH_CPCA_REFIT_ROUNDS,
-                                NULL, out, err);
-        return encode_starts(src, normals, rows, order, settings, r ? r : VDSH_CPCA_REFIT_ROUNDS,
-                             starts, out, err);
+            return encode_alloc(src, normals, rows, order, settings, rounds, NULL, out, err);
+        return encode_starts(src, normals, rows, order, settings, rounds, starts, out, err);
     }
     if (settings->budget)
         return encode_auto(src, normals, rows, order, settings, out, err);
