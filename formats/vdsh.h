@@ -364,10 +364,14 @@ int vdsh_light_box_bad_axis(const float min[3], const float max[3]);
  * which vdsh-merge passes to the encoder. Only in parts whose `part`
  * encoding is cpca, and only with a mix > 0. */
 #define VDSH_MAX_POOL_LIGHTS 65536
+#define VDSH_CPCA_MAX_MARGIN 1e6f /* --cpca margin:S, 0 < S <= this */
+#define VDSH_CPCA_MAX_STARTS 16   /* --cpca starts:N, 1 <= N <= this */
 typedef struct vdsh_light_pool {
     float mix;           /* 0 < mix <= 1 */
     uint32_t count;      /* 1..VDSH_MAX_POOL_LIGHTS */
     const float *lights; /* 3 * count, finite */
+    float margin;        /* --cpca margin:S: 0 (none) or 0 < S <= VDSH_CPCA_MAX_MARGIN */
+    uint32_t starts;     /* --cpca starts:N: 0 (one fit), 1..VDSH_CPCA_MAX_STARTS */
 } vdsh_light_pool;
 
 typedef struct vdsh_file {

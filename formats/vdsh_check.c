@@ -547,6 +547,14 @@ int vdsh_check_light_pool(const vdsh_light_pool *l, int has_part, const vdsh_par
                            "cpca bakes carry one)");
     if (!(l->mix > 0.0f && l->mix <= 1.0f))
         return vdsh_bad(w, "lpol: light mix %g out of range (0, 1]", (double)l->mix);
+    if (!(l->margin == 0.0f || (l->margin > 0.0f && l->margin <= VDSH_CPCA_MAX_MARGIN)))
+        return vdsh_bad(w, "lpol: margin %g out of range (0 or (0, %g])", (double)l->margin,
+                        (double)VDSH_CPCA_MAX_MARGIN);
+    if (l->starts > VDSH_CPCA_MAX_STARTS)
+        return vdsh_bad(w, "lpol: %u starts, out of range 0..%d", l->starts, VDSH_CPCA_MAX_STARTS);
+    if ((l->margin > 0.0f || l->starts) && (!part->cpca_clusters || part->cpca_bits))
+        return vdsh_bad(w, "lpol: a margin or starts with cpca settings other than "
+                           "K,alloc:BYTES");
     if (l->count < 1 || l->count > VDSH_MAX_POOL_LIGHTS)
         return vdsh_bad(w, "lpol: %u lights, out of range 1..%d", l->count, VDSH_MAX_POOL_LIGHTS);
     if (!l->lights)

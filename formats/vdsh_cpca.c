@@ -56,6 +56,16 @@ static int check_light(const vdsh_cpca_settings *s, vdsh_error *err)
             vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: light %zu is not finite", x / 3);
             return 0;
         }
+    if (!(s->margin == 0.0f || (s->margin > 0.0f && s->margin <= VDSH_CPCA_MAX_MARGIN))) {
+        vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: margin %g out of range (0, %g]",
+                   (double)s->margin, (double)VDSH_CPCA_MAX_MARGIN);
+        return 0;
+    }
+    if (s->starts > VDSH_CPCA_MAX_STARTS) {
+        vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: %u starts out of range 1..%d", s->starts,
+                   VDSH_CPCA_MAX_STARTS);
+        return 0;
+    }
     return 1;
 }
 
@@ -96,58 +106,89 @@ static int check_settings(const vdsh_cpca_settings *s, vdsh_error *err)
 
 static vdsh_result parse_base(const char *text, vdsh_cpca_settings *out, vdsh_error *err);
 
-/* "light:A", A a decimal in 0..1 (digits and one point only: no sign,
- * exponent, inf or nan); 0 when malformed. */
-static int parse_light(const char *p, float *mix)
+/* A decimal of at most 16 characters, digits and one point only (no
+ * sign, exponent, inf or nan), into *x; 0 when malformed. */
+static int parse_decimal(const char *p, double *x)
 {
-    if (strncmp(p, "light:", 6) != 0)
-        return 0;
-    p += 6;
     const char *q = p;
     int digits = 0, points = 0;
     for (; *q; q++) {
         if (*q >= '0' && *q <= '9')
             digits++;
-        else if (*q == '.' && !points++)
-            continue;
-        else
+        else if (*q != '.' || points++)
             return 0;
     }
     if (!digits || q - p > 16)
         return 0;
     char *end;
-    double a = strtod(p, &end);
-    if (*end || !(a >= 0.0 && a <= 1.0))
-        return 0;
-    *mix = (float)a;
-    return 1;
+    *x = strtod(p, &end);
+    return *end == '\0';
+}
+
+/* The options a setting may end in (vdsh_cpca_parse), each once. */
+static const char *const OPTIONS[] = {"light:", "margin:", "starts:"};
+
+/* The option token p names (its index in OPTIONS), or -1. */
+static int option_of(const char *p)
+{
+    for (int i = 0; i < 3; i++)
+        if (strncmp(p, OPTIONS[i], strlen(OPTIONS[i])) == 0)
+            return i;
+    return -1;
 }
 
 vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_error *err)
 {
     const char *p = text ? text : "";
-    const char *l = strncmp(p, "light:", 6) == 0 ? p : strstr(p, ",light:");
-    float mix = -1.0f; /* not said */
-    if (l && !parse_light(l + (*l == ','), &mix))
-        return vdsh_failf(err, VDSH_ERR_ARGUMENT,
-                          "cpca settings '%s': expected light:A at the end, A the light mix "
-                          "0..1 (for example 8,alloc:32,light:1)",
-                          p);
+    char buf[128];
+    if (strlen(p) >= sizeof buf)
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca settings '%s': too long", p);
+    strcpy(buf, p);
+    /* the options: from the first comma-separated token that names one */
+    char *opts = option_of(buf) >= 0 ? buf : NULL;
+    for (char *c = strchr(buf, ','); c && !opts; c = strchr(c + 1, ','))
+        if (option_of(c + 1) >= 0)
+            opts = c + 1;
     vdsh_cpca_settings s = vdsh_cpca_settings_default();
-    if (l != p) {
-        char base[64];
-        size_t len = l ? (size_t)(l - p) : strlen(p);
-        if (len >= sizeof base)
-            return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca settings '%s': too long", p);
-        memcpy(base, p, len);
-        base[len] = 0;
-        vdsh_result r = parse_base(base, &s, err);
+    if (opts != buf) {
+        if (opts)
+            opts[-1] = 0;
+        vdsh_result r = parse_base(buf, &s, err);
         if (r != VDSH_OK)
             return r;
     }
+    double value[3];
+    int said[3] = {0, 0, 0};
+    for (char *tok = opts; tok;) {
+        char *next = strchr(tok, ',');
+        if (next)
+            *next++ = 0;
+        const int o = option_of(tok);
+        const int ok =
+            o >= 0 && !said[o] && parse_decimal(tok + strlen(OPTIONS[o]), &value[o]) &&
+            (o == 0   ? value[0] <= 1.0
+             : o == 1 ? value[1] > 0.0 && value[1] <= VDSH_CPCA_MAX_MARGIN
+                      : value[2] >= 1.0 && value[2] <= VDSH_CPCA_MAX_STARTS && !strchr(tok, '.'));
+        if (!ok)
+            return vdsh_failf(
+                err, VDSH_ERR_ARGUMENT,
+                "cpca settings '%s': '%s': expected options at the end, each "
+                "once: light:A (the light mix, 0..1), margin:S (S > 0, at most 1e6) or "
+                "starts:N (1..%d) (for example 16,alloc:32,margin:0.25,starts:2)",
+                p, tok, VDSH_CPCA_MAX_STARTS);
+        said[o] = 1;
+        tok = next;
+    }
     /* Not said: the light density for the byte-budget forms, the uniform
      * hemisphere for fixed widths (vdsh_cpca.h). */
-    s.light_mix = mix >= 0.0f ? mix : s.budget ? VDSH_CPCA_DEFAULT_LIGHT_MIX : 0.0f;
+    s.light_mix = said[0] ? (float)value[0] : s.budget ? VDSH_CPCA_DEFAULT_LIGHT_MIX : 0.0f;
+    s.margin = said[1] ? (float)value[1] : 0.0f;
+    s.starts = said[2] ? (uint32_t)value[2] : 0;
+    if ((said[1] || said[2]) && !(s.budget && s.clusters && s.light_mix > 0.0f))
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                          "cpca settings '%s': margin:S and starts:N need K,alloc:BYTES with a "
+                          "light mix above 0 (they use the light pool)",
+                          p);
     *out = s;
     return VDSH_OK;
 }
@@ -416,8 +457,7 @@ typedef struct lightmix {
     double a;
     uint32_t nl;
     const float *lights, *pos; /* nl x 3, rows x 3 */
-    /* The margin study (VDSH_CPCA_MARGIN, vdsh_cpca_study.h): when wt is
-     * set, each light's weight 1 / (1 + m^2 inv_sigma2), m its margin from
+    /* The margin (settings margin, vdsh_cpca.h): when wt is set, each light's weight 1 / (1 + m^2 inv_sigma2), m its margin from
      * the source's coefficients src (order^2 per row), parallel to tex. */
     const float *src;
     uint32_t order;
@@ -496,7 +536,7 @@ static int light_above(const lightmix *lm, uint32_t l, const float *p, const flo
     return d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0;
 }
 
-/* The margin study's weight of the light in direction d (length r) from
+/* The margin's weight of the light in direction d (length r) from
  * row v: 1 / (1 + m^2 / sigma^2), m = ln D of the row's coefficients at d
  * less ln r (the decision's margin). +, -, x, /, sqrt and det_ln only. */
 static float margin_weight(const lightmix *lm, uint32_t v, const double d[3])
@@ -515,7 +555,7 @@ static float margin_weight(const lightmix *lm, uint32_t v, const double d[3])
 }
 
 /* Row v's texels (normal nv) into tex from slot at (and their margin
- * weights into wt, when the study asks): their count. */
+ * weights into wt, with a margin): their count. */
 static uint32_t row_texels(const lightmix *lm, uint32_t v, const float *nv, size_t at)
 {
     const float *p = lm->pos + 3 * (size_t)v;
@@ -555,7 +595,7 @@ static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float
     const size_t most = (size_t)rows * lm->nl;
     if (!(lm->tex = malloc(sizeof(uint16_t) * ((most < cap ? most : cap) + lm->nl) + 1)))
         return -1;
-    const double sigma = study_knob("VDSH_CPCA_MARGIN", 1e6);
+    const double sigma = st->margin;
     if (sigma > 0.0) {
         lm->src = src;
         lm->order = order;
@@ -697,7 +737,8 @@ static void kmeans(const float *src, const float *normals, uint32_t rows, uint32
                    uint32_t k, uint32_t start, uint32_t *labels, double *dist, double *cent)
 {
     const uint32_t dim = n + 3;
-    /* the seed study (VDSH_CPCA_KMEANS_SEED=N, VDSH_CPCA_STARTS: vdsh_cpca_study.h) */
+    /* the seed study (VDSH_CPCA_KMEANS_SEED=N, vdsh_cpca_study.h) and the
+     * settings' starts */
     uint64_t seed = KMEANS_SEED ^ ((uint64_t)study_knob("VDSH_CPCA_KMEANS_SEED", 65535) + start) *
                                       0x9e3779b97f4a7c15ull;
     /* k-means++ seeding */
@@ -1474,7 +1515,8 @@ static uint32_t largest_basis(uint32_t rows, uint32_t order, const vdsh_cpca_set
 
 static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t rows,
                                 uint32_t order, const vdsh_cpca_settings *settings, uint32_t refit,
-                                vdsh_cpca_refit_report *rep, vdsh_cpca_fit *out, vdsh_error *err);
+                                const lightmix *shared, vdsh_cpca_refit_report *rep,
+                                vdsh_cpca_fit *out, vdsh_error *err);
 
 /* auto: the candidates vdsh_cpca.h names, the least stored_error kept. */
 static vdsh_result encode_auto(const float *src, const float *normals, uint32_t rows,
@@ -1538,37 +1580,45 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
     return VDSH_OK;
 }
 
-/* The starts study (VDSH_CPCA_STARTS=N, vdsh_cpca_study.h): K,alloc:BYTES
- * fitted from the k-means starts 0..N-1 in turn, each scored over the
- * settings' pool (vdsh_cpca_pool_score), the fit with the fewest decisions
- * differing from src's kept (the first on a tie). */
+/* K,alloc:BYTES from settings->starts k-means starts (vdsh_cpca.h): the
+ * fits start, start + 1, ... , all scored in one pass over the settings'
+ * pool (vdsh_cpca_pool_score_streams: each pair's SH evaluated once for
+ * every start), the fit with the fewest decisions differing from src's
+ * kept (the first on a tie). The rows' light texels (and margin weights)
+ * are found once for every start. */
 static vdsh_result encode_starts(const float *src, const float *normals, uint32_t rows,
                                  uint32_t order, const vdsh_cpca_settings *settings, uint32_t refit,
-                                 uint32_t starts, vdsh_cpca_fit *out, vdsh_error *err)
+                                 vdsh_cpca_fit *out, vdsh_error *err)
 {
-    uint64_t best = UINT64_MAX;
-    for (uint32_t i = 0; i < starts; i++) {
+    const uint32_t count = settings->starts;
+    vdsh_cpca_fit fits[VDSH_CPCA_MAX_STARTS];
+    vdsh_stream streams[VDSH_CPCA_MAX_STARTS];
+    vdsh_cpca_pool_scores sc[VDSH_CPCA_MAX_STARTS];
+    memset(fits, 0, sizeof fits);
+    lightmix shared;
+    vdsh_result res = VDSH_OK;
+    if (lightmix_load(&shared, settings, src, order, normals, rows) < 0)
+        res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory for the light texels");
+    for (uint32_t i = 0; res == VDSH_OK && i < count; i++) {
         vdsh_cpca_settings st = *settings;
         st.start = settings->start + i;
-        vdsh_cpca_fit fit = {0};
-        vdsh_cpca_pool_scores sc;
-        vdsh_result res = encode_alloc(src, normals, rows, order, &st, refit, NULL, &fit, err);
-        if (res == VDSH_OK)
-            res = vdsh_cpca_pool_score(src, normals, rows, order, &st, &fit, &sc, err);
-        if (res != VDSH_OK) {
-            vdsh_cpca_fit_free(&fit);
-            vdsh_cpca_fit_free(out);
-            return res;
-        }
-        if (sc.disagree < best) {
-            best = sc.disagree;
-            vdsh_cpca_fit_free(out);
-            *out = fit;
-        } else {
-            vdsh_cpca_fit_free(&fit);
-        }
+        res = encode_alloc(src, normals, rows, order, &st, refit, &shared, NULL, &fits[i], err);
+        streams[i] = fit_stream(&fits[i], order);
     }
-    return VDSH_OK;
+    lightmix_free(&shared);
+    if (res == VDSH_OK)
+        res = vdsh_cpca_pool_score_streams(src, normals, rows, order, settings, streams, count, sc,
+                                           err);
+    uint32_t best = 0;
+    for (uint32_t i = 1; res == VDSH_OK && i < count; i++)
+        if (sc[i].disagree < sc[best].disagree)
+            best = i;
+    for (uint32_t i = 0; i < count; i++)
+        if (res != VDSH_OK || i != best)
+            vdsh_cpca_fit_free(&fits[i]);
+    if (res == VDSH_OK)
+        *out = fits[best];
+    return res;
 }
 
 vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t rows, uint32_t order,
@@ -1591,12 +1641,11 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
         /* the rounds study (VDSH_CPCA_REFIT_ROUNDS=R, vdsh_cpca_study.h) */
         const uint32_t r = (uint32_t)study_knob("VDSH_CPCA_REFIT_ROUNDS", 16);
         const uint32_t rounds = r ? r : VDSH_CPCA_REFIT_ROUNDS;
-        const uint32_t starts = settings->light_count && settings->lights && settings->positions
-                                    ? (uint32_t)study_knob("VDSH_CPCA_STARTS", 16)
-                                    : 0;
-        if (starts < 2)
-            return encode_alloc(src, normals, rows, order, settings, rounds, NULL, out, err);
-        return encode_starts(src, normals, rows, order, settings, rounds, starts, out, err);
+        const int pool = settings->light_mix > 0.0f && settings->light_count && settings->lights &&
+                         settings->positions;
+        if (settings->starts < 2 || !pool)
+            return encode_alloc(src, normals, rows, order, settings, rounds, NULL, NULL, out, err);
+        return encode_starts(src, normals, rows, order, settings, rounds, out, err);
     }
     if (settings->budget)
         return encode_auto(src, normals, rows, order, settings, out, err);
@@ -1637,8 +1686,11 @@ void vdsh_cpca_part_record(const vdsh_cpca_settings *st, vdsh_file *f)
     f->part.cpca_bits = st->budget ? 0 : st->bits;
     f->has_light_pool = st->light_mix > 0.0f && st->light_count && st->lights;
     if (f->has_light_pool)
-        f->light_pool =
-            (vdsh_light_pool){.mix = st->light_mix, .count = st->light_count, .lights = st->lights};
+        f->light_pool = (vdsh_light_pool){.mix = st->light_mix,
+                                          .count = st->light_count,
+                                          .lights = st->lights,
+                                          .margin = st->margin,
+                                          .starts = st->starts};
 }
 
 vdsh_cpca_settings vdsh_cpca_part_settings(const vdsh_file *f)
@@ -1655,6 +1707,8 @@ vdsh_cpca_settings vdsh_cpca_part_settings(const vdsh_file *f)
         st.light_mix = f->light_pool.mix;
         st.light_count = f->light_pool.count;
         st.lights = f->light_pool.lights;
+        st.margin = f->light_pool.margin;
+        st.starts = f->light_pool.starts;
         st.positions = f->positions;
     }
     return st;
@@ -1706,7 +1760,8 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
                                  uint32_t order, const vdsh_cpca_settings *settings,
                                  uint32_t fit_basis, double budget, const uint8_t *widths,
                                  float *decoded, vdsh_cpca_widths_fit *out, vdsh_cpca_fit *fit,
-                                 uint32_t refit, vdsh_cpca_refit_report *rep, vdsh_error *err);
+                                 uint32_t refit, const lightmix *shared,
+                                 vdsh_cpca_refit_report *rep, vdsh_error *err);
 
 vdsh_result vdsh_cpca_encode_widths(const float *src, const float *normals, uint32_t rows,
                                     uint32_t order, const vdsh_cpca_settings *settings,
@@ -1717,7 +1772,7 @@ vdsh_result vdsh_cpca_encode_widths(const float *src, const float *normals, uint
     if (!decoded || !settings || settings->budget)
         return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca widths: bad arguments");
     return encode_widths(src, normals, rows, order, settings, fit_basis, budget, widths, decoded,
-                         out, NULL, 0, NULL, err);
+                         out, NULL, 0, NULL, NULL, err);
 }
 
 vdsh_result vdsh_cpca_encode_refit(const float *src, const float *normals, uint32_t rows,
@@ -1734,7 +1789,7 @@ vdsh_result vdsh_cpca_encode_refit(const float *src, const float *normals, uint3
         return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca refit: bad arguments");
     if (!check_settings(settings, err))
         return VDSH_ERR_ARGUMENT;
-    return encode_alloc(src, normals, rows, order, settings, rounds, report, out, err);
+    return encode_alloc(src, normals, rows, order, settings, rounds, NULL, report, out, err);
 }
 
 /* --cpca K,alloc:BYTES (settings K and budget): refined with the largest
@@ -1742,7 +1797,8 @@ vdsh_result vdsh_cpca_encode_refit(const float *src, const float *normals, uint3
  * min(2B, n) vectors; *out the stream (bits 0, the widths table). */
 static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t rows,
                                 uint32_t order, const vdsh_cpca_settings *settings, uint32_t refit,
-                                vdsh_cpca_refit_report *rep, vdsh_cpca_fit *out, vdsh_error *err)
+                                const lightmix *shared, vdsh_cpca_refit_report *rep,
+                                vdsh_cpca_fit *out, vdsh_error *err)
 {
     const uint32_t n = order * order;
     const uint64_t limit = (uint64_t)settings->budget * rows;
@@ -1764,7 +1820,7 @@ static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t
     uint32_t fb = 2 * st.basis < n ? 2 * st.basis : n;
     vdsh_cpca_widths_fit wf;
     return encode_widths(src, normals, rows, order, &st, fb, (double)settings->budget, NULL, NULL,
-                         &wf, out, refit, rep, err);
+                         &wf, out, refit, shared, rep, err);
 }
 
 /* ---- the quantisation-aware refit (issue 29; docs/ACCURACY.md
@@ -2061,7 +2117,8 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
                                  uint32_t order, const vdsh_cpca_settings *settings,
                                  uint32_t fit_basis, double budget, const uint8_t *widths,
                                  float *decoded, vdsh_cpca_widths_fit *out, vdsh_cpca_fit *fit,
-                                 uint32_t refit, vdsh_cpca_refit_report *rep, vdsh_error *err)
+                                 uint32_t refit, const lightmix *shared,
+                                 vdsh_cpca_refit_report *rep, vdsh_error *err)
 {
     memset(out, 0, sizeof *out);
     if (fit)
@@ -2098,7 +2155,7 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
     fit_scratch fs;
     const uint32_t rounds = k > 1 ? REFINE_ROUNDS : 0;
     vdsh_result res = VDSH_OK;
-    if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, bf, rounds, settings, NULL) ||
+    if (!fit_scratch_alloc(&fs, src, normals, rows, order, k, b, bf, rounds, settings, shared) ||
         !wts || !cdist || !cscale || !tot || !level || !best_level || !mem) {
         res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca widths: out of memory");
         goto done;
@@ -2344,22 +2401,31 @@ vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_
     if (!fit || order < 1 || order > VDSH_MAX_ORDER)
         return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca pool score: bad arguments");
     const vdsh_stream s = fit_stream(fit, order);
-    return vdsh_cpca_pool_score_stream(src, normals, rows, order, settings, &s, out, err);
+    return vdsh_cpca_pool_score_streams(src, normals, rows, order, settings, &s, 1, out, err);
 }
 
-vdsh_result vdsh_cpca_pool_score_stream(const float *src, const float *normals, uint32_t rows,
-                                        uint32_t order, const vdsh_cpca_settings *settings,
-                                        const vdsh_stream *s, vdsh_cpca_pool_scores *out,
-                                        vdsh_error *err)
+vdsh_result vdsh_cpca_pool_score_streams(const float *src, const float *normals, uint32_t rows,
+                                         uint32_t order, const vdsh_cpca_settings *settings,
+                                         const vdsh_stream *s, uint32_t count,
+                                         vdsh_cpca_pool_scores *out, vdsh_error *err)
 {
-    memset(out, 0, sizeof *out);
-    if (!src || !normals || !settings || !s || !settings->light_count || !settings->lights ||
-        !settings->positions || order < 1 || order > VDSH_MAX_ORDER || s->order != order)
+    if (out && count <= VDSH_CPCA_MAX_STARTS)
+        memset(out, 0, sizeof *out * count);
+    if (!src || !normals || !settings || !s || !out || count < 1 || count > VDSH_CPCA_MAX_STARTS ||
+        !settings->light_count || !settings->lights || !settings->positions || order < 1 ||
+        order > VDSH_MAX_ORDER)
         return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca pool score: bad arguments");
+    for (uint32_t k = 0; k < count; k++)
+        if (s[k].order != order)
+            return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                              "cpca pool score: stream %u of order %u, "
+                              "not %u",
+                              k, s[k].order, order);
     const uint32_t n = order * order;
-    float dec[VDSH_MAX_COEFFS], y[VDSH_MAX_COEFFS];
+    float dec[VDSH_CPCA_MAX_STARTS][VDSH_MAX_COEFFS], y[VDSH_MAX_COEFFS];
     for (uint32_t v = 0; v < rows; v++) {
-        vdsh_stream_decode(s, v, dec);
+        for (uint32_t k = 0; k < count; k++)
+            vdsh_stream_decode(&s[k], v, dec[k]);
         const float *x = src + (size_t)v * n, *p = settings->positions + 3 * (size_t)v;
         const float *nv = normals + 3 * (size_t)v;
         for (uint32_t l = 0; l < settings->light_count; l++) {
@@ -2372,16 +2438,19 @@ vdsh_result vdsh_cpca_pool_score_stream(const float *src, const float *normals, 
             const double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
             float df[3] = {(float)(d[0] / r), (float)(d[1] / r), (float)(d[2] / r)};
             vdsh_sh_eval((int)order, df, y);
-            double a = 0.0, b = 0.0;
-            for (uint32_t i = 0; i < n; i++) {
+            double a = 0.0;
+            for (uint32_t i = 0; i < n; i++)
                 a += (double)x[i] * y[i];
-                b += (double)dec[i] * y[i];
-            }
             const double t = det_ln(r);
-            out->pairs++;
-            out->disagree += (a >= t) != (b >= t);
-            out->missed += (a >= t) && !(b >= t);
-            out->squared += (b - a) * (b - a);
+            for (uint32_t k = 0; k < count; k++) {
+                double b = 0.0;
+                for (uint32_t i = 0; i < n; i++)
+                    b += (double)dec[k][i] * y[i];
+                out[k].pairs++;
+                out[k].disagree += (a >= t) != (b >= t);
+                out[k].missed += (a >= t) && !(b >= t);
+                out[k].squared += (b - a) * (b - a);
+            }
         }
     }
     return VDSH_OK;

@@ -74,9 +74,25 @@ typedef struct vdsh_cpca_settings {
      * pass, the same bytes more slowly (vdsh_cpca_encode). A memory cap
      * only; the tests lower it to check that the output does not move. */
     size_t light_cache;
-    /* The k-means start (the seeding's draw): 0, the encoder's own. Study
-     * only (vdsh_cpca_study.h, VDSH_CPCA_STARTS): start i draws as
-     * VDSH_CPCA_KMEANS_SEED=i would. */
+    /* The decision margin's weight (--cpca ...,margin:S; docs/ACCURACY.md
+     * "Weighting the light metric by the decision margin"; VDSH.md "cpca
+     * streams"): with the light-density metric, each pool light of a row
+     * weighs 1 / (1 + (m / S)^2), m the light's margin, ln D of the row's
+     * own coefficients at the light's direction less ln of its distance
+     * (the weights summed per row in place of the count). 0: every light
+     * 1, the bytes without it. 0 or in (0, VDSH_CPCA_MAX_MARGIN]. */
+    float margin;
+    /* K,alloc:BYTES fitted from this many k-means starts (--cpca
+     * ...,starts:N; docs/ACCURACY.md "Keeping the best of several k-means
+     * starts"): each scored over the pool (vdsh_cpca_study.h's
+     * vdsh_cpca_pool_score), the one whose shadow decisions differ from
+     * the uncompressed coefficients' at the fewest (vertex, light) pairs
+     * kept, the first on a tie. 0 or 1: one fit; without a pool, one fit.
+     * 0..VDSH_CPCA_MAX_STARTS. */
+    uint32_t starts;
+    /* The k-means start (the seeding's draw) of a one-start fit: 0, the
+     * encoder's own; start i draws as VDSH_CPCA_KMEANS_SEED=i would
+     * (vdsh_cpca_study.h). With starts N: the starts start..start+N-1. */
     uint32_t start;
 } vdsh_cpca_settings;
 
@@ -103,12 +119,16 @@ typedef struct vdsh_cpca_settings {
 vdsh_cpca_settings vdsh_cpca_settings_default(void);
 
 /* Parse "K,B,BITS" (for example "8,54,4"), "auto" (budget 32),
- * "auto:BYTES" (1..VDSH_CPCA_MAX_BUDGET) or "K,alloc:BYTES", each with an
- * optional ",light:A" (A in 0..1, the light mix; else
- * VDSH_CPCA_DEFAULT_LIGHT_MIX for auto and alloc, 0 for K,B,BITS), or
- * "light:A" alone (the default settings, vdsh_cpca_settings_default's
- * K and budget, with that mix) into *out (no pool: the caller sets it); VDSH_ERR_ARGUMENT
- * with a message for a malformed string or a value out of range. */
+ * "auto:BYTES" (1..VDSH_CPCA_MAX_BUDGET) or "K,alloc:BYTES", each
+ * followed by options, each once, in any order: ",light:A" (A in 0..1,
+ * the light mix; else VDSH_CPCA_DEFAULT_LIGHT_MIX for auto and alloc, 0
+ * for K,B,BITS), and for K,alloc:BYTES with a light mix above 0
+ * ",margin:S" (the margin, S in (0, VDSH_CPCA_MAX_MARGIN]) and
+ * ",starts:N" (1..VDSH_CPCA_MAX_STARTS); or the options alone (the
+ * default settings, vdsh_cpca_settings_default's K and budget, with them:
+ * "light:A", "margin:0.25,starts:2") into *out (no pool: the caller sets
+ * it); VDSH_ERR_ARGUMENT with a message for a malformed string or a value
+ * out of range. */
 vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_error *err);
 
 /* A fitted stream: model (its pointers into storage_) and records
@@ -151,7 +171,8 @@ void vdsh_cpca_fit_free(vdsh_cpca_fit *fit);
 /* A cpca part's record of its settings (VDSH.md "Parts"), into f:
  * part.cpca_clusters, cpca_basis, cpca_bits (K,B,BITS: K, B, BITS; auto:
  * 0, budget, 0; K,alloc:BYTES: K, budget, 0) and, with a light mix > 0 and
- * a pool, the `lpol` chunk's light_pool (borrowing st->lights). */
+ * a pool, the `lpol` chunk's light_pool (borrowing st->lights), the
+ * margin and starts with it. */
 void vdsh_cpca_part_record(const vdsh_cpca_settings *st, vdsh_file *f);
 
 /* The settings cpca part f records, as vdsh_cpca_part_record wrote them,

@@ -84,35 +84,26 @@ vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_
                                  const vdsh_cpca_fit *fit, vdsh_cpca_pool_scores *out,
                                  vdsh_error *err);
 
-/* The same score of any stream of `order` with `rows` vertices (a cpca
- * stream read from a file, say: tests/cpca_kchoice_tool --score). */
-vdsh_result vdsh_cpca_pool_score_stream(const float *src, const float *normals, uint32_t rows,
-                                        uint32_t order, const vdsh_cpca_settings *settings,
-                                        const vdsh_stream *s, vdsh_cpca_pool_scores *out,
-                                        vdsh_error *err);
+/* The same score of `count` streams of `order` with `rows` vertices
+ * (1..VDSH_CPCA_MAX_STARTS; out[k] stream k's) in one pass, each pair's
+ * SH evaluated once for all: encode's starts, and a cpca stream read from
+ * a file (tests/cpca_kchoice_tool --score). Each out[k] is what a pass
+ * over stream k alone gives. */
+vdsh_result vdsh_cpca_pool_score_streams(const float *src, const float *normals, uint32_t rows,
+                                         uint32_t order, const vdsh_cpca_settings *settings,
+                                         const vdsh_stream *s, uint32_t count,
+                                         vdsh_cpca_pool_scores *out, vdsh_error *err);
 
-/* The margin study (issue 29, docs/ACCURACY.md "Weighting the light
- * metric by the decision margin"): with VDSH_CPCA_MARGIN=SIGMA (a number
- * > 0) in the environment, every encoder with the light-density metric
- * weights each pool light of a row by 1 / (1 + (m / SIGMA)^2), m the
- * light's decision margin: ln D of the row's own coefficients at the
- * light's direction less ln of its distance; the weights normalised per
- * row (their sum in place of the count), in the clusters' Grams and the
- * refinement's weights alike. Unset (or empty): the encoder's own bytes.
- * Deterministic as the rest (+, -, x, /, sqrt, the f32 SH basis and a
- * series ln). Not a default: measured, not adopted.
- * Two more knobs, for the same section: VDSH_CPCA_KMEANS_SEED=N (an
- * integer 1..65535) draws the k-means++ seeding from another seed (the
- * fit's own scatter); VDSH_CPCA_REFIT_ROUNDS=R (1..16) runs R refit rounds
- * for K,alloc:BYTES instead of VDSH_CPCA_REFIT_ROUNDS below. A value out of
- * range is ignored with a message on stderr.
- * The starts study (docs/ACCURACY.md "Keeping the best of several k-means
- * starts"): VDSH_CPCA_STARTS=N (2..16) fits K,alloc:BYTES from N k-means
- * starts (the seeds VDSH_CPCA_KMEANS_SEED=0..N-1 give, or S..S+N-1 with
- * that knob at S), scores each over the settings' light pool as
- * vdsh_cpca_pool_score does, and keeps the one whose shadow decisions
- * differ from the uncompressed coefficients' at the fewest pairs (the
- * first on a tie): N fits and N scores. Without a pool: one fit. */
+/* Study knobs (issue 29, docs/ACCURACY.md "Keeping the best of several
+ * k-means starts" and the sections before it), read from the environment
+ * at every use: VDSH_CPCA_KMEANS_SEED=N (an integer 1..65535) draws the
+ * k-means++ seeding from another seed (the fit's own scatter; with
+ * settings starts N, the starts S..S+N-1); VDSH_CPCA_REFIT_ROUNDS=R
+ * (1..16) runs R refit rounds for K,alloc:BYTES instead of
+ * VDSH_CPCA_REFIT_ROUNDS below. A value out of range is ignored with a
+ * message on stderr; unset (or empty): the encoder's own bytes. The
+ * margin and the starts, studied as knobs, are settings now
+ * (vdsh_cpca.h: margin, starts; --cpca ...,margin:S,starts:N). */
 
 /* The quantisation-aware refit (issue 29, docs/ACCURACY.md
  * "Quantisation-aware refit of the model"): vdsh_cpca_encode of settings

@@ -560,9 +560,9 @@ static vdsh_result read_fixed(const reader *r, const chunk_ref *c, uint32_t i, i
     return VDSH_OK;
 }
 
-/* lpol (VDSH.md "Parts"): 16 bytes (u32 count, f32 mix, 8 zero bytes),
- * then count lights of 3 f32; checked against the part chunk once every
- * chunk is read. */
+/* lpol (VDSH.md "Parts"): 16 bytes (u32 count, f32 mix, f32 margin, u32
+ * starts), then count lights of 3 f32; checked against the part chunk once
+ * every chunk is read. */
 static vdsh_result read_lpol(const reader *r, const chunk_ref *c, uint32_t i, layout *L)
 {
     const uint8_t *p = r->d + c->offset + CHUNK_HEADER_SIZE;
@@ -575,11 +575,10 @@ static vdsh_result read_lpol(const reader *r, const chunk_ref *c, uint32_t i, la
         return vdsh_failf_at(r->err, VDSH_ERR_CHUNK, r->name,
                              "lpol: payload is %llu byte%s, must be 16 + 12 x its %u light%s",
                              (unsigned long long)c->size, vdsh_s(c->size), count, vdsh_s(count));
-    if (!all_zero(p + 8, 8))
-        return vdsh_failf_at(r->err, VDSH_ERR_INVALID, r->name,
-                             "lpol: reserved bytes 8..15 not zero");
     L->light_pool.count = count;
     L->light_pool.mix = get_f32(p + 4);
+    L->light_pool.margin = get_f32(p + 8);
+    L->light_pool.starts = get_u32(p + 12);
     L->light_pool.lights = (const float *)(p + 16);
     L->lpol = c->offset + CHUNK_HEADER_SIZE + 16;
     L->has_light_pool = 1;

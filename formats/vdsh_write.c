@@ -255,6 +255,8 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name, vds
     if (f->has_light_pool) { /* a cpca part's light pool (VDSH.md "Parts") */
         put_u32(P->lpol, f->light_pool.count);
         put_f32(P->lpol + 4, f->light_pool.mix);
+        put_f32(P->lpol + 8, f->light_pool.margin);
+        put_u32(P->lpol + 12, f->light_pool.starts);
         add_chunk(P, "lpol", P->lpol, sizeof P->lpol, f->light_pool.lights,
                   12 * (uint64_t)f->light_pool.count);
     }

@@ -217,8 +217,9 @@ target_link_libraries(light_pool_tool PRIVATE vb_core)
 # the uniform metric, light:1 and 0.5 valid other fits, the default's
 # bytes, bad values refused; parts carry the pool (lpol), mismatched or
 # damaged pools refused by the merge and the readers; light_pool_tool's
-# bake:1 is the part's pool; the study knobs (VDSH_CPCA_STARTS keeps the
-# start with the fewest pool decisions differing: cpca_kchoice_tool --score).
+# bake:1 is the part's pool; margin:S and starts:N (starts keeps the start
+# with the fewest pool decisions differing: cpca_kchoice_tool --score),
+# recorded in parts, merged byte-identical; the study knobs.
 add_test(NAME bake_cpca_lightmix
          COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/test_cpca_lightmix.py
                  $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-merge> $<TARGET_FILE:vdsh-info>

@@ -82,8 +82,8 @@ static int score_files(int argc, char **argv)
                     "stream of its order in %s\n",
                     argv[a], argv[2], rows, argv[2]);
             rc = 1;
-        } else if (vdsh_cpca_pool_score_stream((const float *)s->data, f->normals, rows, c->order,
-                                               &st, c, &sc, &err) != VDSH_OK) {
+        } else if (vdsh_cpca_pool_score_streams((const float *)s->data, f->normals, rows, c->order,
+                                                &st, c, 1, &sc, &err) != VDSH_OK) {
             fprintf(stderr, "cpca_kchoice_tool: %s\n", err.msg);
             rc = 1;
         } else {

@@ -767,16 +767,36 @@ static void light_metric(void)
               p.light_mix == VDSH_CPCA_DEFAULT_LIGHT_MIX,
           "auto: the default light mix");
     static const char *const refuse[] = {
-        "light:2",       "light:",           "light:-0",          "light:1e0",
-        "light:inf",     "light:1,8,52,4",   "8,52,4,light:x",    "8,52,4,light:1,",
-        "8,52,4light:1", "auto,light:0.5.1", "3,alloc:0,light:1", "8,52,4,light:1,light:0"};
+        "light:2", "light:", "light:-0", "light:1e0", "light:inf", "light:1,8,52,4",
+        "8,52,4,light:x", "8,52,4,light:1,", "8,52,4light:1", "auto,light:0.5.1",
+        "3,alloc:0,light:1", "8,52,4,light:1,light:0",
+        /* the margin and the starts: K,alloc:BYTES with a light mix only */
+        "3,alloc:16,margin:0", "3,alloc:16,margin:-1", "3,alloc:16,margin:1e3",
+        "3,alloc:16,starts:0", "3,alloc:16,starts:17", "3,alloc:16,starts:2.0",
+        "8,52,4,margin:0.25", "auto,starts:2", "3,alloc:16,light:0,margin:0.25",
+        "3,alloc:16,starts:2,starts:2", "3,alloc:16,margin:0.25,x:1", "margin:0.25,3,alloc:16"};
     for (size_t k = 0; k < sizeof refuse / sizeof *refuse; k++)
         CHECK(vdsh_cpca_parse(refuse[k], &p, &err) == VDSH_ERR_ARGUMENT, "'%s' accepted",
               refuse[k]);
+    CHECK(vdsh_cpca_parse("3,alloc:16,starts:2,light:0.5,margin:0.25", &p, &err) == VDSH_OK &&
+              p.clusters == 3 && p.budget == 16 && p.light_mix == 0.5f && p.margin == 0.25f &&
+              p.starts == 2,
+          "the options in any order");
+    CHECK(vdsh_cpca_parse("margin:.5,starts:16", &p, &err) == VDSH_OK && p.clusters == d.clusters &&
+              p.budget == d.budget && p.light_mix == d.light_mix && p.margin == 0.5f &&
+              p.starts == 16,
+          "margin and starts alone: the default K and budget");
+    CHECK(vdsh_cpca_parse("3,alloc:16", &p, &err) == VDSH_OK && p.margin == 0.0f && !p.starts,
+          "no margin, one start unless said");
     /* a part's record of the settings and back (VDSH.md "Parts": the
      * bake writes it, vdsh-merge encodes with what it reads) */
-    static const char *const kinds[] = {"8,52,4",          "light:1",    "auto:24",
-                                        "auto:24,light:1", "3,alloc:16", "3,alloc:16,light:0.5"};
+    static const char *const kinds[] = {"8,52,4",
+                                        "light:1",
+                                        "auto:24",
+                                        "auto:24,light:1",
+                                        "3,alloc:16",
+                                        "3,alloc:16,light:0.5",
+                                        "3,alloc:16,margin:0.25,starts:3"};
     for (size_t k = 0; k < sizeof kinds / sizeof *kinds; k++) {
         CHECK(vdsh_cpca_parse(kinds[k], &p, &err) == VDSH_OK, "'%s' refused", kinds[k]);
         if (p.light_mix > 0.0f) {
@@ -790,7 +810,8 @@ static void light_metric(void)
         CHECK(part.has_light_pool == (p.light_mix > 0.0f) && q.clusters == p.clusters &&
                   q.budget == p.budget && (p.budget || (q.basis == p.basis && q.bits == p.bits)) &&
                   q.light_mix == p.light_mix && q.light_count == p.light_count &&
-                  q.lights == p.lights && q.positions == p.positions,
+                  q.lights == p.lights && q.positions == p.positions && q.margin == p.margin &&
+                  q.starts == p.starts,
               "'%s': the part's record reads back as other settings", kinds[k]);
     }
 }

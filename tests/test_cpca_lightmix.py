@@ -19,17 +19,25 @@ formats/vdsh_cpca.h; docs/ACCURACY.md, "A light-density metric"):
   (bake.h VB_POOL_SEED, one definition: scripts/cpca_study draws with it);
 - a one-shard part's merge equals the whole bake at light:1 (bake_cpca
   checks 2 shards and threads with the default);
-- the study knobs (formats/vdsh_cpca_study.h; docs/ACCURACY.md "Weighting
-  the light metric by the decision margin"): VDSH_CPCA_MARGIN=1e6 (every
-  light's weight rounds to 1) and VDSH_CPCA_REFIT_ROUNDS=2 (the default's
-  rounds) give light:1's bytes, a value out of range is ignored with a
-  message naming the variable; VDSH_CPCA_MARGIN=0.25 and
-  VDSH_CPCA_KMEANS_SEED=1 are other fits, valid, at the same bytes per
-  vertex budget; VDSH_CPCA_STARTS=2 keeps whichever of the default's and
-  VDSH_CPCA_KMEANS_SEED=1's bytes has the fewer pool decisions differing
-  (tests/cpca_kchoice_tool --score, the pool the bake fitted with),
-  STARTS=3 with KMEANS_SEED=1 the fewest of seeds 1, 2, 3, STARTS=1 is
-  the default's bytes and STARTS=17 is ignored with a message.
+- the margin and the starts (--cpca ...,margin:S,starts:N; docs/
+  ACCURACY.md "Weighting the light metric by the decision margin",
+  "Keeping the best of several k-means starts"): margin:1e6 (every light's
+  weight rounds to 1) and starts:1 give light:1's bytes; margin:0.25 is
+  another fit, valid, within the bytes per vertex budget; starts:2 keeps
+  whichever of the default's and VDSH_CPCA_KMEANS_SEED=1's bytes has the
+  fewer pool decisions differing (tests/cpca_kchoice_tool --score, the
+  pool the bake fitted with), starts:3 with KMEANS_SEED=1 the fewest of
+  seeds 1, 2, 3; margin:0.25,starts:2 in any order is one setting; a part
+  records them (lpol, vdsh-info, the Python reader), two shards merge to
+  the whole bake's bytes, parts whose margin or starts differ are refused,
+  naming the part, and an lpol whose margin is out of range, or set with
+  fixed widths, is refused by the C and Python readers; bad values (a
+  margin of 0, starts 1.5 or 17, either with K,B,BITS or light:0, an
+  option twice) are refused, exit 2, no file;
+- the study knobs (formats/vdsh_cpca_study.h): VDSH_CPCA_REFIT_ROUNDS=2
+  (the default's rounds) gives light:1's bytes, a value out of range is
+  ignored with a message naming the variable; VDSH_CPCA_KMEANS_SEED=1 is
+  another fit.
 
 Usage: test_cpca_lightmix.py VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR WORK_DIR LIGHT_POOL_TOOL
                              KCHOICE_TOOL
@@ -146,42 +154,51 @@ for name, want in (("p1", "l1"), ("p0", "l0")):
     if r.returncode or blob(name + "-m.vdsh") != blob(want + ".vdsh"):
         fail.append("%s merged is not the whole %s bake: %s" % (name, want, r.stderr))
 
-# The study knobs, in the environment of the bake (its encoder).
-def knob_bake(name, env):
-    r = subprocess.run([bake] + TINY + CPCA + ["4,alloc:40,light:1", "-o", path(name)],
+# The study knobs, in the environment of the bake (its encoder), and the
+# margin and starts settings.
+def knob_bake(name, env, setting="4,alloc:40,light:1"):
+    r = subprocess.run([bake] + TINY + CPCA + [setting, "-o", path(name)],
                        capture_output=True, text=True, env=dict(os.environ, **env))
-    must(r, "%s bake" % env)
+    must(r, "%s %s bake" % (env, setting))
     return r.stderr
 
 
-for name, env in (("k-wide.vdsh", {"VDSH_CPCA_MARGIN": "1e6"}),
-                  ("k-r2.vdsh", {"VDSH_CPCA_REFIT_ROUNDS": "2"}),
-                  ("k-st1.vdsh", {"VDSH_CPCA_STARTS": "1"})):
-    knob_bake(name, env)
+for name, env, setting in (("k-wide.vdsh", {}, "4,alloc:40,margin:1000000,light:1"),
+                           ("k-r2.vdsh", {"VDSH_CPCA_REFIT_ROUNDS": "2"}, "4,alloc:40,light:1"),
+                           ("k-st1.vdsh", {}, "4,alloc:40,starts:1")):
+    knob_bake(name, env, setting)
     if blob(name) != blob("l1.vdsh"):
-        fail.append("%s does not give light:1's bytes" % env)
-for var, val in (("VDSH_CPCA_MARGIN", "abc"), ("VDSH_CPCA_KMEANS_SEED", "70000"),
-                 ("VDSH_CPCA_REFIT_ROUNDS", "-1"), ("VDSH_CPCA_STARTS", "17")):
+        fail.append("%s %s does not give light:1's bytes" % (env, setting))
+for var, val in (("VDSH_CPCA_KMEANS_SEED", "70000"), ("VDSH_CPCA_REFIT_ROUNDS", "-1")):
     err = knob_bake("k-bad.vdsh", {var: val})
     if blob("k-bad.vdsh") != blob("l1.vdsh") or var not in err or "ignored" not in err:
         fail.append("%s=%s: not ignored with a message (stderr %r)" % (var, val, err))
-for name, env in (("k-m.vdsh", {"VDSH_CPCA_MARGIN": "0.25"}),
-                  ("k-seed.vdsh", {"VDSH_CPCA_KMEANS_SEED": "1"})):
-    knob_bake(name, env)
+for name, env, setting in (("k-m.vdsh", {}, "4,alloc:40,light:1,margin:0.25"),
+                           ("k-seed.vdsh", {"VDSH_CPCA_KMEANS_SEED": "1"}, "4,alloc:40,light:1")):
+    knob_bake(name, env, setting)
     st = vdsh.read(path(name)).streams[0]
     got = vdsh.coefficients(st).astype(np.float64)
     err = np.sqrt(((got - x) ** 2).sum(1).mean()) / spread
-    print("%s: decoded error %.4f of the spread" % (env, err))
+    print("%s %s: decoded error %.4f of the spread" % (env, setting, err))
     if blob(name) == blob("l1.vdsh") or not err < 0.5:
-        fail.append("%s: not another valid fit (decoded error %.3f)" % (env, err))
+        fail.append("%s %s: not another valid fit (decoded error %.3f)" % (env, setting, err))
     txt = subprocess.run([info, path(name)], capture_output=True, text=True).stdout
     per = re.search(r"([0-9.]+) with the model", txt)
     if not per or not float(per.group(1)) <= 40.0:
-        fail.append("%s: not within the 40-byte budget: %r" % (env, txt))
+        fail.append("%s %s: not within the 40-byte budget: %r" % (env, setting, txt))
+for bad in ("4,alloc:40,margin:0", "4,alloc:40,margin:-1", "4,alloc:40,margin:1e6",
+            "4,alloc:40,margin:2000000", "4,alloc:40,starts:0", "4,alloc:40,starts:1.5",
+            "4,alloc:40,starts:17", "8,54,4,margin:0.25", "auto,starts:2",
+            "4,alloc:40,light:0,starts:2", "4,alloc:40,starts:2,starts:2",
+            "4,alloc:40,margin:0.25,foo:1"):
+    r = run_bake("bad.vdsh", CPCA + [bad])
+    if r.returncode != 2 or "margin:S" not in r.stderr or os.path.exists(path("bad.vdsh")):
+        fail.append("--cpca %s: exit %d, file %s, stderr %r" % (
+            bad, r.returncode, os.path.exists(path("bad.vdsh")), r.stderr))
 
 
-# VDSH_CPCA_STARTS=N: the start whose decisions over the bake's pool
-# (pool.f32, bake:1) differ from the f32 stream's at the fewest pairs.
+# starts:N: the start whose decisions over the bake's pool (pool.f32,
+# bake:1) differ from the f32 stream's at the fewest pairs.
 def disagree(names):
     r = subprocess.run([kchoice, "--score", path("f32.vdsh"), path("pool.f32")] +
                        [path(n) for n in names], capture_output=True, text=True)
@@ -191,16 +208,52 @@ def disagree(names):
 
 for seed in ("2", "3"):
     knob_bake("k-seed%s.vdsh" % seed, {"VDSH_CPCA_KMEANS_SEED": seed})
-for name, env, cands in (("k-st2.vdsh", {"VDSH_CPCA_STARTS": "2"}, ["l1.vdsh", "k-seed.vdsh"]),
-                         ("k-st3.vdsh", {"VDSH_CPCA_STARTS": "3", "VDSH_CPCA_KMEANS_SEED": "1"},
-                          ["k-seed.vdsh", "k-seed2.vdsh", "k-seed3.vdsh"])):
-    knob_bake(name, env)
+for name, env, setting, cands in (
+        ("k-st2.vdsh", {}, "4,alloc:40,starts:2", ["l1.vdsh", "k-seed.vdsh"]),
+        ("k-st3.vdsh", {"VDSH_CPCA_KMEANS_SEED": "1"}, "4,alloc:40,starts:3",
+         ["k-seed.vdsh", "k-seed2.vdsh", "k-seed3.vdsh"])):
+    knob_bake(name, env, setting)
     d = disagree(cands)
     keep = cands[d.index(min(d))]
-    print("%s: decisions differing %s, keeps %s" % (env, d, keep))
+    print("%s %s: decisions differing %s, keeps %s" % (env, setting, d, keep))
     if len(set(blob(c) for c in cands)) != len(cands) or blob(name) != blob(keep):
-        fail.append("%s: not the bytes of %s (fewest decisions differing of %s: %s)" % (
-            env, keep, cands, d))
+        fail.append("%s %s: not the bytes of %s (fewest decisions differing of %s: %s)" % (
+            env, setting, keep, cands, d))
+
+# margin and starts together (each start with the margin), in either
+# order, and through two shards
+MS = "4,alloc:40,margin:0.25,starts:2"
+knob_bake("k-ms.vdsh", {}, MS)
+knob_bake("k-sm.vdsh", {}, "4,alloc:40,starts:2,light:1,margin:0.25")
+knob_bake("k-mseed.vdsh", {"VDSH_CPCA_KMEANS_SEED": "1"}, "4,alloc:40,light:1,margin:0.25")
+cands = ["k-m.vdsh", "k-mseed.vdsh"]
+d = disagree(cands)
+keep = cands[d.index(min(d))]
+print("%s: decisions differing %s, keeps %s" % (MS, d, keep))
+if blob("k-ms.vdsh") != blob("k-sm.vdsh") or blob("k-ms.vdsh") != blob(keep) or \
+        blob("k-m.vdsh") == blob("k-mseed.vdsh"):
+    fail.append("%s: not one setting in either order, or not the bytes of %s (of %s: %s)" % (
+        MS, keep, cands, d))
+for i in (0, 1):
+    must(run_bake("ms%d.vdsh" % i, CPCA + [MS, "--shard", "%d/2" % i]), "%s shard %d" % (MS, i))
+r = subprocess.run([merge, "-q", path("ms0.vdsh"), path("ms1.vdsh"), "-o", path("ms-m.vdsh")],
+                   capture_output=True, text=True)
+if r.returncode or blob("ms-m.vdsh") != blob("k-ms.vdsh"):
+    fail.append("%s: two shards merged are not the whole bake: %s" % (MS, r.stderr))
+lp = vdsh.read(path("ms0.vdsh")).light_pool
+if not lp or lp["margin"] != 0.25 or lp["starts"] != 2 or lp["mix"] != 1:
+    fail.append("%s part's lpol in the Python reader: %r" % (MS, lp and {
+        k: v for k, v in lp.items() if k != "lights"}))
+txt = subprocess.run([info, path("ms0.vdsh")], capture_output=True, text=True).stdout
+if "cpca 4,alloc:40,light:1,margin:0.25,starts:2 (fitted at the merge" not in txt:
+    fail.append("vdsh-info does not show the part's margin and starts: %r" % txt)
+must(run_bake("ms1b.vdsh", CPCA + ["4,alloc:40,margin:0.25,starts:3", "--shard", "1/2"]),
+     "starts:3 shard")
+r = subprocess.run([merge, "-q", path("ms0.vdsh"), path("ms1b.vdsh"), "-o", path("ms-x.vdsh")],
+                   capture_output=True, text=True)
+if r.returncode == 0 or "ms1b.vdsh" not in r.stderr or "starts" not in r.stderr or \
+        os.path.exists(path("ms-x.vdsh")):
+    fail.append("parts with other starts: exit %d, stderr %r" % (r.returncode, r.stderr))
 
 # A whole file does not record the mix or the pool (VDSH.md "cpca
 # streams"): the bake's --report says them, vdsh-info says where to look.
@@ -272,6 +325,22 @@ poff, _, psize = next(c for c in chunks(d) if c[1] == b"part")
 bad[poff:poff + 4] = b"xprt"
 fix_crc(bad, poff, psize)
 refused("lpol-whole.vdsh", bad, ["lpol", "outside a cpca part"])
+d = bytearray(blob("ms0.vdsh"))
+off, _, size = next(c for c in chunks(d) if c[1] == b"lpol")
+bad = bytearray(d)
+struct.pack_into("<f", bad, off + 16 + 8, -0.25)  # a negative margin, the CRC fixed
+fix_crc(bad, off, size)
+refused("lpol-margin.vdsh", bad, ["lpol", "margin"])
+bad = bytearray(d)
+struct.pack_into("<I", bad, off + 16 + 12, 17)  # 17 starts
+fix_crc(bad, off, size)
+refused("lpol-starts.vdsh", bad, ["lpol", "starts"])
+# a margin with fixed widths: the part chunk's bits set (K,B,BITS 4,40,4)
+bad = bytearray(d)
+poff, _, psize = next(c for c in chunks(d) if c[1] == b"part")
+struct.pack_into("<I", bad, poff + 16 + 28, 4)
+fix_crc(bad, poff, psize)
+refused("lpol-fixed.vdsh", bad, ["lpol", "K,alloc:BYTES"])
 
 if fail:
     sys.exit("FAIL:\n  " + "\n  ".join(fail))

@@ -12,7 +12,8 @@
  * Property checked beyond "no crash": whatever the reader accepts, the
  * writer accepts too and writes back to bytes that read the same; a
  * part's `part` and `lpol` chunks read back as they were (the corpus has
- * parts: box-s8s6-part1of2.vdsh, box-cpca-part0of2-lpol6.vdsh), and an
+ * parts: box-s8s6-part1of2.vdsh, box-cpca-part0of2-lpol6.vdsh, and
+ * box-cpca-part0of2-lpol6-margin-starts2.vdsh with a margin and starts), and an
  * lreg chunk the same (cubefloor-f16-lreg-grown.vdsh).
  *
  * Random bytes almost never pass the CRCs, so the value rules behind them
@@ -85,11 +86,14 @@ static void one_input(const uint8_t *data, size_t size)
         abort();
     }
     /* A part (`part`, and `lpol` for a cpca part with a light mix) reads
-     * back as it was: shard, range, merge settings, pool bit for bit. */
+     * back as it was: shard, range, merge settings, margin, starts, pool
+     * bit for bit. */
     if (g->has_part != f->has_part || g->has_light_pool != f->has_light_pool ||
         (f->has_part && memcmp(&f->part, &g->part, sizeof f->part) != 0) ||
         (f->has_light_pool &&
          (memcmp(&f->light_pool.mix, &g->light_pool.mix, sizeof f->light_pool.mix) != 0 ||
+          memcmp(&f->light_pool.margin, &g->light_pool.margin, sizeof f->light_pool.margin) != 0 ||
+          f->light_pool.starts != g->light_pool.starts ||
           f->light_pool.count != g->light_pool.count ||
           memcmp(f->light_pool.lights, g->light_pool.lights,
                  3 * sizeof(float) * f->light_pool.count) != 0))) {

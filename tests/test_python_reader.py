@@ -161,13 +161,15 @@ def compare(path):
                             % (path, ps["order"], k, cs["coefficient0"][k], v))
     if c.get("stats") and p.stats and c["stats"] != {k: p.stats[k] for k in c["stats"]}:
         fail.append("%s: stats differ" % path)
-    # vdsh-info's part carries a cpca part's light pool (lpol) as two keys;
+    # vdsh-info's part carries a cpca part's light pool (lpol) as four keys;
     # the Python reader keeps the pool apart, as f.light_pool.
     pp = dict(p.part) if p.part else p.part
     if pp and pp["encoding"] == "cpca":
         lp = p.light_pool
         pp.update(cpca_light_mix=float(lp["mix"]) if lp else 0.0,
-                  cpca_light_pool=len(lp["lights"]) if lp else 0)
+                  cpca_light_pool=len(lp["lights"]) if lp else 0,
+                  cpca_margin=float(lp["margin"]) if lp else 0.0,
+                  cpca_starts=lp["starts"] if lp else 0)
     if c.get("part") != pp:
         fail.append("%s: part: C %s, Python %s" % (path, c.get("part"), pp))
     ca, pa = c.get("adaptive"), p.adaptive

@@ -378,7 +378,12 @@ static void print_part(const vdsh_file *f)
     else
         printf("               cpca %u,%u,%u", f->part.cpca_clusters, f->part.cpca_basis,
                f->part.cpca_bits);
-    printf(",light:%g (fitted at the merge", mix);
+    printf(",light:%g", mix);
+    if (f->has_light_pool && f->light_pool.margin > 0.0f)
+        printf(",margin:%g", (double)f->light_pool.margin);
+    if (f->has_light_pool && f->light_pool.starts)
+        printf(",starts:%u", f->light_pool.starts);
+    printf(" (fitted at the merge");
     if (f->has_light_pool)
         printf("; light pool of %u light%s", f->light_pool.count, vdsh_s(f->light_pool.count));
     printf(")\n");
@@ -554,6 +559,9 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
             vt_json_f64(&j, pt, "cpca_light_mix",
                         f->has_light_pool ? (double)f->light_pool.mix : 0.0);
             vt_json_u64(&j, pt, "cpca_light_pool", f->has_light_pool ? f->light_pool.count : 0);
+            vt_json_f64(&j, pt, "cpca_margin",
+                        f->has_light_pool ? (double)f->light_pool.margin : 0.0);
+            vt_json_u64(&j, pt, "cpca_starts", f->has_light_pool ? f->light_pool.starts : 0);
         }
     }
     if (f->has_adaptive) {

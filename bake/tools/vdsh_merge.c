@@ -230,6 +230,8 @@ static const char *mismatch(vdsh_file *a, const char *a_path, const vdsh_file *b
         (a->has_light_pool && (memcmp(&la->mix, &lb->mix, 4) != 0 || la->count != lb->count ||
                                memcmp(la->lights, lb->lights, (size_t)la->count * 12) != 0)))
         return "another cpca light pool (lpol chunk differs: another --cpca light:A, seed or scene)";
+    if (a->has_light_pool && (memcmp(&la->margin, &lb->margin, 4) != 0 || la->starts != lb->starts))
+        return "another --cpca margin:S or starts:N (lpol chunk differs)";
     uint64_t v = a->header.vertex_count, t = a->header.triangle_count;
     if (memcmp(a->positions, b->positions, v * 12) != 0 ||
         memcmp(a->indices, b->indices, t * 12) != 0)

@@ -21,7 +21,8 @@
                                        # dict tolerance, min_edge, max_receivers, lights,
                                        # max_rounds, start_receivers, rounds, candidates
     f.light_pool                       # None, or a cpca part's light pool (`lpol`): dict
-                                       # mix (the light mix, 0 < mix <= 1), lights (L x 3)
+                                       # mix (the light mix, 0 < mix <= 1), lights (L x 3),
+                                       # margin (--cpca margin:S, 0: none), starts (0: one)
     f.light_region                     # None, or where the bake's lights went (`lreg`,
                                        # vdsh-bake --light-region): dict rule ("grown" or
                                        # "box"), min, max (3 floats each, scene units)
@@ -240,6 +241,9 @@ def parse(data: bytes, path: str = "memory") -> VdshFile:
         _fail(path, "stat: rays_missed > rays_traced")
     if f.light_pool is not None and (not f.part or f.part["encoding"] != "cpca"):
         _fail(path, "lpol: a light pool outside a cpca part")
+    if f.light_pool is not None and (f.light_pool["margin"] or f.light_pool["starts"]) and (
+            not f.part["cpca_clusters"] or f.part["cpca_bits"]):
+        _fail(path, "lpol: a margin or starts with cpca settings other than K,alloc:BYTES")
     return f
 
 
@@ -342,15 +346,15 @@ def _chunk(f, cid, b, path):
         if len(b) < 16 or len(b) != 16 + 12 * cnt:
             _fail(path, "lpol is %d byte%s, must be 16 + 12 x its %d light%s"
                   % (len(b), _s(len(b)), cnt, _s(cnt)))
-        mix = struct.unpack_from("<f", b, 4)[0]
-        if any(b[8:16]):
-            _fail(path, "lpol: reserved bytes 8..15 not zero")
+        mix, margin, starts = struct.unpack_from("<ffI", b, 4)
         if not (0 < mix <= 1) or not 1 <= cnt <= MAX_POOL_LIGHTS:
             _fail(path, "lpol: light mix %g or %d light%s out of range" % (mix, cnt, _s(cnt)))
+        if not (margin == 0 or 0 < margin <= 1e6) or starts > 16:
+            _fail(path, "lpol: margin %g or %d starts out of range" % (margin, starts))
         lights = np.frombuffer(b, "<f4", 3 * cnt, 16).reshape(cnt, 3)
         if not np.isfinite(lights).all():
             _fail(path, "lpol: a light is not finite")
-        f.light_pool = dict(mix=mix, lights=lights)
+        f.light_pool = dict(mix=mix, lights=lights, margin=margin, starts=starts)
     elif cid == b"lreg":  # where the bake's lights went (VDSH.md `lreg`)
         if len(b) != 32:
             _fail(path, "lreg is %d byte%s, must be 32" % (len(b), _s(len(b))))
