@@ -374,6 +374,53 @@ static double det_ln(double x)
     return 2.0 * sum + e * 0.69314718055994530942;
 }
 
+/* ---- SH over a batch of light directions ----
+ *
+ * The margin weights and the pool score evaluate order n's SH at every
+ * (row, pool light above its horizon) pair: vdsh_sh_eval_soa over a batch
+ * of directions (the arithmetic of vdsh_sh_eval per direction: the same
+ * bits) and the dot products with a row's coefficients summed over the
+ * coefficients in order for each direction, as the one-direction loop
+ * did: the same bytes, several times faster. */
+enum { SH_BATCH = 64 };
+typedef struct sh_batch {
+    uint32_t count;
+    float x[SH_BATCH], y[SH_BATCH], z[SH_BATCH];
+    double r[SH_BATCH];                   /* each direction's distance */
+    double a[SH_BATCH];                   /* scratch of sh_batch_dots */
+    float yk[VDSH_MAX_COEFFS * SH_BATCH]; /* Y_i(direction k) at [i * SH_BATCH + k] */
+} sh_batch;
+
+/* Stage direction d (not 0) into b: 1 when b is full. */
+static int sh_batch_add(sh_batch *b, const double d[3])
+{
+    const double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    b->x[b->count] = (float)(d[0] / r);
+    b->y[b->count] = (float)(d[1] / r);
+    b->z[b->count] = (float)(d[2] / r);
+    b->r[b->count] = r;
+    return ++b->count == SH_BATCH;
+}
+
+static void sh_batch_eval(sh_batch *b, uint32_t order)
+{
+    vdsh_sh_eval_soa((int)order, b->count, b->x, b->y, b->z, b->yk, SH_BATCH);
+}
+
+/* out[k] = sum over i < n, in order, of c[i] * Y_i(direction k) (f64). */
+static void sh_batch_dots(const sh_batch *b, const float *c, uint32_t n, double *out)
+{
+    const uint32_t cnt = b->count;
+    for (uint32_t k = 0; k < cnt; k++)
+        out[k] = 0.0;
+    for (uint32_t i = 0; i < n; i++) {
+        const double ci = c[i];
+        const float *yi = b->yk + (size_t)i * SH_BATCH;
+        for (uint32_t k = 0; k < cnt; k++)
+            out[k] += ci * yi[k];
+    }
+}
+
 /* ---- the metric: the SH's Gram matrix over cube texel directions ---- */
 
 typedef struct metric_dirs {
@@ -463,6 +510,7 @@ typedef struct lightmix {
     uint32_t order;
     double inv_sigma2;
     float *wt;
+    sh_batch *sb; /* the margin weights' scratch */
     /* Every row's texels of its lights above its horizon, in pool order
      * (packed: light_texel), found once by lightmix_load: row v's at
      * tex[at[v]..at[v + 1]), for the rows v < cached (the first that fit
@@ -484,6 +532,7 @@ static void lightmix_free(lightmix *lm)
     free(lm->at);
     free(lm->tex);
     free(lm->wt);
+    free(lm->sb);
     memset(lm, 0, sizeof *lm);
 }
 
@@ -536,22 +585,21 @@ static int light_above(const lightmix *lm, uint32_t l, const float *p, const flo
     return d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0;
 }
 
-/* The margin's weight of the light in direction d (length r) from
- * row v: 1 / (1 + m^2 / sigma^2), m = ln D of the row's coefficients at d
- * less ln r (the decision's margin). +, -, x, /, sqrt and det_ln only. */
-static float margin_weight(const lightmix *lm, uint32_t v, const double d[3])
+/* The margin weights of the lights staged in lm->sb for row v into
+ * wt[0 .. count): 1 / (1 + m^2 / sigma^2), m = ln D of the row's
+ * coefficients at the light's direction less ln of its distance (the
+ * decision's margin). +, -, x, /, sqrt and det_ln only. */
+static void margin_weights(const lightmix *lm, uint32_t v, float *wt)
 {
+    sh_batch *b = lm->sb;
     const uint32_t n = lm->order * lm->order;
-    const double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    const float df[3] = {(float)(d[0] / r), (float)(d[1] / r), (float)(d[2] / r)};
-    float y[VDSH_MAX_COEFFS];
-    vdsh_sh_eval((int)lm->order, df, y);
-    const float *x = lm->src + (size_t)v * n;
-    double a = 0.0;
-    for (uint32_t i = 0; i < n; i++)
-        a += (double)x[i] * y[i];
-    const double m = a - det_ln(r);
-    return (float)(1.0 / (1.0 + m * m * lm->inv_sigma2));
+    sh_batch_eval(b, lm->order);
+    sh_batch_dots(b, lm->src + (size_t)v * n, n, b->a);
+    for (uint32_t k = 0; k < b->count; k++) {
+        const double m = b->a[k] - det_ln(b->r[k]);
+        wt[k] = (float)(1.0 / (1.0 + m * m * lm->inv_sigma2));
+    }
+    b->count = 0;
 }
 
 /* Row v's texels (normal nv) into tex from slot at (and their margin
@@ -564,10 +612,12 @@ static uint32_t row_texels(const lightmix *lm, uint32_t v, const float *nv, size
         double d[3];
         if (!light_above(lm, l, p, nv, d))
             continue;
-        if (lm->wt)
-            lm->wt[at + t] = margin_weight(lm, v, d);
         lm->tex[at + t++] = light_texel(d);
+        if (lm->wt && sh_batch_add(lm->sb, d))
+            margin_weights(lm, v, lm->wt + at + t - SH_BATCH);
     }
+    if (lm->wt && lm->sb->count)
+        margin_weights(lm, v, lm->wt + at + t - lm->sb->count);
     return t;
 }
 
@@ -600,7 +650,8 @@ static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float
         lm->src = src;
         lm->order = order;
         lm->inv_sigma2 = 1.0 / (sigma * sigma);
-        if (!(lm->wt = malloc(sizeof(float) * ((most < cap ? most : cap) + lm->nl) + 1)))
+        if (!(lm->wt = malloc(sizeof(float) * ((most < cap ? most : cap) + lm->nl) + 1)) ||
+            !(lm->sb = calloc(1, sizeof *lm->sb)))
             return -1;
     }
     lm->at[0] = 0;
@@ -2422,7 +2473,14 @@ vdsh_result vdsh_cpca_pool_score_streams(const float *src, const float *normals,
                               "not %u",
                               k, s[k].order, order);
     const uint32_t n = order * order;
-    float dec[VDSH_CPCA_MAX_STARTS][VDSH_MAX_COEFFS], y[VDSH_MAX_COEFFS];
+    float dec[VDSH_CPCA_MAX_STARTS][VDSH_MAX_COEFFS];
+    double(*bk)[SH_BATCH] = malloc(sizeof(double) * SH_BATCH * count);
+    sh_batch *b = calloc(1, sizeof *b);
+    if (!b || !bk) {
+        free(b);
+        free(bk);
+        return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca pool score: out of memory");
+    }
     for (uint32_t v = 0; v < rows; v++) {
         for (uint32_t k = 0; k < count; k++)
             vdsh_stream_decode(&s[k], v, dec[k]);
@@ -2433,25 +2491,28 @@ vdsh_result vdsh_cpca_pool_score_streams(const float *src, const float *normals,
             double d[3];
             for (int i = 0; i < 3; i++)
                 d[i] = (double)q[i] - p[i];
-            if (!(d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0))
+            const int above = d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0;
+            if (!(above && sh_batch_add(b, d)) && !(l + 1 == settings->light_count && b->count))
                 continue;
-            const double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-            float df[3] = {(float)(d[0] / r), (float)(d[1] / r), (float)(d[2] / r)};
-            vdsh_sh_eval((int)order, df, y);
-            double a = 0.0;
-            for (uint32_t i = 0; i < n; i++)
-                a += (double)x[i] * y[i];
-            const double t = det_ln(r);
-            for (uint32_t k = 0; k < count; k++) {
-                double b = 0.0;
-                for (uint32_t i = 0; i < n; i++)
-                    b += (double)dec[k][i] * y[i];
-                out[k].pairs++;
-                out[k].disagree += (a >= t) != (b >= t);
-                out[k].missed += (a >= t) && !(b >= t);
-                out[k].squared += (b - a) * (b - a);
+            /* a full batch, or the row's last: each pair in light order */
+            sh_batch_eval(b, order);
+            sh_batch_dots(b, x, n, b->a);
+            for (uint32_t k = 0; k < count; k++)
+                sh_batch_dots(b, dec[k], n, bk[k]);
+            for (uint32_t j = 0; j < b->count; j++) {
+                const double a = b->a[j], t = det_ln(b->r[j]);
+                for (uint32_t k = 0; k < count; k++) {
+                    const double bb = bk[k][j];
+                    out[k].pairs++;
+                    out[k].disagree += (a >= t) != (bb >= t);
+                    out[k].missed += (a >= t) && !(bb >= t);
+                    out[k].squared += (bb - a) * (bb - a);
+                }
             }
+            b->count = 0;
         }
     }
+    free(b);
+    free(bk);
     return VDSH_OK;
 }

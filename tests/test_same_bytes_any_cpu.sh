@@ -40,6 +40,7 @@ cases=(
   "builtin:room --max-edge 1 --adaptive 0.05 --rays 144 --cube-size 0"
   "builtin:room --max-edge 1 --rays auto --cube-size 0"
   "builtin:room --max-edge 1 --rays 100 --orders 12 --encoding cpca --cube-size 0"
+  "builtin:room --max-edge 1 --rays 100 --orders 12 --encoding cpca --cpca margin:0.25,starts:2 --cube-size 0"
   "builtin:room --max-edge 1 --rays 100 --cube-size 0 --sdf 24"
 )
 if [[ -f $scenes/fandisk/fandisk.obj ]]; then
