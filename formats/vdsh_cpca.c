@@ -11,10 +11,12 @@
 #include "vdsh_internal.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "vdsh_sh.h"
 
@@ -510,16 +512,21 @@ typedef struct lightmix {
     uint32_t order;
     double inv_sigma2;
     float *wt;
-    sh_batch *sb; /* the margin weights' scratch */
     /* Every row's texels of its lights above its horizon, in pool order
      * (packed: light_texel), found once by lightmix_load: row v's at
      * tex[at[v]..at[v + 1]), for the rows v < cached (the first that fit
      * in LIGHT_CACHE texels); the later rows' are found again at every
-     * use, into the scratch at at[cached]. */
-    uint32_t cached;
+     * use, into the scratch stex (and swt). */
+    uint32_t rows, cached;
     size_t *at;
     uint16_t *tex;
     uint16_t ref[6 * CUBE_N * CUBE_N]; /* refine_texel's of each fit texel */
+    /* Scratch, each user's own (lightmix_view): a row past the cache's
+     * texels and weights (nl each), and the margin weights' batch. */
+    uint16_t *stex;
+    float *swt;
+    sh_batch *sb;
+    int view; /* 1: the arrays above the scratch are another's */
 } lightmix;
 
 /* The most texels lightmix_load keeps (x 2 bytes) unless the settings
@@ -529,9 +536,13 @@ typedef struct lightmix {
 
 static void lightmix_free(lightmix *lm)
 {
-    free(lm->at);
-    free(lm->tex);
-    free(lm->wt);
+    if (!lm->view) {
+        free(lm->at);
+        free(lm->tex);
+        free(lm->wt);
+    }
+    free(lm->stex);
+    free(lm->swt);
     free(lm->sb);
     memset(lm, 0, sizeof *lm);
 }
@@ -602,9 +613,10 @@ static void margin_weights(const lightmix *lm, uint32_t v, float *wt)
     b->count = 0;
 }
 
-/* Row v's texels (normal nv) into tex from slot at (and their margin
- * weights into wt, with a margin): their count. */
-static uint32_t row_texels(const lightmix *lm, uint32_t v, const float *nv, size_t at)
+/* Row v's texels (normal nv) into tex (and their margin weights into wt,
+ * with a margin; else wt is NULL): their count. */
+static uint32_t row_texels(const lightmix *lm, uint32_t v, const float *nv, uint16_t *tex,
+                           float *wt)
 {
     const float *p = lm->pos + 3 * (size_t)v;
     uint32_t t = 0;
@@ -612,13 +624,36 @@ static uint32_t row_texels(const lightmix *lm, uint32_t v, const float *nv, size
         double d[3];
         if (!light_above(lm, l, p, nv, d))
             continue;
-        lm->tex[at + t++] = light_texel(d);
-        if (lm->wt && sh_batch_add(lm->sb, d))
-            margin_weights(lm, v, lm->wt + at + t - SH_BATCH);
+        tex[t++] = light_texel(d);
+        if (wt && sh_batch_add(lm->sb, d))
+            margin_weights(lm, v, wt + t - SH_BATCH);
     }
-    if (lm->wt && lm->sb->count)
-        margin_weights(lm, v, lm->wt + at + t - lm->sb->count);
+    if (wt && lm->sb->count)
+        margin_weights(lm, v, wt + t - lm->sb->count);
     return t;
+}
+
+/* view's own scratch (stex, swt, sb) for the rows past lm's cache and the
+ * margin: 1, or 0 out of memory. */
+static int lightmix_scratch(lightmix *lm)
+{
+    if (lm->cached < lm->rows && (!(lm->stex = malloc(sizeof(uint16_t) * lm->nl)) ||
+                                  (lm->wt && !(lm->swt = malloc(sizeof(float) * lm->nl)))))
+        return 0;
+    return !lm->wt || (lm->sb = calloc(1, sizeof *lm->sb)) != NULL;
+}
+
+/* *view: lm's texels and weights, shared (read only), with scratch of its
+ * own, for a thread of its own: 1, or 0 out of memory (free it with
+ * lightmix_free either way). */
+static int lightmix_view(const lightmix *lm, lightmix *view)
+{
+    *view = *lm;
+    view->view = 1;
+    view->stex = NULL;
+    view->swt = NULL;
+    view->sb = NULL;
+    return lightmix_scratch(view);
 }
 
 /* lm from the settings, the rows' texels found (normals, rows x 3): 1 when
@@ -630,6 +665,7 @@ static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float
     if (!st || !(st->light_mix > 0.0f) || !st->light_count || !st->lights || !st->positions)
         return 0;
     lm->a = (double)st->light_mix;
+    lm->rows = rows;
     lm->nl = st->light_count;
     lm->lights = st->lights;
     lm->pos = st->positions;
@@ -639,8 +675,8 @@ static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float
         return -1;
     /* One walk: each row's texels written where it would be kept, until
      * the next would pass the cap; room for every row's (or the cap's)
-     * and one more row's, the scratch of the rows past the cap, then
-     * shrunk to what is kept (pages never written are never touched). */
+     * and one more row's, then shrunk to what is kept (pages never
+     * written are never touched). */
     const size_t cap = st->light_cache ? st->light_cache : LIGHT_CACHE;
     const size_t most = (size_t)rows * lm->nl;
     if (!(lm->tex = malloc(sizeof(uint16_t) * ((most < cap ? most : cap) + lm->nl) + 1)))
@@ -654,15 +690,22 @@ static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float
             !(lm->sb = calloc(1, sizeof *lm->sb)))
             return -1;
     }
+    const float *nv = normals;
     lm->at[0] = 0;
     for (; lm->cached < rows; lm->cached++) {
         const uint32_t v = lm->cached;
-        const uint32_t t = row_texels(lm, v, normals + 3 * (size_t)v, lm->at[v]);
-        if (lm->at[v] + t > cap)
+        const size_t at = lm->at[v];
+        const uint32_t t =
+            row_texels(lm, v, nv + 3 * (size_t)v, lm->tex + at, lm->wt ? lm->wt + at : NULL);
+        if (at + t > cap)
             break;
-        lm->at[v + 1] = lm->at[v] + t;
+        lm->at[v + 1] = at + t;
     }
-    const size_t size = lm->at[lm->cached] + (lm->cached < rows ? lm->nl : 0);
+    free(lm->sb);
+    lm->sb = NULL;
+    if (!lightmix_scratch(lm))
+        return -1;
+    const size_t size = lm->at[lm->cached];
     uint16_t *shrunk = realloc(lm->tex, sizeof(uint16_t) * size + 1);
     if (shrunk)
         lm->tex = shrunk;
@@ -679,15 +722,22 @@ static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float
 static uint32_t light_texels(const lightmix *lm, uint32_t v, const float *nv, const uint16_t **tex,
                              const float **wt, double *sum)
 {
-    size_t at = lm->at[v < lm->cached ? v : lm->cached];
-    uint32_t t = v < lm->cached ? (uint32_t)(lm->at[v + 1] - at) : row_texels(lm, v, nv, at);
-    *tex = lm->tex + at;
-    *wt = lm->wt ? lm->wt + at : NULL;
+    uint32_t t;
+    if (v < lm->cached) {
+        const size_t at = lm->at[v];
+        t = (uint32_t)(lm->at[v + 1] - at);
+        *tex = lm->tex + at;
+        *wt = lm->wt ? lm->wt + at : NULL;
+    } else {
+        t = row_texels(lm, v, nv, lm->stex, lm->swt);
+        *tex = lm->stex;
+        *wt = lm->swt;
+    }
     double s = 0.0;
-    if (lm->wt)
+    if (*wt)
         for (uint32_t i = 0; i < t; i++)
-            s += lm->wt[at + i];
-    *sum = lm->wt ? s : (double)t;
+            s += (*wt)[i];
+    *sum = *wt ? s : (double)t;
     return t;
 }
 
@@ -1631,12 +1681,37 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
     return VDSH_OK;
 }
 
+/* The starts' workers (encode_starts): worker w fits the starts w,
+ * w + workers, ... with a view of the shared light texels of its own. */
+typedef struct start_worker {
+    const float *src, *normals;
+    uint32_t rows, order, refit, index, workers;
+    const vdsh_cpca_settings *settings;
+    lightmix view;
+    vdsh_cpca_fit *fits;
+    vdsh_result *res;
+    vdsh_error *errs;
+} start_worker;
+
+static void *start_worker_run(void *arg)
+{
+    start_worker *w = arg;
+    for (uint32_t i = w->index; i < w->settings->starts; i += w->workers) {
+        vdsh_cpca_settings st = *w->settings;
+        st.start = w->settings->start + i;
+        w->res[i] = encode_alloc(w->src, w->normals, w->rows, w->order, &st, w->refit, &w->view,
+                                 NULL, &w->fits[i], &w->errs[i]);
+    }
+    return NULL;
+}
+
 /* K,alloc:BYTES from settings->starts k-means starts (vdsh_cpca.h): the
- * fits start, start + 1, ... , all scored in one pass over the settings'
- * pool (vdsh_cpca_pool_score_streams: each pair's SH evaluated once for
- * every start), the fit with the fewest decisions differing from src's
- * kept (the first on a tie). The rows' light texels (and margin weights)
- * are found once for every start. */
+ * fits start, start + 1, ... (on up to settings->threads threads, each
+ * start's bytes its own whatever the thread), all scored in one pass over
+ * the settings' pool (vdsh_cpca_pool_score_streams: each pair's SH
+ * evaluated once for every start), the fit with the fewest decisions
+ * differing from src's kept (the first on a tie). The rows' light texels
+ * (and margin weights) are found once for every start. */
 static vdsh_result encode_starts(const float *src, const float *normals, uint32_t rows,
                                  uint32_t order, const vdsh_cpca_settings *settings, uint32_t refit,
                                  vdsh_cpca_fit *out, vdsh_error *err)
@@ -1645,31 +1720,67 @@ static vdsh_result encode_starts(const float *src, const float *normals, uint32_
     vdsh_cpca_fit fits[VDSH_CPCA_MAX_STARTS];
     vdsh_stream streams[VDSH_CPCA_MAX_STARTS];
     vdsh_cpca_pool_scores sc[VDSH_CPCA_MAX_STARTS];
+    vdsh_result res[VDSH_CPCA_MAX_STARTS];
+    vdsh_error errs[VDSH_CPCA_MAX_STARTS];
+    start_worker work[VDSH_CPCA_MAX_STARTS];
+    pthread_t tid[VDSH_CPCA_MAX_STARTS];
+    int started[VDSH_CPCA_MAX_STARTS] = {0};
     memset(fits, 0, sizeof fits);
+    memset(work, 0, sizeof work);
+    long cpus = settings->threads ? (long)settings->threads : sysconf(_SC_NPROCESSORS_ONLN);
+    const uint32_t workers = cpus < 1 ? 1u : cpus < (long)count ? (uint32_t)cpus : count;
+    for (uint32_t i = 0; i < count; i++)
+        res[i] = VDSH_ERR_OUT_OF_MEMORY;
     lightmix shared;
-    vdsh_result res = VDSH_OK;
-    if (lightmix_load(&shared, settings, src, order, normals, rows) < 0)
-        res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory for the light texels");
-    for (uint32_t i = 0; res == VDSH_OK && i < count; i++) {
-        vdsh_cpca_settings st = *settings;
-        st.start = settings->start + i;
-        res = encode_alloc(src, normals, rows, order, &st, refit, &shared, NULL, &fits[i], err);
+    int ok = lightmix_load(&shared, settings, src, order, normals, rows) > 0;
+    for (uint32_t w = 0; w < workers; w++) {
+        work[w] = (start_worker){.src = src,
+                                 .normals = normals,
+                                 .rows = rows,
+                                 .order = order,
+                                 .refit = refit,
+                                 .index = w,
+                                 .workers = workers,
+                                 .settings = settings,
+                                 .fits = fits,
+                                 .res = res,
+                                 .errs = errs};
+        ok = ok && lightmix_view(&shared, &work[w].view);
+    }
+    /* worker 0 on this thread; a thread that cannot start runs here too */
+    for (uint32_t w = 1; ok && w < workers; w++)
+        started[w] = pthread_create(&tid[w], NULL, start_worker_run, &work[w]) == 0;
+    for (uint32_t w = 0; ok && w < workers; w++)
+        if (!started[w])
+            start_worker_run(&work[w]);
+    for (uint32_t w = 1; w < workers; w++)
+        if (started[w])
+            pthread_join(tid[w], NULL);
+    for (uint32_t w = 0; w < workers; w++)
+        lightmix_free(&work[w].view);
+    lightmix_free(&shared);
+    vdsh_result r = VDSH_OK;
+    for (uint32_t i = 0; i < count && r == VDSH_OK; i++) {
+        r = res[i];
+        if (r != VDSH_OK && ok)
+            vdsh_failf(err, r, "%s", errs[i].msg);
         streams[i] = fit_stream(&fits[i], order);
     }
-    lightmix_free(&shared);
-    if (res == VDSH_OK)
-        res = vdsh_cpca_pool_score_streams(src, normals, rows, order, settings, streams, count, sc,
-                                           err);
+    if (!ok)
+        r = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory for the light texels");
+    if (r == VDSH_OK)
+        r = vdsh_cpca_pool_score_streams(src, normals, rows, order, settings, streams, count, sc,
+                                         err);
     uint32_t best = 0;
-    for (uint32_t i = 1; res == VDSH_OK && i < count; i++)
+    for (uint32_t i = 1; r == VDSH_OK && i < count; i++)
         if (sc[i].disagree < sc[best].disagree)
             best = i;
     for (uint32_t i = 0; i < count; i++)
-        if (res != VDSH_OK || i != best)
+        if (r != VDSH_OK || i != best)
             vdsh_cpca_fit_free(&fits[i]);
-    if (res == VDSH_OK)
+    if (r == VDSH_OK)
         *out = fits[best];
-    return res;
+    return r;
 }
 
 vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t rows, uint32_t order,

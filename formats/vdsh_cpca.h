@@ -33,7 +33,9 @@
  *     ... vdsh_write ...
  *     vdsh_cpca_fit_free(&fit);
  *
- * Threading: no shared state.
+ * Threading: no shared state. One thread, but the starts of
+ * K,alloc:BYTES,starts:N run on up to settings->threads threads (vdsh-bake
+ * --threads; vdsh-merge: one per CPU), each start's bytes the same on any.
  */
 #ifndef VDSH_CPCA_H
 #define VDSH_CPCA_H
@@ -90,6 +92,9 @@ typedef struct vdsh_cpca_settings {
      * kept, the first on a tie. 0 or 1: one fit; without a pool, one fit.
      * 0..VDSH_CPCA_MAX_STARTS. */
     uint32_t starts;
+    /* The most threads the starts run on (0: one per CPU online); the
+     * bytes do not depend on it. */
+    uint32_t threads;
     /* The k-means start (the seeding's draw) of a one-start fit: 0, the
      * encoder's own; start i draws as VDSH_CPCA_KMEANS_SEED=i would
      * (vdsh_cpca_study.h). With starts N: the starts start..start+N-1. */

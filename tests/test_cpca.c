@@ -697,6 +697,36 @@ static void light_metric(void)
         vdsh_cpca_fit_free(&h);
         vdsh_cpca_fit_free(&ha);
     }
+    /* The margin and 3 starts, on 1 thread with the whole cache against 3
+     * threads (each with its own scratch for the rows past the cap) and a
+     * cap of 1 or 4096 texels: the same bytes; another fit than one start. */
+    vdsh_cpca_settings ms = alloc;
+    ms.margin = 0.25f;
+    ms.starts = 3;
+    ms.threads = 1;
+    vdsh_cpca_fit fm;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &ms, &fm, &err) == VDSH_OK,
+          "margin 0.25, 3 starts: %s", err.msg);
+    CHECK(fm.records &&
+              (fm.model.record_words != fa.model.record_words ||
+               memcmp(fm.records, fa.records, (size_t)ROWS * 4 * fa.model.record_words) != 0),
+          "margin 0.25, 3 starts: the one start's records");
+    for (size_t cap = 1; cap <= 1u << 24; cap *= 4096) {
+        vdsh_cpca_settings c = ms;
+        c.light_cache = cap;
+        c.threads = 3;
+        vdsh_cpca_fit h;
+        CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &c, &h, &err) == VDSH_OK &&
+                  h.model.record_words == fm.model.record_words &&
+                  h.model.basis == fm.model.basis &&
+                  !memcmp(h.records, fm.records, (size_t)ROWS * 4 * fm.model.record_words) &&
+                  !memcmp(h.storage_, fm.storage_,
+                          (size_t)vdsh_cpca_stream_model_bytes(&fm.model, ORDER) - 16),
+              "margin 0.25, 3 starts, 3 threads, a cache of %zu texels: not 1 thread's bytes (%s)",
+              cap, err.msg);
+        vdsh_cpca_fit_free(&h);
+    }
+    vdsh_cpca_fit_free(&fm);
     vdsh_cpca_fit_free(&fa);
     CHECK(isfinite(f.rms_error) && f.rms_error < 4.0 * u.rms_error, "mix 1: error %g, uniform %g",
           f.rms_error, u.rms_error);

@@ -242,6 +242,7 @@ vb_result vb_job_bake(vb_job *j, const vb_job_desc *d, vb_error *err)
 vdsh_cpca_settings vb_job_cpca_settings(const vb_job *j, const vb_job_desc *d)
 {
     vdsh_cpca_settings st = job_cpca_asked(d);
+    st.threads = d->bake.threads; /* the starts' (0: every online core, as the bake's) */
     if (st.light_mix > 0.0f && j->cpca_lights) {
         st.light_count = j->cpca_lights;
         st.lights = &j->pool[0][0];
