@@ -506,8 +506,9 @@ typedef struct lightmix {
     double a;
     uint32_t nl;
     const float *lights, *pos; /* nl x 3, rows x 3 */
-    /* The margin (settings margin, vdsh_cpca.h): when wt is set, each light's weight 1 / (1 + m^2 inv_sigma2), m its margin from
-     * the source's coefficients src (order^2 per row), parallel to tex. */
+    /* The margin (settings margin, vdsh_cpca.h): when wt is set, each
+     * light's weight 1 / (1 + m^2 inv_sigma2), m its margin from the
+     * source's coefficients src (order^2 per row), parallel to tex. */
     const float *src;
     uint32_t order;
     double inv_sigma2;
@@ -633,14 +634,14 @@ static uint32_t row_texels(const lightmix *lm, uint32_t v, const float *nv, uint
     return t;
 }
 
-/* view's own scratch (stex, swt, sb) for the rows past lm's cache and the
+/* lm's own scratch (stex, swt, sb) for the rows past its cache and the
  * margin: 1, or 0 out of memory. */
 static int lightmix_scratch(lightmix *lm)
 {
     if (lm->cached < lm->rows && (!(lm->stex = malloc(sizeof(uint16_t) * lm->nl)) ||
                                   (lm->wt && !(lm->swt = malloc(sizeof(float) * lm->nl)))))
         return 0;
-    return !lm->wt || (lm->sb = calloc(1, sizeof *lm->sb)) != NULL;
+    return !lm->wt || lm->sb || (lm->sb = calloc(1, sizeof *lm->sb)) != NULL;
 }
 
 /* *view: lm's texels and weights, shared (read only), with scratch of its
@@ -690,19 +691,16 @@ static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float
             !(lm->sb = calloc(1, sizeof *lm->sb)))
             return -1;
     }
-    const float *nv = normals;
     lm->at[0] = 0;
     for (; lm->cached < rows; lm->cached++) {
         const uint32_t v = lm->cached;
         const size_t at = lm->at[v];
         const uint32_t t =
-            row_texels(lm, v, nv + 3 * (size_t)v, lm->tex + at, lm->wt ? lm->wt + at : NULL);
+            row_texels(lm, v, normals + 3 * (size_t)v, lm->tex + at, lm->wt ? lm->wt + at : NULL);
         if (at + t > cap)
             break;
         lm->at[v + 1] = at + t;
     }
-    free(lm->sb);
-    lm->sb = NULL;
     if (!lightmix_scratch(lm))
         return -1;
     const size_t size = lm->at[lm->cached];
@@ -1722,18 +1720,17 @@ static vdsh_result encode_starts(const float *src, const float *normals, uint32_
     vdsh_cpca_pool_scores sc[VDSH_CPCA_MAX_STARTS];
     vdsh_result res[VDSH_CPCA_MAX_STARTS];
     vdsh_error errs[VDSH_CPCA_MAX_STARTS];
-    start_worker work[VDSH_CPCA_MAX_STARTS];
     pthread_t tid[VDSH_CPCA_MAX_STARTS];
     int started[VDSH_CPCA_MAX_STARTS] = {0};
     memset(fits, 0, sizeof fits);
-    memset(work, 0, sizeof work);
     long cpus = settings->threads ? (long)settings->threads : sysconf(_SC_NPROCESSORS_ONLN);
     const uint32_t workers = cpus < 1 ? 1u : cpus < (long)count ? (uint32_t)cpus : count;
     for (uint32_t i = 0; i < count; i++)
         res[i] = VDSH_ERR_OUT_OF_MEMORY;
-    lightmix shared;
-    int ok = lightmix_load(&shared, settings, src, order, normals, rows) > 0;
-    for (uint32_t w = 0; w < workers; w++) {
+    lightmix shared = {0};
+    start_worker *work = calloc(workers, sizeof *work); /* a view is 16 KB */
+    int ok = work && lightmix_load(&shared, settings, src, order, normals, rows) > 0;
+    for (uint32_t w = 0; work && w < workers; w++) {
         work[w] = (start_worker){.src = src,
                                  .normals = normals,
                                  .rows = rows,
@@ -1756,8 +1753,9 @@ static vdsh_result encode_starts(const float *src, const float *normals, uint32_
     for (uint32_t w = 1; w < workers; w++)
         if (started[w])
             pthread_join(tid[w], NULL);
-    for (uint32_t w = 0; w < workers; w++)
+    for (uint32_t w = 0; work && w < workers; w++)
         lightmix_free(&work[w].view);
+    free(work);
     lightmix_free(&shared);
     vdsh_result r = VDSH_OK;
     for (uint32_t i = 0; i < count && r == VDSH_OK; i++) {
