@@ -657,13 +657,20 @@ static int lightmix_view(const lightmix *lm, lightmix *view)
     return lightmix_scratch(view);
 }
 
+/* Whether settings st turn the light-density metric on: a mix above 0
+ * and a pool with the rows' positions. */
+static int lightmix_on(const vdsh_cpca_settings *st)
+{
+    return st && st->light_mix > 0.0f && st->light_count && st->lights && st->positions;
+}
+
 /* lm from the settings, the rows' texels found (normals, rows x 3): 1 when
  * on, 0 when off (lm zeroed), -1 out of memory. */
 static int lightmix_load(lightmix *lm, const vdsh_cpca_settings *st, const float *src,
                          uint32_t order, const float *normals, uint32_t rows)
 {
     memset(lm, 0, sizeof *lm);
-    if (!st || !(st->light_mix > 0.0f) || !st->light_count || !st->lights || !st->positions)
+    if (!lightmix_on(st))
         return 0;
     lm->a = (double)st->light_mix;
     lm->rows = rows;
@@ -1801,9 +1808,7 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
         /* the rounds study (VDSH_CPCA_REFIT_ROUNDS=R, vdsh_cpca_study.h) */
         const uint32_t r = (uint32_t)study_knob("VDSH_CPCA_REFIT_ROUNDS", 16);
         const uint32_t rounds = r ? r : VDSH_CPCA_REFIT_ROUNDS;
-        const int pool = settings->light_mix > 0.0f && settings->light_count && settings->lights &&
-                         settings->positions;
-        if (settings->starts < 2 || !pool)
+        if (settings->starts < 2 || !lightmix_on(settings))
             return encode_alloc(src, normals, rows, order, settings, rounds, NULL, NULL, out, err);
         return encode_starts(src, normals, rows, order, settings, rounds, out, err);
     }
@@ -2564,6 +2569,29 @@ vdsh_result vdsh_cpca_pool_score(const float *src, const float *normals, uint32_
     return vdsh_cpca_pool_score_streams(src, normals, rows, order, settings, &s, 1, out, err);
 }
 
+/* The pairs staged in b for one row (its coefficients x, the streams'
+ * decoded rows dec) added to out[0 .. count), in light order; b emptied. */
+static void score_batch(sh_batch *b, uint32_t order, const float *x, float (*dec)[VDSH_MAX_COEFFS],
+                        uint32_t count, double (*bk)[SH_BATCH], vdsh_cpca_pool_scores *out)
+{
+    const uint32_t n = order * order;
+    sh_batch_eval(b, order);
+    sh_batch_dots(b, x, n, b->a);
+    for (uint32_t k = 0; k < count; k++)
+        sh_batch_dots(b, dec[k], n, bk[k]);
+    for (uint32_t j = 0; j < b->count; j++) {
+        const double a = b->a[j], t = det_ln(b->r[j]);
+        for (uint32_t k = 0; k < count; k++) {
+            const double bb = bk[k][j];
+            out[k].pairs++;
+            out[k].disagree += (a >= t) != (bb >= t);
+            out[k].missed += (a >= t) && !(bb >= t);
+            out[k].squared += (bb - a) * (bb - a);
+        }
+    }
+    b->count = 0;
+}
+
 vdsh_result vdsh_cpca_pool_score_streams(const float *src, const float *normals, uint32_t rows,
                                          uint32_t order, const vdsh_cpca_settings *settings,
                                          const vdsh_stream *s, uint32_t count,
@@ -2600,26 +2628,11 @@ vdsh_result vdsh_cpca_pool_score_streams(const float *src, const float *normals,
             double d[3];
             for (int i = 0; i < 3; i++)
                 d[i] = (double)q[i] - p[i];
-            const int above = d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0;
-            if (!(above && sh_batch_add(b, d)) && !(l + 1 == settings->light_count && b->count))
-                continue;
-            /* a full batch, or the row's last: each pair in light order */
-            sh_batch_eval(b, order);
-            sh_batch_dots(b, x, n, b->a);
-            for (uint32_t k = 0; k < count; k++)
-                sh_batch_dots(b, dec[k], n, bk[k]);
-            for (uint32_t j = 0; j < b->count; j++) {
-                const double a = b->a[j], t = det_ln(b->r[j]);
-                for (uint32_t k = 0; k < count; k++) {
-                    const double bb = bk[k][j];
-                    out[k].pairs++;
-                    out[k].disagree += (a >= t) != (bb >= t);
-                    out[k].missed += (a >= t) && !(bb >= t);
-                    out[k].squared += (bb - a) * (bb - a);
-                }
-            }
-            b->count = 0;
+            if (d[0] * nv[0] + d[1] * nv[1] + d[2] * nv[2] > 0.0 && sh_batch_add(b, d))
+                score_batch(b, order, x, dec, count, bk, out);
         }
+        if (b->count)
+            score_batch(b, order, x, dec, count, bk, out);
     }
     free(b);
     free(bk);
