@@ -112,15 +112,29 @@ typedef struct vdsh_cpca_settings {
  * without one the metric is uniform. */
 #define VDSH_CPCA_DEFAULT_LIGHT_MIX 1.0f
 
+/* The default's margin and starts (--encoding cpca without --cpca, or
+ * the options alone): docs/ACCURACY.md "The margin and two starts become
+ * the default": over fifteen validation bakes +1.50% over uncompressed
+ * order 12 against +2.01% for one start without the margin, over 3% on
+ * two against four, none decidedly worse; 1.1-1.3x the bake's wall time
+ * on two cores (the second start on the other), 2x its encode CPU time.
+ * A base said (16,alloc:32) has neither unless said. */
+#define VDSH_CPCA_DEFAULT_MARGIN 0.25f
+#define VDSH_CPCA_DEFAULT_STARTS 2
+
 /* K,alloc:BYTES with K = VDSH_CPCA_DEFAULT_CLUSTERS (16) and BYTES =
  * VDSH_CPCA_DEFAULT_BUDGET (32), light mix VDSH_CPCA_DEFAULT_LIGHT_MIX,
- * no pool (docs/ACCURACY.md "The default of --encoding cpca": over sixteen
+ * margin VDSH_CPCA_DEFAULT_MARGIN and VDSH_CPCA_DEFAULT_STARTS starts,
+ * no pool: 16,alloc:32,margin:0.25,starts:2 (K and BYTES:
+ * docs/ACCURACY.md "The default of --encoding cpca": over sixteen
  * validation bakes +1.68% over uncompressed order 12, within 3% on 14,
  * against 8,alloc:32's +2.05% and 11; 8,54,4, the default before, passed
  * 32 bytes per vertex below about 32,000 receivers). K is a most: on a
  * mesh too small for 16 clusters' model within 32 bytes per vertex (a few
  * hundred receivers at order 12) vdsh_cpca_encode halves it until one
- * fits; only a mesh no single cluster fits is refused. */
+ * fits; only a mesh no single cluster fits is refused. Without a pool
+ * (the caller sets it) the metric is uniform and the margin and starts
+ * do nothing. */
 vdsh_cpca_settings vdsh_cpca_settings_default(void);
 
 /* Parse "K,B,BITS" (for example "8,54,4"), "auto" (budget 32),
@@ -130,10 +144,13 @@ vdsh_cpca_settings vdsh_cpca_settings_default(void);
  * for K,B,BITS), and for K,alloc:BYTES with a light mix above 0
  * ",margin:S" (the margin, S in (0, VDSH_CPCA_MAX_MARGIN]) and
  * ",starts:N" (1..VDSH_CPCA_MAX_STARTS); or the options alone (the
- * default settings, vdsh_cpca_settings_default's K and budget, with them:
- * "light:A", "margin:0.25,starts:2") into *out (no pool: the caller sets
- * it); VDSH_ERR_ARGUMENT with a message for a malformed string or a value
- * out of range. */
+ * default settings, vdsh_cpca_settings_default's, with the options said
+ * in place of theirs: "light:0.5", "starts:1", "margin:0.5"; "light:0"
+ * alone is the default K and budget with the uniform metric and neither
+ * margin nor starts, which need the pool) into *out (no pool: the caller
+ * sets it); VDSH_ERR_ARGUMENT with a message for a malformed string or a
+ * value out of range. A base said (K,alloc:BYTES) has no margin and one
+ * start unless said. */
 vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_error *err);
 
 /* A fitted stream: model (its pointers into storage_) and records

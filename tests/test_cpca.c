@@ -765,23 +765,37 @@ static void light_metric(void)
               p.budget == 16 && p.light_mix == 0.5f,
           "3,alloc:16,light:0.5");
     CHECK(vdsh_cpca_parse("light:0", &p, &err) == VDSH_OK && p.clusters == d.clusters &&
-              p.basis == d.basis && p.bits == d.bits && p.budget == d.budget && p.light_mix == 0.0f,
-          "light:0 alone");
+              p.basis == d.basis && p.bits == d.bits && p.budget == d.budget &&
+              p.light_mix == 0.0f && p.margin == 0.0f && p.starts == 0,
+          "light:0 alone: the default K and budget, uniform, no margin, one start");
     /* the default: K,alloc:BYTES (16,alloc:32) with the default light mix,
-     * what the text "16,alloc:32" gives (docs/ACCURACY.md "The default of
-     * --encoding cpca") */
+     * margin and starts (docs/ACCURACY.md "The default of --encoding cpca",
+     * "The margin and two starts become the default"), what the text
+     * "16,alloc:32,margin:0.25,starts:2" gives; the base said alone has
+     * neither margin nor starts; an option alone keeps the default's others */
     CHECK(d.clusters == VDSH_CPCA_DEFAULT_CLUSTERS && d.budget == VDSH_CPCA_DEFAULT_BUDGET &&
               d.basis == 0 && d.bits == 0 && d.light_mix == VDSH_CPCA_DEFAULT_LIGHT_MIX &&
-              !d.light_count && !d.lights && !d.positions,
-          "the default settings: K,alloc:BYTES with the default light mix");
+              d.margin == VDSH_CPCA_DEFAULT_MARGIN && d.starts == VDSH_CPCA_DEFAULT_STARTS &&
+              d.margin > 0.0f && d.starts > 1 && !d.light_count && !d.lights && !d.positions,
+          "the default settings: K,alloc:BYTES with the default light mix, margin and starts");
     {
-        char text[32];
+        char text[64];
+        snprintf(text, sizeof text, "%u,alloc:%u,margin:%g,starts:%u", (unsigned)d.clusters,
+                 (unsigned)d.budget, (double)d.margin, (unsigned)d.starts);
+        CHECK(vdsh_cpca_parse(text, &p, &err) == VDSH_OK && !memcmp(&p, &d, sizeof p),
+              "the default settings are %s's", text);
         snprintf(text, sizeof text, "%u,alloc:%u", (unsigned)d.clusters, (unsigned)d.budget);
         CHECK(vdsh_cpca_parse(text, &p, &err) == VDSH_OK && p.clusters == d.clusters &&
-                  p.basis == d.basis && p.bits == d.bits && p.budget == d.budget &&
-                  p.light_mix == d.light_mix && !p.light_count,
-              "the default settings are %s's", text);
+                  p.budget == d.budget && p.light_mix == d.light_mix && p.margin == 0.0f &&
+                  p.starts == 0,
+              "%s said: not one start without the margin", text);
     }
+    CHECK(vdsh_cpca_parse("starts:1", &p, &err) == VDSH_OK && p.clusters == d.clusters &&
+              p.budget == d.budget && p.margin == d.margin && p.starts == 1,
+          "starts:1 alone: not the default's margin with one start");
+    CHECK(vdsh_cpca_parse("light:0.5,margin:0.5", &p, &err) == VDSH_OK && p.light_mix == 0.5f &&
+              p.margin == 0.5f && p.starts == d.starts,
+          "light:0.5,margin:0.5 alone: not the default's starts");
     CHECK(vdsh_cpca_parse("auto,light:0", &p, &err) == VDSH_OK && p.budget == 32 &&
               p.light_mix == 0.0f,
           "auto,light:0");

@@ -6,7 +6,7 @@
 # within f16 and quantisation rounding; with the default-like settings
 # well below the coefficients' spread); --adaptive-order's stream, as a
 # fixed cpca stream of its cap, is alike (threads, shards, decode error);
-# the default settings (16,alloc:32, light:1) alike; bad settings are
+# the default settings (16,alloc:32,margin:0.25,starts:2, light:1) alike; bad settings are
 # usage errors and parts of other settings are refused by the merge.
 # Usage: test_cpca_bake.sh VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR
 set -u
@@ -61,9 +61,10 @@ c = vdsh.read(sys.argv[3]).streams[0]["cpca"]
 assert c["bits"] == 0 and len(c["widths"]) == c["basis"] and 2 <= min(c["widths"]), c["widths"]
 ' "$src/python" "$tmp/c3/p1.vdsh" "$tmp/c1.vdsh"
 
-# The default (--encoding cpca without --cpca: 16,alloc:32 with the light
-# pool, which parts carry in lpol): whole bake = 2 threads = 3 shards
-# merged, byte for byte; a part names the default's settings.
+# The default (--encoding cpca without --cpca: 16,alloc:32,margin:0.25,
+# starts:2 with the light pool, which parts carry in lpol): whole bake =
+# 2 threads = 3 shards merged, byte for byte; a part names the default's
+# settings.
 expect_exit 0 "default cpca, 1 thread" "$bake" "${tiny[@]}" --encoding cpca --threads 1 -o "$tmp/d1.vdsh"
 expect_exit 0 "default cpca, 2 threads" "$bake" "${tiny[@]}" --encoding cpca --threads 2 -o "$tmp/d2.vdsh"
 check "default cpca, 1 and 2 threads: identical" cmp "$tmp/d1.vdsh" "$tmp/d2.vdsh"
@@ -75,7 +76,7 @@ done
 expect_exit 0 "default cpca merge" "$merge" -q "$tmp"/d3/p*.vdsh -o "$tmp/d3/scene.vdsh"
 check "default cpca, 3 shards: identical to the whole bake" cmp "$tmp/d3/scene.vdsh" "$tmp/d1.vdsh"
 expect_exit 0 "vdsh-info on a default part" "$info" "$tmp/d3/p1.vdsh"
-says_any "a default part's settings" "cpca 16,alloc:32,light:1"
+says_any "a default part's settings" "cpca 16,alloc:32,light:1,margin:0.25,starts:2"
 
 # Against the f32 bake of the same options.
 expect_exit 0 "f32 bake" "$bake" "${tiny[@]}" --encoding f32 -o "$tmp/f32.vdsh"

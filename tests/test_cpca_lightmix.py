@@ -7,7 +7,9 @@ formats/vdsh_cpca.h; docs/ACCURACY.md, "A light-density metric"):
 - light:1 and light:0.5 are other fits, valid files that decode near the
   f32 bake; the default (no light:) is VDSH_CPCA_DEFAULT_LIGHT_MIX's for
   alloc, light:0's for fixed widths (8,54,4); the plain --encoding cpca is
-  --help's default settings (16,alloc:32) with light:1;
+  --help's default settings (16,alloc:32,margin:0.25,starts:2) with
+  light:1, not 16,alloc:32 said alone (one start, no margin); starts:1
+  alone is the default base with its margin;
 - bad values are refused with a message naming light:A, exit 2, no file;
 - a part carries the pool (`lpol`), vdsh-info shows the mix; vdsh-merge
   refuses parts whose pools differ, naming the part, and a part whose
@@ -87,15 +89,19 @@ x = vdsh.coefficients(ref.streams[0]).astype(np.float64)
 spread = np.sqrt(((x - x.mean(0)) ** 2).sum(1).mean())
 
 CPCA = ["--encoding", "cpca", "--cpca"]
-# the default settings, as vdsh-bake --help says them (16,alloc:32)
+# the default settings, as vdsh-bake --help says them
+# (16,alloc:32,margin:0.25,starts:2), and their base (16,alloc:32)
 helptext = subprocess.run([bake, "--help"], capture_output=True, text=True).stdout
-DEFAULT = helptext.split("model included); default ")[1].split()[0]
-if ",alloc:" not in DEFAULT:
-    fail.append("--help's default settings %r are not K,alloc:BYTES" % DEFAULT)
+DEFAULT = helptext.split("Default ")[1].split()[0]
+BASE = ",".join(DEFAULT.split(",")[:2])
+if ",alloc:" not in BASE or ",margin:" not in DEFAULT or ",starts:" not in DEFAULT:
+    fail.append("--help's default settings %r are not K,alloc:BYTES,margin:S,starts:N" % DEFAULT)
 for name, setting in (("l0", "4,alloc:40,light:0"), ("l05", "4,alloc:40,light:0.5"),
                       ("l1", "4,alloc:40,light:1"), ("def", "4,alloc:40"),
-                      ("l0alone", "light:0"), ("l0full", DEFAULT + ",light:0"),
+                      ("l0alone", "light:0"), ("l0full", BASE + ",light:0"),
                       ("l1full", DEFAULT + ",light:1"), ("plain", None),
+                      ("base", BASE), ("st1alone", "starts:1"),
+                      ("st1full", BASE + ",margin:" + DEFAULT.split("margin:")[1].split(",")[0]),
                       ("fixed", "8,54,4"), ("fixed0", "8,54,4,light:0")):
     must(run_bake(name + ".vdsh", CPCA + [setting] if setting else CPCA[:2]), str(setting))
     got = vdsh.coefficients(vdsh.read(path(name + ".vdsh")).streams[0]).astype(np.float64)
@@ -108,9 +114,15 @@ if blob("l0.vdsh") in (blob("l1.vdsh"), blob("l05.vdsh")) or blob("l1.vdsh") == 
     fail.append("light:0, 0.5 and 1 are not three fits")
 if blob("l0alone.vdsh") != blob("l0full.vdsh"):
     fail.append("light:0 alone is not the default K and budget with light:0")
-# the plain --encoding cpca is the default settings with their (alloc) mix
+# the plain --encoding cpca is the default settings with their (alloc) mix;
+# the base said alone is one start without the margin, another fit; an
+# option alone keeps the default's others
 if blob("plain.vdsh") != blob("l1full.vdsh"):
     fail.append("--encoding cpca without --cpca is not --cpca %s,light:1" % DEFAULT)
+if blob("base.vdsh") == blob("plain.vdsh"):
+    fail.append("--cpca %s said alone gives the default's bytes (%s)" % (BASE, DEFAULT))
+if blob("st1alone.vdsh") != blob("st1full.vdsh") or blob("st1alone.vdsh") == blob("base.vdsh"):
+    fail.append("starts:1 alone is not the default base with its margin")
 # the default mix, as vdsh-bake --help says it
 default = helptext.split("A in 0..1, default ")[1].split()[0]
 want = {"0": "l0", "1": "l1"}.get(default)

@@ -188,16 +188,9 @@ static void usage(FILE *f)
             "                          (2-4x the encode time of one setting); or\n"
             "                          K,alloc:BYTES: K clusters, a width per basis vector\n"
             "                          (2..8 bits) within BYTES per vertex (1..4096, the\n"
-            "                          model included); default %u,alloc:%u (order 12\n"
-            "                          within 3%% of uncompressed on 14 of 16 validation\n"
-            "                          bakes, mean +1.7%%; 8,alloc:32 11 of 16, +2.1%%,\n"
-            "                          at 0.7x the encode time; 8,54,4, the default\n"
-            "                          before, passes 32 B below ~32k receivers:\n"
-            "                          docs/ACCURACY.md \"The default of --encoding\n"
-            "                          cpca\"; K is a most: a model over the budget\n"
-            "                          halves it); each may end in ,light:A (or light:A\n"
-            "                          alone: the default K and budget): the fit's metric\n"
-            "                          weights each receiver's hemisphere by\n"
+            "                          model included; K is a most: a model over the\n"
+            "                          budget halves it); each may end in ,light:A: the\n"
+            "                          fit's metric weights each receiver's hemisphere by\n"
             "                          (1 - A) + A x the density of 2048 lights placed by\n"
             "                          the scene's light rule (A in 0..1, default %g for\n"
             "                          alloc and auto; 0, the uniform hemisphere, for\n"
@@ -208,10 +201,16 @@ static void usage(FILE *f)
             "                          decision margin) and ,starts:N (N k-means starts,\n"
             "                          the one whose decisions over the pool differ\n"
             "                          least kept, on up to --threads threads: N fits\n"
-            "                          and one score of the pool); margin:0.25,\n"
-            "                          starts:2 gave +1.5%% against +2.0%% over 15\n"
-            "                          validation bakes (docs/ACCURACY.md \"Keeping the\n"
-            "                          best of several k-means starts\")\n"
+            "                          and one score of the pool); a K,alloc:BYTES said\n"
+            "                          has no margin and one start unless said.\n"
+            "                          Default %u,alloc:%u,margin:%g,starts:%u (order 12\n"
+            "                          within 3%% of uncompressed on 13 of 15 validation\n"
+            "                          bakes, mean +1.5%%; %u,alloc:%u alone 11 of 15,\n"
+            "                          +2.0%%, at half the encode's CPU time:\n"
+            "                          docs/ACCURACY.md \"The margin and two starts become\n"
+            "                          the default\"); options alone change the default's\n"
+            "                          (starts:1, margin:0.5; light:0 alone: the uniform\n"
+            "                          metric, no margin, one start)\n"
             "      --shard I/N         bake shard I (0-based) of N only and write a part\n"
             "                          file; vdsh-merge joins the N parts into the file\n"
             "                          the whole bake writes, byte for byte\n"
@@ -367,13 +366,15 @@ static void usage(FILE *f)
             "Exit status: 0 success, 1 error, 2 usage error.\n"
             "Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n",
             VB_DEFAULT_CUBE_SIZE, VB_SDF_MIN_RESOLUTION, VB_SDF_MAX_RESOLUTION, VDSH_MAX_ORDER,
-            VDSH_CPCA_DEFAULT_CLUSTERS, VDSH_CPCA_DEFAULT_BUDGET,
-            (double)VDSH_CPCA_DEFAULT_LIGHT_MIX, VB_DEFAULT_RAYS, rays_side, rays_side,
-            VB_DEFAULT_RAYS, (double)VB_DEFAULT_RAY_TOLERANCE, VDSH_MAX_ORDER, VB_DEFAULT_ORDER_CAP,
-            methods_help(), (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
-            (double)vb_shadow_log_offset(3), (double)vb_shadow_log_offset(5),
-            (double)VB_DEFAULT_FALSE_RATE, VB_DECISION_MAX_PAIRS, VB_DEFAULT_DECISION_LIGHTS,
-            VB_DEFAULT_DECISION_NEAR, VB_ADAPTIVE_ROUNDS, VB_DEFAULT_CREASE, VB_DEFAULT_SEED);
+            (double)VDSH_CPCA_DEFAULT_LIGHT_MIX, VDSH_CPCA_DEFAULT_CLUSTERS,
+            VDSH_CPCA_DEFAULT_BUDGET, (double)VDSH_CPCA_DEFAULT_MARGIN, VDSH_CPCA_DEFAULT_STARTS,
+            VDSH_CPCA_DEFAULT_CLUSTERS, VDSH_CPCA_DEFAULT_BUDGET, VB_DEFAULT_RAYS, rays_side,
+            rays_side, VB_DEFAULT_RAYS, (double)VB_DEFAULT_RAY_TOLERANCE, VDSH_MAX_ORDER,
+            VB_DEFAULT_ORDER_CAP, methods_help(), (double)VB_DEFAULT_LAMBDA,
+            (double)vb_shadow_log_offset(2), (double)vb_shadow_log_offset(3),
+            (double)vb_shadow_log_offset(5), (double)VB_DEFAULT_FALSE_RATE, VB_DECISION_MAX_PAIRS,
+            VB_DEFAULT_DECISION_LIGHTS, VB_DEFAULT_DECISION_NEAR, VB_ADAPTIVE_ROUNDS,
+            VB_DEFAULT_CREASE, VB_DEFAULT_SEED);
 }
 
 static int bad_usage(const char *fmt, const char *arg)
@@ -993,13 +994,14 @@ static int read_choice(int c, const char *arg, options *o)
         vdsh_error e;
         if (vdsh_cpca_parse(arg, &o->cpca, &e) != VDSH_OK) {
             char msg[sizeof e.msg + 512];
-            snprintf(msg, sizeof msg,
-                     "--cpca takes K,B,BITS: clusters 1..256, basis vectors 1..256, bits 2..8, "
-                     "or auto or auto:BYTES, or K,alloc:BYTES (a width per basis vector), bytes "
-                     "per vertex 1..4096 (default 16,alloc:32), each optionally ending in "
-                     ",light:A (the light mix A in 0..1), and K,alloc:BYTES in ,margin:S (S > 0) "
-                     "and ,starts:N (1..16), or those options alone: %s",
-                     e.msg);
+            snprintf(
+                msg, sizeof msg,
+                "--cpca takes K,B,BITS: clusters 1..256, basis vectors 1..256, bits 2..8, "
+                "or auto or auto:BYTES, or K,alloc:BYTES (a width per basis vector), bytes "
+                "per vertex 1..4096 (default 16,alloc:32,margin:0.25,starts:2), each optionally ending in "
+                ",light:A (the light mix A in 0..1), and K,alloc:BYTES in ,margin:S (S > 0) "
+                "and ,starts:N (1..16), or those options alone: %s",
+                e.msg);
             return bad_usage("%s", msg);
         }
         o->have_cpca = 1;
