@@ -116,9 +116,11 @@ typedef struct vdsh_cpca_settings {
  * the options alone): docs/ACCURACY.md "The margin and two starts become
  * the default": over fifteen validation bakes +1.50% over uncompressed
  * order 12 against +2.01% for one start without the margin, over 3% on
- * two against four, none decidedly worse; 1.1-1.3x the bake's wall time
- * on two cores (the second start on the other), 2x its encode CPU time.
- * A base said (16,alloc:32) has neither unless said. */
+ * two against four, none decidedly worse; 1.2-1.8x the bake's wall time
+ * on two cores (fandisk at 12,190 receivers to the room at 58,007; the
+ * second start on the other core), 1.8-2.7x its CPU time, 2x its memory
+ * (docs/BENCHMARKS.md). A base said (16,alloc:32) has neither unless
+ * said. */
 #define VDSH_CPCA_DEFAULT_MARGIN 0.25f
 #define VDSH_CPCA_DEFAULT_STARTS 2
 
