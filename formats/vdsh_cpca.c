@@ -963,6 +963,7 @@ typedef struct fit_ctx {
     double *g, *sc, *sy, *ev, *tmp, *frac; /* scratch */
     uint32_t *idx;
     const lightmix *lm; /* the light-density metric's, or NULL */
+    uint32_t threads;   /* the most threads fit_all and reassign take (0: one per CPU) */
 } fit_ctx;
 
 /* Cluster c's mean and basis from its members (labels): the mean stored
@@ -1080,16 +1081,6 @@ static vdsh_result fit_cluster(fit_ctx *f, uint32_t c, vdsh_error *err)
             }
             f->bases[((size_t)c * b + j) * n + a] = h;
         }
-    }
-    return VDSH_OK;
-}
-
-static vdsh_result fit_all(fit_ctx *f, vdsh_error *err)
-{
-    for (uint32_t c = 0; c < f->k; c++) {
-        vdsh_result r = fit_cluster(f, c, err);
-        if (r != VDSH_OK)
-            return r;
     }
     return VDSH_OK;
 }
@@ -1229,13 +1220,164 @@ static uint32_t vertex_hemisphere(const fit_ctx *f, refine_ctx *r, uint32_t v)
     return nh;
 }
 
-/* One round of reassignment: the number of vertices that moved. */
-static uint32_t reassign(fit_ctx *f, refine_ctx *r)
+/* ---- one fit on threads ----
+ *
+ * fit_all's clusters and reassign's vertices are independent: worker w of
+ * W takes the items w, w + W, ..., each item's output its own (a
+ * cluster's mean, basis and projections; a vertex's new label), so the
+ * bytes are the same on any number of threads. Worker 0 is the caller's
+ * context; the others copies with scratch of their own (and their own
+ * view of the light texels, whose rows past the cache are found into
+ * scratch). */
+typedef struct fit_worker {
+    fit_ctx f;
+    refine_ctx r;
+    lightmix view;
+    uint32_t index, workers, moved;
+    vdsh_result *res; /* fit_all: per cluster */
+    vdsh_error *errs;
+} fit_worker;
+
+static void fit_workers_free(fit_worker *w, uint32_t workers)
 {
+    for (uint32_t i = 1; w && i < workers; i++) {
+        fit_ctx *f = &w[i].f;
+        free(f->l);
+        free(f->g);
+        free(f->sc);
+        free(f->sy);
+        free(f->ev);
+        free(f->tmp);
+        free(f->frac);
+        free(f->idx);
+        free(w[i].r.xval);
+        free(w[i].r.w);
+        free(w[i].r.hemi);
+        free(w[i].r.dw);
+        lightmix_free(&w[i].view);
+    }
+    free(w);
+}
+
+/* The workers for f's clusters (jobs k) or, with r, its rows: at most
+ * f->threads (0: one per CPU online) and jobs; *workers set; NULL out of
+ * memory. */
+static fit_worker *fit_workers(fit_ctx *f, refine_ctx *r, uint32_t jobs, uint32_t *workers)
+{
+    long cpus = f->threads ? (long)f->threads : sysconf(_SC_NPROCESSORS_ONLN);
+    if (cpus > 64)
+        cpus = 64;
+    const uint32_t nw = cpus < 1 || jobs < 1 ? 1u : cpus < (long)jobs ? (uint32_t)cpus : jobs;
+    fit_worker *w = calloc(nw, sizeof *w);
+    *workers = nw;
+    if (!w)
+        return NULL;
+    const size_t nn = (size_t)f->n * f->n;
+    int ok = 1;
+    for (uint32_t i = 0; i < nw; i++) {
+        w[i].f = *f;
+        w[i].index = i;
+        w[i].workers = nw;
+        if (r)
+            w[i].r = *r;
+        if (i == 0)
+            continue;
+        fit_ctx *c = &w[i].f;
+        c->l = c->g = c->sc = c->sy = c->ev = c->tmp = c->frac = NULL;
+        c->idx = NULL;
+        w[i].r.xval = w[i].r.w = w[i].r.dw = NULL;
+        w[i].r.hemi = NULL;
+        if (!ok)
+            continue;
+        if (r) {
+            const uint32_t count = r->rd.count;
+            w[i].r.xval = malloc(sizeof(double) * count);
+            w[i].r.w = malloc(sizeof(double) * f->b);
+            w[i].r.hemi = malloc(sizeof(uint32_t) * count);
+            w[i].r.dw = r->dw ? malloc(sizeof(double) * count) : NULL;
+            ok = w[i].r.xval && w[i].r.w && w[i].r.hemi && (!r->dw || w[i].r.dw);
+        } else {
+            c->l = malloc(sizeof(double) * nn);
+            c->g = malloc(sizeof(double) * nn);
+            c->sc = malloc(sizeof(double) * nn);
+            c->sy = malloc(sizeof(double) * nn);
+            c->ev = malloc(sizeof(double) * nn);
+            c->tmp = malloc(sizeof(double) * nn);
+            c->frac = malloc(sizeof(double) * 6 * CUBE_N * CUBE_N);
+            c->idx = malloc(sizeof(uint32_t) * f->n);
+            ok = c->l && c->g && c->sc && c->sy && c->ev && c->tmp && c->frac && c->idx;
+        }
+        if (ok && f->lm) {
+            ok = lightmix_view(f->lm, &w[i].view);
+            c->lm = &w[i].view;
+        }
+    }
+    if (!ok) {
+        fit_workers_free(w, nw);
+        return NULL;
+    }
+    return w;
+}
+
+/* fn on each worker: worker 0 on this thread, the others on threads of
+ * their own (one that cannot start runs here too). */
+static void run_fit_workers(fit_worker *w, uint32_t workers, void *(*fn)(void *))
+{
+    pthread_t tid[64];
+    int started[64] = {0};
+    for (uint32_t i = 1; i < workers; i++)
+        started[i] = pthread_create(&tid[i], NULL, fn, &w[i]) == 0;
+    for (uint32_t i = 0; i < workers; i++)
+        if (!started[i])
+            fn(&w[i]);
+    for (uint32_t i = 1; i < workers; i++)
+        if (started[i])
+            pthread_join(tid[i], NULL);
+}
+
+static void *fit_clusters_run(void *arg)
+{
+    fit_worker *w = arg;
+    for (uint32_t c = w->index; c < w->f.k; c += w->workers)
+        w->res[c] = fit_cluster(&w->f, c, &w->errs[c]);
+    return NULL;
+}
+
+/* Every cluster's fit (fit_cluster); the first cluster's error that
+ * failed. */
+static vdsh_result fit_all(fit_ctx *f, vdsh_error *err)
+{
+    const uint32_t k = f->k;
+    uint32_t workers;
+    vdsh_result *res = malloc(sizeof *res * k);
+    vdsh_error *errs = malloc(sizeof *errs * k);
+    fit_worker *w = res && errs ? fit_workers(f, NULL, k, &workers) : NULL;
+    vdsh_result r = VDSH_OK;
+    if (!w) {
+        r = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory for the fit's threads");
+    } else {
+        for (uint32_t i = 0; i < workers; i++) {
+            w[i].res = res;
+            w[i].errs = errs;
+        }
+        run_fit_workers(w, workers, fit_clusters_run);
+        for (uint32_t c = 0; c < k && r == VDSH_OK; c++)
+            if ((r = res[c]) != VDSH_OK && err)
+                *err = errs[c];
+        fit_workers_free(w, workers);
+    }
+    free(res);
+    free(errs);
+    return r;
+}
+
+static void *reassign_run(void *arg)
+{
+    fit_worker *w = arg;
+    const fit_ctx *f = &w->f;
+    refine_ctx *r = &w->r;
     const uint32_t n = f->n, k = f->k;
-    cluster_values(f, r);
-    uint32_t moved = 0;
-    for (uint32_t v = 0; v < f->rows; v++) {
+    for (uint32_t v = w->index; v < f->rows; v += w->workers) {
         const float *x = f->src + (size_t)v * n;
         uint32_t nh = vertex_hemisphere(f, r, v);
         uint32_t best = f->labels[v];
@@ -1250,10 +1392,26 @@ static uint32_t reassign(fit_ctx *f, refine_ctx *r)
             }
         }
         r->next[v] = best;
-        moved += best != f->labels[v];
+        w->moved += best != f->labels[v];
     }
+    return NULL;
+}
+
+/* One round of reassignment: *moved, the number of vertices that moved. */
+static vdsh_result reassign(fit_ctx *f, refine_ctx *r, uint32_t *moved, vdsh_error *err)
+{
+    cluster_values(f, r);
+    uint32_t workers;
+    *moved = 0;
+    fit_worker *w = fit_workers(f, r, f->rows, &workers);
+    if (!w)
+        return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory for the fit's threads");
+    run_fit_workers(w, workers, reassign_run);
+    for (uint32_t i = 0; i < workers; i++)
+        *moved += w[i].moved;
+    fit_workers_free(w, workers);
     memcpy(f->labels, r->next, sizeof(uint32_t) * f->rows);
-    return moved;
+    return VDSH_OK;
 }
 
 /* The stored fit's error: the sum over vertices of hemi_error by their
@@ -1399,7 +1557,8 @@ static int fit_scratch_alloc(fit_scratch *s, const float *src, const float *norm
                    .ev = malloc(sizeof(double) * n * n),
                    .tmp = malloc(sizeof(double) * n * n),
                    .frac = malloc(sizeof(double) * 6 * CUBE_N * CUBE_N),
-                   .idx = malloc(sizeof(uint32_t) * n)};
+                   .idx = malloc(sizeof(uint32_t) * n),
+                   .threads = light ? light->threads : 0};
     s->mu = malloc(sizeof(double) * n);
     s->dist = malloc(sizeof(double) * rows);
     s->cent = malloc(sizeof(double) * k * (n + 3));
@@ -1450,7 +1609,9 @@ static vdsh_result cluster_and_fit(fit_scratch *s, uint32_t rounds, vdsh_error *
            s->cent);
     vdsh_result res = fit_all(f, err);
     for (uint32_t round = 0; res == VDSH_OK && round < rounds; round++) {
-        if (!reassign(f, &s->rd))
+        uint32_t moved;
+        res = reassign(f, &s->rd, &moved, err);
+        if (res != VDSH_OK || !moved)
             break;
         res = fit_all(f, err);
     }
@@ -1697,6 +1858,7 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
 typedef struct start_worker {
     const float *src, *normals;
     uint32_t rows, order, refit, index, workers;
+    uint32_t threads; /* each start's fit's (fit_ctx) */
     const vdsh_cpca_settings *settings;
     lightmix view;
     vdsh_cpca_fit *fits;
@@ -1710,6 +1872,7 @@ static void *start_worker_run(void *arg)
     for (uint32_t i = w->index; i < w->settings->starts; i += w->workers) {
         vdsh_cpca_settings st = *w->settings;
         st.start = w->settings->start + i;
+        st.threads = w->threads;
         w->res[i] = encode_alloc(w->src, w->normals, w->rows, w->order, &st, w->refit, &w->view,
                                  NULL, &w->fits[i], &w->errs[i]);
     }
@@ -1751,6 +1914,7 @@ static vdsh_result encode_starts(const float *src, const float *normals, uint32_
                                  .refit = refit,
                                  .index = w,
                                  .workers = workers,
+                                 .threads = cpus / workers > 1 ? (uint32_t)(cpus / workers) : 1,
                                  .settings = settings,
                                  .fits = fits,
                                  .res = res,

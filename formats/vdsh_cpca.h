@@ -18,8 +18,9 @@
  * least error over its own hemisphere, then every cluster fitted again,
  * stopping early when no vertex moves); weights quantised
  * to `bits` bits with a scale per cluster and vector, chosen among the
- * largest |weight| x 1, 0.95, ..., 0.35 by least squared error. f64, one thread,
- * fixed order: the same bytes on any x86-64 CPU and thread count.
+ * largest |weight| x 1, 0.95, ..., 0.35 by least squared error. f64, each
+ * cluster's fit and each vertex's reassignment in a fixed order of its
+ * own: the same bytes on any x86-64 CPU and thread count.
  *
  * Does not: read or write files (vdsh.h does), handle variable-order
  * streams (callers refuse them).
@@ -33,9 +34,12 @@
  *     ... vdsh_write ...
  *     vdsh_cpca_fit_free(&fit);
  *
- * Threading: no shared state. One thread, but the starts of
- * K,alloc:BYTES,starts:N run on up to settings->threads threads (vdsh-bake
- * --threads; vdsh-merge: one per CPU), each start's bytes the same on any.
+ * Threading: no shared state. A fit's clusters (their means and bases)
+ * and its refinement's vertices (each one's new cluster) are split over
+ * up to settings->threads threads (vdsh-bake --threads; vdsh-merge: one
+ * per CPU), the starts of K,alloc:BYTES,starts:N over the same threads
+ * (each start's fit on its share): every cluster's and vertex's result
+ * its own, so the bytes are the same on any number.
  */
 #ifndef VDSH_CPCA_H
 #define VDSH_CPCA_H
@@ -92,7 +96,7 @@ typedef struct vdsh_cpca_settings {
      * kept, the first on a tie. 0 or 1: one fit; without a pool, one fit.
      * 0..VDSH_CPCA_MAX_STARTS. */
     uint32_t starts;
-    /* The most threads the starts run on (0: one per CPU online); the
+    /* The most threads the encoder runs on (0: one per CPU online); the
      * bytes do not depend on it. */
     uint32_t threads;
     /* The k-means start (the seeding's draw) of a one-start fit: 0, the

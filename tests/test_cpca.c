@@ -57,6 +57,7 @@
  */
 #include "vdsh.h"
 #include "vdsh_cpca.h"
+#include "vdsh_plural.h"
 #include "vdsh_cpca_study.h"
 #include "vdsh_sh.h"
 
@@ -726,6 +727,41 @@ static void light_metric(void)
               cap, err.msg);
         vdsh_cpca_fit_free(&h);
     }
+    /* One fit on threads (its clusters' fits and its vertices'
+     * reassignment split): 1 start with the margin on 1 thread against 2
+     * and 5, and 3 starts on 7 (2 threads each), with the whole cache and
+     * a cap of 1 texel: the same bytes. */
+    {
+        vdsh_cpca_settings one = ms;
+        one.starts = 1;
+        vdsh_cpca_fit f1;
+        CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &one, &f1, &err) == VDSH_OK,
+              "margin 0.25, 1 start: %s", err.msg);
+        const struct {
+            uint32_t starts, threads;
+            size_t cap;
+        } runs[] = {{1, 2, 0}, {1, 5, 0}, {1, 5, 1}, {3, 7, 0}, {3, 7, 1}};
+        for (size_t i = 0; i < sizeof runs / sizeof runs[0]; i++) {
+            vdsh_cpca_settings c = ms;
+            c.starts = runs[i].starts;
+            c.threads = runs[i].threads;
+            c.light_cache = runs[i].cap;
+            const vdsh_cpca_fit *want = runs[i].starts == 1 ? &f1 : &fm;
+            vdsh_cpca_fit h;
+            CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &c, &h, &err) == VDSH_OK &&
+                      h.model.record_words == want->model.record_words &&
+                      h.model.basis == want->model.basis &&
+                      !memcmp(h.records, want->records,
+                              (size_t)ROWS * 4 * want->model.record_words) &&
+                      !memcmp(h.storage_, want->storage_,
+                              (size_t)vdsh_cpca_stream_model_bytes(&want->model, ORDER) - 16),
+                  "margin 0.25, %u start%s on %u threads, a cache of %zu texels: not 1 "
+                  "thread's bytes (%s)",
+                  runs[i].starts, vdsh_s(runs[i].starts), runs[i].threads, runs[i].cap, err.msg);
+            vdsh_cpca_fit_free(&h);
+        }
+        vdsh_cpca_fit_free(&f1);
+    }
     vdsh_cpca_fit_free(&fm);
     vdsh_cpca_fit_free(&fa);
     CHECK(isfinite(f.rms_error) && f.rms_error < 4.0 * u.rms_error, "mix 1: error %g, uniform %g",
@@ -963,6 +999,17 @@ int main(int argc, char **argv)
               memcmp(fit.records, again.records, (size_t)ROWS * 4 * fit.model.record_words) == 0,
           "two encodings of the same input differ");
     vdsh_cpca_fit_free(&again);
+    /* the same bytes on 1 and 4 threads (the uniform metric) */
+    for (uint32_t t = 1; t <= 4; t += 3) {
+        vdsh_cpca_settings ts = st;
+        ts.threads = t;
+        CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &ts, &again, &err) == VDSH_OK &&
+                  memcmp(fit.storage_, again.storage_, mb) == 0 &&
+                  memcmp(fit.records, again.records, (size_t)ROWS * 4 * fit.model.record_words) ==
+                      0,
+              "the encoding on %u thread%s differs", t, vdsh_s(t));
+        vdsh_cpca_fit_free(&again);
+    }
 
     vdsh_stream s = {.order = ORDER,
                      .encoding = VDSH_ENCODING_CPCA,
