@@ -966,6 +966,35 @@ typedef struct fit_ctx {
     uint32_t threads;   /* the most threads fit_all and reassign take (0: one per CPU) */
 } fit_ctx;
 
+/* f's scratch for fit_cluster (l, g, sc, sy, ev, tmp, frac, idx), for
+ * f->n coefficients: 1, or 0 out of memory (free it with
+ * fit_ctx_scratch_free either way). */
+static int fit_ctx_scratch(fit_ctx *f)
+{
+    const size_t nn = (size_t)f->n * f->n;
+    f->l = malloc(sizeof(double) * nn);
+    f->g = malloc(sizeof(double) * nn);
+    f->sc = malloc(sizeof(double) * nn);
+    f->sy = malloc(sizeof(double) * nn);
+    f->ev = malloc(sizeof(double) * nn);
+    f->tmp = malloc(sizeof(double) * nn);
+    f->frac = malloc(sizeof(double) * 6 * CUBE_N * CUBE_N);
+    f->idx = malloc(sizeof(uint32_t) * f->n);
+    return f->l && f->g && f->sc && f->sy && f->ev && f->tmp && f->frac && f->idx;
+}
+
+static void fit_ctx_scratch_free(fit_ctx *f)
+{
+    free(f->l);
+    free(f->g);
+    free(f->sc);
+    free(f->sy);
+    free(f->ev);
+    free(f->tmp);
+    free(f->frac);
+    free(f->idx);
+}
+
 /* Cluster c's mean and basis from its members (labels): the mean stored
  * as f16, the basis the leading principal directions of the deviations
  * from it in the members' metric, stored as f16. */
@@ -1241,15 +1270,7 @@ typedef struct fit_worker {
 static void fit_workers_free(fit_worker *w, uint32_t workers)
 {
     for (uint32_t i = 1; w && i < workers; i++) {
-        fit_ctx *f = &w[i].f;
-        free(f->l);
-        free(f->g);
-        free(f->sc);
-        free(f->sy);
-        free(f->ev);
-        free(f->tmp);
-        free(f->frac);
-        free(f->idx);
+        fit_ctx_scratch_free(&w[i].f);
         free(w[i].r.xval);
         free(w[i].r.w);
         free(w[i].r.hemi);
@@ -1272,7 +1293,6 @@ static fit_worker *fit_workers(fit_ctx *f, refine_ctx *r, uint32_t jobs, uint32_
     *workers = nw;
     if (!w)
         return NULL;
-    const size_t nn = (size_t)f->n * f->n;
     int ok = 1;
     for (uint32_t i = 0; i < nw; i++) {
         w[i].f = *f;
@@ -1297,15 +1317,7 @@ static fit_worker *fit_workers(fit_ctx *f, refine_ctx *r, uint32_t jobs, uint32_
             w[i].r.dw = r->dw ? malloc(sizeof(double) * count) : NULL;
             ok = w[i].r.xval && w[i].r.w && w[i].r.hemi && (!r->dw || w[i].r.dw);
         } else {
-            c->l = malloc(sizeof(double) * nn);
-            c->g = malloc(sizeof(double) * nn);
-            c->sc = malloc(sizeof(double) * nn);
-            c->sy = malloc(sizeof(double) * nn);
-            c->ev = malloc(sizeof(double) * nn);
-            c->tmp = malloc(sizeof(double) * nn);
-            c->frac = malloc(sizeof(double) * 6 * CUBE_N * CUBE_N);
-            c->idx = malloc(sizeof(uint32_t) * f->n);
-            ok = c->l && c->g && c->sc && c->sy && c->ev && c->tmp && c->frac && c->idx;
+            ok = fit_ctx_scratch(c);
         }
         if (ok && f->lm) {
             ok = lightmix_view(f->lm, &w[i].view);
@@ -1506,15 +1518,8 @@ static void fit_scratch_free(fit_scratch *s)
     free(f->bases);
     free(f->members);
     free(f->mus);
-    free(f->l);
     free(f->proj);
-    free(f->g);
-    free(f->sc);
-    free(f->sy);
-    free(f->ev);
-    free(f->tmp);
-    free(f->frac);
-    free(f->idx);
+    fit_ctx_scratch_free(f);
     metric_free(&s->md);
     refine_free(&s->rd);
     free(s->mu);
@@ -1549,16 +1554,9 @@ static int fit_scratch_alloc(fit_scratch *s, const float *src, const float *norm
                    .bases = malloc(sizeof(uint16_t) * k * bf * n),
                    .members = malloc(sizeof(uint32_t) * k),
                    .mus = malloc(sizeof(double) * k * n),
-                   .l = malloc(sizeof(double) * n * n),
                    .proj = malloc(sizeof(double) * k * n * bf),
-                   .g = malloc(sizeof(double) * n * n),
-                   .sc = malloc(sizeof(double) * n * n),
-                   .sy = malloc(sizeof(double) * n * n),
-                   .ev = malloc(sizeof(double) * n * n),
-                   .tmp = malloc(sizeof(double) * n * n),
-                   .frac = malloc(sizeof(double) * 6 * CUBE_N * CUBE_N),
-                   .idx = malloc(sizeof(uint32_t) * n),
                    .threads = light ? light->threads : 0};
+    const int scratch = fit_ctx_scratch(f);
     s->mu = malloc(sizeof(double) * n);
     s->dist = malloc(sizeof(double) * rows);
     s->cent = malloc(sizeof(double) * k * (n + 3));
@@ -1574,9 +1572,8 @@ static int fit_scratch_alloc(fit_scratch *s, const float *src, const float *norm
             return 0;
         need_rd = 0; /* done */
     }
-    return f->labels && f->means && f->bases && f->members && f->mus && f->l && f->proj && f->g &&
-           f->sc && f->sy && f->ev && f->tmp && f->frac && f->idx && s->mu && s->dist && s->cent &&
-           metric_init(&s->md, order, CUBE_N) &&
+    return scratch && f->labels && f->means && f->bases && f->members && f->mus && f->proj &&
+           s->mu && s->dist && s->cent && metric_init(&s->md, order, CUBE_N) &&
            (!need_rd || refine_init(&s->rd, order, k, b, rows));
 }
 
