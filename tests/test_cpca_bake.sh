@@ -63,11 +63,14 @@ assert c["bits"] == 0 and len(c["widths"]) == c["basis"] and 2 <= min(c["widths"
 
 # The default (--encoding cpca without --cpca: 16,alloc:32,margin:0.25,
 # starts:2 with the light pool, which parts carry in lpol): whole bake =
-# 2 threads = 3 shards merged, byte for byte; a part names the default's
-# settings.
+# 2 threads = 5 threads = 3 shards merged (on every core and on --threads 1), byte
+# for byte; vdsh-merge --threads 0 is a usage error; a part names the
+# default's settings.
 expect_exit 0 "default cpca, 1 thread" "$bake" "${tiny[@]}" --encoding cpca --threads 1 -o "$tmp/d1.vdsh"
 expect_exit 0 "default cpca, 2 threads" "$bake" "${tiny[@]}" --encoding cpca --threads 2 -o "$tmp/d2.vdsh"
 check "default cpca, 1 and 2 threads: identical" cmp "$tmp/d1.vdsh" "$tmp/d2.vdsh"
+expect_exit 0 "default cpca, 5 threads" "$bake" "${tiny[@]}" --encoding cpca --threads 5 -o "$tmp/d5.vdsh"
+check "default cpca, 1 and 5 threads (each start's fit on 2): identical" cmp "$tmp/d1.vdsh" "$tmp/d5.vdsh"
 mkdir -p "$tmp/d3"
 for i in 0 1 2; do
   expect_exit 0 "default cpca shard $i/3" "$bake" "${tiny[@]}" --encoding cpca --shard "$i/3" \
@@ -75,6 +78,11 @@ for i in 0 1 2; do
 done
 expect_exit 0 "default cpca merge" "$merge" -q "$tmp"/d3/p*.vdsh -o "$tmp/d3/scene.vdsh"
 check "default cpca, 3 shards: identical to the whole bake" cmp "$tmp/d3/scene.vdsh" "$tmp/d1.vdsh"
+expect_exit 0 "default cpca merge, 1 thread" "$merge" -q --threads 1 "$tmp"/d3/p*.vdsh \
+  -o "$tmp/d3/scene1.vdsh"
+check "default cpca, 3 shards merged on 1 thread: identical" cmp "$tmp/d3/scene1.vdsh" "$tmp/d1.vdsh"
+expect_exit 2 "vdsh-merge --threads 0" "$merge" -q --threads 0 "$tmp"/d3/p*.vdsh -o "$tmp/d3/t0.vdsh"
+check "vdsh-merge --threads 0: no file" test ! -e "$tmp/d3/t0.vdsh"
 expect_exit 0 "vdsh-info on a default part" "$info" "$tmp/d3/p1.vdsh"
 says_any "a default part's settings" "cpca 16,alloc:32,light:1,margin:0.25,starts:2"
 

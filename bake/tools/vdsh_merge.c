@@ -61,6 +61,8 @@ static void usage(FILE *f)
           "\n"
           "  -o, --output FILE   the merged .vdsh (written atomically)\n"
           "  -q, --quiet         nothing on stderr but errors (no summary or notes)\n"
+          "      --threads N     cpca streams: the encoder's threads (1..256;\n"
+          "                      default: one per CPU); the bytes do not depend on it\n"
           "  -h, --help          this help\n"
           "  -V, --version       version\n"
           "\n"
@@ -359,7 +361,8 @@ static int encode_spilled(FILE *spill, const char *output, const vdsh_stream *s,
 typedef struct options {
     const char *output;
     int quiet;
-    char **parts; /* the PART arguments */
+    uint32_t threads; /* 0: one per CPU */
+    char **parts;     /* the PART arguments */
     int part_count;
 } options;
 
@@ -367,8 +370,11 @@ typedef struct options {
  * or --version; VT_EXIT_USAGE after saying what is wrong). */
 static int parse_args(int argc, char **argv, options *o)
 {
-    static const struct option longopts[] = {
-        {"output", required_argument, 0, 'o'}, {"quiet", no_argument, 0, 'q'}, VT_CLI_LONGOPTS_END};
+    enum { O_THREADS = 256 };
+    static const struct option longopts[] = {{"output", required_argument, 0, 'o'},
+                                             {"quiet", no_argument, 0, 'q'},
+                                             {"threads", required_argument, 0, O_THREADS},
+                                             VT_CLI_LONGOPTS_END};
     *o = (options){0};
     int c;
     while ((c = getopt_long(argc, argv, "o:qhV", longopts, NULL)) != -1) {
@@ -378,6 +384,10 @@ static int parse_args(int argc, char **argv, options *o)
                 return VT_EXIT_USAGE;
             break;
         case 'q': o->quiet = 1; break;
+        case O_THREADS:
+            if (!vt_opt_u32("--threads", NULL, optarg, 1, 256, &o->threads))
+                return VT_EXIT_USAGE;
+            break;
         default: return vt_cli_common_option(c, usage, NULL);
         }
     }
@@ -412,6 +422,7 @@ typedef struct merge {
     vdsh_file f;
     vdsh_stream streams[VDSH_MAX_STREAMS];
     uint32_t count, V;
+    uint32_t threads; /* the cpca encoder's (0: one per CPU) */
 } merge;
 
 /* The whole file from the first part, m->p0: its receivers, with every
@@ -561,6 +572,7 @@ static int merge_streams(merge *m)
              * (bake/lib/job.c) writes it. */
             /* as the bake's, with the pool it placed (lpol) */
             vdsh_cpca_settings st = vdsh_cpca_part_settings(m->p0);
+            st.threads = m->threads;
             vdsh_stream f32 = m->streams[s];
             f32.encoding = VDSH_ENCODING_F32;
             f32.scale = 1.0f;
@@ -704,7 +716,7 @@ static int run(const options *o)
     int rc = check_outputs(o);
     if (rc)
         return rc;
-    merge m = {0};
+    merge m = {.threads = o->threads};
     int status = 1;
     quiet_merge = o->quiet;
     for (int i = 0; i < o->part_count; i++) {
