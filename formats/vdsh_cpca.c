@@ -43,6 +43,24 @@ vdsh_cpca_settings vdsh_cpca_settings_default(void)
     return s;
 }
 
+void vdsh_cpca_settings_text(const vdsh_cpca_settings *s, char *buf, size_t size)
+{
+    char t[192]; /* the longest: 10-digit numbers, %g at most 13 characters */
+    int n;
+    if (!s->clusters)
+        n = snprintf(t, sizeof t, "auto:%u", s->budget);
+    else if (s->budget)
+        n = snprintf(t, sizeof t, "%u,alloc:%u", s->clusters, s->budget);
+    else
+        n = snprintf(t, sizeof t, "%u,%u,%u", s->clusters, s->basis, s->bits);
+    n += snprintf(t + n, sizeof t - (size_t)n, ",light:%g", (double)s->light_mix);
+    if (s->margin > 0.0f)
+        n += snprintf(t + n, sizeof t - (size_t)n, ",margin:%g", (double)s->margin);
+    if (s->starts)
+        snprintf(t + n, sizeof t - (size_t)n, ",starts:%u", s->starts);
+    snprintf(buf, size, "%s", t);
+}
+
 static int check_light(const vdsh_cpca_settings *s, vdsh_error *err)
 {
     if (!(s->light_mix >= 0.0f && s->light_mix <= 1.0f)) {

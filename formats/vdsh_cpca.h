@@ -143,6 +143,12 @@ typedef struct vdsh_cpca_settings {
  * do nothing. */
 vdsh_cpca_settings vdsh_cpca_settings_default(void);
 
+/* s as the text vdsh_cpca_parse reads back (the pool aside): "K,B,BITS",
+ * "auto:BYTES" or "K,alloc:BYTES", then ",light:A", and ",margin:S" and
+ * ",starts:N" when set (16,alloc:32,light:1,margin:0.25,starts:2), into
+ * buf (truncated to size). vdsh-bake's and vdsh-info's words for a fit. */
+void vdsh_cpca_settings_text(const vdsh_cpca_settings *s, char *buf, size_t size);
+
 /* Parse "K,B,BITS" (for example "8,54,4"), "auto" (budget 32),
  * "auto:BYTES" (1..VDSH_CPCA_MAX_BUDGET) or "K,alloc:BYTES", each
  * followed by options, each once, in any order: ",light:A" (A in 0..1,

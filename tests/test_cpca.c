@@ -826,6 +826,26 @@ static void light_metric(void)
                   p.starts == 0,
               "%s said: not one start without the margin", text);
     }
+    /* vdsh_cpca_settings_text: what parse reads back as the same settings */
+    {
+        static const char *const texts[] = {"8,52,4,light:.25",     "auto:24",
+                                            "margin:0.5",           "3,alloc:16,light:0",
+                                            "16,alloc:32,starts:3", "light:0"};
+        for (size_t i = 0; i < sizeof texts / sizeof texts[0]; i++) {
+            vdsh_cpca_settings a, b;
+            char text[192];
+            CHECK(vdsh_cpca_parse(texts[i], &a, &err) == VDSH_OK, "%s: %s", texts[i], err.msg);
+            vdsh_cpca_settings_text(&a, text, sizeof text);
+            CHECK(vdsh_cpca_parse(text, &b, &err) == VDSH_OK && !memcmp(&a, &b, sizeof a),
+                  "%s: its text %s reads back as other settings (%s)", texts[i], text, err.msg);
+        }
+        char text[192], small[8];
+        vdsh_cpca_settings_text(&d, text, sizeof text);
+        vdsh_cpca_settings_text(&d, small, sizeof small);
+        CHECK(!strcmp(text, "16,alloc:32,light:1,margin:0.25,starts:2") &&
+                  !strcmp(small, "16,allo"),
+              "the default's text %s (truncated: %s)", text, small);
+    }
     CHECK(vdsh_cpca_parse("starts:1", &p, &err) == VDSH_OK && p.clusters == d.clusters &&
               p.budget == d.budget && p.margin == d.margin && p.starts == 1,
           "starts:1 alone: not the default's margin with one start");

@@ -69,8 +69,12 @@ assert c["bits"] == 0 and len(c["widths"]) == c["basis"] and 2 <= min(c["widths"
 expect_exit 0 "default cpca, 1 thread" "$bake" "${tiny[@]}" --encoding cpca --threads 1 -o "$tmp/d1.vdsh"
 expect_exit 0 "default cpca, 2 threads" "$bake" "${tiny[@]}" --encoding cpca --threads 2 -o "$tmp/d2.vdsh"
 check "default cpca, 1 and 2 threads: identical" cmp "$tmp/d1.vdsh" "$tmp/d2.vdsh"
-expect_exit 0 "default cpca, 5 threads" "$bake" "${tiny[@]}" --encoding cpca --threads 5 -o "$tmp/d5.vdsh"
+expect_exit 0 "default cpca, 5 threads" "$bake" builtin:room --max-edge 1.0 --rays 64 \
+  --cube-size 0 --orders 3,7 --encoding cpca --threads 5 -o "$tmp/d5.vdsh"
 check "default cpca, 1 and 5 threads (each start's fit on 2): identical" cmp "$tmp/d1.vdsh" "$tmp/d5.vdsh"
+# the encode, most of a high order's bake, is said before and after
+says_any "the cpca fit announced" "cpca: fitting 16,alloc:32,light:1,margin:0.25,starts:2 over"
+says_any "the cpca fit's time" "cpca: fitted in"
 mkdir -p "$tmp/d3"
 for i in 0 1 2; do
   expect_exit 0 "default cpca shard $i/3" "$bake" "${tiny[@]}" --encoding cpca --shard "$i/3" \

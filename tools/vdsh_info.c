@@ -14,6 +14,7 @@
  * the decoded structs (and, for --verify, vdsh_scan_chunks' list).
  */
 #include "vdsh.h"
+#include "vdsh_cpca.h"
 #include "vdsh_output.h"
 #include "vt_cli.h"
 #include "vt_json.h"
@@ -369,20 +370,11 @@ static void print_part(const vdsh_file *f)
            vdsh_encoding_name(f->part.encoding));
     if (f->part.encoding != VDSH_ENCODING_CPCA)
         return;
-    /* the light mix and its pool: the lpol chunk's (none: light:0) */
-    const double mix = f->has_light_pool ? (double)f->light_pool.mix : 0.0;
-    if (!f->part.cpca_clusters)
-        printf("               cpca auto:%u", f->part.cpca_basis);
-    else if (!f->part.cpca_bits)
-        printf("               cpca %u,alloc:%u", f->part.cpca_clusters, f->part.cpca_basis);
-    else
-        printf("               cpca %u,%u,%u", f->part.cpca_clusters, f->part.cpca_basis,
-               f->part.cpca_bits);
-    printf(",light:%g", mix);
-    if (f->has_light_pool && f->light_pool.margin > 0.0f)
-        printf(",margin:%g", (double)f->light_pool.margin);
-    if (f->has_light_pool && f->light_pool.starts)
-        printf(",starts:%u", f->light_pool.starts);
+    /* the settings, the light mix and its pool the lpol chunk's (none: light:0) */
+    const vdsh_cpca_settings st = vdsh_cpca_part_settings(f);
+    char text[192];
+    vdsh_cpca_settings_text(&st, text, sizeof text);
+    printf("               cpca %s", text);
     printf(" (fitted at the merge");
     if (f->has_light_pool)
         printf("; light pool of %u light%s", f->light_pool.count, vdsh_s(f->light_pool.count));

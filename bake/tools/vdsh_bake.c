@@ -1759,13 +1759,28 @@ static int run(const options *o)
         goto out;
     }
 
-    /* 4. The file: streams, header and all, filled by the core. */
+    /* 4. The file: streams, header and all, filled by the core (cpca's
+     * global step, most of a high order's bake, said before and after). */
+    const int say_cpca = log && o->encoding == VDSH_ENCODING_CPCA && !o->shard_count;
+    if (say_cpca) {
+        const vdsh_cpca_settings st = vb_job_cpca_settings(&job, &jd);
+        char text[192];
+        vdsh_cpca_settings_text(&st, text, sizeof text);
+        const int no_pool = st.light_mix > 0.0f && !st.light_count;
+        fprintf(log, "vdsh-bake: cpca: fitting %s over %u receiver%s%s\n", text,
+                job.receivers.vertex_count, vdsh_s(job.receivers.vertex_count),
+                no_pool         ? " (no light pool in this scene: the uniform metric, one start)"
+                : st.starts > 1 ? " (each start a fit, then the pool's decisions pick one)"
+                                : "");
+    }
     double t = vb_now();
     if (vb_bake_fill_file(&job, &jd, &err) != VB_OK) {
         fprintf(stderr, "vdsh-bake: %s\n", err.msg);
         goto out;
     }
     const double encode_seconds = vb_now() - t;
+    if (say_cpca)
+        fprintf(log, "vdsh-bake: cpca: fitted in %.1f s\n", encode_seconds);
 
     /* 5. The distance volume, if asked: baked and written beside the
      * output before it, so the .vdsh is still the last file to appear. */
