@@ -1267,6 +1267,33 @@ static uint32_t vertex_hemisphere(const fit_ctx *f, refine_ctx *r, uint32_t v)
     return nh;
 }
 
+enum { MAX_WORKERS = 64 };
+
+/* The CPUs settings' threads stand for (0: one per CPU online), 1 ..
+ * MAX_WORKERS. */
+static uint32_t thread_budget(uint32_t threads)
+{
+    long cpus = threads ? (long)threads : sysconf(_SC_NPROCESSORS_ONLN);
+    return cpus < 1 ? 1u : cpus > MAX_WORKERS ? (uint32_t)MAX_WORKERS : (uint32_t)cpus;
+}
+
+/* fn on each of n workers (items of `size` bytes from items, n at most
+ * MAX_WORKERS): worker 0 on this thread, the others on threads of their
+ * own; one whose thread cannot start runs here too. */
+static void run_workers(void *items, size_t size, uint32_t n, void *(*fn)(void *))
+{
+    pthread_t tid[MAX_WORKERS];
+    int started[MAX_WORKERS] = {0};
+    for (uint32_t i = 1; i < n; i++)
+        started[i] = pthread_create(&tid[i], NULL, fn, (char *)items + i * size) == 0;
+    for (uint32_t i = 0; i < n; i++)
+        if (!started[i])
+            fn((char *)items + i * size);
+    for (uint32_t i = 1; i < n; i++)
+        if (started[i])
+            pthread_join(tid[i], NULL);
+}
+
 /* ---- one fit on threads ----
  *
  * fit_all's clusters and reassign's vertices are independent: worker w of
@@ -1303,10 +1330,8 @@ static void fit_workers_free(fit_worker *w, uint32_t workers)
  * memory. */
 static fit_worker *fit_workers(fit_ctx *f, refine_ctx *r, uint32_t jobs, uint32_t *workers)
 {
-    long cpus = f->threads ? (long)f->threads : sysconf(_SC_NPROCESSORS_ONLN);
-    if (cpus > 64)
-        cpus = 64;
-    const uint32_t nw = cpus < 1 || jobs < 1 ? 1u : cpus < (long)jobs ? (uint32_t)cpus : jobs;
+    const uint32_t cpus = thread_budget(f->threads);
+    const uint32_t nw = jobs < 1 ? 1u : cpus < jobs ? cpus : jobs;
     fit_worker *w = calloc(nw, sizeof *w);
     *workers = nw;
     if (!w)
@@ -1349,22 +1374,6 @@ static fit_worker *fit_workers(fit_ctx *f, refine_ctx *r, uint32_t jobs, uint32_
     return w;
 }
 
-/* fn on each worker: worker 0 on this thread, the others on threads of
- * their own (one that cannot start runs here too). */
-static void run_fit_workers(fit_worker *w, uint32_t workers, void *(*fn)(void *))
-{
-    pthread_t tid[64];
-    int started[64] = {0};
-    for (uint32_t i = 1; i < workers; i++)
-        started[i] = pthread_create(&tid[i], NULL, fn, &w[i]) == 0;
-    for (uint32_t i = 0; i < workers; i++)
-        if (!started[i])
-            fn(&w[i]);
-    for (uint32_t i = 1; i < workers; i++)
-        if (started[i])
-            pthread_join(tid[i], NULL);
-}
-
 static void *fit_clusters_run(void *arg)
 {
     fit_worker *w = arg;
@@ -1390,7 +1399,7 @@ static vdsh_result fit_all(fit_ctx *f, vdsh_error *err)
             w[i].res = res;
             w[i].errs = errs;
         }
-        run_fit_workers(w, workers, fit_clusters_run);
+        run_workers(w, sizeof *w, workers, fit_clusters_run);
         for (uint32_t c = 0; c < k && r == VDSH_OK; c++)
             if ((r = res[c]) != VDSH_OK && err)
                 *err = errs[c];
@@ -1436,7 +1445,7 @@ static vdsh_result reassign(fit_ctx *f, refine_ctx *r, uint32_t *moved, vdsh_err
     fit_worker *w = fit_workers(f, r, f->rows, &workers);
     if (!w)
         return vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory for the fit's threads");
-    run_fit_workers(w, workers, reassign_run);
+    run_workers(w, sizeof *w, workers, reassign_run);
     for (uint32_t i = 0; i < workers; i++)
         *moved += w[i].moved;
     fit_workers_free(w, workers);
@@ -1911,11 +1920,9 @@ static vdsh_result encode_starts(const float *src, const float *normals, uint32_
     vdsh_cpca_pool_scores sc[VDSH_CPCA_MAX_STARTS];
     vdsh_result res[VDSH_CPCA_MAX_STARTS];
     vdsh_error errs[VDSH_CPCA_MAX_STARTS];
-    pthread_t tid[VDSH_CPCA_MAX_STARTS];
-    int started[VDSH_CPCA_MAX_STARTS] = {0};
     memset(fits, 0, sizeof fits);
-    long cpus = settings->threads ? (long)settings->threads : sysconf(_SC_NPROCESSORS_ONLN);
-    const uint32_t workers = cpus < 1 ? 1u : cpus < (long)count ? (uint32_t)cpus : count;
+    const uint32_t cpus = thread_budget(settings->threads);
+    const uint32_t workers = cpus < count ? cpus : count;
     for (uint32_t i = 0; i < count; i++)
         res[i] = VDSH_ERR_OUT_OF_MEMORY;
     lightmix shared = {0};
@@ -1929,22 +1936,15 @@ static vdsh_result encode_starts(const float *src, const float *normals, uint32_
                                  .refit = refit,
                                  .index = w,
                                  .workers = workers,
-                                 .threads = cpus / workers > 1 ? (uint32_t)(cpus / workers) : 1,
+                                 .threads = cpus / workers,
                                  .settings = settings,
                                  .fits = fits,
                                  .res = res,
                                  .errs = errs};
         ok = ok && lightmix_view(&shared, &work[w].view);
     }
-    /* worker 0 on this thread; a thread that cannot start runs here too */
-    for (uint32_t w = 1; ok && w < workers; w++)
-        started[w] = pthread_create(&tid[w], NULL, start_worker_run, &work[w]) == 0;
-    for (uint32_t w = 0; ok && w < workers; w++)
-        if (!started[w])
-            start_worker_run(&work[w]);
-    for (uint32_t w = 1; w < workers; w++)
-        if (started[w])
-            pthread_join(tid[w], NULL);
+    if (ok)
+        run_workers(work, sizeof *work, workers, start_worker_run);
     for (uint32_t w = 0; work && w < workers; w++)
         lightmix_free(&work[w].view);
     free(work);
