@@ -1145,7 +1145,29 @@ typedef struct refine_ctx {
     double *dw;     /* count: the light-density weights of the vertex's directions, or NULL */
 } refine_ctx;
 
-static int refine_init(refine_ctx *r, uint32_t order, uint32_t k, uint32_t b, uint32_t rows)
+/* r's scratch for one vertex at a time (xval, w for b vectors, hemi, and
+ * dw with the light-density metric) over r->rd's directions: 1, or 0 out
+ * of memory (free it with refine_scratch_free either way). */
+static int refine_scratch(refine_ctx *r, uint32_t b, int dw)
+{
+    const uint32_t count = r->rd.count;
+    r->xval = malloc(sizeof(double) * count);
+    r->w = malloc(sizeof(double) * b);
+    r->hemi = malloc(sizeof(uint32_t) * count);
+    r->dw = dw ? malloc(sizeof(double) * count) : NULL;
+    return r->xval && r->w && r->hemi && (!dw || r->dw);
+}
+
+static void refine_scratch_free(refine_ctx *r)
+{
+    free(r->xval);
+    free(r->w);
+    free(r->hemi);
+    free(r->dw);
+}
+
+/* dw: the light-density metric's weights too. */
+static int refine_init(refine_ctx *r, uint32_t order, uint32_t k, uint32_t b, uint32_t rows, int dw)
 {
     memset(r, 0, sizeof *r);
     if (!metric_init(&r->rd, order, REFINE_CUBE_N))
@@ -1153,11 +1175,8 @@ static int refine_init(refine_ctx *r, uint32_t order, uint32_t k, uint32_t b, ui
     uint32_t count = r->rd.count;
     r->mval = malloc(sizeof(double) * k * count);
     r->bval = malloc(sizeof(double) * k * count * b);
-    r->xval = malloc(sizeof(double) * count);
-    r->w = malloc(sizeof(double) * b);
-    r->hemi = malloc(sizeof(uint32_t) * count);
     r->next = malloc(sizeof(uint32_t) * rows);
-    return r->mval && r->bval && r->xval && r->w && r->hemi && r->next;
+    return refine_scratch(r, b, dw) && r->mval && r->bval && r->next;
 }
 
 static void refine_free(refine_ctx *r)
@@ -1165,11 +1184,8 @@ static void refine_free(refine_ctx *r)
     metric_free(&r->rd);
     free(r->mval);
     free(r->bval);
-    free(r->xval);
-    free(r->w);
-    free(r->hemi);
     free(r->next);
-    free(r->dw);
+    refine_scratch_free(r);
 }
 
 /* The squared error of a vertex's reconstruction by cluster c with the
@@ -1316,10 +1332,7 @@ static void fit_workers_free(fit_worker *w, uint32_t workers)
 {
     for (uint32_t i = 1; w && i < workers; i++) {
         fit_ctx_scratch_free(&w[i].f);
-        free(w[i].r.xval);
-        free(w[i].r.w);
-        free(w[i].r.hemi);
-        free(w[i].r.dw);
+        refine_scratch_free(&w[i].r);
         lightmix_free(&w[i].view);
     }
     free(w);
@@ -1352,16 +1365,7 @@ static fit_worker *fit_workers(fit_ctx *f, refine_ctx *r, uint32_t jobs, uint32_
         w[i].r.hemi = NULL;
         if (!ok)
             continue;
-        if (r) {
-            const uint32_t count = r->rd.count;
-            w[i].r.xval = malloc(sizeof(double) * count);
-            w[i].r.w = malloc(sizeof(double) * f->b);
-            w[i].r.hemi = malloc(sizeof(uint32_t) * count);
-            w[i].r.dw = r->dw ? malloc(sizeof(double) * count) : NULL;
-            ok = w[i].r.xval && w[i].r.w && w[i].r.hemi && (!r->dw || w[i].r.dw);
-        } else {
-            ok = fit_ctx_scratch(c);
-        }
+        ok = r ? refine_scratch(&w[i].r, f->b, r->dw != NULL) : fit_ctx_scratch(c);
         if (ok && f->lm) {
             ok = lightmix_view(f->lm, &w[i].view);
             c->lm = &w[i].view;
@@ -1591,17 +1595,10 @@ static int fit_scratch_alloc(fit_scratch *s, const float *src, const float *norm
     if (lm < 0)
         return 0;
     f->lm = shared ? shared : lm ? &s->lm : NULL;
-    if (lm && need_rd) {
-        if (!refine_init(&s->rd, order, k, b, rows))
-            return 0;
-        s->rd.dw = malloc(sizeof(double) * s->rd.rd.count);
-        if (!s->rd.dw)
-            return 0;
-        need_rd = 0; /* done */
-    }
+    if (need_rd && !refine_init(&s->rd, order, k, b, rows, lm))
+        return 0;
     return scratch && f->labels && f->means && f->bases && f->members && f->mus && f->proj &&
-           s->mu && s->dist && s->cent && metric_init(&s->md, order, CUBE_N) &&
-           (!need_rd || refine_init(&s->rd, order, k, b, rows));
+           s->mu && s->dist && s->cent && metric_init(&s->md, order, CUBE_N);
 }
 
 /* Clusters by k-means on the coefficients plus the normals (weighted by

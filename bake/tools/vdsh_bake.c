@@ -998,9 +998,9 @@ static int read_choice(int c, const char *arg, options *o)
                 msg, sizeof msg,
                 "--cpca takes K,B,BITS: clusters 1..256, basis vectors 1..256, bits 2..8, "
                 "or auto or auto:BYTES, or K,alloc:BYTES (a width per basis vector), bytes "
-                "per vertex 1..4096 (default 16,alloc:32,margin:0.25,starts:2), each optionally ending in "
-                ",light:A (the light mix A in 0..1), and K,alloc:BYTES in ,margin:S (S > 0) "
-                "and ,starts:N (1..16), or those options alone: %s",
+                "per vertex 1..4096 (default 16,alloc:32,margin:0.25,starts:2), each optionally "
+                "ending in ,light:A (the light mix A in 0..1), and K,alloc:BYTES in ,margin:S "
+                "(S > 0) and ,starts:N (1..16), or those options alone: %s",
                 e.msg);
             return bad_usage("%s", msg);
         }
