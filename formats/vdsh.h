@@ -236,18 +236,26 @@ typedef struct vdsh_source {
  * + sum over j = 0..B-1 in order of w_j * basis_j[i], each product and
  * sum rounded to f32. */
 typedef struct vdsh_cpca {
-    uint32_t clusters;     /* K, 1..VDSH_CPCA_MAX_CLUSTERS */
-    uint32_t basis;        /* B, 1..order^2 */
-    uint32_t bits;         /* per weight, VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS, or 0:
+    uint32_t clusters; /* K, 1..VDSH_CPCA_MAX_CLUSTERS */
+    uint32_t basis;    /* B, 1..order^2 */
+    uint32_t bits;     /* per weight, VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS, or 0:
                               a width per basis vector (widths) */
+    /* 1: the bases are s8 (bases8, -127..127, the value the integer; the
+     * header's bits word has VDSH_CPCA_BASES_S8 set), 0: f16 (bases) */
+    uint32_t bases_s8;
     uint32_t record_words; /* W = vdsh_cpca_record_words(basis, bits), or with
                               bits 0 vdsh_cpca_widths_words(widths, basis) */
     const uint8_t *widths; /* bits 0: B widths, each 2..8; else NULL */
     const float *scales;   /* K * B: vector j of cluster c at c * B + j */
     const uint16_t *means; /* f16, K * order^2: cluster c's at c * order^2 */
-    /* f16, K * B * order^2: vector j of cluster c at (c * B + j) * order^2 */
+    /* f16 (bases_s8 0) or s8 (bases_s8 1), K * B * order^2: vector j of
+     * cluster c at (c * B + j) * order^2; the other NULL */
     const uint16_t *bases;
+    const int8_t *bases8;
 } vdsh_cpca;
+/* In the cpca header's bits word: the bases are s8 (VDSH.md "cpca
+ * streams"); in a part's cpca_bits, K,alloc:BYTES with s8 bases. */
+#define VDSH_CPCA_BASES_S8 0x100u
 #define VDSH_CPCA_MAX_CLUSTERS 256
 #define VDSH_CPCA_MIN_BITS 2
 #define VDSH_CPCA_MAX_BITS 8
@@ -472,8 +480,10 @@ static inline float vdsh_cpca_step(float scale, uint32_t bits)
     return scale / (float)vdsh_cpca_levels(bits);
 }
 /* Bytes between the 48-byte stream header and the records: the 16-byte
- * cpca header, the scales, means and bases, each padded to 16. */
-uint64_t vdsh_cpca_model_bytes(uint32_t order, uint32_t clusters, uint32_t basis);
+ * cpca header, the scales, means and bases (f16, or s8 with bases_s8),
+ * each padded to 16. */
+uint64_t vdsh_cpca_model_bytes(uint32_t order, uint32_t clusters, uint32_t basis,
+                               uint32_t bases_s8);
 /* The same for model m (either form: with bits 0 the widths table, B
  * bytes padded to 16, too). */
 uint64_t vdsh_cpca_stream_model_bytes(const vdsh_cpca *m, uint32_t order);
@@ -520,6 +530,12 @@ uint64_t vdsh_stream_data_bytes(const vdsh_stream *s, uint32_t rows);
  * (the caller checks), NaN stays NaN. */
 uint16_t vdsh_f16_from_f32(float f);
 float vdsh_f32_from_f16(uint16_t h);
+/* Basis value i (index (c * B + j) * order^2 + coefficient) of model m as
+ * f32: the f16 widened, or the s8 integer. */
+static inline float vdsh_cpca_basis_value(const vdsh_cpca *m, size_t i)
+{
+    return m->bases_s8 ? (float)m->bases8[i] : vdsh_f32_from_f16(m->bases[i]);
+}
 
 /* Encode n floats to f16 as value / scale. Returns VDSH_ERR_INVALID if an
  * input is not finite or a result overflows f16; dst is then unspecified. */

@@ -432,10 +432,12 @@ static int check_cpca_data(const vdsh_stream *s, const char *l, uint32_t v, why 
             return vdsh_bad(w, "%s: cpca mean of cluster %zu coefficient %zu is not finite", l,
                             k / n, k % n);
     for (size_t k = 0; k < (size_t)m->clusters * b * n; k++)
-        if ((m->bases[k] & 0x7c00u) == 0x7c00u)
+        if (m->bases_s8 ? m->bases8[k] == -128 : (m->bases[k] & 0x7c00u) == 0x7c00u)
             return vdsh_bad(w,
-                            "%s: cpca basis vector %zu of cluster %zu, coefficient %zu, is "
-                            "not finite",
+                            m->bases_s8 ? "%s: cpca basis vector %zu of cluster %zu, coefficient "
+                                          "%zu, is -128 (s8 bases: -127..127)"
+                                        : "%s: cpca basis vector %zu of cluster %zu, coefficient "
+                                          "%zu, is not finite",
                             l, (k / n) % b, k / n / b, k % n);
     for (uint32_t c = 0; c < m->clusters; c++)
         for (uint32_t i = 0; i < n; i++) {
@@ -444,7 +446,7 @@ static int check_cpca_data(const vdsh_stream *s, const char *l, uint32_t v, why 
                 bound +=
                     (double)vdsh_cpca_levels(vdsh_cpca_width(m, j)) *
                     (double)vdsh_cpca_step(m->scales[(size_t)c * b + j], vdsh_cpca_width(m, j)) *
-                    fabs((double)vdsh_f32_from_f16(m->bases[((size_t)c * b + j) * n + i]));
+                    fabs((double)vdsh_cpca_basis_value(m, ((size_t)c * b + j) * n + i));
             if (!(bound <= 1e38))
                 return vdsh_bad(w, "%s: cpca cluster %u coefficient %u can reach %g, beyond 1e38",
                                 l, c, i, bound);
@@ -522,12 +524,13 @@ int vdsh_check_part(const vdsh_part *t, uint32_t vertex_count, why *w)
             return vdsh_bad(w, "part: cpca settings %u,%u,%u with encoding %s (must be 0)",
                             t->cpca_clusters, t->cpca_basis, t->cpca_bits,
                             vdsh_encoding_name(t->encoding));
-    } else if (!t->cpca_clusters || !t->cpca_bits) { /* auto: 0, budget, 0; alloc: K, budget, 0 */
-        if (t->cpca_basis < 1 || t->cpca_basis > VDSH_CPCA_MAX_BUDGET || t->cpca_bits ||
-            t->cpca_clusters > VDSH_CPCA_MAX_CLUSTERS)
+    } else if (!t->cpca_clusters || !t->cpca_bits || t->cpca_bits == VDSH_CPCA_BASES_S8) {
+        /* auto: 0, budget, 0; alloc: K, budget, 0 or VDSH_CPCA_BASES_S8 (s8 bases) */
+        if (t->cpca_basis < 1 || t->cpca_basis > VDSH_CPCA_MAX_BUDGET ||
+            (t->cpca_bits && !t->cpca_clusters) || t->cpca_clusters > VDSH_CPCA_MAX_CLUSTERS)
             return vdsh_bad(w,
                             "part: cpca auto settings %u,%u,%u out of range (K 0..%d, budget "
-                            "1..%d, 0)",
+                            "1..%d, 0, or 256 with K: s8 bases)",
                             t->cpca_clusters, t->cpca_basis, t->cpca_bits, VDSH_CPCA_MAX_CLUSTERS,
                             VDSH_CPCA_MAX_BUDGET);
     } else if (t->cpca_clusters > VDSH_CPCA_MAX_CLUSTERS || t->cpca_basis < 1 ||
@@ -552,7 +555,8 @@ int vdsh_check_light_pool(const vdsh_light_pool *l, int has_part, const vdsh_par
                         (double)VDSH_CPCA_MAX_MARGIN);
     if (l->starts > VDSH_CPCA_MAX_STARTS)
         return vdsh_bad(w, "lpol: %u starts, out of range 0..%d", l->starts, VDSH_CPCA_MAX_STARTS);
-    if ((l->margin > 0.0f || l->starts) && (!part->cpca_clusters || part->cpca_bits))
+    if ((l->margin > 0.0f || l->starts) &&
+        (!part->cpca_clusters || (part->cpca_bits & ~VDSH_CPCA_BASES_S8)))
         return vdsh_bad(w, "lpol: a margin or starts with cpca settings other than "
                            "K,alloc:BYTES");
     if (l->count < 1 || l->count > VDSH_MAX_POOL_LIGHTS)

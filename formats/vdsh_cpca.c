@@ -57,7 +57,9 @@ void vdsh_cpca_settings_text(const vdsh_cpca_settings *s, char *buf, size_t size
     if (s->margin > 0.0f)
         n += snprintf(t + n, sizeof t - (size_t)n, ",margin:%g", (double)s->margin);
     if (s->starts)
-        snprintf(t + n, sizeof t - (size_t)n, ",starts:%u", s->starts);
+        n += snprintf(t + n, sizeof t - (size_t)n, ",starts:%u", s->starts);
+    if (s->bases_s8)
+        snprintf(t + n, sizeof t - (size_t)n, ",bases:8");
     snprintf(buf, size, "%s", t);
 }
 
@@ -148,12 +150,13 @@ static int parse_decimal(const char *p, double *x)
 }
 
 /* The options a setting may end in (vdsh_cpca_parse), each once. */
-static const char *const OPTIONS[] = {"light:", "margin:", "starts:"};
+static const char *const OPTIONS[] = {"light:", "margin:", "starts:", "bases:"};
+enum { NOPTIONS = 4 };
 
 /* The option token p names (its index in OPTIONS), or -1. */
 static int option_of(const char *p)
 {
-    for (int i = 0; i < 3; i++)
+    for (int i = 0; i < NOPTIONS; i++)
         if (strncmp(p, OPTIONS[i], strlen(OPTIONS[i])) == 0)
             return i;
     return -1;
@@ -179,8 +182,8 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
         if (r != VDSH_OK)
             return r;
     }
-    double value[3];
-    int said[3] = {0, 0, 0};
+    double value[NOPTIONS];
+    int said[NOPTIONS] = {0, 0, 0, 0};
     for (char *tok = opts; tok;) {
         char *next = strchr(tok, ',');
         if (next)
@@ -190,14 +193,15 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
             o >= 0 && !said[o] && parse_decimal(tok + strlen(OPTIONS[o]), &value[o]) &&
             (o == 0   ? value[0] <= 1.0
              : o == 1 ? value[1] > 0.0 && value[1] <= VDSH_CPCA_MAX_MARGIN
-                      : value[2] >= 1.0 && value[2] <= VDSH_CPCA_MAX_STARTS && !strchr(tok, '.'));
+             : o == 2 ? value[2] >= 1.0 && value[2] <= VDSH_CPCA_MAX_STARTS && !strchr(tok, '.')
+                      : (value[3] == 8.0 || value[3] == 16.0) && !strchr(tok, '.'));
         if (!ok)
-            return vdsh_failf(
-                err, VDSH_ERR_ARGUMENT,
-                "cpca settings '%s': '%s': expected options at the end, each "
-                "once: light:A (the light mix, 0..1), margin:S (S > 0, at most 1e6) or "
-                "starts:N (1..%d) (for example 16,alloc:32,margin:0.25,starts:2)",
-                p, tok, VDSH_CPCA_MAX_STARTS);
+            return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                              "cpca settings '%s': '%s': expected options at the end, each "
+                              "once: light:A (the light mix, 0..1), margin:S (S > 0, at most 1e6), "
+                              "starts:N (1..%d) or bases:8|16 (the bases' bits) (for example "
+                              "16,alloc:32,margin:0.25,starts:2)",
+                              p, tok, VDSH_CPCA_MAX_STARTS);
         said[o] = 1;
         tok = next;
     }
@@ -210,11 +214,15 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
     const int deflt = !base && s.light_mix > 0.0f;
     s.margin = said[1] ? (float)value[1] : deflt ? VDSH_CPCA_DEFAULT_MARGIN : 0.0f;
     s.starts = said[2] ? (uint32_t)value[2] : deflt ? VDSH_CPCA_DEFAULT_STARTS : 0;
+    s.bases_s8 = said[3] ? value[3] == 8.0 : 0;
     if ((said[1] || said[2]) && !(s.budget && s.clusters && s.light_mix > 0.0f))
         return vdsh_failf(err, VDSH_ERR_ARGUMENT,
                           "cpca settings '%s': margin:S and starts:N need K,alloc:BYTES with a "
                           "light mix above 0 (they use the light pool)",
                           p);
+    if (said[3] && !(s.budget && s.clusters))
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT,
+                          "cpca settings '%s': bases:8|16 needs K,alloc:BYTES", p);
     *out = s;
     return VDSH_OK;
 }
@@ -1792,7 +1800,7 @@ done:
 static uint64_t fit_bytes(uint32_t rows, uint32_t order, const vdsh_cpca_settings *s)
 {
     return (uint64_t)rows * 4 * vdsh_cpca_record_words(s->basis, s->bits) +
-           vdsh_cpca_model_bytes(order, s->clusters, s->basis);
+           vdsh_cpca_model_bytes(order, s->clusters, s->basis, s->bases_s8);
 }
 
 /* The largest basis (at most order^2) whose stream of `rows` rows with
@@ -1981,6 +1989,8 @@ vdsh_result vdsh_cpca_encode(const float *src, const float *normals, uint32_t ro
                           order);
     if (!check_settings(settings, err))
         return VDSH_ERR_ARGUMENT;
+    if (settings->bases_s8 && !(settings->budget && settings->clusters))
+        return vdsh_failf(err, VDSH_ERR_ARGUMENT, "cpca: s8 bases need K,alloc:BYTES");
     const uint32_t n = order * order;
     for (size_t x = 0; x < (size_t)rows * n; x++)
         if (!isfinite(src[x]))
@@ -2030,7 +2040,7 @@ void vdsh_cpca_part_record(const vdsh_cpca_settings *st, vdsh_file *f)
 {
     f->part.cpca_clusters = st->clusters;
     f->part.cpca_basis = st->budget ? st->budget : st->basis;
-    f->part.cpca_bits = st->budget ? 0 : st->bits;
+    f->part.cpca_bits = !st->budget ? st->bits : st->bases_s8 ? VDSH_CPCA_BASES_S8 : 0;
     f->has_light_pool = st->light_mix > 0.0f && st->light_count && st->lights;
     if (f->has_light_pool)
         f->light_pool = (vdsh_light_pool){.mix = st->light_mix,
@@ -2044,11 +2054,12 @@ vdsh_cpca_settings vdsh_cpca_part_settings(const vdsh_file *f)
 {
     const vdsh_part *pt = &f->part;
     vdsh_cpca_settings st = {.clusters = pt->cpca_clusters};
-    if (pt->cpca_bits) {
+    if (pt->cpca_bits & ~VDSH_CPCA_BASES_S8) {
         st.basis = pt->cpca_basis;
         st.bits = pt->cpca_bits;
     } else {
         st.budget = pt->cpca_basis;
+        st.bases_s8 = pt->cpca_bits == VDSH_CPCA_BASES_S8;
     }
     if (f->has_light_pool) {
         st.light_mix = f->light_pool.mix;
@@ -2097,10 +2108,11 @@ static void allocate_widths(const double *dist, uint32_t m, uint32_t bits, uint3
     }
 }
 
-/* Bytes of the model of k clusters and m vectors with a width table. */
-static uint64_t widths_model_bytes(uint32_t order, uint32_t k, uint32_t m)
+/* Bytes of the model of k clusters and m vectors (bases f16, or s8 with
+ * bases_s8) with a width table. */
+static uint64_t widths_model_bytes(uint32_t order, uint32_t k, uint32_t m, uint32_t bases_s8)
 {
-    return vdsh_cpca_model_bytes(order, k, m) + ((m + 15u) & ~15u);
+    return vdsh_cpca_model_bytes(order, k, m, bases_s8) + ((m + 15u) & ~15u);
 }
 
 static vdsh_result encode_widths(const float *src, const float *normals, uint32_t rows,
@@ -2177,7 +2189,8 @@ static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t
  * kept basis B are fitted again to its members' dequantised weights q_v
  * (least squares, [m B] = X Q^T (Q Q^T)^-1, Q's columns [1; q_v]: the
  * least error in any metric the members share, so in the cluster's
- * metric_gram_members Gram too), rounded to f16; the weights are then
+ * metric_gram_members Gram too), rounded to f16 (the basis to s8 with
+ * s8 bases: round_basis); the weights are then
  * the metric projections onto the new (not orthonormal) basis, the
  * scales chosen again, the weights quantised again. A round is kept only
  * when the cluster's error in its metric, decoded as every reader
@@ -2186,21 +2199,49 @@ static vdsh_result encode_alloc(const float *src, const float *normals, uint32_t
 typedef struct refit_ctx {
     const fit_ctx *f;
     uint32_t kb;
-    const uint8_t *wd;       /* kb widths */
-    uint32_t *mem;           /* rows: the cluster's members */
-    uint32_t count;          /* members */
-    double *g;               /* n x n: the cluster's metric */
-    double *a, *la;          /* (kb + 1)^2 */
-    double *cx;              /* n x (kb + 1) */
-    double *mb, *p;          /* kb x n */
-    double *gb, *lb;         /* kb x kb */
-    double *bd;              /* kb x n: the candidate basis, decoded */
-    double *md;              /* n: the candidate mean, decoded */
-    double *nw;              /* rows x kb: the candidate weights */
-    uint16_t *nmean, *nbase; /* n, kb x n: the candidate, stored */
-    float *nscale;           /* kb */
-    double *r;               /* n */
+    const uint8_t *wd; /* kb widths */
+    uint32_t *mem;     /* rows: the cluster's members */
+    uint32_t count;    /* members */
+    double *g;         /* n x n: the cluster's metric */
+    double *a, *la;    /* (kb + 1)^2 */
+    double *cx;        /* n x (kb + 1) */
+    double *mb, *p;    /* kb x n */
+    double *gb, *lb;   /* kb x kb */
+    double *bd;        /* kb x n: the candidate basis, decoded */
+    double *md;        /* n: the candidate mean, decoded */
+    double *nw;        /* rows x kb: the candidate weights */
+    uint16_t *nmean;   /* n: the candidate mean, stored */
+    float *nbase;      /* kb x n: the candidate basis, its stored values */
+    float *nscale;     /* kb */
+    double *r;         /* n */
+    uint32_t s8;       /* the bases are s8 */
 } refit_ctx;
+
+/* The n values x of one basis vector as the stream stores them, into out
+ * (each exactly an f16, or with s8 an integer -127..127: x over its
+ * largest |value|, times 127, rounded as weights are); 0 when a value does
+ * not fit f16. With s8 *gain is the vector's step, what the integers are
+ * multiplied by to give x (0 for a vector of zeros); else 1. */
+static int round_basis(const double *x, uint32_t n, uint32_t s8, float *out, double *gain)
+{
+    if (!s8) {
+        *gain = 1.0;
+        for (uint32_t a = 0; a < n; a++) {
+            uint16_t h = vdsh_f16_from_f32((float)x[a]);
+            if ((h & 0x7c00u) == 0x7c00u)
+                return 0;
+            out[a] = vdsh_f32_from_f16(h);
+        }
+        return 1;
+    }
+    double big = 0.0;
+    for (uint32_t a = 0; a < n; a++)
+        big = fabs(x[a]) > big ? fabs(x[a]) : big;
+    for (uint32_t a = 0; a < n; a++)
+        out[a] = (float)quantise(x[a], big, 127);
+    *gain = big / 127.0;
+    return 1;
+}
 
 /* The dequantised weight of w (scale s, width bits), as decoders have it. */
 static float dequantised(double w, float s, uint32_t bits)
@@ -2212,7 +2253,7 @@ static float dequantised(double w, float s, uint32_t bits)
 /* The cluster's error in its metric: the sum over its members of r^T G r,
  * r the source less the decoding of (mean, basis, scales, weights w, kb
  * per row). */
-static double refit_error(refit_ctx *rc, const uint16_t *mean, const uint16_t *basis,
+static double refit_error(refit_ctx *rc, const uint16_t *mean, const float *basis,
                           const float *scales, const double *w)
 {
     const fit_ctx *f = rc->f;
@@ -2226,9 +2267,9 @@ static double refit_error(refit_ctx *rc, const uint16_t *mean, const uint16_t *b
         for (uint32_t q = 0; q < kb; q++)
             wq[q] = dequantised(w[(size_t)v * kb + q], scales[q], rc->wd[q]);
         for (uint32_t q = 0; q < kb; q++) {
-            const uint16_t *bq = basis + (size_t)q * n;
+            const float *bq = basis + (size_t)q * n;
             for (uint32_t a = 0; a < n; a++)
-                o[a] = o[a] + wq[q] * vdsh_f32_from_f16(bq[a]);
+                o[a] = o[a] + wq[q] * bq[a];
         }
         const float *x = f->src + (size_t)v * n;
         for (uint32_t a = 0; a < n; a++)
@@ -2264,8 +2305,8 @@ static void chol_solve(const double *l, uint32_t m, double *y)
 /* One round for the cluster whose model is (mean, basis, scales) and
  * weights w: the candidate in rc->nmean, nbase, nscale, nw; 0 when none
  * (a singular system, or a value that does not fit f16). */
-static int refit_round(refit_ctx *rc, const uint16_t *mean, const uint16_t *basis,
-                       const float *scales, const double *w)
+static int refit_round(refit_ctx *rc, const uint16_t *mean, const float *basis, const float *scales,
+                       const double *w)
 {
     const fit_ctx *f = rc->f;
     const uint32_t n = f->n, kb = rc->kb, m = kb + 1;
@@ -2320,15 +2361,18 @@ static int refit_round(refit_ctx *rc, const uint16_t *mean, const uint16_t *basi
         rc->nmean[a] = h;
         rc->md[a] = vdsh_f32_from_f16(h);
     }
-    for (uint32_t q = 0; q < kb; q++)
-        for (uint32_t a = 0; a < n; a++) {
-            uint16_t h = unused[q + 1] ? basis[(size_t)q * n + a]
-                                       : vdsh_f16_from_f32((float)rc->cx[(size_t)a * m + q + 1]);
-            if ((h & 0x7c00u) == 0x7c00u)
-                return 0;
-            rc->nbase[(size_t)q * n + a] = h;
-            rc->bd[(size_t)q * n + a] = vdsh_f32_from_f16(h);
-        }
+    for (uint32_t q = 0; q < kb; q++) {
+        float *nq = rc->nbase + (size_t)q * n;
+        double col[VDSH_MAX_COEFFS], gain;
+        for (uint32_t a = 0; a < n; a++)
+            col[a] = rc->cx[(size_t)a * m + q + 1];
+        if (unused[q + 1])
+            memcpy(nq, basis + (size_t)q * n, sizeof(float) * n);
+        else if (!round_basis(col, n, rc->s8, nq, &gain))
+            return 0;
+        for (uint32_t a = 0; a < n; a++)
+            rc->bd[(size_t)q * n + a] = nq[a];
+    }
     /* the metric projection: w = (B G B^T)^-1 B G (x - m) */
     for (uint32_t q = 0; q < kb; q++) /* mb = B G */
         for (uint32_t a = 0; a < n; a++) {
@@ -2379,11 +2423,11 @@ static int refit_round(refit_ctx *rc, const uint16_t *mean, const uint16_t *basi
  * weights w (rows x kb), in place; *before and *after (may be NULL) the
  * clusters' summed metric error before and after. 0 when out of memory. */
 static int refit_model(const fit_ctx *f, uint32_t kb, const uint8_t *wd, uint32_t rounds,
-                       uint16_t *means, uint16_t *bases, float *scales, double *w, double *before,
-                       double *after, uint32_t *kept)
+                       uint32_t s8, uint16_t *means, float *bases, float *scales, double *w,
+                       double *before, double *after, uint32_t *kept)
 {
     const uint32_t n = f->n, m = kb + 1, rows = f->rows;
-    refit_ctx rc = {.f = f, .kb = kb, .wd = wd};
+    refit_ctx rc = {.f = f, .kb = kb, .wd = wd, .s8 = s8};
     rc.mem = malloc(sizeof(uint32_t) * rows);
     rc.g = malloc(sizeof(double) * n * n);
     rc.a = malloc(sizeof(double) * m * m);
@@ -2397,7 +2441,7 @@ static int refit_model(const fit_ctx *f, uint32_t kb, const uint8_t *wd, uint32_
     rc.md = malloc(sizeof(double) * n);
     rc.nw = malloc(sizeof(double) * rows * kb);
     rc.nmean = malloc(sizeof(uint16_t) * n);
-    rc.nbase = malloc(sizeof(uint16_t) * kb * n);
+    rc.nbase = malloc(sizeof(float) * kb * n);
     rc.nscale = malloc(sizeof(float) * kb);
     rc.r = malloc(sizeof(double) * n);
     double *frac = malloc(sizeof(double) * f->md->count);
@@ -2413,8 +2457,8 @@ static int refit_model(const fit_ctx *f, uint32_t kb, const uint8_t *wd, uint32_
             if (f->labels[v] == c)
                 rc.mem[rc.count++] = v;
         metric_gram_members(f->md, f->normals, f->labels, rows, c, rc.count, frac, rc.g, f->lm);
-        uint16_t *mc = means + (size_t)c * n, *bc = bases + (size_t)c * kb * n;
-        float *sc = scales + (size_t)c * kb;
+        uint16_t *mc = means + (size_t)c * n;
+        float *bc = bases + (size_t)c * kb * n, *sc = scales + (size_t)c * kb;
         double e = refit_error(&rc, mc, bc, sc, w);
         e0 += e;
         for (uint32_t round = 0; round < rounds; round++) {
@@ -2426,7 +2470,7 @@ static int refit_model(const fit_ctx *f, uint32_t kb, const uint8_t *wd, uint32_
             e = en;
             nk++;
             memcpy(mc, rc.nmean, sizeof(uint16_t) * n);
-            memcpy(bc, rc.nbase, sizeof(uint16_t) * kb * n);
+            memcpy(bc, rc.nbase, sizeof(float) * kb * n);
             memcpy(sc, rc.nscale, sizeof(float) * kb);
             for (uint32_t i = 0; i < rc.count; i++)
                 memcpy(w + (size_t)rc.mem[i] * kb, rc.nw + (size_t)rc.mem[i] * kb,
@@ -2567,7 +2611,8 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
         for (uint32_t words = 1; words <= 64; words++) {
             uint32_t m = 0;
             while (m < bf &&
-                   (double)rows * 4.0 * words + (double)widths_model_bytes(order, k, m + 1) <=
+                   (double)rows * 4.0 * words +
+                           (double)widths_model_bytes(order, k, m + 1, settings->bases_s8) <=
                        limit)
                 m++;
             if (!m)
@@ -2615,8 +2660,9 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
         if (out->widths[j])
             out->basis = j + 1;
     out->words = vdsh_cpca_widths_words(out->widths, bf);
-    out->bytes_per_vertex =
-        ((double)rows * 4.0 * out->words + (double)widths_model_bytes(order, k, out->basis)) / rows;
+    out->bytes_per_vertex = ((double)rows * 4.0 * out->words +
+                             (double)widths_model_bytes(order, k, out->basis, settings->bases_s8)) /
+                            rows;
 
     if (fit) { /* the stream: the vectors of width > 0, in order */
         uint32_t kb = 0, keep[VDSH_MAX_COEFFS];
@@ -2626,54 +2672,60 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
         uint8_t wd[VDSH_MAX_COEFFS];
         for (uint32_t q = 0; q < kb; q++)
             wd[q] = (uint8_t)WIDTH_SET[best_level[keep[q]]];
-        const uint32_t words = vdsh_cpca_widths_words(wd, kb);
+        const uint32_t words = vdsh_cpca_widths_words(wd, kb), s8 = settings->bases_s8;
         size_t o_sc = ((size_t)kb + 15) & ~(size_t)15;
         size_t o_means = o_sc + (((size_t)k * kb * 4 + 15) & ~(size_t)15);
         size_t o_bases = o_means + (((size_t)k * n * 2 + 15) & ~(size_t)15);
-        size_t o_rec = o_bases + (((size_t)k * kb * n * 2 + 15) & ~(size_t)15);
+        size_t o_rec = o_bases + (((size_t)k * kb * n * (s8 ? 1 : 2) + 15) & ~(size_t)15);
         uint8_t *block = kb ? calloc(1, o_rec + (size_t)rows * words * 4) : NULL;
-        if (!block) {
+        /* the rows' weights on the kept vectors, the kept bases' stored values */
+        double *kw = malloc(sizeof(double) * rows * kb + 1);
+        float *bv = malloc(sizeof(float) * k * kb * n + 1);
+        if (!block || !kw || !bv) {
+            free(block);
+            free(kw);
+            free(bv);
             res = vdsh_failf(err, kb ? VDSH_ERR_OUT_OF_MEMORY : VDSH_ERR_ARGUMENT,
                              kb ? "cpca: out of memory" : "cpca: alloc kept no basis vector");
             goto done;
         }
         memcpy(block, wd, kb);
         float *sc_out = (float *)(block + o_sc);
-        uint16_t *me_out = (uint16_t *)(block + o_means), *ba_out = (uint16_t *)(block + o_bases);
+        uint16_t *me_out = (uint16_t *)(block + o_means);
         uint32_t *rec = (uint32_t *)(block + o_rec);
         memcpy(me_out, means, sizeof(uint16_t) * k * n);
         for (uint32_t c = 0; c < k; c++)
             for (uint32_t q = 0; q < kb; q++) {
                 uint32_t j = keep[q];
                 sc_out[(size_t)c * kb + q] = cscale[((size_t)c * bf + j) * NWIDTHS + best_level[j]];
-                memcpy(ba_out + ((size_t)c * kb + q) * n, bases + ((size_t)c * bf + j) * n,
-                       sizeof(uint16_t) * n);
+                for (uint32_t a = 0; a < n; a++)
+                    bv[((size_t)c * kb + q) * n + a] =
+                        vdsh_f32_from_f16(bases[((size_t)c * bf + j) * n + a]);
             }
-        fit->model = (vdsh_cpca){.clusters = k,
-                                 .basis = kb,
-                                 .bits = 0,
-                                 .record_words = words,
-                                 .widths = block,
-                                 .scales = sc_out,
-                                 .means = me_out,
-                                 .bases = ba_out};
-        /* the rows' weights on the kept vectors */
-        double *kw = malloc(sizeof(double) * rows * kb + 1);
-        if (!kw) {
-            free(block);
-            res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory");
-            goto done;
-        }
         for (uint32_t v = 0; v < rows; v++)
             for (uint32_t q = 0; q < kb; q++)
                 kw[(size_t)v * kb + q] = wts[(size_t)v * bf + keep[q]];
+        if (s8) /* each vector to s8, its step moved into its weights and scale */
+            for (uint32_t c = 0; c < k; c++)
+                for (uint32_t q = 0; q < kb; q++) {
+                    float *bq = bv + ((size_t)c * kb + q) * n;
+                    double x[VDSH_MAX_COEFFS], gain;
+                    for (uint32_t a = 0; a < n; a++)
+                        x[a] = bq[a];
+                    round_basis(x, n, 1, bq, &gain);
+                    sc_out[(size_t)c * kb + q] = (float)(sc_out[(size_t)c * kb + q] * gain);
+                    for (uint32_t v = 0; v < rows; v++)
+                        if (labels[v] == c)
+                            kw[(size_t)v * kb + q] *= gain;
+                }
         if (rep)
             memset(rep, 0, sizeof *rep);
         if (refit) {
             double e0, e1;
             uint32_t nk;
-            if (!refit_model(fc, kb, wd, refit, me_out, ba_out, sc_out, kw, &e0, &e1, &nk)) {
+            if (!refit_model(fc, kb, wd, refit, s8, me_out, bv, sc_out, kw, &e0, &e1, &nk)) {
                 free(kw);
+                free(bv);
                 free(block);
                 res = vdsh_failf(err, VDSH_ERR_OUT_OF_MEMORY, "cpca: out of memory");
                 goto done;
@@ -2682,6 +2734,26 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
                 *rep = (vdsh_cpca_refit_report){
                     .rounds = refit, .kept = nk, .metric_before = e0, .metric_after = e1};
         }
+        /* the bases as stored: every value of bv is exactly an f16, or an s8 */
+        int8_t *b8_out = s8 ? (int8_t *)(block + o_bases) : NULL;
+        uint16_t *ba_out = s8 ? NULL : (uint16_t *)(block + o_bases);
+        for (size_t x = 0; x < (size_t)k * kb * n; x++) {
+            if (s8)
+                b8_out[x] = (int8_t)bv[x];
+            else
+                ba_out[x] = vdsh_f16_from_f32(bv[x]);
+        }
+        free(bv);
+        fit->model = (vdsh_cpca){.clusters = k,
+                                 .basis = kb,
+                                 .bits = 0,
+                                 .bases_s8 = s8,
+                                 .record_words = words,
+                                 .widths = block,
+                                 .scales = sc_out,
+                                 .means = me_out,
+                                 .bases = ba_out,
+                                 .bases8 = b8_out};
         for (uint32_t v = 0; v < rows; v++) {
             uint32_t *r = rec + (size_t)v * words, c = labels[v];
             r[0] = c;

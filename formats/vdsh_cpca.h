@@ -96,6 +96,12 @@ typedef struct vdsh_cpca_settings {
      * kept, the first on a tie. 0 or 1: one fit; without a pool, one fit.
      * 0..VDSH_CPCA_MAX_STARTS. */
     uint32_t starts;
+    /* K,alloc:BYTES with s8 bases (--cpca ...,bases:8; VDSH.md "cpca
+     * streams"; docs/ACCURACY.md "Bases in 8 bits"): each cluster's basis
+     * vectors stored as s8 with the vector's scale in the weights' scales,
+     * 1 byte per value where f16 takes 2, the bytes freed spent on the
+     * records by the budget's rule. 0: f16. */
+    uint32_t bases_s8;
     /* The most threads the encoder runs on (0: one per CPU online); the
      * bytes do not depend on it. */
     uint32_t threads;

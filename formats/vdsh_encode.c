@@ -318,15 +318,15 @@ void vdsh_cpca_model_field(const vdsh_cpca *m, uint32_t j, uint32_t *word, uint3
 
 uint64_t vdsh_cpca_stream_model_bytes(const vdsh_cpca *m, uint32_t order)
 {
-    return vdsh_cpca_model_bytes(order, m->clusters, m->basis) +
+    return vdsh_cpca_model_bytes(order, m->clusters, m->basis, m->bases_s8) +
            (m->bits ? 0 : ((uint64_t)m->basis + 15) & ~15ull);
 }
 
-uint64_t vdsh_cpca_model_bytes(uint32_t order, uint32_t clusters, uint32_t basis)
+uint64_t vdsh_cpca_model_bytes(uint32_t order, uint32_t clusters, uint32_t basis, uint32_t bases_s8)
 {
-    uint64_t n = (uint64_t)order * order, k = clusters, b = basis;
+    uint64_t n = (uint64_t)order * order, k = clusters, b = basis, e = bases_s8 ? 1 : 2;
     return CPCA_HEADER_SIZE + ((4 * k * b + 15) & ~15ull) + ((2 * k * n + 15) & ~15ull) +
-           ((2 * k * b * n + 15) & ~15ull);
+           ((e * k * b * n + 15) & ~15ull);
 }
 
 /* Point a cpca stream's model arrays into the model block at `model` (the
@@ -342,7 +342,8 @@ void vdsh_cpca_bind(vdsh_stream *s, const uint8_t *model)
     q += (4 * k * b + 15) & ~15ull;
     s->cpca.means = (const uint16_t *)q;
     q += (2 * k * n + 15) & ~15ull;
-    s->cpca.bases = (const uint16_t *)q;
+    s->cpca.bases = s->cpca.bases_s8 ? NULL : (const uint16_t *)q;
+    s->cpca.bases8 = s->cpca.bases_s8 ? (const int8_t *)q : NULL;
 }
 
 static const uint32_t *cpca_record(const vdsh_stream *s, uint32_t v)
@@ -401,10 +402,10 @@ static void cpca_decode(const vdsh_stream *s, uint32_t v, float *out)
     for (uint32_t i = 0; i < n; i++)
         out[i] = vdsh_f32_from_f16(mean[i]);
     for (uint32_t j = 0; j < b; j++) {
-        const uint16_t *basis = s->cpca.bases + ((size_t)c * b + j) * n;
+        const size_t basis = ((size_t)c * b + j) * n;
         /* -std=c11: no contraction into a fused multiply-add */
         for (uint32_t i = 0; i < n; i++)
-            out[i] = out[i] + w[j] * vdsh_f32_from_f16(basis[i]);
+            out[i] = out[i] + w[j] * vdsh_cpca_basis_value(&s->cpca, basis + i);
     }
 }
 

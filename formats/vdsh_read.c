@@ -408,7 +408,10 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
                                  vdsh_s(c->size - STREAM_HEADER_SIZE), CPCA_HEADER_SIZE);
         s->cpca.clusters = get_u32(p + STREAM_HEADER_SIZE);
         s->cpca.basis = get_u32(p + STREAM_HEADER_SIZE + 4);
-        s->cpca.bits = get_u32(p + STREAM_HEADER_SIZE + 8);
+        /* the bits word: the width (or 0), VDSH_CPCA_BASES_S8 for s8 bases */
+        const uint32_t bits_word = get_u32(p + STREAM_HEADER_SIZE + 8);
+        s->cpca.bases_s8 = (bits_word & VDSH_CPCA_BASES_S8) != 0;
+        s->cpca.bits = bits_word & ~VDSH_CPCA_BASES_S8;
         s->cpca.record_words = get_u32(p + STREAM_HEADER_SIZE + 12);
         /* bits 0: the widths table follows the cpca header (checked with
          * the header; B out of range is refused there first) */
@@ -434,7 +437,8 @@ static vdsh_result read_coef(const reader *r, const chunk_ref *c, layout *L)
                              vdsh_s(c->size - STREAM_HEADER_SIZE), (unsigned long long)table);
     if (table && s->encoding == VDSH_ENCODING_CPCA) {
         uint64_t n = (uint64_t)s->order * s->order, k = s->cpca.clusters, b = s->cpca.basis;
-        uint64_t sizes[4] = {s->cpca.bits ? 0 : b, 4 * k * b, 2 * k * n, 2 * k * b * n};
+        uint64_t sizes[4] = {s->cpca.bits ? 0 : b, 4 * k * b, 2 * k * n,
+                             (s->cpca.bases_s8 ? 1 : 2) * k * b * n};
         static const char *const what[4] = {"widths", "scales", "means", "bases"};
         const uint8_t *q = p + STREAM_HEADER_SIZE + CPCA_HEADER_SIZE;
         for (int a = 0; a < 4; a++) {
@@ -516,6 +520,7 @@ static vdsh_result check_coef_sizes(const reader *r, layout *L)
         s->coef_scales = NULL;
         s->cpca.scales = NULL;
         s->cpca.means = s->cpca.bases = NULL;
+        s->cpca.bases8 = NULL;
         L->stream_orders[i] = orders;
         if (orders)
             L->offset_words += (uint64_t)rows + 1;

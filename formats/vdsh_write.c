@@ -108,7 +108,8 @@ static vdsh_result check_file(const vdsh_file *f, const char *name, vdsh_error *
             return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
                                  "not written: COEF stream %u: variable order without orders", i);
         if (s->encoding == VDSH_ENCODING_CPCA &&
-            (!s->cpca.scales || !s->cpca.means || !s->cpca.bases))
+            (!s->cpca.scales || !s->cpca.means ||
+             !(s->cpca.bases_s8 ? (const void *)s->cpca.bases8 : (const void *)s->cpca.bases)))
             return vdsh_failf_at(err, VDSH_ERR_ARGUMENT, name,
                                  "not written: COEF stream %u: cpca without scales, means or bases",
                                  i);
@@ -207,7 +208,7 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name, vds
             const vdsh_cpca *m = &s->cpca;
             put_u32(p + STREAM_HEADER_SIZE, m->clusters);
             put_u32(p + STREAM_HEADER_SIZE + 4, m->basis);
-            put_u32(p + STREAM_HEADER_SIZE + 8, m->bits);
+            put_u32(p + STREAM_HEADER_SIZE + 8, m->bits | (m->bases_s8 ? VDSH_CPCA_BASES_S8 : 0));
             put_u32(p + STREAM_HEADER_SIZE + 12, m->record_words);
             size_t mb = (size_t)vdsh_cpca_stream_model_bytes(m, s->order) - CPCA_HEADER_SIZE;
             size_t n = (size_t)s->order * s->order, k = m->clusters, b = m->basis;
@@ -223,7 +224,10 @@ static vdsh_result plan_build(plan *P, const vdsh_file *f, const char *name, vds
             q += (4 * k * b + 15) & ~(size_t)15;
             memcpy(q, m->means, 2 * k * n);
             q += (2 * k * n + 15) & ~(size_t)15;
-            memcpy(q, m->bases, 2 * k * b * n);
+            if (m->bases_s8)
+                memcpy(q, m->bases8, k * b * n);
+            else
+                memcpy(q, m->bases, 2 * k * b * n);
             add_chunk(P, "COEF", p, STREAM_HEADER_SIZE + CPCA_HEADER_SIZE, s->data, data);
             out_chunk *c = &P->chunks[P->count - 1];
             c->mid = P->model[i];

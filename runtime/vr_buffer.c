@@ -310,8 +310,7 @@ static float *build_model(const vdsh_stream *st, int order, size_t *bytes)
             for (uint32_t j = 0; j < m->basis; j++) {
                 size_t v = (size_t)c * m->basis + j;
                 float step = vdsh_cpca_step(m->scales[v], vdsh_cpca_width(m, j));
-                t[4 * (j + 1)] =
-                    step * vdsh_f32_from_f16(m->bases[v * (size_t)nc + (size_t)seq[p]]);
+                t[4 * (j + 1)] = step * vdsh_cpca_basis_value(m, v * (size_t)nc + (size_t)seq[p]);
             }
         }
     *bytes = floats * sizeof *dst;
@@ -681,8 +680,10 @@ vr_result vr_buffer_upload(vr_scene *s, const vdsh_stream *st, const uint32_t *r
     int order = (int)st->order;
     int cpca = st->encoding == VDSH_ENCODING_CPCA;
     if (order < 1 || order > VDSH_MAX_ORDER || (st->encoding > VDSH_ENCODING_S8S6 && !cpca) ||
-        (cpca && (!st->cpca.scales || !st->cpca.means || !st->cpca.bases ||
-                  (st->flags & VDSH_STREAM_VARIABLE))) ||
+        (cpca &&
+         (!st->cpca.scales || !st->cpca.means ||
+          !(st->cpca.bases_s8 ? (const void *)st->cpca.bases8 : (const void *)st->cpca.bases) ||
+          (st->flags & VDSH_STREAM_VARIABLE))) ||
         (vdsh_encoding_quantised(st->encoding) && !st->coef_scales))
         return vr_fail(err, VR_ERR_FORMAT, "%s: order %d stream: encoding %u cannot be drawn", name,
                        order, st->encoding);

@@ -150,7 +150,7 @@ int main(int argc, char **argv)
         double t2 = now();
         const vdsh_cpca *m = &fit.model;
         double bytes = (double)rows * 4.0 * m->record_words +
-                       (double)vdsh_cpca_model_bytes(order, m->clusters, m->basis) +
+                       (double)vdsh_cpca_model_bytes(order, m->clusters, m->basis, m->bases_s8) +
                        (m->widths ? (double)((m->basis + 15u) & ~15u) : 0.0);
         printf("{\"k\": %s, \"clusters\": %u, \"basis\": %u, \"words\": %u, "
                "\"bytes_per_vertex\": %.3f, \"rms_error\": %.6g, \"pairs\": %llu, "

@@ -55,7 +55,7 @@ int main(int argc, char **argv)
     if (argv[6][0] == 'u') {
         budget = ((double)rows * 4.0 * vdsh_cpca_record_words(st.basis, 4) +
                   (double)vdsh_cpca_model_bytes(order, st.clusters < rows ? st.clusters : rows,
-                                                st.basis)) /
+                                                st.basis, 0)) /
                  rows;
     } else if (argv[6][0] == '=') {
         for (uint32_t j = 0; j < st.basis && j < VDSH_MAX_COEFFS; j++)

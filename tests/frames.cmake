@@ -135,7 +135,7 @@ fi
 endif()
 
 # cpca streams with a width per basis vector (--cpca K,alloc:BYTES, bits 0
-# and a widths table, issue 29): orders 3 (every vector 8 bits) and 12
+# and a widths table, issue 29; with f16 bases and with s8, ,bases:8): orders 3 (every vector 8 bits) and 12
 # (2 to 6 bits, fields skipping the ends of words), drawn per pass and
 # once per frame (vr_buffer.c's BUF_CPCA_UNPACK) against vdsh_stream_decode's
 # C frames, within frames_gl_vs_c's bounds. Skips (77) without GL; the
@@ -145,25 +145,29 @@ if(TARGET vb_frames AND TARGET vdsh-view)
 bake=$1; frames=$2; view=$3; cmp=$4; d=$5; views=$6; info=$7
 set -e
 rm -rf "$d"; mkdir -p "$d"
-"$bake" builtin:room --max-edge 0.5 --rays 400 --cube-size 0 --orders 3,12 --encoding cpca \
-  --cpca 6,alloc:24 -q -o "$d/w.vdsh"
-# the order-12 stream's widths are not all one (else this is the uniform case)
-"$info" "$d/w.vdsh" > "$d/info.txt"
-grep "widths:" "$d/info.txt" | grep -q "x.*,.*x" || { cat "$d/info.txt"; exit 1; }
-"$frames" truth "$d/w.vdsh" --views "$views" -o "$d/w-c" > /dev/null
-set +e
-"$view" "$d/w.vdsh" --views "$views" --frames "$d/w-gl" --modes buf3,buf12 -q
-rc=$?
-set -e
-[ $rc -eq 77 ] && exit 77
-[ $rc -eq 0 ] || exit $rc
-"$cmp" "$views" "$d/w-c" "$d/w-gl" 0.002 0.005 buf3=c-vdsh3 buf12=c-vdsh12
-if "$view" "$d/w.vdsh" --cpca-frame --views "$views" --frames "$d/wf-gl" --modes buf3,buf12 -q \
-    2> "$d/wf.err"; then
-  "$cmp" "$views" "$d/w-c" "$d/wf-gl" 0.002 0.005 buf3=c-vdsh3 buf12=c-vdsh12
-else
-  grep -q "shader storage" "$d/wf.err" || { cat "$d/wf.err"; exit 1; }
-fi
+for w in w w8; do # f16 bases, then s8 (--cpca ...,bases:8)
+  s8=; [ $w = w8 ] && s8=,bases:8
+  "$bake" builtin:room --max-edge 0.5 --rays 400 --cube-size 0 --orders 3,12 --encoding cpca \
+    --cpca 6,alloc:24$s8 -q -o "$d/$w.vdsh"
+  # the order-12 stream's widths are not all one (else this is the uniform case)
+  "$info" "$d/$w.vdsh" > "$d/info.txt"
+  grep "widths:" "$d/info.txt" | grep -q "x.*,.*x" || { cat "$d/info.txt"; exit 1; }
+  [ $w = w ] || grep -q "s8 bases" "$d/info.txt" || { cat "$d/info.txt"; exit 1; }
+  "$frames" truth "$d/$w.vdsh" --views "$views" -o "$d/$w-c" > /dev/null
+  set +e
+  "$view" "$d/$w.vdsh" --views "$views" --frames "$d/$w-gl" --modes buf3,buf12 -q
+  rc=$?
+  set -e
+  [ $rc -eq 77 ] && exit 77
+  [ $rc -eq 0 ] || exit $rc
+  "$cmp" "$views" "$d/$w-c" "$d/$w-gl" 0.002 0.005 buf3=c-vdsh3 buf12=c-vdsh12
+  if "$view" "$d/$w.vdsh" --cpca-frame --views "$views" --frames "$d/${w}f-gl" --modes buf3,buf12 \
+      -q 2> "$d/wf.err"; then
+    "$cmp" "$views" "$d/$w-c" "$d/${w}f-gl" 0.002 0.005 buf3=c-vdsh3 buf12=c-vdsh12
+  else
+    grep -q "shader storage" "$d/wf.err" || { cat "$d/wf.err"; exit 1; }
+  fi
+done
 ]=] sh $<TARGET_FILE:vdsh-bake> $<TARGET_FILE:vdsh-frames> $<TARGET_FILE:vdsh-view>
        $<TARGET_FILE:test_frames_gl> ${CMAKE_CURRENT_BINARY_DIR}/frames_gl_cpca_widths
        ${CMAKE_CURRENT_LIST_DIR}/data/frames_gl.views.json $<TARGET_FILE:vdsh-info>)

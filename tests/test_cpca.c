@@ -87,6 +87,18 @@ static double rnd(void) /* uniform [-1, 1) */
     return (double)(rng >> 11) * 0x1.0p-52 - 1.0;
 }
 
+/* Whether a and b are the same settings, field by field (the struct has
+ * padding). */
+static int same_settings(const vdsh_cpca_settings *a, const vdsh_cpca_settings *b)
+{
+    return a->clusters == b->clusters && a->basis == b->basis && a->bits == b->bits &&
+           a->budget == b->budget && a->light_mix == b->light_mix &&
+           a->light_count == b->light_count && a->lights == b->lights &&
+           a->positions == b->positions && a->light_cache == b->light_cache &&
+           a->margin == b->margin && a->starts == b->starts && a->bases_s8 == b->bases_s8 &&
+           a->threads == b->threads && a->start == b->start;
+}
+
 static uint32_t rd32(const uint8_t *p)
 {
     return p[0] | p[1] << 8 | p[2] << 16 | (uint32_t)p[3] << 24;
@@ -287,7 +299,7 @@ static double rms_vs(const vdsh_stream *s, const float *want)
 static uint64_t fit_bytes(const vdsh_cpca *m, uint32_t rows, uint32_t order)
 {
     return (uint64_t)rows * 4 * vdsh_cpca_record_words(m->basis, m->bits) +
-           vdsh_cpca_model_bytes(order, m->clusters, m->basis);
+           vdsh_cpca_model_bytes(order, m->clusters, m->basis, m->bases_s8);
 }
 
 static void auto_settings(void)
@@ -311,7 +323,7 @@ static void auto_settings(void)
         more.basis++;
         CHECK(m->basis == NC || fit_bytes(&more, ROWS, ORDER) > (uint64_t)budgets[i] * ROWS,
               "auto:%u: B %u not the largest that fits", budgets[i], m->basis);
-        uint64_t model = vdsh_cpca_model_bytes(ORDER, m->clusters, m->basis) - 16;
+        uint64_t model = vdsh_cpca_model_bytes(ORDER, m->clusters, m->basis, 0) - 16;
         CHECK(b.model.clusters == m->clusters && b.model.basis == m->basis &&
                   memcmp(a.storage_, b.storage_, (size_t)model) == 0 &&
                   memcmp(a.records, b.records, (size_t)ROWS * 4 * m->record_words) == 0,
@@ -484,7 +496,7 @@ static void widths_stream(const vdsh_cpca_fit *fit, const char *out_dir)
               "widths: read back differs");
         vdsh_stream_size z = vdsh_stream_size_of(r, ROWS);
         CHECK(fabs(z.mean_bytes -
-                   (8.0 + (double)(vdsh_cpca_model_bytes(ORDER, K, B) + 16) / ROWS)) < 1e-9,
+                   (8.0 + (double)(vdsh_cpca_model_bytes(ORDER, K, B, 0) + 16) / ROWS)) < 1e-9,
               "widths: mean bytes %g", z.mean_bytes);
         int exact = 1;
         for (uint32_t v = 0; v < ROWS; v += 5) {
@@ -612,10 +624,149 @@ static void alloc_settings(void)
           "bad alloc settings accepted");
 }
 
+/* --cpca K,alloc:BYTES,bases:8: the bases stored s8 (VDSH.md "cpca
+ * streams"): parsed and written back as text, refused without
+ * K,alloc:BYTES; the stream within the budget, its bytes freed spent on
+ * more vectors or words than f16's at the same budget and a lower error
+ * here; every non-zero vector reaching +-127; the same bytes twice and on
+ * 1 and 3 threads; its rms_error its decode's; the header's bits word
+ * with VDSH_CPCA_BASES_S8, written and read back to the same decode
+ * (dir: the file and its C decode for the Python reader's test); a basis
+ * value of -128 refused. */
+static void s8_bases(const char *dir)
+{
+    vdsh_error err = {{0}};
+    vdsh_cpca_settings st, f16, p;
+    CHECK(vdsh_cpca_parse("3,alloc:16,bases:8", &st, &err) == VDSH_OK && st.bases_s8 &&
+              st.clusters == 3 && st.budget == 16,
+          "parse 3,alloc:16,bases:8: %s", err.msg);
+    CHECK(vdsh_cpca_parse("3,alloc:16,bases:16", &f16, &err) == VDSH_OK && !f16.bases_s8,
+          "parse 3,alloc:16,bases:16: %s", err.msg);
+    CHECK(vdsh_cpca_parse("bases:8", &p, &err) == VDSH_OK && p.bases_s8 &&
+              p.clusters == VDSH_CPCA_DEFAULT_CLUSTERS && p.margin == VDSH_CPCA_DEFAULT_MARGIN &&
+              p.starts == VDSH_CPCA_DEFAULT_STARTS,
+          "bases:8 alone: the default with s8 bases (%s)", err.msg);
+    char text[192];
+    vdsh_cpca_settings_text(&st, text, sizeof text);
+    CHECK(strstr(text, ",bases:8") && vdsh_cpca_parse(text, &p, &err) == VDSH_OK &&
+              same_settings(&p, &st),
+          "3,alloc:16,bases:8's text %s", text);
+    static const char *const refuse[] = {"8,52,4,bases:8", "auto,bases:8", "3,alloc:16,bases:4",
+                                         "3,alloc:16,bases:8,bases:8", "3,alloc:16,bases:8.0"};
+    for (size_t k = 0; k < sizeof refuse / sizeof *refuse; k++)
+        CHECK(vdsh_cpca_parse(refuse[k], &p, &err) == VDSH_ERR_ARGUMENT && strstr(err.msg, "bases"),
+              "'%s' accepted or bases not named (%s)", refuse[k], err.msg);
+    vdsh_cpca_settings fixed = {.clusters = K, .basis = B, .bits = BITS, .bases_s8 = 1};
+    vdsh_cpca_fit a, b, h;
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &fixed, &a, &err) == VDSH_ERR_ARGUMENT &&
+              strstr(err.msg, "s8") && !a.storage_,
+          "s8 bases with K,B,BITS not refused (%s)", err.msg);
+
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &a, &err) == VDSH_OK, "s8: %s", err.msg);
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &f16, &h, &err) == VDSH_OK, "f16: %s",
+          err.msg);
+    const vdsh_cpca *m = &a.model;
+    const size_t model = (size_t)vdsh_cpca_stream_model_bytes(m, ORDER);
+    const uint64_t bytes = (uint64_t)ROWS * 4 * m->record_words + model;
+    CHECK(m->bases_s8 && m->bases8 && !m->bases && !h.model.bases_s8 && h.model.bases &&
+              model == vdsh_cpca_model_bytes(ORDER, m->clusters, m->basis, 1) +
+                           (((size_t)m->basis + 15) & ~(size_t)15),
+          "s8: the model's form");
+    CHECK(bytes <= 16u * ROWS, "s8: %.2f bytes per vertex over 16", (double)bytes / ROWS);
+    CHECK(m->basis > h.model.basis || m->record_words > h.model.record_words,
+          "s8: %u vectors in %u words, f16 %u in %u: no byte spent", m->basis, m->record_words,
+          h.model.basis, h.model.record_words);
+    CHECK(a.rms_error < h.rms_error, "s8: rms error %g, f16 %g", a.rms_error, h.rms_error);
+    int reach = 1;
+    for (uint32_t v = 0; v < m->clusters * m->basis; v++) {
+        int big = 0;
+        for (uint32_t i = 0; i < NC; i++) {
+            int x = m->bases8[(size_t)v * NC + i];
+            big = x < 0 ? (-x > big ? -x : big) : (x > big ? x : big);
+        }
+        reach &= big == 0 || big == 127;
+    }
+    CHECK(reach, "s8: a vector whose largest |value| is not 127");
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &b, &err) == VDSH_OK &&
+              !memcmp(a.storage_, b.storage_, model - 16) &&
+              !memcmp(a.records, b.records, (size_t)ROWS * 4 * m->record_words),
+          "s8: other bytes the second time");
+    vdsh_cpca_fit_free(&b);
+    for (uint32_t t = 1; t <= 3; t += 2) {
+        vdsh_cpca_settings ts = st;
+        ts.threads = t;
+        CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &ts, &b, &err) == VDSH_OK &&
+                  !memcmp(a.storage_, b.storage_, model - 16) &&
+                  !memcmp(a.records, b.records, (size_t)ROWS * 4 * m->record_words),
+              "s8: other bytes on %u thread%s", t, vdsh_s(t));
+        vdsh_cpca_fit_free(&b);
+    }
+    vdsh_stream s = {.order = ORDER,
+                     .encoding = VDSH_ENCODING_CPCA,
+                     .method = VDSH_METHOD_LSQ,
+                     .quantity = VDSH_QUANTITY_DISTANCE,
+                     .scale = 1.0f,
+                     .data = a.records,
+                     .cpca = *m};
+    CHECK(fabs(rms_vs(&s, src) - a.rms_error) <= 1e-9 * (1 + a.rms_error), "s8: rms %g vs %g",
+          a.rms_error, rms_vs(&s, src));
+    vdsh_file f = file_of(&s);
+    void *mem = NULL;
+    size_t size = 0;
+    vdsh_file *back = NULL;
+    CHECK(
+        vdsh_write_memory(&f, &mem, &size, &err) == VDSH_OK &&
+            vdsh_read_memory(mem, size, "s8", &back, &err) == VDSH_OK &&
+            back->streams[0].cpca.bases_s8 && back->streams[0].cpca.bits == 0 &&
+            !memcmp(back->streams[0].cpca.bases8, m->bases8, (size_t)m->clusters * m->basis * NC) &&
+            rms_vs(&back->streams[0], src) == rms_vs(&s, src),
+        "s8: write and read back: %s", err.msg);
+    if (mem) {
+        const uint8_t *g = mem;
+        const size_t at = coef_at(g, size);
+        CHECK(at && rd32(g + at + 56) == VDSH_CPCA_BASES_S8, "s8: the header's bits word %#x",
+              at ? rd32(g + at + 56) : 0);
+        /* the first basis value: after the headers, widths, scales and means */
+        size_t b0 = 64 + ((m->basis + 15) & ~15u) + ((4 * m->clusters * m->basis + 15) & ~15u) +
+                    ((2 * m->clusters * NC + 15) & ~15u);
+        const uint8_t minus128 = 0x80;
+        expect_refused(g, size, b0, &minus128, 1, "is -128");
+        uint8_t b4[4];
+        wr32(b4, VDSH_CPCA_BASES_S8 | 0x200u);
+        expect_refused(g, size, 56, b4, 4, "bits 512");
+    }
+    if (dir && back) { /* for the Python reader's test */
+        char path[4096];
+        snprintf(path, sizeof path, "%s/cpca-s8.vdsh", dir);
+        FILE *o = fopen(path, "wb");
+        CHECK(o && fwrite(mem, 1, size, o) == size, "cannot write %s", path);
+        if (o)
+            fclose(o);
+        snprintf(path, sizeof path, "%s/cpca-s8.f32", dir);
+        o = fopen(path, "wb");
+        float c[NC];
+        for (uint32_t v = 0; o && v < ROWS; v++) {
+            vdsh_stream_decode(&back->streams[0], v, c);
+            fwrite(c, 4, NC, o);
+        }
+        CHECK(o != NULL, "cannot write %s", path);
+        if (o)
+            fclose(o);
+    }
+    printf("s8 bases, alloc:16 at K 3: %u vectors, %u words, %.2f bytes per vertex, rms error "
+           "%.4f (f16: %u vectors, %u words, %.4f)\n",
+           m->basis, m->record_words, (double)bytes / ROWS, a.rms_error, h.model.basis,
+           h.model.record_words, h.rms_error);
+    vdsh_free(back);
+    free(mem);
+    vdsh_cpca_fit_free(&a);
+    vdsh_cpca_fit_free(&h);
+}
+
 /* Whether two fits of K, B, BITS are the same bytes (model and records). */
 static int same_fit(const vdsh_cpca_fit *a, const vdsh_cpca_fit *b)
 {
-    size_t mb = (size_t)vdsh_cpca_model_bytes(ORDER, K, B) - 16;
+    size_t mb = (size_t)vdsh_cpca_model_bytes(ORDER, K, B, 0) - 16;
     return a->model.record_words == b->model.record_words &&
            memcmp(a->storage_, b->storage_, mb) == 0 &&
            memcmp(a->records, b->records, (size_t)ROWS * 4 * a->model.record_words) == 0;
@@ -818,7 +969,7 @@ static void light_metric(void)
         char text[64];
         snprintf(text, sizeof text, "%u,alloc:%u,margin:%g,starts:%u", (unsigned)d.clusters,
                  (unsigned)d.budget, (double)d.margin, (unsigned)d.starts);
-        CHECK(vdsh_cpca_parse(text, &p, &err) == VDSH_OK && !memcmp(&p, &d, sizeof p),
+        CHECK(vdsh_cpca_parse(text, &p, &err) == VDSH_OK && same_settings(&p, &d),
               "the default settings are %s's", text);
         snprintf(text, sizeof text, "%u,alloc:%u", (unsigned)d.clusters, (unsigned)d.budget);
         CHECK(vdsh_cpca_parse(text, &p, &err) == VDSH_OK && p.clusters == d.clusters &&
@@ -836,7 +987,7 @@ static void light_metric(void)
             char text[192];
             CHECK(vdsh_cpca_parse(texts[i], &a, &err) == VDSH_OK, "%s: %s", texts[i], err.msg);
             vdsh_cpca_settings_text(&a, text, sizeof text);
-            CHECK(vdsh_cpca_parse(text, &b, &err) == VDSH_OK && !memcmp(&a, &b, sizeof a),
+            CHECK(vdsh_cpca_parse(text, &b, &err) == VDSH_OK && same_settings(&a, &b),
                   "%s: its text %s reads back as other settings (%s)", texts[i], text, err.msg);
         }
         char text[192], small[8];
@@ -1014,7 +1165,7 @@ int main(int argc, char **argv)
           fit.model.record_words);
     /* determinism: the same bytes again */
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &again, &err) == VDSH_OK, "encode 2");
-    size_t mb = (size_t)vdsh_cpca_model_bytes(ORDER, K, B) - 16;
+    size_t mb = (size_t)vdsh_cpca_model_bytes(ORDER, K, B, 0) - 16;
     CHECK(memcmp(fit.storage_, again.storage_, mb) == 0 &&
               memcmp(fit.records, again.records, (size_t)ROWS * 4 * fit.model.record_words) == 0,
           "two encodings of the same input differ");
@@ -1103,7 +1254,8 @@ int main(int argc, char **argv)
         CHECK(vdsh_stream_bytes_per_vertex(r) == 8, "bytes per vertex %zu",
               vdsh_stream_bytes_per_vertex(r));
         vdsh_stream_size z = vdsh_stream_size_of(r, ROWS);
-        CHECK(fabs(z.mean_bytes - (8.0 + (double)vdsh_cpca_model_bytes(ORDER, K, B) / ROWS)) < 1e-9,
+        CHECK(fabs(z.mean_bytes - (8.0 + (double)vdsh_cpca_model_bytes(ORDER, K, B, 0) / ROWS)) <
+                  1e-9,
               "mean bytes %g", z.mean_bytes);
         if (argc > 1) { /* for the Python reader's test */
             char p[4096];
@@ -1187,6 +1339,7 @@ int main(int argc, char **argv)
     auto_settings();
     widths_study();
     alloc_settings();
+    s8_bases(argc > 1 ? argv[1] : NULL);
     light_metric();
     pool_score();
 

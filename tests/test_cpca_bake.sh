@@ -61,6 +61,45 @@ c = vdsh.read(sys.argv[3]).streams[0]["cpca"]
 assert c["bits"] == 0 and len(c["widths"]) == c["basis"] and 2 <= min(c["widths"]), c["widths"]
 ' "$src/python" "$tmp/c3/p1.vdsh" "$tmp/c1.vdsh"
 
+# s8 bases (--cpca K,alloc:BYTES,bases:8): 1 thread = 2 threads = 3
+# shards merged, byte for byte; the part records them (cpca_bits 256) and
+# the merge refuses an f16 part beside an s8 one; vdsh-info says s8; the
+# bytes freed go to the records (more vectors or words than f16's at the
+# same budget, within it).
+c8=(--encoding cpca --cpca 4,alloc:40,bases:8)
+expect_exit 0 "s8 bases, 1 thread" "$bake" "${tiny[@]}" "${c8[@]}" --threads 1 -o "$tmp/s1.vdsh"
+expect_exit 0 "s8 bases, 2 threads" "$bake" "${tiny[@]}" "${c8[@]}" --threads 2 -o "$tmp/s2.vdsh"
+check "s8 bases, 1 and 2 threads: identical" cmp "$tmp/s1.vdsh" "$tmp/s2.vdsh"
+mkdir -p "$tmp/s3"
+for i in 0 1 2; do
+  expect_exit 0 "s8 bases shard $i/3" "$bake" "${tiny[@]}" "${c8[@]}" --shard "$i/3" \
+    -o "$tmp/s3/p$i.vdsh"
+done
+expect_exit 0 "s8 bases merge" "$merge" -q "$tmp"/s3/p*.vdsh -o "$tmp/s3/scene.vdsh"
+check "s8 bases, 3 shards: identical to the whole bake" cmp "$tmp/s3/scene.vdsh" "$tmp/s1.vdsh"
+expect_exit 1 "merge of an s8 part with f16 parts" "$merge" -q "$tmp/s3/p0.vdsh" "$tmp/c3/p1.vdsh" \
+  "$tmp/c3/p2.vdsh" -o "$tmp/s3/mixed.vdsh"
+says_any "the mixed merge names the setting" "another --cpca"
+check "no file from the mixed merge" test ! -e "$tmp/s3/mixed.vdsh"
+expect_exit 0 "vdsh-info on an s8 part" "$info" "$tmp/s3/p1.vdsh"
+says_any "vdsh-info shows the part's bases" "cpca 4,alloc:40,light:1,bases:8"
+expect_exit 0 "vdsh-info, s8 bases" "$info" "$tmp/s1.vdsh"
+says_any "vdsh-info shows s8 bases" "bytes, s8 bases)"
+check "s8 bases: the bytes freed spent on the records, within the budget" /usr/bin/python3 -c '
+import sys
+sys.path.insert(0, sys.argv[1])
+import vdsh
+f16, s8 = (vdsh.read(p) for p in sys.argv[2:4])
+p = vdsh.read(sys.argv[4]).part
+assert p["cpca_bits"] == 256, p
+for a, b in zip(f16.streams, s8.streams):
+    if a["encoding"] != "cpca" or a["order"] < 7:  # order 3: all 9 vectors at 8 bits either way
+        continue
+    x, y = a["cpca"], b["cpca"]
+    assert not x["bases_s8"] and y["bases_s8"], (x["bases_s8"], y["bases_s8"])
+    assert y["basis"] > x["basis"] or y["record_words"] > x["record_words"], (x, y)
+' "$src/python" "$tmp/c1.vdsh" "$tmp/s1.vdsh" "$tmp/s3/p1.vdsh"
+
 # The default (--encoding cpca without --cpca: 16,alloc:32,margin:0.25,
 # starts:2 with the light pool, which parts carry in lpol): whole bake =
 # 2 threads = 5 threads = 3 shards merged (on every core and on --threads 1), byte

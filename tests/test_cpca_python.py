@@ -4,7 +4,8 @@ C reader's floats, bit for bit: test_cpca writes a file and its C decode,
 and the same of a stream with a width per basis vector (bits 0 and the
 widths table: 8, 7, 6, 5, 4, 4, 4, 3, 3, 3, 2, 2, 2), whose broken widths,
 padding and 2-bit weight -2 Python refuses as C does, and whose part chunk
-of --cpca K,alloc:BYTES (K, budget, 0) it reads.
+of --cpca K,alloc:BYTES (K, budget, 0) it reads; and a stream with s8
+bases (--cpca ...,bases:8), decoded bit for bit, a value of -128 refused.
 
 Usage: test_cpca_python.py TEST_CPCA SOURCE_DIR WORK_DIR
 """
@@ -111,6 +112,33 @@ try:
 except vdsh.VdshError as e:
     fail.append("alloc part refused: %s" % e)
 refused(with_part(3, 0, 0), "out of range", "alloc part of budget 0")
+try:  # --cpca K,alloc:BYTES,bases:8: cpca_bits 0x100
+    fp = vdsh.parse(bytes(with_part(3, 16, 0x100)), "s8-part.vdsh")
+    if (fp.part or {}).get("cpca_bits") != 0x100:
+        fail.append("s8 alloc part read as %s" % fp.part)
+except vdsh.VdshError as e:
+    fail.append("s8 alloc part refused: %s" % e)
+refused(with_part(0, 16, 0x100), "out of range", "auto part with s8 bases")
+
+# s8 bases (--cpca ...,bases:8; the bits word's 0x100): the decode bit for
+# bit, and a basis value of -128 refused
+spath = os.path.join(work, "cpca-s8.vdsh")
+s8 = vdsh.read(spath).streams[0]
+g8 = vdsh.coefficients(s8)
+w8 = np.fromfile(os.path.join(work, "cpca-s8.f32"), "<f4").reshape(g8.shape)
+c8 = s8["cpca"]
+if not c8["bases_s8"] or c8["bits"] != 0 or np.abs(c8["bases"]).max() != 127:
+    fail.append("s8 stream header: bases_s8 %s, bits %s" % (c8["bases_s8"], c8["bits"]))
+if not np.array_equal(g8.view(np.uint32), w8.view(np.uint32)):
+    fail.append("s8: decode differs from C at %d of %d values" % ((g8 != w8).sum(), g8.size))
+d8 = bytearray(open(spath, "rb").read())
+o8, n8 = [(o, n) for o, c, n in chunks(d8) if c == b"COEF"][0]
+K8, B8, nc8 = c8["clusters"], c8["basis"], s8["order"] ** 2
+r16 = lambda n: (n + 15) // 16 * 16  # noqa: E731
+first = 64 + r16(B8) + r16(4 * K8 * B8) + r16(2 * K8 * nc8)
+d8[o8 + 16 + first] = 0x80
+fix_crc(d8, o8, n8)
+refused(d8, "-128", "s8 basis value -128")
 for m in fail:
     print("FAIL:", m)
 print("cpca python: %d values compared, %s" % (got.size, "bit-identical" if not fail else "FAILED"))

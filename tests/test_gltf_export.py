@@ -316,7 +316,8 @@ for name in ("box-src", "engine-src"):
 # of the --decode-cpca --float export (vdsh_stream_decode's); orders 7
 # and 12 with 5-bit weights (fields skipping the ends of words), and with
 # a width per basis vector (--cpca 6,alloc:24: "bits": 0 and "widths",
-# each level within its own width's range); plain and --compress go to the
+# each level within its own width's range), and the same with s8 bases
+# (,bases:8: the integers exported as f32); plain and --compress go to the
 # validator.
 import numpy as np
 
@@ -384,6 +385,7 @@ def check_cpca(tag, setting):
 
 check_cpca("cpca", "6,20,5")
 check_cpca("cpcaw", "6,alloc:24")
+check_cpca("cpca8", "6,alloc:24,bases:8")  # s8 bases: exported as f32, the same rule
 
 # The validator comes from npm (gltf_npm_setup); where the registry cannot
 # be reached that fixture skips, and so does this test's validation: every

@@ -9,7 +9,8 @@
  * writes is there): a small scene of a floor and a box refined to max
  * edge 1 (orders 2,3,5, f16; and orders 1,4, f32, method full, with the
  * timings chunk; order 6 in cpca, 3 clusters of 7 vectors, 5-bit weights;
- * order 6 in cpca with a width per vector, --cpca 3,alloc:60; shard 0 of 2
+ * order 6 in cpca with a width per vector, --cpca 3,alloc:60, and the same
+ * with s8 bases, --cpca 3,alloc:60,bases:8; shard 0 of 2
  * of that bake with --light-region grown, a part with its part, lpol and
  * lreg chunks, lpol 24 KB of light pool), and
  * builtin:room at max edge 0 (the room's 261 KB are
@@ -206,8 +207,8 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *bake = argv[1], *info = argv[2], *dir = argv[3];
-    char obj[4096], a[4096], b[4096], c[4096], room[4096], var[4096], cp[4096], cw[4096], pt[4096],
-        err_path[4096];
+    char obj[4096], a[4096], b[4096], c[4096], room[4096], var[4096], cp[4096], cw[4096], c8[4096],
+        pt[4096], err_path[4096];
     mkdir(dir, 0755);
     snprintf(obj, sizeof obj, "%s/scene.obj", dir);
     snprintf(a, sizeof a, "%s/scene-f16.vdsh", dir);
@@ -217,6 +218,7 @@ int main(int argc, char **argv)
     snprintf(var, sizeof var, "%s/scene-var.vdsh", dir);
     snprintf(cp, sizeof cp, "%s/scene-cpca.vdsh", dir);
     snprintf(cw, sizeof cw, "%s/scene-cpca-widths.vdsh", dir);
+    snprintf(c8, sizeof c8, "%s/scene-cpca-s8.vdsh", dir);
     snprintf(pt, sizeof pt, "%s/scene-cpca-part.vdsh", dir);
     snprintf(err_path, sizeof err_path, "%s/bake.err", dir);
     if (write_all(obj, (const uint8_t *)scene_obj, sizeof scene_obj - 1) != 0) {
@@ -261,6 +263,25 @@ int main(int argc, char **argv)
     char *bake_cw[] = {(char *)bake,  obj,          "--max-edge", "1",  "--rays",     "64",
                        "--cube-size", "0",          "--orders",   "6",  "--encoding", "cpca",
                        "--cpca",      "3,alloc:60", "-q",         "-o", cw,           NULL};
+    /* s8 bases (--cpca ...,bases:8: the bits word's flag, a byte per value) */
+    char *bake_c8[] = {(char *)bake,
+                       obj,
+                       "--max-edge",
+                       "1",
+                       "--rays",
+                       "64",
+                       "--cube-size",
+                       "0",
+                       "--orders",
+                       "6",
+                       "--encoding",
+                       "cpca",
+                       "--cpca",
+                       "3,alloc:60,bases:8",
+                       "-q",
+                       "-o",
+                       c8,
+                       NULL};
     /* a part of a sharded cpca bake: the part chunk, lpol (the light
      * pool of the byte-budget settings' light-density metric) and lreg
      * (--light-region grown: the pool placed around the scene) */
@@ -271,16 +292,18 @@ int main(int argc, char **argv)
     int ok = run(bake_a, err_path) == 0 && run(bake_b, err_path) == 0 &&
              run(bake_c, err_path) == 0 && run(bake_room, err_path) == 0 &&
              run(bake_var, err_path) == 0 && run(bake_cp, err_path) == 0 &&
-             run(bake_cw, err_path) == 0 && run(bake_pt, err_path) == 0;
+             run(bake_cw, err_path) == 0 && run(bake_c8, err_path) == 0 &&
+             run(bake_pt, err_path) == 0;
     CHECK(ok, "vdsh-bake failed (see %s)", err_path);
     if (!ok)
         return test_report("robust_corrupt");
 
-    const char *names[8] = {
-        "scene-f16.vdsh", "scene-f32.vdsh",  "scene-s8s6.vdsh",        "room.vdsh",
-        "scene-var.vdsh", "scene-cpca.vdsh", "scene-cpca-widths.vdsh", "scene-cpca-part.vdsh"};
-    const char *paths[8] = {a, b, c, room, var, cp, cw, pt};
-    for (int k = 0; k < 8; k++) {
+    const char *names[9] = {
+        "scene-f16.vdsh",      "scene-f32.vdsh",  "scene-s8s6.vdsh",        "room.vdsh",
+        "scene-var.vdsh",      "scene-cpca.vdsh", "scene-cpca-widths.vdsh", "scene-cpca-s8.vdsh",
+        "scene-cpca-part.vdsh"};
+    const char *paths[9] = {a, b, c, room, var, cp, cw, c8, pt};
+    for (int k = 0; k < 9; k++) {
         size_t size;
         uint8_t *data = test_read_file(paths[k], &size);
         CHECK(data && size > 64, "cannot read %s", paths[k]);

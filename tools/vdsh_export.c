@@ -682,7 +682,7 @@ static int export_cpca(const vdsh_stream *s, uint32_t nv, const char *prefix, vi
     for (size_t i = 0; i < K * nc; i++)
         model[K * B + i] = vdsh_f32_from_f16(m->means[i]);
     for (size_t i = 0; i < K * B * nc; i++)
-        model[K * B + K * nc + i] = vdsh_f32_from_f16(m->bases[i]);
+        model[K * B + K * nc + i] = vdsh_cpca_basis_value(m, i);
     int mview = add_view(vl, model, floats * sizeof *model, 4, 0);
     free(model);
     if (mview < 0)

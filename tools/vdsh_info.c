@@ -278,9 +278,10 @@ static void print_cpca(const vdsh_file *f, const vdsh_stream *s)
     size_t bpv = vdsh_stream_bytes_per_vertex(s);
     unsigned long long model = (unsigned long long)vdsh_cpca_stream_model_bytes(m, s->order);
     printf("        cpca: %u cluster%s, %u basis vector%s of %s weights; %zu byte%s "
-           "per vertex, %.1f with the model (%llu byte%s)\n",
+           "per vertex, %.1f with the model (%llu byte%s, %s bases)\n",
            m->clusters, vdsh_s(m->clusters), m->basis, vdsh_s(m->basis),
-           m->bits ? wbits : "per-vector", bpv, vdsh_s(bpv), z.mean_bytes, model, vdsh_s(model));
+           m->bits ? wbits : "per-vector", bpv, vdsh_s(bpv), z.mean_bytes, model, vdsh_s(model),
+           m->bases_s8 ? "s8" : "f16");
     if (!m->bits) { /* runs, vector 1 first: 7x3 is three vectors of 7 bits */
         printf("        widths:");
         for (uint32_t j = 0; j < m->basis;) {
@@ -510,6 +511,7 @@ static int print_json(const char *path, const vdsh_file *f, uint64_t size)
             vt_json_u64(&j, cp, "clusters", s->cpca.clusters);
             vt_json_u64(&j, cp, "basis", s->cpca.basis);
             vt_json_u64(&j, cp, "bits", s->cpca.bits);
+            vt_json_string(&j, cp, "bases", s->cpca.bases_s8 ? "s8" : "f16");
             vt_json_u64(&j, cp, "record_words", s->cpca.record_words);
             vt_json_u64(&j, cp, "model_bytes", vdsh_cpca_stream_model_bytes(&s->cpca, s->order));
             if (!s->cpca.bits) {

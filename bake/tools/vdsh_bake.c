@@ -201,8 +201,11 @@ static void usage(FILE *f)
             "                          decision margin) and ,starts:N (N k-means starts,\n"
             "                          the one whose decisions over the pool differ\n"
             "                          least kept, on up to --threads threads: N fits\n"
-            "                          and one score of the pool); a K,alloc:BYTES said\n"
-            "                          has no margin and one start unless said.\n"
+            "                          and one score of the pool) and ,bases:8 (the\n"
+            "                          basis vectors stored in 8 bits, not f16: the bytes\n"
+            "                          freed go to the weights; docs/ACCURACY.md \"Bases\n"
+            "                          in 8 bits\"); a K,alloc:BYTES said has no margin,\n"
+            "                          one start and f16 bases unless said.\n"
             "                          Default %u,alloc:%u,margin:%g,starts:%u (order 12\n"
             "                          within 3%% of uncompressed on 13 of 15 validation\n"
             "                          bakes, mean +1.5%%; %u,alloc:%u alone 11 of 15,\n"
@@ -1000,7 +1003,7 @@ static int read_choice(int c, const char *arg, options *o)
                 "or auto or auto:BYTES, or K,alloc:BYTES (a width per basis vector), bytes "
                 "per vertex 1..4096 (default 16,alloc:32,margin:0.25,starts:2), each optionally "
                 "ending in ,light:A (the light mix A in 0..1), and K,alloc:BYTES in ,margin:S "
-                "(S > 0) and ,starts:N (1..16), or those options alone: %s",
+                "(S > 0), ,starts:N (1..16) and ,bases:8|16, or those options alone: %s",
                 e.msg);
             return bad_usage("%s", msg);
         }

@@ -7,7 +7,8 @@
     c = vdsh.coefficients(s)           # V x order^2 float32 (stored x scale;
                                        # s8, s8s6: stored x float32(scale_i / levels_i))
     s["cpca"]                          # a cpca stream (VDSH.md "cpca streams"): dict clusters,
-                                       # basis, bits (0: a width per vector), record_words,
+                                       # basis, bits (0: a width per vector), bases_s8 (the
+                                       # bases stored s8, else f16), record_words,
                                        # widths (B ints), scales (K x B), means
                                        # (K x n^2), bases (K x B x n^2) float32, cluster (V),
                                        # levels (V x B ints); c is decoded as vdsh.c does
@@ -242,7 +243,7 @@ def parse(data: bytes, path: str = "memory") -> VdshFile:
     if f.light_pool is not None and (not f.part or f.part["encoding"] != "cpca"):
         _fail(path, "lpol: a light pool outside a cpca part")
     if f.light_pool is not None and (f.light_pool["margin"] or f.light_pool["starts"]) and (
-            not f.part["cpca_clusters"] or f.part["cpca_bits"]):
+            not f.part["cpca_clusters"] or f.part["cpca_bits"] & ~0x100):
         _fail(path, "lpol: a margin or starts with cpca settings other than K,alloc:BYTES")
     return f
 
@@ -332,8 +333,9 @@ def _chunk(f, cid, b, path):
                   % (i, n, rb, re, enc))
         if enc != 4 and (ck or cb or cbits):
             _fail(path, "part: cpca settings with encoding %s (must be 0)" % ENCODINGS[enc])
-        if enc == 4 and (ck == 0 or cbits == 0):  # auto: 0, budget, 0; alloc: K, budget, 0
-            if not (ck <= 256 and 1 <= cb <= 4096 and cbits == 0):
+        if enc == 4 and (ck == 0 or cbits in (0, 0x100)):
+            # auto: 0, budget, 0; alloc: K, budget, 0 or 0x100 (s8 bases)
+            if not (ck <= 256 and 1 <= cb <= 4096 and (cbits == 0 or ck)):
                 _fail(path, "part: cpca %s settings %d,%d,%d out of range"
                       % ("auto" if ck == 0 else "alloc", ck, cb, cbits))
         elif enc == 4 and not (1 <= ck <= 256 and 1 <= cb <= 256 and 2 <= cbits <= 8):
@@ -545,6 +547,8 @@ def _cpca(b, order, V, path):
     if len(b) < 64:
         _fail(path, "COEF: shorter than its cpca header")
     K, B, bits, W = struct.unpack_from("<4I", b, 48)
+    s8 = bool(bits & 0x100)  # VDSH_CPCA_BASES_S8: the bases s8, not f16
+    bits &= ~0x100
     if not (1 <= K <= 256 and 1 <= B <= nc and (bits == 0 or 2 <= bits <= 8)):
         _fail(path, "COEF: cpca clusters %d, basis %d or bits %d out of range" % (K, B, bits))
     r16 = lambda n: (n + 15) // 16 * 16  # noqa: E731
@@ -563,21 +567,24 @@ def _cpca(b, order, V, path):
     fields = _cpca_fields(int(x) for x in widths)
     if W != (fields[-1][0] + 1):
         _fail(path, "COEF: cpca record_words %d, must be %d" % (W, fields[-1][0] + 1))
-    sizes = [4 * K * B, 2 * K * nc, 2 * K * B * nc]
+    sizes = [4 * K * B, 2 * K * nc, (1 if s8 else 2) * K * B * nc]
     model = at + sum(r16(x) for x in sizes)
     if len(b) != model + 4 * W * V:
         _fail(path, "COEF: payload is %d byte%s, must be %d" % (len(b), _s(len(b)), model + 4 * W * V))
     arrays = []
-    for x, dt, shape in zip(sizes, ["<f4", "<f2", "<f2"], [(K, B), (K, nc), (K, B, nc)]):
+    for x, dt, shape in zip(sizes, ["<f4", "<f2", "i1" if s8 else "<f2"],
+                            [(K, B), (K, nc), (K, B, nc)]):
         if any(b[at + x:at + r16(x)]):
             _fail(path, "COEF: padding after a cpca array not zero")
-        arrays.append(np.frombuffer(b, dt, x // (4 if dt == "<f4" else 2), at).reshape(shape))
+        arrays.append(np.frombuffer(b, dt, x // np.dtype(dt).itemsize, at).reshape(shape))
         at += r16(x)
     scales, means16, bases16 = arrays
     if not (np.isfinite(scales).all() and (scales >= 0).all()):
         _fail(path, "COEF: a cpca scale is not finite and >= 0")
     if not (np.isfinite(means16).all() and np.isfinite(bases16).all()):
         _fail(path, "COEF: a cpca mean or basis value is not finite")
+    if s8 and (bases16 == -128).any():
+        _fail(path, "COEF: a cpca s8 basis value is -128 (-127..127)")
     L = (1 << (widths - 1)) - 1  # per vector
     step = (scales.astype(np.float32) / L.astype(np.float32)).astype(np.float32)
     means = means16.astype(np.float32)
@@ -608,7 +615,8 @@ def _cpca(b, order, V, path):
     wts = levels.astype(np.float32) * step[cluster]
     for j in range(B):
         out = out + wts[:, j:j + 1] * bases[cluster, j]
-    return out.astype(np.float32), dict(clusters=K, basis=B, bits=bits, record_words=W,
+    return out.astype(np.float32), dict(clusters=K, basis=B, bits=bits, bases_s8=s8,
+                                        record_words=W,
                                         widths=widths.astype(np.int32),
                                         scales=scales.astype(np.float32), means=means,
                                         bases=bases, cluster=cluster, levels=levels)
