@@ -39,7 +39,8 @@ vdsh_cpca_settings vdsh_cpca_settings_default(void)
                             .budget = VDSH_CPCA_DEFAULT_BUDGET,
                             .light_mix = VDSH_CPCA_DEFAULT_LIGHT_MIX,
                             .margin = VDSH_CPCA_DEFAULT_MARGIN,
-                            .starts = VDSH_CPCA_DEFAULT_STARTS};
+                            .starts = VDSH_CPCA_DEFAULT_STARTS,
+                            .bases_s8 = VDSH_CPCA_DEFAULT_BASES_S8};
     return s;
 }
 
@@ -207,14 +208,15 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
     }
     /* Not said: the light density for the byte-budget forms, the uniform
      * hemisphere for fixed widths; the default's margin and starts with
-     * the options alone and the light density, none with a base said
+     * the options alone and the light density, none with a base said; the
+     * default's s8 bases with the options alone, f16 with a base said
      * (vdsh_cpca.h). */
     const int base = opts != buf;
     s.light_mix = said[0] ? (float)value[0] : s.budget ? VDSH_CPCA_DEFAULT_LIGHT_MIX : 0.0f;
     const int deflt = !base && s.light_mix > 0.0f;
     s.margin = said[1] ? (float)value[1] : deflt ? VDSH_CPCA_DEFAULT_MARGIN : 0.0f;
     s.starts = said[2] ? (uint32_t)value[2] : deflt ? VDSH_CPCA_DEFAULT_STARTS : 0;
-    s.bases_s8 = said[3] ? value[3] == 8.0 : 0;
+    s.bases_s8 = said[3] ? value[3] == 8.0 : base ? 0 : VDSH_CPCA_DEFAULT_BASES_S8;
     if ((said[1] || said[2]) && !(s.budget && s.clusters && s.light_mix > 0.0f))
         return vdsh_failf(err, VDSH_ERR_ARGUMENT,
                           "cpca settings '%s': margin:S and starts:N need K,alloc:BYTES with a "

@@ -958,24 +958,28 @@ static void light_metric(void)
     /* the default: K,alloc:BYTES (16,alloc:32) with the default light mix,
      * margin and starts (docs/ACCURACY.md "The default of --encoding cpca",
      * "The margin and two starts become the default"), what the text
-     * "16,alloc:32,margin:0.25,starts:2" gives; the base said alone has
-     * neither margin nor starts; an option alone keeps the default's others */
+     * "16,alloc:32,margin:0.25,starts:2,bases:8" gives; the base said alone
+     * has neither margin nor starts and f16 bases; an option alone keeps
+     * the default's others */
     CHECK(d.clusters == VDSH_CPCA_DEFAULT_CLUSTERS && d.budget == VDSH_CPCA_DEFAULT_BUDGET &&
               d.basis == 0 && d.bits == 0 && d.light_mix == VDSH_CPCA_DEFAULT_LIGHT_MIX &&
               d.margin == VDSH_CPCA_DEFAULT_MARGIN && d.starts == VDSH_CPCA_DEFAULT_STARTS &&
-              d.margin > 0.0f && d.starts > 1 && !d.light_count && !d.lights && !d.positions,
-          "the default settings: K,alloc:BYTES with the default light mix, margin and starts");
+              d.margin > 0.0f && d.starts > 1 && d.bases_s8 == VDSH_CPCA_DEFAULT_BASES_S8 &&
+              !d.light_count && !d.lights && !d.positions,
+          "the default settings: K,alloc:BYTES with the default light mix, margin, starts and "
+          "bases");
     {
         char text[64];
-        snprintf(text, sizeof text, "%u,alloc:%u,margin:%g,starts:%u", (unsigned)d.clusters,
-                 (unsigned)d.budget, (double)d.margin, (unsigned)d.starts);
+        snprintf(text, sizeof text, "%u,alloc:%u,margin:%g,starts:%u%s", (unsigned)d.clusters,
+                 (unsigned)d.budget, (double)d.margin, (unsigned)d.starts,
+                 d.bases_s8 ? ",bases:8" : "");
         CHECK(vdsh_cpca_parse(text, &p, &err) == VDSH_OK && same_settings(&p, &d),
               "the default settings are %s's", text);
         snprintf(text, sizeof text, "%u,alloc:%u", (unsigned)d.clusters, (unsigned)d.budget);
         CHECK(vdsh_cpca_parse(text, &p, &err) == VDSH_OK && p.clusters == d.clusters &&
                   p.budget == d.budget && p.light_mix == d.light_mix && p.margin == 0.0f &&
-                  p.starts == 0,
-              "%s said: not one start without the margin", text);
+                  p.starts == 0 && !p.bases_s8,
+              "%s said: not one start without the margin, f16 bases", text);
     }
     /* vdsh_cpca_settings_text: what parse reads back as the same settings */
     {
@@ -993,7 +997,7 @@ static void light_metric(void)
         char text[192], small[8];
         vdsh_cpca_settings_text(&d, text, sizeof text);
         vdsh_cpca_settings_text(&d, small, sizeof small);
-        CHECK(!strcmp(text, "16,alloc:32,light:1,margin:0.25,starts:2") &&
+        CHECK(!strcmp(text, "16,alloc:32,light:1,margin:0.25,starts:2,bases:8") &&
                   !strcmp(small, "16,allo"),
               "the default's text %s (truncated: %s)", text, small);
     }

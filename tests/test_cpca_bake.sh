@@ -6,7 +6,7 @@
 # within f16 and quantisation rounding; with the default-like settings
 # well below the coefficients' spread); --adaptive-order's stream, as a
 # fixed cpca stream of its cap, is alike (threads, shards, decode error);
-# the default settings (16,alloc:32,margin:0.25,starts:2, light:1) alike; bad settings are
+# the default settings (16,alloc:32,margin:0.25,starts:2,bases:8, light:1) alike; bad settings are
 # usage errors and parts of other settings are refused by the merge.
 # Usage: test_cpca_bake.sh VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR
 set -u
@@ -112,7 +112,7 @@ expect_exit 0 "default cpca, 5 threads" "$bake" builtin:room --max-edge 1.0 --ra
   --cube-size 0 --orders 3,7 --encoding cpca --threads 5 -o "$tmp/d5.vdsh"
 check "default cpca, 1 and 5 threads (each start's fit on 2): identical" cmp "$tmp/d1.vdsh" "$tmp/d5.vdsh"
 # the encode, most of a high order's bake, is said before and after
-says_any "the cpca fit announced" "cpca: fitting 16,alloc:32,light:1,margin:0.25,starts:2 over"
+says_any "the cpca fit announced" "cpca: fitting 16,alloc:32,light:1,margin:0.25,starts:2,bases:8 over"
 says_any "the cpca fit's time" "cpca: fitted in"
 mkdir -p "$tmp/d3"
 for i in 0 1 2; do
@@ -127,7 +127,7 @@ check "default cpca, 3 shards merged on 1 thread: identical" cmp "$tmp/d3/scene1
 expect_exit 2 "vdsh-merge --threads 0" "$merge" -q --threads 0 "$tmp"/d3/p*.vdsh -o "$tmp/d3/t0.vdsh"
 check "vdsh-merge --threads 0: no file" test ! -e "$tmp/d3/t0.vdsh"
 expect_exit 0 "vdsh-info on a default part" "$info" "$tmp/d3/p1.vdsh"
-says_any "a default part's settings" "cpca 16,alloc:32,light:1,margin:0.25,starts:2"
+says_any "a default part's settings" "cpca 16,alloc:32,light:1,margin:0.25,starts:2,bases:8"
 
 # Against the f32 bake of the same options.
 expect_exit 0 "f32 bake" "$bake" "${tiny[@]}" --encoding f32 -o "$tmp/f32.vdsh"

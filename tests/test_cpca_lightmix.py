@@ -90,18 +90,19 @@ spread = np.sqrt(((x - x.mean(0)) ** 2).sum(1).mean())
 
 CPCA = ["--encoding", "cpca", "--cpca"]
 # the default settings, as vdsh-bake --help says them
-# (16,alloc:32,margin:0.25,starts:2), and their base (16,alloc:32)
+# (16,alloc:32,margin:0.25,starts:2,bases:8), and their base (16,alloc:32)
 helptext = subprocess.run([bake, "--help"], capture_output=True, text=True).stdout
 DEFAULT = helptext.split("Default ")[1].split()[0]
 BASE = ",".join(DEFAULT.split(",")[:2])
+S8 = ",bases:8" if DEFAULT.endswith(",bases:8") else ""  # the default's bases, not the base's
 if ",alloc:" not in BASE or ",margin:" not in DEFAULT or ",starts:" not in DEFAULT:
     fail.append("--help's default settings %r are not K,alloc:BYTES,margin:S,starts:N" % DEFAULT)
 for name, setting in (("l0", "4,alloc:40,light:0"), ("l05", "4,alloc:40,light:0.5"),
                       ("l1", "4,alloc:40,light:1"), ("def", "4,alloc:40"),
-                      ("l0alone", "light:0"), ("l0full", BASE + ",light:0"),
+                      ("l0alone", "light:0"), ("l0full", BASE + ",light:0" + S8),
                       ("l1full", DEFAULT + ",light:1"), ("plain", None),
                       ("base", BASE), ("st1alone", "starts:1"),
-                      ("st1full", BASE + ",margin:" + DEFAULT.split("margin:")[1].split(",")[0]),
+                      ("st1full", BASE + ",margin:" + DEFAULT.split("margin:")[1].split(",")[0] + S8),
                       ("fixed", "8,54,4"), ("fixed0", "8,54,4,light:0")):
     must(run_bake(name + ".vdsh", CPCA + [setting] if setting else CPCA[:2]), str(setting))
     got = vdsh.coefficients(vdsh.read(path(name + ".vdsh")).streams[0]).astype(np.float64)

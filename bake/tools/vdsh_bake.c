@@ -206,14 +206,14 @@ static void usage(FILE *f)
             "                          freed go to the weights; docs/ACCURACY.md \"Bases\n"
             "                          in 8 bits\"); a K,alloc:BYTES said has no margin,\n"
             "                          one start and f16 bases unless said.\n"
-            "                          Default %u,alloc:%u,margin:%g,starts:%u (order 12\n"
-            "                          within 3%% of uncompressed on 13 of 15 validation\n"
-            "                          bakes, mean +1.5%%; %u,alloc:%u alone 11 of 15,\n"
-            "                          +2.0%%, at half the encode's CPU time:\n"
-            "                          docs/ACCURACY.md \"The margin and two starts become\n"
-            "                          the default\"); options alone change the default's\n"
-            "                          (starts:1, margin:0.5; light:0 alone: the uniform\n"
-            "                          metric, no margin, one start)\n"
+            "                          Default %u,alloc:%u,margin:%g,starts:%u%s (order\n"
+            "                          12 within 3%% of uncompressed on 14 of 15\n"
+            "                          validation bakes, mean +1.1%%; with f16 bases 13,\n"
+            "                          +1.5%%; %u,alloc:%u alone 11, +2.0%%, at half the\n"
+            "                          encode's CPU time: docs/ACCURACY.md \"Bases in 8\n"
+            "                          bits\"); options alone change the default's\n"
+            "                          (starts:1, margin:0.5, bases:16; light:0 alone: the\n"
+            "                          uniform metric, no margin, one start)\n"
             "      --shard I/N         bake shard I (0-based) of N only and write a part\n"
             "                          file; vdsh-merge joins the N parts into the file\n"
             "                          the whole bake writes, byte for byte\n"
@@ -371,13 +371,13 @@ static void usage(FILE *f)
             VB_DEFAULT_CUBE_SIZE, VB_SDF_MIN_RESOLUTION, VB_SDF_MAX_RESOLUTION, VDSH_MAX_ORDER,
             (double)VDSH_CPCA_DEFAULT_LIGHT_MIX, VDSH_CPCA_DEFAULT_CLUSTERS,
             VDSH_CPCA_DEFAULT_BUDGET, (double)VDSH_CPCA_DEFAULT_MARGIN, VDSH_CPCA_DEFAULT_STARTS,
-            VDSH_CPCA_DEFAULT_CLUSTERS, VDSH_CPCA_DEFAULT_BUDGET, VB_DEFAULT_RAYS, rays_side,
-            rays_side, VB_DEFAULT_RAYS, (double)VB_DEFAULT_RAY_TOLERANCE, VDSH_MAX_ORDER,
-            VB_DEFAULT_ORDER_CAP, methods_help(), (double)VB_DEFAULT_LAMBDA,
-            (double)vb_shadow_log_offset(2), (double)vb_shadow_log_offset(3),
-            (double)vb_shadow_log_offset(5), (double)VB_DEFAULT_FALSE_RATE, VB_DECISION_MAX_PAIRS,
-            VB_DEFAULT_DECISION_LIGHTS, VB_DEFAULT_DECISION_NEAR, VB_ADAPTIVE_ROUNDS,
-            VB_DEFAULT_CREASE, VB_DEFAULT_SEED);
+            VDSH_CPCA_DEFAULT_BASES_S8 ? ",bases:8" : "", VDSH_CPCA_DEFAULT_CLUSTERS,
+            VDSH_CPCA_DEFAULT_BUDGET, VB_DEFAULT_RAYS, rays_side, rays_side, VB_DEFAULT_RAYS,
+            (double)VB_DEFAULT_RAY_TOLERANCE, VDSH_MAX_ORDER, VB_DEFAULT_ORDER_CAP, methods_help(),
+            (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
+            (double)vb_shadow_log_offset(3), (double)vb_shadow_log_offset(5),
+            (double)VB_DEFAULT_FALSE_RATE, VB_DECISION_MAX_PAIRS, VB_DEFAULT_DECISION_LIGHTS,
+            VB_DEFAULT_DECISION_NEAR, VB_ADAPTIVE_ROUNDS, VB_DEFAULT_CREASE, VB_DEFAULT_SEED);
 }
 
 static int bad_usage(const char *fmt, const char *arg)
@@ -1001,7 +1001,7 @@ static int read_choice(int c, const char *arg, options *o)
                 msg, sizeof msg,
                 "--cpca takes K,B,BITS: clusters 1..256, basis vectors 1..256, bits 2..8, "
                 "or auto or auto:BYTES, or K,alloc:BYTES (a width per basis vector), bytes "
-                "per vertex 1..4096 (default 16,alloc:32,margin:0.25,starts:2), each optionally "
+                "per vertex 1..4096 (default 16,alloc:32,margin:0.25,starts:2,bases:8), each optionally "
                 "ending in ,light:A (the light mix A in 0..1), and K,alloc:BYTES in ,margin:S "
                 "(S > 0), ,starts:N (1..16) and ,bases:8|16, or those options alone: %s",
                 e.msg);
