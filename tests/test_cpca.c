@@ -283,6 +283,18 @@ static void line_and_blob(void)
     vdsh_cpca_fit_free(&fit);
 }
 
+/* A cpca stream of order ORDER (a distance fit) of these records and model. */
+static vdsh_stream stream_of(const uint32_t *records, const vdsh_cpca *model)
+{
+    return (vdsh_stream){.order = ORDER,
+                         .encoding = VDSH_ENCODING_CPCA,
+                         .method = VDSH_METHOD_LSQ,
+                         .quantity = VDSH_QUANTITY_DISTANCE,
+                         .scale = 1.0f,
+                         .data = records,
+                         .cpca = *model};
+}
+
 static double rms_vs(const vdsh_stream *s, const float *want)
 {
     float c[VDSH_MAX_COEFFS];
@@ -358,11 +370,7 @@ static void widths_study(void)
     CHECK(vdsh_cpca_encode_widths(src, normals, ROWS, ORDER, &st, 2 * B, 0.0, uni, dec, &wf,
                                   &err) == VDSH_OK,
           "widths, uniform: %s", err.msg);
-    vdsh_stream s = {.order = ORDER,
-                     .encoding = VDSH_ENCODING_CPCA,
-                     .scale = 1.0f,
-                     .data = fit.records,
-                     .cpca = fit.model};
+    vdsh_stream s = stream_of(fit.records, &fit.model);
     int same = wf.basis == B && wf.words == fit.model.record_words;
     for (uint32_t v = 0; v < ROWS; v++) {
         float c[VDSH_MAX_COEFFS];
@@ -455,11 +463,7 @@ static void widths_stream(const vdsh_cpca_fit *fit, const char *out_dir)
     static uint32_t rec[ROWS * 2];
     static int32_t lv[ROWS][B];
     memset(rec, 0, sizeof rec);
-    vdsh_stream u = {.order = ORDER,
-                     .encoding = VDSH_ENCODING_CPCA,
-                     .scale = 1.0f,
-                     .data = fit->records,
-                     .cpca = fit->model};
+    vdsh_stream u = stream_of(fit->records, &fit->model);
     for (uint32_t v = 0; v < ROWS; v++) {
         int32_t q[VDSH_MAX_COEFFS];
         vdsh_cpca_weights(&u, v, q, NULL);
@@ -472,13 +476,7 @@ static void widths_stream(const vdsh_cpca_fit *fit, const char *out_dir)
             rec[v * 2 + word] |= ((uint32_t)lv[v][j] & ((1u << wd[j]) - 1u)) << shift;
         }
     }
-    vdsh_stream s = {.order = ORDER,
-                     .encoding = VDSH_ENCODING_CPCA,
-                     .method = VDSH_METHOD_LSQ,
-                     .quantity = VDSH_QUANTITY_DISTANCE,
-                     .scale = 1.0f,
-                     .data = rec,
-                     .cpca = m};
+    vdsh_stream s = stream_of(rec, &m);
     vdsh_file f = file_of(&s);
     void *mem = NULL;
     size_t size = 0;
@@ -579,13 +577,7 @@ static void alloc_settings(void)
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &b, &err) == VDSH_OK, "alloc 2: %s",
           err.msg);
     const vdsh_cpca *m = &a.model;
-    vdsh_stream s = {.order = ORDER,
-                     .encoding = VDSH_ENCODING_CPCA,
-                     .method = VDSH_METHOD_LSQ,
-                     .quantity = VDSH_QUANTITY_DISTANCE,
-                     .scale = 1.0f,
-                     .data = a.records,
-                     .cpca = *m};
+    vdsh_stream s = stream_of(a.records, m);
     uint64_t bytes = (uint64_t)ROWS * 4 * m->record_words + vdsh_cpca_stream_model_bytes(m, ORDER);
     int ok = m->bits == 0 && m->widths && m->clusters == 3 && m->basis >= 1 &&
              m->record_words == vdsh_cpca_widths_words(m->widths, m->basis);
@@ -701,13 +693,7 @@ static void s8_bases(const char *dir)
               "s8: other bytes on %u thread%s", t, vdsh_s(t));
         vdsh_cpca_fit_free(&b);
     }
-    vdsh_stream s = {.order = ORDER,
-                     .encoding = VDSH_ENCODING_CPCA,
-                     .method = VDSH_METHOD_LSQ,
-                     .quantity = VDSH_QUANTITY_DISTANCE,
-                     .scale = 1.0f,
-                     .data = a.records,
-                     .cpca = *m};
+    vdsh_stream s = stream_of(a.records, m);
     CHECK(fabs(rms_vs(&s, src) - a.rms_error) <= 1e-9 * (1 + a.rms_error), "s8: rms %g vs %g",
           a.rms_error, rms_vs(&s, src));
     vdsh_file f = file_of(&s);
@@ -1102,11 +1088,7 @@ static void pool_score(void)
     CHECK(vdsh_cpca_pool_score(src, normals, ROWS, ORDER, &st, &f, &b, &err) == VDSH_OK &&
               memcmp(&a, &b, sizeof a) == 0,
           "pool score: not the same twice");
-    vdsh_stream s = {.order = ORDER,
-                     .encoding = VDSH_ENCODING_CPCA,
-                     .scale = 1.0f,
-                     .data = f.records,
-                     .cpca = f.model};
+    vdsh_stream s = stream_of(f.records, &f.model);
     uint64_t pairs = 0, differ = 0, missed = 0;
     double sq = 0.0;
     float dec[VDSH_MAX_COEFFS], y[VDSH_MAX_COEFFS];
@@ -1186,13 +1168,7 @@ int main(int argc, char **argv)
         vdsh_cpca_fit_free(&again);
     }
 
-    vdsh_stream s = {.order = ORDER,
-                     .encoding = VDSH_ENCODING_CPCA,
-                     .method = VDSH_METHOD_LSQ,
-                     .quantity = VDSH_QUANTITY_DISTANCE,
-                     .scale = 1.0f,
-                     .data = fit.records,
-                     .cpca = fit.model};
+    vdsh_stream s = stream_of(fit.records, &fit.model);
     /* the clusters follow the normals: each cluster's vertices share one */
     for (uint32_t v = 0; v < ROWS; v++) {
         uint32_t c = vdsh_cpca_cluster(&s, v);

@@ -32,20 +32,27 @@ says_any "vdsh-info shows the model" "cpca: 4 clusters, 20 basis vectors of 4-bi
 expect_exit 0 "vdsh-info on a part" "$info" "$tmp/n3/p1.vdsh"
 says_any "vdsh-info shows a part's settings" "cpca 4,20,4,light:"
 
+# same_bytes WHAT P SETTING: the tiny bake with --cpca SETTING on 1 and 2
+# threads ($tmp/${P}1.vdsh, ${P}2) and as 3 shards merged ($tmp/${P}3/),
+# byte for byte the same.
+same_bytes() {
+  local what=$1 p=$2 set=(--encoding cpca --cpca "$3")
+  expect_exit 0 "$what, 1 thread" "$bake" "${tiny[@]}" "${set[@]}" --threads 1 -o "$tmp/${p}1.vdsh"
+  expect_exit 0 "$what, 2 threads" "$bake" "${tiny[@]}" "${set[@]}" --threads 2 -o "$tmp/${p}2.vdsh"
+  check "$what, 1 and 2 threads: identical" cmp "$tmp/${p}1.vdsh" "$tmp/${p}2.vdsh"
+  mkdir -p "$tmp/${p}3"
+  for i in 0 1 2; do
+    expect_exit 0 "$what shard $i/3" "$bake" "${tiny[@]}" "${set[@]}" --shard "$i/3" \
+      -o "$tmp/${p}3/p$i.vdsh"
+  done
+  expect_exit 0 "$what merge" "$merge" -q "$tmp/${p}3"/p*.vdsh -o "$tmp/${p}3/scene.vdsh"
+  check "$what, 3 shards: identical to the whole bake" cmp "$tmp/${p}3/scene.vdsh" "$tmp/${p}1.vdsh"
+}
+
 # A width per basis vector (--cpca K,alloc:BYTES): whole bake = 2 threads
 # = 3 shards merged, byte for byte; vdsh-info shows the widths and a
 # part's settings.
-ca=(--encoding cpca --cpca 4,alloc:40)
-expect_exit 0 "alloc cpca, 1 thread" "$bake" "${tiny[@]}" "${ca[@]}" --threads 1 -o "$tmp/c1.vdsh"
-expect_exit 0 "alloc cpca, 2 threads" "$bake" "${tiny[@]}" "${ca[@]}" --threads 2 -o "$tmp/c2.vdsh"
-check "alloc cpca, 1 and 2 threads: identical" cmp "$tmp/c1.vdsh" "$tmp/c2.vdsh"
-mkdir -p "$tmp/c3"
-for i in 0 1 2; do
-  expect_exit 0 "alloc cpca shard $i/3" "$bake" "${tiny[@]}" "${ca[@]}" --shard "$i/3" \
-    -o "$tmp/c3/p$i.vdsh"
-done
-expect_exit 0 "alloc cpca merge" "$merge" -q "$tmp"/c3/p*.vdsh -o "$tmp/c3/scene.vdsh"
-check "alloc cpca, 3 shards: identical to the whole bake" cmp "$tmp/c3/scene.vdsh" "$tmp/c1.vdsh"
+same_bytes "alloc cpca" c 4,alloc:40
 expect_exit 0 "vdsh-info, alloc" "$info" "$tmp/c1.vdsh"
 says_any "vdsh-info shows per-vector weights" "basis vectors of per-vector weights"
 says_any "vdsh-info shows the widths" "widths: "
@@ -66,17 +73,7 @@ assert c["bits"] == 0 and len(c["widths"]) == c["basis"] and 2 <= min(c["widths"
 # the merge refuses an f16 part beside an s8 one; vdsh-info says s8; the
 # bytes freed go to the records (more vectors or words than f16's at the
 # same budget, within it).
-c8=(--encoding cpca --cpca 4,alloc:40,bases:8)
-expect_exit 0 "s8 bases, 1 thread" "$bake" "${tiny[@]}" "${c8[@]}" --threads 1 -o "$tmp/s1.vdsh"
-expect_exit 0 "s8 bases, 2 threads" "$bake" "${tiny[@]}" "${c8[@]}" --threads 2 -o "$tmp/s2.vdsh"
-check "s8 bases, 1 and 2 threads: identical" cmp "$tmp/s1.vdsh" "$tmp/s2.vdsh"
-mkdir -p "$tmp/s3"
-for i in 0 1 2; do
-  expect_exit 0 "s8 bases shard $i/3" "$bake" "${tiny[@]}" "${c8[@]}" --shard "$i/3" \
-    -o "$tmp/s3/p$i.vdsh"
-done
-expect_exit 0 "s8 bases merge" "$merge" -q "$tmp"/s3/p*.vdsh -o "$tmp/s3/scene.vdsh"
-check "s8 bases, 3 shards: identical to the whole bake" cmp "$tmp/s3/scene.vdsh" "$tmp/s1.vdsh"
+same_bytes "s8 bases" s 4,alloc:40,bases:8
 expect_exit 1 "merge of an s8 part with f16 parts" "$merge" -q "$tmp/s3/p0.vdsh" "$tmp/c3/p1.vdsh" \
   "$tmp/c3/p2.vdsh" -o "$tmp/s3/mixed.vdsh"
 says_any "the mixed merge names the setting" "another --cpca"
