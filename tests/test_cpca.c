@@ -295,6 +295,29 @@ static vdsh_stream stream_of(const uint32_t *records, const vdsh_cpca *model)
                          .cpca = *model};
 }
 
+/* For the Python reader's test: DIR/NAME.vdsh (the file's bytes) and
+ * DIR/NAME.f32 (stream r's C decode, ROWS x NC floats). */
+static void write_for_python(const char *dir, const char *name, const void *mem, size_t size,
+                             const vdsh_stream *r)
+{
+    char p[4096];
+    snprintf(p, sizeof p, "%s/%s.vdsh", dir, name);
+    FILE *o = fopen(p, "wb");
+    CHECK(o && fwrite(mem, 1, size, o) == size, "cannot write %s", p);
+    if (o)
+        fclose(o);
+    snprintf(p, sizeof p, "%s/%s.f32", dir, name);
+    o = fopen(p, "wb");
+    for (uint32_t v = 0; o && v < ROWS; v++) {
+        float c[VDSH_MAX_COEFFS];
+        vdsh_stream_decode(r, v, c);
+        CHECK(fwrite(c, 4, NC, o) == NC, "cannot write %s", p);
+    }
+    CHECK(o != NULL, "cannot write %s", p);
+    if (o)
+        fclose(o);
+}
+
 static double rms_vs(const vdsh_stream *s, const float *want)
 {
     float c[VDSH_MAX_COEFFS];
@@ -516,24 +539,8 @@ static void widths_stream(const vdsh_cpca_fit *fit, const char *out_dir)
                 exact &= q[j] == lv[v][j];
         }
         CHECK(exact, "widths: decode is not mean + sum of level x step_j x basis in f32");
-        if (out_dir) { /* for the Python reader's test */
-            char p[4096];
-            snprintf(p, sizeof p, "%s/cpca-widths.vdsh", out_dir);
-            FILE *o = fopen(p, "wb");
-            CHECK(o && fwrite(mem, 1, size, o) == size, "cannot write %s", p);
-            if (o)
-                fclose(o);
-            snprintf(p, sizeof p, "%s/cpca-widths.f32", out_dir);
-            o = fopen(p, "wb");
-            for (uint32_t v = 0; o && v < ROWS; v++) {
-                float c[VDSH_MAX_COEFFS];
-                vdsh_stream_decode(r, v, c);
-                CHECK(fwrite(c, 4, NC, o) == NC, "cannot write %s", p);
-            }
-            CHECK(o != NULL, "cannot write %s", p);
-            if (o)
-                fclose(o);
-        }
+        if (out_dir) /* for the Python reader's test */
+            write_for_python(out_dir, "cpca-widths", mem, size, r);
     }
     vdsh_free(back);
     if (mem) { /* widths table at payload 64, scales from 80 */
@@ -721,24 +728,8 @@ static void s8_bases(const char *dir)
         wr32(b4, VDSH_CPCA_BASES_S8 | 0x200u);
         expect_refused(g, size, 56, b4, 4, "bits 512");
     }
-    if (dir && back) { /* for the Python reader's test */
-        char path[4096];
-        snprintf(path, sizeof path, "%s/cpca-s8.vdsh", dir);
-        FILE *o = fopen(path, "wb");
-        CHECK(o && fwrite(mem, 1, size, o) == size, "cannot write %s", path);
-        if (o)
-            fclose(o);
-        snprintf(path, sizeof path, "%s/cpca-s8.f32", dir);
-        o = fopen(path, "wb");
-        float c[NC];
-        for (uint32_t v = 0; o && v < ROWS; v++) {
-            vdsh_stream_decode(&back->streams[0], v, c);
-            fwrite(c, 4, NC, o);
-        }
-        CHECK(o != NULL, "cannot write %s", path);
-        if (o)
-            fclose(o);
-    }
+    if (dir && back) /* for the Python reader's test */
+        write_for_python(dir, "cpca-s8", mem, size, &back->streams[0]);
     printf("s8 bases, alloc:16 at K 3: %u vectors, %u words, %.2f bytes per vertex, rms error "
            "%.4f (f16: %u vectors, %u words, %.4f)\n",
            m->basis, m->record_words, (double)bytes / ROWS, a.rms_error, h.model.basis,
@@ -1237,23 +1228,8 @@ int main(int argc, char **argv)
         CHECK(fabs(z.mean_bytes - (8.0 + (double)vdsh_cpca_model_bytes(ORDER, K, B, 0) / ROWS)) <
                   1e-9,
               "mean bytes %g", z.mean_bytes);
-        if (argc > 1) { /* for the Python reader's test */
-            char p[4096];
-            snprintf(p, sizeof p, "%s/cpca.vdsh", argv[1]);
-            FILE *o = fopen(p, "wb");
-            CHECK(o && fwrite(mem, 1, size, o) == size, "cannot write %s", p);
-            if (o)
-                fclose(o);
-            snprintf(p, sizeof p, "%s/cpca.f32", argv[1]);
-            o = fopen(p, "wb");
-            for (uint32_t v = 0; o && v < ROWS; v++) {
-                vdsh_stream_decode(r, v, c);
-                fwrite(c, 4, NC, o);
-            }
-            CHECK(o != NULL, "cannot write %s", p);
-            if (o)
-                fclose(o);
-        }
+        if (argc > 1) /* for the Python reader's test */
+            write_for_python(argv[1], "cpca", mem, size, r);
     }
     vdsh_free(back);
     widths_stream(&fit, argc > 1 ? argv[1] : NULL);
