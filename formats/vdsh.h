@@ -239,7 +239,7 @@ typedef struct vdsh_cpca {
     uint32_t clusters; /* K, 1..VDSH_CPCA_MAX_CLUSTERS */
     uint32_t basis;    /* B, 1..order^2 */
     uint32_t bits;     /* per weight, VDSH_CPCA_MIN_BITS..VDSH_CPCA_MAX_BITS, or 0:
-                              a width per basis vector (widths) */
+                          a width per basis vector (widths) */
     /* 1: the bases are s8 (bases8, -127..127, the value the integer; the
      * header's bits word has VDSH_CPCA_BASES_S8 set), 0: f16 (bases) */
     uint32_t bases_s8;

@@ -2222,12 +2222,14 @@ typedef struct refit_ctx {
 /* The n values x of one basis vector as the stream stores them, into out
  * (each exactly an f16, or with s8 an integer -127..127: x over its
  * largest |value|, times 127, rounded as weights are); 0 when a value does
- * not fit f16. With s8 *gain is the vector's step, what the integers are
- * multiplied by to give x (0 for a vector of zeros); else 1. */
+ * not fit f16. *gain (gain may be NULL): with s8 the vector's step, what
+ * the integers are multiplied by to give x (0 for a vector of zeros);
+ * else 1. */
 static int round_basis(const double *x, uint32_t n, uint32_t s8, float *out, double *gain)
 {
     if (!s8) {
-        *gain = 1.0;
+        if (gain)
+            *gain = 1.0;
         for (uint32_t a = 0; a < n; a++) {
             uint16_t h = vdsh_f16_from_f32((float)x[a]);
             if ((h & 0x7c00u) == 0x7c00u)
@@ -2241,7 +2243,8 @@ static int round_basis(const double *x, uint32_t n, uint32_t s8, float *out, dou
         big = fabs(x[a]) > big ? fabs(x[a]) : big;
     for (uint32_t a = 0; a < n; a++)
         out[a] = (float)quantise(x[a], big, 127);
-    *gain = big / 127.0;
+    if (gain)
+        *gain = big / 127.0;
     return 1;
 }
 
@@ -2365,12 +2368,12 @@ static int refit_round(refit_ctx *rc, const uint16_t *mean, const float *basis, 
     }
     for (uint32_t q = 0; q < kb; q++) {
         float *nq = rc->nbase + (size_t)q * n;
-        double col[VDSH_MAX_COEFFS], gain;
+        double col[VDSH_MAX_COEFFS];
         for (uint32_t a = 0; a < n; a++)
             col[a] = rc->cx[(size_t)a * m + q + 1];
         if (unused[q + 1])
             memcpy(nq, basis + (size_t)q * n, sizeof(float) * n);
-        else if (!round_basis(col, n, rc->s8, nq, &gain))
+        else if (!round_basis(col, n, rc->s8, nq, NULL))
             return 0;
         for (uint32_t a = 0; a < n; a++)
             rc->bd[(size_t)q * n + a] = nq[a];
@@ -2683,10 +2686,12 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
         /* the rows' weights on the kept vectors, the kept bases' stored values */
         double *kw = malloc(sizeof(double) * rows * kb + 1);
         float *bv = malloc(sizeof(float) * k * kb * n + 1);
-        if (!block || !kw || !bv) {
+        double *gain = s8 ? malloc(sizeof(double) * k * kb + 1) : NULL; /* s8: each vector's step */
+        if (!block || !kw || !bv || (s8 && !gain)) {
             free(block);
             free(kw);
             free(bv);
+            free(gain);
             res = vdsh_failf(err, kb ? VDSH_ERR_OUT_OF_MEMORY : VDSH_ERR_ARGUMENT,
                              kb ? "cpca: out of memory" : "cpca: alloc kept no basis vector");
             goto done;
@@ -2707,21 +2712,22 @@ static vdsh_result encode_widths(const float *src, const float *normals, uint32_
         for (uint32_t v = 0; v < rows; v++)
             for (uint32_t q = 0; q < kb; q++)
                 kw[(size_t)v * kb + q] = wts[(size_t)v * bf + keep[q]];
-        if (s8) /* each vector to s8, its step moved into its weights and scale */
-            for (uint32_t c = 0; c < k; c++)
-                for (uint32_t q = 0; q < kb; q++) {
-                    float *bq = bv + ((size_t)c * kb + q) * n;
-                    double x[VDSH_MAX_COEFFS], gain;
-                    for (uint32_t a = 0; a < n; a++)
-                        x[a] = bq[a];
-                    round_basis(x, n, 1, bq, &gain);
-                    sc_out[(size_t)c * kb + q] = (float)(sc_out[(size_t)c * kb + q] * gain);
-                    for (uint32_t v = 0; v < rows; v++)
-                        if (labels[v] == c)
-                            kw[(size_t)v * kb + q] *= gain;
-                }
+        if (s8) { /* each vector to s8, its step (gain) moved into its scale and weights */
+            for (size_t x = 0; x < (size_t)k * kb; x++) {
+                float *bq = bv + x * n;
+                double xs[VDSH_MAX_COEFFS];
+                for (uint32_t a = 0; a < n; a++)
+                    xs[a] = bq[a];
+                round_basis(xs, n, 1, bq, &gain[x]);
+                sc_out[x] = (float)(sc_out[x] * gain[x]);
+            }
+            for (uint32_t v = 0; v < rows; v++)
+                for (uint32_t q = 0; q < kb; q++)
+                    kw[(size_t)v * kb + q] *= gain[(size_t)labels[v] * kb + q];
+        }
         if (rep)
             memset(rep, 0, sizeof *rep);
+        free(gain);
         if (refit) {
             double e0, e1;
             uint32_t nk;

@@ -318,6 +318,18 @@ static void write_for_python(const char *dir, const char *name, const void *mem,
         fclose(o);
 }
 
+/* Whether two fits (of ROWS rows, order ORDER) are the same stream: the
+ * same K, B, bits, bases and record words, and the same bytes, model
+ * (widths table, scales, means, bases) and records. */
+static int same_fit(const vdsh_cpca_fit *a, const vdsh_cpca_fit *b)
+{
+    const vdsh_cpca *x = &a->model, *y = &b->model;
+    return x->clusters == y->clusters && x->basis == y->basis && x->bits == y->bits &&
+           x->bases_s8 == y->bases_s8 && x->record_words == y->record_words &&
+           !memcmp(a->storage_, b->storage_, (size_t)vdsh_cpca_stream_model_bytes(x, ORDER) - 16) &&
+           !memcmp(a->records, b->records, (size_t)ROWS * 4 * x->record_words);
+}
+
 static double rms_vs(const vdsh_stream *s, const float *want)
 {
     float c[VDSH_MAX_COEFFS];
@@ -358,11 +370,7 @@ static void auto_settings(void)
         more.basis++;
         CHECK(m->basis == NC || fit_bytes(&more, ROWS, ORDER) > (uint64_t)budgets[i] * ROWS,
               "auto:%u: B %u not the largest that fits", budgets[i], m->basis);
-        uint64_t model = vdsh_cpca_model_bytes(ORDER, m->clusters, m->basis, 0) - 16;
-        CHECK(b.model.clusters == m->clusters && b.model.basis == m->basis &&
-                  memcmp(a.storage_, b.storage_, (size_t)model) == 0 &&
-                  memcmp(a.records, b.records, (size_t)ROWS * 4 * m->record_words) == 0,
-              "auto:%u: other bytes the second time", budgets[i]);
+        CHECK(same_fit(&a, &b), "auto:%u: other bytes the second time", budgets[i]);
         printf("auto:%u: %u,%u,%u, %.2f bytes per vertex, rms error %.4f\n", budgets[i],
                m->clusters, m->basis, m->bits, (double)bytes / ROWS, a.rms_error);
         vdsh_cpca_fit_free(&a);
@@ -592,10 +600,7 @@ static void alloc_settings(void)
         ok = m->widths[j] >= 2 && m->widths[j] <= 8;
     CHECK(ok, "alloc: model %u,%u,%u, W %u", m->clusters, m->basis, m->bits, m->record_words);
     CHECK(bytes <= 16u * ROWS, "alloc: %.2f bytes per vertex over 16", (double)bytes / ROWS);
-    size_t all = (size_t)vdsh_cpca_stream_model_bytes(m, ORDER) - 16;
-    CHECK(b.model.basis == m->basis && memcmp(a.storage_, b.storage_, all) == 0 &&
-              memcmp(a.records, b.records, (size_t)ROWS * 4 * m->record_words) == 0,
-          "alloc: other bytes the second time");
+    CHECK(same_fit(&a, &b), "alloc: other bytes the second time");
     CHECK(fabs(rms_vs(&s, src) - a.rms_error) <= 1e-9 * (1 + a.rms_error), "alloc: rms %g vs %g",
           a.rms_error, rms_vs(&s, src));
     vdsh_file f = file_of(&s);
@@ -686,17 +691,14 @@ static void s8_bases(const char *dir)
         reach &= big == 0 || big == 127;
     }
     CHECK(reach, "s8: a vector whose largest |value| is not 127");
-    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &b, &err) == VDSH_OK &&
-              !memcmp(a.storage_, b.storage_, model - 16) &&
-              !memcmp(a.records, b.records, (size_t)ROWS * 4 * m->record_words),
+    CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &b, &err) == VDSH_OK && same_fit(&a, &b),
           "s8: other bytes the second time");
     vdsh_cpca_fit_free(&b);
     for (uint32_t t = 1; t <= 3; t += 2) {
         vdsh_cpca_settings ts = st;
         ts.threads = t;
         CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &ts, &b, &err) == VDSH_OK &&
-                  !memcmp(a.storage_, b.storage_, model - 16) &&
-                  !memcmp(a.records, b.records, (size_t)ROWS * 4 * m->record_words),
+                  same_fit(&a, &b),
               "s8: other bytes on %u thread%s", t, vdsh_s(t));
         vdsh_cpca_fit_free(&b);
     }
@@ -738,15 +740,6 @@ static void s8_bases(const char *dir)
     free(mem);
     vdsh_cpca_fit_free(&a);
     vdsh_cpca_fit_free(&h);
-}
-
-/* Whether two fits of K, B, BITS are the same bytes (model and records). */
-static int same_fit(const vdsh_cpca_fit *a, const vdsh_cpca_fit *b)
-{
-    size_t mb = (size_t)vdsh_cpca_model_bytes(ORDER, K, B, 0) - 16;
-    return a->model.record_words == b->model.record_words &&
-           memcmp(a->storage_, b->storage_, mb) == 0 &&
-           memcmp(a->records, b->records, (size_t)ROWS * 4 * a->model.record_words) == 0;
 }
 
 /* The light-density metric (settings light_mix and the pool): a mix of 0,
@@ -815,13 +808,7 @@ static void light_metric(void)
                   same_fit(&f, &h),
               "mix 1, a cache of %zu texels: not the uncapped bytes (%s)", cap, err.msg);
         CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &ca, &ha, &err) == VDSH_OK &&
-                  ha.model.clusters == fa.model.clusters && ha.model.basis == fa.model.basis &&
-                  ha.model.record_words == fa.model.record_words &&
-                  ha.model.bits == fa.model.bits &&
-                  (fa.model.bits || !memcmp(ha.model.widths, fa.model.widths, fa.model.basis)) &&
-                  !memcmp(ha.records, fa.records, (size_t)ROWS * 4 * fa.model.record_words) &&
-                  !memcmp(ha.storage_, fa.storage_,
-                          (size_t)vdsh_cpca_stream_model_bytes(&fa.model, ORDER) - 16),
+                  same_fit(&ha, &fa),
               "mix 1, alloc:48, a cache of %zu texels: not the uncapped bytes (%s)", cap, err.msg);
         vdsh_cpca_fit_free(&h);
         vdsh_cpca_fit_free(&ha);
@@ -846,11 +833,7 @@ static void light_metric(void)
         c.threads = 3;
         vdsh_cpca_fit h;
         CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &c, &h, &err) == VDSH_OK &&
-                  h.model.record_words == fm.model.record_words &&
-                  h.model.basis == fm.model.basis &&
-                  !memcmp(h.records, fm.records, (size_t)ROWS * 4 * fm.model.record_words) &&
-                  !memcmp(h.storage_, fm.storage_,
-                          (size_t)vdsh_cpca_stream_model_bytes(&fm.model, ORDER) - 16),
+                  same_fit(&h, &fm),
               "margin 0.25, 3 starts, 3 threads, a cache of %zu texels: not 1 thread's bytes (%s)",
               cap, err.msg);
         vdsh_cpca_fit_free(&h);
@@ -877,12 +860,7 @@ static void light_metric(void)
             const vdsh_cpca_fit *want = runs[i].starts == 1 ? &f1 : &fm;
             vdsh_cpca_fit h;
             CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &c, &h, &err) == VDSH_OK &&
-                      h.model.record_words == want->model.record_words &&
-                      h.model.basis == want->model.basis &&
-                      !memcmp(h.records, want->records,
-                              (size_t)ROWS * 4 * want->model.record_words) &&
-                      !memcmp(h.storage_, want->storage_,
-                              (size_t)vdsh_cpca_stream_model_bytes(&want->model, ORDER) - 16),
+                      same_fit(&h, want),
                   "margin 0.25, %u start%s on %u threads, a cache of %zu texels: not 1 "
                   "thread's bytes (%s)",
                   runs[i].starts, vdsh_s(runs[i].starts), runs[i].threads, runs[i].cap, err.msg);
@@ -1142,19 +1120,14 @@ int main(int argc, char **argv)
           fit.model.record_words);
     /* determinism: the same bytes again */
     CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &st, &again, &err) == VDSH_OK, "encode 2");
-    size_t mb = (size_t)vdsh_cpca_model_bytes(ORDER, K, B, 0) - 16;
-    CHECK(memcmp(fit.storage_, again.storage_, mb) == 0 &&
-              memcmp(fit.records, again.records, (size_t)ROWS * 4 * fit.model.record_words) == 0,
-          "two encodings of the same input differ");
+    CHECK(same_fit(&fit, &again), "two encodings of the same input differ");
     vdsh_cpca_fit_free(&again);
     /* the same bytes on 1 and 4 threads (the uniform metric) */
     for (uint32_t t = 1; t <= 4; t += 3) {
         vdsh_cpca_settings ts = st;
         ts.threads = t;
         CHECK(vdsh_cpca_encode(src, normals, ROWS, ORDER, &ts, &again, &err) == VDSH_OK &&
-                  memcmp(fit.storage_, again.storage_, mb) == 0 &&
-                  memcmp(fit.records, again.records, (size_t)ROWS * 4 * fit.model.record_words) ==
-                      0,
+                  same_fit(&fit, &again),
               "the encoding on %u thread%s differs", t, vdsh_s(t));
         vdsh_cpca_fit_free(&again);
     }

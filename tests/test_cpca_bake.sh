@@ -32,18 +32,18 @@ says_any "vdsh-info shows the model" "cpca: 4 clusters, 20 basis vectors of 4-bi
 expect_exit 0 "vdsh-info on a part" "$info" "$tmp/n3/p1.vdsh"
 says_any "vdsh-info shows a part's settings" "cpca 4,20,4,light:"
 
-# same_bytes WHAT P SETTING: the tiny bake with --cpca SETTING on 1 and 2
-# threads ($tmp/${P}1.vdsh, ${P}2) and as 3 shards merged ($tmp/${P}3/),
-# byte for byte the same.
+# same_bytes WHAT P BAKE_ARGS...: the bake on 1 and 2 threads
+# ($tmp/${P}1.vdsh, ${P}2) and as 3 shards merged ($tmp/${P}3/), byte for
+# byte the same.
 same_bytes() {
-  local what=$1 p=$2 set=(--encoding cpca --cpca "$3")
-  expect_exit 0 "$what, 1 thread" "$bake" "${tiny[@]}" "${set[@]}" --threads 1 -o "$tmp/${p}1.vdsh"
-  expect_exit 0 "$what, 2 threads" "$bake" "${tiny[@]}" "${set[@]}" --threads 2 -o "$tmp/${p}2.vdsh"
+  local what=$1 p=$2
+  shift 2
+  expect_exit 0 "$what, 1 thread" "$bake" "$@" --threads 1 -o "$tmp/${p}1.vdsh"
+  expect_exit 0 "$what, 2 threads" "$bake" "$@" --threads 2 -o "$tmp/${p}2.vdsh"
   check "$what, 1 and 2 threads: identical" cmp "$tmp/${p}1.vdsh" "$tmp/${p}2.vdsh"
   mkdir -p "$tmp/${p}3"
   for i in 0 1 2; do
-    expect_exit 0 "$what shard $i/3" "$bake" "${tiny[@]}" "${set[@]}" --shard "$i/3" \
-      -o "$tmp/${p}3/p$i.vdsh"
+    expect_exit 0 "$what shard $i/3" "$bake" "$@" --shard "$i/3" -o "$tmp/${p}3/p$i.vdsh"
   done
   expect_exit 0 "$what merge" "$merge" -q "$tmp/${p}3"/p*.vdsh -o "$tmp/${p}3/scene.vdsh"
   check "$what, 3 shards: identical to the whole bake" cmp "$tmp/${p}3/scene.vdsh" "$tmp/${p}1.vdsh"
@@ -52,7 +52,7 @@ same_bytes() {
 # A width per basis vector (--cpca K,alloc:BYTES): whole bake = 2 threads
 # = 3 shards merged, byte for byte; vdsh-info shows the widths and a
 # part's settings.
-same_bytes "alloc cpca" c 4,alloc:40
+same_bytes "alloc cpca" c "${tiny[@]}" --encoding cpca --cpca 4,alloc:40
 expect_exit 0 "vdsh-info, alloc" "$info" "$tmp/c1.vdsh"
 says_any "vdsh-info shows per-vector weights" "basis vectors of per-vector weights"
 says_any "vdsh-info shows the widths" "widths: "
@@ -73,7 +73,7 @@ assert c["bits"] == 0 and len(c["widths"]) == c["basis"] and 2 <= min(c["widths"
 # the merge refuses an f16 part beside an s8 one; vdsh-info says s8; the
 # bytes freed go to the records (more vectors or words than f16's at the
 # same budget, within it).
-same_bytes "s8 bases" s 4,alloc:40,bases:8
+same_bytes "s8 bases" s "${tiny[@]}" --encoding cpca --cpca 4,alloc:40,bases:8
 expect_exit 1 "merge of an s8 part with f16 parts" "$merge" -q "$tmp/s3/p0.vdsh" "$tmp/c3/p1.vdsh" \
   "$tmp/c3/p2.vdsh" -o "$tmp/s3/mixed.vdsh"
 says_any "the mixed merge names the setting" "another --cpca"
@@ -157,16 +157,7 @@ PY
 # adaptive stream's shards.
 ad=(builtin:room --max-edge 1.0 --rays 64 --cube-size 0 -q --adaptive-order 0.02 --max-order 7
   --method shadow)
-expect_exit 0 "adaptive cpca, 1 thread" "$bake" "${ad[@]}" "${cp[@]}" --threads 1 -o "$tmp/a1.vdsh"
-expect_exit 0 "adaptive cpca, 2 threads" "$bake" "${ad[@]}" "${cp[@]}" --threads 2 -o "$tmp/a2.vdsh"
-check "adaptive cpca, 1 and 2 threads: identical" cmp "$tmp/a1.vdsh" "$tmp/a2.vdsh"
-mkdir -p "$tmp/a3"
-for i in 0 1 2; do
-  expect_exit 0 "adaptive cpca shard $i/3" "$bake" "${ad[@]}" "${cp[@]}" --shard "$i/3" \
-    -o "$tmp/a3/p$i.vdsh"
-done
-expect_exit 0 "adaptive cpca merge" "$merge" -q "$tmp"/a3/p*.vdsh -o "$tmp/a3/scene.vdsh"
-check "adaptive cpca, 3 shards: identical to the whole bake" cmp "$tmp/a3/scene.vdsh" "$tmp/a1.vdsh"
+same_bytes "adaptive cpca" a "${ad[@]}" "${cp[@]}"
 expect_exit 0 "adaptive f32" "$bake" "${ad[@]}" --encoding f32 -o "$tmp/af32.vdsh"
 expect_exit 0 "adaptive, full basis" "$bake" "${ad[@]}" --encoding cpca --cpca 2,49,8 \
   -o "$tmp/afull.vdsh"
