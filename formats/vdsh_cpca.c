@@ -201,7 +201,7 @@ vdsh_result vdsh_cpca_parse(const char *text, vdsh_cpca_settings *out, vdsh_erro
                               "cpca settings '%s': '%s': expected options at the end, each "
                               "once: light:A (the light mix, 0..1), margin:S (S > 0, at most 1e6), "
                               "starts:N (1..%d) or bases:8|16 (the bases' bits) (for example "
-                              "16,alloc:32,margin:0.25,starts:2)",
+                              "16,alloc:32,margin:0.25,starts:3)",
                               p, tok, VDSH_CPCA_MAX_STARTS);
         said[o] = 1;
         tok = next;
@@ -1884,12 +1884,13 @@ static vdsh_result encode_auto(const float *src, const float *normals, uint32_t 
     return VDSH_OK;
 }
 
-/* The starts' workers (encode_starts): worker w fits the starts w,
- * w + workers, ... with a view of the shared light texels of its own. */
+/* The starts' workers (encode_starts): in each batch worker w fits one
+ * start, index, on threads threads, with a view of the shared light
+ * texels of its own. */
 typedef struct start_worker {
     const float *src, *normals;
-    uint32_t rows, order, refit, index, workers;
-    uint32_t threads; /* each start's fit's (fit_ctx) */
+    uint32_t rows, order, refit, index;
+    uint32_t threads; /* the start's fit's (fit_ctx) */
     const vdsh_cpca_settings *settings;
     lightmix view;
     vdsh_cpca_fit *fits;
@@ -1900,19 +1901,21 @@ typedef struct start_worker {
 static void *start_worker_run(void *arg)
 {
     start_worker *w = arg;
-    for (uint32_t i = w->index; i < w->settings->starts; i += w->workers) {
-        vdsh_cpca_settings st = *w->settings;
-        st.start = w->settings->start + i;
-        st.threads = w->threads;
-        w->res[i] = encode_alloc(w->src, w->normals, w->rows, w->order, &st, w->refit, &w->view,
-                                 NULL, &w->fits[i], &w->errs[i]);
-    }
+    const uint32_t i = w->index;
+    vdsh_cpca_settings st = *w->settings;
+    st.start = w->settings->start + i;
+    st.threads = w->threads;
+    w->res[i] = encode_alloc(w->src, w->normals, w->rows, w->order, &st, w->refit, &w->view, NULL,
+                             &w->fits[i], &w->errs[i]);
     return NULL;
 }
 
 /* K,alloc:BYTES from settings->starts k-means starts (vdsh_cpca.h): the
- * fits start, start + 1, ... (on up to settings->threads threads, each
- * start's bytes its own whatever the thread), all scored in one pass over
+ * fits start, start + 1, ... (on up to settings->threads threads C, in
+ * batches of up to C starts at once, each on C / starts-in-the-batch
+ * threads: three starts on two cores fit two on a thread each, then the
+ * third on both; each start's bytes its own whatever its threads), all
+ * scored in one pass over
  * the settings' pool (vdsh_cpca_pool_score_streams: each pair's SH
  * evaluated once for every start), the fit with the fewest decisions
  * differing from src's kept (the first on a tie). The rows' light texels
@@ -1941,17 +1944,20 @@ static vdsh_result encode_starts(const float *src, const float *normals, uint32_
                                  .rows = rows,
                                  .order = order,
                                  .refit = refit,
-                                 .index = w,
-                                 .workers = workers,
-                                 .threads = cpus / workers,
                                  .settings = settings,
                                  .fits = fits,
                                  .res = res,
                                  .errs = errs};
         ok = ok && lightmix_view(&shared, &work[w].view);
     }
-    if (ok)
-        run_workers(work, sizeof *work, workers, start_worker_run);
+    for (uint32_t first = 0, batch; ok && first < count; first += batch) {
+        batch = count - first < workers ? count - first : workers;
+        for (uint32_t w = 0; w < batch; w++) {
+            work[w].index = first + w;
+            work[w].threads = cpus / batch;
+        }
+        run_workers(work, sizeof *work, batch, start_worker_run);
+    }
     for (uint32_t w = 0; work && w < workers; w++)
         lightmix_free(&work[w].view);
     free(work);

@@ -129,10 +129,17 @@ typedef struct vdsh_cpca_settings {
  * two against four, none decidedly worse; 1.2-1.8x the bake's wall time
  * on two cores (fandisk at 12,190 receivers to the room at 58,007; the
  * second start on the other core), 1.8-2.7x its CPU time, 2x its memory
- * (docs/BENCHMARKS.md). A base said (16,alloc:32) has neither unless
- * said. */
+ * (docs/BENCHMARKS.md). Three starts since "A third start" (docs/
+ * ACCURACY.md, 2026-12-03): with s8 bases over the same fifteen bakes
+ * within 3% on all fifteen against fourteen (the spider +2.70% against
+ * +3.20%), mean +1.00% against +1.09%, one decidedly better and one
+ * decidedly worse (the sphere with a hole, which stays below uncompressed
+ * order 12); the third start's fit runs on both cores of two
+ * (encode_starts' batches): 1.36-1.46x the bake's wall time of two starts
+ * (docs/BENCHMARKS.md "The default's third start"). A base said
+ * (16,alloc:32) has neither unless said. */
 #define VDSH_CPCA_DEFAULT_MARGIN 0.25f
-#define VDSH_CPCA_DEFAULT_STARTS 2
+#define VDSH_CPCA_DEFAULT_STARTS 3
 /* The default's bases are s8 (--cpca ...,bases:8; the options alone too,
  * a base said is f16 unless said): docs/ACCURACY.md "Bases in 8 bits"
  * (fifteen validation bakes, at the same budget). */
@@ -141,7 +148,7 @@ typedef struct vdsh_cpca_settings {
 /* K,alloc:BYTES with K = VDSH_CPCA_DEFAULT_CLUSTERS (16) and BYTES =
  * VDSH_CPCA_DEFAULT_BUDGET (32), light mix VDSH_CPCA_DEFAULT_LIGHT_MIX,
  * margin VDSH_CPCA_DEFAULT_MARGIN, VDSH_CPCA_DEFAULT_STARTS starts and s8
- * bases, no pool: 16,alloc:32,margin:0.25,starts:2,bases:8 (K and BYTES:
+ * bases, no pool: 16,alloc:32,margin:0.25,starts:3,bases:8 (K and BYTES:
  * docs/ACCURACY.md "The default of --encoding cpca": over sixteen
  * validation bakes +1.68% over uncompressed order 12, within 3% on 14,
  * against 8,alloc:32's +2.05% and 11; 8,54,4, the default before, passed
@@ -155,7 +162,7 @@ vdsh_cpca_settings vdsh_cpca_settings_default(void);
 
 /* s as the text vdsh_cpca_parse reads back (the pool aside): "K,B,BITS",
  * "auto:BYTES" or "K,alloc:BYTES", then ",light:A", and ",margin:S" and
- * ",starts:N" when set (16,alloc:32,light:1,margin:0.25,starts:2), into
+ * ",starts:N" when set (16,alloc:32,light:1,margin:0.25,starts:3), into
  * buf (truncated to size). vdsh-bake's and vdsh-info's words for a fit. */
 void vdsh_cpca_settings_text(const vdsh_cpca_settings *s, char *buf, size_t size);
 

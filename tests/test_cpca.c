@@ -913,7 +913,7 @@ static void light_metric(void)
     /* the default: K,alloc:BYTES (16,alloc:32) with the default light mix,
      * margin and starts (docs/ACCURACY.md "The default of --encoding cpca",
      * "The margin and two starts become the default"), what the text
-     * "16,alloc:32,margin:0.25,starts:2,bases:8" gives; the base said alone
+     * "16,alloc:32,margin:0.25,starts:3,bases:8" gives; the base said alone
      * has neither margin nor starts and f16 bases; an option alone keeps
      * the default's others */
     CHECK(d.clusters == VDSH_CPCA_DEFAULT_CLUSTERS && d.budget == VDSH_CPCA_DEFAULT_BUDGET &&
@@ -952,7 +952,7 @@ static void light_metric(void)
         char text[192], small[8];
         vdsh_cpca_settings_text(&d, text, sizeof text);
         vdsh_cpca_settings_text(&d, small, sizeof small);
-        CHECK(!strcmp(text, "16,alloc:32,light:1,margin:0.25,starts:2,bases:8") &&
+        CHECK(!strcmp(text, "16,alloc:32,light:1,margin:0.25,starts:3,bases:8") &&
                   !strcmp(small, "16,allo"),
               "the default's text %s (truncated: %s)", text, small);
     }

@@ -6,7 +6,7 @@
 # within f16 and quantisation rounding; with the default-like settings
 # well below the coefficients' spread); --adaptive-order's stream, as a
 # fixed cpca stream of its cap, is alike (threads, shards, decode error);
-# the default settings (16,alloc:32,margin:0.25,starts:2,bases:8, light:1) alike; bad settings are
+# the default settings (16,alloc:32,margin:0.25,starts:3,bases:8, light:1) alike; bad settings are
 # usage errors and parts of other settings are refused by the merge.
 # Usage: test_cpca_bake.sh VDSH_BAKE VDSH_MERGE VDSH_INFO SOURCE_DIR
 set -u
@@ -98,18 +98,18 @@ for a, b in zip(f16.streams, s8.streams):
 ' "$src/python" "$tmp/c1.vdsh" "$tmp/s1.vdsh" "$tmp/s3/p1.vdsh"
 
 # The default (--encoding cpca without --cpca: 16,alloc:32,margin:0.25,
-# starts:2 with the light pool, which parts carry in lpol): whole bake =
+# starts:3 with the light pool, which parts carry in lpol): whole bake =
 # 2 threads = 5 threads = 3 shards merged (on every core and on --threads 1), byte
 # for byte; vdsh-merge --threads 0 is a usage error; a part names the
 # default's settings.
 expect_exit 0 "default cpca, 1 thread" "$bake" "${tiny[@]}" --encoding cpca --threads 1 -o "$tmp/d1.vdsh"
 expect_exit 0 "default cpca, 2 threads" "$bake" "${tiny[@]}" --encoding cpca --threads 2 -o "$tmp/d2.vdsh"
-check "default cpca, 1 and 2 threads: identical" cmp "$tmp/d1.vdsh" "$tmp/d2.vdsh"
+check "default cpca, 1 and 2 threads (two starts on a thread each, the third on two): identical" cmp "$tmp/d1.vdsh" "$tmp/d2.vdsh"
 expect_exit 0 "default cpca, 5 threads" "$bake" builtin:room --max-edge 1.0 --rays 64 \
   --cube-size 0 --orders 3,7 --encoding cpca --threads 5 -o "$tmp/d5.vdsh"
-check "default cpca, 1 and 5 threads (each start's fit on 2): identical" cmp "$tmp/d1.vdsh" "$tmp/d5.vdsh"
+check "default cpca, 1 and 5 threads (the three starts at once): identical" cmp "$tmp/d1.vdsh" "$tmp/d5.vdsh"
 # the encode, most of a high order's bake, is said before and after
-says_any "the cpca fit announced" "cpca: fitting 16,alloc:32,light:1,margin:0.25,starts:2,bases:8 over"
+says_any "the cpca fit announced" "cpca: fitting 16,alloc:32,light:1,margin:0.25,starts:3,bases:8 over"
 says_any "the cpca fit's time" "cpca: fitted in"
 mkdir -p "$tmp/d3"
 for i in 0 1 2; do
@@ -124,7 +124,7 @@ check "default cpca, 3 shards merged on 1 thread: identical" cmp "$tmp/d3/scene1
 expect_exit 2 "vdsh-merge --threads 0" "$merge" -q --threads 0 "$tmp"/d3/p*.vdsh -o "$tmp/d3/t0.vdsh"
 check "vdsh-merge --threads 0: no file" test ! -e "$tmp/d3/t0.vdsh"
 expect_exit 0 "vdsh-info on a default part" "$info" "$tmp/d3/p1.vdsh"
-says_any "a default part's settings" "cpca 16,alloc:32,light:1,margin:0.25,starts:2,bases:8"
+says_any "a default part's settings" "cpca 16,alloc:32,light:1,margin:0.25,starts:3,bases:8"
 
 # Against the f32 bake of the same options.
 expect_exit 0 "f32 bake" "$bake" "${tiny[@]}" --encoding f32 -o "$tmp/f32.vdsh"

@@ -7,7 +7,7 @@ formats/vdsh_cpca.h; docs/ACCURACY.md, "A light-density metric"):
 - light:1 and light:0.5 are other fits, valid files that decode near the
   f32 bake; the default (no light:) is VDSH_CPCA_DEFAULT_LIGHT_MIX's for
   alloc, light:0's for fixed widths (8,54,4); the plain --encoding cpca is
-  --help's default settings (16,alloc:32,margin:0.25,starts:2) with
+  --help's default settings (16,alloc:32,margin:0.25,starts:3,bases:8) with
   light:1, not 16,alloc:32 said alone (one start, no margin); starts:1
   alone is the default base with its margin;
 - bad values are refused with a message naming light:A, exit 2, no file;
@@ -90,7 +90,7 @@ spread = np.sqrt(((x - x.mean(0)) ** 2).sum(1).mean())
 
 CPCA = ["--encoding", "cpca", "--cpca"]
 # the default settings, as vdsh-bake --help says them
-# (16,alloc:32,margin:0.25,starts:2,bases:8), and their base (16,alloc:32)
+# (16,alloc:32,margin:0.25,starts:3,bases:8), and their base (16,alloc:32)
 helptext = subprocess.run([bake, "--help"], capture_output=True, text=True).stdout
 DEFAULT = helptext.split("Default ")[1].split()[0]
 BASE = ",".join(DEFAULT.split(",")[:2])

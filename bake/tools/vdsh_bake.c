@@ -207,12 +207,13 @@ static void usage(FILE *f)
             "                          in 8 bits\"); a K,alloc:BYTES said has no margin,\n"
             "                          one start and f16 bases unless said.\n"
             "                          Default %u,alloc:%u,margin:%g,starts:%u%s (order\n"
-            "                          12 within 3%% of uncompressed on 14 of 15\n"
-            "                          validation bakes, mean +1.1%%; with f16 bases 13,\n"
-            "                          +1.5%%; %u,alloc:%u alone 11, +2.0%%, at half the\n"
-            "                          encode's CPU time: docs/ACCURACY.md \"Bases in 8\n"
-            "                          bits\"); options alone change the default's\n"
-            "                          (starts:1, margin:0.5, bases:16; light:0 alone: the\n"
+            "                          12 within 3%% of uncompressed on all 15\n"
+            "                          validation bakes, mean +1.0%%; two starts 14,\n"
+            "                          +1.1%%; f16 bases 13, +1.5%%; %u,alloc:%u alone 11,\n"
+            "                          +2.0%%, at a third of the encode's CPU time:\n"
+            "                          docs/ACCURACY.md \"A third start\"); options\n"
+            "                          alone change the default's (starts:2,\n"
+            "                          margin:0.5, bases:16; light:0 alone: the\n"
             "                          uniform metric, no margin, one start)\n"
             "      --shard I/N         bake shard I (0-based) of N only and write a part\n"
             "                          file; vdsh-merge joins the N parts into the file\n"
@@ -1001,7 +1002,7 @@ static int read_choice(int c, const char *arg, options *o)
                 msg, sizeof msg,
                 "--cpca takes K,B,BITS: clusters 1..256, basis vectors 1..256, bits 2..8, "
                 "or auto or auto:BYTES, or K,alloc:BYTES (a width per basis vector), bytes "
-                "per vertex 1..4096 (default 16,alloc:32,margin:0.25,starts:2,bases:8), each optionally "
+                "per vertex 1..4096 (default 16,alloc:32,margin:0.25,starts:3,bases:8), each optionally "
                 "ending in ,light:A (the light mix A in 0..1), and K,alloc:BYTES in ,margin:S "
                 "(S > 0), ,starts:N (1..16) and ,bases:8|16, or those options alone: %s",
                 e.msg);
