@@ -1915,10 +1915,10 @@ static void *start_worker_run(void *arg)
  * batches of up to C starts at once, each on C / starts-in-the-batch
  * threads: three starts on two cores fit two on a thread each, then the
  * third on both; each start's bytes its own whatever its threads), all
- * scored in one pass over
- * the settings' pool (vdsh_cpca_pool_score_streams: each pair's SH
- * evaluated once for every start), the fit with the fewest decisions
- * differing from src's kept (the first on a tie). The rows' light texels
+ * scored in one pass over the settings' pool
+ * (vdsh_cpca_pool_score_streams: each pair's SH evaluated once for every
+ * start), the fit with the fewest decisions differing from src's kept
+ * (the first on a tie). The rows' light texels
  * (and margin weights) are found once for every start. */
 static vdsh_result encode_starts(const float *src, const float *normals, uint32_t rows,
                                  uint32_t order, const vdsh_cpca_settings *settings, uint32_t refit,
