@@ -1002,10 +1002,13 @@ static int read_choice(int c, const char *arg, options *o)
                 msg, sizeof msg,
                 "--cpca takes K,B,BITS: clusters 1..256, basis vectors 1..256, bits 2..8, "
                 "or auto or auto:BYTES, or K,alloc:BYTES (a width per basis vector), bytes "
-                "per vertex 1..4096 (default 16,alloc:32,margin:0.25,starts:3,bases:8), each optionally "
-                "ending in ,light:A (the light mix A in 0..1), and K,alloc:BYTES in ,margin:S "
-                "(S > 0), ,starts:N (1..16) and ,bases:8|16, or those options alone: %s",
-                e.msg);
+                "per vertex 1..4096 (default %u,alloc:%u,margin:%g,starts:%u%s), each "
+                "optionally ending in ,light:A (the light mix A in 0..1), and K,alloc:BYTES in "
+                ",margin:S (S > 0), ,starts:N (1..%d) and ,bases:8|16, or those options alone: "
+                "%s",
+                VDSH_CPCA_DEFAULT_CLUSTERS, VDSH_CPCA_DEFAULT_BUDGET,
+                (double)VDSH_CPCA_DEFAULT_MARGIN, VDSH_CPCA_DEFAULT_STARTS,
+                VDSH_CPCA_DEFAULT_BASES_S8 ? ",bases:8" : "", VDSH_CPCA_MAX_STARTS, e.msg);
             return bad_usage("%s", msg);
         }
         o->have_cpca = 1;
