@@ -144,8 +144,18 @@ static void on_round(void *user, uint32_t round, uint32_t receivers, uint32_t ca
             round, split, candidates, receivers, seconds);
 }
 
+/* The default --cpca as --help and the --cpca usage message say it. */
+static void cpca_default_text(char *buf, size_t size)
+{
+    snprintf(buf, size, "%u,alloc:%u,margin:%g,starts:%u%s", VDSH_CPCA_DEFAULT_CLUSTERS,
+             VDSH_CPCA_DEFAULT_BUDGET, (double)VDSH_CPCA_DEFAULT_MARGIN, VDSH_CPCA_DEFAULT_STARTS,
+             VDSH_CPCA_DEFAULT_BASES_S8 ? ",bases:8" : "");
+}
+
 static void usage(FILE *f)
 {
+    char cpca_default[64];
+    cpca_default_text(cpca_default, sizeof cpca_default);
     /* The default grid's side: the defaults are square grids. */
     const unsigned rays_side = (unsigned)lround(sqrt((double)VB_DEFAULT_RAYS));
     fprintf(f,
@@ -206,7 +216,7 @@ static void usage(FILE *f)
             "                          freed go to the weights; docs/ACCURACY.md \"Bases\n"
             "                          in 8 bits\"); a K,alloc:BYTES said has no margin,\n"
             "                          one start and f16 bases unless said.\n"
-            "                          Default %u,alloc:%u,margin:%g,starts:%u%s (order\n"
+            "                          Default %s (order\n"
             "                          12 within 3%% of uncompressed on all 15\n"
             "                          validation bakes, mean +1.0%%; two starts 14,\n"
             "                          +1.1%%; f16 bases 13, +1.5%%; %u,alloc:%u alone 11,\n"
@@ -370,9 +380,7 @@ static void usage(FILE *f)
             "Exit status: 0 success, 1 error, 2 usage error.\n"
             "Example: vdsh-bake builtin:room --max-edge 0.2 -o room.vdsh\n",
             VB_DEFAULT_CUBE_SIZE, VB_SDF_MIN_RESOLUTION, VB_SDF_MAX_RESOLUTION, VDSH_MAX_ORDER,
-            (double)VDSH_CPCA_DEFAULT_LIGHT_MIX, VDSH_CPCA_DEFAULT_CLUSTERS,
-            VDSH_CPCA_DEFAULT_BUDGET, (double)VDSH_CPCA_DEFAULT_MARGIN, VDSH_CPCA_DEFAULT_STARTS,
-            VDSH_CPCA_DEFAULT_BASES_S8 ? ",bases:8" : "", VDSH_CPCA_DEFAULT_CLUSTERS,
+            (double)VDSH_CPCA_DEFAULT_LIGHT_MIX, cpca_default, VDSH_CPCA_DEFAULT_CLUSTERS,
             VDSH_CPCA_DEFAULT_BUDGET, VB_DEFAULT_RAYS, rays_side, rays_side, VB_DEFAULT_RAYS,
             (double)VB_DEFAULT_RAY_TOLERANCE, VDSH_MAX_ORDER, VB_DEFAULT_ORDER_CAP, methods_help(),
             (double)VB_DEFAULT_LAMBDA, (double)vb_shadow_log_offset(2),
@@ -997,18 +1005,17 @@ static int read_choice(int c, const char *arg, options *o)
     case O_CPCA: {
         vdsh_error e;
         if (vdsh_cpca_parse(arg, &o->cpca, &e) != VDSH_OK) {
-            char msg[sizeof e.msg + 512];
+            char msg[sizeof e.msg + 512], deflt[64];
+            cpca_default_text(deflt, sizeof deflt);
             snprintf(
                 msg, sizeof msg,
                 "--cpca takes K,B,BITS: clusters 1..256, basis vectors 1..256, bits 2..8, "
                 "or auto or auto:BYTES, or K,alloc:BYTES (a width per basis vector), bytes "
-                "per vertex 1..4096 (default %u,alloc:%u,margin:%g,starts:%u%s), each "
+                "per vertex 1..4096 (default %s), each "
                 "optionally ending in ,light:A (the light mix A in 0..1), and K,alloc:BYTES in "
                 ",margin:S (S > 0), ,starts:N (1..%d) and ,bases:8|16, or those options alone: "
                 "%s",
-                VDSH_CPCA_DEFAULT_CLUSTERS, VDSH_CPCA_DEFAULT_BUDGET,
-                (double)VDSH_CPCA_DEFAULT_MARGIN, VDSH_CPCA_DEFAULT_STARTS,
-                VDSH_CPCA_DEFAULT_BASES_S8 ? ",bases:8" : "", VDSH_CPCA_MAX_STARTS, e.msg);
+                deflt, VDSH_CPCA_MAX_STARTS, e.msg);
             return bad_usage("%s", msg);
         }
         o->have_cpca = 1;
